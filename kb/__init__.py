@@ -1,0 +1,56 @@
+"""The cbrs knowledge base: an Oxigraph store of ontologies, advertisements and requirements."""
+
+from kb.errors import (
+    AlreadyRegisteredError,
+    BindingError,
+    InvalidDescriptionError,
+    KnowledgeBaseError,
+    NotFoundError,
+    QuerySyntaxError,
+    RdfParseError,
+    StoreError,
+    UnknownFormatError,
+    UnknownGraphError,
+    UnknownQueryError,
+)
+from kb.knowledge_base import KnowledgeBase
+from kb.model import (
+    Advertisement,
+    EffectiveArea,
+    Parameter,
+    PartNode,
+    Port,
+    QoSValue,
+    Requirement,
+    ServiceDescription,
+    Statement,
+)
+from kb.namespaces import PREFIXES, GraphName
+from kb.store import Store
+
+__all__ = [
+    "PREFIXES",
+    "Advertisement",
+    "AlreadyRegisteredError",
+    "BindingError",
+    "EffectiveArea",
+    "GraphName",
+    "InvalidDescriptionError",
+    "KnowledgeBase",
+    "KnowledgeBaseError",
+    "NotFoundError",
+    "Parameter",
+    "PartNode",
+    "Port",
+    "QoSValue",
+    "QuerySyntaxError",
+    "RdfParseError",
+    "Requirement",
+    "ServiceDescription",
+    "Statement",
+    "Store",
+    "StoreError",
+    "UnknownFormatError",
+    "UnknownGraphError",
+    "UnknownQueryError",
+]

@@ -1,0 +1,113 @@
+"""Typed errors of the knowledge base. Each keeps the offending input and maps to an HTTP status."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+
+class KnowledgeBaseError(Exception):
+    """Base of every error cbrs raises on purpose; ``str(error)`` is one line fit for a person."""
+
+    http_status = 500
+
+
+class StoreError(KnowledgeBaseError):
+    """The store could not be opened or written."""
+
+    def __init__(self, location: str, reason: str) -> None:
+        self.location = location
+        self.reason = reason
+        super().__init__(f"store {location}: {reason}")
+
+
+class RdfParseError(KnowledgeBaseError):
+    """A file or text did not parse; nothing was loaded."""
+
+    http_status = 400
+
+    def __init__(self, source: str, message: str, line: int | None = None, column: int | None = None) -> None:
+        self.source = source
+        self.line = line
+        self.column = column
+        self.message = message
+        where = source if line is None else f"{source}:{line}" + (f":{column}" if column else "")
+        super().__init__(f"{where}: {message}")
+
+
+class UnknownFormatError(KnowledgeBaseError):
+    """The RDF serialisation of a file could not be told from its name or content."""
+
+    http_status = 400
+
+    def __init__(self, source: str, known: Sequence[str]) -> None:
+        self.source = source
+        super().__init__(
+            f"{source}: cannot tell the RDF format; use one of the extensions {', '.join(known)} "
+            "or pass the format explicitly"
+        )
+
+
+class UnknownGraphError(KnowledgeBaseError):
+    http_status = 400
+
+    def __init__(self, graph: str, known: Sequence[str]) -> None:
+        self.graph = graph
+        super().__init__(f"unknown graph {graph!r}; use one of {', '.join(known)} or a full graph IRI")
+
+
+class UnknownQueryError(KnowledgeBaseError):
+    http_status = 404
+
+    def __init__(self, name: str, known: Sequence[str]) -> None:
+        self.name = name
+        super().__init__(f"no named query {name!r}; known queries: {', '.join(known)}")
+
+
+class BindingError(KnowledgeBaseError):
+    """A value bound to a query variable is malformed or names a variable the query does not take."""
+
+    http_status = 400
+
+    def __init__(self, variable: str, value: object, reason: str) -> None:
+        self.variable = variable
+        self.value = value
+        super().__init__(f"binding {variable}={value!r}: {reason}")
+
+
+class QuerySyntaxError(KnowledgeBaseError):
+    http_status = 400
+
+    def __init__(self, query: str, message: str) -> None:
+        self.query = query
+        self.message = message
+        super().__init__(f"SPARQL syntax error: {message}")
+
+
+class NotFoundError(KnowledgeBaseError):
+    """No resource with this IRI is described in the store."""
+
+    http_status = 404
+
+    def __init__(self, iri: str, what: str = "resource") -> None:
+        self.iri = iri
+        self.what = what
+        super().__init__(f"no {what} <{iri}> in the store")
+
+
+class InvalidDescriptionError(KnowledgeBaseError):
+    """A service description lacks what the six-tuple requires; ``problems`` lists each gap."""
+
+    http_status = 400
+
+    def __init__(self, iri: str, problems: Sequence[str]) -> None:
+        self.iri = iri
+        self.problems = list(problems)
+        super().__init__(f"<{iri}> is not a valid service description: {'; '.join(self.problems)}")
+
+
+class AlreadyRegisteredError(KnowledgeBaseError):
+    http_status = 409
+
+    def __init__(self, iri: str) -> None:
+        self.iri = iri
+        super().__init__(f"<{iri}> is already registered; update it instead")

@@ -1,0 +1,79 @@
+"""The one object behind every cbrs command and page: a store with its queries and readers."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+
+import pyoxigraph as ox
+
+from kb.descriptions import DescriptionReader
+from kb.loader import ParsedFile, load_files, parse_file
+from kb.model import Advertisement, Requirement, ServiceDescription
+from kb.namespaces import GraphName
+from kb.queries import QueryLibrary
+from kb.registry import ComponentRegistry
+from kb.resources import bundled_files, query_dir
+from kb.store import QueryResult, Store, Term
+
+
+class KnowledgeBase:
+    """A cbrs knowledge base. ``KnowledgeBase.open(":memory:")`` gives a seeded in-memory one."""
+
+    def __init__(self, store: Store, queries: QueryLibrary | None = None) -> None:
+        self.store = store
+        self.queries = queries or QueryLibrary(query_dir())
+        self.registry = ComponentRegistry(store)
+        self._reader = DescriptionReader(store, self.queries)
+
+    @classmethod
+    def open(cls, location: str | Path, seed: bool = True) -> KnowledgeBase:
+        """Open the store at ``location`` (a directory or ``:memory:``), seeding it on first use."""
+        kb = cls(Store.open(location))
+        if seed and not kb.store.is_seeded():
+            kb.seed()
+        return kb
+
+    def seed(self) -> list[ParsedFile]:
+        """Load the bundled ontologies, advertisements and requirements in one transaction."""
+        parsed = [parse_file(item.path, item.graph) for item in bundled_files()]
+        self.store.add(quad for item in parsed for quad in item.quads)
+        self._reader.clear_cache()
+        return parsed
+
+    def load(self, paths: Sequence[str | Path], graph: str | GraphName | None = None) -> list[ParsedFile]:
+        """Load RDF files all-or-nothing (see :mod:`kb.loader`)."""
+        parsed = load_files(self.store, paths, graph)
+        self._reader.clear_cache()
+        return parsed
+
+    def query(self, text: str, bindings: Mapping[str, Term] | None = None) -> QueryResult:
+        return self.store.query(text, bindings)
+
+    def run(self, name: str, values: Mapping[str, Term | str | int | float] | None = None) -> QueryResult:
+        """Run the named query ``queries/<name>.rq`` with ``values`` bound to its parameters."""
+        return self.queries.run(self.store, name, values)
+
+    def select(self, name: str, values: Mapping[str, Term | str | int | float] | None = None) -> list[dict[str, Term]]:
+        return self.queries.select(self.store, name, values)
+
+    def description(self, iri: str) -> ServiceDescription:
+        return self._reader.read(iri)
+
+    def advertisements(self) -> list[Advertisement]:
+        return self._reader.advertisements()
+
+    def requirements(self) -> list[Requirement]:
+        return self._reader.requirements()
+
+    def statistics(self) -> dict[str, int]:
+        """Triples per named graph."""
+        return {row["graph"].value: int(row["triples"].value) for row in self.select("graph_statistics")}
+
+    def describes(self, iri: str) -> bool:
+        """Whether ``iri`` occurs in the store at all."""
+        node = ox.NamedNode(iri)
+        return any(True for _ in self.store.quads(node)) or any(True for _ in self.store.quads(None, None, node))
+
+    def close(self) -> None:
+        self.store.flush()

@@ -1,0 +1,97 @@
+"""The one prefix table that Turtle output, SPARQL queries and the browser share.
+
+Every IRI cbrs mints lives under ``BASE``.
+"""
+
+from __future__ import annotations
+
+import re
+from enum import Enum
+
+from pyoxigraph import NamedNode
+
+BASE = "https://w3id.org/cbrs/"
+
+CBRS = BASE + "core#"
+HOME = BASE + "home#"
+ACT = BASE + "action#"
+SVC = BASE + "service#"
+REQ = BASE + "requirement#"
+WORLD = BASE + "world#"
+GRAPH = BASE + "graph/"
+GENID = BASE + ".well-known/genid/"
+DUL = "http://www.ontologydesignpatterns.org/ont/dul/DUL.owl#"
+
+RDF = "http://www.w3.org/1999/02/22-rdf-syntax-ns#"
+RDFS = "http://www.w3.org/2000/01/rdf-schema#"
+OWL = "http://www.w3.org/2002/07/owl#"
+XSD = "http://www.w3.org/2001/XMLSchema#"
+
+PREFIXES: dict[str, str] = {
+    "cbrs": CBRS,
+    "home": HOME,
+    "act": ACT,
+    "svc": SVC,
+    "req": REQ,
+    "world": WORLD,
+    "graph": GRAPH,
+    "dul": DUL,
+    "rdf": RDF,
+    "rdfs": RDFS,
+    "owl": OWL,
+    "xsd": XSD,
+    "skos": "http://www.w3.org/2004/02/skos/core#",
+    "dcterms": "http://purl.org/dc/terms/",
+}
+
+
+_SCHEME = re.compile(r"[A-Za-z][A-Za-z0-9+.-]*")
+
+
+class GraphName(str, Enum):
+    """The named graphs of a cbrs store, each holding one kind of knowledge."""
+
+    ONTOLOGY = "ontology"
+    SERVICES = "services"
+    REQUIREMENTS = "requirements"
+    WORLD = "world"
+    PLANS = "plans"
+
+    @property
+    def iri(self) -> str:
+        return GRAPH + self.value
+
+    @property
+    def node(self) -> NamedNode:
+        return NamedNode(self.iri)
+
+
+def expand(name: str) -> str:
+    """Expand ``prefix:local`` with the prefix table; absolute IRIs pass through unchanged.
+
+    Raises ``ValueError`` for a name that is neither.
+    """
+    if name.startswith("<") and name.endswith(">"):
+        return name[1:-1]
+    prefix, sep, local = name.partition(":")
+    if sep and prefix in PREFIXES:
+        return PREFIXES[prefix] + local
+    if sep and _SCHEME.fullmatch(prefix):
+        return name
+    raise ValueError(
+        f"{name!r} is neither an absolute IRI nor a prefixed name with a known prefix "
+        f"({', '.join(PREFIXES)})"
+    )
+
+
+def shorten(iri: str) -> str:
+    """The prefixed form of ``iri`` when a table prefix covers it, else the IRI itself."""
+    best = ""
+    for prefix, namespace in PREFIXES.items():
+        if iri.startswith(namespace) and len(namespace) > len(PREFIXES.get(best, "")):
+            best = prefix
+    if best:
+        local = iri[len(PREFIXES[best]) :]
+        if local and all(ch.isalnum() or ch in "_-." for ch in local):
+            return f"{best}:{local}"
+    return iri

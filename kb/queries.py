@@ -1,0 +1,121 @@
+"""Named SPARQL queries: one ``queries/<name>.rq`` file each, run by name with bound values.
+
+A query file declares its title and parameters in its leading comments::
+
+    # title: Advertisements with their inputs and outputs
+    # param: service iri  Only this advertisement (optional)
+    # param: kind iri required  The component kind
+
+A parameter's value is substituted for the variable of the same name by Oxigraph
+(SEP-0007 substitution), never pasted into the query text.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pyoxigraph as ox
+
+from kb.errors import BindingError, UnknownQueryError
+from kb.namespaces import XSD, expand
+from kb.store import QueryResult, Store, Term
+
+PARAMETER_KINDS = ("iri", "string", "integer", "decimal", "literal")
+_PARAM_LINE = re.compile(r"^#\s*param:\s*(\w+)\s+(\w+)(\s+required)?\s*(.*)$")
+_TITLE_LINE = re.compile(r"^#\s*title:\s*(.+)$")
+
+
+@dataclass(frozen=True)
+class Parameter:
+    name: str
+    kind: str
+    required: bool
+    description: str
+
+
+@dataclass(frozen=True)
+class NamedQuery:
+    name: str
+    title: str
+    text: str
+    parameters: dict[str, Parameter] = field(default_factory=dict)
+
+    def bind(self, values: Mapping[str, Term | str | int | float]) -> dict[str, Term]:
+        """Check ``values`` against the declared parameters and turn them into RDF terms."""
+        unknown = sorted(set(values) - set(self.parameters))
+        if unknown:
+            declared = ", ".join(self.parameters) or "none"
+            raise BindingError(unknown[0], values[unknown[0]], f"query {self.name!r} takes no such parameter (it takes: {declared})")
+        missing = [p.name for p in self.parameters.values() if p.required and p.name not in values]
+        if missing:
+            raise BindingError(missing[0], None, f"query {self.name!r} needs this parameter")
+        return {name: to_term(self.parameters[name], value) for name, value in values.items()}
+
+
+def to_term(parameter: Parameter, value: Term | str | int | float) -> Term:
+    """The RDF term for ``value`` as the parameter's kind reads it (``svc:X`` or a full IRI for iri)."""
+    if isinstance(value, ox.NamedNode | ox.BlankNode | ox.Literal):
+        return value
+    try:
+        if parameter.kind == "iri":
+            return ox.NamedNode(expand(str(value)))
+        if parameter.kind == "integer":
+            return ox.Literal(str(int(value)), datatype=ox.NamedNode(XSD + "integer"))
+        if parameter.kind == "decimal":
+            return ox.Literal(str(float(value)), datatype=ox.NamedNode(XSD + "decimal"))
+        return ox.Literal(str(value))
+    except ValueError as error:
+        raise BindingError(parameter.name, value, f"not a valid {parameter.kind}: {error}") from error
+
+
+class QueryLibrary:
+    """The named queries found in one folder."""
+
+    def __init__(self, folder: Path) -> None:
+        self.folder = folder
+        self._queries = {path.stem: _read(path) for path in sorted(folder.glob("*.rq"))}
+
+    def names(self) -> list[str]:
+        return list(self._queries)
+
+    def get(self, name: str) -> NamedQuery:
+        try:
+            return self._queries[name]
+        except KeyError:
+            raise UnknownQueryError(name, self.names()) from None
+
+    def run(self, store: Store, name: str, values: Mapping[str, Term | str | int | float] | None = None) -> QueryResult:
+        query = self.get(name)
+        return store.query(query.text, query.bind(values or {}))
+
+    def select(
+        self, store: Store, name: str, values: Mapping[str, Term | str | int | float] | None = None
+    ) -> list[dict[str, Term]]:
+        """Rows of a SELECT query as dicts from variable name to term (unbound variables left out)."""
+        result = self.run(store, name, values)
+        if not isinstance(result, ox.QuerySolutions):
+            raise TypeError(f"query {name!r} is not a SELECT query")
+        names = [v.value for v in result.variables]
+        return [{n: row[n] for n in names if row[n] is not None} for row in result]
+
+
+def _read(path: Path) -> NamedQuery:
+    text = path.read_text(encoding="utf-8")
+    title = path.stem.replace("_", " ")
+    parameters: dict[str, Parameter] = {}
+    for line in text.splitlines():
+        if not line.startswith("#"):
+            if line.strip():
+                break
+            continue
+        if match := _TITLE_LINE.match(line):
+            title = match.group(1).strip()
+        elif match := _PARAM_LINE.match(line):
+            name, kind, required, description = match.groups()
+            if kind not in PARAMETER_KINDS:
+                raise ValueError(f"{path}: parameter {name} has unknown kind {kind!r}; use one of {PARAMETER_KINDS}")
+            parameters[name] = Parameter(name, kind, bool(required), description.strip())
+    return NamedQuery(path.stem, title, text, parameters)

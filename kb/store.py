@@ -1,0 +1,144 @@
+"""The Oxigraph store behind cbrs: embedded on disk or in memory.
+
+Every write is one Oxigraph transaction, so a write that fails leaves the store as it was.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Iterator, Mapping
+from pathlib import Path
+
+import pyoxigraph as ox
+
+from kb.errors import QuerySyntaxError, StoreError
+from kb.namespaces import GENID, PREFIXES, GraphName
+
+MEMORY = ":memory:"
+
+Term = ox.NamedNode | ox.BlankNode | ox.Literal
+QueryResult = ox.QuerySolutions | ox.QueryBoolean | ox.QueryTriples
+
+
+class Store:
+    """A cbrs store: an Oxigraph dataset with the cbrs named graphs.
+
+    Queries see the union of all graphs as their default graph, so a query need not know which
+    graph holds a fact; ``GRAPH`` still addresses one graph.
+    """
+
+    def __init__(self, backend: ox.Store, location: str) -> None:
+        self._backend = backend
+        self.location = location
+
+    @classmethod
+    def open(cls, location: str | Path) -> Store:
+        """Open (creating if needed) the store at ``location``: a directory, or ``:memory:``."""
+        text = str(location)
+        if text == MEMORY:
+            return cls(ox.Store(), MEMORY)
+        path = Path(text).expanduser()
+        if path.exists() and not path.is_dir():
+            raise StoreError(text, "exists and is not a directory")
+        try:
+            path.mkdir(parents=True, exist_ok=True)
+            return cls(ox.Store(str(path)), str(path))
+        except OSError as error:
+            raise StoreError(text, str(error)) from error
+
+    @property
+    def in_memory(self) -> bool:
+        return self.location == MEMORY
+
+    # -- reading ---------------------------------------------------------------------------
+
+    def query(self, text: str, bindings: Mapping[str, Term] | None = None) -> QueryResult:
+        """Run a SPARQL query with ``bindings`` substituted for its variables (never pasted into text)."""
+        substitutions = {ox.Variable(name): value for name, value in (bindings or {}).items()}
+        try:
+            return self._backend.query(
+                text, prefixes=PREFIXES, use_default_graph_as_union=True, substitutions=substitutions
+            )
+        except SyntaxError as error:
+            raise QuerySyntaxError(text, str(error)) from error
+
+    def quads(
+        self,
+        subject: Term | None = None,
+        predicate: ox.NamedNode | None = None,
+        object: Term | None = None,
+        graph: ox.NamedNode | None = None,
+    ) -> Iterator[ox.Quad]:
+        return iter(self._backend.quads_for_pattern(subject, predicate, object, graph))
+
+    def count(self, graph: GraphName | ox.NamedNode | None = None) -> int:
+        node = graph.node if isinstance(graph, GraphName) else graph
+        return sum(1 for _ in self._backend.quads_for_pattern(None, None, None, node))
+
+    def graphs(self) -> list[str]:
+        return sorted(g.value for g in self._backend.named_graphs() if isinstance(g, ox.NamedNode))
+
+    def is_seeded(self) -> bool:
+        return self._backend.contains_named_graph(GraphName.ONTOLOGY.node)
+
+    def dump(self, rdf_format: ox.RdfFormat = ox.RdfFormat.N_QUADS) -> bytes:
+        """The whole dataset, serialised; N-Quads sorted, so two dumps compare byte for byte."""
+        if rdf_format == ox.RdfFormat.N_QUADS:
+            lines = sorted(str(quad) + " .\n" for quad in self._backend)
+            return "".join(lines).encode("utf-8")
+        data = self._backend.dump(format=rdf_format, prefixes=PREFIXES)
+        assert data is not None
+        return data
+
+    # -- writing ---------------------------------------------------------------------------
+
+    def add(self, quads: Iterable[ox.Quad]) -> None:
+        """Add ``quads`` in one transaction."""
+        try:
+            self._backend.extend(quads)
+        except OSError as error:
+            raise StoreError(self.location, f"write failed: {error}") from error
+
+    def replace(self, remove: Iterable[ox.Quad], add: Iterable[ox.Quad]) -> None:
+        """Remove and add quads in one transaction.
+
+        Oxigraph's Python API has no multi-operation transaction, but one SPARQL update is one.
+        The quads go into the update as ground data blocks written by Oxigraph's own term
+        serialiser (the term constructors have validated every IRI and escape every literal), so no
+        caller-supplied text reaches the update; blank nodes are refused, since a data block
+        cannot name them (the loader skolemises them).
+        """
+        removing = _data_block(remove)
+        adding = _data_block(add)
+        parts = []
+        if removing:
+            parts.append("DELETE DATA {\n" + removing + "}")
+        if adding:
+            parts.append("INSERT DATA {\n" + adding + "}")
+        if parts:
+            self.update(" ;\n".join(parts))
+
+    def update(self, text: str) -> None:
+        """Run a SPARQL update in one transaction."""
+        try:
+            self._backend.update(text, prefixes=PREFIXES)
+        except SyntaxError as error:
+            raise QuerySyntaxError(text, str(error)) from error
+        except OSError as error:
+            raise StoreError(self.location, f"update failed: {error}") from error
+
+    def flush(self) -> None:
+        if not self.in_memory:
+            self._backend.flush()
+
+
+def _data_block(quads: Iterable[ox.Quad]) -> str:
+    lines = []
+    for quad in quads:
+        for term in (quad.subject, quad.object):
+            if isinstance(term, ox.BlankNode):
+                raise ValueError(f"blank node {term} in a data block; skolemise it under {GENID} first")
+        if isinstance(quad.graph_name, ox.NamedNode):
+            lines.append(f"GRAPH {quad.graph_name} {{ {quad.subject} {quad.predicate} {quad.object} }}\n")
+        else:
+            lines.append(f"{quad.subject} {quad.predicate} {quad.object} .\n")
+    return "".join(lines)
