@@ -157,7 +157,7 @@ def _as_utf8(raw: bytes, source: str, strict: bool = True) -> bytes:
         if raw.startswith(bom):
             return _redeclare(_decode(raw, codec, source, strict).encode("utf-8"))
     declared = _XML_ENCODING.match(raw)
-    if declared and declared.group(2).lower().replace("_", "-") not in {b"utf-8", b"utf8"}:
+    if declared and declared.group(2).lower().replace(b"_", b"-") not in {b"utf-8", b"utf8"}:
         codec = declared.group(2).decode("ascii")
         return _redeclare(_decode(raw, codec, source, strict).encode("utf-8"))
     return raw

@@ -35,6 +35,7 @@ PREFIXES: dict[str, str] = {
     "req": REQ,
     "world": WORLD,
     "graph": GRAPH,
+    "genid": GENID,
     "dul": DUL,
     "rdf": RDF,
     "rdfs": RDFS,

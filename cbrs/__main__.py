@@ -1,0 +1,3 @@
+from cbrs.cli import main
+
+main()

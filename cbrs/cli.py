@@ -1,0 +1,277 @@
+"""The ``cbrs`` command: a thin click layer over :class:`kb.KnowledgeBase`.
+
+Library errors become one-line messages and a non-zero exit here, at the edge, and nowhere else.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+import traceback
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import click
+
+from cbrs import __version__
+from cbrs.output import RESULT_FORMATS, render_result, table, term_text
+from cbrs.settings import SETTINGS, setting
+from kb import Advertisement, KnowledgeBase, KnowledgeBaseError, Requirement, ServiceDescription
+from kb.namespaces import GraphName, expand, shorten
+
+
+@dataclass
+class App:
+    """What every command gets: the resolved settings and, opened on first use, the knowledge base."""
+
+    store_location: str
+    _kb: KnowledgeBase | None = field(default=None, repr=False)
+
+    @property
+    def kb(self) -> KnowledgeBase:
+        if self._kb is None:
+            self._kb = KnowledgeBase.open(self.store_location)
+        return self._kb
+
+
+pass_app = click.make_pass_decorator(App)
+
+
+class _Group(click.Group):
+    """Turns library errors into click's one-line error and exit status 1."""
+
+    def invoke(self, ctx: click.Context) -> Any:
+        try:
+            return super().invoke(ctx)
+        except KnowledgeBaseError as error:
+            raise click.ClickException(str(error)) from error
+        except ValueError as error:  # settings from the environment
+            raise click.ClickException(str(error)) from error
+
+
+@click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(__version__, prog_name="cbrs")
+@click.option(
+    "--store",
+    metavar="PATH|:memory:",
+    help=setting("store").help + f" [env {setting('store').env}; default: the user data directory]",
+)
+@click.pass_context
+def cli(ctx: click.Context, store: str | None) -> None:
+    """cbrs: a knowledge base that lets service robots find and use the services around them."""
+    ctx.obj = App(store_location=setting("store").resolve(store))
+
+
+@cli.command()
+@pass_app
+def init(app: App) -> None:
+    """Create the store and seed it with the bundled ontologies, advertisements and requirements."""
+    kb = app.kb  # opening seeds a new store
+    stats = kb.statistics()
+    click.echo(f"store: {kb.store.location}")
+    for graph in GraphName:
+        click.echo(f"  {shorten(graph.iri):<20} {stats.get(graph.iri, 0):>7} triples")
+    click.echo(f"{len(kb.select('advertisements'))} advertisements, {len(kb.select('requirements'))} requirements")
+
+
+@cli.command()
+@click.argument("files", nargs=-1, required=True, type=click.Path(dir_okay=False, path_type=Path))
+@click.option(
+    "--graph",
+    metavar="NAME|IRI",
+    help="Named graph for the files' triples: " + ", ".join(g.value for g in GraphName) + " or a full IRI. "
+    "Default: ontology for files that declare classes or properties, requirements for requirements, "
+    "services otherwise.",
+)
+@pass_app
+def load(app: App, files: tuple[Path, ...], graph: str | None) -> None:
+    """Load RDF files (Turtle, RDF/XML, OWL, N-Triples, N-Quads, TriG, JSON-LD), all or nothing."""
+    for item in app.kb.load(list(files), graph):
+        click.echo(f"loaded {item.source}: {len(item.quads)} triples into {shorten(item.graph)}")
+
+
+@cli.command()
+@click.argument("text", required=False)
+@click.option("--file", "query_file", type=click.File("r", encoding="utf-8"), help="Read the query from a .rq file.")
+@click.option("--name", help="Run the named query queries/NAME.rq (see --list).")
+@click.option("--bind", "bindings", multiple=True, metavar="VAR=VALUE", help="Bind a named query's parameter.")
+@click.option("--format", "fmt", type=click.Choice(RESULT_FORMATS), help="Output format [env CBRS_FORMAT; default table].")
+@click.option("--list", "list_queries", is_flag=True, help="List the named queries and their parameters.")
+@pass_app
+def query(
+    app: App,
+    text: str | None,
+    query_file: Any,
+    name: str | None,
+    bindings: tuple[str, ...],
+    fmt: str | None,
+    list_queries: bool,
+) -> None:
+    """Run a SPARQL query given as TEXT, from --file, or by --name with --bind values."""
+    fmt = setting("format").resolve(fmt)
+    if fmt not in RESULT_FORMATS:
+        raise click.BadParameter(f"{fmt!r} is not one of {', '.join(RESULT_FORMATS)}", param_hint="CBRS_FORMAT")
+    if list_queries:
+        _list_queries(app)
+        return
+    sources = [s for s in (text, query_file, name) if s]
+    if len(sources) != 1:
+        raise click.UsageError("give exactly one of TEXT, --file or --name")
+    values = dict(_split_binding(b) for b in bindings)
+    if name:
+        result = app.kb.run(name, values)
+    else:
+        if values:
+            raise click.UsageError("--bind works with --name, whose parameters are declared")
+        result = app.kb.query(text if text else query_file.read())
+    click.echo(render_result(result, fmt))
+
+
+@cli.command()
+@click.option("--json", "as_json", is_flag=True, help="Print the advertisements as JSON.")
+@pass_app
+def services(app: App, as_json: bool) -> None:
+    """List the registered advertisements with their kind, device and inputs -> outputs."""
+    rows = app.kb.select("advertisements")
+    if as_json:
+        click.echo(json.dumps([{k: v.value for k, v in row.items()} for row in rows], indent=2))
+        return
+    body = [
+        [
+            term_text(row["service"]),
+            term_text(row.get("kind")).replace("cbrs:", "").replace("Component", ""),
+            term_text(row.get("deviceName")),
+            term_text(row.get("inputs")) or "-",
+            term_text(row.get("outputs")) or "-",
+        ]
+        for row in rows
+    ]
+    click.echo(table(["service", "kind", "device", "inputs", "outputs"], body))
+    click.echo(f"({len(rows)} advertisements)")
+
+
+@cli.command()
+@click.argument("iri")
+@click.option("--json", "as_json", is_flag=True, help="Print as JSON.")
+@pass_app
+def show(app: App, iri: str, as_json: bool) -> None:
+    """Show a service description's six-tuple, or any resource's triples (IRI or prefix:name)."""
+    full = _expand(iri)
+    kb = app.kb
+    if not kb.describes(full):
+        raise click.ClickException(f"nothing in the store mentions <{full}>")
+    is_description = bool(kb.select("description", {"description": full}))
+    if is_description:
+        description = kb.description(full)
+        if as_json:
+            click.echo(json.dumps(description.to_dict(), indent=2))
+        else:
+            click.echo(_describe(description))
+        return
+    rows = kb.select("resource_triples", {"resource": full})
+    if as_json:
+        click.echo(json.dumps([{k: v.value for k, v in row.items() if k != "resource"} for row in rows], indent=2))
+        return
+    click.echo(f"{shorten(full)}")
+    body = [
+        [term_text(r["direction"]), term_text(r["predicate"]), term_text(r["other"]), term_text(r["graph"])]
+        for r in rows
+    ]
+    click.echo(table(["direction", "predicate", "value", "graph"], body))
+
+
+@cli.command("settings")
+def settings_command() -> None:
+    """List the settings, their environment variables and current values."""
+    body = [[s.name, s.env, str(s.resolve()), s.help] for s in SETTINGS]
+    click.echo(table(["setting", "environment", "value", "help"], body))
+
+
+@cli.command()
+@pass_app
+def demo(app: App) -> None:
+    """A tour of the knowledge base: what is stored, an advertisement, a requirement, a query."""
+    kb = app.kb
+    click.echo(f"cbrs {__version__} -- store: {kb.store.location}\n")
+    stats = kb.statistics()
+    click.echo("Named graphs:")
+    for graph in GraphName:
+        click.echo(f"  {shorten(graph.iri):<20} {stats.get(graph.iri, 0):>7} triples")
+    ads = kb.select("advertisements")
+    reqs = kb.select("requirements")
+    click.echo(f"\n{len(ads)} advertisements, {len(reqs)} requirements.\n")
+    click.echo("Paper Table 1, the ceiling camera's LocateMobileRobot advertisement:")
+    click.echo(_describe(kb.description(expand("svc:LocateMobileRobot_CeilingCamera01"))))
+    click.echo("\nPaper Table 2, the robot's self-position requirement:")
+    click.echo(_describe(kb.description(expand("req:RobotSelfPosition"))))
+    click.echo("\nDynamic perception components (cbrs query --name advertisements --bind kind=...):")
+    click.echo(render_result(kb.run("advertisements", {"kind": "cbrs:DynamicPerceptionComponent"}), "table"))
+
+
+def _describe(d: ServiceDescription) -> str:
+    lines = [f"{shorten(d.iri)}  ({', '.join(shorten(t) for t in d.types)})"]
+    if d.label:
+        lines.append(f"  label        {d.label}")
+    lines.append(f"  DN           {d.device_name or '-'}")
+    lines.append(f"  SN           {d.service_name or '-'}")
+    lines.append(f"  SC           {d.category or '-'}")
+    if isinstance(d, Advertisement) and d.device:
+        lines.append(f"  device       {shorten(d.device)}")
+    if isinstance(d, Requirement):
+        if d.requested_by:
+            lines.append(f"  requested by {shorten(d.requested_by)}")
+        if d.for_task:
+            lines.append(f"  for task     {shorten(d.for_task)}")
+    for parameter in (*d.inputs, *d.outputs):
+        parts = ""
+        if parameter.tree and parameter.tree.children:
+            parts = "  parts: " + ", ".join(shorten(c.concept) for c in parameter.tree.children)
+        name = f" {parameter.name}" if parameter.name else ""
+        lines.append(f"  {parameter.direction:<12} {shorten(parameter.type)}{name}{parts}")
+    for role, statements in (("precondition", d.preconditions), ("effect", d.effects)):
+        for s in statements:
+            lines.append(f"  {role:<12} ({shorten(s.subject)}, {shorten(s.predicate)}, {shorten(s.object)})")
+    if d.area:
+        box = f"  x {d.area.bounds[0]}..{d.area.bounds[1]}, y {d.area.bounds[2]}..{d.area.bounds[3]}" if d.area.bounds else ""
+        lines.append(f"  SEA          {', '.join(shorten(a) for a in d.area.areas) or '-'}{box}")
+    for q in d.qos:
+        bound = {"lower": " (max)", "higher": " (min)"}.get(q.better_when or "", "") if isinstance(d, Requirement) else ""
+        lines.append(f"  QoS          {shorten(q.metric)} = {q.value:g}{bound}")
+    return "\n".join(lines)
+
+
+def _list_queries(app: App) -> None:
+    body = []
+    for name in app.kb.queries.names():
+        q = app.kb.queries.get(name)
+        params = ", ".join(f"{p.name}{'*' if p.required else ''}:{p.kind}" for p in q.parameters.values())
+        body.append([name, params or "-", q.title])
+    click.echo(table(["name", "parameters (* required)", "title"], body))
+
+
+def _split_binding(text: str) -> tuple[str, str]:
+    name, sep, value = text.partition("=")
+    if not sep or not name:
+        raise click.BadParameter(f"{text!r} is not VAR=VALUE", param_hint="--bind")
+    return name.lstrip("?$"), value
+
+
+def _expand(name: str) -> str:
+    try:
+        return expand(name)
+    except ValueError as error:
+        raise click.BadParameter(str(error), param_hint="IRI") from error
+
+
+def main() -> None:
+    """Entry point. click reports usage and library errors in one line; anything else is a bug,
+    reported in one line too unless CBRS_DEBUG asks for the traceback."""
+    try:
+        cli.main(prog_name="cbrs")
+    except Exception as error:
+        if os.environ.get("CBRS_DEBUG"):
+            traceback.print_exc()
+        click.echo(f"internal error: {type(error).__name__}: {error} (set CBRS_DEBUG=1 for the traceback)", err=True)
+        sys.exit(2)
