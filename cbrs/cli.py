@@ -73,7 +73,9 @@ def init(app: App) -> None:
     click.echo(f"store: {kb.store.location}")
     for graph in GraphName:
         click.echo(f"  {shorten(graph.iri):<20} {stats.get(graph.iri, 0):>7} triples")
-    click.echo(f"{len(kb.select('advertisements'))} advertisements, {len(kb.select('requirements'))} requirements")
+    click.echo(
+        f"{len(kb.select('advertisements'))} advertisements, {len(kb.select('requirements'))} requirements"
+    )
 
 
 @cli.command()
@@ -94,10 +96,19 @@ def load(app: App, files: tuple[Path, ...], graph: str | None) -> None:
 
 @cli.command()
 @click.argument("text", required=False)
-@click.option("--file", "query_file", type=click.File("r", encoding="utf-8"), help="Read the query from a .rq file.")
+@click.option(
+    "--file", "query_file", type=click.File("r", encoding="utf-8"), help="Read the query from a .rq file."
+)
 @click.option("--name", help="Run the named query queries/NAME.rq (see --list).")
-@click.option("--bind", "bindings", multiple=True, metavar="VAR=VALUE", help="Bind a named query's parameter.")
-@click.option("--format", "fmt", type=click.Choice(RESULT_FORMATS), help="Output format [env CBRS_FORMAT; default table].")
+@click.option(
+    "--bind", "bindings", multiple=True, metavar="VAR=VALUE", help="Bind a named query's parameter."
+)
+@click.option(
+    "--format",
+    "fmt",
+    type=click.Choice(RESULT_FORMATS),
+    help="Output format [env CBRS_FORMAT; default table].",
+)
 @click.option("--list", "list_queries", is_flag=True, help="List the named queries and their parameters.")
 @pass_app
 def query(
@@ -112,7 +123,9 @@ def query(
     """Run a SPARQL query given as TEXT, from --file, or by --name with --bind values."""
     fmt = setting("format").resolve(fmt)
     if fmt not in RESULT_FORMATS:
-        raise click.BadParameter(f"{fmt!r} is not one of {', '.join(RESULT_FORMATS)}", param_hint="CBRS_FORMAT")
+        raise click.BadParameter(
+            f"{fmt!r} is not one of {', '.join(RESULT_FORMATS)}", param_hint="CBRS_FORMAT"
+        )
     if list_queries:
         _list_queries(app)
         return
@@ -172,7 +185,9 @@ def show(app: App, iri: str, as_json: bool) -> None:
         return
     rows = kb.select("resource_triples", {"resource": full})
     if as_json:
-        click.echo(json.dumps([{k: v.value for k, v in row.items() if k != "resource"} for row in rows], indent=2))
+        click.echo(
+            json.dumps([{k: v.value for k, v in row.items() if k != "resource"} for row in rows], indent=2)
+        )
         return
     click.echo(f"{shorten(full)}")
     body = [
@@ -234,10 +249,18 @@ def _describe(d: ServiceDescription) -> str:
         for s in statements:
             lines.append(f"  {role:<12} ({shorten(s.subject)}, {shorten(s.predicate)}, {shorten(s.object)})")
     if d.area:
-        box = f"  x {d.area.bounds[0]}..{d.area.bounds[1]}, y {d.area.bounds[2]}..{d.area.bounds[3]}" if d.area.bounds else ""
+        box = (
+            f"  x {d.area.bounds[0]}..{d.area.bounds[1]}, y {d.area.bounds[2]}..{d.area.bounds[3]}"
+            if d.area.bounds
+            else ""
+        )
         lines.append(f"  SEA          {', '.join(shorten(a) for a in d.area.areas) or '-'}{box}")
     for q in d.qos:
-        bound = {"lower": " (max)", "higher": " (min)"}.get(q.better_when or "", "") if isinstance(d, Requirement) else ""
+        bound = (
+            {"lower": " (max)", "higher": " (min)"}.get(q.better_when or "", "")
+            if isinstance(d, Requirement)
+            else ""
+        )
         lines.append(f"  QoS          {shorten(q.metric)} = {q.value:g}{bound}")
     return "\n".join(lines)
 
@@ -273,5 +296,7 @@ def main() -> None:
     except Exception as error:
         if os.environ.get("CBRS_DEBUG"):
             traceback.print_exc()
-        click.echo(f"internal error: {type(error).__name__}: {error} (set CBRS_DEBUG=1 for the traceback)", err=True)
+        click.echo(
+            f"internal error: {type(error).__name__}: {error} (set CBRS_DEBUG=1 for the traceback)", err=True
+        )
         sys.exit(2)

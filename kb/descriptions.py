@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Literal, cast
+from typing import Any, Literal, cast
 
 import pyoxigraph as ox
 
@@ -50,7 +50,7 @@ class DescriptionReader:
             raise NotFoundError(iri, "service description")
         types = tuple(sorted({_iri(row["type"]) for row in head}))
         first = {name: _value(term) for row in head for name, term in row.items() if name != "type"}
-        common = dict(
+        common: dict[str, Any] = dict(
             iri=iri,
             types=types,
             label=first.get("label"),
@@ -95,7 +95,9 @@ class DescriptionReader:
             cycle = " -> ".join((*path[path.index(concept) :], concept))
             raise InvalidDescriptionError(root, [f"hasPart cycle {cycle}"])
         if len(path) >= MAX_PART_DEPTH:
-            raise InvalidDescriptionError(root, [f"hasPart structure deeper than {MAX_PART_DEPTH} below {root}"])
+            raise InvalidDescriptionError(
+                root, [f"hasPart structure deeper than {MAX_PART_DEPTH} below {root}"]
+            )
         rows = self._queries.select(self._store, "concept_parts", {"concept": concept})
         by_property: dict[str, list[tuple[str, str]]] = {}
         for row in rows:
@@ -115,7 +117,9 @@ class DescriptionReader:
             if _value(row["direction"]) != direction:
                 continue
             if "type" not in row:
-                raise InvalidDescriptionError(iri, [f"{direction} {_iri(row['parameter'])} has no cbrs:parameterType"])
+                raise InvalidDescriptionError(
+                    iri, [f"{direction} {_iri(row['parameter'])} has no cbrs:parameterType"]
+                )
             concept = _iri(row["type"])
             parameters.append(
                 Parameter(

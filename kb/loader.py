@@ -17,6 +17,7 @@ import xml.parsers.expat
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import pyoxigraph as ox
 
@@ -80,7 +81,12 @@ def parse_bytes(
         raise RdfParseError(source, str(error)) from error
     target = resolve_graph(graph) if graph is not None else _graph_for(parsed)
     quads = [
-        ox.Quad(q.subject, q.predicate, q.object, target if isinstance(q.graph_name, ox.DefaultGraph) else q.graph_name)
+        ox.Quad(
+            q.subject,
+            q.predicate,
+            q.object,
+            target if isinstance(q.graph_name, ox.DefaultGraph) else q.graph_name,
+        )
         for q in parsed
     ]
     return ParsedFile(source, target.value, skolemise(quads))
@@ -121,7 +127,7 @@ def skolemise(quads: Iterable[ox.Quad]) -> list[ox.Quad]:
     canonical = sorted(dataset, key=str)
     digest = hashlib.sha256("".join(f"{q} .\n" for q in canonical).encode("utf-8")).hexdigest()[:16]
 
-    def named(term: ox.NamedNode | ox.BlankNode | ox.Literal) -> ox.NamedNode | ox.Literal:
+    def named(term: Any) -> Any:
         if isinstance(term, ox.BlankNode):
             return ox.NamedNode(f"{GENID}{digest}-{term.value}")
         return term
@@ -183,7 +189,9 @@ def _located(error: SyntaxError, source: str, data: bytes, rdf_format: ox.RdfFor
     column = position[2] if len(position) > 2 else None
     if line is None and rdf_format == ox.RdfFormat.RDF_XML:
         line, column = _xml_error_position(data)
-    message = re.sub(r"^Parser error (between|at) line \d+ column \d+( and line \d+ column \d+)?: ", "", message)
+    message = re.sub(
+        r"^Parser error (between|at) line \d+ column \d+( and line \d+ column \d+)?: ", "", message
+    )
     return RdfParseError(source, message, line, column)
 
 
@@ -200,7 +208,11 @@ def _xml_error_position(data: bytes) -> tuple[int | None, int | None]:
 def _graph_for(quads: list[ox.Quad]) -> ox.NamedNode:
     """The graph for a file's triples when none is given: declarations go to the ontology graph,
     requirements to the requirements graph, everything else to the services graph."""
-    types = {q.object.value for q in quads if q.predicate.value == RDF + "type" and isinstance(q.object, ox.NamedNode)}
+    types = {
+        q.object.value
+        for q in quads
+        if q.predicate.value == RDF + "type" and isinstance(q.object, ox.NamedNode)
+    }
     if types & _DECLARATION_TYPES:
         return GraphName.ONTOLOGY.node
     if CBRS + "Requirement" in types and CBRS + "Advertisement" not in types:

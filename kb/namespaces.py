@@ -6,7 +6,7 @@ Every IRI cbrs mints lives under ``BASE``.
 from __future__ import annotations
 
 import re
-from enum import Enum
+from enum import StrEnum
 
 from pyoxigraph import NamedNode
 
@@ -49,7 +49,7 @@ PREFIXES: dict[str, str] = {
 _SCHEME = re.compile(r"[A-Za-z][A-Za-z0-9+.-]*")
 
 
-class GraphName(str, Enum):
+class GraphName(StrEnum):
     """The named graphs of a cbrs store, each holding one kind of knowledge."""
 
     ONTOLOGY = "ontology"
@@ -80,8 +80,7 @@ def expand(name: str) -> str:
     if sep and _SCHEME.fullmatch(prefix):
         return name
     raise ValueError(
-        f"{name!r} is neither an absolute IRI nor a prefixed name with a known prefix "
-        f"({', '.join(PREFIXES)})"
+        f"{name!r} is neither an absolute IRI nor a prefixed name with a known prefix ({', '.join(PREFIXES)})"
     )
 
 

@@ -48,7 +48,11 @@ class NamedQuery:
         unknown = sorted(set(values) - set(self.parameters))
         if unknown:
             declared = ", ".join(self.parameters) or "none"
-            raise BindingError(unknown[0], values[unknown[0]], f"query {self.name!r} takes no such parameter (it takes: {declared})")
+            raise BindingError(
+                unknown[0],
+                values[unknown[0]],
+                f"query {self.name!r} takes no such parameter (it takes: {declared})",
+            )
         missing = [p.name for p in self.parameters.values() if p.required and p.name not in values]
         if missing:
             raise BindingError(missing[0], None, f"query {self.name!r} needs this parameter")
@@ -87,7 +91,9 @@ class QueryLibrary:
         except KeyError:
             raise UnknownQueryError(name, self.names()) from None
 
-    def run(self, store: Store, name: str, values: Mapping[str, Term | str | int | float] | None = None) -> QueryResult:
+    def run(
+        self, store: Store, name: str, values: Mapping[str, Term | str | int | float] | None = None
+    ) -> QueryResult:
         query = self.get(name)
         return store.query(query.text, query.bind(values or {}))
 
@@ -116,6 +122,8 @@ def _read(path: Path) -> NamedQuery:
         elif match := _PARAM_LINE.match(line):
             name, kind, required, description = match.groups()
             if kind not in PARAMETER_KINDS:
-                raise ValueError(f"{path}: parameter {name} has unknown kind {kind!r}; use one of {PARAMETER_KINDS}")
+                raise ValueError(
+                    f"{path}: parameter {name} has unknown kind {kind!r}; use one of {PARAMETER_KINDS}"
+                )
             parameters[name] = Parameter(name, kind, bool(required), description.strip())
     return NamedQuery(path.stem, title, text, parameters)

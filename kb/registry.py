@@ -76,7 +76,9 @@ class ComponentRegistry:
         parsed = parse_bytes(raw, source, ox.RdfFormat.TURTLE, graph=GraphName.SERVICES, base_iri=BASE)
         iris = _advertisements(self._store, parsed.quads)
         if not iris:
-            raise InvalidDescriptionError(source, ["it describes no advertisement (a subject typed with a cbrs component kind)"])
+            raise InvalidDescriptionError(
+                source, ["it describes no advertisement (a subject typed with a cbrs component kind)"]
+            )
         for iri in iris:
             problems = _problems(iri, parsed.quads)
             if problems:
@@ -90,7 +92,10 @@ def _advertisements(store: Store, quads: Iterable[ox.Quad]) -> list[str]:
         {
             q.subject.value
             for q in quads
-            if q.predicate.value == RDF + "type" and q.object.value in kinds and isinstance(q.subject, ox.NamedNode)
+            if q.predicate.value == RDF + "type"
+            and isinstance(q.subject, ox.NamedNode)
+            and isinstance(q.object, ox.NamedNode)
+            and q.object.value in kinds
         }
     )
 
@@ -103,9 +108,11 @@ def _advertisement_classes(store: Store) -> set[str]:
 
 def _problems(iri: str, quads: list[ox.Quad]) -> list[str]:
     """What the six-tuple lacks: checked on the triples before anything is written."""
-    by_subject: dict[str, dict[str, list[ox.NamedNode | ox.BlankNode | ox.Literal]]] = {}
+    by_subject: dict[str, dict[str, list[str]]] = {}
     for q in quads:
-        by_subject.setdefault(q.subject.value, {}).setdefault(q.predicate.value, []).append(q.object)
+        if isinstance(q.subject, ox.NamedNode) and not isinstance(q.object, ox.Triple):
+            fields = by_subject.setdefault(q.subject.value, {})
+            fields.setdefault(q.predicate.value, []).append(q.object.value)
     own = by_subject.get(iri, {})
     problems = []
     for prop, label in ((CBRS.serviceName, "service name (SN)"), (CBRS.deviceName, "device name (DN)")):
@@ -114,17 +121,17 @@ def _problems(iri: str, quads: list[ox.Quad]) -> list[str]:
     models = own.get(CBRS.hasOWLSModel, [])
     if len(models) != 1:
         return [*problems, "needs exactly one cbrs:hasOWLSModel"]
-    model = by_subject.get(models[0].value, {})
+    model = by_subject.get(models[0], {})
     if not model.get(CBRS.hasOutput) and not model.get(CBRS.hasEffect):
         problems.append("its OWLS model has neither an output nor an effect")
     for prop in (CBRS.hasInput, CBRS.hasOutput):
         for parameter in model.get(prop, []):
-            if not by_subject.get(parameter.value, {}).get(CBRS.parameterType):
-                problems.append(f"parameter {parameter.value} has no cbrs:parameterType")
+            if not by_subject.get(parameter, {}).get(CBRS.parameterType):
+                problems.append(f"parameter {parameter} has no cbrs:parameterType")
     for prop in (CBRS.hasPrecondition, CBRS.hasEffect):
         for condition in model.get(prop, []):
-            fields = by_subject.get(condition.value, {})
+            fields = by_subject.get(condition, {})
             missing = [p for p in ("subject", "predicate", "object") if not fields.get(RDF + p)]
             if missing:
-                problems.append(f"statement {condition.value} lacks rdf:{', rdf:'.join(missing)}")
+                problems.append(f"statement {condition} lacks rdf:{', rdf:'.join(missing)}")
     return problems

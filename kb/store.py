@@ -53,7 +53,9 @@ class Store:
 
     def query(self, text: str, bindings: Mapping[str, Term] | None = None) -> QueryResult:
         """Run a SPARQL query with ``bindings`` substituted for its variables (never pasted into text)."""
-        substitutions = {ox.Variable(name): value for name, value in (bindings or {}).items()}
+        substitutions: dict[ox.Variable, ox.NamedNode | ox.BlankNode | ox.Literal | ox.Triple] = {
+            ox.Variable(name): value for name, value in (bindings or {}).items()
+        }
         try:
             return self._backend.query(
                 text, prefixes=PREFIXES, use_default_graph_as_union=True, substitutions=substitutions
@@ -63,7 +65,7 @@ class Store:
 
     def quads(
         self,
-        subject: Term | None = None,
+        subject: ox.NamedNode | ox.BlankNode | None = None,
         predicate: ox.NamedNode | None = None,
         object: Term | None = None,
         graph: ox.NamedNode | None = None,

@@ -75,12 +75,12 @@ def test_malformed_rdfxml_names_the_line() -> None:
 
 
 def test_unknown_format_is_named() -> None:
-    with pytest.raises(UnknownFormatError, match="unknown.format"):
+    with pytest.raises(UnknownFormatError, match=r"unknown\.format"):
         parse_file(BAD / "unknown.format")
 
 
 def test_missing_file_is_a_parse_error_naming_it(tmp_path: Path) -> None:
-    with pytest.raises(RdfParseError, match="nothere.ttl"):
+    with pytest.raises(RdfParseError, match=r"nothere\.ttl"):
         parse_file(tmp_path / "nothere.ttl")
 
 

@@ -67,7 +67,7 @@ def test_has_part_cycle_is_reported(mini_kb: KnowledgeBase, tmp_path) -> None:  
     )
     mini_kb.load([cyclic])
     reader_tree = mini_kb._reader.part_tree
-    with pytest.raises(InvalidDescriptionError, match="hasPart cycle .*A -> .*B -> .*A"):
+    with pytest.raises(InvalidDescriptionError, match=r"hasPart cycle .*A -> .*B -> .*A"):
         reader_tree(EX + "A")
 
 

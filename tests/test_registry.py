@@ -12,12 +12,15 @@ HEAD = """@prefix cbrs: <https://w3id.org/cbrs/core#> .
 
 
 def _tracker(output: str = "ex:Location", name: str = "TrackRobot") -> str:
-    return HEAD + f"""
+    return (
+        HEAD
+        + f"""
 ex:Tracker a cbrs:DynamicPerceptionComponent ;
     cbrs:deviceName "Camera2" ; cbrs:serviceName "{name}" ;
     cbrs:hasOWLSModel [ cbrs:hasInput [ cbrs:parameterType ex:MarkerColour ] ;
                         cbrs:hasOutput [ cbrs:parameterType {output} ] ] .
 """
+    )
 
 
 def test_register_then_read(mini_kb: KnowledgeBase) -> None:
@@ -69,24 +72,41 @@ def test_update_or_deregister_of_unknown_is_not_found(mini_kb: KnowledgeBase) ->
 @pytest.mark.parametrize(
     ("turtle", "problem"),
     [
-        pytest.param(HEAD + 'ex:T a cbrs:MethodInvocationComponent ; cbrs:deviceName "d" ; cbrs:serviceName "s" .',
-                     "hasOWLSModel", id="no-owls-model"),
-        pytest.param(HEAD + 'ex:T a cbrs:MethodInvocationComponent ; cbrs:deviceName "d" ; cbrs:serviceName "s" ;'
-                     " cbrs:hasOWLSModel [ cbrs:hasInput [ cbrs:parameterType ex:A ] ] .",
-                     "neither an output nor an effect", id="no-output"),
-        pytest.param(HEAD + 'ex:T a cbrs:MethodInvocationComponent ; cbrs:deviceName "d" ; cbrs:serviceName "s" ;'
-                     " cbrs:hasOWLSModel [ cbrs:hasOutput [ cbrs:parameterName \"x\" ] ] .",
-                     "no cbrs:parameterType", id="untyped-parameter"),
-        pytest.param(HEAD + 'ex:T a cbrs:MethodInvocationComponent ; cbrs:deviceName "d" ; cbrs:serviceName "s" ;'
-                     " cbrs:hasOWLSModel [ cbrs:hasEffect [ rdf:subject ex:Door ; rdf:object ex:Opened ] ] .",
-                     "lacks rdf:predicate", id="incomplete-statement"),
-        pytest.param(HEAD + 'ex:T a cbrs:MethodInvocationComponent ; cbrs:serviceName "s" ;'
-                     " cbrs:hasOWLSModel [ cbrs:hasOutput [ cbrs:parameterType ex:A ] ] .",
-                     "device name", id="no-device-name"),
+        pytest.param(
+            HEAD + 'ex:T a cbrs:MethodInvocationComponent ; cbrs:deviceName "d" ; cbrs:serviceName "s" .',
+            "hasOWLSModel",
+            id="no-owls-model",
+        ),
+        pytest.param(
+            HEAD + 'ex:T a cbrs:MethodInvocationComponent ; cbrs:deviceName "d" ; cbrs:serviceName "s" ;'
+            " cbrs:hasOWLSModel [ cbrs:hasInput [ cbrs:parameterType ex:A ] ] .",
+            "neither an output nor an effect",
+            id="no-output",
+        ),
+        pytest.param(
+            HEAD + 'ex:T a cbrs:MethodInvocationComponent ; cbrs:deviceName "d" ; cbrs:serviceName "s" ;'
+            ' cbrs:hasOWLSModel [ cbrs:hasOutput [ cbrs:parameterName "x" ] ] .',
+            "no cbrs:parameterType",
+            id="untyped-parameter",
+        ),
+        pytest.param(
+            HEAD + 'ex:T a cbrs:MethodInvocationComponent ; cbrs:deviceName "d" ; cbrs:serviceName "s" ;'
+            " cbrs:hasOWLSModel [ cbrs:hasEffect [ rdf:subject ex:Door ; rdf:object ex:Opened ] ] .",
+            "lacks rdf:predicate",
+            id="incomplete-statement",
+        ),
+        pytest.param(
+            HEAD + 'ex:T a cbrs:MethodInvocationComponent ; cbrs:serviceName "s" ;'
+            " cbrs:hasOWLSModel [ cbrs:hasOutput [ cbrs:parameterType ex:A ] ] .",
+            "device name",
+            id="no-device-name",
+        ),
         pytest.param(HEAD + "ex:T a ex:Camera .", "describes no advertisement", id="not-an-advertisement"),
     ],
 )
-def test_invalid_descriptions_are_refused_and_change_nothing(mini_kb: KnowledgeBase, turtle: str, problem: str) -> None:
+def test_invalid_descriptions_are_refused_and_change_nothing(
+    mini_kb: KnowledgeBase, turtle: str, problem: str
+) -> None:
     before = mini_kb.store.dump()
     with pytest.raises(InvalidDescriptionError, match=problem):
         mini_kb.registry.register(turtle)
@@ -95,5 +115,5 @@ def test_invalid_descriptions_are_refused_and_change_nothing(mini_kb: KnowledgeB
 
 def test_unparseable_registration_names_the_line(mini_kb: KnowledgeBase) -> None:
     with pytest.raises(RdfParseError) as caught:
-        mini_kb.registry.register(HEAD + "ex:T a cbrs:MethodInvocationComponent ;\n  cbrs:serviceName \"s .\n")
+        mini_kb.registry.register(HEAD + 'ex:T a cbrs:MethodInvocationComponent ;\n  cbrs:serviceName "s .\n')
     assert caught.value.line == 5

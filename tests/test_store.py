@@ -17,7 +17,7 @@ def _quad(s: str, o: str) -> ox.Quad:
 
 def test_replace_removes_and_adds_together(mini_kb: KnowledgeBase) -> None:
     mini_kb.store.add([_quad("a", "1")])
-    mini_kb.store.replace([_quad("a", "1")], [_quad("a", "2 \"quoted\" } ; DROP ALL ; {")])
+    mini_kb.store.replace([_quad("a", "1")], [_quad("a", '2 "quoted" } ; DROP ALL ; {')])
     values = [q.object.value for q in mini_kb.store.quads(ox.NamedNode("http://e/a"))]
     assert values == ['2 "quoted" } ; DROP ALL ; {']
     assert mini_kb.store.count(GraphName.ONTOLOGY) > 0
