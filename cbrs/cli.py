@@ -19,7 +19,7 @@ from cbrs import __version__
 from cbrs.output import RESULT_FORMATS, render_result, table, term_text
 from cbrs.settings import SETTINGS, setting
 from kb import Advertisement, KnowledgeBase, KnowledgeBaseError, Requirement, ServiceDescription
-from kb.namespaces import GraphName, expand, shorten
+from kb.namespaces import PREFIXES, GraphName, expand, shorten
 
 
 @dataclass
@@ -34,6 +34,12 @@ class App:
         if self._kb is None:
             self._kb = KnowledgeBase.open(self.store_location)
         return self._kb
+
+    def close(self) -> None:
+        """Flush and release the store, so the next command (even in this process) can open it."""
+        if self._kb is not None:
+            self._kb.close()
+            self._kb = None
 
 
 pass_app = click.make_pass_decorator(App)
@@ -61,7 +67,9 @@ class _Group(click.Group):
 @click.pass_context
 def cli(ctx: click.Context, store: str | None) -> None:
     """cbrs: a knowledge base that lets service robots find and use the services around them."""
-    ctx.obj = App(store_location=setting("store").resolve(store))
+    app = App(store_location=setting("store").resolve(store))
+    ctx.obj = app
+    ctx.call_on_close(app.close)
 
 
 @cli.command()
@@ -174,7 +182,11 @@ def show(app: App, iri: str, as_json: bool) -> None:
     full = _expand(iri)
     kb = app.kb
     if not kb.describes(full):
-        raise click.ClickException(f"nothing in the store mentions <{full}>")
+        hint = ""
+        scheme = full.split(":", 1)[0]
+        if "://" not in full and scheme not in ("urn", "tag", "mailto", "file"):
+            hint = f" (is {scheme!r} a mistyped prefix? known prefixes: {', '.join(PREFIXES)})"
+        raise click.ClickException(f"nothing in the store mentions <{full}>{hint}")
     is_description = bool(kb.select("description", {"description": full}))
     if is_description:
         description = kb.description(full)

@@ -80,7 +80,10 @@ class QuerySyntaxError(KnowledgeBaseError):
     def __init__(self, query: str, message: str) -> None:
         self.query = query
         self.message = message
-        super().__init__(f"SPARQL syntax error: {message}")
+        one_line = " ".join(message.split())
+        if len(one_line) > 240:
+            one_line = one_line[:240] + " ..."
+        super().__init__(f"SPARQL syntax error: {one_line}")
 
 
 class NotFoundError(KnowledgeBaseError):

@@ -80,4 +80,4 @@ class KnowledgeBase:
         )
 
     def close(self) -> None:
-        self.store.flush()
+        self.store.close()

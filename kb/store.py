@@ -27,8 +27,20 @@ class Store:
     """
 
     def __init__(self, backend: ox.Store, location: str) -> None:
-        self._backend = backend
+        self._open: ox.Store | None = backend
         self.location = location
+
+    @property
+    def _backend(self) -> ox.Store:
+        if self._open is None:
+            raise StoreError(self.location, "is closed")
+        return self._open
+
+    def close(self) -> None:
+        """Flush and release the store (and its on-disk lock) even if this object lives on."""
+        if self._open is not None:
+            self.flush()
+            self._open = None
 
     @classmethod
     def open(cls, location: str | Path) -> Store:
@@ -43,6 +55,12 @@ class Store:
             path.mkdir(parents=True, exist_ok=True)
             return cls(ox.Store(str(path)), str(path))
         except OSError as error:
+            if "lock" in str(error).lower():
+                raise StoreError(
+                    text,
+                    "is in use by another process (RocksDB lock held); stop it or pick "
+                    f"another store with --store ({error})",
+                ) from error
             raise StoreError(text, str(error)) from error
 
     @property

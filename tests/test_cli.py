@@ -1,0 +1,210 @@
+"""The cbrs command as a person meets it: exit codes and the messages shown."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from cbrs import __version__
+from cbrs.cli import cli, main
+
+BAD = Path(__file__).parent / "data" / "bad"
+DATA = Path(__file__).parent / "data"
+
+
+@pytest.fixture(scope="module")
+def store(tmp_path_factory: pytest.TempPathFactory) -> str:
+    """An on-disk store seeded once for the module; tests that write use their own."""
+    location = str(tmp_path_factory.mktemp("cli") / "store")
+    result = CliRunner().invoke(cli, ["--store", location, "init"])
+    assert result.exit_code == 0, result.output
+    return location
+
+
+def run(*args: str, store: str | None = None, env: dict[str, str] | None = None) -> tuple[int, str]:
+    argv = (["--store", store] if store else []) + list(args)
+    result = CliRunner().invoke(cli, argv, env=env)
+    return result.exit_code, result.output
+
+
+def test_version() -> None:
+    code, out = run("--version")
+    assert code == 0 and __version__ in out
+
+
+def test_init_reports_graphs_and_is_idempotent(tmp_path: Path) -> None:
+    location = str(tmp_path / "s")
+    code, first = run("init", store=location)
+    assert code == 0
+    assert "graph:ontology" in first and "advertisements" in first
+    code, second = run("init", store=location)
+    assert code == 0 and second == first
+
+
+def test_named_query_lists_locate_mobile_robot_as_json(store: str) -> None:
+    code, out = run("query", "--name", "advertisements", "--format", "json", store=store)
+    assert code == 0
+    rows = {b["service"]["value"]: b for b in json.loads(out)["results"]["bindings"]}
+    locate = rows["https://w3id.org/cbrs/service#LocateMobileRobot_CeilingCamera01"]
+    assert locate["inputs"]["value"] == "https://w3id.org/cbrs/home#MarkerColour"
+    assert locate["outputs"]["value"] == "https://w3id.org/cbrs/home#RobotLocation"
+    assert locate["kind"]["value"] == "https://w3id.org/cbrs/core#DynamicPerceptionComponent"
+
+
+def test_named_query_with_binding(store: str) -> None:
+    code, out = run(
+        "query",
+        "--name",
+        "description_parameters",
+        "--bind",
+        "description=req:RobotSelfPosition",
+        store=store,
+    )
+    assert code == 0
+    assert "home:RobotPosition" in out and "output" in out
+
+
+@pytest.mark.parametrize(
+    ("fmt", "expected"),
+    [
+        ("table", "home:Cup"),
+        ("csv", "https://w3id.org/cbrs/home#Cup"),
+        ("tsv", "<https://w3id.org/cbrs/home#Cup>"),
+    ],
+)
+def test_query_text_in_formats(store: str, fmt: str, expected: str) -> None:
+    code, out = run("query", "SELECT ?c WHERE { BIND(home:Cup AS ?c) }", "--format", fmt, store=store)
+    assert code == 0 and expected in out
+
+
+def test_ask_and_construct(store: str) -> None:
+    assert run("query", "ASK { home:Cup a owl:Class }", store=store) == (0, "true\n")
+    code, out = run("query", "CONSTRUCT { home:Cup a owl:Class } WHERE {}", store=store)
+    assert code == 0 and "home:Cup a owl:Class" in out
+
+
+def test_query_from_file(store: str, tmp_path: Path) -> None:
+    path = tmp_path / "q.rq"
+    path.write_text("SELECT (COUNT(*) AS ?n) WHERE { ?s a cbrs:Requirement }", encoding="utf-8")
+    code, out = run("query", "--file", str(path), "--format", "csv", store=store)
+    assert code == 0 and out.splitlines()[0] == "n" and int(out.splitlines()[1]) >= 1
+
+
+def test_query_list_names_queries_and_parameters(store: str) -> None:
+    code, out = run("query", "--list", store=store)
+    assert code == 0
+    assert "advertisements" in out and "description*:iri" in out
+
+
+def test_syntax_error_is_one_line(store: str) -> None:
+    code, out = run("query", "SELECT ?x WHERE { ?x", store=store)
+    assert code == 1
+    assert out.startswith("Error: SPARQL syntax error")
+    assert out.count("\n") == 1 and "Traceback" not in out
+
+
+@pytest.mark.parametrize(
+    ("args", "code", "message"),
+    [
+        (["query"], 2, "give exactly one of TEXT, --file or --name"),
+        (["query", "ASK {}", "--name", "advertisements"], 2, "give exactly one"),
+        (["query", "--name", "advertisements", "--bind", "kind"], 2, "is not VAR=VALUE"),
+        (["query", "--name", "advertisements", "--bind", "knd=x"], 1, "takes no such parameter"),
+        (["query", "--name", "nosuch"], 1, "no named query 'nosuch'"),
+        (["query", "ASK {}", "--bind", "a=b"], 2, "--bind works with --name"),
+        (["show", "hme:Cup"], 1, "is 'hme' a mistyped prefix? known prefixes: cbrs, home"),
+        (["show", "not an iri"], 2, "neither an absolute IRI nor a prefixed name"),
+        (["show", "svc:NoSuchThing"], 1, "nothing in the store mentions"),
+        (["load", "--graph", "servces", str(DATA / "mini_services.ttl")], 1, "unknown graph 'servces'"),
+        (["load", str(BAD / "unknown.format")], 1, "cannot tell the RDF format"),
+    ],
+)
+def test_errors_name_what_was_wrong(store: str, args: list[str], code: int, message: str) -> None:
+    got_code, out = run(*args, store=store)
+    assert got_code == code, out
+    assert message in out
+    assert "Traceback" not in out
+
+
+def test_broken_file_loads_nothing(tmp_path: Path) -> None:
+    location = str(tmp_path / "s")
+    count = "SELECT (COUNT(*) AS ?n) WHERE { GRAPH ?g { ?s ?p ?o } }"
+    code, before = run("query", count, "--format", "csv", store=location)
+    assert code == 0
+    code, out = run("load", str(DATA / "mini_services.ttl"), str(BAD / "broken.ttl"), store=location)
+    assert code == 1
+    assert f"{BAD / 'broken.ttl'}:4:" in out and out.count("\n") == 1
+    assert run("query", count, "--format", "csv", store=location) == (0, before)
+
+
+def test_load_says_where_each_file_went(tmp_path: Path) -> None:
+    code, out = run(
+        "load", str(DATA / "mini_ontology.ttl"), str(DATA / "mini_services.ttl"), store=str(tmp_path / "s")
+    )
+    assert code == 0
+    assert "mini_ontology.ttl: 39 triples into graph:ontology" in out
+    assert "into graph:services" in out
+
+
+def test_services_table(store: str) -> None:
+    code, out = run("services", store=store)
+    assert code == 0
+    line = next(ln for ln in out.splitlines() if "LocateMobileRobot_CeilingCamera01" in ln)
+    assert "DynamicPerception" in line and "home:MarkerColour" in line and "home:RobotLocation" in line
+    code, out = run("services", "--json", store=store)
+    assert code == 0 and any(r["serviceName"] == "LocateMobileRobot" for r in json.loads(out))
+
+
+def test_show_six_tuple(store: str) -> None:
+    code, out = run("show", "svc:LocateMobileRobot_CeilingCamera01", store=store)
+    assert code == 0
+    for expected in (
+        "SN           LocateMobileRobot",
+        "input        home:MarkerColour",
+        "output       home:RobotLocation",
+    ):
+        assert expected in out
+    code, out = run("show", "svc:LocateMobileRobot_CeilingCamera01", "--json", store=store)
+    assert json.loads(out)["service_name"] == "LocateMobileRobot"
+
+
+def test_show_any_resource(store: str) -> None:
+    code, out = run("show", "home:Cup", store=store)
+    assert code == 0
+    assert "rdf:type" in out and "owl:Class" in out and "graph:ontology" in out
+
+
+def test_settings_lists_environment_variables() -> None:
+    code, out = run("settings", env={"CBRS_STORE": ":memory:"})
+    assert code == 0 and "CBRS_STORE" in out and ":memory:" in out
+
+
+def test_bad_format_from_environment_is_reported(store: str) -> None:
+    code, out = run("query", "ASK {}", store=store, env={"CBRS_FORMAT": "yaml"})
+    assert code == 2 and "'yaml' is not one of" in out
+
+
+def test_demo_tours_the_paper_example() -> None:
+    code, out = run("demo", store=":memory:")
+    assert code == 0, out
+    assert "Table 1" in out and "LocateMobileRobot" in out and "RobotSelfPosition" in out
+
+
+def test_unexpected_errors_are_one_line(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    def explode(*_: object) -> None:
+        raise RuntimeError("disk on fire")
+
+    monkeypatch.setattr("cbrs.cli.KnowledgeBase.open", explode)
+    monkeypatch.setattr(sys, "argv", ["cbrs", "--store", ":memory:", "services"])
+    monkeypatch.delenv("CBRS_DEBUG", raising=False)
+    with pytest.raises(SystemExit) as caught:
+        main()
+    assert caught.value.code == 2
+    err = capsys.readouterr().err
+    assert err == "internal error: RuntimeError: disk on fire (set CBRS_DEBUG=1 for the traceback)\n"
