@@ -1,0 +1,75 @@
+"""Benchmark: seeding a store with the bundled data, reading descriptions, and each named query.
+
+Run: python bench/kb_queries.py [--repeat N]. Prints the machine, the inputs and the figures.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import statistics
+import time
+from collections.abc import Callable
+
+import pyoxigraph
+
+from kb import KnowledgeBase, Store
+from kb.resources import bundled_files
+
+# Sample bindings for the queries that need one.
+BINDINGS = {
+    "description": {"description": "svc:LocateMobileRobot_CeilingCamera01"},
+    "description_parameters": {"description": "svc:LocateMobileRobot_CeilingCamera01"},
+    "description_conditions": {"description": "svc:LocateMobileRobot_CeilingCamera01"},
+    "description_qos": {"description": "svc:LocateMobileRobot_CeilingCamera01"},
+    "description_sea": {"description": "svc:LocateMobileRobot_CeilingCamera01"},
+    "description_ports": {"description": "svc:LocateMobileRobot_CeilingCamera01"},
+    "concept_parts": {"concept": "home:RobotPosition"},
+    "resource_triples": {"resource": "home:Cup"},
+    "action_ordering": {"action": "act:RobotArmServeACup"},
+}
+
+
+def timed(action: Callable[[], object], repeat: int) -> list[float]:
+    samples = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        action()
+        samples.append((time.perf_counter() - start) * 1000)
+    return samples
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--repeat", type=int, default=50, help="runs per measured operation")
+    args = parser.parse_args()
+
+    print(
+        f"machine: {platform.machine()} {platform.system()} {platform.release()}, {os.cpu_count()} cores, "
+        f"python {platform.python_version()}, pyoxigraph {pyoxigraph.__version__}"
+    )
+    print(f"inputs: bundled files {', '.join(f.path.name for f in bundled_files())}; repeat {args.repeat}")
+
+    seed = timed(lambda: KnowledgeBase(Store.open(":memory:")).seed(), max(3, args.repeat // 10))
+    kb = KnowledgeBase.open(":memory:")
+    stats = kb.statistics()
+    print(f"store: {sum(stats.values())} triples, {len(kb.select('advertisements'))} advertisements")
+    print(f"\n{'operation':<34} {'p50 ms':>9} {'p95 ms':>9}")
+    print(f"{'seed in-memory store':<34} {statistics.median(seed):>9.2f} {max(seed):>9.2f}")
+
+    def read_all() -> object:
+        kb._reader.clear_cache()
+        return kb.advertisements()
+
+    rows = timed(read_all, max(3, args.repeat // 10))
+    print(f"{'read all advertisements (cold)':<34} {statistics.median(rows):>9.2f} {max(rows):>9.2f}")
+    for name in kb.queries.names():
+        values = BINDINGS.get(name, {})
+        samples = sorted(timed(lambda n=name, v=values: kb.select(n, v), args.repeat))  # type: ignore[misc]
+        p95 = samples[min(len(samples) - 1, int(len(samples) * 0.95))]
+        print(f"{'query ' + name:<34} {statistics.median(samples):>9.2f} {p95:>9.2f}")
+
+
+if __name__ == "__main__":
+    main()
