@@ -151,6 +151,27 @@ def query(
 
 
 @cli.command()
+@click.argument("file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.option("--update", is_flag=True, help="Replace the descriptions of advertisements already registered.")
+@pass_app
+def register(app: App, file: Path, update: bool) -> None:
+    """Register the advertisements in a Turtle FILE (checked first; one transaction)."""
+    text = file.read_bytes()
+    iris = app.kb.registry.update(text, str(file)) if update else app.kb.registry.register(text, str(file))
+    for iri in iris:
+        click.echo(f"{'updated' if update else 'registered'} {shorten(iri)}")
+
+
+@cli.command()
+@click.argument("iri")
+@pass_app
+def deregister(app: App, iri: str) -> None:
+    """Remove a registered advertisement and the nodes of its description (one transaction)."""
+    removed = app.kb.registry.deregister(_expand(iri))
+    click.echo(f"deregistered {shorten(_expand(iri))} ({removed} triples)")
+
+
+@cli.command()
 @click.option("--json", "as_json", is_flag=True, help="Print the advertisements as JSON.")
 @pass_app
 def services(app: App, as_json: bool) -> None:

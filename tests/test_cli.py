@@ -208,3 +208,29 @@ def test_unexpected_errors_are_one_line(
     assert caught.value.code == 2
     err = capsys.readouterr().err
     assert err == "internal error: RuntimeError: disk on fire (set CBRS_DEBUG=1 for the traceback)\n"
+
+
+def test_register_update_deregister_round_trip(tmp_path: Path) -> None:
+    location = str(tmp_path / "s")
+    turtle = tmp_path / "cam.ttl"
+    body = """@prefix cbrs: <https://w3id.org/cbrs/core#> . @prefix svc: <https://w3id.org/cbrs/service#> .
+    @prefix home: <https://w3id.org/cbrs/home#> .
+    svc:LocateMobileRobot_CeilingCamera03 a cbrs:DynamicPerceptionComponent ;
+      cbrs:deviceName "CeilingCamera03" ; cbrs:serviceName "LocateMobileRobot" ;
+      cbrs:hasOWLSModel [ cbrs:hasInput [ cbrs:parameterType home:MarkerColour ] ;
+                          cbrs:hasOutput [ cbrs:parameterType home:OUTPUT ] ] ."""
+    turtle.write_text(body.replace("OUTPUT", "RobotLocation"), encoding="utf-8")
+    before = run("query", "SELECT (COUNT(*) AS ?n) WHERE { GRAPH ?g { ?s ?p ?o } }", store=location)
+    assert run("register", str(turtle), store=location) == (
+        0,
+        "registered svc:LocateMobileRobot_CeilingCamera03\n",
+    )
+    code, out = run("register", str(turtle), store=location)
+    assert code == 1 and "already registered; update it instead" in out
+    turtle.write_text(body.replace("OUTPUT", "RobotPose"), encoding="utf-8")
+    assert run("register", "--update", str(turtle), store=location)[0] == 0
+    code, out = run("show", "svc:LocateMobileRobot_CeilingCamera03", store=location)
+    assert "home:RobotPose" in out and "home:RobotLocation" not in out
+    code, out = run("deregister", "svc:LocateMobileRobot_CeilingCamera03", store=location)
+    assert code == 0 and out.startswith("deregistered svc:LocateMobileRobot_CeilingCamera03")
+    assert run("query", "SELECT (COUNT(*) AS ?n) WHERE { GRAPH ?g { ?s ?p ?o } }", store=location) == before
