@@ -9,40 +9,17 @@ import json
 import os
 import sys
 import traceback
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import click
 
 from cbrs import __version__
+from cbrs.app import App, parse_iri, pass_app
 from cbrs.output import RESULT_FORMATS, render_result, table, term_text
 from cbrs.settings import SETTINGS, setting
-from kb import Advertisement, KnowledgeBase, KnowledgeBaseError, Requirement, ServiceDescription
+from kb import Advertisement, KnowledgeBaseError, Requirement, ServiceDescription
 from kb.namespaces import PREFIXES, GraphName, expand, shorten
-
-
-@dataclass
-class App:
-    """What every command gets: the resolved settings and, opened on first use, the knowledge base."""
-
-    store_location: str
-    _kb: KnowledgeBase | None = field(default=None, repr=False)
-
-    @property
-    def kb(self) -> KnowledgeBase:
-        if self._kb is None:
-            self._kb = KnowledgeBase.open(self.store_location)
-        return self._kb
-
-    def close(self) -> None:
-        """Flush and release the store, so the next command (even in this process) can open it."""
-        if self._kb is not None:
-            self._kb.close()
-            self._kb = None
-
-
-pass_app = click.make_pass_decorator(App)
 
 
 class _Group(click.Group):
@@ -167,8 +144,8 @@ def register(app: App, file: Path, update: bool) -> None:
 @pass_app
 def deregister(app: App, iri: str) -> None:
     """Remove a registered advertisement and the nodes of its description (one transaction)."""
-    removed = app.kb.registry.deregister(_expand(iri))
-    click.echo(f"deregistered {shorten(_expand(iri))} ({removed} triples)")
+    removed = app.kb.registry.deregister(parse_iri(iri))
+    click.echo(f"deregistered {shorten(parse_iri(iri))} ({removed} triples)")
 
 
 @cli.command()
@@ -200,7 +177,7 @@ def services(app: App, as_json: bool) -> None:
 @pass_app
 def show(app: App, iri: str, as_json: bool) -> None:
     """Show a service description's six-tuple, or any resource's triples (IRI or prefix:name)."""
-    full = _expand(iri)
+    full = parse_iri(iri)
     kb = app.kb
     if not kb.describes(full):
         hint = ""
@@ -314,13 +291,6 @@ def _split_binding(text: str) -> tuple[str, str]:
     return name.lstrip("?$"), value
 
 
-def _expand(name: str) -> str:
-    try:
-        return expand(name)
-    except ValueError as error:
-        raise click.BadParameter(str(error), param_hint="IRI") from error
-
-
 def main() -> None:
     """Entry point. click reports usage and library errors in one line; anything else is a bug,
     reported in one line too unless CBRS_DEBUG asks for the traceback."""
@@ -333,3 +303,12 @@ def main() -> None:
             f"internal error: {type(error).__name__}: {error} (set CBRS_DEBUG=1 for the traceback)", err=True
         )
         sys.exit(2)
+
+
+def _register_subcommands() -> None:
+    from cbrs.cli_reasoner import match
+
+    cli.add_command(match)
+
+
+_register_subcommands()

@@ -35,6 +35,9 @@ def test_named_query_known_answer(case: dict[str, Any]) -> None:
     kb.load([ontology_dir() / "core.ttl"], graph="ontology")
     kb.load([DATA / name for name in case["data"]])
     rows = kb.select(case["query"], {k: _expand(v) for k, v in case.get("bind", {}).items()})
+    if "only_prefix" in case:  # the case lists only rows whose first variable starts with this
+        first = next(iter(case["rows"][0]))
+        rows = [row for row in rows if row[first].value.startswith(case["only_prefix"])]
     expected = case["rows"]
     keys = sorted({key for row in expected for key in row})
     got = sorted(tuple(_normalise(row[k].value) if k in row else "" for k in keys) for row in rows)

@@ -1,0 +1,41 @@
+"""What every command is handed: the resolved settings and, opened on first use, the knowledge base."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import click
+
+from kb import KnowledgeBase
+from kb.namespaces import expand
+
+
+@dataclass
+class App:
+    """Settings for this run, and the knowledge base they name."""
+
+    store_location: str
+    _kb: KnowledgeBase | None = field(default=None, repr=False)
+
+    @property
+    def kb(self) -> KnowledgeBase:
+        if self._kb is None:
+            self._kb = KnowledgeBase.open(self.store_location)
+        return self._kb
+
+    def close(self) -> None:
+        """Flush and release the store, so the next command (even in this process) can open it."""
+        if self._kb is not None:
+            self._kb.close()
+            self._kb = None
+
+
+pass_app = click.make_pass_decorator(App)
+
+
+def parse_iri(name: str, hint: str = "IRI") -> str:
+    """A full IRI from ``prefix:local`` or an absolute IRI, as a click usage error otherwise."""
+    try:
+        return expand(name)
+    except ValueError as error:
+        raise click.BadParameter(str(error), param_hint=hint) from error

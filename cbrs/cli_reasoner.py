@@ -1,0 +1,79 @@
+"""``cbrs match`` and ``cbrs eval``: thin commands over the reasoner package."""
+
+from __future__ import annotations
+
+import json
+
+import click
+
+from cbrs.app import App, parse_iri, pass_app
+from cbrs.output import table
+from kb.namespaces import shorten
+from reasoner.matchmaker import Candidate, Matchmaker, MatchResult, MatchStatus
+from reasoner.methods import METHODS
+
+
+@click.command()
+@click.argument("requirement")
+@click.option(
+    "--top", default=10, show_default=True, type=click.IntRange(min=1), help="How many candidates to show."
+)
+@click.option(
+    "--method", type=click.Choice(METHODS), default="sem-str", show_default=True, help="Matching method."
+)
+@click.option(
+    "--explain", is_flag=True, help="Show, for each shown candidate, the entity pairs and what it lacks."
+)
+@click.option("--json", "as_json", is_flag=True, help="Print the ranking (with explanations) as JSON.")
+@pass_app
+def match(app: App, requirement: str, top: int, method: str, explain: bool, as_json: bool) -> None:
+    """Rank the advertisements against REQUIREMENT (an IRI or prefix:name, e.g. req:RobotSelfPosition)."""
+    iri = parse_iri(requirement, "REQUIREMENT")
+    result = Matchmaker(app.kb, method).rank(iri)
+    if as_json:
+        click.echo(json.dumps(result.to_dict(top), indent=2))
+        return
+    click.echo(_ranking(result, top))
+    if explain:
+        for position, candidate in enumerate(result.candidates[:top], start=1):
+            click.echo("\n" + _explanation(position, candidate))
+
+
+def _ranking(result: MatchResult, top: int) -> str:
+    name = shorten(result.requirement)
+    if result.status is MatchStatus.MATCHED:
+        head = f"{name}: matched by {result.method}; best {shorten(result.candidates[0].advertisement)}"
+    else:
+        head = f"{name}: no acceptable match by {result.method} (--explain says what each lacks)"
+    rows = []
+    for position, c in enumerate(result.candidates[:top], start=1):
+        parts = " ".join(f"{name[:3]}={value:.2f}" for name, value in c.parts.items())
+        verdict = "yes" if c.acceptable else ("; ".join(c.rejected_by) if c.rejected_by else "score too low")
+        rows.append([str(position), shorten(c.advertisement), f"{c.score:.3f}", parts, verdict])
+    shown = min(top, len(result.candidates))
+    return (
+        f"{head}\n"
+        + table(["#", "advertisement", "score", "parts", "acceptable"], rows)
+        + (f"\n({shown} of {len(result.candidates)} advertisements)")
+    )
+
+
+def _explanation(position: int, c: Candidate) -> str:
+    lines = [f"#{position} {shorten(c.advertisement)}  score {c.score:.3f}"]
+    rows = [
+        [
+            p.role,
+            shorten(p.requested),
+            shorten(p.advertised) if p.advertised else "-",
+            f"{p.similarity:.2f}",
+            p.degree,
+            p.how,
+        ]
+        for p in c.pairs
+    ]
+    lines.append(table(["role", "requested", "advertised", "sim", "degree", "how"], rows))
+    for lack in c.lacks:
+        lines.append(f"  lacks: {lack}")
+    for reason in c.rejected_by:
+        lines.append(f"  rejected: {reason}")
+    return "\n".join(lines)

@@ -1,0 +1,319 @@
+"""The matchmaker: rank every advertisement against a requirement, and say why.
+
+A candidate's score combines four parts, each in [0, 1]; parts the requirement does not state are
+left out and the weights of the rest renormalised (MatchConfig):
+
+- outputs: each requested output's best CSS against the advertised outputs, averaged;
+- inputs: both ways, averaged: each advertised input's best CSS against the inputs the requirement
+  provides (can it be invoked?) and each provided input's best CSS against the advertised inputs (does
+  it use what the requester offers?);
+- effects: each requested effect's best statement similarity against the advertised effects;
+- preconditions: each advertised precondition's best statement similarity against the
+  preconditions the requirement guarantees (only when it states any).
+
+The SEA and QoS of the requirement act as filters. "No acceptable match" is a status.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass
+from enum import Enum
+from typing import Any
+
+from kb import Advertisement, KnowledgeBase, Parameter, PartNode, Requirement
+from reasoner.config import MatchConfig
+from reasoner.degrees import Degree, degree_of_match
+from reasoner.methods import Method, make_method
+from reasoner.names import local_name
+from reasoner.spans import SpanMatch, conceptual_span_similarity
+from reasoner.statements import StatementMatch, best_statement_matches
+from reasoner.taxonomy import TaxonomyIndex
+
+
+class MatchStatus(Enum):
+    MATCHED = "matched"
+    NO_ACCEPTABLE_MATCH = "no-acceptable-match"
+
+
+@dataclass(frozen=True)
+class EntityPair:
+    """One compared pair: which requirement entity met which advertised one, how, and how well."""
+
+    role: str  # output, input, effect, precondition
+    requested: str
+    advertised: str | None
+    similarity: float
+    how: str
+    degree: str
+
+
+@dataclass(frozen=True)
+class Candidate:
+    advertisement: str
+    label: str | None
+    score: float
+    parts: dict[str, float]
+    pairs: tuple[EntityPair, ...]
+    lacks: tuple[str, ...]
+    rejected_by: tuple[str, ...]  # SEA / QoS filters (and, for strict logic, a failed output)
+    acceptable: bool  # passes the filters and reaches the acceptance score
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class MatchResult:
+    requirement: str
+    method: str
+    status: MatchStatus
+    candidates: tuple[Candidate, ...]  # ranked, best first; acceptable ones before the rest
+
+    def to_dict(self, top: int | None = None) -> dict[str, Any]:
+        return {
+            "requirement": self.requirement,
+            "method": self.method,
+            "status": self.status.value,
+            "candidates": [c.to_dict() for c in self.candidates[:top]],
+        }
+
+
+class Matchmaker:
+    """Ranks the advertisements in a knowledge base; the taxonomy index is built once."""
+
+    def __init__(
+        self,
+        kb: KnowledgeBase,
+        method: str = "sem-str",
+        config: MatchConfig | None = None,
+        index: TaxonomyIndex | None = None,
+        advertisements: Sequence[Advertisement] | None = None,
+    ) -> None:
+        self.kb = kb
+        self.config = config or MatchConfig()
+        self.index = index or TaxonomyIndex.from_kb(kb)
+        self.method: Method = make_method(method, self.index, self.config)
+        self._advertisements = list(advertisements) if advertisements is not None else None
+
+    @property
+    def advertisements(self) -> list[Advertisement]:
+        if self._advertisements is None:
+            self._advertisements = self.kb.advertisements()
+        return self._advertisements
+
+    def rank(self, requirement: Requirement | str) -> MatchResult:
+        """Score every advertisement against ``requirement`` (an IRI or a Requirement)."""
+        if isinstance(requirement, str):
+            found = self.kb.description(requirement)
+            if not isinstance(found, Requirement):
+                raise TypeError(f"<{requirement}> is an advertisement, not a requirement")
+            requirement = found
+        scored = [self.score(requirement, ad) for ad in self.advertisements]
+        scored.sort(key=lambda c: (not c.acceptable, bool(c.rejected_by), -c.score, c.advertisement))
+        status = MatchStatus.MATCHED if scored and scored[0].acceptable else MatchStatus.NO_ACCEPTABLE_MATCH
+        return MatchResult(requirement.iri, self.method.name, status, tuple(scored))
+
+    def score(self, requirement: Requirement, ad: Advertisement) -> Candidate:
+        pairs: list[EntityPair] = []
+        lacks: list[str] = []
+        parts: dict[str, float] = {}
+        cfg = self.config
+        if requirement.outputs:
+            parts["outputs"] = self._parameters(requirement.outputs, ad.outputs, "output", pairs, lacks)
+        if ad.inputs or requirement.inputs:
+            needed = (
+                self._parameters(ad.inputs, requirement.inputs, "input", pairs, lacks) if ad.inputs else None
+            )
+            used = (
+                self._parameters(requirement.inputs, ad.inputs, "provided input", [], lacks)
+                if requirement.inputs
+                else None
+            )
+            present = [v for v in (needed, used) if v is not None]
+            parts["inputs"] = sum(present) / len(present)
+        if requirement.effects:
+            matches = best_statement_matches(requirement.effects, ad.effects, self.method.measure, cfg)
+            parts["effects"] = self._statements(matches, "effect", pairs, lacks)
+        if ad.preconditions and requirement.preconditions:
+            matches = best_statement_matches(
+                ad.preconditions, requirement.preconditions, self.method.measure, cfg
+            )
+            parts["preconditions"] = self._statements(matches, "precondition", pairs, lacks)
+        weights = {
+            "outputs": cfg.output_weight,
+            "inputs": cfg.input_weight,
+            "effects": cfg.effect_weight,
+            "preconditions": cfg.precondition_weight,
+        }
+        total = sum(weights[name] for name in parts)
+        score = sum(weights[name] * value for name, value in parts.items()) / total if total else 0.0
+        rejected = self._filters(requirement, ad)
+        if self.method.strict:
+            failed = [
+                pair
+                for pair in pairs
+                if pair.role in ("output", "effect") and pair.degree == Degree.FAIL.value
+            ]
+            if failed:
+                rejected.append(
+                    f"strict logic: {failed[0].role} {_short(failed[0].requested)} has no accepted match"
+                )
+        score = round(score, 6)
+        acceptable = not rejected and score >= cfg.accept_score
+        return Candidate(
+            ad.iri, ad.label, score, parts, tuple(pairs), tuple(lacks), tuple(rejected), acceptable
+        )
+
+    # -- parts ---------------------------------------------------------------------------------
+
+    def _parameters(
+        self,
+        wanted: tuple[Parameter, ...],
+        offered: tuple[Parameter, ...],
+        role: str,
+        pairs: list[EntityPair],
+        lacks: list[str],
+    ) -> float:
+        """Each wanted parameter's best CSS against the offered ones. Pairs are recorded requirement
+        side first, whichever side wants."""
+        flip = role == "input"  # the advertisement wants, the requirement offers
+        values = []
+        for parameter in wanted:
+            scored = [(self._trees(parameter, other), other) for other in offered]
+            if not scored:
+                values.append(0.0)
+                lacks.append(f"{role} {_short(parameter.type)}: nothing on the other side")
+                pairs.append(self._pair(False, role, parameter.type, None, 0.0, "no partner"))
+                continue
+            match, other = max(scored, key=lambda item: item[0].value)
+            values.append(match.value)
+            if self.method.strict:
+                pairs.append(self._pair(flip, role, parameter.type, other.type, match.value, "degree"))
+                continue
+            for pair in match.pairs:
+                how = pair.similarity.explain()
+                if pair.span > 1:
+                    how += f", covers {pair.span} parts"
+                elif pair.span == 0:
+                    how += ", its parts carry the match"
+                pairs.append(
+                    self._pair(flip, role, pair.requested, pair.advertised, pair.similarity.value, how)
+                )
+            if not match.pairs:
+                how = "best partner, below the pair threshold"
+                pairs.append(self._pair(flip, role, parameter.type, other.type, match.value, how))
+                best = f"best {_short(other.type)}, {match.value:.2f}"
+                lacks.append(f"{role} {_short(parameter.type)}: no match ({best})")
+                continue
+            if not any(pair.requested == parameter.type for pair in match.pairs):
+                how = "below the pair threshold; its parts matched"
+                pairs.append(self._pair(flip, role, parameter.type, other.type, match.value, how))
+            for leaf in match.uncovered:
+                lacks.append(f"{role} {_short(parameter.type)}: nothing matches its part {_short(leaf)}")
+        return sum(values) / len(values) if values else 0.0
+
+    def _pair(
+        self, flip: bool, role: str, wanted: str, offered: str | None, value: float, how: str
+    ) -> EntityPair:
+        if flip and offered is not None:
+            degree = degree_of_match(self.index, offered, wanted)
+            return EntityPair(role, offered, wanted, value, how, degree.value)
+        degree = degree_of_match(self.index, wanted, offered) if offered else Degree.FAIL
+        return EntityPair(role, wanted, offered, value, how, degree.value)
+
+    def _trees(self, wanted: Parameter, offered: Parameter) -> SpanMatch:
+        if self.method.strict:
+            degree = degree_of_match(self.index, wanted.type, offered.type)
+            return SpanMatch(_DEGREE_SCORE[degree], (), () if degree.accepted else (wanted.type,))
+        return conceptual_span_similarity(
+            wanted.tree or PartNode(wanted.type),
+            offered.tree or PartNode(offered.type),
+            self.method.measure,
+            self.config.pair_threshold,
+            use_parts=self.method.use_parts,
+        )
+
+    def _statements(
+        self, matches: list[StatementMatch], role: str, pairs: list[EntityPair], lacks: list[str]
+    ) -> float:
+        values = []
+        for match in matches:
+            wanted = match.requested
+            text = f"({_short(wanted.subject)}, {_short(wanted.predicate)}, {_short(wanted.object)})"
+            if match.advertised is None:
+                lacks.append(f"{role} {text}: none offered")
+                pairs.append(EntityPair(role, text, None, 0.0, "no partner", Degree.FAIL.value))
+                values.append(0.0)
+                continue
+            got = match.advertised
+            degrees = [
+                degree_of_match(self.index, a, b)
+                for a, b in (
+                    (wanted.subject, got.subject),
+                    (wanted.predicate, got.predicate),
+                    (wanted.object, got.object),
+                )
+            ]
+            degree = min(degrees, key=_DEGREE_SCORE.__getitem__)
+            value = _DEGREE_SCORE[degree] if self.method.strict else match.value
+            offered = f"({_short(got.subject)}, {_short(got.predicate)}, {_short(got.object)})"
+            how = "s/p/o: " + ", ".join(f"{s.value:.2f}" for s in match.parts or ())
+            pairs.append(EntityPair(role, text, offered, value, how, degree.value))
+            if value < self.config.pair_threshold:
+                lacks.append(f"{role} {text}: best offer {offered} scores {value:.2f}")
+            values.append(value)
+        return sum(values) / len(values) if values else 0.0
+
+    # -- filters ---------------------------------------------------------------------------------
+
+    def _filters(self, requirement: Requirement, ad: Advertisement) -> list[str]:
+        reasons = []
+        wanted, offered = requirement.area, ad.area
+        if wanted and offered:
+            if wanted.bounds and offered.bounds:
+                if not _within(wanted.bounds, offered.bounds):
+                    reasons.append(f"SEA: effective area {offered.bounds} does not cover {wanted.bounds}")
+            elif wanted.areas and offered.areas:
+                for area in wanted.areas:
+                    if not any(self._covers(place, area) for place in offered.areas):
+                        reasons.append(
+                            f"SEA: {_short(area)} is outside {', '.join(map(_short, offered.areas))}"
+                        )
+        offered_qos = {q.metric: q.value for q in ad.qos}
+        for bound in requirement.qos:
+            value = offered_qos.get(bound.metric)
+            name = _short(bound.metric)
+            if value is None:
+                if self.config.qos_missing_fails:
+                    reasons.append(f"QoS: states no {name} (needs {bound.value:g})")
+            elif bound.better_when == "lower" and value > bound.value:
+                reasons.append(f"QoS: {name} {value:g} > {bound.value:g}")
+            elif bound.better_when == "higher" and value < bound.value:
+                reasons.append(f"QoS: {name} {value:g} < {bound.value:g}")
+        return reasons
+
+    def _covers(self, place: str, area: str) -> bool:
+        """``place`` covers ``area`` when it is the same, a superclass, or a whole it is part of."""
+        if place == area:
+            return True
+        return (
+            area in self.index and place in self.index and self.index.distance_down(area, place) is not None
+        )
+
+
+_DEGREE_SCORE = {Degree.EXACT: 1.0, Degree.SUBCLASS_OF: 0.8, Degree.HAS_SUBCLASS: 0.6, Degree.FAIL: 0.0}
+
+
+def _within(inner: tuple[float, float, float, float], outer: tuple[float, float, float, float]) -> bool:
+    eps = 1e-9
+    return (
+        inner[0] >= outer[0] - eps
+        and inner[1] <= outer[1] + eps
+        and inner[2] >= outer[2] - eps
+        and inner[3] <= outer[3] + eps
+    )
+
+
+def _short(iri: str) -> str:
+    return local_name(iri) if "://" in iri else iri

@@ -1,0 +1,36 @@
+"""The matching methods behind one interface: an entity measure and how it is applied."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from reasoner.config import MatchConfig
+from reasoner.similarity import EntityMeasure, Lin, SemStr, StringMatch, WuPalmer
+from reasoner.taxonomy import TaxonomyIndex
+
+METHODS = ("sem-str", "string", "wu-palmer", "lin", "logic")
+
+
+@dataclass(frozen=True)
+class Method:
+    """``use_parts``: compare part trees (CSS) or roots only; ``strict``: logic degrees, every
+    requested output must match (Paolucci et al.)."""
+
+    name: str
+    measure: EntityMeasure
+    use_parts: bool
+    strict: bool = False
+
+
+def make_method(name: str, index: TaxonomyIndex, config: MatchConfig) -> Method:
+    if name == "sem-str":
+        return Method(name, SemStr(index, config), use_parts=True)
+    if name == "wu-palmer":
+        return Method(name, WuPalmer(index), use_parts=False)
+    if name == "lin":
+        return Method(name, Lin(index), use_parts=False)
+    if name == "string":
+        return Method(name, StringMatch(), use_parts=False)
+    if name == "logic":
+        return Method(name, WuPalmer(index), use_parts=False, strict=True)
+    raise ValueError(f"unknown matching method {name!r}; use one of {', '.join(METHODS)}")

@@ -1,0 +1,170 @@
+"""Similarity of two entities (concepts or properties): Sem-Str and the baselines.
+
+Every measure answers ``measure(e1, e2) -> Similarity`` with a value in [0, 1] and the reason.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Protocol
+
+import jellyfish
+
+from reasoner.config import MatchConfig
+from reasoner.names import core_split, local_name
+from reasoner.taxonomy import ROOT, TaxonomyIndex
+
+
+@dataclass(frozen=True)
+class Similarity:
+    """A similarity value and how it was reached.
+
+    ``situation`` is "exact", "situation-1", "situation-2", "situation-3" for Sem-Str, or the
+    baseline's name; ``common`` is the most specific common ancestor where the taxonomy was used.
+    """
+
+    value: float
+    situation: str
+    common: str | None = None
+    links: tuple[int, int] | None = None
+
+    def explain(self) -> str:
+        if self.situation == "exact":
+            return "same concept"
+        if self.situation == "situation-1":
+            assert self.links is not None
+            via = "the root" if self.common == ROOT else local_name(self.common or "")
+            return f"1/(1+N), N={sum(self.links)} links via {via}"
+        if self.situation == "situation-2":
+            return f"Wu-Palmer via {local_name(self.common or '')}, links {self.links}"
+        if self.situation == "situation-3":
+            return "no taxonomy: Jaro-Winkler on core and complementary words"
+        return self.situation
+
+
+class EntityMeasure(Protocol):
+    name: str
+
+    def __call__(self, first: str, second: str) -> Similarity: ...
+
+
+class SemStr:
+    """The paper's Sem-Str similarity (Definition 1)."""
+
+    name = "sem-str"
+
+    def __init__(self, index: TaxonomyIndex, config: MatchConfig | None = None) -> None:
+        self.index = index
+        self.config = config or MatchConfig()
+        self._cache: dict[tuple[str, str], Similarity] = {}
+
+    def __call__(self, first: str, second: str) -> Similarity:
+        key = (first, second)
+        found = self._cache.get(key)
+        if found is None:
+            found = self._compute(first, second)
+            self._cache[key] = found
+        return found
+
+    def _compute(self, first: str, second: str) -> Similarity:
+        index = self.index
+        if first == second or (first in index and index.canonical(first) == index.canonical(second)):
+            return Similarity(1.0, "exact", first, (0, 0))
+        if first not in index or second not in index:
+            return self.situation_3(first, second)
+        up = index.distance_down(first, second)
+        if up is not None:  # e1 below e2
+            return Similarity(1 / (1 + up), "situation-1", index.canonical(second), (up, 0))
+        down = index.distance_down(second, first)
+        if down is not None:  # e2 below e1: the measure is symmetric
+            return Similarity(1 / (1 + down), "situation-1", index.canonical(first), (0, down))
+        common, n1, n2 = index.common_ancestor(first, second)
+        if common == ROOT:
+            return Similarity(1 / (1 + n1 + n2), "situation-1", ROOT, (n1, n2))
+        nr = index.depth(common)
+        return Similarity(2 * nr / (n1 + n2 + 2 * nr), "situation-2", common, (n1, n2))
+
+    def situation_3(self, first: str, second: str) -> Similarity:
+        """Jaro-Winkler on the core words and on the complementary words, weighted alpha > beta."""
+        core1, rest1 = core_split(self._name(first))
+        core2, rest2 = core_split(self._name(second))
+        core = jellyfish.jaro_winkler_similarity(core1, core2)
+        if not rest1 and not rest2:
+            rest = 1.0
+        elif not rest1 or not rest2:
+            rest = 0.0
+        else:
+            rest = jellyfish.jaro_winkler_similarity(rest1, rest2)
+        value = self.config.alpha * core + self.config.beta * rest
+        return Similarity(min(1.0, max(0.0, value)), "situation-3")
+
+    def _name(self, iri: str) -> str:
+        return local_name(iri)
+
+
+class WuPalmer:
+    """Wu and Palmer alone: 2Nr/(N1+N2+2Nr); zero when the common ancestor is the root."""
+
+    name = "wu-palmer"
+
+    def __init__(self, index: TaxonomyIndex) -> None:
+        self.index = index
+
+    def __call__(self, first: str, second: str) -> Similarity:
+        if first == second:
+            return Similarity(1.0, "exact")
+        if first not in self.index or second not in self.index:
+            return Similarity(0.0, "wu-palmer: not in the taxonomy")
+        common, n1, n2 = self.index.common_ancestor(first, second)
+        nr = self.index.depth(common)
+        if n1 + n2 + nr == 0:
+            return Similarity(1.0, "exact")
+        return Similarity(2 * nr / (n1 + n2 + 2 * nr), "wu-palmer", common, (n1, n2))
+
+
+class Lin:
+    """Lin's information-theoretic similarity, 2 IC(C) / (IC(e1) + IC(e2)).
+
+    Information content comes from the loaded knowledge, not from an external corpus: a concept's
+    probability is (uses of it and of everything below it + nodes below it) / the same for the root,
+    with uses counted over the service descriptions in the store.
+    """
+
+    name = "lin"
+
+    def __init__(self, index: TaxonomyIndex) -> None:
+        self.index = index
+        # Each node adds its weight to itself and to every ancestor once, even with several parents.
+        totals: dict[str, float] = {}
+        for node in index.nodes():
+            weight = 1 + index.frequency.get(node, 0)
+            for ancestor in index.ancestors(node):
+                totals[ancestor] = totals.get(ancestor, 0.0) + weight
+        root_total = totals.get(ROOT, 1.0)
+        self._ic = {node: -math.log(total / root_total) for node, total in totals.items()}
+
+    def __call__(self, first: str, second: str) -> Similarity:
+        if first == second:
+            return Similarity(1.0, "exact")
+        if first not in self.index or second not in self.index:
+            return Similarity(0.0, "lin: not in the taxonomy")
+        common, _, _ = self.index.common_ancestor(first, second)
+        ic1 = self._ic[self.index.canonical(first)]
+        ic2 = self._ic[self.index.canonical(second)]
+        if ic1 + ic2 == 0:
+            return Similarity(1.0, "exact")
+        return Similarity(min(1.0, 2 * self._ic[common] / (ic1 + ic2)), "lin", common)
+
+
+class StringMatch:
+    """Pure string matching: normalised Levenshtein similarity of the two local names."""
+
+    name = "string"
+
+    def __call__(self, first: str, second: str) -> Similarity:
+        a, b = local_name(first).lower(), local_name(second).lower()
+        if not a and not b:
+            return Similarity(1.0, "string")
+        distance = jellyfish.levenshtein_distance(a, b)
+        return Similarity(1 - distance / max(len(a), len(b)), "string")

@@ -1,0 +1,91 @@
+"""Conceptual span similarity (CSS) between a Requirement Tree and an Advertisement Tree.
+
+The paper's equations 6 and 7 are not in the text; docs/matchmaking.md gives the reasoning for this
+definition. A tree's root is the parameter's concept, its other nodes the concept's parts. Roots are
+compared with roots and parts with parts. Each requirement node n spans the leaves below it (a leaf
+spans itself) and has its own similarity own(n), the best Sim of n against the eligible nodes of the
+advertisement tree. A node is covered either by its own match or by its parts:
+
+    cover(n) = own(n)                                                     n a leaf
+    cover(n) = max(own(n), (own(n) + sum_c span(c) * cover(c)) / (1 + span(n)))   otherwise
+    CSS(RT, AT) = cover(root of RT)
+
+so when the roots match at least as well as their parts do, CSS = Sim(roots), the paper's special
+case; when they do not (Position against Location: siblings, but with the same x, y, theta parts), the
+parts' evidence lifts the score, and the root's own similarity still weighs in. Pairs reaching the
+pair threshold are reported as matched; requirement leaves below it are what the advertisement lacks.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from kb import PartNode
+from reasoner.similarity import EntityMeasure, Similarity
+
+
+@dataclass(frozen=True)
+class PairMatch:
+    requested: str
+    advertised: str
+    similarity: Similarity
+    span: int  # requirement leaves this pair covers
+
+
+@dataclass(frozen=True)
+class SpanMatch:
+    value: float
+    pairs: tuple[PairMatch, ...]
+    uncovered: tuple[str, ...]  # requirement leaves no matched pair covers
+
+
+def span(node: PartNode) -> int:
+    """Leaves at or below ``node``."""
+    return 1 if node.is_leaf else sum(span(child) for child in node.children)
+
+
+def conceptual_span_similarity(
+    requested: PartNode,
+    advertised: PartNode,
+    measure: EntityMeasure,
+    threshold: float,
+    use_parts: bool = True,
+) -> SpanMatch:
+    """CSS of two trees; with ``use_parts`` false only the roots are compared (flat matching)."""
+    parts = [node for node in advertised.walk() if node is not advertised] if use_parts else []
+    pairs: list[PairMatch] = []
+    uncovered: list[str] = []
+
+    def own(node: PartNode, candidates: list[PartNode]) -> tuple[Similarity | None, str | None]:
+        if not candidates:
+            return None, None
+        best, partner = max(
+            ((measure(node.concept, other.concept), other.concept) for other in candidates),
+            key=lambda pair: pair[0].value,
+        )
+        return best, partner
+
+    def cover(node: PartNode, candidates: list[PartNode]) -> float:
+        best, partner = own(node, candidates)
+        value = best.value if best else 0.0
+        if node.is_leaf or not use_parts:
+            if best is not None and partner is not None and value >= threshold:
+                pairs.append(PairMatch(node.concept, partner, best, span(node) if use_parts else 1))
+            else:
+                uncovered.append(node.concept)
+            return value
+        mark = len(pairs), len(uncovered)
+        by_parts = (value + sum(span(c) * cover(c, parts) for c in node.children)) / (1 + span(node))
+        if value >= by_parts:
+            del pairs[mark[0] :], uncovered[mark[1] :]  # the node's own match covers its span
+            if best is not None and partner is not None and value >= threshold:
+                pairs.append(PairMatch(node.concept, partner, best, span(node)))
+            else:
+                uncovered.append(node.concept)
+            return value
+        if best is not None and partner is not None and value >= threshold:
+            pairs.append(PairMatch(node.concept, partner, best, 0))  # reported, its parts carry the span
+        return by_parts
+
+    value = cover(requested, [advertised])
+    return SpanMatch(value, tuple(pairs), tuple(uncovered))

@@ -1,0 +1,51 @@
+"""PE matching: the similarity of two RDF statements over subject, predicate and object (equation 8).
+
+Equation 8 is not in the text. A statement says three things, so its similarity is the weighted mean
+of the similarities of its three positions, each compared with the entity measure (predicates over
+the property hierarchy):
+
+    Sim(R_sup, R_dem) = ws * Sim(s_sup, s_dem) + wp * Sim(p_sup, p_dem) + wo * Sim(o_sup, o_dem)
+
+with ws + wp + wo = 1 (equal by default; see MatchConfig).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from kb import Statement
+from reasoner.config import MatchConfig
+from reasoner.similarity import EntityMeasure, Similarity
+
+
+@dataclass(frozen=True)
+class StatementMatch:
+    requested: Statement
+    advertised: Statement | None
+    value: float
+    parts: tuple[Similarity, Similarity, Similarity] | None = None
+
+
+def statement_similarity(
+    requested: Statement, advertised: Statement, measure: EntityMeasure, config: MatchConfig
+) -> StatementMatch:
+    s = measure(requested.subject, advertised.subject)
+    p = measure(requested.predicate, advertised.predicate)
+    o = measure(requested.object, advertised.object)
+    value = (
+        config.subject_weight * s.value + config.predicate_weight * p.value + config.object_weight * o.value
+    )
+    return StatementMatch(requested, advertised, value, (s, p, o))
+
+
+def best_statement_matches(
+    wanted: tuple[Statement, ...], offered: tuple[Statement, ...], measure: EntityMeasure, config: MatchConfig
+) -> list[StatementMatch]:
+    """For each wanted statement, its most similar offered statement (or none, with value 0)."""
+    matches = []
+    for statement in wanted:
+        options = [statement_similarity(statement, other, measure, config) for other in offered]
+        matches.append(
+            max(options, key=lambda m: m.value) if options else StatementMatch(statement, None, 0.0)
+        )
+    return matches

@@ -1,0 +1,191 @@
+"""The taxonomy index: one in-memory DAG of concepts, built once from the store.
+
+Its links are the paper's (section 3.2): "is-a" links (rdfs:subClassOf, rdfs:subPropertyOf) and
+"hasPart" links (a whole class to the class of its part, from restrictions on the dul:hasPart family).
+Both point from a node up to its parent; above every node with no is-a parent sits one virtual root.
+Equivalent classes, and classes in a subclass cycle, are merged into one node.
+
+Superclasses and depth follow is-a links only (the most specific common *superclass*); whether one
+entity lies below another follows both kinds. Depths and distances count links along shortest paths
+(a class may have several parents).
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+import networkx as nx
+
+from kb import KnowledgeBase
+
+ROOT = "urn:cbrs:taxonomy-root"  # the virtual root above every top-level concept
+
+
+@dataclass(frozen=True)
+class Link:
+    child: str
+    parent: str
+    kind: str  # "is-a", "has-part" or "same"
+
+
+@dataclass
+class TaxonomyIndex:
+    """Concept DAG with depth, ancestors and most specific common ancestor answered in memory."""
+
+    _canonical: dict[str, str] = field(default_factory=dict)
+    _parents: dict[str, dict[str, str]] = field(default_factory=dict)  # node -> {parent: link kind}
+    _children: dict[str, set[str]] = field(default_factory=dict)
+    _depth: dict[str, int] = field(default_factory=dict)
+    _ancestors: dict[tuple[str, bool], dict[str, int]] = field(default_factory=dict)  # cache
+    labels: dict[str, str] = field(default_factory=dict)
+    frequency: dict[str, int] = field(default_factory=dict)  # uses by service descriptions
+
+    # -- building ----------------------------------------------------------------------------
+
+    @classmethod
+    def from_kb(cls, kb: KnowledgeBase) -> TaxonomyIndex:
+        """Read every term and link with two named queries, then build the DAG in memory."""
+        links = [
+            Link(row["child"].value, row["parent"].value, row["link"].value)
+            for row in kb.select("taxonomy_links")
+        ]
+        terms = {row["term"].value: row.get("label") for row in kb.select("taxonomy_terms")}
+        usage = {row["concept"].value: int(row["uses"].value) for row in kb.select("concept_usage")}
+        index = cls.from_links(links, terms=terms)
+        index.labels = {term: label.value for term, label in terms.items() if label is not None}
+        index.frequency = {index.canonical(c): n for c, n in usage.items() if c in index}
+        return index
+
+    @classmethod
+    def from_links(cls, links: Iterable[Link], terms: Iterable[str] = ()) -> TaxonomyIndex:
+        links = list(links)
+        graph: nx.DiGraph[str] = nx.DiGraph()
+        graph.add_nodes_from(terms)
+        for link in links:
+            graph.add_node(link.child)
+            graph.add_node(link.parent)
+            if link.kind in ("is-a", "same"):
+                graph.add_edge(link.child, link.parent)
+            if link.kind == "same":
+                graph.add_edge(link.parent, link.child)
+        # Strongly connected components of is-a (cycles, equivalences) become one node, named by
+        # the smallest IRI so that the choice is stable.
+        canonical: dict[str, str] = {}
+        for component in nx.strongly_connected_components(graph):
+            name = min(component)
+            canonical.update({member: name for member in component})
+        index = cls(_canonical=canonical)
+        for node in set(canonical.values()):
+            index._parents[node] = {}
+            index._children[node] = set()
+        for link in links:
+            child, parent = canonical[link.child], canonical[link.parent]
+            if child == parent or link.kind == "same":
+                continue
+            kind = "is-a" if link.kind == "is-a" else "has-part"
+            # an is-a link wins over a has-part link between the same pair
+            if index._parents[child].get(parent) != "is-a":
+                index._parents[child][parent] = kind
+            index._children[parent].add(child)
+        index._break_part_cycles()
+        index._compute_depths()
+        return index
+
+    def _break_part_cycles(self) -> None:
+        """has-part links can close a cycle (A has part B, B is-a A); drop those links."""
+        graph: nx.DiGraph[str] = nx.DiGraph((c, p) for c, ps in self._parents.items() for p in ps)
+        while True:
+            try:
+                cycle = nx.find_cycle(graph)
+            except nx.NetworkXNoCycle:
+                return
+            child, parent = next(
+                ((c, p) for c, p, *_ in cycle if self._parents[c][p] == "has-part"), cycle[0][:2]
+            )
+            del self._parents[child][parent]
+            self._children[parent].discard(child)
+            graph.remove_edge(child, parent)
+
+    def _compute_depths(self) -> None:
+        self._parents[ROOT] = {}
+        self._children[ROOT] = set()
+        for node, parents in self._parents.items():
+            if node != ROOT and "is-a" not in parents.values():
+                parents[ROOT] = "is-a"
+                self._children[ROOT].add(node)
+        self._depth = {node: links for node, links in self._down_from_root().items()}
+
+    def _down_from_root(self) -> dict[str, int]:
+        depth = {ROOT: 0}
+        queue = deque([ROOT])
+        while queue:
+            node = queue.popleft()
+            for child in self._children[node]:
+                if child not in depth and self._parents[child].get(node) == "is-a":
+                    depth[child] = depth[node] + 1
+                    queue.append(child)
+        return depth
+
+    # -- questions ---------------------------------------------------------------------------
+
+    def __contains__(self, concept: object) -> bool:
+        return isinstance(concept, str) and concept in self._canonical
+
+    def __len__(self) -> int:
+        return len(self._depth) - 1
+
+    def canonical(self, concept: str) -> str:
+        """The node a concept is merged into (itself unless it has equivalents)."""
+        return self._canonical.get(concept, concept)
+
+    def depth(self, concept: str) -> int:
+        """Links from the concept up to the root, along the shortest path."""
+        return self._depth[self.canonical(concept)]
+
+    def parents(self, concept: str) -> dict[str, str]:
+        return dict(self._parents[self.canonical(concept)])
+
+    def children(self, concept: str) -> set[str]:
+        return set(self._children[self.canonical(concept)])
+
+    def ancestors(self, concept: str, is_a_only: bool = False) -> dict[str, int]:
+        """Every node above ``concept`` (itself included, and the root) with its distance in links,
+        following is-a and has-part links, or is-a links only."""
+        node = self.canonical(concept)
+        key = (node, is_a_only)
+        found = self._ancestors.get(key)
+        if found is None:
+            found = {node: 0}
+            queue = deque([node])
+            while queue:
+                current = queue.popleft()
+                for parent, kind in self._parents[current].items():
+                    if parent not in found and (kind == "is-a" or not is_a_only):
+                        found[parent] = found[current] + 1
+                        queue.append(parent)
+            self._ancestors[key] = found
+        return found
+
+    def is_a_ancestors(self, concept: str) -> dict[str, int]:
+        """Superclasses (superproperties) with their distance, the concept itself included, no root."""
+        return {a: d for a, d in self.ancestors(concept, is_a_only=True).items() if a != ROOT}
+
+    def common_ancestor(self, first: str, second: str) -> tuple[str, int, int]:
+        """The most specific common superclass C (is-a links) and the link counts N1, N2 to it.
+
+        Most specific means deepest; ties go to the one nearest both concepts, then by name.
+        """
+        up_first = self.ancestors(first, is_a_only=True)
+        up_second = self.ancestors(second, is_a_only=True)
+        common = set(up_first) & set(up_second)
+        best = max(common, key=lambda c: (self._depth[c], -(up_first[c] + up_second[c]), c))
+        return best, up_first[best], up_second[best]
+
+    def distance_down(self, lower: str, upper: str) -> int | None:
+        """Links (is-a or has-part) from ``lower`` up to ``upper`` when it is above, else None."""
+        return self.ancestors(lower).get(self.canonical(upper))
+
+    def nodes(self) -> list[str]:
+        return [node for node in self._depth if node != ROOT]
