@@ -21,7 +21,7 @@ from dataclasses import asdict, dataclass
 from enum import Enum
 from typing import Any
 
-from kb import Advertisement, KnowledgeBase, Parameter, PartNode, Requirement
+from kb import Advertisement, KnowledgeBase, NotFoundError, Parameter, PartNode, Requirement
 from reasoner.config import MatchConfig
 from reasoner.degrees import Degree, degree_of_match
 from reasoner.methods import Method, make_method
@@ -107,7 +107,7 @@ class Matchmaker:
         if isinstance(requirement, str):
             found = self.kb.description(requirement)
             if not isinstance(found, Requirement):
-                raise TypeError(f"<{requirement}> is an advertisement, not a requirement")
+                raise NotFoundError(requirement, "requirement (it is an advertisement)")
             requirement = found
         scored = [self.score(requirement, ad) for ad in self.advertisements]
         scored.sort(key=lambda c: (not c.acceptable, bool(c.rejected_by), -c.score, c.advertisement))

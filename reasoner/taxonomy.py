@@ -20,7 +20,7 @@ import networkx as nx
 
 from kb import KnowledgeBase
 
-ROOT = "urn:cbrs:taxonomy-root"  # the virtual root above every top-level concept
+ROOT = "http://www.w3.org/2002/07/owl#Thing"  # the root: above every concept with no is-a parent
 
 
 @dataclass(frozen=True)
@@ -72,12 +72,13 @@ class TaxonomyIndex:
                 graph.add_edge(link.parent, link.child)
         # Strongly connected components of is-a (cycles, equivalences) become one node, named by
         # the smallest IRI so that the choice is stable.
+        graph.add_node(ROOT)
         canonical: dict[str, str] = {}
         for component in nx.strongly_connected_components(graph):
-            name = min(component)
+            name = ROOT if ROOT in component else min(component)
             canonical.update({member: name for member in component})
         index = cls(_canonical=canonical)
-        for node in set(canonical.values()):
+        for node in set(canonical.values()) | {ROOT}:
             index._parents[node] = {}
             index._children[node] = set()
         for link in links:
@@ -110,7 +111,6 @@ class TaxonomyIndex:
 
     def _compute_depths(self) -> None:
         self._parents[ROOT] = {}
-        self._children[ROOT] = set()
         for node, parents in self._parents.items():
             if node != ROOT and "is-a" not in parents.values():
                 parents[ROOT] = "is-a"

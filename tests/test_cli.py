@@ -200,7 +200,7 @@ def test_unexpected_errors_are_one_line(
     def explode(*_: object) -> None:
         raise RuntimeError("disk on fire")
 
-    monkeypatch.setattr("cbrs.cli.KnowledgeBase.open", explode)
+    monkeypatch.setattr("cbrs.app.KnowledgeBase.open", explode)
     monkeypatch.setattr(sys, "argv", ["cbrs", "--store", ":memory:", "services"])
     monkeypatch.delenv("CBRS_DEBUG", raising=False)
     with pytest.raises(SystemExit) as caught:

@@ -1,0 +1,207 @@
+from __future__ import annotations
+
+import json
+
+import pytest
+from click.testing import CliRunner
+
+from cbrs.cli import cli
+from kb import KnowledgeBase, NotFoundError, PartNode, Statement
+from reasoner.config import MatchConfig
+from reasoner.matchmaker import Matchmaker, MatchStatus
+from reasoner.methods import METHODS
+from reasoner.similarity import SemStr
+from reasoner.spans import conceptual_span_similarity
+from reasoner.statements import statement_similarity
+from tests.reasoner_examples import E, positions
+
+SVC = "https://w3id.org/cbrs/service#"
+REQ = "https://w3id.org/cbrs/requirement#"
+HOME = "https://w3id.org/cbrs/home#"
+TABLE3 = [
+    "LocateMobileRobot_CeilingCamera01",
+    "LocateMobileRobot_CeilingCamera02",
+    "TrackPerson_CeilingCamera01",
+    "TrackPerson_CeilingCamera02",
+    "RecogniseObjectByColour_Kinect01",
+    "DetectColourMarker_CeilingCamera01",
+    "LocaliseRobotByLaser_LaserScanner01",
+    "EstimateRobotPositionFromSonar_HomeServer01",
+    "DeadReckoning_P3DX01",
+    "DetectPersonByLaser_LaserScanner01",
+]
+
+
+@pytest.fixture(scope="module")
+def sem_str(bundled_kb: KnowledgeBase) -> Matchmaker:
+    return Matchmaker(bundled_kb)
+
+
+def test_table3_ceiling_camera_ranks_first(sem_str: Matchmaker) -> None:
+    result = sem_str.rank(REQ + "RobotSelfPosition")
+    assert result.status is MatchStatus.MATCHED
+    order = [
+        c.advertisement.rsplit("#", 1)[1]
+        for c in result.candidates
+        if c.advertisement.rsplit("#", 1)[1] in TABLE3
+    ]
+    assert order[0] == "LocateMobileRobot_CeilingCamera01"
+    assert result.candidates[0].advertisement == SVC + "LocateMobileRobot_CeilingCamera01"
+
+
+def test_table3_explanation_matches_position_with_location(sem_str: Matchmaker) -> None:
+    best = sem_str.rank(REQ + "RobotSelfPosition").candidates[0]
+    root = next(p for p in best.pairs if p.role == "output" and p.requested == HOME + "RobotPosition")
+    assert root.advertised == HOME + "RobotLocation"
+    assert "Wu-Palmer via SpatialData" in root.how
+    parts = {p.requested for p in best.pairs if p.role == "output" and p.similarity == 1.0}
+    assert {HOME + "XCoordinate", HOME + "YCoordinate"} <= parts
+    marker = next(p for p in best.pairs if p.role == "input" and p.advertised == HOME + "MarkerColour")
+    assert marker.requested == HOME + "ColourOfMarker" and marker.degree == "HasSubClass"
+
+
+def test_sea_filter_rejects_the_kitchen_camera(sem_str: Matchmaker) -> None:
+    result = sem_str.rank(REQ + "RobotSelfPosition")
+    kitchen = next(
+        c for c in result.candidates if c.advertisement == SVC + "LocateMobileRobot_CeilingCamera02"
+    )
+    assert not kitchen.acceptable
+    assert any(reason.startswith("SEA") for reason in kitchen.rejected_by)
+
+
+def test_pure_string_matching_prefers_the_exact_name(bundled_kb: KnowledgeBase, sem_str: Matchmaker) -> None:
+    baseline = Matchmaker(bundled_kb, "string", index=sem_str.index, advertisements=sem_str.advertisements)
+    top = baseline.rank(REQ + "RobotSelfPosition").candidates[0]
+    assert top.advertisement == SVC + "EstimateRobotPositionFromSonar_HomeServer01"
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_every_method_ranks_every_advertisement_deterministically(
+    bundled_kb: KnowledgeBase, sem_str: Matchmaker, method: str
+) -> None:
+    ads = sem_str.advertisements
+    forward = Matchmaker(bundled_kb, method, index=sem_str.index, advertisements=ads).rank(
+        REQ + "RobotSelfPosition"
+    )
+    backward = Matchmaker(bundled_kb, method, index=sem_str.index, advertisements=ads[::-1]).rank(
+        REQ + "RobotSelfPosition"
+    )
+    assert [c.advertisement for c in forward.candidates] == [c.advertisement for c in backward.candidates]
+    assert len(forward.candidates) == len(ads)
+    assert all(0.0 <= c.score <= 1.0 for c in forward.candidates)
+
+
+def test_no_acceptable_match_is_a_status_with_the_table(mini_kb: KnowledgeBase) -> None:
+    mini_kb.registry.register(
+        """@prefix cbrs: <https://w3id.org/cbrs/core#> . @prefix ex: <http://example.org/mini#> .
+        ex:Nothing a cbrs:MethodInvocationComponent ; cbrs:deviceName "d" ; cbrs:serviceName "s" ;
+          cbrs:hasOWLSModel [ cbrs:hasOutput [ cbrs:parameterType ex:Door ] ] ."""
+    )
+    requirement = mini_kb.description("http://example.org/mini#SelfPosition")
+    strict = Matchmaker(
+        mini_kb, config=MatchConfig(accept_score=0.99), advertisements=mini_kb.advertisements()
+    )
+    result = strict.rank(requirement.iri)
+    assert result.status is MatchStatus.NO_ACCEPTABLE_MATCH
+    assert len(result.candidates) == 3
+    assert all(not c.acceptable for c in result.candidates)
+    assert any(c.lacks for c in result.candidates)
+
+
+def test_qos_bound_filters(mini_kb: KnowledgeBase) -> None:
+    # The requirement needs responseTime <= 0.5: the camera (0.1) passes, the door opener states none.
+    result = Matchmaker(mini_kb).rank("http://example.org/mini#SelfPosition")
+    by_iri = {c.advertisement.rsplit("#", 1)[1]: c for c in result.candidates}
+    assert not any(r.startswith("QoS") for r in by_iri["Locate"].rejected_by)
+    assert "QoS: states no responseTime (needs 0.5)" in by_iri["OpenDoor"].rejected_by
+    lenient = Matchmaker(mini_kb, config=MatchConfig(qos_missing_fails=False)).rank(
+        "http://example.org/mini#SelfPosition"
+    )
+    assert not any(c.rejected_by for c in lenient.candidates)
+
+
+def test_rank_refuses_an_advertisement(sem_str: Matchmaker) -> None:
+    with pytest.raises(NotFoundError, match="requirement"):
+        sem_str.rank(SVC + "LocateMobileRobot_CeilingCamera01")
+
+
+# -- conceptual span similarity and statements ----------------------------------------------
+
+X, Y = PartNode(E + "XCoordinate", E + "hasX"), PartNode(E + "YCoordinate", E + "hasY")
+
+
+def tree(concept: str, *children: PartNode) -> PartNode:
+    return PartNode(E + concept, None, children)
+
+
+def test_css_root_match_is_the_root_similarity() -> None:
+    measure = SemStr(positions())
+    match = conceptual_span_similarity(tree("RobotPosition", X, Y), tree("RobotPosition", X, Y), measure, 0.5)
+    assert match.value == 1.0 and match.uncovered == ()
+    only_root = conceptual_span_similarity(tree("RobotPosition"), tree("Position"), measure, 0.5)
+    assert only_root.value == 0.5
+
+
+def test_css_parts_lift_position_against_location() -> None:
+    measure = SemStr(positions())
+    flat = measure(E + "RobotPosition", E + "RobotLocation").value
+    match = conceptual_span_similarity(tree("RobotPosition", X, Y), tree("RobotLocation", X, Y), measure, 0.5)
+    assert match.value == pytest.approx((flat + 2) / 3)
+    assert match.value > flat
+
+
+def test_css_reports_uncovered_parts() -> None:
+    measure = SemStr(positions())
+    match = conceptual_span_similarity(tree("Position", X, Y), tree("Colour", X), measure, 0.9)
+    assert E + "YCoordinate" in match.uncovered
+    assert 0 < match.value < 1
+
+
+def test_statement_similarity_weighs_subject_predicate_object() -> None:
+    measure = SemStr(positions())
+    config = MatchConfig()
+    same = Statement(E + "Position", E + "isNear", E + "Location")
+    assert statement_similarity(same, same, measure, config).value == pytest.approx(1.0)
+    other = Statement(E + "RobotPosition", E + "isNear", E + "Location")
+    value = statement_similarity(same, other, measure, config).value
+    assert value == pytest.approx((0.5 + 1 + 1) / 3)
+
+
+# -- the command ---------------------------------------------------------------------------------
+
+
+def test_cbrs_match_ranks_and_explains() -> None:
+    result = CliRunner().invoke(
+        cli, ["--store", ":memory:", "match", "req:RobotSelfPosition", "--top", "3", "--explain"]
+    )
+    assert result.exit_code == 0, result.output
+    lines = result.output.splitlines()
+    assert lines[0] == "req:RobotSelfPosition: matched by sem-str; best svc:LocateMobileRobot_CeilingCamera01"
+    assert "Wu-Palmer via SpatialData" in result.output
+    assert "(3 of 53 advertisements)" in result.output
+
+
+def test_cbrs_match_json() -> None:
+    result = CliRunner().invoke(
+        cli,
+        ["--store", ":memory:", "match", "req:RobotSelfPosition", "--top", "2", "--json", "--method", "lin"],
+    )
+    assert result.exit_code == 0
+    data = json.loads(result.output)
+    assert data["method"] == "lin" and data["status"] == "matched" and len(data["candidates"]) == 2
+    assert {"advertisement", "score", "parts", "pairs", "lacks", "rejected_by", "acceptable"} <= set(
+        data["candidates"][0]
+    )
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["match", "req:Nope"], "no service description"),
+        (["match", "svc:LocateMobileRobot_CeilingCamera01"], "it is an advertisement"),
+        (["match", "req:RobotSelfPosition", "--method", "magic"], "'magic' is not one of"),
+    ],
+)
+def test_cbrs_match_errors(args: list[str], message: str) -> None:
+    result = CliRunner().invoke(cli, ["--store", ":memory:", *args])
+    assert result.exit_code != 0 and message in result.output

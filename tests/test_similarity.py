@@ -1,0 +1,118 @@
+from __future__ import annotations
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from reasoner.config import MatchConfig
+from reasoner.degrees import Degree, degree_of_match
+from reasoner.names import core_split, local_name, words
+from reasoner.similarity import Lin, SemStr, StringMatch, WuPalmer
+from reasoner.taxonomy import ROOT, Link, TaxonomyIndex
+from tests.reasoner_examples import E, figure5, positions
+
+
+def test_figure5_sim_c_e_is_two_thirds() -> None:
+    sim = SemStr(figure5())(E + "C", E + "E")
+    assert sim.situation == "situation-2"
+    assert round(sim.value, 2) == 0.67
+
+
+def test_figure5_child_of_the_root_is_not_zero() -> None:
+    index = figure5()
+    assert WuPalmer(index)(E + "B", ROOT).value == 0.0
+    sim = SemStr(index)(E + "B", ROOT)
+    assert (sim.situation, sim.value) == ("situation-1", 0.5)
+
+
+def test_figure5_far_apart_through_the_root_is_small() -> None:
+    sim = SemStr(figure5())(E + "E", E + "D")
+    assert sim.situation == "situation-1"
+    assert sim.value == pytest.approx(1 / (1 + 3 + 2))
+
+
+@pytest.mark.parametrize(
+    ("first", "second", "situation", "value"),
+    [
+        pytest.param("RobotPosition", "RobotPosition", "exact", 1.0, id="exact"),
+        pytest.param("RobotPosition", "Position", "situation-1", 0.5, id="subclass"),
+        pytest.param("Position", "RobotPosition", "situation-1", 0.5, id="superclass"),
+        pytest.param("XCoordinate", "Position", "situation-1", 0.5, id="part-of-whole"),
+        pytest.param(
+            "RobotPosition", "RobotLocation", "situation-2", 2 * 2 / (2 + 2 + 2 * 2), id="position-location"
+        ),
+        pytest.param("Position", "Location", "situation-2", 2 * 2 / (1 + 1 + 2 * 2), id="siblings"),
+    ],
+)
+def test_sem_str_situations(first: str, second: str, situation: str, value: float) -> None:
+    sim = SemStr(positions())(E + first, E + second)
+    assert sim.situation == situation
+    assert sim.value == pytest.approx(value)
+
+
+def test_situation_3_uses_core_words() -> None:
+    measure = SemStr(positions(), MatchConfig(alpha=0.7, beta=0.3))
+    same_core = measure(E + "RobotPlace", E + "PersonPlace")  # neither is in the taxonomy
+    other_core = measure(E + "RobotPlace", E + "RobotSpeed")
+    assert same_core.situation == other_core.situation == "situation-3"
+    assert same_core.value > other_core.value  # the core word weighs more (alpha > beta)
+    assert measure(E + "Place", E + "Place").value == 1.0
+
+
+def test_names() -> None:
+    assert local_name("http://x/onto.owl#RobotPosition") == "RobotPosition"
+    assert words("GPSPosition_of-robot") == ["gps", "position", "of", "robot"]
+    assert core_split("RobotPosition") == ("position", "robot")
+    assert core_split("Position") == ("position", "")
+
+
+def test_degrees() -> None:
+    index = positions()
+    assert degree_of_match(index, E + "Position", E + "Position") is Degree.EXACT
+    assert degree_of_match(index, E + "Position", E + "RobotPosition") is Degree.SUBCLASS_OF
+    assert degree_of_match(index, E + "RobotPosition", E + "Position") is Degree.HAS_SUBCLASS
+    assert degree_of_match(index, E + "Position", E + "Location") is Degree.FAIL
+    assert degree_of_match(index, E + "Position", E + "XCoordinate") is Degree.FAIL  # parts do not subsume
+    assert {d for d in Degree if d.accepted} == {Degree.EXACT, Degree.SUBCLASS_OF, Degree.HAS_SUBCLASS}
+
+
+def test_config_is_validated() -> None:
+    with pytest.raises(ValueError, match="alpha > beta"):
+        MatchConfig(alpha=0.3, beta=0.7)
+    with pytest.raises(ValueError, match="sum to 1"):
+        MatchConfig(subject_weight=0.5)
+
+
+# -- properties over random taxonomies ---------------------------------------------------------
+
+NAMES = [f"C{i}" for i in range(12)]
+
+
+@st.composite
+def taxonomies(draw: st.DrawFn) -> TaxonomyIndex:
+    links = []
+    for i, name in enumerate(NAMES):
+        if i and draw(st.booleans()):
+            links.append(Link(E + name, E + NAMES[draw(st.integers(0, i - 1))], "is-a"))
+        if i > 1 and draw(st.integers(0, 4)) == 0:
+            links.append(Link(E + name, E + NAMES[draw(st.integers(0, i - 1))], "has-part"))
+    return TaxonomyIndex.from_links(links, terms=[E + n for n in NAMES])
+
+
+concepts = st.sampled_from([E + n for n in NAMES] + [E + "RobotPlace", E + "Unknown_Thing", ROOT])
+
+
+@settings(max_examples=150, deadline=None)
+@given(taxonomies(), concepts, concepts)
+def test_every_measure_is_in_unit_range_and_symmetric(index: TaxonomyIndex, a: str, b: str) -> None:
+    for measure in (SemStr(index), WuPalmer(index), Lin(index), StringMatch()):
+        forward, backward = measure(a, b).value, measure(b, a).value
+        assert 0.0 <= forward <= 1.0
+        assert forward == pytest.approx(backward)
+
+
+@settings(max_examples=80, deadline=None)
+@given(taxonomies(), concepts)
+def test_exact_gives_one(index: TaxonomyIndex, a: str) -> None:
+    for measure in (SemStr(index), WuPalmer(index), Lin(index), StringMatch()):
+        assert measure(a, a).value == 1.0
