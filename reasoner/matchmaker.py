@@ -16,12 +16,24 @@ The SEA and QoS of the requirement act as filters. "No acceptable match" is a st
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 from enum import Enum
-from typing import Any
+from typing import Any, overload
 
-from kb import Advertisement, KnowledgeBase, NotFoundError, Parameter, PartNode, Requirement
+import numpy as np
+
+from kb import (
+    Advertisement,
+    EffectiveArea,
+    KnowledgeBase,
+    NotFoundError,
+    Parameter,
+    PartNode,
+    QoSValue,
+    Requirement,
+)
+from reasoner.batch import BatchScorer, CompiledPool, ranking_order
 from reasoner.config import MatchConfig
 from reasoner.degrees import Degree, degree_of_match
 from reasoner.methods import Method, make_method
@@ -29,6 +41,7 @@ from reasoner.names import local_name
 from reasoner.spans import SpanMatch, conceptual_span_similarity
 from reasoner.statements import StatementMatch, best_statement_matches
 from reasoner.taxonomy import TaxonomyIndex
+from reasoner.vectors import VectorSpace
 
 
 class MatchStatus(Enum):
@@ -58,6 +71,7 @@ class Candidate:
     lacks: tuple[str, ...]
     rejected_by: tuple[str, ...]  # SEA / QoS filters (and, for strict logic, a failed output)
     acceptable: bool  # passes the filters and reaches the acceptance score
+    explained: bool = True  # pairs and lacks filled in (only the first candidates of a big pool are)
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -68,7 +82,7 @@ class MatchResult:
     requirement: str
     method: str
     status: MatchStatus
-    candidates: tuple[Candidate, ...]  # ranked, best first; acceptable ones before the rest
+    candidates: Sequence[Candidate]  # ranked, best first; acceptable ones before the rest
 
     def to_dict(self, top: int | None = None) -> dict[str, Any]:
         return {
@@ -95,6 +109,8 @@ class Matchmaker:
         self.index = index or TaxonomyIndex.from_kb(kb)
         self.method: Method = make_method(method, self.index, self.config)
         self._advertisements = list(advertisements) if advertisements is not None else None
+        self._pool: CompiledPool | None = None
+        self._pool_source: list[Advertisement] | None = None
 
     @property
     def advertisements(self) -> list[Advertisement]:
@@ -102,17 +118,45 @@ class Matchmaker:
             self._advertisements = self.kb.advertisements()
         return self._advertisements
 
-    def rank(self, requirement: Requirement | str) -> MatchResult:
-        """Score every advertisement against ``requirement`` (an IRI or a Requirement)."""
+    def rank(self, requirement: Requirement | str, explain: int | None = None) -> MatchResult:
+        """Score every advertisement against ``requirement`` (an IRI or a Requirement), best first.
+
+        The whole pool is scored at once (reasoner/batch.py); the first ``explain`` candidates (all
+        when None) also get their explanation: entity pairs and what they lack.
+        """
         if isinstance(requirement, str):
             found = self.kb.description(requirement)
             if not isinstance(found, Requirement):
                 raise NotFoundError(requirement, "requirement (it is an advertisement)")
             requirement = found
-        scored = [self.score(requirement, ad) for ad in self.advertisements]
-        scored.sort(key=lambda c: (not c.acceptable, bool(c.rejected_by), -c.score, c.advertisement))
-        status = MatchStatus.MATCHED if scored and scored[0].acceptable else MatchStatus.NO_ACCEPTABLE_MATCH
-        return MatchResult(requirement.iri, self.method.name, status, tuple(scored))
+        ads = self.advertisements
+        if self.method.strict:  # degrees, not similarities: scored one by one
+            scored = [self.score(requirement, ad) for ad in ads]
+            scored.sort(key=lambda c: (not c.acceptable, bool(c.rejected_by), -c.score, c.advertisement))
+            candidates: Sequence[Candidate] = tuple(scored)
+        else:
+            candidates = self._rank_batch(requirement, ads, len(ads) if explain is None else explain)
+        status = MatchStatus.MATCHED if candidates and candidates[0].acceptable else MatchStatus.NO_ACCEPTABLE_MATCH
+        return MatchResult(requirement.iri, self.method.name, status, candidates)
+
+    def _rank_batch(self, requirement: Requirement, ads: list[Advertisement], explain: int) -> Sequence[Candidate]:
+        if self._pool is None or self._pool_source is not ads:
+            self._pool = CompiledPool(ads, VectorSpace(self.index), self.method.use_parts)
+            self._pool_source = ads
+        scorer = BatchScorer(self._pool, self.method.measure, self.config, self.filters)
+        scores = scorer.score(requirement)
+        order = ranking_order(scores, self._pool, self.config.accept_score).tolist()
+        head = [self.score(requirement, ads[i]) for i in order[:explain]]
+
+        def unexplained(i: int) -> Candidate:
+            ad = ads[i]
+            parts = {name: float(values[i]) for name, values in scores.parts.items() if not np.isnan(values[i])}
+            score = float(scores.score[i])
+            rejected = scores.rejected_by[i]
+            acceptable = not rejected and score >= self.config.accept_score
+            return Candidate(ad.iri, ad.label, score, parts, (), (), rejected, acceptable, explained=False)
+
+        return _Ranking(head, order[explain:], unexplained)
 
     def score(self, requirement: Requirement, ad: Advertisement) -> Candidate:
         pairs: list[EntityPair] = []
@@ -122,9 +166,7 @@ class Matchmaker:
         if requirement.outputs:
             parts["outputs"] = self._parameters(requirement.outputs, ad.outputs, "output", pairs, lacks)
         if ad.inputs or requirement.inputs:
-            needed = (
-                self._parameters(ad.inputs, requirement.inputs, "input", pairs, lacks) if ad.inputs else None
-            )
+            needed = self._parameters(ad.inputs, requirement.inputs, "input", pairs, lacks) if ad.inputs else None
             used = (
                 self._parameters(requirement.inputs, ad.inputs, "provided input", [], lacks)
                 if requirement.inputs
@@ -136,9 +178,7 @@ class Matchmaker:
             matches = best_statement_matches(requirement.effects, ad.effects, self.method.measure, cfg)
             parts["effects"] = self._statements(matches, "effect", pairs, lacks)
         if ad.preconditions and requirement.preconditions:
-            matches = best_statement_matches(
-                ad.preconditions, requirement.preconditions, self.method.measure, cfg
-            )
+            matches = best_statement_matches(ad.preconditions, requirement.preconditions, self.method.measure, cfg)
             parts["preconditions"] = self._statements(matches, "precondition", pairs, lacks)
         weights = {
             "outputs": cfg.output_weight,
@@ -148,22 +188,14 @@ class Matchmaker:
         }
         total = sum(weights[name] for name in parts)
         score = sum(weights[name] * value for name, value in parts.items()) / total if total else 0.0
-        rejected = self._filters(requirement, ad)
+        rejected = self.filters(requirement, ad.area, ad.qos)
         if self.method.strict:
-            failed = [
-                pair
-                for pair in pairs
-                if pair.role in ("output", "effect") and pair.degree == Degree.FAIL.value
-            ]
+            failed = [pair for pair in pairs if pair.role in ("output", "effect") and pair.degree == Degree.FAIL.value]
             if failed:
-                rejected.append(
-                    f"strict logic: {failed[0].role} {_short(failed[0].requested)} has no accepted match"
-                )
+                rejected.append(f"strict logic: {failed[0].role} {_short(failed[0].requested)} has no accepted match")
         score = round(score, 6)
         acceptable = not rejected and score >= cfg.accept_score
-        return Candidate(
-            ad.iri, ad.label, score, parts, tuple(pairs), tuple(lacks), tuple(rejected), acceptable
-        )
+        return Candidate(ad.iri, ad.label, score, parts, tuple(pairs), tuple(lacks), tuple(rejected), acceptable)
 
     # -- parts ---------------------------------------------------------------------------------
 
@@ -197,9 +229,7 @@ class Matchmaker:
                     how += f", covers {pair.span} parts"
                 elif pair.span == 0:
                     how += ", its parts carry the match"
-                pairs.append(
-                    self._pair(flip, role, pair.requested, pair.advertised, pair.similarity.value, how)
-                )
+                pairs.append(self._pair(flip, role, pair.requested, pair.advertised, pair.similarity.value, how))
             if not match.pairs:
                 how = "best partner, below the pair threshold"
                 pairs.append(self._pair(flip, role, parameter.type, other.type, match.value, how))
@@ -213,9 +243,7 @@ class Matchmaker:
                 lacks.append(f"{role} {_short(parameter.type)}: nothing matches its part {_short(leaf)}")
         return sum(values) / len(values) if values else 0.0
 
-    def _pair(
-        self, flip: bool, role: str, wanted: str, offered: str | None, value: float, how: str
-    ) -> EntityPair:
+    def _pair(self, flip: bool, role: str, wanted: str, offered: str | None, value: float, how: str) -> EntityPair:
         if flip and offered is not None:
             degree = degree_of_match(self.index, offered, wanted)
             return EntityPair(role, offered, wanted, value, how, degree.value)
@@ -234,9 +262,7 @@ class Matchmaker:
             use_parts=self.method.use_parts,
         )
 
-    def _statements(
-        self, matches: list[StatementMatch], role: str, pairs: list[EntityPair], lacks: list[str]
-    ) -> float:
+    def _statements(self, matches: list[StatementMatch], role: str, pairs: list[EntityPair], lacks: list[str]) -> float:
         values = []
         for match in matches:
             wanted = match.requested
@@ -267,9 +293,10 @@ class Matchmaker:
 
     # -- filters ---------------------------------------------------------------------------------
 
-    def _filters(self, requirement: Requirement, ad: Advertisement) -> list[str]:
+    def filters(self, requirement: Requirement, offered: EffectiveArea | None, qos: tuple[QoSValue, ...]) -> list[str]:
+        """Why an advertisement with this SEA and QoS fails the requirement's filters (empty: it passes)."""
         reasons = []
-        wanted, offered = requirement.area, ad.area
+        wanted = requirement.area
         if wanted and offered:
             if wanted.bounds and offered.bounds:
                 if not _within(wanted.bounds, offered.bounds):
@@ -277,10 +304,8 @@ class Matchmaker:
             elif wanted.areas and offered.areas:
                 for area in wanted.areas:
                     if not any(self._covers(place, area) for place in offered.areas):
-                        reasons.append(
-                            f"SEA: {_short(area)} is outside {', '.join(map(_short, offered.areas))}"
-                        )
-        offered_qos = {q.metric: q.value for q in ad.qos}
+                        reasons.append(f"SEA: {_short(area)} is outside {', '.join(map(_short, offered.areas))}")
+        offered_qos = {q.metric: q.value for q in qos}
         for bound in requirement.qos:
             value = offered_qos.get(bound.metric)
             name = _short(bound.metric)
@@ -297,9 +322,41 @@ class Matchmaker:
         """``place`` covers ``area`` when it is the same, a superclass, or a whole it is part of."""
         if place == area:
             return True
-        return (
-            area in self.index and place in self.index and self.index.distance_down(area, place) is not None
-        )
+        return area in self.index and place in self.index and self.index.distance_down(area, place) is not None
+
+
+class _Ranking(Sequence[Candidate]):
+    """Ranked candidates: the explained head as built, the rest made on first access (a pool of
+    thousands is ranked far more often than it is read to the end)."""
+
+    def __init__(self, head: list[Candidate], rest: list[int], make: Callable[[int], Candidate]) -> None:
+        self._head = head
+        self._rest = rest
+        self._made: dict[int, Candidate] = {}
+        self._make = make
+
+    def __len__(self) -> int:
+        return len(self._head) + len(self._rest)
+
+    @overload
+    def __getitem__(self, position: int) -> Candidate: ...
+
+    @overload
+    def __getitem__(self, position: slice) -> list[Candidate]: ...
+
+    def __getitem__(self, position: int | slice) -> Candidate | list[Candidate]:
+        if isinstance(position, slice):
+            return [self[i] for i in range(*position.indices(len(self)))]
+        if position < 0:
+            position += len(self)
+        if not 0 <= position < len(self):
+            raise IndexError(position)
+        if position < len(self._head):
+            return self._head[position]
+        found = self._made.get(position)
+        if found is None:
+            found = self._made[position] = self._make(self._rest[position - len(self._head)])
+        return found
 
 
 _DEGREE_SCORE = {Degree.EXACT: 1.0, Degree.SUBCLASS_OF: 0.8, Degree.HAS_SUBCLASS: 0.6, Degree.FAIL: 0.0}

@@ -32,9 +32,7 @@ def statement_similarity(
     s = measure(requested.subject, advertised.subject)
     p = measure(requested.predicate, advertised.predicate)
     o = measure(requested.object, advertised.object)
-    value = (
-        config.subject_weight * s.value + config.predicate_weight * p.value + config.object_weight * o.value
-    )
+    value = config.subject_weight * s.value + config.predicate_weight * p.value + config.object_weight * o.value
     return StatementMatch(requested, advertised, value, (s, p, o))
 
 
@@ -45,7 +43,5 @@ def best_statement_matches(
     matches = []
     for statement in wanted:
         options = [statement_similarity(statement, other, measure, config) for other in offered]
-        matches.append(
-            max(options, key=lambda m: m.value) if options else StatementMatch(statement, None, 0.0)
-        )
+        matches.append(max(options, key=lambda m: m.value) if options else StatementMatch(statement, None, 0.0))
     return matches

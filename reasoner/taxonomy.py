@@ -48,8 +48,7 @@ class TaxonomyIndex:
     def from_kb(cls, kb: KnowledgeBase) -> TaxonomyIndex:
         """Read every term and link with two named queries, then build the DAG in memory."""
         links = [
-            Link(row["child"].value, row["parent"].value, row["link"].value)
-            for row in kb.select("taxonomy_links")
+            Link(row["child"].value, row["parent"].value, row["link"].value) for row in kb.select("taxonomy_links")
         ]
         terms = {row["term"].value: row.get("label") for row in kb.select("taxonomy_terms")}
         usage = {row["concept"].value: int(row["uses"].value) for row in kb.select("concept_usage")}
@@ -102,9 +101,7 @@ class TaxonomyIndex:
                 cycle = nx.find_cycle(graph)
             except nx.NetworkXNoCycle:
                 return
-            child, parent = next(
-                ((c, p) for c, p, *_ in cycle if self._parents[c][p] == "has-part"), cycle[0][:2]
-            )
+            child, parent = next(((c, p) for c, p, *_ in cycle if self._parents[c][p] == "has-part"), cycle[0][:2])
             del self._parents[child][parent]
             self._children[parent].discard(child)
             graph.remove_edge(child, parent)
@@ -149,6 +146,11 @@ class TaxonomyIndex:
 
     def children(self, concept: str) -> set[str]:
         return set(self._children[self.canonical(concept)])
+
+    def child_links(self, concept: str) -> list[tuple[str, str]]:
+        """(child, link kind) for each node directly below ``concept``."""
+        node = self.canonical(concept)
+        return [(child, self._parents[child][node]) for child in self._children[node]]
 
     def ancestors(self, concept: str, is_a_only: bool = False) -> dict[str, int]:
         """Every node above ``concept`` (itself included, and the root) with its distance in links,

@@ -142,9 +142,7 @@ def test_broken_file_loads_nothing(tmp_path: Path) -> None:
 
 
 def test_load_says_where_each_file_went(tmp_path: Path) -> None:
-    code, out = run(
-        "load", str(DATA / "mini_ontology.ttl"), str(DATA / "mini_services.ttl"), store=str(tmp_path / "s")
-    )
+    code, out = run("load", str(DATA / "mini_ontology.ttl"), str(DATA / "mini_services.ttl"), store=str(tmp_path / "s"))
     assert code == 0
     assert "mini_ontology.ttl: 39 triples into graph:ontology" in out
     assert "into graph:services" in out
@@ -194,9 +192,7 @@ def test_demo_tours_the_paper_example() -> None:
     assert "Table 1" in out and "LocateMobileRobot" in out and "RobotSelfPosition" in out
 
 
-def test_unexpected_errors_are_one_line(
-    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
-) -> None:
+def test_unexpected_errors_are_one_line(monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
     def explode(*_: object) -> None:
         raise RuntimeError("disk on fire")
 

@@ -41,9 +41,7 @@ def test_table3_ceiling_camera_ranks_first(sem_str: Matchmaker) -> None:
     result = sem_str.rank(REQ + "RobotSelfPosition")
     assert result.status is MatchStatus.MATCHED
     order = [
-        c.advertisement.rsplit("#", 1)[1]
-        for c in result.candidates
-        if c.advertisement.rsplit("#", 1)[1] in TABLE3
+        c.advertisement.rsplit("#", 1)[1] for c in result.candidates if c.advertisement.rsplit("#", 1)[1] in TABLE3
     ]
     assert order[0] == "LocateMobileRobot_CeilingCamera01"
     assert result.candidates[0].advertisement == SVC + "LocateMobileRobot_CeilingCamera01"
@@ -62,9 +60,7 @@ def test_table3_explanation_matches_position_with_location(sem_str: Matchmaker) 
 
 def test_sea_filter_rejects_the_kitchen_camera(sem_str: Matchmaker) -> None:
     result = sem_str.rank(REQ + "RobotSelfPosition")
-    kitchen = next(
-        c for c in result.candidates if c.advertisement == SVC + "LocateMobileRobot_CeilingCamera02"
-    )
+    kitchen = next(c for c in result.candidates if c.advertisement == SVC + "LocateMobileRobot_CeilingCamera02")
     assert not kitchen.acceptable
     assert any(reason.startswith("SEA") for reason in kitchen.rejected_by)
 
@@ -80,9 +76,7 @@ def test_every_method_ranks_every_advertisement_deterministically(
     bundled_kb: KnowledgeBase, sem_str: Matchmaker, method: str
 ) -> None:
     ads = sem_str.advertisements
-    forward = Matchmaker(bundled_kb, method, index=sem_str.index, advertisements=ads).rank(
-        REQ + "RobotSelfPosition"
-    )
+    forward = Matchmaker(bundled_kb, method, index=sem_str.index, advertisements=ads).rank(REQ + "RobotSelfPosition")
     backward = Matchmaker(bundled_kb, method, index=sem_str.index, advertisements=ads[::-1]).rank(
         REQ + "RobotSelfPosition"
     )
@@ -98,9 +92,7 @@ def test_no_acceptable_match_is_a_status_with_the_table(mini_kb: KnowledgeBase) 
           cbrs:hasOWLSModel [ cbrs:hasOutput [ cbrs:parameterType ex:Door ] ] ."""
     )
     requirement = mini_kb.description("http://example.org/mini#SelfPosition")
-    strict = Matchmaker(
-        mini_kb, config=MatchConfig(accept_score=0.99), advertisements=mini_kb.advertisements()
-    )
+    strict = Matchmaker(mini_kb, config=MatchConfig(accept_score=0.99), advertisements=mini_kb.advertisements())
     result = strict.rank(requirement.iri)
     assert result.status is MatchStatus.NO_ACCEPTABLE_MATCH
     assert len(result.candidates) == 3

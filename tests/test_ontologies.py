@@ -62,9 +62,12 @@ def test_every_term_we_use_is_declared(merged: rdflib.Graph) -> None:
     used = set()
     for _s, p, o in merged:
         used.add(p)
-        if p in (RDF.type, RDFS.subClassOf, OWL.someValuesFrom, OWL.onProperty, RDFS.subPropertyOf) or str(
-            p
-        ) in (CBRS + "parameterType", RDF.subject, RDF.predicate, RDF.object):
+        if p in (RDF.type, RDFS.subClassOf, OWL.someValuesFrom, OWL.onProperty, RDFS.subPropertyOf) or str(p) in (
+            CBRS + "parameterType",
+            RDF.subject,
+            RDF.predicate,
+            RDF.object,
+        ):
             used.add(o)
     ours = {t for t in used if isinstance(t, rdflib.URIRef) and str(t).startswith(OURS)}
     assert sorted(str(t) for t in ours - declared) == []
@@ -73,9 +76,7 @@ def test_every_term_we_use_is_declared(merged: rdflib.Graph) -> None:
 def test_has_part_family_roots_at_dul(merged: rdflib.Graph) -> None:
     has_part = rdflib.URIRef(DUL + "hasPart")
     part_props = {
-        p
-        for restriction in merged.subjects(OWL.onProperty, None)
-        for p in merged.objects(restriction, OWL.onProperty)
+        p for restriction in merged.subjects(OWL.onProperty, None) for p in merged.objects(restriction, OWL.onProperty)
     }
     family = set(merged.transitive_subjects(RDFS.subPropertyOf, has_part))
     assert len(family) > 10

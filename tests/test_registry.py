@@ -104,9 +104,7 @@ def test_update_or_deregister_of_unknown_is_not_found(mini_kb: KnowledgeBase) ->
         pytest.param(HEAD + "ex:T a ex:Camera .", "describes no advertisement", id="not-an-advertisement"),
     ],
 )
-def test_invalid_descriptions_are_refused_and_change_nothing(
-    mini_kb: KnowledgeBase, turtle: str, problem: str
-) -> None:
+def test_invalid_descriptions_are_refused_and_change_nothing(mini_kb: KnowledgeBase, turtle: str, problem: str) -> None:
     before = mini_kb.store.dump()
     with pytest.raises(InvalidDescriptionError, match=problem):
         mini_kb.registry.register(turtle)

@@ -38,9 +38,7 @@ def test_figure5_far_apart_through_the_root_is_small() -> None:
         pytest.param("RobotPosition", "Position", "situation-1", 0.5, id="subclass"),
         pytest.param("Position", "RobotPosition", "situation-1", 0.5, id="superclass"),
         pytest.param("XCoordinate", "Position", "situation-1", 0.5, id="part-of-whole"),
-        pytest.param(
-            "RobotPosition", "RobotLocation", "situation-2", 2 * 2 / (2 + 2 + 2 * 2), id="position-location"
-        ),
+        pytest.param("RobotPosition", "RobotLocation", "situation-2", 2 * 2 / (2 + 2 + 2 * 2), id="position-location"),
         pytest.param("Position", "Location", "situation-2", 2 * 2 / (1 + 1 + 2 * 2), id="siblings"),
     ],
 )

@@ -1,0 +1,231 @@
+"""Score a whole pool of advertisements against one requirement with numpy.
+
+Same numbers as ``Matchmaker.score`` (tests compare them on every pool they use), computed once
+per distinct concept, parameter tree and statement rather than once per advertisement. The
+explanation (pairs, lacks) is left to the scalar path, for the candidates a person looks at.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from kb import Advertisement, EffectiveArea, PartNode, QoSValue, Requirement, Statement
+from reasoner.config import MatchConfig
+from reasoner.similarity import EntityMeasure
+from reasoner.spans import span
+from reasoner.vectors import FloatArray, IntArray, VectorSpace
+
+PARTS = ("outputs", "inputs", "effects", "preconditions")
+
+
+class _Segments:
+    """Per-advertisement lists of indices (CSR), with max and mean reductions over them."""
+
+    def __init__(self, lists: Sequence[Sequence[int]]) -> None:
+        self.counts = np.array([len(items) for items in lists], dtype=np.int64)
+        self.flat = np.array([i for items in lists for i in items] + [0], dtype=np.int64)  # +sentinel
+        self.starts = np.concatenate(([0], np.cumsum(self.counts)[:-1])).astype(np.int64)
+        self.present = self.counts > 0
+
+    def max(self, values: FloatArray) -> FloatArray:
+        gathered = np.append(values[self.flat[:-1]], 0.0)
+        return np.where(self.present, np.maximum.reduceat(gathered, self.starts), 0.0)
+
+    def mean(self, values: FloatArray) -> FloatArray:
+        gathered = np.append(values[self.flat[:-1]], 0.0)
+        sums = np.add.reduceat(gathered, self.starts)
+        return np.where(self.present, sums / np.maximum(self.counts, 1), 0.0)
+
+
+@dataclass(frozen=True)
+class BatchScores:
+    score: FloatArray
+    parts: dict[str, FloatArray]  # each part's value, NaN where the part is left out
+    rejected_by: list[tuple[str, ...]]  # filter reasons per advertisement
+
+
+class CompiledPool:
+    """An advertisement pool laid out as arrays over distinct trees and statements."""
+
+    def __init__(self, ads: Sequence[Advertisement], space: VectorSpace, use_parts: bool) -> None:
+        self.ads = list(ads)
+        self.space = space
+        self.use_parts = use_parts
+        trees: dict[str, PartNode] = {}
+        statements: dict[Statement, int] = {}
+        for ad in self.ads:
+            for parameter in (*ad.inputs, *ad.outputs):
+                trees.setdefault(parameter.type, parameter.tree or PartNode(parameter.type))
+            for statement in (*ad.effects, *ad.preconditions):
+                statements.setdefault(statement, len(statements))
+        self.tree_ids = {concept: i for i, concept in enumerate(trees)}
+        self._layout_trees(list(trees.values()))
+        self.statements = list(statements)
+        cid = space.add
+        self.s_ids = np.array([cid(s.subject) for s in self.statements], dtype=np.int64)
+        self.p_ids = np.array([cid(s.predicate) for s in self.statements], dtype=np.int64)
+        self.o_ids = np.array([cid(s.object) for s in self.statements], dtype=np.int64)
+        self.outputs = _Segments([[self.tree_ids[p.type] for p in ad.outputs] for ad in self.ads])
+        self.inputs = _Segments([[self.tree_ids[p.type] for p in ad.inputs] for ad in self.ads])
+        self.effects = _Segments([[statements[s] for s in ad.effects] for ad in self.ads])
+        self.preconditions = _Segments([[statements[s] for s in ad.preconditions] for ad in self.ads])
+        order = sorted(range(len(self.ads)), key=lambda i: self.ads[i].iri)
+        self.iri_rank = np.empty(len(self.ads), dtype=np.int64)
+        self.iri_rank[order] = np.arange(len(self.ads))
+
+    def _layout_trees(self, trees: list[PartNode]) -> None:
+        """Offered side: each tree's root and its parts (CSR). Wanted side: every node of every
+        tree, flattened with its parent, level and span, for a level-by-level cover."""
+        cid = self.space.add
+        self.root_ids = np.array([cid(t.concept) for t in trees], dtype=np.int64)
+        part_lists = [[cid(n.concept) for n in t.walk() if n is not t] if self.use_parts else [] for t in trees]
+        self.part_segments = _Segments(part_lists)
+        concept: list[int] = []
+        parent: list[int] = []
+        level: list[int] = []
+        width: list[int] = []
+        leaf: list[bool] = []
+        root_of: list[int] = []
+        for tree in trees:
+            root_of.append(len(concept))
+            stack: list[tuple[PartNode, int, int]] = [(tree, -1, 0)]
+            while stack:
+                node, up, depth = stack.pop()
+                position = len(concept)
+                concept.append(cid(node.concept))
+                parent.append(up)
+                level.append(depth)
+                width.append(span(node))
+                leaf.append(node.is_leaf or not self.use_parts)
+                if self.use_parts:
+                    stack.extend((child, position, depth + 1) for child in node.children)
+        self.node_concept = np.array(concept, dtype=np.int64)
+        self.node_parent = np.array(parent, dtype=np.int64)
+        self.node_level = np.array(level, dtype=np.int64)
+        self.node_span = np.array(width, dtype=np.float64)
+        self.node_leaf = np.array(leaf, dtype=bool)
+        self.tree_root_node = np.array(root_of, dtype=np.int64)
+        self.node_is_root = self.node_parent < 0
+
+
+class BatchScorer:
+    def __init__(
+        self,
+        pool: CompiledPool,
+        measure: EntityMeasure,
+        config: MatchConfig,
+        filters: Callable[[Requirement, EffectiveArea | None, tuple[QoSValue, ...]], list[str]],
+    ) -> None:
+        self.pool = pool
+        self.measure = measure
+        self.config = config
+        self.filters = filters
+
+    def _vector(self, concept: str) -> FloatArray:
+        return self.pool.space.vector(self.measure, concept)
+
+    def css_wanted(self, tree: PartNode) -> FloatArray:
+        """CSS of a fixed requirement tree (wanted) against every pool tree (offered)."""
+        pool = self.pool
+
+        def cover(node: PartNode, is_root: bool) -> FloatArray:
+            if is_root:
+                own = self._vector(node.concept)[pool.root_ids]
+            else:
+                own = pool.part_segments.max(self._vector(node.concept))
+            if node.is_leaf or not pool.use_parts:
+                return own
+            total = own.copy()
+            for child in node.children:
+                total += span(child) * cover(child, False)
+            return np.maximum(own, total / (1 + span(node)))
+
+        return cover(tree, True)
+
+    def css_offered(self, tree: PartNode) -> FloatArray:
+        """CSS of every pool tree (wanted, e.g. an advertisement's input) against a fixed offered tree."""
+        pool = self.pool
+        root = self._vector(tree.concept)
+        parts = [n for n in tree.walk() if n is not tree] if pool.use_parts else []
+        best_part = np.zeros(len(pool.space), dtype=np.float64)
+        for node in parts:
+            best_part = np.maximum(best_part, self._vector(node.concept))
+        own = np.where(pool.node_is_root, root[pool.node_concept], best_part[pool.node_concept])
+        cover = own.copy()
+        child_sum = np.zeros_like(own)
+        for level in range(int(pool.node_level.max(initial=0)), -1, -1):
+            at = np.flatnonzero(pool.node_level == level)
+            inner = at[~pool.node_leaf[at]]
+            span_ = pool.node_span[inner]
+            cover[inner] = np.maximum(own[inner], (own[inner] + child_sum[inner]) / (1 + span_))
+            below = at[pool.node_parent[at] >= 0]
+            np.add.at(child_sum, pool.node_parent[below], pool.node_span[below] * cover[below])
+        return cover[pool.tree_root_node]
+
+    def statements(self, statement: Statement) -> FloatArray:
+        cfg, pool = self.config, self.pool
+        return (
+            cfg.subject_weight * self._vector(statement.subject)[pool.s_ids]
+            + cfg.predicate_weight * self._vector(statement.predicate)[pool.p_ids]
+            + cfg.object_weight * self._vector(statement.object)[pool.o_ids]
+        )
+
+    def score(self, requirement: Requirement) -> BatchScores:
+        pool, cfg = self.pool, self.config
+        n = len(pool.ads)
+        nan = np.full(n, np.nan)
+        parts: dict[str, FloatArray] = {name: nan.copy() for name in PARTS}
+        if requirement.outputs:
+            per = [pool.outputs.max(self.css_wanted(p.tree or PartNode(p.type))) for p in requirement.outputs]
+            parts["outputs"] = np.mean(per, axis=0)
+        if requirement.inputs or np.any(pool.inputs.present):
+            needed = np.zeros(len(pool.root_ids))
+            for provided in requirement.inputs:
+                needed = np.maximum(needed, self.css_offered(provided.tree or PartNode(provided.type)))
+            needed_per_ad = pool.inputs.mean(needed)
+            if requirement.inputs:
+                used = np.mean(
+                    [pool.inputs.max(self.css_wanted(p.tree or PartNode(p.type))) for p in requirement.inputs],
+                    axis=0,
+                )
+                inputs = np.where(pool.inputs.present, (needed_per_ad + used) / 2, used)
+            else:
+                inputs = np.where(pool.inputs.present, needed_per_ad, np.nan)
+            parts["inputs"] = inputs
+        if requirement.effects:
+            parts["effects"] = np.mean([pool.effects.max(self.statements(s)) for s in requirement.effects], axis=0)
+        if requirement.preconditions:
+            guaranteed = np.max([self.statements(s) for s in requirement.preconditions], axis=0)
+            parts["preconditions"] = np.where(pool.preconditions.present, pool.preconditions.mean(guaranteed), np.nan)
+        weights = {
+            "outputs": cfg.output_weight,
+            "inputs": cfg.input_weight,
+            "effects": cfg.effect_weight,
+            "preconditions": cfg.precondition_weight,
+        }
+        numerator = np.zeros(n)
+        denominator = np.zeros(n)
+        for name, values in parts.items():
+            present = ~np.isnan(values)
+            numerator += np.where(present, weights[name] * np.nan_to_num(values), 0.0)
+            denominator += np.where(present, weights[name], 0.0)
+        ratio = np.where(denominator > 0, numerator / np.maximum(denominator, 1e-300), 0.0)
+        score = np.round(ratio.astype(np.float64), 6).astype(np.float64)
+        cache: dict[tuple[EffectiveArea | None, tuple[QoSValue, ...]], tuple[str, ...]] = {}
+        rejected = []
+        for ad in pool.ads:
+            key = (ad.area, ad.qos)
+            if key not in cache:
+                cache[key] = tuple(self.filters(requirement, ad.area, ad.qos))
+            rejected.append(cache[key])
+        return BatchScores(score, parts, rejected)
+
+
+def ranking_order(scores: BatchScores, pool: CompiledPool, accept_score: float) -> IntArray:
+    """Acceptable first, then those that pass the filters, then by score, then by IRI."""
+    rejected = np.array([bool(r) for r in scores.rejected_by])
+    acceptable = ~rejected & (scores.score >= accept_score)
+    return np.lexsort((pool.iri_rank, -scores.score, rejected, ~acceptable)).astype(np.int64)
