@@ -29,7 +29,7 @@ from reasoner.methods import METHODS
 def match(app: App, requirement: str, top: int, method: str, explain: bool, as_json: bool) -> None:
     """Rank the advertisements against REQUIREMENT (an IRI or prefix:name, e.g. req:RobotSelfPosition)."""
     iri = parse_iri(requirement, "REQUIREMENT")
-    result = Matchmaker(app.kb, method).rank(iri)
+    result = Matchmaker(app.kb, method).rank(iri, explain=top)
     if as_json:
         click.echo(json.dumps(result.to_dict(top), indent=2))
         return

@@ -1,4 +1,31 @@
-"""Matchmaking: taxonomy index, Sem-Str similarity, conceptual span similarity and PE matching.
+"""Semantic matchmaking of requirements against advertisements (paper sections 3.2 and 4).
 
-Empty until the matchmaking work lands; see docs/architecture.md for where it fits.
+The matchmaker ranks every advertisement with the paper's Sem-Str similarity, conceptual span
+similarity over part trees and RDF-statement matching, or with a baseline; docs/matchmaking.md has the
+formulas.
 """
+
+from reasoner.config import MatchConfig
+from reasoner.degrees import Degree, degree_of_match
+from reasoner.matchmaker import Candidate, EntityPair, Matchmaker, MatchResult, MatchStatus
+from reasoner.methods import METHODS
+from reasoner.similarity import Lin, SemStr, Similarity, StringMatch, WuPalmer
+from reasoner.taxonomy import TaxonomyIndex
+
+__all__ = [
+    "METHODS",
+    "Candidate",
+    "Degree",
+    "EntityPair",
+    "Lin",
+    "MatchConfig",
+    "MatchResult",
+    "MatchStatus",
+    "Matchmaker",
+    "SemStr",
+    "Similarity",
+    "StringMatch",
+    "TaxonomyIndex",
+    "WuPalmer",
+    "degree_of_match",
+]
