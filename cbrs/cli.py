@@ -306,9 +306,10 @@ def main() -> None:
 
 
 def _register_subcommands() -> None:
-    from cbrs.cli_reasoner import match
+    from cbrs.cli_reasoner import eval_group, match
 
     cli.add_command(match)
+    cli.add_command(eval_group)
 
 
 _register_subcommands()

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import click
 
@@ -15,15 +16,9 @@ from reasoner.methods import METHODS
 
 @click.command()
 @click.argument("requirement")
-@click.option(
-    "--top", default=10, show_default=True, type=click.IntRange(min=1), help="How many candidates to show."
-)
-@click.option(
-    "--method", type=click.Choice(METHODS), default="sem-str", show_default=True, help="Matching method."
-)
-@click.option(
-    "--explain", is_flag=True, help="Show, for each shown candidate, the entity pairs and what it lacks."
-)
+@click.option("--top", default=10, show_default=True, type=click.IntRange(min=1), help="How many candidates to show.")
+@click.option("--method", type=click.Choice(METHODS), default="sem-str", show_default=True, help="Matching method.")
+@click.option("--explain", is_flag=True, help="Show, for each shown candidate, the entity pairs and what it lacks.")
 @click.option("--json", "as_json", is_flag=True, help="Print the ranking (with explanations) as JSON.")
 @pass_app
 def match(app: App, requirement: str, top: int, method: str, explain: bool, as_json: bool) -> None:
@@ -77,3 +72,25 @@ def _explanation(position: int, c: Candidate) -> str:
     for reason in c.rejected_by:
         lines.append(f"  rejected: {reason}")
     return "\n".join(lines)
+
+
+@click.group("eval")
+def eval_group() -> None:
+    """Evaluate the matching methods on a test collection."""
+
+
+@eval_group.command("paper")
+@click.option("--method", "methods", multiple=True, type=click.Choice(METHODS), help="Only these methods (repeatable).")
+@click.option("--json", "as_json", is_flag=True, help="Print the figures as JSON.")
+@click.option("--plot", type=click.Path(dir_okay=False, path_type=Path), help="Write a bar chart of the figures (PNG).")
+def eval_paper(methods: tuple[str, ...], as_json: bool, plot: Path | None) -> None:
+    """The paper-style testbed: 20 requirements against 100 components (reasoner/data/)."""
+    from reasoner.evaluation import evaluate_paper, plot_report
+
+    report = evaluate_paper(methods or METHODS)
+    if as_json:
+        click.echo(json.dumps(report.to_json(), indent=2))
+    else:
+        click.echo(report.text())
+    if plot is not None:
+        click.echo(f"chart written to {plot_report(report, plot)}", err=as_json)

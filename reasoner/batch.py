@@ -84,6 +84,7 @@ class CompiledPool:
         part_lists = [[cid(n.concept) for n in t.walk() if n is not t] if self.use_parts else [] for t in trees]
         self.part_segments = _Segments(part_lists)
         concept: list[int] = []
+        tree_root: list[int] = []
         parent: list[int] = []
         level: list[int] = []
         width: list[int] = []
@@ -96,6 +97,7 @@ class CompiledPool:
                 node, up, depth = stack.pop()
                 position = len(concept)
                 concept.append(cid(node.concept))
+                tree_root.append(cid(tree.concept))
                 parent.append(up)
                 level.append(depth)
                 width.append(span(node))
@@ -103,9 +105,11 @@ class CompiledPool:
                 if self.use_parts:
                     stack.extend((child, position, depth + 1) for child in node.children)
         self.node_concept = np.array(concept, dtype=np.int64)
+        self.node_tree_root = np.array(tree_root, dtype=np.int64)
         self.node_parent = np.array(parent, dtype=np.int64)
         self.node_level = np.array(level, dtype=np.int64)
         self.node_span = np.array(width, dtype=np.float64)
+        self.node_weight = np.array([self.space.index.part_weight(self.space.names[c]) for c in concept])
         self.node_leaf = np.array(leaf, dtype=bool)
         self.tree_root_node = np.array(root_of, dtype=np.int64)
         self.node_is_root = self.node_parent < 0
@@ -131,6 +135,8 @@ class BatchScorer:
         """CSS of a fixed requirement tree (wanted) against every pool tree (offered)."""
         pool = self.pool
 
+        superclasses = self._superclasses(tree.concept, pool.root_ids)
+
         def cover(node: PartNode, is_root: bool) -> FloatArray:
             if is_root:
                 own = self._vector(node.concept)[pool.root_ids]
@@ -139,11 +145,28 @@ class BatchScorer:
             if node.is_leaf or not pool.use_parts:
                 return own
             total = own.copy()
+            weight = np.ones_like(own)
             for child in node.children:
-                total += span(child) * cover(child, False)
-            return np.maximum(own, total / (1 + span(node)))
+                counted = np.ones_like(own)
+                if is_root and superclasses is not None:
+                    part = np.full(len(own), pool.space.add(child.concept), dtype=np.int64)
+                    counted = np.where(superclasses >= 0, ~pool.space.implied(np.maximum(superclasses, 0), part), 1.0)
+                strength = counted * pool.space.index.part_weight(child.concept) * span(child)
+                total += strength * cover(child, False)
+                weight += strength
+            return np.maximum(own, total / weight)
 
         return cover(tree, True)
+
+    def _superclasses(self, concept: str, others: IntArray) -> IntArray | None:
+        """Most specific common superclass of ``concept`` with each of ``others`` (-1 where there is
+        none: a concept outside the taxonomy), or None when ``concept`` is outside it."""
+        space = self.pool.space
+        table = space.common_superclasses(concept)
+        if table is None:
+            return None
+        inside = others < space.taxonomy_size
+        return np.where(inside, table[np.where(inside, others, 0)], -1)
 
     def css_offered(self, tree: PartNode) -> FloatArray:
         """CSS of every pool tree (wanted, e.g. an advertisement's input) against a fixed offered tree."""
@@ -154,15 +177,22 @@ class BatchScorer:
         for node in parts:
             best_part = np.maximum(best_part, self._vector(node.concept))
         own = np.where(pool.node_is_root, root[pool.node_concept], best_part[pool.node_concept])
+        counted = np.ones_like(own)  # parts of a root implied by its common superclass with ours: 0
+        superclasses = self._superclasses(tree.concept, pool.node_tree_root) if pool.use_parts else None
+        if superclasses is not None:
+            first = np.flatnonzero((pool.node_level == 1) & (superclasses >= 0))
+            counted[first] = ~pool.space.implied(superclasses[first], pool.node_concept[first])
         cover = own.copy()
         child_sum = np.zeros_like(own)
+        child_weight = np.zeros_like(own)
         for level in range(int(pool.node_level.max(initial=0)), -1, -1):
             at = np.flatnonzero(pool.node_level == level)
             inner = at[~pool.node_leaf[at]]
-            span_ = pool.node_span[inner]
-            cover[inner] = np.maximum(own[inner], (own[inner] + child_sum[inner]) / (1 + span_))
+            cover[inner] = np.maximum(own[inner], (own[inner] + child_sum[inner]) / (1 + child_weight[inner]))
             below = at[pool.node_parent[at] >= 0]
-            np.add.at(child_sum, pool.node_parent[below], pool.node_span[below] * cover[below])
+            weights = counted[below] * pool.node_weight[below] * pool.node_span[below]
+            np.add.at(child_sum, pool.node_parent[below], weights * cover[below])
+            np.add.at(child_weight, pool.node_parent[below], weights)
         return cover[pool.tree_root_node]
 
     def statements(self, statement: Statement) -> FloatArray:

@@ -260,7 +260,16 @@ class Matchmaker:
             self.method.measure,
             self.config.pair_threshold,
             use_parts=self.method.use_parts,
+            implied=self.implied_parts(wanted.type, offered.type) if self.method.use_parts else frozenset(),
+            weight=self.index.part_weight,
         )
+
+    def implied_parts(self, first: str, second: str) -> frozenset[str]:
+        """Parts both concepts have through their common superclass: no evidence of their own."""
+        if first not in self.index or second not in self.index:
+            return frozenset()
+        common, _, _ = self.index.common_ancestor(first, second)
+        return self.index.parts_of(common)
 
     def _statements(self, matches: list[StatementMatch], role: str, pairs: list[EntityPair], lacks: list[str]) -> float:
         values = []

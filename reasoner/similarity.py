@@ -73,13 +73,20 @@ class SemStr:
             return Similarity(1.0, "exact", first, (0, 0))
         if first not in index or second not in index:
             return self.situation_3(first, second)
+        common, n1, n2 = index.common_ancestor(first, second)
+        if common != ROOT and 0 in (n1, n2):
+            # One is a subclass of the other: Wu-Palmer is positive here (C is the upper one).
+            nr = index.depth(common)
+            return Similarity(2 * nr / (n1 + n2 + 2 * nr), "situation-2", common, (n1, n2))
+        # Situation 1, where Wu-Palmer would give zero or says nothing: one entity lies below the
+        # other through a hasPart link (a part is a "leaf" of its whole), or their most specific
+        # common superclass is the root.
         up = index.distance_down(first, second)
-        if up is not None:  # e1 below e2
+        if up is not None:
             return Similarity(1 / (1 + up), "situation-1", index.canonical(second), (up, 0))
         down = index.distance_down(second, first)
-        if down is not None:  # e2 below e1: the measure is symmetric
+        if down is not None:
             return Similarity(1 / (1 + down), "situation-1", index.canonical(first), (0, down))
-        common, n1, n2 = index.common_ancestor(first, second)
         if common == ROOT:
             return Similarity(1 / (1 + n1 + n2), "situation-1", ROOT, (n1, n2))
         nr = index.depth(common)
@@ -91,11 +98,8 @@ class SemStr:
         core2, rest2 = core_split(self._name(second))
         core = jellyfish.jaro_winkler_similarity(core1, core2)
         if not rest1 and not rest2:
-            rest = 1.0
-        elif not rest1 or not rest2:
-            rest = 0.0
-        else:
-            rest = jellyfish.jaro_winkler_similarity(rest1, rest2)
+            return Similarity(core, "situation-3")  # nothing else to compare: the core word says it all
+        rest = jellyfish.jaro_winkler_similarity(rest1, rest2) if rest1 and rest2 else 0.0
         value = self.config.alpha * core + self.config.beta * rest
         return Similarity(min(1.0, max(0.0, value)), "situation-3")
 

@@ -7,17 +7,22 @@ spans itself) and has its own similarity own(n), the best Sim of n against the e
 advertisement tree. A node is covered either by its own match or by its parts:
 
     cover(n) = own(n)                                                     n a leaf
-    cover(n) = max(own(n), (own(n) + sum_c span(c) * cover(c)) / (1 + span(n)))   otherwise
+    cover(n) = max(own(n), (own(n) + sum_c w(c) span(c) cover(c)) / (1 + sum_c w(c) span(c)))   otherwise
     CSS(RT, AT) = cover(root of RT)
 
 so when the roots match at least as well as their parts do, CSS = Sim(roots), the paper's special
 case; when they do not (Position against Location: siblings, but with the same x, y, theta parts), the
-parts' evidence lifts the score, and the root's own similarity still weighs in. Pairs reaching the
-pair threshold are reported as matched; requirement leaves below it are what the advertisement lacks.
+parts' evidence lifts the score, and the root's own similarity still weighs in. Parts of the root that
+both concepts inherit from their common superclass (``implied``) are left out of the sum: the taxonomy
+has already counted them. A part's weight w(c) says how specific it is in the loaded ontology: a part
+that nearly every whole has (a timestamp) is weak evidence that two concepts are alike. Pairs reaching
+the pair threshold are reported as matched; requirement leaves below it are what the advertisement
+lacks.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from kb import PartNode
@@ -50,8 +55,12 @@ def conceptual_span_similarity(
     measure: EntityMeasure,
     threshold: float,
     use_parts: bool = True,
+    implied: frozenset[str] = frozenset(),
+    weight: Callable[[str], float] = lambda _: 1.0,
 ) -> SpanMatch:
-    """CSS of two trees; with ``use_parts`` false only the roots are compared (flat matching)."""
+    """CSS of two trees; with ``use_parts`` false only the roots are compared (flat matching).
+    ``implied``: parts of the roots' common superclass, which do not count as evidence;
+    ``weight``: how much a matched part of a given concept counts (TaxonomyIndex.part_weight)."""
     parts = [node for node in advertised.walk() if node is not advertised] if use_parts else []
     pairs: list[PairMatch] = []
     uncovered: list[str] = []
@@ -75,7 +84,11 @@ def conceptual_span_similarity(
                 uncovered.append(node.concept)
             return value
         mark = len(pairs), len(uncovered)
-        by_parts = (value + sum(span(c) * cover(c, parts) for c in node.children)) / (1 + span(node))
+        counted = [c for c in node.children if not (node is requested and c.concept in implied)]
+        weights = [weight(c.concept) * span(c) for c in counted]
+        by_parts = (value + sum(w * cover(c, parts) for w, c in zip(weights, counted, strict=True))) / (
+            1 + sum(weights)
+        )
         if value >= by_parts:
             del pairs[mark[0] :], uncovered[mark[1] :]  # the node's own match covers its span
             if best is not None and partner is not None and value >= threshold:

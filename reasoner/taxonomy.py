@@ -12,6 +12,7 @@ entity lies below another follows both kinds. Depths and distances count links a
 
 from __future__ import annotations
 
+import math
 from collections import deque
 from collections.abc import Iterable
 from dataclasses import dataclass, field
@@ -39,6 +40,8 @@ class TaxonomyIndex:
     _children: dict[str, set[str]] = field(default_factory=dict)
     _depth: dict[str, int] = field(default_factory=dict)
     _ancestors: dict[tuple[str, bool], dict[str, int]] = field(default_factory=dict)  # cache
+    _parts: dict[str, frozenset[str]] = field(default_factory=dict)  # cache
+    _part_weights: dict[str, float] | None = None
     labels: dict[str, str] = field(default_factory=dict)
     frequency: dict[str, int] = field(default_factory=dict)  # uses by service descriptions
 
@@ -173,6 +176,38 @@ class TaxonomyIndex:
     def is_a_ancestors(self, concept: str) -> dict[str, int]:
         """Superclasses (superproperties) with their distance, the concept itself included, no root."""
         return {a: d for a, d in self.ancestors(concept, is_a_only=True).items() if a != ROOT}
+
+    def parts_of(self, concept: str) -> frozenset[str]:
+        """The parts a concept has by its own hasPart restrictions or inherits by is-a (the root has none)."""
+        node = self.canonical(concept)
+        found = self._parts.get(node)
+        if found is None:
+            found = frozenset(
+                child
+                for owner in self.ancestors(node, is_a_only=True)
+                if owner != ROOT
+                for child, kind in self.child_links(owner)
+                if kind == "has-part"
+            )
+            self._parts[node] = found
+        return found
+
+    def part_weight(self, part: str) -> float:
+        """How much a matched part says: log(M / m) / log(M), with M the concepts that have parts and
+        m those that have this one (own or inherited). A part nearly everything has (a timestamp)
+        says little; a part only a few wholes have says much. A part no whole has weighs 1."""
+        if self._part_weights is None:
+            owners: dict[str, int] = {}
+            wholes = 0
+            for node in self.nodes():
+                parts = self.parts_of(node)
+                if parts:
+                    wholes += 1
+                    for p in parts:
+                        owners[p] = owners.get(p, 0) + 1
+            scale = math.log(wholes) if wholes > 1 else 1.0
+            self._part_weights = {p: math.log(wholes / m) / scale if wholes > 1 else 1.0 for p, m in owners.items()}
+        return self._part_weights.get(self.canonical(part), 1.0)
 
     def common_ancestor(self, first: str, second: str) -> tuple[str, int, int]:
         """The most specific common superclass C (is-a links) and the link counts N1, N2 to it.

@@ -38,6 +38,8 @@ class VectorSpace:
         self._is_a_below: dict[int, tuple[IntArray, IntArray]] = {}
         self._all_below: dict[int, tuple[IntArray, IntArray]] = {}
         self._cache: dict[tuple[int, str], FloatArray] = {}
+        self._lcs: dict[int, IntArray] = {}
+        self._implied: dict[tuple[int, int], bool] = {}
         for concept in sorted(set(extra)):
             self.add(concept)
 
@@ -82,17 +84,22 @@ class VectorSpace:
             values[i] = measure.situation_3(concept, self.names[i]).value
         known = slice(0, self.taxonomy_size)
         x = self.ids[self.index.canonical(concept)]
-        values[known] = self._wu_palmer_or_root(x)
-        # Situation 1: one below the other, by is-a or has-part links (overrides the above).
+        values[known], isa_related = self._wu_palmer_or_root(x)
+        # Situation 1 for what lies below or above x through a hasPart link (is-a relatives keep
+        # their Wu-Palmer value), and through the root (already in the values above).
         ids, dist = self._below(x, is_a_only=False)
-        values[ids] = 1.0 / (1.0 + dist)
+        keep = ~isa_related[ids]
+        values[ids[keep]] = 1.0 / (1.0 + dist[keep])
         for ancestor, links in self.index.ancestors(self.names[x]).items():
-            values[self.ids[ancestor]] = 1.0 / (1.0 + links)
+            a = self.ids[ancestor]
+            if not isa_related[a]:
+                values[a] = 1.0 / (1.0 + links)
         values[x] = 1.0
         return values
 
-    def _wu_palmer_or_root(self, x: int) -> FloatArray:
-        """Situation 2 (or 1 through the root) for every taxonomy node against node x."""
+    def _wu_palmer_or_root(self, x: int) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
+        """Situation 2 (or 1 through the root) for every taxonomy node against node x, and which
+        nodes are is-a relatives of x under a common superclass other than the root."""
         size = self.taxonomy_size
         best = np.full(size, -1, dtype=np.int64)
         limit = (1 << _SUM_BITS) - 1
@@ -108,7 +115,31 @@ class VectorSpace:
         nr = depth.astype(np.float64)
         with np.errstate(divide="ignore", invalid="ignore"):
             wu_palmer = 2 * nr / (total + 2 * nr)
-        return np.where(root, 1.0 / (1.0 + total), wu_palmer)
+        nodes = np.arange(size)
+        isa_related = ~root & ((lcs == x) | (lcs == nodes))
+        self._lcs[x] = lcs
+        return np.where(root, 1.0 / (1.0 + total), wu_palmer), isa_related
+
+    def common_superclasses(self, concept: str) -> IntArray | None:
+        """For every taxonomy node, the id of its most specific common superclass with ``concept``
+        (None when ``concept`` is outside the taxonomy)."""
+        if concept not in self.index:
+            return None
+        x = self.ids[self.index.canonical(concept)]
+        if x not in self._lcs:
+            self._wu_palmer_or_root(x)
+        return self._lcs[x]
+
+    def implied(self, superclass: IntArray, part: IntArray) -> npt.NDArray[np.bool_]:
+        """Element-wise: is part[i] a part that superclass[i] has (its own or inherited)?"""
+        result = np.zeros(len(part), dtype=bool)
+        for i, (a, p) in enumerate(zip(superclass.tolist(), part.tolist(), strict=True)):
+            key = (a, p)
+            found = self._implied.get(key)
+            if found is None:
+                found = self._implied[key] = self.names[p] in self.index.parts_of(self.names[a])
+            result[i] = found
+        return result
 
     def _below(self, node: int, is_a_only: bool) -> tuple[IntArray, IntArray]:
         """Every node at or below ``node`` and its distance, by is-a links or by both kinds."""

@@ -131,7 +131,7 @@ def test_css_root_match_is_the_root_similarity() -> None:
     match = conceptual_span_similarity(tree("RobotPosition", X, Y), tree("RobotPosition", X, Y), measure, 0.5)
     assert match.value == 1.0 and match.uncovered == ()
     only_root = conceptual_span_similarity(tree("RobotPosition"), tree("Position"), measure, 0.5)
-    assert only_root.value == 0.5
+    assert only_root.value == pytest.approx(2 * 3 / (1 + 2 * 3))  # Wu-Palmer, Position at depth 3
 
 
 def test_css_parts_lift_position_against_location() -> None:
@@ -140,6 +140,18 @@ def test_css_parts_lift_position_against_location() -> None:
     match = conceptual_span_similarity(tree("RobotPosition", X, Y), tree("RobotLocation", X, Y), measure, 0.5)
     assert match.value == pytest.approx((flat + 2) / 3)
     assert match.value > flat
+
+
+def test_css_ignores_parts_implied_by_the_common_superclass() -> None:
+    # RobotPosition and PersonPosition both inherit x and y from Position: no evidence beyond it.
+    measure = SemStr(positions())
+    flat = measure(E + "RobotPosition", E + "PersonPosition").value
+    implied = positions().parts_of(E + "Position")
+    assert implied == {E + "XCoordinate", E + "YCoordinate"}
+    match = conceptual_span_similarity(
+        tree("RobotPosition", X, Y), tree("PersonPosition", X, Y), measure, 0.5, implied=implied
+    )
+    assert match.value == pytest.approx(flat)
 
 
 def test_css_reports_uncovered_parts() -> None:
@@ -156,7 +168,7 @@ def test_statement_similarity_weighs_subject_predicate_object() -> None:
     assert statement_similarity(same, same, measure, config).value == pytest.approx(1.0)
     other = Statement(E + "RobotPosition", E + "isNear", E + "Location")
     value = statement_similarity(same, other, measure, config).value
-    assert value == pytest.approx((0.5 + 1 + 1) / 3)
+    assert value == pytest.approx((2 * 3 / (1 + 2 * 3) + 1 + 1) / 3)
 
 
 # -- the command ---------------------------------------------------------------------------------

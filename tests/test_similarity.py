@@ -35,9 +35,12 @@ def test_figure5_far_apart_through_the_root_is_small() -> None:
     ("first", "second", "situation", "value"),
     [
         pytest.param("RobotPosition", "RobotPosition", "exact", 1.0, id="exact"),
-        pytest.param("RobotPosition", "Position", "situation-1", 0.5, id="subclass"),
-        pytest.param("Position", "RobotPosition", "situation-1", 0.5, id="superclass"),
+        # a subclass: Wu-Palmer with C the superclass (depth 3), N1 = 1, N2 = 0
+        pytest.param("RobotPosition", "Position", "situation-2", 2 * 3 / (1 + 2 * 3), id="subclass"),
+        pytest.param("Position", "RobotPosition", "situation-2", 2 * 3 / (1 + 2 * 3), id="superclass"),
+        # a part below its whole: Wu-Palmer would use an unrelated superclass; Situation 1 instead
         pytest.param("XCoordinate", "Position", "situation-1", 0.5, id="part-of-whole"),
+        pytest.param("RobotPosition", "ColourOfMarker", "situation-1", 1 / (1 + 4 + 3), id="through-the-root"),
         pytest.param("RobotPosition", "RobotLocation", "situation-2", 2 * 2 / (2 + 2 + 2 * 2), id="position-location"),
         pytest.param("Position", "Location", "situation-2", 2 * 2 / (1 + 1 + 2 * 2), id="siblings"),
     ],
@@ -55,6 +58,9 @@ def test_situation_3_uses_core_words() -> None:
     assert same_core.situation == other_core.situation == "situation-3"
     assert same_core.value > other_core.value  # the core word weighs more (alpha > beta)
     assert measure(E + "Place", E + "Place").value == 1.0
+    # no complementary words on either side: the core words alone decide, no free share
+    lone = measure(E + "Status", E + "Temperature")
+    assert lone.value < 0.7
 
 
 def test_names() -> None:

@@ -1,0 +1,1 @@
+"""Generated evaluation data: the paper testbed (see reasoner.testbed) and its ground truth."""

@@ -1,0 +1,51 @@
+"""cbrs eval paper: the figures' shape, the chart, and the claims the docs make about them."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from cbrs.cli import cli
+from reasoner.evaluation import Report, evaluate_paper
+from reasoner.methods import METHODS
+
+
+@pytest.fixture(scope="module")
+def report() -> Report:
+    return evaluate_paper()
+
+
+def test_json_shape(tmp_path: Path) -> None:
+    chart = tmp_path / "chart.png"
+    result = CliRunner().invoke(cli, ["eval", "paper", "--json", "--plot", str(chart)])
+    assert result.exit_code == 0, result.output
+    data = json.loads(result.stdout)
+    assert data["requirements"] == 20 and data["services"] == 100
+    assert set(data["methods"]) == set(METHODS)
+    for figures in data["methods"].values():
+        assert set(figures) == {"top1", "p_at_5", "mrr", "map"}
+        assert all(0.0 <= value <= 1.0 for value in figures.values())
+    assert chart.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_text_report_names_every_method_and_the_machine() -> None:
+    result = CliRunner().invoke(cli, ["eval", "paper", "--method", "sem-str", "--method", "string"])
+    assert result.exit_code == 0
+    assert "correct testing pairs" in result.output and "machine:" in result.output
+    assert "wu-palmer" not in result.output
+
+
+def test_paper_method_finds_the_right_component_first(report: Report) -> None:
+    assert report.methods["sem-str"]["top1"] >= 0.95
+
+
+def test_paper_method_ranks_relevant_components_above_every_baseline(report: Report) -> None:
+    # MAP and per-pair correctness judge every relevant component, not only the easiest one.
+    ours = report.methods["sem-str"]
+    for baseline in ("string", "wu-palmer", "lin", "logic"):
+        assert ours["map"] > report.methods[baseline]["map"]
+        assert report.pair_correct_rate("sem-str") > report.pair_correct_rate(baseline)
+    assert report.methods["string"]["top1"] < ours["top1"]
