@@ -12,7 +12,7 @@ from typing import Protocol
 import jellyfish
 
 from reasoner.config import MatchConfig
-from reasoner.names import core_split, local_name
+from reasoner.names import core_split, local_name, words
 from reasoner.taxonomy import ROOT, TaxonomyIndex
 
 
@@ -162,13 +162,12 @@ class Lin:
 
 
 class StringMatch:
-    """Pure string matching: normalised Levenshtein similarity of the two local names."""
+    """Pure string matching, the paper's baseline: two entities match when their names are the same
+    string (case, and the separators of camelCase, snake_case and kebab-case, ignored), else not.
+    (Position and Location "cannot be matched according to a pure string matching standard".)"""
 
     name = "string"
 
     def __call__(self, first: str, second: str) -> Similarity:
-        a, b = local_name(first).lower(), local_name(second).lower()
-        if not a and not b:
-            return Similarity(1.0, "string")
-        distance = jellyfish.levenshtein_distance(a, b)
-        return Similarity(1 - distance / max(len(a), len(b)), "string")
+        same = words(local_name(first)) == words(local_name(second)) or first == second
+        return Similarity(1.0 if same else 0.0, "string")
