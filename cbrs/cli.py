@@ -13,13 +13,16 @@ from pathlib import Path
 from typing import Any
 
 import click
+import pyoxigraph as ox
 
 from cbrs import __version__
 from cbrs.app import App, parse_iri, pass_app
 from cbrs.output import RESULT_FORMATS, render_result, table, term_text
 from cbrs.settings import SETTINGS, setting
 from kb import Advertisement, KnowledgeBaseError, Requirement, ServiceDescription
-from kb.namespaces import PREFIXES, GraphName, expand, shorten
+from kb.catalog import Catalogue, merge
+from kb.loader import LoadReport, ParsedFile
+from kb.namespaces import OWL, PREFIXES, GraphName, expand, shorten
 
 
 class _Group(click.Group):
@@ -58,36 +61,126 @@ def init(app: App) -> None:
     click.echo(f"store: {kb.store.location}")
     for graph in GraphName:
         click.echo(f"  {shorten(graph.iri):<20} {stats.get(graph.iri, 0):>7} triples")
-    click.echo(
-        f"{len(kb.select('advertisements'))} advertisements, {len(kb.select('requirements'))} requirements"
-    )
+    click.echo(f"{len(kb.select('advertisements'))} advertisements, {len(kb.select('requirements'))} requirements")
 
 
 @cli.command()
-@click.argument("files", nargs=-1, required=True, type=click.Path(dir_okay=False, path_type=Path))
+@click.argument("files", nargs=-1, required=True, type=click.Path(path_type=Path))
 @click.option(
     "--graph",
     metavar="NAME|IRI",
     help="Named graph for the files' triples: " + ", ".join(g.value for g in GraphName) + " or a full IRI. "
     "Default: ontology for files that declare classes or properties, requirements for requirements, "
-    "services otherwise.",
+    "services otherwise (OWL-S files: services). OWL-S files loaded into requirements become requirements.",
+)
+@click.option(
+    "--catalog",
+    "catalogs",
+    multiple=True,
+    metavar="DIR|FILE",
+    type=click.Path(exists=True, path_type=Path),
+    help="Resolve owl:imports (and the ontologies of OWL-S parameter types) to local files: a folder of "
+    "ontologies, an OASIS catalog-v001.xml or a two-column TSV. Nothing is fetched from the network.",
 )
 @pass_app
-def load(app: App, files: tuple[Path, ...], graph: str | None) -> None:
-    """Load RDF files (Turtle, RDF/XML, OWL, N-Triples, N-Quads, TriG, JSON-LD), all or nothing."""
-    for item in app.kb.load(list(files), graph):
-        click.echo(f"loaded {item.source}: {len(item.quads)} triples into {shorten(item.graph)}")
+def load(app: App, files: tuple[Path, ...], graph: str | None, catalogs: tuple[Path, ...]) -> None:
+    """Load RDF files (Turtle, RDF/XML, OWL, N-Triples, N-Quads, TriG, JSON-LD) and OWL-S services, all
+    or nothing. A directory stands for the RDF and OWL-S files directly inside it."""
+    catalogue = merge([Catalogue.open(path) for path in catalogs]) if catalogs else None
+    report = app.kb.load(list(files), graph, catalogue)
+    for item in report.files:
+        what = _loaded_what(item)
+        click.echo(f"loaded {item.source}: {what}{len(item.quads)} triples into {shorten(item.graph)}{_mended(item)}")
+    for line in _load_summary(report):
+        click.echo(line)
+
+
+def _plural(count: int, word: str) -> str:
+    return f"{count} {word}" if count == 1 else f"{count} {word}s"
+
+
+def _loaded_what(item: ParsedFile) -> str:
+    if item.owls is None:
+        return ""
+    services = item.owls.services
+    kind = services[0].role if services else "service description"
+    counts = [
+        _plural(sum(s.inputs for s in services), "input"),
+        _plural(sum(s.outputs for s in services), "output"),
+        _plural(sum(s.preconditions for s in services), "precondition"),
+        _plural(sum(s.effects for s in services), "effect"),
+    ]
+    text_only = sum(s.text_only for s in services)
+    if text_only:
+        counts.append(f"{_plural(text_only, 'condition')} as text only")
+    return f"{_plural(len(services), kind)} ({', '.join(counts)}), "
+
+
+def _mended(item: ParsedFile) -> str:
+    return f" (mended: {'; '.join(item.repairs)})" if item.repairs else ""
+
+
+def _load_summary(report: LoadReport) -> list[str]:
+    """The end of a load's output: imported ontologies, then what could not be resolved."""
+    lines = []
+    owls = [item for item in report.files if item.owls is not None]
+    if report.catalogue is not None:
+        triples = sum(len(item.quads) for item in report.imports)
+        count = len(report.imports)
+        lines.append(
+            f"imported {count} {'ontology' if count == 1 else 'ontologies'} ({triples} triples) "
+            f"into {shorten(GraphName.ONTOLOGY.iri)}"
+        )
+        for item in report.imports:
+            if item.repairs:
+                lines.append(f"  {item.source}{_mended(item)}")
+        unresolved = sorted({u.iri for u in report.unresolved_imports})
+        lines.append(f"unresolved imports: {len(unresolved)}{_few(unresolved)}")
+    elif owls:
+        imports = sorted(
+            {
+                q.object.value
+                for item in owls
+                for q in item.quads
+                if q.predicate.value == OWL_IMPORTS and isinstance(q.object, ox.NamedNode)
+            }
+        )
+        if imports:
+            lines.append(f"imports not followed (no --catalog): {len(imports)}{_few(imports)}")
+    if owls or report.catalogue is not None:
+        for used_as in ("parameter type", "statement term"):
+            concepts = sorted({u.iri for u in report.unresolved_concepts if u.used_as == used_as})
+            lines.append(f"unresolved {used_as}s (declared by no loaded ontology): {len(concepts)}{_few(concepts)}")
+    if owls:
+        notes = [note for item in owls if item.owls for note in item.owls.notes]
+        if notes:
+            more = f" and {len(notes) - 1} more" if len(notes) > 1 else ""
+            lines.append(f"conversion notes: {notes[0]}{more}")
+        expressions = sum(item.owls.expressions for item in owls if item.owls)
+        turned = sum(item.owls.expressions_turned for item in owls if item.owls)
+        if expressions:
+            lines.append(
+                f"preconditions and effects: {expressions} expressions, {turned} made statements, "
+                f"{expressions - turned} kept as text only"
+            )
+    return lines
+
+
+OWL_IMPORTS = OWL + "imports"
+
+
+def _few(iris: list[str], limit: int = 3) -> str:
+    if not iris:
+        return ""
+    shown = ", ".join(shorten(i) for i in iris[:limit])
+    return f" ({shown}{', ...' if len(iris) > limit else ''})"
 
 
 @cli.command()
 @click.argument("text", required=False)
-@click.option(
-    "--file", "query_file", type=click.File("r", encoding="utf-8"), help="Read the query from a .rq file."
-)
+@click.option("--file", "query_file", type=click.File("r", encoding="utf-8"), help="Read the query from a .rq file.")
 @click.option("--name", help="Run the named query queries/NAME.rq (see --list).")
-@click.option(
-    "--bind", "bindings", multiple=True, metavar="VAR=VALUE", help="Bind a named query's parameter."
-)
+@click.option("--bind", "bindings", multiple=True, metavar="VAR=VALUE", help="Bind a named query's parameter.")
 @click.option(
     "--format",
     "fmt",
@@ -108,9 +201,7 @@ def query(
     """Run a SPARQL query given as TEXT, from --file, or by --name with --bind values."""
     fmt = setting("format").resolve(fmt)
     if fmt not in RESULT_FORMATS:
-        raise click.BadParameter(
-            f"{fmt!r} is not one of {', '.join(RESULT_FORMATS)}", param_hint="CBRS_FORMAT"
-        )
+        raise click.BadParameter(f"{fmt!r} is not one of {', '.join(RESULT_FORMATS)}", param_hint="CBRS_FORMAT")
     if list_queries:
         _list_queries(app)
         return
@@ -195,9 +286,7 @@ def show(app: App, iri: str, as_json: bool) -> None:
         return
     rows = kb.select("resource_triples", {"resource": full})
     if as_json:
-        click.echo(
-            json.dumps([{k: v.value for k, v in row.items() if k != "resource"} for row in rows], indent=2)
-        )
+        click.echo(json.dumps([{k: v.value for k, v in row.items() if k != "resource"} for row in rows], indent=2))
         return
     click.echo(f"{shorten(full)}")
     body = [
@@ -267,9 +356,7 @@ def _describe(d: ServiceDescription) -> str:
         lines.append(f"  SEA          {', '.join(shorten(a) for a in d.area.areas) or '-'}{box}")
     for q in d.qos:
         bound = (
-            {"lower": " (max)", "higher": " (min)"}.get(q.better_when or "", "")
-            if isinstance(d, Requirement)
-            else ""
+            {"lower": " (max)", "higher": " (min)"}.get(q.better_when or "", "") if isinstance(d, Requirement) else ""
         )
         lines.append(f"  QoS          {shorten(q.metric)} = {q.value:g}{bound}")
     return "\n".join(lines)
@@ -299,9 +386,7 @@ def main() -> None:
     except Exception as error:
         if os.environ.get("CBRS_DEBUG"):
             traceback.print_exc()
-        click.echo(
-            f"internal error: {type(error).__name__}: {error} (set CBRS_DEBUG=1 for the traceback)", err=True
-        )
+        click.echo(f"internal error: {type(error).__name__}: {error} (set CBRS_DEBUG=1 for the traceback)", err=True)
         sys.exit(2)
 
 

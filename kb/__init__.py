@@ -1,8 +1,10 @@
 """The cbrs knowledge base: an Oxigraph store of ontologies, advertisements and requirements."""
 
+from kb.catalog import Catalogue
 from kb.errors import (
     AlreadyRegisteredError,
     BindingError,
+    CatalogueError,
     InvalidDescriptionError,
     KnowledgeBaseError,
     NotFoundError,
@@ -14,6 +16,7 @@ from kb.errors import (
     UnknownQueryError,
 )
 from kb.knowledge_base import KnowledgeBase
+from kb.loader import LoadReport
 from kb.model import (
     Advertisement,
     EffectiveArea,
@@ -33,11 +36,14 @@ __all__ = [
     "Advertisement",
     "AlreadyRegisteredError",
     "BindingError",
+    "Catalogue",
+    "CatalogueError",
     "EffectiveArea",
     "GraphName",
     "InvalidDescriptionError",
     "KnowledgeBase",
     "KnowledgeBaseError",
+    "LoadReport",
     "NotFoundError",
     "Parameter",
     "PartNode",

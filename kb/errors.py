@@ -114,3 +114,14 @@ class AlreadyRegisteredError(KnowledgeBaseError):
     def __init__(self, iri: str) -> None:
         self.iri = iri
         super().__init__(f"<{iri}> is already registered; update it instead")
+
+
+class CatalogueError(KnowledgeBaseError):
+    """An ontology catalogue (a folder, an OASIS XML catalogue or a TSV mapping) could not be read."""
+
+    http_status = 400
+
+    def __init__(self, source: str, reason: str) -> None:
+        self.source = source
+        self.reason = reason
+        super().__init__(f"catalogue {source}: {reason}")

@@ -7,8 +7,9 @@ from pathlib import Path
 
 import pyoxigraph as ox
 
+from kb.catalog import Catalogue
 from kb.descriptions import DescriptionReader
-from kb.loader import ParsedFile, load_files, parse_file
+from kb.loader import LoadReport, ParsedFile, load_files, parse_file
 from kb.model import Advertisement, Requirement, ServiceDescription
 from kb.namespaces import GraphName
 from kb.queries import QueryLibrary
@@ -41,11 +42,23 @@ class KnowledgeBase:
         self._reader.clear_cache()
         return parsed
 
-    def load(self, paths: Sequence[str | Path], graph: str | GraphName | None = None) -> list[ParsedFile]:
-        """Load RDF files all-or-nothing (see :mod:`kb.loader`)."""
-        parsed = load_files(self.store, paths, graph)
+    def load(
+        self,
+        paths: Sequence[str | Path],
+        graph: str | GraphName | None = None,
+        catalogue: Catalogue | str | Path | None = None,
+    ) -> LoadReport:
+        """Load RDF and OWL-S files (or every RDF file of a directory) all-or-nothing.
+
+        OWL-S files are converted into cbrs advertisements, or requirements when ``graph`` is
+        ``requirements`` (see :mod:`kb.owls`). With a ``catalogue`` (a :class:`Catalogue`, a folder or
+        a catalogue file) the ontologies the files import are loaded too, from local files only.
+        """
+        if catalogue is not None and not isinstance(catalogue, Catalogue):
+            catalogue = Catalogue.open(catalogue)
+        report = load_files(self.store, paths, graph, catalogue)
         self._reader.clear_cache()
-        return parsed
+        return report
 
     def query(self, text: str, bindings: Mapping[str, Term] | None = None) -> QueryResult:
         return self.store.query(text, bindings)

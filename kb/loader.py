@@ -3,6 +3,10 @@
 Every file of a load is parsed before anything is written; one that fails to parse aborts the
 whole load with its name and line, and the store is left as it was.
 
+OWL-S files are converted into cbrs descriptions (:mod:`kb.owls`) on the way in, and with a
+:class:`~kb.catalog.Catalogue` the ontologies a load imports are parsed from local files and added in
+the same transaction.
+
 Blank nodes are skolemised (RDF 1.1, section 3.5) to IRIs under ``GENID`` that are derived from
 the canonical form of the file (RDFC-1.0): loading the same file twice adds nothing the second
 time, and every stored node can be named in an update.
@@ -14,15 +18,18 @@ import codecs
 import hashlib
 import re
 import xml.parsers.expat
-from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+from collections import deque
+from collections.abc import Iterable, Iterator, Sequence
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import pyoxigraph as ox
 
+from kb.catalog import Catalogue, Unresolved, is_built_in, ontology_iri
 from kb.errors import RdfParseError, UnknownFormatError, UnknownGraphError
 from kb.namespaces import CBRS, GENID, OWL, RDF, RDFS, GraphName
+from kb.owls import Conversion, Role, Vocabulary, convert, is_owls, referenced_ontologies
 from kb.store import Store
 
 FORMATS_BY_EXTENSION: dict[str, ox.RdfFormat] = {
@@ -42,25 +49,80 @@ FORMATS_BY_EXTENSION: dict[str, ox.RdfFormat] = {
 
 _DECLARATION_TYPES = {OWL + "Class", RDFS + "Class", OWL + "ObjectProperty", OWL + "DatatypeProperty"}
 _XML_ENCODING = re.compile(rb"""^(<\?xml[^>]*?encoding\s*=\s*["'])([A-Za-z0-9._-]+)(["'])""")
+_XMLNS = re.compile(r"""xmlns:([A-Za-z_][\w.-]*)\s*=\s*(["'])(.*?)\2""")
+_ENTITY = re.compile(r"""<!ENTITY\s+([\w.-]+)\s+(["'])(.*?)\2\s*>""", re.S)
+_SINGLE_QUOTED_ENTITY = re.compile(rb"""<!ENTITY(\s+[\w.-]+\s+)'([^'"]*)'(\s*)>""")
+_RDF_ID = re.compile(rb"""rdf:ID\s*=\s*(["'])(.*?)\1""")
+_NCNAME = re.compile(r"^[A-Za-z_\u00c0-\uffff][\w.\-\u00b7\u00c0-\uffff]*$")
 
 
 @dataclass(frozen=True)
 class ParsedFile:
-    """One parsed file: its quads, ready to store, and the graph its triples went to."""
+    """One parsed file: its quads, ready to store, and the graph its triples went to.
+
+    ``owls`` is set for an OWL-S file (what was made from it); ``ontology`` for a file loaded because
+    a catalogue resolved that ontology IRI to it; ``repairs`` lists what was mended to parse it.
+    """
 
     source: str
     graph: str
     quads: list[ox.Quad]
+    owls: Conversion | None = None
+    ontology: str | None = None
+    repairs: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class UnresolvedConcept:
+    """A parameter type or statement term of a loaded description that no loaded ontology declares."""
+
+    iri: str
+    used_as: str  # "parameter type" or "statement term"
+    used_by: str  # the description's IRI
+
+
+@dataclass
+class LoadReport:
+    """What one load added: the files asked for, the ontologies their imports brought in, and what
+    could not be resolved. Iterating it gives the files asked for."""
+
+    files: list[ParsedFile] = field(default_factory=list)
+    imports: list[ParsedFile] = field(default_factory=list)
+    already_loaded: list[str] = field(default_factory=list)
+    unresolved_imports: list[Unresolved] = field(default_factory=list)
+    unresolved_concepts: list[UnresolvedConcept] = field(default_factory=list)
+    catalogue: Catalogue | None = None
+
+    def __iter__(self) -> Iterator[ParsedFile]:
+        return iter(self.files)
+
+    def __len__(self) -> int:
+        return len(self.files)
+
+    @property
+    def quads(self) -> int:
+        return sum(len(item.quads) for item in (*self.files, *self.imports))
+
+
+@dataclass
+class _Raw:
+    """A file parsed but not yet skolemised (an OWL-S file is converted first)."""
+
+    source: str
+    target: ox.NamedNode
+    quads: list[ox.Quad]
+    is_owls: bool
+    prefixes: dict[str, str]
+    repairs: tuple[str, ...]
+    ontology: str | None = None
 
 
 def parse_file(path: str | Path, graph: str | GraphName | None = None) -> ParsedFile:
-    """Parse one file; ``graph`` (a graph name or IRI) overrides the graph chosen from its content."""
-    path = Path(path)
-    try:
-        raw = path.read_bytes()
-    except OSError as error:
-        raise RdfParseError(str(path), f"cannot read: {error.strerror or error}") from error
-    return parse_bytes(raw, str(path), rdf_format=_format_for(path, raw), graph=graph)
+    """Parse one file; ``graph`` (a graph name or IRI) overrides the graph chosen from its content.
+
+    OWL-S files come back as their raw triples; :func:`load_files` is what converts them."""
+    raw = _read(Path(path), graph)
+    return ParsedFile(raw.source, raw.target.value, skolemise(raw.quads), repairs=raw.repairs)
 
 
 def parse_bytes(
@@ -72,33 +134,76 @@ def parse_bytes(
 ) -> ParsedFile:
     """Parse serialised RDF from memory; ``source`` names it in errors."""
     data = _as_utf8(raw, source)
-    base = base_iri or (Path(source).resolve().as_uri() if "://" not in source else source)
-    try:
-        parsed = list(ox.parse(input=data, format=rdf_format, base_iri=base))
-    except SyntaxError as error:
-        raise _located(error, source, data, rdf_format) from error
-    except ValueError as error:
-        raise RdfParseError(source, str(error)) from error
+    parsed, _, repairs = _parse_quads(data, source, rdf_format, _base_for(source, base_iri))
     target = resolve_graph(graph) if graph is not None else _graph_for(parsed)
-    quads = [
-        ox.Quad(
-            q.subject,
-            q.predicate,
-            q.object,
-            target if isinstance(q.graph_name, ox.DefaultGraph) else q.graph_name,
-        )
-        for q in parsed
-    ]
-    return ParsedFile(source, target.value, skolemise(quads))
+    return ParsedFile(source, target.value, skolemise(_into(parsed, target)), repairs=repairs)
 
 
 def load_files(
-    store: Store, paths: Sequence[str | Path], graph: str | GraphName | None = None
-) -> list[ParsedFile]:
-    """Parse every file, then add them all in one transaction; nothing is written if any fails."""
-    parsed = [parse_file(path, graph) for path in paths]
-    store.add(quad for item in parsed for quad in item.quads)
-    return parsed
+    store: Store,
+    paths: Sequence[str | Path],
+    graph: str | GraphName | None = None,
+    catalogue: Catalogue | None = None,
+) -> LoadReport:
+    """Parse every file (and, with a catalogue, every ontology they import), convert OWL-S files,
+    then add everything in one transaction; nothing is written if any file fails to parse.
+
+    OWL-S files (``.owls``, or any file describing an OWL-S service or profile) keep their own
+    triples and gain the cbrs description made from them, in the same graph: the requirements graph
+    and the requirement role when ``graph`` is ``requirements``, else the services graph (or
+    ``graph``) and the advertisement role.
+    """
+    raws = [
+        _read(path, graph, base_iri=catalogue.iri_for(path) if catalogue is not None else None)
+        for path in expand_paths(paths)
+    ]
+    report = LoadReport(catalogue=catalogue)
+    imported: list[_Raw] = []
+    if catalogue is not None:
+        imported = _resolve_imports(store, raws, catalogue, report)
+    ontology = GraphName.ONTOLOGY.node
+    vocabulary: Vocabulary | None = None
+    if any(raw.is_owls for raw in raws):
+        vocabulary = Vocabulary.from_quads(store.quads(None, None, None, ontology))
+        vocabulary.add(q for raw in (*raws, *imported) if raw.target == ontology for q in raw.quads)
+    requirements = graph is not None and resolve_graph(graph) == GraphName.REQUIREMENTS.node
+    role: Role = "requirement" if requirements else "advertisement"
+    for raw in raws:
+        conversion = None
+        if raw.is_owls:
+            conversion = convert(raw.quads, raw.source, role, raw.target, vocabulary, raw.prefixes)
+            raw.quads.extend(conversion.quads)
+            assert vocabulary is not None
+            report.unresolved_concepts.extend(_unresolved(conversion, vocabulary))
+        report.files.append(
+            ParsedFile(raw.source, raw.target.value, skolemise(raw.quads), conversion, repairs=raw.repairs)
+        )
+    report.imports = [
+        ParsedFile(raw.source, raw.target.value, skolemise(raw.quads), ontology=raw.ontology, repairs=raw.repairs)
+        for raw in imported
+    ]
+    store.add(quad for item in (*report.files, *report.imports) for quad in item.quads)
+    return report
+
+
+def expand_paths(paths: Sequence[str | Path]) -> list[Path]:
+    """The files to load: each file as given, and for a directory the files directly inside it with an
+    RDF extension, sorted by name. A ``.xml`` file in a directory counts only when it mentions the RDF
+    namespace near its start, so an OASIS catalogue or other XML beside the ontologies is passed over."""
+    files: list[Path] = []
+    for given in paths:
+        path = Path(given)
+        if not path.is_dir():
+            files.append(path)
+            continue
+        for child in sorted(path.iterdir()):
+            suffix = child.suffix.lower()
+            if not child.is_file() or suffix not in FORMATS_BY_EXTENSION:
+                continue
+            if suffix == ".xml" and RDF.encode("ascii") not in _as_utf8(child.read_bytes()[:4096], str(child), False):
+                continue
+            files.append(child)
+    return files
 
 
 def resolve_graph(graph: str | GraphName) -> ox.NamedNode:
@@ -133,6 +238,162 @@ def skolemise(quads: Iterable[ox.Quad]) -> list[ox.Quad]:
         return term
 
     return [ox.Quad(named(q.subject), q.predicate, named(q.object), q.graph_name) for q in canonical]
+
+
+def _read(
+    path: Path, graph: str | GraphName | None, base_iri: str | None = None, ontology: str | None = None
+) -> _Raw:
+    try:
+        raw = path.read_bytes()
+    except OSError as error:
+        raise RdfParseError(str(path), f"cannot read: {error.strerror or error}") from error
+    rdf_format = _format_for(path, raw)
+    source = str(path)
+    data = _as_utf8(raw, source)
+    quads, prefixes, repairs = _parse_quads(data, source, rdf_format, _base_for(source, base_iri))
+    owls = path.suffix.lower() == ".owls" or is_owls(quads)
+    if graph is not None:
+        target = resolve_graph(graph)
+    elif owls:
+        target = GraphName.SERVICES.node  # OWL-S files often declare stub classes; they are not ontologies
+    else:
+        target = _graph_for(quads)
+    return _Raw(source, target, _into(quads, target), owls, prefixes, repairs, ontology)
+
+
+def _base_for(source: str, base_iri: str | None) -> str:
+    return base_iri or (Path(source).resolve().as_uri() if "://" not in source else source)
+
+
+def _into(quads: list[ox.Quad], target: ox.NamedNode) -> list[ox.Quad]:
+    return [
+        ox.Quad(q.subject, q.predicate, q.object, target if isinstance(q.graph_name, ox.DefaultGraph) else q.graph_name)
+        for q in quads
+    ]
+
+
+def _parse_quads(
+    data: bytes, source: str, rdf_format: ox.RdfFormat, base: str
+) -> tuple[list[ox.Quad], dict[str, str], tuple[str, ...]]:
+    """The file's quads, its namespace prefixes, and the repairs it needed to parse.
+
+    RDF/XML in the wild breaks a few rules that cost nothing to mend: entity declarations in single
+    quotes, ``rdf:ID`` values that are not XML names (``rdf:ID="1CAR"``), the same ``rdf:ID`` given
+    twice. Such a file is mended and parsed again, leniently, with every IRI then checked; any other
+    error stands.
+    """
+    try:
+        parser = ox.parse(input=data, format=rdf_format, base_iri=base)
+        quads = list(parser)
+    except SyntaxError as error:
+        mended = _mend_rdfxml(data, str(error)) if rdf_format == ox.RdfFormat.RDF_XML else None
+        if mended is None:
+            raise _located(error, source, data, rdf_format) from error
+        fixed, repairs = mended
+        try:
+            quads = _checked(ox.parse(input=fixed, format=rdf_format, base_iri=base, lenient=True))
+        except (SyntaxError, ValueError):
+            raise _located(error, source, data, rdf_format) from error
+        return quads, _xml_prefixes(fixed), repairs
+    except ValueError as error:
+        raise RdfParseError(source, str(error)) from error
+    prefixes = _xml_prefixes(data) if rdf_format == ox.RdfFormat.RDF_XML else dict(parser.prefixes)
+    return quads, prefixes, ()
+
+
+def _mend_rdfxml(data: bytes, message: str) -> tuple[bytes, tuple[str, ...]] | None:
+    repairs = []
+    fixed = _SINGLE_QUOTED_ENTITY.sub(rb'<!ENTITY\g<1>"\g<2>"\g<3>>', data)
+    if fixed != data:
+        repairs.append("entity declarations in single quotes")
+
+    def about(match: re.Match[bytes]) -> bytes:
+        value = match.group(2)
+        if _NCNAME.match(value.decode("utf-8", "replace")):
+            return match.group(0)
+        return b'rdf:about="#' + value.replace(b'"', b"&quot;") + b'"'
+
+    renamed = _RDF_ID.sub(about, fixed)
+    if renamed != fixed:
+        repairs.append("rdf:ID values that are not XML names, read as rdf:about")
+    identifiers = [m.group(2) for m in _RDF_ID.finditer(renamed)]
+    if "already been used as rdf:ID" in message or len(identifiers) != len(set(identifiers)):
+        repairs.append("an rdf:ID given twice")
+    return (renamed, tuple(repairs)) if repairs else None
+
+
+def _checked(quads: Iterable[ox.Quad]) -> list[ox.Quad]:
+    """Quads from a lenient parse, with every IRI validated as a strict parse would have."""
+    checked = list(quads)
+    for q in checked:
+        for term in (q.subject, q.predicate, q.object):
+            if isinstance(term, ox.NamedNode):
+                ox.NamedNode(term.value)  # raises ValueError for an invalid IRI
+    return checked
+
+
+def _xml_prefixes(data: bytes) -> dict[str, str]:
+    """The ``xmlns:`` prefixes an RDF/XML file declares, with its DTD entities expanded."""
+    text = data[:65536].decode("utf-8", "replace")
+    entities = {name: value for name, _, value in _ENTITY.findall(text)}
+
+    def expand(value: str) -> str:
+        return re.sub(r"&([\w.-]+);", lambda m: entities.get(m.group(1), m.group(0)), value)
+
+    prefixes: dict[str, str] = {}
+    for prefix, _, namespace in _XMLNS.findall(text):
+        prefixes.setdefault(prefix, expand(namespace))
+    return prefixes
+
+
+def _resolve_imports(store: Store, raws: list[_Raw], catalogue: Catalogue, report: LoadReport) -> list[_Raw]:
+    """Parse, once each, the ontologies the files import (and, for OWL-S files, those their concepts'
+    namespaces name), transitively, from local files only; what the catalogue cannot resolve is
+    reported, not fatal."""
+    pending: deque[tuple[str, str, str]] = deque()
+    for raw in raws:
+        if raw.is_owls:
+            references = referenced_ontologies(raw.quads)
+        else:
+            references = [(iri, "owl:imports") for iri in _imports(raw.quads)]
+        pending.extend((iri, raw.source, reason) for iri, reason in references)
+    seen: set[str] = set()
+    loaded = {Path(raw.source).resolve() for raw in raws}
+    imported: list[_Raw] = []
+    while pending:
+        iri, needed_by, reason = pending.popleft()
+        document = ontology_iri(iri)
+        if document in seen or is_built_in(document):
+            continue
+        seen.add(document)
+        path = catalogue.resolve(document)
+        if path is None:
+            report.unresolved_imports.append(Unresolved(document, needed_by, reason))
+            continue
+        if path.resolve() in loaded:
+            continue
+        loaded.add(path.resolve())
+        raw = _read(path, GraphName.ONTOLOGY, base_iri=document, ontology=document)
+        imported.append(raw)
+        pending.extend((target, raw.source, "owl:imports") for target in _imports(raw.quads))
+    return imported
+
+
+def _imports(quads: Iterable[ox.Quad]) -> list[str]:
+    imports = OWL + "imports"
+    return [q.object.value for q in quads if q.predicate.value == imports and isinstance(q.object, ox.NamedNode)]
+
+
+def _unresolved(conversion: Conversion, vocabulary: Vocabulary) -> list[UnresolvedConcept]:
+    found = []
+    for service in conversion.services:
+        for concept in service.parameter_types:
+            if not vocabulary.declares(concept):
+                found.append(UnresolvedConcept(concept, "parameter type", service.iri))
+        for term in service.statement_terms:
+            if not vocabulary.declares(term):
+                found.append(UnresolvedConcept(term, "statement term", service.iri))
+    return found
 
 
 def _format_for(path: Path, raw: bytes) -> ox.RdfFormat:

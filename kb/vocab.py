@@ -37,6 +37,7 @@ class CBRS:
     accuracy: Final = "https://w3id.org/cbrs/core#accuracy"
     availability: Final = "https://w3id.org/cbrs/core#availability"
     betterWhen: Final = "https://w3id.org/cbrs/core#betterWhen"
+    conditionText: Final = "https://w3id.org/cbrs/core#conditionText"
     cost: Final = "https://w3id.org/cbrs/core#cost"
     dataType: Final = "https://w3id.org/cbrs/core#dataType"
     device: Final = "https://w3id.org/cbrs/core#device"
