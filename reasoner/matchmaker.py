@@ -112,6 +112,20 @@ class Matchmaker:
         self._pool: CompiledPool | None = None
         self._pool_source: list[Advertisement] | None = None
 
+    def prepare(self) -> Matchmaker:
+        """Do the one-time work now (read the advertisements, lay the pool out as arrays), so that
+        the first ranking is as fast as the rest."""
+        ads = self.advertisements
+        if not self.method.strict:
+            self._compiled(ads).space.warm()
+        return self
+
+    def _compiled(self, ads: list[Advertisement]) -> CompiledPool:
+        if self._pool is None or self._pool_source is not ads:
+            self._pool = CompiledPool(ads, VectorSpace(self.index), self.method.use_parts)
+            self._pool_source = ads
+        return self._pool
+
     @property
     def advertisements(self) -> list[Advertisement]:
         if self._advertisements is None:
@@ -140,12 +154,10 @@ class Matchmaker:
         return MatchResult(requirement.iri, self.method.name, status, candidates)
 
     def _rank_batch(self, requirement: Requirement, ads: list[Advertisement], explain: int) -> Sequence[Candidate]:
-        if self._pool is None or self._pool_source is not ads:
-            self._pool = CompiledPool(ads, VectorSpace(self.index), self.method.use_parts)
-            self._pool_source = ads
-        scorer = BatchScorer(self._pool, self.method.measure, self.config, self.filters)
+        pool = self._compiled(ads)
+        scorer = BatchScorer(pool, self.method.measure, self.config, self.filters)
         scores = scorer.score(requirement)
-        order = ranking_order(scores, self._pool, self.config.accept_score).tolist()
+        order = ranking_order(scores, pool, self.config.accept_score).tolist()
         head = [self.score(requirement, ads[i]) for i in order[:explain]]
 
         def unexplained(i: int) -> Candidate:

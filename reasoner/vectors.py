@@ -39,6 +39,7 @@ class VectorSpace:
         self._all_below: dict[int, tuple[IntArray, IntArray]] = {}
         self._cache: dict[tuple[int, str], FloatArray] = {}
         self._lcs: dict[int, IntArray] = {}
+        self._used: set[int] = set()  # ids handed out by add(): where vectors are read
         self._implied: dict[tuple[int, int], bool] = {}
         for concept in sorted(set(extra)):
             self.add(concept)
@@ -46,27 +47,46 @@ class VectorSpace:
     def add(self, concept: str) -> int:
         """The id of ``concept``; a concept outside the taxonomy gets a new id past its nodes."""
         if concept in self.index:
-            return self.ids[self.index.canonical(concept)]
+            known = self.ids[self.index.canonical(concept)]
+            self._used.add(known)
+            return known
         found = self.ids.get(concept)
         if found is None:
             found = len(self.names)
             self.names.append(concept)
             self.ids[concept] = found
             self._cache.clear()  # vectors must cover the new concept
+        self._used.add(found)
         return found
+
+    def warm(self) -> None:
+        """Build now the descendant arrays that vectors for the handed-out concepts will need."""
+        for i in sorted(self._used):
+            if i < self.taxonomy_size:
+                self._below(i, is_a_only=False)
+                for ancestor in self.index.ancestors(self.names[i], is_a_only=True):
+                    self._below(self.ids[ancestor], is_a_only=True)
+
+    def _read_at(self) -> list[int]:
+        """The ids vectors are read at: those handed out, or all while none has been."""
+        return sorted(self._used) if self._used else list(range(len(self.names)))
 
     def __len__(self) -> int:
         return len(self.names)
 
     def vector(self, measure: EntityMeasure, concept: str) -> FloatArray:
-        """measure(concept, c) for every concept id c (cached per measure and concept)."""
+        """measure(concept, c) for every concept id c (cached per measure and concept). Exact at the
+        ids ``add`` handed out; a measure computed pair by pair (Situation 3, the baselines) is only
+        computed there, so a large ontology's unread nodes cost nothing (they hold 0)."""
         key = (id(measure), concept)
         found = self._cache.get(key)
         if found is None:
             if isinstance(measure, SemStr):
                 found = self._sem_str(measure, concept)
             else:
-                found = np.array([measure(concept, other).value for other in self.names], dtype=np.float64)
+                found = np.zeros(len(self.names), dtype=np.float64)
+                for i in self._read_at():
+                    found[i] = measure(concept, self.names[i]).value
             self._cache[key] = found
         return found
 
@@ -77,7 +97,8 @@ class VectorSpace:
         values = np.empty(n, dtype=np.float64)
         unknown = range(self.taxonomy_size, n)
         if concept not in self.index:
-            for i in range(n):
+            values[:] = 0.0
+            for i in self._read_at():
                 values[i] = measure.situation_3(concept, self.names[i]).value if self.names[i] != concept else 1.0
             return values
         for i in unknown:

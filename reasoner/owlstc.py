@@ -1,0 +1,257 @@
+"""Evaluate the matching methods on an OWL-S test collection in the OWLS-TC layout.
+
+A collection folder holds ``services/`` (OWL-S advertisements), ``ontology/`` (the ontologies they
+use), ``queries/`` (OWL-S requests) and ``relevance.xml`` (SME2: a binary relevance set and a graded,
+0-3, relevance set per request; a service a request does not rate is not relevant to it). The whole
+collection is loaded into a fresh in-memory store, offline: imports resolve to ``ontology/``. Every
+method ranks the whole service pool for every request; the figures are the means over the requests.
+"""
+
+from __future__ import annotations
+
+import statistics
+import time
+import xml.etree.ElementTree as ET
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from kb import KnowledgeBase, Store
+from kb.catalog import Catalogue
+from kb.errors import KnowledgeBaseError
+from kb.resources import ontology_dir
+from reasoner.matchmaker import Matchmaker
+from reasoner.methods import METHODS
+from reasoner.metrics import RECALL_LEVELS, average_precision, interpolated_precision, ndcg, precision_at, r_precision
+
+METRICS = ("map", "ndcg", "p_at_1", "p_at_10", "r_precision", "query_ms")
+
+
+class CollectionError(KnowledgeBaseError):
+    """The folder is not an OWLS-TC style collection."""
+
+    http_status = 400
+
+    def __init__(self, root: Path, reason: str) -> None:
+        self.root = root
+        super().__init__(f"{root}: {reason}")
+
+
+@dataclass(frozen=True)
+class Judgements:
+    """Per request IRI (as relevance.xml names it): binary relevance and grades, by offer IRI."""
+
+    binary: dict[str, dict[str, int]]
+    graded: dict[str, dict[str, int]]
+    offers: list[str]
+
+
+def read_relevance(path: Path) -> Judgements:
+    """Read an SME2 relevance file."""
+    try:
+        root = ET.parse(path).getroot()
+    except (OSError, ET.ParseError) as error:
+        raise CollectionError(path.parent, f"cannot read {path.name}: {error}") from error
+
+    def ratings(section: ET.Element | None, value_path: str) -> dict[str, dict[str, int]]:
+        found: dict[str, dict[str, int]] = {}
+        for request in section.iter("request") if section is not None else ():
+            uri = (request.findtext("uri") or "").strip()
+            rated = found.setdefault(uri, {})
+            for offer in request.iter("offer"):
+                value = offer.findtext(value_path)
+                if value is not None:
+                    rated[(offer.findtext("uri") or "").strip()] = int(value.strip())
+        return found
+
+    offers = [(o.findtext("uri") or "").strip() for o in root.iterfind("offers/offer")]
+    binary = ratings(root.find(".//binaryrelevanceset"), "relevant")
+    graded = ratings(root.find(".//relevancegrades"), "grade/value")
+    if not binary:
+        raise CollectionError(path.parent, f"{path.name} has no binary relevance set")
+    return Judgements(binary, graded, offers)
+
+
+def _file_key(uri: str) -> str:
+    """relevance.xml names services by file (``.../services/1.1/x.owls#X``): the file name is the key."""
+    return uri.split("#", 1)[0].rstrip("/").rsplit("/", 1)[-1]
+
+
+@dataclass
+class LoadedCollection:
+    kb: KnowledgeBase
+    advertisements: dict[str, list[str]]  # file name -> advertisement IRIs it holds
+    requirements: dict[str, list[str]]  # file name -> requirement IRIs it holds
+    unresolved_concepts: int
+    unresolved_imports: int
+    seconds: float
+
+
+def check_layout(root: Path) -> None:
+    """Raise CollectionError naming the first part an OWLS-TC folder lacks."""
+    for part in ("services", "queries", "ontology", "relevance.xml"):
+        if not (root / part).exists():
+            raise CollectionError(
+                root, f"no {part} (an OWLS-TC folder has services/, ontology/, queries/, relevance.xml)"
+            )
+
+
+def load_collection(root: Path) -> LoadedCollection:
+    """Load services, requests and ontologies of a collection folder into a fresh in-memory store."""
+    check_layout(root)
+    start = time.perf_counter()
+    kb = KnowledgeBase(Store.open(":memory:"))
+    kb.load([ontology_dir() / "core.ttl"], graph="ontology")  # the service model only, not the home domain
+    catalogue = Catalogue.open(root / "ontology")
+    services = kb.load([root / "services"], catalogue=catalogue)
+    queries = kb.load([root / "queries"], graph="requirements", catalogue=catalogue)
+
+    def by_file(report: Any) -> dict[str, list[str]]:
+        return {
+            Path(item.source).name: [service.iri for service in item.owls.services]
+            for item in report.files
+            if item.owls is not None
+        }
+
+    return LoadedCollection(
+        kb=kb,
+        advertisements=by_file(services),
+        requirements=by_file(queries),
+        unresolved_concepts=len({c.iri for c in (*services.unresolved_concepts, *queries.unresolved_concepts)}),
+        unresolved_imports=len(services.unresolved_imports) + len(queries.unresolved_imports),
+        seconds=time.perf_counter() - start,
+    )
+
+
+@dataclass
+class CollectionReport:
+    methods: dict[str, dict[str, float]]
+    queries: int
+    services: int
+    curves: dict[str, list[float]]  # method -> mean interpolated precision at RECALL_LEVELS
+    unmatched_requests: list[str] = field(default_factory=list)
+    unmatched_offers: int = 0
+    unresolved_concepts: int = 0
+    unresolved_imports: int = 0
+    load_seconds: float = 0.0
+
+    def to_json(self) -> dict[str, Any]:
+        return {
+            "methods": {
+                name: {metric: round(values[metric], 4) for metric in METRICS} for name, values in self.methods.items()
+            },
+            "queries": self.queries,
+            "services": self.services,
+        }
+
+    def text(self) -> str:
+        header = "| method | MAP | NDCG | P@1 | P@10 | R-precision | query ms |"
+        rows = [header, "|---|---:|---:|---:|---:|---:|---:|"]
+        for name, v in self.methods.items():
+            rows.append(
+                f"| {name} | {v['map']:.4f} | {v['ndcg']:.4f} | {v['p_at_1']:.4f} | {v['p_at_10']:.4f} "
+                f"| {v['r_precision']:.4f} | {v['query_ms']:.2f} |"
+            )
+        lines = [
+            f"{self.queries} queries against {self.services} services, loaded in {self.load_seconds:.1f} s; "
+            f"{self.unresolved_concepts} concepts and {self.unresolved_imports} imports unresolved; "
+            f"{self.unmatched_offers} judged offers and {len(self.unmatched_requests)} requests not found in the "
+            "loaded files",
+            "",
+            *rows,
+        ]
+        return "\n".join(lines)
+
+
+def evaluate_collection(root: Path, methods: Sequence[str] = METHODS) -> CollectionReport:
+    """Load the collection and score every method on every judged request."""
+    check_layout(root)
+    judgements = read_relevance(root / "relevance.xml")
+    loaded = load_collection(root)
+
+    def to_iris(uri: str, table: dict[str, list[str]]) -> list[str]:
+        return table.get(_file_key(uri), [])
+
+    requests: dict[str, tuple[dict[str, int], dict[str, int]]] = {}
+    unmatched_requests: list[str] = []
+    unmatched_offers: set[str] = set()
+    for uri, rated in judgements.binary.items():
+        iris = to_iris(uri, loaded.requirements)
+        if not iris:
+            unmatched_requests.append(uri)
+            continue
+        binary: dict[str, int] = {}
+        grades: dict[str, int] = {}
+        for offer, value in rated.items():
+            targets = to_iris(offer, loaded.advertisements)
+            if not targets:
+                unmatched_offers.add(offer)
+            binary.update(dict.fromkeys(targets, value))
+        for offer, value in judgements.graded.get(uri, {}).items():
+            grades.update(dict.fromkeys(to_iris(offer, loaded.advertisements), value))
+        requests[iris[0]] = (binary, grades)
+
+    first: Matchmaker | None = None
+    figures: dict[str, dict[str, float]] = {}
+    curves: dict[str, list[float]] = {}
+    for method in methods:
+        matcher = (
+            Matchmaker(loaded.kb, method, index=first.index, advertisements=first.advertisements)
+            if first is not None
+            else Matchmaker(loaded.kb, method)
+        )
+        first = first or matcher
+        matcher.prepare()  # reading the pool is loading, not answering a query
+        values: dict[str, list[float]] = {metric: [] for metric in METRICS}
+        curve = [0.0] * len(RECALL_LEVELS)
+        for requirement, (binary, grades) in requests.items():
+            start = time.perf_counter()
+            result = matcher.rank(requirement, explain=0)
+            values["query_ms"].append((time.perf_counter() - start) * 1000)
+            ranking = [c.advertisement for c in result.candidates]
+            relevant = {iri for iri, flag in binary.items() if flag}
+            values["map"].append(average_precision(ranking, relevant))
+            values["ndcg"].append(ndcg(ranking, grades))
+            values["p_at_1"].append(precision_at(ranking, relevant, 1))
+            values["p_at_10"].append(precision_at(ranking, relevant, 10))
+            values["r_precision"].append(r_precision(ranking, relevant))
+            for i, p in enumerate(interpolated_precision(ranking, relevant)):
+                curve[i] += p / len(requests)
+        figures[method] = {metric: statistics.fmean(v) if v else 0.0 for metric, v in values.items()}
+        curves[method] = curve
+    return CollectionReport(
+        methods=figures,
+        queries=len(requests),
+        services=len(first.advertisements) if first is not None else 0,
+        curves=curves,
+        unmatched_requests=unmatched_requests,
+        unmatched_offers=len(unmatched_offers),
+        unresolved_concepts=loaded.unresolved_concepts,
+        unresolved_imports=loaded.unresolved_imports,
+        load_seconds=loaded.seconds,
+    )
+
+
+def plot_curves(report: CollectionReport, path: Path) -> Path:
+    """Precision-recall curves (11-point interpolated, mean over requests), one line per method."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 5), dpi=110)
+    for name, curve in report.curves.items():
+        ax.plot(RECALL_LEVELS, curve, marker="o", markersize=3, label=f"{name} (MAP {report.methods[name]['map']:.2f})")
+    ax.set_xlabel("recall")
+    ax.set_ylabel("interpolated precision (mean over requests)")
+    ax.set_xlim(0, 1)
+    ax.set_ylim(0, 1.02)
+    ax.set_title(f"OWL-S test collection: {report.queries} requests, {report.services} services")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, format="png")
+    plt.close(fig)
+    return path
