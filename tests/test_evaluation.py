@@ -21,11 +21,14 @@ from reasoner.evaluation import (
 )
 from reasoner.methods import METHODS
 from reasoner.testbed import (
+    CATALOGUE_FILE,
     RULES,
     SEED,
     TESTBED_FILE,
     TRUTH_FILE,
+    CatalogueError,
     generate,
+    load_catalogue,
     load_truth,
     open_testbed_kb,
     relevant_sets,
@@ -179,6 +182,34 @@ def test_truth_records_a_known_rule_for_every_pair() -> None:
 
 def test_testbed_keeps_its_own_rules(testbed_kb: KnowledgeBase) -> None:
     assert rule_violations(testbed_kb, load_truth()) == []
+
+
+@pytest.mark.parametrize(
+    ("good", "bad", "message"),
+    [
+        pytest.param(
+            'advertised = "home:OccupancyGridMap"',
+            'advertized = "home:OccupancyGridMap"',
+            "intents 'GridMap', relevant 'ProvideOccupancyGrid': unknown field 'advertized' "
+            "(did you mean 'advertised'?)",
+            id="misspelt-field",
+        ),
+        pytest.param(
+            'title = "grid map"\n',
+            "",
+            "intents 'GridMap': missing field 'title'",
+            id="missing-field",
+        ),
+    ],
+)
+def test_a_broken_catalogue_names_the_intent_and_the_field(tmp_path: Path, good: str, bad: str, message: str) -> None:
+    text = CATALOGUE_FILE.read_text(encoding="utf-8")
+    assert text.count(good) == 1
+    broken = tmp_path / "catalogue.toml"
+    broken.write_text(text.replace(good, bad), encoding="utf-8")
+    with pytest.raises(CatalogueError) as raised:
+        load_catalogue(broken)
+    assert str(raised.value) == f"catalogue.toml: {message}"
 
 
 def test_testbed_leaves_the_bundled_services_out(testbed_kb: KnowledgeBase) -> None:
