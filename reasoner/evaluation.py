@@ -28,6 +28,7 @@ from typing import Any
 
 from reasoner.matchmaker import Matchmaker
 from reasoner.methods import METHODS
+from reasoner.metrics import average_precision, first_relevant_rank, precision_at_k, reciprocal_rank, top1
 from reasoner.names import local_name
 from reasoner.testbed import TESTBED_FILE, TRUTH_FILE, load_truth, open_testbed_kb, relevant_sets
 
@@ -37,43 +38,6 @@ METRIC_LABELS = {"top1": "top-1 correct", "p_at_5": "precision at 5", "mrr": "MR
 # --------------------------------------------------------------------------------------------------
 # Metrics on one ranking
 # --------------------------------------------------------------------------------------------------
-
-
-def first_relevant_rank(ranking: Sequence[str], relevant: frozenset[str] | set[str]) -> int | None:
-    """1-based rank of the first relevant item, or None when none is ranked."""
-    for position, item in enumerate(ranking, start=1):
-        if item in relevant:
-            return position
-    return None
-
-
-def top1(ranking: Sequence[str], relevant: frozenset[str] | set[str]) -> float:
-    return 1.0 if ranking and ranking[0] in relevant else 0.0
-
-
-def precision_at_k(ranking: Sequence[str], relevant: frozenset[str] | set[str], k: int = 5) -> float:
-    """Relevant items among the first ``k``, divided by ``k``."""
-    if k <= 0:
-        raise ValueError("k must be positive")
-    return sum(1 for item in ranking[:k] if item in relevant) / k
-
-
-def reciprocal_rank(ranking: Sequence[str], relevant: frozenset[str] | set[str]) -> float:
-    rank = first_relevant_rank(ranking, relevant)
-    return 0.0 if rank is None else 1.0 / rank
-
-
-def average_precision(ranking: Sequence[str], relevant: frozenset[str] | set[str]) -> float:
-    """Mean over the relevant set of the precision at each relevant item's rank (0 for unranked ones)."""
-    if not relevant:
-        return 0.0
-    hits = 0
-    total = 0.0
-    for position, item in enumerate(ranking, start=1):
-        if item in relevant:
-            hits += 1
-            total += hits / position
-    return total / len(relevant)
 
 
 def metric_values(ranking: Sequence[str], relevant: frozenset[str] | set[str]) -> dict[str, float]:

@@ -8,9 +8,29 @@ from collections.abc import Collection, Mapping, Sequence
 RECALL_LEVELS = tuple(i / 10 for i in range(11))
 
 
-def precision_at(ranking: Sequence[str], relevant: Collection[str], k: int) -> float:
+def first_relevant_rank(ranking: Sequence[str], relevant: Collection[str]) -> int | None:
+    """1-based rank of the first relevant item, or None when none is ranked."""
+    for position, item in enumerate(ranking, start=1):
+        if item in relevant:
+            return position
+    return None
+
+
+def top1(ranking: Sequence[str], relevant: Collection[str]) -> float:
+    """1 when the first ranked item is relevant."""
+    return 1.0 if ranking and ranking[0] in relevant else 0.0
+
+
+def reciprocal_rank(ranking: Sequence[str], relevant: Collection[str]) -> float:
+    rank = first_relevant_rank(ranking, relevant)
+    return 0.0 if rank is None else 1.0 / rank
+
+
+def precision_at_k(ranking: Sequence[str], relevant: Collection[str], k: int) -> float:
     """Share of the first ``k`` ranked items that are relevant (k counts even past the list's end)."""
-    return sum(1 for item in ranking[:k] if item in relevant) / k if k > 0 else 0.0
+    if k <= 0:
+        raise ValueError("k must be positive")
+    return sum(1 for item in ranking[:k] if item in relevant) / k
 
 
 def average_precision(ranking: Sequence[str], relevant: Collection[str]) -> float:
@@ -28,7 +48,7 @@ def average_precision(ranking: Sequence[str], relevant: Collection[str]) -> floa
 
 def r_precision(ranking: Sequence[str], relevant: Collection[str]) -> float:
     """Precision at R, R being the number of relevant items."""
-    return precision_at(ranking, relevant, len(relevant))
+    return precision_at_k(ranking, relevant, len(relevant)) if relevant else 0.0
 
 
 def ndcg(ranking: Sequence[str], grades: Mapping[str, int]) -> float:

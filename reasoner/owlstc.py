@@ -23,7 +23,7 @@ from kb.errors import KnowledgeBaseError
 from kb.resources import ontology_dir
 from reasoner.matchmaker import Matchmaker
 from reasoner.methods import METHODS
-from reasoner.metrics import RECALL_LEVELS, average_precision, interpolated_precision, ndcg, precision_at, r_precision
+from reasoner.metrics import RECALL_LEVELS, average_precision, interpolated_precision, ndcg, precision_at_k, r_precision
 
 METRICS = ("map", "ndcg", "p_at_1", "p_at_10", "r_precision", "query_ms")
 
@@ -213,8 +213,8 @@ def evaluate_collection(root: Path, methods: Sequence[str] = METHODS) -> Collect
             relevant = {iri for iri, flag in binary.items() if flag}
             values["map"].append(average_precision(ranking, relevant))
             values["ndcg"].append(ndcg(ranking, grades))
-            values["p_at_1"].append(precision_at(ranking, relevant, 1))
-            values["p_at_10"].append(precision_at(ranking, relevant, 10))
+            values["p_at_1"].append(precision_at_k(ranking, relevant, 1))
+            values["p_at_10"].append(precision_at_k(ranking, relevant, 10))
             values["r_precision"].append(r_precision(ranking, relevant))
             for i, p in enumerate(interpolated_precision(ranking, relevant)):
                 curve[i] += p / len(requests)

@@ -7,19 +7,9 @@ from pathlib import Path
 import pytest
 
 from kb import KnowledgeBase
-from reasoner.evaluation import (
-    METRICS,
-    Report,
-    average_precision,
-    evaluate_paper,
-    first_relevant_rank,
-    metric_values,
-    plot_report,
-    precision_at_k,
-    reciprocal_rank,
-    top1,
-)
+from reasoner.evaluation import METRICS, Report, evaluate_paper, metric_values, plot_report
 from reasoner.methods import METHODS
+from reasoner.metrics import average_precision, first_relevant_rank, precision_at_k, reciprocal_rank, top1
 from reasoner.testbed import (
     CATALOGUE_FILE,
     RULES,

@@ -11,7 +11,7 @@ import pytest
 from click.testing import CliRunner
 
 from cbrs.cli import cli
-from reasoner.metrics import average_precision, interpolated_precision, ndcg, precision_at, r_precision
+from reasoner.metrics import average_precision, interpolated_precision, ndcg, precision_at_k, r_precision
 from reasoner.owlstc import CollectionError, evaluate_collection, read_relevance
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "owls-tc4"
@@ -36,8 +36,8 @@ def test_average_precision(ranking: list[str], relevant: set[str], expected: flo
 
 def test_precision_r_precision_and_curve() -> None:
     ranking = ["a", "x", "b", "y"]
-    assert precision_at(ranking, {"a", "b"}, 1) == 1.0
-    assert precision_at(ranking, {"a", "b"}, 10) == 0.2  # k counts past the end of the list
+    assert precision_at_k(ranking, {"a", "b"}, 1) == 1.0
+    assert precision_at_k(ranking, {"a", "b"}, 10) == 0.2  # k counts past the end of the list
     assert r_precision(ranking, {"a", "b"}) == 0.5
     curve = interpolated_precision(ranking, {"a", "b"})
     assert curve[0] == 1.0 and curve[5] == 1.0 and curve[10] == pytest.approx(2 / 3)
