@@ -17,6 +17,7 @@ import pyoxigraph as ox
 
 from cbrs import __version__
 from cbrs.app import App, parse_iri, pass_app
+from cbrs.cli_reasoner import eval_group, match, ranking_text
 from cbrs.output import RESULT_FORMATS, render_result, table, term_text
 from cbrs.settings import SETTINGS, setting
 from kb import Advertisement, KnowledgeBaseError, Requirement, ServiceDescription
@@ -322,6 +323,8 @@ def demo(app: App) -> None:
     click.echo(_describe(kb.description(expand("req:RobotSelfPosition"))))
     click.echo("\nDynamic perception components (cbrs query --name advertisements --bind kind=...):")
     click.echo(render_result(kb.run("advertisements", {"kind": "cbrs:DynamicPerceptionComponent"}), "table"))
+    click.echo("\nPaper Table 3: the advertisements ranked for the requirement (cbrs match ... --explain):")
+    click.echo(ranking_text(kb, expand("req:RobotSelfPosition"), top=4, explain=1))
 
 
 def _describe(d: ServiceDescription) -> str:
@@ -390,11 +393,5 @@ def main() -> None:
         sys.exit(2)
 
 
-def _register_subcommands() -> None:
-    from cbrs.cli_reasoner import eval_group, match
-
-    cli.add_command(match)
-    cli.add_command(eval_group)
-
-
-_register_subcommands()
+cli.add_command(match)
+cli.add_command(eval_group)

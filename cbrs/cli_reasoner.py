@@ -9,6 +9,7 @@ import click
 
 from cbrs.app import App, parse_iri, pass_app
 from cbrs.output import table
+from kb import KnowledgeBase
 from kb.namespaces import shorten
 from reasoner.matchmaker import Candidate, Matchmaker, MatchResult, MatchStatus
 from reasoner.methods import METHODS
@@ -24,14 +25,20 @@ from reasoner.methods import METHODS
 def match(app: App, requirement: str, top: int, method: str, explain: bool, as_json: bool) -> None:
     """Rank the advertisements against REQUIREMENT (an IRI or prefix:name, e.g. req:RobotSelfPosition)."""
     iri = parse_iri(requirement, "REQUIREMENT")
-    result = Matchmaker(app.kb, method).rank(iri, explain=top)
     if as_json:
+        result = Matchmaker(app.kb, method).rank(iri, explain=top)
         click.echo(json.dumps(result.to_dict(top), indent=2))
         return
-    click.echo(_ranking(result, top))
-    if explain:
-        for position, candidate in enumerate(result.candidates[:top], start=1):
-            click.echo("\n" + _explanation(position, candidate))
+    click.echo(ranking_text(app.kb, iri, top, top if explain else 0, method))
+
+
+def ranking_text(kb: KnowledgeBase, requirement: str, top: int, explain: int, method: str = "sem-str") -> str:
+    """The ranking table for ``requirement`` and the explanations of its first ``explain`` candidates."""
+    result = Matchmaker(kb, method).rank(requirement, explain=top)
+    parts = [_ranking(result, top)]
+    for position, candidate in enumerate(result.candidates[:explain], start=1):
+        parts.append("\n" + _explanation(position, candidate))
+    return "\n".join(parts)
 
 
 def _ranking(result: MatchResult, top: int) -> str:
