@@ -190,6 +190,7 @@ def test_demo_tours_the_paper_example() -> None:
     code, out = run("demo", store=":memory:")
     assert code == 0, out
     assert "Table 1" in out and "LocateMobileRobot" in out and "RobotSelfPosition" in out
+    assert "matched by sem-str; best svc:LocateMobileRobot_CeilingCamera01" in out
 
 
 def test_unexpected_errors_are_one_line(monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
