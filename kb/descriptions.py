@@ -50,6 +50,8 @@ class DescriptionReader:
             raise NotFoundError(iri, "service description")
         types = tuple(sorted({_iri(row["type"]) for row in head}))
         first = {name: _value(term) for row in head for name, term in row.items() if name != "type"}
+        parameters = self._parameters(iri)
+        conditions = self._conditions(iri)
         common: dict[str, Any] = dict(
             iri=iri,
             types=types,
@@ -58,10 +60,10 @@ class DescriptionReader:
             device_name=first.get("deviceName"),
             service_name=first.get("serviceName"),
             category=first.get("category"),
-            inputs=self._parameters(iri, "input"),
-            outputs=self._parameters(iri, "output"),
-            preconditions=self._conditions(iri, "precondition"),
-            effects=self._conditions(iri, "effect"),
+            inputs=parameters["input"],
+            outputs=parameters["output"],
+            preconditions=conditions["precondition"],
+            effects=conditions["effect"],
             area=self._area(iri),
             qos=self._qos(iri),
         )
@@ -95,9 +97,7 @@ class DescriptionReader:
             cycle = " -> ".join((*path[path.index(concept) :], concept))
             raise InvalidDescriptionError(root, [f"hasPart cycle {cycle}"])
         if len(path) >= MAX_PART_DEPTH:
-            raise InvalidDescriptionError(
-                root, [f"hasPart structure deeper than {MAX_PART_DEPTH} below {root}"]
-            )
+            raise InvalidDescriptionError(root, [f"hasPart structure deeper than {MAX_PART_DEPTH} below {root}"])
         rows = self._queries.select(self._store, "concept_parts", {"concept": concept})
         by_property: dict[str, list[tuple[str, str]]] = {}
         for row in rows:
@@ -110,18 +110,16 @@ class DescriptionReader:
                 children.append(self._build_tree(part, prop, (*path, concept), root))
         return PartNode(concept, via, tuple(children))
 
-    def _parameters(self, iri: str, direction: Literal["input", "output"]) -> tuple[Parameter, ...]:
+    def _parameters(self, iri: str) -> dict[str, tuple[Parameter, ...]]:
+        """Inputs and outputs, from one query."""
         rows = self._queries.select(self._store, "description_parameters", {"description": iri})
-        parameters = []
+        found: dict[str, list[Parameter]] = {"input": [], "output": []}
         for row in rows:
-            if _value(row["direction"]) != direction:
-                continue
+            direction = cast(Literal["input", "output"], _value(row["direction"]))
             if "type" not in row:
-                raise InvalidDescriptionError(
-                    iri, [f"{direction} {_iri(row['parameter'])} has no cbrs:parameterType"]
-                )
+                raise InvalidDescriptionError(iri, [f"{direction} {_iri(row['parameter'])} has no cbrs:parameterType"])
             concept = _iri(row["type"])
-            parameters.append(
+            found[direction].append(
                 Parameter(
                     iri=_iri(row["parameter"]),
                     direction=direction,
@@ -130,20 +128,20 @@ class DescriptionReader:
                     tree=self.part_tree(concept),
                 )
             )
-        return tuple(parameters)
+        return {direction: tuple(items) for direction, items in found.items()}
 
-    def _conditions(self, iri: str, role: str) -> tuple[Statement, ...]:
+    def _conditions(self, iri: str) -> dict[str, tuple[Statement, ...]]:
+        """Preconditions and effects, from one query."""
         rows = self._queries.select(self._store, "description_conditions", {"description": iri})
-        statements = []
+        found: dict[str, list[Statement]] = {"precondition": [], "effect": []}
         for row in rows:
-            if _value(row["role"]) != role:
-                continue
+            role = _value(row["role"])
             missing = [part for part in ("subject", "predicate", "object") if part not in row]
             if missing:
                 problem = f"{role} {_iri(row['condition'])} lacks rdf:{', rdf:'.join(missing)}"
                 raise InvalidDescriptionError(iri, [problem])
-            statements.append(Statement(_iri(row["subject"]), _iri(row["predicate"]), _iri(row["object"])))
-        return tuple(statements)
+            found[role].append(Statement(_iri(row["subject"]), _iri(row["predicate"]), _iri(row["object"])))
+        return {role: tuple(items) for role, items in found.items()}
 
     def _area(self, iri: str) -> EffectiveArea | None:
         rows = self._queries.select(self._store, "description_sea", {"description": iri})

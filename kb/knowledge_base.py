@@ -67,9 +67,7 @@ class KnowledgeBase:
         """Run the named query ``queries/<name>.rq`` with ``values`` bound to its parameters."""
         return self.queries.run(self.store, name, values)
 
-    def select(
-        self, name: str, values: Mapping[str, Term | str | int | float] | None = None
-    ) -> list[dict[str, Term]]:
+    def select(self, name: str, values: Mapping[str, Term | str | int | float] | None = None) -> list[dict[str, Term]]:
         return self.queries.select(self.store, name, values)
 
     def description(self, iri: str) -> ServiceDescription:
@@ -88,9 +86,7 @@ class KnowledgeBase:
     def describes(self, iri: str) -> bool:
         """Whether ``iri`` occurs in the store at all."""
         node = ox.NamedNode(iri)
-        return any(True for _ in self.store.quads(node)) or any(
-            True for _ in self.store.quads(None, None, node)
-        )
+        return any(True for _ in self.store.quads(node)) or any(True for _ in self.store.quads(None, None, node))
 
     def close(self) -> None:
         self.store.close()

@@ -240,9 +240,7 @@ def skolemise(quads: Iterable[ox.Quad]) -> list[ox.Quad]:
     return [ox.Quad(named(q.subject), q.predicate, named(q.object), q.graph_name) for q in canonical]
 
 
-def _read(
-    path: Path, graph: str | GraphName | None, base_iri: str | None = None, ontology: str | None = None
-) -> _Raw:
+def _read(path: Path, graph: str | GraphName | None, base_iri: str | None = None, ontology: str | None = None) -> _Raw:
     try:
         raw = path.read_bytes()
     except OSError as error:
@@ -450,9 +448,7 @@ def _located(error: SyntaxError, source: str, data: bytes, rdf_format: ox.RdfFor
     column = position[2] if len(position) > 2 else None
     if line is None and rdf_format == ox.RdfFormat.RDF_XML:
         line, column = _xml_error_position(data)
-    message = re.sub(
-        r"^Parser error (between|at) line \d+ column \d+( and line \d+ column \d+)?: ", "", message
-    )
+    message = re.sub(r"^Parser error (between|at) line \d+ column \d+( and line \d+ column \d+)?: ", "", message)
     return RdfParseError(source, message, line, column)
 
 
@@ -469,11 +465,7 @@ def _xml_error_position(data: bytes) -> tuple[int | None, int | None]:
 def _graph_for(quads: list[ox.Quad]) -> ox.NamedNode:
     """The graph for a file's triples when none is given: declarations go to the ontology graph,
     requirements to the requirements graph, everything else to the services graph."""
-    types = {
-        q.object.value
-        for q in quads
-        if q.predicate.value == RDF + "type" and isinstance(q.object, ox.NamedNode)
-    }
+    types = {q.object.value for q in quads if q.predicate.value == RDF + "type" and isinstance(q.object, ox.NamedNode)}
     if types & _DECLARATION_TYPES:
         return GraphName.ONTOLOGY.node
     if CBRS + "Requirement" in types and CBRS + "Advertisement" not in types:

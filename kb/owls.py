@@ -565,18 +565,12 @@ class _Builder:
         declarations = " ".join(f'xmlns:{p}="{ns}"' for p, ns in namespaces.items() if p and '"' not in ns)
         document = f"<rdf:RDF {declarations}>{text}</rdf:RDF>"
         try:
-            parsed = list(
-                ox.parse(input=document.encode("utf-8"), format=ox.RdfFormat.RDF_XML, base_iri=self.base())
-            )
+            parsed = list(ox.parse(input=document.encode("utf-8"), format=ox.RdfFormat.RDF_XML, base_iri=self.base()))
         except (SyntaxError, ValueError) as error:
             self.note(f"{self.source}: SWRL expression kept as text ({error})")
             return [], 1
         inner = _Index(parsed)
-        heads = [
-            s
-            for s in inner.out
-            if _is_atom_list(inner, s) and not inner.into.get(s, {}).get(RDF + "rest")
-        ]
+        heads = [s for s in inner.out if _is_atom_list(inner, s) and not inner.into.get(s, {}).get(RDF + "rest")]
         atoms: list[_Atom] = []
         kept = 0
         for head in heads:
@@ -796,4 +790,3 @@ def _is_parameter(index: _Index, node: Term) -> bool:
 
 def _render(atoms: Sequence[_Atom]) -> str:
     return " ^ ".join(f"{a.predicate}({', '.join(a.arguments)})" for a in atoms) or "(empty SWRL atom list)"
-

@@ -91,9 +91,7 @@ class QueryLibrary:
         except KeyError:
             raise UnknownQueryError(name, self.names()) from None
 
-    def run(
-        self, store: Store, name: str, values: Mapping[str, Term | str | int | float] | None = None
-    ) -> QueryResult:
+    def run(self, store: Store, name: str, values: Mapping[str, Term | str | int | float] | None = None) -> QueryResult:
         query = self.get(name)
         return store.query(query.text, query.bind(values or {}))
 
@@ -122,8 +120,6 @@ def _read(path: Path) -> NamedQuery:
         elif match := _PARAM_LINE.match(line):
             name, kind, required, description = match.groups()
             if kind not in PARAMETER_KINDS:
-                raise ValueError(
-                    f"{path}: parameter {name} has unknown kind {kind!r}; use one of {PARAMETER_KINDS}"
-                )
+                raise ValueError(f"{path}: parameter {name} has unknown kind {kind!r}; use one of {PARAMETER_KINDS}")
             parameters[name] = Parameter(name, kind, bool(required), description.strip())
     return NamedQuery(path.stem, title, text, parameters)
