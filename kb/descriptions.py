@@ -78,6 +78,27 @@ class DescriptionReader:
             ports=self._ports(iri),
         )
 
+    def read_action(self, iri: str, label: str | None = None) -> Requirement:
+        """The IOPE an action class carries (OWL 2 punning), as a requirement to compose for.
+
+        NotFoundError when ``iri`` carries no OWL-S model.
+        """
+        rows = self._queries.select(self._store, "description_model", {"description": iri})
+        if not rows or rows[0]["models"].value == "0":
+            raise NotFoundError(iri, "action with inputs, outputs, preconditions or effects")
+        parameters = self._parameters(iri)
+        conditions = self._conditions(iri)
+        return Requirement(
+            iri=iri,
+            types=(CBRS.Requirement,),
+            label=label,
+            inputs=parameters["input"],
+            outputs=parameters["output"],
+            preconditions=conditions["precondition"],
+            effects=conditions["effect"],
+            for_task=iri,
+        )
+
     def advertisements(self) -> list[Advertisement]:
         return [cast(Advertisement, self.read(iri)) for iri in self.advertisement_iris()]
 

@@ -79,6 +79,10 @@ class KnowledgeBase:
     def requirements(self) -> list[Requirement]:
         return self._reader.requirements()
 
+    def action_requirement(self, action: str, label: str | None = None) -> Requirement:
+        """The inputs, outputs, preconditions and effects of an action class, as a requirement."""
+        return self._reader.read_action(action, label)
+
     def statistics(self) -> dict[str, int]:
         """Triples per named graph."""
         return {row["graph"].value: int(row["triples"].value) for row in self.select("graph_statistics")}

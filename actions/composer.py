@@ -1,0 +1,544 @@
+"""Composition: from a task to a plan, through the service resource graph (paper section 4).
+
+1. Build the SRG for the task's requirement and search it both ways (``search``).
+2. Extract the plan backwards from SRO/SRE. Each need of a step is bound, in this order of
+   preference, to: what the requirement supplies (SRI); for an input, the output of a *sibling*, a
+   step created for the same consumer (a pre-service prepares data for that consumer, so it takes
+   that consumer's context first: the path planner feeding "navigate to person" takes the person's
+   position as its goal); otherwise a new step of the best qualified provider of a lower forward
+   level (so the extraction cannot loop). "Best" is the highest similarity, then the lowest cost
+   (``objective="similarity"``), or the other way round (``objective="cost"``).
+3. Merge invocations of static-data and method components that have identical bindings.
+4. Order the steps: a producer before its consumers, the action ontology's ordering constraints
+   respected, each step as late as possible (right before the first step that uses it, so perceived
+   data is fresh when it is used).
+5. For every step, list the drop-in alternatives: components that accept the same bindings and meet
+   the same needs (the executor fails over to them).
+
+When the requirement alone cannot be composed and its action class has KnowRob-style sub-actions,
+each sub-action is composed in their partial order and the plans are concatenated ("decomposed").
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from enum import Enum
+from typing import Any
+
+import networkx as nx
+
+from actions.errors import OrderingConflictError
+from actions.graph import SRE, SRI, SRO, Edge, Matcher, Need, ServiceResourceGraph
+from actions.model import ActionLibrary, Task, resolve_task
+from actions.plan import Binding, Plan, PlanStep, Source
+from actions.search import SearchTrace, bidirectional_search
+from kb import Advertisement, KnowledgeBase, Requirement
+from kb.namespaces import GraphName, shorten
+from reasoner.config import MatchConfig
+from reasoner.taxonomy import TaxonomyIndex
+
+GOAL = "GOAL"  # the extraction's virtual consumer: SRO's and SRE's needs together
+
+
+class Objective(Enum):
+    SIMILARITY = "similarity"  # highest similarity first, cost breaks ties
+    COST = "cost"  # lowest cost first, similarity breaks ties
+
+
+@dataclass(frozen=True)
+class ComposeConfig:
+    objective: Objective = Objective.SIMILARITY
+    default_cost: float = 1.0  # seconds, for components that advertise no response time
+    decompose: bool = True  # fall back to the task's sub-actions when the requirement alone fails
+    match: MatchConfig = field(default_factory=MatchConfig)
+
+
+class PlanStatus(Enum):
+    PLANNED = "planned"
+    UNSOLVABLE = "unsolvable"
+
+
+@dataclass(frozen=True)
+class Unsatisfied:
+    """A need no qualified vertex meets, and the chain of needs that led to it."""
+
+    need: str
+    consumer: str
+    chain: tuple[str, ...] = ()  # from the requirement's goal down to this need
+
+    def text(self) -> str:
+        consumer = "the requirement" if self.consumer in (SRO, SRE, GOAL) else shorten(self.consumer)
+        via = f" (on the way to {' <- '.join(self.chain)})" if len(self.chain) > 1 else ""
+        return f"no component provides {self.need} of {consumer}{via}"
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"need": self.need, "consumer": self.consumer, "chain": list(self.chain), "text": self.text()}
+
+
+@dataclass(frozen=True)
+class Attempt:
+    """One composition: its graph, the search, and the outcome."""
+
+    requirement: Requirement
+    graph: ServiceResourceGraph
+    trace: SearchTrace
+    plan: Plan | None
+    unsatisfied: tuple[Unsatisfied, ...]
+
+
+@dataclass(frozen=True)
+class CompositionResult:
+    task: str
+    requirement: str
+    status: PlanStatus
+    plan: Plan | None
+    unsatisfied: tuple[Unsatisfied, ...]
+    attempts: tuple[Attempt, ...]  # the direct attempt, then one per sub-action when decomposed
+
+    def to_dict(self) -> dict[str, Any]:
+        found: dict[str, Any] = {"task": self.task, "requirement": self.requirement, "status": self.status.value}
+        if self.plan is not None:
+            found.update(self.plan.to_dict())
+        found["unsatisfied"] = [u.to_dict() for u in self.unsatisfied]
+        return found
+
+
+class Composer:
+    """Plans tasks over the advertisements in a knowledge base."""
+
+    def __init__(
+        self,
+        kb: KnowledgeBase,
+        config: ComposeConfig | None = None,
+        *,
+        index: TaxonomyIndex | None = None,
+        actions: ActionLibrary | None = None,
+        advertisements: Sequence[Advertisement] | None = None,
+    ) -> None:
+        self.kb = kb
+        self.config = config or ComposeConfig()
+        self.index = index or TaxonomyIndex.from_kb(kb)
+        self.matcher = Matcher(self.index, self.config.match)
+        self.actions = actions or ActionLibrary.from_kb(kb)
+        self._advertisements = list(advertisements) if advertisements is not None else None
+
+    @property
+    def advertisements(self) -> list[Advertisement]:
+        if self._advertisements is None:
+            self._advertisements = self.kb.advertisements()
+        return self._advertisements
+
+    def task(self, name: str) -> Task:
+        return resolve_task(self.kb, self.actions, name)
+
+    def graph(self, requirement: Requirement) -> ServiceResourceGraph:
+        return ServiceResourceGraph(requirement, self.advertisements, self.matcher, self.config.default_cost)
+
+    def compose(self, task: str | Task | Requirement) -> CompositionResult:
+        if isinstance(task, str):
+            task = self.task(task)
+        elif isinstance(task, Requirement):
+            task = Task(task.iri, task, self.actions.actions.get(task.for_task or ""))
+        direct = self.attempt(task.requirement, task)
+        if direct.plan is not None or not self._decomposable(task):
+            return self._result(task, direct.plan, direct.unsatisfied, (direct,))
+        return self._decomposed(task, direct)
+
+    def _decomposable(self, task: Task) -> bool:
+        """Whether every sub-action of the task is stated as a requirement of its own.
+
+        A sub-action's requirement says what is given when that step starts (the tap, the region
+        below it); an action's bare IOPE would take as given what the plan must still produce.
+        """
+        if not (self.config.decompose and task.action and task.action.sub_actions):
+            return False
+        stated = {r.for_task for r in self.kb.requirements()}
+        return all(sub in stated for sub in task.action.sub_actions)
+
+    def attempt(self, requirement: Requirement, task: Task | None = None) -> Attempt:
+        graph = self.graph(requirement)
+        trace = bidirectional_search(graph)
+        extraction = _Extraction(graph, trace, self.config.objective)
+        if not extraction.solved:
+            return Attempt(requirement, graph, trace, None, tuple(extraction.unsatisfied))
+        orderings = self._orderings(task)
+        plan = extraction.plan(task.name if task else requirement.iri, self.index, orderings)
+        return Attempt(requirement, graph, trace, plan, ())
+
+    def _orderings(self, task: Task | None) -> list[tuple[str, str, str]]:
+        if task is None or task.action is None:
+            return []
+        return [(o.constraint, o.before, o.after) for o in self.actions.orderings_for(task.action.iri)]
+
+    def _decomposed(self, task: Task, direct: Attempt) -> CompositionResult:
+        assert task.action is not None
+        attempts = [direct]
+        plans: list[Plan] = []
+        for sub in task.action.ordered_sub_actions():
+            sub_task = resolve_task(self.kb, self.actions, sub)
+            attempt = self.attempt(sub_task.requirement, sub_task)
+            attempts.append(attempt)
+            if attempt.plan is None:
+                unsatisfied = direct.unsatisfied + tuple(
+                    Unsatisfied(u.need, u.consumer, (f"sub-action {shorten(sub)}", *u.chain[1:], shorten(u.consumer)))
+                    for u in attempt.unsatisfied
+                )
+                return self._result(task, None, unsatisfied, tuple(attempts))
+            plans.append(attempt.plan)
+        return self._result(task, _concatenate(task, plans), (), tuple(attempts))
+
+    def _result(
+        self, task: Task, plan: Plan | None, unsatisfied: tuple[Unsatisfied, ...], attempts: tuple[Attempt, ...]
+    ) -> CompositionResult:
+        status = PlanStatus.PLANNED if plan is not None else PlanStatus.UNSOLVABLE
+        return CompositionResult(task.name, task.requirement.iri, status, plan, unsatisfied, attempts)
+
+
+def store_plan(kb: KnowledgeBase, plan: Plan) -> None:
+    """Write ``plan`` to the plans graph, replacing an earlier plan for the same task, in one transaction."""
+    import pyoxigraph as ox
+
+    graph = GraphName.PLANS.node
+    prefix = plan.iri
+    old = [
+        q
+        for q in kb.store.quads(graph=graph)
+        if isinstance(q.subject, ox.NamedNode) and q.subject.value.startswith(prefix)
+    ]
+    kb.store.replace(old, plan.to_quads())
+
+
+# -- extraction ------------------------------------------------------------------------------------
+
+
+@dataclass
+class _Bound:
+    need: Need
+    edge: Edge
+    source: int | None  # producing step id; None: the requirement
+
+
+@dataclass
+class _Step:
+    id: int
+    node: str
+    made_for: int | None
+    bindings: list[_Bound] = field(default_factory=list)
+    producers: list[int] = field(default_factory=list)
+
+
+class _Extraction:
+    """Backward extraction of one plan from a searched SRG."""
+
+    def __init__(self, graph: ServiceResourceGraph, trace: SearchTrace, objective: Objective) -> None:
+        self.graph = graph
+        self.trace = trace
+        self.objective = objective
+        self.steps: dict[int, _Step] = {}
+        self.unsatisfied: list[Unsatisfied] = []
+        goal_needs = [(SRO, n) for n in graph.needs(SRO)] + [(SRE, n) for n in graph.needs(SRE)]
+        if not goal_needs:
+            self.unsatisfied.append(Unsatisfied("an output or effect", GOAL, ("the requirement states none",)))
+            return
+        self._goal_needs = goal_needs
+        blocked = [(node, n) for node, n in goal_needs if not self._ready(node, n)]
+        if blocked:
+            for node, need in blocked:
+                wanted = need.text()
+                if node in (SRO, SRE):
+                    wanted = wanted.replace("precondition", "effect", 1).replace("input", "output", 1)
+                for cause in self._why(node, need, (f"the requirement's {wanted}",), set()):
+                    if all((cause.need, cause.consumer) != (u.need, u.consumer) for u in self.unsatisfied):
+                        self.unsatisfied.append(cause)
+            return
+        self._expand()
+
+    @property
+    def solved(self) -> bool:
+        return not self.unsatisfied
+
+    # a need is ready when some enabled vertex (below the consumer's level) meets it
+    def _ready(self, node: str, need: Need) -> bool:
+        return bool(self._options(node, need, self._level(node)))
+
+    def _level(self, node: str) -> int:
+        return self.trace.levels.get(node, len(self.graph.vertices) + 1) if node not in (SRO, SRE) else 10**9
+
+    def _options(self, node: str, need: Need, below: int) -> list[Edge]:
+        return [
+            e
+            for e in self.graph.providers(node, need)
+            if e.source in self.trace.levels and self.trace.levels[e.source] < below
+        ]
+
+    def _why(self, node: str, need: Need, chain: tuple[str, ...], seen: set[str]) -> list[Unsatisfied]:
+        """Why ``need`` of ``node`` cannot be met: follow the best blocked provider down to a root cause."""
+        providers = [e for e in self.graph.providers(node, need) if e.source != node]
+        if not providers:
+            return [Unsatisfied(need.text(), node, chain)]
+        best = providers[0]
+        if best.source in seen:
+            return [Unsatisfied(need.text(), node, chain)]
+        here = (*chain, shorten(best.source))
+        causes: list[Unsatisfied] = []
+        for sub in self.graph.needs(best.source):
+            if not self._options(best.source, sub, self._level(best.source)):
+                causes += self._why(best.source, sub, here, seen | {best.source})
+        return causes or [Unsatisfied(need.text(), node, chain)]
+
+    def _key(self, edge: Edge) -> tuple[Any, ...]:
+        cost = self.trace.costs[edge.source]
+        level = self.trace.levels[edge.source]
+        if self.objective is Objective.COST:
+            return (round(cost, 9), -round(edge.similarity, 9), level, edge.source, edge.offer.name)
+        return (-round(edge.similarity, 9), round(cost, 9), level, edge.source, edge.offer.name)
+
+    def _new(self, node: str, made_for: int | None) -> _Step:
+        step = _Step(len(self.steps), node, made_for)
+        self.steps[step.id] = step
+        return step
+
+    def _expand(self) -> None:
+        goal = self._new(GOAL, None)
+        queue: deque[int] = deque([goal.id])
+        while queue:
+            step = self.steps[queue.popleft()]
+            needs = self._goal_needs if step.node == GOAL else [(step.node, n) for n in self.graph.needs(step.node)]
+            # pre-actions (P-E) first, then pre-services (I-O), as in the paper's backward search
+            needs.sort(key=lambda item: item[1].role != "precondition")
+            below = 10**9 if step.node == GOAL else self.trace.levels[step.node]
+            for node, need in needs:
+                options = self._options(node, need, below)
+                given = [e for e in options if e.source == SRI]
+                if given:
+                    step.bindings.append(_Bound(need, min(given, key=self._key), None))
+                    continue
+                mine = [(e, p) for p in step.producers for e in options if e.source == self.steps[p].node]
+                if mine:  # a step already made for this consumer meets this need too
+                    edge, producer_id = min(mine, key=lambda item: (self._key(item[0]), item[1]))
+                    step.bindings.append(_Bound(need, edge, producer_id))
+                    continue
+                sibling = self._sibling(step, node, need)
+                if sibling is not None:
+                    step.bindings.append(sibling)
+                    continue
+                best = min((e for e in options if e.source != SRI), key=self._key)
+                producer = self._new(best.source, step.id)
+                step.producers.append(producer.id)
+                step.bindings.append(_Bound(need, best, producer.id))
+                queue.append(producer.id)
+
+    def _sibling(self, step: _Step, node: str, need: Need) -> _Bound | None:
+        """An output of a step made for the same consumer, if one meets this input."""
+        if need.role != "input" or step.made_for is None:
+            return None
+        level = self.trace.levels[step.node]
+        found: list[tuple[tuple[Any, ...], _Bound]] = []
+        for other_id in self.steps[step.made_for].producers:
+            other = self.steps[other_id]
+            if other.id == step.id or self.trace.levels[other.node] >= level:
+                continue
+            for edge in self.graph.providers(node, need):
+                if edge.source == other.node and edge.offer.role == "output":
+                    found.append(((-edge.similarity, other.id, edge.offer.name), _Bound(need, edge, other.id)))
+        return min(found, key=lambda item: item[0])[1] if found else None
+
+    # -- from the extraction to a Plan -----------------------------------------------------------
+
+    def plan(self, task: str, index: TaxonomyIndex, orderings: list[tuple[str, str, str]]) -> Plan:
+        self._merge_shared()
+        order = self._order(index, orderings)
+        number = {step_id: n for n, step_id in enumerate(order, start=1)}
+        requirement = self.graph.requirement
+        steps: list[PlanStep] = []
+        for step_id in order:
+            step = self.steps[step_id]
+            vertex = self.graph.vertices[step.node]
+            ad = vertex.advertisement
+            assert ad is not None
+            steps.append(
+                PlanStep(
+                    index=number[step_id],
+                    component=ad.iri,
+                    label=ad.label,
+                    kind=ad.kind,
+                    device=ad.device,
+                    action=ad.realizes_action,
+                    bindings=tuple(self._binding(b, number, requirement.iri) for b in step.bindings),
+                    outputs=tuple((o.name, o.concept or "") for o in vertex.offers if o.role == "output"),
+                    effects=tuple(o.statement for o in vertex.offers if o.statement is not None),
+                    cost=vertex.cost,
+                    alternatives=tuple(self._alternatives(step)),
+                )
+            )
+        goals = tuple(self._binding(b, number, requirement.iri) for b in self.steps[0].bindings)
+        everything = [b for s in steps for b in s.bindings] + list(goals)
+        similarity = sum(b.similarity for b in everything) / len(everything)
+        return Plan(task, requirement.iri, "direct", tuple(steps), goals, similarity, sum(s.cost for s in steps))
+
+    def _binding(self, bound: _Bound, number: dict[int, int], requirement: str) -> Binding:
+        need, edge = bound.need, bound.edge
+        if bound.source is None:
+            source = Source(edge.offer.name, None, requirement)
+        else:
+            source = Source(edge.offer.name, number[bound.source])
+        return Binding(need.role, need.name, source, edge.degree.value, edge.similarity, need.concept, need.statement)
+
+    def _merge_shared(self) -> None:
+        """One invocation for shareable components bound to the same sources."""
+        signatures: dict[int, tuple[Any, ...]] = {}
+
+        def signature(step_id: int) -> tuple[Any, ...]:
+            if step_id not in signatures:
+                step = self.steps[step_id]
+                if not self.graph.vertices[step.node].shareable:
+                    signatures[step_id] = ("unique", step_id)
+                else:
+                    parts = sorted(
+                        (b.need.key, b.edge.offer.name, signature(b.source) if b.source is not None else ("SRI",))
+                        for b in step.bindings
+                    )
+                    signatures[step_id] = (step.node, tuple(parts))
+            return signatures[step_id]
+
+        keep: dict[tuple[Any, ...], int] = {}
+        alias: dict[int, int] = {}
+        for step_id in sorted(self.steps):
+            if step_id == 0:
+                continue
+            sig = signature(step_id)
+            alias[step_id] = keep.setdefault(sig, step_id)
+        for step in self.steps.values():
+            for bound in step.bindings:
+                if bound.source is not None:
+                    bound.source = alias[bound.source]
+        for step_id, kept in alias.items():
+            if kept != step_id:
+                del self.steps[step_id]
+
+    def _order(self, index: TaxonomyIndex, orderings: list[tuple[str, str, str]]) -> list[int]:
+        """Producers before consumers, ordering constraints kept, each step as late as possible."""
+        dag: nx.DiGraph[int] = nx.DiGraph()
+        dag.add_nodes_from(s for s in self.steps if s != 0)
+        for step in self.steps.values():
+            for bound in step.bindings:
+                if bound.source is not None and step.id != 0:
+                    dag.add_edge(bound.source, step.id)
+        actions = {
+            s.id: ad.realizes_action
+            for s in self.steps.values()
+            if s.id != 0 and (ad := self.graph.vertices[s.node].advertisement) is not None and ad.realizes_action
+        }
+        for constraint, before, after in orderings:
+            firsts = [s for s, a in actions.items() if _is_a(index, a, before)]
+            seconds = [s for s, a in actions.items() if _is_a(index, a, after)]
+            for first in firsts:
+                for second in seconds:
+                    if first == second or dag.has_edge(first, second):
+                        continue
+                    if nx.has_path(dag, second, first):
+                        raise OrderingConflictError(
+                            shorten(constraint),
+                            shorten(self.steps[first].node),
+                            shorten(self.steps[second].node),
+                        )
+                    dag.add_edge(first, second)
+        placed: dict[int, int] = {}  # step -> position counted from the end
+        reverse: list[int] = []
+        waiting = {s: set(dag.successors(s)) for s in dag.nodes}
+        while len(reverse) < len(waiting):
+            ready = [s for s, after in waiting.items() if s not in placed and after <= placed.keys()]
+            # right before the consumer placed most recently; later-created steps first on ties,
+            # so a consumer's inputs end up in their declared order
+            chosen = max(ready, key=lambda s: (max((placed[c] for c in waiting[s]), default=-1), s))
+            placed[chosen] = len(reverse)
+            reverse.append(chosen)
+        return list(reversed(reverse))
+
+    def _alternatives(self, step: _Step) -> list[str]:
+        """Components that accept this step's bindings and meet every need it serves."""
+        served = [
+            (consumer, bound.need)
+            for consumer in self.steps.values()
+            for bound in consumer.bindings
+            if bound.source == step.id
+        ]
+        sources = {SRI} | {self.steps[b.source].node for b in step.bindings if b.source is not None}
+        found: list[tuple[tuple[Any, ...], str]] = []
+        for iri in self.trace.levels:
+            vertex = self.graph.vertices[iri]
+            if iri == step.node or vertex.advertisement is None:
+                continue
+            feeds = []
+            for consumer, need in served:
+                target = self._goal_node(need) if consumer.id == 0 else consumer.node
+                edges = [e for e in self.graph.providers(target, need) if e.source == iri]
+                if not edges:
+                    break
+                feeds.append(edges[0].similarity)
+            else:
+                fed = all(any(e.source in sources for e in self.graph.providers(iri, need)) for need in vertex.needs)
+                if fed and feeds:
+                    found.append(((-min(feeds), vertex.cost, iri), iri))
+        return [iri for _, iri in sorted(found)]
+
+    def _goal_node(self, need: Need) -> str:
+        return SRO if need.role == "input" else SRE
+
+
+def _is_a(index: TaxonomyIndex, concept: str, ancestor: str) -> bool:
+    if concept == ancestor:
+        return True
+    return concept in index and ancestor in index and index.canonical(ancestor) in index.is_a_ancestors(concept)
+
+
+def _concatenate(task: Task, plans: list[Plan]) -> Plan:
+    """One plan from the sub-action plans, renumbered, each step marked with its sub-action."""
+    steps: list[PlanStep] = []
+    goals: list[Binding] = []
+    for plan in plans:
+        offset = len(steps)
+        for step in plan.steps:
+            steps.append(
+                PlanStep(
+                    index=step.index + offset,
+                    component=step.component,
+                    label=step.label,
+                    kind=step.kind,
+                    device=step.device,
+                    action=step.action,
+                    bindings=tuple(_shift(b, offset) for b in step.bindings),
+                    outputs=step.outputs,
+                    effects=step.effects,
+                    cost=step.cost,
+                    part_of=plan.task,
+                    alternatives=step.alternatives,
+                )
+            )
+        goals += [_shift(g, offset) for g in plan.goals]
+    everything = [b for s in steps for b in s.bindings] + goals
+    similarity = sum(b.similarity for b in everything) / len(everything) if everything else 0.0
+    return Plan(
+        task.name,
+        task.requirement.iri,
+        "decomposed",
+        tuple(steps),
+        tuple(goals),
+        similarity,
+        sum(s.cost for s in steps),
+        tuple(p.task for p in plans),
+    )
+
+
+def _shift(binding: Binding, offset: int) -> Binding:
+    if binding.source.step is None:
+        return binding
+    source = Source(binding.source.name, binding.source.step + offset)
+    return Binding(
+        binding.role, binding.name, source, binding.degree, binding.similarity, binding.concept, binding.statement
+    )
+
+
+__all__ = ["ComposeConfig", "Composer", "CompositionResult", "Objective", "PlanStatus", "Unsatisfied", "store_plan"]

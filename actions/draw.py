@@ -1,0 +1,146 @@
+"""Draw the service resource graph of a composition (like the paper's Figure 15).
+
+Vertices are laid out left to right by their forward-search level (SRI first, SRO/SRE last). Blue
+arrows are edges the forward search used, magenta arcs the edges the backward search walked, thick
+black arrows the bindings of the chosen plan. Only the vertices of the plan, their alternatives
+and the virtual nodes are drawn; the full graph of a home has thousands of edges.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt
+from matplotlib.axes import Axes
+from matplotlib.lines import Line2D
+
+from actions.composer import Attempt, CompositionResult
+from actions.graph import SRE, SRI, SRO
+
+FORMATS = (".svg", ".png")
+FORWARD, BACKWARD, PLAN = "#1f77b4", "#d62ad0", "#111111"
+
+
+def draw(result: CompositionResult, path: str | Path) -> Path:
+    """Write the drawing to ``path`` (SVG or PNG, by its suffix) and return the path."""
+    target = Path(path)
+    if target.suffix.lower() not in FORMATS:
+        raise ValueError(f"cannot draw to {target.name!r}: use a file name ending in {' or '.join(FORMATS)}")
+    attempts = [a for a in result.attempts if a.plan is not None] or list(result.attempts[:1])
+    heights = [_rows(a) for a in attempts]
+    figure, axes = plt.subplots(
+        len(attempts), 1, figsize=(16, 1.2 + 0.75 * sum(heights)), squeeze=False, height_ratios=heights
+    )
+    for axis, attempt in zip(axes[:, 0], attempts, strict=True):
+        _draw_attempt(axis, attempt)
+    figure.legend(
+        handles=[
+            Line2D([0], [0], color=FORWARD, lw=1.2, label="forward search (qualified post-service)"),
+            Line2D([0], [0], color=BACKWARD, lw=1.2, label="backward search (qualified pre-service / pre-action)"),
+            Line2D([0], [0], color=PLAN, lw=2.6, label="chosen plan"),
+        ],
+        loc="lower center",
+        ncol=3,
+        frameon=False,
+    )
+    figure.suptitle(f"Service resource graph for {_short(result.task)}: {result.status.value}")
+    figure.subplots_adjust(left=0.02, right=0.98, top=0.93, bottom=0.08, hspace=0.25)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    figure.savefig(target)
+    plt.close(figure)
+    return target
+
+
+def _rows(attempt: Attempt) -> int:
+    """How many vertices share the busiest column of this attempt's drawing (at least 3)."""
+    columns: dict[int, int] = {}
+    if attempt.plan is not None:
+        for iri in {c for s in attempt.plan.steps for c in (s.component, *s.alternatives)}:
+            level = attempt.trace.levels.get(iri, 0)
+            columns[level] = columns.get(level, 0) + 1
+    return max(3, *columns.values()) if columns else 3
+
+
+def _draw_attempt(axis: Axes, attempt: Attempt) -> None:
+    trace, plan = attempt.trace, attempt.plan
+    shown = {SRI} | {goal for goal in (SRO, SRE) if attempt.graph.needs(goal)}
+    plan_edges: set[tuple[str, str]] = set()
+    if plan is not None:
+        by_index = {s.index: s.component for s in plan.steps}
+        for step in plan.steps:
+            shown.add(step.component)
+            shown.update(step.alternatives)
+            for b in step.bindings:
+                plan_edges.add((by_index[b.source.step] if b.source.step else SRI, step.component))
+        for g in plan.goals:
+            goal = SRO if g.role == "input" else SRE
+            plan_edges.add((by_index[g.source.step] if g.source.step else SRI, goal))
+    last = max(trace.levels.values(), default=0) + 1
+    level = {iri: trace.levels.get(iri, last) for iri in shown}
+    level[SRO] = level[SRE] = last
+    columns: dict[int, list[str]] = {}
+    for iri in sorted(shown, key=lambda i: (level[i], _short(i))):
+        columns.setdefault(level[iri], []).append(iri)
+    position = {}
+    for column, members in columns.items():
+        for row, iri in enumerate(members):
+            position[iri] = (float(column), (len(members) - 1) / 2 - row)
+    for edges, colour, rad in ((trace.forward, FORWARD, 0.0), (trace.backward, BACKWARD, 0.25)):
+        seen = set()
+        for e in edges:
+            pair = (e.source, e.target)
+            if e.source in position and e.target in position and pair not in seen:
+                seen.add(pair)
+                _arrow(axis, position[e.source], position[e.target], colour, 0.9, rad)
+    for source, target in plan_edges:
+        if source in position and target in position:
+            _arrow(axis, position[source], position[target], PLAN, 2.4, 0.0)
+    chosen = {s.component for s in plan.steps} if plan else set()
+    for iri, (x, y) in position.items():
+        virtual = iri in (SRI, SRO, SRE)
+        axis.text(
+            x,
+            y,
+            _short(iri),
+            ha="center",
+            va="center",
+            fontsize=7.5,
+            bbox={
+                "boxstyle": "round,pad=0.3",
+                "fc": "#ffe9a8" if virtual else ("#d8f0d8" if iri in chosen else "#f2f2f2"),
+                "ec": PLAN if iri in chosen or virtual else "#999999",
+            },
+        )
+    axis.set_title(_short(attempt.requirement.iri), fontsize=10)
+    ys = [y for _, y in position.values()]
+    axis.set_xlim(-0.7, last + 0.7)
+    axis.set_ylim(min(ys) - 0.8, max(ys) + 0.8)
+    axis.axis("off")
+
+
+def _arrow(
+    axis: Axes, start: tuple[float, float], end: tuple[float, float], colour: str, width: float, rad: float
+) -> None:
+    axis.annotate(
+        "",
+        xy=end,
+        xytext=start,
+        arrowprops={
+            "arrowstyle": "-|>",
+            "color": colour,
+            "lw": width,
+            "shrinkA": 14,
+            "shrinkB": 14,
+            "connectionstyle": f"arc3,rad={rad}",
+            "alpha": 0.85,
+        },
+    )
+
+
+def _short(iri: str) -> str:
+    name = iri.rsplit("#", 1)[-1].rsplit("/", 1)[-1]
+    return name.replace("_", "\n", 1)

@@ -1,0 +1,36 @@
+"""Typed errors of composition and execution. Each keeps the offending input."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from kb import KnowledgeBaseError
+
+
+class ActionsError(KnowledgeBaseError):
+    """Base of the errors composition and execution raise on purpose."""
+
+
+class UnknownTaskError(ActionsError):
+    """The name given as a task is neither a requirement nor an action class in the store."""
+
+    http_status = 404
+
+    def __init__(self, name: str, known: Sequence[str]) -> None:
+        self.name = name
+        self.known = tuple(known)
+        super().__init__(f"no requirement or action named {name!r}; known tasks: {', '.join(known)}")
+
+
+class OrderingConflictError(ActionsError):
+    """An ordering constraint of the action ontology contradicts the data flow a plan needs."""
+
+    http_status = 409
+
+    def __init__(self, constraint: str, before: str, after: str) -> None:
+        self.constraint = constraint
+        self.before = before
+        self.after = after
+        super().__init__(
+            f"ordering constraint {constraint} puts {before} before {after}, but the plan needs the opposite order"
+        )

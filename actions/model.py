@@ -1,0 +1,156 @@
+"""The action model: action classes, their sub-actions and ordering constraints (KnowRob style).
+
+Read from the action ontology in the store; no composition or execution code lives here, so the
+engines can change without touching what an action is.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+
+import networkx as nx
+
+from actions.errors import UnknownTaskError
+from kb import KnowledgeBase, NotFoundError, Requirement
+from kb.namespaces import PREFIXES, expand
+
+
+@dataclass(frozen=True)
+class Ordering:
+    """A strict partial ordering constraint: ``before`` happens before ``after``."""
+
+    constraint: str
+    before: str
+    after: str
+
+
+@dataclass(frozen=True)
+class ActionClass:
+    """An action class with its direct parents, sub-actions and the orderings it declares."""
+
+    iri: str
+    label: str | None = None
+    parents: tuple[str, ...] = ()
+    sub_actions: tuple[str, ...] = ()
+    orderings: tuple[Ordering, ...] = ()
+
+    def ordered_sub_actions(self) -> list[str]:
+        """The sub-actions in an order that respects every ordering constraint (declared order breaks ties)."""
+        graph: nx.DiGraph[str] = nx.DiGraph()
+        graph.add_nodes_from(self.sub_actions)
+        graph.add_edges_from((o.before, o.after) for o in self.orderings if o.before in graph and o.after in graph)
+        rank = {iri: n for n, iri in enumerate(self.sub_actions)}
+        return list(nx.lexicographical_topological_sort(graph, key=lambda iri: rank[iri]))
+
+
+@dataclass
+class ActionLibrary:
+    """Every action class in the store, read once."""
+
+    actions: dict[str, ActionClass] = field(default_factory=dict)
+
+    @classmethod
+    def from_kb(cls, kb: KnowledgeBase) -> ActionLibrary:
+        parents: dict[str, set[str]] = {}
+        subs: dict[str, list[str]] = {}
+        labels: dict[str, str | None] = {}
+        for row in kb.select("actions"):
+            iri = row["action"].value
+            labels[iri] = row["label"].value if "label" in row else None
+            parents.setdefault(iri, set())
+            if "parent" in row:
+                parents[iri].add(row["parent"].value)
+            if "subActions" in row and row["subActions"].value:
+                subs[iri] = sorted(set(row["subActions"].value.split()))
+        orderings: dict[str, list[Ordering]] = {}
+        for row in kb.select("action_ordering"):
+            orderings.setdefault(row["action"].value, []).append(
+                Ordering(row["constraint"].value, row["before"].value, row["after"].value)
+            )
+        library = cls()
+        for iri in parents:
+            ordering = tuple(orderings.get(iri, ()))
+            declared = _ordered(subs.get(iri, []), ordering)
+            library.actions[iri] = ActionClass(iri, labels[iri], tuple(sorted(parents[iri])), declared, ordering)
+        return library
+
+    def __contains__(self, iri: object) -> bool:
+        return iri in self.actions
+
+    def __iter__(self) -> Iterator[ActionClass]:
+        return iter(self.actions.values())
+
+    def get(self, iri: str) -> ActionClass:
+        try:
+            return self.actions[iri]
+        except KeyError:
+            raise NotFoundError(iri, "action class") from None
+
+    def ancestors(self, iri: str) -> list[str]:
+        """``iri`` and every action class above it, nearest first."""
+        seen: list[str] = []
+        queue = [iri]
+        while queue:
+            current = queue.pop(0)
+            if current in seen or current not in self.actions:
+                continue
+            seen.append(current)
+            queue.extend(self.actions[current].parents)
+        return seen
+
+    def orderings_for(self, iri: str) -> list[Ordering]:
+        """The ordering constraints of ``iri`` and of the actions it specialises."""
+        return [o for action in self.ancestors(iri) for o in self.actions[action].orderings]
+
+
+def _ordered(subs: list[str], orderings: tuple[Ordering, ...]) -> tuple[str, ...]:
+    """Sub-actions sorted by the ordering constraints, then by IRI, for a stable declared order."""
+    graph: nx.DiGraph[str] = nx.DiGraph()
+    graph.add_nodes_from(subs)
+    graph.add_edges_from((o.before, o.after) for o in orderings if o.before in graph and o.after in graph)
+    if not nx.is_directed_acyclic_graph(graph):
+        return tuple(subs)
+    return tuple(nx.lexicographical_topological_sort(graph))
+
+
+@dataclass(frozen=True)
+class Task:
+    """What to plan for: a requirement, and the action class it asks for when there is one."""
+
+    name: str
+    requirement: Requirement
+    action: ActionClass | None = None
+
+
+def resolve_task(kb: KnowledgeBase, library: ActionLibrary, name: str) -> Task:
+    """A task from a requirement or action IRI, a prefixed name, or a bare local name.
+
+    A bare name is tried as a requirement first (``req:NAME``), then as an action (``act:NAME``). An
+    action is planned through the requirement that names it with ``cbrs:forTask`` when there is one,
+    otherwise from the inputs, outputs, preconditions and effects the action class carries.
+    """
+    candidates = [name] if ":" in name else [f"req:{name}", f"act:{name}"]
+    for candidate in candidates:
+        try:
+            iri = expand(candidate)
+        except ValueError:
+            continue
+        requirement = next((r for r in kb.requirements() if r.iri == iri), None)
+        if requirement is not None:
+            action = library.actions.get(requirement.for_task or "")
+            return Task(iri, requirement, action)
+        if iri in library:
+            action = library.get(iri)
+            stated = sorted((r for r in kb.requirements() if r.for_task == iri), key=lambda r: r.iri)
+            requirement = stated[0] if stated else kb.action_requirement(iri, action.label)
+            return Task(iri, requirement, action)
+    known = sorted({_short(r.iri) for r in kb.requirements()} | {_short(a.iri) for a in library if a.sub_actions})
+    raise UnknownTaskError(name, known)
+
+
+def _short(iri: str) -> str:
+    for prefix in ("req", "act"):
+        if iri.startswith(PREFIXES[prefix]):
+            return iri[len(PREFIXES[prefix]) :]
+    return iri
