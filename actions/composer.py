@@ -67,14 +67,23 @@ class Unsatisfied:
     need: str
     consumer: str
     chain: tuple[str, ...] = ()  # from the requirement's goal down to this need
+    cycle: bool = False  # providers exist, but each needs (through others) what this need blocks
 
     def text(self) -> str:
         consumer = "the requirement" if self.consumer in (SRO, SRE, GOAL) else shorten(self.consumer)
         via = f" (on the way to {' <- '.join(self.chain)})" if len(self.chain) > 1 else ""
+        if self.cycle:
+            return f"only a cycle of components provides {self.need} of {consumer}{via}"
         return f"no component provides {self.need} of {consumer}{via}"
 
     def to_dict(self) -> dict[str, Any]:
-        return {"need": self.need, "consumer": self.consumer, "chain": list(self.chain), "text": self.text()}
+        return {
+            "need": self.need,
+            "consumer": self.consumer,
+            "chain": list(self.chain),
+            "cycle": self.cycle,
+            "text": self.text(),
+        }
 
 
 @dataclass(frozen=True)
@@ -182,7 +191,9 @@ class Composer:
             attempts.append(attempt)
             if attempt.plan is None:
                 unsatisfied = direct.unsatisfied + tuple(
-                    Unsatisfied(u.need, u.consumer, (f"sub-action {shorten(sub)}", *u.chain[1:], shorten(u.consumer)))
+                    Unsatisfied(
+                        u.need, u.consumer, (f"sub-action {shorten(sub)}", *u.chain[1:], shorten(u.consumer)), u.cycle
+                    )
                     for u in attempt.unsatisfied
                 )
                 return self._result(task, None, unsatisfied, tuple(attempts))
@@ -280,7 +291,7 @@ class _Extraction:
             return [Unsatisfied(need.text(), node, chain)]
         best = providers[0]
         if best.source in seen:
-            return [Unsatisfied(need.text(), node, chain)]
+            return [Unsatisfied(need.text(), node, chain, cycle=True)]
         here = (*chain, shorten(best.source))
         causes: list[Unsatisfied] = []
         for sub in self.graph.needs(best.source):

@@ -1,0 +1,104 @@
+"""Composition: the catalogue of small problems with known answers (tests/data/composition)."""
+
+from __future__ import annotations
+
+import tomllib
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from actions.composer import ComposeConfig, Composer, Objective, PlanStatus
+from actions.graph import SRI, SRO, ServiceResourceGraph
+from actions.search import bidirectional_search
+from kb import KnowledgeBase, Store
+from kb.resources import ontology_dir
+
+DATA = Path(__file__).parent / "data" / "composition"
+EX = "http://example.org/comp#"
+PROBLEMS: list[dict[str, Any]] = tomllib.loads((DATA / "manifest.toml").read_text())["problem"]
+
+
+def problem_kb(file: str) -> KnowledgeBase:
+    kb = KnowledgeBase(Store.open(":memory:"))
+    kb.load([ontology_dir() / "core.ttl"], graph="ontology")
+    kb.load([DATA / "ontology.ttl"], graph="ontology")
+    kb.load([DATA / file])
+    return kb
+
+
+@pytest.mark.parametrize("problem", [pytest.param(p, id=p["id"]) for p in PROBLEMS])
+def test_catalogue_problem(problem: dict[str, Any]) -> None:
+    kb = problem_kb(problem["file"])
+    config = ComposeConfig(objective=Objective(problem.get("objective", "similarity")))
+    result = Composer(kb, config).compose(EX + "Req")
+    if "unsolvable" in problem:
+        assert result.status is PlanStatus.UNSOLVABLE
+        assert result.plan is None
+        report = "\n".join(u.text() for u in result.unsatisfied)
+        for text in problem["unsolvable"]:
+            assert text in report
+        return
+    assert result.status is PlanStatus.PLANNED, [u.text() for u in result.unsatisfied]
+    assert result.plan is not None
+    assert [c.removeprefix(EX) for c in result.plan.components()] == problem["steps"]
+    for component, expected in problem.get("alternatives", {}).items():
+        step = next(s for s in result.plan.steps if s.component == EX + component)
+        assert [a.removeprefix(EX) for a in step.alternatives] == expected
+
+
+def test_every_binding_points_back_to_an_earlier_step_or_the_requirement() -> None:
+    for problem in PROBLEMS:
+        if "steps" not in problem:
+            continue
+        plan = Composer(problem_kb(problem["file"])).compose(EX + "Req").plan
+        assert plan is not None
+        for step in plan.steps:
+            for binding in step.bindings:
+                assert binding.source.step is None or binding.source.step < step.index
+        assert all(g.source.step is None or g.source.step <= len(plan.steps) for g in plan.goals)
+
+
+def test_shared_static_data_is_invoked_once() -> None:
+    plan = Composer(problem_kb("shared.ttl")).compose(EX + "Req").plan
+    assert plan is not None
+    s3 = plan.step(3)
+    sources = {b.name: b.source.step for b in s3.inputs}
+    assert sources == {"b": 1, "c": 2}
+    assert plan.step(2).inputs[0].source.step == 1
+
+
+def test_graph_has_virtual_nodes_and_accepted_edges_only() -> None:
+    kb = problem_kb("similarity_tie.ttl")
+    composer = Composer(kb)
+    graph: ServiceResourceGraph = composer.graph(composer.task(EX + "Req").requirement)
+    into_sro = [e for e in graph.edges() if e.target == SRO]
+    assert {e.source for e in into_sro} == {EX + "SExact", EX + "SGeneral"}
+    degrees = {e.source: e.degree.value for e in into_sro}
+    assert degrees == {EX + "SExact": "Exact", EX + "SGeneral": "HasSubClass"}
+    exact = next(e for e in into_sro if e.source == EX + "SExact")
+    general = next(e for e in into_sro if e.source == EX + "SGeneral")
+    assert exact.similarity > general.similarity
+    from_requirement = [e for e in graph.edges() if e.target == EX + "SExact" and e.source == SRI]
+    assert [e.degree.value for e in from_requirement] == ["Exact"]
+
+
+def test_search_levels_and_meeting() -> None:
+    kb = problem_kb("chain.ttl")
+    composer = Composer(kb)
+    graph = composer.graph(composer.task(EX + "Req").requirement)
+    trace = bidirectional_search(graph)
+    assert trace.levels[SRI] == 0
+    assert trace.levels[EX + "S1"] == 1
+    assert trace.levels[EX + "S2"] == 2
+    assert trace.levels[SRO] == 3
+    assert {EX + "S1", EX + "S2"} <= trace.meeting
+    assert any(e.source == EX + "S2" and e.target == SRO for e in trace.backward)
+    assert any(e.source == SRI and e.target == EX + "S1" for e in trace.forward)
+
+
+def test_unreachable_cycle_is_never_enabled() -> None:
+    kb = problem_kb("cycle.ttl")
+    composer = Composer(kb)
+    trace = bidirectional_search(composer.graph(composer.task(EX + "Req").requirement))
+    assert EX + "S1" not in trace.levels and EX + "S2" not in trace.levels
