@@ -1,4 +1,82 @@
-"""The pybullet home and the simulation-backed components.
+"""The pybullet home of paper section 6.2 and what the robots can do in it.
 
-Empty until the execution work lands; see docs/architecture.md for where it fits.
+A library (no CLI, no knowledge base): ``HomeWorld`` builds the home; ``cameras`` render images;
+``perception`` localises the base, tracks the person and recognises objects from those images;
+``mapping`` and ``planning`` are the map server and the path planners; ``skills`` are the robots'
+actions, each returning an ``Outcome``; ``predicates`` check the knowledge base's statements against
+the simulated world; ``scenarios`` runs the paper's two scenarios with fixed skill sequences.
+See docs/simulation.md.
 """
+
+from __future__ import annotations
+
+from sim.arms import ArmSide
+from sim.errors import (
+    CameraUnavailableError,
+    MapError,
+    NoFreeCellError,
+    NoPathError,
+    NotVisibleError,
+    OutsideMapError,
+    PerceptionError,
+    SimulationError,
+    UnknownAlgorithmError,
+    UnknownColourError,
+    UnknownEntityError,
+    WorldClosedError,
+)
+from sim.geometry import Pose2D, Pose3D, Region
+from sim.grasping import CUP, PEN, GraspPose, ObjectModel, compute_grasp_pose
+from sim.mapping import OccupancyGrid, build_occupancy_grid
+from sim.perception import (
+    ObjectEstimate,
+    PersonEstimate,
+    RobotPoseEstimate,
+    locate_robot,
+    recognise_object,
+    track_person,
+)
+from sim.planning import PlannedPath, plan_path
+from sim.scenarios import ScenarioResult, fetch_pen, serve_cup
+from sim.skills import Outcome
+from sim.world import HomeWorld, open_world
+
+__all__ = [
+    "CUP",
+    "PEN",
+    "ArmSide",
+    "CameraUnavailableError",
+    "GraspPose",
+    "HomeWorld",
+    "MapError",
+    "NoFreeCellError",
+    "NoPathError",
+    "NotVisibleError",
+    "ObjectEstimate",
+    "ObjectModel",
+    "OccupancyGrid",
+    "Outcome",
+    "OutsideMapError",
+    "PerceptionError",
+    "PersonEstimate",
+    "PlannedPath",
+    "Pose2D",
+    "Pose3D",
+    "Region",
+    "RobotPoseEstimate",
+    "ScenarioResult",
+    "SimulationError",
+    "UnknownAlgorithmError",
+    "UnknownColourError",
+    "UnknownEntityError",
+    "WorldClosedError",
+    "build_occupancy_grid",
+    "compute_grasp_pose",
+    "fetch_pen",
+    "locate_robot",
+    "open_world",
+    "plan_path",
+    "recognise_object",
+    "serve_cup",
+    "track_person",
+]

@@ -1,0 +1,408 @@
+"""The dual-arm robot's arms: two Franka Panda arms (pybullet_data) on a fixed torso.
+
+Inverse kinematics runs on copies of the arms in a private pybullet client (``Kinematics``), so a
+solution can be seeded with any joint angles and checked by forward kinematics without touching the
+simulated arms. Cartesian motions are cut into 1 cm pieces and solved in a chain before the arm
+moves: if a piece has no solution the motion is refused and the arm stays where it is. The joint
+position controllers then track the chain while the world steps; every motion is bounded in
+simulated time and reports whether it reached its target.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from enum import StrEnum
+from importlib.resources import files
+
+import numpy as np
+import pybullet as p
+from numpy.typing import NDArray
+
+from sim.geometry import Pose3D, Quat, Vec3, quat_from_matrix, quat_to_matrix
+from sim.grasping import GraspPose
+
+__all__ = [
+    "ARM_JOINTS",
+    "EE_LINK",
+    "HOME_CONFIGURATIONS",
+    "REACH_TOLERANCE",
+    "Arm",
+    "ArmSide",
+    "Kinematics",
+    "MotionResult",
+]
+
+
+class ArmSide(StrEnum):
+    LEFT = "left"
+    RIGHT = "right"
+
+
+PYBULLET_DATA = str(files("pybullet_data"))
+"""Where pybullet_data's models are (the Panda arm)."""
+PANDA_URDF = "franka_panda/panda.urdf"
+ARM_JOINTS = (0, 1, 2, 3, 4, 5, 6)
+FINGER_JOINTS = (9, 10)
+EE_LINK = 11
+"""panda_grasptarget: the point between the fingertips."""
+_MAX_FORCES = (87.0, 87.0, 87.0, 87.0, 12.0, 12.0, 12.0)
+_LOWER = np.array([-2.9671, -1.8326, -2.9671, -3.1416, -2.9671, -0.0873, -2.9671])
+_UPPER = np.array([2.9671, 1.8326, 2.9671, 0.0, 2.9671, 3.8223, 2.9671])
+
+HOME_CONFIGURATIONS: dict[ArmSide, tuple[float, ...]] = {
+    # Folded, elbow up, turned outwards: clear of the table, of the Kinect's view and of the
+    # platform of a base parked at the hand-over pose.
+    ArmSide.LEFT: (0.9, -0.6, 0.0, -2.6, 0.0, 2.0, 0.785),
+    ArmSide.RIGHT: (-0.9, -0.6, 0.0, -2.6, 0.0, 2.0, 0.785),
+}
+_SEEDS: tuple[tuple[float, ...], ...] = (
+    # Postures to start the inverse kinematics from when the arm jumps to a new target: facing the
+    # table, turned either way, with the hand down, pitched or level.
+    (0.0, -0.3, 0.0, -2.2, 0.0, 2.0, 0.785),
+    (0.0, 0.1, 0.0, -2.0, 0.0, 0.6, 0.785),
+    (0.0, 0.1, 0.0, -2.0, 0.0, 0.6, -0.785),
+    (0.0, 0.1, 0.0, -2.0, 0.0, 0.6, 2.356),
+    (0.0, -0.5, 0.0, -2.5, 0.0, 2.0, -0.785),
+    (0.5, -0.5, 0.0, -2.5, 0.0, 2.0, 0.785),
+    (-0.5, -0.5, 0.0, -2.5, 0.0, 2.0, 0.785),
+    (0.0, 0.3, 0.0, -1.8, 0.0, 2.6, 0.785),
+)
+
+CARTESIAN_STEP = 0.01
+"""Length of each straight-line piece (m)."""
+ANGULAR_STEP = 0.05
+"""Largest hand rotation per piece (rad)."""
+ARM_SPEED = 0.30
+"""Hand speed along a straight line (m/s): slow enough for the position controllers to track."""
+ARM_TURN_SPEED = 1.0
+"""Hand rotation speed (rad/s)."""
+JOINT_SPEED = 1.5
+"""Fastest joint speed (rad/s) of joint-space moves."""
+IK_TOLERANCE = 0.002
+"""A piece whose inverse kinematics misses its point by more than 2 mm has no solution."""
+REACH_TOLERANCE = 0.01
+"""A motion has reached its target when the grasp point is within 1 cm of it."""
+SETTLE_LIMIT = 1.0
+"""At most this many simulated seconds of settling after the last piece."""
+GRIPPER_OPEN = 0.08
+
+
+@dataclass(frozen=True)
+class MotionResult:
+    reached: bool
+    error: float
+    """Distance between the grasp point and the target at the end (m); inf when refused."""
+    reason: str = ""
+
+
+@dataclass(frozen=True)
+class _Solution:
+    q: tuple[float, ...]
+    position_error: float
+    orientation_error: float
+
+
+def _slerp(a: Quat, b: Quat, t: float) -> Quat:
+    qa = np.asarray(a, dtype=np.float64)
+    qb = np.asarray(b, dtype=np.float64)
+    dot = float(np.dot(qa, qb))
+    if dot < 0.0:
+        qb, dot = -qb, -dot
+    if dot > 0.9995:
+        q = qa + t * (qb - qa)
+    else:
+        theta = math.acos(dot)
+        q = (math.sin((1 - t) * theta) * qa + math.sin(t * theta) * qb) / math.sin(theta)
+    q /= np.linalg.norm(q)
+    return (float(q[0]), float(q[1]), float(q[2]), float(q[3]))
+
+
+def quat_angle(a: Quat, b: Quat) -> float:
+    """Angle of the rotation between two orientations (rad)."""
+    dot = abs(float(np.dot(np.asarray(a), np.asarray(b))))
+    return 2.0 * math.acos(min(1.0, dot))
+
+
+def flipped(q: Quat) -> Quat:
+    """The same grasp with the hand turned half a turn about its approach axis (the jaws are symmetric)."""
+    m: NDArray[np.float64] = quat_to_matrix(q) @ np.diag([-1.0, -1.0, 1.0])
+    return quat_from_matrix(m)
+
+
+class Kinematics:
+    """Copies of both arms in a private DIRECT client, used only for inverse and forward kinematics."""
+
+    def __init__(self, mounts: dict[ArmSide, tuple[Vec3, Quat]]) -> None:
+        self.client = p.connect(p.DIRECT)
+        try:
+            p.setAdditionalSearchPath(PYBULLET_DATA, physicsClientId=self.client)
+            self._bodies = {
+                side: p.loadURDF(PANDA_URDF, pos, orn, useFixedBase=True, physicsClientId=self.client)
+                for side, (pos, orn) in mounts.items()
+            }
+        except BaseException:
+            p.disconnect(physicsClientId=self.client)
+            raise
+        self._closed = False
+
+    def close(self) -> None:
+        if not self._closed:
+            self._closed = True
+            p.disconnect(physicsClientId=self.client)
+
+    def _set(self, body: int, q: Sequence[float]) -> None:
+        for joint, value in zip(ARM_JOINTS, q, strict=True):
+            p.resetJointState(body, joint, value, physicsClientId=self.client)
+
+    def forward(self, side: ArmSide, q: Sequence[float]) -> Pose3D:
+        body = self._bodies[side]
+        self._set(body, q)
+        state = p.getLinkState(body, EE_LINK, computeForwardKinematics=True, physicsClientId=self.client)
+        pos, orn = state[4], state[5]
+        return Pose3D((pos[0], pos[1], pos[2]), (orn[0], orn[1], orn[2], orn[3]))
+
+    def _refine(self, side: ArmSide, position: Vec3, orientation: Quat, seed: Sequence[float]) -> _Solution:
+        body = self._bodies[side]
+        self._set(body, seed)
+        goal = np.asarray(position)
+        q: tuple[float, ...] = tuple(seed)
+        error, turn = math.inf, math.inf
+        for _ in range(10):
+            raw = p.calculateInverseKinematics(
+                body,
+                EE_LINK,
+                position,
+                orientation,
+                maxNumIterations=50,
+                residualThreshold=1e-6,
+                physicsClientId=self.client,
+            )
+            q = tuple(float(v) for v in np.clip(np.asarray(raw[:7]), _LOWER, _UPPER))
+            pose = self.forward(side, q)
+            error = float(np.linalg.norm(np.asarray(pose.position) - goal))
+            turn = quat_angle(pose.orientation, orientation)
+            if error < 1e-4 and turn < 1e-3:
+                break
+        return _Solution(q, error, turn)
+
+    def solve(self, side: ArmSide, position: Vec3, orientation: Quat, seeds: Sequence[Sequence[float]]) -> _Solution:
+        """The best solution over the seeds; the first seed wins when it is good (keeps motions smooth)."""
+        best: _Solution | None = None
+        for seed in seeds:
+            solution = self._refine(side, position, orientation, seed)
+            if solution.position_error < 1e-4 and solution.orientation_error < 1e-3:
+                return solution
+            score = solution.position_error + 0.1 * solution.orientation_error
+            if best is None or score < best.position_error + 0.1 * best.orientation_error:
+                best = solution
+        if best is None:
+            raise ValueError("no seeds")
+        return best
+
+
+class Arm:
+    """One Panda arm of the dual-arm robot, bound to its world's pybullet client."""
+
+    def __init__(
+        self, client: int, side: ArmSide, body: int, kinematics: Kinematics, step: Callable[[float], None]
+    ) -> None:
+        self.client = client
+        self.side = side
+        self.body = body
+        self._kinematics = kinematics
+        self._step = step
+        self._grasp_constraint: int | None = None
+        self.held: int | None = None
+        """Body id of the object the gripper holds, if any."""
+        self.held_grasp: GraspPose | None = None
+        """The grasp the held object was picked with (how far it hangs below the hand)."""
+        self._targets: tuple[float, ...] = HOME_CONFIGURATIONS[side]
+        self._gripper_width = GRIPPER_OPEN
+        for joint, q in zip(ARM_JOINTS, self._targets, strict=True):
+            p.resetJointState(body, joint, q, physicsClientId=client)
+        for joint in FINGER_JOINTS:
+            p.resetJointState(body, joint, GRIPPER_OPEN / 2.0, physicsClientId=client)
+        self._command()
+
+    # --- state --------------------------------------------------------------------------------
+
+    def joint_positions(self) -> tuple[float, ...]:
+        states = p.getJointStates(self.body, ARM_JOINTS, physicsClientId=self.client)
+        return tuple(float(s[0]) for s in states)
+
+    def ee_pose(self) -> Pose3D:
+        """Pose of the grasp point (between the fingertips)."""
+        state = p.getLinkState(self.body, EE_LINK, computeForwardKinematics=True, physicsClientId=self.client)
+        pos, orn = state[4], state[5]
+        return Pose3D((pos[0], pos[1], pos[2]), (orn[0], orn[1], orn[2], orn[3]))
+
+    def gripper_width(self) -> float:
+        states = p.getJointStates(self.body, FINGER_JOINTS, physicsClientId=self.client)
+        return float(states[0][0] + states[1][0])
+
+    # --- control ------------------------------------------------------------------------------
+
+    def _command(self) -> None:
+        p.setJointMotorControlArray(
+            self.body,
+            ARM_JOINTS,
+            p.POSITION_CONTROL,
+            targetPositions=self._targets,
+            forces=_MAX_FORCES,
+            physicsClientId=self.client,
+        )
+        half = self._gripper_width / 2.0
+        p.setJointMotorControlArray(
+            self.body,
+            FINGER_JOINTS,
+            p.POSITION_CONTROL,
+            targetPositions=(half, half),
+            forces=(40.0, 40.0),
+            physicsClientId=self.client,
+        )
+
+    def _nearer(self, orientation: Quat) -> Quat:
+        """Of a grasp orientation and its half-turn twin, the one nearer the hand's current orientation."""
+        current = self.ee_pose().orientation
+        twin = flipped(orientation)
+        return twin if quat_angle(current, twin) < quat_angle(current, orientation) else orientation
+
+    def move_to(
+        self,
+        position: Vec3,
+        orientation: Quat,
+        speed: float = ARM_SPEED,
+        tolerance: float = REACH_TOLERANCE,
+        symmetric: bool = True,
+    ) -> MotionResult:
+        """Move the grasp point along a straight line to ``position``, turning the hand to ``orientation``.
+
+        With ``symmetric`` the hand may end half a turn about its approach axis from ``orientation``
+        (a parallel gripper grasps the same either way), whichever is the smaller turn.
+        """
+        if symmetric:
+            orientation = self._nearer(orientation)
+        start = self.ee_pose()
+        start_pos = np.asarray(start.position)
+        goal = np.asarray(position, dtype=np.float64)
+        distance = float(np.linalg.norm(goal - start_pos))
+        angle = quat_angle(start.orientation, orientation)
+        pieces = max(1, math.ceil(max(distance / CARTESIAN_STEP, angle / ANGULAR_STEP)))
+        piece_time = max(distance / speed, angle / ARM_TURN_SPEED, 1e-3) / pieces
+        chain: list[tuple[float, ...]] = []
+        seed = self.joint_positions()
+        for i in range(1, pieces + 1):
+            t = i / pieces
+            point = start_pos + (goal - start_pos) * t
+            target = (float(point[0]), float(point[1]), float(point[2]))
+            solution = self._kinematics.solve(self.side, target, _slerp(start.orientation, orientation, t), [seed])
+            if solution.position_error > IK_TOLERANCE or solution.orientation_error > 0.02:
+                return MotionResult(
+                    False, math.inf, f"no inverse kinematics at {i}/{pieces} of the line to {_fmt(position)}"
+                )
+            chain.append(solution.q)
+            seed = solution.q
+        for q in chain:
+            self._targets = q
+            self._command()
+            self._step(piece_time)
+        error = self._settle(goal)
+        return MotionResult(error <= tolerance, error, "" if error <= tolerance else f"stopped {error:.3f} m short")
+
+    def reach(self, position: Vec3, orientation: Quat, symmetric: bool = True) -> MotionResult:
+        """Go to a pose through joint space (from the folded home posture to a pre-grasp pose)."""
+        candidates = [orientation, flipped(orientation)] if symmetric else [orientation]
+        best: _Solution | None = None
+        for candidate in candidates:
+            solution = self._kinematics.solve(self.side, position, candidate, [self.joint_positions(), *_SEEDS])
+            if best is None or solution.position_error + 0.1 * solution.orientation_error < (
+                best.position_error + 0.1 * best.orientation_error
+            ):
+                best = solution
+        if best is None or best.position_error > IK_TOLERANCE or best.orientation_error > 0.02:
+            return MotionResult(False, math.inf, f"no inverse kinematics for {_fmt(position)}")
+        motion = self.move_joints(best.q)
+        error = float(np.linalg.norm(np.asarray(self.ee_pose().position) - np.asarray(position)))
+        ok = motion.reached and error <= REACH_TOLERANCE
+        return MotionResult(ok, error, "" if ok else f"stopped {error:.3f} m short")
+
+    def _settle(self, goal: NDArray[np.float64]) -> float:
+        waited = 0.0
+        error = float(np.linalg.norm(np.asarray(self.ee_pose().position) - goal))
+        while error > REACH_TOLERANCE / 4.0 and waited < SETTLE_LIMIT:
+            self._step(0.05)
+            waited += 0.05
+            error = float(np.linalg.norm(np.asarray(self.ee_pose().position) - goal))
+        return error
+
+    def move_joints(self, configuration: Sequence[float]) -> MotionResult:
+        """Interpolate in joint space to ``configuration`` at up to ``JOINT_SPEED``."""
+        start = np.asarray(self.joint_positions())
+        goal = np.asarray(configuration, dtype=np.float64)
+        seconds = max(0.2, float(np.max(np.abs(goal - start))) / JOINT_SPEED)
+        pieces = max(1, math.ceil(seconds / 0.05))
+        for i in range(1, pieces + 1):
+            q = start + (goal - start) * (i / pieces)
+            self._targets = tuple(float(v) for v in q)
+            self._command()
+            self._step(seconds / pieces)
+        waited = 0.0
+        error = float(np.max(np.abs(np.asarray(self.joint_positions()) - goal)))
+        while error > 0.01 and waited < SETTLE_LIMIT:
+            self._step(0.05)
+            waited += 0.05
+            error = float(np.max(np.abs(np.asarray(self.joint_positions()) - goal)))
+        return MotionResult(error <= 0.02, error, "" if error <= 0.02 else f"joints {error:.3f} rad off")
+
+    def home(self) -> MotionResult:
+        """Fold the arm back to its home posture."""
+        return self.move_joints(HOME_CONFIGURATIONS[self.side])
+
+    def set_gripper(self, width: float, seconds: float = 0.3) -> None:
+        """Open the fingers to ``width`` (m, 0 to 0.08) and give them time to move."""
+        self._gripper_width = min(max(width, 0.0), GRIPPER_OPEN)
+        self._command()
+        self._step(seconds)
+
+    # --- grasping -----------------------------------------------------------------------------
+
+    def attach(self, body: int, grasp: GraspPose | None = None) -> None:
+        """Hold ``body`` rigidly where it is relative to the grasp point (the closed fingers' grip)."""
+        if self.held is not None:
+            self.detach()
+        ee = self.ee_pose()
+        obj_pos, obj_orn = p.getBasePositionAndOrientation(body, physicsClientId=self.client)
+        inv_pos, inv_orn = p.invertTransform(ee.position, ee.orientation)
+        rel_pos, rel_orn = p.multiplyTransforms(inv_pos, inv_orn, obj_pos, obj_orn)
+        self._grasp_constraint = p.createConstraint(
+            self.body,
+            EE_LINK,
+            body,
+            -1,
+            p.JOINT_FIXED,
+            (0.0, 0.0, 0.0),
+            rel_pos,
+            (0.0, 0.0, 0.0),
+            parentFrameOrientation=rel_orn,
+            childFrameOrientation=(0.0, 0.0, 0.0, 1.0),
+            physicsClientId=self.client,
+        )
+        p.changeConstraint(self._grasp_constraint, maxForce=200.0, physicsClientId=self.client)
+        self.held = body
+        self.held_grasp = grasp
+
+    def detach(self) -> int | None:
+        """Let go of the held object; returns its body id."""
+        held = self.held
+        if self._grasp_constraint is not None:
+            p.removeConstraint(self._grasp_constraint, physicsClientId=self.client)
+        self._grasp_constraint = None
+        self.held = None
+        self.held_grasp = None
+        return held
+
+
+def _fmt(point: Vec3) -> str:
+    return f"({point[0]:.3f}, {point[1]:.3f}, {point[2]:.3f})"

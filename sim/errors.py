@@ -1,0 +1,107 @@
+"""Typed errors of the simulation. Each keeps the offending input so a caller can react to it.
+
+``sim`` does not import the knowledge base, so these derive from ``Exception``; the executor that
+wraps the simulation as components maps them onto its own error types.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+
+class SimulationError(Exception):
+    """Base of every error the simulation raises on purpose; ``str(error)`` is one line fit for a person."""
+
+
+class WorldClosedError(SimulationError):
+    """The world was used after ``close()``: its pybullet client no longer exists."""
+
+    def __init__(self, client: int) -> None:
+        self.client = client
+        super().__init__(f"the world on pybullet client {client} is closed")
+
+
+class UnknownEntityError(SimulationError):
+    """A name that is not an entity (body, camera or region) of the home."""
+
+    def __init__(self, name: str, known: Sequence[str]) -> None:
+        self.name = name
+        self.known = tuple(known)
+        super().__init__(f"no entity named {name!r}; known: {', '.join(self.known)}")
+
+
+class CameraUnavailableError(SimulationError):
+    """The camera is switched off (failed); a component should fall back to another camera."""
+
+    def __init__(self, camera: str) -> None:
+        self.camera = camera
+        super().__init__(f"camera {camera} is not available (failed)")
+
+
+class PerceptionError(SimulationError):
+    """Base of the perception failures."""
+
+
+class NotVisibleError(PerceptionError):
+    """What was looked for is not in the image (out of view, occluded, or too few pixels of its colour)."""
+
+    def __init__(self, camera: str, target: str, pixels: int, needed: int) -> None:
+        self.camera = camera
+        self.target = target
+        self.pixels = pixels
+        self.needed = needed
+        super().__init__(f"{target} not visible in {camera}: {pixels} matching pixels, at least {needed} needed")
+
+
+class UnknownColourError(PerceptionError):
+    """A colour name the segmenter has no range for."""
+
+    def __init__(self, colour: str, known: Sequence[str]) -> None:
+        self.colour = colour
+        self.known = tuple(known)
+        super().__init__(f"unknown colour {colour!r}; known: {', '.join(self.known)}")
+
+
+class MapError(SimulationError):
+    """Base of the map and planning failures."""
+
+
+class OutsideMapError(MapError):
+    """A world point that is not on the grid map."""
+
+    def __init__(self, x: float, y: float) -> None:
+        self.x = x
+        self.y = y
+        super().__init__(f"point ({x:.3f}, {y:.3f}) is outside the map")
+
+
+class NoFreeCellError(MapError):
+    """A start or goal lies in an obstacle and no free cell is near enough to snap it to."""
+
+    def __init__(self, x: float, y: float, radius: float) -> None:
+        self.x = x
+        self.y = y
+        self.radius = radius
+        super().__init__(f"no free cell within {radius:.2f} m of ({x:.3f}, {y:.3f})")
+
+
+class NoPathError(MapError):
+    """Start and goal are both free but not connected on the inflated grid."""
+
+    def __init__(self, start: tuple[float, float], goal: tuple[float, float], algorithm: str) -> None:
+        self.start = start
+        self.goal = goal
+        self.algorithm = algorithm
+        super().__init__(
+            f"{algorithm}: no path from ({start[0]:.2f}, {start[1]:.2f}) to ({goal[0]:.2f}, {goal[1]:.2f}) "
+            "on the inflated grid"
+        )
+
+
+class UnknownAlgorithmError(MapError):
+    """A planner name other than the supported ones."""
+
+    def __init__(self, algorithm: str, known: Sequence[str]) -> None:
+        self.algorithm = algorithm
+        self.known = tuple(known)
+        super().__init__(f"unknown planner {algorithm!r}; use one of {', '.join(self.known)}")

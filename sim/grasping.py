@@ -1,0 +1,119 @@
+"""Object models (the manipulation properties the knowledge base holds) and grasp poses computed from them.
+
+A grasp pose is where the gripper's grasp point (between the fingertips) goes, how the hand is turned,
+and from which direction it comes in. Only what perception estimated and the object's model are
+used: never the simulator's ground truth.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from enum import StrEnum
+
+import numpy as np
+
+from sim.geometry import Quat, Vec3, quat_from_matrix
+from sim.layout import ARM_MOUNT_YAW, CUP_HEIGHT, CUP_RADIUS, PEN_WIDTH
+
+__all__ = ["CUP", "OBJECT_MODELS", "PEN", "GraspKind", "GraspPose", "ObjectModel", "compute_grasp_pose"]
+
+
+class GraspKind(StrEnum):
+    """TOP: the hand comes down vertically (flat things). SIDE: it comes in horizontally (upright cups)."""
+
+    TOP = "top"
+    SIDE = "side"
+
+
+@dataclass(frozen=True)
+class ObjectModel:
+    """What the robot knows of an object kind: its colour feature, size and how to grasp it."""
+
+    name: str
+    colour: str
+    height: float
+    width: float
+    """Size across the fingers when grasped (diameter of a cup, thickness of a pen)."""
+    grasp: GraspKind
+    grasp_height: float
+    """Height of the grasp point above the object's bottom."""
+
+
+CUP = ObjectModel("Cup", "red", CUP_HEIGHT, 2 * CUP_RADIUS, GraspKind.SIDE, 0.07)
+PEN = ObjectModel("Pen", "blue", PEN_WIDTH, PEN_WIDTH, GraspKind.TOP, 0.012)
+OBJECT_MODELS: dict[str, ObjectModel] = {CUP.name: CUP, PEN.name: PEN}
+
+SIDE_PITCH = math.radians(35.0)
+"""A side grasp comes in tilted down by 35 degrees: with the arms mounted below the grasp height, a
+level hand would need the wrist at its joint limit, while a tilted one keeps it mid-range."""
+PREGRASP_DISTANCE = 0.10
+"""The pre-grasp pose is this far back along the approach direction: far enough that opening the
+fingers there touches nothing, near enough that the final approach is a short straight move."""
+
+
+@dataclass(frozen=True)
+class GraspPose:
+    """Where to grasp, with which hand orientation, coming from which direction."""
+
+    model: ObjectModel
+    position: Vec3
+    """The grasp point (between the fingertips) in the world frame."""
+    orientation: Quat
+    """Orientation of the gripper's grasp frame (z: approach direction, y: finger opening axis)."""
+    approach: Vec3
+    """Unit vector the gripper moves along to reach the grasp point."""
+    bottom_offset: float
+    """Grasp point height above the object's bottom: how far the object hangs below the hand."""
+
+    @property
+    def pregrasp(self) -> Vec3:
+        x, y, z = self.position
+        ax, ay, az = self.approach
+        return (x - ax * PREGRASP_DISTANCE, y - ay * PREGRASP_DISTANCE, z - az * PREGRASP_DISTANCE)
+
+
+def top_orientation(finger_axis_yaw: float) -> Quat:
+    """Hand pointing down with the fingers closing along the horizontal direction ``finger_axis_yaw``."""
+    z = np.array([0.0, 0.0, -1.0])
+    y = np.array([math.cos(finger_axis_yaw), math.sin(finger_axis_yaw), 0.0])
+    x = np.cross(y, z)
+    return quat_from_matrix(np.column_stack([x, y, z]))
+
+
+def side_orientation(approach_yaw: float, pitch: float = SIDE_PITCH) -> Quat:
+    """Hand coming in along ``approach_yaw``, tilted down by ``pitch``, fingers closing horizontally."""
+    z = np.array([math.cos(approach_yaw) * math.cos(pitch), math.sin(approach_yaw) * math.cos(pitch), -math.sin(pitch)])
+    y = np.array([math.sin(approach_yaw), -math.cos(approach_yaw), 0.0])
+    x = np.cross(y, z)
+    return quat_from_matrix(np.column_stack([x, y, z]))
+
+
+def compute_grasp_pose(model: ObjectModel, centre: Vec3, yaw: float | None, arm_mount: Vec3) -> GraspPose:
+    """The grasp for an object whose centre (and, for long objects, axis yaw) perception estimated.
+
+    A side grasp comes in from the robot's side of the table; a top grasp closes the fingers across
+    the object's long axis.
+    """
+    cx, cy, cz = centre
+    bottom = cz - model.height / 2.0
+    grasp_z = bottom + model.grasp_height
+    if model.grasp is GraspKind.SIDE:
+        # Straight in from the robot's side of the table, whatever the object's position.
+        orientation = side_orientation(ARM_MOUNT_YAW)
+        approach: Vec3 = (
+            math.cos(ARM_MOUNT_YAW) * math.cos(SIDE_PITCH),
+            math.sin(ARM_MOUNT_YAW) * math.cos(SIDE_PITCH),
+            -math.sin(SIDE_PITCH),
+        )
+    else:
+        axis = 0.0 if yaw is None else yaw
+        # Of the two finger directions across the axis, pick the one nearer the arm's natural wrist
+        # yaw (fingers across the arm's reach), so the wrist does not run into its joint limit.
+        reach_yaw = math.atan2(cy - arm_mount[1], cx - arm_mount[0])
+        finger = axis + math.pi / 2.0
+        if math.cos(finger - (reach_yaw + math.pi / 2.0)) < 0.0:
+            finger += math.pi
+        orientation = top_orientation(finger)
+        approach = (0.0, 0.0, -1.0)
+    return GraspPose(model, (cx, cy, grasp_z), orientation, approach, model.grasp_height)

@@ -1,0 +1,131 @@
+"""The map server: a 2D occupancy grid of the home, measured by casting rays down at every cell.
+
+A cell is occupied when the first thing its vertical ray hits (other than the mobile base itself)
+stands higher than ``OBSTACLE_HEIGHT``: walls, furniture, the dual-arm robot and the person. The
+table top counts although the base could drive under part of it, like the conservative maps made
+from a ceiling view. The inflated grid grows every obstacle by the base's radius, so a planner can
+treat the base as a point.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import pybullet as p
+from numpy.typing import NDArray
+
+from sim.errors import OutsideMapError
+from sim.layout import BASE_RADIUS, HOME, MAP_RESOLUTION
+from sim.world import HomeWorld
+
+__all__ = ["OBSTACLE_HEIGHT", "OccupancyGrid", "build_occupancy_grid", "inflate"]
+
+OBSTACLE_HEIGHT = 0.03
+"""Anything taller than 3 cm blocks the base (the floor is at 0)."""
+RAY_TOP = 3.0
+"""Rays start above everything in the home (walls 1 m, the person 1.66 m) and end below the floor."""
+RAY_BATCH = 8192
+"""pybullet caps one rayTestBatch call; stay well below the cap."""
+
+
+@dataclass(frozen=True, eq=False)
+class OccupancyGrid:
+    """Cells of ``resolution`` metres; row i is y, column j is x; cell (0, 0) starts at ``origin``."""
+
+    resolution: float
+    origin: tuple[float, float]
+    occupied: NDArray[np.bool_] = field(repr=False)
+    """Cells with an obstacle, as measured."""
+    inflated: NDArray[np.bool_] = field(repr=False)
+    """Cells the base's centre must avoid (obstacles grown by ``inflation_radius``)."""
+    inflation_radius: float
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        rows, cols = self.occupied.shape
+        return (int(rows), int(cols))
+
+    @property
+    def free(self) -> NDArray[np.bool_]:
+        """Cells where the base's centre may be."""
+        free: NDArray[np.bool_] = ~self.inflated
+        return free
+
+    def world_to_cell(self, x: float, y: float) -> tuple[int, int]:
+        """(row, column) of the cell containing a world point; ``OutsideMapError`` off the map."""
+        col = math.floor((x - self.origin[0]) / self.resolution)
+        row = math.floor((y - self.origin[1]) / self.resolution)
+        rows, cols = self.shape
+        if not (0 <= row < rows and 0 <= col < cols):
+            raise OutsideMapError(x, y)
+        return (row, col)
+
+    def cell_to_world(self, row: int, col: int) -> tuple[float, float]:
+        """World (x, y) of a cell's centre."""
+        return (self.origin[0] + (col + 0.5) * self.resolution, self.origin[1] + (row + 0.5) * self.resolution)
+
+    def is_free(self, x: float, y: float) -> bool:
+        row, col = self.world_to_cell(x, y)
+        return not bool(self.inflated[row, col])
+
+    def is_occupied(self, x: float, y: float) -> bool:
+        """Whether the measured (not inflated) grid has an obstacle at a world point."""
+        row, col = self.world_to_cell(x, y)
+        return bool(self.occupied[row, col])
+
+
+def inflate(occupied: NDArray[np.bool_], radius_cells: float) -> NDArray[np.bool_]:
+    """Grow obstacles by a disc of ``radius_cells`` (a morphological dilation with shifted copies)."""
+    rows, cols = occupied.shape
+    out = occupied.copy()
+    reach = math.ceil(radius_cells)
+    for di in range(-reach, reach + 1):
+        for dj in range(-reach, reach + 1):
+            if (di == 0 and dj == 0) or di * di + dj * dj > radius_cells * radius_cells:
+                continue
+            src = occupied[max(0, -di) : rows - max(0, di), max(0, -dj) : cols - max(0, dj)]
+            out[max(0, di) : rows - max(0, -di), max(0, dj) : cols - max(0, -dj)] |= src
+    return out
+
+
+def build_occupancy_grid(
+    world: HomeWorld,
+    resolution: float = MAP_RESOLUTION,
+    inflation_radius: float = BASE_RADIUS,
+    ignore: Sequence[str] = ("P3DX01",),
+) -> OccupancyGrid:
+    """Measure the home's occupancy grid now; the bodies in ``ignore`` (the base) are seen through."""
+    cols = round((HOME.xmax - HOME.xmin) / resolution)
+    rows = round((HOME.ymax - HOME.ymin) / resolution)
+    origin = (HOME.xmin, HOME.ymin)
+    jj, ii = np.meshgrid(np.arange(cols), np.arange(rows))
+    xs = origin[0] + (jj.ravel() + 0.5) * resolution
+    ys = origin[1] + (ii.ravel() + 0.5) * resolution
+    tops = np.full(xs.shape, RAY_TOP)
+    heights = np.full(xs.shape, -1.0)
+    ignored = {world.body(name) for name in ignore}
+    pending = np.arange(xs.size)
+    for _ in range(4):  # a ray is recast below each ignored body it hits; a few rounds are plenty
+        if pending.size == 0:
+            break
+        again = []
+        for start in range(0, pending.size, RAY_BATCH):
+            chunk = pending[start : start + RAY_BATCH]
+            froms = np.column_stack([xs[chunk], ys[chunk], tops[chunk]])
+            tos = np.column_stack([xs[chunk], ys[chunk], np.full(chunk.size, -0.5)])
+            hits = p.rayTestBatch(froms.tolist(), tos.tolist(), physicsClientId=world.client)
+            for index, hit in zip(chunk, hits, strict=True):
+                body, z = hit[0], hit[3][2]
+                if body in ignored:
+                    tops[index] = z - 1e-3
+                    again.append(index)
+                elif body >= 0:
+                    heights[index] = z
+        pending = np.asarray(again, dtype=np.intp)
+    occupied = (heights > OBSTACLE_HEIGHT).reshape(rows, cols)
+    return OccupancyGrid(
+        resolution, origin, occupied, inflate(occupied, inflation_radius / resolution), inflation_radius
+    )

@@ -1,0 +1,248 @@
+"""Perception from rendered images only: colour segmentation in HSV, then geometry with the calibration.
+
+* ``locate_robot``: the base's colour marker (green front, magenta rear) seen by a ceiling camera;
+  the pixels are intersected with the marker's known plane, the heading is the rear-to-front vector.
+* ``track_person``: the person's yellow shirt seen by a ceiling camera (see ``track_person``).
+* ``recognise_object``: an object of a given colour in the Kinect's RGB-D frame; its 3D points come
+  from the depth image.
+
+None of these read the simulator's state: only ``Frame`` (pixels, depth, calibration) and the known
+heights of the marker and the shirt (calibration knowledge a real system would have too).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from sim.cameras import Frame
+from sim.errors import NotVisibleError, UnknownColourError
+from sim.layout import MARKER_HEIGHT, MARKER_OFFSET, SHIRT_RADIUS, SHIRT_TOP
+
+__all__ = [
+    "COLOURS",
+    "ColourRange",
+    "ObjectEstimate",
+    "PersonEstimate",
+    "RobotPoseEstimate",
+    "locate_robot",
+    "recognise_object",
+    "segment",
+    "track_person",
+]
+
+
+@dataclass(frozen=True)
+class ColourRange:
+    """A colour feature as a hue window (degrees) with minimum saturation and brightness.
+
+    Hue survives the renderer's shading (which scales brightness); the saturation floor keeps out the
+    greys, whites and the wooden table.
+    """
+
+    hue: float
+    hue_tolerance: float
+    min_saturation: float = 0.55
+    min_value: float = 0.20
+
+
+COLOURS: dict[str, ColourRange] = {
+    "red": ColourRange(0.0, 15.0),
+    "yellow": ColourRange(54.0, 12.0),
+    "green": ColourRange(125.0, 25.0),
+    "cyan": ColourRange(180.0, 15.0),
+    "blue": ColourRange(230.0, 20.0),
+    "magenta": ColourRange(300.0, 20.0),
+}
+
+MIN_MARKER_PIXELS = 6
+"""Fewest pixels per marker patch (each patch covers ~25 pixels at the start pose)."""
+MIN_PERSON_PIXELS = 20
+MIN_OBJECT_PIXELS = 15
+MARKER_SPACING_TOLERANCE = 0.08
+"""The two patch centres must be 2 x MARKER_OFFSET apart within 8 cm, else the marker is half hidden."""
+
+
+def _colour(colour: str | ColourRange) -> ColourRange:
+    if isinstance(colour, ColourRange):
+        return colour
+    try:
+        return COLOURS[colour]
+    except KeyError:
+        raise UnknownColourError(colour, sorted(COLOURS)) from None
+
+
+def segment(rgb: NDArray[np.uint8], colour: str | ColourRange) -> NDArray[np.bool_]:
+    """Boolean mask (H x W) of the pixels of a colour."""
+    spec = _colour(colour)
+    img = rgb.astype(np.float32) / 255.0
+    r, g, b = img[..., 0], img[..., 1], img[..., 2]
+    value = img.max(axis=-1)
+    chroma = value - img.min(axis=-1)
+    saturation = np.where(value > 0, chroma / np.maximum(value, 1e-6), 0.0)
+    safe = np.maximum(chroma, 1e-6)
+    hue = (
+        np.where(
+            value == r,
+            ((g - b) / safe) % 6.0,
+            np.where(value == g, (b - r) / safe + 2.0, (r - g) / safe + 4.0),
+        )
+        * 60.0
+    )
+    distance = np.abs((hue - spec.hue + 180.0) % 360.0 - 180.0)
+    mask: NDArray[np.bool_] = (
+        (chroma > 1e-6)
+        & (distance <= spec.hue_tolerance)
+        & (saturation >= spec.min_saturation)
+        & (value >= spec.min_value)
+    )
+    return mask
+
+
+def _pixels(mask: NDArray[np.bool_]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    vs, us = np.nonzero(mask)
+    return us.astype(np.float64), vs.astype(np.float64)
+
+
+@dataclass(frozen=True)
+class RobotPoseEstimate:
+    """The base's pose (x, y, theta: the ontology's RobotLocation) as one camera saw it."""
+
+    x: float
+    y: float
+    theta: float
+    camera: str
+    time: float
+    pixels: int
+
+
+def locate_robot(frame: Frame, front: str = "green", rear: str = "magenta") -> RobotPoseEstimate:
+    """The base's pose from its two-colour marker; ``NotVisibleError`` if either patch is missing."""
+    points = []
+    count = 0
+    for colour, target in ((front, "marker front"), (rear, "marker rear")):
+        us, vs = _pixels(segment(frame.rgb, colour))
+        if us.size < MIN_MARKER_PIXELS:
+            raise NotVisibleError(frame.camera, f"robot {target} ({colour})", int(us.size), MIN_MARKER_PIXELS)
+        count += int(us.size)
+        points.append(frame.intersect_plane(us, vs, MARKER_HEIGHT)[:, :2].mean(axis=0))
+    head, tail = points
+    spacing = float(np.linalg.norm(head - tail))
+    if abs(spacing - 2 * MARKER_OFFSET) > MARKER_SPACING_TOLERANCE:
+        raise NotVisibleError(frame.camera, f"whole robot marker (patches {spacing:.2f} m apart)", count, count + 1)
+    centre = (head + tail) / 2.0
+    theta = math.atan2(float(head[1] - tail[1]), float(head[0] - tail[0]))
+    return RobotPoseEstimate(float(centre[0]), float(centre[1]), theta, frame.camera, frame.time, count)
+
+
+@dataclass(frozen=True)
+class PersonEstimate:
+    """Where the person stands on the floor (x, y: the ontology's PersonPosition)."""
+
+    x: float
+    y: float
+    camera: str
+    time: float
+    pixels: int
+
+
+def track_person(frame: Frame, shirt: str = "yellow") -> PersonEstimate:
+    """The person's floor position from their shirt, seen from above.
+
+    The shirt is an upright cylinder. Seen obliquely, most of its pixels are on the side facing the
+    camera, so a plain centroid is pulled towards the camera. Intersected with the plane of the
+    shoulders, though, the side's pixels land nearer the camera than the cylinder and the shoulders'
+    pixels land where they are: the far edge of the projected blob is the far edge of the shoulders.
+    Across the viewing direction the blob is symmetric. So: centre = far edge minus the shirt's
+    radius along the viewing direction, and the middle of the blob across it.
+    """
+    us, vs = _pixels(segment(frame.rgb, shirt))
+    if us.size < MIN_PERSON_PIXELS:
+        raise NotVisibleError(frame.camera, f"person ({shirt} shirt)", int(us.size), MIN_PERSON_PIXELS)
+    points = frame.intersect_plane(us, vs, SHIRT_TOP)[:, :2]
+    eye = frame.eye[:2]
+    rough = points.mean(axis=0)
+    along = rough - eye
+    norm = float(np.linalg.norm(along))
+    if norm < 0.3:
+        # Right below the camera the blob is the shoulders themselves.
+        centre = rough
+    else:
+        along /= norm
+        across = np.array([-along[1], along[0]])
+        a = (points - eye) @ along
+        c = (points - eye) @ across
+        index = int(np.argmax(a))
+        # The farthest pixel's sample point lies on average half a pixel inside the true edge.
+        u, v = us[index], vs[index]
+        corners = frame.intersect_plane(np.array([u, u + 1.0, u]), np.array([v, v, v + 1.0]), SHIRT_TOP)[:, :2]
+        pixel = abs(float((corners[1] - corners[0]) @ along)) + abs(float((corners[2] - corners[0]) @ along))
+        far = float(a[index]) + pixel / 2.0
+        mid_across = (float(c.min()) + float(c.max())) / 2.0
+        centre = eye + along * (far - SHIRT_RADIUS) + across * mid_across
+    return PersonEstimate(float(centre[0]), float(centre[1]), frame.camera, frame.time, int(us.size))
+
+
+@dataclass(frozen=True)
+class ObjectEstimate:
+    """An object found by colour: the centre of its 3D extent (the ontology's ObjectPosition3D)."""
+
+    x: float
+    y: float
+    z: float
+    yaw: float | None
+    """Direction of the long axis for elongated objects (radians, modulo pi), else None."""
+    size: tuple[float, float, float]
+    """Extent of the seen points along x, y, z (m)."""
+    colour: str
+    camera: str
+    time: float
+    pixels: int
+
+    @property
+    def position(self) -> tuple[float, float, float]:
+        return (self.x, self.y, self.z)
+
+
+def recognise_object(frame: Frame, colour: str) -> ObjectEstimate:
+    """The object of a colour in an RGB-D frame, located from the depth image.
+
+    The seen points cover the top and the camera-facing side. For the upright and lying shapes on
+    the table that is enough: the middle of the points' bounding box (taken along the object's own
+    axis) is the object's centre, within the pixel size. The yaw comes from the points' principal axis.
+    """
+    mask = segment(frame.rgb, colour)
+    us, vs = _pixels(mask)
+    if us.size < MIN_OBJECT_PIXELS:
+        raise NotVisibleError(frame.camera, f"{colour} object", int(us.size), MIN_OBJECT_PIXELS)
+    points = frame.deproject(us, vs)
+    xy = points[:, :2]
+    mean = xy.mean(axis=0)
+    cov = np.cov((xy - mean).T)
+    eigenvalues, eigenvectors = np.linalg.eigh(cov)
+    major = eigenvectors[:, 1]
+    elongated = eigenvalues[1] > 9.0 * max(eigenvalues[0], 1e-12)
+    axes = np.column_stack([major, [-major[1], major[0]]]) if elongated else np.eye(2)
+    local = (xy - mean) @ axes
+    low = local.min(axis=0)
+    high = local.max(axis=0)
+    centre_xy = mean + axes @ ((low + high) / 2.0)
+    z_low, z_high = float(points[:, 2].min()), float(points[:, 2].max())
+    yaw = math.atan2(float(major[1]), float(major[0])) if elongated else None
+    if yaw is not None:
+        yaw = (yaw + math.pi / 2.0) % math.pi - math.pi / 2.0
+    extent = points.max(axis=0) - points.min(axis=0)
+    return ObjectEstimate(
+        float(centre_xy[0]),
+        float(centre_xy[1]),
+        (z_low + z_high) / 2.0,
+        yaw,
+        (float(extent[0]), float(extent[1]), float(extent[2])),
+        colour,
+        frame.camera,
+        frame.time,
+        int(us.size),
+    )

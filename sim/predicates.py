@@ -1,0 +1,216 @@
+"""Belief checks against the simulated world: is a statement of the knowledge base true right now?
+
+These read the simulator's ground truth on purpose: they are the referee that tells whether a
+skill's effect (for instance ``(Cup, isLocated, BelowOfTap)``) really holds, independent of the
+perception the robots used. Each tolerance is a named constant with the reason for its value.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pybullet as p
+
+from sim.arms import ArmSide
+from sim.geometry import Pose2D, Region, quat_to_matrix
+from sim.layout import (
+    BASE_HALF_LENGTH,
+    BASE_HALF_WIDTH,
+    BELOW_OF_TAP,
+    MARKER_HEIGHT,
+    MARKER_OFFSET,
+    PERSON_HAND_HEIGHT,
+    PLATFORM_HEIGHT,
+)
+from sim.world import HomeWorld
+
+__all__ = [
+    "ABOVE_MAX",
+    "ABOVE_MIN",
+    "BASE_NEAR_DISTANCE",
+    "BASE_NEAR_HEADING",
+    "CUP_WATER_MIN",
+    "GRASP_DISTANCE",
+    "GRIPPER_NEAR_DISTANCE",
+    "HAND_HEIGHT_TOLERANCE",
+    "NEAR_PERSON_DISTANCE",
+    "PERSON_REACH",
+    "PLATFORM_MARGIN",
+    "RESTING_SPEED",
+    "RESTING_TOLERANCE",
+    "base_near",
+    "base_near_person",
+    "cup_below_tap",
+    "cup_contains_water",
+    "gripper_near",
+    "is_grasped",
+    "object_above_region",
+    "object_bottom",
+    "object_located_in",
+    "pen_on_platform",
+    "pen_with_person",
+    "robot_visible",
+]
+
+RESTING_TOLERANCE = 0.01
+"""An object rests on a surface when its bottom is within 1 cm of it: contact jitter and the
+settling of a dropped object stay well below that, while a held object is lifted by 3 cm or more."""
+RESTING_SPEED = 0.05
+"""...and it moves slower than 5 cm/s (it is not falling or sliding)."""
+ABOVE_MIN = 0.005
+ABOVE_MAX = 0.30
+"""An object is above a region when its centre is over the region and its bottom is 0.5 cm to
+30 cm over the surface: free of it, yet close enough that putting it down is a short straight move."""
+GRASP_DISTANCE = 0.03
+"""A grasped object's centre is within 3 cm of the grasp point (the grasp is at most 2 cm off the
+centre of the objects here); more means the object slipped."""
+GRIPPER_NEAR_DISTANCE = 0.15
+"""The gripper is near an object when its grasp point is within 15 cm of the object's centre: the
+pre-grasp pose is 10 cm back, so an approach made within 5 cm of the plan counts."""
+BASE_NEAR_DISTANCE = 0.10
+"""The base is near a place (for a hand-over) within 10 cm: the arm plans its put-down on the
+localised platform, and 10 cm keeps the pen well inside the platform's 20 cm middle strip."""
+BASE_NEAR_HEADING = 0.20
+"""...and, when a heading is asked for, within 0.2 rad (11 degrees) of it."""
+NEAR_PERSON_DISTANCE = 1.0
+"""The base is near a person when its centre is within 1 m of theirs: a standing adult reaches a
+platform 0.8 m from their body (person radius 0.18 + arm) and the base's half-length adds 0.2 m."""
+PERSON_REACH = 0.50
+"""The pen is with the person when they hold it: within 50 cm of their body's axis (an arm's
+length) and within ``HAND_HEIGHT_TOLERANCE`` of hand height."""
+HAND_HEIGHT_TOLERANCE = 0.10
+PLATFORM_MARGIN = 0.01
+"""The pen's centre must be 1 cm inside the platform's edge to be on it."""
+CUP_WATER_MIN = 0.5
+"""The cup contains water once at least half full (a full cup takes 4 s of open tap)."""
+
+
+def _position(world: HomeWorld, name: str) -> np.ndarray:
+    pos, _ = p.getBasePositionAndOrientation(world.body(name), physicsClientId=world.client)
+    return np.asarray(pos, dtype=np.float64)
+
+
+def object_bottom(world: HomeWorld, name: str) -> float:
+    """Height of the lowest point of an entity (from its bounding box)."""
+    low, _ = p.getAABB(world.body(name), -1, physicsClientId=world.client)
+    return float(low[2])
+
+
+def _speed(world: HomeWorld, name: str) -> float:
+    linear, _ = p.getBaseVelocity(world.body(name), physicsClientId=world.client)
+    return float(np.linalg.norm(linear))
+
+
+def is_grasped(world: HomeWorld, name: str, side: ArmSide | str | None = None) -> bool:
+    """(object, isGraspedBy, gripper): an arm holds it and it is still between the fingers."""
+    body = world.body(name)
+    sides = [ArmSide(side)] if side is not None else list(ArmSide)
+    for s in sides:
+        arm = world.arm(s)
+        if arm.held == body:
+            distance = float(np.linalg.norm(_position(world, name) - np.asarray(arm.ee_pose().position)))
+            return distance <= GRASP_DISTANCE
+    return False
+
+
+def gripper_near(world: HomeWorld, side: ArmSide | str, name: str) -> bool:
+    """(gripper, isNear, object)."""
+    ee = np.asarray(world.arm(side).ee_pose().position)
+    return float(np.linalg.norm(ee - _position(world, name))) <= GRIPPER_NEAR_DISTANCE
+
+
+def object_above_region(world: HomeWorld, name: str, region: Region) -> bool:
+    """(object, isAbove, region): over the region's footprint and a little above its surface."""
+    x, y, _ = _position(world, name)
+    gap = object_bottom(world, name) - region.zmin
+    return region.contains_xy(float(x), float(y)) and ABOVE_MIN <= gap <= ABOVE_MAX
+
+
+def object_located_in(world: HomeWorld, name: str, region: Region) -> bool:
+    """(object, isLocated, region): centre over the region, resting on its surface, not held."""
+    x, y, _ = _position(world, name)
+    resting = abs(object_bottom(world, name) - region.zmin) <= RESTING_TOLERANCE
+    return (
+        region.contains_xy(float(x), float(y))
+        and resting
+        and _speed(world, name) <= RESTING_SPEED
+        and not is_grasped(world, name)
+    )
+
+
+def cup_below_tap(world: HomeWorld) -> bool:
+    """(Cup, isLocated, BelowOfTap), and upright (a cup on its side catches nothing)."""
+    _, orn = p.getBasePositionAndOrientation(world.body("Cup"), physicsClientId=world.client)
+    upright = quat_to_matrix((orn[0], orn[1], orn[2], orn[3]))[2, 2] > 0.95
+    return upright and object_located_in(world, "Cup", BELOW_OF_TAP)
+
+
+def cup_contains_water(world: HomeWorld) -> bool:
+    """(Cup, contains, Water)."""
+    return world.cup_water >= CUP_WATER_MIN
+
+
+def pen_on_platform(world: HomeWorld) -> bool:
+    """(Pen, isLocatedOn, RobotPlatform): resting on the platform, inside its edges, in the base's frame."""
+    base = world.base_pose()
+    x, y, _ = _position(world, "Pen")
+    dx, dy = x - base.x, y - base.y
+    along = dx * math.cos(base.theta) + dy * math.sin(base.theta)
+    across = -dx * math.sin(base.theta) + dy * math.cos(base.theta)
+    inside = abs(along) <= BASE_HALF_LENGTH - PLATFORM_MARGIN and abs(across) <= BASE_HALF_WIDTH - PLATFORM_MARGIN
+    resting = abs(object_bottom(world, "Pen") - PLATFORM_HEIGHT) <= RESTING_TOLERANCE
+    return inside and resting and not is_grasped(world, "Pen") and world.pen_holder is None
+
+
+def base_near(
+    world: HomeWorld, place: Pose2D | tuple[float, float], distance: float = BASE_NEAR_DISTANCE, heading: bool = False
+) -> bool:
+    """(MobileRobot, isNear, place); with ``heading`` the place's theta must match too."""
+    base = world.base_pose()
+    target = place if isinstance(place, Pose2D) else Pose2D(place[0], place[1])
+    if base.distance_to(target.x, target.y) > distance:
+        return False
+    return not heading or base.heading_error(target.theta) <= BASE_NEAR_HEADING
+
+
+def base_near_person(world: HomeWorld, person: str = "Person") -> bool:
+    """(MobileRobot, isNear, Person)."""
+    x, y, _ = _position(world, person)
+    return world.base_pose().distance_to(float(x), float(y)) <= NEAR_PERSON_DISTANCE
+
+
+def pen_with_person(world: HomeWorld, person: str = "Person") -> bool:
+    """(Pen, isWith, Person): the person took it and it is in their hand."""
+    if world.pen_holder != person:
+        return False
+    px, py, _ = _position(world, person)
+    pen = _position(world, "Pen")
+    in_reach = math.hypot(pen[0] - px, pen[1] - py) <= PERSON_REACH
+    return in_reach and abs(pen[2] - PERSON_HAND_HEIGHT) <= HAND_HEIGHT_TOLERANCE
+
+
+def robot_visible(world: HomeWorld, camera: str) -> bool:
+    """Whether a camera can localise the base now: it works, and both marker patches are in its
+    image with nothing between them and the camera (the precondition of isLocalisedIn)."""
+    cam = world.camera(camera)
+    if cam.failed:
+        return False
+    base = world.base_pose()
+    spec = cam.spec
+    patches = [
+        (base.x + sign * MARKER_OFFSET * math.cos(base.theta), base.y + sign * MARKER_OFFSET * math.sin(base.theta))
+        for sign in (1.0, -1.0)
+    ]
+    points = np.array([[x, y, MARKER_HEIGHT + 0.001] for x, y in patches])
+    rotation = cam.camera_to_world[:3, :3]
+    local = (points - np.asarray(spec.eye)) @ rotation
+    if np.any(local[:, 2] <= 0):
+        return False
+    k = cam.intrinsics
+    us = k.fx * local[:, 0] / local[:, 2] + k.cx
+    vs = k.fy * local[:, 1] / local[:, 2] + k.cy
+    if np.any((us < 0) | (us >= k.width) | (vs < 0) | (vs >= k.height)):
+        return False
+    hits = p.rayTestBatch([spec.eye] * 2, points.tolist(), physicsClientId=world.client)
+    return all(hit[0] in (-1, world.body("P3DX01")) for hit in hits)

@@ -1,0 +1,355 @@
+"""The robots' skills, one function per action-type component of the knowledge base.
+
+Each skill acts only on what it is given (perception estimates, planned paths, regions from the
+layout) and returns an ``Outcome``: succeeded, or failed with a reason. Success is judged by the
+predicate of the skill's effect against the simulated world, not by the skill's own belief, so a
+skill that "did its moves" but dropped the object reports a failure. Every loop is bounded in
+simulated time: a skill never runs forever.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pybullet as p
+
+from sim import predicates as pred
+from sim.arms import GRIPPER_OPEN, Arm, ArmSide
+from sim.geometry import Pose2D, Region, Vec3, wrap_angle
+from sim.grasping import (
+    PEN,
+    PREGRASP_DISTANCE,
+    GraspKind,
+    GraspPose,
+    compute_grasp_pose,
+    side_orientation,
+    top_orientation,
+)
+from sim.layout import ARM_MOUNT_YAW, ARM_MOUNTS, HANDOVER_POSE, PERSON_HAND_HEIGHT, PLATFORM_HEIGHT, TAP_LEVER
+from sim.perception import ObjectEstimate, PersonEstimate, RobotPoseEstimate
+from sim.planning import PlannedPath
+from sim.world import HomeWorld
+
+__all__ = [
+    "ABOVE_CLEARANCE",
+    "FILL_TIME_LIMIT",
+    "LIFT_HEIGHT",
+    "NAVIGATION_TOLERANCE",
+    "Outcome",
+    "approach_object",
+    "carry_object",
+    "clear_view",
+    "deliver_object",
+    "fill_cup_from_tap",
+    "hand_over_onto_platform",
+    "navigate",
+    "navigate_to_person",
+    "navigate_to_place",
+    "pick_up_object",
+    "platform_region",
+    "put_down_object",
+]
+
+LIFT_HEIGHT = 0.04
+"""A picked object is lifted 4 cm: clear of the table, and the cup's top stays under the spout."""
+ABOVE_CLEARANCE = 0.03
+"""Carrying ends with the object's bottom 3 cm above the target surface."""
+PLACE_CLEARANCE = 0.003
+"""Putting down lowers the object to 3 mm above the surface, then lets go: it drops onto it."""
+PLACE_SPEED = 0.10
+SETTLE_TIME = 0.5
+"""Seconds an object is given to come to rest after being let go."""
+LEVER_PUSH = 0.015
+"""How far past the lever's front face the closed fingers push (the tap opens after 6 mm)."""
+PRESS_STANDOFF = 0.08
+FILL_TIME_LIMIT = 6.0
+"""Longest the tap is held open (a full cup takes 4 s)."""
+SPILL_LIMIT = 0.5
+"""If the water has run this long without reaching a cup, the lever is let go."""
+NAVIGATION_TOLERANCE = 0.05
+"""The base has arrived when it is within 5 cm of the last waypoint."""
+PLATFORM_TARGET = 0.05
+"""Half-size of the put-down window on the platform around its localised centre."""
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What a skill (or a perception step of a scenario) reports."""
+
+    skill: str
+    succeeded: bool
+    reason: str
+    started: float
+    """Simulated time at the start (s)."""
+    finished: float
+
+    @property
+    def sim_seconds(self) -> float:
+        return self.finished - self.started
+
+
+def _done(world: HomeWorld, skill: str, started: float, ok: bool, reason: str = "") -> Outcome:
+    return Outcome(skill, ok, "" if ok else reason, started, world.time)
+
+
+def _arm(world: HomeWorld, side: ArmSide | str) -> Arm:
+    return world.arm(side)
+
+
+def clear_view(world: HomeWorld) -> Outcome:
+    """Fold both arms out of the Kinect's view (the first step of FindCupOnTable)."""
+    start = world.time
+    for arm in world.arms.values():
+        result = arm.home()
+        if not result.reached:
+            return _done(world, "ClearView", start, False, f"{arm.side} arm: {result.reason}")
+    return _done(world, "ClearView", start, True)
+
+
+def approach_object(world: HomeWorld, side: ArmSide | str, grasp: GraspPose) -> Outcome:
+    """ApproachToObject: open the gripper and bring it to the pre-grasp pose."""
+    start = world.time
+    arm = _arm(world, side)
+    if arm.held is not None:
+        return _done(world, "ApproachToObject", start, False, f"the {arm.side} gripper is holding something")
+    arm.set_gripper(GRIPPER_OPEN)
+    result = arm.reach(grasp.pregrasp, grasp.orientation)
+    if not result.reached:
+        return _done(world, "ApproachToObject", start, False, result.reason)
+    ok = pred.gripper_near(world, side, grasp.model.name)
+    return _done(world, "ApproachToObject", start, ok, f"the gripper is not near the {grasp.model.name}")
+
+
+def _between_fingers(world: HomeWorld, arm: Arm) -> int | None:
+    """The object both closed fingers touch (within 5 mm), if any: what the gripper actually holds."""
+    for name in ("Cup", "Pen"):
+        body = world.body(name)
+        touching = all(
+            p.getClosestPoints(arm.body, body, 0.005, linkIndexA=finger, physicsClientId=world.client)
+            for finger in (9, 10)
+        )
+        if touching:
+            return body
+    return None
+
+
+def pick_up_object(world: HomeWorld, side: ArmSide | str, grasp: GraspPose) -> Outcome:
+    """PickUpObject: move in to the grasp pose, close the fingers on the object and lift it."""
+    start = world.time
+    arm = _arm(world, side)
+    name = grasp.model.name
+    if arm.held is not None:
+        return _done(world, "PickUpObject", start, False, f"the {arm.side} gripper is holding something")
+    if not pred.gripper_near(world, side, name):
+        return _done(world, "PickUpObject", start, False, f"the gripper is not near the {name}")
+    result = arm.move_to(grasp.position, grasp.orientation, speed=PLACE_SPEED)
+    if not result.reached:
+        return _done(world, "PickUpObject", start, False, result.reason)
+    arm.set_gripper(max(grasp.model.width - 0.004, 0.0), seconds=0.4)
+    body = _between_fingers(world, arm)
+    if body is None:
+        arm.set_gripper(GRIPPER_OPEN)
+        return _done(world, "PickUpObject", start, False, "nothing between the fingers")
+    arm.attach(body, grasp)
+    x, y, z = grasp.position
+    result = arm.move_to((x, y, z + LIFT_HEIGHT), arm.ee_pose().orientation, speed=PLACE_SPEED, symmetric=False)
+    if not result.reached:
+        return _done(world, "PickUpObject", start, False, f"lifting: {result.reason}")
+    held = world.name_of(body) or "?"
+    ok = held == name and pred.is_grasped(world, name, side)
+    return _done(world, "PickUpObject", start, ok, f"holding {held}, not the {name}" if held != name else "slipped")
+
+
+def carry_object(world: HomeWorld, side: ArmSide | str, region: Region, yaw: float | None = None) -> Outcome:
+    """CarryObject: take the held object over ``region`` (its centre over the region's centre, its
+    bottom ABOVE_CLEARANCE over the surface), turning a top-grasped object's axis to ``yaw``."""
+    start = world.time
+    arm = _arm(world, side)
+    grasp = arm.held_grasp
+    if arm.held is None or grasp is None:
+        return _done(world, "CarryObject", start, False, f"the {arm.side} gripper holds nothing")
+    name = world.name_of(arm.held) or "?"
+    ee = arm.ee_pose()
+    orientation = ee.orientation
+    if yaw is not None and grasp.model.grasp is GraspKind.TOP:
+        orientation = top_orientation(yaw + math.pi / 2.0)
+    bottom = ee.position[2] - grasp.bottom_offset
+    above = region.zmin + ABOVE_CLEARANCE
+    transit = max(bottom, above) + grasp.bottom_offset
+    cx, cy, _ = region.center
+    legs: list[Vec3] = [
+        (ee.position[0], ee.position[1], transit),
+        (cx, cy, transit),
+        (cx, cy, above + grasp.bottom_offset),
+    ]
+    for leg in legs:
+        if math.dist(leg, arm.ee_pose().position) < 1e-3:
+            continue
+        result = arm.move_to(leg, orientation)
+        if not result.reached:
+            return _done(world, "CarryObject", start, False, result.reason)
+    ok = pred.object_above_region(world, name, region)
+    return _done(world, "CarryObject", start, ok, f"the {name} is not above {region.name}")
+
+
+def put_down_object(world: HomeWorld, side: ArmSide | str, region: Region) -> Outcome:
+    """PutDownObject: lower the held object onto the surface below, let go, back off, fold the arm."""
+    start = world.time
+    arm = _arm(world, side)
+    grasp = arm.held_grasp
+    if arm.held is None or grasp is None:
+        return _done(world, "PutDownObject", start, False, f"the {arm.side} gripper holds nothing")
+    name = world.name_of(arm.held) or "?"
+    ee = arm.ee_pose()
+    place = (ee.position[0], ee.position[1], region.zmin + PLACE_CLEARANCE + grasp.bottom_offset)
+    result = arm.move_to(place, ee.orientation, speed=PLACE_SPEED, symmetric=False)
+    if not result.reached:
+        return _done(world, "PutDownObject", start, False, result.reason)
+    arm.detach()
+    arm.set_gripper(GRIPPER_OPEN)
+    ax, ay, az = grasp.approach
+    back = (place[0] - ax * PREGRASP_DISTANCE, place[1] - ay * PREGRASP_DISTANCE, place[2] - az * PREGRASP_DISTANCE)
+    retreat = arm.move_to(back, ee.orientation, speed=PLACE_SPEED, symmetric=False)
+    world.step(SETTLE_TIME)
+    folded = arm.home()
+    ok = pred.object_located_in(world, name, region)
+    if ok and not (retreat.reached and folded.reached):
+        return _done(
+            world, "PutDownObject", start, False, f"the arm did not back off: {retreat.reason or folded.reason}"
+        )
+    return _done(world, "PutDownObject", start, ok, f"the {name} did not come to rest in {region.name}")
+
+
+def fill_cup_from_tap(world: HomeWorld, side: ArmSide | str = ArmSide.RIGHT) -> Outcome:
+    """FillCupFromTap: the free arm pushes the tap's lever until the cup below is full.
+
+    The water runs whenever the lever is in; if it reaches no cup for SPILL_LIMIT seconds the arm
+    lets go and the skill fails (the cup was not below the tap).
+    """
+    start = world.time
+    arm = _arm(world, side)
+    if arm.held is not None:
+        return _done(world, "FillCupFromTap", start, False, f"the {arm.side} gripper is holding something")
+    orientation = side_orientation(ARM_MOUNT_YAW)
+    approach = np.array([math.cos(ARM_MOUNT_YAW), math.sin(ARM_MOUNT_YAW), 0.0])
+    x, z = (TAP_LEVER.xmin + TAP_LEVER.xmax) / 2.0, (TAP_LEVER.zmin + TAP_LEVER.zmax) / 2.0
+    press = np.array([x, TAP_LEVER.ymin + LEVER_PUSH, z])
+    pre = press - approach * (LEVER_PUSH + PRESS_STANDOFF)
+    arm.set_gripper(0.0)
+    result = arm.reach((float(pre[0]), float(pre[1]), float(pre[2])), orientation)
+    if not result.reached:
+        return _done(world, "FillCupFromTap", start, False, f"reaching the tap: {result.reason}")
+    arm.move_to((float(press[0]), float(press[1]), float(press[2])), arm.ee_pose().orientation, speed=PLACE_SPEED)
+    opened = world.tap_open()
+    spilled = world.water_spilled
+    held = 0.0
+    while opened and held < FILL_TIME_LIMIT and world.cup_water < 1.0:
+        world.step(0.1)
+        held += 0.1
+        if world.water_spilled - spilled >= SPILL_LIMIT:
+            break
+    arm.move_to((float(pre[0]), float(pre[1]), float(pre[2])), arm.ee_pose().orientation, speed=PLACE_SPEED)
+    arm.set_gripper(GRIPPER_OPEN)
+    arm.home()
+    if not opened:
+        return _done(world, "FillCupFromTap", start, False, "the lever did not open the tap")
+    ok = pred.cup_contains_water(world)
+    return _done(world, "FillCupFromTap", start, ok, "the water ran but no cup below the tap caught it")
+
+
+def platform_region(base: Pose2D | RobotPoseEstimate) -> Region:
+    """Where on a base's platform to put things: a small window around its centre, on its surface."""
+    return Region(
+        "OnRobotPlatform",
+        base.x - PLATFORM_TARGET,
+        base.x + PLATFORM_TARGET,
+        base.y - PLATFORM_TARGET,
+        base.y + PLATFORM_TARGET,
+        PLATFORM_HEIGHT,
+        PLATFORM_HEIGHT + 0.3,
+    )
+
+
+def hand_over_onto_platform(
+    world: HomeWorld, pen: ObjectEstimate, base: Pose2D | RobotPoseEstimate, side: ArmSide | str = ArmSide.RIGHT
+) -> Outcome:
+    """HandOverOntoPlatform: pick the pen up from the table and put it on the middle of the platform
+    of the base, which must be parked at the hand-over pose (``base`` is where it was localised)."""
+    start = world.time
+    if math.hypot(base.x - HANDOVER_POSE.x, base.y - HANDOVER_POSE.y) > pred.BASE_NEAR_DISTANCE:
+        return _done(world, "HandOverOntoPlatform", start, False, "the base is not parked at the hand-over pose")
+    grasp = compute_grasp_pose(PEN, pen.position, pen.yaw, ARM_MOUNTS[ArmSide(side).value])
+    region = platform_region(base)
+    # The pen fits between the marker patches along or across the base: take the placement that
+    # needs the smaller turn of the wrist.
+    pen_yaw = pen.yaw or 0.0
+    along = abs(wrap_angle(2.0 * (base.theta - pen_yaw))) / 2.0
+    yaw = base.theta if along <= math.pi / 4.0 else base.theta + math.pi / 2.0
+    steps: list[Callable[[], Outcome]] = [
+        lambda: approach_object(world, side, grasp),
+        lambda: pick_up_object(world, side, grasp),
+        lambda: carry_object(world, side, region, yaw=yaw),
+        lambda: put_down_object(world, side, region),
+    ]
+    for step in steps:
+        outcome = step()
+        if not outcome.succeeded:
+            return _done(world, "HandOverOntoPlatform", start, False, f"{outcome.skill}: {outcome.reason}")
+    ok = pred.pen_on_platform(world)
+    return _done(world, "HandOverOntoPlatform", start, ok, "the pen is not on the platform")
+
+
+def navigate(world: HomeWorld, waypoints: Sequence[tuple[float, float]], final_heading: float | None = None) -> Outcome:
+    """DriveBase along waypoints: stop at the last one (then turn to ``final_heading``)."""
+    start = world.time
+    if not waypoints:
+        return _done(world, "Navigate", start, False, "no waypoints")
+    result = world.base.follow(list(waypoints), final_heading)
+    if not result.succeeded:
+        return _done(world, "Navigate", start, False, result.reason)
+    gx, gy = waypoints[-1]
+    ok = world.base_pose().distance_to(gx, gy) <= NAVIGATION_TOLERANCE
+    return _done(world, "Navigate", start, ok, "stopped away from the goal")
+
+
+def navigate_to_place(world: HomeWorld, path: PlannedPath, place: Pose2D) -> Outcome:
+    """NavigateToPlace: follow a planned path and stop at ``place`` with its heading."""
+    start = world.time
+    outcome = navigate(world, [*path.waypoints[:-1], place.xy], place.theta)
+    if not outcome.succeeded:
+        return _done(world, "NavigateToPlace", start, False, outcome.reason)
+    ok = pred.base_near(world, place, heading=True)
+    return _done(world, "NavigateToPlace", start, ok, "the base is not at the place")
+
+
+def navigate_to_person(world: HomeWorld, path: PlannedPath, person: PersonEstimate) -> Outcome:
+    """NavigateToPerson: follow a planned path that ends next to the tracked person, facing them."""
+    start = world.time
+    gx, gy = path.waypoints[-1]
+    outcome = navigate(world, path.waypoints, math.atan2(person.y - gy, person.x - gx))
+    if not outcome.succeeded:
+        return _done(world, "NavigateToPerson", start, False, outcome.reason)
+    ok = pred.base_near_person(world)
+    return _done(world, "NavigateToPerson", start, ok, "the base stopped too far from the person")
+
+
+def deliver_object(world: HomeWorld, receiver: str = "Person") -> Outcome:
+    """DeliverObject: standing next to the person, the base waits while they take the pen."""
+    start = world.time
+    if not pred.base_near_person(world, receiver):
+        return _done(world, "DeliverObject", start, False, f"the base is not near {receiver}")
+    if not pred.pen_on_platform(world):
+        return _done(world, "DeliverObject", start, False, "there is no pen on the platform")
+    person = world.pose(receiver).position
+    base = world.base_pose()
+    dx, dy = base.x - person[0], base.y - person[1]
+    norm = math.hypot(dx, dy)
+    reach = min(0.35, norm)
+    hand = (person[0] + dx / norm * reach, person[1] + dy / norm * reach, PERSON_HAND_HEIGHT)
+    world.give_pen_to(receiver, hand)
+    world.step(0.5)
+    ok = pred.pen_with_person(world, receiver)
+    return _done(world, "DeliverObject", start, ok, f"{receiver} does not have the pen")

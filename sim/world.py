@@ -1,0 +1,540 @@
+"""The simulated home: one pybullet client holding the rooms, the furniture, the people and the robots.
+
+Everything is built from primitives except the two Panda arms (pybullet_data). Each world owns its
+own physics client and passes its id on every call, so several worlds can live in one process. The
+seed moves the cup, the pen, the person and the base's start a little; the same seed gives the same
+world and, since stepping is deterministic, the same outcome for the same calls.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
+from dataclasses import dataclass
+from types import TracebackType
+
+import numpy as np
+import pybullet as p
+
+from sim import layout as L
+from sim.arms import PYBULLET_DATA, Arm, ArmSide, Kinematics
+from sim.base import BASE_HEIGHT, MobileBase
+from sim.cameras import Camera
+from sim.errors import UnknownEntityError, WorldClosedError
+from sim.geometry import Pose2D, Pose3D, Quat, Region, Vec3, quat_from_yaw
+
+__all__ = ["TIME_STEP", "HomeWorld", "Perturbation", "open_world"]
+
+TIME_STEP = 1.0 / 240.0
+"""Physics step (s): pybullet's default, at which the Panda's controllers and contacts are stable."""
+FILL_RATE = 0.25
+"""Fraction of the cup filled per second of open tap (a full cup takes 4 s)."""
+TAP_OPEN_TRAVEL = 0.006
+"""The tap runs while its lever is pushed in by more than 6 mm."""
+LEVER_SPRING_FORCE = 4.0
+"""N: the spring that closes the tap when the lever is let go."""
+
+_FLOOR = (0.78, 0.78, 0.76, 1.0)
+_WALL = (0.92, 0.90, 0.84, 1.0)
+_WOOD = (0.62, 0.50, 0.38, 1.0)
+_WHITE = (0.93, 0.93, 0.95, 1.0)
+_STEEL = (0.55, 0.56, 0.58, 1.0)
+_DARK = (0.15, 0.15, 0.17, 1.0)
+_TORSO = (0.45, 0.46, 0.50, 1.0)
+CUP_RED = (0.85, 0.08, 0.08, 1.0)
+PEN_BLUE = (0.10, 0.20, 0.85, 1.0)
+WATER_CYAN = (0.05, 0.80, 0.80, 1.0)
+SHIRT_YELLOW = (0.95, 0.85, 0.10, 1.0)
+MARKER_GREEN = (0.10, 0.85, 0.15, 1.0)
+MARKER_MAGENTA = (0.85, 0.10, 0.85, 1.0)
+_CHASSIS = (0.28, 0.28, 0.30, 1.0)
+_PLATFORM = (0.70, 0.70, 0.72, 1.0)
+_SKIN = (0.85, 0.66, 0.52, 1.0)
+_TROUSERS = (0.30, 0.30, 0.34, 1.0)
+
+_IDENTITY: Quat = (0.0, 0.0, 0.0, 1.0)
+
+
+@dataclass(frozen=True)
+class Perturbation:
+    """The seed's deterministic offsets from the nominal layout (metres, radians)."""
+
+    cup: tuple[float, float]
+    pen: tuple[float, float, float]
+    person: tuple[float, float]
+    base: tuple[float, float, float]
+
+    @classmethod
+    def from_seed(cls, seed: int) -> Perturbation:
+        rng = np.random.default_rng(seed)
+        cup = rng.uniform(-0.02, 0.02, 2)
+        pen = rng.uniform([-0.02, -0.02, -0.15], [0.02, 0.02, 0.15])
+        person = rng.uniform(-0.15, 0.15, 2)
+        base = rng.uniform([-0.10, -0.10, -0.3], [0.10, 0.10, 0.3])
+        return cls(
+            (float(cup[0]), float(cup[1])),
+            (float(pen[0]), float(pen[1]), float(pen[2])),
+            (float(person[0]), float(person[1])),
+            (float(base[0]), float(base[1]), float(base[2])),
+        )
+
+
+@dataclass(frozen=True)
+class _Part:
+    """One box, cylinder or sphere of a multi-part body: shape, size, offset from the body origin, colour."""
+
+    shape: int
+    size: tuple[float, ...]
+    offset: Vec3
+    rgba: tuple[float, float, float, float]
+    collide: bool = True
+    orientation: Quat = _IDENTITY
+
+
+def _box(half: Vec3, offset: Vec3, rgba: tuple[float, float, float, float], collide: bool = True) -> _Part:
+    return _Part(p.GEOM_BOX, half, offset, rgba, collide)
+
+
+def _cylinder(
+    radius: float, length: float, offset: Vec3, rgba: tuple[float, float, float, float], collide: bool = True
+) -> _Part:
+    return _Part(p.GEOM_CYLINDER, (radius, length), offset, rgba, collide)
+
+
+class HomeWorld:
+    """The home of paper section 6.2: living room, kitchen with table and dispenser, bedroom.
+
+    Use ``HomeWorld.create(seed)`` and close it (``with HomeWorld.create() as world:``).
+    """
+
+    def __init__(self, client: int, seed: int, gui: bool, time_step: float) -> None:
+        self.client = client
+        self.seed = seed
+        self.gui = gui
+        self.time_step = time_step
+        self.perturbation = Perturbation.from_seed(seed)
+        self._steps = 0
+        self._closed = False
+        self._bodies: dict[str, int] = {}
+        self.cup_water = 0.0
+        """Fraction of the cup filled with water (0 to 1)."""
+        self.water_spilled = 0.0
+        """Seconds the tap ran with no cup below it."""
+        self._water_shown = False
+        self.pen_holder: str | None = None
+        """Who holds the pen after a delivery (the person's name), else None."""
+        self._handed_constraint: int | None = None
+        self.cameras: dict[str, Camera] = {}
+        self.arms: dict[ArmSide, Arm] = {}
+        self._kinematics: Kinematics | None = None
+        try:
+            self._build()
+            self.base = MobileBase(client, self._bodies["P3DX01"], self.step)
+            self.step(0.3)  # let the objects settle on the table
+        except BaseException:
+            if self._kinematics is not None:
+                self._kinematics.close()
+            raise
+
+    # --- life cycle -----------------------------------------------------------------------------
+
+    @classmethod
+    def create(cls, seed: int = 0, gui: bool = False, time_step: float = TIME_STEP) -> HomeWorld:
+        """Connect a new pybullet client (DIRECT unless ``gui``) and build the home in it."""
+        client = p.connect(p.GUI if gui else p.DIRECT)
+        try:
+            return cls(client, seed, gui, time_step)
+        except BaseException:
+            p.disconnect(physicsClientId=client)
+            raise
+
+    def close(self) -> None:
+        """Disconnect the pybullet client; safe to call twice."""
+        if not self._closed:
+            self._closed = True
+            if self._kinematics is not None:
+                self._kinematics.close()
+            p.disconnect(physicsClientId=self.client)
+
+    @property
+    def closed(self) -> bool:
+        return self._closed
+
+    def __enter__(self) -> HomeWorld:
+        return self
+
+    def __exit__(
+        self, exc_type: type[BaseException] | None, exc: BaseException | None, tb: TracebackType | None
+    ) -> None:
+        self.close()
+
+    def _check(self) -> None:
+        if self._closed:
+            raise WorldClosedError(self.client)
+
+    # --- time -----------------------------------------------------------------------------------
+
+    @property
+    def time(self) -> float:
+        """Simulated seconds since the world was built (settling included)."""
+        return self._steps * self.time_step
+
+    @property
+    def steps(self) -> int:
+        return self._steps
+
+    def step(self, seconds: float) -> None:
+        """Advance the physics by ``seconds``, rounded to whole fixed steps (at least one)."""
+        self._check()
+        count = max(1, round(seconds / self.time_step))
+        for _ in range(count):
+            p.stepSimulation(physicsClientId=self.client)
+            self._steps += 1
+            self._run_tap()
+
+    # --- entities -------------------------------------------------------------------------------
+
+    @property
+    def bodies(self) -> Mapping[str, int]:
+        """Entity name -> pybullet body id."""
+        return dict(self._bodies)
+
+    def body(self, name: str) -> int:
+        try:
+            return self._bodies[name]
+        except KeyError:
+            raise UnknownEntityError(name, sorted(self._bodies)) from None
+
+    def name_of(self, body: int) -> str | None:
+        for name, uid in self._bodies.items():
+            if uid == body:
+                return name
+        return None
+
+    def pose(self, name: str) -> Pose3D:
+        """Ground-truth pose of an entity's base (for checks and tests, not for the robots)."""
+        self._check()
+        pos, orn = p.getBasePositionAndOrientation(self.body(name), physicsClientId=self.client)
+        return Pose3D((pos[0], pos[1], pos[2]), (orn[0], orn[1], orn[2], orn[3]))
+
+    def base_pose(self) -> Pose2D:
+        return self.base.pose()
+
+    def arm(self, side: ArmSide | str) -> Arm:
+        return self.arms[ArmSide(side)]
+
+    def camera(self, name: str) -> Camera:
+        try:
+            return self.cameras[name]
+        except KeyError:
+            raise UnknownEntityError(name, sorted(self.cameras)) from None
+
+    def fail_camera(self, name: str) -> None:
+        """Switch a camera off: its captures raise ``CameraUnavailableError`` until repaired."""
+        self.camera(name).failed = True
+
+    def repair_camera(self, name: str) -> None:
+        self.camera(name).failed = False
+
+    def snapshot(self) -> dict[str, Pose3D]:
+        """Poses of everything that can move (objects, base, person), for comparing runs."""
+        return {name: self.pose(name) for name in ("Cup", "Pen", "P3DX01", "Person")}
+
+    def tap_travel(self) -> float:
+        """How far the tap lever is pushed in (m)."""
+        return float(p.getJointState(self.body("WaterDispenser"), 1, physicsClientId=self.client)[0])
+
+    def tap_open(self) -> bool:
+        return self.tap_travel() > TAP_OPEN_TRAVEL
+
+    def cup_catches_water(self) -> bool:
+        """Physics of the stream: it falls from the outlet into the cup if the cup is upright below it
+        and the outlet's axis passes inside the rim."""
+        pos, orn = p.getBasePositionAndOrientation(self.body("Cup"), physicsClientId=self.client)
+        up = p.getMatrixFromQuaternion(orn)[8]
+        inside = math.hypot(pos[0] - L.TAP_OUTLET[0], pos[1] - L.TAP_OUTLET[1]) < L.CUP_RADIUS - 0.004
+        below = pos[2] + L.CUP_HEIGHT / 2.0 < L.TAP_OUTLET[2]
+        return inside and below and up > 0.95
+
+    def _run_tap(self) -> None:
+        if not self.tap_open():
+            return
+        if self.cup_catches_water():
+            self.cup_water = min(1.0, self.cup_water + FILL_RATE * self.time_step)
+            if not self._water_shown and self.cup_water >= 0.2:
+                p.changeVisualShape(self.body("Cup"), 0, rgbaColor=WATER_CYAN, physicsClientId=self.client)
+                self._water_shown = True
+        else:
+            self.water_spilled += self.time_step
+
+    def give_pen_to(self, person: str, hand: Vec3) -> None:
+        """The person takes the pen into their hand: it leaves the platform and stays with them."""
+        pen = self.body("Pen")
+        holder = self.body(person)
+        p.resetBasePositionAndOrientation(pen, hand, quat_from_yaw(0.0), physicsClientId=self.client)
+        p.resetBaseVelocity(pen, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), physicsClientId=self.client)
+        holder_pos, holder_orn = p.getBasePositionAndOrientation(holder, physicsClientId=self.client)
+        inv_pos, inv_orn = p.invertTransform(holder_pos, holder_orn)
+        rel_pos, rel_orn = p.multiplyTransforms(inv_pos, inv_orn, hand, quat_from_yaw(0.0))
+        self._handed_constraint = p.createConstraint(
+            holder,
+            -1,
+            pen,
+            -1,
+            p.JOINT_FIXED,
+            (0.0, 0.0, 0.0),
+            rel_pos,
+            (0.0, 0.0, 0.0),
+            parentFrameOrientation=rel_orn,
+            physicsClientId=self.client,
+        )
+        self.pen_holder = person
+
+    # --- building -------------------------------------------------------------------------------
+
+    def _multibody(
+        self,
+        name: str,
+        parts: list[_Part],
+        position: Vec3,
+        orientation: Quat = _IDENTITY,
+        mass: float = 0.0,
+        joints: list[tuple[int, Vec3]] | None = None,
+        link_mass: float = 0.001,
+    ) -> int:
+        """A body whose first part is the base and the others fixed (or given) joints' links."""
+        c = self.client
+
+        def shapes(part: _Part) -> tuple[int, int]:
+            if part.shape == p.GEOM_BOX:
+                col = p.createCollisionShape(p.GEOM_BOX, halfExtents=part.size, physicsClientId=c)
+                vis = p.createVisualShape(p.GEOM_BOX, halfExtents=part.size, rgbaColor=part.rgba, physicsClientId=c)
+            elif part.shape == p.GEOM_CYLINDER:
+                radius, length = part.size
+                col = p.createCollisionShape(p.GEOM_CYLINDER, radius=radius, height=length, physicsClientId=c)
+                vis = p.createVisualShape(
+                    p.GEOM_CYLINDER, radius=radius, length=length, rgbaColor=part.rgba, physicsClientId=c
+                )
+            else:
+                col = p.createCollisionShape(p.GEOM_SPHERE, radius=part.size[0], physicsClientId=c)
+                vis = p.createVisualShape(p.GEOM_SPHERE, radius=part.size[0], rgbaColor=part.rgba, physicsClientId=c)
+            return (col if part.collide else -1), vis
+
+        base_col, base_vis = shapes(parts[0])
+        links = parts[1:]
+        link_shapes = [shapes(part) for part in links]
+        kinds = joints or [(p.JOINT_FIXED, (0.0, 0.0, 1.0))] * len(links)
+        body = p.createMultiBody(
+            baseMass=mass,
+            baseCollisionShapeIndex=base_col,
+            baseVisualShapeIndex=base_vis,
+            basePosition=position,
+            baseOrientation=orientation,
+            baseInertialFramePosition=parts[0].offset,
+            linkMasses=[link_mass] * len(links),
+            linkCollisionShapeIndices=[s[0] for s in link_shapes],
+            linkVisualShapeIndices=[s[1] for s in link_shapes],
+            linkPositions=[part.offset for part in links],
+            linkOrientations=[part.orientation for part in links],
+            linkInertialFramePositions=[(0.0, 0.0, 0.0)] * len(links),
+            linkInertialFrameOrientations=[_IDENTITY] * len(links),
+            linkParentIndices=[0] * len(links),
+            linkJointTypes=[k[0] for k in kinds],
+            linkJointAxis=[k[1] for k in kinds],
+            physicsClientId=c,
+        )
+        if parts[0].offset != (0.0, 0.0, 0.0):
+            raise ValueError("the base part of a body must sit at its origin")
+        self._bodies[name] = int(body)
+        return int(body)
+
+    def _build(self) -> None:
+        c = self.client
+        p.resetSimulation(physicsClientId=c)
+        p.setPhysicsEngineParameter(fixedTimeStep=self.time_step, deterministicOverlappingPairs=1, physicsClientId=c)
+        p.setGravity(0.0, 0.0, -9.81, physicsClientId=c)
+        p.setAdditionalSearchPath(PYBULLET_DATA, physicsClientId=c)
+        if self.gui:
+            p.configureDebugVisualizer(p.COV_ENABLE_GUI, 0, physicsClientId=c)
+            p.resetDebugVisualizerCamera(9.0, 0.0, -60.0, (5.0, 4.0, 0.0), physicsClientId=c)
+        render = p.COV_ENABLE_RENDERING
+        if self.gui:
+            p.configureDebugVisualizer(render, 0, physicsClientId=c)
+        self._build_rooms()
+        self._build_kitchen()
+        self._build_robot()
+        self._build_base()
+        self._build_person()
+        for spec in (*L.CAMERAS.values(), L.KINECT):
+            self.cameras[spec.name] = Camera(c, spec, self)
+        if self.gui:
+            p.configureDebugVisualizer(render, 1, physicsClientId=c)
+
+    def _build_rooms(self) -> None:
+        h = L.HOME
+        self._multibody(
+            "Floor",
+            [_box(((h.xmax - h.xmin) / 2 + 0.5, (h.ymax - h.ymin) / 2 + 0.5, 0.05), (0, 0, 0), _FLOOR)],
+            ((h.xmin + h.xmax) / 2, (h.ymin + h.ymax) / 2, -0.05),
+        )
+        t = L.WALL_THICKNESS
+        for wall in L.WALLS:
+            length = math.hypot(wall.x1 - wall.x0, wall.y1 - wall.y0)
+            outer = wall.name in {"WallSouth", "WallNorth", "WallWest", "WallEast"}
+            length += t if outer else 0.0
+            yaw = math.atan2(wall.y1 - wall.y0, wall.x1 - wall.x0)
+            centre = ((wall.x0 + wall.x1) / 2, (wall.y0 + wall.y1) / 2, L.WALL_HEIGHT / 2)
+            self._multibody(
+                wall.name, [_box((length / 2, t / 2, L.WALL_HEIGHT / 2), (0, 0, 0), _WALL)], centre, quat_from_yaw(yaw)
+            )
+
+    def _build_kitchen(self) -> None:
+        t = L.TABLE
+        top = 0.04
+        cx, cy = (t.xmin + t.xmax) / 2, (t.ymin + t.ymax) / 2
+        hx, hy = (t.xmax - t.xmin) / 2, (t.ymax - t.ymin) / 2
+        leg_h = (L.TABLE_HEIGHT - top) / 2
+        legs = [
+            _box((0.025, 0.025, leg_h), (sx * (hx - 0.06), sy * (hy - 0.06), -top / 2 - leg_h), _WOOD)
+            for sx in (-1, 1)
+            for sy in (-1, 1)
+        ]
+        self._multibody("Table", [_box((hx, hy, top / 2), (0, 0, 0), _WOOD), *legs], (cx, cy, L.TABLE_HEIGHT - top / 2))
+
+        d, s, lever = L.DISPENSER, L.SPOUT, L.TAP_LEVER
+        centre = ((d.xmin + d.xmax) / 2, (d.ymin + d.ymax) / 2, (d.zmin + d.zmax) / 2)
+
+        def local(region: Region) -> tuple[Vec3, Vec3]:
+            half = ((region.xmax - region.xmin) / 2, (region.ymax - region.ymin) / 2, (region.zmax - region.zmin) / 2)
+            mid = ((region.xmin + region.xmax) / 2, (region.ymin + region.ymax) / 2, (region.zmin + region.zmax) / 2)
+            return half, (mid[0] - centre[0], mid[1] - centre[1], mid[2] - centre[2])
+
+        body_half, _ = local(d)
+        spout_half, spout_off = local(s)
+        lever_half, lever_off = local(lever)
+        dispenser = self._multibody(
+            "WaterDispenser",
+            [
+                _box(body_half, (0, 0, 0), _WHITE),
+                _box(spout_half, spout_off, _STEEL),
+                _box(lever_half, lever_off, _DARK),
+            ],
+            centre,
+            joints=[(p.JOINT_FIXED, (0.0, 0.0, 1.0)), (p.JOINT_PRISMATIC, (0.0, 1.0, 0.0))],
+            link_mass=0.05,
+        )
+        p.setJointMotorControl2(
+            dispenser, 1, p.POSITION_CONTROL, targetPosition=0.0, force=LEVER_SPRING_FORCE, physicsClientId=self.client
+        )
+
+        dx, dy = self.perturbation.cup
+        cup = self._multibody(
+            "Cup",
+            [
+                _cylinder(L.CUP_RADIUS, L.CUP_HEIGHT, (0, 0, 0), CUP_RED),
+                # The water's surface: red (invisible against the cup) until the cup is filled.
+                _cylinder(L.CUP_RADIUS - 0.004, 0.002, (0, 0, L.CUP_HEIGHT / 2 + 0.0005), CUP_RED, collide=False),
+            ],
+            (L.CUP_START[0] + dx, L.CUP_START[1] + dy, L.TABLE_HEIGHT + L.CUP_HEIGHT / 2 + 0.001),
+            mass=0.15,
+        )
+        px, py, pyaw = self.perturbation.pen
+        pen = self._multibody(
+            "Pen",
+            [_box((L.PEN_LENGTH / 2, L.PEN_WIDTH / 2, L.PEN_WIDTH / 2), (0, 0, 0), PEN_BLUE)],
+            (L.PEN_START[0] + px, L.PEN_START[1] + py, L.TABLE_HEIGHT + L.PEN_WIDTH / 2 + 0.001),
+            quat_from_yaw(L.PEN_START_YAW + pyaw),
+            mass=0.02,
+        )
+        for body in (cup, pen):
+            p.changeDynamics(body, -1, lateralFriction=1.0, spinningFriction=0.001, physicsClientId=self.client)
+
+    def _build_robot(self) -> None:
+        t = L.TORSO
+        half = ((t.xmax - t.xmin) / 2, (t.ymax - t.ymin) / 2, (t.zmax - t.zmin) / 2)
+        self._multibody(
+            "CytonDualArm01", [_box(half, (0, 0, 0), _TORSO)], ((t.xmin + t.xmax) / 2, (t.ymin + t.ymax) / 2, half[2])
+        )
+        k = L.KINECT
+        mast_top = k.eye[2] - 0.03
+        self._multibody(
+            "Kinect01",
+            [
+                _box((0.13, 0.03, 0.025), (0, 0, 0), _DARK),
+                _box((0.015, 0.015, (mast_top - t.zmax) / 2), (0, 0, -0.025 - (mast_top - t.zmax) / 2), _STEEL),
+            ],
+            (k.eye[0], k.eye[1] - 0.06, k.eye[2]),
+        )
+        mounts = {side: (L.ARM_MOUNTS[side.value], quat_from_yaw(L.ARM_MOUNT_YAW)) for side in ArmSide}
+        self._kinematics = Kinematics(mounts)
+        for side in ArmSide:
+            mount = L.ARM_MOUNTS[side.value]
+            body = p.loadURDF(
+                "franka_panda/panda.urdf",
+                mount,
+                quat_from_yaw(L.ARM_MOUNT_YAW),
+                useFixedBase=True,
+                flags=p.URDF_ENABLE_CACHED_GRAPHICS_SHAPES,
+                physicsClientId=self.client,
+            )
+            self._bodies[f"{side.value.capitalize()}Arm"] = body
+            for link in (9, 10):
+                p.changeDynamics(body, link, lateralFriction=1.5, physicsClientId=self.client)
+            self.arms[side] = Arm(self.client, side, body, self._kinematics, self.step)
+
+    def _build_base(self) -> None:
+        bx, by, btheta = self.perturbation.base
+        start = L.BASE_START
+        bottom = 0.02
+        chassis_half = (L.BASE_HALF_LENGTH, L.BASE_HALF_WIDTH, (L.PLATFORM_HEIGHT - 0.02 - bottom) / 2)
+        chassis_centre_z = bottom + chassis_half[2]
+        if abs(chassis_centre_z - BASE_HEIGHT) > 1e-9:
+            raise ValueError("base height and chassis disagree")
+        platform_z = L.PLATFORM_HEIGHT - 0.01 - chassis_centre_z
+        marker_z = L.MARKER_HEIGHT - 0.001 - chassis_centre_z
+        wheel = (math.sqrt(0.5), 0.0, 0.0, math.sqrt(0.5))  # cylinder axis along y
+        parts = [
+            _box(chassis_half, (0, 0, 0), _CHASSIS),
+            _box((L.BASE_HALF_LENGTH, L.BASE_HALF_WIDTH, 0.01), (0, 0, platform_z), _PLATFORM),
+            _box((0.06, 0.15, 0.001), (L.MARKER_OFFSET, 0, marker_z), MARKER_GREEN, collide=False),
+            _box((0.06, 0.15, 0.001), (-L.MARKER_OFFSET, 0, marker_z), MARKER_MAGENTA, collide=False),
+            _Part(p.GEOM_CYLINDER, (0.095, 0.04), (0.0, 0.215, 0.095 - chassis_centre_z), _DARK, False, wheel),
+            _Part(p.GEOM_CYLINDER, (0.095, 0.04), (0.0, -0.215, 0.095 - chassis_centre_z), _DARK, False, wheel),
+        ]
+        body = self._multibody(
+            "P3DX01",
+            parts,
+            (start.x + bx, start.y + by, BASE_HEIGHT),
+            quat_from_yaw(start.theta + btheta),
+            mass=20.0,
+        )
+        p.changeDynamics(body, 0, lateralFriction=1.0, physicsClientId=self.client)
+
+    def _build_person(self) -> None:
+        dx, dy = self.perturbation.person
+        legs = L.SHIRT_BOTTOM
+        self._multibody(
+            "Person",
+            [
+                _cylinder(L.PERSON_RADIUS, legs, (0, 0, 0), _TROUSERS),
+                _cylinder(
+                    L.SHIRT_RADIUS,
+                    L.SHIRT_TOP - L.SHIRT_BOTTOM,
+                    (0, 0, (L.SHIRT_TOP + legs) / 2 - legs / 2),
+                    SHIRT_YELLOW,
+                ),
+                _Part(p.GEOM_SPHERE, (0.10,), (0.0, 0.0, L.SHIRT_TOP + 0.11 - legs / 2), _SKIN),
+            ],
+            (L.PERSON_START[0] + dx, L.PERSON_START[1] + dy, legs / 2),
+        )
+
+
+@contextmanager
+def open_world(seed: int = 0, gui: bool = False) -> Iterator[HomeWorld]:
+    """``with open_world(seed) as world:`` builds a world and always disconnects it."""
+    world = HomeWorld.create(seed, gui)
+    try:
+        yield world
+    finally:
+        world.close()
