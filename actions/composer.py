@@ -30,7 +30,7 @@ from typing import Any
 import networkx as nx
 
 from actions.errors import OrderingConflictError
-from actions.graph import SRE, SRI, SRO, Edge, Matcher, Need, ServiceResourceGraph
+from actions.graph import SRE, SRI, SRO, Edge, Matcher, Need, ServicePool, ServiceResourceGraph
 from actions.model import ActionLibrary, Task, resolve_task
 from actions.plan import Binding, Plan, PlanStep, Source
 from actions.search import SearchTrace, bidirectional_search
@@ -52,6 +52,9 @@ class ComposeConfig:
     objective: Objective = Objective.SIMILARITY
     default_cost: float = 1.0  # seconds, for components that advertise no response time
     decompose: bool = True  # fall back to the task's sub-actions when the requirement alone fails
+    # A step is one invocation, made per use; past this many steps, uses share an existing invocation
+    # of the same component, so deep pools cannot make the plan grow exponentially.
+    max_steps: int = 200
     match: MatchConfig = field(default_factory=MatchConfig)
 
 
@@ -132,6 +135,7 @@ class Composer:
         self.matcher = Matcher(self.index, self.config.match)
         self.actions = actions or ActionLibrary.from_kb(kb)
         self._advertisements = list(advertisements) if advertisements is not None else None
+        self._pool: ServicePool | None = None
 
     @property
     def advertisements(self) -> list[Advertisement]:
@@ -139,11 +143,19 @@ class Composer:
             self._advertisements = self.kb.advertisements()
         return self._advertisements
 
+    @property
+    def pool(self) -> ServicePool:
+        """The components and the edges among them, built on first use and kept (they do not depend
+        on the requirement). Make a new Composer after registering or deregistering components."""
+        if self._pool is None:
+            self._pool = ServicePool(self.advertisements, self.matcher, self.config.default_cost)
+        return self._pool
+
     def task(self, name: str) -> Task:
         return resolve_task(self.kb, self.actions, name)
 
     def graph(self, requirement: Requirement) -> ServiceResourceGraph:
-        return ServiceResourceGraph(requirement, self.advertisements, self.matcher, self.config.default_cost)
+        return ServiceResourceGraph(requirement, self.pool)
 
     def compose(self, task: str | Task | Requirement) -> CompositionResult:
         if isinstance(task, str):
@@ -169,7 +181,7 @@ class Composer:
     def attempt(self, requirement: Requirement, task: Task | None = None) -> Attempt:
         graph = self.graph(requirement)
         trace = bidirectional_search(graph)
-        extraction = _Extraction(graph, trace, self.config.objective)
+        extraction = _Extraction(graph, trace, self.config.objective, self.config.max_steps)
         if not extraction.solved:
             return Attempt(requirement, graph, trace, None, tuple(extraction.unsatisfied))
         orderings = self._orderings(task)
@@ -243,10 +255,12 @@ class _Step:
 class _Extraction:
     """Backward extraction of one plan from a searched SRG."""
 
-    def __init__(self, graph: ServiceResourceGraph, trace: SearchTrace, objective: Objective) -> None:
+    def __init__(self, graph: ServiceResourceGraph, trace: SearchTrace, objective: Objective, max_steps: int) -> None:
         self.graph = graph
         self.trace = trace
         self.objective = objective
+        self.max_steps = max_steps
+        self._explained: set[str] = set()  # vertices whose blocked needs _why has followed
         self.steps: dict[int, _Step] = {}
         self.unsatisfied: list[Unsatisfied] = []
         goal_needs = [(SRO, n) for n in graph.needs(SRO)] + [(SRE, n) for n in graph.needs(SRE)]
@@ -292,12 +306,18 @@ class _Extraction:
         best = providers[0]
         if best.source in seen:
             return [Unsatisfied(need.text(), node, chain, cycle=True)]
+        if best.source in self._explained:  # its causes are reported already, down another chain
+            return []
+        self._explained.add(best.source)
         here = (*chain, shorten(best.source))
-        causes: list[Unsatisfied] = []
-        for sub in self.graph.needs(best.source):
-            if not self._options(best.source, sub, self._level(best.source)):
-                causes += self._why(best.source, sub, here, seen | {best.source})
-        return causes or [Unsatisfied(need.text(), node, chain)]
+        blocked = [
+            sub
+            for sub in self.graph.needs(best.source)
+            if not self._options(best.source, sub, self._level(best.source))
+        ]
+        if not blocked:
+            return [Unsatisfied(need.text(), node, chain)]
+        return [cause for sub in blocked for cause in self._why(best.source, sub, here, seen | {best.source})]
 
     def _key(self, edge: Edge) -> tuple[Any, ...]:
         cost = self.trace.costs[edge.source]
@@ -336,6 +356,11 @@ class _Extraction:
                     step.bindings.append(sibling)
                     continue
                 best = min((e for e in options if e.source != SRI), key=self._key)
+                if len(self.steps) > self.max_steps:
+                    existing = next((other for other in self.steps.values() if other.node == best.source), None)
+                    if existing is not None:
+                        step.bindings.append(_Bound(need, best, existing.id))
+                        continue
                 producer = self._new(best.source, step.id)
                 step.producers.append(producer.id)
                 step.bindings.append(_Bound(need, best, producer.id))

@@ -141,84 +141,129 @@ class Matcher:
         return None
 
 
-class ServiceResourceGraph:
-    """The SRG for one requirement over a pool of advertisements (a networkx MultiDiGraph)."""
+class ServicePool:
+    """The advertised components and the edges among them: built once, shared by every requirement.
 
-    def __init__(
-        self,
-        requirement: Requirement,
-        advertisements: Iterable[Advertisement],
-        matcher: Matcher,
-        default_cost: float = 1.0,
-    ) -> None:
-        self.requirement = requirement
+    Offered concepts are indexed by their is-a ancestors, so each need is compared only with the
+    offers whose degree can be accepted (its subclasses, itself, its superclasses), never with all.
+    """
+
+    def __init__(self, advertisements: Iterable[Advertisement], matcher: Matcher, default_cost: float = 1.0) -> None:
         self.matcher = matcher
-        self.vertices: dict[str, Vertex] = {}
-        given = tuple(_offers(requirement.inputs, ())) + tuple(
-            Offer("effect", statement_text(s), statement=s) for s in requirement.preconditions
-        )
-        self.vertices[SRI] = Vertex(SRI, (), given, 0.0)
-        for ad in advertisements:
-            self.vertices[ad.iri] = Vertex(
+        self.vertices: dict[str, Vertex] = {
+            ad.iri: Vertex(
                 ad.iri,
                 _needs(ad.inputs, ad.preconditions),
                 tuple(_offers(ad.outputs, ad.effects)),
                 _cost(ad, default_cost),
                 ad,
             )
-        self.vertices[SRO] = Vertex(SRO, _needs(requirement.outputs, ()), (), 0.0)
-        self.vertices[SRE] = Vertex(SRE, _needs((), requirement.effects), (), 0.0)
-        self.graph: nx.MultiDiGraph[str] = nx.MultiDiGraph()
-        self.graph.add_nodes_from(self.vertices)
-        self._into: dict[str, dict[str, list[Edge]]] = {iri: {} for iri in self.vertices}
-        self._connect()
-
-    def _connect(self) -> None:
-        # Index offers by concept (and statements by predicate) so each need is compared only with
-        # offers of the same kind, not with every vertex.
-        by_concept: dict[str, list[tuple[str, Offer]]] = {}
-        statements: list[tuple[str, Offer]] = []
+            for ad in advertisements
+        }
+        self._by_concept: dict[str, list[tuple[str, Offer]]] = {}
+        self._statements: list[tuple[str, Offer]] = []
+        self._below: dict[str, set[str]] = {}  # ancestor -> offered concepts at or below it
         for vertex in self.vertices.values():
-            for offer in vertex.offers:
-                if offer.concept is not None:
-                    by_concept.setdefault(offer.concept, []).append((vertex.iri, offer))
-                else:
-                    statements.append((vertex.iri, offer))
+            self.index_offers(vertex)
+        self.into: dict[str, dict[str, list[Edge]]] = {
+            v.iri: {need.key: self.providers_of(v.iri, need) for need in v.needs} for v in self.vertices.values()
+        }
+
+    def index_offers(self, vertex: Vertex) -> None:
+        index = self.matcher.index
+        for offer in vertex.offers:
+            if offer.concept is None:
+                self._statements.append((vertex.iri, offer))
+                continue
+            if offer.concept not in self._by_concept:
+                self._by_concept[offer.concept] = []
+                above = set(index.is_a_ancestors(offer.concept)) if offer.concept in index else set()
+                for ancestor in above | {offer.concept}:
+                    self._below.setdefault(ancestor, set()).add(offer.concept)
+            self._by_concept[offer.concept].append((vertex.iri, offer))
+
+    def candidates(self, concept: str) -> set[str]:
+        """Offered concepts that may match ``concept``: at or below it, or above it."""
+        index = self.matcher.index
+        found = set(self._below.get(concept, ()))
+        if concept in index:
+            found |= set(self._below.get(index.canonical(concept), ()))
+            found |= {a for a in index.is_a_ancestors(concept) if a in self._by_concept}
+        return found
+
+    def providers_of(self, consumer: str, need: Need) -> list[Edge]:
+        """Edges from the pool's offers into ``consumer`` for ``need``, most similar first."""
+        found: list[Edge] = []
+        if need.concept is not None:
+            for concept in self.candidates(need.concept):
+                result = self.matcher.concept(need.concept, concept)
+                if result is not None:
+                    found += [Edge(src, consumer, need, o, *result) for src, o in self._by_concept[concept]]
+        else:
+            for src, offer in self._statements:
+                result = self.matcher.match(need, offer)
+                if result is not None:
+                    found.append(Edge(src, consumer, need, offer, *result))
+        found = [e for e in found if e.source != e.target]
+        found.sort(key=_rank)
+        return found
+
+
+class ServiceResourceGraph:
+    """The SRG for one requirement: the pool's vertices and edges plus SRI, SRO and SRE."""
+
+    def __init__(self, requirement: Requirement, pool: ServicePool) -> None:
+        self.requirement = requirement
+        self.pool = pool
+        self.matcher = pool.matcher
+        given = tuple(_offers(requirement.inputs, ())) + tuple(
+            Offer("effect", statement_text(s), statement=s) for s in requirement.preconditions
+        )
+        self.vertices: dict[str, Vertex] = {
+            SRI: Vertex(SRI, (), given, 0.0),
+            **pool.vertices,
+            SRO: Vertex(SRO, _needs(requirement.outputs, ()), (), 0.0),
+            SRE: Vertex(SRE, _needs((), requirement.effects), (), 0.0),
+        }
+        self._into: dict[str, dict[str, list[Edge]]] = {}
+        for goal in (SRO, SRE):
+            self._into[goal] = {n.key: pool.providers_of(goal, n) for n in self.vertices[goal].needs}
+        # SRI's edges into every vertex that needs what the requirement gives
         for vertex in self.vertices.values():
             for need in vertex.needs:
-                found: list[Edge] = []
-                if need.concept is not None:
-                    for concept, offers in by_concept.items():
-                        result = self.matcher.concept(need.concept, concept)
-                        if result is not None:
-                            found.extend(self._edge(src, vertex.iri, need, offer, result) for src, offer in offers)
-                else:
-                    for src, offer in statements:
-                        result = self.matcher.match(need, offer)
-                        if result is not None:
-                            found.append(self._edge(src, vertex.iri, need, offer, result))
-                found = [e for e in found if e.source != e.target]
-                found.sort(key=lambda e: (-e.similarity, e.source, e.offer.name))
-                self._into[vertex.iri][need.key] = found
-
-    def _edge(self, source: str, target: str, need: Need, offer: Offer, result: tuple[Degree, float]) -> Edge:
-        edge = Edge(source, target, need, offer, result[0], result[1])
-        if source != target:
-            self.graph.add_edge(source, target, key=f"{need.key}<-{offer.name}", edge=edge)
-        return edge
+                given_edges = [Edge(SRI, vertex.iri, need, o, *m) for o in given if (m := self.matcher.match(need, o))]
+                if given_edges:
+                    base = self._into.get(vertex.iri, {}).get(need.key, pool.into.get(vertex.iri, {}).get(need.key, []))
+                    self._into.setdefault(vertex.iri, {})[need.key] = sorted(base + given_edges, key=_rank)
 
     def needs(self, iri: str) -> tuple[Need, ...]:
         return self.vertices[iri].needs
 
     def providers(self, iri: str, need: Need) -> list[Edge]:
         """Edges into ``iri`` that meet ``need``, most similar first."""
-        return self._into[iri].get(need.key, [])
+        mine = self._into.get(iri)
+        if mine is not None and need.key in mine:
+            return mine[need.key]
+        return self.pool.into.get(iri, {}).get(need.key, [])
 
     def edges(self) -> list[Edge]:
-        return [e for by_need in self._into.values() for edges in by_need.values() for e in edges]
+        return [e for iri, vertex in self.vertices.items() for need in vertex.needs for e in self.providers(iri, need)]
+
+    @property
+    def graph(self) -> nx.MultiDiGraph[str]:
+        """The SRG as a networkx multigraph (built on demand: one edge per need met)."""
+        graph: nx.MultiDiGraph[str] = nx.MultiDiGraph()
+        graph.add_nodes_from(self.vertices)
+        for e in self.edges():
+            graph.add_edge(e.source, e.target, key=f"{e.need.key}<-{e.offer.name}", edge=e)
+        return graph
 
     def cost(self, iri: str) -> float:
         return self.vertices[iri].cost
+
+
+def _rank(edge: Edge) -> tuple[float, str, str]:
+    return (-edge.similarity, edge.source, edge.offer.name)
 
 
 def _needs(inputs: Sequence[Parameter], preconditions: Sequence[Statement]) -> tuple[Need, ...]:

@@ -102,3 +102,43 @@ def test_unreachable_cycle_is_never_enabled() -> None:
     composer = Composer(kb)
     trace = bidirectional_search(composer.graph(composer.task(EX + "Req").requirement))
     assert EX + "S1" not in trace.levels and EX + "S2" not in trace.levels
+
+
+def test_deep_fan_in_stays_bounded(bundled_kb: KnowledgeBase) -> None:
+    """Ten layers, each needing two results of the layer below: 2**10 invocations if every use got its
+    own; past max_steps, uses share invocations, and the plan is still well formed."""
+    from actions.composer import ComposeConfig
+    from actions.model import ActionLibrary
+    from kb import Advertisement, Parameter, Requirement
+    from reasoner.taxonomy import ROOT, Link, TaxonomyIndex
+
+    types = [f"{EX}T{i}" for i in range(11)]
+    index = TaxonomyIndex.from_links([Link(t, ROOT, "is-a") for t in types])
+    ads = [
+        Advertisement(
+            iri=f"{EX}L{i}",
+            types=(),
+            inputs=(
+                Parameter(f"{EX}L{i}in1", "input", types[i - 1], "x"),
+                Parameter(f"{EX}L{i}in2", "input", types[i - 1], "y"),
+            ),
+            outputs=(Parameter(f"{EX}L{i}out", "output", types[i], "out"),),
+        )
+        for i in range(1, 11)
+    ]
+    requirement = Requirement(
+        iri=EX + "Deep",
+        types=(),
+        inputs=(Parameter(EX + "given", "input", types[0], "given"),),
+        outputs=(Parameter(EX + "wanted", "output", types[10], "wanted"),),
+    )
+    composer = Composer(
+        bundled_kb, ComposeConfig(max_steps=40), index=index, actions=ActionLibrary(), advertisements=ads
+    )
+    plan = composer.compose(requirement).plan
+    assert plan is not None
+    assert 10 <= len(plan.steps) <= 2 * 40
+    assert plan.steps[-1].component == EX + "L10"
+    for step in plan.steps:
+        assert len(step.inputs) == 2
+        assert all(b.source.step is None or b.source.step < step.index for b in step.bindings)
