@@ -20,7 +20,7 @@ import numpy as np
 import pybullet as p
 from numpy.typing import NDArray
 
-from sim.geometry import Pose3D, Quat, Vec3, quat_from_matrix, quat_to_matrix
+from sim.geometry import Pose3D, Quat, Region, Vec3, quat_from_matrix, quat_to_matrix
 from sim.grasping import GraspPose
 
 __all__ = [
@@ -48,14 +48,16 @@ FINGER_JOINTS = (9, 10)
 EE_LINK = 11
 """panda_grasptarget: the point between the fingertips."""
 _MAX_FORCES = (87.0, 87.0, 87.0, 87.0, 12.0, 12.0, 12.0)
+_POSITION_GAINS = (0.3,) * 7
+"""Stiffer than pybullet's default (0.1), which lets the raised home posture sag by 2 degrees."""
 _LOWER = np.array([-2.9671, -1.8326, -2.9671, -3.1416, -2.9671, -0.0873, -2.9671])
 _UPPER = np.array([2.9671, 1.8326, 2.9671, 0.0, 2.9671, 3.8223, 2.9671])
 
 HOME_CONFIGURATIONS: dict[ArmSide, tuple[float, ...]] = {
-    # Folded, elbow up, turned outwards: clear of the table, of the Kinect's view and of the
-    # platform of a base parked at the hand-over pose.
-    ArmSide.LEFT: (0.9, -0.6, 0.0, -2.6, 0.0, 2.0, 0.785),
-    ArmSide.RIGHT: (-0.9, -0.6, 0.0, -2.6, 0.0, 2.0, 0.785),
+    # Raised and turned outwards: clear of the table, of the Kinect's view, of each other, and of
+    # the ceiling cameras' view of a base parked at the hand-over pose.
+    ArmSide.LEFT: (0.9, 0.0, 0.0, -0.5, 0.0, 1.0, 0.785),
+    ArmSide.RIGHT: (-0.9, 0.0, 0.0, -0.5, 0.0, 1.0, 0.785),
 }
 _SEEDS: tuple[tuple[float, ...], ...] = (
     # Postures to start the inverse kinematics from when the arm jumps to a new target: facing the
@@ -87,6 +89,9 @@ REACH_TOLERANCE = 0.01
 SETTLE_LIMIT = 1.0
 """At most this many simulated seconds of settling after the last piece."""
 GRIPPER_OPEN = 0.08
+COLLISION_MARGIN = 0.01
+"""Joint-space moves keep the arm's links 1 cm clear of the torso, the table, the dispenser, the
+Kinect and the other arm."""
 
 
 @dataclass(frozen=True)
@@ -132,9 +137,11 @@ def flipped(q: Quat) -> Quat:
 
 
 class Kinematics:
-    """Copies of both arms in a private DIRECT client, used only for inverse and forward kinematics."""
+    """Copies of both arms in a private DIRECT client, for inverse and forward kinematics, and boxes
+    standing for the fixed things around them (torso, table top, dispenser, Kinect), so that a
+    joint-space move can be checked for collisions before the real arm makes it."""
 
-    def __init__(self, mounts: dict[ArmSide, tuple[Vec3, Quat]]) -> None:
+    def __init__(self, mounts: dict[ArmSide, tuple[Vec3, Quat]], obstacles: Sequence[Region] = ()) -> None:
         self.client = p.connect(p.DIRECT)
         try:
             p.setAdditionalSearchPath(PYBULLET_DATA, physicsClientId=self.client)
@@ -142,10 +149,52 @@ class Kinematics:
                 side: p.loadURDF(PANDA_URDF, pos, orn, useFixedBase=True, physicsClientId=self.client)
                 for side, (pos, orn) in mounts.items()
             }
+            self._obstacles = [self._box(region) for region in obstacles]
         except BaseException:
             p.disconnect(physicsClientId=self.client)
             raise
         self._closed = False
+
+    def _box(self, region: Region) -> int:
+        half = ((region.xmax - region.xmin) / 2, (region.ymax - region.ymin) / 2, (region.zmax - region.zmin) / 2)
+        centre = ((region.xmin + region.xmax) / 2, (region.ymin + region.ymax) / 2, (region.zmin + region.zmax) / 2)
+        shape = p.createCollisionShape(p.GEOM_BOX, halfExtents=half, physicsClientId=self.client)
+        return int(p.createMultiBody(0.0, shape, -1, centre, physicsClientId=self.client))
+
+    def collides(self, side: ArmSide, q: Sequence[float], others: dict[ArmSide, Sequence[float]]) -> bool:
+        """Whether the arm at ``q`` comes within COLLISION_MARGIN of a fixed thing or of the other arm
+        (set to ``others``). The base links standing on the torso do not count."""
+        body = self._bodies[side]
+        self._set(body, q)
+        for other, configuration in others.items():
+            if other is not side:
+                self._set(self._bodies[other], configuration)
+        targets = [*self._obstacles, *(b for s, b in self._bodies.items() if s is not side)]
+        for target in targets:
+            for point in p.getClosestPoints(body, target, COLLISION_MARGIN, physicsClientId=self.client):
+                if point[3] > 0:
+                    return True
+        return False
+
+    def path_clear(
+        self,
+        side: ArmSide,
+        start: Sequence[float],
+        goal: Sequence[float],
+        others: dict[ArmSide, Sequence[float]],
+        min_height: float | None = None,
+    ) -> bool:
+        """Whether the straight joint-space path from ``start`` to ``goal`` is free of collisions (and
+        keeps the grasp point at or above ``min_height``), checked every 0.05 rad."""
+        a, b = np.asarray(start), np.asarray(goal)
+        samples = max(2, math.ceil(float(np.max(np.abs(b - a))) / 0.05))
+        for i in range(samples + 1):
+            q = [float(v) for v in a + (b - a) * (i / samples)]
+            if self.collides(side, q, others):
+                return False
+            if min_height is not None and self.forward(side, q).position[2] < min_height:
+                return False
+        return True
 
     def close(self) -> None:
         if not self._closed:
@@ -220,6 +269,8 @@ class Arm:
         """The grasp the held object was picked with (how far it hangs below the hand)."""
         self._targets: tuple[float, ...] = HOME_CONFIGURATIONS[side]
         self._gripper_width = GRIPPER_OPEN
+        self.peers: dict[ArmSide, Arm] = {}
+        """Both arms of the robot (set by the world), for collision checks against the other arm."""
         for joint, q in zip(ARM_JOINTS, self._targets, strict=True):
             p.resetJointState(body, joint, q, physicsClientId=client)
         for joint in FINGER_JOINTS:
@@ -251,6 +302,7 @@ class Arm:
             p.POSITION_CONTROL,
             targetPositions=self._targets,
             forces=_MAX_FORCES,
+            positionGains=_POSITION_GAINS,
             physicsClientId=self.client,
         )
         half = self._gripper_width / 2.0
@@ -311,22 +363,41 @@ class Arm:
         error = self._settle(goal)
         return MotionResult(error <= tolerance, error, "" if error <= tolerance else f"stopped {error:.3f} m short")
 
-    def reach(self, position: Vec3, orientation: Quat, symmetric: bool = True) -> MotionResult:
-        """Go to a pose through joint space (from the folded home posture to a pre-grasp pose)."""
+    def reach(
+        self, position: Vec3, orientation: Quat, symmetric: bool = True, min_height: float | None = None
+    ) -> MotionResult:
+        """Go to a pose through joint space (from the home posture to a pre-grasp pose, or across the
+        workspace when a straight line would leave the arm's reach).
+
+        Of the inverse-kinematics solutions (one per seed posture), the nearest one whose straight
+        joint-space path is collision-free is taken. With ``min_height`` the grasp point must also stay
+        at or above that height all the way: a held object then passes over the table and the torso
+        instead of through them.
+        """
         candidates = [orientation, flipped(orientation)] if symmetric else [orientation]
+        current = self.joint_positions()
         best: _Solution | None = None
         for candidate in candidates:
-            solution = self._kinematics.solve(self.side, position, candidate, [self.joint_positions(), *_SEEDS])
-            if best is None or solution.position_error + 0.1 * solution.orientation_error < (
-                best.position_error + 0.1 * best.orientation_error
-            ):
-                best = solution
-        if best is None or best.position_error > IK_TOLERANCE or best.orientation_error > 0.02:
-            return MotionResult(False, math.inf, f"no inverse kinematics for {_fmt(position)}")
+            for seed in (*_SEEDS, current):
+                solution = self._kinematics.solve(self.side, position, candidate, [seed])
+                if solution.position_error > IK_TOLERANCE or solution.orientation_error > 0.02:
+                    continue
+                if not self._kinematics.path_clear(self.side, current, solution.q, self._others(), min_height):
+                    continue
+                if best is None or _joint_distance(current, solution.q) < _joint_distance(current, best.q):
+                    best = solution
+            if best is not None and min_height is None:
+                break
+        if best is None:
+            where = "" if min_height is None else f" above {min_height:.2f} m"
+            return MotionResult(False, math.inf, f"no collision-free joint path to {_fmt(position)}{where}")
         motion = self.move_joints(best.q)
         error = float(np.linalg.norm(np.asarray(self.ee_pose().position) - np.asarray(position)))
         ok = motion.reached and error <= REACH_TOLERANCE
         return MotionResult(ok, error, "" if ok else f"stopped {error:.3f} m short")
+
+    def _others(self) -> dict[ArmSide, Sequence[float]]:
+        return {side: arm.joint_positions() for side, arm in self.peers.items() if side is not self.side}
 
     def _settle(self, goal: NDArray[np.float64]) -> float:
         waited = 0.0
@@ -357,8 +428,20 @@ class Arm:
         return MotionResult(error <= 0.02, error, "" if error <= 0.02 else f"joints {error:.3f} rad off")
 
     def home(self) -> MotionResult:
-        """Fold the arm back to its home posture."""
-        return self.move_joints(HOME_CONFIGURATIONS[self.side])
+        """Raise the arm back to its home posture, through the "ready" posture if the direct joint-space
+        path would hit something."""
+        home = HOME_CONFIGURATIONS[self.side]
+        current = self.joint_positions()
+        others = self._others()
+        ready = _SEEDS[0]
+        if not self._kinematics.path_clear(self.side, current, home, others) and (
+            self._kinematics.path_clear(self.side, current, ready, others)
+            and self._kinematics.path_clear(self.side, ready, home, others)
+        ):
+            via = self.move_joints(ready)
+            if not via.reached:
+                return via
+        return self.move_joints(home)
 
     def set_gripper(self, width: float, seconds: float = 0.3) -> None:
         """Open the fingers to ``width`` (m, 0 to 0.08) and give them time to move."""
@@ -402,6 +485,10 @@ class Arm:
         self.held = None
         self.held_grasp = None
         return held
+
+
+def _joint_distance(a: Sequence[float], b: Sequence[float]) -> float:
+    return float(np.max(np.abs(np.asarray(a) - np.asarray(b))))
 
 
 def _fmt(point: Vec3) -> str:

@@ -30,9 +30,12 @@ __all__ = [
     "HANDOVER_POSE",
     "HOME",
     "KINECT",
+    "KINECT_BODY",
+    "KINECT_MAST",
     "MAP_RESOLUTION",
     "MARKER_HEIGHT",
     "MARKER_OFFSET",
+    "MARKER_PATCH",
     "PEN_LENGTH",
     "PEN_START",
     "PEN_START_YAW",
@@ -147,6 +150,8 @@ MARKER_HEIGHT = PLATFORM_HEIGHT + 0.002
 """Height of the colour marker's top faces, the plane the localiser intersects pixel rays with."""
 MARKER_OFFSET = 0.165
 """The green (front) and magenta (rear) marker patches sit this far ahead of and behind the centre."""
+MARKER_PATCH = (0.12, 0.30)
+"""Size of each marker patch along and across the base (m)."""
 BASE_START = Pose2D(3.0, 1.5, 0.0)
 HANDOVER_POSE = Pose2D(8.5, 2.2, 0.0)
 """Where the base parks so that the right arm can load its platform (south-east of the torso)."""
@@ -188,6 +193,9 @@ KINECT = CameraSpec(
     "Kinect01", (7.75, 2.45, 1.45), (7.75, 3.40, 0.75), (0.0, 0.0, 1.0), fov_deg=45.0, near=0.3, far=4.0
 )
 """The Kinect on a mast at the back of the torso, looking down at the front of the table."""
+KINECT_BODY = Region("Kinect01", 7.62, 7.88, 2.42, 2.48, 1.425, 1.475)
+"""The Kinect's box; the camera sits inside it (its 0.3 m near plane hides the box)."""
+KINECT_MAST = Region("KinectMast", 7.735, 7.765, 2.435, 2.465, TORSO.zmax, KINECT_BODY.zmin)
 
 MAP_RESOLUTION = 0.05
 

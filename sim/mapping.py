@@ -40,7 +40,7 @@ class OccupancyGrid:
     occupied: NDArray[np.bool_] = field(repr=False)
     """Cells with an obstacle, as measured."""
     inflated: NDArray[np.bool_] = field(repr=False)
-    """Cells the base's centre must avoid (obstacles grown by ``inflation_radius``)."""
+    """Cells the base's centre must avoid (obstacles grown by ``inflation_radius`` plus half a cell)."""
     inflation_radius: float
 
     @property
@@ -84,7 +84,7 @@ def inflate(occupied: NDArray[np.bool_], radius_cells: float) -> NDArray[np.bool
     reach = math.ceil(radius_cells)
     for di in range(-reach, reach + 1):
         for dj in range(-reach, reach + 1):
-            if (di == 0 and dj == 0) or di * di + dj * dj > radius_cells * radius_cells:
+            if (di == 0 and dj == 0) or di * di + dj * dj > radius_cells * radius_cells + 1e-9:
                 continue
             src = occupied[max(0, -di) : rows - max(0, di), max(0, -dj) : cols - max(0, dj)]
             out[max(0, di) : rows - max(0, -di), max(0, dj) : cols - max(0, -dj)] |= src
@@ -126,6 +126,6 @@ def build_occupancy_grid(
                     heights[index] = z
         pending = np.asarray(again, dtype=np.intp)
     occupied = (heights > OBSTACLE_HEIGHT).reshape(rows, cols)
-    return OccupancyGrid(
-        resolution, origin, occupied, inflate(occupied, inflation_radius / resolution), inflation_radius
-    )
+    # An obstacle may reach the edge of its cell, half a cell nearer than the cell's centre.
+    radius_cells = (inflation_radius + resolution / 2.0) / resolution
+    return OccupancyGrid(resolution, origin, occupied, inflate(occupied, radius_cells), inflation_radius)

@@ -20,7 +20,7 @@ from numpy.typing import NDArray
 
 from sim.cameras import Frame
 from sim.errors import NotVisibleError, UnknownColourError
-from sim.layout import MARKER_HEIGHT, MARKER_OFFSET, SHIRT_RADIUS, SHIRT_TOP
+from sim.layout import MARKER_HEIGHT, MARKER_OFFSET, MARKER_PATCH, SHIRT_RADIUS, SHIRT_TOP
 
 __all__ = [
     "COLOURS",
@@ -107,6 +107,13 @@ def _pixels(mask: NDArray[np.bool_]) -> tuple[NDArray[np.float64], NDArray[np.fl
     return us.astype(np.float64), vs.astype(np.float64)
 
 
+def _whole(frame: Frame, mask: NDArray[np.bool_], target: str) -> None:
+    """Refuse a blob cut by the image's border: its shape, hence the estimate, would be wrong."""
+    on_border = int(mask[0, :].sum() + mask[-1, :].sum() + mask[:, 0].sum() + mask[:, -1].sum())
+    if on_border:
+        raise NotVisibleError(frame.camera, f"whole {target} (cut by the image border)", 0, 1)
+
+
 @dataclass(frozen=True)
 class RobotPoseEstimate:
     """The base's pose (x, y, theta: the ontology's RobotLocation) as one camera saw it."""
@@ -124,9 +131,20 @@ def locate_robot(frame: Frame, front: str = "green", rear: str = "magenta") -> R
     points = []
     count = 0
     for colour, target in ((front, "marker front"), (rear, "marker rear")):
-        us, vs = _pixels(segment(frame.rgb, colour))
+        mask = segment(frame.rgb, colour)
+        us, vs = _pixels(mask)
         if us.size < MIN_MARKER_PIXELS:
             raise NotVisibleError(frame.camera, f"robot {target} ({colour})", int(us.size), MIN_MARKER_PIXELS)
+        _whole(frame, mask, f"robot {target} ({colour})")
+        # A partly hidden patch would pull its centroid off: compare its pixel count with the fewest
+        # a whole patch covers there, one row and one column less than its size in pixels (pixel
+        # size measured on the marker's plane at the patch).
+        u, v = float(np.median(us)), float(np.median(vs))
+        corners = frame.intersect_plane(np.array([u, u + 1.0, u]), np.array([v, v, v + 1.0]), MARKER_HEIGHT)
+        pixel = math.sqrt(float(np.linalg.norm(np.cross(corners[1] - corners[0], corners[2] - corners[0]))))
+        needed = math.ceil((MARKER_PATCH[0] / pixel - 1.0) * (MARKER_PATCH[1] / pixel - 1.0))
+        if us.size < needed:
+            raise NotVisibleError(frame.camera, f"whole robot {target} ({colour})", int(us.size), needed)
         count += int(us.size)
         points.append(frame.intersect_plane(us, vs, MARKER_HEIGHT)[:, :2].mean(axis=0))
     head, tail = points
@@ -159,9 +177,11 @@ def track_person(frame: Frame, shirt: str = "yellow") -> PersonEstimate:
     Across the viewing direction the blob is symmetric. So: centre = far edge minus the shirt's
     radius along the viewing direction, and the middle of the blob across it.
     """
-    us, vs = _pixels(segment(frame.rgb, shirt))
+    mask = segment(frame.rgb, shirt)
+    us, vs = _pixels(mask)
     if us.size < MIN_PERSON_PIXELS:
         raise NotVisibleError(frame.camera, f"person ({shirt} shirt)", int(us.size), MIN_PERSON_PIXELS)
+    _whole(frame, mask, f"person ({shirt} shirt)")
     points = frame.intersect_plane(us, vs, SHIRT_TOP)[:, :2]
     eye = frame.eye[:2]
     rough = points.mean(axis=0)
@@ -218,6 +238,7 @@ def recognise_object(frame: Frame, colour: str) -> ObjectEstimate:
     us, vs = _pixels(mask)
     if us.size < MIN_OBJECT_PIXELS:
         raise NotVisibleError(frame.camera, f"{colour} object", int(us.size), MIN_OBJECT_PIXELS)
+    _whole(frame, mask, f"{colour} object")
     points = frame.deproject(us, vs)
     xy = points[:, :2]
     mean = xy.mean(axis=0)

@@ -20,6 +20,7 @@ from sim.layout import (
     BELOW_OF_TAP,
     MARKER_HEIGHT,
     MARKER_OFFSET,
+    MARKER_PATCH,
     PERSON_HAND_HEIGHT,
     PLATFORM_HEIGHT,
 )
@@ -191,26 +192,31 @@ def pen_with_person(world: HomeWorld, person: str = "Person") -> bool:
 
 
 def robot_visible(world: HomeWorld, camera: str) -> bool:
-    """Whether a camera can localise the base now: it works, and both marker patches are in its
-    image with nothing between them and the camera (the precondition of isLocalisedIn)."""
+    """Whether a camera can localise the base now: it works, and the centres and corners of both
+    marker patches are in its image with nothing between them and the camera (the precondition of
+    isLocalisedIn)."""
     cam = world.camera(camera)
     if cam.failed:
         return False
     base = world.base_pose()
     spec = cam.spec
-    patches = [
-        (base.x + sign * MARKER_OFFSET * math.cos(base.theta), base.y + sign * MARKER_OFFSET * math.sin(base.theta))
+    c, s = math.cos(base.theta), math.sin(base.theta)
+    half_along, half_across = MARKER_PATCH[0] / 2 - 0.01, MARKER_PATCH[1] / 2 - 0.01
+    # Centre and corners (1 cm inside) of both patches, in the world.
+    local = [
+        (sign * MARKER_OFFSET + da * half_along, db * half_across)
         for sign in (1.0, -1.0)
+        for da, db in ((0, 0), (1, 1), (1, -1), (-1, 1), (-1, -1))
     ]
-    points = np.array([[x, y, MARKER_HEIGHT + 0.001] for x, y in patches])
+    points = np.array([[base.x + a * c - b * s, base.y + a * s + b * c, MARKER_HEIGHT + 0.001] for a, b in local])
     rotation = cam.camera_to_world[:3, :3]
-    local = (points - np.asarray(spec.eye)) @ rotation
-    if np.any(local[:, 2] <= 0):
+    in_camera = (points - np.asarray(spec.eye)) @ rotation
+    if np.any(in_camera[:, 2] <= 0):
         return False
     k = cam.intrinsics
-    us = k.fx * local[:, 0] / local[:, 2] + k.cx
-    vs = k.fy * local[:, 1] / local[:, 2] + k.cy
+    us = k.fx * in_camera[:, 0] / in_camera[:, 2] + k.cx
+    vs = k.fy * in_camera[:, 1] / in_camera[:, 2] + k.cy
     if np.any((us < 0) | (us >= k.width) | (vs < 0) | (vs >= k.height)):
         return False
-    hits = p.rayTestBatch([spec.eye] * 2, points.tolist(), physicsClientId=world.client)
+    hits = p.rayTestBatch([spec.eye] * len(points), points.tolist(), physicsClientId=world.client)
     return all(hit[0] in (-1, world.body("P3DX01")) for hit in hits)

@@ -102,10 +102,12 @@ def fetch_pen(
     world: HomeWorld,
     camera: str = "CeilingCamera01",
     algorithm: str = "astar",
+    person_camera: str = "CeilingCamera01",
     arm: ArmSide = ArmSide.RIGHT,
     grid: OccupancyGrid | None = None,
 ) -> ScenarioResult:
-    """Scenario 2, FetchMyPen. ``camera`` localises the base and tracks the person; ``grid`` reuses a map."""
+    """Scenario 2, FetchMyPen. ``camera`` localises the base, ``person_camera`` tracks the person (only
+    CeilingCamera01 sees the living room's far side); ``grid`` reuses a map instead of measuring one."""
     run = _Run(world, "FetchMyPen", world.time)
 
     def locate() -> RobotPoseEstimate | None:
@@ -128,7 +130,7 @@ def fetch_pen(
     pen = run.sense("RecogniseObjectByColour", lambda: recognise_object(world.camera("Kinect01").capture(), PEN.colour))
     if pen is None or not run.act(skills.hand_over_onto_platform(world, pen, parked, arm)):
         return run.result()
-    person = run.sense(f"TrackPerson_{camera}", lambda: track_person(world.camera(camera).capture()))
+    person = run.sense(f"TrackPerson_{person_camera}", lambda: track_person(world.camera(person_camera).capture()))
     if person is None:
         return run.result()
     here = locate()

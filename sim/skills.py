@@ -57,6 +57,8 @@ LIFT_HEIGHT = 0.04
 """A picked object is lifted 4 cm: clear of the table, and the cup's top stays under the spout."""
 ABOVE_CLEARANCE = 0.03
 """Carrying ends with the object's bottom 3 cm above the target surface."""
+TRANSIT_SAG = 0.02
+"""A joint-space transit may let the grasp point dip 2 cm below the transit height, no more."""
 PLACE_CLEARANCE = 0.003
 """Putting down lowers the object to 3 mm above the surface, then lets go: it drops onto it."""
 PLACE_SPEED = 0.10
@@ -185,10 +187,14 @@ def carry_object(world: HomeWorld, side: ArmSide | str, region: Region, yaw: flo
         (cx, cy, transit),
         (cx, cy, above + grasp.bottom_offset),
     ]
-    for leg in legs:
+    for index, leg in enumerate(legs):
         if math.dist(leg, arm.ee_pose().position) < 1e-3:
             continue
         result = arm.move_to(leg, orientation)
+        if not result.reached and index == 1 and math.isinf(result.error):
+            # The straight line leaves the arm's reach (it would have to change posture on the
+            # way): go through joint space instead, keeping the object at the transit height.
+            result = arm.reach(leg, orientation, min_height=transit - TRANSIT_SAG)
         if not result.reached:
             return _done(world, "CarryObject", start, False, result.reason)
     ok = pred.object_above_region(world, name, region)

@@ -456,18 +456,21 @@ class HomeWorld:
         self._multibody(
             "CytonDualArm01", [_box(half, (0, 0, 0), _TORSO)], ((t.xmin + t.xmax) / 2, (t.ymin + t.ymax) / 2, half[2])
         )
-        k = L.KINECT
-        mast_top = k.eye[2] - 0.03
+        kinect, mast = _half_and_centre(L.KINECT_BODY), _half_and_centre(L.KINECT_MAST)
+        mast_offset = tuple(m - k for m, k in zip(mast[1], kinect[1], strict=True))
         self._multibody(
             "Kinect01",
             [
-                _box((0.13, 0.03, 0.025), (0, 0, 0), _DARK),
-                _box((0.015, 0.015, (mast_top - t.zmax) / 2), (0, 0, -0.025 - (mast_top - t.zmax) / 2), _STEEL),
+                _box(kinect[0], (0, 0, 0), _DARK),
+                _box(mast[0], (mast_offset[0], mast_offset[1], mast_offset[2]), _STEEL),
             ],
-            (k.eye[0], k.eye[1] - 0.06, k.eye[2]),
+            kinect[1],
         )
         mounts = {side: (L.ARM_MOUNTS[side.value], quat_from_yaw(L.ARM_MOUNT_YAW)) for side in ArmSide}
-        self._kinematics = Kinematics(mounts)
+        top = Region(
+            "TableTop", L.TABLE.xmin, L.TABLE.xmax, L.TABLE.ymin, L.TABLE.ymax, L.TABLE_HEIGHT - 0.04, L.TABLE_HEIGHT
+        )
+        self._kinematics = Kinematics(mounts, [L.TORSO, top, L.DISPENSER, L.KINECT_BODY, L.KINECT_MAST])
         for side in ArmSide:
             mount = L.ARM_MOUNTS[side.value]
             body = p.loadURDF(
@@ -482,6 +485,8 @@ class HomeWorld:
             for link in (9, 10):
                 p.changeDynamics(body, link, lateralFriction=1.5, physicsClientId=self.client)
             self.arms[side] = Arm(self.client, side, body, self._kinematics, self.step)
+        for arm in self.arms.values():
+            arm.peers = self.arms
 
     def _build_base(self) -> None:
         bx, by, btheta = self.perturbation.base
@@ -494,11 +499,12 @@ class HomeWorld:
         platform_z = L.PLATFORM_HEIGHT - 0.01 - chassis_centre_z
         marker_z = L.MARKER_HEIGHT - 0.001 - chassis_centre_z
         wheel = (math.sqrt(0.5), 0.0, 0.0, math.sqrt(0.5))  # cylinder axis along y
+        patch = (L.MARKER_PATCH[0] / 2, L.MARKER_PATCH[1] / 2, 0.001)
         parts = [
             _box(chassis_half, (0, 0, 0), _CHASSIS),
             _box((L.BASE_HALF_LENGTH, L.BASE_HALF_WIDTH, 0.01), (0, 0, platform_z), _PLATFORM),
-            _box((0.06, 0.15, 0.001), (L.MARKER_OFFSET, 0, marker_z), MARKER_GREEN, collide=False),
-            _box((0.06, 0.15, 0.001), (-L.MARKER_OFFSET, 0, marker_z), MARKER_MAGENTA, collide=False),
+            _box(patch, (L.MARKER_OFFSET, 0, marker_z), MARKER_GREEN, collide=False),
+            _box(patch, (-L.MARKER_OFFSET, 0, marker_z), MARKER_MAGENTA, collide=False),
             _Part(p.GEOM_CYLINDER, (0.095, 0.04), (0.0, 0.215, 0.095 - chassis_centre_z), _DARK, False, wheel),
             _Part(p.GEOM_CYLINDER, (0.095, 0.04), (0.0, -0.215, 0.095 - chassis_centre_z), _DARK, False, wheel),
         ]
@@ -528,6 +534,12 @@ class HomeWorld:
             ],
             (L.PERSON_START[0] + dx, L.PERSON_START[1] + dy, legs / 2),
         )
+
+
+def _half_and_centre(region: Region) -> tuple[Vec3, Vec3]:
+    half = ((region.xmax - region.xmin) / 2, (region.ymax - region.ymin) / 2, (region.zmax - region.zmin) / 2)
+    centre = ((region.xmin + region.xmax) / 2, (region.ymin + region.ymax) / 2, (region.zmin + region.zmax) / 2)
+    return half, centre
 
 
 @contextmanager

@@ -1,0 +1,141 @@
+"""The occupancy grid measured in the home, and A* / Dijkstra on it."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+
+import numpy as np
+import pytest
+
+from sim import (
+    HomeWorld,
+    NoFreeCellError,
+    NoPathError,
+    OccupancyGrid,
+    OutsideMapError,
+    UnknownAlgorithmError,
+    build_occupancy_grid,
+    plan_path,
+)
+from sim.layout import BASE_RADIUS, HANDOVER_POSE, MAP_RESOLUTION, TABLE, WALLS
+from sim.mapping import inflate
+from sim.planning import approach_point, snap_to_free
+
+
+@pytest.fixture(scope="module")
+def world() -> Iterator[HomeWorld]:
+    with HomeWorld.create(seed=2) as w:
+        yield w
+
+
+@pytest.fixture(scope="module")
+def grid(world: HomeWorld) -> OccupancyGrid:
+    return build_occupancy_grid(world)
+
+
+def test_grid_covers_the_home(grid: OccupancyGrid) -> None:
+    assert grid.shape == (180, 200)
+    assert grid.resolution == MAP_RESOLUTION
+    assert grid.world_to_cell(0.01, 0.01) == (0, 0)
+    assert grid.world_to_cell(9.99, 8.99) == (179, 199)
+    row, col = grid.world_to_cell(3.27, 1.52)
+    x, y = grid.cell_to_world(row, col)
+    assert abs(x - 3.27) <= MAP_RESOLUTION / 2 and abs(y - 1.52) <= MAP_RESOLUTION / 2
+    with pytest.raises(OutsideMapError) as error:
+        grid.world_to_cell(10.5, 2.0)
+    assert (error.value.x, error.value.y) == (10.5, 2.0)
+
+
+def test_walls_are_occupied_and_doors_open(grid: OccupancyGrid) -> None:
+    for wall in WALLS:
+        for t in np.linspace(0.05, 0.95, 7):
+            x = min(max(wall.x0 + t * (wall.x1 - wall.x0), 0.01), 9.99)
+            y = min(max(wall.y0 + t * (wall.y1 - wall.y0), 0.01), 8.99)
+            assert grid.is_occupied(x, y), (wall.name, x, y)
+    assert not grid.is_occupied(6.0, 2.1)  # living room - kitchen door
+    assert not grid.is_occupied(2.5, 5.0)  # living room - bedroom door
+    assert grid.is_free(6.0, 2.1)  # the 1 m door leaves room for the base's 0.6 m
+
+
+def test_furniture_robot_and_person_are_occupied(world: HomeWorld, grid: OccupancyGrid) -> None:
+    for x in np.linspace(TABLE.xmin + 0.05, TABLE.xmax - 0.05, 5):
+        for y in np.linspace(TABLE.ymin + 0.05, TABLE.ymax - 0.05, 5):
+            assert grid.is_occupied(float(x), float(y))
+    assert grid.is_occupied(7.75, 2.55)  # the dual-arm robot's torso
+    person = world.pose("Person").position
+    assert grid.is_occupied(person[0], person[1])
+    base = world.base_pose()
+    assert not grid.is_occupied(base.x, base.y)  # the base does not map itself
+    assert not grid.is_occupied(3.0, 3.0) and not grid.is_occupied(8.0, 1.0)
+
+
+def test_inflation_keeps_the_base_radius_from_obstacles(grid: OccupancyGrid) -> None:
+    west = TABLE.xmin  # the table's west edge, 1 m from the kitchen wall
+    assert grid.is_occupied(west + 0.05, 3.75)
+    assert not grid.is_occupied(west - BASE_RADIUS + 0.05, 3.75)
+    assert not grid.is_free(west - BASE_RADIUS + 0.05, 3.75)  # within the base's radius of the table
+    assert grid.is_free(west - BASE_RADIUS - 0.1, 3.75)
+    assert not grid.is_free(3.0, 0.2)  # 0.2 m from the south wall
+    single = np.zeros((11, 11), dtype=bool)
+    single[5, 5] = True
+    grown = inflate(single, 2.0)
+    assert grown[5, 7] and grown[3, 5] and not grown[5, 8] and not grown[7, 7]
+
+
+@pytest.mark.parametrize(
+    ("start", "goal"),
+    [((3.0, 1.5), HANDOVER_POSE.xy), ((1.0, 1.0), (4.0, 7.5)), ((9.0, 1.0), (1.0, 4.0))],
+    ids=["to-handover", "to-bedroom", "across"],
+)
+def test_astar_and_dijkstra_find_equally_short_collision_free_paths(
+    grid: OccupancyGrid, start: tuple[float, float], goal: tuple[float, float]
+) -> None:
+    astar = plan_path(grid, start, goal, "astar")
+    dijkstra = plan_path(grid, start, goal, "dijkstra")
+    assert astar.length == pytest.approx(dijkstra.length, rel=1e-9)
+    assert astar.length >= math.dist(start, goal) - 2 * MAP_RESOLUTION
+    for path in (astar, dijkstra):
+        assert math.dist(path.waypoints[0], start) < MAP_RESOLUTION
+        assert math.dist(path.waypoints[-1], goal) < MAP_RESOLUTION
+        for a, b in zip(path.waypoints, path.waypoints[1:], strict=False):
+            for t in np.linspace(0.0, 1.0, 50):
+                assert grid.is_free(a[0] + t * (b[0] - a[0]), a[1] + t * (b[1] - a[1]))
+
+
+def test_path_to_the_bedroom_goes_through_its_door(grid: OccupancyGrid) -> None:
+    path = plan_path(grid, (1.0, 1.0), (4.0, 7.5))
+    crossing = [
+        (a, b) for a, b in zip(path.waypoints, path.waypoints[1:], strict=False) if (a[1] - 5.0) * (b[1] - 5.0) < 0
+    ]
+    assert len(crossing) == 1
+    (a, b) = crossing[0]
+    x_at_wall = a[0] + (5.0 - a[1]) / (b[1] - a[1]) * (b[0] - a[0])
+    assert 2.0 < x_at_wall < 3.0
+
+
+def test_a_goal_in_an_obstacle_is_snapped_to_the_nearest_free_cell(grid: OccupancyGrid) -> None:
+    goal = (TABLE.xmin + 0.05, 3.75)  # on the table, by its west edge
+    path = plan_path(grid, (3.0, 1.5), goal)
+    assert grid.is_free(*path.goal)
+    assert math.dist(path.goal, goal) < BASE_RADIUS + 0.05 + 2 * MAP_RESOLUTION
+    assert path.goal[0] < TABLE.xmin - BASE_RADIUS
+    row, col = snap_to_free(grid, 3.0, 3.0)
+    assert grid.cell_to_world(row, col) == grid.cell_to_world(*grid.world_to_cell(3.0, 3.0))
+
+
+def test_planning_fails_clearly(grid: OccupancyGrid) -> None:
+    for algorithm in ("astar", "dijkstra"):
+        with pytest.raises(NoPathError) as error:
+            plan_path(grid, (3.0, 1.5), (8.0, 7.0), algorithm)  # the walled-off north-east corner
+        assert error.value.goal == (8.0, 7.0) and error.value.algorithm == algorithm
+    with pytest.raises(NoFreeCellError) as blocked:
+        plan_path(grid, (7.75, 3.75), (3.0, 1.5))  # the middle of the table, > 1 m from free space
+    assert (blocked.value.x, blocked.value.y) == (7.75, 3.75)
+    with pytest.raises(UnknownAlgorithmError):
+        plan_path(grid, (3.0, 1.5), (4.0, 1.5), "rrt")
+
+
+def test_approach_point_stops_short_of_the_target() -> None:
+    assert approach_point((4.0, 0.0), (0.0, 0.0), 1.0) == pytest.approx((3.0, 0.0))
+    assert approach_point((0.5, 0.0), (0.0, 0.0), 1.0) == (0.0, 0.0)

@@ -1,0 +1,70 @@
+"""Both scenarios of paper section 6.2 end to end, determinism, and a failed camera."""
+
+from __future__ import annotations
+
+import pytest
+
+from sim import HomeWorld, fetch_pen, serve_cup
+from sim import predicates as pred
+from sim.layout import HANDOVER_POSE
+
+SERVE_STEPS = [
+    "ClearView",
+    "RecogniseObjectByColour",
+    "ApproachToObject",
+    "PickUpObject",
+    "CarryObject",
+    "PutDownObject",
+    "FillCupFromTap",
+]
+
+
+def test_scenario_1_serves_a_cup_of_water() -> None:
+    with HomeWorld.create(seed=0) as world:
+        result = serve_cup(world)
+        assert result.succeeded, result.failure
+        assert [step.skill for step in result.steps] == SERVE_STEPS
+        assert pred.cup_below_tap(world) and pred.cup_contains_water(world)
+        assert result.sim_seconds == pytest.approx(sum(step.sim_seconds for step in result.steps))
+
+
+def test_scenario_2_fetches_the_pen() -> None:
+    with HomeWorld.create(seed=0) as world:
+        result = fetch_pen(world)
+        assert result.succeeded, result.failure
+        skills = [step.skill for step in result.steps]
+        assert skills[0] == "LocateMobileRobot_CeilingCamera01"
+        assert skills.index("NavigateToPlace") < skills.index("HandOverOntoPlatform") < skills.index("NavigateToPerson")
+        assert skills[-1] == "DeliverObject"
+        assert pred.pen_with_person(world) and pred.base_near_person(world)
+
+
+def test_scenario_2_localising_with_the_other_camera_and_dijkstra() -> None:
+    with HomeWorld.create(seed=9) as world:
+        result = fetch_pen(world, camera="CeilingCamera02", algorithm="dijkstra")
+        assert result.succeeded, result.failure
+        skills = [step.skill for step in result.steps]
+        assert skills.count("LocateMobileRobot_CeilingCamera02") == 3 and "PlanPath_dijkstra" in skills
+        assert pred.pen_with_person(world)
+
+
+def test_a_failed_camera_stops_the_scenario_with_a_reason() -> None:
+    with HomeWorld.create(seed=0) as world:
+        world.fail_camera("CeilingCamera01")
+        result = fetch_pen(world)
+        assert not result.succeeded
+        failure = result.failure
+        assert failure is not None and failure.skill == "LocateMobileRobot_CeilingCamera01"
+        assert "CeilingCamera01 is not available" in failure.reason
+        assert not pred.base_near(world, HANDOVER_POSE)
+
+
+def test_same_seed_same_outcome_other_seed_other_outcome() -> None:
+    runs = []
+    for seed in (1, 1, 2):
+        with HomeWorld.create(seed=seed) as world:
+            result = serve_cup(world)
+            runs.append((result.succeeded, [(s.skill, s.finished) for s in result.steps], world.snapshot()))
+    assert runs[0] == runs[1]
+    assert runs[0][0] and runs[2][0]
+    assert runs[0][2]["Cup"] != runs[2][2]["Cup"]
