@@ -1,4 +1,40 @@
-"""Composition and execution: service resource graph, plans, component container.
+"""Composition (and, next, execution): the action model, the service resource graph, plans.
 
-Empty until the composition work lands; see docs/architecture.md for where it fits.
+``Composer(kb).compose("FetchMyPen")`` gives a ``CompositionResult`` with the plan or the needs no
+component meets; docs/composition.md explains the algorithm.
 """
+
+from actions.composer import (
+    ComposeConfig,
+    Composer,
+    CompositionResult,
+    Objective,
+    PlanStatus,
+    Unsatisfied,
+    store_plan,
+)
+from actions.errors import ActionsError, OrderingConflictError, UnknownTaskError
+from actions.model import ActionClass, ActionLibrary, Ordering, Task, resolve_task
+from actions.plan import Binding, Plan, PlanStep, Source
+
+__all__ = [
+    "ActionClass",
+    "ActionLibrary",
+    "ActionsError",
+    "Binding",
+    "ComposeConfig",
+    "Composer",
+    "CompositionResult",
+    "Objective",
+    "Ordering",
+    "OrderingConflictError",
+    "Plan",
+    "PlanStatus",
+    "PlanStep",
+    "Source",
+    "Task",
+    "UnknownTaskError",
+    "Unsatisfied",
+    "resolve_task",
+    "store_plan",
+]
