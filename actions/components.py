@@ -1,0 +1,226 @@
+"""Atomic components and the container that manages their lifecycle (paper sections 2.1 and 5).
+
+A component implements one advertised service. The container creates it on first use, hands it its
+resources (``initialise``), runs invocations (``begin`` then ``update`` tick by tick), and moves it
+through a fixed lifecycle; an illegal transition is a bug and raises ``LifecycleError``.
+
+    created -> initialised -> running <-> suspended -> stopped -> (running again) ... -> finalised
+                                  \\-------------------> error ---------------------------^
+
+Components are tested tick by tick with stubs; no simulator is needed (tests/test_execution.py).
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from enum import Enum
+from typing import Any
+
+from actions.errors import ActionsError
+from actions.events import EventBus, Priority
+
+
+class Status(Enum):
+    """What one tick of a component's invocation says."""
+
+    RUNNING = "running"
+    SUCCEEDED = "succeeded"
+    FAILED = "failed"
+
+
+class LifecycleState(Enum):
+    CREATED = "created"
+    INITIALISED = "initialised"
+    RUNNING = "running"
+    SUSPENDED = "suspended"
+    STOPPED = "stopped"
+    ERROR = "error"
+    FINALISED = "finalised"
+
+
+_ALLOWED: dict[LifecycleState, frozenset[LifecycleState]] = {
+    LifecycleState.CREATED: frozenset({LifecycleState.INITIALISED, LifecycleState.ERROR, LifecycleState.FINALISED}),
+    LifecycleState.INITIALISED: frozenset({LifecycleState.RUNNING, LifecycleState.ERROR, LifecycleState.FINALISED}),
+    LifecycleState.RUNNING: frozenset({LifecycleState.SUSPENDED, LifecycleState.STOPPED, LifecycleState.ERROR}),
+    LifecycleState.SUSPENDED: frozenset({LifecycleState.RUNNING, LifecycleState.STOPPED, LifecycleState.ERROR}),
+    LifecycleState.STOPPED: frozenset({LifecycleState.RUNNING, LifecycleState.ERROR, LifecycleState.FINALISED}),
+    LifecycleState.ERROR: frozenset({LifecycleState.FINALISED}),
+    LifecycleState.FINALISED: frozenset(),
+}
+
+
+class LifecycleError(ActionsError):
+    """A component was asked for a transition its lifecycle does not allow."""
+
+    def __init__(self, component: str, current: LifecycleState, wanted: LifecycleState) -> None:
+        self.component = component
+        self.current = current
+        self.wanted = wanted
+        super().__init__(f"component {component}: cannot go from {current.value} to {wanted.value}")
+
+
+class NoImplementationError(ActionsError):
+    """The plan uses a component no implementation is registered for."""
+
+    http_status = 501
+
+    def __init__(self, component: str) -> None:
+        self.component = component
+        super().__init__(f"no implementation for component {component}")
+
+
+class InjectedFault(RuntimeError):
+    """Raised inside a component whose failure was injected (``--fail``)."""
+
+
+class Component(ABC):
+    """One advertised service, implemented. Subclasses override ``begin`` and ``update``."""
+
+    def __init__(self, iri: str) -> None:
+        self.iri = iri
+        self.outputs: dict[str, Any] = {}
+        self.reason = ""  # why the last invocation failed
+
+    def initialise(self, context: Any) -> None:
+        """Take the resources the component needs (a simulated world, a knowledge base)."""
+        return None
+
+    @abstractmethod
+    def begin(self, inputs: Mapping[str, Any]) -> None:
+        """Start one invocation with its inputs (by parameter name)."""
+
+    @abstractmethod
+    def update(self) -> Status:
+        """Advance the invocation by one tick."""
+
+    def halt(self) -> None:
+        """Stop an invocation that is still running (on timeout or failover)."""
+        return None
+
+    def finalise(self) -> None:
+        """Release what ``initialise`` took."""
+        return None
+
+
+@dataclass
+class Managed:
+    component: Component
+    state: LifecycleState = LifecycleState.CREATED
+    failing: bool = False  # an injected fault: every invocation raises
+    history: list[LifecycleState] = field(default_factory=lambda: [LifecycleState.CREATED])
+
+
+class Container:
+    """Creates, runs and retires components; publishes every lifecycle change on the event bus."""
+
+    def __init__(self, factory: Callable[[str], Component], context: Any = None, bus: EventBus | None = None) -> None:
+        self._factory = factory
+        self._context = context
+        self.bus = bus or EventBus()
+        self._managed: dict[str, Managed] = {}
+        self._faults: set[str] = set()
+
+    def inject_fault(self, iri: str) -> None:
+        """Make every invocation of ``iri`` fail from now on (fault-tolerance tests, ``--fail``)."""
+        self._faults.add(iri)
+        if iri in self._managed:
+            self._managed[iri].failing = True
+
+    def state(self, iri: str) -> LifecycleState:
+        return self._managed[iri].state if iri in self._managed else LifecycleState.CREATED
+
+    def history(self, iri: str) -> list[LifecycleState]:
+        return list(self._managed[iri].history) if iri in self._managed else []
+
+    def component(self, iri: str) -> Component:
+        """The component for ``iri``, created and initialised on first use."""
+        if iri not in self._managed:
+            managed = Managed(self._factory(iri), failing=iri in self._faults)
+            self._managed[iri] = managed
+            self._publish(iri, LifecycleState.CREATED)
+            try:
+                managed.component.initialise(self._context)
+            except Exception as error:
+                managed.component.reason = f"initialise failed: {error}"
+                self._move(iri, LifecycleState.ERROR)
+                raise
+            self._move(iri, LifecycleState.INITIALISED)
+        return self._managed[iri].component
+
+    def start(self, iri: str, inputs: Mapping[str, Any]) -> None:
+        component = self.component(iri)
+        self._move(iri, LifecycleState.RUNNING)
+        component.outputs = {}
+        component.reason = ""
+        if self._managed[iri].failing:
+            raise InjectedFault(f"injected failure of {iri}")
+        component.begin(inputs)
+
+    def tick(self, iri: str) -> Status:
+        managed = self._managed[iri]
+        if managed.state is LifecycleState.SUSPENDED:
+            return Status.RUNNING
+        if managed.failing:
+            raise InjectedFault(f"injected failure of {iri}")
+        status = managed.component.update()
+        if status is not Status.RUNNING:
+            self._move(iri, LifecycleState.STOPPED)
+        return status
+
+    def suspend(self, iri: str) -> None:
+        self._move(iri, LifecycleState.SUSPENDED)
+
+    def resume(self, iri: str) -> None:
+        self._move(iri, LifecycleState.RUNNING)
+
+    def abort(self, iri: str, reason: str) -> None:
+        """An invocation went wrong: halt it and put the component in the error state."""
+        managed = self._managed.get(iri)
+        if managed is None or managed.state in (LifecycleState.ERROR, LifecycleState.FINALISED):
+            return
+        if managed.state in (LifecycleState.RUNNING, LifecycleState.SUSPENDED):
+            managed.component.halt()
+        managed.component.reason = reason
+        self._move(iri, LifecycleState.ERROR)
+
+    def finalise_all(self) -> None:
+        for iri, managed in self._managed.items():
+            if managed.state in (LifecycleState.RUNNING, LifecycleState.SUSPENDED):
+                managed.component.halt()
+                self._move(iri, LifecycleState.STOPPED)
+            if managed.state is not LifecycleState.FINALISED:
+                managed.component.finalise()
+                self._move(iri, LifecycleState.FINALISED)
+
+    def _move(self, iri: str, wanted: LifecycleState) -> None:
+        managed = self._managed[iri]
+        if wanted not in _ALLOWED[managed.state]:
+            raise LifecycleError(iri, managed.state, wanted)
+        managed.state = wanted
+        managed.history.append(wanted)
+        self._publish(iri, wanted)
+
+    def _publish(self, iri: str, state: LifecycleState) -> None:
+        priority = Priority.HIGH if state is LifecycleState.ERROR else Priority.NORMAL
+        self.bus.publish("/cbrs/lifecycle", {"component": iri, "state": state.value}, priority)
+
+
+class Registry:
+    """Component implementations by service IRI: what a container's factory looks up."""
+
+    def __init__(self) -> None:
+        self._makers: dict[str, Callable[[str], Component]] = {}
+
+    def add(self, iri: str, maker: Callable[[str], Component]) -> None:
+        self._makers[iri] = maker
+
+    def __contains__(self, iri: object) -> bool:
+        return iri in self._makers
+
+    def __call__(self, iri: str) -> Component:
+        maker = self._makers.get(iri)
+        if maker is None:
+            raise NoImplementationError(iri)
+        return maker(iri)

@@ -1,0 +1,273 @@
+"""Plan execution with fault tolerance (paper section 5).
+
+The executor runs a plan step by step, tick by tick: it resolves each step's inputs from the plan's
+bindings (an earlier step's outputs or the task's given values), starts the step's component in the
+container, ticks it, and checks the step's effects with a verifier. A *violation* (an exception, a
+failed status, a timeout, or an effect not reached) switches the step to its next-best alternative
+component and carries on; when a step has no alternative left, the run fails and the report says
+which step and which need could not be met.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from enum import Enum
+from typing import Any, Protocol
+
+from actions.components import Container, LifecycleState, Status
+from actions.events import Priority
+from actions.graph import statement_text
+from actions.plan import Plan, PlanStep
+from kb import Statement
+
+
+class RunStatus(Enum):
+    RUNNING = "running"
+    SUCCEEDED = "succeeded"
+    FAILED = "failed"
+
+
+class Verifier(Protocol):
+    def __call__(self, step: PlanStep, effect: Statement, outputs: Mapping[str, Any]) -> bool | None:
+        """Whether ``effect`` holds now (None: it cannot be checked)."""
+
+
+@dataclass
+class Attempt:
+    component: str
+    outcome: str  # "succeeded" or "failed"
+    reason: str = ""
+    ticks: int = 0
+    seconds: float = 0.0  # on the executor's clock (simulated seconds in the simulation)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "component": self.component,
+            "outcome": self.outcome,
+            "reason": self.reason,
+            "ticks": self.ticks,
+            "seconds": round(self.seconds, 3),
+        }
+
+
+@dataclass
+class StepReport:
+    index: int
+    planned: str  # the component the plan chose
+    attempts: list[Attempt] = field(default_factory=list)
+    effects: list[tuple[Statement, bool | None]] = field(default_factory=list)
+    outcome: str = "pending"
+
+    @property
+    def component(self) -> str:
+        """The component that did the step (the last one tried)."""
+        return self.attempts[-1].component if self.attempts else self.planned
+
+    @property
+    def failed_over(self) -> bool:
+        """Whether another component than the planned one did (or last tried) the step."""
+        return self.component != self.planned
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "index": self.index,
+            "planned": self.planned,
+            "component": self.component,
+            "outcome": self.outcome,
+            "seconds": round(sum(a.seconds for a in self.attempts), 3),
+            "failover": self.failed_over,
+            "attempts": [a.to_dict() for a in self.attempts],
+            "effects": [{"statement": statement_text(s), "verified": ok} for s, ok in self.effects],
+        }
+
+
+@dataclass
+class ExecutionReport:
+    task: str
+    status: RunStatus
+    steps: list[StepReport]
+    reason: str = ""
+    ticks: int = 0
+    seconds: float = 0.0
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "task": self.task,
+            "status": self.status.value,
+            "reason": self.reason,
+            "ticks": self.ticks,
+            "seconds": round(self.seconds, 3),
+            "steps": [s.to_dict() for s in self.steps],
+        }
+
+
+class Executor:
+    """Runs one plan in a container; ``tick()`` advances it, ``run()`` ticks until it ends."""
+
+    def __init__(
+        self,
+        plan: Plan,
+        container: Container,
+        given: Mapping[str, Any],
+        verifier: Verifier | None = None,
+        clock: Callable[[], float] | None = None,
+        step_timeout: int = 10_000,
+    ) -> None:
+        self.plan = plan
+        self.container = container
+        self.given = dict(given)
+        self.verifier = verifier
+        self.clock = clock or (lambda: 0.0)
+        self.step_timeout = step_timeout
+        self.results: dict[int, dict[str, Any]] = {}
+        self.reports = [StepReport(s.index, s.component) for s in plan.steps]
+        self.status = RunStatus.RUNNING
+        self.reason = ""
+        self.ticks = 0
+        self._position = 0  # index into plan.steps
+        self._active: str | None = None
+        self._tried: list[str] = []
+        self._started_tick = 0
+        self._started_at = 0.0
+        self._began = self.clock()
+
+    # -- driving -----------------------------------------------------------------------------------
+
+    def run(self, max_ticks: int = 1_000_000) -> ExecutionReport:
+        while self.status is RunStatus.RUNNING and self.ticks < max_ticks:
+            self.tick()
+        if self.status is RunStatus.RUNNING:
+            self._finish(RunStatus.FAILED, f"stopped after {max_ticks} ticks")
+        return self.report()
+
+    def tick(self) -> RunStatus:
+        if self.status is not RunStatus.RUNNING:
+            return self.status
+        self.ticks += 1
+        if self._position >= len(self.plan.steps):
+            self._finish(RunStatus.SUCCEEDED)
+            return self.status
+        step = self.plan.steps[self._position]
+        if self._active is None:
+            self._start(step)
+        else:
+            self._advance(step)
+        self.container.bus.dispatch()
+        return self.status
+
+    def report(self) -> ExecutionReport:
+        return ExecutionReport(
+            self.plan.task, self.status, self.reports, self.reason, self.ticks, self.clock() - self._began
+        )
+
+    # -- one step ----------------------------------------------------------------------------------
+
+    def _candidates(self, step: PlanStep) -> list[str]:
+        """The step's components not yet tried for it and not broken by an earlier violation."""
+        return [
+            c
+            for c in (step.component, *step.alternatives)
+            if c not in self._tried and self.container.state(c) is not LifecycleState.ERROR
+        ]
+
+    def _start(self, step: PlanStep) -> None:
+        candidates = self._candidates(step)
+        if not candidates:
+            report = self.reports[self._position]
+            report.outcome = "failed"
+            last = report.attempts[-1].reason if report.attempts else "no component"
+            self._finish(
+                RunStatus.FAILED,
+                f"step {step.index} ({_short(step.component)}) failed with no alternative left: {last}",
+            )
+            return
+        iri = candidates[0]
+        self._tried.append(iri)
+        self._active = iri
+        self._started_tick = self.ticks
+        self._started_at = self.clock()
+        self._publish("step_started", step, iri)
+        try:
+            self.container.start(iri, self._inputs(step))
+        except Exception as error:  # a component may raise anything: it is a violation, not a crash
+            self._violation(step, iri, f"{type(error).__name__}: {error}")
+
+    def _advance(self, step: PlanStep) -> None:
+        iri = self._active
+        assert iri is not None
+        try:
+            status = self.container.tick(iri)
+        except Exception as error:
+            self._violation(step, iri, f"{type(error).__name__}: {error}")
+            return
+        if status is Status.RUNNING:
+            if self.ticks - self._started_tick >= self.step_timeout:
+                self._violation(step, iri, f"timeout after {self.step_timeout} ticks")
+            return
+        component = self.container.component(iri)
+        if status is Status.FAILED:
+            self._violation(step, iri, component.reason or "failed")
+            return
+        checks = [(effect, self._verify(step, effect, component.outputs)) for effect in step.effects]
+        missed = [statement_text(effect) for effect, ok in checks if ok is False]
+        if missed:
+            self.reports[self._position].effects = checks
+            self._violation(step, iri, "effect not reached: " + ", ".join(missed))
+            return
+        report = self.reports[self._position]
+        report.attempts.append(self._attempt(iri, "succeeded"))
+        report.effects = checks
+        report.outcome = "succeeded"
+        self.results[step.index] = dict(component.outputs)
+        self._publish("step_succeeded", step, iri)
+        self._active = None
+        self._tried = []
+        self._position += 1
+
+    def _verify(self, step: PlanStep, effect: Statement, outputs: Mapping[str, Any]) -> bool | None:
+        if self.verifier is None:
+            return None
+        return self.verifier(step, effect, outputs)
+
+    def _violation(self, step: PlanStep, iri: str, reason: str) -> None:
+        """Record the failed attempt; the next tick starts the next alternative (or fails the run)."""
+        self.container.abort(iri, reason)
+        report = self.reports[self._position]
+        report.attempts.append(self._attempt(iri, "failed", reason))
+        left = self._candidates(step)
+        self._publish("step_failed", step, iri, reason=reason, failover=left[0] if left else None)
+        self._active = None
+
+    def _attempt(self, iri: str, outcome: str, reason: str = "") -> Attempt:
+        return Attempt(iri, outcome, reason, self.ticks - self._started_tick, self.clock() - self._started_at)
+
+    def _inputs(self, step: PlanStep) -> dict[str, Any]:
+        values: dict[str, Any] = {}
+        for binding in step.inputs:
+            source = binding.source
+            if source.step is None:
+                if source.name not in self.given:
+                    raise KeyError(f"the task gives no value for {source.name!r}")
+                values[binding.name] = self.given[source.name]
+            else:
+                values[binding.name] = self.results[source.step][source.name]
+        return values
+
+    def _finish(self, status: RunStatus, reason: str = "") -> None:
+        self.status = status
+        self.reason = reason
+        self.container.bus.publish(
+            "/cbrs/task",
+            {"task": self.plan.task, "status": status.value, "reason": reason},
+            Priority.HIGH if status is RunStatus.FAILED else Priority.NORMAL,
+        )
+        self.container.bus.dispatch()
+
+    def _publish(self, kind: str, step: PlanStep, iri: str, **extra: Any) -> None:
+        message = {"event": kind, "task": self.plan.task, "step": step.index, "component": iri, **extra}
+        self.container.bus.publish("/cbrs/task_progress", message)
+
+
+def _short(iri: str) -> str:
+    return iri.rsplit("#", 1)[-1].rsplit("/", 1)[-1]
