@@ -2,7 +2,8 @@
 
 The executor runs a plan step by step, tick by tick: it resolves each step's inputs from the plan's
 bindings (an earlier step's outputs or the task's given values), starts the step's component in the
-container, ticks it, and checks the step's effects with a verifier. A *violation* (an exception, a
+container, ticks it, and checks with a verifier the statements the rest of the plan relies on from
+that step (later steps' preconditions and the requirement's effects). A *violation* (an exception, a
 failed status, a timeout, or an effect not reached) switches the step to its next-best alternative
 component and carries on; when a step has no alternative left, the run fails and the report says
 which step and which need could not be met.
@@ -29,8 +30,8 @@ class RunStatus(Enum):
 
 
 class Verifier(Protocol):
-    def __call__(self, step: PlanStep, effect: Statement, outputs: Mapping[str, Any]) -> bool | None:
-        """Whether ``effect`` holds now (None: it cannot be checked)."""
+    def __call__(self, step: PlanStep, statement: Statement, outputs: Mapping[str, Any]) -> bool | None:
+        """Whether ``statement`` holds now (None: it cannot be checked)."""
 
 
 @dataclass
@@ -121,6 +122,14 @@ class Executor:
         self.clock = clock or (lambda: 0.0)
         self.step_timeout = step_timeout
         self.results: dict[int, dict[str, Any]] = {}
+        # What the rest of the plan relies on from each step: its consumers' preconditions and the
+        # requirement's effects, as they were requested (the advertised effect may be more general).
+        self.needed: dict[int, list[Statement]] = {}
+        for binding in [b for s in plan.steps for b in s.preconditions] + list(plan.goals):
+            if binding.statement is not None and binding.source.step is not None:
+                wanted = self.needed.setdefault(binding.source.step, [])
+                if binding.statement not in wanted:
+                    wanted.append(binding.statement)
         self.reports = [StepReport(s.index, s.component) for s in plan.steps]
         self.status = RunStatus.RUNNING
         self.reason = ""
@@ -209,7 +218,7 @@ class Executor:
         if status is Status.FAILED:
             self._violation(step, iri, component.reason or "failed")
             return
-        checks = [(effect, self._verify(step, effect, component.outputs)) for effect in step.effects]
+        checks = [(need, self._verify(step, need, component.outputs)) for need in self.needed.get(step.index, [])]
         missed = [statement_text(effect) for effect, ok in checks if ok is False]
         if missed:
             self.reports[self._position].effects = checks
@@ -225,10 +234,10 @@ class Executor:
         self._tried = []
         self._position += 1
 
-    def _verify(self, step: PlanStep, effect: Statement, outputs: Mapping[str, Any]) -> bool | None:
+    def _verify(self, step: PlanStep, statement: Statement, outputs: Mapping[str, Any]) -> bool | None:
         if self.verifier is None:
             return None
-        return self.verifier(step, effect, outputs)
+        return self.verifier(step, statement, outputs)
 
     def _violation(self, step: PlanStep, iri: str, reason: str) -> None:
         """Record the failed attempt; the next tick starts the next alternative (or fails the run)."""

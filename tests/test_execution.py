@@ -79,15 +79,18 @@ def step(
     )
 
 
-def plan(*steps: PlanStep) -> Plan:
-    return Plan(EX + "Task", EX + "Req", "direct", steps, (), 1.0, float(len(steps)))
+def plan(*steps: PlanStep, goals: tuple[Binding, ...] = ()) -> Plan:
+    return Plan(EX + "Task", EX + "Req", "direct", steps, goals, 1.0, float(len(steps)))
 
 
 def chain(second_alternatives: tuple[str, ...] = (), effects: tuple[Statement, ...] = ()) -> Plan:
+    """A -> B -> C; ``effects``: what the requirement needs B to have brought about."""
+    goals = tuple(Binding("precondition", "done", Source("e", 2), "Exact", 1.0, None, e) for e in effects)
     return plan(
         step(1, "A", Source("given", None, EX + "Req")),
         step(2, "B", Source("out", 1), second_alternatives, effects),
         step(3, "C", Source("out", 2)),
+        goals=goals,
     )
 
 

@@ -33,7 +33,7 @@ def _normalise(value: str) -> str:
 def test_named_query_known_answer(case: dict[str, Any]) -> None:
     kb = KnowledgeBase(Store.open(":memory:"))
     kb.load([ontology_dir() / "core.ttl"], graph="ontology")
-    kb.load([DATA / name for name in case["data"]])
+    kb.load([DATA / name for name in case["data"]], graph=case.get("graph"))
     rows = kb.select(case["query"], {k: _expand(v) for k, v in case.get("bind", {}).items()})
     if "only_prefix" in case:  # the case lists only rows whose first variable starts with this
         first = next(iter(case["rows"][0]))

@@ -1,0 +1,64 @@
+"""The belief state: what the robot believes about the world now, as RDF in the world graph.
+
+KnowRob keeps beliefs in the knowledge base so that a query answers "where is the pen now". Here the
+world graph is rewritten from an ``Observation`` after every executed step, in one transaction: the
+things (typed individuals), the relations that hold between them (the verified effects among them)
+and their positions. Queries ``world_facts`` and ``world_positions`` read it back.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import pyoxigraph as ox
+
+from kb import GraphName, KnowledgeBase
+from kb.namespaces import BASE, PREFIXES
+from kb.vocab import CBRS
+
+WORLD = BASE + "world#"
+STATE = WORLD + "State"
+_TYPE = ox.NamedNode(PREFIXES["rdf"] + "type")
+_DOUBLE = ox.NamedNode(PREFIXES["xsd"] + "double")
+
+
+@dataclass(frozen=True)
+class Observation:
+    """Things with their classes, the relations that hold, positions, and when (simulated seconds)."""
+
+    types: Mapping[str, str] = field(default_factory=dict)
+    facts: frozenset[tuple[str, str, str]] = frozenset()
+    positions: Mapping[str, tuple[float, float, float]] = field(default_factory=dict)
+    time: float = 0.0
+
+
+class BeliefState:
+    def __init__(self, kb: KnowledgeBase) -> None:
+        self.kb = kb
+
+    def write(self, observation: Observation) -> None:
+        """Replace the world graph with ``observation``, atomically."""
+        graph = GraphName.WORLD.node
+        old = list(self.kb.store.quads(graph=graph))
+        new = [ox.Quad(ox.NamedNode(t), _TYPE, ox.NamedNode(c), graph) for t, c in sorted(observation.types.items())]
+        new += [
+            ox.Quad(ox.NamedNode(s), ox.NamedNode(p), ox.NamedNode(o), graph) for s, p, o in sorted(observation.facts)
+        ]
+        for thing, xyz in sorted(observation.positions.items()):
+            for axis, value in zip((CBRS.positionX, CBRS.positionY, CBRS.positionZ), xyz, strict=True):
+                new.append(ox.Quad(ox.NamedNode(thing), ox.NamedNode(axis), _double(value), graph))
+        new.append(ox.Quad(ox.NamedNode(STATE), ox.NamedNode(CBRS.believedAt), _double(observation.time), graph))
+        self.kb.store.replace(old, new)
+
+    def facts(self, thing: str | None = None) -> set[tuple[str, str, str]]:
+        rows = self.kb.select("world_facts", {"thing": thing} if thing else None)
+        return {(r["thing"].value, r["relation"].value, r["other"].value) for r in rows}
+
+    def positions(self) -> dict[str, tuple[float, float, float]]:
+        rows = self.kb.select("world_positions")
+        return {r["thing"].value: (float(r["x"].value), float(r["y"].value), float(r["z"].value)) for r in rows}
+
+
+def _double(value: float) -> ox.Literal:
+    return ox.Literal(repr(round(float(value), 4)), datatype=_DOUBLE)

@@ -1,0 +1,96 @@
+"""Plan, then execute: what ``cbrs run`` and the task services do, for any environment.
+
+An ``Environment`` provides the component implementations, the values the task gives (the world's
+cup, pen, person), the effect verifier, observations for the belief state, and a clock. The
+simulation provides one (``sim.components``); tests provide stubs.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+from actions.belief import BeliefState, Observation
+from actions.components import Container, Registry
+from actions.composer import Composer, CompositionResult, PlanStatus, store_plan
+from actions.events import Event, EventBus
+from actions.executor import ExecutionReport, Executor
+from actions.plan import Plan, PlanStep
+from kb import KnowledgeBase, Requirement, Statement
+
+
+class Environment(Protocol):
+    registry: Registry
+    context: Any
+
+    def given(self, plan: Plan, requirements: Mapping[str, Requirement]) -> dict[str, Any]:
+        """Values for the inputs the task's requirement(s) give, by parameter name."""
+
+    def verify(self, step: PlanStep, statement: Statement, outputs: Mapping[str, Any]) -> bool | None:
+        """Whether ``statement`` holds now in the environment."""
+
+    def observe(self) -> Observation:
+        """The belief state to write to the world graph now."""
+
+    def clock(self) -> float:
+        """Seconds on the environment's clock (simulated time)."""
+
+
+@dataclass(frozen=True)
+class RunResult:
+    composition: CompositionResult
+    report: ExecutionReport | None  # None when there was no plan to run
+
+    @property
+    def succeeded(self) -> bool:
+        return self.report is not None and self.report.status.value == "succeeded"
+
+    def to_dict(self) -> dict[str, Any]:
+        found: dict[str, Any] = {
+            "task": self.composition.task,
+            "status": self.report.status.value if self.report else PlanStatus.UNSOLVABLE.value,
+            "plan": self.composition.to_dict(),
+        }
+        if self.report is not None:
+            found["execution"] = self.report.to_dict()
+        return found
+
+
+def run_task(
+    kb: KnowledgeBase,
+    task: str,
+    environment: Environment,
+    faults: Iterable[str] = (),
+    composer: Composer | None = None,
+    on_event: Callable[[Event], None] | None = None,
+    max_ticks: int = 100_000,
+) -> RunResult:
+    """Compose ``task``, store the plan, run it in ``environment`` and keep the world graph current."""
+    composer = composer or Composer(kb)
+    composition = composer.compose(task)
+    if composition.plan is None:
+        return RunResult(composition, None)
+    plan = composition.plan
+    store_plan(kb, plan)
+    bus = EventBus()
+    if on_event is not None:
+        bus.subscribe("*", on_event)
+    container = Container(environment.registry, environment.context, bus)
+    for iri in faults:
+        container.inject_fault(iri)
+    requirements = {r.iri: r for r in kb.requirements()}
+    belief = BeliefState(kb)
+    belief.write(environment.observe())
+    executor = Executor(plan, container, environment.given(plan, requirements), environment.verify, environment.clock)
+    done = 0
+    try:
+        while executor.tick().value == "running" and executor.ticks < max_ticks:
+            if len(executor.results) != done:
+                done = len(executor.results)
+                belief.write(environment.observe())
+        report = executor.run(max_ticks) if executor.ticks >= max_ticks else executor.report()
+    finally:
+        container.finalise_all()
+    belief.write(environment.observe())
+    return RunResult(composition, report)
