@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 from sim.errors import CameraUnavailableError
 from sim.layout import CameraSpec
 
-__all__ = ["Camera", "Frame", "Intrinsics", "camera_to_world"]
+__all__ = ["Camera", "Clock", "Frame", "Intrinsics", "camera_to_world", "project"]
 # Where the TINY renderer samples pixel (u, v), in continuous image coordinates: at the pixel's corner
 # in OpenGL's bottom-up rows, which is (u, v + 1) counted from the top. Measured, not assumed: with
 # centres (u + 0.5, v + 0.5) every estimate was half a pixel (1.7 cm on the floor) off.
@@ -61,6 +61,19 @@ def camera_to_world(spec: CameraSpec) -> NDArray[np.float64]:
     return transform
 
 
+def project(
+    intrinsics: Intrinsics, camera_to_world: NDArray[np.float64], points: NDArray[np.float64]
+) -> NDArray[np.float64]:
+    """Pixel coordinates (N x 2) of world points for a calibration (the inverse of ``Frame.rays``)."""
+    cam = (np.atleast_2d(points) - camera_to_world[:3, 3]) @ camera_to_world[:3, :3]
+    k = intrinsics
+    with np.errstate(divide="ignore", invalid="ignore"):
+        u = np.where(cam[:, 2] > 0, k.fx * cam[:, 0] / cam[:, 2] + k.cx - _SAMPLE_U, np.nan)
+        v = np.where(cam[:, 2] > 0, k.fy * cam[:, 1] / cam[:, 2] + k.cy - _SAMPLE_V, np.nan)
+    pixels: NDArray[np.float64] = np.stack([u, v], axis=-1)
+    return pixels
+
+
 @dataclass(frozen=True)
 class Frame:
     """One capture: the images, when they were taken (sim seconds) and the calibration."""
@@ -98,14 +111,9 @@ class Frame:
         return self.eye + self.rays(us, vs) * depth[:, None]
 
     def project(self, points: NDArray[np.float64]) -> NDArray[np.float64]:
-        """Pixel coordinates (N x 2, u and v, continuous) of world points; behind-camera points get NaN."""
-        rotation = self.camera_to_world[:3, :3]
-        cam = (np.atleast_2d(points) - self.eye) @ rotation
-        k = self.intrinsics
-        with np.errstate(divide="ignore", invalid="ignore"):
-            u = np.where(cam[:, 2] > 0, k.fx * cam[:, 0] / cam[:, 2] + k.cx, np.nan)
-            v = np.where(cam[:, 2] > 0, k.fy * cam[:, 1] / cam[:, 2] + k.cy, np.nan)
-        return np.stack([u, v], axis=-1)
+        """Pixel coordinates (N x 2, u and v) of world points: the pixel whose sample point they fall
+        on is (floor(u), floor(v)). Points behind the camera get NaN."""
+        return project(self.intrinsics, self.camera_to_world, points)
 
 
 class Clock(Protocol):

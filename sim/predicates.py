@@ -13,6 +13,7 @@ import numpy as np
 import pybullet as p
 
 from sim.arms import ArmSide
+from sim.cameras import project
 from sim.geometry import Pose2D, Region, quat_to_matrix
 from sim.layout import (
     BASE_HALF_LENGTH,
@@ -209,14 +210,10 @@ def robot_visible(world: HomeWorld, camera: str) -> bool:
         for da, db in ((0, 0), (1, 1), (1, -1), (-1, 1), (-1, -1))
     ]
     points = np.array([[base.x + a * c - b * s, base.y + a * s + b * c, MARKER_HEIGHT + 0.001] for a, b in local])
-    rotation = cam.camera_to_world[:3, :3]
-    in_camera = (points - np.asarray(spec.eye)) @ rotation
-    if np.any(in_camera[:, 2] <= 0):
-        return False
+    pixels = project(cam.intrinsics, cam.camera_to_world, points)
     k = cam.intrinsics
-    us = k.fx * in_camera[:, 0] / in_camera[:, 2] + k.cx
-    vs = k.fy * in_camera[:, 1] / in_camera[:, 2] + k.cy
-    if np.any((us < 0) | (us >= k.width) | (vs < 0) | (vs >= k.height)):
+    inside = (pixels[:, 0] >= 0) & (pixels[:, 0] < k.width) & (pixels[:, 1] >= 0) & (pixels[:, 1] < k.height)
+    if not bool(np.all(inside)):  # NaN (behind the camera) compares False: not inside
         return False
     hits = p.rayTestBatch([spec.eye] * len(points), points.tolist(), physicsClientId=world.client)
     return all(hit[0] in (-1, world.body("P3DX01")) for hit in hits)
