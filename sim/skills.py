@@ -102,7 +102,7 @@ def _arm(world: HomeWorld, side: ArmSide | str) -> Arm:
 
 
 def clear_view(world: HomeWorld) -> Outcome:
-    """Fold both arms out of the Kinect's view (the first step of FindCupOnTable)."""
+    """Raise both arms to their home posture, out of the Kinect's view (the first step of FindCupOnTable)."""
     start = world.time
     for arm in world.arms.values():
         result = arm.home()
@@ -202,7 +202,7 @@ def carry_object(world: HomeWorld, side: ArmSide | str, region: Region, yaw: flo
 
 
 def put_down_object(world: HomeWorld, side: ArmSide | str, region: Region) -> Outcome:
-    """PutDownObject: lower the held object onto the surface below, let go, back off, fold the arm."""
+    """PutDownObject: lower the held object onto the surface below, let go, back off, raise the arm home."""
     start = world.time
     arm = _arm(world, side)
     grasp = arm.held_grasp
