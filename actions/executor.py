@@ -237,7 +237,8 @@ class Executor:
     def _verify(self, step: PlanStep, statement: Statement, outputs: Mapping[str, Any]) -> bool | None:
         if self.verifier is None:
             return None
-        return self.verifier(step, statement, outputs)
+        found = self.verifier(step, statement, outputs)
+        return None if found is None else bool(found)
 
     def _violation(self, step: PlanStep, iri: str, reason: str) -> None:
         """Record the failed attempt; the next tick starts the next alternative (or fails the run)."""

@@ -17,7 +17,7 @@ import pyoxigraph as ox
 
 from cbrs import __version__
 from cbrs.app import App, parse_iri, pass_app
-from cbrs.cli_actions import plan
+from cbrs.cli_actions import plan, run
 from cbrs.cli_reasoner import eval_group, match, ranking_text
 from cbrs.output import RESULT_FORMATS, render_result, table, term_text
 from cbrs.settings import SETTINGS, setting
@@ -396,4 +396,5 @@ def main() -> None:
 
 cli.add_command(match)
 cli.add_command(plan)
+cli.add_command(run)
 cli.add_command(eval_group)

@@ -1,15 +1,24 @@
-"""``cbrs plan``: a thin command over the composer."""
+"""``cbrs plan`` and ``cbrs run``: thin commands over the composer and the runner."""
 
 from __future__ import annotations
 
+import contextlib
+import ctypes
 import json
+import os
+import sys
+import time
+from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import click
 
 from actions.composer import ComposeConfig, Composer, CompositionResult, Objective, PlanStatus, store_plan
+from actions.events import Event
 from actions.plan import Binding, Plan
-from cbrs.app import App, pass_app
+from actions.runner import RunResult, run_task
+from cbrs.app import App, parse_iri, pass_app
 from cbrs.output import table
 from kb.namespaces import shorten
 
@@ -94,3 +103,119 @@ def _source(binding: Binding) -> str:
     if binding.role == "input":
         return f"{name} <- {origin}.{binding.source.name}"
     return f"{binding.name} <- {origin}"
+
+
+@click.command()
+@click.argument("task")
+@click.option("--gui", is_flag=True, help="Show the pybullet window (default: headless).")
+@click.option("--seed", default=0, show_default=True, type=int, help="Seed of the world's small perturbations.")
+@click.option(
+    "--fail",
+    "faults",
+    multiple=True,
+    metavar="COMPONENT_IRI",
+    help="Make this component fail whenever it is invoked (repeatable); prefixed names work.",
+)
+@click.option("--json", "as_json", is_flag=True, help="Print the plan and the execution report as JSON.")
+@click.option(
+    "--record",
+    type=click.Path(dir_okay=False, path_type=Path),
+    help="Write the ceiling camera's view after each step to FILE.gif.",
+)
+@pass_app
+def run(app: App, task: str, gui: bool, seed: int, faults: tuple[str, ...], as_json: bool, record: Path | None) -> None:
+    """Plan TASK, then execute it in the simulated home, step by step, failing over where needed.
+
+    Exits with status 1 when there is no plan or the run fails.
+    """
+    if record is not None and record.suffix.lower() != ".gif":
+        raise click.BadParameter(f"{record.name!r} must end in .gif", param_hint="--record")
+    failing = [parse_iri(f, "--fail") for f in faults]
+    with _quiet_stdout():  # pybullet prints its build time on import, which would spoil --json
+        import pybullet  # noqa: F401
+    from sim.components import SimEnvironment  # pybullet loads only for this command
+    from sim.world import open_world
+
+    start = time.perf_counter()
+    frames: list[Any] = []
+    with open_world(seed=seed, gui=gui) as world:
+        environment = SimEnvironment(world, app.kb)
+        unknown = [f for f in failing if f not in environment.registry]
+        if unknown:
+            raise click.BadParameter(f"no simulated component {', '.join(map(shorten, unknown))}", param_hint="--fail")
+
+        def follow(event: Event) -> None:
+            message = event.message
+            if record is not None and message.get("event") in ("step_succeeded", "step_failed"):
+                frames.append(world.camera("CeilingCamera01").capture().rgb)
+            if not as_json and event.topic == "/cbrs/task_progress":
+                click.echo(_progress(message), err=False)
+
+        if record is not None:
+            frames.append(world.camera("CeilingCamera01").capture().rgb)
+        result = run_task(app.kb, task, environment, failing, on_event=follow)
+        sim_seconds = world.time
+    wall = time.perf_counter() - start
+    if record is not None and frames:
+        _write_gif(frames, record)
+    if as_json:
+        found = result.to_dict()
+        found["seed"] = seed
+        found["sim_seconds"] = round(sim_seconds, 3)
+        click.echo(json.dumps(found, indent=2))
+    else:
+        click.echo(run_text(result, sim_seconds, wall))
+    if not result.succeeded:
+        raise SystemExit(1)
+
+
+def _progress(message: dict[str, Any]) -> str:
+    kind, step, component = message["event"], message["step"], shorten(message["component"])
+    if kind == "step_started":
+        return f"  step {step:>2}  {component} ..."
+    if kind == "step_succeeded":
+        return f"  step {step:>2}  {component} succeeded"
+    nxt = f"; failing over to {shorten(message['failover'])}" if message.get("failover") else ""
+    return f"  step {step:>2}  {component} FAILED: {message.get('reason', '')}{nxt}"
+
+
+def run_text(result: RunResult, sim_seconds: float, wall_seconds: float) -> str:
+    """The execution summary: one row per step, then the verdict."""
+    if result.report is None:
+        return plan_text(result.composition)
+    report = result.report
+    rows = []
+    for step in report.steps:
+        tried = " -> ".join(shorten(a.component) for a in step.attempts) or shorten(step.planned)
+        seconds = sum(a.seconds for a in step.attempts)
+        checks = ", ".join("ok" if ok else ("FAILED" if ok is False else "-") for _, ok in step.effects) or "-"
+        rows.append([str(step.index), tried, f"{seconds:.1f}", step.outcome, checks])
+    verdict = f"{shorten(report.task)}: {report.status.value}"
+    if report.reason:
+        verdict += f" ({report.reason})"
+    failovers = sum(1 for s in report.steps if s.failed_over)
+    timing = f"{sim_seconds:.1f} s simulated, {wall_seconds:.1f} s wall, {failovers} failover(s)"
+    return f"{table(['#', 'component', 'sim s', 'outcome', 'effects checked'], rows)}\n{verdict}; {timing}"
+
+
+@contextlib.contextmanager
+def _quiet_stdout() -> Iterator[None]:
+    """Silence output written straight to file descriptor 1 (by C extensions) for a moment."""
+    sys.stdout.flush()
+    saved = os.dup(1)
+    try:
+        with open(os.devnull, "w") as sink:
+            os.dup2(sink.fileno(), 1)
+            yield
+            ctypes.CDLL(None).fflush(None)  # what C buffered goes to the sink, not to stdout later
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+
+
+def _write_gif(frames: list[Any], target: Path) -> None:
+    from PIL import Image
+
+    images = [Image.fromarray(frame) for frame in frames]
+    target.parent.mkdir(parents=True, exist_ok=True)
+    images[0].save(target, save_all=True, append_images=images[1:], duration=700, loop=0)
