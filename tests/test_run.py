@@ -1,0 +1,115 @@
+"""Plans executed in the simulated home: both scenarios, failover, belief state, determinism."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from actions.belief import WORLD, BeliefState
+from actions.composer import Composer
+from actions.runner import RunResult, run_task
+from cbrs.cli import cli
+from kb import KnowledgeBase
+from kb.namespaces import expand
+from sim.components import SimEnvironment
+from sim.world import open_world
+
+SVC = expand("svc:")
+HOME = expand("home:")
+CAM1 = SVC + "LocateMobileRobot_CeilingCamera01"
+CAM2 = SVC + "LocateMobileRobot_CeilingCamera02"
+
+
+def run(task: str, seed: int = 0, faults: tuple[str, ...] = ()) -> tuple[RunResult, KnowledgeBase, float]:
+    kb = KnowledgeBase.open(":memory:")
+    with open_world(seed=seed) as world:
+        result = run_task(kb, task, SimEnvironment(world, kb), faults, composer=Composer(kb))
+        return result, kb, world.time
+
+
+@pytest.fixture(scope="module")
+def fetch() -> tuple[RunResult, KnowledgeBase, float]:
+    return run("FetchMyPen")
+
+
+def test_fetch_my_pen_succeeds_with_every_effect_verified(fetch: tuple[RunResult, KnowledgeBase, float]) -> None:
+    result, _, _ = fetch
+    assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
+    report = result.report
+    assert report is not None
+    assert all(step.outcome == "succeeded" for step in report.steps)
+    checked = [(s.index, ok) for s in report.steps for _, ok in s.effects]
+    assert checked and all(ok is True for _, ok in checked)
+    deliver = report.steps[-1]
+    assert deliver.component == SVC + "DeliverObject_P3DX01"
+    assert [str(e[0].predicate) for e in deliver.effects] == [HOME + "isWith"]
+
+
+def test_the_world_graph_says_the_pen_is_with_the_person(fetch: tuple[RunResult, KnowledgeBase, float]) -> None:
+    _, kb, _ = fetch
+    belief = BeliefState(kb)
+    facts = belief.facts()
+    assert (WORLD + "Pen", HOME + "isWith", WORLD + "Person") in facts
+    assert (WORLD + "Pen", HOME + "isLocatedOn", WORLD + "KitchenTable") not in facts
+    positions = belief.positions()
+    pen, person = positions[WORLD + "Pen"], positions[WORLD + "Person"]
+    assert abs(pen[0] - person[0]) < 0.6 and abs(pen[1] - person[1]) < 0.6
+
+
+def test_failing_the_chosen_localiser_fails_over_to_the_other_camera() -> None:
+    result, _, _ = run("FetchMyPen", faults=(CAM1,))
+    assert result.succeeded
+    assert result.report is not None
+    located = [s for s in result.report.steps if s.planned == CAM1]
+    assert len(located) == 2
+    first, second = located
+    assert [(a.component, a.outcome) for a in first.attempts] == [(CAM1, "failed"), (CAM2, "succeeded")]
+    assert "injected failure" in first.attempts[0].reason
+    assert [a.component for a in second.attempts] == [CAM2]  # the broken camera is not tried again
+    assert first.failed_over and second.failed_over
+
+
+def test_failure_without_alternative_names_the_step() -> None:
+    result, _, _ = run("FetchMyPen", faults=(SVC + "DeliverObject_P3DX01",))
+    assert not result.succeeded and result.report is not None
+    assert "step 15 (DeliverObject_P3DX01) failed with no alternative left" in result.report.reason
+
+
+def test_serve_a_cup_succeeds_and_the_cup_holds_water() -> None:
+    result, kb, _ = run("RobotArmServeACup")
+    assert result.succeeded and result.report is not None
+    assert result.composition.plan is not None and result.composition.plan.method == "decomposed"
+    assert all(ok is True for s in result.report.steps for _, ok in s.effects)
+    facts = BeliefState(kb).facts()
+    assert (WORLD + "Cup", HOME + "isLocated", WORLD + "BelowOfTap") in facts
+    assert (WORLD + "Cup", HOME + "contains", HOME + "Water") in facts
+
+
+def test_same_seed_same_outcome(fetch: tuple[RunResult, KnowledgeBase, float]) -> None:
+    first, _, first_time = fetch
+    again, _, again_time = run("FetchMyPen")
+    assert first.report is not None and again.report is not None
+    assert again_time == first_time
+    durations = [[round(a.seconds, 6) for a in s.attempts] for s in first.report.steps]
+    assert durations == [[round(a.seconds, 6) for a in s.attempts] for s in again.report.steps]
+
+
+def test_cli_run_json_and_record(tmp_path: Path) -> None:
+    runner = CliRunner()
+    store = str(tmp_path / "store")
+    gif = tmp_path / "run.gif"
+    done = runner.invoke(
+        cli, ["--store", store, "run", "RobotArmServeACup", "--json", "--seed", "1", "--record", str(gif)]
+    )
+    assert done.exit_code == 0, done.output
+    found = json.loads(done.output)
+    assert found["status"] == "succeeded" and found["seed"] == 1
+    assert found["execution"]["steps"][-1]["component"] == SVC + "FillCupFromTap_CytonDualArm01"
+    assert gif.read_bytes()[:6] in (b"GIF87a", b"GIF89a")
+    bad = runner.invoke(cli, ["--store", store, "run", "FetchMyPen", "--fail", "svc:NoSuchComponent"])
+    assert bad.exit_code == 2 and "no simulated component svc:NoSuchComponent" in bad.output
+    bad = runner.invoke(cli, ["--store", store, "run", "FetchMyPen", "--record", str(tmp_path / "x.png")])
+    assert bad.exit_code == 2 and ".gif" in bad.output
