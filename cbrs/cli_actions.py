@@ -2,13 +2,8 @@
 
 from __future__ import annotations
 
-import contextlib
-import ctypes
 import json
-import os
-import sys
 import time
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -20,6 +15,7 @@ from actions.plan import Binding, Plan
 from actions.runner import RunResult, run_task
 from cbrs.app import App, parse_iri, pass_app
 from cbrs.output import table
+from kb import KnowledgeBase
 from kb.namespaces import shorten
 
 
@@ -131,8 +127,6 @@ def run(app: App, task: str, gui: bool, seed: int, faults: tuple[str, ...], as_j
     if record is not None and record.suffix.lower() != ".gif":
         raise click.BadParameter(f"{record.name!r} must end in .gif", param_hint="--record")
     failing = [parse_iri(f, "--fail") for f in faults]
-    with _quiet_stdout():  # pybullet prints its build time on import, which would spoil --json
-        import pybullet  # noqa: F401
     from sim.components import SimEnvironment  # pybullet loads only for this command
     from sim.world import open_world
 
@@ -198,24 +192,48 @@ def run_text(result: RunResult, sim_seconds: float, wall_seconds: float) -> str:
     return f"{table(['#', 'component', 'sim s', 'outcome', 'effects checked'], rows)}\n{verdict}; {timing}"
 
 
-@contextlib.contextmanager
-def _quiet_stdout() -> Iterator[None]:
-    """Silence output written straight to file descriptor 1 (by C extensions) for a moment."""
-    sys.stdout.flush()
-    saved = os.dup(1)
-    try:
-        with open(os.devnull, "w") as sink:
-            os.dup2(sink.fileno(), 1)
-            yield
-            ctypes.CDLL(None).fflush(None)  # what C buffered goes to the sink, not to stdout later
-    finally:
-        os.dup2(saved, 1)
-        os.close(saved)
-
-
 def _write_gif(frames: list[Any], target: Path) -> None:
     from PIL import Image
 
     images = [Image.fromarray(frame) for frame in frames]
     target.parent.mkdir(parents=True, exist_ok=True)
     images[0].save(target, save_all=True, append_images=images[1:], duration=700, loop=0)
+
+
+DEMO_RUNS = (
+    ("RobotArmServeACup", ()),
+    ("FetchMyPen", ()),
+    ("FetchMyPen", ("svc:LocateMobileRobot_CeilingCamera01",)),
+)
+
+
+def scenario_summary(kb: KnowledgeBase, seed: int = 0) -> str:
+    """Run the paper's two scenarios headless (FetchMyPen also with its localiser failed): one row each."""
+    from sim.components import SimEnvironment
+    from sim.world import open_world
+
+    rows = []
+    composer = Composer(kb)
+    for task, faults in DEMO_RUNS:
+        start = time.perf_counter()
+        with open_world(seed=seed) as world:
+            result = run_task(kb, task, SimEnvironment(world, kb), [parse_iri(f) for f in faults], composer=composer)
+            simulated = world.time
+        wall = time.perf_counter() - start
+        report = result.report
+        steps = len(report.steps) if report else 0
+        failovers = ", ".join(
+            f"{shorten(s.planned)} -> {shorten(s.component)}" for s in (report.steps if report else []) if s.failed_over
+        )
+        verified = sum(1 for s in (report.steps if report else []) for _, ok in s.effects if ok)
+        status = report.status.value if report else "no plan"
+        injected = f" (fail {', '.join(faults)})" if faults else ""
+        rows.append(
+            [task + injected, str(steps), status, str(verified), f"{simulated:.1f}", f"{wall:.1f}", failovers or "-"]
+        )
+    facts = "\n".join(
+        f"  ({shorten(r['thing'].value)}, {shorten(r['relation'].value)}, {shorten(r['other'].value)})"
+        for r in kb.select("world_facts")
+    )
+    columns = ["task", "steps", "status", "effects verified", "sim s", "wall s", "failover"]
+    return f"{table(columns, rows)}\nThe world graph after the last run (cbrs query --name world_facts):\n{facts}"

@@ -10,6 +10,7 @@ See docs/simulation.md.
 
 from __future__ import annotations
 
+import sim.quiet  # noqa: F401  (first: keeps pybullet's banner off stdout)
 from sim.arms import ArmSide
 from sim.errors import (
     CameraUnavailableError,

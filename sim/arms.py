@@ -22,6 +22,7 @@ from numpy.typing import NDArray
 
 from sim.geometry import Pose3D, Quat, Region, Vec3, quat_from_matrix, quat_to_matrix
 from sim.grasping import GraspPose
+from sim.quiet import quiet_output
 
 __all__ = [
     "ARM_JOINTS",
@@ -142,7 +143,8 @@ class Kinematics:
     joint-space move can be checked for collisions before the real arm makes it."""
 
     def __init__(self, mounts: dict[ArmSide, tuple[Vec3, Quat]], obstacles: Sequence[Region] = ()) -> None:
-        self.client = p.connect(p.DIRECT)
+        with quiet_output():
+            self.client = p.connect(p.DIRECT)
         try:
             p.setAdditionalSearchPath(PYBULLET_DATA, physicsClientId=self.client)
             self._bodies = {

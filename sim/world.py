@@ -23,6 +23,7 @@ from sim.base import BASE_HEIGHT, MobileBase
 from sim.cameras import Camera
 from sim.errors import UnknownEntityError, WorldClosedError
 from sim.geometry import Pose2D, Pose3D, Quat, Region, Vec3, quat_from_yaw
+from sim.quiet import quiet_output
 
 __all__ = ["TIME_STEP", "HomeWorld", "Perturbation", "open_world"]
 
@@ -142,7 +143,8 @@ class HomeWorld:
     @classmethod
     def create(cls, seed: int = 0, gui: bool = False, time_step: float = TIME_STEP) -> HomeWorld:
         """Connect a new pybullet client (DIRECT unless ``gui``) and build the home in it."""
-        client = p.connect(p.GUI if gui else p.DIRECT)
+        with quiet_output():
+            client = p.connect(p.GUI if gui else p.DIRECT)
         try:
             return cls(client, seed, gui, time_step)
         except BaseException:
