@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import time
+from collections import Counter
 from pathlib import Path
 from typing import Any
 
@@ -222,9 +223,10 @@ def scenario_summary(kb: KnowledgeBase, seed: int = 0) -> str:
         wall = time.perf_counter() - start
         report = result.report
         steps = len(report.steps) if report else 0
-        failovers = ", ".join(
+        switched = Counter(
             f"{shorten(s.planned)} -> {shorten(s.component)}" for s in (report.steps if report else []) if s.failed_over
         )
+        failovers = ", ".join(f"{n} x {what}" if n > 1 else what for what, n in switched.items())
         verified = sum(1 for s in (report.steps if report else []) for _, ok in s.effects if ok)
         status = report.status.value if report else "no plan"
         injected = f" (fail {', '.join(faults)})" if faults else ""
