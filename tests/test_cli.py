@@ -191,6 +191,11 @@ def test_demo_tours_the_paper_example() -> None:
     assert code == 0, out
     assert "Table 1" in out and "LocateMobileRobot" in out and "RobotSelfPosition" in out
     assert "matched by sem-str; best svc:LocateMobileRobot_CeilingCamera01" in out
+    runs = [line.split()[:3] for line in out.splitlines() if line.startswith(("RobotArmServeACup ", "FetchMyPen "))]
+    assert runs == [["RobotArmServeACup", "10", "succeeded"], ["FetchMyPen", "15", "succeeded"]]
+    assert "FetchMyPen (fail svc:LocateMobileRobot_CeilingCamera01)  15     succeeded" in out
+    assert "2 x svc:LocateMobileRobot_CeilingCamera01 -> svc:LocateMobileRobot_CeilingCamera02" in out
+    assert "(world:Pen, home:isWith, world:Person)" in out
 
 
 def test_unexpected_errors_are_one_line(monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
