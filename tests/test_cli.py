@@ -192,7 +192,7 @@ def test_demo_tours_the_paper_example() -> None:
     assert "Table 1" in out and "LocateMobileRobot" in out and "RobotSelfPosition" in out
     assert "matched by sem-str; best svc:LocateMobileRobot_CeilingCamera01" in out
     runs = [line.split()[:3] for line in out.splitlines() if line.startswith(("RobotArmServeACup ", "FetchMyPen "))]
-    assert runs == [["RobotArmServeACup", "10", "succeeded"], ["FetchMyPen", "15", "succeeded"]]
+    assert runs[:2] == [["RobotArmServeACup", "10", "succeeded"], ["FetchMyPen", "15", "succeeded"]]
     assert "FetchMyPen (fail svc:LocateMobileRobot_CeilingCamera01)  15     succeeded" in out
     assert "2 x svc:LocateMobileRobot_CeilingCamera01 -> svc:LocateMobileRobot_CeilingCamera02" in out
     assert "(world:Pen, home:isWith, world:Person)" in out
