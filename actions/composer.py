@@ -28,6 +28,7 @@ from enum import Enum
 from typing import Any
 
 import networkx as nx
+import pyoxigraph as ox
 
 from actions.errors import OrderingConflictError
 from actions.graph import SRE, SRI, SRO, Edge, Matcher, Need, ServicePool, ServiceResourceGraph
@@ -221,14 +222,12 @@ class Composer:
 
 def store_plan(kb: KnowledgeBase, plan: Plan) -> None:
     """Write ``plan`` to the plans graph, replacing an earlier plan for the same task, in one transaction."""
-    import pyoxigraph as ox
-
     graph = GraphName.PLANS.node
-    prefix = plan.iri
     old = [
         q
         for q in kb.store.quads(graph=graph)
-        if isinstance(q.subject, ox.NamedNode) and q.subject.value.startswith(prefix)
+        if isinstance(q.subject, ox.NamedNode)
+        and (q.subject.value == plan.iri or q.subject.value.startswith(plan.iri + "/"))
     ]
     kb.store.replace(old, plan.to_quads())
 
