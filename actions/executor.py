@@ -21,6 +21,7 @@ from actions.events import Priority
 from actions.graph import statement_text
 from actions.plan import Plan, PlanStep
 from kb import Statement
+from reasoner.names import local_name
 
 
 class RunStatus(Enum):
@@ -188,7 +189,7 @@ class Executor:
             last = report.attempts[-1].reason if report.attempts else "no component"
             self._finish(
                 RunStatus.FAILED,
-                f"step {step.index} ({_short(step.component)}) failed with no alternative left: {last}",
+                f"step {step.index} ({local_name(step.component)}) failed with no alternative left: {last}",
             )
             return
         iri = candidates[0]
@@ -277,7 +278,3 @@ class Executor:
     def _publish(self, kind: str, step: PlanStep, iri: str, **extra: Any) -> None:
         message = {"event": kind, "task": self.plan.task, "step": step.index, "component": iri, **extra}
         self.container.bus.publish("/cbrs/task_progress", message)
-
-
-def _short(iri: str) -> str:
-    return iri.rsplit("#", 1)[-1].rsplit("/", 1)[-1]

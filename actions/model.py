@@ -13,7 +13,8 @@ import networkx as nx
 
 from actions.errors import UnknownTaskError
 from kb import KnowledgeBase, NotFoundError, Requirement
-from kb.namespaces import PREFIXES, expand
+from kb.namespaces import expand
+from reasoner.names import local_name
 
 
 @dataclass(frozen=True)
@@ -36,12 +37,9 @@ class ActionClass:
     orderings: tuple[Ordering, ...] = ()
 
     def ordered_sub_actions(self) -> list[str]:
-        """The sub-actions in an order that respects every ordering constraint (declared order breaks ties)."""
-        graph: nx.DiGraph[str] = nx.DiGraph()
-        graph.add_nodes_from(self.sub_actions)
-        graph.add_edges_from((o.before, o.after) for o in self.orderings if o.before in graph and o.after in graph)
-        rank = {iri: n for n, iri in enumerate(self.sub_actions)}
-        return list(nx.lexicographical_topological_sort(graph, key=lambda iri: rank[iri]))
+        """The sub-actions in an order that respects every ordering constraint (IRI order breaks ties);
+        ``ActionLibrary`` stores them in that order when it reads them."""
+        return list(self.sub_actions)
 
 
 @dataclass
@@ -130,27 +128,21 @@ def resolve_task(kb: KnowledgeBase, library: ActionLibrary, name: str) -> Task:
     action is planned through the requirement that names it with ``cbrs:forTask`` when there is one,
     otherwise from the inputs, outputs, preconditions and effects the action class carries.
     """
+    requirements = kb.requirements()
     candidates = [name] if ":" in name else [f"req:{name}", f"act:{name}"]
     for candidate in candidates:
         try:
             iri = expand(candidate)
         except ValueError:
             continue
-        requirement = next((r for r in kb.requirements() if r.iri == iri), None)
+        requirement = next((r for r in requirements if r.iri == iri), None)
         if requirement is not None:
             action = library.actions.get(requirement.for_task or "")
             return Task(iri, requirement, action)
         if iri in library:
             action = library.get(iri)
-            stated = sorted((r for r in kb.requirements() if r.for_task == iri), key=lambda r: r.iri)
+            stated = sorted((r for r in requirements if r.for_task == iri), key=lambda r: r.iri)
             requirement = stated[0] if stated else kb.action_requirement(iri, action.label)
             return Task(iri, requirement, action)
-    known = sorted({_short(r.iri) for r in kb.requirements()} | {_short(a.iri) for a in library if a.sub_actions})
+    known = sorted({local_name(r.iri) for r in requirements} | {local_name(a.iri) for a in library if a.sub_actions})
     raise UnknownTaskError(name, known)
-
-
-def _short(iri: str) -> str:
-    for prefix in ("req", "act"):
-        if iri.startswith(PREFIXES[prefix]):
-            return iri[len(PREFIXES[prefix]) :]
-    return iri

@@ -15,7 +15,7 @@ from actions.belief import BeliefState, Observation
 from actions.components import Container, Registry
 from actions.composer import Composer, CompositionResult, PlanStatus, store_plan
 from actions.events import Event, EventBus
-from actions.executor import ExecutionReport, Executor
+from actions.executor import ExecutionReport, Executor, RunStatus
 from actions.plan import Plan, PlanStep
 from kb import KnowledgeBase, Requirement, Statement
 
@@ -44,7 +44,7 @@ class RunResult:
 
     @property
     def succeeded(self) -> bool:
-        return self.report is not None and self.report.status.value == "succeeded"
+        return self.report is not None and self.report.status is RunStatus.SUCCEEDED
 
     def to_dict(self) -> dict[str, Any]:
         found: dict[str, Any] = {
@@ -85,11 +85,12 @@ def run_task(
     executor = Executor(plan, container, environment.given(plan, requirements), environment.verify, environment.clock)
     done = 0
     try:
-        while executor.tick().value == "running" and executor.ticks < max_ticks:
-            if len(executor.results) != done:
+        while executor.status is RunStatus.RUNNING and executor.ticks < max_ticks:
+            executor.tick()
+            if len(executor.results) != done:  # a step finished: the world changed
                 done = len(executor.results)
                 belief.write(environment.observe())
-        report = executor.run(max_ticks) if executor.ticks >= max_ticks else executor.report()
+        report = executor.run(max_ticks)  # ends a run that hit max_ticks; otherwise just the report
     finally:
         container.finalise_all()
     belief.write(environment.observe())

@@ -96,9 +96,8 @@ def plan_text(result: CompositionResult) -> str:
 
 def _source(binding: Binding) -> str:
     origin = "requirement" if binding.source.step is None else f"#{binding.source.step}"
-    name = binding.name if binding.role == "input" else "pre"
     if binding.role == "input":
-        return f"{name} <- {origin}.{binding.source.name}"
+        return f"{binding.name} <- {origin}.{binding.source.name}"
     return f"{binding.name} <- {origin}"
 
 

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 from actions.belief import WORLD, Observation
@@ -120,8 +120,6 @@ class SimContext:
     grasp: Any = None  # the grasp pose of the object the arm is working on
     arm: ArmSide = ArmSide.LEFT
     region: Region | None = None  # where the carried object goes
-    last_location: RobotPoseEstimate | None = None
-    memory: dict[str, Any] = field(default_factory=dict)
 
 
 Work = Callable[[SimContext, Mapping[str, Any]], dict[str, Any]]
@@ -286,9 +284,7 @@ def locate(camera: str) -> Work:
         colours = inputs.get("markerColour", MarkerColours())
         if not isinstance(colours, MarkerColours):
             raise SkillFailed(f"not a marker colour: {colours!r}")
-        estimate = locate_robot(ctx.world.camera(camera).capture(), colours.front, colours.rear)
-        ctx.last_location = estimate
-        return {"robotLocation": estimate}
+        return {"robotLocation": locate_robot(ctx.world.camera(camera).capture(), colours.front, colours.rear)}
 
     return work
 
