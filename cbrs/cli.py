@@ -301,7 +301,7 @@ def show(app: App, iri: str, as_json: bool) -> None:
 @cli.command("settings")
 def settings_command() -> None:
     """List the settings, their environment variables and current values."""
-    body = [[s.name, s.env, str(s.resolve()), s.help] for s in SETTINGS]
+    body = [[s.name, s.env, s.shown(s.resolve()), s.help] for s in SETTINGS]
     click.echo(table(["setting", "environment", "value", "help"], body))
 
 

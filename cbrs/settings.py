@@ -19,6 +19,27 @@ def _default_store() -> str:
     return str(Path(user_data_dir("cbrs", appauthor=False)) / "store")
 
 
+def _port(text: str) -> int:
+    port = int(text)
+    if not 0 <= port <= 65535:
+        raise ValueError(f"{port} is not a TCP port (0-65535)")
+    return port
+
+
+def _positive(kind: Callable[[str], float]) -> Callable[[str], Any]:
+    def parse(text: str) -> Any:
+        value = kind(text)
+        if value <= 0:
+            raise ValueError(f"{text} must be positive")
+        return value
+
+    return parse
+
+
+def _origins(text: str) -> tuple[str, ...]:
+    return tuple(origin.strip() for origin in text.split(",") if origin.strip())
+
+
 @dataclass(frozen=True)
 class Setting:
     name: str
@@ -26,6 +47,15 @@ class Setting:
     help: str
     env: str
     parse: Callable[[str], Any] = str
+    secret: bool = False
+
+    def shown(self, value: Any) -> str:
+        """The value as ``cbrs settings`` prints it: a secret only says whether it is set."""
+        if self.secret:
+            return "(set)" if value else "(not set)"
+        if isinstance(value, tuple):
+            return ", ".join(value) or "(none)"
+        return "" if value is None else str(value)
 
     def resolve(self, given: Any = None, environ: Mapping[str, str] | None = None) -> Any:
         if given is not None:
@@ -52,6 +82,49 @@ SETTINGS: tuple[Setting, ...] = (
         lambda: "table",
         "Default output format of cbrs query: table, json, csv or tsv.",
         "CBRS_FORMAT",
+    ),
+    Setting(
+        "host",
+        lambda: "127.0.0.1",
+        "Address cbrs serve binds its HTTP and rosbridge ports to; loopback unless you open it on purpose.",
+        "CBRS_HOST",
+    ),
+    Setting("port", lambda: 8080, "HTTP port of cbrs serve (/sparql and the browser).", "CBRS_PORT", _port),
+    Setting("bridge_port", lambda: 9090, "Websocket port of the rosbridge v2 interface.", "CBRS_BRIDGE_PORT", _port),
+    Setting(
+        "update_token",
+        lambda: None,
+        "Bearer token that SPARQL updates must carry; without one the endpoint is read-only.",
+        "CBRS_UPDATE_TOKEN",
+        secret=True,
+    ),
+    Setting(
+        "query_timeout",
+        lambda: 30.0,
+        "Seconds a SPARQL query may run (and be serialised) before the endpoint answers 503.",
+        "CBRS_QUERY_TIMEOUT",
+        _positive(float),
+    ),
+    Setting(
+        "max_result_bytes",
+        lambda: 64 * 1024 * 1024,
+        "Largest serialised SPARQL result the endpoint returns; larger ones are refused with 422.",
+        "CBRS_MAX_RESULT_BYTES",
+        _positive(int),
+    ),
+    Setting(
+        "max_query_bytes",
+        lambda: 1024 * 1024,
+        "Largest SPARQL query or update request accepted; larger ones are refused with 413.",
+        "CBRS_MAX_QUERY_BYTES",
+        _positive(int),
+    ),
+    Setting(
+        "cors_origins",
+        lambda: (),
+        "Comma-separated origins allowed to call the HTTP API from a browser (CORS); none by default.",
+        "CBRS_CORS_ORIGINS",
+        _origins,
     ),
 )
 
