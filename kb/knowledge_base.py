@@ -63,6 +63,13 @@ class KnowledgeBase:
     def query(self, text: str, bindings: Mapping[str, Term] | None = None) -> QueryResult:
         return self.store.query(text, bindings)
 
+    def update(self, text: str) -> None:
+        """Run a SPARQL update in one transaction; the cached descriptions are read afresh afterwards."""
+        try:
+            self.store.update(text)
+        finally:
+            self._reader.clear_cache()
+
     def run(self, name: str, values: Mapping[str, Term | str | int | float] | None = None) -> QueryResult:
         """Run the named query ``queries/<name>.rq`` with ``values`` bound to its parameters."""
         return self.queries.run(self.store, name, values)

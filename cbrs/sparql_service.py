@@ -1,0 +1,265 @@
+"""SPARQL queries and updates as a service: content negotiation, a deadline, size limits and access.
+
+The HTTP endpoint and the rosbridge ``/cbrs/query`` service are thin layers over :class:`SparqlService`.
+
+How a query is bounded (Oxigraph has no query timeout of its own):
+
+- it runs on one of ``workers`` threads; when all are taken the request is refused at once (busy),
+  so runaway queries cannot pile up;
+- its result is serialised by Oxigraph into a writer that checks the deadline and the byte budget on
+  every chunk, so a query that streams many solutions stops at the deadline or the limit;
+- a query still computing its first solution at the deadline is answered "timed out" and its thread
+  is left to finish; it keeps its worker slot until it does.
+"""
+
+from __future__ import annotations
+
+import hmac
+import io
+import threading
+import time
+from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import TimeoutError as FutureTimeout
+from dataclasses import dataclass
+from typing import Any
+
+import pyoxigraph as ox
+from werkzeug.datastructures import MIMEAccept
+from werkzeug.http import parse_accept_header
+
+from kb import KnowledgeBase
+from kb.errors import KnowledgeBaseError
+
+# Media types offered for SELECT and ASK results, the first being the default.
+RESULT_TYPES: dict[str, ox.QueryResultsFormat] = {
+    "application/sparql-results+json": ox.QueryResultsFormat.JSON,
+    "application/sparql-results+xml": ox.QueryResultsFormat.XML,
+    "text/csv": ox.QueryResultsFormat.CSV,
+    "text/tab-separated-values": ox.QueryResultsFormat.TSV,
+    "application/json": ox.QueryResultsFormat.JSON,
+    "application/xml": ox.QueryResultsFormat.XML,
+    "text/xml": ox.QueryResultsFormat.XML,
+}
+# Media types offered for CONSTRUCT and DESCRIBE results, the first being the default.
+GRAPH_TYPES: dict[str, ox.RdfFormat] = {
+    "text/turtle": ox.RdfFormat.TURTLE,
+    "application/n-triples": ox.RdfFormat.N_TRIPLES,
+    "application/ld+json": ox.RdfFormat.JSON_LD,
+    "application/rdf+xml": ox.RdfFormat.RDF_XML,
+    "text/plain": ox.RdfFormat.N_TRIPLES,
+    "application/json": ox.RdfFormat.JSON_LD,
+    "application/xml": ox.RdfFormat.RDF_XML,
+}
+# Short names for the ``format`` / ``output`` request parameter that SPARQLWrapper and browsers send.
+SHORT_NAMES: dict[str, tuple[str, str]] = {
+    "json": ("application/sparql-results+json", "application/ld+json"),
+    "xml": ("application/sparql-results+xml", "application/rdf+xml"),
+    "csv": ("text/csv", "application/n-triples"),
+    "tsv": ("text/tab-separated-values", "application/n-triples"),
+    "turtle": ("application/sparql-results+json", "text/turtle"),
+    "ttl": ("application/sparql-results+json", "text/turtle"),
+    "ntriples": ("text/tab-separated-values", "application/n-triples"),
+    "nt": ("text/tab-separated-values", "application/n-triples"),
+    "jsonld": ("application/sparql-results+json", "application/ld+json"),
+    "json-ld": ("application/sparql-results+json", "application/ld+json"),
+    "rdfxml": ("application/sparql-results+xml", "application/rdf+xml"),
+    "rdf+xml": ("application/sparql-results+xml", "application/rdf+xml"),
+}
+
+
+class EndpointError(KnowledgeBaseError):
+    """A request the endpoint refuses; ``kind`` is a stable machine-readable name."""
+
+    kind = "error"
+
+
+class NotAcceptableError(EndpointError):
+    http_status = 406
+    kind = "not-acceptable"
+
+    def __init__(self, asked: str, offered: Sequence[str]) -> None:
+        self.asked = asked
+        super().__init__(f"cannot answer in {asked!r}; this result is available as {', '.join(offered)}")
+
+
+class QueryTooLargeError(EndpointError):
+    http_status = 413
+    kind = "request-too-large"
+
+    def __init__(self, size: int, limit: int) -> None:
+        self.size = size
+        super().__init__(f"the request is {size} bytes; the limit is {limit} (setting max_query_bytes)")
+
+
+class ResultTooLargeError(EndpointError):
+    http_status = 422
+    kind = "result-too-large"
+
+    def __init__(self, limit: int) -> None:
+        super().__init__(
+            f"the result exceeds {limit} bytes (setting max_result_bytes); add a LIMIT or select fewer variables"
+        )
+
+
+class QueryTimeoutError(EndpointError):
+    http_status = 503
+    kind = "timeout"
+
+    def __init__(self, seconds: float) -> None:
+        self.seconds = seconds
+        super().__init__(f"the query did not finish within {seconds:g} s (setting query_timeout)")
+
+
+class EndpointBusyError(EndpointError):
+    http_status = 503
+    kind = "busy"
+
+    def __init__(self, workers: int) -> None:
+        super().__init__(f"all {workers} query workers are busy; retry shortly")
+
+
+class UpdateForbiddenError(EndpointError):
+    http_status = 403
+    kind = "forbidden"
+
+
+@dataclass(frozen=True)
+class Answer:
+    """A serialised result and its media type."""
+
+    body: bytes
+    media_type: str
+
+
+@dataclass(frozen=True)
+class EndpointConfig:
+    timeout: float = 30.0
+    max_result_bytes: int = 64 * 1024 * 1024
+    max_query_bytes: int = 1024 * 1024
+    update_token: str | None = None
+    workers: int = 4
+
+
+class _Stop(Exception):
+    """Raised inside Oxigraph's serialiser to abandon a result; carries the error to report."""
+
+    def __init__(self, error: EndpointError) -> None:
+        self.error = error
+
+
+class _BudgetWriter(io.BytesIO):
+    """Collects a serialised result, stopping it at the byte limit or the deadline."""
+
+    def __init__(self, limit: int, deadline: float, timeout: float) -> None:
+        super().__init__()
+        self.limit = limit
+        self.deadline = deadline
+        self.timeout = timeout
+
+    def write(self, data: Any) -> int:
+        written = super().write(data)
+        if self.tell() > self.limit:
+            raise _Stop(ResultTooLargeError(self.limit))
+        if time.monotonic() > self.deadline:
+            raise _Stop(QueryTimeoutError(self.timeout))
+        return written
+
+
+class SparqlService:
+    """Queries and updates on a knowledge base, bounded and access-checked."""
+
+    def __init__(self, kb: KnowledgeBase, config: EndpointConfig | None = None, lock: threading.RLock | None = None):
+        self.kb = kb
+        self.config = config or EndpointConfig()
+        self.lock = lock or threading.RLock()  # held by writers, so readers of cached descriptions see whole updates
+        self._slots = threading.BoundedSemaphore(self.config.workers)
+        self._pool = ThreadPoolExecutor(self.config.workers, thread_name_prefix="cbrs-sparql")
+        self._listeners: list[Callable[[], None]] = []
+        self.generation = 0  # bumped by every update, so caches built from the store know they are stale
+
+    @property
+    def writable(self) -> bool:
+        return self.config.update_token is not None
+
+    def query(self, text: str, accept: str | None = None, short_format: str | None = None) -> Answer:
+        """Run ``text`` and serialise its result in the best format for ``accept`` (an Accept header value)."""
+        self._check_size(text)
+        if not self._slots.acquire(blocking=False):
+            raise EndpointBusyError(self.config.workers)
+        deadline = time.monotonic() + self.config.timeout
+        try:
+            future = self._pool.submit(self._evaluate, text, accept, short_format, deadline)
+        except BaseException:
+            self._slots.release()
+            raise
+        try:
+            return future.result(timeout=self.config.timeout)
+        except FutureTimeout:
+            raise QueryTimeoutError(self.config.timeout) from None
+
+    def update(self, text: str, token: str | None) -> None:
+        """Run a SPARQL update when ``token`` is the configured update token; one transaction."""
+        expected = self.config.update_token
+        if expected is None:
+            raise UpdateForbiddenError("updates are disabled: this server is read-only (no update token set)")
+        if token is None or not hmac.compare_digest(token.encode("utf-8"), expected.encode("utf-8")):
+            raise UpdateForbiddenError("updates need the server's token: Authorization: Bearer <token>")
+        self._check_size(text)
+        with self.lock:
+            try:
+                self.kb.update(text)
+            finally:
+                self.generation += 1
+        for listener in list(self._listeners):
+            listener()
+
+    def on_update(self, listener: Callable[[], None]) -> Callable[[], None]:
+        """Call ``listener()`` after each update; returns the call that stops it."""
+        self._listeners.append(listener)
+        return lambda: self._listeners.remove(listener)
+
+    def close(self) -> None:
+        self._pool.shutdown(wait=False, cancel_futures=True)
+
+    def _check_size(self, text: str) -> None:
+        size = len(text.encode("utf-8"))
+        if size > self.config.max_query_bytes:
+            raise QueryTooLargeError(size, self.config.max_query_bytes)
+
+    def _evaluate(self, text: str, accept: str | None, short_format: str | None, deadline: float) -> Answer:
+        result: Any = None  # Oxigraph results must be dropped on the thread that made them
+        try:
+            result = self.kb.query(text)
+            media_type = negotiate(isinstance(result, ox.QueryTriples), accept, short_format)
+            writer = _BudgetWriter(self.config.max_result_bytes, deadline, self.config.timeout)
+            try:
+                if isinstance(result, ox.QueryTriples):
+                    result.serialize(writer, GRAPH_TYPES[media_type])
+                else:
+                    result.serialize(writer, RESULT_TYPES[media_type])
+            except _Stop as stop:
+                raise stop.error from None
+            return Answer(writer.getvalue(), media_type)
+        finally:
+            result = None
+            self._slots.release()
+
+def negotiate(graph: bool, accept: str | None, short_format: str | None = None) -> str:
+    """The media type to answer in: a ``format`` short name wins, then the Accept header, then the default."""
+    offered = list(GRAPH_TYPES if graph else RESULT_TYPES)
+    if short_format:
+        names = SHORT_NAMES.get(short_format.lower())
+        if names is None and short_format in offered:
+            return short_format
+        if names is None:
+            raise NotAcceptableError(short_format, sorted(SHORT_NAMES))
+        return names[1] if graph else names[0]
+    if not accept:
+        return offered[0]
+    parsed = parse_accept_header(accept, MIMEAccept)
+    best = parsed.best_match(offered)
+    if best is None:
+        raise NotAcceptableError(accept, offered[:4])
+    return best
+

@@ -1,0 +1,136 @@
+"""The SPARQL 1.1 Protocol at ``/sparql`` (query and update) and ``/update`` (update only).
+
+A thin layer: it reads the request the three ways the protocol allows (GET, POST form, POST direct),
+hands the text to :class:`cbrs.sparql_service.SparqlService` and maps its errors to statuses.
+"""
+
+from __future__ import annotations
+
+import pyoxigraph as ox
+from flask import Blueprint, Response, current_app, request, url_for
+
+from cbrs.sparql_service import GRAPH_TYPES, EndpointError, SparqlService, negotiate
+
+blueprint = Blueprint("sparql", __name__)
+
+QUERY_TYPE = "application/sparql-query"
+UPDATE_TYPE = "application/sparql-update"
+FORM_TYPE = "application/x-www-form-urlencoded"
+# Dataset parameters of the protocol; cbrs answers over its own union default graph only.
+_RDF_TYPE = "http://www.w3.org/1999/02/22-rdf-syntax-ns#type"
+DATASET_PARAMETERS = ("default-graph-uri", "named-graph-uri", "using-graph-uri", "using-named-graph-uri")
+
+
+class BadProtocolRequest(EndpointError):
+    http_status = 400
+    kind = "bad-request"
+
+
+class UnsupportedMediaType(EndpointError):
+    http_status = 415
+    kind = "unsupported-media-type"
+
+    def __init__(self, media_type: str) -> None:
+        self.media_type = media_type
+        super().__init__(
+            f"a POST to the SPARQL endpoint must be {FORM_TYPE}, {QUERY_TYPE} or {UPDATE_TYPE}, not {media_type!r}"
+        )
+
+
+def service() -> SparqlService:
+    found: SparqlService = current_app.extensions["cbrs.sparql"]
+    return found
+
+
+@blueprint.route("/sparql", methods=["GET", "POST"])
+def sparql() -> Response:
+    query, update = _operation()
+    if update is not None:
+        return _update(update)
+    if query is None:
+        return _service_description()
+    answer = service().query(query, request.headers.get("Accept"), _short_format())
+    return Response(answer.body, content_type=_with_charset(answer.media_type))
+
+
+@blueprint.route("/update", methods=["POST"])
+def update_only() -> Response:
+    query, update = _operation()
+    if query is not None or update is None:
+        raise BadProtocolRequest("/update takes an update (form field update= or a sparql-update body), not a query")
+    return _update(update)
+
+
+def _operation() -> tuple[str | None, str | None]:
+    """The query or the update text of the request, whichever it carries; never both."""
+    for name in DATASET_PARAMETERS:
+        if name in request.values:
+            raise BadProtocolRequest(
+                f"{name} is not supported: cbrs queries the union of its graphs; use GRAPH or FROM in the query"
+            )
+    if request.method == "GET":
+        if "update" in request.args:
+            raise BadProtocolRequest("an update must be sent with POST")
+        return request.args.get("query"), None
+    media_type = request.mimetype
+    if media_type == FORM_TYPE:
+        query, update = request.form.get("query"), request.form.get("update")
+    elif media_type == QUERY_TYPE:
+        query, update = _body(), None
+    elif media_type == UPDATE_TYPE:
+        query, update = None, _body()
+    else:
+        raise UnsupportedMediaType(media_type or "(none)")
+    if query is not None and update is not None:
+        raise BadProtocolRequest("a request carries a query or an update, not both")
+    if query is None and update is None:
+        raise BadProtocolRequest("the POST carries neither query= nor update=")
+    return query, update
+
+
+def _body() -> str:
+    try:
+        return request.get_data(as_text=False).decode("utf-8")
+    except UnicodeDecodeError as error:
+        raise BadProtocolRequest(f"the request body is not UTF-8: {error}") from error
+
+
+def _update(text: str) -> Response:
+    service().update(text, _bearer_token())
+    return Response(status=204)
+
+
+def _bearer_token() -> str | None:
+    header = request.headers.get("Authorization", "")
+    scheme, _, token = header.partition(" ")
+    return token.strip() if scheme.lower() == "bearer" and token.strip() else None
+
+
+def _short_format() -> str | None:
+    return request.values.get("format") or request.values.get("output")
+
+
+def _with_charset(media_type: str) -> str:
+    return media_type + "; charset=utf-8"
+
+
+def _service_description() -> Response:
+    """A GET without a query describes the endpoint (SPARQL 1.1 Service Description), as RDF."""
+    sd = "http://www.w3.org/ns/sparql-service-description#"
+    formats = "http://www.w3.org/ns/formats/"
+    endpoint = ox.NamedNode(url_for("sparql.sparql", _external=True))
+    node = ox.BlankNode("service")
+    triples = [
+        ox.Triple(node, ox.NamedNode(_RDF_TYPE), ox.NamedNode(sd + "Service")),
+        ox.Triple(node, ox.NamedNode(sd + "endpoint"), endpoint),
+        ox.Triple(node, ox.NamedNode(sd + "supportedLanguage"), ox.NamedNode(sd + "SPARQL11Query")),
+        ox.Triple(node, ox.NamedNode(sd + "feature"), ox.NamedNode(sd + "UnionDefaultGraph")),
+    ]
+    if service().writable:
+        triples.append(ox.Triple(node, ox.NamedNode(sd + "supportedLanguage"), ox.NamedNode(sd + "SPARQL11Update")))
+    for name in ("SPARQL_Results_JSON", "SPARQL_Results_XML", "SPARQL_Results_CSV", "SPARQL_Results_TSV", "Turtle"):
+        triples.append(ox.Triple(node, ox.NamedNode(sd + "resultFormat"), ox.NamedNode(formats + name)))
+    media_type = negotiate(True, request.headers.get("Accept"), _short_format())
+    body = ox.serialize(triples, format=GRAPH_TYPES[media_type])
+    return Response(body, content_type=_with_charset(media_type))
+
