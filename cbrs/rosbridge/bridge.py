@@ -1,0 +1,394 @@
+"""The bridge: the rosbridge v2 ops over a graph of topics and services, without any transport.
+
+The server side (``add_service``, ``add_topic``, ``publish``, ``params``) may be used from any thread.
+A transport (``server.py`` for websockets) attaches the bridge to its event loop, opens one
+:class:`Session` per client, feeds it the client's text frames and closes it when the client goes.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import itertools
+import logging
+from collections.abc import Awaitable, Callable, Mapping
+from typing import TYPE_CHECKING, Any
+
+from cbrs.rosbridge import protocol, rosapi
+from cbrs.rosbridge.calls import Call, Calls, run_handler
+from cbrs.rosbridge.errors import ProtocolError, RosbridgeError, UnknownTopicError
+from cbrs.rosbridge.graph import Graph, Handler, Service, Topic
+from cbrs.rosbridge.params import ParamStore
+from cbrs.rosbridge.protocol import LEVELS, Message
+from cbrs.rosbridge.session import Session
+from cbrs.rosbridge.workers import WorkerPool
+
+if TYPE_CHECKING:
+    from cbrs.rosbridge.server import RunningBridge
+
+log = logging.getLogger("cbrs.rosbridge")
+
+MIB = 1 << 20
+
+
+def _api_name(name: str, what: str) -> str:
+    if not isinstance(name, str) or not name.strip("/ "):
+        raise ValueError(f"{what} name must be a non-empty string like '/cbrs/query', not {name!r}")
+    return protocol.resolve(name)
+
+
+class Bridge:
+    """A rosbridge v2 server core: topics, services and parameters shared by its clients.
+
+    ``max_message_bytes`` bounds one incoming message (larger ones get a status error);
+    ``call_timeout`` (seconds) bounds every service call unless the call sets its own ``timeout``;
+    ``params`` seeds the parameter store; ``max_queue_length`` bounds every subscription's queue (and
+    how far a pass-through subscriber may fall behind); ``service_workers`` threads run service handlers.
+    """
+
+    def __init__(
+        self,
+        *,
+        max_message_bytes: int = MIB,
+        call_timeout: float = 30.0,
+        params: Mapping[str, Any] | None = None,
+        max_queue_length: int = 1000,
+        service_workers: int = 8,
+    ) -> None:
+        for label, value in [
+            ("max_message_bytes", max_message_bytes),
+            ("call_timeout", call_timeout),
+            ("max_queue_length", max_queue_length),
+            ("service_workers", service_workers),
+        ]:
+            if isinstance(value, bool) or not isinstance(value, int | float) or value <= 0:
+                raise ValueError(f"{label} must be a positive number, not {value!r}")
+        self.max_message_bytes = int(max_message_bytes)
+        self.call_timeout = float(call_timeout)
+        self.max_queue_length = int(max_queue_length)
+        self.service_workers = int(service_workers)
+        self.params = ParamStore(params)
+        self._graph = Graph()
+        for name, (kind, handler) in rosapi.services(self._graph, self.params).items():
+            self._graph.services[name] = Service(name, kind, handler, inline=True)
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._calls: Calls | None = None
+        self._workers: WorkerPool | None = None
+        self._writers: dict[Session, asyncio.Task[None]] = {}
+        self._clients = itertools.count(1)
+        self._ops: dict[str, Callable[[Session, Message], None]] = {
+            "advertise": self._advertise,
+            "unadvertise": self._unadvertise,
+            "publish": self._publish,
+            "subscribe": self._subscribe,
+            "unsubscribe": self._unsubscribe,
+            "call_service": self._call_service,
+            "service_response": self._service_response,
+            "advertise_service": self._advertise_service,
+            "unadvertise_service": self._unadvertise_service,
+            "set_level": self._set_level,
+        }
+
+    # -- the server side ----------------------------------------------------------------------------
+
+    def add_service(self, name: str, type: str, handler: Handler) -> None:
+        """Offer a service answered by ``handler(args) -> values`` on a worker thread.
+
+        Raising :class:`ServiceError` fails the call with that text; any other exception fails it with
+        ``internal error: <type>: <message>`` (and is logged).
+        """
+        name = _api_name(name, "service")
+        if not callable(handler):
+            raise TypeError(f"the handler of {name} must be callable, not {handler!r}")
+        with self._graph.lock:
+            existing = self._graph.services.get(name)
+            if existing is not None:
+                owner = existing.provider.name if existing.provider else "the server"
+                raise RosbridgeError(f"service {name!r} is already provided by {owner}")
+            self._graph.services[name] = Service(name, type, handler)
+
+    def remove_service(self, name: str) -> None:
+        """Withdraw a service added with :meth:`add_service`; calls in flight still get their answer."""
+        name = _api_name(name, "service")
+        with self._graph.lock:
+            service = self._graph.services.get(name)
+            if service is None or service.handler is None or service.inline:
+                raise RosbridgeError(f"service {name!r} was not added by add_service")
+            del self._graph.services[name]
+
+    def add_topic(self, name: str, type: str, *, latch: bool = False) -> None:
+        """Declare a topic the server publishes on; with ``latch``, new subscribers get its last message."""
+        name = _api_name(name, "topic")
+        with self._graph.lock:
+            topic = self._graph.topics.get(name)
+            if topic is None:
+                topic = self._graph.topics[name] = Topic(name, type)
+            elif topic.type and topic.type != type:
+                raise RosbridgeError(f"topic {name!r} already has type {topic.type!r}, not {type!r}")
+            topic.type, topic.server, topic.latch = type, True, topic.latch or latch
+
+    def publish(self, topic: str, msg: dict[str, Any]) -> None:
+        """Publish ``msg`` on a topic added with :meth:`add_topic`; may be called from any thread."""
+        name = _api_name(topic, "topic")
+        if not isinstance(msg, dict):
+            raise TypeError(f"a message must be a dict, not {type(msg).__name__}")
+        text = protocol.dumps(msg)
+        with self._graph.lock:
+            entry = self._graph.topics.get(name)
+            if entry is None or not entry.server:
+                raise UnknownTopicError(topic)
+            if entry.latch:
+                entry.latched = text
+            loop = self._loop
+        if loop is not None:
+            with contextlib.suppress(RuntimeError):  # the loop closed under us: the server is stopping
+                loop.call_soon_threadsafe(self._fan_out, name, text)
+
+    def topics(self) -> list[tuple[str, str]]:
+        """(name, type) of every topic: the server's, advertised and subscribed ones."""
+        return self._graph.topic_list()
+
+    def services(self) -> list[tuple[str, str]]:
+        """(name, type) of every service: rosapi, the server's and those clients provide."""
+        return self._graph.service_list()
+
+    def start(self, host: str = "127.0.0.1", port: int = 9090) -> RunningBridge:
+        """Serve on a websocket in a background thread with its own event loop (port 0 picks a free one)."""
+        from cbrs.rosbridge.server import start
+
+        return start(self, host, port)
+
+    async def serve(
+        self, host: str = "127.0.0.1", port: int = 9090, *, ready: Callable[[int], None] | None = None
+    ) -> None:
+        """Serve on a websocket in the running event loop until cancelled; ``ready(port)`` once bound."""
+        from cbrs.rosbridge.server import serve
+
+        await serve(self, host, port, ready=ready)
+
+    # -- the transport interface --------------------------------------------------------------------
+
+    @property
+    def running(self) -> bool:
+        return self._loop is not None
+
+    def attach(self, loop: asyncio.AbstractEventLoop) -> None:
+        """Bind to the event loop that will run the sessions (one at a time)."""
+        if self._loop is not None:
+            raise RosbridgeError("this bridge is already being served; stop it before serving it again")
+        self._workers = WorkerPool(self.service_workers)
+        self._calls = Calls(loop, self._workers)
+        self._loop = loop
+
+    async def detach(self) -> WorkerPool:
+        """Close every session, fail the calls in flight; returns the (shut down) worker pool to join."""
+        for session in list(self._writers):
+            self.close_session(session)
+        assert self._calls is not None and self._workers is not None
+        self._calls.fail_all("the server is shutting down")
+        workers = self._workers
+        workers.shutdown()
+        self._loop = self._calls = self._workers = None
+        return workers
+
+    def open_session(self, peer: str, send: Callable[[str], Awaitable[None]], abort: Callable[[str], None]) -> Session:
+        """A new client; its writer task starts on the attached loop."""
+        if self._loop is None:
+            raise RosbridgeError("the bridge is not attached to an event loop")
+        session = Session(f"client {next(self._clients)} ({peer})", send, abort, self.max_queue_length)
+        self._writers[session] = self._loop.create_task(session.run(), name=f"rosbridge writer {session.name}")
+        log.info("%s connected", session.name)
+        return session
+
+    def receive(self, session: Session, frame: str | bytes) -> None:
+        """Handle one frame from a client; a bad one gets a status error, never an exception."""
+        if not isinstance(frame, str):
+            session.report("error", "binary frames are not supported (no CBOR or BSON): send JSON text frames")
+            return
+        op: str | None = None
+        message_id = None
+        try:
+            message = protocol.decode(frame, self.max_message_bytes)
+            message_id = message.get("id")
+            op = protocol.check(message)
+            self._ops[op](session, message)
+        except ProtocolError as error:
+            op = error.op or op
+            text = f"{op}: {error.reason}" if op else error.reason
+            log.info("%s: %s", session.name, text)
+            session.report("error", text, error.message_id if error.message_id is not None else message_id)
+        except Exception as error:
+            log.exception("%s: %s failed", session.name, op)
+            session.report("error", f"{op}: internal error: {type(error).__name__}: {error}", message_id)
+
+    def close_session(self, session: Session) -> None:
+        """The client has gone: drop its topics, services and subscriptions, fail calls waiting on it."""
+        if session not in self._writers:
+            return
+        session.close()
+        self._writers.pop(session).cancel()
+        with self._graph.lock:
+            for name in session.advertised:
+                self._graph.topics[name].publishers.discard(session)
+                self._graph.prune(name)
+            for name in session.queues:
+                self._graph.topics[name].subscribers.discard(session)
+                self._graph.prune(name)
+            for name in session.provided:
+                if self._graph.services[name].provider is session:
+                    del self._graph.services[name]
+        if self._calls is not None:
+            self._calls.fail_provider(session, None, "the provider of {service!r} disconnected")
+        log.info("%s disconnected", session.name)
+
+    # -- ops ----------------------------------------------------------------------------------------
+
+    def _advertise(self, session: Session, message: Message) -> None:
+        name, kind = protocol.resolve(message["topic"], "topic"), message["type"]
+        if not kind:
+            raise ProtocolError("field 'type' must name the message type, e.g. 'std_msgs/String'")
+        with self._graph.lock:
+            topic = self._graph.topics.get(name)
+            if topic is None:
+                topic = self._graph.topics[name] = Topic(name, kind)
+            elif topic.type and topic.type != kind:
+                raise ProtocolError(f"topic {name!r} already has type {topic.type!r}, not {kind!r}")
+            topic.type = kind
+            topic.latch = topic.latch or bool(message.get("latch"))
+            topic.publishers.add(session)
+        session.advertised[name] = message["topic"]
+        session.report("info", f"advertised {name} ({kind})", message.get("id"))
+
+    def _unadvertise(self, session: Session, message: Message) -> None:
+        name = protocol.resolve(message["topic"], "topic")
+        if session.advertised.pop(name, None) is None:
+            session.report("warning", f"unadvertise: this client does not advertise {name!r}", message.get("id"))
+            return
+        with self._graph.lock:
+            self._graph.topics[name].publishers.discard(session)
+            self._graph.prune(name)
+        session.report("info", f"unadvertised {name}", message.get("id"))
+
+    def _publish(self, session: Session, message: Message) -> None:
+        name = protocol.resolve(message["topic"], "topic")
+        text = protocol.dumps(message["msg"])
+        with self._graph.lock:
+            topic = self._graph.topics.get(name)
+            if topic is None:
+                raise ProtocolError(f"topic {name!r} is not advertised: send advertise (with its type) first")
+            topic.publishers.add(session)
+            if topic.latch or message.get("latch"):
+                topic.latched = text
+        session.advertised.setdefault(name, message["topic"])
+        self._fan_out(name, text)
+
+    def _subscribe(self, session: Session, message: Message) -> None:
+        name, kind, message_id = protocol.resolve(message["topic"], "topic"), message.get("type"), message.get("id")
+        throttle_rate, queue_length = message.get("throttle_rate", 0), message.get("queue_length", 0)
+        if throttle_rate < 0 or queue_length < 0:
+            raise ProtocolError("throttle_rate and queue_length must not be negative")
+        if queue_length > self.max_queue_length:
+            session.report("warning", f"queue_length {queue_length} lowered to {self.max_queue_length}", message_id)
+            queue_length = self.max_queue_length
+        if message.get("compression") not in (None, "none"):
+            text = f"compression {message['compression']!r} is not supported; sending JSON"
+            session.report("warning", text, message_id)
+        with self._graph.lock:
+            topic = self._graph.topics.get(name)
+            if topic is None:
+                topic = self._graph.topics[name] = Topic(name, kind or "")
+            elif kind and topic.type and topic.type != kind:
+                raise ProtocolError(f"topic {name!r} has type {topic.type!r}, not {kind!r}")
+            topic.type = topic.type or kind or ""
+            topic.subscribers.add(session)
+            latched = topic.latched
+        session.subscribe(name, message["topic"], message_id, throttle_rate, queue_length)
+        if latched is not None:
+            session.offer(name, protocol.publish_text(message["topic"], latched))
+        session.report("info", f"subscribed to {name}", message_id)
+
+    def _unsubscribe(self, session: Session, message: Message) -> None:
+        name, message_id = protocol.resolve(message["topic"], "topic"), message.get("id")
+        queue = session.queues.get(name)
+        if queue is None or (message_id is not None and message_id not in queue.requests):
+            which = "" if message_id is None else f" with id {message_id!r}"
+            session.report("warning", f"unsubscribe: no subscription to {name!r}{which}", message_id)
+            return
+        if session.unsubscribe(name, message_id, every=message_id is None):
+            with self._graph.lock:
+                self._graph.topics[name].subscribers.discard(session)
+                self._graph.prune(name)
+        session.report("info", f"unsubscribed from {name}", message_id)
+
+    def _call_service(self, session: Session, message: Message) -> None:
+        assert self._calls is not None
+        name = protocol.resolve(message["service"], "service")
+        args = message.get("args") or {}
+        timeout = message.get("timeout") or 0.0
+        timeout = timeout if timeout > 0 else self.call_timeout
+        call = Call(self._calls.new_key(name), name, session, message.get("id"), message["service"])
+        with self._graph.lock:
+            service = self._graph.services.get(name)
+        if service is None:
+            self._calls.finish(call, False, protocol.dumps(f"service {name!r} does not exist"))
+        elif service.provider is not None:
+            provider = service.provider
+            self._calls.to_provider(call, provider, provider.provided[name], args, timeout)
+        elif not isinstance(args, dict):
+            reason = f"service {name!r} takes its args as an object of named fields, not an array"
+            self._calls.finish(call, False, protocol.dumps(reason))
+        elif service.inline:
+            assert service.handler is not None
+            self._calls.finish(call, *run_handler(service.handler, args, name))
+        else:
+            assert service.handler is not None
+            self._calls.to_handler(call, service.handler, args, timeout)
+
+    def _service_response(self, session: Session, message: Message) -> None:
+        assert self._calls is not None
+        message_id = message.get("id")
+        if not self._calls.answer(session, message_id, message["result"], message.get("values")):
+            raise ProtocolError(f"no call with id {message_id!r} is waiting for this client's answer")
+
+    def _advertise_service(self, session: Session, message: Message) -> None:
+        name, kind = protocol.resolve(message["service"], "service"), message["type"]
+        with self._graph.lock:
+            service = self._graph.services.get(name)
+            if service is not None and service.provider is None:
+                raise ProtocolError(f"service {name!r} is provided by the server and cannot be advertised")
+            previous = service.provider if service is not None else None
+            self._graph.services[name] = Service(name, kind, provider=session)
+        if previous is not None and previous is not session:
+            previous.provided.pop(name, None)
+            log.warning("%s took over service %s from %s", session.name, name, previous.name)
+            session.report("warning", f"took over {name} from {previous.name}", message.get("id"))
+        session.provided[name] = message["service"]
+        session.report("info", f"advertised service {name} ({kind})", message.get("id"))
+
+    def _unadvertise_service(self, session: Session, message: Message) -> None:
+        assert self._calls is not None
+        name = protocol.resolve(message["service"], "service")
+        if session.provided.pop(name, None) is None:
+            session.report("warning", f"unadvertise_service: this client does not provide {name!r}", message.get("id"))
+            return
+        with self._graph.lock:
+            del self._graph.services[name]
+        self._calls.fail_provider(session, name, "service {service!r} was unadvertised by its provider")
+        session.report("info", f"unadvertised service {name}", message.get("id"))
+
+    def _set_level(self, session: Session, message: Message) -> None:
+        if message["level"] not in LEVELS:
+            raise ProtocolError(f"level must be one of {', '.join(LEVELS)}, not {message['level']!r}")
+        session.level = message["level"]
+
+    def _fan_out(self, name: str, text: str) -> None:
+        """Queue a message for every subscriber, under the name each one subscribed with."""
+        with self._graph.lock:
+            topic = self._graph.topics.get(name)
+            subscribers = list(topic.subscribers) if topic is not None else []
+        framed: dict[str, str] = {}
+        for session in subscribers:
+            spelling = session.spelling.get(name, name)
+            if spelling not in framed:
+                framed[spelling] = protocol.publish_text(spelling, text)
+            session.offer(name, framed[spelling])

@@ -1,0 +1,128 @@
+"""Service calls in flight: to handlers on worker threads, or forwarded to the client that provides them.
+
+Every call ends in exactly one ``service_response`` to its caller, with the caller's id: the answer, or
+``result: false`` with the reason (handler error, timeout, provider gone). Runs on the bridge's loop;
+only the handler itself runs on a worker thread.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import itertools
+import logging
+from dataclasses import dataclass
+from typing import Any
+
+from cbrs.rosbridge import protocol
+from cbrs.rosbridge.errors import ServiceError
+from cbrs.rosbridge.graph import Handler
+from cbrs.rosbridge.protocol import MessageId
+from cbrs.rosbridge.session import Session
+from cbrs.rosbridge.workers import WorkerPool
+
+log = logging.getLogger("cbrs.rosbridge")
+
+
+@dataclass(eq=False)
+class Call:
+    """One call in flight."""
+
+    key: str
+    service: str  # global name
+    caller: Session
+    caller_id: MessageId | None
+    spelling: str  # the service name as the caller wrote it
+    provider: Session | None = None  # None: a server handler
+    timer: asyncio.TimerHandle | None = None
+    done: bool = False
+
+
+def run_handler(handler: Handler, args: dict[str, Any], service: str) -> tuple[bool, str]:
+    """Run a handler; (result, encoded values), the values being the error text on failure."""
+    try:
+        values = handler(args)
+        if not isinstance(values, dict):
+            raise TypeError(f"the handler returned {type(values).__name__}, not a dict")
+        return True, protocol.dumps(values)
+    except ServiceError as error:
+        log.info("service %s failed: %s", service, error)
+        return False, protocol.dumps(str(error))
+    except Exception as error:
+        log.exception("service %s: handler raised", service)
+        return False, protocol.dumps(f"internal error: {type(error).__name__}: {error}")
+
+
+class Calls:
+    """The calls in flight on one running bridge."""
+
+    def __init__(self, loop: asyncio.AbstractEventLoop, workers: WorkerPool) -> None:
+        self._loop = loop
+        self._workers = workers
+        self._pending: dict[str, Call] = {}
+        self._keys = itertools.count(1)
+
+    def __len__(self) -> int:
+        return len(self._pending)
+
+    def to_handler(self, call: Call, handler: Handler, args: dict[str, Any], timeout: float) -> None:
+        """Run ``handler`` on a worker thread; its answer (or the timeout) goes to the caller."""
+        self._start(call, timeout)
+
+        def job() -> None:
+            if call.done:  # timed out while waiting for a free worker
+                return
+            result, values = run_handler(handler, args, call.service)
+            with contextlib.suppress(RuntimeError):  # the loop has closed: the server stopped meanwhile
+                self._loop.call_soon_threadsafe(self.finish, call, result, values)
+
+        try:
+            self._workers.submit(job)
+        except RuntimeError:
+            self.finish(call, False, protocol.dumps("the server is shutting down"))
+
+    def to_provider(self, call: Call, provider: Session, spelling: str, args: Any, timeout: float) -> None:
+        """Forward the call to the client ``provider`` under a fresh id."""
+        call.provider = provider
+        self._start(call, timeout)
+        provider.reply(protocol.call_service(spelling, args, call.key))
+
+    def answer(self, provider: Session, key: MessageId | None, result: bool, values: Any) -> bool:
+        """A provider's ``service_response``; False if ``provider`` has no call with that id."""
+        call = self._pending.get(str(key))
+        if call is None or call.provider is not provider:
+            return False
+        if values is None:
+            values = {} if result else f"service {call.service!r} failed (its provider gave no reason)"
+        elif result and not isinstance(values, dict):
+            result, values = False, f"service {call.service!r} answered with values that are not an object"
+        self.finish(call, result, protocol.dumps(values))
+        return True
+
+    def fail_provider(self, provider: Session, service: str | None, reason: str) -> None:
+        """Fail the calls waiting on ``provider`` (for ``service``, or all of them)."""
+        for call in list(self._pending.values()):
+            if call.provider is provider and service in (None, call.service):
+                self.finish(call, False, protocol.dumps(reason.format(service=call.service)))
+
+    def fail_all(self, reason: str) -> None:
+        for call in list(self._pending.values()):
+            self.finish(call, False, protocol.dumps(reason))
+
+    def finish(self, call: Call, result: bool, values_json: str) -> None:
+        """Answer the caller once; later answers (a late handler, a late provider) are dropped."""
+        if call.done:
+            return
+        call.done = True
+        self._pending.pop(call.key, None)
+        if call.timer is not None:
+            call.timer.cancel()
+        call.caller.reply(protocol.service_response(call.spelling, result, values_json, call.caller_id))
+
+    def _start(self, call: Call, timeout: float) -> None:
+        self._pending[call.key] = call
+        message = protocol.dumps(f"service {call.service!r} did not answer within {timeout:g} s")
+        call.timer = self._loop.call_later(timeout, self.finish, call, False, message)
+
+    def new_key(self, service: str) -> str:
+        return f"cbrs:{service}:{next(self._keys)}"

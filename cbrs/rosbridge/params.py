@@ -1,0 +1,110 @@
+"""A thread-safe parameter store shaped like the ROS 1 parameter server: a tree of JSON values.
+
+``/robot/speed`` is the ``speed`` child of the ``/robot`` namespace, so after ``set("/robot/speed", 1)``,
+``get("/robot")`` is ``{"speed": 1}``; setting a dictionary sets a whole namespace. Values are copied in
+and out (as JSON), so callers never share mutable state with the store.
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+from collections.abc import Iterator, Mapping
+from typing import Any
+
+_MISSING: Any = object()
+
+
+def _parts(name: str) -> list[str]:
+    return [part for part in name.split("/") if part]
+
+
+def _copy(value: Any) -> Any:
+    """A deep copy through JSON, which also refuses values JSON cannot hold."""
+    try:
+        return json.loads(json.dumps(value, allow_nan=False))
+    except (TypeError, ValueError) as error:
+        raise ValueError(f"a parameter must be JSON (numbers, strings, booleans, lists, dicts): {error}") from None
+
+
+class ParamStore:
+    """Parameters by global name; every method may be called from any thread."""
+
+    def __init__(self, initial: Mapping[str, Any] | None = None) -> None:
+        self._tree: dict[str, Any] = {}
+        self._lock = threading.Lock()
+        for name, value in (initial or {}).items():
+            self.set(name, value)
+
+    def get(self, name: str, default: Any = _MISSING) -> Any:
+        """The value (a dict for a namespace); ``default`` if unset, else :class:`KeyError`."""
+        with self._lock:
+            node: Any = self._tree
+            for part in _parts(name):
+                if not isinstance(node, dict) or part not in node:
+                    if default is _MISSING:
+                        raise KeyError(name)
+                    return default
+                node = node[part]
+            return _copy(node)
+
+    def set(self, name: str, value: Any) -> None:
+        """Set a value; a dict value replaces the whole namespace, intermediate namespaces are created."""
+        parts = _parts(name)
+        value = _copy(value)
+        if not parts and not isinstance(value, dict):
+            raise ValueError("only a dict can be set at the root '/'")
+        with self._lock:
+            if not parts:
+                self._tree = value
+                return
+            node = self._tree
+            for part in parts[:-1]:
+                if not isinstance(node.get(part), dict):
+                    node[part] = {}
+                node = node[part]
+            node[parts[-1]] = value
+
+    def delete(self, name: str) -> bool:
+        """Delete a value or namespace; False if it was not set."""
+        parts = _parts(name)
+        with self._lock:
+            if not parts:
+                had = bool(self._tree)
+                self._tree = {}
+                return had
+            node = self._find(parts[:-1])
+            if not isinstance(node, dict) or parts[-1] not in node:
+                return False
+            del node[parts[-1]]
+            return True
+
+    def has(self, name: str) -> bool:
+        """Whether a value or namespace is set under ``name``."""
+        with self._lock:
+            return self._find(_parts(name)) is not _MISSING
+
+    def names(self) -> list[str]:
+        """The global names of every value (not of namespaces), sorted."""
+        with self._lock:
+            return sorted(self._leaves(self._tree, ""))
+
+    def search(self, name: str) -> str | None:
+        """The global name ``name`` resolves to from the root namespace, if set (rosapi ``search_param``)."""
+        full = "/" + "/".join(_parts(name))
+        return full if _parts(name) and self.has(full) else None
+
+    def _find(self, parts: list[str]) -> Any:
+        node: Any = self._tree
+        for part in parts:
+            if not isinstance(node, dict) or part not in node:
+                return _MISSING
+            node = node[part]
+        return node
+
+    def _leaves(self, node: dict[str, Any], prefix: str) -> Iterator[str]:
+        for key, value in node.items():
+            if isinstance(value, dict) and value:
+                yield from self._leaves(value, f"{prefix}/{key}")
+            else:
+                yield f"{prefix}/{key}"

@@ -1,0 +1,200 @@
+"""The rosbridge v2 wire format: decoding and checking client messages, encoding server messages.
+
+Every check raises :class:`ProtocolError` with a reason a person can act on; the bridge turns it into a
+``status`` message and keeps the connection. Names are resolved as ROS resolves names of a node in the
+root namespace: ``chatter`` and ``/chatter`` are the same topic.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from typing import Any
+
+from cbrs.rosbridge.errors import ProtocolError
+
+Message = dict[str, Any]
+MessageId = str | int
+
+#: Status levels, least verbose first; a client at level L receives statuses of levels up to L.
+LEVELS = ("none", "error", "warning", "info")
+
+
+@dataclass(frozen=True)
+class Field:
+    """One field of an op: its name, the JSON types it may have, whether it must be there."""
+
+    name: str
+    kinds: tuple[type, ...]
+    required: bool = True
+
+
+def _opt(name: str, *kinds: type) -> Field:
+    return Field(name, kinds, required=False)
+
+
+def _req(name: str, *kinds: type) -> Field:
+    return Field(name, kinds)
+
+
+#: The ops this server implements and their fields (``op`` and ``id`` are common to all; other fields
+#: are ignored, as rosbridge does).
+OPS: dict[str, tuple[Field, ...]] = {
+    "advertise": (_req("topic", str), _req("type", str), _opt("latch", bool), _opt("queue_size", int)),
+    "unadvertise": (_req("topic", str),),
+    "publish": (_req("topic", str), _req("msg", dict), _opt("latch", bool)),
+    "subscribe": (
+        _req("topic", str),
+        _opt("type", str),
+        _opt("throttle_rate", int),
+        _opt("queue_length", int),
+        _opt("fragment_size", int),
+        _opt("compression", str),
+    ),
+    "unsubscribe": (_req("topic", str),),
+    "call_service": (
+        _req("service", str),
+        _opt("args", dict, list),
+        _opt("type", str),
+        _opt("timeout", float),
+        _opt("fragment_size", int),
+        _opt("compression", str),
+    ),
+    "service_response": (_req("service", str), _opt("values", dict, str), _req("result", bool)),
+    "advertise_service": (_req("service", str), _req("type", str)),
+    "unadvertise_service": (_req("service", str),),
+    "set_level": (_req("level", str),),
+}
+
+#: Ops of the rosbridge protocol this server knows about but does not implement, and why.
+UNSUPPORTED = {
+    "fragment": "fragmented messages are not supported; send the whole message (see max_message_bytes)",
+    "png": "PNG-compressed messages are not supported; send JSON text",
+    "auth": "authentication is not supported; the server binds to loopback unless opened on purpose",
+    "advertise_action": "actions are not supported; use a service and a feedback topic",
+    "unadvertise_action": "actions are not supported",
+    "send_action_goal": "actions are not supported; use a service and a feedback topic",
+    "cancel_action_goal": "actions are not supported",
+    "action_feedback": "actions are not supported",
+    "action_result": "actions are not supported",
+}
+
+_TYPE_NAMES = {
+    str: "a string",
+    int: "an integer",
+    float: "a number",
+    bool: "a boolean",
+    dict: "an object",
+    list: "an array",
+}
+
+
+def json_type(value: Any) -> str:
+    """The JSON name of a decoded value's type, for messages."""
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return "boolean"
+    if isinstance(value, int | float):
+        return "number"
+    if isinstance(value, str):
+        return "string"
+    if isinstance(value, list):
+        return "array"
+    return "object"
+
+
+def _no_constants(name: str) -> Any:
+    raise ValueError(f"{name} is not JSON")
+
+
+def decode(text: str, limit: int) -> Message:
+    """Parse one text frame into a message with a string ``op``; raises :class:`ProtocolError`."""
+    if len(text) > limit or (len(text) * 4 > limit and len(text.encode("utf-8")) > limit):
+        size = len(text.encode("utf-8"))
+        raise ProtocolError(f"message of {size} bytes exceeds the limit of {limit} bytes (max_message_bytes)")
+    try:
+        message = json.loads(text, parse_constant=_no_constants)
+    except ValueError as error:
+        raise ProtocolError(f"message is not valid JSON: {error}") from None
+    if not isinstance(message, dict):
+        raise ProtocolError(f"a rosbridge message must be a JSON object, not {json_type(message)}")
+    message_id = message.get("id")
+    if message_id is not None and (isinstance(message_id, bool) or not isinstance(message_id, str | int)):
+        raise ProtocolError(f"field 'id' must be a string or an integer, not {json_type(message_id)}")
+    if "op" not in message:
+        raise ProtocolError("message has no 'op' field", message_id=message_id)
+    op = message["op"]
+    if not isinstance(op, str):
+        raise ProtocolError(f"field 'op' must be a string, not {json_type(op)}", message_id=message_id)
+    return message
+
+
+def check(message: Message) -> str:
+    """Check the fields of a decoded message against its op; returns the op. Normalises integral floats."""
+    op: str = message["op"]
+    message_id = message.get("id")
+    if op not in OPS:
+        if op in UNSUPPORTED:
+            raise ProtocolError(UNSUPPORTED[op], op, message_id)
+        raise ProtocolError(f"unknown op {op!r}; this server supports {', '.join(OPS)}", message_id=message_id)
+    for field in OPS[op]:
+        value = message.get(field.name)
+        if value is None:
+            if field.required:
+                raise ProtocolError(f"missing required field {field.name!r}", op, message_id)
+            continue
+        converted = _convert(value, field.kinds)
+        if converted is None:
+            wanted = " or ".join(_TYPE_NAMES[kind] for kind in field.kinds)
+            raise ProtocolError(f"field {field.name!r} must be {wanted}, not {json_type(value)}", op, message_id)
+        message[field.name] = converted
+    return op
+
+
+def _convert(value: Any, kinds: tuple[type, ...]) -> Any:
+    """``value`` if it has one of ``kinds`` (JSON numbers: 3.0 is an integer, 3 is a number), else None."""
+    if isinstance(value, bool):
+        return value if bool in kinds else None
+    if int in kinds and isinstance(value, float) and value.is_integer():
+        return int(value)
+    if float in kinds and isinstance(value, int):
+        return float(value)
+    return value if isinstance(value, kinds) else None
+
+
+def resolve(name: str, what: str = "name") -> str:
+    """The global form of a topic, service or parameter name (``chatter`` -> ``/chatter``)."""
+    if not name or name.isspace():
+        raise ProtocolError(f"{what} must not be empty")
+    return name if name.startswith("/") else "/" + name
+
+
+def dumps(value: Any) -> str:
+    """Compact JSON; NaN and infinities are refused, since JSON has no such numbers."""
+    return json.dumps(value, separators=(",", ":"), ensure_ascii=False, allow_nan=False)
+
+
+def status(level: str, text: str, message_id: MessageId | None) -> str:
+    """A ``status`` message."""
+    message: Message = {"op": "status", "level": level, "msg": text}
+    if message_id is not None:
+        message["id"] = message_id
+    return dumps(message)
+
+
+def publish_text(topic: str, msg_json: str) -> str:
+    """A ``publish`` message from an already encoded ``msg``."""
+    return f'{{"op":"publish","topic":{dumps(topic)},"msg":{msg_json}}}'
+
+
+def service_response(service: str, result: bool, values_json: str, message_id: MessageId | None) -> str:
+    """A ``service_response`` from already encoded ``values`` (an object, or the error text on failure)."""
+    tail = "" if message_id is None else f',"id":{dumps(message_id)}'
+    flag = "true" if result else "false"
+    return f'{{"op":"service_response","service":{dumps(service)},"values":{values_json},"result":{flag}{tail}}}'
+
+
+def call_service(service: str, args: Any, message_id: str) -> str:
+    """A ``call_service`` forwarded to the client that provides ``service``."""
+    return dumps({"op": "call_service", "id": message_id, "service": service, "args": args})

@@ -1,0 +1,123 @@
+"""The rosapi services, answered by the bridge itself from its graph and parameter store.
+
+Requests and responses follow the rosapi service types of ROS 1 (``rosapi/Topics`` and so on). Parameter
+values travel as JSON-encoded strings, as roslibpy and roslibjs send them; ``get_param`` also answers
+the ROS 2 fields ``successful`` and ``reason``, which roslibjs reads when present.
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from typing import Any
+
+from cbrs.rosbridge.errors import ServiceError
+from cbrs.rosbridge.graph import Graph, Handler
+from cbrs.rosbridge.params import ParamStore
+from cbrs.rosbridge.protocol import json_type
+
+#: The node names rosapi reports: the bridge and rosapi itself.
+NODES = ["/cbrs_rosbridge", "/rosapi"]
+
+
+def _text(args: dict[str, Any], name: str, default: str | None = None) -> str:
+    value = args.get(name, default)
+    if value is None:
+        raise ServiceError(f"missing field {name!r}")
+    if not isinstance(value, str):
+        raise ServiceError(f"field {name!r} must be a string, not {json_type(value)}")
+    return value
+
+
+def _global(name: str) -> str:
+    return name if name.startswith("/") else "/" + name
+
+
+def _decoded(text: str, what: str) -> Any:
+    try:
+        return json.loads(text)
+    except ValueError:
+        raise ServiceError(f"{what} must be JSON-encoded (e.g. '3', '\"text\"', '[1, 2]'), not {text!r}") from None
+
+
+def services(graph: Graph, params: ParamStore) -> dict[str, tuple[str, Handler]]:
+    """rosapi service name -> (type, handler)."""
+
+    def topics(_: dict[str, Any]) -> dict[str, Any]:
+        listed = graph.topic_list()
+        return {"topics": [name for name, _ in listed], "types": [kind for _, kind in listed]}
+
+    def topics_for_type(args: dict[str, Any]) -> dict[str, Any]:
+        wanted = _text(args, "type")
+        return {"topics": [name for name, kind in graph.topic_list() if kind == wanted]}
+
+    def topic_type(args: dict[str, Any]) -> dict[str, Any]:
+        name = _global(_text(args, "topic"))
+        return {"type": dict(graph.topic_list()).get(name, "")}
+
+    def service_list(_: dict[str, Any]) -> dict[str, Any]:
+        return {"services": [name for name, _ in graph.service_list()]}
+
+    def service_type(args: dict[str, Any]) -> dict[str, Any]:
+        name = _global(_text(args, "service"))
+        return {"type": dict(graph.service_list()).get(name, "")}
+
+    def services_for_type(args: dict[str, Any]) -> dict[str, Any]:
+        wanted = _text(args, "type")
+        return {"services": [name for name, kind in graph.service_list() if kind == wanted]}
+
+    def nodes(_: dict[str, Any]) -> dict[str, Any]:
+        return {"nodes": list(NODES)}
+
+    def get_param(args: dict[str, Any]) -> dict[str, Any]:
+        name = _global(_text(args, "name"))
+        default = _text(args, "default", "")
+        if params.has(name):
+            return {"value": json.dumps(params.get(name)), "successful": True, "reason": ""}
+        if default:
+            _decoded(default, "default")
+            return {"value": default, "successful": True, "reason": ""}
+        return {"value": "null", "successful": False, "reason": f"parameter {name!r} is not set"}
+
+    def set_param(args: dict[str, Any]) -> dict[str, Any]:
+        name = _global(_text(args, "name"))
+        try:
+            params.set(name, _decoded(_text(args, "value"), "value"))
+        except ValueError as error:
+            raise ServiceError(str(error)) from None
+        return {}
+
+    def delete_param(args: dict[str, Any]) -> dict[str, Any]:
+        params.delete(_global(_text(args, "name")))  # deleting what is not set is not an error (ROS 1)
+        return {}
+
+    def has_param(args: dict[str, Any]) -> dict[str, Any]:
+        return {"exists": params.has(_global(_text(args, "name")))}
+
+    def get_param_names(_: dict[str, Any]) -> dict[str, Any]:
+        return {"names": params.names()}
+
+    def search_param(args: dict[str, Any]) -> dict[str, Any]:
+        return {"global_name": params.search(_text(args, "name")) or ""}
+
+    def get_time(_: dict[str, Any]) -> dict[str, Any]:
+        secs, nsecs = divmod(time.time_ns(), 1_000_000_000)
+        # ROS 1 clients (roslibpy) read secs/nsecs, ROS 2 ones sec/nanosec
+        return {"time": {"secs": secs, "nsecs": nsecs, "sec": secs, "nanosec": nsecs}}
+
+    return {
+        "/rosapi/topics": ("rosapi/Topics", topics),
+        "/rosapi/topics_for_type": ("rosapi/TopicsForType", topics_for_type),
+        "/rosapi/topic_type": ("rosapi/TopicType", topic_type),
+        "/rosapi/services": ("rosapi/Services", service_list),
+        "/rosapi/service_type": ("rosapi/ServiceType", service_type),
+        "/rosapi/services_for_type": ("rosapi/ServicesForType", services_for_type),
+        "/rosapi/nodes": ("rosapi/Nodes", nodes),
+        "/rosapi/get_param": ("rosapi/GetParam", get_param),
+        "/rosapi/set_param": ("rosapi/SetParam", set_param),
+        "/rosapi/delete_param": ("rosapi/DeleteParam", delete_param),
+        "/rosapi/has_param": ("rosapi/HasParam", has_param),
+        "/rosapi/get_param_names": ("rosapi/GetParamNames", get_param_names),
+        "/rosapi/search_param": ("rosapi/SearchParam", search_param),
+        "/rosapi/get_time": ("rosapi/GetTime", get_time),
+    }

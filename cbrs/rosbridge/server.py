@@ -1,0 +1,182 @@
+"""The websocket transport: serve a :class:`Bridge` in an event loop, or in a thread of its own.
+
+Text frames carry rosbridge JSON messages. The websocket's own frame limit is set well above the
+bridge's ``max_message_bytes`` (16 MiB, or twice the bridge's limit if that is larger), so a message
+that is merely too large gets a status error and the connection stays up; only a frame beyond the
+transport limit closes the connection (code 1009, as websockets does).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import logging
+import threading
+import time
+from collections.abc import Callable
+from typing import Any
+
+from websockets.asyncio.server import ServerConnection
+from websockets.asyncio.server import serve as ws_serve
+from websockets.exceptions import ConnectionClosed
+
+from cbrs.rosbridge.bridge import MIB, Bridge
+from cbrs.rosbridge.errors import RosbridgeError
+from cbrs.rosbridge.workers import WorkerPool
+
+log = logging.getLogger("cbrs.rosbridge")
+
+#: How long a client has to answer the server's close frame when the server stops.
+CLOSE_TIMEOUT = 2.0
+
+
+def transport_limit(bridge: Bridge) -> int:
+    """The websocket frame limit for ``bridge``: above its message limit, so that limit can answer."""
+    return max(16 * MIB, 2 * bridge.max_message_bytes)
+
+
+def _peer(address: Any) -> str:
+    try:
+        return f"{address[0]}:{address[1]}"
+    except (TypeError, IndexError):
+        return str(address)
+
+
+async def serve(
+    bridge: Bridge, host: str = "127.0.0.1", port: int = 9090, *, ready: Callable[[int], None] | None = None
+) -> None:
+    """Serve ``bridge`` on ``ws://host:port`` in the running loop until cancelled."""
+    await _serve(bridge, host, port, ready, None)
+
+
+async def _serve(
+    bridge: Bridge,
+    host: str,
+    port: int,
+    ready: Callable[[int], None] | None,
+    detached: Callable[[WorkerPool], None] | None,
+) -> None:
+    loop = asyncio.get_running_loop()
+    bridge.attach(loop)
+    bound = port
+    closing: set[asyncio.Task[None]] = set()
+
+    async def connection(websocket: ServerConnection) -> None:
+        def abort(reason: str) -> None:
+            log.warning("%s: disconnected: %s", session.name, reason)
+            task = loop.create_task(websocket.close(1008, reason))
+            closing.add(task)
+            task.add_done_callback(closing.discard)
+
+        session = bridge.open_session(_peer(websocket.remote_address), websocket.send, abort)
+        try:
+            async for frame in websocket:
+                bridge.receive(session, frame)
+        except ConnectionClosed:
+            pass
+        finally:
+            bridge.close_session(session)
+
+    try:
+        async with ws_serve(
+            connection,
+            host,
+            port,
+            max_size=transport_limit(bridge),
+            compression=None,
+            close_timeout=CLOSE_TIMEOUT,
+        ) as server:
+            bound = int(server.sockets[0].getsockname()[1])
+            log.info("rosbridge serving on ws://%s:%d", host, bound)
+            if ready is not None:
+                ready(bound)
+            await asyncio.Future()  # until cancelled
+    finally:
+        workers = await bridge.detach()
+        if detached is not None:
+            detached(workers)
+        log.info("rosbridge on %s:%d stopped", host, bound)
+
+
+class RunningBridge:
+    """A bridge served by :func:`start` in a background thread; ``stop`` it (or use it as a context)."""
+
+    def __init__(self, host: str, thread: threading.Thread, state: dict[str, Any]) -> None:
+        self.host = host
+        self.port: int = state["port"]
+        self._thread = thread
+        self._state = state
+
+    @property
+    def url(self) -> str:
+        return f"ws://{self.host}:{self.port}"
+
+    def stop(self, timeout: float = 5.0) -> bool:
+        """Close every connection, stop the loop and join its thread and the service workers.
+
+        Returns False if something was still running after ``timeout`` seconds (then logged).
+        """
+        deadline = time.monotonic() + timeout
+        loop: asyncio.AbstractEventLoop | None = self._state.get("loop")
+        task: asyncio.Task[None] | None = self._state.get("task")
+        if loop is not None and task is not None:
+            with contextlib.suppress(RuntimeError):  # the loop is already closed
+                loop.call_soon_threadsafe(task.cancel)
+        self._thread.join(max(0.0, deadline - time.monotonic()))
+        if self._thread.is_alive():
+            log.warning("rosbridge thread still running after %.1f s", timeout)
+            return False
+        workers: WorkerPool | None = self._state.get("workers")
+        return workers is None or workers.join(max(0.0, deadline - time.monotonic())) == 0
+
+    def __enter__(self) -> RunningBridge:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+
+def start(bridge: Bridge, host: str = "127.0.0.1", port: int = 9090, *, startup_timeout: float = 10.0) -> RunningBridge:
+    """Serve ``bridge`` in a new thread with its own event loop; returns once the port is bound."""
+    ready = threading.Event()
+    state: dict[str, Any] = {}
+
+    def on_ready(bound: int) -> None:
+        state["port"] = bound
+        ready.set()
+
+    def on_detached(workers: WorkerPool) -> None:
+        state["workers"] = workers
+
+    def main() -> None:
+        loop = asyncio.new_event_loop()
+        task = loop.create_task(_serve(bridge, host, port, on_ready, on_detached))
+        state["loop"], state["task"] = loop, task
+        try:
+            loop.run_until_complete(task)
+        except asyncio.CancelledError:
+            pass
+        except BaseException as error:
+            state["error"] = error
+            if ready.is_set():
+                log.exception("rosbridge stopped on an error")
+        finally:
+            ready.set()
+            leftovers = asyncio.all_tasks(loop)
+            for leftover in leftovers:
+                leftover.cancel()
+            if leftovers:
+                loop.run_until_complete(asyncio.gather(*leftovers, return_exceptions=True))
+            loop.run_until_complete(loop.shutdown_asyncgens())
+            loop.close()
+
+    thread = threading.Thread(target=main, name=f"cbrs-rosbridge-{host}:{port}", daemon=True)
+    thread.start()
+    if not ready.wait(startup_timeout):
+        running = RunningBridge(host, thread, {**state, "port": port})
+        running.stop()
+        raise RosbridgeError(f"the rosbridge server did not start within {startup_timeout:g} s")
+    if "error" in state:
+        thread.join(startup_timeout)
+        raise state["error"]
+    return RunningBridge(host, thread, state)

@@ -1,0 +1,153 @@
+"""One connected client: what it advertises, provides and subscribes to, and its single writer.
+
+Everything the client receives goes through one writer task, in the order it was produced, except that
+a throttled topic waits for its window. Replies (statuses, service responses, forwarded calls) are never
+dropped; topic messages wait in their :class:`TopicQueue`, so a client that reads slowly only ever has
+its queues' worth of messages pending. The transport hands in ``send`` (await one text frame) and
+``abort`` (drop the connection, with a reason); nothing here knows about websockets.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import logging
+import time
+from collections import deque
+from collections.abc import Awaitable, Callable
+
+from cbrs.rosbridge.outbox import Request, TopicQueue
+from cbrs.rosbridge.protocol import LEVELS, MessageId, status
+
+log = logging.getLogger("cbrs.rosbridge")
+
+#: Replies a client may leave unread before it is disconnected (it is not reading its socket).
+REPLY_BACKLOG = 10_000
+
+
+class Session:
+    """A client of the bridge, confined to the bridge's event loop."""
+
+    def __init__(
+        self,
+        name: str,
+        send: Callable[[str], Awaitable[None]],
+        abort: Callable[[str], None],
+        backlog: int,
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
+        self.name = name
+        self.level = "error"
+        self.closed = False
+        #: topics this client advertised (global name -> the name as the client wrote it), likewise
+        #: services it provides, and the spelling it subscribed with (messages go out under that name)
+        self.advertised: dict[str, str] = {}
+        self.provided: dict[str, str] = {}
+        self.spelling: dict[str, str] = {}
+        self.queues: dict[str, TopicQueue] = {}
+        self._send = send
+        self._abort = abort
+        self._backlog = backlog
+        self._clock = clock
+        self._replies: deque[tuple[int, str]] = deque()
+        self._seq = 0
+        self._wake = asyncio.Event()
+
+    def __repr__(self) -> str:
+        return f"<Session {self.name}>"
+
+    # -- what the bridge calls -------------------------------------------------------------------
+
+    def reply(self, text: str) -> None:
+        """Queue a message that must arrive (a status, a service response, a forwarded call)."""
+        if self.closed:
+            return
+        if len(self._replies) >= REPLY_BACKLOG:
+            self.closed = True
+            self._abort(f"{REPLY_BACKLOG} replies unread")
+            return
+        self._replies.append((self._next_seq(), text))
+        self._wake.set()
+
+    def report(self, level: str, text: str, message_id: MessageId | None = None) -> None:
+        """Send a ``status`` message if the client's level asks for it."""
+        if LEVELS.index(level) <= LEVELS.index(self.level):
+            self.reply(status(level, text, message_id))
+
+    def subscribe(self, topic: str, spelling: str, request: Request, throttle_rate: int, queue_length: int) -> None:
+        queue = self.queues.get(topic)
+        if queue is None:
+            queue = self.queues[topic] = TopicQueue(self._backlog)
+        queue.add(request, throttle_rate, queue_length)
+        self.spelling[topic] = spelling
+
+    def unsubscribe(self, topic: str, request: Request | None, every: bool) -> bool:
+        """Drop one subscribe request (or ``every`` one); True if the client no longer subscribes."""
+        queue = self.queues[topic]
+        if every:
+            queue.requests.clear()
+        else:
+            queue.remove(request)
+        if queue.requests:
+            return False
+        del self.queues[topic]
+        del self.spelling[topic]
+        return True
+
+    def offer(self, topic: str, text: str) -> None:
+        """Queue a ``publish`` message of a subscribed topic."""
+        queue = self.queues.get(topic)
+        if queue is None or self.closed:
+            return
+        before = queue.dropped
+        queue.push(self._next_seq(), text)
+        if queue.dropped != before and (queue.dropped & (queue.dropped - 1)) == 0:
+            log.debug("%s: dropped %d messages of %s (queue of %d)", self.name, queue.dropped, topic, queue.capacity)
+        self._wake.set()
+
+    def close(self) -> None:
+        self.closed = True
+        self._wake.set()
+
+    # -- the writer --------------------------------------------------------------------------------
+
+    async def run(self) -> None:
+        """Send queued messages until closed (or until the transport fails)."""
+        try:
+            while not self.closed:
+                now = self._clock()
+                text, wait = self._take(now)
+                if text is not None:
+                    await self._send(text)
+                    continue
+                self._wake.clear()
+                try:
+                    async with asyncio.timeout(wait):
+                        await self._wake.wait()
+                except TimeoutError:
+                    pass
+        except Exception as error:  # the connection went away under a send
+            log.debug("%s: writer stopped: %r", self.name, error)
+            self.closed = True
+
+    def _take(self, now: float) -> tuple[str | None, float | None]:
+        """The next message due (oldest first), else how long until one is due (None: nothing waits)."""
+        best: TopicQueue | None = None
+        best_seq = self._replies[0][0] if self._replies else None
+        wait: float | None = None
+        for queue in self.queues.values():
+            ready = queue.ready_at()
+            if ready is None:
+                continue
+            if ready > now:
+                wait = ready - now if wait is None else min(wait, ready - now)
+            elif best_seq is None or queue.head() < best_seq:
+                best, best_seq = queue, queue.head()
+        if best is not None:
+            return best.pop(now), None
+        if best_seq is not None:
+            return self._replies.popleft()[1], None
+        return None, wait
+
+    def _next_seq(self) -> int:
+        self._seq += 1
+        return self._seq
