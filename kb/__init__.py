@@ -1,10 +1,12 @@
-"""The cbrs knowledge base: an Oxigraph store of ontologies, advertisements and requirements."""
+"""The cbrs knowledge base: an Oxigraph store (embedded, or a SPARQL server) of ontologies, advertisements and
+requirements."""
 
 from kb.catalog import Catalogue
 from kb.errors import (
     AlreadyRegisteredError,
     BindingError,
     CatalogueError,
+    EndpointError,
     InvalidDescriptionError,
     KnowledgeBaseError,
     NotFoundError,
@@ -29,7 +31,7 @@ from kb.model import (
     Statement,
 )
 from kb.namespaces import PREFIXES, GraphName
-from kb.store import Store
+from kb.store import EmbeddedStore, Store
 
 __all__ = [
     "PREFIXES",
@@ -39,6 +41,8 @@ __all__ = [
     "Catalogue",
     "CatalogueError",
     "EffectiveArea",
+    "EmbeddedStore",
+    "EndpointError",
     "GraphName",
     "InvalidDescriptionError",
     "KnowledgeBase",

@@ -20,6 +20,25 @@ class StoreError(KnowledgeBaseError):
         super().__init__(f"store {location}: {reason}")
 
 
+class EndpointError(StoreError):
+    """A SPARQL endpoint behind a remote store refused or failed a request.
+
+    Keeps the endpoint URL, the HTTP status, the server's own message and the request text sent.
+    """
+
+    http_status = 502
+
+    def __init__(self, location: str, endpoint: str, status: int, message: str, request: str | None = None) -> None:
+        self.endpoint = endpoint
+        self.status = status
+        self.message = message
+        self.request = request
+        one_line = " ".join(message.split()) or "(no message)"
+        if len(one_line) > 240:
+            one_line = one_line[:240] + " ..."
+        super().__init__(location, f"HTTP {status} from {endpoint}: {one_line}")
+
+
 class RdfParseError(KnowledgeBaseError):
     """A file or text did not parse; nothing was loaded."""
 

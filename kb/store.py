@@ -1,10 +1,16 @@
-"""The Oxigraph store behind cbrs: embedded on disk or in memory.
+"""The Oxigraph store behind cbrs: embedded (on disk or in memory) or a SPARQL server.
 
-Every write is one Oxigraph transaction, so a write that fails leaves the store as it was.
+``Store`` is the one interface the knowledge base talks to; ``Store.open`` picks the backend from the
+location: ``http://`` and ``https://`` URLs reach a SPARQL 1.1 endpoint (:mod:`kb.remote_store`),
+anything else is a directory or ``:memory:`` for the embedded :class:`EmbeddedStore`.
+
+Every write is one transaction, so a write that fails leaves the store as it was.
 """
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
+from collections import defaultdict
 from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
 
@@ -14,17 +20,115 @@ from kb.errors import QuerySyntaxError, StoreError
 from kb.namespaces import GENID, PREFIXES, GraphName
 
 MEMORY = ":memory:"
+REMOTE_SCHEMES = ("http://", "https://")
 
 Term = ox.NamedNode | ox.BlankNode | ox.Literal
 QueryResult = ox.QuerySolutions | ox.QueryBoolean | ox.QueryTriples
 
 
-class Store:
-    """A cbrs store: an Oxigraph dataset with the cbrs named graphs.
+class Store(ABC):
+    """A cbrs store: an RDF dataset with the cbrs named graphs.
 
     Queries see the union of all graphs as their default graph, so a query need not know which
     graph holds a fact; ``GRAPH`` still addresses one graph.
     """
+
+    location: str
+
+    @classmethod
+    def open(cls, location: str | Path) -> Store:
+        """Open the store at ``location``: a SPARQL endpoint URL, a directory (created if needed), or ``:memory:``."""
+        text = str(location)
+        if is_remote(text):
+            from kb.remote_store import RemoteStore  # only a remote store needs the HTTP client
+
+            return RemoteStore.open(text)
+        return EmbeddedStore.open(text)
+
+    @property
+    def in_memory(self) -> bool:
+        return False
+
+    # -- reading ---------------------------------------------------------------------------
+
+    @abstractmethod
+    def query(self, text: str, bindings: Mapping[str, Term] | None = None) -> QueryResult:
+        """Run a SPARQL query with ``bindings`` bound to its variables (never pasted into the text as such)."""
+
+    @abstractmethod
+    def quads(
+        self,
+        subject: ox.NamedNode | ox.BlankNode | None = None,
+        predicate: ox.NamedNode | None = None,
+        object: Term | None = None,
+        graph: ox.NamedNode | ox.DefaultGraph | None = None,
+    ) -> Iterator[ox.Quad]:
+        """The quads matching a pattern; ``None`` matches anything (in any graph, for ``graph``)."""
+
+    @abstractmethod
+    def count(self, graph: GraphName | ox.NamedNode | None = None) -> int:
+        """The number of quads in ``graph``, or in the whole dataset."""
+
+    @abstractmethod
+    def graphs(self) -> list[str]:
+        """The named graphs' IRIs, sorted."""
+
+    @abstractmethod
+    def is_seeded(self) -> bool:
+        """Whether the ontology graph exists (the bundled data was loaded)."""
+
+    def dump(self, rdf_format: ox.RdfFormat = ox.RdfFormat.N_QUADS) -> bytes:
+        """The whole dataset, serialised; N-Quads sorted, so two dumps compare byte for byte."""
+        if rdf_format == ox.RdfFormat.N_QUADS:
+            lines = sorted(str(quad) + " .\n" for quad in self.quads())
+            return "".join(lines).encode("utf-8")
+        return ox.serialize(list(self.quads()), format=rdf_format, prefixes=PREFIXES) or b""
+
+    # -- writing ---------------------------------------------------------------------------
+
+    @abstractmethod
+    def add(self, quads: Iterable[ox.Quad]) -> None:
+        """Add ``quads`` in one transaction."""
+
+    def replace(self, remove: Iterable[ox.Quad], add: Iterable[ox.Quad]) -> None:
+        """Remove and add quads in one transaction.
+
+        One SPARQL update is one transaction (in Oxigraph, embedded or served). The quads go into the
+        update as ground data blocks written by Oxigraph's own term serialiser (the term constructors
+        have validated every IRI and escape every literal), so no caller-supplied text reaches the
+        update; blank nodes are refused, since a data block cannot name them (the loader skolemises
+        them).
+        """
+        removing = data_block(remove)
+        adding = data_block(add)
+        parts = []
+        if removing:
+            parts.append("DELETE DATA {\n" + removing + "}")
+        if adding:
+            parts.append("INSERT DATA {\n" + adding + "}")
+        if parts:
+            self.update(" ;\n".join(parts))
+
+    @abstractmethod
+    def update(self, text: str) -> None:
+        """Run a SPARQL update in one transaction."""
+
+    @abstractmethod
+    def flush(self) -> None:
+        """Make every write durable."""
+
+    @abstractmethod
+    def close(self) -> None:
+        """Release the store; using it afterwards raises :class:`StoreError`."""
+
+
+def is_remote(location: str) -> bool:
+    """Whether ``location`` names a SPARQL endpoint rather than a directory."""
+    return location.strip().lower().startswith(REMOTE_SCHEMES)
+
+
+class EmbeddedStore(Store):
+    """An Oxigraph store in this process, on disk or in memory."""
 
     def __init__(self, backend: ox.Store, location: str) -> None:
         self._open: ox.Store | None = backend
@@ -43,11 +147,13 @@ class Store:
             self._open = None
 
     @classmethod
-    def open(cls, location: str | Path) -> Store:
+    def open(cls, location: str | Path) -> EmbeddedStore:
         """Open (creating if needed) the store at ``location``: a directory, or ``:memory:``."""
         text = str(location)
         if text == MEMORY:
             return cls(ox.Store(), MEMORY)
+        if is_remote(text):
+            raise StoreError(text, "is a SPARQL endpoint, not a directory; open it with Store.open")
         path = Path(text).expanduser()
         if path.exists() and not path.is_dir():
             raise StoreError(text, "exists and is not a directory")
@@ -67,8 +173,6 @@ class Store:
     def in_memory(self) -> bool:
         return self.location == MEMORY
 
-    # -- reading ---------------------------------------------------------------------------
-
     def query(self, text: str, bindings: Mapping[str, Term] | None = None) -> QueryResult:
         """Run a SPARQL query with ``bindings`` substituted for its variables (never pasted into text)."""
         substitutions: dict[ox.Variable, ox.NamedNode | ox.BlankNode | ox.Literal | ox.Triple] = {
@@ -86,7 +190,7 @@ class Store:
         subject: ox.NamedNode | ox.BlankNode | None = None,
         predicate: ox.NamedNode | None = None,
         object: Term | None = None,
-        graph: ox.NamedNode | None = None,
+        graph: ox.NamedNode | ox.DefaultGraph | None = None,
     ) -> Iterator[ox.Quad]:
         return iter(self._backend.quads_for_pattern(subject, predicate, object, graph))
 
@@ -101,15 +205,11 @@ class Store:
         return self._backend.contains_named_graph(GraphName.ONTOLOGY.node)
 
     def dump(self, rdf_format: ox.RdfFormat = ox.RdfFormat.N_QUADS) -> bytes:
-        """The whole dataset, serialised; N-Quads sorted, so two dumps compare byte for byte."""
         if rdf_format == ox.RdfFormat.N_QUADS:
-            lines = sorted(str(quad) + " .\n" for quad in self._backend)
-            return "".join(lines).encode("utf-8")
+            return super().dump(rdf_format)
         data = self._backend.dump(format=rdf_format, prefixes=PREFIXES)
         assert data is not None
         return data
-
-    # -- writing ---------------------------------------------------------------------------
 
     def add(self, quads: Iterable[ox.Quad]) -> None:
         """Add ``quads`` in one transaction."""
@@ -118,32 +218,13 @@ class Store:
         except OSError as error:
             raise StoreError(self.location, f"write failed: {error}") from error
 
-    def replace(self, remove: Iterable[ox.Quad], add: Iterable[ox.Quad]) -> None:
-        """Remove and add quads in one transaction.
-
-        Oxigraph's Python API has no multi-operation transaction, but one SPARQL update is one.
-        The quads go into the update as ground data blocks written by Oxigraph's own term
-        serialiser (the term constructors have validated every IRI and escape every literal), so no
-        caller-supplied text reaches the update; blank nodes are refused, since a data block
-        cannot name them (the loader skolemises them).
-        """
-        removing = _data_block(remove)
-        adding = _data_block(add)
-        parts = []
-        if removing:
-            parts.append("DELETE DATA {\n" + removing + "}")
-        if adding:
-            parts.append("INSERT DATA {\n" + adding + "}")
-        if parts:
-            self.update(" ;\n".join(parts))
-
     def update(self, text: str) -> None:
         """Run a SPARQL update in one transaction."""
         try:
             self._backend.update(text, prefixes=PREFIXES)
         except SyntaxError as error:
             raise QuerySyntaxError(text, str(error)) from error
-        except OSError as error:
+        except (OSError, RuntimeError) as error:  # RuntimeError: e.g. CREATE GRAPH of an existing graph
             raise StoreError(self.location, f"update failed: {error}") from error
 
     def flush(self) -> None:
@@ -151,14 +232,26 @@ class Store:
             self._backend.flush()
 
 
-def _data_block(quads: Iterable[ox.Quad]) -> str:
-    lines = []
+def data_block(quads: Iterable[ox.Quad], blank_nodes: bool = False) -> str:
+    """The body of an ``INSERT DATA`` / ``DELETE DATA`` block for ``quads``, one ``GRAPH`` group per graph.
+
+    Every term is written by pyoxigraph's serialiser. Blank nodes are refused unless ``blank_nodes``
+    (they are fresh nodes in an ``INSERT DATA``, and a ``DELETE DATA`` cannot name them).
+    """
+    by_graph: dict[ox.NamedNode | ox.DefaultGraph, list[str]] = defaultdict(list)
     for quad in quads:
-        for term in (quad.subject, quad.object):
-            if isinstance(term, ox.BlankNode):
-                raise ValueError(f"blank node {term} in a data block; skolemise it under {GENID} first")
-        if isinstance(quad.graph_name, ox.NamedNode):
-            lines.append(f"GRAPH {quad.graph_name} {{ {quad.subject} {quad.predicate} {quad.object} }}\n")
+        if not blank_nodes:
+            for term in (quad.subject, quad.object):
+                if isinstance(term, ox.BlankNode):
+                    raise ValueError(f"blank node {term} in a data block; skolemise it under {GENID} first")
+        graph = quad.graph_name
+        if isinstance(graph, ox.BlankNode):
+            raise ValueError(f"blank node graph name {graph} in a data block")
+        by_graph[graph].append(f"{quad.subject} {quad.predicate} {quad.object} .\n")
+    parts = []
+    for graph, lines in by_graph.items():
+        if isinstance(graph, ox.NamedNode):
+            parts.append(f"GRAPH {graph} {{\n{''.join(lines)}}}\n")
         else:
-            lines.append(f"{quad.subject} {quad.predicate} {quad.object} .\n")
-    return "".join(lines)
+            parts.append("".join(lines))
+    return "".join(parts)

@@ -1,0 +1,407 @@
+"""A cbrs store on a SPARQL 1.1 server, spoken to with the SPARQL 1.1 Protocol over HTTP.
+
+Oxigraph server (``oxigraph serve --location DIR --bind HOST:PORT --union-default-graph``) is the
+reference; any endpoint with SPARQL 1.1 Update whose default graph is the union of its named graphs
+will do. See docs/remote-store.md.
+
+Three rules keep it equivalent to the embedded store:
+
+- **Union default graph.** cbrs queries see all named graphs as their default graph. The server must
+  do the same; it is checked at open (and, while the server holds no data, before each query).
+- **Bound values are never pasted as text.** A query's bindings go in as a ``VALUES`` block, the first
+  element of the query's top-level group pattern, so they pre-bind the pattern as Oxigraph's
+  substitutions do (a trailing ``VALUES`` clause would join after ``GROUP BY`` and ``LIMIT``). Terms
+  are written by pyoxigraph's serialiser, which has validated every IRI and escapes every literal.
+- **One write, one request, one transaction.** ``add`` sends one ``INSERT DATA`` and ``replace`` one
+  ``DELETE DATA ; INSERT DATA`` request; a SPARQL update request is one transaction, so a failed
+  write leaves the store as it was. Writes are never split into chunks.
+"""
+
+from __future__ import annotations
+
+import functools
+import re
+import ssl
+from collections.abc import Iterable, Iterator, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import NamedTuple
+
+import httpx
+import pyoxigraph as ox
+
+from kb.errors import BindingError, EndpointError, QuerySyntaxError, StoreError
+from kb.namespaces import PREFIXES, GraphName
+from kb.store import QueryResult, Store, Term, data_block
+
+DEFAULT_TIMEOUT = 60.0  # seconds to wait for an answer (the seed takes well under one)
+CONNECT_TIMEOUT = 5.0
+
+# One line, so the server's "error at LINE:COLUMN" is off by exactly one line (corrected in errors).
+PROLOGUE = " ".join(f"PREFIX {prefix}: <{namespace}>" for prefix, namespace in PREFIXES.items()) + "\n"
+# TSV first: lossless (N-Triples terms) and the quickest to write and read; JSON for other servers.
+_ACCEPT = (
+    "text/tab-separated-values, application/sparql-results+json;q=0.9, application/sparql-results+xml;q=0.8, "
+    "application/n-triples, text/turtle;q=0.9"
+)
+_POSITION = re.compile(r"\berror at (\d+):(\d+)")
+
+# Whether the server's default graph is the union: a quad from a named graph, and whether the
+# default graph shows it. No row: the server holds no named-graph data yet, so it cannot tell.
+_UNION_PROBE = (
+    "SELECT ?seen WHERE { { SELECT ?s ?p ?o WHERE { GRAPH ?g { ?s ?p ?o } } LIMIT 1 } "
+    "BIND (EXISTS { ?s ?p ?o } AS ?seen) }"
+)
+
+
+@dataclass(frozen=True)
+class Endpoints:
+    """Where a remote store sends queries and updates."""
+
+    query: str
+    update: str
+
+    @classmethod
+    def discover(cls, location: str) -> Endpoints:
+        """The endpoints a ``--store`` URL names.
+
+        - ``http://host:7878`` (or any other base, e.g. Fuseki's ``http://host:3030/ds``): the Oxigraph
+          layout, ``<base>/query`` and ``<base>/update``;
+        - a URL ending in ``/query`` or ``/sparql`` is the query endpoint, with ``update`` beside it;
+        - two URLs separated by white space are the query and the update endpoint, as given.
+        """
+        parts = location.split()
+        if len(parts) == 2:
+            return cls(_checked_url(location, parts[0]), _checked_url(location, parts[1]))
+        if len(parts) != 1:
+            raise StoreError(location, "give one endpoint URL, or a query URL and an update URL separated by a space")
+        url = httpx.URL(_checked_url(location, parts[0]))
+        path = url.path.rstrip("/")
+        head, _, last = path.rpartition("/")
+        if last in ("query", "sparql"):
+            return cls(str(url.copy_with(path=path)), str(url.copy_with(path=f"{head}/update")))
+        return cls(str(url.copy_with(path=f"{path}/query")), str(url.copy_with(path=f"{path}/update")))
+
+
+def _checked_url(location: str, text: str) -> str:
+    try:
+        url = httpx.URL(text)
+    except httpx.InvalidURL as error:
+        raise StoreError(location, f"not a valid endpoint URL: {error}") from error
+    if url.scheme not in ("http", "https") or not url.host:
+        raise StoreError(location, f"{text!r} is not an http:// or https:// URL with a host")
+    return str(url)
+
+
+class RemoteStore(Store):
+    """A store on a SPARQL 1.1 endpoint with update. Thread-safe: one pooled HTTP client."""
+
+    def __init__(self, location: str, endpoints: Endpoints, timeout: float = DEFAULT_TIMEOUT) -> None:
+        self.location = location
+        self.endpoints = endpoints
+        self.timeout = timeout
+        self._client: httpx.Client | None = httpx.Client(
+            timeout=httpx.Timeout(timeout, connect=min(timeout, CONNECT_TIMEOUT)),
+            headers={"User-Agent": "cbrs-kb"},
+            verify=_tls_context(),
+        )
+        self._union_verified = False
+
+    @classmethod
+    def open(cls, location: str | Path, timeout: float = DEFAULT_TIMEOUT) -> RemoteStore:
+        """Connect to the endpoint(s) ``location`` names and check its default graph is the union."""
+        text = str(location).strip()
+        store = cls(text, Endpoints.discover(text), timeout)
+        try:
+            store._check_union()
+        except BaseException:
+            store.close()
+            raise
+        return store
+
+    def close(self) -> None:
+        if self._client is not None:
+            self._client.close()
+            self._client = None
+
+    def flush(self) -> None:
+        """Nothing to do: the server has committed every write it acknowledged."""
+        self._http()
+
+    # -- reading ---------------------------------------------------------------------------
+
+    def query(self, text: str, bindings: Mapping[str, Term] | None = None) -> QueryResult:
+        """Run a SPARQL query on the server, ``bindings`` sent as a leading ``VALUES`` block."""
+        if not self._union_verified:
+            self._check_union()
+        sent = inject_values(text, bindings) if bindings else text
+        return self._query(sent, original=text)
+
+    def quads(
+        self,
+        subject: ox.NamedNode | ox.BlankNode | None = None,
+        predicate: ox.NamedNode | None = None,
+        object: Term | None = None,
+        graph: ox.NamedNode | ox.DefaultGraph | None = None,
+    ) -> Iterator[ox.Quad]:
+        given = {"s": subject, "p": predicate, "o": object, "g": graph}
+        fixed = {
+            name: term for name, term in given.items() if isinstance(term, ox.NamedNode | ox.BlankNode | ox.Literal)
+        }
+        query = f"SELECT ?s ?p ?o ?g WHERE {{ {_graph_pattern('?s ?p ?o', graph)} }}"
+        result = self._query(inject_values(query, fixed))
+        assert isinstance(result, ox.QuerySolutions)
+        return iter([ox.Quad(*row) for row in result])  # an unbound ?g is the default graph
+
+    def count(self, graph: GraphName | ox.NamedNode | None = None) -> int:
+        node = graph.node if isinstance(graph, GraphName) else graph
+        result = self._query(f"SELECT (COUNT(*) AS ?n) WHERE {{ {_graph_pattern('?s ?p ?o', node)} }}")
+        assert isinstance(result, ox.QuerySolutions)
+        return int(next(iter(result))["n"].value)
+
+    def graphs(self) -> list[str]:
+        result = self._query("SELECT DISTINCT ?g WHERE { GRAPH ?g { } }")
+        assert isinstance(result, ox.QuerySolutions)
+        return sorted(row["g"].value for row in result if isinstance(row["g"], ox.NamedNode))
+
+    def is_seeded(self) -> bool:
+        return bool(self._query(f"ASK {{ GRAPH {GraphName.ONTOLOGY.node} {{ }} }}"))
+
+    # -- writing ---------------------------------------------------------------------------
+
+    def add(self, quads: Iterable[ox.Quad]) -> None:
+        """Add ``quads`` with one ``INSERT DATA`` request: one transaction, however many quads.
+
+        Blank nodes become fresh nodes on the server (the loader skolemises them before this).
+        """
+        block = data_block(quads, blank_nodes=True)
+        if block:
+            self._update("INSERT DATA {\n" + block + "}", original=None)
+
+    def update(self, text: str) -> None:
+        """Run a SPARQL update on the server in one request, hence one transaction."""
+        self._update(text, original=text)
+
+    # -- the wire ----------------------------------------------------------------------------
+
+    def _http(self) -> httpx.Client:
+        if self._client is None:
+            raise StoreError(self.location, "is closed")
+        return self._client
+
+    def _check_union(self) -> None:
+        result = self._query(_UNION_PROBE)
+        assert isinstance(result, ox.QuerySolutions)
+        rows = list(result)
+        if not rows:
+            return  # no named-graph data yet; checked again before the next query
+        if rows[0]["seen"] != ox.Literal(True):
+            host = httpx.URL(self.endpoints.query)
+            raise StoreError(
+                self.location,
+                "the server's default graph is not the union of its named graphs, which cbrs queries "
+                "rely on; start Oxigraph with --union-default-graph (oxigraph serve --location DIR "
+                f"--bind {host.host}:{host.port or 7878} --union-default-graph), or configure your "
+                "server's union default graph (docs/remote-store.md)",
+            )
+        self._union_verified = True
+
+    def _query(self, text: str, original: str | None = None) -> QueryResult:
+        response = self._post(self.endpoints.query, PROLOGUE + text, "application/sparql-query", original)
+        media = response.headers.get("content-type", "").split(";")[0].strip().lower()
+        try:
+            results_format = ox.QueryResultsFormat.from_media_type(media) if media else None
+            if results_format is not None:
+                return ox.parse_query_results(response.content, results_format)
+            rdf_format = ox.RdfFormat.from_media_type(media) if media else None
+            if rdf_format is not None:
+                return _query_triples(ox.parse(response.content, rdf_format))
+        except SyntaxError as error:
+            raise StoreError(self.location, f"unreadable answer from {self.endpoints.query}: {error}") from error
+        raise StoreError(self.location, f"{self.endpoints.query} answered in an unexpected format {media!r}")
+
+    def _update(self, text: str, original: str | None) -> None:
+        self._post(self.endpoints.update, PROLOGUE + text, "application/sparql-update", original)
+
+    def _post(self, url: str, body: str, content_type: str, original: str | None) -> httpx.Response:
+        """POST ``body``; ``original`` is the caller's own text (None for text cbrs wrote)."""
+        headers = {"Content-Type": content_type}
+        if content_type == "application/sparql-query":
+            headers["Accept"] = _ACCEPT
+        try:
+            response = self._http().post(url, content=body.encode("utf-8"), headers=headers)
+        except httpx.ConnectError as error:
+            target = httpx.URL(url)
+            raise StoreError(
+                self.location,
+                f"cannot connect to {url} ({error}); is the SPARQL server running? Start one with: "
+                f"oxigraph serve --location DIR --bind {target.host}:{target.port or 80} --union-default-graph",
+            ) from error
+        except httpx.TimeoutException as error:
+            raise StoreError(self.location, f"{url} did not answer within {self.timeout:g} s") from error
+        except httpx.HTTPError as error:
+            raise StoreError(self.location, f"request to {url} failed: {error}") from error
+        if response.is_success:
+            return response
+        message = _POSITION.sub(_one_line_up, response.text.strip())
+        too_large = response.status_code == 413 or "limited to" in message
+        if response.status_code == 400 and original is not None and not too_large:
+            raise QuerySyntaxError(original, message)
+        raise EndpointError(self.location, url, response.status_code, message, original or body)
+
+
+@functools.cache
+def _tls_context() -> ssl.SSLContext:
+    """httpx's default TLS context, built once per process (building it costs some 20 ms)."""
+    return httpx.create_ssl_context()
+
+
+def _one_line_up(match: re.Match[str]) -> str:
+    line = int(match.group(1))
+    return f"error at {line - 1 if line > 1 else line}:{match.group(2)}"
+
+
+def _query_triples(quads: Iterable[ox.Quad]) -> ox.QueryTriples:
+    """CONSTRUCT and DESCRIBE results as the ``QueryTriples`` callers consume.
+
+    pyoxigraph builds ``QueryTriples`` only from a query, so the triples are put in a scratch
+    in-memory store and read back with ``CONSTRUCT WHERE``.
+    """
+    scratch = ox.Store()
+    scratch.extend(quads)
+    result = scratch.query("CONSTRUCT WHERE { ?s ?p ?o }")
+    assert isinstance(result, ox.QueryTriples)
+    return result
+
+
+def _graph_pattern(triple: str, graph: ox.NamedNode | ox.DefaultGraph | None) -> str:
+    """``triple`` in ``graph``; with ``None``, in any named graph (``?g``) or in the default graph alone.
+
+    The server's default graph is the union, so its own triples are those in no named graph.
+    """
+    if isinstance(graph, ox.NamedNode):
+        return f"GRAPH {graph} {{ {triple} }}"
+    default_only = f"{triple} FILTER NOT EXISTS {{ GRAPH ?any {{ {triple} }} }}"
+    if isinstance(graph, ox.DefaultGraph):
+        return default_only
+    return f"{{ GRAPH ?g {{ {triple} }} }} UNION {{ {default_only} }}"
+
+
+def sparql_term(variable: str, term: object) -> str:
+    """``term`` as SPARQL text, written by pyoxigraph (validated IRIs, escaped literals)."""
+    if isinstance(term, ox.NamedNode | ox.Literal):
+        return str(term)
+    if isinstance(term, ox.BlankNode):
+        raise BindingError(
+            variable, term, "a blank node cannot be sent to a SPARQL endpoint (it names nothing there); bind an IRI"
+        )
+    raise BindingError(variable, term, "not an IRI or a literal")
+
+
+# -- VALUES injection --------------------------------------------------------------------------
+
+
+class _Token(NamedTuple):
+    kind: str
+    text: str
+    start: int
+    end: int
+
+
+_LOCAL = r"""(?:[^\s{}()\[\]<>"',;#\\]|\\.)*"""
+_TOKENS = re.compile(
+    rf"""
+      (?P<space>\s+)
+    | (?P<comment>\#[^\n\r]*)
+    | (?P<string>\"\"\"(?:[^"\\]|\\.|"(?!""))*\"\"\"
+               |'''(?:[^'\\]|\\.|'(?!''))*'''
+               |"(?:[^"\\\n\r]|\\.)*"
+               |'(?:[^'\\\n\r]|\\.)*')
+    | (?P<iri><[^<>"{{}}|^`\\\x00-\x20]*>)
+    | (?P<variable>[?$]\w+)
+    | (?P<name>[A-Za-z_\u00b7\u00c0-\uffff][\w.\-\u00b7\u00c0-\uffff]*(?::{_LOCAL})?|:{_LOCAL})
+    | (?P<punct>[{{}}()])
+    | (?P<other>.)
+    """,
+    re.VERBOSE | re.DOTALL,
+)
+_FORMS = {"SELECT", "ASK", "CONSTRUCT", "DESCRIBE"}
+_MODIFIERS = {"GROUP", "HAVING", "ORDER", "LIMIT", "OFFSET", "VALUES"}
+
+
+def _tokens(text: str) -> list[_Token]:
+    """The tokens that matter for finding the group pattern: comments, strings and IRIs are skipped whole."""
+    found = []
+    for match in _TOKENS.finditer(text):
+        kind = match.lastgroup or "other"
+        if kind not in ("space", "comment"):
+            found.append(_Token(kind, match.group(), match.start(), match.end()))
+    return found
+
+
+def _closing(tokens: list[_Token], index: int) -> int:
+    """The index of the ``}`` closing the ``{`` at ``index``."""
+    depth = 0
+    for position in range(index, len(tokens)):
+        text = tokens[position].text
+        if tokens[position].kind == "punct" and text in "{}":
+            depth += 1 if text == "{" else -1
+            if depth == 0:
+                return position
+    raise ValueError("unbalanced braces")
+
+
+def values_block(bindings: Mapping[str, Term]) -> str:
+    """`` VALUES (?a ?b) { (<x> "y") } `` for ``bindings``."""
+    names, terms = [], []
+    for name, value in bindings.items():
+        try:
+            names.append(str(ox.Variable(name)))
+        except ValueError as error:
+            raise BindingError(name, value, f"not a SPARQL variable name: {error}") from error
+        terms.append(sparql_term(name, value))
+    return f" VALUES ({' '.join(names)}) {{ ({' '.join(terms)}) }} "
+
+
+def inject_values(query: str, bindings: Mapping[str, Term]) -> str:
+    """``query`` with ``bindings`` as a ``VALUES`` block opening its top-level group pattern.
+
+    Comments, strings (all four quote forms), IRIs, and a CONSTRUCT template are skipped. A
+    ``CONSTRUCT WHERE { T }`` becomes ``CONSTRUCT { T } WHERE { VALUES ... T }``; a ``DESCRIBE``
+    without a WHERE clause gains one.
+    """
+    if not bindings:
+        return query
+    values = values_block(bindings)
+    tokens = _tokens(query)
+    form = next((i for i, t in enumerate(tokens) if t.kind == "name" and t.text.upper() in _FORMS), None)
+    if form is None:
+        raise QuerySyntaxError(query, "cannot bind values: no SELECT, ASK, CONSTRUCT or DESCRIBE found")
+    try:
+        start = form + 1
+        if tokens[form].text.upper() == "CONSTRUCT" and start < len(tokens):
+            if tokens[start].text == "{":
+                start = _closing(tokens, start) + 1  # skip the template
+            else:
+                return _expand_construct_where(query, tokens, form, values)
+        depth = 0
+        for token in tokens[start:]:
+            if token.kind == "punct" and token.text in "()":
+                depth += 1 if token.text == "(" else -1
+            elif depth == 0 and token.kind == "punct" and token.text == "{":
+                return query[: token.end] + values + query[token.end :]
+            elif depth == 0 and token.kind == "name" and token.text.upper() in _MODIFIERS:
+                return query[: token.start] + "WHERE {" + values + "}\n" + query[token.start :]
+    except (ValueError, IndexError) as error:
+        raise QuerySyntaxError(query, f"cannot bind values: {error}") from error
+    return query + "\nWHERE {" + values + "}"
+
+
+def _expand_construct_where(query: str, tokens: list[_Token], form: int, values: str) -> str:
+    opening = next((i for i in range(form + 1, len(tokens)) if tokens[i].kind == "punct" and tokens[i].text == "{"), -1)
+    if opening < 0:
+        raise ValueError("CONSTRUCT without a template or WHERE clause")
+    closing = _closing(tokens, opening)
+    template = query[tokens[opening].end : tokens[closing].start]
+    at = tokens[form].end
+    return query[:at] + " {" + template + "}" + query[at : tokens[opening].end] + values + query[tokens[opening].end :]
