@@ -1,7 +1,16 @@
 from __future__ import annotations
 
+import shutil
+import socket
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import IO
 
+import httpx
 import pytest
 
 from kb import KnowledgeBase, Store
@@ -11,17 +20,149 @@ DATA = Path(__file__).parent / "data"
 MINI_FILES = [DATA / "mini_ontology.ttl", DATA / "mini_services.ttl", DATA / "mini_requirements.ttl"]
 
 
-def make_mini_kb() -> KnowledgeBase:
-    """The core ontology plus the mini test data, in memory (not the bundled home data)."""
-    kb = KnowledgeBase(Store.open(":memory:"))
+def _find_oxigraph() -> str | None:
+    """The Oxigraph server binary: installed by the test extra (PyPI oxigraph) beside this interpreter."""
+    beside = Path(sys.executable).parent / "oxigraph"
+    return str(beside) if beside.is_file() else shutil.which("oxigraph")
+
+
+OXIGRAPH = _find_oxigraph()
+NO_OXIGRAPH = "the oxigraph server binary is not installed (pip install oxigraph, or the test extra)"
+BACKENDS = [pytest.param("embedded", id="embedded"), pytest.param("remote", id="remote")]
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    config.addinivalue_line(
+        "markers", "both_stores: run the module's tests that use store_location on the embedded and the remote store"
+    )
+
+
+def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
+    # In a module marked both_stores, every test that (through its fixtures) uses store_location runs
+    # twice; elsewhere store_location is the embedded in-memory store.
+    if "store_location" in metafunc.fixturenames and metafunc.definition.get_closest_marker("both_stores"):
+        metafunc.parametrize("store_location", BACKENDS, indirect=True)
+
+
+# -- the Oxigraph server -----------------------------------------------------------------------------
+
+
+@dataclass
+class OxigraphServer:
+    """An ``oxigraph serve`` process on a free loopback port, with its log (and data, if on disk) in ``directory``."""
+
+    url: str
+    directory: Path
+    process: subprocess.Popen[bytes]
+    log: IO[bytes]
+    client: httpx.Client = field(default_factory=httpx.Client)
+
+    def clear(self) -> None:
+        response = self.client.post(
+            self.url + "/update", content=b"DROP ALL", headers={"Content-Type": "application/sparql-update"}
+        )
+        response.raise_for_status()
+
+    def stop(self) -> None:
+        self.client.close()
+        self.process.terminate()
+        try:
+            self.process.wait(timeout=10)
+        except subprocess.TimeoutExpired:
+            self.process.kill()
+            self.process.wait()
+        self.log.close()
+
+
+def start_oxigraph(
+    directory: Path, union_default_graph: bool = True, on_disk: bool = True, wait: float = 20.0
+) -> OxigraphServer:
+    """Start ``oxigraph serve`` in ``directory`` and wait (at most ``wait`` seconds) until it answers."""
+    if OXIGRAPH is None:
+        pytest.skip(NO_OXIGRAPH)
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    command = [OXIGRAPH, "serve", "--bind", f"127.0.0.1:{port}"]
+    if on_disk:
+        command += ["--location", str(directory / "data")]
+    if union_default_graph:
+        command.append("--union-default-graph")
+    log = (directory / "server.log").open("wb")
+    process = subprocess.Popen(command, cwd=directory, stdout=log, stderr=subprocess.STDOUT)
+    server = OxigraphServer(f"http://127.0.0.1:{port}", directory, process, log)
+    deadline = time.monotonic() + wait
+    while time.monotonic() < deadline:
+        if process.poll() is not None:
+            raise RuntimeError(
+                f"oxigraph serve exited with {process.returncode}: {(directory / 'server.log').read_text()}"
+            )
+        try:
+            if server.client.get(server.url + "/", timeout=1.0).status_code == 200:
+                return server
+        except httpx.TransportError:
+            time.sleep(0.05)
+    server.stop()
+    raise RuntimeError(f"oxigraph serve did not answer at {server.url} within {wait:g} s")
+
+
+@pytest.fixture(scope="session")
+def oxigraph_servers(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Callable[..., OxigraphServer]]:
+    """Starts Oxigraph servers on demand (``oxigraph_servers(union_default_graph=False)``); all stop at the end."""
+    started: list[OxigraphServer] = []
+
+    def start(union_default_graph: bool = True, on_disk: bool = True) -> OxigraphServer:
+        server = start_oxigraph(tmp_path_factory.mktemp("oxigraph"), union_default_graph, on_disk)
+        started.append(server)
+        return server
+
+    yield start
+    for server in started:
+        server.stop()
+
+
+@pytest.fixture(scope="session")
+def oxigraph_server(oxigraph_servers: Callable[..., OxigraphServer]) -> OxigraphServer:
+    """One Oxigraph server with a union default graph for the whole session, cleared before each test.
+
+    It keeps its data in memory: on disk, the hundreds of DROP ALLs of a test run leave RocksDB
+    tombstones that make every later write slower (the kb tests took about 10 s instead of 6 s). The
+    servers test_remote_store.py starts without a union default graph run on disk.
+    """
+    return oxigraph_servers(on_disk=False)
+
+
+@pytest.fixture
+def remote_location(oxigraph_server: OxigraphServer) -> str:
+    """The session's Oxigraph server, cleared: the location of an empty remote store."""
+    oxigraph_server.clear()
+    return oxigraph_server.url
+
+
+@pytest.fixture
+def store_location(request: pytest.FixtureRequest) -> str:
+    """Where a test's store lives: ``:memory:``, or (in a both_stores module) the cleared server too."""
+    if getattr(request, "param", "embedded") == "remote":
+        return str(request.getfixturevalue("remote_location"))
+    return ":memory:"
+
+
+# -- knowledge bases ---------------------------------------------------------------------------------
+
+
+def make_mini_kb(location: str = ":memory:") -> KnowledgeBase:
+    """The core ontology plus the mini test data (not the bundled home data)."""
+    kb = KnowledgeBase(Store.open(location))
     kb.load([ontology_dir() / "core.ttl"], graph="ontology")
     kb.load(MINI_FILES)
     return kb
 
 
 @pytest.fixture
-def mini_kb() -> KnowledgeBase:
-    return make_mini_kb()
+def mini_kb(store_location: str) -> Iterator[KnowledgeBase]:
+    kb = make_mini_kb(store_location)
+    yield kb
+    kb.close()
 
 
 @pytest.fixture(scope="session")
@@ -31,5 +172,7 @@ def bundled_kb() -> KnowledgeBase:
 
 
 @pytest.fixture
-def fresh_bundled_kb() -> KnowledgeBase:
-    return KnowledgeBase.open(":memory:")
+def fresh_bundled_kb(store_location: str) -> Iterator[KnowledgeBase]:
+    kb = KnowledgeBase.open(store_location)
+    yield kb
+    kb.close()

@@ -9,6 +9,8 @@ from kb import GraphName, KnowledgeBase, RdfParseError, Store, UnknownFormatErro
 from kb.loader import parse_file, skolemise
 from kb.namespaces import GENID
 
+pytestmark = pytest.mark.both_stores
+
 BAD = Path(__file__).parent / "data" / "bad"
 
 SAMPLE = """@prefix ex: <http://example.org/s#> .

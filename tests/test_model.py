@@ -7,6 +7,8 @@ from kb.vocab import CBRS
 
 EX = "http://example.org/mini#"
 
+pytestmark = pytest.mark.both_stores
+
 
 def test_advertisement_six_tuple(mini_kb: KnowledgeBase) -> None:
     ad = mini_kb.description(EX + "Locate")

@@ -33,17 +33,19 @@ TC = Path(__file__).resolve().parents[2] / "shared" / "owls-tc4"
 needs_tc = pytest.mark.skipif(not TC.is_dir(), reason=f"the OWLS-TC 4 collection is not at {TC}")
 TC_PREFIX = "http://127.0.0.1/ontology/"
 
+pytestmark = pytest.mark.both_stores
 
-def _kb() -> KnowledgeBase:
-    """The core ontology alone, in memory: the descriptions read back need nothing else."""
-    kb = KnowledgeBase(Store.open(":memory:"))
+
+def _kb(location: str = ":memory:") -> KnowledgeBase:
+    """The core ontology alone: the descriptions read back need nothing else."""
+    kb = KnowledgeBase(Store.open(location))
     kb.load([ontology_dir() / "core.ttl"], graph="ontology")
     return kb
 
 
 @pytest.fixture
-def kb() -> KnowledgeBase:
-    return _kb()
+def kb(store_location: str) -> KnowledgeBase:
+    return _kb(store_location)
 
 
 def _objects(kb: KnowledgeBase, subject: str, predicate: str) -> list[str]:

@@ -16,6 +16,8 @@ DATA = Path(__file__).parent / "data"
 MANIFEST = tomllib.loads((DATA / "queries" / "manifest.toml").read_text(encoding="utf-8"))["case"]
 TEST_PREFIXES = {**PREFIXES, "ex": "http://example.org/mini#"}
 
+pytestmark = pytest.mark.both_stores
+
 
 def _expand(value: str) -> str:
     prefix, sep, local = value.partition(":")
@@ -30,8 +32,8 @@ def _normalise(value: str) -> str:
 
 
 @pytest.mark.parametrize("case", [pytest.param(c, id=c["id"]) for c in MANIFEST])
-def test_named_query_known_answer(case: dict[str, Any]) -> None:
-    kb = KnowledgeBase(Store.open(":memory:"))
+def test_named_query_known_answer(case: dict[str, Any], store_location: str) -> None:
+    kb = KnowledgeBase(Store.open(store_location))
     kb.load([ontology_dir() / "core.ttl"], graph="ontology")
     kb.load([DATA / name for name in case["data"]], graph=case.get("graph"))
     rows = kb.select(case["query"], {k: _expand(v) for k, v in case.get("bind", {}).items()})

@@ -4,6 +4,8 @@ import pytest
 
 from kb import AlreadyRegisteredError, InvalidDescriptionError, KnowledgeBase, NotFoundError, RdfParseError
 
+pytestmark = pytest.mark.both_stores
+
 EX = "http://example.org/mini#"
 HEAD = """@prefix cbrs: <https://w3id.org/cbrs/core#> .
 @prefix ex: <http://example.org/mini#> .
