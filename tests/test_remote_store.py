@@ -1,0 +1,330 @@
+"""The remote store: endpoint discovery, VALUES injection, the union check, errors, the CLI over HTTP.
+
+What both backends must do alike is in the both_stores modules (test_store.py and the other kb tests);
+this module holds what only a SPARQL server brings.
+"""
+
+from __future__ import annotations
+
+import socket
+import threading
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import httpx
+import pyoxigraph as ox
+import pytest
+from click.testing import CliRunner
+
+from cbrs.cli import cli
+from kb import BindingError, EndpointError, KnowledgeBase, QuerySyntaxError, Store, StoreError
+from kb.namespaces import GraphName
+from kb.remote_store import Endpoints, RemoteStore, inject_values
+from tests.conftest import OxigraphServer
+
+DATA = Path(__file__).parent / "data"
+LOCATE = "https://w3id.org/cbrs/service#LocateMobileRobot_CeilingCamera01"
+
+
+# -- endpoint discovery -------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("location", "query", "update"),
+    [
+        pytest.param("http://h:7878", "http://h:7878/query", "http://h:7878/update", id="oxigraph"),
+        pytest.param("http://h:7878/", "http://h:7878/query", "http://h:7878/update", id="oxigraph-slash"),
+        pytest.param("http://h:7878/query", "http://h:7878/query", "http://h:7878/update", id="oxigraph-query"),
+        pytest.param("https://h/fuseki/ds", "https://h/fuseki/ds/query", "https://h/fuseki/ds/update", id="fuseki"),
+        pytest.param("http://h:3030/ds/sparql", "http://h:3030/ds/sparql", "http://h:3030/ds/update", id="sparql"),
+        pytest.param(
+            "http://h:7200/repositories/r http://h:7200/repositories/r/statements",
+            "http://h:7200/repositories/r",
+            "http://h:7200/repositories/r/statements",
+            id="explicit-pair",
+        ),
+    ],
+)
+def test_endpoints_are_discovered_from_the_url(location: str, query: str, update: str) -> None:
+    assert Endpoints.discover(location) == Endpoints(query, update)
+
+
+@pytest.mark.parametrize("location", ["http://", "http://a b c", "ftp://h/x http://h/y"])
+def test_a_bad_endpoint_url_is_refused(location: str) -> None:
+    with pytest.raises(StoreError):
+        Endpoints.discover(location)
+
+
+# -- VALUES injection ---------------------------------------------------------------------------------
+
+X = {"x": ox.NamedNode("http://e/x")}
+VALUES = " VALUES (?x) { (<http://e/x>) } "
+
+
+@pytest.mark.parametrize(
+    ("query", "expected"),
+    [
+        pytest.param("SELECT * WHERE { ?x ?p ?o }", "SELECT * WHERE {" + VALUES + " ?x ?p ?o }", id="select"),
+        pytest.param("ASK{?x ?p ?o}", "ASK{" + VALUES + "?x ?p ?o}", id="ask-no-where"),
+        pytest.param(
+            "PREFIX e: <http://e/{> # a { comment\nSELECT ?x WHERE { ?x ?p '{' }",
+            "PREFIX e: <http://e/{> # a { comment\nSELECT ?x WHERE {" + VALUES + " ?x ?p '{' }",
+            id="iri-and-comment",
+        ),
+        pytest.param(
+            "SELECT (\"{\" AS ?a) ('}' AS ?b) (\"\"\"{\"\"\" AS ?c) ('''}''' AS ?d) (EXISTS { ?x ?p ?o } AS ?e) {}",
+            "SELECT (\"{\" AS ?a) ('}' AS ?b) (\"\"\"{\"\"\" AS ?c) ('''}''' AS ?d) (EXISTS { ?x ?p ?o } AS ?e) {"
+            + VALUES
+            + "}",
+            id="four-quote-forms-and-exists",
+        ),
+        pytest.param(
+            "SELECT ?x (COUNT(*) AS ?n) WHERE { ?x ?p ?o } GROUP BY ?x LIMIT 1 VALUES ?o { 1 }",
+            "SELECT ?x (COUNT(*) AS ?n) WHERE {" + VALUES + " ?x ?p ?o } GROUP BY ?x LIMIT 1 VALUES ?o { 1 }",
+            id="aggregate-limit-trailing-values",
+        ),
+        pytest.param(
+            'CONSTRUCT { ?x <http://e/says> "}" } WHERE { ?x ?p ?o }',
+            'CONSTRUCT { ?x <http://e/says> "}" } WHERE {' + VALUES + " ?x ?p ?o }",
+            id="construct-template-skipped",
+        ),
+        pytest.param(
+            "CONSTRUCT WHERE { ?x ?p ?o }",
+            "CONSTRUCT { ?x ?p ?o } WHERE {" + VALUES + " ?x ?p ?o }",
+            id="construct-where",
+        ),
+        pytest.param("DESCRIBE ?x", "DESCRIBE ?x\nWHERE {" + VALUES + "}", id="describe"),
+        pytest.param("DESCRIBE ?x LIMIT 1", "DESCRIBE ?x WHERE {" + VALUES + "}\nLIMIT 1", id="describe-limit"),
+        pytest.param(
+            "SELECT ?where WHERE { ?x e:SELECT ?where }",
+            "SELECT ?where WHERE {" + VALUES + " ?x e:SELECT ?where }",
+            id="names",
+        ),
+    ],
+)
+def test_values_open_the_top_level_group(query: str, expected: str) -> None:
+    assert inject_values(query, X) == expected
+
+
+def test_blank_nodes_and_bad_names_cannot_be_bound() -> None:
+    with pytest.raises(BindingError, match="blank node"):
+        inject_values("SELECT * { ?x ?p ?o }", {"x": ox.BlankNode()})
+    with pytest.raises(BindingError, match="variable name"):
+        inject_values("SELECT * { ?x ?p ?o }", {"x y": ox.Literal("1")})
+    with pytest.raises(QuerySyntaxError, match="no SELECT"):
+        inject_values("INSERT DATA { }", X)
+
+
+def test_every_named_query_with_parameters_gives_the_embedded_answer(remote_location: str) -> None:
+    """VALUES pre-binding against Oxigraph substitution, on the bundled data, for every parameter."""
+    embedded, remote = KnowledgeBase.open(":memory:"), KnowledgeBase.open(remote_location)
+    for kb in (embedded, remote):
+        kb.load([DATA / "mini_world.ttl"], graph="world")
+    values = {
+        "action": ["act:PuttingSomethingSomewhere", "act:OpeningADoor"],
+        "service": [LOCATE],
+        "kind": ["cbrs:DynamicPerceptionComponent", "cbrs:PhysicalManipulationComponent"],
+        "concept": ["home:Position", "home:RobotLocation"],
+        "description": [LOCATE, "req:RobotSelfPosition", "act:PuttingSomethingSomewhere"],
+        "requirement": ["req:RobotSelfPosition"],
+        "resource": [LOCATE, "home:Position"],
+        "thing": ["world:Pen", "world:Person"],
+    }
+    checked = 0
+    for name in embedded.queries.names():
+        for parameter in embedded.queries.get(name).parameters:
+            assert parameter in values, f"give test values for the parameter {parameter!r} of {name}.rq"
+            for value in [*values[parameter], "http://example.org/nothing"]:
+                want, got = (_rows(kb, name, {parameter: value}) for kb in (embedded, remote))
+                assert got == want, f"{name}.rq with {parameter}={value}"
+                checked += 1
+    assert checked >= 30
+    remote.close()
+
+
+def _rows(kb: KnowledgeBase, name: str, values: dict[str, str]) -> list[tuple[str, ...]]:
+    rows = kb.select(name, values)
+    keys = sorted({key for row in rows for key in row})
+    # GROUP_CONCAT follows storage order, which differs between the backends: compare as sets.
+    return sorted(tuple(" ".join(sorted(row[k].value.split(" "))) if k in row else "" for k in keys) for row in rows)
+
+
+# -- the union default graph --------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def plain_server(oxigraph_servers: Callable[..., OxigraphServer]) -> OxigraphServer:
+    """A server started without --union-default-graph, its data on disk."""
+    return oxigraph_servers(union_default_graph=False, on_disk=True)
+
+
+def test_a_server_without_a_union_default_graph_is_refused(plain_server: OxigraphServer) -> None:
+    plain_server.clear()
+    KnowledgeBase.open(plain_server.url).close()  # an empty server cannot tell: seeding works
+    with pytest.raises(StoreError) as caught:
+        Store.open(plain_server.url)
+    message = str(caught.value)
+    assert "--union-default-graph" in message and plain_server.url in message and "\n" not in message
+
+
+def test_an_empty_server_is_checked_again_before_a_query(plain_server: OxigraphServer) -> None:
+    plain_server.clear()
+    store = Store.open(plain_server.url)
+    store.add([ox.Quad(ox.NamedNode("http://e/a"), ox.NamedNode("http://e/p"), ox.Literal("x"), GraphName.WORLD.node)])
+    with pytest.raises(StoreError, match="union"):
+        store.query("SELECT * WHERE { ?s ?p ?o }")
+    store.close()
+
+
+# -- errors -------------------------------------------------------------------------------------------
+
+
+def _free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return int(probe.getsockname()[1])
+
+
+def test_connection_refused_is_one_line_naming_the_url() -> None:
+    url = f"http://127.0.0.1:{_free_port()}"
+    with pytest.raises(StoreError) as caught:
+        Store.open(url)
+    message = str(caught.value)
+    assert "\n" not in message and f"cannot connect to {url}/query" in message and "oxigraph serve" in message
+
+
+def test_a_silent_server_times_out() -> None:
+    with socket.socket() as listener:  # accepts connections (the kernel does) but never answers
+        listener.bind(("127.0.0.1", 0))
+        listener.listen(4)
+        url = f"http://127.0.0.1:{listener.getsockname()[1]}"
+        with pytest.raises(StoreError, match=r"did not answer within 0\.2 s"):
+            RemoteStore.open(url, timeout=0.2)
+
+
+def test_syntax_errors_read_as_on_the_embedded_store(remote_location: str) -> None:
+    text = "SELECT ?x\nWHERE { ?x "
+    messages = []
+    for location in (":memory:", remote_location):
+        with pytest.raises(QuerySyntaxError) as caught:
+            Store.open(location).query(text)
+        assert caught.value.query == text
+        messages.append(str(caught.value))
+    assert messages[0] == messages[1] and "error at 2:" in messages[0]
+
+
+def test_a_server_failure_keeps_the_servers_message_and_the_request(remote_location: str) -> None:
+    store = Store.open(remote_location)
+    store.update("CREATE GRAPH graph:world")
+    with pytest.raises(EndpointError) as caught:
+        store.update("CREATE GRAPH graph:world")
+    error = caught.value
+    assert (error.status, error.endpoint, error.request) == (
+        500,
+        remote_location + "/update",
+        "CREATE GRAPH graph:world",
+    )
+    assert "already exists" in error.message and isinstance(error, StoreError)
+    store.close()
+
+
+# -- writes -------------------------------------------------------------------------------------------
+
+
+@pytest.fixture
+def requests_seen(remote_location: str) -> Iterator[tuple[Store, list[httpx.Request]]]:
+    store = Store.open(remote_location)
+    assert isinstance(store, RemoteStore)
+    seen: list[httpx.Request] = []
+    store._http().event_hooks["request"].append(seen.append)
+    yield store, seen
+    store.close()
+
+
+def test_a_large_add_is_one_request(requests_seen: tuple[Store, list[httpx.Request]]) -> None:
+    store, seen = requests_seen
+    p = ox.NamedNode("http://e/p")
+    quads = [
+        ox.Quad(ox.NamedNode(f"http://e/s{i}"), p, ox.Literal("x" * 100 + str(i)), GraphName.WORLD.node)
+        for i in range(20_000)
+    ]
+    store.add(quads)
+    assert [(r.method, r.url.path) for r in seen] == [("POST", "/update")]
+    assert len(seen[0].content) > 2_000_000
+    assert store.count(GraphName.WORLD) == 20_000
+
+
+def test_a_refused_replace_sends_nothing(requests_seen: tuple[Store, list[httpx.Request]]) -> None:
+    store, seen = requests_seen
+    p = ox.NamedNode("http://e/p")
+    kept = ox.Quad(ox.NamedNode("http://e/a"), p, ox.Literal("kept"), GraphName.WORLD.node)
+    store.add([kept])
+    before, sent = store.dump(), len(seen)
+    with pytest.raises(ValueError, match="blank node"):  # a DELETE DATA / INSERT DATA pair cannot name it
+        store.replace([kept], [ox.Quad(ox.BlankNode(), p, ox.Literal("new"), GraphName.WORLD.node)])
+    assert len(seen) == sent and store.dump() == before
+
+
+def test_the_seed_fits_one_request(requests_seen: tuple[Store, list[httpx.Request]]) -> None:
+    store, seen = requests_seen
+    KnowledgeBase(store).seed()
+    [write] = [r for r in seen if r.url.path == "/update"]
+    assert 500_000 < len(write.content) < 2_000_000  # about 0.7 MB for the bundled 5,300 quads
+    assert store.is_seeded()
+
+
+def test_one_store_serves_many_threads(remote_location: str) -> None:
+    kb = KnowledgeBase.open(remote_location)
+    expected = kb.select("description", {"description": LOCATE})
+    failures: list[BaseException] = []
+
+    def work() -> None:
+        try:
+            for _ in range(10):
+                assert kb.select("description", {"description": LOCATE}) == expected
+        except BaseException as error:  # reported below, from the main thread
+            failures.append(error)
+
+    threads = [threading.Thread(target=work) for _ in range(6)]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    assert failures == []
+    kb.close()
+
+
+# -- the command line ---------------------------------------------------------------------------------
+
+
+def test_the_cli_works_against_a_server(remote_location: str) -> None:
+    runner = CliRunner()
+    services = runner.invoke(cli, ["--store", remote_location, "services"])
+    assert services.exit_code == 0, services.output
+    assert "svc:LocateMobileRobot_CeilingCamera01" in services.output
+    named = runner.invoke(
+        cli,
+        [
+            "--store",
+            remote_location,
+            "query",
+            "--name",
+            "advertisements",
+            "--bind",
+            "kind=cbrs:DynamicPerceptionComponent",
+        ],
+    )
+    assert named.exit_code == 0, named.output
+    assert "svc:LocateMobileRobot_CeilingCamera01" in named.output and "PhysicalManipulation" not in named.output
+    text = runner.invoke(
+        cli, ["--store", remote_location, "query", "CONSTRUCT WHERE { ?c rdfs:subClassOf home:Position }"]
+    )
+    assert text.exit_code == 0, text.output
+    assert "rdfs:subClassOf home:Position" in text.output
+
+
+def test_the_cli_names_an_unreachable_server() -> None:
+    url = f"http://127.0.0.1:{_free_port()}"
+    result = CliRunner().invoke(cli, ["--store", url, "services"])
+    assert result.exit_code == 1
+    assert result.output.count("\n") == 1 and url in result.output and "Traceback" not in result.output
