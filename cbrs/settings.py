@@ -74,7 +74,8 @@ SETTINGS: tuple[Setting, ...] = (
         "store",
         _default_store,
         "Where the knowledge base lives: a directory for the embedded Oxigraph store "
-        "(created and seeded on first use), or :memory: for a throw-away one.",
+        "(created and seeded on first use), :memory: for a throw-away one, or the http:// URL of a SPARQL "
+        "server shared by many robots (oxigraph serve --union-default-graph; see docs/remote-store.md).",
         "CBRS_STORE",
     ),
     Setting(
