@@ -72,6 +72,9 @@ async def _serve(
         try:
             async for frame in websocket:
                 bridge.receive(session, frame)
+                # frames already buffered are read without yielding: let the writers run in between,
+                # or a fast publisher fills its subscribers' queues before they send anything
+                await asyncio.sleep(0)
         except ConnectionClosed:
             pass
         finally:
