@@ -235,7 +235,8 @@ class Bridge:
                 self._graph.topics[name].subscribers.discard(session)
                 self._graph.prune(name)
             for name in session.provided:
-                if self._graph.services[name].provider is session:
+                service = self._graph.services.get(name)
+                if service is not None and service.provider is session:
                     del self._graph.services[name]
         if self._calls is not None:
             self._calls.fail_provider(session, None, "the provider of {service!r} disconnected")
