@@ -280,6 +280,7 @@ BAD_FRAMES = [
     pytest.param(
         '{"op": "subscribe", "topic": "/nan", "id": 1, "x": NaN}', "not valid JSON: NaN is not JSON", None, id="nan"
     ),
+    pytest.param("[" * 100_000 + "]" * 100_000, "nested too deeply", None, id="nested"),
     pytest.param(b"\x82\xa2op", "binary frames are not supported", None, id="binary"),
     pytest.param(
         '{"op": "publish", "topic": "/a", "msg": {"data": "' + "x" * (1 << 20) + '"}}',

@@ -219,7 +219,7 @@ class Bridge:
             session.report("error", text, error.message_id if error.message_id is not None else message_id)
         except Exception as error:
             log.exception("%s: %s failed", session.name, op)
-            session.report("error", f"{op}: internal error: {type(error).__name__}: {error}", message_id)
+            session.report("error", f"{op or 'message'}: internal error: {type(error).__name__}: {error}", message_id)
 
     def close_session(self, session: Session) -> None:
         """The client has gone: drop its topics, services and subscriptions, fail calls waiting on it."""

@@ -117,6 +117,8 @@ def decode(text: str, limit: int) -> Message:
         message = json.loads(text, parse_constant=_no_constants)
     except ValueError as error:
         raise ProtocolError(f"message is not valid JSON: {error}") from None
+    except RecursionError:
+        raise ProtocolError("message is nested too deeply to parse") from None
     if not isinstance(message, dict):
         raise ProtocolError(f"a rosbridge message must be a JSON object, not {json_type(message)}")
     message_id = message.get("id")
