@@ -19,6 +19,7 @@ from cbrs import __version__
 from cbrs.app import App, parse_iri, pass_app
 from cbrs.cli_actions import plan, run, scenario_summary
 from cbrs.cli_reasoner import eval_group, match, ranking_text
+from cbrs.cli_serve import serve
 from cbrs.output import RESULT_FORMATS, render_result, table, term_text
 from cbrs.settings import SETTINGS, setting
 from kb import Advertisement, KnowledgeBaseError, Requirement, ServiceDescription
@@ -399,4 +400,5 @@ def main() -> None:
 cli.add_command(match)
 cli.add_command(plan)
 cli.add_command(run)
+cli.add_command(serve)
 cli.add_command(eval_group)

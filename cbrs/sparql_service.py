@@ -119,6 +119,17 @@ class EndpointBusyError(EndpointError):
         super().__init__(f"all {workers} query workers are busy; retry shortly")
 
 
+class EvaluationError(EndpointError):
+    """The store refused a well-formed operation (e.g. CREATE GRAPH on an existing graph); nothing changed."""
+
+    http_status = 400
+    kind = "evaluation-error"
+
+    def __init__(self, operation: str, message: str) -> None:
+        self.operation = operation
+        super().__init__(f"the {operation} failed and changed nothing: {message}")
+
+
 class UpdateForbiddenError(EndpointError):
     http_status = 403
     kind = "forbidden"
@@ -209,6 +220,8 @@ class SparqlService:
         with self.lock:
             try:
                 self.kb.update(text)
+            except RuntimeError as error:  # Oxigraph's evaluation errors; the transaction was rolled back
+                raise EvaluationError("update", str(error)) from error
             finally:
                 self.generation += 1
         for listener in list(self._listeners):
@@ -230,7 +243,10 @@ class SparqlService:
     def _evaluate(self, text: str, accept: str | None, short_format: str | None, deadline: float) -> Answer:
         result: Any = None  # Oxigraph results must be dropped on the thread that made them
         try:
-            result = self.kb.query(text)
+            try:
+                result = self.kb.query(text)
+            except RuntimeError as error:
+                raise EvaluationError("query", str(error)) from error
             media_type = negotiate(isinstance(result, ox.QueryTriples), accept, short_format)
             writer = _BudgetWriter(self.config.max_result_bytes, deadline, self.config.timeout)
             try:
@@ -240,6 +256,8 @@ class SparqlService:
                     result.serialize(writer, RESULT_TYPES[media_type])
             except _Stop as stop:
                 raise stop.error from None
+            except RuntimeError as error:
+                raise EvaluationError("query", str(error)) from error
             return Answer(writer.getvalue(), media_type)
         finally:
             result = None

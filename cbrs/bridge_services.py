@@ -1,0 +1,164 @@
+"""The knowledge base as rosbridge services and topics, for non-ROS nodes and web pages.
+
+Services (request fields -> response values):
+
+- ``/cbrs/query`` ``{query}`` -> ``{media_type, result}``: SPARQL JSON results for SELECT/ASK, JSON-LD
+  for CONSTRUCT/DESCRIBE; read-only, with the endpoint's timeout and size limit.
+- ``/cbrs/match`` ``{requirement, method="sem-str", top=10}`` -> the ranking with explanations.
+- ``/cbrs/plan`` ``{task, objective="similarity"}`` -> the plan (recorded in the plans graph) or what
+  is unsatisfied.
+- ``/cbrs/run_task`` ``{task, seed=0, fail=[], wait=true}`` -> the run; with ``wait`` false it returns
+  at once and the run is followed on the topics, or with ``/cbrs/task_status`` ``{run}``.
+
+Topics: ``/cbrs/task_progress`` (steps started, succeeded, failed, with failovers), ``/cbrs/lifecycle``
+(component states), ``/cbrs/task`` (a run's verdict) and ``/cbrs/events`` (runs starting and ending,
+store updates).
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+from collections.abc import Callable
+from typing import Any, TypeVar
+
+from actions.composer import ComposeConfig, Composer, Objective, store_plan
+from cbrs.rosbridge import Bridge, ServiceError
+from cbrs.sparql_service import SparqlService
+from cbrs.tasks import RUN_TOPIC, TaskRunner
+from kb.errors import KnowledgeBaseError
+from kb.namespaces import expand
+from reasoner.matchmaker import Matchmaker
+from reasoner.methods import METHODS
+
+TOPICS = {
+    "/cbrs/task_progress": "cbrs/TaskProgress",
+    "/cbrs/lifecycle": "cbrs/LifecycleState",
+    "/cbrs/task": "cbrs/TaskStatus",
+    RUN_TOPIC: "cbrs/Event",
+}
+
+T = TypeVar("T")
+Handler = Callable[[dict[str, Any]], dict[str, Any]]
+
+
+class KnowledgeServices:
+    """Request handlers over one knowledge base; the matchmakers are built once per store version."""
+
+    def __init__(self, sparql: SparqlService, tasks: TaskRunner) -> None:
+        self.sparql = sparql
+        self.tasks = tasks
+        self._matchmakers: dict[tuple[str, int], Matchmaker] = {}
+        self._guard = threading.Lock()
+
+    def handlers(self) -> dict[str, tuple[str, Handler]]:
+        """Service name -> (type, handler)."""
+        return {
+            "/cbrs/query": ("cbrs/Query", self.query),
+            "/cbrs/match": ("cbrs/Match", self.match),
+            "/cbrs/plan": ("cbrs/Plan", self.plan),
+            "/cbrs/run_task": ("cbrs/RunTask", self.run_task),
+            "/cbrs/task_status": ("cbrs/TaskStatus", self.task_status),
+        }
+
+    def query(self, args: dict[str, Any]) -> dict[str, Any]:
+        text = _field(args, "query", str)
+        answer = _call(lambda: self.sparql.query(text, short_format="json"))
+        return {"media_type": answer.media_type, "result": json.loads(answer.body)}
+
+    def match(self, args: dict[str, Any]) -> dict[str, Any]:
+        requirement = _iri(_field(args, "requirement", str), "req")
+        method = _field(args, "method", str, "sem-str")
+        top = _field(args, "top", int, 10)
+        if method not in METHODS:
+            raise ServiceError(f"method {method!r} is not one of {', '.join(METHODS)}")
+        if top < 1:
+            raise ServiceError(f"top must be at least 1, not {top}")
+        with self.sparql.lock:
+            matchmaker = self._matchmaker(method)
+            result = _call(lambda: matchmaker.rank(requirement, explain=top))
+        return result.to_dict(top)
+
+    def plan(self, args: dict[str, Any]) -> dict[str, Any]:
+        task = _field(args, "task", str)
+        objective = _field(args, "objective", str, Objective.SIMILARITY.value)
+        if objective not in {o.value for o in Objective}:
+            raise ServiceError(f"objective {objective!r} is not one of {', '.join(o.value for o in Objective)}")
+        with self.sparql.lock:
+            composer = Composer(self.sparql.kb, ComposeConfig(objective=Objective(objective)))
+            result = _call(lambda: composer.compose(task))
+            if result.plan is not None:
+                store_plan(self.sparql.kb, result.plan)
+        return result.to_dict()
+
+    def run_task(self, args: dict[str, Any]) -> dict[str, Any]:
+        task = _field(args, "task", str)
+        seed = _field(args, "seed", int, 0)
+        faults = _field(args, "fail", list, [])
+        wait = _field(args, "wait", bool, True)
+        if not all(isinstance(f, str) for f in faults):
+            raise ServiceError("fail must be a list of component IRIs (strings)")
+        if wait:
+            run = _call(lambda: self.tasks.run(task, seed, faults))
+        else:
+            run = _call(lambda: self.tasks.start(task, seed, faults))
+        return run.to_dict(with_events=False)
+
+    def task_status(self, args: dict[str, Any]) -> dict[str, Any]:
+        run_id = _field(args, "run", str)
+        return _call(lambda: self.tasks.get(run_id)).to_dict()
+
+    def _matchmaker(self, method: str) -> Matchmaker:
+        key = (method, self.sparql.generation)
+        with self._guard:
+            if key not in self._matchmakers:
+                self._matchmakers = {k: m for k, m in self._matchmakers.items() if k[1] == key[1]}
+                self._matchmakers[key] = Matchmaker(self.sparql.kb, method)
+            return self._matchmakers[key]
+
+
+def attach(bridge: Bridge, services: KnowledgeServices) -> Callable[[], None]:
+    """Offer ``services`` on ``bridge`` and relay task events to its topics; returns the detach call."""
+    for name, (kind, handler) in services.handlers().items():
+        bridge.add_service(name, kind, handler)
+    for topic, kind in TOPICS.items():
+        bridge.add_topic(topic, kind)
+
+    def relay(topic: str, message: dict[str, Any]) -> None:
+        if topic in TOPICS:
+            bridge.publish(topic, message)
+
+    unsubscribe_tasks = services.tasks.subscribe(relay)
+    unsubscribe_store = services.sparql.on_update(lambda: bridge.publish(RUN_TOPIC, {"event": "store_updated"}))
+
+    def detach() -> None:
+        unsubscribe_tasks()
+        unsubscribe_store()
+
+    return detach
+
+
+def _field(args: dict[str, Any], name: str, kind: type, default: Any = ...) -> Any:
+    if name not in args or args[name] is None:
+        if default is ...:
+            raise ServiceError(f"missing field {name!r}")
+        return default
+    value = args[name]
+    if (kind is int and isinstance(value, bool)) or not isinstance(value, kind):
+        raise ServiceError(f"field {name!r} must be {kind.__name__}, not {type(value).__name__}")
+    return value
+
+
+def _iri(name: str, default_prefix: str) -> str:
+    try:
+        return expand(name if ":" in name else f"{default_prefix}:{name}")
+    except ValueError as error:
+        raise ServiceError(str(error)) from error
+
+
+def _call(work: Callable[[], T]) -> T:
+    """Run ``work``; a library error becomes the service error the caller sees (result false)."""
+    try:
+        return work()
+    except (KnowledgeBaseError, ValueError) as error:
+        raise ServiceError(str(error)) from error

@@ -1,0 +1,121 @@
+"""``cbrs serve``: the HTTP app on waitress and the rosbridge websocket, over one knowledge base.
+
+Both listen on ``host`` (loopback by default). Each runs in its own thread; :meth:`Server.stop` closes
+both and waits for them, so Ctrl-C (or SIGTERM) ends the process cleanly.
+"""
+
+from __future__ import annotations
+
+import logging
+import signal
+import threading
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from types import FrameType
+from typing import Any
+
+from waitress import wasyncore
+from waitress.server import create_server
+
+from cbrs.bridge_services import KnowledgeServices, attach
+from cbrs.rosbridge import Bridge
+from cbrs.sparql_service import EndpointConfig, SparqlService
+from cbrs.tasks import TaskRunner
+from cbrs.web import create_app
+from kb import KnowledgeBase
+
+log = logging.getLogger("cbrs.server")
+
+
+@dataclass(frozen=True)
+class ServeConfig:
+    host: str = "127.0.0.1"
+    port: int = 8080
+    bridge_port: int = 9090
+    endpoint: EndpointConfig = field(default_factory=EndpointConfig)
+    cors_origins: Sequence[str] = ()
+    http_threads: int = 16  # long requests (a task run, a camera stream) each hold one
+
+
+class Server:
+    """The library objects a running cbrs serves, and the two listeners in front of them."""
+
+    def __init__(self, kb: KnowledgeBase, config: ServeConfig | None = None) -> None:
+        self.kb = kb
+        self.config = config or ServeConfig()
+        self.lock = threading.RLock()
+        self.sparql = SparqlService(kb, self.config.endpoint, self.lock)
+        self.tasks = TaskRunner(kb, self.lock)
+        self.bridge = Bridge()
+        self._detach = attach(self.bridge, KnowledgeServices(self.sparql, self.tasks))
+        self.app = create_app(self.sparql, self.config.cors_origins)
+        self._http: Any = None
+        self._http_map: dict[int, Any] = {}
+        self._http_thread: threading.Thread | None = None
+        self._bridge: Any = None
+
+    @property
+    def http_port(self) -> int:
+        return int(self._http.effective_port)
+
+    @property
+    def bridge_port(self) -> int:
+        return int(self._bridge.port)
+
+    def start(self) -> None:
+        """Open both listeners (port 0 picks a free port) and serve in background threads."""
+        self._http = create_server(
+            self.app,
+            host=self.config.host,
+            port=self.config.port,
+            threads=self.config.http_threads,
+            map=self._http_map,
+            ident="cbrs",
+            clear_untrusted_proxy_headers=True,
+        )
+        self._http_thread = threading.Thread(target=self._http.run, name="cbrs-http", daemon=True)
+        self._http_thread.start()
+        try:
+            self._bridge = self.bridge.start(self.config.host, self.config.bridge_port)
+        except BaseException:
+            self._stop_http(5.0)
+            raise
+
+    def stop(self, timeout: float = 10.0) -> None:
+        """Close both listeners and their connections; a task run still going gets ``timeout`` to end."""
+        if self._bridge is not None:
+            self._bridge.stop(timeout)
+            self._bridge = None
+        self._stop_http(timeout)
+        self._detach()
+        self.tasks.close(timeout)
+        self.sparql.close()
+
+    def serve_forever(self, ready: Callable[[Server], None] | None = None) -> None:
+        """Start, report through ``ready``, and serve until SIGINT or SIGTERM; then stop."""
+        stopping = threading.Event()
+
+        def on_signal(signum: int, frame: FrameType | None) -> None:
+            stopping.set()
+
+        previous = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
+        try:
+            self.start()
+            if ready is not None:
+                ready(self)
+            while not stopping.wait(0.5):
+                pass
+        finally:
+            for signum, handler in previous.items():
+                signal.signal(signum, handler)
+            self.stop()
+
+    def _stop_http(self, timeout: float) -> None:
+        if self._http is None:
+            return
+        server, self._http = self._http, None
+        server.task_dispatcher.shutdown(timeout=timeout)
+        # Close every socket from the server's own loop thread; the loop ends once its map is empty.
+        server.trigger.pull_trigger(lambda: wasyncore.close_all(self._http_map))
+        if self._http_thread is not None:
+            self._http_thread.join(timeout)

@@ -1,0 +1,237 @@
+"""``cbrs serve``: the HTTP endpoint and the rosbridge interface together, over loopback.
+
+Every wait is bounded; servers listen on free ports picked by the OS.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import selectors
+import signal
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Iterator
+from typing import Any
+
+import httpx
+import pytest
+from websockets.sync.client import ClientConnection, connect
+
+from cbrs.server import ServeConfig, Server
+from cbrs.sparql_service import EndpointConfig
+from kb import KnowledgeBase
+from kb.namespaces import expand
+from reasoner.matchmaker import Matchmaker
+
+WAIT = 10.0
+TOKEN = "serve-test-token"
+
+
+@pytest.fixture
+def server(fresh_bundled_kb: KnowledgeBase) -> Iterator[Server]:
+    threads = threading.active_count()
+    config = ServeConfig(port=0, bridge_port=0, endpoint=EndpointConfig(update_token=TOKEN))
+    running = Server(fresh_bundled_kb, config)
+    running.start()
+    yield running
+    running.stop(timeout=WAIT)
+    deadline = time.monotonic() + WAIT
+    while threading.active_count() > threads and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert threading.active_count() <= threads, [t.name for t in threading.enumerate()]
+
+
+def bridge(server: Server) -> ClientConnection:
+    return connect(f"ws://127.0.0.1:{server.bridge_port}", open_timeout=WAIT, close_timeout=WAIT)
+
+
+def receive(ws: ClientConnection, op: str, timeout: float = WAIT, **match: Any) -> dict[str, Any]:
+    """The next message with ``op`` (and the given field values), skipping others; bounded."""
+    deadline = time.monotonic() + timeout
+    while True:
+        message = json.loads(ws.recv(timeout=max(0.01, deadline - time.monotonic())))
+        if message.get("op") == op and all(message.get(k) == v for k, v in match.items()):
+            return message
+
+
+def call(ws: ClientConnection, service: str, args: dict[str, Any], timeout: float = WAIT) -> dict[str, Any]:
+    call_id = f"call:{service}:{time.monotonic_ns()}"
+    ws.send(json.dumps({"op": "call_service", "id": call_id, "service": service, "args": args}))
+    return receive(ws, "service_response", timeout, id=call_id)
+
+
+def test_http_and_bridge_answer_on_loopback(server: Server) -> None:
+    assert server.config.host == "127.0.0.1"
+    base = f"http://127.0.0.1:{server.http_port}"
+    health = httpx.get(base + "/healthz", timeout=WAIT)
+    assert health.json()["status"] == "ok"
+    answer = httpx.get(base + "/sparql", params={"query": "ASK { ?s a cbrs:Advertisement }"}, timeout=WAIT)
+    assert answer.json()["boolean"] is False  # advertisements are typed by their component kind
+    with bridge(server) as ws:
+        response = call(ws, "/rosapi/services", {})
+    assert response["result"] is True
+    assert {"/cbrs/query", "/cbrs/match", "/cbrs/plan", "/cbrs/run_task"} <= set(response["values"]["services"])
+
+
+def test_query_service_returns_sparql_json(server: Server) -> None:
+    with bridge(server) as ws:
+        response = call(ws, "/cbrs/query", {"query": "SELECT ?d WHERE { ?s cbrs:deviceName ?d } ORDER BY ?d LIMIT 2"})
+    assert response["result"] is True
+    values = response["values"]
+    assert values["media_type"] == "application/sparql-results+json"
+    assert values["result"]["head"]["vars"] == ["d"]
+    assert len(values["result"]["results"]["bindings"]) == 2
+
+
+def test_query_service_refuses_updates_and_reports_syntax_errors(server: Server) -> None:
+    before = server.kb.store.dump()
+    with bridge(server) as ws:
+        update = call(ws, "/cbrs/query", {"query": "INSERT DATA { <urn:a> <urn:b> <urn:c> }"})
+        broken = call(ws, "/cbrs/query", {"query": "SELECT ?x WHERE {"})
+        missing = call(ws, "/cbrs/query", {})
+    assert update["result"] is False and "syntax error" in str(update["values"]).lower()
+    assert broken["result"] is False and "syntax error" in str(broken["values"]).lower()
+    assert missing["result"] is False and "query" in str(missing["values"])
+    assert server.kb.store.dump() == before
+
+
+def test_match_service_ranks_like_the_library(server: Server) -> None:
+    expected = Matchmaker(server.kb).rank(expand("req:RobotSelfPosition")).candidates[0].advertisement
+    with bridge(server) as ws:
+        response = call(ws, "/cbrs/match", {"requirement": "RobotSelfPosition", "top": 3})
+        wrong = call(ws, "/cbrs/match", {"requirement": "RobotSelfPosition", "top": "three"})
+    assert response["result"] is True
+    ranked = response["values"]["candidates"]
+    assert len(ranked) == 3
+    assert ranked[0]["advertisement"] == expected
+    assert ranked[0]["pairs"]  # the explanation travels with the score
+    assert wrong["result"] is False and "top" in str(wrong["values"])
+
+
+def test_plan_service_plans_and_records_the_plan(server: Server) -> None:
+    with bridge(server) as ws:
+        response = call(ws, "/cbrs/plan", {"task": "FetchMyPen"})
+        unknown = call(ws, "/cbrs/plan", {"task": "FlyToTheMoon"})
+    assert response["result"] is True
+    plan = response["values"]
+    assert plan["status"] == "planned"
+    assert len(plan["steps"]) > 5
+    recorded = server.kb.query("ASK { ?plan cbrs:planFor req:FetchMyPen }")
+    assert bool(recorded)
+    assert unknown["result"] is False and "FlyToTheMoon" in str(unknown["values"])
+
+
+def test_run_task_streams_progress_and_ends_succeeded(server: Server) -> None:
+    with bridge(server) as watcher, bridge(server) as caller:
+        for topic in ("/cbrs/task_progress", "/cbrs/lifecycle", "/cbrs/events"):
+            watcher.send(json.dumps({"op": "subscribe", "topic": topic}))
+        time.sleep(0.2)  # let the subscriptions land before the run starts
+        response = call(caller, "/cbrs/run_task", {"task": "RobotArmServeACup", "seed": 1}, timeout=120)
+        heard: list[dict[str, Any]] = []
+        deadline = time.monotonic() + WAIT
+        while time.monotonic() < deadline:
+            message = receive(watcher, "publish", timeout=deadline - time.monotonic())
+            heard.append(message)
+            if message["topic"] == "/cbrs/events" and message["msg"].get("event") == "run_finished":
+                break
+    assert response["result"] is True
+    run = response["values"]
+    assert run["status"] == "succeeded"
+    assert run["result"]["execution"]["status"] == "succeeded"
+    progress = [m["msg"] for m in heard if m["topic"] == "/cbrs/task_progress"]
+    assert progress[0]["event"] == "step_started" and progress[0]["run"] == run["id"]
+    assert sum(1 for p in progress if p["event"] == "step_succeeded") == len(run["result"]["plan"]["steps"])
+    assert any(m["topic"] == "/cbrs/lifecycle" for m in heard)
+    finished = [m["msg"] for m in heard if m["topic"] == "/cbrs/events"]
+    assert finished[-1] == {"event": "run_finished", "run": run["id"], "task": "RobotArmServeACup", "status": run["status"]}
+
+
+def test_run_task_without_waiting_then_status_and_one_at_a_time(server: Server) -> None:
+    with bridge(server) as ws:
+        started = call(ws, "/cbrs/run_task", {"task": "RobotArmServeACup", "wait": False})
+        assert started["result"] is True
+        run_id = started["values"]["id"]
+        busy = call(ws, "/cbrs/run_task", {"task": "FetchMyPen", "wait": False})
+        bad_fault = call(ws, "/cbrs/run_task", {"task": "FetchMyPen", "fail": ["svc:NoSuchThing"]})
+        status: dict[str, Any] = {}
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline:
+            status = call(ws, "/cbrs/task_status", {"run": run_id})["values"]
+            if status["status"] != "running":
+                break
+            time.sleep(0.2)
+    assert busy["result"] is False and "one task runs at a time" in str(busy["values"])
+    assert bad_fault["result"] is False and "NoSuchThing" in str(bad_fault["values"])
+    assert status["status"] == "succeeded"
+    assert any(e.get("event") == "step_succeeded" for e in status["events"])
+
+
+def test_update_over_http_is_announced_on_the_bridge(server: Server) -> None:
+    with bridge(server) as ws:
+        ws.send(json.dumps({"op": "subscribe", "topic": "/cbrs/events"}))
+        time.sleep(0.2)
+        refused = httpx.post(
+            f"http://127.0.0.1:{server.http_port}/update",
+            content=b"INSERT DATA { <urn:a> <urn:b> <urn:c> }",
+            headers={"Content-Type": "application/sparql-update"},
+            timeout=WAIT,
+        )
+        assert refused.status_code == 403
+        accepted = httpx.post(
+            f"http://127.0.0.1:{server.http_port}/update",
+            content=b"INSERT DATA { <urn:a> <urn:b> <urn:c> }",
+            headers={"Content-Type": "application/sparql-update", "Authorization": f"Bearer {TOKEN}"},
+            timeout=WAIT,
+        )
+        assert accepted.status_code == 204
+        message = receive(ws, "publish", topic="/cbrs/events")
+    assert message["msg"] == {"event": "store_updated"}
+
+
+# -- the command -----------------------------------------------------------------------------------
+
+
+def _read_until(process: subprocess.Popen[str], marker: str, timeout: float) -> list[str]:
+    lines: list[str] = []
+    assert process.stdout is not None
+    selector = selectors.DefaultSelector()
+    selector.register(process.stdout, selectors.EVENT_READ)
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if not selector.select(timeout=max(0.0, deadline - time.monotonic())):
+            break
+        line = process.stdout.readline()
+        if not line:
+            break
+        lines.append(line.rstrip("\n"))
+        if marker in line:
+            return lines
+    raise AssertionError(f"no {marker!r} within {timeout} s; saw {lines}")
+
+
+def test_cbrs_serve_command_serves_until_ctrl_c(tmp_path: Any) -> None:
+    env = dict(os.environ, CBRS_STORE=":memory:", HOME=str(tmp_path))
+    env.pop("CBRS_UPDATE_TOKEN", None)
+    command = [sys.executable, "-m", "cbrs", "serve", "--port", "0", "--bridge-port", "0"]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env=env)
+    try:
+        lines = _read_until(process, "Ctrl-C stops", timeout=60)
+        assert "read-only" in lines[0]
+        sparql_url = next(line.split()[-1] for line in lines if line.strip().startswith("SPARQL"))
+        bridge_url = next(line.split()[-1] for line in lines if line.strip().startswith("rosbridge"))
+        assert sparql_url.startswith("http://127.0.0.1:") and bridge_url.startswith("ws://127.0.0.1:")
+        answer = httpx.get(sparql_url, params={"query": "ASK { ?s ?p ?o }"}, timeout=WAIT)
+        assert answer.json()["boolean"] is True
+        with connect(bridge_url, open_timeout=WAIT) as ws:
+            assert call(ws, "/rosapi/get_param_names", {})["result"] is True
+        process.send_signal(signal.SIGINT)
+        assert process.wait(timeout=30) == 0
+        assert process.stdout is not None
+        assert "stopped" in process.stdout.read()
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait(5)
