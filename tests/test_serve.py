@@ -146,7 +146,8 @@ def test_run_task_streams_progress_and_ends_succeeded(server: Server) -> None:
     assert sum(1 for p in progress if p["event"] == "step_succeeded") == len(run["result"]["plan"]["steps"])
     assert any(m["topic"] == "/cbrs/lifecycle" for m in heard)
     finished = [m["msg"] for m in heard if m["topic"] == "/cbrs/events"]
-    assert finished[-1] == {"event": "run_finished", "run": run["id"], "task": "RobotArmServeACup", "status": run["status"]}
+    ending = {"event": "run_finished", "run": run["id"], "task": "RobotArmServeACup", "status": run["status"]}
+    assert finished[-1] == ending
 
 
 def test_run_task_without_waiting_then_status_and_one_at_a_time(server: Server) -> None:
