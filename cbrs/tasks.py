@@ -205,4 +205,3 @@ def _check_components(failing: tuple[str, ...]) -> None:
     unknown = [shorten(f) for f in failing if f not in known]
     if unknown:
         raise UnknownComponentError(unknown)
-

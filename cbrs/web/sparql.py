@@ -133,4 +133,3 @@ def _service_description() -> Response:
     media_type = negotiate(True, request.headers.get("Accept"), _short_format())
     body = ox.serialize(triples, format=GRAPH_TYPES[media_type])
     return Response(body, content_type=_with_charset(media_type))
-
