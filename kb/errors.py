@@ -20,11 +20,44 @@ class StoreError(KnowledgeBaseError):
         super().__init__(f"store {location}: {reason}")
 
 
-class EndpointError(StoreError):
-    """A SPARQL endpoint behind a remote store refused or failed a request.
+def _one_line(message: str, limit: int = 240) -> str:
+    text = " ".join(message.split()) or "(no message)"
+    return text if len(text) <= limit else text[:limit] + " ..."
 
-    Keeps the endpoint URL, the HTTP status, the server's own message and the request text sent.
+
+class StoreEvaluationError(StoreError, RuntimeError):
+    """The store refused a well-formed query or update (e.g. CREATE GRAPH of a graph that exists); nothing
+    was written.
+
+    It is a RuntimeError too, as pyoxigraph's own evaluation errors are, so code that catches those sees
+    both backends fail alike. From a remote store, ``endpoint``, ``status`` and ``request`` say what was
+    sent where.
     """
+
+    http_status = 400
+
+    def __init__(
+        self,
+        location: str,
+        operation: str,
+        message: str,
+        endpoint: str | None = None,
+        status: int | None = None,
+        request: str | None = None,
+    ) -> None:
+        self.operation = operation
+        self.message = message
+        self.endpoint = endpoint
+        self.status = status
+        self.request = request
+        where = f" (HTTP {status} from {endpoint})" if endpoint else ""
+        super().__init__(location, f"{operation} failed: {_one_line(message)}{where}")
+
+
+class RemoteStoreError(StoreError):
+    """The SPARQL server behind a remote store refused a request for another reason than its syntax or
+    evaluation (a wrong endpoint, a body too large, a proxy error). Keeps the endpoint URL, the HTTP
+    status, the server's own message and the request text sent."""
 
     http_status = 502
 
@@ -33,10 +66,7 @@ class EndpointError(StoreError):
         self.status = status
         self.message = message
         self.request = request
-        one_line = " ".join(message.split()) or "(no message)"
-        if len(one_line) > 240:
-            one_line = one_line[:240] + " ..."
-        super().__init__(location, f"HTTP {status} from {endpoint}: {one_line}")
+        super().__init__(location, f"HTTP {status} from {endpoint}: {_one_line(message)}")
 
 
 class RdfParseError(KnowledgeBaseError):

@@ -30,7 +30,7 @@ from typing import NamedTuple
 import httpx
 import pyoxigraph as ox
 
-from kb.errors import BindingError, EndpointError, QuerySyntaxError, StoreError
+from kb.errors import BindingError, QuerySyntaxError, RemoteStoreError, StoreError, StoreEvaluationError
 from kb.namespaces import PREFIXES, GraphName
 from kb.store import QueryResult, Store, Term, data_block
 
@@ -244,10 +244,14 @@ class RemoteStore(Store):
         if response.is_success:
             return response
         message = _POSITION.sub(_one_line_up, response.text.strip())
-        too_large = response.status_code == 413 or "limited to" in message
-        if response.status_code == 400 and original is not None and not too_large:
+        status = response.status_code
+        too_large = status == 413 or "limited to" in message
+        if status == 400 and original is not None and not too_large:
             raise QuerySyntaxError(original, message)
-        raise EndpointError(self.location, url, response.status_code, message, original or body)
+        if status == 500:  # Oxigraph's (and Fuseki's) answer to an evaluation error; it rolled back
+            operation = "query" if url == self.endpoints.query else "update"
+            raise StoreEvaluationError(self.location, operation, message, url, status, original or body)
+        raise RemoteStoreError(self.location, url, status, message, original or body)
 
 
 @functools.cache

@@ -16,7 +16,7 @@ from pathlib import Path
 
 import pyoxigraph as ox
 
-from kb.errors import QuerySyntaxError, StoreError
+from kb.errors import QuerySyntaxError, StoreError, StoreEvaluationError
 from kb.namespaces import GENID, PREFIXES, GraphName
 
 MEMORY = ":memory:"
@@ -184,6 +184,8 @@ class EmbeddedStore(Store):
             )
         except SyntaxError as error:
             raise QuerySyntaxError(text, str(error)) from error
+        except RuntimeError as error:  # errors found while iterating the result stay pyoxigraph's RuntimeError
+            raise StoreEvaluationError(self.location, "query", str(error)) from error
 
     def quads(
         self,
@@ -224,8 +226,10 @@ class EmbeddedStore(Store):
             self._backend.update(text, prefixes=PREFIXES)
         except SyntaxError as error:
             raise QuerySyntaxError(text, str(error)) from error
-        except (OSError, RuntimeError) as error:  # RuntimeError: e.g. CREATE GRAPH of an existing graph
+        except OSError as error:
             raise StoreError(self.location, f"update failed: {error}") from error
+        except RuntimeError as error:  # e.g. CREATE GRAPH of a graph that exists
+            raise StoreEvaluationError(self.location, "update", str(error)) from error
 
     def flush(self) -> None:
         if not self.in_memory:

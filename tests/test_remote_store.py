@@ -17,7 +17,15 @@ import pytest
 from click.testing import CliRunner
 
 from cbrs.cli import cli
-from kb import BindingError, EndpointError, KnowledgeBase, QuerySyntaxError, Store, StoreError
+from kb import (
+    BindingError,
+    KnowledgeBase,
+    QuerySyntaxError,
+    RemoteStoreError,
+    Store,
+    StoreError,
+    StoreEvaluationError,
+)
 from kb.namespaces import GraphName
 from kb.remote_store import Endpoints, RemoteStore, inject_values
 from tests.conftest import OxigraphServer
@@ -216,15 +224,23 @@ def test_syntax_errors_read_as_on_the_embedded_store(remote_location: str) -> No
 def test_a_server_failure_keeps_the_servers_message_and_the_request(remote_location: str) -> None:
     store = Store.open(remote_location)
     store.update("CREATE GRAPH graph:world")
-    with pytest.raises(EndpointError) as caught:
+    with pytest.raises(StoreEvaluationError) as caught:
         store.update("CREATE GRAPH graph:world")
     error = caught.value
     assert (error.status, error.endpoint, error.request) == (
         500,
-        remote_location + "/update",
+        f"{remote_location}/update",
         "CREATE GRAPH graph:world",
     )
-    assert "already exists" in error.message and isinstance(error, StoreError)
+    assert "already exists" in error.message and isinstance(error, RuntimeError)  # as pyoxigraph's own are
+    store.close()
+
+
+def test_a_wrong_endpoint_is_a_remote_store_error(remote_location: str) -> None:
+    store = RemoteStore(remote_location, Endpoints(f"{remote_location}/nowhere", f"{remote_location}/update"))
+    with pytest.raises(RemoteStoreError) as caught:
+        store.count()
+    assert caught.value.status == 404 and f"{remote_location}/nowhere" in str(caught.value)
     store.close()
 
 
