@@ -89,7 +89,6 @@ class Server:
         self._stop_http(timeout)
         self._detach()
         self.tasks.close(timeout)
-        self.sparql.close()
 
     def serve_forever(self, ready: Callable[[Server], None] | None = None) -> None:
         """Start, report through ``ready``, and serve until SIGINT or SIGTERM; then stop."""

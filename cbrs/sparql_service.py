@@ -4,7 +4,7 @@ The HTTP endpoint and the rosbridge ``/cbrs/query`` service are thin layers over
 
 How a query is bounded (Oxigraph has no query timeout of its own):
 
-- it runs on one of ``workers`` threads; when all are taken the request is refused at once (busy),
+- it runs on its own thread, at most ``workers`` at once; when all are taken the request is refused at once (busy),
   so runaway queries cannot pile up;
 - its result is serialised by Oxigraph into a writer that checks the deadline and the byte budget on
   every chunk, so a query that streams many solutions stops at the deadline or the limit;
@@ -19,7 +19,7 @@ import io
 import threading
 import time
 from collections.abc import Callable, Sequence
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Future
 from concurrent.futures import TimeoutError as FutureTimeout
 from dataclasses import dataclass
 from typing import Any
@@ -29,7 +29,7 @@ from werkzeug.datastructures import MIMEAccept
 from werkzeug.http import parse_accept_header
 
 from kb import KnowledgeBase
-from kb.errors import KnowledgeBaseError
+from kb.errors import KnowledgeBaseError, StoreEvaluationError
 
 # Media types offered for SELECT and ASK results, the first being the default.
 RESULT_TYPES: dict[str, ox.QueryResultsFormat] = {
@@ -119,17 +119,6 @@ class EndpointBusyError(EndpointError):
         super().__init__(f"all {workers} query workers are busy; retry shortly")
 
 
-class EvaluationError(EndpointError):
-    """The store refused a well-formed operation (e.g. CREATE GRAPH on an existing graph); nothing changed."""
-
-    http_status = 400
-    kind = "evaluation-error"
-
-    def __init__(self, operation: str, message: str) -> None:
-        self.operation = operation
-        super().__init__(f"the {operation} failed and changed nothing: {message}")
-
-
 class UpdateForbiddenError(EndpointError):
     http_status = 403
     kind = "forbidden"
@@ -185,7 +174,6 @@ class SparqlService:
         self.config = config or EndpointConfig()
         self.lock = lock or threading.RLock()  # held by writers, so readers of cached descriptions see whole updates
         self._slots = threading.BoundedSemaphore(self.config.workers)
-        self._pool = ThreadPoolExecutor(self.config.workers, thread_name_prefix="cbrs-sparql")
         self._listeners: list[Callable[[], None]] = []
         self.generation = 0  # bumped by every update, so caches built from the store know they are stale
 
@@ -199,8 +187,18 @@ class SparqlService:
         if not self._slots.acquire(blocking=False):
             raise EndpointBusyError(self.config.workers)
         deadline = time.monotonic() + self.config.timeout
+        future: Future[Answer] = Future()
+
+        def work() -> None:
+            try:
+                future.set_result(self._evaluate(text, accept, short_format, deadline))
+            except BaseException as error:  # handed to the waiting request
+                future.set_exception(error)
+
+        # A daemon thread, not a pool's: an abandoned query must not keep the process from exiting.
+        worker = threading.Thread(target=work, name="cbrs-sparql-query", daemon=True)
         try:
-            future = self._pool.submit(self._evaluate, text, accept, short_format, deadline)
+            worker.start()
         except BaseException:
             self._slots.release()
             raise
@@ -219,9 +217,7 @@ class SparqlService:
         self._check_size(text)
         with self.lock:
             try:
-                self.kb.update(text)
-            except RuntimeError as error:  # Oxigraph's evaluation errors; the transaction was rolled back
-                raise EvaluationError("update", str(error)) from error
+                self.kb.update(text)  # a refused update raises StoreEvaluationError (400); nothing changed
             finally:
                 self.generation += 1
         for listener in list(self._listeners):
@@ -232,9 +228,6 @@ class SparqlService:
         self._listeners.append(listener)
         return lambda: self._listeners.remove(listener)
 
-    def close(self) -> None:
-        self._pool.shutdown(wait=False, cancel_futures=True)
-
     def _check_size(self, text: str) -> None:
         size = len(text.encode("utf-8"))
         if size > self.config.max_query_bytes:
@@ -243,10 +236,7 @@ class SparqlService:
     def _evaluate(self, text: str, accept: str | None, short_format: str | None, deadline: float) -> Answer:
         result: Any = None  # Oxigraph results must be dropped on the thread that made them
         try:
-            try:
-                result = self.kb.query(text)
-            except RuntimeError as error:
-                raise EvaluationError("query", str(error)) from error
+            result = self.kb.query(text)
             media_type = negotiate(isinstance(result, ox.QueryTriples), accept, short_format)
             writer = _BudgetWriter(self.config.max_result_bytes, deadline, self.config.timeout)
             try:
@@ -256,12 +246,15 @@ class SparqlService:
                     result.serialize(writer, RESULT_TYPES[media_type])
             except _Stop as stop:
                 raise stop.error from None
-            except RuntimeError as error:
-                raise EvaluationError("query", str(error)) from error
+            except KnowledgeBaseError:
+                raise
+            except RuntimeError as error:  # Oxigraph evaluates lazily: its errors can surface while serialising
+                raise StoreEvaluationError(self.kb.store.location, "query", str(error)) from error
             return Answer(writer.getvalue(), media_type)
         finally:
             result = None
             self._slots.release()
+
 
 def negotiate(graph: bool, accept: str | None, short_format: str | None = None) -> str:
     """The media type to answer in: a ``format`` short name wins, then the Accept header, then the default."""
@@ -280,4 +273,3 @@ def negotiate(graph: bool, accept: str | None, short_format: str | None = None) 
     if best is None:
         raise NotAcceptableError(accept, offered[:4])
     return best
-
