@@ -76,10 +76,17 @@ class Server:
         self._http_thread = threading.Thread(target=self._http.run, name="cbrs-http", daemon=True)
         self._http_thread.start()
         try:
-            self._bridge = self.bridge.start(self.config.host, self.config.bridge_port)
+            self._bridge = self.bridge.start(self.config.host, self.config.bridge_port, origins=self.bridge_origins())
         except BaseException:
             self._stop_http(5.0)
             raise
+
+    def bridge_origins(self) -> list[str | None]:
+        """Who may open the websocket: clients that send no Origin (roslibpy, node, a microcontroller),
+        pages served by this server itself, and the CORS origins; other web pages get 403."""
+        port = self.http_port
+        own = {f"http://{name}:{port}" for name in (self.config.host, "127.0.0.1", "localhost")}
+        return [None, *sorted(own), *self.config.cors_origins]
 
     def stop(self, timeout: float = 10.0) -> None:
         """Close both listeners and their connections; a task run still going gets ``timeout`` to end."""

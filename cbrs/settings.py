@@ -123,7 +123,8 @@ SETTINGS: tuple[Setting, ...] = (
     Setting(
         "cors_origins",
         lambda: (),
-        "Comma-separated origins allowed to call the HTTP API from a browser (CORS); none by default.",
+        "Comma-separated origins of web pages allowed to call the HTTP API (CORS) and open the rosbridge "
+        "websocket, besides the server's own pages; none by default.",
         "CBRS_CORS_ORIGINS",
         _origins,
     ),

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import json
 import os
-import selectors
+import queue
 import signal
 import subprocess
 import sys
@@ -18,7 +18,9 @@ from typing import Any
 
 import httpx
 import pytest
+from websockets.exceptions import InvalidStatus
 from websockets.sync.client import ClientConnection, connect
+from websockets.typing import Origin
 
 from cbrs.server import ServeConfig, Server
 from cbrs.sparql_service import EndpointConfig
@@ -195,22 +197,27 @@ def test_update_over_http_is_announced_on_the_bridge(server: Server) -> None:
 # -- the command -----------------------------------------------------------------------------------
 
 
-def _read_until(process: subprocess.Popen[str], marker: str, timeout: float) -> list[str]:
-    lines: list[str] = []
-    assert process.stdout is not None
-    selector = selectors.DefaultSelector()
-    selector.register(process.stdout, selectors.EVENT_READ)
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        if not selector.select(timeout=max(0.0, deadline - time.monotonic())):
-            break
-        line = process.stdout.readline()
-        if not line:
-            break
-        lines.append(line.rstrip("\n"))
-        if marker in line:
-            return lines
-    raise AssertionError(f"no {marker!r} within {timeout} s; saw {lines}")
+class Output:
+    """A child's output lines, read by a thread so that every wait for one is bounded."""
+
+    def __init__(self, process: subprocess.Popen[str]) -> None:
+        assert process.stdout is not None
+        stdout = process.stdout
+        self.lines: queue.Queue[str] = queue.Queue()
+        threading.Thread(target=lambda: [self.lines.put(line) for line in stdout], daemon=True).start()
+
+    def until(self, marker: str, timeout: float) -> list[str]:
+        seen: list[str] = []
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            try:
+                line = self.lines.get(timeout=max(0.01, deadline - time.monotonic()))
+            except queue.Empty:
+                break
+            seen.append(line.rstrip("\n"))
+            if marker in line:
+                return seen
+        raise AssertionError(f"no {marker!r} within {timeout} s; saw {seen}")
 
 
 def test_cbrs_serve_command_serves_until_ctrl_c(tmp_path: Any) -> None:
@@ -219,7 +226,8 @@ def test_cbrs_serve_command_serves_until_ctrl_c(tmp_path: Any) -> None:
     command = [sys.executable, "-m", "cbrs", "serve", "--port", "0", "--bridge-port", "0"]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env=env)
     try:
-        lines = _read_until(process, "Ctrl-C stops", timeout=60)
+        output = Output(process)
+        lines = output.until("Ctrl-C stops", timeout=60)
         assert "read-only" in lines[0]
         sparql_url = next(line.split()[-1] for line in lines if line.strip().startswith("SPARQL"))
         bridge_url = next(line.split()[-1] for line in lines if line.strip().startswith("rosbridge"))
@@ -230,9 +238,20 @@ def test_cbrs_serve_command_serves_until_ctrl_c(tmp_path: Any) -> None:
             assert call(ws, "/rosapi/get_param_names", {})["result"] is True
         process.send_signal(signal.SIGINT)
         assert process.wait(timeout=30) == 0
-        assert process.stdout is not None
-        assert "stopped" in process.stdout.read()
+        assert output.until("stopped", timeout=5)
     finally:
         if process.poll() is None:
             process.kill()
             process.wait(5)
+
+
+def test_bridge_admits_its_own_pages_and_clients_without_origin_but_not_other_sites(server: Server) -> None:
+    url = f"ws://127.0.0.1:{server.bridge_port}"
+    with connect(url, open_timeout=WAIT) as ws:  # roslibpy, node, a sensor board: no Origin header
+        assert call(ws, "/rosapi/get_time", {})["result"] is True
+    own = f"http://127.0.0.1:{server.http_port}"
+    with connect(url, origin=Origin(own), open_timeout=WAIT) as ws:  # a page this server served
+        assert call(ws, "/rosapi/get_time", {})["result"] is True
+    with pytest.raises(InvalidStatus) as refused:
+        connect(url, origin=Origin("http://evil.example"), open_timeout=WAIT)
+    assert refused.value.response.status_code == 403

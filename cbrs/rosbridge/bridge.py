@@ -11,7 +11,7 @@ import asyncio
 import contextlib
 import itertools
 import logging
-from collections.abc import Awaitable, Callable, Mapping
+from collections.abc import Awaitable, Callable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
 from cbrs.rosbridge import protocol, rosapi
@@ -152,11 +152,16 @@ class Bridge:
         """(name, type) of every service: rosapi, the server's and those clients provide."""
         return self._graph.service_list()
 
-    def start(self, host: str = "127.0.0.1", port: int = 9090) -> RunningBridge:
-        """Serve on a websocket in a background thread with its own event loop (port 0 picks a free one)."""
+    def start(
+        self, host: str = "127.0.0.1", port: int = 9090, *, origins: Sequence[str | None] | None = None
+    ) -> RunningBridge:
+        """Serve on a websocket in a background thread with its own event loop (port 0 picks a free one).
+
+        ``origins`` limits which web pages may connect (see :func:`cbrs.rosbridge.server.serve`).
+        """
         from cbrs.rosbridge.server import start
 
-        return start(self, host, port)
+        return start(self, host, port, origins=origins)
 
     async def serve(
         self, host: str = "127.0.0.1", port: int = 9090, *, ready: Callable[[int], None] | None = None

@@ -13,12 +13,13 @@ import contextlib
 import logging
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 from websockets.asyncio.server import ServerConnection
 from websockets.asyncio.server import serve as ws_serve
 from websockets.exceptions import ConnectionClosed
+from websockets.typing import Origin
 
 from cbrs.rosbridge.bridge import MIB, Bridge
 from cbrs.rosbridge.errors import RosbridgeError
@@ -43,10 +44,20 @@ def _peer(address: Any) -> str:
 
 
 async def serve(
-    bridge: Bridge, host: str = "127.0.0.1", port: int = 9090, *, ready: Callable[[int], None] | None = None
+    bridge: Bridge,
+    host: str = "127.0.0.1",
+    port: int = 9090,
+    *,
+    ready: Callable[[int], None] | None = None,
+    origins: Sequence[str | None] | None = None,
 ) -> None:
-    """Serve ``bridge`` on ``ws://host:port`` in the running loop until cancelled."""
-    await _serve(bridge, host, port, ready, None)
+    """Serve ``bridge`` on ``ws://host:port`` in the running loop until cancelled.
+
+    ``origins``, when given, is the list of ``Origin`` header values a handshake may carry (``None``
+    admits clients that send none, as roslibpy and node do); browsers always send one, so this keeps
+    pages from other sites off the bridge. Others are refused with HTTP 403.
+    """
+    await _serve(bridge, host, port, ready, None, origins)
 
 
 async def _serve(
@@ -55,6 +66,7 @@ async def _serve(
     port: int,
     ready: Callable[[int], None] | None,
     detached: Callable[[WorkerPool], None] | None,
+    origins: Sequence[str | None] | None = None,
 ) -> None:
     loop = asyncio.get_running_loop()
     bridge.attach(loop)
@@ -87,6 +99,7 @@ async def _serve(
             port,
             max_size=transport_limit(bridge),
             compression=None,
+            origins=None if origins is None else [None if o is None else Origin(o) for o in origins],
             close_timeout=CLOSE_TIMEOUT,
         ) as server:
             bound = int(server.sockets[0].getsockname()[1])
@@ -139,7 +152,14 @@ class RunningBridge:
         self.stop()
 
 
-def start(bridge: Bridge, host: str = "127.0.0.1", port: int = 9090, *, startup_timeout: float = 10.0) -> RunningBridge:
+def start(
+    bridge: Bridge,
+    host: str = "127.0.0.1",
+    port: int = 9090,
+    *,
+    startup_timeout: float = 10.0,
+    origins: Sequence[str | None] | None = None,
+) -> RunningBridge:
     """Serve ``bridge`` in a new thread with its own event loop; returns once the port is bound."""
     ready = threading.Event()
     state: dict[str, Any] = {}
@@ -153,7 +173,7 @@ def start(bridge: Bridge, host: str = "127.0.0.1", port: int = 9090, *, startup_
 
     def main() -> None:
         loop = asyncio.new_event_loop()
-        task = loop.create_task(_serve(bridge, host, port, on_ready, on_detached))
+        task = loop.create_task(_serve(bridge, host, port, on_ready, on_detached, origins))
         state["loop"], state["task"] = loop, task
         try:
             loop.run_until_complete(task)
