@@ -44,7 +44,7 @@ class _Group(click.Group):
 @click.version_option(__version__, prog_name="cbrs")
 @click.option(
     "--store",
-    metavar="PATH|:memory:",
+    metavar="PATH|:memory:|URL",
     help=setting("store").help + f" [env {setting('store').env}; default: the user data directory]",
 )
 @click.pass_context
