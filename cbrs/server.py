@@ -48,7 +48,7 @@ class Server:
         self.tasks = TaskRunner(kb, self.lock)
         self.bridge = Bridge()
         self._detach = attach(self.bridge, KnowledgeServices(self.sparql, self.tasks))
-        self.app = create_app(self.sparql, self.config.cors_origins)
+        self.app = create_app(self.sparql, self.config.cors_origins, self.tasks)
         self._http: Any = None
         self._http_map: dict[int, Any] = {}
         self._http_thread: threading.Thread | None = None

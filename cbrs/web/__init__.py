@@ -1,43 +1,81 @@
-"""The HTTP side of ``cbrs serve``: the SPARQL 1.1 Protocol endpoint (and the knowledge browser).
+"""The HTTP side of ``cbrs serve``: the knowledge browser's pages and the SPARQL 1.1 Protocol endpoint.
 
 ``create_app`` builds the Flask application over the library objects a server holds; every error a
-client causes is answered as JSON ``{"error": kind, "message": text}`` with a 4xx status, never a trace.
+client causes is answered with a 4xx status and never a trace: an HTML page for a page, JSON
+``{"error": kind, "message": text}`` for the ``.json`` twins and the endpoint.
 """
 
 from __future__ import annotations
 
+import importlib
 from collections.abc import Sequence
 from typing import Any
 
-from flask import Flask, Response, jsonify, request
+from flask import Flask, Response, jsonify, render_template, request
 from werkzeug.exceptions import HTTPException
 
 from cbrs import __version__
 from cbrs.sparql_service import SparqlService
+from cbrs.tasks import TaskRunner
+from cbrs.web import links
+from cbrs.web.context import EventLog
 from kb.errors import KnowledgeBaseError
 
+# The page blueprints, in navigation order: (module under cbrs.web, endpoint of its nav link, label).
+PAGES: tuple[tuple[str, str, str], ...] = (("overview", "overview.overview", "Overview"),)
 
-def create_app(sparql: SparqlService, cors_origins: Sequence[str] = ()) -> Flask:
-    """The Flask app answering ``/sparql``, ``/update`` and ``/healthz`` for ``sparql``'s knowledge base."""
+
+def create_app(sparql: SparqlService, cors_origins: Sequence[str] = (), tasks: TaskRunner | None = None) -> Flask:
+    """The Flask app over ``sparql``'s knowledge base: the browser's pages, ``/sparql``, ``/update`` and
+    ``/healthz``. Without ``tasks``, the app makes its own task runner."""
     from cbrs.web.sparql import blueprint
 
     app = Flask(__name__)
     app.config["MAX_CONTENT_LENGTH"] = 3 * sparql.config.max_query_bytes + 4096  # form encoding triples bytes
-    app.extensions["cbrs.sparql"] = sparql
+    app.json.sort_keys = False  # type: ignore[attr-defined]
+    runner = tasks or TaskRunner(sparql.kb, sparql.lock)
+    log = EventLog()
+    runner.subscribe(log.add)
+    sparql.on_update(lambda: log.add("/cbrs/events", {"event": "store_updated"}))
+    app.extensions.update({"cbrs.sparql": sparql, "cbrs.tasks": runner, "cbrs.events": log})
     app.register_blueprint(blueprint)
+    for module, _, _ in PAGES:
+        app.register_blueprint(importlib.import_module(f"cbrs.web.{module}").blueprint)
+    page_blueprints = {module for module, _, _ in PAGES}
     allowed = frozenset(cors_origins)
+    links.install(app)
+
+    @app.context_processor
+    def shared() -> dict[str, Any]:
+        twin = "/index.json" if request.path == "/" else request.path + ".json"
+        if request.query_string:
+            twin += "?" + request.query_string.decode("utf-8", "replace")
+        return {
+            "navigation": [(endpoint, label) for _, endpoint, label in PAGES],
+            "endpoints": set(app.view_functions),
+            "json_twin": twin,
+            "version": __version__,
+            "store_location": sparql.kb.store.location,
+        }
+
+    def as_page() -> bool:
+        return request.blueprint in page_blueprints and not request.path.endswith(".json")
 
     @app.get("/healthz")
     def health() -> Response:
         return jsonify(status="ok", version=__version__, store=sparql.kb.store.location, writable=sparql.writable)
 
     @app.errorhandler(KnowledgeBaseError)
-    def library_error(error: KnowledgeBaseError) -> tuple[Response, int]:
+    def library_error(error: KnowledgeBaseError) -> tuple[Response | str, int]:
+        if as_page():
+            return render_template("error.html", title="Error", message=str(error)), error.http_status
         return _error(getattr(error, "kind", type(error).__name__), str(error)), error.http_status
 
     @app.errorhandler(HTTPException)
-    def http_error(error: HTTPException) -> tuple[Response, int]:
+    def http_error(error: HTTPException) -> tuple[Response | str, int]:
         status = error.code or 500
+        if as_page() or (request.blueprint is None and request.accept_mimetypes.accept_html):
+            return render_template("error.html", title=error.name, message=error.description), status
         return _error(error.name.lower().replace(" ", "-"), error.description or error.name), status
 
     @app.before_request

@@ -1,0 +1,72 @@
+"""Pages with a JSON twin: every page ``/x`` is also ``/x.json``, the same data without the markup.
+
+A view returns a :class:`Page`; :func:`page` registers both routes and renders whichever was asked. A
+form whose input is wrong raises :class:`FormError`; the page is shown again with the message next to
+the field (status 400), and the twin answers ``{"error": "invalid-form", "fields": {...}}``.
+"""
+
+from __future__ import annotations
+
+import functools
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from flask import Blueprint, Response, jsonify, render_template, request
+
+from kb.errors import KnowledgeBaseError
+
+
+@dataclass
+class Page:
+    template: str
+    title: str
+    data: dict[str, Any] = field(default_factory=dict)
+    status: int = 200
+
+
+class FormError(KnowledgeBaseError):
+    """Input in a form is wrong; ``fields`` maps each field name to what is wrong with it."""
+
+    http_status = 400
+    kind = "invalid-form"
+
+    def __init__(self, fields: dict[str, str], page: Page | None = None) -> None:
+        self.fields = fields
+        self.page = page  # shown again, with the messages beside the fields
+        super().__init__("; ".join(f"{name}: {message}" for name, message in fields.items()))
+
+
+View = Callable[..., Page]
+
+
+def wants_json() -> bool:
+    return request.path.endswith(".json")
+
+
+def page(blueprint: Blueprint, rule: str, **options: Any) -> Callable[[View], View]:
+    """Register ``view`` at ``rule`` (HTML) and ``rule + '.json'`` (its twin)."""
+
+    def register(view: View) -> View:
+        @functools.wraps(view)
+        def respond(**kwargs: Any) -> Response | tuple[Response, int] | str | tuple[str, int]:
+            try:
+                shown = view(**kwargs)
+            except FormError as error:
+                if wants_json():
+                    return jsonify(error="invalid-form", message=str(error), fields=error.fields), 400
+                if error.page is None:
+                    raise
+                shown = error.page
+                shown.status = 400
+                shown.data = {**shown.data, "errors": error.fields}
+            if wants_json():
+                return jsonify(shown.data), shown.status
+            return render_template(shown.template, title=shown.title, **shown.data), shown.status
+
+        json_rule = "/index.json" if rule == "/" else rule + ".json"
+        blueprint.add_url_rule(rule, view.__name__, respond, **options)
+        blueprint.add_url_rule(json_rule, view.__name__ + "_json", respond, **options)
+        return view
+
+    return register
