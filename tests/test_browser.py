@@ -1,0 +1,87 @@
+"""The knowledge browser in a real browser: Playwright driving Debian's Chromium against ``cbrs serve``.
+
+Each test walks one page as a user would and takes a screenshot: into a temporary folder, or into
+``$CBRS_SCREENSHOTS`` when set (``CBRS_SCREENSHOTS=docs/screenshots pytest tests/test_browser.py``
+refreshes the README's pictures). Skipped, saying why, where Chromium or Playwright is missing;
+``.ci/run`` installs Chromium with apt.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from cbrs.server import ServeConfig, Server
+from kb import KnowledgeBase
+
+CHROMIUM = os.environ.get("CBRS_CHROMIUM") or shutil.which("chromium") or "/usr/bin/chromium"
+pytestmark = pytest.mark.skipif(
+    not Path(CHROMIUM).exists(), reason=f"Chromium is not installed at {CHROMIUM} (apt-get install chromium)"
+)
+playwright_api = pytest.importorskip("playwright.sync_api", reason="Playwright is not installed (pip install .[test])")
+
+# The flags a headless Chromium needs as root on a machine without a network beyond loopback.
+FLAGS = [
+    "--no-sandbox",
+    "--disable-gpu",
+    "--disable-quic",
+    "--no-first-run",
+    "--disable-background-networking",
+    "--disable-component-update",
+    "--disable-sync",
+]
+WAIT_MS = 15_000
+
+
+@pytest.fixture(scope="module")
+def server() -> Iterator[Server]:
+    running = Server(KnowledgeBase.open(":memory:"), ServeConfig(port=0, bridge_port=0))
+    running.start()
+    yield running
+    running.stop(timeout=10)
+
+
+@pytest.fixture(scope="module")
+def browser() -> Iterator[Any]:
+    with playwright_api.sync_playwright() as playwright:
+        launched = playwright.chromium.launch(executable_path=CHROMIUM, headless=True, args=FLAGS)
+        yield launched
+        launched.close()
+
+
+@pytest.fixture
+def page(browser: Any, server: Server) -> Iterator[Any]:
+    context = browser.new_context(base_url=f"http://127.0.0.1:{server.http_port}", viewport={"width": 1280, "height": 860})
+    context.set_default_timeout(WAIT_MS)
+    opened = context.new_page()
+    errors: list[str] = []
+    opened.on("pageerror", lambda error: errors.append(str(error)))
+    yield opened
+    context.close()
+    assert errors == [], f"JavaScript errors on the page: {errors}"
+
+
+@pytest.fixture
+def shots(tmp_path: Path) -> Path:
+    folder = Path(os.environ.get("CBRS_SCREENSHOTS") or tmp_path)
+    folder.mkdir(parents=True, exist_ok=True)
+    return folder
+
+
+def snap(page: Any, folder: Path, name: str) -> None:
+    target = folder / f"{name}.png"
+    page.screenshot(path=str(target), full_page=True)
+    assert target.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_overview_shows_the_store(page: Any, shots: Path) -> None:
+    page.goto("/")
+    assert page.locator("h1").inner_text() == "Overview"
+    assert int(page.locator("[data-count=services]").inner_text()) == 53
+    assert page.get_by_text("graph:ontology").is_visible()
+    snap(page, shots, "overview")
