@@ -22,7 +22,11 @@ from cbrs.web.context import EventLog
 from kb.errors import KnowledgeBaseError
 
 # The page blueprints, in navigation order: (module under cbrs.web, endpoint of its nav link, label).
-PAGES: tuple[tuple[str, str, str], ...] = (("overview", "overview.overview", "Overview"),)
+PAGES: tuple[tuple[str, str, str], ...] = (
+    ("overview", "overview.overview", "Overview"),
+    ("taxonomy", "taxonomy.taxonomy", "Taxonomy"),
+    ("services", "services.services", "Services"),
+)
 
 
 def create_app(sparql: SparqlService, cors_origins: Sequence[str] = (), tasks: TaskRunner | None = None) -> Flask:

@@ -1,0 +1,156 @@
+"""The page of any IRI: every triple it is the subject or the object of, grouped by predicate, with its graph.
+
+Every IRI link of the browser leads here (``links.py``). The resource page is not in the navigation, so
+it is registered by the taxonomy blueprint (:func:`attach`) rather than through ``PAGES``; its own error
+handlers answer a missing, malformed or unknown IRI with an HTML page, or JSON on the ``.json`` twin.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from typing import Any
+
+import pyoxigraph as ox
+from flask import Blueprint, Response, jsonify, render_template, request, url_for
+from flask.blueprints import BlueprintSetupState
+from markupsafe import Markup, escape
+from werkzeug.exceptions import BadRequest, HTTPException
+
+from cbrs.web import context
+from cbrs.web.links import iri_link
+from cbrs.web.pages import Page, page, wants_json
+from kb.errors import KnowledgeBaseError, NotFoundError
+from kb.namespaces import OWL, RDF, RDFS, XSD, expand, shorten
+
+blueprint = Blueprint("resource", __name__)
+
+RDF_TYPE = RDF + "type"
+# Types whose members have a page in the taxonomy.
+TERM_TYPES = frozenset(
+    {OWL + "Class", RDFS + "Class", OWL + "ObjectProperty", OWL + "DatatypeProperty", RDF + "Property"}
+)
+
+
+def iri_parameter(name: str = "iri") -> str:
+    """The full IRI in request parameter ``name`` (an absolute IRI or ``prefix:local``), or 400 saying why."""
+    given = (request.values.get(name) or "").strip()
+    if not given:
+        raise BadRequest(f"the {name!r} parameter is missing: give an IRI, e.g. ?{name}=home:RobotPosition")
+    try:
+        full = expand(given)
+        ox.NamedNode(full)  # pyoxigraph checks the IRI's syntax
+    except ValueError as error:
+        raise BadRequest(f"{name}={given!r} is not an IRI: {error}") from error
+    return full
+
+
+def term_data(term: ox.NamedNode | ox.BlankNode | ox.Literal | ox.Triple) -> dict[str, Any]:
+    """A term as JSON: ``{"type": "iri" | "bnode" | "literal", "value", "name"?, "datatype"?, "language"?}``."""
+    if isinstance(term, ox.NamedNode):
+        return {"type": "iri", "value": term.value, "name": shorten(term.value)}
+    if isinstance(term, ox.Literal):
+        found: dict[str, Any] = {"type": "literal", "value": term.value}
+        if term.language:
+            found["language"] = term.language
+        else:
+            found["datatype"] = term.datatype.value
+        return found
+    if isinstance(term, ox.BlankNode):
+        return {"type": "bnode", "value": term.value}
+    return {"type": "triple", "value": str(term)}
+
+
+def term_html(term: dict[str, Any]) -> Markup:
+    """A term dict (from :func:`term_data`, or a SPARQL JSON binding) as HTML: IRIs linked, literals typed."""
+    kind = term.get("type")
+    if kind in ("iri", "uri"):
+        return iri_link(term["value"])
+    if kind == "bnode":
+        return Markup(f"<code>_:{escape(term['value'])}</code>")
+    if kind not in ("literal", "typed-literal"):
+        return Markup(f"<code>{escape(term.get('value', ''))}</code>")
+    text = Markup(f'<span class="literal">{escape(term["value"])}</span>')
+    language = term.get("language") or term.get("xml:lang")
+    datatype = term.get("datatype")
+    if language:
+        return text + Markup(f' <span class="lang">@{escape(language)}</span>')
+    if datatype and datatype != XSD + "string":
+        return text + Markup(f' <span class="datatype" title="{escape(datatype)}">{escape(shorten(datatype))}</span>')
+    return text
+
+
+blueprint.add_app_template_global(term_html, "term_html")
+
+
+def attach(state: BlueprintSetupState) -> None:
+    """Register the resource page on the app another page blueprint is being registered on (once)."""
+    if "resource" not in state.app.blueprints:
+        state.app.register_blueprint(blueprint)
+
+
+@page(blueprint, "/resource")
+def resource() -> Page:
+    iri = iri_parameter()
+    kb = context.kb()
+    rows = kb.select("resource_triples", {"resource": iri})
+    if not rows:
+        raise NotFoundError(iri)
+    outgoing = _grouped(row for row in rows if row["direction"].value == "out")
+    incoming = _grouped(row for row in rows if row["direction"].value == "in")
+    label = next((row["other"].value for row in rows if _is(row, "out", RDFS + "label")), None)
+    types = {row["other"].value for row in rows if _is(row, "out", RDF_TYPE)}
+    pages = []
+    if types & TERM_TYPES:
+        pages.append({"text": "In the taxonomy", "href": url_for("taxonomy.concept", iri=iri)})
+    if kb.select("description", {"description": iri}):
+        pages.append({"text": "Service description (six-tuple)", "href": url_for("services.service", iri=iri)})
+    data = {
+        "iri": iri,
+        "name": shorten(iri),
+        "label": label,
+        "pages": pages,
+        "counts": {"outgoing": _count(outgoing), "incoming": _count(incoming)},
+        "outgoing": outgoing,
+        "incoming": incoming,
+    }
+    return Page("resource.html", shorten(iri), data)
+
+
+def _is(row: dict[str, Any], direction: str, predicate: str) -> bool:
+    return bool(row["direction"].value == direction and row["predicate"].value == predicate)
+
+
+def _count(groups: list[dict[str, Any]]) -> int:
+    return sum(len(group["values"]) for group in groups)
+
+
+def _grouped(rows: Iterable[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Rows of one direction as ``[{"predicate", "name", "values": [{"term", "graph"}]}]``, rdf:type first."""
+    groups: dict[str, list[dict[str, Any]]] = {}
+    for row in rows:
+        groups.setdefault(row["predicate"].value, []).append(
+            {"term": term_data(row["other"]), "graph": row["graph"].value}
+        )
+    order = sorted(groups, key=lambda p: (p != RDF_TYPE, shorten(p).casefold()))
+    return [{"predicate": p, "name": shorten(p), "values": groups[p]} for p in order]
+
+
+# The resource blueprint is not in PAGES, so the app's handlers would answer its errors in JSON; these
+# answer them as the other pages do: an HTML page, or JSON on the twin.
+
+
+@blueprint.errorhandler(KnowledgeBaseError)
+def _library_error(error: KnowledgeBaseError) -> tuple[Response | str, int]:
+    return _failure(error.http_status, getattr(error, "kind", type(error).__name__), "Not found", str(error))
+
+
+@blueprint.errorhandler(HTTPException)
+def _http_error(error: HTTPException) -> tuple[Response | str, int]:
+    message = error.description or error.name
+    return _failure(error.code or 500, error.name.lower().replace(" ", "-"), error.name, message)
+
+
+def _failure(status: int, kind: str, title: str, message: str) -> tuple[Response | str, int]:
+    if wants_json():
+        return jsonify(error=kind, message=message), status
+    return render_template("error.html", title=title if status == 404 else "Error", message=message), status

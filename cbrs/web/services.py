@@ -1,0 +1,117 @@
+"""The services: the advertisements table (filterable by component kind), the requirements, and a page per
+service description with its six-tuple ⟨DN, SN, SC, IOPE, SEA, QoS⟩ as ``cbrs show`` gives it."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from flask import Blueprint, current_app, request, url_for
+
+from cbrs.web import context, resource
+from cbrs.web.pages import FormError, Page, page
+from kb import KnowledgeBase
+from kb.model import Advertisement, Requirement
+from kb.namespaces import expand, shorten
+from kb.store import Term
+
+blueprint = Blueprint("services", __name__)
+
+MATCH_ENDPOINT = "matchmaking.matchmaking"
+
+
+@page(blueprint, "/services")
+def services() -> Page:
+    kb = context.kb()
+    rows = [_advertisement_row(row) for row in kb.select("advertisements")]
+    kinds: dict[str, int] = {}
+    for row in rows:
+        kinds[row["kind"]] = kinds.get(row["kind"], 0) + 1
+    data: dict[str, Any] = {
+        "kind": None,
+        "kinds": [{"iri": k, "name": shorten(k), "count": n} for k, n in sorted(kinds.items())],
+        "total": len(rows),
+        "advertisements": rows,
+        "requirements": _requirement_rows(kb),
+    }
+    given = (request.args.get("kind") or "").strip()
+    if not given:
+        return Page("services.html", "Services", data)
+    kind = _kind(given)
+    if kind not in kinds:
+        known = ", ".join(shorten(k) for k in sorted(kinds))
+        message = f"no advertisement is of kind {given!r}; the kinds are {known}"
+        raise FormError({"kind": message}, page=Page("services.html", "Services", {**data, "kind": given}))
+    data["kind"] = kind
+    data["advertisements"] = [row for row in rows if row["kind"] == kind]
+    return Page("services.html", f"Services: {shorten(kind)}", data)
+
+
+def _kind(given: str) -> str:
+    """A kind as typed: a prefixed name, an IRI, or a bare name in the core namespace."""
+    try:
+        return expand(given if ":" in given else "cbrs:" + given)
+    except ValueError:
+        return given
+
+
+@page(blueprint, "/service")
+def service() -> Page:
+    iri = resource.iri_parameter()
+    kb = context.kb()
+    with context.lock():
+        description = kb.description(iri)
+    role = "requirement" if isinstance(description, Requirement) else "advertisement"
+    data: dict[str, Any] = {"role": role, **description.to_dict()}
+    match = MATCH_ENDPOINT in current_app.view_functions
+    if isinstance(description, Requirement):
+        data["match"] = url_for(MATCH_ENDPOINT, requirement=iri) if match else None
+    elif isinstance(description, Advertisement):
+        data["requirements"] = _requirements_for(kb, description) if match else []
+    return Page("service.html", shorten(iri), data)
+
+
+def _split(term: Term | None) -> list[str]:
+    return term.value.split() if term is not None else []
+
+
+def _value(term: Term | None) -> str | None:
+    return term.value if term is not None else None
+
+
+def _advertisement_row(row: dict[str, Term]) -> dict[str, Any]:
+    iri = row["service"].value
+    return {
+        "service": iri,
+        "name": shorten(iri),
+        "label": _value(row.get("label")),
+        "kind": _value(row.get("kind")),
+        "device_name": _value(row.get("deviceName")),
+        "service_name": _value(row.get("serviceName")),
+        "category": _value(row.get("category")),
+        "inputs": _split(row.get("inputs")),
+        "outputs": _split(row.get("outputs")),
+    }
+
+
+def _requirement_rows(kb: KnowledgeBase) -> list[dict[str, Any]]:
+    return [
+        {
+            "requirement": row["requirement"].value,
+            "name": shorten(row["requirement"].value),
+            "label": _value(row.get("label")),
+            "requested_by": _value(row.get("requestedBy")),
+            "task": _value(row.get("task")),
+            "inputs": _split(row.get("inputs")),
+            "outputs": _split(row.get("outputs")),
+        }
+        for row in kb.select("requirements")
+    ]
+
+
+def _requirements_for(kb: KnowledgeBase, ad: Advertisement) -> list[dict[str, Any]]:
+    """Every requirement, to pick one to match against; first those asking for an output this service gives."""
+    offered = {p.type for p in ad.outputs}
+    rows = _requirement_rows(kb)
+    for row in rows:
+        row["shares_output"] = bool(offered & set(row["outputs"]))
+    return sorted(rows, key=lambda r: (not r["shares_output"], r["name"].casefold()))

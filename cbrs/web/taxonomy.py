@@ -1,0 +1,270 @@
+"""The taxonomy: the class and property trees (is-a links, each class with its hasPart children), a search
+over them, and a page per term with its neighbours and the service descriptions that use it.
+
+Everything is read with the named queries the taxonomy index reads (``taxonomy_links``,
+``taxonomy_terms``), plus ``concept_parts``, ``concept_usage`` and ``resource_triples`` for one term.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Set
+from dataclasses import dataclass, field
+from typing import Any
+
+from flask import Blueprint, request, url_for
+from markupsafe import Markup, escape
+
+from cbrs.web import context, resource
+from cbrs.web.pages import Page, page
+from kb import KnowledgeBase
+from kb.errors import NotFoundError
+from kb.namespaces import RDF, RDFS, shorten
+from kb.vocab import CBRS
+
+blueprint = Blueprint("taxonomy", __name__)
+blueprint.record_once(resource.attach)  # the page of any IRI comes with the taxonomy (it is not in the nav)
+
+MAX_PATHS = 12  # ancestor paths shown per search match
+# How a service description reaches a concept, walking incoming triples back to the description.
+_USE_LINKS = {
+    CBRS.parameterType: "parameter",
+    RDF + "subject": "statement",
+    RDF + "predicate": "statement",
+    RDF + "object": "statement",
+}
+_ROLE_LINKS = {
+    CBRS.hasInput: "input",
+    CBRS.hasOutput: "output",
+    CBRS.hasPrecondition: "precondition",
+    CBRS.hasEffect: "effect",
+}
+
+
+def local_name(iri: str) -> str:
+    return iri.rsplit("#", 1)[-1].rsplit("/", 1)[-1]
+
+
+def concept_url(iri: str) -> str:
+    return url_for("taxonomy.concept", iri=shorten(iri))  # expanded again by iri_parameter
+
+
+@blueprint.app_template_global("concept_link")
+def concept_link(iri: str, label: str | None = None) -> Markup:
+    """A link to the taxonomy page of a class or property."""
+    return Markup(f'<a href="{escape(concept_url(iri))}" title="{escape(iri)}">{escape(label or shorten(iri))}</a>')
+
+
+@dataclass
+class Taxonomy:
+    """The terms and links of the store's taxonomy, as read for one request."""
+
+    kinds: dict[str, str] = field(default_factory=dict)  # term -> "class" | "property"
+    labels: dict[str, str] = field(default_factory=dict)
+    parents: dict[str, set[str]] = field(default_factory=dict)  # is-a
+    children: dict[str, set[str]] = field(default_factory=dict)
+    parts: dict[str, set[str]] = field(default_factory=dict)  # whole -> its own declared parts
+    wholes: dict[str, set[str]] = field(default_factory=dict)
+    same: dict[str, set[str]] = field(default_factory=dict)
+
+    @classmethod
+    def read(cls, kb: KnowledgeBase) -> Taxonomy:
+        found = cls()
+        for row in kb.select("taxonomy_terms"):
+            term = row["term"].value
+            found.kinds[term] = row["kind"].value
+            if "label" in row:
+                found.labels[term] = row["label"].value
+        links = [(row["child"].value, row["parent"].value, row["link"].value) for row in kb.select("taxonomy_links")]
+        for child, parent, link in links:
+            if link == "is-a":
+                found.parents.setdefault(child, set()).add(parent)
+                found.children.setdefault(parent, set()).add(child)
+            elif link == "has-part":
+                found.parts.setdefault(parent, set()).add(child)
+                found.wholes.setdefault(child, set()).add(parent)
+            else:
+                found.same.setdefault(child, set()).add(parent)
+                found.same.setdefault(parent, set()).add(child)
+        # Terms only links mention (an imported class, dul:hasPart) take the kind of their neighbours.
+        for child, parent, _ in links:
+            for term, other in ((child, parent), (parent, child)):
+                if term not in found.kinds:
+                    found.kinds[term] = "property" if found.kinds.get(other) == "property" else "class"
+        return found
+
+    def __contains__(self, term: object) -> bool:
+        return term in self.kinds
+
+    def sorted(self, terms: set[str] | None) -> list[str]:
+        return sorted(terms or (), key=lambda t: (shorten(t).casefold(), t))
+
+    def term(self, iri: str) -> dict[str, Any]:
+        return {"iri": iri, "name": shorten(iri), "label": self.labels.get(iri)}
+
+    def roots(self, kind: str) -> list[str]:
+        return self.sorted({t for t, k in self.kinds.items() if k == kind and not self.parents.get(t)})
+
+    def tree(self, kind: str, keep: Set[str] | None = None, matches: Set[str] = frozenset()) -> list[dict[str, Any]]:
+        """Nested nodes from the roots down (a term with two parents appears under both); with ``keep``,
+        only those terms."""
+        return [self._node(root, (), keep, matches) for root in self.roots(kind) if keep is None or root in keep]
+
+    def _node(self, iri: str, path: tuple[str, ...], keep: Set[str] | None, matches: Set[str]) -> dict[str, Any]:
+        below = [c for c in self.sorted(self.children.get(iri)) if c not in path and (keep is None or c in keep)]
+        node = self.term(iri)
+        node["parts"] = [self.term(part) for part in self.sorted(self.parts.get(iri))]
+        if matches:
+            node["match"] = iri in matches
+        node["children"] = [self._node(child, (*path, iri), keep, matches) for child in below]
+        return node
+
+    def search(self, text: str) -> list[str]:
+        """Terms whose label or local name contains ``text``, ignoring case."""
+        needle = text.casefold()
+        return self.sorted(
+            {
+                term
+                for term in self.kinds
+                if needle in local_name(term).casefold() or needle in self.labels.get(term, "").casefold()
+            }
+        )
+
+    def paths(self, iri: str) -> list[list[str]]:
+        """The is-a paths from a root down to ``iri`` (``iri`` excluded), at most ``MAX_PATHS``."""
+        found: list[list[str]] = []
+
+        def up(term: str, below: tuple[str, ...]) -> Iterator[list[str]]:
+            parents = [p for p in self.sorted(self.parents.get(term)) if p not in below]
+            if not parents:
+                yield list(reversed(below[1:]))
+            for parent in parents:
+                yield from up(parent, (*below, parent))
+
+        for path in up(iri, (iri,)):
+            found.append(path)
+            if len(found) == MAX_PATHS:
+                break
+        return found
+
+    def ancestors(self, iri: str) -> set[str]:
+        seen: set[str] = set()
+        stack = [iri]
+        while stack:
+            for parent in self.parents.get(stack.pop(), ()):
+                if parent not in seen:
+                    seen.add(parent)
+                    stack.append(parent)
+        return seen
+
+
+@page(blueprint, "/taxonomy")
+def taxonomy() -> Page:
+    found = Taxonomy.read(context.kb())
+    query = (request.args.get("q") or "").strip()
+    kinds = list(found.kinds.values())
+    counts = {"classes": kinds.count("class"), "properties": kinds.count("property")}
+    data: dict[str, Any] = {"q": query or None, "counts": counts}
+    if query:
+        matches = found.search(query)
+        keep = set(matches).union(*(found.ancestors(m) for m in matches))
+        data["matches"] = [
+            {**found.term(m), "kind": found.kinds[m], "paths": [[found.term(t) for t in p] for p in found.paths(m)]}
+            for m in matches
+        ]
+        data["classes"] = found.tree("class", keep, set(matches))
+        data["properties"] = found.tree("property", keep, set(matches))
+    else:
+        data["classes"] = found.tree("class")
+        data["properties"] = found.tree("property")
+    title = f"Taxonomy: “{query}”" if query else "Taxonomy"
+    return Page("taxonomy.html", title, data)
+
+
+@page(blueprint, "/taxonomy/class")
+def concept() -> Page:
+    iri = resource.iri_parameter()
+    kb = context.kb()
+    found = Taxonomy.read(kb)
+    if iri not in found:
+        raise NotFoundError(iri, "class or property")
+    triples = kb.select("resource_triples", {"resource": iri})
+    comment = next((r["other"].value for r in triples if _out(r, RDFS + "comment")), None)
+    kind = found.kinds[iri]
+    data = {
+        **found.term(iri),
+        "kind": kind,
+        "comment": comment,
+        "paths": [[found.term(t) for t in p] for p in found.paths(iri)],
+        "superclasses": [found.term(t) for t in found.sorted(found.parents.get(iri))],
+        "subclasses": [found.term(t) for t in found.sorted(found.children.get(iri))],
+        "equivalents": [found.term(t) for t in found.sorted(found.same.get(iri))],
+        "parts": _parts(kb, iri) if kind == "class" else [],
+        "part_of": [found.term(t) for t in found.sorted(found.wholes.get(iri))],
+        "usage": _usage(kb, iri, triples),
+    }
+    noun = "Class" if kind == "class" else "Property"
+    return Page("class.html", f"{noun} {shorten(iri)}", data)
+
+
+def _out(row: dict[str, Any], predicate: str) -> bool:
+    return bool(row["direction"].value == "out" and row["predicate"].value == predicate)
+
+
+def _parts(kb: KnowledgeBase, iri: str) -> list[dict[str, Any]]:
+    """The concept's hasPart children, own and inherited (own first when a part is both)."""
+    parts: dict[tuple[str, str], dict[str, Any]] = {}
+    for row in kb.select("concept_parts", {"concept": iri}):
+        key = (row["property"].value, row["part"].value)
+        owner = row["owner"].value
+        if key in parts and parts[key]["inherited_from"] is None:
+            continue
+        parts[key] = {
+            "iri": key[1],
+            "name": shorten(key[1]),
+            "property": key[0],
+            "property_name": shorten(key[0]),
+            "inherited_from": None if owner == iri else owner,
+        }
+    return sorted(parts.values(), key=lambda p: (p["inherited_from"] is not None, p["name"].casefold()))
+
+
+def _usage(kb: KnowledgeBase, iri: str, triples: list[dict[str, Any]]) -> dict[str, Any]:
+    """Which advertisements, requirements and actions use the concept, and as what (input, effect, ...)."""
+    uses = next((int(r["uses"].value) for r in kb.select("concept_usage") if r["concept"].value == iri), 0)
+    roles: dict[str, set[str]] = {}
+    for row in triples:
+        if row["direction"].value == "in" and row["predicate"].value in _USE_LINKS:
+            for description, role in _descriptions_of(kb, row["other"].value):
+                roles.setdefault(description, set()).add(role)
+    advertisements = {r["service"].value: r.get("label") for r in kb.select("advertisements")}
+    requirements = {r["requirement"].value: r.get("label") for r in kb.select("requirements")}
+    groups: dict[str, list[dict[str, Any]]] = {"advertisements": [], "requirements": [], "actions": []}
+    for description in sorted(roles, key=lambda d: shorten(d).casefold()):
+        group = "actions"
+        if description in advertisements:
+            group = "advertisements"
+        elif description in requirements:
+            group = "requirements"
+        label = advertisements.get(description) or requirements.get(description)
+        groups[group].append(
+            {
+                "iri": description,
+                "name": shorten(description),
+                "label": label.value if label is not None else None,
+                "roles": sorted(roles[description]),
+            }
+        )
+    return {"uses": uses, **groups}
+
+
+def _descriptions_of(kb: KnowledgeBase, node: str) -> list[tuple[str, str]]:
+    """(description, role) for a parameter or statement node: node <- model (role) <- description."""
+    found = []
+    for edge in kb.select("resource_triples", {"resource": node}):
+        role = _ROLE_LINKS.get(edge["predicate"].value)
+        if edge["direction"].value != "in" or role is None:
+            continue
+        for up in kb.select("resource_triples", {"resource": edge["other"].value}):
+            if up["direction"].value == "in" and up["predicate"].value == CBRS.hasOWLSModel:
+                found.append((up["other"].value, role))
+    return found

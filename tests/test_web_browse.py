@@ -1,0 +1,224 @@
+"""The browse pages: taxonomy, class, any IRI, services, one service, the SPARQL editor. Assertions are on
+the ``.json`` twins; the HTML pages are checked to render with their headings and links."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from typing import Any
+from urllib.parse import parse_qs, urlsplit
+
+import pytest
+from flask.testing import FlaskClient
+
+from cbrs.sparql_service import SparqlService
+from cbrs.web import create_app
+from kb import KnowledgeBase
+from kb.namespaces import expand
+
+CAMERA = "svc:LocateMobileRobot_CeilingCamera01"
+POSITION = expand("home:Position")
+ROBOT_POSITION = expand("home:RobotPosition")
+XY_THETA = {expand("home:XCoordinate"), expand("home:YCoordinate"), expand("home:Theta")}
+
+
+@pytest.fixture(scope="module")
+def client(bundled_kb: KnowledgeBase) -> FlaskClient:
+    return create_app(SparqlService(bundled_kb)).test_client()
+
+
+def get_json(client: FlaskClient, path: str, status: int = 200, **query: str) -> Any:
+    response = client.get(path, query_string=query)
+    assert response.status_code == status, response.get_data(as_text=True)[:500]
+    assert response.mimetype == "application/json"
+    return response.get_json()
+
+
+def walk(nodes: list[dict[str, Any]]) -> Iterator[dict[str, Any]]:
+    for node in nodes:
+        yield node
+        yield from walk(node["children"])
+
+
+# -- taxonomy --------------------------------------------------------------------------------------
+
+
+def test_taxonomy_tree_nests_robot_position_below_position_with_parts(client: FlaskClient) -> None:
+    body = get_json(client, "/taxonomy.json")
+    position = next(node for node in walk(body["classes"]) if node["iri"] == POSITION)
+    below = {child["iri"]: child for child in position["children"]}
+    assert ROBOT_POSITION in below
+    assert {part["iri"] for part in below[ROBOT_POSITION]["parts"]} == XY_THETA
+    assert {part["iri"] for part in position["parts"]} == XY_THETA
+    assert body["counts"]["classes"] > 300 and body["counts"]["properties"] > 100
+    assert any(node["iri"] == expand("dul:hasPart") for node in walk(body["properties"]))
+
+
+def test_taxonomy_search_finds_matches_with_their_ancestor_paths(client: FlaskClient) -> None:
+    body = get_json(client, "/taxonomy.json", q="POSITION")
+    matches = {m["iri"]: m for m in body["matches"]}
+    assert POSITION in matches and ROBOT_POSITION in matches
+    paths = [[t["iri"] for t in path] for path in matches[ROBOT_POSITION]["paths"]]
+    assert any(path[-2:] == [expand("home:SpatialData"), POSITION] for path in paths)
+    # the tree is pruned to the matches and their ancestors
+    shown = {node["iri"]: node for node in walk(body["classes"])}
+    assert shown[ROBOT_POSITION]["match"] is True and shown[expand("home:SpatialData")]["match"] is False
+    assert expand("home:Cup") not in shown
+
+
+def test_taxonomy_search_without_matches_says_so(client: FlaskClient) -> None:
+    body = get_json(client, "/taxonomy.json", q="no-such-term-anywhere")
+    assert body["matches"] == [] and body["classes"] == []
+    page = client.get("/taxonomy", query_string={"q": "no-such-term-anywhere"}).get_data(as_text=True)
+    assert "0 matches" in page
+
+
+def test_class_page_lists_superclass_parts_and_users(client: FlaskClient) -> None:
+    body = get_json(client, "/taxonomy/class.json", iri="home:RobotPosition")
+    assert body["iri"] == ROBOT_POSITION and body["kind"] == "class" and body["label"] == "robot position"
+    assert [t["iri"] for t in body["superclasses"]] == [POSITION]
+    assert {p["iri"] for p in body["parts"]} == XY_THETA
+    assert {p["property_name"] for p in body["parts"]} == {
+        "home:hasXCoordinate",
+        "home:hasYCoordinate",
+        "home:hasOrientation",
+    }
+    usage = body["usage"]
+    assert usage["uses"] == 3
+    assert [(a["name"], a["roles"]) for a in usage["advertisements"]] == [
+        ("svc:EstimateRobotPositionFromSonar_HomeServer01", ["output"])
+    ]
+    assert {r["name"] for r in usage["requirements"]} == {"req:RobotSelfPosition", "req:RouteToGoal"}
+
+
+def test_class_page_of_position_shows_subclasses_and_inherited_parts(client: FlaskClient) -> None:
+    body = get_json(client, "/taxonomy/class.json", iri=POSITION)
+    assert ROBOT_POSITION in {t["iri"] for t in body["subclasses"]}
+    body = get_json(client, "/taxonomy/class.json", iri="home:ApproachPosition")
+    assert all(p["inherited_from"] is None for p in body["parts"])  # declared again on the class itself
+
+
+def test_class_page_of_a_property_and_of_an_unknown_term(client: FlaskClient) -> None:
+    body = get_json(client, "/taxonomy/class.json", iri="home:hasXCoordinate")
+    assert body["kind"] == "property" and body["parts"] == []
+    error = get_json(client, "/taxonomy/class.json", 404, iri="home:NoSuchClass")
+    assert "home#NoSuchClass" in error["message"]
+
+
+def test_taxonomy_html_pages_render(client: FlaskClient) -> None:
+    page = client.get("/taxonomy").get_data(as_text=True)
+    assert "<title>Taxonomy · cbrs</title>" in page and 'id="q"' in page
+    assert 'href="/taxonomy/class?iri=home:RobotPosition"' in page
+    response = client.get("/taxonomy/class", query_string={"iri": "home:RobotPosition"})
+    page = response.get_data(as_text=True)
+    assert response.status_code == 200
+    assert "<h1>Class home:RobotPosition</h1>" in page and "Superclasses" in page
+    assert 'href="/service?iri=req:RobotSelfPosition"' in page
+
+
+# -- any IRI ---------------------------------------------------------------------------------------
+
+
+def test_resource_lists_outgoing_triples_grouped_with_graphs(client: FlaskClient) -> None:
+    body = get_json(client, "/resource.json", iri=CAMERA)
+    assert body["iri"] == expand(CAMERA) and body["label"] == "Locate mobile robot (ceiling camera 1)"
+    groups = {group["name"]: group["values"] for group in body["outgoing"]}
+    assert body["outgoing"][0]["name"] == "rdf:type"
+    assert groups["rdf:type"][0]["term"] == {
+        "type": "iri",
+        "value": expand("cbrs:DynamicPerceptionComponent"),
+        "name": "cbrs:DynamicPerceptionComponent",
+    }
+    assert groups["rdf:type"][0]["graph"] == expand("graph:services")
+    assert groups["rdfs:label"][0]["term"]["language"] == "en"
+    assert groups["cbrs:serviceName"][0]["term"]["datatype"] == expand("xsd:string")
+    assert body["counts"] == {"outgoing": 11, "incoming": 0}
+    assert any(link["href"] == f"/service?iri={expand(CAMERA).replace('#', '%23')}" for link in body["pages"])
+
+
+def test_resource_html_links_every_iri(client: FlaskClient) -> None:
+    response = client.get("/resource", query_string={"iri": "home:RobotPosition"})
+    page = response.get_data(as_text=True)
+    assert response.status_code == 200
+    assert "<h1>home:RobotPosition</h1>" in page
+    assert 'href="/resource?iri=https://w3id.org/cbrs/home%23Position"' in page
+    assert "In the taxonomy" in page and "cbrs:parameterType" in page
+
+
+@pytest.mark.parametrize(
+    ("query", "status", "kind"),
+    [
+        pytest.param({"iri": "svc:NoSuchService"}, 404, "NotFoundError", id="unknown"),
+        pytest.param({}, 400, "bad-request", id="missing"),
+        pytest.param({"iri": "nope:X"}, 404, "NotFoundError", id="unknown-scheme"),  # an absolute IRI
+        pytest.param({"iri": "  "}, 400, "bad-request", id="blank"),
+        pytest.param({"iri": "http://example.org/a b"}, 400, "bad-request", id="malformed"),
+    ],
+)
+def test_resource_errors_are_pages_and_json(client: FlaskClient, query: dict[str, str], status: int, kind: str) -> None:
+    error = get_json(client, "/resource.json", status, **query)
+    assert error["error"] == kind and error["message"]
+    response = client.get("/resource", query_string=query)
+    assert response.status_code == status and response.mimetype == "text/html"
+    assert 'class="error-box"' in response.get_data(as_text=True)
+
+
+# -- services --------------------------------------------------------------------------------------
+
+
+def test_services_table_has_every_advertisement_and_filters_by_kind(client: FlaskClient) -> None:
+    body = get_json(client, "/services.json")
+    assert body["total"] == 53 and len(body["advertisements"]) == 53 and body["kind"] is None
+    camera = next(row for row in body["advertisements"] if row["name"] == CAMERA)
+    assert camera["inputs"] == [expand("home:MarkerColour")] and camera["device_name"] == "CeilingCamera01"
+    assert sum(k["count"] for k in body["kinds"]) == 53
+    static = get_json(client, "/services.json", kind="cbrs:StaticDataComponent")
+    assert static["kind"] == expand("cbrs:StaticDataComponent")
+    assert 0 < len(static["advertisements"]) < 53
+    assert {row["kind"] for row in static["advertisements"]} == {expand("cbrs:StaticDataComponent")}
+    assert len(get_json(client, "/services.json", kind="StaticDataComponent")["advertisements"]) == len(
+        static["advertisements"]
+    )
+
+
+def test_services_unknown_kind_is_a_field_error(client: FlaskClient) -> None:
+    error = get_json(client, "/services.json", 400, kind="cbrs:Toaster")
+    assert error["error"] == "invalid-form" and "cbrs:Toaster" in error["fields"]["kind"]
+    response = client.get("/services", query_string={"kind": "cbrs:Toaster"})
+    assert response.status_code == 400 and 'id="kind-error"' in response.get_data(as_text=True)
+
+
+def test_service_page_carries_the_six_tuple(client: FlaskClient) -> None:
+    body = get_json(client, "/service.json", iri=CAMERA)
+    assert body["role"] == "advertisement" and body["class"] == "Advertisement"
+    assert (body["device_name"], body["service_name"], body["category"]) == (
+        "CeilingCamera01",
+        "LocateMobileRobot",
+        "Localisation",
+    )
+    assert [p["type"] for p in body["inputs"]] == [expand("home:MarkerColour")]
+    (output,) = body["outputs"]
+    assert output["type"] == expand("home:RobotLocation")
+    assert {child["concept"] for child in output["tree"]["children"]} == XY_THETA
+    assert body["preconditions"] and body["effects"]
+    assert body["area"]["areas"] == [expand("home:LivingRoom")]
+    assert {q["metric"] for q in body["qos"]} >= {expand("cbrs:availability"), expand("cbrs:responseTime")}
+
+
+def test_service_page_of_a_requirement_and_of_something_else(client: FlaskClient) -> None:
+    body = get_json(client, "/service.json", iri="req:RobotSelfPosition")
+    assert body["role"] == "requirement" and [p["type"] for p in body["outputs"]] == [ROBOT_POSITION]
+    if "matchmaking.matchmaking" in client.application.view_functions:
+        assert urlsplit(body["match"]).path == "/match"
+        assert parse_qs(urlsplit(body["match"]).query) == {"requirement": [expand("req:RobotSelfPosition")]}
+    else:
+        assert body["match"] is None
+    get_json(client, "/service.json", 404, iri="home:RobotPosition")
+
+
+def test_services_html_pages_render(client: FlaskClient) -> None:
+    page = client.get("/services").get_data(as_text=True)
+    assert "<title>Services · cbrs</title>" in page
+    assert f'href="/service?iri={CAMERA}"' in page and 'href="/taxonomy/class?iri=home:MarkerColour"' in page
+    page = client.get("/service", query_string={"iri": CAMERA}).get_data(as_text=True)
+    assert "Six-tuple" in page and "markerColour" in page and "home:hasXCoordinate" in page
+    assert "/ceiling_camera_1/robot_location" in page
