@@ -222,3 +222,64 @@ def test_services_html_pages_render(client: FlaskClient) -> None:
     page = client.get("/service", query_string={"iri": CAMERA}).get_data(as_text=True)
     assert "Six-tuple" in page and "markerColour" in page and "home:hasXCoordinate" in page
     assert "/ceiling_camera_1/robot_location" in page
+
+
+# -- SPARQL editor ---------------------------------------------------------------------------------
+
+
+def test_editor_runs_a_named_query(client: FlaskClient, bundled_kb: KnowledgeBase) -> None:
+    text = bundled_kb.queries.get("advertisements").text
+    body = get_json(client, "/query.json", query=text)
+    result = body["result"]
+    assert result["kind"] == "select" and result["count"] == 53 and not result["truncated"]
+    assert result["vars"][:3] == ["service", "label", "kind"]
+    assert result["rows"][0]["service"]["type"] == "uri"
+    assert {e["name"] for e in body["examples"]} == set(bundled_kb.queries.names())
+
+
+def test_editor_download_links_point_at_the_endpoint(client: FlaskClient) -> None:
+    text = "SELECT ?c WHERE { ?c rdfs:subClassOf home:Position }"
+    body = get_json(client, "/query.json", query=text)
+    links = {d["format"]: d["href"] for d in body["downloads"]}
+    for short in ("csv", "json"):
+        url = urlsplit(links[short])
+        assert url.path == "/sparql" and parse_qs(url.query) == {"query": [text], "format": [short]}
+    csv = client.get(links["csv"])
+    assert csv.mimetype == "text/csv" and expand("home:RobotPosition") in csv.get_data(as_text=True)
+
+
+def test_editor_ask_and_construct(client: FlaskClient) -> None:
+    assert get_json(client, "/query.json", query="ASK { home:RobotPosition rdfs:subClassOf home:Position }")[
+        "result"
+    ] == {"kind": "ask", "boolean": True}
+    construct = "CONSTRUCT { ?c rdfs:subClassOf home:Position } WHERE { ?c rdfs:subClassOf home:Position }"
+    result = get_json(client, "/query.json", query=construct)["result"]
+    assert result["kind"] == "graph" and "RobotPosition" in result["turtle"]
+
+
+def test_editor_syntax_error_is_a_field_error(client: FlaskClient) -> None:
+    error = get_json(client, "/query.json", 400, query="SELEC ?x WHERE {}")
+    assert error["error"] == "invalid-form" and "syntax error" in error["fields"]["query"]
+    response = client.get("/query", query_string={"query": "SELEC ?x WHERE {}"})
+    page = response.get_data(as_text=True)
+    assert response.status_code == 400
+    assert 'id="query-error"' in page and "syntax error" in page and "SELEC ?x WHERE {}</textarea>" in page
+    assert "Traceback" not in page
+
+
+def test_editor_page_shows_examples_and_runs_by_post(client: FlaskClient) -> None:
+    page = client.get("/query", query_string={"example": "concept_parts"}).get_data(as_text=True)
+    assert "<title>SPARQL · cbrs</title>" in page and 'data-example="concept_parts"' in page
+    assert "# title: The hasPart children of a concept" in page and "editor.js" in page
+    response = client.post("/query", data={"query": "SELECT ?c WHERE { ?c rdfs:subClassOf home:Position }"})
+    page = response.get_data(as_text=True)
+    assert response.status_code == 200
+    assert 'class="result-table"' in page and ">home:RobotPosition</a>" in page and "format=csv" in page
+    assert client.get("/query.json", query_string={"example": "nope"}).status_code == 400
+
+
+def test_navigation_lists_the_browse_pages_but_not_the_resource_page(client: FlaskClient) -> None:
+    page = client.get("/").get_data(as_text=True)
+    for href, label in (("/taxonomy", "Taxonomy"), ("/services", "Services"), ("/query", "SPARQL")):
+        assert f'<a href="{href}">{label}</a>' in page
+    assert 'href="/resource"' not in page

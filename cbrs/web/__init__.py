@@ -26,6 +26,7 @@ PAGES: tuple[tuple[str, str, str], ...] = (
     ("overview", "overview.overview", "Overview"),
     ("taxonomy", "taxonomy.taxonomy", "Taxonomy"),
     ("services", "services.services", "Services"),
+    ("editor", "editor.editor", "SPARQL"),
 )
 
 

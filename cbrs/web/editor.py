@@ -1,0 +1,91 @@
+"""The SPARQL editor: write or pick a named query, run it with the endpoint's limits, read the result as a
+table (or Turtle), and download it from ``/sparql`` in CSV or JSON. The query travels in the URL, so a
+result can be linked to."""
+
+from __future__ import annotations
+
+import json
+import time
+from typing import Any
+
+from flask import Blueprint, request, url_for
+
+from cbrs.web import context
+from cbrs.web.pages import FormError, Page, page, wants_json
+from kb.errors import KnowledgeBaseError, QuerySyntaxError, UnknownQueryError
+
+blueprint = Blueprint("editor", __name__)
+
+MAX_ROWS = 1000  # rows shown (and in the twin); the downloads carry all of them
+FIRST_EXAMPLE = "advertisements"
+# Download formats offered for each result form: (label, the endpoint's format= short name).
+DOWNLOADS = {
+    "select": (("CSV", "csv"), ("JSON", "json"), ("TSV", "tsv"), ("XML", "xml")),
+    "graph": (("Turtle", "turtle"), ("N-Triples", "ntriples"), ("JSON-LD", "jsonld"), ("RDF/XML", "rdfxml")),
+}
+
+
+@page(blueprint, "/query", methods=["GET", "POST"])
+def editor() -> Page:
+    kb = context.kb()
+    examples = [_example(name) for name in kb.queries.names()]
+    chosen = request.values.get("example")
+    text = request.values.get("query")
+    data: dict[str, Any] = {"query": text, "example": chosen, "result": None, "downloads": [], "examples": examples}
+    shown = Page("editor.html", "SPARQL", data)
+    if text is None:
+        try:
+            data["query"] = kb.queries.get(chosen or FIRST_EXAMPLE).text
+        except UnknownQueryError as error:
+            data["query"] = ""
+            raise FormError({"example": str(error)}, page=shown) from error
+        return shown
+    if not text.strip():
+        raise FormError({"query": "write a query, or pick one of the examples"}, page=shown)
+    started = time.perf_counter()
+    try:
+        # SELECT and ASK come back as SPARQL JSON results, CONSTRUCT and DESCRIBE as Turtle
+        answer = context.sparql().query(text, short_format="turtle")
+    except QuerySyntaxError as error:
+        raise FormError({"query": str(error)}, page=shown) from error
+    except KnowledgeBaseError as error:  # a timeout, a result too large, busy workers, an evaluation error
+        if wants_json():
+            raise
+        data["failure"] = str(error)
+        shown.status = error.http_status
+        return shown
+    data["elapsed_ms"] = round((time.perf_counter() - started) * 1000, 1)
+    data["result"] = _result(answer.body, answer.media_type)
+    form = "graph" if data["result"]["kind"] == "graph" else "select"
+    data["downloads"] = [
+        {"label": label, "format": short, "href": url_for("sparql.sparql", query=text, format=short)}
+        for label, short in DOWNLOADS[form]
+    ]
+    return shown
+
+
+def _example(name: str) -> dict[str, Any]:
+    query = context.kb().queries.get(name)
+    parameters = [
+        {"name": p.name, "kind": p.kind, "required": p.required, "description": p.description}
+        for p in query.parameters.values()
+    ]
+    return {"name": name, "title": query.title, "text": query.text, "parameters": parameters}
+
+
+def _result(body: bytes, media_type: str) -> dict[str, Any]:
+    """The answer as the page shows it: ``{"kind": "select", "vars", "rows", "count", "truncated"}``,
+    ``{"kind": "ask", "boolean"}`` or ``{"kind": "graph", "turtle"}``."""
+    if media_type == "text/turtle":
+        return {"kind": "graph", "turtle": body.decode("utf-8")}
+    parsed = json.loads(body)
+    if "boolean" in parsed:
+        return {"kind": "ask", "boolean": bool(parsed["boolean"])}
+    rows = parsed["results"]["bindings"]
+    return {
+        "kind": "select",
+        "vars": parsed["head"].get("vars", []),
+        "rows": rows[:MAX_ROWS],
+        "count": len(rows),
+        "truncated": len(rows) > MAX_ROWS,
+    }
