@@ -56,7 +56,8 @@ def browser() -> Iterator[Any]:
 
 @pytest.fixture
 def page(browser: Any, server: Server) -> Iterator[Any]:
-    context = browser.new_context(base_url=f"http://127.0.0.1:{server.http_port}", viewport={"width": 1280, "height": 860})
+    base = f"http://127.0.0.1:{server.http_port}"
+    context = browser.new_context(base_url=base, viewport={"width": 1280, "height": 860})
     context.set_default_timeout(WAIT_MS)
     opened = context.new_page()
     errors: list[str] = []
@@ -83,5 +84,36 @@ def test_overview_shows_the_store(page: Any, shots: Path) -> None:
     page.goto("/")
     assert page.locator("h1").inner_text() == "Overview"
     assert int(page.locator("[data-count=services]").inner_text()) == 53
-    assert page.get_by_text("graph:ontology").is_visible()
+    assert page.get_by_role("link", name="graph:ontology").is_visible()
     snap(page, shots, "overview")
+
+
+def test_taxonomy_leads_to_the_ceiling_camera_locating_robots(page: Any, shots: Path) -> None:
+    page.goto("/")
+    page.get_by_role("navigation").get_by_role("link", name="Taxonomy").click()
+    page.locator("#q").fill("RobotLocation")
+    page.locator("#q").press("Enter")
+    page.wait_for_url("**/taxonomy?q=RobotLocation")
+    snap(page, shots, "taxonomy")
+    page.locator("#classes").get_by_role("link", name="home:RobotLocation").first.click()
+    page.wait_for_url("**/taxonomy/class?iri=*")
+    snap(page, shots, "class")
+    page.get_by_role("link", name="svc:LocateMobileRobot_CeilingCamera01").first.click()
+    assert "LocateMobileRobot" in page.locator("main").inner_text()
+    assert "home:MarkerColour" in page.locator("main").inner_text()
+    snap(page, shots, "service")
+
+
+def test_sparql_editor_runs_a_query_into_a_table(page: Any, shots: Path) -> None:
+    page.goto("/query")
+    page.locator("#query").fill("SELECT ?class WHERE { ?class rdfs:subClassOf home:Position } ORDER BY ?class")
+    page.get_by_role("button", name="Run").click()
+    page.wait_for_url("**/query?query=*")
+    cells = page.locator("table.result-table tbody tr")
+    assert cells.count() >= 3
+    assert "home:RobotPosition" in page.locator("table.result-table").inner_text()
+    assert page.locator("a[data-format=csv]").get_attribute("href").startswith("/sparql?")
+    snap(page, shots, "sparql")
+    page.locator("#query").fill("SELECT ?x WHERE {")
+    page.get_by_role("button", name="Run").click()
+    assert page.locator("#query-error").is_visible()  # the parser's message beside the editor
