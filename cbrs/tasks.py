@@ -2,10 +2,16 @@
 
 A run composes the task, executes it in a fresh headless world and records its events; listeners (the
 rosbridge topics, the browser) receive every event as it happens, from the run's thread.
+
+The runner also keeps the ceiling camera's latest view (a JPEG and a counter): taken when a run starts
+and after every step that ends, or of the idle home when nothing has run yet. Frame listeners
+(:meth:`TaskRunner.on_frame`) hear of each new frame; :meth:`TaskRunner.wait_frame` blocks (bounded)
+until one comes, for the browser's MJPEG stream.
 """
 
 from __future__ import annotations
 
+import io
 import itertools
 import logging
 import threading
@@ -29,6 +35,20 @@ Listener = Callable[[str, dict[str, Any]], None]
 
 # Topic on which the runner announces runs starting and ending (the executor's own topics carry the steps).
 RUN_TOPIC = "/cbrs/events"
+
+
+CAMERA = "CeilingCamera01"  # the view the browser shows: it covers the rooms both scenarios use
+JPEG_QUALITY = 80
+
+
+@dataclass(frozen=True)
+class CameraFrame:
+    """One view of the home: ``number`` counts up from 1 across runs; ``run`` is None for the idle home."""
+
+    number: int
+    jpeg: bytes
+    run: str | None
+    taken: float = field(default_factory=time.time)
 
 
 class TaskBusyError(KnowledgeBaseError):
@@ -91,10 +111,15 @@ class TaskRun:
 class TaskRunner:
     """Starts task runs in the simulated home, one at a time, and keeps the last ``keep`` of them."""
 
-    def __init__(self, kb: KnowledgeBase, lock: threading.RLock, keep: int = 20) -> None:
+    def __init__(self, kb: KnowledgeBase, lock: threading.RLock, keep: int = 20, camera: str | None = CAMERA) -> None:
         self.kb = kb
         self.lock = lock
         self.keep = keep
+        self.camera = camera  # None: take no frames (runs are a little faster)
+        self._frame: CameraFrame | None = None
+        self._frame_ready = threading.Condition()
+        self._frame_listeners: list[Callable[[CameraFrame], None]] = []
+        self._idle_render = threading.Lock()
         self._runs: OrderedDict[str, TaskRun] = OrderedDict()
         self._listeners: list[Listener] = []
         self._guard = threading.Lock()
@@ -106,6 +131,52 @@ class TaskRunner:
         with self._guard:
             self._listeners.append(listener)
         return lambda: self._unsubscribe(listener)
+
+    def on_frame(self, listener: Callable[[CameraFrame], None]) -> Callable[[], None]:
+        """Call ``listener(frame)`` for every new camera frame; returns the unsubscribe call."""
+        with self._guard:
+            self._frame_listeners.append(listener)
+
+        def unsubscribe() -> None:
+            with self._guard:
+                if listener in self._frame_listeners:
+                    self._frame_listeners.remove(listener)
+
+        return unsubscribe
+
+    def frame(self) -> CameraFrame | None:
+        """The latest camera frame; before any run, the idle home is rendered once (about half a second).
+
+        None when the runner takes no frames.
+        """
+        if self._frame is None and self.camera is not None:
+            self._render_idle()
+        return self._frame
+
+    @property
+    def frame_number(self) -> int:
+        """The latest frame's number (0 before the first); renders nothing."""
+        frame = self._frame
+        return frame.number if frame is not None else 0
+
+    def wait_frame(self, after: int, timeout: float) -> CameraFrame | None:
+        """The first frame numbered above ``after``, waiting at most ``timeout`` seconds; None if none came."""
+        with self._frame_ready:
+            self._frame_ready.wait_for(lambda: self._frame is not None and self._frame.number > after, timeout)
+            frame = self._frame
+        return frame if frame is not None and frame.number > after else None
+
+    def active(self) -> TaskRun | None:
+        """The run going now, if any."""
+        active = self._active
+        return active[0] if active is not None and active[1].is_alive() else None
+
+    @staticmethod
+    def components() -> list[str]:
+        """The IRIs of the simulated components, which a run may be told to fail."""
+        from sim.components import IMPLEMENTATIONS, SVC
+
+        return sorted(SVC + name for name in IMPLEMENTATIONS)
 
     def start(self, task: str, seed: int = 0, faults: Iterable[str] = ()) -> TaskRun:
         """Check ``task`` and ``faults``, then run the task in the background; returns at once."""
@@ -161,9 +232,12 @@ class TaskRunner:
             message = dict(event.message, run=run.id)
             run.events.append({"topic": event.topic, **message})
             self._emit(event.topic, message)
+            if event.topic == "/cbrs/task_progress" and message.get("event") in ("step_succeeded", "step_failed"):
+                self._capture(world, run.id)
 
         try:
             with self.lock, open_world(seed=run.seed) as world:
+                self._capture(world, run.id)
                 environment = SimEnvironment(world, self.kb)
                 result = run_task(self.kb, run.task, environment, run.faults, Composer(self.kb), follow)
                 found = result.to_dict()
@@ -181,6 +255,47 @@ class TaskRunner:
             run.done.set()
             self._emit(RUN_TOPIC, {"event": "run_finished", "run": run.id, "task": run.task, "status": run.status})
 
+    def _capture(self, world: Any, run_id: str | None) -> None:
+        """Take the camera's view of ``world`` as the latest frame (a camera failure only costs the frame)."""
+        if self.camera is None:
+            return
+        try:
+            jpeg = _jpeg(world.camera(self.camera).capture().rgb)
+        except Exception:
+            log.exception("camera frame of %s failed", run_id or "the idle home")
+            return
+        self._publish_frame(jpeg, run_id)
+
+    def _publish_frame(self, jpeg: bytes, run_id: str | None, only_first: bool = False) -> None:
+        with self._frame_ready:
+            if only_first and self._frame is not None:
+                return  # a run's frame came first: it is newer than the idle home
+            number = self._frame.number + 1 if self._frame is not None else 1
+            frame = self._frame = CameraFrame(number, jpeg, run_id)
+            self._frame_ready.notify_all()
+        with self._guard:
+            listeners = list(self._frame_listeners)
+        for listener in listeners:
+            try:
+                listener(frame)
+            except Exception:
+                log.exception("camera frame listener failed")
+
+    def _render_idle(self) -> None:
+        """Render the home as it stands before any run: open a world, take one frame, close it."""
+        from sim.world import open_world
+
+        with self._idle_render:
+            if self._frame is not None or self.active() is not None or self.camera is None:
+                return  # rendered meanwhile, or a run is about to give frames of its own
+            try:
+                with open_world(seed=0) as world:
+                    jpeg = _jpeg(world.camera(self.camera).capture().rgb)
+            except Exception:
+                log.exception("camera frame of the idle home failed")
+                return
+            self._publish_frame(jpeg, None, only_first=True)
+
     def _emit(self, topic: str, message: dict[str, Any]) -> None:
         with self._guard:
             listeners = list(self._listeners)
@@ -194,6 +309,14 @@ class TaskRunner:
         with self._guard:
             if listener in self._listeners:
                 self._listeners.remove(listener)
+
+
+def _jpeg(rgb: Any) -> bytes:
+    from PIL import Image
+
+    buffer = io.BytesIO()
+    Image.fromarray(rgb).save(buffer, "JPEG", quality=JPEG_QUALITY)
+    return buffer.getvalue()
 
 
 def _check_components(failing: tuple[str, ...]) -> None:
