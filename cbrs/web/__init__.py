@@ -27,6 +27,7 @@ PAGES: tuple[tuple[str, str, str], ...] = (
     ("taxonomy", "taxonomy.taxonomy", "Taxonomy"),
     ("services", "services.services", "Services"),
     ("editor", "editor.editor", "SPARQL"),
+    ("matchmaking", "matchmaking.matchmaking", "Matchmaking"),
 )
 
 

@@ -1,0 +1,271 @@
+"""The matchmaking page: rank the advertisements for a stored or a written requirement, with several
+methods side by side, and say why each candidate ranks where it does."""
+
+from __future__ import annotations
+
+import difflib
+import re
+import threading
+from dataclasses import dataclass, field
+from typing import Any
+
+from flask import Blueprint, current_app, request
+
+from cbrs.web import context
+from cbrs.web.pages import FormError, Page, page, wants_json
+from kb import KnowledgeBase, NotFoundError, Parameter, Requirement, Statement
+from kb.namespaces import PREFIXES, expand, shorten
+from kb.vocab import CBRS
+from reasoner.degrees import Degree
+from reasoner.matchmaker import Candidate, Matchmaker, MatchResult
+from reasoner.methods import METHODS
+from reasoner.taxonomy import TaxonomyIndex
+
+blueprint = Blueprint("matchmaking", __name__)
+
+WRITTEN_IRI = "urn:cbrs:web:written-requirement"
+DEFAULT_TOP = 10
+MAX_TOP = 50
+CONCEPT_FIELDS = ("inputs", "outputs")
+STATEMENT_FIELDS = ("preconditions", "effects")
+# Weakest first: a candidate's degree is the weakest degree among its output and effect pairs.
+DEGREE_ORDER = [Degree.FAIL.value, Degree.HAS_SUBCLASS.value, Degree.SUBCLASS_OF.value, Degree.EXACT.value]
+
+
+@dataclass
+class _Matchmakers:
+    """Matchmakers per (method, store generation); they share one taxonomy index and advertisement pool."""
+
+    generation: int = -1
+    index: TaxonomyIndex | None = None
+    built: dict[str, Matchmaker] = field(default_factory=dict)
+    guard: threading.Lock = field(default_factory=threading.Lock)
+
+    def get(self, kb: KnowledgeBase, method: str, generation: int) -> Matchmaker:
+        with self.guard:
+            if generation != self.generation or self.index is None:
+                self.generation, self.index, self.built = generation, TaxonomyIndex.from_kb(kb), {}
+            if method not in self.built:
+                shared = next(iter(self.built.values()), None)
+                ads = shared.advertisements if shared is not None else None
+                self.built[method] = Matchmaker(kb, method, index=self.index, advertisements=ads)
+            return self.built[method]
+
+
+def matchmaker(method: str) -> Matchmaker:
+    """The cached matchmaker for ``method`` over the store as it is now; call with ``context.lock()`` held."""
+    cache: _Matchmakers = current_app.extensions.setdefault("cbrs.matchmakers", _Matchmakers())
+    return cache.get(context.kb(), method, context.sparql().generation)
+
+
+@page(blueprint, "/match")
+def matchmaking() -> Page:
+    form = _form()
+    data = {"form": form, "methods": list(METHODS), "requirements": _requirements(), "rankings": []}
+    shown = Page("matchmaking.html", "Matchmaking", data)
+    if not wants_json():
+        shown.data["concepts"] = _concepts()  # for the inputs' completion; the twin need not carry them
+    if not _asked(form):
+        return shown
+    shown.title = "Matchmaking: " + (form["requirement"] or "a written requirement")
+    errors = _check_options(form)
+    if errors:
+        raise FormError(errors, page=shown)
+    with context.lock():
+        matchmakers = {method: matchmaker(method) for method in form["methods"]}
+        requirement = _requirement(form, next(iter(matchmakers.values())), shown)
+        results = [m.rank(requirement, explain=form["top"]) for m in matchmakers.values()]
+    shown.data.update(
+        requirement=_requirement_dict(requirement),
+        rankings=[_ranking(result, form["top"], requirement) for result in results],
+    )
+    return shown
+
+
+def _concepts() -> list[str]:
+    with context.lock():
+        nodes = matchmaker("sem-str").index.nodes()
+    return sorted(name for name in map(shorten, nodes) if "://" not in name)
+
+
+# -- the form ------------------------------------------------------------------------------------
+
+
+def _form() -> dict[str, Any]:
+    args = request.args
+    form: dict[str, Any] = {name: args.get(name, "").strip() for name in ("requirement", "top")}
+    for name in (*CONCEPT_FIELDS, *STATEMENT_FIELDS):
+        form[name] = args.get(name, "").strip()
+    form["methods"] = [m for m in args.getlist("methods") if m] or ["sem-str"]
+    return form
+
+
+def _asked(form: dict[str, Any]) -> bool:
+    """Whether the form was sent (any of its fields is in the URL), even with nothing in it."""
+    return any(name in request.args for name in ("requirement", *CONCEPT_FIELDS, *STATEMENT_FIELDS))
+
+
+def _check_options(form: dict[str, Any]) -> dict[str, str]:
+    errors = {}
+    unknown = [m for m in form["methods"] if m not in METHODS]
+    if unknown:
+        errors["methods"] = f"no method {', '.join(map(repr, unknown))}; choose among {', '.join(METHODS)}"
+    form["methods"] = [m for m in dict.fromkeys(form["methods"]) if m in METHODS] or ["sem-str"]
+    top = form["top"] or str(DEFAULT_TOP)
+    if not top.isdigit() or not 1 <= int(top) <= MAX_TOP:
+        errors["top"] = f"{form['top']!r} is not a number from 1 to {MAX_TOP}"
+    else:
+        form["top"] = int(top)
+    written = any(form[name] for name in (*CONCEPT_FIELDS, *STATEMENT_FIELDS))
+    if form["requirement"] and written:
+        errors["requirement"] = "choose a stored requirement or write one below, not both (clear this choice)"
+    elif not form["requirement"] and not written:
+        errors["requirement"] = "choose a stored requirement, or write one: inputs, outputs, effects"
+    return errors
+
+
+def _requirement(form: dict[str, Any], any_matchmaker: Matchmaker, shown: Page) -> Requirement:
+    if form["requirement"]:
+        return _stored(form["requirement"], shown)
+    index = any_matchmaker.index
+    errors: dict[str, str] = {}
+    concepts: dict[str, list[str]] = {}
+    statements: dict[str, list[Statement]] = {}
+    for name in CONCEPT_FIELDS:
+        try:
+            concepts[name] = [_concept(term, index) for term in _terms(form[name])]
+        except ValueError as error:
+            errors[name] = str(error)
+    for name in STATEMENT_FIELDS:
+        try:
+            statements[name] = _statements(form[name], index)
+        except ValueError as error:
+            errors[name] = str(error)
+    if errors:
+        raise FormError(errors, page=shown)
+    kb = context.kb()
+
+    def parameters(direction: str) -> tuple[Parameter, ...]:
+        return tuple(
+            # KnowledgeBase offers part trees only through descriptions; reasoner/testbed.py reads them so too.
+            Parameter(f"{WRITTEN_IRI}/{direction}{i}", direction, c, None, kb._reader.part_tree(c))  # type: ignore[arg-type]
+            for i, c in enumerate(concepts[direction + "s"], start=1)
+        )
+
+    return Requirement(
+        iri=WRITTEN_IRI,
+        types=(CBRS.Requirement,),
+        label="written requirement",
+        inputs=parameters("input"),
+        outputs=parameters("output"),
+        preconditions=tuple(statements["preconditions"]),
+        effects=tuple(statements["effects"]),
+    )
+
+
+def _stored(name: str, shown: Page) -> Requirement:
+    try:
+        iri = expand(name if ":" in name else f"req:{name}")
+        found = context.kb().description(iri)
+    except (ValueError, NotFoundError) as error:
+        raise FormError({"requirement": str(error)}, page=shown) from None
+    if not isinstance(found, Requirement):
+        raise FormError({"requirement": f"{name} is an advertisement, not a requirement"}, page=shown)
+    return found
+
+
+def _terms(text: str) -> list[str]:
+    return [t for t in re.split(r"[\s,;]+", text) if t]
+
+
+def _concept(term: str, index: TaxonomyIndex) -> str:
+    prefix = term.partition(":")[0]
+    if not term.startswith("<") and prefix not in PREFIXES and prefix not in ("http", "https", "urn"):
+        raise ValueError(f"{term}: {prefix}: is not a known prefix; use one of {', '.join(PREFIXES)}")
+    iri = expand(term)
+    if iri not in index:
+        near = difflib.get_close_matches(term, [shorten(n) for n in index.nodes()], n=3, cutoff=0.75)
+        hint = f"; did you mean {' or '.join(near)}?" if near else "; concepts are prefixed names, e.g. home:Cup"
+        raise ValueError(f"{term} is not a concept or property of the ontology{hint}")
+    return iri
+
+
+def _statements(text: str, index: TaxonomyIndex) -> list[Statement]:
+    """One statement a line: ``subject predicate object``, prefixed names (brackets and commas allowed)."""
+    found = []
+    for number, line in enumerate(text.splitlines(), start=1):
+        terms = _terms(line.strip().strip("()"))
+        if not terms:
+            continue
+        if len(terms) != 3:
+            raise ValueError(f"line {number}: {line.strip()!r} is not 'subject predicate object'")
+        s, p, o = (_concept(t, index) for t in terms)
+        found.append(Statement(s, p, o))
+    return found
+
+
+def _requirements() -> list[dict[str, str | None]]:
+    with context.lock():
+        found = context.kb().requirements()
+    return [{"iri": r.iri, "name": shorten(r.iri), "label": r.label} for r in sorted(found, key=lambda r: r.iri)]
+
+
+# -- the answer ----------------------------------------------------------------------------------
+
+
+def _requirement_dict(requirement: Requirement) -> dict[str, Any]:
+    def statement(s: Statement) -> list[str]:
+        return [s.subject, s.predicate, s.object]
+
+    return {
+        "iri": requirement.iri,
+        "name": shorten(requirement.iri),
+        "label": requirement.label,
+        "written": requirement.iri == WRITTEN_IRI,
+        "inputs": [p.type for p in requirement.inputs],
+        "outputs": [p.type for p in requirement.outputs],
+        "preconditions": [statement(s) for s in requirement.preconditions],
+        "effects": [statement(s) for s in requirement.effects],
+    }
+
+
+def _ranking(result: MatchResult, top: int, requirement: Requirement) -> dict[str, Any]:
+    outputs = {p.type for p in requirement.outputs}
+    return {
+        "method": result.method,
+        "status": result.status.value,
+        "count": len(result.candidates),
+        "candidates": [_candidate(rank, c, outputs) for rank, c in enumerate(result.candidates[:top], start=1)],
+    }
+
+
+def _candidate(rank: int, c: Candidate, outputs: set[str]) -> dict[str, Any]:
+    # The logic degree of the whole: the weakest over the requested outputs (not their parts) and effects.
+    degrees = [
+        p.degree
+        for p in c.pairs
+        if ((p.role == "output" and p.requested in outputs) or p.role == "effect") and p.degree in DEGREE_ORDER
+    ]
+    return {
+        "rank": rank,
+        "advertisement": c.advertisement,
+        "name": shorten(c.advertisement),
+        "label": c.label,
+        "score": c.score,
+        "parts": c.parts,
+        "degree": min(degrees, key=DEGREE_ORDER.index) if degrees else None,
+        "acceptable": c.acceptable,
+        "rejected_by": list(c.rejected_by),
+        "lacks": list(c.lacks),
+        "explanation": [
+            {
+                "role": p.role,
+                "wanted": p.requested,
+                "offered": p.advertised,
+                "similarity": round(p.similarity, 4),
+                "degree": p.degree,
+                "how": p.how,
+            }
+            for p in c.pairs
+        ],
+    }
