@@ -28,6 +28,8 @@ PAGES: tuple[tuple[str, str, str], ...] = (
     ("services", "services.services", "Services"),
     ("editor", "editor.editor", "SPARQL"),
     ("matchmaking", "matchmaking.matchmaking", "Matchmaking"),
+    ("plans", "plans.plans", "Plans"),
+    ("matchmaking", "matchmaking.matchmaking", "Matchmaking"),
 )
 
 

@@ -1,0 +1,112 @@
+"""The plans page: compose a task into a plan of service invocations, as ``cbrs plan`` does, and draw
+its service resource graph."""
+
+from __future__ import annotations
+
+import tempfile
+from pathlib import Path
+from typing import Any
+
+from flask import Blueprint, Response, request, url_for
+
+from actions.composer import ComposeConfig, Composer, CompositionResult, Objective, store_plan
+from actions.errors import UnknownTaskError
+from actions.model import ActionLibrary
+from cbrs.web import context
+from cbrs.web.pages import FormError, Page, page
+from kb.namespaces import shorten
+
+blueprint = Blueprint("plans", __name__)
+
+OBJECTIVES = [o.value for o in Objective]
+
+
+@page(blueprint, "/plans")
+def plans() -> Page:
+    task = request.args.get("task", "").strip()
+    objective = request.args.get("objective", "").strip() or Objective.SIMILARITY.value
+    options = _tasks()
+    data: dict[str, Any] = {"task": task, "objective": objective, "objectives": OBJECTIVES, "tasks": options}
+    data["selected"] = _selected(task, options)
+    shown = Page("plans.html", "Plans", data)
+    if "task" not in request.args:
+        return shown
+    shown.title = f"Plan for {task}" if task else "Plans"
+    with context.lock():
+        result = _compose(task, objective, shown)
+        if result.plan is not None:
+            store_plan(context.kb(), result.plan)  # as cbrs plan does: the plans graph holds the latest
+    data["composition"] = _composition(result)
+    data["graph"] = url_for("plans.graph", task=task, objective=objective)
+    return shown
+
+
+@blueprint.get("/plans/graph.svg")
+def graph() -> Response:
+    """The service resource graph of the task's composition, with the chosen plan, as SVG."""
+    task = request.args.get("task", "").strip()
+    objective = request.args.get("objective", "").strip() or Objective.SIMILARITY.value
+    with context.lock():  # pyplot is not thread-safe either
+        result = _compose(task, objective, None)
+        svg = _svg(result)
+    return Response(svg, mimetype="image/svg+xml", headers={"Cache-Control": "no-cache"})
+
+
+def _compose(task: str, objective: str, shown: Page | None) -> CompositionResult:
+    """Call with ``context.lock()`` held."""
+    if objective not in OBJECTIVES:
+        raise FormError({"objective": f"{objective!r} is not one of {', '.join(OBJECTIVES)}"}, page=shown)
+    if not task:
+        raise FormError({"task": "choose a task: a requirement or an action"}, page=shown)
+    composer = Composer(context.kb(), ComposeConfig(objective=Objective(objective)))
+    try:
+        return composer.compose(task)
+    except UnknownTaskError as error:
+        known = ", ".join(error.known)
+        raise FormError(
+            {"task": f"no requirement or action named {task!r}; known tasks: {known}"}, page=shown
+        ) from None
+
+
+def _svg(result: CompositionResult) -> bytes:
+    from actions.draw import draw  # matplotlib is slow to import; only when a drawing is asked for
+
+    with tempfile.TemporaryDirectory(prefix="cbrs-srg-") as folder:
+        return draw(result, Path(folder) / "graph.svg").read_bytes()
+
+
+def _tasks() -> dict[str, list[dict[str, str | None]]]:
+    """What can be planned: the requirements, and the action classes that have sub-actions."""
+    kb = context.kb()
+    with context.lock():
+        requirements = kb.requirements()
+        library = ActionLibrary.from_kb(kb)
+    return {
+        "requirements": [{"name": shorten(r.iri), "label": r.label} for r in sorted(requirements, key=lambda r: r.iri)],
+        "actions": [
+            {"name": shorten(a.iri), "label": a.label} for a in sorted(library, key=lambda a: a.iri) if a.sub_actions
+        ],
+    }
+
+
+def _selected(task: str, options: dict[str, list[dict[str, str | None]]]) -> str | None:
+    """The option a task name means: a bare name is a requirement first, as for ``resolve_task``."""
+    names = [str(t["name"]) for group in ("requirements", "actions") for t in options[group]]
+    return next((n for n in names if task in (n, n.partition(":")[2])), None)
+
+
+def _composition(result: CompositionResult) -> dict[str, Any]:
+    """``cbrs plan --json``'s shape, with each binding's source said in words for the page."""
+    found = result.to_dict()
+    for step in found.get("steps", []):
+        for binding in (*step["inputs"], *step["preconditions"]):
+            binding["source"] = _source(binding)
+    for goal in found.get("goals", []):
+        goal["source"] = _source(goal)
+    return found
+
+
+def _source(binding: dict[str, Any]) -> str:
+    origin = binding["from"]
+    where = "requirement" if "step" not in origin else f"#{origin['step']}"
+    return f"{where}.{origin['name']}" if binding["role"] == "input" else where
