@@ -29,7 +29,7 @@ PAGES: tuple[tuple[str, str, str], ...] = (
     ("editor", "editor.editor", "SPARQL"),
     ("matchmaking", "matchmaking.matchmaking", "Matchmaking"),
     ("plans", "plans.plans", "Plans"),
-    ("matchmaking", "matchmaking.matchmaking", "Matchmaking"),
+    ("tasks", "tasks.tasks", "Tasks"),
 )
 
 

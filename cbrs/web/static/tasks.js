@@ -1,0 +1,206 @@
+// The tasks page, live: follows /tasks/events (server-sent events) and keeps the step table, the event
+// list, the status badge, the camera's frame counter and the recent runs current. No dependencies.
+(function () {
+  "use strict";
+  const live = document.getElementById("live");
+  if (!live || !window.EventSource) return;
+
+  const follow = live.dataset.follow; // "latest", or the id of the run this page shows
+  const prefixes = JSON.parse(live.dataset.prefixes || "{}");
+  const resource = live.dataset.resource;
+  const byId = (id) => document.getElementById(id);
+  const steps = byId("steps");
+  const eventList = byId("event-list");
+  const badge = byId("run-status");
+  const runName = byId("run-name");
+  const verdict = byId("verdict");
+  const frameCount = byId("frame");
+  const camera = byId("camera");
+  const streamState = byId("stream-state");
+  let current = live.dataset.run || null;
+  const MAX_EVENTS = 300;
+
+  function shorten(iri) {
+    let best = "";
+    for (const [prefix, namespace] of Object.entries(prefixes)) {
+      if (iri.startsWith(namespace) && namespace.length > (prefixes[best] || "").length) best = prefix;
+    }
+    const local = best ? iri.slice(prefixes[best].length) : "";
+    return local && /^[\w.-]+$/.test(local) ? best + ":" + local : iri;
+  }
+
+  function el(tag, attrs, ...children) {
+    const node = document.createElement(tag);
+    for (const [name, value] of Object.entries(attrs || {})) node.setAttribute(name, value);
+    for (const child of children) node.append(child);
+    return node;
+  }
+
+  function iriLink(iri) {
+    if (!resource) return el("span", { title: iri }, shorten(iri));
+    return el("a", { href: resource + "?iri=" + encodeURIComponent(iri), title: iri }, shorten(iri));
+  }
+
+  function setBadge(status) {
+    badge.textContent = status;
+    badge.className = "badge status-" + status;
+    live.dataset.status = status;
+  }
+
+  function row(step) {
+    let tr = steps.querySelector('tr[data-step="' + step + '"]');
+    if (!tr) {
+      tr = el("tr", { "data-step": String(step) }, el("td", { class: "num" }, String(step)), el("td"), el("td"));
+      tr.tried = [];
+      steps.append(tr);
+    }
+    if (!tr.tried) tr.tried = Array.from(tr.querySelectorAll("td:nth-child(2) [title]"), (a) => a.title);
+    return tr;
+  }
+
+  function stepEvent(message) {
+    const tr = row(message.step);
+    const [, who, state] = tr.children;
+    if (message.event === "step_started" && !tr.tried.includes(message.component)) {
+      tr.tried.push(message.component);
+      who.replaceChildren();
+      tr.tried.forEach((iri, i) => {
+        if (i) who.append(" ", el("span", { class: "arrow", "aria-label": "failed over to" }, "→"), " ");
+        who.append(iriLink(iri));
+      });
+    }
+    const status = { step_started: "started", step_succeeded: "succeeded", step_failed: "failed" }[message.event];
+    state.replaceChildren(el("span", { class: "badge status-" + status }, status));
+    if (message.reason) state.append(el("br"), el("span", { class: "small muted" }, message.reason));
+    tr.className = "step-" + status + (tr.tried.length > 1 || message.failover ? " failover" : "");
+  }
+
+  function listEvent(message) {
+    const parts = [el("code", {}, message.topic || ""), " " + (message.event || message.state || message.status || "")];
+    if (message.step) parts.push(" · step " + message.step);
+    if (message.component) parts.push(" · " + shorten(message.component));
+    if (message.reason) parts.push(" · ", el("span", { class: "muted" }, message.reason));
+    if (message.failover) parts.push(" · failover to " + shorten(message.failover));
+    eventList.prepend(el("li", {}, ...parts));
+    while (eventList.children.length > MAX_EVENTS) eventList.lastChild.remove();
+  }
+
+  function startRun(id, task) {
+    current = id;
+    steps.replaceChildren();
+    eventList.replaceChildren();
+    verdict.textContent = "";
+    runName.replaceChildren(el("a", { href: live.dataset.runs + "/" + id }, id), " · " + task);
+    setBadge("running");
+    restartCamera();
+  }
+
+  function restartCamera() {
+    // The stream ends by itself when idle; a new run deserves a fresh one.
+    camera.src = live.dataset.stream + "?t=" + Date.now();
+  }
+
+  function showFrame(number) {
+    if (number > Number(frameCount.dataset.frame || 0)) {
+      frameCount.dataset.frame = String(number);
+      frameCount.textContent = String(number);
+    }
+  }
+
+  async function refreshRuns() {
+    const response = await fetch(live.dataset.runs + ".json", { headers: { Accept: "application/json" } });
+    if (!response.ok) return;
+    const data = await response.json();
+    const body = byId("runs");
+    if (!body) return;
+    body.replaceChildren(
+      ...data.runs.map((r) =>
+        el(
+          "tr",
+          {},
+          el("td", {}, el("a", { href: r.url }, r.id)),
+          el("td", {}, r.task),
+          el("td", { class: "num" }, String(r.seed)),
+          el("td", {}, r.faults.join(", ") || "–"),
+          el("td", {}, el("span", { class: "badge status-" + r.status }, r.status)),
+          el("td", { class: "num" }, r.finished ? (r.finished - r.started).toFixed(1) : "…"),
+        ),
+      ),
+    );
+  }
+
+  async function catchUp(id) {
+    // Events sent before this page subscribed: rebuild the table and the list from the run's record.
+    const response = await fetch(live.dataset.runs + "/" + encodeURIComponent(id) + ".json");
+    if (!response.ok) return;
+    const run = await response.json();
+    if (current !== id) startRun(id, run.task);
+    steps.replaceChildren();
+    eventList.replaceChildren();
+    run.events.forEach(handleRunEvent);
+    setBadge(run.status);
+  }
+
+  function handleRunEvent(message) {
+    if (message.topic === "/cbrs/task_progress") stepEvent(message);
+    if (message.topic === "/cbrs/task") verdict.textContent = message.status + (message.reason ? ": " + message.reason : "");
+    if (message.event === "run_finished") setBadge(message.status);
+    listEvent(message);
+  }
+
+  function handle(message) {
+    if (message.event === "hello") {
+      showFrame(message.frame);
+      const mine = follow === "latest" || follow === message.active;
+      if (message.active && mine) catchUp(message.active);
+      else if (live.dataset.status === "running" && current) catchUp(current); // it ended while we were away
+      return;
+    }
+    if (message.event === "frame") return showFrame(message.frame);
+    if (message.event === "store_updated") return;
+    if (message.event === "run_started" && follow === "latest") startRun(message.run, message.task);
+    if (message.run !== current) return;
+    handleRunEvent(message);
+    if (message.event === "run_finished") refreshRuns();
+  }
+
+  const source = new EventSource(live.dataset.events);
+  source.onopen = () => (streamState.textContent = "· live");
+  source.onerror = () => (streamState.textContent = "· reconnecting…");
+  source.onmessage = (event) => handle(JSON.parse(event.data));
+  source.addEventListener("end", () => (streamState.textContent = "· paused, reconnecting…"));
+
+  // Start a run without leaving the page; the form still works without this script.
+  const form = byId("start");
+  if (form) {
+    form.addEventListener("submit", async (event) => {
+      event.preventDefault();
+      const button = byId("start-button");
+      button.disabled = true;
+      form.parentElement.querySelectorAll(".field-error, .form-message").forEach((node) => node.remove());
+      try {
+        const response = await fetch(form.action + ".json", {
+          method: "POST",
+          body: new URLSearchParams(new FormData(form)),
+        });
+        const data = await response.json();
+        let note;
+        if (response.status === 202) {
+          startRun(data.started.id, data.started.task);
+          note = el("p", { class: "ok-box form-message", role: "status" }, data.message);
+        } else if (data.fields) {
+          for (const [name, text] of Object.entries(data.fields)) {
+            const field = byId(name);
+            if (field) field.after(el("span", { class: "field-error", id: name + "-error", role: "alert" }, text));
+          }
+        } else {
+          const link = data.running ? el("a", { href: live.dataset.runs + "/" + data.running }, data.running) : "";
+          note = el("p", { class: "error-box form-message", role: "alert" }, data.message + " ", link);
+        }
+        if (note) form.before(note);
+      } finally {
+        button.disabled = false;
+      }
+    });
+  }
+})();

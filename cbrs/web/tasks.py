@@ -1,0 +1,308 @@
+"""The tasks page: start one of the paper's scenarios in the simulated home and follow it live.
+
+Live updates travel as server-sent events (``/tasks/events``) and the ceiling camera as an MJPEG
+stream (``/camera.mjpg``). Each open stream holds one of waitress's request threads, so both end by
+themselves: after ``CBRS_STREAM_SECONDS`` at most, or ``CBRS_STREAM_IDLE_SECONDS`` without news, or as
+soon as a write finds the client gone (a heartbeat or a repeated frame every few seconds makes sure
+one is tried). The browser's EventSource reconnects by itself; the page restarts the camera stream
+when a run starts.
+"""
+
+from __future__ import annotations
+
+import json
+import queue
+import time
+from collections.abc import Iterator
+from typing import Any
+
+from flask import Blueprint, Response, current_app, request, url_for
+from flask.sansio.blueprints import BlueprintSetupState
+from werkzeug.exceptions import Forbidden, NotFound, ServiceUnavailable
+
+from cbrs.tasks import CameraFrame, TaskBusyError, TaskRun, UnknownComponentError
+from cbrs.web import context
+from cbrs.web.pages import FormError, Page, page, wants_json
+from kb.namespaces import PREFIXES, expand, shorten
+
+blueprint = Blueprint("tasks", __name__)
+
+TASKS = ("RobotArmServeACup", "FetchMyPen")  # the paper's scenarios; FetchMyPen is the web-initiated one
+DEFAULTS = {
+    "CBRS_STREAM_SECONDS": 600.0,  # the longest a stream lives; EventSource reconnects after it ends
+    "CBRS_STREAM_IDLE_SECONDS": 120.0,  # a stream with no event (no new frame) this long ends
+    "CBRS_HEARTBEAT_SECONDS": 5.0,  # an SSE comment this often, so a gone client is noticed
+    "CBRS_CAMERA_REPEAT_SECONDS": 2.0,  # the last frame again this often, so the browser keeps showing it
+}
+QUEUE_SIZE = 1000  # events a slow client may fall behind by before its stream ends (a run sends ~150)
+BOUNDARY = "frame"
+STEP_EVENTS = ("step_started", "step_succeeded", "step_failed")
+
+
+@blueprint.record_once
+def _defaults(state: BlueprintSetupState) -> None:
+    for name, value in DEFAULTS.items():
+        state.app.config.setdefault(name, value)
+
+
+@page(blueprint, "/tasks", methods=["GET", "POST"])
+def tasks() -> Page:
+    """The scenarios to start, the run going now (or the last one), the camera and the recent runs.
+
+    A POST starts a run (202); while one is going it is refused with 409 and says which.
+    """
+    form = _form()
+    shown = Page("tasks.html", "Tasks", {"mode": "tasks", **_overview(form)})
+    _for_script(shown)
+    if request.method != "POST":
+        return shown
+    _same_origin()
+    task, seed, faults = _checked(form, shown)
+    try:
+        started = context.tasks().start(task, seed, faults)
+    except UnknownComponentError as error:
+        raise FormError({"fail": str(error)}, page=shown) from None
+    except TaskBusyError as error:
+        shown.status = 409
+        shown.data.update(error="busy", message=str(error), running=error.running)
+        return shown
+    shown.status = 202
+    shown.title = f"Tasks: {started.id} started"
+    shown.data.update(_overview(form), started=_summary(started), message=f"{started.id} started: {started.task}")
+    return shown
+
+
+@page(blueprint, "/tasks/<run_id>")
+def run(run_id: str) -> Page:
+    """One run: its steps, every event it published, and its result (the plan and execution report)."""
+    found = context.tasks().get(run_id)  # an unknown run: 404
+    data = {"mode": "run", "run": _detail(found), **_live()}
+    return _for_script(Page("tasks.html", f"Run {found.id}: {found.task}, {found.status}", data))
+
+
+def _for_script(shown: Page) -> Page:
+    if not wants_json():
+        shown.data["prefixes"] = PREFIXES  # tasks.js shortens IRIs as the server does
+    return shown
+
+
+def _form() -> dict[str, Any]:
+    body = request.get_json(silent=True) if request.is_json else None
+    if isinstance(body, dict):
+        fail = body.get("fail", [])
+        return {
+            "task": str(body.get("task", "")),
+            "seed": str(body.get("seed", 0)),
+            "fail": [str(f) for f in (fail if isinstance(fail, list) else [fail])],
+        }
+    values = request.form if request.method == "POST" else request.args
+    return {
+        "task": values.get("task", TASKS[-1]).strip(),
+        "seed": values.get("seed", "0").strip(),
+        "fail": [f.strip() for f in values.getlist("fail") if f.strip()],
+    }
+
+
+def _checked(form: dict[str, Any], shown: Page) -> tuple[str, int, list[str]]:
+    errors = {}
+    if form["task"] not in TASKS:
+        errors["task"] = f"{form['task']!r} is not one of {', '.join(TASKS)}"
+    seed = 0
+    try:
+        seed = int(form["seed"] or "0")
+    except ValueError:
+        errors["seed"] = f"{form['seed']!r} is not a whole number"
+    faults = []
+    for name in form["fail"]:
+        try:
+            faults.append(expand(name))
+        except ValueError as error:
+            errors["fail"] = str(error)
+    if errors:
+        raise FormError(errors, page=shown)
+    return form["task"], seed, faults
+
+
+def _same_origin() -> None:
+    """Starting a run moves a (simulated) robot: refuse forms that other sites' pages post here."""
+    origin = request.headers.get("Origin")
+    if origin is not None and origin.rstrip("/") != request.host_url.rstrip("/"):
+        raise Forbidden(f"a task may be started only from this server's own pages, not from {origin}")
+
+
+def _overview(form: dict[str, Any]) -> dict[str, Any]:
+    runner = context.tasks()
+    active = runner.active()
+    runs = runner.runs()
+    latest = active or (runs[-1] if runs else None)
+    return {
+        "form": form,
+        "tasks": list(TASKS),
+        "components": [shorten(c) for c in runner.components()],
+        "active": _detail(latest) if latest is not None else None,
+        "runs": [_summary(r) for r in reversed(runs)],
+        **_live(),
+    }
+
+
+def _live() -> dict[str, Any]:
+    """Where the page follows runs: the event stream, and the camera with its latest frame's number."""
+    camera = {
+        "frame": context.tasks().frame_number,
+        "stream": url_for("tasks.camera"),
+        "still": url_for("tasks.snapshot"),
+    }
+    return {"event_stream": url_for("tasks.events"), "camera": camera}
+
+
+def _summary(found: TaskRun) -> dict[str, Any]:
+    data = found.to_dict(with_events=False)
+    data.pop("result", None)
+    data["faults"] = [shorten(f) for f in found.faults]
+    data["url"] = url_for("tasks.run", run_id=found.id)
+    return data
+
+
+def _detail(found: TaskRun) -> dict[str, Any]:
+    data = found.to_dict()
+    data["url"] = url_for("tasks.run", run_id=found.id)
+    data["steps"] = steps(data["events"])
+    return data
+
+
+def steps(events: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """One row per plan step from a run's progress events: the components tried, in order, and the outcome."""
+    rows: dict[int, dict[str, Any]] = {}
+    for event in events:
+        if event.get("topic", "/cbrs/task_progress") != "/cbrs/task_progress" or event.get("event") not in STEP_EVENTS:
+            continue
+        row = rows.setdefault(event["step"], {"step": event["step"], "tried": [], "status": "started", "reasons": []})
+        if event["event"] == "step_started":
+            if event["component"] not in row["tried"]:
+                row["tried"].append(event["component"])
+            row["status"] = "started"
+        elif event["event"] == "step_succeeded":
+            row["status"] = "succeeded"
+        else:
+            row["status"] = "failed"
+            row["reasons"].append(event.get("reason", ""))
+            row["failover"] = event.get("failover")
+    for row in rows.values():
+        row["failed_over"] = len(row["tried"]) > 1 or bool(row.get("failover"))
+    return [rows[k] for k in sorted(rows)]
+
+
+# -- live updates ----------------------------------------------------------------------------------
+
+
+@blueprint.get("/tasks/events")
+def events() -> Response:
+    """Every task runner event as it happens, and the camera's frame numbers, as server-sent events."""
+    config = current_app.config
+    runner = context.tasks()
+    life = float(config["CBRS_STREAM_SECONDS"])
+    idle = float(config["CBRS_STREAM_IDLE_SECONDS"])
+    beat = float(config["CBRS_HEARTBEAT_SECONDS"])
+
+    def stream() -> Iterator[str]:
+        inbox: queue.Queue[dict[str, Any]] = queue.Queue(QUEUE_SIZE)
+        overflow: list[bool] = []
+
+        def put(message: dict[str, Any]) -> None:
+            try:
+                inbox.put_nowait(message)
+            except queue.Full:
+                overflow.append(True)
+
+        def on_frame(frame: CameraFrame) -> None:
+            put({"topic": "/cbrs/camera", "event": "frame", "frame": frame.number, "run": frame.run})
+
+        # Subscribed here, not before: a generator closed before it starts runs no finally.
+        unsubscribe = [
+            runner.subscribe(lambda topic, message: put({"topic": topic, **message})),
+            runner.on_frame(on_frame),
+        ]
+        try:
+            active = runner.active()
+            yield "retry: 3000\n\n"
+            yield _sse({"event": "hello", "active": active.id if active else None, "frame": runner.frame_number})
+            started = last = time.monotonic()
+            reason = "idle"
+            while True:
+                now = time.monotonic()
+                if now - started >= life:
+                    reason = "life"
+                    break
+                if now - last >= idle:
+                    break
+                try:
+                    message = inbox.get(timeout=max(0.01, min(beat, life - (now - started), idle - (now - last))))
+                except queue.Empty:
+                    yield ": heartbeat\n\n"
+                    continue
+                if overflow:
+                    reason = "overflow"
+                    break
+                last = time.monotonic()
+                yield _sse(message)
+            yield "event: end\n" + _sse({"event": "end", "reason": reason})
+        finally:
+            for call in unsubscribe:
+                call()
+
+    return Response(stream(), mimetype="text/event-stream", headers=_no_buffering())
+
+
+@blueprint.get("/camera.mjpg")
+def camera() -> Response:
+    """The ceiling camera as ``multipart/x-mixed-replace``: the frame now, each new one, the last again every ~2 s."""
+    config = current_app.config
+    runner = context.tasks()
+    life = float(config["CBRS_STREAM_SECONDS"])
+    idle = float(config["CBRS_STREAM_IDLE_SECONDS"])
+    repeat = float(config["CBRS_CAMERA_REPEAT_SECONDS"])
+    first = runner.frame()
+    if first is None:
+        raise ServiceUnavailable("this server takes no camera frames")
+
+    def stream(frame: CameraFrame) -> Iterator[bytes]:
+        started = last = time.monotonic()
+        yield _part(frame)
+        while True:
+            now = time.monotonic()
+            if now - started >= life or now - last >= idle:
+                return
+            newer = runner.wait_frame(frame.number, max(0.01, min(repeat, life - (now - started))))
+            if newer is not None:
+                frame, last = newer, time.monotonic()
+            yield _part(frame)
+
+    mimetype = f"multipart/x-mixed-replace; boundary={BOUNDARY}"
+    return Response(stream(first), headers={**_no_buffering(), "Content-Type": mimetype})
+
+
+@blueprint.get("/camera.jpg")
+def snapshot() -> Response:
+    """The ceiling camera's latest frame, once (its number in ``X-Frame``)."""
+    frame = context.tasks().frame()
+    if frame is None:
+        raise NotFound("this server takes no camera frames")
+    return Response(
+        frame.jpeg, mimetype="image/jpeg", headers={"Cache-Control": "no-store", "X-Frame": str(frame.number)}
+    )
+
+
+def _sse(message: dict[str, Any]) -> str:
+    return f"data: {json.dumps(message, separators=(',', ':'))}\n\n"
+
+
+def _part(frame: CameraFrame) -> bytes:
+    head = (
+        f"--{BOUNDARY}\r\nContent-Type: image/jpeg\r\nContent-Length: {len(frame.jpeg)}\r\n"
+        f"X-Frame: {frame.number}\r\n\r\n"
+    )
+    return head.encode("ascii") + frame.jpeg + b"\r\n"
+
+
+def _no_buffering() -> dict[str, str]:
+    return {"Cache-Control": "no-store", "X-Accel-Buffering": "no"}
