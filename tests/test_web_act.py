@@ -1,0 +1,262 @@
+"""The pages that act: matchmaking, plans and tasks (with their live event and camera streams).
+
+Flask's test client throughout; streamed responses are read a bounded number of chunks, and every
+wait on a run is bounded.
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+import time
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+from flask import Flask
+from flask.testing import FlaskClient
+
+from cbrs.sparql_service import SparqlService
+from cbrs.tasks import TaskRunner
+from cbrs.web import create_app
+from kb import KnowledgeBase
+from kb.namespaces import expand
+
+RUN_WAIT = 120.0
+CAMERA = "svc:LocateMobileRobot_CeilingCamera01"
+
+
+@pytest.fixture(scope="module")
+def shared_kb() -> Iterator[KnowledgeBase]:
+    """One seeded store for the read-only pages (plans write only the plans graph, as cbrs plan does)."""
+    kb = KnowledgeBase.open(":memory:")
+    yield kb
+    kb.close()
+
+
+@pytest.fixture(scope="module")
+def client(shared_kb: KnowledgeBase) -> FlaskClient:
+    sparql = SparqlService(shared_kb)
+    return create_app(sparql, tasks=TaskRunner(shared_kb, sparql.lock)).test_client()
+
+
+@pytest.fixture
+def live(fresh_bundled_kb: KnowledgeBase) -> Iterator[tuple[Flask, TaskRunner]]:
+    """An app over a fresh store whose streams live briefly."""
+    sparql = SparqlService(fresh_bundled_kb)
+    runner = TaskRunner(fresh_bundled_kb, sparql.lock)
+    app = create_app(sparql, tasks=runner)
+    app.config.update(
+        CBRS_STREAM_SECONDS=60.0,
+        CBRS_STREAM_IDLE_SECONDS=1.5,
+        CBRS_HEARTBEAT_SECONDS=0.3,
+        CBRS_CAMERA_REPEAT_SECONDS=0.2,
+    )
+    yield app, runner
+    runner.close(RUN_WAIT)
+
+
+def start(client: FlaskClient, task: str = "FetchMyPen", **form: Any) -> Any:
+    return client.post("/tasks.json", data={"task": task, **form})
+
+
+def wait_done(runner: TaskRunner, run_id: str) -> None:
+    assert runner.get(run_id).done.wait(RUN_WAIT), f"{run_id} did not end within {RUN_WAIT:g} s"
+
+
+# -- matchmaking -----------------------------------------------------------------------------------
+
+
+def test_stored_requirement_ranks_the_ceiling_camera_first_with_explanations(client: FlaskClient) -> None:
+    response = client.get("/match.json", query_string={"requirement": "req:RobotSelfPosition"})
+    assert response.status_code == 200
+    body = response.get_json()
+    assert body["requirement"]["name"] == "req:RobotSelfPosition"
+    [ranking] = body["rankings"]
+    assert ranking["method"] == "sem-str" and ranking["status"] == "matched"
+    best = ranking["candidates"][0]
+    assert best["name"] == "svc:LocateMobileRobot_CeilingCamera01" and best["acceptable"]
+    assert set(best["parts"]) == {"outputs", "inputs"}
+    wanted = {(p["role"], p["wanted"], p["offered"]) for p in best["explanation"]}
+    position, location = expand("home:RobotPosition"), expand("home:RobotLocation")
+    assert ("output", position, location) in wanted
+    assert all({"similarity", "degree", "how"} <= set(p) for p in best["explanation"])
+    second_camera = next(c for c in ranking["candidates"] if c["name"] == "svc:LocateMobileRobot_CeilingCamera02")
+    assert not second_camera["acceptable"] and second_camera["rejected_by"][0].startswith("SEA:")
+
+
+def test_methods_side_by_side_give_one_ranking_each(client: FlaskClient) -> None:
+    methods = ["sem-str", "wu-palmer", "string", "logic"]
+    response = client.get("/match.json", query_string={"requirement": "req:RobotSelfPosition", "methods": methods})
+    body = response.get_json()
+    assert [r["method"] for r in body["rankings"]] == methods
+    assert all(len(r["candidates"]) == 10 for r in body["rankings"])
+    page = client.get("/match", query_string={"requirement": "req:RobotSelfPosition", "methods": methods}).text
+    assert all(f'id="ranking-{m}"' in page for m in methods) and "<details>" in page
+
+
+def test_a_written_requirement_is_ranked(client: FlaskClient) -> None:
+    written = {"inputs": "home:MarkerColour", "outputs": "home:RobotPosition", "methods": ["sem-str", "lin"]}
+    body = client.get("/match.json", query_string=written).get_json()
+    assert body["requirement"]["written"] is True
+    assert body["requirement"]["outputs"] == [expand("home:RobotPosition")]
+    semstr, lin = body["rankings"]
+    assert semstr["candidates"][0]["name"].startswith("svc:LocateMobileRobot_CeilingCamera")
+    assert lin["method"] == "lin" and lin["candidates"][0]["name"] != semstr["candidates"][0]["name"]  # parts count
+
+
+@pytest.mark.parametrize(
+    ("query", "field", "says"),
+    [
+        pytest.param(
+            {"inputs": "home:MarkerColor", "outputs": "home:RobotPosition"}, "inputs", "home:MarkerColour", id="typo"
+        ),
+        pytest.param({"outputs": "nowhere:Thing"}, "outputs", "not a known prefix", id="prefix"),
+        pytest.param({"effects": "home:Pen home:isWith"}, "effects", "subject predicate object", id="statement"),
+        pytest.param({"inputs": "", "outputs": ""}, "requirement", "write one", id="empty"),
+        pytest.param({"requirement": "req:NoSuchNeed"}, "requirement", "NoSuchNeed", id="unknown-requirement"),
+        pytest.param({"requirement": "req:RobotSelfPosition", "methods": "magic"}, "methods", "magic", id="method"),
+    ],
+)
+def test_bad_requirements_are_field_errors(client: FlaskClient, query: dict[str, str], field: str, says: str) -> None:
+    response = client.get("/match.json", query_string=query)
+    assert response.status_code == 400
+    body = response.get_json()
+    assert body["error"] == "invalid-form" and says in body["fields"][field]
+    page = client.get("/match", query_string=query)
+    assert page.status_code == 400 and "Traceback" not in page.text
+    assert f'<span class="field-error" id="{field}-error" role="alert">' in page.text
+    assert f'aria-describedby="{field}-error"' in page.text
+
+
+# -- plans -----------------------------------------------------------------------------------------
+
+
+def test_plan_page_gives_the_fifteen_step_plan_and_its_drawing(client: FlaskClient) -> None:
+    body = client.get("/plans.json", query_string={"task": "FetchMyPen"}).get_json()
+    plan = body["composition"]
+    assert plan["status"] == "planned" and len(plan["steps"]) == 15
+    assert plan["steps"][1]["component"] == expand(CAMERA)
+    assert plan["steps"][1]["alternatives"] == [expand("svc:LocateMobileRobot_CeilingCamera02")]
+    assert plan["goals"][0]["source"] == "#15"
+    drawing = client.get(body["graph"])
+    assert drawing.status_code == 200 and drawing.mimetype == "image/svg+xml"
+    assert b"<svg" in drawing.data[:1000]
+    page = client.get("/plans", query_string={"task": "FetchMyPen"}).text
+    assert f'<img class="drawing" src="{body["graph"].replace("&", "&amp;")}"' in page and 'id="step-15"' in page
+
+
+def test_unknown_task_is_a_field_error(client: FlaskClient) -> None:
+    response = client.get("/plans.json", query_string={"task": "MakeCoffee"})
+    assert response.status_code == 400 and "FetchMyPen" in response.get_json()["fields"]["task"]
+    assert 'id="task-error"' in client.get("/plans", query_string={"task": "MakeCoffee"}).text
+    assert client.get("/plans/graph.svg", query_string={"task": "MakeCoffee"}).status_code == 400
+
+
+# -- tasks -----------------------------------------------------------------------------------------
+
+
+def test_a_started_run_succeeds_and_a_second_is_refused_while_it_goes(live: tuple[Flask, TaskRunner]) -> None:
+    app, runner = live
+    client = app.test_client()
+    frames_before = client.get("/tasks.json").get_json()["camera"]["frame"]
+    response = start(client, seed="1", fail=CAMERA)
+    assert response.status_code == 202, response.get_json()
+    run_id = response.get_json()["started"]["id"]
+    busy = start(client, "RobotArmServeACup")
+    assert busy.status_code == 409 and busy.get_json()["running"] == run_id
+    assert "one task runs at a time" in busy.get_json()["message"]
+    assert "one task runs at a time" in client.post("/tasks", data={"task": "FetchMyPen"}).text
+    wait_done(runner, run_id)
+    run = client.get(f"/tasks/{run_id}.json").get_json()["run"]
+    assert run["status"] == "succeeded" and run["faults"] == [expand(CAMERA)]
+    assert any(e["event"] == "step_failed" and e.get("failover") for e in run["events"] if "event" in e)
+    failed_over = [s for s in run["steps"] if s["failed_over"]]
+    assert failed_over and failed_over[0]["tried"][-1] == expand("svc:LocateMobileRobot_CeilingCamera02")
+    assert len(run["steps"]) == len(run["result"]["plan"]["steps"])
+    listing = client.get("/tasks.json").get_json()
+    assert listing["runs"][0]["id"] == run_id and listing["runs"][0]["url"] == f"/tasks/{run_id}"
+    assert listing["camera"]["frame"] > frames_before + len(run["steps"]) // 2
+    page = client.get(f"/tasks/{run_id}").text
+    assert "failover" in page and "status-succeeded" in page
+
+
+@pytest.mark.parametrize(
+    ("form", "field"),
+    [
+        pytest.param({"task": "MakeCoffee"}, "task", id="task"),
+        pytest.param({"task": "FetchMyPen", "seed": "x"}, "seed", id="seed"),
+        pytest.param({"task": "FetchMyPen", "fail": "svc:NoSuchThing"}, "fail", id="component"),
+    ],
+)
+def test_bad_start_forms_are_field_errors(client: FlaskClient, form: dict[str, str], field: str) -> None:
+    response = client.post("/tasks.json", data=form)
+    assert response.status_code == 400 and field in response.get_json()["fields"]
+    assert f'id="{field}-error"' in client.post("/tasks", data=form).text
+
+
+def test_other_sites_cannot_start_a_run(client: FlaskClient) -> None:
+    response = client.post("/tasks.json", data={"task": "FetchMyPen"}, headers={"Origin": "https://evil.example"})
+    assert response.status_code == 403
+    assert client.get("/tasks/run-999.json").status_code == 404
+
+
+def sse_messages(chunks: Iterator[bytes]) -> list[dict[str, Any]]:
+    """The JSON of every ``data:`` line in the rest of an event stream."""
+    text = b"".join(chunks).decode()
+    return [json.loads(line[6:]) for line in text.splitlines() if line.startswith("data: ")]
+
+
+def test_event_stream_delivers_the_steps_live_and_ends_by_itself(live: tuple[Flask, TaskRunner]) -> None:
+    app, runner = live
+    client = app.test_client()
+    stream = client.get("/tasks/events", buffered=False)
+    assert stream.status_code == 200 and stream.mimetype == "text/event-stream"
+    chunks = iter(stream.response)
+    assert next(chunks).startswith(b"retry:")
+    hello = json.loads(next(chunks).decode()[6:])
+    assert hello["event"] == "hello" and hello["active"] is None
+    run_id = start(client, "RobotArmServeACup").get_json()["started"]["id"]
+    wait_done(runner, run_id)
+    started = time.monotonic()
+    messages = sse_messages(chunks)
+    assert time.monotonic() - started < 10  # idle for 1.5 s after the run: ends
+    kinds = [m.get("event") for m in messages]
+    assert kinds[0] == "run_started" and "run_finished" in kinds and kinds[-1] == "end"
+    steps = [m for m in messages if m.get("topic") == "/cbrs/task_progress"]
+    assert steps and all(m["run"] == run_id for m in steps)
+    assert {"step_started", "step_succeeded"} <= {m["event"] for m in steps}
+    frames = [m["frame"] for m in messages if m.get("event") == "frame"]
+    assert len(frames) >= 2 and frames == sorted(frames)
+    stream.close()
+    assert not runner._listeners[1:] and not runner._frame_listeners  # the stream unsubscribed (the event log stays)
+
+
+def test_camera_stream_sends_jpeg_parts_and_frames_rise_during_a_run(live: tuple[Flask, TaskRunner]) -> None:
+    app, runner = live
+    app.config["CBRS_STREAM_IDLE_SECONDS"] = 3.0  # from the stream's start until the run's first frame
+    client = app.test_client()
+    stream = client.get("/camera.mjpg", buffered=False)
+    assert stream.status_code == 200
+    assert stream.headers["Content-Type"] == "multipart/x-mixed-replace; boundary=frame"
+    body, numbers = b"", []
+    chunks = iter(stream.response)
+    while len(numbers) < 2 and len(body) < 2_000_000:
+        part = next(chunks)
+        body += part
+        assert part.startswith(b"--frame\r\nContent-Type: image/jpeg\r\n")
+        head, _, jpeg = part.partition(b"\r\n\r\n")
+        assert jpeg.startswith(b"\xff\xd8") and jpeg.endswith(b"\xff\xd9\r\n")
+        numbers.append(int(head.split(b"X-Frame: ")[1]))
+    assert numbers == [1, 1]  # the idle home, then the same again (no run yet)
+    run_id = start(client, "RobotArmServeACup").get_json()["started"]["id"]
+    seen: list[int] = []
+    reader = threading.Thread(target=lambda: seen.extend(int(p.split(b"X-Frame: ")[1].split(b"\r")[0]) for p in chunks))
+    reader.start()
+    wait_done(runner, run_id)
+    reader.join(30)
+    assert not reader.is_alive(), "the camera stream did not end by itself"
+    stream.close()
+    assert max(seen) > 2 and seen == sorted(seen)
+    still = client.get("/camera.jpg")
+    assert still.mimetype == "image/jpeg" and int(still.headers["X-Frame"]) == max(seen)
