@@ -90,6 +90,7 @@ class Server:
 
     def stop(self, timeout: float = 10.0) -> None:
         """Close both listeners and their connections; a task run still going gets ``timeout`` to end."""
+        self.app.extensions["cbrs.closing"].set()  # event and camera streams end within half a second
         if self._bridge is not None:
             self._bridge.stop(timeout)
             self._bridge = None

@@ -255,3 +255,25 @@ def test_bridge_admits_its_own_pages_and_clients_without_origin_but_not_other_si
     with pytest.raises(InvalidStatus) as refused:
         connect(url, origin=Origin("http://evil.example"), open_timeout=WAIT)
     assert refused.value.response.status_code == 403
+
+
+def test_stopping_the_server_ends_open_event_streams(fresh_bundled_kb: KnowledgeBase) -> None:
+    running = Server(fresh_bundled_kb, ServeConfig(port=0, bridge_port=0))
+    running.start()
+    received: list[str] = []
+
+    def listen() -> None:
+        url = f"http://127.0.0.1:{running.http_port}/tasks/events"
+        with httpx.stream("GET", url, timeout=WAIT) as response:
+            for line in response.iter_lines():
+                received.append(line)
+
+    listener = threading.Thread(target=listen, daemon=True)
+    listener.start()
+    deadline = time.monotonic() + WAIT
+    while not any("hello" in line for line in received) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    running.stop(timeout=WAIT)
+    listener.join(WAIT)
+    assert not listener.is_alive()
+    assert [line for line in received if line][-1] == 'data: {"event":"end","reason":"closing"}'

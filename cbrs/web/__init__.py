@@ -8,6 +8,7 @@ client causes is answered with a 4xx status and never a trace: an HTML page for 
 from __future__ import annotations
 
 import importlib
+import threading
 from collections.abc import Sequence
 from typing import Any
 
@@ -45,7 +46,9 @@ def create_app(sparql: SparqlService, cors_origins: Sequence[str] = (), tasks: T
     log = EventLog()
     runner.subscribe(log.add)
     sparql.on_update(lambda: log.add("/cbrs/events", {"event": "store_updated"}))
-    app.extensions.update({"cbrs.sparql": sparql, "cbrs.tasks": runner, "cbrs.events": log})
+    app.extensions.update(
+        {"cbrs.sparql": sparql, "cbrs.tasks": runner, "cbrs.events": log, "cbrs.closing": threading.Event()}
+    )
     app.register_blueprint(blueprint)
     for module, _, _ in PAGES:
         app.register_blueprint(importlib.import_module(f"cbrs.web.{module}").blueprint)

@@ -51,3 +51,9 @@ def tasks() -> TaskRunner:
 def events() -> EventLog:
     found: EventLog = current_app.extensions["cbrs.events"]
     return found
+
+
+def closing() -> threading.Event:
+    """Set when the server stops, so that long responses (event and camera streams) end promptly."""
+    found: threading.Event = current_app.extensions["cbrs.closing"]
+    return found

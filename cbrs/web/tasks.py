@@ -34,6 +34,7 @@ DEFAULTS = {
     "CBRS_HEARTBEAT_SECONDS": 5.0,  # an SSE comment this often, so a gone client is noticed
     "CBRS_CAMERA_REPEAT_SECONDS": 2.0,  # the last frame again this often, so the browser keeps showing it
 }
+SLICE = 0.5  # seconds a stream waits at most before it looks whether the server is closing
 QUEUE_SIZE = 1000  # events a slow client may fall behind by before its stream ends (a run sends ~150)
 BOUNDARY = "frame"
 STEP_EVENTS = ("step_started", "step_succeeded", "step_failed")
@@ -203,6 +204,7 @@ def events() -> Response:
     life = float(config["CBRS_STREAM_SECONDS"])
     idle = float(config["CBRS_STREAM_IDLE_SECONDS"])
     beat = float(config["CBRS_HEARTBEAT_SECONDS"])
+    closing = context.closing()
 
     def stream() -> Iterator[str]:
         inbox: queue.Queue[dict[str, Any]] = queue.Queue(QUEUE_SIZE)
@@ -226,7 +228,7 @@ def events() -> Response:
             active = runner.active()
             yield "retry: 3000\n\n"
             yield _sse({"event": "hello", "active": active.id if active else None, "frame": runner.frame_number})
-            started = last = time.monotonic()
+            started = last = beaten = time.monotonic()
             reason = "idle"
             while True:
                 now = time.monotonic()
@@ -236,9 +238,14 @@ def events() -> Response:
                 if now - last >= idle:
                     break
                 try:
-                    message = inbox.get(timeout=max(0.01, min(beat, life - (now - started), idle - (now - last))))
+                    message = inbox.get(timeout=max(0.01, min(SLICE, life - (now - started), idle - (now - last))))
                 except queue.Empty:
-                    yield ": heartbeat\n\n"
+                    if closing.is_set():
+                        reason = "closing"
+                        break
+                    if time.monotonic() - beaten >= beat:
+                        beaten = time.monotonic()
+                        yield ": heartbeat\n\n"
                     continue
                 if overflow:
                     reason = "overflow"
@@ -261,20 +268,24 @@ def camera() -> Response:
     life = float(config["CBRS_STREAM_SECONDS"])
     idle = float(config["CBRS_STREAM_IDLE_SECONDS"])
     repeat = float(config["CBRS_CAMERA_REPEAT_SECONDS"])
+    closing = context.closing()
     first = runner.frame()
     if first is None:
         raise ServiceUnavailable("this server takes no camera frames")
 
     def stream(frame: CameraFrame) -> Iterator[bytes]:
-        started = last = time.monotonic()
+        started = last = sent = time.monotonic()
         yield _part(frame)
         while True:
             now = time.monotonic()
-            if now - started >= life or now - last >= idle:
+            if now - started >= life or now - last >= idle or closing.is_set():
                 return
-            newer = runner.wait_frame(frame.number, max(0.01, min(repeat, life - (now - started))))
+            newer = runner.wait_frame(frame.number, max(0.01, min(SLICE, life - (now - started))))
             if newer is not None:
                 frame, last = newer, time.monotonic()
+            elif time.monotonic() - sent < repeat:
+                continue
+            sent = time.monotonic()
             yield _part(frame)
 
     mimetype = f"multipart/x-mixed-replace; boundary={BOUNDARY}"
