@@ -10,7 +10,7 @@ import pyoxigraph as ox
 from kb.catalog import Catalogue
 from kb.descriptions import DescriptionReader
 from kb.loader import LoadReport, ParsedFile, load_files, parse_file
-from kb.model import Advertisement, Requirement, ServiceDescription
+from kb.model import Advertisement, PartNode, Requirement, ServiceDescription
 from kb.namespaces import GraphName
 from kb.queries import QueryLibrary
 from kb.registry import ComponentRegistry
@@ -89,6 +89,10 @@ class KnowledgeBase:
     def action_requirement(self, action: str, label: str | None = None) -> Requirement:
         """The inputs, outputs, preconditions and effects of an action class, as a requirement."""
         return self._reader.read_action(action, label)
+
+    def part_tree(self, concept: str) -> PartNode:
+        """The hasPart tree of ``concept`` (its own and inherited parts), as advertisements carry them."""
+        return self._reader.part_tree(concept)
 
     def statistics(self) -> dict[str, int]:
         """Triples per named graph."""

@@ -7,7 +7,7 @@ import difflib
 import re
 import threading
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Literal
 
 from flask import Blueprint, current_app, request
 
@@ -145,10 +145,9 @@ def _requirement(form: dict[str, Any], any_matchmaker: Matchmaker, shown: Page) 
         raise FormError(errors, page=shown)
     kb = context.kb()
 
-    def parameters(direction: str) -> tuple[Parameter, ...]:
+    def parameters(direction: Literal["input", "output"]) -> tuple[Parameter, ...]:
         return tuple(
-            # KnowledgeBase offers part trees only through descriptions; reasoner/testbed.py reads them so too.
-            Parameter(f"{WRITTEN_IRI}/{direction}{i}", direction, c, None, kb._reader.part_tree(c))  # type: ignore[arg-type]
+            Parameter(f"{WRITTEN_IRI}/{direction}{i}", direction, c, None, kb.part_tree(c))
             for i, c in enumerate(concepts[direction + "s"], start=1)
         )
 
