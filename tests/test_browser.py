@@ -117,3 +117,45 @@ def test_sparql_editor_runs_a_query_into_a_table(page: Any, shots: Path) -> None
     page.locator("#query").fill("SELECT ?x WHERE {")
     page.get_by_role("button", name="Run").click()
     assert page.locator("#query-error").is_visible()  # the parser's message beside the editor
+
+
+def test_matchmaking_ranks_the_ceiling_camera_first(page: Any, shots: Path) -> None:
+    page.goto("/match")
+    page.locator("#requirement").select_option("req:RobotSelfPosition")
+    page.locator("#methods").select_option(["sem-str", "wu-palmer"])
+    page.get_by_role("button", name="Rank").click()
+    page.wait_for_url("**/match?*")
+    first = page.locator("#ranking-sem-str").locator("xpath=..").locator("ol.candidates > li").first
+    assert "LocateMobileRobot_CeilingCamera01" in first.locator(".name").inner_text()
+    first.locator("summary").click()  # its explanation: the entity pairs
+    assert "home:RobotLocation" in first.locator(".explanation").inner_text()
+    assert page.locator("#ranking-wu-palmer").is_visible()  # the baseline beside it
+    snap(page, shots, "matchmaking")
+
+
+def test_fetch_my_pen_started_from_the_page_succeeds_while_the_camera_updates(page: Any, shots: Path) -> None:
+    page.goto("/tasks")
+    frame_before = int(page.locator("#frame").inner_text())
+    page.locator("#task").select_option(label="FetchMyPen")
+    page.locator("#start-button").click()
+    status = "document.querySelector('#run-status').textContent.trim()"
+    page.wait_for_function(f"{status} === 'running'", timeout=30_000)
+    page.wait_for_function(f"['succeeded', 'failed', 'error', 'no-plan'].includes({status})", timeout=120_000)
+    assert page.locator("#run-status").inner_text().strip() == "succeeded"
+    assert int(page.locator("#frame").inner_text()) > frame_before + 5  # a frame after every step
+    assert page.locator("#steps tr").count() >= 15
+    assert page.locator("#camera").evaluate("image => image.naturalWidth") > 0  # the MJPEG stream shows
+    snap(page, shots, "tasks")
+
+
+def test_plans_page_shows_the_plan_and_draws_the_graph(page: Any, shots: Path) -> None:
+    page.goto("/plans")
+    page.locator("#task").select_option("req:FetchMyPen")
+    page.get_by_role("button", name="Plan").click()
+    page.wait_for_url("**/plans?*")
+    assert page.locator("tr[id^=step-]").count() == 15
+    drawing = page.locator("img.drawing")
+    drawing.scroll_into_view_if_needed()
+    page.wait_for_function("document.querySelector('img.drawing').complete", timeout=30_000)
+    assert drawing.evaluate("image => image.naturalWidth") > 0  # the SVG arrived and decoded
+    snap(page, shots, "plans")
