@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import queue
+import threading
 import time
 from collections.abc import Iterator
 from typing import Any
@@ -199,12 +200,9 @@ def steps(events: list[dict[str, Any]]) -> list[dict[str, Any]]:
 @blueprint.get("/tasks/events")
 def events() -> Response:
     """Every task runner event as it happens, and the camera's frame numbers, as server-sent events."""
-    config = current_app.config
     runner = context.tasks()
-    life = float(config["CBRS_STREAM_SECONDS"])
-    idle = float(config["CBRS_STREAM_IDLE_SECONDS"])
-    beat = float(config["CBRS_HEARTBEAT_SECONDS"])
-    closing = context.closing()
+    life, idle, closing = _stream_bounds()
+    beat = float(current_app.config["CBRS_HEARTBEAT_SECONDS"])
 
     def stream() -> Iterator[str]:
         inbox: queue.Queue[dict[str, Any]] = queue.Queue(QUEUE_SIZE)
@@ -263,12 +261,9 @@ def events() -> Response:
 @blueprint.get("/camera.mjpg")
 def camera() -> Response:
     """The ceiling camera as ``multipart/x-mixed-replace``: the frame now, each new one, the last again every ~2 s."""
-    config = current_app.config
     runner = context.tasks()
-    life = float(config["CBRS_STREAM_SECONDS"])
-    idle = float(config["CBRS_STREAM_IDLE_SECONDS"])
-    repeat = float(config["CBRS_CAMERA_REPEAT_SECONDS"])
-    closing = context.closing()
+    life, idle, closing = _stream_bounds()
+    repeat = float(current_app.config["CBRS_CAMERA_REPEAT_SECONDS"])
     first = runner.frame()
     if first is None:
         raise ServiceUnavailable("this server takes no camera frames")
@@ -301,6 +296,12 @@ def snapshot() -> Response:
     return Response(
         frame.jpeg, mimetype="image/jpeg", headers={"Cache-Control": "no-store", "X-Frame": str(frame.number)}
     )
+
+
+def _stream_bounds() -> tuple[float, float, threading.Event]:
+    """How long a stream may live, how long it may go without news, and the server's closing signal."""
+    config = current_app.config
+    return float(config["CBRS_STREAM_SECONDS"]), float(config["CBRS_STREAM_IDLE_SECONDS"]), context.closing()
 
 
 def _sse(message: dict[str, Any]) -> str:
