@@ -18,17 +18,16 @@ store updates).
 from __future__ import annotations
 
 import json
-import threading
 from collections.abc import Callable
 from typing import Any, TypeVar
 
 from actions.composer import ComposeConfig, Composer, Objective, store_plan
+from cbrs.matchmakers import Matchmakers
 from cbrs.rosbridge import Bridge, ServiceError
 from cbrs.sparql_service import SparqlService
 from cbrs.tasks import RUN_TOPIC, TaskRunner
 from kb.errors import KnowledgeBaseError
 from kb.namespaces import expand
-from reasoner.matchmaker import Matchmaker
 from reasoner.methods import METHODS
 
 TOPICS = {
@@ -43,13 +42,12 @@ Handler = Callable[[dict[str, Any]], dict[str, Any]]
 
 
 class KnowledgeServices:
-    """Request handlers over one knowledge base; the matchmakers are built once per store version."""
+    """Request handlers over one knowledge base."""
 
-    def __init__(self, sparql: SparqlService, tasks: TaskRunner) -> None:
+    def __init__(self, sparql: SparqlService, tasks: TaskRunner, matchmakers: Matchmakers | None = None) -> None:
         self.sparql = sparql
         self.tasks = tasks
-        self._matchmakers: dict[tuple[str, int], Matchmaker] = {}
-        self._guard = threading.Lock()
+        self.matchmakers = matchmakers or Matchmakers(sparql)
 
     def handlers(self) -> dict[str, tuple[str, Handler]]:
         """Service name -> (type, handler)."""
@@ -75,7 +73,7 @@ class KnowledgeServices:
         if top < 1:
             raise ServiceError(f"top must be at least 1, not {top}")
         with self.sparql.lock:
-            matchmaker = self._matchmaker(method)
+            matchmaker = self.matchmakers.get(method)
             result = _call(lambda: matchmaker.rank(requirement, explain=top))
         return result.to_dict(top)
 
@@ -107,14 +105,6 @@ class KnowledgeServices:
     def task_status(self, args: dict[str, Any]) -> dict[str, Any]:
         run_id = _field(args, "run", str)
         return _call(lambda: self.tasks.get(run_id)).to_dict()
-
-    def _matchmaker(self, method: str) -> Matchmaker:
-        key = (method, self.sparql.generation)
-        with self._guard:
-            if key not in self._matchmakers:
-                self._matchmakers = {k: m for k, m in self._matchmakers.items() if k[1] == key[1]}
-                self._matchmakers[key] = Matchmaker(self.sparql.kb, method)
-            return self._matchmakers[key]
 
 
 def attach(bridge: Bridge, services: KnowledgeServices) -> Callable[[], None]:

@@ -18,6 +18,7 @@ from waitress import wasyncore
 from waitress.server import create_server
 
 from cbrs.bridge_services import KnowledgeServices, attach
+from cbrs.matchmakers import Matchmakers
 from cbrs.rosbridge import Bridge
 from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.tasks import TaskRunner
@@ -47,8 +48,9 @@ class Server:
         self.sparql = SparqlService(kb, self.config.endpoint, self.lock)
         self.tasks = TaskRunner(kb, self.lock)
         self.bridge = Bridge()
-        self._detach = attach(self.bridge, KnowledgeServices(self.sparql, self.tasks))
-        self.app = create_app(self.sparql, self.config.cors_origins, self.tasks)
+        self.matchmakers = Matchmakers(self.sparql)  # one taxonomy index for the pages and the bridge
+        self._detach = attach(self.bridge, KnowledgeServices(self.sparql, self.tasks, self.matchmakers))
+        self.app = create_app(self.sparql, self.config.cors_origins, self.tasks, self.matchmakers)
         self._http: Any = None
         self._http_map: dict[int, Any] = {}
         self._http_thread: threading.Thread | None = None

@@ -16,6 +16,7 @@ from flask import Flask, Response, jsonify, render_template, request
 from werkzeug.exceptions import HTTPException
 
 from cbrs import __version__
+from cbrs.matchmakers import Matchmakers
 from cbrs.sparql_service import SparqlService
 from cbrs.tasks import TaskRunner
 from cbrs.web import links
@@ -34,9 +35,14 @@ PAGES: tuple[tuple[str, str, str], ...] = (
 )
 
 
-def create_app(sparql: SparqlService, cors_origins: Sequence[str] = (), tasks: TaskRunner | None = None) -> Flask:
+def create_app(
+    sparql: SparqlService,
+    cors_origins: Sequence[str] = (),
+    tasks: TaskRunner | None = None,
+    matchmakers: Matchmakers | None = None,
+) -> Flask:
     """The Flask app over ``sparql``'s knowledge base: the browser's pages, ``/sparql``, ``/update`` and
-    ``/healthz``. Without ``tasks``, the app makes its own task runner."""
+    ``/healthz``. Without ``tasks`` or ``matchmakers``, the app makes its own."""
     from cbrs.web.sparql import blueprint
 
     app = Flask(__name__)
@@ -47,7 +53,13 @@ def create_app(sparql: SparqlService, cors_origins: Sequence[str] = (), tasks: T
     runner.subscribe(log.add)
     sparql.on_update(lambda: log.add("/cbrs/events", {"event": "store_updated"}))
     app.extensions.update(
-        {"cbrs.sparql": sparql, "cbrs.tasks": runner, "cbrs.events": log, "cbrs.closing": threading.Event()}
+        {
+            "cbrs.sparql": sparql,
+            "cbrs.tasks": runner,
+            "cbrs.matchmakers": matchmakers or Matchmakers(sparql),
+            "cbrs.events": log,
+            "cbrs.closing": threading.Event(),
+        }
     )
     app.register_blueprint(blueprint)
     for module, _, _ in PAGES:

@@ -8,6 +8,7 @@ from typing import Any
 
 from flask import current_app
 
+from cbrs.matchmakers import Matchmakers
 from cbrs.sparql_service import SparqlService
 from cbrs.tasks import TaskRunner
 from kb import KnowledgeBase
@@ -41,6 +42,11 @@ def kb() -> KnowledgeBase:
 def lock() -> threading.RLock:
     """Held while reading through caches the knowledge base keeps (descriptions, matchmakers)."""
     return sparql().lock
+
+
+def matchmakers() -> Matchmakers:
+    found: Matchmakers = current_app.extensions["cbrs.matchmakers"]
+    return found
 
 
 def tasks() -> TaskRunner:

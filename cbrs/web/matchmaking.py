@@ -5,15 +5,13 @@ from __future__ import annotations
 
 import difflib
 import re
-import threading
-from dataclasses import dataclass, field
 from typing import Any, Literal
 
-from flask import Blueprint, current_app, request
+from flask import Blueprint, request
 
 from cbrs.web import context
 from cbrs.web.pages import FormError, Page, page, wants_json
-from kb import KnowledgeBase, NotFoundError, Parameter, Requirement, Statement
+from kb import NotFoundError, Parameter, Requirement, Statement
 from kb.namespaces import PREFIXES, expand, shorten
 from kb.vocab import CBRS
 from reasoner.degrees import Degree
@@ -32,30 +30,9 @@ STATEMENT_FIELDS = ("preconditions", "effects")
 DEGREE_ORDER = [Degree.FAIL.value, Degree.HAS_SUBCLASS.value, Degree.SUBCLASS_OF.value, Degree.EXACT.value]
 
 
-@dataclass
-class _Matchmakers:
-    """Matchmakers per (method, store generation); they share one taxonomy index and advertisement pool."""
-
-    generation: int = -1
-    index: TaxonomyIndex | None = None
-    built: dict[str, Matchmaker] = field(default_factory=dict)
-    guard: threading.Lock = field(default_factory=threading.Lock)
-
-    def get(self, kb: KnowledgeBase, method: str, generation: int) -> Matchmaker:
-        with self.guard:
-            if generation != self.generation or self.index is None:
-                self.generation, self.index, self.built = generation, TaxonomyIndex.from_kb(kb), {}
-            if method not in self.built:
-                shared = next(iter(self.built.values()), None)
-                ads = shared.advertisements if shared is not None else None
-                self.built[method] = Matchmaker(kb, method, index=self.index, advertisements=ads)
-            return self.built[method]
-
-
 def matchmaker(method: str) -> Matchmaker:
     """The cached matchmaker for ``method`` over the store as it is now; call with ``context.lock()`` held."""
-    cache: _Matchmakers = current_app.extensions.setdefault("cbrs.matchmakers", _Matchmakers())
-    return cache.get(context.kb(), method, context.sparql().generation)
+    return context.matchmakers().get(method)
 
 
 @page(blueprint, "/match")

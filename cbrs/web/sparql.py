@@ -7,9 +7,10 @@ hands the text to :class:`cbrs.sparql_service.SparqlService` and maps its errors
 from __future__ import annotations
 
 import pyoxigraph as ox
-from flask import Blueprint, Response, current_app, request, url_for
+from flask import Blueprint, Response, request, url_for
 
-from cbrs.sparql_service import GRAPH_TYPES, EndpointError, SparqlService, negotiate
+from cbrs.sparql_service import GRAPH_TYPES, EndpointError, negotiate
+from cbrs.web import context
 
 blueprint = Blueprint("sparql", __name__)
 
@@ -37,11 +38,6 @@ class UnsupportedMediaType(EndpointError):
         )
 
 
-def service() -> SparqlService:
-    found: SparqlService = current_app.extensions["cbrs.sparql"]
-    return found
-
-
 @blueprint.route("/sparql", methods=["GET", "POST"])
 def sparql() -> Response:
     query, update = _operation()
@@ -49,7 +45,7 @@ def sparql() -> Response:
         return _update(update)
     if query is None:
         return _service_description()
-    answer = service().query(query, request.headers.get("Accept"), _short_format())
+    answer = context.sparql().query(query, request.headers.get("Accept"), _short_format())
     return Response(answer.body, content_type=_with_charset(answer.media_type))
 
 
@@ -96,7 +92,7 @@ def _body() -> str:
 
 
 def _update(text: str) -> Response:
-    service().update(text, _bearer_token())
+    context.sparql().update(text, _bearer_token())
     return Response(status=204)
 
 
@@ -126,7 +122,7 @@ def _service_description() -> Response:
         ox.Triple(node, ox.NamedNode(sd + "supportedLanguage"), ox.NamedNode(sd + "SPARQL11Query")),
         ox.Triple(node, ox.NamedNode(sd + "feature"), ox.NamedNode(sd + "UnionDefaultGraph")),
     ]
-    if service().writable:
+    if context.sparql().writable:
         triples.append(ox.Triple(node, ox.NamedNode(sd + "supportedLanguage"), ox.NamedNode(sd + "SPARQL11Update")))
     for name in ("SPARQL_Results_JSON", "SPARQL_Results_XML", "SPARQL_Results_CSV", "SPARQL_Results_TSV", "Turtle"):
         triples.append(ox.Triple(node, ox.NamedNode(sd + "resultFormat"), ox.NamedNode(formats + name)))
