@@ -20,6 +20,7 @@ from typing import Any
 
 from actions.errors import ActionsError
 from actions.events import EventBus, Priority
+from actions.faults import Fault, FaultPolicy
 
 
 class Status(Enum):
@@ -108,25 +109,40 @@ class Component(ABC):
 class Managed:
     component: Component
     state: LifecycleState = LifecycleState.CREATED
-    failing: bool = False  # an injected fault: every invocation raises
+    fault: Fault | None = None  # an injected fault: invocations raise once it has worked fault.after_ticks
+    worked: int = 0  # ticks of work over every invocation in this run
     history: list[LifecycleState] = field(default_factory=lambda: [LifecycleState.CREATED])
 
 
 class Container:
     """Creates, runs and retires components; publishes every lifecycle change on the event bus."""
 
-    def __init__(self, factory: Callable[[str], Component], context: Any = None, bus: EventBus | None = None) -> None:
+    def __init__(
+        self,
+        factory: Callable[[str], Component],
+        context: Any = None,
+        bus: EventBus | None = None,
+        faults: FaultPolicy | None = None,
+    ) -> None:
         self._factory = factory
         self._context = context
         self.bus = bus or EventBus()
         self._managed: dict[str, Managed] = {}
-        self._faults: set[str] = set()
+        self._policy = faults
+        self._faults: dict[str, Fault] = {}
 
-    def inject_fault(self, iri: str) -> None:
-        """Make every invocation of ``iri`` fail from now on (fault-tolerance tests, ``--fail``)."""
-        self._faults.add(iri)
+    def inject_fault(self, iri: str, after_ticks: int = 0) -> None:
+        """Make ``iri`` fail once it has worked ``after_ticks`` ticks (0: every invocation fails)."""
+        fault = Fault(iri, after_ticks)
+        self._faults[iri] = fault
         if iri in self._managed:
-            self._managed[iri].failing = True
+            self._managed[iri].fault = fault
+
+    def fault_for(self, iri: str) -> Fault | None:
+        """The fault ``iri`` suffers in this run: injected by hand, else the policy's, else None."""
+        if iri in self._faults:
+            return self._faults[iri]
+        return self._policy.fault_for(iri) if self._policy is not None else None
 
     def state(self, iri: str) -> LifecycleState:
         return self._managed[iri].state if iri in self._managed else LifecycleState.CREATED
@@ -137,7 +153,7 @@ class Container:
     def component(self, iri: str) -> Component:
         """The component for ``iri``, created and initialised on first use."""
         if iri not in self._managed:
-            managed = Managed(self._factory(iri), failing=iri in self._faults)
+            managed = Managed(self._factory(iri), fault=self.fault_for(iri))
             self._managed[iri] = managed
             self._publish(iri, LifecycleState.CREATED)
             try:
@@ -154,16 +170,15 @@ class Container:
         self._move(iri, LifecycleState.RUNNING)
         component.outputs = {}
         component.reason = ""
-        if self._managed[iri].failing:
-            raise InjectedFault(f"injected failure of {iri}")
+        self._check_fault(self._managed[iri])
         component.begin(inputs)
 
     def tick(self, iri: str) -> Status:
         managed = self._managed[iri]
         if managed.state is LifecycleState.SUSPENDED:
             return Status.RUNNING
-        if managed.failing:
-            raise InjectedFault(f"injected failure of {iri}")
+        managed.worked += 1
+        self._check_fault(managed)
         status = managed.component.update()
         if status is not Status.RUNNING:
             self._move(iri, LifecycleState.STOPPED)
@@ -193,6 +208,13 @@ class Container:
             if managed.state is not LifecycleState.FINALISED:
                 managed.component.finalise()
                 self._move(iri, LifecycleState.FINALISED)
+
+    @staticmethod
+    def _check_fault(managed: Managed) -> None:
+        fault = managed.fault
+        if fault is not None and managed.worked >= fault.after_ticks:
+            when = f" after {fault.after_ticks} ticks of work" if fault.after_ticks else ""
+            raise InjectedFault(f"injected failure of {managed.component.iri}{when}")
 
     def _move(self, iri: str, wanted: LifecycleState) -> None:
         managed = self._managed[iri]

@@ -84,6 +84,39 @@ class StepReport:
         }
 
 
+@dataclass(frozen=True)
+class Unmet:
+    """Why a run failed, in the plan's terms: the requirement left unmet, the step that could not be
+    done, what the rest of the plan needed from it, and every component tried for it."""
+
+    requirement: str  # the task's requirement
+    step: int
+    sub_action: str | None  # the part of a decomposed task the step belongs to
+    provides: tuple[str, ...]  # outputs and effects the rest of the plan or the requirement relied on
+    needed_by: tuple[str, ...]  # "step N" for later steps, "the requirement" for its outputs and effects
+    tried: tuple[Attempt, ...]
+
+    def text(self) -> str:
+        what = ", ".join(self.provides) or "its completion"
+        part = f" of {local_name(self.sub_action)}" if self.sub_action else ""
+        tried = "; ".join(f"{local_name(a.component)}: {a.reason}" for a in self.tried) or "none"
+        return (
+            f"requirement {local_name(self.requirement)} not met: no component could provide {what}"
+            f" for {', '.join(self.needed_by) or 'the plan'} (step {self.step}{part}; tried {tried})"
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "requirement": self.requirement,
+            "step": self.step,
+            "sub_action": self.sub_action,
+            "provides": list(self.provides),
+            "needed_by": list(self.needed_by),
+            "tried": [a.to_dict() for a in self.tried],
+            "text": self.text(),
+        }
+
+
 @dataclass
 class ExecutionReport:
     task: str
@@ -92,12 +125,14 @@ class ExecutionReport:
     reason: str = ""
     ticks: int = 0
     seconds: float = 0.0
+    unmet: Unmet | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return {
             "task": self.task,
             "status": self.status.value,
             "reason": self.reason,
+            "unmet": None if self.unmet is None else self.unmet.to_dict(),
             "ticks": self.ticks,
             "seconds": round(self.seconds, 3),
             "steps": [s.to_dict() for s in self.steps],
@@ -134,6 +169,7 @@ class Executor:
         self.reports = [StepReport(s.index, s.component) for s in plan.steps]
         self.status = RunStatus.RUNNING
         self.reason = ""
+        self.unmet: Unmet | None = None
         self.ticks = 0
         self._position = 0  # index into plan.steps
         self._active: str | None = None
@@ -168,7 +204,7 @@ class Executor:
 
     def report(self) -> ExecutionReport:
         return ExecutionReport(
-            self.plan.task, self.status, self.reports, self.reason, self.ticks, self.clock() - self._began
+            self.plan.task, self.status, self.reports, self.reason, self.ticks, self.clock() - self._began, self.unmet
         )
 
     # -- one step ----------------------------------------------------------------------------------
@@ -176,9 +212,7 @@ class Executor:
     def _candidates(self, step: PlanStep) -> list[str]:
         """The step's components not yet tried for it and not broken by an earlier violation."""
         return [
-            c
-            for c in (step.component, *step.alternatives)
-            if c not in self._tried and self.container.state(c) is not LifecycleState.ERROR
+            c for c in step.candidates if c not in self._tried and self.container.state(c) is not LifecycleState.ERROR
         ]
 
     def _start(self, step: PlanStep) -> None:
@@ -186,10 +220,10 @@ class Executor:
         if not candidates:
             report = self.reports[self._position]
             report.outcome = "failed"
-            last = report.attempts[-1].reason if report.attempts else "no component"
+            self.unmet = self._unmet(step, report)
             self._finish(
                 RunStatus.FAILED,
-                f"step {step.index} ({local_name(step.component)}) failed with no alternative left: {last}",
+                f"step {step.index} ({local_name(step.component)}) failed with no alternative left; {self.unmet.text()}",
             )
             return
         iri = candidates[0]
@@ -234,6 +268,29 @@ class Executor:
         self._active = None
         self._tried = []
         self._position += 1
+
+    def _unmet(self, step: PlanStep, report: StepReport) -> Unmet:
+        """What the plan loses with ``step``: the outputs and effects later steps and the goals take from it."""
+        provides: list[str] = []
+        needed_by: list[str] = []
+        for later in self.plan.steps:
+            used = [b for b in later.bindings if b.source.step == step.index]
+            if used:
+                needed_by.append(f"step {later.index}")
+                provides += [b.source.name for b in used]
+        goals = [g for g in self.plan.goals if g.source.step == step.index]
+        if goals:
+            needed_by.append("the requirement")
+            provides += [statement_text(g.statement) if g.statement is not None else g.source.name for g in goals]
+        provides += [statement_text(s) for s in self.needed.get(step.index, [])]
+        return Unmet(
+            self.plan.requirement,
+            step.index,
+            step.part_of,
+            tuple(dict.fromkeys(provides)),
+            tuple(needed_by),
+            tuple(report.attempts),
+        )
 
     def _verify(self, step: PlanStep, statement: Statement, outputs: Mapping[str, Any]) -> bool | None:
         if self.verifier is None:

@@ -75,6 +75,11 @@ class PlanStep:
     alternatives: tuple[str, ...] = ()  # components that can replace this one with the same bindings
 
     @property
+    def candidates(self) -> tuple[str, ...]:
+        """The components that can do this step, in the order the executor tries them."""
+        return (self.component, *self.alternatives)
+
+    @property
     def inputs(self) -> tuple[Binding, ...]:
         return tuple(b for b in self.bindings if b.role == "input")
 

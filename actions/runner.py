@@ -16,6 +16,7 @@ from actions.components import Container, Registry
 from actions.composer import Composer, CompositionResult, PlanStatus, store_plan
 from actions.events import Event, EventBus
 from actions.executor import ExecutionReport, Executor, RunStatus
+from actions.faults import FaultPolicy
 from actions.plan import Plan, PlanStep
 from kb import KnowledgeBase, Requirement, Statement
 
@@ -65,8 +66,12 @@ def run_task(
     composer: Composer | None = None,
     on_event: Callable[[Event], None] | None = None,
     max_ticks: int = 100_000,
+    fault_policy: FaultPolicy | None = None,
 ) -> RunResult:
-    """Compose ``task``, store the plan, run it in ``environment`` and keep the world graph current."""
+    """Compose ``task``, store the plan, run it in ``environment`` and keep the world graph current.
+
+    ``faults`` fail whenever invoked; ``fault_policy`` (e.g. ``RandomFaults``) may break others mid-run.
+    """
     composer = composer or Composer(kb)
     composition = composer.compose(task)
     if composition.plan is None:
@@ -76,7 +81,7 @@ def run_task(
     bus = EventBus()
     if on_event is not None:
         bus.subscribe("*", on_event)
-    container = Container(environment.registry, environment.context, bus)
+    container = Container(environment.registry, environment.context, bus, fault_policy)
     for iri in faults:
         container.inject_fault(iri)
     requirements = {r.iri: r for r in kb.requirements()}

@@ -12,6 +12,7 @@ import click
 
 from actions.composer import ComposeConfig, Composer, CompositionResult, Objective, PlanStatus, store_plan
 from actions.events import Event
+from actions.faults import RandomFaults, planned_faults
 from actions.plan import Binding, Plan
 from actions.runner import RunResult, run_task
 from cbrs.app import App, parse_iri, pass_app
@@ -112,6 +113,18 @@ def _source(binding: Binding) -> str:
     metavar="COMPONENT_IRI",
     help="Make this component fail whenever it is invoked (repeatable); prefixed names work.",
 )
+@click.option(
+    "--fault-rate",
+    type=click.FloatRange(0.0, 1.0),
+    default=0.0,
+    show_default=True,
+    help="Break each component the plan may use with this probability, after a random amount of work.",
+)
+@click.option(
+    "--fault-seed",
+    type=int,
+    help="Seed of the random faults (default: --seed); the same seed breaks the same components.",
+)
 @click.option("--json", "as_json", is_flag=True, help="Print the plan and the execution report as JSON.")
 @click.option(
     "--record",
@@ -119,10 +132,21 @@ def _source(binding: Binding) -> str:
     help="Write the ceiling camera's view after each step to FILE.gif.",
 )
 @pass_app
-def run(app: App, task: str, gui: bool, seed: int, faults: tuple[str, ...], as_json: bool, record: Path | None) -> None:
+def run(
+    app: App,
+    task: str,
+    gui: bool,
+    seed: int,
+    faults: tuple[str, ...],
+    fault_rate: float,
+    fault_seed: int | None,
+    as_json: bool,
+    record: Path | None,
+) -> None:
     """Plan TASK, then execute it in the simulated home, step by step, failing over where needed.
 
-    Exits with status 1 when there is no plan or the run fails.
+    Exits with status 1 when there is no plan or the run fails; a failed run names the requirement
+    it could not meet and every component tried for it.
     """
     if record is not None and record.suffix.lower() != ".gif":
         raise click.BadParameter(f"{record.name!r} must end in .gif", param_hint="--record")
@@ -147,7 +171,8 @@ def run(app: App, task: str, gui: bool, seed: int, faults: tuple[str, ...], as_j
 
         if record is not None:
             frames.append(world.camera("CeilingCamera01").capture().rgb)
-        result = run_task(app.kb, task, environment, failing, on_event=follow)
+        policy = RandomFaults(seed if fault_seed is None else fault_seed, fault_rate) if fault_rate > 0 else None
+        result = run_task(app.kb, task, environment, failing, on_event=follow, fault_policy=policy)
         sim_seconds = world.time
     wall = time.perf_counter() - start
     if record is not None and frames:
@@ -156,11 +181,24 @@ def run(app: App, task: str, gui: bool, seed: int, faults: tuple[str, ...], as_j
         found = result.to_dict()
         found["seed"] = seed
         found["sim_seconds"] = round(sim_seconds, 3)
+        if policy is not None:
+            found["random_faults"] = {"seed": policy.seed, "rate": policy.rate, "planned": _planned(policy, result)}
         click.echo(json.dumps(found, indent=2))
     else:
+        if policy is not None:
+            planned = ", ".join(
+                f"{shorten(f['component'])} after {f['after_ticks']} ticks" for f in _planned(policy, result)
+            )
+            click.echo(f"random faults (seed {policy.seed}, rate {policy.rate}): {planned or 'none'}")
         click.echo(run_text(result, sim_seconds, wall))
     if not result.succeeded:
         raise SystemExit(1)
+
+
+def _planned(policy: RandomFaults, result: RunResult) -> list[dict[str, Any]]:
+    plan = result.composition.plan
+    faults = planned_faults(policy, plan) if plan is not None else []
+    return [{"component": f.component, "after_ticks": f.after_ticks} for f in faults]
 
 
 def _progress(message: dict[str, Any]) -> str:

@@ -165,7 +165,9 @@ def test_no_alternative_left_fails_the_run_and_names_the_step() -> None:
     stubs = {"A": Stub(EX + "A"), "B": Stub(EX + "B", mode="fail"), "C": Stub(EX + "C")}
     report = Executor(chain(), setup(stubs), {"given": "g"}).run(max_ticks=100)
     assert report.status is RunStatus.FAILED
-    assert "step 2 (B) failed with no alternative left: nothing seen" in report.reason
+    assert report.reason.startswith("step 2 (B) failed with no alternative left; requirement Req not met")
+    assert "could provide out for step 3 (step 2; tried B: nothing seen)" in report.reason
+    assert report.unmet is not None and report.unmet.needed_by == ("step 3",)
     assert report.steps[1].outcome == "failed" and report.steps[2].outcome == "pending"
     assert stubs["C"].seen == []
 

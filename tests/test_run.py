@@ -10,6 +10,7 @@ from click.testing import CliRunner
 
 from actions.belief import WORLD, BeliefState
 from actions.composer import Composer
+from actions.faults import FaultPolicy, RandomFaults, doomed_steps, planned_faults
 from actions.runner import RunResult, run_task
 from cbrs.cli import cli
 from kb import KnowledgeBase
@@ -23,10 +24,12 @@ CAM1 = SVC + "LocateMobileRobot_CeilingCamera01"
 CAM2 = SVC + "LocateMobileRobot_CeilingCamera02"
 
 
-def run(task: str, seed: int = 0, faults: tuple[str, ...] = ()) -> tuple[RunResult, KnowledgeBase, float]:
+def run(
+    task: str, seed: int = 0, faults: tuple[str, ...] = (), policy: FaultPolicy | None = None
+) -> tuple[RunResult, KnowledgeBase, float]:
     kb = KnowledgeBase.open(":memory:")
     with open_world(seed=seed) as world:
-        result = run_task(kb, task, SimEnvironment(world, kb), faults, composer=Composer(kb))
+        result = run_task(kb, task, SimEnvironment(world, kb), faults, composer=Composer(kb), fault_policy=policy)
         return result, kb, world.time
 
 
@@ -76,6 +79,52 @@ def test_failure_without_alternative_names_the_step() -> None:
     result, _, _ = run("FetchMyPen", faults=(SVC + "DeliverObject_P3DX01",))
     assert not result.succeeded and result.report is not None
     assert "step 15 (DeliverObject_P3DX01) failed with no alternative left" in result.report.reason
+
+
+def chaos_policies(wanted: int, doomed: bool) -> list[RandomFaults]:
+    """The first seeded policies (breaking, at random moments, components of FetchMyPen's steps that have
+    an alternative) that break something and leave every step a healthy provider, or (``doomed``) that
+    break every provider of a step within its first invocation (a simulated component's whole skill
+    is one tick), so that the run must fail."""
+    kb = KnowledgeBase.open(":memory:")
+    plan = Composer(kb).compose("FetchMyPen").plan
+    assert plan is not None
+    spare = frozenset(c for s in plan.steps if s.alternatives for c in (s.component, *s.alternatives))
+    found = []
+    for seed in range(200):
+        policy = RandomFaults(seed, 0.5, among=spare)
+        faults = {f.component: f.after_ticks for f in planned_faults(policy, plan)}
+        sure = [i for i in doomed_steps(policy, plan) if all(faults[c] <= 1 for c in plan.step(i).candidates)]
+        if faults and (bool(sure) if doomed else not doomed_steps(policy, plan)):
+            found.append(policy)
+        if len(found) == wanted:
+            return found
+    raise AssertionError("no such seed below 200")
+
+
+@pytest.mark.parametrize("policy", chaos_policies(3, doomed=False), ids=lambda p: f"seed{p.seed}")
+def test_random_faults_with_a_healthy_alternative_left_never_stop_the_task(policy: RandomFaults) -> None:
+    result, _, _ = run("FetchMyPen", policy=policy)
+    assert result.succeeded and result.report is not None, result.report.reason if result.report else ""
+    assert all(ok is True for s in result.report.steps for _, ok in s.effects)
+    for step in result.report.steps:
+        failed = [a for a in step.attempts if a.outcome == "failed"]
+        assert all("injected failure" in a.reason for a in failed)
+
+
+@pytest.mark.parametrize("policy", chaos_policies(1, doomed=True), ids=lambda p: f"seed{p.seed}")
+def test_random_faults_that_leave_no_provider_name_the_unmet_requirement(policy: RandomFaults) -> None:
+    result, _, _ = run("FetchMyPen", policy=policy)
+    plan = result.composition.plan
+    assert plan is not None and result.report is not None
+    assert not result.succeeded
+    unmet = result.report.unmet
+    assert unmet is not None and unmet.step in doomed_steps(policy, plan)
+    assert unmet.requirement == plan.requirement
+    assert [a.component for a in unmet.tried] == list(plan.step(unmet.step).candidates)
+    assert all("injected failure" in a.reason for a in unmet.tried)
+    assert result.report.reason.startswith(f"step {unmet.step} (")
+    assert "requirement FetchMyPen not met: no component could provide" in result.report.reason
 
 
 def test_serve_a_cup_succeeds_and_the_cup_holds_water() -> None:
