@@ -221,10 +221,8 @@ class Executor:
             report = self.reports[self._position]
             report.outcome = "failed"
             self.unmet = self._unmet(step, report)
-            self._finish(
-                RunStatus.FAILED,
-                f"step {step.index} ({local_name(step.component)}) failed with no alternative left; {self.unmet.text()}",
-            )
+            where = f"step {step.index} ({local_name(step.component)})"
+            self._finish(RunStatus.FAILED, f"{where} failed with no alternative left; {self.unmet.text()}")
             return
         iri = candidates[0]
         self._tried.append(iri)

@@ -85,9 +85,10 @@ class KnowledgeServices:
         with self.sparql.lock:
             composer = Composer(self.sparql.kb, ComposeConfig(objective=Objective(objective)))
             result = _call(lambda: composer.compose(task))
-            if result.plan is not None:
+            recorded = result.plan is not None and not self.sparql.config.read_only
+            if result.plan is not None and recorded:
                 store_plan(self.sparql.kb, result.plan)
-        return result.to_dict()
+        return {**result.to_dict(), "recorded": recorded}
 
     def run_task(self, args: dict[str, Any]) -> dict[str, Any]:
         task = _field(args, "task", str)

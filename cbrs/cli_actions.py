@@ -13,6 +13,7 @@ import click
 from actions.composer import ComposeConfig, Composer, CompositionResult, Objective, PlanStatus, store_plan
 from actions.events import Event
 from actions.faults import RandomFaults, planned_faults
+from actions.model import ActionLibrary, resolve_task
 from actions.plan import Binding, Plan
 from actions.runner import RunResult, run_task
 from cbrs.app import App, parse_iri, pass_app
@@ -151,6 +152,7 @@ def run(
     if record is not None and record.suffix.lower() != ".gif":
         raise click.BadParameter(f"{record.name!r} must end in .gif", param_hint="--record")
     failing = [parse_iri(f, "--fail") for f in faults]
+    resolve_task(app.kb, ActionLibrary.from_kb(app.kb), task)  # an unknown task fails before the world is built
     from sim.components import SimEnvironment  # pybullet loads only for this command
     from sim.world import open_world
 

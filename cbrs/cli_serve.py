@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import ipaddress
 import logging
+from pathlib import Path
 
 import click
 
@@ -22,9 +23,12 @@ def _help(name: str) -> str:
 @click.option("--port", type=click.IntRange(0, 65535), help=_help("port") + " [default 8080; 0 picks a free port]")
 @click.option("--bridge-port", type=click.IntRange(0, 65535), help=_help("bridge_port") + " [default 9090]")
 @click.option(
-    "--update-token",
-    help=_help("update_token") + " Prefer the environment variable: a command line is visible to other users.",
+    "--update-token-file",
+    type=click.Path(exists=True, dir_okay=False, path_type=Path),
+    help="Read the update token from the first line of FILE (instead of CBRS_UPDATE_TOKEN). There is no "
+    "option taking the token itself: a command line is visible to every user of the machine.",
 )
+@click.option("--read-only", is_flag=True, default=None, help=_help("read_only"))
 @click.option("--cors-origin", "cors_origins", multiple=True, metavar="ORIGIN", help=_help("cors_origins"))
 @pass_app
 def serve(
@@ -32,13 +36,15 @@ def serve(
     host: str | None,
     port: int | None,
     bridge_port: int | None,
-    update_token: str | None,
+    update_token_file: Path | None,
+    read_only: bool | None,
     cors_origins: tuple[str, ...],
 ) -> None:
     """Serve the knowledge base: SPARQL 1.1 at /sparql on the HTTP port, rosbridge v2 on the bridge port.
 
     Binds to 127.0.0.1 unless told otherwise. Updates need the update token; without one the endpoint is
-    read-only. Ctrl-C stops both listeners cleanly.
+    read-only, and --read-only refuses every write (updates, task runs, recorded plans). Ctrl-C stops both
+    listeners cleanly.
     """
     from cbrs.server import ServeConfig, Server  # waitress and websockets load only for this command
 
@@ -51,7 +57,8 @@ def serve(
             timeout=setting("query_timeout").resolve(),
             max_result_bytes=setting("max_result_bytes").resolve(),
             max_query_bytes=setting("max_query_bytes").resolve(),
-            update_token=setting("update_token").resolve(update_token),
+            update_token=setting("update_token").resolve(_read_token(update_token_file)),
+            read_only=setting("read_only").resolve(read_only),
         ),
         cors_origins=setting("cors_origins").resolve(cors_origins or None),
     )
@@ -61,7 +68,10 @@ def serve(
 
     def ready(running: Server) -> None:
         host_text = f"[{config.host}]" if ":" in config.host else config.host
-        access = "read-write with the update token" if running.sparql.writable else "read-only"
+        if config.endpoint.read_only:
+            access = "read-only: no updates, task runs or recorded plans"
+        else:
+            access = "read-write with the update token" if running.sparql.writable else "read-only"
         click.echo(f"cbrs serving {app.kb.store.location} ({access})")
         click.echo(f"  SPARQL    http://{host_text}:{running.http_port}/sparql")
         click.echo(f"  rosbridge ws://{host_text}:{running.bridge_port}")
@@ -69,6 +79,19 @@ def serve(
 
     server.serve_forever(ready)
     click.echo("stopped")
+
+
+def _read_token(path: Path | None) -> str | None:
+    if path is None:
+        return None
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except (OSError, UnicodeDecodeError) as error:
+        raise click.BadParameter(f"cannot read {path}: {error}", param_hint="--update-token-file") from None
+    token = lines[0].strip() if lines else ""
+    if not token:
+        raise click.BadParameter(f"{path} is empty: its first line must be the token", param_hint="--update-token-file")
+    return token
 
 
 def _is_loopback(host: str) -> bool:

@@ -46,7 +46,7 @@ class Server:
         self.config = config or ServeConfig()
         self.lock = threading.RLock()
         self.sparql = SparqlService(kb, self.config.endpoint, self.lock)
-        self.tasks = TaskRunner(kb, self.lock)
+        self.tasks = TaskRunner(kb, self.lock, read_only=self.config.endpoint.read_only)
         self.bridge = Bridge()
         self.matchmakers = Matchmakers(self.sparql)  # one taxonomy index for the pages and the bridge
         self._detach = attach(self.bridge, KnowledgeServices(self.sparql, self.tasks, self.matchmakers))

@@ -36,6 +36,15 @@ def _positive(kind: Callable[[str], float]) -> Callable[[str], Any]:
     return parse
 
 
+def _flag(text: str) -> bool:
+    word = text.strip().lower()
+    if word in ("1", "true", "yes", "on"):
+        return True
+    if word in ("0", "false", "no", "off"):
+        return False
+    raise ValueError(f"{text!r} is not a yes/no value (1, true, yes, on / 0, false, no, off)")
+
+
 def _origins(text: str) -> tuple[str, ...]:
     return tuple(origin.strip() for origin in text.split(",") if origin.strip())
 
@@ -98,6 +107,13 @@ SETTINGS: tuple[Setting, ...] = (
         "Bearer token that SPARQL updates must carry; without one the endpoint is read-only.",
         "CBRS_UPDATE_TOKEN",
         secret=True,
+    ),
+    Setting(
+        "read_only",
+        lambda: False,
+        "Refuse every write, even with the update token: SPARQL updates, task runs, recorded plans.",
+        "CBRS_READ_ONLY",
+        _flag,
     ),
     Setting(
         "query_timeout",

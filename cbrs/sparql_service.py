@@ -139,6 +139,7 @@ class EndpointConfig:
     max_query_bytes: int = 1024 * 1024
     update_token: str | None = None
     workers: int = 4
+    read_only: bool = False  # refuse every write, token or not
 
 
 class _Stop(Exception):
@@ -179,7 +180,7 @@ class SparqlService:
 
     @property
     def writable(self) -> bool:
-        return self.config.update_token is not None
+        return self.config.update_token is not None and not self.config.read_only
 
     def query(self, text: str, accept: str | None = None, short_format: str | None = None) -> Answer:
         """Run ``text`` and serialise its result in the best format for ``accept`` (an Accept header value)."""
@@ -210,6 +211,8 @@ class SparqlService:
     def update(self, text: str, token: str | None) -> None:
         """Run a SPARQL update when ``token`` is the configured update token; one transaction."""
         expected = self.config.update_token
+        if self.config.read_only:
+            raise UpdateForbiddenError("updates are disabled: this server was started read-only")
         if expected is None:
             raise UpdateForbiddenError("updates are disabled: this server is read-only (no update token set)")
         if token is None or not hmac.compare_digest(token.encode("utf-8"), expected.encode("utf-8")):

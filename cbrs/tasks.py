@@ -59,6 +59,16 @@ class TaskBusyError(KnowledgeBaseError):
         super().__init__(f"task run {running} is still going; one task runs at a time")
 
 
+class TasksDisabledError(KnowledgeBaseError):
+    """A read-only server runs no tasks: a run writes its plan and the world graph into the store."""
+
+    http_status = 403
+    kind = "forbidden"
+
+    def __init__(self) -> None:
+        super().__init__("task runs are disabled: this server is read-only (a run writes its plan and the world graph)")
+
+
 class UnknownComponentError(KnowledgeBaseError):
     http_status = 400
 
@@ -111,9 +121,17 @@ class TaskRun:
 class TaskRunner:
     """Starts task runs in the simulated home, one at a time, and keeps the last ``keep`` of them."""
 
-    def __init__(self, kb: KnowledgeBase, lock: threading.RLock, keep: int = 20, camera: str | None = CAMERA) -> None:
+    def __init__(
+        self,
+        kb: KnowledgeBase,
+        lock: threading.RLock,
+        keep: int = 20,
+        camera: str | None = CAMERA,
+        read_only: bool = False,
+    ) -> None:
         self.kb = kb
         self.lock = lock
+        self.read_only = read_only
         self.keep = keep
         self.camera = camera  # None: take no frames (runs are a little faster)
         self._frame: CameraFrame | None = None
@@ -180,6 +198,8 @@ class TaskRunner:
 
     def start(self, task: str, seed: int = 0, faults: Iterable[str] = ()) -> TaskRun:
         """Check ``task`` and ``faults``, then run the task in the background; returns at once."""
+        if self.read_only:
+            raise TasksDisabledError()
         failing = tuple(expand(f) for f in faults)
         _check_components(failing)
         self._refuse_if_busy()  # before taking the lock, which a run holds until it ends

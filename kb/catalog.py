@@ -160,11 +160,9 @@ class Catalogue:
                 return target
         for prefix, folder in sorted(self.prefixes, key=lambda item: -len(item[0])):
             if document.startswith(prefix):
-                rest = unquote(document[len(prefix) :])
-                if rest and ".." not in Path(rest).parts:
-                    target = folder / rest
-                    if target.is_file():
-                        return target
+                target = _inside(folder, unquote(document[len(prefix) :]))
+                if target is not None and target.is_file():
+                    return target
         segment = _last_segment(document)
         if segment:
             for folder in self.folders:
@@ -187,6 +185,15 @@ class Catalogue:
                 continue
             return prefix + relative.as_posix()
         return None
+
+
+def _inside(folder: Path, rest: str) -> Path | None:
+    """``folder/rest`` if it stays inside ``folder``: an IRI must not reach other files through ``..``,
+    an absolute path (``/etc/passwd`` or ``%2Fetc``, which ``Path`` joins by replacing) or a symlink."""
+    if not rest or "\x00" in rest:
+        return None
+    target = (folder / rest).resolve()
+    return target if target.is_relative_to(folder.resolve()) else None
 
 
 @dataclass(frozen=True)

@@ -162,3 +162,24 @@ def test_cli_run_json_and_record(tmp_path: Path) -> None:
     assert bad.exit_code == 2 and "no simulated component svc:NoSuchComponent" in bad.output
     bad = runner.invoke(cli, ["--store", store, "run", "FetchMyPen", "--record", str(tmp_path / "x.png")])
     assert bad.exit_code == 2 and ".gif" in bad.output
+
+
+def test_cli_run_with_random_faults_reports_them_and_the_unmet_requirement(tmp_path: Path) -> None:
+    runner = CliRunner()
+    store = str(tmp_path / "store")
+    argv = ["--store", store, "run", "FetchMyPen", "--json", "--fault-rate", "1", "--fault-seed", "5"]
+    done = runner.invoke(cli, argv)
+    assert done.exit_code == 1, done.output
+    found = json.loads(done.output)
+    planned = found["random_faults"]["planned"]
+    assert found["random_faults"]["seed"] == 5 and found["random_faults"]["rate"] == 1.0
+    assert {f["component"] for f in planned} >= {s["component"] for s in found["plan"]["steps"]}
+    unmet = found["execution"]["unmet"]
+    assert unmet["requirement"] == found["plan"]["requirement"]
+    assert unmet["tried"] and all("injected failure" in a["reason"] for a in unmet["tried"])
+    text = runner.invoke(cli, argv[:4] + argv[5:])
+    assert text.exit_code == 1
+    assert "\nrandom faults (seed 5, rate 1.0): " in text.output
+    assert "requirement FetchMyPen not met: no component could provide" in text.output
+    wrong = runner.invoke(cli, ["--store", store, "run", "FetchMyPen", "--fault-rate", "2"])
+    assert wrong.exit_code == 2 and "--fault-rate" in wrong.output

@@ -28,7 +28,7 @@ CAMERA = "svc:LocateMobileRobot_CeilingCamera01"
 
 @pytest.fixture(scope="module")
 def shared_kb() -> Iterator[KnowledgeBase]:
-    """One seeded store for the read-only pages (plans write only the plans graph, as cbrs plan does)."""
+    """One seeded store for the pages that only read (the plans page shows a plan without recording it)."""
     kb = KnowledgeBase.open(":memory:")
     yield kb
     kb.close()

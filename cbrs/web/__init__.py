@@ -46,9 +46,10 @@ def create_app(
     from cbrs.web.sparql import blueprint
 
     app = Flask(__name__)
+    app.debug = False  # whatever FLASK_DEBUG says: the debugger runs code and tracebacks show internals
     app.config["MAX_CONTENT_LENGTH"] = 3 * sparql.config.max_query_bytes + 4096  # form encoding triples bytes
     app.json.sort_keys = False  # type: ignore[attr-defined]
-    runner = tasks or TaskRunner(sparql.kb, sparql.lock)
+    runner = tasks or TaskRunner(sparql.kb, sparql.lock, read_only=sparql.config.read_only)
     log = EventLog()
     runner.subscribe(log.add)
     sparql.on_update(lambda: log.add("/cbrs/events", {"event": "store_updated"}))

@@ -9,7 +9,7 @@ from typing import Any
 
 from flask import Blueprint, Response, request, url_for
 
-from actions.composer import ComposeConfig, Composer, CompositionResult, Objective, store_plan
+from actions.composer import ComposeConfig, Composer, CompositionResult, Objective
 from actions.errors import UnknownTaskError
 from actions.model import ActionLibrary
 from cbrs.web import context
@@ -32,10 +32,8 @@ def plans() -> Page:
     if "task" not in request.args:
         return shown
     shown.title = f"Plan for {task}" if task else "Plans"
-    with context.lock():
+    with context.lock():  # a GET stays safe: the plan is shown, not recorded (cbrs plan and /cbrs/plan record)
         result = _compose(task, objective, shown)
-        if result.plan is not None:
-            store_plan(context.kb(), result.plan)  # as cbrs plan does: the plans graph holds the latest
     data["composition"] = _composition(result)
     data["graph"] = url_for("plans.graph", task=task, objective=objective)
     return shown
