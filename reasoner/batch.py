@@ -11,6 +11,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 from kb import Advertisement, EffectiveArea, PartNode, QoSValue, Requirement, Statement
 from reasoner.config import MatchConfig
@@ -122,11 +123,13 @@ class BatchScorer:
         measure: EntityMeasure,
         config: MatchConfig,
         filters: Callable[[Requirement, EffectiveArea | None, tuple[QoSValue, ...]], list[str]],
+        plugin_inputs: bool = False,
     ) -> None:
         self.pool = pool
         self.measure = measure
         self.config = config
         self.filters = filters
+        self.plugin_inputs = plugin_inputs
 
     def _vector(self, concept: str) -> FloatArray:
         return self.pool.space.vector(self.measure, concept)
@@ -136,6 +139,7 @@ class BatchScorer:
         pool = self.pool
 
         superclasses = self._superclasses(tree.concept, pool.root_ids)
+        inherited = self._inherited(tree.concept, superclasses)
 
         def cover(node: PartNode, is_root: bool) -> FloatArray:
             if is_root:
@@ -148,15 +152,36 @@ class BatchScorer:
             weight = np.ones_like(own)
             for child in node.children:
                 counted = np.ones_like(own)
+                child_cover = cover(child, False)
                 if is_root and superclasses is not None:
                     part = np.full(len(own), pool.space.add(child.concept), dtype=np.int64)
-                    counted = np.where(superclasses >= 0, ~pool.space.implied(np.maximum(superclasses, 0), part), 1.0)
+                    implied = (superclasses >= 0) & pool.space.implied(np.maximum(superclasses, 0), part)
+                    counted = np.where(implied & ~inherited, 0.0, 1.0)
+                    child_cover = np.where(implied & inherited, 1.0, child_cover)
                 strength = counted * pool.space.index.part_weight(child.concept) * span(child)
-                total += strength * cover(child, False)
+                total += strength * child_cover
                 weight += strength
             return np.maximum(own, total / weight)
 
         return cover(tree, True)
+
+    def _inherited(self, concept: str, superclasses: IntArray | None) -> npt.NDArray[np.bool_]:
+        """Where the other concept is a subclass of ``concept`` (their common superclass is
+        ``concept`` itself), so that it inherits every part of it (MatchConfig.inherited_parts)."""
+        space = self.pool.space
+        if superclasses is None or not self.config.inherited_parts:
+            return np.zeros(0 if superclasses is None else len(superclasses), dtype=bool)
+        return np.asarray(superclasses == space.ids[space.index.canonical(concept)], dtype=bool)
+
+    def plugin(self, concept: str) -> FloatArray:
+        """1 for every pool tree whose root ``concept`` can be passed to as it is (the same concept or
+        a superclass of it, by is-a links), else 0."""
+        space, index = self.pool.space, self.pool.space.index
+        if concept in index:
+            above = [space.ids[a] for a in index.is_a_ancestors(concept)]
+        else:
+            above = [space.ids[concept]] if concept in space.ids else []
+        return np.isin(self.pool.root_ids, np.array(above, dtype=np.int64)).astype(np.float64)
 
     def _superclasses(self, concept: str, others: IntArray) -> IntArray | None:
         """Most specific common superclass of ``concept`` with each of ``others`` (-1 where there is
@@ -178,10 +203,15 @@ class BatchScorer:
             best_part = np.maximum(best_part, self._vector(node.concept))
         own = np.where(pool.node_is_root, root[pool.node_concept], best_part[pool.node_concept])
         counted = np.ones_like(own)  # parts of a root implied by its common superclass with ours: 0
+        forced = np.zeros(0, dtype=np.int64)  # ... or 1, covered, when ours is a subclass of that root
         superclasses = self._superclasses(tree.concept, pool.node_tree_root) if pool.use_parts else None
         if superclasses is not None:
             first = np.flatnonzero((pool.node_level == 1) & (superclasses >= 0))
-            counted[first] = ~pool.space.implied(superclasses[first], pool.node_concept[first])
+            implied = pool.space.implied(superclasses[first], pool.node_concept[first])
+            counted[first] = ~implied
+            if self.config.inherited_parts:
+                forced = first[implied & (superclasses[first] == pool.node_tree_root[first])]
+                counted[forced] = 1.0
         cover = own.copy()
         child_sum = np.zeros_like(own)
         child_weight = np.zeros_like(own)
@@ -189,6 +219,8 @@ class BatchScorer:
             at = np.flatnonzero(pool.node_level == level)
             inner = at[~pool.node_leaf[at]]
             cover[inner] = np.maximum(own[inner], (own[inner] + child_sum[inner]) / (1 + child_weight[inner]))
+            if level == 1:
+                cover[forced] = 1.0
             below = at[pool.node_parent[at] >= 0]
             weights = counted[below] * pool.node_weight[below] * pool.node_span[below]
             np.add.at(child_sum, pool.node_parent[below], weights * cover[below])
@@ -215,6 +247,8 @@ class BatchScorer:
             needed = np.zeros(len(pool.root_ids))
             for provided in requirement.inputs:
                 needed = np.maximum(needed, self.css_offered(provided.tree or PartNode(provided.type)))
+                if self.plugin_inputs:
+                    needed = np.maximum(needed, self.plugin(provided.type))
             needed_per_ad = pool.inputs.mean(needed)
             if requirement.inputs:
                 used = np.mean(

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from reasoner.config import MatchConfig
 from reasoner.matchmaker import Matchmaker
 from reasoner.methods import METHODS
 from reasoner.metrics import average_precision, first_relevant_rank, precision_at_k, reciprocal_rank, top1
@@ -70,9 +71,14 @@ class Report:
     seconds: float = 0.0
 
     def to_json(self) -> dict[str, Any]:
+        """The figures per method, each method's correct testing pairs (``pair_correct_rate``) beside them."""
         return {
             "methods": {
-                name: {metric: round(values[metric], 4) for metric in METRICS} for name, values in self.methods.items()
+                name: {
+                    **{metric: round(values[metric], 4) for metric in METRICS},
+                    "pair_correct_rate": round(self.pair_correct_rate(name), 4),
+                }
+                for name, values in self.methods.items()
             },
             "requirements": self.requirements,
             "services": self.services,
@@ -165,11 +171,13 @@ class Report:
         return "\n".join([head, rule, *rows])
 
     def table(self) -> str:
-        """The figures as a Markdown table."""
-        head = "| method | " + " | ".join(METRIC_LABELS[m] for m in METRICS) + " |"
-        rule = "|---|" + "---:|" * len(METRICS)
+        """The figures as a Markdown table, with the correct testing pairs in the last column."""
+        head = "| method | " + " | ".join(METRIC_LABELS[m] for m in METRICS) + " | correct pairs |"
+        rule = "|---|" + "---:|" * (len(METRICS) + 1)
         rows = [
-            f"| {name} | " + " | ".join(f"{values[m]:.4f}" for m in METRICS) + " |"
+            f"| {name} | "
+            + " | ".join(f"{values[m]:.4f}" for m in METRICS)
+            + f" | {self.pair_correct_rate(name):.4f} |"
             for name, values in self.methods.items()
         ]
         return "\n".join([head, rule, *rows])
@@ -197,9 +205,13 @@ def machine_line() -> str:
 
 
 def evaluate_paper(
-    methods: Sequence[str] = METHODS, testbed: Path = TESTBED_FILE, truth_file: Path = TRUTH_FILE
+    methods: Sequence[str] = METHODS,
+    testbed: Path = TESTBED_FILE,
+    truth_file: Path = TRUTH_FILE,
+    config: MatchConfig | None = None,
 ) -> Report:
-    """Rank every testbed advertisement for every testbed requirement with each method, and score."""
+    """Rank every testbed advertisement for every testbed requirement with each method, and score.
+    ``config``: the matching parameters (the defaults of MatchConfig when None)."""
     start = time.perf_counter()
     truth = load_truth(truth_file)
     relevant = relevant_sets(truth)
@@ -215,9 +227,9 @@ def evaluate_paper(
         scores: dict[str, dict[str, float]] = {}
         for method in methods:
             if first is None:
-                matcher = first = Matchmaker(kb, method)
+                matcher = first = Matchmaker(kb, method, config)
             else:
-                matcher = Matchmaker(kb, method, index=first.index, advertisements=first.advertisements)
+                matcher = Matchmaker(kb, method, config, index=first.index, advertisements=first.advertisements)
             per_requirement: dict[str, tuple[str, ...]] = {}
             groups: dict[str, frozenset[str]] = {}
             sums = dict.fromkeys(METRICS, 0.0)

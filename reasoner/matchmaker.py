@@ -38,7 +38,8 @@ from reasoner.config import MatchConfig
 from reasoner.degrees import Degree, degree_of_match
 from reasoner.methods import Method, make_method
 from reasoner.names import local_name
-from reasoner.spans import SpanMatch, conceptual_span_similarity
+from reasoner.similarity import Similarity
+from reasoner.spans import PairMatch, SpanMatch, conceptual_span_similarity, span
 from reasoner.statements import StatementMatch, best_statement_matches
 from reasoner.taxonomy import TaxonomyIndex
 from reasoner.vectors import VectorSpace
@@ -155,7 +156,7 @@ class Matchmaker:
 
     def _rank_batch(self, requirement: Requirement, ads: list[Advertisement], explain: int) -> Sequence[Candidate]:
         pool = self._compiled(ads)
-        scorer = BatchScorer(pool, self.method.measure, self.config, self.filters)
+        scorer = BatchScorer(pool, self.method.measure, self.config, self.filters, plugin_inputs=self.plugin_inputs)
         scores = scorer.score(requirement)
         order = ranking_order(scores, pool, self.config.accept_score).tolist()
         head = [self.score(requirement, ads[i]) for i in order[:explain]]
@@ -224,7 +225,7 @@ class Matchmaker:
         flip = role == "input"  # the advertisement wants, the requirement offers
         values = []
         for parameter in wanted:
-            scored = [(self._trees(parameter, other), other) for other in offered]
+            scored = [(self._trees(parameter, other, invoking=flip), other) for other in offered]
             if not scored:
                 values.append(0.0)
                 lacks.append(f"{role} {_short(parameter.type)}: nothing on the other side")
@@ -262,10 +263,15 @@ class Matchmaker:
         degree = degree_of_match(self.index, wanted, offered) if offered else Degree.FAIL
         return EntityPair(role, wanted, offered, value, how, degree.value)
 
-    def _trees(self, wanted: Parameter, offered: Parameter) -> SpanMatch:
+    def _trees(self, wanted: Parameter, offered: Parameter, invoking: bool = False) -> SpanMatch:
+        """CSS of two parameters' trees. ``invoking``: ``wanted`` is an advertised input and ``offered``
+        what the requester provides; the same concept or a subclass can be passed as it is."""
         if self.method.strict:
             degree = degree_of_match(self.index, wanted.type, offered.type)
             return SpanMatch(_DEGREE_SCORE[degree], (), () if degree.accepted else (wanted.type,))
+        if invoking and self.plugin_inputs and self._subsumes(wanted.type, offered.type):
+            whole = span(wanted.tree) if wanted.tree and self.method.use_parts else 1
+            return SpanMatch(1.0, (PairMatch(wanted.type, offered.type, Similarity(1.0, "plug-in"), whole),), ())
         return conceptual_span_similarity(
             wanted.tree or PartNode(wanted.type),
             offered.tree or PartNode(offered.type),
@@ -274,7 +280,16 @@ class Matchmaker:
             use_parts=self.method.use_parts,
             implied=self.implied_parts(wanted.type, offered.type) if self.method.use_parts else frozenset(),
             weight=self.index.part_weight,
+            inherited=self.config.inherited_parts and self._subsumes(wanted.type, offered.type),
         )
+
+    @property
+    def plugin_inputs(self) -> bool:
+        return self.config.plugin_inputs and self.method.taxonomy
+
+    def _subsumes(self, upper: str, lower: str) -> bool:
+        """Is ``lower`` the same concept as ``upper`` or a subclass of it (is-a links)?"""
+        return degree_of_match(self.index, upper, lower) in (Degree.EXACT, Degree.SUBCLASS_OF)
 
     def implied_parts(self, first: str, second: str) -> frozenset[str]:
         """Parts both concepts have through their common superclass: no evidence of their own."""

@@ -14,12 +14,14 @@ METHODS = ("sem-str", "string", "wu-palmer", "lin", "logic")
 @dataclass(frozen=True)
 class Method:
     """``use_parts``: compare part trees (CSS) or roots only; ``strict``: logic degrees, every
-    requested output must match (Paolucci et al.)."""
+    requested output must match (Paolucci et al.); ``taxonomy``: the method reads is-a links, so an
+    input offered as a subclass of the advertised one counts as invocable (MatchConfig.plugin_inputs)."""
 
     name: str
     measure: EntityMeasure
     use_parts: bool
     strict: bool = False
+    taxonomy: bool = True
 
 
 def make_method(name: str, index: TaxonomyIndex, config: MatchConfig) -> Method:
@@ -30,7 +32,7 @@ def make_method(name: str, index: TaxonomyIndex, config: MatchConfig) -> Method:
     if name == "lin":
         return Method(name, Lin(index), use_parts=False)
     if name == "string":
-        return Method(name, StringMatch(), use_parts=False)
+        return Method(name, StringMatch(), use_parts=False, taxonomy=False)
     if name == "logic":
         return Method(name, WuPalmer(index), use_parts=False, strict=True)
     raise ValueError(f"unknown matching method {name!r}; use one of {', '.join(METHODS)}")

@@ -21,6 +21,7 @@ from kb import KnowledgeBase, Store
 from kb.catalog import Catalogue
 from kb.errors import KnowledgeBaseError
 from kb.resources import ontology_dir
+from reasoner.config import MatchConfig
 from reasoner.matchmaker import Matchmaker
 from reasoner.methods import METHODS
 from reasoner.metrics import RECALL_LEVELS, average_precision, interpolated_precision, ndcg, precision_at_k, r_precision
@@ -164,8 +165,11 @@ class CollectionReport:
         return "\n".join(lines)
 
 
-def evaluate_collection(root: Path, methods: Sequence[str] = METHODS) -> CollectionReport:
-    """Load the collection and score every method on every judged request."""
+def evaluate_collection(
+    root: Path, methods: Sequence[str] = METHODS, config: MatchConfig | None = None
+) -> CollectionReport:
+    """Load the collection and score every method on every judged request (``config``: the matching
+    parameters, MatchConfig's defaults when None)."""
     check_layout(root)
     judgements = read_relevance(root / "relevance.xml")
     loaded = load_collection(root)
@@ -197,9 +201,9 @@ def evaluate_collection(root: Path, methods: Sequence[str] = METHODS) -> Collect
     curves: dict[str, list[float]] = {}
     for method in methods:
         matcher = (
-            Matchmaker(loaded.kb, method, index=first.index, advertisements=first.advertisements)
+            Matchmaker(loaded.kb, method, config, index=first.index, advertisements=first.advertisements)
             if first is not None
-            else Matchmaker(loaded.kb, method)
+            else Matchmaker(loaded.kb, method, config)
         )
         first = first or matcher
         matcher.prepare()  # reading the pool is loading, not answering a query

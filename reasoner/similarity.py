@@ -40,6 +40,10 @@ class Similarity:
             return f"Wu-Palmer via {local_name(self.common or '')}, links {self.links}"
         if self.situation == "situation-3":
             return "no taxonomy: Jaro-Winkler on core and complementary words"
+        if self.situation == "inherited":
+            return "a part the advertised subclass inherits"
+        if self.situation == "plug-in":
+            return "offered as the advertised input or a subclass of it: invocable"
         return self.situation
 
 
@@ -96,15 +100,41 @@ class SemStr:
         """Jaro-Winkler on the core words and on the complementary words, weighted alpha > beta."""
         core1, rest1 = core_split(self._name(first))
         core2, rest2 = core_split(self._name(second))
-        core = jellyfish.jaro_winkler_similarity(core1, core2)
+        floor = self.config.jaro_winkler_floor
+        core = rescaled_jaro_winkler(core1, core2, floor)
         if not rest1 and not rest2:
             return Similarity(core, "situation-3")  # nothing else to compare: the core word says it all
-        rest = jellyfish.jaro_winkler_similarity(rest1, rest2) if rest1 and rest2 else 0.0
-        value = self.config.alpha * core + self.config.beta * rest
+        if not rest1 or not rest2:
+            # One name is the other's core narrowed by k modifier words: a name k steps below, scored
+            # as Situation 1 scores a concept k links below another, and only as far as the cores agree.
+            extra = len((rest1 or rest2).split())
+            value = core * (self.config.alpha + self.config.beta / (1 + extra))
+        else:
+            rest = complement_similarity(rest1.split(), rest2.split(), floor)
+            value = self.config.alpha * core + self.config.beta * rest
         return Similarity(min(1.0, max(0.0, value)), "situation-3")
 
     def _name(self, iri: str) -> str:
         return local_name(iri)
+
+
+def rescaled_jaro_winkler(first: str, second: str, floor: float) -> float:
+    """Jaro-Winkler with chance agreement removed: values at or below ``floor`` (what different words
+    reach by sharing letters) become 0, the rest is stretched linearly so that equal words keep 1."""
+    if first == second:
+        return 1.0
+    value = jellyfish.jaro_winkler_similarity(first, second)
+    return max(0.0, (value - floor) / (1.0 - floor))
+
+
+def complement_similarity(first: list[str], second: list[str], floor: float) -> float:
+    """Complementary words compared word by word, in any order: each word's best rescaled Jaro-Winkler
+    against the other side's words, averaged over the words of both sides (symmetric)."""
+    if not first or not second:
+        return 0.0
+    best_first = [max(rescaled_jaro_winkler(a, b, floor) for b in second) for a in first]
+    best_second = [max(rescaled_jaro_winkler(a, b, floor) for a in first) for b in second]
+    return (sum(best_first) + sum(best_second)) / (len(first) + len(second))
 
 
 class WuPalmer:

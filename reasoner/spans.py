@@ -57,10 +57,13 @@ def conceptual_span_similarity(
     use_parts: bool = True,
     implied: frozenset[str] = frozenset(),
     weight: Callable[[str], float] = lambda _: 1.0,
+    inherited: bool = False,
 ) -> SpanMatch:
     """CSS of two trees; with ``use_parts`` false only the roots are compared (flat matching).
-    ``implied``: parts of the roots' common superclass, which do not count as evidence;
-    ``weight``: how much a matched part of a given concept counts (TaxonomyIndex.part_weight)."""
+    ``implied``: parts of the roots' common superclass, which do not count as evidence, unless
+    ``inherited``: the advertised root is a subclass of the requested one, so it has every implied part
+    (they count as covered, similarity 1); ``weight``: how much a matched part of a given concept
+    counts (TaxonomyIndex.part_weight)."""
     parts = [node for node in advertised.walk() if node is not advertised] if use_parts else []
     pairs: list[PairMatch] = []
     uncovered: list[str] = []
@@ -84,11 +87,16 @@ def conceptual_span_similarity(
                 uncovered.append(node.concept)
             return value
         mark = len(pairs), len(uncovered)
-        counted = [c for c in node.children if not (node is requested and c.concept in implied)]
+        at_root = node is requested
+        counted = [c for c in node.children if not (at_root and c.concept in implied and not inherited)]
         weights = [weight(c.concept) * span(c) for c in counted]
-        by_parts = (value + sum(w * cover(c, parts) for w, c in zip(weights, counted, strict=True))) / (
-            1 + sum(weights)
-        )
+        by_parts = (
+            value
+            + sum(
+                w * (inherit(c) if at_root and c.concept in implied else cover(c, parts))
+                for w, c in zip(weights, counted, strict=True)
+            )
+        ) / (1 + sum(weights))
         if value >= by_parts:
             del pairs[mark[0] :], uncovered[mark[1] :]  # the node's own match covers its span
             if best is not None and partner is not None and value >= threshold:
@@ -99,6 +107,10 @@ def conceptual_span_similarity(
         if best is not None and partner is not None and value >= threshold:
             pairs.append(PairMatch(node.concept, partner, best, 0))  # reported, its parts carry the span
         return by_parts
+
+    def inherit(node: PartNode) -> float:
+        pairs.append(PairMatch(node.concept, node.concept, Similarity(1.0, "inherited"), span(node)))
+        return 1.0
 
     value = cover(requested, [advertised])
     return SpanMatch(value, tuple(pairs), tuple(uncovered))

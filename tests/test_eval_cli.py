@@ -26,7 +26,7 @@ def test_json_shape(tmp_path: Path) -> None:
     assert data["requirements"] == 20 and data["services"] == 100
     assert set(data["methods"]) == set(METHODS)
     for figures in data["methods"].values():
-        assert set(figures) == {"top1", "p_at_5", "mrr", "map"}
+        assert set(figures) == {"top1", "p_at_5", "mrr", "map", "pair_correct_rate"}
         assert all(0.0 <= value <= 1.0 for value in figures.values())
     assert chart.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
 
@@ -45,6 +45,7 @@ def test_paper_method_finds_the_right_component_first(report: Report) -> None:
 def test_paper_method_ranks_relevant_components_above_every_baseline(report: Report) -> None:
     # MAP and per-pair correctness judge every relevant component, not only the easiest one.
     ours = report.methods["sem-str"]
+    assert report.pair_correct_rate("sem-str") >= 0.85
     for baseline in ("string", "wu-palmer", "lin", "logic"):
         assert ours["map"] > report.methods[baseline]["map"]
         assert report.pair_correct_rate("sem-str") > report.pair_correct_rate(baseline)

@@ -223,8 +223,10 @@ def test_report_json_has_the_agreed_shape(report: Report) -> None:
     assert data["requirements"] == 20
     assert data["services"] == 100
     assert list(data["methods"]) == list(METHODS)
-    for figures in data["methods"].values():
-        assert list(figures) == ["top1", "p_at_5", "mrr", "map"]
+    for name, figures in data["methods"].items():
+        # the four keys, then the correct testing pairs beside them
+        assert list(figures) == ["top1", "p_at_5", "mrr", "map", "pair_correct_rate"]
+        assert figures["pair_correct_rate"] == round(report.pair_correct_rate(name), 4)
         for value in figures.values():
             assert isinstance(value, float)
             assert 0.0 <= value <= 1.0

@@ -6,7 +6,7 @@ import pytest
 from click.testing import CliRunner
 
 from cbrs.cli import cli
-from kb import KnowledgeBase, NotFoundError, PartNode, Statement
+from kb import Advertisement, KnowledgeBase, NotFoundError, Parameter, PartNode, Requirement, Statement, Store
 from reasoner.config import MatchConfig
 from reasoner.matchmaker import Matchmaker, MatchStatus
 from reasoner.methods import METHODS
@@ -152,6 +152,50 @@ def test_css_ignores_parts_implied_by_the_common_superclass() -> None:
         tree("RobotPosition", X, Y), tree("PersonPosition", X, Y), measure, 0.5, implied=implied
     )
     assert match.value == pytest.approx(flat)
+
+
+def test_css_a_subclass_inherits_every_requested_part() -> None:
+    # RobotPosition is a Position: it has x and y by inheritance, so they are covered, not left out.
+    # Left out, a subclass (0.86) ranked below a sibling lifted by the same parts (Location, 0.89).
+    index = positions()
+    measure = SemStr(index)
+    implied = index.parts_of(E + "Position")
+    flat = measure(E + "Position", E + "RobotPosition").value
+    wanted = tree("Position", X, Y)
+    subclass = conceptual_span_similarity(wanted, tree("RobotPosition"), measure, 0.5, implied=implied, inherited=True)
+    assert subclass.value == pytest.approx((flat + 2) / 3)
+    inherited = {p.requested for p in subclass.pairs if p.similarity.situation == "inherited"}
+    assert inherited == {E + "XCoordinate", E + "YCoordinate"} and subclass.uncovered == ()
+    left_out = conceptual_span_similarity(wanted, tree("RobotPosition"), measure, 0.5, implied=implied)
+    assert left_out.value == pytest.approx(flat)
+    sibling = conceptual_span_similarity(wanted, tree("Location", X, Y), measure, 0.5)
+    assert subclass.value > sibling.value > measure(E + "Position", E + "Location").value
+
+
+def _parameter(direction: str, concept: str) -> Parameter:
+    return Parameter(f"{E}{direction}-{concept}", direction, E + concept)  # type: ignore[arg-type]
+
+
+def test_an_input_offered_as_a_subclass_makes_the_advertisement_invocable() -> None:
+    # The advertisement takes any Position; the requester offers a RobotPosition, which it can pass as
+    # it is: "can it be invoked?" scores 1, though the taxonomy gives the pair 0.86.
+    index = positions()
+    kb = KnowledgeBase(Store.open(":memory:"))
+    wants = Advertisement(E + "WantsPosition", (), inputs=(_parameter("input", "Position"),))
+    sibling = Advertisement(E + "WantsLocation", (), inputs=(_parameter("input", "Location"),))
+    requirement = Requirement(E + "Needs", (), inputs=(_parameter("input", "RobotPosition"),))
+    ranked = Matchmaker(kb, index=index, advertisements=[sibling, wants]).rank(requirement)
+    best = ranked.candidates[0]
+    assert best.advertisement == E + "WantsPosition"
+    needed = next(p for p in best.pairs if p.role == "input")
+    assert needed.similarity == 1.0 and "invocable" in needed.how
+    used = SemStr(index)(E + "RobotPosition", E + "Position").value
+    assert best.parts["inputs"] == pytest.approx((1 + used) / 2)
+    off = Matchmaker(kb, config=MatchConfig(plugin_inputs=False), index=index, advertisements=[wants])
+    assert off.score(requirement, wants).parts["inputs"] == pytest.approx(used)
+    # pure string matching knows no subclasses
+    string = Matchmaker(kb, "string", index=index, advertisements=[wants]).score(requirement, wants)
+    assert string.parts["inputs"] == 0.0
 
 
 def test_css_reports_uncovered_parts() -> None:

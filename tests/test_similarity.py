@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 from reasoner.config import MatchConfig
 from reasoner.degrees import Degree, degree_of_match
 from reasoner.names import core_split, local_name, words
-from reasoner.similarity import Lin, SemStr, StringMatch, WuPalmer
+from reasoner.similarity import Lin, SemStr, StringMatch, WuPalmer, complement_similarity, rescaled_jaro_winkler
 from reasoner.taxonomy import ROOT, Link, TaxonomyIndex
 from tests.reasoner_examples import E, figure5, positions
 
@@ -63,6 +63,32 @@ def test_situation_3_uses_core_words() -> None:
     assert lone.value < 0.7
 
 
+def test_situation_3_gives_nothing_for_chance_agreement_between_head_words() -> None:
+    # Raw Jaro-Winkler gives "status" and "temperature" 0.68 (shared letters) and door / indoor 0.89:
+    # DoorStatus reached 0.74 against an undeclared IndoorTemperature. Below the floor it is chance.
+    measure = SemStr(positions())
+    assert rescaled_jaro_winkler("status", "temperature", 0.65) < 0.1
+    unrelated = measure(E + "DoorStatus", E + "IndoorTemperature")
+    assert unrelated.situation == "situation-3" and unrelated.value < 0.3
+    raw = SemStr(positions(), MatchConfig(jaro_winkler_floor=0.0))(E + "DoorStatus", E + "IndoorTemperature")
+    assert raw.value > 0.5  # what the floor removes
+
+
+def test_situation_3_a_narrowed_name_keeps_most_of_its_head() -> None:
+    # FullyOpened is Opened narrowed by one modifier word: alpha + beta / (1 + 1) of the core's value.
+    measure = SemStr(positions())
+    assert measure(E + "FullyOpened", E + "Opened").value == pytest.approx(0.7 + 0.3 / 2)
+    assert measure(E + "FullyOpened", E + "Closed").value < 0.2  # only as far as the cores agree
+    # ... and more than a name whose modifier is unrelated to the other's
+    assert measure(E + "FullyOpened", E + "Opened").value > measure(E + "RobotPlace", E + "PersonPlace").value
+
+
+def test_complementary_words_compare_word_by_word_in_any_order() -> None:
+    assert complement_similarity(["fall", "down"], ["down", "fall"], 0.65) == 1.0
+    assert complement_similarity(["mobile", "robot"], ["robot"], 0.65) == pytest.approx(2 / 3)
+    assert complement_similarity(["obstacle", "detected"], ["person", "fall", "down"], 0.65) == 0.0
+
+
 def test_names() -> None:
     assert local_name("http://x/onto.owl#RobotPosition") == "RobotPosition"
     assert words("GPSPosition_of-robot") == ["gps", "position", "of", "robot"]
@@ -85,6 +111,8 @@ def test_config_is_validated() -> None:
         MatchConfig(alpha=0.3, beta=0.7)
     with pytest.raises(ValueError, match="sum to 1"):
         MatchConfig(subject_weight=0.5)
+    with pytest.raises(ValueError, match="jaro_winkler_floor"):
+        MatchConfig(jaro_winkler_floor=1.0)
 
 
 # -- properties over random taxonomies ---------------------------------------------------------
@@ -120,3 +148,21 @@ def test_every_measure_is_in_unit_range_and_symmetric(index: TaxonomyIndex, a: s
 def test_exact_gives_one(index: TaxonomyIndex, a: str) -> None:
     for measure in (SemStr(index), WuPalmer(index), Lin(index), StringMatch()):
         assert measure(a, a).value == 1.0
+
+
+word_lists = st.lists(st.text("abcdeor", min_size=1, max_size=8), max_size=4)
+
+
+@settings(max_examples=150, deadline=None)
+@given(word_lists, word_lists, st.floats(0.0, 0.99))
+def test_name_measures_are_in_unit_range_symmetric_and_one_for_equal_words(
+    first: list[str], second: list[str], floor: float
+) -> None:
+    value = complement_similarity(first, second, floor)
+    assert 0.0 <= value <= 1.0
+    assert value == pytest.approx(complement_similarity(second, first, floor))
+    for a, b in zip(first, second, strict=False):
+        assert 0.0 <= rescaled_jaro_winkler(a, b, floor) <= 1.0
+        assert rescaled_jaro_winkler(a, a, floor) == 1.0
+    if first:
+        assert complement_similarity(first, first, floor) == 1.0
