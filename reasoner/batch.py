@@ -46,6 +46,7 @@ class BatchScores:
     score: FloatArray
     parts: dict[str, FloatArray]  # each part's value, NaN where the part is left out
     rejected_by: list[tuple[str, ...]]  # filter reasons per advertisement
+    accepted_on: FloatArray | None = None  # the IO/PE score acceptability is judged on, when not ``score``
 
 
 class CompiledPool:
@@ -291,5 +292,6 @@ class BatchScorer:
 def ranking_order(scores: BatchScores, pool: CompiledPool, accept_score: float) -> IntArray:
     """Acceptable first, then those that pass the filters, then by score, then by IRI."""
     rejected = np.array([bool(r) for r in scores.rejected_by])
-    acceptable = ~rejected & (scores.score >= accept_score)
+    basis = scores.score if scores.accepted_on is None else scores.accepted_on
+    acceptable = ~rejected & (basis >= accept_score)
     return np.lexsort((pool.iri_rank, -scores.score, rejected, ~acceptable)).astype(np.int64)

@@ -32,6 +32,9 @@ class MatchConfig:
     # An advertised concept that is a subclass of the requested one inherits every part of it: those parts
     # count as covered (similarity 1) in CSS instead of being left out as implied.
     inherited_parts: bool = True
+    # The hybrid method (sem-str-text): the share of the TF-IDF cosine of names and text descriptions in
+    # the ranking score; the rest is the Sem-Str IO/PE score, which alone decides acceptability.
+    text_weight: float = 0.3
     # A candidate that passes the SEA and QoS filters is acceptable from this combined score up.
     accept_score: float = 0.5
     # An advertisement that states no value for a QoS metric the requirement bounds: fail it?
@@ -42,7 +45,7 @@ class MatchConfig:
             raise ValueError(f"need alpha > beta >= 0 and alpha + beta = 1, got {self.alpha}, {self.beta}")
         if not 0 <= self.jaro_winkler_floor < 1:
             raise ValueError(f"jaro_winkler_floor must lie in [0, 1), got {self.jaro_winkler_floor}")
-        for name in ("pair_threshold", "accept_score"):
+        for name in ("pair_threshold", "accept_score", "text_weight"):
             value = getattr(self, name)
             if not 0 <= value <= 1:
                 raise ValueError(f"{name} must lie in [0, 1], got {value}")

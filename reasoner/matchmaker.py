@@ -33,7 +33,7 @@ from kb import (
     QoSValue,
     Requirement,
 )
-from reasoner.batch import BatchScorer, CompiledPool, ranking_order
+from reasoner.batch import BatchScorer, BatchScores, CompiledPool, ranking_order
 from reasoner.config import MatchConfig
 from reasoner.degrees import Degree, degree_of_match
 from reasoner.methods import Method, make_method
@@ -42,7 +42,8 @@ from reasoner.similarity import Similarity
 from reasoner.spans import PairMatch, SpanMatch, conceptual_span_similarity, span
 from reasoner.statements import StatementMatch, best_statement_matches
 from reasoner.taxonomy import TaxonomyIndex
-from reasoner.vectors import VectorSpace
+from reasoner.text import TextIndex, description_text
+from reasoner.vectors import FloatArray, VectorSpace
 
 
 class MatchStatus(Enum):
@@ -112,6 +113,8 @@ class Matchmaker:
         self._advertisements = list(advertisements) if advertisements is not None else None
         self._pool: CompiledPool | None = None
         self._pool_source: list[Advertisement] | None = None
+        self._text: TextIndex | None = None
+        self._text_source: list[Advertisement] | None = None
 
     def prepare(self) -> Matchmaker:
         """Do the one-time work now (read the advertisements, lay the pool out as arrays), so that
@@ -119,7 +122,15 @@ class Matchmaker:
         ads = self.advertisements
         if not self.method.strict:
             self._compiled(ads).space.warm()
+        if self.method.text:
+            self._text_index(ads)
         return self
+
+    def _text_index(self, ads: list[Advertisement]) -> TextIndex:
+        if self._text is None or self._text_source is not ads:
+            self._text = TextIndex(ads)
+            self._text_source = ads
+        return self._text
 
     def _compiled(self, ads: list[Advertisement]) -> CompiledPool:
         if self._pool is None or self._pool_source is not ads:
@@ -158,6 +169,11 @@ class Matchmaker:
         pool = self._compiled(ads)
         scorer = BatchScorer(pool, self.method.measure, self.config, self.filters, plugin_inputs=self.plugin_inputs)
         scores = scorer.score(requirement)
+        text = description_text(requirement)
+        if self.method.text and text:
+            similarity = self._text_index(ads).similarities(text)
+            hybrid = _mix(scores.score, similarity, self.config.text_weight)
+            scores = BatchScores(hybrid, {**scores.parts, "text": similarity}, scores.rejected_by, scores.score)
         order = ranking_order(scores, pool, self.config.accept_score).tolist()
         head = [self.score(requirement, ads[i]) for i in order[:explain]]
 
@@ -165,8 +181,9 @@ class Matchmaker:
             ad = ads[i]
             parts = {name: float(values[i]) for name, values in scores.parts.items() if not np.isnan(values[i])}
             score = float(scores.score[i])
+            basis = score if scores.accepted_on is None else float(scores.accepted_on[i])
             rejected = scores.rejected_by[i]
-            acceptable = not rejected and score >= self.config.accept_score
+            acceptable = not rejected and basis >= self.config.accept_score
             return Candidate(ad.iri, ad.label, score, parts, (), (), rejected, acceptable, explained=False)
 
         return _Ranking(head, order[explain:], unexplained)
@@ -208,6 +225,10 @@ class Matchmaker:
                 rejected.append(f"strict logic: {failed[0].role} {_short(failed[0].requested)} has no accepted match")
         score = round(score, 6)
         acceptable = not rejected and score >= cfg.accept_score
+        text = description_text(requirement) if self.method.text else ""
+        if text:  # the hybrid: text helps rank, the IO/PE score alone decides acceptability
+            parts["text"] = self._text_index(self.advertisements).similarity(text, ad)
+            score = float(_mix(np.array([score]), np.array([parts["text"]]), cfg.text_weight)[0])
         return Candidate(ad.iri, ad.label, score, parts, tuple(pairs), tuple(lacks), tuple(rejected), acceptable)
 
     # -- parts ---------------------------------------------------------------------------------
@@ -396,6 +417,11 @@ class _Ranking(Sequence[Candidate]):
 
 
 _DEGREE_SCORE = {Degree.EXACT: 1.0, Degree.SUBCLASS_OF: 0.8, Degree.HAS_SUBCLASS: 0.6, Degree.FAIL: 0.0}
+
+
+def _mix(score: FloatArray, text: FloatArray, weight: float) -> FloatArray:
+    """The hybrid's ranking score: (1 - w) IO/PE score + w text similarity, rounded as scores are."""
+    return np.round((1 - weight) * score + weight * text, 6).astype(np.float64)
 
 
 def _within(inner: tuple[float, float, float, float], outer: tuple[float, float, float, float]) -> bool:

@@ -8,25 +8,29 @@ from reasoner.config import MatchConfig
 from reasoner.similarity import EntityMeasure, Lin, SemStr, StringMatch, WuPalmer
 from reasoner.taxonomy import TaxonomyIndex
 
-METHODS = ("sem-str", "string", "wu-palmer", "lin", "logic")
+METHODS = ("sem-str", "string", "wu-palmer", "lin", "logic", "sem-str-text")
 
 
 @dataclass(frozen=True)
 class Method:
     """``use_parts``: compare part trees (CSS) or roots only; ``strict``: logic degrees, every
     requested output must match (Paolucci et al.); ``taxonomy``: the method reads is-a links, so an
-    input offered as a subclass of the advertised one counts as invocable (MatchConfig.plugin_inputs)."""
+    input offered as a subclass of the advertised one counts as invocable (MatchConfig.plugin_inputs);
+    ``text``: the ranking score mixes in the text similarity of the descriptions (MatchConfig.text_weight)."""
 
     name: str
     measure: EntityMeasure
     use_parts: bool
     strict: bool = False
     taxonomy: bool = True
+    text: bool = False
 
 
 def make_method(name: str, index: TaxonomyIndex, config: MatchConfig) -> Method:
     if name == "sem-str":
         return Method(name, SemStr(index, config), use_parts=True)
+    if name == "sem-str-text":
+        return Method(name, SemStr(index, config), use_parts=True, text=True)
     if name == "wu-palmer":
         return Method(name, WuPalmer(index), use_parts=False)
     if name == "lin":

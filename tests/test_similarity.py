@@ -113,6 +113,8 @@ def test_config_is_validated() -> None:
         MatchConfig(subject_weight=0.5)
     with pytest.raises(ValueError, match="jaro_winkler_floor"):
         MatchConfig(jaro_winkler_floor=1.0)
+    with pytest.raises(ValueError, match="text_weight"):
+        MatchConfig(text_weight=1.5)
 
 
 # -- properties over random taxonomies ---------------------------------------------------------
