@@ -95,12 +95,15 @@ class KnowledgeServices:
         seed = _field(args, "seed", int, 0)
         faults = _field(args, "fail", list, [])
         wait = _field(args, "wait", bool, True)
+        rate = args.get("fault_rate", 0.0)
         if not all(isinstance(f, str) for f in faults):
             raise ServiceError("fail must be a list of component IRIs (strings)")
+        if isinstance(rate, bool) or not isinstance(rate, (int, float)):
+            raise ServiceError(f"field 'fault_rate' must be a number in [0, 1], not {type(rate).__name__}")
         if wait:
-            run = _call(lambda: self.tasks.run(task, seed, faults))
+            run = _call(lambda: self.tasks.run(task, seed, faults, fault_rate=float(rate)))
         else:
-            run = _call(lambda: self.tasks.start(task, seed, faults))
+            run = _call(lambda: self.tasks.start(task, seed, faults, float(rate)))
         return run.to_dict(with_events=False)
 
     def task_status(self, args: dict[str, Any]) -> dict[str, Any]:

@@ -23,6 +23,7 @@ from typing import Any
 
 from actions.composer import Composer
 from actions.events import Event
+from actions.faults import RandomFaults
 from actions.model import ActionLibrary, resolve_task
 from actions.runner import run_task
 from kb import KnowledgeBase
@@ -91,6 +92,7 @@ class TaskRun:
     task: str
     seed: int
     faults: tuple[str, ...]
+    fault_rate: float = 0.0  # random faults, seeded with ``seed`` (actions.faults.RandomFaults)
     status: str = "running"  # then succeeded, failed, no-plan or error
     started: float = field(default_factory=time.time)
     finished: float | None = None
@@ -105,6 +107,7 @@ class TaskRun:
             "task": self.task,
             "seed": self.seed,
             "faults": list(self.faults),
+            "fault_rate": self.fault_rate,
             "status": self.status,
             "started": self.started,
             "finished": self.finished,
@@ -196,10 +199,14 @@ class TaskRunner:
 
         return sorted(SVC + name for name in IMPLEMENTATIONS)
 
-    def start(self, task: str, seed: int = 0, faults: Iterable[str] = ()) -> TaskRun:
-        """Check ``task`` and ``faults``, then run the task in the background; returns at once."""
+    def start(self, task: str, seed: int = 0, faults: Iterable[str] = (), fault_rate: float = 0.0) -> TaskRun:
+        """Check ``task`` and ``faults``, then run the task in the background; returns at once.
+
+        ``fault_rate`` breaks each component with that probability at a random moment, seeded by ``seed``.
+        """
         if self.read_only:
             raise TasksDisabledError()
+        RandomFaults(seed, fault_rate)  # an impossible rate fails here (FaultSpecError), not in the thread
         failing = tuple(expand(f) for f in faults)
         _check_components(failing)
         self._refuse_if_busy()  # before taking the lock, which a run holds until it ends
@@ -207,7 +214,7 @@ class TaskRunner:
             resolve_task(self.kb, ActionLibrary.from_kb(self.kb), task)  # an unknown task fails here, not in the thread
         with self._guard:
             self._refuse_if_busy()
-            run = TaskRun(f"run-{next(self._ids)}", task, seed, failing)
+            run = TaskRun(f"run-{next(self._ids)}", task, seed, failing, fault_rate)
             thread = threading.Thread(target=self._run, args=(run,), name=f"cbrs-{run.id}", daemon=True)
             self._active = (run, thread)
             self._runs[run.id] = run
@@ -222,9 +229,11 @@ class TaskRunner:
         if active is not None and active[1].is_alive():
             raise TaskBusyError(active[0].id)
 
-    def run(self, task: str, seed: int = 0, faults: Iterable[str] = (), timeout: float = 300.0) -> TaskRun:
+    def run(
+        self, task: str, seed: int = 0, faults: Iterable[str] = (), timeout: float = 300.0, fault_rate: float = 0.0
+    ) -> TaskRun:
         """Start ``task`` and wait (at most ``timeout`` seconds) until it ends."""
-        run = self.start(task, seed, faults)
+        run = self.start(task, seed, faults, fault_rate)
         run.done.wait(timeout)
         return run
 
@@ -259,7 +268,10 @@ class TaskRunner:
             with self.lock, open_world(seed=run.seed) as world:
                 self._capture(world, run.id)
                 environment = SimEnvironment(world, self.kb)
-                result = run_task(self.kb, run.task, environment, run.faults, Composer(self.kb), follow)
+                policy = RandomFaults(run.seed, run.fault_rate) if run.fault_rate > 0 else None
+                result = run_task(
+                    self.kb, run.task, environment, run.faults, Composer(self.kb), follow, fault_policy=policy
+                )
                 found = result.to_dict()
                 found["sim_seconds"] = round(world.time, 3)
             run.result = found

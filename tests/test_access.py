@@ -240,6 +240,10 @@ def test_hostile_values_in_bridge_service_arguments_change_nothing(server: Serve
         for value in HOSTILE:
             failing = call(ws, "/cbrs/run_task", {"task": "FetchMyPen", "fail": [value]})
             assert failing["result"] is False
+            rate = call(ws, "/cbrs/run_task", {"task": "FetchMyPen", "fault_rate": value})
+            assert rate["result"] is False and "fault_rate" in str(rate["values"])
+        impossible = call(ws, "/cbrs/run_task", {"task": "FetchMyPen", "fault_rate": 2})
+        assert impossible["result"] is False and "rate" in str(impossible["values"])
     assert server.kb.store.dump() == before
 
 

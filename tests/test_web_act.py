@@ -187,12 +187,30 @@ def test_a_started_run_succeeds_and_a_second_is_refused_while_it_goes(live: tupl
         pytest.param({"task": "MakeCoffee"}, "task", id="task"),
         pytest.param({"task": "FetchMyPen", "seed": "x"}, "seed", id="seed"),
         pytest.param({"task": "FetchMyPen", "fail": "svc:NoSuchThing"}, "fail", id="component"),
+        pytest.param({"task": "FetchMyPen", "fault_rate": "often"}, "fault_rate", id="fault-rate-word"),
+        pytest.param({"task": "FetchMyPen", "fault_rate": "1.5"}, "fault_rate", id="fault-rate-range"),
+        pytest.param({"task": "FetchMyPen", "fault_rate": "nan"}, "fault_rate", id="fault-rate-nan"),
     ],
 )
 def test_bad_start_forms_are_field_errors(client: FlaskClient, form: dict[str, str], field: str) -> None:
     response = client.post("/tasks.json", data=form)
     assert response.status_code == 400 and field in response.get_json()["fields"]
     assert f'id="{field}-error"' in client.post("/tasks", data=form).text
+
+
+def test_a_run_with_random_faults_says_which_requirement_it_could_not_meet(live: tuple[Flask, TaskRunner]) -> None:
+    app, runner = live
+    client = app.test_client()
+    response = start(client, seed="5", fault_rate="1")  # every component breaks, within its first two ticks
+    assert response.status_code == 202, response.get_json()
+    run_id = response.get_json()["started"]["id"]
+    wait_done(runner, run_id)
+    run = client.get(f"/tasks/{run_id}.json").get_json()["run"]
+    assert run["status"] == "failed" and run["fault_rate"] == 1.0
+    unmet = run["result"]["execution"]["unmet"]
+    assert unmet["requirement"] == run["result"]["plan"]["requirement"]
+    assert all("injected failure" in a["reason"] for a in unmet["tried"])
+    assert "requirement FetchMyPen not met" in client.get(f"/tasks/{run_id}").text
 
 
 def test_other_sites_cannot_start_a_run(client: FlaskClient) -> None:

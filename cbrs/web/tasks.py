@@ -59,9 +59,9 @@ def tasks() -> Page:
     if request.method != "POST":
         return shown
     _same_origin()
-    task, seed, faults = _checked(form, shown)
+    task, seed, faults, fault_rate = _checked(form, shown)
     try:
-        started = context.tasks().start(task, seed, faults)
+        started = context.tasks().start(task, seed, faults, fault_rate)
     except UnknownComponentError as error:
         raise FormError({"fail": str(error)}, page=shown) from None
     except TaskBusyError as error:
@@ -96,16 +96,18 @@ def _form() -> dict[str, Any]:
             "task": str(body.get("task", "")),
             "seed": str(body.get("seed", 0)),
             "fail": [str(f) for f in (fail if isinstance(fail, list) else [fail])],
+            "fault_rate": str(body.get("fault_rate", 0)),
         }
     values = request.form if request.method == "POST" else request.args
     return {
         "task": values.get("task", TASKS[-1]).strip(),
         "seed": values.get("seed", "0").strip(),
         "fail": [f.strip() for f in values.getlist("fail") if f.strip()],
+        "fault_rate": values.get("fault_rate", "0").strip(),
     }
 
 
-def _checked(form: dict[str, Any], shown: Page) -> tuple[str, int, list[str]]:
+def _checked(form: dict[str, Any], shown: Page) -> tuple[str, int, list[str], float]:
     errors = {}
     if form["task"] not in TASKS:
         errors["task"] = f"{form['task']!r} is not one of {', '.join(TASKS)}"
@@ -120,9 +122,16 @@ def _checked(form: dict[str, Any], shown: Page) -> tuple[str, int, list[str]]:
             faults.append(expand(name))
         except ValueError as error:
             errors["fail"] = str(error)
+    fault_rate = 0.0
+    try:
+        fault_rate = float(form["fault_rate"] or "0")
+    except ValueError:
+        errors["fault_rate"] = f"{form['fault_rate']!r} is not a number"
+    if not 0.0 <= fault_rate <= 1.0:  # also refuses nan
+        errors["fault_rate"] = f"{form['fault_rate']!r} is not a probability between 0 and 1"
     if errors:
         raise FormError(errors, page=shown)
-    return form["task"], seed, faults
+    return form["task"], seed, faults, fault_rate
 
 
 def _same_origin() -> None:
