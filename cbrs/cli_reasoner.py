@@ -11,6 +11,7 @@ from cbrs.app import App, parse_iri, pass_app
 from cbrs.output import table
 from kb import KnowledgeBase
 from kb.namespaces import shorten
+from reasoner.config import MatchConfig
 from reasoner.matchmaker import Candidate, Matchmaker, MatchResult, MatchStatus
 from reasoner.methods import METHODS
 
@@ -103,18 +104,28 @@ def eval_paper(methods: tuple[str, ...], as_json: bool, plot: Path | None) -> No
         click.echo(f"chart written to {plot_report(report, plot)}", err=as_json)
 
 
+_TEXT_WEIGHT = click.option(
+    "--text-weight",
+    type=click.FloatRange(0.0, 1.0),
+    default=MatchConfig.text_weight,
+    show_default=True,
+    help="The share of the text similarity in sem-str-text's ranking score.",
+)
+
+
 @eval_group.command("owls-tc")
 @click.argument("folder", type=click.Path(exists=True, file_okay=False, path_type=Path))
 @click.option("--method", "methods", multiple=True, type=click.Choice(METHODS), help="Only these methods (repeatable).")
 @click.option("--json", "as_json", is_flag=True, help="Print the figures as JSON.")
 @click.option("--plot", type=click.Path(dir_okay=False, path_type=Path), help="Write precision-recall curves (PNG).")
-def eval_owls_tc(folder: Path, methods: tuple[str, ...], as_json: bool, plot: Path | None) -> None:
+@_TEXT_WEIGHT
+def eval_owls_tc(folder: Path, methods: tuple[str, ...], as_json: bool, plot: Path | None, text_weight: float) -> None:
     """An OWL-S test collection in the OWLS-TC layout: services/, ontology/, queries/, relevance.xml."""
     from reasoner.owlstc import evaluate_collection, plot_curves
 
     if not as_json:
         click.echo(f"loading {folder} and ranking every service for every query ...", err=True)
-    report = evaluate_collection(folder, methods or METHODS)
+    report = evaluate_collection(folder, methods or METHODS, MatchConfig(text_weight=text_weight))
     click.echo(json.dumps(report.to_json(), indent=2) if as_json else report.text())
     if plot is not None:
         click.echo(f"chart written to {plot_curves(report, plot)}", err=as_json)

@@ -102,6 +102,7 @@ def test_subset_end_to_end(subset: Path) -> None:
         assert all(0.0 <= figures[m] <= 1.0 for m in ("map", "ndcg", "p_at_1", "p_at_10", "r_precision"))
     # Each request has a same-named service with identical inputs and outputs: found first.
     assert report.methods["sem-str"]["p_at_1"] == 1.0
+    assert report.methods["sem-str-text"]["p_at_1"] == 1.0
 
 
 @needs_collection
@@ -114,6 +115,13 @@ def test_cbrs_eval_owls_tc_json_and_plot(subset: Path, tmp_path: Path) -> None:
     assert result.exit_code == 0, result.output
     data = json.loads(result.stdout)
     assert data["queries"] == 2 and set(data["methods"]) == {"sem-str", "logic"}
+    # the hybrid's text weight is a setting: at 0 it ranks as Sem-Str does
+    plain = CliRunner().invoke(
+        cli, ["eval", "owls-tc", str(subset), "--json", "--method", "sem-str-text", "--text-weight", "0"]
+    )
+    assert plain.exit_code == 0, plain.output
+    figures = json.loads(plain.stdout)["methods"]["sem-str-text"]
+    assert {k: figures[k] for k in ("map", "ndcg")} == {k: data["methods"]["sem-str"][k] for k in ("map", "ndcg")}
     assert set(data["methods"]["sem-str"]) == {"map", "ndcg", "p_at_1", "p_at_10", "r_precision", "query_ms"}
     assert chart.read_bytes()[:4] == b"\x89PNG"
 
