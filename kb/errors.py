@@ -80,7 +80,7 @@ class RdfParseError(KnowledgeBaseError):
         self.column = column
         self.message = message
         where = source if line is None else f"{source}:{line}" + (f":{column}" if column else "")
-        super().__init__(f"{where}: {message}")
+        super().__init__(f"{where}: {_one_line(message)}")  # parsers quote the offending text, newlines and all
 
 
 class UnknownFormatError(KnowledgeBaseError):
@@ -174,3 +174,20 @@ class CatalogueError(KnowledgeBaseError):
         self.source = source
         self.reason = reason
         super().__init__(f"catalogue {source}: {reason}")
+
+
+class PartCycleError(KnowledgeBaseError):
+    """A load would make a concept a part of itself (A hasPart B, B hasPart A); nothing was loaded.
+
+    Every part tree through such a concept is endless, so every description using it, and every
+    ranking or plan that reads those descriptions, would fail; the load is refused instead."""
+
+    http_status = 400
+
+    def __init__(self, sources: Sequence[str], cycle: Sequence[str]) -> None:
+        self.sources = list(sources)
+        self.cycle = list(cycle)
+        super().__init__(
+            f"{', '.join(self.sources)}: hasPart cycle {' -> '.join(self.cycle)}; "
+            "a concept cannot be a part of itself, so nothing was loaded"
+        )

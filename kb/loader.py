@@ -17,8 +17,10 @@ from __future__ import annotations
 import codecs
 import hashlib
 import re
+import subprocess
+import sys
 import xml.parsers.expat
-from collections import deque
+from collections import defaultdict, deque
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -27,8 +29,8 @@ from typing import Any
 import pyoxigraph as ox
 
 from kb.catalog import Catalogue, Unresolved, is_built_in, ontology_iri
-from kb.errors import RdfParseError, UnknownFormatError, UnknownGraphError
-from kb.namespaces import CBRS, GENID, OWL, RDF, RDFS, GraphName
+from kb.errors import PartCycleError, RdfParseError, UnknownFormatError, UnknownGraphError
+from kb.namespaces import CBRS, DUL, GENID, OWL, RDF, RDFS, GraphName
 from kb.owls import Conversion, Role, Vocabulary, convert, is_owls, referenced_ontologies
 from kb.store import Store
 
@@ -53,6 +55,10 @@ _XMLNS = re.compile(r"""xmlns:([A-Za-z_][\w.-]*)\s*=\s*(["'])(.*?)\2""")
 _ENTITY = re.compile(r"""<!ENTITY\s+([\w.-]+)\s+(["'])(.*?)\2\s*>""", re.S)
 _SINGLE_QUOTED_ENTITY = re.compile(rb"""<!ENTITY(\s+[\w.-]+\s+)'([^'"]*)'(\s*)>""")
 _RDF_ID = re.compile(rb"""rdf:ID\s*=\s*(["'])(.*?)\1""")
+# Oxigraph repeats the position at the head of its messages, in three spellings; the error carries it already.
+_POSITION_PREFIX = re.compile(
+    r"^Parser error (?:at|between) line \d+ (?:column \d+|between columns \d+ and \d+)(?: and line \d+ column \d+)?: "
+)
 _NCNAME = re.compile(r"^[A-Za-z_\u00c0-\uffff][\w.\-\u00b7\u00c0-\uffff]*$")
 
 
@@ -122,7 +128,7 @@ def parse_file(path: str | Path, graph: str | GraphName | None = None) -> Parsed
 
     OWL-S files come back as their raw triples; :func:`load_files` is what converts them."""
     raw = _read(Path(path), graph)
-    return ParsedFile(raw.source, raw.target.value, skolemise(raw.quads), repairs=raw.repairs)
+    return ParsedFile(raw.source, raw.target.value, skolemise(raw.quads, raw.source), repairs=raw.repairs)
 
 
 def parse_bytes(
@@ -136,7 +142,7 @@ def parse_bytes(
     data = _as_utf8(raw, source)
     parsed, _, repairs = _parse_quads(data, source, rdf_format, _base_for(source, base_iri))
     target = resolve_graph(graph) if graph is not None else _graph_for(parsed)
-    return ParsedFile(source, target.value, skolemise(_into(parsed, target)), repairs=repairs)
+    return ParsedFile(source, target.value, skolemise(_into(parsed, target), source), repairs=repairs)
 
 
 def load_files(
@@ -176,12 +182,15 @@ def load_files(
             assert vocabulary is not None
             report.unresolved_concepts.extend(_unresolved(conversion, vocabulary))
         report.files.append(
-            ParsedFile(raw.source, raw.target.value, skolemise(raw.quads), conversion, repairs=raw.repairs)
+            ParsedFile(raw.source, raw.target.value, skolemise(raw.quads, raw.source), conversion, repairs=raw.repairs)
         )
     report.imports = [
-        ParsedFile(raw.source, raw.target.value, skolemise(raw.quads), ontology=raw.ontology, repairs=raw.repairs)
+        ParsedFile(
+            raw.source, raw.target.value, skolemise(raw.quads, raw.source), ontology=raw.ontology, repairs=raw.repairs
+        )
         for raw in imported
     ]
+    _check_part_cycles(store, [*raws, *imported])
     store.add(quad for item in (*report.files, *report.imports) for quad in item.quads)
     return report
 
@@ -222,14 +231,22 @@ def resolve_graph(graph: str | GraphName) -> ox.NamedNode:
     raise UnknownGraphError(graph, [g.value for g in GraphName])
 
 
-def skolemise(quads: Iterable[ox.Quad]) -> list[ox.Quad]:
-    """Replace blank nodes with IRIs derived from the canonical form of ``quads``."""
+def skolemise(quads: Iterable[ox.Quad], source: str = "the input") -> list[ox.Quad]:
+    """Replace blank nodes with IRIs derived from the canonical form of ``quads``.
+
+    RDFC-1.0 tries every order of blank nodes it cannot tell apart, which is exponential: twelve
+    blank nodes all linked to each other take minutes and gigabytes. A graph with such look-alikes is
+    canonicalised in a child process bounded by ``CANONICAL_SECONDS`` and ``CANONICAL_BYTES``; one
+    that does not finish is refused (``RdfParseError`` naming ``source``), never left to hang a load."""
     quads = list(quads)
     if not any(isinstance(t, ox.BlankNode) for q in quads for t in (q.subject, q.object)):
         return quads
-    dataset = ox.Dataset(quads)
-    dataset.canonicalize(ox.CanonicalizationAlgorithm.RDFC_1_0)
-    canonical = sorted(dataset, key=str)
+    if _has_look_alikes(quads):
+        canonical = _canonical_in_child(quads, source)
+    else:
+        dataset = ox.Dataset(quads)
+        dataset.canonicalize(ox.CanonicalizationAlgorithm.RDFC_1_0)
+        canonical = sorted(dataset, key=str)
     digest = hashlib.sha256("".join(f"{q} .\n" for q in canonical).encode("utf-8")).hexdigest()[:16]
 
     def named(term: Any) -> Any:
@@ -240,13 +257,77 @@ def skolemise(quads: Iterable[ox.Quad]) -> list[ox.Quad]:
     return [ox.Quad(named(q.subject), q.predicate, named(q.object), q.graph_name) for q in canonical]
 
 
+CANONICAL_SECONDS = 10.0
+CANONICAL_BYTES = 2 << 30  # address space of the child that canonicalises a hard graph
+_CANONICALISE = """
+import resource, sys
+import pyoxigraph as ox
+limit = int(sys.argv[1])
+try:
+    resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+except (ValueError, OSError):
+    pass
+dataset = ox.Dataset(ox.parse(sys.stdin.buffer.read(), format=ox.RdfFormat.N_QUADS))
+dataset.canonicalize(ox.CanonicalizationAlgorithm.RDFC_1_0)
+sys.stdout.buffer.write(ox.serialize(list(dataset), format=ox.RdfFormat.N_QUADS) or b"")
+"""
+
+
+def _has_look_alikes(quads: list[ox.Quad]) -> bool:
+    """Whether RDFC-1.0 would have to permute: a blank node with two or more blank neighbours that
+    share their link (direction, predicate) and look alike (the same first-degree hash). Lists,
+    OWL restrictions and service description trees have none."""
+    around: dict[ox.BlankNode, list[ox.Quad]] = defaultdict(list)
+    for q in quads:
+        for term in {q.subject, q.object}:
+            if isinstance(term, ox.BlankNode):
+                around[term].append(q)
+
+    def shape(q: ox.Quad, node: ox.BlankNode) -> tuple[str, ...]:
+        return tuple(
+            "_:a" if t == node else "_:z" if isinstance(t, ox.BlankNode) else str(t)
+            for t in (q.subject, q.predicate, q.object, q.graph_name)
+        )
+
+    first = {node: hash(tuple(sorted(shape(q, node) for q in links))) for node, links in around.items()}
+    for node, links in around.items():
+        seen: set[tuple[str, str, int]] = set()
+        for q in links:
+            for end, other in (("subject", q.subject), ("object", q.object)):
+                if isinstance(other, ox.BlankNode) and other != node:
+                    key = (end, q.predicate.value, first[other])
+                    if key in seen:
+                        return True
+                    seen.add(key)
+    return False
+
+
+def _canonical_in_child(quads: list[ox.Quad], source: str) -> list[ox.Quad]:
+    data = ox.serialize(quads, format=ox.RdfFormat.N_QUADS) or b""
+    command = [sys.executable, "-c", _CANONICALISE, str(CANONICAL_BYTES)]
+    blank = len({t for q in quads for t in (q.subject, q.object) if isinstance(t, ox.BlankNode)})
+    refusal = (
+        f"{blank} blank nodes, many alike, that RDF canonicalisation could not name within "
+        f"{CANONICAL_SECONDS:g} s and {CANONICAL_BYTES >> 20} MiB; give some of them IRIs"
+    )
+    try:
+        done = subprocess.run(command, input=data, capture_output=True, timeout=CANONICAL_SECONDS, check=False)
+    except subprocess.TimeoutExpired as error:
+        raise RdfParseError(source, refusal) from error
+    if done.returncode != 0:
+        raise RdfParseError(source, refusal)
+    return sorted(ox.parse(done.stdout, format=ox.RdfFormat.N_QUADS), key=str)
+
+
 def _read(path: Path, graph: str | GraphName | None, base_iri: str | None = None, ontology: str | None = None) -> _Raw:
     try:
         raw = path.read_bytes()
     except OSError as error:
         raise RdfParseError(str(path), f"cannot read: {error.strerror or error}") from error
-    rdf_format = _format_for(path, raw)
     source = str(path)
+    if not raw.strip():
+        raise RdfParseError(source, "the file is empty" if not raw else "the file holds only white space")
+    rdf_format = _format_for(path, raw)
     data = _as_utf8(raw, source)
     quads, prefixes, repairs = _parse_quads(data, source, rdf_format, _base_for(source, base_iri))
     owls = path.suffix.lower() == ".owls" or is_owls(quads)
@@ -292,11 +373,14 @@ def _parse_quads(
             quads = _checked(ox.parse(input=fixed, format=rdf_format, base_iri=base, lenient=True))
         except (SyntaxError, ValueError):
             raise _located(error, source, data, rdf_format) from error
+        _check_well_formed(fixed, source)
         return quads, _xml_prefixes(fixed), repairs
     except ValueError as error:
         raise RdfParseError(source, str(error)) from error
-    prefixes = _xml_prefixes(data) if rdf_format == ox.RdfFormat.RDF_XML else dict(parser.prefixes)
-    return quads, prefixes, ()
+    if rdf_format == ox.RdfFormat.RDF_XML:
+        _check_well_formed(data, source)
+        return quads, _xml_prefixes(data), ()
+    return quads, dict(parser.prefixes), ()
 
 
 def _mend_rdfxml(data: bytes, message: str) -> tuple[bytes, tuple[str, ...]] | None:
@@ -377,6 +461,108 @@ def _resolve_imports(store: Store, raws: list[_Raw], catalogue: Catalogue, repor
     return imported
 
 
+_SUBCLASS, _SUBPROPERTY = RDFS + "subClassOf", RDFS + "subPropertyOf"
+_ON_PROPERTY, _SOME_VALUES = OWL + "onProperty", OWL + "someValuesFrom"
+_PART_SHAPE = (_SUBCLASS, _SUBPROPERTY, _ON_PROPERTY, _SOME_VALUES)
+
+
+def _check_part_cycles(store: Store, raws: Sequence[_Raw]) -> None:
+    """Refuse a load whose hasPart restrictions would close a cycle with themselves or the store's.
+
+    Parts are read as ``queries/concept_parts.rq`` reads them (restrictions on dul:hasPart or a
+    subproperty, inherited along rdfs:subClassOf, a class's own restriction narrowing an inherited
+    one on the same property), so what is refused is what would make a part tree endless. A cycle
+    the store already holds is not this load's doing and does not stop it."""
+    added = [(q, raw.source) for raw in raws for q in raw.quads if q.predicate.value in _PART_SHAPE]
+    if not added:
+        return
+    stored = [q for name in _PART_SHAPE for q in store.quads(None, ox.NamedNode(name))]
+    before = _part_edges(stored)
+    after = _part_edges([*stored, *(q for q, _ in added)])
+    for whole in sorted(after):
+        for part in sorted(after[whole] - before.get(whole, set())):
+            path = _part_path(after, part, whole)
+            if path is None:
+                continue
+            cycle = [whole, *path]
+            sources = sorted(
+                {src for q, src in added if isinstance(q.subject, ox.NamedNode) and q.subject.value in cycle}
+            )
+            raise PartCycleError(sources or sorted({source for _, source in added}), cycle)
+
+
+def _part_edges(quads: Iterable[ox.Quad]) -> dict[str, set[str]]:
+    """Each named class and the parts its part tree would list (own or inherited)."""
+    parents: dict[Any, set[Any]] = defaultdict(set)
+    super_properties: dict[Any, set[Any]] = defaultdict(set)
+    on_property: dict[Any, Any] = {}
+    some_values: dict[Any, Any] = {}
+    for q in quads:
+        name = q.predicate.value
+        if name == _SUBCLASS:
+            parents[q.subject].add(q.object)
+        elif name == _SUBPROPERTY:
+            super_properties[q.subject].add(q.object)
+        elif name == _ON_PROPERTY:
+            on_property[q.subject] = q.object
+        elif name == _SOME_VALUES:
+            some_values[q.subject] = q.object
+    has_part = ox.NamedNode(DUL + "hasPart")
+    own: dict[Any, dict[Any, set[str]]] = defaultdict(lambda: defaultdict(set))
+    for owner, supers in parents.items():
+        for restriction in supers:
+            prop, part = on_property.get(restriction), some_values.get(restriction)
+            if (
+                isinstance(part, ox.NamedNode)
+                and not part.value.startswith(GENID)
+                and prop is not None
+                and has_part in _closure(prop, super_properties)
+            ):
+                own[owner][prop].add(part.value)
+    edges: dict[str, set[str]] = {}
+    for concept in parents:
+        if not isinstance(concept, ox.NamedNode) or concept.value.startswith(GENID):
+            continue
+        inherited: dict[Any, set[str]] = defaultdict(set)
+        for owner in _closure(concept, parents):
+            for prop, parts in own.get(owner, {}).items():
+                inherited[prop] |= parts
+        found = {part for prop, parts in inherited.items() for part in own.get(concept, {}).get(prop, parts)}
+        if found:
+            edges[concept.value] = found
+    return edges
+
+
+def _closure(start: Any, links: dict[Any, set[Any]]) -> set[Any]:
+    """``start`` and everything reachable from it along ``links``."""
+    seen = {start}
+    queue = deque([start])
+    while queue:
+        for nxt in links.get(queue.popleft(), ()):
+            if nxt not in seen:
+                seen.add(nxt)
+                queue.append(nxt)
+    return seen
+
+
+def _part_path(edges: dict[str, set[str]], start: str, goal: str) -> list[str] | None:
+    """The shortest chain of parts from ``start`` down to ``goal`` (both included), or None."""
+    previous: dict[str, str | None] = {start: None}
+    queue = deque([start])
+    while queue:
+        node = queue.popleft()
+        if node == goal:
+            path = [node]
+            while (back := previous[path[-1]]) is not None:
+                path.append(back)
+            return path[::-1]
+        for nxt in sorted(edges.get(node, ())):
+            if nxt not in previous:
+                previous[nxt] = node
+                queue.append(nxt)
+    return None
+
+
 def _imports(quads: Iterable[ox.Quad]) -> list[str]:
     imports = OWL + "imports"
     return [q.object.value for q in quads if q.predicate.value == imports and isinstance(q.object, ox.NamedNode)]
@@ -425,7 +611,18 @@ def _as_utf8(raw: bytes, source: str, strict: bool = True) -> bytes:
     if declared and declared.group(2).lower().replace(b"_", b"-") not in {b"utf-8", b"utf8"}:
         codec = declared.group(2).decode("ascii")
         return _redeclare(_decode(raw, codec, source, strict).encode("utf-8"))
+    if strict and b"\x00" in raw[:4096]:
+        raise RdfParseError(source, _nul_bytes(raw[:4096]))
     return raw
+
+
+def _nul_bytes(head: bytes) -> str:
+    """Why a file with NUL bytes cannot be read: UTF-16 without its byte-order mark (every other
+    byte NUL), or not text at all. Either way the parsers would report a misleading syntax error."""
+    for name, zeros in (("UTF-16LE", head[1::2]), ("UTF-16BE", head[0::2])):
+        if len(zeros) > 1 and zeros.count(0) >= 0.9 * len(zeros):
+            return f"looks like {name} without a byte-order mark; save it as UTF-8 (or UTF-16 with the mark)"
+    return "holds NUL bytes: binary data, not RDF text"
 
 
 def _decode(raw: bytes, codec: str, source: str, strict: bool) -> str:
@@ -446,20 +643,57 @@ def _located(error: SyntaxError, source: str, data: bytes, rdf_format: ox.RdfFor
     position = error.args[1] if len(error.args) > 1 and isinstance(error.args[1], tuple) else ()
     line = position[1] if len(position) > 1 else None
     column = position[2] if len(position) > 2 else None
+    message = _POSITION_PREFIX.sub("", message)
+    not_utf8 = re.search(r"invalid utf-8|cannot decode input using utf-8", message, re.IGNORECASE) is not None
     if line is None and rdf_format == ox.RdfFormat.RDF_XML:
-        line, column = _xml_error_position(data)
-    message = re.sub(r"^Parser error (between|at) line \d+ column \d+( and line \d+ column \d+)?: ", "", message)
+        malformed = _xml_error(data)
+        if malformed is not None:
+            reason, line, column = malformed
+            if not (message.startswith("ill-formed") or not_utf8):  # Oxigraph's own words are clear then
+                message = f"malformed XML, {reason} ({message})"
+        else:
+            line, column = _position_of(data, message)
+    if not_utf8:
+        declare = " or declare its encoding in <?xml ... encoding=...?>" if rdf_format == ox.RdfFormat.RDF_XML else ""
+        message += f"; the file is not UTF-8: save it as UTF-8{declare}"
     return RdfParseError(source, message, line, column)
 
 
-def _xml_error_position(data: bytes) -> tuple[int | None, int | None]:
-    """Oxigraph's RDF/XML errors carry no position; expat finds it when the XML is malformed."""
+def _position_of(data: bytes, message: str) -> tuple[int | None, int | None]:
+    """Where the value a well-formed RDF/XML file's error quotes (an IRI, a prefix) first occurs."""
+    quoted = re.search(r"'([^']+)'", message) or re.search(r"Unknown prefix (\S+:)", message)
+    if quoted is None:
+        return None, None
+    needle = quoted.group(1).encode("utf-8")
+    if quoted.re.pattern.startswith("Unknown"):
+        needle = b"<" + needle
+    at = data.find(needle)
+    if at < 0:
+        return None, None
+    line_start = data.rfind(b"\n", 0, at) + 1
+    return data.count(b"\n", 0, at) + 1, at - line_start + 1
+
+
+def _check_well_formed(data: bytes, source: str) -> None:
+    """Oxigraph's RDF/XML parser takes a document that ends before its elements are closed (a
+    truncated download) and returns the triples read so far; expat does not, so that file loads nothing."""
+    malformed = _xml_error(data)
+    if malformed is not None:
+        reason, line, column = malformed
+        raise RdfParseError(source, f"malformed XML, {reason}", line, column)
+
+
+def _xml_error(data: bytes) -> tuple[str, int, int] | None:
+    """Expat's reason and position when the XML is malformed (Oxigraph's RDF/XML errors carry no position)."""
     parser = xml.parsers.expat.ParserCreate()
     try:
         parser.Parse(data, True)
     except xml.parsers.expat.ExpatError as error:
-        return error.lineno, error.offset + 1
-    return None, None
+        reason = xml.parsers.expat.errors.messages[error.code] if error.code else str(error)
+        if reason == "no element found" and error.lineno > 1:
+            reason = "the document ends before its elements are closed"
+        return reason, error.lineno, error.offset + 1
+    return None
 
 
 def _graph_for(quads: list[ox.Quad]) -> ox.NamedNode:
