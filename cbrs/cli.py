@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import sys
 import traceback
 from pathlib import Path
@@ -217,8 +218,24 @@ def query(
     else:
         if values:
             raise click.UsageError("--bind works with --name, whose parameters are declared")
-        result = app.kb.query(text if text else query_file.read())
+        body = text if text else query_file.read()
+        update = _UPDATE_START.match(body)
+        if update:
+            raise click.ClickException(
+                f"this is a SPARQL update ({update.group(1).upper()}); cbrs query runs queries only: "
+                "send updates to /update of cbrs serve (with its update token)"
+            )
+        result = app.kb.query(body)
     click.echo(render_result(result, fmt))
+
+
+# An update, after its prologue (PREFIX and BASE declarations, comments): the query parser's own
+# message for one ("expected CONSTRUCT") does not say what is wrong.
+_UPDATE_START = re.compile(
+    r"(?:\s|#[^\n]*|PREFIX\s*[\w.-]*:\s*<[^>]*>|BASE\s*<[^>]*>)*"
+    r"(INSERT|DELETE|LOAD|CLEAR|DROP|CREATE|ADD|MOVE|COPY|WITH)\b",
+    re.IGNORECASE,
+)
 
 
 @cli.command()
