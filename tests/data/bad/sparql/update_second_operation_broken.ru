@@ -1,0 +1,2 @@
+INSERT DATA { GRAPH <urn:bad:g> { <urn:bad:s> <urn:bad:p> "o" } } ;
+DELETE WHERE { ?s ?p }
