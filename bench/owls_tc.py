@@ -27,7 +27,9 @@ DEFAULT = Path(__file__).resolve().parents[2] / "shared" / "owls-tc4"
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("folder", nargs="?", type=Path, default=DEFAULT)
-    parser.add_argument("--method", action="append", choices=METHODS, help="repeatable; default sem-str and sem-str-text")
+    parser.add_argument(
+        "--method", action="append", choices=METHODS, help="repeatable; default sem-str and sem-str-text"
+    )
     parser.add_argument("--repeat", type=int, default=3, help="passes over the requests (the first is cold)")
     args = parser.parse_args()
     print(
