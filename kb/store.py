@@ -9,6 +9,7 @@ Every write is one transaction, so a write that fails leaves the store as it was
 
 from __future__ import annotations
 
+import re
 from abc import ABC, abstractmethod
 from collections import defaultdict
 from collections.abc import Iterable, Iterator, Mapping
@@ -21,6 +22,23 @@ from kb.namespaces import GENID, PREFIXES, GraphName
 
 MEMORY = ":memory:"
 REMOTE_SCHEMES = ("http://", "https://")
+
+MAX_NESTING = 256
+"""The deepest bracket nesting a query or update may have. Oxigraph's SPARQL parser recurses once per
+level and overflows a thread's stack (killing the process) at about 3,000; hand-written and generated
+queries stay within a few dozen."""
+
+# What can hide a bracket (strings, IRIs, comments) or is one; anything else is skipped.
+_LEXEME = re.compile(
+    r'"""(?:[^"\\]|\\.|"(?!""))*"""'
+    r"|'''(?:[^'\\]|\\.|'(?!''))*'''"
+    r'|"(?:[^"\\\n]|\\.)*"'
+    r"|'(?:[^'\\\n]|\\.)*'"
+    r'|<[^<>"{}|^`\\\x00-\x20]*>'
+    r"|#[^\n]*"
+    r"|[(){}\[\]]",
+    re.DOTALL,
+)
 
 Term = ox.NamedNode | ox.BlankNode | ox.Literal
 QueryResult = ox.QuerySolutions | ox.QueryBoolean | ox.QueryTriples
@@ -122,6 +140,28 @@ class Store(ABC):
         """Release the store; using it afterwards raises :class:`StoreError`."""
 
 
+def nesting_depth(text: str) -> int:
+    """The deepest nesting of ``(``, ``{`` and ``[`` in SPARQL ``text``, outside strings, IRIs and comments."""
+    depth = deepest = 0
+    for match in _LEXEME.finditer(text):
+        token = match.group()
+        if token in "({[":
+            depth += 1
+            deepest = max(deepest, depth)
+        elif token in ")}]":
+            depth = max(depth - 1, 0)
+    return deepest
+
+
+def refuse_deep_nesting(text: str) -> None:
+    """Raise :class:`QuerySyntaxError` for text nested deeper than :data:`MAX_NESTING`, before a parser sees it."""
+    depth = nesting_depth(text)
+    if depth > MAX_NESTING:
+        raise QuerySyntaxError(
+            text, f"brackets nested {depth} deep; at most {MAX_NESTING} levels are accepted (kb.store.MAX_NESTING)"
+        )
+
+
 def is_remote(location: str) -> bool:
     """Whether ``location`` names a SPARQL endpoint rather than a directory."""
     return location.strip().lower().startswith(REMOTE_SCHEMES)
@@ -178,6 +218,7 @@ class EmbeddedStore(Store):
         substitutions: dict[ox.Variable, ox.NamedNode | ox.BlankNode | ox.Literal | ox.Triple] = {
             ox.Variable(name): value for name, value in (bindings or {}).items()
         }
+        refuse_deep_nesting(text)
         try:
             return self._backend.query(
                 text, prefixes=PREFIXES, use_default_graph_as_union=True, substitutions=substitutions
@@ -222,6 +263,7 @@ class EmbeddedStore(Store):
 
     def update(self, text: str) -> None:
         """Run a SPARQL update in one transaction."""
+        refuse_deep_nesting(text)
         try:
             self._backend.update(text, prefixes=PREFIXES)
         except SyntaxError as error:

@@ -401,12 +401,6 @@ print(response.status_code, response.get_json()["error"])
 """
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="Oxigraph's SPARQL parser recurses once per nesting level and overflows the thread's stack at a few "
-    "thousand levels: the process dies with SIGSEGV. Needs a nesting-depth check before parsing, in "
-    "kb/store.py (Store.query and Store.update) or cbrs/sparql_service.py, giving 400 QuerySyntaxError",
-)
 def test_a_deeply_nested_query_is_refused_not_fatal() -> None:
     done = subprocess.run(
         [sys.executable, "-c", NESTED_PROBE], input=NESTED, capture_output=True, text=True, timeout=60, check=False

@@ -7,6 +7,7 @@ import pytest
 
 from kb import KnowledgeBase, QuerySyntaxError, Store, StoreError
 from kb.namespaces import GraphName
+from kb.store import nesting_depth
 
 pytestmark = pytest.mark.both_stores
 
@@ -37,6 +38,35 @@ def test_query_syntax_error_is_typed(mini_kb: KnowledgeBase) -> None:
     with pytest.raises(QuerySyntaxError) as caught:
         mini_kb.query("SELECT ?x WHERE { ?x ")
     assert caught.value.query == "SELECT ?x WHERE { ?x "
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "SELECT * WHERE { FILTER(" + "(" * 300 + "1" + ")" * 300 + ") }",
+        "SELECT * WHERE " + "{" * 300 + "?s ?p ?o" + "}" * 300,
+        "INSERT { <http://e/a> <http://e/p> 1 } WHERE " + "{" * 300 + "}" * 300,
+    ],
+)
+def test_deep_nesting_is_refused_before_parsing(mini_kb: KnowledgeBase, text: str) -> None:
+    before = mini_kb.store.dump()
+    with pytest.raises(QuerySyntaxError, match=r"nested 30[0-9] deep; at most 256"):
+        if text.startswith("INSERT"):
+            mini_kb.store.update(text)
+        else:
+            mini_kb.query(text)
+    assert mini_kb.store.dump() == before
+
+
+def test_brackets_in_strings_iris_and_comments_do_not_count(mini_kb: KnowledgeBase) -> None:
+    brackets = "(" * 400
+    long_string = '"' * 3 + brackets + "\n" + '"' * 3
+    text = (
+        f"SELECT ?x WHERE {{ # {brackets}\n"
+        f"VALUES ?x {{ \"{brackets}\" '{brackets}' {long_string} <http://e/{brackets}> }} }}"
+    )
+    assert len(list(mini_kb.query(text))) == 4
+    assert nesting_depth(text) == 2
 
 
 def test_queries_see_every_graph_by_default(mini_kb: KnowledgeBase) -> None:
