@@ -3,6 +3,8 @@ from __future__ import annotations
 import pytest
 
 from kb import Advertisement, InvalidDescriptionError, KnowledgeBase, NotFoundError, Requirement, Statement
+from kb.errors import PartCycleError
+from kb.namespaces import GraphName
 from kb.vocab import CBRS
 
 EX = "http://example.org/mini#"
@@ -67,7 +69,19 @@ def test_has_part_cycle_is_reported(mini_kb: KnowledgeBase, tmp_path) -> None:  
         ex:B a owl:Class ; rdfs:subClassOf [ owl:onProperty ex:hasX ; owl:someValuesFrom ex:A ] .""",
         encoding="utf-8",
     )
-    mini_kb.load([cyclic])
+    before = mini_kb.store.dump()
+    with pytest.raises(PartCycleError, match=r"hasPart cycle .*A -> .*B -> .*A"):
+        mini_kb.load([cyclic])
+    assert mini_kb.store.dump() == before
+    # A cycle that reached the store another way (a SPARQL update) is still named when read.
+    mini_kb.store.update(
+        f"""PREFIX ex: <{EX}> PREFIX owl: <http://www.w3.org/2002/07/owl#>
+        PREFIX rdfs: <http://www.w3.org/2000/01/rdf-schema#>
+        INSERT DATA {{ GRAPH <{GraphName.ONTOLOGY.node.value}> {{
+            ex:A a owl:Class ; rdfs:subClassOf ex:rA . ex:rA owl:onProperty ex:hasX ; owl:someValuesFrom ex:B .
+            ex:B a owl:Class ; rdfs:subClassOf ex:rB . ex:rB owl:onProperty ex:hasX ; owl:someValuesFrom ex:A .
+        }} }}"""
+    )
     reader_tree = mini_kb._reader.part_tree
     with pytest.raises(InvalidDescriptionError, match=r"hasPart cycle .*A -> .*B -> .*A"):
         reader_tree(EX + "A")
