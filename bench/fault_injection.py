@@ -1,0 +1,91 @@
+"""Benchmark: the paper's scenarios under seeded random component failures, in the simulated home.
+
+Run: python bench/fault_injection.py [--seeds 20] [--rate 0.1] [--spare-rate 0.5]. Two regimes per task:
+``all`` breaks any component of the plan with probability --rate; ``spare`` breaks only components of
+steps that have an alternative, with probability --spare-rate. Prints the machine, the inputs, one row
+per run (what the policy breaks, the steps it dooms, the outcome, failovers, the unmet step) and a
+summary: runs that kept a healthy provider for every step and how many of them succeeded; doomed runs
+and how they ended (failed naming the unmet requirement, or succeeded because the faults struck after
+the components' last use).
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib.metadata
+import os
+import platform
+import time
+from collections import Counter
+
+from actions.composer import Composer
+from actions.faults import RandomFaults, doomed_steps, planned_faults
+from actions.runner import run_task
+from kb import KnowledgeBase
+from kb.namespaces import shorten
+from sim.components import SimEnvironment
+from sim.world import HomeWorld
+
+TASKS = ("FetchMyPen", "RobotArmServeACup")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--seeds", type=int, default=20, help="fault seeds 0..N-1 per task and regime")
+    parser.add_argument("--rate", type=float, default=0.1, help="fault probability per component (all)")
+    parser.add_argument("--spare-rate", type=float, default=0.5, help="fault probability (spare regime)")
+    parser.add_argument("--quiet", action="store_true", help="print the summary only")
+    args = parser.parse_args()
+    print(
+        f"machine: {platform.platform()}, {os.cpu_count()} cores, python {platform.python_version()}, "
+        f"pybullet {importlib.metadata.version('pybullet')}"
+    )
+    print(
+        f"inputs: tasks {', '.join(TASKS)}; fault seeds 0-{args.seeds - 1}; regimes all (rate {args.rate}) "
+        f"and spare (rate {args.spare_rate}); max_after_ticks 2; world seed 0; DIRECT, headless\n"
+    )
+    kb = KnowledgeBase.open(":memory:")
+    composer = Composer(kb)
+    summary: Counter[tuple[str, str, str]] = Counter()
+    started = time.perf_counter()
+    if not args.quiet:
+        print(f"{'task':<18} {'regime':<6} {'seed':>4} {'broken':>6} {'doomed':<10} {'status':<10} {'fo':>2}  unmet")
+    for task in TASKS:
+        plan = composer.compose(task).plan
+        assert plan is not None, task
+        spare = frozenset(c for s in plan.steps if s.alternatives for c in s.candidates)
+        for regime in ("all", "spare"):
+            for seed in range(args.seeds):
+                if regime == "all":
+                    policy = RandomFaults(seed, args.rate)
+                else:
+                    policy = RandomFaults(seed, args.spare_rate, among=spare)
+                doomed = doomed_steps(policy, plan)
+                world = HomeWorld.create(seed=0)
+                try:
+                    result = run_task(kb, task, SimEnvironment(world, kb), composer=composer, fault_policy=policy)
+                finally:
+                    world.close()
+                report = result.report
+                assert report is not None
+                failovers = sum(1 for s in report.steps if s.failed_over)
+                kind = "doomed" if doomed else "healthy"
+                outcome = report.status.value
+                if report.unmet is not None:
+                    outcome += " (unmet named)" if report.unmet.step in doomed else " (unmet elsewhere!)"
+                summary[(task, kind, outcome)] += 1
+                if not args.quiet:
+                    last = report.unmet.tried[-1].component if report.unmet and report.unmet.tried else ""
+                    unmet = f"step {report.unmet.step}: {shorten(last)}" if report.unmet else "-"
+                    print(
+                        f"{task:<18} {regime:<6} {seed:>4} {len(planned_faults(policy, plan)):>6} "
+                        f"{','.join(map(str, doomed)) or '-':<10} {report.status.value:<10} {failovers:>2}  {unmet}"
+                    )
+    print(f"\n{'task':<18} {'faults leave':<13} {'ended':<26} {'runs':>4}")
+    for (task, kind, outcome), count in sorted(summary.items()):
+        print(f"{task:<18} {('a provider' if kind == 'healthy' else 'none (doomed)'):<13} {outcome:<26} {count:>4}")
+    print(f"\n{sum(summary.values())} runs in {time.perf_counter() - started:.0f} s")
+
+
+if __name__ == "__main__":
+    main()
