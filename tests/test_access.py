@@ -12,7 +12,6 @@ import json
 import os
 import socket
 import threading
-import time
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -29,6 +28,7 @@ from cbrs.tasks import TaskRunner
 from cbrs.web import create_app
 from kb import KnowledgeBase
 from kb.catalog import Catalogue
+from tests.helpers_threads import assert_threads_end
 from tests.test_serve import bridge, call
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -215,9 +215,7 @@ def _serve(kb: KnowledgeBase, endpoint: EndpointConfig) -> Iterator[Server]:
     running.start()
     yield running
     running.stop(timeout=WAIT)
-    deadline = time.monotonic() + WAIT
-    while threading.active_count() > threads and time.monotonic() < deadline:
-        time.sleep(0.05)
+    assert_threads_end(threads, WAIT)
 
 
 def test_hostile_values_in_bridge_service_arguments_change_nothing(server: Server) -> None:

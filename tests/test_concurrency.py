@@ -10,7 +10,6 @@ published after its subscribe, exactly once, in order per publisher.
 from __future__ import annotations
 
 import threading
-import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
@@ -22,6 +21,7 @@ from cbrs.server import ServeConfig, Server
 from cbrs.sparql_service import EndpointConfig
 from kb import KnowledgeBase
 from tests.helpers_concurrency import BATCH_QUERY, WAIT, BridgeLoad, SparqlLoad, bridge_load, canonical, sparql_load
+from tests.helpers_threads import assert_threads_end
 
 TOKEN = "concurrency-test-token"
 READERS = 8
@@ -57,10 +57,7 @@ def start_server() -> Iterator[StartServer]:
     yield start
     for server in started:
         server.stop(timeout=WAIT)
-    deadline = time.monotonic() + WAIT
-    while threading.active_count() > threads and time.monotonic() < deadline:
-        time.sleep(0.05)
-    assert threading.active_count() <= threads, [t.name for t in threading.enumerate()]
+    assert_threads_end(threads, WAIT)
 
 
 def _stable_query(kb: KnowledgeBase) -> str:

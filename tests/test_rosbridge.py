@@ -22,6 +22,7 @@ from websockets.sync.client import ClientConnection, connect
 from cbrs.rosbridge import Bridge, ParamStore, RosbridgeError, RunningBridge, ServiceError, UnknownTopicError
 from cbrs.rosbridge.outbox import TopicQueue
 from cbrs.rosbridge.workers import WorkerPool
+from tests.helpers_threads import assert_threads_end
 
 WAIT = 3.0  # seconds any single answer may take before a test fails
 
@@ -197,10 +198,7 @@ def server(bridge: Bridge) -> Iterator[RunningBridge]:
     running = bridge.start(port=0)
     yield running
     assert running.stop(timeout=5.0)
-    deadline = time.monotonic() + WAIT  # websockets' client threads end just after their close
-    while threading.active_count() > threads and time.monotonic() < deadline:
-        time.sleep(0.01)
-    assert threading.active_count() == threads, threading.enumerate()
+    assert_threads_end(threads, WAIT)
 
 
 @pytest.fixture
@@ -637,10 +635,7 @@ def test_stop_closes_connections_and_a_second_serve_is_refused(bridge: Bridge) -
     again = bridge.start(port=0)  # a stopped bridge can be served again
     Client(again.url).close()
     assert again.stop()
-    deadline = time.monotonic() + WAIT
-    while threading.active_count() > threads and time.monotonic() < deadline:
-        time.sleep(0.01)
-    assert threading.active_count() == threads
+    assert_threads_end(threads, WAIT)
 
 
 def test_stop_does_not_wait_for_ever_on_a_stuck_handler() -> None:

@@ -10,13 +10,13 @@ import json
 import shutil
 import subprocess
 import threading
-import time
 from pathlib import Path
 from typing import Any
 
 import pytest
 
 from cbrs.rosbridge import Bridge, ServiceError
+from tests.helpers_threads import assert_threads_end
 
 JS = Path(__file__).parent / "js"
 NODE = shutil.which("node")
@@ -58,7 +58,4 @@ def test_roslibjs_round_trips() -> None:
         "deleted": {"failed": "parameter '/test/gain' is not set"},  # roslibjs reads successful/reason
     }
     assert bridge.topics() == [("/test/events", "test/Event")]
-    deadline = time.monotonic() + 5.0
-    while threading.active_count() > threads and time.monotonic() < deadline:
-        time.sleep(0.01)
-    assert threading.active_count() == threads
+    assert_threads_end(threads, 5.0)

@@ -27,6 +27,7 @@ from cbrs.sparql_service import EndpointConfig
 from kb import KnowledgeBase
 from kb.namespaces import expand
 from reasoner.matchmaker import Matchmaker
+from tests.helpers_threads import assert_threads_end
 
 WAIT = 10.0
 TOKEN = "serve-test-token"
@@ -40,10 +41,7 @@ def server(fresh_bundled_kb: KnowledgeBase) -> Iterator[Server]:
     running.start()
     yield running
     running.stop(timeout=WAIT)
-    deadline = time.monotonic() + WAIT
-    while threading.active_count() > threads and time.monotonic() < deadline:
-        time.sleep(0.05)
-    assert threading.active_count() <= threads, [t.name for t in threading.enumerate()]
+    assert_threads_end(threads, WAIT)
 
 
 def bridge(server: Server) -> ClientConnection:
