@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 
 import click
 
+from cbrs.settings import setting
 from kb import KnowledgeBase
 from kb.namespaces import expand
 
@@ -20,7 +21,7 @@ class App:
     @property
     def kb(self) -> KnowledgeBase:
         if self._kb is None:
-            self._kb = KnowledgeBase.open(self.store_location)
+            self._kb = KnowledgeBase.open(self.store_location, remote_timeout=setting("remote_timeout").resolve())
         return self._kb
 
     def close(self) -> None:

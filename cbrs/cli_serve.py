@@ -55,6 +55,7 @@ def serve(
         bridge_port=setting("bridge_port").resolve(bridge_port),
         endpoint=EndpointConfig(
             timeout=setting("query_timeout").resolve(),
+            workers=setting("query_workers").resolve(),
             max_result_bytes=setting("max_result_bytes").resolve(),
             max_query_bytes=setting("max_query_bytes").resolve(),
             update_token=setting("update_token").resolve(_read_token(update_token_file)),
@@ -73,7 +74,10 @@ def serve(
         else:
             access = "read-write with the update token" if running.sparql.writable else "read-only"
         click.echo(f"cbrs serving {app.kb.store.location} ({access})")
-        click.echo(f"  SPARQL    http://{host_text}:{running.http_port}/sparql")
+        click.echo(
+            f"  SPARQL    http://{host_text}:{running.http_port}/sparql "
+            f"({config.endpoint.workers} query workers, {config.endpoint.timeout:g} s timeout)"
+        )
         click.echo(f"  rosbridge ws://{host_text}:{running.bridge_port}")
         click.echo("Ctrl-C stops.", nl=True)
 

@@ -123,6 +123,20 @@ SETTINGS: tuple[Setting, ...] = (
         _positive(float),
     ),
     Setting(
+        "query_workers",
+        lambda: 4,
+        "SPARQL queries the endpoint runs at once; one more is refused with 503 busy rather than queued.",
+        "CBRS_QUERY_WORKERS",
+        _positive(int),
+    ),
+    Setting(
+        "remote_timeout",
+        lambda: 60.0,
+        "Seconds to wait for a remote store (an http:// store) to answer one request before giving up.",
+        "CBRS_REMOTE_TIMEOUT",
+        _positive(float),
+    ),
+    Setting(
         "max_result_bytes",
         lambda: 64 * 1024 * 1024,
         "Largest serialised SPARQL result the endpoint returns; larger ones are refused with 422.",

@@ -116,7 +116,7 @@ class EndpointBusyError(EndpointError):
     kind = "busy"
 
     def __init__(self, workers: int) -> None:
-        super().__init__(f"all {workers} query workers are busy; retry shortly")
+        super().__init__(f"all {workers} query workers are busy; retry shortly (setting query_workers)")
 
 
 class UpdateForbiddenError(EndpointError):

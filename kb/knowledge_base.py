@@ -15,7 +15,7 @@ from kb.namespaces import GraphName
 from kb.queries import QueryLibrary
 from kb.registry import ComponentRegistry
 from kb.resources import bundled_files, query_dir
-from kb.store import QueryResult, Store, Term
+from kb.store import QueryResult, Store, Term, is_remote
 
 
 class KnowledgeBase:
@@ -28,9 +28,15 @@ class KnowledgeBase:
         self._reader = DescriptionReader(store, self.queries)
 
     @classmethod
-    def open(cls, location: str | Path, seed: bool = True) -> KnowledgeBase:
-        """Open the store at ``location`` (a directory or ``:memory:``), seeding it on first use."""
-        kb = cls(Store.open(location))
+    def open(cls, location: str | Path, seed: bool = True, remote_timeout: float | None = None) -> KnowledgeBase:
+        """Open the store at ``location`` (a directory, ``:memory:`` or an endpoint URL), seeding it on first use."""
+        if remote_timeout is not None and is_remote(str(location)):
+            from kb.remote_store import RemoteStore  # only a remote store needs the HTTP client
+
+            store: Store = RemoteStore.open(location, remote_timeout)
+        else:
+            store = Store.open(location)
+        kb = cls(store)
         if seed and not kb.store.is_seeded():
             kb.seed()
         return kb

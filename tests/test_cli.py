@@ -199,7 +199,7 @@ def test_demo_tours_the_paper_example() -> None:
 
 
 def test_unexpected_errors_are_one_line(monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]) -> None:
-    def explode(*_: object) -> None:
+    def explode(*_: object, **__: object) -> None:
         raise RuntimeError("disk on fire")
 
     monkeypatch.setattr("cbrs.app.KnowledgeBase.open", explode)

@@ -229,6 +229,16 @@ def test_a_silent_server_times_out() -> None:
             RemoteStore.open(url, timeout=0.2)
 
 
+def test_the_cli_waits_for_a_silent_server_as_long_as_remote_timeout_says() -> None:
+    with socket.socket() as listener:
+        listener.bind(("127.0.0.1", 0))
+        listener.listen(4)
+        url = f"http://127.0.0.1:{listener.getsockname()[1]}"
+        result = CliRunner().invoke(cli, ["--store", url, "services"], env={"CBRS_REMOTE_TIMEOUT": "0.3"})
+    assert result.exit_code == 1
+    assert result.output.count("\n") == 1 and "did not answer within 0.3 s" in result.output, result.output
+
+
 def test_syntax_errors_read_as_on_the_embedded_store(remote_location: str) -> None:
     text = "SELECT ?x\nWHERE { ?x "
     messages = []

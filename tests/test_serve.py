@@ -219,7 +219,7 @@ class Output:
 
 
 def test_cbrs_serve_command_serves_until_ctrl_c(tmp_path: Any) -> None:
-    env = dict(os.environ, CBRS_STORE=":memory:", HOME=str(tmp_path))
+    env = dict(os.environ, CBRS_STORE=":memory:", HOME=str(tmp_path), CBRS_QUERY_WORKERS="2")
     env.pop("CBRS_UPDATE_TOKEN", None)
     command = [sys.executable, "-m", "cbrs", "serve", "--port", "0", "--bridge-port", "0"]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env=env)
@@ -227,7 +227,9 @@ def test_cbrs_serve_command_serves_until_ctrl_c(tmp_path: Any) -> None:
         output = Output(process)
         lines = output.until("Ctrl-C stops", timeout=60)
         assert "read-only" in lines[0]
-        sparql_url = next(line.split()[-1] for line in lines if line.strip().startswith("SPARQL"))
+        sparql_line = next(line for line in lines if line.strip().startswith("SPARQL"))
+        assert "(2 query workers, 30 s timeout)" in sparql_line
+        sparql_url = sparql_line.split()[1]
         bridge_url = next(line.split()[-1] for line in lines if line.strip().startswith("rosbridge"))
         assert sparql_url.startswith("http://127.0.0.1:") and bridge_url.startswith("ws://127.0.0.1:")
         answer = httpx.get(sparql_url, params={"query": "ASK { ?s ?p ?o }"}, timeout=WAIT)
