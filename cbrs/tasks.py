@@ -209,7 +209,7 @@ class TaskRunner:
         RandomFaults(seed, fault_rate)  # an impossible rate fails here (FaultSpecError), not in the thread
         failing = tuple(expand(f) for f in faults)
         _check_components(failing)
-        self._refuse_if_busy()  # before taking the lock, which a run holds until it ends
+        self._refuse_if_busy()  # a second run is refused before its task is checked
         with self.lock:
             resolve_task(self.kb, ActionLibrary.from_kb(self.kb), task)  # an unknown task fails here, not in the thread
         with self._guard:
@@ -265,13 +265,17 @@ class TaskRunner:
                 self._capture(world, run.id)
 
         try:
-            with self.lock, open_world(seed=run.seed) as world:
+            # The lock covers reading the taxonomy, actions and components as one view (an update cannot
+            # land half-way); the run itself only writes its plan and the world graph, one transaction
+            # each, so matchmaking, plans and queries go on while the robot moves.
+            with self.lock:
+                composer = Composer(self.kb)
+                _ = composer.pool  # built now, under the lock
+            with open_world(seed=run.seed) as world:
                 self._capture(world, run.id)
                 environment = SimEnvironment(world, self.kb)
                 policy = RandomFaults(run.seed, run.fault_rate) if run.fault_rate > 0 else None
-                result = run_task(
-                    self.kb, run.task, environment, run.faults, Composer(self.kb), follow, fault_policy=policy
-                )
+                result = run_task(self.kb, run.task, environment, run.faults, composer, follow, fault_policy=policy)
                 found = result.to_dict()
                 found["sim_seconds"] = round(world.time, 3)
             run.result = found

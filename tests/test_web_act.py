@@ -181,6 +181,40 @@ def test_a_started_run_succeeds_and_a_second_is_refused_while_it_goes(live: tupl
     assert "failover" in page and "status-succeeded" in page
 
 
+def test_matchmaking_and_plans_answer_while_a_run_is_going(
+    live: tuple[Flask, TaskRunner], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A run holds the knowledge-base lock only while it reads its view, not while the robot moves."""
+    app, runner = live
+    moving, release = threading.Event(), threading.Event()
+
+    def held_run(*_: object, **__: object) -> None:
+        moving.set()
+        release.wait(RUN_WAIT)  # the robot "moves" until the test has its answers
+        raise RuntimeError("run stopped by the test")
+
+    monkeypatch.setattr("cbrs.tasks.run_task", held_run)
+    client = app.test_client()
+    run_id = start(client).get_json()["started"]["id"]
+    try:
+        assert moving.wait(RUN_WAIT)
+        answers: list[int] = []
+
+        def ask() -> None:
+            answers.append(client.get("/match.json", query_string={"requirement": "req:RobotSelfPosition"}).status_code)
+            answers.append(client.get("/plans.json", query_string={"task": "FetchMyPen"}).status_code)
+
+        asking = threading.Thread(target=ask)
+        asking.start()
+        asking.join(60.0)
+        assert answers == [200, 200], "matchmaking or plans waited for the running task"
+        assert not runner.get(run_id).done.is_set()
+    finally:
+        release.set()
+    wait_done(runner, run_id)
+    assert runner.get(run_id).status == "error" and "stopped by the test" in (runner.get(run_id).error or "")
+
+
 @pytest.mark.parametrize(
     ("form", "field"),
     [
