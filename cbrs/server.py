@@ -125,6 +125,10 @@ class Server:
         server, self._http = self._http, None
         server.task_dispatcher.shutdown(timeout=timeout)
         # Close every socket from the server's own loop thread; the loop ends once its map is empty.
-        server.trigger.pull_trigger(lambda: wasyncore.close_all(self._http_map))
+        try:
+            server.trigger.pull_trigger(lambda: wasyncore.close_all(self._http_map))
+        except OSError as error:  # the loop's wake-up pipe is gone, so the loop cannot be asked: close here
+            log.warning("HTTP loop could not be woken (%s); closing its sockets from this thread", error)
+            wasyncore.close_all(self._http_map, ignore_all=True)
         if self._http_thread is not None:
             self._http_thread.join(timeout)
