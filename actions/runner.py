@@ -16,7 +16,7 @@ from actions.components import Container, Registry
 from actions.composer import Composer, CompositionResult, PlanStatus, store_plan
 from actions.events import Event, EventBus
 from actions.executor import ExecutionReport, Executor, RunStatus
-from actions.faults import FaultPolicy
+from actions.faults import Combined, FaultPolicy, FixedFaults
 from actions.plan import Plan, PlanStep
 from kb import KnowledgeBase, Requirement, Statement
 
@@ -81,9 +81,9 @@ def run_task(
     bus = EventBus()
     if on_event is not None:
         bus.subscribe("*", on_event)
-    container = Container(environment.registry, environment.context, bus, fault_policy)
-    for iri in faults:
-        container.inject_fault(iri)
+    failing = FixedFaults.of(faults)
+    policy = failing if fault_policy is None else Combined((failing, fault_policy))
+    container = Container(environment.registry, environment.context, bus, policy)
     requirements = {r.iri: r for r in kb.requirements()}
     belief = BeliefState(kb)
     belief.write(environment.observe())
