@@ -21,7 +21,11 @@ class App:
     @property
     def kb(self) -> KnowledgeBase:
         if self._kb is None:
-            self._kb = KnowledgeBase.open(self.store_location, remote_timeout=setting("remote_timeout").resolve())
+            self._kb = KnowledgeBase.open(
+                self.store_location,
+                remote_timeout=setting("remote_timeout").resolve(),
+                check_timeout=setting("query_check_timeout").resolve(),
+            )
         return self._kb
 
     def close(self) -> None:

@@ -130,6 +130,14 @@ SETTINGS: tuple[Setting, ...] = (
         _positive(int),
     ),
     Setting(
+        "query_check_timeout",
+        lambda: 10.0,
+        "Seconds an isolated checker may take to parse a query or update longer than 512 characters "
+        "before it reaches the store; texts that crash or outlast it are refused (docs/security.md).",
+        "CBRS_QUERY_CHECK_TIMEOUT",
+        _positive(float),
+    ),
+    Setting(
         "remote_timeout",
         lambda: 60.0,
         "Seconds to wait for a remote store (an http:// store) to answer one request before giving up.",

@@ -30,6 +30,7 @@ from werkzeug.http import parse_accept_header
 
 from kb import KnowledgeBase
 from kb.errors import KnowledgeBaseError, StoreEvaluationError
+from kb.query_guard import start_evaluation_thread
 
 # Media types offered for SELECT and ASK results, the first being the default.
 RESULT_TYPES: dict[str, ox.QueryResultsFormat] = {
@@ -199,7 +200,7 @@ class SparqlService:
         # A daemon thread, not a pool's: an abandoned query must not keep the process from exiting.
         worker = threading.Thread(target=work, name="cbrs-sparql-query", daemon=True)
         try:
-            worker.start()
+            start_evaluation_thread(worker)  # the stack kb.query_guard's margin is measured against
         except BaseException:
             self._slots.release()
             raise

@@ -135,6 +135,18 @@ class QuerySyntaxError(KnowledgeBaseError):
         super().__init__(f"SPARQL syntax error: {one_line}")
 
 
+class QueryTooComplexError(QuerySyntaxError):
+    """A query or update the store's SPARQL engine cannot run without risking the process (see
+    :mod:`kb.query_guard`): it crashed an isolated checker, or could not be checked in time."""
+
+    def __init__(self, query: str, message: str) -> None:
+        super().__init__(query, message)
+        self.args = (f"refused: {' '.join(message.split())}",)
+
+    def __str__(self) -> str:
+        return str(self.args[0])
+
+
 class NotFoundError(KnowledgeBaseError):
     """No resource with this IRI is described in the store."""
 

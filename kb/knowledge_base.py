@@ -13,9 +13,10 @@ from kb.loader import LoadReport, ParsedFile, load_files, parse_file
 from kb.model import Advertisement, PartNode, Requirement, ServiceDescription
 from kb.namespaces import GraphName
 from kb.queries import QueryLibrary
+from kb.query_guard import QueryGuard
 from kb.registry import ComponentRegistry
 from kb.resources import bundled_files, query_dir
-from kb.store import QueryResult, Store, Term, is_remote
+from kb.store import EmbeddedStore, QueryResult, Store, Term, is_remote
 
 
 class KnowledgeBase:
@@ -28,14 +29,26 @@ class KnowledgeBase:
         self._reader = DescriptionReader(store, self.queries)
 
     @classmethod
-    def open(cls, location: str | Path, seed: bool = True, remote_timeout: float | None = None) -> KnowledgeBase:
-        """Open the store at ``location`` (a directory, ``:memory:`` or an endpoint URL), seeding it on first use."""
+    def open(
+        cls,
+        location: str | Path,
+        seed: bool = True,
+        remote_timeout: float | None = None,
+        check_timeout: float | None = None,
+    ) -> KnowledgeBase:
+        """Open the store at ``location`` (a directory, ``:memory:`` or an endpoint URL), seeding it on first use.
+
+        ``check_timeout`` bounds how long an embedded store's query guard checks a long text (see
+        :mod:`kb.query_guard`).
+        """
         if remote_timeout is not None and is_remote(str(location)):
             from kb.remote_store import RemoteStore  # only a remote store needs the HTTP client
 
             store: Store = RemoteStore.open(location, remote_timeout)
         else:
             store = Store.open(location)
+        if check_timeout is not None and isinstance(store, EmbeddedStore) and check_timeout != store.guard.timeout:
+            store.guard = QueryGuard(timeout=check_timeout)
         kb = cls(store)
         if seed and not kb.store.is_seeded():
             kb.seed()

@@ -19,14 +19,15 @@ import pyoxigraph as ox
 
 from kb.errors import QuerySyntaxError, StoreError, StoreEvaluationError
 from kb.namespaces import GENID, PREFIXES, GraphName
+from kb.query_guard import QueryGuard
 
 MEMORY = ":memory:"
 REMOTE_SCHEMES = ("http://", "https://")
 
 MAX_NESTING = 256
-"""The deepest bracket nesting a query or update may have. Oxigraph's SPARQL parser recurses once per
-level and overflows a thread's stack (killing the process) at about 3,000; hand-written and generated
-queries stay within a few dozen."""
+"""The deepest bracket nesting a query or update may have: a quick, clear refusal of the commonest deep
+text. It is not what keeps the process alive (other constructs recurse as deeply without brackets);
+:mod:`kb.query_guard` is."""
 
 # What can hide a bracket (strings, IRIs, comments) or is one; anything else is skipped.
 _LEXEME = re.compile(
@@ -125,7 +126,11 @@ class Store(ABC):
         if adding:
             parts.append("INSERT DATA {\n" + adding + "}")
         if parts:
-            self.update(" ;\n".join(parts))
+            self._apply_own_update(" ;\n".join(parts))
+
+    def _apply_own_update(self, text: str) -> None:
+        """Run an update cbrs wrote itself from validated terms (flat data blocks)."""
+        self.update(text)
 
     @abstractmethod
     def update(self, text: str) -> None:
@@ -168,7 +173,13 @@ def is_remote(location: str) -> bool:
 
 
 class EmbeddedStore(Store):
-    """An Oxigraph store in this process, on disk or in memory."""
+    """An Oxigraph store in this process, on disk or in memory.
+
+    Every query and update text passes :attr:`guard` first, so that no text can crash the process
+    (see :mod:`kb.query_guard`); the texts cbrs writes itself (:meth:`replace`) are flat and skip it.
+    """
+
+    guard = QueryGuard()  # one per process: its checker processes serve every store
 
     def __init__(self, backend: ox.Store, location: str) -> None:
         self._open: ox.Store | None = backend
@@ -219,6 +230,7 @@ class EmbeddedStore(Store):
             ox.Variable(name): value for name, value in (bindings or {}).items()
         }
         refuse_deep_nesting(text)
+        self.guard.admit("query", text)
         try:
             return self._backend.query(
                 text, prefixes=PREFIXES, use_default_graph_as_union=True, substitutions=substitutions
@@ -264,6 +276,10 @@ class EmbeddedStore(Store):
     def update(self, text: str) -> None:
         """Run a SPARQL update in one transaction."""
         refuse_deep_nesting(text)
+        self.guard.admit("update", text)
+        self._apply_own_update(text)
+
+    def _apply_own_update(self, text: str) -> None:
         try:
             self._backend.update(text, prefixes=PREFIXES)
         except SyntaxError as error:
