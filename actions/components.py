@@ -241,6 +241,10 @@ class Registry:
     def __contains__(self, iri: object) -> bool:
         return iri in self._makers
 
+    def names(self) -> list[str]:
+        """The IRIs of the components this registry can make."""
+        return sorted(self._makers)
+
     def __call__(self, iri: str) -> Component:
         maker = self._makers.get(iri)
         if maker is None:

@@ -35,7 +35,7 @@ from actions.graph import SRE, SRI, SRO, Edge, Matcher, Need, ServicePool, Servi
 from actions.model import ActionLibrary, Task, resolve_task
 from actions.plan import Binding, Plan, PlanStep, Source
 from actions.search import SearchTrace, bidirectional_search
-from kb import Advertisement, KnowledgeBase, Requirement
+from kb import Advertisement, KnowledgeBase, Requirement, Statement
 from kb.namespaces import GraphName, shorten
 from reasoner.config import MatchConfig
 from reasoner.taxonomy import TaxonomyIndex
@@ -480,6 +480,7 @@ class _Extraction:
                             shorten(self.steps[second].node),
                         )
                     dag.add_edge(first, second)
+        self._protect(index, dag)
         placed: dict[int, int] = {}  # step -> position counted from the end
         reverse: list[int] = []
         waiting = {s: set(dag.successors(s)) for s in dag.nodes}
@@ -491,6 +492,36 @@ class _Extraction:
             placed[chosen] = len(reverse)
             reverse.append(chosen)
         return list(reversed(reverse))
+
+    def _protect(self, index: TaxonomyIndex, dag: nx.DiGraph[int]) -> None:
+        """Order every step that deletes a statement a consumer relies on outside the span from its
+        producer to its consumer: before the producer, or else after the consumer (a goal must still
+        hold at the end, so its threats go before its producer). A threat that fits neither way is
+        left, and execution's verification catches it."""
+        deleting = {
+            s.id: ad.deletes
+            for s in self.steps.values()
+            if s.id != 0 and (ad := self.graph.vertices[s.node].advertisement) is not None and ad.deletes
+        }
+        for consumer in sorted(self.steps.values(), key=lambda s: s.id):
+            for bound in consumer.bindings:
+                needed = bound.need.statement
+                if needed is None:
+                    continue
+                for threat, deletes in sorted(deleting.items()):
+                    if threat in (consumer.id, bound.source) or not any(
+                        _threatens(index, deleted, needed) for deleted in deletes
+                    ):
+                        continue
+                    options = []
+                    if bound.source is not None:
+                        options.append((threat, bound.source))
+                    if consumer.id != 0:
+                        options.append((consumer.id, threat))
+                    for before, after in options:
+                        if dag.has_edge(before, after) or not nx.has_path(dag, after, before):
+                            dag.add_edge(before, after)
+                            break
 
     def _alternatives(self, step: _Step) -> list[str]:
         """Components that accept this step's bindings and meet every need it serves."""
@@ -527,6 +558,17 @@ def _is_a(index: TaxonomyIndex, concept: str, ancestor: str) -> bool:
     if concept == ancestor:
         return True
     return concept in index and ancestor in index and index.canonical(ancestor) in index.is_a_ancestors(concept)
+
+
+def _threatens(index: TaxonomyIndex, deleted: Statement, needed: Statement) -> bool:
+    """Whether deleting ``deleted`` may falsify ``needed``: the same relation, between things of which
+    one is a kind of the other on both ends."""
+    if deleted.predicate != needed.predicate:
+        return False
+    return all(
+        _is_a(index, a, b) or _is_a(index, b, a)
+        for a, b in ((deleted.subject, needed.subject), (deleted.object, needed.object))
+    )
 
 
 def _concatenate(task: Task, plans: list[Plan]) -> Plan:

@@ -23,6 +23,7 @@ from actions.faults import RandomFaults, doomed_steps, planned_faults
 from actions.runner import run_task
 from kb import KnowledgeBase
 from kb.namespaces import shorten
+from kb.semantic_map import SemanticMap
 from sim.components import SimEnvironment
 from sim.world import HomeWorld
 
@@ -61,7 +62,7 @@ def main() -> None:
                 else:
                     policy = RandomFaults(seed, args.spare_rate, among=spare)
                 doomed = doomed_steps(policy, plan)
-                world = HomeWorld.create(seed=0)
+                world = HomeWorld.create(seed=0, semantic_map=SemanticMap.read(kb))
                 try:
                     result = run_task(kb, task, SimEnvironment(world, kb), composer=composer, fault_policy=policy)
                 finally:

@@ -18,6 +18,7 @@ from actions.composer import Composer
 from actions.runner import run_task
 from kb import KnowledgeBase
 from kb.namespaces import expand
+from kb.semantic_map import SemanticMap
 from sim.components import SimEnvironment
 from sim.world import HomeWorld
 
@@ -46,7 +47,7 @@ def main() -> None:
     for task in TASKS:
         for seed in seeds:
             start = time.perf_counter()
-            world = HomeWorld.create(seed=seed)
+            world = HomeWorld.create(seed=seed, semantic_map=SemanticMap.read(kb))
             built = time.perf_counter() - start
             try:
                 start = time.perf_counter()

@@ -15,9 +15,10 @@ import time
 from collections.abc import Callable
 from importlib.metadata import version
 
-from sim import HomeWorld, ScenarioResult, build_occupancy_grid, fetch_pen, plan_path, serve_cup
+from sim import HomeWorld, build_occupancy_grid, plan_path
 from sim.layout import HANDOVER_POSE
 from sim.world import TIME_STEP
+from tests.reference_scenarios import ScenarioResult, fetch_pen, serve_cup
 
 
 def run(seed: int, scenario: Callable[[HomeWorld], ScenarioResult]) -> tuple[ScenarioResult, float, float]:

@@ -192,12 +192,12 @@ class TaskRunner:
         active = self._active
         return active[0] if active is not None and active[1].is_alive() else None
 
-    @staticmethod
-    def components() -> list[str]:
+    def components(self) -> list[str]:
         """The IRIs of the simulated components, which a run may be told to fail."""
-        from sim.components import IMPLEMENTATIONS, SVC
+        from sim.components import implementations
 
-        return sorted(SVC + name for name in IMPLEMENTATIONS)
+        with self.lock:
+            return sorted(implementations(self.kb).names())
 
     def start(self, task: str, seed: int = 0, faults: Iterable[str] = (), fault_rate: float = 0.0) -> TaskRun:
         """Check ``task`` and ``faults``, then run the task in the background; returns at once.
@@ -208,7 +208,7 @@ class TaskRunner:
             raise TasksDisabledError()
         RandomFaults(seed, fault_rate)  # an impossible rate fails here (FaultSpecError), not in the thread
         failing = tuple(expand(f) for f in faults)
-        _check_components(failing)
+        _check_components(self.kb, failing)
         self._refuse_if_busy()  # a second run is refused before its task is checked
         with self.lock:
             resolve_task(self.kb, ActionLibrary.from_kb(self.kb), task)  # an unknown task fails here, not in the thread
@@ -254,6 +254,7 @@ class TaskRunner:
             active[1].join(timeout)
 
     def _run(self, run: TaskRun) -> None:
+        from kb.semantic_map import SemanticMap
         from sim.components import SimEnvironment  # pybullet loads only when a task runs
         from sim.world import open_world
 
@@ -271,7 +272,8 @@ class TaskRunner:
             with self.lock:
                 composer = Composer(self.kb)
                 _ = composer.pool  # built now, under the lock
-            with open_world(seed=run.seed) as world:
+                semantic_map = SemanticMap.read(self.kb)
+            with open_world(seed=run.seed, semantic_map=semantic_map) as world:
                 self._capture(world, run.id)
                 environment = SimEnvironment(world, self.kb)
                 policy = RandomFaults(run.seed, run.fault_rate) if run.fault_rate > 0 else None
@@ -319,13 +321,16 @@ class TaskRunner:
 
     def _render_idle(self) -> None:
         """Render the home as it stands before any run: open a world, take one frame, close it."""
+        from kb.semantic_map import SemanticMap
         from sim.world import open_world
 
         with self._idle_render:
             if self._frame is not None or self.active() is not None or self.camera is None:
                 return  # rendered meanwhile, or a run is about to give frames of its own
             try:
-                with open_world(seed=0) as world:
+                with self.lock:
+                    semantic_map = SemanticMap.read(self.kb)
+                with open_world(seed=0, semantic_map=semantic_map) as world:
                     jpeg = _jpeg(world.camera(self.camera).capture().rgb)
             except Exception:
                 log.exception("camera frame of the idle home failed")
@@ -355,12 +360,12 @@ def _jpeg(rgb: Any) -> bytes:
     return buffer.getvalue()
 
 
-def _check_components(failing: tuple[str, ...]) -> None:
+def _check_components(kb: KnowledgeBase, failing: tuple[str, ...]) -> None:
     if not failing:
         return
     from sim.components import implementations
 
-    known = implementations()
+    known = implementations(kb)
     unknown = [shorten(f) for f in failing if f not in known]
     if unknown:
         raise UnknownComponentError(unknown)

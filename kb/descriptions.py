@@ -64,6 +64,7 @@ class DescriptionReader:
             outputs=parameters["output"],
             preconditions=conditions["precondition"],
             effects=conditions["effect"],
+            deletes=conditions["delete"],
             area=self._area(iri),
             qos=self._qos(iri),
         )
@@ -96,6 +97,7 @@ class DescriptionReader:
             outputs=parameters["output"],
             preconditions=conditions["precondition"],
             effects=conditions["effect"],
+            deletes=conditions["delete"],
             for_task=iri,
         )
 
@@ -154,7 +156,7 @@ class DescriptionReader:
     def _conditions(self, iri: str) -> dict[str, tuple[Statement, ...]]:
         """Preconditions and effects, from one query."""
         rows = self._queries.select(self._store, "description_conditions", {"description": iri})
-        found: dict[str, list[Statement]] = {"precondition": [], "effect": []}
+        found: dict[str, list[Statement]] = {"precondition": [], "effect": [], "delete": []}
         for row in rows:
             role = _value(row["role"])
             missing = [part for part in ("subject", "predicate", "object") if part not in row]

@@ -52,7 +52,17 @@ class KnowledgeBase:
         kb = cls(store)
         if seed and not kb.store.is_seeded():
             kb.seed()
+        elif seed and GraphName.MAP.iri not in kb.store.graphs():
+            kb.add_semantic_map()
         return kb
+
+    def add_semantic_map(self) -> None:
+        """Bring a store seeded before the semantic map existed up to date: the bundled ontology files
+        are added again (their new terms join; nothing is removed) and the bundled map is loaded."""
+        wanted = (GraphName.ONTOLOGY, GraphName.MAP)
+        parsed = [parse_file(item.path, item.graph) for item in bundled_files() if item.graph in wanted]
+        self.store.add(quad for item in parsed for quad in item.quads)
+        self._reader.clear_cache()
 
     def seed(self) -> list[ParsedFile]:
         """Load the bundled ontologies, advertisements and requirements in one transaction."""

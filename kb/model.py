@@ -95,6 +95,8 @@ class ServiceDescription:
     outputs: tuple[Parameter, ...] = ()
     preconditions: tuple[Statement, ...] = ()
     effects: tuple[Statement, ...] = ()
+    deletes: tuple[Statement, ...] = ()
+    """Statements that stop being true when the service has run (delete effects)."""
     area: EffectiveArea | None = None
     qos: tuple[QoSValue, ...] = ()
 

@@ -55,6 +55,7 @@ class GraphName(StrEnum):
     ONTOLOGY = "ontology"
     SERVICES = "services"
     REQUIREMENTS = "requirements"
+    MAP = "map"
     WORLD = "world"
     PLANS = "plans"
 

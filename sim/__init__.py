@@ -4,7 +4,8 @@ A library (no CLI, no knowledge base): ``HomeWorld`` builds the home; ``cameras`
 ``perception`` localises the base, tracks the person and recognises objects from those images;
 ``mapping`` and ``planning`` are the map server and the path planners; ``skills`` are the robots'
 actions, each returning an ``Outcome``; ``predicates`` check the knowledge base's statements against
-the simulated world; ``scenarios`` runs the paper's two scenarios with fixed skill sequences.
+the simulated world. (The paper's two scenarios as fixed skill sequences, the reference runs, are
+in tests/reference_scenarios.py.)
 See docs/simulation.md.
 """
 
@@ -27,7 +28,7 @@ from sim.errors import (
     WorldClosedError,
 )
 from sim.geometry import Pose2D, Pose3D, Region
-from sim.grasping import CUP, PEN, GraspPose, ObjectModel, compute_grasp_pose
+from sim.grasping import GraspPose, ObjectModel, compute_grasp_pose
 from sim.mapping import OccupancyGrid, build_occupancy_grid
 from sim.perception import (
     ObjectEstimate,
@@ -38,13 +39,10 @@ from sim.perception import (
     track_person,
 )
 from sim.planning import PlannedPath, plan_path
-from sim.scenarios import ScenarioResult, fetch_pen, serve_cup
 from sim.skills import Outcome
 from sim.world import HomeWorld, open_world
 
 __all__ = [
-    "CUP",
-    "PEN",
     "ArmSide",
     "CameraUnavailableError",
     "GraspPose",
@@ -65,7 +63,6 @@ __all__ = [
     "Pose3D",
     "Region",
     "RobotPoseEstimate",
-    "ScenarioResult",
     "SimulationError",
     "UnknownAlgorithmError",
     "UnknownColourError",
@@ -73,11 +70,9 @@ __all__ = [
     "WorldClosedError",
     "build_occupancy_grid",
     "compute_grasp_pose",
-    "fetch_pen",
     "locate_robot",
     "open_world",
     "plan_path",
     "recognise_object",
-    "serve_cup",
     "track_person",
 ]

@@ -1,35 +1,37 @@
 """The simulation as an execution environment: components for the home's advertised services.
 
-Each advertised component of ``ontologies/services.ttl`` that acts in the home has an implementation
-here, built on the ``sim`` library: localisation from the ceiling camera image, recognition by colour
-with the Kinect's depth, the map server, A* and Dijkstra on the grid, the arm and base skills. One
-tick of a component runs one whole skill (the skill steps the physics itself), so an executor tick is
-a unit of work, not of time; durations are reported in simulated seconds.
+Each advertised component that acts in the home is implemented by the skill its service names
+(``LocateMobileRobot``, ``ApproachToObject``...), on the device the store says it runs on: a
+ceiling camera's localiser uses that camera, wherever it hangs. One tick of a component runs one
+whole skill (the skill steps the physics itself), so an executor tick is a unit of work, not of time;
+durations are reported in simulated seconds.
 
-``SimEnvironment`` also gives the task's inputs (the world's cup, pen, person, regions), verifies the
-statements a plan relies on against the simulated world, and observes the world for the belief
-state (the world graph).
+Nothing here names an object, a place or an arm. ``SimEnvironment`` resolves a task's inputs to
+things of the semantic map by SPARQL (:func:`kb.semantic_map.designate`), components read what they
+need of a thing (its size, colour, grasp, docking pose) from the map, the arm is the free one that
+reaches, and a statement is verified by the generic test the store maps its predicate to
+(``home:computedBy``: inside, on, near, above, grasped-by, with, contains, localised-in, perceived).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
-from actions.belief import WORLD, Observation
+from actions.belief import Observation
 from actions.components import Component, Registry, Status
 from actions.plan import Plan, PlanStep
 from kb import KnowledgeBase, Requirement, Statement
 from kb.namespaces import PREFIXES
+from kb.semantic_map import SemanticMap, Thing, designate, local_name
 from sim import predicates as pred
 from sim import skills
 from sim.arms import ArmSide
 from sim.errors import SimulationError
 from sim.geometry import Pose2D, Region
-from sim.grasping import CUP, PEN, ObjectModel, compute_grasp_pose
-from sim.layout import ARM_MOUNTS, BELOW_OF_TAP, DISPENSER, HANDOVER_POSE, TABLE, TAP_LEVER, room_of
+from sim.grasping import GraspPose, ObjectModel, compute_grasp_pose
 from sim.mapping import OccupancyGrid, build_occupancy_grid
 from sim.perception import (
     ObjectEstimate,
@@ -42,87 +44,52 @@ from sim.perception import (
 from sim.planning import plan_path
 from sim.world import HomeWorld
 
-__all__ = ["MarkerColours", "Place", "SimContext", "SimEnvironment", "implementations"]
+__all__ = ["GraspPlan", "SimContext", "SimEnvironment", "designator", "implementations"]
 
 HOME = PREFIXES["home"]
-SVC = PREFIXES["svc"]
-MODELS = {"Cup": CUP, "Pen": PEN}
-ARM_FOR = {"Cup": ArmSide.LEFT, "Pen": ArmSide.RIGHT}  # the cup's arm leaves the other for the tap
-TAP_ARM = ArmSide.RIGHT
 LOCALISATION_TOLERANCE = 0.10
 """A localisation is believed (isLocalisedIn holds) when it is within this distance (m) of the truth."""
+ARM_TIE = 0.01
+"""Two arms whose mounts are within 1 cm as far from a target reach it equally well."""
 
 
-@dataclass(frozen=True)
-class MarkerColours:
-    """The two colours of the marker a mobile robot carries (front and rear patch)."""
-
-    front: str = "green"
-    rear: str = "magenta"
-
-
-@dataclass(frozen=True)
-class Place:
-    """A place where objects are kept, with the pose a mobile robot parks at to reach it."""
-
-    name: str
-    region: Region
-    approach: Pose2D
+def designator(iri: str, concept: str) -> dict[str, str]:
+    """A thing of the world as a value between steps: plain JSON, its IRI and the class it was asked as."""
+    return {"@id": iri, "@type": concept}
 
 
 @dataclass(frozen=True)
 class GraspPlan:
-    """What ComputeGraspPose gives: how to grasp this kind of object and with which arm; the grasp
-    pose itself is fixed against the object's position when the arm approaches."""
+    """What ComputeGraspPose gives: how to grasp this kind of object; the arm and the grasp pose itself
+    are fixed against the object's position when an arm approaches."""
 
     model: ObjectModel
-    arm: ArmSide
-
-
-PLACES = {WORLD + "KitchenTable": Place("KitchenTable", TABLE, HANDOVER_POSE)}
-
-# The world's things: individual IRI -> (class, body name in the simulation or None)
-THINGS: dict[str, tuple[str, str | None]] = {
-    WORLD + "Cup": (HOME + "Cup", "Cup"),
-    WORLD + "Pen": (HOME + "Pen", "Pen"),
-    WORLD + "Person": (HOME + "Person", "Person"),
-    SVC + "P3DX01": (HOME + "CarrierRobot", "P3DX01"),
-    WORLD + "P3DX01Platform": (HOME + "RobotPlatform", None),
-    SVC + "CytonDualArm01": (HOME + "DualArmRobot", None),
-    WORLD + "KitchenTable": (HOME + "Table", None),
-    WORLD + "BelowOfTap": (HOME + "BelowOfTap", None),
-    WORLD + "Kitchen": (HOME + "Kitchen", None),
-    WORLD + "LivingRoom": (HOME + "LivingRoom", None),
-    WORLD + "Bedroom": (HOME + "Bedroom", None),
-}
-
-# What the task's inputs are in this world, by the parameter's class.
-GIVEN_BY_TYPE: dict[str, Any] = {
-    HOME + "Cup": CUP,
-    HOME + "Pen": PEN,
-    HOME + "Person": "Person",
-    HOME + "ColourOfMarker": MarkerColours(),
-    HOME + "MarkerColour": MarkerColours(),
-    HOME + "BelowOfTap": BELOW_OF_TAP,
-    HOME + "TableTop": TABLE,
-    HOME + "Tap": TAP_LEVER,
-    HOME + "WaterDispenser": DISPENSER,
-}
 
 
 @dataclass
 class SimContext:
-    """What sim components share: the world, the knowledge base, and what the arm is doing."""
+    """What sim components share: the world, the knowledge base, and what the arms are doing."""
 
     world: HomeWorld
     kb: KnowledgeBase
     grid: OccupancyGrid | None = None
-    grasp: Any = None  # the grasp pose of the object the arm is working on
+    grasp: GraspPose | None = None  # the grasp pose of the object the arm is working on
     arm: ArmSide = ArmSide.LEFT
     region: Region | None = None  # where the carried object goes
+    last_arm: ArmSide | None = None  # the arm that acted last, so a tie goes to the other
+    inputs: Mapping[str, Any] = field(default_factory=dict)  # what the running component was given
+
+    @property
+    def map(self) -> SemanticMap:
+        return self.world.map
+
+    @property
+    def object(self) -> str | None:
+        return self.grasp.model.name if self.grasp is not None else None
 
 
-Work = Callable[[SimContext, Mapping[str, Any]], dict[str, Any]]
+Work = Callable[[SimContext, Mapping[str, Any], str], dict[str, Any]]
+"""A skill as a component: (context, inputs, the component's device name) -> outputs."""
 
 
 class SkillFailed(Exception):
@@ -132,9 +99,10 @@ class SkillFailed(Exception):
 class SimComponent(Component):
     """A component whose invocation is one call of ``work`` on the shared context."""
 
-    def __init__(self, iri: str, work: Work) -> None:
+    def __init__(self, iri: str, work: Work, device: str) -> None:
         super().__init__(iri)
         self._work = work
+        self._device = device
         self._inputs: Mapping[str, Any] = {}
         self._context: SimContext | None = None
 
@@ -145,11 +113,13 @@ class SimComponent(Component):
 
     def begin(self, inputs: Mapping[str, Any]) -> None:
         self._inputs = inputs
+        if self._context is not None:
+            self._context.inputs = inputs  # the step's verification grounds its statements in them
 
     def update(self) -> Status:
         assert self._context is not None
         try:
-            self.outputs = self._work(self._context, self._inputs)
+            self.outputs = self._work(self._context, self._inputs, self._device)
         except (SimulationError, SkillFailed) as error:
             self.reason = str(error)
             return Status.FAILED
@@ -161,109 +131,176 @@ def _check(outcome: skills.Outcome) -> None:
         raise SkillFailed(f"{outcome.skill}: {outcome.reason}")
 
 
+# -- what a value between steps means ------------------------------------------------------------
+
+
+def _iri(value: Any, what: str) -> str:
+    if isinstance(value, dict) and isinstance(value.get("@id"), str):
+        return str(value["@id"])
+    raise SkillFailed(f"expected a thing of the world for {what}, got {value!r}")
+
+
+def _model(ctx: SimContext, value: Any) -> ObjectModel:
+    """The object model of a designator (or a model passed on as it is)."""
+    if isinstance(value, ObjectModel):
+        return value
+    if isinstance(value, GraspPlan):
+        return value.model
+    iri = _iri(value, "an object")
+    obj = ctx.map.objects.get(iri)
+    if obj is None:
+        raise SkillFailed(f"the semantic map has no shape, size or grasp for {local_name(iri)}")
+    return ObjectModel.of(obj)
+
+
+def _place(ctx: SimContext, value: Any, what: str) -> Thing:
+    iri = _iri(value, what)
+    thing = ctx.map.things.get(iri)
+    if thing is None:
+        raise SkillFailed(f"the semantic map gives no extent for {local_name(iri)} ({what})")
+    return thing
+
+
+def _region(thing: Thing) -> Region:
+    box = thing.box
+    return Region(thing.name, box.min_x, box.max_x, box.min_y, box.max_y, box.min_z, box.max_z)
+
+
+def _dock(thing: Thing) -> Pose2D:
+    if thing.dock is None:
+        raise SkillFailed(f"the semantic map gives no docking pose at {thing.name}")
+    return Pose2D(thing.dock.x, thing.dock.y, thing.dock.yaw)
+
+
+def _free_arm(ctx: SimContext, x: float, y: float, what: str) -> ArmSide:
+    """The free arm whose mount is nearest (x, y) and within its reach; on a tie, not the one that just acted."""
+    options = []
+    for side, spec in ctx.world.arm_specs.items():
+        distance = math.hypot(x - spec.mount[0], y - spec.mount[1])
+        if ctx.world.arm(side).held is None and distance <= spec.reach:
+            options.append((distance, side))
+    if not options:
+        raise SkillFailed(f"no free arm reaches {what} at ({x:.2f}, {y:.2f})")
+    best = min(distance for distance, _ in options)
+    tied = [side for distance, side in options if distance - best <= ARM_TIE]
+    fresh = [side for side in tied if side != ctx.last_arm]
+    return sorted(fresh or tied)[0]
+
+
 # -- object knowledge and perception at the table -------------------------------------------------
 
 
-def _model(value: Any) -> ObjectModel:
-    if isinstance(value, ObjectModel):
-        return value
-    if isinstance(value, str) and value in MODELS:
-        return MODELS[value]
-    raise SkillFailed(f"no object model for {value!r}")
+def infer_object_property(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
+    return {"colourFeature": _model(ctx, inputs["objectType"]).colour}
 
 
-def infer_object_property(ctx: SimContext, inputs: Mapping[str, Any]) -> dict[str, Any]:
-    return {"colourFeature": _model(inputs["objectType"]).colour}
+def query_manipulation_property(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
+    return {"manipulationProperty": _model(ctx, inputs["objectType"])}
 
 
-def query_manipulation_property(ctx: SimContext, inputs: Mapping[str, Any]) -> dict[str, Any]:
-    return {"manipulationProperty": _model(inputs["objectType"])}
+def compute_grasp(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
+    return {"graspPose": GraspPlan(_model(ctx, inputs["manipulationProperty"]))}
 
 
-def compute_grasp(ctx: SimContext, inputs: Mapping[str, Any]) -> dict[str, Any]:
-    model = _model(inputs["manipulationProperty"])
-    return {"graspPose": GraspPlan(model, ARM_FOR.get(model.name, ArmSide.LEFT))}
+def _recognise(ctx: SimContext, camera: str, colour: str) -> ObjectEstimate:
+    _check(skills.clear_view(ctx.world))  # the camera between the arms: fold them first
+    return recognise_object(ctx.world.camera(camera).capture(), colour)
 
 
-def _recognise(ctx: SimContext, colour: str) -> ObjectEstimate:
-    _check(skills.clear_view(ctx.world))  # the Kinect sits between the arms: fold them first
-    return recognise_object(ctx.world.camera("Kinect01").capture(), colour)
+def recognise_by_colour(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
+    return {"objectPosition": _recognise(ctx, device, str(inputs["colourFeature"]))}
 
 
-def recognise_by_colour(ctx: SimContext, inputs: Mapping[str, Any]) -> dict[str, Any]:
-    return {"objectPosition": _recognise(ctx, str(inputs["colourFeature"]))}
+def find_object_on_table(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
+    """FindCupOnTable, for whatever object its input names: by the object's colour, with the robot's camera."""
+    camera = _robot_camera(ctx, device)
+    return {"cupPosition": _recognise(ctx, camera, _model(ctx, inputs["cup"]).colour)}
 
 
-def find_cup_on_table(ctx: SimContext, inputs: Mapping[str, Any]) -> dict[str, Any]:
-    return {"cupPosition": _recognise(ctx, _model(inputs["cup"]).colour)}
+def _robot_camera(ctx: SimContext, robot: str) -> str:
+    """The camera mounted on a robot (home:mountedOn in the store)."""
+    rows = ctx.kb.select("mounted_cameras", {"robot": PREFIXES["svc"] + robot})
+    cameras = [local_name(row["device"].value) for row in rows if local_name(row["device"].value) in ctx.world.cameras]
+    if not cameras:
+        raise SkillFailed(f"no camera is mounted on {robot}")
+    return cameras[0]
 
 
 # -- the dual-arm robot ---------------------------------------------------------------------------
 
 
-def approach(ctx: SimContext, inputs: Mapping[str, Any]) -> dict[str, Any]:
-    plan = inputs["graspPose"]
+def approach(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
+    model = _model(ctx, inputs["graspPose"])
     estimate: ObjectEstimate = inputs["objectPosition"]
-    if not isinstance(plan, GraspPlan):
-        raise SkillFailed(f"expected a grasp plan, got {type(plan).__name__}")
-    ctx.arm = plan.arm
-    ctx.grasp = compute_grasp_pose(plan.model, estimate.position, estimate.yaw, ARM_MOUNTS[plan.arm.value])
+    x, y, _ = estimate.position
+    ctx.arm = _free_arm(ctx, x, y, f"the {model.name}")
+    ctx.grasp = compute_grasp_pose(model, estimate.position, estimate.yaw, ctx.world.arm_specs[ctx.arm].mount)
+    ctx.last_arm = ctx.arm
     _check(skills.approach_object(ctx.world, ctx.arm, ctx.grasp))
     return {}
 
 
-def pick_up(ctx: SimContext, inputs: Mapping[str, Any]) -> dict[str, Any]:
+def pick_up(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     if ctx.grasp is None:
         raise SkillFailed("no object was approached")
     _check(skills.pick_up_object(ctx.world, ctx.arm, ctx.grasp))
     return {}
 
 
-def carry(ctx: SimContext, inputs: Mapping[str, Any]) -> dict[str, Any]:
-    region = inputs["targetPlace"]
-    if not isinstance(region, Region):
-        raise SkillFailed(f"cannot carry to {region!r}: not a region of the home")
-    ctx.region = region
-    _check(skills.carry_object(ctx.world, ctx.arm, region))
+def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
+    ctx.region = _region(_place(ctx, inputs["targetPlace"], "the target place"))
+    _check(skills.carry_object(ctx.world, ctx.arm, ctx.region))
     return {}
 
 
-def put_down(ctx: SimContext, inputs: Mapping[str, Any]) -> dict[str, Any]:
+def put_down(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     if ctx.region is None:
         raise SkillFailed("nothing is being carried to a place")
     _check(skills.put_down_object(ctx.world, ctx.arm, ctx.region))
     return {}
 
 
-def fill_cup(ctx: SimContext, inputs: Mapping[str, Any]) -> dict[str, Any]:
-    _check(skills.fill_cup_from_tap(ctx.world, TAP_ARM))
+def fill_from_tap(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
+    """FillCupFromTap: the container its input names, from the tap its input names, by the free arm."""
+    container = _model(ctx, inputs["cup"]).name
+    lever = _region(_place(ctx, inputs["tap"], "the tap"))
+    cx, cy, _ = (lever.xmin + lever.xmax) / 2, (lever.ymin + lever.ymax) / 2, 0.0
+    side = _free_arm(ctx, cx, cy, "the tap")
+    ctx.last_arm = side
+    _check(skills.fill_cup_from_tap(ctx.world, side, lever, container))
     return {}
 
 
-def hand_over(ctx: SimContext, inputs: Mapping[str, Any]) -> dict[str, Any]:
-    pen: ObjectEstimate = inputs["objectPosition"]
-    plan = inputs["graspPose"]
-    side = plan.arm if isinstance(plan, GraspPlan) else ArmSide.RIGHT
-    # The base parks against the table's docking mark, which the dual-arm robot knows.
-    _check(skills.hand_over_onto_platform(ctx.world, pen, ctx.world.base_pose(), side))
+def hand_over(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
+    estimate: ObjectEstimate = inputs["objectPosition"]
+    model = _model(ctx, inputs["graspPose"])
+    x, y, _ = estimate.position
+    side = _free_arm(ctx, x, y, f"the {model.name}")
+    ctx.last_arm = side
+    # The base parks against the place's docking mark, which the dual-arm robot knows.
+    reach = ctx.world.arm_specs[side].reach
+    _check(skills.hand_over_onto_platform(ctx.world, estimate, ctx.world.base_pose(), side, model, reach))
     return {}
 
 
 # -- the home server, the ceiling cameras and the mobile base -------------------------------------
 
 
-def infer_object_place(ctx: SimContext, inputs: Mapping[str, Any]) -> dict[str, Any]:
-    """Where the object is kept, from the world graph (KnowRob style), and how to reach that place."""
-    model = _model(inputs["object"])
-    thing = WORLD + model.name
-    places = [o for _, p, o in _facts(ctx.kb, thing) if p in (HOME + "isLocatedOn", HOME + "isLocated") and o in PLACES]
+def infer_object_place(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
+    """Where the object is kept, from the belief state (else the semantic map), and where to park to reach it."""
+    iri = _iri(inputs["object"], "the object")
+    model = _model(ctx, inputs["object"])
+    believed = [o for _, p, o in _facts(ctx.kb, iri) if p in (HOME + "isLocatedOn", HOME + "isLocated")]
+    known = ctx.map.facts.get(iri, {}).get(HOME + "isLocatedOn", [])
+    places = [o for o in [*believed, *known] if o in ctx.map.things and ctx.map.things[o].dock is not None]
     if not places:
-        raise SkillFailed(f"the knowledge base does not say where the {model.name} is")
-    place = PLACES[places[0]]
+        raise SkillFailed(f"the knowledge base does not say where the {model.name} is kept, or how to reach it")
+    place = ctx.map.things[places[0]]
+    dock = _dock(place)
     return {
-        "objectPlace": place,
-        "objectLocation": place.approach,
-        "approachPosition": place.approach,
+        "objectPlace": designator(place.iri, HOME + "ObjectPlace"),
+        "objectLocation": dock,
+        "approachPosition": dock,
         "objectFeature": model.colour,
     }
 
@@ -273,27 +310,27 @@ def _facts(kb: KnowledgeBase, thing: str) -> list[tuple[str, str, str]]:
     return [(r["thing"].value, r["relation"].value, r["other"].value) for r in rows]
 
 
-def provide_grid_map(ctx: SimContext, inputs: Mapping[str, Any]) -> dict[str, Any]:
+def provide_grid_map(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     if ctx.grid is None:
-        ctx.grid = build_occupancy_grid(ctx.world)
+        ctx.grid = build_occupancy_grid(ctx.world, ignore=(ctx.world.base_name,))
     return {"map": ctx.grid}
 
 
-def locate(camera: str) -> Work:
-    def work(ctx: SimContext, inputs: Mapping[str, Any]) -> dict[str, Any]:
-        colours = inputs.get("markerColour", MarkerColours())
-        if not isinstance(colours, MarkerColours):
-            raise SkillFailed(f"not a marker colour: {colours!r}")
-        return {"robotLocation": locate_robot(ctx.world.camera(camera).capture(), colours.front, colours.rear)}
+def locate(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
+    value = inputs.get("markerColour")
+    colours = ctx.map.marker_colours(_iri(value, "the marker colour")) if value is not None else None
+    if colours is None:
+        colours = ctx.world.robot.marker_colours
+    if colours is None:
+        raise SkillFailed("the semantic map gives no marker colours to look for")
+    return {"robotLocation": locate_robot(ctx.world.camera(device).capture(), colours[0], colours[1])}
 
-    return work
 
-
-def track(camera: str) -> Work:
-    def work(ctx: SimContext, inputs: Mapping[str, Any]) -> dict[str, Any]:
-        return {"personPosition": track_person(ctx.world.camera(camera).capture())}
-
-    return work
+def track(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
+    value = inputs.get("person")
+    person = ctx.map.people.get(_iri(value, "the person")) if value is not None else ctx.world.person
+    shirt = person.colour if person is not None and person.colour else "yellow"
+    return {"personPosition": track_person(ctx.world.camera(device).capture(), shirt)}
 
 
 def _xy(value: Any) -> tuple[float, float]:
@@ -303,7 +340,7 @@ def _xy(value: Any) -> tuple[float, float]:
 
 
 def planner(algorithm: str) -> Work:
-    def work(ctx: SimContext, inputs: Mapping[str, Any]) -> dict[str, Any]:
+    def work(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
         grid = inputs["map"]
         if not isinstance(grid, OccupancyGrid):
             raise SkillFailed("the map is not an occupancy grid")
@@ -312,60 +349,66 @@ def planner(algorithm: str) -> Work:
     return work
 
 
-def navigate_to_place(ctx: SimContext, inputs: Mapping[str, Any]) -> dict[str, Any]:
-    place = inputs["objectPlace"]
-    if not isinstance(place, Place):
-        raise SkillFailed(f"not a place: {place!r}")
-    _check(skills.navigate_to_place(ctx.world, inputs["path"], place.approach))
+def navigate_to_place(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
+    place = _place(ctx, inputs["objectPlace"], "the place")
+    _check(skills.navigate_to_place(ctx.world, inputs["path"], _dock(place)))
     return {}
 
 
-def navigate_to_person(ctx: SimContext, inputs: Mapping[str, Any]) -> dict[str, Any]:
+def navigate_to_person(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     _check(skills.navigate_to_person(ctx.world, inputs["path"], inputs["personPosition"]))
     return {}
 
 
-def deliver(ctx: SimContext, inputs: Mapping[str, Any]) -> dict[str, Any]:
-    receiver = inputs.get("receiver", "Person")
-    _check(skills.deliver_object(ctx.world, str(receiver)))
+def deliver(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
+    value = inputs.get("receiver")
+    receiver = local_name(_iri(value, "the receiver")) if value is not None else None
+    _check(skills.deliver_object(ctx.world, receiver))
     return {}
 
 
-IMPLEMENTATIONS: dict[str, Work] = {
-    "InferObjectProperty_HomeServer01": infer_object_property,
-    "QueryManipulationProperty_HomeServer01": query_manipulation_property,
-    "ComputeGraspPose_CytonDualArm01": compute_grasp,
-    "RecogniseObjectByColour_Kinect01": recognise_by_colour,
-    "FindCupOnTable_CytonDualArm01": find_cup_on_table,
-    "ApproachToObject_CytonDualArm01": approach,
-    "PickUpObject_CytonDualArm01": pick_up,
-    "CarryObject_CytonDualArm01": carry,
-    "PutDownObject_CytonDualArm01": put_down,
-    "FillCupFromTap_CytonDualArm01": fill_cup,
-    "HandOverOntoPlatform_CytonDualArm01": hand_over,
-    "InferObjectPlace_HomeServer01": infer_object_place,
-    "ProvideGridMap_HomeServer01": provide_grid_map,
-    "LocateMobileRobot_CeilingCamera01": locate("CeilingCamera01"),
-    "LocateMobileRobot_CeilingCamera02": locate("CeilingCamera02"),
-    "TrackPerson_CeilingCamera01": track("CeilingCamera01"),
-    "PlanPathAStar_HomeServer01": planner("astar"),
-    "PlanPathDijkstra_HomeServer01": planner("dijkstra"),
-    "NavigateToPlace_P3DX01": navigate_to_place,
-    "NavigateToPerson_P3DX01": navigate_to_person,
-    "DeliverObject_P3DX01": deliver,
+SKILLS: dict[str, Work] = {
+    "InferObjectProperty": infer_object_property,
+    "QueryManipulationProperty": query_manipulation_property,
+    "ComputeGraspPose": compute_grasp,
+    "RecogniseObjectByColour": recognise_by_colour,
+    "FindCupOnTable": find_object_on_table,
+    "ApproachToObject": approach,
+    "PickUpObject": pick_up,
+    "CarryObject": carry,
+    "PutDownObject": put_down,
+    "FillCupFromTap": fill_from_tap,
+    "HandOverOntoPlatform": hand_over,
+    "InferObjectPlace": infer_object_place,
+    "ProvideGridMap": provide_grid_map,
+    "LocateMobileRobot": locate,
+    "TrackPerson": track,
+    "PlanPathAStar": planner("astar"),
+    "PlanPathDijkstra": planner("dijkstra"),
+    "NavigateToPlace": navigate_to_place,
+    "NavigateToPerson": navigate_to_person,
+    "DeliverObject": deliver,
 }
+"""The simulated skill behind each service name; the device comes from the advertisement."""
 
 
-def implementations() -> Registry:
-    """Every simulated component, by its service IRI."""
+def implementations(kb: KnowledgeBase, world: HomeWorld | None = None) -> Registry:
+    """A simulated component for every advertisement whose service the simulation can perform on its
+    device (cameras must exist in the world)."""
     registry = Registry()
-    for name, work in IMPLEMENTATIONS.items():
-        registry.add(SVC + name, _maker(work))
+    for ad in kb.advertisements():
+        work = SKILLS.get(ad.service_name or "")
+        device = ad.device_name or ""
+        if work is None:
+            continue
+        if world is not None and work in (locate, track, recognise_by_colour) and device not in world.cameras:
+            continue
+        registry.add(ad.iri, _maker(work, device))
     return registry
 
 
-def _maker(work: Work) -> Callable[[str], Component]:
-    return lambda iri: SimComponent(iri, work)
+def _maker(work: Work, device: str) -> Callable[[str], Component]:
+    return lambda iri: SimComponent(iri, work, device)
 
 
 # -- the environment ------------------------------------------------------------------------------
@@ -377,14 +420,16 @@ class SimEnvironment:
     def __init__(self, world: HomeWorld, kb: KnowledgeBase) -> None:
         self.world = world
         self.kb = kb
-        self.registry = implementations()
+        self.registry = implementations(kb, world)
         self.context = SimContext(world, kb)
+        self._superclasses: dict[str, set[str]] | None = None
+        self._computables: dict[str, str] | None = None
 
     def clock(self) -> float:
         return self.world.time
 
     def given(self, plan: Plan, requirements: Mapping[str, Requirement]) -> dict[str, Any]:
-        """The world's thing for each input a requirement gives, chosen by the input's class."""
+        """The world's thing for each input a requirement gives: the one individual of the input's class."""
         values: dict[str, Any] = {}
         for step in plan.steps:
             for binding in step.inputs:
@@ -392,81 +437,188 @@ class SimEnvironment:
                 if source.step is not None or source.name in values:
                     continue
                 requirement = requirements.get(source.requirement or "")
-                types = [p.type for p in requirement.inputs if p.name == source.name] if requirement else []
-                for concept in types:
-                    if concept in GIVEN_BY_TYPE:
-                        values[source.name] = GIVEN_BY_TYPE[concept]
+                if requirement is None:
+                    continue
+                for parameter in requirement.inputs:
+                    if parameter.name == source.name:
+                        iri = designate(self.kb, parameter.type, prefer=requirement.requested_by)
+                        values[source.name] = designator(iri, parameter.type)
         return values
 
+    # -- verification: the generic test the store maps each predicate to ---------------------
+
+    def is_a(self, concept: str, superclass: str) -> bool:
+        if self._superclasses is None:
+            table: dict[str, set[str]] = {}
+            for row in self.kb.select("subclasses"):
+                table.setdefault(row["class"].value, set()).add(row["superclass"].value)
+            self._superclasses = table
+        return concept == superclass or superclass in self._superclasses.get(concept, set())
+
+    def computable(self, predicate: str) -> str | None:
+        if self._computables is None:
+            table: dict[str, str] = {}
+            for row in self.kb.select("computables"):  # nearest ancestor first
+                table.setdefault(row["relation"].value, row["computable"].value)
+            self._computables = table
+        return self._computables.get(predicate)
+
+    def _ground(self, concept: str, inputs: Mapping[str, Any]) -> tuple[str, str] | None:
+        """(role, name) of the thing a class-level statement means at this step: a thing the step was
+        given, else what is at hand (the arm's object, its gripper, the base, the person, the target)."""
+        for value in inputs.values():
+            if isinstance(value, dict) and "@id" in value:
+                iri = str(value["@id"])
+                types = (*self.world.map.types.get(iri, ()), str(value.get("@type", "")))
+                if any(self.is_a(t, concept) for t in types):
+                    return ("thing", iri)
+        ctx = self.context
+        if self.is_a(concept, HOME + "Gripper") or self.is_a(concept, HOME + "Arm"):
+            return ("gripper", ctx.arm.value)
+        if self.is_a(concept, HOME + "RobotPlatform"):
+            return ("platform", self.world.base_name)
+        if self.is_a(concept, HOME + "MobileRobot"):
+            return ("base", self.world.base_name)
+        if self.is_a(concept, HOME + "Robot"):
+            return ("robot", "")
+        if self.is_a(concept, HOME + "Person"):
+            return ("person", self.world.person_name)
+        if self.is_a(concept, HOME + "Substance"):
+            return ("substance", concept)
+        if self.is_a(concept, HOME + "PhysicalObject"):
+            plans = [value for value in inputs.values() if isinstance(value, GraspPlan)]
+            if plans:
+                return ("object", plans[0].model.name)
+            if ctx.object is not None:
+                return ("object", ctx.object)
+        if self.is_a(concept, HOME + "Place") and ctx.region is not None:
+            return ("region", ctx.region.name)
+        candidates = [iri for iri, types in self.world.map.types.items() if any(self.is_a(t, concept) for t in types)]
+        if len(candidates) == 1:
+            return ("thing", candidates[0])
+        return None
+
     def verify(self, step: PlanStep, statement: Statement, outputs: Mapping[str, Any]) -> bool | None:
-        """Check a (class-level) statement against the simulated world, for the things at hand."""
-        world, predicate = self.world, statement.predicate.removeprefix(HOME)
-        subject, obj = statement.subject.removeprefix(HOME), statement.object.removeprefix(HOME)
-        model_name = self.context.grasp.model.name if self.context.grasp is not None else None
-        if predicate == "isLocalisedIn":
+        """Decide a (class-level) statement by its predicate's computable, for the things at hand;
+        None when the store maps the predicate to no test or the things cannot be told."""
+        test = self.computable(statement.predicate)
+        if test is None:
+            return None
+        if test == "perceived":
+            return bool(outputs)
+        if test == "localised-in":
             estimate = outputs.get("robotLocation")
             if not isinstance(estimate, RobotPoseEstimate):
                 return False
-            truth = world.base_pose()
+            truth = self.world.base_pose()
             return math.hypot(estimate.x - truth.x, estimate.y - truth.y) <= LOCALISATION_TOLERANCE
-        if predicate == "isNear" and obj == "Person":
-            return pred.base_near_person(world)
-        if predicate == "isNear" and subject == "Gripper":
-            return model_name is not None and pred.gripper_near(world, self.context.arm, model_name)
-        if predicate == "isNear":
-            return pred.base_near(world, HANDOVER_POSE, heading=True)
-        if predicate == "isGraspedBy":
-            return model_name is not None and pred.is_grasped(world, model_name, self.context.arm)
-        if predicate == "isAbove":
-            region = self.context.region
-            return model_name is not None and region is not None and pred.object_above_region(world, model_name, region)
-        if predicate == "isLocated" and obj == "BelowOfTap":
-            return pred.cup_below_tap(world)
-        if predicate == "isLocated":
-            region = self.context.region
-            return model_name is not None and region is not None and pred.object_located_in(world, model_name, region)
-        if predicate == "isLocatedOn" and obj == "RobotPlatform":
-            return pred.pen_on_platform(world)
-        if predicate == "isWith":
-            return pred.pen_with_person(world)
-        if predicate == "contains":
-            return pred.cup_contains_water(world)
-        if predicate == "isPerceivedBy":
-            return bool(outputs)
+        inputs = self.context.inputs
+        subject = self._ground(statement.subject, inputs)
+        obj = self._ground(statement.object, inputs)
+        if subject is None or obj is None:
+            return None
+        return self._decide(test, subject, obj)
+
+    def _object_name(self, grounded: tuple[str, str]) -> str | None:
+        role, name = grounded
+        if role == "object":
+            return name
+        if role == "thing":
+            return local_name(name) if name in self.world.map.objects else None
         return None
 
-    def observe(self) -> Observation:
-        """Types, the relations that hold now among the world's things, and their positions."""
+    def _decide(self, test: str, subject: tuple[str, str], obj: tuple[str, str]) -> bool | None:
         world = self.world
+        thing = self._object_name(subject)
+        if test == "near":
+            if subject[0] == "gripper":
+                target = self._object_name(obj)
+                return target is not None and pred.gripper_near(world, subject[1], target)
+            if subject[0] == "base" and obj[0] == "person":
+                return pred.base_near_person(world, obj[1])
+            if subject[0] == "base":
+                place = self._thing(obj)
+                if place is None or place.dock is None:
+                    return None
+                return pred.base_near(world, _dock(place), heading=True)
+            return None
+        if thing is None:
+            return None
+        if test == "grasped-by":
+            return pred.is_grasped(world, thing, self.context.arm if obj[0] == "gripper" else None)
+        if test == "with":
+            return pred.with_person(world, thing, obj[1] if obj[0] == "person" else None)
+        if test == "contains":
+            return pred.contains_water(world, thing)
+        if test == "on" and obj[0] == "platform":
+            return pred.on_platform(world, thing)
+        region = self._region_of(obj)
+        if region is None:
+            return None
+        if test == "above":
+            return pred.object_above_region(world, thing, region)
+        if test in ("inside", "on"):
+            if thing in world.containers:
+                return pred.upright_in(world, thing, region)
+            return pred.object_located_in(world, thing, region)
+        return None
+
+    def _thing(self, grounded: tuple[str, str]) -> Thing | None:
+        role, name = grounded
+        if role == "thing":
+            return self.world.map.things.get(name)
+        if role == "region":
+            return next((t for t in self.world.map.things.values() if t.name == name), None)
+        return None
+
+    def _region_of(self, grounded: tuple[str, str]) -> Region | None:
+        if grounded[0] == "region" and self.context.region is not None:
+            return self.context.region
+        thing = self._thing(grounded)
+        return _region(thing) if thing is not None else None
+
+    # -- the belief state ----------------------------------------------------------------------
+
+    def observe(self) -> Observation:
+        """Types, the relations that hold now among the world's things, and their positions: each
+        relation decided by the same generic tests as verification."""
+        world, smap = self.world, self.world.map
         facts: set[tuple[str, str, str]] = set()
-
-        def holds(condition: bool, s: str, p: str, o: str) -> None:
-            if condition:
-                facts.add((s, HOME + p, o))
-
-        for name in ("Cup", "Pen"):
-            on_table = pred.object_located_in(world, name, TABLE) and world.pen_holder != "Person"
-            holds(
-                on_table and not (name == "Cup" and pred.cup_below_tap(world)),
-                WORLD + name,
-                "isLocatedOn",
-                WORLD + "KitchenTable",
-            )
-        holds(pred.cup_below_tap(world), WORLD + "Cup", "isLocated", WORLD + "BelowOfTap")
-        holds(pred.cup_contains_water(world), WORLD + "Cup", "contains", HOME + "Water")
-        holds(pred.pen_on_platform(world), WORLD + "Pen", "isLocatedOn", WORLD + "P3DX01Platform")
-        holds(pred.pen_with_person(world), WORLD + "Pen", "isWith", WORLD + "Person")
-        holds(pred.base_near_person(world), SVC + "P3DX01", "isNear", WORLD + "Person")
-        holds(pred.base_near(world, HANDOVER_POSE), SVC + "P3DX01", "isNear", WORLD + "KitchenTable")
-        for iri, body in ((SVC + "P3DX01", "P3DX01"), (WORLD + "Person", "Person")):
+        rooms = [t for t in smap.things.values() if t.box.max_z == 0.0]
+        supports = [t for t in smap.things.values() if t.box.min_z == 0.0 < t.box.max_z]
+        regions = [t for t in smap.things.values() if t.box.min_z > 0.0]
+        base_iri = world.robot.iri
+        person_iri = world.person.iri
+        for obj in smap.objects.values():
+            name = obj.name
+            inside = [r for r in regions if self._decide("inside", ("object", name), ("thing", r.iri))]
+            for region in inside:
+                facts.add((obj.iri, HOME + "isLocated", region.iri))
+            for support in supports:  # an object in a region on the table is on the table too
+                box = support.box
+                top = Region(support.name, box.min_x, box.max_x, box.min_y, box.max_y, box.max_z, box.max_z)
+                if pred.object_located_in(world, name, top):
+                    facts.add((obj.iri, HOME + "isLocatedOn", support.iri))
+            if world.robot.platform is not None and pred.on_platform(world, name):
+                facts.add((obj.iri, HOME + "isLocatedOn", world.robot.platform))
+            if pred.with_person(world, name):
+                facts.add((obj.iri, HOME + "isWith", person_iri))
+            if name in world.containers and pred.contains_water(world, name):
+                facts.add((obj.iri, HOME + "contains", HOME + "Water"))
+        if pred.base_near_person(world):
+            facts.add((base_iri, HOME + "isNear", person_iri))
+        for support in supports:
+            if support.dock is not None and pred.base_near(world, _dock(support)):
+                facts.add((base_iri, HOME + "isNear", support.iri))
+        for iri, body in ((base_iri, world.base_name), (person_iri, world.person_name)):
             x, y, _ = world.pose(body).position
-            room = room_of(float(x), float(y))
-            if room is not None:
-                holds(True, iri, "isLocated", WORLD + room)
+            for room in rooms:
+                if room.box.contains_xy(float(x), float(y)):
+                    facts.add((iri, HOME + "isLocated", room.iri))
         positions = {}
-        for thing, (_, body_name) in THINGS.items():
-            if body_name is not None:
-                position = world.pose(body_name).position
-                positions[thing] = (float(position[0]), float(position[1]), float(position[2]))
-        types = {iri: concept for iri, (concept, _) in THINGS.items()}
+        bodies = [*((o.iri, o.name) for o in smap.objects.values()), (person_iri, world.person_name)]
+        for iri, body in [*bodies, (base_iri, world.base_name)]:
+            position = world.pose(body).position
+            positions[iri] = (float(position[0]), float(position[1]), float(position[2]))
+        types = {iri: kinds[0] for iri, kinds in smap.types.items() if kinds and not iri.endswith("/world")}
         return Observation(types, frozenset(facts), positions, world.time)

@@ -13,10 +13,11 @@ from enum import StrEnum
 
 import numpy as np
 
+from kb.semantic_map import MapObject
 from sim.geometry import Quat, Vec3, quat_from_matrix
-from sim.layout import ARM_MOUNT_YAW, CUP_HEIGHT, CUP_RADIUS, PEN_WIDTH
+from sim.layout import ARM_MOUNT_YAW
 
-__all__ = ["CUP", "OBJECT_MODELS", "PEN", "GraspKind", "GraspPose", "ObjectModel", "compute_grasp_pose"]
+__all__ = ["GraspKind", "GraspPose", "ObjectModel", "compute_grasp_pose"]
 
 
 class GraspKind(StrEnum):
@@ -39,10 +40,13 @@ class ObjectModel:
     grasp_height: float
     """Height of the grasp point above the object's bottom."""
 
-
-CUP = ObjectModel("Cup", "red", CUP_HEIGHT, 2 * CUP_RADIUS, GraspKind.SIDE, 0.07)
-PEN = ObjectModel("Pen", "blue", PEN_WIDTH, PEN_WIDTH, GraspKind.TOP, 0.012)
-OBJECT_MODELS: dict[str, ObjectModel] = {CUP.name: CUP, PEN.name: PEN}
+    @classmethod
+    def of(cls, obj: MapObject) -> ObjectModel:
+        """The model of a semantic-map object: a side grasp closes across a cylinder's diameter, a top
+        grasp across the object's width (its y size: the fingers close across its x axis)."""
+        kind = GraspKind(obj.grasp_approach)
+        width = min(obj.size[0], obj.size[1]) if obj.shape == "cylinder" else obj.size[1]
+        return cls(obj.name, obj.colour, obj.size[2], width, kind, obj.grasp_height)
 
 SIDE_PITCH = math.radians(35.0)
 """A side grasp comes in tilted down by 35 degrees: with the arms mounted below the grasp height, a

@@ -95,9 +95,9 @@ def build_occupancy_grid(
     world: HomeWorld,
     resolution: float = MAP_RESOLUTION,
     inflation_radius: float = BASE_RADIUS,
-    ignore: Sequence[str] = ("P3DX01",),
+    ignore: Sequence[str] | None = None,
 ) -> OccupancyGrid:
-    """Measure the home's occupancy grid now; the bodies in ``ignore`` (the base) are seen through."""
+    """Measure the home's occupancy grid now; the bodies in ``ignore`` (by default the mobile base) are seen through."""
     cols = round((HOME.xmax - HOME.xmin) / resolution)
     rows = round((HOME.ymax - HOME.ymin) / resolution)
     origin = (HOME.xmin, HOME.ymin)
@@ -106,7 +106,7 @@ def build_occupancy_grid(
     ys = origin[1] + (ii.ravel() + 0.5) * resolution
     tops = np.full(xs.shape, RAY_TOP)
     heights = np.full(xs.shape, -1.0)
-    ignored = {world.body(name) for name in ignore}
+    ignored = {world.body(name) for name in (ignore if ignore is not None else (world.base_name,))}
     pending = np.arange(xs.size)
     for _ in range(4):  # a ray is recast below each ignored body it hits; a few rounds are plenty
         if pending.size == 0:

@@ -18,7 +18,6 @@ from sim.geometry import Pose2D, Region, quat_to_matrix
 from sim.layout import (
     BASE_HALF_LENGTH,
     BASE_HALF_WIDTH,
-    BELOW_OF_TAP,
     MARKER_HEIGHT,
     MARKER_OFFSET,
     MARKER_PATCH,
@@ -32,7 +31,6 @@ __all__ = [
     "ABOVE_MIN",
     "BASE_NEAR_DISTANCE",
     "BASE_NEAR_HEADING",
-    "CUP_WATER_MIN",
     "GRASP_DISTANCE",
     "GRIPPER_NEAR_DISTANCE",
     "HAND_HEIGHT_TOLERANCE",
@@ -41,18 +39,20 @@ __all__ = [
     "PLATFORM_MARGIN",
     "RESTING_SPEED",
     "RESTING_TOLERANCE",
+    "WATER_MIN",
     "base_near",
     "base_near_person",
-    "cup_below_tap",
-    "cup_contains_water",
+    "contains_water",
     "gripper_near",
     "is_grasped",
     "object_above_region",
     "object_bottom",
     "object_located_in",
-    "pen_on_platform",
-    "pen_with_person",
+    "objects_on_platform",
+    "on_platform",
     "robot_visible",
+    "upright_in",
+    "with_person",
 ]
 
 RESTING_TOLERANCE = 0.01
@@ -84,7 +84,7 @@ length) and within ``HAND_HEIGHT_TOLERANCE`` of hand height."""
 HAND_HEIGHT_TOLERANCE = 0.10
 PLATFORM_MARGIN = 0.01
 """The pen's centre must be 1 cm inside the platform's edge to be on it."""
-CUP_WATER_MIN = 0.5
+WATER_MIN = 0.5
 """The cup contains water once at least half full (a full cup takes 4 s of open tap)."""
 
 
@@ -141,28 +141,33 @@ def object_located_in(world: HomeWorld, name: str, region: Region) -> bool:
     )
 
 
-def cup_below_tap(world: HomeWorld) -> bool:
-    """(Cup, isLocated, BelowOfTap), and upright (a cup on its side catches nothing)."""
-    _, orn = p.getBasePositionAndOrientation(world.body("Cup"), physicsClientId=world.client)
+def upright_in(world: HomeWorld, name: str, region: Region) -> bool:
+    """(object, isLocated, region) for a container: upright as well (a cup on its side catches nothing)."""
+    _, orn = p.getBasePositionAndOrientation(world.body(name), physicsClientId=world.client)
     upright = quat_to_matrix((orn[0], orn[1], orn[2], orn[3]))[2, 2] > 0.95
-    return upright and object_located_in(world, "Cup", BELOW_OF_TAP)
+    return upright and object_located_in(world, name, region)
 
 
-def cup_contains_water(world: HomeWorld) -> bool:
-    """(Cup, contains, Water)."""
-    return world.cup_water >= CUP_WATER_MIN
+def contains_water(world: HomeWorld, name: str) -> bool:
+    """(container, contains, Water): filled at least half."""
+    return world.water_level(name) >= WATER_MIN
 
 
-def pen_on_platform(world: HomeWorld) -> bool:
-    """(Pen, isLocatedOn, RobotPlatform): resting on the platform, inside its edges, in the base's frame."""
+def on_platform(world: HomeWorld, name: str) -> bool:
+    """(object, isLocatedOn, RobotPlatform): resting on the platform, inside its edges, in the base's frame."""
     base = world.base_pose()
-    x, y, _ = _position(world, "Pen")
+    x, y, _ = _position(world, name)
     dx, dy = x - base.x, y - base.y
     along = dx * math.cos(base.theta) + dy * math.sin(base.theta)
     across = -dx * math.sin(base.theta) + dy * math.cos(base.theta)
     inside = abs(along) <= BASE_HALF_LENGTH - PLATFORM_MARGIN and abs(across) <= BASE_HALF_WIDTH - PLATFORM_MARGIN
-    resting = abs(object_bottom(world, "Pen") - PLATFORM_HEIGHT) <= RESTING_TOLERANCE
-    return inside and resting and not is_grasped(world, "Pen") and world.pen_holder is None
+    resting = abs(object_bottom(world, name) - PLATFORM_HEIGHT) <= RESTING_TOLERANCE
+    return inside and resting and not is_grasped(world, name) and name not in world.holders
+
+
+def objects_on_platform(world: HomeWorld) -> list[str]:
+    """The movable objects resting on the base's platform now (what a load sensor in it reports)."""
+    return [name for name in sorted(world.objects) if on_platform(world, name)]
 
 
 def base_near(
@@ -176,20 +181,22 @@ def base_near(
     return not heading or base.heading_error(target.theta) <= BASE_NEAR_HEADING
 
 
-def base_near_person(world: HomeWorld, person: str = "Person") -> bool:
-    """(MobileRobot, isNear, Person)."""
+def base_near_person(world: HomeWorld, person: str | None = None) -> bool:
+    """(MobileRobot, isNear, Person); the world's person by default."""
+    person = person or world.person_name
     x, y, _ = _position(world, person)
     return world.base_pose().distance_to(float(x), float(y)) <= NEAR_PERSON_DISTANCE
 
 
-def pen_with_person(world: HomeWorld, person: str = "Person") -> bool:
-    """(Pen, isWith, Person): the person took it and it is in their hand."""
-    if world.pen_holder != person:
+def with_person(world: HomeWorld, name: str, person: str | None = None) -> bool:
+    """(object, isWith, Person): the person took it and it is in their hand."""
+    person = person or world.person_name
+    if world.holders.get(name) != person:
         return False
     px, py, _ = _position(world, person)
-    pen = _position(world, "Pen")
-    in_reach = math.hypot(pen[0] - px, pen[1] - py) <= PERSON_REACH
-    return in_reach and abs(pen[2] - PERSON_HAND_HEIGHT) <= HAND_HEIGHT_TOLERANCE
+    thing = _position(world, name)
+    in_reach = math.hypot(thing[0] - px, thing[1] - py) <= PERSON_REACH
+    return in_reach and abs(thing[2] - PERSON_HAND_HEIGHT) <= HAND_HEIGHT_TOLERANCE
 
 
 def robot_visible(world: HomeWorld, camera: str) -> bool:
@@ -216,4 +223,4 @@ def robot_visible(world: HomeWorld, camera: str) -> bool:
     if not bool(np.all(inside)):  # NaN (behind the camera) compares False: not inside
         return False
     hits = p.rayTestBatch([spec.eye] * len(points), points.tolist(), physicsClientId=world.client)
-    return all(hit[0] in (-1, world.body("P3DX01")) for hit in hits)
+    return all(hit[0] in (-1, world.body(world.base_name)) for hit in hits)

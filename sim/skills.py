@@ -20,15 +20,15 @@ from sim import predicates as pred
 from sim.arms import GRIPPER_OPEN, Arm, ArmSide
 from sim.geometry import Pose2D, Region, Vec3, wrap_angle
 from sim.grasping import (
-    PEN,
     PREGRASP_DISTANCE,
     GraspKind,
     GraspPose,
+    ObjectModel,
     compute_grasp_pose,
     side_orientation,
     top_orientation,
 )
-from sim.layout import ARM_MOUNT_YAW, ARM_MOUNTS, HANDOVER_POSE, PERSON_HAND_HEIGHT, PLATFORM_HEIGHT, TAP_LEVER
+from sim.layout import ARM_MOUNT_YAW, PERSON_HAND_HEIGHT, PLATFORM_HEIGHT
 from sim.perception import ObjectEstimate, PersonEstimate, RobotPoseEstimate
 from sim.planning import PlannedPath
 from sim.world import HomeWorld
@@ -127,7 +127,7 @@ def approach_object(world: HomeWorld, side: ArmSide | str, grasp: GraspPose) -> 
 
 def _between_fingers(world: HomeWorld, arm: Arm) -> int | None:
     """The object both closed fingers touch (within 5 mm), if any: what the gripper actually holds."""
-    for name in ("Cup", "Pen"):
+    for name in sorted(world.objects):
         body = world.body(name)
         touching = all(
             p.getClosestPoints(arm.body, body, 0.005, linkIndexA=finger, physicsClientId=world.client)
@@ -229,11 +229,11 @@ def put_down_object(world: HomeWorld, side: ArmSide | str, region: Region) -> Ou
     return _done(world, "PutDownObject", start, ok, f"the {name} did not come to rest in {region.name}")
 
 
-def fill_cup_from_tap(world: HomeWorld, side: ArmSide | str = ArmSide.RIGHT) -> Outcome:
-    """FillCupFromTap: the free arm pushes the tap's lever until the cup below is full.
+def fill_cup_from_tap(world: HomeWorld, side: ArmSide | str, lever: Region, container: str) -> Outcome:
+    """FillCupFromTap: the free arm pushes the tap's ``lever`` until ``container`` below is full.
 
-    The water runs whenever the lever is in; if it reaches no cup for SPILL_LIMIT seconds the arm
-    lets go and the skill fails (the cup was not below the tap).
+    The water runs whenever the lever is in; if it reaches no container for SPILL_LIMIT seconds the
+    arm lets go and the skill fails (the container was not below the tap).
     """
     start = world.time
     arm = _arm(world, side)
@@ -241,8 +241,8 @@ def fill_cup_from_tap(world: HomeWorld, side: ArmSide | str = ArmSide.RIGHT) -> 
         return _done(world, "FillCupFromTap", start, False, f"the {arm.side} gripper is holding something")
     orientation = side_orientation(ARM_MOUNT_YAW)
     approach = np.array([math.cos(ARM_MOUNT_YAW), math.sin(ARM_MOUNT_YAW), 0.0])
-    x, z = (TAP_LEVER.xmin + TAP_LEVER.xmax) / 2.0, (TAP_LEVER.zmin + TAP_LEVER.zmax) / 2.0
-    press = np.array([x, TAP_LEVER.ymin + LEVER_PUSH, z])
+    x, z = (lever.xmin + lever.xmax) / 2.0, (lever.zmin + lever.zmax) / 2.0
+    press = np.array([x, lever.ymin + LEVER_PUSH, z])
     pre = press - approach * (LEVER_PUSH + PRESS_STANDOFF)
     arm.set_gripper(0.0)
     result = arm.reach((float(pre[0]), float(pre[1]), float(pre[2])), orientation)
@@ -252,7 +252,7 @@ def fill_cup_from_tap(world: HomeWorld, side: ArmSide | str = ArmSide.RIGHT) -> 
     opened = world.tap_open()
     spilled = world.water_spilled
     held = 0.0
-    while opened and held < FILL_TIME_LIMIT and world.cup_water < 1.0:
+    while opened and held < FILL_TIME_LIMIT and world.water_level(container) < 1.0:
         world.step(0.1)
         held += 0.1
         if world.water_spilled - spilled >= SPILL_LIMIT:
@@ -262,8 +262,8 @@ def fill_cup_from_tap(world: HomeWorld, side: ArmSide | str = ArmSide.RIGHT) -> 
     arm.home()
     if not opened:
         return _done(world, "FillCupFromTap", start, False, "the lever did not open the tap")
-    ok = pred.cup_contains_water(world)
-    return _done(world, "FillCupFromTap", start, ok, "the water ran but no cup below the tap caught it")
+    ok = pred.contains_water(world, container)
+    return _done(world, "FillCupFromTap", start, ok, f"the water ran but the {container} did not catch it")
 
 
 def platform_region(base: Pose2D | RobotPoseEstimate) -> Region:
@@ -280,14 +280,22 @@ def platform_region(base: Pose2D | RobotPoseEstimate) -> Region:
 
 
 def hand_over_onto_platform(
-    world: HomeWorld, pen: ObjectEstimate, base: Pose2D | RobotPoseEstimate, side: ArmSide | str = ArmSide.RIGHT
+    world: HomeWorld,
+    pen: ObjectEstimate,
+    base: Pose2D | RobotPoseEstimate,
+    side: ArmSide | str,
+    model: ObjectModel,
+    reach: float,
 ) -> Outcome:
-    """HandOverOntoPlatform: pick the pen up from the table and put it on the middle of the platform
-    of the base, which must be parked at the hand-over pose (``base`` is where it was localised)."""
+    """HandOverOntoPlatform: pick the object up from the table and put it on the middle of the platform
+    of the base, which must be parked within the arm's ``reach`` (``base`` is where it was localised)."""
     start = world.time
-    if math.hypot(base.x - HANDOVER_POSE.x, base.y - HANDOVER_POSE.y) > pred.BASE_NEAR_DISTANCE:
-        return _done(world, "HandOverOntoPlatform", start, False, "the base is not parked at the hand-over pose")
-    grasp = compute_grasp_pose(PEN, pen.position, pen.yaw, ARM_MOUNTS[ArmSide(side).value])
+    mount = world.arm_specs[ArmSide(side)].mount
+    if math.hypot(base.x - mount[0], base.y - mount[1]) > reach:
+        return _done(
+            world, "HandOverOntoPlatform", start, False, f"the base's platform is out of the {side} arm's reach"
+        )
+    grasp = compute_grasp_pose(model, pen.position, pen.yaw, mount)
     region = platform_region(base)
     # The pen fits between the marker patches along or across the base: take the placement that
     # needs the smaller turn of the wrist.
@@ -304,8 +312,8 @@ def hand_over_onto_platform(
         outcome = step()
         if not outcome.succeeded:
             return _done(world, "HandOverOntoPlatform", start, False, f"{outcome.skill}: {outcome.reason}")
-    ok = pred.pen_on_platform(world)
-    return _done(world, "HandOverOntoPlatform", start, ok, "the pen is not on the platform")
+    ok = pred.on_platform(world, model.name)
+    return _done(world, "HandOverOntoPlatform", start, ok, f"the {model.name} is not on the platform")
 
 
 def navigate(world: HomeWorld, waypoints: Sequence[tuple[float, float]], final_heading: float | None = None) -> Outcome:
@@ -342,20 +350,23 @@ def navigate_to_person(world: HomeWorld, path: PlannedPath, person: PersonEstima
     return _done(world, "NavigateToPerson", start, ok, "the base stopped too far from the person")
 
 
-def deliver_object(world: HomeWorld, receiver: str = "Person") -> Outcome:
-    """DeliverObject: standing next to the person, the base waits while they take the pen."""
+def deliver_object(world: HomeWorld, receiver: str | None = None) -> Outcome:
+    """DeliverObject: standing next to the person, the base waits while they take what is on its platform."""
     start = world.time
+    receiver = receiver or world.person_name
     if not pred.base_near_person(world, receiver):
         return _done(world, "DeliverObject", start, False, f"the base is not near {receiver}")
-    if not pred.pen_on_platform(world):
-        return _done(world, "DeliverObject", start, False, "there is no pen on the platform")
+    carried = pred.objects_on_platform(world)
+    if not carried:
+        return _done(world, "DeliverObject", start, False, "there is nothing on the platform")
     person = world.pose(receiver).position
     base = world.base_pose()
     dx, dy = base.x - person[0], base.y - person[1]
     norm = math.hypot(dx, dy)
     reach = min(0.35, norm)
     hand = (person[0] + dx / norm * reach, person[1] + dy / norm * reach, PERSON_HAND_HEIGHT)
-    world.give_pen_to(receiver, hand)
+    for name in carried:
+        world.give_to(name, receiver, hand)
     world.step(0.5)
-    ok = pred.pen_with_person(world, receiver)
-    return _done(world, "DeliverObject", start, ok, f"{receiver} does not have the pen")
+    ok = all(pred.with_person(world, name, receiver) for name in carried)
+    return _done(world, "DeliverObject", start, ok, f"{receiver} does not have the {', '.join(carried)}")

@@ -9,7 +9,7 @@ world and, since stepping is deterministic, the same outcome for the same calls.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass
 from types import TracebackType
@@ -17,6 +17,8 @@ from types import TracebackType
 import numpy as np
 import pybullet as p
 
+from kb.semantic_map import Arm as ArmSpec
+from kb.semantic_map import MapObject, SemanticMap
 from sim import layout as L
 from sim.arms import PYBULLET_DATA, Arm, ArmSide, Kinematics
 from sim.base import BASE_HEIGHT, MobileBase
@@ -24,6 +26,7 @@ from sim.cameras import Camera
 from sim.errors import UnknownEntityError, WorldClosedError
 from sim.geometry import Pose2D, Pose3D, Quat, Region, Vec3, quat_from_yaw
 from sim.quiet import quiet_output
+from sim.scene import bundled_map
 
 __all__ = ["TIME_STEP", "HomeWorld", "Perturbation", "open_world"]
 
@@ -43,12 +46,25 @@ _WHITE = (0.93, 0.93, 0.95, 1.0)
 _STEEL = (0.55, 0.56, 0.58, 1.0)
 _DARK = (0.15, 0.15, 0.17, 1.0)
 _TORSO = (0.45, 0.46, 0.50, 1.0)
-CUP_RED = (0.85, 0.08, 0.08, 1.0)
-PEN_BLUE = (0.10, 0.20, 0.85, 1.0)
 WATER_CYAN = (0.05, 0.80, 0.80, 1.0)
-SHIRT_YELLOW = (0.95, 0.85, 0.10, 1.0)
-MARKER_GREEN = (0.10, 0.85, 0.15, 1.0)
-MARKER_MAGENTA = (0.85, 0.10, 0.85, 1.0)
+_NAMED_COLOURS = {
+    "red": (0.85, 0.08, 0.08, 1.0),
+    "yellow": (0.95, 0.85, 0.10, 1.0),
+    "green": (0.10, 0.85, 0.15, 1.0),
+    "cyan": (0.05, 0.80, 0.80, 1.0),
+    "blue": (0.10, 0.20, 0.85, 1.0),
+    "magenta": (0.85, 0.10, 0.85, 1.0),
+}
+"""How each colour perception knows (sim.perception.COLOURS) is painted: saturated, well inside its hue window."""
+
+
+def _named(colour: str) -> tuple[float, float, float, float]:
+    try:
+        return _NAMED_COLOURS[colour]
+    except KeyError:
+        raise ValueError(f"no display colour for {colour!r}; known: {', '.join(_NAMED_COLOURS)}") from None
+
+
 _CHASSIS = (0.28, 0.28, 0.30, 1.0)
 _PLATFORM = (0.70, 0.70, 0.72, 1.0)
 _SKIN = (0.85, 0.66, 0.52, 1.0)
@@ -59,23 +75,25 @@ _IDENTITY: Quat = (0.0, 0.0, 0.0, 1.0)
 
 @dataclass(frozen=True)
 class Perturbation:
-    """The seed's deterministic offsets from the nominal layout (metres, radians)."""
+    """The seed's deterministic offsets from the semantic map's start poses (metres, radians): each
+    object by up to 2 cm and, if it is not round, 0.15 rad; the person by 15 cm; the base by 10 cm and 0.3 rad."""
 
-    cup: tuple[float, float]
-    pen: tuple[float, float, float]
+    objects: Mapping[str, tuple[float, float, float]]
     person: tuple[float, float]
     base: tuple[float, float, float]
 
     @classmethod
-    def from_seed(cls, seed: int) -> Perturbation:
+    def from_seed(cls, seed: int, objects: Mapping[str, bool] | None = None) -> Perturbation:
+        """``objects`` maps each object's name to whether it is round (no yaw offset), in any order."""
         rng = np.random.default_rng(seed)
-        cup = rng.uniform(-0.02, 0.02, 2)
-        pen = rng.uniform([-0.02, -0.02, -0.15], [0.02, 0.02, 0.15])
         person = rng.uniform(-0.15, 0.15, 2)
         base = rng.uniform([-0.10, -0.10, -0.3], [0.10, 0.10, 0.3])
+        moved = {}
+        for name in sorted(objects or {}):
+            dx, dy, dyaw = rng.uniform([-0.02, -0.02, -0.15], [0.02, 0.02, 0.15])
+            moved[name] = (float(dx), float(dy), 0.0 if (objects or {})[name] else float(dyaw))
         return cls(
-            (float(cup[0]), float(cup[1])),
-            (float(pen[0]), float(pen[1]), float(pen[2])),
+            moved,
             (float(person[0]), float(person[1])),
             (float(base[0]), float(base[1]), float(base[2])),
         )
@@ -109,29 +127,48 @@ class HomeWorld:
     Use ``HomeWorld.create(seed)`` and close it (``with HomeWorld.create() as world:``).
     """
 
-    def __init__(self, client: int, seed: int, gui: bool, time_step: float) -> None:
+    def __init__(
+        self, client: int, seed: int, gui: bool, time_step: float, semantic_map: SemanticMap | None = None
+    ) -> None:
         self.client = client
         self.seed = seed
         self.gui = gui
         self.time_step = time_step
-        self.perturbation = Perturbation.from_seed(seed)
+        self.map = semantic_map if semantic_map is not None else bundled_map()
+        self.objects: dict[str, MapObject] = {obj.name: obj for obj in self.map.objects.values()}
+        """The movable objects by body name (the local name of their IRI)."""
+        self.containers = {name for name, obj in self.objects.items() if obj.iri in self.map.containers}
+        robots = list(self.map.robots.values())
+        people = list(self.map.people.values())
+        if len(robots) != 1 or len(people) != 1:
+            raise ValueError(
+                f"the simulated home takes one mobile robot and one person; the semantic map has {len(robots)} "
+                f"and {len(people)}"
+            )
+        self.robot, self.person = robots[0], people[0]
+        self.base_name, self.person_name = self.robot.name, self.person.name
+        self.perturbation = Perturbation.from_seed(
+            seed, {name: obj.shape == "cylinder" for name, obj in self.objects.items()}
+        )
         self._steps = 0
+        self._watchers: list[tuple[int, Callable[[], None]]] = []
         self._closed = False
         self._bodies: dict[str, int] = {}
-        self.cup_water = 0.0
-        """Fraction of the cup filled with water (0 to 1)."""
+        self.water: dict[str, float] = dict.fromkeys(self.containers, 0.0)
+        """Fraction of each container filled with water (0 to 1)."""
         self.water_spilled = 0.0
-        """Seconds the tap ran with no cup below it."""
-        self._water_shown = False
-        self.pen_holder: str | None = None
-        """Who holds the pen after a delivery (the person's name), else None."""
-        self._handed_constraint: int | None = None
+        """Seconds the tap ran with no container below it."""
+        self._water_shown: set[str] = set()
+        self.holders: dict[str, str] = {}
+        """Who holds an object after a delivery: object name -> person name."""
         self.cameras: dict[str, Camera] = {}
         self.arms: dict[ArmSide, Arm] = {}
+        self.arm_specs: dict[ArmSide, ArmSpec] = {}
+        """What the semantic map says of each arm: its mount pose and reach."""
         self._kinematics: Kinematics | None = None
         try:
             self._build()
-            self.base = MobileBase(client, self._bodies["P3DX01"], self.step)
+            self.base = MobileBase(client, self._bodies[self.base_name], self.step)
             self.step(0.3)  # let the objects settle on the table
         except BaseException:
             if self._kinematics is not None:
@@ -141,12 +178,15 @@ class HomeWorld:
     # --- life cycle -----------------------------------------------------------------------------
 
     @classmethod
-    def create(cls, seed: int = 0, gui: bool = False, time_step: float = TIME_STEP) -> HomeWorld:
-        """Connect a new pybullet client (DIRECT unless ``gui``) and build the home in it."""
+    def create(
+        cls, seed: int = 0, gui: bool = False, time_step: float = TIME_STEP, semantic_map: SemanticMap | None = None
+    ) -> HomeWorld:
+        """Connect a new pybullet client (DIRECT unless ``gui``) and build the home of ``semantic_map`` in
+        it (the bundled map by default)."""
         with quiet_output():
             client = p.connect(p.GUI if gui else p.DIRECT)
         try:
-            return cls(client, seed, gui, time_step)
+            return cls(client, seed, gui, time_step, semantic_map)
         except BaseException:
             p.disconnect(physicsClientId=client)
             raise
@@ -194,6 +234,16 @@ class HomeWorld:
             p.stepSimulation(physicsClientId=self.client)
             self._steps += 1
             self._run_tap()
+            for every, callback in list(self._watchers):
+                if self._steps % every == 0:
+                    callback()
+
+    def on_steps(self, every: int, callback: Callable[[], None]) -> Callable[[], None]:
+        """Call ``callback()`` after every ``every``-th physics step (a recorder's frames); returns the
+        call that stops it."""
+        entry = (max(1, every), callback)
+        self._watchers.append(entry)
+        return lambda: self._watchers.remove(entry) if entry in self._watchers else None
 
     # --- entities -------------------------------------------------------------------------------
 
@@ -241,7 +291,11 @@ class HomeWorld:
 
     def snapshot(self) -> dict[str, Pose3D]:
         """Poses of everything that can move (objects, base, person), for comparing runs."""
-        return {name: self.pose(name) for name in ("Cup", "Pen", "P3DX01", "Person")}
+        return {name: self.pose(name) for name in (*sorted(self.objects), self.base_name, self.person_name)}
+
+    def water_level(self, name: str) -> float:
+        """Fraction of a container filled with water; 0 for anything that is not a container."""
+        return self.water.get(name, 0.0)
 
     def tap_travel(self) -> float:
         """How far the tap lever is pushed in (m)."""
@@ -250,39 +304,42 @@ class HomeWorld:
     def tap_open(self) -> bool:
         return self.tap_travel() > TAP_OPEN_TRAVEL
 
-    def cup_catches_water(self) -> bool:
-        """Physics of the stream: it falls from the outlet into the cup if the cup is upright below it
-        and the outlet's axis passes inside the rim."""
-        pos, orn = p.getBasePositionAndOrientation(self.body("Cup"), physicsClientId=self.client)
+    def catches_water(self, name: str) -> bool:
+        """Physics of the stream: it falls from the outlet into a container if the container is upright
+        below it and the outlet's axis passes inside the rim."""
+        obj = self.objects[name]
+        pos, orn = p.getBasePositionAndOrientation(self.body(name), physicsClientId=self.client)
         up = p.getMatrixFromQuaternion(orn)[8]
-        inside = math.hypot(pos[0] - L.TAP_OUTLET[0], pos[1] - L.TAP_OUTLET[1]) < L.CUP_RADIUS - 0.004
-        below = pos[2] + L.CUP_HEIGHT / 2.0 < L.TAP_OUTLET[2]
+        rim = min(obj.size[0], obj.size[1]) / 2.0
+        inside = math.hypot(pos[0] - L.TAP_OUTLET[0], pos[1] - L.TAP_OUTLET[1]) < rim - 0.004
+        below = pos[2] + obj.size[2] / 2.0 < L.TAP_OUTLET[2]
         return inside and below and up > 0.95
 
     def _run_tap(self) -> None:
         if not self.tap_open():
             return
-        if self.cup_catches_water():
-            self.cup_water = min(1.0, self.cup_water + FILL_RATE * self.time_step)
-            if not self._water_shown and self.cup_water >= 0.2:
-                p.changeVisualShape(self.body("Cup"), 0, rgbaColor=WATER_CYAN, physicsClientId=self.client)
-                self._water_shown = True
-        else:
+        catching = next((name for name in sorted(self.containers) if self.catches_water(name)), None)
+        if catching is None:
             self.water_spilled += self.time_step
+            return
+        self.water[catching] = min(1.0, self.water[catching] + FILL_RATE * self.time_step)
+        if catching not in self._water_shown and self.water[catching] >= 0.2:
+            p.changeVisualShape(self.body(catching), 0, rgbaColor=WATER_CYAN, physicsClientId=self.client)
+            self._water_shown.add(catching)
 
-    def give_pen_to(self, person: str, hand: Vec3) -> None:
-        """The person takes the pen into their hand: it leaves the platform and stays with them."""
-        pen = self.body("Pen")
+    def give_to(self, name: str, person: str, hand: Vec3) -> None:
+        """The person takes the object into their hand: it leaves the platform and stays with them."""
+        thing = self.body(name)
         holder = self.body(person)
-        p.resetBasePositionAndOrientation(pen, hand, quat_from_yaw(0.0), physicsClientId=self.client)
-        p.resetBaseVelocity(pen, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), physicsClientId=self.client)
+        p.resetBasePositionAndOrientation(thing, hand, quat_from_yaw(0.0), physicsClientId=self.client)
+        p.resetBaseVelocity(thing, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), physicsClientId=self.client)
         holder_pos, holder_orn = p.getBasePositionAndOrientation(holder, physicsClientId=self.client)
         inv_pos, inv_orn = p.invertTransform(holder_pos, holder_orn)
         rel_pos, rel_orn = p.multiplyTransforms(inv_pos, inv_orn, hand, quat_from_yaw(0.0))
-        self._handed_constraint = p.createConstraint(
+        p.createConstraint(
             holder,
             -1,
-            pen,
+            thing,
             -1,
             p.JOINT_FIXED,
             (0.0, 0.0, 0.0),
@@ -291,7 +348,7 @@ class HomeWorld:
             parentFrameOrientation=rel_orn,
             physicsClientId=self.client,
         )
-        self.pen_holder = person
+        self.holders[name] = person
 
     # --- building -------------------------------------------------------------------------------
 
@@ -368,7 +425,13 @@ class HomeWorld:
         self._build_robot()
         self._build_base()
         self._build_person()
-        for spec in (*L.CAMERAS.values(), L.KINECT):
+        ceiling = [
+            L.CameraSpec(
+                cam.name, cam.position, (cam.position[0], cam.position[1], 0.0), (0.0, 1.0, 0.0), fov_deg=cam.fov
+            )
+            for cam in self.map.cameras.values()
+        ]
+        for spec in (*ceiling, L.KINECT):
             self.cameras[spec.name] = Camera(c, spec, self)
         if self.gui:
             p.configureDebugVisualizer(render, 1, physicsClientId=c)
@@ -430,27 +493,30 @@ class HomeWorld:
             dispenser, 1, p.POSITION_CONTROL, targetPosition=0.0, force=LEVER_SPRING_FORCE, physicsClientId=self.client
         )
 
-        dx, dy = self.perturbation.cup
-        cup = self._multibody(
-            "Cup",
-            [
-                _cylinder(L.CUP_RADIUS, L.CUP_HEIGHT, (0, 0, 0), CUP_RED),
-                # The water's surface: red (invisible against the cup) until the cup is filled.
-                _cylinder(L.CUP_RADIUS - 0.004, 0.002, (0, 0, L.CUP_HEIGHT / 2 + 0.0005), CUP_RED, collide=False),
-            ],
-            (L.CUP_START[0] + dx, L.CUP_START[1] + dy, L.TABLE_HEIGHT + L.CUP_HEIGHT / 2 + 0.001),
-            mass=0.15,
+        for obj in self.objects.values():
+            self._build_object(obj)
+
+    def _build_object(self, obj: MapObject) -> None:
+        """An object of the semantic map at its start pose (moved by the seed), resting on its support."""
+        support = self.map.things.get(obj.support) if obj.support else None
+        surface = support.box.max_z if support is not None else 0.0
+        dx, dy, dyaw = self.perturbation.objects.get(obj.name, (0.0, 0.0, 0.0))
+        length, width, height = obj.size
+        if obj.shape == "cylinder":
+            radius = min(length, width) / 2.0
+            parts = [_cylinder(radius, height, (0, 0, 0), obj.rgba)]
+            if obj.name in self.containers:  # the water's surface: invisible against the cup until it fills
+                parts.append(_cylinder(radius - 0.004, 0.002, (0, 0, height / 2 + 0.0005), obj.rgba, collide=False))
+        else:
+            parts = [_box((length / 2, width / 2, height / 2), (0, 0, 0), obj.rgba)]
+        body = self._multibody(
+            obj.name,
+            parts,
+            (obj.start.x + dx, obj.start.y + dy, surface + height / 2 + 0.001),
+            quat_from_yaw(obj.start.yaw + dyaw),
+            mass=obj.mass,
         )
-        px, py, pyaw = self.perturbation.pen
-        pen = self._multibody(
-            "Pen",
-            [_box((L.PEN_LENGTH / 2, L.PEN_WIDTH / 2, L.PEN_WIDTH / 2), (0, 0, 0), PEN_BLUE)],
-            (L.PEN_START[0] + px, L.PEN_START[1] + py, L.TABLE_HEIGHT + L.PEN_WIDTH / 2 + 0.001),
-            quat_from_yaw(L.PEN_START_YAW + pyaw),
-            mass=0.02,
-        )
-        for body in (cup, pen):
-            p.changeDynamics(body, -1, lateralFriction=1.0, spinningFriction=0.001, physicsClientId=self.client)
+        p.changeDynamics(body, -1, lateralFriction=1.0, spinningFriction=0.001, physicsClientId=self.client)
 
     def _build_robot(self) -> None:
         t = L.TORSO
@@ -468,17 +534,23 @@ class HomeWorld:
             ],
             kinect[1],
         )
-        mounts = {side: (L.ARM_MOUNTS[side.value], quat_from_yaw(L.ARM_MOUNT_YAW)) for side in ArmSide}
+        arms = {ArmSide(arm.side): arm for arm in self.map.arms.values()}
+        self.arm_specs = arms
+        if set(arms) != set(ArmSide):
+            raise ValueError(
+                f"the dual-arm robot needs a left and a right arm in the semantic map; it has {sorted(arms)}"
+            )
+        mounts = {side: (arms[side].mount, quat_from_yaw(arms[side].yaw)) for side in ArmSide}
         top = Region(
             "TableTop", L.TABLE.xmin, L.TABLE.xmax, L.TABLE.ymin, L.TABLE.ymax, L.TABLE_HEIGHT - 0.04, L.TABLE_HEIGHT
         )
         self._kinematics = Kinematics(mounts, [L.TORSO, top, L.DISPENSER, L.KINECT_BODY, L.KINECT_MAST])
         for side in ArmSide:
-            mount = L.ARM_MOUNTS[side.value]
+            mount, orientation = mounts[side]
             body = p.loadURDF(
                 "franka_panda/panda.urdf",
                 mount,
-                quat_from_yaw(L.ARM_MOUNT_YAW),
+                orientation,
                 useFixedBase=True,
                 flags=p.URDF_ENABLE_CACHED_GRAPHICS_SHAPES,
                 physicsClientId=self.client,
@@ -492,7 +564,8 @@ class HomeWorld:
 
     def _build_base(self) -> None:
         bx, by, btheta = self.perturbation.base
-        start = L.BASE_START
+        start = self.robot.start
+        front, rear = self.robot.marker_colours or ("green", "magenta")
         bottom = 0.02
         chassis_half = (L.BASE_HALF_LENGTH, L.BASE_HALF_WIDTH, (L.PLATFORM_HEIGHT - 0.02 - bottom) / 2)
         chassis_centre_z = bottom + chassis_half[2]
@@ -505,16 +578,16 @@ class HomeWorld:
         parts = [
             _box(chassis_half, (0, 0, 0), _CHASSIS),
             _box((L.BASE_HALF_LENGTH, L.BASE_HALF_WIDTH, 0.01), (0, 0, platform_z), _PLATFORM),
-            _box(patch, (L.MARKER_OFFSET, 0, marker_z), MARKER_GREEN, collide=False),
-            _box(patch, (-L.MARKER_OFFSET, 0, marker_z), MARKER_MAGENTA, collide=False),
+            _box(patch, (L.MARKER_OFFSET, 0, marker_z), _named(front), collide=False),
+            _box(patch, (-L.MARKER_OFFSET, 0, marker_z), _named(rear), collide=False),
             _Part(p.GEOM_CYLINDER, (0.095, 0.04), (0.0, 0.215, 0.095 - chassis_centre_z), _DARK, False, wheel),
             _Part(p.GEOM_CYLINDER, (0.095, 0.04), (0.0, -0.215, 0.095 - chassis_centre_z), _DARK, False, wheel),
         ]
         body = self._multibody(
-            "P3DX01",
+            self.base_name,
             parts,
             (start.x + bx, start.y + by, BASE_HEIGHT),
-            quat_from_yaw(start.theta + btheta),
+            quat_from_yaw(start.yaw + btheta),
             mass=20.0,
         )
         p.changeDynamics(body, 0, lateralFriction=1.0, physicsClientId=self.client)
@@ -523,18 +596,18 @@ class HomeWorld:
         dx, dy = self.perturbation.person
         legs = L.SHIRT_BOTTOM
         self._multibody(
-            "Person",
+            self.person_name,
             [
                 _cylinder(L.PERSON_RADIUS, legs, (0, 0, 0), _TROUSERS),
                 _cylinder(
                     L.SHIRT_RADIUS,
                     L.SHIRT_TOP - L.SHIRT_BOTTOM,
                     (0, 0, (L.SHIRT_TOP + legs) / 2 - legs / 2),
-                    SHIRT_YELLOW,
+                    self.person.rgba,
                 ),
                 _Part(p.GEOM_SPHERE, (0.10,), (0.0, 0.0, L.SHIRT_TOP + 0.11 - legs / 2), _SKIN),
             ],
-            (L.PERSON_START[0] + dx, L.PERSON_START[1] + dy, legs / 2),
+            (self.person.start.x + dx, self.person.start.y + dy, legs / 2),
         )
 
 
@@ -545,9 +618,9 @@ def _half_and_centre(region: Region) -> tuple[Vec3, Vec3]:
 
 
 @contextmanager
-def open_world(seed: int = 0, gui: bool = False) -> Iterator[HomeWorld]:
+def open_world(seed: int = 0, gui: bool = False, semantic_map: SemanticMap | None = None) -> Iterator[HomeWorld]:
     """``with open_world(seed) as world:`` builds a world and always disconnects it."""
-    world = HomeWorld.create(seed, gui)
+    world = HomeWorld.create(seed, gui, semantic_map=semantic_map)
     try:
         yield world
     finally:

@@ -136,7 +136,10 @@ def test_every_named_query_with_parameters_gives_the_embedded_answer(remote_loca
         "description": [LOCATE, "req:RobotSelfPosition", "act:PuttingSomethingSomewhere"],
         "requirement": ["req:RobotSelfPosition"],
         "resource": [LOCATE, "home:Position"],
-        "thing": ["world:Pen", "world:Person"],
+        "thing": ["world:Pen", "world:Person", "world:Cup"],
+        "relation": ["home:isLocatedOn", "home:isNear"],
+        "class": ["home:Cup", "home:Drinkware"],
+        "robot": ["svc:CytonDualArm01"],
     }
     checked = 0
     for name in embedded.queries.names():

@@ -15,6 +15,7 @@ from actions.runner import RunResult, run_task
 from cbrs.cli import cli
 from kb import KnowledgeBase
 from kb.namespaces import expand
+from kb.semantic_map import SemanticMap
 from sim.components import SimEnvironment
 from sim.world import open_world
 
@@ -28,7 +29,7 @@ def run(
     task: str, seed: int = 0, faults: tuple[str, ...] = (), policy: FaultPolicy | None = None
 ) -> tuple[RunResult, KnowledgeBase, float]:
     kb = KnowledgeBase.open(":memory:")
-    with open_world(seed=seed) as world:
+    with open_world(seed=seed, semantic_map=SemanticMap.read(kb)) as world:
         result = run_task(kb, task, SimEnvironment(world, kb), faults, composer=Composer(kb), fault_policy=policy)
         return result, kb, world.time
 

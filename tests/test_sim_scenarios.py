@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from sim import HomeWorld, fetch_pen, serve_cup
+from sim import HomeWorld
 from sim import predicates as pred
-from sim.layout import HANDOVER_POSE
+from sim.layout import BELOW_OF_TAP, HANDOVER_POSE
+from tests.reference_scenarios import fetch_pen, serve_cup
 
 SERVE_STEPS = [
     "ClearView",
@@ -24,7 +25,7 @@ def test_scenario_1_serves_a_cup_of_water() -> None:
         result = serve_cup(world)
         assert result.succeeded, result.failure
         assert [step.skill for step in result.steps] == SERVE_STEPS
-        assert pred.cup_below_tap(world) and pred.cup_contains_water(world)
+        assert pred.upright_in(world, "Cup", BELOW_OF_TAP) and pred.contains_water(world, "Cup")
         assert result.sim_seconds == pytest.approx(sum(step.sim_seconds for step in result.steps))
 
 
@@ -36,7 +37,7 @@ def test_scenario_2_fetches_the_pen() -> None:
         assert skills[0] == "LocateMobileRobot_CeilingCamera01"
         assert skills.index("NavigateToPlace") < skills.index("HandOverOntoPlatform") < skills.index("NavigateToPerson")
         assert skills[-1] == "DeliverObject"
-        assert pred.pen_with_person(world) and pred.base_near_person(world)
+        assert pred.with_person(world, "Pen") and pred.base_near_person(world)
 
 
 def test_scenario_2_localising_with_the_other_camera_and_dijkstra() -> None:
@@ -45,7 +46,7 @@ def test_scenario_2_localising_with_the_other_camera_and_dijkstra() -> None:
         assert result.succeeded, result.failure
         skills = [step.skill for step in result.steps]
         assert skills.count("LocateMobileRobot_CeilingCamera02") == 3 and "PlanPath_dijkstra" in skills
-        assert pred.pen_with_person(world)
+        assert pred.with_person(world, "Pen")
 
 
 def test_a_failed_camera_stops_the_scenario_with_a_reason() -> None:

@@ -7,9 +7,8 @@ from collections.abc import Iterator
 
 import pytest
 
+from kb.namespaces import PREFIXES
 from sim import (
-    CUP,
-    PEN,
     ArmSide,
     HomeWorld,
     Pose2D,
@@ -20,10 +19,15 @@ from sim import (
     track_person,
 )
 from sim import predicates as pred
-from sim.layout import ARM_MOUNTS, BELOW_OF_TAP, HANDOVER_POSE, TABLE
+from sim.grasping import ObjectModel
+from sim.layout import ARM_MOUNTS, BELOW_OF_TAP, HANDOVER_POSE, TABLE, TAP_LEVER
 from sim.mapping import build_occupancy_grid
 from sim.planning import approach_point, plan_path
-from sim.scenarios import PERSON_APPROACH_DISTANCE
+from sim.scene import bundled_map
+from tests.reference_scenarios import PERSON_APPROACH_DISTANCE
+
+CUP = ObjectModel.of(bundled_map().objects[PREFIXES["world"] + "Cup"])
+PEN = ObjectModel.of(bundled_map().objects[PREFIXES["world"] + "Pen"])
 
 
 @pytest.fixture
@@ -50,20 +54,20 @@ def test_serving_a_cup_skill_by_skill(world: HomeWorld) -> None:
 
     outcome = skills.carry_object(world, left, BELOW_OF_TAP)
     assert outcome.succeeded, outcome.reason
-    assert pred.object_above_region(world, "Cup", BELOW_OF_TAP) and not pred.cup_below_tap(world)
+    assert pred.object_above_region(world, "Cup", BELOW_OF_TAP) and not pred.upright_in(world, "Cup", BELOW_OF_TAP)
 
     outcome = skills.put_down_object(world, left, BELOW_OF_TAP)
     assert outcome.succeeded, outcome.reason
-    assert pred.cup_below_tap(world) and not pred.is_grasped(world, "Cup")
+    assert pred.upright_in(world, "Cup", BELOW_OF_TAP) and not pred.is_grasped(world, "Cup")
     assert not pred.object_above_region(world, "Cup", BELOW_OF_TAP)
 
-    assert not pred.cup_contains_water(world)
-    outcome = skills.fill_cup_from_tap(world, right)
+    assert not pred.contains_water(world, "Cup")
+    outcome = skills.fill_cup_from_tap(world, right, TAP_LEVER, "Cup")
     assert outcome.succeeded, outcome.reason
-    assert pred.cup_contains_water(world) and world.cup_water == pytest.approx(1.0)
+    assert pred.contains_water(world, "Cup") and world.water_level("Cup") == pytest.approx(1.0)
     assert world.water_spilled < 0.2  # only while the lever moved in and out
     assert not world.tap_open()
-    assert pred.cup_below_tap(world)
+    assert pred.upright_in(world, "Cup", BELOW_OF_TAP)
     for outcome_time in (outcome.started, outcome.finished):
         assert outcome_time <= world.time
 
@@ -81,10 +85,10 @@ def test_fetching_a_pen_skill_by_skill(world: HomeWorld) -> None:
 
     parked = locate_robot(camera.capture())
     pen = recognise_object(world.camera("Kinect01").capture(), PEN.colour)
-    assert not pred.pen_on_platform(world)
-    outcome = skills.hand_over_onto_platform(world, pen, parked, ArmSide.RIGHT)
+    assert not pred.on_platform(world, "Pen")
+    outcome = skills.hand_over_onto_platform(world, pen, parked, ArmSide.RIGHT, PEN, 0.85)
     assert outcome.succeeded, outcome.reason
-    assert pred.pen_on_platform(world) and not pred.is_grasped(world, "Pen")
+    assert pred.on_platform(world, "Pen") and not pred.is_grasped(world, "Pen")
 
     person = track_person(camera.capture())
     here = locate_robot(camera.capture())
@@ -94,12 +98,12 @@ def test_fetching_a_pen_skill_by_skill(world: HomeWorld) -> None:
     outcome = skills.navigate_to_person(world, path, person)
     assert outcome.succeeded, outcome.reason
     assert pred.base_near_person(world)
-    assert pred.pen_on_platform(world), "the pen must ride on the platform, carried by friction"
+    assert pred.on_platform(world, "Pen"), "the pen must ride on the platform, carried by friction"
 
-    assert not pred.pen_with_person(world)
+    assert not pred.with_person(world, "Pen")
     outcome = skills.deliver_object(world)
     assert outcome.succeeded, outcome.reason
-    assert pred.pen_with_person(world) and not pred.pen_on_platform(world)
+    assert pred.with_person(world, "Pen") and not pred.on_platform(world, "Pen")
 
 
 def test_skills_refuse_what_they_cannot_do(world: HomeWorld) -> None:
@@ -110,7 +114,10 @@ def test_skills_refuse_what_they_cannot_do(world: HomeWorld) -> None:
         (skills.carry_object(world, "left", BELOW_OF_TAP), "holds nothing"),
         (skills.put_down_object(world, "left", BELOW_OF_TAP), "holds nothing"),
         (skills.deliver_object(world), "not near Person"),
-        (skills.hand_over_onto_platform(world, cup, world.base_pose()), "not parked"),
+        (
+            skills.hand_over_onto_platform(world, cup, world.base_pose(), ArmSide.RIGHT, CUP, 0.85),
+            "out of the right arm's reach",
+        ),
         (skills.navigate(world, []), "no waypoints"),
     ]
     for outcome, reason in refused:
@@ -121,10 +128,10 @@ def test_skills_refuse_what_they_cannot_do(world: HomeWorld) -> None:
 
 
 def test_filling_with_no_cup_below_the_tap_fails_and_spills(world: HomeWorld) -> None:
-    outcome = skills.fill_cup_from_tap(world, ArmSide.RIGHT)
+    outcome = skills.fill_cup_from_tap(world, ArmSide.RIGHT, TAP_LEVER, "Cup")
     assert not outcome.succeeded
-    assert "no cup" in outcome.reason
-    assert world.cup_water == 0.0 and world.water_spilled > 0.3
+    assert "did not catch it" in outcome.reason
+    assert world.water_level("Cup") == 0.0 and world.water_spilled > 0.3
     assert not world.tap_open()  # the lever was let go
 
 

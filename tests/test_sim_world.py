@@ -58,7 +58,7 @@ def test_objects_start_on_the_table_near_their_nominal_place(world: HomeWorld) -
     assert pred.object_located_in(world, "Cup", TABLE)
     assert pred.object_located_in(world, "Pen", TABLE)
     assert not pred.is_grasped(world, "Cup")
-    assert world.cup_water == 0.0
+    assert world.water_level("Cup") == 0.0
 
 
 def test_base_and_person_start_in_the_living_room(world: HomeWorld) -> None:

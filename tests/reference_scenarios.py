@@ -19,8 +19,8 @@ from typing import TypeVar
 from sim import skills
 from sim.arms import ArmSide
 from sim.errors import SimulationError
-from sim.grasping import CUP, PEN, compute_grasp_pose
-from sim.layout import ARM_MOUNTS, BELOW_OF_TAP, HANDOVER_POSE
+from sim.grasping import ObjectModel, compute_grasp_pose
+from sim.layout import ARM_MOUNTS, BELOW_OF_TAP, HANDOVER_POSE, TAP_LEVER
 from sim.mapping import OccupancyGrid, build_occupancy_grid
 from sim.perception import RobotPoseEstimate, locate_robot, recognise_object, track_person
 from sim.planning import approach_point, plan_path
@@ -81,16 +81,19 @@ def serve_cup(world: HomeWorld, arm: ArmSide = ArmSide.LEFT, tap_arm: ArmSide = 
     run = _Run(world, "RobotArmServeACup", world.time)
     if not run.act(skills.clear_view(world)):
         return run.result()
-    cup = run.sense("RecogniseObjectByColour", lambda: recognise_object(world.camera("Kinect01").capture(), CUP.colour))
+    model = ObjectModel.of(world.objects["Cup"])
+    cup = run.sense(
+        "RecogniseObjectByColour", lambda: recognise_object(world.camera("Kinect01").capture(), model.colour)
+    )
     if cup is None:
         return run.result()
-    grasp = compute_grasp_pose(CUP, cup.position, cup.yaw, ARM_MOUNTS[arm.value])
+    grasp = compute_grasp_pose(model, cup.position, cup.yaw, ARM_MOUNTS[arm.value])
     steps: list[Callable[[], Outcome]] = [
         lambda: skills.approach_object(world, arm, grasp),
         lambda: skills.pick_up_object(world, arm, grasp),
         lambda: skills.carry_object(world, arm, BELOW_OF_TAP),
         lambda: skills.put_down_object(world, arm, BELOW_OF_TAP),
-        lambda: skills.fill_cup_from_tap(world, tap_arm),
+        lambda: skills.fill_cup_from_tap(world, tap_arm, TAP_LEVER, "Cup"),
     ]
     for step in steps:
         if not run.act(step()):
@@ -127,8 +130,12 @@ def fetch_pen(
     parked = locate()
     if parked is None:
         return run.result()
-    pen = run.sense("RecogniseObjectByColour", lambda: recognise_object(world.camera("Kinect01").capture(), PEN.colour))
-    if pen is None or not run.act(skills.hand_over_onto_platform(world, pen, parked, arm)):
+    model = ObjectModel.of(world.objects["Pen"])
+    pen = run.sense(
+        "RecogniseObjectByColour", lambda: recognise_object(world.camera("Kinect01").capture(), model.colour)
+    )
+    reach = world.arm_specs[arm].reach
+    if pen is None or not run.act(skills.hand_over_onto_platform(world, pen, parked, arm, model, reach)):
         return run.result()
     person = run.sense(f"TrackPerson_{person_camera}", lambda: track_person(world.camera(person_camera).capture()))
     if person is None:

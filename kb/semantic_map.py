@@ -1,0 +1,392 @@
+"""The semantic map: the home's rooms, furniture, regions, objects, people and robot parts, as typed values.
+
+The map lives in the store (``ontologies/world.ttl`` seeds the ``map`` graph; a user's Turtle may add
+to it), KnowRob style; this module reads it with the named queries ``map_facts``, ``map_types`` and
+``grasp_affordances`` into plain frozen dataclasses, so that the simulation can build its scene from
+it and the executor can resolve a task's inputs against it (:func:`designate`). Nothing here knows a
+particular cup or table: every value comes from the store.
+"""
+
+from __future__ import annotations
+
+from collections import defaultdict
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+from kb.errors import KnowledgeBaseError
+from kb.namespaces import PREFIXES
+
+if TYPE_CHECKING:
+    from kb.knowledge_base import KnowledgeBase
+
+HOME = PREFIXES["home"]
+
+__all__ = [
+    "AmbiguousDesignatorError",
+    "Arm",
+    "Box",
+    "Camera",
+    "MapError",
+    "MapObject",
+    "MobileRobot",
+    "Person",
+    "Pose",
+    "SemanticMap",
+    "UnresolvedDesignatorError",
+    "designate",
+    "local_name",
+]
+
+
+class MapError(KnowledgeBaseError):
+    """The semantic map lacks or contradicts what is needed; names the thing and the property."""
+
+    http_status = 422
+
+    def __init__(self, thing: str, problem: str) -> None:
+        self.thing = thing
+        super().__init__(f"semantic map: {local_name(thing)} ({thing}) {problem}")
+
+
+class UnresolvedDesignatorError(KnowledgeBaseError):
+    """No thing of the world is of the class a task's input names."""
+
+    http_status = 422
+
+    def __init__(self, concept: str) -> None:
+        self.concept = concept
+        super().__init__(
+            f"nothing in the world is a {local_name(concept)} ({concept}): add an individual of that class to the "
+            "semantic map (see docs/tasks.md)"
+        )
+
+
+class AmbiguousDesignatorError(KnowledgeBaseError):
+    """Several things of the world are of the class a task's input names, and nothing tells them apart."""
+
+    http_status = 422
+
+    def __init__(self, concept: str, candidates: list[str]) -> None:
+        self.concept = concept
+        self.candidates = candidates
+        names = ", ".join(local_name(c) for c in candidates)
+        super().__init__(
+            f"{local_name(concept)} is ambiguous: {names} are all {local_name(concept)}s; name the individual "
+            "in the task or make the input's class more specific"
+        )
+
+
+def local_name(iri: str) -> str:
+    return iri.rsplit("#", 1)[-1].rsplit("/", 1)[-1]
+
+
+@dataclass(frozen=True)
+class Pose:
+    x: float
+    y: float
+    yaw: float = 0.0
+
+
+@dataclass(frozen=True)
+class Box:
+    """An axis-aligned extent; ``min_z``/``max_z`` default to the floor for rooms."""
+
+    min_x: float
+    max_x: float
+    min_y: float
+    max_y: float
+    min_z: float = 0.0
+    max_z: float = 0.0
+
+    @property
+    def centre(self) -> tuple[float, float, float]:
+        return ((self.min_x + self.max_x) / 2, (self.min_y + self.max_y) / 2, (self.min_z + self.max_z) / 2)
+
+    def contains_xy(self, x: float, y: float, margin: float = 0.0) -> bool:
+        return self.min_x - margin <= x <= self.max_x + margin and self.min_y - margin <= y <= self.max_y + margin
+
+
+@dataclass(frozen=True)
+class Thing:
+    """Anything in the map that has an extent: a room, a piece of furniture, a region, a tap lever."""
+
+    iri: str
+    types: tuple[str, ...]
+    box: Box
+    dock: Pose | None = None
+
+    @property
+    def name(self) -> str:
+        return local_name(self.iri)
+
+
+@dataclass(frozen=True)
+class MapObject:
+    """A movable object: its shape and size, mass, colour, start pose and how it is grasped."""
+
+    iri: str
+    types: tuple[str, ...]
+    shape: str  # "box" or "cylinder"
+    size: tuple[float, float, float]
+    mass: float
+    colour: str
+    rgba: tuple[float, float, float, float]
+    start: Pose
+    support: str | None
+    grasp_approach: str
+    grasp_height: float
+
+    @property
+    def name(self) -> str:
+        return local_name(self.iri)
+
+
+@dataclass(frozen=True)
+class Person:
+    iri: str
+    start: Pose
+    colour: str
+    rgba: tuple[float, float, float, float]
+
+    @property
+    def name(self) -> str:
+        return local_name(self.iri)
+
+
+@dataclass(frozen=True)
+class Arm:
+    iri: str
+    robot: str
+    side: str
+    mount: tuple[float, float, float]
+    yaw: float
+    reach: float
+
+
+@dataclass(frozen=True)
+class Camera:
+    """A camera on the ceiling: where it hangs (it looks straight down) and its vertical field of view."""
+
+    iri: str
+    position: tuple[float, float, float]
+    fov: float
+
+    @property
+    def name(self) -> str:
+        return local_name(self.iri)
+
+
+@dataclass(frozen=True)
+class MobileRobot:
+    iri: str
+    start: Pose
+    platform: str | None
+    platform_height: float | None
+    marker_colours: tuple[str, str] | None  # front, rear
+
+    @property
+    def name(self) -> str:
+        return local_name(self.iri)
+
+
+@dataclass(frozen=True)
+class SemanticMap:
+    """What the store says the home holds, by IRI."""
+
+    things: dict[str, Thing] = field(default_factory=dict)
+    objects: dict[str, MapObject] = field(default_factory=dict)
+    people: dict[str, Person] = field(default_factory=dict)
+    arms: dict[str, Arm] = field(default_factory=dict)
+    robots: dict[str, MobileRobot] = field(default_factory=dict)
+    cameras: dict[str, Camera] = field(default_factory=dict)
+    types: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    facts: dict[str, dict[str, list[str]]] = field(default_factory=dict)
+    containers: frozenset[str] = frozenset()
+    """The things that are a home:Container by the taxonomy: what a tap can fill."""
+
+    def of_type(self, concept: str) -> list[str]:
+        """The things whose asserted classes include ``concept`` (no subclass reasoning: see :func:`designate`)."""
+        return sorted(iri for iri, types in self.types.items() if concept in types)
+
+    def marker_colours(self, iri: str) -> tuple[str, str] | None:
+        """The front and rear colours of a marker-colours individual (or a robot's marker)."""
+        values = self.facts.get(iri, {})
+        if HOME + "frontColourName" in values and HOME + "rearColourName" in values:
+            return values[HOME + "frontColourName"][0], values[HOME + "rearColourName"][0]
+        robot = self.robots.get(iri)
+        return robot.marker_colours if robot else None
+
+    @classmethod
+    def read(cls, kb: KnowledgeBase) -> SemanticMap:
+        facts: dict[str, dict[str, list[str]]] = defaultdict(lambda: defaultdict(list))
+        for row in kb.select("map_facts"):
+            facts[row["thing"].value][row["property"].value].append(row["value"].value)
+        types: dict[str, list[str]] = defaultdict(list)
+        for row in kb.select("map_types"):
+            types[row["thing"].value].append(row["type"].value)
+        affordances: dict[str, tuple[str, float]] = {}
+        for row in kb.select("grasp_affordances"):  # nearest ancestor first
+            affordances.setdefault(row["class"].value, (row["approach"].value, float(row["ratio"].value)))
+        containers = frozenset(row["thing"].value for row in kb.select("designate", {"class": HOME + "Container"}))
+        built = cls(
+            types={k: tuple(v) for k, v in types.items()},
+            facts={k: dict(v) for k, v in facts.items()},
+            containers=containers,
+        )
+        for iri, values in facts.items():
+            _classify(built, iri, values, tuple(types.get(iri, ())), affordances, facts)
+        return built
+
+
+def _number(values: dict[str, list[str]], name: str, iri: str, default: float | None = None) -> float:
+    raw = values.get(HOME + name)
+    if not raw:
+        if default is None:
+            raise MapError(iri, f"has no home:{name}")
+        return default
+    try:
+        return float(raw[0])
+    except ValueError:
+        raise MapError(iri, f"has home:{name} {raw[0]!r}, not a number") from None
+
+
+def _text(values: dict[str, list[str]], name: str) -> str | None:
+    raw = values.get(HOME + name)
+    return raw[0] if raw else None
+
+
+def _rgba(iri: str, values: dict[str, list[str]]) -> tuple[float, float, float, float]:
+    text = _text(values, "rgba") or "0.5 0.5 0.5 1"
+    try:
+        parts = [float(part) for part in text.split()]
+    except ValueError:
+        raise MapError(iri, f"has home:rgba {text!r}; write four numbers in 0..1") from None
+    if len(parts) == 3:
+        parts.append(1.0)
+    if len(parts) != 4 or not all(0.0 <= part <= 1.0 for part in parts):
+        raise MapError(iri, f"has home:rgba {text!r}; write four numbers in 0..1")
+    return (parts[0], parts[1], parts[2], parts[3])
+
+
+def _classify(
+    built: SemanticMap,
+    iri: str,
+    values: dict[str, list[str]],
+    types: tuple[str, ...],
+    affordances: dict[str, tuple[str, float]],
+    facts: dict[str, dict[str, list[str]]],
+) -> None:
+    if HOME + "fieldOfView" in values:
+        position = (_number(values, "x", iri), _number(values, "y", iri), _number(values, "z", iri))
+        built.cameras[iri] = Camera(iri, position, _number(values, "fieldOfView", iri))
+        return
+    if HOME + "armSide" in values:
+        robots = [robot for robot, props in facts.items() if iri in props.get(HOME + "hasArm", [])]
+        built.arms[iri] = Arm(
+            iri,
+            robots[0] if robots else "",
+            _text(values, "armSide") or "",
+            (_number(values, "x", iri), _number(values, "y", iri), _number(values, "z", iri)),
+            _number(values, "yaw", iri, 0.0),
+            _number(values, "reach", iri),
+        )
+        return
+    if HOME + "shapeKind" in values:
+        shape = _text(values, "shapeKind") or ""
+        if shape not in ("box", "cylinder"):
+            raise MapError(iri, f'has home:shapeKind {shape!r}; use "box" or "cylinder"')
+        grasp = next((affordances[t] for t in types if t in affordances), None)
+        if grasp is None:
+            raise MapError(
+                iri,
+                f"is a {', '.join(local_name(t) for t in types) or 'thing of no class'} and no class above it says how "
+                "to grasp it: give one home:graspApproach and home:graspHeightRatio",
+            )
+        size = (_number(values, "sizeX", iri), _number(values, "sizeY", iri), _number(values, "sizeZ", iri))
+        if min(size) <= 0:
+            raise MapError(iri, f"has a size of {size}; every size must be positive")
+        support = values.get(HOME + "isLocatedOn", [None])[0]
+        built.objects[iri] = MapObject(
+            iri,
+            types,
+            shape,
+            size,
+            _number(values, "massKg", iri),
+            _text(values, "colourName") or "",
+            _rgba(iri, values),
+            Pose(_number(values, "x", iri), _number(values, "y", iri), _number(values, "yaw", iri, 0.0)),
+            support,
+            grasp[0],
+            grasp[1] * size[2],
+        )
+        return
+    if HOME + "Person" in types or any(t.endswith("Person") for t in types):
+        built.people[iri] = Person(
+            iri,
+            Pose(_number(values, "x", iri), _number(values, "y", iri), _number(values, "yaw", iri, 0.0)),
+            _text(values, "colourName") or "",
+            _rgba(iri, values),
+        )
+        return
+    if HOME + "hasPlatform" in values or HOME + "hasMarker" in values:
+        platform = values.get(HOME + "hasPlatform", [None])[0]
+        height = None
+        if platform is not None:
+            height = _number(facts.get(platform, {}), "maxZ", platform)
+        marker = values.get(HOME + "hasMarker", [None])[0]
+        colours = None
+        if marker is not None:
+            colour_node = facts.get(marker, {}).get(HOME + "hasColour", [marker])[0]
+            node = facts.get(colour_node, {})
+            front, rear = _text(node, "frontColourName"), _text(node, "rearColourName")
+            colours = (front, rear) if front and rear else None
+        built.robots[iri] = MobileRobot(
+            iri,
+            Pose(_number(values, "x", iri), _number(values, "y", iri), _number(values, "yaw", iri, 0.0)),
+            platform,
+            height,
+            colours,
+        )
+        return
+    if HOME + "minX" in values:
+        top = _number(values, "maxZ", iri, 0.0)
+        box = Box(
+            _number(values, "minX", iri),
+            _number(values, "maxX", iri),
+            _number(values, "minY", iri),
+            _number(values, "maxY", iri),
+            _number(values, "minZ", iri, top),
+            top,
+        )
+        dock_iri = values.get(HOME + "dockingPose", [None])[0]
+        dock = None
+        if dock_iri is not None:
+            node = facts.get(dock_iri, {})
+            dock = Pose(_number(node, "x", dock_iri), _number(node, "y", dock_iri), _number(node, "yaw", dock_iri, 0.0))
+        built.things[iri] = Thing(iri, types, box, dock)
+
+
+def designate(kb: KnowledgeBase, concept: str, prefer: str | None = None) -> str:
+    """The one thing of the world that is a ``concept`` (a task input's class), by the ``designate`` query.
+
+    With several candidates, those that are parts of ``prefer`` (the requesting robot, through any
+    one or two links) win; still several is :class:`AmbiguousDesignatorError`, none is
+    :class:`UnresolvedDesignatorError`.
+    """
+    candidates = sorted({row["thing"].value for row in kb.select("designate", {"class": concept})})
+    if not candidates:
+        raise UnresolvedDesignatorError(concept)
+    if len(candidates) > 1 and prefer is not None:
+        owned = [c for c in candidates if _linked(kb, prefer, c)]
+        if len(owned) == 1:
+            return owned[0]
+    if len(candidates) > 1:
+        raise AmbiguousDesignatorError(concept, candidates)
+    return candidates[0]
+
+
+def _linked(kb: KnowledgeBase, owner: str, thing: str) -> bool:
+    first = {row["value"].value for row in kb.select("map_facts", {"thing": owner})}
+    if thing in first:
+        return True
+    return any(thing in {row["value"].value for row in kb.select("map_facts", {"thing": hop})} for hop in first)

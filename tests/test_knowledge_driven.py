@@ -1,0 +1,128 @@
+"""Execution driven by the knowledge base: tasks, objects and places written only in Turtle run in a
+simulated home built from the store's semantic map (tests/data/tasks holds the files)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from actions.composer import Composer
+from actions.runner import RunResult, run_task
+from kb import KnowledgeBase
+from kb.namespaces import PREFIXES
+from kb.semantic_map import AmbiguousDesignatorError, MapError, SemanticMap, UnresolvedDesignatorError, designate
+from sim.components import SimEnvironment
+from sim.world import open_world
+
+TASKS = Path(__file__).parent / "data" / "tasks"
+HOME, WORLD, REQ = PREFIXES["home"], PREFIXES["world"], PREFIXES["req"]
+
+
+def run(kb: KnowledgeBase, task: str, seed: int = 0) -> RunResult:
+    with open_world(seed=seed, semantic_map=SemanticMap.read(kb)) as world:
+        return run_task(kb, task, SimEnvironment(world, kb), composer=Composer(kb))
+
+
+def world_facts(kb: KnowledgeBase) -> set[tuple[str, str, str]]:
+    return {(r["thing"].value, r["relation"].value, r["other"].value) for r in kb.select("world_facts")}
+
+
+def test_a_new_object_is_fetched_by_a_goal_only_task_written_in_turtle() -> None:
+    kb = KnowledgeBase.open(":memory:")
+    kb.load([TASKS / "pencil_on_the_table.ttl"], graph="map")
+    kb.load([TASKS / "fetch_my_pencil.ttl"], graph="requirements")
+    result = run(kb, "FetchMyPencil")
+    assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
+    assert result.report is not None
+    order = [step.planned.rsplit("#", 1)[-1] for step in result.report.steps]
+    # no hierarchy orders them: NavigateToPlace deletes "near the person", so it goes first
+    assert order.index("NavigateToPlace_P3DX01") < order.index("HandOverOntoPlatform_CytonDualArm01")
+    assert order.index("HandOverOntoPlatform_CytonDualArm01") < order.index("NavigateToPerson_P3DX01")
+    assert (WORLD + "Pencil1", HOME + "isWith", WORLD + "Person") in world_facts(kb)
+    assert (WORLD + "Pen", HOME + "isLocatedOn", WORLD + "KitchenTable") in world_facts(kb)  # the pen stayed
+
+
+def test_a_new_destination_written_in_turtle() -> None:
+    kb = KnowledgeBase.open(":memory:")
+    kb.load([TASKS / "tray_place.ttl"], graph="map")
+    kb.load([TASKS / "put_cup_on_tray.ttl"], graph="requirements")
+    result = run(kb, "PutCupOnTray")
+    assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
+    assert (WORLD + "Cup", HOME + "isLocated", WORLD + "TrayPlace") in world_facts(kb)
+
+
+def test_moving_the_cup_in_the_store_moves_it_in_the_simulation() -> None:
+    kb = KnowledgeBase.open(":memory:")
+    kb.update(
+        "DELETE { GRAPH graph:map { world:Cup home:x ?x ; home:y ?y } } "
+        "INSERT { GRAPH graph:map { world:Cup home:x 7.30 ; home:y 3.60 } } "
+        "WHERE { GRAPH graph:map { world:Cup home:x ?x ; home:y ?y } }"
+    )
+    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
+        x, y, z = world.pose("Cup").position
+    assert abs(x - 7.30) < 0.03 and abs(y - 3.60) < 0.03
+    assert abs(z - (0.75 + 0.05)) < 0.01  # resting on the table it is said to be on
+
+
+def test_a_book_added_without_a_grasp_says_what_to_add() -> None:
+    kb = KnowledgeBase.open(":memory:")
+    kb.update(
+        "INSERT DATA { GRAPH graph:map { world:Book1 a home:Book ; home:shapeKind 'box' ; home:sizeX 0.2 ; "
+        "home:sizeY 0.15 ; home:sizeZ 0.03 ; home:massKg 0.4 ; home:x 8.2 ; home:y 4.0 ; "
+        "home:isLocatedOn world:KitchenTable } }"
+    )
+    with pytest.raises(MapError, match="graspApproach") as refused:
+        SemanticMap.read(kb)
+    assert refused.value.thing == WORLD + "Book1"
+    affordance = "home:graspApproach 'top' ; home:graspHeightRatio 0.5"
+    kb.update(f"INSERT DATA {{ GRAPH graph:ontology {{ <{HOME}Book> {affordance} }} }}")
+    book = SemanticMap.read(kb).objects[WORLD + "Book1"]
+    assert (book.grasp_approach, book.grasp_height) == ("top", pytest.approx(0.015))
+    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
+        x, y, _ = world.pose("Book1").position
+    assert abs(x - 8.2) < 0.03 and abs(y - 4.0) < 0.03
+
+
+def test_an_input_is_resolved_by_its_class_and_ambiguity_names_the_candidates() -> None:
+    kb = KnowledgeBase.open(":memory:")
+    assert designate(kb, HOME + "Drinkware") == WORLD + "Cup"  # by the taxonomy, not by name
+    kb.update("INSERT DATA { GRAPH graph:map { world:Mug1 a home:Mug } }")
+    with pytest.raises(AmbiguousDesignatorError) as ambiguous:
+        designate(kb, HOME + "Drinkware")
+    assert ambiguous.value.candidates == [WORLD + "Cup", WORLD + "Mug1"]
+    assert "Cup, Mug1" in str(ambiguous.value)
+    with pytest.raises(UnresolvedDesignatorError, match="nothing in the world is a Bottle"):
+        designate(kb, HOME + "Bottle")
+
+
+def test_a_task_whose_input_has_no_thing_in_the_world_says_which(tmp_path: Path) -> None:
+    kb = KnowledgeBase.open(":memory:")
+    task = (TASKS / "fetch_my_pencil.ttl").read_text(encoding="utf-8")
+    kb.load([TASKS / "fetch_my_pencil.ttl"], graph="requirements")
+    assert "Pencil" in task
+    with pytest.raises(UnresolvedDesignatorError, match="Pencil"):
+        run(kb, "FetchMyPencil")
+
+
+def test_a_store_seeded_before_the_semantic_map_gets_it_on_open(tmp_path: Path) -> None:
+    kb = KnowledgeBase.open(tmp_path / "store")
+    kb.update("DROP GRAPH graph:map")
+    kb.update(f"DELETE WHERE {{ GRAPH graph:ontology {{ ?class <{HOME}graspApproach> ?approach }} }}")
+    before = kb.store.count()
+    kb.store.close()
+    reopened = KnowledgeBase.open(tmp_path / "store")
+    assert reopened.store.count() > before
+    assert WORLD + "Cup" in SemanticMap.read(reopened).objects  # with its inherited grasp again
+
+
+def test_a_better_camera_registered_in_turtle_is_used_by_fetch_my_pen() -> None:
+    kb = KnowledgeBase.open(":memory:")
+    kb.load([TASKS / "better_camera.ttl"], graph="services")
+    kb.load([TASKS / "better_camera_on_the_ceiling.ttl"], graph="map")
+    result = run(kb, "FetchMyPen")
+    assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
+    assert result.report is not None
+    used = [step.attempts[-1].component for step in result.report.steps if step.attempts]
+    assert PREFIXES["svc"] + "LocateMobileRobot_CeilingCamera03" in used
+    assert len(result.report.steps) == 15
