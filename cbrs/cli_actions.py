@@ -130,7 +130,10 @@ def _source(binding: Binding) -> str:
 @click.option(
     "--record",
     type=click.Path(dir_okay=False, path_type=Path),
-    help="Write the ceiling camera's view after each step to FILE.gif.",
+    help=(
+        "Record the run to FILE (.gif; .mp4 or .webm need ffmpeg): 640x480, a frame every 0.5 simulated s,"
+        " each captioned with the step; also draws the paths top-down to FILE-path.png."
+    ),
 )
 @pass_app
 def run(
@@ -149,36 +152,51 @@ def run(
     Exits with status 1 when there is no plan or the run fails; a failed run names the requirement
     it could not meet and every component tried for it.
     """
-    if record is not None and record.suffix.lower() != ".gif":
-        raise click.BadParameter(f"{record.name!r} must end in .gif", param_hint="--record")
-    failing = [parse_iri(f, "--fail") for f in faults]
-    resolve_task(app.kb, ActionLibrary.from_kb(app.kb), task)  # an unknown task fails before the world is built
+    from kb.semantic_map import SemanticMap
     from sim.components import SimEnvironment  # pybullet loads only for this command
+    from sim.recording import Recorder, RecordingError, check_target
     from sim.world import open_world
 
+    if record is not None:
+        try:  # an unknown format, or a video with no ffmpeg, fails before anything runs
+            check_target(record)
+        except RecordingError as error:
+            raise click.BadParameter(str(error), param_hint="--record") from None
+    failing = [parse_iri(f, "--fail") for f in faults]
+    resolve_task(app.kb, ActionLibrary.from_kb(app.kb), task)  # an unknown task fails before the world is built
+
     start = time.perf_counter()
-    frames: list[Any] = []
-    with open_world(seed=seed, gui=gui) as world:
+    recorder: Recorder | None = None
+    with open_world(seed=seed, gui=gui, semantic_map=SemanticMap.read(app.kb)) as world:
         environment = SimEnvironment(world, app.kb)
         unknown = [f for f in failing if f not in environment.registry]
         if unknown:
             raise click.BadParameter(f"no simulated component {', '.join(map(shorten, unknown))}", param_hint="--fail")
+        if record is not None:
+            recorder = Recorder(world, title=task)
 
         def follow(event: Event) -> None:
-            message = event.message
-            if record is not None and message.get("event") in ("step_succeeded", "step_failed"):
-                frames.append(world.camera("CeilingCamera01").capture().rgb)
+            if recorder is not None:
+                recorder.on_event(event)
             if not as_json and event.topic == "/cbrs/task_progress":
-                click.echo(_progress(message), err=False)
+                click.echo(_progress(event.message), err=False)
 
-        if record is not None:
-            frames.append(world.camera("CeilingCamera01").capture().rgb)
         policy = RandomFaults(seed if fault_seed is None else fault_seed, fault_rate) if fault_rate > 0 else None
-        result = run_task(app.kb, task, environment, failing, on_event=follow, fault_policy=policy)
+        if recorder is not None:
+            recorder.start()
+        try:
+            result = run_task(app.kb, task, environment, failing, on_event=follow, fault_policy=policy)
+        finally:
+            if recorder is not None:
+                recorder.stop()
         sim_seconds = world.time
     wall = time.perf_counter() - start
-    if record is not None and frames:
-        _write_gif(frames, record)
+    recorded = None
+    if recorder is not None and record is not None:
+        try:
+            recorded = recorder.save(record)
+        except RecordingError as error:
+            raise click.ClickException(str(error)) from None
     if as_json:
         found = result.to_dict()
         found["seed"] = seed
@@ -193,6 +211,11 @@ def run(
             )
             click.echo(f"random faults (seed {policy.seed}, rate {policy.rate}): {planned or 'none'}")
         click.echo(run_text(result, sim_seconds, wall))
+        if recorded is not None:
+            click.echo(
+                f"recording written to {recorded.video} ({recorded.frames} frames over {recorded.seconds:.1f} s"
+                f" simulated); paths drawn to {recorded.path_map}"
+            )
     if not result.succeeded:
         raise SystemExit(1)
 
@@ -232,14 +255,6 @@ def run_text(result: RunResult, sim_seconds: float, wall_seconds: float) -> str:
     return f"{table(['#', 'component', 'sim s', 'outcome', 'effects checked'], rows)}\n{verdict}; {timing}"
 
 
-def _write_gif(frames: list[Any], target: Path) -> None:
-    from PIL import Image
-
-    images = [Image.fromarray(frame) for frame in frames]
-    target.parent.mkdir(parents=True, exist_ok=True)
-    images[0].save(target, save_all=True, append_images=images[1:], duration=700, loop=0)
-
-
 DEMO_RUNS = (
     ("RobotArmServeACup", ()),
     ("FetchMyPen", ()),
@@ -247,16 +262,19 @@ DEMO_RUNS = (
 )
 
 
-def scenario_summary(kb: KnowledgeBase, seed: int = 0) -> str:
-    """Run the paper's two scenarios headless (FetchMyPen also with its localiser failed): one row each."""
+def scenario_runs(kb: KnowledgeBase, seed: int = 0) -> tuple[str, bool]:
+    """Run the paper's two scenarios headless (FetchMyPen also with its localiser failed): one row
+    each, then the world graph; and whether every run succeeded."""
+    from kb.semantic_map import SemanticMap
     from sim.components import SimEnvironment
     from sim.world import open_world
 
     rows = []
+    failed = 0
     composer = Composer(kb)
     for task, faults in DEMO_RUNS:
         start = time.perf_counter()
-        with open_world(seed=seed) as world:
+        with open_world(seed=seed, semantic_map=SemanticMap.read(kb)) as world:
             result = run_task(kb, task, SimEnvironment(world, kb), [parse_iri(f) for f in faults], composer=composer)
             simulated = world.time
         wall = time.perf_counter() - start
@@ -268,6 +286,7 @@ def scenario_summary(kb: KnowledgeBase, seed: int = 0) -> str:
         failovers = ", ".join(f"{n} x {what}" if n > 1 else what for what, n in switched.items())
         verified = sum(1 for s in (report.steps if report else []) for _, ok in s.effects if ok)
         status = report.status.value if report else "no plan"
+        failed += 0 if result.succeeded else 1
         injected = f" (fail {', '.join(faults)})" if faults else ""
         rows.append(
             [task + injected, str(steps), status, str(verified), f"{simulated:.1f}", f"{wall:.1f}", failovers or "-"]
@@ -277,4 +296,6 @@ def scenario_summary(kb: KnowledgeBase, seed: int = 0) -> str:
         for r in kb.select("world_facts")
     )
     columns = ["task", "steps", "status", "effects verified", "sim s", "wall s", "failover"]
-    return f"{table(columns, rows)}\nThe world graph after the last run (cbrs query --name world_facts):\n{facts}"
+    verdict = f"\n{failed} of {len(rows)} runs did not succeed." if failed else ""
+    graph = f"The world graph after the last run (cbrs query --name world_facts):\n{facts}"
+    return f"{table(columns, rows)}{verdict}\n{graph}", failed == 0
