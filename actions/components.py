@@ -147,6 +147,10 @@ class Container:
     def state(self, iri: str) -> LifecycleState:
         return self._managed[iri].state if iri in self._managed else LifecycleState.CREATED
 
+    def reason(self, iri: str) -> str:
+        """Why ``iri``'s last invocation went wrong (empty if it did not, or never ran)."""
+        return self._managed[iri].component.reason if iri in self._managed else ""
+
     def history(self, iri: str) -> list[LifecycleState]:
         return list(self._managed[iri].history) if iri in self._managed else []
 
@@ -199,6 +203,26 @@ class Container:
             managed.component.halt()
         managed.component.reason = reason
         self._move(iri, LifecycleState.ERROR)
+
+    def recover(self) -> list[str]:
+        """Give a fresh instance to every component in the error state whose fault has not struck: a
+        skill that failed because the world was not as expected may succeed in a new plan, while a
+        broken one (its fault fired) stays broken. Returns the components recovered."""
+        recovered = []
+        for iri, managed in list(self._managed.items()):
+            fault = managed.fault
+            if managed.state is not LifecycleState.ERROR or (fault is not None and managed.worked >= fault.after_ticks):
+                continue
+            managed.component.finalise()
+            self._move(iri, LifecycleState.FINALISED)
+            del self._managed[iri]
+            try:
+                self.component(iri)
+            except Exception:  # it cannot even start again: it stays in the error state
+                continue
+            self._managed[iri].worked = managed.worked  # a fault due later still comes when it is due
+            recovered.append(iri)
+        return recovered
 
     def finalise_all(self) -> None:
         for iri, managed in self._managed.items():

@@ -57,6 +57,7 @@ class ComposeConfig:
     # of the same component, so deep pools cannot make the plan grow exponentially.
     max_steps: int = 200
     match: MatchConfig = field(default_factory=MatchConfig)
+    world_state: bool = True  # preconditions may be met by what holds in the map and belief graphs
 
 
 class PlanStatus(Enum):
@@ -156,7 +157,14 @@ class Composer:
         return resolve_task(self.kb, self.actions, name)
 
     def graph(self, requirement: Requirement) -> ServiceResourceGraph:
-        return ServiceResourceGraph(requirement, self.pool)
+        return ServiceResourceGraph(requirement, self.pool, self.world_state() if self.config.world_state else ())
+
+    def world_state(self) -> list[Statement]:
+        """What holds now in the semantic map and the belief state, as statements between classes."""
+        return [
+            Statement(row["subjectType"].value, row["relation"].value, row["objectType"].value)
+            for row in self.kb.select("world_state")
+        ]
 
     def compose(self, task: str | Task | Requirement) -> CompositionResult:
         if isinstance(task, str):

@@ -281,13 +281,19 @@ class Executor:
             needed_by.append("the requirement")
             provides += [statement_text(g.statement) if g.statement is not None else g.source.name for g in goals]
         provides += [statement_text(s) for s in self.needed.get(step.index, [])]
+        attempted = {a.component for a in report.attempts}
+        broken = [  # out of order since an earlier step or plan: not tried again, but named
+            Attempt(c, "failed", f"out of order since it failed earlier ({self.container.reason(c)})")
+            for c in step.candidates
+            if c not in attempted and self.container.state(c) is LifecycleState.ERROR
+        ]
         return Unmet(
             self.plan.requirement,
             step.index,
             step.part_of,
             tuple(dict.fromkeys(provides)),
             tuple(needed_by),
-            tuple(report.attempts),
+            (*report.attempts, *broken),
         )
 
     def _verify(self, step: PlanStep, statement: Statement, outputs: Mapping[str, Any]) -> bool | None:

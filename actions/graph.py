@@ -212,15 +212,23 @@ class ServicePool:
 class ServiceResourceGraph:
     """The SRG for one requirement: the pool's vertices and edges plus SRI, SRO and SRE."""
 
-    def __init__(self, requirement: Requirement, pool: ServicePool) -> None:
+    def __init__(self, requirement: Requirement, pool: ServicePool, holding: Sequence[Statement] = ()) -> None:
+        """``holding``: statements that hold in the world now (the belief state, lifted to classes);
+        SRI offers them to the components' preconditions, never to the goals, so what is already
+        achieved is kept and a goal is still planned for."""
         self.requirement = requirement
         self.pool = pool
         self.matcher = pool.matcher
         given = tuple(_offers(requirement.inputs, ())) + tuple(
             Offer("effect", statement_text(s), statement=s) for s in requirement.preconditions
         )
+        state = tuple(
+            Offer("effect", f"holds {statement_text(s)}", statement=s)
+            for s in holding
+            if s not in requirement.preconditions
+        )
         self.vertices: dict[str, Vertex] = {
-            SRI: Vertex(SRI, (), given, 0.0),
+            SRI: Vertex(SRI, (), given + state, 0.0),
             **pool.vertices,
             SRO: Vertex(SRO, _needs(requirement.outputs, ()), (), 0.0),
             SRE: Vertex(SRE, _needs((), requirement.effects), (), 0.0),
@@ -230,8 +238,11 @@ class ServiceResourceGraph:
             self._into[goal] = {n.key: pool.providers_of(goal, n) for n in self.vertices[goal].needs}
         # SRI's edges into every vertex that needs what the requirement gives
         for vertex in self.vertices.values():
+            offered = given if vertex.iri in (SRO, SRE) else given + state
             for need in vertex.needs:
-                given_edges = [Edge(SRI, vertex.iri, need, o, *m) for o in given if (m := self.matcher.match(need, o))]
+                given_edges = [
+                    Edge(SRI, vertex.iri, need, o, *m) for o in offered if (m := self.matcher.match(need, o))
+                ]
                 if given_edges:
                     base = self._into.get(vertex.iri, {}).get(need.key, pool.into.get(vertex.iri, {}).get(need.key, []))
                     self._into.setdefault(vertex.iri, {})[need.key] = sorted(base + given_edges, key=_rank)

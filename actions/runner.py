@@ -39,9 +39,22 @@ class Environment(Protocol):
 
 
 @dataclass(frozen=True)
+class Replan:
+    """A plan that was given up: what it was, how its execution went, and why it was replaced."""
+
+    plan: Plan
+    report: ExecutionReport
+    reason: str
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"plan": self.plan.to_dict(), "execution": self.report.to_dict(), "reason": self.reason}
+
+
+@dataclass(frozen=True)
 class RunResult:
-    composition: CompositionResult
-    report: ExecutionReport | None  # None when there was no plan to run
+    composition: CompositionResult  # the last composition: of the plan that ran last, or the one that failed
+    report: ExecutionReport | None  # the last plan's execution; None when there was no plan to run
+    replans: tuple[Replan, ...] = ()  # the plans replaced before it, in order
 
     @property
     def succeeded(self) -> bool:
@@ -55,6 +68,7 @@ class RunResult:
         }
         if self.report is not None:
             found["execution"] = self.report.to_dict()
+        found["replans"] = [replan.to_dict() for replan in self.replans]
         return found
 
 
@@ -67,36 +81,56 @@ def run_task(
     on_event: Callable[[Event], None] | None = None,
     max_ticks: int = 100_000,
     fault_policy: FaultPolicy | None = None,
+    max_replans: int = 2,
 ) -> RunResult:
-    """Compose ``task``, store the plan, run it in ``environment`` and keep the world graph current.
+    """Perceive, compose ``task`` from what holds now, run it in ``environment``, keep the world graph current.
 
-    ``faults`` fail whenever invoked; ``fault_policy`` (e.g. ``RandomFaults``) may break others mid-run.
+    When a plan fails (a step failed or its effect was not reached, and no alternative was left) the
+    world is perceived again and the task composed afresh from the current belief, with the components
+    registered since: what is achieved is kept, since the belief offers it to the new plan's
+    preconditions. At most ``max_replans`` times; each replaced plan is kept in the result with its
+    reason. ``faults`` fail whenever invoked; ``fault_policy`` (e.g. ``RandomFaults``) may break others.
     """
     composer = composer or Composer(kb)
-    composition = composer.compose(task)
-    if composition.plan is None:
-        return RunResult(composition, None)
-    plan = composition.plan
-    store_plan(kb, plan)
     bus = EventBus()
     if on_event is not None:
         bus.subscribe("*", on_event)
     failing = FixedFaults.of(faults)
     policy = failing if fault_policy is None else Combined((failing, fault_policy))
     container = Container(environment.registry, environment.context, bus, policy)
-    requirements = {r.iri: r for r in kb.requirements()}
     belief = BeliefState(kb)
-    belief.write(environment.observe())
-    executor = Executor(plan, container, environment.given(plan, requirements), environment.verify, environment.clock)
-    done = 0
+    belief.write(environment.observe())  # plan from what holds now, not from a past run's belief
+    composition = composer.compose(task)
+    replans: list[Replan] = []
+    report: ExecutionReport | None = None
     try:
-        while executor.status is RunStatus.RUNNING and executor.ticks < max_ticks:
-            executor.tick()
-            if len(executor.results) != done:  # a step finished: the world changed
-                done = len(executor.results)
-                belief.write(environment.observe())
-        report = executor.run(max_ticks)  # ends a run that hit max_ticks; otherwise just the report
+        while composition.plan is not None:
+            plan = composition.plan
+            store_plan(kb, plan)
+            requirements = {r.iri: r for r in kb.requirements()}
+            given = environment.given(plan, requirements)
+            executor = Executor(plan, container, given, environment.verify, environment.clock)
+            done = 0
+            while executor.status is RunStatus.RUNNING and executor.ticks < max_ticks:
+                executor.tick()
+                if len(executor.results) != done:  # a step finished: the world changed
+                    done = len(executor.results)
+                    belief.write(environment.observe())
+            report = executor.run(max_ticks)  # ends a run that hit max_ticks; otherwise just the report
+            if report.status is not RunStatus.FAILED or len(replans) >= max_replans:
+                break
+            replans.append(Replan(plan, report, report.reason))
+            bus.publish(
+                "/cbrs/task_progress", {"event": "replanning", "plan": len(replans) + 1, "reason": report.reason}
+            )
+            belief.write(environment.observe())  # perceive again
+            container.recover()  # what failed for the world's sake may be tried again; the broken stay broken
+            refresh = getattr(environment, "refresh", None)
+            if callable(refresh):
+                refresh()  # components registered since the last plan
+            composer = Composer(kb, composer.config)
+            composition = composer.compose(task)
     finally:
         container.finalise_all()
     belief.write(environment.observe())
-    return RunResult(composition, report)
+    return RunResult(composition, report, tuple(replans))

@@ -227,6 +227,8 @@ def _planned(policy: RandomFaults, result: RunResult) -> list[dict[str, Any]]:
 
 
 def _progress(message: dict[str, Any]) -> str:
+    if message["event"] == "replanning":
+        return f"  re-planning (plan {message['plan']}) from what holds now: {message.get('reason', '')}"
     kind, step, component = message["event"], message["step"], shorten(message["component"])
     if kind == "step_started":
         return f"  step {step:>2}  {component} ..."
@@ -241,6 +243,11 @@ def run_text(result: RunResult, sim_seconds: float, wall_seconds: float) -> str:
     if result.report is None:
         return plan_text(result.composition)
     report = result.report
+    replaced = [
+        f"plan {n} replaced after {sum(1 for s in r.report.steps if s.outcome == 'succeeded')} step(s): {r.reason}"
+        for n, r in enumerate(result.replans, start=1)
+    ]
+    header = "\n".join(replaced) + ("\n" if replaced else "")
     rows = []
     for step in report.steps:
         tried = " -> ".join(shorten(a.component) for a in step.attempts) or shorten(step.planned)
@@ -252,7 +259,9 @@ def run_text(result: RunResult, sim_seconds: float, wall_seconds: float) -> str:
         verdict += f" ({report.reason})"
     failovers = sum(1 for s in report.steps if s.failed_over)
     timing = f"{sim_seconds:.1f} s simulated, {wall_seconds:.1f} s wall, {failovers} failover(s)"
-    return f"{table(['#', 'component', 'sim s', 'outcome', 'effects checked'], rows)}\n{verdict}; {timing}"
+    timing += f", {len(result.replans)} re-plan(s)" if result.replans else ""
+    steps = table(["#", "component", "sim s", "outcome", "effects checked"], rows)
+    return f"{header}{steps}\n{verdict}; {timing}"
 
 
 DEMO_RUNS = (

@@ -396,6 +396,11 @@ class Recorder:
             self.caption = Caption(task, int(message["step"]), component, status, detail)
             if kind != "step_started":
                 self.capture()
+        elif event.topic == "/cbrs/task_progress" and message.get("event") == "replanning":
+            self.caption = Caption(
+                task, 0, f"re-planning (plan {message.get('plan')})", "failed", str(message.get("reason", ""))
+            )
+            self.capture()
         elif event.topic == "/cbrs/task" and "status" in message:
             self.verdict = str(message["status"])
             reason = str(message.get("reason", ""))

@@ -28,7 +28,7 @@ from sim.geometry import Pose2D, Pose3D, Quat, Region, Vec3, quat_from_yaw
 from sim.quiet import quiet_output
 from sim.scene import bundled_map
 
-__all__ = ["TIME_STEP", "HomeWorld", "Perturbation", "open_world"]
+__all__ = ["TIME_STEP", "HomeWorld", "Perturbation", "Spread", "open_world"]
 
 TIME_STEP = 1.0 / 240.0
 """Physics step (s): pybullet's default, at which the Panda's controllers and contacts are stable."""
@@ -74,23 +74,37 @@ _IDENTITY: Quat = (0.0, 0.0, 0.0, 1.0)
 
 
 @dataclass(frozen=True)
+class Spread:
+    """How far a seed moves things from the semantic map's start poses: each object up to ``object``
+    metres in x and y (and, if it is not round, ``yaw`` radians), kept on its support; the person up to
+    ``person`` metres; the base up to ``base`` metres and ``base_yaw`` radians. The default is the small
+    jitter of a real home; the perturbation benchmark moves things much further."""
+
+    object: float = 0.02
+    yaw: float = 0.15
+    person: float = 0.15
+    base: float = 0.10
+    base_yaw: float = 0.3
+
+
+@dataclass(frozen=True)
 class Perturbation:
-    """The seed's deterministic offsets from the semantic map's start poses (metres, radians): each
-    object by up to 2 cm and, if it is not round, 0.15 rad; the person by 15 cm; the base by 10 cm and 0.3 rad."""
+    """The seed's deterministic offsets from the semantic map's start poses (metres, radians)."""
 
     objects: Mapping[str, tuple[float, float, float]]
     person: tuple[float, float]
     base: tuple[float, float, float]
 
     @classmethod
-    def from_seed(cls, seed: int, objects: Mapping[str, bool] | None = None) -> Perturbation:
+    def from_seed(cls, seed: int, objects: Mapping[str, bool] | None = None, spread: Spread = Spread()) -> Perturbation:
         """``objects`` maps each object's name to whether it is round (no yaw offset), in any order."""
         rng = np.random.default_rng(seed)
-        person = rng.uniform(-0.15, 0.15, 2)
-        base = rng.uniform([-0.10, -0.10, -0.3], [0.10, 0.10, 0.3])
+        person = rng.uniform(-spread.person, spread.person, 2)
+        base = rng.uniform([-spread.base, -spread.base, -spread.base_yaw], [spread.base, spread.base, spread.base_yaw])
         moved = {}
         for name in sorted(objects or {}):
-            dx, dy, dyaw = rng.uniform([-0.02, -0.02, -0.15], [0.02, 0.02, 0.15])
+            limits = [spread.object, spread.object, spread.yaw]
+            dx, dy, dyaw = rng.uniform([-v for v in limits], limits)
             moved[name] = (float(dx), float(dy), 0.0 if (objects or {})[name] else float(dyaw))
         return cls(
             moved,
@@ -128,7 +142,13 @@ class HomeWorld:
     """
 
     def __init__(
-        self, client: int, seed: int, gui: bool, time_step: float, semantic_map: SemanticMap | None = None
+        self,
+        client: int,
+        seed: int,
+        gui: bool,
+        time_step: float,
+        semantic_map: SemanticMap | None = None,
+        spread: Spread = Spread(),
     ) -> None:
         self.client = client
         self.seed = seed
@@ -148,7 +168,7 @@ class HomeWorld:
         self.robot, self.person = robots[0], people[0]
         self.base_name, self.person_name = self.robot.name, self.person.name
         self.perturbation = Perturbation.from_seed(
-            seed, {name: obj.shape == "cylinder" for name, obj in self.objects.items()}
+            seed, {name: obj.shape == "cylinder" for name, obj in self.objects.items()}, spread
         )
         self._steps = 0
         self._watchers: list[tuple[int, Callable[[], None]]] = []
@@ -179,14 +199,19 @@ class HomeWorld:
 
     @classmethod
     def create(
-        cls, seed: int = 0, gui: bool = False, time_step: float = TIME_STEP, semantic_map: SemanticMap | None = None
+        cls,
+        seed: int = 0,
+        gui: bool = False,
+        time_step: float = TIME_STEP,
+        semantic_map: SemanticMap | None = None,
+        spread: Spread = Spread(),
     ) -> HomeWorld:
         """Connect a new pybullet client (DIRECT unless ``gui``) and build the home of ``semantic_map`` in
         it (the bundled map by default)."""
         with quiet_output():
             client = p.connect(p.GUI if gui else p.DIRECT)
         try:
-            return cls(client, seed, gui, time_step, semantic_map)
+            return cls(client, seed, gui, time_step, semantic_map, spread)
         except BaseException:
             p.disconnect(physicsClientId=client)
             raise
@@ -292,6 +317,16 @@ class HomeWorld:
     def snapshot(self) -> dict[str, Pose3D]:
         """Poses of everything that can move (objects, base, person), for comparing runs."""
         return {name: self.pose(name) for name in (*sorted(self.objects), self.base_name, self.person_name)}
+
+    def place(self, name: str, x: float, y: float, yaw: float | None = None) -> None:
+        """Put a body somewhere else on the floor or on what it stands on (the world changing by itself:
+        the person walks away, someone moves the cup), at rest."""
+        self._check()
+        body = self.body(name)
+        (_, _, z), orientation = p.getBasePositionAndOrientation(body, physicsClientId=self.client)
+        turned = quat_from_yaw(yaw) if yaw is not None else orientation
+        p.resetBasePositionAndOrientation(body, (x, y, z), turned, physicsClientId=self.client)
+        p.resetBaseVelocity(body, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), physicsClientId=self.client)
 
     def water_level(self, name: str) -> float:
         """Fraction of a container filled with water; 0 for anything that is not a container."""
@@ -502,6 +537,11 @@ class HomeWorld:
         surface = support.box.max_z if support is not None else 0.0
         dx, dy, dyaw = self.perturbation.objects.get(obj.name, (0.0, 0.0, 0.0))
         length, width, height = obj.size
+        x, y = obj.start.x + dx, obj.start.y + dy
+        if support is not None:  # moved, it stays on what it stands on
+            edge = max(length, width) / 2.0
+            x = min(max(x, support.box.min_x + edge), support.box.max_x - edge)
+            y = min(max(y, support.box.min_y + edge), support.box.max_y - edge)
         if obj.shape == "cylinder":
             radius = min(length, width) / 2.0
             parts = [_cylinder(radius, height, (0, 0, 0), obj.rgba)]
@@ -512,7 +552,7 @@ class HomeWorld:
         body = self._multibody(
             obj.name,
             parts,
-            (obj.start.x + dx, obj.start.y + dy, surface + height / 2 + 0.001),
+            (x, y, surface + height / 2 + 0.001),
             quat_from_yaw(obj.start.yaw + dyaw),
             mass=obj.mass,
         )
@@ -618,9 +658,11 @@ def _half_and_centre(region: Region) -> tuple[Vec3, Vec3]:
 
 
 @contextmanager
-def open_world(seed: int = 0, gui: bool = False, semantic_map: SemanticMap | None = None) -> Iterator[HomeWorld]:
+def open_world(
+    seed: int = 0, gui: bool = False, semantic_map: SemanticMap | None = None, spread: Spread = Spread()
+) -> Iterator[HomeWorld]:
     """``with open_world(seed) as world:`` builds a world and always disconnects it."""
-    world = HomeWorld.create(seed, gui, semantic_map=semantic_map)
+    world = HomeWorld.create(seed, gui, semantic_map=semantic_map, spread=spread)
     try:
         yield world
     finally:

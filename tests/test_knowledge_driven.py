@@ -3,17 +3,19 @@ simulated home built from the store's semantic map (tests/data/tasks holds the f
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
 
 from actions.composer import Composer
+from actions.events import Event
 from actions.runner import RunResult, run_task
 from kb import KnowledgeBase
 from kb.namespaces import PREFIXES
 from kb.semantic_map import AmbiguousDesignatorError, MapError, SemanticMap, UnresolvedDesignatorError, designate
 from sim.components import SimEnvironment
-from sim.world import open_world
+from sim.world import HomeWorld, open_world
 
 TASKS = Path(__file__).parent / "data" / "tasks"
 HOME, WORLD, REQ = PREFIXES["home"], PREFIXES["world"], PREFIXES["req"]
@@ -126,3 +128,43 @@ def test_a_better_camera_registered_in_turtle_is_used_by_fetch_my_pen() -> None:
     used = [step.attempts[-1].component for step in result.report.steps if step.attempts]
     assert PREFIXES["svc"] + "LocateMobileRobot_CeilingCamera03" in used
     assert len(result.report.steps) == 15
+
+
+def _moving(world: HomeWorld, after: str, body: str, to: tuple[float, float]) -> Callable[[Event], None]:
+    """An event listener that moves ``body`` once, right after the step of ``after`` succeeds."""
+    moved: list[bool] = []
+
+    def listen(event: Event) -> None:
+        message = event.message
+        if not moved and message.get("event") == "step_succeeded" and str(message.get("component", "")).endswith(after):
+            world.place(body, *to)
+            moved.append(True)
+
+    return listen
+
+
+def run_with(kb: KnowledgeBase, task: str, change: tuple[str, str, tuple[float, float]]) -> RunResult:
+    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
+        listener = _moving(world, *change)
+        return run_task(kb, task, SimEnvironment(world, kb), composer=Composer(kb), on_event=listener)
+
+
+def test_the_person_walking_away_before_the_delivery_is_caught_and_replanned() -> None:
+    kb = KnowledgeBase.open(":memory:")
+    result = run_with(kb, "FetchMyPen", ("NavigateToPerson_P3DX01", "Person", (3.6, 3.9)))
+    assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
+    assert result.replans and "DeliverObject" in result.replans[0].reason
+    assert result.report is not None
+    new_plan = [step.planned.rsplit("#", 1)[-1] for step in result.report.steps]
+    # the pen is already on the platform: the new plan goes straight to the person
+    assert "HandOverOntoPlatform_CytonDualArm01" not in new_plan
+    assert new_plan[-1] == "DeliverObject_P3DX01"
+    assert (WORLD + "Pen", HOME + "isWith", WORLD + "Person") in world_facts(kb)
+
+
+def test_the_pen_moved_after_it_was_seen_is_found_again() -> None:
+    kb = KnowledgeBase.open(":memory:")
+    result = run_with(kb, "FetchMyPen", ("RecogniseObjectByColour_Kinect01", "Pen", (7.98, 3.22)))
+    assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
+    assert len(result.replans) == 1
+    assert (WORLD + "Pen", HOME + "isWith", WORLD + "Person") in world_facts(kb)
