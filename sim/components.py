@@ -11,6 +11,10 @@ things of the semantic map by SPARQL (:func:`kb.semantic_map.designate`), compon
 need of a thing (its size, colour, grasp, docking pose) from the map, the arm is the free one that
 reaches, and a statement is verified by the generic test the store maps its predicate to
 (``home:computedBy``: inside, on, near, above, grasped-by, with, contains, localised-in, perceived).
+
+Every value a component gives or takes is plain JSON of its port's type (:mod:`sim.values`), so that
+a component outside this process could stand in for any of these: each work function decodes its
+inputs first and encodes its outputs last.
 """
 
 from __future__ import annotations
@@ -41,7 +45,21 @@ from sim.perception import (
     recognise_object,
     track_person,
 )
-from sim.planning import plan_path
+from sim.planning import PlannedPath, plan_path
+from sim.values import (
+    APPROACH_POSITION,
+    GRASP_POSE,
+    OBJECT_LOCATION,
+    ColourFeature,
+    GraspPlan,
+    MalformedValueError,
+    Manipulation,
+    ObjectFeature,
+    decode,
+    designator,
+    from_json,
+    to_json,
+)
 from sim.world import HomeWorld
 
 __all__ = ["GraspPlan", "SimContext", "SimEnvironment", "designator", "implementations"]
@@ -51,19 +69,6 @@ LOCALISATION_TOLERANCE = 0.10
 """A localisation is believed (isLocalisedIn holds) when it is within this distance (m) of the truth."""
 ARM_TIE = 0.01
 """Two arms whose mounts are within 1 cm as far from a target reach it equally well."""
-
-
-def designator(iri: str, concept: str) -> dict[str, str]:
-    """A thing of the world as a value between steps: plain JSON, its IRI and the class it was asked as."""
-    return {"@id": iri, "@type": concept}
-
-
-@dataclass(frozen=True)
-class GraspPlan:
-    """What ComputeGraspPose gives: how to grasp this kind of object; the arm and the grasp pose itself
-    are fixed against the object's position when an arm approaches."""
-
-    model: ObjectModel
 
 
 @dataclass
@@ -140,17 +145,25 @@ def _iri(value: Any, what: str) -> str:
     raise SkillFailed(f"expected a thing of the world for {what}, got {value!r}")
 
 
+def _knowledge(ctx: SimContext, value: Any) -> Manipulation:
+    """How to handle an object: from the semantic map for a designator, else as a ManipulationProperty
+    or GraspPose value carries it (an earlier step, maybe a remote one, looked it up)."""
+    if isinstance(value, dict) and "@id" in value:
+        iri = _iri(value, "an object")
+        obj = ctx.map.objects.get(iri)
+        if obj is None:
+            raise SkillFailed(f"the semantic map has no shape, size or grasp for {local_name(iri)}")
+        return Manipulation.of(obj)
+    found = from_json(value)
+    if isinstance(found, GraspPlan):
+        return Manipulation(found.object, found.model)
+    if isinstance(found, Manipulation):
+        return found
+    raise SkillFailed(f"expected an object, its manipulation property or its grasp, got {value!r}")
+
+
 def _model(ctx: SimContext, value: Any) -> ObjectModel:
-    """The object model of a designator (or a model passed on as it is)."""
-    if isinstance(value, ObjectModel):
-        return value
-    if isinstance(value, GraspPlan):
-        return value.model
-    iri = _iri(value, "an object")
-    obj = ctx.map.objects.get(iri)
-    if obj is None:
-        raise SkillFailed(f"the semantic map has no shape, size or grasp for {local_name(iri)}")
-    return ObjectModel.of(obj)
+    return _knowledge(ctx, value).model
 
 
 def _place(ctx: SimContext, value: Any, what: str) -> Thing:
@@ -191,15 +204,16 @@ def _free_arm(ctx: SimContext, x: float, y: float, what: str) -> ArmSide:
 
 
 def infer_object_property(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
-    return {"colourFeature": _model(ctx, inputs["objectType"]).colour}
+    return {"colourFeature": to_json(ColourFeature(_model(ctx, inputs["objectType"]).colour))}
 
 
 def query_manipulation_property(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
-    return {"manipulationProperty": _model(ctx, inputs["objectType"])}
+    return {"manipulationProperty": to_json(_knowledge(ctx, inputs["objectType"]))}
 
 
 def compute_grasp(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
-    return {"graspPose": GraspPlan(_model(ctx, inputs["manipulationProperty"]))}
+    known = _knowledge(ctx, inputs["manipulationProperty"])
+    return {"graspPose": to_json(GraspPlan(known.object, known.model))}
 
 
 def _recognise(ctx: SimContext, camera: str, colour: str) -> ObjectEstimate:
@@ -208,13 +222,20 @@ def _recognise(ctx: SimContext, camera: str, colour: str) -> ObjectEstimate:
 
 
 def recognise_by_colour(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
-    return {"objectPosition": _recognise(ctx, device, str(inputs["colourFeature"]))}
+    colour = decode(inputs["colourFeature"], ColourFeature).colour
+    return {"objectPosition": to_json(_recognise(ctx, device, colour))}
 
 
 def find_object_on_table(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     """FindCupOnTable, for whatever object its input names: by the object's colour, with the robot's camera."""
     camera = _robot_camera(ctx, device)
-    return {"cupPosition": _recognise(ctx, camera, _model(ctx, inputs["cup"]).colour)}
+    if "cup" in inputs:
+        colour = _model(ctx, inputs["cup"]).colour
+    elif "colourFeature" in inputs:  # standing in for a recogniser: it was given the colour itself
+        colour = decode(inputs["colourFeature"], ColourFeature).colour
+    else:
+        raise SkillFailed(f"FindCupOnTable needs the object (cup) or its colour; it was given {sorted(inputs)}")
+    return {"cupPosition": to_json(_recognise(ctx, camera, colour))}
 
 
 def _robot_camera(ctx: SimContext, robot: str) -> str:
@@ -231,7 +252,7 @@ def _robot_camera(ctx: SimContext, robot: str) -> str:
 
 def approach(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     model = _model(ctx, inputs["graspPose"])
-    estimate: ObjectEstimate = inputs["objectPosition"]
+    estimate = decode(inputs["objectPosition"], ObjectEstimate)
     x, y, _ = estimate.position
     ctx.arm = _free_arm(ctx, x, y, f"the {model.name}")
     ctx.grasp = compute_grasp_pose(model, estimate.position, estimate.yaw, ctx.world.arm_specs[ctx.arm].mount)
@@ -272,7 +293,7 @@ def fill_from_tap(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> di
 
 
 def hand_over(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
-    estimate: ObjectEstimate = inputs["objectPosition"]
+    estimate = decode(inputs["objectPosition"], ObjectEstimate)
     model = _model(ctx, inputs["graspPose"])
     x, y, _ = estimate.position
     side = _free_arm(ctx, x, y, f"the {model.name}")
@@ -299,9 +320,9 @@ def infer_object_place(ctx: SimContext, inputs: Mapping[str, Any], device: str) 
     dock = _dock(place)
     return {
         "objectPlace": designator(place.iri, HOME + "ObjectPlace"),
-        "objectLocation": dock,
-        "approachPosition": dock,
-        "objectFeature": model.colour,
+        "objectLocation": to_json(dock, OBJECT_LOCATION),
+        "approachPosition": to_json(dock, APPROACH_POSITION),
+        "objectFeature": to_json(ObjectFeature(model.colour)),
     }
 
 
@@ -313,7 +334,7 @@ def _facts(kb: KnowledgeBase, thing: str) -> list[tuple[str, str, str]]:
 def provide_grid_map(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     if ctx.grid is None:
         ctx.grid = build_occupancy_grid(ctx.world, ignore=(ctx.world.base_name,))
-    return {"map": ctx.grid}
+    return {"map": to_json(ctx.grid)}
 
 
 def locate(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
@@ -323,40 +344,41 @@ def locate(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str,
         colours = ctx.world.robot.marker_colours
     if colours is None:
         raise SkillFailed("the semantic map gives no marker colours to look for")
-    return {"robotLocation": locate_robot(ctx.world.camera(device).capture(), colours[0], colours[1])}
+    return {"robotLocation": to_json(locate_robot(ctx.world.camera(device).capture(), colours[0], colours[1]))}
 
 
 def track(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     value = inputs.get("person")
     person = ctx.map.people.get(_iri(value, "the person")) if value is not None else ctx.world.person
     shirt = person.colour if person is not None and person.colour else "yellow"
-    return {"personPosition": track_person(ctx.world.camera(device).capture(), shirt)}
+    return {"personPosition": to_json(track_person(ctx.world.camera(device).capture(), shirt))}
 
 
 def _xy(value: Any) -> tuple[float, float]:
-    if isinstance(value, (Pose2D, RobotPoseEstimate, PersonEstimate)):
-        return (value.x, value.y)
+    """Where on the floor a position of any kind is (a robot's, a person's, an approach pose, an object's)."""
+    found = from_json(value)
+    if isinstance(found, (Pose2D, RobotPoseEstimate, PersonEstimate, ObjectEstimate)):
+        return (found.x, found.y)
     raise SkillFailed(f"not a position on the floor: {value!r}")
 
 
 def planner(algorithm: str) -> Work:
     def work(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
-        grid = inputs["map"]
-        if not isinstance(grid, OccupancyGrid):
-            raise SkillFailed("the map is not an occupancy grid")
-        return {"path": plan_path(grid, _xy(inputs["start"]), _xy(inputs["goal"]), algorithm)}
+        grid = decode(inputs["map"], OccupancyGrid)
+        return {"path": to_json(plan_path(grid, _xy(inputs["start"]), _xy(inputs["goal"]), algorithm))}
 
     return work
 
 
 def navigate_to_place(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     place = _place(ctx, inputs["objectPlace"], "the place")
-    _check(skills.navigate_to_place(ctx.world, inputs["path"], _dock(place)))
+    _check(skills.navigate_to_place(ctx.world, decode(inputs["path"], PlannedPath), _dock(place)))
     return {}
 
 
 def navigate_to_person(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
-    _check(skills.navigate_to_person(ctx.world, inputs["path"], inputs["personPosition"]))
+    path = decode(inputs["path"], PlannedPath)
+    _check(skills.navigate_to_person(ctx.world, path, decode(inputs["personPosition"], PersonEstimate)))
     return {}
 
 
@@ -392,10 +414,10 @@ SKILLS: dict[str, Work] = {
 """The simulated skill behind each service name; the device comes from the advertisement."""
 
 
-def implementations(kb: KnowledgeBase, world: HomeWorld | None = None) -> Registry:
+def implementations(kb: KnowledgeBase, world: HomeWorld | None = None, registry: Registry | None = None) -> Registry:
     """A simulated component for every advertisement whose service the simulation can perform on its
-    device (cameras must exist in the world)."""
-    registry = Registry()
+    device (cameras must exist in the world); added to ``registry`` if given (a refresh)."""
+    registry = registry if registry is not None else Registry()
     for ad in kb.advertisements():
         work = SKILLS.get(ad.service_name or "")
         device = ad.device_name or ""
@@ -403,15 +425,42 @@ def implementations(kb: KnowledgeBase, world: HomeWorld | None = None) -> Regist
             continue
         if world is not None and work in (locate, track, recognise_by_colour) and device not in world.cameras:
             continue
-        registry.add(ad.iri, _maker(work, device))
+        names = tuple(p.name for p in ad.outputs if p.name)
+        registry.add(ad.iri, _maker(work, device, names))
     return registry
 
 
-def _maker(work: Work, device: str) -> Callable[[str], Component]:
-    return lambda iri: SimComponent(iri, work, device)
+def _maker(work: Work, device: str, outputs: tuple[str, ...]) -> Callable[[str], Component]:
+    return lambda iri: SimComponent(iri, _named(work, outputs), device)
+
+
+def _named(work: Work, advertised: tuple[str, ...]) -> Work:
+    """``work`` with its one output under the name the advertisement gives it (a second camera's
+    tracker may call the person's position personLocation)."""
+    if len(advertised) != 1:
+        return work
+
+    def renamed(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
+        outputs = work(ctx, inputs, device)
+        if len(outputs) == 1 and advertised[0] not in outputs:
+            return {advertised[0]: next(iter(outputs.values()))}
+        return outputs
+
+    return renamed
 
 
 # -- the environment ------------------------------------------------------------------------------
+
+
+def _grasped(inputs: Mapping[str, Any]) -> str | None:
+    """The object a step's GraspPose input is about (its body name): the object at hand."""
+    for value in inputs.values():
+        if isinstance(value, dict) and value.get("@type") == GRASP_POSE:
+            try:
+                return decode(value, GraspPlan).model.name
+            except MalformedValueError:
+                continue
+    return None
 
 
 class SimEnvironment:
@@ -427,6 +476,12 @@ class SimEnvironment:
 
     def clock(self) -> float:
         return self.world.time
+
+    def refresh(self) -> None:
+        """Before a new plan: forget the measured map (the world may have changed) and add the
+        components registered since."""
+        self.context.grid = None
+        implementations(self.kb, self.world, self.registry)
 
     def given(self, plan: Plan, requirements: Mapping[str, Requirement]) -> dict[str, Any]:
         """The world's thing for each input a requirement gives: the one individual of the input's class."""
@@ -486,9 +541,9 @@ class SimEnvironment:
         if self.is_a(concept, HOME + "Substance"):
             return ("substance", concept)
         if self.is_a(concept, HOME + "PhysicalObject"):
-            plans = [value for value in inputs.values() if isinstance(value, GraspPlan)]
-            if plans:
-                return ("object", plans[0].model.name)
+            held = _grasped(inputs)
+            if held is not None:
+                return ("object", held)
             if ctx.object is not None:
                 return ("object", ctx.object)
         if self.is_a(concept, HOME + "Place") and ctx.region is not None:
@@ -507,8 +562,9 @@ class SimEnvironment:
         if test == "perceived":
             return bool(outputs)
         if test == "localised-in":
-            estimate = outputs.get("robotLocation")
-            if not isinstance(estimate, RobotPoseEstimate):
+            try:
+                estimate = decode(outputs.get("robotLocation"), RobotPoseEstimate)
+            except MalformedValueError:
                 return False
             truth = self.world.base_pose()
             return math.hypot(estimate.x - truth.x, estimate.y - truth.y) <= LOCALISATION_TOLERANCE
