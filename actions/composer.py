@@ -157,7 +157,8 @@ class Composer:
         return resolve_task(self.kb, self.actions, name)
 
     def graph(self, requirement: Requirement) -> ServiceResourceGraph:
-        return ServiceResourceGraph(requirement, self.pool, self.world_state() if self.config.world_state else ())
+        holding = self.world_state() if self.config.world_state else ()
+        return ServiceResourceGraph(requirement, self.pool, holding)
 
     def world_state(self) -> list[Statement]:
         """What holds now in the semantic map and the belief state, as statements between classes."""
