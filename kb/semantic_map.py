@@ -203,6 +203,8 @@ class SemanticMap:
     facts: dict[str, dict[str, list[str]]] = field(default_factory=dict)
     containers: frozenset[str] = frozenset()
     """The things that are a home:Container by the taxonomy: what a tap can fill."""
+    furniture: frozenset[str] = frozenset()
+    """The things that are home:Furniture by the taxonomy: what the simulation builds as tables."""
 
     def of_type(self, concept: str) -> list[str]:
         """The things whose asserted classes include ``concept`` (no subclass reasoning: see :func:`designate`)."""
@@ -228,10 +230,12 @@ class SemanticMap:
         for row in kb.select("grasp_affordances"):  # nearest ancestor first
             affordances.setdefault(row["class"].value, (row["approach"].value, float(row["ratio"].value)))
         containers = frozenset(row["thing"].value for row in kb.select("designate", {"class": HOME + "Container"}))
+        furniture = frozenset(row["thing"].value for row in kb.select("designate", {"class": HOME + "Furniture"}))
         built = cls(
             types={k: tuple(v) for k, v in types.items()},
             facts={k: dict(v) for k, v in facts.items()},
             containers=containers,
+            furniture=furniture,
         )
         for iri, values in facts.items():
             _classify(built, iri, values, tuple(types.get(iri, ())), affordances, facts)

@@ -84,7 +84,6 @@ MOVED = 0.05
 """A body counts as moved once it is this far (m) from where it was when recording started."""
 PERSON_NEAR = 2.5
 """The person is framed once the base has driven this close to them (m): they are who it is going to."""
-_FIXED_ACTORS = ("Table", "CytonDualArm01")
 _STATUS_COLOURS = {
     "running": (255, 196, 70),
     "succeeded": (110, 220, 120),
@@ -280,6 +279,7 @@ class _Floor:
     walls: list[Box] = field(default_factory=list)
     furniture: list[tuple[str, Box]] = field(default_factory=list)
     colours: dict[str, tuple[float, float, float]] = field(default_factory=dict)
+    labelled: frozenset[str] = frozenset()  # the furniture and the dual-arm robot: named on the map
 
 
 class Recorder:
@@ -317,6 +317,7 @@ class Recorder:
         self._base = ""
         self._person = ""
         self._movable: list[str] = []
+        self._fixed: list[str] = []
         self._starts: dict[str, tuple[float, float]] = {}
         self._box: Box | None = None
         self._camera: tuple[float, float, float] | None = None  # target x, target y, distance
@@ -337,6 +338,8 @@ class Recorder:
         self._base = world.name_of(world.base.body) or "base"
         self._person = world.person_name
         self._movable = [name for name in world.snapshot() if name != self._person]
+        robots = {arm.robot.rsplit("#", 1)[-1] for arm in world.arm_specs.values()}
+        self._fixed = [*world.furniture, *sorted(robots)]  # where the arms work: framed from the start
         self._floor = self._read_floor()
         self._starts = {name: self._xy(name) for name in self._movable}
         self._unsubscribe = [
@@ -426,7 +429,7 @@ class Recorder:
     def _wanted_box(self) -> Box:
         world = self.world
         points: list[tuple[float, float]] = []
-        for name in _FIXED_ACTORS:
+        for name in self._fixed:
             if name in world.bodies:
                 low, high = p.getAABB(world.body(name), physicsClientId=world.client)
                 points += [(low[0], low[1]), (high[0], high[1])]
@@ -487,7 +490,7 @@ class Recorder:
 
     def _read_floor(self) -> _Floor:
         world = self.world
-        floor = _Floor()
+        floor = _Floor(labelled=frozenset(self._fixed))
         tracked = {*self._movable, self._person}
         for name, body in world.bodies.items():
             data = p.getVisualShapeData(body, physicsClientId=world.client)
@@ -670,7 +673,7 @@ def _draw_layer(
                 (box.xmin, box.ymin), box.xmax - box.xmin, box.ymax - box.ymin, facecolor="0.88", edgecolor="0.55"
             )
         )
-        if labels and name in _FIXED_ACTORS:
+        if labels and name in floor.labelled:
             axes.annotate(
                 name, ((box.xmin + box.xmax) / 2, box.ymax), ha="center", va="bottom", fontsize=7, color="0.4"
             )

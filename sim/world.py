@@ -318,6 +318,16 @@ class HomeWorld:
         """Poses of everything that can move (objects, base, person), for comparing runs."""
         return {name: self.pose(name) for name in (*sorted(self.objects), self.base_name, self.person_name)}
 
+    def aabb(self, name: str) -> tuple[Vec3, Vec3]:
+        """The axis-aligned bounds of a body (all its links), low and high corners."""
+        self._check()
+        low, high = p.getAABB(self.body(name), physicsClientId=self.client)
+        for link in range(p.getNumJoints(self.body(name), physicsClientId=self.client)):
+            l_low, l_high = p.getAABB(self.body(name), link, physicsClientId=self.client)
+            low = tuple(min(a, b) for a, b in zip(low, l_low, strict=True))
+            high = tuple(max(a, b) for a, b in zip(high, l_high, strict=True))
+        return (float(low[0]), float(low[1]), float(low[2])), (float(high[0]), float(high[1]), float(high[2]))
+
     def place(self, name: str, x: float, y: float, yaw: float | None = None) -> None:
         """Put a body somewhere else on the floor or on what it stands on (the world changing by itself:
         the person walks away, someone moves the cup), at rest."""
@@ -489,18 +499,33 @@ class HomeWorld:
                 wall.name, [_box((length / 2, t / 2, L.WALL_HEIGHT / 2), (0, 0, 0), _WALL)], centre, quat_from_yaw(yaw)
             )
 
-    def _build_kitchen(self) -> None:
-        t = L.TABLE
+    @property
+    def furniture(self) -> list[str]:
+        """The body names of the semantic map's furniture (its tables), in the map's order."""
+        return sorted(self.map.things[iri].name for iri in self.map.furniture if iri in self.map.things)
+
+    def _build_furniture(self) -> None:
+        """Each piece of furniture of the map as a table: a 4 cm top at its height on four legs."""
         top = 0.04
-        cx, cy = (t.xmin + t.xmax) / 2, (t.ymin + t.ymax) / 2
-        hx, hy = (t.xmax - t.xmin) / 2, (t.ymax - t.ymin) / 2
-        leg_h = (L.TABLE_HEIGHT - top) / 2
-        legs = [
-            _box((0.025, 0.025, leg_h), (sx * (hx - 0.06), sy * (hy - 0.06), -top / 2 - leg_h), _WOOD)
-            for sx in (-1, 1)
-            for sy in (-1, 1)
-        ]
-        self._multibody("Table", [_box((hx, hy, top / 2), (0, 0, 0), _WOOD), *legs], (cx, cy, L.TABLE_HEIGHT - top / 2))
+        for iri in sorted(self.map.furniture):
+            thing = self.map.things.get(iri)
+            if thing is None:
+                continue
+            box = thing.box
+            cx, cy = (box.min_x + box.max_x) / 2, (box.min_y + box.max_y) / 2
+            hx, hy = (box.max_x - box.min_x) / 2, (box.max_y - box.min_y) / 2
+            leg_h = (box.max_z - top) / 2
+            legs = [
+                _box((0.025, 0.025, leg_h), (sx * (hx - 0.06), sy * (hy - 0.06), -top / 2 - leg_h), _WOOD)
+                for sx in (-1, 1)
+                for sy in (-1, 1)
+            ]
+            self._multibody(
+                thing.name, [_box((hx, hy, top / 2), (0, 0, 0), _WOOD), *legs], (cx, cy, box.max_z - top / 2)
+            )
+
+    def _build_kitchen(self) -> None:
+        self._build_furniture()
 
         d, s, lever = L.DISPENSER, L.SPOUT, L.TAP_LEVER
         centre = ((d.xmin + d.xmax) / 2, (d.ymin + d.ymax) / 2, (d.zmin + d.zmax) / 2)
@@ -581,10 +606,12 @@ class HomeWorld:
                 f"the dual-arm robot needs a left and a right arm in the semantic map; it has {sorted(arms)}"
             )
         mounts = {side: (arms[side].mount, quat_from_yaw(arms[side].yaw)) for side in ArmSide}
-        top = Region(
-            "TableTop", L.TABLE.xmin, L.TABLE.xmax, L.TABLE.ymin, L.TABLE.ymax, L.TABLE_HEIGHT - 0.04, L.TABLE_HEIGHT
-        )
-        self._kinematics = Kinematics(mounts, [L.TORSO, top, L.DISPENSER, L.KINECT_BODY, L.KINECT_MAST])
+        tops = [
+            Region(thing.name, b.min_x, b.max_x, b.min_y, b.max_y, b.max_z - 0.04, b.max_z)
+            for iri in sorted(self.map.furniture)
+            if (thing := self.map.things.get(iri)) is not None and (b := thing.box) is not None
+        ]
+        self._kinematics = Kinematics(mounts, [L.TORSO, *tops, L.DISPENSER, L.KINECT_BODY, L.KINECT_MAST])
         for side in ArmSide:
             mount, orientation = mounts[side]
             body = p.loadURDF(

@@ -169,3 +169,22 @@ def test_the_pen_moved_after_it_was_seen_is_found_again() -> None:
     assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
     assert len(result.replans) == 1
     assert (WORLD + "Pen", HOME + "isWith", WORLD + "Person") in world_facts(kb)
+
+
+def test_a_task_runs_in_a_home_whose_table_was_moved_and_a_second_table_added() -> None:
+    kb = KnowledgeBase.open(":memory:")
+    kb.update(  # the kitchen table 15 cm further east (the docking pose is where the arm reaches: it stays)
+        "DELETE { GRAPH graph:map { ?t home:minX ?a ; home:maxX ?b } } "
+        "INSERT { GRAPH graph:map { ?t home:minX ?a2 ; home:maxX ?b2 } } "
+        "WHERE { GRAPH graph:map { VALUES ?t { world:KitchenTable world:KitchenTableTop } "
+        "?t home:minX ?a ; home:maxX ?b } BIND(?a + 0.15 AS ?a2) BIND(?b + 0.15 AS ?b2) } ; "
+        "INSERT DATA { GRAPH graph:map { world:LivingRoomTable a home:Table ; home:minX 1.0 ; home:maxX 1.8 ; "
+        "home:minY 0.5 ; home:maxY 1.1 ; home:minZ 0.0 ; home:maxZ 0.7 } }"
+    )
+    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
+        assert world.furniture == ["KitchenTable", "LivingRoomTable"]
+        low, high = world.aabb("KitchenTable")
+        assert abs(low[0] - 7.15) < 0.01 and abs(high[0] - 8.65) < 0.01
+        assert abs(world.aabb("LivingRoomTable")[1][2] - 0.7) < 0.01
+        result = run_task(kb, "FetchMyPen", SimEnvironment(world, kb), composer=Composer(kb))
+    assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
