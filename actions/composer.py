@@ -25,19 +25,33 @@ from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from enum import Enum
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import networkx as nx
 import pyoxigraph as ox
 
 from actions.errors import OrderingConflictError
-from actions.graph import SRE, SRI, SRO, Edge, Matcher, Need, ServicePool, ServiceResourceGraph
+from actions.graph import (
+    SRE,
+    SRI,
+    SRO,
+    Edge,
+    Matcher,
+    Need,
+    ServicePool,
+    ServiceResourceGraph,
+    parameter_names,
+    statement_text,
+)
 from actions.model import ActionLibrary, Task, resolve_task
 from actions.plan import Binding, Plan, PlanStep, Source
 from actions.search import SearchTrace, bidirectional_search
 from kb import Advertisement, KnowledgeBase, Requirement, Statement
 from kb.namespaces import GraphName, shorten
 from reasoner.config import MatchConfig
+
+if TYPE_CHECKING:
+    from reasoner.matchmaker import EntityPair
 from reasoner.taxonomy import TaxonomyIndex
 
 GOAL = "GOAL"  # the extraction's virtual consumer: SRO's and SRE's needs together
@@ -58,6 +72,7 @@ class ComposeConfig:
     max_steps: int = 200
     match: MatchConfig = field(default_factory=MatchConfig)
     world_state: bool = True  # preconditions may be met by what holds in the map and belief graphs
+    matched: bool = True  # when nothing composes, one advertisement the matchmaker accepts for the whole requirement
 
 
 class PlanStatus(Enum):
@@ -173,9 +188,127 @@ class Composer:
         elif isinstance(task, Requirement):
             task = Task(task.iri, task, self.actions.actions.get(task.for_task or ""))
         direct = self.attempt(task.requirement, task)
-        if direct.plan is not None or not self._decomposable(task):
+        if direct.plan is not None:
             return self._result(task, direct.plan, direct.unsatisfied, (direct,))
-        return self._decomposed(task, direct)
+        result = self._decomposed(task, direct) if self._decomposable(task) else None
+        if result is not None and result.plan is not None:
+            return result
+        if self.config.matched:
+            plan = self._matched(task)
+            if plan is not None:
+                return self._result(task, plan, (), (direct,))
+        return result or self._result(task, None, direct.unsatisfied, (direct,))
+
+    def _matched(self, task: Task) -> Plan | None:
+        """The paper's own answer when no plan composes: one advertisement the matchmaker accepts for
+        the whole requirement (Sem-Str, paper Table 3: the ceiling camera's RobotLocation for a robot
+        asking its RobotPosition), run on its own, if the requirement gives each of its inputs and the
+        requirement or the world its preconditions, and it states every effect the requirement wants."""
+        from reasoner.matchmaker import Matchmaker  # only when composition found nothing
+
+        requirement = task.requirement
+        ranking = Matchmaker(self.kb, index=self.index, advertisements=self.advertisements).rank(requirement, explain=5)
+        offered = {ad.iri: ad for ad in self.advertisements}
+        top_level = {p.type for p in requirement.outputs}
+        for candidate in ranking.candidates[:5]:
+            ad = offered.get(candidate.advertisement)
+            if ad is None or not candidate.acceptable or candidate.lacks:
+                continue
+            # Every pair is-a related, except an output whose parts all are (the paper's Position for
+            # Location): a concept with no matched parts and no is-a link is no match to act on.
+            failed = [p for p in candidate.pairs if p.degree == "Fail"]
+            parts = [
+                p for p in candidate.pairs if p.role == "output" and p.degree != "Fail" and p.requested not in top_level
+            ]
+            if any(p.role != "output" or p.requested not in top_level for p in failed) or (failed and not parts):
+                continue
+            plan = self._single_step(task, requirement, ad, candidate.pairs, candidate.score)
+            if plan is not None:
+                return plan
+        return None
+
+    def _single_step(
+        self, task: Task, requirement: Requirement, ad: Advertisement, pairs: Sequence[EntityPair], score: float
+    ) -> Plan | None:
+        """The plan of ``ad`` alone for ``requirement``, its inputs and outputs bound as the matchmaker paired them."""
+        bindings: list[Binding] = []
+        requirement_inputs = list(zip(parameter_names(requirement.inputs), requirement.inputs, strict=True))
+        for name, parameter in zip(parameter_names(ad.inputs), ad.inputs, strict=True):
+            given = next((p for p in pairs if p.role == "input" and p.advertised == parameter.type), None)
+            source = next((n for n, r in requirement_inputs if given is not None and r.type == given.requested), None)
+            if given is None or source is None:
+                return None
+            bindings.append(
+                Binding(
+                    "input",
+                    name,
+                    Source(source, None, requirement.iri),
+                    given.degree,
+                    given.similarity,
+                    parameter.type,
+                )
+            )
+        holding = [*requirement.preconditions, *(self.world_state() if self.config.world_state else [])]
+        for wanted in ad.preconditions:
+            met = next((h for h in holding if self.matcher.statement(wanted, h) is not None), None)
+            if met is None:
+                return None
+            degree, similarity = self.matcher.statement(wanted, met) or (None, 0.0)
+            bindings.append(
+                Binding(
+                    "precondition",
+                    statement_text(wanted),
+                    Source(statement_text(met), None, requirement.iri),
+                    degree.value if degree else "",
+                    similarity,
+                    statement=wanted,
+                )
+            )
+        goals: list[Binding] = []
+        offered_outputs = list(zip(parameter_names(ad.outputs), ad.outputs, strict=True))
+        for wanted_name, wanted_output in zip(parameter_names(requirement.outputs), requirement.outputs, strict=True):
+            pair = next((p for p in pairs if p.role == "output" and p.requested == wanted_output.type), None)
+            output = next((n for n, o in offered_outputs if pair is not None and o.type == pair.advertised), None)
+            if pair is None or output is None:
+                return None
+            goals.append(
+                Binding(
+                    "input",
+                    wanted_name,
+                    Source(output, 1),
+                    pair.degree,
+                    pair.similarity,
+                    wanted_output.type,
+                )
+            )
+        for effect in requirement.effects:
+            stated = next((e for e in ad.effects if self.matcher.statement(effect, e) is not None), None)
+            if stated is None:
+                return None
+            degree, similarity = self.matcher.statement(effect, stated) or (None, 0.0)
+            goals.append(
+                Binding(
+                    "precondition",
+                    statement_text(effect),
+                    Source(statement_text(stated), 1),
+                    degree.value if degree else "",
+                    similarity,
+                    statement=effect,
+                )
+            )
+        step = PlanStep(
+            index=1,
+            component=ad.iri,
+            label=ad.label,
+            kind=ad.kind,
+            device=ad.device,
+            action=ad.realizes_action,
+            bindings=tuple(bindings),
+            outputs=tuple((n, o.type) for n, o in offered_outputs),
+            effects=ad.effects,
+            cost=self.pool.vertices[ad.iri].cost if ad.iri in self.pool.vertices else self.config.default_cost,
+        )
+        return Plan(task.name, requirement.iri, "matched", (step,), tuple(goals), score, step.cost)
 
     def _decomposable(self, task: Task) -> bool:
         """Whether every sub-action of the task is stated as a requirement of its own.

@@ -289,6 +289,11 @@ def _offers(outputs: Sequence[Parameter], effects: Sequence[Statement]) -> list[
     return offers
 
 
+def parameter_names(parameters: Sequence[Parameter]) -> list[str]:
+    """The names steps and plans use for ``parameters`` (see ``_names``)."""
+    return _names(parameters)
+
+
 def _names(parameters: Sequence[Parameter]) -> list[str]:
     """Parameter names, unique within one list (the type's local name when a parameter has none)."""
     names: list[str] = []

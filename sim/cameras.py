@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 import pybullet as p
@@ -19,7 +19,7 @@ from numpy.typing import NDArray
 from sim.errors import CameraUnavailableError
 from sim.layout import CameraSpec
 
-__all__ = ["Camera", "Clock", "Frame", "Intrinsics", "camera_to_world", "project"]
+__all__ = ["Camera", "Clock", "Frame", "Intrinsics", "camera_to_world", "project", "render"]
 # Where the TINY renderer samples pixel (u, v), in continuous image coordinates: at the pixel's corner
 # in OpenGL's bottom-up rows, which is (u, v + 1) counted from the top. Measured, not assumed: with
 # centres (u + 0.5, v + 0.5) every estimate was half a pixel (1.7 cm on the floor) off.
@@ -123,6 +123,26 @@ class Clock(Protocol):
     def time(self) -> float: ...
 
 
+def render(client: int, width: int, height: int, view: Any, projection: Any) -> tuple[Any, Any]:
+    """One frame (RGBA and depth buffer) by pybullet's software renderer, lit the same for every
+    camera: the perception thresholds and the recordings see the same colours."""
+    _, _, rgba, zbuffer, _ = p.getCameraImage(
+        width,
+        height,
+        view,
+        projection,
+        shadow=0,
+        lightDirection=(0.3, 0.2, 1.0),
+        lightAmbientCoeff=0.6,
+        lightDiffuseCoeff=0.4,
+        lightSpecularCoeff=0.0,
+        renderer=p.ER_TINY_RENDERER,
+        flags=p.ER_NO_SEGMENTATION_MASK,
+        physicsClientId=client,
+    )
+    return rgba, zbuffer
+
+
 class Camera:
     """A camera placed in one world's pybullet client; ``capture()`` renders with the TINY renderer."""
 
@@ -145,20 +165,7 @@ class Camera:
         if self.failed:
             raise CameraUnavailableError(self.name)
         s = self.spec
-        _, _, rgba, zbuffer, _ = p.getCameraImage(
-            s.width,
-            s.height,
-            self._view,
-            self._projection,
-            shadow=0,
-            lightDirection=(0.3, 0.2, 1.0),
-            lightAmbientCoeff=0.6,
-            lightDiffuseCoeff=0.4,
-            lightSpecularCoeff=0.0,
-            renderer=p.ER_TINY_RENDERER,
-            flags=p.ER_NO_SEGMENTATION_MASK,
-            physicsClientId=self._client,
-        )
+        rgba, zbuffer = render(self._client, s.width, s.height, self._view, self._projection)
         rgb = np.ascontiguousarray(np.reshape(np.asarray(rgba, dtype=np.uint8), (s.height, s.width, 4))[:, :, :3])
         z = np.reshape(np.asarray(zbuffer, dtype=np.float64), (s.height, s.width))
         depth = (s.far * s.near / (s.far - (s.far - s.near) * z)).astype(np.float32)

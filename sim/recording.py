@@ -31,6 +31,7 @@ import pybullet as p
 from numpy.typing import NDArray
 from PIL import Image, ImageDraw, ImageFont
 
+from sim.cameras import render
 from sim.world import HomeWorld
 
 __all__ = [
@@ -471,20 +472,7 @@ class Recorder:
         client = self.world.client
         view = p.computeViewMatrixFromYawPitchRoll((x, y, 0.4), distance, 0.0, PITCH, 0.0, 2, physicsClientId=client)
         projection = p.computeProjectionMatrixFOV(FOV, width / height, 0.1, 60.0, physicsClientId=client)
-        _, _, rgba, _, _ = p.getCameraImage(
-            width,
-            height,
-            view,
-            projection,
-            shadow=0,
-            lightDirection=(0.3, 0.2, 1.0),
-            lightAmbientCoeff=0.6,
-            lightDiffuseCoeff=0.4,
-            lightSpecularCoeff=0.0,
-            renderer=p.ER_TINY_RENDERER,
-            flags=p.ER_NO_SEGMENTATION_MASK,
-            physicsClientId=client,
-        )
+        rgba, _ = render(client, width, height, view, projection)
         image = np.reshape(np.asarray(rgba, dtype=np.uint8), (height, width, 4))[:, :, :3]
         return np.ascontiguousarray(image)
 

@@ -21,6 +21,14 @@ TASKS = Path(__file__).parent / "data" / "tasks"
 HOME, WORLD, REQ = PREFIXES["home"], PREFIXES["world"], PREFIXES["req"]
 
 
+def knowledge(*files: tuple[str, str]) -> KnowledgeBase:
+    """A fresh knowledge base with the given (graph, file of tests/data/tasks) loaded."""
+    kb = KnowledgeBase.open(":memory:")
+    for graph, name in files:
+        kb.load([TASKS / name], graph=graph)
+    return kb
+
+
 def run(kb: KnowledgeBase, task: str, seed: int = 0) -> RunResult:
     with open_world(seed=seed, semantic_map=SemanticMap.read(kb)) as world:
         return run_task(kb, task, SimEnvironment(world, kb), composer=Composer(kb))
@@ -31,9 +39,7 @@ def world_facts(kb: KnowledgeBase) -> set[tuple[str, str, str]]:
 
 
 def test_a_new_object_is_fetched_by_a_goal_only_task_written_in_turtle() -> None:
-    kb = KnowledgeBase.open(":memory:")
-    kb.load([TASKS / "pencil_on_the_table.ttl"], graph="map")
-    kb.load([TASKS / "fetch_my_pencil.ttl"], graph="requirements")
+    kb = knowledge(("map", "pencil_on_the_table.ttl"), ("requirements", "fetch_my_pencil.ttl"))
     result = run(kb, "FetchMyPencil")
     assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
     assert result.report is not None
@@ -46,9 +52,7 @@ def test_a_new_object_is_fetched_by_a_goal_only_task_written_in_turtle() -> None
 
 
 def test_a_new_destination_written_in_turtle() -> None:
-    kb = KnowledgeBase.open(":memory:")
-    kb.load([TASKS / "tray_place.ttl"], graph="map")
-    kb.load([TASKS / "put_cup_on_tray.ttl"], graph="requirements")
+    kb = knowledge(("map", "tray_place.ttl"), ("requirements", "put_cup_on_tray.ttl"))
     result = run(kb, "PutCupOnTray")
     assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
     assert (WORLD + "Cup", HOME + "isLocated", WORLD + "TrayPlace") in world_facts(kb)
@@ -119,9 +123,7 @@ def test_a_store_seeded_before_the_semantic_map_gets_it_on_open(tmp_path: Path) 
 
 
 def test_a_better_camera_registered_in_turtle_is_used_by_fetch_my_pen() -> None:
-    kb = KnowledgeBase.open(":memory:")
-    kb.load([TASKS / "better_camera.ttl"], graph="services")
-    kb.load([TASKS / "better_camera_on_the_ceiling.ttl"], graph="map")
+    kb = knowledge(("services", "better_camera.ttl"), ("map", "better_camera_on_the_ceiling.ttl"))
     result = run(kb, "FetchMyPen")
     assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
     assert result.report is not None
@@ -188,3 +190,13 @@ def test_a_task_runs_in_a_home_whose_table_was_moved_and_a_second_table_added() 
         assert abs(world.aabb("LivingRoomTable")[1][2] - 0.7) < 0.01
         result = run_task(kb, "FetchMyPen", SimEnvironment(world, kb), composer=Composer(kb))
     assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
+
+
+def test_the_papers_table_2_requirement_plans_and_runs_on_the_camera_the_matchmaker_ranks_first() -> None:
+    kb = KnowledgeBase.open(":memory:")
+    result = run(kb, "RobotSelfPosition")
+    assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
+    plan = result.composition.plan
+    assert plan is not None and plan.method == "matched"  # no is-a chain gives a RobotPosition: Table 3's match
+    assert [step.component for step in plan.steps] == [PREFIXES["svc"] + "LocateMobileRobot_CeilingCamera01"]
+    assert [(goal.name, goal.source.name) for goal in plan.goals] == [("selfPosition", "robotLocation")]
