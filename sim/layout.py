@@ -11,23 +11,15 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from sim.geometry import Pose2D, Region, Vec3
+from sim.geometry import Region, Vec3
 
 __all__ = [
-    "ARM_MOUNTS",
     "ARM_MOUNT_YAW",
     "BASE_HALF_LENGTH",
     "BASE_HALF_WIDTH",
     "BASE_RADIUS",
-    "BASE_START",
-    "BELOW_OF_TAP",
-    "CAMERAS",
-    "CUP_HEIGHT",
-    "CUP_RADIUS",
-    "CUP_START",
     "DISPENSER",
     "DOORS",
-    "HANDOVER_POSE",
     "HOME",
     "KINECT",
     "KINECT_BODY",
@@ -36,20 +28,13 @@ __all__ = [
     "MARKER_HEIGHT",
     "MARKER_OFFSET",
     "MARKER_PATCH",
-    "PEN_LENGTH",
-    "PEN_START",
-    "PEN_START_YAW",
-    "PEN_WIDTH",
     "PERSON_HAND_HEIGHT",
     "PERSON_RADIUS",
-    "PERSON_START",
     "PLATFORM_HEIGHT",
-    "ROOMS",
     "SHIRT_BOTTOM",
     "SHIRT_RADIUS",
     "SHIRT_TOP",
     "SPOUT",
-    "TABLE",
     "TABLE_HEIGHT",
     "TAP_LEVER",
     "TAP_OUTLET",
@@ -59,18 +44,14 @@ __all__ = [
     "WALL_THICKNESS",
     "CameraSpec",
     "WallSpec",
-    "room_of",
 ]
 
 # --- the home and its rooms -------------------------------------------------------------------
 
 HOME = Region("Home", 0.0, 10.0, 0.0, 9.0)
-ROOMS: dict[str, Region] = {
-    "LivingRoom": Region("LivingRoom", 0.0, 6.0, 0.0, 5.0),
-    "Kitchen": Region("Kitchen", 6.0, 10.0, 0.0, 5.0),
-    "Bedroom": Region("Bedroom", 0.0, 6.0, 5.0, 9.0),
-}
-"""The north-east corner (x 6-10, y 5-9) belongs to no room: it is walled off with no door."""
+# The rooms, the furniture, the objects, the person, the arms' mounts, the base's start and the
+# ceiling cameras are in the semantic map (ontologies/world.ttl), not here. The north-east corner
+# (x 6-10, y 5-9) belongs to no room: it is walled off with no door.
 
 WALL_THICKNESS = 0.10
 WALL_HEIGHT = 1.0
@@ -110,7 +91,6 @@ DOORS: dict[str, Region] = {
 # --- the kitchen table, the water dispenser and the objects on the table -----------------------
 
 TABLE_HEIGHT = 0.75
-TABLE = Region("TableTop", 7.0, 8.5, 3.0, 4.5, TABLE_HEIGHT, TABLE_HEIGHT)
 
 DISPENSER = Region("WaterDispenser", 7.66, 7.84, 3.42, 3.62, TABLE_HEIGHT, 1.10)
 """The dispenser's body, standing on the table; its spout sticks out towards the dual-arm robot."""
@@ -119,23 +99,11 @@ TAP_LEVER = Region("TapLever", 7.72, 7.78, 3.27, 3.29, 0.94, 0.99)
 """Pushing the lever towards the dispenser (+y) opens the tap; a spring pushes it back."""
 TAP_OUTLET: Vec3 = (7.75, 3.31, 0.95)
 """Where the water leaves the spout: the axis of the region below the tap."""
-BELOW_OF_TAP = Region("BelowOfTap", 7.725, 7.775, 3.285, 3.335, TABLE_HEIGHT, SPOUT.zmin)
-"""A cup whose centre is in this 5 cm square on the table catches the water: the stream (on the
-outlet axis) then falls at most 2.5 cm from the cup's axis, inside its 3 cm radius."""
 
-CUP_RADIUS = 0.03
-CUP_HEIGHT = 0.10
-CUP_START = (7.45, 3.32)
-PEN_LENGTH = 0.14
-PEN_WIDTH = 0.016
-PEN_START = (8.07, 3.30)
-PEN_START_YAW = 0.0
 
 # --- the dual-arm robot and its Kinect ---------------------------------------------------------
 
 TORSO = Region("CytonDualArm01", 7.5, 8.0, 2.40, 2.70, 0.0, 0.65)
-ARM_MOUNTS: dict[str, Vec3] = {"left": (7.57, 2.55, 0.65), "right": (7.93, 2.55, 0.65)}
-"""Where each arm's base sits on the torso; both arms face the table (+y)."""
 ARM_MOUNT_YAW = math.pi / 2.0
 
 # --- the mobile base (a Pioneer 3-DX with a carrying platform) ---------------------------------
@@ -152,13 +120,9 @@ MARKER_OFFSET = 0.165
 """The green (front) and magenta (rear) marker patches sit this far ahead of and behind the centre."""
 MARKER_PATCH = (0.12, 0.30)
 """Size of each marker patch along and across the base (m)."""
-BASE_START = Pose2D(3.0, 1.5, 0.0)
-HANDOVER_POSE = Pose2D(8.5, 2.2, 0.0)
-"""Where the base parks so that the right arm can load its platform (south-east of the torso)."""
 
 # --- the person -------------------------------------------------------------------------------
 
-PERSON_START = (2.0, 3.6)
 PERSON_RADIUS = 0.18
 SHIRT_RADIUS = 0.22
 SHIRT_BOTTOM = 0.85
@@ -183,12 +147,6 @@ class CameraSpec:
     far: float = 8.0
 
 
-CAMERAS: dict[str, CameraSpec] = {
-    "CeilingCamera01": CameraSpec("CeilingCamera01", (4.5, 2.5, 4.5), (4.5, 2.5, 0.0), (0.0, 1.0, 0.0)),
-    "CeilingCamera02": CameraSpec("CeilingCamera02", (7.0, 2.5, 4.5), (7.0, 2.5, 0.0), (0.0, 1.0, 0.0)),
-}
-"""Both look straight down from 4.5 m with a 90 x 106 degree view: each sees the base's start pose
-in the living room and its hand-over pose in the kitchen, so either can stand in for the other."""
 KINECT = CameraSpec(
     "Kinect01", (7.75, 2.45, 1.45), (7.75, 3.40, 0.75), (0.0, 0.0, 1.0), fov_deg=45.0, near=0.3, far=4.0
 )
@@ -200,9 +158,3 @@ KINECT_MAST = Region("KinectMast", 7.735, 7.765, 2.435, 2.465, TORSO.zmax, KINEC
 MAP_RESOLUTION = 0.05
 
 
-def room_of(x: float, y: float) -> str | None:
-    """The room a floor point is in (the ontology's LocateRoomOfPosition), or None outside every room."""
-    for name, room in ROOMS.items():
-        if room.contains_xy(x, y):
-            return name
-    return None

@@ -20,12 +20,13 @@ from sim import skills
 from sim.arms import ArmSide
 from sim.errors import SimulationError
 from sim.grasping import ObjectModel, compute_grasp_pose
-from sim.layout import ARM_MOUNTS, BELOW_OF_TAP, HANDOVER_POSE, TAP_LEVER
+from sim.layout import TAP_LEVER
 from sim.mapping import OccupancyGrid, build_occupancy_grid
 from sim.perception import RobotPoseEstimate, locate_robot, recognise_object, track_person
 from sim.planning import approach_point, plan_path
 from sim.skills import Outcome
 from sim.world import HomeWorld
+from tests.home_layout import ARM_MOUNTS, BELOW_OF_TAP, HANDOVER_POSE
 
 __all__ = ["PERSON_APPROACH_DISTANCE", "ScenarioResult", "fetch_pen", "serve_cup"]
 

@@ -18,9 +18,10 @@ from sim import (
     build_occupancy_grid,
     plan_path,
 )
-from sim.layout import BASE_RADIUS, HANDOVER_POSE, MAP_RESOLUTION, TABLE, WALLS
+from sim.layout import BASE_RADIUS, MAP_RESOLUTION, WALLS
 from sim.mapping import inflate
 from sim.planning import approach_point, snap_to_free
+from tests.home_layout import HANDOVER_POSE, TABLE
 
 
 @pytest.fixture(scope="module")

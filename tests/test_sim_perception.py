@@ -20,8 +20,9 @@ from sim import (
 )
 from sim import predicates as pred
 from sim.geometry import wrap_angle
-from sim.layout import BASE_START, HANDOVER_POSE, SHIRT_TOP
+from sim.layout import SHIRT_TOP
 from sim.perception import segment
+from tests.home_layout import BASE_START, HANDOVER_POSE
 
 LOCALISATION_ERROR = 0.05
 HEADING_ERROR = 0.10

@@ -6,7 +6,7 @@ import pytest
 
 from sim import HomeWorld
 from sim import predicates as pred
-from sim.layout import BELOW_OF_TAP, HANDOVER_POSE
+from tests.home_layout import BELOW_OF_TAP, HANDOVER_POSE
 from tests.reference_scenarios import fetch_pen, serve_cup
 
 SERVE_STEPS = [

@@ -20,10 +20,11 @@ from sim import (
 )
 from sim import predicates as pred
 from sim.grasping import ObjectModel
-from sim.layout import ARM_MOUNTS, BELOW_OF_TAP, HANDOVER_POSE, TABLE, TAP_LEVER
+from sim.layout import TAP_LEVER
 from sim.mapping import build_occupancy_grid
 from sim.planning import approach_point, plan_path
 from sim.scene import bundled_map
+from tests.home_layout import ARM_MOUNTS, BELOW_OF_TAP, HANDOVER_POSE, TABLE
 from tests.reference_scenarios import PERSON_APPROACH_DISTANCE
 
 CUP = ObjectModel.of(bundled_map().objects[PREFIXES["world"] + "Cup"])

@@ -9,7 +9,8 @@ import pytest
 
 from sim import HomeWorld, UnknownEntityError, WorldClosedError, open_world
 from sim import predicates as pred
-from sim.layout import (
+from sim.skills import navigate
+from tests.home_layout import (
     BASE_START,
     CAMERAS,
     CUP_START,
@@ -20,7 +21,6 @@ from sim.layout import (
     TABLE,
     room_of,
 )
-from sim.skills import navigate
 
 
 @pytest.fixture(scope="module")
