@@ -55,6 +55,7 @@ if TYPE_CHECKING:
 from reasoner.taxonomy import TaxonomyIndex
 
 GOAL = "GOAL"  # the extraction's virtual consumer: SRO's and SRE's needs together
+MAX_DEPTH = 4  # how many levels of sub-actions a task may be decomposed into
 
 
 class Objective(Enum):
@@ -336,24 +337,44 @@ class Composer:
             return []
         return [(o.constraint, o.before, o.after) for o in self.actions.orderings_for(task.action.iri)]
 
-    def _decomposed(self, task: Task, direct: Attempt) -> CompositionResult:
+    def _decomposed(self, task: Task, direct: Attempt, depth: int = 0) -> CompositionResult:
+        """Compose each sub-action on its own, in order, and concatenate the plans. A sub-action that
+        is a task with sub-actions of its own is decomposed in turn (two-level tasks), at most
+        ``MAX_DEPTH`` levels down."""
         assert task.action is not None
         attempts = [direct]
         plans: list[Plan] = []
+        holding = self.world_state() if self.config.world_state else []
         for sub in task.action.ordered_sub_actions():
             sub_task = resolve_task(self.kb, self.actions, sub)
+            if self._achieved(sub_task.requirement, holding):
+                continue  # its effects hold already (a re-plan keeps what the last plan achieved)
             attempt = self.attempt(sub_task.requirement, sub_task)
             attempts.append(attempt)
-            if attempt.plan is None:
+            plan = attempt.plan
+            unsatisfied = attempt.unsatisfied
+            if plan is None and depth < MAX_DEPTH and self._decomposable(sub_task):
+                nested = self._decomposed(sub_task, attempt, depth + 1)
+                attempts += nested.attempts[1:]
+                plan, unsatisfied = nested.plan, nested.unsatisfied or unsatisfied
+            if plan is None:
                 unsatisfied = direct.unsatisfied + tuple(
                     Unsatisfied(
                         u.need, u.consumer, (f"sub-action {shorten(sub)}", *u.chain[1:], shorten(u.consumer)), u.cycle
                     )
-                    for u in attempt.unsatisfied
+                    for u in unsatisfied
                 )
                 return self._result(task, None, unsatisfied, tuple(attempts))
-            plans.append(attempt.plan)
+            plans.append(plan)
+        if not plans:  # every part is achieved: nothing to do but check
+            return self._result(task, None, direct.unsatisfied, tuple(attempts))
         return self._result(task, _concatenate(task, plans), (), tuple(attempts))
+
+    def _achieved(self, requirement: Requirement, holding: Sequence[Statement]) -> bool:
+        """Whether a sub-task is done: it wants effects only, and each holds in the world now."""
+        if requirement.outputs or not requirement.effects:
+            return False
+        return all(any(self.matcher.statement(e, h) is not None for h in holding) for e in requirement.effects)
 
     def _result(
         self, task: Task, plan: Plan | None, unsatisfied: tuple[Unsatisfied, ...], attempts: tuple[Attempt, ...]
@@ -732,7 +753,7 @@ def _concatenate(task: Task, plans: list[Plan]) -> Plan:
                     outputs=step.outputs,
                     effects=step.effects,
                     cost=step.cost,
-                    part_of=plan.task,
+                    part_of=step.part_of or plan.task,
                     alternatives=step.alternatives,
                 )
             )

@@ -78,6 +78,7 @@ class SimContext:
     world: HomeWorld
     kb: KnowledgeBase
     grid: OccupancyGrid | None = None
+    focus: str | None = None  # the object an arm last took (by name)
     grasp: GraspPose | None = None  # the grasp pose of the object the arm is working on
     arm: ArmSide = ArmSide.LEFT
     region: Region | None = None  # where the carried object goes
@@ -90,7 +91,8 @@ class SimContext:
 
     @property
     def object(self) -> str | None:
-        return self.grasp.model.name if self.grasp is not None else None
+        """The object an arm last took in hand."""
+        return self.focus or (self.grasp.model.name if self.grasp is not None else None)
 
 
 Work = Callable[[SimContext, Mapping[str, Any], str], dict[str, Any]]
@@ -256,6 +258,7 @@ def approach(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[st
     x, y, _ = estimate.position
     ctx.arm = _free_arm(ctx, x, y, f"the {model.name}")
     ctx.grasp = compute_grasp_pose(model, estimate.position, estimate.yaw, ctx.world.arm_specs[ctx.arm].mount)
+    ctx.focus = model.name
     ctx.last_arm = ctx.arm
     _check(skills.approach_object(ctx.world, ctx.arm, ctx.grasp))
     return {}
@@ -297,7 +300,7 @@ def hand_over(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[s
     model = _model(ctx, inputs["graspPose"])
     x, y, _ = estimate.position
     side = _free_arm(ctx, x, y, f"the {model.name}")
-    ctx.last_arm = side
+    ctx.last_arm, ctx.focus = side, model.name
     # The base parks against the place's docking mark, which the dual-arm robot knows.
     reach = ctx.world.arm_specs[side].reach
     _check(skills.hand_over_onto_platform(ctx.world, estimate, ctx.world.base_pose(), side, model, reach))
@@ -540,17 +543,17 @@ class SimEnvironment:
             return ("person", self.world.person_name)
         if self.is_a(concept, HOME + "Substance"):
             return ("substance", concept)
-        if self.is_a(concept, HOME + "PhysicalObject"):
-            held = _grasped(inputs)
-            if held is not None:
-                return ("object", held)
-            if ctx.object is not None:
-                return ("object", ctx.object)
-        if self.is_a(concept, HOME + "Place") and ctx.region is not None:
-            return ("region", ctx.region.name)
+        held = _grasped(inputs) if self.is_a(concept, HOME + "PhysicalObject") else None
+        if held is not None:
+            return ("object", held)
+        # a class only one thing of the world belongs to (the Pen) means that thing, whatever is at hand
         candidates = [iri for iri, types in self.world.map.types.items() if any(self.is_a(t, concept) for t in types)]
         if len(candidates) == 1:
             return ("thing", candidates[0])
+        if self.is_a(concept, HOME + "PhysicalObject") and ctx.object is not None:
+            return ("object", ctx.object)
+        if self.is_a(concept, HOME + "Place") and ctx.region is not None:
+            return ("region", ctx.region.name)
         return None
 
     def verify(self, step: PlanStep, statement: Statement, outputs: Mapping[str, Any]) -> bool | None:

@@ -200,3 +200,43 @@ def test_the_papers_table_2_requirement_plans_and_runs_on_the_camera_the_matchma
     assert plan is not None and plan.method == "matched"  # no is-a chain gives a RobotPosition: Table 3's match
     assert [step.component for step in plan.steps] == [PREFIXES["svc"] + "LocateMobileRobot_CeilingCamera01"]
     assert [(goal.name, goal.source.name) for goal in plan.goals] == [("selfPosition", "robotLocation")]
+
+
+@pytest.mark.parametrize(
+    ("task", "files", "fact"),
+    [
+        pytest.param(
+            "FetchMyPencilLikeMyPen",
+            [("map", "pencil_on_the_table.ttl"), ("requirements", "fetch_my_pencil_like_my_pen.ttl")],
+            (WORLD + "Pencil1", HOME + "isWith", WORLD + "Person"),
+            id="another-object-in-an-existing-hierarchy",
+        ),
+        pytest.param(
+            "FetchMyChopstick",
+            [("ontology", "chopstick.ttl"), ("map", "chopstick.ttl"), ("requirements", "fetch_my_chopstick.ttl")],
+            (WORLD + "Chopstick1", HOME + "isWith", WORLD + "Person"),
+            id="a-new-object-class-with-its-shape-and-grasp",
+        ),
+        pytest.param(
+            "MorningRoutine",
+            [("ontology", "morning_routine.ttl")],
+            (WORLD + "Cup", HOME + "contains", HOME + "Water"),
+            id="a-two-level-task",
+        ),
+    ],
+)
+def test_a_task_written_only_in_turtle_runs(
+    task: str, files: list[tuple[str, str]], fact: tuple[str, str, str]
+) -> None:
+    kb = knowledge(*files)
+    result = run(kb, task)
+    assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
+    assert fact in world_facts(kb)
+    if task == "MorningRoutine":
+        plan = result.composition.plan
+        assert plan is not None and plan.method == "decomposed"
+        assert (WORLD + "Pen", HOME + "isWith", WORLD + "Person") in world_facts(kb)
+        assert {step.part_of for step in plan.steps} >= {
+            PREFIXES["act"] + "FindCupOnTable",
+            PREFIXES["act"] + "FetchMyPen",
+        }  # two levels: ServeACup's own sub-actions, and FetchMyPen
