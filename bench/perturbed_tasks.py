@@ -3,7 +3,8 @@ moved on the floor, one world per seed.
 
 Run: python bench/perturbed_tasks.py [--seeds 20] [--object 0.04] [--person 0.8] [--tasks ...] [--json FILE]. The
 tasks are the paper's two scenarios and the Turtle-only tasks of tests/data/tasks (a new object
-fetched by a goal-only task; the cup put on a new place). Prints the machine, the inputs, one row per
+fetched by a goal-only task and through FetchMyPen's hierarchy, the cup put on a new place, a new
+object class, a two-level task). Prints the machine, the inputs, one row per
 run (seed, outcome, re-plans, simulated seconds, the reason of a failure) and per task the success
 rate; with --json, the same as a record.
 """
@@ -33,6 +34,13 @@ TASKS: dict[str, list[tuple[str, str]]] = {
     "FetchMyPen": [],
     "FetchMyPencil": [("map", "pencil_on_the_table.ttl"), ("requirements", "fetch_my_pencil.ttl")],
     "PutCupOnTray": [("map", "tray_place.ttl"), ("requirements", "put_cup_on_tray.ttl")],
+    "FetchMyPencilLikeMyPen": [("map", "pencil_on_the_table.ttl"), ("requirements", "fetch_my_pencil_like_my_pen.ttl")],
+    "FetchMyChopstick": [
+        ("ontology", "chopstick.ttl"),
+        ("map", "chopstick.ttl"),
+        ("requirements", "fetch_my_chopstick.ttl"),
+    ],
+    "MorningRoutine": [("ontology", "morning_routine.ttl")],
 }
 
 

@@ -587,12 +587,12 @@ class HomeWorld:
         t = L.TORSO
         half = ((t.xmax - t.xmin) / 2, (t.ymax - t.ymin) / 2, (t.zmax - t.zmin) / 2)
         self._multibody(
-            "CytonDualArm01", [_box(half, (0, 0, 0), _TORSO)], ((t.xmin + t.xmax) / 2, (t.ymin + t.ymax) / 2, half[2])
+            t.name, [_box(half, (0, 0, 0), _TORSO)], ((t.xmin + t.xmax) / 2, (t.ymin + t.ymax) / 2, half[2])
         )
         kinect, mast = _half_and_centre(L.KINECT_BODY), _half_and_centre(L.KINECT_MAST)
         mast_offset = tuple(m - k for m, k in zip(mast[1], kinect[1], strict=True))
         self._multibody(
-            "Kinect01",
+            L.KINECT.name,
             [
                 _box(kinect[0], (0, 0, 0), _DARK),
                 _box(mast[0], (mast_offset[0], mast_offset[1], mast_offset[2]), _STEEL),
