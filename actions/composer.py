@@ -154,6 +154,7 @@ class Composer:
         self.actions = actions or ActionLibrary.from_kb(kb)
         self._advertisements = list(advertisements) if advertisements is not None else None
         self._pool: ServicePool | None = None
+        self._belief = False
 
     @property
     def advertisements(self) -> list[Advertisement]:
@@ -177,13 +178,25 @@ class Composer:
         return ServiceResourceGraph(requirement, self.pool, holding)
 
     def world_state(self) -> list[Statement]:
-        """What holds now in the semantic map and the belief state, as statements between classes."""
+        """What holds, as statements between classes: in the semantic map, and in the belief state when
+        composing for a run that has just perceived it (``compose(task, belief=True)``); a belief left by
+        an earlier run is not the state of the next one."""
+        graphs = [GraphName.MAP, GraphName.WORLD] if self._belief else [GraphName.MAP]
         return [
             Statement(row["subjectType"].value, row["relation"].value, row["objectType"].value)
-            for row in self.kb.select("world_state")
+            for graph in graphs
+            for row in self.kb.select("world_state", {"graph": graph.iri})
         ]
 
-    def compose(self, task: str | Task | Requirement) -> CompositionResult:
+    def compose(self, task: str | Task | Requirement, belief: bool = False) -> CompositionResult:
+        """Plan ``task``; with ``belief``, from what the belief graph says holds now as well."""
+        self._belief = belief
+        try:
+            return self._compose(task)
+        finally:
+            self._belief = False
+
+    def _compose(self, task: str | Task | Requirement) -> CompositionResult:
         if isinstance(task, str):
             task = self.task(task)
         elif isinstance(task, Requirement):

@@ -100,7 +100,7 @@ def run_task(
     container = Container(environment.registry, environment.context, bus, policy)
     belief = BeliefState(kb)
     belief.write(environment.observe())  # plan from what holds now, not from a past run's belief
-    composition = composer.compose(task)
+    composition = composer.compose(task, belief=True)
     replans: list[Replan] = []
     report: ExecutionReport | None = None
     try:
@@ -129,7 +129,7 @@ def run_task(
             if callable(refresh):
                 refresh()  # components registered since the last plan
             composer = Composer(kb, composer.config)
-            composition = composer.compose(task)
+            composition = composer.compose(task, belief=True)
     finally:
         container.finalise_all()
     belief.write(environment.observe())

@@ -140,6 +140,7 @@ def test_every_named_query_with_parameters_gives_the_embedded_answer(remote_loca
         "relation": ["home:isLocatedOn", "home:isNear"],
         "class": ["home:Cup", "home:Drinkware"],
         "robot": ["svc:CytonDualArm01"],
+        "graph": ["graph:world", "graph:map"],
     }
     checked = 0
     for name in embedded.queries.names():
