@@ -22,7 +22,7 @@ each sub-action is composed in their partial order and the plans are concatenate
 from __future__ import annotations
 
 from collections import deque
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from enum import Enum
 from typing import TYPE_CHECKING, Any
@@ -264,20 +264,10 @@ class Composer:
             )
         holding = [*requirement.preconditions, *(self.world_state() if self.config.world_state else [])]
         for wanted in ad.preconditions:
-            met = next((h for h in holding if self.matcher.statement(wanted, h) is not None), None)
-            if met is None:
+            bound = self._statement_binding(wanted, holding, lambda met: Source(met, None, requirement.iri))
+            if bound is None:
                 return None
-            degree, similarity = self.matcher.statement(wanted, met) or (None, 0.0)
-            bindings.append(
-                Binding(
-                    "precondition",
-                    statement_text(wanted),
-                    Source(statement_text(met), None, requirement.iri),
-                    degree.value if degree else "",
-                    similarity,
-                    statement=wanted,
-                )
-            )
+            bindings.append(bound)
         goals: list[Binding] = []
         offered_outputs = list(zip(parameter_names(ad.outputs), ad.outputs, strict=True))
         for wanted_name, wanted_output in zip(parameter_names(requirement.outputs), requirement.outputs, strict=True):
@@ -296,20 +286,10 @@ class Composer:
                 )
             )
         for effect in requirement.effects:
-            stated = next((e for e in ad.effects if self.matcher.statement(effect, e) is not None), None)
-            if stated is None:
+            bound = self._statement_binding(effect, ad.effects, lambda stated: Source(stated, 1))
+            if bound is None:
                 return None
-            degree, similarity = self.matcher.statement(effect, stated) or (None, 0.0)
-            goals.append(
-                Binding(
-                    "precondition",
-                    statement_text(effect),
-                    Source(statement_text(stated), 1),
-                    degree.value if degree else "",
-                    similarity,
-                    statement=effect,
-                )
-            )
+            goals.append(bound)
         step = PlanStep(
             index=1,
             component=ad.iri,
@@ -323,6 +303,24 @@ class Composer:
             cost=self.pool.vertices[ad.iri].cost if ad.iri in self.pool.vertices else self.config.default_cost,
         )
         return Plan(task.name, requirement.iri, "matched", (step,), tuple(goals), score, step.cost)
+
+    def _statement_binding(
+        self, wanted: Statement, offered: Sequence[Statement], source: Callable[[str], Source]
+    ) -> Binding | None:
+        """A binding of ``wanted`` to the first of ``offered`` that meets it, or None."""
+        for candidate in offered:
+            match = self.matcher.statement(wanted, candidate)
+            if match is not None:
+                degree, similarity = match
+                return Binding(
+                    "precondition",
+                    statement_text(wanted),
+                    source(statement_text(candidate)),
+                    degree.value,
+                    similarity,
+                    statement=wanted,
+                )
+        return None
 
     def _decomposable(self, task: Task) -> bool:
         """Whether every sub-action of the task is stated as a requirement of its own.
