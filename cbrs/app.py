@@ -25,6 +25,7 @@ class App:
                 self.store_location,
                 remote_timeout=setting("remote_timeout").resolve(),
                 check_timeout=setting("query_check_timeout").resolve(),
+                remote_access=setting("federation_allow").resolve(),
             )
         return self._kb
 

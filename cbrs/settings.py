@@ -49,6 +49,9 @@ def _origins(text: str) -> tuple[str, ...]:
     return tuple(origin.strip() for origin in text.split(",") if origin.strip())
 
 
+_prefixes = _origins  # a comma-separated list of IRI prefixes reads the same way
+
+
 @dataclass(frozen=True)
 class Setting:
     name: str
@@ -136,6 +139,14 @@ SETTINGS: tuple[Setting, ...] = (
         "before it reaches the store; texts that crash or outlast it are refused (docs/security.md).",
         "CBRS_QUERY_CHECK_TIMEOUT",
         _positive(float),
+    ),
+    Setting(
+        "federation_allow",
+        lambda: (),
+        "Comma-separated IRI prefixes that SPARQL SERVICE (federated queries) and LOAD may reach; none by "
+        "default, so no request can make the server fetch a URL, read a file or probe the network.",
+        "CBRS_FEDERATION_ALLOW",
+        _prefixes,
     ),
     Setting(
         "remote_timeout",

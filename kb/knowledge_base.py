@@ -35,11 +35,13 @@ class KnowledgeBase:
         seed: bool = True,
         remote_timeout: float | None = None,
         check_timeout: float | None = None,
+        remote_access: tuple[str, ...] = (),
     ) -> KnowledgeBase:
         """Open the store at ``location`` (a directory, ``:memory:`` or an endpoint URL), seeding it on first use.
 
         ``check_timeout`` bounds how long an embedded store's query guard checks a long text (see
-        :mod:`kb.query_guard`).
+        :mod:`kb.query_guard`); ``remote_access`` lists the IRI prefixes a SERVICE or LOAD may reach
+        (:mod:`kb.remote_access`; none by default).
         """
         if remote_timeout is not None and is_remote(str(location)):
             from kb.remote_store import RemoteStore  # only a remote store needs the HTTP client
@@ -47,6 +49,7 @@ class KnowledgeBase:
             store: Store = RemoteStore.open(location, remote_timeout)
         else:
             store = Store.open(location)
+        store.remote_access = tuple(remote_access)
         if check_timeout is not None and isinstance(store, EmbeddedStore) and check_timeout != store.guard.timeout:
             store.guard = QueryGuard(timeout=check_timeout)
         kb = cls(store)

@@ -32,6 +32,7 @@ import pyoxigraph as ox
 
 from kb.errors import BindingError, QuerySyntaxError, RemoteStoreError, StoreError, StoreEvaluationError
 from kb.namespaces import PREFIXES, GraphName
+from kb.remote_access import refuse_remote_access
 from kb.store import QueryResult, Store, Term, data_block, refuse_deep_nesting
 
 DEFAULT_TIMEOUT = 60.0  # seconds to wait for an answer (the seed takes well under one)
@@ -133,6 +134,7 @@ class RemoteStore(Store):
     def query(self, text: str, bindings: Mapping[str, Term] | None = None) -> QueryResult:
         """Run a SPARQL query on the server, ``bindings`` sent as a leading ``VALUES`` block."""
         refuse_deep_nesting(text)
+        refuse_remote_access(text, self.remote_access)
         if not self._union_verified:
             self._check_union()
         sent = inject_values(text, bindings) if bindings else text
@@ -182,6 +184,7 @@ class RemoteStore(Store):
     def update(self, text: str) -> None:
         """Run a SPARQL update on the server in one request, hence one transaction."""
         refuse_deep_nesting(text)
+        refuse_remote_access(text, self.remote_access)
         self._update(text, original=text)
 
     # -- the wire ----------------------------------------------------------------------------

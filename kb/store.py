@@ -20,6 +20,7 @@ import pyoxigraph as ox
 from kb.errors import QuerySyntaxError, StoreError, StoreEvaluationError
 from kb.namespaces import GENID, PREFIXES, GraphName
 from kb.query_guard import QueryGuard
+from kb.remote_access import refuse_remote_access
 
 MEMORY = ":memory:"
 REMOTE_SCHEMES = ("http://", "https://")
@@ -53,6 +54,8 @@ class Store(ABC):
     """
 
     location: str
+    remote_access: tuple[str, ...] = ()
+    """IRI prefixes a SERVICE or LOAD may reach (:mod:`kb.remote_access`); none by default."""
 
     @classmethod
     def open(cls, location: str | Path) -> Store:
@@ -230,6 +233,7 @@ class EmbeddedStore(Store):
             ox.Variable(name): value for name, value in (bindings or {}).items()
         }
         refuse_deep_nesting(text)
+        refuse_remote_access(text, self.remote_access)
         self.guard.admit("query", text)
         try:
             return self._backend.query(
@@ -276,6 +280,7 @@ class EmbeddedStore(Store):
     def update(self, text: str) -> None:
         """Run a SPARQL update in one transaction."""
         refuse_deep_nesting(text)
+        refuse_remote_access(text, self.remote_access)
         self.guard.admit("update", text)
         self._apply_own_update(text)
 

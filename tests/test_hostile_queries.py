@@ -205,3 +205,16 @@ def test_cbrs_query_refuses_a_hostile_text_with_one_line(tmp_path: Path, text: s
     assert done.returncode == 1, done.stderr[-500:]
     assert done.stderr.startswith("Error: ") and len(done.stderr.strip().splitlines()) == 1
     assert "refused" in done.stderr or "nested" in done.stderr
+
+
+def test_service_and_load_reach_nothing_on_either_surface(served: Served) -> None:
+    service = "SELECT * WHERE { SERVICE <http://127.0.0.1:9/sparql> { ?s ?p ?o } }"
+    answer = served.client.post(served.sparql, data={"query": service})
+    assert answer.status_code == 400 and "federation_allow" in answer.text
+    load = served.client.post(
+        served.update, data={"update": "LOAD <file:///etc/passwd>"}, headers={"Authorization": f"Bearer {TOKEN}"}
+    )
+    assert load.status_code == 400 and "LOAD of <file:///etc/passwd> is refused" in load.text
+    response = bridge_query(served.bridge, service)
+    assert response["result"] is False and "federation_allow" in str(response["values"])
+    served.alive()
