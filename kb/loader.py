@@ -205,6 +205,7 @@ def expand_paths(paths: Sequence[str | Path]) -> list[Path]:
         if not path.is_dir():
             files.append(path)
             continue
+        found = len(files)
         for child in sorted(path.iterdir()):
             suffix = child.suffix.lower()
             if not child.is_file() or suffix not in FORMATS_BY_EXTENSION:
@@ -212,6 +213,11 @@ def expand_paths(paths: Sequence[str | Path]) -> list[Path]:
             if suffix == ".xml" and RDF.encode("ascii") not in _as_utf8(child.read_bytes()[:4096], str(child), False):
                 continue
             files.append(child)
+        if len(files) == found:
+            known = ", ".join(sorted(FORMATS_BY_EXTENSION))
+            raise RdfParseError(
+                str(path), f"a directory with no RDF file in it (extensions {known}); nothing was loaded"
+            )
     return files
 
 

@@ -168,7 +168,7 @@ class RemoteStore(Store):
         return sorted(row["g"].value for row in result if isinstance(row["g"], ox.NamedNode))
 
     def is_seeded(self) -> bool:
-        return bool(self._query(f"ASK {{ GRAPH {GraphName.ONTOLOGY.node} {{ }} }}"))
+        return bool(self._query(f"ASK {{ GRAPH {GraphName.ONTOLOGY.node} {{ ?s ?p ?o }} }}"))
 
     # -- writing ---------------------------------------------------------------------------
 

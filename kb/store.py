@@ -97,7 +97,7 @@ class Store(ABC):
 
     @abstractmethod
     def is_seeded(self) -> bool:
-        """Whether the ontology graph exists (the bundled data was loaded)."""
+        """Whether the ontology graph holds anything (the bundled data was loaded and not deleted)."""
 
     def dump(self, rdf_format: ox.RdfFormat = ox.RdfFormat.N_QUADS) -> bytes:
         """The whole dataset, serialised; N-Quads sorted, so two dumps compare byte for byte."""
@@ -261,7 +261,8 @@ class EmbeddedStore(Store):
         return sorted(g.value for g in self._backend.named_graphs() if isinstance(g, ox.NamedNode))
 
     def is_seeded(self) -> bool:
-        return self._backend.contains_named_graph(GraphName.ONTOLOGY.node)
+        # a graph emptied by an update still exists in Oxigraph: what counts is that it holds something
+        return next(iter(self._backend.quads_for_pattern(None, None, None, GraphName.ONTOLOGY.node)), None) is not None
 
     def dump(self, rdf_format: ox.RdfFormat = ox.RdfFormat.N_QUADS) -> bytes:
         if rdf_format == ox.RdfFormat.N_QUADS:

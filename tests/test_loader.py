@@ -141,3 +141,21 @@ def test_on_disk_store_keeps_what_was_loaded(tmp_path: Path) -> None:
     reopened = Store.open(location)
     assert reopened.count() == count
     assert reopened.is_seeded()
+
+
+def test_a_directory_with_no_rdf_file_is_an_error_not_a_silent_success(tmp_path: Path) -> None:
+    (tmp_path / "notes.txt").write_text("not RDF", encoding="utf-8")
+    kb = KnowledgeBase.open(":memory:")
+    before = kb.store.dump()
+    with pytest.raises(RdfParseError, match="a directory with no RDF file in it"):
+        kb.load([tmp_path])
+    assert kb.store.dump() == before
+
+
+def test_a_store_emptied_by_an_update_is_seeded_again_on_open(tmp_path: Path) -> None:
+    kb = KnowledgeBase.open(tmp_path / "store")
+    kb.update("DELETE { GRAPH ?g { ?s ?p ?o } } WHERE { GRAPH ?g { ?s ?p ?o } }")
+    assert kb.store.count() == 0 and not kb.store.is_seeded()
+    kb.store.close()
+    again = KnowledgeBase.open(tmp_path / "store")
+    assert again.store.is_seeded() and again.store.count() > 1000
