@@ -194,10 +194,9 @@ class TaskRunner:
 
     def components(self) -> list[str]:
         """The IRIs of the simulated components, which a run may be told to fail."""
-        from sim.components import implementations
+        from sim.components import simulated
 
-        with self.lock:
-            return sorted(implementations(self.kb).names())
+        return simulated(self.kb)
 
     def start(self, task: str, seed: int = 0, faults: Iterable[str] = (), fault_rate: float = 0.0) -> TaskRun:
         """Check ``task`` and ``faults``, then run the task in the background; returns at once.
@@ -363,9 +362,9 @@ def _jpeg(rgb: Any) -> bytes:
 def _check_components(kb: KnowledgeBase, failing: tuple[str, ...]) -> None:
     if not failing:
         return
-    from sim.components import implementations
+    from sim.components import simulated
 
-    known = implementations(kb)
+    known = set(simulated(kb))
     unknown = [shorten(f) for f in failing if f not in known]
     if unknown:
         raise UnknownComponentError(unknown)

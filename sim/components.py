@@ -62,7 +62,7 @@ from sim.values import (
 )
 from sim.world import HomeWorld
 
-__all__ = ["GraspPlan", "SimContext", "SimEnvironment", "designator", "implementations"]
+__all__ = ["GraspPlan", "SimContext", "SimEnvironment", "designator", "implementations", "simulated"]
 
 HOME = PREFIXES["home"]
 LOCALISATION_TOLERANCE = 0.10
@@ -415,6 +415,13 @@ SKILLS: dict[str, Work] = {
     "DeliverObject": deliver,
 }
 """The simulated skill behind each service name; the device comes from the advertisement."""
+
+
+def simulated(kb: KnowledgeBase) -> list[str]:
+    """The advertisements the simulation has a skill for, by one named query (no descriptions read):
+    what a run may be told to fail, listed at once for the tasks page."""
+    rows = kb.select("advertisements")
+    return sorted(row["service"].value for row in rows if "serviceName" in row and row["serviceName"].value in SKILLS)
 
 
 def implementations(kb: KnowledgeBase, world: HomeWorld | None = None, registry: Registry | None = None) -> Registry:
