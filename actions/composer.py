@@ -95,7 +95,18 @@ class Unsatisfied:
         via = f" (on the way to {' <- '.join(self.chain)})" if len(self.chain) > 1 else ""
         if self.cycle:
             return f"only a cycle of components provides {self.need} of {consumer}{via}"
-        return f"no component provides {self.need} of {consumer}{via}"
+        return f"no component provides {self.need} of {consumer}{via}; {self.remedy()}"
+
+    def remedy(self) -> str:
+        """What to register or state so that this need is met."""
+        if self.need.startswith("precondition "):
+            statement = self.need.removeprefix("precondition ")
+            return (
+                f"register a component whose effect is {statement}, or state it as a precondition of the task "
+                "or a fact of the semantic map"
+            )
+        concept = self.need.rsplit("(", 1)[-1].rstrip(")") if "(" in self.need else self.need
+        return f"register a component whose output is a {concept}, or give one as an input of the task"
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -104,6 +115,7 @@ class Unsatisfied:
             "chain": list(self.chain),
             "cycle": self.cycle,
             "text": self.text(),
+            "remedy": self.remedy(),
         }
 
 

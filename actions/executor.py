@@ -102,8 +102,14 @@ class Unmet:
         tried = "; ".join(f"{local_name(a.component)}: {a.reason}" for a in self.tried) or "none"
         return (
             f"requirement {local_name(self.requirement)} not met: no component could provide {what}"
-            f" for {', '.join(self.needed_by) or 'the plan'} (step {self.step}{part}; tried {tried})"
+            f" for {', '.join(self.needed_by) or 'the plan'} (step {self.step}{part}; tried {tried});"
+            f" {self.remedy()}"
         )
+
+    def remedy(self) -> str:
+        """What would let a new run get past this step."""
+        broken = ", ".join(dict.fromkeys(local_name(a.component) for a in self.tried)) or "its component"
+        return f"repair {broken} or register another component that provides {', '.join(self.provides) or 'it'}"
 
     def to_dict(self) -> dict[str, Any]:
         return {

@@ -84,6 +84,9 @@ def test_failure_without_alternative_names_the_step() -> None:
     assert "step 15 (DeliverObject_P3DX01) failed with no alternative left" in result.replans[0].reason
     assert "(DeliverObject_P3DX01) failed with no alternative left" in result.report.reason
     assert "DeliverObject_P3DX01: out of order since it failed earlier (InjectedFault" in result.report.reason
+    assert result.report.reason.endswith(
+        "repair DeliverObject_P3DX01 or register another component that provides (home:Pen, home:isWith, home:Person)"
+    )
 
 
 def chaos_policies(wanted: int, doomed: bool) -> list[RandomFaults]:

@@ -170,6 +170,7 @@ def test_cli_plan_json_and_exit_codes(tmp_path: Path) -> None:
     failed = runner.invoke(cli, ["--store", store, "plan", "FetchMyPen"])
     assert failed.exit_code == 1
     assert "no component provides" in failed.output and "isWith" in failed.output
+    assert "register a component whose effect is (home:Pen, home:isWith, home:Person)" in failed.output
     unknown = runner.invoke(cli, ["--store", store, "plan", "Nope"])
     assert unknown.exit_code == 1 and "no requirement or action named 'Nope'" in unknown.output
     bad = runner.invoke(cli, ["--store", store, "plan", "FetchMyPen", "--draw", str(tmp_path / "g.pdf")])
