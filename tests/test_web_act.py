@@ -312,3 +312,21 @@ def test_camera_stream_sends_jpeg_parts_and_frames_rise_during_a_run(live: tuple
     assert max(seen) > 2 and seen == sorted(seen)
     still = client.get("/camera.jpg")
     assert still.mimetype == "image/jpeg" and int(still.headers["X-Frame"]) == max(seen)
+
+
+def test_the_steps_of_a_new_plan_follow_the_old_plans_steps() -> None:
+    from cbrs.web.tasks import steps
+
+    progress = "/cbrs/task_progress"
+    events = [
+        {"topic": progress, "event": "step_started", "step": 1, "component": "svc:A"},
+        {"topic": progress, "event": "step_failed", "step": 1, "component": "svc:A", "reason": "blocked"},
+        {"topic": progress, "event": "replanning", "plan": 2, "reason": "step 1 failed"},
+        {"topic": progress, "event": "step_started", "step": 1, "component": "svc:B"},
+        {"topic": progress, "event": "step_succeeded", "step": 1, "component": "svc:B"},
+    ]
+    rows = steps(events)
+    assert [(r["plan"], r["step"], r["tried"], r["status"]) for r in rows] == [
+        (1, 1, ["svc:A"], "failed"),
+        (2, 1, ["svc:B"], "succeeded"),
+    ]

@@ -182,12 +182,22 @@ def _detail(found: TaskRun) -> dict[str, Any]:
 
 
 def steps(events: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """One row per plan step from a run's progress events: the components tried, in order, and the outcome."""
-    rows: dict[int, dict[str, Any]] = {}
+    """One row per plan step from a run's progress events: the components tried, in order, and the
+    outcome; after a re-plan, the new plan's steps follow the old one's (``plan`` counts from 1)."""
+    rows: dict[tuple[int, int], dict[str, Any]] = {}
+    plan = 1
     for event in events:
-        if event.get("topic", "/cbrs/task_progress") != "/cbrs/task_progress" or event.get("event") not in STEP_EVENTS:
+        if event.get("topic", "/cbrs/task_progress") != "/cbrs/task_progress":
             continue
-        row = rows.setdefault(event["step"], {"step": event["step"], "tried": [], "status": "started", "reasons": []})
+        if event.get("event") == "replanning":
+            plan = int(event.get("plan", plan + 1))
+            continue
+        if event.get("event") not in STEP_EVENTS:
+            continue
+        row = rows.setdefault(
+            (plan, event["step"]),
+            {"plan": plan, "step": event["step"], "tried": [], "status": "started", "reasons": []},
+        )
         if event["event"] == "step_started":
             if event["component"] not in row["tried"]:
                 row["tried"].append(event["component"])
