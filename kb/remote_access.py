@@ -16,15 +16,10 @@ import re
 from collections.abc import Sequence
 
 from kb.errors import KnowledgeBaseError
+from kb.sparql_lexemes import HIDING
 
 _TOKEN = re.compile(
-    r'"""(?:[^"\\]|\\.|"(?!""))*"""'
-    r"|'''(?:[^'\\]|\\.|'(?!''))*'''"
-    r'|"(?:[^"\\\n]|\\.)*"'
-    r"|'(?:[^'\\\n]|\\.)*'"
-    r'|<[^<>"{}|^`\\\x00-\x20]*>'
-    r"|#[^\n]*"
-    r"|[?$][A-Za-z0-9_\u00b7-\uffff]+"
+    HIDING + r"|[?$][A-Za-z0-9_\u00b7-\uffff]+"
     r"|[A-Za-z_][\w.-]*:[^\s{}()<>;,\"']*"
     r"|[A-Za-z_][\w-]*"
     r"|\S",

@@ -21,6 +21,7 @@ from kb.errors import QuerySyntaxError, StoreError, StoreEvaluationError
 from kb.namespaces import GENID, PREFIXES, GraphName
 from kb.query_guard import QueryGuard
 from kb.remote_access import refuse_remote_access
+from kb.sparql_lexemes import HIDING
 
 MEMORY = ":memory:"
 REMOTE_SCHEMES = ("http://", "https://")
@@ -31,16 +32,7 @@ text. It is not what keeps the process alive (other constructs recurse as deeply
 :mod:`kb.query_guard` is."""
 
 # What can hide a bracket (strings, IRIs, comments) or is one; anything else is skipped.
-_LEXEME = re.compile(
-    r'"""(?:[^"\\]|\\.|"(?!""))*"""'
-    r"|'''(?:[^'\\]|\\.|'(?!''))*'''"
-    r'|"(?:[^"\\\n]|\\.)*"'
-    r"|'(?:[^'\\\n]|\\.)*'"
-    r'|<[^<>"{}|^`\\\x00-\x20]*>'
-    r"|#[^\n]*"
-    r"|[(){}\[\]]",
-    re.DOTALL,
-)
+_LEXEME = re.compile(HIDING + r"|[(){}\[\]]", re.DOTALL)
 
 Term = ox.NamedNode | ox.BlankNode | ox.Literal
 QueryResult = ox.QuerySolutions | ox.QueryBoolean | ox.QueryTriples
