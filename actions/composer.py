@@ -167,6 +167,7 @@ class Composer:
         self._advertisements = list(advertisements) if advertisements is not None else None
         self._pool: ServicePool | None = None
         self._belief = False
+        self._state: list[Statement] | None = None  # what holds, read once per compose
 
     @property
     def advertisements(self) -> list[Advertisement]:
@@ -193,6 +194,8 @@ class Composer:
         """What holds, as statements between classes: in the semantic map, and in the belief state when
         composing for a run that has just perceived it (``compose(task, belief=True)``); a belief left by
         an earlier run is not the state of the next one."""
+        if self._state is not None:  # composing: read once for all its attempts
+            return self._state
         graphs = [GraphName.MAP, GraphName.WORLD] if self._belief else [GraphName.MAP]
         return [
             Statement(row["subjectType"].value, row["relation"].value, row["objectType"].value)
@@ -202,11 +205,12 @@ class Composer:
 
     def compose(self, task: str | Task | Requirement, belief: bool = False) -> CompositionResult:
         """Plan ``task``; with ``belief``, from what the belief graph says holds now as well."""
-        self._belief = belief
+        self._belief, self._state = belief, None
         try:
+            self._state = self.world_state() if self.config.world_state else []
             return self._compose(task)
         finally:
-            self._belief = False
+            self._belief, self._state = False, None
 
     def _compose(self, task: str | Task | Requirement) -> CompositionResult:
         if isinstance(task, str):

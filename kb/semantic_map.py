@@ -229,8 +229,11 @@ class SemanticMap:
         affordances: dict[str, tuple[str, float]] = {}
         for row in kb.select("grasp_affordances"):  # nearest ancestor first
             affordances.setdefault(row["class"].value, (row["approach"].value, float(row["ratio"].value)))
-        containers = frozenset(row["thing"].value for row in kb.select("designate", {"class": HOME + "Container"}))
-        furniture = frozenset(row["thing"].value for row in kb.select("designate", {"class": HOME + "Furniture"}))
+
+        def things_of(concept: str) -> frozenset[str]:
+            return frozenset(row["thing"].value for row in kb.select("designate", {"class": HOME + concept}))
+
+        containers, furniture, people = things_of("Container"), things_of("Furniture"), things_of("Person")
         built = cls(
             types={k: tuple(v) for k, v in types.items()},
             facts={k: dict(v) for k, v in facts.items()},
@@ -238,7 +241,7 @@ class SemanticMap:
             furniture=furniture,
         )
         for iri, values in facts.items():
-            _classify(built, iri, values, tuple(types.get(iri, ())), affordances, facts)
+            _classify(built, iri, values, tuple(types.get(iri, ())), affordances, facts, iri in people)
         return built
 
 
@@ -279,6 +282,7 @@ def _classify(
     types: tuple[str, ...],
     affordances: dict[str, tuple[str, float]],
     facts: dict[str, dict[str, list[str]]],
+    person: bool,
 ) -> None:
     if HOME + "fieldOfView" in values:
         position = (_number(values, "x", iri), _number(values, "y", iri), _number(values, "z", iri))
@@ -324,7 +328,7 @@ def _classify(
             grasp[1] * size[2],
         )
         return
-    if HOME + "Person" in types or any(t.endswith("Person") for t in types):
+    if person:  # a home:Person by the taxonomy
         built.people[iri] = Person(
             iri,
             Pose(_number(values, "x", iri), _number(values, "y", iri), _number(values, "yaw", iri, 0.0)),

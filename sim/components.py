@@ -257,7 +257,8 @@ def approach(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[st
     estimate = decode(inputs["objectPosition"], ObjectEstimate)
     x, y, _ = estimate.position
     ctx.arm = _free_arm(ctx, x, y, f"the {model.name}")
-    ctx.grasp = compute_grasp_pose(model, estimate.position, estimate.yaw, ctx.world.arm_specs[ctx.arm].mount)
+    spec = ctx.world.arm_specs[ctx.arm]
+    ctx.grasp = compute_grasp_pose(model, estimate.position, estimate.yaw, spec.mount, spec.yaw)
     ctx.focus = model.name
     ctx.last_arm = ctx.arm
     _check(skills.approach_object(ctx.world, ctx.arm, ctx.grasp))
@@ -353,7 +354,9 @@ def locate(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str,
 def track(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     value = inputs.get("person")
     person = ctx.map.people.get(_iri(value, "the person")) if value is not None else ctx.world.person
-    shirt = person.colour if person is not None and person.colour else "yellow"
+    if person is None or not person.colour:
+        raise SkillFailed("the semantic map gives no colour to find the person by (home:colourName)")
+    shirt = person.colour
     return {"personPosition": to_json(track_person(ctx.world.camera(device).capture(), shirt))}
 
 

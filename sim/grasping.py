@@ -48,6 +48,7 @@ class ObjectModel:
         width = min(obj.size[0], obj.size[1]) if obj.shape == "cylinder" else obj.size[1]
         return cls(obj.name, obj.colour, obj.size[2], width, kind, obj.grasp_height)
 
+
 SIDE_PITCH = math.radians(35.0)
 """A side grasp comes in tilted down by 35 degrees: with the arms mounted below the grasp height, a
 level hand would need the wrist at its joint limit, while a tilted one keeps it mid-range."""
@@ -93,7 +94,9 @@ def side_orientation(approach_yaw: float, pitch: float = SIDE_PITCH) -> Quat:
     return quat_from_matrix(np.column_stack([x, y, z]))
 
 
-def compute_grasp_pose(model: ObjectModel, centre: Vec3, yaw: float | None, arm_mount: Vec3) -> GraspPose:
+def compute_grasp_pose(
+    model: ObjectModel, centre: Vec3, yaw: float | None, arm_mount: Vec3, facing: float = ARM_MOUNT_YAW
+) -> GraspPose:
     """The grasp for an object whose centre (and, for long objects, axis yaw) perception estimated.
 
     A side grasp comes in from the robot's side of the table; a top grasp closes the fingers across
@@ -104,10 +107,10 @@ def compute_grasp_pose(model: ObjectModel, centre: Vec3, yaw: float | None, arm_
     grasp_z = bottom + model.grasp_height
     if model.grasp is GraspKind.SIDE:
         # Straight in from the robot's side of the table, whatever the object's position.
-        orientation = side_orientation(ARM_MOUNT_YAW)
+        orientation = side_orientation(facing)
         approach: Vec3 = (
-            math.cos(ARM_MOUNT_YAW) * math.cos(SIDE_PITCH),
-            math.sin(ARM_MOUNT_YAW) * math.cos(SIDE_PITCH),
+            math.cos(facing) * math.cos(SIDE_PITCH),
+            math.sin(facing) * math.cos(SIDE_PITCH),
             -math.sin(SIDE_PITCH),
         )
     else:

@@ -156,5 +156,3 @@ KINECT_BODY = Region("Kinect01", 7.62, 7.88, 2.42, 2.48, 1.425, 1.475)
 KINECT_MAST = Region("KinectMast", 7.735, 7.765, 2.435, 2.465, TORSO.zmax, KINECT_BODY.zmin)
 
 MAP_RESOLUTION = 0.05
-
-

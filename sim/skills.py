@@ -28,7 +28,7 @@ from sim.grasping import (
     side_orientation,
     top_orientation,
 )
-from sim.layout import ARM_MOUNT_YAW, PERSON_HAND_HEIGHT, PLATFORM_HEIGHT
+from sim.layout import PERSON_HAND_HEIGHT, PLATFORM_HEIGHT
 from sim.perception import ObjectEstimate, PersonEstimate, RobotPoseEstimate
 from sim.planning import PlannedPath
 from sim.world import HomeWorld
@@ -239,8 +239,9 @@ def fill_cup_from_tap(world: HomeWorld, side: ArmSide | str, lever: Region, cont
     arm = _arm(world, side)
     if arm.held is not None:
         return _done(world, "FillCupFromTap", start, False, f"the {arm.side} gripper is holding something")
-    orientation = side_orientation(ARM_MOUNT_YAW)
-    approach = np.array([math.cos(ARM_MOUNT_YAW), math.sin(ARM_MOUNT_YAW), 0.0])
+    facing = world.arm_specs[ArmSide(side)].yaw  # the way the arm faces, from the semantic map
+    orientation = side_orientation(facing)
+    approach = np.array([math.cos(facing), math.sin(facing), 0.0])
     x, z = (lever.xmin + lever.xmax) / 2.0, (lever.zmin + lever.zmax) / 2.0
     press = np.array([x, lever.ymin + LEVER_PUSH, z])
     pre = press - approach * (LEVER_PUSH + PRESS_STANDOFF)
@@ -295,7 +296,7 @@ def hand_over_onto_platform(
         return _done(
             world, "HandOverOntoPlatform", start, False, f"the base's platform is out of the {side} arm's reach"
         )
-    grasp = compute_grasp_pose(model, pen.position, pen.yaw, mount)
+    grasp = compute_grasp_pose(model, pen.position, pen.yaw, mount, world.arm_specs[ArmSide(side)].yaw)
     region = platform_region(base)
     # The pen fits between the marker patches along or across the base: take the placement that
     # needs the smaller turn of the wrist.

@@ -632,7 +632,12 @@ class HomeWorld:
     def _build_base(self) -> None:
         bx, by, btheta = self.perturbation.base
         start = self.robot.start
-        front, rear = self.robot.marker_colours or ("green", "magenta")
+        if self.robot.marker_colours is None:
+            raise ValueError(
+                f"the semantic map gives {self.robot.name} no marker colours (home:hasMarker, with a node of "
+                "home:frontColourName and home:rearColourName): the ceiling cameras could not find it"
+            )
+        front, rear = self.robot.marker_colours
         bottom = 0.02
         chassis_half = (L.BASE_HALF_LENGTH, L.BASE_HALF_WIDTH, (L.PLATFORM_HEIGHT - 0.02 - bottom) / 2)
         chassis_centre_z = bottom + chassis_half[2]
