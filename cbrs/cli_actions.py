@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import json
+import os
+import socket
+import sys
 import time
 from collections import Counter
 from pathlib import Path
@@ -157,6 +160,12 @@ def run(
     from sim.recording import Recorder, RecordingError, check_target
     from sim.world import open_world
 
+    if gui:
+        missing = display_problem(os.environ)
+        if missing:  # pybullet would exit the process with status 1, saying nothing useful
+            raise click.UsageError(
+                f"--gui needs a display, but {missing}; run without --gui (headless), or under xvfb-run"
+            )
     if record is not None:
         try:  # an unknown format, or a video with no ffmpeg, fails before anything runs
             check_target(record)
@@ -218,6 +227,43 @@ def run(
             )
     if not result.succeeded:
         raise SystemExit(1)
+
+
+def display_problem(environ: dict[str, str] | os._Environ[str]) -> str | None:
+    """Why pybullet's window could not open here (None when an X display looks reachable).
+
+    Only X11 needs checking: on macOS and Windows pybullet opens its own window.
+    """
+    if not sys.platform.startswith("linux"):
+        return None
+    display = environ.get("DISPLAY", "")
+    if not display:
+        return "DISPLAY is not set (no X server to show the window on)"
+    host, _, rest = display.rpartition(":")
+    number = rest.split(".", 1)[0]
+    if not number.isdigit():
+        return f"DISPLAY={display!r} is not an X display name such as :0"
+    if host in ("", "unix"):
+        path = f"/tmp/.X11-unix/X{number}"
+        if os.path.exists(path) or _abstract_socket_answers(path):
+            return None
+        return f"no X server listens on DISPLAY={display} (no {path})"
+    try:
+        socket.create_connection((host, 6000 + int(number)), timeout=2).close()
+    except OSError as error:
+        return f"the X server of DISPLAY={display} cannot be reached ({error.strerror or error})"
+    return None
+
+
+def _abstract_socket_answers(path: str) -> bool:
+    """Whether an X server listens on Linux's abstract socket of that name (as Xorg also does)."""
+    with socket.socket(socket.AF_UNIX, socket.SOCK_STREAM) as probe:
+        probe.settimeout(2)
+        try:
+            probe.connect("\0" + path)
+        except OSError:
+            return False
+    return True
 
 
 def _planned(policy: RandomFaults, result: RunResult) -> list[dict[str, Any]]:

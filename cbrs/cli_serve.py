@@ -2,14 +2,16 @@
 
 from __future__ import annotations
 
+import errno
 import ipaddress
 import logging
+import socket
 from pathlib import Path
 
 import click
 
 from cbrs.app import App, pass_app
-from cbrs.settings import setting
+from cbrs.settings import LOG_LEVELS, setting
 from cbrs.sparql_service import EndpointConfig
 
 
@@ -30,6 +32,9 @@ def _help(name: str) -> str:
 )
 @click.option("--read-only", is_flag=True, default=None, help=_help("read_only"))
 @click.option("--cors-origin", "cors_origins", multiple=True, metavar="ORIGIN", help=_help("cors_origins"))
+@click.option(
+    "--log-level", type=click.Choice(LOG_LEVELS, case_sensitive=False), help=_help("log_level") + " [default INFO]"
+)
 @pass_app
 def serve(
     app: App,
@@ -39,6 +44,7 @@ def serve(
     update_token_file: Path | None,
     read_only: bool | None,
     cors_origins: tuple[str, ...],
+    log_level: str | None,
 ) -> None:
     """Serve the knowledge base: SPARQL 1.1 at /sparql on the HTTP port, rosbridge v2 on the bridge port.
 
@@ -48,7 +54,9 @@ def serve(
     """
     from cbrs.server import ServeConfig, Server  # waitress and websockets load only for this command
 
-    logging.basicConfig(level=logging.INFO, format="%(asctime)s %(name)s %(levelname)s: %(message)s")
+    level = setting("log_level").resolve(log_level.upper() if log_level else None)
+    logging.basicConfig(format="%(asctime)s %(name)s %(levelname)s: %(message)s")
+    logging.getLogger().setLevel(level)  # also when something has configured logging before
     config = ServeConfig(
         host=setting("host").resolve(host),
         port=setting("port").resolve(port),
@@ -65,6 +73,8 @@ def serve(
     )
     if not _is_loopback(config.host):
         click.echo(f"warning: listening on {config.host}, reachable from other machines", err=True)
+    _check_free(config.host, config.port, "--port", "CBRS_PORT")
+    _check_free(config.host, config.bridge_port, "--bridge-port", "CBRS_BRIDGE_PORT")
     server = Server(app.kb, config)
 
     def ready(running: Server) -> None:
@@ -81,8 +91,35 @@ def serve(
         click.echo(f"  rosbridge ws://{host_text}:{running.bridge_port}")
         click.echo("Ctrl-C stops.", nl=True)
 
-    server.serve_forever(ready)
+    try:
+        server.serve_forever(ready)
+    except OSError as error:  # a port taken between the check above and the listen, or a host not ours
+        raise click.ClickException(
+            f"cannot listen on {config.host} (HTTP port {config.port}, bridge port {config.bridge_port}): "
+            f"{error.strerror or error}"
+        ) from None
     click.echo("stopped")
+
+
+def _check_free(host: str, port: int, option: str, env: str) -> None:
+    """Fail with a message naming the port when it cannot be listened on (port 0 always can)."""
+    if port == 0:
+        return
+    try:
+        family, kind, proto, _, address = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)[0]
+    except socket.gaierror as error:
+        raise click.BadParameter(f"cannot resolve host {host!r}: {error}", param_hint="--host") from None
+    with socket.socket(family, kind, proto) as probe:
+        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)  # as both listeners do
+        try:
+            probe.bind(address)
+        except OSError as error:
+            if error.errno == errno.EADDRINUSE:
+                raise click.ClickException(
+                    f"port {port} on {host} is already in use (another cbrs serve?); stop that process or "
+                    f"choose another port with {option} or {env} (0 picks a free one)"
+                ) from None
+            raise click.ClickException(f"cannot listen on {host} port {port}: {error.strerror or error}") from None
 
 
 def _read_token(path: Path | None) -> str | None:

@@ -52,6 +52,16 @@ def _origins(text: str) -> tuple[str, ...]:
 _prefixes = _origins  # a comma-separated list of IRI prefixes reads the same way
 
 
+LOG_LEVELS = ("DEBUG", "INFO", "WARNING", "ERROR", "CRITICAL")
+
+
+def _log_level(text: str) -> str:
+    level = text.strip().upper()
+    if level not in LOG_LEVELS:
+        raise ValueError(f"{text!r} is not a log level ({', '.join(LOG_LEVELS)})")
+    return level
+
+
 @dataclass(frozen=True)
 class Setting:
     name: str
@@ -176,6 +186,13 @@ SETTINGS: tuple[Setting, ...] = (
         "websocket, besides the server's own pages; none by default.",
         "CBRS_CORS_ORIGINS",
         _origins,
+    ),
+    Setting(
+        "log_level",
+        lambda: "INFO",
+        "Lowest level of the log lines cbrs serve writes to standard error: " + ", ".join(LOG_LEVELS) + ".",
+        "CBRS_LOG_LEVEL",
+        _log_level,
     ),
 )
 

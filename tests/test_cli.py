@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import json
+import logging
+import socket
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -236,3 +239,60 @@ def test_register_update_deregister_round_trip(tmp_path: Path) -> None:
     code, out = run("deregister", "svc:LocateMobileRobot_CeilingCamera03", store=location)
     assert code == 0 and out.startswith("deregistered svc:LocateMobileRobot_CeilingCamera03")
     assert run("query", "SELECT (COUNT(*) AS ?n) WHERE { GRAPH ?g { ?s ?p ?o } }", store=location) == before
+
+
+# -- serving and running where the machine says no ------------------------------------------------
+
+
+@pytest.fixture
+def taken_port() -> Iterator[int]:
+    """A loopback port another process (here: this one) is listening on."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as holder:
+        holder.bind(("127.0.0.1", 0))
+        holder.listen(1)
+        yield holder.getsockname()[1]
+
+
+@pytest.mark.parametrize(
+    ("option", "hint"), [("--port", "--port or CBRS_PORT"), ("--bridge-port", "--bridge-port or CBRS_BRIDGE_PORT")]
+)
+def test_serve_on_a_port_in_use_names_the_port(taken_port: int, option: str, hint: str) -> None:
+    other = "--bridge-port" if option == "--port" else "--port"
+    code, out = run("serve", option, str(taken_port), other, "0", store=":memory:")
+    assert code == 1, out
+    assert f"Error: port {taken_port} on 127.0.0.1 is already in use" in out
+    assert hint in out and "internal error" not in out
+
+
+def test_serve_takes_its_log_level_from_the_setting(monkeypatch: pytest.MonkeyPatch) -> None:
+    root = logging.getLogger()
+    monkeypatch.setattr(root, "level", root.level)  # restored afterwards
+    monkeypatch.setattr("cbrs.server.Server.serve_forever", lambda self, ready=None: None)
+    code, out = run("serve", "--port", "0", "--bridge-port", "0", store=":memory:", env={"CBRS_LOG_LEVEL": "warning"})
+    assert code == 0, out
+    assert root.level == logging.WARNING
+    code, out = run("serve", "--log-level", "debug", "--port", "0", "--bridge-port", "0", store=":memory:")
+    assert code == 0 and root.level == logging.DEBUG
+    code, out = run("serve", store=":memory:", env={"CBRS_LOG_LEVEL": "loud"})
+    assert code == 1 and "CBRS_LOG_LEVEL='loud': 'loud' is not a log level (DEBUG, INFO" in out
+
+
+@pytest.mark.parametrize(
+    ("environ", "reason"),
+    [
+        pytest.param({}, "DISPLAY is not set", id="unset"),
+        pytest.param({"DISPLAY": ":987"}, "no X server listens on DISPLAY=:987", id="no-server"),
+        pytest.param({"DISPLAY": "wayland"}, "is not an X display name", id="malformed"),
+    ],
+)
+def test_run_gui_without_a_display_says_why(
+    monkeypatch: pytest.MonkeyPatch, environ: dict[str, str], reason: str
+) -> None:
+    if not sys.platform.startswith("linux"):
+        pytest.skip("only X11 needs a display found first")
+    monkeypatch.delenv("DISPLAY", raising=False)
+    for name, value in environ.items():
+        monkeypatch.setenv(name, value)
+    code, out = run("run", "FetchMyPen", "--gui", store=":memory:")
+    assert code != 0
+    assert "--gui needs a display" in out and reason in out and "xvfb-run" in out
