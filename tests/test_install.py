@@ -4,13 +4,61 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import subprocess
 import sys
+import tomllib
 from pathlib import Path
 
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
+PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+TOP_LEVEL = sorted({name.split(".")[0] for name in PYPROJECT["tool"]["setuptools"]["packages"]})
+
+
+def test_every_top_level_package_ships_py_typed() -> None:
+    # PEP 561: the marker in a top-level package covers its subpackages.
+    package_data = PYPROJECT["tool"]["setuptools"]["package-data"]
+    for package in TOP_LEVEL:
+        assert (ROOT / package / "py.typed").is_file(), f"{package}/py.typed is missing"
+        assert "py.typed" in package_data.get(package, []), f"package-data does not install {package}/py.typed"
+
+
+def test_licence_file_matches_the_declared_licence() -> None:
+    project = PYPROJECT["project"]
+    assert project["license"] == "MIT" and project["license-files"] == ["LICENSE"]
+    text = (ROOT / "LICENSE").read_text(encoding="utf-8")
+    assert text.startswith("MIT License") and "Permission is hereby granted, free of charge" in text
+
+
+def test_changelog_has_a_section_for_the_current_version() -> None:
+    from cbrs import __version__
+
+    text = (ROOT / "CHANGELOG.md").read_text(encoding="utf-8")
+    assert re.search(rf"^## \[?{re.escape(__version__)}\]?", text, re.MULTILINE), f"no section for {__version__}"
+    assert re.search(r"^## \[?Unreleased\]?", text, re.MULTILINE)
+
+
+def _runtime_imports() -> set[str]:
+    """Top-level modules imported by the installed packages' code (not tests, not bench)."""
+    found: set[str] = set()
+    pattern = re.compile(r"^\s*(?:from|import)\s+([A-Za-z_]\w*)", re.MULTILINE)
+    for package in TOP_LEVEL:
+        for path in (ROOT / package).rglob("*.py"):
+            found.update(pattern.findall(path.read_text(encoding="utf-8")))
+    return found
+
+
+def test_runtime_dependencies_are_what_runtime_code_imports() -> None:
+    import_names = {"pillow": "PIL", "scikit-learn": "sklearn"}
+    declared = {re.split(r"[<>=!~\[ ]", dep, maxsplit=1)[0].lower() for dep in PYPROJECT["project"]["dependencies"]}
+    imported = _runtime_imports()
+    unused = sorted(dep for dep in declared if import_names.get(dep, dep).replace("-", "_") not in imported)
+    assert not unused, f"declared but imported by no runtime code: {unused}"
+    provided = {import_names.get(dep, dep).replace("-", "_") for dep in declared} | set(TOP_LEVEL)
+    undeclared = sorted(imported - provided - set(sys.stdlib_module_names) - {"__future__"})
+    assert not undeclared, f"imported by runtime code but not a declared dependency: {undeclared}"
 
 
 @pytest.mark.slow
