@@ -35,6 +35,8 @@ def plans() -> Page:
     with context.lock():  # a GET stays safe: the plan is shown, not recorded (cbrs plan and /cbrs/plan record)
         result = _compose(task, objective, shown)
     data["composition"] = _composition(result)
+    # The page only shows the plan; link the plans graph's copy only when one was recorded (cbrs plan).
+    data["recorded"] = result.plan is not None and context.kb().describes(result.plan.iri)
     data["graph"] = url_for("plans.graph", task=task, objective=objective)
     return shown
 
