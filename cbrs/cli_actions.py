@@ -16,11 +16,11 @@ import click
 from actions.composer import ComposeConfig, Composer, CompositionResult, Objective, PlanStatus, store_plan
 from actions.events import Event
 from actions.faults import RandomFaults, planned_faults
-from actions.model import ActionLibrary, resolve_task
 from actions.plan import Binding, Plan
 from actions.runner import RunResult, run_task
 from cbrs.app import App, parse_iri, pass_app
 from cbrs.output import table
+from cbrs.task_names import task_iri
 from kb import KnowledgeBase
 from kb.namespaces import shorten
 
@@ -51,7 +51,7 @@ def plan(app: App, task: str, as_json: bool, drawing: Path | None, objective: st
     if drawing is not None and drawing.suffix.lower() not in (".svg", ".png"):
         raise click.BadParameter(f"{drawing.name!r} must end in .svg or .png", param_hint="--draw")
     composer = Composer(app.kb, ComposeConfig(objective=Objective(objective)))
-    result = composer.compose(task)
+    result = composer.compose(task_iri(app.kb, task))
     if result.plan is not None and not no_store:
         store_plan(app.kb, result.plan)
     if drawing is not None:
@@ -172,7 +172,7 @@ def run(
         except RecordingError as error:
             raise click.BadParameter(str(error), param_hint="--record") from None
     failing = [parse_iri(f, "--fail") for f in faults]
-    resolve_task(app.kb, ActionLibrary.from_kb(app.kb), task)  # an unknown task fails before the world is built
+    iri = task_iri(app.kb, task)  # an unknown task fails before the world is built
 
     start = time.perf_counter()
     recorder: Recorder | None = None
@@ -194,7 +194,7 @@ def run(
         if recorder is not None:
             recorder.start()
         try:
-            result = run_task(app.kb, task, environment, failing, on_event=follow, fault_policy=policy)
+            result = run_task(app.kb, iri, environment, failing, on_event=follow, fault_policy=policy)
         finally:
             if recorder is not None:
                 recorder.stop()

@@ -14,6 +14,8 @@ from click.testing import CliRunner
 
 from cbrs import __version__
 from cbrs.cli import cli, main
+from cbrs.task_names import task_iri
+from kb import KnowledgeBase
 
 BAD = Path(__file__).parent / "data" / "bad"
 DATA = Path(__file__).parent / "data"
@@ -296,3 +298,63 @@ def test_run_gui_without_a_display_says_why(
     code, out = run("run", "FetchMyPen", "--gui", store=":memory:")
     assert code != 0
     assert "--gui needs a display" in out and reason in out and "xvfb-run" in out
+
+
+# -- task names ------------------------------------------------------------------------------------
+
+LAB_TASK = """@prefix cbrs: <https://w3id.org/cbrs/core#> . @prefix home: <https://w3id.org/cbrs/home#> .
+@prefix lab: <http://example.org/lab#> .
+lab:WhereIsMyRobot a cbrs:Requirement ; cbrs:deviceName "P3DX01" ; cbrs:serviceName "WhereIsMyRobot" ;
+  cbrs:hasOWLSModel [ cbrs:hasInput [ cbrs:parameterType home:ColourOfMarker ] ;
+                      cbrs:hasOutput [ cbrs:parameterType home:RobotPosition ] ] .
+"""
+
+
+@pytest.fixture(scope="module")
+def lab_store(tmp_path_factory: pytest.TempPathFactory) -> str:
+    """A store with a requirement under a namespace of its own, and one whose name a lab namespace shares."""
+    folder = tmp_path_factory.mktemp("lab")
+    (folder / "lab.ttl").write_text(
+        LAB_TASK + LAB_TASK.replace("lab#>", "lab2#>").replace("Robot a", "Robot2 a"), "utf-8"
+    )
+    location = str(folder / "store")
+    code, out = run("load", "--graph", "requirements", str(folder / "lab.ttl"), store=location)
+    assert code == 0, out
+    return location
+
+
+def test_a_listed_task_of_another_namespace_plans_by_its_bare_name(lab_store: str) -> None:
+    code, out = run("plan", "WhereIsMyRobot", "--no-store", store=lab_store)
+    assert code == 0, out
+    assert out.startswith("http://example.org/lab#WhereIsMyRobot: planned")
+    code, out = run("plan", "<http://example.org/lab2#WhereIsMyRobot2>", "--no-store", store=lab_store)
+    assert code == 0, out
+
+
+@pytest.mark.parametrize(
+    ("command", "name", "message"),
+    [
+        ("plan", "WhereIsMyRobt", "no requirement or action named 'WhereIsMyRobt'; did you mean WhereIsMyRobot"),
+        ("run", "RobotSelfPositon", "did you mean RobotSelfPosition?"),
+        ("plan", "fetchmypen", "did you mean FetchMyPen or act:FetchMyPen?"),
+        ("plan", "MakeCoffee", "no requirement or action named 'MakeCoffee'. Known tasks: FallDownAlert"),
+    ],
+)
+def test_an_unknown_task_gets_a_did_you_mean(lab_store: str, command: str, name: str, message: str) -> None:
+    code, out = run(command, name, store=lab_store)
+    assert code == 1 and message in out, out
+    known = out.split("Known tasks: ", 1)[1].strip().split(", ")
+    assert "WhereIsMyRobot" in known and "RobotSelfPosition" in known
+
+
+def test_every_listed_task_name_resolves(lab_store: str) -> None:
+    _, out = run("plan", "NoSuchTask", store=lab_store)
+    listed = out.split("Known tasks: ", 1)[1].strip().split(", ")
+    assert "WhereIsMyRobot2" in listed and "act:FetchMyPen" in listed
+    kb = KnowledgeBase.open(lab_store)
+    try:
+        resolved = {name: task_iri(kb, name) for name in listed}  # TaskNameError for any that does not
+    finally:
+        kb.close()
+    assert resolved["WhereIsMyRobot2"] == "http://example.org/lab2#WhereIsMyRobot2"
+    assert len(set(resolved.values())) == len(listed)

@@ -12,6 +12,7 @@ from flask import Blueprint, Response, request, url_for
 from actions.composer import ComposeConfig, Composer, CompositionResult, Objective
 from actions.errors import UnknownTaskError
 from actions.model import ActionLibrary
+from cbrs.task_names import task_iri
 from cbrs.web import context
 from cbrs.web.pages import FormError, Page, page
 from kb.namespaces import shorten
@@ -60,12 +61,9 @@ def _compose(task: str, objective: str, shown: Page | None) -> CompositionResult
         raise FormError({"task": "choose a task: a requirement or an action"}, page=shown)
     composer = Composer(context.kb(), ComposeConfig(objective=Objective(objective)))
     try:
-        return composer.compose(task)
-    except UnknownTaskError as error:
-        known = ", ".join(error.known)
-        raise FormError(
-            {"task": f"no requirement or action named {task!r}; known tasks: {known}"}, page=shown
-        ) from None
+        return composer.compose(task_iri(context.kb(), task))
+    except UnknownTaskError as error:  # says what was meant and how to type every known task
+        raise FormError({"task": str(error)}, page=shown) from None
 
 
 def _svg(result: CompositionResult) -> bytes:

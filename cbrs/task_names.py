@@ -1,0 +1,110 @@
+"""Task names as a person types them: a bare local name of any namespace, a prefixed name or an IRI.
+
+The composer resolves a bare name in the bundled namespaces only (``req:NAME``, then ``act:NAME``); a
+task loaded under its own namespace (``lab:FetchMyCup``) is listed by its local name, so a listed name
+must resolve too. :func:`task_iri` turns what was typed into the IRI the composer is given, or fails
+with a did-you-mean and every known task spelt as it can be typed.
+"""
+
+from __future__ import annotations
+
+import difflib
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from actions.errors import UnknownTaskError
+from actions.model import ActionLibrary
+from kb import KnowledgeBase
+from kb.namespaces import expand, shorten
+from kb.owls import local_name
+
+
+class TaskNameError(UnknownTaskError):
+    """No task (or more than one) answers to ``name``; ``suggestions`` are the likeliest meant."""
+
+    def __init__(self, name: str, known: Sequence[str], suggestions: Sequence[str], ambiguous: bool = False) -> None:
+        super().__init__(name, known)
+        self.suggestions = tuple(suggestions)
+        self.ambiguous = ambiguous
+        if ambiguous:
+            text = f"{name!r} names {len(suggestions)} tasks; type one of {', '.join(suggestions)}"
+        else:
+            hint = f"; did you mean {' or '.join(suggestions)}?" if suggestions else "."
+            text = f"no requirement or action named {name!r}{hint} Known tasks: {', '.join(known)}"
+        self.args = (text,)
+
+    def __str__(self) -> str:
+        return str(self.args[0])
+
+
+@dataclass(frozen=True)
+class _Task:
+    iri: str
+    listed: bool  # a requirement, or an action with sub-actions: what the known list shows
+
+
+def task_iri(kb: KnowledgeBase, name: str, library: ActionLibrary | None = None) -> str:
+    """The IRI of the requirement or action ``name`` means; :class:`TaskNameError` when there is none."""
+    tasks = _tasks(kb, library or ActionLibrary.from_kb(kb))
+    typed = name.strip()
+    if ":" in typed:
+        try:
+            iri = expand(typed)
+        except ValueError:
+            iri = ""
+        if any(task.iri == iri for task in tasks):
+            return iri
+    else:
+        found = _bare(typed, tasks)
+        if found is not None:
+            return found
+        named = sorted(task.iri for task in tasks if local_name(task.iri) == typed)
+        if named:
+            raise TaskNameError(name, _known(tasks), [_typed(iri, tasks) for iri in named], ambiguous=True)
+    raise TaskNameError(name, _known(tasks), _suggestions(typed, tasks))
+
+
+def _tasks(kb: KnowledgeBase, library: ActionLibrary) -> list[_Task]:
+    requirements = [_Task(row["requirement"].value, True) for row in kb.select("requirements")]
+    actions = [_Task(action.iri, bool(action.sub_actions)) for action in library]
+    return requirements + actions
+
+
+def _bare(name: str, tasks: Sequence[_Task]) -> str | None:
+    """The task a bare name means: ``req:NAME``, else ``act:NAME`` (as the composer tries them), else the
+    one task of any namespace with that local name."""
+    iris = {task.iri for task in tasks}
+    for bundled in (expand(f"req:{name}"), expand(f"act:{name}")):
+        if bundled in iris:
+            return bundled
+    named = {iri for iri in iris if local_name(iri) == name}
+    return named.pop() if len(named) == 1 else None
+
+
+def _typed(iri: str, tasks: Sequence[_Task]) -> str:
+    """How to type ``iri``: its bare name when that means it, else its prefixed name, else ``<IRI>``."""
+    bare = local_name(iri)
+    if _bare(bare, tasks) == iri:
+        return bare
+    short = shorten(iri)
+    return short if short != iri else f"<{iri}>"
+
+
+def _known(tasks: Sequence[_Task]) -> list[str]:
+    return sorted({_typed(task.iri, tasks) for task in tasks if task.listed})
+
+
+def _suggestions(typed: str, tasks: Sequence[_Task]) -> list[str]:
+    """The closest spellings, compared by local name with case aside: a name differing only in case
+    alone, else the best few difflib finds."""
+    key = (local_name(typed) if ":" in typed else typed).lower()
+    by_name: dict[str, list[str]] = {}
+    for task in tasks:
+        by_name.setdefault(local_name(task.iri).lower(), []).append(task.iri)
+    if key in by_name:
+        close = [key]
+    else:
+        scored = sorted(((difflib.SequenceMatcher(None, key, n).ratio(), n) for n in by_name), reverse=True)
+        best = scored[0][0] if scored else 0.0
+        close = [n for score, n in scored[:3] if score >= max(0.75, best - 0.05)]
+    return sorted({_typed(iri, tasks) for name in close for iri in by_name[name]})
