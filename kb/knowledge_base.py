@@ -18,6 +18,8 @@ from kb.registry import ComponentRegistry
 from kb.resources import bundled_files, query_dir
 from kb.store import EmbeddedStore, QueryResult, Store, Term, is_remote
 
+_VERSION_INFO = ox.NamedNode("http://www.w3.org/2002/07/owl#versionInfo")
+
 
 class KnowledgeBase:
     """A cbrs knowledge base. ``KnowledgeBase.open(":memory:")`` gives a seeded in-memory one."""
@@ -55,16 +57,43 @@ class KnowledgeBase:
         kb = cls(store)
         if seed and not kb.store.is_seeded():
             kb.seed()
-        elif seed and GraphName.MAP.iri not in kb.store.graphs():
+        elif seed and kb._map_outdated():
             kb.add_semantic_map()
         return kb
 
+    def _map_outdated(self) -> bool:
+        """Whether the store's semantic map is missing or of an older version than the bundled one."""
+        if GraphName.MAP.iri not in self.store.graphs():
+            return True
+        bundled = {
+            str(quad.object)
+            for item in bundled_files()
+            if item.graph is GraphName.MAP
+            for quad in parse_file(item.path, item.graph).quads
+            if quad.predicate == _VERSION_INFO
+        }
+        stored = {str(quad.object) for quad in self.store.quads(predicate=_VERSION_INFO, graph=GraphName.MAP.node)}
+        return not bundled <= stored
+
     def add_semantic_map(self) -> None:
-        """Bring a store seeded before the semantic map existed up to date: the bundled ontology files
-        are added again (their new terms join; nothing is removed) and the bundled map is loaded."""
+        """Bring a store seeded before the semantic map (or its current version) existed up to date.
+
+        The bundled ontology files are added again (their new terms join; nothing is removed). Of the
+        bundled map, what the stored map does not say yet is added: a statement joins unless the stored
+        map already gives its subject a value for that property, so a thing a user moved stays moved.
+        """
         wanted = (GraphName.ONTOLOGY, GraphName.MAP)
         parsed = [parse_file(item.path, item.graph) for item in bundled_files() if item.graph in wanted]
-        self.store.add(quad for item in parsed for quad in item.quads)
+        known = {(quad.subject, quad.predicate) for quad in self.store.quads(graph=GraphName.MAP.node)}
+        added = [
+            quad
+            for item in parsed
+            for quad in item.quads
+            if item.graph is not GraphName.MAP
+            or (quad.subject, quad.predicate) not in known
+            or quad.predicate == _VERSION_INFO
+        ]
+        self.store.add(added)
         self._reader.clear_cache()
 
     def seed(self) -> list[ParsedFile]:

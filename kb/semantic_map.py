@@ -9,6 +9,7 @@ particular cup or table: every value comes from the store.
 
 from __future__ import annotations
 
+import math
 from collections import defaultdict
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
@@ -26,8 +27,10 @@ __all__ = [
     "Arm",
     "Box",
     "Camera",
+    "Dispenser",
     "MapError",
     "MapObject",
+    "Marker",
     "MobileRobot",
     "Person",
     "Pose",
@@ -165,15 +168,44 @@ class Arm:
 
 @dataclass(frozen=True)
 class Camera:
-    """A camera on the ceiling: where it hangs (it looks straight down) and its vertical field of view."""
+    """A camera: where its eye is, where it looks (``pitch`` -pi/2 is straight down, with the top of
+    the image towards ``yaw``), its vertical field of view (degrees) and range, and for a camera on a
+    robot its housing's size and what it is mounted on."""
 
     iri: str
     position: tuple[float, float, float]
     fov: float
+    yaw: float = math.pi / 2
+    pitch: float = -math.pi / 2
+    near: float = 0.2
+    far: float = 8.0
+    size: tuple[float, float, float] | None = None
+    mount: str | None = None
+
+    @property
+    def looks_down(self) -> bool:
+        return abs(math.cos(self.pitch)) < 1e-6
+
+    @property
+    def direction(self) -> tuple[float, float, float]:
+        """The unit vector the camera looks along."""
+        c = math.cos(self.pitch)
+        return (c * math.cos(self.yaw), c * math.sin(self.yaw), math.sin(self.pitch))
 
     @property
     def name(self) -> str:
         return local_name(self.iri)
+
+
+@dataclass(frozen=True)
+class Marker:
+    """A colour marker of two patches on a robot's platform: their colours, one patch's size (along and
+    across the robot) and the distance between the patches' centres."""
+
+    front: str
+    rear: str
+    patch: tuple[float, float]
+    separation: float
 
 
 @dataclass(frozen=True)
@@ -183,6 +215,25 @@ class MobileRobot:
     platform: str | None
     platform_height: float | None
     marker_colours: tuple[str, str] | None  # front, rear
+    footprint: tuple[float, float] = (0.45, 0.38)
+    """Length along the heading and width (m)."""
+    marker: Marker | None = None
+
+    @property
+    def name(self) -> str:
+        return local_name(self.iri)
+
+
+@dataclass(frozen=True)
+class Dispenser:
+    """An appliance with a tap: its body, the tap's lever (pushed towards the body, it opens the tap)
+    and the spout, with the point where the water leaves it."""
+
+    iri: str
+    body: Thing
+    lever: Thing
+    spout: Thing
+    outlet: tuple[float, float, float]
 
     @property
     def name(self) -> str:
@@ -205,6 +256,25 @@ class SemanticMap:
     """The things that are a home:Container by the taxonomy: what a tap can fill."""
     furniture: frozenset[str] = frozenset()
     """The things that are home:Furniture by the taxonomy: what the simulation builds as tables."""
+    rooms: frozenset[str] = frozenset()
+    regions: frozenset[str] = frozenset()
+    """The things that are a home:Region (below the tap, the table's top): where objects can be put."""
+    walls: frozenset[str] = frozenset()
+    bodies: frozenset[str] = frozenset()
+    """Robots with an extent of their own (a torso standing on the floor), by the taxonomy (home:Robot)."""
+    dispensers: dict[str, Dispenser] = field(default_factory=dict)
+
+    def extent(self) -> Box:
+        """The box around every room: the home's floor."""
+        boxes = [self.things[iri].box for iri in self.rooms if iri in self.things]
+        if not boxes:
+            raise MapError(HOME + "Room", "has no individual with an extent: the home has no rooms")
+        return Box(
+            min(b.min_x for b in boxes),
+            max(b.max_x for b in boxes),
+            min(b.min_y for b in boxes),
+            max(b.max_y for b in boxes),
+        )
 
     def of_type(self, concept: str) -> list[str]:
         """The things whose asserted classes include ``concept`` (no subclass reasoning: see :func:`designate`)."""
@@ -233,15 +303,22 @@ class SemanticMap:
         def things_of(concept: str) -> frozenset[str]:
             return frozenset(row["thing"].value for row in kb.select("designate", {"class": HOME + concept}))
 
-        containers, furniture, people = things_of("Container"), things_of("Furniture"), things_of("Person")
+        people = things_of("Person")
         built = cls(
             types={k: tuple(v) for k, v in types.items()},
             facts={k: dict(v) for k, v in facts.items()},
-            containers=containers,
-            furniture=furniture,
+            containers=things_of("Container"),
+            furniture=things_of("Furniture"),
+            rooms=things_of("Room"),
+            regions=things_of("Region"),
+            walls=things_of("Wall"),
+            bodies=things_of("Robot"),
         )
         for iri, values in facts.items():
             _classify(built, iri, values, tuple(types.get(iri, ())), affordances, facts, iri in people)
+        for iri, values in facts.items():
+            for tap in values.get(HOME + "hasTap", []):
+                built.dispensers[iri] = _dispenser(built, iri, tap, facts)
         return built
 
 
@@ -286,7 +363,25 @@ def _classify(
 ) -> None:
     if HOME + "fieldOfView" in values:
         position = (_number(values, "x", iri), _number(values, "y", iri), _number(values, "z", iri))
-        built.cameras[iri] = Camera(iri, position, _number(values, "fieldOfView", iri))
+        size = None
+        if HOME + "sizeX" in values:
+            size = (_number(values, "sizeX", iri), _number(values, "sizeY", iri), _number(values, "sizeZ", iri))
+        camera = Camera(
+            iri,
+            position,
+            _number(values, "fieldOfView", iri),
+            yaw=_number(values, "yaw", iri, math.pi / 2),
+            pitch=_number(values, "pitch", iri, -math.pi / 2),
+            near=_number(values, "minRange", iri, 0.2),
+            far=_number(values, "maxRange", iri, 8.0),
+            size=size,
+            mount=values.get(HOME + "mountedOn", [None])[0],
+        )
+        if not 0.0 < camera.near < camera.far:
+            raise MapError(iri, f"has a range of {camera.near}..{camera.far} m; need 0 < home:minRange < home:maxRange")
+        if not 0.0 < camera.fov < 180.0:
+            raise MapError(iri, f"has a field of view of {camera.fov} degrees; it must be between 0 and 180")
+        built.cameras[iri] = camera
         return
     if HOME + "armSide" in values:
         robots = [robot for robot, props in facts.items() if iri in props.get(HOME + "hasArm", [])]
@@ -343,17 +438,27 @@ def _classify(
             height = _number(facts.get(platform, {}), "maxZ", platform)
         marker = values.get(HOME + "hasMarker", [None])[0]
         colours = None
+        geometry = None
         if marker is not None:
-            colour_node = facts.get(marker, {}).get(HOME + "hasColour", [marker])[0]
+            marker_values = facts.get(marker, {})
+            colour_node = marker_values.get(HOME + "hasColour", [marker])[0]
             node = facts.get(colour_node, {})
             front, rear = _text(node, "frontColourName"), _text(node, "rearColourName")
             colours = (front, rear) if front and rear else None
+            if colours is not None:
+                patch = (_number(marker_values, "sizeX", marker), _number(marker_values, "sizeY", marker))
+                geometry = Marker(colours[0], colours[1], patch, _number(marker_values, "markerSeparation", marker))
+        footprint = (_number(values, "sizeX", iri), _number(values, "sizeY", iri))
+        if min(footprint) <= 0:
+            raise MapError(iri, f"has a footprint of {footprint}; home:sizeX and home:sizeY must be positive")
         built.robots[iri] = MobileRobot(
             iri,
             Pose(_number(values, "x", iri), _number(values, "y", iri), _number(values, "yaw", iri, 0.0)),
             platform,
             height,
             colours,
+            footprint,
+            geometry,
         )
         return
     if HOME + "minX" in values:
@@ -372,6 +477,19 @@ def _classify(
             node = facts.get(dock_iri, {})
             dock = Pose(_number(node, "x", dock_iri), _number(node, "y", dock_iri), _number(node, "yaw", dock_iri, 0.0))
         built.things[iri] = Thing(iri, types, box, dock)
+
+
+def _dispenser(built: SemanticMap, iri: str, tap: str, facts: dict[str, dict[str, list[str]]]) -> Dispenser:
+    spout = facts.get(tap, {}).get(HOME + "hasSpout", [None])[0]
+    if spout is None:
+        raise MapError(tap, "is a tap with no home:hasSpout: the water would come from nowhere")
+    parts = {"the appliance": iri, "its tap": tap, "its spout": spout}
+    for what, part in parts.items():
+        if part not in built.things:
+            raise MapError(part, f"({what}) has no extent: give home:minX .. home:maxZ")
+    values = facts.get(spout, {})
+    outlet = (_number(values, "x", spout), _number(values, "y", spout), _number(values, "z", spout))
+    return Dispenser(iri, built.things[iri], built.things[tap], built.things[spout], outlet)
 
 
 def designate(kb: KnowledgeBase, concept: str, prefer: str | None = None) -> str:

@@ -17,10 +17,8 @@ import pybullet as p
 
 from sim.geometry import Pose2D, quat_from_yaw, wrap_angle, yaw_of
 
-__all__ = ["BASE_HEIGHT", "DriveResult", "MobileBase"]
+__all__ = ["DriveResult", "MobileBase"]
 
-BASE_HEIGHT = 0.225
-"""Height of the chassis centre (the body's origin) above the floor."""
 MAX_SPEED = 0.6
 """m/s"""
 MAX_TURN_RATE = 1.2
@@ -58,6 +56,8 @@ class MobileBase:
         self.client = client
         self.body = body
         self._step = step
+        self.height = float(p.getBasePositionAndOrientation(body, physicsClientId=client)[0][2])
+        """Height of the chassis centre (the body's origin) above the floor, kept while it drives."""
         pose = self.pose()
         self._setpoint = pose
         self._constraint = p.createConstraint(
@@ -68,7 +68,7 @@ class MobileBase:
             p.JOINT_FIXED,
             (0.0, 0.0, 0.0),
             (0.0, 0.0, 0.0),
-            (pose.x, pose.y, BASE_HEIGHT),
+            (pose.x, pose.y, self.height),
             childFrameOrientation=quat_from_yaw(pose.theta),
             physicsClientId=client,
         )
@@ -82,7 +82,7 @@ class MobileBase:
         self._setpoint = pose
         p.changeConstraint(
             self._constraint,
-            jointChildPivot=(pose.x, pose.y, BASE_HEIGHT),
+            jointChildPivot=(pose.x, pose.y, self.height),
             jointChildFrameOrientation=quat_from_yaw(pose.theta),
             maxForce=CONSTRAINT_FORCE,
             physicsClientId=self.client,
@@ -91,7 +91,7 @@ class MobileBase:
     def place(self, pose: Pose2D) -> None:
         """Put the base at ``pose`` at once (scenario set-up and tests; not a motion)."""
         p.resetBasePositionAndOrientation(
-            self.body, (pose.x, pose.y, BASE_HEIGHT), quat_from_yaw(pose.theta), physicsClientId=self.client
+            self.body, (pose.x, pose.y, self.height), quat_from_yaw(pose.theta), physicsClientId=self.client
         )
         p.resetBaseVelocity(self.body, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), physicsClientId=self.client)
         self._command(pose)

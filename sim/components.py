@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 from actions.belief import Observation
@@ -348,7 +348,11 @@ def locate(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str,
         colours = ctx.world.robot.marker_colours
     if colours is None:
         raise SkillFailed("the semantic map gives no marker colours to look for")
-    return {"robotLocation": to_json(locate_robot(ctx.world.camera(device).capture(), colours[0], colours[1]))}
+    try:
+        marker = replace(ctx.world.marker_model, front=colours[0], rear=colours[1])
+    except ValueError as error:
+        raise SkillFailed(str(error)) from None
+    return {"robotLocation": to_json(locate_robot(ctx.world.camera(device).capture(), marker))}
 
 
 def track(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:

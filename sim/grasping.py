@@ -15,7 +15,6 @@ import numpy as np
 
 from kb.semantic_map import MapObject
 from sim.geometry import Quat, Vec3, quat_from_matrix
-from sim.layout import ARM_MOUNT_YAW
 
 __all__ = ["GraspKind", "GraspPose", "ObjectModel", "compute_grasp_pose"]
 
@@ -95,9 +94,10 @@ def side_orientation(approach_yaw: float, pitch: float = SIDE_PITCH) -> Quat:
 
 
 def compute_grasp_pose(
-    model: ObjectModel, centre: Vec3, yaw: float | None, arm_mount: Vec3, facing: float = ARM_MOUNT_YAW
+    model: ObjectModel, centre: Vec3, yaw: float | None, arm_mount: Vec3, facing: float
 ) -> GraspPose:
-    """The grasp for an object whose centre (and, for long objects, axis yaw) perception estimated.
+    """The grasp for an object whose centre (and, for long objects, axis yaw) perception estimated, by
+    an arm mounted at ``arm_mount`` facing ``facing`` (its yaw in the semantic map).
 
     A side grasp comes in from the robot's side of the table; a top grasp closes the fingers across
     the object's long axis.

@@ -18,7 +18,7 @@ import pybullet as p
 from numpy.typing import NDArray
 
 from sim.errors import OutsideMapError
-from sim.layout import BASE_RADIUS, HOME, MAP_RESOLUTION
+from sim.layout import MAP_RESOLUTION
 from sim.world import HomeWorld
 
 __all__ = ["OBSTACLE_HEIGHT", "OccupancyGrid", "build_occupancy_grid", "inflate"]
@@ -94,13 +94,17 @@ def inflate(occupied: NDArray[np.bool_], radius_cells: float) -> NDArray[np.bool
 def build_occupancy_grid(
     world: HomeWorld,
     resolution: float = MAP_RESOLUTION,
-    inflation_radius: float = BASE_RADIUS,
+    inflation_radius: float | None = None,
     ignore: Sequence[str] | None = None,
 ) -> OccupancyGrid:
-    """Measure the home's occupancy grid now; the bodies in ``ignore`` (by default the mobile base) are seen through."""
-    cols = round((HOME.xmax - HOME.xmin) / resolution)
-    rows = round((HOME.ymax - HOME.ymin) / resolution)
-    origin = (HOME.xmin, HOME.ymin)
+    """Measure the home's occupancy grid now; the bodies in ``ignore`` (by default the mobile base) are
+    seen through. Obstacles are inflated by ``inflation_radius``, by default the base's (``world.base_radius``)."""
+    if inflation_radius is None:
+        inflation_radius = world.base_radius
+    home = world.extent
+    cols = round((home.xmax - home.xmin) / resolution)
+    rows = round((home.ymax - home.ymin) / resolution)
+    origin = (home.xmin, home.ymin)
     jj, ii = np.meshgrid(np.arange(cols), np.arange(rows))
     xs = origin[0] + (jj.ravel() + 0.5) * resolution
     ys = origin[1] + (ii.ravel() + 0.5) * resolution

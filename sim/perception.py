@@ -20,11 +20,12 @@ from numpy.typing import NDArray
 
 from sim.cameras import Frame
 from sim.errors import NotVisibleError, UnknownColourError
-from sim.layout import MARKER_HEIGHT, MARKER_OFFSET, MARKER_PATCH, SHIRT_RADIUS, SHIRT_TOP
+from sim.layout import SHIRT_RADIUS, SHIRT_TOP
 
 __all__ = [
     "COLOURS",
     "ColourRange",
+    "MarkerModel",
     "ObjectEstimate",
     "PersonEstimate",
     "RobotPoseEstimate",
@@ -63,7 +64,7 @@ MIN_MARKER_PIXELS = 6
 MIN_PERSON_PIXELS = 20
 MIN_OBJECT_PIXELS = 15
 MARKER_SPACING_TOLERANCE = 0.08
-"""The two patch centres must be 2 x MARKER_OFFSET apart within 8 cm, else the marker is half hidden."""
+"""The two patch centres must be the marker's separation apart within 8 cm, else the marker is half hidden."""
 
 
 def _colour(colour: str | ColourRange) -> ColourRange:
@@ -126,11 +127,24 @@ class RobotPoseEstimate:
     pixels: int
 
 
-def locate_robot(frame: Frame, front: str = "green", rear: str = "magenta") -> RobotPoseEstimate:
+@dataclass(frozen=True)
+class MarkerModel:
+    """What the localiser knows of a robot's colour marker (from the semantic map): the front and rear
+    patches' colours, one patch's size along and across the robot, the distance between the patches'
+    centres, and the height of their top faces, the plane pixel rays are intersected with."""
+
+    front: str
+    rear: str
+    patch: tuple[float, float]
+    separation: float
+    height: float
+
+
+def locate_robot(frame: Frame, marker: MarkerModel) -> RobotPoseEstimate:
     """The base's pose from its two-colour marker; ``NotVisibleError`` if either patch is missing."""
     points = []
     count = 0
-    for colour, target in ((front, "marker front"), (rear, "marker rear")):
+    for colour, target in ((marker.front, "marker front"), (marker.rear, "marker rear")):
         mask = segment(frame.rgb, colour)
         us, vs = _pixels(mask)
         if us.size < MIN_MARKER_PIXELS:
@@ -140,16 +154,16 @@ def locate_robot(frame: Frame, front: str = "green", rear: str = "magenta") -> R
         # a whole patch covers there, one row and one column less than its size in pixels (pixel
         # size measured on the marker's plane at the patch).
         u, v = float(np.median(us)), float(np.median(vs))
-        corners = frame.intersect_plane(np.array([u, u + 1.0, u]), np.array([v, v, v + 1.0]), MARKER_HEIGHT)
+        corners = frame.intersect_plane(np.array([u, u + 1.0, u]), np.array([v, v, v + 1.0]), marker.height)
         pixel = math.sqrt(float(np.linalg.norm(np.cross(corners[1] - corners[0], corners[2] - corners[0]))))
-        needed = math.ceil((MARKER_PATCH[0] / pixel - 1.0) * (MARKER_PATCH[1] / pixel - 1.0))
+        needed = math.ceil((marker.patch[0] / pixel - 1.0) * (marker.patch[1] / pixel - 1.0))
         if us.size < needed:
             raise NotVisibleError(frame.camera, f"whole robot {target} ({colour})", int(us.size), needed)
         count += int(us.size)
-        points.append(frame.intersect_plane(us, vs, MARKER_HEIGHT)[:, :2].mean(axis=0))
+        points.append(frame.intersect_plane(us, vs, marker.height)[:, :2].mean(axis=0))
     head, tail = points
     spacing = float(np.linalg.norm(head - tail))
-    if abs(spacing - 2 * MARKER_OFFSET) > MARKER_SPACING_TOLERANCE:
+    if abs(spacing - marker.separation) > MARKER_SPACING_TOLERANCE:
         raise NotVisibleError(frame.camera, f"whole robot marker (patches {spacing:.2f} m apart)", count, count + 1)
     centre = (head + tail) / 2.0
     theta = math.atan2(float(head[1] - tail[1]), float(head[0] - tail[0]))

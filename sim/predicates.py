@@ -15,15 +15,7 @@ import pybullet as p
 from sim.arms import ArmSide
 from sim.cameras import project
 from sim.geometry import Pose2D, Region, quat_to_matrix
-from sim.layout import (
-    BASE_HALF_LENGTH,
-    BASE_HALF_WIDTH,
-    MARKER_HEIGHT,
-    MARKER_OFFSET,
-    MARKER_PATCH,
-    PERSON_HAND_HEIGHT,
-    PLATFORM_HEIGHT,
-)
+from sim.layout import PERSON_HAND_HEIGHT
 from sim.world import HomeWorld
 
 __all__ = [
@@ -160,8 +152,9 @@ def on_platform(world: HomeWorld, name: str) -> bool:
     dx, dy = x - base.x, y - base.y
     along = dx * math.cos(base.theta) + dy * math.sin(base.theta)
     across = -dx * math.sin(base.theta) + dy * math.cos(base.theta)
-    inside = abs(along) <= BASE_HALF_LENGTH - PLATFORM_MARGIN and abs(across) <= BASE_HALF_WIDTH - PLATFORM_MARGIN
-    resting = abs(object_bottom(world, name) - PLATFORM_HEIGHT) <= RESTING_TOLERANCE
+    length, width = world.robot.footprint
+    inside = abs(along) <= length / 2 - PLATFORM_MARGIN and abs(across) <= width / 2 - PLATFORM_MARGIN
+    resting = abs(object_bottom(world, name) - world.platform_height) <= RESTING_TOLERANCE
     return inside and resting and not is_grasped(world, name) and name not in world.holders
 
 
@@ -209,14 +202,15 @@ def robot_visible(world: HomeWorld, camera: str) -> bool:
     base = world.base_pose()
     spec = cam.spec
     c, s = math.cos(base.theta), math.sin(base.theta)
-    half_along, half_across = MARKER_PATCH[0] / 2 - 0.01, MARKER_PATCH[1] / 2 - 0.01
+    marker = world.marker_model
+    half_along, half_across = marker.patch[0] / 2 - 0.01, marker.patch[1] / 2 - 0.01
     # Centre and corners (1 cm inside) of both patches, in the world.
     local = [
-        (sign * MARKER_OFFSET + da * half_along, db * half_across)
+        (sign * marker.separation / 2 + da * half_along, db * half_across)
         for sign in (1.0, -1.0)
         for da, db in ((0, 0), (1, 1), (1, -1), (-1, 1), (-1, -1))
     ]
-    points = np.array([[base.x + a * c - b * s, base.y + a * s + b * c, MARKER_HEIGHT + 0.001] for a, b in local])
+    points = np.array([[base.x + a * c - b * s, base.y + a * s + b * c, marker.height + 0.001] for a, b in local])
     pixels = project(cam.intrinsics, cam.camera_to_world, points)
     k = cam.intrinsics
     inside = (pixels[:, 0] >= 0) & (pixels[:, 0] < k.width) & (pixels[:, 1] >= 0) & (pixels[:, 1] < k.height)

@@ -28,7 +28,7 @@ from sim.grasping import (
     side_orientation,
     top_orientation,
 )
-from sim.layout import PERSON_HAND_HEIGHT, PLATFORM_HEIGHT
+from sim.layout import PERSON_HAND_HEIGHT
 from sim.perception import ObjectEstimate, PersonEstimate, RobotPoseEstimate
 from sim.planning import PlannedPath
 from sim.world import HomeWorld
@@ -267,16 +267,16 @@ def fill_cup_from_tap(world: HomeWorld, side: ArmSide | str, lever: Region, cont
     return _done(world, "FillCupFromTap", start, ok, f"the water ran but the {container} did not catch it")
 
 
-def platform_region(base: Pose2D | RobotPoseEstimate) -> Region:
-    """Where on a base's platform to put things: a small window around its centre, on its surface."""
+def platform_region(base: Pose2D | RobotPoseEstimate, height: float) -> Region:
+    """Where on a base's platform (its top at ``height``) to put things: a small window around its centre."""
     return Region(
         "OnRobotPlatform",
         base.x - PLATFORM_TARGET,
         base.x + PLATFORM_TARGET,
         base.y - PLATFORM_TARGET,
         base.y + PLATFORM_TARGET,
-        PLATFORM_HEIGHT,
-        PLATFORM_HEIGHT + 0.3,
+        height,
+        height + 0.3,
     )
 
 
@@ -297,7 +297,7 @@ def hand_over_onto_platform(
             world, "HandOverOntoPlatform", start, False, f"the base's platform is out of the {side} arm's reach"
         )
     grasp = compute_grasp_pose(model, pen.position, pen.yaw, mount, world.arm_specs[ArmSide(side)].yaw)
-    region = platform_region(base)
+    region = platform_region(base, world.platform_height)
     # The pen fits between the marker patches along or across the base: take the placement that
     # needs the smaller turn of the wrist.
     pen_yaw = pen.yaw or 0.0

@@ -30,7 +30,6 @@ from kb.semantic_map import MapObject, local_name
 from sim.errors import SimulationError
 from sim.geometry import Pose2D
 from sim.grasping import GraspKind, ObjectModel
-from sim.layout import BASE_RADIUS
 from sim.mapping import OccupancyGrid, inflate
 from sim.perception import ObjectEstimate, PersonEstimate, RobotPoseEstimate
 from sim.planning import PlannedPath
@@ -67,6 +66,9 @@ __all__ = [
     "to_json",
 ]
 
+DEFAULT_INFLATION_RADIUS = 0.30
+"""A grid map value that does not say how far its obstacles were inflated is taken to be inflated by 30 cm
+(the bundled base's footprint radius, rounded up)."""
 ROBOT_LOCATION = HOME + "RobotLocation"
 PERSON_POSITION = HOME + "PersonPosition"
 PERSON_LOCATION = HOME + "PersonLocation"
@@ -372,7 +374,7 @@ def _decode_grid(f: _Fields) -> OccupancyGrid:
         if size < 1:
             f.fail(name, size, "a positive number of cells")
     cells = f.text("cells")
-    radius = f.number("inflationRadius", BASE_RADIUS)
+    radius = f.number("inflationRadius", DEFAULT_INFLATION_RADIUS)
     if not 0.0 <= radius <= max(width, height) * resolution:
         f.fail("inflationRadius", radius, "a number of metres from 0 to the map's size")  # bounds the work
     cached = _grids.get((resolution, origin, width, height, cells, radius))

@@ -18,13 +18,15 @@ import numpy as np
 import pybullet as p
 
 from kb.semantic_map import Arm as ArmSpec
-from kb.semantic_map import MapObject, SemanticMap
+from kb.semantic_map import Box, Dispenser, MapObject, SemanticMap, Thing
 from sim import layout as L
 from sim.arms import PYBULLET_DATA, Arm, ArmSide, Kinematics
-from sim.base import BASE_HEIGHT, MobileBase
+from sim.base import MobileBase
 from sim.cameras import Camera
 from sim.errors import UnknownEntityError, WorldClosedError
 from sim.geometry import Pose2D, Pose3D, Quat, Region, Vec3, quat_from_yaw
+from sim.layout import CameraSpec
+from sim.perception import MarkerModel
 from sim.quiet import quiet_output
 from sim.scene import bundled_map
 
@@ -38,6 +40,8 @@ TAP_OPEN_TRAVEL = 0.006
 """The tap runs while its lever is pushed in by more than 6 mm."""
 LEVER_SPRING_FORCE = 4.0
 """N: the spring that closes the tap when the lever is let go."""
+MARKER_LIFT = 0.002
+"""The marker's patches lie on the platform: their top faces are 2 mm above it."""
 
 _FLOOR = (0.78, 0.78, 0.76, 1.0)
 _WALL = (0.92, 0.90, 0.84, 1.0)
@@ -342,28 +346,44 @@ class HomeWorld:
         """Fraction of a container filled with water; 0 for anything that is not a container."""
         return self.water.get(name, 0.0)
 
-    def tap_travel(self) -> float:
-        """How far the tap lever is pushed in (m)."""
-        return float(p.getJointState(self.body("WaterDispenser"), 1, physicsClientId=self.client)[0])
+    @property
+    def dispensers(self) -> list[Dispenser]:
+        """The semantic map's appliances with a tap, in IRI order."""
+        return [self.map.dispensers[iri] for iri in sorted(self.map.dispensers)]
 
-    def tap_open(self) -> bool:
-        return self.tap_travel() > TAP_OPEN_TRAVEL
+    def tap_travel(self, dispenser: str | None = None) -> float:
+        """How far a dispenser's tap lever is pushed in (m); with no name, the most of any dispenser."""
+        chosen = [d for d in self.dispensers if dispenser is None or d.name == dispenser]
+        if dispenser is not None and not chosen:
+            raise UnknownEntityError(dispenser, [d.name for d in self.dispensers])
+        travels = [float(p.getJointState(self.body(d.name), 1, physicsClientId=self.client)[0]) for d in chosen]
+        return max(travels, default=0.0)
 
-    def catches_water(self, name: str) -> bool:
-        """Physics of the stream: it falls from the outlet into a container if the container is upright
-        below it and the outlet's axis passes inside the rim."""
+    def tap_open(self, dispenser: str | None = None) -> bool:
+        return self.tap_travel(dispenser) > TAP_OPEN_TRAVEL
+
+    def catches_water(self, name: str, outlet: Vec3 | None = None) -> bool:
+        """Physics of the stream: it falls from the outlet (the first dispenser's by default) into a
+        container if the container is upright below it and the outlet's axis passes inside the rim."""
+        if outlet is None:
+            if not self.dispensers:
+                return False
+            outlet = self.dispensers[0].outlet
         obj = self.objects[name]
         pos, orn = p.getBasePositionAndOrientation(self.body(name), physicsClientId=self.client)
         up = p.getMatrixFromQuaternion(orn)[8]
         rim = min(obj.size[0], obj.size[1]) / 2.0
-        inside = math.hypot(pos[0] - L.TAP_OUTLET[0], pos[1] - L.TAP_OUTLET[1]) < rim - 0.004
-        below = pos[2] + obj.size[2] / 2.0 < L.TAP_OUTLET[2]
+        inside = math.hypot(pos[0] - outlet[0], pos[1] - outlet[1]) < rim - 0.004
+        below = pos[2] + obj.size[2] / 2.0 < outlet[2]
         return inside and below and up > 0.95
 
     def _run_tap(self) -> None:
-        if not self.tap_open():
-            return
-        catching = next((name for name in sorted(self.containers) if self.catches_water(name)), None)
+        for dispenser in self.dispensers:
+            if self.tap_open(dispenser.name):
+                self._pour(dispenser.outlet)
+
+    def _pour(self, outlet: Vec3) -> None:
+        catching = next((name for name in sorted(self.containers) if self.catches_water(name, outlet)), None)
         if catching is None:
             self.water_spilled += self.time_step
             return
@@ -470,34 +490,47 @@ class HomeWorld:
         self._build_robot()
         self._build_base()
         self._build_person()
-        ceiling = [
-            L.CameraSpec(
-                cam.name, cam.position, (cam.position[0], cam.position[1], 0.0), (0.0, 1.0, 0.0), fov_deg=cam.fov
+        for iri in sorted(self.map.cameras):
+            cam = self.map.cameras[iri]
+            direction = cam.direction
+            target = tuple(e + d for e, d in zip(cam.position, direction, strict=True))
+            # looking straight down, the top of the image faces the camera's yaw; otherwise up is up
+            up = (math.cos(cam.yaw), math.sin(cam.yaw), 0.0) if cam.looks_down else (0.0, 0.0, 1.0)
+            spec = CameraSpec(
+                cam.name,
+                cam.position,
+                (target[0], target[1], target[2]),
+                up,
+                fov_deg=cam.fov,
+                near=cam.near,
+                far=cam.far,
             )
-            for cam in self.map.cameras.values()
-        ]
-        for spec in (*ceiling, L.KINECT):
             self.cameras[spec.name] = Camera(c, spec, self)
         if self.gui:
             p.configureDebugVisualizer(render, 1, physicsClientId=c)
 
     def _build_rooms(self) -> None:
-        h = L.HOME
+        h = self.extent
         self._multibody(
             "Floor",
             [_box(((h.xmax - h.xmin) / 2 + 0.5, (h.ymax - h.ymin) / 2 + 0.5, 0.05), (0, 0, 0), _FLOOR)],
             ((h.xmin + h.xmax) / 2, (h.ymin + h.ymax) / 2, -0.05),
         )
-        t = L.WALL_THICKNESS
-        for wall in L.WALLS:
-            length = math.hypot(wall.x1 - wall.x0, wall.y1 - wall.y0)
-            outer = wall.name in {"WallSouth", "WallNorth", "WallWest", "WallEast"}
-            length += t if outer else 0.0
-            yaw = math.atan2(wall.y1 - wall.y0, wall.x1 - wall.x0)
-            centre = ((wall.x0 + wall.x1) / 2, (wall.y0 + wall.y1) / 2, L.WALL_HEIGHT / 2)
-            self._multibody(
-                wall.name, [_box((length / 2, t / 2, L.WALL_HEIGHT / 2), (0, 0, 0), _WALL)], centre, quat_from_yaw(yaw)
-            )
+        for iri in sorted(self.map.walls):
+            wall = self.map.things.get(iri)
+            if wall is not None:
+                self._solid(wall.name, wall.box, _WALL)
+
+    @property
+    def extent(self) -> Region:
+        """The home's floor: the box around its rooms."""
+        box = self.map.extent()
+        return Region("Home", box.min_x, box.max_x, box.min_y, box.max_y)
+
+    def _solid(self, name: str, box: Box, rgba: tuple[float, float, float, float]) -> int:
+        """A fixed box body filling ``box``."""
+        half, centre = _half_and_centre(_region(name, box))
+        return self._multibody(name, [_box(half, (0, 0, 0), rgba)], centre)
 
     @property
     def furniture(self) -> list[str]:
@@ -526,35 +559,39 @@ class HomeWorld:
 
     def _build_kitchen(self) -> None:
         self._build_furniture()
+        for dispenser in self.dispensers:
+            self._build_dispenser(dispenser)
+        for obj in self.objects.values():
+            self._build_object(obj)
 
-        d, s, lever = L.DISPENSER, L.SPOUT, L.TAP_LEVER
-        centre = ((d.xmin + d.xmax) / 2, (d.ymin + d.ymax) / 2, (d.zmin + d.zmax) / 2)
+    def _build_dispenser(self, dispenser: Dispenser) -> None:
+        """The appliance's body with its spout and its tap's lever, which slides towards the body
+        (pushed in, it opens the tap; a spring pushes it back)."""
+        body = _region(dispenser.name, dispenser.body.box)
+        body_half, centre = _half_and_centre(body)
 
-        def local(region: Region) -> tuple[Vec3, Vec3]:
-            half = ((region.xmax - region.xmin) / 2, (region.ymax - region.ymin) / 2, (region.zmax - region.zmin) / 2)
-            mid = ((region.xmin + region.xmax) / 2, (region.ymin + region.ymax) / 2, (region.zmin + region.zmax) / 2)
+        def local(thing: Thing) -> tuple[Vec3, Vec3]:
+            half, mid = _half_and_centre(_region(thing.name, thing.box))
             return half, (mid[0] - centre[0], mid[1] - centre[1], mid[2] - centre[2])
 
-        body_half, _ = local(d)
-        spout_half, spout_off = local(s)
-        lever_half, lever_off = local(lever)
-        dispenser = self._multibody(
-            "WaterDispenser",
+        spout_half, spout_off = local(dispenser.spout)
+        lever_half, lever_off = local(dispenser.lever)
+        norm = math.hypot(lever_off[0], lever_off[1]) or 1.0
+        push = (-lever_off[0] / norm, -lever_off[1] / norm, 0.0)
+        uid = self._multibody(
+            dispenser.name,
             [
                 _box(body_half, (0, 0, 0), _WHITE),
                 _box(spout_half, spout_off, _STEEL),
                 _box(lever_half, lever_off, _DARK),
             ],
             centre,
-            joints=[(p.JOINT_FIXED, (0.0, 0.0, 1.0)), (p.JOINT_PRISMATIC, (0.0, 1.0, 0.0))],
+            joints=[(p.JOINT_FIXED, (0.0, 0.0, 1.0)), (p.JOINT_PRISMATIC, push)],
             link_mass=0.05,
         )
         p.setJointMotorControl2(
-            dispenser, 1, p.POSITION_CONTROL, targetPosition=0.0, force=LEVER_SPRING_FORCE, physicsClientId=self.client
+            uid, 1, p.POSITION_CONTROL, targetPosition=0.0, force=LEVER_SPRING_FORCE, physicsClientId=self.client
         )
-
-        for obj in self.objects.values():
-            self._build_object(obj)
 
     def _build_object(self, obj: MapObject) -> None:
         """An object of the semantic map at its start pose (moved by the seed), resting on its support."""
@@ -584,21 +621,14 @@ class HomeWorld:
         p.changeDynamics(body, -1, lateralFriction=1.0, spinningFriction=0.001, physicsClientId=self.client)
 
     def _build_robot(self) -> None:
-        t = L.TORSO
-        half = ((t.xmax - t.xmin) / 2, (t.ymax - t.ymin) / 2, (t.zmax - t.zmin) / 2)
-        self._multibody(
-            t.name, [_box(half, (0, 0, 0), _TORSO)], ((t.xmin + t.xmax) / 2, (t.ymin + t.ymax) / 2, half[2])
-        )
-        kinect, mast = _half_and_centre(L.KINECT_BODY), _half_and_centre(L.KINECT_MAST)
-        mast_offset = tuple(m - k for m, k in zip(mast[1], kinect[1], strict=True))
-        self._multibody(
-            L.KINECT.name,
-            [
-                _box(kinect[0], (0, 0, 0), _DARK),
-                _box(mast[0], (mast_offset[0], mast_offset[1], mast_offset[2]), _STEEL),
-            ],
-            kinect[1],
-        )
+        obstacles: list[Region] = []
+        for iri in sorted(self.map.bodies):  # a robot's own extent: the dual-arm robot's torso
+            body = self.map.things.get(iri)
+            if body is not None:
+                self._solid(body.name, body.box, _TORSO)
+                obstacles.append(_region(body.name, body.box))
+        obstacles += self._build_camera_housings()
+        arms = {ArmSide(arm.side): arm for arm in self.map.arms.values()}
         arms = {ArmSide(arm.side): arm for arm in self.map.arms.values()}
         self.arm_specs = arms
         if set(arms) != set(ArmSide):
@@ -611,7 +641,8 @@ class HomeWorld:
             for iri in sorted(self.map.furniture)
             if (thing := self.map.things.get(iri)) is not None and (b := thing.box) is not None
         ]
-        self._kinematics = Kinematics(mounts, [L.TORSO, *tops, L.DISPENSER, L.KINECT_BODY, L.KINECT_MAST])
+        appliances = [_region(d.name, d.body.box) for d in self.dispensers]
+        self._kinematics = Kinematics(mounts, [*obstacles, *tops, *appliances])
         for side in ArmSide:
             mount, orientation = mounts[side]
             body = p.loadURDF(
@@ -629,36 +660,92 @@ class HomeWorld:
         for arm in self.arms.values():
             arm.peers = self.arms
 
+    def _build_camera_housings(self) -> list[Region]:
+        """The housing of each camera the map gives a size, on a mast down to the top of what it is
+        mounted on; returns their extents (obstacles for the arms)."""
+        extents = []
+        for iri in sorted(self.map.cameras):
+            cam = self.map.cameras[iri]
+            if cam.size is None:
+                continue
+            x, y, z = cam.position
+            sx, sy, sz = cam.size
+            housing = Region(cam.name, x - sx / 2, x + sx / 2, y - sy / 2, y + sy / 2, z - sz / 2, z + sz / 2)
+            parts = [_box(_half_and_centre(housing)[0], (0, 0, 0), _DARK)]
+            extents.append(housing)
+            mount = self.map.things.get(cam.mount or "")
+            if mount is not None and mount.box.max_z < housing.zmin:
+                mast = Region(
+                    cam.name + "Mast", x - 0.015, x + 0.015, y - 0.015, y + 0.015, mount.box.max_z, housing.zmin
+                )
+                half, mid = _half_and_centre(mast)
+                parts.append(_box(half, (mid[0] - x, mid[1] - y, mid[2] - z), _STEEL))
+                extents.append(mast)
+            self._multibody(cam.name, parts, (x, y, z))
+        return extents
+
+    @property
+    def platform_height(self) -> float:
+        """Height of the mobile robot's platform top, where things are put (from the semantic map)."""
+        if self.robot.platform_height is None:
+            raise ValueError(f"the semantic map gives {self.robot.name} no platform (home:hasPlatform with home:maxZ)")
+        return self.robot.platform_height
+
+    @property
+    def marker_model(self) -> MarkerModel:
+        """The base's colour marker as perception knows it: colours, patch size, spacing and height."""
+        marker = self.robot.marker
+        if marker is None:
+            raise ValueError(
+                f"the semantic map gives {self.robot.name} no marker (home:hasMarker, with home:sizeX, home:sizeY, "
+                "home:markerSeparation and a node of home:frontColourName and home:rearColourName): the ceiling "
+                "cameras could not find it"
+            )
+        return MarkerModel(
+            marker.front, marker.rear, marker.patch, marker.separation, self.platform_height + MARKER_LIFT
+        )
+
+    @property
+    def base_radius(self) -> float:
+        """The base's footprint's circumscribed radius, rounded up to 5 cm: the map's obstacle inflation."""
+        length, width = self.robot.footprint
+        return math.ceil(math.hypot(length / 2, width / 2) / 0.05 - 1e-9) * 0.05
+
     def _build_base(self) -> None:
         bx, by, btheta = self.perturbation.base
         start = self.robot.start
-        if self.robot.marker_colours is None:
-            raise ValueError(
-                f"the semantic map gives {self.robot.name} no marker colours (home:hasMarker, with a node of "
-                "home:frontColourName and home:rearColourName): the ceiling cameras could not find it"
-            )
-        front, rear = self.robot.marker_colours
+        marker = self.marker_model
+        half_length, half_width = self.robot.footprint[0] / 2, self.robot.footprint[1] / 2
         bottom = 0.02
-        chassis_half = (L.BASE_HALF_LENGTH, L.BASE_HALF_WIDTH, (L.PLATFORM_HEIGHT - 0.02 - bottom) / 2)
+        chassis_half = (half_length, half_width, (self.platform_height - 0.02 - bottom) / 2)
         chassis_centre_z = bottom + chassis_half[2]
-        if abs(chassis_centre_z - BASE_HEIGHT) > 1e-9:
-            raise ValueError("base height and chassis disagree")
-        platform_z = L.PLATFORM_HEIGHT - 0.01 - chassis_centre_z
-        marker_z = L.MARKER_HEIGHT - 0.001 - chassis_centre_z
+        platform_z = self.platform_height - 0.01 - chassis_centre_z
+        marker_z = marker.height - 0.001 - chassis_centre_z
         wheel = (math.sqrt(0.5), 0.0, 0.0, math.sqrt(0.5))  # cylinder axis along y
-        patch = (L.MARKER_PATCH[0] / 2, L.MARKER_PATCH[1] / 2, 0.001)
+        patch = (marker.patch[0] / 2, marker.patch[1] / 2, 0.001)
+        offset = marker.separation / 2
+        wheel_radius = min(0.095, chassis_centre_z)
         parts = [
             _box(chassis_half, (0, 0, 0), _CHASSIS),
-            _box((L.BASE_HALF_LENGTH, L.BASE_HALF_WIDTH, 0.01), (0, 0, platform_z), _PLATFORM),
-            _box(patch, (L.MARKER_OFFSET, 0, marker_z), _named(front), collide=False),
-            _box(patch, (-L.MARKER_OFFSET, 0, marker_z), _named(rear), collide=False),
-            _Part(p.GEOM_CYLINDER, (0.095, 0.04), (0.0, 0.215, 0.095 - chassis_centre_z), _DARK, False, wheel),
-            _Part(p.GEOM_CYLINDER, (0.095, 0.04), (0.0, -0.215, 0.095 - chassis_centre_z), _DARK, False, wheel),
+            _box((half_length, half_width, 0.01), (0, 0, platform_z), _PLATFORM),
+            _box(patch, (offset, 0, marker_z), _named(marker.front), collide=False),
+            _box(patch, (-offset, 0, marker_z), _named(marker.rear), collide=False),
+            *(
+                _Part(
+                    p.GEOM_CYLINDER,
+                    (wheel_radius, 0.04),
+                    (0.0, side * (half_width + 0.025), wheel_radius - chassis_centre_z),
+                    _DARK,
+                    False,
+                    wheel,
+                )
+                for side in (1.0, -1.0)
+            ),
         ]
         body = self._multibody(
             self.base_name,
             parts,
-            (start.x + bx, start.y + by, BASE_HEIGHT),
+            (start.x + bx, start.y + by, chassis_centre_z),
             quat_from_yaw(start.yaw + btheta),
             mass=20.0,
         )
@@ -681,6 +768,10 @@ class HomeWorld:
             ],
             (self.person.start.x + dx, self.person.start.y + dy, legs / 2),
         )
+
+
+def _region(name: str, box: Box) -> Region:
+    return Region(name, box.min_x, box.max_x, box.min_y, box.max_y, box.min_z, box.max_z)
 
 
 def _half_and_centre(region: Region) -> tuple[Vec3, Vec3]:

@@ -36,13 +36,19 @@ PERSON_START = (_person.start.x, _person.start.y)
 _robot = next(iter(_MAP.robots.values()))
 BASE_START = Pose2D(_robot.start.x, _robot.start.y, _robot.start.yaw)
 ARM_MOUNTS = {arm.side: arm.mount for arm in _MAP.arms.values()}
-ROOMS = {thing.name: region(thing.name) for thing in _MAP.things.values() if thing.box.max_z == 0.0}
+ARM_FACING = {arm.side: arm.yaw for arm in _MAP.arms.values()}
+ROOMS = {local_name(iri): region(local_name(iri)) for iri in _MAP.rooms}
 CAMERAS = {
     cam.name: CameraSpec(
         cam.name, cam.position, (cam.position[0], cam.position[1], 0.0), (0.0, 1.0, 0.0), fov_deg=cam.fov
     )
     for cam in _MAP.cameras.values()
+    if cam.looks_down
 }
+"""The ceiling cameras (each looks straight down, the top of its image to the north)."""
+_dispenser = next(iter(_MAP.dispensers.values()))
+TAP_LEVER = region(_dispenser.lever.name)
+WALLS = [region(local_name(iri)) for iri in sorted(_MAP.walls)]
 
 
 def room_of(x: float, y: float) -> str | None:
@@ -51,6 +57,7 @@ def room_of(x: float, y: float) -> str | None:
 
 
 __all__ = [
+    "ARM_FACING",
     "ARM_MOUNTS",
     "BASE_START",
     "BELOW_OF_TAP",
@@ -61,6 +68,8 @@ __all__ = [
     "PERSON_START",
     "ROOMS",
     "TABLE",
+    "TAP_LEVER",
+    "WALLS",
     "local_name",
     "room_of",
 ]

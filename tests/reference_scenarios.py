@@ -20,13 +20,12 @@ from sim import skills
 from sim.arms import ArmSide
 from sim.errors import SimulationError
 from sim.grasping import ObjectModel, compute_grasp_pose
-from sim.layout import TAP_LEVER
 from sim.mapping import OccupancyGrid, build_occupancy_grid
 from sim.perception import RobotPoseEstimate, locate_robot, recognise_object, track_person
 from sim.planning import approach_point, plan_path
 from sim.skills import Outcome
 from sim.world import HomeWorld
-from tests.home_layout import ARM_MOUNTS, BELOW_OF_TAP, HANDOVER_POSE
+from tests.home_layout import ARM_FACING, ARM_MOUNTS, BELOW_OF_TAP, HANDOVER_POSE, TAP_LEVER
 
 __all__ = ["PERSON_APPROACH_DISTANCE", "ScenarioResult", "fetch_pen", "serve_cup"]
 
@@ -88,7 +87,7 @@ def serve_cup(world: HomeWorld, arm: ArmSide = ArmSide.LEFT, tap_arm: ArmSide = 
     )
     if cup is None:
         return run.result()
-    grasp = compute_grasp_pose(model, cup.position, cup.yaw, ARM_MOUNTS[arm.value])
+    grasp = compute_grasp_pose(model, cup.position, cup.yaw, ARM_MOUNTS[arm.value], ARM_FACING[arm.value])
     steps: list[Callable[[], Outcome]] = [
         lambda: skills.approach_object(world, arm, grasp),
         lambda: skills.pick_up_object(world, arm, grasp),
@@ -115,7 +114,9 @@ def fetch_pen(
     run = _Run(world, "FetchMyPen", world.time)
 
     def locate() -> RobotPoseEstimate | None:
-        return run.sense(f"LocateMobileRobot_{camera}", lambda: locate_robot(world.camera(camera).capture()))
+        return run.sense(
+            f"LocateMobileRobot_{camera}", lambda: locate_robot(world.camera(camera).capture(), world.marker_model)
+        )
 
     start = locate()
     if start is None:

@@ -15,6 +15,7 @@ from kb import KnowledgeBase
 from kb.namespaces import PREFIXES
 from kb.semantic_map import AmbiguousDesignatorError, MapError, SemanticMap, UnresolvedDesignatorError, designate
 from sim.components import SimEnvironment
+from sim.mapping import build_occupancy_grid
 from sim.world import HomeWorld, open_world
 
 TASKS = Path(__file__).parent / "data" / "tasks"
@@ -120,6 +121,39 @@ def test_a_store_seeded_before_the_semantic_map_gets_it_on_open(tmp_path: Path) 
     reopened = KnowledgeBase.open(tmp_path / "store")
     assert reopened.store.count() > before
     assert WORLD + "Cup" in SemanticMap.read(reopened).objects  # with its inherited grasp again
+
+
+def test_a_store_with_an_older_map_gets_the_new_statements_and_keeps_what_the_user_moved(tmp_path: Path) -> None:
+    kb = KnowledgeBase.open(tmp_path / "store")
+    robot = PREFIXES["svc"] + "P3DX01"
+    kb.update(  # what a store seeded by the previous version looks like: no footprint, version 0.1.0
+        f"""DELETE WHERE {{ GRAPH graph:map {{ <{robot}> home:sizeX ?x ; home:sizeY ?y .
+                                          <https://w3id.org/cbrs/world> owl:versionInfo ?v }} }}"""
+    )
+    kb.update("INSERT DATA { GRAPH graph:map { <https://w3id.org/cbrs/world> owl:versionInfo '0.1.0' } }")
+    kb.update(f"DELETE WHERE {{ GRAPH graph:map {{ <{WORLD}Cup> home:x ?x }} }}")
+    kb.update(f"INSERT DATA {{ GRAPH graph:map {{ <{WORLD}Cup> home:x 7.3 }} }}")  # the user moved the cup
+    with pytest.raises(MapError, match=r"P3DX01.*home:sizeX"):
+        SemanticMap.read(kb)
+    kb.store.close()
+    reopened = SemanticMap.read(KnowledgeBase.open(tmp_path / "store"))
+    assert reopened.robots[robot].footprint == (0.45, 0.38)
+    assert reopened.objects[WORLD + "Cup"].start.x == 7.3
+
+
+def test_a_wall_written_in_turtle_is_built_and_mapped() -> None:
+    kb = KnowledgeBase.open(":memory:")
+    kb.update(
+        f"""INSERT DATA {{ GRAPH graph:map {{
+            <{WORLD}Partition> a home:Wall ; home:minX 4.0 ; home:maxX 4.1 ; home:minY 3.0 ; home:maxY 4.5 ;
+                home:minZ 0.0 ; home:maxZ 1.0 . }} }}"""
+    )
+    with open_world(semantic_map=SemanticMap.read(kb)) as world:
+        assert "Partition" in world.bodies
+        grid = build_occupancy_grid(world)
+        assert grid.is_occupied(4.05, 3.75)
+    with open_world() as bundled:
+        assert not build_occupancy_grid(bundled).is_occupied(4.05, 3.75)
 
 
 def test_a_better_camera_registered_in_turtle_is_used_by_fetch_my_pen() -> None:

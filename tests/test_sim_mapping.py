@@ -18,10 +18,10 @@ from sim import (
     build_occupancy_grid,
     plan_path,
 )
-from sim.layout import BASE_RADIUS, MAP_RESOLUTION, WALLS
+from sim.layout import MAP_RESOLUTION
 from sim.mapping import inflate
 from sim.planning import approach_point, snap_to_free
-from tests.home_layout import HANDOVER_POSE, TABLE
+from tests.home_layout import HANDOVER_POSE, TABLE, WALLS
 
 
 @pytest.fixture(scope="module")
@@ -49,10 +49,13 @@ def test_grid_covers_the_home(grid: OccupancyGrid) -> None:
 
 
 def test_walls_are_occupied_and_doors_open(grid: OccupancyGrid) -> None:
+    assert len(WALLS) == 10
     for wall in WALLS:
+        along_x = wall.xmax - wall.xmin > wall.ymax - wall.ymin
         for t in np.linspace(0.05, 0.95, 7):
-            x = min(max(wall.x0 + t * (wall.x1 - wall.x0), 0.01), 9.99)
-            y = min(max(wall.y0 + t * (wall.y1 - wall.y0), 0.01), 8.99)
+            x = wall.xmin + t * (wall.xmax - wall.xmin) if along_x else (wall.xmin + wall.xmax) / 2
+            y = (wall.ymin + wall.ymax) / 2 if along_x else wall.ymin + t * (wall.ymax - wall.ymin)
+            x, y = min(max(x, 0.01), 9.99), min(max(y, 0.01), 8.99)
             assert grid.is_occupied(x, y), (wall.name, x, y)
     assert not grid.is_occupied(6.0, 2.1)  # living room - kitchen door
     assert not grid.is_occupied(2.5, 5.0)  # living room - bedroom door
@@ -74,9 +77,9 @@ def test_furniture_robot_and_person_are_occupied(world: HomeWorld, grid: Occupan
 def test_inflation_keeps_the_base_radius_from_obstacles(grid: OccupancyGrid) -> None:
     west = TABLE.xmin  # the table's west edge, 1 m from the kitchen wall
     assert grid.is_occupied(west + 0.05, 3.75)
-    assert not grid.is_occupied(west - BASE_RADIUS + 0.05, 3.75)
-    assert not grid.is_free(west - BASE_RADIUS + 0.05, 3.75)  # within the base's radius of the table
-    assert grid.is_free(west - BASE_RADIUS - 0.1, 3.75)
+    assert not grid.is_occupied(west - grid.inflation_radius + 0.05, 3.75)
+    assert not grid.is_free(west - grid.inflation_radius + 0.05, 3.75)  # within the base's radius of the table
+    assert grid.is_free(west - grid.inflation_radius - 0.1, 3.75)
     assert not grid.is_free(3.0, 0.2)  # 0.2 m from the south wall
     single = np.zeros((11, 11), dtype=bool)
     single[5, 5] = True
@@ -119,8 +122,8 @@ def test_a_goal_in_an_obstacle_is_snapped_to_the_nearest_free_cell(grid: Occupan
     goal = (TABLE.xmin + 0.05, 3.75)  # on the table, by its west edge
     path = plan_path(grid, (3.0, 1.5), goal)
     assert grid.is_free(*path.goal)
-    assert math.dist(path.goal, goal) < BASE_RADIUS + 0.05 + 2 * MAP_RESOLUTION
-    assert path.goal[0] < TABLE.xmin - BASE_RADIUS
+    assert math.dist(path.goal, goal) < grid.inflation_radius + 0.05 + 2 * MAP_RESOLUTION
+    assert path.goal[0] < TABLE.xmin - grid.inflation_radius
     row, col = snap_to_free(grid, 3.0, 3.0)
     assert grid.cell_to_world(row, col) == grid.cell_to_world(*grid.world_to_cell(3.0, 3.0))
 

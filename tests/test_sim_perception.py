@@ -61,7 +61,7 @@ def test_localisation_from_the_marker(world: HomeWorld, pose: Pose2D, camera: st
     world.step(0.05)
     truth = world.base_pose()
     assert pred.robot_visible(world, camera)
-    estimate = locate_robot(world.camera(camera).capture())
+    estimate = locate_robot(world.camera(camera).capture(), world.marker_model)
     assert math.hypot(estimate.x - truth.x, estimate.y - truth.y) < LOCALISATION_ERROR
     assert abs(wrap_angle(estimate.theta - truth.theta)) < HEADING_ERROR
     assert estimate.camera == camera
@@ -73,7 +73,7 @@ def test_a_base_out_of_view_is_reported_not_visible(world: HomeWorld) -> None:
     for camera in CEILING:
         assert not pred.robot_visible(world, camera)
         with pytest.raises(NotVisibleError) as error:
-            locate_robot(world.camera(camera).capture())
+            locate_robot(world.camera(camera).capture(), world.marker_model)
         assert error.value.camera == camera
         assert error.value.pixels < error.value.needed
     world.base.place(BASE_START)
@@ -89,11 +89,11 @@ def test_a_failed_camera_raises_and_the_other_stands_in(world: HomeWorld) -> Non
         with pytest.raises(CameraUnavailableError) as error:
             world.camera("CeilingCamera01").capture()
         assert error.value.camera == "CeilingCamera01"
-        estimate = locate_robot(world.camera("CeilingCamera02").capture())
+        estimate = locate_robot(world.camera("CeilingCamera02").capture(), world.marker_model)
         assert math.hypot(estimate.x - BASE_START.x, estimate.y - BASE_START.y) < LOCALISATION_ERROR
     finally:
         world.repair_camera("CeilingCamera01")
-    assert locate_robot(world.camera("CeilingCamera01").capture()).camera == "CeilingCamera01"
+    assert locate_robot(world.camera("CeilingCamera01").capture(), world.marker_model).camera == "CeilingCamera01"
 
 
 def test_person_tracking_by_shirt_colour(world: HomeWorld) -> None:

@@ -20,11 +20,10 @@ from sim import (
 )
 from sim import predicates as pred
 from sim.grasping import ObjectModel
-from sim.layout import TAP_LEVER
 from sim.mapping import build_occupancy_grid
 from sim.planning import approach_point, plan_path
 from sim.scene import bundled_map
-from tests.home_layout import ARM_MOUNTS, BELOW_OF_TAP, HANDOVER_POSE, TABLE
+from tests.home_layout import ARM_FACING, ARM_MOUNTS, BELOW_OF_TAP, HANDOVER_POSE, TABLE, TAP_LEVER
 from tests.reference_scenarios import PERSON_APPROACH_DISTANCE
 
 CUP = ObjectModel.of(bundled_map().objects[PREFIXES["world"] + "Cup"])
@@ -41,7 +40,7 @@ def test_serving_a_cup_skill_by_skill(world: HomeWorld) -> None:
     left, right = ArmSide.LEFT, ArmSide.RIGHT
     assert skills.clear_view(world).succeeded
     cup = recognise_object(world.camera("Kinect01").capture(), CUP.colour)
-    grasp = compute_grasp_pose(CUP, cup.position, cup.yaw, ARM_MOUNTS[left.value])
+    grasp = compute_grasp_pose(CUP, cup.position, cup.yaw, ARM_MOUNTS[left.value], ARM_FACING[left.value])
 
     assert not pred.gripper_near(world, left, "Cup")
     outcome = skills.approach_object(world, left, grasp)
@@ -76,7 +75,7 @@ def test_serving_a_cup_skill_by_skill(world: HomeWorld) -> None:
 def test_fetching_a_pen_skill_by_skill(world: HomeWorld) -> None:
     camera = world.camera("CeilingCamera01")
     grid = build_occupancy_grid(world)
-    start = locate_robot(camera.capture())
+    start = locate_robot(camera.capture(), world.marker_model)
     path = plan_path(grid, (start.x, start.y), HANDOVER_POSE.xy)
     assert not pred.base_near(world, HANDOVER_POSE)
     outcome = skills.navigate_to_place(world, path, HANDOVER_POSE)
@@ -84,7 +83,7 @@ def test_fetching_a_pen_skill_by_skill(world: HomeWorld) -> None:
     assert pred.base_near(world, HANDOVER_POSE, heading=True)
     assert pred.robot_visible(world, "CeilingCamera01") and pred.robot_visible(world, "CeilingCamera02")
 
-    parked = locate_robot(camera.capture())
+    parked = locate_robot(camera.capture(), world.marker_model)
     pen = recognise_object(world.camera("Kinect01").capture(), PEN.colour)
     assert not pred.on_platform(world, "Pen")
     outcome = skills.hand_over_onto_platform(world, pen, parked, ArmSide.RIGHT, PEN, 0.85)
@@ -92,7 +91,7 @@ def test_fetching_a_pen_skill_by_skill(world: HomeWorld) -> None:
     assert pred.on_platform(world, "Pen") and not pred.is_grasped(world, "Pen")
 
     person = track_person(camera.capture())
-    here = locate_robot(camera.capture())
+    here = locate_robot(camera.capture(), world.marker_model)
     goal = approach_point((person.x, person.y), (here.x, here.y), PERSON_APPROACH_DISTANCE)
     path = plan_path(grid, (here.x, here.y), goal, "dijkstra")
     assert not pred.base_near_person(world)
@@ -109,7 +108,7 @@ def test_fetching_a_pen_skill_by_skill(world: HomeWorld) -> None:
 
 def test_skills_refuse_what_they_cannot_do(world: HomeWorld) -> None:
     cup = recognise_object(world.camera("Kinect01").capture(), CUP.colour)
-    grasp = compute_grasp_pose(CUP, cup.position, cup.yaw, ARM_MOUNTS["left"])
+    grasp = compute_grasp_pose(CUP, cup.position, cup.yaw, ARM_MOUNTS["left"], ARM_FACING["left"])
     refused = [
         (skills.pick_up_object(world, "left", grasp), "not near"),
         (skills.carry_object(world, "left", BELOW_OF_TAP), "holds nothing"),
@@ -154,10 +153,10 @@ def test_navigation_that_cannot_finish_in_time_gives_up(world: HomeWorld) -> Non
 
 
 def test_grasp_poses_follow_the_object_models() -> None:
-    side = compute_grasp_pose(CUP, (7.45, 3.32, 0.80), None, ARM_MOUNTS["left"])
+    side = compute_grasp_pose(CUP, (7.45, 3.32, 0.80), None, ARM_MOUNTS["left"], ARM_FACING["left"])
     assert side.position[2] == pytest.approx(0.75 + CUP.grasp_height)
     assert side.approach[1] > 0.5 and side.approach[2] < 0  # in from the robot, tilted down
     assert math.dist(side.pregrasp, side.position) == pytest.approx(0.10)
-    top = compute_grasp_pose(PEN, (8.07, 3.3, 0.758), 0.3, ARM_MOUNTS["right"])
+    top = compute_grasp_pose(PEN, (8.07, 3.3, 0.758), 0.3, ARM_MOUNTS["right"], ARM_FACING["right"])
     assert top.approach == (0.0, 0.0, -1.0)
     assert top.pregrasp[2] == pytest.approx(top.position[2] + 0.10)

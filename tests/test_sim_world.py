@@ -30,7 +30,7 @@ def world() -> Iterator[HomeWorld]:
 
 
 def test_the_entities_of_the_ontology_are_there(world: HomeWorld) -> None:
-    for name in ("P3DX01", "CytonDualArm01", "Kinect01", "Cup", "Pen", "Person", "KitchenTable", "WaterDispenser"):
+    for name in ("P3DX01", "CytonDualArm01", "Kinect01", "Cup", "Pen", "Person", "KitchenTable", "WaterDispenser01"):
         assert world.body(name) >= 0
     assert set(world.cameras) == {*CAMERAS, "Kinect01"}
     with pytest.raises(UnknownEntityError) as error:

@@ -24,13 +24,13 @@ from sim.components import SKILLS, SimComponent, SimContext, SimEnvironment
 from sim.errors import SimulationError
 from sim.geometry import Pose2D
 from sim.grasping import GraspKind, ObjectModel
-from sim.layout import BASE_RADIUS
 from sim.mapping import OccupancyGrid, inflate
 from sim.perception import ObjectEstimate, PersonEstimate, RobotPoseEstimate
 from sim.planning import PlannedPath
 from sim.values import (
     APPROACH_POSITION,
     COLOUR_FEATURE,
+    DEFAULT_INFLATION_RADIUS,
     GRASP_POSE,
     MANIPULATION_PROPERTY,
     OBJECT_FEATURE,
@@ -222,7 +222,7 @@ def test_a_grid_decodes_to_the_same_cells_once_the_encoded_one_is_gone() -> None
     made = {"@type": OCCUPANCY_GRID_MAP, "resolution": 0.1, "origin": [0, 0], "width": 3, "height": 2, "cells": "sA=="}
     grid = decode(made, OccupancyGrid)  # bits 101 100, padded: 0xB0
     assert grid.occupied.tolist() == [[True, False, True], [True, False, False]]
-    assert grid.inflation_radius == BASE_RADIUS and grid.inflated.all()  # 0.30 m covers the 3 x 2 cells
+    assert grid.inflation_radius == DEFAULT_INFLATION_RADIUS and grid.inflated.all()  # 0.30 m covers the 3 x 2 cells
 
 
 def test_values_from_elsewhere_may_leave_out_what_only_the_simulation_knows() -> None:
