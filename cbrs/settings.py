@@ -36,6 +36,13 @@ def _positive(kind: Callable[[str], float]) -> Callable[[str], Any]:
     return parse
 
 
+def _non_negative(text: str) -> int:
+    value = int(text)
+    if value < 0:
+        raise ValueError(f"{text} must not be negative")
+    return value
+
+
 def _flag(text: str) -> bool:
     word = text.strip().lower()
     if word in ("1", "true", "yes", "on"):
@@ -140,6 +147,45 @@ SETTINGS: tuple[Setting, ...] = (
         lambda: 4,
         "SPARQL queries the endpoint runs at once; one more is refused with 503 busy rather than queued.",
         "CBRS_QUERY_WORKERS",
+        _positive(int),
+    ),
+    Setting(
+        "query_workers_per_client",
+        lambda: 2,
+        "SPARQL queries one client (an IP address) may run at once, on HTTP and the bridge together; one "
+        "more is refused with 503 busy, so no client can take every query worker.",
+        "CBRS_QUERY_WORKERS_PER_CLIENT",
+        _positive(int),
+    ),
+    Setting(
+        "query_memory",
+        lambda: 1024 * 1024 * 1024,
+        "Bytes of memory one SPARQL query may hold (its worker process's resident size); a query that "
+        "needs more is stopped and refused with 422. 0 sets no limit.",
+        "CBRS_QUERY_MEMORY",
+        _non_negative,
+    ),
+    Setting(
+        "stream_limit",
+        lambda: 8,
+        "Event and camera streams (/tasks/events, /camera.mjpg) open at once; each has a thread of its own "
+        "beside the 16 that answer requests, and one more is refused with 503.",
+        "CBRS_STREAM_LIMIT",
+        _positive(int),
+    ),
+    Setting(
+        "streams_per_client",
+        lambda: 2,
+        "Event and camera streams one client (an IP address) may have open at once.",
+        "CBRS_STREAMS_PER_CLIENT",
+        _positive(int),
+    ),
+    Setting(
+        "bridge_connections_per_client",
+        lambda: 64,
+        "Websocket connections one client (an IP address) may hold on the rosbridge port; one more is "
+        "refused with HTTP 503 at the handshake.",
+        "CBRS_BRIDGE_CONNECTIONS_PER_CLIENT",
         _positive(int),
     ),
     Setting(

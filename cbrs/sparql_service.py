@@ -4,12 +4,15 @@ The HTTP endpoint and the rosbridge ``/cbrs/query`` service are thin layers over
 
 How a query is bounded (Oxigraph has no query timeout of its own):
 
-- it runs on its own thread, at most ``workers`` at once; when all are taken the request is refused at once (busy),
-  so runaway queries cannot pile up;
+- at most ``workers`` run at once, and at most ``workers_per_client`` for one client (an IP address);
+  one more is refused at once (busy), so runaway queries cannot pile up and one client cannot take them all;
+- on an on-disk store it is evaluated in a worker process on a snapshot of the store
+  (:mod:`cbrs.query_workers`), killed at the deadline or when it holds more than ``memory`` bytes:
+  its core, its memory and its slot are free at once;
 - its result is serialised by Oxigraph into a writer that checks the deadline and the byte budget on
   every chunk, so a query that streams many solutions stops at the deadline or the limit;
-- a query still computing its first solution at the deadline is answered "timed out" and its thread
-  is left to finish; it keeps its worker slot until it does.
+- on an in-memory or remote store it runs on a thread instead; a query still computing its first
+  solution at the deadline is answered "timed out" and that thread is left to finish, keeping its slot.
 """
 
 from __future__ import annotations
@@ -18,19 +21,23 @@ import hmac
 import io
 import threading
 import time
+from collections import Counter
 from collections.abc import Callable, Sequence
 from concurrent.futures import Future
 from concurrent.futures import TimeoutError as FutureTimeout
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import pyoxigraph as ox
 from werkzeug.datastructures import MIMEAccept
 from werkzeug.http import parse_accept_header
 
+from cbrs.query_workers import QueryProcesses, QueryStopped, Request
+from cbrs.settings import setting
 from kb import KnowledgeBase
-from kb.errors import KnowledgeBaseError, StoreEvaluationError
+from kb.errors import KnowledgeBaseError, QueryTooComplexError, StoreEvaluationError
 from kb.query_guard import start_evaluation_thread
+from kb.store import EmbeddedStore
 
 # Media types offered for SELECT and ASK results, the first being the default.
 RESULT_TYPES: dict[str, ox.QueryResultsFormat] = {
@@ -107,17 +114,38 @@ class QueryTimeoutError(EndpointError):
     http_status = 503
     kind = "timeout"
 
-    def __init__(self, seconds: float) -> None:
+    def __init__(self, seconds: float, stopped: bool = False) -> None:
         self.seconds = seconds
-        super().__init__(f"the query did not finish within {seconds:g} s (setting query_timeout)")
+        end = "; it was stopped" if stopped else ""
+        super().__init__(f"the query did not finish within {seconds:g} s (setting query_timeout){end}")
+
+
+class QueryMemoryError(EndpointError):
+    http_status = 422
+    kind = "query-too-large"
+
+    def __init__(self, limit: int) -> None:
+        self.limit = limit
+        super().__init__(
+            f"the query needed more than {limit >> 20} MiB of memory (setting query_memory) and was stopped; "
+            "add a LIMIT, or narrow its patterns"
+        )
 
 
 class EndpointBusyError(EndpointError):
     http_status = 503
     kind = "busy"
 
-    def __init__(self, workers: int) -> None:
-        super().__init__(f"all {workers} query workers are busy; retry shortly (setting query_workers)")
+    def __init__(self, workers: int, client: str | None = None, per_client: int | None = None) -> None:
+        self.client = client
+        if client is not None:
+            message = (
+                f"{client} already runs {per_client} queries, the most one client may run at once; retry when "
+                "one has ended (setting query_workers_per_client)"
+            )
+        else:
+            message = f"all {workers} query workers are busy; retry shortly (setting query_workers)"
+        super().__init__(message)
 
 
 class UpdateForbiddenError(EndpointError):
@@ -141,6 +169,11 @@ class EndpointConfig:
     update_token: str | None = None
     workers: int = 4
     read_only: bool = False  # refuse every write, token or not
+    # queries one client (an IP address) may run at once, and the resident bytes a query's worker
+    # process may hold (0: no limit); from the settings table unless given
+    workers_per_client: int = field(default_factory=lambda: setting("query_workers_per_client").resolve())
+    memory: int = field(default_factory=lambda: setting("query_memory").resolve())
+    isolate: bool = True  # evaluate in killable worker processes when the store is on disk
 
 
 class _Stop(Exception):
@@ -176,18 +209,33 @@ class SparqlService:
         self.config = config or EndpointConfig()
         self.lock = lock or threading.RLock()  # held by writers, so readers of cached descriptions see whole updates
         self._slots = threading.BoundedSemaphore(self.config.workers)
+        self._clients: Counter[str] = Counter()
+        self._clients_lock = threading.Lock()
         self._listeners: list[Callable[[], None]] = []
         self.generation = 0  # bumped by every update, so caches built from the store know they are stale
+        store = kb.store
+        self.processes: QueryProcesses | None = None
+        if self.config.isolate and isinstance(store, EmbeddedStore) and not store.in_memory:
+            self.processes = QueryProcesses(store, self.config.workers, self.config.memory)
 
     @property
     def writable(self) -> bool:
         return self.config.update_token is not None and not self.config.read_only
 
-    def query(self, text: str, accept: str | None = None, short_format: str | None = None) -> Answer:
-        """Run ``text`` and serialise its result in the best format for ``accept`` (an Accept header value)."""
+    def query(
+        self, text: str, accept: str | None = None, short_format: str | None = None, client: str | None = None
+    ) -> Answer:
+        """Run ``text`` and serialise its result in the best format for ``accept`` (an Accept header value).
+
+        ``client`` (an IP address) is who asks: one client runs at most ``workers_per_client`` queries at once.
+        """
         self._check_size(text)
-        if not self._slots.acquire(blocking=False):
-            raise EndpointBusyError(self.config.workers)
+        release = self._admit(client)
+        if self.processes is not None:
+            try:
+                return self._in_process(text, accept, short_format)
+            finally:
+                release()
         deadline = time.monotonic() + self.config.timeout
         future: Future[Answer] = Future()
 
@@ -196,18 +244,88 @@ class SparqlService:
                 future.set_result(self._evaluate(text, accept, short_format, deadline))
             except BaseException as error:  # handed to the waiting request
                 future.set_exception(error)
+            finally:
+                release()
 
         # A daemon thread, not a pool's: an abandoned query must not keep the process from exiting.
         worker = threading.Thread(target=work, name="cbrs-sparql-query", daemon=True)
         try:
             start_evaluation_thread(worker)  # the stack kb.query_guard's margin is measured against
         except BaseException:
-            self._slots.release()
+            release()
             raise
         try:
             return future.result(timeout=self.config.timeout)
         except FutureTimeout:
             raise QueryTimeoutError(self.config.timeout) from None
+
+    def close(self) -> None:
+        """Stop the query worker processes and delete their snapshots."""
+        if self.processes is not None:
+            self.processes.close()
+
+    def _admit(self, client: str | None) -> Callable[[], None]:
+        """Take a worker slot for ``client``; the call returned gives it back (once)."""
+        limit = min(self.config.workers_per_client, self.config.workers)
+        with self._clients_lock:
+            if client is not None and self._clients[client] >= limit:
+                raise EndpointBusyError(self.config.workers, client, limit)
+            if not self._slots.acquire(blocking=False):
+                raise EndpointBusyError(self.config.workers)
+            if client is not None:
+                self._clients[client] += 1
+        released = threading.Event()
+
+        def release() -> None:
+            if released.is_set():
+                return
+            released.set()
+            with self._clients_lock:
+                if client is not None:
+                    self._clients[client] -= 1
+                    if self._clients[client] <= 0:
+                        del self._clients[client]
+                self._slots.release()
+
+        return release
+
+    def _in_process(self, text: str, accept: str | None, short_format: str | None) -> Answer:
+        assert self.processes is not None
+        store = self.processes.store
+        refusals: dict[bool, NotAcceptableError] = {}
+        chosen: dict[bool, str | None] = {}
+        for graph in (False, True):
+            try:
+                chosen[graph] = negotiate(graph, accept, short_format)
+            except NotAcceptableError as error:
+                refusals[graph], chosen[graph] = error, None
+        store.check_query(text)
+        results, graph_type = chosen[False], chosen[True]
+        request = Request(
+            text=text,
+            results_type=results,
+            graph_type=graph_type,
+            results_format=RESULT_TYPES[results].media_type if results else "application/sparql-results+json",
+            graph_format=GRAPH_TYPES[graph_type].media_type if graph_type else "application/n-triples",
+            limit=self.config.max_result_bytes,
+            timeout=self.config.timeout,
+        )
+        try:
+            body, media_type = self.processes.run(request)
+        except QueryStopped as stopped:
+            raise self._stopped(stopped, refusals) from None
+        except QueryTooComplexError as error:
+            raise QueryTooComplexError(text, error.message) from None
+        return Answer(body, media_type)
+
+    def _stopped(self, stopped: QueryStopped, refusals: dict[bool, NotAcceptableError]) -> EndpointError:
+        if stopped.reason == "timeout":
+            return QueryTimeoutError(self.config.timeout, stopped=True)
+        if stopped.reason == "memory":
+            return QueryMemoryError(self.config.memory)
+        if stopped.reason == "too-large":
+            return ResultTooLargeError(self.config.max_result_bytes)
+        return refusals[str(stopped) == "graph"]
 
     def update(self, text: str, token: str | None) -> None:
         """Run a SPARQL update when ``token`` is the configured update token; one transaction."""
@@ -257,7 +375,6 @@ class SparqlService:
             return Answer(writer.getvalue(), media_type)
         finally:
             result = None
-            self._slots.release()
 
 
 def negotiate(graph: bool, accept: str | None, short_format: str | None = None) -> str:

@@ -179,6 +179,8 @@ class EmbeddedStore(Store):
     def __init__(self, backend: ox.Store, location: str) -> None:
         self._open: ox.Store | None = backend
         self.location = location
+        self.generation = 0
+        """Counts the writes made through this object, so a snapshot knows whether it is current."""
 
     @property
     def _backend(self) -> ox.Store:
@@ -224,9 +226,7 @@ class EmbeddedStore(Store):
         substitutions: dict[ox.Variable, ox.NamedNode | ox.BlankNode | ox.Literal | ox.Triple] = {
             ox.Variable(name): value for name, value in (bindings or {}).items()
         }
-        refuse_deep_nesting(text)
-        refuse_remote_access(text, self.remote_access)
-        self.guard.admit("query", text)
+        self.check_query(text)
         try:
             return self._backend.query(
                 text, prefixes=PREFIXES, use_default_graph_as_union=True, substitutions=substitutions
@@ -235,6 +235,21 @@ class EmbeddedStore(Store):
             raise QuerySyntaxError(text, str(error)) from error
         except RuntimeError as error:  # errors found while iterating the result stay pyoxigraph's RuntimeError
             raise StoreEvaluationError(self.location, "query", str(error)) from error
+
+    def check_query(self, text: str) -> None:
+        """Refuse, before any parser sees it, a query that nests too deeply, reaches out or crashes the
+        guard's checker; what :meth:`query` does first, for callers that evaluate elsewhere."""
+        refuse_deep_nesting(text)
+        refuse_remote_access(text, self.remote_access)
+        self.guard.admit("query", text)
+
+    def snapshot(self, target: Path) -> None:
+        """A read-only copy of the store as it is now in ``target`` (which must not exist): a RocksDB
+        checkpoint, hard links to the store's immutable files when on the same file system."""
+        try:
+            self._backend.backup(str(target))
+        except OSError as error:
+            raise StoreError(self.location, f"snapshot into {target} failed: {error}") from error
 
     def quads(
         self,
@@ -269,6 +284,8 @@ class EmbeddedStore(Store):
             self._backend.extend(quads)
         except OSError as error:
             raise StoreError(self.location, f"write failed: {error}") from error
+        finally:
+            self.generation += 1
 
     def update(self, text: str) -> None:
         """Run a SPARQL update in one transaction."""
@@ -278,6 +295,7 @@ class EmbeddedStore(Store):
         self._apply_own_update(text)
 
     def _apply_own_update(self, text: str) -> None:
+        self.generation += 1  # before as well as after: a snapshot taken meanwhile is never current
         try:
             self._backend.update(text, prefixes=PREFIXES)
         except SyntaxError as error:
@@ -286,6 +304,8 @@ class EmbeddedStore(Store):
             raise StoreError(self.location, f"update failed: {error}") from error
         except RuntimeError as error:  # e.g. CREATE GRAPH of a graph that exists
             raise StoreEvaluationError(self.location, "update", str(error)) from error
+        finally:
+            self.generation += 1
 
     def flush(self) -> None:
         if not self.in_memory:

@@ -48,7 +48,7 @@ def start_server() -> Iterator[StartServer]:
     threads = threading.active_count()
 
     def start(kb: KnowledgeBase, workers: int) -> Server:
-        endpoint = EndpointConfig(update_token=TOKEN, workers=workers)
+        endpoint = EndpointConfig(update_token=TOKEN, workers=workers, workers_per_client=workers)  # one client here
         server = Server(kb, ServeConfig(port=0, bridge_port=0, endpoint=endpoint))
         server.start()
         started.append(server)

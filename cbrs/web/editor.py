@@ -45,7 +45,7 @@ def editor() -> Page:
     started = time.perf_counter()
     try:
         # SELECT and ASK come back as SPARQL JSON results, CONSTRUCT and DESCRIBE as Turtle
-        answer = context.sparql().query(text, short_format="turtle")
+        answer = context.sparql().query(text, short_format="turtle", client=request.remote_addr)
     except QuerySyntaxError as error:
         raise FormError({"query": str(error)}, page=shown) from error
     except KnowledgeBaseError as error:  # a timeout, a result too large, busy workers, an evaluation error

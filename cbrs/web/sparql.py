@@ -45,7 +45,7 @@ def sparql() -> Response:
         return _update(update)
     if query is None:
         return _service_description()
-    answer = context.sparql().query(query, request.headers.get("Accept"), _short_format())
+    answer = context.sparql().query(query, request.headers.get("Accept"), _short_format(), client=request.remote_addr)
     return Response(answer.body, content_type=_with_charset(answer.media_type))
 
 

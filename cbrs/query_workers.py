@@ -1,0 +1,336 @@
+"""SPARQL queries evaluated in worker processes, so that a query past its deadline can be stopped.
+
+Oxigraph has no way to interrupt an evaluation: a query computing an aggregate over a cartesian
+product holds its thread (and a core, and a growing amount of memory) until it ends, however long
+that is, and a thread cannot be killed from Python. A process can. So the endpoint evaluates each
+query in one of a few worker processes (:mod:`cbrs._query_worker`) on a read-only snapshot of the
+store, and kills the worker when the query outlasts ``timeout`` or its resident memory passes
+``memory``: the core and the memory are back at once, the slot is free, and a fresh worker starts.
+
+A snapshot is a RocksDB checkpoint of the store (hard links to its immutable files, made in tens of
+milliseconds), taken when a query finds the store written since the last one, so a query always sees
+every write that came before it. A snapshot no worker reads and that is not the newest is deleted.
+Only an on-disk embedded store can be snapshotted; the endpoint evaluates in threads otherwise.
+"""
+
+from __future__ import annotations
+
+import atexit
+import contextlib
+import json
+import logging
+import os
+import select
+import shutil
+import signal
+import struct
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from kb.errors import KnowledgeBaseError, QuerySyntaxError, QueryTooComplexError, StoreEvaluationError
+from kb.namespaces import PREFIXES
+from kb.query_guard import EVALUATION_STACK
+from kb.store import EmbeddedStore
+
+log = logging.getLogger("cbrs.query_workers")
+
+_SCRIPT = Path(__file__).with_name("_query_worker.py")
+_REQUEST = struct.Struct(">I")
+_REPLY = struct.Struct(">cI")
+_WATCH = 0.05  # seconds between two looks at a busy worker's resident memory
+_START = 20.0  # seconds a new worker may take to say it is ready
+_PAGE = os.sysconf("SC_PAGE_SIZE") if hasattr(os, "sysconf") else 4096
+
+
+class QueryStopped(KnowledgeBaseError):
+    """A query the endpoint stopped: ``reason`` is ``timeout``, ``memory``, ``too-large`` or ``not-acceptable``."""
+
+    def __init__(self, reason: str, detail: str = "") -> None:
+        self.reason = reason
+        super().__init__(detail or reason)
+
+
+@dataclass(frozen=True)
+class Request:
+    text: str
+    results_type: str | None  # the media type to answer a SELECT or ASK in; None: not acceptable
+    graph_type: str | None  # likewise for CONSTRUCT and DESCRIBE
+    results_format: str  # the canonical media type of the serialiser for each
+    graph_format: str
+    limit: int
+    timeout: float
+
+
+class _Snapshot:
+    def __init__(self, path: Path, generation: int) -> None:
+        self.path = path
+        self.generation = generation
+        self.readers = 0
+
+
+class _Process:
+    """One worker process and the snapshot it has open."""
+
+    def __init__(self, stack: int, memory: int) -> None:
+        command = [sys.executable, str(_SCRIPT), json.dumps(PREFIXES), str(stack), str(memory)]
+        self.popen = subprocess.Popen(
+            command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, start_new_session=True
+        )
+        self.ready = False
+        self.snapshot: _Snapshot | None = None
+        _started.add(self.popen)
+
+    def alive(self) -> bool:
+        return self.popen.poll() is None
+
+    def resident(self) -> int:
+        try:
+            with open(f"/proc/{self.popen.pid}/statm", encoding="ascii") as statm:
+                return int(statm.read().split()[1]) * _PAGE
+        except (OSError, ValueError, IndexError):
+            return 0
+
+    def kill(self) -> None:
+        _stop(self.popen)
+        _started.discard(self.popen)
+
+
+class QueryProcesses:
+    """Up to ``size`` worker processes evaluating queries on snapshots of ``store``."""
+
+    def __init__(self, store: EmbeddedStore, size: int, memory: int, stack: int = EVALUATION_STACK) -> None:
+        if store.in_memory:
+            raise ValueError("an in-memory store cannot be snapshotted for worker processes")
+        self.store = store
+        self.size = size
+        self.memory = memory
+        self.stack = stack
+        self.killed = 0  # workers killed for a deadline or memory: for tests and the log
+        self._idle: list[_Process] = []
+        self._lock = threading.Lock()
+        self._snapshot_lock = threading.Lock()
+        self._current: _Snapshot | None = None
+        self._count = 0
+        self._closed = False
+        parent = Path(store.location).resolve().parent
+        try:  # beside the store, so the checkpoint hard-links its files instead of copying them
+            self._root = Path(tempfile.mkdtemp(prefix=".cbrs-query-snapshots-", dir=parent))
+        except OSError:
+            self._root = Path(tempfile.mkdtemp(prefix="cbrs-query-snapshots-"))
+        _roots.add(self._root)
+
+    def run(self, request: Request) -> tuple[bytes, str]:
+        """Evaluate ``request`` in a worker; (body, media type), or an error the endpoint reports."""
+        snapshot = self._fresh()
+        worker = self._take()
+        deadline = time.monotonic() + request.timeout
+        try:
+            self._hold(worker, snapshot)
+            payload = json.dumps(
+                {
+                    "snapshot": str(snapshot.path),
+                    "text": request.text,
+                    "results": request.results_type,
+                    "graph": request.graph_type,
+                    "results_format": request.results_format,
+                    "graph_format": request.graph_format,
+                    "limit": request.limit,
+                    "seconds": request.timeout,
+                }
+            ).encode("utf-8", "surrogatepass")
+            assert worker.popen.stdin is not None
+            worker.popen.stdin.write(_REQUEST.pack(len(payload)) + payload)
+            worker.popen.stdin.flush()
+            status, body = self._reply(worker, deadline)
+        except BaseException:
+            self._discard(worker)
+            raise
+        self._give_back(worker)
+        return self._outcome(request, status, body)
+
+    def close(self) -> None:
+        """Stop every idle worker and delete the snapshots (busy workers are killed when their query ends)."""
+        with self._lock:
+            self._closed = True
+            idle, self._idle = self._idle, []
+        for worker in idle:
+            worker.kill()
+        shutil.rmtree(self._root, ignore_errors=True)
+        _roots.discard(self._root)
+
+    # -- snapshots -------------------------------------------------------------------------------------
+
+    def _fresh(self) -> _Snapshot:
+        with self._snapshot_lock:
+            generation = self.store.generation
+            current = self._current
+            if current is not None and current.generation == generation:
+                return current
+            self._count += 1
+            path = self._root / f"snapshot-{self._count}"
+            self.store.snapshot(path)
+            self._current = _Snapshot(path, generation)
+            with self._lock:
+                if current is not None and current.readers == 0:
+                    shutil.rmtree(current.path, ignore_errors=True)
+            return self._current
+
+    def _hold(self, worker: _Process, snapshot: _Snapshot) -> None:
+        with self._lock:
+            self._release(worker)
+            worker.snapshot = snapshot
+            snapshot.readers += 1
+
+    def _release(self, worker: _Process) -> None:
+        """Called with ``_lock`` held: ``worker`` no longer reads its snapshot."""
+        old, worker.snapshot = worker.snapshot, None
+        if old is None:
+            return
+        old.readers -= 1
+        if old.readers == 0 and old is not self._current:
+            shutil.rmtree(old.path, ignore_errors=True)
+
+    # -- workers ---------------------------------------------------------------------------------------
+
+    def _take(self) -> _Process:
+        with self._lock:
+            while self._idle:
+                worker = self._idle.pop()
+                if worker.alive():
+                    return worker
+                self._release(worker)
+                worker.kill()
+        worker = _Process(self.stack, self.memory)
+        try:
+            status, _ = self._reply(worker, time.monotonic() + _START, starting=True)
+        except BaseException:
+            worker.kill()
+            raise
+        worker.ready = status == b"K"
+        return worker
+
+    def _give_back(self, worker: _Process) -> None:
+        with self._lock:
+            if not self._closed and len(self._idle) < self.size:
+                self._idle.append(worker)
+                return
+            self._release(worker)
+        worker.kill()
+
+    def _discard(self, worker: _Process) -> None:
+        with self._lock:
+            self._release(worker)
+        worker.kill()
+
+    def _spare(self) -> None:
+        """Start a worker in the background to replace a killed one, so the next query need not wait."""
+        with self._lock:
+            if self._closed or len(self._idle) >= self.size:
+                return
+
+        def start() -> None:
+            try:
+                worker = _Process(self.stack, self.memory)
+                self._reply(worker, time.monotonic() + _START, starting=True)
+            except Exception:  # no spare then: the next query starts its own worker
+                return
+            self._give_back(worker)
+
+        threading.Thread(target=start, name="cbrs-query-worker-start", daemon=True).start()
+
+    def _reply(self, worker: _Process, deadline: float, starting: bool = False) -> tuple[bytes, bytes]:
+        """The worker's answer; kills it at ``deadline`` or when it holds more than ``memory``."""
+        stdout = worker.popen.stdout
+        assert stdout is not None
+        buffer = b""
+        needed = _REPLY.size
+        header: tuple[bytes, int] | None = None
+        fd = stdout.fileno()
+        while True:
+            remaining = deadline - time.monotonic()
+            if remaining <= 0:
+                self._stop(worker, "timeout")
+                raise QueryStopped("timeout")
+            ready, _, _ = select.select([fd], [], [], min(_WATCH, remaining))
+            if not ready:
+                if not starting and self.memory > 0 and worker.resident() > self.memory:
+                    self._stop(worker, "memory")
+                    raise QueryStopped("memory")
+                continue
+            chunk = os.read(fd, max(65536, needed - len(buffer)))
+            if not chunk:
+                raise self._died(worker, starting)
+            buffer += chunk
+            if header is None and len(buffer) >= _REPLY.size:
+                header = _REPLY.unpack(buffer[: _REPLY.size])
+                buffer = buffer[_REPLY.size :]
+                needed = header[1]
+            if header is not None and len(buffer) >= needed:
+                return header[0], buffer[:needed]
+
+    def _stop(self, worker: _Process, why: str) -> None:
+        self.killed += 1
+        log.info("query worker %d killed: %s", worker.popen.pid, why)
+        self._discard(worker)
+        self._spare()
+
+    def _died(self, worker: _Process, starting: bool) -> KnowledgeBaseError:
+        try:
+            code = worker.popen.wait(timeout=5)
+        except subprocess.TimeoutExpired:
+            code = None
+        self._discard(worker)
+        self._spare()
+        how = f"signal {signal.Signals(-code).name}" if code is not None and code < 0 else f"exit status {code}"
+        if code == -signal.SIGABRT and self.memory > 0:  # an allocation past the address-space cap aborts
+            return QueryStopped("memory")
+        if starting:
+            return StoreEvaluationError(self.store.location, "query", f"a query worker could not start ({how})")
+        return QueryTooComplexError(
+            "", f"the query ended its worker process ({how}): it crashed the SPARQL engine or ran out of memory"
+        )
+
+    def _outcome(self, request: Request, status: bytes, body: bytes) -> tuple[bytes, str]:
+        message = body.decode("utf-8", "replace")
+        if status == b"K":
+            media, _, result = body.partition(b"\0")
+            return result, media.decode("ascii")
+        if status == b"S":
+            raise QuerySyntaxError(request.text, message)
+        if status == b"E":
+            raise StoreEvaluationError(self.store.location, "query", message)
+        if status == b"L":
+            raise QueryStopped("too-large")
+        if status == b"T":
+            raise QueryStopped("timeout")
+        if status == b"N":
+            raise QueryStopped("not-acceptable", message)
+        raise StoreEvaluationError(self.store.location, "query", f"unexpected worker answer {status!r}")
+
+
+_started: set[subprocess.Popen[bytes]] = set()
+_roots: set[Path] = set()
+
+
+def _stop(process: subprocess.Popen[bytes]) -> None:
+    if process.poll() is None:
+        process.kill()
+    with contextlib.suppress(subprocess.TimeoutExpired):
+        process.wait(timeout=5)
+    for stream in (process.stdin, process.stdout):
+        if stream is not None:
+            with contextlib.suppress(OSError):
+                stream.close()
+
+
+@atexit.register
+def _stop_all() -> None:
+    for process in list(_started):
+        _stop(process)
+    for root in list(_roots):
+        shutil.rmtree(root, ignore_errors=True)
