@@ -5,10 +5,14 @@ Services (request fields -> response values):
 - ``/cbrs/query`` ``{query}`` -> ``{media_type, result}``: SPARQL JSON results for SELECT/ASK, JSON-LD
   for CONSTRUCT/DESCRIBE; read-only, with the endpoint's timeout and size limit.
 - ``/cbrs/match`` ``{requirement, method="sem-str", top=10}`` -> the ranking with explanations.
-- ``/cbrs/plan`` ``{task, objective="similarity"}`` -> the plan (recorded in the plans graph) or what
-  is unsatisfied.
+- ``/cbrs/plan`` ``{task, objective="similarity"}`` -> the plan (recorded in the plans graph when the
+  caller may write) or what is unsatisfied.
 - ``/cbrs/run_task`` ``{task, seed=0, fail=[], wait=true}`` -> the run; with ``wait`` false it returns
   at once and the run is followed on the topics, or with ``/cbrs/task_status`` ``{run}``.
+
+Anonymous clients only read: recording a plan and running a task write the store, so they need a
+caller that sent the update token (op ``auth``) or a page of this server's own (its handshake's
+``Origin``). The topics below belong to the server; clients cannot advertise or publish them.
 
 Topics: ``/cbrs/task_progress`` (steps started, succeeded, failed, with failovers), ``/cbrs/lifecycle``
 (component states), ``/cbrs/task`` (a run's verdict) and ``/cbrs/events`` (runs starting and ending,
@@ -18,12 +22,12 @@ store updates).
 from __future__ import annotations
 
 import json
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 from typing import Any, TypeVar
 
 from actions.composer import ComposeConfig, Composer, Objective, store_plan
 from cbrs.matchmakers import Matchmakers
-from cbrs.rosbridge import Bridge, ServiceError
+from cbrs.rosbridge import Bridge, ServiceError, current_caller
 from cbrs.sparql_service import SparqlService
 from cbrs.tasks import RUN_TOPIC, TaskRunner
 from kb.errors import KnowledgeBaseError
@@ -44,10 +48,25 @@ Handler = Callable[[dict[str, Any]], dict[str, Any]]
 class KnowledgeServices:
     """Request handlers over one knowledge base."""
 
-    def __init__(self, sparql: SparqlService, tasks: TaskRunner, matchmakers: Matchmakers | None = None) -> None:
+    def __init__(
+        self,
+        sparql: SparqlService,
+        tasks: TaskRunner,
+        matchmakers: Matchmakers | None = None,
+        own_origins: Callable[[], Collection[str]] = lambda: (),
+    ) -> None:
         self.sparql = sparql
         self.tasks = tasks
         self.matchmakers = matchmakers or Matchmakers(sparql)
+        self.own_origins = own_origins
+
+    def may_write(self) -> bool:
+        """Whether the client whose call is answered may write: it sent the token, or it is one of this
+        server's pages. A call from this process (no bridge client) may."""
+        caller = current_caller()
+        if caller is None or caller.authorised:
+            return True
+        return caller.origin is not None and caller.origin.rstrip("/") in self.own_origins()
 
     def handlers(self) -> dict[str, tuple[str, Handler]]:
         """Service name -> (type, handler)."""
@@ -61,7 +80,9 @@ class KnowledgeServices:
 
     def query(self, args: dict[str, Any]) -> dict[str, Any]:
         text = _field(args, "query", str)
-        answer = _call(lambda: self.sparql.query(text, short_format="json"))
+        caller = current_caller()
+        client = caller.peer if caller is not None else None
+        answer = _call(lambda: self.sparql.query(text, short_format="json", client=client))
         return {"media_type": answer.media_type, "result": json.loads(answer.body)}
 
     def match(self, args: dict[str, Any]) -> dict[str, Any]:
@@ -85,7 +106,7 @@ class KnowledgeServices:
         with self.sparql.lock:
             composer = Composer(self.sparql.kb, ComposeConfig(objective=Objective(objective)))
             result = _call(lambda: composer.compose(task))
-            recorded = result.plan is not None and not self.sparql.config.read_only
+            recorded = result.plan is not None and not self.sparql.config.read_only and self.may_write()
             if result.plan is not None and recorded:
                 store_plan(self.sparql.kb, result.plan)
         return {**result.to_dict(), "recorded": recorded}
@@ -100,6 +121,11 @@ class KnowledgeServices:
             raise ServiceError("fail must be a list of component IRIs (strings)")
         if isinstance(rate, bool) or not isinstance(rate, (int, float)):
             raise ServiceError(f"field 'fault_rate' must be a number in [0, 1], not {type(rate).__name__}")
+        if not self.may_write() and not self.sparql.config.read_only:  # a read-only server says so itself
+            raise ServiceError(
+                "a task run moves the robot and writes the store: send the update token first "
+                '({"op": "auth", "mac": "<token>"}), or start it from this server\'s tasks page'
+            )
         if wait:
             run = _call(lambda: self.tasks.run(task, seed, faults, fault_rate=float(rate)))
         else:

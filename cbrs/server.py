@@ -20,9 +20,11 @@ from waitress.server import create_server
 from cbrs.bridge_services import KnowledgeServices, attach
 from cbrs.matchmakers import Matchmakers
 from cbrs.rosbridge import Bridge
+from cbrs.settings import setting
 from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.tasks import TaskRunner
 from cbrs.web import create_app
+from cbrs.web.context import StreamSlots
 from kb import KnowledgeBase
 
 log = logging.getLogger("cbrs.server")
@@ -35,7 +37,12 @@ class ServeConfig:
     bridge_port: int = 9090
     endpoint: EndpointConfig = field(default_factory=EndpointConfig)
     cors_origins: Sequence[str] = ()
-    http_threads: int = 16  # long requests (a task run, a camera stream) each hold one
+    http_threads: int = 16  # threads answering requests; the streams have their own on top
+    stream_limit: int = field(default_factory=lambda: setting("stream_limit").resolve())
+    streams_per_client: int = field(default_factory=lambda: setting("streams_per_client").resolve())
+    bridge_connections_per_client: int = field(
+        default_factory=lambda: setting("bridge_connections_per_client").resolve()
+    )
 
 
 class Server:
@@ -47,10 +54,18 @@ class Server:
         self.lock = threading.RLock()
         self.sparql = SparqlService(kb, self.config.endpoint, self.lock)
         self.tasks = TaskRunner(kb, self.lock, read_only=self.config.endpoint.read_only)
-        self.bridge = Bridge()
+        endpoint = self.config.endpoint
+        token = None if endpoint.read_only else endpoint.update_token
+        self.bridge = Bridge(
+            token=token,
+            reserved=("/cbrs/",),
+            connections_per_client=self.config.bridge_connections_per_client,
+        )
         self.matchmakers = Matchmakers(self.sparql)  # one taxonomy index for the pages and the bridge
-        self._detach = attach(self.bridge, KnowledgeServices(self.sparql, self.tasks, self.matchmakers))
-        self.app = create_app(self.sparql, self.config.cors_origins, self.tasks, self.matchmakers)
+        services = KnowledgeServices(self.sparql, self.tasks, self.matchmakers, self.own_origins)
+        self._detach = attach(self.bridge, services)
+        self.app = create_app(self.sparql, self.config.cors_origins, self.tasks, self.matchmakers, self.own_origins)
+        self.app.extensions["cbrs.streams"] = StreamSlots(self.config.stream_limit, self.config.streams_per_client)
         self._http: Any = None
         self._http_map: dict[int, Any] = {}
         self._http_thread: threading.Thread | None = None
@@ -70,7 +85,7 @@ class Server:
             self.app,
             host=self.config.host,
             port=self.config.port,
-            threads=self.config.http_threads,
+            threads=self.config.http_threads + self.config.stream_limit,
             map=self._http_map,
             ident="cbrs",
             clear_untrusted_proxy_headers=True,
@@ -83,12 +98,20 @@ class Server:
             self._stop_http(5.0)
             raise
 
+    def own_origins(self) -> frozenset[str]:
+        """The origins this server's pages come from: the address it binds (and, for loopback, the
+        loopback names), on its HTTP port. Never taken from a request, so DNS rebinding cannot add one."""
+        if self._http is None:
+            return frozenset()
+        port = self.http_port
+        host = f"[{self.config.host}]" if ":" in self.config.host else self.config.host
+        names = {host, "127.0.0.1", "localhost", "[::1]"}
+        return frozenset(f"http://{name}:{port}" for name in names)
+
     def bridge_origins(self) -> list[str | None]:
         """Who may open the websocket: clients that send no Origin (roslibpy, node, a microcontroller),
         pages served by this server itself, and the CORS origins; other web pages get 403."""
-        port = self.http_port
-        own = {f"http://{name}:{port}" for name in (self.config.host, "127.0.0.1", "localhost")}
-        return [None, *sorted(own), *self.config.cors_origins]
+        return [None, *sorted(self.own_origins()), *self.config.cors_origins]
 
     def stop(self, timeout: float = 10.0) -> None:
         """Close both listeners and their connections; a task run still going gets ``timeout`` to end."""
@@ -99,6 +122,7 @@ class Server:
         self._stop_http(timeout)
         self._detach()
         self.tasks.close(timeout)
+        self.sparql.close()
 
     def serve_forever(self, ready: Callable[[Server], None] | None = None) -> None:
         """Start, report through ``ready``, and serve until SIGINT or SIGTERM; then stop."""

@@ -229,7 +229,7 @@ def test_hostile_values_in_bridge_service_arguments_change_nothing(server: Serve
         ("/cbrs/task_status", "run", {}),
         ("/cbrs/query", "query", {}),
     )
-    with bridge(server) as ws:
+    with bridge(server, TOKEN) as ws:  # with the token, so the values reach as far as they can
         for service, name, extra in calls:
             for value in HOSTILE:
                 response = call(ws, service, {**extra, name: value})
@@ -307,7 +307,7 @@ def test_the_same_writes_work_with_the_token_when_not_read_only(server: Server) 
         timeout=WAIT,
     )
     assert update.status_code == 204, update.text
-    with bridge(server) as ws:
+    with bridge(server, TOKEN) as ws:
         planned = call(ws, "/cbrs/plan", {"task": "FetchMyPen"})
     assert planned["values"]["recorded"] is True
     assert bool(server.kb.query("ASK { ?plan cbrs:planFor req:FetchMyPen }"))

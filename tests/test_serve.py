@@ -5,6 +5,7 @@ Every wait is bounded; servers listen on free ports picked by the OS.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import queue
@@ -44,8 +45,17 @@ def server(fresh_bundled_kb: KnowledgeBase) -> Iterator[Server]:
     assert_threads_end(threads, WAIT)
 
 
-def bridge(server: Server) -> ClientConnection:
-    return connect(f"ws://127.0.0.1:{server.bridge_port}", open_timeout=WAIT, close_timeout=WAIT)
+@contextlib.contextmanager
+def bridge(server: Server, token: str | None = None) -> Iterator[ClientConnection]:
+    """A websocket to the bridge; with ``token``, authorised to write (op auth) before it is handed over."""
+    with connect(f"ws://127.0.0.1:{server.bridge_port}", open_timeout=WAIT, close_timeout=WAIT) as ws:
+        if token is not None:
+            ws.send(json.dumps({"op": "set_level", "level": "info"}))
+            ws.send(json.dumps({"op": "auth", "id": "auth", "mac": token}))
+            answer = receive(ws, "status", id="auth")
+            assert answer["level"] == "info", answer
+            ws.send(json.dumps({"op": "set_level", "level": "error"}))
+        yield ws
 
 
 def receive(ws: ClientConnection, op: str, timeout: float = WAIT, **match: Any) -> dict[str, Any]:
@@ -112,7 +122,7 @@ def test_match_service_ranks_like_the_library(server: Server) -> None:
 
 
 def test_plan_service_plans_and_records_the_plan(server: Server) -> None:
-    with bridge(server) as ws:
+    with bridge(server, TOKEN) as ws:
         response = call(ws, "/cbrs/plan", {"task": "FetchMyPen"})
         unknown = call(ws, "/cbrs/plan", {"task": "FlyToTheMoon"})
     assert response["result"] is True
@@ -125,7 +135,7 @@ def test_plan_service_plans_and_records_the_plan(server: Server) -> None:
 
 
 def test_run_task_streams_progress_and_ends_succeeded(server: Server) -> None:
-    with bridge(server) as watcher, bridge(server) as caller:
+    with bridge(server) as watcher, bridge(server, TOKEN) as caller:
         for topic in ("/cbrs/task_progress", "/cbrs/lifecycle", "/cbrs/events"):
             watcher.send(json.dumps({"op": "subscribe", "topic": topic}))
         time.sleep(0.2)  # let the subscriptions land before the run starts
@@ -151,7 +161,7 @@ def test_run_task_streams_progress_and_ends_succeeded(server: Server) -> None:
 
 
 def test_run_task_without_waiting_then_status_and_one_at_a_time(server: Server) -> None:
-    with bridge(server) as ws:
+    with bridge(server, TOKEN) as ws:
         started = call(ws, "/cbrs/run_task", {"task": "RobotArmServeACup", "wait": False})
         assert started["result"] is True
         run_id = started["values"]["id"]

@@ -4,7 +4,10 @@ Each client runs in a child process (roslibpy's reactor runs once per process; r
 this file, run as a script, is the roslibpy client; tests/js/cbrs_services.mjs is the roslibjs one.
 Both print what they saw as one line of JSON, which the tests compare with the library's own answers.
 
-    python tests/test_serve_clients.py PORT
+    python tests/test_serve_clients.py PORT TOKEN
+
+Running a task writes the store, so each client sends the update token with rosbridge's ``auth`` op
+(``Ros.authenticate``, the token as its ``mac``); the roslibjs client is first refused without it.
 """
 
 from __future__ import annotations
@@ -21,16 +24,18 @@ from typing import Any
 import pytest
 
 WAIT = 10.0
+TOKEN = "clients-test-token"
 JS = Path(__file__).parent / "js"
 NODE = shutil.which("node")
 QUERY = "SELECT ?d WHERE { ?s cbrs:deviceName ?d } ORDER BY ?d LIMIT 3"
 
 
-def run_client(port: int) -> dict[str, Any]:
+def run_client(port: int, token: str) -> dict[str, Any]:
     """What a roslibpy user does with cbrs: list topics, query, match, run a task and follow it."""
     import roslibpy
 
     ros = roslibpy.Ros("127.0.0.1", port)
+    ros.authenticate(token, "", "", "", 0, "", 0)  # sent when the connection is ready
     ros.run(timeout=WAIT)
     found: dict[str, Any] = {"topics": sorted(ros.get_topics())}
     progress: list[dict[str, Any]] = []
@@ -60,8 +65,9 @@ def run_client(port: int) -> dict[str, Any]:
 @pytest.fixture
 def served(fresh_bundled_kb: Any) -> Iterator[tuple[int, Any]]:
     from cbrs.server import ServeConfig, Server
+    from cbrs.sparql_service import EndpointConfig
 
-    server = Server(fresh_bundled_kb, ServeConfig(port=0, bridge_port=0))
+    server = Server(fresh_bundled_kb, ServeConfig(port=0, bridge_port=0, endpoint=EndpointConfig(update_token=TOKEN)))
     server.start()
     yield server.bridge_port, fresh_bundled_kb
     server.stop(timeout=WAIT)
@@ -79,7 +85,7 @@ def expected(kb: Any) -> tuple[list[str], str]:
 def test_roslibpy_uses_the_knowledge_base_services(served: tuple[int, Any]) -> None:
     port, kb = served
     devices, best = expected(kb)
-    child = subprocess.run([sys.executable, __file__, str(port)], capture_output=True, text=True, timeout=180)
+    child = subprocess.run([sys.executable, __file__, str(port), TOKEN], capture_output=True, text=True, timeout=180)
     assert child.returncode == 0, child.stderr
     found = json.loads(child.stdout.strip().splitlines()[-1])
     assert {"/cbrs/task_progress", "/cbrs/lifecycle", "/cbrs/task", "/cbrs/events"} <= set(found["topics"])
@@ -98,7 +104,7 @@ def test_roslibjs_uses_the_knowledge_base_services(served: tuple[int, Any]) -> N
     devices, best = expected(kb)
     assert NODE is not None
     child = subprocess.run(
-        [NODE, str(JS / "cbrs_services.mjs"), str(port)], capture_output=True, text=True, timeout=180
+        [NODE, str(JS / "cbrs_services.mjs"), str(port), TOKEN], capture_output=True, text=True, timeout=180
     )
     assert child.returncode == 0, child.stderr
     found = json.loads(child.stdout.strip().splitlines()[-1])
@@ -108,7 +114,8 @@ def test_roslibjs_uses_the_knowledge_base_services(served: tuple[int, Any]) -> N
     assert found["run"] == "succeeded"
     assert found["progress"] == found["steps"] > 0
     assert found["refused"].startswith("missing field 'query'")
+    assert "update token" in found["anonymous"]
 
 
 if __name__ == "__main__":
-    print(json.dumps(run_client(int(sys.argv[1]))), flush=True)
+    print(json.dumps(run_client(int(sys.argv[1]), sys.argv[2])), flush=True)

@@ -32,15 +32,18 @@ from cbrs.rosbridge.bridge import Bridge
 from cbrs.rosbridge.errors import ProtocolError, RosbridgeError, ServiceError, UnknownTopicError
 from cbrs.rosbridge.params import ParamStore
 from cbrs.rosbridge.server import RunningBridge, serve, start
+from cbrs.rosbridge.session import Caller, current_caller
 
 __all__ = [
     "Bridge",
+    "Caller",
     "ParamStore",
     "ProtocolError",
     "RosbridgeError",
     "RunningBridge",
     "ServiceError",
     "UnknownTopicError",
+    "current_caller",
     "serve",
     "start",
 ]

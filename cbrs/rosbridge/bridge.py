@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import hmac
 import itertools
 import logging
 from collections.abc import Awaitable, Callable, Mapping, Sequence
@@ -43,7 +44,12 @@ class Bridge:
     ``max_message_bytes`` bounds one incoming message (larger ones get a status error);
     ``call_timeout`` (seconds) bounds every service call unless the call sets its own ``timeout``;
     ``params`` seeds the parameter store; ``max_queue_length`` bounds every subscription's queue (and
-    how far a pass-through subscriber may fall behind); ``service_workers`` threads run service handlers.
+    how far a pass-through subscriber may fall behind) and ``max_queue_bytes`` the characters it holds;
+    ``service_workers`` threads run service handlers. ``token``, when set, is what a client sends with the
+    ``auth`` op to be :attr:`Caller.authorised`; topics and services whose names start with one of
+    ``reserved`` (and every topic added with :meth:`add_topic`) belong to the server: clients may
+    subscribe and call, but not advertise, publish or provide them. One client address may hold
+    ``connections_per_client`` connections; the next is closed at once (code 1013, try again later).
     """
 
     def __init__(
@@ -54,12 +60,18 @@ class Bridge:
         params: Mapping[str, Any] | None = None,
         max_queue_length: int = 1000,
         service_workers: int = 8,
+        max_queue_bytes: int = 16 * MIB,
+        token: str | None = None,
+        reserved: Sequence[str] = (),
+        connections_per_client: int = 64,
     ) -> None:
         for label, value in [
             ("max_message_bytes", max_message_bytes),
             ("call_timeout", call_timeout),
             ("max_queue_length", max_queue_length),
             ("service_workers", service_workers),
+            ("max_queue_bytes", max_queue_bytes),
+            ("connections_per_client", connections_per_client),
         ]:
             if isinstance(value, bool) or not isinstance(value, int | float) or value <= 0:
                 raise ValueError(f"{label} must be a positive number, not {value!r}")
@@ -67,6 +79,10 @@ class Bridge:
         self.call_timeout = float(call_timeout)
         self.max_queue_length = int(max_queue_length)
         self.service_workers = int(service_workers)
+        self.max_queue_bytes = int(max_queue_bytes)
+        self.connections_per_client = int(connections_per_client)
+        self.token = token
+        self.reserved = tuple(protocol.resolve(prefix) for prefix in reserved)
         self.params = ParamStore(params)
         self._graph = Graph()
         for name, (kind, handler) in rosapi.services(self._graph, self.params).items():
@@ -87,6 +103,7 @@ class Bridge:
             "advertise_service": self._advertise_service,
             "unadvertise_service": self._unadvertise_service,
             "set_level": self._set_level,
+            "auth": self._auth,
         }
 
     # -- the server side ----------------------------------------------------------------------------
@@ -196,11 +213,27 @@ class Bridge:
         self._loop = self._calls = self._workers = None
         return workers
 
-    def open_session(self, peer: str, send: Callable[[str], Awaitable[None]], abort: Callable[[str], None]) -> Session:
-        """A new client; its writer task starts on the attached loop."""
+    def open_session(
+        self,
+        peer: str,
+        send: Callable[[str], Awaitable[None]],
+        abort: Callable[[str], None],
+        origin: str | None = None,
+        address: str | None = None,
+    ) -> Session:
+        """A new client (``peer`` names it in logs, ``address`` is its IP address, ``origin`` its
+        handshake's Origin header); its writer task starts on the attached loop."""
         if self._loop is None:
             raise RosbridgeError("the bridge is not attached to an event loop")
-        session = Session(f"client {next(self._clients)} ({peer})", send, abort, self.max_queue_length)
+        session = Session(
+            f"client {next(self._clients)} ({peer})",
+            send,
+            abort,
+            self.max_queue_length,
+            peer=address if address is not None else peer,
+            origin=origin,
+            backlog_bytes=self.max_queue_bytes,
+        )
         self._writers[session] = self._loop.create_task(session.run(), name=f"rosbridge writer {session.name}")
         log.info("%s connected", session.name)
         return session
@@ -249,12 +282,22 @@ class Bridge:
 
     # -- ops ----------------------------------------------------------------------------------------
 
+    def _owned(self, name: str) -> bool:
+        return any(name.startswith(prefix) for prefix in self.reserved)
+
+    def _refuse_owned_topic(self, name: str, topic: Topic | None) -> None:
+        if (topic is not None and topic.server) or self._owned(name):
+            raise ProtocolError(
+                f"topic {name!r} belongs to this server: clients may subscribe to it, not advertise or publish on it"
+            )
+
     def _advertise(self, session: Session, message: Message) -> None:
         name, kind = protocol.resolve(message["topic"], "topic"), message["type"]
         if not kind:
             raise ProtocolError("field 'type' must name the message type, e.g. 'std_msgs/String'")
         with self._graph.lock:
             topic = self._graph.topics.get(name)
+            self._refuse_owned_topic(name, topic)
             if topic is None:
                 topic = self._graph.topics[name] = Topic(name, kind)
             elif topic.type and topic.type != kind:
@@ -280,6 +323,7 @@ class Bridge:
         text = protocol.dumps(message["msg"])
         with self._graph.lock:
             topic = self._graph.topics.get(name)
+            self._refuse_owned_topic(name, topic)
             if topic is None:
                 raise ProtocolError(f"topic {name!r} is not advertised: send advertise (with its type) first")
             topic.publishers.add(session)
@@ -345,7 +389,7 @@ class Bridge:
             self._calls.finish(call, False, protocol.dumps(reason))
         elif service.inline:
             assert service.handler is not None
-            self._calls.finish(call, *run_handler(service.handler, args, name))
+            self._calls.finish(call, *run_handler(service.handler, args, name, session.identity()))
         else:
             assert service.handler is not None
             self._calls.to_handler(call, service.handler, args, timeout)
@@ -358,6 +402,8 @@ class Bridge:
 
     def _advertise_service(self, session: Session, message: Message) -> None:
         name, kind = protocol.resolve(message["service"], "service"), message["type"]
+        if self._owned(name):
+            raise ProtocolError(f"service {name!r} is in a namespace of this server; clients cannot provide it")
         with self._graph.lock:
             service = self._graph.services.get(name)
             if service is not None and service.provider is None:
@@ -381,6 +427,16 @@ class Bridge:
             del self._graph.services[name]
         self._calls.fail_provider(session, name, "service {service!r} was unadvertised by its provider")
         session.report("info", f"unadvertised service {name}", message.get("id"))
+
+    def _auth(self, session: Session, message: Message) -> None:
+        given = message.get("mac") or message.get("token")
+        if self.token is None:
+            raise ProtocolError("this server takes no token: it is read-only for every client", "auth")
+        if not given or not hmac.compare_digest(str(given).encode("utf-8"), self.token.encode("utf-8")):
+            session.authorised = False
+            raise ProtocolError("the token is not this server's update token", "auth")
+        session.authorised = True
+        session.report("info", "authorised: this client may write", message.get("id"))
 
     def _set_level(self, session: Session, message: Message) -> None:
         if message["level"] not in LEVELS:

@@ -18,7 +18,7 @@ from cbrs.rosbridge import protocol
 from cbrs.rosbridge.errors import ServiceError
 from cbrs.rosbridge.graph import Handler
 from cbrs.rosbridge.protocol import MessageId
-from cbrs.rosbridge.session import Session
+from cbrs.rosbridge.session import _CALLER, Caller, Session
 from cbrs.rosbridge.workers import WorkerPool
 
 log = logging.getLogger("cbrs.rosbridge")
@@ -38,8 +38,10 @@ class Call:
     done: bool = False
 
 
-def run_handler(handler: Handler, args: dict[str, Any], service: str) -> tuple[bool, str]:
-    """Run a handler; (result, encoded values), the values being the error text on failure."""
+def run_handler(handler: Handler, args: dict[str, Any], service: str, caller: Caller | None = None) -> tuple[bool, str]:
+    """Run a handler (``caller`` is what :func:`current_caller` gives it); (result, encoded values), the
+    values being the error text on failure."""
+    token = _CALLER.set(caller)
     try:
         values = handler(args)
         if not isinstance(values, dict):
@@ -51,6 +53,8 @@ def run_handler(handler: Handler, args: dict[str, Any], service: str) -> tuple[b
     except Exception as error:
         log.exception("service %s: handler raised", service)
         return False, protocol.dumps(f"internal error: {type(error).__name__}: {error}")
+    finally:
+        _CALLER.reset(token)
 
 
 class Calls:
@@ -68,11 +72,12 @@ class Calls:
     def to_handler(self, call: Call, handler: Handler, args: dict[str, Any], timeout: float) -> None:
         """Run ``handler`` on a worker thread; its answer (or the timeout) goes to the caller."""
         self._start(call, timeout)
+        caller = call.caller.identity()
 
         def job() -> None:
             if call.done:  # timed out while waiting for a free worker
                 return
-            result, values = run_handler(handler, args, call.service)
+            result, values = run_handler(handler, args, call.service, caller)
             with contextlib.suppress(RuntimeError):  # the loop has closed: the server stopped meanwhile
                 self._loop.call_soon_threadsafe(self.finish, call, result, values)
 

@@ -10,6 +10,9 @@ merged: the smallest ``throttle_rate`` and the largest ``queue_length`` apply.
 - ``queue_length`` N > 0: a queue of N messages, drained from its head at most one per T ms (as fast as
   the client reads when T is 0); when full, the oldest message is dropped for the newest.
 
+Whatever the lengths, the messages waiting in one queue hold at most ``max_bytes`` (16 MiB by default):
+past that the oldest are dropped too, always keeping the newest.
+
 This module is pure bookkeeping on a clock the caller passes in, so tests can step time by hand.
 """
 
@@ -26,8 +29,10 @@ Request = MessageId | None
 class TopicQueue:
     """The merged subscription of one client to one topic, with its pending messages."""
 
-    def __init__(self, backlog: int) -> None:
+    def __init__(self, backlog: int, max_bytes: int = 16 << 20) -> None:
         self.backlog = backlog
+        self.max_bytes = max_bytes
+        self.size = 0  # bytes of the messages waiting
         self.requests: dict[Request, tuple[int, int]] = {}
         self.throttle = 0.0
         self.dropped = 0
@@ -57,7 +62,16 @@ class TopicQueue:
         """Queue a message (``seq`` orders it among everything else the client receives)."""
         if len(self._pending) == self._pending.maxlen:
             self.dropped += 1
+            self.size -= len(self._pending[0][1])
         self._pending.append((seq, text))
+        self.size += len(text)
+        while self.size > self.max_bytes and len(self._pending) > 1:
+            self.size -= len(self._pending.popleft()[1])
+            self.dropped += 1
+
+    def clear(self) -> None:
+        self._pending.clear()
+        self.size = 0
 
     def ready_at(self) -> float | None:
         """When the next message may be sent (clock seconds), or None if nothing is waiting."""
@@ -72,7 +86,9 @@ class TopicQueue:
     def pop(self, now: float) -> str:
         """Take the next message, sent at ``now``."""
         self._last_sent = now
-        return self._pending.popleft()[1]
+        text = self._pending.popleft()[1]
+        self.size -= len(text)
+        return text
 
     def __len__(self) -> int:
         return len(self._pending)
@@ -86,3 +102,4 @@ class TopicQueue:
         capacity = min(queue_length, self.backlog)
         if capacity != self._pending.maxlen:
             self._pending = deque(self._pending, maxlen=capacity)
+            self.size = sum(len(text) for _, text in self._pending)

@@ -64,13 +64,14 @@ OPS: dict[str, tuple[Field, ...]] = {
     "advertise_service": (_req("service", str), _req("type", str)),
     "unadvertise_service": (_req("service", str),),
     "set_level": (_req("level", str),),
+    # rosbridge's auth op carries a rosauth MAC; cbrs reads its update token from ``mac`` (or ``token``)
+    "auth": (_opt("mac", str), _opt("token", str)),
 }
 
 #: Ops of the rosbridge protocol this server knows about but does not implement, and why.
 UNSUPPORTED = {
     "fragment": "fragmented messages are not supported; send the whole message (see max_message_bytes)",
     "png": "PNG-compressed messages are not supported; send JSON text",
-    "auth": "authentication is not supported; the server binds to loopback unless opened on purpose",
     "advertise_action": "actions are not supported; use a service and a feedback topic",
     "unadvertise_action": "actions are not supported",
     "send_action_goal": "actions are not supported; use a service and a feedback topic",

@@ -13,6 +13,7 @@ import contextlib
 import logging
 import threading
 import time
+from collections import Counter
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -72,15 +73,37 @@ async def _serve(
     bridge.attach(loop)
     bound = port
     closing: set[asyncio.Task[None]] = set()
+    per_address: Counter[str] = Counter()
 
     async def connection(websocket: ServerConnection) -> None:
+        address = websocket.remote_address
+        ip = str(address[0]) if isinstance(address, tuple) and address else str(address)
+        if per_address[ip] >= bridge.connections_per_client:
+            log.warning("%s: refused, it holds %d connections already", ip, per_address[ip])
+            await websocket.close(1013, f"{ip} holds {bridge.connections_per_client} connections already")
+            return
+        per_address[ip] += 1
+        try:
+            await _session(websocket, ip)
+        finally:
+            per_address[ip] -= 1
+            if per_address[ip] <= 0:
+                del per_address[ip]
+
+    async def _session(websocket: ServerConnection, ip: str) -> None:
         def abort(reason: str) -> None:
             log.warning("%s: disconnected: %s", session.name, reason)
             task = loop.create_task(websocket.close(1008, reason))
             closing.add(task)
             task.add_done_callback(closing.discard)
 
-        session = bridge.open_session(_peer(websocket.remote_address), websocket.send, abort)
+        session = bridge.open_session(
+            _peer(websocket.remote_address),
+            websocket.send,
+            abort,
+            origin=websocket.request.headers.get("Origin") if websocket.request is not None else None,
+            address=ip,
+        )
         try:
             async for frame in websocket:
                 bridge.receive(session, frame)

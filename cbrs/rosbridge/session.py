@@ -14,6 +14,8 @@ import logging
 import time
 from collections import deque
 from collections.abc import Awaitable, Callable
+from contextvars import ContextVar
+from dataclasses import dataclass
 
 from cbrs.rosbridge.outbox import Request, TopicQueue
 from cbrs.rosbridge.protocol import LEVELS, MessageId, status
@@ -22,6 +24,25 @@ log = logging.getLogger("cbrs.rosbridge")
 
 #: Replies a client may leave unread before it is disconnected (it is not reading its socket).
 REPLY_BACKLOG = 10_000
+#: Bytes of replies a client may leave unread before it is disconnected.
+REPLY_BYTES = 64 << 20
+
+
+@dataclass(frozen=True)
+class Caller:
+    """Who made a service call, as a handler sees it through :func:`current_caller`."""
+
+    peer: str  # the client's address (IP), which per-client limits count by
+    origin: str | None  # the Origin header of its websocket handshake: a web page's, or None for a program
+    authorised: bool  # it sent the server's token with the auth op
+
+
+_CALLER: ContextVar[Caller | None] = ContextVar("cbrs_rosbridge_caller", default=None)
+
+
+def current_caller() -> Caller | None:
+    """The client whose service call the running handler answers (None outside a bridge call)."""
+    return _CALLER.get()
 
 
 class Session:
@@ -34,8 +55,15 @@ class Session:
         abort: Callable[[str], None],
         backlog: int,
         clock: Callable[[], float] = time.monotonic,
+        *,
+        peer: str = "",
+        origin: str | None = None,
+        backlog_bytes: int = 16 << 20,
     ) -> None:
         self.name = name
+        self.peer = peer
+        self.origin = origin
+        self.authorised = False
         self.level = "error"
         self.closed = False
         #: topics this client advertised (global name -> the name as the client wrote it), likewise
@@ -47,13 +75,23 @@ class Session:
         self._send = send
         self._abort = abort
         self._backlog = backlog
+        self._backlog_bytes = backlog_bytes
         self._clock = clock
         self._replies: deque[tuple[int, str]] = deque()
+        self._reply_bytes = 0
         self._seq = 0
         self._wake = asyncio.Event()
 
     def __repr__(self) -> str:
         return f"<Session {self.name}>"
+
+    def identity(self) -> Caller:
+        return Caller(self.peer, self.origin, self.authorised)
+
+    @property
+    def pending_bytes(self) -> int:
+        """Bytes of messages waiting to be sent to this client (replies and topic queues)."""
+        return self._reply_bytes + sum(queue.size for queue in self.queues.values())
 
     # -- what the bridge calls -------------------------------------------------------------------
 
@@ -61,11 +99,13 @@ class Session:
         """Queue a message that must arrive (a status, a service response, a forwarded call)."""
         if self.closed:
             return
-        if len(self._replies) >= REPLY_BACKLOG:
+        if len(self._replies) >= REPLY_BACKLOG or self._reply_bytes + len(text) > REPLY_BYTES:
             self.closed = True
-            self._abort(f"{REPLY_BACKLOG} replies unread")
+            self._abort(f"{len(self._replies)} replies ({self._reply_bytes} bytes) unread")
+            self.drop()
             return
         self._replies.append((self._next_seq(), text))
+        self._reply_bytes += len(text)
         self._wake.set()
 
     def report(self, level: str, text: str, message_id: MessageId | None = None) -> None:
@@ -76,7 +116,7 @@ class Session:
     def subscribe(self, topic: str, spelling: str, request: Request, throttle_rate: int, queue_length: int) -> None:
         queue = self.queues.get(topic)
         if queue is None:
-            queue = self.queues[topic] = TopicQueue(self._backlog)
+            queue = self.queues[topic] = TopicQueue(self._backlog, self._backlog_bytes)
         queue.add(request, throttle_rate, queue_length)
         self.spelling[topic] = spelling
 
@@ -106,7 +146,15 @@ class Session:
 
     def close(self) -> None:
         self.closed = True
+        self.drop()
         self._wake.set()
+
+    def drop(self) -> None:
+        """Forget every message waiting: a client that has gone holds no memory."""
+        self._replies.clear()
+        self._reply_bytes = 0
+        for queue in self.queues.values():
+            queue.clear()
 
     # -- the writer --------------------------------------------------------------------------------
 
@@ -145,7 +193,9 @@ class Session:
         if best is not None:
             return best.pop(now), None
         if best_seq is not None:
-            return self._replies.popleft()[1], None
+            text = self._replies.popleft()[1]
+            self._reply_bytes -= len(text)
+            return text, None
         return None, wait
 
     def _next_seq(self) -> int:

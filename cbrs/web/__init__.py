@@ -8,19 +8,21 @@ client causes is answered with a 4xx status and never a trace: an HTML page for 
 from __future__ import annotations
 
 import importlib
+import secrets
 import threading
-from collections.abc import Sequence
+from collections.abc import Callable, Collection, Sequence
 from typing import Any
+from urllib.parse import urlsplit
 
-from flask import Flask, Response, jsonify, render_template, request
-from werkzeug.exceptions import HTTPException
+from flask import Flask, Response, g, jsonify, render_template, request
+from werkzeug.exceptions import HTTPException, MisdirectedRequest
 
 from cbrs import __version__
 from cbrs.matchmakers import Matchmakers
 from cbrs.sparql_service import SparqlService
 from cbrs.tasks import TaskRunner
 from cbrs.web import links
-from cbrs.web.context import EventLog
+from cbrs.web.context import EventLog, StreamSlots
 from kb.errors import KnowledgeBaseError
 
 # The page blueprints, in navigation order: (module under cbrs.web, endpoint of its nav link, label).
@@ -35,14 +37,30 @@ PAGES: tuple[tuple[str, str, str], ...] = (
 )
 
 
+# Where the pages may load from and be shown: this server only, never in another site's frame.
+CONTENT_SECURITY_POLICY = (
+    "default-src 'self'; script-src 'self' 'nonce-{nonce}'; style-src 'self'; style-src-attr 'unsafe-inline'; "
+    "img-src 'self' data:; connect-src 'self'; object-src 'none'; base-uri 'none'; form-action 'self'; "
+    "frame-ancestors 'none'"
+)
+LOOPBACK_NAMES = frozenset({"127.0.0.1", "localhost", "::1"})
+
+
 def create_app(
     sparql: SparqlService,
     cors_origins: Sequence[str] = (),
     tasks: TaskRunner | None = None,
     matchmakers: Matchmakers | None = None,
+    own_origins: Callable[[], Collection[str]] | None = None,
 ) -> Flask:
     """The Flask app over ``sparql``'s knowledge base: the browser's pages, ``/sparql``, ``/update`` and
-    ``/healthz``. Without ``tasks`` or ``matchmakers``, the app makes its own."""
+    ``/healthz``. Without ``tasks`` or ``matchmakers``, the app makes its own.
+
+    ``own_origins`` gives the origins this server's pages are served from (``http://127.0.0.1:8080``...),
+    from the address it was told to bind, never from a request's ``Host`` header (which DNS rebinding
+    sets). ``cbrs serve`` passes them; then a request whose ``Host`` names none of them (when bound to
+    loopback) is refused, and a task may be started only from those pages or with the update token.
+    """
     from cbrs.web.sparql import blueprint
 
     app = Flask(__name__)
@@ -60,6 +78,8 @@ def create_app(
             "cbrs.matchmakers": matchmakers or Matchmakers(sparql),
             "cbrs.events": log,
             "cbrs.closing": threading.Event(),
+            "cbrs.own_origins": own_origins,
+            "cbrs.streams": StreamSlots(),
         }
     )
     app.register_blueprint(blueprint)
@@ -80,6 +100,7 @@ def create_app(
             "json_twin": twin,
             "version": __version__,
             "store_location": sparql.kb.store.location,
+            "csp_nonce": _nonce(),
         }
 
     def as_page() -> bool:
@@ -104,12 +125,19 @@ def create_app(
 
     @app.before_request
     def preflight() -> Response | None:
+        if own_origins is not None:
+            _check_host(own_origins(), allowed)
         if request.method == "OPTIONS" and request.headers.get("Origin") in allowed:
             return Response(status=204)
         return None
 
     @app.after_request
     def cors(response: Response) -> Response:
+        response.headers["X-Content-Type-Options"] = "nosniff"
+        response.headers.setdefault("Referrer-Policy", "same-origin")
+        if response.mimetype == "text/html":
+            response.headers["Content-Security-Policy"] = CONTENT_SECURITY_POLICY.format(nonce=_nonce())
+            response.headers["X-Frame-Options"] = "DENY"
         origin = request.headers.get("Origin")
         if origin is not None and origin in allowed:
             response.headers["Access-Control-Allow-Origin"] = origin
@@ -123,3 +151,28 @@ def create_app(
 
 def _error(kind: str, message: str, **extra: Any) -> Response:
     return jsonify(error=kind, message=message, **extra)
+
+
+def _nonce() -> str:
+    """This response's script nonce: inline scripts of our templates carry it, injected ones cannot."""
+    if "csp_nonce" not in g:
+        g.csp_nonce = secrets.token_urlsafe(16)
+    return str(g.csp_nonce)
+
+
+def _check_host(own: Collection[str], cors_origins: Collection[str]) -> None:
+    """Refuse a request whose ``Host`` is not a name of this server, when it serves only loopback.
+
+    A page of another site whose name was made to resolve to 127.0.0.1 (DNS rebinding) reaches the
+    server as same-origin to the browser, with its own name in ``Host``: that is what gives it away.
+    """
+    hosts = {urlsplit(origin).hostname for origin in own}
+    if not hosts or not hosts <= LOOPBACK_NAMES | {None}:
+        return  # bound to a routable address: clients use names we cannot know
+    names = hosts | LOOPBACK_NAMES | {urlsplit(origin).hostname for origin in cors_origins}
+    given = urlsplit("//" + request.host).hostname
+    if given not in names:
+        raise MisdirectedRequest(
+            f"this server answers to {', '.join(sorted(n for n in names if n))}, not to {given!r} "
+            "(a page whose name resolves to this machine is not one of its own)"
+        )

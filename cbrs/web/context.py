@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import threading
-from collections import deque
+from collections import Counter, deque
+from collections.abc import Callable
 from typing import Any
 
 from flask import current_app
@@ -12,6 +13,7 @@ from cbrs.matchmakers import Matchmakers
 from cbrs.sparql_service import SparqlService
 from cbrs.tasks import TaskRunner
 from kb import KnowledgeBase
+from kb.errors import KnowledgeBaseError
 
 
 class EventLog:
@@ -28,6 +30,58 @@ class EventLog:
     def recent(self, count: int = 20) -> list[dict[str, Any]]:
         with self._guard:
             return list(self._events)[-count:]
+
+
+class TooManyStreamsError(KnowledgeBaseError):
+    """Every stream slot is taken, or this client holds as many streams as one client may."""
+
+    http_status = 503
+    kind = "busy"
+
+
+class StreamSlots:
+    """How many event and camera streams are open: at most ``limit`` in all, ``per_client`` per address.
+
+    Each open stream holds one of the HTTP server's threads; ``cbrs serve`` gives the streams their own
+    ``limit`` threads on top of those that answer requests, so streams can never take those.
+    """
+
+    def __init__(self, limit: int = 8, per_client: int = 2) -> None:
+        self.limit = limit
+        self.per_client = per_client
+        self._open: Counter[str] = Counter()
+        self._guard = threading.Lock()
+
+    @property
+    def open(self) -> int:
+        with self._guard:
+            return sum(self._open.values())
+
+    def take(self, client: str) -> Callable[[], None]:
+        """Take a slot for ``client`` (an address); the call returned gives it back (once)."""
+        with self._guard:
+            if self._open[client] >= self.per_client:
+                raise TooManyStreamsError(
+                    f"{client} already has {self.per_client} open streams, the most one client may have "
+                    "(setting streams_per_client); close one first"
+                )
+            if sum(self._open.values()) >= self.limit:
+                raise TooManyStreamsError(
+                    f"all {self.limit} stream slots are taken (setting stream_limit); retry shortly"
+                )
+            self._open[client] += 1
+        done = threading.Event()
+
+        def release() -> None:
+            if done.is_set():
+                return
+            done.set()
+            with self._guard:
+                self._open[client] -= 1
+                if self._open[client] <= 0:
+                    del self._open[client]
+
+        return release
 
 
 def sparql() -> SparqlService:
@@ -56,6 +110,11 @@ def tasks() -> TaskRunner:
 
 def events() -> EventLog:
     found: EventLog = current_app.extensions["cbrs.events"]
+    return found
+
+
+def streams() -> StreamSlots:
+    found: StreamSlots = current_app.extensions["cbrs.streams"]
     return found
 
 

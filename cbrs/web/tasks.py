@@ -1,21 +1,23 @@
 """The tasks page: start one of the paper's scenarios in the simulated home and follow it live.
 
 Live updates travel as server-sent events (``/tasks/events``) and the ceiling camera as an MJPEG
-stream (``/camera.mjpg``). Each open stream holds one of waitress's request threads, so both end by
-themselves: after ``CBRS_STREAM_SECONDS`` at most, or ``CBRS_STREAM_IDLE_SECONDS`` without news, or as
-soon as a write finds the client gone (a heartbeat or a repeated frame every few seconds makes sure
-one is tried). The browser's EventSource reconnects by itself; the page restarts the camera stream
-when a run starts.
+stream (``/camera.mjpg``). Each open stream holds one of waitress's threads, so streams are counted
+(:class:`cbrs.web.context.StreamSlots`: a few in all, two per client address; one more is refused
+with 503) and end by themselves: after ``CBRS_STREAM_SECONDS`` at most, or ``CBRS_STREAM_IDLE_SECONDS``
+without news, or as soon as a write finds the client gone (a heartbeat or a repeated frame every few
+seconds makes sure one is tried). The browser's EventSource reconnects by itself; the page restarts
+the camera stream when a run starts.
 """
 
 from __future__ import annotations
 
+import hmac
 import json
 import queue
 import threading
 import time
-from collections.abc import Iterator
-from typing import Any
+from collections.abc import Callable, Iterable, Iterator
+from typing import Any, Generic, TypeVar
 
 from flask import Blueprint, Response, current_app, request, url_for
 from flask.sansio.blueprints import BlueprintSetupState
@@ -58,7 +60,7 @@ def tasks() -> Page:
     _for_script(shown)
     if request.method != "POST":
         return shown
-    _same_origin()
+    _may_start()
     task, seed, faults, fault_rate = _checked(form, shown)
     try:
         started = context.tasks().start(task, seed, faults, fault_rate)
@@ -134,11 +136,34 @@ def _checked(form: dict[str, Any], shown: Page) -> tuple[str, int, list[str], fl
     return form["task"], seed, faults, fault_rate
 
 
-def _same_origin() -> None:
-    """Starting a run moves a (simulated) robot: refuse forms that other sites' pages post here."""
+def _may_start() -> None:
+    """Starting a run moves a (simulated) robot and writes the store: from this server's own pages (their
+    ``Origin``), or with the update token. Behind ``cbrs serve`` the pages' origins are those of the
+    address it binds, never read from the request; a request with no ``Origin`` (not a browser) needs
+    the token."""
     origin = request.headers.get("Origin")
-    if origin is not None and origin.rstrip("/") != request.host_url.rstrip("/"):
-        raise Forbidden(f"a task may be started only from this server's own pages, not from {origin}")
+    own = current_app.extensions.get("cbrs.own_origins")
+    if own is None:  # an app not behind cbrs serve (a test client): the page's own host is all we know
+        if origin is not None and origin.rstrip("/") != request.host_url.rstrip("/"):
+            raise Forbidden(f"a task may be started only from this server's own pages, not from {origin}")
+        return
+    if origin is not None:
+        if origin.rstrip("/") not in own():
+            raise Forbidden(f"a task may be started only from this server's own pages, not from {origin}")
+        return
+    if not _has_token():
+        raise Forbidden(
+            "a task run moves the robot: start it from this server's tasks page, or send the update token "
+            "(Authorization: Bearer <token>)"
+        )
+
+
+def _has_token() -> bool:
+    expected = context.sparql().config.update_token
+    scheme, _, given = request.headers.get("Authorization", "").partition(" ")
+    if expected is None or scheme.lower() != "bearer" or not given.strip():
+        return False
+    return hmac.compare_digest(given.strip().encode("utf-8"), expected.encode("utf-8"))
 
 
 def _overview(form: dict[str, Any]) -> dict[str, Any]:
@@ -216,6 +241,33 @@ def steps(events: list[dict[str, Any]]) -> list[dict[str, Any]]:
 # -- live updates ----------------------------------------------------------------------------------
 
 
+T = TypeVar("T")
+
+
+class _Held(Generic[T]):
+    """A response body that gives its stream slot back when the server closes it, started or not
+    (a generator closed before it starts runs no ``finally``)."""
+
+    def __init__(self, body: Iterator[T], release: Callable[[], None]) -> None:
+        self._body = body
+        self._release = release
+
+    def __iter__(self) -> Iterator[T]:
+        return self._body
+
+    def close(self) -> None:
+        try:
+            close = getattr(self._body, "close", None)
+            if close is not None:
+                close()
+        finally:
+            self._release()
+
+
+def _held(body: Iterator[T]) -> Iterable[T]:
+    return _Held(body, context.streams().take(request.remote_addr or "unknown"))
+
+
 @blueprint.get("/tasks/events")
 def events() -> Response:
     """Every task runner event as it happens, and the camera's frame numbers, as server-sent events."""
@@ -274,7 +326,7 @@ def events() -> Response:
             for call in unsubscribe:
                 call()
 
-    return Response(stream(), mimetype="text/event-stream", headers=_no_buffering())
+    return Response(_held(stream()), mimetype="text/event-stream", headers=_no_buffering())
 
 
 @blueprint.get("/camera.mjpg")
@@ -303,7 +355,7 @@ def camera() -> Response:
             yield _part(frame)
 
     mimetype = f"multipart/x-mixed-replace; boundary={BOUNDARY}"
-    return Response(stream(first), headers={**_no_buffering(), "Content-Type": mimetype})
+    return Response(_held(stream(first)), headers={**_no_buffering(), "Content-Type": mimetype})
 
 
 @blueprint.get("/camera.jpg")

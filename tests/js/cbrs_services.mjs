@@ -63,6 +63,8 @@ const ranking = await call(ros, "/cbrs/match", "cbrs/Match", { requirement: "Rob
 found.best = ranking.candidates[0].advertisement;
 found.refused = (await call(ros, "/cbrs/query", "cbrs/Query", {})).failed;
 
+found.anonymous = (await call(ros, "/cbrs/run_task", "cbrs/RunTask", { task: "RobotArmServeACup" })).failed;
+ros.authenticate(process.argv[3], "", "", "", 0, "", 0); // cbrs reads its update token from the mac field
 const run = await call(ros, "/cbrs/run_task", "cbrs/RunTask", { task: "RobotArmServeACup" }, 120000);
 found.run = run.status;
 found.steps = run.result.plan.steps.length;
