@@ -17,6 +17,7 @@ from actions.composer import Composer, CompositionResult, PlanStatus, store_plan
 from actions.events import Event, EventBus
 from actions.executor import ExecutionReport, Executor, RunStatus
 from actions.faults import Combined, FaultPolicy, FixedFaults
+from actions.graph import statement_text
 from actions.plan import Plan, PlanStep
 from kb import KnowledgeBase, Requirement, Statement
 
@@ -51,24 +52,50 @@ class Replan:
 
 
 @dataclass(frozen=True)
+class GoalCheck:
+    """One goal of the task at the end of a run: what the robots believe, and what really holds (None
+    where the environment cannot tell)."""
+
+    statement: Statement
+    believed: bool | None
+    holds: bool | None
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"statement": statement_text(self.statement), "believed": self.believed, "holds": self.holds}
+
+
+@dataclass(frozen=True)
 class RunResult:
     composition: CompositionResult  # the last composition: of the plan that ran last, or the one that failed
     report: ExecutionReport | None  # the last plan's execution; None when there was no plan to run
     replans: tuple[Replan, ...] = ()  # the plans replaced before it, in order
+    goals: tuple[GoalCheck, ...] = ()  # the task's effects at the end, believed and in the world
 
     @property
     def succeeded(self) -> bool:
+        """The run succeeded: every step did and verified its effects on the robots' belief, and no
+        goal is known not to hold in the world."""
+        return self.executed and not self.refuted
+
+    @property
+    def executed(self) -> bool:
+        """The executor finished the plan (by the robots' belief)."""
         return self.report is not None and self.report.status is RunStatus.SUCCEEDED
 
+    @property
+    def refuted(self) -> tuple[GoalCheck, ...]:
+        """The goals the world contradicts (the robots may believe them)."""
+        return tuple(goal for goal in self.goals if goal.holds is False)
+
     def to_dict(self) -> dict[str, Any]:
-        found: dict[str, Any] = {
-            "task": self.composition.task,
-            "status": self.report.status.value if self.report else PlanStatus.UNSOLVABLE.value,
-            "plan": self.composition.to_dict(),
-        }
+        status = self.report.status.value if self.report else PlanStatus.UNSOLVABLE.value
+        if self.executed and self.refuted:
+            status = RunStatus.FAILED.value
+        found: dict[str, Any] = {"task": self.composition.task, "status": status, "plan": self.composition.to_dict()}
         if self.report is not None:
             found["execution"] = self.report.to_dict()
         found["replans"] = [replan.to_dict() for replan in self.replans]
+        found["goals"] = [goal.to_dict() for goal in self.goals]
         return found
 
 
@@ -99,10 +126,12 @@ def run_task(
     policy = failing if fault_policy is None else Combined((failing, fault_policy))
     container = Container(environment.registry, environment.context, bus, policy)
     belief = BeliefState(kb)
+    _perceive(environment)
     belief.write(environment.observe())  # plan from what holds now, not from a past run's belief
     composition = composer.compose(task, belief=True)
     replans: list[Replan] = []
     report: ExecutionReport | None = None
+    outputs: Mapping[int, Mapping[str, Any]] = {}
     try:
         while composition.plan is not None:
             plan = composition.plan
@@ -117,13 +146,15 @@ def run_task(
                     done = len(executor.results)
                     belief.write(environment.observe())
             report = executor.run(max_ticks)  # ends a run that hit max_ticks; otherwise just the report
+            outputs = executor.results
             if report.status is not RunStatus.FAILED or len(replans) >= max_replans:
                 break
             replans.append(Replan(plan, report, report.reason))
             bus.publish(
                 "/cbrs/task_progress", {"event": "replanning", "plan": len(replans) + 1, "reason": report.reason}
             )
-            belief.write(environment.observe())  # perceive again
+            _perceive(environment)  # look again
+            belief.write(environment.observe())
             container.recover()  # what failed for the world's sake may be tried again; the broken stay broken
             refresh = getattr(environment, "refresh", None)
             if callable(refresh):
@@ -133,4 +164,32 @@ def run_task(
     finally:
         container.finalise_all()
     belief.write(environment.observe())
-    return RunResult(composition, report, tuple(replans))
+    goals = _check_goals(environment, composition.plan, outputs) if report is not None else ()
+    return RunResult(composition, report, tuple(replans), goals)
+
+
+def _perceive(environment: Environment) -> None:
+    """Let an environment that can look at the world do so (the Environment protocol's optional part)."""
+    perceive = getattr(environment, "perceive", None)
+    if callable(perceive):
+        perceive()
+
+
+def _check_goals(
+    environment: Environment, plan: Plan | None, outputs: Mapping[int, Mapping[str, Any]]
+) -> tuple[GoalCheck, ...]:
+    """The plan's goal effects, as the robots believe them now and, where the environment has a
+    referee (``audit``), as they really are."""
+    if plan is None:
+        return ()
+    audit = getattr(environment, "audit", None)
+    checks = []
+    for goal in plan.goals:
+        if goal.statement is None:
+            continue
+        step = plan.step(goal.source.step) if goal.source.step is not None else None
+        made = outputs.get(step.index, {}) if step is not None else {}
+        believed = environment.verify(step, goal.statement, made) if step is not None else None
+        holds = audit(goal.statement) if callable(audit) else None
+        checks.append(GoalCheck(goal.statement, believed, holds if holds is None else bool(holds)))
+    return tuple(checks)

@@ -16,6 +16,7 @@ import click
 from actions.composer import ComposeConfig, Composer, CompositionResult, Objective, PlanStatus, store_plan
 from actions.events import Event
 from actions.faults import RandomFaults, planned_faults
+from actions.graph import statement_text
 from actions.plan import Binding, Plan
 from actions.runner import RunResult, run_task
 from cbrs.app import App, parse_iri, pass_app
@@ -303,6 +304,12 @@ def run_text(result: RunResult, sim_seconds: float, wall_seconds: float) -> str:
     verdict = f"{shorten(report.task)}: {report.status.value}"
     if report.reason:
         verdict += f" ({report.reason})"
+    if result.executed and result.refuted:  # the robots believed it done; the world says otherwise
+        verdict = f"{shorten(report.task)}: failed (the robots believed it done, but in the world "
+        verdict += "; ".join(f"{statement_text(goal.statement)} does not hold" for goal in result.refuted) + ")"
+    elif result.goals and all(goal.holds for goal in result.goals if goal.holds is not None):
+        checked = sum(1 for goal in result.goals if goal.holds is not None)
+        verdict += f"; {checked} goal(s) confirmed in the world" if checked else ""
     failovers = sum(1 for s in report.steps if s.failed_over)
     timing = f"{sim_seconds:.1f} s simulated, {wall_seconds:.1f} s wall, {failovers} failover(s)"
     timing += f", {len(result.replans)} re-plan(s)" if result.replans else ""

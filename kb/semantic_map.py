@@ -280,6 +280,16 @@ class SemanticMap:
         """The things whose asserted classes include ``concept`` (no subclass reasoning: see :func:`designate`)."""
         return sorted(iri for iri, types in self.types.items() if concept in types)
 
+    def appearance(self, concept: str) -> tuple[str, tuple[float, float, float, float]] | None:
+        """How the things asserted to be a ``concept`` look (the first by IRI with a colour name): how
+        perception finds them and how the simulation shows them; None when none says."""
+        for iri in self.of_type(concept):
+            values = self.facts.get(iri, {})
+            name = _text(values, "colourName")
+            if name:
+                return name, _rgba(iri, values)
+        return None
+
     def marker_colours(self, iri: str) -> tuple[str, str] | None:
         """The front and rear colours of a marker-colours individual (or a robot's marker)."""
         values = self.facts.get(iri, {})

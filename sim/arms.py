@@ -269,6 +269,9 @@ class Arm:
         """Body id of the object the gripper holds, if any."""
         self.held_grasp: GraspPose | None = None
         """The grasp the held object was picked with (how far it hangs below the hand)."""
+        self.released: tuple[int, Vec3] | None = None
+        """The last object let go and where its centre was by the hand's pose then (proprioception: the
+        arm knows where it put a thing down without seeing it)."""
         self._targets: tuple[float, ...] = HOME_CONFIGURATIONS[side]
         self._gripper_width = GRIPPER_OPEN
         self.peers: dict[ArmSide, Arm] = {}
@@ -290,6 +293,15 @@ class Arm:
         state = p.getLinkState(self.body, EE_LINK, computeForwardKinematics=True, physicsClientId=self.client)
         pos, orn = state[4], state[5]
         return Pose3D((pos[0], pos[1], pos[2]), (orn[0], orn[1], orn[2], orn[3]))
+
+    def carried_centre(self) -> Vec3 | None:
+        """Where the held object's centre is by the hand's pose and the grasp it was taken with (it
+        hangs ``bottom_offset`` below the grasp point, and its centre half its height above its bottom)."""
+        if self.held is None or self.held_grasp is None:
+            return None
+        x, y, z = self.ee_pose().position
+        grasp = self.held_grasp
+        return (x, y, z - grasp.bottom_offset + grasp.model.height / 2.0)
 
     def gripper_width(self) -> float:
         states = p.getJointStates(self.body, FINGER_JOINTS, physicsClientId=self.client)
@@ -481,6 +493,8 @@ class Arm:
     def detach(self) -> int | None:
         """Let go of the held object; returns its body id."""
         held = self.held
+        if held is not None:
+            self.released = (held, self.carried_centre() or self.ee_pose().position)
         if self._grasp_constraint is not None:
             p.removeConstraint(self._grasp_constraint, physicsClientId=self.client)
         self._grasp_constraint = None

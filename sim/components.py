@@ -37,6 +37,7 @@ from sim.errors import SimulationError
 from sim.geometry import Pose2D, Region
 from sim.grasping import GraspPose, ObjectModel, compute_grasp_pose
 from sim.mapping import OccupancyGrid, build_occupancy_grid
+from sim.perceived import PerceivedWorld
 from sim.perception import (
     ObjectEstimate,
     PersonEstimate,
@@ -46,6 +47,8 @@ from sim.perception import (
     track_person,
 )
 from sim.planning import PlannedPath, plan_path
+from sim.referee import Referee
+from sim.relations import Grounded, Judge
 from sim.values import (
     APPROACH_POSITION,
     GRASP_POSE,
@@ -66,7 +69,8 @@ __all__ = ["GraspPlan", "SimContext", "SimEnvironment", "designator", "implement
 
 HOME = PREFIXES["home"]
 LOCALISATION_TOLERANCE = 0.10
-"""A localisation is believed (isLocalisedIn holds) when it is within this distance (m) of the truth."""
+"""A localisation is believed (isLocalisedIn holds) when it agrees with the base's odometry within this
+distance (m)."""
 ARM_TIE = 0.01
 """Two arms whose mounts are within 1 cm as far from a target reach it equally well."""
 
@@ -481,13 +485,22 @@ def _grasped(inputs: Mapping[str, Any]) -> str | None:
 
 
 class SimEnvironment:
-    """The pybullet home as an execution environment for ``actions.runner.run_task``."""
+    """The pybullet home as an execution environment for ``actions.runner.run_task``.
+
+    Verification and the world graph come from what the robots perceive and feel
+    (:class:`~sim.perceived.PerceivedWorld`); the simulator's own state only answers :meth:`audit`,
+    whether the task's goals really hold.
+    """
 
     def __init__(self, world: HomeWorld, kb: KnowledgeBase) -> None:
         self.world = world
         self.kb = kb
         self.registry = implementations(kb, world)
         self.context = SimContext(world, kb)
+        self.belief = PerceivedWorld(world)
+        self.referee = Referee(world)
+        self.effects: set[tuple[str, str, str]] = set()
+        """Relations believed because a step with that effect succeeded, where no test decides them."""
         self._superclasses: dict[str, set[str]] | None = None
         self._computables: dict[str, str] | None = None
 
@@ -499,6 +512,10 @@ class SimEnvironment:
         components registered since."""
         self.context.grid = None
         implementations(self.kb, self.world, self.registry)
+
+    def perceive(self) -> None:
+        """Look at everything with every working camera (before a plan, and before a re-plan)."""
+        self.belief.look()
 
     def given(self, plan: Plan, requirements: Mapping[str, Requirement]) -> dict[str, Any]:
         """The world's thing for each input a requirement gives: the one individual of the input's class."""
@@ -535,163 +552,167 @@ class SimEnvironment:
             self._computables = table
         return self._computables.get(predicate)
 
-    def _ground(self, concept: str, inputs: Mapping[str, Any]) -> tuple[str, str] | None:
-        """(role, name) of the thing a class-level statement means at this step: a thing the step was
-        given, else what is at hand (the arm's object, its gripper, the base, the person, the target)."""
+    def _ground(self, concept: str, inputs: Mapping[str, Any]) -> Grounded | None:
+        """The thing a class-level statement means at this step: a thing the step was given, else what
+        is at hand (the arm's object, its gripper, the base, the person, the target)."""
         for value in inputs.values():
             if isinstance(value, dict) and "@id" in value:
                 iri = str(value["@id"])
                 types = (*self.world.map.types.get(iri, ()), str(value.get("@type", "")))
                 if any(self.is_a(t, concept) for t in types):
-                    return ("thing", iri)
+                    return Grounded("thing", iri)
         ctx = self.context
         if self.is_a(concept, HOME + "Gripper") or self.is_a(concept, HOME + "Arm"):
-            return ("gripper", ctx.arm.value)
+            return Grounded("gripper", ctx.arm.value)
         if self.is_a(concept, HOME + "RobotPlatform"):
-            return ("platform", self.world.base_name)
+            return Grounded("platform", self.world.base_name)
         if self.is_a(concept, HOME + "MobileRobot"):
-            return ("base", self.world.base_name)
+            return Grounded("base", self.world.base_name)
         if self.is_a(concept, HOME + "Robot"):
-            return ("robot", "")
+            return Grounded("robot", "")
         if self.is_a(concept, HOME + "Person"):
-            return ("person", self.world.person_name)
+            return Grounded("person", self.world.person_name)
         if self.is_a(concept, HOME + "Substance"):
-            return ("substance", concept)
+            return Grounded("substance", concept)
         held = _grasped(inputs) if self.is_a(concept, HOME + "PhysicalObject") else None
         if held is not None:
-            return ("object", held)
+            return Grounded("object", held)
         # a class only one thing of the world belongs to (the Pen) means that thing, whatever is at hand
         candidates = [iri for iri, types in self.world.map.types.items() if any(self.is_a(t, concept) for t in types)]
         if len(candidates) == 1:
-            return ("thing", candidates[0])
+            return Grounded("thing", candidates[0])
         if self.is_a(concept, HOME + "PhysicalObject") and ctx.object is not None:
-            return ("object", ctx.object)
+            return Grounded("object", ctx.object)
         if self.is_a(concept, HOME + "Place") and ctx.region is not None:
-            return ("region", ctx.region.name)
+            return Grounded("region", ctx.region.name)
         return None
 
     def verify(self, step: PlanStep, statement: Statement, outputs: Mapping[str, Any]) -> bool | None:
-        """Decide a (class-level) statement by its predicate's computable, for the things at hand;
-        None when the store maps the predicate to no test or the things cannot be told."""
+        """Decide a (class-level) statement by its predicate's computable, for the things at hand, on
+        what the robots perceive now; None when the store maps the predicate to no test or the things
+        cannot be told."""
+        found = self._judge(self.belief, statement, outputs, look=True)
+        if found is None:
+            self._believe_effect(statement)
+        return found
+
+    def _believe_effect(self, statement: Statement) -> None:
+        """A relation no test decides is believed because a step that has it as its effect succeeded:
+        it joins the world graph, grounded in the things at hand."""
+        sides = [self._ground(concept, self.context.inputs) for concept in (statement.subject, statement.object)]
+        iris = [self._iri_of(side) for side in sides if side is not None]
+        if len(iris) == 2 and iris[0] is not None and iris[1] is not None:
+            self.effects.add((iris[0], statement.predicate, iris[1]))
+
+    def _iri_of(self, grounded: Grounded) -> str | None:
+        world = self.world
+        if grounded.role in ("thing", "substance"):
+            return grounded.name
+        if grounded.role == "object":
+            return world.objects[grounded.name].iri if grounded.name in world.objects else None
+        if grounded.role == "person":
+            return world.person.iri
+        if grounded.role == "base":
+            return world.robot.iri
+        if grounded.role == "platform":
+            return world.robot.platform
+        return None
+
+    def audit(self, statement: Statement) -> bool | None:
+        """Whether ``statement`` really holds in the simulated world now (the referee, not the robots)."""
+        return self._judge(self.referee, statement, {}, look=False)
+
+    def _judge(self, judge: Judge, statement: Statement, outputs: Mapping[str, Any], look: bool) -> bool | None:
         test = self.computable(statement.predicate)
         if test is None:
             return None
         if test == "perceived":
-            return bool(outputs)
+            return bool(outputs) if look else None
         if test == "localised-in":
+            if not look:
+                return None
             try:
                 estimate = decode(outputs.get("robotLocation"), RobotPoseEstimate)
             except MalformedValueError:
                 return False
-            truth = self.world.base_pose()
-            return math.hypot(estimate.x - truth.x, estimate.y - truth.y) <= LOCALISATION_TOLERANCE
+            odometry = self.world.base_pose()  # the base's own estimate of where it is
+            return math.hypot(estimate.x - odometry.x, estimate.y - odometry.y) <= LOCALISATION_TOLERANCE
         inputs = self.context.inputs
         subject = self._ground(statement.subject, inputs)
         obj = self._ground(statement.object, inputs)
         if subject is None or obj is None:
             return None
-        return self._decide(test, subject, obj)
+        if look and isinstance(judge, PerceivedWorld):
+            self._look_for(judge, test, subject, obj)
+        return judge.decide(test, subject, obj, self.context.arm, self.context.region)
 
-    def _object_name(self, grounded: tuple[str, str]) -> str | None:
-        role, name = grounded
-        if role == "object":
-            return name
-        if role == "thing":
-            return local_name(name) if name in self.world.map.objects else None
-        return None
-
-    def _decide(self, test: str, subject: tuple[str, str], obj: tuple[str, str]) -> bool | None:
-        world = self.world
-        thing = self._object_name(subject)
-        if test == "near":
-            if subject[0] == "gripper":
-                target = self._object_name(obj)
-                return target is not None and pred.gripper_near(world, subject[1], target)
-            if subject[0] == "base" and obj[0] == "person":
-                return pred.base_near_person(world, obj[1])
-            if subject[0] == "base":
-                place = self._thing(obj)
-                if place is None or place.dock is None:
-                    return None
-                return pred.base_near(world, _dock(place), heading=True)
-            return None
-        if thing is None:
-            return None
-        if test == "grasped-by":
-            return pred.is_grasped(world, thing, self.context.arm if obj[0] == "gripper" else None)
-        if test == "with":
-            return pred.with_person(world, thing, obj[1] if obj[0] == "person" else None)
-        if test == "contains":
-            return pred.contains_water(world, thing)
-        if test == "on" and obj[0] == "platform":
-            return pred.on_platform(world, thing)
-        region = self._region_of(obj)
-        if region is None:
-            return None
-        if test == "above":
-            return pred.object_above_region(world, thing, region)
-        if test in ("inside", "on"):
-            if thing in world.containers:
-                return pred.upright_in(world, thing, region)
-            return pred.object_located_in(world, thing, region)
-        return None
-
-    def _thing(self, grounded: tuple[str, str]) -> Thing | None:
-        role, name = grounded
-        if role == "thing":
-            return self.world.map.things.get(name)
-        if role == "region":
-            return next((t for t in self.world.map.things.values() if t.name == name), None)
-        return None
-
-    def _region_of(self, grounded: tuple[str, str]) -> Region | None:
-        if grounded[0] == "region" and self.context.region is not None:
-            return self.context.region
-        thing = self._thing(grounded)
-        return _region(thing) if thing is not None else None
+    def _look_for(self, belief: PerceivedWorld, test: str, subject: Grounded, obj: Grounded) -> None:
+        """Perceive what a test is about: the object in a region or a container's water by the cameras,
+        the person the base should be near by the ceiling cameras; the rest the robots feel."""
+        thing = belief.object_name(subject)
+        if test in ("inside", "on", "contains") and thing is not None and obj.role != "platform":
+            belief.look([thing], people=False)
+        elif test == "near" and obj.role == "person":
+            belief.look([], people=True)
+        elif test == "near" and subject.role == "gripper" and belief.object_name(obj) is not None:
+            belief.look([name for name in [belief.object_name(obj)] if name is not None], people=False)
+        else:
+            belief.feel()
 
     # -- the belief state ----------------------------------------------------------------------
 
     def observe(self) -> Observation:
-        """Types, the relations that hold now among the world's things, and their positions: each
-        relation decided by the same generic tests as verification."""
+        """Types, the relations believed to hold now among the world's things, and where they are
+        believed to be: from the robots' perception and proprioception (no new images are taken)."""
+        belief = self.belief
+        belief.feel()
         world, smap = self.world, self.world.map
+        arm = self.context.arm
         facts: set[tuple[str, str, str]] = set()
-        rooms = [t for t in smap.things.values() if t.box.max_z == 0.0]
-        supports = [t for t in smap.things.values() if t.box.min_z == 0.0 < t.box.max_z]
-        regions = [t for t in smap.things.values() if t.box.min_z > 0.0]
+        supports = [smap.things[iri] for iri in sorted(smap.furniture) if iri in smap.things]
+        regions = [smap.things[iri] for iri in sorted(smap.regions) if iri in smap.things]
         base_iri = world.robot.iri
         person_iri = world.person.iri
         for obj in smap.objects.values():
             name = obj.name
-            inside = [r for r in regions if self._decide("inside", ("object", name), ("thing", r.iri))]
-            for region in inside:
-                facts.add((obj.iri, HOME + "isLocated", region.iri))
+            here = Grounded("object", name)
+            for region in regions:
+                if belief.decide("inside", here, Grounded("thing", region.iri), arm):
+                    facts.add((obj.iri, HOME + "isLocated", region.iri))
             for support in supports:  # an object in a region on the table is on the table too
                 box = support.box
                 top = Region(support.name, box.min_x, box.max_x, box.min_y, box.max_y, box.max_z, box.max_z)
-                if pred.object_located_in(world, name, top):
+                if belief.located_in(name, top, upright=False):
                     facts.add((obj.iri, HOME + "isLocatedOn", support.iri))
-            if world.robot.platform is not None and pred.on_platform(world, name):
+            if world.robot.platform is not None and belief.on_platform(name):
                 facts.add((obj.iri, HOME + "isLocatedOn", world.robot.platform))
-            if pred.with_person(world, name):
+            if belief.with_person(name, None):
                 facts.add((obj.iri, HOME + "isWith", person_iri))
-            if name in world.containers and pred.contains_water(world, name):
+            if name in world.containers and belief.contains_water(name):
                 facts.add((obj.iri, HOME + "contains", HOME + "Water"))
-        if pred.base_near_person(world):
+        if belief.base_near_person(world.person_name):
             facts.add((base_iri, HOME + "isNear", person_iri))
+        odometry = world.base_pose()
         for support in supports:
-            if support.dock is not None and pred.base_near(world, _dock(support)):
+            if (
+                support.dock is not None
+                and odometry.distance_to(support.dock.x, support.dock.y) <= pred.BASE_NEAR_DISTANCE
+            ):
                 facts.add((base_iri, HOME + "isNear", support.iri))
-        for iri, body in ((base_iri, world.base_name), (person_iri, world.person_name)):
-            x, y, _ = world.pose(body).position
-            for room in rooms:
-                if room.box.contains_xy(float(x), float(y)):
-                    facts.add((iri, HOME + "isLocated", room.iri))
-        positions = {}
-        bodies = [*((o.iri, o.name) for o in smap.objects.values()), (person_iri, world.person_name)]
-        for iri, body in [*bodies, (base_iri, world.base_name)]:
-            position = world.pose(body).position
-            positions[iri] = (float(position[0]), float(position[1]), float(position[2]))
+        positions: dict[str, tuple[float, float, float]] = {base_iri: (odometry.x, odometry.y, 0.0)}
+        for obj in smap.objects.values():
+            where = belief.position(obj.name)
+            if where is not None:
+                positions[obj.iri] = where
+        seen = belief.people.get(world.person_name)
+        if seen is not None:
+            positions[person_iri] = seen.position
+        rooms = [smap.things[iri] for iri in sorted(smap.rooms) if iri in smap.things]
+        for iri, (x, y, _) in positions.items():
+            if iri in (base_iri, person_iri):
+                for room in rooms:
+                    if room.box.contains_xy(x, y):
+                        facts.add((iri, HOME + "isLocated", room.iri))
+        facts |= self.effects
         types = {iri: kinds[0] for iri, kinds in smap.types.items() if kinds and not iri.endswith("/world")}
         return Observation(types, frozenset(facts), positions, world.time)

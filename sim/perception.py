@@ -241,18 +241,29 @@ class ObjectEstimate:
         return (self.x, self.y, self.z)
 
 
-def recognise_object(frame: Frame, colour: str) -> ObjectEstimate:
+def recognise_object(
+    frame: Frame, colour: str, near: tuple[float, float] | None = None, radius: float = 0.25
+) -> ObjectEstimate:
     """The object of a colour in an RGB-D frame, located from the depth image.
 
     The seen points cover the top and the camera-facing side. For the upright and lying shapes on
     the table that is enough: the middle of the points' bounding box (taken along the object's own
     axis) is the object's centre, within the pixel size. The yaw comes from the points' principal axis.
+    With ``near`` (x, y), only the points of that colour within ``radius`` of it count: another thing
+    of the same colour elsewhere is not this object.
     """
     mask = segment(frame.rgb, colour)
     us, vs = _pixels(mask)
+    target = f"{colour} object" if near is None else f"{colour} object near ({near[0]:.2f}, {near[1]:.2f})"
+    if near is not None and us.size:
+        seen = frame.deproject(us, vs)
+        keep = np.hypot(seen[:, 0] - near[0], seen[:, 1] - near[1]) <= radius
+        us, vs = us[keep], vs[keep]
+        mask = np.zeros_like(mask)
+        mask[vs.astype(np.intp), us.astype(np.intp)] = True
     if us.size < MIN_OBJECT_PIXELS:
-        raise NotVisibleError(frame.camera, f"{colour} object", int(us.size), MIN_OBJECT_PIXELS)
-    _whole(frame, mask, f"{colour} object")
+        raise NotVisibleError(frame.camera, target, int(us.size), MIN_OBJECT_PIXELS)
+    _whole(frame, mask, target)
     points = frame.deproject(us, vs)
     xy = points[:, :2]
     mean = xy.mean(axis=0)

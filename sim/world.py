@@ -17,6 +17,7 @@ from types import TracebackType
 import numpy as np
 import pybullet as p
 
+from kb.namespaces import PREFIXES
 from kb.semantic_map import Arm as ArmSpec
 from kb.semantic_map import Box, Dispenser, MapObject, SemanticMap, Thing
 from sim import layout as L
@@ -51,6 +52,7 @@ _STEEL = (0.55, 0.56, 0.58, 1.0)
 _DARK = (0.15, 0.15, 0.17, 1.0)
 _TORSO = (0.45, 0.46, 0.50, 1.0)
 WATER_CYAN = (0.05, 0.80, 0.80, 1.0)
+HOME = PREFIXES["home"]
 _NAMED_COLOURS = {
     "red": (0.85, 0.08, 0.08, 1.0),
     "yellow": (0.95, 0.85, 0.10, 1.0),
@@ -342,6 +344,12 @@ class HomeWorld:
         p.resetBasePositionAndOrientation(body, (x, y, z), turned, physicsClientId=self.client)
         p.resetBaseVelocity(body, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0), physicsClientId=self.client)
 
+    @property
+    def water_rgba(self) -> tuple[float, float, float, float]:
+        """How water is shown: the display colour of the semantic map's water (cyan when it says none)."""
+        look = self.map.appearance(HOME + "Water")
+        return look[1] if look is not None else WATER_CYAN
+
     def water_level(self, name: str) -> float:
         """Fraction of a container filled with water; 0 for anything that is not a container."""
         return self.water.get(name, 0.0)
@@ -389,7 +397,7 @@ class HomeWorld:
             return
         self.water[catching] = min(1.0, self.water[catching] + FILL_RATE * self.time_step)
         if catching not in self._water_shown and self.water[catching] >= 0.2:
-            p.changeVisualShape(self.body(catching), 0, rgbaColor=WATER_CYAN, physicsClientId=self.client)
+            p.changeVisualShape(self.body(catching), 0, rgbaColor=self.water_rgba, physicsClientId=self.client)
             self._water_shown.add(catching)
 
     def give_to(self, name: str, person: str, hand: Vec3) -> None:
