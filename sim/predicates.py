@@ -1,8 +1,10 @@
-"""Belief checks against the simulated world: is a statement of the knowledge base true right now?
+"""Checks against the simulated world's state: is a statement of the knowledge base really true now?
 
-These read the simulator's ground truth on purpose: they are the referee that tells whether a
-skill's effect (for instance ``(Cup, isLocated, BelowOfTap)``) really holds, independent of the
-perception the robots used. Each tolerance is a named constant with the reason for its value.
+These read the simulator's ground truth on purpose: they are the referee (:mod:`sim.referee`) that
+tells whether a task's goal (for instance ``(Cup, isLocated, BelowOfTap)``) really holds, independent
+of the perception the robots used, and the skills' own success checks. The robots' belief
+(:mod:`sim.perceived`) shares their tolerances. ``objects_on_platform`` is also the platform's load
+sensor. Each tolerance is a named constant with the reason for its value.
 """
 
 from __future__ import annotations
