@@ -37,7 +37,7 @@ from cbrs.settings import setting
 from kb import KnowledgeBase
 from kb.errors import KnowledgeBaseError, QueryTooComplexError, StoreEvaluationError
 from kb.query_guard import start_evaluation_thread
-from kb.store import EmbeddedStore
+from kb.store import EmbeddedStore, refuse_inserted_blank_nodes
 
 # Media types offered for SELECT and ASK results, the first being the default.
 RESULT_TYPES: dict[str, ox.QueryResultsFormat] = {
@@ -337,6 +337,7 @@ class SparqlService:
         if token is None or not hmac.compare_digest(token.encode("utf-8"), expected.encode("utf-8")):
             raise UpdateForbiddenError("updates need the server's token: Authorization: Bearer <token>")
         self._check_size(text)
+        refuse_inserted_blank_nodes(text)  # what cbrs stores it must be able to read back by name
         with self.lock:
             try:
                 self.kb.update(text)  # a refused update raises StoreEvaluationError (400); nothing changed

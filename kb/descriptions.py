@@ -2,11 +2,12 @@
 
 from __future__ import annotations
 
+import logging
 from typing import Any, Literal, cast
 
 import pyoxigraph as ox
 
-from kb.errors import InvalidDescriptionError, NotFoundError
+from kb.errors import BlankNodeError, InvalidDescriptionError, NotFoundError
 from kb.model import (
     Advertisement,
     EffectiveArea,
@@ -21,6 +22,8 @@ from kb.model import (
 from kb.queries import QueryLibrary
 from kb.store import Store, Term
 from kb.vocab import CBRS
+
+log = logging.getLogger("kb.descriptions")
 
 MAX_PART_DEPTH = 8  # deeper part structures are modelling errors, not taxonomies
 
@@ -38,13 +41,21 @@ class DescriptionReader:
         self._trees.clear()
 
     def advertisement_iris(self) -> list[str]:
-        return [_iri(row["service"]) for row in self._queries.select(self._store, "advertisements")]
+        """The advertisements' IRIs; one that is a blank node (an update's doing) is passed over."""
+        return _named(row["service"] for row in self._queries.select(self._store, "advertisements"))
 
     def requirement_iris(self) -> list[str]:
-        return [_iri(row["requirement"]) for row in self._queries.select(self._store, "requirements")]
+        return _named(row["requirement"] for row in self._queries.select(self._store, "requirements"))
 
     def read(self, iri: str) -> ServiceDescription:
-        """The advertisement or requirement ``iri``; NotFoundError when it is neither."""
+        """The advertisement or requirement ``iri``; NotFoundError when it is neither, BlankNodeError
+        (400) when a node of it is blank."""
+        try:
+            return self._read(iri)
+        except BlankNodeError as error:
+            raise BlankNodeError(iri, error.node) from None
+
+    def _read(self, iri: str) -> ServiceDescription:
         head = self._queries.select(self._store, "description", {"description": iri})
         if not head:
             raise NotFoundError(iri, "service description")
@@ -102,10 +113,21 @@ class DescriptionReader:
         )
 
     def advertisements(self) -> list[Advertisement]:
-        return [cast(Advertisement, self.read(iri)) for iri in self.advertisement_iris()]
+        """Every readable advertisement: one with a blank node inside is passed over (and logged), so
+        one bad update does not stop matching and planning for everyone."""
+        return [cast(Advertisement, found) for found in self._readable(self.advertisement_iris())]
 
     def requirements(self) -> list[Requirement]:
-        return [cast(Requirement, self.read(iri)) for iri in self.requirement_iris()]
+        return [cast(Requirement, found) for found in self._readable(self.requirement_iris())]
+
+    def _readable(self, iris: list[str]) -> list[ServiceDescription]:
+        found = []
+        for iri in iris:
+            try:
+                found.append(self.read(iri))
+            except BlankNodeError as error:
+                log.warning("passed over: %s", error)
+        return found
 
     def part_tree(self, concept: str) -> PartNode:
         """The concept with its hasPart children, recursively; a cycle is a modelling error."""
@@ -213,9 +235,21 @@ class DescriptionReader:
 
 
 def _iri(term: Term) -> str:
+    if isinstance(term, ox.BlankNode):
+        raise BlankNodeError("(a description)", str(term))
     if not isinstance(term, ox.NamedNode):
         raise TypeError(f"expected an IRI, got {term}")
     return term.value
+
+
+def _named(terms: Any) -> list[str]:
+    found = []
+    for term in terms:
+        if isinstance(term, ox.NamedNode):
+            found.append(term.value)
+        else:
+            log.warning("passed over a description named by the blank node %s", term)
+    return found
 
 
 def _value(term: Term) -> str:

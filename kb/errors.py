@@ -169,6 +169,29 @@ class InvalidDescriptionError(KnowledgeBaseError):
         super().__init__(f"<{iri}> is not a valid service description: {'; '.join(self.problems)}")
 
 
+class BlankNodeInsertError(KnowledgeBaseError):
+    """An update that would insert a blank node: cbrs names every node it stores."""
+
+    http_status = 400
+
+    def __init__(self, update: str, node: str) -> None:
+        self.update = update
+        self.node = node
+        super().__init__(
+            f"the update inserts a blank node ({node}); cbrs names every node it stores so that it can be read "
+            "and deleted by name: give it an IRI (a description's parts under its own IRI, <...#output1>)"
+        )
+
+
+class BlankNodeError(InvalidDescriptionError):
+    """A description names a blank node where an IRI is needed (written by an update, not the loader,
+    which names every node): it cannot be read, addressed or deleted by name."""
+
+    def __init__(self, iri: str, node: str) -> None:
+        super().__init__(iri, [f"{node} is a blank node where an IRI is needed; give it an IRI (cbrs load names them)"])
+        self.node = node
+
+
 class AlreadyRegisteredError(KnowledgeBaseError):
     http_status = 409
 

@@ -33,6 +33,7 @@ from kb.errors import PartCycleError, RdfParseError, UnknownFormatError, Unknown
 from kb.namespaces import CBRS, DUL, GENID, OWL, RDF, RDFS, GraphName
 from kb.owls import Conversion, Role, Vocabulary, convert, is_owls, referenced_ontologies
 from kb.store import Store
+from kb.xml_limits import check_entities
 
 FORMATS_BY_EXTENSION: dict[str, ox.RdfFormat] = {
     ".ttl": ox.RdfFormat.TURTLE,
@@ -178,12 +179,16 @@ def load_files(
         conversion = None
         if raw.is_owls:
             conversion = convert(raw.quads, raw.source, role, raw.target, vocabulary, raw.prefixes)
+            _check_whole(conversion, raw.source)
             raw.quads.extend(conversion.quads)
             assert vocabulary is not None
             report.unresolved_concepts.extend(_unresolved(conversion, vocabulary))
-        report.files.append(
-            ParsedFile(raw.source, raw.target.value, skolemise(raw.quads, raw.source), conversion, repairs=raw.repairs)
+        parsed = ParsedFile(
+            raw.source, raw.target.value, skolemise(raw.quads, raw.source), conversion, repairs=raw.repairs
         )
+        if conversion is not None:
+            _check_not_merged(store, parsed)
+        report.files.append(parsed)
     report.imports = [
         ParsedFile(
             raw.source, raw.target.value, skolemise(raw.quads, raw.source), ontology=raw.ontology, repairs=raw.repairs
@@ -193,6 +198,45 @@ def load_files(
     _check_part_cycles(store, [*raws, *imported])
     store.add(quad for item in (*report.files, *report.imports) for quad in item.quads)
     return report
+
+
+def _check_whole(conversion: Conversion, source: str) -> None:
+    """An OWL-S file must describe a service by a profile or a process; one that lacks a part is named
+    in the conversion's notes, so a load never passes a partial description off as whole."""
+    if not conversion.services:
+        raise RdfParseError(
+            source, "the OWL-S file describes no service with an IRI (Service:Service or Profile:Profile)"
+        )
+    for converted in conversion.services:
+        if "profile" in converted.missing and "process" in converted.missing:
+            raise RdfParseError(
+                source,
+                f"OWL-S service <{converted.service}> has neither a profile nor a process: nothing describes what "
+                "it takes or gives; nothing was loaded",
+            )
+        if converted.missing:
+            conversion.notes.append(
+                f"{source}: OWL-S service <{converted.service}> has no {' and no '.join(converted.missing)}; its "
+                "description was made from the rest"
+            )
+
+
+def _check_not_merged(store: Store, parsed: ParsedFile) -> None:
+    """Loading an OWL-S file whose service is already in the store adds nothing when it is the same
+    file (its nodes are named from its content); a different file under the same IRI is refused rather
+    than merged into the first description."""
+    assert parsed.owls is not None
+    for converted in parsed.owls.services:
+        node = ox.NamedNode(converted.iri)
+        if next(iter(store.quads(node, ox.NamedNode(RDF + "type"))), None) is None:
+            continue
+        if all(next(iter(store.quads(q.subject, q.predicate, q.object, q.graph_name)), None) for q in parsed.quads):
+            continue
+        raise RdfParseError(
+            parsed.source,
+            f"<{converted.iri}> is already in the store, described differently; loading this file would merge "
+            "two descriptions into one. Deregister it first (cbrs deregister IRI), or give the new one another IRI",
+        )
 
 
 def expand_paths(paths: Sequence[str | Path]) -> list[Path]:
@@ -367,6 +411,8 @@ def _parse_quads(
     twice. Such a file is mended and parsed again, leniently, with every IRI then checked; any other
     error stands.
     """
+    if rdf_format == ox.RdfFormat.RDF_XML:
+        check_entities(data, source)  # before Oxigraph expands them: a kilobyte can expand to gigabytes
     try:
         parser = ox.parse(input=data, format=rdf_format, base_iri=base)
         quads = list(parser)

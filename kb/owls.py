@@ -30,8 +30,15 @@ from urllib.parse import urljoin
 import pyoxigraph as ox
 
 from kb.catalog import is_built_in, namespace_document
+from kb.errors import RdfParseError
 from kb.namespaces import OWL, RDF, RDFS
 from kb.vocab import CBRS
+from kb.xml_limits import check_entities
+
+CONDITION_TEXT_BUDGET = 16 << 20
+"""Characters of expression text one file's statements may carry between them. Every statement made
+from an expression carries the expression's text, so an expression of n atoms costs n times its text;
+past this budget an expression is kept as its text alone, once, and the conversion says so."""
 
 Role = Literal["advertisement", "requirement"]
 Term = Any  # an ox.NamedNode, ox.BlankNode or ox.Literal
@@ -198,6 +205,7 @@ class ConvertedService:
     text_only: int  # condition nodes holding only the expression's text
     parameter_types: tuple[str, ...]
     statement_terms: tuple[str, ...]  # subjects, predicates and objects of its statements
+    missing: tuple[str, ...] = ()  # which of service, profile and process the file does not give it
 
 
 @dataclass
@@ -335,6 +343,7 @@ class _Builder:
     ) -> None:
         self.index = index
         self.result = result
+        self.text_spent = 0  # characters of expression text the statements made so far carry
         self.source = source
         self.role = role
         self.graph = graph if graph is not None else ox.DefaultGraph()
@@ -365,6 +374,16 @@ class _Builder:
             *index.values(profiles, "Profile:has_process"),
         ]
         holders = [*profiles, *processes]
+        typed = set(index.typed("Service:Service"))
+        missing = tuple(
+            part
+            for part, present in (
+                ("service", service in typed),
+                ("profile", bool(profiles)),
+                ("process", bool(processes)),
+            )
+            if not present
+        )
         iri = service.value if self.role == "advertisement" else requirement_iri(service.value)
         node = ox.NamedNode(iri)
         name = _first_text(index, profiles, "Profile:serviceName") or local_name(service.value)
@@ -423,6 +442,7 @@ class _Builder:
                 text_only=text_only,
                 parameter_types=tuple(dict.fromkeys(types)),
                 statement_terms=tuple(dict.fromkeys(terms)),
+                missing=missing,
             )
         )
 
@@ -479,6 +499,14 @@ class _Builder:
         """Turn one expression into statements; False when it was kept as text only."""
         self.result.expressions += 1
         text, atoms, kept = self.read_expression(expression)
+        cost = len(text) * len(atoms)
+        if cost and self.text_spent + cost > CONDITION_TEXT_BUDGET:
+            self.note(
+                f"{self.source}: an expression of {len(atoms)} atoms and {len(text)} characters kept as text "
+                f"(its statements would carry {cost} characters; {CONDITION_TEXT_BUDGET} per file at most)"
+            )
+            atoms, kept = [], kept + len(atoms)
+        self.text_spent += cost if atoms else 0
         kind = CBRS.Precondition if role == "precondition" else CBRS.Effect
         link = CBRS.hasPrecondition if role == "precondition" else CBRS.hasEffect
         made = 0
@@ -540,10 +568,14 @@ class _Builder:
                 self.note(f"{self.source}: PDDL expression kept as text ({error}): {_short(text)}")
                 return text, [], 1
             atoms, kept = [], 0
-            for formula in tree:
-                found, skipped = _pddl_atoms(formula)
-                atoms.extend(found)
-                kept += skipped
+            try:
+                for formula in tree:
+                    found, skipped = _pddl_atoms(formula)
+                    atoms.extend(found)
+                    kept += skipped
+            except RecursionError:
+                self.note(f"{self.source}: PDDL expression nested too deeply, kept as text: {_short(text)}")
+                return text, [], 1
             return text, atoms, kept
         return text, [], 1
 
@@ -565,8 +597,9 @@ class _Builder:
         declarations = " ".join(f'xmlns:{p}="{ns}"' for p, ns in namespaces.items() if p and '"' not in ns)
         document = f"<rdf:RDF {declarations}>{text}</rdf:RDF>"
         try:
+            check_entities(document.encode("utf-8"), self.source)
             parsed = list(ox.parse(input=document.encode("utf-8"), format=ox.RdfFormat.RDF_XML, base_iri=self.base()))
-        except (SyntaxError, ValueError) as error:
+        except (SyntaxError, ValueError, RdfParseError) as error:
             self.note(f"{self.source}: SWRL expression kept as text ({error})")
             return [], 1
         inner = _Index(parsed)

@@ -42,6 +42,11 @@ class RemoteAccessError(KnowledgeBaseError):
         )
 
 
+def loads(text: str) -> bool:
+    """Whether ``text`` holds a ``LOAD`` (read as SPARQL tokens, so not one inside a string or IRI)."""
+    return any(m.group().upper() == "LOAD" for m in _TOKEN.finditer(text))
+
+
 def refuse_remote_access(text: str, allowed: Sequence[str] = ()) -> None:
     """Raise :class:`RemoteAccessError` for a ``SERVICE`` or ``LOAD`` in ``text`` whose target is not allowed."""
     tokens = [m.group() for m in _TOKEN.finditer(text) if not m.group().startswith("#")]

@@ -17,10 +17,10 @@ from pathlib import Path
 
 import pyoxigraph as ox
 
-from kb.errors import QuerySyntaxError, StoreError, StoreEvaluationError
+from kb.errors import BlankNodeInsertError, QuerySyntaxError, StoreError, StoreEvaluationError
 from kb.namespaces import GENID, PREFIXES, GraphName
 from kb.query_guard import QueryGuard
-from kb.remote_access import refuse_remote_access
+from kb.remote_access import loads, refuse_remote_access
 from kb.sparql_lexemes import HIDING
 
 MEMORY = ":memory:"
@@ -33,6 +33,8 @@ text. It is not what keeps the process alive (other constructs recurse as deeply
 
 # What can hide a bracket (strings, IRIs, comments) or is one; anything else is skipped.
 _LEXEME = re.compile(HIDING + r"|[(){}\[\]]", re.DOTALL)
+# The same, with keywords and blank node labels: what an INSERT template is read with.
+_TEMPLATE_LEXEME = re.compile(HIDING + r"|_:[\w.-]*|[A-Za-z]+|[{}\[]", re.DOTALL)
 
 Term = ox.NamedNode | ox.BlankNode | ox.Literal
 QueryResult = ox.QuerySolutions | ox.QueryBoolean | ox.QueryTriples
@@ -160,6 +162,28 @@ def refuse_deep_nesting(text: str) -> None:
         raise QuerySyntaxError(
             text, f"brackets nested {depth} deep; at most {MAX_NESTING} levels are accepted (kb.store.MAX_NESTING)"
         )
+
+
+def refuse_inserted_blank_nodes(text: str) -> None:
+    """Raise :class:`BlankNodeInsertError` for an update that would insert a blank node (``_:x`` or ``[...]``
+    in an ``INSERT`` or ``INSERT DATA`` block). cbrs names every node it stores (the loader skolemises
+    them) so that a description can be read, addressed and deleted; a blank node inserted by an update
+    can be none of these. ``WHERE`` and ``DELETE`` patterns may use them."""
+    tokens = [m.group() for m in _TEMPLATE_LEXEME.finditer(text) if not m.group().startswith("#")]
+    depth = 0
+    inserting = False
+    for token in tokens:
+        if depth == 0 and token.upper() == "INSERT":
+            inserting = True
+            continue
+        if token == "{":
+            depth += 1
+        elif token == "}":
+            depth = max(depth - 1, 0)
+            if depth == 0:
+                inserting = False
+        elif inserting and depth > 0 and (token.startswith("_:") or token == "["):
+            raise BlankNodeInsertError(text, token if token.startswith("_:") else "[ ... ]")
 
 
 def is_remote(location: str) -> bool:
@@ -292,7 +316,13 @@ class EmbeddedStore(Store):
         refuse_deep_nesting(text)
         refuse_remote_access(text, self.remote_access)
         self.guard.admit("update", text)
-        self._apply_own_update(text)
+        try:
+            self._apply_own_update(text)
+        except StoreError as error:
+            # an allowed LOAD that cannot read its file or URL is the request's fault, not the store's
+            if isinstance(error, StoreEvaluationError) or not loads(text):
+                raise
+            raise StoreEvaluationError(self.location, "update", f"LOAD failed: {error.__cause__}") from error
 
     def _apply_own_update(self, text: str) -> None:
         self.generation += 1  # before as well as after: a snapshot taken meanwhile is never current
