@@ -16,6 +16,7 @@ from kb.queries import QueryLibrary
 from kb.query_guard import QueryGuard
 from kb.registry import ComponentRegistry
 from kb.resources import bundled_files, query_dir
+from kb.shapes import checked_update
 from kb.store import EmbeddedStore, QueryResult, Store, Term, is_remote
 
 _VERSION_INFO = ox.NamedNode("http://www.w3.org/2002/07/owl#versionInfo")
@@ -127,7 +128,8 @@ class KnowledgeBase:
     def update(self, text: str) -> None:
         """Run a SPARQL update in one transaction; the cached descriptions are read afresh afterwards."""
         try:
-            self.store.update(text)
+            with checked_update(self.store):  # a description the update breaks is put back (kb/shapes.py)
+                self.store.update(text)
         finally:
             self._reader.clear_cache()
 

@@ -10,6 +10,7 @@ import pyoxigraph as ox
 from kb.errors import AlreadyRegisteredError, InvalidDescriptionError, NotFoundError
 from kb.loader import parse_bytes
 from kb.namespaces import BASE, GENID, RDF, GraphName
+from kb.shapes import check_descriptions
 from kb.store import Store
 from kb.vocab import CBRS
 
@@ -76,6 +77,7 @@ class ComponentRegistry:
         parsed = parse_bytes(raw, source, ox.RdfFormat.TURTLE, graph=GraphName.SERVICES, base_iri=BASE)
         iris = _advertisements(self._store, parsed.quads)
         if not iris:
+            check_descriptions(self._store, parsed.quads)  # a misspelt component kind gets its did-you-mean
             raise InvalidDescriptionError(
                 source, ["it describes no advertisement (a subject typed with a cbrs component kind)"]
             )
@@ -83,6 +85,7 @@ class ComponentRegistry:
             problems = _problems(iri, parsed.quads)
             if problems:
                 raise InvalidDescriptionError(iri, problems)
+        check_descriptions(self._store, parsed.quads)  # SHACL shapes and declared terms (kb/shapes.py)
         return parsed.quads, iris
 
 

@@ -1,0 +1,372 @@
+"""Service descriptions checked against the SHACL shapes in ``ontologies/shapes.ttl`` before they are written.
+
+Two checks, each naming the description, the node, the property and the value at fault:
+
+- the shapes (pySHACL): counts, datatypes, a SEA box whose minimum exceeds its maximum, a QoS value
+  that is a word rather than a number;
+- the terms: every class a description names (its types, parameter types, port data types, effective
+  areas, statement subjects and objects) and every property it uses must be declared somewhere, in the
+  store or in what is being written, with a did-you-mean for a near spelling (``home:MarkerColor`` ->
+  ``home:MarkerColour``). A term of a namespace the store knows nothing of is let through: there is
+  nothing to compare it with (an OWL-S import's unresolved concepts are likewise reported, not refused).
+
+Every way in calls :func:`check_descriptions` (the registry, the loader through :func:`check_loaded`,
+:meth:`KnowledgeBase.update` through :func:`checked_update`). OWL-S imports are checked against the
+shapes only: their unresolved concepts are reported by the loader, not refused.
+"""
+
+from __future__ import annotations
+
+import difflib
+import functools
+from collections.abc import Iterable, Iterator, Sequence
+from contextlib import contextmanager
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import pyoxigraph as ox
+
+from kb.errors import InvalidDescriptionError
+from kb.namespaces import GENID, OWL, RDF, RDFS, XSD, GraphName, shorten
+from kb.resources import ontology_dir
+from kb.store import Store
+from kb.vocab import CBRS
+
+if TYPE_CHECKING:
+    from kb.loader import LoadReport
+
+SH = "http://www.w3.org/ns/shacl#"
+SHAPES_FILE = "shapes.ttl"
+
+# Where a description names a class (or an individual, or a property used as a concept).
+_TERM_POSITIONS = frozenset(
+    {
+        RDF + "type",
+        CBRS.parameterType,
+        CBRS.dataType,
+        CBRS.effectiveArea,
+        CBRS.realizesAction,
+        CBRS.forTask,
+        RDF + "subject",
+        RDF + "object",
+    }
+)
+_PROPERTY_POSITION = RDF + "predicate"  # a statement's predicate is a property
+
+
+@dataclass(frozen=True)
+class ShapeProblem:
+    """One thing wrong with one description."""
+
+    description: str
+    message: str
+    focus: str | None = None  # the node at fault when it is not the description itself
+    path: str | None = None
+    value: str | None = None
+    suggestion: str | None = None
+
+    def text(self) -> str:
+        path = shorten(self.path) if self.path else None
+        if self.value is not None:
+            got = f"; got {path} {self.value}" if path else f"; got {self.value}"
+        else:
+            got = f" (as {path})" if path and path not in self.message else ""
+        hint = f"; did you mean {self.suggestion}?" if self.suggestion else ""
+        return f"{self.message}{got}{hint}"
+
+
+class DescriptionShapeError(InvalidDescriptionError):
+    """A description breaks a shape or names an undeclared term; nothing was written."""
+
+    http_status = 400
+
+    def __init__(self, problems: Sequence[ShapeProblem]) -> None:
+        self.shape_problems = list(problems)
+        first = self.shape_problems[0].description
+        super().__init__(first, [p.text() for p in self.shape_problems if p.description == first])
+        others = {p.description for p in self.shape_problems} - {first}
+        if others:
+            count = len(others)
+            self.args = (f"{self.args[0]} (and {count} other description{'s' if count > 1 else ''} with problems)",)
+
+    def __str__(self) -> str:
+        return str(self.args[0])
+
+
+# -- the ways in -----------------------------------------------------------------------------------
+
+
+def check_descriptions(store: Store, quads: Iterable[ox.Quad], terms: bool = True) -> None:
+    """Raise :class:`DescriptionShapeError` when a description among ``quads`` breaks a shape or (with
+    ``terms``) names a class or property declared neither in ``store`` nor in ``quads``."""
+    incoming = list(quads)
+    closures = _closures(incoming)
+    if not closures:
+        return
+    problems = _shape_problems(closures)
+    if terms:
+        problems += _term_problems(store, closures, incoming)
+    if problems:
+        raise DescriptionShapeError(problems)
+
+
+def check_loaded(store: Store, report: LoadReport) -> None:
+    """The loader's check before it writes: RDF files in full, OWL-S conversions against the shapes only."""
+    owls = [q for item in report.files if item.owls is not None for q in item.quads]
+    plain = [q for item in (*report.files, *report.imports) if item.owls is None for q in item.quads]
+    context = plain + owls
+    if _closures(plain):
+        _check_with_context(store, plain, context)
+    check_descriptions(store, owls, terms=False)
+
+
+def _check_with_context(store: Store, quads: list[ox.Quad], context: list[ox.Quad]) -> None:
+    closures = _closures(quads)
+    problems = _shape_problems(closures) + _term_problems(store, closures, context)
+    if problems:
+        raise DescriptionShapeError(problems)
+
+
+@contextmanager
+def checked_update(store: Store) -> Iterator[None]:
+    """Run the enclosed update, then check the descriptions it changed in the services and requirements
+    graphs; when one is broken, undo the update's changes to those graphs and raise."""
+    graphs = (GraphName.SERVICES.node, GraphName.REQUIREMENTS.node)
+    before = {q for graph in graphs for q in store.quads(graph=graph)}
+    yield
+    after = {q for graph in graphs for q in store.quads(graph=graph)}
+    added, removed = after - before, before - after
+    if not added and not removed:
+        return
+    closures = _closures(after)
+    changed = {q.subject for q in (*added, *removed)}
+    touched = {root: quads for root, quads in closures.items() if changed & {q.subject for q in quads}}
+    problems = _shape_problems(touched) + _term_problems(store, touched, [])
+    if problems:
+        _undo(store, added, removed)
+        raise DescriptionShapeError(problems)
+
+
+def _undo(store: Store, added: set[ox.Quad], removed: set[ox.Quad]) -> None:
+    if not any(isinstance(t, ox.BlankNode) for q in (*added, *removed) for t in (q.subject, q.object)):
+        store.replace(added, removed)  # one transaction
+        return
+    # A data block cannot name a blank node: empty the graphs the update touched, then restore them.
+    graphs = {q.graph_name for q in (*added, *removed)}
+    kept = [q for q in store.quads() if q.graph_name in graphs and q not in added]
+    for graph in graphs:
+        store.update(f"DROP SILENT GRAPH {graph}")
+    store.add([*kept, *removed])
+
+
+# -- descriptions and their nodes ------------------------------------------------------------------
+
+
+def _closures(quads: Iterable[ox.Quad]) -> dict[str, list[ox.Quad]]:
+    """Each description (a subject with an OWLS model) with its own quads and those of the nodes hanging
+    off it (blank or skolemised), as the registry reads a description."""
+    by_subject: dict[Any, list[ox.Quad]] = {}
+    roots: set[ox.NamedNode] = set()
+    for quad in quads:
+        by_subject.setdefault(quad.subject, []).append(quad)
+        subject = quad.subject
+        if quad.predicate.value == CBRS.hasOWLSModel and isinstance(subject, ox.NamedNode) and not _is_inner(subject):
+            roots.add(subject)
+    closures = {}
+    for root in sorted(roots, key=lambda node: node.value):
+        found: list[ox.Quad] = []
+        pending: list[Any] = [root]
+        seen = set()
+        while pending:
+            node = pending.pop()
+            if node in seen:
+                continue
+            seen.add(node)
+            for quad in by_subject.get(node, []):
+                found.append(quad)
+                if _is_inner(quad.object):
+                    pending.append(quad.object)
+        closures[root.value] = found
+    return closures
+
+
+def _iri(term: Any) -> str:
+    return term.value if isinstance(term, ox.NamedNode) else ""
+
+
+def _is_inner(term: Any) -> bool:
+    return isinstance(term, ox.BlankNode) or (isinstance(term, ox.NamedNode) and term.value.startswith(GENID))
+
+
+# -- the SHACL shapes ------------------------------------------------------------------------------
+
+
+@functools.cache
+def _shapes_graph() -> Any:
+    import rdflib
+
+    return rdflib.Graph().parse(ontology_dir() / SHAPES_FILE, format="turtle")
+
+
+def _shape_problems(closures: dict[str, list[ox.Quad]]) -> list[ShapeProblem]:
+    if not closures:
+        return []
+    import rdflib
+    from pyshacl import validate
+
+    owner = {q.subject: root for root, quads in closures.items() for q in quads}
+    triples = [ox.Triple(q.subject, q.predicate, q.object) for quads in closures.values() for q in quads]
+    data = rdflib.Graph().parse(data=ox.serialize(triples, format=ox.RdfFormat.N_TRIPLES), format="nt")
+    conforms, results, _ = validate(data, shacl_graph=_shapes_graph(), inference="none", allow_warnings=True)
+    if conforms:
+        return []
+    problems = []
+    sh = rdflib.Namespace(SH)
+    reports = list(results.subjects(rdflib.RDF.type, sh.ValidationReport))
+    for result in (r for report in reports for r in results.objects(report, sh.result)):  # not sh:detail
+        focus = results.value(result, sh.focusNode)
+        path = results.value(result, sh.resultPath)
+        value = results.value(result, sh.value)
+        message = results.value(result, sh.resultMessage)
+        focus_term = _ox_term(focus)
+        root = owner.get(focus_term, focus_term.value if focus_term is not None else "")
+        problems.append(
+            ShapeProblem(
+                description=str(root),
+                message=str(message) if message is not None else "breaks a shape",
+                focus=None if focus_term is None or str(root) == focus_term.value else _node_text(focus_term),
+                path=str(path) if isinstance(path, rdflib.URIRef) else None,
+                value=_literal_text(value),
+            )
+        )
+    return sorted(set(problems), key=lambda p: (p.description, p.path or "", p.message))
+
+
+def _ox_term(term: Any) -> Any:
+    import rdflib
+
+    if isinstance(term, rdflib.URIRef):
+        return ox.NamedNode(str(term))
+    if isinstance(term, rdflib.BNode):
+        return ox.BlankNode(str(term))
+    return None
+
+
+def _node_text(term: Any) -> str:
+    return "a blank node" if isinstance(term, ox.BlankNode) else shorten(term.value)
+
+
+def _literal_text(value: Any) -> str | None:
+    import rdflib
+
+    if value is None:
+        return None
+    if isinstance(value, rdflib.Literal):
+        datatype = str(value.datatype) if value.datatype else None
+        if datatype in (XSD + "decimal", XSD + "integer", XSD + "double", XSD + "float"):
+            return str(value)
+        typed = f"^^{shorten(datatype)}" if datatype and datatype != XSD + "string" else ""
+        return f'"{value}"{typed}' + (f"@{value.language}" if value.language else "")
+    if isinstance(value, rdflib.BNode):
+        return "a blank node"
+    return shorten(str(value))
+
+
+# -- declared terms --------------------------------------------------------------------------------
+
+
+def _term_problems(store: Store, closures: dict[str, list[ox.Quad]], context: Sequence[ox.Quad]) -> list[ShapeProblem]:
+    """Classes and properties the descriptions use that nothing declares, each with a near spelling."""
+    # (description, the property the term is a value of, the term, whether it is used as a property)
+    uses: list[tuple[str, str | None, ox.NamedNode, bool]] = []
+    for root, quads in closures.items():
+        for quad in quads:
+            uses.append((root, None, quad.predicate, True))
+            if not isinstance(quad.object, ox.NamedNode) or _is_inner(quad.object):
+                continue
+            if quad.predicate.value in _TERM_POSITIONS:
+                uses.append((root, quad.predicate.value, quad.object, False))
+            elif quad.predicate.value == _PROPERTY_POSITION:
+                uses.append((root, quad.predicate.value, quad.object, True))
+    described = {q for quads in closures.values() for q in quads}
+    declared_here = {_iri(q.subject) for q in (*context, *described)}
+    # A namespace is known when something besides the descriptions themselves declares a term of it.
+    beside = {_iri(q.subject) for q in context if q not in described}
+    w3c_namespaces, w3c_terms = _w3c_terms()
+    unknown = {term.value for _, _, term, _ in uses} - declared_here - w3c_terms
+    unknown -= _declared_in_store(store, unknown)
+    problems = []
+    for root, position, term, is_property in uses:
+        if term.value not in unknown or term.value.startswith(GENID):
+            continue
+        namespace = _namespace(term.value)
+        if namespace not in w3c_namespaces and not _namespace_known(store, namespace, beside):
+            continue  # a vocabulary the store has never seen: nothing to compare with (as OWL-S imports allow)
+        near = _near(term.value, _candidates(store, namespace, declared_here))
+        problems.append(
+            ShapeProblem(
+                description=root,
+                message=f"{'the property ' if is_property else ''}{shorten(term.value)} is declared nowhere "
+                "in the store or in this input",
+                path=position,
+                suggestion=shorten(near) if near else None,
+            )
+        )
+    return sorted(set(problems), key=lambda p: (p.description, p.message))
+
+
+def _namespace(iri: str) -> str:
+    for separator in ("#", "/"):
+        if separator in iri:
+            return iri.rsplit(separator, 1)[0] + separator
+    return iri
+
+
+def _declared_in_store(store: Store, iris: set[str]) -> set[str]:
+    if not iris:
+        return set()
+    values = " ".join(str(ox.NamedNode(iri)) for iri in sorted(iris))
+    result = store.query(f"SELECT ?t WHERE {{ VALUES ?t {{ {values} }} FILTER EXISTS {{ ?t ?p ?o }} }}")
+    assert isinstance(result, ox.QuerySolutions)
+    return {row["t"].value for row in result}
+
+
+def _candidates(store: Store, namespace: str, declared_here: set[str]) -> list[str]:
+    w3c_namespaces, w3c_terms = _w3c_terms()
+    if namespace in w3c_namespaces:
+        return sorted(t for t in w3c_terms if t.startswith(namespace))
+    prefix = ox.Literal(namespace)  # written by Oxigraph's serialiser, escaped
+    result = store.query(f"SELECT DISTINCT ?t WHERE {{ ?t ?p ?o FILTER(isIRI(?t) && STRSTARTS(STR(?t), {prefix})) }}")
+    assert isinstance(result, ox.QuerySolutions)
+    return sorted({row["t"].value for row in result} | {t for t in declared_here if t.startswith(namespace)})
+
+
+def _namespace_known(store: Store, namespace: str, declared: set[str]) -> bool:
+    if any(t.startswith(namespace) for t in declared):
+        return True
+    prefix = ox.Literal(namespace)
+    result = store.query(f"ASK {{ ?t ?p ?o FILTER(isIRI(?t) && STRSTARTS(STR(?t), {prefix})) }}")
+    return bool(result)
+
+
+def _near(iri: str, candidates: Sequence[str]) -> str | None:
+    """The candidate whose local name is closest to ``iri``'s, if any is close (case aside)."""
+    namespace = _namespace(iri)
+    local = iri[len(namespace) :]
+    names = {c[len(namespace) :].lower(): c for c in candidates if c.startswith(namespace)}
+    close = difflib.get_close_matches(local.lower(), list(names), n=1, cutoff=0.75)
+    return names[close[0]] if close else None
+
+
+@functools.cache
+def _w3c_terms() -> tuple[frozenset[str], frozenset[str]]:
+    """The closed RDF, RDFS, OWL and XSD vocabularies and the cbrs core, known without a declaration in the store."""
+    from rdflib.namespace import OWL as R_OWL
+    from rdflib.namespace import RDF as R_RDF
+    from rdflib.namespace import RDFS as R_RDFS
+    from rdflib.namespace import XSD as R_XSD
+
+    spaces = {RDF: R_RDF, RDFS: R_RDFS, OWL: R_OWL, XSD: R_XSD}
+    terms = {ns + name for ns, vocabulary in spaces.items() for name in vocabulary.__annotations__}
+    core = {value for name, value in vars(CBRS).items() if name != "NS" and isinstance(value, str)}
+    return frozenset({*spaces, CBRS.NS}), frozenset(terms | core)
