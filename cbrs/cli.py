@@ -316,6 +316,51 @@ def show(app: App, iri: str, as_json: bool) -> None:
     click.echo(table(["direction", "predicate", "value", "graph"], body))
 
 
+@cli.command("check")
+@click.option(
+    "--graph",
+    "graphs",
+    multiple=True,
+    type=click.Choice([g.value for g in GraphName]),
+    help="A graph to reason over (repeatable). Default: ontology, services and requirements.",
+)
+@click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
+@pass_app
+def check_command(app: App, graphs: tuple[str, ...], as_json: bool) -> None:
+    """Run the HermiT OWL reasoner (owlready2; needs Java) over the ontologies and registered descriptions.
+
+    Reports whether they are consistent and which classes are unsatisfiable; exits with status 1 if either.
+    """
+    from cbrs.check import DEFAULT_GRAPHS, check  # owlready2 loads only for this command
+
+    result = check(app.kb, tuple(GraphName(g) for g in graphs) or DEFAULT_GRAPHS)
+    if as_json:
+        click.echo(json.dumps(result.to_dict(), indent=2))
+    else:
+        click.echo(_check_text(result))
+    if not result.ok:
+        raise SystemExit(1)
+
+
+def _check_text(result: Any) -> str:
+    where = f"{', '.join(shorten(g) for g in result.graphs)} ({result.triples} triples)"
+    if not result.consistent:
+        verdict = "INCONSISTENT"
+    elif result.unsatisfiable:
+        count = len(result.unsatisfiable)
+        verdict = f"consistent, {count} unsatisfiable class{'es' if count > 1 else ''}"
+    else:
+        verdict = "consistent, no unsatisfiable class"
+    lines = [f"{result.reasoner} over {where}: {verdict} ({result.seconds:.1f} s)"]
+    lines += [f"  unsatisfiable: {shorten(iri)}" for iri in result.unsatisfiable]
+    if result.range_clashes:
+        lines.append("Literals whose datatype is not their property's declared range (places to look first):")
+        lines += [f"  {clash.text()}" for clash in result.range_clashes[:20]]
+        if len(result.range_clashes) > 20:
+            lines.append(f"  ... and {len(result.range_clashes) - 20} more (--json lists them all)")
+    return "\n".join(lines)
+
+
 @cli.command("settings")
 def settings_command() -> None:
     """List the settings, their environment variables and current values."""

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import ast
 import json
 import os
 import re
@@ -43,10 +44,13 @@ def test_changelog_has_a_section_for_the_current_version() -> None:
 def _runtime_imports() -> set[str]:
     """Top-level modules imported by the installed packages' code (not tests, not bench)."""
     found: set[str] = set()
-    pattern = re.compile(r"^\s*(?:from|import)\s+([A-Za-z_]\w*)", re.MULTILINE)
     for package in TOP_LEVEL:
         for path in (ROOT / package).rglob("*.py"):
-            found.update(pattern.findall(path.read_text(encoding="utf-8")))
+            for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+                if isinstance(node, ast.Import):
+                    found.update(alias.name.split(".")[0] for alias in node.names)
+                elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+                    found.add(node.module.split(".")[0])
     return found
 
 
