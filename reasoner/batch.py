@@ -125,18 +125,56 @@ class BatchScorer:
         config: MatchConfig,
         filters: Callable[[Requirement, EffectiveArea | None, tuple[QoSValue, ...]], list[str]],
         plugin_inputs: bool = False,
+        plugin_outputs: bool = False,
     ) -> None:
         self.pool = pool
         self.measure = measure
         self.config = config
         self.filters = filters
         self.plugin_inputs = plugin_inputs
+        self.plugin_outputs = plugin_outputs
 
     def _vector(self, concept: str) -> FloatArray:
         return self.pool.space.vector(self.measure, concept)
 
-    def css_wanted(self, tree: PartNode) -> FloatArray:
-        """CSS of a fixed requirement tree (wanted) against every pool tree (offered)."""
+    def delivered(self, concept: str, below: bool) -> FloatArray | None:
+        """The floor 1 - specialisation_step * k for every concept k is-a links below ``concept`` (or
+        above it, ``below`` false), 0 elsewhere; None when the rule is off or ``concept`` is unknown."""
+        space, index = self.pool.space, self.pool.space.index
+        if not self.plugin_outputs or concept not in index:
+            return None
+        floor = np.zeros(len(space), dtype=np.float64)
+        if below:
+            ids, links = space.below_is_a(concept)
+        else:
+            up = index.is_a_ancestors(concept)
+            ids = np.array([space.ids[a] for a in up], dtype=np.int64)
+            links = np.array(list(up.values()), dtype=np.int64)
+        floor[ids] = np.maximum(0.0, 1.0 - self.config.specialisation_step * links)
+        return floor
+
+    def relatedness(self, concept: str) -> FloatArray:
+        """1 for ``concept``, its is-a descendants and ancestors, unrelated_output_factor for every other
+        concept (all 1 when the factor is 1 or the rule is off)."""
+        space, index = self.pool.space, self.pool.space.index
+        factor = self.config.unrelated_output_factor
+        if not self.plugin_outputs or factor >= 1:
+            return np.ones(len(space), dtype=np.float64)
+        values = np.full(len(space), factor, dtype=np.float64)
+        if concept in index:
+            values[space.below_is_a(concept)[0]] = 1.0
+            values[[space.ids[a] for a in index.is_a_ancestors(concept)]] = 1.0
+        elif concept in space.ids:
+            values[space.ids[concept]] = 1.0
+        return values
+
+    def css_wanted(self, tree: PartNode, floor: FloatArray | None = None) -> FloatArray:
+        """CSS of a fixed requirement tree (wanted) against every pool tree (offered); ``floor``: a
+        lowest value per offered root concept (MatchConfig.plugin_outputs)."""
+        result = self._css_wanted(tree)
+        return result if floor is None else np.maximum(result, floor[self.pool.root_ids])
+
+    def _css_wanted(self, tree: PartNode) -> FloatArray:
         pool = self.pool
 
         superclasses = self._superclasses(tree.concept, pool.root_ids)
@@ -230,19 +268,27 @@ class BatchScorer:
 
     def statements(self, statement: Statement) -> FloatArray:
         cfg, pool = self.config, self.pool
-        return (
-            cfg.subject_weight * self._vector(statement.subject)[pool.s_ids]
-            + cfg.predicate_weight * self._vector(statement.predicate)[pool.p_ids]
-            + cfg.object_weight * self._vector(statement.object)[pool.o_ids]
-        )
+        s = self._vector(statement.subject)[pool.s_ids]
+        p = self._vector(statement.predicate)[pool.p_ids]
+        o = self._vector(statement.object)[pool.o_ids]
+        if cfg.statement_mean == "geometric":
+            return np.asarray(s**cfg.subject_weight * p**cfg.predicate_weight * o**cfg.object_weight, dtype=np.float64)
+        return cfg.subject_weight * s + cfg.predicate_weight * p + cfg.object_weight * o
 
     def score(self, requirement: Requirement) -> BatchScores:
         pool, cfg = self.pool, self.config
         n = len(pool.ads)
         nan = np.full(n, np.nan)
         parts: dict[str, FloatArray] = {name: nan.copy() for name in PARTS}
+        invocable = np.ones(n)
         if requirement.outputs:
-            per = [pool.outputs.max(self.css_wanted(p.tree or PartNode(p.type))) for p in requirement.outputs]
+            per = [
+                pool.outputs.max(
+                    self.css_wanted(p.tree or PartNode(p.type), self.delivered(p.type, below=True))
+                    * self.relatedness(p.type)[pool.root_ids]
+                )
+                for p in requirement.outputs
+            ]
             parts["outputs"] = np.mean(per, axis=0)
         if requirement.inputs or np.any(pool.inputs.present):
             needed = np.zeros(len(pool.root_ids))
@@ -251,12 +297,21 @@ class BatchScorer:
                 if self.plugin_inputs:
                     needed = np.maximum(needed, self.plugin(provided.type))
             needed_per_ad = pool.inputs.mean(needed)
+            invocable = np.where(pool.inputs.present, needed_per_ad, 1.0)
             if requirement.inputs:
                 used = np.mean(
-                    [pool.inputs.max(self.css_wanted(p.tree or PartNode(p.type))) for p in requirement.inputs],
+                    [
+                        pool.inputs.max(
+                            self.css_wanted(p.tree or PartNode(p.type), self.delivered(p.type, below=False))
+                        )
+                        for p in requirement.inputs
+                    ],
                     axis=0,
                 )
-                inputs = np.where(pool.inputs.present, (needed_per_ad + used) / 2, used)
+                u = cfg.input_use_weight
+                inputs = (1 - u) * invocable + u * used
+                if not cfg.no_input_invocable:
+                    inputs = np.where(pool.inputs.present, inputs, used)
             else:
                 inputs = np.where(pool.inputs.present, needed_per_ad, np.nan)
             parts["inputs"] = inputs
@@ -278,6 +333,7 @@ class BatchScorer:
             numerator += np.where(present, weights[name] * np.nan_to_num(values), 0.0)
             denominator += np.where(present, weights[name], 0.0)
         ratio = np.where(denominator > 0, numerator / np.maximum(denominator, 1e-300), 0.0)
+        ratio = ratio * (1 - cfg.input_gate + cfg.input_gate * invocable)
         score = np.round(ratio.astype(np.float64), 6).astype(np.float64)
         cache: dict[tuple[EffectiveArea | None, tuple[QoSValue, ...]], tuple[str, ...]] = {}
         rejected = []

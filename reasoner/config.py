@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 
 @dataclass(frozen=True)
@@ -14,12 +14,23 @@ class MatchConfig:
     # counts 0; above it, values are stretched back to [0, 1] (about 95 % of pairs of different words in
     # the bundled ontologies score below 0.65).
     jaro_winkler_floor: float = 0.65
+    # Lexical knowledge for core words (reasoner/lexicon.py, WordNet 3.0 nouns): Situation 3 compares words
+    # by the larger of rescaled Jaro-Winkler and WordNet similarity; two concepts the taxonomy relates only
+    # through the root, whose core words are the same lemma or WordNet neighbours within lexical_links
+    # hypernym links, score at least cross_branch_weight times that Situation 3 value.
+    lexicon: bool = True
+    lexical_links: int = 2
+    cross_branch_weight: float = 0.8
     # A pair of entities counts as matched when its similarity reaches this threshold (CSS, PE).
     pair_threshold: float = 0.5
     # Weights of subject, predicate and object in an RDF statement's similarity (equation 8).
     subject_weight: float = 1 / 3
     predicate_weight: float = 1 / 3
     object_weight: float = 1 / 3
+    # How the three positions of a statement combine: "arithmetic" (the weighted mean, one wrong position
+    # costs its weight) or "geometric" (the weighted geometric mean: a statement is about as good as its
+    # worst position, so (Robot, isLocatedIn, ChargingStation) is no near miss for (Robot, isLocatedIn, Room)).
+    statement_mean: str = "geometric"
     # How the parts of a match combine; parts the requirement does not state are left out and the
     # remaining weights renormalised.
     output_weight: float = 0.4
@@ -32,6 +43,27 @@ class MatchConfig:
     # An advertised concept that is a subclass of the requested one inherits every part of it: those parts
     # count as covered (similarity 1) in CSS instead of being left out as implied.
     inherited_parts: bool = True
+    # A requested output the advertisement delivers as a subclass (k is-a links below it) is delivered:
+    # that pair scores at least 1 - specialisation_step * k, whatever the depth-bound Wu-Palmer says. The
+    # same holds for an advertised input that accepts what the requester provides as a subclass
+    # (docs/matchmaking.md, "Delivered as a subclass"); plugin_outputs false turns it off.
+    plugin_outputs: bool = True
+    specialisation_step: float = 0.02
+    # A requested output met only by a concept that is neither the same, a subclass nor a superclass of it
+    # (a sibling, a cousin, another branch) is not the thing asked for, however alike: its CSS is
+    # multiplied by this factor (1 keeps Sem-Str's value; strict logic would make it 0).
+    unrelated_output_factor: float = 1.0
+    # The inputs part: (1 - input_use_weight) * invocable + input_use_weight * used, where invocable says
+    # how well the requester can supply what the advertisement needs (1 when it needs nothing) and used
+    # how much of what the requester provides the advertisement takes.
+    input_use_weight: float = 0.5
+    # An advertisement that needs no input can be invoked by anyone: its invocable side is 1. False: only
+    # the used side counts for it (the published behaviour, which the baselines keep).
+    no_input_invocable: bool = True
+    # Input gating: the score is multiplied by (1 - input_gate) + input_gate * invocable, invocable being
+    # the mean over the advertised inputs of how well the requester can supply each (1 when it provides
+    # the concept or a subclass, else the best similarity to what it provides; 1 with no inputs).
+    input_gate: float = 0.0
     # The hybrid method (sem-str-text): the share of the TF-IDF cosine of names and text descriptions in
     # the ranking score; the rest is the Sem-Str IO/PE score, which alone decides acceptability.
     text_weight: float = 0.3
@@ -40,15 +72,40 @@ class MatchConfig:
     # An advertisement that states no value for a QoS metric the requirement bounds: fail it?
     qos_missing_fails: bool = True
 
+    def published(self) -> MatchConfig:
+        """This configuration with every refinement of docs/matchmaking.md section 9 turned off: how the
+        baselines (and Sem-Str as first published here) score."""
+        return replace(
+            self,
+            plugin_outputs=False,
+            unrelated_output_factor=1.0,
+            input_gate=0.0,
+            input_use_weight=0.5,
+            no_input_invocable=False,
+            statement_mean="arithmetic",
+            lexicon=False,
+        )
+
     def __post_init__(self) -> None:
         if not self.alpha > self.beta >= 0 or abs(self.alpha + self.beta - 1) > 1e-9:
             raise ValueError(f"need alpha > beta >= 0 and alpha + beta = 1, got {self.alpha}, {self.beta}")
         if not 0 <= self.jaro_winkler_floor < 1:
             raise ValueError(f"jaro_winkler_floor must lie in [0, 1), got {self.jaro_winkler_floor}")
-        for name in ("pair_threshold", "accept_score", "text_weight"):
+        for name in (
+            "pair_threshold",
+            "accept_score",
+            "text_weight",
+            "specialisation_step",
+            "input_gate",
+            "cross_branch_weight",
+            "input_use_weight",
+            "unrelated_output_factor",
+        ):
             value = getattr(self, name)
             if not 0 <= value <= 1:
                 raise ValueError(f"{name} must lie in [0, 1], got {value}")
+        if self.statement_mean not in ("arithmetic", "geometric"):
+            raise ValueError(f"statement_mean must be 'arithmetic' or 'geometric', got {self.statement_mean!r}")
         spo = self.subject_weight + self.predicate_weight + self.object_weight
         if abs(spo - 1) > 1e-9:
             raise ValueError(f"subject, predicate and object weights must sum to 1, got {spo}")

@@ -36,7 +36,7 @@ from kb import (
 from reasoner.batch import BatchScorer, BatchScores, CompiledPool, ranking_order
 from reasoner.config import MatchConfig
 from reasoner.degrees import Degree, degree_of_match
-from reasoner.methods import Method, make_method
+from reasoner.methods import REFINED, Method, make_method
 from reasoner.names import local_name
 from reasoner.similarity import Similarity
 from reasoner.spans import PairMatch, SpanMatch, conceptual_span_similarity, span
@@ -107,7 +107,9 @@ class Matchmaker:
         advertisements: Sequence[Advertisement] | None = None,
     ) -> None:
         self.kb = kb
-        self.config = config or MatchConfig()
+        config = config or MatchConfig()
+        refined = method in REFINED
+        self.config = config if refined else config.published()  # the baselines stay as published
         self.index = index or TaxonomyIndex.from_kb(kb)
         self.method: Method = make_method(method, self.index, self.config)
         self._advertisements = list(advertisements) if advertisements is not None else None
@@ -167,7 +169,14 @@ class Matchmaker:
 
     def _rank_batch(self, requirement: Requirement, ads: list[Advertisement], explain: int) -> Sequence[Candidate]:
         pool = self._compiled(ads)
-        scorer = BatchScorer(pool, self.method.measure, self.config, self.filters, plugin_inputs=self.plugin_inputs)
+        scorer = BatchScorer(
+            pool,
+            self.method.measure,
+            self.config,
+            self.filters,
+            plugin_inputs=self.plugin_inputs,
+            plugin_outputs=self.plugin_outputs,
+        )
         scores = scorer.score(requirement)
         text = description_text(requirement)
         if self.method.text and text:
@@ -195,15 +204,18 @@ class Matchmaker:
         cfg = self.config
         if requirement.outputs:
             parts["outputs"] = self._parameters(requirement.outputs, ad.outputs, "output", pairs, lacks)
-        if ad.inputs or requirement.inputs:
-            needed = self._parameters(ad.inputs, requirement.inputs, "input", pairs, lacks) if ad.inputs else None
-            used = (
-                self._parameters(requirement.inputs, ad.inputs, "provided input", [], lacks)
-                if requirement.inputs
-                else None
-            )
-            present = [v for v in (needed, used) if v is not None]
-            parts["inputs"] = sum(present) / len(present)
+        needed: float | None = None  # how well the requester can supply the advertised inputs
+        if ad.inputs:
+            needed = self._parameters(ad.inputs, requirement.inputs, "input", pairs, lacks)
+        if requirement.inputs:
+            used = self._parameters(requirement.inputs, ad.inputs, "provided input", [], lacks) if ad.inputs else 0.0
+            u = cfg.input_use_weight
+            if needed is None and not cfg.no_input_invocable:
+                parts["inputs"] = used
+            else:
+                parts["inputs"] = (1 - u) * (1.0 if needed is None else needed) + u * used
+        elif needed is not None:
+            parts["inputs"] = needed
         if requirement.effects:
             matches = best_statement_matches(requirement.effects, ad.effects, self.method.measure, cfg)
             parts["effects"] = self._statements(matches, "effect", pairs, lacks)
@@ -218,6 +230,7 @@ class Matchmaker:
         }
         total = sum(weights[name] for name in parts)
         score = sum(weights[name] * value for name, value in parts.items()) / total if total else 0.0
+        score *= 1 - cfg.input_gate + cfg.input_gate * (needed if needed is not None else 1.0)
         rejected = self.filters(requirement, ad.area, ad.qos)
         if self.method.strict:
             failed = [pair for pair in pairs if pair.role in ("output", "effect") and pair.degree == Degree.FAIL.value]
@@ -246,7 +259,7 @@ class Matchmaker:
         flip = role == "input"  # the advertisement wants, the requirement offers
         values = []
         for parameter in wanted:
-            scored = [(self._trees(parameter, other, invoking=flip), other) for other in offered]
+            scored = [(self._trees(parameter, other, invoking=flip, role=role), other) for other in offered]
             if not scored:
                 values.append(0.0)
                 lacks.append(f"{role} {_short(parameter.type)}: nothing on the other side")
@@ -284,15 +297,45 @@ class Matchmaker:
         degree = degree_of_match(self.index, wanted, offered) if offered else Degree.FAIL
         return EntityPair(role, wanted, offered, value, how, degree.value)
 
-    def _trees(self, wanted: Parameter, offered: Parameter, invoking: bool = False) -> SpanMatch:
+    def _trees(self, wanted: Parameter, offered: Parameter, invoking: bool = False, role: str = "") -> SpanMatch:
         """CSS of two parameters' trees. ``invoking``: ``wanted`` is an advertised input and ``offered``
-        what the requester provides; the same concept or a subclass can be passed as it is."""
+        what the requester provides; the same concept or a subclass can be passed as it is. ``role``
+        "output" or "provided input": a pair that delivers by subclass has a floor (plugin_outputs)."""
         if self.method.strict:
             degree = degree_of_match(self.index, wanted.type, offered.type)
             return SpanMatch(_DEGREE_SCORE[degree], (), () if degree.accepted else (wanted.type,))
+        whole = span(wanted.tree) if wanted.tree and self.method.use_parts else 1
         if invoking and self.plugin_inputs and self._subsumes(wanted.type, offered.type):
-            whole = span(wanted.tree) if wanted.tree and self.method.use_parts else 1
             return SpanMatch(1.0, (PairMatch(wanted.type, offered.type, Similarity(1.0, "plug-in"), whole),), ())
+        css = self._css(wanted, offered)
+        links = None
+        if self.plugin_outputs and role == "output":
+            links = self._links_below(wanted.type, offered.type)
+        elif self.plugin_outputs and role == "provided input":
+            links = self._links_below(offered.type, wanted.type)
+        if links is not None:
+            floor = max(0.0, 1.0 - self.config.specialisation_step * links)
+            if floor > css.value:
+                how = Similarity(floor, "delivered", links=(links, 0))
+                return SpanMatch(floor, (PairMatch(wanted.type, offered.type, how, whole),), ())
+        factor = self.config.unrelated_output_factor
+        if self.plugin_outputs and role == "output" and factor < 1 and not self._related(wanted.type, offered.type):
+            return SpanMatch(css.value * factor, css.pairs, css.uncovered)
+        return css
+
+    def _related(self, first: str, second: str) -> bool:
+        """The same concept, or one a subclass of the other (is-a links)."""
+        if first == second:
+            return True
+        return self._links_below(first, second) is not None or self._links_below(second, first) is not None
+
+    def _links_below(self, upper: str, lower: str) -> int | None:
+        """is-a links from ``lower`` up to ``upper`` when ``lower`` is ``upper`` or a subclass of it."""
+        if upper not in self.index or lower not in self.index:
+            return None
+        return self.index.is_a_ancestors(lower).get(self.index.canonical(upper))
+
+    def _css(self, wanted: Parameter, offered: Parameter) -> SpanMatch:
         return conceptual_span_similarity(
             wanted.tree or PartNode(wanted.type),
             offered.tree or PartNode(offered.type),
@@ -307,6 +350,10 @@ class Matchmaker:
     @property
     def plugin_inputs(self) -> bool:
         return self.config.plugin_inputs and self.method.taxonomy
+
+    @property
+    def plugin_outputs(self) -> bool:
+        return self.config.plugin_outputs and self.method.taxonomy
 
     def _subsumes(self, upper: str, lower: str) -> bool:
         """Is ``lower`` the same concept as ``upper`` or a subclass of it (is-a links)?"""

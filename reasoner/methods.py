@@ -9,6 +9,9 @@ from reasoner.similarity import EntityMeasure, Lin, SemStr, StringMatch, WuPalme
 from reasoner.taxonomy import TaxonomyIndex
 
 METHODS = ("sem-str", "string", "wu-palmer", "lin", "logic", "sem-str-text")
+# The methods that use the refinements of docs/matchmaking.md section 9; the baselines keep the published
+# frame (MatchConfig.published).
+REFINED = frozenset({"sem-str", "sem-str-text"})
 
 
 @dataclass(frozen=True)

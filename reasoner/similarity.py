@@ -6,12 +6,14 @@ Every measure answers ``measure(e1, e2) -> Similarity`` with a value in [0, 1] a
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Protocol
 
 import jellyfish
 
 from reasoner.config import MatchConfig
+from reasoner.lexicon import Lexicon, bundled
 from reasoner.names import core_split, local_name, words
 from reasoner.taxonomy import ROOT, TaxonomyIndex
 
@@ -39,9 +41,14 @@ class Similarity:
         if self.situation == "situation-2":
             return f"Wu-Palmer via {local_name(self.common or '')}, links {self.links}"
         if self.situation == "situation-3":
-            return "no taxonomy: Jaro-Winkler on core and complementary words"
+            return "no taxonomy: Jaro-Winkler or WordNet on core and complementary words"
+        if self.situation == "cross-branch":
+            return "related only through the root; core words the same or WordNet neighbours"
         if self.situation == "inherited":
             return "a part the advertised subclass inherits"
+        if self.situation == "delivered":
+            assert self.links is not None
+            return f"delivered as a subclass, {self.links[0]} is-a links below: 1 - step x links"
         if self.situation == "plug-in":
             return "offered as the advertised input or a subclass of it: invocable"
         return self.situation
@@ -58,10 +65,14 @@ class SemStr:
 
     name = "sem-str"
 
-    def __init__(self, index: TaxonomyIndex, config: MatchConfig | None = None) -> None:
+    def __init__(self, index: TaxonomyIndex, config: MatchConfig | None = None, lexicon: Lexicon | None = None) -> None:
         self.index = index
         self.config = config or MatchConfig()
+        if lexicon is None:
+            lexicon = bundled(self.config.lexical_links) if self.config.lexicon else Lexicon.empty()
+        self.lexicon = lexicon
         self._cache: dict[tuple[str, str], Similarity] = {}
+        self._words: dict[tuple[str, str], float] = {}
 
     def __call__(self, first: str, second: str) -> Similarity:
         key = (first, second)
@@ -92,16 +103,41 @@ class SemStr:
         if down is not None:
             return Similarity(1 / (1 + down), "situation-1", index.canonical(first), (0, down))
         if common == ROOT:
-            return Similarity(1 / (1 + n1 + n2), "situation-1", ROOT, (n1, n2))
+            through_root = Similarity(1 / (1 + n1 + n2), "situation-1", ROOT, (n1, n2))
+            lexical = self.cross_branch(first, second)
+            return lexical if lexical.value > through_root.value else through_root
         nr = index.depth(common)
         return Similarity(2 * nr / (n1 + n2 + 2 * nr), "situation-2", common, (n1, n2))
 
+    def core_key(self, concept: str) -> str:
+        """The lemma of a concept's core word: what cross-branch links are looked up by."""
+        return self.lexicon.lemma(core_split(self._name(concept))[0])
+
+    def cross_branch(self, first: str, second: str) -> Similarity:
+        """Two concepts the taxonomy relates only through the root: Situation 3 times
+        cross_branch_weight when their core words are the same lemma or WordNet neighbours, else 0."""
+        a, b = self.core_key(first), self.core_key(second)
+        if a != b and self.lexicon.similarity(a, b) <= 0:
+            return Similarity(0.0, "cross-branch")
+        value = self.config.cross_branch_weight * self.situation_3(first, second).value
+        return Similarity(value, "cross-branch", ROOT)
+
+    def word_similarity(self, first: str, second: str) -> float:
+        """Two words: the larger of rescaled Jaro-Winkler and the lexicon's similarity."""
+        key = (first, second)
+        found = self._words.get(key)
+        if found is None:
+            found = rescaled_jaro_winkler(first, second, self.config.jaro_winkler_floor)
+            if found < 1 and self.lexicon:
+                found = max(found, self.lexicon.similarity(first, second))
+            self._words[key] = found
+        return found
+
     def situation_3(self, first: str, second: str) -> Similarity:
-        """Jaro-Winkler on the core words and on the complementary words, weighted alpha > beta."""
+        """Core words and complementary words compared (word_similarity), weighted alpha > beta."""
         core1, rest1 = core_split(self._name(first))
         core2, rest2 = core_split(self._name(second))
-        floor = self.config.jaro_winkler_floor
-        core = rescaled_jaro_winkler(core1, core2, floor)
+        core = self.word_similarity(core1, core2)
         if not rest1 and not rest2:
             return Similarity(core, "situation-3")  # nothing else to compare: the core word says it all
         if not rest1 or not rest2:
@@ -110,7 +146,7 @@ class SemStr:
             extra = len((rest1 or rest2).split())
             value = core * (self.config.alpha + self.config.beta / (1 + extra))
         else:
-            rest = complement_similarity(rest1.split(), rest2.split(), floor)
+            rest = complement_similarity(rest1.split(), rest2.split(), self.word_similarity)
             value = self.config.alpha * core + self.config.beta * rest
         return Similarity(min(1.0, max(0.0, value)), "situation-3")
 
@@ -127,13 +163,20 @@ def rescaled_jaro_winkler(first: str, second: str, floor: float) -> float:
     return max(0.0, (value - floor) / (1.0 - floor))
 
 
-def complement_similarity(first: list[str], second: list[str], floor: float) -> float:
-    """Complementary words compared word by word, in any order: each word's best rescaled Jaro-Winkler
-    against the other side's words, averaged over the words of both sides (symmetric)."""
+def complement_similarity(first: list[str], second: list[str], word: Callable[[str, str], float] | float) -> float:
+    """Complementary words compared word by word, in any order: each word's best ``word`` similarity (a
+    function, or a Jaro-Winkler floor for rescaled_jaro_winkler) against the other side's words, averaged
+    over the words of both sides (symmetric)."""
     if not first or not second:
         return 0.0
-    best_first = [max(rescaled_jaro_winkler(a, b, floor) for b in second) for a in first]
-    best_second = [max(rescaled_jaro_winkler(a, b, floor) for a in first) for b in second]
+    if not callable(word):
+        floor = word
+
+        def word(a: str, b: str) -> float:
+            return rescaled_jaro_winkler(a, b, floor)
+
+    best_first = [max(word(a, b) for b in second) for a in first]
+    best_second = [max(word(a, b) for a in first) for b in second]
     return (sum(best_first) + sum(best_second)) / (len(first) + len(second))
 
 

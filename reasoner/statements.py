@@ -32,8 +32,15 @@ def statement_similarity(
     s = measure(requested.subject, advertised.subject)
     p = measure(requested.predicate, advertised.predicate)
     o = measure(requested.object, advertised.object)
-    value = config.subject_weight * s.value + config.predicate_weight * p.value + config.object_weight * o.value
+    value = combine(config, s.value, p.value, o.value)
     return StatementMatch(requested, advertised, value, (s, p, o))
+
+
+def combine(config: MatchConfig, s: float, p: float, o: float) -> float:
+    """The statement's similarity from its three positions' (MatchConfig.statement_mean)."""
+    if config.statement_mean == "geometric":
+        return float(s**config.subject_weight * p**config.predicate_weight * o**config.object_weight)
+    return config.subject_weight * s + config.predicate_weight * p + config.object_weight * o
 
 
 def best_statement_matches(

@@ -41,6 +41,7 @@ class VectorSpace:
         self._lcs: dict[int, IntArray] = {}
         self._used: set[int] = set()  # ids handed out by add(): where vectors are read
         self._implied: dict[tuple[int, int], bool] = {}
+        self._by_core: dict[int, dict[str, list[int]]] = {}
         for concept in sorted(set(extra)):
             self.add(concept)
 
@@ -106,6 +107,7 @@ class VectorSpace:
         known = slice(0, self.taxonomy_size)
         x = self.ids[self.index.canonical(concept)]
         values[known], isa_related = self._wu_palmer_or_root(x)
+        self._cross_branch(measure, x, values)
         # Situation 1 for what lies below or above x through a hasPart link (is-a relatives keep
         # their Wu-Palmer value), and through the root (already in the values above).
         ids, dist = self._below(x, is_a_only=False)
@@ -117,6 +119,30 @@ class VectorSpace:
                 values[a] = 1.0 / (1.0 + links)
         values[x] = 1.0
         return values
+
+    def _cross_branch(self, measure: SemStr, x: int, values: FloatArray) -> None:
+        """Raise the nodes related to x only through the root whose core words are lexically related
+        (SemStr.cross_branch); they are found by core word, not by scoring every node."""
+        by_core = self._core_index(measure)
+        key = measure.core_key(self.names[x])
+        lemmas = [key, *measure.lexicon.related(key)] if measure.lexicon else [key]
+        root = self.ids[ROOT]
+        lcs = self._lcs[x]
+        for lemma in lemmas:
+            for i in by_core.get(lemma, ()):
+                if lcs[i] == root and i != x:
+                    values[i] = max(values[i], measure.cross_branch(self.names[x], self.names[i]).value)
+
+    def _core_index(self, measure: SemStr) -> dict[str, list[int]]:
+        """Taxonomy node ids by the lemma of their core word (built once per measure)."""
+        found = self._by_core.get(id(measure))
+        if found is None:
+            found = {}
+            for i in range(self.taxonomy_size):
+                if self.names[i] != ROOT:
+                    found.setdefault(measure.core_key(self.names[i]), []).append(i)
+            self._by_core[id(measure)] = found
+        return found
 
     def _wu_palmer_or_root(self, x: int) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
         """Situation 2 (or 1 through the root) for every taxonomy node against node x, and which
@@ -161,6 +187,10 @@ class VectorSpace:
                 found = self._implied[key] = self.names[p] in self.index.parts_of(self.names[a])
             result[i] = found
         return result
+
+    def below_is_a(self, concept: str) -> tuple[IntArray, IntArray]:
+        """Ids of ``concept`` (a taxonomy node) and every is-a descendant, with their distances in links."""
+        return self._below(self.ids[self.index.canonical(concept)], is_a_only=True)
 
     def _below(self, node: int, is_a_only: bool) -> tuple[IntArray, IntArray]:
         """Every node at or below ``node`` and its distance, by is-a links or by both kinds."""

@@ -190,8 +190,12 @@ def test_an_input_offered_as_a_subclass_makes_the_advertisement_invocable() -> N
     needed = next(p for p in best.pairs if p.role == "input")
     assert needed.similarity == 1.0 and "invocable" in needed.how
     used = SemStr(index)(E + "RobotPosition", E + "Position").value
-    assert best.parts["inputs"] == pytest.approx((1 + used) / 2)
-    off = Matchmaker(kb, config=MatchConfig(plugin_inputs=False), index=index, advertisements=[wants])
+    # "does it use what the requester offers?": a Position input takes the RobotPosition one link below
+    delivered = 1 - MatchConfig().specialisation_step
+    assert best.parts["inputs"] == pytest.approx((1 + delivered) / 2)
+    off = Matchmaker(
+        kb, config=MatchConfig(plugin_inputs=False, plugin_outputs=False), index=index, advertisements=[wants]
+    )
     assert off.score(requirement, wants).parts["inputs"] == pytest.approx(used)
     # pure string matching knows no subclasses
     string = Matchmaker(kb, "string", index=index, advertisements=[wants]).score(requirement, wants)
@@ -212,7 +216,10 @@ def test_statement_similarity_weighs_subject_predicate_object() -> None:
     assert statement_similarity(same, same, measure, config).value == pytest.approx(1.0)
     other = Statement(E + "RobotPosition", E + "isNear", E + "Location")
     value = statement_similarity(same, other, measure, config).value
-    assert value == pytest.approx((2 * 3 / (1 + 2 * 3) + 1 + 1) / 3)
+    subject = 2 * 3 / (1 + 2 * 3)
+    assert value == pytest.approx(subject ** (1 / 3))  # geometric: a statement is as good as its worst position
+    arithmetic = MatchConfig(statement_mean="arithmetic")
+    assert statement_similarity(same, other, measure, arithmetic).value == pytest.approx((subject + 1 + 1) / 3)
 
 
 # -- the command ---------------------------------------------------------------------------------
