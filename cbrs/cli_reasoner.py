@@ -12,7 +12,8 @@ from cbrs.output import table
 from kb import KnowledgeBase
 from kb.namespaces import shorten
 from reasoner.config import MatchConfig
-from reasoner.matchmaker import Candidate, Matchmaker, MatchResult, MatchStatus
+from reasoner.degrees import Degree
+from reasoner.matchmaker import Candidate, EntityPair, Matchmaker, MatchResult, MatchStatus
 from reasoner.methods import METHODS
 
 
@@ -61,6 +62,15 @@ def _ranking(result: MatchResult, top: int) -> str:
     )
 
 
+def _degree(pair: EntityPair) -> str:
+    """The degree of match as a person reads it: a pair with no is-a link that Sem-Str still matched
+    (siblings with the same parts, a synonym in another branch) is "Similar", not "Fail"; "Fail" is left
+    for a pair below the pair threshold."""
+    if pair.degree == Degree.FAIL.value and pair.similarity >= MatchConfig().pair_threshold:
+        return "Similar"
+    return pair.degree
+
+
 def _explanation(position: int, c: Candidate) -> str:
     lines = [f"#{position} {shorten(c.advertisement)}  score {c.score:.3f}"]
     rows = [
@@ -69,7 +79,7 @@ def _explanation(position: int, c: Candidate) -> str:
             shorten(p.requested),
             shorten(p.advertised) if p.advertised else "-",
             f"{p.similarity:.2f}",
-            p.degree,
+            _degree(p),
             p.how,
         ]
         for p in c.pairs

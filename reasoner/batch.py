@@ -346,8 +346,8 @@ class BatchScorer:
 
 
 def ranking_order(scores: BatchScores, pool: CompiledPool, accept_score: float) -> IntArray:
-    """Acceptable first, then those that pass the filters, then by score, then by IRI."""
+    """Those that pass the filters first, each group by score (so the ranking and the scores agree),
+    then by IRI. ``accept_score`` does not reorder: acceptability is shown, not ranked on."""
+    del accept_score
     rejected = np.array([bool(r) for r in scores.rejected_by])
-    basis = scores.score if scores.accepted_on is None else scores.accepted_on
-    acceptable = ~rejected & (basis >= accept_score)
-    return np.lexsort((pool.iri_rank, -scores.score, rejected, ~acceptable)).astype(np.int64)
+    return np.lexsort((pool.iri_rank, -scores.score, rejected)).astype(np.int64)

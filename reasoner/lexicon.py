@@ -124,6 +124,12 @@ class Lexicon:
     def hyponyms(self) -> dict[int, list[int]]:
         return _hyponyms(self)
 
+    def warm(self) -> None:
+        """Build the inverted tables now rather than on the first lookup."""
+        if self:
+            self.members()
+            self.hyponyms()
+
 
 def _related(lexicon: Lexicon, word: str) -> dict[str, float]:
     senses = lexicon._lemmas.get(word, [])

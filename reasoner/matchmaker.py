@@ -38,7 +38,7 @@ from reasoner.config import MatchConfig
 from reasoner.degrees import Degree, degree_of_match
 from reasoner.methods import REFINED, Method, make_method
 from reasoner.names import local_name
-from reasoner.similarity import Similarity
+from reasoner.similarity import SemStr, Similarity
 from reasoner.spans import PairMatch, SpanMatch, conceptual_span_similarity, span
 from reasoner.statements import StatementMatch, best_statement_matches
 from reasoner.taxonomy import TaxonomyIndex
@@ -84,7 +84,7 @@ class MatchResult:
     requirement: str
     method: str
     status: MatchStatus
-    candidates: Sequence[Candidate]  # ranked, best first; acceptable ones before the rest
+    candidates: Sequence[Candidate]  # ranked by score, best first; those a filter rejects after the rest
 
     def to_dict(self, top: int | None = None) -> dict[str, Any]:
         return {
@@ -123,7 +123,10 @@ class Matchmaker:
         the first ranking is as fast as the rest."""
         ads = self.advertisements
         if not self.method.strict:
-            self._compiled(ads).space.warm()
+            space = self._compiled(ads).space
+            space.warm()
+            if isinstance(self.method.measure, SemStr):
+                space.warm_lexical(self.method.measure)
         if self.method.text:
             self._text_index(ads)
         return self
@@ -160,7 +163,7 @@ class Matchmaker:
         ads = self.advertisements
         if self.method.strict:  # degrees, not similarities: scored one by one
             scored = [self.score(requirement, ad) for ad in ads]
-            scored.sort(key=lambda c: (not c.acceptable, bool(c.rejected_by), -c.score, c.advertisement))
+            scored.sort(key=lambda c: (bool(c.rejected_by), -c.score, c.advertisement))
             candidates: Sequence[Candidate] = tuple(scored)
         else:
             candidates = self._rank_batch(requirement, ads, len(ads) if explain is None else explain)
@@ -414,7 +417,8 @@ class Matchmaker:
             value = offered_qos.get(bound.metric)
             name = _short(bound.metric)
             if value is None:
-                if self.config.qos_missing_fails:
+                # an advertisement that states no QoS at all (an OWL-S service) is not judged on it
+                if self.config.qos_missing_fails and qos:
                     reasons.append(f"QoS: states no {name} (needs {bound.value:g})")
             elif bound.better_when == "lower" and value > bound.value:
                 reasons.append(f"QoS: {name} {value:g} > {bound.value:g}")

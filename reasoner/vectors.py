@@ -41,7 +41,7 @@ class VectorSpace:
         self._lcs: dict[int, IntArray] = {}
         self._used: set[int] = set()  # ids handed out by add(): where vectors are read
         self._implied: dict[tuple[int, int], bool] = {}
-        self._by_core: dict[int, dict[str, list[int]]] = {}
+        self._by_core: dict[int, tuple[int, dict[str, list[int]]]] = {}
         for concept in sorted(set(extra)):
             self.add(concept)
 
@@ -67,6 +67,11 @@ class VectorSpace:
                 self._below(i, is_a_only=False)
                 for ancestor in self.index.ancestors(self.names[i], is_a_only=True):
                     self._below(self.ids[ancestor], is_a_only=True)
+
+    def warm_lexical(self, measure: SemStr) -> None:
+        """Build now the core-word index and the lexicon's tables that cross-branch links read."""
+        self._core_index(measure)
+        measure.lexicon.warm()
 
     def _read_at(self) -> list[int]:
         """The ids vectors are read at: those handed out, or all while none has been."""
@@ -134,15 +139,16 @@ class VectorSpace:
                     values[i] = max(values[i], measure.cross_branch(self.names[x], self.names[i]).value)
 
     def _core_index(self, measure: SemStr) -> dict[str, list[int]]:
-        """Taxonomy node ids by the lemma of their core word (built once per measure)."""
+        """The taxonomy ids where vectors are read (``_read_at``), by the lemma of their core word; built
+        again when ``add`` has handed out more ids since."""
+        at = [i for i in self._read_at() if i < self.taxonomy_size and self.names[i] != ROOT]
         found = self._by_core.get(id(measure))
-        if found is None:
-            found = {}
-            for i in range(self.taxonomy_size):
-                if self.names[i] != ROOT:
-                    found.setdefault(measure.core_key(self.names[i]), []).append(i)
-            self._by_core[id(measure)] = found
-        return found
+        if found is None or found[0] != len(at):
+            table: dict[str, list[int]] = {}
+            for i in at:
+                table.setdefault(measure.core_key(self.names[i]), []).append(i)
+            found = self._by_core[id(measure)] = (len(at), table)
+        return found[1]
 
     def _wu_palmer_or_root(self, x: int) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
         """Situation 2 (or 1 through the root) for every taxonomy node against node x, and which
