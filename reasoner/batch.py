@@ -140,18 +140,15 @@ class BatchScorer:
     def delivered(self, concept: str, below: bool) -> FloatArray | None:
         """The floor 1 - specialisation_step * k for every concept k is-a links below ``concept`` (or
         above it, ``below`` false), 0 elsewhere; None when the rule is off or ``concept`` is unknown."""
-        space, index = self.pool.space, self.pool.space.index
-        if not self.plugin_outputs or concept not in index:
+        if not self.plugin_outputs or concept not in self.pool.space.index:
             return None
-        floor = np.zeros(len(space), dtype=np.float64)
-        if below:
-            ids, links = space.below_is_a(concept)
-        else:
-            up = index.is_a_ancestors(concept)
-            ids = np.array([space.ids[a] for a in up], dtype=np.int64)
-            links = np.array(list(up.values()), dtype=np.int64)
-        floor[ids] = np.maximum(0.0, 1.0 - self.config.specialisation_step * links)
-        return floor
+        return self.pool.space.delivered(concept, below, self.config.specialisation_step)
+
+    def _output_css(self, tree: PartNode) -> FloatArray:
+        css = self.css_wanted(tree, self.delivered(tree.concept, below=True))
+        if self.plugin_outputs and self.config.unrelated_output_factor < 1:
+            css = css * self.relatedness(tree.concept)[self.pool.root_ids]
+        return css
 
     def relatedness(self, concept: str) -> FloatArray:
         """1 for ``concept``, its is-a descendants and ancestors, unrelated_output_factor for every other
@@ -283,10 +280,7 @@ class BatchScorer:
         invocable = np.ones(n)
         if requirement.outputs:
             per = [
-                pool.outputs.max(
-                    self.css_wanted(p.tree or PartNode(p.type), self.delivered(p.type, below=True))
-                    * self.relatedness(p.type)[pool.root_ids]
-                )
+                pool.outputs.max(self._output_css(p.tree or PartNode(p.type)))
                 for p in requirement.outputs
             ]
             parts["outputs"] = np.mean(per, axis=0)

@@ -42,6 +42,7 @@ class VectorSpace:
         self._used: set[int] = set()  # ids handed out by add(): where vectors are read
         self._implied: dict[tuple[int, int], bool] = {}
         self._by_core: dict[int, tuple[int, dict[str, list[int]]]] = {}
+        self._floors: dict[tuple[str, bool, float], FloatArray] = {}
         for concept in sorted(set(extra)):
             self.add(concept)
 
@@ -193,6 +194,23 @@ class VectorSpace:
                 found = self._implied[key] = self.names[p] in self.index.parts_of(self.names[a])
             result[i] = found
         return result
+
+    def delivered(self, concept: str, below: bool, step: float) -> FloatArray:
+        """1 - step * k at every concept k is-a links below ``concept`` (a taxonomy node; above it when
+        ``below`` is false), 0 elsewhere (cached)."""
+        key = (concept, below, step)
+        found = self._floors.get(key)
+        if found is None or len(found) != len(self.names):
+            found = np.zeros(len(self.names), dtype=np.float64)
+            if below:
+                ids, links = self.below_is_a(concept)
+            else:
+                up = self.index.is_a_ancestors(concept)
+                ids = np.array([self.ids[a] for a in up], dtype=np.int64)
+                links = np.array(list(up.values()), dtype=np.int64)
+            found[ids] = np.maximum(0.0, 1.0 - step * links)
+            self._floors[key] = found
+        return found
 
     def below_is_a(self, concept: str) -> tuple[IntArray, IntArray]:
         """Ids of ``concept`` (a taxonomy node) and every is-a descendant, with their distances in links."""

@@ -1,0 +1,134 @@
+"""The refinements of docs/matchmaking.md section 9: each one on a small known-answer case, on and off."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from kb import Advertisement, KnowledgeBase, Parameter, Requirement, Statement, Store
+from reasoner.config import MatchConfig
+from reasoner.lexicon import DATA_FILE, Lexicon
+from reasoner.matchmaker import Matchmaker
+from reasoner.owlstc import evaluate_collection
+from reasoner.similarity import SemStr
+from reasoner.statements import statement_similarity
+from reasoner.taxonomy import Link, TaxonomyIndex
+from tests.reasoner_examples import E, positions
+
+ROBOT = Path(__file__).parent / "data" / "robot_services"
+needs_wordnet = pytest.mark.skipif(not DATA_FILE.exists(), reason=f"no bundled WordNet data at {DATA_FILE}")
+
+
+def _p(direction: str, concept: str) -> Parameter:
+    return Parameter(f"{E}{direction}-{concept}", direction, E + concept)  # type: ignore[arg-type]
+
+
+def _rank(config: MatchConfig, requirement: Requirement, *ads: Advertisement, method: str = "sem-str") -> list[str]:
+    kb = KnowledgeBase(Store.open(":memory:"))
+    result = Matchmaker(kb, method, config, index=positions(), advertisements=list(ads)).rank(requirement)
+    return [c.advertisement.removeprefix(E) for c in result.candidates]
+
+
+def test_an_output_delivered_as_a_subclass_beats_a_look_alike_sibling() -> None:
+    # Asked for a Position: a RobotPosition is one; a Location (a sibling with the same parts) is not.
+    wanted = Requirement(E + "Wants", (), outputs=(_p("output", "Position"),))
+    sub = Advertisement(E + "GivesRobotPosition", (), outputs=(_p("output", "RobotPosition"),))
+    sibling = Advertisement(E + "GivesLocation", (), outputs=(_p("output", "Location"),))
+    on = _rank(MatchConfig(), wanted, sibling, sub)
+    assert on[0] == "GivesRobotPosition"
+    kb = KnowledgeBase(Store.open(":memory:"))
+    best = Matchmaker(kb, index=positions(), advertisements=[sub]).score(wanted, sub)
+    assert best.parts["outputs"] == pytest.approx(1 - MatchConfig().specialisation_step)
+    assert any("delivered as a subclass" in p.how for p in best.pairs)
+    off = Matchmaker(kb, config=MatchConfig(plugin_outputs=False), index=positions(), advertisements=[sub])
+    assert off.score(wanted, sub).parts["outputs"] < best.parts["outputs"]
+
+
+def test_baselines_keep_the_published_frame() -> None:
+    wanted = Requirement(E + "Wants", (), outputs=(_p("output", "Position"),))
+    sub = Advertisement(E + "GivesRobotPosition", (), outputs=(_p("output", "RobotPosition"),))
+    kb = KnowledgeBase(Store.open(":memory:"))
+    wu_palmer = Matchmaker(kb, "wu-palmer", index=positions(), advertisements=[sub])
+    assert wu_palmer.config == MatchConfig().published()
+    assert wu_palmer.score(wanted, sub).parts["outputs"] < 1 - MatchConfig().specialisation_step
+
+
+def test_an_offer_that_needs_nothing_is_invocable() -> None:
+    wanted = Requirement(E + "Wants", (), inputs=(_p("input", "Colour"),), outputs=(_p("output", "Position"),))
+    free = Advertisement(E + "NeedsNothing", (), outputs=(_p("output", "Position"),))
+    kb = KnowledgeBase(Store.open(":memory:"))
+    on = Matchmaker(kb, index=positions(), advertisements=[free]).score(wanted, free)
+    assert on.parts["inputs"] == pytest.approx(1 - MatchConfig().input_use_weight)
+    off = Matchmaker(kb, config=MatchConfig(no_input_invocable=False), index=positions(), advertisements=[free])
+    assert off.score(wanted, free).parts["inputs"] == 0.0
+
+
+def test_input_gate_scales_the_score_by_what_the_requester_can_supply() -> None:
+    wanted = Requirement(E + "Wants", (), inputs=(_p("input", "Colour"),), outputs=(_p("output", "Position"),))
+    needy = Advertisement(E + "NeedsLaser", (), inputs=(_p("input", "Timestamp"),), outputs=(_p("output", "Position"),))
+    kb = KnowledgeBase(Store.open(":memory:"))
+    plain = Matchmaker(kb, index=positions(), advertisements=[needy]).score(wanted, needy)
+    gated = Matchmaker(kb, config=MatchConfig(input_gate=0.5), index=positions(), advertisements=[needy])
+    assert gated.score(wanted, needy).score < plain.score
+
+
+def test_a_statement_is_about_as_good_as_its_worst_position() -> None:
+    measure = SemStr(positions())
+    wanted = Statement(E + "Position", E + "isNear", E + "Location")
+    far = Statement(E + "Position", E + "isNear", E + "Timestamp")
+    geometric = statement_similarity(wanted, far, measure, MatchConfig()).value
+    arithmetic = statement_similarity(wanted, far, measure, MatchConfig(statement_mean="arithmetic")).value
+    assert geometric < arithmetic
+    with pytest.raises(ValueError, match="statement_mean"):
+        MatchConfig(statement_mean="median")
+
+
+def test_same_name_in_another_ontology_is_linked_across_branches() -> None:
+    # Two ontologies, each with its own City: the taxonomy meets them only at the root.
+    index = TaxonomyIndex.from_links(
+        [
+            Link("http://a.org/o#City", "http://a.org/o#Place", "is-a"),
+            Link("http://b.org/o#City", "http://b.org/o#Area", "is-a"),
+        ]
+    )
+    on = SemStr(index)("http://a.org/o#City", "http://b.org/o#City")
+    off = SemStr(index, MatchConfig(cross_branch_weight=0.0))("http://a.org/o#City", "http://b.org/o#City")
+    assert on.situation == "cross-branch" and on.value == pytest.approx(MatchConfig().cross_branch_weight)
+    assert off.situation == "situation-1" and off.value < on.value
+
+
+@needs_wordnet
+def test_wordnet_links_core_words() -> None:
+    lexicon = Lexicon.load()
+    assert lexicon.similarity("image", "picture") == 1.0  # one synset
+    assert lexicon.similarity("boxes", "box") == 1.0  # a plural is its lemma
+    assert 0 < lexicon.similarity("city", "town") < 1
+    assert lexicon.similarity("status", "temperature") == 0.0
+    assert lexicon.similarity("e", "d") == 0.0  # letters are no words
+    measure = SemStr(positions())
+    # outside the taxonomy (Situation 3): Picture against Image is a synonym, not a chance of letters
+    assert measure(E + "Picture", E + "Image").value == pytest.approx(1.0)
+    assert SemStr(positions(), MatchConfig(lexicon=False))(E + "Picture", E + "Image").value < 0.5
+
+
+def test_empty_lexicon_knows_only_equal_words(tmp_path: Path) -> None:
+    lexicon = Lexicon.load(tmp_path / "absent.json")
+    assert not lexicon
+    assert lexicon.similarity("cat", "cat") == 1.0 and lexicon.similarity("image", "picture") == 0.0
+
+
+@pytest.fixture(scope="module")
+def robot_report():  # type: ignore[no-untyped-def]
+    return evaluate_collection(ROBOT, ["sem-str", "wu-palmer", "logic"])
+
+
+def test_robot_collection_has_the_size_the_issue_asks(robot_report) -> None:  # type: ignore[no-untyped-def]
+    assert robot_report.services >= 60 and robot_report.queries >= 15
+    assert robot_report.unmatched_requests == [] and robot_report.unmatched_offers == 0
+
+
+def test_sem_str_ranks_the_robot_collection_above_the_baselines(robot_report) -> None:  # type: ignore[no-untyped-def]
+    figures = robot_report.methods
+    assert figures["sem-str"]["map"] > max(figures["wu-palmer"]["map"], figures["logic"]["map"]) - 0.03
+    assert figures["sem-str"]["map"] > figures["wu-palmer"]["map"]
