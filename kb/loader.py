@@ -32,7 +32,6 @@ from kb.catalog import Catalogue, Unresolved, is_built_in, ontology_iri
 from kb.errors import PartCycleError, RdfParseError, UnknownFormatError, UnknownGraphError
 from kb.namespaces import CBRS, DUL, GENID, OWL, RDF, RDFS, GraphName
 from kb.owls import Conversion, Role, Vocabulary, convert, is_owls, referenced_ontologies
-from kb.shapes import check_loaded
 from kb.store import Store
 from kb.xml_limits import check_entities
 
@@ -197,7 +196,6 @@ def load_files(
         for raw in imported
     ]
     _check_part_cycles(store, [*raws, *imported])
-    check_loaded(store, report)  # descriptions against the SHACL shapes, and their terms (kb/shapes.py)
     store.add(quad for item in (*report.files, *report.imports) for quad in item.quads)
     return report
 
@@ -232,13 +230,20 @@ def _check_not_merged(store: Store, parsed: ParsedFile) -> None:
         node = ox.NamedNode(converted.iri)
         if next(iter(store.quads(node, ox.NamedNode(RDF + "type"))), None) is None:
             continue
-        if all(next(iter(store.quads(q.subject, q.predicate, q.object, q.graph_name)), None) for q in parsed.quads):
+        if all(_stored(store, q) for q in parsed.quads):
             continue
         raise RdfParseError(
             parsed.source,
             f"<{converted.iri}> is already in the store, described differently; loading this file would merge "
             "two descriptions into one. Deregister it first (cbrs deregister IRI), or give the new one another IRI",
         )
+
+
+def _stored(store: Store, quad: ox.Quad) -> bool:
+    subject, obj, graph = quad.subject, quad.object, quad.graph_name
+    if isinstance(subject, ox.Triple) or isinstance(obj, ox.Triple) or isinstance(graph, ox.BlankNode):
+        return False
+    return next(iter(store.quads(subject, quad.predicate, obj, graph)), None) is not None
 
 
 def expand_paths(paths: Sequence[str | Path]) -> list[Path]:
