@@ -32,6 +32,7 @@ from kb.catalog import Catalogue, Unresolved, is_built_in, ontology_iri
 from kb.errors import PartCycleError, RdfParseError, UnknownFormatError, UnknownGraphError
 from kb.namespaces import CBRS, DUL, GENID, OWL, RDF, RDFS, GraphName
 from kb.owls import Conversion, Role, Vocabulary, convert, is_owls, referenced_ontologies
+from kb.shapes import check_loaded
 from kb.store import Store
 from kb.xml_limits import check_entities
 
@@ -196,6 +197,7 @@ def load_files(
         for raw in imported
     ]
     _check_part_cycles(store, [*raws, *imported])
+    check_loaded(store, report)  # descriptions against the SHACL shapes, and their terms (kb/shapes.py)
     store.add(quad for item in (*report.files, *report.imports) for quad in item.quads)
     return report
 
