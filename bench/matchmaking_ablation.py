@@ -33,7 +33,7 @@ VARIANTS: dict[str, MatchConfig] = {
     "no delivered-as-subclass": replace(BASE, plugin_outputs=False),
     "no free no-input offers": replace(BASE, no_input_invocable=False),
     "arithmetic statement mean": replace(BASE, statement_mean="arithmetic"),
-    "no WordNet (same lemma only)": replace(BASE, lexicon=False),
+    "with WordNet core words": replace(BASE, lexicon=True),
     "no cross-branch links": replace(BASE, cross_branch_weight=0.0),
     "input gate 0.4": replace(BASE, input_gate=0.4),
     "all off (published frame)": BASE.published(),

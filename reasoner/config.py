@@ -18,7 +18,7 @@ class MatchConfig:
     # by the larger of rescaled Jaro-Winkler and WordNet similarity; two concepts the taxonomy relates only
     # through the root, whose core words are the same lemma or WordNet neighbours within lexical_links
     # hypernym links, score at least cross_branch_weight times that Situation 3 value.
-    lexicon: bool = True
+    lexicon: bool = False  # off by default: bench/matchmaking_ablation.py shows no robust gain (docs)
     lexical_links: int = 2
     cross_branch_weight: float = 0.8
     # A pair of entities counts as matched when its similarity reaches this threshold (CSS, PE).
