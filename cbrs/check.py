@@ -21,7 +21,7 @@ from typing import Any
 import pyoxigraph as ox
 
 from kb import KnowledgeBase, KnowledgeBaseError
-from kb.namespaces import OWL, RDFS, XSD, GraphName, shorten
+from kb.namespaces import OWL, GraphName, shorten
 
 DEFAULT_GRAPHS = (GraphName.ONTOLOGY, GraphName.SERVICES, GraphName.REQUIREMENTS)
 JAVA_HINT = "install a Java runtime (Debian/Ubuntu: apt-get install default-jre-headless) or put java on PATH"
@@ -128,17 +128,9 @@ def check(kb: KnowledgeBase, graphs: Sequence[GraphName] = DEFAULT_GRAPHS) -> Ch
 
 def _range_clashes(kb: KnowledgeBase, graphs: Sequence[GraphName]) -> list[RangeClash]:
     """Literals typed with another XSD datatype than the one their property's rdfs:range names."""
-    sources = " ".join(str(graph.node) for graph in graphs)
-    result = kb.query(
-        f"""SELECT DISTINCT ?s ?p ?o ?range WHERE {{
-              ?p <{RDFS}range> ?range . FILTER(STRSTARTS(STR(?range), "{XSD}"))
-              VALUES ?g {{ {sources} }} GRAPH ?g {{ ?s ?p ?o }}
-              FILTER(isLiteral(?o) && DATATYPE(?o) != ?range && !(?range = <{XSD}string> && LANG(?o) != ""))
-            }} ORDER BY ?s ?p"""
-    )
-    assert isinstance(result, ox.QuerySolutions)
+    rows = [row for graph in graphs for row in kb.select("range_clashes", {"graph": graph.iri})]
     clashes = []
-    for row in result:
+    for row in rows:
         literal = row["o"]
         assert isinstance(literal, ox.Literal)
         clashes.append(

@@ -30,7 +30,8 @@ import pyoxigraph as ox
 
 from kb.errors import InvalidDescriptionError
 from kb.namespaces import GENID, OWL, RDF, RDFS, XSD, GraphName, shorten
-from kb.resources import ontology_dir
+from kb.queries import QueryLibrary
+from kb.resources import ontology_dir, query_dir
 from kb.store import Store
 from kb.vocab import CBRS
 
@@ -117,9 +118,18 @@ def check_loaded(store: Store, report: LoadReport) -> None:
     owls = [q for item in report.files if item.owls is not None for q in item.quads]
     plain = [q for item in (*report.files, *report.imports) if item.owls is None for q in item.quads]
     context = plain + owls
-    if _closures(plain):
-        _check_with_context(store, plain, context)
-    check_descriptions(store, owls, terms=False)
+    try:
+        if _closures(plain):
+            _check_with_context(store, plain, context)
+        check_descriptions(store, owls, terms=False)
+    except DescriptionShapeError as error:  # name the file the description came from
+        subject = ox.NamedNode(error.iri)
+        sources = [
+            item.source for item in (*report.files, *report.imports) if any(q.subject == subject for q in item.quads)
+        ]
+        if sources:
+            error.args = (f"{sources[0]}: {error.args[0]}",)
+        raise
 
 
 def _check_with_context(store: Store, quads: list[ox.Quad], context: list[ox.Quad]) -> None:
@@ -157,7 +167,8 @@ def _undo(store: Store, added: set[ox.Quad], removed: set[ox.Quad]) -> None:
     graphs = {q.graph_name for q in (*added, *removed)}
     kept = [q for q in store.quads() if q.graph_name in graphs and q not in added]
     for graph in graphs:
-        store.update(f"DROP SILENT GRAPH {graph}")
+        if isinstance(graph, ox.NamedNode):
+            store.clear_graph(graph)
     store.add([*kept, *removed])
 
 
@@ -329,20 +340,15 @@ def _namespace(iri: str) -> str:
 def _declared_in_store(store: Store, iris: set[str]) -> set[str]:
     if not iris:
         return set()
-    values = " ".join(str(ox.NamedNode(iri)) for iri in sorted(iris))
-    result = store.query(f"SELECT ?t WHERE {{ VALUES ?t {{ {values} }} FILTER EXISTS {{ ?t ?p ?o }} }}")
-    assert isinstance(result, ox.QuerySolutions)
-    return {row["t"].value for row in result}
+    return {iri for iri in iris if next(iter(store.quads(ox.NamedNode(iri))), None) is not None}
 
 
 def _candidates(store: Store, namespace: str, declared_here: set[str]) -> list[str]:
     w3c_namespaces, w3c_terms = _w3c_terms()
     if namespace in w3c_namespaces:
         return sorted(t for t in w3c_terms if t.startswith(namespace))
-    prefix = ox.Literal(namespace)  # written by Oxigraph's serialiser, escaped
-    result = store.query(f"SELECT DISTINCT ?t WHERE {{ ?t ?p ?o FILTER(isIRI(?t) && STRSTARTS(STR(?t), {prefix})) }}")
-    assert isinstance(result, ox.QuerySolutions)
-    return sorted({row["t"].value for row in result} | {t for t in declared_here if t.startswith(namespace)})
+    rows = _queries().select(store, "namespace_terms", {"namespace": namespace})
+    return sorted({row["term"].value for row in rows} | {t for t in declared_here if t.startswith(namespace)})
 
 
 def _near(iri: str, candidates: Sequence[str]) -> str | None:
@@ -379,3 +385,8 @@ def _w3c_terms() -> tuple[frozenset[str], frozenset[str]]:
     terms = {ns + name for ns, vocabulary in spaces.items() for name in vocabulary.__annotations__}
     core = {value for name, value in vars(CBRS).items() if name != "NS" and isinstance(value, str)}
     return frozenset({*spaces, CBRS.NS}), frozenset(terms | core)
+
+
+@functools.cache
+def _queries() -> QueryLibrary:
+    return QueryLibrary(query_dir())

@@ -125,6 +125,10 @@ class Store(ABC):
         if parts:
             self._apply_own_update(" ;\n".join(parts))
 
+    def clear_graph(self, graph: ox.NamedNode) -> None:
+        """Empty one named graph, blank nodes included (which a data block cannot name), in one transaction."""
+        self._apply_own_update(f"DROP SILENT GRAPH {graph}")  # the IRI as Oxigraph's serialiser writes it
+
     def _apply_own_update(self, text: str) -> None:
         """Run an update cbrs wrote itself from validated terms (flat data blocks)."""
         self.update(text)
