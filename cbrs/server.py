@@ -17,7 +17,9 @@ from typing import Any
 from waitress import wasyncore
 from waitress.server import create_server
 
+from cbrs.bridge_client import BridgeClient
 from cbrs.bridge_services import KnowledgeServices, attach
+from cbrs.live_components import LiveComponents
 from cbrs.matchmakers import Matchmakers
 from cbrs.rosbridge import Bridge
 from cbrs.settings import setting
@@ -43,6 +45,7 @@ class ServeConfig:
     bridge_connections_per_client: int = field(
         default_factory=lambda: setting("bridge_connections_per_client").resolve()
     )
+    component_lease: float = field(default_factory=lambda: setting("component_lease").resolve())
 
 
 class Server:
@@ -64,6 +67,12 @@ class Server:
         self.matchmakers = Matchmakers(self.sparql)  # one taxonomy index for the pages and the bridge
         services = KnowledgeServices(self.sparql, self.tasks, self.matchmakers, self.own_origins)
         self._detach = attach(self.bridge, services)
+        self.live = LiveComponents(self.sparql, ttl=self.config.component_lease)
+        for name, (kind, handler) in self.live.handlers().items():
+            self.bridge.add_service(name, kind, handler)
+        self.bridge.on_disconnect(self.live.disconnected)
+        self.tasks.transport = self._own_bridge
+        self._transport: BridgeClient | None = None
         self.app = create_app(self.sparql, self.config.cors_origins, self.tasks, self.matchmakers, self.own_origins)
         self.app.extensions["cbrs.streams"] = StreamSlots(self.config.stream_limit, self.config.streams_per_client)
         self._http: Any = None
@@ -97,6 +106,17 @@ class Server:
         except BaseException:
             self._stop_http(5.0)
             raise
+        self.live.start()
+
+    def _own_bridge(self) -> BridgeClient | None:
+        """A connection to this server's own bridge, through which task runs call live components."""
+        if self._bridge is None:
+            return None
+        if self._transport is None or self._transport.closed:
+            host = "127.0.0.1" if self.config.host in ("0.0.0.0", "::") else self.config.host
+            token = self.config.endpoint.update_token
+            self._transport = BridgeClient(f"ws://{host}:{self.bridge_port}", token)
+        return self._transport
 
     def own_origins(self) -> frozenset[str]:
         """The origins this server's pages come from: the address it binds (and, for loopback, the
@@ -116,6 +136,10 @@ class Server:
     def stop(self, timeout: float = 10.0) -> None:
         """Close both listeners and their connections; a task run still going gets ``timeout`` to end."""
         self.app.extensions["cbrs.closing"].set()  # event and camera streams end within half a second
+        self.live.stop()
+        if self._transport is not None:
+            self._transport.close()
+            self._transport = None
         if self._bridge is not None:
             self._bridge.stop(timeout)
             self._bridge = None

@@ -189,6 +189,14 @@ SETTINGS: tuple[Setting, ...] = (
         _positive(int),
     ),
     Setting(
+        "component_lease",
+        lambda: 3.0,
+        "Seconds a component registered live over the bridge stays available without a heartbeat; when "
+        "its session closes or its lease lapses it is marked unavailable (docs/components.md).",
+        "CBRS_COMPONENT_LEASE",
+        _positive(float),
+    ),
+    Setting(
         "query_check_timeout",
         lambda: 10.0,
         "Seconds an isolated checker may take to parse a query or update longer than 512 characters "

@@ -346,6 +346,13 @@ class SparqlService:
         for listener in list(self._listeners):
             listener()
 
+    def changed(self) -> None:
+        """Say the store was written other than by :meth:`update` (a live registration, a lapsed
+        lease): caches go stale and the update listeners hear of it. Call with :attr:`lock` held."""
+        self.generation += 1
+        for listener in list(self._listeners):
+            listener()
+
     def on_update(self, listener: Callable[[], None]) -> Callable[[], None]:
         """Call ``listener()`` after each update; returns the call that stops it."""
         self._listeners.append(listener)

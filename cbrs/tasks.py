@@ -25,6 +25,7 @@ from actions.composer import Composer
 from actions.events import Event
 from actions.faults import RandomFaults
 from actions.model import ActionLibrary, resolve_task
+from actions.remote import Transport
 from actions.runner import run_task
 from kb import KnowledgeBase
 from kb.errors import KnowledgeBaseError
@@ -146,6 +147,8 @@ class TaskRunner:
         self._guard = threading.Lock()
         self._active: tuple[TaskRun, threading.Thread] | None = None
         self._ids = itertools.count(1)
+        self.transport: Callable[[], Transport | None] | None = None
+        """How a run reaches components in other processes (the server's own bridge connection)."""
 
     def subscribe(self, listener: Listener) -> Callable[[], None]:
         """Call ``listener(topic, message)`` for every event of every run; returns the unsubscribe call."""
@@ -274,7 +277,7 @@ class TaskRunner:
                 semantic_map = SemanticMap.read(self.kb)
             with open_world(seed=run.seed, semantic_map=semantic_map) as world:
                 self._capture(world, run.id)
-                environment = SimEnvironment(world, self.kb)
+                environment = SimEnvironment(world, self.kb, self.transport() if self.transport else None)
                 policy = RandomFaults(run.seed, run.fault_rate) if run.fault_rate > 0 else None
                 result = run_task(self.kb, run.task, environment, run.faults, composer, follow, fault_policy=policy)
                 found = result.to_dict()

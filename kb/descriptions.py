@@ -229,6 +229,7 @@ class DescriptionReader:
                     name=_value(row["name"]) if "name" in row else None,
                     data_type=_iri(row["dataType"]) if "dataType" in row else None,
                     topic=_value(row["topic"]) if "topic" in row else None,
+                    message_type=_value(row["messageType"]) if "messageType" in row else None,
                 )
             )
         return tuple(ports)

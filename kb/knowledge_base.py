@@ -9,6 +9,7 @@ import pyoxigraph as ox
 
 from kb.catalog import Catalogue
 from kb.descriptions import DescriptionReader
+from kb.liveness import Liveness
 from kb.loader import LoadReport, ParsedFile, load_files, parse_file
 from kb.model import Advertisement, PartNode, Requirement, ServiceDescription
 from kb.namespaces import GraphName
@@ -143,8 +144,19 @@ class KnowledgeBase:
     def description(self, iri: str) -> ServiceDescription:
         return self._reader.read(iri)
 
-    def advertisements(self) -> list[Advertisement]:
-        return self._reader.advertisements()
+    def advertisements(self, include_unavailable: bool = False) -> list[Advertisement]:
+        """The advertisements; those of live components that cannot be invoked now (their session
+        closed or their lease lapsed, :mod:`kb.liveness`) only with ``include_unavailable``."""
+        found = self._reader.advertisements()
+        if include_unavailable:
+            return found
+        gone = self.liveness.unavailable()
+        return [ad for ad in found if ad.iri not in gone] if gone else found
+
+    @property
+    def liveness(self) -> Liveness:
+        """The live components' availability and leases."""
+        return Liveness(self.store)
 
     def requirements(self) -> list[Requirement]:
         return self._reader.requirements()

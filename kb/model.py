@@ -78,6 +78,7 @@ class Port:
     name: str | None = None
     data_type: str | None = None
     topic: str | None = None
+    message_type: str | None = None  # with a topic, on a service port: the component is invoked over the bridge
 
 
 @dataclass(frozen=True)

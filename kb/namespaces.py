@@ -58,6 +58,7 @@ class GraphName(StrEnum):
     MAP = "map"
     WORLD = "world"
     PLANS = "plans"
+    LIVENESS = "liveness"
 
     @property
     def iri(self) -> str:

@@ -27,6 +27,7 @@ from typing import Any
 from actions.belief import Observation
 from actions.components import Component, Registry, Status
 from actions.plan import Plan, PlanStep
+from actions.remote import RemoteComponent, Transport
 from kb import KnowledgeBase, Requirement, Statement
 from kb.namespaces import PREFIXES
 from kb.semantic_map import SemanticMap, Thing, designate, local_name
@@ -58,6 +59,7 @@ from sim.values import (
     MalformedValueError,
     Manipulation,
     ObjectFeature,
+    check,
     decode,
     designator,
     from_json,
@@ -435,11 +437,24 @@ def simulated(kb: KnowledgeBase) -> list[str]:
     return sorted(row["service"].value for row in rows if "serviceName" in row and row["serviceName"].value in SKILLS)
 
 
-def implementations(kb: KnowledgeBase, world: HomeWorld | None = None, registry: Registry | None = None) -> Registry:
-    """A simulated component for every advertisement whose service the simulation can perform on its
-    device (cameras must exist in the world); added to ``registry`` if given (a refresh)."""
+def implementations(
+    kb: KnowledgeBase,
+    world: HomeWorld | None = None,
+    registry: Registry | None = None,
+    transport: Transport | None = None,
+) -> Registry:
+    """An implementation for every advertisement the store says how to invoke, added to ``registry``
+    if given (a refresh): a remote component for one whose service port names a bridge service and its
+    type (when there is a ``transport`` to reach it), else a simulated one where the simulation can
+    perform its service on its device (cameras must exist in the world)."""
     registry = registry if registry is not None else Registry()
     for ad in kb.advertisements():
+        remote = next((p for p in ad.ports if p.kind == "service" and p.topic and p.message_type), None)
+        if remote is not None:
+            if transport is not None and remote.topic is not None:
+                outputs = {p.name: p.type for p in ad.outputs if p.name}
+                registry.add(ad.iri, _remote(transport, remote.topic, outputs))
+            continue
         work = SKILLS.get(ad.service_name or "")
         device = ad.device_name or ""
         if work is None:
@@ -449,6 +464,14 @@ def implementations(kb: KnowledgeBase, world: HomeWorld | None = None, registry:
         names = tuple(p.name for p in ad.outputs if p.name)
         registry.add(ad.iri, _maker(work, device, names))
     return registry
+
+
+REMOTE_TIMEOUT = 10.0
+"""Seconds a remote component has to answer one call (a perception or a computation, not a motion)."""
+
+
+def _remote(transport: Transport, service: str, outputs: Mapping[str, str]) -> Callable[[str], Component]:
+    return lambda iri: RemoteComponent(iri, transport, service, outputs, check, REMOTE_TIMEOUT)
 
 
 def _maker(work: Work, device: str, outputs: tuple[str, ...]) -> Callable[[str], Component]:
@@ -492,10 +515,12 @@ class SimEnvironment:
     whether the task's goals really hold.
     """
 
-    def __init__(self, world: HomeWorld, kb: KnowledgeBase) -> None:
+    def __init__(self, world: HomeWorld, kb: KnowledgeBase, transport: Transport | None = None) -> None:
         self.world = world
         self.kb = kb
-        self.registry = implementations(kb, world)
+        self.transport = transport
+        """How components in other processes are reached (a bridge connection); None: only simulated ones."""
+        self.registry = implementations(kb, world, transport=transport)
         self.context = SimContext(world, kb)
         self.belief = PerceivedWorld(world)
         self.referee = Referee(world)
@@ -511,7 +536,7 @@ class SimEnvironment:
         """Before a new plan: forget the measured map (the world may have changed) and add the
         components registered since."""
         self.context.grid = None
-        implementations(self.kb, self.world, self.registry)
+        implementations(self.kb, self.world, self.registry, self.transport)
 
     def perceive(self) -> None:
         """Look at everything with every working camera (before a plan, and before a re-plan)."""

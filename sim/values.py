@@ -25,7 +25,7 @@ from typing import Any, NoReturn, TypeAlias, TypeVar
 import numpy as np
 from numpy.typing import NDArray
 
-from kb.namespaces import HOME
+from kb.namespaces import HOME, expand
 from kb.semantic_map import MapObject, local_name
 from sim.errors import SimulationError
 from sim.geometry import Pose2D
@@ -59,6 +59,7 @@ __all__ = [
     "Manipulation",
     "ObjectFeature",
     "Value",
+    "check",
     "concepts_of",
     "decode",
     "designator",
@@ -562,4 +563,35 @@ def decode(data: object, kind: type[V]) -> V:
         expected = "one of " + ", ".join(local_name(c) for c in concepts)
         assert isinstance(data, dict)
         raise MalformedValueError(None, "@type", data.get("@type"), expected)
+    return value
+
+
+def check(concept: str, data: object) -> dict[str, Any]:
+    """A value another process sent for a port of type ``concept``, checked: a JSON object whose
+    ``"@type"`` is the port's class (a prefixed name is expanded) or, for a class with a shape here,
+    one that decodes to the same kind. A class with no shape here takes any JSON object of that
+    ``@type`` (a thermometer's reading). Returns the value with its ``@type`` written in full;
+    ``MalformedValueError`` (a ``ValueError``) says what was wrong."""
+    if not isinstance(data, dict):
+        raise MalformedValueError(concept, "(value)", data, f"a JSON object with '@type' {local_name(concept)}")
+    written = data.get("@type", MISSING)
+    if not isinstance(written, str) or not written:
+        raise MalformedValueError(concept, "@type", written, f"the class of the value ({local_name(concept)})")
+    try:
+        full = expand(written)
+    except ValueError:
+        raise MalformedValueError(concept, "@type", written, "an IRI or a prefixed name") from None
+    value = {**data, "@type": full}
+    if "@id" in value:
+        from_json(value)  # a designator: an IRI and a class
+        return value
+    codec = _BY_CONCEPT.get(concept)
+    if codec is None:
+        if full != concept:
+            raise MalformedValueError(concept, "@type", written, local_name(concept))
+        return value
+    decoded = from_json(value)
+    if not isinstance(decoded, codec.kind):
+        expected = "one of " + ", ".join(local_name(c) for c in codec.concepts)
+        raise MalformedValueError(concept, "@type", written, expected)
     return value

@@ -92,6 +92,7 @@ class Bridge:
         self._workers: WorkerPool | None = None
         self._writers: dict[Session, asyncio.Task[None]] = {}
         self._clients = itertools.count(1)
+        self._disconnect_listeners: list[Callable[[str], None]] = []
         self._ops: dict[str, Callable[[Session, Message], None]] = {
             "advertise": self._advertise,
             "unadvertise": self._unadvertise,
@@ -279,6 +280,16 @@ class Bridge:
         if self._calls is not None:
             self._calls.fail_provider(session, None, "the provider of {service!r} disconnected")
         log.info("%s disconnected", session.name)
+        for listener in list(self._disconnect_listeners):
+            try:
+                listener(session.name)
+            except Exception:  # a listener's bug must not keep the session open
+                log.exception("a disconnect listener failed for %s", session.name)
+
+    def on_disconnect(self, listener: Callable[[str], None]) -> None:
+        """Call ``listener(session name)`` on the bridge's loop when a client disconnects (a live
+        component's registration ends with its session)."""
+        self._disconnect_listeners.append(listener)
 
     # -- ops ----------------------------------------------------------------------------------------
 

@@ -35,6 +35,7 @@ class Caller:
     peer: str  # the client's address (IP), which per-client limits count by
     origin: str | None  # the Origin header of its websocket handshake: a web page's, or None for a program
     authorised: bool  # it sent the server's token with the auth op
+    session: str = ""  # the connection's name, unique in the server (what outlives a call: a registration)
 
 
 _CALLER: ContextVar[Caller | None] = ContextVar("cbrs_rosbridge_caller", default=None)
@@ -86,7 +87,7 @@ class Session:
         return f"<Session {self.name}>"
 
     def identity(self) -> Caller:
-        return Caller(self.peer, self.origin, self.authorised)
+        return Caller(self.peer, self.origin, self.authorised, self.name)
 
     @property
     def pending_bytes(self) -> int:

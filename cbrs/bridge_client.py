@@ -1,0 +1,186 @@
+"""A rosbridge v2 client for Python programs: call services, provide services, publish.
+
+One websocket, one reader thread. ``call`` returns a future (it is the executor's
+:class:`~actions.remote.Transport`); ``provide`` answers calls from the server with a handler run on a
+small thread pool, so a slow handler does not hold up the connection. The component SDK
+(:mod:`cbrs.component`) and the executor's remote components are built on it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import itertools
+import json
+import logging
+import threading
+from collections.abc import Callable, Mapping
+from concurrent.futures import Future, ThreadPoolExecutor
+from typing import Any
+
+from websockets.exceptions import ConnectionClosed
+from websockets.sync.client import ClientConnection, connect
+
+from actions.remote import RemoteCallError
+
+__all__ = ["BridgeClient", "BridgeClosedError", "ServiceHandler"]
+
+log = logging.getLogger("cbrs.bridge_client")
+
+ServiceHandler = Callable[[dict[str, Any]], Mapping[str, Any]]
+"""A provided service: the request's fields -> the response's fields (raise to answer result: false)."""
+
+
+class BridgeClosedError(ConnectionError):
+    """The connection to the bridge is closed; calls waiting on it fail with this."""
+
+
+class BridgeClient:
+    """A connection to a rosbridge server (``ws://host:port``), optionally authorised with ``token``."""
+
+    def __init__(self, url: str, token: str | None = None, timeout: float = 10.0, workers: int = 4) -> None:
+        self.url = url
+        self.timeout = timeout
+        self._exit = contextlib.ExitStack()
+        try:
+            self._socket: ClientConnection = self._exit.enter_context(
+                connect(url, open_timeout=timeout, max_size=16 << 20)
+            )
+        except (OSError, TimeoutError) as error:
+            raise BridgeClosedError(f"cannot reach the bridge at {url}: {error}") from error
+        self._send_lock = threading.Lock()
+        self._ids = itertools.count(1)
+        self._waiting: dict[str, Future[dict[str, Any]]] = {}
+        self._handlers: dict[str, ServiceHandler] = {}
+        self._pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="cbrs-provide")
+        self._closed = threading.Event()
+        self.statuses: list[dict[str, Any]] = []
+        """The status messages the server sent (its errors and warnings about this client's ops)."""
+        self._reader = threading.Thread(target=self._read, name="cbrs-bridge-reader", daemon=True)
+        self._reader.start()
+        if token is not None:
+            self.send({"op": "auth", "mac": token})
+
+    # -- life cycle ---------------------------------------------------------------------------------
+
+    @property
+    def closed(self) -> bool:
+        return self._closed.is_set()
+
+    def close(self) -> None:
+        """Close the connection; calls still waiting fail with :class:`BridgeClosedError`."""
+        self._exit.close()
+        self._reader.join(timeout=self.timeout)
+        self._shutdown("the connection was closed by this client")
+
+    def __enter__(self) -> BridgeClient:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def wait_closed(self, timeout: float | None = None) -> bool:
+        return self._closed.wait(timeout)
+
+    # -- calls --------------------------------------------------------------------------------------
+
+    def call(self, service: str, args: Mapping[str, Any], timeout: float | None = None) -> Future[dict[str, Any]]:
+        """Call ``service``; the future gets the response's values, or raises :class:`RemoteCallError`
+        (the service answered ``result: false``) or :class:`BridgeClosedError`."""
+        future: Future[dict[str, Any]] = Future()
+        if self.closed:
+            future.set_exception(BridgeClosedError(f"the connection to {self.url} is closed"))
+            return future
+        key = f"call:{service}:{next(self._ids)}"
+        self._waiting[key] = future
+        message: dict[str, Any] = {"op": "call_service", "id": key, "service": service, "args": dict(args)}
+        if timeout is not None:
+            message["timeout"] = timeout
+        try:
+            self.send(message)
+        except BridgeClosedError as error:
+            self._waiting.pop(key, None)
+            future.set_exception(error)
+        return future
+
+    def call_sync(self, service: str, args: Mapping[str, Any], timeout: float | None = None) -> dict[str, Any]:
+        """Call ``service`` and wait for the answer (at most ``timeout``, the client's by default)."""
+        wait = timeout if timeout is not None else self.timeout
+        return self.call(service, args, wait).result(timeout=wait + 1.0)
+
+    # -- providing ----------------------------------------------------------------------------------
+
+    def provide(self, service: str, service_type: str, handler: ServiceHandler) -> None:
+        """Advertise ``service`` and answer the server's calls to it with ``handler``."""
+        self._handlers[service] = handler
+        self.send({"op": "advertise_service", "service": service, "type": service_type})
+
+    def publish(self, topic: str, msg: Mapping[str, Any]) -> None:
+        self.send({"op": "publish", "topic": topic, "msg": dict(msg)})
+
+    # -- the wire -----------------------------------------------------------------------------------
+
+    def send(self, message: Mapping[str, Any]) -> None:
+        text = json.dumps(message, separators=(",", ":"))
+        with self._send_lock:
+            try:
+                self._socket.send(text)
+            except ConnectionClosed as error:
+                raise BridgeClosedError(f"the connection to {self.url} is closed") from error
+
+    def _read(self) -> None:
+        try:
+            while True:
+                frame = self._socket.recv()
+                try:
+                    message = json.loads(frame)
+                except ValueError:
+                    log.warning("the bridge sent a frame that is not JSON")
+                    continue
+                if isinstance(message, dict):
+                    self._dispatch(message)
+        except ConnectionClosed:
+            pass
+        finally:
+            self._shutdown(f"the connection to {self.url} closed")
+
+    def _dispatch(self, message: dict[str, Any]) -> None:
+        op = message.get("op")
+        if op == "service_response":
+            future = self._waiting.pop(str(message.get("id")), None)
+            if future is None or future.done():
+                return
+            values = message.get("values")
+            if message.get("result", False) is True:
+                future.set_result(values if isinstance(values, dict) else {"values": values})
+            else:
+                future.set_exception(RemoteCallError(str(values)))
+        elif op == "call_service":
+            self._pool.submit(self._answer, message)
+        elif op == "status":
+            self.statuses.append(message)
+
+    def _answer(self, message: dict[str, Any]) -> None:
+        service = str(message.get("service", ""))
+        handler = self._handlers.get(service)
+        args = message.get("args")
+        reply: dict[str, Any] = {"op": "service_response", "service": service, "id": message.get("id")}
+        try:
+            if handler is None:
+                raise LookupError(f"this client does not provide {service}")
+            values = dict(handler(args if isinstance(args, dict) else {}))
+            json.dumps(values)  # what cannot be sent is the handler's error, answered as such
+            reply |= {"result": True, "values": values}
+        except Exception as error:  # the handler's failure is the call's answer, not this client's crash
+            reply |= {"result": False, "values": f"{type(error).__name__}: {error}"}
+        with contextlib.suppress(BridgeClosedError):
+            self.send(reply)
+
+    def _shutdown(self, reason: str) -> None:
+        if self._closed.is_set():
+            return
+        self._closed.set()
+        for key in list(self._waiting):
+            future = self._waiting.pop(key, None)
+            if future is not None and not future.done():
+                future.set_exception(BridgeClosedError(reason))
+        self._pool.shutdown(wait=False, cancel_futures=True)

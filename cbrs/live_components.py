@@ -1,0 +1,252 @@
+"""Components that run in other processes: they register while the server runs, keep a lease, and go.
+
+A component connects to the bridge, authenticates with the update token (op ``auth``), advertises the
+rosbridge service that does its work, and calls ``/cbrs/register`` with its six-tuple description
+(Turtle or JSON-LD) in which a service port names that service and its message type
+(``cbrs:topic``, ``cbrs:messageType``). The description is validated like any registration and
+written at once, so every process on the store can match it; its lease (``ttl`` seconds) is then
+renewed by ``/cbrs/heartbeat``. When its session closes or its lease lapses, the component is marked
+unavailable in the store's liveness graph (:mod:`kb.liveness`): its description stays, matchmaking
+and planning pass it over, a step waiting on it fails over. Registering again brings it back.
+The same registration is offered over HTTP (``POST /components``, with the bearer token).
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import pyoxigraph as ox
+
+from cbrs.rosbridge import ServiceError, current_caller
+from cbrs.sparql_service import SparqlService
+from kb.errors import AlreadyRegisteredError, InvalidDescriptionError, KnowledgeBaseError
+from kb.loader import parse_bytes
+from kb.namespaces import BASE, RDF, GraphName
+from kb.vocab import CBRS
+
+__all__ = ["DEFAULT_TTL", "MAX_DESCRIPTION_BYTES", "LiveComponents", "grounding"]
+
+log = logging.getLogger("cbrs.live_components")
+
+DEFAULT_TTL = 3.0
+"""Seconds a lease lasts unless renewed: three missed one-second heartbeats."""
+MAX_DESCRIPTION_BYTES = 256 << 10
+"""A six-tuple description is a few kilobytes; anything near this is not one."""
+FORMATS = {"turtle": ox.RdfFormat.TURTLE, "json-ld": ox.RdfFormat.JSON_LD}
+
+
+@dataclass
+class _Lease:
+    session: str
+    deadline: float  # monotonic seconds
+    ttl: float
+    written_until: float  # the monotonic time the stored leaseUntil corresponds to
+
+
+def grounding(quads: list[ox.Quad], component: str) -> tuple[str, str] | None:
+    """The rosbridge service and its type a description's service port names, if one does."""
+    ports = [q.object for q in quads if q.subject == ox.NamedNode(component) and q.predicate.value == CBRS.hasPort]
+    for port in ports:
+        facts: dict[str, str] = {}
+        for q in quads:
+            if q.subject == port and isinstance(q.object, ox.NamedNode | ox.Literal):
+                facts.setdefault(q.predicate.value, q.object.value)
+        if facts.get(RDF + "type") == CBRS.ServicePort and CBRS.topic in facts and CBRS.messageType in facts:
+            return facts[CBRS.topic], facts[CBRS.messageType]
+    return None
+
+
+class LiveComponents:
+    """The live registrations of one server, with a watchdog that ends lapsed leases."""
+
+    def __init__(
+        self,
+        sparql: SparqlService,
+        ttl: float = DEFAULT_TTL,
+        name: str = "cbrs",
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
+        if ttl <= 0:
+            raise ValueError(f"a lease must last a positive time, not {ttl!r} s")
+        self.sparql = sparql
+        self.ttl = ttl
+        self.name = name
+        self._clock = clock
+        self._leases: dict[str, _Lease] = {}
+        self._guard = threading.Lock()
+        self._stop = threading.Event()
+        self._watchdog: threading.Thread | None = None
+
+    # -- the bridge services ------------------------------------------------------------------
+
+    def handlers(self) -> dict[str, tuple[str, Callable[[dict[str, Any]], dict[str, Any]]]]:
+        return {
+            "/cbrs/register": ("cbrs/Register", self.register_call),
+            "/cbrs/heartbeat": ("cbrs/Heartbeat", self.heartbeat_call),
+        }
+
+    def register_call(self, args: dict[str, Any]) -> dict[str, Any]:
+        caller = current_caller()
+        if caller is not None and not caller.authorised:
+            raise ServiceError("registering a component needs the update token: send it first with the auth op")
+        session = caller.session if caller is not None else "in-process"
+        description = args.get("description")
+        if not isinstance(description, str):
+            raise ServiceError("missing field 'description' (the component's description, as text)")
+        fmt = args.get("format", "turtle")
+        ttl = args.get("ttl", self.ttl)
+        if isinstance(ttl, bool) or not isinstance(ttl, int | float) or not 0.1 <= ttl <= 3600:
+            raise ServiceError(f"field 'ttl' must be a number of seconds from 0.1 to 3600, not {ttl!r}")
+        try:
+            components = self.register(description, session, str(fmt), float(ttl))
+        except (KnowledgeBaseError, ValueError) as error:
+            raise ServiceError(str(error)) from error
+        return {"components": components, "ttl": float(ttl)}
+
+    def heartbeat_call(self, args: dict[str, Any]) -> dict[str, Any]:
+        caller = current_caller()
+        session = caller.session if caller is not None else "in-process"
+        renewed = self.renew(session)
+        if not renewed:
+            raise ServiceError("this session has no live component: register first")
+        return {"components": renewed}
+
+    # -- the library ---------------------------------------------------------------------------
+
+    def register(self, description: str, session: str, fmt: str = "turtle", ttl: float | None = None) -> list[str]:
+        """Register (or bring back) the components ``description`` describes, for ``session``."""
+        ttl = self.ttl if ttl is None else ttl
+        if len(description.encode("utf-8")) > MAX_DESCRIPTION_BYTES:
+            raise InvalidDescriptionError("<registration>", [f"it is larger than {MAX_DESCRIPTION_BYTES} bytes"])
+        if fmt not in FORMATS:
+            raise ValueError(f"unknown description format {fmt!r}; use {' or '.join(FORMATS)}")
+        turtle = description if fmt == "turtle" else _to_turtle(description, FORMATS[fmt])
+        parsed = parse_bytes(turtle.encode("utf-8"), "<registration>", ox.RdfFormat.TURTLE, GraphName.SERVICES, BASE)
+        named = {
+            q.subject.value
+            for q in parsed.quads
+            if q.predicate.value == CBRS.serviceName and isinstance(q.subject, ox.NamedNode)
+        }
+        for iri in sorted(named):
+            if grounding(parsed.quads, iri) is None:
+                raise InvalidDescriptionError(
+                    iri,
+                    [
+                        "no service port grounds it in the bridge: give it a cbrs:ServicePort with the rosbridge "
+                        "service (cbrs:topic) and its type (cbrs:messageType)"
+                    ],
+                )
+        kb = self.sparql.kb
+        with self.sparql.lock:
+            states = kb.liveness.states()
+            returning = []
+            for iri in sorted(named):
+                if not kb.registry.is_registered(iri):
+                    continue
+                owner = self._leases.get(iri)
+                if iri not in states:
+                    raise AlreadyRegisteredError(iri)  # a component of the store, not a live one
+                if owner is not None and owner.session != session and states[iri].live:
+                    raise AlreadyRegisteredError(iri)  # another live session holds the name
+                returning.append(iri)
+            if returning and len(returning) != len(named):
+                raise ValueError("register the components coming back apart from the new ones")
+            if returning:
+                iris = kb.registry.update(turtle, "<registration>")
+            else:
+                iris = kb.registry.register(turtle, "<registration>")
+            now = self._clock()
+            for iri in iris:
+                kb.liveness.renew(iri, ttl, registered_by=f"{self.name} session {session}")
+                with self._guard:
+                    self._leases[iri] = _Lease(session, now + ttl, ttl, now + ttl)
+            self.sparql.changed()
+        log.info("%s registered %s (lease %g s)", session, ", ".join(iris), ttl)
+        return iris
+
+    def renew(self, session: str) -> list[str]:
+        """Renew the leases of ``session``'s components; the store is written when half a lease has passed."""
+        now = self._clock()
+        renewed, stale = [], []
+        with self._guard:
+            for iri, lease in self._leases.items():
+                if lease.session == session and lease.deadline >= now:
+                    lease.deadline = now + lease.ttl
+                    renewed.append(iri)
+                    if lease.written_until - now < lease.ttl / 2:
+                        lease.written_until = lease.deadline
+                        stale.append((iri, lease.ttl))
+        if stale:
+            with self.sparql.lock:
+                for iri, ttl in stale:
+                    self.sparql.kb.liveness.renew(iri, ttl)
+        return sorted(renewed)
+
+    def disconnected(self, session: str) -> None:
+        """``session`` closed: its components become unavailable at once."""
+        self._end([iri for iri, lease in self._leases_of(session)], "its session closed")
+
+    def expire_lapsed(self) -> list[str]:
+        """End the leases not renewed in time; returns the components made unavailable."""
+        now = self._clock()
+        with self._guard:
+            lapsed = [iri for iri, lease in self._leases.items() if lease.deadline < now]
+        self._end(lapsed, "its lease lapsed")
+        return lapsed
+
+    def live(self) -> list[str]:
+        with self._guard:
+            return sorted(self._leases)
+
+    def _leases_of(self, session: str) -> list[tuple[str, _Lease]]:
+        with self._guard:
+            return [(iri, lease) for iri, lease in self._leases.items() if lease.session == session]
+
+    def _end(self, components: list[str], reason: str) -> None:
+        if not components:
+            return
+        with self._guard:
+            for iri in components:
+                self._leases.pop(iri, None)
+        with self.sparql.lock:
+            for iri in components:
+                self.sparql.kb.liveness.expire(iri, reason)
+            self.sparql.changed()
+        log.info("%s unavailable: %s", ", ".join(components), reason)
+
+    # -- the watchdog --------------------------------------------------------------------------
+
+    def start(self) -> None:
+        if self._watchdog is None:
+            self._stop.clear()
+            self._watchdog = threading.Thread(target=self._watch, name="cbrs-leases", daemon=True)
+            self._watchdog.start()
+
+    def stop(self) -> None:
+        self._stop.set()
+        if self._watchdog is not None:
+            self._watchdog.join(timeout=5.0)
+            self._watchdog = None
+
+    def _watch(self) -> None:
+        period = min(0.25, self.ttl / 4)
+        while not self._stop.wait(period):
+            try:
+                self.expire_lapsed()
+            except Exception:  # the watchdog must outlive a failed write
+                log.exception("ending lapsed leases failed")
+
+
+def _to_turtle(text: str, fmt: ox.RdfFormat) -> str:
+    try:
+        triples = list(ox.parse(text.encode("utf-8"), format=fmt, base_iri=BASE))
+    except SyntaxError as error:
+        raise InvalidDescriptionError("<registration>", [f"it is not valid {fmt.name}: {error}"]) from None
+    written = ox.serialize(triples, format=ox.RdfFormat.TURTLE)
+    assert written is not None  # serialize writes to bytes when given no output
+    return written.decode("utf-8")

@@ -1,0 +1,128 @@
+"""Whether the components that run outside the process can be invoked now: leases in the store.
+
+A component registered live (over the bridge or HTTP) is available while the session it registered
+through stays open and it renews its lease. Its state lives in the ``liveness`` graph, apart from its
+description, so a component that goes away keeps its six-tuple (for the browser and SPARQL) but is
+no longer matched or planned. The lease's end is written as a time, so a component whose server died
+without a word lapses for every other process on the store as well.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import pyoxigraph as ox
+
+from kb.namespaces import GraphName
+from kb.store import Store
+from kb.vocab import CBRS
+
+__all__ = ["ComponentState", "Liveness"]
+
+_XSD = "http://www.w3.org/2001/XMLSchema#"
+_PROPERTIES = (CBRS.available, CBRS.leaseUntil, CBRS.unavailableBecause, CBRS.registeredBy)
+
+
+@dataclass(frozen=True)
+class ComponentState:
+    """A live component's state: available now (its lease unexpired), until when, and why not."""
+
+    component: str
+    live: bool
+    lease_until: dt.datetime | None
+    reason: str | None
+    registered_by: str | None
+
+
+class Liveness:
+    """Reads and writes live components' states in the store's liveness graph."""
+
+    def __init__(self, store: Store, clock: Callable[[], dt.datetime] | None = None) -> None:
+        self._store = store
+        self._clock = clock or (lambda: dt.datetime.now(dt.UTC))
+
+    def renew(self, component: str, ttl: float, registered_by: str | None = None) -> dt.datetime:
+        """Mark ``component`` available for ``ttl`` seconds from now; returns when the lease ends."""
+        until = self._clock() + dt.timedelta(seconds=ttl)
+        facts = [(CBRS.available, _boolean(True)), (CBRS.leaseUntil, _time(until))]
+        if registered_by is not None:
+            facts.append((CBRS.registeredBy, ox.Literal(registered_by)))
+        else:
+            facts += [(CBRS.registeredBy, term) for term in self._values(component, CBRS.registeredBy)]
+        self._write(component, facts)
+        return until
+
+    def expire(self, component: str, reason: str) -> None:
+        """Mark ``component`` unavailable, saying why; its description stays."""
+        kept = [(CBRS.registeredBy, term) for term in self._values(component, CBRS.registeredBy)]
+        self._write(
+            component, [(CBRS.available, _boolean(False)), (CBRS.unavailableBecause, ox.Literal(reason)), *kept]
+        )
+
+    def forget(self, component: str) -> None:
+        """Remove every liveness statement about ``component`` (it was deregistered)."""
+        self._write(component, [])
+
+    def states(self) -> dict[str, ComponentState]:
+        """Every live component's state, by IRI."""
+        found: dict[str, ComponentState] = {}
+        now = self._clock()
+        graph = GraphName.LIVENESS.node
+        values: dict[str, dict[str, ox.NamedNode | ox.BlankNode | ox.Literal | ox.Triple]] = {}
+        for quad in self._store.quads(graph=graph):
+            if isinstance(quad.subject, ox.NamedNode) and quad.predicate.value in _PROPERTIES:
+                values.setdefault(quad.subject.value, {})[quad.predicate.value] = quad.object
+        for component, props in values.items():
+            available = _as_bool(props.get(CBRS.available))
+            until = _as_time(props.get(CBRS.leaseUntil))
+            reason = props.get(CBRS.unavailableBecause)
+            registered = props.get(CBRS.registeredBy)
+            live = available and (until is None or until >= now)
+            if available and not live:
+                reason = ox.Literal("its lease lapsed")
+            found[component] = ComponentState(
+                component,
+                live,
+                until,
+                reason.value if isinstance(reason, ox.Literal) else None,
+                registered.value if isinstance(registered, ox.Literal) else None,
+            )
+        return found
+
+    def unavailable(self) -> set[str]:
+        """The components registered live that cannot be invoked now."""
+        return {iri for iri, state in self.states().items() if not state.live}
+
+    def _values(self, component: str, predicate: str) -> list[ox.Literal]:
+        quads = self._store.quads(ox.NamedNode(component), ox.NamedNode(predicate), graph=GraphName.LIVENESS.node)
+        return [quad.object for quad in quads if isinstance(quad.object, ox.Literal)]
+
+    def _write(self, component: str, facts: list[tuple[str, ox.Literal]]) -> None:
+        graph, subject = GraphName.LIVENESS.node, ox.NamedNode(component)
+        old = list(self._store.quads(subject, graph=graph))
+        new = [ox.Quad(subject, ox.NamedNode(predicate), value, graph) for predicate, value in facts]
+        self._store.replace(old, new)
+
+
+def _boolean(value: bool) -> ox.Literal:
+    return ox.Literal("true" if value else "false", datatype=ox.NamedNode(_XSD + "boolean"))
+
+
+def _time(value: dt.datetime) -> ox.Literal:
+    return ox.Literal(value.astimezone(dt.UTC).isoformat(), datatype=ox.NamedNode(_XSD + "dateTime"))
+
+
+def _as_bool(term: object) -> bool:
+    return isinstance(term, ox.Literal) and term.value in ("true", "1")
+
+
+def _as_time(term: object) -> dt.datetime | None:
+    if not isinstance(term, ox.Literal):
+        return None
+    try:
+        parsed = dt.datetime.fromisoformat(term.value)
+    except ValueError:
+        return None
+    return parsed if parsed.tzinfo is not None else parsed.replace(tzinfo=dt.UTC)

@@ -1,0 +1,215 @@
+"""Components in other processes: register over the bridge, get matched, planned and invoked, and go.
+
+A server runs in this process on loopback ports; components connect to its bridge like any program
+(the SDK, cbrs.component). Every wait is a bounded poll."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterator
+from typing import Any
+
+import pytest
+
+from actions.components import Status
+from actions.composer import Composer
+from actions.remote import RemoteCallError, RemoteComponent
+from actions.runner import run_task
+from cbrs.bridge_client import BridgeClient
+from cbrs.component import Component
+from cbrs.server import ServeConfig, Server
+from cbrs.sparql_service import EndpointConfig
+from kb import KnowledgeBase
+from kb.errors import InvalidDescriptionError
+from kb.namespaces import PREFIXES
+from kb.semantic_map import SemanticMap
+from reasoner.matchmaker import Matchmaker
+from sim.components import SimEnvironment
+from sim.values import check
+from sim.world import open_world
+
+TOKEN = "live-components-test-token"
+SVC, HOME, REQ = PREFIXES["svc"], PREFIXES["home"], PREFIXES["req"]
+THERMOMETER = SVC + "ReadRoomTemperature_Thermometer07"
+
+
+def thermometer(service: str = "/thermometer07/read", kind: str = "home:RoomTemperature", port: bool = True) -> str:
+    grounding = (
+        f'; cbrs:hasPort [ a cbrs:ServicePort ; cbrs:portName "read" ; cbrs:topic "{service}" ; '
+        'cbrs:messageType "cbrs_msgs/RoomTemperature" ]'
+        if port
+        else ""
+    )
+    return f"""
+@prefix svc: <{SVC}> . @prefix home: <{HOME}> . @prefix cbrs: <https://w3id.org/cbrs/core#> .
+@prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .
+svc:ReadRoomTemperature_Thermometer07 a cbrs:DynamicPerceptionComponent ;
+    rdfs:label "Room temperature (thermometer 7)"@en ;
+    cbrs:deviceName "Thermometer07" ; cbrs:serviceName "ReadRoomTemperature" ;
+    cbrs:serviceCategory "EnvironmentalSensing" ;
+    cbrs:hasOWLSModel [ a cbrs:OWLSModel ;
+        cbrs:hasOutput [ a cbrs:Parameter ; cbrs:parameterName "roomTemperature" ; cbrs:parameterType {kind} ] ] ;
+    cbrs:hasSEAModel [ a cbrs:SEAModel ; cbrs:effectiveArea home:LivingRoom ;
+        cbrs:minX 0.0 ; cbrs:maxX 6.0 ; cbrs:minY 0.0 ; cbrs:maxY 5.0 ] ;
+    cbrs:hasQoSModel [ a cbrs:QoSModel ; cbrs:updateRate 1.0 ; cbrs:accuracy 0.95 ]
+    {grounding} .
+"""
+
+
+READING = {"roomTemperature": {"@type": "home:RoomTemperature", "celsius": 21.5}}
+
+
+@pytest.fixture
+def server() -> Iterator[Server]:
+    endpoint = EndpointConfig(update_token=TOKEN, isolate=False)
+    running = Server(KnowledgeBase.open(":memory:"), ServeConfig(port=0, bridge_port=0, endpoint=endpoint))
+    running.start()
+    try:
+        yield running
+    finally:
+        running.stop()
+
+
+def url(server: Server) -> str:
+    return f"ws://127.0.0.1:{server.bridge_port}"
+
+
+def eventually(condition: Callable[[], bool], seconds: float = 5.0) -> bool:
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        if condition():
+            return True
+        time.sleep(0.02)
+    return condition()
+
+
+def sdk_thermometer(answer: Callable[[dict[str, Any]], dict[str, Any]] = lambda request: READING) -> Component:
+    component = Component(thermometer())
+    component.handler(answer)
+    return component
+
+
+def test_a_component_written_with_the_sdk_is_matched_planned_and_invoked(server: Server) -> None:
+    kb = server.kb
+    assert not kb.registry.is_registered(THERMOMETER)
+    calls: list[dict[str, Any]] = []
+
+    def read(request: dict[str, Any]) -> dict[str, Any]:
+        calls.append(request)
+        return READING
+
+    with sdk_thermometer(read).connect(url(server), TOKEN) as connected:
+        assert connected.registered == [THERMOMETER]
+        assert kb.liveness.states()[THERMOMETER].live
+        ranking = Matchmaker(kb, "sem-str").rank(REQ + "RoomTemperature", explain=0)
+        assert ranking.candidates[0].advertisement == THERMOMETER
+        plan = Composer(kb).compose(REQ + "RoomTemperature").plan
+        assert plan is not None and plan.components() == [THERMOMETER]
+        with open_world(semantic_map=SemanticMap.read(kb)) as world, BridgeClient(url(server), TOKEN) as bridge:
+            result = run_task(kb, REQ + "RoomTemperature", SimEnvironment(world, kb, bridge), composer=Composer(kb))
+        assert result.succeeded, result.report
+        assert calls == [{}]
+        step = result.report.steps[0] if result.report else None
+        assert step is not None and step.attempts[0].component == THERMOMETER
+
+
+def test_a_component_that_disconnects_is_unavailable_at_once_and_comes_back_when_it_registers_again(
+    server: Server,
+) -> None:
+    kb = server.kb
+    connected = sdk_thermometer().connect(url(server), TOKEN)
+    assert THERMOMETER in [ad.iri for ad in kb.advertisements()]
+    connected.stop()
+    assert eventually(lambda: not kb.liveness.states()[THERMOMETER].live)
+    state = kb.liveness.states()[THERMOMETER]
+    assert state.reason == "its session closed"
+    assert THERMOMETER not in [ad.iri for ad in kb.advertisements()]  # not matched, not planned
+    assert THERMOMETER in [ad.iri for ad in kb.advertisements(include_unavailable=True)]
+    assert kb.registry.is_registered(THERMOMETER)  # the description is kept
+    rows = kb.select("component_liveness", {"component": THERMOMETER})
+    assert [row["live"].value for row in rows] == ["false"]
+    with sdk_thermometer().connect(url(server), TOKEN):
+        assert kb.liveness.states()[THERMOMETER].live
+        assert THERMOMETER in [ad.iri for ad in kb.advertisements()]
+
+
+def test_a_component_that_stops_renewing_its_lease_lapses(server: Server) -> None:
+    kb = server.kb
+    with BridgeClient(url(server), TOKEN) as client:  # registers, provides, but sends no heartbeat
+        client.provide("/thermometer07/read", "cbrs_msgs/RoomTemperature", lambda request: READING)
+        client.call_sync("/cbrs/register", {"description": thermometer(), "ttl": 0.3})
+        assert kb.liveness.states()[THERMOMETER].live
+        assert eventually(lambda: not kb.liveness.states()[THERMOMETER].live)
+        assert kb.liveness.states()[THERMOMETER].reason == "its lease lapsed"
+
+
+def test_heartbeats_keep_a_short_lease_alive(server: Server) -> None:
+    kb = server.kb
+    with sdk_thermometer().connect(url(server), TOKEN, heartbeat=0.1, ttl=0.5):
+        time.sleep(1.5)  # three lease periods
+        assert kb.liveness.states()[THERMOMETER].live
+
+
+@pytest.mark.parametrize(
+    ("description", "token", "expected"),
+    [
+        (thermometer(), "not-the-token", "token"),
+        (thermometer(), None, "needs the update token"),
+        (thermometer(port=False), TOKEN, "cbrs:messageType"),
+        (thermometer(kind="home:RoomTemprature"), TOKEN, "RoomTemperature"),  # did-you-mean
+        (
+            thermometer().replace("ReadRoomTemperature_Thermometer07", "LocateMobileRobot_CeilingCamera01"),
+            TOKEN,
+            "already",
+        ),
+        ("this is not turtle", TOKEN, "registration"),
+    ],
+)
+def test_a_bad_registration_is_refused_with_a_reason_and_leaves_the_store_as_it_was(
+    server: Server, description: str, token: str | None, expected: str
+) -> None:
+    kb = server.kb
+    before = kb.store.count()
+    with BridgeClient(url(server), token) as client, pytest.raises(RemoteCallError, match=expected):
+        client.call_sync("/cbrs/register", {"description": description})
+    assert kb.store.count() == before
+
+
+def test_the_sdk_refuses_a_description_without_a_bridge_service() -> None:
+    with pytest.raises(InvalidDescriptionError, match="cbrs:messageType"):
+        Component(thermometer(port=False))
+
+
+def test_a_component_answering_the_wrong_type_or_never_fails_its_step_with_the_reason(server: Server) -> None:
+    answers: dict[str, Any] = {"value": {"roomTemperature": {"@type": "home:PersonPosition", "x": 1.0}}}
+
+    def read(request: dict[str, Any]) -> dict[str, Any]:
+        if answers["value"] is None:
+            time.sleep(2.0)  # never answers in time
+        return dict(answers["value"])
+
+    outputs = {"roomTemperature": HOME + "RoomTemperature"}
+    with sdk_thermometer(read).connect(url(server), TOKEN), BridgeClient(url(server), TOKEN) as bridge:
+
+        def invoke(timeout: float = 5.0) -> RemoteComponent:
+            component = RemoteComponent(THERMOMETER, bridge, "/thermometer07/read", outputs, check, timeout)
+            component.begin({})
+            for _ in range(5000):  # ticks of at most a few milliseconds each
+                status = component.update()
+                if status is not Status.RUNNING:
+                    component.outputs["status"] = status
+                    break
+            return component
+
+        wrong = invoke()
+        assert wrong.outputs["status"] is Status.FAILED and "wrong roomTemperature" in wrong.reason
+        answers["value"] = {"temperature": 20.0}
+        missing = invoke()
+        assert missing.outputs["status"] is Status.FAILED and "without roomTemperature" in missing.reason
+        answers["value"] = None
+        silent = invoke(timeout=0.3)
+        assert silent.outputs["status"] is Status.FAILED and "did not answer within 0.3 s" in silent.reason
+        answers["value"] = READING
+        right = invoke()
+        assert right.outputs["status"] is Status.SUCCEEDED
+        assert right.outputs["roomTemperature"]["@type"] == HOME + "RoomTemperature"
