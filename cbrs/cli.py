@@ -369,9 +369,19 @@ def settings_command() -> None:
 
 
 @cli.command()
+@click.option(
+    "--external",
+    is_flag=True,
+    help="Run the ceiling cameras as programs of their own that register over the bridge, kill one "
+    "mid-run with SIGKILL, and finish FetchMyPen on the other (docs/components.md).",
+)
+@click.option("--seed", type=int, default=0, show_default=True, help="World seed of the external demo's run.")
 @pass_app
-def demo(app: App) -> None:
+def demo(app: App, external: bool, seed: int) -> None:
     """A tour of the knowledge base: what is stored, an advertisement, a requirement, a query."""
+    if external:
+        _external_demo(seed)
+        return
     kb = app.kb
     click.echo(f"cbrs {__version__} -- store: {kb.store.location}\n")
     stats = kb.statistics()
@@ -394,6 +404,21 @@ def demo(app: App) -> None:
     click.echo(text)
     if not succeeded:
         raise SystemExit(1)  # a tour that reports a failed run must not tell a script all went well
+
+
+def _external_demo(seed: int) -> None:
+    from cbrs.cli_actions import run_text
+    from cbrs.external_demo import run_external_demo
+
+    run = run_external_demo(seed=seed, say=click.echo)
+    result = run.result
+    if result is None:
+        raise SystemExit(1)
+    click.echo(run_text(result, 0.0, 0.0).rsplit(";", 1)[0])
+    if run.detected_after is not None:
+        click.echo(f"the killed camera was noticed after {run.detected_after:.3f} s (lease {run.lease:g} s)")
+    if not result.succeeded:
+        raise SystemExit(1)
 
 
 def _describe(d: ServiceDescription) -> str:

@@ -1,0 +1,99 @@
+"""A ceiling camera's robot localiser as a program of its own: ``python -m cbrs.external_camera CAMERA``.
+
+It is what a lab's camera would run: it takes the camera's bundled LocateMobileRobot description,
+grounds it in a bridge service of its own, registers it with the server at ``--url`` (the update
+token from ``CBRS_UPDATE_TOKEN``), and answers each call by taking a frame from the camera (the
+simulation's ``/sim/capture``, standing in for the camera's hardware) and finding the robot's marker
+in it. ``cbrs demo --external`` starts two of them and kills one mid-run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from typing import Any
+
+import pyoxigraph as ox
+
+from cbrs.bridge_client import BridgeClient
+from cbrs.component import Component
+from cbrs.sim_sensors import CAPTURE_SERVICE, frame_from_json
+from kb import KnowledgeBase
+from kb.namespaces import PREFIXES, GraphName
+from kb.semantic_map import SemanticMap
+from kb.vocab import CBRS
+from sim.perception import MarkerModel, locate_robot
+from sim.values import to_json
+
+__all__ = ["description", "localiser", "main"]
+
+MARKER_LIFT = 0.002  # the marker's patches lie on the platform (as the simulation builds them)
+
+
+def description(kb: KnowledgeBase, camera: str) -> str:
+    """The camera's bundled LocateMobileRobot description, grounded in ``/<camera>/locate_robot``."""
+    component = ox.NamedNode(PREFIXES["svc"] + f"LocateMobileRobot_{camera}")
+    quads = kb.registry.description_quads(component.value)
+    if not quads:
+        raise SystemExit(f"the store has no LocateMobileRobot_{camera} to run")
+    port = ox.NamedNode(component.value + "_bridge_port")
+    graph = GraphName.SERVICES.node
+    grounding = [
+        ox.Quad(component, ox.NamedNode(CBRS.hasPort), port, graph),
+        ox.Quad(port, ox.NamedNode(PREFIXES["rdf"] + "type"), ox.NamedNode(CBRS.ServicePort), graph),
+        ox.Quad(port, ox.NamedNode(CBRS.portName), ox.Literal("locate"), graph),
+        ox.Quad(port, ox.NamedNode(CBRS.topic), ox.Literal(f"/{camera.lower()}/locate_robot"), graph),
+        ox.Quad(port, ox.NamedNode(CBRS.messageType), ox.Literal("cbrs_msgs/LocateMobileRobot"), graph),
+    ]
+    triples = [ox.Triple(q.subject, q.predicate, q.object) for q in (*quads, *grounding)]
+    written = ox.serialize(triples, format=ox.RdfFormat.TURTLE)
+    assert written is not None
+    return written.decode("utf-8")
+
+
+def localiser(camera: str, capture: BridgeClient, smap: SemanticMap) -> Any:
+    """The handler: a frame of ``camera`` from the simulation, the marker found in it."""
+    robot = next(iter(smap.robots.values()))
+    if robot.marker is None or robot.platform_height is None:
+        raise SystemExit(f"the semantic map gives {robot.name} no marker on a platform")
+    marker = MarkerModel(
+        robot.marker.front,
+        robot.marker.rear,
+        robot.marker.patch,
+        robot.marker.separation,
+        robot.platform_height + MARKER_LIFT,
+    )
+
+    def locate(request: dict[str, Any]) -> dict[str, Any]:
+        frame = frame_from_json(capture.call_sync(CAPTURE_SERVICE, {"camera": camera}))
+        return {"robotLocation": to_json(locate_robot(frame, marker))}
+
+    return locate
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m cbrs.external_camera", description=__doc__.splitlines()[0])
+    parser.add_argument("camera", help="the ceiling camera, e.g. CeilingCamera01")
+    parser.add_argument("--url", default="ws://127.0.0.1:9090", help="the server's bridge")
+    parser.add_argument("--heartbeat", type=float, default=1.0, help="seconds between heartbeats")
+    parser.add_argument("--lease", type=float, default=3.0, help="seconds the lease lasts")
+    args = parser.parse_args(argv)
+    token = os.environ.get("CBRS_UPDATE_TOKEN")
+    kb = KnowledgeBase.open(":memory:")  # the bundled descriptions and map: the camera's own knowledge
+    component = Component(description(kb, args.camera))
+    with BridgeClient(args.url, token) as capture:
+        component.handler(localiser(args.camera, capture, SemanticMap.read(kb)))
+        connected = component.connect(args.url, token, args.heartbeat, args.lease)
+        print(f"{args.camera}: registered {', '.join(connected.registered)}", flush=True)
+        try:
+            connected.client.wait_closed()
+        except KeyboardInterrupt:
+            pass
+        finally:
+            connected.stop()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,142 @@
+"""The ceiling cameras as programs of their own: FetchMyPen with one of them killed mid-run.
+
+``cbrs demo --external`` (and ``tests/test_external_demo.py``): a server on loopback ports, the
+simulated home offering its cameras' frames on the bridge, and one ``python -m cbrs.external_camera``
+process per ceiling camera, which registers that camera's LocateMobileRobot component over the bridge
+in place of the simulated one. When the run first asks the ``kill`` camera to locate the robot, that
+process is killed with SIGKILL; the server sees its session close, marks it unavailable, and the
+step fails over to the other camera.
+"""
+
+from __future__ import annotations
+
+import os
+import secrets
+import signal
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+from actions.composer import Composer
+from actions.events import Event
+from actions.runner import RunResult, run_task
+from cbrs.bridge_client import BridgeClient
+from cbrs.server import ServeConfig, Server
+from cbrs.sim_sensors import offer_cameras
+from cbrs.sparql_service import EndpointConfig
+from kb import KnowledgeBase
+from kb.namespaces import PREFIXES
+from kb.semantic_map import SemanticMap
+from sim.components import SimEnvironment
+from sim.world import open_world
+
+__all__ = ["CAMERAS", "ExternalRun", "run_external_demo"]
+
+CAMERAS = ("CeilingCamera01", "CeilingCamera02")
+REGISTRATION_WAIT = 60.0
+"""Seconds the camera programs have to start (import cbrs, seed their own knowledge) and register."""
+
+
+@dataclass
+class ExternalRun:
+    """What happened: the run, the camera processes' ids, which was killed and how soon it was noticed."""
+
+    pids: dict[str, int]
+    lease: float
+    result: RunResult | None = None
+    killed: str | None = None
+    detected_after: float | None = None
+    """Seconds from the SIGKILL to the component being unavailable in the store."""
+    log: list[str] = field(default_factory=list)
+
+
+def _component(camera: str) -> str:
+    return PREFIXES["svc"] + f"LocateMobileRobot_{camera}"
+
+
+def run_external_demo(
+    seed: int = 0, kill: str | None = "CeilingCamera01", lease: float = 1.0, say: Callable[[str], None] = print
+) -> ExternalRun:
+    """Run FetchMyPen on external cameras, killing ``kill``'s process at its first call (None: none)."""
+    kb = KnowledgeBase.open(":memory:")
+    for camera in CAMERAS:  # these run as programs of their own now
+        kb.registry.deregister(_component(camera))
+    token = secrets.token_urlsafe(16)
+    endpoint = EndpointConfig(update_token=token, isolate=False)
+    server = Server(kb, ServeConfig(port=0, bridge_port=0, endpoint=endpoint, component_lease=lease))
+    processes: dict[str, subprocess.Popen[bytes]] = {}
+    server.start()
+    try:
+        url = f"ws://127.0.0.1:{server.bridge_port}"
+        with open_world(seed=seed, semantic_map=SemanticMap.read(kb)) as world:
+            offer_cameras(server.bridge, world)
+            environment = {**os.environ, "CBRS_UPDATE_TOKEN": token}
+            for camera in CAMERAS:
+                command = [sys.executable, "-m", "cbrs.external_camera", camera, "--url", url]
+                command += ["--heartbeat", str(lease / 3), "--lease", str(lease)]
+                processes[camera] = subprocess.Popen(command, env=environment, stdout=subprocess.DEVNULL)
+            started = ", ".join(f"{camera} (pid {process.pid})" for camera, process in processes.items())
+            say(f"started {started}; waiting for them to register")
+            _wait_registered(kb, processes)
+            say("both cameras registered over the bridge; running FetchMyPen")
+            run = ExternalRun({c: p.pid for c, p in processes.items()}, lease)
+            watcher = _killer(kb, processes, kill, run, say) if kill else None
+            with BridgeClient(url, token) as bridge:
+                run.result = run_task(
+                    kb, "FetchMyPen", SimEnvironment(world, kb, bridge), composer=Composer(kb), on_event=watcher
+                )
+            return run
+    finally:
+        for process in processes.values():  # stopped by their PID, whatever happened
+            if process.poll() is None:
+                process.kill()
+            process.wait(timeout=10)
+        server.stop()
+
+
+def _wait_registered(kb: KnowledgeBase, processes: dict[str, subprocess.Popen[bytes]]) -> None:
+    deadline = time.monotonic() + REGISTRATION_WAIT
+    while time.monotonic() < deadline:
+        states = kb.liveness.states()
+        if all(_component(c) in states and states[_component(c)].live for c in processes):
+            return
+        dead = [c for c, p in processes.items() if p.poll() is not None]
+        if dead:
+            raise RuntimeError(f"the camera program of {', '.join(dead)} exited before it registered")
+        time.sleep(0.05)
+    raise TimeoutError(f"the camera programs did not register within {REGISTRATION_WAIT:g} s")
+
+
+def _killer(
+    kb: KnowledgeBase,
+    processes: dict[str, subprocess.Popen[bytes]],
+    camera: str,
+    run: ExternalRun,
+    say: Callable[[str], None],
+) -> Callable[[Event], None]:
+    """An event handler that kills ``camera``'s process when its component is first started."""
+    component = _component(camera)
+
+    def on_event(event: Event) -> None:
+        if run.killed or event.message.get("event") != "step_started" or event.message.get("component") != component:
+            return
+        run.killed = camera
+        killed_at = time.monotonic()
+        os.kill(processes[camera].pid, signal.SIGKILL)
+        say(f"step {event.message.get('step')}: killed {camera} (pid {processes[camera].pid}) with SIGKILL")
+
+        def watch() -> None:
+            while time.monotonic() - killed_at < 10 * run.lease:
+                state = kb.liveness.states().get(component)
+                if state is not None and not state.live:
+                    run.detected_after = time.monotonic() - killed_at
+                    say(f"{camera} unavailable after {run.detected_after * 1000:.0f} ms ({state.reason})")
+                    return
+                time.sleep(0.005)
+
+        threading.Thread(target=watch, name="cbrs-demo-watch", daemon=True).start()
+
+    return on_event
