@@ -175,8 +175,9 @@ SETTINGS: tuple[Setting, ...] = (
     ),
     Setting(
         "streams_per_client",
-        lambda: 2,
-        "Event and camera streams one client (an IP address) may have open at once.",
+        lambda: 4,
+        "Event and camera streams one client (an IP address) may have open at once: the tasks page holds "
+        "two, and one more for a moment while it restarts its camera stream.",
         "CBRS_STREAMS_PER_CLIENT",
         _positive(int),
     ),

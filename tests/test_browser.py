@@ -9,6 +9,7 @@ refreshes the README's pictures). Skipped, saying why, where Chromium or Playwri
 from __future__ import annotations
 
 import os
+import re
 import shutil
 from collections.abc import Iterator
 from pathlib import Path
@@ -138,9 +139,13 @@ def test_fetch_my_pen_started_from_the_page_succeeds_while_the_camera_updates(pa
     frame_before = int(page.locator("#frame").inner_text())
     page.locator("#task").select_option(label="FetchMyPen")
     page.locator("#start-button").click()
-    status = "document.querySelector('#run-status').textContent.trim()"
-    page.wait_for_function(f"{status} === 'running'", timeout=30_000)
-    page.wait_for_function(f"['succeeded', 'failed', 'error', 'no-plan'].includes({status})", timeout=120_000)
+    # expect() polls without evaluating text in the page, which its Content-Security-Policy forbids
+    playwright_api.expect(page.locator("#run-status")).to_have_text(
+        re.compile("running|succeeded|failed|error|no-plan"), timeout=30_000
+    )
+    playwright_api.expect(page.locator("#run-status")).to_have_text(
+        re.compile("succeeded|failed|error|no-plan"), timeout=120_000
+    )
     assert page.locator("#run-status").inner_text().strip() == "succeeded"
     assert int(page.locator("#frame").inner_text()) > frame_before + 5  # a frame after every step
     assert page.locator("#steps tr").count() >= 15
@@ -156,6 +161,9 @@ def test_plans_page_shows_the_plan_and_draws_the_graph(page: Any, shots: Path) -
     assert page.locator("tr[id^=step-]").count() == 15
     drawing = page.locator("img.drawing")
     drawing.scroll_into_view_if_needed()
-    page.wait_for_function("document.querySelector('img.drawing').complete", timeout=30_000)
+    for _ in range(300):  # bounded: 30 s for the SVG to arrive and decode
+        if drawing.evaluate("image => image.complete"):
+            break
+        page.wait_for_timeout(100)
     assert drawing.evaluate("image => image.naturalWidth") > 0  # the SVG arrived and decoded
     snap(page, shots, "plans")

@@ -2,7 +2,7 @@
 
 Live updates travel as server-sent events (``/tasks/events``) and the ceiling camera as an MJPEG
 stream (``/camera.mjpg``). Each open stream holds one of waitress's threads, so streams are counted
-(:class:`cbrs.web.context.StreamSlots`: a few in all, two per client address; one more is refused
+(:class:`cbrs.web.context.StreamSlots`: a few in all, four per client address; one more is refused
 with 503) and end by themselves: after ``CBRS_STREAM_SECONDS`` at most, or ``CBRS_STREAM_IDLE_SECONDS``
 without news, or as soon as a write finds the client gone (a heartbeat or a repeated frame every few
 seconds makes sure one is tried). The browser's EventSource reconnects by itself; the page restarts
