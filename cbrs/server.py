@@ -26,6 +26,7 @@ from cbrs.settings import setting
 from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.tasks import TaskRunner
 from cbrs.web import create_app
+from cbrs.web.components import blueprint as components_blueprint
 from cbrs.web.context import StreamSlots
 from kb import KnowledgeBase
 
@@ -74,6 +75,8 @@ class Server:
         self.tasks.transport = self._own_bridge
         self._transport: BridgeClient | None = None
         self.app = create_app(self.sparql, self.config.cors_origins, self.tasks, self.matchmakers, self.own_origins)
+        self.app.extensions["cbrs.live"] = self.live
+        self.app.register_blueprint(components_blueprint)
         self.app.extensions["cbrs.streams"] = StreamSlots(self.config.stream_limit, self.config.streams_per_client)
         self._http: Any = None
         self._http_map: dict[int, Any] = {}

@@ -9,6 +9,8 @@ import time
 from collections.abc import Callable, Iterator
 from typing import Any
 
+import httpx
+import pyoxigraph as ox
 import pytest
 
 from actions.components import Status
@@ -213,3 +215,38 @@ def test_a_component_answering_the_wrong_type_or_never_fails_its_step_with_the_r
         right = invoke()
         assert right.outputs["status"] is Status.SUCCEEDED
         assert right.outputs["roomTemperature"]["@type"] == HOME + "RoomTemperature"
+
+
+def test_a_component_registers_renews_and_ends_its_lease_over_http(server: Server) -> None:
+    kb = server.kb
+    base = f"http://127.0.0.1:{server.http_port}"
+    turtle = {"Content-Type": "text/turtle"}
+    with httpx.Client(base_url=base, timeout=10) as http:
+        assert http.post("/components", content=thermometer(), headers=turtle).status_code == 403
+        bearer = {**turtle, "Authorization": f"Bearer {TOKEN}"}
+        wrong_type = http.post("/components", content=thermometer(), headers={**bearer, "Content-Type": "text/plain"})
+        assert wrong_type.status_code == 415
+        created = http.post("/components?ttl=30", content=thermometer(), headers=bearer)
+        assert created.status_code == 201, created.text
+        lease = created.json()["lease"]
+        assert created.json()["components"] == [THERMOMETER]
+        listed = {row["component"]: row for row in http.get("/components").json()}
+        assert listed[THERMOMETER]["available"] is True
+        renewed = http.post(f"/components/leases/{lease}", headers=bearer)
+        assert renewed.json() == {"components": [THERMOMETER]}
+        assert http.delete(f"/components/leases/{lease}", headers=bearer).status_code == 204
+        assert not kb.liveness.states()[THERMOMETER].live
+        assert http.post(f"/components/leases/{lease}", headers=bearer).status_code == 404
+        listed = {row["component"]: row for row in http.get("/components").json()}
+        assert listed[THERMOMETER]["available"] is False and listed[THERMOMETER]["reason"] == "its session closed"
+
+
+def test_a_description_in_json_ld_registers_like_turtle(server: Server) -> None:
+    triples = list(ox.parse(thermometer().encode("utf-8"), format=ox.RdfFormat.TURTLE))
+    json_ld = ox.serialize(triples, format=ox.RdfFormat.JSON_LD)
+    assert json_ld is not None
+    headers = {"Content-Type": "application/ld+json", "Authorization": f"Bearer {TOKEN}"}
+    created = httpx.post(f"http://127.0.0.1:{server.http_port}/components", content=json_ld, headers=headers)
+    assert created.status_code == 201, created.text
+    assert server.kb.liveness.states()[THERMOMETER].live
+    assert server.kb.description(THERMOMETER).outputs[0].type == HOME + "RoomTemperature"
