@@ -5,8 +5,12 @@ A server runs in this process on loopback ports; components connect to its bridg
 
 from __future__ import annotations
 
+import json
+import shutil
+import subprocess
 import time
 from collections.abc import Callable, Iterator
+from pathlib import Path
 from typing import Any
 
 import httpx
@@ -250,3 +254,33 @@ def test_a_description_in_json_ld_registers_like_turtle(server: Server) -> None:
     assert created.status_code == 201, created.text
     assert server.kb.liveness.states()[THERMOMETER].live
     assert server.kb.description(THERMOMETER).outputs[0].type == HOME + "RoomTemperature"
+
+
+NODE = shutil.which("node")
+JS = Path(__file__).parent / "js"
+
+
+@pytest.mark.skipif(NODE is None, reason="node is not installed (roslibjs runs on node >= 20)")
+@pytest.mark.skipif(
+    not (JS / "node_modules" / "roslib").is_dir(), reason="roslibjs is not installed: run npm ci --prefix tests/js"
+)
+def test_a_component_written_with_roslibjs_registers_and_is_invoked(server: Server, tmp_path: Path) -> None:
+    kb = server.kb
+    description = tmp_path / "thermometer.ttl"
+    description.write_text(thermometer(), encoding="utf-8")
+    assert NODE is not None
+    command = [NODE, str(JS / "thermometer.mjs"), str(server.bridge_port), TOKEN, str(description), "60"]
+    child = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert child.stdout is not None
+        first = json.loads(child.stdout.readline())  # blocks until registered; the script gives up by itself
+        assert first == {"registered": [THERMOMETER]}
+        assert kb.liveness.states()[THERMOMETER].live
+        with open_world(semantic_map=SemanticMap.read(kb)) as world, BridgeClient(url(server), TOKEN) as bridge:
+            result = run_task(kb, REQ + "RoomTemperature", SimEnvironment(world, kb, bridge), composer=Composer(kb))
+        assert result.succeeded, result.report
+        assert json.loads(child.stdout.readline()) == {"answered": {}}
+    finally:
+        child.kill()  # stopped by its PID
+        child.wait(timeout=10)
+    assert eventually(lambda: not kb.liveness.states()[THERMOMETER].live)
