@@ -51,6 +51,7 @@ class BridgeClient:
         self._ids = itertools.count(1)
         self._waiting: dict[str, Future[dict[str, Any]]] = {}
         self._handlers: dict[str, ServiceHandler] = {}
+        self._listeners: dict[str, list[Callable[[dict[str, Any]], None]]] = {}
         self._pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="cbrs-provide")
         self._closed = threading.Event()
         self.statuses: list[dict[str, Any]] = []
@@ -117,6 +118,11 @@ class BridgeClient:
     def publish(self, topic: str, msg: Mapping[str, Any]) -> None:
         self.send({"op": "publish", "topic": topic, "msg": dict(msg)})
 
+    def subscribe(self, topic: str, callback: Callable[[dict[str, Any]], None]) -> None:
+        """Call ``callback(msg)`` (on the reader thread) for each message on ``topic``."""
+        self._listeners.setdefault(topic, []).append(callback)
+        self.send({"op": "subscribe", "topic": topic})
+
     # -- the wire -----------------------------------------------------------------------------------
 
     def send(self, message: Mapping[str, Any]) -> None:
@@ -158,6 +164,11 @@ class BridgeClient:
             self._pool.submit(self._answer, message)
         elif op == "status":
             self.statuses.append(message)
+        elif op == "publish":
+            msg = message.get("msg")
+            for listener in self._listeners.get(str(message.get("topic")), []):
+                if isinstance(msg, dict):
+                    listener(msg)
 
     def _answer(self, message: dict[str, Any]) -> None:
         service = str(message.get("service", ""))

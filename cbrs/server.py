@@ -22,6 +22,7 @@ from cbrs.bridge_services import KnowledgeServices, attach
 from cbrs.live_components import LiveComponents
 from cbrs.matchmakers import Matchmakers
 from cbrs.rosbridge import Bridge
+from cbrs.rosbridge.rosout import RosoutHandler
 from cbrs.settings import setting
 from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.tasks import TaskRunner
@@ -31,6 +32,8 @@ from cbrs.web.context import StreamSlots
 from kb import KnowledgeBase
 
 log = logging.getLogger("cbrs.server")
+LOGGERS = ("cbrs", "kb", "actions", "reasoner", "sim")
+"""The loggers whose records go out on the bridge's /rosout topic."""
 
 
 @dataclass(frozen=True)
@@ -72,6 +75,7 @@ class Server:
         for name, (kind, handler) in self.live.handlers().items():
             self.bridge.add_service(name, kind, handler)
         self.bridge.on_disconnect(self.live.disconnected)
+        self._rosout = RosoutHandler(self.bridge)
         self.tasks.transport = self._own_bridge
         self._transport: BridgeClient | None = None
         self.app = create_app(self.sparql, self.config.cors_origins, self.tasks, self.matchmakers, self.own_origins)
@@ -110,6 +114,8 @@ class Server:
             self._stop_http(5.0)
             raise
         self.live.start()
+        for name in LOGGERS:
+            logging.getLogger(name).addHandler(self._rosout)
 
     def _own_bridge(self) -> BridgeClient | None:
         """A connection to this server's own bridge, through which task runs call live components."""
@@ -140,6 +146,8 @@ class Server:
         """Close both listeners and their connections; a task run still going gets ``timeout`` to end."""
         self.app.extensions["cbrs.closing"].set()  # event and camera streams end within half a second
         self.live.stop()
+        for name in LOGGERS:
+            logging.getLogger(name).removeHandler(self._rosout)
         if self._transport is not None:
             self._transport.close()
             self._transport = None

@@ -284,3 +284,23 @@ def test_a_component_written_with_roslibjs_registers_and_is_invoked(server: Serv
         child.kill()  # stopped by its PID
         child.wait(timeout=10)
     assert eventually(lambda: not kb.liveness.states()[THERMOMETER].live)
+
+
+def test_rosout_carries_the_servers_log_and_rosapi_describes_the_bridge(
+    server: Server, caplog: pytest.LogCaptureFixture
+) -> None:
+    caplog.set_level("INFO", logger="cbrs")  # what cbrs serve's log_level setting does
+    heard: list[dict[str, Any]] = []
+    with BridgeClient(url(server), TOKEN) as listener:
+        listener.subscribe("/rosout", heard.append)
+        time.sleep(0.2)  # the subscription is in place before the registration logs
+        with sdk_thermometer().connect(url(server), TOKEN):
+            assert eventually(lambda: any("registered" in message["msg"] for message in heard))
+        record = next(message for message in heard if "registered" in message["msg"])
+        assert record["level"] == 2 and record["name"] == "cbrs.live_components"
+        details = listener.call_sync("/rosapi/node_details", {"node": "/cbrs_rosbridge"})
+        assert "/rosout" in details["publishing"] and "/cbrs/register" in details["services"]
+        assert listener.call_sync("/rosapi/service_node", {"service": "/cbrs/register"}) == {"node": "/cbrs_rosbridge"}
+        assert listener.call_sync("/rosapi/message_details", {"type": "rosgraph_msgs/Log"}) == {"typedefs": []}
+        raw = listener.call_sync("/rosapi/topics_and_raw_types", {})
+        assert "/rosout" in raw["topics"] and len(raw["typedefs_full_text"]) == len(raw["topics"])

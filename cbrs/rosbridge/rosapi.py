@@ -105,7 +105,46 @@ def services(graph: Graph, params: ParamStore) -> dict[str, tuple[str, Handler]]
         # ROS 1 clients (roslibpy) read secs/nsecs, ROS 2 ones sec/nanosec
         return {"time": {"secs": secs, "nsecs": nsecs, "sec": secs, "nanosec": nsecs}}
 
+    def node_details(args: dict[str, Any]) -> dict[str, Any]:
+        node = _global(_text(args, "node"))
+        if node != NODES[0]:
+            return {"subscribing": [], "publishing": [], "services": []}
+        with graph.lock:
+            served = sorted(t.name for t in graph.topics.values() if t.server)
+        return {"subscribing": [], "publishing": served, "services": [name for name, _ in graph.service_list()]}
+
+    def service_node(args: dict[str, Any]) -> dict[str, Any]:
+        name = _global(_text(args, "service"))
+        return {"node": NODES[0] if name in dict(graph.service_list()) else ""}
+
+    def service_providers(args: dict[str, Any]) -> dict[str, Any]:
+        wanted = _text(args, "service")
+        return {"providers": [NODES[0]] if any(kind == wanted for _, kind in graph.service_list()) else []}
+
+    def topics_and_raw_types(_: dict[str, Any]) -> dict[str, Any]:
+        listed = graph.topic_list()
+        return {
+            "topics": [name for name, _ in listed],
+            "types": [kind for _, kind in listed],
+            "typedefs_full_text": ["" for _ in listed],  # the bridge's messages are JSON with no .msg file
+        }
+
+    def no_typedefs(args: dict[str, Any]) -> dict[str, Any]:
+        _text(args, "type")
+        return {"typedefs": []}  # JSON messages: no ROS message definitions to describe
+
+    def action_servers(_: dict[str, Any]) -> dict[str, Any]:
+        return {"action_servers": []}
+
     return {
+        "/rosapi/node_details": ("rosapi/NodeDetails", node_details),
+        "/rosapi/service_node": ("rosapi/ServiceNode", service_node),
+        "/rosapi/service_providers": ("rosapi/ServiceProviders", service_providers),
+        "/rosapi/topics_and_raw_types": ("rosapi/TopicsAndRawTypes", topics_and_raw_types),
+        "/rosapi/message_details": ("rosapi/MessageDetails", no_typedefs),
+        "/rosapi/service_request_details": ("rosapi/ServiceRequestDetails", no_typedefs),
+        "/rosapi/service_response_details": ("rosapi/ServiceResponseDetails", no_typedefs),
+        "/rosapi/action_servers": ("rosapi/GetActionServers", action_servers),
         "/rosapi/topics": ("rosapi/Topics", topics),
         "/rosapi/topics_for_type": ("rosapi/TopicsForType", topics_for_type),
         "/rosapi/topic_type": ("rosapi/TopicType", topic_type),
