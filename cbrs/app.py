@@ -26,6 +26,7 @@ class App:
                 remote_timeout=setting("remote_timeout").resolve(),
                 check_timeout=setting("query_check_timeout").resolve(),
                 remote_access=setting("federation_allow").resolve(),
+                remote_token=setting("update_token").resolve(),
             )
         return self._kb
 

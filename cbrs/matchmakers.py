@@ -6,6 +6,8 @@ from __future__ import annotations
 import threading
 
 from cbrs.sparql_service import SparqlService
+from kb.namespaces import GraphName
+from kb.remote_store import RemoteStore
 from reasoner.matchmaker import Matchmaker
 from reasoner.taxonomy import TaxonomyIndex
 
@@ -15,14 +17,22 @@ class Matchmakers:
 
     def __init__(self, sparql: SparqlService) -> None:
         self.sparql = sparql
-        self._generation = -1
+        self._generation: object = -1
         self._index: TaxonomyIndex | None = None
         self._built: dict[str, Matchmaker] = {}
         self._guard = threading.Lock()
 
     def get(self, method: str) -> Matchmaker:
-        """The matchmaker for ``method``; call with the knowledge-base lock held."""
-        kb, generation = self.sparql.kb, self.sparql.generation
+        """The matchmaker for ``method``; call with the knowledge-base lock held.
+
+        On a remote store other processes write too (another ``cbrs serve`` on the same server): the
+        sizes of the ontology and services graphs are then part of the store's version, so a
+        description registered through another process is matched here at the next ranking.
+        """
+        kb = self.sparql.kb
+        generation: object = self.sparql.generation
+        if isinstance(kb.store, RemoteStore):
+            generation = (generation, kb.store.count(GraphName.ONTOLOGY), kb.store.count(GraphName.SERVICES))
         with self._guard:
             if generation != self._generation or self._index is None:
                 self._generation, self._index, self._built = generation, TaxonomyIndex.from_kb(kb), {}

@@ -30,6 +30,7 @@ from cbrs.web import create_app
 from cbrs.web.components import blueprint as components_blueprint
 from cbrs.web.context import StreamSlots
 from kb import KnowledgeBase
+from kb.store import EmbeddedStore, mark_served
 
 log = logging.getLogger("cbrs.server")
 LOGGERS = ("cbrs", "kb", "actions", "reasoner", "sim")
@@ -114,6 +115,9 @@ class Server:
             self._stop_http(5.0)
             raise
         self.live.start()
+        if isinstance(self.kb.store, EmbeddedStore) and not self.kb.store.in_memory:
+            host = "127.0.0.1" if self.config.host in ("0.0.0.0", "::") else self.config.host
+            mark_served(self.kb.store.location, f"http://{host}:{self.http_port}")
         for name in LOGGERS:
             logging.getLogger(name).addHandler(self._rosout)
 
@@ -146,6 +150,8 @@ class Server:
         """Close both listeners and their connections; a task run still going gets ``timeout`` to end."""
         self.app.extensions["cbrs.closing"].set()  # event and camera streams end within half a second
         self.live.stop()
+        if isinstance(self.kb.store, EmbeddedStore) and not self.kb.store.in_memory:
+            mark_served(self.kb.store.location, None)
         for name in LOGGERS:
             logging.getLogger(name).removeHandler(self._rosout)
         if self._transport is not None:

@@ -40,17 +40,20 @@ class KnowledgeBase:
         remote_timeout: float | None = None,
         check_timeout: float | None = None,
         remote_access: tuple[str, ...] = (),
+        remote_token: str | None = None,
     ) -> KnowledgeBase:
         """Open the store at ``location`` (a directory, ``:memory:`` or an endpoint URL), seeding it on first use.
 
         ``check_timeout`` bounds how long an embedded store's query guard checks a long text (see
         :mod:`kb.query_guard`); ``remote_access`` lists the IRI prefixes a SERVICE or LOAD may reach
-        (:mod:`kb.remote_access`; none by default).
+        (:mod:`kb.remote_access`; none by default). ``remote_token`` goes with every request to a remote
+        store, as a bearer token: a ``cbrs serve``'s update token.
         """
-        if remote_timeout is not None and is_remote(str(location)):
-            from kb.remote_store import RemoteStore  # only a remote store needs the HTTP client
+        if is_remote(str(location)) and (remote_timeout is not None or remote_token is not None):
+            from kb.remote_store import DEFAULT_TIMEOUT, RemoteStore  # only a remote store needs the HTTP client
 
-            store: Store = RemoteStore.open(location, remote_timeout)
+            timeout = remote_timeout if remote_timeout is not None else DEFAULT_TIMEOUT
+            store: Store = RemoteStore.open(location, timeout, remote_token)
         else:
             store = Store.open(location)
         store.remote_access = tuple(remote_access)

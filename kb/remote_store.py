@@ -97,22 +97,28 @@ def _checked_url(location: str, text: str) -> str:
 class RemoteStore(Store):
     """A store on a SPARQL 1.1 endpoint with update. Thread-safe: one pooled HTTP client."""
 
-    def __init__(self, location: str, endpoints: Endpoints, timeout: float = DEFAULT_TIMEOUT) -> None:
+    def __init__(
+        self, location: str, endpoints: Endpoints, timeout: float = DEFAULT_TIMEOUT, token: str | None = None
+    ) -> None:
         self.location = location
         self.endpoints = endpoints
         self.timeout = timeout
+        headers = {"User-Agent": "cbrs-kb"}
+        if token:  # a cbrs server takes updates with its bearer token; Oxigraph's server ignores it
+            headers["Authorization"] = f"Bearer {token}"
         self._client: httpx.Client | None = httpx.Client(
             timeout=httpx.Timeout(timeout, connect=min(timeout, CONNECT_TIMEOUT)),
-            headers={"User-Agent": "cbrs-kb"},
+            headers=headers,
             verify=_tls_context(),
         )
         self._union_verified = False
 
     @classmethod
-    def open(cls, location: str | Path, timeout: float = DEFAULT_TIMEOUT) -> RemoteStore:
-        """Connect to the endpoint(s) ``location`` names and check its default graph is the union."""
+    def open(cls, location: str | Path, timeout: float = DEFAULT_TIMEOUT, token: str | None = None) -> RemoteStore:
+        """Connect to the endpoint(s) ``location`` names and check its default graph is the union;
+        ``token`` is sent as a bearer token (a ``cbrs serve``'s update token)."""
         text = str(location).strip()
-        store = cls(text, Endpoints.discover(text), timeout)
+        store = cls(text, Endpoints.discover(text), timeout, token)
         try:
             store._check_union()
         except BaseException:

@@ -238,11 +238,13 @@ class EmbeddedStore(Store):
             return cls(ox.Store(str(path)), str(path))
         except OSError as error:
             if "lock" in str(error).lower():
-                raise StoreError(
-                    text,
-                    "is in use by another process (RocksDB lock held); stop it or pick "
-                    f"another store with --store ({error})",
-                ) from error
+                served = _served_at(path)
+                hint = (
+                    f"a cbrs server serves it: use --store {served} (the token from CBRS_UPDATE_TOKEN)"
+                    if served
+                    else "stop it or pick another store with --store"
+                )
+                raise StoreError(text, f"is in use by another process (RocksDB lock held); {hint} ({error})") from error
             raise StoreError(text, str(error)) from error
 
     @property
@@ -369,3 +371,24 @@ def data_block(quads: Iterable[ox.Quad], blank_nodes: bool = False) -> str:
         else:
             parts.append("".join(lines))
     return "".join(parts)
+
+
+SERVED_AT = "cbrs-served-at.txt"
+"""A file a running ``cbrs serve`` keeps in its on-disk store, holding its base URL: what another
+command that finds the store locked tells its user to use instead."""
+
+
+def mark_served(location: str, url: str | None) -> None:
+    """Note (or, with None, forget) the URL a server serves the on-disk store at ``location`` from."""
+    marker = Path(location) / SERVED_AT
+    if url is None:
+        marker.unlink(missing_ok=True)
+    else:
+        marker.write_text(url + "\n", encoding="utf-8")
+
+
+def _served_at(path: Path) -> str | None:
+    try:
+        return (path / SERVED_AT).read_text(encoding="utf-8").strip() or None
+    except OSError:
+        return None

@@ -167,6 +167,9 @@ class Matchmaker:
             candidates: Sequence[Candidate] = tuple(scored)
         else:
             candidates = self._rank_batch(requirement, ads, len(ads) if explain is None else explain)
+        gone = self.kb.liveness.unavailable()  # read at every ranking: a component may leave at any time
+        if gone:
+            candidates = tuple(c for c in candidates if c.advertisement not in gone)
         status = MatchStatus.MATCHED if candidates and candidates[0].acceptable else MatchStatus.NO_ACCEPTABLE_MATCH
         return MatchResult(requirement.iri, self.method.name, status, candidates)
 

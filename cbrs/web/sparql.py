@@ -39,6 +39,7 @@ class UnsupportedMediaType(EndpointError):
 
 
 @blueprint.route("/sparql", methods=["GET", "POST"])
+@blueprint.route("/query", methods=["GET", "POST"])  # Oxigraph's layout: `cbrs --store http://host:port` finds it
 def sparql() -> Response:
     query, update = _operation()
     if update is not None:
