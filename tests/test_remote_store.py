@@ -141,6 +141,8 @@ def test_every_named_query_with_parameters_gives_the_embedded_answer(remote_loca
         "class": ["home:Cup", "home:Drinkware"],
         "robot": ["svc:CytonDualArm01"],
         "graph": ["graph:world", "graph:map"],
+        "component": [LOCATE],
+        "namespace": ["https://w3id.org/cbrs/world#"],
     }
     checked = 0
     for name in embedded.queries.names():
