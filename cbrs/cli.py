@@ -5,6 +5,7 @@ Library errors become one-line messages and a non-zero exit here, at the edge, a
 
 from __future__ import annotations
 
+import importlib
 import json
 import os
 import re
@@ -18,9 +19,6 @@ import pyoxigraph as ox
 
 from cbrs import __version__
 from cbrs.app import App, parse_iri, pass_app
-from cbrs.cli_actions import plan, run, scenario_runs
-from cbrs.cli_reasoner import eval_group, match, ranking_text
-from cbrs.cli_serve import serve
 from cbrs.output import RESULT_FORMATS, render_result, table, term_text
 from cbrs.settings import SETTINGS, setting
 from kb import Advertisement, KnowledgeBaseError, Requirement, ServiceDescription
@@ -28,9 +26,59 @@ from kb.catalog import Catalogue, merge
 from kb.loader import LoadReport, ParsedFile
 from kb.namespaces import OWL, PREFIXES, GraphName, expand, shorten
 
+# Commands whose modules import numpy, networkx, the composer or the web server (most of a second at
+# start-up): each is imported when it runs or shows its own help. ``cbrs --help`` lists them from the
+# first paragraph of their help, kept here (tests/test_scale.py checks it against the commands).
+_LAZY_COMMANDS: dict[str, tuple[str, str, str]] = {
+    "eval": ("cbrs.cli_reasoner", "eval_group", "Evaluate the matching methods on a test collection."),
+    "match": (
+        "cbrs.cli_reasoner",
+        "match",
+        "Rank the advertisements against REQUIREMENT (an IRI or prefix:name, e.g. req:RobotSelfPosition).",
+    ),
+    "plan": (
+        "cbrs.cli_actions",
+        "plan",
+        "Compose a plan for TASK: a requirement or action (req:FetchMyPen, act:RobotArmServeACup, or a bare name).",
+    ),
+    "run": (
+        "cbrs.cli_actions",
+        "run",
+        "Plan TASK, then execute it in the simulated home, step by step, failing over where needed.",
+    ),
+    "serve": (
+        "cbrs.cli_serve",
+        "serve",
+        "Serve the knowledge base: SPARQL 1.1 at /sparql on the HTTP port, rosbridge v2 on the bridge port.",
+    ),
+}
+
 
 class _Group(click.Group):
-    """Turns library errors into click's one-line error and exit status 1."""
+    """Turns library errors into click's one-line error and exit status 1; imports the commands of
+    ``_LAZY_COMMANDS`` only when they are used."""
+
+    def list_commands(self, ctx: click.Context) -> list[str]:
+        return sorted({*self.commands, *_LAZY_COMMANDS})
+
+    def get_command(self, ctx: click.Context, cmd_name: str) -> click.Command | None:
+        if cmd_name not in self.commands and cmd_name in _LAZY_COMMANDS:
+            module, attribute, _ = _LAZY_COMMANDS[cmd_name]
+            self.add_command(getattr(importlib.import_module(module), attribute), cmd_name)
+        return self.commands.get(cmd_name)
+
+    def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
+        """As click lists the commands, with a stand-in carrying the help of each command not imported."""
+        commands = [
+            self.commands.get(name) or click.Command(name, help=_LAZY_COMMANDS[name][2])
+            for name in self.list_commands(ctx)
+        ]
+        shown = [(command.name or "", command) for command in commands if not command.hidden]
+        if not shown:
+            return
+        limit = formatter.width - 6 - max(len(name) for name, _ in shown)
+        with formatter.section("Commands"):
+            formatter.write_dl([(name, command.get_short_help_str(limit)) for name, command in shown])
 
     def invoke(self, ctx: click.Context) -> Any:
         try:
@@ -397,6 +445,9 @@ def demo(app: App, external: bool, seed: int) -> None:
     click.echo(_describe(kb.description(expand("req:RobotSelfPosition"))))
     click.echo("\nDynamic perception components (cbrs query --name advertisements --bind kind=...):")
     click.echo(render_result(kb.run("advertisements", {"kind": "cbrs:DynamicPerceptionComponent"}), "table"))
+    from cbrs.cli_actions import scenario_runs
+    from cbrs.cli_reasoner import ranking_text
+
     click.echo("\nPaper Table 3: the advertisements ranked for the requirement (cbrs match ... --explain):")
     click.echo(ranking_text(kb, expand("req:RobotSelfPosition"), top=4, explain=1))
     click.echo("\nPaper section 6.2: the two scenarios, planned and run in the simulated home (cbrs run TASK):")
@@ -485,10 +536,3 @@ def main() -> None:
             traceback.print_exc()
         click.echo(f"internal error: {type(error).__name__}: {error} (set CBRS_DEBUG=1 for the traceback)", err=True)
         sys.exit(2)
-
-
-cli.add_command(match)
-cli.add_command(plan)
-cli.add_command(run)
-cli.add_command(serve)
-cli.add_command(eval_group)

@@ -16,12 +16,11 @@ The SEA and QoS of the requirement act as filters. "No acceptable match" is a st
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 from enum import Enum
-from typing import Any, overload
-
-import numpy as np
+from typing import TYPE_CHECKING, Any, overload
 
 from kb import (
     Advertisement,
@@ -33,7 +32,6 @@ from kb import (
     QoSValue,
     Requirement,
 )
-from reasoner.batch import BatchScorer, BatchScores, CompiledPool, ranking_order
 from reasoner.config import MatchConfig
 from reasoner.degrees import Degree, degree_of_match
 from reasoner.methods import REFINED, Method, make_method
@@ -42,8 +40,12 @@ from reasoner.similarity import SemStr, Similarity
 from reasoner.spans import PairMatch, SpanMatch, conceptual_span_similarity, span
 from reasoner.statements import StatementMatch, best_statement_matches
 from reasoner.taxonomy import TaxonomyIndex
-from reasoner.text import TextIndex, description_text
-from reasoner.vectors import FloatArray, VectorSpace
+from reasoner.text import description_text
+
+if TYPE_CHECKING:  # numpy and the batch scorer load with the first ranking: importing cbrs stays fast
+    from reasoner.batch import CompiledPool
+    from reasoner.text import TextIndex
+    from reasoner.vectors import FloatArray
 
 
 class MatchStatus(Enum):
@@ -133,12 +135,17 @@ class Matchmaker:
 
     def _text_index(self, ads: list[Advertisement]) -> TextIndex:
         if self._text is None or self._text_source is not ads:
+            from reasoner.text import TextIndex
+
             self._text = TextIndex(ads)
             self._text_source = ads
         return self._text
 
     def _compiled(self, ads: list[Advertisement]) -> CompiledPool:
         if self._pool is None or self._pool_source is not ads:
+            from reasoner.batch import CompiledPool
+            from reasoner.vectors import VectorSpace
+
             self._pool = CompiledPool(ads, VectorSpace(self.index), self.method.use_parts)
             self._pool_source = ads
         return self._pool
@@ -174,6 +181,8 @@ class Matchmaker:
         return MatchResult(requirement.iri, self.method.name, status, candidates)
 
     def _rank_batch(self, requirement: Requirement, ads: list[Advertisement], explain: int) -> Sequence[Candidate]:
+        from reasoner.batch import BatchScorer, BatchScores, ranking_order
+
         pool = self._compiled(ads)
         scorer = BatchScorer(
             pool,
@@ -194,7 +203,7 @@ class Matchmaker:
 
         def unexplained(i: int) -> Candidate:
             ad = ads[i]
-            parts = {name: float(values[i]) for name, values in scores.parts.items() if not np.isnan(values[i])}
+            parts = {name: float(values[i]) for name, values in scores.parts.items() if not math.isnan(values[i])}
             score = float(scores.score[i])
             basis = score if scores.accepted_on is None else float(scores.accepted_on[i])
             rejected = scores.rejected_by[i]
@@ -247,6 +256,8 @@ class Matchmaker:
         text = description_text(requirement) if self.method.text else ""
         if text:  # the hybrid: text helps rank, the IO/PE score alone decides acceptability
             parts["text"] = self._text_index(self.advertisements).similarity(text, ad)
+            import numpy as np  # loaded by the text index already
+
             score = float(_mix(np.array([score]), np.array([parts["text"]]), cfg.text_weight)[0])
         return Candidate(ad.iri, ad.label, score, parts, tuple(pairs), tuple(lacks), tuple(rejected), acceptable)
 
@@ -475,6 +486,8 @@ _DEGREE_SCORE = {Degree.EXACT: 1.0, Degree.SUBCLASS_OF: 0.8, Degree.HAS_SUBCLASS
 
 def _mix(score: FloatArray, text: FloatArray, weight: float) -> FloatArray:
     """The hybrid's ranking score: (1 - w) IO/PE score + w text similarity, rounded as scores are."""
+    import numpy as np
+
     return np.round((1 - weight) * score + weight * text, 6).astype(np.float64)
 
 

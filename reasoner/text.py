@@ -9,13 +9,16 @@ words first (``BookPriceService`` -> book price service), with the same splitter
 from __future__ import annotations
 
 from collections.abc import Sequence
-
-import numpy as np
-from sklearn.feature_extraction.text import ENGLISH_STOP_WORDS, TfidfVectorizer  # type: ignore[import-untyped]
+from functools import cache
+from typing import TYPE_CHECKING
 
 from kb import ServiceDescription
 from reasoner.names import words
-from reasoner.vectors import FloatArray
+
+if TYPE_CHECKING:
+    from sklearn.feature_extraction.text import TfidfVectorizer  # type: ignore[import-untyped]
+
+    from reasoner.vectors import FloatArray
 
 
 def description_text(description: ServiceDescription) -> str:
@@ -28,8 +31,17 @@ def description_text(description: ServiceDescription) -> str:
     return " ".join(seen)
 
 
+@cache
+def _stop_words() -> frozenset[str]:
+    # scikit-learn (with scipy) takes over half a second to import: only the text method loads it
+    from sklearn.feature_extraction.text import ENGLISH_STOP_WORDS
+
+    return frozenset(ENGLISH_STOP_WORDS)
+
+
 def _analyse(text: str) -> list[str]:
-    return [word for word in words(text) if word not in ENGLISH_STOP_WORDS and not word.isdigit()]
+    stop_words = _stop_words()
+    return [word for word in words(text) if word not in stop_words and not word.isdigit()]
 
 
 class TextIndex:
@@ -41,12 +53,16 @@ class TextIndex:
         self._rows = {d.iri: i for i, d in enumerate(descriptions)}
         self._vectorizer: TfidfVectorizer | None = None
         if any(_analyse(text) for text in texts):
+            from sklearn.feature_extraction.text import TfidfVectorizer
+
             self._vectorizer = TfidfVectorizer(analyzer=_analyse, sublinear_tf=True)
             self._matrix = self._vectorizer.fit_transform(texts)
 
     def similarities(self, text: str) -> FloatArray:
         """Cosine of ``text`` against every description of the pool, in pool order (0 where either has
         no known word)."""
+        import numpy as np  # loaded with the first ranking (reasoner.matchmaker), not with this module
+
         if self._vectorizer is None or not text:
             return np.zeros(self.size, dtype=np.float64)
         query = self._vectorizer.transform([text])
@@ -55,6 +71,8 @@ class TextIndex:
 
     def similarity(self, text: str, description: ServiceDescription) -> float:
         """Cosine of ``text`` against one description (of the pool or not)."""
+        import numpy as np
+
         row = self._rows.get(description.iri)
         if row is not None:
             return float(self.similarities(text)[row])
