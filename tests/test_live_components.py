@@ -304,3 +304,21 @@ def test_rosout_carries_the_servers_log_and_rosapi_describes_the_bridge(
         assert listener.call_sync("/rosapi/message_details", {"type": "rosgraph_msgs/Log"}) == {"typedefs": []}
         raw = listener.call_sync("/rosapi/topics_and_raw_types", {})
         assert "/rosout" in raw["topics"] and len(raw["typedefs_full_text"]) == len(raw["topics"])
+
+
+def test_a_flooding_component_harms_no_plan_and_no_store(server: Server) -> None:
+    kb = server.kb
+    with sdk_thermometer().connect(url(server), TOKEN), BridgeClient(url(server), TOKEN) as flood:
+        before = kb.store.count()
+        beats = [flood.call("/cbrs/heartbeat", {}, 10.0) for _ in range(500)]  # as fast as it can send
+        huge = flood.call("/cbrs/register", {"description": "# " + "x" * (300 << 10)}, 10.0)
+        with pytest.raises(RemoteCallError, match="larger than"):
+            huge.result(timeout=20)
+        for beat in beats:  # each is answered (this session has no component of its own), none harms
+            with pytest.raises(RemoteCallError, match="no live component"):
+                beat.result(timeout=20)
+        assert kb.store.count() == before  # no write for any of it
+        with open_world(semantic_map=SemanticMap.read(kb)) as world, BridgeClient(url(server), TOKEN) as bridge:
+            result = run_task(kb, REQ + "RoomTemperature", SimEnvironment(world, kb, bridge), composer=Composer(kb))
+        assert result.succeeded, result.report
+        assert kb.liveness.states()[THERMOMETER].live
