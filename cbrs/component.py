@@ -109,13 +109,7 @@ class Component:
 
     def run(self, url: str, token: str | None, heartbeat: float = 1.0, ttl: float = DEFAULT_TTL) -> None:
         """Connect and serve until the connection closes or the process is interrupted."""
-        connected = self.connect(url, token, heartbeat, ttl)
-        try:
-            connected.client.wait_closed()
-        except KeyboardInterrupt:
-            pass
-        finally:
-            connected.stop()
+        self.connect(url, token, heartbeat, ttl).serve()
 
 
 class ConnectedComponent:
@@ -138,6 +132,15 @@ class ConnectedComponent:
                 return
             except Exception as error:  # a missed beat is the server's to count, not a reason to stop
                 log.warning("heartbeat of %s failed: %s", self.component.iri, error)
+
+    def serve(self) -> None:
+        """Serve until the connection closes or the process is interrupted; then stop."""
+        try:
+            self.client.wait_closed()
+        except KeyboardInterrupt:
+            pass
+        finally:
+            self.stop()
 
     def stop(self) -> None:
         if self._stop.is_set():

@@ -86,12 +86,7 @@ def main(argv: list[str] | None = None) -> int:
         component.handler(localiser(args.camera, capture, SemanticMap.read(kb)))
         connected = component.connect(args.url, token, args.heartbeat, args.lease)
         print(f"{args.camera}: registered {', '.join(connected.registered)}", flush=True)
-        try:
-            connected.client.wait_closed()
-        except KeyboardInterrupt:
-            pass
-        finally:
-            connected.stop()
+        connected.serve()
     return 0
 
 

@@ -7,6 +7,7 @@
 // Every wait is bounded; the script gives up (exit status 2) after 150 s in all.
 
 import { Ros, Service, Topic } from "roslib";
+import { bounded } from "./bounded.mjs";
 
 const WAIT = 10000;
 const url = `ws://127.0.0.1:${Number(process.argv[2])}`;
@@ -17,21 +18,6 @@ setTimeout(() => {
   process.exit(2);
 }, 150000).unref();
 
-function bounded(what, ms, executor) {
-  return new Promise((resolve, reject) => {
-    const timer = setTimeout(() => reject(new Error(`${what}: no answer within ${ms} ms`)), ms);
-    executor(
-      (value) => {
-        clearTimeout(timer);
-        resolve(value);
-      },
-      (error) => {
-        clearTimeout(timer);
-        reject(error);
-      },
-    );
-  });
-}
 
 // A failed call resolves to {failed: <the error text>}.
 function call(ros, name, type, request, ms = WAIT) {

@@ -6,6 +6,7 @@
 // Every wait is bounded: a step that gets no answer within WAIT ms fails the script (exit status 1).
 
 import { Param, Ros, Service, Topic } from "roslib";
+import { bounded as boundedFor } from "./bounded.mjs";
 
 const WAIT = 5000;
 const port = Number(process.argv[2]);
@@ -17,19 +18,7 @@ setTimeout(() => {
 }, 30000).unref();
 
 function bounded(what, executor) {
-  return new Promise((resolve, reject) => {
-    const timer = setTimeout(() => reject(new Error(`${what}: no answer within ${WAIT} ms`)), WAIT);
-    executor(
-      (value) => {
-        clearTimeout(timer);
-        resolve(value);
-      },
-      (error) => {
-        clearTimeout(timer);
-        reject(error);
-      },
-    );
-  });
+  return boundedFor(what, WAIT, executor);
 }
 
 function connect() {

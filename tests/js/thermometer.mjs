@@ -10,29 +10,18 @@
 
 import { readFileSync } from "node:fs";
 import { Ros, Service } from "roslib";
+import { bounded } from "./bounded.mjs";
 
 const [port, token, descriptionFile, seconds = "60"] = process.argv.slice(2);
 const WAIT = 10000;
 
 setTimeout(() => process.exit(0), Number(seconds) * 1000).unref();
 
-function bounded(what, executor) {
-  return new Promise((resolve, reject) => {
-    const timer = setTimeout(() => reject(new Error(`${what}: no answer within ${WAIT} ms`)), WAIT);
-    executor(
-      (value) => {
-        clearTimeout(timer);
-        resolve(value);
-      },
-      (error) => {
-        clearTimeout(timer);
-        reject(new Error(`${what}: ${error}`));
-      },
-    );
-  });
-}
+// bounded, with the failure named after what was waited for
+const wait = (what, executor) =>
+  bounded(what, WAIT, (resolve, reject) => executor(resolve, (error) => reject(new Error(`${what}: ${error}`))));
 
-const ros = await bounded("connect", (resolve, reject) => {
+const ros = await wait("connect", (resolve, reject) => {
   const connection = new Ros({ url: `ws://127.0.0.1:${Number(port)}` });
   connection.on("connection", () => resolve(connection));
   connection.on("error", (error) => reject(error?.message ?? error));
@@ -48,7 +37,7 @@ await read.advertise((request, response) => {
 });
 
 const register = new Service({ ros, name: "/cbrs/register", serviceType: "cbrs/Register" });
-const answer = await bounded("register", (resolve, reject) =>
+const answer = await wait("register", (resolve, reject) =>
   register.callService({ description: readFileSync(descriptionFile, "utf-8"), ttl: 3 }, resolve, reject),
 );
 console.log(JSON.stringify({ registered: answer.components }));
