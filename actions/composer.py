@@ -51,7 +51,7 @@ from kb.namespaces import GraphName, shorten
 from reasoner.config import MatchConfig
 
 if TYPE_CHECKING:
-    from reasoner.matchmaker import EntityPair
+    from reasoner.matchmaker import EntityPair, Matchmaker
 from reasoner.taxonomy import TaxonomyIndex
 
 GOAL = "GOAL"  # the extraction's virtual consumer: SRO's and SRE's needs together
@@ -168,6 +168,7 @@ class Composer:
         self._pool: ServicePool | None = None
         self._belief = False
         self._state: list[Statement] | None = None  # what holds, read once per compose
+        self._matchmaker: Matchmaker | None = None  # for _matched, made on first use
 
     @property
     def advertisements(self) -> list[Advertisement]:
@@ -237,7 +238,9 @@ class Composer:
         from reasoner.matchmaker import Matchmaker  # only when composition found nothing
 
         requirement = task.requirement
-        ranking = Matchmaker(self.kb, index=self.index, advertisements=self.advertisements).rank(requirement, explain=5)
+        if self._matchmaker is None:  # kept: it lays the advertisements out as arrays once
+            self._matchmaker = Matchmaker(self.kb, index=self.index, advertisements=self.advertisements)
+        ranking = self._matchmaker.rank(requirement, explain=5)
         offered = {ad.iri: ad for ad in self.advertisements}
         top_level = {p.type for p in requirement.outputs}
         for candidate in ranking.candidates[:5]:
@@ -463,7 +466,7 @@ class _Extraction:
                 wanted = need.text()
                 if node in (SRO, SRE):
                     wanted = wanted.replace("precondition", "effect", 1).replace("input", "output", 1)
-                for cause in self._why(node, need, (f"the requirement's {wanted}",), set()):
+                for cause in self._why(node, need, (f"the requirement's {wanted}",)):
                     if all((cause.need, cause.consumer) != (u.need, u.consumer) for u in self.unsatisfied):
                         self.unsatisfied.append(cause)
             return
@@ -487,26 +490,48 @@ class _Extraction:
             if e.source in self.trace.levels and self.trace.levels[e.source] < below
         ]
 
-    def _why(self, node: str, need: Need, chain: tuple[str, ...], seen: set[str]) -> list[Unsatisfied]:
-        """Why ``need`` of ``node`` cannot be met: follow the best blocked provider down to a root cause."""
-        providers = [e for e in self.graph.providers(node, need) if e.source != node]
-        if not providers:
-            return [Unsatisfied(need.text(), node, chain)]
-        best = providers[0]
-        if best.source in seen:
-            return [Unsatisfied(need.text(), node, chain, cycle=True)]
-        if best.source in self._explained:  # its causes are reported already, down another chain
-            return []
-        self._explained.add(best.source)
-        here = (*chain, shorten(best.source))
-        blocked = [
-            sub
-            for sub in self.graph.needs(best.source)
-            if not self._options(best.source, sub, self._level(best.source))
-        ]
-        if not blocked:
-            return [Unsatisfied(need.text(), node, chain)]
-        return [cause for sub in blocked for cause in self._why(best.source, sub, here, seen | {best.source})]
+    def _why(self, node: str, need: Need, chain: tuple[str, ...]) -> list[Unsatisfied]:
+        """Why ``need`` of ``node`` cannot be met: follow the best blocked provider down to a root cause.
+
+        Depth first, on a stack of its own: a chain of blocked providers can be thousands long."""
+        causes: list[Unsatisfied] = []
+        followed: list[str] = []  # the providers followed down to the need on top of the stack
+        on_path: set[str] = set()
+        stack: list[tuple[str, Need] | None] = [(node, need)]  # None: back up from the last provider followed
+        while stack:
+            item = stack.pop()
+            if item is None:
+                on_path.discard(followed.pop())
+                continue
+            node, need = item
+            providers = [e for e in self.graph.providers(node, need) if e.source != node]
+            if not providers:
+                causes.append(Unsatisfied(need.text(), node, self._chain(chain, followed)))
+                continue
+            best = providers[0]
+            if best.source in on_path:
+                causes.append(Unsatisfied(need.text(), node, self._chain(chain, followed), cycle=True))
+                continue
+            if best.source in self._explained:  # its causes are reported already, down another chain
+                continue
+            self._explained.add(best.source)
+            blocked = [
+                sub
+                for sub in self.graph.needs(best.source)
+                if not self._options(best.source, sub, self._level(best.source))
+            ]
+            if not blocked:
+                causes.append(Unsatisfied(need.text(), node, self._chain(chain, followed)))
+                continue
+            followed.append(best.source)
+            on_path.add(best.source)
+            stack.append(None)
+            stack.extend((best.source, sub) for sub in reversed(blocked))
+        return causes
+
+    @staticmethod
+    def _chain(start: tuple[str, ...], followed: list[str]) -> tuple[str, ...]:
+        return (*start, *map(shorten, followed))
 
     def _key(self, edge: Edge) -> tuple[Any, ...]:
         cost = self.trace.costs[edge.source]
@@ -616,16 +641,26 @@ class _Extraction:
         signatures: dict[int, tuple[Any, ...]] = {}
 
         def signature(step_id: int) -> tuple[Any, ...]:
-            if step_id not in signatures:
-                step = self.steps[step_id]
+            # producers before consumers, on a stack of its own: a plan can be thousands of steps deep
+            stack = [step_id]
+            while stack:
+                current = stack[-1]
+                if current in signatures:
+                    stack.pop()
+                    continue
+                step = self.steps[current]
                 if not self.graph.vertices[step.node].shareable:
-                    signatures[step_id] = ("unique", step_id)
-                else:
-                    parts = sorted(
-                        (b.need.key, b.edge.offer.name, signature(b.source) if b.source is not None else ("SRI",))
-                        for b in step.bindings
-                    )
-                    signatures[step_id] = (step.node, tuple(parts))
+                    signatures[current] = ("unique", current)
+                    continue
+                missing = [b.source for b in step.bindings if b.source is not None and b.source not in signatures]
+                if missing:
+                    stack += missing
+                    continue
+                parts = sorted(
+                    (b.need.key, b.edge.offer.name, signatures[b.source] if b.source is not None else ("SRI",))
+                    for b in step.bindings
+                )
+                signatures[current] = (step.node, tuple(parts))
             return signatures[step_id]
 
         keep: dict[tuple[Any, ...], int] = {}

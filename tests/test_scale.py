@@ -10,7 +10,11 @@ import click
 import pytest
 from click.testing import CliRunner
 
+from actions.composer import ComposeConfig, Composer, PlanStatus
+from actions.model import ActionLibrary
 from cbrs.cli import _LAZY_COMMANDS, cli
+from kb import Advertisement, KnowledgeBase, Parameter, Requirement
+from reasoner.taxonomy import ROOT, Link, TaxonomyIndex
 
 # -- start-up ------------------------------------------------------------------------------------
 
@@ -48,3 +52,58 @@ def test_help_lists_every_command_and_each_lazy_one_runs() -> None:
         shown = CliRunner().invoke(cli, [name, "--help"])
         assert shown.exit_code == 0, shown.output
         assert f"Usage: cli {name}" in shown.output
+
+
+# -- composition over a large pool --------------------------------------------------------------
+
+N = 10_000  # converters: ad{i} takes concept C{i} and gives C{i+1}
+NS = "http://example.org/scale#"
+
+
+def _concept(i: int) -> str:
+    return f"{NS}C{i}"
+
+
+@pytest.fixture(scope="module")
+def chain_composer() -> Composer:
+    """A pool of ``N`` advertisements, each the next link of one long chain: the longest explanation
+    a pool of that size can need, and a short plan at its end."""
+    index = TaxonomyIndex.from_links(
+        [Link(_concept(i), ROOT, "is-a") for i in range(N + 1)] + [Link(NS + "X", ROOT, "is-a")]
+    )
+    pool = [
+        Advertisement(
+            iri=f"{NS}ad{i}",
+            types=(),
+            inputs=(Parameter(f"{NS}ad{i}in", "input", _concept(i)),),
+            outputs=(Parameter(f"{NS}ad{i}out", "output", _concept(i + 1)),),
+        )
+        for i in range(N)
+    ]
+    kb = KnowledgeBase.open(":memory:")
+    return Composer(kb, ComposeConfig(matched=False), index=index, actions=ActionLibrary(), advertisements=pool)
+
+
+def _requirement(given: str, wanted: str) -> Requirement:
+    return Requirement(
+        iri=NS + "req",
+        types=(),
+        inputs=(Parameter(NS + "given", "input", given),),
+        outputs=(Parameter(NS + "wanted", "output", wanted),),
+    )
+
+
+def test_a_blocked_chain_as_long_as_the_pool_is_explained_to_its_root(chain_composer: Composer) -> None:
+    result = chain_composer.compose(_requirement(NS + "X", _concept(N)))
+    assert result.status is PlanStatus.UNSOLVABLE
+    [cause] = result.unsatisfied
+    assert cause.consumer == f"{NS}ad0"  # nothing gives C0: the root of every link's failure
+    assert len(cause.chain) == N + 1  # the requirement's output, then every advertisement followed
+    assert not cause.cycle
+
+
+def test_a_plan_at_the_end_of_a_large_pool(chain_composer: Composer) -> None:
+    result = chain_composer.compose(_requirement(_concept(N - 5), _concept(N)))
+    assert result.status is PlanStatus.PLANNED
+    assert result.plan is not None
+    assert [c.removeprefix(NS) for c in result.plan.components()] == [f"ad{i}" for i in range(N - 5, N)]
