@@ -25,6 +25,24 @@ REPLY = struct.Struct(">cI")
 OK, SYNTAX, EVALUATION, TOO_LARGE, NOT_ACCEPTABLE, LATE = b"K", b"S", b"E", b"L", b"N", b"T"
 
 
+def dataset_options(dataset: dict[str, Any]) -> dict[str, Any]:
+    """Oxigraph's ``Store.query`` options for a dataset as :func:`cbrs.sparql_service.dataset_for` decides it.
+
+    ``{"union": true}``: no dataset was given, the default graph is the union of all graphs; otherwise
+    ``default`` and ``named`` are IRI lists (protocol parameters, which override the query's FROM) or
+    both absent (the query's own FROM / FROM NAMED, which Oxigraph applies). Shared by the endpoint's
+    in-process evaluation, so both paths answer alike.
+    """
+    if dataset.get("union"):
+        return {"use_default_graph_as_union": True}
+    if dataset.get("default") is None and dataset.get("named") is None:
+        return {}
+    return {
+        "default_graph": [ox.NamedNode(iri) for iri in dataset.get("default") or ()],
+        "named_graphs": [ox.NamedNode(iri) for iri in dataset.get("named") or ()],
+    }
+
+
 class _Stop(Exception):
     def __init__(self, status: bytes) -> None:
         self.status = status
@@ -64,7 +82,7 @@ class _Worker:
         deadline = time.monotonic() + float(request["seconds"])
         try:
             result = self.open(request["snapshot"]).query(
-                request["text"], prefixes=self.prefixes, use_default_graph_as_union=True
+                request["text"], prefixes=self.prefixes, **dataset_options(request["dataset"])
             )
         except SyntaxError as error:
             return SYNTAX, str(error).encode()

@@ -29,8 +29,10 @@ import sys
 import tempfile
 import threading
 import time
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from kb.errors import KnowledgeBaseError, QuerySyntaxError, QueryTooComplexError, StoreEvaluationError
 from kb.namespaces import PREFIXES
@@ -64,6 +66,7 @@ class Request:
     graph_format: str
     limit: int
     timeout: float
+    dataset: Mapping[str, Any] = field(default_factory=lambda: {"union": True})  # see _query_worker.dataset_options
 
 
 class _Snapshot:
@@ -141,6 +144,7 @@ class QueryProcesses:
                     "graph_format": request.graph_format,
                     "limit": request.limit,
                     "seconds": request.timeout,
+                    "dataset": dict(request.dataset),
                 }
             ).encode("utf-8", "surrogatepass")
             assert worker.popen.stdin is not None

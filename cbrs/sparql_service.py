@@ -13,12 +13,17 @@ How a query is bounded (Oxigraph has no query timeout of its own):
   every chunk, so a query that streams many solutions stops at the deadline or the limit;
 - on an in-memory or remote store it runs on a thread instead; a query still computing its first
   solution at the deadline is answered "timed out" and that thread is left to finish, keeping its slot.
+
+Which graphs a query reads follows SPARQL 1.1 (Query §13.2, Protocol §2.1.4): the protocol's
+``default-graph-uri`` / ``named-graph-uri`` (a :class:`Dataset`) win over the query's ``FROM`` /
+``FROM NAMED``, which win over cbrs's own default, the union of all graphs (:func:`dataset_for`).
 """
 
 from __future__ import annotations
 
 import hmac
 import io
+import re
 import threading
 import time
 from collections import Counter
@@ -32,12 +37,16 @@ import pyoxigraph as ox
 from werkzeug.datastructures import MIMEAccept
 from werkzeug.http import parse_accept_header
 
+from cbrs._query_worker import dataset_options
 from cbrs.query_workers import QueryProcesses, QueryStopped, Request
 from cbrs.settings import setting
 from kb import KnowledgeBase
-from kb.errors import KnowledgeBaseError, QueryTooComplexError, StoreEvaluationError
+from kb.errors import KnowledgeBaseError, QuerySyntaxError, QueryTooComplexError, StoreEvaluationError
+from kb.namespaces import PREFIXES
 from kb.query_guard import start_evaluation_thread
-from kb.store import EmbeddedStore, refuse_inserted_blank_nodes
+from kb.remote_store import RemoteStore
+from kb.sparql_lexemes import HIDING
+from kb.store import EmbeddedStore, QueryResult, refuse_inserted_blank_nodes
 
 # Media types offered for SELECT and ASK results, the first being the default.
 RESULT_TYPES: dict[str, ox.QueryResultsFormat] = {
@@ -55,6 +64,10 @@ GRAPH_TYPES: dict[str, ox.RdfFormat] = {
     "application/n-triples": ox.RdfFormat.N_TRIPLES,
     "application/ld+json": ox.RdfFormat.JSON_LD,
     "application/rdf+xml": ox.RdfFormat.RDF_XML,
+    "application/n-quads": ox.RdfFormat.N_QUADS,  # the triples in the default graph
+    "application/trig": ox.RdfFormat.TRIG,
+    "text/n3": ox.RdfFormat.N3,
+    "text/rdf+n3": ox.RdfFormat.N3,
     "text/plain": ox.RdfFormat.N_TRIPLES,
     "application/json": ox.RdfFormat.JSON_LD,
     "application/xml": ox.RdfFormat.RDF_XML,
@@ -73,6 +86,10 @@ SHORT_NAMES: dict[str, tuple[str, str]] = {
     "json-ld": ("application/sparql-results+json", "application/ld+json"),
     "rdfxml": ("application/sparql-results+xml", "application/rdf+xml"),
     "rdf+xml": ("application/sparql-results+xml", "application/rdf+xml"),
+    "nquads": ("text/tab-separated-values", "application/n-quads"),
+    "nq": ("text/tab-separated-values", "application/n-quads"),
+    "trig": ("application/sparql-results+json", "application/trig"),
+    "n3": ("application/sparql-results+json", "text/n3"),
 }
 
 
@@ -153,6 +170,110 @@ class UpdateForbiddenError(EndpointError):
     kind = "forbidden"
 
 
+class BadDatasetError(EndpointError):
+    http_status = 400
+    kind = "bad-dataset"
+
+    def __init__(self, parameter: str, value: str, reason: str) -> None:
+        self.parameter = parameter
+        self.value = value
+        super().__init__(f"{parameter}={value!r} is not an absolute IRI ({reason}); give a graph's full IRI")
+
+
+@dataclass(frozen=True)
+class Dataset:
+    """The RDF dataset a request names with the protocol's ``default-graph-uri`` and ``named-graph-uri``.
+
+    The default graph is the merge of ``default_graphs`` (none: an empty graph), and only
+    ``named_graphs`` can be reached with ``GRAPH``; it overrides the query's ``FROM`` / ``FROM NAMED``.
+    """
+
+    default_graphs: tuple[str, ...] = ()
+    named_graphs: tuple[str, ...] = ()
+
+    @classmethod
+    def from_parameters(cls, default_graphs: Sequence[str], named_graphs: Sequence[str]) -> Dataset | None:
+        """The dataset the parameters name, or ``None`` when there are none; refuses what is not an IRI."""
+        if not default_graphs and not named_graphs:
+            return None
+        for parameter, values in (("default-graph-uri", default_graphs), ("named-graph-uri", named_graphs)):
+            for value in values:
+                try:
+                    ox.NamedNode(value)
+                except ValueError as error:
+                    raise BadDatasetError(parameter, value, str(error)) from None
+        return cls(tuple(default_graphs), tuple(named_graphs))
+
+
+# The query's tokens that matter for its dataset clause: IRIs, prefixed names and keywords; strings,
+# comments, variables and language tags are matched whole so that nothing inside them counts.
+_TOKEN = re.compile(
+    r'(?P<iri><[^<>"{}|^`\\\x00-\x20]*>)|'
+    + HIDING
+    + r"""|[?$]\w+|@[A-Za-z][\w-]*|(?P<pname>[\w.\-\u00b7\u00c0-\uffff]*:(?:[^\s{}()\[\]<>"',;#\\]|\\.)*)"""
+    r"|(?P<word>[A-Za-z_]\w*)",
+    re.DOTALL,
+)
+_FORMS = {"SELECT", "CONSTRUCT", "DESCRIBE", "ASK"}
+
+
+def has_dataset_clause(text: str) -> bool:
+    """Whether the query names its own dataset with ``FROM`` or ``FROM NAMED`` (only those clauses use the keyword)."""
+    return any((match.group("word") or "").upper() == "FROM" for match in _TOKEN.finditer(text))
+
+
+def dataset_clause(text: str) -> Dataset | None:
+    """The dataset the query's ``FROM`` / ``FROM NAMED`` clauses name, or ``None`` when it names none.
+
+    The graph names are read as written (IRIs or prefixed names) and resolved by Oxigraph against the
+    query's own prologue (``BASE``, ``PREFIX``) and cbrs's prefixes. ``None`` too for a clause that cannot
+    be read: the query is then evaluated as written and its parser reports what is wrong.
+    """
+    tokens = [m for m in _TOKEN.finditer(text) if m.lastgroup in ("iri", "pname", "word")]
+    prologue_end = next((m.start() for m in tokens if m.lastgroup == "word" and m.group().upper() in _FORMS), 0)
+    names: list[tuple[bool, str]] = []
+    for index, match in enumerate(tokens):
+        if match.lastgroup != "word" or match.group().upper() != "FROM":
+            continue
+        named = index + 1 < len(tokens) and tokens[index + 1].group().upper() == "NAMED"
+        at = index + 2 if named else index + 1
+        if at >= len(tokens) or tokens[at].lastgroup not in ("iri", "pname"):
+            return None
+        names.append((named, tokens[at].group()))
+    if not names:
+        return None
+    variables = " ".join(f"?g{i}" for i in range(len(names)))
+    terms = " ".join(name for _, name in names)
+    resolver = f"{text[:prologue_end]}\nSELECT * WHERE {{ VALUES ({variables}) {{ ({terms}) }} }}"
+    try:
+        solutions = ox.Store().query(resolver, prefixes=PREFIXES)
+    except SyntaxError:
+        return None
+    assert isinstance(solutions, ox.QuerySolutions)
+    row = next(iter(solutions))
+    iris = [row[f"g{i}"].value for i in range(len(names))]
+    return Dataset(
+        tuple(iri for (named, _), iri in zip(names, iris, strict=True) if not named),
+        tuple(iri for (named, _), iri in zip(names, iris, strict=True) if named),
+    )
+
+
+def dataset_for(text: str, dataset: Dataset | None) -> dict[str, Any]:
+    """How the query ``text`` is evaluated, for :func:`cbrs._query_worker.dataset_options`: the protocol's
+    dataset if given, else the query's own ``FROM`` / ``FROM NAMED``, else the union default graph.
+
+    The query's clause is passed on as an explicit dataset rather than left to the store, because a
+    store whose default graph is the union (Oxigraph's union option, embedded or served) would let the
+    union override it."""
+    if dataset is None and has_dataset_clause(text):
+        dataset = dataset_clause(text)
+        if dataset is None:
+            return {}
+    if dataset is not None:
+        return {"default": list(dataset.default_graphs), "named": list(dataset.named_graphs)}
+    return {"union": True}
+
+
 @dataclass(frozen=True)
 class Answer:
     """A serialised result and its media type."""
@@ -223,17 +344,24 @@ class SparqlService:
         return self.config.update_token is not None and not self.config.read_only
 
     def query(
-        self, text: str, accept: str | None = None, short_format: str | None = None, client: str | None = None
+        self,
+        text: str,
+        accept: str | None = None,
+        short_format: str | None = None,
+        client: str | None = None,
+        dataset: Dataset | None = None,
     ) -> Answer:
         """Run ``text`` and serialise its result in the best format for ``accept`` (an Accept header value).
 
         ``client`` (an IP address) is who asks: one client runs at most ``workers_per_client`` queries at once.
+        ``dataset`` is the protocol's ``default-graph-uri`` / ``named-graph-uri``, if the request gave any.
         """
         self._check_size(text)
+        graphs = dataset_for(text, dataset)
         release = self._admit(client)
         if self.processes is not None:
             try:
-                return self._in_process(text, accept, short_format)
+                return self._in_process(text, accept, short_format, graphs)
             finally:
                 release()
         deadline = time.monotonic() + self.config.timeout
@@ -241,7 +369,7 @@ class SparqlService:
 
         def work() -> None:
             try:
-                future.set_result(self._evaluate(text, accept, short_format, deadline))
+                future.set_result(self._evaluate(text, accept, short_format, deadline, graphs))
             except BaseException as error:  # handed to the waiting request
                 future.set_exception(error)
             finally:
@@ -289,7 +417,7 @@ class SparqlService:
 
         return release
 
-    def _in_process(self, text: str, accept: str | None, short_format: str | None) -> Answer:
+    def _in_process(self, text: str, accept: str | None, short_format: str | None, graphs: dict[str, Any]) -> Answer:
         assert self.processes is not None
         store = self.processes.store
         refusals: dict[bool, NotAcceptableError] = {}
@@ -309,6 +437,7 @@ class SparqlService:
             graph_format=GRAPH_TYPES[graph_type].media_type if graph_type else "application/n-triples",
             limit=self.config.max_result_bytes,
             timeout=self.config.timeout,
+            dataset=graphs,
         )
         try:
             body, media_type = self.processes.run(request)
@@ -363,10 +492,12 @@ class SparqlService:
         if size > self.config.max_query_bytes:
             raise QueryTooLargeError(size, self.config.max_query_bytes)
 
-    def _evaluate(self, text: str, accept: str | None, short_format: str | None, deadline: float) -> Answer:
+    def _evaluate(
+        self, text: str, accept: str | None, short_format: str | None, deadline: float, graphs: dict[str, Any]
+    ) -> Answer:
         result: Any = None  # Oxigraph results must be dropped on the thread that made them
         try:
-            result = self.kb.query(text)
+            result = self._run(text, graphs)
             media_type = negotiate(isinstance(result, ox.QueryTriples), accept, short_format)
             writer = _BudgetWriter(self.config.max_result_bytes, deadline, self.config.timeout)
             try:
@@ -383,6 +514,25 @@ class SparqlService:
             return Answer(writer.getvalue(), media_type)
         finally:
             result = None
+
+    def _run(self, text: str, graphs: dict[str, Any]) -> QueryResult:
+        """Evaluate ``text`` on this thread over the dataset ``graphs`` (see :func:`dataset_for`)."""
+        store = self.kb.store
+        if graphs.get("union"):
+            return self.kb.query(text)  # the store's own rule: the union default graph
+        if isinstance(store, RemoteStore):  # the server applies FROM, and the parameters sent on
+            return store.query_dataset(text, graphs.get("default"), graphs.get("named"))
+        if not isinstance(store, EmbeddedStore):
+            raise StoreEvaluationError(store.location, "query", "this store cannot take a dataset; query without one")
+        store.check_query(text)
+        # EmbeddedStore.query always reads the union default graph, so the dataset goes to Oxigraph here,
+        # with the same options the worker processes use.
+        try:
+            return store._backend.query(text, prefixes=PREFIXES, **dataset_options(graphs))
+        except SyntaxError as error:
+            raise QuerySyntaxError(text, str(error)) from error
+        except (OSError, RuntimeError) as error:
+            raise StoreEvaluationError(store.location, "query", str(error)) from error
 
 
 def negotiate(graph: bool, accept: str | None, short_format: str | None = None) -> str:

@@ -1,15 +1,18 @@
 """The SPARQL 1.1 Protocol at ``/sparql`` (query and update) and ``/update`` (update only).
 
-A thin layer: it reads the request the three ways the protocol allows (GET, POST form, POST direct),
-hands the text to :class:`cbrs.sparql_service.SparqlService` and maps its errors to statuses.
+A thin layer: it reads the request the three ways the protocol allows (GET, POST form, POST direct;
+HEAD answers as GET without a body), with the dataset parameters ``default-graph-uri`` and
+``named-graph-uri``, hands the text to :class:`cbrs.sparql_service.SparqlService` and maps its errors
+to statuses.
 """
 
 from __future__ import annotations
 
 import pyoxigraph as ox
-from flask import Blueprint, Response, request, url_for
+from flask import Blueprint, Response, request
+from werkzeug.datastructures import MultiDict
 
-from cbrs.sparql_service import GRAPH_TYPES, EndpointError, negotiate
+from cbrs.sparql_service import GRAPH_TYPES, Dataset, EndpointError, negotiate
 from cbrs.web import context
 
 blueprint = Blueprint("sparql", __name__)
@@ -17,9 +20,10 @@ blueprint = Blueprint("sparql", __name__)
 QUERY_TYPE = "application/sparql-query"
 UPDATE_TYPE = "application/sparql-update"
 FORM_TYPE = "application/x-www-form-urlencoded"
-# Dataset parameters of the protocol; cbrs answers over its own union default graph only.
 _RDF_TYPE = "http://www.w3.org/1999/02/22-rdf-syntax-ns#type"
-DATASET_PARAMETERS = ("default-graph-uri", "named-graph-uri", "using-graph-uri", "using-named-graph-uri")
+# The protocol's dataset parameters: of a query, and of an update (which cbrs does not take).
+QUERY_DATASET = ("default-graph-uri", "named-graph-uri")
+UPDATE_DATASET = ("using-graph-uri", "using-named-graph-uri")
 
 
 class BadProtocolRequest(EndpointError):
@@ -46,8 +50,20 @@ def sparql() -> Response:
         return _update(update)
     if query is None:
         return _service_description()
-    answer = context.sparql().query(query, request.headers.get("Accept"), _short_format(), client=request.remote_addr)
+    dataset = Dataset.from_parameters(
+        request.values.getlist(QUERY_DATASET[0]), request.values.getlist(QUERY_DATASET[1])
+    )
+    answer = context.sparql().query(
+        query, request.headers.get("Accept"), _short_format(), client=request.remote_addr, dataset=dataset
+    )
     return Response(answer.body, content_type=_with_charset(answer.media_type))
+
+
+@blueprint.after_request
+def _vary(response: Response) -> Response:
+    # The answer depends on the Accept header, and its CORS headers on the Origin: caches must key on both.
+    response.vary.update(("Accept", "Origin"))
+    return response
 
 
 @blueprint.route("/update", methods=["POST"])
@@ -60,29 +76,48 @@ def update_only() -> Response:
 
 def _operation() -> tuple[str | None, str | None]:
     """The query or the update text of the request, whichever it carries; never both."""
-    for name in DATASET_PARAMETERS:
-        if name in request.values:
-            raise BadProtocolRequest(
-                f"{name} is not supported: cbrs queries the union of its graphs; use GRAPH or FROM in the query"
-            )
-    if request.method == "GET":
+    if request.method in ("GET", "HEAD"):
         if "update" in request.args:
             raise BadProtocolRequest("an update must be sent with POST")
-        return request.args.get("query"), None
-    media_type = request.mimetype
-    if media_type == FORM_TYPE:
-        query, update = request.form.get("query"), request.form.get("update")
-    elif media_type == QUERY_TYPE:
-        query, update = _body(), None
-    elif media_type == UPDATE_TYPE:
-        query, update = None, _body()
+        query, update = _one("query", request.args), None
     else:
-        raise UnsupportedMediaType(media_type or "(none)")
-    if query is not None and update is not None:
-        raise BadProtocolRequest("a request carries a query or an update, not both")
-    if query is None and update is None:
-        raise BadProtocolRequest("the POST carries neither query= nor update=")
+        media_type = request.mimetype
+        if media_type == FORM_TYPE:
+            query, update = _one("query", request.form), _one("update", request.form)
+        elif media_type == QUERY_TYPE:
+            query, update = _body(), None
+        elif media_type == UPDATE_TYPE:
+            query, update = None, _body()
+        else:
+            raise UnsupportedMediaType(media_type or "(none)")
+        if query is not None and update is not None:
+            raise BadProtocolRequest("a request carries a query or an update, not both")
+        if query is None and update is None:
+            raise BadProtocolRequest("the POST carries neither query= nor update=")
+    _check_dataset_parameters(update is not None)
     return query, update
+
+
+def _one(name: str, values: MultiDict[str, str]) -> str | None:
+    """The single value of parameter ``name``; the protocol allows exactly one query or update per request."""
+    given = values.getlist(name)
+    if len(given) > 1:
+        raise BadProtocolRequest(f"the request carries {len(given)} {name}= parameters; send exactly one")
+    return given[0] if given else None
+
+
+def _check_dataset_parameters(updating: bool) -> None:
+    """Refuse the dataset parameters of the other operation, and an update's (cbrs has no USING rewrite)."""
+    for name in UPDATE_DATASET:
+        if name in request.values:
+            if not updating:
+                raise BadProtocolRequest(f"{name} belongs to updates; scope a query with default-graph-uri or FROM")
+            raise BadProtocolRequest(
+                f"{name} is not supported; name the graph in the update itself (WITH, USING or GRAPH)"
+            )
+    for name in QUERY_DATASET:
+        if updating and name in request.values:
+            raise BadProtocolRequest(f"{name} belongs to queries; an update names its graphs with WITH, USING or GRAPH")
 
 
 def _body() -> str:
@@ -115,7 +150,7 @@ def _service_description() -> Response:
     """A GET without a query describes the endpoint (SPARQL 1.1 Service Description), as RDF."""
     sd = "http://www.w3.org/ns/sparql-service-description#"
     formats = "http://www.w3.org/ns/formats/"
-    endpoint = ox.NamedNode(url_for("sparql.sparql", _external=True))
+    endpoint = ox.NamedNode(request.base_url)  # /sparql or /query, whichever was asked
     node = ox.BlankNode("service")
     triples = [
         ox.Triple(node, ox.NamedNode(_RDF_TYPE), ox.NamedNode(sd + "Service")),
@@ -125,7 +160,19 @@ def _service_description() -> Response:
     ]
     if context.sparql().writable:
         triples.append(ox.Triple(node, ox.NamedNode(sd + "supportedLanguage"), ox.NamedNode(sd + "SPARQL11Update")))
-    for name in ("SPARQL_Results_JSON", "SPARQL_Results_XML", "SPARQL_Results_CSV", "SPARQL_Results_TSV", "Turtle"):
+    for name in (
+        "SPARQL_Results_JSON",
+        "SPARQL_Results_XML",
+        "SPARQL_Results_CSV",
+        "SPARQL_Results_TSV",
+        "Turtle",
+        "N-Triples",
+        "N-Quads",
+        "TriG",
+        "N3",
+        "RDF_XML",
+        "JSON-LD",
+    ):
         triples.append(ox.Triple(node, ox.NamedNode(sd + "resultFormat"), ox.NamedNode(formats + name)))
     media_type = negotiate(True, request.headers.get("Accept"), _short_format())
     body = ox.serialize(triples, format=GRAPH_TYPES[media_type])
