@@ -31,7 +31,8 @@ from cbrs.rosbridge import Bridge, ServiceError, current_caller
 from cbrs.sparql_service import SparqlService
 from cbrs.tasks import RUN_TOPIC, TaskRunner
 from kb.errors import KnowledgeBaseError
-from kb.namespaces import expand
+from kb.namespaces import GraphName, expand
+from kb.remote_store import RemoteStore
 from reasoner.methods import METHODS
 
 TOPICS = {
@@ -58,6 +59,7 @@ class KnowledgeServices:
         self.sparql = sparql
         self.tasks = tasks
         self.matchmakers = matchmakers or Matchmakers(sparql)
+        self.composers = Composers(sparql)
         self.own_origins = own_origins
 
     def may_write(self) -> bool:
@@ -104,7 +106,7 @@ class KnowledgeServices:
         if objective not in {o.value for o in Objective}:
             raise ServiceError(f"objective {objective!r} is not one of {', '.join(o.value for o in Objective)}")
         with self.sparql.lock:
-            composer = Composer(self.sparql.kb, ComposeConfig(objective=Objective(objective)))
+            composer = self.composers.get(Objective(objective))
             result = _call(lambda: composer.compose(task))
             recorded = result.plan is not None and not self.sparql.config.read_only and self.may_write()
             if result.plan is not None and recorded:
@@ -135,6 +137,43 @@ class KnowledgeServices:
     def task_status(self, args: dict[str, Any]) -> dict[str, Any]:
         run_id = _field(args, "run", str)
         return _call(lambda: self.tasks.get(run_id)).to_dict()
+
+
+class Composers:
+    """Composers kept between /cbrs/plan calls, one per objective, sharing the taxonomy index, the
+    action library and the advertisements (building them is most of a call's time).
+
+    They are made again when the store changes: an update through the endpoint or a component
+    registered or leaving (``SparqlService.generation``), a component whose lease lapsed (the set of
+    unavailable components), and on a remote store, other processes' writes (the sizes of the
+    ontology and services graphs). Call ``get`` and compose with the knowledge-base lock held: a
+    composer is not safe for two compositions at once.
+    """
+
+    def __init__(self, sparql: SparqlService) -> None:
+        self.sparql = sparql
+        self._version: object = None
+        self._built: dict[Objective, Composer] = {}
+
+    def get(self, objective: Objective) -> Composer:
+        kb = self.sparql.kb
+        version: tuple[object, ...] = (self.sparql.generation, frozenset(kb.liveness.unavailable()))
+        if isinstance(kb.store, RemoteStore):
+            version += (kb.store.count(GraphName.ONTOLOGY), kb.store.count(GraphName.SERVICES))
+        if version != self._version:
+            self._version, self._built = version, {}
+        composer = self._built.get(objective)
+        if composer is None:
+            shared = next(iter(self._built.values()), None)
+            composer = Composer(
+                kb,
+                ComposeConfig(objective=objective),
+                index=shared.index if shared is not None else None,
+                actions=shared.actions if shared is not None else None,
+                advertisements=shared.advertisements if shared is not None else None,
+            )
+            self._built[objective] = composer
+        return composer
 
 
 def attach(bridge: Bridge, services: KnowledgeServices) -> Callable[[], None]:

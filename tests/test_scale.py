@@ -10,9 +10,12 @@ import click
 import pytest
 from click.testing import CliRunner
 
-from actions.composer import ComposeConfig, Composer, PlanStatus
+from actions.composer import ComposeConfig, Composer, Objective, PlanStatus
 from actions.model import ActionLibrary
+from cbrs.bridge_services import KnowledgeServices
 from cbrs.cli import _LAZY_COMMANDS, cli
+from cbrs.sparql_service import SparqlService
+from cbrs.tasks import TaskRunner
 from kb import Advertisement, KnowledgeBase, Parameter, Requirement
 from reasoner.taxonomy import ROOT, Link, TaxonomyIndex
 
@@ -107,3 +110,42 @@ def test_a_plan_at_the_end_of_a_large_pool(chain_composer: Composer) -> None:
     assert result.status is PlanStatus.PLANNED
     assert result.plan is not None
     assert [c.removeprefix(NS) for c in result.plan.components()] == [f"ad{i}" for i in range(N - 5, N)]
+
+
+# -- /cbrs/plan keeps its composer ---------------------------------------------------------------
+
+CAMERA = "https://w3id.org/cbrs/service#LocateMobileRobot_CeilingCamera01"
+
+
+def _planned_components(services: KnowledgeServices) -> list[str]:
+    answer = services.plan({"task": "FetchMyPen"})
+    assert answer["status"] == "planned"
+    return [step["component"] for step in answer["steps"]]
+
+
+@pytest.fixture
+def services() -> KnowledgeServices:
+    kb = KnowledgeBase.open(":memory:")
+    sparql = SparqlService(kb)
+    return KnowledgeServices(sparql, TaskRunner(kb, sparql.lock, camera=None))
+
+
+def test_plan_calls_share_a_composer_until_the_store_changes(services: KnowledgeServices) -> None:
+    first = _planned_components(services)
+    composer = services.composers.get(Objective.SIMILARITY)
+    assert (
+        _planned_components(services) == first == Composer(services.sparql.kb).compose("FetchMyPen").plan.components()
+    )  # type: ignore[union-attr]
+    assert services.composers.get(Objective.SIMILARITY) is composer
+    assert CAMERA in first
+
+    services.sparql.kb.registry.deregister(CAMERA)
+    services.sparql.changed()  # as a registration or an update through the endpoint does
+    assert CAMERA not in _planned_components(services)
+    assert services.composers.get(Objective.SIMILARITY) is not composer
+
+
+def test_a_component_whose_lease_lapsed_is_planned_without(services: KnowledgeServices) -> None:
+    assert CAMERA in _planned_components(services)
+    services.sparql.kb.liveness.expire(CAMERA, "lease lapsed")  # no store generation: seen at the next call
+    assert CAMERA not in _planned_components(services)
