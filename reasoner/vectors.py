@@ -8,8 +8,9 @@ per concept.
 
 from __future__ import annotations
 
-from collections import deque
-from collections.abc import Iterable
+from collections import OrderedDict, deque
+from collections.abc import Callable, Hashable, Iterable
+from typing import Any, Generic, TypeVar
 
 import numpy as np
 import numpy.typing as npt
@@ -20,8 +21,58 @@ from reasoner.taxonomy import ROOT, TaxonomyIndex
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
 
+ARRAY_CACHE_BYTES = 32 * 2**20
+"""The most each cache of whole-taxonomy arrays (similarity vectors, common superclasses, output
+floors) keeps, least recently used first out: 32 MB, so 64 arrays over a 64,000-class taxonomy and
+thousands over the bundled ontologies. The arrays of the pool's own concepts are rebuilt when needed
+again; the per-node descendant arrays are not bounded (one per taxonomy node at most)."""
+
+IMPLIED_CACHE_ENTRIES = 200_000
+"""The most (superclass, part) answers ``VectorSpace.implied`` keeps (about 30 MB)."""
+
+K = TypeVar("K", bound=Hashable)
+V = TypeVar("V")
+
 _SUM_BITS = 20  # link sums and name ranks stay far below 2**20
 _DEPTH_SHIFT = 2 * _SUM_BITS
+
+
+class _Lru(Generic[K, V]):
+    """A mapping that drops its least recently used items once their total weight passes ``limit``
+    (the newest item always stays)."""
+
+    def __init__(self, limit: int, weigh: Callable[[V], int]) -> None:
+        self.limit = limit
+        self._weigh = weigh
+        self._items: OrderedDict[K, V] = OrderedDict()
+        self.weight = 0
+
+    def get(self, key: K) -> V | None:
+        found = self._items.get(key)
+        if found is not None:
+            self._items.move_to_end(key)
+        return found
+
+    def __setitem__(self, key: K, value: V) -> None:
+        old = self._items.pop(key, None)
+        if old is not None:
+            self.weight -= self._weigh(old)
+        self._items[key] = value
+        self.weight += self._weigh(value)
+        while self.weight > self.limit and len(self._items) > 1:
+            _, dropped = self._items.popitem(last=False)
+            self.weight -= self._weigh(dropped)
+
+    def __len__(self) -> int:
+        return len(self._items)
+
+    def clear(self) -> None:
+        self._items.clear()
+        self.weight = 0
+
+
+def _nbytes(array: npt.NDArray[Any]) -> int:
+    return array.nbytes
 
 
 class VectorSpace:
@@ -37,12 +88,12 @@ class VectorSpace:
         self.name_rank = np.arange(len(nodes), dtype=np.int64)  # names are sorted: rank = id
         self._is_a_below: dict[int, tuple[IntArray, IntArray]] = {}
         self._all_below: dict[int, tuple[IntArray, IntArray]] = {}
-        self._cache: dict[tuple[int, str], FloatArray] = {}
-        self._lcs: dict[int, IntArray] = {}
+        self._cache: _Lru[tuple[int, str], FloatArray] = _Lru(ARRAY_CACHE_BYTES, _nbytes)
+        self._lcs: _Lru[int, IntArray] = _Lru(ARRAY_CACHE_BYTES, _nbytes)
         self._used: set[int] = set()  # ids handed out by add(): where vectors are read
-        self._implied: dict[tuple[int, int], bool] = {}
+        self._implied: _Lru[tuple[int, int], bool] = _Lru(IMPLIED_CACHE_ENTRIES, lambda _: 1)
         self._by_core: dict[int, tuple[int, dict[str, list[int]]]] = {}
-        self._floors: dict[tuple[str, bool, float], FloatArray] = {}
+        self._floors: _Lru[tuple[str, bool, float], FloatArray] = _Lru(ARRAY_CACHE_BYTES, _nbytes)
         for concept in sorted(set(extra)):
             self.add(concept)
 
@@ -133,7 +184,8 @@ class VectorSpace:
         key = measure.core_key(self.names[x])
         lemmas = [key, *measure.lexicon.related(key)] if measure.lexicon else [key]
         root = self.ids[ROOT]
-        lcs = self._lcs[x]
+        lcs = self.common_superclasses(self.names[x])
+        assert lcs is not None  # x is a taxonomy node
         for lemma in lemmas:
             for i in by_core.get(lemma, ()):
                 if lcs[i] == root and i != x:
@@ -180,9 +232,11 @@ class VectorSpace:
         if concept not in self.index:
             return None
         x = self.ids[self.index.canonical(concept)]
-        if x not in self._lcs:
+        found = self._lcs.get(x)
+        if found is None:
             self._wu_palmer_or_root(x)
-        return self._lcs[x]
+            found = self._lcs.get(x)
+        return found
 
     def implied(self, superclass: IntArray, part: IntArray) -> npt.NDArray[np.bool_]:
         """Element-wise: is part[i] a part that superclass[i] has (its own or inherited)?"""

@@ -17,6 +17,8 @@ from cbrs.cli import _LAZY_COMMANDS, cli
 from cbrs.sparql_service import SparqlService
 from cbrs.tasks import TaskRunner
 from kb import Advertisement, KnowledgeBase, Parameter, Requirement
+from reasoner import synthetic, vectors
+from reasoner.matchmaker import Matchmaker
 from reasoner.taxonomy import ROOT, Link, TaxonomyIndex
 
 # -- start-up ------------------------------------------------------------------------------------
@@ -149,3 +151,24 @@ def test_a_component_whose_lease_lapsed_is_planned_without(services: KnowledgeSe
     assert CAMERA in _planned_components(services)
     services.sparql.kb.liveness.expire(CAMERA, "lease lapsed")  # no store generation: seen at the next call
     assert CAMERA not in _planned_components(services)
+
+
+# -- the matchmaker's caches are bounded ---------------------------------------------------------
+
+
+def test_bounded_vector_caches_rank_as_unbounded_ones(monkeypatch: pytest.MonkeyPatch) -> None:
+    index, pool, requirements = synthetic.build(400, 60, 12, seed=3)
+    kb = KnowledgeBase.open(":memory:")
+    expected = [_order(Matchmaker(kb, index=index, advertisements=pool), r) for r in requirements]
+    monkeypatch.setattr(vectors, "ARRAY_CACHE_BYTES", 3 * 8 * 401)  # three vectors of the taxonomy
+    monkeypatch.setattr(vectors, "IMPLIED_CACHE_ENTRIES", 10)
+    matchmaker = Matchmaker(kb, index=index, advertisements=pool)
+    assert [_order(matchmaker, r) for r in requirements * 2] == expected * 2
+    space = matchmaker._compiled(matchmaker.advertisements).space
+    for cache in (space._cache, space._lcs, space._floors):
+        assert cache.weight <= 3 * 8 * len(space) or len(cache) == 1
+    assert len(space._implied) <= 10
+
+
+def _order(matchmaker: Matchmaker, requirement: Requirement) -> list[tuple[str, float]]:
+    return [(c.advertisement, c.score) for c in matchmaker.rank(requirement, explain=3).candidates]
