@@ -12,6 +12,9 @@ Three rules keep it equivalent to the embedded store:
   element of the query's top-level group pattern, so they pre-bind the pattern as Oxigraph's
   substitutions do (a trailing ``VALUES`` clause would join after ``GROUP BY`` and ``LIMIT``). Terms
   are written by pyoxigraph's serialiser, which has validated every IRI and escapes every literal.
+- **Queries by form POST.** ``query=`` in an ``application/x-www-form-urlencoded`` body is the one
+  way every SPARQL 1.1 server answers (Virtuoso 7 never answers a ``application/sparql-query`` body);
+  updates go as an ``application/sparql-update`` body, which Oxigraph, Fuseki and Virtuoso all take.
 - **One write, one request, one transaction.** ``add`` sends one ``INSERT DATA`` and ``replace`` one
   ``DELETE DATA ; INSERT DATA`` request; a SPARQL update request is one transaction, so a failed
   write leaves the store as it was. Writes are never split into chunks.
@@ -26,6 +29,7 @@ from collections.abc import Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import NamedTuple
+from urllib.parse import urlencode
 
 import httpx
 import pyoxigraph as ox
@@ -40,11 +44,16 @@ CONNECT_TIMEOUT = 5.0
 
 # One line, so the server's "error at LINE:COLUMN" is off by exactly one line (corrected in errors).
 PROLOGUE = " ".join(f"PREFIX {prefix}: <{namespace}>" for prefix, namespace in PREFIXES.items()) + "\n"
-# TSV first: lossless (N-Triples terms) and the quickest to write and read; JSON for other servers.
-_ACCEPT = (
+# From Oxigraph, TSV first: lossless (N-Triples terms) and the quickest to write and read. Other
+# servers' TSV need not be SPARQL 1.1's (Virtuoso 7 writes IRIs as quoted strings), so JSON first.
+_ACCEPT_OXIGRAPH = (
     "text/tab-separated-values, application/sparql-results+json;q=0.9, application/sparql-results+xml;q=0.8, "
     "application/n-triples, text/turtle;q=0.9"
 )
+# Some servers (Virtuoso 7) pick the first type listed whatever the query form, so ask by form.
+_ACCEPT_RESULTS = "application/sparql-results+json, application/sparql-results+xml;q=0.9"
+_ACCEPT_GRAPH = "application/n-triples, text/turtle;q=0.9"
+_FORM = "application/x-www-form-urlencoded"
 _POSITION = re.compile(r"\berror at (\d+):(\d+)")
 
 # Whether the server's default graph is the union: a quad from a named graph, and whether the
@@ -112,6 +121,7 @@ class RemoteStore(Store):
             verify=_tls_context(),
         )
         self._union_verified = False
+        self._oxigraph = False  # learnt from the Server header of each answer: whether TSV can be asked for
 
     @classmethod
     def open(cls, location: str | Path, timeout: float = DEFAULT_TIMEOUT, token: str | None = None) -> RemoteStore:
@@ -218,7 +228,8 @@ class RemoteStore(Store):
         rows = list(result)
         if not rows:
             return  # no named-graph data yet; checked again before the next query
-        if rows[0]["seen"] != ox.Literal(True):
+        seen = rows[0]["seen"]
+        if not (isinstance(seen, ox.Literal) and seen.value in ("true", "1")):  # Virtuoso 7 says 1
             host = httpx.URL(self.endpoints.query)
             raise StoreError(
                 self.location,
@@ -230,7 +241,13 @@ class RemoteStore(Store):
         self._union_verified = True
 
     def _query(self, text: str, original: str | None = None, params: Sequence[tuple[str, str]] = ()) -> QueryResult:
-        response = self._post(self.endpoints.query, PROLOGUE + text, "application/sparql-query", original, params)
+        form = urlencode([("query", PROLOGUE + text), *params])
+        if self._oxigraph:
+            accept = _ACCEPT_OXIGRAPH
+        else:
+            forms = (t.text.upper() for t in _tokens(text) if t.kind == "name" and t.text.upper() in _FORMS)
+            accept = _ACCEPT_GRAPH if next(forms, "SELECT") in ("CONSTRUCT", "DESCRIBE") else _ACCEPT_RESULTS
+        response = self._post(self.endpoints.query, form, _FORM, original, readable=text, accept=accept)
         media = response.headers.get("content-type", "").split(";")[0].strip().lower()
         try:
             results_format = ox.QueryResultsFormat.from_media_type(media) if media else None
@@ -247,16 +264,21 @@ class RemoteStore(Store):
         self._post(self.endpoints.update, PROLOGUE + text, "application/sparql-update", original)
 
     def _post(
-        self, url: str, body: str, content_type: str, original: str | None, params: Sequence[tuple[str, str]] = ()
+        self,
+        url: str,
+        body: str,
+        content_type: str,
+        original: str | None,
+        readable: str | None = None,
+        accept: str | None = None,
     ) -> httpx.Response:
-        """POST ``body`` (``params`` in the URL); ``original`` is the caller's own text (None for text cbrs wrote)."""
+        """POST ``body``; ``original`` is the caller's own text (None for text cbrs wrote), ``readable`` the
+        text an error shows when ``body`` is encoded."""
         headers = {"Content-Type": content_type}
-        if content_type == "application/sparql-query":
-            headers["Accept"] = _ACCEPT
+        if accept is not None:
+            headers["Accept"] = accept
         try:
-            response = self._http().post(
-                url, content=body.encode("utf-8"), headers=headers, params=list(params) or None
-            )
+            response = self._http().post(url, content=body.encode("utf-8"), headers=headers)
         except httpx.ConnectError as error:
             target = httpx.URL(url)
             raise StoreError(
@@ -268,6 +290,7 @@ class RemoteStore(Store):
             raise StoreError(self.location, f"{url} did not answer within {self.timeout:g} s") from error
         except httpx.HTTPError as error:
             raise StoreError(self.location, f"request to {url} failed: {error}") from error
+        self._oxigraph = response.headers.get("server", "").lower().startswith("oxigraph/")
         if response.is_success:
             return response
         message = _POSITION.sub(_one_line_up, response.text.strip())
@@ -277,8 +300,8 @@ class RemoteStore(Store):
             raise QuerySyntaxError(original, message)
         if status == 500:  # Oxigraph's (and Fuseki's) answer to an evaluation error; it rolled back
             operation = "query" if url == self.endpoints.query else "update"
-            raise StoreEvaluationError(self.location, operation, message, url, status, original or body)
-        raise RemoteStoreError(self.location, url, status, message, original or body)
+            raise StoreEvaluationError(self.location, operation, message, url, status, original or readable or body)
+        raise RemoteStoreError(self.location, url, status, message, original or readable or body)
 
 
 @functools.cache

@@ -12,12 +12,17 @@ Then HEAD, a repeated ``query=``, the graph formats, ``Vary``, and rdflib's ``SP
 
 from __future__ import annotations
 
+import re
+import shutil
 import socket
+import subprocess
 import threading
+import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
+import httpx
 import pyoxigraph as ox
 import pytest
 from flask.testing import FlaskClient
@@ -29,6 +34,7 @@ from werkzeug.test import TestResponse
 from cbrs.sparql_service import EndpointConfig, SparqlService, has_dataset_clause
 from cbrs.web import create_app
 from kb import KnowledgeBase
+from kb.remote_store import RemoteStore
 from kb.store import Store
 from tests.conftest import OxigraphServer
 
@@ -339,3 +345,82 @@ def test_rdflib_sparqlupdatestore_writes_one_named_graph(live: str) -> None:
     added.remove(triple)
     assert list(added) == [(URIRef("urn:test:new"), URIRef("urn:test:p"), Literal("again"))]
     assert len(Graph(store, identifier=URIRef(G2))) == 2
+
+
+# -- a remote store on another server than Oxigraph ---------------------------------------------------
+
+
+def _free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port: int = probe.getsockname()[1]
+        return port
+
+
+@pytest.fixture(scope="module")
+def virtuoso(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
+    """Virtuoso 7 (Debian's virtuoso-opensource) on free loopback ports, its SPARQL user allowed to
+    update; the URL of its endpoint. Stopped by its PID."""
+    server, isql = shutil.which("virtuoso-t"), shutil.which("isql-vt")
+    template = Path("/etc/virtuoso-opensource-7/virtuoso.ini")
+    if server is None or isql is None or not template.is_file():
+        pytest.skip("Virtuoso is not installed (apt-get install virtuoso-opensource)")
+    directory = tmp_path_factory.mktemp("virtuoso")
+    sql_port, http_port = _free_port(), _free_port()
+    ini = template.read_text()
+    ini = ini.replace("/var/lib/virtuoso-opensource-7/db/", f"{directory}/")
+    ini = re.sub(r"(?m)^ServerPort(\s*)=\s*1111$", rf"ServerPort\g<1>= {sql_port}", ini)
+    ini = re.sub(r"(?m)^ServerPort(\s*)=\s*8890$", rf"ServerPort\g<1>= {http_port}", ini)
+    (directory / "virtuoso.ini").write_text(ini)
+    log = (directory / "out.log").open("wb")
+    process = subprocess.Popen(
+        [server, "+configfile", str(directory / "virtuoso.ini"), "+foreground"],
+        cwd=directory,
+        stdout=log,
+        stderr=subprocess.STDOUT,
+    )
+    url = f"http://127.0.0.1:{http_port}/sparql"
+    try:
+        deadline = time.monotonic() + 60
+        while True:
+            assert process.poll() is None, (directory / "out.log").read_text()
+            try:
+                if httpx.get(url, params={"query": "ASK {}"}, timeout=2).status_code == 200:
+                    break
+            except httpx.TransportError:
+                pass
+            assert time.monotonic() < deadline, "Virtuoso did not answer within 60 s"
+            time.sleep(0.2)
+        grant = 'grant SPARQL_UPDATE to "SPARQL";'
+        subprocess.run(
+            [isql, str(sql_port), "dba", "dba", f"exec={grant}"], check=True, timeout=30, capture_output=True
+        )
+        yield url
+    finally:
+        process.terminate()
+        try:
+            process.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait(timeout=10)
+        log.close()
+
+
+def test_a_remote_store_on_virtuoso_reads_and_writes(virtuoso: str) -> None:
+    # Virtuoso 7 never answers a query sent as an application/sparql-query body: a form POST it does.
+    store = RemoteStore.open(f"{virtuoso} {virtuoso}", timeout=WAIT)
+    try:
+        store.add(quads())
+        assert store.count(ox.NamedNode(G3)) == 4
+        solutions = store.query(f"SELECT ?s WHERE {{ GRAPH <{G2}> {{ ?s ?p ?o }} }} ORDER BY ?s")
+        assert isinstance(solutions, ox.QuerySolutions)
+        assert [row["s"] for row in solutions] == [ox.NamedNode(f"{G2}:s0"), ox.NamedNode(f"{G2}:s1")]
+        assert bool(store.query(f"ASK {{ <{G1}:s0> ?p 0 }}"))  # the default graph is the union
+        scoped = store.query_dataset(COUNT.format(""), [G3], [])
+        assert isinstance(scoped, ox.QuerySolutions)
+        assert [row["n"] for row in scoped] == [ox.Literal(4)]
+        built = store.query(f"CONSTRUCT WHERE {{ GRAPH <{G1}> {{ ?s ?p ?o }} }}")
+        assert isinstance(built, ox.QueryTriples) and len(list(built)) == 1
+    finally:
+        store.update(f"DROP SILENT GRAPH <{G1}> ; DROP SILENT GRAPH <{G2}> ; DROP SILENT GRAPH <{G3}>")
+        store.close()
