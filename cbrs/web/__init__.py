@@ -141,7 +141,7 @@ def create_app(
         origin = request.headers.get("Origin")
         if origin is not None and origin in allowed:
             response.headers["Access-Control-Allow-Origin"] = origin
-            response.headers["Vary"] = "Origin"
+            response.vary.add("Origin")  # beside Accept, which the SPARQL answers vary on too
             response.headers["Access-Control-Allow-Methods"] = "GET, POST, OPTIONS"
             response.headers["Access-Control-Allow-Headers"] = "Accept, Authorization, Content-Type"
         return response
