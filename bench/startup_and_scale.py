@@ -1,0 +1,253 @@
+"""Benchmark: start-up, composition at scale, /cbrs/plan over the bridge and matchmaker memory (issue 18).
+
+Run: python bench/startup_and_scale.py [--repeat 5] [--chain 10000] [--classes 64000] [--ads 2000]
+[--requirements 200] [--json FILE]
+
+Each row is measured next to an anchor in the same run: a bare ``python -c pass`` and ``oxigraph serve``
+for the process starts, the in-process composer for /cbrs/plan, the memory before the requirements
+for the matchmaker. Prints the machine, the inputs, the figures and the ratios.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import shutil
+import socket
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+import urllib.request
+from pathlib import Path
+from typing import Any
+
+PYTHON = sys.executable
+FETCH = "FetchMyPen"
+
+
+def _median_seconds(argv: list[str], repeat: int) -> float:
+    samples = []
+    for _ in range(repeat):
+        start = time.perf_counter()
+        subprocess.run(argv, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        samples.append(time.perf_counter() - start)
+    return statistics.median(samples)
+
+
+def _free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return int(probe.getsockname()[1])
+
+
+def _ready_seconds(argv: list[str], url: str) -> float:
+    """From spawning ``argv`` to the first answer of ``url`` (a server's ready time)."""
+    start = time.perf_counter()
+    process = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        while True:
+            try:
+                urllib.request.urlopen(url, timeout=1).read()
+                return time.perf_counter() - start
+            except OSError:
+                if process.poll() is not None:
+                    raise RuntimeError(f"{argv[0]} exited with {process.returncode}") from None
+                time.sleep(0.005)
+    finally:
+        process.terminate()
+        process.wait()
+
+
+def startup(repeat: int) -> dict[str, float]:
+    cbrs = [PYTHON, "-m", "cbrs"]
+    figures = {
+        "python -c pass": _median_seconds([PYTHON, "-c", "pass"], repeat),
+        "cbrs --help": _median_seconds([*cbrs, "--help"], repeat),
+        "cbrs query (:memory:)": _median_seconds([*cbrs, "--store", ":memory:", "query", "ASK {}"], repeat),
+    }
+    ask = "/query?query=ASK%7B%7D"
+    with tempfile.TemporaryDirectory() as folder:
+        store = Path(folder) / "store"
+        subprocess.run([*cbrs, "--store", str(store), "init"], check=True, stdout=subprocess.DEVNULL)
+        serve: list[float] = []
+        for _ in range(repeat):
+            port = _free_port()
+            argv = [*cbrs, "--store", str(store), "serve", "--port", str(port), "--bridge-port", "0"]
+            serve.append(_ready_seconds(argv, f"http://127.0.0.1:{port}/sparql?query=ASK%7B%7D"))
+        figures["cbrs serve ready (on-disk store)"] = statistics.median(serve)
+        oxigraph = shutil.which("oxigraph") or str(Path(PYTHON).parent / "oxigraph")
+        if Path(oxigraph).exists():
+            anchor: list[float] = []
+            for n in range(repeat):
+                port = _free_port()
+                argv = [oxigraph, "serve", "--location", str(Path(folder) / f"ox{n}"), "--bind", f"127.0.0.1:{port}"]
+                anchor.append(_ready_seconds(argv, f"http://127.0.0.1:{port}{ask}"))
+            figures["oxigraph serve ready"] = statistics.median(anchor)
+    return figures
+
+
+def composition(chain: int) -> dict[str, float]:
+    from actions.composer import ComposeConfig, Composer, PlanStatus
+    from actions.model import ActionLibrary
+    from kb import Advertisement, KnowledgeBase, Parameter, Requirement
+    from reasoner.taxonomy import ROOT, Link, TaxonomyIndex
+
+    ns = "http://example.org/scale#"
+    links = [Link(f"{ns}C{i}", ROOT, "is-a") for i in range(chain + 1)] + [Link(ns + "X", ROOT, "is-a")]
+    pool = [
+        Advertisement(
+            iri=f"{ns}ad{i}",
+            types=(),
+            inputs=(Parameter(f"{ns}ad{i}in", "input", f"{ns}C{i}"),),
+            outputs=(Parameter(f"{ns}ad{i}out", "output", f"{ns}C{i + 1}"),),
+        )
+        for i in range(chain)
+    ]
+    start = time.perf_counter()
+    composer = Composer(
+        KnowledgeBase.open(":memory:"),
+        ComposeConfig(matched=False),
+        index=TaxonomyIndex.from_links(links),
+        actions=ActionLibrary(),
+        advertisements=pool,
+    )
+    _ = composer.pool
+    built = time.perf_counter() - start
+
+    def compose(given: str) -> float:
+        requirement = Requirement(
+            iri=ns + "req",
+            types=(),
+            inputs=(Parameter(ns + "given", "input", given),),
+            outputs=(Parameter(ns + "wanted", "output", f"{ns}C{chain}"),),
+        )
+        start = time.perf_counter()
+        result = composer.compose(requirement)
+        seconds = time.perf_counter() - start
+        assert result.status is (PlanStatus.PLANNED if given != ns + "X" else PlanStatus.UNSOLVABLE)
+        return seconds
+
+    return {
+        "pool build": built,
+        f"unsolvable, explained down {chain} links": compose(ns + "X"),
+        "planned, 5 steps at the chain's end": compose(f"{ns}C{chain - 5}"),
+    }
+
+
+def plan_over_bridge(repeat: int) -> dict[str, float]:
+    from actions.composer import Composer
+    from cbrs.bridge_client import BridgeClient
+    from cbrs.server import ServeConfig, Server
+    from kb import KnowledgeBase
+
+    kb = KnowledgeBase.open(":memory:")
+    composer = Composer(kb)
+    composer.compose(FETCH)
+    local = []
+    for _ in range(repeat * 4):
+        start = time.perf_counter()
+        composer.compose(FETCH)
+        local.append(time.perf_counter() - start)
+    server = Server(kb, ServeConfig(port=0, bridge_port=0))
+    server.start()
+    try:
+        with BridgeClient(f"ws://127.0.0.1:{server.bridge_port}") as client:
+            client.call_sync("/cbrs/plan", {"task": FETCH})
+            remote = []
+            for _ in range(repeat * 4):
+                start = time.perf_counter()
+                client.call_sync("/cbrs/plan", {"task": FETCH})
+                remote.append(time.perf_counter() - start)
+    finally:
+        server.stop()
+    return {
+        "Composer.compose in-process": statistics.median(local),
+        "/cbrs/plan over the bridge": statistics.median(remote),
+    }
+
+
+def matchmaker_memory(classes: int, ads: int, requirements: int) -> dict[str, float]:
+    from kb import KnowledgeBase
+    from reasoner import synthetic
+    from reasoner.matchmaker import Matchmaker
+
+    def rss() -> float:
+        return int(Path("/proc/self/statm").read_text().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2**20
+
+    index, pool, wanted = synthetic.build(classes, ads, requirements + 1, seed=11)
+    matchmaker = Matchmaker(KnowledgeBase.open(":memory:"), index=index, advertisements=pool).prepare()
+    matchmaker.rank(wanted[0], explain=1)
+    before = rss()
+    half = requirements // 2
+    start = time.perf_counter()
+    for requirement in wanted[1 : half + 1]:
+        matchmaker.rank(requirement, explain=1)
+    middle = rss()
+    for requirement in wanted[half + 1 :]:
+        matchmaker.rank(requirement, explain=1)
+    after = rss()
+    return {
+        "RSS before the requirements, MB": before,
+        f"RSS after {requirements} distinct requirements, MB": after,
+        "MB per requirement, second half": (after - middle) / max(1, requirements - half),
+        "ms per ranking": (time.perf_counter() - start) * 1000 / requirements,
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeat", type=int, default=5)
+    parser.add_argument("--chain", type=int, default=10_000)
+    parser.add_argument("--classes", type=int, default=64_000)
+    parser.add_argument("--ads", type=int, default=2_000)
+    parser.add_argument("--requirements", type=int, default=200)
+    parser.add_argument("--json", type=Path, help="Also write the figures to FILE as JSON.")
+    args = parser.parse_args()
+    load = os.getloadavg()[0]
+    machine = f"{platform.platform()}, {os.cpu_count()} cores, python {platform.python_version()}"
+    print(f"machine: {machine}, load average {load:.2f}")
+    print(
+        f"inputs: repeat {args.repeat}; chain pool of {args.chain} advertisements; matchmaker over "
+        f"{args.classes} classes, {args.ads} advertisements, {args.requirements} distinct requirements"
+    )
+    record: dict[str, Any] = {"machine": platform.platform(), "cores": os.cpu_count(), "load": load}
+
+    print("\nProcess start (median of repeat, seconds):")
+    figures = record["startup"] = startup(args.repeat)
+    bare = figures["python -c pass"]
+    for name, seconds in figures.items():
+        anchor = figures.get("oxigraph serve ready") if "serve" in name else bare
+        ratio = f"{seconds / anchor:6.1f}x {'oxigraph serve' if 'serve' in name else 'python -c pass'}"
+        print(f"  {name:<36} {seconds:7.3f}  {ratio if anchor else ''}")
+
+    print("\nComposition over a chain pool (seconds):")
+    try:
+        record["composition"] = composition(args.chain)
+    except RecursionError as error:  # what the composer raised before issue 18
+        record["composition"] = {"error": f"RecursionError: {error}"}
+        print(f"  RecursionError: {error}")
+    else:
+        for name, seconds in record["composition"].items():
+            print(f"  {name:<42} {seconds:7.3f}")
+
+    print("\n/cbrs/plan FetchMyPen (median, ms):")
+    plan = record["plan"] = plan_over_bridge(args.repeat)
+    local = plan["Composer.compose in-process"]
+    for name, seconds in plan.items():
+        print(f"  {name:<36} {seconds * 1000:7.1f}  {seconds / local:5.2f}x in-process")
+
+    print("\nMatchmaker memory:")
+    record["memory"] = matchmaker_memory(args.classes, args.ads, args.requirements)
+    for name, value in record["memory"].items():
+        print(f"  {name:<42} {value:8.1f}")
+    if args.json is not None:
+        args.json.write_text(json.dumps(record, indent=2) + "\n")
+        print(f"\nwritten to {args.json}")
+
+
+if __name__ == "__main__":
+    main()
