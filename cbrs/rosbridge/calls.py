@@ -97,9 +97,11 @@ class Calls:
         call = self._pending.get(str(key))
         if call is None or call.provider is not provider:
             return False
-        if values is None:
+        if isinstance(values, dict):
+            result = True  # rosbridge_suite's rule: an object of values is the response, whatever `result` says
+        elif values is None:
             values = {} if result else f"service {call.service!r} failed (its provider gave no reason)"
-        elif result and not isinstance(values, dict):
+        elif result:
             result, values = False, f"service {call.service!r} answered with values that are not an object"
         self.finish(call, result, protocol.dumps(values))
         return True
