@@ -4,7 +4,7 @@
 component meets; docs/composition.md explains the algorithm.
 """
 
-from actions.composer import (
+from cbrs.actions.composer import (
     ComposeConfig,
     Composer,
     CompositionResult,
@@ -13,9 +13,9 @@ from actions.composer import (
     Unsatisfied,
     store_plan,
 )
-from actions.errors import ActionsError, OrderingConflictError, UnknownTaskError
-from actions.model import ActionClass, ActionLibrary, Ordering, Task, resolve_task
-from actions.plan import Binding, Plan, PlanStep, Source
+from cbrs.actions.errors import ActionsError, OrderingConflictError, UnknownTaskError
+from cbrs.actions.model import ActionClass, ActionLibrary, Ordering, Task, resolve_task
+from cbrs.actions.plan import Binding, Plan, PlanStep, Source
 
 __all__ = [
     "ActionClass",

@@ -13,9 +13,9 @@ from dataclasses import dataclass, field
 
 import pyoxigraph as ox
 
-from kb import GraphName, KnowledgeBase
-from kb.namespaces import BASE, PREFIXES
-from kb.vocab import CBRS
+from cbrs.kb import GraphName, KnowledgeBase
+from cbrs.kb.namespaces import BASE, PREFIXES
+from cbrs.kb.vocab import CBRS
 
 WORLD = BASE + "world#"
 STATE = WORLD + "State"

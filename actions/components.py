@@ -18,9 +18,9 @@ from dataclasses import dataclass, field
 from enum import Enum
 from typing import Any
 
-from actions.errors import ActionsError
-from actions.events import EventBus, Priority
-from actions.faults import Fault, FaultPolicy
+from cbrs.actions.errors import ActionsError
+from cbrs.actions.events import EventBus, Priority
+from cbrs.actions.faults import Fault, FaultPolicy
 
 
 class Status(Enum):

@@ -30,8 +30,8 @@ from typing import TYPE_CHECKING, Any
 import networkx as nx
 import pyoxigraph as ox
 
-from actions.errors import OrderingConflictError
-from actions.graph import (
+from cbrs.actions.errors import OrderingConflictError
+from cbrs.actions.graph import (
     SRE,
     SRI,
     SRO,
@@ -43,16 +43,16 @@ from actions.graph import (
     parameter_names,
     statement_text,
 )
-from actions.model import ActionLibrary, Task, resolve_task
-from actions.plan import Binding, Plan, PlanStep, Source
-from actions.search import SearchTrace, bidirectional_search
-from kb import Advertisement, KnowledgeBase, Requirement, Statement
-from kb.namespaces import GraphName, shorten
-from reasoner.config import MatchConfig
+from cbrs.actions.model import ActionLibrary, Task, resolve_task
+from cbrs.actions.plan import Binding, Plan, PlanStep, Source
+from cbrs.actions.search import SearchTrace, bidirectional_search
+from cbrs.kb import Advertisement, KnowledgeBase, Requirement, Statement
+from cbrs.kb.namespaces import GraphName, shorten
+from cbrs.reasoner.config import MatchConfig
 
 if TYPE_CHECKING:
-    from reasoner.matchmaker import EntityPair, Matchmaker
-from reasoner.taxonomy import TaxonomyIndex
+    from cbrs.reasoner.matchmaker import EntityPair, Matchmaker
+from cbrs.reasoner.taxonomy import TaxonomyIndex
 
 GOAL = "GOAL"  # the extraction's virtual consumer: SRO's and SRE's needs together
 MAX_DEPTH = 4  # how many levels of sub-actions a task may be decomposed into
@@ -235,7 +235,7 @@ class Composer:
         the whole requirement (Sem-Str, paper Table 3: the ceiling camera's RobotLocation for a robot
         asking its RobotPosition), run on its own, if the requirement gives each of its inputs and the
         requirement or the world its preconditions, and it states every effect the requirement wants."""
-        from reasoner.matchmaker import Matchmaker  # only when composition found nothing
+        from cbrs.reasoner.matchmaker import Matchmaker  # only when composition found nothing
 
         requirement = task.requirement
         if self._matchmaker is None:  # kept: it lays the advertisements out as arrays once

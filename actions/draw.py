@@ -18,8 +18,8 @@ import matplotlib.pyplot as plt
 from matplotlib.axes import Axes
 from matplotlib.lines import Line2D
 
-from actions.composer import Attempt, CompositionResult
-from actions.graph import SRE, SRI, SRO
+from cbrs.actions.composer import Attempt, CompositionResult
+from cbrs.actions.graph import SRE, SRI, SRO
 
 FORMATS = (".svg", ".png")
 FORWARD, BACKWARD, PLAN = "#1f77b4", "#d62ad0", "#111111"

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from kb import KnowledgeBaseError
+from cbrs.kb import KnowledgeBaseError
 
 
 class ActionsError(KnowledgeBaseError):

@@ -16,12 +16,12 @@ from dataclasses import dataclass, field
 from enum import Enum
 from typing import Any, Protocol
 
-from actions.components import Container, LifecycleState, Status
-from actions.events import Priority
-from actions.graph import statement_text
-from actions.plan import Plan, PlanStep
-from kb import Statement
-from reasoner.names import local_name
+from cbrs.actions.components import Container, LifecycleState, Status
+from cbrs.actions.events import Priority
+from cbrs.actions.graph import statement_text
+from cbrs.actions.plan import Plan, PlanStep
+from cbrs.kb import Statement
+from cbrs.reasoner.names import local_name
 
 
 class RunStatus(Enum):

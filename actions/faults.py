@@ -14,8 +14,8 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Protocol
 
-from actions.errors import ActionsError
-from actions.plan import Plan
+from cbrs.actions.errors import ActionsError
+from cbrs.actions.plan import Plan
 
 
 class FaultSpecError(ActionsError, ValueError):

@@ -19,14 +19,14 @@ from typing import Literal
 
 import networkx as nx
 
-from kb import Advertisement, Parameter, Requirement, Statement
-from kb.namespaces import shorten
-from kb.vocab import CBRS
-from reasoner.config import MatchConfig
-from reasoner.degrees import Degree, degree_of_match
-from reasoner.similarity import SemStr
-from reasoner.statements import statement_similarity
-from reasoner.taxonomy import TaxonomyIndex
+from cbrs.kb import Advertisement, Parameter, Requirement, Statement
+from cbrs.kb.namespaces import shorten
+from cbrs.kb.vocab import CBRS
+from cbrs.reasoner.config import MatchConfig
+from cbrs.reasoner.degrees import Degree, degree_of_match
+from cbrs.reasoner.similarity import SemStr
+from cbrs.reasoner.statements import statement_similarity
+from cbrs.reasoner.taxonomy import TaxonomyIndex
 
 SRI = "SRI"  # virtual entrance: provides the requirement's inputs and preconditions
 SRO = "SRO"  # virtual exit: needs the requirement's outputs

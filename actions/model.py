@@ -11,10 +11,10 @@ from dataclasses import dataclass, field
 
 import networkx as nx
 
-from actions.errors import UnknownTaskError
-from kb import KnowledgeBase, NotFoundError, Requirement
-from kb.namespaces import expand
-from reasoner.names import local_name
+from cbrs.actions.errors import UnknownTaskError
+from cbrs.kb import KnowledgeBase, NotFoundError, Requirement
+from cbrs.kb.namespaces import expand
+from cbrs.reasoner.names import local_name
 
 
 @dataclass(frozen=True)

@@ -12,9 +12,9 @@ from typing import Any
 
 import pyoxigraph as ox
 
-from kb import Statement
-from kb.namespaces import BASE, PREFIXES, GraphName
-from kb.vocab import CBRS
+from cbrs.kb import Statement
+from cbrs.kb.namespaces import BASE, PREFIXES, GraphName
+from cbrs.kb.vocab import CBRS
 
 RDF_TYPE = ox.NamedNode(PREFIXES["rdf"] + "type")
 RDFS_LABEL = ox.NamedNode(PREFIXES["rdfs"] + "label")

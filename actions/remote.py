@@ -15,7 +15,7 @@ from concurrent.futures import Future
 from concurrent.futures import TimeoutError as FutureTimeout
 from typing import Any, Protocol
 
-from actions.components import Component, Status
+from cbrs.actions.components import Component, Status
 
 __all__ = ["POLL_SECONDS", "RemoteCallError", "RemoteComponent", "Transport"]
 

@@ -11,15 +11,15 @@ from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any, Protocol
 
-from actions.belief import BeliefState, Observation
-from actions.components import Container, Registry
-from actions.composer import Composer, CompositionResult, PlanStatus, store_plan
-from actions.events import Event, EventBus
-from actions.executor import ExecutionReport, Executor, RunStatus
-from actions.faults import Combined, FaultPolicy, FixedFaults
-from actions.graph import statement_text
-from actions.plan import Plan, PlanStep
-from kb import KnowledgeBase, Requirement, Statement
+from cbrs.actions.belief import BeliefState, Observation
+from cbrs.actions.components import Container, Registry
+from cbrs.actions.composer import Composer, CompositionResult, PlanStatus, store_plan
+from cbrs.actions.events import Event, EventBus
+from cbrs.actions.executor import ExecutionReport, Executor, RunStatus
+from cbrs.actions.faults import Combined, FaultPolicy, FixedFaults
+from cbrs.actions.graph import statement_text
+from cbrs.actions.plan import Plan, PlanStep
+from cbrs.kb import KnowledgeBase, Requirement, Statement
 
 
 class Environment(Protocol):

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from actions.graph import SRE, SRI, SRO, Edge, ServiceResourceGraph
+from cbrs.actions.graph import SRE, SRI, SRO, Edge, ServiceResourceGraph
 
 
 @dataclass(frozen=True)

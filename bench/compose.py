@@ -15,10 +15,10 @@ import platform
 import statistics
 import time
 
-from actions.composer import Composer, PlanStatus
-from actions.model import ActionLibrary
-from kb import KnowledgeBase
-from reasoner import synthetic
+from cbrs.actions.composer import Composer, PlanStatus
+from cbrs.actions.model import ActionLibrary
+from cbrs.kb import KnowledgeBase
+from cbrs.reasoner import synthetic
 
 TASKS = ["PutCupBelowOfTapOfWaterDispenser", "FetchMyPen", "RobotArmServeACup"]
 

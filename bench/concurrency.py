@@ -32,11 +32,11 @@ import httpx
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the scenarios live in tests/ (run from anywhere)
 
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.queries import QueryLibrary
+from cbrs.kb.resources import query_dir
 from cbrs.server import ServeConfig, Server
 from cbrs.sparql_service import EndpointConfig
-from kb import KnowledgeBase
-from kb.queries import QueryLibrary
-from kb.resources import query_dir
 from tests.helpers_concurrency import (
     BATCH_QUERY,
     BridgeLoad,

@@ -19,14 +19,14 @@ import platform
 import time
 from collections import Counter
 
-from actions.composer import Composer
-from actions.faults import RandomFaults, doomed_steps, planned_faults
-from actions.runner import run_task
-from kb import KnowledgeBase
-from kb.namespaces import shorten
-from kb.semantic_map import SemanticMap
-from sim.components import SimEnvironment
-from sim.world import HomeWorld
+from cbrs.actions.composer import Composer
+from cbrs.actions.faults import RandomFaults, doomed_steps, planned_faults
+from cbrs.actions.runner import run_task
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import shorten
+from cbrs.kb.semantic_map import SemanticMap
+from cbrs.sim.components import SimEnvironment
+from cbrs.sim.world import HomeWorld
 
 TASKS = ("FetchMyPen", "RobotArmServeACup")
 

@@ -14,8 +14,8 @@ from collections.abc import Callable
 
 import pyoxigraph
 
-from kb import KnowledgeBase, Store
-from kb.resources import bundled_files
+from cbrs.kb import KnowledgeBase, Store
+from cbrs.kb.resources import bundled_files
 
 # Sample bindings for the queries that need one.
 BINDINGS = {

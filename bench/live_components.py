@@ -32,17 +32,17 @@ from typing import Any
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from actions.components import Component, Status  # noqa: E402
-from actions.remote import RemoteComponent  # noqa: E402
+from cbrs.actions.components import Component, Status  # noqa: E402
+from cbrs.actions.remote import RemoteComponent  # noqa: E402
 from cbrs.bridge_client import BridgeClient  # noqa: E402
 from cbrs.component import Component as SdkComponent  # noqa: E402
 from cbrs.external_demo import run_external_demo  # noqa: E402
+from cbrs.kb import KnowledgeBase  # noqa: E402
+from cbrs.kb.namespaces import PREFIXES  # noqa: E402
+from cbrs.reasoner.matchmaker import Matchmaker  # noqa: E402
 from cbrs.server import ServeConfig, Server  # noqa: E402
+from cbrs.sim.values import check  # noqa: E402
 from cbrs.sparql_service import EndpointConfig  # noqa: E402
-from kb import KnowledgeBase  # noqa: E402
-from kb.namespaces import PREFIXES  # noqa: E402
-from reasoner.matchmaker import Matchmaker  # noqa: E402
-from sim.values import check  # noqa: E402
 from tests.test_live_components import READING, THERMOMETER, thermometer  # noqa: E402
 
 TOKEN = "bench-live-components"

@@ -15,10 +15,10 @@ import platform
 import statistics
 import time
 
-from kb import KnowledgeBase, Store
-from reasoner.matchmaker import Matchmaker
-from reasoner.methods import METHODS
-from reasoner.synthetic import build
+from cbrs.kb import KnowledgeBase, Store
+from cbrs.reasoner.matchmaker import Matchmaker
+from cbrs.reasoner.methods import METHODS
+from cbrs.reasoner.synthetic import build
 
 
 def main() -> None:

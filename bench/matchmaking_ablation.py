@@ -19,11 +19,11 @@ import sys
 from dataclasses import replace
 from pathlib import Path
 
-from reasoner.config import MatchConfig
-from reasoner.evaluation import evaluate_paper
-from reasoner.matchmaker import Matchmaker
-from reasoner.metrics import average_precision
-from reasoner.owlstc import _file_key, load_collection, read_relevance
+from cbrs.reasoner.config import MatchConfig
+from cbrs.reasoner.evaluation import evaluate_paper
+from cbrs.reasoner.matchmaker import Matchmaker
+from cbrs.reasoner.metrics import average_precision
+from cbrs.reasoner.owlstc import _file_key, load_collection, read_relevance
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULTS = [ROOT.parent / "shared" / "owls-tc4", ROOT / "tests" / "data" / "robot_services"]

@@ -17,9 +17,9 @@ import statistics
 import time
 from pathlib import Path
 
-from reasoner.matchmaker import Matchmaker
-from reasoner.methods import METHODS
-from reasoner.owlstc import load_collection
+from cbrs.reasoner.matchmaker import Matchmaker
+from cbrs.reasoner.methods import METHODS
+from cbrs.reasoner.owlstc import load_collection
 
 DEFAULT = Path(__file__).resolve().parents[2] / "shared" / "owls-tc4"
 

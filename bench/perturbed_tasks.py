@@ -21,12 +21,12 @@ import time
 from pathlib import Path
 from typing import Any
 
-from actions.composer import Composer
-from actions.runner import run_task
-from kb import KnowledgeBase
-from kb.semantic_map import SemanticMap
-from sim.components import SimEnvironment
-from sim.world import Spread, open_world
+from cbrs.actions.composer import Composer
+from cbrs.actions.runner import run_task
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.semantic_map import SemanticMap
+from cbrs.sim.components import SimEnvironment
+from cbrs.sim.world import Spread, open_world
 
 DATA = Path(__file__).resolve().parents[1] / "tests" / "data" / "tasks"
 TASKS: dict[str, list[tuple[str, str]]] = {

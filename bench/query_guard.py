@@ -22,8 +22,8 @@ import threading
 import time
 from collections.abc import Callable
 
-from kb.errors import QueryTooComplexError
-from kb.query_guard import DIRECT_CHARS, QueryGuard
+from cbrs.kb.errors import QueryTooComplexError
+from cbrs.kb.query_guard import DIRECT_CHARS, QueryGuard
 
 CONSTRUCTS: dict[str, Callable[[int], str]] = {
     "nested brackets": lambda n: "SELECT * WHERE { FILTER(" + "(" * n + "1" + ")" * n + ") }",

@@ -25,8 +25,8 @@ from pathlib import Path
 import httpx
 import pyoxigraph
 
-from kb import KnowledgeBase
-from kb.resources import bundled_files
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.resources import bundled_files
 
 LOCATE = "svc:LocateMobileRobot_CeilingCamera01"
 CAMERA3 = """@prefix cbrs: <https://w3id.org/cbrs/core#> . @prefix home: <https://w3id.org/cbrs/home#> .

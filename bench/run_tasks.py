@@ -14,13 +14,13 @@ import platform
 import statistics
 import time
 
-from actions.composer import Composer
-from actions.runner import run_task
-from kb import KnowledgeBase
-from kb.namespaces import expand
-from kb.semantic_map import SemanticMap
-from sim.components import SimEnvironment
-from sim.world import HomeWorld
+from cbrs.actions.composer import Composer
+from cbrs.actions.runner import run_task
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import expand
+from cbrs.kb.semantic_map import SemanticMap
+from cbrs.sim.components import SimEnvironment
+from cbrs.sim.world import HomeWorld
 
 TASKS = ("RobotArmServeACup", "FetchMyPen")
 

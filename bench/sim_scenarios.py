@@ -15,8 +15,8 @@ import time
 from collections.abc import Callable
 from importlib.metadata import version
 
-from sim import HomeWorld, build_occupancy_grid, plan_path
-from sim.world import TIME_STEP
+from cbrs.sim import HomeWorld, build_occupancy_grid, plan_path
+from cbrs.sim.world import TIME_STEP
 from tests.home_layout import HANDOVER_POSE
 from tests.reference_scenarios import ScenarioResult, fetch_pen, serve_cup
 

@@ -28,9 +28,9 @@ from pathlib import Path
 
 import httpx
 
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import PREFIXES
 from cbrs.server import ServeConfig, Server
-from kb import KnowledgeBase
-from kb.namespaces import PREFIXES
 
 PER_QUERY = 30
 TRIVIAL = "SELECT ?s WHERE { ?s a <https://w3id.org/cbrs/core#Requirement> } LIMIT 1"  # mostly HTTP overhead

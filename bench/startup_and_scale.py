@@ -91,10 +91,10 @@ def startup(repeat: int) -> dict[str, float]:
 
 
 def composition(chain: int) -> dict[str, float]:
-    from actions.composer import ComposeConfig, Composer, PlanStatus
-    from actions.model import ActionLibrary
-    from kb import Advertisement, KnowledgeBase, Parameter, Requirement
-    from reasoner.taxonomy import ROOT, Link, TaxonomyIndex
+    from cbrs.actions.composer import ComposeConfig, Composer, PlanStatus
+    from cbrs.actions.model import ActionLibrary
+    from cbrs.kb import Advertisement, KnowledgeBase, Parameter, Requirement
+    from cbrs.reasoner.taxonomy import ROOT, Link, TaxonomyIndex
 
     ns = "http://example.org/scale#"
     links = [Link(f"{ns}C{i}", ROOT, "is-a") for i in range(chain + 1)] + [Link(ns + "X", ROOT, "is-a")]
@@ -139,10 +139,10 @@ def composition(chain: int) -> dict[str, float]:
 
 
 def plan_over_bridge(repeat: int) -> dict[str, float]:
-    from actions.composer import Composer
+    from cbrs.actions.composer import Composer
     from cbrs.bridge_client import BridgeClient
+    from cbrs.kb import KnowledgeBase
     from cbrs.server import ServeConfig, Server
-    from kb import KnowledgeBase
 
     kb = KnowledgeBase.open(":memory:")
     composer = Composer(kb)
@@ -171,9 +171,9 @@ def plan_over_bridge(repeat: int) -> dict[str, float]:
 
 
 def matchmaker_memory(classes: int, ads: int, requirements: int) -> dict[str, float]:
-    from kb import KnowledgeBase
-    from reasoner import synthetic
-    from reasoner.matchmaker import Matchmaker
+    from cbrs.kb import KnowledgeBase
+    from cbrs.reasoner import synthetic
+    from cbrs.reasoner.matchmaker import Matchmaker
 
     def rss() -> float:
         return int(Path("/proc/self/statm").read_text().split()[1]) * os.sysconf("SC_PAGE_SIZE") / 2**20

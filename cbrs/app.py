@@ -6,9 +6,9 @@ from dataclasses import dataclass, field
 
 import click
 
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import expand
 from cbrs.settings import setting
-from kb import KnowledgeBase
-from kb.namespaces import expand
 
 
 @dataclass

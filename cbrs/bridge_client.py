@@ -20,7 +20,7 @@ from typing import Any
 from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import ClientConnection, connect
 
-from actions.remote import RemoteCallError
+from cbrs.actions.remote import RemoteCallError
 
 __all__ = ["BridgeClient", "BridgeClosedError", "ServiceHandler"]
 

@@ -25,15 +25,15 @@ import json
 from collections.abc import Callable, Collection
 from typing import Any, TypeVar
 
-from actions.composer import ComposeConfig, Composer, Objective, store_plan
+from cbrs.actions.composer import ComposeConfig, Composer, Objective, store_plan
+from cbrs.kb.errors import KnowledgeBaseError
+from cbrs.kb.namespaces import GraphName, expand
+from cbrs.kb.remote_store import RemoteStore
 from cbrs.matchmakers import Matchmakers
+from cbrs.reasoner.methods import METHODS
 from cbrs.rosbridge import Bridge, ServiceError, current_caller
 from cbrs.sparql_service import SparqlService
 from cbrs.tasks import RUN_TOPIC, TaskRunner
-from kb.errors import KnowledgeBaseError
-from kb.namespaces import GraphName, expand
-from kb.remote_store import RemoteStore
-from reasoner.methods import METHODS
 
 TOPICS = {
     "/cbrs/task_progress": "cbrs/TaskProgress",

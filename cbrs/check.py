@@ -20,8 +20,8 @@ from typing import Any
 
 import pyoxigraph as ox
 
-from kb import KnowledgeBase, KnowledgeBaseError
-from kb.namespaces import OWL, GraphName, shorten
+from cbrs.kb import KnowledgeBase, KnowledgeBaseError
+from cbrs.kb.namespaces import OWL, GraphName, shorten
 
 DEFAULT_GRAPHS = (GraphName.ONTOLOGY, GraphName.SERVICES, GraphName.REQUIREMENTS)
 JAVA_HINT = "install a Java runtime (Debian/Ubuntu: apt-get install default-jre-headless) or put java on PATH"

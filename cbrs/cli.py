@@ -19,12 +19,12 @@ import pyoxigraph as ox
 
 from cbrs import __version__
 from cbrs.app import App, parse_iri, pass_app
+from cbrs.kb import Advertisement, KnowledgeBaseError, Requirement, ServiceDescription
+from cbrs.kb.catalog import Catalogue, merge
+from cbrs.kb.loader import LoadReport, ParsedFile
+from cbrs.kb.namespaces import OWL, PREFIXES, GraphName, expand, shorten
 from cbrs.output import RESULT_FORMATS, render_result, table, term_text
 from cbrs.settings import SETTINGS, setting
-from kb import Advertisement, KnowledgeBaseError, Requirement, ServiceDescription
-from kb.catalog import Catalogue, merge
-from kb.loader import LoadReport, ParsedFile
-from kb.namespaces import OWL, PREFIXES, GraphName, expand, shorten
 
 # Commands whose modules import numpy, networkx, the composer or the web server (most of a second at
 # start-up): each is imported when it runs or shows its own help. ``cbrs --help`` lists them from the

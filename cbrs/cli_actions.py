@@ -13,17 +13,17 @@ from typing import Any
 
 import click
 
-from actions.composer import ComposeConfig, Composer, CompositionResult, Objective, PlanStatus, store_plan
-from actions.events import Event
-from actions.faults import RandomFaults, planned_faults
-from actions.graph import statement_text
-from actions.plan import Binding, Plan
-from actions.runner import RunResult, run_task
+from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, Objective, PlanStatus, store_plan
+from cbrs.actions.events import Event
+from cbrs.actions.faults import RandomFaults, planned_faults
+from cbrs.actions.graph import statement_text
+from cbrs.actions.plan import Binding, Plan
+from cbrs.actions.runner import RunResult, run_task
 from cbrs.app import App, parse_iri, pass_app
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import shorten
 from cbrs.output import table
 from cbrs.task_names import task_iri
-from kb import KnowledgeBase
-from kb.namespaces import shorten
 
 
 @click.command()
@@ -56,7 +56,7 @@ def plan(app: App, task: str, as_json: bool, drawing: Path | None, objective: st
     if result.plan is not None and not no_store:
         store_plan(app.kb, result.plan)
     if drawing is not None:
-        from actions.draw import draw  # matplotlib is slow to import; only when asked
+        from cbrs.actions.draw import draw  # matplotlib is slow to import; only when asked
 
         draw(result, drawing)
     click.echo(json.dumps(result.to_dict(), indent=2) if as_json else plan_text(result))
@@ -156,10 +156,10 @@ def run(
     Exits with status 1 when there is no plan or the run fails; a failed run names the requirement
     it could not meet and every component tried for it.
     """
-    from kb.semantic_map import SemanticMap
-    from sim.components import SimEnvironment  # pybullet loads only for this command
-    from sim.recording import Recorder, RecordingError, check_target
-    from sim.world import open_world
+    from cbrs.kb.semantic_map import SemanticMap
+    from cbrs.sim.components import SimEnvironment  # pybullet loads only for this command
+    from cbrs.sim.recording import Recorder, RecordingError, check_target
+    from cbrs.sim.world import open_world
 
     if gui:
         missing = display_problem(os.environ)
@@ -327,9 +327,9 @@ DEMO_RUNS = (
 def scenario_runs(kb: KnowledgeBase, seed: int = 0) -> tuple[str, bool]:
     """Run the paper's two scenarios headless (FetchMyPen also with its localiser failed): one row
     each, then the world graph; and whether every run succeeded."""
-    from kb.semantic_map import SemanticMap
-    from sim.components import SimEnvironment
-    from sim.world import open_world
+    from cbrs.kb.semantic_map import SemanticMap
+    from cbrs.sim.components import SimEnvironment
+    from cbrs.sim.world import open_world
 
     rows = []
     failed = 0

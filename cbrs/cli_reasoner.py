@@ -8,13 +8,13 @@ from pathlib import Path
 import click
 
 from cbrs.app import App, parse_iri, pass_app
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import shorten
 from cbrs.output import table
-from kb import KnowledgeBase
-from kb.namespaces import shorten
-from reasoner.config import MatchConfig
-from reasoner.degrees import Degree
-from reasoner.matchmaker import Candidate, EntityPair, Matchmaker, MatchResult, MatchStatus
-from reasoner.methods import METHODS
+from cbrs.reasoner.config import MatchConfig
+from cbrs.reasoner.degrees import Degree
+from cbrs.reasoner.matchmaker import Candidate, EntityPair, Matchmaker, MatchResult, MatchStatus
+from cbrs.reasoner.methods import METHODS
 
 
 @click.command()
@@ -103,7 +103,7 @@ def eval_group() -> None:
 @click.option("--plot", type=click.Path(dir_okay=False, path_type=Path), help="Write a bar chart of the figures (PNG).")
 def eval_paper(methods: tuple[str, ...], as_json: bool, plot: Path | None) -> None:
     """The paper-style testbed: 20 requirements against 100 components (reasoner/data/)."""
-    from reasoner.evaluation import evaluate_paper, plot_report
+    from cbrs.reasoner.evaluation import evaluate_paper, plot_report
 
     report = evaluate_paper(methods or METHODS)
     if as_json:
@@ -131,7 +131,7 @@ _TEXT_WEIGHT = click.option(
 @_TEXT_WEIGHT
 def eval_owls_tc(folder: Path, methods: tuple[str, ...], as_json: bool, plot: Path | None, text_weight: float) -> None:
     """An OWL-S test collection in the OWLS-TC layout: services/, ontology/, queries/, relevance.xml."""
-    from reasoner.owlstc import evaluate_collection, plot_curves
+    from cbrs.reasoner.owlstc import evaluate_collection, plot_curves
 
     if not as_json:
         click.echo(f"loading {folder} and ranking every service for every query ...", err=True)

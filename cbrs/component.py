@@ -24,11 +24,11 @@ from collections.abc import Callable
 import pyoxigraph as ox
 
 from cbrs.bridge_client import BridgeClient, BridgeClosedError, ServiceHandler
+from cbrs.kb.errors import InvalidDescriptionError
+from cbrs.kb.loader import parse_bytes
+from cbrs.kb.namespaces import BASE, GraphName
+from cbrs.kb.vocab import CBRS
 from cbrs.live_components import DEFAULT_TTL, FORMATS, grounding
-from kb.errors import InvalidDescriptionError
-from kb.loader import parse_bytes
-from kb.namespaces import BASE, GraphName
-from kb.vocab import CBRS
 
 __all__ = ["Component", "ConnectedComponent"]
 

@@ -18,13 +18,13 @@ import pyoxigraph as ox
 
 from cbrs.bridge_client import BridgeClient
 from cbrs.component import Component
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import PREFIXES, GraphName
+from cbrs.kb.semantic_map import SemanticMap
+from cbrs.kb.vocab import CBRS
+from cbrs.sim.perception import MarkerModel, locate_robot
+from cbrs.sim.values import to_json
 from cbrs.sim_sensors import CAPTURE_SERVICE, frame_from_json
-from kb import KnowledgeBase
-from kb.namespaces import PREFIXES, GraphName
-from kb.semantic_map import SemanticMap
-from kb.vocab import CBRS
-from sim.perception import MarkerModel, locate_robot
-from sim.values import to_json
 
 __all__ = ["description", "localiser", "main"]
 

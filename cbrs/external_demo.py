@@ -20,18 +20,18 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from actions.composer import Composer
-from actions.events import Event
-from actions.runner import RunResult, run_task
+from cbrs.actions.composer import Composer
+from cbrs.actions.events import Event
+from cbrs.actions.runner import RunResult, run_task
 from cbrs.bridge_client import BridgeClient
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.semantic_map import SemanticMap
 from cbrs.server import ServeConfig, Server
+from cbrs.sim.components import SimEnvironment
+from cbrs.sim.world import open_world
 from cbrs.sim_sensors import offer_cameras
 from cbrs.sparql_service import EndpointConfig
-from kb import KnowledgeBase
-from kb.namespaces import PREFIXES
-from kb.semantic_map import SemanticMap
-from sim.components import SimEnvironment
-from sim.world import open_world
 
 __all__ = ["CAMERAS", "ExternalRun", "run_external_demo"]
 

@@ -22,12 +22,12 @@ from typing import Any
 
 import pyoxigraph as ox
 
+from cbrs.kb.errors import AlreadyRegisteredError, InvalidDescriptionError, KnowledgeBaseError
+from cbrs.kb.loader import parse_bytes
+from cbrs.kb.namespaces import BASE, RDF, GraphName
+from cbrs.kb.vocab import CBRS
 from cbrs.rosbridge import ServiceError, current_caller
 from cbrs.sparql_service import SparqlService
-from kb.errors import AlreadyRegisteredError, InvalidDescriptionError, KnowledgeBaseError
-from kb.loader import parse_bytes
-from kb.namespaces import BASE, RDF, GraphName
-from kb.vocab import CBRS
 
 __all__ = ["DEFAULT_TTL", "MAX_DESCRIPTION_BYTES", "LiveComponents", "grounding"]
 

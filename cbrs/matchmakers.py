@@ -5,11 +5,11 @@ from __future__ import annotations
 
 import threading
 
+from cbrs.kb.namespaces import GraphName
+from cbrs.kb.remote_store import RemoteStore
+from cbrs.reasoner.matchmaker import Matchmaker
+from cbrs.reasoner.taxonomy import TaxonomyIndex
 from cbrs.sparql_service import SparqlService
-from kb.namespaces import GraphName
-from kb.remote_store import RemoteStore
-from reasoner.matchmaker import Matchmaker
-from reasoner.taxonomy import TaxonomyIndex
 
 
 class Matchmakers:

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pyoxigraph as ox
 
-from kb.namespaces import PREFIXES, shorten
-from kb.store import QueryResult, Term
+from cbrs.kb.namespaces import PREFIXES, shorten
+from cbrs.kb.store import QueryResult, Term
 
 RESULT_FORMATS = ("table", "json", "csv", "tsv")
 

@@ -34,10 +34,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from kb.errors import KnowledgeBaseError, QuerySyntaxError, QueryTooComplexError, StoreEvaluationError
-from kb.namespaces import PREFIXES
-from kb.query_guard import EVALUATION_STACK
-from kb.store import EmbeddedStore
+from cbrs.kb.errors import KnowledgeBaseError, QuerySyntaxError, QueryTooComplexError, StoreEvaluationError
+from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.query_guard import EVALUATION_STACK
+from cbrs.kb.store import EmbeddedStore
 
 log = logging.getLogger("cbrs.query_workers")
 

@@ -19,6 +19,8 @@ from waitress.server import create_server
 
 from cbrs.bridge_client import BridgeClient
 from cbrs.bridge_services import KnowledgeServices, attach
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.store import EmbeddedStore, mark_served
 from cbrs.live_components import LiveComponents
 from cbrs.matchmakers import Matchmakers
 from cbrs.rosbridge import Bridge
@@ -29,8 +31,6 @@ from cbrs.tasks import TaskRunner
 from cbrs.web import create_app
 from cbrs.web.components import blueprint as components_blueprint
 from cbrs.web.context import StreamSlots
-from kb import KnowledgeBase
-from kb.store import EmbeddedStore, mark_served
 
 log = logging.getLogger("cbrs.server")
 LOGGERS = ("cbrs", "kb", "actions", "reasoner", "sim")

@@ -16,9 +16,9 @@ import numpy as np
 from PIL import Image
 
 from cbrs.rosbridge import Bridge, ServiceError
-from sim.cameras import Frame, Intrinsics
-from sim.errors import SimulationError
-from sim.world import HomeWorld
+from cbrs.sim.cameras import Frame, Intrinsics
+from cbrs.sim.errors import SimulationError
+from cbrs.sim.world import HomeWorld
 
 __all__ = ["CAPTURE_SERVICE", "frame_from_json", "frame_to_json", "offer_cameras"]
 

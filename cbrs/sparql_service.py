@@ -38,15 +38,15 @@ from werkzeug.datastructures import MIMEAccept
 from werkzeug.http import parse_accept_header
 
 from cbrs._query_worker import dataset_options
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.errors import KnowledgeBaseError, QuerySyntaxError, QueryTooComplexError, StoreEvaluationError
+from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.query_guard import start_evaluation_thread
+from cbrs.kb.remote_store import RemoteStore
+from cbrs.kb.sparql_lexemes import HIDING
+from cbrs.kb.store import EmbeddedStore, QueryResult, refuse_inserted_blank_nodes
 from cbrs.query_workers import QueryProcesses, QueryStopped, Request
 from cbrs.settings import setting
-from kb import KnowledgeBase
-from kb.errors import KnowledgeBaseError, QuerySyntaxError, QueryTooComplexError, StoreEvaluationError
-from kb.namespaces import PREFIXES
-from kb.query_guard import start_evaluation_thread
-from kb.remote_store import RemoteStore
-from kb.sparql_lexemes import HIDING
-from kb.store import EmbeddedStore, QueryResult, refuse_inserted_blank_nodes
 
 # Media types offered for SELECT and ASK results, the first being the default.
 RESULT_TYPES: dict[str, ox.QueryResultsFormat] = {

@@ -12,11 +12,11 @@ import difflib
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from actions.errors import UnknownTaskError
-from actions.model import ActionLibrary
-from kb import KnowledgeBase
-from kb.namespaces import expand, shorten
-from kb.owls import local_name
+from cbrs.actions.errors import UnknownTaskError
+from cbrs.actions.model import ActionLibrary
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import expand, shorten
+from cbrs.kb.owls import local_name
 
 
 class TaskNameError(UnknownTaskError):

@@ -21,15 +21,15 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from typing import Any
 
-from actions.composer import Composer
-from actions.events import Event
-from actions.faults import RandomFaults
-from actions.model import ActionLibrary, resolve_task
-from actions.remote import Transport
-from actions.runner import run_task
-from kb import KnowledgeBase
-from kb.errors import KnowledgeBaseError
-from kb.namespaces import expand, shorten
+from cbrs.actions.composer import Composer
+from cbrs.actions.events import Event
+from cbrs.actions.faults import RandomFaults
+from cbrs.actions.model import ActionLibrary, resolve_task
+from cbrs.actions.remote import Transport
+from cbrs.actions.runner import run_task
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.errors import KnowledgeBaseError
+from cbrs.kb.namespaces import expand, shorten
 
 log = logging.getLogger("cbrs.tasks")
 
@@ -197,7 +197,7 @@ class TaskRunner:
 
     def components(self) -> list[str]:
         """The IRIs of the simulated components, which a run may be told to fail."""
-        from sim.components import simulated
+        from cbrs.sim.components import simulated
 
         return simulated(self.kb)
 
@@ -256,9 +256,9 @@ class TaskRunner:
             active[1].join(timeout)
 
     def _run(self, run: TaskRun) -> None:
-        from kb.semantic_map import SemanticMap
-        from sim.components import SimEnvironment  # pybullet loads only when a task runs
-        from sim.world import open_world
+        from cbrs.kb.semantic_map import SemanticMap
+        from cbrs.sim.components import SimEnvironment  # pybullet loads only when a task runs
+        from cbrs.sim.world import open_world
 
         def follow(event: Event) -> None:
             message = dict(event.message, run=run.id)
@@ -323,8 +323,8 @@ class TaskRunner:
 
     def _render_idle(self) -> None:
         """Render the home as it stands before any run: open a world, take one frame, close it."""
-        from kb.semantic_map import SemanticMap
-        from sim.world import open_world
+        from cbrs.kb.semantic_map import SemanticMap
+        from cbrs.sim.world import open_world
 
         with self._idle_render:
             if self._frame is not None or self.active() is not None or self.camera is None:
@@ -365,7 +365,7 @@ def _jpeg(rgb: Any) -> bytes:
 def _check_components(kb: KnowledgeBase, failing: tuple[str, ...]) -> None:
     if not failing:
         return
-    from sim.components import simulated
+    from cbrs.sim.components import simulated
 
     known = set(simulated(kb))
     unknown = [shorten(f) for f in failing if f not in known]

@@ -1,8 +1,8 @@
 """The cbrs knowledge base: an Oxigraph store (embedded, or a SPARQL server) of ontologies, advertisements and
 requirements."""
 
-from kb.catalog import Catalogue
-from kb.errors import (
+from cbrs.kb.catalog import Catalogue
+from cbrs.kb.errors import (
     AlreadyRegisteredError,
     BindingError,
     CatalogueError,
@@ -18,9 +18,9 @@ from kb.errors import (
     UnknownGraphError,
     UnknownQueryError,
 )
-from kb.knowledge_base import KnowledgeBase
-from kb.loader import LoadReport
-from kb.model import (
+from cbrs.kb.knowledge_base import KnowledgeBase
+from cbrs.kb.loader import LoadReport
+from cbrs.kb.model import (
     Advertisement,
     EffectiveArea,
     Parameter,
@@ -31,8 +31,8 @@ from kb.model import (
     ServiceDescription,
     Statement,
 )
-from kb.namespaces import PREFIXES, GraphName
-from kb.store import EmbeddedStore, Store
+from cbrs.kb.namespaces import PREFIXES, GraphName
+from cbrs.kb.store import EmbeddedStore, Store
 
 __all__ = [
     "PREFIXES",

@@ -22,8 +22,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from urllib.parse import unquote, urlsplit
 
-from kb.errors import CatalogueError
-from kb.namespaces import OWL, RDF, RDFS, XSD
+from cbrs.kb.errors import CatalogueError
+from cbrs.kb.namespaces import OWL, RDF, RDFS, XSD
 
 OWLS_TC_PREFIX = "http://127.0.0.1/ontology/"
 OASIS_NS = "urn:oasis:names:tc:entity:xmlns:xml:catalog"

@@ -7,8 +7,8 @@ from typing import Any, Literal, cast
 
 import pyoxigraph as ox
 
-from kb.errors import BlankNodeError, InvalidDescriptionError, NotFoundError
-from kb.model import (
+from cbrs.kb.errors import BlankNodeError, InvalidDescriptionError, NotFoundError
+from cbrs.kb.model import (
     Advertisement,
     EffectiveArea,
     Parameter,
@@ -19,9 +19,9 @@ from kb.model import (
     ServiceDescription,
     Statement,
 )
-from kb.queries import QueryLibrary
-from kb.store import Store, Term
-from kb.vocab import CBRS
+from cbrs.kb.queries import QueryLibrary
+from cbrs.kb.store import Store, Term
+from cbrs.kb.vocab import CBRS
 
 log = logging.getLogger("kb.descriptions")
 

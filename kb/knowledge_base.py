@@ -7,18 +7,18 @@ from pathlib import Path
 
 import pyoxigraph as ox
 
-from kb.catalog import Catalogue
-from kb.descriptions import DescriptionReader
-from kb.liveness import Liveness
-from kb.loader import LoadReport, ParsedFile, load_files, parse_file
-from kb.model import Advertisement, PartNode, Requirement, ServiceDescription
-from kb.namespaces import GraphName
-from kb.queries import QueryLibrary
-from kb.query_guard import QueryGuard
-from kb.registry import ComponentRegistry
-from kb.resources import bundled_files, query_dir
-from kb.shapes import checked_update
-from kb.store import EmbeddedStore, QueryResult, Store, Term, is_remote
+from cbrs.kb.catalog import Catalogue
+from cbrs.kb.descriptions import DescriptionReader
+from cbrs.kb.liveness import Liveness
+from cbrs.kb.loader import LoadReport, ParsedFile, load_files, parse_file
+from cbrs.kb.model import Advertisement, PartNode, Requirement, ServiceDescription
+from cbrs.kb.namespaces import GraphName
+from cbrs.kb.queries import QueryLibrary
+from cbrs.kb.query_guard import QueryGuard
+from cbrs.kb.registry import ComponentRegistry
+from cbrs.kb.resources import bundled_files, query_dir
+from cbrs.kb.shapes import checked_update
+from cbrs.kb.store import EmbeddedStore, QueryResult, Store, Term, is_remote
 
 _VERSION_INFO = ox.NamedNode("http://www.w3.org/2002/07/owl#versionInfo")
 
@@ -50,7 +50,7 @@ class KnowledgeBase:
         store, as a bearer token: a ``cbrs serve``'s update token.
         """
         if is_remote(str(location)) and (remote_timeout is not None or remote_token is not None):
-            from kb.remote_store import DEFAULT_TIMEOUT, RemoteStore  # only a remote store needs the HTTP client
+            from cbrs.kb.remote_store import DEFAULT_TIMEOUT, RemoteStore  # only a remote store needs the HTTP client
 
             timeout = remote_timeout if remote_timeout is not None else DEFAULT_TIMEOUT
             store: Store = RemoteStore.open(location, timeout, remote_token)

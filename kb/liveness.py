@@ -15,9 +15,9 @@ from dataclasses import dataclass
 
 import pyoxigraph as ox
 
-from kb.namespaces import GraphName
-from kb.store import Store
-from kb.vocab import CBRS
+from cbrs.kb.namespaces import GraphName
+from cbrs.kb.store import Store
+from cbrs.kb.vocab import CBRS
 
 __all__ = ["ComponentState", "Liveness"]
 

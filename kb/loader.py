@@ -28,13 +28,13 @@ from typing import Any
 
 import pyoxigraph as ox
 
-from kb.catalog import Catalogue, Unresolved, is_built_in, ontology_iri
-from kb.errors import PartCycleError, RdfParseError, UnknownFormatError, UnknownGraphError
-from kb.namespaces import CBRS, DUL, GENID, OWL, RDF, RDFS, GraphName
-from kb.owls import Conversion, Role, Vocabulary, convert, is_owls, referenced_ontologies
-from kb.shapes import check_loaded
-from kb.store import Store
-from kb.xml_limits import check_entities
+from cbrs.kb.catalog import Catalogue, Unresolved, is_built_in, ontology_iri
+from cbrs.kb.errors import PartCycleError, RdfParseError, UnknownFormatError, UnknownGraphError
+from cbrs.kb.namespaces import CBRS, DUL, GENID, OWL, RDF, RDFS, GraphName
+from cbrs.kb.owls import Conversion, Role, Vocabulary, convert, is_owls, referenced_ontologies
+from cbrs.kb.shapes import check_loaded
+from cbrs.kb.store import Store
+from cbrs.kb.xml_limits import check_entities
 
 FORMATS_BY_EXTENSION: dict[str, ox.RdfFormat] = {
     ".ttl": ox.RdfFormat.TURTLE,

@@ -29,11 +29,11 @@ from urllib.parse import urljoin
 
 import pyoxigraph as ox
 
-from kb.catalog import is_built_in, namespace_document
-from kb.errors import RdfParseError
-from kb.namespaces import OWL, RDF, RDFS
-from kb.vocab import CBRS
-from kb.xml_limits import check_entities
+from cbrs.kb.catalog import is_built_in, namespace_document
+from cbrs.kb.errors import RdfParseError
+from cbrs.kb.namespaces import OWL, RDF, RDFS
+from cbrs.kb.vocab import CBRS
+from cbrs.kb.xml_limits import check_entities
 
 CONDITION_TEXT_BUDGET = 16 << 20
 """Characters of expression text one file's statements may carry between them. Every statement made

@@ -19,9 +19,9 @@ from pathlib import Path
 
 import pyoxigraph as ox
 
-from kb.errors import BindingError, UnknownQueryError
-from kb.namespaces import XSD, expand
-from kb.store import QueryResult, Store, Term
+from cbrs.kb.errors import BindingError, UnknownQueryError
+from cbrs.kb.namespaces import XSD, expand
+from cbrs.kb.store import QueryResult, Store, Term
 
 PARAMETER_KINDS = ("iri", "string", "integer", "decimal", "literal")
 _PARAM_LINE = re.compile(r"^#\s*param:\s*(\w+)\s+(\w+)(\s+required)?\s*(.*)$")

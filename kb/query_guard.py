@@ -39,7 +39,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import IO, Literal
 
-from kb.errors import QuerySyntaxError, QueryTooComplexError, StoreError
+from cbrs.kb.errors import QuerySyntaxError, QueryTooComplexError, StoreError
 
 Kind = Literal["query", "update"]
 
@@ -290,7 +290,7 @@ def serve_checks(stack: int) -> None:
 def _run_check(kind: bytes, text: str, reply: Callable[[bytes, str], None]) -> None:
     import pyoxigraph as ox
 
-    from kb.namespaces import PREFIXES
+    from cbrs.kb.namespaces import PREFIXES
 
     store = ox.Store()
     try:

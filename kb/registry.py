@@ -7,12 +7,12 @@ from collections.abc import Iterable
 
 import pyoxigraph as ox
 
-from kb.errors import AlreadyRegisteredError, InvalidDescriptionError, NotFoundError
-from kb.loader import parse_bytes
-from kb.namespaces import BASE, GENID, RDF, GraphName
-from kb.shapes import check_descriptions
-from kb.store import Store
-from kb.vocab import CBRS
+from cbrs.kb.errors import AlreadyRegisteredError, InvalidDescriptionError, NotFoundError
+from cbrs.kb.loader import parse_bytes
+from cbrs.kb.namespaces import BASE, GENID, RDF, GraphName
+from cbrs.kb.shapes import check_descriptions
+from cbrs.kb.store import Store
+from cbrs.kb.vocab import CBRS
 
 
 class ComponentRegistry:

@@ -15,8 +15,8 @@ from __future__ import annotations
 import re
 from collections.abc import Sequence
 
-from kb.errors import KnowledgeBaseError
-from kb.sparql_lexemes import HIDING
+from cbrs.kb.errors import KnowledgeBaseError
+from cbrs.kb.sparql_lexemes import HIDING
 
 _TOKEN = re.compile(
     HIDING + r"|[?$][A-Za-z0-9_\u00b7-\uffff]+"

@@ -34,10 +34,10 @@ from urllib.parse import urlencode
 import httpx
 import pyoxigraph as ox
 
-from kb.errors import BindingError, QuerySyntaxError, RemoteStoreError, StoreError, StoreEvaluationError
-from kb.namespaces import PREFIXES, GraphName
-from kb.remote_access import refuse_remote_access
-from kb.store import QueryResult, Store, Term, data_block, refuse_deep_nesting
+from cbrs.kb.errors import BindingError, QuerySyntaxError, RemoteStoreError, StoreError, StoreEvaluationError
+from cbrs.kb.namespaces import PREFIXES, GraphName
+from cbrs.kb.remote_access import refuse_remote_access
+from cbrs.kb.store import QueryResult, Store, Term, data_block, refuse_deep_nesting
 
 DEFAULT_TIMEOUT = 60.0  # seconds to wait for an answer (the seed takes well under one)
 CONNECT_TIMEOUT = 5.0

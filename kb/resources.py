@@ -6,7 +6,7 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from kb.namespaces import GraphName
+from cbrs.kb.namespaces import GraphName
 
 
 def _data_dir(name: str) -> Path:

@@ -14,11 +14,11 @@ from collections import defaultdict
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
-from kb.errors import KnowledgeBaseError
-from kb.namespaces import PREFIXES
+from cbrs.kb.errors import KnowledgeBaseError
+from cbrs.kb.namespaces import PREFIXES
 
 if TYPE_CHECKING:
-    from kb.knowledge_base import KnowledgeBase
+    from cbrs.kb.knowledge_base import KnowledgeBase
 
 HOME = PREFIXES["home"]
 

@@ -28,15 +28,15 @@ from typing import TYPE_CHECKING, Any
 
 import pyoxigraph as ox
 
-from kb.errors import InvalidDescriptionError
-from kb.namespaces import GENID, OWL, RDF, RDFS, XSD, GraphName, shorten
-from kb.queries import QueryLibrary
-from kb.resources import ontology_dir, query_dir
-from kb.store import Store
-from kb.vocab import CBRS
+from cbrs.kb.errors import InvalidDescriptionError
+from cbrs.kb.namespaces import GENID, OWL, RDF, RDFS, XSD, GraphName, shorten
+from cbrs.kb.queries import QueryLibrary
+from cbrs.kb.resources import ontology_dir, query_dir
+from cbrs.kb.store import Store
+from cbrs.kb.vocab import CBRS
 
 if TYPE_CHECKING:
-    from kb.loader import LoadReport
+    from cbrs.kb.loader import LoadReport
 
 SH = "http://www.w3.org/ns/shacl#"
 SHAPES_FILE = "shapes.ttl"

@@ -17,11 +17,11 @@ from pathlib import Path
 
 import pyoxigraph as ox
 
-from kb.errors import BlankNodeInsertError, QuerySyntaxError, StoreError, StoreEvaluationError
-from kb.namespaces import GENID, PREFIXES, GraphName
-from kb.query_guard import QueryGuard
-from kb.remote_access import loads, refuse_remote_access
-from kb.sparql_lexemes import HIDING
+from cbrs.kb.errors import BlankNodeInsertError, QuerySyntaxError, StoreError, StoreEvaluationError
+from cbrs.kb.namespaces import GENID, PREFIXES, GraphName
+from cbrs.kb.query_guard import QueryGuard
+from cbrs.kb.remote_access import loads, refuse_remote_access
+from cbrs.kb.sparql_lexemes import HIDING
 
 MEMORY = ":memory:"
 REMOTE_SCHEMES = ("http://", "https://")
@@ -56,7 +56,7 @@ class Store(ABC):
         """Open the store at ``location``: a SPARQL endpoint URL, a directory (created if needed), or ``:memory:``."""
         text = str(location)
         if is_remote(text):
-            from kb.remote_store import RemoteStore  # only a remote store needs the HTTP client
+            from cbrs.kb.remote_store import RemoteStore  # only a remote store needs the HTTP client
 
             return RemoteStore.open(text)
         return EmbeddedStore.open(text)

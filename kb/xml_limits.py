@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import re
 
-from kb.errors import RdfParseError
+from cbrs.kb.errors import RdfParseError
 
 MAX_ENTITY_BYTES = 1 << 20
 """The most one entity may expand to."""

@@ -5,12 +5,12 @@ similarity over part trees and RDF-statement matching, or with a baseline; docs/
 formulas.
 """
 
-from reasoner.config import MatchConfig
-from reasoner.degrees import Degree, degree_of_match
-from reasoner.matchmaker import Candidate, EntityPair, Matchmaker, MatchResult, MatchStatus
-from reasoner.methods import METHODS
-from reasoner.similarity import Lin, SemStr, Similarity, StringMatch, WuPalmer
-from reasoner.taxonomy import TaxonomyIndex
+from cbrs.reasoner.config import MatchConfig
+from cbrs.reasoner.degrees import Degree, degree_of_match
+from cbrs.reasoner.matchmaker import Candidate, EntityPair, Matchmaker, MatchResult, MatchStatus
+from cbrs.reasoner.methods import METHODS
+from cbrs.reasoner.similarity import Lin, SemStr, Similarity, StringMatch, WuPalmer
+from cbrs.reasoner.taxonomy import TaxonomyIndex
 
 __all__ = [
     "METHODS",

@@ -13,11 +13,11 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from kb import Advertisement, EffectiveArea, PartNode, QoSValue, Requirement, Statement
-from reasoner.config import MatchConfig
-from reasoner.similarity import EntityMeasure
-from reasoner.spans import span
-from reasoner.vectors import FloatArray, IntArray, VectorSpace
+from cbrs.kb import Advertisement, EffectiveArea, PartNode, QoSValue, Requirement, Statement
+from cbrs.reasoner.config import MatchConfig
+from cbrs.reasoner.similarity import EntityMeasure
+from cbrs.reasoner.spans import span
+from cbrs.reasoner.vectors import FloatArray, IntArray, VectorSpace
 
 PARTS = ("outputs", "inputs", "effects", "preconditions")
 
@@ -279,10 +279,7 @@ class BatchScorer:
         parts: dict[str, FloatArray] = {name: nan.copy() for name in PARTS}
         invocable = np.ones(n)
         if requirement.outputs:
-            per = [
-                pool.outputs.max(self._output_css(p.tree or PartNode(p.type)))
-                for p in requirement.outputs
-            ]
+            per = [pool.outputs.max(self._output_css(p.tree or PartNode(p.type))) for p in requirement.outputs]
             parts["outputs"] = np.mean(per, axis=0)
         if requirement.inputs or np.any(pool.inputs.present):
             needed = np.zeros(len(pool.root_ids))

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from enum import Enum
 
-from reasoner.taxonomy import TaxonomyIndex
+from cbrs.reasoner.taxonomy import TaxonomyIndex
 
 
 class Degree(Enum):

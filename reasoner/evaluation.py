@@ -26,12 +26,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from reasoner.config import MatchConfig
-from reasoner.matchmaker import Matchmaker
-from reasoner.methods import METHODS
-from reasoner.metrics import average_precision, first_relevant_rank, precision_at_k, reciprocal_rank, top1
-from reasoner.names import local_name
-from reasoner.testbed import TESTBED_FILE, TRUTH_FILE, load_truth, open_testbed_kb, relevant_sets
+from cbrs.reasoner.config import MatchConfig
+from cbrs.reasoner.matchmaker import Matchmaker
+from cbrs.reasoner.methods import METHODS
+from cbrs.reasoner.metrics import average_precision, first_relevant_rank, precision_at_k, reciprocal_rank, top1
+from cbrs.reasoner.names import local_name
+from cbrs.reasoner.testbed import TESTBED_FILE, TRUTH_FILE, load_truth, open_testbed_kb, relevant_sets
 
 METRICS = ("top1", "p_at_5", "mrr", "map")
 METRIC_LABELS = {"top1": "top-1 correct", "p_at_5": "precision at 5", "mrr": "MRR", "map": "MAP"}

@@ -8,7 +8,7 @@ of one synset or of synsets a few hypernym links apart score WordNet's Wu-Palmer
 
 The data file holds, for every noun lemma without capitals (proper names left out), its first senses in
 WordNet's order, and for every synset its hypernyms and its depth. It is made from Debian's
-``wordnet-base`` by ``python -m reasoner.lexicon build /usr/share/wordnet`` (WordNet 3.0 licence:
+``wordnet-base`` by ``python -m cbrs.reasoner.lexicon build /usr/share/wordnet`` (WordNet 3.0 licence:
 reasoner/data/WORDNET_LICENSE). Nothing is downloaded at run time; without the file the lexicon knows
 only equal words.
 """
@@ -241,4 +241,4 @@ if __name__ == "__main__":
     if len(sys.argv) == 3 and sys.argv[1] == "build":
         print(build(Path(sys.argv[2])))
     else:
-        print("usage: python -m reasoner.lexicon build WORDNET_DIR   (e.g. /usr/share/wordnet)")
+        print("usage: python -m cbrs.reasoner.lexicon build WORDNET_DIR   (e.g. /usr/share/wordnet)")

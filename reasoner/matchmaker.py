@@ -22,7 +22,7 @@ from dataclasses import asdict, dataclass
 from enum import Enum
 from typing import TYPE_CHECKING, Any, overload
 
-from kb import (
+from cbrs.kb import (
     Advertisement,
     EffectiveArea,
     KnowledgeBase,
@@ -32,20 +32,20 @@ from kb import (
     QoSValue,
     Requirement,
 )
-from reasoner.config import MatchConfig
-from reasoner.degrees import Degree, degree_of_match
-from reasoner.methods import REFINED, Method, make_method
-from reasoner.names import local_name
-from reasoner.similarity import SemStr, Similarity
-from reasoner.spans import PairMatch, SpanMatch, conceptual_span_similarity, span
-from reasoner.statements import StatementMatch, best_statement_matches
-from reasoner.taxonomy import TaxonomyIndex
-from reasoner.text import description_text
+from cbrs.reasoner.config import MatchConfig
+from cbrs.reasoner.degrees import Degree, degree_of_match
+from cbrs.reasoner.methods import REFINED, Method, make_method
+from cbrs.reasoner.names import local_name
+from cbrs.reasoner.similarity import SemStr, Similarity
+from cbrs.reasoner.spans import PairMatch, SpanMatch, conceptual_span_similarity, span
+from cbrs.reasoner.statements import StatementMatch, best_statement_matches
+from cbrs.reasoner.taxonomy import TaxonomyIndex
+from cbrs.reasoner.text import description_text
 
 if TYPE_CHECKING:  # numpy and the batch scorer load with the first ranking: importing cbrs stays fast
-    from reasoner.batch import CompiledPool
-    from reasoner.text import TextIndex
-    from reasoner.vectors import FloatArray
+    from cbrs.reasoner.batch import CompiledPool
+    from cbrs.reasoner.text import TextIndex
+    from cbrs.reasoner.vectors import FloatArray
 
 
 class MatchStatus(Enum):
@@ -135,7 +135,7 @@ class Matchmaker:
 
     def _text_index(self, ads: list[Advertisement]) -> TextIndex:
         if self._text is None or self._text_source is not ads:
-            from reasoner.text import TextIndex
+            from cbrs.reasoner.text import TextIndex
 
             self._text = TextIndex(ads)
             self._text_source = ads
@@ -143,8 +143,8 @@ class Matchmaker:
 
     def _compiled(self, ads: list[Advertisement]) -> CompiledPool:
         if self._pool is None or self._pool_source is not ads:
-            from reasoner.batch import CompiledPool
-            from reasoner.vectors import VectorSpace
+            from cbrs.reasoner.batch import CompiledPool
+            from cbrs.reasoner.vectors import VectorSpace
 
             self._pool = CompiledPool(ads, VectorSpace(self.index), self.method.use_parts)
             self._pool_source = ads
@@ -181,7 +181,7 @@ class Matchmaker:
         return MatchResult(requirement.iri, self.method.name, status, candidates)
 
     def _rank_batch(self, requirement: Requirement, ads: list[Advertisement], explain: int) -> Sequence[Candidate]:
-        from reasoner.batch import BatchScorer, BatchScores, ranking_order
+        from cbrs.reasoner.batch import BatchScorer, BatchScores, ranking_order
 
         pool = self._compiled(ads)
         scorer = BatchScorer(

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from reasoner.config import MatchConfig
-from reasoner.similarity import EntityMeasure, Lin, SemStr, StringMatch, WuPalmer
-from reasoner.taxonomy import TaxonomyIndex
+from cbrs.reasoner.config import MatchConfig
+from cbrs.reasoner.similarity import EntityMeasure, Lin, SemStr, StringMatch, WuPalmer
+from cbrs.reasoner.taxonomy import TaxonomyIndex
 
 METHODS = ("sem-str", "string", "wu-palmer", "lin", "logic", "sem-str-text")
 # The methods that use the refinements of docs/matchmaking.md section 9; the baselines keep the published

@@ -17,14 +17,21 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from kb import KnowledgeBase, Store
-from kb.catalog import Catalogue
-from kb.errors import KnowledgeBaseError
-from kb.resources import ontology_dir
-from reasoner.config import MatchConfig
-from reasoner.matchmaker import Matchmaker
-from reasoner.methods import METHODS
-from reasoner.metrics import RECALL_LEVELS, average_precision, interpolated_precision, ndcg, precision_at_k, r_precision
+from cbrs.kb import KnowledgeBase, Store
+from cbrs.kb.catalog import Catalogue
+from cbrs.kb.errors import KnowledgeBaseError
+from cbrs.kb.resources import ontology_dir
+from cbrs.reasoner.config import MatchConfig
+from cbrs.reasoner.matchmaker import Matchmaker
+from cbrs.reasoner.methods import METHODS
+from cbrs.reasoner.metrics import (
+    RECALL_LEVELS,
+    average_precision,
+    interpolated_precision,
+    ndcg,
+    precision_at_k,
+    r_precision,
+)
 
 METRICS = ("map", "ndcg", "p_at_1", "p_at_10", "r_precision", "query_ms")
 

@@ -12,10 +12,10 @@ from typing import Protocol
 
 import jellyfish
 
-from reasoner.config import MatchConfig
-from reasoner.lexicon import Lexicon, bundled
-from reasoner.names import core_split, local_name, words
-from reasoner.taxonomy import ROOT, TaxonomyIndex
+from cbrs.reasoner.config import MatchConfig
+from cbrs.reasoner.lexicon import Lexicon, bundled
+from cbrs.reasoner.names import core_split, local_name, words
+from cbrs.reasoner.taxonomy import ROOT, TaxonomyIndex
 
 
 @dataclass(frozen=True)

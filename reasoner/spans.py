@@ -25,8 +25,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from kb import PartNode
-from reasoner.similarity import EntityMeasure, Similarity
+from cbrs.kb import PartNode
+from cbrs.reasoner.similarity import EntityMeasure, Similarity
 
 
 @dataclass(frozen=True)

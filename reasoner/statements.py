@@ -13,9 +13,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from kb import Statement
-from reasoner.config import MatchConfig
-from reasoner.similarity import EntityMeasure, Similarity
+from cbrs.kb import Statement
+from cbrs.reasoner.config import MatchConfig
+from cbrs.reasoner.similarity import EntityMeasure, Similarity
 
 
 @dataclass(frozen=True)

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import random
 
-from kb import Advertisement, Parameter, PartNode, Requirement, Statement
-from reasoner.taxonomy import ROOT, Link, TaxonomyIndex
+from cbrs.kb import Advertisement, Parameter, PartNode, Requirement, Statement
+from cbrs.reasoner.taxonomy import ROOT, Link, TaxonomyIndex
 
 NS = "http://example.org/bench#"
 

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 
 import networkx as nx
 
-from kb import KnowledgeBase
+from cbrs.kb import KnowledgeBase
 
 ROOT = "http://www.w3.org/2002/07/owl#Thing"  # the root: above every concept with no is-a parent
 

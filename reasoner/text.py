@@ -12,13 +12,13 @@ from collections.abc import Sequence
 from functools import cache
 from typing import TYPE_CHECKING
 
-from kb import ServiceDescription
-from reasoner.names import words
+from cbrs.kb import ServiceDescription
+from cbrs.reasoner.names import words
 
 if TYPE_CHECKING:
     from sklearn.feature_extraction.text import TfidfVectorizer  # type: ignore[import-untyped]
 
-    from reasoner.vectors import FloatArray
+    from cbrs.reasoner.vectors import FloatArray
 
 
 def description_text(description: ServiceDescription) -> str:

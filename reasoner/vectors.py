@@ -15,8 +15,8 @@ from typing import Any, Generic, TypeVar
 import numpy as np
 import numpy.typing as npt
 
-from reasoner.similarity import EntityMeasure, SemStr
-from reasoner.taxonomy import ROOT, TaxonomyIndex
+from cbrs.reasoner.similarity import EntityMeasure, SemStr
+from cbrs.reasoner.taxonomy import ROOT, TaxonomyIndex
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]

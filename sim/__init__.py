@@ -11,9 +11,9 @@ See docs/simulation.md.
 
 from __future__ import annotations
 
-import sim.quiet  # noqa: F401  (first: keeps pybullet's banner off stdout)
-from sim.arms import ArmSide
-from sim.errors import (
+import cbrs.sim.quiet  # noqa: F401  (first: keeps pybullet's banner off stdout)
+from cbrs.sim.arms import ArmSide
+from cbrs.sim.errors import (
     CameraUnavailableError,
     MapError,
     NoFreeCellError,
@@ -27,10 +27,10 @@ from sim.errors import (
     UnknownEntityError,
     WorldClosedError,
 )
-from sim.geometry import Pose2D, Pose3D, Region
-from sim.grasping import GraspPose, ObjectModel, compute_grasp_pose
-from sim.mapping import OccupancyGrid, build_occupancy_grid
-from sim.perception import (
+from cbrs.sim.geometry import Pose2D, Pose3D, Region
+from cbrs.sim.grasping import GraspPose, ObjectModel, compute_grasp_pose
+from cbrs.sim.mapping import OccupancyGrid, build_occupancy_grid
+from cbrs.sim.perception import (
     ObjectEstimate,
     PersonEstimate,
     RobotPoseEstimate,
@@ -38,9 +38,9 @@ from sim.perception import (
     recognise_object,
     track_person,
 )
-from sim.planning import PlannedPath, plan_path
-from sim.skills import Outcome
-from sim.world import HomeWorld, open_world
+from cbrs.sim.planning import PlannedPath, plan_path
+from cbrs.sim.skills import Outcome
+from cbrs.sim.world import HomeWorld, open_world
 
 __all__ = [
     "ArmSide",

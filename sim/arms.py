@@ -20,9 +20,9 @@ import numpy as np
 import pybullet as p
 from numpy.typing import NDArray
 
-from sim.geometry import Pose3D, Quat, Region, Vec3, quat_from_matrix, quat_to_matrix
-from sim.grasping import GraspPose
-from sim.quiet import quiet_output
+from cbrs.sim.geometry import Pose3D, Quat, Region, Vec3, quat_from_matrix, quat_to_matrix
+from cbrs.sim.grasping import GraspPose
+from cbrs.sim.quiet import quiet_output
 
 __all__ = [
     "ARM_JOINTS",

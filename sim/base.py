@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import pybullet as p
 
-from sim.geometry import Pose2D, quat_from_yaw, wrap_angle, yaw_of
+from cbrs.sim.geometry import Pose2D, quat_from_yaw, wrap_angle, yaw_of
 
 __all__ = ["DriveResult", "MobileBase"]
 

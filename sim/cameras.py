@@ -16,8 +16,8 @@ import numpy as np
 import pybullet as p
 from numpy.typing import NDArray
 
-from sim.errors import CameraUnavailableError
-from sim.layout import CameraSpec
+from cbrs.sim.errors import CameraUnavailableError
+from cbrs.sim.layout import CameraSpec
 
 __all__ = ["Camera", "Clock", "Frame", "Intrinsics", "camera_to_world", "project", "render"]
 # Where the TINY renderer samples pixel (u, v), in continuous image coordinates: at the pixel's corner

@@ -24,22 +24,22 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any
 
-from actions.belief import Observation
-from actions.components import Component, Registry, Status
-from actions.plan import Plan, PlanStep
-from actions.remote import RemoteComponent, Transport
-from kb import KnowledgeBase, Requirement, Statement
-from kb.namespaces import PREFIXES
-from kb.semantic_map import SemanticMap, Thing, designate, local_name
-from sim import predicates as pred
-from sim import skills
-from sim.arms import ArmSide
-from sim.errors import SimulationError
-from sim.geometry import Pose2D, Region
-from sim.grasping import GraspPose, ObjectModel, compute_grasp_pose
-from sim.mapping import OccupancyGrid, build_occupancy_grid
-from sim.perceived import PerceivedWorld
-from sim.perception import (
+from cbrs.actions.belief import Observation
+from cbrs.actions.components import Component, Registry, Status
+from cbrs.actions.plan import Plan, PlanStep
+from cbrs.actions.remote import RemoteComponent, Transport
+from cbrs.kb import KnowledgeBase, Requirement, Statement
+from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.semantic_map import SemanticMap, Thing, designate, local_name
+from cbrs.sim import predicates as pred
+from cbrs.sim import skills
+from cbrs.sim.arms import ArmSide
+from cbrs.sim.errors import SimulationError
+from cbrs.sim.geometry import Pose2D, Region
+from cbrs.sim.grasping import GraspPose, ObjectModel, compute_grasp_pose
+from cbrs.sim.mapping import OccupancyGrid, build_occupancy_grid
+from cbrs.sim.perceived import PerceivedWorld
+from cbrs.sim.perception import (
     ObjectEstimate,
     PersonEstimate,
     RobotPoseEstimate,
@@ -47,10 +47,10 @@ from sim.perception import (
     recognise_object,
     track_person,
 )
-from sim.planning import PlannedPath, plan_path
-from sim.referee import Referee
-from sim.relations import Grounded, Judge
-from sim.values import (
+from cbrs.sim.planning import PlannedPath, plan_path
+from cbrs.sim.referee import Referee
+from cbrs.sim.relations import Grounded, Judge
+from cbrs.sim.values import (
     APPROACH_POSITION,
     GRASP_POSE,
     OBJECT_LOCATION,
@@ -65,7 +65,7 @@ from sim.values import (
     from_json,
     to_json,
 )
-from sim.world import HomeWorld
+from cbrs.sim.world import HomeWorld
 
 __all__ = ["GraspPlan", "SimContext", "SimEnvironment", "designator", "implementations", "simulated"]
 

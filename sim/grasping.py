@@ -13,8 +13,8 @@ from enum import StrEnum
 
 import numpy as np
 
-from kb.semantic_map import MapObject
-from sim.geometry import Quat, Vec3, quat_from_matrix
+from cbrs.kb.semantic_map import MapObject
+from cbrs.sim.geometry import Quat, Vec3, quat_from_matrix
 
 __all__ = ["GraspKind", "GraspPose", "ObjectModel", "compute_grasp_pose"]
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from sim.geometry import Vec3
+from cbrs.sim.geometry import Vec3
 
 __all__ = [
     "MAP_RESOLUTION",

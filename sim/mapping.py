@@ -17,9 +17,9 @@ import numpy as np
 import pybullet as p
 from numpy.typing import NDArray
 
-from sim.errors import OutsideMapError
-from sim.layout import MAP_RESOLUTION
-from sim.world import HomeWorld
+from cbrs.sim.errors import OutsideMapError
+from cbrs.sim.layout import MAP_RESOLUTION
+from cbrs.sim.world import HomeWorld
 
 __all__ = ["OBSTACLE_HEIGHT", "OccupancyGrid", "build_occupancy_grid", "inflate"]
 

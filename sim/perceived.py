@@ -21,16 +21,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from kb.namespaces import PREFIXES
-from sim import predicates as pred
-from sim.arms import Arm, ArmSide
-from sim.cameras import Camera, Frame, project
-from sim.errors import SimulationError
-from sim.geometry import Pose2D, Region, Vec3
-from sim.layout import PERSON_HAND_HEIGHT
-from sim.perception import recognise_object, track_person
-from sim.relations import Judge
-from sim.world import HomeWorld
+from cbrs.kb.namespaces import PREFIXES
+from cbrs.sim import predicates as pred
+from cbrs.sim.arms import Arm, ArmSide
+from cbrs.sim.cameras import Camera, Frame, project
+from cbrs.sim.errors import SimulationError
+from cbrs.sim.geometry import Pose2D, Region, Vec3
+from cbrs.sim.layout import PERSON_HAND_HEIGHT
+from cbrs.sim.perception import recognise_object, track_person
+from cbrs.sim.relations import Judge
+from cbrs.sim.world import HomeWorld
 
 __all__ = ["PERCEIVED_RESTING", "SEARCH_RADIUS", "PerceivedWorld", "Sighting"]
 

@@ -18,9 +18,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from sim.cameras import Frame
-from sim.errors import NotVisibleError, UnknownColourError
-from sim.layout import SHIRT_RADIUS, SHIRT_TOP
+from cbrs.sim.cameras import Frame
+from cbrs.sim.errors import NotVisibleError, UnknownColourError
+from cbrs.sim.layout import SHIRT_RADIUS, SHIRT_TOP
 
 __all__ = [
     "COLOURS",

@@ -19,8 +19,8 @@ from typing import Literal
 import networkx as nx
 import numpy as np
 
-from sim.errors import NoFreeCellError, NoPathError, UnknownAlgorithmError
-from sim.mapping import OccupancyGrid
+from cbrs.sim.errors import NoFreeCellError, NoPathError, UnknownAlgorithmError
+from cbrs.sim.mapping import OccupancyGrid
 
 __all__ = ["ALGORITHMS", "SNAP_RADIUS", "PlannedPath", "approach_point", "plan_path", "snap_to_free"]
 

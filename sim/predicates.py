@@ -14,11 +14,11 @@ import math
 import numpy as np
 import pybullet as p
 
-from sim.arms import ArmSide
-from sim.cameras import project
-from sim.geometry import Pose2D, Region, quat_to_matrix
-from sim.layout import PERSON_HAND_HEIGHT
-from sim.world import HomeWorld
+from cbrs.sim.arms import ArmSide
+from cbrs.sim.cameras import project
+from cbrs.sim.geometry import Pose2D, Region, quat_to_matrix
+from cbrs.sim.layout import PERSON_HAND_HEIGHT
+from cbrs.sim.world import HomeWorld
 
 __all__ = [
     "ABOVE_MAX",

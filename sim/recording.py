@@ -31,8 +31,8 @@ import pybullet as p
 from numpy.typing import NDArray
 from PIL import Image, ImageDraw, ImageFont
 
-from sim.cameras import render
-from sim.world import HomeWorld
+from cbrs.sim.cameras import render
+from cbrs.sim.world import HomeWorld
 
 __all__ = [
     "FORMATS",

@@ -7,10 +7,10 @@ really hold, so that a belief that went wrong is reported as a failure and not a
 
 from __future__ import annotations
 
-from sim import predicates as pred
-from sim.arms import ArmSide
-from sim.geometry import Pose2D, Region
-from sim.relations import Judge
+from cbrs.sim import predicates as pred
+from cbrs.sim.arms import ArmSide
+from cbrs.sim.geometry import Pose2D, Region
+from cbrs.sim.relations import Judge
 
 __all__ = ["Referee"]
 

@@ -14,10 +14,10 @@ from __future__ import annotations
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
 
-from kb.semantic_map import Thing
-from sim.arms import ArmSide
-from sim.geometry import Pose2D, Region
-from sim.world import HomeWorld
+from cbrs.kb.semantic_map import Thing
+from cbrs.sim.arms import ArmSide
+from cbrs.sim.geometry import Pose2D, Region
+from cbrs.sim.world import HomeWorld
 
 __all__ = ["Grounded", "Judge", "region_of"]
 

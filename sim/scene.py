@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from functools import lru_cache
 
-from kb import KnowledgeBase
-from kb.semantic_map import SemanticMap
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.semantic_map import SemanticMap
 
 __all__ = ["bundled_map"]
 

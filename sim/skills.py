@@ -16,10 +16,10 @@ from dataclasses import dataclass
 import numpy as np
 import pybullet as p
 
-from sim import predicates as pred
-from sim.arms import GRIPPER_OPEN, Arm, ArmSide
-from sim.geometry import Pose2D, Region, Vec3, wrap_angle
-from sim.grasping import (
+from cbrs.sim import predicates as pred
+from cbrs.sim.arms import GRIPPER_OPEN, Arm, ArmSide
+from cbrs.sim.geometry import Pose2D, Region, Vec3, wrap_angle
+from cbrs.sim.grasping import (
     PREGRASP_DISTANCE,
     GraspKind,
     GraspPose,
@@ -28,10 +28,10 @@ from sim.grasping import (
     side_orientation,
     top_orientation,
 )
-from sim.layout import PERSON_HAND_HEIGHT
-from sim.perception import ObjectEstimate, PersonEstimate, RobotPoseEstimate
-from sim.planning import PlannedPath
-from sim.world import HomeWorld
+from cbrs.sim.layout import PERSON_HAND_HEIGHT
+from cbrs.sim.perception import ObjectEstimate, PersonEstimate, RobotPoseEstimate
+from cbrs.sim.planning import PlannedPath
+from cbrs.sim.world import HomeWorld
 
 __all__ = [
     "ABOVE_CLEARANCE",

@@ -25,14 +25,14 @@ from typing import Any, NoReturn, TypeAlias, TypeVar
 import numpy as np
 from numpy.typing import NDArray
 
-from kb.namespaces import HOME, expand
-from kb.semantic_map import MapObject, local_name
-from sim.errors import SimulationError
-from sim.geometry import Pose2D
-from sim.grasping import GraspKind, ObjectModel
-from sim.mapping import OccupancyGrid, inflate
-from sim.perception import ObjectEstimate, PersonEstimate, RobotPoseEstimate
-from sim.planning import PlannedPath
+from cbrs.kb.namespaces import HOME, expand
+from cbrs.kb.semantic_map import MapObject, local_name
+from cbrs.sim.errors import SimulationError
+from cbrs.sim.geometry import Pose2D
+from cbrs.sim.grasping import GraspKind, ObjectModel
+from cbrs.sim.mapping import OccupancyGrid, inflate
+from cbrs.sim.perception import ObjectEstimate, PersonEstimate, RobotPoseEstimate
+from cbrs.sim.planning import PlannedPath
 
 __all__ = [
     "APPROACH_POSITION",

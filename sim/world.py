@@ -17,19 +17,19 @@ from types import TracebackType
 import numpy as np
 import pybullet as p
 
-from kb.namespaces import PREFIXES
-from kb.semantic_map import Arm as ArmSpec
-from kb.semantic_map import Box, Dispenser, MapObject, SemanticMap, Thing
-from sim import layout as L
-from sim.arms import PYBULLET_DATA, Arm, ArmSide, Kinematics
-from sim.base import MobileBase
-from sim.cameras import Camera
-from sim.errors import UnknownEntityError, WorldClosedError
-from sim.geometry import Pose2D, Pose3D, Quat, Region, Vec3, quat_from_yaw
-from sim.layout import CameraSpec
-from sim.perception import MarkerModel
-from sim.quiet import quiet_output
-from sim.scene import bundled_map
+from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.semantic_map import Arm as ArmSpec
+from cbrs.kb.semantic_map import Box, Dispenser, MapObject, SemanticMap, Thing
+from cbrs.sim import layout as L
+from cbrs.sim.arms import PYBULLET_DATA, Arm, ArmSide, Kinematics
+from cbrs.sim.base import MobileBase
+from cbrs.sim.cameras import Camera
+from cbrs.sim.errors import UnknownEntityError, WorldClosedError
+from cbrs.sim.geometry import Pose2D, Pose3D, Quat, Region, Vec3, quat_from_yaw
+from cbrs.sim.layout import CameraSpec
+from cbrs.sim.perception import MarkerModel
+from cbrs.sim.quiet import quiet_output
+from cbrs.sim.scene import bundled_map
 
 __all__ = ["TIME_STEP", "HomeWorld", "Perturbation", "Spread", "open_world"]
 

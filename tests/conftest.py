@@ -13,8 +13,8 @@ from typing import IO
 import httpx
 import pytest
 
-from kb import KnowledgeBase, Store
-from kb.resources import ontology_dir
+from cbrs.kb import KnowledgeBase, Store
+from cbrs.kb.resources import ontology_dir
 
 DATA = Path(__file__).parent / "data"
 MINI_FILES = [DATA / "mini_ontology.ttl", DATA / "mini_services.ttl", DATA / "mini_requirements.ttl"]

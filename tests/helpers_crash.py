@@ -19,7 +19,7 @@ import time
 from collections.abc import Callable
 from typing import Any
 
-from kb.store import EmbeddedStore
+from cbrs.kb.store import EmbeddedStore
 
 SERVE_LIFETIME = 60.0
 
@@ -54,7 +54,7 @@ def load(store: str, file: str) -> None:
 
 
 def update(store: str, text: str) -> None:
-    from kb import KnowledgeBase
+    from cbrs.kb import KnowledgeBase
 
     kb = KnowledgeBase.open(store, seed=False)
     say("started")
@@ -63,9 +63,9 @@ def update(store: str, text: str) -> None:
 
 
 def serve(store: str, token: str) -> None:
+    from cbrs.kb import KnowledgeBase
     from cbrs.server import ServeConfig, Server
     from cbrs.sparql_service import EndpointConfig
-    from kb import KnowledgeBase
 
     config = ServeConfig(port=0, bridge_port=0, endpoint=EndpointConfig(update_token=token))
     server = Server(KnowledgeBase.open(store, seed=False), config)

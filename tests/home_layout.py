@@ -3,11 +3,11 @@ tests that drive skills directly: nothing here is a second copy of the map."""
 
 from __future__ import annotations
 
-from kb.namespaces import PREFIXES
-from kb.semantic_map import Thing, local_name
-from sim.geometry import Pose2D, Region
-from sim.layout import CameraSpec
-from sim.scene import bundled_map
+from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.semantic_map import Thing, local_name
+from cbrs.sim.geometry import Pose2D, Region
+from cbrs.sim.layout import CameraSpec
+from cbrs.sim.scene import bundled_map
 
 WORLD, HOME = PREFIXES["world"], PREFIXES["home"]
 _MAP = bundled_map()

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from reasoner.taxonomy import ROOT, Link, TaxonomyIndex
+from cbrs.reasoner.taxonomy import ROOT, Link, TaxonomyIndex
 
 E = "http://example.org/t#"
 

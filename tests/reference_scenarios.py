@@ -16,15 +16,15 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TypeVar
 
-from sim import skills
-from sim.arms import ArmSide
-from sim.errors import SimulationError
-from sim.grasping import ObjectModel, compute_grasp_pose
-from sim.mapping import OccupancyGrid, build_occupancy_grid
-from sim.perception import RobotPoseEstimate, locate_robot, recognise_object, track_person
-from sim.planning import approach_point, plan_path
-from sim.skills import Outcome
-from sim.world import HomeWorld
+from cbrs.sim import skills
+from cbrs.sim.arms import ArmSide
+from cbrs.sim.errors import SimulationError
+from cbrs.sim.grasping import ObjectModel, compute_grasp_pose
+from cbrs.sim.mapping import OccupancyGrid, build_occupancy_grid
+from cbrs.sim.perception import RobotPoseEstimate, locate_robot, recognise_object, track_person
+from cbrs.sim.planning import approach_point, plan_path
+from cbrs.sim.skills import Outcome
+from cbrs.sim.world import HomeWorld
 from tests.home_layout import ARM_FACING, ARM_MOUNTS, BELOW_OF_TAP, HANDOVER_POSE, TAP_LEVER
 
 __all__ = ["PERSON_APPROACH_DISTANCE", "ScenarioResult", "fetch_pen", "serve_cup"]

@@ -21,13 +21,13 @@ from click.testing import CliRunner
 from flask.testing import FlaskClient
 
 from cbrs.cli import cli
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.catalog import Catalogue
 from cbrs.server import ServeConfig, Server
 from cbrs.settings import setting
 from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.tasks import TaskRunner
 from cbrs.web import create_app
-from kb import KnowledgeBase
-from kb.catalog import Catalogue
 from tests.helpers_threads import assert_threads_end
 from tests.test_serve import bridge, call
 

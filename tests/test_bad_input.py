@@ -27,16 +27,16 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from websockets.sync.client import ClientConnection, connect
 
-import kb.loader
 from cbrs.bridge_services import KnowledgeServices, attach
 from cbrs.cli import cli
+from cbrs.kb import GraphName, KnowledgeBase, KnowledgeBaseError, Store
+from cbrs.kb import loader as kb_loader
+from cbrs.kb.errors import InvalidDescriptionError, PartCycleError, RdfParseError
+from cbrs.kb.resources import ontology_dir
 from cbrs.rosbridge import Bridge, RunningBridge
 from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.tasks import TaskRunner
 from cbrs.web import create_app
-from kb import GraphName, KnowledgeBase, KnowledgeBaseError, Store
-from kb.errors import InvalidDescriptionError, PartCycleError, RdfParseError
-from kb.resources import ontology_dir
 
 DATA = Path(__file__).parent / "data"
 BAD = DATA / "bad"
@@ -95,8 +95,8 @@ def dump(location: str) -> bytes:
 @pytest.fixture(autouse=True)
 def quick_canonicalisation(monkeypatch: pytest.MonkeyPatch) -> None:
     """The look-alike blank nodes must be refused in seconds, not the production limit's ten."""
-    monkeypatch.setattr(kb.loader, "CANONICAL_SECONDS", 2.0)
-    monkeypatch.setattr(kb.loader, "CANONICAL_BYTES", 512 << 20)
+    monkeypatch.setattr(kb_loader, "CANONICAL_SECONDS", 2.0)
+    monkeypatch.setattr(kb_loader, "CANONICAL_BYTES", 512 << 20)
 
 
 LOAD_ERRORS = [case for case in cases("load") if "error" in case.values[1]]
@@ -145,7 +145,7 @@ def test_a_usable_file_with_flaws_loads_and_names_them(tmp_path: Path, path: Pat
 def test_rdfxml_cut_off_mid_element_loads_nothing_even_alone(tmp_path: Path) -> None:
     """Oxigraph returns the triples before the cut; the loader must not store them."""
     with pytest.raises(RdfParseError) as caught:
-        kb.loader.parse_file(BAD / "rdfxml_truncated.rdf")
+        kb_loader.parse_file(BAD / "rdfxml_truncated.rdf")
     assert caught.value.line == 6
 
 
@@ -153,11 +153,11 @@ def test_look_alike_blank_nodes_canonicalise_the_same_in_the_child(tmp_path: Pat
     """A small graph of look-alikes goes through the child process and gets the names it gets in process."""
     p = ox.NamedNode("http://example.org/p")
     ring = [ox.Quad(ox.BlankNode(f"b{i}"), p, ox.BlankNode(f"b{j}")) for i in range(4) for j in range(4) if i != j]
-    assert kb.loader._has_look_alikes(ring)
+    assert kb_loader._has_look_alikes(ring)
     dataset = ox.Dataset(ring)
     dataset.canonicalize(ox.CanonicalizationAlgorithm.RDFC_1_0)
-    assert kb.loader._canonical_in_child(ring, "ring") == sorted(dataset, key=str)
-    assert kb.loader.skolemise(ring) == kb.loader.skolemise(list(reversed(ring)))
+    assert kb_loader._canonical_in_child(ring, "ring") == sorted(dataset, key=str)
+    assert kb_loader.skolemise(ring) == kb_loader.skolemise(list(reversed(ring)))
 
 
 # -- hasPart cycles: refused at load, and what the reader and the taxonomy make of one -------------
@@ -220,13 +220,13 @@ def test_a_narrowed_part_is_no_cycle(tmp_path: Path) -> None:
 
 def test_a_stored_cycle_is_refused_by_the_reader_and_broken_by_the_taxonomy() -> None:
     """What happens to a cycle that got in another way (an update): both terminate, one refuses clearly."""
-    from reasoner.taxonomy import TaxonomyIndex
+    from cbrs.reasoner.taxonomy import TaxonomyIndex
 
     knowledge = KnowledgeBase(Store.open(":memory:"))
     knowledge.load([ontology_dir() / "core.ttl"], graph="ontology")
     quads = ox.parse((BAD / "requirement_haspart_cycle.ttl").read_bytes(), format=ox.RdfFormat.TURTLE)
     graph = GraphName.ONTOLOGY.node
-    knowledge.store.add(kb.loader.skolemise([ox.Quad(q.subject, q.predicate, q.object, graph) for q in quads]))
+    knowledge.store.add(kb_loader.skolemise([ox.Quad(q.subject, q.predicate, q.object, graph) for q in quads]))
     with pytest.raises(InvalidDescriptionError, match="hasPart cycle"):
         knowledge.part_tree("http://example.org/cycle#Wheel")
     index = TaxonomyIndex.from_kb(knowledge)
@@ -254,7 +254,7 @@ def test_a_load_is_refused_exactly_when_a_part_tree_would_be_endless(
         refused = True
         quads = ox.parse(path.read_bytes(), format=ox.RdfFormat.TURTLE)
         graph = GraphName.ONTOLOGY.node
-        knowledge.store.add(kb.loader.skolemise([ox.Quad(q.subject, q.predicate, q.object, graph) for q in quads]))
+        knowledge.store.add(kb_loader.skolemise([ox.Quad(q.subject, q.predicate, q.object, graph) for q in quads]))
     endless = False
     for n in range(5):
         try:
@@ -396,7 +396,7 @@ NESTED_PROBE = """
 import sys
 from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.web import create_app
-from kb import KnowledgeBase, Store
+from cbrs.kb import KnowledgeBase, Store
 client = create_app(SparqlService(KnowledgeBase(Store.open(":memory:")), EndpointConfig())).test_client()
 response = client.get("/sparql", query_string={"query": sys.stdin.read()})
 print(response.status_code, response.get_json()["error"])

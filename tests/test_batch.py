@@ -7,12 +7,12 @@ import random
 import numpy as np
 import pytest
 
-from kb import KnowledgeBase, Store
-from reasoner.matchmaker import Matchmaker
-from reasoner.methods import METHODS
-from reasoner.similarity import SemStr
-from reasoner.synthetic import build
-from reasoner.vectors import VectorSpace
+from cbrs.kb import KnowledgeBase, Store
+from cbrs.reasoner.matchmaker import Matchmaker
+from cbrs.reasoner.methods import METHODS
+from cbrs.reasoner.similarity import SemStr
+from cbrs.reasoner.synthetic import build
+from cbrs.reasoner.vectors import VectorSpace
 from tests.reasoner_examples import E, positions
 
 SIMILARITY_METHODS = [m for m in METHODS if m != "logic"]

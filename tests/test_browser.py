@@ -17,8 +17,8 @@ from typing import Any
 
 import pytest
 
+from cbrs.kb import KnowledgeBase
 from cbrs.server import ServeConfig, Server
-from kb import KnowledgeBase
 
 CHROMIUM = os.environ.get("CBRS_CHROMIUM") or shutil.which("chromium") or "/usr/bin/chromium"
 pytestmark = pytest.mark.skipif(

@@ -11,8 +11,8 @@ from click.testing import CliRunner
 
 from cbrs.check import JavaMissingError, check
 from cbrs.cli import cli
-from kb import KnowledgeBase
-from kb.namespaces import GraphName
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import GraphName
 
 needs_java = pytest.mark.skipif(
     shutil.which(str(owlready2.JAVA_EXE)) is None, reason="no Java runtime (apt-get install default-jre-headless)"

@@ -14,8 +14,8 @@ from click.testing import CliRunner
 
 from cbrs import __version__
 from cbrs.cli import cli, main
+from cbrs.kb import KnowledgeBase
 from cbrs.task_names import task_iri
-from kb import KnowledgeBase
 
 BAD = Path(__file__).parent / "data" / "bad"
 DATA = Path(__file__).parent / "data"

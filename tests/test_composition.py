@@ -8,11 +8,11 @@ from typing import Any
 
 import pytest
 
-from actions.composer import ComposeConfig, Composer, Objective, PlanStatus
-from actions.graph import SRI, SRO, ServiceResourceGraph
-from actions.search import bidirectional_search
-from kb import KnowledgeBase, Store
-from kb.resources import ontology_dir
+from cbrs.actions.composer import ComposeConfig, Composer, Objective, PlanStatus
+from cbrs.actions.graph import SRI, SRO, ServiceResourceGraph
+from cbrs.actions.search import bidirectional_search
+from cbrs.kb import KnowledgeBase, Store
+from cbrs.kb.resources import ontology_dir
 
 DATA = Path(__file__).parent / "data" / "composition"
 EX = "http://example.org/comp#"
@@ -107,10 +107,10 @@ def test_unreachable_cycle_is_never_enabled() -> None:
 def test_deep_fan_in_stays_bounded(bundled_kb: KnowledgeBase) -> None:
     """Ten layers, each needing two results of the layer below: 2**10 invocations if every use got its
     own; past max_steps, uses share invocations, and the plan is still well formed."""
-    from actions.composer import ComposeConfig
-    from actions.model import ActionLibrary
-    from kb import Advertisement, Parameter, Requirement
-    from reasoner.taxonomy import ROOT, Link, TaxonomyIndex
+    from cbrs.actions.composer import ComposeConfig
+    from cbrs.actions.model import ActionLibrary
+    from cbrs.kb import Advertisement, Parameter, Requirement
+    from cbrs.reasoner.taxonomy import ROOT, Link, TaxonomyIndex
 
     types = [f"{EX}T{i}" for i in range(11)]
     index = TaxonomyIndex.from_links([Link(t, ROOT, "is-a") for t in types])

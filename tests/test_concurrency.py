@@ -17,9 +17,9 @@ from typing import Any
 import httpx
 import pytest
 
+from cbrs.kb import KnowledgeBase
 from cbrs.server import ServeConfig, Server
 from cbrs.sparql_service import EndpointConfig
-from kb import KnowledgeBase
 from tests.helpers_concurrency import BATCH_QUERY, WAIT, BridgeLoad, SparqlLoad, bridge_load, canonical, sparql_load
 from tests.helpers_threads import assert_threads_end
 

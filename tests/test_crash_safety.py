@@ -27,7 +27,7 @@ import httpx
 import pyoxigraph as ox
 import pytest
 
-from kb import KnowledgeBase, Store
+from cbrs.kb import KnowledgeBase, Store
 
 HELPER = Path(__file__).with_name("helpers_crash.py")
 WAIT = 30.0  # bound on every wait for the child; the trials take a few seconds each

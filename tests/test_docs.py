@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from cbrs.kb import _vocabgen
 from cbrs.settings import SETTINGS
-from kb import _vocabgen
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -18,7 +18,7 @@ def test_every_setting_is_documented() -> None:
 
 def test_generated_vocabulary_is_current() -> None:
     assert _vocabgen.TARGET.read_text(encoding="utf-8") == _vocabgen.render(), (
-        "kb/vocab.py is stale: run python -m kb._vocabgen"
+        "kb/vocab.py is stale: run python -m cbrs.kb._vocabgen"
     )
 
 

@@ -9,8 +9,8 @@ import pytest
 from click.testing import CliRunner
 
 from cbrs.cli import cli
-from reasoner.evaluation import Report, evaluate_paper
-from reasoner.methods import METHODS
+from cbrs.reasoner.evaluation import Report, evaluate_paper
+from cbrs.reasoner.methods import METHODS
 
 
 @pytest.fixture(scope="module")

@@ -6,11 +6,11 @@ from pathlib import Path
 
 import pytest
 
-from kb import KnowledgeBase
-from reasoner.evaluation import METRICS, Report, evaluate_paper, metric_values, plot_report
-from reasoner.methods import METHODS
-from reasoner.metrics import average_precision, first_relevant_rank, precision_at_k, reciprocal_rank, top1
-from reasoner.testbed import (
+from cbrs.kb import KnowledgeBase
+from cbrs.reasoner.evaluation import METRICS, Report, evaluate_paper, metric_values, plot_report
+from cbrs.reasoner.methods import METHODS
+from cbrs.reasoner.metrics import average_precision, first_relevant_rank, precision_at_k, reciprocal_rank, top1
+from cbrs.reasoner.testbed import (
     CATALOGUE_FILE,
     RULES,
     SEED,
@@ -115,8 +115,8 @@ def testbed_kb() -> KnowledgeBase:
 
 def test_committed_testbed_is_what_the_seed_generates() -> None:
     turtle, truth = generate(SEED)
-    assert TESTBED_FILE.read_text(encoding="utf-8") == turtle, "run python -m reasoner.testbed"
-    assert TRUTH_FILE.read_text(encoding="utf-8") == truth_json(truth), "run python -m reasoner.testbed"
+    assert TESTBED_FILE.read_text(encoding="utf-8") == turtle, "run python -m cbrs.reasoner.testbed"
+    assert TRUTH_FILE.read_text(encoding="utf-8") == truth_json(truth), "run python -m cbrs.reasoner.testbed"
 
 
 def test_generation_is_deterministic_and_the_seed_changes_only_placement() -> None:

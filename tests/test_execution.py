@@ -7,7 +7,7 @@ from typing import Any
 
 import pytest
 
-from actions.components import (
+from cbrs.actions.components import (
     Component,
     Container,
     LifecycleError,
@@ -16,10 +16,10 @@ from actions.components import (
     Registry,
     Status,
 )
-from actions.events import Event, EventBus, Priority
-from actions.executor import Executor, RunStatus
-from actions.plan import Binding, Plan, PlanStep, Source
-from kb import Statement
+from cbrs.actions.events import Event, EventBus, Priority
+from cbrs.actions.executor import Executor, RunStatus
+from cbrs.actions.plan import Binding, Plan, PlanStep, Source
+from cbrs.kb import Statement
 
 EX = "http://example.org/exec#"
 DONE = Statement(EX + "Thing", EX + "is", EX + "Done")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import os
 
 from cbrs.external_demo import run_external_demo
-from kb.namespaces import PREFIXES
+from cbrs.kb.namespaces import PREFIXES
 
 SVC = PREFIXES["svc"]
 

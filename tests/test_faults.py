@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import pytest
 
-from actions.components import Container, Registry
-from actions.executor import Executor, RunStatus
-from actions.faults import Combined, Fault, FaultSpecError, FixedFaults, RandomFaults, doomed_steps, planned_faults
-from actions.plan import Plan, Source
+from cbrs.actions.components import Container, Registry
+from cbrs.actions.executor import Executor, RunStatus
+from cbrs.actions.faults import Combined, Fault, FaultSpecError, FixedFaults, RandomFaults, doomed_steps, planned_faults
+from cbrs.actions.plan import Plan, Source
 from tests.test_execution import EX, Stub, plan, step
 
 COMPONENTS = ("Map", "Cam1", "Cam2", "Plan1", "Plan2", "Drive", "Arm")

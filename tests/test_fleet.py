@@ -16,9 +16,9 @@ from click.testing import CliRunner
 from cbrs.bridge_client import BridgeClient
 from cbrs.cli import cli
 from cbrs.component import Component
+from cbrs.kb import KnowledgeBase
 from cbrs.server import ServeConfig, Server
 from cbrs.sparql_service import EndpointConfig
-from kb import KnowledgeBase
 from tests.test_live_components import READING, THERMOMETER, thermometer
 
 TOKEN = "fleet-test-token"

@@ -10,10 +10,10 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from cbrs.cli import cli
-from kb import Advertisement, KnowledgeBase, Parameter, Requirement, Store
-from reasoner.config import MatchConfig
-from reasoner.matchmaker import Matchmaker
-from reasoner.text import TextIndex, description_text
+from cbrs.kb import Advertisement, KnowledgeBase, Parameter, Requirement, Store
+from cbrs.reasoner.config import MatchConfig
+from cbrs.reasoner.matchmaker import Matchmaker
+from cbrs.reasoner.text import TextIndex, description_text
 from tests.reasoner_examples import E, positions
 
 

@@ -41,11 +41,18 @@ def test_changelog_has_a_section_for_the_current_version() -> None:
     assert re.search(r"^## \[?Unreleased\]?", text, re.MULTILINE)
 
 
+def _source_folders() -> list[Path]:
+    """The folders of the installed packages' code: cbrs and the folders its links (cbrs/kb...) point to."""
+    folders = [ROOT / package for package in TOP_LEVEL]
+    linked = [entry.resolve() for entry in (ROOT / "cbrs").iterdir() if entry.is_symlink() and entry.is_dir()]
+    return folders + sorted(linked)
+
+
 def _runtime_imports() -> set[str]:
     """Top-level modules imported by the installed packages' code (not tests, not bench)."""
     found: set[str] = set()
-    for package in TOP_LEVEL:
-        for path in (ROOT / package).rglob("*.py"):
+    for folder in _source_folders():
+        for path in folder.rglob("*.py"):
             for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
                 if isinstance(node, ast.Import):
                     found.update(alias.name.split(".")[0] for alias in node.names)
@@ -63,6 +70,25 @@ def test_runtime_dependencies_are_what_runtime_code_imports() -> None:
     provided = {import_names.get(dep, dep).replace("-", "_") for dep in declared} | set(TOP_LEVEL)
     undeclared = sorted(imported - provided - set(sys.stdlib_module_names) - {"__future__"})
     assert not undeclared, f"imported by runtime code but not a declared dependency: {undeclared}"
+
+
+def test_only_cbrs_is_importable_from_outside_the_checkout(tmp_path: Path) -> None:
+    """kb, reasoner, actions and sim install under cbrs: a user's own `kb` cannot shadow ours, nor ours theirs."""
+    env = {key: value for key, value in os.environ.items() if key != "PYTHONPATH"}
+    for name in ("kb", "reasoner", "actions", "sim"):
+        found = subprocess.run(
+            [sys.executable, "-c", f"import importlib.util as u; print(u.find_spec({name!r}) is None)"],
+            cwd=tmp_path,
+            env=env,
+            capture_output=True,
+            text=True,
+            check=True,
+        )
+        assert found.stdout.strip() == "True", f"{name} is importable outside the checkout"
+        inside = subprocess.run(
+            [sys.executable, "-c", f"import cbrs.{name}"], cwd=tmp_path, env=env, capture_output=True, text=True
+        )
+        assert inside.returncode == 0, inside.stderr
 
 
 @pytest.mark.slow
@@ -103,7 +129,7 @@ def test_plain_install_runs_from_another_directory(tmp_path: Path) -> None:
 
     # The installed copy, not the checkout, answered.
     where = subprocess.run(
-        [str(venv / "bin" / "python"), "-c", "import kb.resources as r; print(r.query_dir())"],
+        [str(venv / "bin" / "python"), "-c", "import cbrs.kb.resources as r; print(r.query_dir())"],
         cwd=elsewhere,
         env=env,
         capture_output=True,

@@ -8,15 +8,15 @@ from pathlib import Path
 
 import pytest
 
-from actions.composer import Composer
-from actions.events import Event
-from actions.runner import RunResult, run_task
-from kb import KnowledgeBase
-from kb.namespaces import PREFIXES
-from kb.semantic_map import AmbiguousDesignatorError, MapError, SemanticMap, UnresolvedDesignatorError, designate
-from sim.components import SimEnvironment
-from sim.mapping import build_occupancy_grid
-from sim.world import HomeWorld, open_world
+from cbrs.actions.composer import Composer
+from cbrs.actions.events import Event
+from cbrs.actions.runner import RunResult, run_task
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.semantic_map import AmbiguousDesignatorError, MapError, SemanticMap, UnresolvedDesignatorError, designate
+from cbrs.sim.components import SimEnvironment
+from cbrs.sim.mapping import build_occupancy_grid
+from cbrs.sim.world import HomeWorld, open_world
 
 TASKS = Path(__file__).parent / "data" / "tasks"
 HOME, WORLD, REQ = PREFIXES["home"], PREFIXES["world"], PREFIXES["req"]

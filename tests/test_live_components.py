@@ -17,22 +17,22 @@ import httpx
 import pyoxigraph as ox
 import pytest
 
-from actions.components import Status
-from actions.composer import Composer
-from actions.remote import RemoteCallError, RemoteComponent
-from actions.runner import run_task
+from cbrs.actions.components import Status
+from cbrs.actions.composer import Composer
+from cbrs.actions.remote import RemoteCallError, RemoteComponent
+from cbrs.actions.runner import run_task
 from cbrs.bridge_client import BridgeClient
 from cbrs.component import Component
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.errors import InvalidDescriptionError
+from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.semantic_map import SemanticMap
+from cbrs.reasoner.matchmaker import Matchmaker
 from cbrs.server import ServeConfig, Server
+from cbrs.sim.components import SimEnvironment
+from cbrs.sim.values import check
+from cbrs.sim.world import open_world
 from cbrs.sparql_service import EndpointConfig
-from kb import KnowledgeBase
-from kb.errors import InvalidDescriptionError
-from kb.namespaces import PREFIXES
-from kb.semantic_map import SemanticMap
-from reasoner.matchmaker import Matchmaker
-from sim.components import SimEnvironment
-from sim.values import check
-from sim.world import open_world
 
 TOKEN = "live-components-test-token"
 SVC, HOME, REQ = PREFIXES["svc"], PREFIXES["home"], PREFIXES["req"]

@@ -5,9 +5,9 @@ from pathlib import Path
 import pyoxigraph as ox
 import pytest
 
-from kb import GraphName, KnowledgeBase, RdfParseError, Store, UnknownFormatError, UnknownGraphError
-from kb.loader import parse_file, skolemise
-from kb.namespaces import GENID
+from cbrs.kb import GraphName, KnowledgeBase, RdfParseError, Store, UnknownFormatError, UnknownGraphError
+from cbrs.kb.loader import parse_file, skolemise
+from cbrs.kb.namespaces import GENID
 
 pytestmark = pytest.mark.both_stores
 

@@ -6,7 +6,7 @@ import pytest
 from click.testing import CliRunner
 
 from cbrs.cli import cli
-from kb import (
+from cbrs.kb import (
     Advertisement,
     KnowledgeBase,
     NotFoundError,
@@ -17,12 +17,12 @@ from kb import (
     Statement,
     Store,
 )
-from reasoner.config import MatchConfig
-from reasoner.matchmaker import Matchmaker, MatchStatus
-from reasoner.methods import METHODS
-from reasoner.similarity import SemStr
-from reasoner.spans import conceptual_span_similarity
-from reasoner.statements import statement_similarity
+from cbrs.reasoner.config import MatchConfig
+from cbrs.reasoner.matchmaker import Matchmaker, MatchStatus
+from cbrs.reasoner.methods import METHODS
+from cbrs.reasoner.similarity import SemStr
+from cbrs.reasoner.spans import conceptual_span_similarity
+from cbrs.reasoner.statements import statement_similarity
 from tests.reasoner_examples import E, positions
 
 SVC = "https://w3id.org/cbrs/service#"

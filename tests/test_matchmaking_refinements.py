@@ -6,14 +6,14 @@ from pathlib import Path
 
 import pytest
 
-from kb import Advertisement, KnowledgeBase, Parameter, Requirement, Statement, Store
-from reasoner.config import MatchConfig
-from reasoner.lexicon import DATA_FILE, Lexicon
-from reasoner.matchmaker import Matchmaker
-from reasoner.owlstc import evaluate_collection
-from reasoner.similarity import SemStr
-from reasoner.statements import statement_similarity
-from reasoner.taxonomy import Link, TaxonomyIndex
+from cbrs.kb import Advertisement, KnowledgeBase, Parameter, Requirement, Statement, Store
+from cbrs.reasoner.config import MatchConfig
+from cbrs.reasoner.lexicon import DATA_FILE, Lexicon
+from cbrs.reasoner.matchmaker import Matchmaker
+from cbrs.reasoner.owlstc import evaluate_collection
+from cbrs.reasoner.similarity import SemStr
+from cbrs.reasoner.statements import statement_similarity
+from cbrs.reasoner.taxonomy import Link, TaxonomyIndex
 from tests.reasoner_examples import E, positions
 
 ROBOT = Path(__file__).parent / "data" / "robot_services"

@@ -2,10 +2,10 @@ from __future__ import annotations
 
 import pytest
 
-from kb import Advertisement, InvalidDescriptionError, KnowledgeBase, NotFoundError, Requirement, Statement
-from kb.errors import PartCycleError
-from kb.namespaces import GraphName
-from kb.vocab import CBRS
+from cbrs.kb import Advertisement, InvalidDescriptionError, KnowledgeBase, NotFoundError, Requirement, Statement
+from cbrs.kb.errors import PartCycleError
+from cbrs.kb.namespaces import GraphName
+from cbrs.kb.vocab import CBRS
 
 EX = "http://example.org/mini#"
 

@@ -8,9 +8,9 @@ import pytest
 import rdflib
 from rdflib.namespace import OWL, RDF, RDFS
 
-from kb import Advertisement, KnowledgeBase, Requirement
-from kb.namespaces import ACT, CBRS, DUL, HOME, REQ, SVC
-from kb.resources import bundled_files, ontology_dir
+from cbrs.kb import Advertisement, KnowledgeBase, Requirement
+from cbrs.kb.namespaces import ACT, CBRS, DUL, HOME, REQ, SVC
+from cbrs.kb.resources import bundled_files, ontology_dir
 
 OURS = (CBRS, HOME, ACT, SVC, REQ)
 DECLARED_TYPES = {

@@ -12,13 +12,13 @@ import pytest
 from click.testing import CliRunner
 
 from cbrs.cli import cli
-from kb import Advertisement, CatalogueError, GraphName, KnowledgeBase, RdfParseError, Requirement, Store
-from kb.catalog import Catalogue
-from kb.loader import expand_paths, parse_file
-from kb.namespaces import RDF, RDFS
-from kb.owls import Vocabulary, convert, requirement_iri
-from kb.resources import ontology_dir
-from kb.vocab import CBRS
+from cbrs.kb import Advertisement, CatalogueError, GraphName, KnowledgeBase, RdfParseError, Requirement, Store
+from cbrs.kb.catalog import Catalogue
+from cbrs.kb.loader import expand_paths, parse_file
+from cbrs.kb.namespaces import RDF, RDFS
+from cbrs.kb.owls import Vocabulary, convert, requirement_iri
+from cbrs.kb.resources import ontology_dir
+from cbrs.kb.vocab import CBRS
 
 OWLS = Path(__file__).parent / "data" / "owls"
 ONTOLOGY = OWLS / "ontology"

@@ -11,8 +11,8 @@ import pytest
 from click.testing import CliRunner
 
 from cbrs.cli import cli
-from reasoner.metrics import average_precision, interpolated_precision, ndcg, precision_at_k, r_precision
-from reasoner.owlstc import CollectionError, evaluate_collection, read_relevance
+from cbrs.reasoner.metrics import average_precision, interpolated_precision, ndcg, precision_at_k, r_precision
+from cbrs.reasoner.owlstc import CollectionError, evaluate_collection, read_relevance
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "owls-tc4"
 needs_collection = pytest.mark.skipif(

@@ -7,15 +7,15 @@ from typing import Any
 
 import pybullet as p
 
-from actions.composer import Composer
-from actions.events import Event
-from actions.runner import run_task
-from kb import KnowledgeBase, Statement
-from kb.semantic_map import SemanticMap
-from sim.components import SimEnvironment
-from sim.perceived import PerceivedWorld
-from sim.referee import Referee
-from sim.world import HomeWorld, open_world
+from cbrs.actions.composer import Composer
+from cbrs.actions.events import Event
+from cbrs.actions.runner import run_task
+from cbrs.kb import KnowledgeBase, Statement
+from cbrs.kb.semantic_map import SemanticMap
+from cbrs.sim.components import SimEnvironment
+from cbrs.sim.perceived import PerceivedWorld
+from cbrs.sim.referee import Referee
+from cbrs.sim.world import HomeWorld, open_world
 
 CAMERA_SOURCES = ("Kinect01", "CeilingCamera01", "CeilingCamera02")
 

@@ -8,10 +8,10 @@ from collections.abc import Iterator
 import pytest
 from flask.testing import FlaskClient
 
-from actions.composer import Composer, store_plan
+from cbrs.actions.composer import Composer, store_plan
+from cbrs.kb import KnowledgeBase
 from cbrs.sparql_service import SparqlService
 from cbrs.web import create_app
-from kb import KnowledgeBase
 
 
 @pytest.fixture

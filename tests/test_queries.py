@@ -8,9 +8,9 @@ from typing import Any
 
 import pytest
 
-from kb import BindingError, KnowledgeBase, Store, UnknownQueryError
-from kb.namespaces import PREFIXES
-from kb.resources import ontology_dir, query_dir
+from cbrs.kb import BindingError, KnowledgeBase, Store, UnknownQueryError
+from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.resources import ontology_dir, query_dir
 
 DATA = Path(__file__).parent / "data"
 MANIFEST = tomllib.loads((DATA / "queries" / "manifest.toml").read_text(encoding="utf-8"))["case"]

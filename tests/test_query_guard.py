@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import pytest
 
-from kb.errors import QuerySyntaxError, QueryTooComplexError
-from kb.query_guard import QueryGuard
-from kb.store import EmbeddedStore
+from cbrs.kb.errors import QuerySyntaxError, QueryTooComplexError
+from cbrs.kb.query_guard import QueryGuard
+from cbrs.kb.store import EmbeddedStore
 
 # The issue's text: the old bracket guard read '<+(+(...>' as an IRI.
 ISSUE_QUERY = "SELECT * WHERE { FILTER(1<" + "+(" * 5000 + "1+" + ")" * 5000 + ">0) }"

@@ -21,7 +21,7 @@ import pytest
 from click.testing import CliRunner
 
 from cbrs.cli import cli
-from kb.namespaces import expand
+from cbrs.kb.namespaces import expand
 
 ROOT = Path(__file__).resolve().parents[1]
 README = (ROOT / "README.md").read_text(encoding="utf-8")

@@ -18,8 +18,8 @@ from PIL import Image, ImageSequence
 
 import cbrs.cli_actions
 from cbrs.cli import cli
-from sim import recording
-from sim.recording import (
+from cbrs.sim import recording
+from cbrs.sim.recording import (
     CAPTION_HEIGHT,
     FRAME_INTERVAL,
     PATH_MAP_SIZE,
@@ -29,7 +29,7 @@ from sim.recording import (
     find_ffmpeg,
     path_map_name,
 )
-from sim.world import HomeWorld, open_world
+from cbrs.sim.world import HomeWorld, open_world
 
 SERVE = "RobotArmServeACup"
 FIND_CUP = "svc:FindCupOnTable_CytonDualArm01"  # the first step; nothing stands in for it

@@ -2,7 +2,7 @@ from __future__ import annotations
 
 import pytest
 
-from kb import AlreadyRegisteredError, InvalidDescriptionError, KnowledgeBase, NotFoundError, RdfParseError
+from cbrs.kb import AlreadyRegisteredError, InvalidDescriptionError, KnowledgeBase, NotFoundError, RdfParseError
 
 pytestmark = pytest.mark.both_stores
 

@@ -5,9 +5,9 @@ from __future__ import annotations
 
 import pytest
 
-from kb import KnowledgeBase
-from kb.remote_access import RemoteAccessError, refuse_remote_access
-from kb.store import EmbeddedStore
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.remote_access import RemoteAccessError, refuse_remote_access
+from cbrs.kb.store import EmbeddedStore
 
 REFUSED = [
     pytest.param("SELECT * WHERE { SERVICE <http://127.0.0.1:9/sparql> { ?s ?p ?o } }", id="service-loopback"),

@@ -17,7 +17,7 @@ import pytest
 from click.testing import CliRunner
 
 from cbrs.cli import cli
-from kb import (
+from cbrs.kb import (
     BindingError,
     KnowledgeBase,
     QuerySyntaxError,
@@ -26,8 +26,8 @@ from kb import (
     StoreError,
     StoreEvaluationError,
 )
-from kb.namespaces import GraphName
-from kb.remote_store import Endpoints, RemoteStore, inject_values
+from cbrs.kb.namespaces import GraphName
+from cbrs.kb.remote_store import Endpoints, RemoteStore, inject_values
 from tests.conftest import OxigraphServer
 
 DATA = Path(__file__).parent / "data"

@@ -18,9 +18,9 @@ from pathlib import Path
 
 import pytest
 
+from cbrs.kb import KnowledgeBase
 from cbrs.server import ServeConfig, Server
 from cbrs.sparql_service import EndpointConfig
-from kb import KnowledgeBase
 
 SDISTS = sorted((Path(__file__).parent / ".roslibpy").glob("roslibpy-*/tests"))
 PORT = 9090  # what roslibpy's tests connect to

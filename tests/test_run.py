@@ -8,16 +8,16 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from actions.belief import WORLD, BeliefState
-from actions.composer import Composer
-from actions.faults import FaultPolicy, RandomFaults, doomed_steps, planned_faults
-from actions.runner import RunResult, run_task
+from cbrs.actions.belief import WORLD, BeliefState
+from cbrs.actions.composer import Composer
+from cbrs.actions.faults import FaultPolicy, RandomFaults, doomed_steps, planned_faults
+from cbrs.actions.runner import RunResult, run_task
 from cbrs.cli import cli
-from kb import KnowledgeBase
-from kb.namespaces import expand
-from kb.semantic_map import SemanticMap
-from sim.components import SimEnvironment
-from sim.world import open_world
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import expand
+from cbrs.kb.semantic_map import SemanticMap
+from cbrs.sim.components import SimEnvironment
+from cbrs.sim.world import open_world
 
 SVC = expand("svc:")
 HOME = expand("home:")

@@ -10,16 +10,16 @@ import click
 import pytest
 from click.testing import CliRunner
 
-from actions.composer import ComposeConfig, Composer, Objective, PlanStatus
-from actions.model import ActionLibrary
+from cbrs.actions.composer import ComposeConfig, Composer, Objective, PlanStatus
+from cbrs.actions.model import ActionLibrary
 from cbrs.bridge_services import KnowledgeServices
 from cbrs.cli import _LAZY_COMMANDS, cli
+from cbrs.kb import Advertisement, KnowledgeBase, Parameter, Requirement
+from cbrs.reasoner import synthetic, vectors
+from cbrs.reasoner.matchmaker import Matchmaker
+from cbrs.reasoner.taxonomy import ROOT, Link, TaxonomyIndex
 from cbrs.sparql_service import SparqlService
 from cbrs.tasks import TaskRunner
-from kb import Advertisement, KnowledgeBase, Parameter, Requirement
-from reasoner import synthetic, vectors
-from reasoner.matchmaker import Matchmaker
-from reasoner.taxonomy import ROOT, Link, TaxonomyIndex
 
 # -- start-up ------------------------------------------------------------------------------------
 
@@ -32,12 +32,12 @@ def _imported_after(statement: str, modules: tuple[str, ...]) -> list[str]:
 
 
 def test_the_cli_imports_no_heavy_library() -> None:
-    heavy = ("numpy", "networkx", "sklearn", "scipy", "werkzeug", "actions", "reasoner")
+    heavy = ("numpy", "networkx", "sklearn", "scipy", "werkzeug", "cbrs.actions", "cbrs.reasoner")
     assert _imported_after("import cbrs.cli", heavy) == []
 
 
 def test_the_reasoner_loads_scikit_learn_and_numpy_only_when_ranking() -> None:
-    assert _imported_after("import reasoner, actions", ("sklearn", "scipy", "numpy")) == []
+    assert _imported_after("import cbrs.reasoner, cbrs.actions", ("sklearn", "scipy", "numpy")) == []
 
 
 @pytest.mark.parametrize("name", sorted(_LAZY_COMMANDS))

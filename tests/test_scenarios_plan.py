@@ -8,13 +8,13 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from actions.composer import Composer, PlanStatus, store_plan
-from actions.draw import draw
-from actions.errors import UnknownTaskError
-from actions.model import ActionLibrary, resolve_task
+from cbrs.actions.composer import Composer, PlanStatus, store_plan
+from cbrs.actions.draw import draw
+from cbrs.actions.errors import UnknownTaskError
+from cbrs.actions.model import ActionLibrary, resolve_task
 from cbrs.cli import cli
-from kb import GraphName, KnowledgeBase
-from kb.namespaces import expand
+from cbrs.kb import GraphName, KnowledgeBase
+from cbrs.kb.namespaces import expand
 
 SVC = expand("svc:")
 ACT = expand("act:")

@@ -15,12 +15,12 @@ from pathlib import Path
 import pyoxigraph as ox
 import pytest
 
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.errors import BlankNodeError, BlankNodeInsertError, RdfParseError, StoreEvaluationError
+from cbrs.kb.loader import parse_bytes
+from cbrs.kb.namespaces import expand
+from cbrs.reasoner.matchmaker import Matchmaker
 from cbrs.sparql_service import EndpointConfig, SparqlService
-from kb import KnowledgeBase
-from kb.errors import BlankNodeError, BlankNodeInsertError, RdfParseError, StoreEvaluationError
-from kb.loader import parse_bytes
-from kb.namespaces import expand
-from reasoner.matchmaker import Matchmaker
 
 DATA = Path(__file__).parent / "data"
 OWLS = DATA / "owls"

@@ -25,10 +25,10 @@ from typing import Any
 import httpx
 import pytest
 
+from cbrs.kb import KnowledgeBase
 from cbrs.rosbridge import Bridge
 from cbrs.server import ServeConfig, Server
 from cbrs.sparql_service import EndpointBusyError, EndpointConfig, QueryMemoryError, QueryTimeoutError, SparqlService
-from kb import KnowledgeBase
 from tests.test_serve import bridge, call, receive
 
 WAIT = 10.0

@@ -23,11 +23,11 @@ from websockets.exceptions import InvalidStatus
 from websockets.sync.client import ClientConnection, connect
 from websockets.typing import Origin
 
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import expand
+from cbrs.reasoner.matchmaker import Matchmaker
 from cbrs.server import ServeConfig, Server
 from cbrs.sparql_service import EndpointConfig
-from kb import KnowledgeBase
-from kb.namespaces import expand
-from reasoner.matchmaker import Matchmaker
 from tests.helpers_threads import assert_threads_end
 
 WAIT = 10.0

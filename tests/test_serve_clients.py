@@ -74,8 +74,8 @@ def served(fresh_bundled_kb: Any) -> Iterator[tuple[int, Any]]:
 
 
 def expected(kb: Any) -> tuple[list[str], str]:
-    from kb.namespaces import expand
-    from reasoner.matchmaker import Matchmaker
+    from cbrs.kb.namespaces import expand
+    from cbrs.reasoner.matchmaker import Matchmaker
 
     devices = [row["d"].value for row in kb.query(QUERY)]
     best = Matchmaker(kb).rank(expand("req:RobotSelfPosition")).candidates[0].advertisement

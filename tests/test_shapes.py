@@ -14,10 +14,10 @@ import pytest
 from click.testing import CliRunner
 
 from cbrs.cli import cli
-from kb import KnowledgeBase
-from kb.errors import InvalidDescriptionError
-from kb.namespaces import GraphName
-from kb.shapes import DescriptionShapeError, check_descriptions
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.errors import InvalidDescriptionError
+from cbrs.kb.namespaces import GraphName
+from cbrs.kb.shapes import DescriptionShapeError, check_descriptions
 
 ROOT = Path(__file__).resolve().parents[1]
 OWLS = Path(__file__).parent / "data" / "owls"

@@ -8,7 +8,7 @@ from collections.abc import Iterator
 import numpy as np
 import pytest
 
-from sim import (
+from cbrs.sim import (
     HomeWorld,
     NoFreeCellError,
     NoPathError,
@@ -18,9 +18,9 @@ from sim import (
     build_occupancy_grid,
     plan_path,
 )
-from sim.layout import MAP_RESOLUTION
-from sim.mapping import inflate
-from sim.planning import approach_point, snap_to_free
+from cbrs.sim.layout import MAP_RESOLUTION
+from cbrs.sim.mapping import inflate
+from cbrs.sim.planning import approach_point, snap_to_free
 from tests.home_layout import HANDOVER_POSE, TABLE, WALLS
 
 

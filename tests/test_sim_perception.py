@@ -8,7 +8,7 @@ from collections.abc import Iterator
 import numpy as np
 import pytest
 
-from sim import (
+from cbrs.sim import (
     CameraUnavailableError,
     HomeWorld,
     NotVisibleError,
@@ -18,10 +18,10 @@ from sim import (
     recognise_object,
     track_person,
 )
-from sim import predicates as pred
-from sim.geometry import wrap_angle
-from sim.layout import SHIRT_TOP
-from sim.perception import segment
+from cbrs.sim import predicates as pred
+from cbrs.sim.geometry import wrap_angle
+from cbrs.sim.layout import SHIRT_TOP
+from cbrs.sim.perception import segment
 from tests.home_layout import BASE_START, HANDOVER_POSE
 
 LOCALISATION_ERROR = 0.05

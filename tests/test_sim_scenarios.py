@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from sim import HomeWorld
-from sim import predicates as pred
+from cbrs.sim import HomeWorld
+from cbrs.sim import predicates as pred
 from tests.home_layout import BELOW_OF_TAP, HANDOVER_POSE
 from tests.reference_scenarios import fetch_pen, serve_cup
 

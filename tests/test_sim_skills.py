@@ -7,8 +7,8 @@ from collections.abc import Iterator
 
 import pytest
 
-from kb.namespaces import PREFIXES
-from sim import (
+from cbrs.kb.namespaces import PREFIXES
+from cbrs.sim import (
     ArmSide,
     HomeWorld,
     Pose2D,
@@ -18,11 +18,11 @@ from sim import (
     skills,
     track_person,
 )
-from sim import predicates as pred
-from sim.grasping import ObjectModel
-from sim.mapping import build_occupancy_grid
-from sim.planning import approach_point, plan_path
-from sim.scene import bundled_map
+from cbrs.sim import predicates as pred
+from cbrs.sim.grasping import ObjectModel
+from cbrs.sim.mapping import build_occupancy_grid
+from cbrs.sim.planning import approach_point, plan_path
+from cbrs.sim.scene import bundled_map
 from tests.home_layout import ARM_FACING, ARM_MOUNTS, BELOW_OF_TAP, HANDOVER_POSE, TABLE, TAP_LEVER
 from tests.reference_scenarios import PERSON_APPROACH_DISTANCE
 

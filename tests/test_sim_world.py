@@ -7,9 +7,9 @@ from collections.abc import Iterator
 
 import pytest
 
-from sim import HomeWorld, UnknownEntityError, WorldClosedError, open_world
-from sim import predicates as pred
-from sim.skills import navigate
+from cbrs.sim import HomeWorld, UnknownEntityError, WorldClosedError, open_world
+from cbrs.sim import predicates as pred
+from cbrs.sim.skills import navigate
 from tests.home_layout import (
     BASE_START,
     CAMERAS,

@@ -4,11 +4,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from reasoner.config import MatchConfig
-from reasoner.degrees import Degree, degree_of_match
-from reasoner.names import core_split, local_name, words
-from reasoner.similarity import Lin, SemStr, StringMatch, WuPalmer, complement_similarity, rescaled_jaro_winkler
-from reasoner.taxonomy import ROOT, Link, TaxonomyIndex
+from cbrs.reasoner.config import MatchConfig
+from cbrs.reasoner.degrees import Degree, degree_of_match
+from cbrs.reasoner.names import core_split, local_name, words
+from cbrs.reasoner.similarity import Lin, SemStr, StringMatch, WuPalmer, complement_similarity, rescaled_jaro_winkler
+from cbrs.reasoner.taxonomy import ROOT, Link, TaxonomyIndex
 from tests.reasoner_examples import E, figure5, positions
 
 

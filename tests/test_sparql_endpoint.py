@@ -15,10 +15,10 @@ from flask.testing import FlaskClient
 from waitress import wasyncore
 from waitress.server import create_server
 
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import GraphName, expand
 from cbrs.sparql_service import EndpointConfig, SparqlService, negotiate
 from cbrs.web import create_app
-from kb import KnowledgeBase
-from kb.namespaces import GraphName, expand
 
 TOKEN = "correct horse battery staple"
 SELECT = "SELECT ?ad WHERE { ?ad a cbrs:DynamicPerceptionComponent } ORDER BY ?ad LIMIT 3"

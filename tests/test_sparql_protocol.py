@@ -31,11 +31,11 @@ from waitress.server import create_server
 from werkzeug.datastructures import MultiDict
 from werkzeug.test import TestResponse
 
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.remote_store import RemoteStore
+from cbrs.kb.store import Store
 from cbrs.sparql_service import EndpointConfig, SparqlService, has_dataset_clause
 from cbrs.web import create_app
-from kb import KnowledgeBase
-from kb.remote_store import RemoteStore
-from kb.store import Store
 from tests.conftest import OxigraphServer
 
 TOKEN = "protocol-test-token"

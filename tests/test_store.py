@@ -5,9 +5,9 @@ from pathlib import Path
 import pyoxigraph as ox
 import pytest
 
-from kb import KnowledgeBase, QuerySyntaxError, Store, StoreError
-from kb.namespaces import GraphName
-from kb.store import nesting_depth
+from cbrs.kb import KnowledgeBase, QuerySyntaxError, Store, StoreError
+from cbrs.kb.namespaces import GraphName
+from cbrs.kb.store import nesting_depth
 
 pytestmark = pytest.mark.both_stores
 

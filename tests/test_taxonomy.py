@@ -1,6 +1,6 @@
 from __future__ import annotations
 
-from reasoner.taxonomy import ROOT, Link, TaxonomyIndex
+from cbrs.reasoner.taxonomy import ROOT, Link, TaxonomyIndex
 from tests.reasoner_examples import E, figure5, isa, part, positions
 
 

@@ -14,20 +14,20 @@ from typing import Any
 import numpy as np
 import pytest
 
-from actions.components import Component, Registry, Status
-from actions.composer import Composer
-from actions.runner import RunResult, run_task
-from kb import KnowledgeBase
-from kb.namespaces import PREFIXES
-from kb.semantic_map import SemanticMap
-from sim.components import SKILLS, SimComponent, SimContext, SimEnvironment
-from sim.errors import SimulationError
-from sim.geometry import Pose2D
-from sim.grasping import GraspKind, ObjectModel
-from sim.mapping import OccupancyGrid, inflate
-from sim.perception import ObjectEstimate, PersonEstimate, RobotPoseEstimate
-from sim.planning import PlannedPath
-from sim.values import (
+from cbrs.actions.components import Component, Registry, Status
+from cbrs.actions.composer import Composer
+from cbrs.actions.runner import RunResult, run_task
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.semantic_map import SemanticMap
+from cbrs.sim.components import SKILLS, SimComponent, SimContext, SimEnvironment
+from cbrs.sim.errors import SimulationError
+from cbrs.sim.geometry import Pose2D
+from cbrs.sim.grasping import GraspKind, ObjectModel
+from cbrs.sim.mapping import OccupancyGrid, inflate
+from cbrs.sim.perception import ObjectEstimate, PersonEstimate, RobotPoseEstimate
+from cbrs.sim.planning import PlannedPath
+from cbrs.sim.values import (
     APPROACH_POSITION,
     COLOUR_FEATURE,
     DEFAULT_INFLATION_RADIUS,
@@ -51,7 +51,7 @@ from sim.values import (
     from_json,
     to_json,
 )
-from sim.world import open_world
+from cbrs.sim.world import open_world
 
 HOME, WORLD = PREFIXES["home"], PREFIXES["world"]
 DOC = Path(__file__).resolve().parents[1] / "docs" / "values.md"

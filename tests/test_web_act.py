@@ -16,11 +16,11 @@ import pytest
 from flask import Flask
 from flask.testing import FlaskClient
 
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import expand
 from cbrs.sparql_service import SparqlService
 from cbrs.tasks import TaskRunner
 from cbrs.web import create_app
-from kb import KnowledgeBase
-from kb.namespaces import expand
 
 RUN_WAIT = 120.0
 CAMERA = "svc:LocateMobileRobot_CeilingCamera01"

@@ -10,10 +10,10 @@ from urllib.parse import parse_qs, urlsplit
 import pytest
 from flask.testing import FlaskClient
 
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import expand
 from cbrs.sparql_service import SparqlService
 from cbrs.web import create_app
-from kb import KnowledgeBase
-from kb.namespaces import expand
 
 CAMERA = "svc:LocateMobileRobot_CeilingCamera01"
 POSITION = expand("home:Position")

@@ -18,12 +18,12 @@ from flask import Flask, Response, g, jsonify, render_template, request
 from werkzeug.exceptions import HTTPException, MisdirectedRequest
 
 from cbrs import __version__
+from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.matchmakers import Matchmakers
 from cbrs.sparql_service import SparqlService
 from cbrs.tasks import TaskRunner
 from cbrs.web import links
 from cbrs.web.context import EventLog, StreamSlots
-from kb.errors import KnowledgeBaseError
 
 # The page blueprints, in navigation order: (module under cbrs.web, endpoint of its nav link, label).
 PAGES: tuple[tuple[str, str, str], ...] = (

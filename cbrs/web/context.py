@@ -9,11 +9,11 @@ from typing import Any
 
 from flask import current_app
 
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.matchmakers import Matchmakers
 from cbrs.sparql_service import SparqlService
 from cbrs.tasks import TaskRunner
-from kb import KnowledgeBase
-from kb.errors import KnowledgeBaseError
 
 
 class EventLog:

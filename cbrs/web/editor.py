@@ -10,9 +10,9 @@ from typing import Any
 
 from flask import Blueprint, request, url_for
 
+from cbrs.kb.errors import KnowledgeBaseError, QuerySyntaxError, UnknownQueryError
 from cbrs.web import context
 from cbrs.web.pages import FormError, Page, page, wants_json
-from kb.errors import KnowledgeBaseError, QuerySyntaxError, UnknownQueryError
 
 blueprint = Blueprint("editor", __name__)
 

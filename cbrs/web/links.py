@@ -5,7 +5,7 @@ from __future__ import annotations
 from flask import Flask, url_for
 from markupsafe import Markup, escape
 
-from kb.namespaces import shorten
+from cbrs.kb.namespaces import shorten
 
 RESOURCE_ENDPOINT = "resource.resource"
 

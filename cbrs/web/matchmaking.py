@@ -9,15 +9,15 @@ from typing import Any, Literal
 
 from flask import Blueprint, request
 
+from cbrs.kb import NotFoundError, Parameter, Requirement, Statement
+from cbrs.kb.namespaces import PREFIXES, expand, shorten
+from cbrs.kb.vocab import CBRS
+from cbrs.reasoner.degrees import Degree
+from cbrs.reasoner.matchmaker import Candidate, Matchmaker, MatchResult
+from cbrs.reasoner.methods import METHODS
+from cbrs.reasoner.taxonomy import TaxonomyIndex
 from cbrs.web import context
 from cbrs.web.pages import FormError, Page, page, wants_json
-from kb import NotFoundError, Parameter, Requirement, Statement
-from kb.namespaces import PREFIXES, expand, shorten
-from kb.vocab import CBRS
-from reasoner.degrees import Degree
-from reasoner.matchmaker import Candidate, Matchmaker, MatchResult
-from reasoner.methods import METHODS
-from reasoner.taxonomy import TaxonomyIndex
 
 blueprint = Blueprint("matchmaking", __name__)
 

@@ -4,9 +4,9 @@ from __future__ import annotations
 
 from flask import Blueprint
 
+from cbrs.kb.namespaces import GraphName, shorten
 from cbrs.web import context
 from cbrs.web.pages import Page, page
-from kb.namespaces import GraphName, shorten
 
 blueprint = Blueprint("overview", __name__)
 

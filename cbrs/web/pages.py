@@ -14,7 +14,7 @@ from typing import Any
 
 from flask import Blueprint, Response, jsonify, render_template, request
 
-from kb.errors import KnowledgeBaseError
+from cbrs.kb.errors import KnowledgeBaseError
 
 
 @dataclass

@@ -9,13 +9,13 @@ from typing import Any
 
 from flask import Blueprint, Response, request, url_for
 
-from actions.composer import ComposeConfig, Composer, CompositionResult, Objective
-from actions.errors import UnknownTaskError
-from actions.model import ActionLibrary
+from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, Objective
+from cbrs.actions.errors import UnknownTaskError
+from cbrs.actions.model import ActionLibrary
+from cbrs.kb.namespaces import shorten
 from cbrs.task_names import task_iri
 from cbrs.web import context
 from cbrs.web.pages import FormError, Page, page
-from kb.namespaces import shorten
 
 blueprint = Blueprint("plans", __name__)
 
@@ -67,7 +67,7 @@ def _compose(task: str, objective: str, shown: Page | None) -> CompositionResult
 
 
 def _svg(result: CompositionResult) -> bytes:
-    from actions.draw import draw  # matplotlib is slow to import; only when a drawing is asked for
+    from cbrs.actions.draw import draw  # matplotlib is slow to import; only when a drawing is asked for
 
     with tempfile.TemporaryDirectory(prefix="cbrs-srg-") as folder:
         return draw(result, Path(folder) / "graph.svg").read_bytes()

@@ -16,11 +16,11 @@ from flask.blueprints import BlueprintSetupState
 from markupsafe import Markup, escape
 from werkzeug.exceptions import BadRequest, HTTPException
 
+from cbrs.kb.errors import KnowledgeBaseError, NotFoundError
+from cbrs.kb.namespaces import OWL, RDF, RDFS, XSD, expand, shorten
 from cbrs.web import context
 from cbrs.web.links import iri_link
 from cbrs.web.pages import Page, page, wants_json
-from kb.errors import KnowledgeBaseError, NotFoundError
-from kb.namespaces import OWL, RDF, RDFS, XSD, expand, shorten
 
 blueprint = Blueprint("resource", __name__)
 

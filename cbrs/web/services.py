@@ -7,12 +7,12 @@ from typing import Any
 
 from flask import Blueprint, current_app, request, url_for
 
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.model import Advertisement, Requirement
+from cbrs.kb.namespaces import expand, shorten
+from cbrs.kb.store import Term
 from cbrs.web import context, resource
 from cbrs.web.pages import FormError, Page, page
-from kb import KnowledgeBase
-from kb.model import Advertisement, Requirement
-from kb.namespaces import expand, shorten
-from kb.store import Term
 
 blueprint = Blueprint("services", __name__)
 

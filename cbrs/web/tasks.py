@@ -23,10 +23,10 @@ from flask import Blueprint, Response, current_app, request, url_for
 from flask.sansio.blueprints import BlueprintSetupState
 from werkzeug.exceptions import Forbidden, NotFound, ServiceUnavailable
 
+from cbrs.kb.namespaces import PREFIXES, expand, shorten
 from cbrs.tasks import CameraFrame, TaskBusyError, TaskRun, UnknownComponentError
 from cbrs.web import context
 from cbrs.web.pages import FormError, Page, page, wants_json
-from kb.namespaces import PREFIXES, expand, shorten
 
 blueprint = Blueprint("tasks", __name__)
 

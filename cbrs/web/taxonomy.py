@@ -14,12 +14,12 @@ from typing import Any
 from flask import Blueprint, request, url_for
 from markupsafe import Markup, escape
 
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.errors import NotFoundError
+from cbrs.kb.namespaces import RDF, RDFS, shorten
+from cbrs.kb.vocab import CBRS
 from cbrs.web import context, resource
 from cbrs.web.pages import Page, page
-from kb import KnowledgeBase
-from kb.errors import NotFoundError
-from kb.namespaces import RDF, RDFS, shorten
-from kb.vocab import CBRS
 
 blueprint = Blueprint("taxonomy", __name__)
 blueprint.record_once(resource.attach)  # the page of any IRI comes with the taxonomy (it is not in the nav)
