@@ -93,6 +93,19 @@ class Endpoints:
         return cls(str(url.copy_with(path=f"{path}/query")), str(url.copy_with(path=f"{path}/update")))
 
 
+    @classmethod
+    def candidates(cls, location: str) -> list[Endpoints]:
+        """The endpoints to try for ``location``: what :meth:`discover` says, and for a bare base URL
+        (no path) also a ``cbrs serve``'s layout, ``<base>/sparql`` and ``<base>/update``, so that
+        ``--store http://host:8080`` reaches a running cbrs server as well as an Oxigraph one."""
+        found = [cls.discover(location)]
+        parts = location.split()
+        if len(parts) == 1 and httpx.URL(parts[0]).path.rstrip("/") == "":
+            base = parts[0].rstrip("/")
+            found.append(cls(_checked_url(location, base + "/sparql"), _checked_url(location, base + "/update")))
+        return found
+
+
 def _checked_url(location: str, text: str) -> str:
     try:
         url = httpx.URL(text)
@@ -128,13 +141,21 @@ class RemoteStore(Store):
         """Connect to the endpoint(s) ``location`` names and check its default graph is the union;
         ``token`` is sent as a bearer token (a ``cbrs serve``'s update token)."""
         text = str(location).strip()
-        store = cls(text, Endpoints.discover(text), timeout, token)
-        try:
-            store._check_union()
-        except BaseException:
-            store.close()
-            raise
-        return store
+        first_error: StoreError | None = None
+        for endpoints in Endpoints.candidates(text):
+            store = cls(text, endpoints, timeout, token)
+            try:
+                store._check_union()
+            except StoreError as error:
+                store.close()
+                first_error = first_error or error
+                continue
+            except BaseException:
+                store.close()
+                raise
+            return store
+        assert first_error is not None
+        raise first_error
 
     def close(self) -> None:
         if self._client is not None:

@@ -1,4 +1,4 @@
-"""The SPARQL 1.1 Protocol's finer points on ``/sparql`` (and ``/query``), in the manner of the W3C protocol tests.
+"""The SPARQL 1.1 Protocol's finer points on ``/sparql``, in the manner of the W3C protocol tests.
 
 Which graphs a query reads (SPARQL 1.1 Query §13.2, Protocol §2.1.4): the query's ``FROM`` / ``FROM NAMED``
 and the protocol's ``default-graph-uri`` / ``named-graph-uri``, with cbrs's union default graph only when
@@ -166,11 +166,6 @@ def test_a_from_clause_may_use_prefixed_names(client: FlaskClient) -> None:
     assert send(client, query, [], "get")["results"]["bindings"][0]["n"]["value"] == "2"
 
 
-def test_query_is_an_alias_with_the_same_rules(client: FlaskClient) -> None:
-    params = [("default-graph-uri", G3)]
-    assert send(client, COUNT.format(""), params, "get", path="/query")["results"]["bindings"][0]["n"]["value"] == "4"
-
-
 def test_ask_and_construct_read_the_dataset_too(client: FlaskClient) -> None:
     ask = client.get("/sparql", query_string={"query": f"ASK FROM <{G1}> {{ <{G2}:s0> ?p ?o }}"})
     assert ask.get_json()["boolean"] is False
@@ -237,7 +232,7 @@ def test_each_operation_refuses_the_others_dataset_parameters(client: FlaskClien
 # -- HEAD, formats, Vary ------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("path", ["/sparql", "/query"])
+@pytest.mark.parametrize("path", ["/sparql"])
 def test_head_answers_like_get_without_a_body(client: FlaskClient, path: str) -> None:
     asked = {"query": COUNT.format("")}
     got = client.get(path, query_string=asked)
@@ -279,7 +274,7 @@ def test_every_answer_varies_on_origin(client: FlaskClient) -> None:
         client.get("/sparql", query_string={"query": "ASK {}"}),
         client.get("/sparql", query_string={"query": "ASK {}"}, headers={"Origin": "http://elsewhere.example"}),
         client.post("/sparql", data="ASK {}", content_type="application/sparql-query"),
-        client.get("/query", query_string={"query": "NOT SPARQL"}),
+        client.get("/sparql", query_string={"query": "NOT SPARQL"}),
         client.get("/sparql"),
         client.post("/update", data={"update": "CLEAR ALL"}),
     ]

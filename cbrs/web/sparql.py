@@ -43,7 +43,6 @@ class UnsupportedMediaType(EndpointError):
 
 
 @blueprint.route("/sparql", methods=["GET", "POST"])
-@blueprint.route("/query", methods=["GET", "POST"])  # Oxigraph's layout: `cbrs --store http://host:port` finds it
 def sparql() -> Response:
     query, update = _operation()
     if update is not None:
@@ -150,7 +149,7 @@ def _service_description() -> Response:
     """A GET without a query describes the endpoint (SPARQL 1.1 Service Description), as RDF."""
     sd = "http://www.w3.org/ns/sparql-service-description#"
     formats = "http://www.w3.org/ns/formats/"
-    endpoint = ox.NamedNode(request.base_url)  # /sparql or /query, whichever was asked
+    endpoint = ox.NamedNode(request.base_url)
     node = ox.BlankNode("service")
     triples = [
         ox.Triple(node, ox.NamedNode(_RDF_TYPE), ox.NamedNode(sd + "Service")),
