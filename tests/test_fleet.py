@@ -6,8 +6,7 @@ says which URL to use. Every wait is a bounded poll."""
 
 from __future__ import annotations
 
-import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -19,7 +18,7 @@ from cbrs.component import Component
 from cbrs.kb import KnowledgeBase
 from cbrs.server import ServeConfig, Server
 from cbrs.sparql_service import EndpointConfig
-from tests.test_live_components import READING, THERMOMETER, thermometer
+from tests.test_live_components import READING, THERMOMETER, eventually, thermometer
 
 TOKEN = "fleet-test-token"
 
@@ -41,15 +40,6 @@ def fleet(remote_location: str) -> Iterator[tuple[Server, Server]]:
     finally:
         second.stop()
         first.stop()
-
-
-def eventually(condition: Callable[[], bool], seconds: float = 10.0) -> bool:
-    deadline = time.monotonic() + seconds
-    while time.monotonic() < deadline:
-        if condition():
-            return True
-        time.sleep(0.05)
-    return condition()
 
 
 def best_for_room_temperature(server: Server) -> str:
