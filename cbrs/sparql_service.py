@@ -456,8 +456,8 @@ class SparqlService:
             return ResultTooLargeError(self.config.max_result_bytes)
         return refusals[str(stopped) == "graph"]
 
-    def update(self, text: str, token: str | None) -> None:
-        """Run a SPARQL update when ``token`` is the configured update token; one transaction."""
+    def check_token(self, token: str | None) -> None:
+        """Refuse a write (``UpdateForbiddenError``, 403) unless ``token`` is the configured update token."""
         expected = self.config.update_token
         if self.config.read_only:
             raise UpdateForbiddenError("updates are disabled: this server was started read-only")
@@ -465,6 +465,10 @@ class SparqlService:
             raise UpdateForbiddenError("updates are disabled: this server is read-only (no update token set)")
         if token is None or not hmac.compare_digest(token.encode("utf-8"), expected.encode("utf-8")):
             raise UpdateForbiddenError("updates need the server's token: Authorization: Bearer <token>")
+
+    def update(self, text: str, token: str | None) -> None:
+        """Run a SPARQL update when ``token`` is the configured update token; one transaction."""
+        self.check_token(token)
         self._check_size(text)
         refuse_inserted_blank_nodes(text)  # what cbrs stores it must be able to read back by name
         with self.lock:

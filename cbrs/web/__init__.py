@@ -61,6 +61,7 @@ def create_app(
     sets). ``cbrs serve`` passes them; then a request whose ``Host`` names none of them (when bound to
     loopback) is refused, and a task may be started only from those pages or with the update token.
     """
+    from cbrs.web.graph_store import blueprint as graph_store_blueprint
     from cbrs.web.sparql import blueprint
 
     app = Flask(__name__)
@@ -83,6 +84,7 @@ def create_app(
         }
     )
     app.register_blueprint(blueprint)
+    app.register_blueprint(graph_store_blueprint)
     for module, _, _ in PAGES:
         app.register_blueprint(importlib.import_module(f"cbrs.web.{module}").blueprint)
     page_blueprints = {module for module, _, _ in PAGES}

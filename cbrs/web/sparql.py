@@ -127,11 +127,11 @@ def _body() -> str:
 
 
 def _update(text: str) -> Response:
-    context.sparql().update(text, _bearer_token())
+    context.sparql().update(text, bearer_token())
     return Response(status=204)
 
 
-def _bearer_token() -> str | None:
+def bearer_token() -> str | None:
     header = request.headers.get("Authorization", "")
     scheme, _, token = header.partition(" ")
     return token.strip() if scheme.lower() == "bearer" and token.strip() else None

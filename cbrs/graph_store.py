@@ -1,0 +1,161 @@
+"""The SPARQL 1.1 Graph Store HTTP Protocol over the knowledge base: read, replace, add to and drop graphs.
+
+One named graph (``graph=IRI``), the store's own default graph (``default``), or, for reading and for
+adding quads, the whole dataset. Writes take the update token, parse the body whole before anything
+is written (a broken body changes nothing), pass the description shapes like every other way in, and
+are one transaction each.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import pyoxigraph as ox
+
+from cbrs.kb.errors import KnowledgeBaseError
+from cbrs.kb.loader import parse_bytes
+from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.shapes import check_descriptions
+from cbrs.sparql_service import SparqlService
+
+__all__ = ["GraphStore", "GraphStoreError", "Target", "UnknownGraphError"]
+
+GRAPH_FORMATS = (
+    ox.RdfFormat.TURTLE,
+    ox.RdfFormat.N_TRIPLES,
+    ox.RdfFormat.RDF_XML,
+    ox.RdfFormat.JSON_LD,
+    ox.RdfFormat.N3,
+)
+DATASET_FORMATS = (ox.RdfFormat.TRIG, ox.RdfFormat.N_QUADS)
+
+
+class GraphStoreError(KnowledgeBaseError):
+    """A Graph Store request that cannot be answered as asked; names what was wrong."""
+
+    http_status = 400
+
+
+class UnknownGraphError(GraphStoreError):
+    http_status = 404
+
+    def __init__(self, graph: str) -> None:
+        self.graph = graph
+        super().__init__(f"the store has no graph <{graph}>")
+
+
+class NotAcceptableFormatError(GraphStoreError):
+    http_status = 406
+
+    def __init__(self, asked: str, offered: tuple[ox.RdfFormat, ...]) -> None:
+        self.asked = asked
+        names = ", ".join(f.media_type for f in offered)
+        super().__init__(f"cannot answer in {asked!r}; ask for one of {names}")
+
+
+@dataclass(frozen=True)
+class Target:
+    """What a request is about: a named graph, the default graph, or (``graph`` None) the dataset."""
+
+    graph: str | None
+    default: bool = False
+
+    @property
+    def node(self) -> ox.NamedNode | ox.DefaultGraph | None:
+        if self.default:
+            return ox.DefaultGraph()
+        return ox.NamedNode(self.graph) if self.graph is not None else None
+
+
+class GraphStore:
+    """The protocol's four operations over one SPARQL service (its lock, token and caches)."""
+
+    def __init__(self, sparql: SparqlService) -> None:
+        self.sparql = sparql
+
+    def read(self, target: Target, accept: str | None) -> tuple[bytes, str]:
+        """The graph (or the dataset) serialised in the format ``accept`` names, with its media type."""
+        store = self.sparql.kb.store
+        whole = target.node is None
+        fmt = _negotiate(accept, DATASET_FORMATS if whole else GRAPH_FORMATS)
+        if whole:
+            quads = list(store.quads())
+            data = ox.serialize(quads, format=fmt, prefixes=PREFIXES)
+        else:
+            node = target.node
+            assert node is not None
+            if isinstance(node, ox.NamedNode) and node.value not in store.graphs():
+                raise UnknownGraphError(node.value)
+            triples = [ox.Triple(q.subject, q.predicate, q.object) for q in store.quads(graph=node)]
+            data = ox.serialize(triples, format=fmt, prefixes=PREFIXES)
+        return data or b"", fmt.media_type
+
+    def replace(self, target: Target, body: bytes, media_type: str, token: str | None) -> bool:
+        """PUT: the graph becomes the body's triples; True when the graph did not exist before."""
+        self.sparql.check_token(token)
+        node = self._graph_node(target, "PUT")
+        new = self._parse(body, media_type, node)
+        with self.sparql.lock:
+            store = self.sparql.kb.store
+            created = isinstance(node, ox.NamedNode) and node.value not in store.graphs()
+            store.replace(list(store.quads(graph=node)), new)
+            self.sparql.changed()
+        return created
+
+    def add(self, target: Target, body: bytes, media_type: str, token: str | None) -> None:
+        """POST: the body's triples join the graph (or, for the dataset, its quads join the store)."""
+        self.sparql.check_token(token)
+        node = target.node
+        new = self._parse(body, media_type, node)
+        with self.sparql.lock:
+            self.sparql.kb.store.add(new)
+            self.sparql.changed()
+
+    def drop(self, target: Target, token: str | None) -> None:
+        """DELETE: the graph is emptied and gone; 404 when there is no such graph."""
+        self.sparql.check_token(token)
+        node = self._graph_node(target, "DELETE")
+        with self.sparql.lock:
+            store = self.sparql.kb.store
+            if isinstance(node, ox.NamedNode):
+                if node.value not in store.graphs():
+                    raise UnknownGraphError(node.value)
+                store.clear_graph(node)
+            else:
+                store.replace(list(store.quads(graph=node)), [])
+            self.sparql.changed()
+
+    def _graph_node(self, target: Target, method: str) -> ox.NamedNode | ox.DefaultGraph:
+        node = target.node
+        if node is None:
+            raise GraphStoreError(f"{method} needs ?graph=IRI or ?default: it acts on one graph, not the whole store")
+        return node
+
+    def _parse(self, body: bytes, media_type: str, node: ox.NamedNode | ox.DefaultGraph | None) -> list[ox.Quad]:
+        offered = DATASET_FORMATS if node is None else GRAPH_FORMATS
+        fmt = ox.RdfFormat.from_media_type(media_type) if media_type else None
+        if fmt not in offered:
+            names = ", ".join(f.media_type for f in offered)
+            raise GraphStoreError(f"a body of {media_type or '(no type)'} cannot be stored here; send one of {names}")
+        assert fmt is not None
+        graph = node.value if isinstance(node, ox.NamedNode) else None
+        parsed = parse_bytes(body, "<request body>", fmt, graph=graph, base_iri=graph)  # whole, or an error
+        quads = parsed.quads
+        if isinstance(node, ox.DefaultGraph):
+            quads = [ox.Quad(q.subject, q.predicate, q.object, ox.DefaultGraph()) for q in quads]
+        check_descriptions(self.sparql.kb.store, quads)  # a description written so passes the shapes too
+        return quads
+
+
+def _negotiate(accept: str | None, offered: tuple[ox.RdfFormat, ...]) -> ox.RdfFormat:
+    if not accept or accept.strip() in ("*/*", ""):
+        return offered[0]
+    for part in accept.split(","):
+        media = part.split(";")[0].strip().lower()
+        if media in ("*/*", "text/*", "application/*"):
+            return offered[0]
+        fmt = ox.RdfFormat.from_media_type(media)
+        if fmt in offered:
+            assert fmt is not None
+            return fmt
+    raise NotAcceptableFormatError(accept, offered)

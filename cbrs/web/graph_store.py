@@ -1,0 +1,61 @@
+"""``/store``: the SPARQL 1.1 Graph Store HTTP Protocol, as Oxigraph's server and Fuseki offer it.
+
+``GET``/``HEAD`` ``/store?graph=IRI`` (or ``?default``) answer the graph in the format the Accept header
+asks (Turtle by default); ``GET /store`` answers the whole dataset (TriG or N-Quads). ``PUT`` replaces
+a graph with the body, ``POST`` adds the body to it (or, with no graph, adds a TriG or N-Quads body to
+the store), ``DELETE`` drops it. Writes need ``Authorization: Bearer <token>``.
+"""
+
+from __future__ import annotations
+
+from flask import Blueprint, Response, request
+from werkzeug.exceptions import BadRequest
+
+from cbrs.graph_store import GraphStore, Target
+from cbrs.web import context
+from cbrs.web.sparql import bearer_token
+
+__all__ = ["blueprint"]
+
+blueprint = Blueprint("graph_store", __name__)
+
+
+def _target() -> Target:
+    graphs = request.args.getlist("graph")
+    default = "default" in request.args
+    if len(graphs) > 1 or (graphs and default):
+        raise BadRequest("name one graph: ?graph=IRI or ?default, once")
+    if graphs:
+        graph = graphs[0]
+        if "://" not in graph and not graph.startswith("urn:"):
+            raise BadRequest(f"graph must be an absolute IRI, not {graph!r}")
+        return Target(graph)
+    return Target(None, default)
+
+
+def _store() -> GraphStore:
+    return GraphStore(context.sparql())
+
+
+@blueprint.route("/store", methods=["GET", "HEAD"])
+def read() -> Response:
+    data, media_type = _store().read(_target(), request.headers.get("Accept"))
+    return Response(b"" if request.method == "HEAD" else data, content_type=media_type, headers={"Vary": "Accept"})
+
+
+@blueprint.put("/store")
+def replace() -> Response:
+    created = _store().replace(_target(), request.get_data(), request.mimetype, bearer_token())
+    return Response(status=201 if created else 204)
+
+
+@blueprint.post("/store")
+def add() -> Response:
+    _store().add(_target(), request.get_data(), request.mimetype, bearer_token())
+    return Response(status=204)
+
+
+@blueprint.delete("/store")
+def drop() -> Response:
+    _store().drop(_target(), bearer_token())
+    return Response(status=204)
