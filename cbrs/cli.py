@@ -19,6 +19,7 @@ import pyoxigraph as ox
 
 from cbrs import __version__
 from cbrs.app import App, parse_iri, pass_app
+from cbrs.extras import require
 from cbrs.kb import Advertisement, KnowledgeBaseError, Requirement, ServiceDescription
 from cbrs.kb.catalog import Catalogue, merge
 from cbrs.kb.loader import LoadReport, ParsedFile
@@ -458,6 +459,7 @@ def demo(app: App, external: bool, seed: int) -> None:
 
 
 def _external_demo(seed: int) -> None:
+    require("sim", "cbrs demo --external")
     from cbrs.cli_actions import run_text
     from cbrs.external_demo import run_external_demo
 

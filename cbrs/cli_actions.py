@@ -20,6 +20,7 @@ from cbrs.actions.graph import statement_text
 from cbrs.actions.plan import Binding, Plan
 from cbrs.actions.runner import RunResult, run_task
 from cbrs.app import App, parse_iri, pass_app
+from cbrs.extras import require
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import shorten
 from cbrs.output import table
@@ -56,6 +57,7 @@ def plan(app: App, task: str, as_json: bool, drawing: Path | None, objective: st
     if result.plan is not None and not no_store:
         store_plan(app.kb, result.plan)
     if drawing is not None:
+        require("eval", "cbrs plan --draw")
         from cbrs.actions.draw import draw  # matplotlib is slow to import; only when asked
 
         draw(result, drawing)
@@ -156,6 +158,7 @@ def run(
     Exits with status 1 when there is no plan or the run fails; a failed run names the requirement
     it could not meet and every component tried for it.
     """
+    require("sim", "cbrs run")
     from cbrs.kb.semantic_map import SemanticMap
     from cbrs.sim.components import SimEnvironment  # pybullet loads only for this command
     from cbrs.sim.recording import Recorder, RecordingError, check_target
@@ -327,6 +330,7 @@ DEMO_RUNS = (
 def scenario_runs(kb: KnowledgeBase, seed: int = 0) -> tuple[str, bool]:
     """Run the paper's two scenarios headless (FetchMyPen also with its localiser failed): one row
     each, then the world graph; and whether every run succeeded."""
+    require("sim", "the demo's runs in the simulated home")
     from cbrs.kb.semantic_map import SemanticMap
     from cbrs.sim.components import SimEnvironment
     from cbrs.sim.world import open_world

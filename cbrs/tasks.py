@@ -27,6 +27,7 @@ from cbrs.actions.faults import RandomFaults
 from cbrs.actions.model import ActionLibrary, resolve_task
 from cbrs.actions.remote import Transport
 from cbrs.actions.runner import run_task
+from cbrs.extras import installed, require
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import expand, shorten
@@ -196,7 +197,9 @@ class TaskRunner:
         return active[0] if active is not None and active[1].is_alive() else None
 
     def components(self) -> list[str]:
-        """The IRIs of the simulated components, which a run may be told to fail."""
+        """The IRIs of the simulated components, which a run may be told to fail (none without [sim])."""
+        if not installed("sim"):
+            return []
         from cbrs.sim.components import simulated
 
         return simulated(self.kb)
@@ -208,6 +211,7 @@ class TaskRunner:
         """
         if self.read_only:
             raise TasksDisabledError()
+        require("sim", "a task run")
         RandomFaults(seed, fault_rate)  # an impossible rate fails here (FaultSpecError), not in the thread
         failing = tuple(expand(f) for f in faults)
         _check_components(self.kb, failing)
@@ -326,6 +330,8 @@ class TaskRunner:
         from cbrs.kb.semantic_map import SemanticMap
         from cbrs.sim.world import open_world
 
+        if not installed("sim"):
+            return  # no simulated home, no camera frame
         with self._idle_render:
             if self._frame is not None or self.active() is not None or self.camera is None:
                 return  # rendered meanwhile, or a run is about to give frames of its own

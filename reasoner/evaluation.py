@@ -277,6 +277,9 @@ def evaluate_paper(
 
 def plot_report(report: Report, path: str | Path) -> Path:
     """A grouped bar chart: one group per metric, one bar per method. Written as PNG to ``path``."""
+    from cbrs.extras import require
+
+    require("eval", "the plot (--plot)")
     import matplotlib
 
     matplotlib.use("Agg")

@@ -246,6 +246,9 @@ def evaluate_collection(
 
 def plot_curves(report: CollectionReport, path: Path) -> Path:
     """Precision-recall curves (11-point interpolated, mean over requests), one line per method."""
+    from cbrs.extras import require
+
+    require("eval", "the plot (--plot)")
     import matplotlib
 
     matplotlib.use("Agg")

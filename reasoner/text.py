@@ -12,6 +12,7 @@ from collections.abc import Sequence
 from functools import cache
 from typing import TYPE_CHECKING
 
+from cbrs.extras import require
 from cbrs.kb import ServiceDescription
 from cbrs.reasoner.names import words
 
@@ -34,6 +35,7 @@ def description_text(description: ServiceDescription) -> str:
 @cache
 def _stop_words() -> frozenset[str]:
     # scikit-learn (with scipy) takes over half a second to import: only the text method loads it
+    require("eval", "the text-aware method (sem-str-text)")
     from sklearn.feature_extraction.text import ENGLISH_STOP_WORDS
 
     return frozenset(ENGLISH_STOP_WORDS)

@@ -13,6 +13,8 @@ from pathlib import Path
 
 import pytest
 
+from cbrs.extras import EXTRAS
+
 ROOT = Path(__file__).resolve().parents[1]
 PYPROJECT = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
 TOP_LEVEL = sorted({name.split(".")[0] for name in PYPROJECT["tool"]["setuptools"]["packages"]})
@@ -63,7 +65,13 @@ def _runtime_imports() -> set[str]:
 
 def test_runtime_dependencies_are_what_runtime_code_imports() -> None:
     import_names = {"pillow": "PIL", "scikit-learn": "sklearn"}
-    declared = {re.split(r"[<>=!~\[ ]", dep, maxsplit=1)[0].lower() for dep in PYPROJECT["project"]["dependencies"]}
+    optional = [
+        dep for name, deps in PYPROJECT["project"]["optional-dependencies"].items() if name in EXTRAS for dep in deps
+    ]
+    declared = {
+        re.split(r"[<>=!~\[ ]", dep, maxsplit=1)[0].lower()
+        for dep in [*PYPROJECT["project"]["dependencies"], *optional]
+    }
     imported = _runtime_imports()
     unused = sorted(dep for dep in declared if import_names.get(dep, dep).replace("-", "_") not in imported)
     assert not unused, f"declared but imported by no runtime code: {unused}"
@@ -126,6 +134,12 @@ def test_plain_install_runs_from_another_directory(tmp_path: Path) -> None:
     locate = by_service["LocateMobileRobot_CeilingCamera01"]
     assert locate["inputs"]["value"].endswith("#MarkerColour")
     assert locate["outputs"]["value"].endswith("#RobotLocation")
+
+    # Without the [sim] extra, a command that needs the simulation says which extra to install.
+    run = subprocess.run(
+        [cbrs, "run", "FetchMyPen"], cwd=elsewhere, env=env, capture_output=True, text=True, check=False
+    )
+    assert run.returncode != 0 and "pip install 'cbrs[sim]'" in run.stderr + run.stdout
 
     # The installed copy, not the checkout, answered.
     where = subprocess.run(

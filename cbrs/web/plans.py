@@ -12,6 +12,7 @@ from flask import Blueprint, Response, request, url_for
 from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, Objective
 from cbrs.actions.errors import UnknownTaskError
 from cbrs.actions.model import ActionLibrary
+from cbrs.extras import require
 from cbrs.kb.namespaces import shorten
 from cbrs.task_names import task_iri
 from cbrs.web import context
@@ -67,6 +68,7 @@ def _compose(task: str, objective: str, shown: Page | None) -> CompositionResult
 
 
 def _svg(result: CompositionResult) -> bytes:
+    require("eval", "the plan's drawing")
     from cbrs.actions.draw import draw  # matplotlib is slow to import; only when a drawing is asked for
 
     with tempfile.TemporaryDirectory(prefix="cbrs-srg-") as folder:
