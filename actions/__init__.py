@@ -1,21 +1,45 @@
-"""Composition (and, next, execution): the action model, the service resource graph, plans.
+"""Composition and execution: the action model, the service resource graph, plans, the container.
 
 ``Composer(kb).compose("FetchMyPen")`` gives a ``CompositionResult`` with the plan or the needs no
-component meets; docs/composition.md explains the algorithm.
+component meets; docs/composition.md explains the algorithm. The names below load their modules on
+first use (the composer brings networkx): a program that only needs, say, a remote component's
+error type does not pay for the planner.
 """
 
-from cbrs.actions.composer import (
-    ComposeConfig,
-    Composer,
-    CompositionResult,
-    Objective,
-    PlanStatus,
-    Unsatisfied,
-    store_plan,
-)
-from cbrs.actions.errors import ActionsError, OrderingConflictError, UnknownTaskError
-from cbrs.actions.model import ActionClass, ActionLibrary, Ordering, Task, resolve_task
-from cbrs.actions.plan import Binding, Plan, PlanStep, Source
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from cbrs.actions.composer import (
+        ComposeConfig,
+        Composer,
+        CompositionResult,
+        Objective,
+        PlanStatus,
+        Unsatisfied,
+        store_plan,
+    )
+    from cbrs.actions.errors import ActionsError, OrderingConflictError, UnknownTaskError
+    from cbrs.actions.model import ActionClass, ActionLibrary, Ordering, Task, resolve_task
+    from cbrs.actions.plan import Binding, Plan, PlanStep, Source
+
+_HOMES = {
+    "cbrs.actions.composer": (
+        "ComposeConfig",
+        "Composer",
+        "CompositionResult",
+        "Objective",
+        "PlanStatus",
+        "Unsatisfied",
+        "store_plan",
+    ),
+    "cbrs.actions.errors": ("ActionsError", "OrderingConflictError", "UnknownTaskError"),
+    "cbrs.actions.model": ("ActionClass", "ActionLibrary", "Ordering", "Task", "resolve_task"),
+    "cbrs.actions.plan": ("Binding", "Plan", "PlanStep", "Source"),
+}
+_WHERE = {name: module for module, names in _HOMES.items() for name in names}
 
 __all__ = [
     "ActionClass",
@@ -38,3 +62,12 @@ __all__ = [
     "resolve_task",
     "store_plan",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    module = _WHERE.get(name)
+    if module is None:
+        raise AttributeError(f"module 'cbrs.actions' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value

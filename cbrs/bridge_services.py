@@ -23,17 +23,19 @@ from __future__ import annotations
 
 import json
 from collections.abc import Callable, Collection
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
-from cbrs.actions.composer import ComposeConfig, Composer, Objective, store_plan
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import GraphName, expand
-from cbrs.kb.remote_store import RemoteStore
+from cbrs.kb.store import is_remote
 from cbrs.matchmakers import Matchmakers
 from cbrs.reasoner.methods import METHODS
 from cbrs.rosbridge import Bridge, ServiceError, current_caller
 from cbrs.sparql_service import SparqlService
 from cbrs.tasks import RUN_TOPIC, TaskRunner
+
+if TYPE_CHECKING:
+    from cbrs.actions.composer import Composer, Objective
 
 TOPICS = {
     "/cbrs/task_progress": "cbrs/TaskProgress",
@@ -101,6 +103,8 @@ class KnowledgeServices:
         return result.to_dict(top)
 
     def plan(self, args: dict[str, Any]) -> dict[str, Any]:
+        from cbrs.actions.composer import Objective, store_plan  # the planner loads with the first plan
+
         task = _field(args, "task", str)
         objective = _field(args, "objective", str, Objective.SIMILARITY.value)
         if objective not in {o.value for o in Objective}:
@@ -156,9 +160,11 @@ class Composers:
         self._built: dict[Objective, Composer] = {}
 
     def get(self, objective: Objective) -> Composer:
+        from cbrs.actions.composer import ComposeConfig, Composer
+
         kb = self.sparql.kb
         version: tuple[object, ...] = (self.sparql.generation, frozenset(kb.liveness.unavailable()))
-        if isinstance(kb.store, RemoteStore):
+        if is_remote(kb.store.location):
             version += (kb.store.count(GraphName.ONTOLOGY), kb.store.count(GraphName.SERVICES))
         if version != self._version:
             self._version, self._built = version, {}

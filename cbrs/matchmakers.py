@@ -6,7 +6,7 @@ from __future__ import annotations
 import threading
 
 from cbrs.kb.namespaces import GraphName
-from cbrs.kb.remote_store import RemoteStore
+from cbrs.kb.store import is_remote
 from cbrs.reasoner.matchmaker import Matchmaker
 from cbrs.reasoner.taxonomy import TaxonomyIndex
 from cbrs.sparql_service import SparqlService
@@ -31,7 +31,7 @@ class Matchmakers:
         """
         kb = self.sparql.kb
         generation: object = self.sparql.generation
-        if isinstance(kb.store, RemoteStore):
+        if is_remote(kb.store.location):
             generation = (generation, kb.store.count(GraphName.ONTOLOGY), kb.store.count(GraphName.SERVICES))
         with self._guard:
             if generation != self._generation or self._index is None:
