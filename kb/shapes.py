@@ -123,10 +123,11 @@ def check_loaded(store: Store, report: LoadReport) -> None:
             _check_with_context(store, plain, context)
         check_descriptions(store, owls, terms=False)
     except DescriptionShapeError as error:  # name the file the description came from
-        subject = ox.NamedNode(error.iri)
-        sources = [
-            item.source for item in (*report.files, *report.imports) if any(q.subject == subject for q in item.quads)
-        ]
+        node = ox.NamedNode(error.iri)  # a description, or a node of one (a parameter) that may have no triples
+        items = [*report.files, *report.imports]
+        sources = [item.source for item in items if any(node in (q.subject, q.object) for q in item.quads)]
+        if not sources and len(items) == 1:
+            sources = [items[0].source]
         if sources:
             error.args = (f"{sources[0]}: {error.args[0]}",)
         raise

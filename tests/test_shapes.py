@@ -248,3 +248,18 @@ def test_the_docs_errors_are_what_cbrs_prints(tmp_path: Path, index: int) -> Non
     result = CliRunner().invoke(cli, ["--store", ":memory:", "register", str(tmp_path / name)])
     assert result.exit_code == 1
     assert result.output.strip() == error.strip()
+
+
+def test_a_shape_error_on_a_node_with_no_triples_of_its_own_names_the_file(tmp_path: Path) -> None:
+    """A parameter that is only pointed at (its element was mangled) is still traced to its file."""
+    broken = tmp_path / "dangling.ttl"
+    broken.write_text(
+        """@prefix cbrs: <https://w3id.org/cbrs/core#> . @prefix home: <https://w3id.org/cbrs/home#> .
+        <urn:x:Locate> a cbrs:DynamicPerceptionComponent ; cbrs:deviceName "C" ; cbrs:serviceName "Locate" ;
+          cbrs:hasOWLSModel [ a cbrs:OWLSModel ; cbrs:hasOutput _:nothing ] .""",
+        encoding="utf-8",
+    )
+    kb = KnowledgeBase.open(":memory:")
+    with pytest.raises(InvalidDescriptionError) as refused:
+        kb.load([broken])
+    assert str(refused.value).startswith(str(broken))
