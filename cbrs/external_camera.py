@@ -22,21 +22,34 @@ from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES, GraphName
 from cbrs.kb.semantic_map import SemanticMap
 from cbrs.kb.vocab import CBRS
-from cbrs.sim.perception import MarkerModel, locate_robot
+from cbrs.sim.perception import locate_robot
 from cbrs.sim.values import to_json
+from cbrs.sim.world import marker_model
 from cbrs.sim_sensors import CAPTURE_SERVICE, frame_from_json
 
-__all__ = ["description", "localiser", "main"]
+__all__ = ["LOCATE", "description", "localiser", "localisers", "main"]
 
-MARKER_LIFT = 0.002  # the marker's patches lie on the platform (as the simulation builds them)
+LOCATE = "LocateMobileRobot"
+"""The service the camera programs run (a service name, as the simulation's skills are named)."""
+
+
+def localisers(kb: KnowledgeBase) -> dict[str, str]:
+    """The cameras of the semantic map with a LocateMobileRobot component: device name -> component IRI."""
+    cameras = {camera.name for camera in SemanticMap.read(kb).cameras.values()}
+    return {
+        ad.device_name: ad.iri
+        for ad in kb.advertisements()
+        if ad.service_name == LOCATE and ad.device_name is not None and ad.device_name in cameras
+    }
 
 
 def description(kb: KnowledgeBase, camera: str) -> str:
     """The camera's bundled LocateMobileRobot description, grounded in ``/<camera>/locate_robot``."""
-    component = ox.NamedNode(PREFIXES["svc"] + f"LocateMobileRobot_{camera}")
+    found = localisers(kb).get(camera)
+    if found is None:
+        raise SystemExit(f"the store has no {LOCATE} component of a camera named {camera} to run")
+    component = ox.NamedNode(found)
     quads = kb.registry.description_quads(component.value)
-    if not quads:
-        raise SystemExit(f"the store has no LocateMobileRobot_{camera} to run")
     port = ox.NamedNode(component.value + "_bridge_port")
     graph = GraphName.SERVICES.node
     grounding = [
@@ -44,7 +57,7 @@ def description(kb: KnowledgeBase, camera: str) -> str:
         ox.Quad(port, ox.NamedNode(PREFIXES["rdf"] + "type"), ox.NamedNode(CBRS.ServicePort), graph),
         ox.Quad(port, ox.NamedNode(CBRS.portName), ox.Literal("locate"), graph),
         ox.Quad(port, ox.NamedNode(CBRS.topic), ox.Literal(f"/{camera.lower()}/locate_robot"), graph),
-        ox.Quad(port, ox.NamedNode(CBRS.messageType), ox.Literal("cbrs_msgs/LocateMobileRobot"), graph),
+        ox.Quad(port, ox.NamedNode(CBRS.messageType), ox.Literal(f"cbrs_msgs/{LOCATE}"), graph),
     ]
     triples = [ox.Triple(q.subject, q.predicate, q.object) for q in (*quads, *grounding)]
     written = ox.serialize(triples, format=ox.RdfFormat.TURTLE)
@@ -54,16 +67,10 @@ def description(kb: KnowledgeBase, camera: str) -> str:
 
 def localiser(camera: str, capture: BridgeClient, smap: SemanticMap) -> Any:
     """The handler: a frame of ``camera`` from the simulation, the marker found in it."""
-    robot = next(iter(smap.robots.values()))
-    if robot.marker is None or robot.platform_height is None:
-        raise SystemExit(f"the semantic map gives {robot.name} no marker on a platform")
-    marker = MarkerModel(
-        robot.marker.front,
-        robot.marker.rear,
-        robot.marker.patch,
-        robot.marker.separation,
-        robot.platform_height + MARKER_LIFT,
-    )
+    try:
+        marker = marker_model(next(iter(smap.robots.values())))
+    except ValueError as error:
+        raise SystemExit(str(error)) from None
 
     def locate(request: dict[str, Any]) -> dict[str, Any]:
         frame = frame_from_json(capture.call_sync(CAPTURE_SERVICE, {"camera": camera}))

@@ -24,8 +24,8 @@ from cbrs.actions.composer import Composer
 from cbrs.actions.events import Event
 from cbrs.actions.runner import RunResult, run_task
 from cbrs.bridge_client import BridgeClient
+from cbrs.external_camera import localisers
 from cbrs.kb import KnowledgeBase
-from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
 from cbrs.server import ServeConfig, Server
 from cbrs.sim.components import SimEnvironment
@@ -33,9 +33,10 @@ from cbrs.sim.world import open_world
 from cbrs.sim_sensors import offer_cameras
 from cbrs.sparql_service import EndpointConfig
 
-__all__ = ["CAMERAS", "ExternalRun", "run_external_demo"]
+__all__ = ["IN_USE", "ExternalRun", "run_external_demo"]
 
-CAMERAS = ("CeilingCamera01", "CeilingCamera02")
+IN_USE = "in use"
+"""``kill=IN_USE``: kill whichever camera the run first asks to locate the robot."""
 REGISTRATION_WAIT = 60.0
 """Seconds the camera programs have to start (import cbrs, seed their own knowledge) and register."""
 
@@ -53,17 +54,16 @@ class ExternalRun:
     log: list[str] = field(default_factory=list)
 
 
-def _component(camera: str) -> str:
-    return PREFIXES["svc"] + f"LocateMobileRobot_{camera}"
-
-
 def run_external_demo(
-    seed: int = 0, kill: str | None = "CeilingCamera01", lease: float = 1.0, say: Callable[[str], None] = print
+    seed: int = 0, kill: str | None = IN_USE, lease: float = 1.0, say: Callable[[str], None] = print
 ) -> ExternalRun:
-    """Run FetchMyPen on external cameras, killing ``kill``'s process at its first call (None: none)."""
+    """Run FetchMyPen on external cameras, killing ``kill``'s process at its first call (``IN_USE``: the
+    first camera asked; None: none). The cameras are those of the semantic map with a LocateMobileRobot
+    component."""
     kb = KnowledgeBase.open(":memory:")
-    for camera in CAMERAS:  # these run as programs of their own now
-        kb.registry.deregister(_component(camera))
+    components = localisers(kb)
+    for component in components.values():  # these run as programs of their own now
+        kb.registry.deregister(component)
     token = secrets.token_urlsafe(16)
     endpoint = EndpointConfig(update_token=token, isolate=False)
     server = Server(kb, ServeConfig(port=0, bridge_port=0, endpoint=endpoint, component_lease=lease))
@@ -74,16 +74,16 @@ def run_external_demo(
         with open_world(seed=seed, semantic_map=SemanticMap.read(kb)) as world:
             offer_cameras(server.bridge, world)
             environment = {**os.environ, "CBRS_UPDATE_TOKEN": token}
-            for camera in CAMERAS:
+            for camera in sorted(components):
                 command = [sys.executable, "-m", "cbrs.external_camera", camera, "--url", url]
                 command += ["--heartbeat", str(lease / 3), "--lease", str(lease)]
                 processes[camera] = subprocess.Popen(command, env=environment, stdout=subprocess.DEVNULL)
             started = ", ".join(f"{camera} (pid {process.pid})" for camera, process in processes.items())
             say(f"started {started}; waiting for them to register")
-            _wait_registered(kb, processes)
-            say("both cameras registered over the bridge; running FetchMyPen")
+            _wait_registered(kb, components, processes)
+            say("the cameras registered over the bridge; running FetchMyPen")
             run = ExternalRun({c: p.pid for c, p in processes.items()}, lease)
-            watcher = _killer(kb, processes, kill, run, say) if kill else None
+            watcher = _killer(kb, components, processes, kill, run, say) if kill else None
             with BridgeClient(url, token) as bridge:
                 run.result = run_task(
                     kb, "FetchMyPen", SimEnvironment(world, kb, bridge), composer=Composer(kb), on_event=watcher
@@ -97,11 +97,13 @@ def run_external_demo(
         server.stop()
 
 
-def _wait_registered(kb: KnowledgeBase, processes: dict[str, subprocess.Popen[bytes]]) -> None:
+def _wait_registered(
+    kb: KnowledgeBase, components: dict[str, str], processes: dict[str, subprocess.Popen[bytes]]
+) -> None:
     deadline = time.monotonic() + REGISTRATION_WAIT
     while time.monotonic() < deadline:
         states = kb.liveness.states()
-        if all(_component(c) in states and states[_component(c)].live for c in processes):
+        if all(components[c] in states and states[components[c]].live for c in processes):
             return
         dead = [c for c, p in processes.items() if p.poll() is not None]
         if dead:
@@ -112,16 +114,19 @@ def _wait_registered(kb: KnowledgeBase, processes: dict[str, subprocess.Popen[by
 
 def _killer(
     kb: KnowledgeBase,
+    components: dict[str, str],
     processes: dict[str, subprocess.Popen[bytes]],
-    camera: str,
+    kill: str,
     run: ExternalRun,
     say: Callable[[str], None],
 ) -> Callable[[Event], None]:
-    """An event handler that kills ``camera``'s process when its component is first started."""
-    component = _component(camera)
+    """An event handler that kills a camera's process when its component is first started: ``kill``'s,
+    or with ``IN_USE`` the first camera's the run starts."""
+    cameras = {component: camera for camera, component in components.items() if kill in (IN_USE, camera)}
 
     def on_event(event: Event) -> None:
-        if run.killed or event.message.get("event") != "step_started" or event.message.get("component") != component:
+        camera = cameras.get(str(event.message.get("component")))
+        if run.killed or event.message.get("event") != "step_started" or camera is None:
             return
         run.killed = camera
         killed_at = time.monotonic()
@@ -130,7 +135,7 @@ def _killer(
 
         def watch() -> None:
             while time.monotonic() - killed_at < 10 * run.lease:
-                state = kb.liveness.states().get(component)
+                state = kb.liveness.states().get(components[camera])
                 if state is not None and not state.live:
                     run.detected_after = time.monotonic() - killed_at
                     say(f"{camera} unavailable after {run.detected_after * 1000:.0f} ms ({state.reason})")

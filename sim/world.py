@@ -19,7 +19,7 @@ import pybullet as p
 
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import Arm as ArmSpec
-from cbrs.kb.semantic_map import Box, Dispenser, MapObject, SemanticMap, Thing
+from cbrs.kb.semantic_map import Box, Dispenser, MapObject, MobileRobot, SemanticMap, Thing
 from cbrs.sim import layout as L
 from cbrs.sim.arms import PYBULLET_DATA, Arm, ArmSide, Kinematics
 from cbrs.sim.base import MobileBase
@@ -31,7 +31,7 @@ from cbrs.sim.perception import MarkerModel
 from cbrs.sim.quiet import quiet_output
 from cbrs.sim.scene import bundled_map
 
-__all__ = ["TIME_STEP", "HomeWorld", "Perturbation", "Spread", "open_world"]
+__all__ = ["TIME_STEP", "HomeWorld", "Perturbation", "Spread", "marker_model", "open_world"]
 
 TIME_STEP = 1.0 / 240.0
 """Physics step (s): pybullet's default, at which the Panda's controllers and contacts are stable."""
@@ -702,16 +702,7 @@ class HomeWorld:
     @property
     def marker_model(self) -> MarkerModel:
         """The base's colour marker as perception knows it: colours, patch size, spacing and height."""
-        marker = self.robot.marker
-        if marker is None:
-            raise ValueError(
-                f"the semantic map gives {self.robot.name} no marker (home:hasMarker, with home:sizeX, home:sizeY, "
-                "home:markerSeparation and a node of home:frontColourName and home:rearColourName): the ceiling "
-                "cameras could not find it"
-            )
-        return MarkerModel(
-            marker.front, marker.rear, marker.patch, marker.separation, self.platform_height + MARKER_LIFT
-        )
+        return marker_model(self.robot)
 
     @property
     def base_radius(self) -> float:
@@ -776,6 +767,19 @@ class HomeWorld:
             ],
             (self.person.start.x + dx, self.person.start.y + dy, legs / 2),
         )
+
+
+def marker_model(robot: MobileRobot) -> MarkerModel:
+    """A mobile robot's colour marker as perception knows it from the semantic map: colours, one patch's
+    size, the patches' spacing, and the height of their top faces (lying on the platform)."""
+    marker = robot.marker
+    if marker is None or robot.platform_height is None:
+        raise ValueError(
+            f"the semantic map gives {robot.name} no marker on a platform (home:hasPlatform with home:maxZ; "
+            "home:hasMarker, with home:sizeX, home:sizeY, home:markerSeparation and a node of "
+            "home:frontColourName and home:rearColourName): the ceiling cameras could not find it"
+        )
+    return MarkerModel(marker.front, marker.rear, marker.patch, marker.separation, robot.platform_height + MARKER_LIFT)
 
 
 def _region(name: str, box: Box) -> Region:
