@@ -28,6 +28,7 @@ class RunStatus(Enum):
     RUNNING = "running"
     SUCCEEDED = "succeeded"
     FAILED = "failed"
+    CANCELLED = "cancelled"  # stopped on request between steps (run_task's ``cancelled``)
 
 
 class Verifier(Protocol):
@@ -207,6 +208,15 @@ class Executor:
             self._advance(step)
         self.container.bus.dispatch()
         return self.status
+
+    def cancel(self, reason: str) -> None:
+        """Stop the run on request: the step under way is aborted and nothing more starts."""
+        if self.status is not RunStatus.RUNNING:
+            return
+        if self._active is not None:
+            self.container.abort(self._active, reason)
+            self._active = None
+        self._finish(RunStatus.CANCELLED, reason)
 
     def report(self) -> ExecutionReport:
         return ExecutionReport(

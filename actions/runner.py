@@ -109,6 +109,7 @@ def run_task(
     max_ticks: int = 100_000,
     fault_policy: FaultPolicy | None = None,
     max_replans: int = 2,
+    cancelled: Callable[[], bool] | None = None,
 ) -> RunResult:
     """Perceive, compose ``task`` from what holds now, run it in ``environment``, keep the world graph current.
 
@@ -117,6 +118,8 @@ def run_task(
     registered since: what is achieved is kept, since the belief offers it to the new plan's
     preconditions. At most ``max_replans`` times; each replaced plan is kept in the result with its
     reason. ``faults`` fail whenever invoked; ``fault_policy`` (e.g. ``RandomFaults``) may break others.
+    ``cancelled`` is asked before the first step and after each step: once it says True the run stops
+    there (status cancelled), without replanning; a step under way is never cut short.
     """
     composer = composer or Composer(kb)
     bus = EventBus()
@@ -140,11 +143,13 @@ def run_task(
             given = environment.given(plan, requirements)
             executor = Executor(plan, container, given, environment.verify, environment.clock)
             done = 0
+            _stop_if_cancelled(executor, cancelled, done)
             while executor.status is RunStatus.RUNNING and executor.ticks < max_ticks:
                 executor.tick()
                 if len(executor.results) != done:  # a step finished: the world changed
                     done = len(executor.results)
                     belief.write(environment.observe())
+                    _stop_if_cancelled(executor, cancelled, done)
             report = executor.run(max_ticks)  # ends a run that hit max_ticks; otherwise just the report
             outputs = executor.results
             if report.status is not RunStatus.FAILED or len(replans) >= max_replans:
@@ -166,6 +171,12 @@ def run_task(
     belief.write(environment.observe())
     goals = _check_goals(environment, composition.plan, outputs) if report is not None else ()
     return RunResult(composition, report, tuple(replans), goals)
+
+
+def _stop_if_cancelled(executor: Executor, cancelled: Callable[[], bool] | None, done: int) -> None:
+    """Between steps: stop the run if asked to (a plan whose steps are all done just finishes)."""
+    if cancelled is not None and done < len(executor.plan.steps) and cancelled():
+        executor.cancel(f"cancelled on request after {done} of {len(executor.plan.steps)} steps")
 
 
 def _perceive(environment: Environment) -> None:

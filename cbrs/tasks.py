@@ -23,6 +23,7 @@ from typing import Any
 
 from cbrs.actions.composer import Composer
 from cbrs.actions.events import Event
+from cbrs.actions.executor import RunStatus
 from cbrs.actions.faults import RandomFaults
 from cbrs.actions.model import ActionLibrary, resolve_task
 from cbrs.actions.remote import Transport
@@ -95,13 +96,14 @@ class TaskRun:
     seed: int
     faults: tuple[str, ...]
     fault_rate: float = 0.0  # random faults, seeded with ``seed`` (actions.faults.RandomFaults)
-    status: str = "running"  # then succeeded, failed, no-plan or error
+    status: str = "running"  # then succeeded, failed, cancelled, no-plan or error
     started: float = field(default_factory=time.time)
     finished: float | None = None
     events: list[dict[str, Any]] = field(default_factory=list)
     result: dict[str, Any] | None = None
     error: str | None = None
     done: threading.Event = field(default_factory=threading.Event, repr=False)
+    cancel_requested: threading.Event = field(default_factory=threading.Event, repr=False)
 
     def to_dict(self, with_events: bool = True) -> dict[str, Any]:
         found: dict[str, Any] = {
@@ -243,6 +245,12 @@ class TaskRunner:
         run.done.wait(timeout)
         return run
 
+    def cancel(self, run_id: str) -> TaskRun:
+        """Ask a run to stop after the step under way (a run that has ended is left as it is)."""
+        run = self.get(run_id)
+        run.cancel_requested.set()
+        return run
+
     def get(self, run_id: str) -> TaskRun:
         with self._guard:
             if run_id not in self._runs:
@@ -283,12 +291,23 @@ class TaskRunner:
                 self._capture(world, run.id)
                 environment = SimEnvironment(world, self.kb, self.transport() if self.transport else None)
                 policy = RandomFaults(run.seed, run.fault_rate) if run.fault_rate > 0 else None
-                result = run_task(self.kb, run.task, environment, run.faults, composer, follow, fault_policy=policy)
+                result = run_task(
+                    self.kb,
+                    run.task,
+                    environment,
+                    run.faults,
+                    composer,
+                    follow,
+                    fault_policy=policy,
+                    cancelled=run.cancel_requested.is_set,
+                )
                 found = result.to_dict()
                 found["sim_seconds"] = round(world.time, 3)
             run.result = found
             if result.report is None:
                 run.status = "no-plan"
+            elif result.report.status is RunStatus.CANCELLED:
+                run.status = "cancelled"
             else:
                 run.status = "succeeded" if result.succeeded else "failed"
         except Exception as error:  # a run must end with a status, whatever broke
