@@ -10,6 +10,15 @@ Services (request fields -> response values):
 - ``/cbrs/run_task`` ``{task, seed=0, fail=[], wait=true}`` -> the run; with ``wait`` false it returns
   at once and the run is followed on the topics, or with ``/cbrs/task_status`` ``{run}``.
 
+Action (rosbridge's ROS 2 action ops, ``send_action_goal`` and the rest):
+
+- ``/cbrs/run_task`` (type ``cbrs/action/RunTask``), goal ``{task, seed=0, fail=[], fault_rate=0}``:
+  one feedback ``{run, plan, step, action, component, status, reason, failover}`` per plan step that
+  ends (``status`` succeeded or failed); the result is the run as the service returns it, with status
+  SUCCEEDED, CANCELED (the client cancelled: the run stops after the step under way) or ABORTED (the
+  run failed, found no plan or broke). A refused goal (no token, unknown task, a run going) fails as
+  rosbridge fails a goal: ``result: false``, status UNKNOWN, the reason as ``values``.
+
 Anonymous clients only read: recording a plan and running a task write the store, so they need a
 caller that sent the update token (op ``auth``) or a page of this server's own (its handshake's
 ``Origin``). The topics below belong to the server; clients cannot advertise or publish them.
@@ -22,6 +31,7 @@ store updates).
 from __future__ import annotations
 
 import json
+import threading
 from collections.abc import Callable, Collection
 from typing import TYPE_CHECKING, Any, TypeVar
 
@@ -30,7 +40,7 @@ from cbrs.kb.namespaces import GraphName, expand
 from cbrs.kb.store import is_remote
 from cbrs.matchmakers import Matchmakers
 from cbrs.reasoner.methods import METHODS
-from cbrs.rosbridge import Bridge, ServiceError, current_caller
+from cbrs.rosbridge import Bridge, GoalHandle, GoalResult, GoalStatus, ServiceError, current_caller
 from cbrs.sparql_service import SparqlService
 from cbrs.tasks import RUN_TOPIC, TaskRunner
 
@@ -43,6 +53,12 @@ TOPICS = {
     "/cbrs/task": "cbrs/TaskStatus",
     RUN_TOPIC: "cbrs/Event",
 }
+
+#: The actions offered: name -> type. /cbrs/run_task is also a service; ROS 2 keeps the two apart.
+ACTIONS = {"/cbrs/run_task": "cbrs/action/RunTask"}
+
+#: A run's end status (TaskRun.status) -> the action goal's status; anything else aborted the goal.
+GOAL_STATUS = {"succeeded": GoalStatus.SUCCEEDED, "cancelled": GoalStatus.CANCELED}
 
 T = TypeVar("T")
 Handler = Callable[[dict[str, Any]], dict[str, Any]]
@@ -118,10 +134,42 @@ class KnowledgeServices:
         return {**result.to_dict(), "recorded": recorded}
 
     def run_task(self, args: dict[str, Any]) -> dict[str, Any]:
+        task, seed, faults, rate = self._run_request(args)
+        if _field(args, "wait", bool, True):
+            run = _call(lambda: self.tasks.run(task, seed, faults, fault_rate=rate))
+        else:
+            run = _call(lambda: self.tasks.start(task, seed, faults, rate))
+        return run.to_dict(with_events=False)
+
+    def run_task_goal(self, goal: GoalHandle) -> GoalResult:
+        """The /cbrs/run_task action: start the run, relay its steps as feedback, wait for its end.
+
+        A cancel asks the run to stop after the step under way. The wait has no deadline of its own:
+        a run always ends (the executor's tick bound), and a server stopping cancels the goal.
+        """
+        task, seed, faults, rate = self._run_request(goal.args)
+        with self.sparql.lock:
+            realises = {ad.iri: ad.realizes_action for ad in self.sparql.kb.advertisements(include_unavailable=True)}
+        feed = StepFeed(goal, realises)
+        unsubscribe = self.tasks.subscribe(feed)
+        try:
+            run = _call(lambda: self.tasks.start(task, seed, faults, rate))
+            feed.follow(run.id)
+
+            def cancel() -> None:
+                self.tasks.cancel(run.id)  # the run stops after the step under way
+
+            goal.on_cancel(cancel)
+            run.done.wait()
+        finally:
+            unsubscribe()
+        return GoalResult(GOAL_STATUS.get(run.status, GoalStatus.ABORTED), run.to_dict(with_events=False))
+
+    def _run_request(self, args: dict[str, Any]) -> tuple[str, int, list[str], float]:
+        """A run's task, seed, failing components and fault rate, checked, from a client that may write."""
         task = _field(args, "task", str)
         seed = _field(args, "seed", int, 0)
         faults = _field(args, "fail", list, [])
-        wait = _field(args, "wait", bool, True)
         rate = args.get("fault_rate", 0.0)
         if not all(isinstance(f, str) for f in faults):
             raise ServiceError("fail must be a list of component IRIs (strings)")
@@ -132,15 +180,62 @@ class KnowledgeServices:
                 "a task run moves the robot and writes the store: send the update token first "
                 '({"op": "auth", "mac": "<token>"}), or start it from this server\'s tasks page'
             )
-        if wait:
-            run = _call(lambda: self.tasks.run(task, seed, faults, fault_rate=float(rate)))
-        else:
-            run = _call(lambda: self.tasks.start(task, seed, faults, float(rate)))
-        return run.to_dict(with_events=False)
+        return task, seed, faults, float(rate)
 
     def task_status(self, args: dict[str, Any]) -> dict[str, Any]:
         run_id = _field(args, "run", str)
         return _call(lambda: self.tasks.get(run_id)).to_dict()
+
+
+class StepFeed:
+    """A task listener that turns one run's step events into its goal's feedback: one message per step
+    that ends. Events that come before the run's id is known are held, then relayed in order."""
+
+    def __init__(self, goal: GoalHandle, realises: dict[str, str | None]) -> None:
+        self.goal = goal
+        self.realises = realises  # component IRI -> the action class it realises
+        self._lock = threading.Lock()
+        self._run: str | None = None
+        self._early: list[dict[str, Any]] = []
+        self._plan = 1
+
+    def __call__(self, topic: str, message: dict[str, Any]) -> None:
+        if topic != "/cbrs/task_progress":
+            return
+        with self._lock:  # held while relaying, so the held events go first
+            if self._run is None:
+                self._early.append(message)
+            else:
+                self._relay(message)
+
+    def follow(self, run_id: str) -> None:
+        """The run is known: relay what came before and follow it from now on."""
+        with self._lock:
+            self._run = run_id
+            early, self._early = self._early, []
+            for message in early:
+                self._relay(message)
+
+    def _relay(self, message: dict[str, Any]) -> None:
+        if message.get("run") != self._run:
+            return
+        event = message.get("event")
+        if event == "replanning":
+            self._plan = int(message.get("plan", self._plan + 1))
+        elif event in ("step_succeeded", "step_failed"):
+            component = message.get("component")
+            self.goal.publish_feedback(
+                {
+                    "run": self._run,
+                    "plan": self._plan,
+                    "step": message.get("step"),
+                    "action": self.realises.get(component) if isinstance(component, str) else None,
+                    "component": component,
+                    "status": "succeeded" if event == "step_succeeded" else "failed",
+                    "reason": message.get("reason", ""),
+                    "failover": message.get("failover"),
+                }
+            )
 
 
 class Composers:
@@ -188,6 +283,8 @@ def attach(bridge: Bridge, services: KnowledgeServices) -> Callable[[], None]:
         bridge.add_service(name, kind, handler)
     for topic, kind in TOPICS.items():
         bridge.add_topic(topic, kind)
+    for action, kind in ACTIONS.items():
+        bridge.add_action(action, kind, services.run_task_goal)
 
     def relay(topic: str, message: dict[str, Any]) -> None:
         if topic in TOPICS:

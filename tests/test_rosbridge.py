@@ -225,7 +225,7 @@ BAD_FRAMES = [
     pytest.param(
         '{"op": "fragment", "id": "f"}', "fragment: fragmented messages are not supported", "f", id="fragment"
     ),
-    pytest.param('{"op": "send_action_goal"}', "actions are not supported", None, id="action"),
+    pytest.param('{"op": "png", "data": "x"}', "png: PNG-compressed messages are not supported", None, id="png"),
     pytest.param(
         '{"op": "publish", "topic": "/a", "id": "p"}', "publish: missing required field 'msg'", "p", id="missing"
     ),

@@ -1,6 +1,7 @@
-"""The bridge: the rosbridge v2 ops over a graph of topics and services, without any transport.
+"""The bridge: the rosbridge v2 ops over a graph of topics, services and actions, without any transport.
 
-The server side (``add_service``, ``add_topic``, ``publish``, ``params``) may be used from any thread.
+The server side (``add_service``, ``add_action``, ``add_topic``, ``publish``, ``params``) may be used
+from any thread.
 A transport (``server.py`` for websockets) attaches the bridge to its event loop, opens one
 :class:`Session` per client, feeds it the client's text frames and closes it when the client goes.
 """
@@ -18,7 +19,8 @@ from typing import TYPE_CHECKING, Any
 from cbrs.rosbridge import protocol, rosapi
 from cbrs.rosbridge.calls import Call, Calls, run_handler
 from cbrs.rosbridge.errors import ProtocolError, RosbridgeError, UnknownTopicError
-from cbrs.rosbridge.graph import Graph, Handler, Service, Topic
+from cbrs.rosbridge.goals import ActionHandler, Goal, Goals, GoalStatus
+from cbrs.rosbridge.graph import Action, Graph, Handler, Service, Topic
 from cbrs.rosbridge.params import ParamStore
 from cbrs.rosbridge.protocol import LEVELS, Message
 from cbrs.rosbridge.session import Session
@@ -45,10 +47,11 @@ class Bridge:
     ``call_timeout`` (seconds) bounds every service call unless the call sets its own ``timeout``;
     ``params`` seeds the parameter store; ``max_queue_length`` bounds every subscription's queue (and
     how far a pass-through subscriber may fall behind) and ``max_queue_bytes`` the characters it holds;
-    ``service_workers`` threads run service handlers. ``token``, when set, is what a client sends with the
+    ``service_workers`` threads run service handlers and ``action_workers`` other threads action handlers
+    (goals run long: they must not hold up service calls). ``token``, when set, is what a client sends with the
     ``auth`` op to be :attr:`Caller.authorised`; topics and services whose names start with one of
     ``reserved`` (and every topic added with :meth:`add_topic`) belong to the server: clients may
-    subscribe and call, but not advertise, publish or provide them. One client address may hold
+    subscribe, call and send goals, but not advertise, publish or provide them. One client address may hold
     ``connections_per_client`` connections; the next is closed at once (code 1013, try again later).
     """
 
@@ -64,6 +67,7 @@ class Bridge:
         token: str | None = None,
         reserved: Sequence[str] = (),
         connections_per_client: int = 64,
+        action_workers: int = 4,
     ) -> None:
         for label, value in [
             ("max_message_bytes", max_message_bytes),
@@ -72,6 +76,7 @@ class Bridge:
             ("service_workers", service_workers),
             ("max_queue_bytes", max_queue_bytes),
             ("connections_per_client", connections_per_client),
+            ("action_workers", action_workers),
         ]:
             if isinstance(value, bool) or not isinstance(value, int | float) or value <= 0:
                 raise ValueError(f"{label} must be a positive number, not {value!r}")
@@ -81,6 +86,7 @@ class Bridge:
         self.service_workers = int(service_workers)
         self.max_queue_bytes = int(max_queue_bytes)
         self.connections_per_client = int(connections_per_client)
+        self.action_workers = int(action_workers)
         self.token = token
         self.reserved = tuple(protocol.resolve(prefix) for prefix in reserved)
         self.params = ParamStore(params)
@@ -90,6 +96,8 @@ class Bridge:
         self._loop: asyncio.AbstractEventLoop | None = None
         self._calls: Calls | None = None
         self._workers: WorkerPool | None = None
+        self._goals: Goals | None = None
+        self._goal_workers: WorkerPool | None = None
         self._writers: dict[Session, asyncio.Task[None]] = {}
         self._clients = itertools.count(1)
         self._disconnect_listeners: list[Callable[[str], None]] = []
@@ -103,6 +111,12 @@ class Bridge:
             "service_response": self._service_response,
             "advertise_service": self._advertise_service,
             "unadvertise_service": self._unadvertise_service,
+            "advertise_action": self._advertise_action,
+            "unadvertise_action": self._unadvertise_action,
+            "send_action_goal": self._send_action_goal,
+            "cancel_action_goal": self._cancel_action_goal,
+            "action_feedback": self._action_feedback,
+            "action_result": self._action_result,
             "set_level": self._set_level,
             "auth": self._auth,
         }
@@ -133,6 +147,34 @@ class Bridge:
             if service is None or service.handler is None or service.inline:
                 raise RosbridgeError(f"service {name!r} was not added by add_service")
             del self._graph.services[name]
+
+    def add_action(self, name: str, type: str, handler: ActionHandler) -> None:
+        """Offer an action whose goals ``handler(goal: GoalHandle)`` runs to the end on a worker thread.
+
+        The handler returns the result values (the goal succeeded) or a :class:`GoalResult` with the end
+        status (CANCELED, ABORTED); it may send ``goal.publish_feedback(values)`` and should stop when
+        ``goal.cancel_requested``. Raising :class:`ServiceError` fails the goal with that text, as
+        rosbridge fails it (``result: false``, status UNKNOWN); any other exception too, as an internal
+        error (and is logged).
+        """
+        name = _api_name(name, "action")
+        if not callable(handler):
+            raise TypeError(f"the handler of {name} must be callable, not {handler!r}")
+        with self._graph.lock:
+            existing = self._graph.actions.get(name)
+            if existing is not None:
+                owner = existing.provider.name if existing.provider else "the server"
+                raise RosbridgeError(f"action {name!r} is already provided by {owner}")
+            self._graph.actions[name] = Action(name, type, handler)
+
+    def remove_action(self, name: str) -> None:
+        """Withdraw an action added with :meth:`add_action`; goals in flight run to their end."""
+        name = _api_name(name, "action")
+        with self._graph.lock:
+            action = self._graph.actions.get(name)
+            if action is None or action.handler is None:
+                raise RosbridgeError(f"action {name!r} was not added by add_action")
+            del self._graph.actions[name]
 
     def add_topic(self, name: str, type: str, *, latch: bool = False) -> None:
         """Declare a topic the server publishes on; with ``latch``, new subscribers get its last message."""
@@ -170,6 +212,10 @@ class Bridge:
         """(name, type) of every service: rosapi, the server's and those clients provide."""
         return self._graph.service_list()
 
+    def actions(self) -> list[tuple[str, str]]:
+        """(name, type) of every action: the server's and those clients provide."""
+        return self._graph.action_list()
+
     def start(
         self, host: str = "127.0.0.1", port: int = 9090, *, origins: Sequence[str | None] | None = None
     ) -> RunningBridge:
@@ -200,19 +246,25 @@ class Bridge:
         if self._loop is not None:
             raise RosbridgeError("this bridge is already being served; stop it before serving it again")
         self._workers = WorkerPool(self.service_workers)
+        self._goal_workers = WorkerPool(self.action_workers, name="cbrs-rosbridge-action")
         self._calls = Calls(loop, self._workers)
+        self._goals = Goals(loop, self._goal_workers)
         self._loop = loop
 
-    async def detach(self) -> WorkerPool:
-        """Close every session, fail the calls in flight; returns the (shut down) worker pool to join."""
+    async def detach(self) -> list[WorkerPool]:
+        """Close every session, fail the calls and goals in flight (asking action handlers to stop);
+        returns the (shut down) worker pools to join."""
         for session in list(self._writers):
             self.close_session(session)
         assert self._calls is not None and self._workers is not None
+        assert self._goals is not None and self._goal_workers is not None
         self._calls.fail_all("the server is shutting down")
-        workers = self._workers
-        workers.shutdown()
-        self._loop = self._calls = self._workers = None
-        return workers
+        self._goals.stop_all("the server is shutting down")
+        pools = [self._workers, self._goal_workers]
+        for pool in pools:
+            pool.shutdown()
+        self._loop = self._calls = self._workers = self._goals = self._goal_workers = None
+        return pools
 
     def open_session(
         self,
@@ -246,6 +298,7 @@ class Bridge:
             return
         op: str | None = None
         message_id = None
+        message: Message | None = None
         try:
             message = protocol.decode(frame, self.max_message_bytes)
             message_id = message.get("id")
@@ -256,6 +309,8 @@ class Bridge:
             text = f"{op}: {error.reason}" if op else error.reason
             log.info("%s: %s", session.name, text)
             session.report("error", text, error.message_id if error.message_id is not None else message_id)
+            if op == "send_action_goal" and message is not None:  # the goal's callbacks hear of it too
+                self._refuse_goal(session, message, text)
         except Exception as error:
             log.exception("%s: %s failed", session.name, op)
             session.report("error", f"{op or 'message'}: internal error: {type(error).__name__}: {error}", message_id)
@@ -277,8 +332,14 @@ class Bridge:
                 service = self._graph.services.get(name)
                 if service is not None and service.provider is session:
                     del self._graph.services[name]
+            for name in session.provided_actions:
+                action = self._graph.actions.get(name)
+                if action is not None and action.provider is session:
+                    del self._graph.actions[name]
         if self._calls is not None:
             self._calls.fail_provider(session, None, "the provider of {service!r} disconnected")
+        if self._goals is not None:
+            self._goals.fail_provider(session, None, "the provider of {action!r} disconnected")
         log.info("%s disconnected", session.name)
         for listener in list(self._disconnect_listeners):
             try:
@@ -438,6 +499,88 @@ class Bridge:
             del self._graph.services[name]
         self._calls.fail_provider(session, name, "service {service!r} was unadvertised by its provider")
         session.report("info", f"unadvertised service {name}", message.get("id"))
+
+    def _advertise_action(self, session: Session, message: Message) -> None:
+        name, kind = protocol.resolve(message["action"], "action"), message["type"]
+        if self._owned(name):
+            raise ProtocolError(f"action {name!r} is in a namespace of this server; clients cannot provide it")
+        with self._graph.lock:
+            action = self._graph.actions.get(name)
+            if action is not None and action.provider is None:
+                raise ProtocolError(f"action {name!r} is provided by the server and cannot be advertised")
+            previous = action.provider if action is not None else None
+            self._graph.actions[name] = Action(name, kind, provider=session, spelling=message["action"])
+        if previous is not None and previous is not session:  # goals in flight stay with the old provider
+            previous.provided_actions.pop(name, None)
+            log.warning("%s took over action %s from %s", session.name, name, previous.name)
+            session.report("warning", f"took over action {name} from {previous.name}", message.get("id"))
+        session.provided_actions[name] = message["action"]
+        session.report("info", f"advertised action {name} ({kind})", message.get("id"))
+
+    def _unadvertise_action(self, session: Session, message: Message) -> None:
+        assert self._goals is not None
+        name = protocol.resolve(message["action"], "action")
+        if session.provided_actions.pop(name, None) is None:
+            raise ProtocolError(f"this client does not provide action {name!r}")
+        with self._graph.lock:
+            del self._graph.actions[name]
+        self._goals.fail_provider(session, name, "action {action!r} was unadvertised by its provider")
+        session.report("info", f"unadvertised action {name}", message.get("id"))
+
+    def _send_action_goal(self, session: Session, message: Message) -> None:
+        assert self._goals is not None
+        name = protocol.resolve(message["action"], "action")
+        goal = self._goals.new(session, message, name)
+        args = message.get("args")
+        args = {} if args is None else args
+        with self._graph.lock:
+            action = self._graph.actions.get(name)
+        if self._goals.sent(session, goal.caller_id) is not None:
+            self._goals.fail(goal, f"a goal with id {goal.caller_id!r} is already running; give each goal its own id")
+        elif action is None:
+            self._goals.fail(goal, f"action {name!r} does not exist")
+        elif action.provider is not None:
+            self._goals.to_provider(goal, action.provider, action.spelling, action.type, args)
+        elif not isinstance(args, dict):
+            self._goals.fail(goal, f"action {name!r} takes its goal as an object of named fields, not an array")
+        else:
+            assert action.handler is not None
+            self._goals.to_handler(goal, action.handler, args)
+
+    def _refuse_goal(self, session: Session, message: Message, reason: str) -> None:
+        """Answer a ``send_action_goal`` that could not be read with a failed ``action_result``."""
+        spelling = message.get("action")
+        spelling = spelling if isinstance(spelling, str) else ""
+        values = protocol.dumps(reason)
+        session.reply(protocol.action_result(spelling, False, GoalStatus.UNKNOWN, values, message.get("id")))
+
+    def _cancel_action_goal(self, session: Session, message: Message) -> None:
+        assert self._goals is not None
+        message_id = message.get("id")
+        if message_id is None:
+            raise ProtocolError("missing field 'id': the id of the goal to cancel")
+        goal = self._goals.sent(session, message_id)
+        if goal is None:
+            text = f"cancel_action_goal: no goal with id {message_id!r} of this client is in progress"
+            session.report("warning", text, message_id)
+            return
+        self._goals.cancel(goal)
+
+    def _provided_goal(self, session: Session, message: Message) -> Goal:
+        assert self._goals is not None
+        goal = self._goals.provided(session, message.get("id"))
+        if goal is None:
+            raise ProtocolError(f"no goal with id {message.get('id')!r} is waiting for this client")
+        return goal
+
+    def _action_feedback(self, session: Session, message: Message) -> None:
+        assert self._goals is not None
+        self._goals.provider_feedback(self._provided_goal(session, message), message.get("values") or {})
+
+    def _action_result(self, session: Session, message: Message) -> None:
+        assert self._goals is not None
+        goal = self._provided_goal(session, message)
+        self._goals.provider_result(goal, message["result"], message["status"], message.get("values"))
 
     def _auth(self, session: Session, message: Message) -> None:
         given = message.get("mac") or message.get("token")

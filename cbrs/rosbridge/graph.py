@@ -1,4 +1,4 @@
-"""The topics and services the bridge knows: who publishes, subscribes and provides what.
+"""The topics, services and actions the bridge knows: who publishes, subscribes and provides what.
 
 Server-side entries are added from any thread, client-side ones on the bridge's loop; one lock guards
 the tables so that rosapi, ``Bridge.publish`` and registration all see a consistent view.
@@ -11,6 +11,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+from cbrs.rosbridge.goals import ActionHandler
 from cbrs.rosbridge.session import Session
 
 Handler = Callable[[dict[str, Any]], dict[str, Any]]
@@ -44,13 +45,25 @@ class Service:
     provider: Session | None = None
 
 
+@dataclass(eq=False)
+class Action:
+    """An action, run by a handler on the server or by the client that advertised it."""
+
+    name: str
+    type: str
+    handler: ActionHandler | None = None
+    provider: Session | None = None
+    spelling: str = ""  # the name as its provider wrote it (goals go to it under that name)
+
+
 class Graph:
-    """Topics and services by global name."""
+    """Topics, services and actions by global name."""
 
     def __init__(self) -> None:
         self.lock = threading.RLock()
         self.topics: dict[str, Topic] = {}
         self.services: dict[str, Service] = {}
+        self.actions: dict[str, Action] = {}
 
     def topic_list(self) -> list[tuple[str, str]]:
         """(name, type) of every topic, sorted by name."""
@@ -61,6 +74,11 @@ class Graph:
         """(name, type) of every service, sorted by name."""
         with self.lock:
             return sorted((service.name, service.type) for service in self.services.values())
+
+    def action_list(self) -> list[tuple[str, str]]:
+        """(name, type) of every action, sorted by name."""
+        with self.lock:
+            return sorted((action.name, action.type) for action in self.actions.values())
 
     def prune(self, name: str) -> None:
         """Forget a topic nobody publishes or subscribes to any more (as ROS forgets it)."""

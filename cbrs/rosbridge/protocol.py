@@ -63,6 +63,19 @@ OPS: dict[str, tuple[Field, ...]] = {
     "service_response": (_req("service", str), _opt("values", dict, str), _req("result", bool)),
     "advertise_service": (_req("service", str), _req("type", str)),
     "unadvertise_service": (_req("service", str),),
+    "advertise_action": (_req("action", str), _req("type", str)),
+    "unadvertise_action": (_req("action", str),),
+    "send_action_goal": (
+        _req("action", str),
+        _req("action_type", str),
+        _opt("args", dict, list),
+        _opt("feedback", bool),
+        _opt("fragment_size", int),
+        _opt("compression", str),
+    ),
+    "cancel_action_goal": (_req("action", str),),
+    "action_feedback": (_req("action", str), _opt("values", dict)),
+    "action_result": (_req("action", str), _opt("values", dict), _req("status", int), _req("result", bool)),
     "set_level": (_req("level", str),),
     # rosbridge's auth op carries a rosauth MAC; cbrs reads its update token from ``mac`` (or ``token``)
     "auth": (_opt("mac", str), _opt("token", str)),
@@ -72,12 +85,6 @@ OPS: dict[str, tuple[Field, ...]] = {
 UNSUPPORTED = {
     "fragment": "fragmented messages are not supported; send the whole message (see max_message_bytes)",
     "png": "PNG-compressed messages are not supported; send JSON text",
-    "advertise_action": "actions are not supported; use a service and a feedback topic",
-    "unadvertise_action": "actions are not supported",
-    "send_action_goal": "actions are not supported; use a service and a feedback topic",
-    "cancel_action_goal": "actions are not supported",
-    "action_feedback": "actions are not supported",
-    "action_result": "actions are not supported",
 }
 
 _TYPE_NAMES = {
@@ -201,3 +208,27 @@ def service_response(service: str, result: bool, values_json: str, message_id: M
 def call_service(service: str, args: Any, message_id: str) -> str:
     """A ``call_service`` forwarded to the client that provides ``service``."""
     return dumps({"op": "call_service", "id": message_id, "service": service, "args": args})
+
+
+def action_result(action: str, result: bool, status: int, values_json: str, message_id: MessageId | None) -> str:
+    """An ``action_result`` from already encoded ``values`` (an object, or the reason on failure)."""
+    tail = "" if message_id is None else f',"id":{dumps(message_id)}'
+    head = f'{{"op":"action_result","action":{dumps(action)},"values":{values_json}'
+    return f'{head},"status":{status},"result":{"true" if result else "false"}{tail}}}'
+
+
+def action_feedback(action: str, values_json: str, message_id: MessageId | None) -> str:
+    """An ``action_feedback`` from already encoded ``values``."""
+    tail = "" if message_id is None else f',"id":{dumps(message_id)}'
+    return f'{{"op":"action_feedback","action":{dumps(action)},"values":{values_json}{tail}}}'
+
+
+def send_action_goal(action: str, action_type: str, args: Any, message_id: str) -> str:
+    """A ``send_action_goal`` forwarded to the client that provides ``action`` (always with feedback)."""
+    message = {"op": "send_action_goal", "id": message_id, "action": action, "action_type": action_type}
+    return dumps({**message, "args": args, "feedback": True})
+
+
+def cancel_action_goal(action: str, message_id: str) -> str:
+    """A ``cancel_action_goal`` forwarded to the client that provides ``action``."""
+    return dumps({"op": "cancel_action_goal", "id": message_id, "action": action})

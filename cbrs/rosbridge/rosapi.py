@@ -134,7 +134,7 @@ def services(graph: Graph, params: ParamStore) -> dict[str, tuple[str, Handler]]
         return {"typedefs": []}  # JSON messages: no ROS message definitions to describe
 
     def action_servers(_: dict[str, Any]) -> dict[str, Any]:
-        return {"action_servers": []}
+        return {"action_servers": [name for name, _ in graph.action_list()]}
 
     return {
         "/rosapi/node_details": ("rosapi/NodeDetails", node_details),

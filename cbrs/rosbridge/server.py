@@ -66,7 +66,7 @@ async def _serve(
     host: str,
     port: int,
     ready: Callable[[int], None] | None,
-    detached: Callable[[WorkerPool], None] | None,
+    detached: Callable[[list[WorkerPool]], None] | None,
     origins: Sequence[str | None] | None = None,
 ) -> None:
     loop = asyncio.get_running_loop()
@@ -131,9 +131,9 @@ async def _serve(
                 ready(bound)
             await asyncio.Future()  # until cancelled
     finally:
-        workers = await bridge.detach()
+        pools = await bridge.detach()
         if detached is not None:
-            detached(workers)
+            detached(pools)
         log.info("rosbridge on %s:%d stopped", host, bound)
 
 
@@ -151,7 +151,7 @@ class RunningBridge:
         return f"ws://{self.host}:{self.port}"
 
     def stop(self, timeout: float = 5.0) -> bool:
-        """Close every connection, stop the loop and join its thread and the service workers.
+        """Close every connection, stop the loop and join its thread and the service and action workers.
 
         Returns False if something was still running after ``timeout`` seconds (then logged).
         """
@@ -165,8 +165,8 @@ class RunningBridge:
         if self._thread.is_alive():
             log.warning("rosbridge thread still running after %.1f s", timeout)
             return False
-        workers: WorkerPool | None = self._state.get("workers")
-        return workers is None or workers.join(max(0.0, deadline - time.monotonic())) == 0
+        pools: list[WorkerPool] = self._state.get("workers", [])
+        return sum(pool.join(max(0.0, deadline - time.monotonic())) for pool in pools) == 0
 
     def __enter__(self) -> RunningBridge:
         return self
@@ -191,8 +191,8 @@ def start(
         state["port"] = bound
         ready.set()
 
-    def on_detached(workers: WorkerPool) -> None:
-        state["workers"] = workers
+    def on_detached(pools: list[WorkerPool]) -> None:
+        state["workers"] = pools
 
     def main() -> None:
         loop = asyncio.new_event_loop()

@@ -68,9 +68,10 @@ class Session:
         self.level = "error"
         self.closed = False
         #: topics this client advertised (global name -> the name as the client wrote it), likewise
-        #: services it provides, and the spelling it subscribed with (messages go out under that name)
+        #: services and actions it provides, and the spelling it subscribed with (messages go out under that name)
         self.advertised: dict[str, str] = {}
         self.provided: dict[str, str] = {}
+        self.provided_actions: dict[str, str] = {}
         self.spelling: dict[str, str] = {}
         self.queues: dict[str, TopicQueue] = {}
         self._send = send
