@@ -143,7 +143,7 @@ def load(app: App, files: tuple[Path, ...], graph: str | None, catalogs: tuple[P
     report = app.kb.load(list(files), graph, catalogue)
     for item in report.files:
         what = _loaded_what(item)
-        click.echo(f"loaded {item.source}: {what}{len(item.quads)} triples into {shorten(item.graph)}{_mended(item)}")
+        click.echo(f"loaded {item.source}: {what}{item.triples} triples into {shorten(item.graph)}{_mended(item)}")
     for line in _load_summary(report):
         click.echo(line)
 
@@ -178,7 +178,7 @@ def _load_summary(report: LoadReport) -> list[str]:
     lines = []
     owls = [item for item in report.files if item.owls is not None]
     if report.catalogue is not None:
-        triples = sum(len(item.quads) for item in report.imports)
+        triples = sum(item.triples for item in report.imports)
         count = len(report.imports)
         lines.append(
             f"imported {count} {'ontology' if count == 1 else 'ontologies'} ({triples} triples) "

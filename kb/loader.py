@@ -10,6 +10,13 @@ the same transaction.
 Blank nodes are skolemised (RDF 1.1, section 3.5) to IRIs under ``GENID`` that are derived from
 the canonical form of the file (RDFC-1.0): loading the same file twice adds nothing the second
 time, and every stored node can be named in an update.
+
+A large plain data file (``BULK_BYTES`` or more of N-Triples or Turtle, loaded alone, without a
+catalogue, into a graph that holds nothing yet) takes a faster way that keeps the same promise: a
+first pass parses all of it and checks that it needs none of the processing above (no blank nodes, no
+OWL-S, no service descriptions); only then does Oxigraph's bulk loader write it, straight into the
+store's files without a transaction log. That writer is not one transaction, so if it fails (a full
+disk) the graph, empty before, is dropped again. A file that needs more takes the full path.
 """
 
 from __future__ import annotations
@@ -31,9 +38,9 @@ import pyoxigraph as ox
 from cbrs.kb.catalog import Catalogue, Unresolved, is_built_in, ontology_iri
 from cbrs.kb.errors import PartCycleError, RdfParseError, UnknownFormatError, UnknownGraphError
 from cbrs.kb.namespaces import CBRS, DUL, GENID, OWL, RDF, RDFS, GraphName
-from cbrs.kb.owls import Conversion, Role, Vocabulary, convert, is_owls, referenced_ontologies
+from cbrs.kb.owls import Conversion, Role, Vocabulary, convert, is_owls, owls_key, referenced_ontologies
 from cbrs.kb.shapes import check_loaded
-from cbrs.kb.store import Store
+from cbrs.kb.store import EmbeddedStore, Store
 from cbrs.kb.xml_limits import check_entities
 
 FORMATS_BY_EXTENSION: dict[str, ox.RdfFormat] = {
@@ -63,6 +70,12 @@ _POSITION_PREFIX = re.compile(
 )
 _NCNAME = re.compile(r"^[A-Za-z_\u00c0-\uffff][\w.\-\u00b7\u00c0-\uffff]*$")
 
+BULK_BYTES = 16 * 1024 * 1024
+"""The size from which a lone N-Triples or Turtle file is written by Oxigraph's bulk loader (see the
+module's docstring): below it the full path costs little, above it a transaction holds every quad in
+memory and writes them twice (log and tables)."""
+_BULK_FORMATS = (ox.RdfFormat.N_TRIPLES, ox.RdfFormat.TURTLE)
+
 
 @dataclass(frozen=True)
 class ParsedFile:
@@ -78,6 +91,12 @@ class ParsedFile:
     owls: Conversion | None = None
     ontology: str | None = None
     repairs: tuple[str, ...] = ()
+    bulk: int | None = None  # a bulk-loaded file's triple count; its quads are not kept in memory
+
+    @property
+    def triples(self) -> int:
+        """How many triples (quads) the file gave."""
+        return len(self.quads) if self.bulk is None else self.bulk
 
 
 @dataclass(frozen=True)
@@ -109,7 +128,7 @@ class LoadReport:
 
     @property
     def quads(self) -> int:
-        return sum(len(item.quads) for item in (*self.files, *self.imports))
+        return sum(item.triples for item in (*self.files, *self.imports))
 
 
 @dataclass
@@ -161,10 +180,12 @@ def load_files(
     and the requirement role when ``graph`` is ``requirements``, else the services graph (or
     ``graph``) and the advertisement role.
     """
-    raws = [
-        _read(path, graph, base_iri=catalogue.iri_for(path) if catalogue is not None else None)
-        for path in expand_paths(paths)
-    ]
+    files = expand_paths(paths)
+    if len(files) == 1 and catalogue is None and isinstance(store, EmbeddedStore):
+        bulk = _bulk_load(store, files[0], graph)
+        if bulk is not None:
+            return bulk
+    raws = [_read(path, graph, base_iri=catalogue.iri_for(path) if catalogue is not None else None) for path in files]
     report = LoadReport(catalogue=catalogue)
     imported: list[_Raw] = []
     if catalogue is not None:
@@ -200,6 +221,64 @@ def load_files(
     check_loaded(store, report)  # descriptions against the SHACL shapes, and their terms (kb/shapes.py)
     store.add(quad for item in (*report.files, *report.imports) for quad in item.quads)
     return report
+
+
+@dataclass
+class _Scan:
+    """What the first pass over a bulk candidate found: its size and what decides its graph."""
+
+    triples: int = 0
+    types: set[str] = field(default_factory=set)
+    part_shape: list[ox.Quad] = field(default_factory=list)  # what the part-cycle check reads
+
+
+def _bulk_load(store: EmbeddedStore, path: Path, graph: str | GraphName | None) -> LoadReport | None:
+    """Load one large plain file with Oxigraph's bulk loader, all or nothing; ``None`` when the file
+    must take the full path (too small, another format, something to convert, or a graph in use)."""
+    rdf_format = FORMATS_BY_EXTENSION.get(path.suffix.lower())
+    if rdf_format not in _BULK_FORMATS:
+        return None
+    try:
+        if path.stat().st_size < BULK_BYTES:
+            return None
+    except OSError:
+        return None  # the full path reports it
+    source = str(path)
+    base = _base_for(source, None)
+    scan = _scan(path, rdf_format, base)
+    if scan is None:
+        return None
+    target = resolve_graph(graph) if graph is not None else _graph_for_types(scan.types)
+    if next(iter(store.quads(graph=target)), None) is not None:
+        return None  # a failed bulk write could not be undone without undoing what was there
+    _check_part_cycles(store, [_Raw(source, target, scan.part_shape, False, {}, ())])
+    store.bulk_load(path, rdf_format, target, base)
+    return LoadReport(files=[ParsedFile(source, target.value, [], bulk=scan.triples)])
+
+
+def _scan(path: Path, rdf_format: ox.RdfFormat, base: str) -> _Scan | None:
+    """Parse the whole file once, keeping nothing but what decides its graph; ``None`` when it has
+    anything the full path must handle (blank nodes, quoted triples, OWL-S, service descriptions) or
+    does not parse as it is (the full path then names the error, or mends the encoding)."""
+    found = _Scan()
+    rdf_type, has_model = RDF + "type", CBRS + "hasOWLSModel"
+    try:
+        for quad in ox.parse(path=str(path), format=rdf_format, base_iri=base):
+            found.triples += 1
+            subject, predicate, obj = quad.subject, quad.predicate.value, quad.object
+            if not isinstance(subject, ox.NamedNode) or isinstance(obj, ox.BlankNode | ox.Triple):
+                return None
+            if predicate == rdf_type and isinstance(obj, ox.NamedNode):
+                found.types.add(obj.value)
+            elif predicate in _PART_SHAPE:
+                found.part_shape.append(quad)
+            elif predicate == has_model:
+                return None
+    except (SyntaxError, ValueError, OSError):
+        return None
+    if any(owls_key(kind) in ("Service:Service", "Profile:Profile") for kind in found.types):
+        return None
+    return found
 
 
 def _check_whole(conversion: Conversion, source: str) -> None:
@@ -760,7 +839,12 @@ def _xml_error(data: bytes) -> tuple[str, int, int] | None:
 def _graph_for(quads: list[ox.Quad]) -> ox.NamedNode:
     """The graph for a file's triples when none is given: declarations go to the ontology graph,
     requirements to the requirements graph, everything else to the services graph."""
-    types = {q.object.value for q in quads if q.predicate.value == RDF + "type" and isinstance(q.object, ox.NamedNode)}
+    return _graph_for_types(
+        {q.object.value for q in quads if q.predicate.value == RDF + "type" and isinstance(q.object, ox.NamedNode)}
+    )
+
+
+def _graph_for_types(types: set[str]) -> ox.NamedNode:
     if types & _DECLARATION_TYPES:
         return GraphName.ONTOLOGY.node
     if CBRS + "Requirement" in types and CBRS + "Advertisement" not in types:

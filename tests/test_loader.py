@@ -159,3 +159,119 @@ def test_a_store_emptied_by_an_update_is_seeded_again_on_open(tmp_path: Path) ->
     kb.store.close()
     again = KnowledgeBase.open(tmp_path / "store")
     assert again.store.is_seeded() and again.store.count() > 1000
+
+
+# -- the bulk path for large plain files (kb.loader.BULK_BYTES) -----------------------------------------
+
+BULK_DATA = "".join(
+    f"<http://example.org/bulk#e{i}> <http://example.org/bulk#next> <http://example.org/bulk#e{i + 1}> .\n"
+    for i in range(200)
+)
+BULK_GRAPH = "http://example.org/bulk-graph"
+
+
+@pytest.fixture
+def bulk_sized(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Every file counts as large, so that small test files take the bulk path."""
+    monkeypatch.setattr("cbrs.kb.loader.BULK_BYTES", 1)
+
+
+@pytest.fixture
+def disk_kb(tmp_path: Path) -> KnowledgeBase:
+    return KnowledgeBase.open(tmp_path / "store")
+
+
+def _spy_bulk(monkeypatch: pytest.MonkeyPatch) -> list[str]:
+    from cbrs.kb.store import EmbeddedStore
+
+    calls: list[str] = []
+    original = EmbeddedStore.bulk_load
+
+    def spy(self: EmbeddedStore, path: Path, *args: object) -> None:
+        calls.append(str(path))
+        original(self, path, *args)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(EmbeddedStore, "bulk_load", spy)
+    return calls
+
+
+@pytest.mark.usefixtures("bulk_sized")
+def test_a_large_plain_file_is_bulk_loaded_into_its_graph(
+    tmp_path: Path, disk_kb: KnowledgeBase, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    calls = _spy_bulk(monkeypatch)
+    path = tmp_path / "big.nt"
+    path.write_text(BULK_DATA, encoding="utf-8")
+    report = disk_kb.load([path], BULK_GRAPH)
+    assert calls == [str(path)]
+    assert [(item.graph, item.triples) for item in report] == [(BULK_GRAPH, 200)]
+    assert report.quads == 200
+    assert disk_kb.store.count(ox.NamedNode(BULK_GRAPH)) == 200
+
+
+@pytest.mark.usefixtures("bulk_sized")
+def test_a_large_file_that_fails_to_parse_loads_nothing_and_names_the_line(
+    tmp_path: Path, disk_kb: KnowledgeBase
+) -> None:
+    before = disk_kb.store.dump()
+    path = tmp_path / "big.nt"
+    path.write_text(BULK_DATA + "<http://example.org/bulk#broken> <oops .\n", encoding="utf-8")
+    with pytest.raises(RdfParseError) as raised:
+        disk_kb.load([path], BULK_GRAPH)
+    assert raised.value.line == 201
+    assert disk_kb.store.dump() == before
+
+
+@pytest.mark.usefixtures("bulk_sized")
+def test_a_large_file_with_blank_nodes_takes_the_full_path(
+    tmp_path: Path, disk_kb: KnowledgeBase, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    calls = _spy_bulk(monkeypatch)
+    path = tmp_path / "big.ttl"
+    path.write_text(SAMPLE, encoding="utf-8")
+    disk_kb.load([path], BULK_GRAPH)
+    assert calls == []
+    subjects = {q.subject.value for q in disk_kb.store.quads(graph=ox.NamedNode(BULK_GRAPH))}
+    assert any(s.startswith(GENID) for s in subjects)  # skolemised, as always
+
+
+@pytest.mark.usefixtures("bulk_sized")
+def test_a_large_file_into_a_graph_in_use_takes_the_full_path(
+    tmp_path: Path, disk_kb: KnowledgeBase, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    calls = _spy_bulk(monkeypatch)
+    first, second = tmp_path / "a.nt", tmp_path / "b.nt"
+    first.write_text(BULK_DATA[: BULK_DATA.index("\n") + 1], encoding="utf-8")
+    second.write_text(BULK_DATA, encoding="utf-8")
+    disk_kb.load([first], BULK_GRAPH)  # one file, bulk (the graph was empty)
+    disk_kb.load([second], BULK_GRAPH)  # the graph holds a triple now: one transaction instead
+    assert calls == [str(first)]
+    assert disk_kb.store.count(ox.NamedNode(BULK_GRAPH)) == 200
+
+
+@pytest.mark.usefixtures("bulk_sized")
+def test_a_bulk_write_that_fails_leaves_the_store_as_it_was(
+    tmp_path: Path, disk_kb: KnowledgeBase, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from cbrs.kb.errors import StoreError
+
+    before = disk_kb.store.dump()
+    backend = disk_kb.store._backend  # type: ignore[attr-defined]
+
+    class HalfWritten:
+        """Oxigraph's bulk loader that writes part of the file and then meets a full disk."""
+
+        def __getattr__(self, name: str) -> object:
+            return getattr(backend, name)
+
+        def bulk_load(self, path: str, format: ox.RdfFormat, base_iri: str, to_graph: ox.NamedNode) -> None:
+            quads = list(ox.parse(path=path, format=format, base_iri=base_iri))[:50]
+            backend.bulk_extend(ox.Quad(q.subject, q.predicate, q.object, to_graph) for q in quads)
+            raise OSError("No space left on device")
+
+    monkeypatch.setattr(disk_kb.store, "_open", HalfWritten())
+    path = tmp_path / "big.nt"
+    path.write_text(BULK_DATA, encoding="utf-8")
+    with pytest.raises(StoreError, match=r"No space left on device.*undone"):
+        disk_kb.load([path], BULK_GRAPH)
+    assert disk_kb.store.dump() == before
