@@ -1,7 +1,9 @@
 """roslibjs (the npm package ``roslib``), unchanged, against the cbrs rosbridge server.
 
-tests/js/roundtrip.mjs does the round trips in node and prints what it saw as JSON. Install its
-dependencies once with ``npm ci --prefix tests/js``; without node or them, the test is skipped.
+tests/js/roundtrip.mjs does the round trips in node and prints what it saw as JSON; tests/js/actions.mjs
+does the same with ROS 2 actions, and tests/js/run_task_action.mjs runs a task of ``cbrs serve`` as an
+action. Install their dependencies once with ``npm ci --prefix tests/js``; without node or them, the
+tests are skipped.
 """
 
 from __future__ import annotations
@@ -10,6 +12,7 @@ import json
 import shutil
 import subprocess
 import threading
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -17,15 +20,27 @@ import pytest
 
 from cbrs.rosbridge import Bridge, ServiceError
 from tests.helpers_threads import assert_threads_end
+from tests.test_rosbridge_actions import TOKEN, count
 
 JS = Path(__file__).parent / "js"
 NODE = shutil.which("node")
+pytestmark = [
+    pytest.mark.skipif(NODE is None, reason="node is not installed (roslibjs runs on node >= 20)"),
+    pytest.mark.skipif(
+        not (JS / "node_modules" / "roslib").is_dir(), reason="roslibjs is not installed: run npm ci --prefix tests/js"
+    ),
+]
 
 
-@pytest.mark.skipif(NODE is None, reason="node is not installed (roslibjs runs on node >= 20)")
-@pytest.mark.skipif(
-    not (JS / "node_modules" / "roslib").is_dir(), reason="roslibjs is not installed: run npm ci --prefix tests/js"
-)
+def node(script: str, *args: object, timeout: float = 60) -> dict[str, Any]:
+    """Run a node script of tests/js; the one line of JSON it prints last."""
+    assert NODE is not None
+    child = subprocess.run([NODE, str(JS / script), *map(str, args)], capture_output=True, text=True, timeout=timeout)
+    assert child.returncode == 0, child.stderr
+    found: dict[str, Any] = json.loads(child.stdout.strip().splitlines()[-1])
+    return found
+
+
 def test_roslibjs_round_trips() -> None:
     def refuse(args: dict[str, Any]) -> dict[str, Any]:
         raise ServiceError("the robot is busy")
@@ -36,12 +51,8 @@ def test_roslibjs_round_trips() -> None:
     bridge.add_topic("/test/events", "test/Event")
     threads = threading.active_count()
     with bridge.start(port=0) as running:
-        assert NODE is not None
-        child = subprocess.run(
-            [NODE, str(JS / "roundtrip.mjs"), str(running.port)], capture_output=True, text=True, timeout=60
-        )
-    assert child.returncode == 0, child.stderr
-    assert json.loads(child.stdout.strip().splitlines()[-1]) == {
+        found = node("roundtrip.mjs", running.port)
+    assert found == {
         "connected": True,
         "subscribed": True,
         "heard": ["one", "two", "three"],
@@ -59,3 +70,53 @@ def test_roslibjs_round_trips() -> None:
     }
     assert bridge.topics() == [("/test/events", "test/Event")]
     assert_threads_end(threads, 5.0)
+
+
+def test_roslibjs_sends_provides_and_cancels_action_goals() -> None:
+    bridge = Bridge(call_timeout=5.0)
+    bridge.add_action("/test/count", "test/action/Count", count)
+    threads = threading.active_count()
+    with bridge.start(port=0) as running:
+        found = node("actions.mjs", running.port)
+    assert found == {
+        "count": {"feedback": [0, 1, 2], "result": {"reached": 3, "authorised": False}},
+        # roslibjs's failed callback: GoalError with the status's words and the values
+        "unknown": {
+            "feedback": [],
+            "failed": "GoalError: Action status unknown: action '/no/such/action' does not exist",
+        },
+        "listed": True,
+        "fibonacci": {"feedback": [3, 4, 5], "result": {"sequence": [0, 1, 1, 2, 3]}},
+        "failed": {"feedback": [], "failed": "GoalError: Action was aborted: {}"},
+        "cancelled": {"failed": 'GoalError: Action was canceled: {"sequence":[]}'},
+    }
+    assert bridge.actions() == [("/test/count", "test/action/Count")]  # the provider's went with it
+    assert_threads_end(threads, 5.0)
+
+
+@pytest.fixture
+def served(fresh_bundled_kb: Any) -> Iterator[int]:
+    pytest.importorskip("pybullet", reason="a task run needs the [sim] extra")
+    from cbrs.server import ServeConfig, Server
+    from cbrs.sparql_service import EndpointConfig
+
+    server = Server(fresh_bundled_kb, ServeConfig(port=0, bridge_port=0, endpoint=EndpointConfig(update_token=TOKEN)))
+    server.start()
+    yield server.bridge_port
+    server.stop(timeout=10.0)
+
+
+def test_roslibjs_runs_a_task_as_an_action_with_feedback_per_step(served: int) -> None:
+    found = node("run_task_action.mjs", served, TOKEN, timeout=180)
+    anonymous = found["anonymous"]
+    assert anonymous["feedback"] == [] and anonymous["failed"].startswith(
+        "GoalError: Action status unknown: a task run"
+    )
+    run = found["run"]["result"]
+    assert run["status"] == "succeeded"
+    steps = run["result"]["plan"]["steps"]
+    feedback = found["run"]["feedback"]
+    assert [(f["step"], f["component"], f["action"], f["status"]) for f in feedback] == [
+        (s["index"], s["component"], s["action"], "succeeded") for s in steps
+    ]
+    assert all(f["run"] == run["id"] for f in feedback)
