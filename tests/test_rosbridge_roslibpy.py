@@ -1,4 +1,4 @@
-"""roslibpy, unchanged, against the cbrs rosbridge server.
+"""roslibpy, unchanged, against the cbrs rosbridge server (topics, services, parameters, ROS 2 actions).
 
 roslibpy's transports run on a process-wide event loop (Twisted's reactor cannot be restarted, and
 Autobahn binds one async framework per process), so the client runs in a child process: this file,
@@ -88,6 +88,8 @@ def run_client(port: int, transport: str) -> dict[str, Any]:
     results["deleted"] = b.get_param("/test/gain")
     results["time"] = a.get_time().secs > 0
 
+    results["actions"] = run_actions(roslibpy, b)
+
     listener.unsubscribe()
     talker.unadvertise()
     provider.unadvertise()
@@ -96,9 +98,36 @@ def run_client(port: int, transport: str) -> dict[str, Any]:
     return results
 
 
+def run_actions(roslibpy: Any, ros: Any) -> dict[str, Any]:
+    """roslibpy's ROS 2 ActionClient: a goal with feedback, an unknown action, a cancelled goal."""
+    found: dict[str, Any] = {}
+
+    def send(action: Any, goal: dict[str, Any], cancel_after: int | None = None) -> dict[str, Any]:
+        seen: dict[str, Any] = {"feedback": []}
+
+        def ended(key: str) -> Callable[[dict[str, Any]], None]:
+            return lambda outcome: seen.update({key: outcome["status"].name, "values": outcome["values"]})
+
+        def feedback(values: dict[str, Any]) -> None:
+            seen["feedback"].append(values["n"])
+
+        goal_id = action.send_goal(roslibpy.Goal(goal), ended("result"), feedback, ended("error"))
+        if cancel_after is not None and _until(lambda: len(seen["feedback"]) >= cancel_after):
+            action.cancel_goal(goal_id)
+        action.wait_goal(goal_id, timeout=WAIT)
+        return seen
+
+    count = roslibpy.ActionClient(ros, "/test/count", "test/action/Count")
+    found["count"] = send(count, {"to": 3})
+    found["unknown"] = send(roslibpy.ActionClient(ros, "/no/such/action", "x/Y"), {})
+    found["cancelled"] = send(count, {"to": 5, "hold": 1}, cancel_after=1)
+    return found
+
+
 @pytest.mark.parametrize("transport", ["twisted", "asyncio"])
 def test_roslibpy_round_trips(transport: str) -> None:
     from cbrs.rosbridge import Bridge, ServiceError
+    from tests.test_rosbridge_actions import count
 
     def refuse(args: dict[str, Any]) -> dict[str, Any]:
         raise ServiceError("the robot is busy")
@@ -107,6 +136,7 @@ def test_roslibpy_round_trips(transport: str) -> None:
     bridge.add_service("/test/add", "test/Add", lambda args: {"sum": args["a"] + args["b"]})
     bridge.add_service("/test/refuse", "test/Refuse", refuse)
     bridge.add_topic("/test/events", "test/Event")
+    bridge.add_action("/test/count", "test/action/Count", count)
     threads = threading.active_count()
     with bridge.start(port=0) as running:
         child = subprocess.run(
@@ -129,6 +159,11 @@ def test_roslibpy_round_trips(transport: str) -> None:
         "params": ["/robot/speed", "/test/gain/k", "/test/gain/on"],
         "deleted": None,
         "time": True,
+        "actions": {
+            "count": {"feedback": [0, 1, 2], "result": "SUCCEEDED", "values": {"reached": 3, "authorised": False}},
+            "unknown": {"feedback": [], "error": "UNKNOWN", "values": "action '/no/such/action' does not exist"},
+            "cancelled": {"feedback": [0], "result": "CANCELED", "values": {"reached": 1}},
+        },
     }
     assert bridge.topics() == [("/test/events", "test/Event")]  # the clients' topics went with them
     assert _until(lambda: threading.active_count() == threads)
