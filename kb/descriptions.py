@@ -222,7 +222,8 @@ class DescriptionReader:
             role = _value(row["role"])
             missing = [part for part in ("subject", "predicate", "object") if part not in row]
             if missing:
-                problem = f"{role} {_iri(row['condition'])} lacks rdf:{', rdf:'.join(missing)}"
+                names = ", ".join(f"cbrs:condition{part.title()}" for part in missing)
+                problem = f"{role} {_iri(row['condition'])} lacks {names}"
                 raise InvalidDescriptionError(iri, [problem])
             found[role].append(Statement(_iri(row["subject"]), _iri(row["predicate"]), _iri(row["object"])))
         return {role: tuple(items) for role, items in found.items()}

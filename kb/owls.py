@@ -30,6 +30,7 @@ from urllib.parse import urljoin
 import pyoxigraph as ox
 
 from cbrs.kb.catalog import is_built_in, namespace_document
+from cbrs.kb.conditions import CONDITION_PARTS
 from cbrs.kb.errors import RdfParseError
 from cbrs.kb.namespaces import OWL, RDF, RDFS
 from cbrs.kb.vocab import CBRS
@@ -523,8 +524,8 @@ class _Builder:
                 statements[key] = node
                 self.add(model, link, node)
                 self.add(node, RDF + "type", ox.NamedNode(kind))
-                for part, value in zip(("subject", "predicate", "object"), triple, strict=True):
-                    self.add(node, RDF + part, ox.NamedNode(value))
+                for part, value in zip(CONDITION_PARTS, triple, strict=True):
+                    self.add(node, part, ox.NamedNode(value))
                 terms.extend(t for t in triple if t != RDF + "type")
             if text:
                 self.add(node, CBRS.conditionText, ox.Literal(text))

@@ -7,9 +7,10 @@ from collections.abc import Iterable
 
 import pyoxigraph as ox
 
+from cbrs.kb.conditions import CONDITION_PARTS, LEGACY_PARTS
 from cbrs.kb.errors import AlreadyRegisteredError, InvalidDescriptionError, NotFoundError
 from cbrs.kb.loader import parse_bytes
-from cbrs.kb.namespaces import BASE, GENID, RDF, GraphName
+from cbrs.kb.namespaces import BASE, GENID, RDF, GraphName, shorten
 from cbrs.kb.shapes import check_descriptions
 from cbrs.kb.store import Store
 from cbrs.kb.vocab import CBRS
@@ -17,7 +18,7 @@ from cbrs.kb.vocab import CBRS
 
 class ComponentRegistry:
     """Advertisements in the services graph. A description is the advertisement's own triples
-    plus those of the nodes hanging off it (its OWLS, SEA and QoS models, parameters, statements)."""
+    plus those of the nodes hanging off it (its OWLS, SEA and QoS models, parameters, conditions)."""
 
     def __init__(self, store: Store) -> None:
         self._store = store
@@ -134,7 +135,13 @@ def _problems(iri: str, quads: list[ox.Quad]) -> list[str]:
     for prop in (CBRS.hasPrecondition, CBRS.hasEffect):
         for condition in model.get(prop, []):
             fields = by_subject.get(condition, {})
-            missing = [p for p in ("subject", "predicate", "object") if not fields.get(RDF + p)]
-            if missing:
-                problems.append(f"statement {condition} lacks rdf:{', rdf:'.join(missing)}")
+            legacy = [shorten(p) for p in LEGACY_PARTS if fields.get(p)]
+            missing = [shorten(p) for p in CONDITION_PARTS if not fields.get(p)]
+            if legacy:
+                problems.append(
+                    f"condition {condition} uses {', '.join(legacy)}, the reified form of core 0.1.0 "
+                    "(outside OWL 2 DL): write cbrs:conditionSubject, cbrs:conditionPredicate and cbrs:conditionObject"
+                )
+            elif missing:
+                problems.append(f"condition {condition} lacks {', '.join(missing)}")
     return problems

@@ -5,7 +5,7 @@ Two checks, each naming the description, the node, the property and the value at
 - the shapes (pySHACL): counts, datatypes, a SEA box whose minimum exceeds its maximum, a QoS value
   that is a word rather than a number;
 - the terms: every class a description names (its types, parameter types, port data types, effective
-  areas, statement subjects and objects) and every property it uses must be declared somewhere, in the
+  areas, condition subjects and objects) and every property it uses must be declared somewhere, in the
   store or in what is being written. An undeclared term one or two typing slips from a declared term
   of its namespace is refused with a did-you-mean (``home:MarkerColor`` -> ``home:MarkerColour``); one
   with none is taken for a new concept and let through, since matchmaking compares undeclared concepts
@@ -50,11 +50,11 @@ _TERM_POSITIONS = frozenset(
         CBRS.effectiveArea,
         CBRS.realizesAction,
         CBRS.forTask,
-        RDF + "subject",
-        RDF + "object",
+        CBRS.conditionSubject,
+        CBRS.conditionObject,
     }
 )
-_PROPERTY_POSITION = RDF + "predicate"  # a statement's predicate is a property
+_PROPERTY_POSITION = CBRS.conditionPredicate  # a condition's predicate is a property
 
 
 @dataclass(frozen=True)

@@ -394,7 +394,10 @@ def _owls_model(described: Ad | Intent) -> str:
         ("cbrs:hasEffect", "cbrs:Effect", described.effects),
     ):
         for s, p, o in statements:
-            lines.append(f"        {prop} [ a {cls} ; rdf:subject {s} ; rdf:predicate {p} ; rdf:object {o} ]")
+            lines.append(
+                f"        {prop} [ a {cls} ; cbrs:conditionSubject {s} ; cbrs:conditionPredicate {p} ; "
+                f"cbrs:conditionObject {o} ]"
+            )
     return " ;\n".join(lines) + " ]"
 
 

@@ -65,9 +65,9 @@ def test_every_term_we_use_is_declared(merged: rdflib.Graph) -> None:
         used.add(p)
         if p in (RDF.type, RDFS.subClassOf, OWL.someValuesFrom, OWL.onProperty, RDFS.subPropertyOf) or str(p) in (
             CBRS + "parameterType",
-            RDF.subject,
-            RDF.predicate,
-            RDF.object,
+            CBRS + "conditionSubject",
+            CBRS + "conditionPredicate",
+            CBRS + "conditionObject",
         ):
             used.add(o)
     ours = {t for t in used if isinstance(t, rdflib.URIRef) and str(t).startswith(OURS)}

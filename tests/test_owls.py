@@ -131,7 +131,7 @@ def test_an_expression_that_makes_no_statement_is_kept_as_text(kb: KnowledgeBase
         "(robots:Charged ?Robot)",
     ]
     text_only = next(node for node, texts in preconditions.items() if texts[0].startswith("(not"))
-    assert not _objects(kb, text_only, RDF + "subject")
+    assert not _objects(kb, text_only, CBRS.conditionSubject)
     # hung off the OWLS model with rdfs:seeAlso, not cbrs:hasPrecondition, so readers see no half statement
     [model] = _objects(kb, NAVIGATE_SERVICE, CBRS.hasOWLSModel)
     assert _objects(kb, model, RDFS + "seeAlso") == [text_only]

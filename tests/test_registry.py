@@ -93,9 +93,17 @@ def test_update_or_deregister_of_unknown_is_not_found(mini_kb: KnowledgeBase) ->
         ),
         pytest.param(
             HEAD + 'ex:T a cbrs:MethodInvocationComponent ; cbrs:deviceName "d" ; cbrs:serviceName "s" ;'
-            " cbrs:hasOWLSModel [ cbrs:hasEffect [ rdf:subject ex:Door ; rdf:object ex:Opened ] ] .",
-            "lacks rdf:predicate",
-            id="incomplete-statement",
+            " cbrs:hasOWLSModel [ cbrs:hasEffect [ cbrs:conditionSubject ex:Door ;"
+            " cbrs:conditionObject ex:Opened ] ] .",
+            "lacks cbrs:conditionPredicate",
+            id="incomplete-condition",
+        ),
+        pytest.param(
+            HEAD + 'ex:T a cbrs:MethodInvocationComponent ; cbrs:deviceName "d" ; cbrs:serviceName "s" ;'
+            " cbrs:hasOWLSModel [ cbrs:hasEffect [ rdf:subject ex:Door ; rdf:predicate ex:hasStatus ;"
+            " rdf:object ex:Opened ] ] .",
+            "uses rdf:subject, rdf:predicate, rdf:object, the reified form of core 0.1.0",
+            id="reified-condition",
         ),
         pytest.param(
             HEAD + 'ex:T a cbrs:MethodInvocationComponent ; cbrs:serviceName "s" ;'

@@ -16,7 +16,7 @@ from markupsafe import Markup, escape
 
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import NotFoundError
-from cbrs.kb.namespaces import RDF, RDFS, shorten
+from cbrs.kb.namespaces import RDFS, shorten
 from cbrs.kb.vocab import CBRS
 from cbrs.web import context, resource
 from cbrs.web.pages import Page, page
@@ -28,9 +28,9 @@ MAX_PATHS = 12  # ancestor paths shown per search match
 # How a service description reaches a concept, walking incoming triples back to the description.
 _USE_LINKS = {
     CBRS.parameterType: "parameter",
-    RDF + "subject": "statement",
-    RDF + "predicate": "statement",
-    RDF + "object": "statement",
+    CBRS.conditionSubject: "condition",
+    CBRS.conditionPredicate: "condition",
+    CBRS.conditionObject: "condition",
 }
 _ROLE_LINKS = {
     CBRS.hasInput: "input",
