@@ -19,6 +19,7 @@ from cbrs.kb.registry import ComponentRegistry
 from cbrs.kb.resources import bundled_files, query_dir
 from cbrs.kb.shapes import checked_update
 from cbrs.kb.store import EmbeddedStore, QueryResult, Store, Term, is_remote
+from cbrs.kb.upgrade import UpgradeReport, new_terms, upgrade_store
 
 _VERSION_INFO = ox.NamedNode("http://www.w3.org/2002/07/owl#versionInfo")
 
@@ -62,9 +63,19 @@ class KnowledgeBase:
         kb = cls(store)
         if seed and not kb.store.is_seeded():
             kb.seed()
-        elif seed and kb._map_outdated():
-            kb.add_semantic_map()
+        elif seed:
+            kb.upgrade()
+            if kb._map_outdated():
+                kb.add_semantic_map()
         return kb
+
+    def upgrade(self) -> UpgradeReport:
+        """Bring a store seeded by an older cbrs up to the bundled ontologies (:mod:`kb.upgrade`): its
+        conditions out of the reified form, the core vocabulary and the ontology headers replaced."""
+        report = upgrade_store(self.store, self.queries)
+        if report.changed:
+            self._reader.clear_cache()
+        return report
 
     def _map_outdated(self) -> bool:
         """Whether the store's semantic map is missing or of an older version than the bundled one."""
@@ -83,20 +94,22 @@ class KnowledgeBase:
     def add_semantic_map(self) -> None:
         """Bring a store seeded before the semantic map (or its current version) existed up to date.
 
-        The bundled ontology files are added again (their new terms join; nothing is removed). Of the
-        bundled map, what the stored map does not say yet is added: a statement joins unless the stored
-        map already gives its subject a value for that property, so a thing a user moved stays moved.
+        The bundled ontology files are added again: their new terms join, nothing is removed, and a term the
+        store describes keeps its structures (:func:`kb.upgrade.new_terms`). Of the bundled map, what the
+        stored map does not say yet is added: a statement joins unless the stored map already gives its
+        subject a value for that property, so a thing a user moved stays moved.
         """
         wanted = (GraphName.ONTOLOGY, GraphName.MAP)
         parsed = [parse_file(item.path, item.graph) for item in bundled_files() if item.graph in wanted]
         known = {(quad.subject, quad.predicate) for quad in self.store.quads(graph=GraphName.MAP.node)}
-        added = [
+        ontology = [item for item in parsed if item.graph is not GraphName.MAP]
+        added = [quad for item in ontology for quad in new_terms(self.store, item.quads)]
+        added += [
             quad
             for item in parsed
+            if item.graph is GraphName.MAP
             for quad in item.quads
-            if item.graph is not GraphName.MAP
-            or (quad.subject, quad.predicate) not in known
-            or quad.predicate == _VERSION_INFO
+            if (quad.subject, quad.predicate) not in known or quad.predicate == _VERSION_INFO
         ]
         self.store.add(added)
         self._reader.clear_cache()

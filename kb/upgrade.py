@@ -1,0 +1,194 @@
+"""A store seeded by an older cbrs, brought up to the bundled ontologies when it is opened.
+
+:meth:`KnowledgeBase.open` calls :func:`upgrade_store` on every seeded store; it writes only when
+something is out of date, and then in one transaction. Three rules, each about what cbrs owns:
+
+- conditions: in every graph, a condition written in the reified form of core 0.1.0 (``rdf:subject``,
+  ``rdf:predicate``, ``rdf:object``, ``rdf:type rdf:Statement``) is rewritten with
+  ``cbrs:conditionSubject``, ``cbrs:conditionPredicate`` and ``cbrs:conditionObject``
+  (:mod:`kb.conditions`), keeping its node, type and text;
+- the core vocabulary: in the ontology graph, what the store says about the terms ``core.ttl``
+  describes (and any other ``cbrs:`` term) is replaced by what the bundled ``core.ttl`` says, so
+  ``cbrs:Condition`` is no longer an ``rdf:Statement`` and ``cbrs:hasOWLSModel`` gets its new domain;
+- ontology headers: the header (version, description) of each bundled ontology the store holds is
+  replaced by the bundled one, so that the next open finds nothing to do.
+
+Nothing else is touched: the advertisements and requirements a user registered, changed or
+deregistered stay as they are, and the semantic map keeps its own upgrade
+(:meth:`KnowledgeBase.add_semantic_map`). A condition on a blank node (which no cbrs write makes) is
+left alone.
+"""
+
+from __future__ import annotations
+
+import functools
+import logging
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import pyoxigraph as ox
+
+from cbrs.kb.conditions import LEGACY_PARTS
+from cbrs.kb.loader import parse_file
+from cbrs.kb.namespaces import CBRS, GENID, OWL, RDF, GraphName
+from cbrs.kb.queries import QueryLibrary
+from cbrs.kb.resources import bundled_files
+from cbrs.kb.store import Store
+
+__all__ = ["UpgradeReport", "new_terms", "upgrade_store"]
+
+log = logging.getLogger(__name__)
+
+UPGRADED_GRAPHS = (GraphName.ONTOLOGY, GraphName.SERVICES, GraphName.REQUIREMENTS)
+CORE_FILE = "core.ttl"
+_VERSION_INFO = OWL + "versionInfo"
+
+
+@dataclass(frozen=True)
+class UpgradeReport:
+    """What :func:`upgrade_store` changed."""
+
+    conditions: int = 0  # condition nodes rewritten from the reified form
+    removed: int = 0  # quads removed, all rules together
+    added: int = 0
+
+    @property
+    def changed(self) -> bool:
+        return bool(self.removed or self.added)
+
+
+def upgrade_store(store: Store, queries: QueryLibrary) -> UpgradeReport:
+    """Bring ``store`` up to the bundled ontologies (the three rules above), in one transaction."""
+    remove, add, conditions = _condition_changes(store, queries)
+    if _headers_outdated(store):
+        core_remove, core_add = _core_changes(store)
+        header_remove, header_add = _header_changes(store)
+        remove += core_remove + header_remove
+        add += core_add + header_add
+    removing = set(remove) - set(add)
+    adding = set(add) - set(remove)
+    adding = {quad for quad in adding if not _stored(store, quad)}
+    if not removing and not adding:
+        return UpgradeReport()
+    store.replace(sorted(removing, key=str), sorted(adding, key=str))
+    log.info("upgraded the store: %d conditions rewritten, %d quads out, %d in", conditions, len(removing), len(adding))
+    return UpgradeReport(conditions, len(removing), len(adding))
+
+
+def _condition_changes(store: Store, queries: QueryLibrary) -> tuple[list[ox.Quad], list[ox.Quad], int]:
+    remove: list[ox.Quad] = []
+    add: list[ox.Quad] = []
+    nodes = set()
+    for row in queries.select(store, "legacy_conditions"):
+        node, part, value, graph = row["condition"], row["part"], row["value"], row["graph"]
+        if not isinstance(node, ox.NamedNode) or not isinstance(graph, ox.NamedNode):
+            continue
+        nodes.add(node)
+        remove.append(ox.Quad(node, ox.NamedNode(part.value), value, graph))
+        if part.value in LEGACY_PARTS:
+            add.append(ox.Quad(node, ox.NamedNode(LEGACY_PARTS[part.value]), value, graph))
+    return remove, add, len(nodes)
+
+
+@functools.cache
+def _bundled(path: Path, graph: GraphName) -> tuple[ox.Quad, ...]:
+    """A bundled file's quads, skolemised as a fresh seed would store them (parsed once per process)."""
+    return tuple(parse_file(path, graph).quads)
+
+
+@functools.cache
+def _bundled_headers() -> tuple[tuple[ox.NamedNode, GraphName, tuple[ox.Quad, ...]], ...]:
+    """(ontology IRI, graph, header quads) of the bundled ontologies in the upgraded graphs, read without
+    skolemising: a header has no blank nodes, and this runs on every open."""
+    found = []
+    for item in bundled_files():
+        if item.graph not in UPGRADED_GRAPHS:
+            continue
+        triples = list(ox.parse(path=str(item.path), format=ox.RdfFormat.TURTLE))
+        heads = {t.subject for t in triples if t.predicate.value == RDF + "type" and t.object.value == OWL + "Ontology"}
+        for head in heads:
+            if isinstance(head, ox.NamedNode):
+                own = (t for t in triples if t.subject == head)
+                found.append(
+                    (head, item.graph, tuple(ox.Quad(t.subject, t.predicate, t.object, item.graph.node) for t in own))
+                )
+    return tuple(found)
+
+
+def _headers_outdated(store: Store) -> bool:
+    """Whether a bundled ontology the store holds has another version there than in its file."""
+    version = ox.NamedNode(_VERSION_INFO)
+    for head, graph, quads in _bundled_headers():
+        stored = {q.object for q in store.quads(head, version, None, graph.node)}
+        bundled = {q.object for q in quads if q.predicate == version}
+        if stored and stored != bundled:
+            return True
+    return False
+
+
+def _header_changes(store: Store) -> tuple[list[ox.Quad], list[ox.Quad]]:
+    remove: list[ox.Quad] = []
+    add: list[ox.Quad] = []
+    for head, graph, quads in _bundled_headers():
+        stored = list(store.quads(head, None, None, graph.node))
+        if stored:  # an ontology the store never held is not added by an upgrade
+            remove += stored
+            add += quads
+    return remove, add
+
+
+def _core_changes(store: Store) -> tuple[list[ox.Quad], list[ox.Quad]]:
+    """The stored statements about core terms, and the bundled core's, with the nodes hanging off them."""
+    item = next((i for i in bundled_files() if i.path.name == CORE_FILE), None)
+    if item is None:
+        return [], []
+    core = _bundled(item.path, item.graph)
+    graph = item.graph.node
+    terms = {q.subject for q in core if isinstance(q.subject, ox.NamedNode) and not q.subject.value.startswith(GENID)}
+    stored = list(store.quads(graph=graph))
+    terms |= {q.subject for q in stored if isinstance(q.subject, ox.NamedNode) and q.subject.value.startswith(CBRS)}
+    others = {
+        q for i in bundled_files() if i.graph is item.graph and i.path != item.path for q in _bundled(i.path, i.graph)
+    }
+    remove = [q for q in _closure(stored, terms) if q not in others]
+    return remove, list(core)
+
+
+def new_terms(store: Store, quads: Sequence[ox.Quad]) -> list[ox.Quad]:
+    """What of a bundled file's ``quads`` may join a store seeded from an older version of it: every
+    statement between IRIs, and the skolemised structures (restrictions, models) of the terms the store
+    does not describe yet. A term the store describes keeps its structures: taken again from a changed
+    file, they would come in a second time under other skolem IRIs (the file's digest names them)."""
+    described = {q.subject for q in store.quads(graph=quads[0].graph_name)} if quads else set()  # type: ignore[arg-type]
+    flat = [q for q in quads if not _skolem(q.subject) and not _skolem(q.object)]
+    roots = {q.subject for q in quads if isinstance(q.subject, ox.NamedNode) and not _skolem(q.subject)} - described
+    return flat + [q for q in _closure(quads, roots) if _skolem(q.subject) or _skolem(q.object)]
+
+
+def _skolem(term: object) -> bool:
+    return isinstance(term, ox.NamedNode) and term.value.startswith(GENID)
+
+
+def _closure(quads: Iterable[ox.Quad], roots: set[ox.NamedNode]) -> list[ox.Quad]:
+    """The quads about ``roots`` and, recursively, about the skolemised nodes they reach."""
+    by_subject: dict[ox.NamedNode | ox.BlankNode | ox.Triple, list[ox.Quad]] = {}
+    for quad in quads:
+        by_subject.setdefault(quad.subject, []).append(quad)
+    found: list[ox.Quad] = []
+    pending: list[ox.NamedNode] = list(roots)
+    seen: set[ox.NamedNode] = set()
+    while pending:
+        node = pending.pop()
+        if node in seen:
+            continue
+        seen.add(node)
+        for quad in by_subject.get(node, []):
+            found.append(quad)
+            if isinstance(quad.object, ox.NamedNode) and quad.object.value.startswith(GENID):
+                pending.append(quad.object)
+    return found
+
+
+def _stored(store: Store, quad: ox.Quad) -> bool:
+    return any(True for _ in store.quads(quad.subject, quad.predicate, quad.object, quad.graph_name))  # type: ignore[arg-type]
