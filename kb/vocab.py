@@ -12,6 +12,7 @@ class CBRS:
     """Terms of <https://w3id.org/cbrs/core#>, as declared in ontologies/core.ttl."""
 
     NS: Final = "https://w3id.org/cbrs/core#"
+    ActionType: Final = "https://w3id.org/cbrs/core#ActionType"
     Advertisement: Final = "https://w3id.org/cbrs/core#Advertisement"
     Binding: Final = "https://w3id.org/cbrs/core#Binding"
     Condition: Final = "https://w3id.org/cbrs/core#Condition"
