@@ -21,6 +21,7 @@ Which graphs a query reads follows SPARQL 1.1 (Query §13.2, Protocol §2.1.4): 
 
 from __future__ import annotations
 
+import functools
 import hmac
 import io
 import re
@@ -46,6 +47,7 @@ from cbrs.kb.remote_store import RemoteStore
 from cbrs.kb.sparql_lexemes import HIDING
 from cbrs.kb.store import EmbeddedStore, QueryResult, refuse_inserted_blank_nodes
 from cbrs.query_workers import QueryProcesses, QueryStopped, Request
+from cbrs.scan_queries import is_single_scan
 from cbrs.settings import setting
 
 # Media types offered for SELECT and ASK results, the first being the default.
@@ -358,7 +360,14 @@ class SparqlService:
         """
         self._check_size(text)
         graphs = dataset_for(text, dataset)
-        release = self._admit(client)
+        scan = isinstance(self.kb.store, EmbeddedStore) and is_single_scan(text)
+        release = self._admit(client, slot=not scan)
+        if scan:  # one index scan: stopped by the writer's deadline, so it needs no worker (cbrs.scan_queries)
+            try:
+                deadline = time.monotonic() + self.config.timeout
+                return self._evaluate(text, accept, short_format, deadline, graphs, flat=True)
+            finally:
+                release()
         if self.processes is not None:
             try:
                 return self._in_process(text, accept, short_format, graphs)
@@ -392,28 +401,31 @@ class SparqlService:
         if self.processes is not None:
             self.processes.close()
 
-    def _admit(self, client: str | None) -> Callable[[], None]:
-        """Take a worker slot for ``client``; the call returned gives it back (once)."""
+    def _admit(self, client: str | None, slot: bool = True) -> Callable[[], None]:
+        """Count a query of ``client`` against its share and, with ``slot``, take one of the ``workers``
+        slots (a single scan runs on the request's thread and takes none); the call returned gives
+        them back (once)."""
         limit = min(self.config.workers_per_client, self.config.workers)
         with self._clients_lock:
             if client is not None and self._clients[client] >= limit:
                 raise EndpointBusyError(self.config.workers, client, limit)
-            if not self._slots.acquire(blocking=False):
+            if slot and not self._slots.acquire(blocking=False):
                 raise EndpointBusyError(self.config.workers)
             if client is not None:
                 self._clients[client] += 1
-        released = threading.Event()
+        released = [False]
 
         def release() -> None:
-            if released.is_set():
-                return
-            released.set()
             with self._clients_lock:
+                if released[0]:
+                    return
+                released[0] = True
                 if client is not None:
                     self._clients[client] -= 1
                     if self._clients[client] <= 0:
                         del self._clients[client]
-                self._slots.release()
+                if slot:
+                    self._slots.release()
 
         return release
 
@@ -497,11 +509,17 @@ class SparqlService:
             raise QueryTooLargeError(size, self.config.max_query_bytes)
 
     def _evaluate(
-        self, text: str, accept: str | None, short_format: str | None, deadline: float, graphs: dict[str, Any]
+        self,
+        text: str,
+        accept: str | None,
+        short_format: str | None,
+        deadline: float,
+        graphs: dict[str, Any],
+        flat: bool = False,
     ) -> Answer:
         result: Any = None  # Oxigraph results must be dropped on the thread that made them
         try:
-            result = self._run(text, graphs)
+            result = self._run_flat(text, graphs) if flat else self._run(text, graphs)
             media_type = negotiate(isinstance(result, ox.QueryTriples), accept, short_format)
             writer = _BudgetWriter(self.config.max_result_bytes, deadline, self.config.timeout)
             try:
@@ -518,6 +536,18 @@ class SparqlService:
             return Answer(writer.getvalue(), media_type)
         finally:
             result = None
+
+    def _run_flat(self, text: str, graphs: dict[str, Any]) -> QueryResult:
+        """Evaluate a single scan (:func:`cbrs.scan_queries.is_single_scan`) on the embedded store. Its text
+        is flat by construction and names no SERVICE, so the checks for deep or reaching texts are moot."""
+        store = self.kb.store
+        assert isinstance(store, EmbeddedStore)
+        try:
+            return store._backend.query(text, prefixes=PREFIXES, **dataset_options(graphs))
+        except SyntaxError as error:
+            raise QuerySyntaxError(text, str(error)) from error
+        except (OSError, RuntimeError) as error:
+            raise StoreEvaluationError(store.location, "query", str(error)) from error
 
     def _run(self, text: str, graphs: dict[str, Any]) -> QueryResult:
         """Evaluate ``text`` on this thread over the dataset ``graphs`` (see :func:`dataset_for`)."""
@@ -539,8 +569,12 @@ class SparqlService:
             raise StoreEvaluationError(store.location, "query", str(error)) from error
 
 
+@functools.lru_cache(maxsize=256)
 def negotiate(graph: bool, accept: str | None, short_format: str | None = None) -> str:
-    """The media type to answer in: a ``format`` short name wins, then the Accept header, then the default."""
+    """The media type to answer in: a ``format`` short name wins, then the Accept header, then the default.
+
+    Kept for the last 256 requests' headers: clients send the same few, and parsing one costs more
+    than a point lookup's evaluation."""
     offered = list(GRAPH_TYPES if graph else RESULT_TYPES)
     if short_format:
         names = SHORT_NAMES.get(short_format.lower())

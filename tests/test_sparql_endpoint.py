@@ -17,7 +17,14 @@ from waitress.server import create_server
 
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import GraphName, expand
-from cbrs.sparql_service import EndpointConfig, SparqlService, negotiate
+from cbrs.sparql_service import (
+    EndpointBusyError,
+    EndpointConfig,
+    QueryTimeoutError,
+    ResultTooLargeError,
+    SparqlService,
+    negotiate,
+)
 from cbrs.web import create_app
 
 TOKEN = "correct horse battery staple"
@@ -324,3 +331,104 @@ def test_rdflib_sparqlstore_reads_select_and_construct(live: tuple[str, Knowledg
     assert len(constructed) == 3
     kind = URIRef("https://w3id.org/cbrs/core#DynamicPerceptionComponent")
     assert set(constructed.objects()) == {kind}
+
+
+# -- single scans and the hot path (cbrs.scan_queries, cbrs.web.sparql_wsgi) ----------------------------
+
+LOOKUP = "SELECT ?p ?o WHERE { home:Cup ?p ?o }"
+
+
+@pytest.mark.parametrize(
+    ("text", "scan"),
+    [
+        pytest.param("SELECT ?p ?o WHERE { <urn:x> ?p ?o }", True, id="subject-lookup"),
+        pytest.param("PREFIX ex: <http://e/#>\nselect * { ex:x ?p ?o . } LIMIT 5", True, id="prologue-star-limit"),
+        pytest.param("SELECT ?s WHERE { ?s a home:Cup }", True, id="a-and-pname"),
+        pytest.param('ASK { ?s rdfs:label "cup"@en }', True, id="ask-literal"),
+        pytest.param("SELECT ?o FROM <urn:g> WHERE { <urn:x> <urn:p> ?o }", True, id="from"),
+        pytest.param("SELECT ?s ?p ?o WHERE { ?s ?p ?o }", False, id="whole-store"),
+        pytest.param("SELECT ?x WHERE { ?x <urn:p> ?x }", False, id="repeated-variable"),
+        pytest.param("SELECT ?p ?o WHERE { <urn:x> ?p ?o } OFFSET 10", False, id="offset"),
+        pytest.param("SELECT DISTINCT ?p WHERE { <urn:x> ?p ?o }", False, id="distinct"),
+        pytest.param("SELECT ?p ?o WHERE { <urn:x> ?p ?o } ORDER BY ?o", False, id="order"),
+        pytest.param("SELECT ?o WHERE { <urn:x> <urn:p>* ?o }", False, id="path"),
+        pytest.param("SELECT ?o WHERE { <urn:x> ?p ?o FILTER(?o > 1) }", False, id="filter"),
+        pytest.param("SELECT ?o WHERE { <urn:x> ?p ?o . ?o ?q ?r }", False, id="join"),
+        pytest.param("SELECT ?o WHERE { <urn:x> ?p ?o } # comment", False, id="comment"),
+        pytest.param("SELECT ?o WHERE { _:b ?p ?o }", False, id="blank-node"),
+        pytest.param("SELECT (COUNT(*) AS ?n) WHERE { <urn:x> ?p ?o }", False, id="aggregate"),
+        pytest.param("SELECT ?o WHERE { SERVICE <http://e/> { <urn:x> ?p ?o } }", False, id="service"),
+        pytest.param("DESCRIBE <urn:x>", False, id="describe"),
+    ],
+)
+def test_single_scans_are_recognised_strictly(text: str, scan: bool) -> None:
+    from cbrs.scan_queries import is_single_scan
+
+    assert is_single_scan(text) is scan
+
+
+@pytest.mark.parametrize(
+    ("method", "path", "headers", "data"),
+    [
+        pytest.param("GET", f"/sparql?query={LOOKUP}", {}, None, id="get-lookup"),
+        pytest.param("HEAD", f"/sparql?query={LOOKUP}", {}, None, id="head-lookup"),
+        pytest.param("GET", f"/sparql?query={SELECT}&format=xml", {}, None, id="get-format-worker"),
+        pytest.param("GET", f"/sparql?query={LOOKUP}", {"Accept": "text/csv"}, None, id="accept-csv"),
+        pytest.param("GET", f"/sparql?query={LOOKUP}", {"Accept": "text/nope"}, None, id="not-acceptable"),
+        pytest.param("GET", "/sparql?query=SELECT%20%3Fx%20WHERE%20%7B", {}, None, id="syntax-error"),
+        pytest.param("GET", f"/sparql?query={LOOKUP}&output=tsv", {}, None, id="output"),
+        pytest.param("GET", f"/sparql?query={LOOKUP}&query=ASK{{}}", {}, None, id="two-queries"),
+        pytest.param("GET", f"/sparql?query={LOOKUP}", {"Origin": "http://other.example"}, None, id="origin"),
+        pytest.param("POST", "/sparql", {"Content-Type": "application/sparql-query"}, LOOKUP, id="post-direct"),
+        pytest.param("POST", "/sparql", {"Content-Type": "application/sparql-query"}, b"\xff", id="post-not-utf8"),
+        pytest.param("POST", "/sparql", {"Content-Type": "text/plain"}, LOOKUP, id="post-wrong-type"),
+        pytest.param("GET", "/sparql", {}, None, id="service-description"),
+    ],
+)
+def test_the_hot_path_answers_as_the_flask_view_does(
+    bundled_kb: KnowledgeBase, method: str, path: str, headers: dict[str, str], data: str | bytes | None
+) -> None:
+    from werkzeug.test import Client
+
+    app = create_app(SparqlService(bundled_kb, EndpointConfig()), own_origins=lambda: {"http://127.0.0.1:8080"})
+    hot, flask_only = Client(app.wsgi_app), Client(app.wsgi_app.app)  # type: ignore[attr-defined]
+    headers = {"Host": "127.0.0.1:8080", **headers}
+    answers = [c.open(path, method=method, headers=headers, data=data) for c in (hot, flask_only)]
+    assert answers[0].status == answers[1].status
+    assert answers[0].headers == answers[1].headers
+    assert answers[0].data == answers[1].data
+
+
+def test_the_hot_path_leaves_a_foreign_host_to_the_rebinding_check(bundled_kb: KnowledgeBase) -> None:
+    app = create_app(SparqlService(bundled_kb, EndpointConfig()), own_origins=lambda: {"http://127.0.0.1:8080"})
+    response = app.test_client().get("/sparql", query_string={"query": LOOKUP}, headers={"Host": "evil.example"})
+    assert response.status_code == 421
+
+
+def test_a_single_scan_takes_no_query_worker_but_counts_against_the_client_share(bundled_kb: KnowledgeBase) -> None:
+    service = SparqlService(bundled_kb, EndpointConfig(workers=1, workers_per_client=1))
+    release = service._admit("127.0.0.2")  # another client holds the only worker
+    try:
+        answer = service.query(LOOKUP, client="127.0.0.3")
+        assert json.loads(answer.body)["results"]["bindings"]
+        held = service._admit("127.0.0.3", slot=False)  # this client is at its share of one
+        try:
+            with pytest.raises(EndpointBusyError, match=r"127\.0\.0\.3 already runs 1"):
+                service.query(LOOKUP, client="127.0.0.3")
+        finally:
+            held()
+    finally:
+        release()
+
+
+def test_a_single_scan_stops_at_the_byte_limit_and_the_deadline(
+    bundled_kb: KnowledgeBase, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    scan_all_types = "SELECT ?s ?t WHERE { ?s a ?t }"  # one scan, every typed node of the bundled data
+    small = SparqlService(bundled_kb, EndpointConfig(max_result_bytes=2000))
+    with pytest.raises(ResultTooLargeError):
+        small.query(scan_all_types)
+    clock = iter(float(second) for second in range(10**6))  # each look at the clock: one second later
+    monkeypatch.setattr("cbrs.sparql_service.time.monotonic", lambda: next(clock))
+    with pytest.raises(QueryTimeoutError):
+        SparqlService(bundled_kb, EndpointConfig(timeout=5.0)).query(scan_all_types)

@@ -7,6 +7,7 @@ client causes is answered with a 4xx status and never a trace: an HTML page for 
 
 from __future__ import annotations
 
+import functools
 import importlib
 import secrets
 import threading
@@ -24,6 +25,7 @@ from cbrs.sparql_service import SparqlService
 from cbrs.tasks import TaskRunner
 from cbrs.web import links
 from cbrs.web.context import EventLog, StreamSlots
+from cbrs.web.sparql_wsgi import SparqlHotPath
 
 # The page blueprints, in navigation order: (module under cbrs.web, endpoint of its nav link, label).
 PAGES: tuple[tuple[str, str, str], ...] = (
@@ -90,6 +92,12 @@ def create_app(
     page_blueprints = {module for module, _, _ in PAGES}
     allowed = frozenset(cors_origins)
     links.install(app)
+
+    def names() -> frozenset[str | None] | None:
+        return None if own_origins is None else host_names(frozenset(own_origins()), allowed)
+
+    # plain /sparql queries skip Flask's request machinery (cbrs.web.sparql_wsgi), with the same answers
+    app.wsgi_app = SparqlHotPath(app.wsgi_app, sparql, names, app.config["MAX_CONTENT_LENGTH"])  # type: ignore[method-assign]
 
     @app.context_processor
     def shared() -> dict[str, Any]:
@@ -168,13 +176,20 @@ def _check_host(own: Collection[str], cors_origins: Collection[str]) -> None:
     A page of another site whose name was made to resolve to 127.0.0.1 (DNS rebinding) reaches the
     server as same-origin to the browser, with its own name in ``Host``: that is what gives it away.
     """
-    hosts = {urlsplit(origin).hostname for origin in own}
-    if not hosts or not hosts <= LOOPBACK_NAMES | {None}:
-        return  # bound to a routable address: clients use names we cannot know
-    names = hosts | LOOPBACK_NAMES | {urlsplit(origin).hostname for origin in cors_origins}
     given = urlsplit("//" + request.host).hostname
-    if given not in names:
+    names = host_names(frozenset(own), frozenset(cors_origins))
+    if names is not None and given not in names:
         raise MisdirectedRequest(
             f"this server answers to {', '.join(sorted(n for n in names if n))}, not to {given!r} "
             "(a page whose name resolves to this machine is not one of its own)"
         )
+
+
+@functools.lru_cache(maxsize=16)
+def host_names(own: frozenset[str], cors_origins: frozenset[str]) -> frozenset[str | None] | None:
+    """The host names a request may give when the server binds only loopback; ``None``: any (bound to
+    a routable address, clients use names we cannot know)."""
+    hosts = {urlsplit(origin).hostname for origin in own}
+    if not hosts or not hosts <= LOOPBACK_NAMES | {None}:
+        return None
+    return frozenset(hosts | LOOPBACK_NAMES | {urlsplit(origin).hostname for origin in cors_origins})

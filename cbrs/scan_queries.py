@@ -1,0 +1,59 @@
+"""Which SPARQL queries are one index scan: cheap, and stoppable without a worker process.
+
+The endpoint evaluates a query in a worker process because Oxigraph cannot be interrupted while it
+computes (an aggregate, a join, a sort). A query that is one triple pattern with at least one bound
+term and no modifier but ``LIMIT`` is different: Oxigraph answers it by walking one index range and
+hands out each matching triple as a solution as it goes, so the serialiser's writer, which checks the
+deadline and the byte budget on every chunk (:class:`cbrs.sparql_service._BudgetWriter`), stops it as
+surely as killing a process would, and it needs no more memory than the result it writes. Such a
+query, the point lookup of a robot (``SELECT ?p ?o WHERE { <thing> ?p ?o }``), is evaluated on the
+request's own thread, which saves the round trip to a worker (a process hop and a JSON frame each way).
+
+The test is on the text, strictly: a prologue of ``PREFIX`` / ``BASE``, ``SELECT`` of variables or ``*``
+(or ``ASK``), optional ``FROM`` / ``FROM NAMED`` clauses, ``WHERE { s p o }`` with terms that are IRIs,
+prefixed names, variables, ``a`` or (as object) literals, each variable once, then an optional
+``LIMIT``. Anything else (a comment, a path, a filter, ``DISTINCT``, ``OFFSET``, a blank node, an escape
+in a prefixed name) is not recognised and goes to a worker as before. ``OFFSET`` and a repeated
+variable are left out on purpose: with them, Oxigraph walks triples that produce no output, which the
+writer's deadline could not see.
+"""
+
+from __future__ import annotations
+
+import re
+
+_IRI = r'<[^<>"{}|^`\\\x00-\x20]*>'
+_PN = r"[A-Za-z\u00c0-\uffff](?:[\w\-\u00b7\u00c0-\uffff.]*[\w\-\u00b7\u00c0-\uffff])?"
+_LOCAL = r"[\w\u00c0-\uffff:](?:[\w\-\u00b7\u00c0-\uffff.:]*[\w\-\u00b7\u00c0-\uffff:])?"
+_PNAME = rf"(?:{_PN})?:(?:{_LOCAL})?"
+_VAR = r"[?$]\w+"
+_STRING = r'"(?:[^"\\\n\r]|\\.)*"' + r"|'(?:[^'\\\n\r]|\\.)*'"
+_LITERAL = (
+    rf"(?:(?:{_STRING})(?:@[A-Za-z]+(?:-[A-Za-z0-9]+)*|\^\^(?:{_IRI}|{_PNAME}))?"
+    r"|[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|true|false)"
+)
+_NODE = rf"(?:{_IRI}|{_PNAME}|{_VAR})"
+_S = r"\s*"
+
+_SHAPE = re.compile(
+    rf"{_S}(?:(?:BASE{_S}{_IRI}|PREFIX{_S}(?:{_PN})?:{_S}{_IRI}){_S})*"
+    rf"(?:SELECT{_S}(?P<projection>\*|(?:{_VAR}{_S})+)|ASK){_S}"
+    rf"(?:FROM{_S}(?:NAMED\s+)?(?:{_IRI}|{_PNAME}){_S})*"
+    rf"(?:WHERE{_S})?\{{{_S}(?P<s>{_NODE}){_S}(?P<p>{_NODE}|a(?=[\s<?$])){_S}(?P<o>{_NODE}|{_LITERAL}){_S}\.?{_S}\}}"
+    rf"{_S}(?:LIMIT{_S}\d+{_S})?",
+    re.IGNORECASE,
+)
+
+
+def is_single_scan(text: str) -> bool:
+    """Whether ``text`` is a query Oxigraph answers with one index scan that yields a solution per
+    triple it reads (see the module's docstring); it may still be malformed in ways the parser finds."""
+    match = _SHAPE.fullmatch(text)
+    if match is None:
+        return False
+    terms = [match.group("s"), match.group("p"), match.group("o")]
+    variables = [term for term in terms if term[0] in "?$"]
+    if len(variables) == 3:
+        return False  # the whole store: not a lookup
+    names = [v[1:] for v in variables]
+    return len(set(names)) == len(names)
