@@ -27,6 +27,7 @@ class App:
                 check_timeout=setting("query_check_timeout").resolve(),
                 remote_access=setting("federation_allow").resolve(),
                 remote_token=setting("update_token").resolve(),
+                remote_batch=setting("remote_batch").resolve(),
             )
         return self._kb
 

@@ -221,6 +221,14 @@ SETTINGS: tuple[Setting, ...] = (
         _positive(float),
     ),
     Setting(
+        "remote_batch",
+        lambda: 1000,
+        "Most quads one write request to a remote store carries; a larger write (the seed, a load) is "
+        "staged in batches this size and published by one operation (docs/remote-store.md).",
+        "CBRS_REMOTE_BATCH",
+        _positive(int),
+    ),
+    Setting(
         "max_result_bytes",
         lambda: 64 * 1024 * 1024,
         "Largest serialised SPARQL result the endpoint returns; larger ones are refused with 422.",

@@ -42,19 +42,23 @@ class KnowledgeBase:
         check_timeout: float | None = None,
         remote_access: tuple[str, ...] = (),
         remote_token: str | None = None,
+        remote_batch: int | None = None,
     ) -> KnowledgeBase:
         """Open the store at ``location`` (a directory, ``:memory:`` or an endpoint URL), seeding it on first use.
 
         ``check_timeout`` bounds how long an embedded store's query guard checks a long text (see
         :mod:`kb.query_guard`); ``remote_access`` lists the IRI prefixes a SERVICE or LOAD may reach
         (:mod:`kb.remote_access`; none by default). ``remote_token`` goes with every request to a remote
-        store, as a bearer token: a ``cbrs serve``'s update token.
+        store, as a bearer token: a ``cbrs serve``'s update token. ``remote_batch`` is the most quads one
+        write request to a remote store carries; larger writes are staged (:mod:`kb.staged_writes`).
         """
-        if is_remote(str(location)) and (remote_timeout is not None or remote_token is not None):
-            from cbrs.kb.remote_store import DEFAULT_TIMEOUT, RemoteStore  # only a remote store needs the HTTP client
+        remote_options = (remote_timeout, remote_token, remote_batch)
+        if is_remote(str(location)) and any(option is not None for option in remote_options):
+            from cbrs.kb.remote_store import DEFAULT_BATCH, DEFAULT_TIMEOUT, RemoteStore  # only a remote store needs httpx
 
             timeout = remote_timeout if remote_timeout is not None else DEFAULT_TIMEOUT
-            store: Store = RemoteStore.open(location, timeout, remote_token)
+            batch = remote_batch if remote_batch is not None else DEFAULT_BATCH
+            store: Store = RemoteStore.open(location, timeout, remote_token, batch)
         else:
             store = Store.open(location)
         store.remote_access = tuple(remote_access)

@@ -15,9 +15,11 @@ Three rules keep it equivalent to the embedded store:
 - **Queries by form POST.** ``query=`` in an ``application/x-www-form-urlencoded`` body is the one
   way every SPARQL 1.1 server answers (Virtuoso 7 never answers a ``application/sparql-query`` body);
   updates go as an ``application/sparql-update`` body, which Oxigraph, Fuseki and Virtuoso all take.
-- **One write, one request, one transaction.** ``add`` sends one ``INSERT DATA`` and ``replace`` one
-  ``DELETE DATA ; INSERT DATA`` request; a SPARQL update request is one transaction, so a failed
-  write leaves the store as it was. Writes are never split into chunks.
+- **One write, one operation.** A server need not run a request of several operations as one
+  transaction (Virtuoso 7 does not), but every server keeps one operation whole. ``add`` of up to
+  ``batch`` quads sends one ``INSERT DATA``; a larger one is staged in batches and published by one
+  operation (:mod:`kb.staged_writes`); ``replace`` sends one ``DELETE { } INSERT { } WHERE { }``. A
+  failed write leaves the store as it was.
 """
 
 from __future__ import annotations
@@ -26,7 +28,7 @@ import functools
 import re
 import ssl
 from collections.abc import Iterable, Iterator, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import NamedTuple
 from urllib.parse import urlencode
@@ -37,10 +39,14 @@ import pyoxigraph as ox
 from cbrs.kb.errors import BindingError, QuerySyntaxError, RemoteStoreError, StoreError, StoreEvaluationError
 from cbrs.kb.namespaces import PREFIXES, GraphName
 from cbrs.kb.remote_access import refuse_remote_access
+from cbrs.kb.staged_writes import write_staged
 from cbrs.kb.store import QueryResult, Store, Term, data_block, refuse_deep_nesting
 
 DEFAULT_TIMEOUT = 60.0  # seconds to wait for an answer (the seed takes well under one)
 CONNECT_TIMEOUT = 5.0
+DEFAULT_BATCH = 1000
+"""The most quads one write request carries (setting ``remote_batch``); a larger write is staged
+(:mod:`kb.staged_writes`). Virtuoso 7 refuses an ``INSERT DATA`` of about 1,400 simple triples."""
 
 # One line, so the server's "error at LINE:COLUMN" is off by exactly one line (corrected in errors).
 PROLOGUE = " ".join(f"PREFIX {prefix}: <{namespace}>" for prefix, namespace in PREFIXES.items()) + "\n"
@@ -70,6 +76,9 @@ class Endpoints:
 
     query: str
     update: str
+    update_guessed: bool = field(default=False, compare=False)
+    """Whether ``update`` was guessed from a single query URL: a server that answers 404 there takes
+    updates at the query URL instead (Virtuoso's one ``/sparql``, which SPARQL 1.1 allows)."""
 
     @classmethod
     def discover(cls, location: str) -> Endpoints:
@@ -89,9 +98,8 @@ class Endpoints:
         path = url.path.rstrip("/")
         head, _, last = path.rpartition("/")
         if last in ("query", "sparql"):
-            return cls(str(url.copy_with(path=path)), str(url.copy_with(path=f"{head}/update")))
-        return cls(str(url.copy_with(path=f"{path}/query")), str(url.copy_with(path=f"{path}/update")))
-
+            return cls(str(url.copy_with(path=path)), str(url.copy_with(path=f"{head}/update")), True)
+        return cls(str(url.copy_with(path=f"{path}/query")), str(url.copy_with(path=f"{path}/update")), True)
 
     @classmethod
     def candidates(cls, location: str) -> list[Endpoints]:
@@ -120,11 +128,19 @@ class RemoteStore(Store):
     """A store on a SPARQL 1.1 endpoint with update. Thread-safe: one pooled HTTP client."""
 
     def __init__(
-        self, location: str, endpoints: Endpoints, timeout: float = DEFAULT_TIMEOUT, token: str | None = None
+        self,
+        location: str,
+        endpoints: Endpoints,
+        timeout: float = DEFAULT_TIMEOUT,
+        token: str | None = None,
+        batch: int = DEFAULT_BATCH,
     ) -> None:
+        if batch < 1:
+            raise StoreError(location, f"batch must be at least 1 quad, not {batch}")
         self.location = location
         self.endpoints = endpoints
         self.timeout = timeout
+        self.batch = batch
         headers = {"User-Agent": "cbrs-kb"}
         if token:  # a cbrs server takes updates with its bearer token; Oxigraph's server ignores it
             headers["Authorization"] = f"Bearer {token}"
@@ -134,16 +150,26 @@ class RemoteStore(Store):
             verify=_tls_context(),
         )
         self._union_verified = False
-        self._oxigraph = False  # learnt from the Server header of each answer: whether TSV can be asked for
+        # learnt from the Server header of each answer: whether TSV can be asked for (Oxigraph), and
+        # whether bound values go in as BIND clauses (Virtuoso, see _binds)
+        self._oxigraph = False
+        self._virtuoso = False
 
     @classmethod
-    def open(cls, location: str | Path, timeout: float = DEFAULT_TIMEOUT, token: str | None = None) -> RemoteStore:
+    def open(
+        cls,
+        location: str | Path,
+        timeout: float = DEFAULT_TIMEOUT,
+        token: str | None = None,
+        batch: int = DEFAULT_BATCH,
+    ) -> RemoteStore:
         """Connect to the endpoint(s) ``location`` names and check its default graph is the union;
-        ``token`` is sent as a bearer token (a ``cbrs serve``'s update token)."""
+        ``token`` is sent as a bearer token (a ``cbrs serve``'s update token); ``batch`` is the most
+        quads one write request carries."""
         text = str(location).strip()
         first_error: StoreError | None = None
         for endpoints in Endpoints.candidates(text):
-            store = cls(text, endpoints, timeout, token)
+            store = cls(text, endpoints, timeout, token, batch)
             try:
                 store._check_union()
             except StoreError as error:
@@ -174,8 +200,9 @@ class RemoteStore(Store):
         refuse_remote_access(text, self.remote_access)
         if not self._union_verified:
             self._check_union()
-        sent = inject_values(text, bindings) if bindings else text
-        return self._query(sent, original=text)
+        if not bindings:
+            return self._query(text, original=text)
+        return self._query(inject_values(text, bindings, bind=self._binds(text)), original=text)
 
     def query_dataset(
         self, text: str, default_graphs: Sequence[str] | None = None, named_graphs: Sequence[str] | None = None
@@ -212,7 +239,9 @@ class RemoteStore(Store):
         return int(next(iter(result))["n"].value)
 
     def graphs(self) -> list[str]:
-        result = self._query("SELECT DISTINCT ?g WHERE { GRAPH ?g { } }")
+        # Virtuoso 7 matches no graph with an empty pattern; it lists no empty graph either way
+        pattern = "?s ?p ?o" if self._virtuoso else ""
+        result = self._query(f"SELECT DISTINCT ?g WHERE {{ GRAPH ?g {{ {pattern} }} }}")
         assert isinstance(result, ox.QuerySolutions)
         return sorted(row["g"].value for row in result if isinstance(row["g"], ox.NamedNode))
 
@@ -222,13 +251,30 @@ class RemoteStore(Store):
     # -- writing ---------------------------------------------------------------------------
 
     def add(self, quads: Iterable[ox.Quad]) -> None:
-        """Add ``quads`` with one ``INSERT DATA`` request: one transaction, however many quads.
+        """Add ``quads`` all or nothing: up to :attr:`batch` of them as one ``INSERT DATA`` operation,
+        more through staging graphs published by one operation (:mod:`kb.staged_writes`).
 
         Blank nodes become fresh nodes on the server (the loader skolemises them before this).
         """
+        quads = list(quads)
+        if len(quads) > self.batch:
+            write_staged(self.location, quads, self.batch, lambda text: self._update(text, original=None))
+            return
         block = data_block(quads, blank_nodes=True)
         if block:
             self._update("INSERT DATA {\n" + block + "}", original=None)
+
+    def replace(self, remove: Iterable[ox.Quad], add: Iterable[ox.Quad]) -> None:
+        """Remove and add quads in one ``DELETE { } INSERT { } WHERE { }`` operation, which a server keeps
+        whole even where it does not keep a request of two operations whole (Virtuoso 7)."""
+        removing = data_block(remove)
+        adding = data_block(add)
+        if removing and adding:
+            self._update(f"DELETE {{\n{removing}}}\nINSERT {{\n{adding}}}\nWHERE {{ }}", original=None)
+        elif removing:
+            self._update("DELETE DATA {\n" + removing + "}", original=None)
+        elif adding:
+            self._update("INSERT DATA {\n" + adding + "}", original=None)
 
     def update(self, text: str) -> None:
         """Run a SPARQL update on the server in one request, hence one transaction."""
@@ -242,6 +288,16 @@ class RemoteStore(Store):
         if self._client is None:
             raise StoreError(self.location, "is closed")
         return self._client
+
+    def _binds(self, text: str) -> bool:
+        """Whether to bind values with BIND clauses rather than a VALUES block: on Virtuoso 7, which starts
+        no transitive path (``p*``, ``p+``) from a VALUES block and mis-joins it elsewhere too, except in
+        a query that aggregates with GROUP_CONCAT or SAMPLE, whose groups Virtuoso collapses into one
+        after a BIND. Both forms give the one solution a substitution gives (docs/remote-store.md)."""
+        if not self._virtuoso:
+            return False
+        names = {token.text.upper() for token in _tokens(text) if token.kind == "name"}
+        return not names & {"GROUP_CONCAT", "SAMPLE"}
 
     def _check_union(self) -> None:
         result = self._query(_UNION_PROBE)
@@ -282,7 +338,14 @@ class RemoteStore(Store):
         raise StoreError(self.location, f"{self.endpoints.query} answered in an unexpected format {media!r}")
 
     def _update(self, text: str, original: str | None) -> None:
-        self._post(self.endpoints.update, PROLOGUE + text, "application/sparql-update", original)
+        try:
+            self._post(self.endpoints.update, PROLOGUE + text, "application/sparql-update", original)
+        except RemoteStoreError as error:
+            # nothing listens at a guessed update URL: the query URL takes updates too (Virtuoso's /sparql)
+            if error.status != 404 or not self.endpoints.update_guessed:
+                raise
+            self.endpoints = Endpoints(self.endpoints.query, self.endpoints.query)
+            self._post(self.endpoints.update, PROLOGUE + text, "application/sparql-update", original)
 
     def _post(
         self,
@@ -311,7 +374,9 @@ class RemoteStore(Store):
             raise StoreError(self.location, f"{url} did not answer within {self.timeout:g} s") from error
         except httpx.HTTPError as error:
             raise StoreError(self.location, f"request to {url} failed: {error}") from error
-        self._oxigraph = response.headers.get("server", "").lower().startswith("oxigraph/")
+        server = response.headers.get("server", "").lower()
+        self._oxigraph = server.startswith("oxigraph/")
+        self._virtuoso = server.startswith("virtuoso/")
         if response.is_success:
             return response
         message = _POSITION.sub(_one_line_up, response.text.strip())
@@ -426,8 +491,7 @@ def _closing(tokens: list[_Token], index: int) -> int:
     raise ValueError("unbalanced braces")
 
 
-def values_block(bindings: Mapping[str, Term]) -> str:
-    """`` VALUES (?a ?b) { (<x> "y") } `` for ``bindings``."""
+def _written(bindings: Mapping[str, Term]) -> tuple[list[str], list[str]]:
     names, terms = [], []
     for name, value in bindings.items():
         try:
@@ -435,11 +499,25 @@ def values_block(bindings: Mapping[str, Term]) -> str:
         except ValueError as error:
             raise BindingError(name, value, f"not a SPARQL variable name: {error}") from error
         terms.append(sparql_term(name, value))
+    return names, terms
+
+
+def values_block(bindings: Mapping[str, Term]) -> str:
+    """`` VALUES (?a ?b) { (<x> "y") } `` for ``bindings``."""
+    names, terms = _written(bindings)
     return f" VALUES ({' '.join(names)}) {{ ({' '.join(terms)}) }} "
 
 
-def inject_values(query: str, bindings: Mapping[str, Term]) -> str:
-    """``query`` with ``bindings`` as a ``VALUES`` block opening its top-level group pattern.
+def bind_block(bindings: Mapping[str, Term]) -> str:
+    """`` BIND (<x> AS ?a) BIND ("y" AS ?b) `` for ``bindings``: opening a group, the same one solution as
+    :func:`values_block`, in the form Virtuoso 7 takes as the start of a transitive property path."""
+    names, terms = _written(bindings)
+    return " " + " ".join(f"BIND ({term} AS {name})" for name, term in zip(names, terms, strict=True)) + " "
+
+
+def inject_values(query: str, bindings: Mapping[str, Term], bind: bool = False) -> str:
+    """``query`` with ``bindings`` as a ``VALUES`` block (``BIND`` clauses with ``bind``) opening its
+    top-level group pattern.
 
     Comments, strings (all four quote forms), IRIs, and a CONSTRUCT template are skipped. A
     ``CONSTRUCT WHERE { T }`` becomes ``CONSTRUCT { T } WHERE { VALUES ... T }``; a ``DESCRIBE``
@@ -447,7 +525,7 @@ def inject_values(query: str, bindings: Mapping[str, Term]) -> str:
     """
     if not bindings:
         return query
-    values = values_block(bindings)
+    values = bind_block(bindings) if bind else values_block(bindings)
     tokens = _tokens(query)
     form = next((i for i, t in enumerate(tokens) if t.kind == "name" and t.text.upper() in _FORMS), None)
     if form is None:

@@ -1,5 +1,6 @@
 from __future__ import annotations
 
+import re
 import shutil
 import socket
 import subprocess
@@ -145,6 +146,94 @@ def store_location(request: pytest.FixtureRequest) -> str:
     if getattr(request, "param", "embedded") == "remote":
         return str(request.getfixturevalue("remote_location"))
     return ":memory:"
+
+
+# -- Virtuoso 7 --------------------------------------------------------------------------------------
+
+
+@dataclass
+class VirtuosoServer:
+    """Virtuoso 7 (Debian's virtuoso-opensource) on free loopback ports; ``url`` is its one SPARQL endpoint."""
+
+    url: str
+    own_graphs: frozenset[str]  # Virtuoso's system graphs, which clear() keeps
+    process: subprocess.Popen[bytes]
+
+    def graphs(self) -> set[str]:
+        answer = httpx.post(
+            self.url,
+            data={"query": "SELECT DISTINCT ?g WHERE { GRAPH ?g { ?s ?p ?o } }"},
+            headers={"Accept": "application/sparql-results+json"},
+            timeout=30,
+        )
+        answer.raise_for_status()
+        return {row["g"]["value"] for row in answer.json()["results"]["bindings"]}
+
+    def clear(self) -> None:
+        """Drop every graph but Virtuoso's own (a DROP ALL would drop those too)."""
+        drops = " ; ".join(f"DROP SILENT GRAPH <{g}>" for g in sorted(self.graphs() - self.own_graphs))
+        if drops:
+            answer = httpx.post(
+                self.url, content=drops.encode(), headers={"Content-Type": "application/sparql-update"}, timeout=60
+            )
+            answer.raise_for_status()
+
+
+def _free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port: int = probe.getsockname()[1]
+        return port
+
+
+@pytest.fixture(scope="session")
+def virtuoso_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[VirtuosoServer]:
+    """One Virtuoso for the session, its SPARQL user allowed to update; skipped when not installed (CI
+    installs it). Stopped by its PID."""
+    server, isql = shutil.which("virtuoso-t"), shutil.which("isql-vt")
+    template = Path("/etc/virtuoso-opensource-7/virtuoso.ini")
+    if server is None or isql is None or not template.is_file():
+        pytest.skip("Virtuoso is not installed (apt-get install virtuoso-opensource)")
+    directory = tmp_path_factory.mktemp("virtuoso")
+    sql_port, http_port = _free_port(), _free_port()
+    ini = template.read_text()
+    ini = ini.replace("/var/lib/virtuoso-opensource-7/db/", f"{directory}/")
+    ini = re.sub(r"(?m)^ServerPort(\s*)=\s*1111$", rf"ServerPort\g<1>= {sql_port}", ini)
+    ini = re.sub(r"(?m)^ServerPort(\s*)=\s*8890$", rf"ServerPort\g<1>= {http_port}", ini)
+    (directory / "virtuoso.ini").write_text(ini)
+    log = (directory / "out.log").open("wb")
+    process = subprocess.Popen(
+        [server, "+configfile", str(directory / "virtuoso.ini"), "+foreground"],
+        cwd=directory,
+        stdout=log,
+        stderr=subprocess.STDOUT,
+    )
+    url = f"http://127.0.0.1:{http_port}/sparql"
+    try:
+        deadline = time.monotonic() + 60
+        while True:
+            assert process.poll() is None, (directory / "out.log").read_text()
+            try:
+                if httpx.get(url, params={"query": "ASK {}"}, timeout=2).status_code == 200:
+                    break
+            except httpx.TransportError:
+                pass
+            assert time.monotonic() < deadline, "Virtuoso did not answer within 60 s"
+            time.sleep(0.2)
+        grant = 'grant SPARQL_UPDATE to "SPARQL";'
+        subprocess.run(
+            [isql, str(sql_port), "dba", "dba", f"exec={grant}"], check=True, timeout=30, capture_output=True
+        )
+        started = VirtuosoServer(url, frozenset(), process)
+        yield VirtuosoServer(url, frozenset(started.graphs()), process)
+    finally:
+        process.terminate()
+        try:
+            process.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait(timeout=10)
+        log.close()
 
 
 # -- knowledge bases ---------------------------------------------------------------------------------

@@ -27,7 +27,8 @@ from cbrs.kb import (
     StoreEvaluationError,
 )
 from cbrs.kb.namespaces import GraphName
-from cbrs.kb.remote_store import Endpoints, RemoteStore, inject_values
+from cbrs.kb.remote_store import DEFAULT_BATCH, Endpoints, RemoteStore, inject_values
+from cbrs.kb.staged_writes import STAGED, STAGING, batches, publication
 from tests.conftest import OxigraphServer
 
 DATA = Path(__file__).parent / "data"
@@ -292,8 +293,10 @@ def requests_seen(remote_location: str) -> Iterator[tuple[Store, list[httpx.Requ
     store.close()
 
 
-def test_a_large_add_is_one_request(requests_seen: tuple[Store, list[httpx.Request]]) -> None:
-    store, seen = requests_seen
+def test_an_add_within_the_batch_is_one_request(remote_location: str) -> None:
+    store = RemoteStore.open(remote_location, batch=20_000)
+    seen: list[httpx.Request] = []
+    store._http().event_hooks["request"].append(seen.append)
     p = ox.NamedNode("http://e/p")
     quads = [
         ox.Quad(ox.NamedNode(f"http://e/s{i}"), p, ox.Literal("x" * 100 + str(i)), GraphName.WORLD.node)
@@ -303,6 +306,7 @@ def test_a_large_add_is_one_request(requests_seen: tuple[Store, list[httpx.Reque
     assert [(r.method, r.url.path) for r in seen] == [("POST", "/update")]
     assert len(seen[0].content) > 2_000_000
     assert store.count(GraphName.WORLD) == 20_000
+    store.close()
 
 
 def test_a_refused_replace_sends_nothing(requests_seen: tuple[Store, list[httpx.Request]]) -> None:
@@ -316,12 +320,34 @@ def test_a_refused_replace_sends_nothing(requests_seen: tuple[Store, list[httpx.
     assert len(seen) == sent and store.dump() == before
 
 
-def test_the_seed_fits_one_request(requests_seen: tuple[Store, list[httpx.Request]]) -> None:
+def test_the_seed_is_staged_in_batches(requests_seen: tuple[Store, list[httpx.Request]]) -> None:
     store, seen = requests_seen
-    KnowledgeBase(store).seed()
-    [write] = [r for r in seen if r.url.path == "/update"]
-    assert 500_000 < len(write.content) < 2_000_000  # about 0.7 MB for the bundled 5,300 quads
-    assert store.is_seeded()
+    quads = sum(len(parsed.quads) for parsed in KnowledgeBase(store).seed())
+    writes = [r.content.decode() for r in seen if r.url.path == "/update"]
+    batches = -(-quads // DEFAULT_BATCH)
+    assert [w.count("INSERT DATA") for w in writes] == [1] * batches + [0, 0]  # the batches, publish, drop
+    assert store.is_seeded() and not [g for g in store.graphs() if g.startswith(STAGING)]
+
+
+def test_batches_keep_each_blank_nodes_quads_together() -> None:
+    p = ox.NamedNode("http://e/p")
+    a, b, c = ox.BlankNode("a"), ox.BlankNode("b"), ox.BlankNode("c")
+    linked = [ox.Quad(a, p, b), ox.Quad(b, p, ox.Literal("1")), ox.Quad(ox.NamedNode("http://e/x"), p, a)]
+    alone = [ox.Quad(c, p, ox.Literal("2"))]
+    plain = [ox.Quad(ox.NamedNode(f"http://e/s{i}"), p, ox.Literal(str(i))) for i in range(5)]
+    found = batches([*linked[:1], *plain, *alone, *linked[1:]], 3)
+    assert sorted(map(len, found)) == [1, 2, 3, 3]  # 3 + 2 plain quads, the linked three, the lone one
+    assert any(set(linked) <= set(part) for part in found)
+    assert [len(part) for part in batches(linked, 2)] == [3]  # a group larger than a batch stays whole
+
+
+def test_the_publication_is_one_operation_naming_every_staging_graph() -> None:
+    stages = {
+        ox.NamedNode(f"https://w3id.org/cbrs/graph/{g}"): ox.NamedNode(f"{STAGING}run/{i}") for i, g in enumerate("ab")
+    }
+    text = publication(stages)
+    assert text.count("INSERT") == 1 and ";" not in text
+    assert f"(<{STAGING}run/0> <https://w3id.org/cbrs/graph/a>)" in text and f'"{STAGED}"' in text
 
 
 def test_one_store_serves_many_threads(remote_location: str) -> None:

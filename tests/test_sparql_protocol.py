@@ -12,17 +12,12 @@ Then HEAD, a repeated ``query=``, the graph formats, ``Vary``, and rdflib's ``SP
 
 from __future__ import annotations
 
-import re
-import shutil
 import socket
-import subprocess
 import threading
-import time
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
-import httpx
 import pyoxigraph as ox
 import pytest
 from flask.testing import FlaskClient
@@ -36,7 +31,7 @@ from cbrs.kb.remote_store import RemoteStore
 from cbrs.kb.store import Store
 from cbrs.sparql_service import EndpointConfig, SparqlService, has_dataset_clause
 from cbrs.web import create_app
-from tests.conftest import OxigraphServer
+from tests.conftest import OxigraphServer, VirtuosoServer
 
 TOKEN = "protocol-test-token"
 WAIT = 10.0
@@ -345,60 +340,11 @@ def test_rdflib_sparqlupdatestore_writes_one_named_graph(live: str) -> None:
 # -- a remote store on another server than Oxigraph ---------------------------------------------------
 
 
-def _free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        port: int = probe.getsockname()[1]
-        return port
-
-
-@pytest.fixture(scope="module")
-def virtuoso(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
-    """Virtuoso 7 (Debian's virtuoso-opensource) on free loopback ports, its SPARQL user allowed to
-    update; the URL of its endpoint. Stopped by its PID."""
-    server, isql = shutil.which("virtuoso-t"), shutil.which("isql-vt")
-    template = Path("/etc/virtuoso-opensource-7/virtuoso.ini")
-    if server is None or isql is None or not template.is_file():
-        pytest.skip("Virtuoso is not installed (apt-get install virtuoso-opensource)")
-    directory = tmp_path_factory.mktemp("virtuoso")
-    sql_port, http_port = _free_port(), _free_port()
-    ini = template.read_text()
-    ini = ini.replace("/var/lib/virtuoso-opensource-7/db/", f"{directory}/")
-    ini = re.sub(r"(?m)^ServerPort(\s*)=\s*1111$", rf"ServerPort\g<1>= {sql_port}", ini)
-    ini = re.sub(r"(?m)^ServerPort(\s*)=\s*8890$", rf"ServerPort\g<1>= {http_port}", ini)
-    (directory / "virtuoso.ini").write_text(ini)
-    log = (directory / "out.log").open("wb")
-    process = subprocess.Popen(
-        [server, "+configfile", str(directory / "virtuoso.ini"), "+foreground"],
-        cwd=directory,
-        stdout=log,
-        stderr=subprocess.STDOUT,
-    )
-    url = f"http://127.0.0.1:{http_port}/sparql"
-    try:
-        deadline = time.monotonic() + 60
-        while True:
-            assert process.poll() is None, (directory / "out.log").read_text()
-            try:
-                if httpx.get(url, params={"query": "ASK {}"}, timeout=2).status_code == 200:
-                    break
-            except httpx.TransportError:
-                pass
-            assert time.monotonic() < deadline, "Virtuoso did not answer within 60 s"
-            time.sleep(0.2)
-        grant = 'grant SPARQL_UPDATE to "SPARQL";'
-        subprocess.run(
-            [isql, str(sql_port), "dba", "dba", f"exec={grant}"], check=True, timeout=30, capture_output=True
-        )
-        yield url
-    finally:
-        process.terminate()
-        try:
-            process.wait(timeout=20)
-        except subprocess.TimeoutExpired:
-            process.kill()
-            process.wait(timeout=10)
-        log.close()
+@pytest.fixture
+def virtuoso(virtuoso_server: VirtuosoServer) -> str:
+    """The session's Virtuoso (tests/conftest.py), cleared: the URL of its endpoint."""
+    virtuoso_server.clear()
+    return virtuoso_server.url
 
 
 def test_a_remote_store_on_virtuoso_reads_and_writes(virtuoso: str) -> None:
