@@ -355,7 +355,7 @@ class Bridge:
     # -- ops ----------------------------------------------------------------------------------------
 
     def _owned(self, name: str) -> bool:
-        return any(name.startswith(prefix) for prefix in self.reserved)
+        return bool(self.reserved) and name.startswith(self.reserved)
 
     def _refuse_owned_topic(self, name: str, topic: Topic | None) -> None:
         if (topic is not None and topic.server) or self._owned(name):
@@ -401,8 +401,9 @@ class Bridge:
             topic.publishers.add(session)
             if topic.latch or message.get("latch"):
                 topic.latched = text
+            subscribers = list(topic.subscribers)
         session.advertised.setdefault(name, message["topic"])
-        self._fan_out(name, text)
+        self._fan_out(name, text, subscribers)
 
     def _subscribe(self, session: Session, message: Message) -> None:
         name, kind, message_id = protocol.resolve(message["topic"], "topic"), message.get("type"), message.get("id")
@@ -597,11 +598,13 @@ class Bridge:
             raise ProtocolError(f"level must be one of {', '.join(LEVELS)}, not {message['level']!r}")
         session.level = message["level"]
 
-    def _fan_out(self, name: str, text: str) -> None:
-        """Queue a message for every subscriber, under the name each one subscribed with."""
-        with self._graph.lock:
-            topic = self._graph.topics.get(name)
-            subscribers = list(topic.subscribers) if topic is not None else []
+    def _fan_out(self, name: str, text: str, subscribers: list[Session] | None = None) -> None:
+        """Queue a message for every subscriber (those given, or the topic's now), under the name each
+        one subscribed with."""
+        if subscribers is None:
+            with self._graph.lock:
+                topic = self._graph.topics.get(name)
+                subscribers = list(topic.subscribers) if topic is not None else []
         framed: dict[str, str] = {}
         for session in subscribers:
             spelling = session.spelling.get(name, name)

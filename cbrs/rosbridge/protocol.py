@@ -7,6 +7,7 @@ root namespace: ``chatter`` and ``/chatter`` are the same topic.
 
 from __future__ import annotations
 
+import functools
 import json
 from dataclasses import dataclass
 from typing import Any
@@ -116,13 +117,18 @@ def _no_constants(name: str) -> Any:
     raise ValueError(f"{name} is not JSON")
 
 
+# Made once: json.loads and json.dumps with options build a new decoder or encoder on every call.
+_DECODER = json.JSONDecoder(parse_constant=_no_constants)
+_ENCODER = json.JSONEncoder(separators=(",", ":"), ensure_ascii=False, allow_nan=False)
+
+
 def decode(text: str, limit: int) -> Message:
     """Parse one text frame into a message with a string ``op``; raises :class:`ProtocolError`."""
     if len(text) > limit or (len(text) * 4 > limit and len(text.encode("utf-8")) > limit):
         size = len(text.encode("utf-8"))
         raise ProtocolError(f"message of {size} bytes exceeds the limit of {limit} bytes (max_message_bytes)")
     try:
-        message = json.loads(text, parse_constant=_no_constants)
+        message = _DECODER.decode(text)
     except ValueError as error:
         raise ProtocolError(f"message is not valid JSON: {error}") from None
     except RecursionError:
@@ -150,6 +156,8 @@ def check(message: Message) -> str:
         raise ProtocolError(f"unknown op {op!r}; this server supports {', '.join(OPS)}", message_id=message_id)
     for field in OPS[op]:
         value = message.get(field.name)
+        if type(value) in field.kinds:  # the common case, with nothing to convert (True is no integer here)
+            continue
         if value is None:
             if field.required:
                 raise ProtocolError(f"missing required field {field.name!r}", op, message_id)
@@ -182,7 +190,7 @@ def resolve(name: str, what: str = "name") -> str:
 
 def dumps(value: Any) -> str:
     """Compact JSON; NaN and infinities are refused, since JSON has no such numbers."""
-    return json.dumps(value, separators=(",", ":"), ensure_ascii=False, allow_nan=False)
+    return _ENCODER.encode(value)
 
 
 def status(level: str, text: str, message_id: MessageId | None) -> str:
@@ -195,7 +203,13 @@ def status(level: str, text: str, message_id: MessageId | None) -> str:
 
 def publish_text(topic: str, msg_json: str) -> str:
     """A ``publish`` message from an already encoded ``msg``."""
-    return f'{{"op":"publish","topic":{dumps(topic)},"msg":{msg_json}}}'
+    return f"{_publish_head(topic)}{msg_json}}}"
+
+
+@functools.lru_cache(maxsize=4096)
+def _publish_head(topic: str) -> str:
+    """The start of a ``publish`` message on ``topic``, encoded once per topic (every message needs it)."""
+    return f'{{"op":"publish","topic":{dumps(topic)},"msg":'
 
 
 def service_response(service: str, result: bool, values_json: str, message_id: MessageId | None) -> str:

@@ -31,6 +31,12 @@ log = logging.getLogger("cbrs.rosbridge")
 #: How long a client has to answer the server's close frame when the server stops.
 CLOSE_TIMEOUT = 2.0
 
+#: Frames of one client handled before its reader yields to the other tasks. Frames already buffered are
+#: read without yielding, so without a bound a fast publisher could fill its subscribers' queues before
+#: their writers send anything; yielding after every frame instead costs a writer wake-up per message.
+#: 16 publishers x 16 frames stay well inside a pass-through queue (max_queue_length, 1000).
+FRAMES_PER_TURN = 16
+
 
 def transport_limit(bridge: Bridge) -> int:
     """The websocket frame limit for ``bridge``: above its message limit, so that limit can answer."""
@@ -104,12 +110,14 @@ async def _serve(
             origin=websocket.request.headers.get("Origin") if websocket.request is not None else None,
             address=ip,
         )
+        turn = 0
         try:
             async for frame in websocket:
                 bridge.receive(session, frame)
-                # frames already buffered are read without yielding: let the writers run in between,
-                # or a fast publisher fills its subscribers' queues before they send anything
-                await asyncio.sleep(0)
+                turn += 1
+                if turn == FRAMES_PER_TURN:  # let the writers send what this client's frames queued
+                    turn = 0
+                    await asyncio.sleep(0)
         except ConnectionClosed:
             pass
         finally:

@@ -82,7 +82,7 @@ class Session:
         self._replies: deque[tuple[int, str]] = deque()
         self._reply_bytes = 0
         self._seq = 0
-        self._wake = asyncio.Event()
+        self._waiter: asyncio.Future[None] | None = None  # the writer waiting for something to send
 
     def __repr__(self) -> str:
         return f"<Session {self.name}>"
@@ -108,7 +108,7 @@ class Session:
             return
         self._replies.append((self._next_seq(), text))
         self._reply_bytes += len(text)
-        self._wake.set()
+        self._wake()
 
     def report(self, level: str, text: str, message_id: MessageId | None = None) -> None:
         """Send a ``status`` message if the client's level asks for it."""
@@ -144,12 +144,12 @@ class Session:
         queue.push(self._next_seq(), text)
         if queue.dropped != before and (queue.dropped & (queue.dropped - 1)) == 0:
             log.debug("%s: dropped %d messages of %s (queue of %d)", self.name, queue.dropped, topic, queue.capacity)
-        self._wake.set()
+        self._wake()
 
     def close(self) -> None:
         self.closed = True
         self.drop()
-        self._wake.set()
+        self._wake()
 
     def drop(self) -> None:
         """Forget every message waiting: a client that has gone holds no memory."""
@@ -169,12 +169,18 @@ class Session:
                 if text is not None:
                     await self._send(text)
                     continue
-                self._wake.clear()
+                # nothing to send now: sleep until woken, or until a throttled message is due
+                self._waiter = waiter = asyncio.get_running_loop().create_future()
                 try:
-                    async with asyncio.timeout(wait):
-                        await self._wake.wait()
+                    if wait is None:  # no timer to arm and cancel: the common case, woken per message
+                        await waiter
+                    else:
+                        async with asyncio.timeout(wait):
+                            await waiter
                 except TimeoutError:
                     pass
+                finally:
+                    self._waiter = None
         except Exception as error:  # the connection went away under a send
             log.debug("%s: writer stopped: %r", self.name, error)
             self.closed = True
@@ -199,6 +205,12 @@ class Session:
             self._reply_bytes -= len(text)
             return text, None
         return None, wait
+
+    def _wake(self) -> None:
+        """Wake the writer if it waits (a bare future: cheaper than an Event, woken once per message)."""
+        waiter = self._waiter
+        if waiter is not None and not waiter.done():
+            waiter.set_result(None)
 
     def _next_seq(self) -> int:
         self._seq += 1
