@@ -11,6 +11,10 @@ A snapshot is a RocksDB checkpoint of the store (hard links to its immutable fil
 milliseconds), taken when a query finds the store written since the last one, so a query always sees
 every write that came before it. A snapshot no worker reads and that is not the newest is deleted.
 Only an on-disk embedded store can be snapshotted; the endpoint evaluates in threads otherwise.
+
+A worker left idle for ``idle`` seconds (setting ``query_worker_idle``) is stopped, so that a server
+that answered a heavy query an hour ago does not hold a process and its memory for it; the next query
+that needs one starts a worker again (a few tens of milliseconds).
 """
 
 from __future__ import annotations
@@ -86,6 +90,7 @@ class _Process:
         )
         self.ready = False
         self.snapshot: _Snapshot | None = None
+        self.idle_since = time.monotonic()
         _started.add(self.popen)
 
     def alive(self) -> bool:
@@ -106,13 +111,16 @@ class _Process:
 class QueryProcesses:
     """Up to ``size`` worker processes evaluating queries on snapshots of ``store``."""
 
-    def __init__(self, store: EmbeddedStore, size: int, memory: int, stack: int = EVALUATION_STACK) -> None:
+    def __init__(
+        self, store: EmbeddedStore, size: int, memory: int, stack: int = EVALUATION_STACK, idle: float = 30.0
+    ) -> None:
         if store.in_memory:
             raise ValueError("an in-memory store cannot be snapshotted for worker processes")
         self.store = store
         self.size = size
         self.memory = memory
         self.stack = stack
+        self.idle = idle
         self.killed = 0  # workers killed for a deadline or memory: for tests and the log
         self._idle: list[_Process] = []
         self._lock = threading.Lock()
@@ -120,6 +128,8 @@ class QueryProcesses:
         self._current: _Snapshot | None = None
         self._count = 0
         self._closed = False
+        self._reaper: threading.Thread | None = None
+        self._wake = threading.Event()
         parent = Path(store.location).resolve().parent
         try:  # beside the store, so the checkpoint hard-links its files instead of copying them
             self._root = Path(tempfile.mkdtemp(prefix=".cbrs-query-snapshots-", dir=parent))
@@ -162,6 +172,7 @@ class QueryProcesses:
         with self._lock:
             self._closed = True
             idle, self._idle = self._idle, []
+        self._wake.set()
         for worker in idle:
             worker.kill()
         shutil.rmtree(self._root, ignore_errors=True)
@@ -221,10 +232,26 @@ class QueryProcesses:
     def _give_back(self, worker: _Process) -> None:
         with self._lock:
             if not self._closed and len(self._idle) < self.size:
+                worker.idle_since = time.monotonic()
                 self._idle.append(worker)
+                if self._reaper is None:
+                    self._reaper = threading.Thread(target=self._reap, name="cbrs-query-reaper", daemon=True)
+                    self._reaper.start()
                 return
             self._release(worker)
         worker.kill()
+
+    def _reap(self) -> None:
+        """Stop the workers idle for longer than ``idle`` seconds, until closed."""
+        while not self._wake.wait(max(0.05, min(self.idle / 2, 5.0))):
+            cutoff = time.monotonic() - self.idle
+            with self._lock:
+                stale = [worker for worker in self._idle if worker.idle_since <= cutoff]
+                self._idle = [worker for worker in self._idle if worker.idle_since > cutoff]
+                for worker in stale:
+                    self._release(worker)
+            for worker in stale:
+                worker.kill()
 
     def _discard(self, worker: _Process) -> None:
         with self._lock:

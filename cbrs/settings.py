@@ -166,6 +166,14 @@ SETTINGS: tuple[Setting, ...] = (
         _non_negative,
     ),
     Setting(
+        "query_worker_idle",
+        lambda: 30.0,
+        "Seconds a SPARQL query worker process may sit idle before it is stopped, giving its memory back; "
+        "the next query that needs one starts it again (tens of milliseconds).",
+        "CBRS_QUERY_WORKER_IDLE",
+        _positive(float),
+    ),
+    Setting(
         "stream_limit",
         lambda: 8,
         "Event and camera streams (/tasks/events, /camera.mjpg) open at once; each has a thread of its own "

@@ -47,7 +47,7 @@ from cbrs.kb.remote_store import RemoteStore
 from cbrs.kb.sparql_lexemes import HIDING
 from cbrs.kb.store import EmbeddedStore, QueryResult, refuse_inserted_blank_nodes
 from cbrs.query_workers import QueryProcesses, QueryStopped, Request
-from cbrs.scan_queries import is_single_scan
+from cbrs.scan_queries import is_single_scan, uses_prefixes
 from cbrs.settings import setting
 
 # Media types offered for SELECT and ASK results, the first being the default.
@@ -221,6 +221,8 @@ _FORMS = {"SELECT", "CONSTRUCT", "DESCRIBE", "ASK"}
 
 def has_dataset_clause(text: str) -> bool:
     """Whether the query names its own dataset with ``FROM`` or ``FROM NAMED`` (only those clauses use the keyword)."""
+    if "FROM" not in text.upper():
+        return False  # the common case, without tokenising
     return any((match.group("word") or "").upper() == "FROM" for match in _TOKEN.finditer(text))
 
 
@@ -296,6 +298,7 @@ class EndpointConfig:
     # process may hold (0: no limit); from the settings table unless given
     workers_per_client: int = field(default_factory=lambda: setting("query_workers_per_client").resolve())
     memory: int = field(default_factory=lambda: setting("query_memory").resolve())
+    worker_idle: float = field(default_factory=lambda: setting("query_worker_idle").resolve())
     isolate: bool = True  # evaluate in killable worker processes when the store is on disk
 
 
@@ -339,7 +342,9 @@ class SparqlService:
         store = kb.store
         self.processes: QueryProcesses | None = None
         if self.config.isolate and isinstance(store, EmbeddedStore) and not store.in_memory:
-            self.processes = QueryProcesses(store, self.config.workers, self.config.memory)
+            self.processes = QueryProcesses(
+                store, self.config.workers, self.config.memory, idle=self.config.worker_idle
+            )
 
     @property
     def writable(self) -> bool:
@@ -543,7 +548,8 @@ class SparqlService:
         store = self.kb.store
         assert isinstance(store, EmbeddedStore)
         try:
-            return store._backend.query(text, prefixes=PREFIXES, **dataset_options(graphs))
+            prefixes = PREFIXES if uses_prefixes(text) else None
+            return store._backend.query(text, prefixes=prefixes, **dataset_options(graphs))
         except SyntaxError as error:
             raise QuerySyntaxError(text, str(error)) from error
         except (OSError, RuntimeError) as error:

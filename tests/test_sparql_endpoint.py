@@ -7,6 +7,7 @@ import threading
 import time
 import urllib.error
 from collections.abc import Iterator
+from pathlib import Path
 from typing import Any
 
 import pyoxigraph as ox
@@ -432,3 +433,22 @@ def test_a_single_scan_stops_at_the_byte_limit_and_the_deadline(
     monkeypatch.setattr("cbrs.sparql_service.time.monotonic", lambda: next(clock))
     with pytest.raises(QueryTimeoutError):
         SparqlService(bundled_kb, EndpointConfig(timeout=5.0)).query(scan_all_types)
+
+
+def test_an_idle_query_worker_is_stopped_and_a_later_query_starts_another(tmp_path: Path) -> None:
+    kb = KnowledgeBase.open(tmp_path / "store")
+    service = SparqlService(kb, EndpointConfig(worker_idle=0.2))
+    try:
+        assert service.processes is not None
+        assert json.loads(service.query(SELECT).body)["results"]["bindings"]  # not a single scan: a worker
+        assert len(service.processes._idle) == 1
+        worker = service.processes._idle[0]
+        deadline = time.monotonic() + 20
+        while service.processes._idle and time.monotonic() < deadline:
+            time.sleep(0.05)
+        assert service.processes._idle == []
+        assert worker.popen.wait(timeout=10) is not None  # the process has ended
+        assert json.loads(service.query(SELECT).body)["results"]["bindings"]
+    finally:
+        service.close()
+        kb.close()

@@ -93,8 +93,15 @@ def create_app(
     allowed = frozenset(cors_origins)
     links.install(app)
 
+    known: list[frozenset[str | None] | None] = []
+
     def names() -> frozenset[str | None] | None:
-        return None if own_origins is None else host_names(frozenset(own_origins()), allowed)
+        if known:
+            return known[0]
+        own = frozenset(own_origins()) if own_origins is not None else frozenset()
+        if own:  # the server is listening: its address and port stay what they are
+            known.append(host_names(own, allowed))
+        return host_names(own, allowed)
 
     # plain /sparql queries skip Flask's request machinery (cbrs.web.sparql_wsgi), with the same answers
     app.wsgi_app = SparqlHotPath(app.wsgi_app, sparql, names, app.config["MAX_CONTENT_LENGTH"])  # type: ignore[method-assign]
