@@ -45,6 +45,15 @@ _SHAPE = re.compile(
 )
 
 
+_IRI_OR_STRING = re.compile(rf"{_IRI}|{_STRING}")
+
+
+def uses_prefixes(text: str) -> bool:
+    """Whether ``text`` may use a prefixed name (a colon outside IRIs and strings): a query that uses
+    none is evaluated without cbrs's prefix table, whose hand-over costs more than a lookup."""
+    return ":" in _IRI_OR_STRING.sub("", text)
+
+
 def is_single_scan(text: str) -> bool:
     """Whether ``text`` is a query Oxigraph answers with one index scan that yields a solution per
     triple it reads (see the module's docstring); it may still be malformed in ways the parser finds."""
