@@ -1,4 +1,4 @@
-"""Path planning on the inflated occupancy grid with networkx's A* and Dijkstra.
+"""Path planning on the inflated occupancy grid with A* and Dijkstra.
 
 The graph has one node per free cell and 8-connected edges weighted by their length in metres;
 a diagonal step is only allowed when both cells beside it are free, so paths never cut a corner of
@@ -6,17 +6,22 @@ an obstacle. A* uses the straight-line distance, which never overestimates, so b
 paths of the same (shortest) length. A start or goal inside an obstacle is moved to the nearest free
 cell first. The cell path is then shortened to the corners that are needed (line of sight on the
 inflated grid), which is what the base drives along.
+
+The searches walk the grid itself rather than a graph built from it: building networkx's graph of a
+home's 20,000 free cells took longer than the search (0.3-0.45 s per grid, and every decoded grid
+is a new one). They are networkx's ``astar_path`` and ``dijkstra_path`` step for step, with each
+cell's neighbours in the order networkx's graph held them, so they return the very same paths
+(tests/test_sim_mapping.py compares them on random grids).
 """
 
 from __future__ import annotations
 
 import itertools
 import math
-import weakref
 from dataclasses import dataclass
+from heapq import heappop, heappush
 from typing import Literal
 
-import networkx as nx
 import numpy as np
 
 from cbrs.sim.errors import NoFreeCellError, NoPathError, UnknownAlgorithmError
@@ -30,8 +35,6 @@ SNAP_RADIUS = 1.0
 """A start or goal may be moved at most this far (m) to reach a free cell."""
 
 Cell = tuple[int, int]
-
-_graphs: weakref.WeakKeyDictionary[OccupancyGrid, nx.Graph[Cell]] = weakref.WeakKeyDictionary()
 
 
 @dataclass(frozen=True)
@@ -50,28 +53,113 @@ class PlannedPath:
     """Number of cells on the cell path."""
 
 
-def _graph(grid: OccupancyGrid) -> nx.Graph[Cell]:
-    cached = _graphs.get(grid)
-    if cached is not None:
-        return cached
-    free = grid.free
-    graph: nx.Graph[Cell] = nx.Graph()
-    graph.add_nodes_from((int(i), int(j)) for i, j in np.argwhere(free))
-    r = grid.resolution
-    diagonal = r * math.sqrt(2.0)
-    # Right and up neighbours, then the two diagonals with both side cells free.
-    right = free[:, :-1] & free[:, 1:]
-    up = free[:-1, :] & free[1:, :]
-    up_right = free[:-1, :-1] & free[1:, 1:] & free[1:, :-1] & free[:-1, 1:]
-    up_left = free[:-1, 1:] & free[1:, :-1] & free[1:, 1:] & free[:-1, :-1]
-    edges: list[tuple[Cell, Cell, float]] = []
-    edges += [((int(i), int(j)), (int(i), int(j) + 1), r) for i, j in np.argwhere(right)]
-    edges += [((int(i), int(j)), (int(i) + 1, int(j)), r) for i, j in np.argwhere(up)]
-    edges += [((int(i), int(j)), (int(i) + 1, int(j) + 1), diagonal) for i, j in np.argwhere(up_right)]
-    edges += [((int(i), int(j) + 1), (int(i) + 1, int(j)), diagonal) for i, j in np.argwhere(up_left)]
-    graph.add_weighted_edges_from(edges)
-    _graphs[grid] = graph
-    return graph
+class _Grid:
+    """The 8-connected graph of a grid's free cells, read off the grid as the search goes."""
+
+    def __init__(self, grid: OccupancyGrid) -> None:
+        rows, cols = grid.shape
+        padded = np.zeros((rows + 2, cols + 2), dtype=bool)  # a border of obstacles: no bounds checks
+        padded[1:-1, 1:-1] = grid.free
+        self.free: list[list[bool]] = padded.tolist()
+        self.straight = grid.resolution
+        self.diagonal = grid.resolution * math.sqrt(2.0)
+
+    def neighbours(self, cell: Cell) -> list[tuple[Cell, float]]:
+        """The cells one step from ``cell`` with the step's length, in the order networkx's graph of
+        the grid listed them (its edges were added right, up, up-right, up-left, each row by row)."""
+        i, j = cell
+        f = self.free
+        below, here, above = f[i], f[i + 1], f[i + 2]  # rows i - 1, i, i + 1 (padded by one)
+        c = j + 1
+        found: list[tuple[Cell, float]] = []
+        if not here[c]:
+            return found
+        r, d = self.straight, self.diagonal
+        if here[c - 1]:
+            found.append(((i, j - 1), r))
+        if here[c + 1]:
+            found.append(((i, j + 1), r))
+        if below[c]:
+            found.append(((i - 1, j), r))
+        if above[c]:
+            found.append(((i + 1, j), r))
+        if below[c - 1] and below[c] and here[c - 1]:
+            found.append(((i - 1, j - 1), d))
+        if above[c + 1] and above[c] and here[c + 1]:
+            found.append(((i + 1, j + 1), d))
+        if below[c + 1] and below[c] and here[c + 1]:
+            found.append(((i - 1, j + 1), d))
+        if above[c - 1] and above[c] and here[c - 1]:
+            found.append(((i + 1, j - 1), d))
+        return found
+
+
+def _astar(graph: _Grid, source: Cell, target: Cell) -> list[Cell] | None:
+    """networkx's astar_path with the straight-line heuristic; None when the target is not reached."""
+    r = graph.straight
+    counter = itertools.count()
+    queue: list[tuple[float, int, Cell, float, Cell | None]] = [(0, next(counter), source, 0, None)]
+    enqueued: dict[Cell, tuple[float, float]] = {}
+    explored: dict[Cell, Cell | None] = {}
+    while queue:
+        _, _, node, dist, parent = heappop(queue)
+        if node == target:
+            path = [node]
+            back = parent
+            while back is not None:
+                path.append(back)
+                back = explored[back]
+            path.reverse()
+            return path
+        if node in explored:
+            if explored[node] is None:
+                continue
+            if enqueued[node][0] < dist:
+                continue
+        explored[node] = parent
+        for neighbour, cost in graph.neighbours(node):
+            ncost = dist + cost
+            if neighbour in enqueued:
+                qcost, h = enqueued[neighbour]
+                if qcost <= ncost:
+                    continue
+            else:
+                h = r * math.hypot(neighbour[0] - target[0], neighbour[1] - target[1])
+            enqueued[neighbour] = ncost, h
+            heappush(queue, (ncost + h, next(counter), neighbour, ncost, node))
+    return None
+
+
+def _dijkstra(graph: _Grid, source: Cell, target: Cell) -> list[Cell] | None:
+    """networkx's dijkstra_path (a node's predecessor is the one that last shortened it); None when
+    the target is not reached."""
+    counter = itertools.count()
+    fringe: list[tuple[float, int, Cell]] = [(0, next(counter), source)]
+    dist: dict[Cell, float] = {}
+    seen: dict[Cell, float] = {source: 0}
+    previous: dict[Cell, Cell] = {}
+    while fringe:
+        dist_v, _, v = heappop(fringe)
+        if v in dist:
+            continue
+        dist[v] = dist_v
+        if v == target:
+            break
+        for u, cost in graph.neighbours(v):
+            vu_dist = dist_v + cost
+            if u in dist:
+                continue
+            if u not in seen or vu_dist < seen[u]:
+                seen[u] = vu_dist
+                heappush(fringe, (vu_dist, next(counter), u))
+                previous[u] = v
+    if target not in dist:
+        return None
+    path = [target]
+    while path[-1] in previous:
+        path.append(previous[path[-1]])
+    path.reverse()
+    return path
 
 
 def snap_to_free(grid: OccupancyGrid, x: float, y: float, radius: float = SNAP_RADIUS) -> tuple[int, int]:
@@ -126,20 +214,12 @@ def plan_path(
         raise UnknownAlgorithmError(algorithm, ALGORITHMS)
     source = snap_to_free(grid, *start)
     target = snap_to_free(grid, *goal)
-    graph = _graph(grid)
-    r = grid.resolution
-
-    def heuristic(a: Cell, b: Cell) -> float:
-        return r * math.hypot(a[0] - b[0], a[1] - b[1])
-
-    try:
-        if algorithm == "astar":
-            cells: list[Cell] = nx.astar_path(graph, source, target, heuristic=heuristic, weight="weight")
-        else:
-            cells = nx.dijkstra_path(graph, source, target, weight="weight")
-    except nx.NetworkXNoPath:
-        raise NoPathError(start, goal, algorithm) from None
-    length = float(sum(graph.edges[a, b]["weight"] for a, b in itertools.pairwise(cells)))
+    graph = _Grid(grid)
+    cells = (_astar if algorithm == "astar" else _dijkstra)(graph, source, target)
+    if cells is None:
+        raise NoPathError(start, goal, algorithm)
+    steps = (graph.straight if a[0] == b[0] or a[1] == b[1] else graph.diagonal for a, b in itertools.pairwise(cells))
+    length = float(sum(steps))
     points = [grid.cell_to_world(i, j) for i, j in cells]
     waypoints = _shortcut(grid, points) if len(points) > 1 else points
     return PlannedPath(

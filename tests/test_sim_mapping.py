@@ -20,7 +20,7 @@ from cbrs.sim import (
 )
 from cbrs.sim.layout import MAP_RESOLUTION
 from cbrs.sim.mapping import inflate
-from cbrs.sim.planning import approach_point, snap_to_free
+from cbrs.sim.planning import _astar, _dijkstra, _Grid, _shortcut, approach_point, snap_to_free
 from tests.home_layout import HANDOVER_POSE, TABLE, WALLS
 
 
@@ -143,3 +143,68 @@ def test_planning_fails_clearly(grid: OccupancyGrid) -> None:
 def test_approach_point_stops_short_of_the_target() -> None:
     assert approach_point((4.0, 0.0), (0.0, 0.0), 1.0) == pytest.approx((3.0, 0.0))
     assert approach_point((0.5, 0.0), (0.0, 0.0), 1.0) == (0.0, 0.0)
+
+
+Cell = tuple[int, int]
+
+
+def _networkx_path(grid: OccupancyGrid, source: Cell, target: Cell, algorithm: str) -> tuple[list[Cell], float] | None:
+    """The cell path and length networkx's searches find on the graph the planner used to build from
+    the grid (the reference the planner's own searches must match)."""
+    import itertools
+
+    import networkx as nx
+
+    free, r = grid.free, grid.resolution
+    graph: nx.Graph[Cell] = nx.Graph()
+    graph.add_nodes_from((int(i), int(j)) for i, j in np.argwhere(free))
+    right = free[:, :-1] & free[:, 1:]
+    up = free[:-1, :] & free[1:, :]
+    block = free[:-1, :-1] & free[1:, 1:] & free[1:, :-1] & free[:-1, 1:]
+    edges = [((int(i), int(j)), (int(i), int(j) + 1), r) for i, j in np.argwhere(right)]
+    edges += [((int(i), int(j)), (int(i) + 1, int(j)), r) for i, j in np.argwhere(up)]
+    edges += [((int(i), int(j)), (int(i) + 1, int(j) + 1), r * math.sqrt(2.0)) for i, j in np.argwhere(block)]
+    edges += [((int(i), int(j) + 1), (int(i) + 1, int(j)), r * math.sqrt(2.0)) for i, j in np.argwhere(block)]
+    graph.add_weighted_edges_from(edges)
+    try:
+        if algorithm == "astar":
+            cells = nx.astar_path(graph, source, target, lambda a, b: r * math.hypot(a[0] - b[0], a[1] - b[1]))
+        else:
+            cells = nx.dijkstra_path(graph, source, target)
+    except nx.NetworkXNoPath:
+        return None
+    return cells, sum(graph.edges[a, b]["weight"] for a, b in itertools.pairwise(cells))
+
+
+def _same_as_networkx(grid: OccupancyGrid, start: tuple[float, float], goal: tuple[float, float]) -> None:
+    source, target = snap_to_free(grid, *start), snap_to_free(grid, *goal)
+    for algorithm, search in (("astar", _astar), ("dijkstra", _dijkstra)):
+        expected = _networkx_path(grid, source, target, algorithm)
+        assert search(_Grid(grid), source, target) == (expected[0] if expected else None)
+        if expected is None:
+            with pytest.raises(NoPathError):
+                plan_path(grid, start, goal, algorithm)
+            continue
+        cells, length = expected
+        path = plan_path(grid, start, goal, algorithm)
+        assert path.length == length and path.cells == len(cells)
+        assert list(path.waypoints) == _shortcut(grid, [grid.cell_to_world(i, j) for i, j in cells])
+
+
+@pytest.mark.parametrize("seed", range(24))
+def test_the_searches_find_the_paths_networkx_finds(seed: int) -> None:
+    """The very same cells, on random grids full of equally short paths (and none where there is none)."""
+    rng = np.random.default_rng(seed)
+    rows, cols = int(rng.integers(3, 40)), int(rng.integers(3, 40))
+    blocked = rng.random((rows, cols)) < rng.uniform(0.0, 0.35)
+    grid = OccupancyGrid(0.05, (0.0, 0.0), blocked, blocked, 0.0)
+    free = np.argwhere(~blocked)
+    for _ in range(6 if len(free) >= 2 else 0):
+        a, b = rng.choice(len(free), 2)
+        start = grid.cell_to_world(int(free[a][0]), int(free[a][1]))
+        _same_as_networkx(grid, start, grid.cell_to_world(int(free[b][0]), int(free[b][1])))
+
+
+def test_the_searches_find_the_paths_networkx_finds_in_the_home(grid: OccupancyGrid) -> None:
+    for start, goal in [((3.0, 1.5), HANDOVER_POSE.xy), ((3.0, 1.5), (2.5, 7.5)), ((8.5, 2.2), (1.0, 4.0))]:
+        _same_as_networkx(grid, start, goal)
