@@ -1,11 +1,13 @@
 """Benchmark: start-up, composition at scale, /cbrs/plan over the bridge and matchmaker memory (issue 18).
 
-Run: python bench/startup_and_scale.py [--repeat 5] [--chain 10000] [--classes 64000] [--ads 2000]
+Run: python bench/startup_and_scale.py [--quick] [--repeat 5] [--chain 10000] [--classes 64000] [--ads 2000]
 [--requirements 200] [--json FILE]
 
 Each row is measured next to an anchor in the same run: a bare ``python -c pass`` and ``oxigraph serve``
 for the process starts, the in-process composer for /cbrs/plan, the memory before the requirements
-for the matchmaker. Prints the machine, the inputs, the figures and the ratios.
+for the matchmaker. Prints the machine, the inputs, the figures and the ratios; ``--json FILE`` writes
+the rows of issue 18 as records ``{row, value, anchor, ratio, unit, goal, met}`` (bench/all_rows.py
+merges them with the other benches').
 """
 
 from __future__ import annotations
@@ -205,8 +207,11 @@ def main() -> None:
     parser.add_argument("--classes", type=int, default=64_000)
     parser.add_argument("--ads", type=int, default=2_000)
     parser.add_argument("--requirements", type=int, default=200)
-    parser.add_argument("--json", type=Path, help="Also write the figures to FILE as JSON.")
+    parser.add_argument("--quick", action="store_true", help="3 repeats, a 2,000-link chain, 8,000 classes")
+    parser.add_argument("--json", type=Path, help="Also write the rows to FILE as a JSON list of records.")
     args = parser.parse_args()
+    if args.quick:
+        args.repeat, args.chain, args.classes, args.ads, args.requirements = 3, 2_000, 8_000, 500, 40
     load = os.getloadavg()[0]
     machine = f"{platform.platform()}, {os.cpu_count()} cores, python {platform.python_version()}"
     print(f"machine: {machine}, load average {load:.2f}")
@@ -245,8 +250,43 @@ def main() -> None:
     for name, value in record["memory"].items():
         print(f"  {name:<42} {value:8.1f}")
     if args.json is not None:
-        args.json.write_text(json.dumps(record, indent=2) + "\n")
+        args.json.parent.mkdir(parents=True, exist_ok=True)
+        args.json.write_text(json.dumps(records(record, args.requirements), indent=2) + "\n")
         print(f"\nwritten to {args.json}")
+
+
+def records(record: dict[str, Any], requirements: int) -> list[dict[str, Any]]:
+    """The figures as issue 18's rows: ``{row, value, anchor, ratio, unit, goal, met}``."""
+
+    def row(name: str, value: float | None, anchor: float | None, unit: str, goal: str, met: bool | None = None):
+        ratio = value / anchor if value is not None and anchor else None
+        if met is None:  # an absolute goal: "<= limit" in the row's unit
+            met = value is not None and value <= float(goal.split()[1])
+        return {"row": name, "value": value, "anchor": anchor, "ratio": ratio, "unit": unit, "goal": goal, "met": met}
+
+    start = record["startup"]
+    bare, oxigraph = start["python -c pass"], start.get("oxigraph serve ready")
+    plan = record["plan"]
+    local, remote = plan["Composer.compose in-process"], plan["/cbrs/plan over the bridge"]
+    memory = record["memory"]
+    after = next(value for name, value in memory.items() if name.startswith("RSS after"))
+    bounded = memory["MB per requirement, second half"] < 1.0
+    chain = next((v for k, v in record["composition"].items() if k.startswith("unsolvable")), None)
+    return [
+        row("cbrs --help, process start", start["cbrs --help"], bare, "s", "<= 0.3"),
+        row("cbrs query, process start", start["cbrs query (:memory:)"], bare, "s", "<= 0.3"),
+        row("cbrs serve ready", start["cbrs serve ready (on-disk store)"], oxigraph, "s", "<= 0.5"),
+        row("composition over a long chain pool", chain, None, "s", "composes", "error" not in record["composition"]),
+        row("/cbrs/plan over the bridge, FetchMyPen", remote * 1000, local * 1000, "ms", "<= 20"),
+        row(
+            f"matchmaker RSS after {requirements} distinct requirements",
+            after,
+            None,
+            "MB",
+            "<= 500",
+            after <= 500 and bounded,
+        ),
+    ]
 
 
 if __name__ == "__main__":
