@@ -97,8 +97,8 @@ class MobileBase:
         self._command(pose)
 
     def _lagging(self) -> bool:
-        actual = self.pose()
-        return actual.distance_to(self._setpoint.x, self._setpoint.y) > BLOCKED_DISTANCE
+        (x, y, _), _ = p.getBasePositionAndOrientation(self.body, physicsClientId=self.client)
+        return math.hypot(x - self._setpoint.x, y - self._setpoint.y) > BLOCKED_DISTANCE  # the pose without its yaw
 
     def follow(
         self, waypoints: Sequence[tuple[float, float]], final_heading: float | None = None, time_limit: float = 0.0

@@ -9,7 +9,7 @@ world and, since stepping is deterministic, the same outcome for the same calls.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Hashable, Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass
 from types import TracebackType
@@ -192,8 +192,12 @@ class HomeWorld:
         self.arm_specs: dict[ArmSide, ArmSpec] = {}
         """What the semantic map says of each arm: its mount pose and reach."""
         self._kinematics: Kinematics | None = None
+        self._taps: list[tuple[Dispenser, int]] = []
+        self._joints: list[tuple[int, list[int]]] = []
         try:
             self._build()
+            self._taps = [(d, self._bodies[d.name]) for d in self.dispensers]
+            self._joints = self._moving_joints()
             self.base = MobileBase(client, self._bodies[self.base_name], self.step)
             self.step(0.3)  # let the objects settle on the table
         except BaseException:
@@ -261,13 +265,15 @@ class HomeWorld:
         """Advance the physics by ``seconds``, rounded to whole fixed steps (at least one)."""
         self._check()
         count = max(1, round(seconds / self.time_step))
+        client = self.client
         for _ in range(count):
-            p.stepSimulation(physicsClientId=self.client)
+            p.stepSimulation(physicsClientId=client)
             self._steps += 1
             self._run_tap()
-            for every, callback in list(self._watchers):
-                if self._steps % every == 0:
-                    callback()
+            if self._watchers:
+                for every, callback in list(self._watchers):
+                    if self._steps % every == 0:
+                        callback()
 
     def on_steps(self, every: int, callback: Callable[[], None]) -> Callable[[], None]:
         """Call ``callback()`` after every ``every``-th physics step (a recorder's frames); returns the
@@ -319,6 +325,29 @@ class HomeWorld:
 
     def repair_camera(self, name: str) -> None:
         self.camera(name).failed = False
+
+    def scene_key(self) -> Hashable:
+        """What a camera's image depends on: the step, every body's pose, the moving joints' angles and
+        the water shown. Equal keys, equal images: a camera asked twice with nothing changed between
+        (the belief looking, then a goal check) renders once."""
+        c = self.client
+        poses = tuple(p.getBasePositionAndOrientation(body, physicsClientId=c) for body in self._bodies.values())
+        joints = tuple(
+            tuple(state[0] for state in p.getJointStates(body, indices, physicsClientId=c))
+            for body, indices in self._joints
+        )
+        return (self._steps, poses, joints, frozenset(self._water_shown))
+
+    def _moving_joints(self) -> list[tuple[int, list[int]]]:
+        """Each body with joints that move (the arms, the taps' levers) and those joints."""
+        found = []
+        for body in self._bodies.values():
+            count = p.getNumJoints(body, physicsClientId=self.client)
+            kinds = [p.getJointInfo(body, j, physicsClientId=self.client)[2] for j in range(count)]
+            moving = [j for j, kind in enumerate(kinds) if kind != p.JOINT_FIXED]
+            if moving:
+                found.append((body, moving))
+        return found
 
     def snapshot(self) -> dict[str, Pose3D]:
         """Poses of everything that can move (objects, base, person), for comparing runs."""
@@ -386,8 +415,8 @@ class HomeWorld:
         return inside and below and up > 0.95
 
     def _run_tap(self) -> None:
-        for dispenser in self.dispensers:
-            if self.tap_open(dispenser.name):
+        for dispenser, body in self._taps:  # tap_open of each, without looking the dispensers up every step
+            if float(p.getJointState(body, 1, physicsClientId=self.client)[0]) > TAP_OPEN_TRAVEL:
                 self._pour(dispenser.outlet)
 
     def _pour(self, outlet: Vec3) -> None:
@@ -513,7 +542,7 @@ class HomeWorld:
                 near=cam.near,
                 far=cam.far,
             )
-            self.cameras[spec.name] = Camera(c, spec, self)
+            self.cameras[spec.name] = Camera(c, spec, self, self.scene_key)
         if self.gui:
             p.configureDebugVisualizer(render, 1, physicsClientId=c)
 

@@ -6,6 +6,7 @@ import math
 from collections.abc import Iterator
 
 import numpy as np
+import pybullet as p
 import pytest
 
 from cbrs.sim import (
@@ -135,3 +136,31 @@ def test_a_person_at_the_edge_of_the_image_is_not_guessed(world: HomeWorld) -> N
     with pytest.raises(NotVisibleError) as error:
         track_person(world.camera("CeilingCamera02").capture())
     assert error.value.camera == "CeilingCamera02"
+
+
+def test_a_camera_renders_again_only_when_the_scene_changed(monkeypatch: pytest.MonkeyPatch) -> None:
+    """Asked twice with nothing changed, a camera gives the same image without rendering it again;
+    a step, a body put elsewhere or an arm's joint set anew makes it render."""
+    from cbrs.sim import cameras
+
+    renders: list[int] = []
+    real = cameras.render
+    monkeypatch.setattr(cameras, "render", lambda *args: (renders.append(1), real(*args))[1])
+    with HomeWorld.create(seed=4) as w:
+        camera = w.camera("CeilingCamera01")
+        first = camera.capture()
+        first.rgb[:] = 0  # what a caller does with its frame stays its own
+        again = camera.capture()
+        assert len(renders) == 1 and again.time == first.time and again.rgb.any()
+        w.base.place(HANDOVER_POSE)  # no step between: the pose changes the image
+        moved = camera.capture()
+        assert len(renders) == 2 and not np.array_equal(moved.rgb, again.rgb)
+        arm = w.arm("left")
+        p.resetJointState(arm.body, 0, 0.2, physicsClientId=w.client)
+        camera.capture()
+        assert len(renders) == 3
+        w.step(w.time_step)
+        stepped = camera.capture()
+        assert len(renders) == 4 and stepped.time > moved.time
+        fresh = cameras.Camera(w.client, camera.spec, w)  # no scene to go by: renders every time
+        assert np.array_equal(fresh.capture().rgb, fresh.capture().rgb) and len(renders) == 6
