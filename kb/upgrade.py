@@ -100,28 +100,57 @@ def _bundled(path: Path, graph: GraphName) -> tuple[ox.Quad, ...]:
 @functools.cache
 def _bundled_headers() -> tuple[tuple[ox.NamedNode, GraphName, tuple[ox.Quad, ...]], ...]:
     """(ontology IRI, graph, header quads) of the bundled ontologies in the upgraded graphs, read without
-    skolemising: a header has no blank nodes, and this runs on every open."""
+    skolemising (a header has no blank nodes)."""
     found = []
     for item in bundled_files():
         if item.graph not in UPGRADED_GRAPHS:
             continue
         triples = list(ox.parse(path=str(item.path), format=ox.RdfFormat.TURTLE))
-        heads = {t.subject for t in triples if t.predicate.value == RDF + "type" and t.object.value == OWL + "Ontology"}
-        for head in heads:
+        for head in {t.subject for t in triples if _is_header(t)}:
             if isinstance(head, ox.NamedNode):
-                own = (t for t in triples if t.subject == head)
-                found.append(
-                    (head, item.graph, tuple(ox.Quad(t.subject, t.predicate, t.object, item.graph.node) for t in own))
-                )
+                own = (ox.Quad(t.subject, t.predicate, t.object, item.graph.node) for t in triples if t.subject == head)
+                found.append((head, item.graph, tuple(own)))
     return tuple(found)
+
+
+@functools.cache
+def _bundled_versions() -> tuple[tuple[ox.NamedNode, GraphName, frozenset[str]], ...]:
+    """(ontology IRI, graph, versions) of the bundled ontologies in the upgraded graphs. This runs on every
+    open, so a file is read only as far as its header block (where our files keep ``owl:versionInfo``);
+    one whose header block names no version is read whole."""
+    found = []
+    for item in bundled_files():
+        if item.graph not in UPGRADED_GRAPHS:
+            continue
+        head: ox.NamedNode | ox.BlankNode | ox.Triple | None = None
+        versions: set[str] = set()
+        for triple in ox.parse(path=str(item.path), format=ox.RdfFormat.TURTLE):
+            if head is None and _is_header(triple):
+                head = triple.subject
+            if head is not None and triple.subject != head:
+                break
+            if head is not None and triple.predicate.value == _VERSION_INFO:
+                versions.add(str(triple.object))
+        if isinstance(head, ox.NamedNode) and versions:
+            found.append((head, item.graph, frozenset(versions)))
+            continue
+        for head, graph, quads in _bundled_headers():
+            if graph is item.graph:
+                found.append(
+                    (head, graph, frozenset(str(q.object) for q in quads if q.predicate.value == _VERSION_INFO))
+                )
+    return tuple(dict.fromkeys(found))
+
+
+def _is_header(triple: ox.Triple) -> bool:
+    return triple.predicate.value == RDF + "type" and triple.object == ox.NamedNode(OWL + "Ontology")
 
 
 def _headers_outdated(store: Store) -> bool:
     """Whether a bundled ontology the store holds has another version there than in its file."""
     version = ox.NamedNode(_VERSION_INFO)
-    for head, graph, quads in _bundled_headers():
-        stored = {q.object for q in store.quads(head, version, None, graph.node)}
-        bundled = {q.object for q in quads if q.predicate == version}
+    for head, graph, bundled in _bundled_versions():
+        stored = {str(q.object) for q in store.quads(head, version, None, graph.node)}
         if stored and stored != bundled:
             return True
     return False
