@@ -23,25 +23,28 @@ from __future__ import annotations
 import re
 
 _IRI = r'<[^<>"{}|^`\\\x00-\x20]*>'
-_PN = r"[A-Za-z\u00c0-\uffff](?:[\w\-\u00b7\u00c0-\uffff.]*[\w\-\u00b7\u00c0-\uffff])?"
-_LOCAL = r"[\w\u00c0-\uffff:](?:[\w\-\u00b7\u00c0-\uffff.:]*[\w\-\u00b7\u00c0-\uffff:])?"
+# Names are read with \w (letters and digits of every script, and _); the rarer characters SPARQL
+# allows in them (U+00B7, U+203F...) and %-escapes are not recognised, and such a query takes a worker.
+_PN = r"[^\W\d_](?:[\w\-.]*[\w\-])?"
+_LOCAL = r"[\w:](?:[\w\-.:]*[\w\-:])?"
 _PNAME = rf"(?:{_PN})?:(?:{_LOCAL})?"
 _VAR = r"[?$]\w+"
 _STRING = r'"(?:[^"\\\n\r]|\\.)*"' + r"|'(?:[^'\\\n\r]|\\.)*'"
 _LITERAL = (
     rf"(?:(?:{_STRING})(?:@[A-Za-z]+(?:-[A-Za-z0-9]+)*|\^\^(?:{_IRI}|{_PNAME}))?"
-    r"|[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|true|false)"
+    r"|[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?|(?i:true|false))"
 )
 _NODE = rf"(?:{_IRI}|{_PNAME}|{_VAR})"
 _S = r"\s*"
 
+# Keywords are matched case-insensitively, and only they (a case-insensitive pattern over wide
+# character ranges takes a second to compile).
 _SHAPE = re.compile(
-    rf"{_S}(?:(?:BASE{_S}{_IRI}|PREFIX{_S}(?:{_PN})?:{_S}{_IRI}){_S})*"
-    rf"(?:SELECT{_S}(?P<projection>\*|(?:{_VAR}{_S})+)|ASK){_S}"
-    rf"(?:FROM{_S}(?:NAMED\s+)?(?:{_IRI}|{_PNAME}){_S})*"
-    rf"(?:WHERE{_S})?\{{{_S}(?P<s>{_NODE}){_S}(?P<p>{_NODE}|a(?=[\s<?$])){_S}(?P<o>{_NODE}|{_LITERAL}){_S}\.?{_S}\}}"
-    rf"{_S}(?:LIMIT{_S}\d+{_S})?",
-    re.IGNORECASE,
+    rf"{_S}(?:(?:(?i:BASE){_S}{_IRI}|(?i:PREFIX){_S}(?:{_PN})?:{_S}{_IRI}){_S})*"
+    rf"(?:(?i:SELECT){_S}(?P<projection>\*|(?:{_VAR}{_S})+)|(?i:ASK)){_S}"
+    rf"(?:(?i:FROM){_S}(?:(?i:NAMED)\s+)?(?:{_IRI}|{_PNAME}){_S})*"
+    rf"(?:(?i:WHERE){_S})?\{{{_S}(?P<s>{_NODE}){_S}(?P<p>{_NODE}|a(?=[\s<?$])){_S}(?P<o>{_NODE}|{_LITERAL}){_S}\.?{_S}\}}"
+    rf"{_S}(?:(?i:LIMIT){_S}\d+{_S})?"
 )
 
 
