@@ -15,7 +15,7 @@ import numpy.typing as npt
 
 from cbrs.kb import Advertisement, EffectiveArea, PartNode, QoSValue, Requirement, Statement
 from cbrs.reasoner.config import MatchConfig
-from cbrs.reasoner.similarity import EntityMeasure
+from cbrs.reasoner.similarity import EntityMeasure, SemStr
 from cbrs.reasoner.spans import span
 from cbrs.reasoner.vectors import FloatArray, IntArray, VectorSpace
 
@@ -269,8 +269,14 @@ class BatchScorer:
         p = self._vector(statement.predicate)[pool.p_ids]
         o = self._vector(statement.object)[pool.o_ids]
         if cfg.statement_mean == "geometric":
-            return np.asarray(s**cfg.subject_weight * p**cfg.predicate_weight * o**cfg.object_weight, dtype=np.float64)
-        return cfg.subject_weight * s + cfg.predicate_weight * p + cfg.object_weight * o
+            values = np.asarray(s**cfg.subject_weight * p**cfg.predicate_weight * o**cfg.object_weight, np.float64)
+        else:
+            values = cfg.subject_weight * s + cfg.predicate_weight * p + cfg.object_weight * o
+        if cfg.disjoint_statements and isinstance(self.measure, SemStr):  # statements.contradiction
+            space = pool.space
+            clash = space.disjoint(statement.subject)[pool.s_ids] | space.disjoint(statement.object)[pool.o_ids]
+            values = np.where(clash, 0.0, values)
+        return values
 
     def score(self, requirement: Requirement) -> BatchScores:
         pool, cfg = self.pool, self.config

@@ -31,6 +31,10 @@ class MatchConfig:
     # costs its weight) or "geometric" (the weighted geometric mean: a statement is about as good as its
     # worst position, so (Robot, isLocatedIn, ChargingStation) is no near miss for (Robot, isLocatedIn, Room)).
     statement_mean: str = "geometric"
+    # A statement whose subject or object is declared disjoint (owl:disjointWith, owl:AllDisjointClasses;
+    # inherited by subclasses) with the requested one contradicts it: similarity 0, however alike the
+    # names or the places in the taxonomy ((Door, hasStatus, Closed) for (Door, hasStatus, Opened)).
+    disjoint_statements: bool = True
     # How the parts of a match combine; parts the requirement does not state are left out and the
     # remaining weights renormalised.
     output_weight: float = 0.4
@@ -84,6 +88,7 @@ class MatchConfig:
             no_input_invocable=False,
             statement_mean="arithmetic",
             lexicon=False,
+            disjoint_statements=False,
         )
 
     def __post_init__(self) -> None:

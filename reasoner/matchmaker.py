@@ -406,6 +406,9 @@ class Matchmaker:
             value = _DEGREE_SCORE[degree] if self.method.strict else match.value
             offered = f"({_short(got.subject)}, {_short(got.predicate)}, {_short(got.object)})"
             how = "s/p/o: " + ", ".join(f"{s.value:.2f}" for s in match.parts or ())
+            if match.contradicts:
+                clash = _short(getattr(got, match.contradicts)), _short(getattr(wanted, match.contradicts))
+                how += f"; contradicts: {clash[0]} is disjoint with {clash[1]}"
             pairs.append(EntityPair(role, text, offered, value, how, degree.value))
             if value < self.config.pair_threshold:
                 lacks.append(f"{role} {text}: best offer {offered} scores {value:.2f}")

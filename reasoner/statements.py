@@ -6,7 +6,9 @@ the property hierarchy):
 
     Sim(R_sup, R_dem) = ws * Sim(s_sup, s_dem) + wp * Sim(p_sup, p_dem) + wo * Sim(o_sup, o_dem)
 
-with ws + wp + wo = 1 (equal by default; see MatchConfig).
+with ws + wp + wo = 1 (equal by default; see MatchConfig), or the weighted geometric mean. A statement
+whose subject or object is declared disjoint with the requested one contradicts it and scores 0
+(MatchConfig.disjoint_statements; Sem-Str only, which knows the taxonomy).
 """
 
 from __future__ import annotations
@@ -15,7 +17,7 @@ from dataclasses import dataclass
 
 from cbrs.kb import Statement
 from cbrs.reasoner.config import MatchConfig
-from cbrs.reasoner.similarity import EntityMeasure, Similarity
+from cbrs.reasoner.similarity import EntityMeasure, SemStr, Similarity
 
 
 @dataclass(frozen=True)
@@ -24,6 +26,7 @@ class StatementMatch:
     advertised: Statement | None
     value: float
     parts: tuple[Similarity, Similarity, Similarity] | None = None
+    contradicts: str | None = None  # "subject" or "object": that position is disjoint with the requested one
 
 
 def statement_similarity(
@@ -32,8 +35,23 @@ def statement_similarity(
     s = measure(requested.subject, advertised.subject)
     p = measure(requested.predicate, advertised.predicate)
     o = measure(requested.object, advertised.object)
-    value = combine(config, s.value, p.value, o.value)
-    return StatementMatch(requested, advertised, value, (s, p, o))
+    clash = contradiction(requested, advertised, measure, config)
+    value = 0.0 if clash else combine(config, s.value, p.value, o.value)
+    return StatementMatch(requested, advertised, value, (s, p, o), clash)
+
+
+def contradiction(
+    requested: Statement, advertised: Statement, measure: EntityMeasure, config: MatchConfig
+) -> str | None:
+    """The position ("subject", "object") where ``advertised`` names a class disjoint with the requested
+    one, or None (always None unless MatchConfig.disjoint_statements and the measure is Sem-Str)."""
+    if not config.disjoint_statements or not isinstance(measure, SemStr):
+        return None
+    if measure.index.disjoint(requested.subject, advertised.subject):
+        return "subject"
+    if measure.index.disjoint(requested.object, advertised.object):
+        return "object"
+    return None
 
 
 def combine(config: MatchConfig, s: float, p: float, o: float) -> float:

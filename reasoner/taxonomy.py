@@ -42,6 +42,8 @@ class TaxonomyIndex:
     _ancestors: dict[tuple[str, bool], dict[str, int]] = field(default_factory=dict)  # cache
     _parts: dict[str, frozenset[str]] = field(default_factory=dict)  # cache
     _part_weights: dict[str, float] | None = None
+    _disjoint: dict[str, frozenset[str]] = field(default_factory=dict)  # declared, both ways, canonical
+    _disjoint_closure: dict[str, frozenset[str]] = field(default_factory=dict)  # cache
     labels: dict[str, str] = field(default_factory=dict)
     frequency: dict[str, int] = field(default_factory=dict)  # uses by service descriptions
 
@@ -55,13 +57,17 @@ class TaxonomyIndex:
         ]
         terms = {row["term"].value: row.get("label") for row in kb.select("taxonomy_terms")}
         usage = {row["concept"].value: int(row["uses"].value) for row in kb.select("concept_usage")}
-        index = cls.from_links(links, terms=terms)
+        disjoint = [(row["first"].value, row["second"].value) for row in kb.select("taxonomy_disjoint")]
+        index = cls.from_links(links, terms=terms, disjoint=disjoint)
         index.labels = {term: label.value for term, label in terms.items() if label is not None}
         index.frequency = {index.canonical(c): n for c, n in usage.items() if c in index}
         return index
 
     @classmethod
-    def from_links(cls, links: Iterable[Link], terms: Iterable[str] = ()) -> TaxonomyIndex:
+    def from_links(
+        cls, links: Iterable[Link], terms: Iterable[str] = (), disjoint: Iterable[tuple[str, str]] = ()
+    ) -> TaxonomyIndex:
+        """The index of these links; ``disjoint``: pairs of classes declared disjoint."""
         links = list(links)
         graph: nx.DiGraph[str] = nx.DiGraph()
         graph.add_nodes_from(terms)
@@ -94,6 +100,13 @@ class TaxonomyIndex:
             index._children[parent].add(child)
         index._break_part_cycles()
         index._compute_depths()
+        declared: dict[str, set[str]] = {}
+        for first, second in disjoint:
+            a, b = canonical.get(first), canonical.get(second)
+            if a is not None and b is not None and a != b:  # a class "disjoint" with its equivalent: ignored
+                declared.setdefault(a, set()).add(b)
+                declared.setdefault(b, set()).add(a)
+        index._disjoint = {node: frozenset(others) for node, others in declared.items()}
         return index
 
     def _break_part_cycles(self) -> None:
@@ -208,6 +221,34 @@ class TaxonomyIndex:
             scale = math.log(wholes) if wholes > 1 else 1.0
             self._part_weights = {p: math.log(wholes / m) / scale if wholes > 1 else 1.0 for p, m in owners.items()}
         return self._part_weights.get(self.canonical(part), 1.0)
+
+    def disjoint_with(self, concept: str) -> frozenset[str]:
+        """Every node that shares no instance with ``concept``: the is-a descendants of each class declared
+        disjoint with it or with one of its superclasses (disjointness is inherited downwards)."""
+        if not self._disjoint or concept not in self:
+            return frozenset()
+        node = self.canonical(concept)
+        found = self._disjoint_closure.get(node)
+        if found is None:
+            roots = {other for up in self.ancestors(node, is_a_only=True) for other in self._disjoint.get(up, ())}
+            found = frozenset(self._is_a_descendants(roots))
+            self._disjoint_closure[node] = found
+        return found
+
+    def disjoint(self, first: str, second: str) -> bool:
+        """Are the two concepts declared (or, by their superclasses, implied) disjoint?"""
+        return second in self and self.canonical(second) in self.disjoint_with(first)
+
+    def _is_a_descendants(self, tops: Iterable[str]) -> set[str]:
+        found = set(tops)
+        queue = deque(found)
+        while queue:
+            current = queue.popleft()
+            for child in self._children[current]:
+                if child not in found and self._parents[child].get(current) == "is-a":
+                    found.add(child)
+                    queue.append(child)
+        return found
 
     def common_ancestor(self, first: str, second: str) -> tuple[str, int, int]:
         """The most specific common superclass C (is-a links) and the link counts N1, N2 to it.

@@ -94,6 +94,7 @@ class VectorSpace:
         self._implied: _Lru[tuple[int, int], bool] = _Lru(IMPLIED_CACHE_ENTRIES, lambda _: 1)
         self._by_core: dict[int, tuple[int, dict[str, list[int]]]] = {}
         self._floors: _Lru[tuple[str, bool, float], FloatArray] = _Lru(ARRAY_CACHE_BYTES, _nbytes)
+        self._disjoint: _Lru[str, npt.NDArray[np.bool_]] = _Lru(ARRAY_CACHE_BYTES, _nbytes)
         for concept in sorted(set(extra)):
             self.add(concept)
 
@@ -236,6 +237,17 @@ class VectorSpace:
         if found is None:
             self._wu_palmer_or_root(x)
             found = self._lcs.get(x)
+        return found
+
+    def disjoint(self, concept: str) -> npt.NDArray[np.bool_]:
+        """For every concept id: is it declared (or by a superclass implied) disjoint with ``concept``?"""
+        found = self._disjoint.get(concept)
+        if found is None or len(found) != len(self.names):
+            found = np.zeros(len(self.names), dtype=bool)
+            others = self.index.disjoint_with(concept)
+            if others:
+                found[[self.ids[other] for other in others]] = True
+            self._disjoint[concept] = found
         return found
 
     def implied(self, superclass: IntArray, part: IntArray) -> npt.NDArray[np.bool_]:

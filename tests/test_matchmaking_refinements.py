@@ -132,3 +132,48 @@ def test_sem_str_ranks_the_robot_collection_above_the_baselines(robot_report) ->
     figures = robot_report.methods
     assert figures["sem-str"]["map"] > max(figures["wu-palmer"]["map"], figures["logic"]["map"]) - 0.03
     assert figures["sem-str"]["map"] > figures["wu-palmer"]["map"]
+
+
+DEFINED = Path(__file__).parent / "data" / "defined_classes.ttl"
+M = "http://example.org/mini#"
+
+
+@pytest.fixture(scope="module")
+def defined_kb() -> KnowledgeBase:
+    kb = KnowledgeBase(Store.open(":memory:"))
+    kb.load([DEFINED], graph="ontology")
+    return kb
+
+
+def test_classes_defined_by_intersection_or_union_have_their_named_classes_as_relatives(defined_kb) -> None:  # type: ignore[no-untyped-def]
+    index = TaxonomyIndex.from_kb(defined_kb)
+    assert M + "Camera" in index.parents(M + "Digital")  # Digital = Camera and (hasLens some Lens)
+    assert index.distance_down(M + "Bread", M + "BreadOrBiscuit") == 1  # BreadOrBiscuit = Bread or Biscuit
+
+
+def test_disjointness_is_read_and_inherited(defined_kb) -> None:  # type: ignore[no-untyped-def]
+    index = TaxonomyIndex.from_kb(defined_kb)
+    assert index.disjoint(M + "Opened", M + "Closed") and index.disjoint(M + "Closed", M + "Opened")
+    assert index.disjoint(M + "Locked", M + "Opened")  # Locked is a Closed
+    assert index.disjoint(M + "Ajar", M + "Opened")  # owl:AllDisjointClasses
+    assert not index.disjoint(M + "Locked", M + "Closed") and not index.disjoint(M + "Ajar", M + "Closed")
+    assert not index.disjoint(M + "Opened", M + "Unknown")
+
+
+def test_an_effect_that_contradicts_the_requested_one_scores_nothing(defined_kb) -> None:  # type: ignore[no-untyped-def]
+    def effect(state: str) -> tuple[Statement, ...]:
+        return (Statement(M + "Door", M + "hasState", M + state),)
+
+    wanted = Requirement(M + "OpenTheDoor", (), effects=effect("Opened"))
+    ads = [Advertisement(M + f"Make{state}", (), effects=effect(state)) for state in ("Closed", "Locked", "Opened")]
+    index = TaxonomyIndex.from_kb(defined_kb)
+    on = Matchmaker(defined_kb, index=index, advertisements=ads)
+    ranked = on.rank(wanted, explain=0).candidates
+    assert ranked[0].advertisement == M + "MakeOpened"
+    for candidate in ranked[1:]:  # the batch scores agree with the explained ones
+        explained = on.score(wanted, next(a for a in ads if a.iri == candidate.advertisement))
+        assert candidate.score == explained.score == 0.0
+        assert "contradicts" in explained.pairs[0].how
+    off = Matchmaker(defined_kb, config=MatchConfig(disjoint_statements=False), index=index, advertisements=ads)
+    assert off.score(wanted, ads[0]).parts["effects"] > 0.5  # Closed and Opened: siblings, alike by the taxonomy
+    assert Matchmaker(defined_kb, "wu-palmer", index=index, advertisements=ads).config.disjoint_statements is False
