@@ -12,8 +12,9 @@ request's own thread, which saves the round trip to a worker (a process hop and 
 The test is on the text, strictly: a prologue of ``PREFIX`` / ``BASE``, ``SELECT`` of variables or ``*``
 (or ``ASK``), optional ``FROM`` / ``FROM NAMED`` clauses, ``WHERE { s p o }`` with terms that are IRIs,
 prefixed names, variables, ``a`` or (as object) literals, each variable once, then an optional
-``LIMIT``. Anything else (a comment, a path, a filter, ``DISTINCT``, ``OFFSET``, a blank node, an escape
-in a prefixed name) is not recognised and goes to a worker as before. ``OFFSET`` and a repeated
+``LIMIT``; or the empty group (``ASK {}``, what health checks send), which reads nothing. Anything
+else (a comment, a path, a filter, ``DISTINCT``, ``OFFSET``, a blank node, an escape in a prefixed
+name) is not recognised and goes to a worker as before. ``OFFSET`` and a repeated
 variable are left out on purpose: with them, Oxigraph walks triples that produce no output, which the
 writer's deadline could not see.
 """
@@ -43,7 +44,7 @@ _SHAPE = re.compile(
     rf"{_S}(?:(?:(?i:BASE){_S}{_IRI}|(?i:PREFIX){_S}(?:{_PN})?:{_S}{_IRI}){_S})*"
     rf"(?:(?i:SELECT){_S}(?P<projection>\*|(?:{_VAR}{_S})+)|(?i:ASK)){_S}"
     rf"(?:(?i:FROM){_S}(?:(?i:NAMED)\s+)?(?:{_IRI}|{_PNAME}){_S})*"
-    rf"(?:(?i:WHERE){_S})?\{{{_S}(?P<s>{_NODE}){_S}(?P<p>{_NODE}|a(?=[\s<?$])){_S}(?P<o>{_NODE}|{_LITERAL}){_S}\.?{_S}\}}"
+    rf"(?:(?i:WHERE){_S})?\{{{_S}(?:(?P<s>{_NODE}){_S}(?P<p>{_NODE}|a(?=[\s<?$])){_S}(?P<o>{_NODE}|{_LITERAL}){_S}\.?{_S})?\}}"
     rf"{_S}(?:(?i:LIMIT){_S}\d+{_S})?"
 )
 
@@ -63,6 +64,8 @@ def is_single_scan(text: str) -> bool:
     match = _SHAPE.fullmatch(text)
     if match is None:
         return False
+    if match.group("s") is None:
+        return True  # an empty group (ASK {}, a liveness probe): one empty solution, no scan at all
     terms = [match.group("s"), match.group("p"), match.group("o")]
     variables = [term for term in terms if term[0] in "?$"]
     if len(variables) == 3:

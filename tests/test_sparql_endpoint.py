@@ -347,6 +347,7 @@ LOOKUP = "SELECT ?p ?o WHERE { home:Cup ?p ?o }"
         pytest.param("SELECT ?s WHERE { ?s a home:Cup }", True, id="a-and-pname"),
         pytest.param('ASK { ?s rdfs:label "cup"@en }', True, id="ask-literal"),
         pytest.param("SELECT ?o FROM <urn:g> WHERE { <urn:x> <urn:p> ?o }", True, id="from"),
+        pytest.param("ASK {}", True, id="empty-group"),
         pytest.param("SELECT ?s ?p ?o WHERE { ?s ?p ?o }", False, id="whole-store"),
         pytest.param("SELECT ?x WHERE { ?x <urn:p> ?x }", False, id="repeated-variable"),
         pytest.param("SELECT ?p ?o WHERE { <urn:x> ?p ?o } OFFSET 10", False, id="offset"),
