@@ -77,29 +77,32 @@ def _colour(colour: str | ColourRange) -> ColourRange:
 
 
 def segment(rgb: NDArray[np.uint8], colour: str | ColourRange) -> NDArray[np.bool_]:
-    """Boolean mask (H x W) of the pixels of a colour."""
+    """Boolean mask (H x W) of the pixels of a colour.
+
+    Hue is worked out only for the pixels saturated and bright enough to count (a few hundred of the
+    image's 76,800: the rest is white, grey and wood), with the same arithmetic as for all of them.
+    """
     spec = _colour(colour)
-    img = rgb.astype(np.float32) / 255.0
-    r, g, b = img[..., 0], img[..., 1], img[..., 2]
-    value = img.max(axis=-1)
-    chroma = value - img.min(axis=-1)
+    red, green, blue = rgb[..., 0], rgb[..., 1], rgb[..., 2]  # (a reduction over the last axis is slow)
+    value = np.maximum(np.maximum(red, green), blue).astype(np.float32) / 255.0  # largest and smallest channel
+    chroma = value - np.minimum(np.minimum(red, green), blue).astype(np.float32) / 255.0
     saturation = np.where(value > 0, chroma / np.maximum(value, 1e-6), 0.0)
-    safe = np.maximum(chroma, 1e-6)
+    mask: NDArray[np.bool_] = (chroma > 1e-6) & (saturation >= spec.min_saturation) & (value >= spec.min_value)
+    rows, cols = np.nonzero(mask)
+    pixels = rgb[rows, cols].astype(np.float32) / 255.0
+    r, g, b = pixels[:, 0], pixels[:, 1], pixels[:, 2]
+    top = value[rows, cols]
+    safe = np.maximum(chroma[rows, cols], 1e-6)
     hue = (
         np.where(
-            value == r,
+            top == r,
             ((g - b) / safe) % 6.0,
-            np.where(value == g, (b - r) / safe + 2.0, (r - g) / safe + 4.0),
+            np.where(top == g, (b - r) / safe + 2.0, (r - g) / safe + 4.0),
         )
         * 60.0
     )
     distance = np.abs((hue - spec.hue + 180.0) % 360.0 - 180.0)
-    mask: NDArray[np.bool_] = (
-        (chroma > 1e-6)
-        & (distance <= spec.hue_tolerance)
-        & (saturation >= spec.min_saturation)
-        & (value >= spec.min_value)
-    )
+    mask[rows, cols] = distance <= spec.hue_tolerance
     return mask
 
 

@@ -164,3 +164,42 @@ def test_a_camera_renders_again_only_when_the_scene_changed(monkeypatch: pytest.
         assert len(renders) == 4 and stepped.time > moved.time
         fresh = cameras.Camera(w.client, camera.spec, w)  # no scene to go by: renders every time
         assert np.array_equal(fresh.capture().rgb, fresh.capture().rgb) and len(renders) == 6
+
+
+def _segment_everywhere(rgb: np.ndarray, colour: str) -> np.ndarray:  # type: ignore[type-arg]
+    """The segmentation as first written, hue worked out for every pixel: the reference."""
+    from cbrs.sim.perception import COLOURS
+
+    spec = COLOURS[colour]
+    img = rgb.astype(np.float32) / 255.0
+    r, g, b = img[..., 0], img[..., 1], img[..., 2]
+    value = img.max(axis=-1)
+    chroma = value - img.min(axis=-1)
+    saturation = np.where(value > 0, chroma / np.maximum(value, 1e-6), 0.0)
+    safe = np.maximum(chroma, 1e-6)
+    hue = (
+        np.where(value == r, ((g - b) / safe) % 6.0, np.where(value == g, (b - r) / safe + 2.0, (r - g) / safe + 4.0))
+        * 60.0
+    )
+    distance = np.abs((hue - spec.hue + 180.0) % 360.0 - 180.0)
+    return (
+        (chroma > 1e-6)
+        & (distance <= spec.hue_tolerance)
+        & (saturation >= spec.min_saturation)
+        & (value >= spec.min_value)
+    )
+
+
+def test_segmentation_marks_the_pixels_the_per_pixel_hue_marks(world: HomeWorld) -> None:
+    from cbrs.sim.perception import COLOURS
+
+    rng = np.random.default_rng(5)
+    images = [world.camera(name).capture().rgb for name in sorted(world.cameras)]
+    images += [rng.integers(0, 256, (60, 80, 3), dtype=np.uint8) for _ in range(4)]
+    reds, greens = np.meshgrid(np.arange(256), np.arange(256), indexing="ij")  # every red and green, some blue
+    images.append(np.stack([reds, greens, np.full((256, 256), 40)], -1).astype(np.uint8))
+    for rgb in images:
+        for colour in COLOURS:
+            expected = _segment_everywhere(rgb, colour)
+            assert np.array_equal(segment(rgb, colour), expected), colour
+    assert any(segment(rgb, colour).any() for rgb in images[:3] for colour in COLOURS)
