@@ -152,6 +152,7 @@ class Kinematics:
                 for side, (pos, orn) in mounts.items()
             }
             self._obstacles = [self._box(region) for region in obstacles]
+            self._at: dict[int, tuple[float, ...]] = {}  # where each copy's joints were last put
         except BaseException:
             p.disconnect(physicsClientId=self.client)
             raise
@@ -204,8 +205,20 @@ class Kinematics:
             p.disconnect(physicsClientId=self.client)
 
     def _set(self, body: int, q: Sequence[float]) -> None:
-        for joint, value in zip(ARM_JOINTS, q, strict=True):
-            p.resetJointState(body, joint, value, physicsClientId=self.client)
+        """Put a copy at ``q`` (all joints in one call; nothing to do if it is there already)."""
+        values = tuple(q)
+        if len(values) != len(ARM_JOINTS):
+            raise ValueError(f"expected {len(ARM_JOINTS)} joint angles, got {len(values)}")
+        if self._at.get(body) == values:
+            return
+        p.resetJointStatesMultiDof(
+            body,
+            ARM_JOINTS,
+            [[value] for value in values],
+            [[0.0]] * len(ARM_JOINTS),
+            physicsClientId=self.client,
+        )
+        self._at[body] = values
 
     def forward(self, side: ArmSide, q: Sequence[float]) -> Pose3D:
         body = self._bodies[side]
