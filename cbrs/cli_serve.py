@@ -68,6 +68,7 @@ def serve(
             max_query_bytes=setting("max_query_bytes").resolve(),
             update_token=setting("update_token").resolve(_read_token(update_token_file)),
             read_only=setting("read_only").resolve(read_only),
+            isolate_memory=True,  # a query past its deadline is stopped whatever the store
         ),
         cors_origins=setting("cors_origins").resolve(cors_origins or None),
     )

@@ -10,7 +10,10 @@ store, and kills the worker when the query outlasts ``timeout`` or its resident 
 A snapshot is a RocksDB checkpoint of the store (hard links to its immutable files, made in tens of
 milliseconds), taken when a query finds the store written since the last one, so a query always sees
 every write that came before it. A snapshot no worker reads and that is not the newest is deleted.
-Only an on-disk embedded store can be snapshotted; the endpoint evaluates in threads otherwise.
+An in-memory store has no files to link: its snapshot is a copy of its quads into an on-disk store
+(Oxigraph's bulk loader, some ten thousand quads in a few tens of milliseconds), made under the same
+rule, so its cost grows with the store; ``cbrs serve`` isolates an in-memory store this way
+(``EndpointConfig.isolate_memory``), the library's default is threads.
 
 A worker left idle for ``idle`` seconds (setting ``query_worker_idle``) is stopped, so that a server
 that answered a heavy query an hour ago does not hold a process and its memory for it; the next query
@@ -114,8 +117,6 @@ class QueryProcesses:
     def __init__(
         self, store: EmbeddedStore, size: int, memory: int, stack: int = EVALUATION_STACK, idle: float = 30.0
     ) -> None:
-        if store.in_memory:
-            raise ValueError("an in-memory store cannot be snapshotted for worker processes")
         self.store = store
         self.size = size
         self.memory = memory
@@ -130,8 +131,10 @@ class QueryProcesses:
         self._closed = False
         self._reaper: threading.Thread | None = None
         self._wake = threading.Event()
-        parent = Path(store.location).resolve().parent
         try:  # beside the store, so the checkpoint hard-links its files instead of copying them
+            if store.in_memory:
+                raise OSError("an in-memory store's snapshots are copies: the temporary folder will do")
+            parent = Path(store.location).resolve().parent
             self._root = Path(tempfile.mkdtemp(prefix=".cbrs-query-snapshots-", dir=parent))
         except OSError:
             self._root = Path(tempfile.mkdtemp(prefix="cbrs-query-snapshots-"))

@@ -11,8 +11,10 @@ How a query is bounded (Oxigraph has no query timeout of its own):
   its core, its memory and its slot are free at once;
 - its result is serialised by Oxigraph into a writer that checks the deadline and the byte budget on
   every chunk, so a query that streams many solutions stops at the deadline or the limit;
-- on an in-memory or remote store it runs on a thread instead; a query still computing its first
-  solution at the deadline is answered "timed out" and that thread is left to finish, keeping its slot.
+- an in-memory store is evaluated so too when ``isolate_memory`` is set (``cbrs serve`` sets it), its
+  snapshot being a copy; otherwise, and on a remote store, the query runs on a thread: a query still
+  computing its first solution at the deadline is answered "timed out" and that thread is left to
+  finish, keeping its slot (a remote store's own ``remote_timeout`` ends its wait).
 
 Which graphs a query reads follows SPARQL 1.1 (Query §13.2, Protocol §2.1.4): the protocol's
 ``default-graph-uri`` / ``named-graph-uri`` (a :class:`Dataset`) win over the query's ``FROM`` /
@@ -300,6 +302,7 @@ class EndpointConfig:
     memory: int = field(default_factory=lambda: setting("query_memory").resolve())
     worker_idle: float = field(default_factory=lambda: setting("query_worker_idle").resolve())
     isolate: bool = True  # evaluate in killable worker processes when the store is on disk
+    isolate_memory: bool = False  # and when it is in memory (a copy per write: cbrs serve turns it on)
 
 
 class _Stop(Exception):
@@ -341,7 +344,11 @@ class SparqlService:
         self.generation = 0  # bumped by every update, so caches built from the store know they are stale
         store = kb.store
         self.processes: QueryProcesses | None = None
-        if self.config.isolate and isinstance(store, EmbeddedStore) and not store.in_memory:
+        if (
+            self.config.isolate
+            and isinstance(store, EmbeddedStore)
+            and (self.config.isolate_memory or not store.in_memory)
+        ):
             self.processes = QueryProcesses(
                 store, self.config.workers, self.config.memory, idle=self.config.worker_idle
             )

@@ -287,8 +287,15 @@ class EmbeddedStore(Store):
 
     def snapshot(self, target: Path) -> None:
         """A read-only copy of the store as it is now in ``target`` (which must not exist): a RocksDB
-        checkpoint, hard links to the store's immutable files when on the same file system."""
+        checkpoint, hard links to the store's immutable files when on the same file system; for an
+        in-memory store, its quads copied into a new on-disk store there."""
         try:
+            if self.in_memory:
+                copy = ox.Store(str(target))
+                copy.bulk_extend(self._backend.quads_for_pattern(None, None, None, None))
+                copy.flush()
+                del copy  # closes it, so that a worker can open it
+                return
             self._backend.backup(str(target))
         except OSError as error:
             raise StoreError(self.location, f"snapshot into {target} failed: {error}") from error

@@ -453,3 +453,20 @@ def test_an_idle_query_worker_is_stopped_and_a_later_query_starts_another(tmp_pa
     finally:
         service.close()
         kb.close()
+
+
+def test_an_in_memory_store_served_isolated_stops_a_query_at_its_deadline(fresh_bundled_kb: KnowledgeBase) -> None:
+    if not fresh_bundled_kb.store.in_memory:
+        pytest.skip("the in-memory store's case")
+    service = SparqlService(fresh_bundled_kb, EndpointConfig(isolate_memory=True, timeout=0.5, workers=1))
+    try:
+        assert service.processes is not None
+        with pytest.raises(QueryTimeoutError, match="it was stopped"):
+            service.query(SLOW)
+        assert service.processes.killed == 1
+        answer = service.query("SELECT (COUNT(*) AS ?n) WHERE { ?s ?p ?o }")  # the one slot is free again
+        assert int(json.loads(answer.body)["results"]["bindings"][0]["n"]["value"]) > 1000
+        fresh_bundled_kb.update(INSERT)  # a write reaches the next snapshot, copied afresh (a filter: a worker's)
+        assert json.loads(service.query("ASK { <urn:test:s> ?p 'added' FILTER(?p != <urn:x>) }").body)["boolean"]
+    finally:
+        service.close()
