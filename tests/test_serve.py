@@ -6,6 +6,7 @@ Every wait is bounded; servers listen on free ports picked by the OS.
 from __future__ import annotations
 
 import contextlib
+import http.client
 import json
 import os
 import queue
@@ -14,7 +15,9 @@ import subprocess
 import sys
 import threading
 import time
+import urllib.parse
 from collections.abc import Iterator
+from pathlib import Path
 from typing import Any
 
 import httpx
@@ -304,3 +307,42 @@ def test_stop_closes_the_http_listener_even_when_its_wake_up_pipe_is_gone(fresh_
     with pytest.raises(httpx.ConnectError):
         httpx.get(f"http://127.0.0.1:{port}/healthz", timeout=WAIT)
     assert_threads_end(threads, WAIT)
+
+
+def test_one_long_query_leaves_the_server_answering_others_and_is_stopped_at_its_deadline(tmp_path: Path) -> None:
+    endless = (  # an aggregate over a 6000 x 6000 product: minutes of work, never interrupted by Oxigraph
+        "SELECT (COUNT(*) AS ?n) WHERE { { SELECT ?a WHERE { ?a ?p ?x } LIMIT 6000 } "
+        "{ SELECT ?b WHERE { ?b ?q ?y } LIMIT 6000 } FILTER (?a != ?b) }"
+    )
+    kb = KnowledgeBase.open(tmp_path / "store")
+    server = Server(kb, ServeConfig(port=0, bridge_port=0, endpoint=EndpointConfig(timeout=3.0, workers=2)))
+    server.start()
+    try:
+        port = server.http_port
+
+        def ask(query: str, source: str) -> tuple[int, bytes]:
+            connection = http.client.HTTPConnection("127.0.0.1", port, timeout=30, source_address=(source, 0))
+            connection.request("GET", "/sparql?" + urllib.parse.urlencode({"query": query}))
+            response = connection.getresponse()
+            answer = response.status, response.read()
+            connection.close()
+            return answer
+
+        long_answer: list[tuple[int, bytes]] = []
+        runner = threading.Thread(target=lambda: long_answer.append(ask(endless, "127.0.0.1")))
+        runner.start()
+        deadline = time.monotonic() + 10
+        while server.sparql._slots._value == 2 and time.monotonic() < deadline:  # type: ignore[attr-defined]
+            time.sleep(0.01)  # until the long query holds its worker
+        lookups = [ask("SELECT ?p ?o WHERE { home:Cup ?p ?o }", "127.0.0.2") for _ in range(5)]
+        lookups.append(ask("SELECT (COUNT(*) AS ?n) WHERE { ?s a ?c }", "127.0.0.2"))  # the other worker
+        assert runner.is_alive()  # all answered while the long query still ran
+        assert [status for status, _ in lookups] == [200] * 6
+        runner.join(30)
+        status, body = long_answer[0]
+        assert status == 503 and json.loads(body)["error"] == "timeout"
+        assert server.sparql.processes is not None and server.sparql.processes.killed == 1
+        assert ask(endless.replace("6000", "3"), "127.0.0.1")[0] == 200  # its worker slot is free again
+    finally:
+        server.stop()
+        kb.close()
