@@ -110,7 +110,7 @@ def build_occupancy_grid(
     ys = origin[1] + (ii.ravel() + 0.5) * resolution
     tops = np.full(xs.shape, RAY_TOP)
     heights = np.full(xs.shape, -1.0)
-    ignored = {world.body(name) for name in (ignore if ignore is not None else (world.base_name,))}
+    ignored = [world.body(name) for name in (ignore if ignore is not None else (world.base_name,))]
     pending = np.arange(xs.size)
     for _ in range(4):  # a ray is recast below each ignored body it hits; a few rounds are plenty
         if pending.size == 0:
@@ -121,14 +121,16 @@ def build_occupancy_grid(
             froms = np.column_stack([xs[chunk], ys[chunk], tops[chunk]])
             tos = np.column_stack([xs[chunk], ys[chunk], np.full(chunk.size, -0.5)])
             hits = p.rayTestBatch(froms.tolist(), tos.tolist(), physicsClientId=world.client)
-            for index, hit in zip(chunk, hits, strict=True):
-                body, z = hit[0], hit[3][2]
-                if body in ignored:
-                    tops[index] = z - 1e-3
-                    again.append(index)
-                elif body >= 0:
-                    heights[index] = z
-        pending = np.asarray(again, dtype=np.intp)
+            if len(hits) != chunk.size:
+                raise RuntimeError(f"rayTestBatch answered {len(hits)} rays of {chunk.size}")
+            bodies = np.fromiter((hit[0] for hit in hits), dtype=np.int64, count=chunk.size)
+            zs = np.fromiter((hit[3][2] for hit in hits), dtype=np.float64, count=chunk.size)
+            through = np.isin(bodies, ignored)  # seen through: cast again from just below the hit
+            tops[chunk[through]] = zs[through] - 1e-3
+            again.append(chunk[through])
+            hit = ~through & (bodies >= 0)
+            heights[chunk[hit]] = zs[hit]
+        pending = np.concatenate(again).astype(np.intp)
     occupied = (heights > OBSTACLE_HEIGHT).reshape(rows, cols)
     # An obstacle may reach the edge of its cell, half a cell nearer than the cell's centre.
     radius_cells = (inflation_radius + resolution / 2.0) / resolution
