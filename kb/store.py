@@ -19,7 +19,7 @@ from pathlib import Path
 import pyoxigraph as ox
 
 from cbrs.kb.errors import BlankNodeInsertError, QuerySyntaxError, StoreError, StoreEvaluationError
-from cbrs.kb.namespaces import GENID, PREFIXES, GraphName
+from cbrs.kb.namespaces import BASE, GENID, GRAPH, PREFIXES, GraphName
 from cbrs.kb.query_guard import QueryGuard
 from cbrs.kb.remote_access import loads, refuse_remote_access
 from cbrs.kb.sparql_lexemes import HIDING
@@ -36,6 +36,11 @@ text. It is not what keeps the process alive (other constructs recurse as deeply
 _LEXEME = re.compile(HIDING + r"|[(){}\[\]]", re.DOTALL)
 # The same, with keywords and blank node labels: what an INSERT template is read with.
 _TEMPLATE_LEXEME = re.compile(HIDING + r"|_:[\w.-]*|[A-Za-z]+|[{}\[]", re.DOTALL)
+
+BULK_LOADING = ox.NamedNode(GRAPH + "bulk-loading")
+"""The graph that, while a bulk load runs, names the graph it writes (``cbrs:bulkLoadOf``): a store
+opened with a note there was killed mid-load, and the graph named is dropped (it was empty before)."""
+_BULK_LOAD_OF = ox.NamedNode(BASE + "core#bulkLoadOf")
 
 Term = ox.NamedNode | ox.BlankNode | ox.Literal
 QueryResult = ox.QuerySolutions | ox.QueryBoolean | ox.QueryTriples
@@ -244,7 +249,9 @@ class EmbeddedStore(Store):
             raise StoreError(text, "exists and is not a directory")
         try:
             path.mkdir(parents=True, exist_ok=True)
-            return cls(ox.Store(str(path)), str(path))
+            store = cls(ox.Store(str(path)), str(path))
+            store._undo_broken_bulk_load()
+            return store
         except OSError as error:
             if "lock" in str(error).lower():
                 served = _served_at(path)
@@ -344,6 +351,9 @@ class EmbeddedStore(Store):
         transaction. So the caller parses the file whole first (:mod:`kb.loader`) and ``graph`` must
         hold nothing yet: if the write fails all the same, ``graph`` is dropped again."""
         self.generation += 1
+        # A note, in the transaction log before the first table is written: a process killed from here on
+        # leaves it, and the next open drops the graph (_undo_broken_bulk_load), so the load is all or nothing.
+        self._backend.add(ox.Quad(graph, _BULK_LOAD_OF, ox.Literal(str(path)), BULK_LOADING))
         try:
             self._backend.bulk_load(path=str(path), format=rdf_format, base_iri=base_iri, to_graph=graph)
             self.flush()
@@ -351,11 +361,23 @@ class EmbeddedStore(Store):
             undone = "it was undone"
             try:
                 self._backend.remove_graph(graph)
+                self._backend.remove_graph(BULK_LOADING)
             except (OSError, RuntimeError) as second:
-                undone = f"undoing it failed too ({second}): drop graph {graph} before using it"
+                undone = f"undoing it failed too ({second}); the next open of the store drops graph {graph}"
             raise StoreError(self.location, f"bulk load of {path} failed ({error}); {undone}") from error
         finally:
             self.generation += 1
+        self._backend.remove_graph(BULK_LOADING)  # the load stands
+
+    def _undo_broken_bulk_load(self) -> None:
+        """Drop the graph a bulk load was writing when its process died (see :meth:`bulk_load`)."""
+        notes = list(self._backend.quads_for_pattern(None, _BULK_LOAD_OF, None, BULK_LOADING))
+        for note in notes:
+            assert isinstance(note.subject, ox.NamedNode)
+            self._backend.remove_graph(note.subject)
+        if notes:
+            self._backend.remove_graph(BULK_LOADING)
+            self._backend.flush()
 
     def update(self, text: str) -> None:
         """Run a SPARQL update in one transaction."""

@@ -1,5 +1,9 @@
 from __future__ import annotations
 
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import pyoxigraph as ox
@@ -275,3 +279,71 @@ def test_a_bulk_write_that_fails_leaves_the_store_as_it_was(
     with pytest.raises(StoreError, match=r"No space left on device.*undone"):
         disk_kb.load([path], BULK_GRAPH)
     assert disk_kb.store.dump() == before
+
+
+_KILLED_LOADER = """
+import sys
+import cbrs.kb.loader as loader
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.store import EmbeddedStore
+loader.BULK_BYTES = 1
+original = EmbeddedStore.bulk_load
+def announced(self, *args):
+    print("bulk", flush=True)
+    original(self, *args)
+EmbeddedStore.bulk_load = announced
+KnowledgeBase.open(sys.argv[1]).load([sys.argv[2]], sys.argv[3])
+print("loaded", flush=True)
+"""
+
+
+@pytest.mark.parametrize("delay", [0.0, 0.5], ids=["at-start", "later"])
+def test_a_bulk_load_killed_mid_way_leaves_none_of_it(tmp_path: Path, delay: float) -> None:
+    path = tmp_path / "big.nt"
+    lines = [
+        f"<http://example.org/bulk#n{i}> <http://example.org/bulk#v> <http://example.org/bulk#n{i + 1}> .\n"
+        for i in range(150_000)
+    ]
+    path.write_text("".join(lines), encoding="utf-8")
+    store = tmp_path / "store"
+    KnowledgeBase.open(store).close()  # seeded first
+    child = subprocess.Popen(
+        [sys.executable, "-c", _KILLED_LOADER, str(store), str(path), BULK_GRAPH],
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert child.stdout is not None
+        assert child.stdout.readline().strip() == "bulk"
+        time.sleep(delay)
+        child.send_signal(signal.SIGKILL)
+    finally:
+        child.wait(30)
+    kb = KnowledgeBase.open(store)
+    try:
+        assert kb.store.count(ox.NamedNode(BULK_GRAPH)) in (0, 150_000)
+        assert "bulk-loading" not in " ".join(kb.store.graphs())
+        assert kb.select("advertisements")  # the rest of the store is as it was
+    finally:
+        kb.close()
+
+
+def test_a_store_left_mid_bulk_load_drops_the_graph_when_opened(tmp_path: Path) -> None:
+    from cbrs.kb.store import _BULK_LOAD_OF, BULK_LOADING, EmbeddedStore
+
+    store = EmbeddedStore.open(tmp_path / "store")
+    graph = ox.NamedNode(BULK_GRAPH)
+    backend = store._backend
+    backend.add(ox.Quad(graph, _BULK_LOAD_OF, ox.Literal("big.nt"), BULK_LOADING))  # as bulk_load starts
+    part = list(ox.parse(input=BULK_DATA, format=ox.RdfFormat.N_TRIPLES))[:50]
+    backend.bulk_extend(ox.Quad(q.subject, q.predicate, q.object, graph) for q in part)  # then dies
+    backend.add(ox.Quad(ox.NamedNode("urn:other"), ox.NamedNode("urn:p"), ox.Literal("kept")))
+    store.close()
+    del backend  # Oxigraph releases the store's lock with its last reference
+    reopened = EmbeddedStore.open(tmp_path / "store")
+    try:
+        assert reopened.count(graph) == 0
+        assert reopened.graphs() == []
+        assert reopened.count() == 1  # what else the store held is kept
+    finally:
+        reopened.close()
