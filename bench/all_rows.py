@@ -29,7 +29,14 @@ from typing import Any
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
-BENCHES = ("store_limits.py", "startup_and_scale.py", "rosbridge*.py", "match_scale.py", "sim_rtf.py")
+BENCHES = (
+    "store_limits.py",
+    "startup_and_scale.py",
+    "rosbridge*.py",
+    "match_scale.py",
+    "sim_rtf.py",
+    "cold_match.py",
+)
 """The issue-18 benches, in the order they run (a glob may name several)."""
 _GOAL = re.compile(r"^\s*(>=|<=)\s*([0-9.]+)\s*(x?)")
 
@@ -155,6 +162,9 @@ def draw(merged: dict[str, Any], path: Path) -> None:
     axes.set_xlim(10 ** math.floor(math.log10(low)), 10 ** math.ceil(math.log10(high)))
     axes.set_xlabel("figure relative to its goal (1 = goal; right of the line is better; log scale)")
     when = merged.get("when", "")
+    loads = [bench["load_average"] for bench in merged.get("benches", {}).values() if "load_average" in bench]
+    if loads:
+        when += f", load average {min(loads):.1f}-{max(loads):.1f} before the benches"
     axes.set_title(f"Issue 18 rows, {'quick' if merged.get('quick') else 'full'} run {when}\n{merged['machine']}",
                    fontsize=9)  # fmt: skip
     figure.tight_layout()
