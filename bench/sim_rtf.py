@@ -1,0 +1,217 @@
+"""Benchmark: the simulation's real-time factor as cbrs runs a task headless, against pybullet stepping
+the same scene alone.
+
+Run: python bench/sim_rtf.py [--tasks RobotArmServeACup,FetchMyPen] [--seeds 0,1,2] [--profile N] [--json FILE]
+
+For each task and seed, a world is built from the store's semantic map (as ``cbrs run`` builds it;
+not timed), then:
+
+* anchor: pybullet alone steps that freshly built world (``p.stepSimulation`` in a loop, the world's
+  time step, the same bodies, nothing else) for as many steps as the task took; its real-time factor
+  is simulated seconds per wall second;
+* task: a second world of the same seed runs the task as ``cbrs run`` does (``actions.runner.run_task``
+  with ``SimEnvironment``: perception with the cameras, path planning, the skills' control loops, the
+  belief written to the store after every step, verification), timed from building the environment
+  to the end of the run, less the time spent composing plans (``Composer.compose``); its real-time
+  factor is the world's simulated seconds over that wall time.
+
+The row's ratio is the median of the task's factors over the median of the anchor's (goal >= 0.8x).
+The same ratio on this thread's CPU time is printed too: on a machine shared with other jobs it
+moves less than the wall-clock one (pybullet's DIRECT client steps and renders on this thread).
+``--profile N`` also runs the tasks once under cProfile and prints the N functions with the most
+time of their own. ``--json FILE`` writes the rows as a list of records.
+"""
+
+from __future__ import annotations
+
+import argparse
+import cProfile
+import io
+import json
+import os
+import platform
+import pstats
+import statistics
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from importlib.metadata import version
+from pathlib import Path
+from typing import Any
+
+import pybullet as p
+
+from cbrs.actions.composer import Composer
+from cbrs.actions.runner import run_task
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.semantic_map import SemanticMap
+from cbrs.sim.components import SimEnvironment
+from cbrs.sim.world import TIME_STEP, HomeWorld
+
+TASKS = ("RobotArmServeACup", "FetchMyPen")
+GOAL = 0.8
+"""The task's real-time factor must be at least this fraction of pybullet's alone."""
+
+
+@dataclass(frozen=True)
+class Sample:
+    task: str
+    seed: int
+    status: str
+    steps: int
+    simulated: float
+    wall: float
+    composing: float
+    alone: float  # wall seconds pybullet took for the same number of steps alone
+    cpu: float  # this thread's CPU seconds for the task, composing left out
+    cpu_alone: float
+
+    @property
+    def cpu_ratio(self) -> float:
+        return self.cpu_alone / self.cpu
+
+    @property
+    def factor(self) -> float:
+        return self.simulated / (self.wall - self.composing)
+
+    @property
+    def anchor(self) -> float:
+        return self.simulated / self.alone
+
+
+@contextmanager
+def composing_time() -> Iterator[list[float]]:
+    """Add the wall and CPU time of every ``Composer.compose`` call (replans' composers too) to the
+    yielded list."""
+    spent = [0.0, 0.0]
+    original = Composer.compose
+
+    def timed(self: Composer, *args: Any, **kwargs: Any) -> Any:
+        start, cpu = time.perf_counter(), time.thread_time()
+        try:
+            return original(self, *args, **kwargs)
+        finally:
+            spent[0] += time.perf_counter() - start
+            spent[1] += time.thread_time() - cpu
+
+    Composer.compose = timed  # type: ignore[method-assign]
+    try:
+        yield spent
+    finally:
+        Composer.compose = original  # type: ignore[method-assign]
+
+
+def step_alone(world: HomeWorld, steps: int) -> tuple[float, float]:
+    """Wall and CPU seconds pybullet takes for ``steps`` steps of the world with nothing else running."""
+    client = world.client
+    start, cpu = time.perf_counter(), time.thread_time()
+    for _ in range(steps):
+        p.stepSimulation(physicsClientId=client)
+    return time.perf_counter() - start, time.thread_time() - cpu
+
+
+def run_one(kb: KnowledgeBase, smap: SemanticMap, composer: Composer, task: str, seed: int) -> Sample:
+    world = HomeWorld.create(seed=seed, semantic_map=smap)
+    try:
+        steps0 = world.steps
+        with composing_time() as spent:
+            start, cpu = time.perf_counter(), time.thread_time()
+            result = run_task(kb, task, SimEnvironment(world, kb), composer=composer)
+            wall, cpu = time.perf_counter() - start, time.thread_time() - cpu
+        steps = world.steps - steps0
+    finally:
+        world.close()
+    with HomeWorld.create(seed=seed, semantic_map=smap) as fresh:
+        alone, cpu_alone = step_alone(fresh, steps)
+    status = result.report.status.value if result.report else "no plan"
+    simulated = steps * world.time_step
+    return Sample(task, seed, status, steps, simulated, wall, spent[0], alone, cpu - spent[1], cpu_alone)
+
+
+def profile(kb: KnowledgeBase, smap: SemanticMap, composer: Composer, tasks: list[str], top: int) -> str:
+    profiler = cProfile.Profile()
+    for task in tasks:
+        world = HomeWorld.create(seed=0, semantic_map=smap)
+        try:
+            profiler.enable()
+            run_task(kb, task, SimEnvironment(world, kb), composer=composer)
+            profiler.disable()
+        finally:
+            world.close()
+    out = io.StringIO()
+    pstats.Stats(profiler, stream=out).sort_stats("tottime").print_stats(top)
+    return out.getvalue()
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--tasks", default=",".join(TASKS))
+    parser.add_argument("--seeds", default="0,1,2")
+    parser.add_argument("--profile", type=int, default=0, metavar="N", help="print the N costliest functions")
+    parser.add_argument("--json", type=Path, help="also write the rows to FILE as a list of records")
+    args = parser.parse_args()
+    tasks = args.tasks.split(",")
+    seeds = [int(s) for s in args.seeds.split(",")]
+    print(
+        f"machine: {platform.platform()}, {os.cpu_count()} cores, python {platform.python_version()}, "
+        f"pybullet {version('pybullet')}, pyoxigraph {version('pyoxigraph')}; "
+        f"load average at start {os.getloadavg()[0]:.2f}"
+    )
+    kb = KnowledgeBase.open(":memory:")
+    smap = SemanticMap.read(kb)
+    composer = Composer(kb)
+    print(f"inputs: tasks {', '.join(tasks)}; seeds {seeds}; physics step {TIME_STEP:.6f} s; DIRECT, headless\n")
+
+    print(
+        f"{'task':<18} {'seed':>4} {'status':>10} {'steps':>6} {'sim s':>6} {'run s':>6} {'plan s':>6} "
+        f"{'alone s':>7} {'RTF':>6} {'alone':>6} {'ratio':>6} {'CPU ratio':>9}"
+    )
+    samples: list[Sample] = []
+    for task in tasks:
+        for seed in seeds:
+            s = run_one(kb, smap, composer, task, seed)
+            samples.append(s)
+            print(
+                f"{task:<18} {seed:>4} {s.status:>10} {s.steps:>6} {s.simulated:>6.1f} {s.wall:>6.2f} "
+                f"{s.composing:>6.2f} {s.alone:>7.2f} {s.factor:>6.1f} {s.anchor:>6.1f} {s.factor / s.anchor:>6.2f} "
+                f"{s.cpu_ratio:>9.2f}"
+            )
+
+    records = [row(f"{task}, headless", [s for s in samples if s.task == task]) for task in tasks]
+    records.append(row("both tasks, headless", samples))
+    print()
+    for record, group in zip(records, [*([s for s in samples if s.task == t] for t in tasks), samples], strict=True):
+        verdict = "met" if record["met"] else "not met"
+        cpu = statistics.median(s.cpu_ratio for s in group)
+        print(
+            f"{record['row']}: real-time factor {record['value']:.1f} vs pybullet alone {record['anchor']:.1f}: "
+            f"{record['ratio']:.2f}x (goal >= {GOAL:g}x: {verdict}); on CPU time {cpu:.2f}x"
+        )
+    print(f"load average at end {os.getloadavg()[0]:.2f}")
+    if args.profile:
+        listing = profile(kb, smap, composer, tasks, args.profile)
+        print(f"\nprofile of one run of each task (seed 0), by own time:\n{listing}")
+    if args.json is not None:
+        args.json.write_text(json.dumps(records, indent=2) + "\n", encoding="utf-8")
+        print(f"written to {args.json}")
+
+
+def row(name: str, samples: list[Sample]) -> dict[str, Any]:
+    """One record: the medians of the task's and the anchor's real-time factors, and their ratio."""
+    value = statistics.median(s.factor for s in samples)
+    anchor = statistics.median(s.anchor for s in samples)
+    ratio = value / anchor
+    return {
+        "row": f"simulation real-time factor, {name}, vs pybullet stepping the same scene alone",
+        "value": round(value, 2),
+        "anchor": round(anchor, 2),
+        "ratio": round(ratio, 3),
+        "unit": "simulated s per wall s",
+        "goal": f">= {GOAL:g}x",
+        "met": ratio >= GOAL,
+    }
+
+
+if __name__ == "__main__":
+    main()
