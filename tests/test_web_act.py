@@ -247,7 +247,27 @@ def test_a_run_with_random_faults_says_which_requirement_it_could_not_meet(live:
     assert "requirement FetchMyPen not met" in client.get(f"/tasks/{run_id}").text
 
 
-def test_other_sites_cannot_start_a_run(client: FlaskClient) -> None:
+def test_a_run_stopped_from_the_page_ends_cancelled_before_its_last_step(live: tuple[Flask, TaskRunner]) -> None:
+    app, runner = live
+    client = app.test_client()
+    run_id = start(client).get_json()["started"]["id"]
+    assert 'id="cancel"' in client.get(f"/tasks/{run_id}").text
+    stopping = client.post(f"/tasks/{run_id}/cancel.json")
+    assert stopping.status_code == 202 and "asked to stop" in stopping.get_json()["message"]
+    wait_done(runner, run_id)
+    run = client.get(f"/tasks/{run_id}.json").get_json()["run"]
+    assert run["status"] == "cancelled"
+    outcomes = [step["outcome"] for step in run["result"]["execution"]["steps"]]
+    assert outcomes[-1] == "pending" and outcomes.count("succeeded") < len(run["result"]["plan"]["steps"])
+    again = client.post(f"/tasks/{run_id}/cancel.json")
+    assert again.status_code == 409 and "already ended: cancelled" in again.get_json()["message"]
+    assert "already ended" in client.post(f"/tasks/{run_id}/cancel").text
+
+
+def test_other_sites_cannot_start_or_stop_a_run(client: FlaskClient) -> None:
+    evil = {"Origin": "https://evil.example"}
+    assert client.post("/tasks/run-1/cancel.json", headers=evil).status_code == 403
+    assert client.post("/tasks/run-999/cancel.json").status_code == 404
     response = client.post("/tasks.json", data={"task": "FetchMyPen"}, headers={"Origin": "https://evil.example"})
     assert response.status_code == 403
     assert client.get("/tasks/run-999.json").status_code == 404

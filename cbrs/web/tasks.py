@@ -60,7 +60,7 @@ def tasks() -> Page:
     _for_script(shown)
     if request.method != "POST":
         return shown
-    _may_start()
+    _may_act()
     task, seed, faults, fault_rate = _checked(form, shown)
     try:
         started = context.tasks().start(task, seed, faults, fault_rate)
@@ -82,6 +82,27 @@ def run(run_id: str) -> Page:
     found = context.tasks().get(run_id)  # an unknown run: 404
     data = {"mode": "run", "run": _detail(found), **_live()}
     return _for_script(Page("tasks.html", f"Run {found.id}: {found.task}, {found.status}", data))
+
+
+@page(blueprint, "/tasks/<run_id>/cancel", methods=["POST"])
+def cancel(run_id: str) -> Page:
+    """Ask a run to stop after the step under way (202); the same people who may start a run may stop it.
+
+    A run that has already ended is left as it is and said so (409), as the bridge's cancel does.
+    """
+    _may_act("stopped")
+    found = context.tasks().get(run_id)  # an unknown run: 404
+    data = {"mode": "run", **_live()}
+    if found.done.is_set():
+        data.update(run=_detail(found), error="ended", message=f"{found.id} has already ended: {found.status}")
+        shown = Page("tasks.html", f"Run {found.id}: {found.task}, {found.status}", data)
+        shown.status = 409
+        return _for_script(shown)
+    context.tasks().cancel(run_id)
+    data.update(run=_detail(found), message=f"{found.id}: asked to stop after the step under way")
+    shown = Page("tasks.html", f"Run {found.id}: {found.task}, stopping", data)
+    shown.status = 202
+    return _for_script(shown)
 
 
 def _for_script(shown: Page) -> Page:
@@ -136,24 +157,24 @@ def _checked(form: dict[str, Any], shown: Page) -> tuple[str, int, list[str], fl
     return form["task"], seed, faults, fault_rate
 
 
-def _may_start() -> None:
-    """Starting a run moves a (simulated) robot and writes the store: from this server's own pages (their
-    ``Origin``), or with the update token. Behind ``cbrs serve`` the pages' origins are those of the
+def _may_act(verb: str = "started") -> None:
+    """Starting (or stopping) a run moves a (simulated) robot and writes the store: from this server's own
+    pages (their ``Origin``), or with the update token. Behind ``cbrs serve`` the pages' origins are those of the
     address it binds, never read from the request; a request with no ``Origin`` (not a browser) needs
     the token."""
     origin = request.headers.get("Origin")
     own = current_app.extensions.get("cbrs.own_origins")
     if own is None:  # an app not behind cbrs serve (a test client): the page's own host is all we know
         if origin is not None and origin.rstrip("/") != request.host_url.rstrip("/"):
-            raise Forbidden(f"a task may be started only from this server's own pages, not from {origin}")
+            raise Forbidden(f"a task may be {verb} only from this server's own pages, not from {origin}")
         return
     if origin is not None:
         if origin.rstrip("/") not in own():
-            raise Forbidden(f"a task may be started only from this server's own pages, not from {origin}")
+            raise Forbidden(f"a task may be {verb} only from this server's own pages, not from {origin}")
         return
     if not _has_token():
         raise Forbidden(
-            "a task run moves the robot: start it from this server's tasks page, or send the update token "
+            f"a task run moves the robot: it may be {verb} from this server's tasks page, or with the update token "
             "(Authorization: Bearer <token>)"
         )
 

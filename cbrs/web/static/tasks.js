@@ -45,6 +45,11 @@
     badge.textContent = status;
     badge.className = "badge status-" + status;
     live.dataset.status = status;
+    const stop = byId("cancel");
+    if (stop) {
+      stop.hidden = status !== "running";
+      if (current) stop.action = live.dataset.runs + "/" + encodeURIComponent(current) + "/cancel";
+    }
   }
 
   function row(step) {
@@ -169,6 +174,25 @@
   source.onerror = () => (streamState.textContent = "· reconnecting…");
   source.onmessage = (event) => handle(JSON.parse(event.data));
   source.addEventListener("end", () => (streamState.textContent = "· paused, reconnecting…"));
+
+  // Stop the run shown without leaving the page; the form still works without this script.
+  const stopForm = byId("cancel");
+  if (stopForm) {
+    stopForm.addEventListener("submit", async (event) => {
+      event.preventDefault();
+      const button = byId("cancel-button");
+      button.disabled = true;
+      try {
+        const response = await fetch(stopForm.action + ".json", { method: "POST" });
+        const data = await response.json();
+        stopForm.parentElement.querySelectorAll(".form-message").forEach((node) => node.remove());
+        const box = response.status === 202 ? "ok-box" : "error-box";
+        stopForm.before(el("p", { class: box + " form-message", role: "status" }, data.message || response.statusText));
+      } finally {
+        button.disabled = false;
+      }
+    });
+  }
 
   // Start a run without leaving the page; the form still works without this script.
   const form = byId("start");
