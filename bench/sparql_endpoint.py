@@ -6,7 +6,8 @@ Both servers hold the seeded bundled knowledge base on disk (a cbrs store in a t
 its dump loaded into a fresh Oxigraph server directory) and answer the same query texts: the named
 queries that take no required value, with the cbrs prefixes declared in each text, and one trivial
 query that shows the HTTP overhead. First each query alone (median of sequential requests), then
-C client threads (one pooled HTTP connection each, JSON results asked for) for S seconds, round-robin
+C client threads (one pooled HTTP connection each, from an address of its own, JSON results asked
+for) for S seconds, round-robin
 over the queries; the load generator runs on the same machine, so both servers share the cores.
 Prints the machine, the inputs, queries per second and latency percentiles of each server, and cbrs's
 rate as a fraction of Oxigraph's.
@@ -21,6 +22,7 @@ import shutil
 import socket
 import statistics
 import subprocess
+import sys
 import tempfile
 import threading
 import time
@@ -41,7 +43,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seconds", type=float, default=5.0)
     parser.add_argument("--clients", default="1,4")
-    parser.add_argument("--oxigraph", default=shutil.which("oxigraph") or "oxigraph")
+    parser.add_argument("--oxigraph", default=shutil.which("oxigraph") or str(Path(sys.executable).parent / "oxigraph"))
     args = parser.parse_args()
     version = subprocess.run([args.oxigraph, "--version"], capture_output=True, text=True, check=True).stdout.strip()
     print(f"machine: {platform.platform()}, {os.cpu_count()} cores, python {platform.python_version()}")
@@ -129,7 +131,8 @@ def _load(url: str, texts: list[str], clients: int, seconds: float) -> tuple[flo
     deadline = time.perf_counter() + seconds
 
     def work(index: int) -> None:
-        with httpx.Client() as client:
+        # each client from an address of its own, as robots are: cbrs shares its query workers per address
+        with httpx.Client(transport=httpx.HTTPTransport(local_address=f"127.0.0.{10 + index}")) as client:
             n = index
             while time.perf_counter() < deadline:
                 start = time.perf_counter()
