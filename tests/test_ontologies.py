@@ -33,9 +33,11 @@ def merged() -> rdflib.Graph:
 
 
 def test_bundle_lists_every_ontology_file() -> None:
-    listed = {item.path.name for item in bundled_files()}
-    shapes = {path.name for path in ontology_dir().glob("shapes*.ttl")}  # read by the validator, not stored
-    assert listed == {path.name for path in ontology_dir().glob("*.ttl")} - shapes
+    folder = ontology_dir()
+    listed = {item.path.relative_to(folder) for item in bundled_files()}
+    shapes = {path.relative_to(folder) for path in folder.glob("shapes*.ttl")}  # read by the validator, not stored
+    files = [*folder.glob("*.ttl"), *folder.glob("standards/*.ttl")]
+    assert listed == {path.relative_to(folder) for path in files} - shapes
 
 
 def test_protege_catalogue_maps_every_import_to_a_bundled_file(merged: rdflib.Graph) -> None:
