@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -9,6 +10,7 @@ import pyoxigraph as ox
 
 from cbrs.kb.catalog import Catalogue
 from cbrs.kb.descriptions import DescriptionReader
+from cbrs.kb.errors import StoreError
 from cbrs.kb.liveness import Liveness
 from cbrs.kb.loader import LoadReport, ParsedFile, load_files, parse_file
 from cbrs.kb.model import Advertisement, PartNode, Requirement, ServiceDescription
@@ -18,9 +20,11 @@ from cbrs.kb.query_guard import QueryGuard
 from cbrs.kb.registry import ComponentRegistry
 from cbrs.kb.resources import bundled_files, query_dir
 from cbrs.kb.shapes import checked_update
+from cbrs.kb.standard_terms import Refresh, StandardTerms
 from cbrs.kb.store import EmbeddedStore, QueryResult, Store, Term, is_remote
 from cbrs.kb.upgrade import UpgradeReport, new_terms, upgrade_store
 
+_log = logging.getLogger(__name__)
 _VERSION_INFO = ox.NamedNode("http://www.w3.org/2002/07/owl#versionInfo")
 
 
@@ -30,7 +34,8 @@ class KnowledgeBase:
     def __init__(self, store: Store, queries: QueryLibrary | None = None) -> None:
         self.store = store
         self.queries = queries or QueryLibrary(query_dir())
-        self.registry = ComponentRegistry(store)
+        self.standard_terms = StandardTerms(store)
+        self.registry = ComponentRegistry(store, self.standard_terms)
         self._reader = DescriptionReader(store, self.queries)
 
     @classmethod
@@ -54,7 +59,7 @@ class KnowledgeBase:
         """
         remote_options = (remote_timeout, remote_token, remote_batch)
         if is_remote(str(location)) and any(option is not None for option in remote_options):
-            from cbrs.kb.remote_store import DEFAULT_BATCH, DEFAULT_TIMEOUT, RemoteStore  # only a remote store needs httpx
+            from cbrs.kb.remote_store import DEFAULT_BATCH, DEFAULT_TIMEOUT, RemoteStore  # needs httpx
 
             timeout = remote_timeout if remote_timeout is not None else DEFAULT_TIMEOUT
             batch = remote_batch if remote_batch is not None else DEFAULT_BATCH
@@ -71,7 +76,21 @@ class KnowledgeBase:
             kb.upgrade()
             if kb._map_outdated():
                 kb.add_semantic_map()
+            if next(kb.store.quads(graph=GraphName.ENTAILED.node), None) is None:
+                kb._entail()  # a store seeded before the alignments existed
         return kb
+
+    def refresh_standard_terms(self) -> Refresh:
+        """Rewrite graph:entailed: what the alignments entail in standard vocabularies (:mod:`kb.standard_terms`).
+        Every write method here calls it; call it after writing to the store by other means."""
+        return self.standard_terms.refresh()
+
+    def _entail(self) -> None:
+        """After a write that stands: bring graph:entailed up to date, or say why it lags."""
+        try:
+            self.standard_terms.refresh()
+        except StoreError as error:
+            _log.warning("graph:entailed not brought up to date (it lags until the next write): %s", error)
 
     def upgrade(self) -> UpgradeReport:
         """Bring a store seeded by an older cbrs up to the bundled ontologies (:mod:`kb.upgrade`): its
@@ -79,6 +98,7 @@ class KnowledgeBase:
         report = upgrade_store(self.store, self.queries)
         if report.changed:
             self._reader.clear_cache()
+            self._entail()
         return report
 
     def _map_outdated(self) -> bool:
@@ -117,12 +137,14 @@ class KnowledgeBase:
         ]
         self.store.add(added)
         self._reader.clear_cache()
+        self._entail()
 
     def seed(self) -> list[ParsedFile]:
         """Load the bundled ontologies, advertisements and requirements in one transaction."""
         parsed = [parse_file(item.path, item.graph) for item in bundled_files()]
         self.store.add(quad for item in parsed for quad in item.quads)
         self._reader.clear_cache()
+        self._entail()
         return parsed
 
     def load(
@@ -141,6 +163,7 @@ class KnowledgeBase:
             catalogue = Catalogue.open(catalogue)
         report = load_files(self.store, paths, graph, catalogue)
         self._reader.clear_cache()
+        self._entail()
         return report
 
     def query(self, text: str, bindings: Mapping[str, Term] | None = None) -> QueryResult:
@@ -153,6 +176,7 @@ class KnowledgeBase:
                 self.store.update(text)
         finally:
             self._reader.clear_cache()
+        self._entail()
 
     def run(self, name: str, values: Mapping[str, Term | str | int | float] | None = None) -> QueryResult:
         """Run the named query ``queries/<name>.rq`` with ``values`` bound to its parameters."""

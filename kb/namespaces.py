@@ -43,6 +43,17 @@ PREFIXES: dict[str, str] = {
     "xsd": XSD,
     "skos": "http://www.w3.org/2004/02/skos/core#",
     "dcterms": "http://purl.org/dc/terms/",
+    # the standard vocabularies cbrs is aligned with (ontologies/alignments.ttl, docs/vocabularies.md)
+    "align": BASE + "align#",
+    "sosa": "http://www.w3.org/ns/sosa/",
+    "profile": "http://www.daml.org/services/owl-s/1.1/Profile.owl#",
+    "process": "http://www.daml.org/services/owl-s/1.1/Process.owl#",
+    "service": "http://www.daml.org/services/owl-s/1.1/Service.owl#",
+    "expr": "http://www.daml.org/services/owl-s/1.1/generic/Expression.owl#",
+    "qudt": "http://qudt.org/schema/qudt/",
+    "unit": "http://qudt.org/vocab/unit/",
+    "quantitykind": "http://qudt.org/vocab/quantitykind/",
+    "soma": "http://www.ease-crc.org/ont/SOMA.owl#",
 }
 
 
@@ -59,6 +70,9 @@ class GraphName(StrEnum):
     WORLD = "world"
     PLANS = "plans"
     LIVENESS = "liveness"
+    ENTAILED = "entailed"
+    """What the alignments entail in standard vocabularies, derived from the other graphs and rewritten
+    whenever they change (kb/standard_terms.py); not to be written by hand."""
 
     @property
     def iri(self) -> str:

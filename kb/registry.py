@@ -12,6 +12,7 @@ from cbrs.kb.errors import AlreadyRegisteredError, InvalidDescriptionError, NotF
 from cbrs.kb.loader import parse_bytes
 from cbrs.kb.namespaces import BASE, GENID, RDF, GraphName, shorten
 from cbrs.kb.shapes import check_descriptions
+from cbrs.kb.standard_terms import StandardTerms
 from cbrs.kb.store import Store
 from cbrs.kb.vocab import CBRS
 
@@ -20,9 +21,10 @@ class ComponentRegistry:
     """Advertisements in the services graph. A description is the advertisement's own triples
     plus those of the nodes hanging off it (its OWLS, SEA and QoS models, parameters, conditions)."""
 
-    def __init__(self, store: Store) -> None:
+    def __init__(self, store: Store, standard_terms: StandardTerms | None = None) -> None:
         self._store = store
         self._graph = GraphName.SERVICES.node
+        self._standard_terms = standard_terms or StandardTerms(store)  # graph:entailed kept up to date
 
     def register(self, turtle: str | bytes, source: str = "<registration>") -> list[str]:
         """Add the advertisements described in ``turtle``; refuses any that already exist."""
@@ -30,7 +32,9 @@ class ComponentRegistry:
         for iri in iris:
             if self.is_registered(iri):
                 raise AlreadyRegisteredError(iri)
+        before = self._standard_terms.begin()
         self._store.add(quads)
+        self._standard_terms.changed(before, [], quads)
         return iris
 
     def update(self, turtle: str | bytes, source: str = "<update>") -> list[str]:
@@ -42,7 +46,9 @@ class ComponentRegistry:
                 raise NotFoundError(iri, "registered advertisement")
             old.extend(self.description_quads(iri))
         new, kept = set(quads), set(old)
+        before = self._standard_terms.begin()
         self._store.replace([q for q in old if q not in new], [q for q in quads if q not in kept])
+        self._standard_terms.changed(before, old, quads)
         return iris
 
     def deregister(self, iri: str) -> int:
@@ -50,7 +56,9 @@ class ComponentRegistry:
         if not self.is_registered(iri):
             raise NotFoundError(iri, "registered advertisement")
         old = self.description_quads(iri)
+        before = self._standard_terms.begin()
         self._store.replace(old, [])
+        self._standard_terms.changed(before, old, [])
         return len(old)
 
     def is_registered(self, iri: str) -> bool:

@@ -325,7 +325,9 @@ def test_the_seed_is_staged_in_batches(requests_seen: tuple[Store, list[httpx.Re
     quads = sum(len(parsed.quads) for parsed in KnowledgeBase(store).seed())
     writes = [r.content.decode() for r in seen if r.url.path == "/update"]
     batches = -(-quads // DEFAULT_BATCH)
-    assert [w.count("INSERT DATA") for w in writes] == [1] * batches + [0, 0]  # the batches, publish, drop
+    seed, entailed = writes[: batches + 2], writes[batches + 2 :]
+    assert [w.count("INSERT DATA") for w in seed] == [1] * batches + [0, 0]  # the batches, publish, drop
+    assert entailed and all("graph/entailed" in w or "staging" in w for w in entailed)  # then graph:entailed
     assert store.is_seeded() and not [g for g in store.graphs() if g.startswith(STAGING)]
 
 

@@ -1,0 +1,302 @@
+"""Standard vocabularies over cbrs's data: what the alignments entail, kept in the graph graph:entailed.
+
+The store answers SPARQL without an OWL reasoner, so ``?s a sosa:Sensor`` would find nothing although
+home:Sensor is a subclass of sosa:Sensor (ontologies/alignments.ttl). Rather than rewrite queries, cbrs
+materialises: whenever descriptions change (seed, load, update, registration) :func:`refresh` works out
+what the alignments entail in the standard vocabularies and makes graph:entailed hold exactly that. A
+query in standard terms then needs nothing of cbrs, so a client talking SPARQL to the server directly,
+an export and a KnowRob import see it too. The choice and its cost: docs/vocabularies.md.
+
+What is entailed, each conclusion in a standard namespace (``align:standardNamespace``) only:
+
+- **types**: an individual of C is one of every standard class above C (``rdfs:subClassOf`` and
+  ``owl:equivalentClass``, through any classes);
+- **statements**: (s P o) gives (s Q o) for every standard property Q above P (``rdfs:subPropertyOf``,
+  ``owl:equivalentProperty``, ``align:entails``), and (s Q "o"^^xsd:anyURI) for ``align:entailsAsAnyURI``;
+- the **domains, ranges and inverses** of those standard properties (RDFS rules 2 and 3, ``owl:inverseOf``);
+- **rules**: the answers of the CONSTRUCT queries in ``align:rule`` annotations of the bundled alignments.
+
+Statements about blank nodes are not materialised (cbrs names every node it loads).
+"""
+
+from __future__ import annotations
+
+import functools
+import logging
+from collections import defaultdict
+from collections.abc import Iterable, Iterator, Sequence
+from dataclasses import dataclass
+
+import pyoxigraph as ox
+
+from cbrs.kb.errors import StoreError
+from cbrs.kb.namespaces import OWL, PREFIXES, RDF, RDFS, XSD, GraphName
+from cbrs.kb.resources import ontology_dir
+from cbrs.kb.store import Store
+
+ALIGN = PREFIXES["align"]
+ALIGNMENTS_FILE = "alignments.ttl"
+
+_log = logging.getLogger(__name__)
+_TYPE = ox.NamedNode(RDF + "type")
+_ANY_URI = ox.NamedNode(XSD + "anyURI")
+_GRAPH = GraphName.ENTAILED.node
+
+# The links between terms, from every graph but graph:entailed; one pattern per link, so each is an
+# index lookup on any server.
+_LINKS = [RDFS + "subClassOf", OWL + "equivalentClass", RDFS + "subPropertyOf", OWL + "equivalentProperty"]
+_LINKS += [ALIGN + "entails", ALIGN + "entailsAsAnyURI", OWL + "inverseOf", RDFS + "domain", RDFS + "range"]
+_LINK_QUERY = (
+    "SELECT ?a ?link ?b WHERE {\n"
+    + "\n  UNION ".join(f"{{ GRAPH ?g {{ ?a <{link}> ?b }} BIND (<{link}> AS ?link) }}" for link in _LINKS)
+    + "\n  FILTER (?g != graph:entailed && isIRI(?a) && isIRI(?b))\n}"
+)
+_LINK_SET = frozenset(_LINKS) | {ALIGN + "standardNamespace"}
+_NAMESPACE_QUERY = "SELECT DISTINCT ?namespace WHERE { ?vocabulary align:standardNamespace ?namespace }"
+_TYPE_QUERY = "SELECT ?s ?c WHERE { GRAPH ?g { ?s a ?c } FILTER (?g != graph:entailed && isIRI(?s)) }"
+_STATEMENT_QUERY = "SELECT ?s ?p ?o WHERE { GRAPH ?g { ?s ?p ?o } FILTER (?g != graph:entailed && isIRI(?s)) }"
+
+
+@dataclass(frozen=True)
+class Refresh:
+    """What :func:`refresh` changed in graph:entailed."""
+
+    added: int
+    removed: int
+    total: int
+
+
+class Alignment:
+    """The alignments found in a store: which standard terms each term entails."""
+
+    def __init__(self, links: Iterable[tuple[str, str, str]], namespaces: Iterable[str]) -> None:
+        self.namespaces = tuple(sorted(set(namespaces)))
+        down: dict[str, set[str]] = defaultdict(set)  # term -> the terms just below it
+        self._as_uri: dict[str, set[str]] = defaultdict(set)
+        self._inverse: dict[str, set[str]] = defaultdict(set)
+        self._domain: dict[str, set[str]] = defaultdict(set)
+        self._range: dict[str, set[str]] = defaultdict(set)
+        standard: set[str] = set()
+        for a, link, b in links:
+            name = link.rsplit("#", 1)[-1]
+            if name in ("subClassOf", "subPropertyOf", "entails"):
+                down[b].add(a)
+            elif name in ("equivalentClass", "equivalentProperty"):
+                down[b].add(a)
+                down[a].add(b)
+            elif name == "entailsAsAnyURI":
+                self._as_uri[a].add(b)
+            elif name == "inverseOf":
+                self._inverse[a].add(b)
+                self._inverse[b].add(a)
+            elif name == "domain":
+                self._domain[a].add(b)
+            else:
+                self._range[a].add(b)
+            standard.update(term for term in (a, b) if self.is_standard(term))
+        self.standard = frozenset(standard)
+        # Walk down from each standard term: everything below it has it above. Only the (small) part of
+        # the taxonomy under standard terms is visited.
+        above: dict[str, set[str]] = defaultdict(set)
+        for top in self.standard:
+            seen, pending = {top}, [top]
+            while pending:
+                for lower in down.get(pending.pop(), ()):
+                    if lower not in seen:
+                        seen.add(lower)
+                        pending.append(lower)
+            for lower in seen - {top}:
+                above[lower].add(top)
+        self._above = {term: frozenset(uppers) for term, uppers in above.items()}
+
+    def is_standard(self, iri: str) -> bool:
+        return bool(self.namespaces) and iri.startswith(self.namespaces)
+
+    def above(self, term: str) -> frozenset[str]:
+        """The standard terms above ``term`` (not ``term`` itself), through any terms."""
+        return self._above.get(term, frozenset())
+
+    def classes(self) -> set[str]:
+        """The classes whose individuals to read: those with a standard class above them, and the
+        standard ones (so that what the data asserts in standard terms is not repeated)."""
+        return set(self._above) | set(self.standard)
+
+    def properties(self) -> set[str]:
+        """The properties whose statements to read: those with a standard property above them or an
+        anyURI counterpart, and the standard ones."""
+        return set(self._above) | set(self._as_uri) | set(self.standard)
+
+    def statement(self, s: ox.NamedNode, p: str, o: ox.NamedNode | ox.BlankNode | ox.Literal) -> Iterator[ox.Triple]:
+        """What (s p o) entails."""
+        standard = set(self.above(p)) | ({p} if self.is_standard(p) else set())
+        for q in self.above(p):
+            yield ox.Triple(s, ox.NamedNode(q), o)
+        for q in self._as_uri.get(p, ()):
+            if isinstance(o, ox.NamedNode) and self.is_standard(q):
+                yield ox.Triple(s, ox.NamedNode(q), ox.Literal(o.value, datatype=_ANY_URI))
+        for q in standard:
+            yield from self._typed(s, self._domain.get(q, ()))
+            if isinstance(o, ox.NamedNode):
+                yield from self._typed(o, self._range.get(q, ()))
+                for inverse in self._inverse.get(q, ()):
+                    if self.is_standard(inverse):
+                        yield ox.Triple(o, ox.NamedNode(inverse), s)
+
+    def typed(self, s: ox.NamedNode, cls: str) -> Iterator[ox.Triple]:
+        """What (s rdf:type cls) entails."""
+        return self._typed(s, self.above(cls))
+
+    def triple(self, triple: ox.Triple) -> Iterator[ox.Triple]:
+        """What one statement entails, whatever its predicate."""
+        s, p, o = triple.subject, triple.predicate, triple.object
+        if not isinstance(s, ox.NamedNode) or isinstance(o, ox.Triple):
+            return
+        if p == _TYPE and isinstance(o, ox.NamedNode):
+            yield from self.typed(s, o.value)
+        else:
+            yield from self.statement(s, p.value, o)
+
+    def _typed(self, s: ox.NamedNode, classes: Iterable[str]) -> Iterator[ox.Triple]:
+        for cls in classes:
+            if self.is_standard(cls):
+                yield ox.Triple(s, _TYPE, ox.NamedNode(cls))
+                for upper in self.above(cls):
+                    yield ox.Triple(s, _TYPE, ox.NamedNode(upper))
+
+
+class StandardTerms:
+    """graph:entailed of one store, kept to what the rest of the store entails.
+
+    :meth:`refresh` works it out from the whole store (after a seed, a load, an update); :meth:`begin`
+    and :meth:`changed` bring it up to date after one description changed, from that description's
+    statements alone (a registration), reusing the alignments read at the last refresh.
+    """
+
+    def __init__(self, store: Store) -> None:
+        self.store = store
+        self._alignment: Alignment | None = None
+
+    def alignment(self) -> Alignment:
+        if self._alignment is None:
+            self._alignment = read_alignment(self.store)
+        return self._alignment
+
+    def refresh(self) -> Refresh:
+        """Make graph:entailed hold what the store entails now: one write of the difference."""
+        self._alignment = read_alignment(self.store)
+        wanted = self._entailed(self._alignment)
+        held = set(self.store.quads(graph=_GRAPH))
+        return self._write(held - wanted, wanted - held, len(wanted))
+
+    def begin(self) -> frozenset[ox.Triple]:
+        """What the rules conclude now: call it before changing a description, then :meth:`changed`."""
+        return frozenset(self._rule_conclusions(self.alignment())) if self.alignment().namespaces else frozenset()
+
+    def changed(self, before: frozenset[ox.Triple], removed: Sequence[ox.Quad], added: Sequence[ox.Quad]) -> Refresh:
+        """Bring graph:entailed up to date after one description's ``removed`` quads made way for ``added``.
+
+        What the removed statements entailed about the description's own nodes goes, what the added
+        ones entail comes, and the rules' conclusions are compared before and after. A change to the
+        alignments themselves (a subclass axiom in a description) takes a whole :meth:`refresh`.
+        """
+        try:
+            if any(quad.predicate.value in _LINK_SET for quad in (*removed, *added)):
+                return self.refresh()
+            return self._changed(before, removed, added)
+        except StoreError as error:
+            # the description's own write stands; graph:entailed lags until the next refresh
+            _log.warning("graph:entailed not brought up to date: %s", error)
+            self._alignment = None
+            return Refresh(0, 0, -1)
+
+    def _changed(self, before: frozenset[ox.Triple], removed: Sequence[ox.Quad], added: Sequence[ox.Quad]) -> Refresh:
+        alignment = self.alignment()
+        if not alignment.namespaces:
+            return Refresh(0, 0, 0)
+        own = {ox.Triple(q.subject, q.predicate, q.object) for q in added}
+        new = {t for q in added for t in alignment.triple(ox.Triple(q.subject, q.predicate, q.object))} - own
+        nodes = {q.subject for q in removed}
+        old = {t for q in removed for t in alignment.triple(ox.Triple(q.subject, q.predicate, q.object))}
+        after = set(self._rule_conclusions(alignment))
+        stale = {t for t in old if t.subject in nodes} - new - after
+        stale |= set(before) - after - new
+        return self._write({_quad(t) for t in stale}, {_quad(t) for t in (new | after) - own}, None)
+
+    def _entailed(self, alignment: Alignment) -> set[ox.Quad]:
+        if not alignment.namespaces:
+            return set()
+        triples: set[ox.Triple] = set()
+        asserted: set[ox.Triple] = set()
+        for cls in sorted(alignment.classes()):
+            for row in _rows(self.store, _TYPE_QUERY, {"c": ox.NamedNode(cls)}):
+                asserted.add(ox.Triple(row["s"], _TYPE, row["c"]))
+                triples.update(alignment.typed(row["s"], cls))
+        for prop in sorted(alignment.properties()):
+            for row in _rows(self.store, _STATEMENT_QUERY, {"p": ox.NamedNode(prop)}):
+                asserted.add(ox.Triple(row["s"], row["p"], row["o"]))
+                triples.update(alignment.statement(row["s"], prop, row["o"]))
+        triples.update(self._rule_conclusions(alignment))
+        return {_quad(t) for t in triples - asserted if _named(t)}
+
+    def _rule_conclusions(self, alignment: Alignment) -> Iterator[ox.Triple]:
+        for rule in rules():
+            result = self.store.query(rule)
+            assert isinstance(result, ox.QueryTriples)
+            for found in result:
+                if _named(found):
+                    yield found
+                    yield from alignment.triple(found)
+
+    def _write(self, stale: set[ox.Quad], fresh: set[ox.Quad], total: int | None) -> Refresh:
+        removing, adding = sorted(stale, key=str), sorted(fresh, key=str)
+        batch: int | None = getattr(self.store, "batch", None)  # a remote store's largest write
+        if batch is None or len(removing) + len(adding) <= batch:
+            if removing or adding:
+                self.store.replace(removing, adding)
+        else:
+            # Too large for one request: the new statements first (one staged write, whole or nothing),
+            # then the stale ones; if that fails part way, stale statements stay until the next refresh.
+            self.store.add(adding)
+            for start in range(0, len(removing), batch):
+                self.store.replace(removing[start : start + batch], [])
+        return Refresh(len(adding), len(removing), total if total is not None else -1)
+
+
+def read_alignment(store: Store) -> Alignment:
+    """The alignments and standard namespaces the store holds (outside graph:entailed)."""
+    links = _rows(store, _LINK_QUERY)
+    namespaces = [row["namespace"].value for row in _rows(store, _NAMESPACE_QUERY)]
+    return Alignment(((r["a"].value, r["link"].value, r["b"].value) for r in links), namespaces)
+
+
+def entailed(store: Store) -> set[ox.Quad]:
+    """Every quad graph:entailed should hold, worked out from the rest of the store."""
+    terms = StandardTerms(store)
+    return terms._entailed(terms.alignment())
+
+
+def refresh(store: Store) -> Refresh:
+    """Make graph:entailed hold what the store entails now (:meth:`StandardTerms.refresh`)."""
+    return StandardTerms(store).refresh()
+
+
+@functools.cache
+def rules() -> tuple[str, ...]:
+    """The CONSTRUCT rules of the bundled alignments (read from the package, not the store: a rule is
+    a query cbrs runs on every change, so only the shipped ones run)."""
+    graph = ox.parse(path=str(ontology_dir() / ALIGNMENTS_FILE), format=ox.RdfFormat.TURTLE)
+    return tuple(sorted(t.object.value for t in graph if t.predicate.value == ALIGN + "rule"))
+
+
+def _named(triple: ox.Triple) -> bool:
+    return not isinstance(triple.subject, ox.BlankNode) and not isinstance(triple.object, ox.BlankNode)
+
+
+def _quad(triple: ox.Triple) -> ox.Quad:
+    return ox.Quad(triple.subject, triple.predicate, triple.object, _GRAPH)
+
+
+def _rows(store: Store, query: str, bindings: dict[str, ox.NamedNode] | None = None) -> list[ox.QuerySolution]:
+    result = store.query(query, bindings)
+    assert isinstance(result, ox.QuerySolutions)
+    return list(result)
