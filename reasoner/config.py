@@ -21,6 +21,11 @@ class MatchConfig:
     lexicon: bool = False  # off by default: bench/matchmaking_ablation.py shows no robust gain (docs)
     lexical_links: int = 2
     cross_branch_weight: float = 0.8
+    # Two taxonomy concepts that are not is-a related (siblings, cousins, other branches) and both have
+    # complementary words (the words before the core word): their Sem-Str is multiplied by
+    # (1 - complement_weight) + complement_weight * Comp(complementary words), so PersonLocation is further
+    # from RobotLocation than the taxonomy alone says (docs/matchmaking.md, "Complementary words").
+    complement_weight: float = 0.2
     # A pair of entities counts as matched when its similarity reaches this threshold (CSS, PE).
     pair_threshold: float = 0.5
     # Weights of subject, predicate and object in an RDF statement's similarity (equation 8).
@@ -89,6 +94,7 @@ class MatchConfig:
             statement_mean="arithmetic",
             lexicon=False,
             disjoint_statements=False,
+            complement_weight=0.0,
         )
 
     def __post_init__(self) -> None:
@@ -105,6 +111,7 @@ class MatchConfig:
             "cross_branch_weight",
             "input_use_weight",
             "unrelated_output_factor",
+            "complement_weight",
         ):
             value = getattr(self, name)
             if not 0 <= value <= 1:

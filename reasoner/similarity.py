@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Protocol
 
 import jellyfish
@@ -30,8 +30,15 @@ class Similarity:
     situation: str
     common: str | None = None
     links: tuple[int, int] | None = None
+    qualified: float = 1.0  # the factor for differing complementary words (SemStr.qualifier_factor), applied
 
     def explain(self) -> str:
+        text = self._explain()
+        if self.qualified < 1:
+            text += f"; complementary words differ: x{self.qualified:.2f}"
+        return text
+
+    def _explain(self) -> str:
         if self.situation == "exact":
             return "same concept"
         if self.situation == "situation-1":
@@ -93,6 +100,29 @@ class SemStr:
             # One is a subclass of the other: Wu-Palmer is positive here (C is the upper one).
             nr = index.depth(common)
             return Similarity(2 * nr / (n1 + n2 + 2 * nr), "situation-2", common, (n1, n2))
+        found = self._unrelated(first, second, common, n1, n2)
+        factor = self.qualifier_factor(index.canonical(first), index.canonical(second))
+        return replace(found, value=found.value * factor, qualified=factor) if factor < 1 else found
+
+    def qualifier_factor(self, first: str, second: str) -> float:
+        """(1 - w) + w Comp(complementary words) for two concepts that are not is-a related and both have
+        complementary words, else 1 (w = MatchConfig.complement_weight). Their complementary words say
+        what each is about: PersonLocation and RobotLocation are both Locations, of different things."""
+        weight = self.config.complement_weight
+        if not weight:
+            return 1.0
+        rest1, rest2 = self.complementary_words(first), self.complementary_words(second)
+        if not rest1 or not rest2:
+            return 1.0
+        return 1 - weight + weight * complement_similarity(rest1, rest2, self.word_similarity)
+
+    def complementary_words(self, iri: str) -> list[str]:
+        """The words before the core word in the concept's name (RobotPosition: ["robot"])."""
+        return core_split(self._name(iri))[1].split()
+
+    def _unrelated(self, first: str, second: str, common: str, n1: int, n2: int) -> Similarity:
+        """Sem-Str of two taxonomy concepts neither of which is an is-a descendant of the other."""
+        index = self.index
         # Situation 1, where Wu-Palmer would give zero or says nothing: one entity lies below the
         # other through a hasPart link (a part is a "leaf" of its whole), or their most specific
         # common superclass is the root.

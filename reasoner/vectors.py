@@ -15,6 +15,7 @@ from typing import Any, Generic, TypeVar
 import numpy as np
 import numpy.typing as npt
 
+from cbrs.reasoner.names import core_split, local_name
 from cbrs.reasoner.similarity import EntityMeasure, SemStr
 from cbrs.reasoner.taxonomy import ROOT, TaxonomyIndex
 
@@ -95,6 +96,7 @@ class VectorSpace:
         self._by_core: dict[int, tuple[int, dict[str, list[int]]]] = {}
         self._floors: _Lru[tuple[str, bool, float], FloatArray] = _Lru(ARRAY_CACHE_BYTES, _nbytes)
         self._disjoint: _Lru[str, npt.NDArray[np.bool_]] = _Lru(ARRAY_CACHE_BYTES, _nbytes)
+        self._complements: dict[int, str] = {}
         for concept in sorted(set(extra)):
             self.add(concept)
 
@@ -176,7 +178,26 @@ class VectorSpace:
             if not isa_related[a]:
                 values[a] = 1.0 / (1.0 + links)
         values[x] = 1.0
+        if measure.config.complement_weight:
+            self._qualify(measure, x, values, isa_related)
         return values
+
+    def _qualify(self, measure: SemStr, x: int, values: FloatArray, isa_related: npt.NDArray[np.bool_]) -> None:
+        """SemStr.qualifier_factor at the read ids that are not is-a relatives of x, computed once per
+        distinct list of complementary words."""
+        if not measure.complementary_words(self.names[x]):
+            return
+        factors: dict[str, float] = {}
+        for i in self._read_at():
+            if i >= self.taxonomy_size or i == x or isa_related[i] or values[i] <= 0:
+                continue
+            rest = self._complement(i)
+            if not rest:
+                continue
+            factor = factors.get(rest)
+            if factor is None:
+                factor = factors[rest] = measure.qualifier_factor(self.names[x], self.names[i])
+            values[i] *= factor
 
     def _cross_branch(self, measure: SemStr, x: int, values: FloatArray) -> None:
         """Raise the nodes related to x only through the root whose core words are lexically related
@@ -203,6 +224,13 @@ class VectorSpace:
                 table.setdefault(measure.core_key(self.names[i]), []).append(i)
             found = self._by_core[id(measure)] = (len(at), table)
         return found[1]
+
+    def _complement(self, i: int) -> str:
+        """The complementary words of concept i's name (cached)."""
+        found = self._complements.get(i)
+        if found is None:
+            found = self._complements[i] = core_split(local_name(self.names[i]))[1]
+        return found
 
     def _wu_palmer_or_root(self, x: int) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
         """Situation 2 (or 1 through the root) for every taxonomy node against node x, and which

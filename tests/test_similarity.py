@@ -46,9 +46,25 @@ def test_figure5_far_apart_through_the_root_is_small() -> None:
     ],
 )
 def test_sem_str_situations(first: str, second: str, situation: str, value: float) -> None:
-    sim = SemStr(positions())(E + first, E + second)
+    # Definition 1 as the paper gives it: complementary words of unrelated concepts not compared
+    sim = SemStr(positions(), MatchConfig(complement_weight=0.0))(E + first, E + second)
     assert sim.situation == situation
     assert sim.value == pytest.approx(value)
+
+
+def test_unrelated_concepts_with_different_complementary_words_are_further_apart() -> None:
+    weight = MatchConfig().complement_weight
+    measure = SemStr(positions())
+    plain = SemStr(positions(), MatchConfig(complement_weight=0.0))
+    # RobotPosition and ColourOfMarker meet at the root; "robot" shares nothing with "colour of"
+    far = measure(E + "RobotPosition", E + "ColourOfMarker")
+    assert far.value == pytest.approx((1 - weight) * plain(E + "RobotPosition", E + "ColourOfMarker").value)
+    assert far.qualified == pytest.approx(1 - weight) and "complementary words differ" in far.explain()
+    # the same complementary word: unchanged; a subclass keeps its Wu-Palmer value whatever its words
+    assert (
+        measure(E + "RobotPosition", E + "RobotLocation").value == plain(E + "RobotPosition", E + "RobotLocation").value
+    )
+    assert measure(E + "RobotPosition", E + "Position").value == plain(E + "RobotPosition", E + "Position").value
 
 
 def test_situation_3_uses_core_words() -> None:
