@@ -263,6 +263,16 @@ class BatchScorer:
             np.add.at(child_weight, pool.node_parent[below], weights)
         return cover[pool.tree_root_node]
 
+    def observed(self, effects: tuple[Statement, ...]) -> FloatArray:
+        """Per advertisement, the mean over ``effects`` of its outputs' best Sem-Str with the effect's
+        object or subject."""
+        pool = self.pool
+        per = []
+        for effect in effects:
+            terms = np.maximum(self._vector(effect.object), self._vector(effect.subject))
+            per.append(pool.outputs.max(terms[pool.root_ids]))
+        return np.asarray(np.mean(per, axis=0), dtype=np.float64)
+
     def statements(self, statement: Statement) -> FloatArray:
         cfg, pool = self.config, self.pool
         s = self._vector(statement.subject)[pool.s_ids]
@@ -313,7 +323,11 @@ class BatchScorer:
                 inputs = np.where(pool.inputs.present, needed_per_ad, np.nan)
             parts["inputs"] = inputs
         if requirement.effects:
-            parts["effects"] = np.mean([pool.effects.max(self.statements(s)) for s in requirement.effects], axis=0)
+            effects = np.mean([pool.effects.max(self.statements(s)) for s in requirement.effects], axis=0)
+            if cfg.observed_state_weight > 0:  # Matchmaker._observed
+                reports = pool.outputs.present & ~pool.effects.present
+                effects = np.where(reports, cfg.observed_state_weight * self.observed(requirement.effects), effects)
+            parts["effects"] = effects
         if requirement.preconditions:
             guaranteed = np.max([self.statements(s) for s in requirement.preconditions], axis=0)
             parts["preconditions"] = np.where(pool.preconditions.present, pool.preconditions.mean(guaranteed), np.nan)

@@ -40,6 +40,10 @@ class MatchConfig:
     # inherited by subclasses) with the requested one contradicts it: similarity 0, however alike the
     # names or the places in the taxonomy ((Door, hasStatus, Closed) for (Door, hasStatus, Opened)).
     disjoint_statements: bool = True
+    # A requested effect and an advertisement that changes nothing (no effects) but outputs the state the
+    # effect is about (DoorState for (Door, hasState, Opened)): a sensing step towards it. Its effects part
+    # is observed_state_weight times the best Sem-Str of its outputs with the effect's object or subject.
+    observed_state_weight: float = 0.5
     # How the parts of a match combine; parts the requirement does not state are left out and the
     # remaining weights renormalised.
     output_weight: float = 0.4
@@ -95,6 +99,7 @@ class MatchConfig:
             lexicon=False,
             disjoint_statements=False,
             complement_weight=0.0,
+            observed_state_weight=0.0,
         )
 
     def __post_init__(self) -> None:
@@ -112,6 +117,7 @@ class MatchConfig:
             "input_use_weight",
             "unrelated_output_factor",
             "complement_weight",
+            "observed_state_weight",
         ):
             value = getattr(self, name)
             if not 0 <= value <= 1:

@@ -31,6 +31,7 @@ from cbrs.kb import (
     PartNode,
     QoSValue,
     Requirement,
+    Statement,
 )
 from cbrs.reasoner.config import MatchConfig
 from cbrs.reasoner.degrees import Degree, degree_of_match
@@ -233,7 +234,10 @@ class Matchmaker:
             parts["inputs"] = needed
         if requirement.effects:
             matches = best_statement_matches(requirement.effects, ad.effects, self.method.measure, cfg)
-            parts["effects"] = self._statements(matches, "effect", pairs, lacks)
+            if not ad.effects and ad.outputs and cfg.observed_state_weight > 0:
+                parts["effects"] = self._observed(requirement.effects, ad.outputs, pairs)
+            else:
+                parts["effects"] = self._statements(matches, "effect", pairs, lacks)
         if ad.preconditions and requirement.preconditions:
             matches = best_statement_matches(ad.preconditions, requirement.preconditions, self.method.measure, cfg)
             parts["preconditions"] = self._statements(matches, "precondition", pairs, lacks)
@@ -382,6 +386,24 @@ class Matchmaker:
             return frozenset()
         common, _, _ = self.index.common_ancestor(first, second)
         return self.index.parts_of(common)
+
+    def _observed(
+        self, effects: tuple[Statement, ...], outputs: tuple[Parameter, ...], pairs: list[EntityPair]
+    ) -> float:
+        """An advertisement that changes nothing but outputs the state a requested effect is about: each
+        effect's best Sem-Str of an output with its object or subject, times observed_state_weight."""
+        measure, weight = self.method.measure, self.config.observed_state_weight
+        values = []
+        for effect in effects:
+            found = [
+                (measure(out.type, term), out.type, term) for out in outputs for term in (effect.object, effect.subject)
+            ]
+            best, output, term = max(found, key=lambda item: item[0].value)
+            text = f"({_short(effect.subject)}, {_short(effect.predicate)}, {_short(effect.object)})"
+            how = f"no effect; output {_short(output)} reports {_short(term)} ({best.value:.2f}) x {weight:g}"
+            pairs.append(EntityPair("effect", text, output, weight * best.value, how, Degree.FAIL.value))
+            values.append(weight * best.value)
+        return sum(values) / len(values)
 
     def _statements(self, matches: list[StatementMatch], role: str, pairs: list[EntityPair], lacks: list[str]) -> float:
         values = []

@@ -177,3 +177,19 @@ def test_an_effect_that_contradicts_the_requested_one_scores_nothing(defined_kb)
     off = Matchmaker(defined_kb, config=MatchConfig(disjoint_statements=False), index=index, advertisements=ads)
     assert off.score(wanted, ads[0]).parts["effects"] > 0.5  # Closed and Opened: siblings, alike by the taxonomy
     assert Matchmaker(defined_kb, "wu-palmer", index=index, advertisements=ads).config.disjoint_statements is False
+
+
+def test_an_offer_that_reports_the_requested_state_is_a_step_towards_it(defined_kb) -> None:  # type: ignore[no-untyped-def]
+    wanted = Requirement(M + "OpenTheDoor", (), effects=(Statement(M + "Door", M + "hasState", M + "Opened"),))
+    checks = Advertisement(M + "DoorChecker", (), outputs=(Parameter(M + "out", "output", M + "DoorState"),))
+    other = Advertisement(M + "LensFinder", (), outputs=(Parameter(M + "out2", "output", M + "Lens"),))
+    index = TaxonomyIndex.from_kb(defined_kb)
+    matcher = Matchmaker(defined_kb, index=index, advertisements=[other, checks])
+    ranked = matcher.rank(wanted, explain=0).candidates
+    assert ranked[0].advertisement == M + "DoorChecker"
+    explained = matcher.score(wanted, checks)
+    opened_state = SemStr(index)(M + "DoorState", M + "Opened").value
+    assert explained.parts["effects"] == pytest.approx(MatchConfig().observed_state_weight * opened_state)
+    assert ranked[0].score == explained.score and "reports Opened" in explained.pairs[0].how
+    off = Matchmaker(defined_kb, config=MatchConfig(observed_state_weight=0.0), index=index, advertisements=[checks])
+    assert off.score(wanted, checks).parts["effects"] == 0.0
