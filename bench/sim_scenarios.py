@@ -62,7 +62,6 @@ def main() -> None:
         print(
             "plan start->hand-over: "
             + "; ".join(f"{name} {ms:.0f} ms ({length:.2f} m)" for name, ms, length in timings)
-            + " (the first call builds the grid graph)"
         )
 
     print(f"\n{'scenario':<20} {'success':>8} {'sim s':>8} {'build s':>8} {'wall s':>8} {'RTF':>7}")

@@ -149,7 +149,7 @@ class Camera:
 
     ``scene``, if given, tells what the image depends on (``HomeWorld.scene_key``): asked again before
     it changes, the camera gives a copy of its last frame instead of rendering the same image again
-    (a render costs 15-70 ms, most of it the Panda arms' 230,000 triangles).
+    (a render costs 50-70 ms, about 35 ms of it the Panda arms' 205,000 triangles).
     """
 
     def __init__(
