@@ -276,7 +276,10 @@ class BatchScorer:
     def statements(self, statement: Statement) -> FloatArray:
         cfg, pool = self.config, self.pool
         s = self._vector(statement.subject)[pool.s_ids]
-        p = self._vector(statement.predicate)[pool.p_ids]
+        if isinstance(self.measure, SemStr):
+            p = pool.space.predicate_vector(self.measure, statement.predicate)[pool.p_ids]
+        else:
+            p = self._vector(statement.predicate)[pool.p_ids]
         o = self._vector(statement.object)[pool.o_ids]
         if cfg.statement_mean == "geometric":
             values = np.asarray(s**cfg.subject_weight * p**cfg.predicate_weight * o**cfg.object_weight, np.float64)

@@ -36,6 +36,10 @@ class MatchConfig:
     # costs its weight) or "geometric" (the weighted geometric mean: a statement is about as good as its
     # worst position, so (Robot, isLocatedIn, ChargingStation) is no near miss for (Robot, isLocatedIn, Room)).
     statement_mean: str = "geometric"
+    # Two predicates the property hierarchy relates only through the root (no subproperty path) name
+    # different relations: their Sem-Str (Situation 1, 1/3 for two top-level properties) is multiplied by
+    # this factor, unless they are namesakes across ontologies (cross-branch links). 1 keeps Sem-Str.
+    unrelated_predicate_factor: float = 0.0
     # A statement whose subject or object is declared disjoint (owl:disjointWith, owl:AllDisjointClasses;
     # inherited by subclasses) with the requested one contradicts it: similarity 0, however alike the
     # names or the places in the taxonomy ((Door, hasStatus, Closed) for (Door, hasStatus, Opened)).
@@ -99,6 +103,7 @@ class MatchConfig:
             lexicon=False,
             disjoint_statements=False,
             complement_weight=0.0,
+            unrelated_predicate_factor=1.0,
             observed_state_weight=0.0,
         )
 
@@ -117,6 +122,7 @@ class MatchConfig:
             "input_use_weight",
             "unrelated_output_factor",
             "complement_weight",
+            "unrelated_predicate_factor",
             "observed_state_weight",
         ):
             value = getattr(self, name)

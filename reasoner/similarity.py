@@ -51,6 +51,8 @@ class Similarity:
             return "no taxonomy: Jaro-Winkler or WordNet on core and complementary words"
         if self.situation == "cross-branch":
             return "related only through the root; core words the same or WordNet neighbours"
+        if self.situation == "unrelated-predicates":
+            return "predicates related only through the root: another relation (unrelated_predicate_factor)"
         if self.situation == "inherited":
             return "a part the advertised subclass inherits"
         if self.situation == "delivered":
@@ -142,6 +144,29 @@ class SemStr:
     def core_key(self, concept: str) -> str:
         """The lemma of a concept's core word: what cross-branch links are looked up by."""
         return self.lexicon.lemma(core_split(self._name(concept))[0])
+
+    def predicate(self, first: str, second: str) -> Similarity:
+        """Two predicates of RDF statements. Related by the property hierarchy (or not both in it): Sem-Str.
+        Related only through the root: unrelated_predicate_factor times Sem-Str, or the cross-branch
+        value of a namesake if higher. A property hierarchy is flat: Situation 1 gives two unrelated
+        top-level properties 1/3, which says nothing about how alike two relations are."""
+        found = self(first, second)
+        factor = self.config.unrelated_predicate_factor
+        if factor >= 1 or not self.through_root_only(first, second):
+            return found
+        namesake = self.cross_branch(first, second)
+        if namesake.value > 0 and namesake.value >= factor * found.value:
+            return namesake
+        return replace(found, value=factor * found.value, situation="unrelated-predicates")
+
+    def through_root_only(self, first: str, second: str) -> bool:
+        """Two different taxonomy nodes whose only relation is through the root (no is-a or has-part path)."""
+        index = self.index
+        if first not in index or second not in index or index.canonical(first) == index.canonical(second):
+            return False
+        if index.common_ancestor(first, second)[0] != ROOT:
+            return False
+        return index.distance_down(first, second) is None and index.distance_down(second, first) is None
 
     def cross_branch(self, first: str, second: str) -> Similarity:
         """Two concepts the taxonomy relates only through the root: Situation 3 times

@@ -33,7 +33,10 @@ def statement_similarity(
     requested: Statement, advertised: Statement, measure: EntityMeasure, config: MatchConfig
 ) -> StatementMatch:
     s = measure(requested.subject, advertised.subject)
-    p = measure(requested.predicate, advertised.predicate)
+    if isinstance(measure, SemStr):
+        p = measure.predicate(requested.predicate, advertised.predicate)
+    else:
+        p = measure(requested.predicate, advertised.predicate)
     o = measure(requested.object, advertised.object)
     clash = contradiction(requested, advertised, measure, config)
     value = 0.0 if clash else combine(config, s.value, p.value, o.value)

@@ -182,6 +182,29 @@ class VectorSpace:
             self._qualify(measure, x, values, isa_related)
         return values
 
+    def predicate_vector(self, measure: SemStr, concept: str) -> FloatArray:
+        """SemStr.predicate(concept, c) for every concept id c (cached)."""
+        factor = measure.config.unrelated_predicate_factor
+        base = self.vector(measure, concept)
+        if factor >= 1 or concept not in self.index:
+            return base
+        key = (id(measure), "predicate:" + concept)
+        found = self._cache.get(key)
+        if found is None:
+            x = self.ids[self.index.canonical(concept)]
+            lcs = self.common_superclasses(concept)
+            assert lcs is not None  # concept is a taxonomy node
+            through = np.zeros(len(self.names), dtype=bool)
+            through[: self.taxonomy_size] = lcs == self.ids[ROOT]
+            through[self._below(x, is_a_only=False)[0]] = False
+            through[[self.ids[a] for a in self.index.ancestors(self.names[x])]] = False
+            through[x] = False
+            namesakes = np.zeros(len(self.names), dtype=np.float64)
+            self._cross_branch(measure, x, namesakes)
+            found = np.where(through, np.maximum(namesakes, factor * base), base)
+            self._cache[key] = found
+        return found
+
     def _qualify(self, measure: SemStr, x: int, values: FloatArray, isa_related: npt.NDArray[np.bool_]) -> None:
         """SemStr.qualifier_factor at the read ids that are not is-a relatives of x, computed once per
         distinct list of complementary words."""

@@ -193,3 +193,37 @@ def test_an_offer_that_reports_the_requested_state_is_a_step_towards_it(defined_
     assert ranked[0].score == explained.score and "reports Opened" in explained.pairs[0].how
     off = Matchmaker(defined_kb, config=MatchConfig(observed_state_weight=0.0), index=index, advertisements=[checks])
     assert off.score(wanted, checks).parts["effects"] == 0.0
+
+
+def test_a_statement_with_another_relation_states_another_fact() -> None:
+    a, b = "http://a.org/o#", "http://b.org/o#"
+    index = TaxonomyIndex.from_links(
+        [
+            Link(a + "isNear", a + "spatialRelation", "is-a"),
+            Link(a + "isOn", a + "spatialRelation", "is-a"),
+            Link(a + "isHeldBy", a + "holding", "is-a"),
+            Link(b + "isNear", b + "relation", "is-a"),
+        ]
+    )
+    config = MatchConfig()
+    wanted = Statement(E + "Cup", a + "isNear", E + "Table")
+
+    def similarity(predicate: str, cfg: MatchConfig = config) -> float:
+        offered = Statement(E + "Cup", predicate, E + "Table")
+        return statement_similarity(wanted, offered, SemStr(index, cfg), cfg).value
+
+    assert similarity(a + "isHeldBy") == 0.0  # related only through the root: another relation
+    assert similarity(a + "isOn") > 0.5  # a sibling under spatialRelation
+    assert similarity(b + "isNear") > 0.5  # the same relation in another ontology (cross-branch)
+    published = MatchConfig(unrelated_predicate_factor=1.0)
+    assert similarity(a + "isHeldBy", published) > 0.0
+    kb = KnowledgeBase(Store.open(":memory:"))
+    ads = [
+        Advertisement(E + p, (), effects=(Statement(E + "Cup", x + p, E + "Table"),))
+        for x, p in ((a, "isHeldBy"), (b, "isNear"))
+    ]
+    requirement = Requirement(E + "Wants", (), effects=(wanted,))
+    matcher = Matchmaker(kb, index=index, advertisements=ads)
+    for candidate in matcher.rank(requirement, explain=0).candidates:  # the batch agrees with the scalar path
+        ad = next(x for x in ads if x.iri == candidate.advertisement)
+        assert candidate.score == matcher.score(requirement, ad).score
