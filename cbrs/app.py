@@ -27,7 +27,7 @@ class App:
                 check_timeout=setting("query_check_timeout").resolve(),
                 remote_access=setting("federation_allow").resolve(),
                 remote_token=setting("update_token").resolve(),
-                remote_batch=setting("remote_batch").resolve(),
+                remote_batch=_batch(setting("remote_batch").resolve()),
             )
         return self._kb
 
@@ -39,6 +39,11 @@ class App:
 
 
 pass_app = click.make_pass_decorator(App)
+
+
+def _batch(value: int | str) -> int | None:
+    """The remote_batch setting as KnowledgeBase.open takes it: None lets the store choose."""
+    return None if value == "auto" else int(value)
 
 
 def parse_iri(name: str, hint: str = "IRI") -> str:

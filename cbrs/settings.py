@@ -59,6 +59,14 @@ def _origins(text: str) -> tuple[str, ...]:
 _prefixes = _origins  # a comma-separated list of IRI prefixes reads the same way
 
 
+def _batch(text: str) -> int | str:
+    """``auto`` (chosen by the server) or a positive number of quads."""
+    if text.strip().lower() == "auto":
+        return "auto"
+    parsed: int = _positive(int)(text)
+    return parsed
+
+
 LOG_LEVELS = ("DEBUG", "INFO", "WARNING", "ERROR", "CRITICAL")
 
 
@@ -230,11 +238,12 @@ SETTINGS: tuple[Setting, ...] = (
     ),
     Setting(
         "remote_batch",
-        lambda: 1000,
+        lambda: "auto",
         "Most quads one write request to a remote store carries; a larger write (the seed, a load) is "
-        "staged in batches this size and published by one operation (docs/remote-store.md).",
+        "staged in batches this size and published by one operation. auto: 100000 on Oxigraph, 250 on "
+        "other servers (docs/remote-store.md).",
         "CBRS_REMOTE_BATCH",
-        _positive(int),
+        _batch,
     ),
     Setting(
         "max_result_bytes",

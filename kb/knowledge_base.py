@@ -55,15 +55,15 @@ class KnowledgeBase:
         :mod:`kb.query_guard`); ``remote_access`` lists the IRI prefixes a SERVICE or LOAD may reach
         (:mod:`kb.remote_access`; none by default). ``remote_token`` goes with every request to a remote
         store, as a bearer token: a ``cbrs serve``'s update token. ``remote_batch`` is the most quads one
-        write request to a remote store carries; larger writes are staged (:mod:`kb.staged_writes`).
+        write request to a remote store carries (None: chosen by the server); larger writes are staged
+        (:mod:`kb.staged_writes`).
         """
         remote_options = (remote_timeout, remote_token, remote_batch)
         if is_remote(str(location)) and any(option is not None for option in remote_options):
-            from cbrs.kb.remote_store import DEFAULT_BATCH, DEFAULT_TIMEOUT, RemoteStore  # needs httpx
+            from cbrs.kb.remote_store import DEFAULT_TIMEOUT, RemoteStore  # only a remote store needs httpx
 
             timeout = remote_timeout if remote_timeout is not None else DEFAULT_TIMEOUT
-            batch = remote_batch if remote_batch is not None else DEFAULT_BATCH
-            store: Store = RemoteStore.open(location, timeout, remote_token, batch)
+            store: Store = RemoteStore.open(location, timeout, remote_token, remote_batch)
         else:
             store = Store.open(location)
         store.remote_access = tuple(remote_access)

@@ -27,7 +27,7 @@ from cbrs.kb import (
     StoreEvaluationError,
 )
 from cbrs.kb.namespaces import GraphName
-from cbrs.kb.remote_store import DEFAULT_BATCH, Endpoints, RemoteStore, inject_values
+from cbrs.kb.remote_store import OXIGRAPH_BATCH, Endpoints, RemoteStore, inject_values
 from cbrs.kb.staged_writes import STAGED, STAGING, batches, publication
 from tests.conftest import OxigraphServer
 
@@ -320,15 +320,27 @@ def test_a_refused_replace_sends_nothing(requests_seen: tuple[Store, list[httpx.
     assert len(seen) == sent and store.dump() == before
 
 
-def test_the_seed_is_staged_in_batches(requests_seen: tuple[Store, list[httpx.Request]]) -> None:
-    store, seen = requests_seen
+def test_the_seed_is_one_request_to_oxigraph(requests_seen: tuple[Store, list[httpx.Request]]) -> None:
+    store, seen = requests_seen  # remote_batch auto: 100,000 quads a request on Oxigraph
+    assert isinstance(store, RemoteStore) and store.batch == OXIGRAPH_BATCH
+    KnowledgeBase(store).seed()
+    seed, entailed = (r.content.decode() for r in seen if r.url.path == "/update")
+    assert seed.count("INSERT DATA") == 1 and 500_000 < len(seed) < 2_000_000  # about 0.8 MB
+    assert "graph/entailed" in entailed and store.is_seeded()
+
+
+def test_the_seed_is_staged_in_batches(remote_location: str) -> None:
+    store = RemoteStore.open(remote_location, batch=1000)
+    seen: list[httpx.Request] = []
+    store._http().event_hooks["request"].append(seen.append)
     quads = sum(len(parsed.quads) for parsed in KnowledgeBase(store).seed())
     writes = [r.content.decode() for r in seen if r.url.path == "/update"]
-    batches = -(-quads // DEFAULT_BATCH)
+    batches = -(-quads // 1000)
     seed, entailed = writes[: batches + 2], writes[batches + 2 :]
     assert [w.count("INSERT DATA") for w in seed] == [1] * batches + [0, 0]  # the batches, publish, drop
     assert entailed and all("graph/entailed" in w or "staging" in w for w in entailed)  # then graph:entailed
     assert store.is_seeded() and not [g for g in store.graphs() if g.startswith(STAGING)]
+    store.close()
 
 
 def test_batches_keep_each_blank_nodes_quads_together() -> None:
