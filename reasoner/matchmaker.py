@@ -120,11 +120,16 @@ class Matchmaker:
         self._pool_source: list[Advertisement] | None = None
         self._text: TextIndex | None = None
         self._text_source: list[Advertisement] | None = None
+        self._requirements: dict[str, Requirement] = {}
+        self._requirements_at: object = None  # the store generation they were read at
 
     def prepare(self) -> Matchmaker:
-        """Do the one-time work now (read the advertisements, lay the pool out as arrays), so that
-        the first ranking is as fast as the rest."""
+        """Do the one-time work now (read the advertisements and the store's requirements, lay the pool
+        out as arrays), so that the first ranking is as fast as the rest."""
         ads = self.advertisements
+        if self._generation() is not None:
+            self._requirements = {r.iri: r for r in self.kb.requirements()}
+            self._requirements_at = self._generation()
         if not self.method.strict:
             space = self._compiled(ads).space
             space.warm()
@@ -164,10 +169,7 @@ class Matchmaker:
         when None) also get their explanation: entity pairs and what they lack.
         """
         if isinstance(requirement, str):
-            found = self.kb.description(requirement)
-            if not isinstance(found, Requirement):
-                raise NotFoundError(requirement, "requirement (it is an advertisement)")
-            requirement = found
+            requirement = self._requirement(requirement)
         ads = self.advertisements
         if self.method.strict:  # degrees, not similarities: scored one by one
             scored = [self.score(requirement, ad) for ad in ads]
@@ -180,6 +182,26 @@ class Matchmaker:
             candidates = tuple(c for c in candidates if c.advertisement not in gone)
         status = MatchStatus.MATCHED if candidates and candidates[0].acceptable else MatchStatus.NO_ACCEPTABLE_MATCH
         return MatchResult(requirement.iri, self.method.name, status, candidates)
+
+    def _requirement(self, iri: str) -> Requirement:
+        """The requirement ``iri`` as the store has it: read once per store generation (an embedded store
+        counts its writes; a remote one is read every time)."""
+        generation = self._generation()
+        if generation is not None and generation != self._requirements_at:
+            self._requirements = {}
+            self._requirements_at = generation
+        found = self._requirements.get(iri) if generation is not None else None
+        if found is None:
+            description = self.kb.description(iri)
+            if not isinstance(description, Requirement):
+                raise NotFoundError(iri, "requirement (it is an advertisement)")
+            found = description
+            if generation is not None:
+                self._requirements[iri] = found
+        return found
+
+    def _generation(self) -> object:
+        return getattr(self.kb.store, "generation", None)
 
     def _rank_batch(self, requirement: Requirement, ads: list[Advertisement], explain: int) -> Sequence[Candidate]:
         from cbrs.reasoner.batch import BatchScorer, BatchScores, ranking_order

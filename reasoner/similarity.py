@@ -82,6 +82,7 @@ class SemStr:
         self.lexicon = lexicon
         self._cache: dict[tuple[str, str], Similarity] = {}
         self._words: dict[tuple[str, str], float] = {}
+        self._factors: dict[tuple[str, str], float] = {}
 
     def __call__(self, first: str, second: str) -> Similarity:
         key = (first, second)
@@ -110,17 +111,21 @@ class SemStr:
         """(1 - w) + w Comp(complementary words) for two concepts that are not is-a related and both have
         complementary words, else 1 (w = MatchConfig.complement_weight). Their complementary words say
         what each is about: PersonLocation and RobotLocation are both Locations, of different things."""
-        weight = self.config.complement_weight
-        if not weight:
+        if not self.config.complement_weight:
             return 1.0
-        rest1, rest2 = self.complementary_words(first), self.complementary_words(second)
-        if not rest1 or not rest2:
-            return 1.0
-        return 1 - weight + weight * complement_similarity(rest1, rest2, self.word_similarity)
+        return self.complement_factor(core_split(self._name(first))[1], core_split(self._name(second))[1])
 
-    def complementary_words(self, iri: str) -> list[str]:
-        """The words before the core word in the concept's name (RobotPosition: ["robot"])."""
-        return core_split(self._name(iri))[1].split()
+    def complement_factor(self, first: str, second: str) -> float:
+        """qualifier_factor from two names' complementary words (space-separated; cached by pair)."""
+        weight = self.config.complement_weight
+        if not weight or not first or not second:
+            return 1.0
+        key = (first, second)
+        found = self._factors.get(key)
+        if found is None:
+            similarity = complement_similarity(first.split(), second.split(), self.word_similarity)
+            found = self._factors[key] = 1 - weight + weight * similarity
+        return found
 
     def _unrelated(self, first: str, second: str, common: str, n1: int, n2: int) -> Similarity:
         """Sem-Str of two taxonomy concepts neither of which is an is-a descendant of the other."""

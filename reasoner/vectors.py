@@ -10,8 +10,10 @@ from __future__ import annotations
 
 from collections import OrderedDict, deque
 from collections.abc import Callable, Hashable, Iterable
+from dataclasses import dataclass
 from typing import Any, Generic, TypeVar
 
+import jellyfish
 import numpy as np
 import numpy.typing as npt
 
@@ -76,6 +78,20 @@ def _nbytes(array: npt.NDArray[Any]) -> int:
     return array.nbytes
 
 
+@dataclass(frozen=True)
+class _Groups:
+    """Read ids with complementary words (``ids``), the number of each one's distinct list of them
+    (``group``), and those lists as word numbers into ``vocabulary`` (CSR: ``flat``, ``starts``, ``counts``)."""
+
+    read: int
+    ids: IntArray
+    group: IntArray
+    vocabulary: list[str]
+    flat: IntArray
+    starts: IntArray
+    counts: IntArray
+
+
 class VectorSpace:
     """Concept numbering plus the per-node arrays the vectorised Sem-Str needs."""
 
@@ -92,27 +108,31 @@ class VectorSpace:
         self._cache: _Lru[tuple[int, str], FloatArray] = _Lru(ARRAY_CACHE_BYTES, _nbytes)
         self._lcs: _Lru[int, IntArray] = _Lru(ARRAY_CACHE_BYTES, _nbytes)
         self._used: set[int] = set()  # ids handed out by add(): where vectors are read
+        self._read: list[int] | None = None  # _used, sorted
         self._implied: _Lru[tuple[int, int], bool] = _Lru(IMPLIED_CACHE_ENTRIES, lambda _: 1)
         self._by_core: dict[int, tuple[int, dict[str, list[int]]]] = {}
         self._floors: _Lru[tuple[str, bool, float], FloatArray] = _Lru(ARRAY_CACHE_BYTES, _nbytes)
         self._disjoint: _Lru[str, npt.NDArray[np.bool_]] = _Lru(ARRAY_CACHE_BYTES, _nbytes)
         self._complements: dict[int, str] = {}
+        self._groups: _Groups | None = None
+        self._word_rows: dict[tuple[int, str], FloatArray] = {}
         for concept in sorted(set(extra)):
             self.add(concept)
 
     def add(self, concept: str) -> int:
         """The id of ``concept``; a concept outside the taxonomy gets a new id past its nodes."""
         if concept in self.index:
-            known = self.ids[self.index.canonical(concept)]
-            self._used.add(known)
-            return known
-        found = self.ids.get(concept)
-        if found is None:
-            found = len(self.names)
-            self.names.append(concept)
-            self.ids[concept] = found
-            self._cache.clear()  # vectors must cover the new concept
-        self._used.add(found)
+            found = self.ids[self.index.canonical(concept)]
+        else:
+            found = self.ids.get(concept, -1)
+            if found < 0:
+                found = len(self.names)
+                self.names.append(concept)
+                self.ids[concept] = found
+                self._cache.clear()  # vectors must cover the new concept
+        if found not in self._used:
+            self._used.add(found)
+            self._read = None
         return found
 
     def warm(self) -> None:
@@ -129,8 +149,12 @@ class VectorSpace:
         measure.lexicon.warm()
 
     def _read_at(self) -> list[int]:
-        """The ids vectors are read at: those handed out, or all while none has been."""
-        return sorted(self._used) if self._used else list(range(len(self.names)))
+        """The ids vectors are read at: those handed out, or all while none has been (kept sorted)."""
+        if not self._used:
+            return list(range(len(self.names)))
+        if self._read is None:
+            self._read = sorted(self._used)
+        return self._read
 
     def __len__(self) -> int:
         return len(self.names)
@@ -206,21 +230,67 @@ class VectorSpace:
         return found
 
     def _qualify(self, measure: SemStr, x: int, values: FloatArray, isa_related: npt.NDArray[np.bool_]) -> None:
-        """SemStr.qualifier_factor at the read ids that are not is-a relatives of x, computed once per
-        distinct list of complementary words."""
-        if not measure.complementary_words(self.names[x]):
+        """SemStr.qualifier_factor at the read ids that are not is-a relatives of x, for every distinct list
+        of complementary words at once: complement_similarity over a matrix of word similarities."""
+        mine = self._complement(x).split()
+        if not mine:
             return
-        factors: dict[str, float] = {}
-        for i in self._read_at():
-            if i >= self.taxonomy_size or i == x or isa_related[i] or values[i] <= 0:
-                continue
-            rest = self._complement(i)
-            if not rest:
-                continue
-            factor = factors.get(rest)
-            if factor is None:
-                factor = factors[rest] = measure.qualifier_factor(self.names[x], self.names[i])
-            values[i] *= factor
+        groups = self._complement_groups()
+        keep = (groups.ids != x) & ~isa_related[groups.ids] & (values[groups.ids] > 0)
+        if not keep.any():
+            return
+        words = np.vstack([self._word_row(measure, word, groups.vocabulary) for word in mine])  # k x V
+        first = np.maximum.reduceat(words[:, groups.flat], groups.starts, axis=1).sum(axis=0)
+        second = np.add.reduceat(words.max(axis=0)[groups.flat], groups.starts)
+        similarity = (first + second) / (len(mine) + groups.counts)
+        weight = measure.config.complement_weight
+        factors = 1 - weight + weight * similarity
+        ids = groups.ids[keep]
+        values[ids] *= factors[groups.group[keep]]
+
+    def _word_row(self, measure: SemStr, word: str, vocabulary: list[str]) -> FloatArray:
+        """measure.word_similarity(word, v) for every v of ``vocabulary`` (cached while it stays the same)."""
+        key = (id(measure), word)
+        found = self._word_rows.get(key)
+        if found is None or len(found) != len(vocabulary):
+            if measure.lexicon:
+                found = np.array([measure.word_similarity(word, other) for other in vocabulary], dtype=np.float64)
+            else:  # rescaled_jaro_winkler, one call per word into jellyfish
+                floor = measure.config.jaro_winkler_floor
+                jw = jellyfish.jaro_winkler_similarity
+                raw = np.fromiter((jw(word, other) for other in vocabulary), np.float64, len(vocabulary))
+                found = np.maximum(0.0, (raw - floor) / (1.0 - floor))
+                found[[i for i, other in enumerate(vocabulary) if other == word]] = 1.0
+            self._word_rows[key] = found
+        return found
+
+    def _complement_groups(self) -> _Groups:
+        """The read taxonomy ids whose names have complementary words, grouped by their distinct lists of
+        them; rebuilt when ``add`` has handed out more ids."""
+        at = self._read_at()
+        if self._groups is None or self._groups.read != len(at):
+            numbers: dict[str, int] = {}
+            ids, group = [], []
+            for i in at:
+                if i < self.taxonomy_size:
+                    rest = self._complement(i)
+                    if rest:
+                        ids.append(i)
+                        group.append(numbers.setdefault(rest, len(numbers)))
+            vocabulary: dict[str, int] = {}
+            lists = [[vocabulary.setdefault(word, len(vocabulary)) for word in text.split()] for text in numbers]
+            counts = np.array([len(words) for words in lists], dtype=np.int64)
+            self._groups = _Groups(
+                read=len(at),
+                ids=np.array(ids, dtype=np.int64),
+                group=np.array(group, dtype=np.int64),
+                vocabulary=list(vocabulary),
+                flat=np.array([w for words in lists for w in words], dtype=np.int64),
+                starts=np.concatenate(([0], np.cumsum(counts)[:-1])).astype(np.int64),
+                counts=counts,
+            )
+            self._word_rows.clear()
+        return self._groups
 
     def _cross_branch(self, measure: SemStr, x: int, values: FloatArray) -> None:
         """Raise the nodes related to x only through the root whose core words are lexically related

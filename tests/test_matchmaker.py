@@ -131,6 +131,21 @@ def test_rank_refuses_an_advertisement(sem_str: Matchmaker) -> None:
         sem_str.rank(SVC + "LocateMobileRobot_CeilingCamera01")
 
 
+def test_requirements_are_read_again_after_the_store_changes(mini_kb: KnowledgeBase) -> None:
+    iri = "http://example.org/mini#SelfPosition"
+    matcher = Matchmaker(mini_kb).prepare()  # reads the store's requirements once
+    before = {c.advertisement: c.parts for c in matcher.rank(iri).candidates}
+    mini_kb.update(
+        """PREFIX cbrs: <https://w3id.org/cbrs/core#> PREFIX ex: <http://example.org/mini#>
+        DELETE { GRAPH ?g { ?p cbrs:parameterType ex:RobotPosition } }
+        INSERT { GRAPH ?g { ?p cbrs:parameterType ex:Door } }
+        WHERE { GRAPH ?g { ex:SelfPosition cbrs:hasOWLSModel/cbrs:hasOutput ?p . ?p cbrs:parameterType ?t } }"""
+    )
+    after = {c.advertisement: c.parts for c in matcher.rank(iri).candidates}
+    assert after != before  # the output asked for is now a Door, not the cached RobotPosition
+    assert matcher.rank(iri).requirement == iri
+
+
 # -- conceptual span similarity and statements ----------------------------------------------
 
 X, Y = PartNode(E + "XCoordinate", E + "hasX"), PartNode(E + "YCoordinate", E + "hasY")
