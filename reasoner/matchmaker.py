@@ -45,6 +45,7 @@ from cbrs.reasoner.text import description_text
 
 if TYPE_CHECKING:  # numpy and the batch scorer load with the first ranking: importing cbrs stays fast
     from cbrs.reasoner.batch import CompiledPool
+    from cbrs.reasoner.strict import StrictScorer
     from cbrs.reasoner.text import TextIndex
     from cbrs.reasoner.vectors import FloatArray
 
@@ -122,6 +123,7 @@ class Matchmaker:
         self._text_source: list[Advertisement] | None = None
         self._requirements: dict[str, Requirement] = {}
         self._requirements_at: object = None  # the store generation they were read at
+        self._strict_scorer: StrictScorer | None = None
 
     def prepare(self) -> Matchmaker:
         """Do the one-time work now (read the advertisements and the store's requirements, lay the pool
@@ -130,11 +132,10 @@ class Matchmaker:
         if self._generation() is not None:
             self._requirements = {r.iri: r for r in self.kb.requirements()}
             self._requirements_at = self._generation()
-        if not self.method.strict:
-            space = self._compiled(ads).space
-            space.warm()
-            if isinstance(self.method.measure, SemStr):
-                space.warm_lexical(self.method.measure)
+        space = self._compiled(ads).space
+        space.warm()
+        if isinstance(self.method.measure, SemStr):
+            space.warm_lexical(self.method.measure)
         if self.method.text:
             self._text_index(ads)
         return self
@@ -171,17 +172,20 @@ class Matchmaker:
         if isinstance(requirement, str):
             requirement = self._requirement(requirement)
         ads = self.advertisements
-        if self.method.strict:  # degrees, not similarities: scored one by one
-            scored = [self.score(requirement, ad) for ad in ads]
-            scored.sort(key=lambda c: (bool(c.rejected_by), -c.score, c.advertisement))
-            candidates: Sequence[Candidate] = tuple(scored)
-        else:
-            candidates = self._rank_batch(requirement, ads, len(ads) if explain is None else explain)
+        candidates = self._rank_batch(requirement, ads, len(ads) if explain is None else explain)
         gone = self.kb.liveness.unavailable()  # read at every ranking: a component may leave at any time
         if gone:
             candidates = tuple(c for c in candidates if c.advertisement not in gone)
         status = MatchStatus.MATCHED if candidates and candidates[0].acceptable else MatchStatus.NO_ACCEPTABLE_MATCH
         return MatchResult(requirement.iri, self.method.name, status, candidates)
+
+    def _strict(self, pool: CompiledPool) -> StrictScorer:
+        """The strict scorer of this pool, kept with it (its degree arrays are cached per concept)."""
+        from cbrs.reasoner.strict import StrictScorer
+
+        if self._strict_scorer is None or self._strict_scorer.pool is not pool:
+            self._strict_scorer = StrictScorer(pool, self.method.measure, self.config, self.filters)
+        return self._strict_scorer
 
     def _requirement(self, iri: str) -> Requirement:
         """The requirement ``iri`` as the store has it: read once per store generation (an embedded store
@@ -207,15 +211,18 @@ class Matchmaker:
         from cbrs.reasoner.batch import BatchScorer, BatchScores, ranking_order
 
         pool = self._compiled(ads)
-        scorer = BatchScorer(
-            pool,
-            self.method.measure,
-            self.config,
-            self.filters,
-            plugin_inputs=self.plugin_inputs,
-            plugin_outputs=self.plugin_outputs,
-        )
-        scores = scorer.score(requirement)
+        if self.method.strict:  # degrees of match, not similarities
+            scores = self._strict(pool).score(requirement)
+        else:
+            scorer = BatchScorer(
+                pool,
+                self.method.measure,
+                self.config,
+                self.filters,
+                plugin_inputs=self.plugin_inputs,
+                plugin_outputs=self.plugin_outputs,
+            )
+            scores = scorer.score(requirement)
         text = description_text(requirement)
         if self.method.text and text:
             similarity = self._text_index(ads).similarities(text)

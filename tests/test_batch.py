@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import random
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -10,12 +11,13 @@ import pytest
 from cbrs.kb import KnowledgeBase, Store
 from cbrs.reasoner.matchmaker import Matchmaker
 from cbrs.reasoner.methods import METHODS
+from cbrs.reasoner.owlstc import load_collection
 from cbrs.reasoner.similarity import SemStr
 from cbrs.reasoner.synthetic import build
 from cbrs.reasoner.vectors import VectorSpace
 from tests.reasoner_examples import E, positions
 
-SIMILARITY_METHODS = [m for m in METHODS if m != "logic"]
+ROBOT = Path(__file__).parent / "data" / "robot_services"
 
 
 def _assert_same(matchmaker: Matchmaker, requirement) -> None:  # type: ignore[no-untyped-def]
@@ -30,7 +32,7 @@ def _assert_same(matchmaker: Matchmaker, requirement) -> None:  # type: ignore[n
         assert fast.acceptable == scalar.acceptable
 
 
-@pytest.mark.parametrize("method", SIMILARITY_METHODS)
+@pytest.mark.parametrize("method", METHODS)
 def test_batch_equals_scalar_on_the_bundled_home(bundled_kb: KnowledgeBase, method: str) -> None:
     base = Matchmaker(bundled_kb)
     matchmaker = Matchmaker(bundled_kb, method, index=base.index, advertisements=base.advertisements)
@@ -38,11 +40,21 @@ def test_batch_equals_scalar_on_the_bundled_home(bundled_kb: KnowledgeBase, meth
         _assert_same(matchmaker, requirement)
 
 
+@pytest.mark.parametrize("method", ["sem-str", "logic"])
 @pytest.mark.parametrize("seed", [1, 2, 3])
-def test_batch_equals_scalar_on_random_pools(seed: int) -> None:
+def test_batch_equals_scalar_on_random_pools(seed: int, method: str) -> None:
     index, pool, requirements = build(classes=300, ads=150, queries=4, seed=seed)
-    matchmaker = Matchmaker(KnowledgeBase(Store.open(":memory:")), index=index, advertisements=pool)
+    matchmaker = Matchmaker(KnowledgeBase(Store.open(":memory:")), method, index=index, advertisements=pool)
     for requirement in requirements:
+        _assert_same(matchmaker, requirement)
+
+
+@pytest.mark.parametrize("method", ["sem-str", "logic"])
+def test_batch_equals_scalar_on_the_robot_collection(method: str) -> None:
+    # OWL-S services with effects, and requests with effects and inputs only
+    kb = load_collection(ROBOT).kb
+    matchmaker = Matchmaker(kb, method)
+    for requirement in kb.requirements():
         _assert_same(matchmaker, requirement)
 
 
