@@ -12,12 +12,11 @@ import threading
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from types import FrameType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from waitress import wasyncore
 from waitress.server import create_server
 
-from cbrs.bridge_client import BridgeClient
 from cbrs.bridge_services import KnowledgeServices, attach
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.store import EmbeddedStore, mark_served
@@ -31,6 +30,9 @@ from cbrs.tasks import TaskRunner
 from cbrs.web import create_app
 from cbrs.web.components import blueprint as components_blueprint
 from cbrs.web.context import StreamSlots
+
+if TYPE_CHECKING:
+    from cbrs.bridge_client import BridgeClient  # its websocket client loads with the first task run
 
 log = logging.getLogger("cbrs.server")
 LOGGERS = ("cbrs", "kb", "actions", "reasoner", "sim")
@@ -126,6 +128,8 @@ class Server:
         if self._bridge is None:
             return None
         if self._transport is None or self._transport.closed:
+            from cbrs.bridge_client import BridgeClient
+
             host = "127.0.0.1" if self.config.host in ("0.0.0.0", "::") else self.config.host
             token = self.config.endpoint.update_token
             self._transport = BridgeClient(f"ws://{host}:{self.bridge_port}", token)

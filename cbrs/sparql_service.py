@@ -45,9 +45,8 @@ from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import KnowledgeBaseError, QuerySyntaxError, QueryTooComplexError, StoreEvaluationError
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.query_guard import start_evaluation_thread
-from cbrs.kb.remote_store import RemoteStore
 from cbrs.kb.sparql_lexemes import HIDING
-from cbrs.kb.store import EmbeddedStore, QueryResult, refuse_inserted_blank_nodes
+from cbrs.kb.store import EmbeddedStore, QueryResult, is_remote, refuse_inserted_blank_nodes
 from cbrs.query_workers import QueryProcesses, QueryStopped, Request
 from cbrs.scan_queries import is_single_scan, uses_prefixes
 from cbrs.settings import setting
@@ -567,7 +566,10 @@ class SparqlService:
         store = self.kb.store
         if graphs.get("union"):
             return self.kb.query(text)  # the store's own rule: the union default graph
-        if isinstance(store, RemoteStore):  # the server applies FROM, and the parameters sent on
+        if is_remote(store.location):  # the server applies FROM, and the parameters sent on
+            from cbrs.kb.remote_store import RemoteStore  # httpx loads only for a remote store
+
+            assert isinstance(store, RemoteStore)
             return store.query_dataset(text, graphs.get("default"), graphs.get("named"))
         if not isinstance(store, EmbeddedStore):
             raise StoreEvaluationError(store.location, "query", "this store cannot take a dataset; query without one")
