@@ -170,6 +170,10 @@ class StandardTerms:
     :meth:`refresh` works it out from the whole store (after a seed, a load, an update); :meth:`begin`
     and :meth:`changed` bring it up to date after one description changed, from that description's
     statements alone (a registration), reusing the alignments read at the last refresh.
+
+    Each is two writes: first what the alignments entail statement by statement, then the rules'
+    conclusions, so that a rule may ask for standard types (``?sensor a sosa:Sensor``) instead of
+    following ``rdfs:subClassOf*`` paths, which Virtuoso 7 evaluates unreliably inside larger patterns.
     """
 
     def __init__(self, store: Store) -> None:
@@ -182,17 +186,22 @@ class StandardTerms:
         return self._alignment
 
     def refresh(self) -> Refresh:
-        """Make graph:entailed hold what the store entails now: one write of the difference."""
-        self._alignment = read_alignment(self.store)
-        wanted = self._entailed(self._alignment)
+        """Make graph:entailed hold what the store entails now."""
+        alignment = self._alignment = read_alignment(self.store)
+        before = self._rule_conclusions(alignment)
+        wanted, asserted = self._closure(alignment)
         held = set(self.store.quads(graph=_GRAPH))
-        return self._write(held - wanted, wanted - held, len(wanted))
+        first = self._write(held - wanted - before, wanted - held)
+        held = (held - (held - wanted - before)) | wanted
+        after = self._rule_conclusions(alignment) - asserted
+        second = self._write(held - wanted - after, after - held)
+        return Refresh(first.added + second.added, first.removed + second.removed, len(wanted | after))
 
-    def begin(self) -> frozenset[ox.Triple]:
+    def begin(self) -> frozenset[ox.Quad]:
         """What the rules conclude now: call it before changing a description, then :meth:`changed`."""
-        return frozenset(self._rule_conclusions(self.alignment())) if self.alignment().namespaces else frozenset()
+        return frozenset(self._rule_conclusions(self.alignment()))
 
-    def changed(self, before: frozenset[ox.Triple], removed: Sequence[ox.Quad], added: Sequence[ox.Quad]) -> Refresh:
+    def changed(self, before: frozenset[ox.Quad], removed: Sequence[ox.Quad], added: Sequence[ox.Quad]) -> Refresh:
         """Bring graph:entailed up to date after one description's ``removed`` quads made way for ``added``.
 
         What the removed statements entailed about the description's own nodes goes, what the added
@@ -209,22 +218,23 @@ class StandardTerms:
             self._alignment = None
             return Refresh(0, 0, -1)
 
-    def _changed(self, before: frozenset[ox.Triple], removed: Sequence[ox.Quad], added: Sequence[ox.Quad]) -> Refresh:
+    def _changed(self, before: frozenset[ox.Quad], removed: Sequence[ox.Quad], added: Sequence[ox.Quad]) -> Refresh:
         alignment = self.alignment()
         if not alignment.namespaces:
             return Refresh(0, 0, 0)
-        own = {ox.Triple(q.subject, q.predicate, q.object) for q in added}
-        new = {t for q in added for t in alignment.triple(ox.Triple(q.subject, q.predicate, q.object))} - own
+        own = {_quad(ox.Triple(q.subject, q.predicate, q.object)) for q in added}
+        new = {_quad(t) for q in added for t in alignment.triple(ox.Triple(q.subject, q.predicate, q.object))} - own
         nodes = {q.subject for q in removed}
-        old = {t for q in removed for t in alignment.triple(ox.Triple(q.subject, q.predicate, q.object))}
-        after = set(self._rule_conclusions(alignment))
-        stale = {t for t in old if t.subject in nodes} - new - after
-        stale |= set(before) - after - new
-        return self._write({_quad(t) for t in stale}, {_quad(t) for t in (new | after) - own}, None)
+        old = {_quad(t) for q in removed for t in alignment.triple(ox.Triple(q.subject, q.predicate, q.object))}
+        first = self._write({q for q in old if q.subject in nodes} - new - before, new)
+        after = self._rule_conclusions(alignment) - own
+        second = self._write(set(before) - after - new, after)
+        return Refresh(first.added + second.added, first.removed + second.removed, -1)
 
-    def _entailed(self, alignment: Alignment) -> set[ox.Quad]:
+    def _closure(self, alignment: Alignment) -> tuple[set[ox.Quad], set[ox.Quad]]:
+        """What the statements of the store entail one by one, and the statements read for it."""
         if not alignment.namespaces:
-            return set()
+            return set(), set()
         triples: set[ox.Triple] = set()
         asserted: set[ox.Triple] = set()
         for cls in sorted(alignment.classes()):
@@ -235,19 +245,23 @@ class StandardTerms:
             for row in _rows(self.store, _STATEMENT_QUERY, {"p": ox.NamedNode(prop)}):
                 asserted.add(ox.Triple(row["s"], row["p"], row["o"]))
                 triples.update(alignment.statement(row["s"], prop, row["o"]))
-        triples.update(self._rule_conclusions(alignment))
-        return {_quad(t) for t in triples - asserted if _named(t)}
+        return {_quad(t) for t in triples - asserted if _named(t)}, {_quad(t) for t in asserted}
 
-    def _rule_conclusions(self, alignment: Alignment) -> Iterator[ox.Triple]:
+    def _rule_conclusions(self, alignment: Alignment) -> set[ox.Quad]:
+        """What the rules conclude from the store as it is now (graph:entailed included), closed."""
+        found: set[ox.Quad] = set()
+        if not alignment.namespaces:
+            return found
         for rule in rules():
             result = self.store.query(rule)
             assert isinstance(result, ox.QueryTriples)
-            for found in result:
-                if _named(found):
-                    yield found
-                    yield from alignment.triple(found)
+            for triple in result:
+                if _named(triple):
+                    found.add(_quad(triple))
+                    found.update(_quad(t) for t in alignment.triple(triple) if _named(t))
+        return found
 
-    def _write(self, stale: set[ox.Quad], fresh: set[ox.Quad], total: int | None) -> Refresh:
+    def _write(self, stale: set[ox.Quad], fresh: set[ox.Quad]) -> Refresh:
         removing, adding = sorted(stale, key=str), sorted(fresh, key=str)
         batch: int | None = getattr(self.store, "batch", None)  # a remote store's largest write
         if batch is None or len(removing) + len(adding) <= batch:
@@ -259,7 +273,7 @@ class StandardTerms:
             self.store.add(adding)
             for start in range(0, len(removing), batch):
                 self.store.replace(removing[start : start + batch], [])
-        return Refresh(len(adding), len(removing), total if total is not None else -1)
+        return Refresh(len(adding), len(removing), -1)
 
 
 def read_alignment(store: Store) -> Alignment:
@@ -270,9 +284,13 @@ def read_alignment(store: Store) -> Alignment:
 
 
 def entailed(store: Store) -> set[ox.Quad]:
-    """Every quad graph:entailed should hold, worked out from the rest of the store."""
+    """Every quad graph:entailed should hold, worked out from the rest of the store: what its statements
+    entail one by one, and what the rules conclude from those and the rest (for checking: it does not
+    write, so a rule sees the statement-by-statement part as graph:entailed holds it now)."""
     terms = StandardTerms(store)
-    return terms._entailed(terms.alignment())
+    alignment = terms.alignment()
+    wanted, asserted = terms._closure(alignment)
+    return wanted | (terms._rule_conclusions(alignment) - asserted)
 
 
 def refresh(store: Store) -> Refresh:
