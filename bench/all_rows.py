@@ -23,6 +23,7 @@ import re
 import subprocess
 import sys
 import tempfile
+import textwrap
 import time
 from pathlib import Path
 from typing import Any
@@ -146,11 +147,11 @@ def draw(merged: dict[str, Any], path: Path) -> None:
 
     rows = [(record, attainment(record)) for record in merged["rows"]]
     shown = [(record, value) for record, value in rows if value is not None]
-    labels = [f"{record['row']} ({record['goal']})" for record, _ in shown]
+    labels = [textwrap.shorten(f"{record['row']} ({record['goal']})", 64, placeholder="...") for record, _ in shown]
     values = [value for _, value in shown]
     colours = ["#2e7d32" if record.get("met") else "#c62828" for record, _ in shown]
     height = max(2.5, 0.32 * len(shown) + 1.2)
-    figure, axes = plt.subplots(figsize=(10, height))
+    figure, axes = plt.subplots(figsize=(11, height))
     positions = list(range(len(shown)))[::-1]
     axes.hlines(positions, 1.0, values, colors=colours, linewidth=4)  # from the goal to the figure
     axes.scatter(values, positions, color=colours, zorder=3)
@@ -165,8 +166,8 @@ def draw(merged: dict[str, Any], path: Path) -> None:
     loads = [bench["load_average"] for bench in merged.get("benches", {}).values() if "load_average" in bench]
     if loads:
         when += f", load average {min(loads):.1f}-{max(loads):.1f} before the benches"
-    axes.set_title(f"Issue 18 rows, {'quick' if merged.get('quick') else 'full'} run {when}\n{merged['machine']}",
-                   fontsize=9)  # fmt: skip
+    title = f"Issue 18 rows, {'quick' if merged.get('quick') else 'full'} run {when}\n{merged['machine']}"
+    axes.set_title(title, fontsize=8)
     figure.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     figure.savefig(path, dpi=110)
