@@ -11,7 +11,10 @@ something is out of date, and then in one transaction. Three rules, each about w
   describes (and any other ``cbrs:`` term) is replaced by what the bundled ``core.ttl`` says, so
   ``cbrs:Condition`` is no longer an ``rdf:Statement`` and ``cbrs:hasOWLSModel`` gets its new domain;
 - ontology headers: the header (version, description) of each bundled ontology the store holds is
-  replaced by the bundled one, so that the next open finds nothing to do.
+  replaced by the bundled one, so that the next open finds nothing to do;
+- new ontologies: a bundled file of the ontology graph whose ontology the store does not name at all
+  (the standard vocabularies and the alignments, for a store seeded before they were bundled) is
+  added whole, as a seed would have stored it.
 
 Nothing else is touched: the advertisements and requirements a user registered, changed or
 deregistered stay as they are, and the semantic map keeps its own upgrade
@@ -61,6 +64,7 @@ class UpgradeReport:
 def upgrade_store(store: Store, queries: QueryLibrary) -> UpgradeReport:
     """Bring ``store`` up to the bundled ontologies (the three rules above), in one transaction."""
     remove, add, conditions = _condition_changes(store, queries)
+    add += _missing_ontologies(store)
     if _headers_outdated(store):
         core_remove, core_add = _core_changes(store)
         header_remove, header_add = _header_changes(store)
@@ -140,6 +144,33 @@ def _bundled_versions() -> tuple[tuple[ox.NamedNode, GraphName, frozenset[str]],
                     (head, graph, frozenset(str(q.object) for q in quads if q.predicate.value == _VERSION_INFO))
                 )
     return tuple(dict.fromkeys(found))
+
+
+@functools.cache
+def _bundled_ontology_files() -> tuple[tuple[Path, GraphName, ox.NamedNode], ...]:
+    """(file, graph, ontology IRI) of the bundled files of the ontology graph, each read up to its header."""
+    found = []
+    for item in bundled_files():
+        if item.graph is not GraphName.ONTOLOGY:
+            continue
+        for triple in ox.parse(path=str(item.path), format=ox.RdfFormat.TURTLE):
+            if _is_header(triple):
+                if isinstance(triple.subject, ox.NamedNode):
+                    found.append((item.path, item.graph, triple.subject))
+                break
+    return tuple(found)
+
+
+def _missing_ontologies(store: Store) -> list[ox.Quad]:
+    """The quads of every bundled ontology-graph file whose ontology the store does not name."""
+    ontology = ox.NamedNode(OWL + "Ontology")
+    kind = ox.NamedNode(RDF + "type")
+    missing: list[ox.Quad] = []
+    for path, graph, head in _bundled_ontology_files():
+        if next(store.quads(head, kind, ontology, graph.node), None) is None:
+            log.info("adding %s, new in this version of cbrs", path.name)
+            missing += _bundled(path, graph)
+    return missing
 
 
 def _is_header(triple: ox.Triple) -> bool:

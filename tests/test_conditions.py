@@ -157,3 +157,25 @@ def test_a_misspelt_condition_predicate_gets_a_did_you_mean(store_location: str)
         kb.registry.register(turtle)
     assert "the property home:hasStatsu is declared nowhere" in str(caught.value)
     assert "home:hasStatus" in str(caught.value)
+
+
+def test_a_store_seeded_before_the_standard_vocabularies_gets_them_on_open(location: str) -> None:
+    """Files new in the bundle (the standard vocabularies, the alignments) join an older store whole, and
+    the standard terms are entailed from them."""
+    KnowledgeBase.open(location).close()
+    old = Store.open(location)
+    new_files = [i for i in bundled_files() if i.path.parent.name == "standards" or i.path.name == "alignments.ttl"]
+    assert new_files, "the bundle names the standard vocabularies"
+    old.replace([quad for item in new_files for quad in parse_file(item.path, item.graph).quads], [])
+    old.clear_graph(GraphName.ENTAILED.node)
+    old.close()
+    kb = KnowledgeBase.open(location)
+    fresh = KnowledgeBase.open(":memory:")
+    assert _canonical(kb.store, GraphName.ONTOLOGY.node) == _canonical(fresh.store, GraphName.ONTOLOGY.node)
+    sensors = "SELECT ?s WHERE { GRAPH ?g { ?s a <http://www.w3.org/ns/sosa/Sensor> } }"
+    assert sorted(str(r["s"]) for r in kb.store.query(sensors)) == sorted(
+        str(r["s"]) for r in fresh.store.query(sensors)
+    )
+    assert list(kb.store.query(sensors))
+    assert not kb.upgrade().changed
+    kb.close()
