@@ -8,6 +8,7 @@ are one transaction each.
 
 from __future__ import annotations
 
+import logging
 from dataclasses import dataclass
 
 import pyoxigraph as ox
@@ -28,6 +29,9 @@ GRAPH_FORMATS = (
     ox.RdfFormat.N3,
 )
 DATASET_FORMATS = (ox.RdfFormat.TRIG, ox.RdfFormat.N_QUADS)
+
+
+log = logging.getLogger(__name__)
 
 
 class GraphStoreError(KnowledgeBaseError):
@@ -99,7 +103,7 @@ class GraphStore:
             store = self.sparql.kb.store
             created = isinstance(node, ox.NamedNode) and node.value not in store.graphs()
             store.replace(list(store.quads(graph=node)), new)
-            self.sparql.changed()
+            self._written()
         return created
 
     def add(self, target: Target, body: bytes, media_type: str, token: str | None) -> None:
@@ -109,7 +113,7 @@ class GraphStore:
         new = self._parse(body, media_type, node)
         with self.sparql.lock:
             self.sparql.kb.store.add(new)
-            self.sparql.changed()
+            self._written()
 
     def drop(self, target: Target, token: str | None) -> None:
         """DELETE: the graph is emptied and gone; 404 when there is no such graph."""
@@ -123,7 +127,17 @@ class GraphStore:
                 store.clear_graph(node)
             else:
                 store.replace(list(store.quads(graph=node)), [])
-            self.sparql.changed()
+            self._written()
+
+    def _written(self) -> None:
+        """After a write that stands: what it entails in standard vocabularies (graph:entailed, as every
+        other write path brings it up to date), then the endpoint's caches. A failure of the first is
+        logged; the graph lags until the next write."""
+        try:
+            self.sparql.kb.refresh_standard_terms()
+        except KnowledgeBaseError as error:
+            log.warning("graph:entailed not brought up to date after a /store write: %s", error)
+        self.sparql.changed()
 
     def _graph_node(self, target: Target, method: str) -> ox.NamedNode | ox.DefaultGraph:
         node = target.node

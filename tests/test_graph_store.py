@@ -91,3 +91,19 @@ def test_a_description_written_through_the_graph_store_passes_the_shapes(client:
     )
     assert posted.status_code == 400 and "RobotLocation" in posted.get_json()["message"]  # its did-you-mean
     assert client.get("/store?graph=https://w3id.org/cbrs/graph/services").data == before
+
+
+def test_a_write_through_the_graph_store_reaches_the_standard_terms(client: FlaskClient) -> None:
+    """graph:entailed follows /store writes as it follows /update: a camera put in a graph is a sosa:Sensor."""
+    sensors = "SELECT ?s WHERE { GRAPH ?g { ?s a <http://www.w3.org/ns/sosa/Sensor> } }"
+    camera = "<urn:test:camera9> a <https://w3id.org/cbrs/home#CeilingCamera> ."
+
+    def found() -> set[str]:
+        answer = client.post("/sparql", data={"query": sensors}, headers={"Accept": "application/sparql-results+json"})
+        return {row["s"]["value"] for row in answer.get_json()["results"]["bindings"]}
+
+    assert "urn:test:camera9" not in found()
+    assert client.put(f"/store?graph={GRAPH}", data=camera, content_type=TURTLE, headers=AUTH).status_code == 201
+    assert "urn:test:camera9" in found()
+    assert client.delete(f"/store?graph={GRAPH}", headers=AUTH).status_code == 204
+    assert "urn:test:camera9" not in found()
