@@ -30,22 +30,30 @@ class _Segments:
         self.flat = np.array([i for items in lists for i in items] + [0], dtype=np.int64)  # +sentinel
         self.starts = np.concatenate(([0], np.cumsum(self.counts)[:-1])).astype(np.int64)
         self.present = self.counts > 0
+        # reduceat over the flat values of the segments that have any (an empty one reads its neighbour)
+        self._owners = np.flatnonzero(self.present)
+        self._starts = self.starts[self._owners]
 
     def max(self, values: FloatArray) -> FloatArray:
-        gathered = np.append(values[self.flat[:-1]], 0.0)
-        return np.where(self.present, np.maximum.reduceat(gathered, self.starts), 0.0)
+        result = np.zeros(len(self.counts), dtype=np.float64)
+        if len(self._owners):
+            result[self._owners] = np.maximum.reduceat(values[self.flat[:-1]], self._starts)
+        return result
 
     def mean(self, values: FloatArray) -> FloatArray:
-        gathered = np.append(values[self.flat[:-1]], 0.0)
-        sums = np.add.reduceat(gathered, self.starts)
-        return np.where(self.present, sums / np.maximum(self.counts, 1), 0.0)
+        result = np.zeros(len(self.counts), dtype=np.float64)
+        if len(self._owners):
+            sums = np.add.reduceat(values[self.flat[:-1]], self._starts)
+            result[self._owners] = sums / self.counts[self._owners]
+        return result
 
 
 @dataclass(frozen=True)
 class BatchScores:
     score: FloatArray
     parts: dict[str, FloatArray]  # each part's value, NaN where the part is left out
-    rejected_by: list[tuple[str, ...]]  # filter reasons per advertisement
+    rejected_by: Sequence[tuple[str, ...]]  # filter reasons per advertisement
+    rejected: npt.NDArray[np.bool_]  # where they are not empty
     accepted_on: FloatArray | None = None  # the IO/PE score acceptability is judged on, when not ``score``
 
 
@@ -74,9 +82,22 @@ class CompiledPool:
         self.inputs = _Segments([[self.tree_ids[p.type] for p in ad.inputs] for ad in self.ads])
         self.effects = _Segments([[statements[s] for s in ad.effects] for ad in self.ads])
         self.preconditions = _Segments([[statements[s] for s in ad.preconditions] for ad in self.ads])
+        keys: dict[tuple[EffectiveArea | None, tuple[QoSValue, ...]], int] = {}
+        self.filter_key = np.array([keys.setdefault((ad.area, ad.qos), len(keys)) for ad in self.ads], np.int64)
+        self.filter_inputs = list(keys)  # the distinct (SEA, QoS) pairs the filters are asked about
         order = sorted(range(len(self.ads)), key=lambda i: self.ads[i].iri)
         self.iri_rank = np.empty(len(self.ads), dtype=np.int64)
         self.iri_rank[order] = np.arange(len(self.ads))
+
+    def filtered(
+        self,
+        requirement: Requirement,
+        filters: Callable[[Requirement, EffectiveArea | None, tuple[QoSValue, ...]], list[str]],
+    ) -> tuple[list[tuple[str, ...]], npt.NDArray[np.bool_]]:
+        """Each advertisement's filter reasons, asked once per distinct (SEA, QoS), and where there are any."""
+        reasons = [tuple(filters(requirement, area, qos)) for area, qos in self.filter_inputs]
+        rejected = np.array([bool(r) for r in reasons], dtype=bool)[self.filter_key]
+        return [reasons[k] for k in self.filter_key.tolist()], rejected
 
     def _layout_trees(self, trees: list[PartNode]) -> None:
         """Offered side: each tree's root and its parts (CSR). Wanted side: every node of every
@@ -115,6 +136,13 @@ class CompiledPool:
         self.node_leaf = np.array(leaf, dtype=bool)
         self.tree_root_node = np.array(root_of, dtype=np.int64)
         self.node_is_root = self.node_parent < 0
+        # per level, deepest last: the inner nodes, the nodes with a parent, their parents and weights
+        self.levels: list[tuple[IntArray, IntArray, IntArray, FloatArray]] = []
+        for depth in range(int(self.node_level.max(initial=0)) + 1):
+            at = np.flatnonzero(self.node_level == depth)
+            below = at[self.node_parent[at] >= 0]
+            strength = self.node_weight[below] * self.node_span[below]
+            self.levels.append((at[~self.node_leaf[at]], below, self.node_parent[below], strength))
 
 
 class BatchScorer:
@@ -190,7 +218,7 @@ class BatchScorer:
                 counted = np.ones_like(own)
                 child_cover = cover(child, False)
                 if is_root and superclasses is not None:
-                    part = np.full(len(own), pool.space.add(child.concept), dtype=np.int64)
+                    part = np.full(len(own), pool.space.id_of(child.concept), dtype=np.int64)
                     implied = (superclasses >= 0) & pool.space.implied(np.maximum(superclasses, 0), part)
                     counted = np.where(implied & ~inherited, 0.0, 1.0)
                     child_cover = np.where(implied & inherited, 1.0, child_cover)
@@ -251,16 +279,16 @@ class BatchScorer:
         cover = own.copy()
         child_sum = np.zeros_like(own)
         child_weight = np.zeros_like(own)
-        for level in range(int(pool.node_level.max(initial=0)), -1, -1):
-            at = np.flatnonzero(pool.node_level == level)
-            inner = at[~pool.node_leaf[at]]
+        for level in range(len(pool.levels) - 1, -1, -1):
+            inner, below, parents, strength = pool.levels[level]
             cover[inner] = np.maximum(own[inner], (own[inner] + child_sum[inner]) / (1 + child_weight[inner]))
             if level == 1:
                 cover[forced] = 1.0
-            below = at[pool.node_parent[at] >= 0]
-            weights = counted[below] * pool.node_weight[below] * pool.node_span[below]
-            np.add.at(child_sum, pool.node_parent[below], weights * cover[below])
-            np.add.at(child_weight, pool.node_parent[below], weights)
+            if not len(below):
+                continue
+            weights = counted[below] * strength
+            child_sum += np.bincount(parents, weights * cover[below], minlength=len(child_sum))
+            child_weight += np.bincount(parents, weights, minlength=len(child_weight))
         return cover[pool.tree_root_node]
 
     def observed(self, effects: tuple[Statement, ...]) -> FloatArray:
@@ -281,7 +309,9 @@ class BatchScorer:
         else:
             p = self._vector(statement.predicate)[pool.p_ids]
         o = self._vector(statement.object)[pool.o_ids]
-        if cfg.statement_mean == "geometric":
+        if cfg.statement_mean == "geometric" and cfg.subject_weight == cfg.predicate_weight == cfg.object_weight:
+            values = np.cbrt(s * p * o)  # the equal weights of 1/3, with one root instead of three powers
+        elif cfg.statement_mean == "geometric":
             values = np.asarray(s**cfg.subject_weight * p**cfg.predicate_weight * o**cfg.object_weight, np.float64)
         else:
             values = cfg.subject_weight * s + cfg.predicate_weight * p + cfg.object_weight * o
@@ -349,19 +379,14 @@ class BatchScorer:
         ratio = np.where(denominator > 0, numerator / np.maximum(denominator, 1e-300), 0.0)
         ratio = ratio * (1 - cfg.input_gate + cfg.input_gate * invocable)
         score = np.round(ratio.astype(np.float64), 6).astype(np.float64)
-        cache: dict[tuple[EffectiveArea | None, tuple[QoSValue, ...]], tuple[str, ...]] = {}
-        rejected = []
-        for ad in pool.ads:
-            key = (ad.area, ad.qos)
-            if key not in cache:
-                cache[key] = tuple(self.filters(requirement, ad.area, ad.qos))
-            rejected.append(cache[key])
-        return BatchScores(score, parts, rejected)
+        return BatchScores(score, parts, *pool.filtered(requirement, self.filters))
 
 
 def ranking_order(scores: BatchScores, pool: CompiledPool, accept_score: float) -> IntArray:
     """Those that pass the filters first, each group by score (so the ranking and the scores agree),
     then by IRI. ``accept_score`` does not reorder: acceptability is shown, not ranked on."""
     del accept_score
-    rejected = np.array([bool(r) for r in scores.rejected_by])
-    return np.lexsort((pool.iri_rank, -scores.score, rejected)).astype(np.int64)
+    # one integer key: rejected first bit, then the score (six decimals, highest first), then the IRI's rank
+    score = np.rint(scores.score * 1e6).astype(np.int64)
+    key = (scores.rejected.astype(np.int64) << 62) | ((1_000_000 - score) << 32) | pool.iri_rank
+    return np.argsort(key, kind="stable").astype(np.int64)

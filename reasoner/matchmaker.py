@@ -227,7 +227,9 @@ class Matchmaker:
         if self.method.text and text:
             similarity = self._text_index(ads).similarities(text)
             hybrid = _mix(scores.score, similarity, self.config.text_weight)
-            scores = BatchScores(hybrid, {**scores.parts, "text": similarity}, scores.rejected_by, scores.score)
+            scores = BatchScores(
+                hybrid, {**scores.parts, "text": similarity}, scores.rejected_by, scores.rejected, scores.score
+            )
         order = ranking_order(scores, pool, self.config.accept_score).tolist()
         head = [self.score(requirement, ads[i]) for i in order[:explain]]
 
@@ -395,7 +397,16 @@ class Matchmaker:
             implied=self.implied_parts(wanted.type, offered.type) if self.method.use_parts else frozenset(),
             weight=self.index.part_weight,
             inherited=self.config.inherited_parts and self._subsumes(wanted.type, offered.type),
+            value=self._value,
         )
+
+    def _value(self, first: str, second: str) -> float:
+        """The measure's value of a pair, from a similarity vector of the pool when one is cached."""
+        if self._pool is not None and isinstance(self.method.measure, SemStr):
+            found = self._pool.space.cached_value(self.method.measure, first, second)
+            if found is not None:
+                return found
+        return self.method.measure(first, second).value
 
     @property
     def plugin_inputs(self) -> bool:

@@ -83,6 +83,7 @@ class SemStr:
         self._cache: dict[tuple[str, str], Similarity] = {}
         self._words: dict[tuple[str, str], float] = {}
         self._factors: dict[tuple[str, str], float] = {}
+        self._splits: dict[str, tuple[str, str]] = {}
 
     def __call__(self, first: str, second: str) -> Similarity:
         key = (first, second)
@@ -113,7 +114,7 @@ class SemStr:
         what each is about: PersonLocation and RobotLocation are both Locations, of different things."""
         if not self.config.complement_weight:
             return 1.0
-        return self.complement_factor(core_split(self._name(first))[1], core_split(self._name(second))[1])
+        return self.complement_factor(self._split(first)[1], self._split(second)[1])
 
     def complement_factor(self, first: str, second: str) -> float:
         """qualifier_factor from two names' complementary words (space-separated; cached by pair)."""
@@ -148,7 +149,7 @@ class SemStr:
 
     def core_key(self, concept: str) -> str:
         """The lemma of a concept's core word: what cross-branch links are looked up by."""
-        return self.lexicon.lemma(core_split(self._name(concept))[0])
+        return self.lexicon.lemma(self._split(concept)[0])
 
     def predicate(self, first: str, second: str) -> Similarity:
         """Two predicates of RDF statements. Related by the property hierarchy (or not both in it): Sem-Str.
@@ -195,8 +196,8 @@ class SemStr:
 
     def situation_3(self, first: str, second: str) -> Similarity:
         """Core words and complementary words compared (word_similarity), weighted alpha > beta."""
-        core1, rest1 = core_split(self._name(first))
-        core2, rest2 = core_split(self._name(second))
+        core1, rest1 = self._split(first)
+        core2, rest2 = self._split(second)
         core = self.word_similarity(core1, core2)
         if not rest1 and not rest2:
             return Similarity(core, "situation-3")  # nothing else to compare: the core word says it all
@@ -212,6 +213,13 @@ class SemStr:
 
     def _name(self, iri: str) -> str:
         return local_name(iri)
+
+    def _split(self, iri: str) -> tuple[str, str]:
+        """core_split of the IRI's local name (cached)."""
+        found = self._splits.get(iri)
+        if found is None:
+            found = self._splits[iri] = core_split(self._name(iri))
+        return found
 
 
 def rescaled_jaro_winkler(first: str, second: str, floor: float) -> float:

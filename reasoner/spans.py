@@ -58,12 +58,14 @@ def conceptual_span_similarity(
     implied: frozenset[str] = frozenset(),
     weight: Callable[[str], float] = lambda _: 1.0,
     inherited: bool = False,
+    value: Callable[[str, str], float] | None = None,
 ) -> SpanMatch:
     """CSS of two trees; with ``use_parts`` false only the roots are compared (flat matching).
     ``implied``: parts of the roots' common superclass, which do not count as evidence, unless
     ``inherited``: the advertised root is a subclass of the requested one, so it has every implied part
     (they count as covered, similarity 1); ``weight``: how much a matched part of a given concept
-    counts (TaxonomyIndex.part_weight)."""
+    counts (TaxonomyIndex.part_weight); ``value``: the measure's value alone, when it is cheaper to have
+    (a cached vector), so that the full Similarity is built only for each node's best partner."""
     parts = [node for node in advertised.walk() if node is not advertised] if use_parts else []
     pairs: list[PairMatch] = []
     uncovered: list[str] = []
@@ -71,6 +73,10 @@ def conceptual_span_similarity(
     def own(node: PartNode, candidates: list[PartNode]) -> tuple[Similarity | None, str | None]:
         if not candidates:
             return None, None
+        if value is not None and len(candidates) > 1:  # values first; the reasons of the best only
+            values = [value(node.concept, other.concept) for other in candidates]
+            partner = candidates[values.index(max(values))].concept
+            return measure(node.concept, partner), partner
         best, partner = max(
             ((measure(node.concept, other.concept), other.concept) for other in candidates),
             key=lambda pair: pair[0].value,
@@ -112,5 +118,5 @@ def conceptual_span_similarity(
         pairs.append(PairMatch(node.concept, node.concept, Similarity(1.0, "inherited"), span(node)))
         return 1.0
 
-    value = cover(requested, [advertised])
-    return SpanMatch(value, tuple(pairs), tuple(uncovered))
+    result = cover(requested, [advertised])
+    return SpanMatch(result, tuple(pairs), tuple(uncovered))

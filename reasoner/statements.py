@@ -13,6 +13,7 @@ whose subject or object is declared disjoint with the requested one contradicts 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from cbrs.kb import Statement
@@ -59,6 +60,11 @@ def contradiction(
 
 def combine(config: MatchConfig, s: float, p: float, o: float) -> float:
     """The statement's similarity from its three positions' (MatchConfig.statement_mean)."""
+    if (
+        config.statement_mean == "geometric"
+        and config.subject_weight == config.predicate_weight == config.object_weight
+    ):
+        return math.cbrt(s * p * o)  # as batch.py computes it
     if config.statement_mean == "geometric":
         return float(s**config.subject_weight * p**config.predicate_weight * o**config.object_weight)
     return config.subject_weight * s + config.predicate_weight * p + config.object_weight * o

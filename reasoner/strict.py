@@ -103,18 +103,13 @@ class StrictScorer:
             denominator += np.where(present, weights[name], 0.0)
         ratio = np.where(denominator > 0, numerator / np.maximum(denominator, 1e-300), 0.0)
         score = np.round(ratio.astype(np.float64), 6).astype(np.float64)
-        cache: dict[tuple[EffectiveArea | None, tuple[QoSValue, ...]], tuple[str, ...]] = {}
-        rejected = []
-        for i, ad in enumerate(pool.ads):
-            key = (ad.area, ad.qos)
-            if key not in cache:
-                cache[key] = tuple(self.filters(requirement, ad.area, ad.qos))
-            reasons = cache[key]
-            first = next((what for what, where in failed if where[i]), None)
-            if first is not None:
-                reasons = (*reasons, f"strict logic: {first} has no accepted match")
-            rejected.append(reasons)
-        return BatchScores(score, parts, rejected)
+        reasons, rejected = pool.filtered(requirement, self.filters)
+        why = np.full(n, -1, dtype=np.int64)  # the first failed output or effect names the rejection
+        for k in range(len(failed) - 1, -1, -1):
+            why[failed[k][1]] = k
+        for i in np.flatnonzero(why >= 0).tolist():
+            reasons[i] = (*reasons[i], f"strict logic: {failed[why[i]][0]} has no accepted match")
+        return BatchScores(score, parts, reasons, rejected | (why >= 0))
 
     def _inputs(self, requirement: Requirement, parts: dict[str, FloatArray]) -> None:
         """Matchmaker.score's inputs part with degrees: how well the requester supplies each advertised

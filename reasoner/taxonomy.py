@@ -40,6 +40,7 @@ class TaxonomyIndex:
     _children: dict[str, set[str]] = field(default_factory=dict)
     _depth: dict[str, int] = field(default_factory=dict)
     _ancestors: dict[tuple[str, bool], dict[str, int]] = field(default_factory=dict)  # cache
+    _is_a_up: dict[str, dict[str, int]] = field(default_factory=dict)  # cache of is_a_ancestors
     _parts: dict[str, frozenset[str]] = field(default_factory=dict)  # cache
     _part_weights: dict[str, float] | None = None
     _disjoint: dict[str, frozenset[str]] = field(default_factory=dict)  # declared, both ways, canonical
@@ -187,8 +188,13 @@ class TaxonomyIndex:
         return found
 
     def is_a_ancestors(self, concept: str) -> dict[str, int]:
-        """Superclasses (superproperties) with their distance, the concept itself included, no root."""
-        return {a: d for a, d in self.ancestors(concept, is_a_only=True).items() if a != ROOT}
+        """Superclasses (superproperties) with their distance, the concept itself included, no root
+        (cached: do not modify the answer)."""
+        node = self.canonical(concept)
+        found = self._is_a_up.get(node)
+        if found is None:
+            found = self._is_a_up[node] = {a: d for a, d in self.ancestors(node, is_a_only=True).items() if a != ROOT}
+        return found
 
     def parts_of(self, concept: str) -> frozenset[str]:
         """The parts a concept has by its own hasPart restrictions or inherits by is-a (the root has none)."""

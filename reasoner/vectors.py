@@ -30,8 +30,6 @@ floors) keeps, least recently used first out: 32 MB, so 64 arrays over a 64,000-
 thousands over the bundled ontologies. The arrays of the pool's own concepts are rebuilt when needed
 again; the per-node descendant arrays are not bounded (one per taxonomy node at most)."""
 
-IMPLIED_CACHE_ENTRIES = 200_000
-"""The most (superclass, part) answers ``VectorSpace.implied`` keeps (about 30 MB)."""
 
 K = TypeVar("K", bound=Hashable)
 V = TypeVar("V")
@@ -109,7 +107,9 @@ class VectorSpace:
         self._lcs: _Lru[int, IntArray] = _Lru(ARRAY_CACHE_BYTES, _nbytes)
         self._used: set[int] = set()  # ids handed out by add(): where vectors are read
         self._read: list[int] | None = None  # _used, sorted
-        self._implied: _Lru[tuple[int, int], bool] = _Lru(IMPLIED_CACHE_ENTRIES, lambda _: 1)
+        self._read_mask: npt.NDArray[np.bool_] | None = None
+        self._read_below: dict[int, tuple[IntArray, IntArray]] = {}
+        self._parts_masks: _Lru[int, npt.NDArray[np.bool_]] = _Lru(ARRAY_CACHE_BYTES, _nbytes)
         self._by_core: dict[int, tuple[int, dict[str, list[int]]]] = {}
         self._floors: _Lru[tuple[str, bool, float], FloatArray] = _Lru(ARRAY_CACHE_BYTES, _nbytes)
         self._disjoint: _Lru[str, npt.NDArray[np.bool_]] = _Lru(ARRAY_CACHE_BYTES, _nbytes)
@@ -133,13 +133,24 @@ class VectorSpace:
         if found not in self._used:
             self._used.add(found)
             self._read = None
+            self._read_mask = None
+            self._read_below.clear()
+            self._cache.clear()  # vectors are exact where they are read: now here too
+            self._lcs.clear()
         return found
+
+    def id_of(self, concept: str) -> int:
+        """The id of ``concept`` without reading vectors at it (``add`` for a concept outside the taxonomy)."""
+        if concept in self.index:
+            return self.ids[self.index.canonical(concept)]
+        return self.add(concept)
 
     def warm(self) -> None:
         """Build now the descendant arrays that vectors for the handed-out concepts will need."""
         for i in sorted(self._used):
             if i < self.taxonomy_size:
                 self._below(i, is_a_only=False)
+                self.index.ancestors(self.names[i])  # what the explanations' Sem-Str reads
                 for ancestor in self.index.ancestors(self.names[i], is_a_only=True):
                     self._below(self.ids[ancestor], is_a_only=True)
 
@@ -174,6 +185,17 @@ class VectorSpace:
                     found[i] = measure(concept, self.names[i]).value
             self._cache[key] = found
         return found
+
+    def cached_value(self, measure: EntityMeasure, first: str, second: str) -> float | None:
+        """measure(first, second) read from a cached vector of either concept (the measures this is asked
+        for are symmetric), or None when neither is cached or the other concept has no id here."""
+        for concept, other in ((first, second), (second, first)):
+            found = self._cache.get((id(measure), concept))
+            if found is not None:
+                at = self.ids.get(self.index.canonical(other) if other in self.index else other)
+                if at is not None and at < len(found) and (at in self._used or not self._used):
+                    return float(found[at])
+        return None
 
     # -- Sem-Str, vectorised ------------------------------------------------------------------
 
@@ -309,13 +331,14 @@ class VectorSpace:
     def _core_index(self, measure: SemStr) -> dict[str, list[int]]:
         """The taxonomy ids where vectors are read (``_read_at``), by the lemma of their core word; built
         again when ``add`` has handed out more ids since."""
-        at = [i for i in self._read_at() if i < self.taxonomy_size and self.names[i] != ROOT]
+        read = self._read_at()
         found = self._by_core.get(id(measure))
-        if found is None or found[0] != len(at):
+        if found is None or found[0] != len(read):
             table: dict[str, list[int]] = {}
-            for i in at:
-                table.setdefault(measure.core_key(self.names[i]), []).append(i)
-            found = self._by_core[id(measure)] = (len(at), table)
+            for i in read:
+                if i < self.taxonomy_size and self.names[i] != ROOT:
+                    table.setdefault(measure.core_key(self.names[i]), []).append(i)
+            found = self._by_core[id(measure)] = (len(read), table)
         return found[1]
 
     def _complement(self, i: int) -> str:
@@ -329,13 +352,20 @@ class VectorSpace:
         """Situation 2 (or 1 through the root) for every taxonomy node against node x, and which
         nodes are is-a relatives of x under a common superclass other than the root."""
         size = self.taxonomy_size
-        best = np.full(size, -1, dtype=np.int64)
         limit = (1 << _SUM_BITS) - 1
-        for ancestor, dx in self.index.ancestors(self.names[x], is_a_only=True).items():
+        ups = self.index.ancestors(self.names[x], is_a_only=True)
+        root = self.ids[ROOT]
+        # The root is above every node, at the distance of its depth: its keys need no gather. The other
+        # ancestors are asked only about the ids vectors are read at (a large ontology's unread nodes keep
+        # the root's answer, which no reader sees).
+        best = (((limit - ups[ROOT]) << _SUM_BITS) | int(self.name_rank[root])) - (self.depth << _SUM_BITS)
+        for ancestor, dx in ups.items():
             a = self.ids[ancestor]
-            ids, dc = self._below(a, is_a_only=True)
-            keys = (int(self.depth[a]) << _DEPTH_SHIFT) | ((limit - (dx + dc)) << _SUM_BITS) | int(self.name_rank[a])
-            np.maximum.at(best, ids, keys)
+            if a == root:
+                continue
+            ids, dc = self._below_read(a)
+            head = (int(self.depth[a]) << _DEPTH_SHIFT) | ((limit - dx) << _SUM_BITS) | int(self.name_rank[a])
+            best[ids] = np.maximum(best[ids], head - (dc << _SUM_BITS))  # ids are distinct: no maximum.at
         depth = best >> _DEPTH_SHIFT
         total = limit - ((best >> _SUM_BITS) & limit)
         lcs = best & limit  # name rank is the node id
@@ -372,15 +402,31 @@ class VectorSpace:
         return found
 
     def implied(self, superclass: IntArray, part: IntArray) -> npt.NDArray[np.bool_]:
-        """Element-wise: is part[i] a part that superclass[i] has (its own or inherited)?"""
+        """Element-wise: is part[i] a part that superclass[i] has (its own or inherited)? Answered per
+        distinct superclass (the common superclasses of one concept with a pool are few: its ancestors)."""
         result = np.zeros(len(part), dtype=bool)
-        for i, (a, p) in enumerate(zip(superclass.tolist(), part.tolist(), strict=True)):
-            key = (a, p)
-            found = self._implied.get(key)
-            if found is None:
-                found = self._implied[key] = self.names[p] in self.index.parts_of(self.names[a])
-            result[i] = found
+        if not len(part):
+            return result
+        order = np.argsort(superclass, kind="stable")
+        ordered = superclass[order]
+        starts = np.flatnonzero(np.concatenate(([True], ordered[1:] != ordered[:-1])))
+        ends = np.append(starts[1:], len(ordered))
+        for start, end in zip(starts.tolist(), ends.tolist(), strict=True):
+            at = order[start:end]
+            result[at] = self.parts_mask(int(ordered[start]))[part[at]]
         return result
+
+    def parts_mask(self, whole: int) -> npt.NDArray[np.bool_]:
+        """For every concept id: is it a part of concept ``whole``, its own or inherited (TaxonomyIndex.parts_of)?"""
+        found = self._parts_masks.get(whole)
+        if found is None or len(found) != len(self.names):
+            found = np.zeros(len(self.names), dtype=bool)
+            if whole < self.taxonomy_size:
+                parts = self.index.parts_of(self.names[whole])
+                if parts:
+                    found[[self.ids[p] for p in parts]] = True
+            self._parts_masks[whole] = found
+        return found
 
     def delivered(self, concept: str, below: bool, step: float) -> FloatArray:
         """1 - step * k at every concept k is-a links below ``concept`` (a taxonomy node; above it when
@@ -397,6 +443,20 @@ class VectorSpace:
                 links = np.array(list(up.values()), dtype=np.int64)
             found[ids] = np.maximum(0.0, 1.0 - step * links)
             self._floors[key] = found
+        return found
+
+    def _below_read(self, node: int) -> tuple[IntArray, IntArray]:
+        """``_below(node, is_a_only=True)`` at the ids vectors are read at (all of them while none is)."""
+        found = self._read_below.get(node)
+        if found is None:
+            ids, dc = self._below(node, is_a_only=True)
+            if self._used:
+                if self._read_mask is None or len(self._read_mask) != len(self.names):
+                    self._read_mask = np.zeros(len(self.names), dtype=bool)
+                    self._read_mask[self._read_at()] = True
+                keep = self._read_mask[ids]
+                ids, dc = ids[keep], dc[keep]
+            found = self._read_below[node] = (ids, dc)
         return found
 
     def below_is_a(self, concept: str) -> tuple[IntArray, IntArray]:
