@@ -293,13 +293,26 @@ class BatchScorer:
 
     def observed(self, effects: tuple[Statement, ...]) -> FloatArray:
         """Per advertisement, the mean over ``effects`` of its outputs' best Sem-Str with the effect's
-        object or subject."""
+        object or subject, where the output is one of them or an is-a relative (Matchmaker._observed)."""
         pool = self.pool
         per = []
         for effect in effects:
-            terms = np.maximum(self._vector(effect.object), self._vector(effect.subject))
+            terms = np.zeros(len(pool.space), dtype=np.float64)
+            for term in (effect.object, effect.subject):
+                terms = np.maximum(terms, np.where(self._related_to(term), self._vector(term), 0.0))
             per.append(pool.outputs.max(terms[pool.root_ids]))
         return np.asarray(np.mean(per, axis=0), dtype=np.float64)
+
+    def _related_to(self, concept: str) -> npt.NDArray[np.bool_]:
+        """For every concept id: is it ``concept``, an is-a descendant or an is-a ancestor of it?"""
+        space = self.pool.space
+        related = np.zeros(len(space), dtype=bool)
+        if concept in space.index:
+            related[space.below_is_a(concept)[0]] = True
+            related[[space.ids[a] for a in space.index.is_a_ancestors(concept)]] = True
+        elif concept in space.ids:
+            related[space.ids[concept]] = True
+        return related
 
     def statements(self, statement: Statement) -> FloatArray:
         cfg, pool = self.config, self.pool

@@ -431,12 +431,15 @@ class Matchmaker:
         self, effects: tuple[Statement, ...], outputs: tuple[Parameter, ...], pairs: list[EntityPair]
     ) -> float:
         """An advertisement that changes nothing but outputs the state a requested effect is about: each
-        effect's best Sem-Str of an output with its object or subject, times observed_state_weight."""
+        effect's best Sem-Str of an output that is its object or subject, or an is-a relative of either,
+        times observed_state_weight."""
         measure, weight = self.method.measure, self.config.observed_state_weight
         values = []
         for effect in effects:
             found = [
-                (measure(out.type, term), out.type, term) for out in outputs for term in (effect.object, effect.subject)
+                (measure(out.type, term) if self._related(out.type, term) else _UNRELATED, out.type, term)
+                for out in outputs
+                for term in (effect.object, effect.subject)
             ]
             best, output, term = max(found, key=lambda item: item[0].value)
             text = f"({_short(effect.subject)}, {_short(effect.predicate)}, {_short(effect.object)})"
@@ -546,6 +549,7 @@ class _Ranking(Sequence[Candidate]):
         return found
 
 
+_UNRELATED = Similarity(0.0, "not the state asked about, nor an is-a relative of it")
 _DEGREE_SCORE = {Degree.EXACT: 1.0, Degree.SUBCLASS_OF: 0.8, Degree.HAS_SUBCLASS: 0.6, Degree.FAIL: 0.0}
 
 

@@ -191,6 +191,7 @@ def test_an_offer_that_reports_the_requested_state_is_a_step_towards_it(defined_
     opened_state = SemStr(index)(M + "DoorState", M + "Opened").value
     assert explained.parts["effects"] == pytest.approx(MatchConfig().observed_state_weight * opened_state)
     assert ranked[0].score == explained.score and "reports Opened" in explained.pairs[0].how
+    assert matcher.score(wanted, other).parts["effects"] == 0.0  # a Lens is no state of a door, however alike
     off = Matchmaker(defined_kb, config=MatchConfig(observed_state_weight=0.0), index=index, advertisements=[checks])
     assert off.score(wanted, checks).parts["effects"] == 0.0
 
