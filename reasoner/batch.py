@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import overload
 
 import numpy as np
 import numpy.typing as npt
@@ -33,19 +34,52 @@ class _Segments:
         # reduceat over the flat values of the segments that have any (an empty one reads its neighbour)
         self._owners = np.flatnonzero(self.present)
         self._starts = self.starts[self._owners]
+        self._body = self.flat[:-1]
+        self._full = len(self._owners) == len(self.counts) > 0  # every segment has items
 
     def max(self, values: FloatArray) -> FloatArray:
+        if self._full:
+            return np.asarray(np.maximum.reduceat(values[self._body], self._starts), dtype=np.float64)
         result = np.zeros(len(self.counts), dtype=np.float64)
         if len(self._owners):
-            result[self._owners] = np.maximum.reduceat(values[self.flat[:-1]], self._starts)
+            result[self._owners] = np.maximum.reduceat(values[self._body], self._starts)
         return result
 
     def mean(self, values: FloatArray) -> FloatArray:
+        if self._full:
+            return np.asarray(np.add.reduceat(values[self._body], self._starts) / self.counts, dtype=np.float64)
         result = np.zeros(len(self.counts), dtype=np.float64)
         if len(self._owners):
-            sums = np.add.reduceat(values[self.flat[:-1]], self._starts)
+            sums = np.add.reduceat(values[self._body], self._starts)
             result[self._owners] = sums / self.counts[self._owners]
         return result
+
+
+class _Reasons(Sequence[tuple[str, ...]]):
+    """Each advertisement's filter reasons, read through its (SEA, QoS) number: no list of a whole pool."""
+
+    def __init__(self, keys: IntArray, reasons: list[tuple[str, ...]]) -> None:
+        self._keys = keys
+        self._reasons = reasons
+        self._extra: dict[int, tuple[str, ...]] = {}
+
+    def __len__(self) -> int:
+        return len(self._keys)
+
+    @overload
+    def __getitem__(self, i: int) -> tuple[str, ...]: ...
+
+    @overload
+    def __getitem__(self, i: slice) -> list[tuple[str, ...]]: ...
+
+    def __getitem__(self, i: int | slice) -> tuple[str, ...] | list[tuple[str, ...]]:
+        if isinstance(i, slice):
+            return [self[j] for j in range(*i.indices(len(self)))]
+        return self._extra.get(i) or self._reasons[int(self._keys[i])]
+
+    def add(self, i: int, reason: str) -> None:
+        """One more reason for advertisement i (strict logic's failed output or effect)."""
+        self._extra[i] = (*self[i], reason)
 
 
 @dataclass(frozen=True)
@@ -93,11 +127,11 @@ class CompiledPool:
         self,
         requirement: Requirement,
         filters: Callable[[Requirement, EffectiveArea | None, tuple[QoSValue, ...]], list[str]],
-    ) -> tuple[list[tuple[str, ...]], npt.NDArray[np.bool_]]:
+    ) -> tuple[_Reasons, npt.NDArray[np.bool_]]:
         """Each advertisement's filter reasons, asked once per distinct (SEA, QoS), and where there are any."""
         reasons = [tuple(filters(requirement, area, qos)) for area, qos in self.filter_inputs]
         rejected = np.array([bool(r) for r in reasons], dtype=bool)[self.filter_key]
-        return [reasons[k] for k in self.filter_key.tolist()], rejected
+        return _Reasons(self.filter_key, reasons), rejected
 
     def _layout_trees(self, trees: list[PartNode]) -> None:
         """Offered side: each tree's root and its parts (CSR). Wanted side: every node of every
@@ -399,7 +433,20 @@ def ranking_order(scores: BatchScores, pool: CompiledPool, accept_score: float) 
     """Those that pass the filters first, each group by score (so the ranking and the scores agree),
     then by IRI. ``accept_score`` does not reorder: acceptability is shown, not ranked on."""
     del accept_score
-    # one integer key: rejected first bit, then the score (six decimals, highest first), then the IRI's rank
+    return np.argsort(ranking_keys(scores, pool)).astype(np.int64)  # distinct keys: no ties to keep stable
+
+
+def ranking_keys(scores: BatchScores, pool: CompiledPool) -> IntArray:
+    """One integer per advertisement that sorts as the ranking does: whether a filter rejects it, then
+    its score (six decimals, highest first), then its IRI's rank (so the keys are distinct)."""
     score = np.rint(scores.score * 1e6).astype(np.int64)
-    key = (scores.rejected.astype(np.int64) << 62) | ((1_000_000 - score) << 32) | pool.iri_rank
-    return np.argsort(key, kind="stable").astype(np.int64)
+    return np.asarray((scores.rejected.astype(np.int64) << 62) | ((1_000_000 - score) << 32) | pool.iri_rank)
+
+
+def first_ranked(keys: IntArray, count: int) -> IntArray:
+    """The ``count`` best by ``keys``, in order, without sorting the rest."""
+    count = min(count, len(keys))
+    if count <= 0:
+        return np.zeros(0, dtype=np.int64)
+    chosen = np.argpartition(keys, count - 1)[:count] if count < len(keys) else np.arange(len(keys))
+    return np.asarray(chosen[np.argsort(keys[chosen])], dtype=np.int64)

@@ -208,7 +208,9 @@ class Matchmaker:
         return getattr(self.kb.store, "generation", None)
 
     def _rank_batch(self, requirement: Requirement, ads: list[Advertisement], explain: int) -> Sequence[Candidate]:
-        from cbrs.reasoner.batch import BatchScorer, BatchScores, ranking_order
+        import numpy as np
+
+        from cbrs.reasoner.batch import BatchScorer, BatchScores, first_ranked, ranking_keys
 
         pool = self._compiled(ads)
         if self.method.strict:  # degrees of match, not similarities
@@ -230,8 +232,13 @@ class Matchmaker:
             scores = BatchScores(
                 hybrid, {**scores.parts, "text": similarity}, scores.rejected_by, scores.rejected, scores.score
             )
-        order = ranking_order(scores, pool, self.config.accept_score).tolist()
-        head = [self.score(requirement, ads[i]) for i in order[:explain]]
+        keys = ranking_keys(scores, pool)
+        first = first_ranked(keys, explain).tolist()
+        head = [self.score(requirement, ads[i]) for i in first]
+
+        def rest() -> list[int]:  # the whole order, sorted only when a candidate past the head is read
+            order: list[int] = np.argsort(keys)[len(first) :].tolist()
+            return order
 
         def unexplained(i: int) -> Candidate:
             ad = ads[i]
@@ -242,7 +249,7 @@ class Matchmaker:
             acceptable = not rejected and basis >= self.config.accept_score
             return Candidate(ad.iri, ad.label, score, parts, (), (), rejected, acceptable, explained=False)
 
-        return _Ranking(head, order[explain:], unexplained)
+        return _Ranking(head, rest, len(ads) - len(first), unexplained)
 
     def score(self, requirement: Requirement, ad: Advertisement) -> Candidate:
         pairs: list[EntityPair] = []
@@ -516,17 +523,21 @@ class Matchmaker:
 
 
 class _Ranking(Sequence[Candidate]):
-    """Ranked candidates: the explained head as built, the rest made on first access (a pool of
-    thousands is ranked far more often than it is read to the end)."""
+    """Ranked candidates: the explained head as built, the rest ordered and made on first access (a pool
+    of thousands is ranked far more often than it is read to the end)."""
 
-    def __init__(self, head: list[Candidate], rest: list[int], make: Callable[[int], Candidate]) -> None:
+    def __init__(
+        self, head: list[Candidate], rest: Callable[[], list[int]], remaining: int, make: Callable[[int], Candidate]
+    ) -> None:
         self._head = head
-        self._rest = rest
+        self._order = rest  # the positions past the head, computed on first need
+        self._rest: list[int] | None = None
+        self._remaining = remaining
         self._made: dict[int, Candidate] = {}
         self._make = make
 
     def __len__(self) -> int:
-        return len(self._head) + len(self._rest)
+        return len(self._head) + self._remaining
 
     @overload
     def __getitem__(self, position: int) -> Candidate: ...
@@ -545,6 +556,8 @@ class _Ranking(Sequence[Candidate]):
             return self._head[position]
         found = self._made.get(position)
         if found is None:
+            if self._rest is None:
+                self._rest = self._order()
             found = self._made[position] = self._make(self._rest[position - len(self._head)])
         return found
 

@@ -108,7 +108,7 @@ class StrictScorer:
         for k in range(len(failed) - 1, -1, -1):
             why[failed[k][1]] = k
         for i in np.flatnonzero(why >= 0).tolist():
-            reasons[i] = (*reasons[i], f"strict logic: {failed[why[i]][0]} has no accepted match")
+            reasons.add(i, f"strict logic: {failed[why[i]][0]} has no accepted match")
         return BatchScores(score, parts, reasons, rejected | (why >= 0))
 
     def _inputs(self, requirement: Requirement, parts: dict[str, FloatArray]) -> None:

@@ -359,13 +359,34 @@ class VectorSpace:
         # ancestors are asked only about the ids vectors are read at (a large ontology's unread nodes keep
         # the root's answer, which no reader sees).
         best = (((limit - ups[ROOT]) << _SUM_BITS) | int(self.name_rank[root])) - (self.depth << _SUM_BITS)
+        # The key's depth dominates: deeper ancestors first, each node settled by the first that has it
+        # (ancestors of equal depth together, by the larger key).
+        by_depth: dict[int, list[tuple[int, int]]] = {}
         for ancestor, dx in ups.items():
             a = self.ids[ancestor]
-            if a == root:
-                continue
-            ids, dc = self._below_read(a)
-            head = (int(self.depth[a]) << _DEPTH_SHIFT) | ((limit - dx) << _SUM_BITS) | int(self.name_rank[a])
-            best[ids] = np.maximum(best[ids], head - (dc << _SUM_BITS))  # ids are distinct: no maximum.at
+            if a != root:
+                by_depth.setdefault(int(self.depth[a]), []).append((a, dx))
+        settled = np.zeros(size, dtype=bool)
+        for level in sorted(by_depth, reverse=True):
+            group = by_depth[level]
+            found = []
+            for a, dx in group:
+                ids, dc = self._below_read(a)
+                fresh = ~settled[ids]
+                ids, dc = ids[fresh], dc[fresh]
+                head = (level << _DEPTH_SHIFT) | ((limit - dx) << _SUM_BITS) | int(self.name_rank[a])
+                found.append((ids, head - (dc << _SUM_BITS)))
+            if len(found) == 1:
+                ids, keys = found[0]
+                best[ids] = keys
+            else:
+                candidate = np.full(size, -1, dtype=np.int64)
+                for ids, keys in found:
+                    candidate[ids] = np.maximum(candidate[ids], keys)  # ids are distinct within one ancestor
+                ids = np.unique(np.concatenate([ids for ids, _ in found]))
+                best[ids] = candidate[ids]
+            for ids, _ in found:
+                settled[ids] = True
         depth = best >> _DEPTH_SHIFT
         total = limit - ((best >> _SUM_BITS) & limit)
         lcs = best & limit  # name rank is the node id
