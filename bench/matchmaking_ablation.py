@@ -33,8 +33,12 @@ VARIANTS: dict[str, MatchConfig] = {
     "no delivered-as-subclass": replace(BASE, plugin_outputs=False),
     "no free no-input offers": replace(BASE, no_input_invocable=False),
     "arithmetic statement mean": replace(BASE, statement_mean="arithmetic"),
-    "with WordNet core words": replace(BASE, lexicon=True),
+    "no complementary words (complement_weight 0)": replace(BASE, complement_weight=0.0),
+    "predicates through the root as Sem-Str (factor 1)": replace(BASE, unrelated_predicate_factor=1.0),
+    "no observed state (observed_state_weight 0)": replace(BASE, observed_state_weight=0.0),
+    "no disjoint statements": replace(BASE, disjoint_statements=False),
     "no cross-branch links": replace(BASE, cross_branch_weight=0.0),
+    "with WordNet core words": replace(BASE, lexicon=True),
     "input gate 0.4": replace(BASE, input_gate=0.4),
     "all off (published frame)": BASE.published(),
 }
