@@ -161,13 +161,11 @@ def test_bounded_vector_caches_rank_as_unbounded_ones(monkeypatch: pytest.Monkey
     kb = KnowledgeBase.open(":memory:")
     expected = [_order(Matchmaker(kb, index=index, advertisements=pool), r) for r in requirements]
     monkeypatch.setattr(vectors, "ARRAY_CACHE_BYTES", 3 * 8 * 401)  # three vectors of the taxonomy
-    monkeypatch.setattr(vectors, "IMPLIED_CACHE_ENTRIES", 10)
     matchmaker = Matchmaker(kb, index=index, advertisements=pool)
     assert [_order(matchmaker, r) for r in requirements * 2] == expected * 2
     space = matchmaker._compiled(matchmaker.advertisements).space
-    for cache in (space._cache, space._lcs, space._floors):
+    for cache in (space._cache, space._lcs, space._floors, space._parts_masks, space._disjoint):
         assert cache.weight <= 3 * 8 * len(space) or len(cache) == 1
-    assert len(space._implied) <= 10
 
 
 def _order(matchmaker: Matchmaker, requirement: Requirement) -> list[tuple[str, float]]:
