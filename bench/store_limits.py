@@ -1,6 +1,7 @@
 """Benchmark: cbrs at the store's own limit, side by side with Oxigraph's own server and loader (issue 18).
 
-Run: python bench/store_limits.py [--quick] [--triples N] [--seconds S] [--clients 1,4,8] [--json FILE]
+Run: python bench/store_limits.py [--quick] [--triples N] [--seconds S] [--clients 1,4,8] [--rounds 3]
+[--repeat 5] [--rows load,serve,memory] [--json FILE]
 
 One run does every row against its anchor, on the same data and the same machine:
 
@@ -11,7 +12,8 @@ One run does every row against its anchor, on the same data and the same machine
 - both stores served (``cbrs serve`` and ``oxigraph serve --union-default-graph``, each holding the big
   graph and cbrs's bundled data), then point lookups (``SELECT ?p ?o WHERE { <entity> ?p ?o }`` for a
   seeded random entity, JSON results) from 1, 4 and 8 client processes with one kept-alive HTTP
-  connection each, for S seconds: queries per second and the 99th percentile of the latency;
+  connection each (from a loopback address of its own), S seconds a turn, the servers in turns, the
+  median of ``--rounds`` turns: queries per second and the 99th percentile of the latency;
 - heavy queries (aggregates over the whole store), one at a time: the median time of each;
 - the memory of an idle ``cbrs serve`` over the bundled data after it answered a point lookup and a
   heavy query: resident and proportional set size of its whole process tree (query workers included),
