@@ -39,7 +39,6 @@ from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import GraphName, expand
 from cbrs.kb.store import is_remote
 from cbrs.matchmakers import Matchmakers
-from cbrs.reasoner.methods import METHODS
 from cbrs.rosbridge import Bridge, GoalHandle, GoalResult, GoalStatus, ServiceError, current_caller
 from cbrs.sparql_service import SparqlService
 from cbrs.tasks import RUN_TOPIC, TaskRunner
@@ -109,6 +108,8 @@ class KnowledgeServices:
         requirement = _iri(_field(args, "requirement", str), "req")
         method = _field(args, "method", str, "sem-str")
         top = _field(args, "top", int, 10)
+        from cbrs.reasoner.methods import METHODS  # the reasoner loads with the first match, not at start-up
+
         if method not in METHODS:
             raise ServiceError(f"method {method!r} is not one of {', '.join(METHODS)}")
         if top < 1:

@@ -4,12 +4,15 @@ store version and shared by every method, for the browser and the rosbridge serv
 from __future__ import annotations
 
 import threading
+from typing import TYPE_CHECKING
 
 from cbrs.kb.namespaces import GraphName
 from cbrs.kb.store import is_remote
-from cbrs.reasoner.matchmaker import Matchmaker
-from cbrs.reasoner.taxonomy import TaxonomyIndex
 from cbrs.sparql_service import SparqlService
+
+if TYPE_CHECKING:  # the reasoner loads with the first ranking, not at cbrs serve's start-up
+    from cbrs.reasoner.matchmaker import Matchmaker
+    from cbrs.reasoner.taxonomy import TaxonomyIndex
 
 
 class Matchmakers:
@@ -29,6 +32,9 @@ class Matchmakers:
         sizes of the ontology and services graphs are then part of the store's version, so a
         description registered through another process is matched here at the next ranking.
         """
+        from cbrs.reasoner.matchmaker import Matchmaker
+        from cbrs.reasoner.taxonomy import TaxonomyIndex
+
         kb = self.sparql.kb
         generation: object = self.sparql.generation
         if is_remote(kb.store.location):

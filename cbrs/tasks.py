@@ -19,19 +19,17 @@ import time
 from collections import OrderedDict
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from cbrs.actions.composer import Composer
-from cbrs.actions.events import Event
-from cbrs.actions.executor import RunStatus
-from cbrs.actions.faults import RandomFaults
-from cbrs.actions.model import ActionLibrary, resolve_task
-from cbrs.actions.remote import Transport
-from cbrs.actions.runner import run_task
 from cbrs.extras import installed, require
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import expand, shorten
+
+if TYPE_CHECKING:
+    from cbrs.actions.events import Event
+    from cbrs.actions.remote import Transport
+    from cbrs.actions.runner import RunResult
 
 log = logging.getLogger("cbrs.tasks")
 
@@ -214,6 +212,9 @@ class TaskRunner:
         if self.read_only:
             raise TasksDisabledError()
         require("sim", "a task run")
+        from cbrs.actions.faults import RandomFaults  # the planner loads with the first run, not at start-up
+        from cbrs.actions.model import ActionLibrary, resolve_task
+
         RandomFaults(seed, fault_rate)  # an impossible rate fails here (FaultSpecError), not in the thread
         failing = tuple(expand(f) for f in faults)
         _check_components(self.kb, failing)
@@ -268,6 +269,9 @@ class TaskRunner:
             active[1].join(timeout)
 
     def _run(self, run: TaskRun) -> None:
+        from cbrs.actions.composer import Composer
+        from cbrs.actions.executor import RunStatus
+        from cbrs.actions.faults import RandomFaults
         from cbrs.kb.semantic_map import SemanticMap
         from cbrs.sim.components import SimEnvironment  # pybullet loads only when a task runs
         from cbrs.sim.world import open_world
@@ -377,6 +381,14 @@ class TaskRunner:
         with self._guard:
             if listener in self._listeners:
                 self._listeners.remove(listener)
+
+
+def run_task(*args: Any, **kwargs: Any) -> RunResult:
+    """:func:`cbrs.actions.runner.run_task`, imported with the first run: the planner and networkx stay
+    out of ``cbrs serve``'s start-up."""
+    from cbrs.actions.runner import run_task as run
+
+    return run(*args, **kwargs)
 
 
 def _jpeg(rgb: Any) -> bytes:

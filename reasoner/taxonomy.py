@@ -16,10 +16,12 @@ import math
 from collections import deque
 from collections.abc import Iterable
 from dataclasses import dataclass, field
-
-import networkx as nx
+from typing import TYPE_CHECKING
 
 from cbrs.kb import KnowledgeBase
+
+if TYPE_CHECKING:
+    import networkx as nx  # imported where an index is built: cbrs serve starts without it
 
 ROOT = "http://www.w3.org/2002/07/owl#Thing"  # the root: above every concept with no is-a parent
 
@@ -69,6 +71,8 @@ class TaxonomyIndex:
         cls, links: Iterable[Link], terms: Iterable[str] = (), disjoint: Iterable[tuple[str, str]] = ()
     ) -> TaxonomyIndex:
         """The index of these links; ``disjoint``: pairs of classes declared disjoint."""
+        import networkx as nx
+
         links = list(links)
         graph: nx.DiGraph[str] = nx.DiGraph()
         graph.add_nodes_from(terms)
@@ -112,6 +116,8 @@ class TaxonomyIndex:
 
     def _break_part_cycles(self) -> None:
         """has-part links can close a cycle (A has part B, B is-a A); drop those links."""
+        import networkx as nx
+
         graph: nx.DiGraph[str] = nx.DiGraph((c, p) for c, ps in self._parents.items() for p in ps)
         while True:
             try:

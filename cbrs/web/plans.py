@@ -5,30 +5,39 @@ from __future__ import annotations
 
 import tempfile
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from flask import Blueprint, Response, request, url_for
 
-from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, Objective
-from cbrs.actions.errors import UnknownTaskError
-from cbrs.actions.model import ActionLibrary
 from cbrs.extras import require
 from cbrs.kb.namespaces import shorten
-from cbrs.task_names import task_iri
 from cbrs.web import context
 from cbrs.web.pages import FormError, Page, page
 
+if TYPE_CHECKING:  # the planner (and networkx) load with the first plan asked for, not at start-up
+    from cbrs.actions.composer import CompositionResult
+
 blueprint = Blueprint("plans", __name__)
 
-OBJECTIVES = [o.value for o in Objective]
+
+def _objectives() -> list[str]:
+    from cbrs.actions.composer import Objective
+
+    return [o.value for o in Objective]
+
+
+def _default_objective() -> str:
+    from cbrs.actions.composer import Objective
+
+    return Objective.SIMILARITY.value
 
 
 @page(blueprint, "/plans")
 def plans() -> Page:
     task = request.args.get("task", "").strip()
-    objective = request.args.get("objective", "").strip() or Objective.SIMILARITY.value
+    objective = request.args.get("objective", "").strip() or _default_objective()
     options = _tasks()
-    data: dict[str, Any] = {"task": task, "objective": objective, "objectives": OBJECTIVES, "tasks": options}
+    data: dict[str, Any] = {"task": task, "objective": objective, "objectives": _objectives(), "tasks": options}
     data["selected"] = _selected(task, options)
     shown = Page("plans.html", "Plans", data)
     if "task" not in request.args:
@@ -47,7 +56,7 @@ def plans() -> Page:
 def graph() -> Response:
     """The service resource graph of the task's composition, with the chosen plan, as SVG."""
     task = request.args.get("task", "").strip()
-    objective = request.args.get("objective", "").strip() or Objective.SIMILARITY.value
+    objective = request.args.get("objective", "").strip() or _default_objective()
     with context.lock():  # pyplot is not thread-safe either
         result = _compose(task, objective, None)
         svg = _svg(result)
@@ -56,8 +65,13 @@ def graph() -> Response:
 
 def _compose(task: str, objective: str, shown: Page | None) -> CompositionResult:
     """Call with ``context.lock()`` held."""
-    if objective not in OBJECTIVES:
-        raise FormError({"objective": f"{objective!r} is not one of {', '.join(OBJECTIVES)}"}, page=shown)
+    from cbrs.actions.composer import ComposeConfig, Composer, Objective
+    from cbrs.actions.errors import UnknownTaskError
+    from cbrs.task_names import task_iri
+
+    objectives = _objectives()
+    if objective not in objectives:
+        raise FormError({"objective": f"{objective!r} is not one of {', '.join(objectives)}"}, page=shown)
     if not task:
         raise FormError({"task": "choose a task: a requirement or an action"}, page=shown)
     composer = Composer(context.kb(), ComposeConfig(objective=Objective(objective)))
@@ -77,6 +91,8 @@ def _svg(result: CompositionResult) -> bytes:
 
 def _tasks() -> dict[str, list[dict[str, str | None]]]:
     """What can be planned: the requirements, and the action classes that have sub-actions."""
+    from cbrs.actions.model import ActionLibrary
+
     kb = context.kb()
     with context.lock():
         requirements = kb.requirements()
