@@ -215,6 +215,9 @@ def main() -> None:
     load = os.getloadavg()[0]
     machine = f"{platform.platform()}, {os.cpu_count()} cores, python {platform.python_version()}"
     print(f"machine: {machine}, load average {load:.2f}")
+    if os.environ.get("PYTHONDONTWRITEBYTECODE"):
+        # every process start then compiles cbrs's sources again (about 0.1-0.2 s here): not what users see
+        print("note: PYTHONDONTWRITEBYTECODE is set, so the process starts include compiling the sources")
     print(
         f"inputs: repeat {args.repeat}; chain pool of {args.chain} advertisements; matchmaker over "
         f"{args.classes} classes, {args.ads} advertisements, {args.requirements} distinct requirements"
