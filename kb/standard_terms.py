@@ -55,6 +55,8 @@ _LINK_SET = frozenset(_LINKS) | {ALIGN + "standardNamespace"}
 _NAMESPACE_QUERY = "SELECT DISTINCT ?namespace WHERE { ?vocabulary align:standardNamespace ?namespace }"
 _TYPE_QUERY = "SELECT ?s ?c WHERE { GRAPH ?g { ?s a ?c } FILTER (?g != graph:entailed && isIRI(?s)) }"
 _STATEMENT_QUERY = "SELECT ?s ?p ?o WHERE { GRAPH ?g { ?s ?p ?o } FILTER (?g != graph:entailed && isIRI(?s)) }"
+#: The query texts above: cbrs's own, so they skip the query guard's checker (:func:`kb.store.bundled_query_texts`).
+OWN_QUERIES = (_LINK_QUERY, _NAMESPACE_QUERY, _TYPE_QUERY, _STATEMENT_QUERY)
 
 
 @dataclass(frozen=True)

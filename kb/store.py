@@ -154,10 +154,14 @@ class Store(ABC):
 
 @functools.cache
 def bundled_query_texts() -> frozenset[str]:
-    """The texts of the named queries cbrs ships (``queries/*.rq``), as :class:`kb.queries.QueryLibrary` runs them."""
+    """The query texts cbrs ships: the named queries (``queries/*.rq``) as :class:`kb.queries.QueryLibrary`
+    runs them, and those that work out graph:entailed (:mod:`kb.standard_terms`, its rules from the
+    bundled alignments), which run after every load and update."""
+    from cbrs.kb import standard_terms
     from cbrs.kb.resources import query_dir
 
-    return frozenset(path.read_text(encoding="utf-8") for path in query_dir().glob("*.rq"))
+    named = {path.read_text(encoding="utf-8") for path in query_dir().glob("*.rq")}
+    return frozenset(named | set(standard_terms.OWN_QUERIES) | set(standard_terms.rules()))
 
 
 def nesting_depth(text: str) -> int:

@@ -224,3 +224,19 @@ def test_each_standard_subset_names_its_source_and_licence(path: Path) -> None:
 
 def _held(kb: KnowledgeBase) -> set[ox.Quad]:
     return set(kb.store.quads(graph=GraphName.ENTAILED.node))
+
+
+def test_working_out_the_standard_terms_needs_no_checker_process(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The texts that work out graph:entailed are cbrs's own: on an on-disk store they skip the query
+    guard, whose checker process would otherwise start (and stay) after every load and update."""
+    store = KnowledgeBase.open(tmp_path / "store")
+    admitted: list[str] = []
+    monkeypatch.setattr(store.store.guard, "admit", lambda kind, text: admitted.append(text))  # type: ignore[attr-defined]
+    refresh = store.refresh_standard_terms()
+    assert admitted == []
+    assert next(store.store.quads(graph=GraphName.ENTAILED.node), None) is not None, refresh
+    store.store.query("SELECT * WHERE { ?s ?p ?o } LIMIT 1")  # any other text is still checked
+    assert admitted == ["SELECT * WHERE { ?s ?p ?o } LIMIT 1"]
+    store.close()
