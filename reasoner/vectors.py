@@ -108,6 +108,7 @@ class VectorSpace:
         self._used: set[int] = set()  # ids handed out by add(): where vectors are read
         self._read: list[int] | None = None  # _used, sorted
         self._read_mask: npt.NDArray[np.bool_] | None = None
+        self._read_nodes: tuple[IntArray, IntArray] | None = None
         self._read_below: dict[int, tuple[IntArray, IntArray]] = {}
         self._parts_masks: _Lru[int, npt.NDArray[np.bool_]] = _Lru(ARRAY_CACHE_BYTES, _nbytes)
         self._by_core: dict[int, tuple[int, dict[str, list[int]]]] = {}
@@ -134,6 +135,7 @@ class VectorSpace:
             self._used.add(found)
             self._read = None
             self._read_mask = None
+            self._read_nodes = None
             self._read_below.clear()
             self._cache.clear()  # vectors are exact where they are read: now here too
             self._lcs.clear()
@@ -350,54 +352,70 @@ class VectorSpace:
 
     def _wu_palmer_or_root(self, x: int) -> tuple[FloatArray, npt.NDArray[np.bool_]]:
         """Situation 2 (or 1 through the root) for every taxonomy node against node x, and which
-        nodes are is-a relatives of x under a common superclass other than the root."""
+        nodes are is-a relatives of x under a common superclass other than the root. Computed at the
+        ids vectors are read at (all while none is); elsewhere the values are 0, the common superclass
+        the root: no reader sees them, and a large ontology's unread nodes cost nothing."""
         size = self.taxonomy_size
+        read, position = self._read_taxonomy()
         limit = (1 << _SUM_BITS) - 1
         ups = self.index.ancestors(self.names[x], is_a_only=True)
         root = self.ids[ROOT]
-        # The root is above every node, at the distance of its depth: its keys need no gather. The other
-        # ancestors are asked only about the ids vectors are read at (a large ontology's unread nodes keep
-        # the root's answer, which no reader sees).
-        best = (((limit - ups[ROOT]) << _SUM_BITS) | int(self.name_rank[root])) - (self.depth << _SUM_BITS)
-        # The key's depth dominates: deeper ancestors first, each node settled by the first that has it
-        # (ancestors of equal depth together, by the larger key).
+        # The root is above every node, at the distance of its depth. The key's depth dominates: deeper
+        # ancestors first, each node settled by the first that has it (equal depths by the larger key).
+        best = (((limit - ups[ROOT]) << _SUM_BITS) | int(self.name_rank[root])) - (self.depth[read] << _SUM_BITS)
         by_depth: dict[int, list[tuple[int, int]]] = {}
         for ancestor, dx in ups.items():
             a = self.ids[ancestor]
             if a != root:
                 by_depth.setdefault(int(self.depth[a]), []).append((a, dx))
-        settled = np.zeros(size, dtype=bool)
+        settled = np.zeros(len(read), dtype=bool)
         for level in sorted(by_depth, reverse=True):
-            group = by_depth[level]
             found = []
-            for a, dx in group:
+            for a, dx in by_depth[level]:
                 ids, dc = self._below_read(a)
-                fresh = ~settled[ids]
-                ids, dc = ids[fresh], dc[fresh]
+                at = position[ids]
+                fresh = ~settled[at]
                 head = (level << _DEPTH_SHIFT) | ((limit - dx) << _SUM_BITS) | int(self.name_rank[a])
-                found.append((ids, head - (dc << _SUM_BITS)))
+                found.append((at[fresh], head - (dc[fresh] << _SUM_BITS)))
             if len(found) == 1:
-                ids, keys = found[0]
-                best[ids] = keys
+                at, keys = found[0]
+                best[at] = keys
             else:
-                candidate = np.full(size, -1, dtype=np.int64)
-                for ids, keys in found:
-                    candidate[ids] = np.maximum(candidate[ids], keys)  # ids are distinct within one ancestor
-                ids = np.unique(np.concatenate([ids for ids, _ in found]))
-                best[ids] = candidate[ids]
-            for ids, _ in found:
-                settled[ids] = True
+                candidate = np.full(len(read), -1, dtype=np.int64)
+                for at, keys in found:
+                    candidate[at] = np.maximum(candidate[at], keys)  # positions distinct within one ancestor
+                at = np.unique(np.concatenate([at for at, _ in found]))
+                best[at] = candidate[at]
+            for at, _ in found:
+                settled[at] = True
         depth = best >> _DEPTH_SHIFT
         total = limit - ((best >> _SUM_BITS) & limit)
-        lcs = best & limit  # name rank is the node id
-        root = lcs == self.ids[ROOT]
+        common = best & limit  # name rank is the node id
+        through_root = common == root
         nr = depth.astype(np.float64)
         with np.errstate(divide="ignore", invalid="ignore"):
             wu_palmer = 2 * nr / (total + 2 * nr)
-        nodes = np.arange(size)
-        isa_related = ~root & ((lcs == x) | (lcs == nodes))
+        values = np.zeros(size, dtype=np.float64)
+        values[read] = np.where(through_root, 1.0 / (1.0 + total), wu_palmer)
+        isa_related = np.zeros(size, dtype=bool)
+        isa_related[read] = ~through_root & ((common == x) | (common == read))
+        lcs = np.full(size, root, dtype=np.int64)
+        lcs[read] = common
         self._lcs[x] = lcs
-        return np.where(root, 1.0 / (1.0 + total), wu_palmer), isa_related
+        return values, isa_related
+
+    def _read_taxonomy(self) -> tuple[IntArray, IntArray]:
+        """The taxonomy ids vectors are read at (all while none is handed out), and each id's position
+        among them (-1 when not read)."""
+        if self._read_nodes is None:
+            if self._used:
+                read = np.array([i for i in self._read_at() if i < self.taxonomy_size], dtype=np.int64)
+            else:
+                read = np.arange(self.taxonomy_size, dtype=np.int64)
+            position = np.full(self.taxonomy_size, -1, dtype=np.int64)
+            position[read] = np.arange(len(read))
+            self._read_nodes = (read, position)
+        return self._read_nodes
 
     def common_superclasses(self, concept: str) -> IntArray | None:
         """For every taxonomy node, the id of its most specific common superclass with ``concept``
