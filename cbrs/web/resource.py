@@ -17,7 +17,7 @@ from markupsafe import Markup, escape
 from werkzeug.exceptions import BadRequest, HTTPException
 
 from cbrs.kb.errors import KnowledgeBaseError, NotFoundError
-from cbrs.kb.namespaces import OWL, RDF, RDFS, XSD, expand, shorten
+from cbrs.kb.namespaces import OWL, RDF, RDFS, XSD, GraphName, expand, shorten
 from cbrs.web import context
 from cbrs.web.links import iri_link
 from cbrs.web.pages import Page, page, wants_json
@@ -109,7 +109,11 @@ def resource() -> Page:
         "name": shorten(iri),
         "label": label,
         "pages": pages,
-        "counts": {"outgoing": _count(outgoing), "incoming": _count(incoming)},
+        "counts": {
+            "outgoing": _count(outgoing),
+            "incoming": _count(incoming),
+            "entailed": sum(row["graph"].value == GraphName.ENTAILED.iri for row in rows),
+        },
         "outgoing": outgoing,
         "incoming": incoming,
     }
@@ -131,6 +135,8 @@ def _grouped(rows: Iterable[dict[str, Any]]) -> list[dict[str, Any]]:
         groups.setdefault(row["predicate"].value, []).append(
             {"term": term_data(row["other"]), "graph": row["graph"].value}
         )
+    for values in groups.values():  # what the store states first, then what the alignments entail from it
+        values.sort(key=lambda value: value["graph"] == GraphName.ENTAILED.iri)
     order = sorted(groups, key=lambda p: (p != RDF_TYPE, shorten(p).casefold()))
     return [{"predicate": p, "name": shorten(p), "values": groups[p]} for p in order]
 
