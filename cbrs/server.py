@@ -52,6 +52,7 @@ class ServeConfig:
     bridge_connections_per_client: int = field(
         default_factory=lambda: setting("bridge_connections_per_client").resolve()
     )
+    action_workers: int = field(default_factory=lambda: setting("action_workers").resolve())
     component_lease: float = field(default_factory=lambda: setting("component_lease").resolve())
 
 
@@ -70,6 +71,7 @@ class Server:
             token=token,
             reserved=("/cbrs/",),
             connections_per_client=self.config.bridge_connections_per_client,
+            action_workers=self.config.action_workers,
         )
         self.matchmakers = Matchmakers(self.sparql)  # one taxonomy index for the pages and the bridge
         services = KnowledgeServices(self.sparql, self.tasks, self.matchmakers, self.own_origins)

@@ -206,6 +206,14 @@ SETTINGS: tuple[Setting, ...] = (
         _positive(int),
     ),
     Setting(
+        "action_workers",
+        lambda: 4,
+        "Threads that run the bridge's own actions (the /cbrs/run_task action): a goal holds one until it "
+        "ends, so these are apart from the service threads and a long task never delays a service call.",
+        "CBRS_ACTION_WORKERS",
+        _positive(int),
+    ),
+    Setting(
         "component_lease",
         lambda: 3.0,
         "Seconds a component registered live over the bridge stays available without a heartbeat; when "

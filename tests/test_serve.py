@@ -346,3 +346,13 @@ def test_one_long_query_leaves_the_server_answering_others_and_is_stopped_at_its
     finally:
         server.stop()
         kb.close()
+
+
+def test_the_bridge_gets_its_action_workers_from_the_setting(monkeypatch: pytest.MonkeyPatch) -> None:
+    kb = KnowledgeBase.open(":memory:")
+    monkeypatch.setenv("CBRS_ACTION_WORKERS", "2")
+    assert Server(kb, ServeConfig(port=0, bridge_port=0)).bridge.action_workers == 2
+    monkeypatch.setenv("CBRS_ACTION_WORKERS", "none")
+    with pytest.raises(ValueError, match="CBRS_ACTION_WORKERS='none'"):
+        ServeConfig()
+    kb.close()
