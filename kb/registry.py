@@ -10,8 +10,9 @@ import pyoxigraph as ox
 from cbrs.kb.conditions import CONDITION_PARTS, LEGACY_PARTS
 from cbrs.kb.errors import AlreadyRegisteredError, InvalidDescriptionError, NotFoundError
 from cbrs.kb.loader import parse_bytes
-from cbrs.kb.namespaces import BASE, GENID, RDF, GraphName, shorten
+from cbrs.kb.namespaces import BASE, RDF, GraphName, shorten
 from cbrs.kb.shapes import check_descriptions
+from cbrs.kb.skolem import closure
 from cbrs.kb.standard_terms import StandardTerms
 from cbrs.kb.store import Store
 from cbrs.kb.vocab import CBRS
@@ -67,19 +68,7 @@ class ComponentRegistry:
 
     def description_quads(self, iri: str) -> list[ox.Quad]:
         """The advertisement's triples and, recursively, those of its skolemised nodes."""
-        found: list[ox.Quad] = []
-        pending = [ox.NamedNode(iri)]
-        seen = set()
-        while pending:
-            node = pending.pop()
-            if node in seen:
-                continue
-            seen.add(node)
-            for quad in self._store.quads(node, None, None, self._graph):
-                found.append(quad)
-                if isinstance(quad.object, ox.NamedNode) and quad.object.value.startswith(GENID):
-                    pending.append(quad.object)
-        return found
+        return closure([ox.NamedNode(iri)], lambda node: self._store.quads(node, None, None, self._graph))  # type: ignore[arg-type]
 
     def _parse(self, turtle: str | bytes, source: str) -> tuple[list[ox.Quad], list[str]]:
         raw = turtle.encode("utf-8") if isinstance(turtle, str) else turtle

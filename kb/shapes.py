@@ -32,6 +32,7 @@ from cbrs.kb.errors import InvalidDescriptionError
 from cbrs.kb.namespaces import GENID, OWL, RDF, RDFS, XSD, GraphName, shorten
 from cbrs.kb.queries import QueryLibrary
 from cbrs.kb.resources import ontology_dir, query_dir
+from cbrs.kb.skolem import closure, is_skolem, quads_by_subject
 from cbrs.kb.store import Store
 from cbrs.kb.vocab import CBRS
 
@@ -179,37 +180,24 @@ def _undo(store: Store, added: set[ox.Quad], removed: set[ox.Quad]) -> None:
 def _closures(quads: Iterable[ox.Quad]) -> dict[str, list[ox.Quad]]:
     """Each description (a subject with an OWLS model) with its own quads and those of the nodes hanging
     off it (blank or skolemised), as the registry reads a description."""
-    by_subject: dict[Any, list[ox.Quad]] = {}
-    roots: set[ox.NamedNode] = set()
-    for quad in quads:
-        by_subject.setdefault(quad.subject, []).append(quad)
-        subject = quad.subject
-        if quad.predicate.value == CBRS.hasOWLSModel and isinstance(subject, ox.NamedNode) and not _is_inner(subject):
-            roots.add(subject)
-    closures = {}
-    for root in sorted(roots, key=lambda node: node.value):
-        found: list[ox.Quad] = []
-        pending: list[Any] = [root]
-        seen = set()
-        while pending:
-            node = pending.pop()
-            if node in seen:
-                continue
-            seen.add(node)
-            for quad in by_subject.get(node, []):
-                found.append(quad)
-                if _is_inner(quad.object):
-                    pending.append(quad.object)
-        closures[root.value] = found
-    return closures
+    quads = list(quads)
+    roots = {
+        quad.subject
+        for quad in quads
+        if quad.predicate.value == CBRS.hasOWLSModel
+        and isinstance(quad.subject, ox.NamedNode)
+        and not _is_inner(quad.subject)
+    }
+    quads_of = quads_by_subject(quads)
+    return {root.value: closure([root], quads_of, _is_inner) for root in sorted(roots, key=lambda node: node.value)}
 
 
 def _iri(term: Any) -> str:
     return term.value if isinstance(term, ox.NamedNode) else ""
 
 
-def _is_inner(term: Any) -> bool:
-    return isinstance(term, ox.BlankNode) or (isinstance(term, ox.NamedNode) and term.value.startswith(GENID))
+def _is_inner(term: object) -> bool:
+    return isinstance(term, ox.BlankNode) or is_skolem(term)
 
 
 # -- the SHACL shapes ------------------------------------------------------------------------------

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import functools
 import logging
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -34,9 +34,10 @@ import pyoxigraph as ox
 
 from cbrs.kb.conditions import LEGACY_PARTS
 from cbrs.kb.loader import parse_file
-from cbrs.kb.namespaces import CBRS, GENID, OWL, RDF, GraphName
+from cbrs.kb.namespaces import CBRS, OWL, RDF, GraphName
 from cbrs.kb.queries import QueryLibrary
 from cbrs.kb.resources import bundled_files
+from cbrs.kb.skolem import closure, is_skolem, quads_by_subject
 from cbrs.kb.store import Store
 
 __all__ = ["UpgradeReport", "new_terms", "upgrade_store"]
@@ -205,13 +206,13 @@ def _core_changes(store: Store) -> tuple[list[ox.Quad], list[ox.Quad]]:
         return [], []
     core = _bundled(item.path, item.graph)
     graph = item.graph.node
-    terms = {q.subject for q in core if isinstance(q.subject, ox.NamedNode) and not q.subject.value.startswith(GENID)}
+    terms = {q.subject for q in core if isinstance(q.subject, ox.NamedNode) and not is_skolem(q.subject)}
     stored = list(store.quads(graph=graph))
     terms |= {q.subject for q in stored if isinstance(q.subject, ox.NamedNode) and q.subject.value.startswith(CBRS)}
     others = {
         q for i in bundled_files() if i.graph is item.graph and i.path != item.path for q in _bundled(i.path, i.graph)
     }
-    remove = [q for q in _closure(stored, terms) if q not in others]
+    remove = [q for q in closure(terms, quads_by_subject(stored)) if q not in others]
     return remove, list(core)
 
 
@@ -221,33 +222,10 @@ def new_terms(store: Store, quads: Sequence[ox.Quad]) -> list[ox.Quad]:
     does not describe yet. A term the store describes keeps its structures: taken again from a changed
     file, they would come in a second time under other skolem IRIs (the file's digest names them)."""
     described = {q.subject for q in store.quads(graph=quads[0].graph_name)} if quads else set()  # type: ignore[arg-type]
-    flat = [q for q in quads if not _skolem(q.subject) and not _skolem(q.object)]
-    roots = {q.subject for q in quads if isinstance(q.subject, ox.NamedNode) and not _skolem(q.subject)} - described
-    return flat + [q for q in _closure(quads, roots) if _skolem(q.subject) or _skolem(q.object)]
-
-
-def _skolem(term: object) -> bool:
-    return isinstance(term, ox.NamedNode) and term.value.startswith(GENID)
-
-
-def _closure(quads: Iterable[ox.Quad], roots: set[ox.NamedNode]) -> list[ox.Quad]:
-    """The quads about ``roots`` and, recursively, about the skolemised nodes they reach."""
-    by_subject: dict[ox.NamedNode | ox.BlankNode | ox.Triple, list[ox.Quad]] = {}
-    for quad in quads:
-        by_subject.setdefault(quad.subject, []).append(quad)
-    found: list[ox.Quad] = []
-    pending: list[ox.NamedNode] = list(roots)
-    seen: set[ox.NamedNode] = set()
-    while pending:
-        node = pending.pop()
-        if node in seen:
-            continue
-        seen.add(node)
-        for quad in by_subject.get(node, []):
-            found.append(quad)
-            if isinstance(quad.object, ox.NamedNode) and quad.object.value.startswith(GENID):
-                pending.append(quad.object)
-    return found
+    flat = [q for q in quads if not is_skolem(q.subject) and not is_skolem(q.object)]
+    roots = {q.subject for q in quads if isinstance(q.subject, ox.NamedNode) and not is_skolem(q.subject)} - described
+    hanging = closure(roots, quads_by_subject(quads))
+    return flat + [q for q in hanging if is_skolem(q.subject) or is_skolem(q.object)]
 
 
 def _stored(store: Store, quad: ox.Quad) -> bool:
