@@ -453,6 +453,7 @@ class _Extraction:
         self.objective = objective
         self.max_steps = max_steps
         self._explained: set[str] = set()  # vertices whose blocked needs _why has followed
+        self._best: dict[tuple[str, str], dict[str, Edge]] = {}  # see _best_from
         self.steps: dict[int, _Step] = {}
         self.unsatisfied: list[Unsatisfied] = []
         goal_needs = [(SRO, n) for n in graph.needs(SRO)] + [(SRE, n) for n in graph.needs(SRE)]
@@ -756,24 +757,39 @@ class _Extraction:
             for bound in consumer.bindings
             if bound.source == step.id
         ]
+        if not served:
+            return []
         sources = {SRI} | {self.steps[b.source].node for b in step.bindings if b.source is not None}
+        into = [
+            self._best_from(self._goal_node(need) if consumer.id == 0 else consumer.node, need)
+            for consumer, need in served
+        ]
         found: list[tuple[tuple[Any, ...], str]] = []
         for iri in self.trace.levels:
             vertex = self.graph.vertices[iri]
             if iri == step.node or vertex.advertisement is None:
                 continue
             feeds = []
-            for consumer, need in served:
-                target = self._goal_node(need) if consumer.id == 0 else consumer.node
-                edges = [e for e in self.graph.providers(target, need) if e.source == iri]
-                if not edges:
+            for best in into:
+                edge = best.get(iri)
+                if edge is None:
                     break
-                feeds.append(edges[0].similarity)
+                feeds.append(edge.similarity)
             else:
                 fed = all(any(e.source in sources for e in self.graph.providers(iri, need)) for need in vertex.needs)
                 if fed and feeds:
                     found.append(((-min(feeds), vertex.cost, iri), iri))
         return [iri for _, iri in sorted(found)]
+
+    def _best_from(self, target: str, need: Need) -> dict[str, Edge]:
+        """Each provider's most similar edge into ``need`` of ``target`` (every step's alternatives ask)."""
+        key = (target, need.key)
+        best = self._best.get(key)
+        if best is None:
+            best = self._best[key] = {}
+            for edge in self.graph.providers(target, need):  # most similar first
+                best.setdefault(edge.source, edge)
+        return best
 
     def _goal_node(self, need: Need) -> str:
         return SRO if need.role == "input" else SRE

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Literal
 
 import networkx as nx
@@ -51,7 +52,7 @@ class Need:
     concept: str | None = None
     statement: Statement | None = None
 
-    @property
+    @cached_property  # looked up for every edge an extraction considers
     def key(self) -> str:
         return f"{self.role}:{self.name}"
 
@@ -106,6 +107,7 @@ class Matcher:
         self.config = config or MatchConfig()
         self.measure = SemStr(index, self.config)
         self._concepts: dict[tuple[str, str], tuple[Degree, float] | None] = {}
+        self._statements: dict[tuple[Statement, Statement], tuple[Degree, float] | None] = {}
 
     def concept(self, wanted: str, offered: str) -> tuple[Degree, float] | None:
         key = (wanted, offered)
@@ -115,6 +117,12 @@ class Matcher:
         return self._concepts[key]
 
     def statement(self, wanted: Statement, offered: Statement) -> tuple[Degree, float] | None:
+        key = (wanted, offered)
+        if key not in self._statements:  # every composition matches the world state against each precondition
+            self._statements[key] = self._statement(wanted, offered)
+        return self._statements[key]
+
+    def _statement(self, wanted: Statement, offered: Statement) -> tuple[Degree, float] | None:
         degrees = [
             degree_of_match(self.index, w, o)
             for w, o in (
@@ -236,10 +244,17 @@ class ServiceResourceGraph:
         self._into: dict[str, dict[str, list[Edge]]] = {}
         for goal in (SRO, SRE):
             self._into[goal] = {n.key: pool.providers_of(goal, n) for n in self.vertices[goal].needs}
-        # SRI's edges into every vertex that needs what the requirement gives
+        # SRI's edges into every vertex that needs what the requirement gives; an input is met by
+        # outputs only and a precondition by statements only, so each is compared with its kind alone
+        kinds = {
+            (to_goal, role): tuple(o for o in offers if (o.concept is not None) == (role == "input"))
+            for to_goal, offers in ((True, given), (False, given + state))
+            for role in ("input", "precondition")
+        }
         for vertex in self.vertices.values():
-            offered = given if vertex.iri in (SRO, SRE) else given + state
+            to_goal = vertex.iri in (SRO, SRE)
             for need in vertex.needs:
+                offered = kinds[to_goal, need.role]
                 given_edges = [
                     Edge(SRI, vertex.iri, need, o, *m) for o in offered if (m := self.matcher.match(need, o))
                 ]
