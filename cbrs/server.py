@@ -1,7 +1,9 @@
-"""``cbrs serve``: the HTTP app on waitress and the rosbridge websocket, over one knowledge base.
+"""``cbrs serve``: the HTTP app on Granian and the rosbridge websocket, over one knowledge base.
 
 Both listen on ``host`` (loopback by default). Each runs in its own thread; :meth:`Server.stop` closes
-both and waits for them, so Ctrl-C (or SIGTERM) ends the process cleanly.
+both and waits for them, so Ctrl-C (or SIGTERM) ends the process cleanly. HTTP is Granian, a Rust
+server embedded in this process (:mod:`cbrs.http_listener`), in front of an ASGI app that answers plain
+``/sparql`` queries itself and hands every other request to the Flask app (:mod:`cbrs.asgi_front`).
 """
 
 from __future__ import annotations
@@ -14,10 +16,9 @@ from dataclasses import dataclass, field
 from types import FrameType
 from typing import TYPE_CHECKING, Any
 
-from waitress import wasyncore
-from waitress.server import create_server
-
+from cbrs.asgi_front import SparqlFront
 from cbrs.bridge_services import KnowledgeServices, attach
+from cbrs.http_listener import HttpListener, ListenerConfig
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.store import EmbeddedStore, mark_served
 from cbrs.live_components import LiveComponents
@@ -27,7 +28,7 @@ from cbrs.rosbridge.rosout import RosoutHandler
 from cbrs.settings import setting
 from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.tasks import TaskRunner
-from cbrs.web import create_app
+from cbrs.web import create_app, host_names
 from cbrs.web.components import blueprint as components_blueprint
 from cbrs.web.context import StreamSlots
 
@@ -47,6 +48,9 @@ class ServeConfig:
     endpoint: EndpointConfig = field(default_factory=EndpointConfig)
     cors_origins: Sequence[str] = ()
     http_threads: int = 16  # threads answering requests; the streams have their own on top
+    http_io_threads: int = 1  # Granian's Rust threads reading and writing HTTP, off the GIL
+    header_timeout: float = 10.0  # seconds a client may take to send a request's headers, then it is dropped
+    inline_bytes: int = 256 * 1024  # a single scan answered on the loop up to this result size, else on a thread
     stream_limit: int = field(default_factory=lambda: setting("stream_limit").resolve())
     streams_per_client: int = field(default_factory=lambda: setting("streams_per_client").resolve())
     bridge_connections_per_client: int = field(
@@ -87,14 +91,15 @@ class Server:
         self.app.extensions["cbrs.live"] = self.live
         self.app.register_blueprint(components_blueprint)
         self.app.extensions["cbrs.streams"] = StreamSlots(self.config.stream_limit, self.config.streams_per_client)
-        self._http: Any = None
-        self._http_map: dict[int, Any] = {}
-        self._http_thread: threading.Thread | None = None
+        self._http: HttpListener | None = None
+        self._front: SparqlFront | None = None
+        self._names: list[frozenset[str | None] | None] = []
         self._bridge: Any = None
 
     @property
     def http_port(self) -> int:
-        return int(self._http.effective_port)
+        assert self._http is not None, "the server is not listening"
+        return self._http.port
 
     @property
     def bridge_port(self) -> int:
@@ -102,17 +107,28 @@ class Server:
 
     def start(self) -> None:
         """Open both listeners (port 0 picks a free port) and serve in background threads."""
-        self._http = create_server(
-            self.app,
+        self._front = SparqlFront(
+            self.app.wsgi_app,
+            self.sparql,
+            self._host_names,
+            self.app.config["MAX_CONTENT_LENGTH"],
+            threads=self.config.http_threads,
+            wsgi_threads=self.config.http_threads + self.config.stream_limit,
+            inline_bytes=self.config.inline_bytes,
+        )
+        listener = ListenerConfig(
             host=self.config.host,
             port=self.config.port,
-            threads=self.config.http_threads + self.config.stream_limit,
-            map=self._http_map,
-            ident="cbrs",
-            clear_untrusted_proxy_headers=True,
+            io_threads=self.config.http_io_threads,
+            header_timeout=self.config.header_timeout,
         )
-        self._http_thread = threading.Thread(target=self._http.run, name="cbrs-http", daemon=True)
-        self._http_thread.start()
+        self._http = HttpListener(self._front, listener)
+        try:
+            self._http.start()
+        except BaseException:
+            self._http = None
+            self._front.close()
+            raise
         try:
             self._bridge = self.bridge.start(self.config.host, self.config.bridge_port, origins=self.bridge_origins())
         except BaseException:
@@ -140,7 +156,7 @@ class Server:
     def own_origins(self) -> frozenset[str]:
         """The origins this server's pages come from: the address it binds (and, for loopback, the
         loopback names), on its HTTP port. Never taken from a request, so DNS rebinding cannot add one."""
-        if self._http is None:
+        if self._http is None or not self._http.port:
             return frozenset()
         port = self.http_port
         host = f"[{self.config.host}]" if ":" in self.config.host else self.config.host
@@ -190,16 +206,21 @@ class Server:
                 signal.signal(signum, handler)
             self.stop()
 
+    def _host_names(self) -> frozenset[str | None] | None:
+        """The names a request's Host may give (cbrs.web.host_names), fixed once the port is known."""
+        if self._names:
+            return self._names[0]
+        own = self.own_origins()
+        names = host_names(own, frozenset(self.config.cors_origins))
+        if own and self._http is not None and self._http.port:
+            self._names.append(names)
+        return names
+
     def _stop_http(self, timeout: float) -> None:
         if self._http is None:
             return
-        server, self._http = self._http, None
-        server.task_dispatcher.shutdown(timeout=timeout)
-        # Close every socket from the server's own loop thread; the loop ends once its map is empty.
-        try:
-            server.trigger.pull_trigger(lambda: wasyncore.close_all(self._http_map))
-        except OSError as error:  # the loop's wake-up pipe is gone, so the loop cannot be asked: close here
-            log.warning("HTTP loop could not be woken (%s); closing its sockets from this thread", error)
-            wasyncore.close_all(self._http_map, ignore_all=True)
-        if self._http_thread is not None:
-            self._http_thread.join(timeout)
+        listener, self._http = self._http, None
+        listener.stop(timeout)
+        if self._front is not None:
+            self._front.close()
+            self._front = None

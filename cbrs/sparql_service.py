@@ -407,6 +407,29 @@ class SparqlService:
         except FutureTimeout:
             raise QueryTimeoutError(self.config.timeout) from None
 
+    def query_here(
+        self, text: str, accept: str | None, short_format: str | None, client: str | None, budget: int
+    ) -> Answer | None:
+        """Answer ``text`` on the caller's thread if it is a single scan whose result fits in ``budget``
+        bytes; ``None`` if it is not one, or its result grew past ``budget`` (then :meth:`query` it on a
+        thread that may wait). An event loop answers point lookups so, without a thread hand-over, and
+        ``budget`` bounds how long it is kept from its other requests."""
+        self._check_size(text)
+        if not (isinstance(self.kb.store, EmbeddedStore) and is_single_scan(text)):
+            return None
+        graphs = dataset_for(text, None)
+        release = self._admit(client, slot=False)
+        limit = min(budget, self.config.max_result_bytes)
+        try:
+            deadline = time.monotonic() + self.config.timeout
+            return self._evaluate(text, accept, short_format, deadline, graphs, flat=True, limit=limit)
+        except ResultTooLargeError:
+            if limit < self.config.max_result_bytes:
+                return None  # not too large for the endpoint, only for this thread
+            raise
+        finally:
+            release()
+
     def close(self) -> None:
         """Stop the query worker processes and delete their snapshots."""
         if self.processes is not None:
@@ -527,12 +550,13 @@ class SparqlService:
         deadline: float,
         graphs: dict[str, Any],
         flat: bool = False,
+        limit: int | None = None,
     ) -> Answer:
         result: Any = None  # Oxigraph results must be dropped on the thread that made them
         try:
             result = self._run_flat(text, graphs) if flat else self._run(text, graphs)
             media_type = negotiate(isinstance(result, ox.QueryTriples), accept, short_format)
-            writer = _BudgetWriter(self.config.max_result_bytes, deadline, self.config.timeout)
+            writer = _BudgetWriter(limit or self.config.max_result_bytes, deadline, self.config.timeout)
             try:
                 if isinstance(result, ox.QueryTriples):
                     result.serialize(writer, GRAPH_TYPES[media_type])

@@ -1,0 +1,264 @@
+"""The ASGI application ``cbrs serve`` puts on Granian: ``/sparql`` queries here, everything else to Flask.
+
+A point lookup costs Oxigraph some tens of microseconds; under waitress the HTTP server's own Python
+(parsing, threads, the WSGI call) cost ten times that, holding the GIL, so the endpoint did about one
+core's worth of lookups whatever the number of clients. Granian (:mod:`cbrs.http_listener`) reads and
+writes HTTP in Rust, off the GIL, and calls this application on one asyncio loop. It answers the
+request the WSGI hot path (:mod:`cbrs.web.sparql_wsgi`) answers, with the same status, headers and
+body: a ``GET`` or ``HEAD`` whose only parameters are one ``query`` and optionally ``format`` or
+``output``, or a ``POST`` of an ``application/sparql-query`` body with no parameters, from a client that
+sends no ``Origin`` and names this server in ``Host``. A single scan whose result fits in
+``inline_bytes`` is answered on the loop itself (:meth:`SparqlService.query_here`); any other query
+waits on one of ``threads`` threads, so the loop never waits for a query worker. Every other request,
+and any this front is unsure of, goes to the Flask app through a2wsgi's WSGI-to-ASGI adapter, whose
+threads run it as waitress's did.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import functools
+import json
+import logging
+from collections.abc import Awaitable, Callable, Collection, Iterable
+from concurrent.futures import ThreadPoolExecutor
+from typing import Any
+from urllib.parse import parse_qsl, urlsplit
+
+from a2wsgi import WSGIMiddleware
+from a2wsgi.wsgi import WSGIResponder
+from werkzeug.exceptions import InternalServerError
+
+from cbrs.kb.errors import KnowledgeBaseError
+from cbrs.sparql_service import Answer, SparqlService
+
+log = logging.getLogger("cbrs.web")
+
+Scope = dict[str, Any]
+Message = dict[str, Any]
+Receive = Callable[[], Awaitable[Message]]
+Send = Callable[[Message], Awaitable[None]]
+WSGIApp = Callable[[dict[str, Any], Callable[..., Any]], Iterable[bytes]]
+
+_SHORT_FORMAT = ("format", "output")
+_QUERY_TYPE = "application/sparql-query"
+# What every answer of /sparql carries, as the Flask view sends it (cbrs.web.sparql_wsgi._COMMON).
+_COMMON = [
+    (b"vary", b"Accept, Origin"),
+    (b"x-content-type-options", b"nosniff"),
+    (b"referrer-policy", b"same-origin"),
+]
+# The request headers the front reads; a request repeating one of them goes to Flask, which joins them.
+_READ = frozenset({b"host", b"accept", b"origin", b"content-type", b"content-length"})
+
+
+class SparqlFront:
+    """An ASGI app: plain ``/sparql`` queries answered here, every other request handed to ``wsgi_app``."""
+
+    def __init__(
+        self,
+        wsgi_app: WSGIApp,
+        sparql: SparqlService,
+        host_names: Callable[[], Collection[str | None] | None],
+        max_body: int,
+        threads: int = 16,
+        wsgi_threads: int = 24,
+        inline_bytes: int = 256 * 1024,
+    ) -> None:
+        self.sparql = sparql
+        self.host_names = host_names  # the names Host may give, None for any (as cbrs.web._check_host)
+        self.max_body = max_body
+        self.inline_bytes = inline_bytes
+        self.wsgi = _WsgiAdapter(wsgi_app, workers=wsgi_threads)  # type: ignore[arg-type]
+        self._queries = ThreadPoolExecutor(threads, thread_name_prefix="cbrs-sparql")
+
+    def close(self) -> None:
+        """Let the threads end once their request has (new requests no longer arrive)."""
+        self._queries.shutdown(wait=False, cancel_futures=True)
+        self.wsgi.executor.shutdown(wait=False, cancel_futures=True)
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            await self.wsgi(scope, receive, send)
+            return
+        headers = _headers(scope)
+        plain = self._plain_query(scope, headers) if headers is not None else None
+        if headers is None or plain is None:
+            await self.wsgi(scope, receive, send)
+            return
+        text, short, length = plain
+        if length >= 0:  # a POST: the body is the query
+            body = await _read_body(receive)
+            try:
+                text = body.decode("utf-8")
+            except UnicodeDecodeError:  # Flask reads it again and names the error
+                await self.wsgi(scope, _replay(body, receive), send)
+                return
+        client = scope.get("client")
+        status, media_type, content = await self._answer(text, headers.get(b"accept"), short, client and client[0])
+        await _respond(send, scope["method"] == "HEAD", status, media_type, content)
+
+    async def _answer(
+        self, text: str, accept: str | None, short: str | None, client: str | None
+    ) -> tuple[int, str, bytes]:
+        try:
+            answer: Answer | None = self.sparql.query_here(text, accept, short, client, self.inline_bytes)
+            if answer is None:
+                run = functools.partial(self.sparql.query, text, accept, short, client=client)
+                answer = await asyncio.get_running_loop().run_in_executor(self._queries, run)
+        except KnowledgeBaseError as error:  # as cbrs.web's error handler answers a non-page request
+            kind = getattr(error, "kind", type(error).__name__)
+            return error.http_status, "application/json", _json({"error": kind, "message": str(error)})
+        except Exception:
+            log.exception("/sparql failed")
+            message = InternalServerError.description
+            return 500, "application/json", _json({"error": "internal-server-error", "message": message})
+        return 200, answer.media_type + "; charset=utf-8", answer.body
+
+    def _plain_query(self, scope: Scope, headers: dict[bytes, str]) -> tuple[str, str | None, int] | None:
+        """(query, short format, -1) of a GET or HEAD this front answers, ("", None, body length) of such
+        a POST; None for Flask's."""
+        if scope.get("path") != "/sparql" or scope.get("root_path") or b"origin" in headers:
+            return None
+        if not self._host_ok(headers.get(b"host")):
+            return None
+        try:
+            query_string = scope.get("query_string", b"").decode("ascii")
+            parameters = parse_qsl(query_string, keep_blank_values=True, errors="strict")
+        except (UnicodeDecodeError, ValueError):
+            return None
+        method = scope.get("method")
+        if method in ("GET", "HEAD"):
+            names = [name for name, _ in parameters]
+            if names.count("query") != 1 or any(names.count(n) > 1 for n in _SHORT_FORMAT):
+                return None
+            if set(names) - {"query", *_SHORT_FORMAT}:
+                return None
+            values = dict(parameters)
+            return values["query"], values.get("format") or values.get("output"), -1
+        if method == "POST" and not parameters:
+            media_type = headers.get(b"content-type", "").partition(";")[0].strip().lower()
+            try:
+                length = int(headers.get(b"content-length") or "-1")
+            except ValueError:
+                return None
+            if media_type != _QUERY_TYPE or not 0 <= length <= self.max_body:
+                return None
+            return "", None, length
+        return None
+
+    def _host_ok(self, host: str | None) -> bool:
+        names = self.host_names()
+        if names is None:
+            return True
+        if not host:
+            return False
+        try:
+            return urlsplit("//" + host).hostname in names
+        except ValueError:
+            return False
+
+
+class ClientDisconnectedError(OSError):
+    """Raised in a WSGI thread writing to a client that has gone, so that the app's iterable is closed
+    (a stream ends and gives its slot back) instead of writing on into nothing."""
+
+
+class _WsgiAdapter(WSGIMiddleware):
+    """a2wsgi's WSGI-to-ASGI adapter, telling the WSGI app when its client has gone (as waitress did)."""
+
+    async def __call__(self, scope: Any, receive: Any, send: Any) -> None:
+        if scope["type"] != "http":
+            await super().__call__(scope, _coroutine(receive), send)  # type: ignore[arg-type]
+            return
+        await _Responder(self.app, self.executor, self.send_queue_size)(scope, receive, send)
+
+
+class _Responder(WSGIResponder):
+    """One request through the adapter. Granian drops what is sent to a closed connection without a
+    word; its ``http.disconnect`` is the only sign, so a task reads the request's messages as they come
+    (handing the body on to the WSGI app) and notes the disconnect, after which a write raises."""
+
+    gone = False
+
+    async def __call__(self, scope: Any, receive: Any, send: Any) -> None:
+        messages: asyncio.Queue[Message] = asyncio.Queue()
+
+        async def pump() -> None:
+            while True:
+                message = await receive()
+                if message["type"] == "http.disconnect":
+                    self.gone = True
+                await messages.put(message)
+                if message["type"] == "http.disconnect":
+                    return
+
+        reader = self.loop.create_task(pump())
+        try:
+            await super().__call__(scope, messages.get, send)  # type: ignore[arg-type]
+        except ClientDisconnectedError:
+            pass  # nobody to answer
+        finally:
+            reader.cancel()
+
+    def send(self, message: Any) -> None:
+        if self.gone:
+            raise ClientDisconnectedError("the client closed the connection")
+        super().send(message)
+
+
+def _headers(scope: Scope) -> dict[bytes, str] | None:
+    """The headers the front reads, or None when one of them repeats (Flask decides then)."""
+    found: dict[bytes, str] = {}
+    for name, value in scope.get("headers", ()):
+        if name in _READ:
+            if name in found:
+                return None
+            found[name] = value.decode("latin-1")
+    return found
+
+
+async def _read_body(receive: Receive) -> bytes:
+    """The request body (the server holds it to its Content-Length, which the front has checked)."""
+    chunks: list[bytes] = []
+    while True:
+        message = await receive()
+        if message["type"] != "http.request":
+            break
+        chunks.append(message.get("body", b""))
+        if not message.get("more_body", False):
+            break
+    return b"".join(chunks)
+
+
+def _coroutine(receive: Receive) -> Receive:
+    """``receive`` as a coroutine function: Granian's gives an awaitable of its own, which a2wsgi's
+    ``asyncio.run_coroutine_threadsafe`` refuses."""
+
+    async def receive_coroutine() -> Message:
+        return await receive()
+
+    return receive_coroutine
+
+
+def _replay(body: bytes, receive: Receive) -> Receive:
+    """A ``receive`` that gives ``body`` again, then whatever the connection says next."""
+    given = [False]
+
+    async def again() -> Message:
+        if not given[0]:
+            given[0] = True
+            return {"type": "http.request", "body": body, "more_body": False}
+        return await receive()
+
+    return again
+
+
+def _json(value: Any) -> bytes:
+    return (json.dumps(value, separators=(",", ":")) + "\n").encode("utf-8")  # as Flask's jsonify writes it
+
+
+async def _respond(send: Send, head: bool, status: int, media_type: str, body: bytes) -> None:
+    headers = [(b"content-type", media_type.encode("latin-1")), (b"content-length", str(len(body)).encode()), *_COMMON]
+    await send({"type": "http.response.start", "status": status, "headers": headers})
+    await send({"type": "http.response.body", "body": b"" if head else body})

@@ -1,0 +1,143 @@
+"""Granian's embedded server, run on a thread of the cbrs process: the HTTP listener of ``cbrs serve``.
+
+Granian is a Rust HTTP server: hyper reads and writes the connections on its own threads without the
+GIL, and hands each request to an ASGI app (:class:`cbrs.asgi_front.SparqlFront`) on one asyncio loop.
+It runs in the same process as the store because it must: an on-disk Oxigraph store admits one
+process (RocksDB's lock), and Granian embeds in a process only for ASGI (for WSGI it runs worker
+processes). The listener's socket is made before the loop starts, so ``port=0`` gives a known free
+port, and :meth:`HttpListener.stop` ends the server from any thread: it stops accepting, the loop
+ends, and the port is closed when :meth:`stop` returns.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import logging
+import os
+import socket
+import threading
+from dataclasses import dataclass
+from typing import Any
+
+from granian._granian import ListenerSpec
+from granian.constants import HTTPModes, Interfaces
+from granian.http import HTTP1Settings
+from granian.log import LogLevels
+from granian.server.embed import Server as _Embedded
+
+log = logging.getLogger("cbrs.server")
+
+# Granian's own log records go to the root logger (cbrs serve's format), errors only: its
+# default configuration prints every start and stop on stdout, where cbrs serve says it is ready.
+_LOGGING: dict[str, Any] = {
+    "version": 1,
+    "disable_existing_loggers": False,
+    "formatters": {},
+    "handlers": {},
+    "loggers": {"_granian": {"propagate": True}, "granian.access": {"propagate": True}},
+}
+
+
+@dataclass(frozen=True)
+class ListenerConfig:
+    """How the listener treats connections (docs/serving.md, "The HTTP front")."""
+
+    host: str = "127.0.0.1"
+    port: int = 8080
+    io_threads: int = 1  # Rust threads doing the HTTP work; Python runs on the one loop whatever this is
+    header_timeout: float = 10.0  # seconds a client may take to send a request's headers
+    max_header_bytes: int = 64 * 1024  # what one connection may buffer while its headers are read
+    backlog: int = 128  # connections waiting to be accepted; also the requests in Python at once
+
+
+class _Server(_Embedded):
+    """Granian's embedded server with its socket made once, here, and kept: on Linux Granian would
+    make one per worker with SO_REUSEPORT, whose port cannot be learnt when it was 0."""
+
+    def _init_shared_socket(self) -> None:
+        holder = ListenerSpec(self.bind_addr, self.bind_port, self.backlog).build()
+        self._ssp, self._shd, self._sfd = None, holder, holder.get_fd()  # type: ignore[assignment]
+
+
+class HttpListener:
+    """An ASGI app served by Granian on a thread; start, read :attr:`port`, stop."""
+
+    def __init__(self, app: Any, config: ListenerConfig) -> None:
+        self.config = config
+        self._server = _Server(
+            app,
+            address=config.host,
+            port=config.port,
+            interface=Interfaces.ASGINL,
+            http=HTTPModes.http1,
+            websockets=False,  # the rosbridge websocket has its own port and server
+            runtime_threads=config.io_threads,
+            backlog=config.backlog,
+            http1_settings=HTTP1Settings(
+                header_read_timeout=int(config.header_timeout * 1000), max_buffer_size=config.max_header_bytes
+            ),
+            log_level=LogLevels.error,  # its warning that embedding is "experimental" would greet every start
+            log_dictconfig=_LOGGING,
+        )
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._thread: threading.Thread | None = None
+        self._listening = threading.Event()
+        self._failed: BaseException | None = None
+        self.port = 0
+
+    def start(self, timeout: float = 10.0) -> None:
+        """Listen and serve on a thread; returns once the socket is open, raising OSError if it cannot be."""
+        self._thread = threading.Thread(target=self._run, name="cbrs-http", daemon=True)
+        self._thread.start()
+        if not self._listening.wait(timeout) and self._failed is None:
+            self.stop(timeout)
+            raise OSError(f"the HTTP listener did not start within {timeout:g} s")
+        if self._failed is not None:
+            self._thread.join(timeout)
+            raise self._failed
+
+    def stop(self, timeout: float = 10.0) -> None:
+        """Stop accepting, end the loop and close the port; bounded by ``timeout``."""
+        loop, thread = self._loop, self._thread
+        if loop is not None and not loop.is_closed():
+            with contextlib.suppress(RuntimeError):  # the loop ended meanwhile
+                loop.call_soon_threadsafe(self._server.stop)
+        if thread is not None:
+            thread.join(timeout)
+            if thread.is_alive():
+                log.warning("the HTTP listener did not stop within %g s", timeout)
+        self._thread = None
+
+    def _run(self) -> None:
+        loop = asyncio.new_event_loop()
+        asyncio.set_event_loop(loop)
+        self._loop = loop
+        startup = self._server.startup
+
+        def started(*args: Any) -> None:
+            try:
+                startup(*args)  # type: ignore[no-untyped-call]
+                fd: int = self._server._sfd  # type: ignore[assignment]
+                with socket.socket(fileno=os.dup(fd)) as bound:
+                    self.port = int(bound.getsockname()[1])
+            except BaseException as error:
+                self._failed = error
+                raise
+            finally:
+                self._listening.set()
+
+        self._server.startup = started  # type: ignore[method-assign]
+        try:
+            loop.run_until_complete(self._server.serve())
+        except BaseException as error:  # a port taken, a host not ours: start() raises it
+            if not self._listening.is_set():
+                self._failed = error
+                self._listening.set()
+            else:
+                log.exception("the HTTP listener failed")
+        finally:
+            try:
+                loop.run_until_complete(loop.shutdown_asyncgens())
+            finally:
+                loop.close()
