@@ -15,6 +15,7 @@ import numpy as np
 import numpy.typing as npt
 
 from cbrs.kb import Advertisement, EffectiveArea, PartNode, QoSValue, Requirement, Statement
+from cbrs.reasoner.antonyms import opposite
 from cbrs.reasoner.config import MatchConfig
 from cbrs.reasoner.similarity import EntityMeasure, SemStr
 from cbrs.reasoner.spans import span
@@ -108,6 +109,7 @@ class CompiledPool:
         self.tree_ids = {concept: i for i, concept in enumerate(trees)}
         self._layout_trees(list(trees.values()))
         self.statements = list(statements)
+        self._opposites: dict[Statement, npt.NDArray[np.bool_]] = {}
         cid = space.add
         self.s_ids = np.array([cid(s.subject) for s in self.statements], dtype=np.int64)
         self.p_ids = np.array([cid(s.predicate) for s in self.statements], dtype=np.int64)
@@ -122,6 +124,18 @@ class CompiledPool:
         order = sorted(range(len(self.ads)), key=lambda i: self.ads[i].iri)
         self.iri_rank = np.empty(len(self.ads), dtype=np.int64)
         self.iri_rank[order] = np.arange(len(self.ads))
+
+    def opposites(self, wanted: Statement) -> npt.NDArray[np.bool_]:
+        """Per pool statement: is its subject or object named by an antonym of ``wanted``'s
+        (antonyms.opposite)? Kept per requested statement: the pool's statements are few and fixed."""
+        found = self._opposites.get(wanted)
+        if found is None:
+            found = np.array(
+                [opposite(wanted.subject, s.subject) or opposite(wanted.object, s.object) for s in self.statements],
+                dtype=bool,
+            )
+            self._opposites[wanted] = found
+        return found
 
     def filtered(
         self,
@@ -362,11 +376,20 @@ class BatchScorer:
             values = np.asarray(s**cfg.subject_weight * p**cfg.predicate_weight * o**cfg.object_weight, np.float64)
         else:
             values = cfg.subject_weight * s + cfg.predicate_weight * p + cfg.object_weight * o
-        if cfg.disjoint_statements and isinstance(self.measure, SemStr):  # statements.contradiction
+        return np.where(self.contradicts(statement), 0.0, values)
+
+    def contradicts(self, statement: Statement) -> npt.NDArray[np.bool_]:
+        """Per pool statement: does it contradict ``statement`` (statements.contradiction)?"""
+        cfg, pool = self.config, self.pool
+        clash = np.zeros(len(pool.statements), dtype=bool)
+        if not isinstance(self.measure, SemStr):
+            return clash
+        if cfg.disjoint_statements:
             space = pool.space
-            clash = space.disjoint(statement.subject)[pool.s_ids] | space.disjoint(statement.object)[pool.o_ids]
-            values = np.where(clash, 0.0, values)
-        return values
+            clash |= space.disjoint(statement.subject)[pool.s_ids] | space.disjoint(statement.object)[pool.o_ids]
+        if cfg.antonym_statements:
+            clash |= pool.opposites(statement)
+        return clash
 
     def score(self, requirement: Requirement) -> BatchScores:
         pool, cfg = self.pool, self.config
@@ -425,6 +448,9 @@ class BatchScorer:
             denominator += np.where(present, weights[name], 0.0)
         ratio = np.where(denominator > 0, numerator / np.maximum(denominator, 1e-300), 0.0)
         ratio = ratio * (1 - cfg.input_gate + cfg.input_gate * invocable)
+        if requirement.effects and cfg.contradiction_factor < 1:  # statements.contradiction_factor
+            clash = np.max([pool.effects.max(self.contradicts(s).astype(np.float64)) for s in requirement.effects], 0)
+            ratio = np.where(clash > 0, cfg.contradiction_factor * ratio, ratio)
         score = np.round(ratio.astype(np.float64), 6).astype(np.float64)
         return BatchScores(score, parts, *pool.filtered(requirement, self.filters))
 

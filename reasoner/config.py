@@ -44,6 +44,14 @@ class MatchConfig:
     # inherited by subclasses) with the requested one contradicts it: similarity 0, however alike the
     # names or the places in the taxonomy ((Door, hasStatus, Closed) for (Door, hasStatus, Opened)).
     disjoint_statements: bool = True
+    # A statement whose subject or object is named by a WordNet antonym of the requested one's core word
+    # (Closed for Opened, Unlocked for Locked, Off for On; reasoner/antonyms.py) contradicts it too:
+    # similarity 0, for taxonomies that leave such opposite states undeclared siblings.
+    antonym_statements: bool = True
+    # An advertisement with an effect that contradicts a requested effect (above) does the opposite of what
+    # is asked (closes the door it should open): its whole score is multiplied by this factor, so that
+    # matching inputs cannot rank it above services that help. 1 leaves only that statement at 0.
+    contradiction_factor: float = 0.0
     # A requested effect and an advertisement that changes nothing (no effects) but outputs the state the
     # effect is about (DoorState for (Door, hasState, Opened)): a sensing step towards it. Its effects part
     # is observed_state_weight times the best Sem-Str of its outputs with the effect's object or subject.
@@ -102,6 +110,8 @@ class MatchConfig:
             statement_mean="arithmetic",
             lexicon=False,
             disjoint_statements=False,
+            antonym_statements=False,
+            contradiction_factor=1.0,
             complement_weight=0.0,
             unrelated_predicate_factor=1.0,
             observed_state_weight=0.0,
@@ -124,6 +134,7 @@ class MatchConfig:
             "complement_weight",
             "unrelated_predicate_factor",
             "observed_state_weight",
+            "contradiction_factor",
         ):
             value = getattr(self, name)
             if not 0 <= value <= 1:

@@ -39,7 +39,7 @@ from cbrs.reasoner.methods import REFINED, Method, make_method
 from cbrs.reasoner.names import local_name
 from cbrs.reasoner.similarity import SemStr, Similarity
 from cbrs.reasoner.spans import PairMatch, SpanMatch, conceptual_span_similarity, span
-from cbrs.reasoner.statements import StatementMatch, best_statement_matches
+from cbrs.reasoner.statements import StatementMatch, best_statement_matches, contradiction_factor
 from cbrs.reasoner.taxonomy import TaxonomyIndex
 from cbrs.reasoner.text import description_text
 
@@ -288,6 +288,7 @@ class Matchmaker:
         total = sum(weights[name] for name in parts)
         score = sum(weights[name] * value for name, value in parts.items()) / total if total else 0.0
         score *= 1 - cfg.input_gate + cfg.input_gate * (needed if needed is not None else 1.0)
+        score *= contradiction_factor(requirement.effects, ad.effects, self.method.measure, cfg)
         rejected = self.filters(requirement, ad.area, ad.qos)
         if self.method.strict:
             failed = [pair for pair in pairs if pair.role in ("output", "effect") and pair.degree == Degree.FAIL.value]

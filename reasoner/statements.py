@@ -7,8 +7,9 @@ the property hierarchy):
     Sim(R_sup, R_dem) = ws * Sim(s_sup, s_dem) + wp * Sim(p_sup, p_dem) + wo * Sim(o_sup, o_dem)
 
 with ws + wp + wo = 1 (equal by default; see MatchConfig), or the weighted geometric mean. A statement
-whose subject or object is declared disjoint with the requested one contradicts it and scores 0
-(MatchConfig.disjoint_statements; Sem-Str only, which knows the taxonomy).
+whose subject or object is declared disjoint with the requested one, or named by an antonym of it
+(antonyms.py), contradicts it and scores 0 (MatchConfig.disjoint_statements, antonym_statements;
+Sem-Str only).
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import math
 from dataclasses import dataclass
 
 from cbrs.kb import Statement
+from cbrs.reasoner.antonyms import opposite
 from cbrs.reasoner.config import MatchConfig
 from cbrs.reasoner.similarity import EntityMeasure, SemStr, Similarity
 
@@ -48,14 +50,27 @@ def contradiction(
     requested: Statement, advertised: Statement, measure: EntityMeasure, config: MatchConfig
 ) -> str | None:
     """The position ("subject", "object") where ``advertised`` names a class disjoint with the requested
-    one, or None (always None unless MatchConfig.disjoint_statements and the measure is Sem-Str)."""
-    if not config.disjoint_statements or not isinstance(measure, SemStr):
+    one (MatchConfig.disjoint_statements) or its opposite state (MatchConfig.antonym_statements), or
+    None (always None for a measure other than Sem-Str)."""
+    if not isinstance(measure, SemStr):
         return None
-    if measure.index.disjoint(requested.subject, advertised.subject):
-        return "subject"
-    if measure.index.disjoint(requested.object, advertised.object):
-        return "object"
+    for position in ("subject", "object"):
+        wanted, got = getattr(requested, position), getattr(advertised, position)
+        if config.disjoint_statements and measure.index.disjoint(wanted, got):
+            return position
+        if config.antonym_statements and opposite(wanted, got):
+            return position
     return None
+
+
+def contradiction_factor(
+    requested: tuple[Statement, ...], advertised: tuple[Statement, ...], measure: EntityMeasure, config: MatchConfig
+) -> float:
+    """MatchConfig.contradiction_factor when an advertised effect contradicts a requested one, else 1."""
+    if config.contradiction_factor >= 1:
+        return 1.0
+    clash = any(contradiction(wanted, got, measure, config) for wanted in requested for got in advertised)
+    return config.contradiction_factor if clash else 1.0
 
 
 def combine(config: MatchConfig, s: float, p: float, o: float) -> float:

@@ -7,6 +7,8 @@ from pathlib import Path
 import pytest
 
 from cbrs.kb import Advertisement, KnowledgeBase, Parameter, Requirement, Statement, Store
+from cbrs.reasoner.antonyms import DATA_FILE as ANTONYMS
+from cbrs.reasoner.antonyms import forms, opposite
 from cbrs.reasoner.config import MatchConfig
 from cbrs.reasoner.lexicon import DATA_FILE, Lexicon
 from cbrs.reasoner.matchmaker import Matchmaker
@@ -174,7 +176,8 @@ def test_an_effect_that_contradicts_the_requested_one_scores_nothing(defined_kb)
         explained = on.score(wanted, next(a for a in ads if a.iri == candidate.advertisement))
         assert candidate.score == explained.score == 0.0
         assert "contradicts" in explained.pairs[0].how
-    off = Matchmaker(defined_kb, config=MatchConfig(disjoint_statements=False), index=index, advertisements=ads)
+    config = MatchConfig(disjoint_statements=False, antonym_statements=False)
+    off = Matchmaker(defined_kb, config=config, index=index, advertisements=ads)
     assert off.score(wanted, ads[0]).parts["effects"] > 0.5  # Closed and Opened: siblings, alike by the taxonomy
     assert Matchmaker(defined_kb, "wu-palmer", index=index, advertisements=ads).config.disjoint_statements is False
 
@@ -228,3 +231,36 @@ def test_a_statement_with_another_relation_states_another_fact() -> None:
     for candidate in matcher.rank(requirement, explain=0).candidates:  # the batch agrees with the scalar path
         ad = next(x for x in ads if x.iri == candidate.advertisement)
         assert candidate.score == matcher.score(requirement, ad).score
+
+
+@pytest.mark.skipif(not ANTONYMS.exists(), reason=f"no bundled WordNet antonyms at {ANTONYMS}")
+def test_opposite_states_are_known_by_their_names() -> None:
+    assert forms("Opened".lower()) >= {"open", "opened"} and "stop" in forms("stopped")
+    assert opposite(E + "Opened", E + "Closed") and opposite(E + "Closed", E + "Opened")
+    assert opposite(E + "LightOn", E + "LightOff") and opposite(E + "DoorLocked", E + "Unlocked")
+    assert not opposite(E + "Opened", E + "Locked") and not opposite(E + "Position", E + "Location")
+    assert not opposite(E + "Opened", E + "FullyOpened")
+
+
+@pytest.mark.skipif(not ANTONYMS.exists(), reason=f"no bundled WordNet antonyms at {ANTONYMS}")
+def test_an_offer_that_does_the_opposite_of_what_is_asked_scores_nothing() -> None:
+    # No disjointness declared (the states are not even in the taxonomy): the names say Closed undoes Opened.
+    def door(state: str) -> tuple[Statement, ...]:
+        return (Statement(E + "Door", E + "hasState", E + state),)
+
+    wanted = Requirement(E + "OpenTheDoor", (), inputs=(_p("input", "Position"),), effects=door("Opened"))
+    closer = Advertisement(E + "CloseDoor", (), inputs=(_p("input", "Position"),), effects=door("Closed"))
+    ajar = Advertisement(E + "PushDoor", (), inputs=(_p("input", "Location"),), effects=door("Ajar"))
+    kb = KnowledgeBase(Store.open(":memory:"))
+    on = Matchmaker(kb, index=positions(), advertisements=[closer, ajar])
+    ranked = on.rank(wanted, explain=0).candidates
+    assert [c.advertisement for c in ranked] == [E + "PushDoor", E + "CloseDoor"]
+    explained = on.score(wanted, closer)
+    assert ranked[1].score == explained.score == 0.0  # batch and scalar agree
+    assert explained.parts["effects"] == 0.0 and "contradicts" in explained.pairs[-1].how
+    kept = Matchmaker(kb, config=MatchConfig(contradiction_factor=1.0), index=positions(), advertisements=[closer])
+    assert kept.rank(wanted, explain=0).candidates[0].score == kept.score(wanted, closer).score > 0.3  # its inputs
+    names_off = MatchConfig(antonym_statements=False)
+    off = Matchmaker(kb, config=names_off, index=positions(), advertisements=[closer])
+    assert off.score(wanted, closer).parts["effects"] > 0.3  # Jaro-Winkler: closed and opened share letters
+    assert Matchmaker(kb, "wu-palmer", index=positions(), advertisements=[closer]).config.contradiction_factor == 1
