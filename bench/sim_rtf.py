@@ -2,6 +2,7 @@
 the same scene alone.
 
 Run: python bench/sim_rtf.py [--tasks RobotArmServeACup,FetchMyPen] [--seeds 0,1,2] [--profile N] [--json FILE]
+                              [--digests FILE] [--check FILE]
 
 For each task and seed, a world is built from the store's semantic map (as ``cbrs run`` builds it;
 not timed), then:
@@ -20,18 +21,28 @@ The same ratio on this thread's CPU time is printed too: on a machine shared wit
 moves less than the wall-clock one (pybullet's DIRECT client steps and renders on this thread).
 ``--profile N`` also runs the tasks once under cProfile and prints the N functions with the most
 time of their own. ``--json FILE`` writes the rows as a list of records.
+
+Every run also gets a digest of what it did, so that a change made for speed can be shown to leave
+the runs as they were: SHA-256 over every observation written to the world graph (the belief after
+each step: types, relations, positions, time), the run's report (``RunResult.to_dict``), the poses of
+everything that moves, every moving joint's angle, the water in each container and spilled, and who
+holds what. The frames taken are counted beside it but not in it (a cost, not an outcome).
+``--digests FILE`` writes them (task, seed -> digest); ``--check FILE`` compares them with such a file
+and exits with status 1 if any differs.
 """
 
 from __future__ import annotations
 
 import argparse
 import cProfile
+import hashlib
 import io
 import json
 import os
 import platform
 import pstats
 import statistics
+import sys
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -42,8 +53,9 @@ from typing import Any
 
 import pybullet as p
 
+from cbrs.actions.belief import BeliefState, Observation
 from cbrs.actions.composer import Composer
-from cbrs.actions.runner import run_task
+from cbrs.actions.runner import RunResult, run_task
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.semantic_map import SemanticMap
 from cbrs.sim.components import SimEnvironment
@@ -66,6 +78,8 @@ class Sample:
     alone: float  # wall seconds pybullet took for the same number of steps alone
     cpu: float  # this thread's CPU seconds for the task, composing left out
     cpu_alone: float
+    digest: str = ""
+    frames: int = 0  # images rendered (a camera asked again with nothing changed renders none)
 
     @property
     def cpu_ratio(self) -> float:
@@ -102,6 +116,51 @@ def composing_time() -> Iterator[list[float]]:
         Composer.compose = original  # type: ignore[method-assign]
 
 
+@contextmanager
+def observations() -> Iterator[list[Observation]]:
+    """Keep every observation written to the world graph (the belief after each step) in the yielded list."""
+    written: list[Observation] = []
+    original = BeliefState.write
+
+    def keep(self: BeliefState, observation: Observation) -> None:
+        written.append(observation)
+        original(self, observation)
+
+    BeliefState.write = keep  # type: ignore[method-assign]
+    try:
+        yield written
+    finally:
+        BeliefState.write = original  # type: ignore[method-assign]
+
+
+def digest(world: HomeWorld, result: RunResult, written: list[Observation]) -> str:
+    """SHA-256 of what a run did: its beliefs, its report and the world's end state (floats exact)."""
+    beliefs = [
+        [sorted(o.types.items()), sorted(o.facts), sorted((k, list(v)) for k, v in o.positions.items()), o.time]
+        for o in written
+    ]
+    client = world.client
+    joints = {
+        name: [
+            s[0]
+            for s in p.getJointStates(body, range(p.getNumJoints(body, physicsClientId=client)), physicsClientId=client)
+        ]
+        for name, body in sorted(world.bodies.items())
+        if p.getNumJoints(body, physicsClientId=client)
+    }
+    state = {
+        "beliefs": beliefs,
+        "report": result.to_dict(),
+        "poses": {name: [list(pose.position), list(pose.orientation)] for name, pose in world.snapshot().items()},
+        "joints": joints,
+        "water": sorted(world.water.items()),
+        "spilled": world.water_spilled,
+        "holders": sorted(world.holders.items()),
+    }
+    text = json.dumps(state, sort_keys=True, default=repr)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
 def step_alone(world: HomeWorld, steps: int) -> tuple[float, float]:
     """Wall and CPU seconds pybullet takes for ``steps`` steps of the world with nothing else running."""
     client = world.client
@@ -115,18 +174,23 @@ def run_one(kb: KnowledgeBase, smap: SemanticMap, composer: Composer, task: str,
     world = HomeWorld.create(seed=seed, semantic_map=smap)
     try:
         steps0 = world.steps
-        with composing_time() as spent:
+        with composing_time() as spent, observations() as written:
             start, cpu = time.perf_counter(), time.thread_time()
-            result = run_task(kb, task, SimEnvironment(world, kb), composer=composer)
+            environment = SimEnvironment(world, kb)
+            result = run_task(kb, task, environment, composer=composer)
             wall, cpu = time.perf_counter() - start, time.thread_time() - cpu
         steps = world.steps - steps0
+        outcome = digest(world, result, written)
+        frames = sum(getattr(camera, "renders", 0) for camera in world.cameras.values())
     finally:
         world.close()
     with HomeWorld.create(seed=seed, semantic_map=smap) as fresh:
         alone, cpu_alone = step_alone(fresh, steps)
     status = result.report.status.value if result.report else "no plan"
     simulated = steps * world.time_step
-    return Sample(task, seed, status, steps, simulated, wall, spent[0], alone, cpu - spent[1], cpu_alone)
+    return Sample(
+        task, seed, status, steps, simulated, wall, spent[0], alone, cpu - spent[1], cpu_alone, outcome, frames
+    )
 
 
 def profile(kb: KnowledgeBase, smap: SemanticMap, composer: Composer, tasks: list[str], top: int) -> str:
@@ -150,6 +214,8 @@ def main() -> None:
     parser.add_argument("--seeds", default="0,1,2")
     parser.add_argument("--profile", type=int, default=0, metavar="N", help="print the N costliest functions")
     parser.add_argument("--json", type=Path, help="also write the rows to FILE as a list of records")
+    parser.add_argument("--digests", type=Path, help="write each run's outcome digest to FILE (JSON)")
+    parser.add_argument("--check", type=Path, help="compare the runs' digests with FILE; exit 1 if any differs")
     args = parser.parse_args()
     tasks = args.tasks.split(",")
     seeds = [int(s) for s in args.seeds.split(",")]
@@ -165,7 +231,7 @@ def main() -> None:
 
     print(
         f"{'task':<18} {'seed':>4} {'status':>10} {'steps':>6} {'sim s':>6} {'run s':>6} {'plan s':>6} "
-        f"{'alone s':>7} {'RTF':>6} {'alone':>6} {'ratio':>6} {'CPU ratio':>9}"
+        f"{'alone s':>7} {'RTF':>6} {'alone':>6} {'ratio':>6} {'CPU ratio':>9} {'frames':>6}  digest"
     )
     samples: list[Sample] = []
     for task in tasks:
@@ -175,7 +241,7 @@ def main() -> None:
             print(
                 f"{task:<18} {seed:>4} {s.status:>10} {s.steps:>6} {s.simulated:>6.1f} {s.wall:>6.2f} "
                 f"{s.composing:>6.2f} {s.alone:>7.2f} {s.factor:>6.1f} {s.anchor:>6.1f} {s.factor / s.anchor:>6.2f} "
-                f"{s.cpu_ratio:>9.2f}"
+                f"{s.cpu_ratio:>9.2f} {s.frames:>6}  {s.digest}"
             )
 
     records = [row(f"{task}, headless", [s for s in samples if s.task == task]) for task in tasks]
@@ -195,6 +261,20 @@ def main() -> None:
     if args.json is not None:
         args.json.write_text(json.dumps(records, indent=2) + "\n", encoding="utf-8")
         print(f"written to {args.json}")
+    digests = {f"{s.task} {s.seed}": s.digest for s in samples}
+    if args.digests is not None:
+        args.digests.write_text(json.dumps(digests, indent=2) + "\n", encoding="utf-8")
+        print(f"digests written to {args.digests}")
+    if args.check is not None:
+        expected = json.loads(args.check.read_text(encoding="utf-8"))
+        differ = sorted(key for key, value in digests.items() if key in expected and expected[key] != value)
+        compared = sum(key in expected for key in digests)
+        print(
+            f"digests: {compared - len(differ)} of {compared} runs as in {args.check}"
+            + (f"; differ: {differ}" if differ else "")
+        )
+        if differ:
+            sys.exit(1)
 
 
 def row(name: str, samples: list[Sample]) -> dict[str, Any]:

@@ -30,9 +30,11 @@ __all__ = [
     "HOME_CONFIGURATIONS",
     "REACH_TOLERANCE",
     "Arm",
+    "ArmDetail",
     "ArmSide",
     "Kinematics",
     "MotionResult",
+    "panda_urdf",
 ]
 
 
@@ -44,6 +46,28 @@ class ArmSide(StrEnum):
 PYBULLET_DATA = str(files("pybullet_data"))
 """Where pybullet_data's models are (the Panda arm)."""
 PANDA_URDF = "franka_panda/panda.urdf"
+
+
+class ArmDetail(StrEnum):
+    """Which visual meshes the arms are drawn with; physics is the same for both (same URDF, same
+    collision meshes, same inertias).
+
+    * ``reduced``: ``sim/meshes/panda_lod``, about 10,500 triangles an arm, decimated offline from
+      pybullet_data's meshes by ``tools/panda_lod.py``; a camera frame takes 20-40 ms instead of 50-75.
+    * ``full``: pybullet_data's own, about 102,000 triangles an arm (smoother in close-ups).
+    """
+
+    REDUCED = "reduced"
+    FULL = "full"
+
+
+def panda_urdf(detail: ArmDetail | str = ArmDetail.REDUCED) -> str:
+    """The Panda arm's URDF for a level of visual detail: an absolute path, or pybullet_data's name."""
+    if ArmDetail(detail) is ArmDetail.FULL:
+        return PANDA_URDF
+    return str(files("cbrs.sim") / "meshes" / "panda_lod" / "panda.urdf")
+
+
 ARM_JOINTS = (0, 1, 2, 3, 4, 5, 6)
 FINGER_JOINTS = (9, 10)
 EE_LINK = 11
@@ -148,7 +172,8 @@ class Kinematics:
         try:
             p.setAdditionalSearchPath(PYBULLET_DATA, physicsClientId=self.client)
             self._bodies = {
-                side: p.loadURDF(PANDA_URDF, pos, orn, useFixedBase=True, physicsClientId=self.client)
+                # it never renders: the reduced meshes only make it quicker to load
+                side: p.loadURDF(panda_urdf(), pos, orn, useFixedBase=True, physicsClientId=self.client)
                 for side, (pos, orn) in mounts.items()
             }
             self._obstacles = [self._box(region) for region in obstacles]

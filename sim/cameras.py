@@ -169,6 +169,8 @@ class Camera:
         )
         self._scene = scene
         self._last: tuple[Hashable, Frame] | None = None
+        self.renders = 0
+        """How many images this camera rendered (a capture answered from the last frame renders none)."""
 
     def capture(self) -> Frame:
         """Render one RGB-D frame of the world as it is now."""
@@ -179,6 +181,7 @@ class Camera:
             return _copy(self._last[1])
         s = self.spec
         rgba, zbuffer = render(self._client, s.width, s.height, self._view, self._projection)
+        self.renders += 1
         rgb = np.ascontiguousarray(np.reshape(np.asarray(rgba, dtype=np.uint8), (s.height, s.width, 4))[:, :, :3])
         z = np.reshape(np.asarray(zbuffer, dtype=np.float64), (s.height, s.width))
         depth = (s.far * s.near / (s.far - (s.far - s.near) * z)).astype(np.float32)

@@ -104,44 +104,62 @@ class PerceivedWorld(Judge):
         self.loaded = loaded
 
     def look(self, objects: Iterable[str] | None = None, people: bool = True) -> None:
-        """Take an image with every working camera that may see what is looked for, and update the
-        belief of ``objects`` (body names; all by default) and, with ``people``, of the people."""
+        """Update the belief of ``objects`` (body names; all by default) and, with ``people``, of the
+        people, from the working cameras that may see them.
+
+        An object's belief comes from the preferred camera that finds it: the cameras are asked in
+        reverse name order (Kinect01, CeilingCamera02, CeilingCamera01 in the bundled home) and the
+        first that finds the object decides; a camera is rendered only when it is asked. A person's
+        comes from the camera looking down that sees most of their shirt, so all those are rendered.
+        """
         self.feel()
         names = sorted(self.world.objects) if objects is None else sorted(set(objects))
         names = [name for name in names if self._holding_arm(name) is None]  # the hand knows better
+        cameras = [self.world.cameras[name] for name in sorted(self.world.cameras)]
+        frames: dict[str, Frame | None] = {}
+        for name in names:
+            for camera in reversed(cameras):
+                if camera.failed or not self._may_see(camera, name):
+                    continue
+                frame = self._frame(camera, frames)
+                if frame is not None and self._find(frame, name):
+                    break
+        if not people:
+            return
         found_people: dict[str, tuple[int, Sighting]] = {}
-        for camera in (self.world.cameras[name] for name in sorted(self.world.cameras)):
-            if camera.failed:
+        for camera in cameras:
+            frame = self._frame(camera, frames) if not camera.failed and _looks_down(camera) else None
+            if frame is None:
                 continue
-            wanted = [name for name in names if self._may_see(camera, name)]
-            see_people = people and _looks_down(camera)
-            if not wanted and not see_people:
-                continue
-            try:
-                frame = camera.capture()
-            except SimulationError:
-                continue
-            self.frames += 1
-            for name in wanted:
-                self._find(frame, name)
-            if see_people:
-                for person in self.world.map.people.values():
-                    try:
-                        estimate = track_person(frame, person.colour)
-                    except SimulationError:
-                        continue
-                    sighting = Sighting((estimate.x, estimate.y, 0.0), camera.spec.name, frame.time)
-                    if estimate.pixels > found_people.get(person.name, (0, sighting))[0]:
-                        found_people[person.name] = (estimate.pixels, sighting)
+            for person in self.world.map.people.values():
+                try:
+                    estimate = track_person(frame, person.colour)
+                except SimulationError:
+                    continue
+                sighting = Sighting((estimate.x, estimate.y, 0.0), camera.spec.name, frame.time)
+                if estimate.pixels > found_people.get(person.name, (0, sighting))[0]:
+                    found_people[person.name] = (estimate.pixels, sighting)
         for name, (_, sighting) in found_people.items():
             self.people[name] = sighting
+
+    def _frame(self, camera: Camera, frames: dict[str, Frame | None]) -> Frame | None:
+        """The camera's image for this look, taken the first time it is asked for (None if it fails)."""
+        if camera.name not in frames:
+            try:
+                frames[camera.name] = camera.capture()
+                self.frames += 1
+            except SimulationError:
+                frames[camera.name] = None
+        return frames[camera.name]
 
     def position(self, name: str) -> Vec3 | None:
         """Where an object is believed to be (its centre), if anywhere."""
         sighting = self.objects.get(name)
         return sighting.position if sighting is not None else None
 
-    def _find(self, frame: Frame, name: str) -> None:
+    def _find(self, frame: Frame, name: str) -> bool:
+        """Look for an object in a frame near where it is believed to be (anywhere, if its colour is its
+        own and it is not there); whether it was found, and then the belief is what the frame shows."""
         obj = self.world.objects[name]
         prior = self.objects.get(name)
         near = prior.position[:2] if prior is not None else (obj.start.x, obj.start.y)
@@ -154,7 +172,8 @@ class PerceivedWorld(Judge):
             self.objects[name] = Sighting(estimate.position, frame.camera, frame.time)
             if name in self.world.containers and self.water_colour is not None:
                 self._see_water(frame, name, estimate.position)
-            return
+            return True
+        return False
 
     def _see_water(self, frame: Frame, name: str, centre: Vec3) -> None:
         assert self.water_colour is not None

@@ -21,7 +21,7 @@ from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import Arm as ArmSpec
 from cbrs.kb.semantic_map import Box, Dispenser, MapObject, MobileRobot, SemanticMap, Thing
 from cbrs.sim import layout as L
-from cbrs.sim.arms import PYBULLET_DATA, Arm, ArmSide, Kinematics
+from cbrs.sim.arms import PYBULLET_DATA, Arm, ArmDetail, ArmSide, Kinematics, panda_urdf
 from cbrs.sim.base import MobileBase
 from cbrs.sim.cameras import Camera
 from cbrs.sim.errors import UnknownEntityError, WorldClosedError
@@ -155,11 +155,14 @@ class HomeWorld:
         time_step: float,
         semantic_map: SemanticMap | None = None,
         spread: Spread = Spread(),
+        arm_detail: ArmDetail | str = ArmDetail.REDUCED,
     ) -> None:
         self.client = client
         self.seed = seed
         self.gui = gui
         self.time_step = time_step
+        self.arm_detail = ArmDetail(arm_detail)
+        """The arms' visual meshes, for every camera and recording of this world (``ArmDetail``)."""
         self.map = semantic_map if semantic_map is not None else bundled_map()
         self.objects: dict[str, MapObject] = {obj.name: obj for obj in self.map.objects.values()}
         """The movable objects by body name (the local name of their IRI)."""
@@ -215,13 +218,15 @@ class HomeWorld:
         time_step: float = TIME_STEP,
         semantic_map: SemanticMap | None = None,
         spread: Spread = Spread(),
+        arm_detail: ArmDetail | str = ArmDetail.REDUCED,
     ) -> HomeWorld:
         """Connect a new pybullet client (DIRECT unless ``gui``) and build the home of ``semantic_map`` in
-        it (the bundled map by default)."""
+        it (the bundled map by default). ``arm_detail`` picks the arms' visual meshes (``ArmDetail``:
+        reduced, the default, or full); physics is the same with either."""
         with quiet_output():
             client = p.connect(p.GUI if gui else p.DIRECT)
         try:
-            return cls(client, seed, gui, time_step, semantic_map, spread)
+            return cls(client, seed, gui, time_step, semantic_map, spread, arm_detail)
         except BaseException:
             p.disconnect(physicsClientId=client)
             raise
@@ -683,7 +688,7 @@ class HomeWorld:
         for side in ArmSide:
             mount, orientation = mounts[side]
             body = p.loadURDF(
-                "franka_panda/panda.urdf",
+                panda_urdf(self.arm_detail),
                 mount,
                 orientation,
                 useFixedBase=True,
@@ -823,10 +828,14 @@ def _half_and_centre(region: Region) -> tuple[Vec3, Vec3]:
 
 @contextmanager
 def open_world(
-    seed: int = 0, gui: bool = False, semantic_map: SemanticMap | None = None, spread: Spread = Spread()
+    seed: int = 0,
+    gui: bool = False,
+    semantic_map: SemanticMap | None = None,
+    spread: Spread = Spread(),
+    arm_detail: ArmDetail | str = ArmDetail.REDUCED,
 ) -> Iterator[HomeWorld]:
     """``with open_world(seed) as world:`` builds a world and always disconnects it."""
-    world = HomeWorld.create(seed, gui, semantic_map=semantic_map, spread=spread)
+    world = HomeWorld.create(seed, gui, semantic_map=semantic_map, spread=spread, arm_detail=arm_detail)
     try:
         yield world
     finally:
