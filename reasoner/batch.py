@@ -346,10 +346,23 @@ class BatchScorer:
         per = []
         for effect in effects:
             terms = np.zeros(len(pool.space), dtype=np.float64)
-            for term in (effect.object, effect.subject):
-                terms = np.maximum(terms, np.where(self._related_to(term), self._vector(term), 0.0))
+            if self.config.observed_state_kind:  # statements.reported: a strict superclass of the object
+                kinds = self._kinds_of(effect.object)
+                terms = np.where(kinds, self._vector(effect.object), 0.0)
+            else:
+                for term in (effect.object, effect.subject):
+                    terms = np.maximum(terms, np.where(self._related_to(term), self._vector(term), 0.0))
             per.append(pool.outputs.max(terms[pool.root_ids]))
         return np.asarray(np.mean(per, axis=0), dtype=np.float64)
+
+    def _kinds_of(self, concept: str) -> npt.NDArray[np.bool_]:
+        """For every concept id: is it a strict is-a superclass of ``concept``?"""
+        space = self.pool.space
+        kinds = np.zeros(len(space), dtype=bool)
+        if concept in space.index:
+            above = [space.ids[a] for a, links in space.index.is_a_ancestors(concept).items() if links > 0]
+            kinds[above] = True
+        return kinds
 
     def _related_to(self, concept: str) -> npt.NDArray[np.bool_]:
         """For every concept id: is it ``concept``, an is-a descendant or an is-a ancestor of it?"""

@@ -56,6 +56,12 @@ class MatchConfig:
     # effect is about (DoorState for (Door, hasState, Opened)): a sensing step towards it. Its effects part
     # is observed_state_weight times the best Sem-Str of its outputs with the effect's object or subject.
     observed_state_weight: float = 0.5
+    # Which outputs report the requested state: True, only a kind of the requested value (a strict is-a
+    # superclass of the effect's object: DoorState for Opened, Room for Kitchen); a service that outputs the
+    # object itself produces it (a speech recogniser outputs the SpeechText a person should hear) and one that
+    # outputs the subject finds it (a door detector). False: the object, the subject or an is-a relative of
+    # either (the first rule).
+    observed_state_kind: bool = True
     # How the parts of a match combine; parts the requirement does not state are left out and the
     # remaining weights renormalised.
     output_weight: float = 0.4

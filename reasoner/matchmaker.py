@@ -39,7 +39,7 @@ from cbrs.reasoner.methods import REFINED, Method, make_method
 from cbrs.reasoner.names import local_name
 from cbrs.reasoner.similarity import SemStr, Similarity
 from cbrs.reasoner.spans import PairMatch, SpanMatch, conceptual_span_similarity, span
-from cbrs.reasoner.statements import StatementMatch, best_statement_matches, contradiction_factor
+from cbrs.reasoner.statements import StatementMatch, best_statement_matches, contradiction_factor, reported
 from cbrs.reasoner.taxonomy import TaxonomyIndex
 from cbrs.reasoner.text import description_text
 
@@ -439,13 +439,19 @@ class Matchmaker:
         self, effects: tuple[Statement, ...], outputs: tuple[Parameter, ...], pairs: list[EntityPair]
     ) -> float:
         """An advertisement that changes nothing but outputs the state a requested effect is about: each
-        effect's best Sem-Str of an output that is its object or subject, or an is-a relative of either,
-        times observed_state_weight."""
+        effect's best Sem-Str of an output that reports one of its terms (statements.reported), times
+        observed_state_weight."""
         measure, weight = self.method.measure, self.config.observed_state_weight
         values = []
         for effect in effects:
             found = [
-                (measure(out.type, term) if self._related(out.type, term) else _UNRELATED, out.type, term)
+                (
+                    measure(out.type, term)
+                    if term in reported(self.index, self.config, out.type, effect)
+                    else _UNRELATED,
+                    out.type,
+                    term,
+                )
                 for out in outputs
                 for term in (effect.object, effect.subject)
             ]

@@ -21,6 +21,7 @@ from cbrs.kb import Statement
 from cbrs.reasoner.antonyms import opposite
 from cbrs.reasoner.config import MatchConfig
 from cbrs.reasoner.similarity import EntityMeasure, SemStr, Similarity
+from cbrs.reasoner.taxonomy import TaxonomyIndex
 
 
 @dataclass(frozen=True)
@@ -71,6 +72,27 @@ def contradiction_factor(
         return 1.0
     clash = any(contradiction(wanted, got, measure, config) for wanted in requested for got in advertised)
     return config.contradiction_factor if clash else 1.0
+
+
+def reported(index: TaxonomyIndex, config: MatchConfig, output: str, effect: Statement) -> tuple[str, ...]:
+    """The terms of a requested ``effect`` that an advertised ``output`` reports, for a service that changes
+    nothing (MatchConfig.observed_state_weight, observed_state_kind)."""
+    if config.observed_state_kind:
+        above = output in index and effect.object in index
+        links = index.is_a_ancestors(effect.object).get(index.canonical(output)) if above else None
+        return (effect.object,) if links else ()  # 0 links: the object itself
+    return tuple(term for term in (effect.object, effect.subject) if _is_a_related(index, output, term))
+
+
+def _is_a_related(index: TaxonomyIndex, first: str, second: str) -> bool:
+    """The same concept, or one a subclass of the other (is-a links)."""
+    if first == second:
+        return True
+    if first not in index or second not in index:
+        return False
+    return index.canonical(first) in index.is_a_ancestors(second) or index.canonical(second) in index.is_a_ancestors(
+        first
+    )
 
 
 def combine(config: MatchConfig, s: float, p: float, o: float) -> float:

@@ -264,3 +264,24 @@ def test_an_offer_that_does_the_opposite_of_what_is_asked_scores_nothing() -> No
     off = Matchmaker(kb, config=names_off, index=positions(), advertisements=[closer])
     assert off.score(wanted, closer).parts["effects"] > 0.3  # Jaro-Winkler: closed and opened share letters
     assert Matchmaker(kb, "wu-palmer", index=positions(), advertisements=[closer]).config.contradiction_factor == 1
+
+
+def test_only_a_kind_of_the_requested_value_reports_it(defined_kb) -> None:  # type: ignore[no-untyped-def]
+    # DoorState is what a door state detector outputs; an output that is the value itself (Opened) or the
+    # subject (Door) is something the service produces or finds, not the state it observes.
+    wanted = Requirement(M + "OpenTheDoor", (), effects=(Statement(M + "Door", M + "hasState", M + "Opened"),))
+    ads = [
+        Advertisement(M + f"Gives{c}", (), outputs=(Parameter(M + f"out{c}", "output", M + c),))
+        for c in ("DoorState", "Opened", "Door")
+    ]
+    index = TaxonomyIndex.from_kb(defined_kb)
+    matcher = Matchmaker(defined_kb, index=index, advertisements=ads)
+    ranked = {c.advertisement: c for c in matcher.rank(wanted, explain=0).candidates}
+    for ad in ads:
+        assert ranked[ad.iri].score == matcher.score(wanted, ad).score  # batch and scalar agree
+    assert ranked[M + "GivesDoorState"].parts["effects"] > 0
+    assert ranked[M + "GivesOpened"].parts["effects"] == ranked[M + "GivesDoor"].parts["effects"] == 0.0
+    old = Matchmaker(defined_kb, config=MatchConfig(observed_state_kind=False), index=index, advertisements=ads)
+    old_ranked = {c.advertisement: c for c in old.rank(wanted, explain=0).candidates}
+    assert old_ranked[M + "GivesOpened"].parts["effects"] == MatchConfig().observed_state_weight
+    assert old.score(wanted, ads[1]).score == old_ranked[M + "GivesOpened"].score
