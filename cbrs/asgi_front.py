@@ -23,7 +23,7 @@ import logging
 from collections.abc import Awaitable, Callable, Collection, Iterable
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
-from urllib.parse import parse_qsl, urlsplit
+from urllib.parse import unquote_plus, urlsplit
 
 from a2wsgi import WSGIMiddleware
 from a2wsgi.wsgi import WSGIResponder
@@ -64,12 +64,16 @@ class SparqlFront:
         threads: int = 16,
         wsgi_threads: int = 24,
         inline_bytes: int = 256 * 1024,
+        body_timeout: float = 30.0,
     ) -> None:
         self.sparql = sparql
         self.host_names = host_names  # the names Host may give, None for any (as cbrs.web._check_host)
         self.max_body = max_body
         self.inline_bytes = inline_bytes
-        self.wsgi = _WsgiAdapter(wsgi_app, workers=wsgi_threads)  # type: ignore[arg-type]
+        self.body_timeout = body_timeout
+        self.wsgi = _WsgiAdapter(wsgi_app, wsgi_threads, max_body, body_timeout)
+        self._names: Collection[str | None] | None = None
+        self._hosts: dict[str, bool] = {}
         self._queries = ThreadPoolExecutor(threads, thread_name_prefix="cbrs-sparql")
 
     def close(self) -> None:
@@ -88,7 +92,12 @@ class SparqlFront:
             return
         text, short, length = plain
         if length >= 0:  # a POST: the body is the query
-            body = await _read_body(receive)
+            try:
+                body = await asyncio.wait_for(_read_body(receive), self.body_timeout)
+            except TimeoutError:
+                message = f"the request body did not arrive within {self.body_timeout:g} s"
+                await _respond(send, False, 408, "application/json", _json({"error": "timeout", "message": message}))
+                return
             try:
                 text = body.decode("utf-8")
             except UnicodeDecodeError:  # Flask reads it again and names the error
@@ -123,8 +132,7 @@ class SparqlFront:
         if not self._host_ok(headers.get(b"host")):
             return None
         try:
-            query_string = scope.get("query_string", b"").decode("ascii")
-            parameters = parse_qsl(query_string, keep_blank_values=True, errors="strict")
+            parameters = _parameters(scope.get("query_string", b"").decode("ascii"))
         except (UnicodeDecodeError, ValueError):
             return None
         method = scope.get("method")
@@ -153,10 +161,17 @@ class SparqlFront:
             return True
         if not host:
             return False
-        try:
-            return urlsplit("//" + host).hostname in names
-        except ValueError:
-            return False
+        if names is not self._names:  # the names are fixed once the server listens: remember answers
+            self._names, self._hosts = names, {}
+        known = self._hosts.get(host)
+        if known is None:
+            try:
+                known = urlsplit("//" + host).hostname in names
+            except ValueError:
+                known = False
+            if len(self._hosts) < 64:  # the few Host values clients send; other values are not kept
+                self._hosts[host] = known
+        return known
 
 
 class ClientDisconnectedError(OSError):
@@ -165,37 +180,63 @@ class ClientDisconnectedError(OSError):
 
 
 class _WsgiAdapter(WSGIMiddleware):
-    """a2wsgi's WSGI-to-ASGI adapter, telling the WSGI app when its client has gone (as waitress did)."""
+    """a2wsgi's WSGI-to-ASGI adapter, made to treat clients as waitress did: a request reaches a WSGI
+    thread only once its body is in (at most ``max_body`` bytes of it, within ``body_timeout``), so a
+    slow client holds no thread; and the app hears when its client has gone."""
+
+    def __init__(self, app: WSGIApp, workers: int, max_body: int, body_timeout: float) -> None:
+        super().__init__(app, workers=workers)  # type: ignore[arg-type]
+        self.max_body = max_body
+        self.body_timeout = body_timeout
 
     async def __call__(self, scope: Any, receive: Any, send: Any) -> None:
         if scope["type"] != "http":
             await super().__call__(scope, _coroutine(receive), send)  # type: ignore[arg-type]
             return
-        await _Responder(self.app, self.executor, self.send_queue_size)(scope, receive, send)
+        responder = _Responder(self.app, self.executor, self.send_queue_size)
+        await responder.serve(scope, receive, send, self.max_body, self.body_timeout)
 
 
 class _Responder(WSGIResponder):
-    """One request through the adapter. Granian drops what is sent to a closed connection without a
-    word; its ``http.disconnect`` is the only sign, so a task reads the request's messages as they come
-    (handing the body on to the WSGI app) and notes the disconnect, after which a write raises."""
+    """One request through the adapter. A task reads the request's messages as they come: the body,
+    kept for the WSGI app up to one chunk past ``max_body`` (Flask's limit refuses it then), and the
+    disconnect, after which a write raises (Granian drops what is sent to a closed connection without a
+    word, and a stream would go on)."""
 
     gone = False
 
-    async def __call__(self, scope: Any, receive: Any, send: Any) -> None:
+    async def serve(self, scope: Any, receive: Any, send: Any, max_body: int, body_timeout: float) -> None:
         messages: asyncio.Queue[Message] = asyncio.Queue()
+        body_in = asyncio.Event()
 
         async def pump() -> None:
+            size = 0
             while True:
                 message = await receive()
                 if message["type"] == "http.disconnect":
                     self.gone = True
-                await messages.put(message)
-                if message["type"] == "http.disconnect":
+                    body_in.set()
+                    await messages.put(message)
                     return
+                if body_in.is_set():
+                    continue  # past the limit: not kept
+                size += len(message.get("body", b""))
+                if size > max_body:
+                    message = {**message, "more_body": False}
+                if not message.get("more_body", False):
+                    body_in.set()
+                await messages.put(message)
 
         reader = self.loop.create_task(pump())
         try:
-            await super().__call__(scope, messages.get, send)  # type: ignore[arg-type]
+            try:
+                await asyncio.wait_for(body_in.wait(), body_timeout)
+            except TimeoutError:
+                message = f"the request body did not arrive within {body_timeout:g} s"
+                await _respond(send, False, 408, "application/json", _json({"error": "timeout", "message": message}))
+                return
+            if not self.gone:
+                await self(scope, messages.get, send)  # type: ignore[arg-type]
         except ClientDisconnectedError:
             pass  # nobody to answer
         finally:
@@ -205,6 +246,17 @@ class _Responder(WSGIResponder):
         if self.gone:
             raise ClientDisconnectedError("the client closed the connection")
         super().send(message)
+
+
+def _parameters(query_string: str) -> list[tuple[str, str]]:
+    """``parse_qsl(query_string, keep_blank_values=True, errors="strict")``, without its generality:
+    this runs for every lookup (tests/test_asgi_front.py checks the two agree)."""
+    pairs = []
+    for field in query_string.split("&"):
+        if field:
+            name, _, value = field.partition("=")
+            pairs.append((unquote_plus(name, errors="strict"), unquote_plus(value, errors="strict")))
+    return pairs
 
 
 def _headers(scope: Scope) -> dict[bytes, str] | None:

@@ -17,6 +17,7 @@ import logging
 import os
 import socket
 import threading
+import time
 from dataclasses import dataclass
 from typing import Any
 
@@ -96,6 +97,19 @@ class HttpListener:
         if self._failed is not None:
             self._thread.join(timeout)
             raise self._failed
+        self._await_listen(timeout)
+
+    def _await_listen(self, timeout: float) -> None:
+        """Wait until the worker listens on the socket (Granian's start-up returns when it is bound),
+        so that whoever hears "ready" can connect."""
+        fd: int = self._server._sfd  # type: ignore[assignment]
+        deadline = time.monotonic() + timeout
+        with socket.socket(fileno=os.dup(fd)) as bound:
+            while not bound.getsockopt(socket.SOL_SOCKET, socket.SO_ACCEPTCONN):
+                if time.monotonic() > deadline or self._thread is None or not self._thread.is_alive():
+                    self.stop(timeout)
+                    raise OSError(f"the HTTP listener did not start listening within {timeout:g} s")
+                time.sleep(0.001)
 
     def stop(self, timeout: float = 10.0) -> None:
         """Stop accepting, end the loop and close the port; bounded by ``timeout``."""

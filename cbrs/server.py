@@ -50,6 +50,7 @@ class ServeConfig:
     http_threads: int = 16  # threads answering requests; the streams have their own on top
     http_io_threads: int = 1  # Granian's Rust threads reading and writing HTTP, off the GIL
     header_timeout: float = 10.0  # seconds a client may take to send a request's headers, then it is dropped
+    body_timeout: float = 30.0  # seconds it may take to send a body (held on the loop, not a thread); then 408
     inline_bytes: int = 256 * 1024  # a single scan answered on the loop up to this result size, else on a thread
     stream_limit: int = field(default_factory=lambda: setting("stream_limit").resolve())
     streams_per_client: int = field(default_factory=lambda: setting("streams_per_client").resolve())
@@ -115,6 +116,7 @@ class Server:
             threads=self.config.http_threads,
             wsgi_threads=self.config.http_threads + self.config.stream_limit,
             inline_bytes=self.config.inline_bytes,
+            body_timeout=self.config.body_timeout,
         )
         listener = ListenerConfig(
             host=self.config.host,
