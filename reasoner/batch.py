@@ -90,6 +90,7 @@ class BatchScores:
     rejected_by: Sequence[tuple[str, ...]]  # filter reasons per advertisement
     rejected: npt.NDArray[np.bool_]  # where they are not empty
     accepted_on: FloatArray | None = None  # the IO/PE score acceptability is judged on, when not ``score``
+    tie: FloatArray | None = None  # what orders equal scores before the IRI (MatchConfig.tie_break_result)
 
 
 class CompiledPool:
@@ -465,7 +466,19 @@ class BatchScorer:
             clash = np.max([pool.effects.max(self.contradicts(s).astype(np.float64)) for s in requirement.effects], 0)
             ratio = np.where(clash > 0, cfg.contradiction_factor * ratio, ratio)
         score = np.round(ratio.astype(np.float64), 6).astype(np.float64)
-        return BatchScores(score, parts, *pool.filtered(requirement, self.filters))
+        tie = self._result(parts, weights) if cfg.tie_break_result else None
+        return BatchScores(score, parts, *pool.filtered(requirement, self.filters), tie=tie)
+
+    @staticmethod
+    def _result(parts: dict[str, FloatArray], weights: dict[str, float]) -> FloatArray:
+        """The result part of each score: outputs and effects, weighted as in the score (0 where neither)."""
+        numerator = np.zeros(len(parts["outputs"]))
+        denominator = np.zeros(len(parts["outputs"]))
+        for name in ("outputs", "effects"):
+            present = ~np.isnan(parts[name])
+            numerator += np.where(present, weights[name] * np.nan_to_num(parts[name]), 0.0)
+            denominator += np.where(present, weights[name], 0.0)
+        return np.where(denominator > 0, numerator / np.maximum(denominator, 1e-300), 0.0)
 
 
 def ranking_order(scores: BatchScores, pool: CompiledPool, accept_score: float) -> IntArray:
@@ -477,9 +490,13 @@ def ranking_order(scores: BatchScores, pool: CompiledPool, accept_score: float) 
 
 def ranking_keys(scores: BatchScores, pool: CompiledPool) -> IntArray:
     """One integer per advertisement that sorts as the ranking does: whether a filter rejects it, then
-    its score (six decimals, highest first), then its IRI's rank (so the keys are distinct)."""
+    its score (six decimals, highest first), then its result part when ``scores.tie`` is given (three
+    decimals, highest first), then its IRI's rank (so the keys are distinct)."""
     score = np.rint(scores.score * 1e6).astype(np.int64)
-    return np.asarray((scores.rejected.astype(np.int64) << 62) | ((1_000_000 - score) << 32) | pool.iri_rank)
+    tie = np.zeros(len(score), dtype=np.int64) if scores.tie is None else np.rint(scores.tie * 1e3).astype(np.int64)
+    return np.asarray(
+        (scores.rejected.astype(np.int64) << 62) | ((1_000_000 - score) << 42) | ((1000 - tie) << 32) | pool.iri_rank
+    )
 
 
 def first_ranked(keys: IntArray, count: int) -> IntArray:

@@ -95,6 +95,10 @@ class MatchConfig:
     # the mean over the advertised inputs of how well the requester can supply each (1 when it provides
     # the concept or a subclass, else the best similarity to what it provides; 1 with no inputs).
     input_gate: float = 0.0
+    # Candidates with equal scores are put in order by their result part (outputs and effects, weighted as in
+    # the score, to three decimals) before their IRI: what the requester asked for before how the service is
+    # invoked. False: by IRI alone (the published order, which the baselines keep).
+    tie_break_result: bool = True
     # The hybrid method (sem-str-text): the share of the TF-IDF cosine of names and text descriptions in
     # the ranking score; the rest is the Sem-Str IO/PE score, which alone decides acceptability.
     text_weight: float = 0.3
@@ -118,6 +122,7 @@ class MatchConfig:
             disjoint_statements=False,
             antonym_statements=False,
             contradiction_factor=1.0,
+            tie_break_result=False,
             complement_weight=0.0,
             unrelated_predicate_factor=1.0,
             observed_state_weight=0.0,

@@ -230,7 +230,12 @@ class Matchmaker:
             similarity = self._text_index(ads).similarities(text)
             hybrid = _mix(scores.score, similarity, self.config.text_weight)
             scores = BatchScores(
-                hybrid, {**scores.parts, "text": similarity}, scores.rejected_by, scores.rejected, scores.score
+                hybrid,
+                {**scores.parts, "text": similarity},
+                scores.rejected_by,
+                scores.rejected,
+                scores.score,
+                scores.tie,
             )
         keys = ranking_keys(scores, pool)
         first = first_ranked(keys, explain).tolist()

@@ -12,7 +12,7 @@ from cbrs.reasoner.antonyms import forms, opposite
 from cbrs.reasoner.config import MatchConfig
 from cbrs.reasoner.lexicon import DATA_FILE, Lexicon
 from cbrs.reasoner.matchmaker import Matchmaker
-from cbrs.reasoner.owlstc import evaluate_collection
+from cbrs.reasoner.owlstc import evaluate_collection, load_collection
 from cbrs.reasoner.similarity import SemStr
 from cbrs.reasoner.statements import statement_similarity
 from cbrs.reasoner.taxonomy import Link, TaxonomyIndex
@@ -285,3 +285,19 @@ def test_only_a_kind_of_the_requested_value_reports_it(defined_kb) -> None:  # t
     old_ranked = {c.advertisement: c for c in old.rank(wanted, explain=0).candidates}
     assert old_ranked[M + "GivesOpened"].parts["effects"] == MatchConfig().observed_state_weight
     assert old.score(wanted, ads[1]).score == old_ranked[M + "GivesOpened"].score
+
+
+def test_equal_scores_are_ordered_by_what_was_asked_for_before_the_iri() -> None:
+    loaded = load_collection(ROBOT)
+    wanted = loaded.requirements["room_temperature.owls"][0]
+    on = Matchmaker(loaded.kb).rank(wanted, explain=0).candidates
+    names = [c.advertisement.rsplit("#", 1)[-1] for c in on]
+    thermostat, humidity = (on[names.index(n)] for n in ("THERMOSTAT_READER_SERVICE", "HUMIDITY_SENSOR_SERVICE"))
+    assert thermostat.score == humidity.score  # a Temperature from a Room it is not given; a Humidity
+    assert thermostat.parts["outputs"] > humidity.parts["outputs"]
+    assert names.index("THERMOSTAT_READER_SERVICE") < names.index("HUMIDITY_SENSOR_SERVICE")
+    scores = [c.score for c in on]
+    assert scores == sorted(scores, reverse=True)
+    off = Matchmaker(loaded.kb, config=MatchConfig(tie_break_result=False)).rank(wanted, explain=0).candidates
+    order = [c.advertisement for c in off]  # by IRI: the humidity sensor's sorts first
+    assert order.index(humidity.advertisement) < order.index(thermostat.advertisement)
