@@ -208,9 +208,10 @@ class _Responder(WSGIResponder):
     async def serve(self, scope: Any, receive: Any, send: Any, max_body: int, body_timeout: float) -> None:
         messages: asyncio.Queue[Message] = asyncio.Queue()
         body_in = asyncio.Event()
+        size = 0
 
         async def pump() -> None:
-            size = 0
+            nonlocal size
             while True:
                 message = await receive()
                 if message["type"] == "http.disconnect":
@@ -236,7 +237,7 @@ class _Responder(WSGIResponder):
                 await _respond(send, False, 408, "application/json", _json({"error": "timeout", "message": message}))
                 return
             if not self.gone:
-                await self(scope, messages.get, send)  # type: ignore[arg-type]
+                await self(_with_length(scope, size), messages.get, send)  # type: ignore[arg-type]
         except ClientDisconnectedError:
             pass  # nobody to answer
         finally:
@@ -246,6 +247,16 @@ class _Responder(WSGIResponder):
         if self.gone:
             raise ClientDisconnectedError("the client closed the connection")
         super().send(message)
+
+
+def _with_length(scope: Scope, size: int) -> Scope:
+    """``scope`` with the Content-Length of its body, which is in: a chunked body is given to the WSGI
+    app as waitress gave it (werkzeug reads no body without a length, and refuses one past its limit)."""
+    headers = scope.get("headers", [])
+    if any(name == b"content-length" for name, _ in headers):
+        return scope
+    kept = [(name, value) for name, value in headers if name != b"transfer-encoding"]
+    return {**scope, "headers": [*kept, (b"content-length", str(size).encode("ascii"))]}
 
 
 def _parameters(query_string: str) -> list[tuple[str, str]]:

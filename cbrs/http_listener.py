@@ -57,8 +57,21 @@ class _Server(_Embedded):
     make one per worker with SO_REUSEPORT, whose port cannot be learnt when it was 0."""
 
     def _init_shared_socket(self) -> None:
+        _refuse_taken(self.bind_addr, self.bind_port)
         holder = ListenerSpec(self.bind_addr, self.bind_port, self.backlog).build()
         self._ssp, self._shd, self._sfd = None, holder, holder.get_fd()  # type: ignore[assignment]
+
+
+def _refuse_taken(host: str, port: int) -> None:
+    """Raise EADDRINUSE when something listens on ``host:port``. Granian's socket sets SO_REUSEPORT, so
+    its own bind would succeed beside another server of this user (a second cbrs serve) and the two
+    would share the connections; a plain bind first says the port is taken, as waitress's did."""
+    if port == 0:
+        return
+    family, kind, proto, _, address = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)[0]
+    with socket.socket(family, kind, proto) as probe:
+        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        probe.bind(address)
 
 
 class HttpListener:
