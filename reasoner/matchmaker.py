@@ -17,6 +17,7 @@ The SEA and QoS of the requirement act as filters. "No acceptable match" is a st
 from __future__ import annotations
 
 import math
+import threading
 from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 from enum import Enum
@@ -124,6 +125,7 @@ class Matchmaker:
         self._requirements: dict[str, Requirement] = {}
         self._requirements_at: object = None  # the store generation they were read at
         self._strict_scorer: StrictScorer | None = None
+        self._lock = threading.RLock()  # rankings and the explanations read from them share the caches
 
     def prepare(self) -> Matchmaker:
         """Do the one-time work now (read the advertisements and the store's requirements, lay the pool
@@ -167,16 +169,17 @@ class Matchmaker:
         """Score every advertisement against ``requirement`` (an IRI or a Requirement), best first.
 
         The whole pool is scored at once (reasoner/batch.py); the first ``explain`` candidates (all
-        when None) also get their explanation: entity pairs and what they lack.
+        when None) also carry their explanation (entity pairs and what they lack), worked out when a
+        candidate is first read: a caller that reads three of ten explained candidates pays for three.
         """
-        if isinstance(requirement, str):
-            requirement = self._requirement(requirement)
-        ads = self.advertisements
-        candidates = self._rank_batch(requirement, ads, len(ads) if explain is None else explain)
-        gone = self.kb.liveness.unavailable()  # read at every ranking: a component may leave at any time
-        if gone:
-            candidates = tuple(c for c in candidates if c.advertisement not in gone)
-        status = MatchStatus.MATCHED if candidates and candidates[0].acceptable else MatchStatus.NO_ACCEPTABLE_MATCH
+        with self._lock:
+            if isinstance(requirement, str):
+                requirement = self._requirement(requirement)
+            ads = self.advertisements
+            gone = self.kb.liveness.unavailable()  # read at every ranking: a component may leave at any time
+            candidates = self._rank_batch(requirement, ads, len(ads) if explain is None else explain, gone)
+            matched = candidates.first_acceptable()
+        status = MatchStatus.MATCHED if matched else MatchStatus.NO_ACCEPTABLE_MATCH
         return MatchResult(requirement.iri, self.method.name, status, candidates)
 
     def _strict(self, pool: CompiledPool) -> StrictScorer:
@@ -207,7 +210,9 @@ class Matchmaker:
     def _generation(self) -> object:
         return getattr(self.kb.store, "generation", None)
 
-    def _rank_batch(self, requirement: Requirement, ads: list[Advertisement], explain: int) -> Sequence[Candidate]:
+    def _rank_batch(
+        self, requirement: Requirement, ads: list[Advertisement], explain: int, gone: set[str] | frozenset[str]
+    ) -> _Ranking:
         import numpy as np
 
         from cbrs.reasoner.batch import BatchScorer, BatchScores, first_ranked, ranking_keys
@@ -238,11 +243,17 @@ class Matchmaker:
                 scores.tie,
             )
         keys = ranking_keys(scores, pool)
-        first = first_ranked(keys, explain).tolist()
-        head = [self.score(requirement, ads[i]) for i in first]
+        size = len(ads)
+        if gone:  # unavailable components sort past every key and are left out of the ranking
+            away = np.array([ad.iri in gone for ad in ads], dtype=bool)
+            keys = np.where(away, np.iinfo(np.int64).max, keys)
+            size -= int(away.sum())
+        first = first_ranked(keys, max(1, min(explain, size))).tolist() if size else []
+        best = first[0] if first else -1  # what the status is read from, explained or not
+        first = first[: min(explain, size)]
 
         def rest() -> list[int]:  # the whole order, sorted only when a candidate past the head is read
-            order: list[int] = np.argsort(keys)[len(first) :].tolist()
+            order: list[int] = np.argsort(keys)[len(first) : size].tolist()
             return order
 
         def unexplained(i: int) -> Candidate:
@@ -254,7 +265,11 @@ class Matchmaker:
             acceptable = not rejected and basis >= self.config.accept_score
             return Candidate(ad.iri, ad.label, score, parts, (), (), rejected, acceptable, explained=False)
 
-        return _Ranking(head, rest, len(ads) - len(first), unexplained)
+        def explained(i: int) -> Candidate:
+            with self._lock:  # the caller may read the ranking after letting go of the store's lock
+                return self.score(requirement, ads[i])
+
+        return _Ranking(first, explained, rest, size - len(first), unexplained, best)
 
     def score(self, requirement: Requirement, ad: Advertisement) -> Candidate:
         pairs: list[EntityPair] = []
@@ -535,13 +550,22 @@ class Matchmaker:
 
 
 class _Ranking(Sequence[Candidate]):
-    """Ranked candidates: the explained head as built, the rest ordered and made on first access (a pool
-    of thousands is ranked far more often than it is read to the end)."""
+    """Ranked candidates, each made on first access: the head explained (``explain``), the rest from the
+    batch scores, ordered only when a candidate past the head is read (a pool of thousands is ranked far
+    more often than it is read to the end, and its explanations are read for a few candidates at most)."""
 
     def __init__(
-        self, head: list[Candidate], rest: Callable[[], list[int]], remaining: int, make: Callable[[int], Candidate]
+        self,
+        head: list[int],
+        explain: Callable[[int], Candidate],
+        rest: Callable[[], list[int]],
+        remaining: int,
+        make: Callable[[int], Candidate],
+        best: int,
     ) -> None:
         self._head = head
+        self._best = best  # the advertisement ranked first (-1: none)
+        self._explain = explain
         self._order = rest  # the positions past the head, computed on first need
         self._rest: list[int] | None = None
         self._remaining = remaining
@@ -550,6 +574,17 @@ class _Ranking(Sequence[Candidate]):
 
     def __len__(self) -> int:
         return len(self._head) + self._remaining
+
+    def first_acceptable(self) -> bool:
+        """Is the best candidate acceptable? Read from the batch scores, without explaining it (tests check
+        that the batch and the explanation agree on acceptability)."""
+        return self._best >= 0 and self._make(self._best).acceptable
+
+    def _position(self, position: int) -> int:
+        """The advertisement at ``position``, past the head."""
+        if self._rest is None:
+            self._rest = self._order()
+        return self._rest[position - len(self._head)]
 
     @overload
     def __getitem__(self, position: int) -> Candidate: ...
@@ -564,13 +599,13 @@ class _Ranking(Sequence[Candidate]):
             position += len(self)
         if not 0 <= position < len(self):
             raise IndexError(position)
-        if position < len(self._head):
-            return self._head[position]
         found = self._made.get(position)
         if found is None:
-            if self._rest is None:
-                self._rest = self._order()
-            found = self._made[position] = self._make(self._rest[position - len(self._head)])
+            if position < len(self._head):
+                found = self._explain(self._head[position])
+            else:
+                found = self._make(self._position(position))
+            self._made[position] = found
         return found
 
 

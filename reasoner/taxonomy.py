@@ -170,6 +170,10 @@ class TaxonomyIndex:
     def children(self, concept: str) -> set[str]:
         return set(self._children[self.canonical(concept)])
 
+    def is_a_parent_count(self, concept: str) -> int:
+        """How many direct superclasses ``concept`` has (the root counts for a class with none)."""
+        return sum(kind == "is-a" for kind in self._parents[self.canonical(concept)].values())
+
     def child_links(self, concept: str) -> list[tuple[str, str]]:
         """(child, link kind) for each node directly below ``concept``."""
         node = self.canonical(concept)

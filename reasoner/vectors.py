@@ -90,6 +90,28 @@ class _Groups:
     counts: IntArray
 
 
+@dataclass(frozen=True)
+class _Tree:
+    """The is-a tree: which taxonomy ids are in it, and each one's pre-order range [start, end)."""
+
+    pure: npt.NDArray[np.bool_]
+    start: IntArray
+    end: IntArray
+
+
+@dataclass(frozen=True)
+class _ReadSplit:
+    """The read taxonomy nodes (positions in ``_read_taxonomy``'s order, and ids): those of the is-a tree
+    in pre-order with their entries, the others with each id's position among them (-1: not one)."""
+
+    tree: IntArray
+    tree_ids: IntArray
+    tree_entry: IntArray
+    general: IntArray
+    general_ids: IntArray
+    general_position: IntArray
+
+
 class VectorSpace:
     """Concept numbering plus the per-node arrays the vectorised Sem-Str needs."""
 
@@ -107,9 +129,10 @@ class VectorSpace:
         self._lcs: _Lru[int, IntArray] = _Lru(ARRAY_CACHE_BYTES, _nbytes)
         self._used: set[int] = set()  # ids handed out by add(): where vectors are read
         self._read: list[int] | None = None  # _used, sorted
-        self._read_mask: npt.NDArray[np.bool_] | None = None
         self._read_nodes: tuple[IntArray, IntArray] | None = None
         self._read_below: dict[int, tuple[IntArray, IntArray]] = {}
+        self._is_a_tree: _Tree | None = None
+        self._split: _ReadSplit | None = None
         self._parts_masks: _Lru[int, npt.NDArray[np.bool_]] = _Lru(ARRAY_CACHE_BYTES, _nbytes)
         self._by_core: dict[int, tuple[int, dict[str, list[int]]]] = {}
         self._floors: _Lru[tuple[str, bool, float], FloatArray] = _Lru(ARRAY_CACHE_BYTES, _nbytes)
@@ -134,8 +157,8 @@ class VectorSpace:
         if found not in self._used:
             self._used.add(found)
             self._read = None
-            self._read_mask = None
             self._read_nodes = None
+            self._split = None
             self._read_below.clear()
             self._cache.clear()  # vectors are exact where they are read: now here too
             self._lcs.clear()
@@ -148,13 +171,16 @@ class VectorSpace:
         return self.add(concept)
 
     def warm(self) -> None:
-        """Build now the descendant arrays that vectors for the handed-out concepts will need."""
+        """Build now the descendant arrays that vectors for the handed-out concepts will need (those of
+        their superclasses only when some read node lies outside the is-a tree)."""
+        general = len(self._read_split().general) > 0
         for i in sorted(self._used):
             if i < self.taxonomy_size:
                 self._below(i, is_a_only=False)
+                self._below(i, is_a_only=True)
                 self.index.ancestors(self.names[i])  # what the explanations' Sem-Str reads
-                for ancestor in self.index.ancestors(self.names[i], is_a_only=True):
-                    self._below(self.ids[ancestor], is_a_only=True)
+                for ancestor in self.index.ancestors(self.names[i], is_a_only=True) if general else ():
+                    self._below_general(self.ids[ancestor])
 
     def warm_lexical(self, measure: SemStr) -> None:
         """Build now the core-word index and the lexicon's tables that cross-branch links read."""
@@ -356,12 +382,54 @@ class VectorSpace:
         ids vectors are read at (all while none is); elsewhere the values are 0, the common superclass
         the root: no reader sees them, and a large ontology's unread nodes cost nothing."""
         size = self.taxonomy_size
-        read, position = self._read_taxonomy()
-        limit = (1 << _SUM_BITS) - 1
+        read, _ = self._read_taxonomy()
         ups = self.index.ancestors(self.names[x], is_a_only=True)
+        common = np.empty(len(read), dtype=np.int64)  # the most specific common superclass with x
+        total = np.empty(len(read), dtype=np.int64)  # N1 + N2: links from x and from the node up to it
+        split = self._read_split()
+        self._lcs_of_tree_nodes(ups, split, common, total)
+        if len(split.general):
+            self._lcs_of_other_nodes(ups, split, common, total)
         root = self.ids[ROOT]
-        # The root is above every node, at the distance of its depth. The key's depth dominates: deeper
-        # ancestors first, each node settled by the first that has it (equal depths by the larger key).
+        through_root = common == root
+        nr = self.depth[common].astype(np.float64)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            wu_palmer = 2 * nr / (total + 2 * nr)
+        values = np.zeros(size, dtype=np.float64)
+        values[read] = np.where(through_root, 1.0 / (1.0 + total), wu_palmer)
+        isa_related = np.zeros(size, dtype=bool)
+        isa_related[read] = ~through_root & ((common == x) | (common == read))
+        lcs = np.full(size, root, dtype=np.int64)
+        lcs[read] = common
+        self._lcs[x] = lcs
+        return values, isa_related
+
+    def _lcs_of_tree_nodes(self, ups: dict[str, int], split: _ReadSplit, common: IntArray, total: IntArray) -> None:
+        """The common superclass with x of every read node of the is-a tree (``_tree``): the deepest of
+        its chain of superclasses that is above x too. Each such ancestor of x owns a slice of the read
+        tree nodes in pre-order; filled shallowest first, a deeper one overwrites its own slice."""
+        tree = self._tree()
+        above = [(self.ids[a], dx) for a, dx in ups.items() if tree.pure[self.ids[a]]]
+        above.sort(key=lambda item: int(self.depth[item[0]]))
+        ids = np.array([a for a, _ in above], dtype=np.int64)
+        low = np.searchsorted(split.tree_entry, tree.start[ids])
+        high = np.searchsorted(split.tree_entry, tree.end[ids])
+        owner = np.empty(len(split.tree), dtype=np.int64)
+        links = np.empty(len(split.tree), dtype=np.int64)
+        for (a, dx), lo, hi in zip(above, low.tolist(), high.tolist(), strict=True):
+            owner[lo:hi] = a
+            links[lo:hi] = dx
+        common[split.tree] = owner  # the root is pure and above everything: every slot is filled
+        total[split.tree] = links + self.depth[split.tree_ids] - self.depth[owner]
+
+    def _lcs_of_other_nodes(self, ups: dict[str, int], split: _ReadSplit, common: IntArray, total: IntArray) -> None:
+        """The common superclass with x of the read nodes with more than one way up (multiple
+        inheritance): deeper ancestors of x first, each node settled by the first that has it; among
+        ancestors of one depth the smallest N1 + N2, then the larger name rank, wins."""
+        read = split.general_ids
+        position = split.general_position
+        limit = (1 << _SUM_BITS) - 1
+        root = self.ids[ROOT]
         best = (((limit - ups[ROOT]) << _SUM_BITS) | int(self.name_rank[root])) - (self.depth[read] << _SUM_BITS)
         by_depth: dict[int, list[tuple[int, int]]] = {}
         for ancestor, dx in ups.items():
@@ -372,7 +440,7 @@ class VectorSpace:
         for level in sorted(by_depth, reverse=True):
             found = []
             for a, dx in by_depth[level]:
-                ids, dc = self._below_read(a)
+                ids, dc = self._below_general(a)
                 at = position[ids]
                 fresh = ~settled[at]
                 head = (level << _DEPTH_SHIFT) | ((limit - dx) << _SUM_BITS) | int(self.name_rank[a])
@@ -388,21 +456,59 @@ class VectorSpace:
                 best[at] = candidate[at]
             for at, _ in found:
                 settled[at] = True
-        depth = best >> _DEPTH_SHIFT
-        total = limit - ((best >> _SUM_BITS) & limit)
-        common = best & limit  # name rank is the node id
-        through_root = common == root
-        nr = depth.astype(np.float64)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            wu_palmer = 2 * nr / (total + 2 * nr)
-        values = np.zeros(size, dtype=np.float64)
-        values[read] = np.where(through_root, 1.0 / (1.0 + total), wu_palmer)
-        isa_related = np.zeros(size, dtype=bool)
-        isa_related[read] = ~through_root & ((common == x) | (common == read))
-        lcs = np.full(size, root, dtype=np.int64)
-        lcs[read] = common
-        self._lcs[x] = lcs
-        return values, isa_related
+        common[split.general] = best & limit  # name rank is the node id
+        total[split.general] = limit - ((best >> _SUM_BITS) & limit)
+
+    def _tree(self) -> _Tree:
+        """The is-a tree inside the taxonomy: the nodes with one way up (one is-a parent, itself in the
+        tree; the root is), numbered in pre-order so that each one's tree descendants are a range."""
+        if self._is_a_tree is None:
+            size = self.taxonomy_size
+            pure = np.zeros(size, dtype=bool)
+            start = np.zeros(size, dtype=np.int64)
+            end = np.zeros(size, dtype=np.int64)
+            root = self.ids[ROOT]
+            pure[root] = True
+            clock = 0
+            stack: list[tuple[int, bool]] = [(root, False)]
+            while stack:
+                node, done = stack.pop()
+                if done:
+                    end[node] = clock
+                    continue
+                start[node] = clock
+                clock += 1
+                stack.append((node, True))
+                for child, kind in self.index.child_links(self.names[node]):
+                    if kind == "is-a" and self.index.is_a_parent_count(child) == 1:
+                        c = self.ids[child]
+                        pure[c] = True
+                        stack.append((c, False))
+            self._is_a_tree = _Tree(pure, start, end)
+        return self._is_a_tree
+
+    def _read_split(self) -> _ReadSplit:
+        """The read taxonomy nodes split into those of the is-a tree (in pre-order) and the others."""
+        if self._split is None:
+            read, _ = self._read_taxonomy()
+            tree = self._tree()
+            inside = tree.pure[read]
+            at = np.flatnonzero(inside)
+            at = at[np.argsort(tree.start[read[at]], kind="stable")]
+            general = np.flatnonzero(~inside)
+            position = np.full(self.taxonomy_size, -1, dtype=np.int64)
+            position[read[general]] = np.arange(len(general))
+            self._split = _ReadSplit(at, read[at], tree.start[read[at]], general, read[general], position)
+        return self._split
+
+    def _below_general(self, node: int) -> tuple[IntArray, IntArray]:
+        """``_below(node, is_a_only=True)`` at the read nodes outside the is-a tree (``_read_split``)."""
+        found = self._read_below.get(node)
+        if found is None:
+            ids, dc = self._below(node, is_a_only=True)
+            keep = self._read_split().general_position[ids] >= 0
+            found = self._read_below[node] = (ids[keep], dc[keep])
+        return found
 
     def _read_taxonomy(self) -> tuple[IntArray, IntArray]:
         """The taxonomy ids vectors are read at (all while none is handed out), and each id's position
@@ -482,20 +588,6 @@ class VectorSpace:
                 links = np.array(list(up.values()), dtype=np.int64)
             found[ids] = np.maximum(0.0, 1.0 - step * links)
             self._floors[key] = found
-        return found
-
-    def _below_read(self, node: int) -> tuple[IntArray, IntArray]:
-        """``_below(node, is_a_only=True)`` at the ids vectors are read at (all of them while none is)."""
-        found = self._read_below.get(node)
-        if found is None:
-            ids, dc = self._below(node, is_a_only=True)
-            if self._used:
-                if self._read_mask is None or len(self._read_mask) != len(self.names):
-                    self._read_mask = np.zeros(len(self.names), dtype=bool)
-                    self._read_mask[self._read_at()] = True
-                keep = self._read_mask[ids]
-                ids, dc = ids[keep], dc[keep]
-            found = self._read_below[node] = (ids, dc)
         return found
 
     def below_is_a(self, concept: str) -> tuple[IntArray, IntArray]:

@@ -1,0 +1,100 @@
+"""What makes ranking a large pool cheap keeps its answers: explanations made when read, and the common
+superclasses of the is-a tree found by pre-order ranges (reasoner/vectors.py) next to the general walk."""
+
+from __future__ import annotations
+
+import random
+
+import numpy as np
+import pytest
+
+from cbrs.kb import KnowledgeBase, Requirement, Store
+from cbrs.reasoner.matchmaker import Candidate, Matchmaker
+from cbrs.reasoner.similarity import SemStr
+from cbrs.reasoner.synthetic import NS, build
+from cbrs.reasoner.taxonomy import ROOT, Link, TaxonomyIndex
+from cbrs.reasoner.vectors import VectorSpace
+
+
+def _pool(seed: int = 4) -> tuple[Matchmaker, list[Requirement]]:
+    index, pool, requirements = build(classes=300, ads=120, queries=3, seed=seed)
+    return Matchmaker(KnowledgeBase(Store.open(":memory:")), index=index, advertisements=pool), requirements
+
+
+def test_a_ranking_explains_a_candidate_when_it_is_read() -> None:
+    matchmaker, requirements = _pool()
+    calls: list[str] = []
+    scalar = matchmaker.score
+
+    def counted(requirement: Requirement, ad):  # type: ignore[no-untyped-def]
+        calls.append(ad.iri)
+        return scalar(requirement, ad)
+
+    matchmaker.score = counted  # type: ignore[method-assign]
+    result = matchmaker.rank(requirements[0], explain=5)
+    assert calls == []  # ranking, and the status, explain nothing
+    third = result.candidates[2]
+    assert calls == [third.advertisement] and third.explained
+    assert result.candidates[2] is third  # made once
+    ad = next(a for a in matchmaker.advertisements if a.iri == third.advertisement)
+    assert third == scalar(requirements[0], ad)
+    assert not result.candidates[5].explained and calls == [third.advertisement]
+
+
+def test_a_lazy_ranking_reads_as_an_eager_one() -> None:
+    matchmaker, requirements = _pool(seed=6)
+    by_iri = {ad.iri: ad for ad in matchmaker.advertisements}
+    for requirement in requirements:
+        result = matchmaker.rank(requirement, explain=4)
+        candidates: list[Candidate] = list(result.candidates)
+        plain = matchmaker.rank(requirement, explain=0).candidates
+        assert [c.advertisement for c in candidates] == [c.advertisement for c in plain]
+        assert candidates[:4] == [matchmaker.score(requirement, by_iri[c.advertisement]) for c in candidates[:4]]
+        assert all(c.explained for c in candidates[:4]) and not any(c.explained for c in candidates[4:])
+        assert result.status.value == ("matched" if candidates[0].acceptable else "no-acceptable-match")
+        assert result.to_dict(4)["candidates"] == [c.to_dict() for c in candidates[:4]]
+
+
+def _tangled(seed: int) -> TaxonomyIndex:
+    """A random is-a tree of 200 classes, then 40 more is-a links: classes with two or three ways up
+    (and their descendants) sit outside the tree the ranges cover."""
+    rng = random.Random(seed)
+    names = [f"{NS}T{i}" for i in range(200)]
+    links = [Link(names[0], ROOT, "is-a")]
+    links += [Link(names[i], names[rng.randrange(max(0, i // 2 - 10), i)], "is-a") for i in range(1, 200)]
+    for _ in range(40):
+        child = rng.randrange(20, 200)
+        links.append(Link(names[child], names[rng.randrange(0, child)], "is-a"))
+    links += [Link(names[rng.randrange(100, 200)], names[rng.randrange(0, 100)], "has-part") for _ in range(20)]
+    return TaxonomyIndex.from_links(links)
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_wu_palmer_vectors_equal_the_scalar_measure_with_multiple_inheritance(seed: int) -> None:
+    index = _tangled(seed)
+    measure = SemStr(index)
+    space = VectorSpace(index)
+    rng = random.Random(seed)
+    for name in rng.sample(index.nodes(), 120):  # vectors are exact where they are read
+        space.add(name)
+    split = space._read_split()
+    assert len(split.tree) and len(split.general)  # both ways of finding the common superclass are used
+    read = [space.names[i] for i in space._read_at()]
+    for concept in rng.sample(read, 25):
+        vector = space.vector(measure, concept)
+        for other in read:
+            assert vector[space.ids[other]] == pytest.approx(measure(concept, other).value), (concept, other)
+
+
+def test_the_common_superclass_table_names_the_deepest_shared_superclass() -> None:
+    index = _tangled(5)
+    space = VectorSpace(index)
+    for name in index.nodes():
+        space.add(name)
+    for concept in random.Random(5).sample(index.nodes(), 15):
+        table = space.common_superclasses(concept)
+        assert table is not None
+        for other in index.nodes():
+            found, _, _ = index.common_ancestor(concept, other)
+            assert space.names[int(table[space.ids[other]])] == found, (concept, other)
+    assert np.all(space._tree().pure[[space.ids[ROOT], space.ids[NS + "T0"]]])
