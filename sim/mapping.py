@@ -1,7 +1,10 @@
 """The map server: a 2D occupancy grid of the home, measured by casting rays down at every cell.
 
 A cell is occupied when the first thing its vertical ray hits (other than the mobile base itself)
-stands higher than ``OBSTACLE_HEIGHT``: walls, furniture, the dual-arm robot and the person. The
+stands higher than ``OBSTACLE_HEIGHT``: walls, furniture, the dual-arm robot and the person. Only the
+cells inside some body's bounding box (seen from above) are cast: elsewhere the ray could meet
+nothing but the floor, so those cells are free without asking (about a tenth of the 36,000 rays are
+cast; the grid is the same, tested). The
 table top counts although the base could drive under part of it, like the conservative maps made
 from a ceiling view. The inflated grid grows every obstacle by the base's radius, so a planner can
 treat the base as a point.
@@ -111,7 +114,12 @@ def build_occupancy_grid(
     tops = np.full(xs.shape, RAY_TOP)
     heights = np.full(xs.shape, -1.0)
     ignored = [world.body(name) for name in (ignore if ignore is not None else (world.base_name,))]
-    pending = np.arange(xs.size)
+    # A ray outside every other body's bounding box can only meet the floor: it is not cast.
+    floor = world.bodies.get("Floor")
+    standing = [body for body in world.bodies.values() if body != floor and body not in ignored]
+    under = _under_any(world.client, standing, xs, ys)
+    heights[~under] = 0.0 if floor is not None else -1.0
+    pending = np.flatnonzero(under)
     for _ in range(4):  # a ray is recast below each ignored body it hits; a few rounds are plenty
         if pending.size == 0:
             break
@@ -135,3 +143,15 @@ def build_occupancy_grid(
     # An obstacle may reach the edge of its cell, half a cell nearer than the cell's centre.
     radius_cells = (inflation_radius + resolution / 2.0) / resolution
     return OccupancyGrid(resolution, origin, occupied, inflate(occupied, radius_cells), inflation_radius)
+
+
+def _under_any(
+    client: int, bodies: Sequence[int], xs: NDArray[np.float64], ys: NDArray[np.float64]
+) -> NDArray[np.bool_]:
+    """Which points (x, y) lie inside the footprint of some body's bounding box (any link of it)."""
+    under = np.zeros(xs.shape, dtype=bool)
+    for body in bodies:
+        for link in range(-1, p.getNumJoints(body, physicsClientId=client)):
+            (x0, y0, _), (x1, y1, _) = p.getAABB(body, link, physicsClientId=client)
+            under |= (xs >= x0) & (xs <= x1) & (ys >= y0) & (ys <= y1)
+    return under

@@ -208,3 +208,41 @@ def test_the_searches_find_the_paths_networkx_finds(seed: int) -> None:
 def test_the_searches_find_the_paths_networkx_finds_in_the_home(grid: OccupancyGrid) -> None:
     for start, goal in [((3.0, 1.5), HANDOVER_POSE.xy), ((3.0, 1.5), (2.5, 7.5)), ((8.5, 2.2), (1.0, 4.0))]:
         _same_as_networkx(grid, start, goal)
+
+
+def _every_ray(world: HomeWorld) -> np.ndarray:
+    """The occupied cells with a ray cast down at every cell, seeing through the base (the reference)."""
+    import pybullet as p
+
+    home, r = world.extent, MAP_RESOLUTION
+    cols, rows = round((home.xmax - home.xmin) / r), round((home.ymax - home.ymin) / r)
+    jj, ii = np.meshgrid(np.arange(cols), np.arange(rows))
+    xs, ys = home.xmin + (jj.ravel() + 0.5) * r, home.ymin + (ii.ravel() + 0.5) * r
+    heights = np.full(xs.size, -1.0)
+    base = world.body(world.base_name)
+    for start in range(0, xs.size, 4096):
+        top = np.full(xs[start : start + 4096].size, 3.0)
+        for _ in range(3):
+            hits = p.rayTestBatch(
+                np.column_stack([xs[start : start + 4096], ys[start : start + 4096], top]).tolist(),
+                np.column_stack([xs[start : start + 4096], ys[start : start + 4096], np.full(top.size, -0.5)]).tolist(),
+                physicsClientId=world.client,
+            )
+            through = np.array([hit[0] == base for hit in hits])
+            zs = np.array([hit[3][2] for hit in hits])
+            done = ~through & np.array([hit[0] >= 0 for hit in hits])
+            heights[start : start + 4096][done] = zs[done]
+            top = np.where(through, zs - 1e-3, top)
+    occupied: np.ndarray = (heights > 0.03).reshape(rows, cols)
+    return occupied
+
+
+@pytest.mark.parametrize("seed", [0, 3])
+def test_only_rays_that_may_meet_something_are_cast_and_the_grid_is_the_same(seed: int) -> None:
+    """Rays outside every body's bounding box would meet the bare floor: not casting them changes no cell."""
+    from cbrs.sim.geometry import Pose2D
+
+    with HomeWorld.create(seed=seed) as world:
+        if seed:
+            world.base.place(Pose2D(8.3, 2.2, 0.3))  # under the arms, by the table
+        assert np.array_equal(build_occupancy_grid(world).occupied, _every_ray(world))
