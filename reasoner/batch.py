@@ -15,7 +15,6 @@ import numpy as np
 import numpy.typing as npt
 
 from cbrs.kb import Advertisement, EffectiveArea, PartNode, QoSValue, Requirement, Statement
-from cbrs.reasoner.antonyms import opposite
 from cbrs.reasoner.config import MatchConfig
 from cbrs.reasoner.similarity import EntityMeasure, SemStr
 from cbrs.reasoner.spans import span
@@ -131,10 +130,7 @@ class CompiledPool:
         (antonyms.opposite)? Kept per requested statement: the pool's statements are few and fixed."""
         found = self._opposites.get(wanted)
         if found is None:
-            found = np.array(
-                [opposite(wanted.subject, s.subject) or opposite(wanted.object, s.object) for s in self.statements],
-                dtype=bool,
-            )
+            found = self.space.opposites(wanted.subject)[self.s_ids] | self.space.opposites(wanted.object)[self.o_ids]
             self._opposites[wanted] = found
         return found
 

@@ -17,6 +17,7 @@ import jellyfish
 import numpy as np
 import numpy.typing as npt
 
+from cbrs.reasoner import antonyms
 from cbrs.reasoner.names import core_split, local_name
 from cbrs.reasoner.similarity import EntityMeasure, SemStr
 from cbrs.reasoner.taxonomy import ROOT, TaxonomyIndex
@@ -137,6 +138,8 @@ class VectorSpace:
         self._by_core: dict[int, tuple[int, dict[str, list[int]]]] = {}
         self._floors: _Lru[tuple[str, bool, float], FloatArray] = _Lru(ARRAY_CACHE_BYTES, _nbytes)
         self._disjoint: _Lru[str, npt.NDArray[np.bool_]] = _Lru(ARRAY_CACHE_BYTES, _nbytes)
+        self._opposites: _Lru[str, npt.NDArray[np.bool_]] = _Lru(ARRAY_CACHE_BYTES, _nbytes)
+        self._by_form: tuple[int, dict[str, list[int]]] | None = None
         self._complements: dict[int, str] = {}
         self._groups: _Groups | None = None
         self._word_rows: dict[tuple[int, str], FloatArray] = {}
@@ -162,6 +165,7 @@ class VectorSpace:
             self._read_below.clear()
             self._cache.clear()  # vectors are exact where they are read: now here too
             self._lcs.clear()
+            self._opposites.clear()
         return found
 
     def id_of(self, concept: str) -> int:
@@ -545,6 +549,40 @@ class VectorSpace:
                 found[[self.ids[other] for other in others]] = True
             self._disjoint[concept] = found
         return found
+
+    def opposites(self, concept: str) -> npt.NDArray[np.bool_]:
+        """For every concept id: is it named by an antonym of ``concept``'s core word (antonyms.opposite)?
+        Exact at the ids ``add`` handed out (all while none is); answered through an index of their core
+        words' forms, so a requirement costs a look-up per antonym, not a call per concept."""
+        found = self._opposites.get(concept)
+        if found is None or len(found) != len(self.names):
+            word = core_split(local_name(concept))[0]
+            found = np.zeros(len(self.names), dtype=bool)
+            if len(word) >= antonyms.MIN_LETTERS:
+                known = antonyms.table()
+                by_form = self._forms_index()
+                hits = {i for f in antonyms.forms(word) for t in known.get(f, ()) for i in by_form.get(t, ())}
+                lower = word.lower()
+                hits = {i for i in hits if self._core_word(i).lower() != lower}
+                found[list(hits)] = True
+            self._opposites[concept] = found
+        return found
+
+    def _forms_index(self) -> dict[str, list[int]]:
+        """The read ids by each form of their core word (antonyms.forms), for words of MIN_LETTERS or more."""
+        read = self._read_at()
+        if self._by_form is None or self._by_form[0] != len(read):
+            table: dict[str, list[int]] = {}
+            for i in read:
+                word = self._core_word(i)
+                if len(word) >= antonyms.MIN_LETTERS:
+                    for form in antonyms.forms(word):
+                        table.setdefault(form, []).append(i)
+            self._by_form = (len(read), table)
+        return self._by_form[1]
+
+    def _core_word(self, i: int) -> str:
+        return core_split(local_name(self.names[i]))[0]
 
     def implied(self, superclass: IntArray, part: IntArray) -> npt.NDArray[np.bool_]:
         """Element-wise: is part[i] a part that superclass[i] has (its own or inherited)? Answered per

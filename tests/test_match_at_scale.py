@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from cbrs.kb import KnowledgeBase, Requirement, Store
+from cbrs.reasoner.antonyms import opposite
 from cbrs.reasoner.matchmaker import Candidate, Matchmaker
 from cbrs.reasoner.similarity import SemStr
 from cbrs.reasoner.synthetic import NS, build
@@ -98,3 +99,20 @@ def test_the_common_superclass_table_names_the_deepest_shared_superclass() -> No
             found, _, _ = index.common_ancestor(concept, other)
             assert space.names[int(table[space.ids[other]])] == found, (concept, other)
     assert np.all(space._tree().pure[[space.ids[ROOT], space.ids[NS + "T0"]]])
+
+
+def test_opposite_names_are_found_by_their_forms_as_pair_by_pair() -> None:
+    words = ["Opened", "Open", "Closed", "Close", "Locked", "Unlocked", "DoorOpening", "On", "Off", "Full"]
+    words += ["Empty", "LightOn", "X", "Stopped", "Started", "Door", "HasState"]
+    index = TaxonomyIndex.from_links([Link(NS + w, ROOT, "is-a") for w in words[:12]])
+    space = VectorSpace(index)
+    for name in words:  # the last ones are outside the taxonomy
+        space.add(NS + name)
+    found_any = False
+    for first in words:
+        mask = space.opposites(NS + first)
+        for second in words:
+            expected = opposite(NS + first, NS + second)
+            found_any |= expected
+            assert bool(mask[space.ids[NS + second]]) == expected, (first, second)
+    assert found_any
