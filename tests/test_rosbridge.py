@@ -279,6 +279,10 @@ BAD_FRAMES = [
         '{"op": "subscribe", "topic": "/nan", "id": 1, "x": NaN}', "not valid JSON: NaN is not JSON", None, id="nan"
     ),
     pytest.param("[" * 100_000 + "]" * 100_000, "nested too deeply", None, id="nested"),
+    pytest.param('{"op": "set_level", "level": "info"} {"op": "x"}', "not valid JSON: Extra data", None, id="two"),
+    pytest.param(  # white space around a message is JSON: it is read
+        ' {"op": "publish", "topic": "/nobody", "msg": {}}\n', "'/nobody' is not advertised", None, id="spaced"
+    ),
     pytest.param(b"\x82\xa2op", "binary frames are not supported", None, id="binary"),
     pytest.param(
         '{"op": "publish", "topic": "/a", "msg": {"data": "' + "x" * (1 << 20) + '"}}',
@@ -327,6 +331,16 @@ def test_publish_reaches_subscribers_in_order_under_their_own_spelling(client: C
         assert {m["topic"] for m in messages} == {spelling}
         assert [m["msg"]["data"] for m in messages] == [str(n) for n in range(200)]
     talker.nothing()  # a publisher that does not subscribe gets nothing back
+
+
+def test_a_client_latched_message_waits_for_the_first_subscriber_as_sent(client: Callable[[], Client]) -> None:
+    talker, listener = client(), client()
+    talker.send(op="advertise", topic="/pose", type="test/Pose", latch=True)
+    sent = {"name": "Küche ✓", "xy": [1.5, -2, 1e-9], "deep": {"a": [None, True, {"b": ""}]}, "big": 2**70}
+    talker.send(op="publish", topic="/pose", msg=sent)  # nobody subscribes yet
+    talker.sync()
+    listener.send(op="subscribe", topic="/pose")
+    assert listener.expect("publish")["msg"] == sent
 
 
 def test_advertise_conflicts_and_unknown_unadvertise(client: Callable[[], Client]) -> None:

@@ -391,18 +391,24 @@ class Bridge:
         session.report("info", f"unadvertised {name}", message.get("id"))
 
     def _publish(self, session: Session, message: Message) -> None:
+        # every message a client publishes passes here: keep it lean (bench/rosbridge_relay.py)
         name = protocol.resolve(message["topic"], "topic")
-        text = protocol.dumps(message["msg"])
         with self._graph.lock:
             topic = self._graph.topics.get(name)
             self._refuse_owned_topic(name, topic)
             if topic is None:
                 raise ProtocolError(f"topic {name!r} is not advertised: send advertise (with its type) first")
-            topic.publishers.add(session)
-            if topic.latch or message.get("latch"):
-                topic.latched = text
+            if session not in topic.publishers:
+                topic.publishers.add(session)
+                session.advertised.setdefault(name, message["topic"])
+            latch = topic.latch or message.get("latch")
             subscribers = list(topic.subscribers)
-        session.advertised.setdefault(name, message["topic"])
+        if not (subscribers or latch):  # nobody to send it to, now or later: not even encoded
+            return
+        text = protocol.dumps_decoded(message["msg"])
+        if latch:
+            with self._graph.lock:
+                topic.latched = text
         self._fan_out(name, text, subscribers)
 
     def _subscribe(self, session: Session, message: Message) -> None:
