@@ -15,6 +15,7 @@ import numpy as np
 import numpy.typing as npt
 
 from cbrs.kb import Advertisement, EffectiveArea, PartNode, QoSValue, Requirement, Statement
+from cbrs.reasoner.antonyms import table as antonym_table
 from cbrs.reasoner.config import MatchConfig
 from cbrs.reasoner.similarity import EntityMeasure, SemStr
 from cbrs.reasoner.spans import span
@@ -110,6 +111,8 @@ class CompiledPool:
         self._layout_trees(list(trees.values()))
         self.statements = list(statements)
         self._opposites: dict[Statement, npt.NDArray[np.bool_]] = {}
+        if self.statements:
+            antonym_table()  # read once per process here, in prepare(), rather than in the first ranking
         cid = space.add
         self.s_ids = np.array([cid(s.subject) for s in self.statements], dtype=np.int64)
         self.p_ids = np.array([cid(s.predicate) for s in self.statements], dtype=np.int64)
