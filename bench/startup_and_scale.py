@@ -17,6 +17,7 @@ import argparse
 import json
 import os
 import platform
+import resource
 import shutil
 import socket
 import statistics
@@ -32,13 +33,18 @@ PYTHON = sys.executable
 FETCH = "FetchMyPen"
 
 
-def _median_seconds(argv: list[str], repeat: int) -> float:
-    samples = []
+def _median_seconds(argv: list[str], repeat: int) -> tuple[float, float]:
+    """Median wall seconds of running ``argv``, and its median CPU seconds (user + system, all its
+    threads): on a shared machine the wall time grows with the load, the CPU time much less."""
+    samples, cpu = [], []
     for _ in range(repeat):
+        used = resource.getrusage(resource.RUSAGE_CHILDREN)
         start = time.perf_counter()
         subprocess.run(argv, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
         samples.append(time.perf_counter() - start)
-    return statistics.median(samples)
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpu.append(after.ru_utime + after.ru_stime - used.ru_utime - used.ru_stime)
+    return statistics.median(samples), statistics.median(cpu)
 
 
 def _free_port() -> int:
@@ -65,17 +71,23 @@ def _ready_seconds(argv: list[str], url: str) -> float:
         process.wait()
 
 
-def startup(repeat: int) -> dict[str, float]:
+def startup(repeat: int) -> tuple[dict[str, float], dict[str, float]]:
+    """Wall seconds of each process start and server's ready time, and CPU seconds of the process starts."""
     cbrs = [PYTHON, "-m", "cbrs"]
-    figures = {
-        "python -c pass": _median_seconds([PYTHON, "-c", "pass"], repeat),
-        "cbrs --help": _median_seconds([*cbrs, "--help"], repeat),
-        "cbrs query (:memory:)": _median_seconds([*cbrs, "--store", ":memory:", "query", "ASK {}"], repeat),
-    }
     ask = "/query?query=ASK%7B%7D"
     with tempfile.TemporaryDirectory() as folder:
         store = Path(folder) / "store"
         subprocess.run([*cbrs, "--store", str(store), "init"], check=True, stdout=subprocess.DEVNULL)
+        commands = {
+            "python -c pass": [PYTHON, "-c", "pass"],
+            "cbrs --help": [*cbrs, "--help"],
+            # an in-memory store is seeded with the bundled ontologies at every start
+            "cbrs query (:memory:)": [*cbrs, "--store", ":memory:", "query", "ASK {}"],
+            "cbrs query (on-disk store)": [*cbrs, "--store", str(store), "query", "ASK {}"],
+        }
+        timed = {name: _median_seconds(argv, repeat) for name, argv in commands.items()}
+        figures = {name: wall for name, (wall, _) in timed.items()}
+        cpu = {name: used for name, (_, used) in timed.items()}
         serve: list[float] = []
         for _ in range(repeat):
             port = _free_port()
@@ -90,7 +102,7 @@ def startup(repeat: int) -> dict[str, float]:
                 argv = [oxigraph, "serve", "--location", str(Path(folder) / f"ox{n}"), "--bind", f"127.0.0.1:{port}"]
                 anchor.append(_ready_seconds(argv, f"http://127.0.0.1:{port}{ask}"))
             figures["oxigraph serve ready"] = statistics.median(anchor)
-    return figures
+    return figures, cpu
 
 
 def composition(chain: int) -> dict[str, float]:
@@ -229,13 +241,14 @@ def main() -> None:
     )
     record: dict[str, Any] = {"machine": platform.platform(), "cores": os.cpu_count(), "load": load}
 
-    print("\nProcess start (median of repeat, seconds):")
-    figures = record["startup"] = startup(args.repeat)
+    print("\nProcess start (median of repeat, seconds; CPU: user + system of the process):")
+    figures, cpu = record["startup"], record["startup_cpu"] = startup(args.repeat)
     bare = figures["python -c pass"]
     for name, seconds in figures.items():
         anchor = figures.get("oxigraph serve ready") if "serve" in name else bare
         ratio = f"{seconds / anchor:6.1f}x {'oxigraph serve' if 'serve' in name else 'python -c pass'}"
-        print(f"  {name:<36} {seconds:7.3f}  {ratio if anchor else ''}")
+        used = f"  CPU {cpu[name]:6.3f}" if name in cpu else ""
+        print(f"  {name:<36} {seconds:7.3f}  {ratio if anchor else ''}{used}")
 
     print("\nComposition over a chain pool (seconds):")
     try:
@@ -282,6 +295,7 @@ def records(record: dict[str, Any], requirements: int) -> list[dict[str, Any]]:
     return [
         row("cbrs --help, process start", start["cbrs --help"], bare, "s", "<= 0.3"),
         row("cbrs query, process start", start["cbrs query (:memory:)"], bare, "s", "<= 0.3"),
+        row("cbrs query on an on-disk store, process start", start["cbrs query (on-disk store)"], bare, "s", "<= 0.3"),
         row("cbrs serve ready", start["cbrs serve ready (on-disk store)"], oxigraph, "s", "<= 0.5"),
         row("composition over a long chain pool", chain, None, "s", "composes", "error" not in record["composition"]),
         row("/cbrs/plan over the bridge, FetchMyPen", remote * 1000, local * 1000, "ms", "<= 20"),
