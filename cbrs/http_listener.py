@@ -168,3 +168,9 @@ class HttpListener:
                 loop.run_until_complete(loop.shutdown_asyncgens())
             finally:
                 loop.close()
+                # Let Granian's objects go now, by reference count, while the interpreter runs: the
+                # hook above made a cycle, and a cycle freed at interpreter exit dropped Rust objects
+                # that needed it, which aborted the process now and then.
+                del self._server.startup
+                self._server._shd = None
+                self._server.wrks.clear()
