@@ -12,7 +12,8 @@ all queries and over the odd- and even-numbered ones (held-out halves):
 - OWLS-MX's role-free signature similarity: each requested input or output against the best of all the
   advertised inputs and outputs, mixed into the score with a small weight.
 
-Ties are broken as the matchmaker breaks them (the result part, then the IRI).
+Ties are broken as the matchmaker breaks them (the result part, then the IRI). Two more rows bound how
+much the order of equal scores can matter: relevant services first, or last, among equal scores.
 
 Run: python bench/matchmaking_alternatives.py [FOLDER ...]
 """
@@ -82,7 +83,8 @@ def main() -> None:
         pool = semstr.prepare()._compiled(semstr.advertisements)
         logic_pool = logic.prepare()._compiled(logic.advertisements)
         scorer = BatchScorer(pool, semstr.method.measure, semstr.config, semstr.filters, True, True)
-        rows: dict[str, list[float]] = {name: [] for name in ALTERNATIVES}
+        bounds = ("bound: relevant first among equal scores", "bound: relevant last among equal scores")
+        rows: dict[str, list[float]] = {name: [] for name in (*ALTERNATIVES, *bounds)}
         for iri, relevant in queries.items():
             requirement = semstr._requirement(iri)
             s = scorer.score(requirement)
@@ -92,6 +94,10 @@ def main() -> None:
                 score = np.round(alternative(s, lg, sig), 6)
                 tie = np.zeros(len(score)) if s.tie is None else np.round(s.tie, 3)
                 order = np.lexsort((pool.iri_rank, -tie, -score, s.rejected))  # as batch.ranking_keys sorts
+                rows[name].append(average_precision([pool.ads[i].iri for i in order], relevant))
+            hit = np.array([ad.iri in relevant for ad in pool.ads], dtype=np.int64)
+            for name, sign in zip(bounds, (-1, 1), strict=True):  # how much the order of ties can matter
+                order = np.lexsort((pool.iri_rank, sign * hit, -s.score, s.rejected))
                 rows[name].append(average_precision([pool.ads[i].iri for i in order], relevant))
         print(f"\n{folder}: {len(queries)} queries, {len(pool.ads)} services")
         print("| ordering | MAP | odd queries | even queries |\n|---|---:|---:|---:|")
