@@ -271,10 +271,14 @@ class HomeWorld:
         self._check()
         count = max(1, round(seconds / self.time_step))
         client = self.client
+        # the hot loop of every run (a drive steps once per control tick): names bound once
+        step_simulation, joint_state, taps = p.stepSimulation, p.getJointState, self._taps
         for _ in range(count):
-            p.stepSimulation(physicsClientId=client)
+            step_simulation(physicsClientId=client)
             self._steps += 1
-            self._run_tap()
+            for dispenser, body in taps:  # each tap runs while its lever is pushed in (tap_open)
+                if joint_state(body, 1, client)[0] > TAP_OPEN_TRAVEL:
+                    self._pour(dispenser.outlet)
             if self._watchers:
                 for every, callback in list(self._watchers):
                     if self._steps % every == 0:
@@ -418,11 +422,6 @@ class HomeWorld:
         inside = math.hypot(pos[0] - outlet[0], pos[1] - outlet[1]) < rim - 0.004
         below = pos[2] + obj.size[2] / 2.0 < outlet[2]
         return inside and below and up > 0.95
-
-    def _run_tap(self) -> None:
-        for dispenser, body in self._taps:  # tap_open of each, without looking the dispensers up every step
-            if float(p.getJointState(body, 1, physicsClientId=self.client)[0]) > TAP_OPEN_TRAVEL:
-                self._pour(dispenser.outlet)
 
     def _pour(self, outlet: Vec3) -> None:
         catching = next((name for name in sorted(self.containers) if self.catches_water(name, outlet)), None)
