@@ -1,4 +1,4 @@
-"""Profile: server CPU time per point lookup, cbrs serve against oxigraph serve and bare WSGI servers.
+"""Profile: server CPU time per point lookup, cbrs serve against oxigraph serve and bare HTTP servers.
 
 Run: python bench/endpoint_cpu.py [--requests 3000] [--triples 200000]
 
@@ -9,8 +9,10 @@ connection sends point lookups (after 300 unmeasured ones) to each server in tur
 
 - ``oxigraph serve --union-default-graph`` and ``cbrs serve`` over the same generated data
   (bench/store_limits.generate, loaded by each one's own loader);
-- waitress serving a WSGI function that returns a fixed body of the same size, and the same behind a
-  Flask route: the floor the HTTP server alone sets.
+- the HTTP front of cbrs serve (Granian embedded, ``cbrs.http_listener``) answering a fixed body of the
+  same size from a bare ASGI function: the floor the HTTP front alone sets;
+- waitress serving a WSGI function that returns that body, and the same behind a Flask route: the
+  front cbrs serve had before.
 
 Prints the machine, the inputs and, per server, CPU microseconds per request on the server and in the
 client, and the wall time per request.
@@ -34,6 +36,19 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from store_limits import GRAPH, NS, Served, _free_port, generate, serve_cbrs, serve_oxigraph
 
+_GRANIAN = textwrap.dedent(
+    """
+    import sys, threading
+    from cbrs.http_listener import HttpListener, ListenerConfig
+    body = b"x" * int(sys.argv[2])
+    headers = [(b"content-type", b"application/sparql-results+json"), (b"content-length", str(len(body)).encode())]
+    async def bare(scope, receive, send):
+        await send({"type": "http.response.start", "status": 200, "headers": headers})
+        await send({"type": "http.response.body", "body": body})
+    HttpListener(bare, ListenerConfig(port=int(sys.argv[1]))).start()
+    threading.Event().wait()
+    """
+)
 _BARE = textwrap.dedent(
     """
     import sys
@@ -117,6 +132,7 @@ def main() -> None:
         servers = [
             ("oxigraph serve", lambda: serve_oxigraph(args.oxigraph, ox_store)),
             ("cbrs serve", lambda: serve_cbrs(cbrs_store)),
+            ("Granian, bare ASGI", lambda: _granian(size)),
             ("waitress, bare WSGI", lambda: _bare("bare", size)),
             ("waitress + Flask route", lambda: _bare("flask", size)),
         ]
@@ -128,6 +144,11 @@ def main() -> None:
             finally:
                 served.stop()
             print(f"{label:<24} {server:>17.0f} {client:>17.0f} {wall:>12.0f}")
+
+
+def _granian(size: int) -> Served:
+    port = _free_port()
+    return Served("granian bare", [sys.executable, "-c", _GRANIAN, str(port), str(size)], port, "/sparql")
 
 
 def _bare(kind: str, size: int) -> Served:
