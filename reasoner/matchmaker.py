@@ -507,7 +507,7 @@ class Matchmaker:
             how = "s/p/o: " + ", ".join(f"{s.value:.2f}" for s in match.parts or ())
             if match.contradicts:
                 clash = _short(getattr(got, match.contradicts)), _short(getattr(wanted, match.contradicts))
-                how += f"; contradicts: {clash[0]} is disjoint with {clash[1]}"
+                how += f"; contradicts: {clash[0]} is {match.relation} {clash[1]}"
             pairs.append(EntityPair(role, text, offered, value, how, degree.value))
             if value < self.config.pair_threshold:
                 lacks.append(f"{role} {text}: best offer {offered} scores {value:.2f}")

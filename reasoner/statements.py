@@ -30,7 +30,8 @@ class StatementMatch:
     advertised: Statement | None
     value: float
     parts: tuple[Similarity, Similarity, Similarity] | None = None
-    contradicts: str | None = None  # "subject" or "object": that position is disjoint with the requested one
+    contradicts: str | None = None  # "subject" or "object": that position contradicts the requested one
+    relation: str = "disjoint with"  # how it does: "disjoint with" (declared) or "the opposite of" (antonyms)
 
 
 def statement_similarity(
@@ -42,9 +43,10 @@ def statement_similarity(
     else:
         p = measure(requested.predicate, advertised.predicate)
     o = measure(requested.object, advertised.object)
-    clash = contradiction(requested, advertised, measure, config)
-    value = 0.0 if clash else combine(config, s.value, p.value, o.value)
-    return StatementMatch(requested, advertised, value, (s, p, o), clash)
+    clash = _contradiction(requested, advertised, measure, config)
+    if clash is None:
+        return StatementMatch(requested, advertised, combine(config, s.value, p.value, o.value), (s, p, o))
+    return StatementMatch(requested, advertised, 0.0, (s, p, o), *clash)
 
 
 def contradiction(
@@ -53,14 +55,22 @@ def contradiction(
     """The position ("subject", "object") where ``advertised`` names a class disjoint with the requested
     one (MatchConfig.disjoint_statements) or its opposite state (MatchConfig.antonym_statements), or
     None (always None for a measure other than Sem-Str)."""
+    clash = _contradiction(requested, advertised, measure, config)
+    return None if clash is None else clash[0]
+
+
+def _contradiction(
+    requested: Statement, advertised: Statement, measure: EntityMeasure, config: MatchConfig
+) -> tuple[str, str] | None:
+    """(position, relation) of the first contradiction, or None."""
     if not isinstance(measure, SemStr):
         return None
     for position in ("subject", "object"):
         wanted, got = getattr(requested, position), getattr(advertised, position)
         if config.disjoint_statements and measure.index.disjoint(wanted, got):
-            return position
+            return position, "disjoint with"
         if config.antonym_statements and opposite(wanted, got):
-            return position
+            return position, "the opposite of"
     return None
 
 

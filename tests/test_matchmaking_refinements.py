@@ -257,7 +257,9 @@ def test_an_offer_that_does_the_opposite_of_what_is_asked_scores_nothing() -> No
     assert [c.advertisement for c in ranked] == [E + "PushDoor", E + "CloseDoor"]
     explained = on.score(wanted, closer)
     assert ranked[1].score == explained.score == 0.0  # batch and scalar agree
-    assert explained.parts["effects"] == 0.0 and "contradicts" in explained.pairs[-1].how
+    assert (
+        explained.parts["effects"] == 0.0 and "contradicts: Closed is the opposite of Opened" in explained.pairs[-1].how
+    )
     kept = Matchmaker(kb, config=MatchConfig(contradiction_factor=1.0), index=positions(), advertisements=[closer])
     assert kept.rank(wanted, explain=0).candidates[0].score == kept.score(wanted, closer).score > 0.3  # its inputs
     names_off = MatchConfig(antonym_statements=False)
