@@ -142,3 +142,15 @@ def test_deep_fan_in_stays_bounded(bundled_kb: KnowledgeBase) -> None:
     for step in plan.steps:
         assert len(step.inputs) == 2
         assert all(b.source.step is None or b.source.step < step.index for b in step.bindings)
+
+
+def test_a_task_names_a_requirement_never_an_advertisement() -> None:
+    """A task is read by its own IRI first; an advertisement there is no task, and the error lists the
+    requirements there are."""
+    from cbrs.actions.errors import UnknownTaskError
+
+    composer = Composer(problem_kb("chain.ttl"))
+    assert composer.task(EX + "Req").requirement.iri == EX + "Req"
+    with pytest.raises(UnknownTaskError) as error:
+        composer.task(EX + "S1")
+    assert error.value.known == ("Req",)
