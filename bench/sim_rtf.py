@@ -1,8 +1,8 @@
 """Benchmark: the simulation's real-time factor as cbrs runs a task headless, against pybullet stepping
 the same scene alone.
 
-Run: python bench/sim_rtf.py [--tasks RobotArmServeACup,FetchMyPen] [--seeds 0,1,2] [--profile N] [--json FILE]
-                              [--digests FILE] [--check FILE]
+Run: python bench/sim_rtf.py [--tasks RobotArmServeACup,FetchMyPen] [--seeds 0,1,2] [--profile N] [--physics]
+                             [--json FILE] [--digests FILE] [--check FILE]
 
 For each task and seed, a world is built from the store's semantic map (as ``cbrs run`` builds it;
 not timed), then:
@@ -20,7 +20,9 @@ The row's ratio is the median of the task's factors over the median of the ancho
 The same ratio on this thread's CPU time is printed too: on a machine shared with other jobs it
 moves less than the wall-clock one (pybullet's DIRECT client steps and renders on this thread).
 ``--profile N`` also runs the tasks once under cProfile (CPU time) and prints the N functions with
-the most time of their own, and how the task's own physics steps compare with stepping alone.
+the most time of their own. ``--physics`` runs each task and seed once more, timing its own physics
+steps (``p.stepSimulation``) against the fresh world's steps alone: the ratio the run would reach if
+nothing but its physics cost anything (cProfile is not on then: it cools the caches between steps).
 ``--json FILE`` writes the rows as a list of records.
 
 Every run also gets a digest of what it did, so that a change made for speed can be shown to leave
@@ -195,36 +197,52 @@ def run_one(kb: KnowledgeBase, smap: SemanticMap, composer: Composer, task: str,
 
 
 def profile(kb: KnowledgeBase, smap: SemanticMap, composer: Composer, tasks: list[str], top: int) -> str:
-    """The N costliest functions of one run of each task (seed 0), and how the tasks' own physics steps
-    compare with pybullet stepping the freshly built world alone: the arms' motors and contacts make a
-    task's steps dearer, which bounds the ratio even if nothing else cost anything."""
-    profiler = cProfile.Profile(time.thread_time)  # CPU seconds, as step_alone's
+    """The N costliest functions (own CPU time) of one run of each task, seed 0."""
     lines = []
     for task in tasks:
+        profiler = cProfile.Profile(time.thread_time)
         world = HomeWorld.create(seed=0, semantic_map=smap)
         try:
-            steps0 = world.steps
             profiler.enable()
             run_task(kb, task, SimEnvironment(world, kb), composer=composer)
             profiler.disable()
-            steps = world.steps - steps0
         finally:
             world.close()
-        stats = pstats.Stats(profiler)
-        physics = sum(v[2] for k, v in stats.stats.items() if k[2] == "<built-in method pybullet.stepSimulation>")  # type: ignore[attr-defined]
-        profiler = cProfile.Profile(time.thread_time)  # one table per task
-        with HomeWorld.create(seed=0, semantic_map=smap) as fresh:
-            _, alone = step_alone(fresh, steps)
-        lines.append(
-            f"{task}: stepSimulation in the run {physics:.2f} s of CPU for {steps} steps "
-            f"({physics / steps * 1e6:.0f} us a step), alone {alone / steps * 1e6:.0f} us a step: with nothing but "
-            f"its physics the run would reach {alone / physics:.2f}x"
-        )
         out = io.StringIO()
-        stats.stream = out  # type: ignore[attr-defined]
-        stats.sort_stats("tottime").print_stats(top)
-        lines.append(out.getvalue())
+        pstats.Stats(profiler, stream=out).sort_stats("tottime").print_stats(top)
+        lines.append(f"{task}:{out.getvalue()}")
     return "\n".join(lines)
+
+
+def physics_bound(
+    kb: KnowledgeBase, smap: SemanticMap, composer: Composer, task: str, seed: int
+) -> tuple[float, float]:
+    """CPU seconds a step of ``task``'s own physics takes in a run (the arms' motors and contacts make
+    it dearer, and the work between steps cools the caches), and a step of the fresh world alone."""
+    spent = [0.0]
+    original = p.stepSimulation
+
+    def timed(**kwargs: Any) -> Any:
+        start = time.thread_time()
+        try:
+            return original(**kwargs)
+        finally:
+            spent[0] += time.thread_time() - start
+
+    world = HomeWorld.create(seed=seed, semantic_map=smap)
+    try:
+        steps0 = world.steps
+        p.stepSimulation = timed
+        try:
+            run_task(kb, task, SimEnvironment(world, kb), composer=composer)
+        finally:
+            p.stepSimulation = original
+        steps = world.steps - steps0
+    finally:
+        world.close()
+    with HomeWorld.create(seed=seed, semantic_map=smap) as fresh:
+        _, alone = step_alone(fresh, steps)
+    return spent[0] / steps, alone / steps
 
 
 def main() -> None:
@@ -232,6 +250,9 @@ def main() -> None:
     parser.add_argument("--tasks", default=",".join(TASKS))
     parser.add_argument("--seeds", default="0,1,2")
     parser.add_argument("--profile", type=int, default=0, metavar="N", help="print the N costliest functions")
+    parser.add_argument(
+        "--physics", action="store_true", help="also time the tasks' own physics steps against stepping alone"
+    )
     parser.add_argument("--json", type=Path, help="also write the rows to FILE as a list of records")
     parser.add_argument("--digests", type=Path, help="write each run's outcome digest to FILE (JSON)")
     parser.add_argument("--check", type=Path, help="compare the runs' digests with FILE; exit 1 if any differs")
@@ -274,9 +295,18 @@ def main() -> None:
             f"{record['ratio']:.2f}x (goal >= {GOAL:g}x: {verdict}); on CPU time {cpu:.2f}x"
         )
     print(f"load average at end {os.getloadavg()[0]:.2f}")
+    if args.physics:
+        print("\nphysics alone: a task's own steps (CPU, in a run) against the fresh world's steps alone")
+        for task in tasks:
+            for seed in seeds:
+                in_run, alone = physics_bound(kb, smap, composer, task, seed)
+                print(
+                    f"{task:<18} {seed:>4}: {in_run * 1e6:.0f} us a step in the run, {alone * 1e6:.0f} alone: "
+                    f"with nothing but its physics the run would reach {alone / in_run:.2f}x"
+                )
     if args.profile:
         listing = profile(kb, smap, composer, tasks, args.profile)
-        print(f"\nprofile of one run of each task (seed 0), by own time:\n{listing}")
+        print(f"\nprofile of one run of each task (seed 0), by own CPU time:\n{listing}")
     if args.json is not None:
         args.json.write_text(json.dumps(records, indent=2) + "\n", encoding="utf-8")
         print(f"written to {args.json}")

@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import pybullet as p
@@ -146,7 +147,7 @@ def build_occupancy_grid(
 
 
 def _under_any(
-    client: int, bodies: Sequence[int], xs: NDArray[np.float64], ys: NDArray[np.float64]
+    client: int, bodies: Sequence[int], xs: NDArray[np.floating[Any]], ys: NDArray[np.floating[Any]]
 ) -> NDArray[np.bool_]:
     """Which points (x, y) lie inside the footprint of some body's bounding box (any link of it)."""
     under = np.zeros(xs.shape, dtype=bool)
