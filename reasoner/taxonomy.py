@@ -228,8 +228,7 @@ class TaxonomyIndex:
         if self._part_weights is None:
             owners: dict[str, int] = {}
             wholes = 0
-            for node in self.nodes():
-                parts = self.parts_of(node)
+            for parts in self._all_parts().values():
                 if parts:
                     wholes += 1
                     for p in parts:
@@ -237,6 +236,29 @@ class TaxonomyIndex:
             scale = math.log(wholes) if wholes > 1 else 1.0
             self._part_weights = {p: math.log(wholes / m) / scale if wholes > 1 else 1.0 for p, m in owners.items()}
         return self._part_weights.get(self.canonical(part), 1.0)
+
+    def _all_parts(self) -> dict[str, frozenset[str]]:
+        """parts_of for every node at once, superclasses first (their parts are inherited): a class with
+        no parts of its own and one superclass shares that superclass's set. Fills the parts_of cache."""
+        waiting = {node: sum(kind == "is-a" for kind in parents.values()) for node, parents in self._parents.items()}
+        queue = deque([ROOT])
+        self._parts[ROOT] = frozenset()
+        while queue:
+            node = queue.popleft()
+            for child, kind in self.child_links(node):
+                if kind != "is-a":
+                    continue
+                waiting[child] -= 1
+                if waiting[child]:
+                    continue
+                own = {part for part, link in self.child_links(child) if link == "has-part"}
+                above = [self._parts[p] for p, link in self._parents[child].items() if link == "is-a"]
+                if not own and len(above) == 1:
+                    self._parts[child] = above[0]
+                else:
+                    self._parts[child] = frozenset(own.union(*above))
+                queue.append(child)
+        return {node: found for node, found in self._parts.items() if node != ROOT}
 
     def disjoint_with(self, concept: str) -> frozenset[str]:
         """Every node that shares no instance with ``concept``: the is-a descendants of each class declared

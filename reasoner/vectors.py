@@ -35,6 +35,7 @@ again; the per-node descendant arrays are not bounded (one per taxonomy node at 
 K = TypeVar("K", bound=Hashable)
 V = TypeVar("V")
 
+_STACKED_MASKS = 64  # implied(): up to this many distinct superclasses, their parts masks are stacked
 _SUM_BITS = 20  # link sums and name ranks stay far below 2**20
 _DEPTH_SHIFT = 2 * _SUM_BITS
 
@@ -108,6 +109,7 @@ class _ReadSplit:
     tree: IntArray
     tree_ids: IntArray
     tree_entry: IntArray
+    tree_depth: FloatArray
     general: IntArray
     general_ids: IntArray
     general_position: IntArray
@@ -135,6 +137,7 @@ class VectorSpace:
         self._is_a_tree: _Tree | None = None
         self._split: _ReadSplit | None = None
         self._parts_masks: _Lru[int, npt.NDArray[np.bool_]] = _Lru(ARRAY_CACHE_BYTES, _nbytes)
+        self._no_parts: npt.NDArray[np.bool_] | None = None
         self._by_core: dict[int, tuple[int, dict[str, list[int]]]] = {}
         self._floors: _Lru[tuple[str, bool, float], FloatArray] = _Lru(ARRAY_CACHE_BYTES, _nbytes)
         self._disjoint: _Lru[str, npt.NDArray[np.bool_]] = _Lru(ARRAY_CACHE_BYTES, _nbytes)
@@ -386,50 +389,69 @@ class VectorSpace:
         ids vectors are read at (all while none is); elsewhere the values are 0, the common superclass
         the root: no reader sees them, and a large ontology's unread nodes cost nothing."""
         size = self.taxonomy_size
-        read, _ = self._read_taxonomy()
         ups = self.index.ancestors(self.names[x], is_a_only=True)
-        common = np.empty(len(read), dtype=np.int64)  # the most specific common superclass with x
-        total = np.empty(len(read), dtype=np.int64)  # N1 + N2: links from x and from the node up to it
         split = self._read_split()
-        self._lcs_of_tree_nodes(ups, split, common, total)
-        if len(split.general):
-            self._lcs_of_other_nodes(ups, split, common, total)
         root = self.ids[ROOT]
-        through_root = common == root
-        nr = self.depth[common].astype(np.float64)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            wu_palmer = 2 * nr / (total + 2 * nr)
         values = np.zeros(size, dtype=np.float64)
-        values[read] = np.where(through_root, 1.0 / (1.0 + total), wu_palmer)
         isa_related = np.zeros(size, dtype=bool)
-        isa_related[read] = ~through_root & ((common == x) | (common == read))
         lcs = np.full(size, root, dtype=np.int64)
-        lcs[read] = common
+        self._tree_wu_palmer(x, ups, split, values, isa_related, lcs)
+        if len(split.general):
+            common, total = self._lcs_of_other_nodes(ups, split)
+            ids = split.general_ids
+            through_root = common == root
+            nr = self.depth[common].astype(np.float64)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                wu_palmer = 2 * nr / (total + 2 * nr)
+            values[ids] = np.where(through_root, 1.0 / (1.0 + total), wu_palmer)
+            isa_related[ids] = ~through_root & ((common == x) | (common == ids))
+            lcs[ids] = common
         self._lcs[x] = lcs
         return values, isa_related
 
-    def _lcs_of_tree_nodes(self, ups: dict[str, int], split: _ReadSplit, common: IntArray, total: IntArray) -> None:
-        """The common superclass with x of every read node of the is-a tree (``_tree``): the deepest of
-        its chain of superclasses that is above x too. Each such ancestor of x owns a slice of the read
-        tree nodes in pre-order; filled shallowest first, a deeper one overwrites its own slice."""
+    def _tree_wu_palmer(
+        self,
+        x: int,
+        ups: dict[str, int],
+        split: _ReadSplit,
+        values: FloatArray,
+        isa_related: npt.NDArray[np.bool_],
+        lcs: IntArray,
+    ) -> None:
+        """``_wu_palmer_or_root`` at the read nodes of the is-a tree (``_tree``). A tree node's common
+        superclass with x is the deepest of its chain of superclasses that is above x too: each such
+        ancestor a of x owns the slice of the read tree nodes (in pre-order) below it, filled shallowest
+        first so that a deeper one overwrites its own slice. With N1 the links from x up to a, a node c
+        of depth D gets 2 d(a) / (N1 + d(a) + D), or 1 / (1 + N1 + D) when a is the root."""
         tree = self._tree()
-        above = [(self.ids[a], dx) for a, dx in ups.items() if tree.pure[self.ids[a]]]
-        above.sort(key=lambda item: int(self.depth[item[0]]))
+        above = sorted(((self.ids[a], dx) for a, dx in ups.items() if tree.pure[self.ids[a]]), key=self._depth_of)
         ids = np.array([a for a, _ in above], dtype=np.int64)
-        low = np.searchsorted(split.tree_entry, tree.start[ids])
-        high = np.searchsorted(split.tree_entry, tree.end[ids])
-        owner = np.empty(len(split.tree), dtype=np.int64)
-        links = np.empty(len(split.tree), dtype=np.int64)
-        for (a, dx), lo, hi in zip(above, low.tolist(), high.tolist(), strict=True):
-            owner[lo:hi] = a
-            links[lo:hi] = dx
-        common[split.tree] = owner  # the root is pure and above everything: every slot is filled
-        total[split.tree] = links + self.depth[split.tree_ids] - self.depth[owner]
+        links = np.array([dx for _, dx in above], dtype=np.float64)
+        depth = self.depth[ids].astype(np.float64)
+        top = depth == 0  # the root, whose slice is every read tree node
+        numerator = np.where(top, 1.0, 2.0 * depth)
+        offset = np.where(top, 1.0 + links, links + depth)
+        low = np.searchsorted(split.tree_entry, tree.start[ids]).tolist()
+        high = np.searchsorted(split.tree_entry, tree.end[ids]).tolist()
+        slot = np.empty(len(split.tree), dtype=np.intp)
+        for k, (lo, hi) in enumerate(zip(low, high, strict=True)):
+            slot[lo:hi] = k
+        at = split.tree_ids
+        values[at] = numerator[slot] / (offset[slot] + split.tree_depth)
+        lcs[at] = ids[slot]
+        if tree.pure[x]:  # x is the last (deepest) of them: its slice is what lies below it
+            isa_related[at[low[-1] : high[-1]]] = True
+        read = self._used
+        isa_related[[a for a in ids[~top].tolist() if a in read or not read]] = True
 
-    def _lcs_of_other_nodes(self, ups: dict[str, int], split: _ReadSplit, common: IntArray, total: IntArray) -> None:
+    def _depth_of(self, item: tuple[int, int]) -> int:
+        return int(self.depth[item[0]])
+
+    def _lcs_of_other_nodes(self, ups: dict[str, int], split: _ReadSplit) -> tuple[IntArray, IntArray]:
         """The common superclass with x of the read nodes with more than one way up (multiple
         inheritance): deeper ancestors of x first, each node settled by the first that has it; among
-        ancestors of one depth the smallest N1 + N2, then the larger name rank, wins."""
+        ancestors of one depth the smallest N1 + N2, then the larger name rank, wins. Returns, for each of
+        those nodes, the common superclass and N1 + N2 (the links from x and from the node up to it)."""
         read = split.general_ids
         position = split.general_position
         limit = (1 << _SUM_BITS) - 1
@@ -460,8 +482,7 @@ class VectorSpace:
                 best[at] = candidate[at]
             for at, _ in found:
                 settled[at] = True
-        common[split.general] = best & limit  # name rank is the node id
-        total[split.general] = limit - ((best >> _SUM_BITS) & limit)
+        return best & limit, limit - ((best >> _SUM_BITS) & limit)  # name rank is the node id
 
     def _tree(self) -> _Tree:
         """The is-a tree inside the taxonomy: the nodes with one way up (one is-a parent, itself in the
@@ -502,7 +523,9 @@ class VectorSpace:
             general = np.flatnonzero(~inside)
             position = np.full(self.taxonomy_size, -1, dtype=np.int64)
             position[read[general]] = np.arange(len(general))
-            self._split = _ReadSplit(at, read[at], tree.start[read[at]], general, read[general], position)
+            ids = read[at]
+            depth = self.depth[ids].astype(np.float64)
+            self._split = _ReadSplit(at, ids, tree.start[ids], depth, general, read[general], position)
         return self._split
 
     def _below_general(self, node: int) -> tuple[IntArray, IntArray]:
@@ -590,6 +613,14 @@ class VectorSpace:
         result = np.zeros(len(part), dtype=bool)
         if not len(part):
             return result
+        if superclass.min() >= 0:
+            counts = np.bincount(superclass)
+            distinct = np.flatnonzero(counts)
+            if len(distinct) <= _STACKED_MASKS:  # one gather from the masks stacked
+                table = np.stack([self.parts_mask(int(d)) for d in distinct.tolist()])
+                row = np.zeros(len(counts), dtype=np.intp)
+                row[distinct] = np.arange(len(distinct))
+                return np.asarray(table[row[superclass], part], dtype=bool)
         order = np.argsort(superclass, kind="stable")
         ordered = superclass[order]
         starts = np.flatnonzero(np.concatenate(([True], ordered[1:] != ordered[:-1])))
@@ -603,11 +634,14 @@ class VectorSpace:
         """For every concept id: is it a part of concept ``whole``, its own or inherited (TaxonomyIndex.parts_of)?"""
         found = self._parts_masks.get(whole)
         if found is None or len(found) != len(self.names):
+            parts = self.index.parts_of(self.names[whole]) if whole < self.taxonomy_size else frozenset()
+            if not parts:  # most classes have none: one shared, read-only array answers for them all
+                if self._no_parts is None or len(self._no_parts) != len(self.names):
+                    self._no_parts = np.zeros(len(self.names), dtype=bool)
+                    self._no_parts.flags.writeable = False
+                return self._no_parts
             found = np.zeros(len(self.names), dtype=bool)
-            if whole < self.taxonomy_size:
-                parts = self.index.parts_of(self.names[whole])
-                if parts:
-                    found[[self.ids[p] for p in parts]] = True
+            found[[self.ids[p] for p in parts]] = True
             self._parts_masks[whole] = found
         return found
 

@@ -116,3 +116,35 @@ def test_opposite_names_are_found_by_their_forms_as_pair_by_pair() -> None:
             found_any |= expected
             assert bool(mask[space.ids[NS + second]]) == expected, (first, second)
     assert found_any
+
+
+@pytest.mark.parametrize("seed", [1, 4])
+def test_parts_worked_out_superclasses_first_are_the_inherited_ones(seed: int) -> None:
+    index = _tangled(seed)
+    expected = {
+        node: frozenset(
+            child
+            for owner in index.ancestors(node, is_a_only=True)
+            if owner != ROOT
+            for child, kind in index.child_links(owner)
+            if kind == "has-part"
+        )
+        for node in index.nodes()
+    }
+    assert any(expected.values())
+    assert index._all_parts() == expected
+    assert {node: index.parts_of(node) for node in index.nodes()} == expected
+
+
+def test_implied_parts_answer_element_by_element_as_parts_of() -> None:
+    index = _tangled(2)
+    space = VectorSpace(index)
+    nodes = index.nodes()
+    rng = random.Random(2)
+    wholes = np.array([space.ids[rng.choice(nodes)] for _ in range(500)], dtype=np.int64)
+    parts = np.array([space.ids[rng.choice(nodes)] for _ in range(500)], dtype=np.int64)
+    for few in (wholes, wholes % 7 + space.ids[nodes[0]]):  # many distinct superclasses, then a few
+        found = space.implied(few, parts)
+        expected = [space.names[p] in index.parts_of(space.names[w]) for w, p in zip(few, parts, strict=True)]
+        assert found.tolist() == expected
+    assert any(expected)
