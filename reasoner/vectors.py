@@ -190,8 +190,12 @@ class VectorSpace:
                     self._below_general(self.ids[ancestor])
 
     def warm_lexical(self, measure: SemStr) -> None:
-        """Build now the core-word index and the lexicon's tables that cross-branch links read."""
+        """Build now the core-word indexes (cross-branch links, antonyms), the groups of complementary
+        words and the lexicon's tables that the first vectors would otherwise build."""
         self._core_index(measure)
+        self._forms_index()
+        if measure.config.complement_weight:
+            self._complement_groups()
         measure.lexicon.warm()
 
     def _read_at(self) -> list[int]:
@@ -293,8 +297,7 @@ class VectorSpace:
         if not mine:
             return
         groups = self._complement_groups()
-        keep = (groups.ids != x) & ~isa_related[groups.ids] & (values[groups.ids] > 0)
-        if not keep.any():
+        if not len(groups.ids):
             return
         words = np.vstack([self._word_row(measure, word, groups.vocabulary) for word in mine])  # k x V
         first = np.maximum.reduceat(words[:, groups.flat], groups.starts, axis=1).sum(axis=0)
@@ -302,8 +305,15 @@ class VectorSpace:
         similarity = (first + second) / (len(mine) + groups.counts)
         weight = measure.config.complement_weight
         factors = 1 - weight + weight * similarity
-        ids = groups.ids[keep]
-        values[ids] *= factors[groups.group[keep]]
+        changing = factors != 1.0  # a factor of 1 leaves its group's values as they are
+        if not changing.any():
+            return
+        at, group = groups.ids, groups.group
+        if not changing.all():
+            chosen = changing[group]
+            at, group = at[chosen], group[chosen]
+        keep = (at != x) & ~isa_related[at] & (values[at] > 0)
+        values[at[keep]] *= factors[group[keep]]
 
     def _word_row(self, measure: SemStr, word: str, vocabulary: list[str]) -> FloatArray:
         """measure.word_similarity(word, v) for every v of ``vocabulary`` (cached while it stays the same)."""
@@ -566,10 +576,11 @@ class VectorSpace:
         """For every concept id: is it declared (or by a superclass implied) disjoint with ``concept``?"""
         found = self._disjoint.get(concept)
         if found is None or len(found) != len(self.names):
-            found = np.zeros(len(self.names), dtype=bool)
             others = self.index.disjoint_with(concept)
-            if others:
-                found[[self.ids[other] for other in others]] = True
+            if not others:
+                return self._none()
+            found = np.zeros(len(self.names), dtype=bool)
+            found[[self.ids[other] for other in others]] = True
             self._disjoint[concept] = found
         return found
 
@@ -580,14 +591,17 @@ class VectorSpace:
         found = self._opposites.get(concept)
         if found is None or len(found) != len(self.names):
             word = core_split(local_name(concept))[0]
+            if len(word) < antonyms.MIN_LETTERS:
+                return self._none()
+            known = antonyms.table()
+            by_form = self._forms_index()
+            hits = {i for f in antonyms.forms(word) for t in known.get(f, ()) for i in by_form.get(t, ())}
+            lower = word.lower()
+            hits = {i for i in hits if self._core_word(i).lower() != lower}
+            if not hits:
+                return self._none()
             found = np.zeros(len(self.names), dtype=bool)
-            if len(word) >= antonyms.MIN_LETTERS:
-                known = antonyms.table()
-                by_form = self._forms_index()
-                hits = {i for f in antonyms.forms(word) for t in known.get(f, ()) for i in by_form.get(t, ())}
-                lower = word.lower()
-                hits = {i for i in hits if self._core_word(i).lower() != lower}
-                found[list(hits)] = True
+            found[list(hits)] = True
             self._opposites[concept] = found
         return found
 
@@ -635,15 +649,20 @@ class VectorSpace:
         found = self._parts_masks.get(whole)
         if found is None or len(found) != len(self.names):
             parts = self.index.parts_of(self.names[whole]) if whole < self.taxonomy_size else frozenset()
-            if not parts:  # most classes have none: one shared, read-only array answers for them all
-                if self._no_parts is None or len(self._no_parts) != len(self.names):
-                    self._no_parts = np.zeros(len(self.names), dtype=bool)
-                    self._no_parts.flags.writeable = False
-                return self._no_parts
+            if not parts:
+                return self._none()
             found = np.zeros(len(self.names), dtype=bool)
             found[[self.ids[p] for p in parts]] = True
             self._parts_masks[whole] = found
         return found
+
+    def _none(self) -> npt.NDArray[np.bool_]:
+        """False for every concept id: one shared, read-only array answers for the many concepts without
+        parts, disjoint classes or antonyms (the caches then keep only the masks that say something)."""
+        if self._no_parts is None or len(self._no_parts) != len(self.names):
+            self._no_parts = np.zeros(len(self.names), dtype=bool)
+            self._no_parts.flags.writeable = False
+        return self._no_parts
 
     def delivered(self, concept: str, below: bool, step: float) -> FloatArray:
         """1 - step * k at every concept k is-a links below ``concept`` (a taxonomy node; above it when
