@@ -444,6 +444,22 @@ def test_a_reader_that_does_not_read_keeps_only_its_queue(server: RunningBridge,
     assert seen == sorted(seen) and len(seen) < 64
 
 
+def test_a_topic_the_server_takes_over_refuses_its_client_publisher(
+    bridge: Bridge, client: Callable[[], Client]
+) -> None:
+    talker, listener = client(), client()
+    listener.send(op="subscribe", topic="/test/taken")
+    listener.sync()
+    talker.send(op="advertise", topic="/test/taken", type="test/State")
+    talker.send(op="publish", topic="/test/taken", msg={"n": 1})
+    assert listener.expect("publish")["msg"] == {"n": 1}
+    bridge.add_topic("/test/taken", "test/State")
+    talker.send(op="publish", topic="test/taken", msg={"n": 2}, id="late")
+    status = talker.expect("status")
+    assert "belongs to this server" in status["msg"] and status["id"] == "late"
+    listener.nothing()
+
+
 def test_server_topics_publish_from_any_thread_and_latch(bridge: Bridge, client: Callable[[], Client]) -> None:
     bridge.add_topic("/test/state", "test/State", latch=True)
     bridge.publish("/test/state", {"state": "idle"})

@@ -392,15 +392,17 @@ class Bridge:
 
     def _publish(self, session: Session, message: Message) -> None:
         # every message a client publishes passes here: keep it lean (bench/rosbridge_relay.py)
-        name = protocol.resolve(message["topic"], "topic")
+        spelling = message["topic"]
+        name = spelling if spelling[:1] == "/" else protocol.resolve(spelling, "topic")
         with self._graph.lock:
             topic = self._graph.topics.get(name)
-            self._refuse_owned_topic(name, topic)
-            if topic is None:
-                raise ProtocolError(f"topic {name!r} is not advertised: send advertise (with its type) first")
-            if session not in topic.publishers:
+            # a publisher of the topic has passed the checks: only the server may take the topic since
+            if topic is None or topic.server or session not in topic.publishers:
+                self._refuse_owned_topic(name, topic)
+                if topic is None:
+                    raise ProtocolError(f"topic {name!r} is not advertised: send advertise (with its type) first")
                 topic.publishers.add(session)
-                session.advertised.setdefault(name, message["topic"])
+                session.advertised.setdefault(name, spelling)
             latch = topic.latch or message.get("latch")
             subscribers = list(topic.subscribers)
         if not (subscribers or latch):  # nobody to send it to, now or later: not even encoded
@@ -611,6 +613,10 @@ class Bridge:
             with self._graph.lock:
                 topic = self._graph.topics.get(name)
                 subscribers = list(topic.subscribers) if topic is not None else []
+        if len(subscribers) == 1:  # the usual case, with no table of spellings to keep
+            session = subscribers[0]
+            session.offer(name, protocol.publish_text(session.spelling.get(name, name), text))
+            return
         framed: dict[str, str] = {}
         for session in subscribers:
             spelling = session.spelling.get(name, name)

@@ -141,7 +141,8 @@ class Session:
         if queue is None or self.closed:
             return
         before = queue.dropped
-        queue.push(self._next_seq(), text)
+        self._seq += 1
+        queue.push(self._seq, text)
         if queue.dropped != before and (queue.dropped & (queue.dropped - 1)) == 0:
             log.debug("%s: dropped %d messages of %s (queue of %d)", self.name, queue.dropped, topic, queue.capacity)
         self._wake()
