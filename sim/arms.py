@@ -428,16 +428,22 @@ class Arm:
         """
         candidates = [orientation, flipped(orientation)] if symmetric else [orientation]
         current = self.joint_positions()
+        others = self._others()
         best: _Solution | None = None
         for candidate in candidates:
+            found = []
             for seed in (*_SEEDS, current):
                 solution = self._kinematics.solve(self.side, position, candidate, [seed])
-                if solution.position_error > IK_TOLERANCE or solution.orientation_error > 0.02:
-                    continue
-                if not self._kinematics.path_clear(self.side, current, solution.q, self._others(), min_height):
-                    continue
-                if best is None or _joint_distance(current, solution.q) < _joint_distance(current, best.q):
+                if solution.position_error <= IK_TOLERANCE and solution.orientation_error <= 0.02:
+                    found.append(solution)
+            # Nearest first (a stable sort keeps the seeds' order among equals): the first whose path is
+            # clear is the nearest clear one, so the farther ones' paths need no checking.
+            for solution in sorted(found, key=lambda s: _joint_distance(current, s.q)):
+                if best is not None and not _joint_distance(current, solution.q) < _joint_distance(current, best.q):
+                    break
+                if self._kinematics.path_clear(self.side, current, solution.q, others, min_height):
                     best = solution
+                    break
             if best is not None and min_height is None:
                 break
         if best is None:
