@@ -452,7 +452,9 @@ class Matchmaker:
         """Parts both concepts have through their common superclass: no evidence of their own."""
         if first not in self.index or second not in self.index:
             return frozenset()
-        common, _, _ = self.index.common_ancestor(first, second)
+        common = self._pool.space.cached_superclass(first, second) if self._pool is not None else None
+        if common is None:
+            common, _, _ = self.index.common_ancestor(first, second)
         return self.index.parts_of(common)
 
     def _observed(

@@ -295,7 +295,8 @@ class TaxonomyIndex:
         """
         up_first = self.ancestors(first, is_a_only=True)
         up_second = self.ancestors(second, is_a_only=True)
-        common = set(up_first) & set(up_second)
+        small, large = (up_first, up_second) if len(up_first) <= len(up_second) else (up_second, up_first)
+        common = [c for c in small if c in large]  # the root is above both: never empty
         best = max(common, key=lambda c: (self._depth[c], -(up_first[c] + up_second[c]), c))
         return best, up_first[best], up_second[best]
 

@@ -225,6 +225,16 @@ class VectorSpace:
             self._cache[key] = found
         return found
 
+    def cached_superclass(self, first: str, second: str) -> str | None:
+        """The most specific common superclass of two taxonomy nodes (TaxonomyIndex.common_ancestor) read
+        from the cached table of either, or None when neither is cached or the other is not read here."""
+        for concept, other in ((first, second), (second, first)):
+            table = self._lcs.get(self.ids[self.index.canonical(concept)])
+            at = self.ids[self.index.canonical(other)]
+            if table is not None and (at in self._used or not self._used):
+                return self.names[int(table[at])]
+        return None
+
     def cached_value(self, measure: EntityMeasure, first: str, second: str) -> float | None:
         """measure(first, second) read from a cached vector of either concept (the measures this is asked
         for are symmetric), or None when neither is cached or the other concept has no id here."""
