@@ -52,7 +52,7 @@ def serve(
     read-only, and --read-only refuses every write (updates, task runs, recorded plans). Ctrl-C stops both
     listeners cleanly.
     """
-    from cbrs.server import ServeConfig, Server  # waitress and websockets load only for this command
+    from cbrs.server import ServeConfig, Server  # Granian, Flask and websockets load only for this command
 
     level = setting("log_level").resolve(log_level.upper() if log_level else None)
     logging.basicConfig(format="%(asctime)s %(name)s %(levelname)s: %(message)s")
