@@ -22,6 +22,7 @@ from cbrs.reasoner.spans import span
 from cbrs.reasoner.vectors import FloatArray, IntArray, VectorSpace
 
 PARTS = ("outputs", "inputs", "effects", "preconditions")
+_PADDED = 8  # _Segments: the longest segment reduced by padded rows (numpy sums 8 items or fewer in order)
 
 
 class _Segments:
@@ -37,8 +38,31 @@ class _Segments:
         self._starts = self.starts[self._owners]
         self._body = self.flat[:-1]
         self._full = len(self._owners) == len(self.counts) > 0  # every segment has items
+        # Segments of up to _PADDED items: one row of indices per position, so that max and mean are a
+        # few gathers instead of a reduceat (several times faster on 100,000 advertisements). Past a
+        # segment's end a max row repeats its first item and a sum row reads an appended 0 (index -1);
+        # the sum adds the first item to the sum of the rest, as reduceat does, so the means are the same.
+        self._max_rows: npt.NDArray[np.intp] | None = None
+        self._sum_rows: npt.NDArray[np.intp] | None = None
+        longest = int(self.counts.max(initial=0))
+        if 0 < longest <= _PADDED:
+            first = np.where(self.present, self.flat[np.minimum(self.starts, len(self._body))], 0)
+            self._max_rows = np.empty((longest, len(self.counts)), dtype=np.intp)
+            self._sum_rows = np.empty((longest, len(self.counts)), dtype=np.intp)
+            for j in range(longest):
+                has = self.counts > j
+                at = self.flat[np.where(has, self.starts + j, 0)]
+                self._max_rows[j] = np.where(has, at, first)
+                self._sum_rows[j] = np.where(has, at, -1)
 
     def max(self, values: FloatArray) -> FloatArray:
+        if self._max_rows is not None:
+            found = np.take(values, self._max_rows[0])
+            for row in self._max_rows[1:]:
+                np.maximum(found, np.take(values, row), out=found)
+            if not self._full:
+                found[~self.present] = 0.0
+            return np.asarray(found, dtype=np.float64)
         if self._full:
             return np.asarray(np.maximum.reduceat(values[self._body], self._starts), dtype=np.float64)
         result = np.zeros(len(self.counts), dtype=np.float64)
@@ -47,6 +71,17 @@ class _Segments:
         return result
 
     def mean(self, values: FloatArray) -> FloatArray:
+        if self._sum_rows is not None:
+            padded = np.append(values, 0.0)
+            total = np.take(padded, self._sum_rows[0])
+            if len(self._sum_rows) > 1:
+                rest = np.take(padded, self._sum_rows[1])
+                for row in self._sum_rows[2:]:
+                    rest += np.take(padded, row)
+                total += rest
+            result = np.zeros(len(self.counts), dtype=np.float64)
+            np.divide(total, self.counts, out=result, where=self.present)
+            return result
         if self._full:
             return np.asarray(np.add.reduceat(values[self._body], self._starts) / self.counts, dtype=np.float64)
         result = np.zeros(len(self.counts), dtype=np.float64)

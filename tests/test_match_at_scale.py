@@ -148,3 +148,22 @@ def test_implied_parts_answer_element_by_element_as_parts_of() -> None:
         expected = [space.names[p] in index.parts_of(space.names[w]) for w, p in zip(few, parts, strict=True)]
         assert found.tolist() == expected
     assert any(expected)
+
+
+@pytest.mark.parametrize("longest", [1, 3, 8, 12])
+def test_segment_reductions_by_padded_rows_equal_reduceat(longest: int) -> None:
+    from cbrs.reasoner.batch import _Segments
+
+    rng = np.random.default_rng(longest)
+    values = rng.random(300) * rng.choice([1e-3, 1.0, 1e3], 300)
+    for low in (0, 1):  # with empty segments, then without
+        lists = [rng.integers(0, 300, int(rng.integers(low, longest + 1))).tolist() for _ in range(2000)]
+        segments = _Segments(lists)
+        present = [i for i, items in enumerate(lists) if items]
+        starts = np.cumsum([0] + [len(items) for items in lists])[:-1][present]
+        flat = np.array([i for items in lists for i in items], dtype=np.int64)
+        maxima, means = np.zeros(len(lists)), np.zeros(len(lists))
+        maxima[present] = np.maximum.reduceat(values[flat], starts)
+        means[present] = np.add.reduceat(values[flat], starts) / np.array([len(lists[i]) for i in present])
+        assert np.array_equal(segments.max(values), maxima)
+        assert np.array_equal(segments.mean(values), means)  # the same sums, bit for bit
