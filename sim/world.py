@@ -531,6 +531,7 @@ class HomeWorld:
         self._build_robot()
         self._build_base()
         self._build_person()
+        self._draw_floor_last()
         for iri in sorted(self.map.cameras):
             cam = self.map.cameras[iri]
             direction = cam.direction
@@ -561,6 +562,22 @@ class HomeWorld:
             wall = self.map.things.get(iri)
             if wall is not None:
                 self._solid(wall.name, wall.box, _WALL)
+
+    def _draw_floor_last(self) -> None:
+        """Draw the floor after everything that stands on it. The TINY renderer draws bodies in the
+        order they were made and shades every pixel that passes the depth test so far: drawn first,
+        the floor was shaded wherever the table, the robots and the walls then covered it (a quarter
+        of a Kinect frame's time). A body with the floor's look and no collision shape, made last,
+        draws it; the floor body keeps its collision shape and its colour, made invisible, so that
+        physics and everything that reads the floor's colour are as they were."""
+        c = self.client
+        floor = self._bodies["Floor"]
+        (_, _, _, size, _, _, _, rgba, *_), *_ = p.getVisualShapeData(floor, physicsClientId=c)
+        position, orientation = p.getBasePositionAndOrientation(floor, physicsClientId=c)
+        half = (size[0] / 2, size[1] / 2, size[2] / 2)
+        look = p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=rgba, physicsClientId=c)
+        p.createMultiBody(0.0, -1, look, position, orientation, physicsClientId=c)
+        p.changeVisualShape(floor, -1, rgbaColor=(rgba[0], rgba[1], rgba[2], 0.0), physicsClientId=c)
 
     @property
     def extent(self) -> Region:

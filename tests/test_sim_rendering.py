@@ -107,3 +107,23 @@ def test_a_look_for_people_renders_every_camera_looking_down() -> None:
             "CeilingCamera02": 1,
             "Kinect01": 0,
         }
+
+
+def test_the_floor_is_drawn_last_by_a_body_of_its_own_and_keeps_its_collision_shape_and_colour() -> None:
+    with open_world(seed=0) as world:
+        c = world.client
+        floor = world.body("Floor")
+        assert p.getCollisionShapeData(floor, -1, physicsClientId=c)
+        (*_, rgba), *_ = [shape[:8] for shape in p.getVisualShapeData(floor, physicsClientId=c)]
+        assert rgba[3] == 0.0 and rgba[:3] != (0.0, 0.0, 0.0)  # invisible, its colour still readable
+        drawing = p.getBodyUniqueId(p.getNumBodies(physicsClientId=c) - 1, physicsClientId=c)
+        assert drawing not in world.bodies.values()
+        assert not p.getCollisionShapeData(drawing, -1, physicsClientId=c)
+        assert p.getVisualShapeData(drawing, physicsClientId=c)[0][7] == (*rgba[:3], 1.0)
+        # below the ceiling camera (4.5 m up, over the living room's bare floor) the floor is drawn
+        frame = world.camera("CeilingCamera01").capture()
+        assert frame.depth[120, 160] == pytest.approx(4.5, abs=0.01)
+        red, green, blue = (int(v) for v in frame.rgb[120, 160])
+        assert (
+            max(red, green, blue) < 250 and max(red, green, blue) - min(red, green, blue) < 10
+        )  # grey, not the white background
