@@ -12,11 +12,15 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from platformdirs import user_data_dir
+from platformdirs import user_cache_dir, user_data_dir
 
 
 def _default_store() -> str:
     return str(Path(user_data_dir("cbrs", appauthor=False)) / "store")
+
+
+def _default_seed_cache() -> str:
+    return user_cache_dir("cbrs", appauthor=False)
 
 
 def _port(text: str) -> int:
@@ -252,6 +256,14 @@ SETTINGS: tuple[Setting, ...] = (
         "other servers (docs/remote-store.md).",
         "CBRS_REMOTE_BATCH",
         _batch,
+    ),
+    Setting(
+        "seed_cache",
+        _default_seed_cache,
+        "Folder where the seed of a new embedded store is kept, by a digest of the bundled files and the kb "
+        "code, so that later new stores copy it (milliseconds instead of a third of a second); off keeps it "
+        "only within a process. Read by cbrs.kb itself, so it applies to library use too.",
+        "CBRS_SEED_CACHE",
     ),
     Setting(
         "max_result_bytes",

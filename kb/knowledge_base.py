@@ -19,6 +19,7 @@ from cbrs.kb.queries import QueryLibrary
 from cbrs.kb.query_guard import QueryGuard
 from cbrs.kb.registry import ComponentRegistry
 from cbrs.kb.resources import bundled_files, query_dir
+from cbrs.kb.seed_cache import SeedCache, bundle_digest
 from cbrs.kb.shapes import checked_update
 from cbrs.kb.standard_terms import Refresh, StandardTerms
 from cbrs.kb.store import EmbeddedStore, QueryResult, Store, Term, is_remote
@@ -48,6 +49,7 @@ class KnowledgeBase:
         remote_access: tuple[str, ...] = (),
         remote_token: str | None = None,
         remote_batch: int | None = None,
+        seed_cache: SeedCache | None = None,
     ) -> KnowledgeBase:
         """Open the store at ``location`` (a directory, ``:memory:`` or an endpoint URL), seeding it on first use.
 
@@ -56,7 +58,8 @@ class KnowledgeBase:
         (:mod:`kb.remote_access`; none by default). ``remote_token`` goes with every request to a remote
         store, as a bearer token: a ``cbrs serve``'s update token. ``remote_batch`` is the most quads one
         write request to a remote store carries (None: chosen by the server); larger writes are staged
-        (:mod:`kb.staged_writes`).
+        (:mod:`kb.staged_writes`). A new embedded store is seeded from ``seed_cache``'s copy when it
+        holds one for this bundle (:mod:`kb.seed_cache`; None: :meth:`SeedCache.default`).
         """
         remote_options = (remote_timeout, remote_token, remote_batch)
         if is_remote(str(location)) and any(option is not None for option in remote_options):
@@ -71,7 +74,7 @@ class KnowledgeBase:
             store.guard = QueryGuard(timeout=check_timeout)
         kb = cls(store)
         if seed and not kb.store.is_seeded():
-            kb.seed()
+            kb._seed_kept(seed_cache or SeedCache.default())
         elif seed:
             kb.upgrade()
             if kb._map_outdated():
@@ -146,6 +149,19 @@ class KnowledgeBase:
         self._reader.clear_cache()
         self._entail()
         return parsed
+
+    def _seed_kept(self, cache: SeedCache) -> None:
+        """Seed from ``cache``'s copy of this bundle's seed, else in full and keep the result. A remote
+        store is always seeded in full: its server works graph:entailed out for itself."""
+        if not isinstance(self.store, EmbeddedStore):
+            self.seed()
+            return
+        digest = bundle_digest()
+        if cache.restore(digest, self.store):
+            self._reader.clear_cache()
+            return
+        self.seed()
+        cache.keep(digest, self.store)
 
     def load(
         self,
