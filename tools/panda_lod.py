@@ -1,6 +1,7 @@
 """Make the Panda arm's camera-detail visual meshes (``sim/meshes/panda_lod/``) from pybullet_data's.
 
-Run: python tools/panda_lod.py [--keep 0.1] [--out sim/meshes/panda_lod]
+Run: python tools/panda_lod.py [--keep 0.1] [--whole hand,finger] [--out sim/meshes/panda_lod]
+     python tools/panda_lod.py --compare docs/arm-detail.png   (the two arms side by side, full | reduced)
 
 The TINY renderer draws every triangle of every visual mesh at every render, whatever the image size:
 pybullet_data's Panda has about 102,000 visual triangles an arm, which cost about 35 ms of a 50-70 ms
@@ -162,6 +163,26 @@ def write_obj(obj: Obj, keep: float, target: Path, source: Path) -> int:
     return triangles
 
 
+def compare(target: Path) -> None:
+    """Save a 640 x 480 close-up of the dual-arm robot drawn with each ``ArmDetail``, side by side."""
+    import pybullet as p
+    from PIL import Image
+
+    from cbrs.sim.arms import ArmDetail
+    from cbrs.sim.cameras import render
+    from cbrs.sim.world import open_world
+
+    images = []
+    for detail in (ArmDetail.FULL, ArmDetail.REDUCED):
+        with open_world(seed=0, arm_detail=detail) as world:
+            view = p.computeViewMatrix((7.75, 1.6, 1.5), (7.75, 2.6, 0.9), (0.0, 0.0, 1.0))
+            projection = p.computeProjectionMatrixFOV(45.0, 640 / 480, 0.1, 10.0)
+            rgba, _ = render(world.client, 640, 480, view, projection)
+            images.append(np.reshape(np.asarray(rgba, dtype=np.uint8), (480, 640, 4))[:, :, :3])
+    Image.fromarray(np.concatenate(images, axis=1)).save(target)
+    print(f"written to {target}: {ArmDetail.FULL.value} | {ArmDetail.REDUCED.value}")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--keep", type=float, default=0.1, help="fraction of each part's triangles kept")
@@ -171,7 +192,11 @@ def main() -> None:
         help="meshes kept whole (comma-separated stems): the parts that reach into view",
     )
     parser.add_argument("--out", type=Path, default=OUT)
+    parser.add_argument("--compare", type=Path, metavar="PNG", help="only draw the arms both ways into PNG")
     args = parser.parse_args()
+    if args.compare is not None:
+        compare(args.compare)
+        return
     out: Path = args.out
     (out / "meshes" / "visual").mkdir(parents=True, exist_ok=True)
     (out / "meshes" / "collision").mkdir(parents=True, exist_ok=True)
