@@ -16,6 +16,7 @@ The SEA and QoS of the requirement act as filters. "No acceptable match" is a st
 
 from __future__ import annotations
 
+import gc
 import math
 import threading
 from collections.abc import Callable, Sequence
@@ -140,6 +141,9 @@ class Matchmaker:
             space.warm_lexical(self.method.measure)
         if self.method.text:
             self._text_index(ads)
+        # The set-up leaves many new long-lived objects, which make a full garbage collection due: run
+        # it now rather than in the middle of a later ranking (some 50 ms over OWLS-TC in cbrs eval).
+        gc.collect()
         return self
 
     def _text_index(self, ads: list[Advertisement]) -> TextIndex:

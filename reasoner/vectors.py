@@ -180,6 +180,8 @@ class VectorSpace:
     def warm(self) -> None:
         """Build now the descendant arrays that vectors for the handed-out concepts will need (those of
         their superclasses only when some read node lies outside the is-a tree)."""
+        import numpy.ma  # noqa: F401  (np.unique and np.isin import it on first use: some 20 ms of a first ranking)
+
         general = len(self._read_split().general) > 0
         for i in sorted(self._used):
             if i < self.taxonomy_size:
@@ -498,7 +500,7 @@ class VectorSpace:
                 candidate = np.full(len(read), -1, dtype=np.int64)
                 for at, keys in found:
                     candidate[at] = np.maximum(candidate[at], keys)  # positions distinct within one ancestor
-                at = np.unique(np.concatenate([at for at, _ in found]))
+                at = np.concatenate([at for at, _ in found])  # repeated positions get the same value
                 best[at] = candidate[at]
             for at, _ in found:
                 settled[at] = True
