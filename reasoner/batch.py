@@ -19,7 +19,7 @@ from cbrs.reasoner.antonyms import table as antonym_table
 from cbrs.reasoner.config import MatchConfig
 from cbrs.reasoner.similarity import EntityMeasure, SemStr
 from cbrs.reasoner.spans import span
-from cbrs.reasoner.vectors import FloatArray, IntArray, VectorSpace
+from cbrs.reasoner.vectors import ARRAY_CACHE_BYTES, FloatArray, IntArray, VectorSpace, _Lru, _nbytes
 
 PARTS = ("outputs", "inputs", "effects", "preconditions")
 _PADDED = 8  # _Segments: the longest segment reduced by padded rows (numpy sums 8 items or fewer in order)
@@ -145,7 +145,7 @@ class CompiledPool:
         self.tree_ids = {concept: i for i, concept in enumerate(trees)}
         self._layout_trees(list(trees.values()))
         self.statements = list(statements)
-        self._opposites: dict[Statement, npt.NDArray[np.bool_]] = {}
+        self._opposites: _Lru[Statement, npt.NDArray[np.bool_]] = _Lru(ARRAY_CACHE_BYTES, _nbytes)  # bounded
         if self.statements:
             antonym_table()  # read once per process here, in prepare(), rather than in the first ranking
         cid = space.add
