@@ -101,3 +101,23 @@ def test_bound_values_are_not_pasted_into_the_text(mini_kb: KnowledgeBase) -> No
     assert rows == []
     query = mini_kb.queries.get("description")
     assert "http://e/x" not in query.text
+
+
+def test_the_texts_that_skip_the_checks_pass_them() -> None:
+    """cbrs's own query texts skip the store's checks (kb.store.check_query); each would pass them."""
+    from cbrs.kb.remote_access import refuse_remote_access
+    from cbrs.kb.store import bundled_query_texts, refuse_deep_nesting
+
+    texts = bundled_query_texts()
+    assert len(texts) > len(list(query_dir().glob("*.rq")))  # the named queries and the entailment rules
+    for text in texts:
+        refuse_deep_nesting(text)
+        refuse_remote_access(text, ())
+
+
+def test_a_text_not_ours_is_still_checked() -> None:
+    from cbrs.kb.remote_access import RemoteAccessError
+
+    store = Store.open(":memory:")
+    with pytest.raises(RemoteAccessError):
+        store.check_query("SELECT * WHERE { SERVICE <http://example.org/sparql> { ?s ?p ?o } }")
