@@ -167,3 +167,16 @@ def test_segment_reductions_by_padded_rows_equal_reduceat(longest: int) -> None:
         means[present] = np.add.reduceat(values[flat], starts) / np.array([len(lists[i]) for i in present])
         assert np.array_equal(segments.max(values), maxima)
         assert np.array_equal(segments.mean(values), means)  # the same sums, bit for bit
+
+
+def test_an_unavailable_component_is_left_out_and_the_explained_head_is_of_those_available() -> None:
+    kb = KnowledgeBase.open(":memory:")
+    requirement = "https://w3id.org/cbrs/requirement#RobotSelfPosition"
+    before = [c.advertisement for c in Matchmaker(kb).rank(requirement, explain=3).candidates]
+    kb.liveness.renew(before[1], ttl=60)
+    kb.liveness.expire(before[1], "its session closed")
+    result = Matchmaker(kb).rank(requirement, explain=3)
+    after = list(result.candidates)
+    assert [c.advertisement for c in after] == [iri for iri in before if iri != before[1]]
+    assert [c.explained for c in after[:4]] == [True, True, True, False]
+    assert len(result.candidates) == len(before) - 1
