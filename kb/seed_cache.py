@@ -55,9 +55,9 @@ def bundle_digest() -> str:
     inputs += sorted(query_dir().glob("*.rq")) + sorted(code.glob("*.py"))
     digest = hashlib.sha256()
     for path in inputs:
-        digest.update(path.name.encode("utf-8") + b"\0")
-        digest.update(path.read_bytes())
-        digest.update(b"\0")
+        for part in (path.name.encode("utf-8"), path.read_bytes()):
+            digest.update(part)
+            digest.update(b"\0")
     return digest.hexdigest()[:32]
 
 
