@@ -69,11 +69,10 @@ _BARE = textwrap.dedent(
 
 
 def cpu_seconds(pid: int) -> float:
-    total = 0
-    for task in Path(f"/proc/{pid}/task").iterdir():
-        fields = (task / "stat").read_text().rsplit(")", 1)[1].split()
-        total += int(fields[11]) + int(fields[12])
-    return total / os.sysconf("SC_CLK_TCK")
+    """User and system CPU of the whole process: /proc/PID/stat counts every thread, also those that
+    have ended (reading each thread's own stat lost an idle thread's time, or raced with its exit)."""
+    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
 def measure(served: Served, entities: int, requests: int) -> tuple[float, float, float]:
