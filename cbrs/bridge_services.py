@@ -76,7 +76,7 @@ class KnowledgeServices:
         self.sparql = sparql
         self.tasks = tasks
         self.matchmakers = matchmakers or Matchmakers(sparql)
-        self.composers = Composers(sparql)
+        self.composers = Composers(sparql, self.matchmakers)
         self.own_origins = own_origins
 
     def may_write(self) -> bool:
@@ -240,8 +240,9 @@ class StepFeed:
 
 
 class Composers:
-    """Composers kept between /cbrs/plan calls, one per objective, sharing the taxonomy index, the
-    action library and the advertisements (building them is most of a call's time).
+    """Composers kept between /cbrs/plan calls, one per objective, sharing the taxonomy index (with the
+    matchmakers, when given them), the action library and the advertisements (building them is most of
+    a call's time).
 
     They are made again when the store changes: an update through the endpoint or a component
     registered or leaving (``SparqlService.generation``), a component whose lease lapsed (the set of
@@ -250,8 +251,9 @@ class Composers:
     composer is not safe for two compositions at once.
     """
 
-    def __init__(self, sparql: SparqlService) -> None:
+    def __init__(self, sparql: SparqlService, matchmakers: Matchmakers | None = None) -> None:
         self.sparql = sparql
+        self.matchmakers = matchmakers  # whose taxonomy index the composers take: one per store version
         self._version: object = None
         self._built: dict[Objective, Composer] = {}
 
@@ -267,10 +269,12 @@ class Composers:
         composer = self._built.get(objective)
         if composer is None:
             shared = next(iter(self._built.values()), None)
+            matchmakers = self.matchmakers
+            index = shared.index if shared is not None else matchmakers.index() if matchmakers is not None else None
             composer = Composer(
                 kb,
                 ComposeConfig(objective=objective),
-                index=shared.index if shared is not None else None,
+                index=index,
                 actions=shared.actions if shared is not None else None,
                 advertisements=shared.advertisements if shared is not None else None,
             )

@@ -33,17 +33,28 @@ class Matchmakers:
         description registered through another process is matched here at the next ranking.
         """
         from cbrs.reasoner.matchmaker import Matchmaker
+
+        with self._guard:
+            index = self._current()
+            if method not in self._built:
+                shared = next(iter(self._built.values()), None)
+                ads = shared.advertisements if shared is not None else None
+                self._built[method] = Matchmaker(self.sparql.kb, method, index=index, advertisements=ads)
+            return self._built[method]
+
+    def index(self) -> TaxonomyIndex:
+        """The taxonomy index of the store as it is now, which the composers of /cbrs/plan share too;
+        call with the knowledge-base lock held."""
+        with self._guard:
+            return self._current()
+
+    def _current(self) -> TaxonomyIndex:
         from cbrs.reasoner.taxonomy import TaxonomyIndex
 
         kb = self.sparql.kb
         generation: object = self.sparql.generation
         if is_remote(kb.store.location):
             generation = (generation, kb.store.count(GraphName.ONTOLOGY), kb.store.count(GraphName.SERVICES))
-        with self._guard:
-            if generation != self._generation or self._index is None:
-                self._generation, self._index, self._built = generation, TaxonomyIndex.from_kb(kb), {}
-            if method not in self._built:
-                shared = next(iter(self._built.values()), None)
-                ads = shared.advertisements if shared is not None else None
-                self._built[method] = Matchmaker(kb, method, index=self._index, advertisements=ads)
-            return self._built[method]
+        if generation != self._generation or self._index is None:
+            self._generation, self._index, self._built = generation, TaxonomyIndex.from_kb(kb), {}
+        return self._index

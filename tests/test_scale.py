@@ -147,6 +147,16 @@ def test_plan_calls_share_a_composer_until_the_store_changes(services: Knowledge
     assert services.composers.get(Objective.SIMILARITY) is not composer
 
 
+def test_plans_and_rankings_share_one_taxonomy_index_per_store_version(services: KnowledgeServices) -> None:
+    ranked = services.matchmakers.get("sem-str")
+    composer = services.composers.get(Objective.SIMILARITY)
+    assert composer.index is ranked.index is services.matchmakers.index()
+    services.sparql.changed()
+    fresh = services.composers.get(Objective.SIMILARITY)
+    assert fresh.index is not composer.index
+    assert services.matchmakers.get("sem-str").index is fresh.index
+
+
 def test_a_component_whose_lease_lapsed_is_planned_without(services: KnowledgeServices) -> None:
     assert CAMERA in _planned_components(services)
     services.sparql.kb.liveness.expire(CAMERA, "lease lapsed")  # no store generation: seen at the next call
