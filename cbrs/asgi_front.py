@@ -18,21 +18,16 @@ from __future__ import annotations
 
 import asyncio
 import functools
-import json
-import logging
 from collections.abc import Awaitable, Callable, Collection, Iterable
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
-from urllib.parse import unquote_plus, urlsplit
+from urllib.parse import unquote_plus
 
 from a2wsgi import WSGIMiddleware
 from a2wsgi.wsgi import WSGIResponder
-from werkzeug.exceptions import InternalServerError
 
-from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.sparql_service import Answer, SparqlService
-
-log = logging.getLogger("cbrs.web")
+from cbrs.web.sparql_wsgi import COMMON_HEADERS, error_answer, host_allowed, json_body, plain_get, plain_post_length
 
 Scope = dict[str, Any]
 Message = dict[str, Any]
@@ -40,14 +35,8 @@ Receive = Callable[[], Awaitable[Message]]
 Send = Callable[[Message], Awaitable[None]]
 WSGIApp = Callable[[dict[str, Any], Callable[..., Any]], Iterable[bytes]]
 
-_SHORT_FORMAT = ("format", "output")
-_QUERY_TYPE = "application/sparql-query"
-# What every answer of /sparql carries, as the Flask view sends it (cbrs.web.sparql_wsgi._COMMON).
-_COMMON = [
-    (b"vary", b"Accept, Origin"),
-    (b"x-content-type-options", b"nosniff"),
-    (b"referrer-policy", b"same-origin"),
-]
+# What every answer of /sparql carries, as the Flask view sends it.
+_COMMON = [(name.lower().encode("latin-1"), value.encode("latin-1")) for name, value in COMMON_HEADERS]
 # The request headers the front reads; a request repeating one of them goes to Flask, which joins them.
 _READ = frozenset({b"host", b"accept", b"origin", b"content-type", b"content-length"})
 
@@ -95,8 +84,7 @@ class SparqlFront:
             try:
                 body = await asyncio.wait_for(_read_body(receive), self.body_timeout)
             except TimeoutError:
-                message = f"the request body did not arrive within {self.body_timeout:g} s"
-                await _respond(send, False, 408, "application/json", _json({"error": "timeout", "message": message}))
+                await _body_late(send, self.body_timeout)
                 return
             try:
                 text = body.decode("utf-8")
@@ -115,13 +103,9 @@ class SparqlFront:
             if answer is None:
                 run = functools.partial(self.sparql.query, text, accept, short, client=client)
                 answer = await asyncio.get_running_loop().run_in_executor(self._queries, run)
-        except KnowledgeBaseError as error:  # as cbrs.web's error handler answers a non-page request
-            kind = getattr(error, "kind", type(error).__name__)
-            return error.http_status, "application/json", _json({"error": kind, "message": str(error)})
-        except Exception:
-            log.exception("/sparql failed")
-            message = InternalServerError.description
-            return 500, "application/json", _json({"error": "internal-server-error", "message": message})
+        except Exception as error:
+            status, body = error_answer(error)
+            return status, "application/json", body
         return 200, answer.media_type + "; charset=utf-8", answer.body
 
     def _plain_query(self, scope: Scope, headers: dict[bytes, str]) -> tuple[str, str | None, int] | None:
@@ -137,22 +121,11 @@ class SparqlFront:
             return None
         method = scope.get("method")
         if method in ("GET", "HEAD"):
-            names = [name for name, _ in parameters]
-            if names.count("query") != 1 or any(names.count(n) > 1 for n in _SHORT_FORMAT):
-                return None
-            if set(names) - {"query", *_SHORT_FORMAT}:
-                return None
-            values = dict(parameters)
-            return values["query"], values.get("format") or values.get("output"), -1
+            plain = plain_get(parameters)
+            return None if plain is None else (*plain, -1)
         if method == "POST" and not parameters:
-            media_type = headers.get(b"content-type", "").partition(";")[0].strip().lower()
-            try:
-                length = int(headers.get(b"content-length") or "-1")
-            except ValueError:
-                return None
-            if media_type != _QUERY_TYPE or not 0 <= length <= self.max_body:
-                return None
-            return "", None, length
+            length = plain_post_length(headers.get(b"content-type"), headers.get(b"content-length"), self.max_body)
+            return None if length is None else ("", None, length)
         return None
 
     def _host_ok(self, host: str | None) -> bool:
@@ -165,10 +138,7 @@ class SparqlFront:
             self._names, self._hosts = names, {}
         known = self._hosts.get(host)
         if known is None:
-            try:
-                known = urlsplit("//" + host).hostname in names
-            except ValueError:
-                known = False
+            known = host_allowed(host, names)
             if len(self._hosts) < 64:  # the few Host values clients send; other values are not kept
                 self._hosts[host] = known
         return known
@@ -233,8 +203,7 @@ class _Responder(WSGIResponder):
             try:
                 await asyncio.wait_for(body_in.wait(), body_timeout)
             except TimeoutError:
-                message = f"the request body did not arrive within {body_timeout:g} s"
-                await _respond(send, False, 408, "application/json", _json({"error": "timeout", "message": message}))
+                await _body_late(send, body_timeout)
                 return
             if not self.gone:
                 await self(_with_length(scope, size), messages.get, send)  # type: ignore[arg-type]
@@ -317,8 +286,9 @@ def _replay(body: bytes, receive: Receive) -> Receive:
     return again
 
 
-def _json(value: Any) -> bytes:
-    return (json.dumps(value, separators=(",", ":")) + "\n").encode("utf-8")  # as Flask's jsonify writes it
+async def _body_late(send: Send, timeout: float) -> None:
+    message = f"the request body did not arrive within {timeout:g} s"
+    await _respond(send, False, 408, "application/json", json_body({"error": "timeout", "message": message}))
 
 
 async def _respond(send: Send, head: bool, status: int, media_type: str, body: bytes) -> None:

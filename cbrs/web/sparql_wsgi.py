@@ -31,7 +31,7 @@ WSGIApp = Callable[[dict[str, Any], Callable[..., Any]], Iterable[bytes]]
 _SHORT_FORMAT = ("format", "output")
 _QUERY_TYPE = "application/sparql-query"
 # What every answer of /sparql carries (the blueprint's Vary, the app's other after_request headers).
-_COMMON = [("Vary", "Accept, Origin"), ("X-Content-Type-Options", "nosniff"), ("Referrer-Policy", "same-origin")]
+COMMON_HEADERS = (("Vary", "Accept, Origin"), ("X-Content-Type-Options", "nosniff"), ("Referrer-Policy", "same-origin"))
 
 
 class SparqlHotPath:
@@ -57,13 +57,9 @@ class SparqlHotPath:
             answer = self.sparql.query(
                 text, environ.get("HTTP_ACCEPT"), short_format, client=environ.get("REMOTE_ADDR")
             )
-        except KnowledgeBaseError as error:  # as cbrs.web's error handler answers a non-page request
-            kind = getattr(error, "kind", type(error).__name__)
-            return _json(start_response, environ, error.http_status, {"error": kind, "message": str(error)})
-        except Exception:
-            log.exception("/sparql failed")
-            message = InternalServerError.description
-            return _json(start_response, environ, 500, {"error": "internal-server-error", "message": message})
+        except Exception as error:
+            status, body = error_answer(error)
+            return _answer(start_response, environ, status, "application/json", body)
         return _answer(start_response, environ, 200, answer.media_type + "; charset=utf-8", answer.body)
 
     def _plain_query(self, environ: dict[str, Any]) -> tuple[str | None, str | None]:
@@ -76,21 +72,10 @@ class SparqlHotPath:
         except (UnicodeDecodeError, ValueError):
             return None, None
         if method in ("GET", "HEAD"):
-            names = [name for name, _ in parameters]
-            if names.count("query") != 1 or any(names.count(n) > 1 for n in _SHORT_FORMAT):
-                return None, None
-            if set(names) - {"query", *_SHORT_FORMAT}:
-                return None, None
-            values = dict(parameters)
-            short = values.get("format") or values.get("output")
-            return values["query"], short
+            return plain_get(parameters) or (None, None)
         if method == "POST" and not parameters:
-            media_type = environ.get("CONTENT_TYPE", "").partition(";")[0].strip().lower()
-            try:
-                length = int(environ.get("CONTENT_LENGTH") or "-1")
-            except ValueError:
-                return None, None
-            if media_type != _QUERY_TYPE or not 0 <= length <= self.max_body:
+            length = plain_post_length(environ.get("CONTENT_TYPE"), environ.get("CONTENT_LENGTH"), self.max_body)
+            if length is None:
                 return None, None
             body = environ["wsgi.input"].read(length)
             try:
@@ -103,15 +88,54 @@ class SparqlHotPath:
 
     def _host_ok(self, environ: dict[str, Any]) -> bool:
         names = self.host_names()
-        if names is None:
-            return True
-        host = environ.get("HTTP_HOST")
-        if not host:
-            return False
-        try:
-            return urlsplit("//" + host).hostname in names
-        except ValueError:
-            return False
+        return names is None or host_allowed(environ.get("HTTP_HOST"), names)
+
+
+def plain_get(parameters: list[tuple[str, str]]) -> tuple[str, str | None] | None:
+    """The query and short format of a GET or HEAD this path answers: its only parameters one ``query``
+    and at most one ``format`` or ``output``. None for any other."""
+    names = [name for name, _ in parameters]
+    if names.count("query") != 1 or any(names.count(n) > 1 for n in _SHORT_FORMAT):
+        return None
+    if set(names) - {"query", *_SHORT_FORMAT}:
+        return None
+    values = dict(parameters)
+    return values["query"], values.get("format") or values.get("output")
+
+
+def plain_post_length(content_type: str | None, content_length: str | None, max_body: int) -> int | None:
+    """The body length of a POST this path answers: an ``application/sparql-query`` body of at most
+    ``max_body`` bytes. None for any other."""
+    media_type = (content_type or "").partition(";")[0].strip().lower()
+    try:
+        length = int(content_length or "-1")
+    except ValueError:
+        return None
+    return length if media_type == _QUERY_TYPE and 0 <= length <= max_body else None
+
+
+def host_allowed(host: str | None, names: Collection[str | None]) -> bool:
+    """Whether a request's ``Host`` names one of ``names`` (as cbrs.web._check_host)."""
+    if not host:
+        return False
+    try:
+        return urlsplit("//" + host).hostname in names
+    except ValueError:
+        return False
+
+
+def json_body(value: Any) -> bytes:
+    return (json.dumps(value, separators=(",", ":")) + "\n").encode("utf-8")  # as Flask's jsonify writes it
+
+
+def error_answer(error: Exception) -> tuple[int, bytes]:
+    """The status and JSON body of ``/sparql``'s answer to ``error``, as cbrs.web's error handler answers
+    a non-page request; anything but a KnowledgeBaseError is logged and answered 500."""
+    if isinstance(error, KnowledgeBaseError):
+        kind = getattr(error, "kind", type(error).__name__)
+        return error.http_status, json_body({"error": kind, "message": str(error)})
+    log.error("/sparql failed", exc_info=error)
+    return 500, json_body({"error": "internal-server-error", "message": InternalServerError.description})
 
 
 class _Replay:
@@ -128,14 +152,9 @@ class _Replay:
         return self.read(size)
 
 
-def _json(start_response: Callable[..., Any], environ: dict[str, Any], status: int, value: Any) -> list[bytes]:
-    body = (json.dumps(value, separators=(",", ":")) + "\n").encode("utf-8")  # as Flask's jsonify writes it
-    return _answer(start_response, environ, status, "application/json", body)
-
-
 def _answer(
     start_response: Callable[..., Any], environ: dict[str, Any], status: int, media_type: str, body: bytes
 ) -> list[bytes]:
-    headers = [("Content-Type", media_type), ("Content-Length", str(len(body))), *_COMMON]
+    headers = [("Content-Type", media_type), ("Content-Length", str(len(body))), *COMMON_HEADERS]
     start_response(f"{status} {HTTP_STATUS_CODES.get(status, 'unknown').upper()}", headers)
     return [] if environ.get("REQUEST_METHOD") == "HEAD" else [body]
