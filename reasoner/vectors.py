@@ -591,8 +591,7 @@ class VectorSpace:
             others = self.index.disjoint_with(concept)
             if not others:
                 return self._none()
-            found = np.zeros(len(self.names), dtype=bool)
-            found[[self.ids[other] for other in others]] = True
+            found = self._mask([self.ids[other] for other in others])
             self._disjoint[concept] = found
         return found
 
@@ -612,8 +611,7 @@ class VectorSpace:
             hits = {i for i in hits if self._core_word(i).lower() != lower}
             if not hits:
                 return self._none()
-            found = np.zeros(len(self.names), dtype=bool)
-            found[list(hits)] = True
+            found = self._mask(list(hits))
             self._opposites[concept] = found
         return found
 
@@ -663,9 +661,14 @@ class VectorSpace:
             parts = self.index.parts_of(self.names[whole]) if whole < self.taxonomy_size else frozenset()
             if not parts:
                 return self._none()
-            found = np.zeros(len(self.names), dtype=bool)
-            found[[self.ids[p] for p in parts]] = True
+            found = self._mask([self.ids[p] for p in parts])
             self._parts_masks[whole] = found
+        return found
+
+    def _mask(self, ids: list[int]) -> npt.NDArray[np.bool_]:
+        """True at ``ids``, False at every other concept id."""
+        found = np.zeros(len(self.names), dtype=bool)
+        found[ids] = True
         return found
 
     def _none(self) -> npt.NDArray[np.bool_]:
