@@ -1,8 +1,11 @@
 """Benchmark: the bridge's publish -> subscriber throughput beside a minimal websockets relay (issue 18).
 
-Run: python bench/rosbridge_relay.py [--messages M] [--publishers 1,4] [--size BYTES] [--rounds R] [--json FILE]
+Run: python bench/rosbridge_relay.py [--messages M] [--publishers 1,4] [--size BYTES] [--rounds R] [--quick]
+     [--json FILE]
 
-Two servers, each in a child process of its own, on the same loopback and the same websockets library:
+Two servers, each in a child process of its own, on the same loopback and the same websockets library
+(permessage-deflate off on both: each accepts no extension, ``compression=None``, so none is
+negotiated; the bench checks that on every connection):
 
 - cbrs: a default ``Bridge`` (what ``cbrs serve`` runs), publish relayed to a pass-through subscriber;
 - the anchor: the least a rosbridge relay has to do, written here. It reads each text frame's JSON for
@@ -12,12 +15,18 @@ Two servers, each in a child process of its own, on the same loopback and the sa
 
 The clients are websockets sync clients in this process (as in bench/rosbridge.py): P publishers send M
 messages in all, as fast as they can, to one subscriber; the rate is from the first send to the last
-receive. Beside it, the server process's CPU time per message (user + system, from /proc), which other
-work on the machine disturbs far less than the rate. The two servers are measured in turns, R rounds
-each, in one run on one machine; the best round of each is its rate (other work only ever slows a round
-down; the median round is printed too), and the median round its CPU per message. Prints the machine
-(with its load average), the inputs, both figures and the ratio of each row; ``--json FILE`` writes the
-rate rows as records ``{row, value, anchor, ratio, unit, goal, met}``.
+receive. Both servers get the same clients, payload and count. The machine is shared, so the bench
+pairs its measurements: in each of R rounds the two servers are measured back to back (which goes
+first alternates from round to round and row to row), and the round's ratio is cbrs's rate over the
+relay's. A row's ratio is the median of its R round ratios, printed with their range; no round is left
+out (one that lost messages has rate 0). Beside the rate, each server process's CPU time per message
+(from /proc's per-thread schedstat; other work disturbs it far less than the rate), as medians and
+the median of the rounds' ratios, and this process's CPU per message (the clients'), which shows
+whether the clients or a server set the pace. One short warm-up round per server and count comes first and is not
+counted. Prints the machine, the load average (at the start, before each pair, at the end), the
+inputs and every round; ``--json FILE`` writes the rows as records ``{row, value, anchor, ratio, unit,
+goal, met}`` (value and anchor the median rates, ratio the median round ratio) with ``spread``,
+``rounds``, ``cpu_us_per_message`` and ``load_average`` besides.
 """
 
 from __future__ import annotations
@@ -28,10 +37,12 @@ import json
 import multiprocessing
 import os
 import platform
+import statistics
 import threading
 import time
 from collections.abc import Callable
 from contextlib import ExitStack
+from dataclasses import dataclass, field
 from multiprocessing.synchronize import Event
 from pathlib import Path
 from typing import Any
@@ -43,7 +54,7 @@ from websockets.sync.client import ClientConnection, connect
 
 TIMEOUT = 10.0
 GOAL = ">= 0.9x"
-Key = tuple[str, int]  # (server, publishers)
+GOAL_RATIO = 0.9
 
 
 def serve_cbrs(ports: multiprocessing.Queue[int], stop: Event) -> None:
@@ -112,6 +123,9 @@ def rate(url: str, messages: int, publishers: int, payload: str) -> tuple[float,
     with ExitStack() as stack:
         listener = stack.enter_context(connect(url, max_size=None))
         talkers = [stack.enter_context(connect(url, max_size=None)) for _ in range(publishers)]
+        for ws in (listener, *talkers):
+            if ws.protocol.extensions:  # a compressed server would do other work than the relay
+                raise RuntimeError(f"{url} negotiated {ws.protocol.extensions}: the bench compares uncompressed")
         send(listener, op="subscribe", topic="/bench/rate", type="bench/Blob")
         sync(listener)
         for ws in talkers:
@@ -162,37 +176,109 @@ class Server:
         self._child.join(TIMEOUT)
 
     def cpu(self) -> float:
-        """CPU seconds (user + system) the server process has used so far (Linux /proc)."""
-        fields = Path(f"/proc/{self._child.pid}/stat").read_text().rsplit(")", 1)[1].split()
-        return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+        """CPU seconds the server process's threads have run so far: the nanosecond counters of
+        /proc/PID/task/*/schedstat (Linux), finer than /proc/PID/stat's clock ticks (10 ms, which is
+        3% of a 10,000-message round)."""
+        tasks = Path(f"/proc/{self._child.pid}/task")
+        total = 0
+        for task in tasks.iterdir():
+            try:
+                total += int((task / "schedstat").read_text().split()[0])
+            except (FileNotFoundError, ProcessLookupError):  # a thread that ended meanwhile
+                continue
+        return total / 1e9
 
 
-def median(values: list[float]) -> float:
-    ordered = sorted(values)
-    return ordered[len(ordered) // 2]
+@dataclass
+class Pair:
+    """One round of one publisher count: both servers measured back to back, in the order given."""
+
+    order: tuple[str, str]
+    load: float  # 1-minute load average just before the pair
+    rate: dict[str, float] = field(default_factory=dict)  # msg/s; 0 if the round lost messages
+    cpu: dict[str, float] = field(default_factory=dict)  # server CPU us per received message
+    client: dict[str, float] = field(default_factory=dict)  # this process's CPU us per message
+
+    def ratio(self, what: str) -> float:
+        figures = self.rate if what == "rate" else self.cpu
+        return figures["cbrs"] / figures["relay"] if figures["relay"] else 0.0
 
 
-def measure(args: argparse.Namespace, counts: list[int]) -> tuple[dict[Key, list[float]], dict[Key, list[float]]]:
-    """Each server's rate and CPU per message in every round (a round that lost messages has rate 0),
-    by (server, publishers)."""
+def one(server: Server, messages: int, count: int, payload: str) -> tuple[float, float, float, int]:
+    """One server's round: its rate (0 if messages were lost), server and client CPU us per message."""
+    before, mine = server.cpu(), time.process_time()
+    measured, received = rate(server.url, messages, count, payload)
+    per_message = (server.cpu() - before) / max(received, 1) * 1e6
+    client = (time.process_time() - mine) / max(received, 1) * 1e6
+    sent = messages // count * count
+    return (measured if received == sent else 0.0), per_message, client, received
+
+
+def measure(args: argparse.Namespace, counts: list[int]) -> dict[int, list[Pair]]:
+    """Every round's pair of measurements, by publisher count. Before the rounds, one short warm-up
+    round per server and count (both servers alike, not counted: the first messages a fresh process
+    relays pay for imports and caches)."""
     payload = "x" * args.size
-    rates: dict[Key, list[float]] = {}
-    cpu: dict[Key, list[float]] = {}
+    pairs: dict[int, list[Pair]] = {count: [] for count in counts}
     with Server(serve_cbrs) as cbrs, Server(serve_relay) as relay:
+        servers = {"cbrs": cbrs, "relay": relay}
+        for count in counts:
+            for server in servers.values():
+                rate(server.url, min(args.messages, 2000), count, payload)
         for n in range(args.rounds):
-            for count in counts:
-                for name, server in (("cbrs", cbrs), ("relay", relay)):
-                    before = server.cpu()
-                    measured, received = rate(server.url, args.messages, count, payload)
-                    per_message = (server.cpu() - before) / max(received, 1) * 1e6
-                    cpu.setdefault((name, count), []).append(per_message)
-                    sent = args.messages // count * count
+            for k, count in enumerate(counts):
+                order = ("cbrs", "relay") if (n + k) % 2 == 0 else ("relay", "cbrs")  # who goes first alternates
+                pair = Pair(order, os.getloadavg()[0])
+                for name in order:
+                    measured, cpu, client, received = one(servers[name], args.messages, count, payload)
+                    pair.rate[name], pair.cpu[name], pair.client[name] = measured, cpu, client
                     print(
                         f"  round {n + 1}: {name:<5} {count:>2} publisher(s) {measured:>9,.0f} msg/s "
-                        f"{received}/{sent}, server CPU {per_message:5.1f} us/msg"
+                        f"{received:>6} received, server CPU {cpu:5.1f} us/msg, client CPU {client:5.1f} us/msg "
+                        f"(load {pair.load:.2f})"
                     )
-                    rates.setdefault((name, count), []).append(measured if received == sent else 0.0)
-    return rates, cpu
+                pairs[count].append(pair)
+    return pairs
+
+
+def summary(count: int, pairs: list[Pair]) -> dict[str, Any]:
+    """The row of one publisher count: median rates and CPU, the median of the rounds' ratios and their
+    range (every round counts: a round that lost messages has ratio 0)."""
+    rates, cpus = [p.ratio("rate") for p in pairs], [p.ratio("cpu") for p in pairs]
+    ratio = statistics.median(rates)
+    return {
+        "row": f"publish -> subscriber, {count} publisher(s)",
+        "value": round(statistics.median([p.rate["cbrs"] for p in pairs])),
+        "anchor": round(statistics.median([p.rate["relay"] for p in pairs])),
+        "ratio": round(ratio, 3),
+        "unit": "msg/s",
+        "goal": GOAL,
+        "met": ratio >= GOAL_RATIO,
+        "spread": [round(min(rates), 3), round(max(rates), 3)],
+        "rounds": len(pairs),
+        "cpu_us_per_message": {
+            "cbrs": round(statistics.median([p.cpu["cbrs"] for p in pairs]), 1),
+            "relay": round(statistics.median([p.cpu["relay"] for p in pairs]), 1),
+            "ratio": round(statistics.median(cpus), 3),
+            "spread": [round(min(cpus), 3), round(max(cpus), 3)],
+        },
+        "load_average": [round(min(p.load for p in pairs), 2), round(max(p.load for p in pairs), 2)],
+    }
+
+
+def report(records: list[dict[str, Any]]) -> None:
+    print(
+        f"\n  {'row (median of rounds)':<38} {'cbrs':>8} {'relay':>8} {'ratio':>6} {'range':>12}"
+        f"  {'goal':<8} {'':<7} | {'CPU us/msg: cbrs':>16} {'relay':>6} {'ratio':>6} {'range':>12}"
+    )
+    for r in records:
+        cpu = r["cpu_us_per_message"]
+        spread, cpu_spread = "{:.2f}-{:.2f}x".format(*r["spread"]), "{:.2f}-{:.2f}x".format(*cpu["spread"])
+        print(
+            f"  {r['row']:<38} {r['value']:>8,} {r['anchor']:>8,} {r['ratio']:>5.2f}x {spread:>12}  {GOAL:<8} "
+            f"{'met' if r['met'] else 'NOT met':<7} | {cpu['cbrs']:>16.1f} {cpu['relay']:>6.1f} "
+            f"{cpu['ratio']:>5.2f}x {cpu_spread:>12}"
+        )
 
 
 def main() -> None:
@@ -200,42 +286,24 @@ def main() -> None:
     parser.add_argument("--messages", type=int, default=30000, help="messages per round")
     parser.add_argument("--publishers", default="1,4", help="publisher counts, comma-separated")
     parser.add_argument("--size", type=int, default=100, help="bytes of payload per message")
-    parser.add_argument("--rounds", type=int, default=5, help="rounds per server and publisher count (best kept)")
+    parser.add_argument("--rounds", type=int, default=7, help="rounds (pairs of measurements) per publisher count")
+    parser.add_argument("--quick", action="store_true", help="10000 messages and 3 rounds (a rough look)")
     parser.add_argument("--json", type=Path, help="write the rows to FILE as a JSON list of records")
     args = parser.parse_args()
+    if args.quick:
+        args.messages, args.rounds = 10000, 3
     counts = [int(c) for c in args.publishers.split(",")]
-    print(
-        f"machine: {platform.platform()}, {os.cpu_count()} cores, python {platform.python_version()}, "
-        f"load average {os.getloadavg()[0]:.2f}"
-    )
+    print(f"machine: {platform.platform()}, {os.cpu_count()} cores, python {platform.python_version()}")
+    print("load average at the start: {:.2f} {:.2f} {:.2f}".format(*os.getloadavg()))
     print(
         f"inputs: {args.messages} messages of {args.size}-byte payload per round, publishers {counts} -> 1 "
-        f"subscriber, {args.rounds} rounds per server in turns (best kept); servers in child processes, "
-        "websockets sync clients here, loopback"
+        f"subscriber, {args.rounds} rounds; in each round the two servers back to back, the first "
+        "alternating; servers in child processes, websockets sync clients here, loopback"
     )
-    rates, cpu = measure(args, counts)
-    records = []
-    print(f"\n  {'row':<44} {'cbrs':>10} {'relay':>10} {'ratio':>7}  {'unit':<6} {'goal':<8}")
-    for count in counts:
-        value, anchor = max(rates[("cbrs", count)]), max(rates[("relay", count)])
-        ratio = value / anchor if anchor else 0.0
-        row = f"publish -> subscriber, {count} publisher(s)"
-        met = ratio >= float(GOAL.split()[1].rstrip("x"))
-        records.append(
-            {"row": row, "value": round(value), "anchor": round(anchor), "ratio": round(ratio, 3), "unit": "msg/s",
-             "goal": GOAL, "met": met}
-        )  # fmt: skip
-        verdict = "met" if met else "NOT met"
-        print(f"  {row:<44} {value:>10,.0f} {anchor:>10,.0f} {ratio:>6.2f}x  msg/s  {GOAL:<8} {verdict}")
-    print(f"\n  {'median round, publish -> subscriber':<44} {'cbrs':>10} {'relay':>10} {'ratio':>7}  unit")
-    for count in counts:
-        value, anchor = median(rates[("cbrs", count)]), median(rates[("relay", count)])
-        ratio = value / anchor if anchor else 0.0
-        print(f"  {f'{count} publisher(s)':<44} {value:>10,.0f} {anchor:>10,.0f} {ratio:>6.2f}x  msg/s")
-    print(f"\n  {'server CPU per message (median of rounds)':<44} {'cbrs':>10} {'relay':>10} {'ratio':>7}  unit")
-    for count in counts:
-        value, anchor = median(cpu[("cbrs", count)]), median(cpu[("relay", count)])
-        print(f"  {f'{count} publisher(s)':<44} {value:>10.1f} {anchor:>10.1f} {value / anchor:>6.2f}x  us/msg")
+    pairs = measure(args, counts)
+    print("load average at the end: {:.2f} {:.2f} {:.2f}".format(*os.getloadavg()))
+    records = [summary(count, pairs[count]) for count in counts]
+    report(records)
     if args.json is not None:
         args.json.parent.mkdir(parents=True, exist_ok=True)
         args.json.write_text(json.dumps(records, indent=2) + "\n")
