@@ -6,6 +6,7 @@ receive has a timeout, so a missing answer fails the test instead of hanging it.
 
 from __future__ import annotations
 
+import asyncio
 import itertools
 import json
 import socket
@@ -16,11 +17,16 @@ from contextlib import ExitStack
 from typing import Any
 
 import pytest
+from websockets.asyncio.client import connect as ws_connect
+from websockets.asyncio.server import ServerConnection
+from websockets.asyncio.server import serve as ws_serve
 from websockets.exceptions import ConnectionClosed
 from websockets.sync.client import ClientConnection, connect
 
 from cbrs.rosbridge import Bridge, ParamStore, RosbridgeError, RunningBridge, ServiceError, UnknownTopicError
 from cbrs.rosbridge.outbox import TopicQueue
+from cbrs.rosbridge.server import send_frames
+from cbrs.rosbridge.session import WRITE_BATCH, WRITE_BATCH_CHARS, Session
 from cbrs.rosbridge.workers import WorkerPool
 from tests.helpers_threads import assert_threads_end
 
@@ -91,6 +97,107 @@ def test_several_requests_merge_to_the_fastest_rate_and_the_longest_queue() -> N
     assert queue.remove("fast")
     assert (queue.throttle, queue.capacity) == (1.0, 1)
     assert not queue.remove("fast")
+
+
+# -- the writer's bursts and the websocket's batched frames -----------------------------------------
+
+
+def test_the_writer_sends_what_is_due_in_bursts_in_order_and_leaves_a_throttled_message_for_its_window() -> None:
+    async def scenario() -> tuple[list[list[str]], list[str]]:
+        bursts: list[list[str]] = []
+        singles: list[str] = []
+
+        async def send(text: str) -> None:
+            singles.append(text)
+
+        async def send_many(texts: list[str]) -> None:
+            bursts.append(texts)
+
+        clock = [10.0]
+        session = Session("s", send, lambda reason: None, 1000, lambda: clock[0], send_many=send_many)
+        session.subscribe("/fast", "/fast", None, 0, 0)
+        session.subscribe("/slow", "/slow", None, 500, 2)  # one message per 500 ms, two kept
+        for n in range(WRITE_BATCH + 10):
+            session.offer("/fast", f"f{n}")
+            if n == 3:
+                session.reply("reply")
+            if n in (1, 5):  # the first goes at once; the second waits for the end of the window
+                session.offer("/slow", f"s{n}")
+        writer = asyncio.create_task(session.run())
+        await asyncio.sleep(0.01)
+        clock[0] = 10.5
+        session.offer("/fast", "last")  # wakes the writer after the window ended
+        await asyncio.sleep(0.01)
+        session.close()
+        await writer
+        return bursts, singles
+
+    bursts, singles = asyncio.run(scenario())
+    fast = [f"f{n}" for n in range(WRITE_BATCH + 10)]
+    assert bursts[0] == [*fast[:2], "s1", *fast[2:4], "reply", *fast[4 : WRITE_BATCH - 2]]
+    assert bursts[1] == fast[WRITE_BATCH - 2 :]  # the rest of what was due; s5 waits for its window
+    assert bursts[2:] == [["s5", "last"]]
+    assert singles == []
+
+
+def test_a_burst_over_the_character_bound_is_split_and_a_lone_message_goes_alone() -> None:
+    async def scenario() -> tuple[list[int], list[str]]:
+        sizes: list[int] = []
+        singles: list[str] = []
+
+        async def send(text: str) -> None:
+            singles.append(text)
+
+        async def send_many(texts: list[str]) -> None:
+            sizes.append(len(texts))
+
+        session = Session("s", send, lambda reason: None, 1000, send_many=send_many)
+        session.subscribe("/big", "/big", None, 0, 0)
+        for _ in range(5):
+            session.offer("/big", "x" * (WRITE_BATCH_CHARS // 2))
+        writer = asyncio.create_task(session.run())
+        await asyncio.sleep(0.01)
+        session.offer("/big", "alone")
+        await asyncio.sleep(0.01)
+        session.close()
+        await writer
+        return sizes, singles
+
+    sizes, singles = asyncio.run(scenario())
+    assert sizes == [2, 2]  # two halves reach the bound; then the fifth message, alone, and later "alone"
+    assert len(singles) == 2 and singles[-1] == "alone"
+
+
+def test_frames_sent_in_one_write_arrive_as_separate_messages_in_order() -> None:
+    texts = [f'{{"n":{n},"data":"é{"x" * n}"}}' for n in range(300)]
+
+    async def scenario() -> tuple[list[str], bool]:
+        got: list[str] = []
+        closed = asyncio.Event()
+        refused = False
+
+        async def handler(websocket: ServerConnection) -> None:
+            nonlocal refused
+            await send_frames(websocket, texts[:1])
+            await send_frames(websocket, texts[1:])
+            await closed.wait()
+            try:
+                await send_frames(websocket, texts[:2])
+            except ConnectionClosed:
+                refused = True
+
+        async with ws_serve(handler, "127.0.0.1", 0, compression=None) as server:
+            port = server.sockets[0].getsockname()[1]
+            async with ws_connect(f"ws://127.0.0.1:{port}", compression=None) as client:
+                while len(got) < len(texts):
+                    got.append(str(await asyncio.wait_for(client.recv(), WAIT)))
+            closed.set()
+            await asyncio.sleep(0.1)
+        return got, refused
+
+    got, refused = asyncio.run(scenario())
+    assert got == texts
+    assert refused  # a closed connection raises as websockets' own send does
 
 
 # -- the parameter store --------------------------------------------------------------------------

@@ -273,9 +273,11 @@ class Bridge:
         abort: Callable[[str], None],
         origin: str | None = None,
         address: str | None = None,
+        send_many: Callable[[list[str]], Awaitable[None]] | None = None,
     ) -> Session:
         """A new client (``peer`` names it in logs, ``address`` is its IP address, ``origin`` its
-        handshake's Origin header); its writer task starts on the attached loop."""
+        handshake's Origin header); its writer task starts on the attached loop. ``send`` sends one
+        message; ``send_many``, if the transport has it, several in order with fewer writes."""
         if self._loop is None:
             raise RosbridgeError("the bridge is not attached to an event loop")
         session = Session(
@@ -286,6 +288,7 @@ class Bridge:
             peer=address if address is not None else peer,
             origin=origin,
             backlog_bytes=self.max_queue_bytes,
+            send_many=send_many,
         )
         self._writers[session] = self._loop.create_task(session.run(), name=f"rosbridge writer {session.name}")
         log.info("%s connected", session.name)

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import functools
 import logging
 import threading
 import time
@@ -20,6 +21,7 @@ from typing import Any
 from websockets.asyncio.server import ServerConnection
 from websockets.asyncio.server import serve as ws_serve
 from websockets.exceptions import ConnectionClosed
+from websockets.protocol import State
 from websockets.typing import Origin
 
 from cbrs.rosbridge.bridge import MIB, Bridge
@@ -41,6 +43,22 @@ FRAMES_PER_TURN = 16
 def transport_limit(bridge: Bridge) -> int:
     """The websocket frame limit for ``bridge``: above its message limit, so that limit can answer."""
     return max(16 * MIB, 2 * bridge.max_message_bytes)
+
+
+async def send_frames(websocket: ServerConnection, texts: list[str]) -> None:
+    """Send ``texts`` as text frames, in order, with two socket writes instead of one per message.
+
+    All but the last are framed by the connection's own sans-I/O protocol (``send_text``, as
+    ``websocket.send`` frames them) and written to the transport joined; the last goes through
+    ``websocket.send``, which applies websockets' flow control and raises ``ConnectionClosed`` as usual.
+    A connection that is not open gets only that ``send`` (which raises).
+    """
+    protocol = websocket.protocol
+    if len(texts) > 1 and protocol.state is State.OPEN:
+        for text in texts[:-1]:
+            protocol.send_text(text.encode())
+        websocket.transport.write(b"".join(protocol.data_to_send()))
+    await websocket.send(texts[-1])
 
 
 def _peer(address: Any) -> str:
@@ -109,6 +127,7 @@ async def _serve(
             abort,
             origin=websocket.request.headers.get("Origin") if websocket.request is not None else None,
             address=ip,
+            send_many=functools.partial(send_frames, websocket),
         )
         turn = 0
         try:

@@ -26,6 +26,12 @@ log = logging.getLogger("cbrs.rosbridge")
 REPLY_BACKLOG = 10_000
 #: Bytes of replies a client may leave unread before it is disconnected.
 REPLY_BYTES = 64 << 20
+#: Messages the writer hands the transport at once when several are due (with ``send_many``): one socket
+#: write for a burst instead of one per message. Bounded, so a burst held outside the queues (where the
+#: queues' drop-oldest rule no longer reaches it) stays small.
+WRITE_BATCH = 64
+#: Characters of messages in one such burst (a burst always takes at least one message, whatever its size).
+WRITE_BATCH_CHARS = 256 << 10
 
 
 @dataclass(frozen=True)
@@ -60,6 +66,7 @@ class Session:
         peer: str = "",
         origin: str | None = None,
         backlog_bytes: int = 16 << 20,
+        send_many: Callable[[list[str]], Awaitable[None]] | None = None,
     ) -> None:
         self.name = name
         self.peer = peer
@@ -75,6 +82,7 @@ class Session:
         self.spelling: dict[str, str] = {}
         self.queues: dict[str, TopicQueue] = {}
         self._send = send
+        self._send_many = send_many
         self._abort = abort
         self._backlog = backlog
         self._backlog_bytes = backlog_bytes
@@ -168,7 +176,7 @@ class Session:
                 now = self._clock()
                 text, wait = self._take(now)
                 if text is not None:
-                    await self._send(text)
+                    await (self._send(text) if self._send_many is None else self._send_due(text, now))
                     continue
                 # nothing to send now: sleep until woken, or until a throttled message is due
                 self._waiter = waiter = asyncio.get_running_loop().create_future()
@@ -185,6 +193,18 @@ class Session:
         except Exception as error:  # the connection went away under a send
             log.debug("%s: writer stopped: %r", self.name, error)
             self.closed = True
+
+    async def _send_due(self, first: str, now: float) -> None:
+        """Send ``first`` with the other messages due ``now`` (up to a batch) in one ``send_many`` call."""
+        assert self._send_many is not None
+        batch, size = [first], len(first)
+        while len(batch) < WRITE_BATCH and size < WRITE_BATCH_CHARS:
+            text, _ = self._take(now)
+            if text is None:
+                break
+            batch.append(text)
+            size += len(text)
+        await (self._send(first) if len(batch) == 1 else self._send_many(batch))
 
     def _take(self, now: float) -> tuple[str | None, float | None]:
         """The next message due (oldest first), else how long until one is due (None: nothing waits)."""
