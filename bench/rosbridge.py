@@ -1,8 +1,9 @@
 """Benchmark: the rosbridge server's round-trip latency and message rate over loopback websockets.
 
 Run: python bench/rosbridge.py [--samples N] [--messages M] [--publishers 1,4,16] [--size BYTES].
-Prints the machine, the inputs and the figures. The server (a default Bridge) runs in a child process,
-so it has an interpreter lock of its own; the clients are websockets sync clients in this process.
+Prints the machine (with its load average, at the start and the end), the inputs and the figures.
+The server (a default Bridge) runs in a child process, so it has an interpreter lock of its own; the
+clients are websockets sync clients in this process.
 Latency is measured one message at a time: publish -> the subscriber has it; call_service ->
 service_response, for a trivial server service (run on a worker thread), for rosapi (answered on the
 event loop) and for a service a client provides (relayed both ways). Rate: M messages sent as fast as
@@ -152,7 +153,10 @@ def main() -> None:
     parser.add_argument("--publishers", default="1,4,16", help="publisher counts for the rate figures")
     parser.add_argument("--size", type=int, default=100, help="bytes of payload per message")
     args = parser.parse_args()
-    print(f"machine: {platform.platform()}, {os.cpu_count()} cores, python {platform.python_version()}")
+    print(
+        f"machine: {platform.platform()}, {os.cpu_count()} cores, python {platform.python_version()}, "
+        f"load average {os.getloadavg()[0]:.2f}"
+    )
     print(
         f"inputs: default Bridge in a child process, loopback, websockets sync clients; {args.samples} round trips "
         f"per latency, {args.messages} messages per rate, {args.size}-byte payload"
@@ -174,6 +178,7 @@ def main() -> None:
     finally:
         stop.set()
         child.join(TIMEOUT)
+    print(f"\nload average at the end: {os.getloadavg()[0]:.2f}")
 
 
 if __name__ == "__main__":
