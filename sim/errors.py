@@ -30,6 +30,15 @@ class UnknownEntityError(SimulationError):
         super().__init__(f"no entity named {name!r}; known: {', '.join(self.known)}")
 
 
+class ImageSizeError(SimulationError, ValueError):
+    """An image size for a camera that is not two positive whole numbers of pixels."""
+
+    def __init__(self, camera: str, size: object) -> None:
+        self.camera = camera
+        self.size = size
+        super().__init__(f"image size {size!r} for camera {camera!r}: give (width, height), two positive integers")
+
+
 class CameraUnavailableError(SimulationError):
     """The camera is switched off (failed); a component should fall back to another camera."""
 

@@ -24,7 +24,7 @@ from cbrs.sim import layout as L
 from cbrs.sim.arms import PYBULLET_DATA, Arm, ArmDetail, ArmSide, Kinematics, panda_urdf
 from cbrs.sim.base import MobileBase
 from cbrs.sim.cameras import Camera
-from cbrs.sim.errors import UnknownEntityError, WorldClosedError
+from cbrs.sim.errors import ImageSizeError, UnknownEntityError, WorldClosedError
 from cbrs.sim.geometry import Pose2D, Pose3D, Quat, Region, Vec3, quat_from_yaw
 from cbrs.sim.layout import CameraSpec
 from cbrs.sim.perception import MarkerModel
@@ -156,6 +156,7 @@ class HomeWorld:
         semantic_map: SemanticMap | None = None,
         spread: Spread = Spread(),
         arm_detail: ArmDetail | str = ArmDetail.REDUCED,
+        image_sizes: Mapping[str, tuple[int, int]] | None = None,
     ) -> None:
         self.client = client
         self.seed = seed
@@ -164,6 +165,9 @@ class HomeWorld:
         self.arm_detail = ArmDetail(arm_detail)
         """The arms' visual meshes, for every camera and recording of this world (``ArmDetail``)."""
         self.map = semantic_map if semantic_map is not None else bundled_map()
+        self.image_sizes = _image_sizes(self.map, image_sizes or {})
+        """Each camera's image width and height in pixels (``layout.DOWNWARD_IMAGE_SIZE`` and
+        ``OTHER_IMAGE_SIZE`` unless ``image_sizes`` named the camera)."""
         self.objects: dict[str, MapObject] = {obj.name: obj for obj in self.map.objects.values()}
         """The movable objects by body name (the local name of their IRI)."""
         self.containers = {name for name, obj in self.objects.items() if obj.iri in self.map.containers}
@@ -219,14 +223,18 @@ class HomeWorld:
         semantic_map: SemanticMap | None = None,
         spread: Spread = Spread(),
         arm_detail: ArmDetail | str = ArmDetail.REDUCED,
+        image_sizes: Mapping[str, tuple[int, int]] | None = None,
     ) -> HomeWorld:
         """Connect a new pybullet client (DIRECT unless ``gui``) and build the home of ``semantic_map`` in
         it (the bundled map by default). ``arm_detail`` picks the arms' visual meshes (``ArmDetail``:
-        reduced, the default, or full); physics is the same with either."""
+        reduced, the default, or full); physics is the same with either. ``image_sizes`` gives cameras,
+        by name, another image size (width, height) than the layout's default for their kind."""
+        if image_sizes:  # a bad size is refused before a client is connected
+            _image_sizes(semantic_map if semantic_map is not None else bundled_map(), image_sizes)
         with quiet_output():
             client = p.connect(p.GUI if gui else p.DIRECT)
         try:
-            return cls(client, seed, gui, time_step, semantic_map, spread, arm_detail)
+            return cls(client, seed, gui, time_step, semantic_map, spread, arm_detail, image_sizes)
         except BaseException:
             p.disconnect(physicsClientId=client)
             raise
@@ -538,11 +546,14 @@ class HomeWorld:
             target = tuple(e + d for e, d in zip(cam.position, direction, strict=True))
             # looking straight down, the top of the image faces the camera's yaw; otherwise up is up
             up = (math.cos(cam.yaw), math.sin(cam.yaw), 0.0) if cam.looks_down else (0.0, 0.0, 1.0)
+            width, height = self.image_sizes[cam.name]
             spec = CameraSpec(
                 cam.name,
                 cam.position,
                 (target[0], target[1], target[2]),
                 up,
+                width,
+                height,
                 fov_deg=cam.fov,
                 near=cam.near,
                 far=cam.far,
@@ -842,6 +853,27 @@ def _half_and_centre(region: Region) -> tuple[Vec3, Vec3]:
     return half, centre
 
 
+def _image_sizes(semantic_map: SemanticMap, given: Mapping[str, tuple[int, int]]) -> dict[str, tuple[int, int]]:
+    """Every camera's image size: ``given`` for the cameras it names, else the layout's default for a
+    camera looking straight down or for any other."""
+    cameras = {cam.name: cam for cam in semantic_map.cameras.values()}
+    for name, size in given.items():
+        if name not in cameras:
+            raise UnknownEntityError(name, sorted(cameras))
+        if (
+            not isinstance(size, tuple | list)
+            or len(size) != 2
+            or not all(isinstance(v, int) and not isinstance(v, bool) and v > 0 for v in size)
+        ):
+            raise ImageSizeError(name, size)
+    sizes = {}
+    for name, cam in cameras.items():
+        default = L.DOWNWARD_IMAGE_SIZE if cam.looks_down else L.OTHER_IMAGE_SIZE
+        width, height = given.get(name, default)
+        sizes[name] = (int(width), int(height))
+    return sizes
+
+
 @contextmanager
 def open_world(
     seed: int = 0,
@@ -849,9 +881,12 @@ def open_world(
     semantic_map: SemanticMap | None = None,
     spread: Spread = Spread(),
     arm_detail: ArmDetail | str = ArmDetail.REDUCED,
+    image_sizes: Mapping[str, tuple[int, int]] | None = None,
 ) -> Iterator[HomeWorld]:
     """``with open_world(seed) as world:`` builds a world and always disconnects it."""
-    world = HomeWorld.create(seed, gui, semantic_map=semantic_map, spread=spread, arm_detail=arm_detail)
+    world = HomeWorld.create(
+        seed, gui, semantic_map=semantic_map, spread=spread, arm_detail=arm_detail, image_sizes=image_sizes
+    )
     try:
         yield world
     finally:

@@ -20,8 +20,9 @@ from cbrs.sim import (
     track_person,
 )
 from cbrs.sim import predicates as pred
+from cbrs.sim.errors import ImageSizeError, UnknownEntityError
 from cbrs.sim.geometry import wrap_angle
-from cbrs.sim.layout import SHIRT_TOP
+from cbrs.sim.layout import DOWNWARD_IMAGE_SIZE, OTHER_IMAGE_SIZE, SHIRT_TOP
 from cbrs.sim.perception import segment
 from tests.home_layout import BASE_START, HANDOVER_POSE
 
@@ -40,12 +41,13 @@ def world() -> Iterator[HomeWorld]:
 
 def test_frames_have_images_depth_and_calibration(world: HomeWorld) -> None:
     frame = world.camera("Kinect01").capture()
-    assert frame.rgb.shape == (240, 320, 3) and frame.rgb.dtype == np.uint8
-    assert frame.depth.shape == (240, 320)
+    width, height = OTHER_IMAGE_SIZE  # the Kinect does not look straight down
+    assert frame.rgb.shape == (height, width, 3) and frame.rgb.dtype == np.uint8
+    assert frame.depth.shape == (height, width)
     assert float(frame.depth.min()) > 0.3 and float(frame.depth.max()) < 4.0
     cup = np.array([world.pose("Cup").position])
     u, v = frame.project(cup)[0]
-    assert 0 <= u < 320 and 0 <= v < 240
+    assert 0 <= u < width and 0 <= v < height
     # Back through the depth image: the pixel shows the cup's surface, a few cm from its centre.
     seen = frame.deproject(np.array([math.floor(u)], dtype=float), np.array([math.floor(v)], dtype=float))[0]
     assert np.linalg.norm(seen - cup[0]) < 0.05
@@ -119,6 +121,32 @@ def test_object_recognition_with_the_kinect(world: HomeWorld, colour: str, name:
         assert abs(wrap_angle(2 * (estimate.yaw - truth.yaw))) / 2 < 0.05
     else:
         assert estimate.yaw is None
+
+
+@pytest.mark.parametrize("size", [(320, 240), (160, 120)], ids=["320x240", "160x120"])
+def test_a_camera_renders_the_image_size_it_is_given(size: tuple[int, int]) -> None:
+    with HomeWorld.create(seed=4, image_sizes={"Kinect01": size}) as w:
+        assert w.image_sizes == {
+            "CeilingCamera01": DOWNWARD_IMAGE_SIZE,
+            "CeilingCamera02": DOWNWARD_IMAGE_SIZE,
+            "Kinect01": size,
+        }
+        frame = w.camera("Kinect01").capture()
+        assert frame.rgb.shape == (size[1], size[0], 3) and frame.intrinsics.width == size[0]
+        for colour, name in (("red", "Cup"), ("blue", "Pen")):
+            estimate = recognise_object(frame, colour)
+            truth = np.array(w.pose(name).position)
+            assert np.linalg.norm(np.array(estimate.position) - truth) < RECOGNITION_ERROR
+
+
+@pytest.mark.parametrize("size", [(0, 120), (160,), (160.0, 120.0), "160x120"], ids=["zero", "one", "floats", "text"])
+def test_a_bad_image_size_is_refused_by_name(size: object) -> None:
+    with pytest.raises(ImageSizeError) as refused:
+        HomeWorld.create(image_sizes={"Kinect01": size})  # type: ignore[dict-item]  # deliberately wrong
+    assert refused.value.camera == "Kinect01" and refused.value.size == size
+    with pytest.raises(UnknownEntityError) as unknown:
+        HomeWorld.create(image_sizes={"Kinect02": (160, 120)})
+    assert unknown.value.name == "Kinect02"
 
 
 def test_recognition_errors_are_typed(world: HomeWorld) -> None:
