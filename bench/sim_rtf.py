@@ -1,8 +1,8 @@
 """Benchmark: the simulation's real-time factor as cbrs runs a task headless, against pybullet stepping
 the same scene alone.
 
-Run: python bench/sim_rtf.py [--tasks RobotArmServeACup,FetchMyPen] [--seeds 0,1,2] [--profile N] [--physics]
-                             [--json FILE] [--digests FILE] [--check FILE]
+Run: python bench/sim_rtf.py [--tasks RobotArmServeACup,FetchMyPen] [--seeds 0,1,2] [--repeat N] [--profile N]
+                             [--physics] [--json FILE] [--digests FILE] [--check FILE]
 
 For each task and seed, a world is built from the store's semantic map (as ``cbrs run`` builds it;
 not timed), then:
@@ -17,6 +17,8 @@ not timed), then:
   factor is the world's simulated seconds over that wall time.
 
 The row's ratio is the median of the task's factors over the median of the anchor's (goal >= 0.8x).
+``--repeat N`` runs each task and seed N times (each run followed by its anchor), so that the medians
+are taken over N times as many samples: on a shared machine one sample of either moves by a third.
 The same ratio on this thread's CPU time is printed too: on a machine shared with other jobs it
 moves less than the wall-clock one (pybullet's DIRECT client steps and renders on this thread).
 ``--profile N`` also runs the tasks once under cProfile (CPU time) and prints the N functions with
@@ -87,6 +89,12 @@ class Sample:
     @property
     def cpu_ratio(self) -> float:
         return self.cpu_alone / self.cpu
+
+    @property
+    def off_cpu(self) -> float:
+        """Wall seconds of the run (composing left out) when this thread was not on a CPU: waiting, or
+        made to wait by other processes (the run has no other thread and sleeps nowhere)."""
+        return max(0.0, self.wall - self.composing - self.cpu)
 
     @property
     def factor(self) -> float:
@@ -249,6 +257,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--tasks", default=",".join(TASKS))
     parser.add_argument("--seeds", default="0,1,2")
+    parser.add_argument("--repeat", type=int, default=1, metavar="N", help="run each task and seed N times")
     parser.add_argument("--profile", type=int, default=0, metavar="N", help="print the N costliest functions")
     parser.add_argument(
         "--physics", action="store_true", help="also time the tasks' own physics steps against stepping alone"
@@ -271,18 +280,19 @@ def main() -> None:
 
     print(
         f"{'task':<18} {'seed':>4} {'status':>10} {'steps':>6} {'sim s':>6} {'run s':>6} {'plan s':>6} "
-        f"{'alone s':>7} {'RTF':>6} {'alone':>6} {'ratio':>6} {'CPU ratio':>9} {'frames':>6}  digest"
+        f"{'alone s':>7} {'RTF':>6} {'alone':>6} {'ratio':>6} {'CPU ratio':>9} {'off CPU':>7} {'frames':>6}  digest"
     )
     samples: list[Sample] = []
     for task in tasks:
         for seed in seeds:
-            s = run_one(kb, smap, composer, task, seed)
-            samples.append(s)
-            print(
-                f"{task:<18} {seed:>4} {s.status:>10} {s.steps:>6} {s.simulated:>6.1f} {s.wall:>6.2f} "
-                f"{s.composing:>6.2f} {s.alone:>7.2f} {s.factor:>6.1f} {s.anchor:>6.1f} {s.factor / s.anchor:>6.2f} "
-                f"{s.cpu_ratio:>9.2f} {s.frames:>6}  {s.digest}"
-            )
+            for _ in range(max(1, args.repeat)):
+                s = run_one(kb, smap, composer, task, seed)
+                samples.append(s)
+                print(
+                    f"{task:<18} {seed:>4} {s.status:>10} {s.steps:>6} {s.simulated:>6.1f} {s.wall:>6.2f} "
+                    f"{s.composing:>6.2f} {s.alone:>7.2f} {s.factor:>6.1f} {s.anchor:>6.1f} "
+                    f"{s.factor / s.anchor:>6.2f} {s.cpu_ratio:>9.2f} {s.off_cpu:>7.2f} {s.frames:>6}  {s.digest}"
+                )
 
     records = [row(f"{task}, headless", [s for s in samples if s.task == task]) for task in tasks]
     records.append(row("both tasks, headless", samples))
@@ -311,6 +321,10 @@ def main() -> None:
         args.json.write_text(json.dumps(records, indent=2) + "\n", encoding="utf-8")
         print(f"written to {args.json}")
     digests = {f"{s.task} {s.seed}": s.digest for s in samples}
+    unsteady = sorted({f"{s.task} {s.seed}" for s in samples if s.digest != digests[f"{s.task} {s.seed}"]})
+    if unsteady:  # the same seed must give the same run every time
+        print(f"digests differ between repeats of: {unsteady}")
+        sys.exit(1)
     if args.digests is not None:
         args.digests.write_text(json.dumps(digests, indent=2) + "\n", encoding="utf-8")
         print(f"digests written to {args.digests}")
