@@ -18,15 +18,18 @@ messages in all, as fast as they can, to one subscriber; the rate is from the fi
 receive. Both servers get the same clients, payload and count. The machine is shared, so the bench
 pairs its measurements: in each of R rounds the two servers are measured back to back (which goes
 first alternates from round to round and row to row), and the round's ratio is cbrs's rate over the
-relay's. A row's ratio is the median of its R round ratios, printed with their range; no round is left
-out (one that lost messages has rate 0). Beside the rate, each server process's CPU time per message
-(from /proc's per-thread schedstat; other work disturbs it far less than the rate), as medians and
-the median of the rounds' ratios, and this process's CPU per message (the clients'), which shows
-whether the clients or a server set the pace. One short warm-up round per server and count comes first and is not
-counted. Prints the machine, the load average (at the start, before each pair, at the end), the
-inputs and every round; ``--json FILE`` writes the rows as records ``{row, value, anchor, ratio, unit,
-goal, met}`` (value and anchor the median rates, ratio the median round ratio) with ``spread``,
-``rounds``, ``cpu_us_per_message`` and ``load_average`` besides.
+relay's. A measurement is short (20,000 messages by default, about a second), so the two of a pair
+see much the same machine, and there are many rounds (11) for the median. A row's ratio is the median
+of its R round ratios, printed with their range; no round is left out (one that lost messages has
+rate 0). Beside the rate, each server process's CPU time per message (from /proc's per-thread
+schedstat), as medians and the median of the rounds' ratios: other work disturbs it less than the
+rate, though not entirely (a server kept waiting finds fewer frames per wake-up). And this process's
+CPU per message (the clients'), which shows whether the clients or a server set the pace. One short
+warm-up round per server and count comes first and is not counted. Prints the machine, the load
+average (at the start, before each pair, at the end), the inputs and every round; ``--json FILE``
+writes the rows as records ``{row, value, anchor, ratio, unit, goal, met}`` (value and anchor the
+median rates, ratio the median round ratio) with ``spread``, ``rounds``, ``cpu_us_per_message`` and
+``load_average`` besides.
 """
 
 from __future__ import annotations
@@ -283,20 +286,20 @@ def report(records: list[dict[str, Any]]) -> None:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--messages", type=int, default=30000, help="messages per round")
+    parser.add_argument("--messages", type=int, default=20000, help="messages per measurement")
     parser.add_argument("--publishers", default="1,4", help="publisher counts, comma-separated")
     parser.add_argument("--size", type=int, default=100, help="bytes of payload per message")
-    parser.add_argument("--rounds", type=int, default=7, help="rounds (pairs of measurements) per publisher count")
-    parser.add_argument("--quick", action="store_true", help="10000 messages and 3 rounds (a rough look)")
+    parser.add_argument("--rounds", type=int, default=11, help="rounds (pairs of measurements) per publisher count")
+    parser.add_argument("--quick", action="store_true", help="10000 messages and 5 rounds (a rough look)")
     parser.add_argument("--json", type=Path, help="write the rows to FILE as a JSON list of records")
     args = parser.parse_args()
     if args.quick:
-        args.messages, args.rounds = 10000, 3
+        args.messages, args.rounds = 10000, 5
     counts = [int(c) for c in args.publishers.split(",")]
     print(f"machine: {platform.platform()}, {os.cpu_count()} cores, python {platform.python_version()}")
     print("load average at the start: {:.2f} {:.2f} {:.2f}".format(*os.getloadavg()))
     print(
-        f"inputs: {args.messages} messages of {args.size}-byte payload per round, publishers {counts} -> 1 "
+        f"inputs: {args.messages} messages of {args.size}-byte payload per measurement, publishers {counts} -> 1 "
         f"subscriber, {args.rounds} rounds; in each round the two servers back to back, the first "
         "alternating; servers in child processes, websockets sync clients here, loopback"
     )
