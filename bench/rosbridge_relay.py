@@ -20,11 +20,12 @@ pairs its measurements: in each of R rounds the two servers are measured back to
 first alternates from round to round and row to row), and the round's ratio is cbrs's rate over the
 relay's. A measurement is short (20,000 messages by default, about a second), so the two of a pair
 see much the same machine, and there are many rounds (11) for the median. A row's ratio is the median
-of its R round ratios, printed with their range; no round is left out (one that lost messages has
-rate 0). Beside the rate, each server process's CPU time per message (from /proc's per-thread
-schedstat), as medians and the median of the rounds' ratios: other work disturbs it less than the
-rate, though not entirely (a server kept waiting finds fewer frames per wake-up). And this process's
-CPU per message (the clients'), which shows whether the clients or a server set the pace. One short
+of its R round ratios, printed with their range; no round is left out (one in which either server
+lost messages counts as ratio 0, against cbrs). Beside the rate, each server process's CPU time per
+message (from /proc's per-thread schedstat), as medians and the median of the rounds' ratios: other
+work disturbs it less than the rate, though not entirely (a server kept waiting finds fewer frames per
+wake-up). And this process's CPU per message (the clients'), which shows whether the clients or a
+server set the pace. One short
 warm-up round per server and count comes first and is not counted. Prints the machine, the load
 average (at the start, before each pair, at the end), the inputs and every round; ``--json FILE``
 writes the rows as records ``{row, value, anchor, ratio, unit, goal, met}`` (value and anchor the
@@ -246,7 +247,7 @@ def measure(args: argparse.Namespace, counts: list[int]) -> dict[int, list[Pair]
 
 def summary(count: int, pairs: list[Pair]) -> dict[str, Any]:
     """The row of one publisher count: median rates and CPU, the median of the rounds' ratios and their
-    range (every round counts: a round that lost messages has ratio 0)."""
+    range (every round counts: a round in which either server lost messages has ratio 0)."""
     rates, cpus = [p.ratio("rate") for p in pairs], [p.ratio("cpu") for p in pairs]
     ratio = statistics.median(rates)
     return {
