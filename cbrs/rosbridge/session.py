@@ -26,9 +26,9 @@ log = logging.getLogger("cbrs.rosbridge")
 REPLY_BACKLOG = 10_000
 #: Bytes of replies a client may leave unread before it is disconnected.
 REPLY_BYTES = 64 << 20
-#: Messages the writer hands the transport at once when several are due (with ``send_many``): one socket
-#: write for a burst instead of one per message. Bounded, so a burst held outside the queues (where the
-#: queues' drop-oldest rule no longer reaches it) stays small.
+#: Messages the writer hands the transport at once when several are due (with ``send_many``), so the
+#: transport can write a burst together instead of message by message. Bounded, so a burst held outside
+#: the queues (where the queues' drop-oldest rule no longer reaches it) stays small.
 WRITE_BATCH = 64
 #: Characters of messages in one such burst (a burst always takes at least one message, whatever its size).
 WRITE_BATCH_CHARS = 256 << 10
