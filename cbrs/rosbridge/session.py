@@ -3,7 +3,8 @@
 Everything the client receives goes through one writer task, in the order it was produced, except that
 a throttled topic waits for its window. Replies (statuses, service responses, forwarded calls) are never
 dropped; topic messages wait in their :class:`TopicQueue`, so a client that reads slowly only ever has
-its queues' worth of messages pending. The transport hands in ``send`` (await one text frame) and
+its queues' worth of messages pending. The transport hands in ``send`` (await one text frame),
+optionally ``send_many`` (await several, in order: the writer hands it what is due at once), and
 ``abort`` (drop the connection, with a reason); nothing here knows about websockets.
 """
 
