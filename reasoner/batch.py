@@ -143,6 +143,7 @@ class CompiledPool:
             for statement in (*ad.effects, *ad.preconditions):
                 statements.setdefault(statement, len(statements))
         self.tree_ids = {concept: i for i, concept in enumerate(trees)}
+        self.tree_concepts = list(trees)  # each tree's root concept, by tree id
         self._layout_trees(list(trees.values()))
         self.statements = list(statements)
         self._opposites: _Lru[Statement, npt.NDArray[np.bool_]] = _Lru(ARRAY_CACHE_BYTES, _nbytes)  # bounded
@@ -390,6 +391,55 @@ class BatchScorer:
             per.append(pool.outputs.max(terms[pool.root_ids]))
         return np.asarray(np.mean(per, axis=0), dtype=np.float64)
 
+    def steps(self, requirement: Requirement, own: FloatArray) -> FloatArray:
+        """Per advertisement, the best decomposition_weight x an achiever's effects part (``own``) x the
+        delivered floor of its output as an input the achiever needs and the requester does not provide
+        (reasoner/steps.py); 0 where it feeds no achiever."""
+        pool, cfg = self.pool, self.config
+        found = np.zeros(len(pool.ads), dtype=np.float64)
+        achieving = pool.effects.present & (own >= cfg.pair_threshold)
+        for wanted in requirement.effects:
+            if not achieving.any():
+                return found
+            above = (
+                self._at_or_above(wanted.subject)[pool.s_ids]
+                & self._at_or_above(wanted.predicate)[pool.p_ids]
+                & self._at_or_above(wanted.object)[pool.o_ids]
+            )
+            achieving &= pool.effects.max(above.astype(np.float64)) > 0
+        given = np.zeros(len(pool.root_ids), dtype=bool)  # pool trees the requester provides as they are
+        for provided in requirement.inputs:
+            given |= self.plugin(provided.type) > 0
+        for a in np.flatnonzero(achieving):
+            start, count = pool.inputs.starts[a], pool.inputs.counts[a]
+            for tree in dict.fromkeys(pool.inputs.flat[start : start + count].tolist()):
+                if given[tree]:
+                    continue
+                feed = pool.outputs.max(self._floor_below(pool.tree_concepts[tree])[pool.root_ids])
+                np.maximum(found, cfg.decomposition_weight * own[a] * feed, out=found)
+        return found
+
+    def _floor_below(self, concept: str) -> FloatArray:
+        """1 - specialisation_step * k for every concept id k is-a links below ``concept`` (the concept
+        itself only, 1, when it is outside the taxonomy), 0 elsewhere."""
+        space = self.pool.space
+        if concept in space.index:
+            return space.delivered(concept, True, self.config.specialisation_step)
+        floor = np.zeros(len(space), dtype=np.float64)
+        if concept in space.ids:
+            floor[space.ids[concept]] = 1.0
+        return floor
+
+    def _at_or_above(self, concept: str) -> npt.NDArray[np.bool_]:
+        """For every concept id: is it ``concept`` or an is-a superclass of it (steps.at_or_above)?"""
+        space = self.pool.space
+        mask = np.zeros(len(space), dtype=bool)
+        if concept in space.index:
+            mask[[space.ids[a] for a in space.index.is_a_ancestors(concept)]] = True
+        elif concept in space.ids:
+            mask[space.ids[concept]] = True
+        return mask
+
     def _kinds_of(self, concept: str) -> npt.NDArray[np.bool_]:
         """For every concept id: is it a strict is-a superclass of ``concept``?"""
         space = self.pool.space
@@ -474,10 +524,13 @@ class BatchScorer:
                 inputs = np.where(pool.inputs.present, needed_per_ad, np.nan)
             parts["inputs"] = inputs
         if requirement.effects:
-            effects = np.mean([pool.effects.max(self.statements(s)) for s in requirement.effects], axis=0)
+            own = np.mean([pool.effects.max(self.statements(s)) for s in requirement.effects], axis=0)
+            effects = own
+            reports = pool.outputs.present & ~pool.effects.present
             if cfg.observed_state_weight > 0:  # Matchmaker._observed
-                reports = pool.outputs.present & ~pool.effects.present
                 effects = np.where(reports, cfg.observed_state_weight * self.observed(requirement.effects), effects)
+            if cfg.decomposition_weight > 0 and isinstance(self.measure, SemStr):  # Matchmaker._step
+                effects = np.where(reports, np.maximum(effects, self.steps(requirement, own)), effects)
             parts["effects"] = effects
         if requirement.preconditions:
             guaranteed = np.max([self.statements(s) for s in requirement.preconditions], axis=0)

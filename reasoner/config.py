@@ -62,6 +62,11 @@ class MatchConfig:
     # outputs the subject finds it (a door detector). False: the object, the subject or an is-a relative of
     # either (the first rule).
     observed_state_kind: bool = True
+    # A step of the decomposition towards a requested effect (reasoner/steps.py): an advertisement that
+    # changes nothing but outputs an input that an achiever of the effect needs and the requester does not
+    # provide (the grasp planner's GraspPose, for a pick-up service that achieves (Cup, isHeldBy, Robot)).
+    # Its effects part is at least this weight times the achiever's effects part. 0 turns it off.
+    decomposition_weight: float = 0.5
     # How the parts of a match combine; parts the requirement does not state are left out and the
     # remaining weights renormalised.
     output_weight: float = 0.4
@@ -126,6 +131,7 @@ class MatchConfig:
             complement_weight=0.0,
             unrelated_predicate_factor=1.0,
             observed_state_weight=0.0,
+            decomposition_weight=0.0,
         )
 
     def __post_init__(self) -> None:
@@ -145,6 +151,7 @@ class MatchConfig:
             "complement_weight",
             "unrelated_predicate_factor",
             "observed_state_weight",
+            "decomposition_weight",
             "contradiction_factor",
         ):
             value = getattr(self, name)

@@ -42,6 +42,7 @@ from cbrs.reasoner.names import local_name
 from cbrs.reasoner.similarity import SemStr, Similarity
 from cbrs.reasoner.spans import PairMatch, SpanMatch, conceptual_span_similarity, span
 from cbrs.reasoner.statements import StatementMatch, best_statement_matches, contradiction_factor, reported
+from cbrs.reasoner.steps import Achiever, achievers, feeds
 from cbrs.reasoner.taxonomy import TaxonomyIndex
 from cbrs.reasoner.text import description_text
 
@@ -126,6 +127,7 @@ class Matchmaker:
         self._requirements: dict[str, Requirement] = {}
         self._requirements_at: object = None  # the store generation they were read at
         self._strict_scorer: StrictScorer | None = None
+        self._achievers_of: tuple[Requirement, list[Advertisement], list[Achiever]] | None = None  # _step's
         self._lock = threading.RLock()  # rankings and the explanations read from them share the caches
 
     def prepare(self) -> Matchmaker:
@@ -300,6 +302,13 @@ class Matchmaker:
                 parts["effects"] = self._observed(requirement.effects, ad.outputs, pairs)
             else:
                 parts["effects"] = self._statements(matches, "effect", pairs, lacks)
+            if (
+                not ad.effects
+                and ad.outputs
+                and cfg.decomposition_weight > 0
+                and isinstance(self.method.measure, SemStr)
+            ):
+                parts["effects"] = max(parts["effects"], self._step(requirement, ad, pairs))
         if ad.preconditions and requirement.preconditions:
             matches = best_statement_matches(ad.preconditions, requirement.preconditions, self.method.measure, cfg)
             parts["preconditions"] = self._statements(matches, "precondition", pairs, lacks)
@@ -487,6 +496,38 @@ class Matchmaker:
             pairs.append(EntityPair("effect", text, output, weight * best.value, how, Degree.FAIL.value))
             values.append(weight * best.value)
         return sum(values) / len(values)
+
+    def _step(self, requirement: Requirement, ad: Advertisement, pairs: list[EntityPair]) -> float:
+        """An advertisement that changes nothing but outputs an input an achiever of the requested effects
+        needs and the requester lacks (reasoner/steps.py): decomposition_weight x the achiever's effects
+        part x the output's delivered floor, with its pair when it is above 0."""
+        cfg = self.config
+        found = self._achievers_of
+        if found is None or found[0] is not requirement or found[1] is not self.advertisements:
+            listed = achievers(self.index, requirement, self.advertisements, self.method.measure, cfg)
+            found = self._achievers_of = (requirement, self.advertisements, listed)
+        best, why, output = 0.0, "", ""
+        for achiever in found[2]:
+            for needed in achiever.missing:
+                for out in ad.outputs:
+                    value = (
+                        cfg.decomposition_weight
+                        * achiever.value
+                        * feeds(self.index, out.type, needed, cfg.specialisation_step)
+                    )
+                    if value > best:
+                        best, output = value, out.type
+                        why = (
+                            f"no effect; output {_short(out.type)} is the {_short(needed)} that"
+                            f" {_short(achiever.advertisement.iri)} needs to achieve it ({achiever.value:.2f})"
+                            f" x {cfg.decomposition_weight:g}"
+                        )
+        if best > 0:
+            text = ", ".join(
+                f"({_short(e.subject)}, {_short(e.predicate)}, {_short(e.object)})" for e in requirement.effects
+            )
+            pairs.append(EntityPair("effect", text, output, best, why, Degree.FAIL.value))
+        return best
 
     def _statements(self, matches: list[StatementMatch], role: str, pairs: list[EntityPair], lacks: list[str]) -> float:
         values = []

@@ -303,3 +303,85 @@ def test_equal_scores_are_ordered_by_what_was_asked_for_before_the_iri() -> None
     off = Matchmaker(loaded.kb, config=MatchConfig(tie_break_result=False)).rank(wanted, explain=0).candidates
     order = [c.advertisement for c in off]  # by IRI: the humidity sensor's sorts first
     assert order.index(humidity.advertisement) < order.index(thermostat.advertisement)
+
+
+def _manipulation() -> TaxonomyIndex:
+    """Objects, agents and poses for pick-up requests: a Cup is a PhysicalObject, a GraspPose a Pose."""
+    pairs = [
+        ("PhysicalObject", "Thing"),
+        ("Cup", "PhysicalObject"),
+        ("Agent", "PhysicalObject"),
+        ("Robot", "Agent"),
+        ("Person", "Agent"),
+        ("SpatialData", "Thing"),
+        ("Pose", "SpatialData"),
+        ("GraspPose", "Pose"),
+        ("TopGraspPose", "GraspPose"),
+        ("RobotPose", "Pose"),
+        ("Location", "SpatialData"),
+        ("ObjectLocation", "Location"),
+        ("PersonLocation", "Location"),
+    ]
+    return TaxonomyIndex.from_links([Link(E + child, E + parent, "is-a") for child, parent in pairs])
+
+
+def _held(thing: str, by: str) -> tuple[Statement, ...]:
+    return (Statement(E + thing, E + "isHeldBy", E + by),)
+
+
+def test_an_offer_that_prepares_what_an_achiever_lacks_is_a_step_towards_the_effect() -> None:
+    # Pick up the cup, knowing where it is. PickObject picks anything up but needs a GraspPose the requester
+    # lacks: the grasp planner that outputs one is a step of the decomposition; a RobotPose is no GraspPose.
+    wanted = Requirement(E + "GraspCup", (), inputs=(_p("input", "ObjectLocation"),), effects=_held("Cup", "Robot"))
+    achiever = Advertisement(
+        E + "PickObject", (), inputs=(_p("input", "GraspPose"),), effects=_held("PhysicalObject", "Robot")
+    )
+    planner = Advertisement(
+        E + "GraspPlanner", (), inputs=(_p("input", "ObjectLocation"),), outputs=(_p("output", "GraspPose"),)
+    )
+    top = Advertisement(E + "TopGraspPlanner", (), outputs=(_p("output", "TopGraspPose"),))
+    localiser = Advertisement(
+        E + "Localiser", (), inputs=(_p("input", "ObjectLocation"),), outputs=(_p("output", "RobotPose"),)
+    )
+    # Handing over to a Person does not achieve holding by the Robot, so what it needs is no step...
+    hand_over = Advertisement(
+        E + "HandOver", (), inputs=(_p("input", "PersonLocation"),), effects=_held("PhysicalObject", "Person")
+    )
+    tracker = Advertisement(E + "PersonTracker", (), outputs=(_p("output", "PersonLocation"),))
+    # ... nor is producing what the requester already has (PickCup takes the ObjectLocation it provides).
+    pick_cup = Advertisement(E + "PickCup", (), inputs=(_p("input", "ObjectLocation"),), effects=_held("Cup", "Robot"))
+    finder = Advertisement(E + "ObjectFinder", (), outputs=(_p("output", "ObjectLocation"),))
+    ads = [achiever, planner, top, localiser, hand_over, tracker, pick_cup, finder]
+    kb = KnowledgeBase(Store.open(":memory:"))
+    matcher = Matchmaker(kb, index=_manipulation(), advertisements=ads)
+    ranked = {c.advertisement.removeprefix(E): c for c in matcher.rank(wanted, explain=0).candidates}
+    for ad in ads:  # the batch agrees with the scalar path
+        assert ranked[ad.iri.removeprefix(E)].score == matcher.score(wanted, ad).score
+    weight, step = MatchConfig().decomposition_weight, MatchConfig().specialisation_step
+    pick = ranked["PickObject"].parts["effects"]
+    assert pick >= MatchConfig().pair_threshold
+    assert ranked["GraspPlanner"].parts["effects"] == pytest.approx(weight * pick)
+    assert ranked["TopGraspPlanner"].parts["effects"] == pytest.approx(weight * pick * (1 - step))  # a subclass
+    for other in ("Localiser", "PersonTracker", "ObjectFinder"):
+        assert ranked[other].parts["effects"] == 0.0
+    assert ranked["GraspPlanner"].score > ranked["Localiser"].score  # same inputs, only the planner feeds PickObject
+    explained = matcher.score(wanted, planner)
+    assert any("GraspPose that PickObject needs" in pair.how for pair in explained.pairs)
+    off = Matchmaker(kb, config=MatchConfig(decomposition_weight=0.0), index=_manipulation(), advertisements=ads)
+    assert off.score(wanted, planner).parts["effects"] == 0.0
+    assert off.rank(wanted, explain=0).candidates[0].advertisement == E + "PickCup"
+    assert Matchmaker(kb, "wu-palmer", index=_manipulation(), advertisements=ads).config.decomposition_weight == 0
+
+
+def test_the_grasp_planner_ranks_as_a_step_on_the_robot_collection() -> None:
+    loaded = load_collection(ROBOT)
+    wanted = loaded.requirements["grasp_cup.owls"][0]
+
+    def place(config: MatchConfig, name: str) -> int:
+        ranked = Matchmaker(loaded.kb, config=config).rank(wanted, explain=0).candidates
+        return [c.advertisement.rsplit("#", 1)[-1] for c in ranked].index(name)
+
+    on, off = MatchConfig(), MatchConfig(decomposition_weight=0.0)
+    # grade 1 (a step: plans the grasp) against grade 0 (puts the held object down: no input it lacks)
+    assert place(on, "GRASP_PLANNER_SERVICE") < place(on, "PLACE_OBJECT_SERVICE")
+    assert place(off, "GRASP_PLANNER_SERVICE") > place(off, "PLACE_OBJECT_SERVICE")

@@ -1,0 +1,93 @@
+"""Steps of a decomposition: a service that prepares what another one needs to achieve a requested effect.
+
+The paper composes services through their resources: one service's output is another's input. For a
+requested effect, an advertisement *achieves* it when one of its effects states at least that change
+(each of subject, predicate and object is the requested one or an is-a superclass of it: picking up any
+PhysicalObject for the Robot achieves picking up the Cup) and matches it at the pair threshold. When the
+achiever needs an input the requester does not provide (neither that concept nor a subclass of it: the
+GraspPose of a pick-up service, for a requester that only knows where the cup is), an advertisement
+that changes nothing but outputs that input (or a subclass of it) is a step of the decomposition, the
+grasp planner. Its effects part is at least MatchConfig.decomposition_weight times the achiever's
+effects part, times the delivered floor of its output (1 - specialisation_step per is-a link below).
+
+Both scoring paths use these rules: reasoner/batch.py over the whole pool, ``Matchmaker.score`` one
+advertisement at a time through ``achievers`` and ``feeds``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from cbrs.kb import Advertisement, Requirement, Statement
+from cbrs.reasoner.config import MatchConfig
+from cbrs.reasoner.similarity import EntityMeasure
+from cbrs.reasoner.statements import best_statement_matches
+from cbrs.reasoner.taxonomy import TaxonomyIndex
+
+
+@dataclass(frozen=True)
+class Achiever:
+    """An advertisement that achieves the requested effects, its effects part, and the inputs it needs
+    that the requester does not provide."""
+
+    advertisement: Advertisement
+    value: float
+    missing: tuple[str, ...]
+
+
+def at_or_above(index: TaxonomyIndex, requested: str, offered: str) -> bool:
+    """Is ``offered`` the ``requested`` concept (or property) or an is-a superclass of it?"""
+    if requested == offered:
+        return True
+    if requested not in index or offered not in index:
+        return False
+    return index.canonical(offered) in index.is_a_ancestors(requested)
+
+
+def achieves(index: TaxonomyIndex, requested: Statement, offered: Statement) -> bool:
+    """Does ``offered`` state at least the change ``requested`` asks for (each position the same or above)?"""
+    return (
+        at_or_above(index, requested.subject, offered.subject)
+        and at_or_above(index, requested.predicate, offered.predicate)
+        and at_or_above(index, requested.object, offered.object)
+    )
+
+
+def provided(index: TaxonomyIndex, requirement: Requirement, concept: str) -> bool:
+    """Does the requester provide ``concept`` or a subclass of it (an input it can pass as it is)?"""
+    return any(at_or_above(index, given.type, concept) for given in requirement.inputs)
+
+
+def achievers(
+    index: TaxonomyIndex,
+    requirement: Requirement,
+    ads: Sequence[Advertisement],
+    measure: EntityMeasure,
+    config: MatchConfig,
+) -> list[Achiever]:
+    """The advertisements that achieve every requested effect (``achieves``, effects part at the pair
+    threshold or above) and need an input the requester does not provide."""
+    found = []
+    for ad in ads:
+        if not ad.effects or not requirement.effects:
+            continue
+        if not all(any(achieves(index, wanted, got) for got in ad.effects) for wanted in requirement.effects):
+            continue
+        matches = best_statement_matches(requirement.effects, ad.effects, measure, config)
+        value = sum(m.value for m in matches) / len(matches)
+        missing = tuple(dict.fromkeys(p.type for p in ad.inputs if not provided(index, requirement, p.type)))
+        if value >= config.pair_threshold and missing:
+            found.append(Achiever(ad, value, missing))
+    return found
+
+
+def feeds(index: TaxonomyIndex, output: str, needed: str, step: float) -> float:
+    """The delivered floor of ``output`` as the ``needed`` input: 1 - step * k when it is ``needed`` or k
+    is-a links below it, else 0."""
+    if output == needed:
+        return 1.0
+    if output not in index or needed not in index:
+        return 0.0
+    links = index.is_a_ancestors(output).get(index.canonical(needed))
+    return 0.0 if links is None else max(0.0, 1.0 - step * links)
