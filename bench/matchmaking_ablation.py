@@ -41,6 +41,7 @@ VARIANTS: dict[str, MatchConfig] = {
     "contradicting offers keep their score (contradiction_factor 1)": replace(BASE, contradiction_factor=1.0),
     "observed state by any is-a relative (observed_state_kind off)": replace(BASE, observed_state_kind=False),
     "equal scores by IRI only (tie_break_result off)": replace(BASE, tie_break_result=False),
+    "no decomposition steps (decomposition_weight 0)": replace(BASE, decomposition_weight=0.0),
     "no cross-branch links": replace(BASE, cross_branch_weight=0.0),
     "with WordNet core words": replace(BASE, lexicon=True),
     "input gate 0.4": replace(BASE, input_gate=0.4),

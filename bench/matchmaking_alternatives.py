@@ -10,7 +10,11 @@ all queries and over the odd- and even-numbered ones (held-out halves):
 - outputs weighing more than inputs: the score recomputed from its parts with output_weight 0.5, or
   multiplied by (1 - g + g * outputs) (an output gate);
 - OWLS-MX's role-free signature similarity: each requested input or output against the best of all the
-  advertised inputs and outputs, mixed into the score with a small weight.
+  advertised inputs and outputs, mixed into the score with a small weight;
+- co-consumers as steps of a decomposition: an offer without effects that takes an input an achiever of
+  the requested effect needs and the requester lacks (the path planner takes the NavigationGoal the
+  navigation service needs) gets a share of the achiever's effects part, as the committed
+  decomposition_weight gives the producers of that input (reasoner/steps.py).
 
 Ties are broken as the matchmaker breaks them (the result part, then the IRI). Two more rows bound how
 much the order of equal scores can matter: relevant services first, or last, among equal scores.
@@ -39,7 +43,9 @@ sys.path.insert(0, str(Path(__file__).parent))
 from matchmaking_ablation import DEFAULTS, _queries
 
 WEIGHTS = {"outputs": 0.4, "inputs": 0.2, "effects": 0.3, "preconditions": 0.1}
-Score = Callable[[BatchScores, BatchScores, np.ndarray], np.ndarray]  # (sem-str, logic, signature) -> score
+# (sem-str, logic, extras: "signature" similarity, "co-consumer" effects share at weight 1) -> score, or
+# (score, result part for ties) when the alternative changes the result part
+Score = Callable[[BatchScores, BatchScores, dict[str, np.ndarray]], np.ndarray | tuple[np.ndarray, np.ndarray]]
 
 
 def _mean(parts: dict[str, np.ndarray], weights: dict[str, float]) -> np.ndarray:
@@ -48,14 +54,26 @@ def _mean(parts: dict[str, np.ndarray], weights: dict[str, float]) -> np.ndarray
     return np.asarray(np.where(denominator > 0, numerator / np.maximum(denominator, 1e-300), 0.0))
 
 
+def _with_effects(s: BatchScores, share: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The score and its result part (outputs and effects) with the effects part raised to ``share`` where
+    that is higher (only offers without effects get a share, so no contradiction factor is undone)."""
+    raised = ~np.isnan(s.parts["effects"]) & (share > s.parts["effects"])
+    parts = {**s.parts, "effects": np.where(raised, share, s.parts["effects"])}
+    result = _mean(parts, {"outputs": WEIGHTS["outputs"], "effects": WEIGHTS["effects"]})
+    tie = result if s.tie is None else np.where(raised, result, s.tie)
+    return np.where(raised, _mean(parts, WEIGHTS), s.score), tie
+
+
 ALTERNATIVES: dict[str, Score] = {
-    "default": lambda s, lg, sig: s.score,
-    "strict logic rejects last, then Sem-Str": lambda s, lg, sig: s.score - 2.0 * lg.rejected,
-    "logic degree score first, then Sem-Str": lambda s, lg, sig: s.score + 2.0 * np.where(lg.rejected, 0, lg.score),
-    "Sem-Str + 0.2 logic score": lambda s, lg, sig: s.score + 0.2 * np.where(lg.rejected, 0, lg.score),
-    "output_weight 0.5": lambda s, lg, sig: _mean(s.parts, {**WEIGHTS, "outputs": 0.5}),
-    "output gate 0.2": lambda s, lg, sig: s.score * (0.8 + 0.2 * np.nan_to_num(s.parts["outputs"], nan=1.0)),
-    "signature similarity 0.1": lambda s, lg, sig: 0.9 * s.score + 0.1 * sig,
+    "default": lambda s, lg, x: s.score,
+    "strict logic rejects last, then Sem-Str": lambda s, lg, x: s.score - 2.0 * lg.rejected,
+    "logic degree score first, then Sem-Str": lambda s, lg, x: s.score + 2.0 * np.where(lg.rejected, 0, lg.score),
+    "Sem-Str + 0.2 logic score": lambda s, lg, x: s.score + 0.2 * np.where(lg.rejected, 0, lg.score),
+    "output_weight 0.5": lambda s, lg, x: _mean(s.parts, {**WEIGHTS, "outputs": 0.5}),
+    "output gate 0.2": lambda s, lg, x: s.score * (0.8 + 0.2 * np.nan_to_num(s.parts["outputs"], nan=1.0)),
+    "signature similarity 0.1": lambda s, lg, x: 0.9 * s.score + 0.1 * x["signature"],
+    "co-consumers of an achiever's missing input, 0.5": lambda s, lg, x: _with_effects(s, 0.5 * x["co-consumer"]),
+    "co-consumers of an achiever's missing input, 0.3": lambda s, lg, x: _with_effects(s, 0.3 * x["co-consumer"]),
 }
 
 
@@ -69,6 +87,37 @@ def _signature(scorer: BatchScorer, requirement: object) -> np.ndarray:
         css = scorer.css_wanted(parameter.tree or PartNode(parameter.type))
         per.append(np.maximum(pool.outputs.max(css), pool.inputs.max(css)))
     return np.asarray(np.mean(per, axis=0))
+
+
+def _co_consumers(scorer: BatchScorer, requirement: object) -> np.ndarray:
+    """Per offer without effects: the best effects part of an achiever (steps.py's rule) that needs an
+    input this offer takes too and the requester does not provide; 0 elsewhere."""
+    pool, cfg = scorer.pool, scorer.config
+    found = np.zeros(len(pool.ads))
+    effects = requirement.effects  # type: ignore[attr-defined]
+    if not effects:
+        return found
+    own = np.mean([pool.effects.max(scorer.statements(e)) for e in effects], axis=0)
+    achieving = pool.effects.present & (own >= cfg.pair_threshold)
+    for wanted in effects:
+        above = (
+            scorer._at_or_above(wanted.subject)[pool.s_ids]
+            & scorer._at_or_above(wanted.predicate)[pool.p_ids]
+            & scorer._at_or_above(wanted.object)[pool.o_ids]
+        )
+        achieving &= pool.effects.max(above.astype(np.float64)) > 0
+    given = np.zeros(len(pool.root_ids), dtype=bool)
+    for provided in requirement.inputs:  # type: ignore[attr-defined]
+        given |= scorer.plugin(provided.type) > 0
+    free = pool.outputs.present & ~pool.effects.present
+    for a in np.flatnonzero(achieving):
+        start, count = pool.inputs.starts[a], pool.inputs.counts[a]
+        for tree in set(pool.inputs.flat[start : start + count].tolist()):
+            if not given[tree]:
+                takes = np.zeros(len(pool.root_ids))
+                takes[tree] = 1.0
+                found = np.maximum(found, np.where(free, own[a] * pool.inputs.max(takes), 0.0))
+    return found
 
 
 def main() -> None:
@@ -89,10 +138,12 @@ def main() -> None:
             requirement = semstr._requirement(iri)
             s = scorer.score(requirement)
             lg = logic._strict(logic_pool).score(requirement)
-            sig = _signature(scorer, requirement)
+            extras = {"signature": _signature(scorer, requirement), "co-consumer": _co_consumers(scorer, requirement)}
             for name, alternative in ALTERNATIVES.items():
-                score = np.round(alternative(s, lg, sig), 6)
-                tie = np.zeros(len(score)) if s.tie is None else np.round(s.tie, 3)
+                found = alternative(s, lg, extras)
+                score, tie = found if isinstance(found, tuple) else (found, s.tie)
+                score = np.round(score, 6)
+                tie = np.zeros(len(score)) if tie is None else np.round(tie, 3)
                 order = np.lexsort((pool.iri_rank, -tie, -score, s.rejected))  # as batch.ranking_keys sorts
                 rows[name].append(average_precision([pool.ads[i].iri for i in order], relevant))
             hit = np.array([ad.iri in relevant for ad in pool.ads], dtype=np.int64)
