@@ -21,7 +21,7 @@ import functools
 from collections.abc import Awaitable, Callable, Collection, Iterable
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
-from urllib.parse import unquote_plus
+from urllib.parse import unquote_to_bytes
 
 from a2wsgi import WSGIMiddleware
 from a2wsgi.wsgi import WSGIResponder
@@ -229,14 +229,22 @@ def _with_length(scope: Scope, size: int) -> Scope:
 
 
 def _parameters(query_string: str) -> list[tuple[str, str]]:
-    """``parse_qsl(query_string, keep_blank_values=True, errors="strict")``, without its generality:
-    this runs for every lookup (tests/test_asgi_front.py checks the two agree)."""
+    """``parse_qsl(query_string, keep_blank_values=True, errors="strict")`` of an ASCII query string,
+    without its generality: this runs for every lookup (tests/test_asgi_front.py checks the two agree)."""
     pairs = []
     for field in query_string.split("&"):
         if field:
             name, _, value = field.partition("=")
-            pairs.append((unquote_plus(name, errors="strict"), unquote_plus(value, errors="strict")))
+            pairs.append((_unquote(name), _unquote(value)))
     return pairs
+
+
+def _unquote(text: str) -> str:
+    """``unquote_plus(text, errors="strict")`` of an ASCII ``text``: for such a text ``unquote`` splits
+    off no non-ASCII run and decodes the bytes of its escapes at once, which this does without the
+    split (half the time of a point lookup's query string)."""
+    text = text.replace("+", " ")
+    return unquote_to_bytes(text).decode("utf-8") if "%" in text else text
 
 
 def _headers(scope: Scope) -> dict[bytes, str] | None:

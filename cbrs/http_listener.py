@@ -50,6 +50,7 @@ class ListenerConfig:
     header_timeout: float = 10.0  # seconds a client may take to send a request's headers
     max_header_bytes: int = 64 * 1024  # what one connection may buffer while its headers are read
     backlog: int = 128  # connections waiting to be accepted; also the requests in Python at once
+    loop: str = "auto"  # the asyncio loop the app runs on: "uvloop", "asyncio", or "auto" (uvloop when installed)
 
 
 class _Server(_Embedded):
@@ -72,6 +73,24 @@ def _refuse_taken(host: str, port: int) -> None:
     with socket.socket(family, kind, proto) as probe:
         probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         probe.bind(address)
+
+
+def new_loop(kind: str) -> asyncio.AbstractEventLoop:
+    """A new event loop of ``kind`` (:attr:`ListenerConfig.loop`). uvloop's is written in C: Granian's
+    thread hands each request to the loop with ``call_soon_threadsafe``, which in asyncio's loop is
+    Python and a write to a socket pair holding the GIL, in uvloop's a wake-up of libuv; and the loop's
+    own turn per request is C, not Python (docs/serving.md, "The HTTP front")."""
+    if kind not in ("auto", "uvloop", "asyncio"):
+        raise ValueError(f"unknown event loop {kind!r}; use auto, uvloop or asyncio")
+    if kind != "asyncio":
+        try:
+            import uvloop
+        except ImportError:
+            if kind == "uvloop":
+                raise
+        else:
+            return uvloop.new_event_loop()
+    return asyncio.new_event_loop()
 
 
 class HttpListener:
@@ -137,7 +156,7 @@ class HttpListener:
         self._thread = None
 
     def _run(self) -> None:
-        loop = asyncio.new_event_loop()
+        loop = new_loop(self.config.loop)
         asyncio.set_event_loop(loop)
         self._loop = loop
         startup = self._server.startup

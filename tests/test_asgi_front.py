@@ -17,10 +17,12 @@ from urllib.parse import parse_qsl, quote
 
 import httpx
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from werkzeug.test import Client
 
 from cbrs.asgi_front import SparqlFront, _parameters
-from cbrs.http_listener import HttpListener, ListenerConfig
+from cbrs.http_listener import HttpListener, ListenerConfig, new_loop
 from cbrs.kb import KnowledgeBase
 from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.web import create_app
@@ -139,6 +141,18 @@ def test_query_strings_are_read_as_parse_qsl_reads_them(query_string: str) -> No
     assert _parameters(query_string) == parse_qsl(query_string, keep_blank_values=True, errors="strict")
 
 
+@settings(max_examples=300, deadline=None)
+@given(st.text(alphabet="%+&=aZ09fF-_.~ ?<>{}", max_size=40))
+def test_any_ascii_query_string_is_read_as_parse_qsl_reads_it(query_string: str) -> None:
+    try:
+        expected = parse_qsl(query_string, keep_blank_values=True, errors="strict")
+    except UnicodeDecodeError:
+        with pytest.raises(UnicodeDecodeError):
+            _parameters(query_string)
+        return
+    assert _parameters(query_string) == expected
+
+
 def test_a_query_string_that_is_not_utf8_goes_to_flask() -> None:
     with pytest.raises(UnicodeDecodeError):
         _parameters("query=%FF")
@@ -164,6 +178,31 @@ def _exchange(port: int, request: bytes) -> bytes:
     with socket.create_connection(("127.0.0.1", port), timeout=WAIT) as connection:
         connection.sendall(request)
         return connection.recv(4096)
+
+
+def test_the_loop_is_uvloop_when_installed_and_asyncio_when_asked() -> None:
+    uvloop = pytest.importorskip("uvloop")
+    for kind, expected in (("auto", uvloop.Loop), ("uvloop", uvloop.Loop), ("asyncio", asyncio.BaseEventLoop)):
+        loop = new_loop(kind)
+        try:
+            assert isinstance(loop, expected)
+            assert kind != "asyncio" or not isinstance(loop, uvloop.Loop)
+        finally:
+            loop.close()
+    with pytest.raises(ValueError, match="'trio'"):
+        new_loop("trio")
+
+
+@pytest.mark.parametrize("kind", ["asyncio", "auto"])
+def test_the_listener_serves_and_stops_on_either_loop(kind: str) -> None:
+    running = HttpListener(_hello, ListenerConfig(port=0, loop=kind))
+    running.start()
+    try:
+        assert httpx.get(f"http://127.0.0.1:{running.port}/", timeout=WAIT).text == "hello"
+    finally:
+        running.stop(WAIT)
+    with pytest.raises(OSError), socket.create_connection(("127.0.0.1", running.port), timeout=1):
+        pass
 
 
 def test_start_returns_once_the_port_accepts_and_stop_closes_it() -> None:
