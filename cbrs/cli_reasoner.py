@@ -12,8 +12,7 @@ from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import shorten
 from cbrs.output import table
 from cbrs.reasoner.config import MatchConfig
-from cbrs.reasoner.degrees import Degree
-from cbrs.reasoner.matchmaker import Candidate, EntityPair, Matchmaker, MatchResult, MatchStatus
+from cbrs.reasoner.matchmaker import Candidate, Matchmaker, MatchResult, MatchStatus
 from cbrs.reasoner.methods import METHODS
 
 
@@ -62,15 +61,6 @@ def _ranking(result: MatchResult, top: int) -> str:
     )
 
 
-def _degree(pair: EntityPair) -> str:
-    """The degree of match as a person reads it: a pair with no is-a link that Sem-Str still matched
-    (siblings with the same parts, a synonym in another branch) is "Similar", not "Fail"; "Fail" is left
-    for a pair below the pair threshold."""
-    if pair.degree == Degree.FAIL.value and pair.similarity >= MatchConfig().pair_threshold:
-        return "Similar"
-    return pair.degree
-
-
 def _explanation(position: int, c: Candidate) -> str:
     lines = [f"#{position} {shorten(c.advertisement)}  score {c.score:.3f}"]
     rows = [
@@ -79,7 +69,7 @@ def _explanation(position: int, c: Candidate) -> str:
             shorten(p.requested),
             shorten(p.advertised) if p.advertised else "-",
             f"{p.similarity:.2f}",
-            _degree(p),
+            p.shown_degree(),
             p.how,
         ]
         for p in c.pairs

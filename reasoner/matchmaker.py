@@ -68,6 +68,19 @@ class EntityPair:
     similarity: float
     how: str
     degree: str
+    #: The rule that gave a partial share when no is-a link did: "reports" (an output observes the
+    #: requested state) or "step" (an output an achiever of the effect needs); "" for a plain comparison.
+    rule: str = ""
+
+    def shown_degree(self, pair_threshold: float = MatchConfig().pair_threshold) -> str:
+        """The degree as a person reads it. A pair with no is-a link that Sem-Str still matched (siblings
+        with the same parts, a synonym in another branch) is "Similar"; a share given by a rule is named
+        by the rule ("Reports", "Step"); "Fail" is left for a pair below the threshold and no rule."""
+        if self.degree != Degree.FAIL.value:
+            return self.degree
+        if self.rule:
+            return self.rule.capitalize()
+        return "Similar" if self.similarity >= pair_threshold else self.degree
 
 
 @dataclass(frozen=True)
@@ -493,7 +506,7 @@ class Matchmaker:
             best, output, term = max(found, key=lambda item: item[0].value)
             text = f"({_short(effect.subject)}, {_short(effect.predicate)}, {_short(effect.object)})"
             how = f"no effect; output {_short(output)} reports {_short(term)} ({best.value:.2f}) x {weight:g}"
-            pairs.append(EntityPair("effect", text, output, weight * best.value, how, Degree.FAIL.value))
+            pairs.append(EntityPair("effect", text, output, weight * best.value, how, Degree.FAIL.value, "reports"))
             values.append(weight * best.value)
         return sum(values) / len(values)
 
@@ -526,7 +539,7 @@ class Matchmaker:
             text = ", ".join(
                 f"({_short(e.subject)}, {_short(e.predicate)}, {_short(e.object)})" for e in requirement.effects
             )
-            pairs.append(EntityPair("effect", text, output, best, why, Degree.FAIL.value))
+            pairs.append(EntityPair("effect", text, output, best, why, Degree.FAIL.value, "step"))
         return best
 
     def _statements(self, matches: list[StatementMatch], role: str, pairs: list[EntityPair], lacks: list[str]) -> float:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
@@ -11,7 +12,7 @@ from cbrs.reasoner.antonyms import DATA_FILE as ANTONYMS
 from cbrs.reasoner.antonyms import forms, opposite
 from cbrs.reasoner.config import MatchConfig
 from cbrs.reasoner.lexicon import DATA_FILE, Lexicon
-from cbrs.reasoner.matchmaker import Matchmaker
+from cbrs.reasoner.matchmaker import EntityPair, Matchmaker
 from cbrs.reasoner.owlstc import evaluate_collection, load_collection
 from cbrs.reasoner.similarity import SemStr
 from cbrs.reasoner.statements import statement_similarity
@@ -136,6 +137,26 @@ def test_sem_str_ranks_the_robot_collection_above_the_baselines(robot_report) ->
     assert figures["sem-str"]["map"] > figures["wu-palmer"]["map"]
 
 
+def test_the_best_match_of_every_robot_query_is_explained_without_fail() -> None:
+    """Issue 19: the explanation of the best match says how each pair matched; "Fail" only below the
+    pair threshold with no rule, which the best match of a query never shows."""
+    loaded = load_collection(ROBOT)
+    matcher = Matchmaker(loaded.kb)
+    shown = {
+        iri: [pair.shown_degree() for pair in matcher.rank(iri, explain=1).candidates[0].pairs]
+        for iris in loaded.requirements.values()
+        for iri in iris
+    }
+    assert len(shown) >= 15 and all(degrees for degrees in shown.values())
+    assert {iri: degrees for iri, degrees in shown.items() if "Fail" in degrees} == {}
+
+
+def test_a_pair_reads_as_similar_above_the_threshold_and_fail_below() -> None:
+    pair = EntityPair("output", M + "Location", M + "Position", 0.8, "situation-2", "Fail")
+    assert pair.shown_degree() == "Similar" and replace(pair, similarity=0.3).shown_degree() == "Fail"
+    assert replace(pair, degree="SubClassOf", similarity=0.1).shown_degree() == "SubClassOf"
+
+
 DEFINED = Path(__file__).parent / "data" / "defined_classes.ttl"
 M = "http://example.org/mini#"
 
@@ -194,6 +215,8 @@ def test_an_offer_that_reports_the_requested_state_is_a_step_towards_it(defined_
     opened_state = SemStr(index)(M + "DoorState", M + "Opened").value
     assert explained.parts["effects"] == pytest.approx(MatchConfig().observed_state_weight * opened_state)
     assert ranked[0].score == explained.score and "reports Opened" in explained.pairs[0].how
+    # the logic degree stays Fail (no is-a link: the composer must not act on it); a reader sees the rule
+    assert explained.pairs[0].degree == "Fail" and explained.pairs[0].shown_degree() == "Reports"
     assert matcher.score(wanted, other).parts["effects"] == 0.0  # a Lens is no state of a door, however alike
     off = Matchmaker(defined_kb, config=MatchConfig(observed_state_weight=0.0), index=index, advertisements=[checks])
     assert off.score(wanted, checks).parts["effects"] == 0.0
@@ -366,7 +389,8 @@ def test_an_offer_that_prepares_what_an_achiever_lacks_is_a_step_towards_the_eff
         assert ranked[other].parts["effects"] == 0.0
     assert ranked["GraspPlanner"].score > ranked["Localiser"].score  # same inputs, only the planner feeds PickObject
     explained = matcher.score(wanted, planner)
-    assert any("GraspPose that PickObject needs" in pair.how for pair in explained.pairs)
+    step_pairs = [pair for pair in explained.pairs if "GraspPose that PickObject needs" in pair.how]
+    assert step_pairs and {(pair.degree, pair.shown_degree()) for pair in step_pairs} == {("Fail", "Step")}
     off = Matchmaker(kb, config=MatchConfig(decomposition_weight=0.0), index=_manipulation(), advertisements=ads)
     assert off.score(wanted, planner).parts["effects"] == 0.0
     assert off.rank(wanted, explain=0).candidates[0].advertisement == E + "PickCup"

@@ -239,7 +239,7 @@ def _candidate(rank: int, c: Candidate, outputs: set[str]) -> dict[str, Any]:
                 "wanted": p.requested,
                 "offered": p.advertised,
                 "similarity": round(p.similarity, 4),
-                "degree": p.degree,
+                "degree": p.shown_degree(),
                 "how": p.how,
             }
             for p in c.pairs
