@@ -135,14 +135,28 @@ def test_a_scan_past_the_inline_budget_is_answered_on_a_thread_alike(bundled_kb:
 
 @pytest.mark.parametrize(
     "query_string",
-    ["query=a+b%20c&format=json", "a", "a=&b", "&&x=1", "q=%zz", "x=1=2", "query=%E2%82%AC", ""],
+    [
+        "query=a+b%20c&format=json",
+        "a",
+        "a=&b",
+        "&&x=1",
+        "q=%zz",
+        "x=1=2",
+        "query=%E2%82%AC",
+        "",
+        "q=%5Cx41%4",
+        "q=\\%41\\x41",
+        "q=%41%",
+        "q=%C3%A9%2",
+        "q=%%41",
+    ],
 )
 def test_query_strings_are_read_as_parse_qsl_reads_them(query_string: str) -> None:
     assert _parameters(query_string) == parse_qsl(query_string, keep_blank_values=True, errors="strict")
 
 
-@settings(max_examples=300, deadline=None)
-@given(st.text(alphabet="%+&=aZ09fF-_.~ ?<>{}", max_size=40))
+@settings(max_examples=500, deadline=None)
+@given(st.text(alphabet="%+&=aZ09fFxX-_.~ ?<>{}\\", max_size=40))
 def test_any_ascii_query_string_is_read_as_parse_qsl_reads_it(query_string: str) -> None:
     try:
         expected = parse_qsl(query_string, keep_blank_values=True, errors="strict")
