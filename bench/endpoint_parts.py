@@ -4,7 +4,7 @@ Run: python bench/endpoint_parts.py [--triples 200000] [--clients 4] [--seconds 
 
 Four servers over the same generated data (bench/store_limits.generate, 10 triples per entity), each
 its own process, up at once and measured in turns (the order reversed every other round), with point
-lookups from C client processes (``store_limits._client``, no warm-up): for each, the median over the
+lookups from C client processes (``store_limits.run_clients``, no warm-up): for each, the median over the
 rounds of the queries per second and of the server's CPU per lookup (user + system of the whole
 process, from /proc/PID/stat, around the turn, divided by the lookups answered in it):
 
@@ -23,7 +23,6 @@ inputs and one line per server.
 from __future__ import annotations
 
 import argparse
-import multiprocessing
 import os
 import platform
 import shutil
@@ -36,7 +35,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from endpoint_cpu import cpu_seconds
-from store_limits import GRAPH, PYTHON, Served, _client, _free_port, generate, serve_cbrs, serve_oxigraph
+from store_limits import GRAPH, PYTHON, Served, _free_port, generate, run_clients, serve_cbrs, serve_oxigraph
 
 _PART = textwrap.dedent(
     """
@@ -128,18 +127,7 @@ def main() -> None:
 def lookups(served: Served, entities: int, clients: int, seconds: float) -> int:
     """The point lookups ``clients`` processes had answered in ``seconds``, none left out as warm-up:
     the server's CPU is read around the whole turn."""
-    context = multiprocessing.get_context("fork")
-    pipes, processes = [], []
-    for index in range(clients):
-        receive, send = context.Pipe(duplex=False)
-        process = context.Process(target=_client, args=(served.port, served.path, entities, index, 0.0, seconds, send))
-        process.start()
-        pipes.append(receive)
-        processes.append(process)
-    answered = sum(len(pipe.recv()) for pipe in pipes)
-    for process in processes:
-        process.join()
-    return answered
+    return len(run_clients(served, entities, clients, 0.0, seconds))
 
 
 def _part(store: Path, part: str, size: int) -> Served:

@@ -167,20 +167,27 @@ def _client(port: int, path: str, entities: int, seed: int, warm: float, seconds
     out.close()
 
 
-def point_lookups(served: Served, entities: int, clients: int, seconds: float) -> tuple[float, float]:
-    """Queries per second and p99 latency (ms) of ``clients`` processes sending point lookups."""
+def run_clients(served: Served, entities: int, clients: int, warmup: float, seconds: float) -> list[float]:
+    """The latencies (s) of the point lookups ``clients`` processes had answered in ``seconds`` after
+    ``warmup`` seconds left out."""
     context = multiprocessing.get_context("fork")
     pipes, processes = [], []
     for index in range(clients):
         receive, send = context.Pipe(duplex=False)
-        process = context.Process(target=_client, args=(served.port, served.path, entities, index, 0.5, seconds, send))
+        args = (served.port, served.path, entities, index, warmup, seconds, send)
+        process = context.Process(target=_client, args=args)
         process.start()
         pipes.append(receive)
         processes.append(process)
     latencies = [x for pipe in pipes for x in pipe.recv()]
     for process in processes:
         process.join()
-    latencies.sort()
+    return latencies
+
+
+def point_lookups(served: Served, entities: int, clients: int, seconds: float) -> tuple[float, float]:
+    """Queries per second and p99 latency (ms) of ``clients`` processes sending point lookups."""
+    latencies = sorted(run_clients(served, entities, clients, 0.5, seconds))
     return len(latencies) / seconds, latencies[min(len(latencies) - 1, int(len(latencies) * 0.99))] * 1000
 
 
