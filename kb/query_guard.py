@@ -34,12 +34,12 @@ import subprocess
 import sys
 import threading
 import time
-from collections import OrderedDict
 from collections.abc import Callable
 from pathlib import Path
 from typing import IO, Literal
 
 from cbrs.kb.errors import QuerySyntaxError, QueryTooComplexError, StoreError
+from cbrs.kb.recent_keys import RecentKeys
 
 Kind = Literal["query", "update"]
 
@@ -83,7 +83,7 @@ class QueryGuard:
         self.timeout = timeout
         self.checkers = checkers
         self.remember = remember
-        self._admitted: OrderedDict[bytes, None] = OrderedDict()
+        self._admitted = RecentKeys()
         self._idle: list[_Checker] = []
         self._slots = threading.BoundedSemaphore(checkers)
         self._lock = threading.Lock()
@@ -94,15 +94,10 @@ class QueryGuard:
         if len(text) <= self.direct_chars:
             return
         key = hashlib.blake2b(f"{kind}\0{text}".encode(), digest_size=16).digest()
-        with self._lock:
-            if key in self._admitted:
-                self._admitted.move_to_end(key)
-                return
+        if self._admitted.seen(key):
+            return
         self._check(kind, text)
-        with self._lock:
-            self._admitted[key] = None
-            while len(self._admitted) > self.remember:
-                self._admitted.popitem(last=False)
+        self._admitted.add(key, self.remember)
 
     def close(self) -> None:
         """Stop the idle checker processes (busy ones stop when their check ends)."""

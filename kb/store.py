@@ -12,9 +12,8 @@ from __future__ import annotations
 import functools
 import hashlib
 import re
-import threading
 from abc import ABC, abstractmethod
-from collections import OrderedDict, defaultdict
+from collections import defaultdict
 from collections.abc import Iterable, Iterator, Mapping
 from pathlib import Path
 
@@ -23,6 +22,7 @@ import pyoxigraph as ox
 from cbrs.kb.errors import BlankNodeInsertError, QuerySyntaxError, StoreError, StoreEvaluationError
 from cbrs.kb.namespaces import BASE, GENID, GRAPH, PREFIXES, GraphName
 from cbrs.kb.query_guard import QueryGuard
+from cbrs.kb.recent_keys import RecentKeys
 from cbrs.kb.remote_access import loads, refuse_remote_access
 from cbrs.kb.sparql_lexemes import HIDING
 
@@ -237,8 +237,7 @@ class EmbeddedStore(Store):
         self.location = location
         self.generation = 0
         """Counts the writes made through this object, so a snapshot knows whether it is current."""
-        self._checked: OrderedDict[tuple[bytes, tuple[str, ...]], None] = OrderedDict()
-        self._checked_lock = threading.Lock()
+        self._checked = RecentKeys()
 
     @property
     def _backend(self) -> ox.Store:
@@ -307,17 +306,12 @@ class EmbeddedStore(Store):
         if text in bundled_query_texts():
             return
         key = self._checked_key(text)
-        with self._checked_lock:
-            if key in self._checked:
-                self._checked.move_to_end(key)
-                return
+        if self._checked.seen(key):
+            return
         refuse_deep_nesting(text)
         refuse_remote_access(text, self.remote_access)
         self.guard.admit("query", text)
-        with self._checked_lock:
-            self._checked[key] = None
-            while len(self._checked) > self.checked_texts:
-                self._checked.popitem(last=False)
+        self._checked.add(key, self.checked_texts)
 
     def _checked_key(self, text: str) -> tuple[bytes, tuple[str, ...]]:
         """What a passed text is remembered by (:data:`CHECKED_TEXTS`): its digest, and the prefixes it
