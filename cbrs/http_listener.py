@@ -27,6 +27,8 @@ from granian.http import HTTP1Settings
 from granian.log import LogLevels
 from granian.server.embed import Server as _Embedded
 
+from cbrs.settings import EVENT_LOOPS
+
 log = logging.getLogger("cbrs.server")
 
 # Granian's own log records go to the root logger (cbrs serve's format), errors only: its
@@ -75,13 +77,21 @@ def _refuse_taken(host: str, port: int) -> None:
         probe.bind(address)
 
 
+class UnknownLoopError(ValueError):
+    """An event loop kind that is none of :data:`cbrs.settings.EVENT_LOOPS`; carries it."""
+
+    def __init__(self, kind: str) -> None:
+        super().__init__(f"unknown event loop {kind!r}; use {', '.join(EVENT_LOOPS)}")
+        self.kind = kind
+
+
 def new_loop(kind: str) -> asyncio.AbstractEventLoop:
     """A new event loop of ``kind`` (:attr:`ListenerConfig.loop`). uvloop's is written in C: Granian's
     thread hands each request to the loop with ``call_soon_threadsafe``, which in asyncio's loop is
     Python and a write to a socket pair holding the GIL, in uvloop's a wake-up of libuv; and the loop's
     own turn per request is C, not Python (docs/serving.md, "The HTTP front")."""
-    if kind not in ("auto", "uvloop", "asyncio"):
-        raise ValueError(f"unknown event loop {kind!r}; use auto, uvloop or asyncio")
+    if kind not in EVENT_LOOPS:
+        raise UnknownLoopError(kind)
     if kind != "asyncio":
         try:
             import uvloop

@@ -52,6 +52,7 @@ class ServeConfig:
     header_timeout: float = 10.0  # seconds a client may take to send a request's headers, then it is dropped
     body_timeout: float = 30.0  # seconds it may take to send a body (held on the loop, not a thread); then 408
     inline_bytes: int = 256 * 1024  # a single scan answered on the loop up to this result size, else on a thread
+    http_loop: str = field(default_factory=lambda: setting("http_loop").resolve())  # auto, uvloop or asyncio
     stream_limit: int = field(default_factory=lambda: setting("stream_limit").resolve())
     streams_per_client: int = field(default_factory=lambda: setting("streams_per_client").resolve())
     bridge_connections_per_client: int = field(
@@ -123,6 +124,7 @@ class Server:
             port=self.config.port,
             io_threads=self.config.http_io_threads,
             header_timeout=self.config.header_timeout,
+            loop=self.config.http_loop,
         )
         self._http = HttpListener(self._front, listener)
         try:

@@ -71,6 +71,16 @@ def _batch(text: str) -> int | str:
     return parsed
 
 
+EVENT_LOOPS = ("auto", "uvloop", "asyncio")
+
+
+def _event_loop(text: str) -> str:
+    kind = text.strip().lower()
+    if kind not in EVENT_LOOPS:
+        raise ValueError(f"{text!r} is not an event loop ({', '.join(EVENT_LOOPS)})")
+    return kind
+
+
 LOG_LEVELS = ("DEBUG", "INFO", "WARNING", "ERROR", "CRITICAL")
 
 
@@ -192,6 +202,14 @@ SETTINGS: tuple[Setting, ...] = (
         "beside the 16 that answer requests, and one more is refused with 503.",
         "CBRS_STREAM_LIMIT",
         _positive(int),
+    ),
+    Setting(
+        "http_loop",
+        lambda: "auto",
+        "The asyncio event loop cbrs serve's HTTP front runs on: uvloop (written in C, quicker per request), "
+        "asyncio (the standard library's), or auto (uvloop when it is installed).",
+        "CBRS_HTTP_LOOP",
+        _event_loop,
     ),
     Setting(
         "streams_per_client",

@@ -22,7 +22,7 @@ from hypothesis import strategies as st
 from werkzeug.test import Client
 
 from cbrs.asgi_front import SparqlFront, _parameters
-from cbrs.http_listener import HttpListener, ListenerConfig, new_loop
+from cbrs.http_listener import HttpListener, ListenerConfig, UnknownLoopError, new_loop
 from cbrs.kb import KnowledgeBase
 from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.web import create_app
@@ -203,8 +203,9 @@ def test_the_loop_is_uvloop_when_installed_and_asyncio_when_asked() -> None:
             assert kind != "asyncio" or not isinstance(loop, uvloop.Loop)
         finally:
             loop.close()
-    with pytest.raises(ValueError, match="'trio'"):
+    with pytest.raises(UnknownLoopError, match="'trio'") as refused:
         new_loop("trio")
+    assert refused.value.kind == "trio"
 
 
 @pytest.mark.parametrize("kind", ["asyncio", "auto"])
@@ -331,3 +332,15 @@ def test_threads_end_after_a_served_stream(fresh_bundled_kb: KnowledgeBase) -> N
     finally:
         server.stop(WAIT)
     assert_threads_end(threads, WAIT)
+
+
+def test_the_serve_config_takes_its_loop_from_the_setting(monkeypatch: pytest.MonkeyPatch) -> None:
+    from cbrs.server import ServeConfig
+
+    monkeypatch.setenv("CBRS_HTTP_LOOP", " AsyncIO ")
+    assert ServeConfig().http_loop == "asyncio"
+    monkeypatch.setenv("CBRS_HTTP_LOOP", "trio")
+    with pytest.raises(ValueError, match="CBRS_HTTP_LOOP='trio'"):
+        ServeConfig()
+    monkeypatch.delenv("CBRS_HTTP_LOOP")
+    assert ServeConfig().http_loop == "auto"
