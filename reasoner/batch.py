@@ -331,6 +331,14 @@ class BatchScorer:
             above = [space.ids[concept]] if concept in space.ids else []
         return np.isin(self.pool.root_ids, np.array(above, dtype=np.int64)).astype(np.float64)
 
+    def narrower(self, concept: str) -> FloatArray:
+        """For every pool tree whose root is k is-a links below ``concept`` (a provided input), the floor
+        1 - narrower_input_step * k of its "can it be invoked?" side (Matchmaker._trees); 0 elsewhere."""
+        space, step = self.pool.space, self.config.narrower_input_step
+        if step >= 1 or concept not in space.index:
+            return np.zeros(len(self.pool.root_ids), dtype=np.float64)
+        return space.delivered(concept, True, step)[self.pool.root_ids]
+
     def _superclasses(self, concept: str, others: IntArray) -> IntArray | None:
         """Most specific common superclass of ``concept`` with each of ``others`` (-1 where there is
         none: a concept outside the taxonomy), or None when ``concept`` is outside it."""
@@ -504,6 +512,7 @@ class BatchScorer:
                 needed = np.maximum(needed, self.css_offered(provided.tree or PartNode(provided.type)))
                 if self.plugin_inputs:
                     needed = np.maximum(needed, self.plugin(provided.type))
+                    needed = np.maximum(needed, self.narrower(provided.type))
             needed_per_ad = pool.inputs.mean(needed)
             invocable = np.where(pool.inputs.present, needed_per_ad, 1.0)
             if requirement.inputs:

@@ -76,6 +76,11 @@ class MatchConfig:
     # An advertised input the requester offers as the same concept or a subclass can be given as it is:
     # the advertisement can be invoked with it (OWL-S plug-in), so the "can it be invoked?" side scores 1.
     plugin_inputs: bool = True
+    # An advertised input narrower than what the requester provides, k is-a links below it (the service
+    # takes an Author, the requester has a Person): the requester's instance may be one, OWL-S's "subsumes"
+    # degree for inputs, weaker than plug-in but no failure. The "can it be invoked?" side scores at least
+    # 1 - narrower_input_step * k for it (the step of a delivered subclass); 1 turns it off.
+    narrower_input_step: float = 0.02
     # An advertised concept that is a subclass of the requested one inherits every part of it: those parts
     # count as covered (similarity 1) in CSS instead of being left out as implied.
     inherited_parts: bool = True
@@ -118,6 +123,7 @@ class MatchConfig:
         return replace(
             self,
             plugin_outputs=False,
+            narrower_input_step=1.0,
             unrelated_output_factor=1.0,
             input_gate=0.0,
             input_use_weight=0.5,
@@ -144,6 +150,7 @@ class MatchConfig:
             "accept_score",
             "text_weight",
             "specialisation_step",
+            "narrower_input_step",
             "input_gate",
             "cross_branch_weight",
             "input_use_weight",

@@ -415,14 +415,18 @@ class Matchmaker:
             return SpanMatch(1.0, (PairMatch(wanted.type, offered.type, Similarity(1.0, "plug-in"), whole),), ())
         css = self._css(wanted, offered)
         links = None
+        step, situation = self.config.specialisation_step, "delivered"
         if self.plugin_outputs and role == "output":
             links = self._links_below(wanted.type, offered.type)
         elif self.plugin_outputs and role == "provided input":
             links = self._links_below(offered.type, wanted.type)
+        elif invoking and self.plugin_inputs:  # an advertised input narrower than what is provided
+            links = self._links_below(offered.type, wanted.type)
+            step, situation = self.config.narrower_input_step, "narrower"
         if links is not None:
-            floor = max(0.0, 1.0 - self.config.specialisation_step * links)
+            floor = max(0.0, 1.0 - step * links)
             if floor > css.value:
-                how = Similarity(floor, "delivered", links=(links, 0))
+                how = Similarity(floor, situation, links=(links, 0))
                 return SpanMatch(floor, (PairMatch(wanted.type, offered.type, how, whole),), ())
         factor = self.config.unrelated_output_factor
         if self.plugin_outputs and role == "output" and factor < 1 and not self._related(wanted.type, offered.type):

@@ -58,6 +58,9 @@ class Similarity:
         if self.situation == "delivered":
             assert self.links is not None
             return f"delivered as a subclass, {self.links[0]} is-a links below: 1 - step x links"
+        if self.situation == "narrower":
+            assert self.links is not None
+            return f"the advertised input is {self.links[0]} is-a links below the one offered: 1 - step x links"
         if self.situation == "plug-in":
             return "offered as the advertised input or a subclass of it: invocable"
         return self.situation

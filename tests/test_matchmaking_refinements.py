@@ -48,6 +48,36 @@ def test_an_output_delivered_as_a_subclass_beats_a_look_alike_sibling() -> None:
     assert off.score(wanted, sub).parts["outputs"] < best.parts["outputs"]
 
 
+def test_an_input_narrower_than_the_one_offered_is_nearly_invocable() -> None:
+    # The requester offers some Information. One service takes a RobotPosition, three is-a links below it:
+    # the requester's information may be one (OWL-S's "subsumes" degree for inputs), though Wu-Palmer
+    # gives the pair 0.4. Another service needs nothing. Both give the Colour asked for.
+    wanted = Requirement(E + "Wants", (), inputs=(_p("input", "Information"),), outputs=(_p("output", "Colour"),))
+    narrower = Advertisement(
+        E + "TakesRobotPosition", (), inputs=(_p("input", "RobotPosition"),), outputs=(_p("output", "Colour"),)
+    )
+    free = Advertisement(E + "NeedsNothing", (), outputs=(_p("output", "Colour"),))
+    step = MatchConfig().narrower_input_step
+    kb = KnowledgeBase(Store.open(":memory:"))
+    on = Matchmaker(kb, index=positions(), advertisements=[free, narrower])
+    ranked = on.rank(wanted)  # scored by the batch path, the head explained by the scalar one
+    assert [c.advertisement.removeprefix(E) for c in ranked.candidates] == ["TakesRobotPosition", "NeedsNothing"]
+    best = ranked.candidates[0]
+    assert best.score == pytest.approx(on.rank(wanted, explain=0).candidates[0].score)
+    pair = next(p for p in best.pairs if p.role == "input")
+    assert pair.similarity == pytest.approx(1 - 3 * step) and "below the one offered" in pair.how
+    used = SemStr(positions())(E + "Information", E + "RobotPosition").value  # the other side keeps Sem-Str
+    u = MatchConfig().input_use_weight
+    assert best.parts["inputs"] == pytest.approx((1 - u) * (1 - 3 * step) + u * used)
+    # off (step 1): the pair keeps its Wu-Palmer value and the offer that needs nothing ranks first
+    config = MatchConfig(narrower_input_step=1.0)
+    off = Matchmaker(kb, config=config, index=positions(), advertisements=[free, narrower])
+    assert off.score(wanted, narrower).parts["inputs"] == pytest.approx(used)
+    assert _rank(config, wanted, free, narrower) == ["NeedsNothing", "TakesRobotPosition"]
+    # the baselines keep the published frame: no floor for a narrower input
+    assert MatchConfig().published().narrower_input_step == 1.0
+
+
 def test_baselines_keep_the_published_frame() -> None:
     wanted = Requirement(E + "Wants", (), outputs=(_p("output", "Position"),))
     sub = Advertisement(E + "GivesRobotPosition", (), outputs=(_p("output", "RobotPosition"),))
