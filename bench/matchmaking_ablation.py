@@ -32,6 +32,7 @@ VARIANTS: dict[str, MatchConfig] = {
     "default": BASE,
     "no delivered-as-subclass": replace(BASE, plugin_outputs=False),
     "no free no-input offers": replace(BASE, no_input_invocable=False),
+    "no floor for narrower inputs (narrower_input_step 1)": replace(BASE, narrower_input_step=1.0),
     "arithmetic statement mean": replace(BASE, statement_mean="arithmetic"),
     "no complementary words (complement_weight 0)": replace(BASE, complement_weight=0.0),
     "predicates through the root as Sem-Str (factor 1)": replace(BASE, unrelated_predicate_factor=1.0),
