@@ -21,7 +21,7 @@ from cbrs.kb.registry import ComponentRegistry
 from cbrs.kb.resources import bundled_files, query_dir
 from cbrs.kb.seed_cache import SeedCache, bundle_digest
 from cbrs.kb.shapes import checked_update
-from cbrs.kb.standard_terms import Refresh, StandardTerms
+from cbrs.kb.standard_terms import PendingUpdate, Refresh, StandardTerms
 from cbrs.kb.store import EmbeddedStore, QueryResult, Store, Term, is_remote
 from cbrs.kb.upgrade import UpgradeReport, new_terms, upgrade_store
 
@@ -88,10 +88,14 @@ class KnowledgeBase:
         Every write method here calls it; call it after writing to the store by other means."""
         return self.standard_terms.refresh()
 
-    def _entail(self) -> None:
-        """After a write that stands: bring graph:entailed up to date, or say why it lags."""
+    def _entail(self, update: PendingUpdate | None = None) -> None:
+        """After a write that stands: bring graph:entailed up to date, or say why it lags. After an update
+        :meth:`StandardTerms.prepare` read, from the nodes it changed; otherwise from the whole store."""
         try:
-            self.standard_terms.refresh()
+            if update is None:
+                self.standard_terms.refresh()
+            else:
+                self.standard_terms.updated(update)
         except StoreError as error:
             _log.warning("graph:entailed not brought up to date (it lags until the next write): %s", error)
 
@@ -186,13 +190,15 @@ class KnowledgeBase:
         return self.store.query(text, bindings)
 
     def update(self, text: str) -> None:
-        """Run a SPARQL update in one transaction; the cached descriptions are read afresh afterwards."""
+        """Run a SPARQL update in one transaction; the cached descriptions are read afresh afterwards, and
+        graph:entailed follows (node by node after a data update: :meth:`StandardTerms.prepare`)."""
+        pending = self.standard_terms.prepare(text)
         try:
             with checked_update(self.store):  # a description the update breaks is put back (kb/shapes.py)
                 self.store.update(text)
         finally:
             self._reader.clear_cache()
-        self._entail()
+        self._entail(pending)
 
     def run(self, name: str, values: Mapping[str, Term | str | int | float] | None = None) -> QueryResult:
         """Run the named query ``queries/<name>.rq`` with ``values`` bound to its parameters."""

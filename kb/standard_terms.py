@@ -32,7 +32,8 @@ import pyoxigraph as ox
 from cbrs.kb.errors import StoreError
 from cbrs.kb.namespaces import OWL, PREFIXES, RDF, RDFS, XSD, GraphName
 from cbrs.kb.resources import ontology_dir
-from cbrs.kb.store import Store
+from cbrs.kb.store import EmbeddedStore, Store
+from cbrs.kb.update_delta import DataUpdate
 
 ALIGN = PREFIXES["align"]
 ALIGNMENTS_FILE = "alignments.ttl"
@@ -66,6 +67,15 @@ class Refresh:
     added: int
     removed: int
     total: int
+
+
+@dataclass(frozen=True)
+class PendingUpdate:
+    """An update about to run, as :meth:`StandardTerms.prepare` read it: its data, and what the rules
+    concluded before it ran."""
+
+    data: DataUpdate
+    before: frozenset[ox.Quad]
 
 
 class Alignment:
@@ -110,6 +120,12 @@ class Alignment:
             for lower in seen - {top}:
                 above[lower].add(top)
         self._above = {term: frozenset(uppers) for term, uppers in above.items()}
+        self._classes = frozenset(self.classes())
+        self._properties = frozenset(self.properties())
+        # The properties whose statements entail something about their object (a range or an inverse).
+        self.object_reaching = frozenset(
+            p for p in self._properties if any(self._range.get(q) or self._inverse.get(q) for q in self._standard_of(p))
+        )
 
     def is_standard(self, iri: str) -> bool:
         return bool(self.namespaces) and iri.startswith(self.namespaces)
@@ -128,9 +144,15 @@ class Alignment:
         anyURI counterpart, and the standard ones."""
         return set(self._above) | set(self._as_uri) | set(self.standard)
 
-    def statement(self, s: ox.NamedNode, p: str, o: ox.NamedNode | ox.BlankNode | ox.Literal) -> Iterator[ox.Triple]:
+    def _standard_of(self, p: str) -> set[str]:
+        """The standard properties (s p o) is a statement of: those above ``p``, and ``p`` if it is one."""
+        return set(self.above(p)) | ({p} if self.is_standard(p) else set())
+
+    def statement(
+        self, s: ox.NamedNode, p: str, o: ox.NamedNode | ox.BlankNode | ox.Literal | ox.Triple
+    ) -> Iterator[ox.Triple]:
         """What (s p o) entails."""
-        standard = set(self.above(p)) | ({p} if self.is_standard(p) else set())
+        standard = self._standard_of(p)
         for q in self.above(p):
             yield ox.Triple(s, ox.NamedNode(q), o)
         for q in self._as_uri.get(p, ()):
@@ -158,6 +180,24 @@ class Alignment:
         else:
             yield from self.statement(s, p.value, o)
 
+    def is_read(self, triple: ox.Triple) -> bool:
+        """Whether :meth:`StandardTerms.refresh` reads ``triple`` (when in a named graph other than
+        graph:entailed): a type of one of :meth:`classes`, a statement of one of :meth:`properties`."""
+        s, p, o = triple.subject, triple.predicate, triple.object
+        if not isinstance(s, ox.NamedNode):
+            return False
+        return (p == _TYPE and isinstance(o, ox.NamedNode) and o.value in self._classes) or p.value in self._properties
+
+    def entailments(self, triple: ox.Triple) -> Iterator[ox.Triple]:
+        """What one statement entails as :meth:`StandardTerms.refresh` reads it (:meth:`is_read`)."""
+        s, p, o = triple.subject, triple.predicate, triple.object
+        if not isinstance(s, ox.NamedNode):
+            return
+        if p == _TYPE and isinstance(o, ox.NamedNode) and o.value in self._classes:
+            yield from self.typed(s, o.value)
+        if p.value in self._properties:
+            yield from self.statement(s, p.value, o)
+
     def _typed(self, s: ox.NamedNode, classes: Iterable[str]) -> Iterator[ox.Triple]:
         for cls in classes:
             if self.is_standard(cls):
@@ -169,9 +209,10 @@ class Alignment:
 class StandardTerms:
     """graph:entailed of one store, kept to what the rest of the store entails.
 
-    :meth:`refresh` works it out from the whole store (after a seed, a load, an update); :meth:`begin`
-    and :meth:`changed` bring it up to date after one description changed, from that description's
-    statements alone (a registration), reusing the alignments read at the last refresh.
+    :meth:`refresh` works it out from the whole store (after a seed, a load, an update of any kind);
+    :meth:`prepare` and :meth:`updated` bring it up to date after an update of ground data (``INSERT
+    DATA``, ``DELETE DATA``) from the nodes it changed alone, and :meth:`begin` and :meth:`changed` after
+    one description changed (a registration), both reusing the alignments read at the last refresh.
 
     Each is two writes: first what the alignments entail statement by statement, then the rules'
     conclusions, so that a rule may ask for standard types (``?sensor a sosa:Sensor``) instead of
@@ -181,6 +222,9 @@ class StandardTerms:
     def __init__(self, store: Store) -> None:
         self.store = store
         self._alignment: Alignment | None = None
+        # Whether graph:entailed is known to be what the store entails: a whole refresh in this process
+        # made it so and every change since was followed. Until then an update takes a whole refresh.
+        self._exact = False
 
     def alignment(self) -> Alignment:
         if self._alignment is None:
@@ -189,6 +233,7 @@ class StandardTerms:
 
     def refresh(self) -> Refresh:
         """Make graph:entailed hold what the store entails now."""
+        self._exact = False
         alignment = self._alignment = read_alignment(self.store)
         before = self._rule_conclusions(alignment)
         wanted, asserted = self._closure(alignment)
@@ -197,7 +242,32 @@ class StandardTerms:
         held = (held - (held - wanted - before)) | wanted
         after = self._rule_conclusions(alignment) - asserted
         second = self._write(held - wanted - after, after - held)
+        self._exact = True
         return Refresh(first.added + second.added, first.removed + second.removed, len(wanted | after))
+
+    def prepare(self, text: str) -> PendingUpdate | None:
+        """Before the update ``text`` runs: what :meth:`updated` needs to follow it node by node, or None
+        when it cannot and a whole :meth:`refresh` must follow instead: the text is not only ground data
+        operations (:mod:`kb.update_delta`), it names an alignment, a standard namespace or graph:entailed
+        itself, the store is a remote one (which other clients write meanwhile), or graph:entailed is not
+        known to be exact yet."""
+        if not self._exact or not isinstance(self.store, EmbeddedStore):
+            return None
+        data = DataUpdate.read(text, self.store)
+        if data is None or any(q.predicate.value in _LINK_SET or q.graph_name == _GRAPH for q in data.named):
+            return None
+        return PendingUpdate(data, self.begin())
+
+    def updated(self, pending: PendingUpdate | None) -> Refresh:
+        """After an update ran: bring graph:entailed up to date from the nodes it changed (``pending``, from
+        :meth:`prepare`), or by a whole :meth:`refresh` when there is none or its reading is not borne out."""
+        delta = pending.data.delta(self.store) if pending is not None and self._exact else None
+        if pending is None or delta is None:
+            if pending is not None:
+                _log.info("update not read for certain; graph:entailed is worked out from the whole store")
+            return self.refresh()
+        added, removed = delta
+        return self._follow(pending.before, _nodes(self.alignment(), (*added, *removed)))
 
     def begin(self) -> frozenset[ox.Quad]:
         """What the rules conclude now: call it before changing a description, then :meth:`changed`."""
@@ -213,6 +283,8 @@ class StandardTerms:
         try:
             if any(quad.predicate.value in _LINK_SET for quad in (*removed, *added)):
                 return self.refresh()
+            if isinstance(self.store, EmbeddedStore):
+                return self._follow(before, _nodes(self.alignment(), (*removed, *added)))
             return self._changed(before, removed, added)
         except StoreError as error:
             # the description's own write stands; graph:entailed lags until the next refresh
@@ -232,6 +304,68 @@ class StandardTerms:
         after = self._rule_conclusions(alignment) - own
         second = self._write(set(before) - after - new, after)
         return Refresh(first.added + second.added, first.removed + second.removed, -1)
+
+    def _follow(self, before: frozenset[ox.Quad], nodes: set[ox.NamedNode]) -> Refresh:
+        """Bring graph:entailed up to date after the statements about ``nodes`` changed (and nothing else),
+        when ``before`` is what the rules concluded before the change: as :meth:`refresh` would, but
+        reading only the statements about those nodes.
+
+        What the statements entail one by one about a node is worked out from all the statements about
+        it now, those it is the object of included (ranges, inverses): a conclusion stays while any
+        statement supports it. Nothing about another node can have changed, except what the rules
+        concluded: the two writes are :meth:`refresh`'s, over the changed nodes and the subjects of the
+        rules' conclusions that came or went. Exact when graph:entailed was: what it holds beyond the
+        statements' entailments is what the rules concluded (``before``).
+        """
+        exact, self._exact = self._exact, False  # not exact if a write fails half way
+        alignment = self.alignment()
+        if not alignment.namespaces:
+            self._exact = exact
+            return Refresh(0, 0, 0)
+        now = self._rule_conclusions(alignment)  # what refresh calls before: the rules on the changed store
+        near = nodes | _subjects(before - now)
+        wanted = self._wanted(alignment, near)
+        held = {quad for node in near for quad in self.store.quads(node, None, None, _GRAPH)}
+        first = self._write(held - wanted - now, wanted - held)
+        after = {quad for quad in self._rule_conclusions(alignment) if not self._asserted(alignment, quad)}
+        gone = now - after
+        wanted |= self._wanted(alignment, _subjects(gone) - near)
+        second = self._write(
+            {q for q in gone if q not in wanted and _holds(self.store, q)},
+            {q for q in after if not _holds(self.store, q)},
+        )
+        self._exact = exact
+        return Refresh(first.added + second.added, first.removed + second.removed, -1)
+
+    def _wanted(self, alignment: Alignment, nodes: Iterable[ox.NamedNode]) -> set[ox.Quad]:
+        """What the statements of the store entail one by one about ``nodes`` (:meth:`_closure`'s part)."""
+        found: set[ox.Quad] = set()
+        reaching = [ox.NamedNode(p) for p in sorted(alignment.object_reaching)]
+        for node in nodes:
+            triples: set[ox.Triple] = set()
+            asserted: set[ox.Triple] = set()
+            for quad in self.store.quads(node):
+                if _read(quad):
+                    triple = ox.Triple(quad.subject, quad.predicate, quad.object)
+                    if alignment.is_read(triple):
+                        asserted.add(triple)
+                        triples.update(alignment.entailments(triple))
+            for predicate in reaching:
+                for quad in self.store.quads(None, predicate, node):
+                    if _read(quad):
+                        triples.update(alignment.entailments(ox.Triple(quad.subject, quad.predicate, quad.object)))
+            found.update(_quad(t) for t in triples - asserted if t.subject == node and _named(t))
+        return found
+
+    def _asserted(self, alignment: Alignment, quad: ox.Quad) -> bool:
+        """Whether :meth:`_closure` reads ``quad``'s statement from the store (so it is no conclusion)."""
+        subject = quad.subject
+        if not isinstance(subject, ox.NamedNode) or isinstance(quad.object, ox.Triple):
+            return False
+        triple = ox.Triple(subject, quad.predicate, quad.object)
+        return alignment.is_read(triple) and any(
+            _read(q) for q in self.store.quads(subject, quad.predicate, quad.object)
+        )
 
     def _closure(self, alignment: Alignment) -> tuple[set[ox.Quad], set[ox.Quad]]:
         """What the statements of the store entail one by one, and the statements read for it."""
@@ -310,6 +444,33 @@ def rules() -> tuple[str, ...]:
 
 def _named(triple: ox.Triple) -> bool:
     return not isinstance(triple.subject, ox.BlankNode) and not isinstance(triple.object, ox.BlankNode)
+
+
+def _read(quad: ox.Quad) -> bool:
+    """Whether :meth:`StandardTerms.refresh` reads ``quad``'s graph: a named graph other than graph:entailed."""
+    return not isinstance(quad.graph_name, ox.DefaultGraph) and quad.graph_name != _GRAPH
+
+
+def _holds(store: Store, quad: ox.Quad) -> bool:
+    """Whether graph:entailed holds ``quad``."""
+    subject, obj = quad.subject, quad.object
+    if isinstance(subject, ox.Triple) or isinstance(obj, ox.Triple):
+        return False
+    return next(store.quads(subject, quad.predicate, obj, _GRAPH), None) is not None
+
+
+def _subjects(quads: Iterable[ox.Quad]) -> set[ox.NamedNode]:
+    return {quad.subject for quad in quads if isinstance(quad.subject, ox.NamedNode)}
+
+
+def _nodes(alignment: Alignment, quads: Sequence[ox.Quad]) -> set[ox.NamedNode]:
+    """The nodes what ``quads`` entail one by one is about: their subjects, and their objects when the
+    predicate has a range or an inverse."""
+    nodes = _subjects(quads)
+    for quad in quads:
+        if isinstance(quad.object, ox.NamedNode) and quad.predicate.value in alignment.object_reaching:
+            nodes.add(quad.object)
+    return nodes
 
 
 def _quad(triple: ox.Triple) -> ox.Quad:
