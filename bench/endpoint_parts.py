@@ -1,8 +1,9 @@
 """Profile: where a point lookup's server CPU goes in cbrs serve, part by part, beside oxigraph serve.
 
 Run: python bench/endpoint_parts.py [--triples 200000] [--clients 4] [--seconds 2.5] [--rounds 5]
+[--memory] [--against DIR]
 
-Four servers over the same generated data (bench/store_limits.generate, 10 triples per entity), each
+Four servers (up to seven with the options) over the same generated data (10 triples per entity), each
 its own process, up at once and measured in turns (the order reversed every other round), with point
 lookups from C client processes (``store_limits.run_clients``, no warm-up): for each, the median over the
 rounds of the queries per second and of the server's CPU per lookup (user + system of the whole
@@ -13,7 +14,12 @@ process, from /proc/PID/stat, around the turn, divided by the lookups answered i
   a bare ASGI function that unquotes the query and has pyoxigraph evaluate it and write its JSON into
   bytes: Granian and pyoxigraph without cbrs's checks, accounting and budget writer;
 - the same answering a fixed body of a lookup's size: Granian alone, in the cbrs process;
-- ``oxigraph serve --union-default-graph``.
+- ``oxigraph serve --union-default-graph``;
+- with ``--memory``, a cbrs server as ``cbrs serve`` makes it over an in-memory store holding the same
+  data (a store ``cbrs serve --store :memory:`` cannot be loaded from outside before it serves);
+- with ``--against DIR``, each cbrs server also run from the cbrs package in DIR (another version,
+  such as ``git archive HEAD~1 | tar -x -C DIR``): a change measured beside what it changes, turn by
+  turn in one run.
 
 Each cbrs server has its own copy of the store (an on-disk store admits one process). The load
 generator runs on the same cores as the servers. Prints the machine (with its load average), the
@@ -67,6 +73,20 @@ _PART = textwrap.dedent(
     threading.Event().wait()
     """
 )
+_MEMORY = textwrap.dedent(
+    """
+    import sys, threading
+    import pyoxigraph as ox
+    from cbrs.kb import KnowledgeBase
+    from cbrs.server import ServeConfig, Server
+    from cbrs.sparql_service import EndpointConfig
+    data, graph, port = sys.argv[1], sys.argv[2], int(sys.argv[3])
+    kb = KnowledgeBase.open(":memory:")
+    kb.store._backend.bulk_load(path=data, format=ox.RdfFormat.N_TRIPLES, to_graph=ox.NamedNode(graph))
+    Server(kb, ServeConfig(port=port, bridge_port=0, endpoint=EndpointConfig(isolate_memory=True))).start()
+    threading.Event().wait()
+    """
+)
 
 
 def main() -> None:
@@ -76,6 +96,8 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=2.5)
     parser.add_argument("--rounds", type=int, default=5)
     parser.add_argument("--oxigraph", default=str(Path(PYTHON).parent / "oxigraph"))
+    parser.add_argument("--memory", action="store_true", help="also serve the data from an in-memory store")
+    parser.add_argument("--against", type=Path, help="a cbrs version (a directory holding cbrs/) to serve beside")
     args = parser.parse_args()
     print(f"machine: {platform.platform()}, {os.cpu_count()} cores, python {platform.python_version()}, "
           f"load average {os.getloadavg()[0]:.2f}")  # fmt: skip
@@ -85,7 +107,7 @@ def main() -> None:
         folder = Path(name)
         data = folder / "data.nt"
         entities = generate(data, args.triples)
-        stores = [folder / f"cbrs{i}" for i in range(3)]
+        stores = [folder / f"cbrs{i}" for i in range(4)]
         subprocess.run([PYTHON, "-m", "cbrs", "--store", str(stores[0]), "load", str(data), "--graph", GRAPH],
                        check=True, stdout=subprocess.DEVNULL)  # fmt: skip
         for copy in stores[1:]:
@@ -100,6 +122,13 @@ def main() -> None:
             "cbrs process, fixed body": lambda: _part(stores[2], "fixed", size),
             "oxigraph serve": lambda: serve_oxigraph(args.oxigraph, ox_store),
         }
+        if args.memory:
+            starts["cbrs serve, in memory"] = lambda: _in_memory(data, None)
+        if args.against is not None:
+            against = args.against.resolve()
+            starts[f"cbrs serve, {against.name}"] = lambda: serve_cbrs(stores[3], against)
+            if args.memory:
+                starts[f"cbrs serve, in memory, {against.name}"] = lambda: _in_memory(data, against)
         servers: dict[str, Served] = {}
         samples: dict[str, list[tuple[float, float]]] = {label: [] for label in starts}
         try:
@@ -116,11 +145,11 @@ def main() -> None:
         finally:
             for served in servers.values():
                 served.stop()
-    print(f"\n{'server':<32} {'queries/s':>10} {'server CPU us/lookup':>21}   (medians)")
+    print(f"\n{'server':<40} {'queries/s':>10} {'server CPU us/lookup':>21}   (medians)")
     for label, taken in samples.items():
         rate = statistics.median(r for r, _ in taken)
         cpu = statistics.median(c for _, c in taken)
-        print(f"{label:<32} {rate:>10.0f} {cpu:>21.0f}")
+        print(f"{label:<40} {rate:>10.0f} {cpu:>21.0f}")
     print(f"load average at the end: {os.getloadavg()[0]:.2f}")
 
 
@@ -128,6 +157,14 @@ def lookups(served: Served, entities: int, clients: int, seconds: float) -> int:
     """The point lookups ``clients`` processes had answered in ``seconds``, none left out as warm-up:
     the server's CPU is read around the whole turn."""
     return len(run_clients(served, entities, clients, 0.0, seconds))
+
+
+def _in_memory(data: Path, source: Path | None) -> Served:
+    """A cbrs server over an in-memory store holding ``data``; with ``source``, cbrs from there."""
+    port = _free_port()
+    argv = [PYTHON, "-c", _MEMORY, str(data), GRAPH, str(port)]
+    env = None if source is None else {**os.environ, "PYTHONPATH": str(source)}
+    return Served("cbrs serve, in memory", argv, port, "/sparql", env)
 
 
 def _part(store: Path, part: str, size: int) -> Served:

@@ -103,9 +103,9 @@ def _ask(connection: http.client.HTTPConnection, path: str, query: str) -> bytes
 class Served:
     """A server process (cbrs serve or oxigraph serve) and where its SPARQL endpoint is."""
 
-    def __init__(self, label: str, argv: list[str], port: int, path: str) -> None:
+    def __init__(self, label: str, argv: list[str], port: int, path: str, env: dict[str, str] | None = None) -> None:
         self.label, self.port, self.path = label, port, path
-        self.process = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+        self.process = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)
         deadline = time.monotonic() + 120
         while True:
             try:
@@ -129,10 +129,15 @@ class Served:
             self.process.wait()
 
 
-def serve_cbrs(store: Path) -> Served:
+def serve_cbrs(store: Path, source: Path | None = None) -> Served:
+    """``cbrs serve`` over ``store``; with ``source``, the cbrs package found there (another checkout,
+    put first on PYTHONPATH), so two versions can be measured side by side in one run."""
     port = _free_port()
     argv = [PYTHON, "-m", "cbrs", "--store", str(store), "serve", "--port", str(port), "--bridge-port", "0"]
-    return Served("cbrs serve", argv, port, "/sparql")
+    if source is None:
+        return Served("cbrs serve", argv, port, "/sparql")
+    env = {**os.environ, "PYTHONPATH": str(source)}
+    return Served(f"cbrs serve ({source})", argv, port, "/sparql", env)
 
 
 def serve_oxigraph(oxigraph: str, location: Path) -> Served:
