@@ -42,10 +42,10 @@ _S = r"\s*"
 # character ranges takes a second to compile).
 _SHAPE = re.compile(
     rf"{_S}(?:(?:(?i:BASE){_S}{_IRI}|(?i:PREFIX){_S}(?:{_PN})?:{_S}{_IRI}){_S})*"
-    rf"(?:(?i:SELECT){_S}(?P<projection>\*|(?:{_VAR}{_S})+)|(?i:ASK)){_S}"
-    rf"(?:(?i:FROM){_S}(?:(?i:NAMED)\s+)?(?:{_IRI}|{_PNAME}){_S})*"
+    rf"(?P<form>(?i:SELECT){_S}(?P<projection>\*|(?:{_VAR}{_S})+)|(?i:ASK)){_S}"
+    rf"(?P<dataset>(?:(?i:FROM){_S}(?:(?i:NAMED)\s+)?(?:{_IRI}|{_PNAME}){_S})*)"
     rf"(?:(?i:WHERE){_S})?\{{{_S}(?:(?P<s>{_NODE}){_S}(?P<p>{_NODE}|a(?=[\s<?$])){_S}(?P<o>{_NODE}|{_LITERAL}){_S}\.?{_S})?\}}"
-    rf"{_S}(?:(?i:LIMIT){_S}\d+{_S})?"
+    rf"{_S}(?:(?i:LIMIT){_S}(?P<limit>\d+){_S})?"
 )
 
 
@@ -61,14 +61,22 @@ def uses_prefixes(text: str) -> bool:
 def is_single_scan(text: str) -> bool:
     """Whether ``text`` is a query Oxigraph answers with one index scan that yields a solution per
     triple it reads (see the module's docstring); it may still be malformed in ways the parser finds."""
+    return single_scan(text) is not None
+
+
+def single_scan(text: str) -> re.Match[str] | None:
+    """The match of a single scan (:func:`is_single_scan`), ``None`` for any other text. Its groups are
+    ``form`` (from ``SELECT`` or ``ASK`` to the projection's end), ``projection`` (``None`` for ``ASK``),
+    ``dataset`` (the ``FROM`` clauses, maybe empty), ``s``, ``p``, ``o`` (``None`` for the empty group)
+    and ``limit``; the prologue is what precedes ``form``. :mod:`cbrs.pattern_lookup` reads them."""
     match = _SHAPE.fullmatch(text)
     if match is None:
-        return False
+        return None
     if match.group("s") is None:
-        return True  # an empty group (ASK {}, a liveness probe): one empty solution, no scan at all
+        return match  # an empty group (ASK {}, a liveness probe): one empty solution, no scan at all
     terms = [match.group("s"), match.group("p"), match.group("o")]
     variables = [term for term in terms if term[0] in "?$"]
     if len(variables) == 3:
-        return False  # the whole store: not a lookup
+        return None  # the whole store: not a lookup
     names = [v[1:] for v in variables]
-    return len(set(names)) == len(names)
+    return match if len(set(names)) == len(names) else None

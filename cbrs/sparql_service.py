@@ -40,6 +40,7 @@ import pyoxigraph as ox
 from werkzeug.datastructures import MIMEAccept
 from werkzeug.http import parse_accept_header
 
+from cbrs import pattern_lookup
 from cbrs._query_worker import dataset_options
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import KnowledgeBaseError, QuerySyntaxError, QueryTooComplexError, StoreEvaluationError
@@ -48,7 +49,7 @@ from cbrs.kb.query_guard import start_evaluation_thread
 from cbrs.kb.sparql_lexemes import HIDING
 from cbrs.kb.store import EmbeddedStore, QueryResult, is_remote, refuse_inserted_blank_nodes
 from cbrs.query_workers import QueryProcesses, QueryStopped, Request
-from cbrs.scan_queries import is_single_scan, uses_prefixes
+from cbrs.scan_queries import is_single_scan, single_scan, uses_prefixes
 from cbrs.settings import setting
 
 # Media types offered for SELECT and ASK results, the first being the default.
@@ -413,16 +414,33 @@ class SparqlService:
         """Answer ``text`` on the caller's thread if it is a single scan whose result fits in ``budget``
         bytes; ``None`` if it is not one, or its result grew past ``budget`` (then :meth:`query` it on a
         thread that may wait). An event loop answers point lookups so, without a thread hand-over, and
-        ``budget`` bounds how long it is kept from its other requests."""
+        ``budget`` bounds how long it is kept from its other requests. On an in-memory store, a lookup of
+        the shape :func:`cbrs.pattern_lookup.parse` takes, asked in SPARQL JSON, is answered from the
+        index directly, with the bytes the engine would write."""
         self._check_size(text)
-        if not (isinstance(self.kb.store, EmbeddedStore) and is_single_scan(text)):
+        store = self.kb.store
+        scan = single_scan(text) if isinstance(store, EmbeddedStore) else None
+        if scan is None or not isinstance(store, EmbeddedStore):
             return None
         graphs = dataset_for(text, None)
         release = self._admit(client, slot=False)
         limit = min(budget, self.config.max_result_bytes)
         try:
             deadline = time.monotonic() + self.config.timeout
-            return self._evaluate(text, accept, short_format, deadline, graphs, flat=True, limit=limit)
+            # In memory only: on disk, quads_for_pattern reads the subject and graph name of every quad
+            # back from RocksDB, which the engine skips, and that costs what the direct path saves.
+            direct = store.in_memory and graphs.get("union")
+            lookup = pattern_lookup.parse(scan, PREFIXES) if direct else None
+            media_type = _json_results_type(accept, short_format) if lookup is not None else None
+            if lookup is None or media_type is None:
+                return self._evaluate(text, accept, short_format, deadline, graphs, flat=True, limit=limit)
+            try:  # read from the index without the SPARQL engine's parse and plan (cbrs.pattern_lookup)
+                body = pattern_lookup.json_results(store._backend, lookup, limit, deadline)
+            except pattern_lookup.Stopped as stopped:
+                if stopped.reason == "timeout":
+                    raise QueryTimeoutError(self.config.timeout) from None
+                raise ResultTooLargeError(limit) from None
+            return Answer(body, media_type)
         except ResultTooLargeError:
             if limit < self.config.max_result_bytes:
                 return None  # not too large for the endpoint, only for this thread
@@ -606,6 +624,16 @@ class SparqlService:
             raise QuerySyntaxError(text, str(error)) from error
         except (OSError, RuntimeError) as error:
             raise StoreEvaluationError(store.location, "query", str(error)) from error
+
+
+def _json_results_type(accept: str | None, short_format: str | None) -> str | None:
+    """The media type a SELECT or ASK result is answered in when it is SPARQL JSON, else ``None``
+    (another format, or none acceptable: the engine's path answers or refuses)."""
+    try:
+        media_type = negotiate(False, accept, short_format)
+    except NotAcceptableError:
+        return None
+    return media_type if RESULT_TYPES[media_type] == ox.QueryResultsFormat.JSON else None
 
 
 @functools.lru_cache(maxsize=256)
