@@ -245,16 +245,16 @@ class StandardTerms:
         self._exact = True
         return Refresh(first.added + second.added, first.removed + second.removed, len(wanted | after))
 
-    def prepare(self, text: str) -> PendingUpdate | None:
-        """Before the update ``text`` runs: what :meth:`updated` needs to follow it node by node, or None
-        when it cannot and a whole :meth:`refresh` must follow instead: the text is not only ground data
-        operations (:mod:`kb.update_delta`), it names an alignment, a standard namespace or graph:entailed
+    def prepare(self, data: DataUpdate | None) -> PendingUpdate | None:
+        """Before an update runs (``data``: it, read by :meth:`DataUpdate.read`, None if it could not be):
+        what :meth:`updated` needs to follow it node by node, or None when it cannot and a whole
+        :meth:`refresh` must follow instead: the update is not only ground data operations read for
+        certain (:mod:`kb.update_delta`), it names an alignment, a standard namespace or graph:entailed
         itself, the store is a remote one (which other clients write meanwhile), or graph:entailed is not
         known to be exact yet."""
-        if not self._exact or not isinstance(self.store, EmbeddedStore):
+        if data is None or not self._exact or not isinstance(self.store, EmbeddedStore):
             return None
-        data = DataUpdate.read(text, self.store)
-        if data is None or any(q.predicate.value in _LINK_SET or q.graph_name == _GRAPH for q in data.named):
+        if any(q.predicate.value in _LINK_SET or q.graph_name == _GRAPH for q in data.named):
             return None
         return PendingUpdate(data, self.begin())
 

@@ -14,14 +14,16 @@ Refused, so that SPARQL's reading and TriG's cannot differ: any other operation 
 and relative IRIs (no base to resolve against), ``\\u``/``\\U`` escapes (SPARQL reads them before the
 grammar does), backslashes outside strings, ``GRAPH`` blocks with braces inside, and blank nodes or
 quoted triples in the data (an inserted blank node is a fresh node nobody can name). :class:`DataUpdate`
-then checks the reading against the real one: on a scratch store holding every quad the text names,
-pyoxigraph's SPARQL update must leave exactly what the reading says; and on the store itself each quad
-named must be present or absent afterwards as the reading says.
+then checks the reading against the real one before the update runs: on a scratch store holding every
+quad the text names, pyoxigraph's SPARQL update must leave exactly what the reading says (the text is flat,
+braces two deep at most, so its parser needs no guard of :mod:`kb.query_guard` for it); and afterwards,
+on the store itself, each quad named must be present or absent as the reading says.
 """
 
 from __future__ import annotations
 
 import re
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import pyoxigraph as ox
@@ -167,9 +169,8 @@ def _wrapped(text: str, run: list[_Token]) -> str:
 
 
 class DataUpdate:
-    """A data update about to run on a store: the quads it names and whether each is there before it runs.
-
-    Make it (:meth:`read`) before the update runs, then ask :meth:`delta` afterwards.
+    """A data update about to run on a store, read for certain: the quads it names and whether each is
+    there before it runs. Make it (:meth:`read`) before the update runs, then ask :meth:`delta` afterwards.
     """
 
     def __init__(self, text: str, operations: tuple[DataOperation, ...], present: dict[ox.Quad, bool]) -> None:
@@ -179,50 +180,56 @@ class DataUpdate:
 
     @classmethod
     def read(cls, text: str, store: Store) -> DataUpdate | None:
-        """The update ``text`` about to run on ``store``, or None if it is not only data operations."""
+        """The update ``text`` about to run on ``store``, or None if it is not only data operations or
+        SPARQL would not read it as :func:`data_operations` does."""
         operations = data_operations(text)
-        if operations is None:
+        if operations is None or not _confirmed(text, operations):
             return None
         named = {quad for operation in operations for quad in operation.quads}
         return cls(text, operations, {quad: _holds(store, quad) for quad in named})
+
+    def names_graph(self, graphs: Iterable[ox.NamedNode]) -> bool:
+        """Whether the text names a quad in one of ``graphs`` (if not, the update leaves them as they are)."""
+        wanted = set(graphs)
+        return any(quad.graph_name in wanted for quad in self._present)
 
     @property
     def named(self) -> frozenset[ox.Quad]:
         """Every quad the text names, whether or not the update changes it."""
         return frozenset(self._present)
 
-    def expected(self, start: dict[ox.Quad, bool]) -> dict[ox.Quad, bool]:
-        """Which named quads the operations leave present, from ``start``."""
-        present = dict(start)
-        for operation in self.operations:
-            for quad in operation.quads:
-                present[quad] = operation.insert
-        return present
-
     def delta(self, store: Store) -> tuple[frozenset[ox.Quad], frozenset[ox.Quad]] | None:
         """What the update added to and removed from ``store`` (it ran since :meth:`read`), or None when
-        the reading is not borne out: by pyoxigraph's own SPARQL update on a scratch store, or by the store."""
-        if not self._confirmed():
-            return None
-        after = self.expected(self._present)
+        the store does not bear the reading out."""
+        after = _expected(self.operations, self._present)
         if any(_holds(store, quad) != present for quad, present in after.items()):
             return None
         added = frozenset(q for q, present in after.items() if present and not self._present[q])
         removed = frozenset(q for q, present in after.items() if not present and self._present[q])
         return added, removed
 
-    def _confirmed(self) -> bool:
-        """Whether SPARQL reads the text as the TriG reading does: run on a store holding every named
-        quad, it must leave exactly the quads the reading leaves (a quad read otherwise would be left
-        behind, or be one too many)."""
-        scratch = ox.Store()
-        scratch.extend(self.named)
-        try:
-            scratch.update(self.text, prefixes=PREFIXES)
-        except (SyntaxError, OSError, RuntimeError, ValueError):
-            return False
-        left = {quad for quad, present in self.expected(dict.fromkeys(self.named, True)).items() if present}
-        return len(scratch) == len(left) and all(quad in scratch for quad in left)
+
+def _expected(operations: tuple[DataOperation, ...], start: dict[ox.Quad, bool]) -> dict[ox.Quad, bool]:
+    """Which named quads ``operations`` leave present, from ``start``."""
+    present = dict(start)
+    for operation in operations:
+        for quad in operation.quads:
+            present[quad] = operation.insert
+    return present
+
+
+def _confirmed(text: str, operations: tuple[DataOperation, ...]) -> bool:
+    """Whether SPARQL reads ``text`` as ``operations`` say: run on a store holding every quad they name, it
+    must leave exactly the quads they leave (a quad read otherwise would be left behind, or be one too many)."""
+    named = {quad for operation in operations for quad in operation.quads}
+    scratch = ox.Store()
+    scratch.extend(named)
+    try:
+        scratch.update(text, prefixes=PREFIXES)
+    except (SyntaxError, OSError, RuntimeError, ValueError):
+        return False
+    left = {quad for quad, present in _expected(operations, dict.fromkeys(named, True)).items() if present}
+    return len(scratch) == len(left) and all(quad in scratch for quad in left)
 
 
 def _holds(store: Store, quad: ox.Quad) -> bool:

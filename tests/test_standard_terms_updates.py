@@ -14,8 +14,9 @@ from hypothesis import strategies as st
 
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import KnowledgeBaseError, QuerySyntaxError
+from cbrs.kb.knowledge_base import _CHECKED_GRAPHS
 from cbrs.kb.namespaces import PREFIXES, GraphName
-from cbrs.kb.shapes import DescriptionShapeError
+from cbrs.kb.shapes import DescriptionShapeError, checked_update
 from cbrs.kb.standard_terms import StandardTerms, entailed
 from cbrs.kb.update_delta import data_operations
 
@@ -288,3 +289,36 @@ def test_an_update_the_shape_check_refuses_leaves_everything_as_it_was(kb: Knowl
 def test_a_syntax_error_raises_the_stores_error(kb: KnowledgeBase) -> None:
     with pytest.raises(QuerySyntaxError):
         kb.update(f"INSERT DATA {{ <{TEST}s0> a }}")
+
+
+def test_a_data_update_skips_the_shape_check_only_outside_the_graphs_it_checks(
+    kb: KnowledgeBase, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """KnowledgeBase.update leaves out kb.shapes.checked_update for a data update naming no quad in the
+    graphs it checks (_CHECKED_GRAPHS): the graphs it reads must be exactly those."""
+    read: set[object] = set()
+    quads = kb.store.quads
+
+    def spied(*args: object, **kwargs: object) -> Iterator[ox.Quad]:
+        read.add(kwargs.get("graph", args[3] if len(args) > 3 else None))
+        return quads(*args, **kwargs)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(kb.store, "quads", spied)
+    with checked_update(kb.store):
+        kb.store.update(f"INSERT DATA {{ GRAPH <{SERVICES}> {{ <{TEST}s0> rdfs:label 'x' }} }}")
+    assert read == set(_CHECKED_GRAPHS)
+
+
+def test_a_broken_requirement_written_by_a_data_update_is_refused(kb: KnowledgeBase) -> None:
+    """The shape check still runs for a data update into graph:requirements (and graph:services, as
+    tests/test_shapes.py checks): a requirement's parameter typed by a string instead of a class."""
+    requirements = GraphName.REQUIREMENTS.node
+    typed = next(kb.store.quads(None, ox.NamedNode(CBRS + "parameterType"), None, requirements))
+    before = kb.store.dump()
+    text = (
+        f"DELETE DATA {{ GRAPH {requirements} {{ {typed.triple} }} }} ;\n"
+        f'INSERT DATA {{ GRAPH {requirements} {{ {typed.subject} {typed.predicate} "not a class" }} }}'
+    )
+    with pytest.raises(DescriptionShapeError):
+        kb.update(text)
+    assert kb.store.dump() == before

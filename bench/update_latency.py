@@ -1,0 +1,159 @@
+"""Benchmark: how long one small SPARQL update takes, graph:entailed following it node by node or whole.
+
+Run: python bench/update_latency.py [--owls-tc FOLDER | --bundled-only] [--repeat N] [--json FILE]
+
+On an in-memory store seeded with the bundled files, and (with --owls-tc, default ../shared/owls-tc4 when
+it exists) on one that also holds the OWLS-TC services (loaded as `cbrs load --catalog` loads them), it
+times ``KnowledgeBase.update`` for:
+
+* a one-triple ``INSERT DATA`` of a new, unaligned statement (a robot's observation), then the
+  ``DELETE DATA`` of it;
+* the same for an aligned one (``a home:Sensor``, which entails ``a sosa:Sensor``);
+* a ``DELETE/INSERT ... WHERE`` changing one such statement, which always takes the whole refresh.
+
+Each data update is timed twice, alternating: as cbrs runs it (graph:entailed followed node by node,
+kb/standard_terms.py StandardTerms.prepare/updated; no shape check when it names no quad in the graphs
+kb/shapes.py checks) and as the anchor, the update as every update ran before: the shape check
+(checked_update), the store's update, a whole refresh. Also timed: the store's update alone, and with the
+shape check. Medians and 90th
+percentiles of --repeat samples; the machine, inputs and load average are printed.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import statistics
+import sys
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+import pyoxigraph as ox
+
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.catalog import Catalogue
+from cbrs.kb.namespaces import GraphName
+from cbrs.kb.shapes import checked_update
+
+DEFAULT_OWLS_TC = Path(__file__).resolve().parents[2] / "shared" / "owls-tc4"
+GRAPH = "urn:bench:observations"
+
+
+def texts(kind: str, n: int) -> tuple[str, str]:
+    """The INSERT DATA and DELETE DATA of the n-th statement of ``kind`` (plain or aligned)."""
+    statement = (
+        f'<urn:bench:obs{n}> <urn:bench:value> "{n}"'
+        if kind == "plain"
+        else f"<urn:bench:sensor{n}> a <https://w3id.org/cbrs/home#Sensor>"
+    )
+    return (
+        f"INSERT DATA {{ GRAPH <{GRAPH}> {{ {statement} }} }}",
+        f"DELETE DATA {{ GRAPH <{GRAPH}> {{ {statement} }} }}",
+    )
+
+
+def where_text(n: int) -> str:
+    """A DELETE/INSERT WHERE moving a sensor's statement to the next number."""
+    return (
+        f"DELETE {{ GRAPH <{GRAPH}> {{ ?s a home:Sensor }} }}"
+        f" INSERT {{ GRAPH <{GRAPH}> {{ <urn:bench:w{n}> a home:Sensor }} }}"
+        f" WHERE {{ GRAPH <{GRAPH}> {{ ?s a home:Sensor }} FILTER (STRSTARTS(STR(?s), 'urn:bench:w')) }}"
+    )
+
+
+def whole(kb: KnowledgeBase, text: str) -> None:
+    """The update as ``KnowledgeBase.update`` ran it before graph:entailed followed data updates node by
+    node: the shape check, the store's update, a whole refresh."""
+    with checked_update(kb.store):
+        kb.store.update(text)
+    kb.refresh_standard_terms()
+
+
+def shape_checked(kb: KnowledgeBase, text: str) -> None:
+    with checked_update(kb.store):
+        kb.store.update(text)
+
+
+def timed(action: Callable[[], object]) -> float:
+    start = time.perf_counter()
+    action()
+    return (time.perf_counter() - start) * 1000
+
+
+def summary(samples: list[float]) -> dict[str, float]:
+    ordered = sorted(samples)
+    return {"median_ms": statistics.median(ordered), "p90_ms": ordered[int(0.9 * (len(ordered) - 1))]}
+
+
+def measure(kb: KnowledgeBase, repeat: int) -> dict[str, dict[str, float]]:
+    """Per-update times on ``kb``, node-by-node and whole samples alternating."""
+    kb.refresh_standard_terms()  # graph:entailed known exact, as after the first update of a process
+    samples: dict[str, list[float]] = {}
+    n = 0
+    for _ in range(repeat):
+        for kind in ("plain", "aligned"):
+            for way, run in (("followed", kb.update), ("whole", lambda text: whole(kb, text))):
+                n += 1
+                insert, delete = texts(kind, n)
+                samples.setdefault(f"{kind} INSERT DATA, {way}", []).append(timed(lambda: run(insert)))  # noqa: B023
+                samples.setdefault(f"{kind} DELETE DATA, {way}", []).append(timed(lambda: run(delete)))  # noqa: B023
+        n += 1
+        insert, delete = texts("plain", n)
+        samples.setdefault("plain INSERT DATA, store alone", []).append(timed(lambda: kb.store.update(insert)))  # noqa: B023
+        samples.setdefault("plain DELETE DATA, store alone", []).append(timed(lambda: kb.store.update(delete)))  # noqa: B023
+        n += 1
+        insert, delete = texts("plain", n)
+        samples.setdefault("plain INSERT DATA, store + shape check", []).append(
+            timed(lambda: shape_checked(kb, insert))  # noqa: B023
+        )
+        samples.setdefault("plain DELETE DATA, store + shape check", []).append(
+            timed(lambda: shape_checked(kb, delete))  # noqa: B023
+        )
+        samples.setdefault("DELETE/INSERT WHERE (whole)", []).append(timed(lambda: kb.update(where_text(n))))  # noqa: B023
+    entailed = set(kb.store.quads(graph=GraphName.ENTAILED.node))
+    kb.refresh_standard_terms()
+    assert entailed == set(kb.store.quads(graph=GraphName.ENTAILED.node)), "graph:entailed drifted from a whole refresh"
+    return {name: summary(values) for name, values in samples.items()}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--owls-tc", type=Path, default=DEFAULT_OWLS_TC if DEFAULT_OWLS_TC.is_dir() else None)
+    parser.add_argument("--bundled-only", action="store_true", help="leave the OWLS-TC store out")
+    parser.add_argument("--repeat", type=int, default=20)
+    parser.add_argument("--json", type=Path)
+    args = parser.parse_args()
+    print(
+        f"machine: {platform.machine()} {platform.system()} {platform.release()}, {os.cpu_count()} cores, "
+        f"python {platform.python_version()}, pyoxigraph {ox.__version__}; load average at start "
+        f"{' '.join(f'{x:.2f}' for x in os.getloadavg())}; repeat {args.repeat}"
+    )
+    rows: dict[str, dict[str, object]] = {}
+    kb = KnowledgeBase.open(":memory:")
+    stores = [("bundled", kb)]
+    if args.owls_tc is not None and not args.bundled_only:
+        big = KnowledgeBase.open(":memory:")
+        start = time.perf_counter()
+        big.load([args.owls_tc / "services"], catalogue=Catalogue.open(args.owls_tc / "ontology"))
+        print(f"OWLS-TC services from {args.owls_tc} loaded in {time.perf_counter() - start:.0f} s")
+        stores.append(("owls-tc", big))
+    for name, store in stores:
+        quads = store.store.count()
+        entailed = store.store.count(GraphName.ENTAILED)
+        services = store.store.count(GraphName.SERVICES)
+        results = measure(store, args.repeat)
+        rows[name] = {"quads": quads, "entailed": entailed, "services_quads": services, **results}
+        print(f"\n{name}: {quads} quads, {services} in graph:services, {entailed} in graph:entailed")
+        print(f"  {'update':<42} {'median ms':>10} {'p90 ms':>8}")
+        for label, figures in results.items():
+            print(f"  {label:<42} {figures['median_ms']:>10.2f} {figures['p90_ms']:>8.2f}")
+    print(f"\nload average at end {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
+    if args.json:
+        args.json.write_text(json.dumps(rows, indent=2), encoding="utf-8")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
