@@ -45,6 +45,7 @@ VARIANTS: dict[str, MatchConfig] = {
     "no decomposition steps (decomposition_weight 0)": replace(BASE, decomposition_weight=0.0),
     "no cross-branch links": replace(BASE, cross_branch_weight=0.0),
     "with WordNet core words": replace(BASE, lexicon=True),
+    "with undone states (undone_state_factor 0)": replace(BASE, undone_state_factor=0.0),
     "input gate 0.4": replace(BASE, input_gate=0.4),
     "all off (published frame)": BASE.published(),
 }

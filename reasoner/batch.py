@@ -497,6 +497,30 @@ class BatchScorer:
             clash |= pool.opposites(statement)
         return clash
 
+    def undoing(self, requirement: Requirement) -> npt.NDArray[np.bool_]:
+        """Per pool statement: does it make a precondition the requirement guarantees false (the same fact,
+        a contradicting object: statements.undoes) while stating no requested effect (Matchmaker._undone_state)?"""
+        cfg, pool, space = self.config, self.pool, self.pool.space
+        undone = np.zeros(len(pool.statements), dtype=bool)
+        for held in requirement.preconditions:
+            clash = np.zeros(len(space), dtype=bool)
+            if cfg.disjoint_statements:
+                clash |= space.disjoint(held.object)
+            if cfg.antonym_statements:
+                clash |= space.opposites(held.object)
+            undone |= (
+                self._related_to(held.subject)[pool.s_ids]
+                & self._related_to(held.predicate)[pool.p_ids]
+                & clash[pool.o_ids]
+            )
+        for wanted in requirement.effects:
+            undone &= ~(
+                self._at_or_above(wanted.subject)[pool.s_ids]
+                & self._at_or_above(wanted.predicate)[pool.p_ids]
+                & self._at_or_above(wanted.object)[pool.o_ids]
+            )
+        return undone
+
     def score(self, requirement: Requirement) -> BatchScores:
         pool, cfg = self.pool, self.config
         n = len(pool.ads)
@@ -561,6 +585,9 @@ class BatchScorer:
         if requirement.effects and cfg.contradiction_factor < 1:  # statements.contradiction_factor
             clash = np.max([pool.effects.max(self.contradicts(s).astype(np.float64)) for s in requirement.effects], 0)
             ratio = np.where(clash > 0, cfg.contradiction_factor * ratio, ratio)
+        if requirement.preconditions and cfg.undone_state_factor < 1 and isinstance(self.measure, SemStr):
+            undone = pool.effects.max(self.undoing(requirement).astype(np.float64)) > 0
+            ratio = np.where(undone, cfg.undone_state_factor * ratio, ratio)
         score = np.round(ratio.astype(np.float64), 6).astype(np.float64)
         tie = self._result(parts, weights) if cfg.tie_break_result else None
         return BatchScores(score, parts, *pool.filtered(requirement, self.filters), tie=tie)

@@ -52,6 +52,13 @@ class MatchConfig:
     # is asked (closes the door it should open): its whole score is multiplied by this factor, so that
     # matching inputs cannot rank it above services that help. 1 leaves only that statement at 0.
     contradiction_factor: float = 0.0
+    # An advertisement with an effect that contradicts a precondition the requirement guarantees (the state
+    # the requester is in: an is-a related subject and predicate, an object declared disjoint with or named
+    # by the opposite of the guaranteed one), and that achieves no requested effect, undoes that state as a
+    # side effect (it opens the door the requester said was closed and asked to lock): a planner's threat.
+    # Its whole score is multiplied by this factor; 1 (the default) leaves such offers as they are. Off: on the
+    # OWLS-TC development part it moves one pair of one query (docs/matchmaking.md 9.5).
+    undone_state_factor: float = 1.0
     # A requested effect and an advertisement that changes nothing (no effects) but outputs the state the
     # effect is about (DoorState for (Door, hasState, Opened)): a sensing step towards it. Its effects part
     # is observed_state_weight times the best Sem-Str of its outputs with the effect's object or subject.
@@ -133,6 +140,7 @@ class MatchConfig:
             disjoint_statements=False,
             antonym_statements=False,
             contradiction_factor=1.0,
+            undone_state_factor=1.0,
             tie_break_result=False,
             complement_weight=0.0,
             unrelated_predicate_factor=1.0,
@@ -160,6 +168,7 @@ class MatchConfig:
             "observed_state_weight",
             "decomposition_weight",
             "contradiction_factor",
+            "undone_state_factor",
         ):
             value = getattr(self, name)
             if not 0 <= value <= 1:

@@ -41,8 +41,8 @@ from cbrs.reasoner.methods import REFINED, Method, make_method
 from cbrs.reasoner.names import local_name
 from cbrs.reasoner.similarity import SemStr, Similarity
 from cbrs.reasoner.spans import PairMatch, SpanMatch, conceptual_span_similarity, span
-from cbrs.reasoner.statements import StatementMatch, best_statement_matches, contradiction_factor, reported
-from cbrs.reasoner.steps import Achiever, achievers, feeds
+from cbrs.reasoner.statements import StatementMatch, best_statement_matches, contradiction_factor, reported, undoes
+from cbrs.reasoner.steps import Achiever, achievers, at_or_above, feeds
 from cbrs.reasoner.taxonomy import TaxonomyIndex
 from cbrs.reasoner.text import description_text
 
@@ -335,6 +335,7 @@ class Matchmaker:
         score = sum(weights[name] * value for name, value in parts.items()) / total if total else 0.0
         score *= 1 - cfg.input_gate + cfg.input_gate * (needed if needed is not None else 1.0)
         score *= contradiction_factor(requirement.effects, ad.effects, self.method.measure, cfg)
+        score *= self._undone_state(requirement, ad, lacks)
         rejected = self.filters(requirement, ad.area, ad.qos)
         if self.method.strict:
             failed = [pair for pair in pairs if pair.role in ("output", "effect") and pair.degree == Degree.FAIL.value]
@@ -546,6 +547,29 @@ class Matchmaker:
             pairs.append(EntityPair("effect", text, output, best, why, Degree.FAIL.value, "step"))
         return best
 
+    def _undone_state(self, requirement: Requirement, ad: Advertisement, lacks: list[str]) -> float:
+        """MatchConfig.undone_state_factor when one of the advertisement's effects achieves no requested
+        effect and makes a precondition the requirement guarantees false (statements.undoes), else 1."""
+        factor = self.config.undone_state_factor
+        if factor >= 1 or not requirement.preconditions:
+            return 1.0
+        for effect in ad.effects:
+            if any(self._states_at_least(effect, wanted) for wanted in requirement.effects):
+                continue
+            for held in requirement.preconditions:
+                if undoes(held, effect, self.method.measure, self.config):
+                    lacks.append(f"effect {_text(effect)} undoes the guaranteed {_text(held)}: score x{factor:g}")
+                    return factor
+        return 1.0
+
+    def _states_at_least(self, effect: Statement, wanted: Statement) -> bool:
+        """Does ``effect`` state at least the change ``wanted`` asks for (each position the requested one or
+        an is-a superclass of it, as an achiever's does: steps.py)?"""
+        return all(
+            at_or_above(self.index, getattr(wanted, position), getattr(effect, position))
+            for position in ("subject", "predicate", "object")
+        )
+
     def _statements(self, matches: list[StatementMatch], role: str, pairs: list[EntityPair], lacks: list[str]) -> float:
         values = []
         for match in matches:
@@ -696,3 +720,7 @@ def _within(inner: tuple[float, float, float, float], outer: tuple[float, float,
 
 def _short(iri: str) -> str:
     return local_name(iri) if "://" in iri else iri
+
+
+def _text(statement: Statement) -> str:
+    return f"({_short(statement.subject)}, {_short(statement.predicate)}, {_short(statement.object)})"

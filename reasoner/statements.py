@@ -66,12 +66,32 @@ def _contradiction(
     if not isinstance(measure, SemStr):
         return None
     for position in ("subject", "object"):
-        wanted, got = getattr(requested, position), getattr(advertised, position)
-        if config.disjoint_statements and measure.index.disjoint(wanted, got):
-            return position, "disjoint with"
-        if config.antonym_statements and opposite(wanted, got):
-            return position, "the opposite of"
+        relation = _clash(getattr(requested, position), getattr(advertised, position), measure, config)
+        if relation is not None:
+            return position, relation
     return None
+
+
+def _clash(wanted: str, got: str, measure: SemStr, config: MatchConfig) -> str | None:
+    """How ``got`` contradicts ``wanted`` ("disjoint with", "the opposite of"), or None."""
+    if config.disjoint_statements and measure.index.disjoint(wanted, got):
+        return "disjoint with"
+    if config.antonym_statements and opposite(wanted, got):
+        return "the opposite of"
+    return None
+
+
+def undoes(held: Statement, effect: Statement, measure: EntityMeasure, config: MatchConfig) -> bool:
+    """Does ``effect`` make the guaranteed statement ``held`` false: the same fact (is-a related subjects
+    and predicates) with a contradicting object (MatchConfig.undone_state_factor; Sem-Str only)? A
+    statement about another thing (the red lamp's state for the green lamp's) undoes nothing."""
+    if not isinstance(measure, SemStr):
+        return False
+    index = measure.index
+    same_fact = _is_a_related(index, held.subject, effect.subject) and _is_a_related(
+        index, held.predicate, effect.predicate
+    )
+    return same_fact and _clash(held.object, effect.object, measure, config) is not None
 
 
 def contradiction_factor(

@@ -233,6 +233,42 @@ def test_an_effect_that_contradicts_the_requested_one_scores_nothing(defined_kb)
     assert Matchmaker(defined_kb, "wu-palmer", index=index, advertisements=ads).config.disjoint_statements is False
 
 
+def test_an_offer_that_undoes_the_state_the_requester_is_in_can_score_nothing(defined_kb) -> None:  # type: ignore[no-untyped-def]
+    # The requester guarantees the door is Opened and asks for it Ajar. Closing it is no contradiction of
+    # Ajar (nothing declares them disjoint), but it makes the guaranteed Opened false without giving what
+    # was asked: a side effect that undoes the requester's state. Making it Ajar undoes Opened too, and is
+    # the change asked for; closing a Lens is about another thing.
+    def state(thing: str, value: str) -> Statement:
+        return Statement(M + thing, M + "hasState", M + value)
+
+    wanted = Requirement(M + "PushAjar", (), preconditions=(state("Door", "Opened"),), effects=(state("Door", "Ajar"),))
+    ads = [
+        Advertisement(M + name, (), effects=(state(thing, value),))
+        for name, thing, value in (
+            ("CloseDoor", "Door", "Closed"),
+            ("AjarDoor", "Door", "Ajar"),
+            ("CloseLens", "Lens", "Closed"),
+        )
+    ]
+    index = TaxonomyIndex.from_kb(defined_kb)
+    on = Matchmaker(defined_kb, config=MatchConfig(undone_state_factor=0.0), index=index, advertisements=ads)
+    ranked = on.rank(wanted, explain=0).candidates
+    assert [c.advertisement.removeprefix(M) for c in ranked] == ["AjarDoor", "CloseLens", "CloseDoor"]
+    closer = on.score(wanted, ads[0])
+    assert ranked[2].score == closer.score == 0.0  # batch and scalar agree
+    assert any("undoes the guaranteed (Door, hasState, Opened)" in lack for lack in closer.lacks)
+    assert on.score(wanted, ads[1]).score == 1.0 and on.score(wanted, ads[2]).score > 0
+    off = Matchmaker(defined_kb, index=index, advertisements=ads)  # the default: off (docs/matchmaking.md 9.5)
+    kept = off.rank(wanted, explain=0).candidates
+    assert kept[1].advertisement == M + "CloseDoor" and kept[1].score == off.score(wanted, ads[0]).score > 0.5
+    assert (
+        Matchmaker(
+            defined_kb, "wu-palmer", config=on.config, index=index, advertisements=ads
+        ).config.undone_state_factor
+        == 1
+    )
+
+
 def test_an_offer_that_reports_the_requested_state_is_a_step_towards_it(defined_kb) -> None:  # type: ignore[no-untyped-def]
     wanted = Requirement(M + "OpenTheDoor", (), effects=(Statement(M + "Door", M + "hasState", M + "Opened"),))
     checks = Advertisement(M + "DoorChecker", (), outputs=(Parameter(M + "out", "output", M + "DoorState"),))
