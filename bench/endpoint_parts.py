@@ -163,8 +163,7 @@ def _in_memory(data: Path, source: Path | None) -> Served:
     """A cbrs server over an in-memory store holding ``data``; with ``source``, cbrs from there."""
     port = _free_port()
     argv = [PYTHON, "-c", _MEMORY, str(data), GRAPH, str(port)]
-    env = None if source is None else {**os.environ, "PYTHONPATH": str(source)}
-    return Served("cbrs serve, in memory", argv, port, "/sparql", env)
+    return Served("cbrs serve, in memory", argv, port, "/sparql", source)
 
 
 def _part(store: Path, part: str, size: int) -> Served:

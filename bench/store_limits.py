@@ -103,9 +103,13 @@ def _ask(connection: http.client.HTTPConnection, path: str, query: str) -> bytes
 class Served:
     """A server process (cbrs serve or oxigraph serve) and where its SPARQL endpoint is."""
 
-    def __init__(self, label: str, argv: list[str], port: int, path: str, env: dict[str, str] | None = None) -> None:
+    def __init__(self, label: str, argv: list[str], port: int, path: str, source: Path | None = None) -> None:
         self.label, self.port, self.path = label, port, path
-        self.process = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)
+        env, cwd = None, None
+        if source is not None:  # cbrs from there: first on the path, and the working directory (python -m
+            # and -c put the working directory before PYTHONPATH, so the checkout run from would win)
+            env, cwd = {**os.environ, "PYTHONPATH": str(source)}, source
+        self.process = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env, cwd=cwd)
         deadline = time.monotonic() + 120
         while True:
             try:
@@ -130,14 +134,11 @@ class Served:
 
 
 def serve_cbrs(store: Path, source: Path | None = None) -> Served:
-    """``cbrs serve`` over ``store``; with ``source``, the cbrs package found there (another checkout,
-    put first on PYTHONPATH), so two versions can be measured side by side in one run."""
+    """``cbrs serve`` over ``store`` (an absolute path); with ``source``, the cbrs package in that
+    directory (another version), so two versions can be measured side by side in one run."""
     port = _free_port()
     argv = [PYTHON, "-m", "cbrs", "--store", str(store), "serve", "--port", str(port), "--bridge-port", "0"]
-    if source is None:
-        return Served("cbrs serve", argv, port, "/sparql")
-    env = {**os.environ, "PYTHONPATH": str(source)}
-    return Served(f"cbrs serve ({source})", argv, port, "/sparql", env)
+    return Served("cbrs serve" if source is None else f"cbrs serve ({source})", argv, port, "/sparql", source)
 
 
 def serve_oxigraph(oxigraph: str, location: Path) -> Served:
