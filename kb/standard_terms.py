@@ -327,7 +327,9 @@ class StandardTerms:
         wanted = self._wanted(alignment, near)
         held = {quad for node in near for quad in self.store.quads(node, None, None, _GRAPH)}
         first = self._write(held - wanted - now, wanted - held)
-        after = {quad for quad in self._rule_conclusions(alignment) if not self._asserted(alignment, quad)}
+        # the rules again on the store as the first write left it (which, if it wrote nothing, is as it was)
+        concluded = self._rule_conclusions(alignment) if first.added or first.removed else now
+        after = {quad for quad in concluded if not self._asserted(alignment, quad)}
         gone = now - after
         wanted |= self._wanted(alignment, _subjects(gone) - near)
         second = self._write(
