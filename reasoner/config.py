@@ -26,6 +26,12 @@ class MatchConfig:
     # (1 - complement_weight) + complement_weight * Comp(complementary words), so PersonLocation is further
     # from RobotLocation than the taxonomy alone says (docs/matchmaking.md, "Complementary words").
     complement_weight: float = 0.2
+    # A concept outside the taxonomy is placed as the index places a class with no declared parent: under the
+    # root. Against a taxonomy concept of depth d it scores at least Situation 1 through the root, 1 / (2 + d),
+    # and Situation 3 (the names) only raises that; two concepts outside the taxonomy keep Situation 3 alone.
+    # False: Situation 3 alone (Definition 1 as written), so an undeclared concept scores below every declared
+    # unrelated one (docs/matchmaking.md, section 9).
+    unknown_under_root: bool = True
     # A pair of entities counts as matched when its similarity reaches this threshold (CSS, PE).
     pair_threshold: float = 0.5
     # Weights of subject, predicate and object in an RDF statement's similarity (equation 8).
@@ -146,6 +152,7 @@ class MatchConfig:
             unrelated_predicate_factor=1.0,
             observed_state_weight=0.0,
             decomposition_weight=0.0,
+            unknown_under_root=False,
         )
 
     def __post_init__(self) -> None:

@@ -47,6 +47,9 @@ class Similarity:
             return f"1/(1+N), N={sum(self.links)} links via {via}"
         if self.situation == "situation-2":
             return f"Wu-Palmer via {local_name(self.common or '')}, links {self.links}"
+        if self.situation == "outside":
+            assert self.links is not None
+            return f"not in the taxonomy: placed under the root, 1/(1+N), N={sum(self.links)} links via the root"
         if self.situation == "situation-3":
             return "no taxonomy: Jaro-Winkler or WordNet on core and complementary words"
         if self.situation == "cross-branch":
@@ -101,7 +104,7 @@ class SemStr:
         if first == second or (first in index and index.canonical(first) == index.canonical(second)):
             return Similarity(1.0, "exact", first, (0, 0))
         if first not in index or second not in index:
-            return self.situation_3(first, second)
+            return self.outside(first, second)
         common, n1, n2 = index.common_ancestor(first, second)
         if common != ROOT and 0 in (n1, n2):
             # One is a subclass of the other: Wu-Palmer is positive here (C is the upper one).
@@ -150,6 +153,22 @@ class SemStr:
         nr = index.depth(common)
         return Similarity(2 * nr / (n1 + n2 + 2 * nr), "situation-2", common, (n1, n2))
 
+    def outside(self, first: str, second: str) -> Similarity:
+        """Two entities, one or both outside the taxonomy: Situation 3 (their names). With unknown_under_root,
+        one outside the taxonomy hangs from the root as a class without a declared parent does (section 1 of
+        docs/matchmaking.md), so against a taxonomy node of depth d it scores at least Situation 1 through
+        the root, 1 / (1 + 1 + d): an undeclared concept is no further from a declared one than two declared
+        concepts that meet only at the root. Two entities outside it keep Situation 3: nothing places them."""
+        found = self.situation_3(first, second)
+        index = self.index
+        if not self.config.unknown_under_root or (first in index) == (second in index):
+            return found
+        depth = index.depth(first if first in index else second)
+        if 1 / (2 + depth) <= found.value:
+            return found
+        links = (depth, 1) if first in index else (1, depth)
+        return Similarity(1 / (2 + depth), "outside", ROOT, links)
+
     def core_key(self, concept: str) -> str:
         """The lemma of a concept's core word: what cross-branch links are looked up by."""
         return self.lexicon.lemma(self._split(concept)[0])
@@ -161,6 +180,11 @@ class SemStr:
         top-level properties 1/3, which says nothing about how alike two relations are."""
         found = self(first, second)
         factor = self.config.unrelated_predicate_factor
+        if found.situation == "outside" and factor < 1:  # a predicate placed under the root: another relation
+            named = self.situation_3(first, second)
+            if named.value >= factor * found.value:
+                return named
+            return replace(found, value=factor * found.value, situation="unrelated-predicates")
         if factor >= 1 or not self.through_root_only(first, second):
             return found
         namesake = self.cross_branch(first, second)

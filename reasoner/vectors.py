@@ -254,13 +254,14 @@ class VectorSpace:
         n = len(self.names)
         values = np.empty(n, dtype=np.float64)
         unknown = range(self.taxonomy_size, n)
-        if concept not in self.index:
-            values[:] = 0.0
-            for i in self._read_at():
-                values[i] = measure.situation_3(concept, self.names[i]).value if self.names[i] != concept else 1.0
+        if concept not in self.index:  # SemStr.outside: Situation 3, at least 1 / (2 + depth) under the root
+            values = self._named(measure, concept).copy()
+            if measure.config.unknown_under_root:
+                read = self._read_known()
+                values[read] = np.maximum(values[read], 1.0 / (2.0 + self.depth[read]))
             return values
         for i in unknown:
-            values[i] = measure.situation_3(concept, self.names[i]).value
+            values[i] = measure.outside(concept, self.names[i]).value
         known = slice(0, self.taxonomy_size)
         x = self.ids[self.index.canonical(concept)]
         values[known], isa_related = self._wu_palmer_or_root(x)
@@ -279,14 +280,35 @@ class VectorSpace:
             self._qualify(measure, x, values, isa_related)
         return values
 
+    def _named(self, measure: SemStr, concept: str) -> FloatArray:
+        """Situation 3 of a concept outside the taxonomy against every read id (1 at itself; cached)."""
+        key = (id(measure), "named:" + concept)
+        found = self._cache.get(key)
+        if found is None:
+            found = np.zeros(len(self.names), dtype=np.float64)
+            for i in self._read_at():
+                found[i] = measure.situation_3(concept, self.names[i]).value if self.names[i] != concept else 1.0
+            self._cache[key] = found
+        return found
+
+    def _read_known(self) -> IntArray:
+        """The read ids that are taxonomy nodes."""
+        read = np.array(self._read_at(), dtype=np.int64)
+        return read[read < self.taxonomy_size]
+
     def predicate_vector(self, measure: SemStr, concept: str) -> FloatArray:
         """SemStr.predicate(concept, c) for every concept id c (cached)."""
         factor = measure.config.unrelated_predicate_factor
         base = self.vector(measure, concept)
-        if factor >= 1 or concept not in self.index:
+        if factor >= 1 or (concept not in self.index and not measure.config.unknown_under_root):
             return base
         key = (id(measure), "predicate:" + concept)
         found = self._cache.get(key)
+        if found is None and concept not in self.index:  # under the root: factor x Situation 1, or the names
+            found = self._named(measure, concept).copy()
+            read = self._read_known()
+            found[read] = np.maximum(found[read], factor / (2.0 + self.depth[read]))
+            self._cache[key] = found
         if found is None:
             x = self.ids[self.index.canonical(concept)]
             lcs = self.common_superclasses(concept)
@@ -299,6 +321,9 @@ class VectorSpace:
             namesakes = np.zeros(len(self.names), dtype=np.float64)
             self._cross_branch(measure, x, namesakes)
             found = np.where(through, np.maximum(namesakes, factor * base), base)
+            if measure.config.unknown_under_root:  # outside the taxonomy: SemStr.predicate, pair by pair
+                for i in range(self.taxonomy_size, len(self.names)):
+                    found[i] = measure.predicate(concept, self.names[i]).value
             self._cache[key] = found
         return found
 

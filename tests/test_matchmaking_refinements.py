@@ -475,3 +475,56 @@ def test_the_grasp_planner_ranks_as_a_step_on_the_robot_collection() -> None:
     # grade 1 (a step: plans the grasp) against grade 0 (puts the held object down: no input it lacks)
     assert place(on, "GRASP_PLANNER_SERVICE") < place(on, "PLACE_OBJECT_SERVICE")
     assert place(off, "GRASP_PLANNER_SERVICE") > place(off, "PLACE_OBJECT_SERVICE")
+
+
+def test_a_concept_outside_the_taxonomy_hangs_from_the_root() -> None:
+    index = positions()
+    on, off = SemStr(index), SemStr(index, MatchConfig(unknown_under_root=False))
+    # Picture is declared nowhere: against Position (depth 3) it is Situation 1 through the root, N = 1 + 3
+    picture = on(E + "Picture", E + "Position")
+    assert picture.situation == "outside" and picture.value == pytest.approx(1 / (2 + index.depth(E + "Position")))
+    assert "placed under the root" in picture.explain()
+    assert off(E + "Picture", E + "Position").value == 0.0  # Situation 3: no word in common
+    # no further from a declared concept than two declared concepts that meet only at the root
+    assert picture.value >= on(E + "MarkerColour", E + "Position").value > 0
+    # where the names say more, Situation 3 stands; two undeclared concepts keep Situation 3 alone
+    named = on(E + "RobotPlace", E + "RobotPosition")
+    assert named.situation == "situation-3" and named == off(E + "RobotPlace", E + "RobotPosition")
+    assert on(E + "Picture", E + "Image") == off(E + "Picture", E + "Image")
+    # an offer that takes an undeclared input no longer ranks below one that takes a declared unrelated one
+    wanted = Requirement(E + "Wants", (), inputs=(_p("input", "MarkerColour"),), outputs=(_p("output", "Position"),))
+    undeclared = Advertisement(
+        E + "TakesPicture", (), inputs=(_p("input", "Picture"),), outputs=(_p("output", "Position"),)
+    )
+    unrelated = Advertisement(
+        E + "TakesXCoordinate", (), inputs=(_p("input", "XCoordinate"),), outputs=(_p("output", "Position"),)
+    )
+    assert _rank(MatchConfig(), wanted, unrelated, undeclared)[0] == "TakesPicture"
+    assert _rank(MatchConfig(unknown_under_root=False), wanted, undeclared, unrelated)[0] == "TakesXCoordinate"
+    kb = KnowledgeBase(Store.open(":memory:"))
+    matcher = Matchmaker(kb, index=index, advertisements=[undeclared, unrelated])
+    for candidate in matcher.rank(wanted, explain=0).candidates:  # the batch agrees with the scalar path
+        ad = undeclared if candidate.advertisement == undeclared.iri else unrelated
+        assert candidate.score == matcher.score(wanted, ad).score
+
+
+def test_a_predicate_outside_the_taxonomy_is_another_relation() -> None:
+    a = "http://a.org/o#"
+    index = TaxonomyIndex.from_links([Link(a + "isNear", a + "spatialRelation", "is-a")])
+    wanted = Statement(E + "Cup", a + "isNear", E + "Table")
+    offered = Statement(E + "Cup", E + "touches", E + "Table")  # a predicate no ontology declares
+    assert statement_similarity(wanted, offered, SemStr(index), MatchConfig()).value == 0.0
+    published = MatchConfig(unrelated_predicate_factor=1.0)
+    assert statement_similarity(wanted, offered, SemStr(index, published), published).value > 0.0
+    kb = KnowledgeBase(Store.open(":memory:"))
+    ads = [Advertisement(E + "Touches", (), effects=(offered,)), Advertisement(E + "Near", (), effects=(wanted,))]
+    for config in (MatchConfig(), published):  # the batch agrees with the scalar path, either way round
+        for requirement in (
+            Requirement(E + "WantsNear", (), effects=(wanted,)),
+            Requirement(E + "WantsTouch", (), effects=(offered,)),
+        ):
+            matcher = Matchmaker(kb, config=config, index=index, advertisements=ads)
+            for candidate in matcher.rank(requirement, explain=0).candidates:
+                ad = next(x for x in ads if x.iri == candidate.advertisement)
+                assert candidate.score == matcher.score(requirement, ad).score
+
