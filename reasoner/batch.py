@@ -70,6 +70,10 @@ class _Segments:
             result[self._owners] = np.maximum.reduceat(values[self._body], self._starts)
         return result
 
+    def min(self, values: FloatArray) -> FloatArray:
+        """The lowest value of each segment (0 for an empty one)."""
+        return np.asarray(-self.max(-values), dtype=np.float64) + 0.0  # + 0.0: no -0.0 for empty segments
+
     def mean(self, values: FloatArray) -> FloatArray:
         if self._sum_rows is not None:
             padded = np.append(values, 0.0)
@@ -567,7 +571,9 @@ class BatchScorer:
             parts["effects"] = effects
         if requirement.preconditions:
             guaranteed = np.max([self.statements(s) for s in requirement.preconditions], axis=0)
-            parts["preconditions"] = np.where(pool.preconditions.present, pool.preconditions.mean(guaranteed), np.nan)
+            # all of an advertisement's preconditions must hold (precondition_conjunction): the worst decides
+            combine = pool.preconditions.min if cfg.precondition_conjunction else pool.preconditions.mean
+            parts["preconditions"] = np.where(pool.preconditions.present, combine(guaranteed), np.nan)
         weights = {
             "outputs": cfg.output_weight,
             "inputs": cfg.input_weight,

@@ -86,6 +86,10 @@ class MatchConfig:
     input_weight: float = 0.2
     effect_weight: float = 0.3
     precondition_weight: float = 0.1
+    # An advertisement's preconditions must all hold before it can be invoked (a conjunction): its
+    # preconditions part is the lowest of their best matches among what the requirement guarantees.
+    # False: their mean, so one guaranteed precondition made up for one nothing guarantees.
+    precondition_conjunction: bool = True
     # An advertised input the requester offers as the same concept or a subclass can be given as it is:
     # the advertisement can be invoked with it (OWL-S plug-in), so the "can it be invoked?" side scores 1.
     plugin_inputs: bool = True
@@ -153,6 +157,7 @@ class MatchConfig:
             observed_state_weight=0.0,
             decomposition_weight=0.0,
             unknown_under_root=False,
+            precondition_conjunction=False,
         )
 
     def __post_init__(self) -> None:

@@ -9,7 +9,8 @@ left out and the weights of the rest renormalised (MatchConfig):
   it use what the requester offers?);
 - effects: each requested effect's best statement similarity against the advertised effects;
 - preconditions: each advertised precondition's best statement similarity against the
-  preconditions the requirement guarantees (only when it states any).
+  preconditions the requirement guarantees (only when it states any); all must hold, so the lowest
+  counts (MatchConfig.precondition_conjunction).
 
 The SEA and QoS of the requirement act as filters. "No acceptable match" is a status.
 """
@@ -324,7 +325,8 @@ class Matchmaker:
                 parts["effects"] = max(parts["effects"], self._step(requirement, ad, pairs))
         if ad.preconditions and requirement.preconditions:
             matches = best_statement_matches(ad.preconditions, requirement.preconditions, self.method.measure, cfg)
-            parts["preconditions"] = self._statements(matches, "precondition", pairs, lacks)
+            every = cfg.precondition_conjunction  # all must hold: the worst one decides
+            parts["preconditions"] = self._statements(matches, "precondition", pairs, lacks, every)
         weights = {
             "outputs": cfg.output_weight,
             "inputs": cfg.input_weight,
@@ -570,7 +572,15 @@ class Matchmaker:
             for position in ("subject", "predicate", "object")
         )
 
-    def _statements(self, matches: list[StatementMatch], role: str, pairs: list[EntityPair], lacks: list[str]) -> float:
+    def _statements(
+        self,
+        matches: list[StatementMatch],
+        role: str,
+        pairs: list[EntityPair],
+        lacks: list[str],
+        conjunction: bool = False,
+    ) -> float:
+        """The statements' best matches, averaged, or their lowest when they form a ``conjunction``."""
         values = []
         for match in matches:
             wanted = match.requested
@@ -600,6 +610,8 @@ class Matchmaker:
             if value < self.config.pair_threshold:
                 lacks.append(f"{role} {text}: best offer {offered} scores {value:.2f}")
             values.append(value)
+        if conjunction and values:
+            return min(values)
         return sum(values) / len(values) if values else 0.0
 
     # -- filters ---------------------------------------------------------------------------------

@@ -528,3 +528,33 @@ def test_a_predicate_outside_the_taxonomy_is_another_relation() -> None:
                 ad = next(x for x in ads if x.iri == candidate.advertisement)
                 assert candidate.score == matcher.score(requirement, ad).score
 
+
+def test_every_precondition_of_an_offer_must_hold() -> None:
+    at = E + "isAt"
+    guaranteed = Statement(E + "Position", at, E + "XCoordinate")
+    wanted = Requirement(E + "Wants", (), outputs=(_p("output", "Position"),), preconditions=(guaranteed,))
+    # one precondition the requester guarantees and one it does not
+    half = Advertisement(
+        E + "HalfGuaranteed",
+        (),
+        outputs=(_p("output", "Position"),),
+        preconditions=(guaranteed, Statement(E + "MarkerColour", at, E + "Colour")),
+    )
+    # one precondition, a near miss (another object, met only through the root)
+    near = Advertisement(
+        E + "NearMiss",
+        (),
+        outputs=(_p("output", "Position"),),
+        preconditions=(Statement(E + "Position", at, E + "Colour"),),
+    )
+    kb = KnowledgeBase(Store.open(":memory:"))
+    for config, first in ((MatchConfig(), "NearMiss"), (MatchConfig(precondition_conjunction=False), "HalfGuaranteed")):
+        matcher = Matchmaker(kb, config=config, index=positions(), advertisements=[half, near])
+        result = matcher.rank(wanted, explain=0)
+        assert result.candidates[0].advertisement.removeprefix(E) == first
+        for candidate in result.candidates:  # the batch agrees with the scalar path
+            ad = half if candidate.advertisement == half.iri else near
+            assert candidate.score == matcher.score(wanted, ad).score
+    pairs = Matchmaker(kb, index=positions(), advertisements=[half]).score(wanted, half)
+    values = [p.similarity for p in pairs.pairs if p.role == "precondition"]
+    assert pairs.parts["preconditions"] == pytest.approx(min(values)) and max(values) == 1.0
