@@ -11,12 +11,12 @@ times ``KnowledgeBase.update`` for:
 * the same for an aligned one (``a home:Sensor``, which entails ``a sosa:Sensor``);
 * a ``DELETE/INSERT ... WHERE`` changing one such statement, which always takes the whole refresh.
 
-Each data update is timed twice, alternating: as cbrs runs it (graph:entailed followed node by node,
-kb/standard_terms.py StandardTerms.prepare/updated; no shape check when it names no quad in the graphs
-kb/shapes.py checks) and as the anchor, the update as every update ran before: the shape check
-(checked_update), the store's update, a whole refresh. Also timed: the store's update alone, and with the
-shape check. Medians and 90th
-percentiles of --repeat samples; the machine, inputs and load average are printed.
+Each data update is timed both ways, in turn (a run of RUN as cbrs runs it, then one as the anchor): as
+cbrs runs it, graph:entailed followed node by node (kb/standard_terms.py StandardTerms.prepare/updated)
+and no shape check when it names no quad in the graphs kb/shapes.py checks; and as every update ran
+before, the anchor: the shape check (checked_update), the store's update, a whole refresh. Also timed:
+the store's update alone, and with the shape check. Medians and 90th percentiles of the samples; the
+machine, inputs and load average are printed.
 """
 
 from __future__ import annotations
@@ -40,6 +40,10 @@ from cbrs.kb.shapes import checked_update
 
 DEFAULT_OWLS_TC = Path(__file__).resolve().parents[2] / "shared" / "owls-tc4"
 GRAPH = "urn:bench:observations"
+RUN = 3
+"""Data updates in a row, as a robot's writes come: the first write after a whole refresh costs the
+in-memory store more (13 to 40 ms on the OWLS-TC store, then 0.1 ms), which alternating one by one with
+the anchor would charge to every followed update."""
 
 
 def texts(kind: str, n: int) -> tuple[str, str]:
@@ -89,30 +93,36 @@ def summary(samples: list[float]) -> dict[str, float]:
 
 
 def measure(kb: KnowledgeBase, repeat: int) -> dict[str, dict[str, float]]:
-    """Per-update times on ``kb``, node-by-node and whole samples alternating."""
+    """Per-update times on ``kb``: in each repeat and for each kind, a run of :data:`RUN` data updates as
+    cbrs follows them, then one as before (whole); then the store alone, the shape check, a WHERE update."""
     kb.refresh_standard_terms()  # graph:entailed known exact, as after the first update of a process
     samples: dict[str, list[float]] = {}
     n = 0
+
+    def sample(label: str, action: Callable[[], object]) -> None:
+        samples.setdefault(label, []).append(timed(action))
+
     for _ in range(repeat):
         for kind in ("plain", "aligned"):
-            for way, run in (("followed", kb.update), ("whole", lambda text: whole(kb, text))):
+            for _ in range(RUN):
                 n += 1
                 insert, delete = texts(kind, n)
-                samples.setdefault(f"{kind} INSERT DATA, {way}", []).append(timed(lambda: run(insert)))  # noqa: B023
-                samples.setdefault(f"{kind} DELETE DATA, {way}", []).append(timed(lambda: run(delete)))  # noqa: B023
-        n += 1
-        insert, delete = texts("plain", n)
-        samples.setdefault("plain INSERT DATA, store alone", []).append(timed(lambda: kb.store.update(insert)))  # noqa: B023
-        samples.setdefault("plain DELETE DATA, store alone", []).append(timed(lambda: kb.store.update(delete)))  # noqa: B023
-        n += 1
-        insert, delete = texts("plain", n)
-        samples.setdefault("plain INSERT DATA, store + shape check", []).append(
-            timed(lambda: shape_checked(kb, insert))  # noqa: B023
-        )
-        samples.setdefault("plain DELETE DATA, store + shape check", []).append(
-            timed(lambda: shape_checked(kb, delete))  # noqa: B023
-        )
-        samples.setdefault("DELETE/INSERT WHERE (whole)", []).append(timed(lambda: kb.update(where_text(n))))  # noqa: B023
+                sample(f"{kind} INSERT DATA, followed", lambda: kb.update(insert))  # noqa: B023
+                sample(f"{kind} DELETE DATA, followed", lambda: kb.update(delete))  # noqa: B023
+            if kind == "plain":
+                n += 1
+                insert, delete = texts("plain", n)
+                sample("plain INSERT DATA, store alone", lambda: kb.store.update(insert))  # noqa: B023
+                sample("plain DELETE DATA, store alone", lambda: kb.store.update(delete))  # noqa: B023
+                n += 1
+                insert, delete = texts("plain", n)
+                sample("plain INSERT DATA, store + shape check", lambda: shape_checked(kb, insert))  # noqa: B023
+                sample("plain DELETE DATA, store + shape check", lambda: shape_checked(kb, delete))  # noqa: B023
+            n += 1
+            insert, delete = texts(kind, n)
+            sample(f"{kind} INSERT DATA, whole", lambda: whole(kb, insert))  # noqa: B023
+            sample(f"{kind} DELETE DATA, whole", lambda: whole(kb, delete))  # noqa: B023
+        sample("DELETE/INSERT WHERE (whole)", lambda: kb.update(where_text(n)))  # noqa: B023
     entailed = set(kb.store.quads(graph=GraphName.ENTAILED.node))
     kb.refresh_standard_terms()
     assert entailed == set(kb.store.quads(graph=GraphName.ENTAILED.node)), "graph:entailed drifted from a whole refresh"

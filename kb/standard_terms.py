@@ -246,12 +246,12 @@ class StandardTerms:
         return Refresh(first.added + second.added, first.removed + second.removed, len(wanted | after))
 
     def prepare(self, data: DataUpdate | None) -> PendingUpdate | None:
-        """Before an update runs (``data``: it, read by :meth:`DataUpdate.read`, None if it could not be):
-        what :meth:`updated` needs to follow it node by node, or None when it cannot and a whole
-        :meth:`refresh` must follow instead: the update is not only ground data operations read for
-        certain (:mod:`kb.update_delta`), it names an alignment, a standard namespace or graph:entailed
-        itself, the store is a remote one (which other clients write meanwhile), or graph:entailed is not
-        known to be exact yet."""
+        """Before an update runs: what :meth:`updated` needs to follow it node by node, or None when a whole
+        :meth:`refresh` must follow instead. ``data`` is the update as :meth:`DataUpdate.read` read it, None
+        when it is not only ground data operations read for certain (:mod:`kb.update_delta`); a whole
+        refresh follows too when it names an alignment, a standard namespace or graph:entailed itself,
+        on a remote store (which other clients write meanwhile), and while graph:entailed is not known
+        to be exact."""
         if data is None or not self._exact or not isinstance(self.store, EmbeddedStore):
             return None
         if any(q.predicate.value in _LINK_SET or q.graph_name == _GRAPH for q in data.named):

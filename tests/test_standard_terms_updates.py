@@ -322,3 +322,51 @@ def test_a_broken_requirement_written_by_a_data_update_is_refused(kb: KnowledgeB
     with pytest.raises(DescriptionShapeError):
         kb.update(text)
     assert kb.store.dump() == before
+
+
+READ_ALIKE = [
+    "insert data { <urn:a> a home:Sensor }",
+    "PREFIX home: <urn:other#> INSERT DATA { home:a home:b home:c } ; INSERT DATA { home:d home:e home:f }",
+    'INSERT DATA { <urn:a> <urn:b> "x}{ GRAPH"@en , 1.0 ; <urn:c> +1 , """long "} string""" , true }',
+    "INSERT DATA { # a comment with { and }\n <urn:a> <urn:b> <urn:c> . GRAPH graph:world { <urn:a> <urn:b> <urn:c> } ."
+    " <urn:d> <urn:e> <urn:f> . }",
+    "PREFIX : <urn:e#> DELETE DATA { GRAPH :g { :a :b :c } GRAPH <urn:g> { :a :b 'c' } } ; INSERT DATA { } ;",
+    'INSERT DATA { GRAPH <urn:g> { <urn:a> <urn:b> "1"^^xsd:integer , "x"^^<urn:t> } }',
+    "",
+]
+READ_OTHERWISE_OR_NOT_AT_ALL = [
+    "INSERT DATA { <a> <b> <c> }",  # relative IRIs
+    "BASE <urn:x/> INSERT DATA { <urn:a> <urn:b> <urn:c> }",
+    'INSERT DATA { <urn:a> <urn:b> "\\u0022" }',  # SPARQL unescapes before it tokenises
+    "INSERT DATA { <urn:a> <urn:b> ex:c\\.d }",  # an escape in a prefixed name
+    "INSERT DATA { <urn:a> <urn:b> [ <urn:c> <urn:d> ] }",
+    "INSERT DATA { <urn:a> <urn:b> ( <urn:c> ) }",
+    "INSERT DATA { _:a <urn:b> <urn:c> }",
+    "INSERT DATA { <urn:a> <urn:b> << <urn:c> <urn:d> <urn:e> >> }",
+    "INSERT DATA { GRAPH ?g { <urn:a> <urn:b> <urn:c> } }",
+    "INSERT DATA { GRAPH <urn:g> { GRAPH <urn:h> { <urn:a> <urn:b> <urn:c> } } }",
+    "INSERT DATA { <urn:a> <urn:b> <urn:c> } INSERT DATA { <urn:a> <urn:b> <urn:d> }",
+    "; INSERT DATA { <urn:a> <urn:b> <urn:c> }",
+    "INSERT { <urn:a> <urn:b> <urn:c> } WHERE { }",
+    "WITH <urn:g> INSERT DATA { <urn:a> <urn:b> <urn:c> }",
+    "CLEAR DEFAULT",
+    "INSERT DATA { <urn:a> <urn:b> <urn:c> ",
+]
+
+
+@pytest.mark.parametrize("text", READ_ALIKE)
+def test_a_data_update_is_read_as_sparql_reads_it(text: str) -> None:
+    operations = data_operations(text)
+    assert operations is not None
+    applied = ox.Store()
+    applied.update(text, prefixes=PREFIXES)
+    present: dict[ox.Quad, bool] = {}
+    for operation in operations:
+        present.update(dict.fromkeys(operation.quads, operation.insert))
+    left = [q for q, there in present.items() if there]  # the store writes numbers in canonical form
+    assert len(left) == len(applied) and all(q in applied for q in left)
+
+
+@pytest.mark.parametrize("text", READ_OTHERWISE_OR_NOT_AT_ALL)
+def test_what_sparql_might_read_otherwise_is_not_read(text: str) -> None:
+    assert data_operations(text) is None
