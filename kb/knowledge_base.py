@@ -21,7 +21,7 @@ from cbrs.kb.query_guard import QueryGuard
 from cbrs.kb.registry import ComponentRegistry
 from cbrs.kb.resources import bundled_files, query_dir
 from cbrs.kb.seed_cache import SeedCache, bundle_digest
-from cbrs.kb.shapes import checked_update
+from cbrs.kb.shapes import DescriptionShapeError, checked_update
 from cbrs.kb.standard_terms import PendingUpdate, Refresh, StandardTerms
 from cbrs.kb.store import EmbeddedStore, QueryResult, Store, Term, is_remote
 from cbrs.kb.update_delta import DataUpdate
@@ -206,6 +206,10 @@ class KnowledgeBase:
         try:
             with checking:
                 self.store.update(text)
+        except DescriptionShapeError:
+            if data is not None:
+                data.undo(self.store)  # its writes to the other graphs go too: all or nothing
+            raise
         finally:
             self._reader.clear_cache()
         self._entail(pending)

@@ -209,6 +209,15 @@ class DataUpdate:
         return added, removed
 
 
+    def undo(self, store: Store) -> None:
+        """Put every quad the text names back as it was before the update ran, in one transaction: a
+        refused update (kb/shapes.py puts back only the description graphs) leaves no other write behind."""
+        removing = [quad for quad, before in self._present.items() if not before and _holds(store, quad)]
+        adding = [quad for quad, before in self._present.items() if before and not _holds(store, quad)]
+        if removing or adding:
+            store.replace(removing, adding)
+
+
 def _expected(operations: tuple[DataOperation, ...], start: dict[ox.Quad, bool]) -> dict[ox.Quad, bool]:
     """Which named quads ``operations`` leave present, from ``start``."""
     present = dict(start)

@@ -286,6 +286,24 @@ def test_an_update_the_shape_check_refuses_leaves_everything_as_it_was(kb: Knowl
     assert held(kb) == entailed(kb.store)
 
 
+def test_a_refused_data_update_takes_back_its_writes_to_other_graphs_too(kb: KnowledgeBase) -> None:
+    """The shape check puts back the description graphs; the update's other quads (an observation in
+    another graph, a deleted one) must not outlive its refusal either."""
+    typed = next(kb.store.quads(None, ox.NamedNode(CBRS + "parameterType"), None, GraphName.REQUIREMENTS.node))
+    kb.update(f"INSERT DATA {{ GRAPH <{TEST}g1> {{ <{TEST}s1> a home:Sensor . <{TEST}s1> rdfs:label 'old' }} }}")
+    before, held_before = kb.store.dump(), held(kb)
+    text = (
+        f"DELETE DATA {{ GRAPH <{TEST}g1> {{ <{TEST}s1> rdfs:label 'old' }} }} ;\n"
+        f"INSERT DATA {{ GRAPH <{TEST}g2> {{ <{TEST}s2> a home:Sensor }} }} ;\n"
+        f'INSERT DATA {{ GRAPH {GraphName.REQUIREMENTS.node} {{ {typed.subject} {typed.predicate} "not a class" }} }}'
+    )
+    assert data_operations(text) is not None
+    with pytest.raises(DescriptionShapeError):
+        kb.update(text)
+    assert kb.store.dump() == before
+    assert held(kb) == held_before == entailed(kb.store)
+
+
 def test_a_syntax_error_raises_the_stores_error(kb: KnowledgeBase) -> None:
     with pytest.raises(QuerySyntaxError):
         kb.update(f"INSERT DATA {{ <{TEST}s0> a }}")
