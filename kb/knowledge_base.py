@@ -21,7 +21,7 @@ from cbrs.kb.query_guard import QueryGuard
 from cbrs.kb.registry import ComponentRegistry
 from cbrs.kb.resources import bundled_files, query_dir
 from cbrs.kb.seed_cache import SeedCache, bundle_digest
-from cbrs.kb.shapes import DescriptionShapeError, checked_update
+from cbrs.kb.shapes import CHECKED_GRAPHS, DescriptionShapeError, checked_update
 from cbrs.kb.standard_terms import PendingUpdate, Refresh, StandardTerms
 from cbrs.kb.store import EmbeddedStore, QueryResult, Store, Term, is_remote
 from cbrs.kb.update_delta import DataUpdate
@@ -32,7 +32,6 @@ _VERSION_INFO = ox.NamedNode("http://www.w3.org/2002/07/owl#versionInfo")
 # The graphs whose descriptions kb.shapes.checked_update checks (tests/test_standard_terms_updates.py pins
 # it): a data update naming no quad in them leaves them as they are, so it skips the check, which reads
 # both graphs whole twice (1.5 s a write on a store of OWLS-TC's services).
-_CHECKED_GRAPHS = (GraphName.SERVICES.node, GraphName.REQUIREMENTS.node)
 
 
 class KnowledgeBase:
@@ -201,7 +200,7 @@ class KnowledgeBase:
         data = DataUpdate.read(text, self.store) if isinstance(self.store, EmbeddedStore) else None
         pending = self.standard_terms.prepare(data)
         checking: AbstractContextManager[None] = nullcontext()
-        if data is None or data.names_graph(_CHECKED_GRAPHS):
+        if data is None or data.names_graph(CHECKED_GRAPHS):
             checking = checked_update(self.store)  # a description the update breaks is put back (kb/shapes.py)
         try:
             with checking:

@@ -141,11 +141,15 @@ def _check_with_context(store: Store, quads: list[ox.Quad], context: list[ox.Qua
         raise DescriptionShapeError(problems)
 
 
+CHECKED_GRAPHS = (GraphName.SERVICES.node, GraphName.REQUIREMENTS.node)
+"""The graphs :func:`checked_update` reads: an update that writes none of them needs no check."""
+
+
 @contextmanager
 def checked_update(store: Store) -> Iterator[None]:
     """Run the enclosed update, then check the descriptions it changed in the services and requirements
     graphs; when one is broken, undo the update's changes to those graphs and raise."""
-    graphs = (GraphName.SERVICES.node, GraphName.REQUIREMENTS.node)
+    graphs = CHECKED_GRAPHS
     before = {q for graph in graphs for q in store.quads(graph=graph)}
     yield
     after = {q for graph in graphs for q in store.quads(graph=graph)}

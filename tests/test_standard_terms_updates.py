@@ -14,9 +14,8 @@ from hypothesis import strategies as st
 
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import KnowledgeBaseError, QuerySyntaxError
-from cbrs.kb.knowledge_base import _CHECKED_GRAPHS
 from cbrs.kb.namespaces import PREFIXES, GraphName
-from cbrs.kb.shapes import DescriptionShapeError, checked_update
+from cbrs.kb.shapes import CHECKED_GRAPHS, DescriptionShapeError, checked_update
 from cbrs.kb.standard_terms import StandardTerms, entailed
 from cbrs.kb.update_delta import data_operations
 
@@ -313,7 +312,7 @@ def test_a_data_update_skips_the_shape_check_only_outside_the_graphs_it_checks(
     kb: KnowledgeBase, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     """KnowledgeBase.update leaves out kb.shapes.checked_update for a data update naming no quad in the
-    graphs it checks (_CHECKED_GRAPHS): the graphs it reads must be exactly those."""
+    graphs it checks (CHECKED_GRAPHS): the graphs it reads must be exactly those."""
     read: set[object] = set()
     quads = kb.store.quads
 
@@ -324,7 +323,7 @@ def test_a_data_update_skips_the_shape_check_only_outside_the_graphs_it_checks(
     monkeypatch.setattr(kb.store, "quads", spied)
     with checked_update(kb.store):
         kb.store.update(f"INSERT DATA {{ GRAPH <{SERVICES}> {{ <{TEST}s0> rdfs:label 'x' }} }}")
-    assert read == set(_CHECKED_GRAPHS)
+    assert read == set(CHECKED_GRAPHS)
 
 
 def test_a_broken_requirement_written_by_a_data_update_is_refused(kb: KnowledgeBase) -> None:
