@@ -25,7 +25,7 @@ import pyoxigraph as ox
 from cbrs.kb import KnowledgeBase, Store
 from cbrs.kb.namespaces import GraphName
 from cbrs.kb.registry import ComponentRegistry
-from cbrs.kb.standard_terms import StandardTerms
+from cbrs.kb.standard_terms import PendingUpdate, StandardTerms
 
 DEFAULT_OWLS_TC = Path(__file__).resolve().parents[2] / "shared" / "owls-tc4"
 CAMERA = "https://w3id.org/cbrs/service#BenchCamera"
@@ -82,7 +82,7 @@ def measure(kb: KnowledgeBase, repeat: int) -> dict[str, float]:
 class _NoEntailment(KnowledgeBase):
     """A KnowledgeBase whose writes leave graph:entailed alone: the seed's work without the refresh."""
 
-    def _entail(self) -> None:
+    def _entail(self, update: PendingUpdate | None = None) -> None:
         pass
 
 
