@@ -15,7 +15,6 @@ import json
 import os
 import platform
 import statistics
-import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
@@ -43,7 +42,7 @@ REGISTRATION = f"""@prefix cbrs: <https://w3id.org/cbrs/core#> . @prefix home: <
 class _NoTerms(StandardTerms):
     """A StandardTerms that does nothing: the registry's work without the incremental update."""
 
-    def begin(self) -> frozenset[ox.Triple]:
+    def begin(self) -> frozenset[ox.Quad]:
         return frozenset()
 
     def changed(self, before: object, removed: object, added: object) -> object:  # type: ignore[override]
@@ -131,4 +130,4 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    main()
