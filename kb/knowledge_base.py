@@ -21,7 +21,7 @@ from cbrs.kb.query_guard import QueryGuard
 from cbrs.kb.registry import ComponentRegistry
 from cbrs.kb.resources import bundled_files, query_dir
 from cbrs.kb.seed_cache import SeedCache, bundle_digest
-from cbrs.kb.shapes import CHECKED_GRAPHS, DescriptionShapeError, checked_update
+from cbrs.kb.shapes import CHECKED_GRAPHS, DescriptionShapeError, checked_update, may_write_descriptions
 from cbrs.kb.standard_terms import PendingUpdate, Refresh, StandardTerms
 from cbrs.kb.store import EmbeddedStore, QueryResult, Store, Term, is_remote
 from cbrs.kb.update_delta import DataUpdate
@@ -200,8 +200,11 @@ class KnowledgeBase:
         data = DataUpdate.read(text, self.store) if isinstance(self.store, EmbeddedStore) else None
         pending = self.standard_terms.prepare(data)
         checking: AbstractContextManager[None] = nullcontext()
-        if data is None or data.names_graph(CHECKED_GRAPHS):
-            checking = checked_update(self.store)  # a description the update breaks is put back (kb/shapes.py)
+        if data is None:  # what else it writes is unknown: keep the whole store if it might be refused
+            whole = isinstance(self.store, EmbeddedStore) and may_write_descriptions(text)
+            checking = checked_update(self.store, whole)  # a description it breaks is put back (kb/shapes.py)
+        elif data.names_graph(CHECKED_GRAPHS):
+            checking = checked_update(self.store)
         try:
             with checking:
                 self.store.update(text)

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import difflib
 import functools
+import re
 from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
@@ -146,11 +147,14 @@ CHECKED_GRAPHS = (GraphName.SERVICES.node, GraphName.REQUIREMENTS.node)
 
 
 @contextmanager
-def checked_update(store: Store) -> Iterator[None]:
+def checked_update(store: Store, whole: bool = False) -> Iterator[None]:
     """Run the enclosed update, then check the descriptions it changed in the services and requirements
-    graphs; when one is broken, undo the update's changes to those graphs and raise."""
+    graphs; when one is broken, undo the update's changes to those graphs and raise. With ``whole``, the
+    whole store is kept beforehand and a refused update is undone everywhere (the caller cannot know what
+    else it wrote: :func:`may_write_descriptions`)."""
     graphs = CHECKED_GRAPHS
     before = {q for graph in graphs for q in store.quads(graph=graph)}
+    everything = set(store.quads()) if whole else None
     yield
     after = {q for graph in graphs for q in store.quads(graph=graph)}
     added, removed = after - before, before - after
@@ -161,8 +165,25 @@ def checked_update(store: Store) -> Iterator[None]:
     touched = {root: quads for root, quads in closures.items() if changed & {q.subject for q in quads}}
     problems = _shape_problems(touched) + _term_problems(store, touched, [])
     if problems:
+        if everything is not None:
+            now = set(store.quads())
+            added, removed = now - everything, everything - now
         _undo(store, added, removed)
         raise DescriptionShapeError(problems)
+
+
+_MAY_REACH = re.compile(
+    r"services|requirements|prefix|base|\\u|GRAPH(?:\s|#[^\n]*\n)*[?$]|\b(?:ALL|NAMED)\b", re.IGNORECASE
+)
+
+
+def may_write_descriptions(text: str) -> bool:
+    """Whether the SPARQL update ``text`` might write graph:services or graph:requirements: it names one of
+    them (or a word of theirs), declares a prefix or a base that could spell them, has an escape, a
+    variable graph or CLEAR/DROP ALL/NAMED. Deliberately loose: it only decides whether
+    :func:`checked_update` keeps the whole store to undo a refused update everywhere; the check itself
+    runs for every update that is not data outside those graphs."""
+    return _MAY_REACH.search(text) is not None
 
 
 def _undo(store: Store, added: set[ox.Quad], removed: set[ox.Quad]) -> None:

@@ -15,7 +15,7 @@ from hypothesis import strategies as st
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import KnowledgeBaseError, QuerySyntaxError
 from cbrs.kb.namespaces import PREFIXES, GraphName
-from cbrs.kb.shapes import CHECKED_GRAPHS, DescriptionShapeError, checked_update
+from cbrs.kb.shapes import CHECKED_GRAPHS, DescriptionShapeError, checked_update, may_write_descriptions
 from cbrs.kb.standard_terms import StandardTerms, entailed
 from cbrs.kb.update_delta import data_operations
 
@@ -301,6 +301,43 @@ def test_a_refused_data_update_takes_back_its_writes_to_other_graphs_too(kb: Kno
         kb.update(text)
     assert kb.store.dump() == before
     assert held(kb) == held_before == entailed(kb.store)
+
+
+def test_a_refused_update_with_a_where_clause_takes_back_its_writes_to_other_graphs_too(kb: KnowledgeBase) -> None:
+    """Not a data update, so what it wrote is unknown beforehand: the whole store is kept and put back."""
+    kb.update(f"INSERT DATA {{ GRAPH <{TEST}g1> {{ <{TEST}s1> a home:Sensor . <{TEST}s1> rdfs:label 'old' }} }}")
+    before, held_before = kb.store.dump(), held(kb)
+    text = (
+        f"DELETE {{ GRAPH <{TEST}g1> {{ ?s rdfs:label ?l }} }}\n"
+        f"INSERT {{ GRAPH <{TEST}g2> {{ ?s a home:Sensor }}\n"
+        f'         GRAPH <{GraphName.REQUIREMENTS.iri}> {{ ?typed cbrs:parameterType "not a class" }} }}\n'
+        f"WHERE {{ GRAPH <{TEST}g1> {{ ?s rdfs:label ?l }}\n"
+        f"        GRAPH <{GraphName.REQUIREMENTS.iri}> {{ ?typed cbrs:parameterType ?class }} }}"
+    )
+    assert data_operations(text) is None and may_write_descriptions(text)
+    with pytest.raises(DescriptionShapeError):
+        kb.update(text)
+    assert kb.store.dump() == before
+    assert held(kb) == held_before == entailed(kb.store)
+
+
+@pytest.mark.parametrize(
+    ("text", "may"),
+    [
+        ("INSERT { GRAPH <https://w3id.org/cbrs/graph/services> { <urn:a> <urn:b> 1 } } WHERE {}", True),
+        ("INSERT { GRAPH graph:requirements { <urn:a> <urn:b> 1 } } WHERE {}", True),
+        ("PREFIX g: <https://w3id.org/cbrs/graph/serv> INSERT { GRAPH g:ices { <urn:a> <urn:b> 1 } } WHERE {}", True),
+        ("INSERT { GRAPH ?g { <urn:a> <urn:b> 1 } } WHERE { GRAPH ?g { ?s ?p ?o } }", True),
+        ("INSERT { GRAPH # a comment\n $g { <urn:a> <urn:b> 1 } } WHERE { GRAPH ?g { ?s ?p ?o } }", True),
+        ("INSERT { GRAPH <https://w3id.org/cbrs/graph/\\u0073ervices> { <urn:a> <urn:b> 1 } } WHERE {}", True),
+        ("DROP ALL", True),
+        ("CLEAR NAMED", True),
+        ("DELETE { GRAPH <urn:g> { ?s <urn:p> ?o } } WHERE { GRAPH <urn:g> { ?s <urn:p> ?o } }", False),
+        ("CLEAR GRAPH <urn:g>", False),
+    ],
+)
+def test_an_update_that_might_write_a_description_graph_is_recognised(text: str, may: bool) -> None:
+    assert may_write_descriptions(text) is may
 
 
 def test_a_syntax_error_raises_the_stores_error(kb: KnowledgeBase) -> None:
