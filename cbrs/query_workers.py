@@ -142,8 +142,12 @@ class QueryProcesses:
 
     def run(self, request: Request) -> tuple[bytes, str]:
         """Evaluate ``request`` in a worker; (body, media type), or an error the endpoint reports."""
-        snapshot = self._fresh()
-        worker = self._take()
+        snapshot = self._fresh()  # reserved for this request: no later write's snapshot deletes it
+        try:
+            worker = self._take()
+        except BaseException:
+            self._unreserve(snapshot)
+            raise
         deadline = time.monotonic() + request.timeout
         try:
             self._hold(worker, snapshot)
@@ -184,25 +188,37 @@ class QueryProcesses:
     # -- snapshots -------------------------------------------------------------------------------------
 
     def _fresh(self) -> _Snapshot:
+        """The snapshot of the store as it is now, reserved (counted as read) for the caller, who hands the
+        reservation to a worker (:meth:`_hold`) or gives it up (:meth:`_unreserve`). Reserved here, under the
+        lock that makes snapshots, so a write's next snapshot cannot delete it while the caller starts a
+        worker (tens of milliseconds), which it did when writes came faster than that."""
         with self._snapshot_lock:
             generation = self.store.generation
             current = self._current
-            if current is not None and current.generation == generation:
-                return current
-            self._count += 1
-            path = self._root / f"snapshot-{self._count}"
-            self.store.snapshot(path)
-            self._current = _Snapshot(path, generation)
+            fresh = current
+            if fresh is None or fresh.generation != generation:
+                self._count += 1
+                path = self._root / f"snapshot-{self._count}"
+                self.store.snapshot(path)
+                fresh = self._current = _Snapshot(path, generation)
             with self._lock:
-                if current is not None and current.readers == 0:
+                fresh.readers += 1
+                if current is not None and current is not fresh and current.readers == 0:
                     shutil.rmtree(current.path, ignore_errors=True)
-            return self._current
+            return fresh
+
+    def _unreserve(self, snapshot: _Snapshot) -> None:
+        """Give up a reservation :meth:`_fresh` made that no worker took."""
+        with self._lock:
+            snapshot.readers -= 1
+            if snapshot.readers == 0 and snapshot is not self._current:
+                shutil.rmtree(snapshot.path, ignore_errors=True)
 
     def _hold(self, worker: _Process, snapshot: _Snapshot) -> None:
+        """``worker`` now reads ``snapshot``, taking over the reservation :meth:`_fresh` made for it."""
         with self._lock:
             self._release(worker)
             worker.snapshot = snapshot
-            snapshot.readers += 1
 
     def _release(self, worker: _Process) -> None:
         """Called with ``_lock`` held: ``worker`` no longer reads its snapshot."""
