@@ -153,8 +153,11 @@ def checked_update(store: Store, whole: bool = False) -> Iterator[None]:
     whole store is kept beforehand and a refused update is undone everywhere (the caller cannot know what
     else it wrote: :func:`may_write_descriptions`)."""
     graphs = CHECKED_GRAPHS
-    before = {q for graph in graphs for q in store.quads(graph=graph)}
     everything = set(store.quads()) if whole else None
+    if everything is not None:  # the two graphs are in it: no second read
+        before = {q for q in everything if q.graph_name in graphs}
+    else:
+        before = {q for graph in graphs for q in store.quads(graph=graph)}
     yield
     after = {q for graph in graphs for q in store.quads(graph=graph)}
     added, removed = after - before, before - after
@@ -173,7 +176,9 @@ def checked_update(store: Store, whole: bool = False) -> Iterator[None]:
 
 
 _MAY_REACH = re.compile(
-    r"services|requirements|prefix|base|\\u|GRAPH(?:\s|#[^\n]*\n)*[?$]|\b(?:ALL|NAMED)\b", re.IGNORECASE
+    "|".join(re.escape(graph.value.rsplit("/", 1)[-1]) for graph in CHECKED_GRAPHS)  # their names' last words
+    + r"|prefix|base|\\u|GRAPH(?:\s|#[^\n]*\n)*[?$]|\b(?:ALL|NAMED)\b",
+    re.IGNORECASE,
 )
 
 
