@@ -43,6 +43,7 @@ VARIANTS: dict[str, MatchConfig] = {
     "observed state by any is-a relative (observed_state_kind off)": replace(BASE, observed_state_kind=False),
     "equal scores by IRI only (tie_break_result off)": replace(BASE, tie_break_result=False),
     "no decomposition steps (decomposition_weight 0)": replace(BASE, decomposition_weight=0.0),
+    "only producers are steps (consumer_steps off)": replace(BASE, consumer_steps=False),
     "no cross-branch links": replace(BASE, cross_branch_weight=0.0),
     "unknown concepts by their names alone (unknown_under_root off)": replace(BASE, unknown_under_root=False),
     "preconditions averaged (precondition_conjunction off)": replace(BASE, precondition_conjunction=False),

@@ -405,8 +405,9 @@ class BatchScorer:
 
     def steps(self, requirement: Requirement, own: FloatArray) -> FloatArray:
         """Per advertisement, the best decomposition_weight x an achiever's effects part (``own``) x the
-        delivered floor of its output as an input the achiever needs and the requester does not provide
-        (reasoner/steps.py); 0 where it feeds no achiever."""
+        delivered floor of its output as an input the achiever needs and the requester does not provide,
+        or x 1 where it takes that input and works towards the goal (consumer_steps; reasoner/steps.py);
+        0 where it is no step."""
         pool, cfg = self.pool, self.config
         found = np.zeros(len(pool.ads), dtype=np.float64)
         achieving = pool.effects.present & (own >= cfg.pair_threshold)
@@ -422,12 +423,21 @@ class BatchScorer:
         given = np.zeros(len(pool.root_ids), dtype=bool)  # pool trees the requester provides as they are
         for provided in requirement.inputs:
             given |= self.plugin(provided.type) > 0
+        after = np.ones(len(pool.ads), dtype=bool)  # consumers that need what the requester asks to get
+        if cfg.consumer_steps:
+            takes_result = np.zeros(len(pool.root_ids), dtype=bool)
+            for wanted_output in requirement.outputs:
+                takes_result |= self.plugin(wanted_output.type) > 0
+            after = pool.inputs.max(takes_result.astype(np.float64)) > 0
         for a in np.flatnonzero(achieving):
             start, count = pool.inputs.starts[a], pool.inputs.counts[a]
             for tree in dict.fromkeys(pool.inputs.flat[start : start + count].tolist()):
                 if given[tree]:
                     continue
-                feed = pool.outputs.max(self._floor_below(pool.tree_concepts[tree])[pool.root_ids])
+                concept = pool.tree_concepts[tree]
+                feed = pool.outputs.max(self._floor_below(concept)[pool.root_ids])
+                if cfg.consumer_steps:  # steps.works_towards
+                    feed = np.maximum(feed, np.where(after, 0.0, pool.inputs.max(self.plugin(concept))))
                 np.maximum(found, cfg.decomposition_weight * own[a] * feed, out=found)
         return found
 

@@ -80,6 +80,13 @@ class MatchConfig:
     # provide (the grasp planner's GraspPose, for a pick-up service that achieves (Cup, isHeldBy, Robot)).
     # Its effects part is at least this weight times the achiever's effects part. 0 turns it off.
     decomposition_weight: float = 0.5
+    # A step may also take what the achiever lacks: an advertisement that changes nothing, accepts such an
+    # input as it is (the input's concept or an is-a superclass of it: the path planner's NavigationGoal, for
+    # navigate_to_goal) and needs nothing the requester asks to get works on the achiever's goal before it
+    # is reached (plans the path, the arm's trajectory), with a producer's share. One that needs a requested
+    # output comes after the request, not before (the price of the book being ordered). False: only
+    # producers are steps.
+    consumer_steps: bool = True
     # How the parts of a match combine; parts the requirement does not state are left out and the
     # remaining weights renormalised.
     output_weight: float = 0.4
@@ -156,6 +163,7 @@ class MatchConfig:
             unrelated_predicate_factor=1.0,
             observed_state_weight=0.0,
             decomposition_weight=0.0,
+            consumer_steps=False,
             unknown_under_root=False,
             precondition_conjunction=False,
         )

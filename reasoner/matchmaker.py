@@ -43,7 +43,7 @@ from cbrs.reasoner.names import local_name
 from cbrs.reasoner.similarity import SemStr, Similarity
 from cbrs.reasoner.spans import PairMatch, SpanMatch, conceptual_span_similarity, span
 from cbrs.reasoner.statements import StatementMatch, best_statement_matches, contradiction_factor, reported, undoes
-from cbrs.reasoner.steps import Achiever, achievers, at_or_above, feeds
+from cbrs.reasoner.steps import Achiever, achievers, at_or_above, feeds, works_towards
 from cbrs.reasoner.taxonomy import TaxonomyIndex
 from cbrs.reasoner.text import description_text
 
@@ -519,8 +519,9 @@ class Matchmaker:
 
     def _step(self, requirement: Requirement, ad: Advertisement, pairs: list[EntityPair]) -> float:
         """An advertisement that changes nothing but outputs an input an achiever of the requested effects
-        needs and the requester lacks (reasoner/steps.py): decomposition_weight x the achiever's effects
-        part x the output's delivered floor, with its pair when it is above 0."""
+        needs and the requester lacks, or takes it towards the same goal (reasoner/steps.py):
+        decomposition_weight x the achiever's effects part x the output's delivered floor (1 for a taker),
+        with its pair when it is above 0."""
         cfg = self.config
         found = self._achievers_of
         if found is None or found[0] is not requirement or found[1] is not self.advertisements:
@@ -528,20 +529,23 @@ class Matchmaker:
             found = self._achievers_of = (requirement, self.advertisements, listed)
         best, why, output = 0.0, "", ""
         for achiever in found[2]:
+            needs = f"{_short(achiever.advertisement.iri)} needs to achieve it ({achiever.value:.2f})"
             for needed in achiever.missing:
-                for out in ad.outputs:
-                    value = (
-                        cfg.decomposition_weight
-                        * achiever.value
-                        * feeds(self.index, out.type, needed, cfg.specialisation_step)
+                offers = [
+                    (
+                        feeds(self.index, out.type, needed, cfg.specialisation_step),
+                        out.type,
+                        f"output {_short(out.type)} is the {_short(needed)} that {needs}",
                     )
+                    for out in ad.outputs
+                ]
+                if cfg.consumer_steps and works_towards(self.index, requirement, ad, needed):
+                    offers.append((1.0, needed, f"takes the {_short(needed)} that {needs}, towards the same goal"))
+                for feed, concept, what in offers:
+                    value = cfg.decomposition_weight * achiever.value * feed
                     if value > best:
-                        best, output = value, out.type
-                        why = (
-                            f"no effect; output {_short(out.type)} is the {_short(needed)} that"
-                            f" {_short(achiever.advertisement.iri)} needs to achieve it ({achiever.value:.2f})"
-                            f" x {cfg.decomposition_weight:g}"
-                        )
+                        best, output = value, concept
+                        why = f"no effect; {what} x {cfg.decomposition_weight:g}"
         if best > 0:
             text = ", ".join(
                 f"({_short(e.subject)}, {_short(e.predicate)}, {_short(e.object)})" for e in requirement.effects

@@ -9,6 +9,10 @@ GraspPose of a pick-up service, for a requester that only knows where the cup is
 that changes nothing but outputs that input (or a subclass of it) is a step of the decomposition, the
 grasp planner. Its effects part is at least MatchConfig.decomposition_weight times the achiever's
 effects part, times the delivered floor of its output (1 - specialisation_step per is-a link below).
+With MatchConfig.consumer_steps, an advertisement that changes nothing but takes such an input as it is
+(that concept or an is-a superclass of it) is a step too, with a producer's share: the path planner that
+takes the NavigationGoal a drive service needs works on the same goal before it is reached. One that
+needs what the requester asks to get is not: it comes after the request (the price of the ordered book).
 
 Both scoring paths use these rules: reasoner/batch.py over the whole pool, ``Matchmaker.score`` one
 advertisement at a time through ``achievers`` and ``feeds``.
@@ -115,3 +119,12 @@ def feeds(index: TaxonomyIndex, output: str, needed: str, step: float) -> float:
         return 0.0
     links = index.is_a_ancestors(output).get(index.canonical(needed))
     return 0.0 if links is None else max(0.0, 1.0 - step * links)
+
+
+def works_towards(index: TaxonomyIndex, requirement: Requirement, ad: Advertisement, needed: str) -> bool:
+    """Does ``ad`` take ``needed`` as it is (an input that is the concept or an is-a superclass of it)
+    without needing anything the requester asks to get (no input that would take a requested output)?"""
+    takes = any(at_or_above(index, needed, given.type) for given in ad.inputs)
+    return takes and not any(
+        at_or_above(index, wanted.type, given.type) for wanted in requirement.outputs for given in ad.inputs
+    )

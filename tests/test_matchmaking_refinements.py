@@ -463,6 +463,74 @@ def test_an_offer_that_prepares_what_an_achiever_lacks_is_a_step_towards_the_eff
     assert Matchmaker(kb, "wu-palmer", index=_manipulation(), advertisements=ads).config.decomposition_weight == 0
 
 
+def test_an_offer_that_takes_what_an_achiever_lacks_works_towards_the_same_goal() -> None:
+    # Hold the cup, knowing where it is. PickObject needs a GraspPose the requester lacks; a planner that
+    # takes one (or any Pose: it accepts a GraspPose as it is) works on the pick before it happens, a
+    # consumer of something narrower (a TopGraspPose) cannot take every GraspPose, and one that also needs
+    # what the requester asks to get comes after the request.
+    wanted = Requirement(
+        E + "GraspCup",
+        (),
+        inputs=(_p("input", "ObjectLocation"),),
+        outputs=(_p("output", "PersonLocation"),),
+        effects=_held("Cup", "Robot"),
+    )
+    achiever = Advertisement(
+        E + "PickObject", (), inputs=(_p("input", "GraspPose"),), effects=_held("PhysicalObject", "Robot")
+    )
+    trajectory = Advertisement(
+        E + "TrajectoryPlanner", (), inputs=(_p("input", "GraspPose"),), outputs=(_p("output", "Location"),)
+    )
+    any_pose = Advertisement(E + "PoseChecker", (), inputs=(_p("input", "Pose"),), outputs=(_p("output", "Location"),))
+    narrower = Advertisement(
+        E + "TopOnly", (), inputs=(_p("input", "TopGraspPose"),), outputs=(_p("output", "Location"),)
+    )
+    afterwards = Advertisement(
+        E + "PoseAfter",
+        (),
+        inputs=(_p("input", "GraspPose"), _p("input", "Location")),
+        outputs=(_p("output", "Location"),),
+    )
+    ads = [achiever, trajectory, any_pose, narrower, afterwards]
+    kb = KnowledgeBase(Store.open(":memory:"))
+    matcher = Matchmaker(kb, index=_manipulation(), advertisements=ads)
+    ranked = {c.advertisement.removeprefix(E): c for c in matcher.rank(wanted, explain=0).candidates}
+    for ad in ads:  # the batch agrees with the scalar path
+        assert ranked[ad.iri.removeprefix(E)].score == matcher.score(wanted, ad).score
+    pick = ranked["PickObject"].parts["effects"]
+    share = MatchConfig().decomposition_weight * pick
+    assert pick >= MatchConfig().pair_threshold
+    assert ranked["TrajectoryPlanner"].parts["effects"] == pytest.approx(share)  # a producer's share
+    assert ranked["PoseChecker"].parts["effects"] == pytest.approx(share)
+    assert ranked["TopOnly"].parts["effects"] == 0.0
+    assert ranked["PoseAfter"].parts["effects"] == 0.0
+    explained = matcher.score(wanted, trajectory)
+    steps = [pair for pair in explained.pairs if "takes the GraspPose that PickObject needs" in pair.how]
+    assert steps and {pair.shown_degree() for pair in steps} == {"Step"}
+    off = Matchmaker(kb, config=MatchConfig(consumer_steps=False), index=_manipulation(), advertisements=ads)
+    assert off.score(wanted, trajectory).parts["effects"] == 0.0
+    assert off.score(wanted, trajectory).score < explained.score
+    assert MatchConfig().published().consumer_steps is False
+
+
+def test_the_planners_that_take_an_achievers_goal_rank_as_steps_on_the_robot_collection() -> None:
+    loaded = load_collection(ROBOT)
+
+    def place(query: str, config: MatchConfig, name: str) -> int:
+        wanted = loaded.requirements[query][0]
+        ranked = Matchmaker(loaded.kb, config=config).rank(wanted, explain=0).candidates
+        return [c.advertisement.rsplit("#", 1)[-1] for c in ranked].index(name)
+
+    on, off = MatchConfig(), MatchConfig(consumer_steps=False)
+    # grade 1 (a step: plans the path; plans the arm's motion) against grade 0 services below them
+    for query, planner, other in (
+        ("go_to_kitchen.owls", "PATH_PLANNER_SERVICE", "AIR_QUALITY_MONITOR_SERVICE"),
+        ("grasp_cup.owls", "ARM_TRAJECTORY_PLANNER_SERVICE", "PLACE_OBJECT_SERVICE"),
+    ):
+        assert place(query, on, planner) < place(query, on, other)
+        assert place(query, off, planner) > place(query, off, other)
+
+
 def test_the_grasp_planner_ranks_as_a_step_on_the_robot_collection() -> None:
     loaded = load_collection(ROBOT)
     wanted = loaded.requirements["grasp_cup.owls"][0]
