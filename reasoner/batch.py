@@ -429,15 +429,19 @@ class BatchScorer:
             for wanted_output in requirement.outputs:
                 takes_result |= self.plugin(wanted_output.type) > 0
             after = pool.inputs.max(takes_result.astype(np.float64)) > 0
+        feeds: dict[int, FloatArray] = {}  # per missing input tree: how well each advertisement is a step
         for a in np.flatnonzero(achieving):
             start, count = pool.inputs.starts[a], pool.inputs.counts[a]
             for tree in dict.fromkeys(pool.inputs.flat[start : start + count].tolist()):
                 if given[tree]:
                     continue
-                concept = pool.tree_concepts[tree]
-                feed = pool.outputs.max(self._floor_below(concept)[pool.root_ids])
-                if cfg.consumer_steps:  # steps.works_towards
-                    feed = np.maximum(feed, np.where(after, 0.0, pool.inputs.max(self.plugin(concept))))
+                feed = feeds.get(tree)
+                if feed is None:
+                    concept = pool.tree_concepts[tree]
+                    feed = pool.outputs.max(self._floor_below(concept)[pool.root_ids])
+                    if cfg.consumer_steps:  # steps.works_towards
+                        feed = np.maximum(feed, np.where(after, 0.0, pool.inputs.max(self.plugin(concept))))
+                    feeds[tree] = feed
                 np.maximum(found, cfg.decomposition_weight * own[a] * feed, out=found)
         return found
 
