@@ -14,6 +14,33 @@ from cbrs.output import table
 from cbrs.reasoner.config import MatchConfig
 from cbrs.reasoner.matchmaker import Candidate, Matchmaker, MatchResult, MatchStatus
 from cbrs.reasoner.methods import METHODS
+from cbrs.settings import setting
+
+
+def match_config(params: tuple[str, ...], base: MatchConfig | None = None) -> MatchConfig:
+    """``base`` (MatchConfig's defaults) with the ``--param`` options, else the match_params setting."""
+    return (base or MatchConfig()).with_params(setting("match_params").resolve(params or None))
+
+
+def _list_params(ctx: click.Context, _: click.Parameter, value: bool) -> None:
+    """``--params``: every matchmaking parameter with its default, then exit."""
+    if not value or ctx.resilient_parsing:
+        return
+    defaults = MatchConfig()
+    rows = [[name, repr(getattr(defaults, name))] for name in MatchConfig.parameter_names()]
+    click.echo(table(["parameter", "default"], rows))
+    click.echo("(docs/matchmaking.md section 9.1 says what each does; set them with --param NAME=VALUE)")
+    ctx.exit()
+
+
+_PARAM = click.option(
+    "--param",
+    "params",
+    multiple=True,
+    metavar="NAME=VALUE",
+    help="Set a matchmaking parameter (repeatable; --params lists them), instead of the match_params "
+    f"setting [env {setting('match_params').env}].",
+)
 
 
 @click.command()
@@ -22,20 +49,40 @@ from cbrs.reasoner.methods import METHODS
 @click.option("--method", type=click.Choice(METHODS), default="sem-str", show_default=True, help="Matching method.")
 @click.option("--explain", is_flag=True, help="Show, for each shown candidate, the entity pairs and what it lacks.")
 @click.option("--json", "as_json", is_flag=True, help="Print the ranking (with explanations) as JSON.")
+@_PARAM
+@click.option(
+    "--params",
+    "list_params",
+    is_flag=True,
+    expose_value=False,
+    is_eager=True,
+    callback=_list_params,
+    help="List the matchmaking parameters and their defaults, then exit.",
+)
 @pass_app
-def match(app: App, requirement: str, top: int, method: str, explain: bool, as_json: bool) -> None:
+def match(
+    app: App, requirement: str, top: int, method: str, explain: bool, as_json: bool, params: tuple[str, ...]
+) -> None:
     """Rank the advertisements against REQUIREMENT (an IRI or prefix:name, e.g. req:RobotSelfPosition)."""
+    config = match_config(params)
     iri = parse_iri(requirement, "REQUIREMENT")
     if as_json:
-        result = Matchmaker(app.kb, method).rank(iri, explain=top)
+        result = Matchmaker(app.kb, method, config).rank(iri, explain=top)
         click.echo(json.dumps(result.to_dict(top), indent=2))
         return
-    click.echo(ranking_text(app.kb, iri, top, top if explain else 0, method))
+    click.echo(ranking_text(app.kb, iri, top, top if explain else 0, method, config))
 
 
-def ranking_text(kb: KnowledgeBase, requirement: str, top: int, explain: int, method: str = "sem-str") -> str:
+def ranking_text(
+    kb: KnowledgeBase,
+    requirement: str,
+    top: int,
+    explain: int,
+    method: str = "sem-str",
+    config: MatchConfig | None = None,
+) -> str:
     """The ranking table for ``requirement`` and the explanations of its first ``explain`` candidates."""
-    result = Matchmaker(kb, method).rank(requirement, explain=top)
+    result = Matchmaker(kb, method, config).rank(requirement, explain=top)
     parts = [_ranking(result, top)]
     for position, candidate in enumerate(result.candidates[:explain], start=1):
         parts.append("\n" + _explanation(position, candidate))
@@ -91,11 +138,12 @@ def eval_group() -> None:
 @click.option("--method", "methods", multiple=True, type=click.Choice(METHODS), help="Only these methods (repeatable).")
 @click.option("--json", "as_json", is_flag=True, help="Print the figures as JSON.")
 @click.option("--plot", type=click.Path(dir_okay=False, path_type=Path), help="Write a bar chart of the figures (PNG).")
-def eval_paper(methods: tuple[str, ...], as_json: bool, plot: Path | None) -> None:
+@_PARAM
+def eval_paper(methods: tuple[str, ...], as_json: bool, plot: Path | None, params: tuple[str, ...]) -> None:
     """The paper-style testbed: 20 requirements against 100 components (reasoner/data/)."""
     from cbrs.reasoner.evaluation import evaluate_paper, plot_report
 
-    report = evaluate_paper(methods or METHODS)
+    report = evaluate_paper(methods or METHODS, config=match_config(params))
     if as_json:
         click.echo(json.dumps(report.to_json(), indent=2))
     else:
@@ -119,13 +167,22 @@ _TEXT_WEIGHT = click.option(
 @click.option("--json", "as_json", is_flag=True, help="Print the figures as JSON.")
 @click.option("--plot", type=click.Path(dir_okay=False, path_type=Path), help="Write precision-recall curves (PNG).")
 @_TEXT_WEIGHT
-def eval_owls_tc(folder: Path, methods: tuple[str, ...], as_json: bool, plot: Path | None, text_weight: float) -> None:
+@_PARAM
+def eval_owls_tc(
+    folder: Path,
+    methods: tuple[str, ...],
+    as_json: bool,
+    plot: Path | None,
+    text_weight: float,
+    params: tuple[str, ...],
+) -> None:
     """An OWL-S test collection in the OWLS-TC layout: services/, ontology/, queries/, relevance.xml."""
     from cbrs.reasoner.owlstc import evaluate_collection, plot_curves
 
+    config = match_config(params, MatchConfig(text_weight=text_weight))
     if not as_json:
         click.echo(f"loading {folder} and ranking every service for every query ...", err=True)
-    report = evaluate_collection(folder, methods or METHODS, MatchConfig(text_weight=text_weight))
+    report = evaluate_collection(folder, methods or METHODS, config)
     click.echo(json.dumps(report.to_json(), indent=2) if as_json else report.text())
     if plot is not None:
         click.echo(f"chart written to {plot_curves(report, plot)}", err=as_json)

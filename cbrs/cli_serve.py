@@ -35,6 +35,13 @@ def _help(name: str) -> str:
 @click.option(
     "--log-level", type=click.Choice(LOG_LEVELS, case_sensitive=False), help=_help("log_level") + " [default INFO]"
 )
+@click.option(
+    "--match-param",
+    "match_params",
+    multiple=True,
+    metavar="NAME=VALUE",
+    help=_help("match_params") + " (repeatable; cbrs match --params lists them)",
+)
 @pass_app
 def serve(
     app: App,
@@ -45,6 +52,7 @@ def serve(
     read_only: bool | None,
     cors_origins: tuple[str, ...],
     log_level: str | None,
+    match_params: tuple[str, ...],
 ) -> None:
     """Serve the knowledge base: SPARQL 1.1 at /sparql on the HTTP port, rosbridge v2 on the bridge port.
 
@@ -71,7 +79,12 @@ def serve(
             isolate_memory=True,  # a query past its deadline is stopped whatever the store
         ),
         cors_origins=setting("cors_origins").resolve(cors_origins or None),
+        match_params=setting("match_params").resolve(match_params or None),
     )
+    if config.match_params:  # a wrong name or value fails now, not at the first ranking
+        from cbrs.reasoner.config import MatchConfig
+
+        MatchConfig().with_params(config.match_params)
     if not _is_loopback(config.host):
         click.echo(f"warning: listening on {config.host}, reachable from other machines", err=True)
     _check_free(config.host, config.port, "--port", "CBRS_PORT")
@@ -90,6 +103,8 @@ def serve(
             f"({config.endpoint.workers} query workers, {config.endpoint.timeout:g} s timeout)"
         )
         click.echo(f"  rosbridge ws://{host_text}:{running.bridge_port}")
+        if config.match_params:
+            click.echo(f"  matchmaking parameters: {', '.join(config.match_params)}")
         click.echo("Ctrl-C stops.", nl=True)
 
     try:

@@ -11,15 +11,20 @@ from cbrs.kb.store import is_remote
 from cbrs.sparql_service import SparqlService
 
 if TYPE_CHECKING:  # the reasoner loads with the first ranking, not at cbrs serve's start-up
+    from cbrs.reasoner.config import MatchConfig
     from cbrs.reasoner.matchmaker import Matchmaker
     from cbrs.reasoner.taxonomy import TaxonomyIndex
 
 
 class Matchmakers:
-    """One matchmaker per method over the store as it is now; a SPARQL update makes them stale."""
+    """One matchmaker per method over the store as it is now; a SPARQL update makes them stale.
 
-    def __init__(self, sparql: SparqlService) -> None:
+    ``params``: ``name=value`` matchmaking parameters (the match_params setting) every ranking uses."""
+
+    def __init__(self, sparql: SparqlService, params: tuple[str, ...] = ()) -> None:
         self.sparql = sparql
+        self.params = params
+        self._config: MatchConfig | None = None
         self._generation: object = -1
         self._index: TaxonomyIndex | None = None
         self._built: dict[str, Matchmaker] = {}
@@ -32,14 +37,17 @@ class Matchmakers:
         sizes of the ontology and services graphs are then part of the store's version, so a
         description registered through another process is matched here at the next ranking.
         """
+        from cbrs.reasoner.config import MatchConfig
         from cbrs.reasoner.matchmaker import Matchmaker
 
         with self._guard:
             index = self._current()
+            if self._config is None:
+                self._config = MatchConfig().with_params(self.params)
             if method not in self._built:
                 shared = next(iter(self._built.values()), None)
                 ads = shared.advertisements if shared is not None else None
-                self._built[method] = Matchmaker(self.sparql.kb, method, index=index, advertisements=ads)
+                self._built[method] = Matchmaker(self.sparql.kb, method, self._config, index=index, advertisements=ads)
             return self._built[method]
 
     def index(self) -> TaxonomyIndex:

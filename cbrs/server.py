@@ -60,6 +60,7 @@ class ServeConfig:
     )
     action_workers: int = field(default_factory=lambda: setting("action_workers").resolve())
     component_lease: float = field(default_factory=lambda: setting("component_lease").resolve())
+    match_params: tuple[str, ...] = field(default_factory=lambda: setting("match_params").resolve())
 
 
 class Server:
@@ -79,7 +80,8 @@ class Server:
             connections_per_client=self.config.bridge_connections_per_client,
             action_workers=self.config.action_workers,
         )
-        self.matchmakers = Matchmakers(self.sparql)  # one taxonomy index for the pages and the bridge
+        # one taxonomy index for the pages and the bridge
+        self.matchmakers = Matchmakers(self.sparql, tuple(self.config.match_params))
         services = KnowledgeServices(self.sparql, self.tasks, self.matchmakers, self.own_origins)
         self._detach = attach(self.bridge, services)
         self.live = LiveComponents(self.sparql, ttl=self.config.component_lease)

@@ -63,6 +63,17 @@ def _origins(text: str) -> tuple[str, ...]:
 _prefixes = _origins  # a comma-separated list of IRI prefixes reads the same way
 
 
+def _match_params(text: str) -> tuple[str, ...]:
+    """Comma-separated ``name=value`` pairs; only their form is checked here (the names and values are
+    checked against MatchConfig where a matchmaker is made, so that reading settings loads no reasoner)."""
+    pairs = _origins(text)
+    for pair in pairs:
+        name, equals, _ = pair.partition("=")
+        if not equals or not name.strip().isidentifier():
+            raise ValueError(f"{pair!r} is not NAME=VALUE")
+    return tuple("=".join(part.strip() for part in pair.partition("=")[::2]) for pair in pairs)
+
+
 def _batch(text: str) -> int | str:
     """``auto`` (chosen by the server) or a positive number of quads."""
     if text.strip().lower() == "auto":
@@ -304,6 +315,14 @@ SETTINGS: tuple[Setting, ...] = (
         "websocket, besides the server's own pages; none by default.",
         "CBRS_CORS_ORIGINS",
         _origins,
+    ),
+    Setting(
+        "match_params",
+        lambda: (),
+        "Comma-separated NAME=VALUE matchmaking parameters (MatchConfig fields, e.g. consumer_steps=off, "
+        "undone_state_factor=0) for cbrs match, cbrs eval and cbrs serve's rankings; none by default.",
+        "CBRS_MATCH_PARAMS",
+        _match_params,
     ),
     Setting(
         "log_level",

@@ -1,8 +1,27 @@
-"""Every tunable parameter of matchmaking in one place, with the defaults docs/matchmaking.md explains."""
+"""Every tunable parameter of matchmaking in one place, with the defaults docs/matchmaking.md explains.
+
+Also read from text (``name=value``, as ``cbrs match --param`` and the ``match_params`` setting give
+them) by ``MatchConfig.with_params``, so a deployment can turn a rule on or off without code.
+"""
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+import difflib
+from collections.abc import Iterable
+from dataclasses import dataclass, fields, replace
+from typing import Any
+
+
+class MatchParameterError(ValueError):
+    """A matchmaking parameter that does not exist, or a value it cannot take."""
+
+    def __init__(self, name: str, value: str | None, reason: str) -> None:
+        shown = repr(name) if value is None else f"{name}={value!r}"
+        super().__init__(f"matchmaking parameter {shown}: {reason}")
+        self.name, self.value, self.reason = name, value, reason
+
+
+_WORDS = {"1": True, "true": True, "yes": True, "on": True, "0": False, "false": False, "no": False, "off": False}
 
 
 @dataclass(frozen=True)
@@ -141,6 +160,32 @@ class MatchConfig:
     # An advertisement that states no value for a QoS metric the requirement bounds: fail it?
     qos_missing_fails: bool = True
 
+    @classmethod
+    def parameter_names(cls) -> tuple[str, ...]:
+        return tuple(f.name for f in fields(cls))
+
+    def with_params(self, params: Iterable[str]) -> MatchConfig:
+        """This configuration with each ``name=value`` of ``params`` set (1/true/yes/on and 0/false/no/off
+        for a yes/no parameter); a later one wins. Raises MatchParameterError naming the first parameter
+        that does not exist, whose value is not of its type or lies outside its range."""
+        types = {f.name: f.type for f in fields(self)}
+        values: dict[str, Any] = {}
+        for item in params:
+            name, equals, text = item.partition("=")
+            name, text = name.strip(), text.strip()
+            if not equals:
+                raise MatchParameterError(item.strip(), None, "expected NAME=VALUE")
+            if name not in types:
+                close = difflib.get_close_matches(name, types, n=3)
+                hint = f"; did you mean {' or '.join(close)}?" if close else "; cbrs match --params lists them"
+                raise MatchParameterError(name, text, "no such parameter" + hint)
+            values[name] = _parsed(name, text, str(types[name]))
+        try:
+            return replace(self, **values)
+        except ValueError as error:  # __post_init__'s range checks name the field
+            name = next((n for n in values if n in str(error)), next(iter(values)))
+            raise MatchParameterError(name, str(values[name]), str(error)) from error
+
     def published(self) -> MatchConfig:
         """This configuration with every refinement of docs/matchmaking.md section 9 turned off: how the
         baselines (and Sem-Str as first published here) score."""
@@ -198,3 +243,19 @@ class MatchConfig:
         spo = self.subject_weight + self.predicate_weight + self.object_weight
         if abs(spo - 1) > 1e-9:
             raise ValueError(f"subject, predicate and object weights must sum to 1, got {spo}")
+
+
+def _parsed(name: str, text: str, kind: str) -> Any:
+    """``text`` as the type a MatchConfig field is declared with."""
+    if kind == "bool":
+        if text.lower() not in _WORDS:
+            raise MatchParameterError(name, text, "expected a yes/no value (1, true, yes, on / 0, false, no, off)")
+        return _WORDS[text.lower()]
+    try:
+        if kind == "int":
+            return int(text)
+        if kind == "float":
+            return float(text)
+    except ValueError:
+        raise MatchParameterError(name, text, f"expected a number ({kind})") from None
+    return text
