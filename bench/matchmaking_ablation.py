@@ -26,7 +26,11 @@ from cbrs.reasoner.metrics import average_precision
 from cbrs.reasoner.owlstc import _file_key, load_collection, read_relevance
 
 ROOT = Path(__file__).resolve().parents[1]
-DEFAULTS = [ROOT.parent / "shared" / "owls-tc4", ROOT / "tests" / "data" / "robot_services"]
+DEFAULTS = [
+    ROOT.parent / "shared" / "owls-tc4",
+    ROOT / "tests" / "data" / "robot_services",
+    ROOT / "tests" / "data" / "robot_heldout",
+]
 BASE = MatchConfig()
 VARIANTS: dict[str, MatchConfig] = {
     "default": BASE,
@@ -39,6 +43,7 @@ VARIANTS: dict[str, MatchConfig] = {
     "no observed state (observed_state_weight 0)": replace(BASE, observed_state_weight=0.0),
     "no disjoint statements": replace(BASE, disjoint_statements=False),
     "no antonym statements": replace(BASE, antonym_statements=False),
+    "any position contradicts (same_fact_contradictions off)": replace(BASE, same_fact_contradictions=False),
     "contradicting offers keep their score (contradiction_factor 1)": replace(BASE, contradiction_factor=1.0),
     "observed state by any is-a relative (observed_state_kind off)": replace(BASE, observed_state_kind=False),
     "equal scores by IRI only (tie_break_result off)": replace(BASE, tie_break_result=False),

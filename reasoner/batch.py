@@ -508,12 +508,30 @@ class BatchScorer:
         clash = np.zeros(len(pool.statements), dtype=bool)
         if not isinstance(self.measure, SemStr):
             return clash
-        if cfg.disjoint_statements:
-            space = pool.space
-            clash |= space.disjoint(statement.subject)[pool.s_ids] | space.disjoint(statement.object)[pool.o_ids]
-        if cfg.antonym_statements:
-            clash |= pool.opposites(statement)
+        if not cfg.same_fact_contradictions:
+            if cfg.disjoint_statements:
+                space = pool.space
+                clash |= space.disjoint(statement.subject)[pool.s_ids] | space.disjoint(statement.object)[pool.o_ids]
+            if cfg.antonym_statements:
+                clash |= pool.opposites(statement)
+            return clash
+        subject, predicate, obj = (
+            self._related_to(t) for t in (statement.subject, statement.predicate, statement.object)
+        )
+        same_predicate = predicate[pool.p_ids]
+        clash |= self._clashes(statement.subject)[pool.s_ids] & same_predicate & obj[pool.o_ids]
+        clash |= self._clashes(statement.object)[pool.o_ids] & same_predicate & subject[pool.s_ids]
         return clash
+
+    def _clashes(self, concept: str) -> npt.NDArray[np.bool_]:
+        """For every concept id: declared disjoint with ``concept`` or named by its antonym (statements._clash)."""
+        cfg, space = self.config, self.pool.space
+        found = np.zeros(len(space), dtype=bool)
+        if cfg.disjoint_statements:
+            found |= space.disjoint(concept)
+        if cfg.antonym_statements:
+            found |= space.opposites(concept)
+        return found
 
     def undoing(self, requirement: Requirement) -> npt.NDArray[np.bool_]:
         """Per pool statement: does it make a precondition the requirement guarantees false (the same fact,

@@ -73,6 +73,11 @@ class MatchConfig:
     # (Closed for Opened, Unlocked for Locked, Off for On; reasoner/antonyms.py) contradicts it too:
     # similarity 0, for taxonomies that leave such opposite states undeclared siblings.
     antonym_statements: bool = True
+    # A contradiction is the same fact with an incompatible value: a disjoint or opposite subject counts only
+    # when the predicates and objects are is-a related, a disjoint or opposite object only when the subjects
+    # and predicates are. (Medication, isDeliveredTo, OlderAdult) does not contradict (OlderAdult, receives,
+    # MedicationReminder), though a person is no reminder: it is another fact. False: any position clashes.
+    same_fact_contradictions: bool = True
     # An advertisement with an effect that contradicts a requested effect (above) does the opposite of what
     # is asked (closes the door it should open): its whole score is multiplied by this factor, so that
     # matching inputs cannot rank it above services that help. 1 leaves only that statement at 0.
@@ -201,6 +206,7 @@ class MatchConfig:
             lexicon=False,
             disjoint_statements=False,
             antonym_statements=False,
+            same_fact_contradictions=False,
             contradiction_factor=1.0,
             undone_state_factor=1.0,
             tie_break_result=False,

@@ -7,9 +7,9 @@ the property hierarchy):
     Sim(R_sup, R_dem) = ws * Sim(s_sup, s_dem) + wp * Sim(p_sup, p_dem) + wo * Sim(o_sup, o_dem)
 
 with ws + wp + wo = 1 (equal by default; see MatchConfig), or the weighted geometric mean. A statement
-whose subject or object is declared disjoint with the requested one, or named by an antonym of it
-(antonyms.py), contradicts it and scores 0 (MatchConfig.disjoint_statements, antonym_statements;
-Sem-Str only).
+about the same fact (the other two positions is-a related) whose subject or object is declared disjoint
+with the requested one, or named by an antonym of it (antonyms.py), contradicts it and scores 0
+(MatchConfig.disjoint_statements, antonym_statements, same_fact_contradictions; Sem-Str only).
 """
 
 from __future__ import annotations
@@ -65,7 +65,12 @@ def _contradiction(
     """(position, relation) of the first contradiction, or None."""
     if not isinstance(measure, SemStr):
         return None
-    for position in ("subject", "object"):
+    index = measure.index
+    for position, others in (("subject", ("predicate", "object")), ("object", ("subject", "predicate"))):
+        if config.same_fact_contradictions and not all(
+            _is_a_related(index, getattr(requested, other), getattr(advertised, other)) for other in others
+        ):
+            continue  # another fact: its value cannot contradict this one
         relation = _clash(getattr(requested, position), getattr(advertised, position), measure, config)
         if relation is not None:
             return position, relation

@@ -233,6 +233,35 @@ def test_an_effect_that_contradicts_the_requested_one_scores_nothing(defined_kb)
     assert Matchmaker(defined_kb, "wu-palmer", index=index, advertisements=ads).config.disjoint_statements is False
 
 
+def test_only_the_same_fact_with_an_incompatible_value_is_a_contradiction(defined_kb) -> None:  # type: ignore[no-untyped-def]
+    # Opened and Closed are declared disjoint. (Door, hasState, Closed) is the same fact as the requested
+    # (Door, hasState, Opened) with an incompatible value: a contradiction. (Door, showsLabel, Closed) is
+    # another relation and (Lens, hasState, Closed) another thing: neither says the door is not open, so
+    # they keep their similarity (same_fact_contradictions; off, any position clashes as before).
+    wanted = Requirement(M + "OpenTheDoor", (), effects=(Statement(M + "Door", M + "hasState", M + "Opened"),))
+    ads = [
+        Advertisement(M + name, (), effects=(Statement(M + thing, M + relation, M + "Closed"),))
+        for name, thing, relation in (
+            ("CloseDoor", "Door", "hasState"),
+            ("LabelClosed", "Door", "showsLabel"),
+            ("CloseLens", "Lens", "hasState"),
+        )
+    ]
+    index = TaxonomyIndex.from_kb(defined_kb)
+    config = MatchConfig(unrelated_predicate_factor=1.0)  # so that another relation keeps a similarity
+    on = Matchmaker(defined_kb, config=config, index=index, advertisements=ads)
+    ranked = {c.advertisement.removeprefix(M): c.score for c in on.rank(wanted, explain=0).candidates}
+    for ad in ads:  # the batch agrees with the explained scores
+        assert ranked[ad.iri.removeprefix(M)] == on.score(wanted, ad).score
+    contradicting = {ad.iri.removeprefix(M) for ad in ads if "contradicts" in on.score(wanted, ad).pairs[0].how}
+    assert contradicting == {"CloseDoor"} and ranked["CloseDoor"] == 0.0
+    assert ranked["LabelClosed"] > 0 and ranked["CloseLens"] > 0
+    old = Matchmaker(
+        defined_kb, config=replace(config, same_fact_contradictions=False), index=index, advertisements=ads
+    )
+    assert {c.score for c in old.rank(wanted, explain=0).candidates} == {0.0}
+
+
 def test_an_offer_that_undoes_the_state_the_requester_is_in_can_score_nothing(defined_kb) -> None:  # type: ignore[no-untyped-def]
     # The requester guarantees the door is Opened and asks for it Ajar. Closing it is no contradiction of
     # Ajar (nothing declares them disjoint), but it makes the guaranteed Opened false without giving what
