@@ -30,6 +30,7 @@ DEFAULTS = [
     ROOT.parent / "shared" / "owls-tc4",
     ROOT / "tests" / "data" / "robot_services",
     ROOT / "tests" / "data" / "robot_heldout",
+    ROOT / "tests" / "data" / "robot_validation",
 ]
 BASE = MatchConfig()
 VARIANTS: dict[str, MatchConfig] = {
@@ -49,6 +50,7 @@ VARIANTS: dict[str, MatchConfig] = {
     "equal scores by IRI only (tie_break_result off)": replace(BASE, tie_break_result=False),
     "no decomposition steps (decomposition_weight 0)": replace(BASE, decomposition_weight=0.0),
     "only producers are steps (consumer_steps off)": replace(BASE, consumer_steps=False),
+    "no steps that bring about a precondition (precondition_steps off)": replace(BASE, precondition_steps=False),
     "no cross-branch links": replace(BASE, cross_branch_weight=0.0),
     "unknown concepts by their names alone (unknown_under_root off)": replace(BASE, unknown_under_root=False),
     "preconditions averaged (precondition_conjunction off)": replace(BASE, precondition_conjunction=False),

@@ -19,6 +19,7 @@ from cbrs.reasoner.antonyms import table as antonym_table
 from cbrs.reasoner.config import MatchConfig
 from cbrs.reasoner.similarity import EntityMeasure, SemStr
 from cbrs.reasoner.spans import span
+from cbrs.reasoner.steps import guaranteed
 from cbrs.reasoner.vectors import ARRAY_CACHE_BYTES, FloatArray, IntArray, VectorSpace, _Lru, _nbytes
 
 PARTS = ("outputs", "inputs", "effects", "preconditions")
@@ -403,6 +404,45 @@ class BatchScorer:
             per.append(pool.outputs.max(terms[pool.root_ids]))
         return np.asarray(np.mean(per, axis=0), dtype=np.float64)
 
+    def _achieving(self, requirement: Requirement, own: FloatArray) -> npt.NDArray[np.bool_]:
+        """Per advertisement: does it achieve every requested effect (steps.achievers)?"""
+        pool = self.pool
+        achieving = pool.effects.present & (own >= self.config.pair_threshold)
+        for wanted in requirement.effects:
+            if not achieving.any():
+                break
+            achieving &= pool.effects.max(self._establishing(wanted).astype(np.float64)) > 0
+        return achieving
+
+    def _establishing(self, wanted: Statement) -> npt.NDArray[np.bool_]:
+        """Per pool statement: each position ``wanted``'s concept or an is-a superclass (steps.establishes)."""
+        pool = self.pool
+        return (
+            self._at_or_above(wanted.subject)[pool.s_ids]
+            & self._at_or_above(wanted.predicate)[pool.p_ids]
+            & self._at_or_above(wanted.object)[pool.o_ids]
+        )
+
+    def precondition_steps(self, requirement: Requirement, own: FloatArray) -> FloatArray:
+        """Per advertisement, the best decomposition_weight x an achiever's effects part (``own``) where one
+        of its effects brings about a precondition of that achiever the requester does not guarantee
+        (precondition_steps; reasoner/steps.py); 0 where it is no such step."""
+        pool, cfg, index = self.pool, self.config, self.pool.space.index
+        found = np.zeros(len(pool.ads), dtype=np.float64)
+        feeds: dict[int, FloatArray] = {}  # per unmet precondition: which advertisements bring it about
+        for a in np.flatnonzero(self._achieving(requirement, own)):
+            start, count = pool.preconditions.starts[a], pool.preconditions.counts[a]
+            for condition in dict.fromkeys(pool.preconditions.flat[start : start + count].tolist()):
+                if guaranteed(index, requirement, pool.statements[condition]):
+                    continue
+                feed = feeds.get(condition)
+                if feed is None:
+                    feed = feeds[condition] = pool.effects.max(
+                        self._establishing(pool.statements[condition]).astype(np.float64)
+                    )
+                np.maximum(found, cfg.decomposition_weight * own[a] * feed, out=found)
+        return found
+
     def steps(self, requirement: Requirement, own: FloatArray) -> FloatArray:
         """Per advertisement, the best decomposition_weight x an achiever's effects part (``own``) x the
         delivered floor of its output as an input the achiever needs and the requester does not provide,
@@ -410,16 +450,9 @@ class BatchScorer:
         0 where it is no step."""
         pool, cfg = self.pool, self.config
         found = np.zeros(len(pool.ads), dtype=np.float64)
-        achieving = pool.effects.present & (own >= cfg.pair_threshold)
-        for wanted in requirement.effects:
-            if not achieving.any():
-                return found
-            above = (
-                self._at_or_above(wanted.subject)[pool.s_ids]
-                & self._at_or_above(wanted.predicate)[pool.p_ids]
-                & self._at_or_above(wanted.object)[pool.o_ids]
-            )
-            achieving &= pool.effects.max(above.astype(np.float64)) > 0
+        achieving = self._achieving(requirement, own)
+        if not achieving.any():
+            return found
         given = np.zeros(len(pool.root_ids), dtype=bool)  # pool trees the requester provides as they are
         for provided in requirement.inputs:
             given |= self.plugin(provided.type) > 0
@@ -600,6 +633,9 @@ class BatchScorer:
                 effects = np.where(reports, cfg.observed_state_weight * self.observed(requirement.effects), effects)
             if cfg.decomposition_weight > 0 and isinstance(self.measure, SemStr):  # Matchmaker._step
                 effects = np.where(reports, np.maximum(effects, self.steps(requirement, own)), effects)
+                if cfg.precondition_steps:  # Matchmaker._precondition_step
+                    steps = self.precondition_steps(requirement, own)
+                    effects = np.where(pool.effects.present, np.maximum(effects, steps), effects)
             parts["effects"] = effects
         if requirement.preconditions:
             guaranteed = np.max([self.statements(s) for s in requirement.preconditions], axis=0)

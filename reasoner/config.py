@@ -111,6 +111,11 @@ class MatchConfig:
     # output comes after the request, not before (the price of the book being ordered). False: only
     # producers are steps.
     consumer_steps: bool = True
+    # A step may also bring about what the achiever needs to hold: when an achiever has a precondition the
+    # requester does not guarantee (hand over the item the robot holds), an advertisement whose effect
+    # brings it about (picks the item up) is a step too, with a producer's share: the paper's composition by
+    # preconditions and effects, as producers are its composition by inputs and outputs. False: off.
+    precondition_steps: bool = True
     # How the parts of a match combine; parts the requirement does not state are left out and the
     # remaining weights renormalised.
     output_weight: float = 0.4
@@ -215,6 +220,7 @@ class MatchConfig:
             observed_state_weight=0.0,
             decomposition_weight=0.0,
             consumer_steps=False,
+            precondition_steps=False,
             unknown_under_root=False,
             precondition_conjunction=False,
         )

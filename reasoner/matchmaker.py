@@ -43,7 +43,7 @@ from cbrs.reasoner.names import local_name
 from cbrs.reasoner.similarity import SemStr, Similarity
 from cbrs.reasoner.spans import PairMatch, SpanMatch, conceptual_span_similarity, span
 from cbrs.reasoner.statements import StatementMatch, best_statement_matches, contradiction_factor, reported, undoes
-from cbrs.reasoner.steps import Achiever, achievers, at_or_above, feeds, works_towards
+from cbrs.reasoner.steps import Achiever, achievers, at_or_above, establishes, feeds, works_towards
 from cbrs.reasoner.taxonomy import TaxonomyIndex
 from cbrs.reasoner.text import description_text
 
@@ -323,6 +323,13 @@ class Matchmaker:
                 and isinstance(self.method.measure, SemStr)
             ):
                 parts["effects"] = max(parts["effects"], self._step(requirement, ad, pairs))
+            if (
+                ad.effects
+                and cfg.precondition_steps
+                and cfg.decomposition_weight > 0
+                and isinstance(self.method.measure, SemStr)
+            ):
+                parts["effects"] = max(parts["effects"], self._precondition_step(requirement, ad, pairs))
         if ad.preconditions and requirement.preconditions:
             matches = best_statement_matches(ad.preconditions, requirement.preconditions, self.method.measure, cfg)
             every = cfg.precondition_conjunction  # all must hold: the worst one decides
@@ -523,12 +530,8 @@ class Matchmaker:
         decomposition_weight x the achiever's effects part x the output's delivered floor (1 for a taker),
         with its pair when it is above 0."""
         cfg = self.config
-        found = self._achievers_of
-        if found is None or found[0] is not requirement or found[1] is not self.advertisements:
-            listed = achievers(self.index, requirement, self.advertisements, self.method.measure, cfg)
-            found = self._achievers_of = (requirement, self.advertisements, listed)
         best, why, output = 0.0, "", ""
-        for achiever in found[2]:
+        for achiever in self._achievers(requirement):
             needs = f"{_short(achiever.advertisement.iri)} needs to achieve it ({achiever.value:.2f})"
             for needed in achiever.missing:
                 offers = [
@@ -551,6 +554,36 @@ class Matchmaker:
                 f"({_short(e.subject)}, {_short(e.predicate)}, {_short(e.object)})" for e in requirement.effects
             )
             pairs.append(EntityPair("effect", text, output, best, why, Degree.FAIL.value, "step"))
+        return best
+
+    def _achievers(self, requirement: Requirement) -> list[Achiever]:
+        """The achievers of ``requirement``'s effects that need something it lacks (steps.achievers), listed
+        once per requirement and pool."""
+        found = self._achievers_of
+        if found is None or found[0] is not requirement or found[1] is not self.advertisements:
+            listed = achievers(self.index, requirement, self.advertisements, self.method.measure, self.config)
+            found = self._achievers_of = (requirement, self.advertisements, listed)
+        return found[2]
+
+    def _precondition_step(self, requirement: Requirement, ad: Advertisement, pairs: list[EntityPair]) -> float:
+        """An advertisement one of whose effects brings about a precondition an achiever of the requested
+        effects needs and the requester does not guarantee (reasoner/steps.py): decomposition_weight x the
+        achiever's effects part, with its pair when it is above 0."""
+        weight = self.config.decomposition_weight
+        best, why, offered = 0.0, "", ""
+        for achiever in self._achievers(requirement):
+            for condition in achiever.unmet:
+                effect = next((e for e in ad.effects if establishes(self.index, e, condition)), None)
+                if effect is not None and weight * achiever.value > best:
+                    best, offered = weight * achiever.value, _statement_text(effect)
+                    why = (
+                        f"effect {offered} brings about {_statement_text(condition)}, which"
+                        f" {_short(achiever.advertisement.iri)} needs before it achieves it ({achiever.value:.2f})"
+                        f" x {weight:g}"
+                    )
+        if best > 0:
+            text = ", ".join(_statement_text(e) for e in requirement.effects)
+            pairs.append(EntityPair("effect", text, offered, best, why, Degree.FAIL.value, "step"))
         return best
 
     def _undone_state(self, requirement: Requirement, ad: Advertisement, lacks: list[str]) -> float:
@@ -732,6 +765,10 @@ def _within(inner: tuple[float, float, float, float], outer: tuple[float, float,
         and inner[2] >= outer[2] - eps
         and inner[3] <= outer[3] + eps
     )
+
+
+def _statement_text(statement: Statement) -> str:
+    return f"({_short(statement.subject)}, {_short(statement.predicate)}, {_short(statement.object)})"
 
 
 def _short(iri: str) -> str:

@@ -9,6 +9,10 @@ GraspPose of a pick-up service, for a requester that only knows where the cup is
 that changes nothing but outputs that input (or a subclass of it) is a step of the decomposition, the
 grasp planner. Its effects part is at least MatchConfig.decomposition_weight times the achiever's
 effects part, times the delivered floor of its output (1 - specialisation_step per is-a link below).
+The same holds for preconditions (MatchConfig.precondition_steps): when an achiever has a precondition
+the requester does not guarantee (hand over the item the robot holds, for a requester whose robot holds
+nothing), an advertisement whose effect brings it about (picking the item up) is a step, with the same
+share.
 With MatchConfig.consumer_steps, an advertisement that changes nothing but takes such an input as it is
 (that concept or an is-a superclass of it) is a step too, with a producer's share: the path planner that
 takes the NavigationGoal a drive service needs works on the same goal before it is reached. One that
@@ -23,7 +27,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from cbrs.kb import Advertisement, Requirement
+from cbrs.kb import Advertisement, Requirement, Statement
 from cbrs.reasoner.config import MatchConfig
 from cbrs.reasoner.similarity import EntityMeasure
 from cbrs.reasoner.statements import best_statement_matches
@@ -32,12 +36,13 @@ from cbrs.reasoner.taxonomy import TaxonomyIndex
 
 @dataclass(frozen=True)
 class Achiever:
-    """An advertisement that achieves the requested effects, its effects part, and the inputs it needs
-    that the requester does not provide."""
+    """An advertisement that achieves the requested effects, its effects part, the inputs it needs that
+    the requester does not provide, and its preconditions that the requester does not guarantee."""
 
     advertisement: Advertisement
     value: float
     missing: tuple[str, ...]
+    unmet: tuple[Statement, ...] = ()
 
 
 def at_or_above(index: TaxonomyIndex, requested: str, offered: str) -> bool:
@@ -89,9 +94,31 @@ def achievers(
         matches = best_statement_matches(requirement.effects, ad.effects, measure, config)
         value = sum(m.value for m in matches) / len(matches)
         missing = tuple(dict.fromkeys(p.type for p in ad.inputs if not provided(index, requirement, p.type)))
-        if value >= config.pair_threshold and missing:
-            found.append(Achiever(ad, value, missing))
+        unmet = tuple(c for c in ad.preconditions if not guaranteed(index, requirement, c))
+        if value >= config.pair_threshold and (missing or unmet):
+            found.append(Achiever(ad, value, missing, unmet))
     return found
+
+
+def guaranteed(index: TaxonomyIndex, requirement: Requirement, condition: Statement) -> bool:
+    """Does the requester guarantee ``condition``: one of its preconditions states it or a more specific
+    fact (each position the condition's concept or an is-a subclass of it)?"""
+    return any(states_at_least(index, held, condition) for held in requirement.preconditions)
+
+
+def states_at_least(index: TaxonomyIndex, stated: Statement, wanted: Statement) -> bool:
+    """Does the fact ``stated`` make ``wanted`` true: each of its positions ``wanted``'s concept or an is-a
+    subclass of it ((Cup, isGraspedBy, Robot) makes (HouseholdItem, isGraspedBy, Robot) true)?"""
+    return all(at_or_above(index, getattr(stated, at), getattr(wanted, at)) for at in _POSITIONS)
+
+
+def establishes(index: TaxonomyIndex, effect: Statement, condition: Statement) -> bool:
+    """Does an advertised ``effect`` bring ``condition`` about: each position the condition's concept or an
+    is-a superclass of it, as an achiever's does (grasping any PhysicalObject grasps the HouseholdItem)?"""
+    return all(at_or_above(index, getattr(condition, at), getattr(effect, at)) for at in _POSITIONS)
+
+
+_POSITIONS = ("subject", "predicate", "object")
 
 
 def _at_or_above_set(index: TaxonomyIndex, requested: str) -> tuple[str, frozenset[str] | None]:

@@ -20,6 +20,7 @@ from cbrs.reasoner.taxonomy import Link, TaxonomyIndex
 from tests.reasoner_examples import E, positions
 
 ROBOT = Path(__file__).parent / "data" / "robot_services"
+HELDOUT = Path(__file__).parent / "data" / "robot_heldout"
 needs_wordnet = pytest.mark.skipif(not DATA_FILE.exists(), reason=f"no bundled WordNet data at {DATA_FILE}")
 
 
@@ -558,6 +559,65 @@ def test_the_planners_that_take_an_achievers_goal_rank_as_steps_on_the_robot_col
     ):
         assert place(query, on, planner) < place(query, on, other)
         assert place(query, off, planner) > place(query, off, other)
+
+
+def test_an_offer_that_brings_about_what_an_achiever_needs_to_hold_is_a_step() -> None:
+    # Give the cup to a person. HandOver achieves it but needs the robot to hold what it hands over, which
+    # the requester does not guarantee: picking any PhysicalObject up brings that about (a step); holding
+    # only cups does not bring about holding any object, holding a Person is another thing; and where the
+    # requester guarantees the robot holds the cup already, nothing needs bringing about.
+    def held(thing: str) -> Statement:
+        return Statement(E + thing, E + "isHeldBy", E + "Robot")
+
+    give = (Statement(E + "Cup", E + "isDeliveredTo", E + "Person"),)
+    wanted = Requirement(E + "GiveCup", (), inputs=(_p("input", "PersonLocation"),), effects=give)
+    holding = replace(wanted, iri=E + "GiveHeldCup", preconditions=(held("Cup"),))
+    achiever = Advertisement(
+        E + "HandOver",
+        (),
+        inputs=(_p("input", "PersonLocation"),),
+        preconditions=(held("PhysicalObject"),),
+        effects=(Statement(E + "PhysicalObject", E + "isDeliveredTo", E + "Person"),),
+    )
+    pick_any = Advertisement(E + "PickAnything", (), effects=(held("PhysicalObject"),))
+    pick_cup = Advertisement(E + "PickCupOnly", (), effects=(held("Cup"),))
+    carry_person = Advertisement(E + "CarryPerson", (), effects=(held("Person"),))
+    ads = [achiever, pick_any, pick_cup, carry_person]
+    kb = KnowledgeBase(Store.open(":memory:"))
+    matcher = Matchmaker(kb, index=_manipulation(), advertisements=ads)
+    ranked = {c.advertisement.removeprefix(E): c for c in matcher.rank(wanted, explain=0).candidates}
+    for requirement in (wanted, holding):  # the batch agrees with the scalar path
+        batch = {c.advertisement: c.score for c in matcher.rank(requirement, explain=0).candidates}
+        assert all(batch[ad.iri] == matcher.score(requirement, ad).score for ad in ads)
+
+    def steps(matcher: Matchmaker, requirement: Requirement, ad: Advertisement) -> list[str]:
+        return [pair.how for pair in matcher.score(requirement, ad).pairs if pair.shown_degree() == "Step"]
+
+    share = MatchConfig().decomposition_weight * ranked["HandOver"].parts["effects"]
+    assert ranked["PickAnything"].parts["effects"] == pytest.approx(share)
+    explained = steps(matcher, wanted, pick_any)
+    assert explained and "brings about (PhysicalObject, isHeldBy, Robot), which HandOver needs" in explained[0]
+    # holding only cups does not bring about holding any PhysicalObject HandOver may be asked to hand over
+    assert steps(matcher, wanted, pick_cup) == [] and steps(matcher, wanted, carry_person) == []
+    assert steps(matcher, holding, pick_any) == []  # the requester's robot holds the cup already
+    off = Matchmaker(kb, config=MatchConfig(precondition_steps=False), index=_manipulation(), advertisements=ads)
+    assert steps(off, wanted, pick_any) == [] and off.score(wanted, pick_any).score < ranked["PickAnything"].score
+    assert MatchConfig().published().precondition_steps is False
+
+
+def test_docking_ranks_as_a_step_of_recharging_on_the_held_out_collection() -> None:
+    # The charge controller charges only a docked robot; the requester's robot is not docked, so a service
+    # that docks it (grade 2) is a step and ranks above a fuel gauge (grade 0).
+    loaded = load_collection(HELDOUT)
+    wanted = loaded.requirements["recharge_battery.owls"][0]
+
+    def place(config: MatchConfig, name: str) -> int:
+        ranked = Matchmaker(loaded.kb, config=config).rank(wanted, explain=0).candidates
+        return [c.advertisement.rsplit("#", 1)[-1] for c in ranked].index(name)
+
+    on, off = MatchConfig(), MatchConfig(precondition_steps=False)
+    assert place(on, "RETURN_TO_CHARGER_SERVICE") < place(on, "FUEL_GAUGE_SERVICE")
+    assert place(off, "RETURN_TO_CHARGER_SERVICE") > place(off, "FUEL_GAUGE_SERVICE")
 
 
 def test_the_grasp_planner_ranks_as_a_step_on_the_robot_collection() -> None:
