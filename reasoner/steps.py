@@ -68,7 +68,7 @@ def achievers(
 ) -> list[Achiever]:
     """The advertisements that achieve every requested effect (each position the requested one or an is-a
     superclass, effects part at the pair threshold or above) and need an input the requester does not
-    provide."""
+    provide or a precondition it does not guarantee."""
     if not requirement.effects:
         return []
     # each requested position's concept and its is-a ancestors, once: the scan over the pool is then
