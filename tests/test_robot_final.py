@@ -1,0 +1,104 @@
+"""The final collection (tests/data/robot_final) loads as written: structure only, never a ranking.
+
+The collection is measured once and must not be tuned on, so nothing here computes a MAP. A file that
+lost a parameter, a condition or a relevance entry would still give a figure, a wrong one; these
+checks catch that first.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+from pathlib import Path
+from types import ModuleType
+
+import pytest
+
+from cbrs.reasoner.owlstc import LoadedCollection, _file_key, load_collection, read_relevance
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = ROOT / "tests" / "data" / "robot_final"
+
+
+@pytest.fixture(scope="module")
+def spec() -> ModuleType:
+    found = importlib.util.spec_from_file_location("robot_final", ROOT / "bench" / "robot_final.py")
+    assert found is not None and found.loader is not None
+    module = importlib.util.module_from_spec(found)
+    found.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture(scope="module")
+def loaded() -> LoadedCollection:
+    return load_collection(DATA)
+
+
+def _iri(spec: ModuleType, term: str) -> str:
+    """How the loader names a spec term: a ?Name parameter by its type, a constant by its class."""
+    return f"{spec.ONT}#{term.removeprefix('?')}"
+
+
+def test_one_description_per_file_and_the_briefs_sizes(loaded: LoadedCollection, spec: ModuleType) -> None:
+    services = sorted(p.name for p in (DATA / "services").glob("*.owls"))
+    queries = sorted(p.name for p in (DATA / "queries").glob("*.owls"))
+    assert services == sorted(f"{n}.owls" for n in spec.S)
+    assert queries == sorted(f"{n}.owls" for n in spec.QUERY)
+    assert len(services) >= 45 and len(queries) >= 14
+    assert sorted(loaded.advertisements) == services
+    assert sorted(loaded.requirements) == queries
+    for iris in (*loaded.advertisements.values(), *loaded.requirements.values()):
+        assert len(iris) == 1
+    assert len(loaded.kb.advertisements()) == len(services)
+    assert len(loaded.kb.requirements()) == len(queries)
+    assert sum(bool(q[3]) for q in spec.QUERY.values()) >= 6
+
+
+def test_just_the_intended_concepts_are_undeclared(loaded: LoadedCollection, spec: ModuleType) -> None:
+    assert 2 <= len(spec.UNDECLARED) <= 4
+    assert loaded.unresolved_concepts == len(spec.UNDECLARED)
+
+
+def test_each_description_has_the_specs_parameters_and_conditions(loaded: LoadedCollection, spec: ModuleType) -> None:
+    described = {d.iri: d for d in (*loaded.kb.advertisements(), *loaded.kb.requirements())}
+    for files, entries in ((loaded.advertisements, spec.S), (loaded.requirements, spec.QUERY)):
+        for name, (inputs, outputs, pre, effects, *_) in entries.items():
+            d = described[files[f"{name}.owls"][0]]
+            assert sorted(p.type for p in d.inputs) == sorted(_iri(spec, c) for c in inputs), name
+            assert sorted(p.type for p in d.outputs) == sorted(_iri(spec, c) for c in outputs), name
+            for got, wanted in ((d.preconditions, pre), (d.effects, effects)):
+                assert sorted((st.subject, st.predicate, st.object) for st in got) == sorted(
+                    tuple(_iri(spec, t) for t in st) for st in wanted
+                ), name
+
+
+def test_the_relevance_file_names_loaded_services_with_the_specs_grades(
+    loaded: LoadedCollection, spec: ModuleType
+) -> None:
+    judged = read_relevance(DATA / "relevance.xml")
+    assert {_file_key(o) for o in judged.offers} == set(loaded.advertisements)
+    for rated in (judged.binary, judged.graded):
+        assert {_file_key(r) for r in rated} == set(loaded.requirements)
+        for offers in rated.values():
+            assert {_file_key(o) for o in offers} <= set(loaded.advertisements)
+    for request, grades in judged.graded.items():
+        wanted = spec.QUERY[_file_key(request).removesuffix(".owls")][5]
+        assert {_file_key(o): g for o, g in grades.items()} == {f"{s}.owls": g for s, (g, _) in wanted.items()}
+        assert judged.binary[request] == {o: int(g >= 1) for o, g in grades.items()}
+        assert sum(g >= 1 for g in grades.values()) >= 2, request
+        assert 0 in grades.values(), request
+
+
+def test_the_ontology_carries_the_property_tree_and_the_disjointness(spec: ModuleType) -> None:
+    text = (DATA / "ontology" / "robot_final.owl").read_text(encoding="utf-8")
+    for prop, parent in spec.PROPERTIES.items():
+        if parent is not None:
+            assert f'rdf:ID="{prop}"><rdfs:subPropertyOf rdf:resource="#{parent}"/>' in text
+    assert text.count("<owl:disjointWith") == len(spec.DISJOINT)
+
+
+def test_the_committed_files_are_what_the_generator_writes(tmp_path: Path, spec: ModuleType) -> None:
+    spec.write(tmp_path)
+    written = sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*") if p.is_file())
+    assert written == sorted(p.relative_to(DATA) for p in DATA.rglob("*") if p.is_file())
+    for path in written:
+        assert (tmp_path / path).read_bytes() == (DATA / path).read_bytes(), path
