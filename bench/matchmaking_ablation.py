@@ -31,6 +31,7 @@ DEFAULTS = [
     ROOT / "tests" / "data" / "robot_services",
     ROOT / "tests" / "data" / "robot_heldout",
     ROOT / "tests" / "data" / "robot_validation",
+    ROOT / "tests" / "data" / "robot_final",
 ]
 BASE = MatchConfig()
 VARIANTS: dict[str, MatchConfig] = {

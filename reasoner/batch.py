@@ -19,7 +19,7 @@ from cbrs.reasoner.antonyms import table as antonym_table
 from cbrs.reasoner.config import MatchConfig
 from cbrs.reasoner.similarity import EntityMeasure, SemStr
 from cbrs.reasoner.spans import span
-from cbrs.reasoner.steps import guaranteed
+from cbrs.reasoner.steps import unmet_conditions
 from cbrs.reasoner.vectors import ARRAY_CACHE_BYTES, FloatArray, IntArray, VectorSpace, _Lru, _nbytes
 
 PARTS = ("outputs", "inputs", "effects", "preconditions")
@@ -429,17 +429,12 @@ class BatchScorer:
         (precondition_steps; reasoner/steps.py); 0 where it is no such step."""
         pool, cfg, index = self.pool, self.config, self.pool.space.index
         found = np.zeros(len(pool.ads), dtype=np.float64)
-        feeds: dict[int, FloatArray] = {}  # per unmet precondition: which advertisements bring it about
+        feeds: dict[Statement, FloatArray] = {}  # per unmet precondition: which advertisements bring it about
         for a in np.flatnonzero(self._achieving(requirement, own)):
-            start, count = pool.preconditions.starts[a], pool.preconditions.counts[a]
-            for condition in dict.fromkeys(pool.preconditions.flat[start : start + count].tolist()):
-                if guaranteed(index, requirement, pool.statements[condition]):
-                    continue
+            for condition in unmet_conditions(index, requirement, pool.ads[a]):
                 feed = feeds.get(condition)
                 if feed is None:
-                    feed = feeds[condition] = pool.effects.max(
-                        self._establishing(pool.statements[condition]).astype(np.float64)
-                    )
+                    feed = feeds[condition] = pool.effects.max(self._establishing(condition).astype(np.float64))
                 np.maximum(found, cfg.decomposition_weight * own[a] * feed, out=found)
         return found
 
@@ -625,6 +620,7 @@ class BatchScorer:
             else:
                 inputs = np.where(pool.inputs.present, needed_per_ad, np.nan)
             parts["inputs"] = inputs
+        brings_about = np.zeros(n, dtype=bool)  # precondition steps: no offer that undoes the effect
         if requirement.effects:
             own = np.mean([pool.effects.max(self.statements(s)) for s in requirement.effects], axis=0)
             effects = own
@@ -634,8 +630,9 @@ class BatchScorer:
             if cfg.decomposition_weight > 0 and isinstance(self.measure, SemStr):  # Matchmaker._step
                 effects = np.where(reports, np.maximum(effects, self.steps(requirement, own)), effects)
                 if cfg.precondition_steps:  # Matchmaker._precondition_step
-                    steps = self.precondition_steps(requirement, own)
-                    effects = np.where(pool.effects.present, np.maximum(effects, steps), effects)
+                    steps = np.where(pool.effects.present, self.precondition_steps(requirement, own), 0.0)
+                    effects = np.maximum(effects, steps)
+                    brings_about = steps > 0
             parts["effects"] = effects
         if requirement.preconditions:
             guaranteed = np.max([self.statements(s) for s in requirement.preconditions], axis=0)
@@ -658,7 +655,7 @@ class BatchScorer:
         ratio = ratio * (1 - cfg.input_gate + cfg.input_gate * invocable)
         if requirement.effects and cfg.contradiction_factor < 1:  # statements.contradiction_factor
             clash = np.max([pool.effects.max(self.contradicts(s).astype(np.float64)) for s in requirement.effects], 0)
-            ratio = np.where(clash > 0, cfg.contradiction_factor * ratio, ratio)
+            ratio = np.where((clash > 0) & ~brings_about, cfg.contradiction_factor * ratio, ratio)
         if requirement.preconditions and cfg.undone_state_factor < 1 and isinstance(self.measure, SemStr):
             undone = pool.effects.max(self.undoing(requirement).astype(np.float64)) > 0
             ratio = np.where(undone, cfg.undone_state_factor * ratio, ratio)

@@ -296,6 +296,7 @@ class Matchmaker:
         lacks: list[str] = []
         parts: dict[str, float] = {}
         cfg = self.config
+        brings_about = 0.0  # the share as a step that brings about an achiever's precondition
         if requirement.outputs:
             parts["outputs"] = self._parameters(requirement.outputs, ad.outputs, "output", pairs, lacks)
         needed: float | None = None  # how well the requester can supply the advertised inputs
@@ -329,7 +330,8 @@ class Matchmaker:
                 and cfg.decomposition_weight > 0
                 and isinstance(self.method.measure, SemStr)
             ):
-                parts["effects"] = max(parts["effects"], self._precondition_step(requirement, ad, pairs))
+                brings_about = self._precondition_step(requirement, ad, pairs)
+                parts["effects"] = max(parts["effects"], brings_about)
         if ad.preconditions and requirement.preconditions:
             matches = best_statement_matches(ad.preconditions, requirement.preconditions, self.method.measure, cfg)
             every = cfg.precondition_conjunction  # all must hold: the worst one decides
@@ -343,7 +345,8 @@ class Matchmaker:
         total = sum(weights[name] for name in parts)
         score = sum(weights[name] * value for name, value in parts.items()) / total if total else 0.0
         score *= 1 - cfg.input_gate + cfg.input_gate * (needed if needed is not None else 1.0)
-        score *= contradiction_factor(requirement.effects, ad.effects, self.method.measure, cfg)
+        if not brings_about:  # a step towards the effect does not undo it, though its own effect clashes
+            score *= contradiction_factor(requirement.effects, ad.effects, self.method.measure, cfg)
         score *= self._undone_state(requirement, ad, lacks)
         rejected = self.filters(requirement, ad.area, ad.qos)
         if self.method.strict:

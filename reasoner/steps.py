@@ -11,8 +11,8 @@ grasp planner. Its effects part is at least MatchConfig.decomposition_weight tim
 effects part, times the delivered floor of its output (1 - specialisation_step per is-a link below).
 The same holds for preconditions (MatchConfig.precondition_steps): when an achiever has a precondition
 the requester does not guarantee (hand over the item the robot holds, for a requester whose robot holds
-nothing), an advertisement whose effect brings it about (picking the item up) is a step, with the same
-share.
+nothing), an advertisement whose effect brings it about for what the request is about (picking the
+item up) is a step, with the same share.
 With MatchConfig.consumer_steps, an advertisement that changes nothing but takes such an input as it is
 (that concept or an is-a superclass of it) is a step too, with a producer's share: the path planner that
 takes the NavigationGoal a drive service needs works on the same goal before it is reached. One that
@@ -94,7 +94,7 @@ def achievers(
         matches = best_statement_matches(requirement.effects, ad.effects, measure, config)
         value = sum(m.value for m in matches) / len(matches)
         missing = tuple(dict.fromkeys(p.type for p in ad.inputs if not provided(index, requirement, p.type)))
-        unmet = tuple(c for c in ad.preconditions if not guaranteed(index, requirement, c))
+        unmet = unmet_conditions(index, requirement, ad)
         if value >= config.pair_threshold and (missing or unmet):
             found.append(Achiever(ad, value, missing, unmet))
     return found
@@ -114,8 +114,24 @@ def states_at_least(index: TaxonomyIndex, stated: Statement, wanted: Statement) 
 
 def establishes(index: TaxonomyIndex, effect: Statement, condition: Statement) -> bool:
     """Does an advertised ``effect`` bring ``condition`` about: each position the condition's concept or an
-    is-a superclass of it, as an achiever's does (grasping any PhysicalObject grasps the HouseholdItem)?"""
+    is-a superclass of it, as an achiever's does (grasping any PhysicalObject grasps the Cup)?"""
     return all(at_or_above(index, getattr(condition, at), getattr(effect, at)) for at in _POSITIONS)
+
+
+def unmet_conditions(index: TaxonomyIndex, requirement: Requirement, ad: Advertisement) -> tuple[Statement, ...]:
+    """The preconditions of an achiever ``ad`` that the requester does not guarantee, each about what the
+    request is about: a concept of the achiever's effect stands for the requested concept it achieves the
+    effect for, in its preconditions too (a hand-over of any Item that needs the Item held, asked to hand
+    over Spectacles, needs the Spectacles held: picking up any PersonalItem brings that about, carrying a
+    Person does not)."""
+    binding: dict[str, str] = {}
+    for wanted in requirement.effects:
+        for got in ad.effects:
+            if establishes(index, got, wanted):
+                for at in _POSITIONS:
+                    binding.setdefault(getattr(got, at), getattr(wanted, at))
+    bound = (Statement(*(binding.get(getattr(c, at), getattr(c, at)) for at in _POSITIONS)) for c in ad.preconditions)
+    return tuple(dict.fromkeys(c for c in bound if not guaranteed(index, requirement, c)))
 
 
 _POSITIONS = ("subject", "predicate", "object")
