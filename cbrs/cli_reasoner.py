@@ -18,8 +18,12 @@ from cbrs.settings import setting
 
 
 def match_config(params: tuple[str, ...], base: MatchConfig | None = None) -> MatchConfig:
-    """``base`` (MatchConfig's defaults) with the ``--param`` options, else the match_params setting."""
-    return (base or MatchConfig()).with_params(setting("match_params").resolve(params or None))
+    """``base`` (MatchConfig's defaults) with the ``--param`` options, else the match_params setting; says
+    on standard error which are set, so that no figure is read as the defaults' by mistake."""
+    given = setting("match_params").resolve(params or None)
+    if given:
+        click.echo(f"matchmaking parameters: {', '.join(given)}", err=True)
+    return (base or MatchConfig()).with_params(given)
 
 
 def _list_params(ctx: click.Context, _: click.Parameter, value: bool) -> None:

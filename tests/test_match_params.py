@@ -59,7 +59,10 @@ def _scores(*args: str, env: dict[str, str] | None = None) -> dict[str, float]:
         cli, ["--store", ":memory:", "match", "req:RobotSelfPosition", "--json", "--top", "53", *args], env=env
     )
     assert result.exit_code == 0, result.output
-    return {c["advertisement"]: c["score"] for c in json.loads(result.output)["candidates"]}
+    given = [a for a in args if "=" in a] or [v for v in (env or {}).values() if v]
+    # which parameters are set goes to standard error, so that the JSON stays the same
+    assert ("matchmaking parameters: " in result.stderr) == bool(given)
+    return {c["advertisement"]: c["score"] for c in json.loads(result.stdout)["candidates"]}
 
 
 def test_cbrs_match_ranks_with_the_parameters_given() -> None:
