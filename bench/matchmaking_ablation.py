@@ -32,6 +32,7 @@ DEFAULTS = [
     ROOT / "tests" / "data" / "robot_heldout",
     ROOT / "tests" / "data" / "robot_validation",
     ROOT / "tests" / "data" / "robot_final",
+    ROOT / "tests" / "data" / "robot_blind5",
 ]
 BASE = MatchConfig()
 VARIANTS: dict[str, MatchConfig] = {
