@@ -7,6 +7,7 @@ them) by ``MatchConfig.with_params``, so a deployment can turn a rule on or off 
 from __future__ import annotations
 
 import difflib
+import math
 from collections.abc import Iterable
 from dataclasses import dataclass, fields, replace
 from typing import Any
@@ -267,7 +268,10 @@ def _parsed(name: str, text: str, kind: str) -> Any:
         if kind == "int":
             return int(text)
         if kind == "float":
-            return float(text)
+            value = float(text)
+            if not math.isfinite(value):
+                raise ValueError(text)
+            return value
     except ValueError:
         raise MatchParameterError(name, text, f"expected a number ({kind})") from None
     return text

@@ -35,6 +35,7 @@ def test_each_kind_of_parameter_is_read_as_its_type() -> None:
         ("statement_mean=median", "statement_mean", "'arithmetic' or 'geometric'"),
         ("consumer_steps=maybe", "consumer_steps", "yes/no"),
         ("lexical_links=1.5", "lexical_links", "expected a number (int)"),
+        ("output_weight=nan", "output_weight", "expected a number (float)"),
         ("complement_weight", "complement_weight", "expected NAME=VALUE"),
     ],
 )
