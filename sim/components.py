@@ -38,7 +38,7 @@ from cbrs.sim.errors import SimulationError
 from cbrs.sim.geometry import Pose2D, Region
 from cbrs.sim.grasping import GraspPose, ObjectModel, compute_grasp_pose
 from cbrs.sim.mapping import OccupancyGrid, build_occupancy_grid
-from cbrs.sim.perceived import PerceivedWorld
+from cbrs.sim.perceived import SEARCH_RADIUS, PerceivedWorld
 from cbrs.sim.perception import (
     ObjectEstimate,
     PersonEstimate,
@@ -90,6 +90,8 @@ class SimContext:
     region: Region | None = None  # where the carried object goes
     last_arm: ArmSide | None = None  # the arm that acted last, so a tie goes to the other
     inputs: Mapping[str, Any] = field(default_factory=dict)  # what the running component was given
+    belief: PerceivedWorld | None = None  # where the robots believe things are
+    designated: frozenset[str] = frozenset()  # the things the running task's inputs name (IRIs)
 
     @property
     def map(self) -> SemanticMap:
@@ -225,8 +227,25 @@ def compute_grasp(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> di
 
 
 def _recognise(ctx: SimContext, camera: str, colour: str) -> ObjectEstimate:
+    """The object of ``colour`` in the camera's image. Where several things of the home share the
+    colour, it is the one the task names (else the one thing of that colour), looked for where it is
+    believed to be: another thing of its colour is not it."""
     _check(skills.clear_view(ctx.world))  # the camera between the arms: fold them first
-    return recognise_object(ctx.world.camera(camera).capture(), colour)
+    frame = ctx.world.camera(camera).capture()
+    alike = sorted(name for name, obj in ctx.world.objects.items() if obj.colour == colour)
+    meant = [name for name in alike if ctx.world.objects[name].iri in ctx.designated] if len(alike) > 1 else alike
+    if len(meant) != 1:
+        return recognise_object(frame, colour)  # one thing of its colour in view, else ambiguous
+    name = meant[0]
+    believed = ctx.belief.position(name) if ctx.belief is not None else None
+    start = ctx.world.objects[name].start
+    near = (believed[0], believed[1]) if believed is not None else (start.x, start.y)
+    try:
+        return recognise_object(frame, colour, near=near, radius=SEARCH_RADIUS)
+    except SimulationError:
+        if len(alike) > 1:
+            raise
+        return recognise_object(frame, colour)  # its colour is its own: wherever it is now
 
 
 def recognise_by_colour(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
@@ -521,8 +540,8 @@ class SimEnvironment:
         self.transport = transport
         """How components in other processes are reached (a bridge connection); None: only simulated ones."""
         self.registry = implementations(kb, world, transport=transport)
-        self.context = SimContext(world, kb)
         self.belief = PerceivedWorld(world)
+        self.context = SimContext(world, kb, belief=self.belief)
         self.referee = Referee(world)
         self.effects: set[tuple[str, str, str]] = set()
         """Relations believed because a step with that effect succeeded, where no test decides them."""
@@ -557,6 +576,7 @@ class SimEnvironment:
                     if parameter.name == source.name:
                         iri = designate(self.kb, parameter.type, prefer=requirement.requested_by)
                         values[source.name] = designator(iri, parameter.type)
+        self.context.designated = frozenset(str(value["@id"]) for value in values.values())
         return values
 
     # -- verification: the generic test the store maps each predicate to ---------------------

@@ -62,6 +62,20 @@ class NotVisibleError(PerceptionError):
         super().__init__(f"{target} not visible in {camera}: {pixels} matching pixels, at least {needed} needed")
 
 
+class AmbiguousSightingError(PerceptionError):
+    """Several separate things of the colour looked for are in view, and nothing says which is meant."""
+
+    def __init__(self, camera: str, colour: str, positions: Sequence[tuple[float, float, float]]) -> None:
+        self.camera = camera
+        self.colour = colour
+        self.positions = tuple(positions)
+        where = ", ".join(f"({x:.2f}, {y:.2f})" for x, y, _ in self.positions)
+        super().__init__(
+            f"{len(self.positions)} separate {colour} things in view of {camera}, at {where}: "
+            "say where the one meant is believed to be"
+        )
+
+
 class UnknownColourError(PerceptionError):
     """A colour name the segmenter has no range for."""
 

@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cbrs.sim.cameras import Frame
-from cbrs.sim.errors import NotVisibleError, UnknownColourError
+from cbrs.sim.errors import AmbiguousSightingError, NotVisibleError, UnknownColourError
 from cbrs.sim.layout import SHIRT_RADIUS, SHIRT_TOP
 
 __all__ = [
@@ -29,6 +29,7 @@ __all__ = [
     "ObjectEstimate",
     "PersonEstimate",
     "RobotPoseEstimate",
+    "blobs",
     "locate_robot",
     "recognise_object",
     "segment",
@@ -65,6 +66,9 @@ MIN_PERSON_PIXELS = 20
 MIN_OBJECT_PIXELS = 15
 MARKER_SPACING_TOLERANCE = 0.08
 """The two patch centres must be the marker's separation apart within 8 cm, else the marker is half hidden."""
+MARKER_MERGED_FACTOR = 1.5
+"""A patch blob with more than 1.5 times the pixels a whole patch can cover there has merged with
+something else of its colour (an object of the marker's colour touching it): its centre would be wrong."""
 
 
 def _colour(colour: str | ColourRange) -> ColourRange:
@@ -106,9 +110,44 @@ def segment(rgb: NDArray[np.uint8], colour: str | ColourRange) -> NDArray[np.boo
     return mask
 
 
-def _pixels(mask: NDArray[np.bool_]) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def blobs(mask: NDArray[np.bool_]) -> list[tuple[NDArray[np.float64], NDArray[np.float64]]]:
+    """The 8-connected blobs of a mask as (us, vs) pixel coordinates, the largest first.
+
+    Colours are shared: an object of the marker's green or of the person's yellow is a blob of its
+    own, which must not be averaged into what is looked for. Masks hold a few hundred pixels, so a
+    breadth-first walk over them is cheap.
+    """
     vs, us = np.nonzero(mask)
-    return us.astype(np.float64), vs.astype(np.float64)
+    label = {(int(v), int(u)): -1 for v, u in zip(vs, us, strict=True)}
+    found: list[list[tuple[int, int]]] = []
+    for start in label:
+        if label[start] >= 0:
+            continue
+        label[start] = len(found)
+        members = [start]
+        index = 0
+        while index < len(members):
+            v, u = members[index]
+            index += 1
+            for dv in (-1, 0, 1):
+                for du in (-1, 0, 1):
+                    key = (v + dv, u + du)
+                    if label.get(key) == -1:
+                        label[key] = len(found)
+                        members.append(key)
+        found.append(members)
+    found.sort(key=len, reverse=True)
+    result = []
+    for members in found:
+        pixels = np.array(members, dtype=np.float64)
+        result.append((pixels[:, 1], pixels[:, 0]))
+    return result
+
+
+def _mask_of(shape: tuple[int, ...], us: NDArray[np.float64], vs: NDArray[np.float64]) -> NDArray[np.bool_]:
+    mask = np.zeros(shape[:2], dtype=bool)
+    mask[vs.astype(np.intp), us.astype(np.intp)] = True
+    return mask
 
 
 def _whole(frame: Frame, mask: NDArray[np.bool_], target: str) -> None:
@@ -144,30 +183,48 @@ class MarkerModel:
 
 
 def locate_robot(frame: Frame, marker: MarkerModel) -> RobotPoseEstimate:
-    """The base's pose from its two-colour marker; ``NotVisibleError`` if either patch is missing."""
-    points = []
-    count = 0
+    """The base's pose from its two-colour marker; ``NotVisibleError`` if either patch is missing.
+
+    Each colour may show several blobs (a green object on the table, a magenta book): the patches are
+    the front and rear blobs whose centres are the marker's separation apart, the pair closest to it.
+    """
+    candidates: list[list[tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]]] = []
     for colour, target in ((marker.front, "marker front"), (marker.rear, "marker rear")):
-        mask = segment(frame.rgb, colour)
-        us, vs = _pixels(mask)
-        if us.size < MIN_MARKER_PIXELS:
-            raise NotVisibleError(frame.camera, f"robot {target} ({colour})", int(us.size), MIN_MARKER_PIXELS)
-        _whole(frame, mask, f"robot {target} ({colour})")
+        found = [(us, vs) for us, vs in blobs(segment(frame.rgb, colour)) if us.size >= MIN_MARKER_PIXELS]
+        if not found:
+            raise NotVisibleError(frame.camera, f"robot {target} ({colour})", 0, MIN_MARKER_PIXELS)
+        candidates.append(
+            [(us, vs, frame.intersect_plane(us, vs, marker.height)[:, :2].mean(axis=0)) for us, vs in found]
+        )
+    pairs = [
+        (abs(float(np.linalg.norm(f[2] - r[2])) - marker.separation), f, r)
+        for f in candidates[0]
+        for r in candidates[1]
+    ]
+    error, front, rear = min(pairs, key=lambda pair: pair[0])
+    count = int(front[0].size + rear[0].size)
+    if error > MARKER_SPACING_TOLERANCE:
+        spacing = float(np.linalg.norm(front[2] - rear[2]))
+        raise NotVisibleError(frame.camera, f"whole robot marker (patches {spacing:.2f} m apart)", count, count + 1)
+    for (us, vs, _), colour, target in ((front, marker.front, "marker front"), (rear, marker.rear, "marker rear")):
+        _whole(frame, _mask_of(frame.rgb.shape, us, vs), f"robot {target} ({colour})")
         # A partly hidden patch would pull its centroid off: compare its pixel count with the fewest
         # a whole patch covers there, one row and one column less than its size in pixels (pixel
-        # size measured on the marker's plane at the patch).
+        # size measured on the marker's plane at the patch); one merged with a thing of its colour
+        # covers more than a whole patch can.
         u, v = float(np.median(us)), float(np.median(vs))
         corners = frame.intersect_plane(np.array([u, u + 1.0, u]), np.array([v, v, v + 1.0]), marker.height)
         pixel = math.sqrt(float(np.linalg.norm(np.cross(corners[1] - corners[0], corners[2] - corners[0]))))
-        needed = math.ceil((marker.patch[0] / pixel - 1.0) * (marker.patch[1] / pixel - 1.0))
+        along, across = marker.patch[0] / pixel, marker.patch[1] / pixel
+        needed = math.ceil((along - 1.0) * (across - 1.0))
         if us.size < needed:
             raise NotVisibleError(frame.camera, f"whole robot {target} ({colour})", int(us.size), needed)
-        count += int(us.size)
-        points.append(frame.intersect_plane(us, vs, marker.height)[:, :2].mean(axis=0))
-    head, tail = points
-    spacing = float(np.linalg.norm(head - tail))
-    if abs(spacing - marker.separation) > MARKER_SPACING_TOLERANCE:
-        raise NotVisibleError(frame.camera, f"whole robot marker (patches {spacing:.2f} m apart)", count, count + 1)
+        most = MARKER_MERGED_FACTOR * (along + 1.0) * (across + 1.0)
+        if us.size > most:
+            raise NotVisibleError(
+                frame.camera, f"robot {target} ({colour}) apart from another {colour} thing touching it", 0, 1
+            )
+    head, tail = front[2], rear[2]
     centre = (head + tail) / 2.0
     theta = math.atan2(float(head[1] - tail[1]), float(head[0] - tail[0]))
     return RobotPoseEstimate(float(centre[0]), float(centre[1]), theta, frame.camera, frame.time, count)
@@ -194,12 +251,20 @@ def track_person(frame: Frame, shirt: str = "yellow") -> PersonEstimate:
     Across the viewing direction the blob is symmetric. So: centre = far edge minus the shirt's
     radius along the viewing direction, and the middle of the blob across it.
     """
-    mask = segment(frame.rgb, shirt)
-    us, vs = _pixels(mask)
-    if us.size < MIN_PERSON_PIXELS:
-        raise NotVisibleError(frame.camera, f"person ({shirt} shirt)", int(us.size), MIN_PERSON_PIXELS)
-    _whole(frame, mask, f"person ({shirt} shirt)")
-    points = frame.intersect_plane(us, vs, SHIRT_TOP)[:, :2]
+    found = blobs(segment(frame.rgb, shirt))
+    if not found or found[0][0].size < MIN_PERSON_PIXELS:
+        raise NotVisibleError(
+            frame.camera, f"person ({shirt} shirt)", int(found[0][0].size) if found else 0, MIN_PERSON_PIXELS
+        )
+    # The shirt is the largest blob of its colour, with the pieces of it within a shirt's width (the
+    # head may cut it); a thing of that colour farther away is not the person.
+    pieces = [(us, vs, frame.intersect_plane(us, vs, SHIRT_TOP)[:, :2]) for us, vs in found]
+    middle = pieces[0][2].mean(axis=0)
+    kept = [piece for piece in pieces if float(np.linalg.norm(piece[2].mean(axis=0) - middle)) <= 2.0 * SHIRT_RADIUS]
+    us = np.concatenate([piece[0] for piece in kept])
+    vs = np.concatenate([piece[1] for piece in kept])
+    _whole(frame, _mask_of(frame.rgb.shape, us, vs), f"person ({shirt} shirt)")
+    points = np.concatenate([piece[2] for piece in kept])
     eye = frame.eye[:2]
     rough = points.mean(axis=0)
     along = rough - eye
@@ -221,6 +286,43 @@ def track_person(frame: Frame, shirt: str = "yellow") -> PersonEstimate:
         mid_across = (float(c.min()) + float(c.max())) / 2.0
         centre = eye + along * (far - SHIRT_RADIUS) + across * mid_across
     return PersonEstimate(float(centre[0]), float(centre[1]), frame.camera, frame.time, int(us.size))
+
+
+SAME_THING_GAP = 0.03
+"""Blobs of one colour whose 3D points come within 3 cm of each other are one thing (split by what
+stands in front of it); farther apart, they are separate things."""
+
+
+def _things(
+    frame: Frame, mask: NDArray[np.bool_]
+) -> list[tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]]:
+    """The separate things of a colour in an RGB-D frame: (us, vs, 3D points), the largest first."""
+    pieces = [(us, vs, frame.deproject(us, vs)) for us, vs in blobs(mask)]
+    group = list(range(len(pieces)))
+
+    def root(i: int) -> int:
+        while group[i] != i:
+            i = group[i]
+        return i
+
+    for i in range(len(pieces)):
+        for j in range(i + 1, len(pieces)):
+            a, b = pieces[i][2], pieces[j][2]
+            if np.any(np.abs(a[:, None, :] - b[None, :, :]).max(axis=2) <= SAME_THING_GAP):
+                group[root(j)] = root(i)
+    merged: dict[int, list[int]] = {}
+    for i in range(len(pieces)):
+        merged.setdefault(root(i), []).append(i)
+    things = [
+        (
+            np.concatenate([pieces[i][0] for i in members]),
+            np.concatenate([pieces[i][1] for i in members]),
+            np.concatenate([pieces[i][2] for i in members]),
+        )
+        for members in merged.values()
+    ]
+    things.sort(key=lambda thing: thing[0].size, reverse=True)
+    return things
 
 
 @dataclass(frozen=True)
@@ -252,22 +354,30 @@ def recognise_object(
     The seen points cover the top and the camera-facing side. For the upright and lying shapes on
     the table that is enough: the middle of the points' bounding box (taken along the object's own
     axis) is the object's centre, within the pixel size. The yaw comes from the points' principal axis.
-    With ``near`` (x, y), only the points of that colour within ``radius`` of it count: another thing
-    of the same colour elsewhere is not this object.
+    The pixels of the colour are split into separate things (:func:`blobs`, joined where their points
+    touch). With ``near`` (x, y) the object is the thing whose centre is nearest it, within ``radius``:
+    another thing of the same colour is not this object. Without it, two things of the colour in view
+    are an ``AmbiguousSightingError`` rather than one estimate between them.
     """
-    mask = segment(frame.rgb, colour)
-    us, vs = _pixels(mask)
     target = f"{colour} object" if near is None else f"{colour} object near ({near[0]:.2f}, {near[1]:.2f})"
-    if near is not None and us.size:
-        seen = frame.deproject(us, vs)
-        keep = np.hypot(seen[:, 0] - near[0], seen[:, 1] - near[1]) <= radius
-        us, vs = us[keep], vs[keep]
-        mask = np.zeros_like(mask)
-        mask[vs.astype(np.intp), us.astype(np.intp)] = True
-    if us.size < MIN_OBJECT_PIXELS:
-        raise NotVisibleError(frame.camera, target, int(us.size), MIN_OBJECT_PIXELS)
-    _whole(frame, mask, target)
-    points = frame.deproject(us, vs)
+    things = _things(frame, segment(frame.rgb, colour))
+    if near is not None:
+        # the thing nearest where the object is believed to be, if it is within the radius; another
+        # thing of its colour nearby is not part of it
+        distance = [float(np.hypot(*(points[:, :2].mean(axis=0) - near))) for _, _, points in things]
+        things = [thing for thing, d in sorted(zip(things, distance, strict=True), key=lambda t: t[1]) if d <= radius]
+    else:
+        big = [thing for thing in things if thing[0].size >= MIN_OBJECT_PIXELS]
+        if len(big) > 1:
+            centres = [points.mean(axis=0) for _, _, points in big]
+            raise AmbiguousSightingError(
+                frame.camera, colour, [(float(c[0]), float(c[1]), float(c[2])) for c in centres]
+            )
+    pixels = int(things[0][0].size) if things else 0
+    if pixels < MIN_OBJECT_PIXELS:
+        raise NotVisibleError(frame.camera, target, pixels, MIN_OBJECT_PIXELS)
+    us, vs, points = things[0]
+    _whole(frame, _mask_of(frame.rgb.shape, us, vs), target)
     xy = points[:, :2]
     mean = xy.mean(axis=0)
     cov = np.cov((xy - mean).T)
