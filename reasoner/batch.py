@@ -22,7 +22,8 @@ from cbrs.reasoner.spans import span
 from cbrs.reasoner.steps import unmet_conditions
 from cbrs.reasoner.vectors import ARRAY_CACHE_BYTES, FloatArray, IntArray, VectorSpace, _Lru, _nbytes
 
-PARTS = ("outputs", "inputs", "effects", "preconditions")
+PARTS = ("outputs", "inputs", "effects", "deletes", "preconditions")
+RESULTS = ("outputs", "effects", "deletes")  # what a service brings about, as opposed to what it needs
 _PADDED = 8  # _Segments: the longest segment reduced by padded rows (numpy sums 8 items or fewer in order)
 
 
@@ -145,7 +146,7 @@ class CompiledPool:
         for ad in self.ads:
             for parameter in (*ad.inputs, *ad.outputs):
                 trees.setdefault(parameter.type, parameter.tree or PartNode(parameter.type))
-            for statement in (*ad.effects, *ad.preconditions):
+            for statement in (*ad.effects, *ad.deletes, *ad.preconditions):
                 statements.setdefault(statement, len(statements))
         self.tree_ids = {concept: i for i, concept in enumerate(trees)}
         self.tree_concepts = list(trees)  # each tree's root concept, by tree id
@@ -161,6 +162,7 @@ class CompiledPool:
         self.outputs = _Segments([[self.tree_ids[p.type] for p in ad.outputs] for ad in self.ads])
         self.inputs = _Segments([[self.tree_ids[p.type] for p in ad.inputs] for ad in self.ads])
         self.effects = _Segments([[statements[s] for s in ad.effects] for ad in self.ads])
+        self.deletes = _Segments([[statements[s] for s in ad.deletes] for ad in self.ads])
         self.preconditions = _Segments([[statements[s] for s in ad.preconditions] for ad in self.ads])
         keys: dict[tuple[EffectiveArea | None, tuple[QoSValue, ...]], int] = {}
         self.filter_key = np.array([keys.setdefault((ad.area, ad.qos), len(keys)) for ad in self.ads], np.int64)
@@ -634,17 +636,14 @@ class BatchScorer:
                     effects = np.maximum(effects, steps)
                     brings_about = steps > 0
             parts["effects"] = effects
+        if requirement.deletes:
+            parts["deletes"] = np.mean([pool.deletes.max(self.statements(s)) for s in requirement.deletes], axis=0)
         if requirement.preconditions:
             guaranteed = np.max([self.statements(s) for s in requirement.preconditions], axis=0)
             # all of an advertisement's preconditions must hold (precondition_conjunction): the worst decides
             combine = pool.preconditions.min if cfg.precondition_conjunction else pool.preconditions.mean
             parts["preconditions"] = np.where(pool.preconditions.present, combine(guaranteed), np.nan)
-        weights = {
-            "outputs": cfg.output_weight,
-            "inputs": cfg.input_weight,
-            "effects": cfg.effect_weight,
-            "preconditions": cfg.precondition_weight,
-        }
+        weights = cfg.part_weights
         numerator = np.zeros(n)
         denominator = np.zeros(n)
         for name, values in parts.items():
@@ -665,10 +664,11 @@ class BatchScorer:
 
     @staticmethod
     def _result(parts: dict[str, FloatArray], weights: dict[str, float]) -> FloatArray:
-        """The result part of each score: outputs and effects, weighted as in the score (0 where neither)."""
+        """The result part of each score: outputs, effects and delete effects, weighted as in the score (0
+        where none)."""
         numerator = np.zeros(len(parts["outputs"]))
         denominator = np.zeros(len(parts["outputs"]))
-        for name in ("outputs", "effects"):
+        for name in RESULTS:
             present = ~np.isnan(parts[name])
             numerator += np.where(present, weights[name] * np.nan_to_num(parts[name]), 0.0)
             denominator += np.where(present, weights[name], 0.0)

@@ -123,6 +123,10 @@ class MatchConfig:
     input_weight: float = 0.2
     effect_weight: float = 0.3
     precondition_weight: float = 0.1
+    # What a requirement asks to stop being true (cbrs:hasDeleteEffect, a cbrs extension: the paper's PE
+    # has effects only) is a result like an effect: each requested delete effect's best statement match
+    # among the advertised delete effects, averaged, weighed as much as the effects.
+    delete_weight: float = 0.3
     # An advertisement's preconditions must all hold before it can be invoked (a conjunction): its
     # preconditions part is the lowest of their best matches among what the requirement guarantees.
     # False: their mean, so one guaranteed precondition made up for one nothing guarantees.
@@ -159,9 +163,9 @@ class MatchConfig:
     # the mean over the advertised inputs of how well the requester can supply each (1 when it provides
     # the concept or a subclass, else the best similarity to what it provides; 1 with no inputs).
     input_gate: float = 0.0
-    # Candidates with equal scores are put in order by their result part (outputs and effects, weighted as in
-    # the score, to three decimals) before their IRI: what the requester asked for before how the service is
-    # invoked. False: by IRI alone (the published order, which the baselines keep).
+    # Candidates with equal scores are put in order by their result part (outputs, effects and delete
+    # effects, weighted as in the score, to three decimals) before their IRI: what the requester asked for
+    # before how the service is invoked. False: by IRI alone (the published order, which the baselines keep).
     tie_break_result: bool = True
     # The hybrid method (sem-str-text): the share of the TF-IDF cosine of names and text descriptions in
     # the ranking score; the rest is the Sem-Str IO/PE score, which alone decides acceptability.
@@ -196,6 +200,18 @@ class MatchConfig:
         except ValueError as error:  # __post_init__'s range checks name the field
             name = next((n for n in values if n in str(error)), next(iter(values)))
             raise MatchParameterError(name, str(values[name]), str(error)) from error
+
+    @property
+    def part_weights(self) -> dict[str, float]:
+        """The weight of each part of a score, by the part's name (the parts a requirement does not
+        state are left out and the rest renormalised)."""
+        return {
+            "outputs": self.output_weight,
+            "inputs": self.input_weight,
+            "effects": self.effect_weight,
+            "deletes": self.delete_weight,
+            "preconditions": self.precondition_weight,
+        }
 
     def published(self) -> MatchConfig:
         """This configuration with every refinement of docs/matchmaking.md section 9 turned off: how the

@@ -1,6 +1,6 @@
 """The matchmaker: rank every advertisement against a requirement, and say why.
 
-A candidate's score combines four parts, each in [0, 1]; parts the requirement does not state are
+A candidate's score combines up to five parts, each in [0, 1]; parts the requirement does not state are
 left out and the weights of the rest renormalised (MatchConfig):
 
 - outputs: each requested output's best CSS against the advertised outputs, averaged;
@@ -8,6 +8,8 @@ left out and the weights of the rest renormalised (MatchConfig):
   provides (can it be invoked?) and each provided input's best CSS against the advertised inputs (does
   it use what the requester offers?);
 - effects: each requested effect's best statement similarity against the advertised effects;
+- deletes: likewise for what the requirement asks to stop being true, against the advertised delete
+  effects;
 - preconditions: each advertised precondition's best statement similarity against the
   preconditions the requirement guarantees (only when it states any); all must hold, so the lowest
   counts (MatchConfig.precondition_conjunction).
@@ -332,16 +334,14 @@ class Matchmaker:
             ):
                 brings_about = self._precondition_step(requirement, ad, pairs)
                 parts["effects"] = max(parts["effects"], brings_about)
+        if requirement.deletes:
+            matches = best_statement_matches(requirement.deletes, ad.deletes, self.method.measure, cfg)
+            parts["deletes"] = self._statements(matches, "delete effect", pairs, lacks)
         if ad.preconditions and requirement.preconditions:
             matches = best_statement_matches(ad.preconditions, requirement.preconditions, self.method.measure, cfg)
             every = cfg.precondition_conjunction  # all must hold: the worst one decides
             parts["preconditions"] = self._statements(matches, "precondition", pairs, lacks, every)
-        weights = {
-            "outputs": cfg.output_weight,
-            "inputs": cfg.input_weight,
-            "effects": cfg.effect_weight,
-            "preconditions": cfg.precondition_weight,
-        }
+        weights = cfg.part_weights
         total = sum(weights[name] for name in parts)
         score = sum(weights[name] * value for name, value in parts.items()) / total if total else 0.0
         score *= 1 - cfg.input_gate + cfg.input_gate * (needed if needed is not None else 1.0)
@@ -350,7 +350,8 @@ class Matchmaker:
         score *= self._undone_state(requirement, ad, lacks)
         rejected = self.filters(requirement, ad.area, ad.qos)
         if self.method.strict:
-            failed = [pair for pair in pairs if pair.role in ("output", "effect") and pair.degree == Degree.FAIL.value]
+            results = ("output", "effect", "delete effect")
+            failed = [pair for pair in pairs if pair.role in results and pair.degree == Degree.FAIL.value]
             if failed:
                 rejected.append(f"strict logic: {failed[0].role} {_short(failed[0].requested)} has no accepted match")
         score = round(score, 6)

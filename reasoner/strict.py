@@ -88,14 +88,17 @@ class StrictScorer:
                 text = f"({_short(effect.subject)}, {_short(effect.predicate)}, {_short(effect.object)})"
                 failed.append((f"effect {text}", best <= 0))
             parts["effects"] = np.mean(per, axis=0)
+        if requirement.deletes:
+            per = []
+            for deleted in requirement.deletes:
+                best = self._statements(deleted, pool.deletes, inverse=False)
+                per.append(best)
+                text = f"({_short(deleted.subject)}, {_short(deleted.predicate)}, {_short(deleted.object)})"
+                failed.append((f"delete effect {text}", best <= 0))
+            parts["deletes"] = np.mean(per, axis=0)
         if requirement.preconditions:
             parts["preconditions"] = self._preconditions(requirement.preconditions)
-        weights = {
-            "outputs": cfg.output_weight,
-            "inputs": cfg.input_weight,
-            "effects": cfg.effect_weight,
-            "preconditions": cfg.precondition_weight,
-        }
+        weights = cfg.part_weights
         numerator, denominator = np.zeros(n), np.zeros(n)
         for name, values in parts.items():
             present = ~np.isnan(values)
