@@ -22,10 +22,12 @@ from cbrs.app import App, parse_iri, pass_app
 from cbrs.extras import require
 from cbrs.kb import Advertisement, KnowledgeBaseError, Requirement, ServiceDescription
 from cbrs.kb.catalog import Catalogue, merge
+from cbrs.kb.errors import QuerySyntaxError
 from cbrs.kb.loader import LoadReport, ParsedFile
 from cbrs.kb.namespaces import OWL, PREFIXES, GraphName, expand, shorten
 from cbrs.output import RESULT_FORMATS, render_result, table, term_text
 from cbrs.settings import SETTINGS, setting
+from cbrs.sparql_hints import explain_syntax_error
 
 # Commands whose modules import numpy, networkx, the composer or the web server (most of a second at
 # start-up): each is imported when it runs or shows its own help. ``cbrs --help`` lists them from the
@@ -274,7 +276,13 @@ def query(
                 f"this is a SPARQL update ({update.group(1).upper()}); cbrs query runs queries only: "
                 "send updates to /update of cbrs serve (with its update token)"
             )
-        result = app.kb.query(body)
+        try:
+            result = app.kb.query(body)
+        except QuerySyntaxError as error:  # a prefix nobody declared: said plainly, as the endpoint does
+            explained = explain_syntax_error(error, body, "query")
+            if explained is error:
+                raise
+            raise explained from error
     click.echo(render_result(result, fmt))
 
 

@@ -17,7 +17,7 @@ from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.loader import parse_bytes
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.shapes import check_descriptions
-from cbrs.sparql_service import SparqlService
+from cbrs.sparql_service import NotAcceptableError, SparqlService, negotiate
 
 __all__ = ["GraphStore", "GraphStoreError", "Target", "UnknownGraphError"]
 
@@ -162,14 +162,10 @@ class GraphStore:
 
 
 def _negotiate(accept: str | None, offered: tuple[ox.RdfFormat, ...]) -> ox.RdfFormat:
-    if not accept or accept.strip() in ("*/*", ""):
-        return offered[0]
-    for part in accept.split(","):
-        media = part.split(";")[0].strip().lower()
-        if media in ("*/*", "text/*", "application/*"):
-            return offered[0]
-        fmt = ox.RdfFormat.from_media_type(media)
-        if fmt in offered:
-            assert fmt is not None
-            return fmt
-    raise NotAcceptableFormatError(accept, offered)
+    """The offered format the Accept header prefers, by its q-values and with the endpoint's reading of
+    media types (parameters ignored, Oxigraph's aliases such as ``application/x-turtle``)."""
+    by_type = {fmt.media_type: fmt for fmt in offered}
+    try:
+        return by_type[negotiate(True, accept, None, tuple(by_type))]
+    except NotAcceptableError as error:
+        raise NotAcceptableFormatError(accept or "", offered) from error

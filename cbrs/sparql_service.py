@@ -26,7 +26,6 @@ from __future__ import annotations
 import functools
 import hmac
 import io
-import re
 import threading
 import time
 from collections import Counter
@@ -34,11 +33,10 @@ from collections.abc import Callable, Sequence
 from concurrent.futures import Future
 from concurrent.futures import TimeoutError as FutureTimeout
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Concatenate, Literal, ParamSpec, TypeVar
 
 import pyoxigraph as ox
 from werkzeug.datastructures import MIMEAccept
-from werkzeug.http import parse_accept_header
 
 from cbrs import pattern_lookup
 from cbrs._query_worker import dataset_options
@@ -46,11 +44,11 @@ from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import KnowledgeBaseError, QuerySyntaxError, QueryTooComplexError, StoreEvaluationError
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.query_guard import start_evaluation_thread
-from cbrs.kb.sparql_lexemes import HIDING
 from cbrs.kb.store import EmbeddedStore, QueryResult, is_remote, refuse_inserted_blank_nodes
 from cbrs.query_workers import QueryProcesses, QueryStopped, Request
 from cbrs.scan_queries import is_single_scan, single_scan, uses_prefixes
 from cbrs.settings import setting
+from cbrs.sparql_hints import FORMS, TOKENS, explain_syntax_error
 
 # Media types offered for SELECT and ASK results, the first being the default.
 RESULT_TYPES: dict[str, ox.QueryResultsFormat] = {
@@ -209,23 +207,11 @@ class Dataset:
         return cls(tuple(default_graphs), tuple(named_graphs))
 
 
-# The query's tokens that matter for its dataset clause: IRIs, prefixed names and keywords; strings,
-# comments, variables and language tags are matched whole so that nothing inside them counts.
-_TOKEN = re.compile(
-    r'(?P<iri><[^<>"{}|^`\\\x00-\x20]*>)|'
-    + HIDING
-    + r"""|[?$]\w+|@[A-Za-z][\w-]*|(?P<pname>[\w.\-\u00b7\u00c0-\uffff]*:(?:[^\s{}()\[\]<>"',;#\\]|\\.)*)"""
-    r"|(?P<word>[A-Za-z_]\w*)",
-    re.DOTALL,
-)
-_FORMS = {"SELECT", "CONSTRUCT", "DESCRIBE", "ASK"}
-
-
 def has_dataset_clause(text: str) -> bool:
     """Whether the query names its own dataset with ``FROM`` or ``FROM NAMED`` (only those clauses use the keyword)."""
     if "FROM" not in text.upper():
         return False  # the common case, without tokenising
-    return any((match.group("word") or "").upper() == "FROM" for match in _TOKEN.finditer(text))
+    return any((match.group("word") or "").upper() == "FROM" for match in TOKENS.finditer(text))
 
 
 def dataset_clause(text: str) -> Dataset | None:
@@ -235,8 +221,8 @@ def dataset_clause(text: str) -> Dataset | None:
     query's own prologue (``BASE``, ``PREFIX``) and cbrs's prefixes. ``None`` too for a clause that cannot
     be read: the query is then evaluated as written and its parser reports what is wrong.
     """
-    tokens = [m for m in _TOKEN.finditer(text) if m.lastgroup in ("iri", "pname", "word")]
-    prologue_end = next((m.start() for m in tokens if m.lastgroup == "word" and m.group().upper() in _FORMS), 0)
+    tokens = [m for m in TOKENS.finditer(text) if m.lastgroup in ("iri", "pname", "word")]
+    prologue_end = next((m.start() for m in tokens if m.lastgroup == "word" and m.group().upper() in FORMS), 0)
     names: list[tuple[bool, str]] = []
     for index, match in enumerate(tokens):
         if match.lastgroup != "word" or match.group().upper() != "FROM":
@@ -330,6 +316,33 @@ class _BudgetWriter(io.BytesIO):
         return written
 
 
+_P = ParamSpec("_P")
+_R = TypeVar("_R")
+
+
+def _explains(
+    expected: Literal["query", "update"],
+) -> Callable[[Callable[Concatenate[SparqlService, str, _P], _R]], Callable[Concatenate[SparqlService, str, _P], _R]]:
+    """Run a method taking the SPARQL text first, its syntax errors explained (:func:`explain_syntax_error`)."""
+
+    def wrap(
+        method: Callable[Concatenate[SparqlService, str, _P], _R],
+    ) -> Callable[Concatenate[SparqlService, str, _P], _R]:
+        @functools.wraps(method)
+        def run(self: SparqlService, text: str, /, *args: _P.args, **kwargs: _P.kwargs) -> _R:
+            try:
+                return method(self, text, *args, **kwargs)
+            except QuerySyntaxError as error:
+                explained = explain_syntax_error(error, text, expected)
+                if explained is error:
+                    raise
+                raise explained from error
+
+        return run
+
+    return wrap
+
+
 class SparqlService:
     """Queries and updates on a knowledge base, bounded and access-checked."""
 
@@ -357,6 +370,7 @@ class SparqlService:
     def writable(self) -> bool:
         return self.config.update_token is not None and not self.config.read_only
 
+    @_explains("query")
     def query(
         self,
         text: str,
@@ -408,6 +422,7 @@ class SparqlService:
         except FutureTimeout:
             raise QueryTimeoutError(self.config.timeout) from None
 
+    @_explains("query")
     def query_here(
         self, text: str, accept: str | None, short_format: str | None, client: str | None, budget: int
     ) -> Answer | None:
@@ -530,6 +545,7 @@ class SparqlService:
         if token is None or not hmac.compare_digest(token.encode("utf-8"), expected.encode("utf-8")):
             raise UpdateForbiddenError("updates need the server's token: Authorization: Bearer <token>")
 
+    @_explains("update")
     def update(self, text: str, token: str | None) -> None:
         """Run a SPARQL update when ``token`` is the configured update token; one transaction."""
         self.check_token(token)
@@ -637,12 +653,15 @@ def _json_results_type(accept: str | None, short_format: str | None) -> str | No
 
 
 @functools.lru_cache(maxsize=256)
-def negotiate(graph: bool, accept: str | None, short_format: str | None = None) -> str:
+def negotiate(
+    graph: bool, accept: str | None, short_format: str | None = None, only: tuple[str, ...] | None = None
+) -> str:
     """The media type to answer in: a ``format`` short name wins, then the Accept header, then the default.
+    ``only`` narrows the offer (the Graph Store protocol writes fewer formats), its first the default.
 
     Kept for the last 256 requests' headers: clients send the same few, and parsing one costs more
     than a point lookup's evaluation."""
-    offered = list(GRAPH_TYPES if graph else RESULT_TYPES)
+    offered = list(only if only is not None else GRAPH_TYPES if graph else RESULT_TYPES)
     if short_format:
         names = SHORT_NAMES.get(short_format.lower())
         if names is None and short_format in offered:
@@ -650,10 +669,49 @@ def negotiate(graph: bool, accept: str | None, short_format: str | None = None) 
         if names is None:
             raise NotAcceptableError(short_format, sorted(SHORT_NAMES))
         return names[1] if graph else names[0]
-    if not accept:
+    ranges = accept_ranges(accept) if accept else []
+    if not ranges:  # no header, or nothing in it that reads as a media range: the default
         return offered[0]
-    parsed = parse_accept_header(accept, MIMEAccept)
-    best = parsed.best_match(offered)
+    ranges = [(_offered_alias(graph, media, offered), quality) for media, quality in ranges]
+    best = MIMEAccept(ranges).best_match(offered)
     if best is None:
-        raise NotAcceptableError(accept, offered[:4])
+        raise NotAcceptableError(accept or "", offered[:4])
     return best
+
+
+def _offered_alias(graph: bool, media: str, offered: list[str]) -> str:
+    """``media`` as one of the ``offered`` types when Oxigraph reads it as that format
+    (``application/x-turtle``, ``application/x-sparql-results+json``, ``text/tsv``), else as it is."""
+    if media in offered or "*" in media:
+        return media
+    known = ox.RdfFormat.from_media_type(media) if graph else ox.QueryResultsFormat.from_media_type(media)
+    canonical = known.media_type.partition(";")[0] if known is not None else media  # text/csv; charset=utf-8
+    return canonical if canonical in offered else media
+
+
+def accept_ranges(accept: str) -> list[tuple[str, float]]:
+    """The media ranges of an Accept header with their qualities, each without its other parameters.
+
+    Werkzeug matches ``application/sparql-results+json; charset=utf-8`` only with an offer that carries
+    the same parameter, so a client asking for UTF-8 JSON (which every answer here is) got 406; the
+    parameters name nothing cbrs could answer differently, so only ``q`` is kept. A range that is not
+    ``type/subtype`` is left out, and a ``q`` that is not a number counts as 1, as lenient servers read it."""
+    ranges: list[tuple[str, float]] = []
+    for part in accept.split(","):
+        media, *parameters = part.split(";")
+        media = media.strip().lower()
+        kind, slash, subtype = media.partition("/")
+        if not (kind and slash and subtype) or "/" in subtype:
+            continue
+        quality = 1.0
+        for parameter in parameters:
+            name, _, value = parameter.partition("=")
+            if name.strip().lower() == "q":
+                try:
+                    quality = min(max(float(value.strip()), 0.0), 1.0)
+                except ValueError:
+                    quality = 1.0
+                if quality != quality:  # nan
+                    quality = 1.0
+        ranges.append((media, quality))
+    return ranges

@@ -121,6 +121,8 @@ def create_app(
         }
 
     def as_page() -> bool:
+        if g.get("sparql_protocol"):  # a SPARQL client's request to a page's path (/query)
+            return False
         return request.blueprint in page_blueprints and not request.path.endswith(".json")
 
     @app.get("/healthz")
@@ -150,6 +152,8 @@ def create_app(
 
     @app.after_request
     def cors(response: Response) -> Response:
+        if response.status_code == 204:  # no content, so no type (Flask would label it text/html)
+            response.headers.pop("Content-Type", None)
         response.headers["X-Content-Type-Options"] = "nosniff"
         response.headers.setdefault("Referrer-Policy", "same-origin")
         if response.mimetype == "text/html":

@@ -8,11 +8,12 @@ import json
 import time
 from typing import Any
 
-from flask import Blueprint, request, url_for
+from flask import Blueprint, Response, request, url_for
 
 from cbrs.kb.errors import KnowledgeBaseError, QuerySyntaxError, UnknownQueryError
 from cbrs.web import context
 from cbrs.web.pages import FormError, Page, page, wants_json
+from cbrs.web.sparql import protocol_answer, wants_protocol
 
 blueprint = Blueprint("editor", __name__)
 
@@ -23,6 +24,22 @@ DOWNLOADS = {
     "select": (("CSV", "csv"), ("JSON", "json"), ("TSV", "tsv"), ("XML", "xml")),
     "graph": (("Turtle", "turtle"), ("N-Triples", "ntriples"), ("JSON-LD", "jsonld"), ("RDF/XML", "rdfxml")),
 }
+
+
+@blueprint.before_request
+def _sparql_client() -> Response | None:
+    """``/query`` is also where Oxigraph's layout puts the query endpoint: a SPARQL client (SPARQLWrapper,
+    rdflib, Jena, curl) asking there gets the endpoint's answer, a browser the editor."""
+    if request.path == "/query" and wants_protocol():
+        return protocol_answer()
+    return None
+
+
+@blueprint.after_request
+def _vary(response: Response) -> Response:
+    if request.path == "/query":  # the page or the endpoint's answer, by the Accept header
+        response.vary.update(("Accept", "Origin"))
+    return response
 
 
 @page(blueprint, "/query", methods=["GET", "POST"])

@@ -9,10 +9,10 @@ to statuses.
 from __future__ import annotations
 
 import pyoxigraph as ox
-from flask import Blueprint, Response, request
-from werkzeug.datastructures import MultiDict
+from flask import Blueprint, Response, g, request
+from werkzeug.datastructures import MIMEAccept, MultiDict
 
-from cbrs.sparql_service import GRAPH_TYPES, Dataset, EndpointError, negotiate
+from cbrs.sparql_service import GRAPH_TYPES, RESULT_TYPES, Dataset, EndpointError, accept_ranges, negotiate
 from cbrs.web import context
 
 blueprint = Blueprint("sparql", __name__)
@@ -71,6 +71,45 @@ def update_only() -> Response:
     if query is not None or update is None:
         raise BadProtocolRequest("/update takes an update (form field update= or a sparql-update body), not a query")
     return _update(update)
+
+
+_HTML = ("text/html", "application/xhtml+xml")
+_SPARQL_TYPES = tuple(dict.fromkeys((*RESULT_TYPES, *GRAPH_TYPES)))
+
+
+def wants_protocol() -> bool:
+    """Whether a request to a page that shares its path with a SPARQL endpoint (``/query``: the editor
+    there, the query endpoint in Oxigraph's layout) comes from a SPARQL client rather than a browser.
+
+    A SPARQL body or an update, a ``format``/``output`` parameter, or an ``Accept`` header that ranks a
+    SPARQL result type above HTML say so; a header that accepts anything (curl's ``*/*``) does when the
+    request carries a query. Browsers name ``text/html`` first, and a request without ``Accept`` keeps
+    the page, as before."""
+    if request.method == "POST" and request.mimetype in (QUERY_TYPE, UPDATE_TYPE):
+        return True
+    if "update" in (request.form if request.method == "POST" else request.args):
+        return True
+    if request.args.get("format") or request.args.get("output"):
+        return True
+    accept = request.headers.get("Accept")
+    ranges = accept_ranges(accept) if accept else []
+    if not ranges:
+        return False
+    parsed = MIMEAccept(ranges)
+    html = max(parsed.quality(media) for media in _HTML)
+    best = max(parsed.quality(media) for media in _SPARQL_TYPES)
+    if best != html:
+        return best > html
+    named_html = any(media in _HTML for media, _ in ranges)
+    return best > 0 and not named_html and "query" in request.values
+
+
+def protocol_answer() -> Response:
+    """The SPARQL endpoint's answer to this request, whatever its path (errors in JSON, as ``/sparql``'s)."""
+    g.sparql_protocol = True
+    response = sparql()
+    response.vary.update(("Accept", "Origin"))
+    return response
 
 
 def _operation() -> tuple[str | None, str | None]:

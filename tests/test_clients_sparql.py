@@ -1,0 +1,249 @@
+"""SPARQL clients other than the ones cbrs was written against, over loopback on a served knowledge base.
+
+What they send that the endpoint once got wrong: media-type parameters in ``Accept``
+(``application/sparql-results+json; charset=utf-8`` was a 406), other spellings of the formats
+(``application/x-turtle``, ``text/tsv``), q-values on the Graph Store protocol (it took the first type
+named), and Oxigraph's layout, where ``/query`` is the query endpoint (cbrs answered with the editor's
+HTML). And what a person sends by mistake: an update as a query, a query as an update, a prefix
+nobody declared, each answered with a 400 that says so rather than the parser's list of tokens.
+"""
+
+from __future__ import annotations
+
+import http.client
+import json
+import urllib.parse
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+from websockets.sync.client import connect
+
+from cbrs.kb import KnowledgeBase
+from cbrs.server import ServeConfig, Server
+from cbrs.sparql_service import EndpointConfig
+
+TOKEN = "clients-sparql-token"
+WAIT = 10.0
+SELECT = "SELECT ?c WHERE { ?c rdfs:subClassOf home:Position } ORDER BY ?c"
+CONSTRUCT = "CONSTRUCT { ?c rdfs:subClassOf home:Position } WHERE { ?c rdfs:subClassOf home:Position }"
+ONTOLOGY = "https://w3id.org/cbrs/graph/ontology"
+BROWSER = "text/html,application/xhtml+xml,application/xml;q=0.9,*/*;q=0.8"
+
+
+@pytest.fixture(scope="module")
+def server() -> Iterator[Server]:
+    served = Server(
+        KnowledgeBase.open(":memory:"),
+        ServeConfig(port=0, bridge_port=0, endpoint=EndpointConfig(update_token=TOKEN)),
+    )
+    served.start()
+    yield served
+    served.stop(timeout=WAIT)
+
+
+def ask(
+    server: Server, method: str, path: str, body: bytes | None = None, headers: dict[str, str] | None = None
+) -> tuple[int, dict[str, str], bytes]:
+    connection = http.client.HTTPConnection("127.0.0.1", server.http_port, timeout=WAIT)
+    try:
+        connection.request(method, path, body=body, headers=headers or {})
+        response = connection.getresponse()
+        return response.status, {k.lower(): v for k, v in response.getheaders()}, response.read()
+    finally:
+        connection.close()
+
+
+def get(server: Server, path: str, query: str, accept: str | None = None) -> tuple[int, dict[str, str], bytes]:
+    headers = {"Accept": accept} if accept is not None else {}
+    return ask(server, "GET", f"{path}?{urllib.parse.urlencode({'query': query})}", headers=headers)
+
+
+def media(headers: dict[str, str]) -> str:
+    return headers.get("content-type", "").partition(";")[0]
+
+
+@pytest.mark.parametrize(
+    ("query", "accept", "expected"),
+    [
+        (SELECT, "application/sparql-results+json; charset=utf-8", "application/sparql-results+json"),
+        (SELECT, "application/sparql-results+json;charset=UTF-8", "application/sparql-results+json"),
+        (SELECT, "text/csv; header=present", "text/csv"),
+        (
+            SELECT,
+            "text/csv;charset=utf-8;q=0.2, application/sparql-results+xml; charset=utf-8;q=0.9",
+            "application/sparql-results+xml",
+        ),
+        (SELECT, "application/x-sparql-results+json", "application/sparql-results+json"),
+        (SELECT, "text/tsv", "text/tab-separated-values"),
+        (SELECT, "text/csv;q=abc", "text/csv"),  # a q that is not a number counts as 1
+        (SELECT, ",,,", "application/sparql-results+json"),  # nothing readable: as if no Accept
+        (CONSTRUCT, "text/turtle; charset=utf-8", "text/turtle"),
+        (CONSTRUCT, "application/x-turtle", "text/turtle"),
+        (CONSTRUCT, "text/turtle;q=0.1, application/n-triples", "application/n-triples"),
+    ],
+)
+@pytest.mark.parametrize("how", ["get", "post-form", "post-direct"])
+def test_accept_with_parameters_aliases_and_q_values(
+    server: Server, query: str, accept: str, expected: str, how: str
+) -> None:
+    if how == "get":  # the ASGI front's own path for a plain query
+        status, headers, body = get(server, "/sparql", query, accept)
+    elif how == "post-form":  # Flask's
+        form = urllib.parse.urlencode({"query": query}).encode()
+        content = {"Content-Type": "application/x-www-form-urlencoded", "Accept": accept}
+        status, headers, body = ask(server, "POST", "/sparql", form, content)
+    else:
+        content = {"Content-Type": "application/sparql-query", "Accept": accept}
+        status, headers, body = ask(server, "POST", "/sparql", query.encode(), content)
+    assert status == 200, body
+    assert media(headers) == expected
+    assert b"Position2D" in body
+
+
+def test_a_type_the_result_cannot_take_is_still_406(server: Server) -> None:
+    status, _, body = get(server, "/sparql", SELECT, "image/png; charset=utf-8")
+    assert status == 406 and json.loads(body)["error"] == "not-acceptable"
+
+
+@pytest.mark.parametrize(
+    ("accept", "expected"),
+    [
+        ("text/turtle;q=0.1, application/n-triples", "application/n-triples"),
+        ("application/n-triples; charset=utf-8", "application/n-triples"),
+        ("text/turtle;q=0, */*;q=0.5", "application/n-triples"),
+        ("application/x-turtle", "text/turtle"),
+    ],
+)
+def test_the_graph_store_reads_accept_as_the_endpoint_does(server: Server, accept: str, expected: str) -> None:
+    status, headers, body = ask(
+        server, "GET", f"/store?graph={urllib.parse.quote(ONTOLOGY)}", headers={"Accept": accept}
+    )
+    assert status == 200, body
+    assert media(headers) == expected
+
+
+@pytest.mark.parametrize(
+    ("accept", "expected"),
+    [
+        ("application/sparql-results+json", "application/sparql-results+json"),
+        ("application/sparql-results+xml", "application/sparql-results+xml"),
+        (
+            "application/sparql-results+json,application/json,text/javascript,application/javascript",
+            "application/sparql-results+json",
+        ),  # SPARQLWrapper
+        ("text/csv", "text/csv"),
+        ("*/*", "application/sparql-results+json"),  # curl
+    ],
+)
+def test_a_sparql_client_at_query_gets_the_endpoint(server: Server, accept: str, expected: str) -> None:
+    status, headers, body = get(server, "/query", SELECT, accept)
+    assert status == 200, body
+    assert media(headers) == expected
+    assert "Accept" in headers.get("vary", "")
+    assert b"Position2D" in body
+
+
+def test_a_browser_at_query_gets_the_editor(server: Server) -> None:
+    for accept in (BROWSER, None):
+        status, headers, body = get(server, "/query", SELECT, accept)
+        assert status == 200 and media(headers) == "text/html"
+        assert b"<html" in body
+
+
+def test_query_takes_post_bodies_and_updates_as_oxigraph_does(server: Server) -> None:
+    direct = {"Content-Type": "application/sparql-query", "Accept": BROWSER}  # the body says it: a query
+    status, headers, body = ask(server, "POST", "/query", b"ASK { home:Position2D ?p ?o }", direct)
+    assert status == 200 and media(headers) == "application/xml", body  # application/xml;q=0.9 in BROWSER
+    assert b"<boolean>true</boolean>" in body
+    wrong = ask(server, "POST", "/query", b"SELEC ?x", {"Content-Type": "application/sparql-query"})
+    assert wrong[0] == 400 and json.loads(wrong[2])["error"] == "QuerySyntaxError"  # JSON, not a page
+    insert = b"INSERT DATA { GRAPH <urn:test:clients> { <urn:test:q> <urn:test:p> 1 } }"
+    update = {"Content-Type": "application/sparql-update"}
+    assert ask(server, "POST", "/query", insert, update)[0] == 403
+    assert ask(server, "POST", "/query", insert, {**update, "Authorization": f"Bearer {TOKEN}"})[0] == 204
+    asked = get(server, "/query", "ASK { <urn:test:q> <urn:test:p> 1 }", "application/sparql-results+json")
+    assert json.loads(asked[2])["boolean"] is True
+
+
+def test_sparqlwrapper_at_the_query_path() -> None:
+    sparqlwrapper = pytest.importorskip("SPARQLWrapper")
+    served = Server(KnowledgeBase.open(":memory:"), ServeConfig(port=0, bridge_port=0))
+    served.start()
+    try:
+        client = sparqlwrapper.SPARQLWrapper(f"http://127.0.0.1:{served.http_port}/query")
+        client.setTimeout(int(WAIT))
+        client.setQuery(SELECT)
+        client.setReturnFormat(sparqlwrapper.JSON)
+        rows = client.query().convert()["results"]["bindings"]
+        assert "https://w3id.org/cbrs/home#Position2D" in {row["c"]["value"] for row in rows}
+        client.setMethod(sparqlwrapper.POST)
+        client.setQuery(CONSTRUCT)
+        client.setReturnFormat(sparqlwrapper.TURTLE)
+        assert b"Position2D" in client.query().convert()
+    finally:
+        served.stop(timeout=WAIT)
+
+
+@pytest.mark.parametrize(
+    ("method", "path", "text", "said"),
+    [
+        (
+            "GET",
+            "/sparql",
+            "INSERT DATA { GRAPH <urn:g> { <urn:a> <urn:b> <urn:c> } }",
+            "this is a SPARQL update, not a query",
+        ),
+        (
+            "POST-query",
+            "/sparql",
+            "PREFIX x: <urn:x#> DELETE WHERE { GRAPH ?g { ?s x:p ?o } }",
+            "this is a SPARQL update, not a query",
+        ),
+        ("POST-update", "/update", "SELECT * WHERE { ?s ?p ?o }", "this is a SPARQL query, not an update"),
+        ("GET", "/sparql", "SELECT ?x WHERE { ?x hme:partOf ?y }", "the prefix 'hme:' is not declared"),
+        ("GET", "/sparql", "SELECT ?p ?o WHERE { hme:Cup ?p ?o }", "did you mean 'home:'?"),  # a lookup's path
+        (
+            "POST-update",
+            "/update",
+            "INSERT DATA { GRAPH <urn:g> { <urn:a> zzq:b <urn:c> } }",
+            "the prefix 'zzq:' is not declared",
+        ),
+    ],
+)
+def test_a_mistaken_text_is_a_400_that_says_what_is_wrong(
+    server: Server, method: str, path: str, text: str, said: str
+) -> None:
+    auth = {"Authorization": f"Bearer {TOKEN}"}
+    if method == "GET":
+        status, _, body = get(server, path, text)
+    elif method == "POST-query":
+        status, _, body = ask(server, "POST", path, text.encode(), {"Content-Type": "application/sparql-query"})
+    else:
+        status, _, body = ask(
+            server, "POST", path, text.encode(), {"Content-Type": "application/sparql-update", **auth}
+        )
+    answer = json.loads(body)
+    assert status == 400 and answer["error"] == "QuerySyntaxError", answer
+    assert said in answer["message"] and "error at 1:" in answer["message"]
+
+
+def test_the_bridge_query_service_explains_an_update_too(server: Server) -> None:
+    with connect(f"ws://127.0.0.1:{server.bridge_port}", open_timeout=WAIT) as ws:
+        text = "INSERT DATA { GRAPH <urn:g> { <urn:a> <urn:b> <urn:c> } }"
+        ws.send(json.dumps({"op": "call_service", "service": "/cbrs/query", "id": "q1", "args": {"query": text}}))
+        answer: dict[str, Any] = json.loads(ws.recv(timeout=WAIT))
+    assert answer["id"] == "q1" and answer["result"] is False
+    assert "this is a SPARQL update, not a query" in answer["values"]
+
+
+def test_a_failed_update_changes_nothing_and_a_204_has_no_type(server: Server) -> None:
+    auth = {"Content-Type": "application/sparql-update", "Authorization": f"Bearer {TOKEN}"}
+    first = b"INSERT DATA { GRAPH <urn:test:atomic> { <urn:test:a> <urn:test:p> 1 } }"
+    status, headers, _ = ask(server, "POST", "/update", first, auth)
+    assert status == 204 and "content-type" not in headers
+    both = b"INSERT DATA { GRAPH <urn:test:atomic> { <urn:test:b> <urn:test:p> 2 } } ; CREATE GRAPH <urn:test:atomic>"
+    status, _, body = ask(server, "POST", "/update", both, auth)
+    assert status == 400 and json.loads(body)["error"] == "StoreEvaluationError"
+    asked = get(server, "/sparql", "ASK { <urn:test:b> ?p ?o }", "application/sparql-results+json")
+    assert json.loads(asked[2])["boolean"] is False
