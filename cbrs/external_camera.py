@@ -16,6 +16,7 @@ from typing import Any
 
 import pyoxigraph as ox
 
+from cbrs.actions.remote import RemoteCallError
 from cbrs.bridge_client import BridgeClient
 from cbrs.component import Component
 from cbrs.kb import KnowledgeBase
@@ -89,11 +90,15 @@ def main(argv: list[str] | None = None) -> int:
     token = os.environ.get("CBRS_UPDATE_TOKEN")
     kb = KnowledgeBase.open(":memory:")  # the bundled descriptions and map: the camera's own knowledge
     component = Component(description(kb, args.camera))
-    with BridgeClient(args.url, token) as capture:
-        component.handler(localiser(args.camera, capture, SemanticMap.read(kb)))
-        connected = component.connect(args.url, token, args.heartbeat, args.lease)
-        print(f"{args.camera}: registered {', '.join(connected.registered)}", flush=True)
-        connected.serve()
+    try:
+        with BridgeClient(args.url, token) as capture:
+            component.handler(localiser(args.camera, capture, SemanticMap.read(kb)))
+            connected = component.connect(args.url, token, args.heartbeat, args.lease)
+            print(f"{args.camera}: registered {', '.join(connected.registered)}", flush=True)
+            connected.serve()
+    except (RemoteCallError, ConnectionError) as error:  # refused, or no server: one line, as the CLI says it
+        print(f"Error: {args.camera}: {error}", file=sys.stderr)
+        return 1
     return 0
 
 

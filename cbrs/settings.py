@@ -234,7 +234,7 @@ SETTINGS: tuple[Setting, ...] = (
         "bridge_connections_per_client",
         lambda: 64,
         "Websocket connections one client (an IP address) may hold on the rosbridge port; one more is "
-        "refused with HTTP 503 at the handshake.",
+        "accepted and closed at once with code 1013 (try again later).",
         "CBRS_BRIDGE_CONNECTIONS_PER_CLIENT",
         _positive(int),
     ),
