@@ -31,6 +31,7 @@ BRIEFS = [
     Brief("validation", 45, 14, 6),
     Brief("final", 45, 14, 6),
     Brief("blind5", 45, 15, 7),
+    Brief("blind6", 60, 16, 7),
 ]
 
 
@@ -112,7 +113,7 @@ def test_the_relevance_file_names_loaded_services_with_the_specs_grades(collecti
         assert 0 in grades.values(), request
 
 
-@pytest.mark.parametrize("name", ["final", "blind5"])
+@pytest.mark.parametrize("name", ["final", "blind5", "blind6"])
 def test_the_ontology_carries_the_property_tree_and_the_disjointness(name: str) -> None:
     spec = _generator(name)
     text = (ROOT / "tests" / "data" / f"robot_{name}" / "ontology" / f"robot_{name}.owl").read_text(encoding="utf-8")
