@@ -1,6 +1,6 @@
 """Ablation of the matchmaking refinements: MAP of sem-str with each one turned off, on each collection.
 
-For every collection (default: ../shared/owls-tc4 when present, and tests/data/robot_services) it loads
+For every collection (default: ../shared/owls-tc4 when present, and the robot collections in tests/data) it loads
 the collection once and ranks every query with the default MatchConfig, then with one refinement
 turned off at a time, then with all of them off (MatchConfig.published(), the frame before them).
 Besides the MAP over all queries it prints the MAP over the odd- and even-numbered queries, two
@@ -33,6 +33,7 @@ DEFAULTS = [
     ROOT / "tests" / "data" / "robot_validation",
     ROOT / "tests" / "data" / "robot_final",
     ROOT / "tests" / "data" / "robot_blind5",
+    ROOT / "tests" / "data" / "robot_blind6",
 ]
 BASE = MatchConfig()
 VARIANTS: dict[str, MatchConfig] = {
