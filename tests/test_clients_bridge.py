@@ -1,5 +1,9 @@
 """Programs and rosbridge clients as a new user runs them against a served knowledge base.
 
+rosbridge's fragments and PNG compression, which cbrs refused before: a client may send a message in
+``fragment`` pieces (a board with small buffers), and ask for a subscription's messages or a call's
+response in pieces of ``fragment_size`` or, for a subscription, as PNG images; roslibjs decodes both.
+
 The README's camera program, started beside a plain ``cbrs serve``, used to end in a traceback: the
 store already holds the bundled camera it registers. It now says why in one line and exits 1, as the
 CLI does, and once the bundled component makes way it registers.
@@ -7,18 +11,31 @@ CLI does, and once the bundled component makes way it registers.
 
 from __future__ import annotations
 
+import base64
+import io
+import json
+import shutil
 import socket
+import subprocess
+import time
 from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
 
 import pytest
+from websockets.sync.client import ClientConnection, connect
 
 from cbrs import external_camera
 from cbrs.kb import KnowledgeBase
+from cbrs.rosbridge import Bridge, RunningBridge
+from cbrs.rosbridge.wire import MAX_PARTIAL, MIN_FRAGMENT
 from cbrs.server import ServeConfig, Server
 from cbrs.sparql_service import EndpointConfig
 
 TOKEN = "clients-bridge-token"
 WAIT = 10.0
+NODE = shutil.which("node")
+JS = Path(__file__).parent / "js"
 
 
 @pytest.fixture(scope="module")
@@ -57,3 +74,182 @@ def test_the_camera_program_refused_says_why_in_one_line(
     assert external_camera.main(["--url", url, "CeilingCamera01"]) == 1
     err = capsys.readouterr().err
     assert "LocateMobileRobot_CeilingCamera01> is already registered" in err and err.count("\n") == 1, err
+
+
+# -- rosbridge's fragments and PNG compression ------------------------------------------------------
+
+
+@pytest.fixture
+def bridge() -> Iterator[RunningBridge]:
+    served = Bridge(max_message_bytes=64 * 1024)
+    served.add_service("/test/big", "test/Big", lambda args: {"text": "y" * args.get("n", 3000)})
+    with served.start(port=0) as running:
+        yield running
+
+
+def receive_all(ws: ClientConnection, quiet: float = 0.3) -> list[dict[str, Any]]:
+    """Every message that arrives until none has for ``quiet`` seconds (bounded: the test's clients are few)."""
+    got: list[dict[str, Any]] = []
+    while len(got) < 1000:
+        try:
+            got.append(json.loads(ws.recv(timeout=quiet)))
+        except TimeoutError:
+            break
+    return got
+
+
+def joined(pieces: list[dict[str, Any]]) -> dict[str, Any]:
+    assert all(piece["op"] == "fragment" for piece in pieces), pieces
+    assert [piece["num"] for piece in pieces] == list(range(pieces[0]["total"]))
+    assert len({piece["id"] for piece in pieces}) == 1
+    whole: dict[str, Any] = json.loads("".join(piece["data"] for piece in pieces))
+    return whole
+
+
+def test_a_message_sent_in_pieces_in_any_order_is_acted_on(bridge: RunningBridge) -> None:
+    with connect(bridge.url, open_timeout=WAIT) as ws:
+        text = json.dumps({"op": "call_service", "service": "/rosapi/get_time", "id": "t1"})
+        pieces = [text[at : at + 10] for at in range(0, len(text), 10)]
+        for num in reversed(range(len(pieces))):
+            ws.send(json.dumps({"op": "fragment", "id": "m1", "data": pieces[num], "num": num, "total": len(pieces)}))
+        (answer,) = receive_all(ws)
+    assert answer["op"] == "service_response" and answer["id"] == "t1" and answer["result"] is True
+
+
+@pytest.mark.parametrize(
+    ("pieces", "said"),
+    [
+        ([{"data": "{", "num": 0, "total": 2}], "a fragment needs the 'id'"),
+        ([{"id": "a", "data": "{", "num": 2, "total": 2}], "num must be from 0 to total - 1, not 2 of 2"),
+        (
+            [{"id": "a", "data": "{", "num": 0, "total": 2}, {"id": "a", "data": "}", "num": 1, "total": 3}],
+            "total 3 differs",
+        ),
+        (
+            [{"id": "a", "data": "x" * 40_000, "num": 0, "total": 2}] * 1
+            + [{"id": "a", "data": "x" * 40_000, "num": 1, "total": 2}],
+            "exceed the limit",
+        ),
+        (
+            [{"id": "a", "data": '{"op":"fragment","id":"b","data":"{}","num":0,"total":1}', "num": 0, "total": 1}],
+            "must not be a fragment again",
+        ),
+        ([{"id": "a", "data": '{"op": "publish"', "num": 0, "total": 1}], "message is not valid JSON"),
+        ([{"id": "a", "data": 3, "num": 0, "total": 1}], "field 'data' must be a string"),
+    ],
+)
+def test_pieces_that_cannot_belong_get_a_status_and_the_connection_stays(
+    bridge: RunningBridge, pieces: list[dict[str, Any]], said: str
+) -> None:
+    with connect(bridge.url, open_timeout=WAIT, max_size=None) as ws:
+        for piece in pieces:
+            ws.send(json.dumps({"op": "fragment", **piece}))
+        statuses = [m for m in receive_all(ws) if m["op"] == "status"]
+        assert statuses and statuses[-1]["level"] == "error" and said in statuses[-1]["msg"], statuses
+        ws.send(json.dumps({"op": "call_service", "service": "/rosapi/get_time", "id": "after"}))
+        assert receive_all(ws)[-1]["id"] == "after"
+
+
+def test_a_piece_sent_twice_is_a_warning_and_the_first_is_kept(bridge: RunningBridge) -> None:
+    text = json.dumps({"op": "call_service", "service": "/rosapi/get_time", "id": "twice"})
+    with connect(bridge.url, open_timeout=WAIT) as ws:
+        ws.send(json.dumps({"op": "set_level", "level": "warning"}))
+        first = {"op": "fragment", "id": "m", "data": text[:20], "num": 0, "total": 2}
+        ws.send(json.dumps(first))
+        ws.send(json.dumps({**first, "data": "garbage"}))
+        ws.send(json.dumps({"op": "fragment", "id": "m", "data": text[20:], "num": 1, "total": 2}))
+        got = receive_all(ws)
+    assert got[0]["level"] == "warning" and "came twice" in got[0]["msg"]
+    assert got[-1]["op"] == "service_response" and got[-1]["id"] == "twice"
+
+
+def test_a_client_holds_a_bounded_number_of_unfinished_messages(bridge: RunningBridge) -> None:
+    with connect(bridge.url, open_timeout=WAIT) as ws:
+        ws.send(json.dumps({"op": "set_level", "level": "warning"}))
+        for index in range(MAX_PARTIAL + 1):
+            ws.send(json.dumps({"op": "fragment", "id": f"never{index}", "data": "{", "num": 0, "total": 2}))
+        (warning,) = receive_all(ws)
+    assert "dropped the unfinished fragments of message 'never0'" in warning["msg"]
+
+
+def test_subscriptions_and_calls_in_pieces_of_fragment_size(bridge: RunningBridge) -> None:
+    with connect(bridge.url, open_timeout=WAIT) as publisher, connect(bridge.url, open_timeout=WAIT) as reader:
+        reader.send(json.dumps({"op": "set_level", "level": "warning"}))
+        reader.send(json.dumps({"op": "subscribe", "topic": "/big", "type": "t/T", "fragment_size": 10, "id": "s"}))
+        (raised,) = receive_all(reader)
+        assert raised["msg"] == f"fragment_size 10 raised to {MIN_FRAGMENT}" and raised["id"] == "s"
+        publisher.send(json.dumps({"op": "advertise", "topic": "/big", "type": "t/T"}))
+        publisher.send(json.dumps({"op": "publish", "topic": "/big", "msg": {"data": "z" * 700}}))
+        publisher.send(json.dumps({"op": "publish", "topic": "/big", "msg": {"data": "small"}}))
+        got = receive_all(reader)
+        assert len(got) == 4 and got[0]["total"] == 3  # 3 pieces of at most 256 characters, then the small one whole
+        assert joined(got[:3]) == {"op": "publish", "topic": "/big", "msg": {"data": "z" * 700}}
+        assert got[3] == {"op": "publish", "topic": "/big", "msg": {"data": "small"}}
+        reader.send(json.dumps({"op": "call_service", "service": "/test/big", "id": "c1", "fragment_size": 1000}))
+        pieces = receive_all(reader)
+        assert [piece["id"] for piece in pieces] == ["c1"] * 4
+        response = joined(pieces)
+        assert (
+            response["op"] == "service_response" and response["id"] == "c1" and response["values"]["text"] == "y" * 3000
+        )
+        reader.send(json.dumps({"op": "call_service", "service": "/test/big", "args": {"n": 3}, "fragment_size": 1000}))
+        (whole,) = receive_all(reader)  # it fits: sent whole
+        assert whole["values"] == {"text": "yyy"}
+
+
+def test_a_subscription_with_png_compression_gets_rosbridge_png_messages(bridge: RunningBridge) -> None:
+    image = pytest.importorskip("PIL.Image")
+    message = {"data": "é ☃ " * 40, "n": [1, 2.5, None]}
+    with connect(bridge.url, open_timeout=WAIT) as publisher, connect(bridge.url, open_timeout=WAIT) as reader:
+        reader.send(json.dumps({"op": "subscribe", "topic": "/img", "type": "t/T", "compression": "png"}))
+        publisher.send(json.dumps({"op": "advertise", "topic": "/img", "type": "t/T"}))
+        time.sleep(0.1)
+        publisher.send(json.dumps({"op": "publish", "topic": "/img", "msg": message}))
+        (png,) = receive_all(reader)
+    assert set(png) == {"op", "data"} and png["op"] == "png"
+    decoded = image.open(io.BytesIO(base64.b64decode(png["data"])), formats=("png",))
+    assert decoded.mode == "RGB"  # rosbridge_suite's decode: the pixels' bytes, newlines stripped
+    assert json.loads(decoded.tobytes().decode("utf-8")) == {"op": "publish", "topic": "/img", "msg": message}
+
+
+ROSLIBJS = """
+import { Ros, Topic } from "roslib";
+setTimeout(() => { console.error("gave up"); process.exit(2); }, 20000).unref();
+const url = process.argv[1];
+const open = () => new Promise((resolve, reject) => {
+  const ros = new Ros({ url });
+  ros.on("connection", () => resolve(ros));
+  ros.on("error", reject);
+});
+const [a, b] = [await open(), await open()];
+const heard = { png: [], pieces: [] };
+new Topic({ ros: b, name: "/img", messageType: "t/T", compression: "png" }).subscribe((m) => heard.png.push(m));
+b.callOnConnection({ op: "subscribe", id: "s", topic: "/big", type: "t/T", fragment_size: 300 });
+b.on("/big", (m) => heard.pieces.push(m.msg ?? m));  // roslibjs emits the publish message
+await new Promise((resolve) => setTimeout(resolve, 300));
+const img = new Topic({ ros: a, name: "/img", messageType: "t/T" });
+const big = new Topic({ ros: a, name: "/big", messageType: "t/T" });
+img.publish({ data: "snow ☃", n: 1 });
+big.publish({ data: "z".repeat(2000) });
+const deadline = Date.now() + 5000;
+while ((heard.png.length < 1 || heard.pieces.length < 1) && Date.now() < deadline) {
+  await new Promise((resolve) => setTimeout(resolve, 50));
+}
+console.log(JSON.stringify({ png: heard.png, sizes: heard.pieces.map((m) => m.data.length) }));
+process.exit(0);
+"""
+
+
+@pytest.mark.skipif(NODE is None or not (JS / "node_modules" / "roslib").is_dir(), reason="roslibjs under node")
+def test_roslibjs_decodes_png_and_fragments_from_the_bridge(bridge: RunningBridge) -> None:
+    assert NODE is not None
+    child = subprocess.run(
+        [NODE, "--input-type=module", "-e", ROSLIBJS, bridge.url],
+        cwd=JS,  # where "roslib" resolves
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert child.returncode == 0, child.stderr
+    found = json.loads(child.stdout.strip().splitlines()[-1])
+    assert found == {"png": [{"data": "snow ☃", "n": 1}], "sizes": [2000]}

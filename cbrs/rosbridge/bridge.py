@@ -16,7 +16,7 @@ import logging
 from collections.abc import Awaitable, Callable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
-from cbrs.rosbridge import protocol, rosapi
+from cbrs.rosbridge import protocol, rosapi, wire
 from cbrs.rosbridge.calls import Call, Calls, run_handler
 from cbrs.rosbridge.errors import ProtocolError, RosbridgeError, UnknownTopicError
 from cbrs.rosbridge.goals import ActionHandler, Goal, Goals, GoalStatus
@@ -119,6 +119,7 @@ class Bridge:
             "action_result": self._action_result,
             "set_level": self._set_level,
             "auth": self._auth,
+            "fragment": self._fragment,
         }
 
     # -- the server side ----------------------------------------------------------------------------
@@ -299,6 +300,10 @@ class Bridge:
         if not isinstance(frame, str):
             session.report("error", "binary frames are not supported (no CBOR or BSON): send JSON text frames")
             return
+        self._handle(session, frame)
+
+    def _handle(self, session: Session, frame: str, whole: bool = False) -> None:
+        """Decode, check and act on one message's text (``whole``: put together from fragments)."""
         op: str | None = None
         message_id = None
         message: Message | None = None
@@ -306,6 +311,8 @@ class Bridge:
             message = protocol.decode(frame, self.max_message_bytes)
             message_id = message.get("id")
             op = protocol.check(message)
+            if whole and op == "fragment":
+                raise ProtocolError("the pieces of a message put together must not be a fragment again", op)
             self._ops[op](session, message)
         except ProtocolError as error:
             op = error.op or op
@@ -424,9 +431,10 @@ class Bridge:
         if queue_length > self.max_queue_length:
             session.report("warning", f"queue_length {queue_length} lowered to {self.max_queue_length}", message_id)
             queue_length = self.max_queue_length
-        if message.get("compression") not in (None, "none"):
-            text = f"compression {message['compression']!r} is not supported; sending JSON"
-            session.report("warning", text, message_id)
+        compression = message.get("compression") or "none"
+        if compression not in ("none", "png"):
+            session.report("warning", f"compression {compression!r} is not supported; sending JSON", message_id)
+        fragment_size = self._fragment_size(session, message)
         with self._graph.lock:
             topic = self._graph.topics.get(name)
             if topic is None:
@@ -436,7 +444,9 @@ class Bridge:
             topic.type = topic.type or kind or ""
             topic.subscribers.add(session)
             latched = topic.latched
-        session.subscribe(name, message["topic"], message_id, throttle_rate, queue_length)
+        session.subscribe(
+            name, message["topic"], message_id, throttle_rate, queue_length, compression == "png", fragment_size
+        )
         if latched is not None:
             session.offer(name, protocol.publish_text(message["topic"], latched))
         session.report("info", f"subscribed to {name}", message_id)
@@ -461,6 +471,7 @@ class Bridge:
         timeout = message.get("timeout") or 0.0
         timeout = timeout if timeout > 0 else self.call_timeout
         call = Call(self._calls.new_key(name), name, session, message.get("id"), message["service"])
+        call.fragment_size = self._fragment_size(session, message)
         with self._graph.lock:
             service = self._graph.services.get(name)
         if service is None:
@@ -603,6 +614,28 @@ class Bridge:
             raise ProtocolError("the token is not this server's update token", "auth")
         session.authorised = True
         session.report("info", "authorised: this client may write", message.get("id"))
+
+    def _fragment_size(self, session: Session, message: Message) -> int | None:
+        """The ``fragment_size`` a subscribe or call asks for (None: whole messages), raised to the least
+        the server sends (:data:`wire.MIN_FRAGMENT`, with a warning)."""
+        size: int | None = message.get("fragment_size")
+        if size is None:
+            return None
+        if size < 1:
+            raise ProtocolError(f"fragment_size must be at least 1, not {size}")
+        if size < wire.MIN_FRAGMENT:
+            text = f"fragment_size {size} raised to {wire.MIN_FRAGMENT}"
+            session.report("warning", text, message.get("id"))
+        return max(size, wire.MIN_FRAGMENT)
+
+    def _fragment(self, session: Session, message: Message) -> None:
+        if session.reassembly is None:
+            session.reassembly = wire.Reassembly(self.max_message_bytes)
+        text, warning = session.reassembly.add(message)
+        if warning is not None:
+            session.report("warning", f"fragment: {warning}", message.get("id"))
+        if text is not None:
+            self._handle(session, text, whole=True)
 
     def _set_level(self, session: Session, message: Message) -> None:
         if message["level"] not in LEVELS:

@@ -36,6 +36,7 @@ class Call:
     provider: Session | None = None  # None: a server handler
     timer: asyncio.TimerHandle | None = None
     done: bool = False
+    fragment_size: int | None = None  # the caller asked for the response in pieces of this size
 
 
 def run_handler(handler: Handler, args: dict[str, Any], service: str, caller: Caller | None = None) -> tuple[bool, str]:
@@ -124,7 +125,12 @@ class Calls:
         self._pending.pop(call.key, None)
         if call.timer is not None:
             call.timer.cancel()
-        call.caller.reply(protocol.service_response(call.spelling, result, values_json, call.caller_id))
+        text = protocol.service_response(call.spelling, result, values_json, call.caller_id)
+        if call.fragment_size is None:
+            call.caller.reply(text)
+        else:
+            piece_id = call.caller_id or f"service_response:{call.spelling}:{call.key.rpartition(':')[2]}"
+            call.caller.reply_in_pieces(text, call.fragment_size, piece_id)
 
     def _start(self, call: Call, timeout: float) -> None:
         self._pending[call.key] = call

@@ -79,14 +79,15 @@ OPS: dict[str, tuple[Field, ...]] = {
     "action_feedback": (_req("action", str), _opt("values", dict)),
     "action_result": (_req("action", str), _opt("values", dict), _req("status", int), _req("result", bool)),
     "set_level": (_req("level", str),),
+    # one piece of a message sent in pieces (cbrs.rosbridge.wire); ``id`` names the message
+    "fragment": (_req("data", str), _req("num", int), _req("total", int)),
     # rosbridge's auth op carries a rosauth MAC; cbrs reads its update token from ``mac`` (or ``token``)
     "auth": (_opt("mac", str), _opt("token", str)),
 }
 
 #: Ops of the rosbridge protocol this server knows about but does not implement, and why.
 UNSUPPORTED = {
-    "fragment": "fragmented messages are not supported; send the whole message (see max_message_bytes)",
-    "png": "PNG-compressed messages are not supported; send JSON text",
+    "png": "PNG-compressed messages from a client are not supported; send JSON text (or fragments)",
 }
 
 _TYPE_NAMES = {

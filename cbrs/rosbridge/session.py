@@ -20,6 +20,7 @@ from dataclasses import dataclass
 
 from cbrs.rosbridge.outbox import Request, TopicQueue
 from cbrs.rosbridge.protocol import LEVELS, MessageId, status
+from cbrs.rosbridge.wire import Reassembly, fragments, png_message
 
 log = logging.getLogger("cbrs.rosbridge")
 
@@ -82,6 +83,14 @@ class Session:
         self.provided_actions: dict[str, str] = {}
         self.spelling: dict[str, str] = {}
         self.queues: dict[str, TopicQueue] = {}
+        #: how a subscribed topic's messages go out when a subscription asked (cbrs.rosbridge.wire): per
+        #: subscribe request (png, fragment_size), and merged per topic as rosbridge merges them (PNG if
+        #: any asks, the smallest fragment size); topics sent as plain JSON are not in ``wire``
+        self._wire_requests: dict[str, dict[Request, tuple[bool, int | None]]] = {}
+        self.wire: dict[str, tuple[bool, int | None]] = {}
+        self.reassembly: Reassembly | None = None  # the client's messages arriving in pieces, once it sends one
+        self._pieces: deque[str] = deque()  # the rest of a topic message being sent in pieces
+        self._piece_ids = 0
         self._send = send
         self._send_many = send_many
         self._abort = abort
@@ -119,29 +128,59 @@ class Session:
         self._reply_bytes += len(text)
         self._wake()
 
+    def reply_in_pieces(self, text: str, size: int, message_id: MessageId) -> None:
+        """Queue a reply as ``fragment`` ops of at most ``size`` characters (whole if it fits)."""
+        for piece in fragments(text, size, message_id):
+            self.reply(piece)
+
     def report(self, level: str, text: str, message_id: MessageId | None = None) -> None:
         """Send a ``status`` message if the client's level asks for it."""
         if LEVELS.index(level) <= LEVELS.index(self.level):
             self.reply(status(level, text, message_id))
 
-    def subscribe(self, topic: str, spelling: str, request: Request, throttle_rate: int, queue_length: int) -> None:
+    def subscribe(
+        self,
+        topic: str,
+        spelling: str,
+        request: Request,
+        throttle_rate: int,
+        queue_length: int,
+        png: bool = False,
+        fragment_size: int | None = None,
+    ) -> None:
         queue = self.queues.get(topic)
         if queue is None:
             queue = self.queues[topic] = TopicQueue(self._backlog, self._backlog_bytes)
         queue.add(request, throttle_rate, queue_length)
         self.spelling[topic] = spelling
+        self._wire_requests.setdefault(topic, {})[request] = (png, fragment_size)
+        self._merge_wire(topic)
+
+    def _merge_wire(self, topic: str) -> None:
+        requests = self._wire_requests.get(topic, {}).values()
+        png = any(asked for asked, _ in requests)
+        sizes = [size for _, size in requests if size is not None]
+        if png or sizes:
+            self.wire[topic] = (png, min(sizes) if sizes else None)
+        else:
+            self.wire.pop(topic, None)
 
     def unsubscribe(self, topic: str, request: Request | None, every: bool) -> bool:
         """Drop one subscribe request (or ``every`` one); True if the client no longer subscribes."""
         queue = self.queues[topic]
+        wire = self._wire_requests.get(topic, {})
         if every:
             queue.requests.clear()
+            wire.clear()
         else:
             queue.remove(request)
+            wire.pop(request, None)
+        self._merge_wire(topic)
         if queue.requests:
             return False
         del self.queues[topic]
         del self.spelling[topic]
+        self._wire_requests.pop(topic, None)
         return True
 
     def offer(self, topic: str, text: str) -> None:
@@ -165,6 +204,9 @@ class Session:
         """Forget every message waiting: a client that has gone holds no memory."""
         self._replies.clear()
         self._reply_bytes = 0
+        self._pieces.clear()
+        if self.reassembly is not None:
+            self.reassembly.clear()
         for queue in self.queues.values():
             queue.clear()
 
@@ -209,24 +251,43 @@ class Session:
 
     def _take(self, now: float) -> tuple[str | None, float | None]:
         """The next message due (oldest first), else how long until one is due (None: nothing waits)."""
+        if self._pieces:  # a topic message in pieces goes out whole before anything else
+            return self._pieces.popleft(), None
         best: TopicQueue | None = None
+        best_topic = ""
         best_seq = self._replies[0][0] if self._replies else None
         wait: float | None = None
-        for queue in self.queues.values():
+        for topic, queue in self.queues.items():
             ready = queue.ready_at()
             if ready is None:
                 continue
             if ready > now:
                 wait = ready - now if wait is None else min(wait, ready - now)
             elif best_seq is None or queue.head() < best_seq:
-                best, best_seq = queue, queue.head()
+                best, best_seq, best_topic = queue, queue.head(), topic
         if best is not None:
-            return best.pop(now), None
+            text = best.pop(now)
+            return (self._encoded(best_topic, text) if self.wire else text), None
         if best_seq is not None:
             text = self._replies.popleft()[1]
             self._reply_bytes -= len(text)
             return text, None
         return None, wait
+
+    def _encoded(self, topic: str, text: str) -> str:
+        """A topic message as its subscription asked for it: PNG, in pieces, or as it is."""
+        wire = self.wire.get(topic)
+        if wire is None:
+            return text
+        png, size = wire
+        if png:
+            text = png_message(text)
+        if size is None:
+            return text
+        self._piece_ids += 1
+        first, *rest = fragments(text, size, f"publish:{self.spelling.get(topic, topic)}:{self._piece_ids}")
+        self._pieces.extend(rest)
+        return first
 
     def _wake(self) -> None:
         """Wake the writer if it waits (a bare future: cheaper than an Event, woken once per message)."""
