@@ -235,7 +235,8 @@ const deadline = Date.now() + 5000;
 while ((heard.png.length < 1 || heard.pieces.length < 1) && Date.now() < deadline) {
   await new Promise((resolve) => setTimeout(resolve, 50));
 }
-console.log(JSON.stringify({ png: heard.png, sizes: heard.pieces.map((m) => m.data.length) }));
+const publishers = await new Promise((resolve, reject) => big.getPublishers(resolve, reject));
+console.log(JSON.stringify({ png: heard.png, sizes: heard.pieces.map((m) => m.data.length), publishers }));
 process.exit(0);
 """
 
@@ -252,4 +253,23 @@ def test_roslibjs_decodes_png_and_fragments_from_the_bridge(bridge: RunningBridg
     )
     assert child.returncode == 0, child.stderr
     found = json.loads(child.stdout.strip().splitlines()[-1])
-    assert found == {"png": [{"data": "snow ☃", "n": 1}], "sizes": [2000]}
+    assert found == {"png": [{"data": "snow ☃", "n": 1}], "sizes": [2000], "publishers": ["/cbrs_rosbridge"]}
+
+
+def test_rosapi_names_the_bridge_as_the_node_at_either_end_of_a_clients_topic(bridge: RunningBridge) -> None:
+    def rosapi(ws: ClientConnection, service: str, **args: str) -> dict[str, Any]:
+        ws.send(json.dumps({"op": "call_service", "service": f"/rosapi/{service}", "args": args, "id": service}))
+        answer: dict[str, Any] = json.loads(ws.recv(timeout=WAIT))
+        assert answer["result"] is True and answer["id"] == service, answer
+        return dict(answer["values"])
+
+    with connect(bridge.url, open_timeout=WAIT) as talker, connect(bridge.url, open_timeout=WAIT) as listener:
+        talker.send(json.dumps({"op": "advertise", "topic": "/chatter", "type": "std_msgs/String"}))
+        listener.send(json.dumps({"op": "subscribe", "topic": "/heard", "type": "std_msgs/String"}))
+        time.sleep(0.1)
+        assert rosapi(talker, "publishers", topic="/chatter") == {"publishers": ["/cbrs_rosbridge"]}
+        assert rosapi(talker, "publishers", topic="heard") == {"publishers": []}
+        assert rosapi(talker, "subscribers", topic="heard") == {"subscribers": ["/cbrs_rosbridge"]}
+        assert rosapi(talker, "subscribers", topic="/nobody") == {"subscribers": []}
+        details = rosapi(talker, "node_details", node="/cbrs_rosbridge")
+        assert details["publishing"] == ["/chatter"] and details["subscribing"] == ["/heard"]

@@ -105,13 +105,28 @@ def services(graph: Graph, params: ParamStore) -> dict[str, tuple[str, Handler]]
         # ROS 1 clients (roslibpy) read secs/nsecs, ROS 2 ones sec/nanosec
         return {"time": {"secs": secs, "nsecs": nsecs, "sec": secs, "nanosec": nsecs}}
 
+    # As in ROS, where rosbridge publishes and subscribes on its clients' behalf, the bridge is the node
+    # at the end of every topic a client or the server uses: clients have no node names of their own.
+    def published() -> list[str]:
+        with graph.lock:
+            return sorted(t.name for t in graph.topics.values() if t.server or t.publishers)
+
+    def subscribed() -> list[str]:
+        with graph.lock:
+            return sorted(t.name for t in graph.topics.values() if t.subscribers)
+
     def node_details(args: dict[str, Any]) -> dict[str, Any]:
         node = _global(_text(args, "node"))
         if node != NODES[0]:
             return {"subscribing": [], "publishing": [], "services": []}
-        with graph.lock:
-            served = sorted(t.name for t in graph.topics.values() if t.server)
-        return {"subscribing": [], "publishing": served, "services": [name for name, _ in graph.service_list()]}
+        services = [name for name, _ in graph.service_list()]
+        return {"subscribing": subscribed(), "publishing": published(), "services": services}
+
+    def publishers(args: dict[str, Any]) -> dict[str, Any]:
+        return {"publishers": [NODES[0]] if _global(_text(args, "topic")) in published() else []}
+
+    def subscribers(args: dict[str, Any]) -> dict[str, Any]:
+        return {"subscribers": [NODES[0]] if _global(_text(args, "topic")) in subscribed() else []}
 
     def service_node(args: dict[str, Any]) -> dict[str, Any]:
         name = _global(_text(args, "service"))
@@ -146,6 +161,8 @@ def services(graph: Graph, params: ParamStore) -> dict[str, tuple[str, Handler]]
         "/rosapi/service_response_details": ("rosapi/ServiceResponseDetails", no_typedefs),
         "/rosapi/action_servers": ("rosapi/GetActionServers", action_servers),
         "/rosapi/topics": ("rosapi/Topics", topics),
+        "/rosapi/publishers": ("rosapi/Publishers", publishers),
+        "/rosapi/subscribers": ("rosapi/Subscribers", subscribers),
         "/rosapi/topics_for_type": ("rosapi/TopicsForType", topics_for_type),
         "/rosapi/topic_type": ("rosapi/TopicType", topic_type),
         "/rosapi/services": ("rosapi/Services", service_list),
