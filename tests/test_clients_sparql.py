@@ -247,3 +247,18 @@ def test_a_failed_update_changes_nothing_and_a_204_has_no_type(server: Server) -
     assert status == 400 and json.loads(body)["error"] == "StoreEvaluationError"
     asked = get(server, "/sparql", "ASK { <urn:test:b> ?p ?o }", "application/sparql-results+json")
     assert json.loads(asked[2])["boolean"] is False
+
+
+@pytest.mark.parametrize(
+    ("method", "path"),
+    [("DELETE", "/sparql"), ("PUT", "/update"), ("GET", "/update"), ("PATCH", "/store"), ("GET", "/nothing.json")],
+)
+def test_protocol_paths_answer_errors_in_json_whatever_accept_says(server: Server, method: str, path: str) -> None:
+    status, headers, body = ask(server, method, path, headers={"Accept": "*/*"})  # curl's default
+    assert status in (404, 405) and media(headers) == "application/json", body
+    assert json.loads(body)["error"] in ("not-found", "method-not-allowed")
+
+
+def test_a_page_that_does_not_exist_is_still_a_page_for_a_browser(server: Server) -> None:
+    status, headers, _ = ask(server, "GET", "/nothing", headers={"Accept": BROWSER})
+    assert status == 404 and media(headers) == "text/html"

@@ -46,6 +46,9 @@ CONTENT_SECURITY_POLICY = (
     "frame-ancestors 'none'"
 )
 LOOPBACK_NAMES = frozenset({"127.0.0.1", "localhost", "::1"})
+# Paths only programs ask (the protocols, the components' registrations): errors there are always JSON.
+PROGRAM_PATHS = frozenset({"/sparql", "/update", "/store", "/components", "/healthz"})
+PROGRAM_PREFIXES = ("/components/",)
 
 
 def create_app(
@@ -135,9 +138,17 @@ def create_app(
             return render_template("error.html", title="Error", message=str(error)), error.http_status
         return _error(getattr(error, "kind", type(error).__name__), str(error)), error.http_status
 
+    def for_programs() -> bool:
+        """A path only programs use (the protocol endpoints, a ``.json`` twin): its errors are JSON even
+        when the request accepts HTML, as curl's ``*/*`` does (a 405 or 404 there came as a page)."""
+        path = request.path
+        return path.endswith(".json") or path in PROGRAM_PATHS or path.startswith(PROGRAM_PREFIXES)
+
     @app.errorhandler(HTTPException)
     def http_error(error: HTTPException) -> tuple[Response | str, int]:
         status = error.code or 500
+        if g.get("sparql_protocol") or for_programs():
+            return _error(error.name.lower().replace(" ", "-"), error.description or error.name), status
         if as_page() or (request.blueprint is None and request.accept_mimetypes.accept_html):
             return render_template("error.html", title=error.name, message=error.description), status
         return _error(error.name.lower().replace(" ", "-"), error.description or error.name), status
