@@ -262,3 +262,18 @@ def test_protocol_paths_answer_errors_in_json_whatever_accept_says(server: Serve
 def test_a_page_that_does_not_exist_is_still_a_page_for_a_browser(server: Server) -> None:
     status, headers, _ = ask(server, "GET", "/nothing", headers={"Accept": BROWSER})
     assert status == 404 and media(headers) == "text/html"
+
+
+@pytest.mark.parametrize("charset", ["iso-8859-1", "utf-16", "UTF-8", '"utf-8"'])
+def test_a_body_is_read_in_the_charset_it_declares(server: Server, charset: str) -> None:
+    query = 'ASK { FILTER("café" = "caf\\u00e9") }'  # true only if the é arrived as an é
+    content = {"Content-Type": f"application/sparql-query; charset={charset}", "Accept": "application/json"}
+    status, _, body = ask(server, "POST", "/sparql", query.encode(charset.strip('"')), content)
+    assert status == 200, body
+    assert json.loads(body)["boolean"] is True
+
+
+def test_a_charset_nobody_knows_is_a_400_naming_it(server: Server) -> None:
+    content = {"Content-Type": "application/sparql-query; charset=klingon"}
+    status, _, body = ask(server, "POST", "/sparql", b"ASK {}", content)
+    assert status == 400 and "klingon" in json.loads(body)["message"]

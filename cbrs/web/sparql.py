@@ -159,10 +159,14 @@ def _check_dataset_parameters(updating: bool) -> None:
 
 
 def _body() -> str:
+    """The body's text, in the charset its Content-Type declares (UTF-8 when it declares none)."""
+    charset = request.mimetype_params.get("charset") or "utf-8"
     try:
-        return request.get_data(as_text=False).decode("utf-8")
+        return request.get_data(as_text=False).decode(charset)
+    except LookupError:
+        raise BadProtocolRequest(f"the request body's charset {charset!r} is not one this server knows") from None
     except UnicodeDecodeError as error:
-        raise BadProtocolRequest(f"the request body is not UTF-8: {error}") from error
+        raise BadProtocolRequest(f"the request body is not {charset}: {error}") from error
 
 
 def _update(text: str) -> Response:

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import json
 import logging
+import re
 from collections.abc import Callable, Collection, Iterable
 from typing import Any
 from urllib.parse import parse_qsl, urlsplit
@@ -103,15 +104,20 @@ def plain_get(parameters: list[tuple[str, str]]) -> tuple[str, str | None] | Non
     return values["query"], values.get("format") or values.get("output")
 
 
+_UTF8 = re.compile(r"charset\s*=\s*\"?utf-?8\"?\s*(?:;|$)", re.IGNORECASE)
+
+
 def plain_post_length(content_type: str | None, content_length: str | None, max_body: int) -> int | None:
     """The body length of a POST this path answers: an ``application/sparql-query`` body of at most
     ``max_body`` bytes. None for any other."""
-    media_type = (content_type or "").partition(";")[0].strip().lower()
+    media_type, _, parameters = (content_type or "").partition(";")
+    if "charset" in parameters.lower() and not _UTF8.search(parameters):
+        return None  # another charset: Flask's view decodes the body as declared
     try:
         length = int(content_length or "-1")
     except ValueError:
         return None
-    return length if media_type == _QUERY_TYPE and 0 <= length <= max_body else None
+    return length if media_type.strip().lower() == _QUERY_TYPE and 0 <= length <= max_body else None
 
 
 def host_allowed(host: str | None, names: Collection[str | None]) -> bool:
