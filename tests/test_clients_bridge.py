@@ -169,7 +169,24 @@ def test_a_client_holds_a_bounded_number_of_unfinished_messages(bridge: RunningB
         for index in range(MAX_PARTIAL + 1):
             ws.send(json.dumps({"op": "fragment", "id": f"never{index}", "data": "{", "num": 0, "total": 2}))
         (warning,) = receive_all(ws)
-    assert "dropped the unfinished fragments of message 'never0'" in warning["msg"]
+    assert warning["msg"] == "fragment: dropped the unfinished fragments of 'never0' to make room"
+
+
+def test_a_stale_unfinished_message_makes_way_for_a_new_one(bridge: RunningBridge) -> None:
+    text = json.dumps(
+        {"op": "call_service", "service": "/rosapi/get_time", "id": "fresh", "args": {"pad": "x" * 30_000}}
+    )
+    with connect(bridge.url, open_timeout=WAIT) as ws:  # the bridge's max_message_bytes: 64 KiB
+        ws.send(json.dumps({"op": "set_level", "level": "warning"}))
+        ws.send(json.dumps({"op": "fragment", "id": "stale", "data": "{" + " " * 40_000, "num": 0, "total": 2}))
+        for num, at in enumerate(range(0, len(text), 20_000)):
+            ws.send(json.dumps({"op": "fragment", "id": "new", "data": text[at : at + 20_000], "num": num, "total": 2}))
+        warning, answer = receive_all(ws)
+        assert warning["msg"] == "fragment: dropped the unfinished fragments of 'stale' to make room"
+        assert answer["op"] == "service_response" and answer["id"] == "fresh"
+        ws.send(json.dumps({"op": "fragment", "id": "tiny", "data": "{", "num": 0, "total": 64 * 1024}))
+        (refused,) = receive_all(ws)
+        assert refused["level"] == "error" and "more pieces than a message may have (1024)" in refused["msg"]
 
 
 def test_subscriptions_and_calls_in_pieces_of_fragment_size(bridge: RunningBridge) -> None:

@@ -11,9 +11,11 @@
   image padded with newlines, base64 in ``{"op": "png", "data": ...}``, as rosbridge_suite's
   ``pngcompression.encode`` writes it and roslibjs decodes it.
 
-Both are bounded: a message in pieces is no larger than ``max_message_bytes`` once whole, a client
-has at most :data:`MAX_PARTIAL` messages in pieces (the oldest is dropped), and a ``fragment_size``
-below :data:`MIN_FRAGMENT` is raised to it, so one message never becomes millions of frames.
+Both are bounded: the pieces a client has pending hold at most ``max_message_bytes`` characters
+together, in at most one piece per :data:`PIECE_CHARS` of that (the oldest unfinished messages make way,
+then the message that still does not fit is refused), in at most :data:`MAX_PARTIAL` messages; and a
+``fragment_size`` below :data:`MIN_FRAGMENT` is raised to it, so one message never becomes millions
+of frames.
 """
 
 from __future__ import annotations
@@ -33,6 +35,9 @@ from cbrs.rosbridge.protocol import Message, MessageId, dumps
 MAX_PARTIAL = 16
 #: The smallest piece the server sends: a smaller ``fragment_size`` is raised to it.
 MIN_FRAGMENT = 256
+#: A client's pending pieces number at most one per this many characters of ``max_message_bytes``
+#: (16,384 for 1 MiB): a piece costs its bookkeeping whatever its size, so tiny pieces are counted too.
+PIECE_CHARS = 64
 _PNG_SIGNATURE = b"\x89PNG\r\n\x1a\n"
 
 
@@ -47,8 +52,11 @@ class Reassembly:
     """One client's messages arriving in ``fragment`` ops."""
 
     def __init__(self, limit: int) -> None:
-        self.limit = limit  # characters a whole message may have (max_message_bytes)
+        self.limit = limit  # characters a whole message, and all pending pieces together, may have
+        self.max_pieces = max(1, limit // PIECE_CHARS)
         self._partial: OrderedDict[MessageId, _Partial] = OrderedDict()
+        self._size = 0  # characters pending, all messages together
+        self._pieces = 0  # pieces pending
 
     def __len__(self) -> int:
         return len(self._partial)
@@ -61,14 +69,15 @@ class Reassembly:
             raise ProtocolError("a fragment needs the 'id' of the message it is part of")
         if total < 1 or not 0 <= num < total:
             raise ProtocolError(f"num must be from 0 to total - 1, not {num} of {total}", message_id=message_id)
-        if total > self.limit:  # every piece carries at least a character
-            raise ProtocolError(f"total {total} is more pieces than a message may have", message_id=message_id)
-        warning = None
+        if total > self.max_pieces:
+            raise ProtocolError(
+                f"total {total} is more pieces than a message may have ({self.max_pieces})", message_id=message_id
+            )
+        dropped: list[MessageId] = []
         partial = self._partial.get(message_id)
         if partial is None:
             if len(self._partial) >= MAX_PARTIAL:
-                dropped, _ = self._partial.popitem(last=False)
-                warning = f"dropped the unfinished fragments of message {dropped!r} ({MAX_PARTIAL} at most at once)"
+                dropped.append(self._drop_oldest())
             partial = self._partial[message_id] = _Partial(total)
         elif partial.total != total:
             raise ProtocolError(
@@ -76,21 +85,39 @@ class Reassembly:
             )
         if num in partial.pieces:
             return None, f"piece {num} of message {message_id!r} came twice; the first is kept"
-        if partial.size + len(data) > self.limit:
-            del self._partial[message_id]
-            raise ProtocolError(
-                f"the pieces of message {message_id!r} exceed the limit of {self.limit} bytes (max_message_bytes)",
-                message_id=message_id,
-            )
+        while self._size + len(data) > self.limit or self._pieces + 1 > self.max_pieces:
+            if next(iter(self._partial)) == message_id:  # the oldest is this one: it cannot fit
+                self._drop(message_id)
+                raise ProtocolError(
+                    f"the pieces of message {message_id!r} exceed the limit of {self.limit} bytes (max_message_bytes)",
+                    message_id=message_id,
+                )
+            dropped.append(self._drop_oldest())
         partial.pieces[num] = data
         partial.size += len(data)
+        self._size += len(data)
+        self._pieces += 1
+        warning = (
+            f"dropped the unfinished fragments of {', '.join(map(repr, dropped))} to make room" if dropped else None
+        )
         if len(partial.pieces) < total:
             return None, warning
-        del self._partial[message_id]
+        self._drop(message_id)
         return "".join(partial.pieces[index] for index in range(total)), warning
+
+    def _drop(self, message_id: MessageId) -> None:
+        partial = self._partial.pop(message_id)
+        self._size -= partial.size
+        self._pieces -= len(partial.pieces)
+
+    def _drop_oldest(self) -> MessageId:
+        oldest = next(iter(self._partial))
+        self._drop(oldest)
+        return oldest
 
     def clear(self) -> None:
         self._partial.clear()
+        self._size = self._pieces = 0
 
 
 def fragments(text: str, size: int, message_id: MessageId) -> list[str]:
