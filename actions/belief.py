@@ -51,6 +51,14 @@ class BeliefState:
         new.append(ox.Quad(ox.NamedNode(STATE), ox.NamedNode(CBRS.believedAt), _double(observation.time), graph))
         self.kb.store.replace(old, new)
 
+    def snapshot(self) -> list[ox.Quad]:
+        """The world graph as it is, for :meth:`restore`."""
+        return list(self.kb.store.quads(graph=GraphName.WORLD.node))
+
+    def restore(self, quads: list[ox.Quad]) -> None:
+        """Put the world graph back as a :meth:`snapshot` found it (a run refused before it acted)."""
+        self.kb.store.replace(self.snapshot(), quads)
+
     def facts(self, thing: str | None = None) -> set[tuple[str, str, str]]:
         rows = self.kb.select("world_facts", {"thing": thing} if thing else None)
         return {(r["thing"].value, r["relation"].value, r["other"].value) for r in rows}

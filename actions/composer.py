@@ -21,9 +21,10 @@ each sub-action is composed in their partial order and the plans are concatenate
 
 from __future__ import annotations
 
+import re
 from collections import deque
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from enum import Enum
 from typing import TYPE_CHECKING, Any
 
@@ -89,16 +90,33 @@ class Unsatisfied:
     consumer: str
     chain: tuple[str, ...] = ()  # from the requirement's goal down to this need
     cycle: bool = False  # providers exist, but each needs (through others) what this need blocks
+    undeclared: tuple[str, ...] = ()  # classes the need names that the ontology does not have
 
     def text(self) -> str:
         consumer = "the requirement" if self.consumer in (SRO, SRE, GOAL) else shorten(self.consumer)
         via = f" (on the way to {' <- '.join(self.chain)})" if len(self.chain) > 1 else ""
+        need = self.need
+        if self.consumer == SRE and need.startswith("precondition "):  # the goal is the end's precondition
+            need = "effect " + need.removeprefix("precondition ")
         if self.cycle:
-            return f"only a cycle of components provides {self.need} of {consumer}{via}"
-        return f"no component provides {self.need} of {consumer}{via}; {self.remedy()}"
+            return f"only a cycle of components provides {need} of {consumer}{via}"
+        return f"no component provides {need} of {consumer}{via}; {self.remedy()}"
 
     def remedy(self) -> str:
-        """What to register or state so that this need is met."""
+        """What to register or state so that this need is met (first, a class to declare: no component
+        can be matched against a class the ontology does not have)."""
+        if self.undeclared:
+            names = ", ".join(shorten(c) for c in self.undeclared)
+            example = shorten(self.undeclared[0])
+            return (
+                f"{names} {'is no class' if len(self.undeclared) == 1 else 'are no classes'} of the ontology: "
+                f"declare {'it' if len(self.undeclared) == 1 else 'them'} under a class the components know "
+                f"(e.g. {example} rdfs:subClassOf home:PersonalItem, loaded into the ontology graph), "
+                f"or {self._remedy()}"
+            )
+        return self._remedy()
+
+    def _remedy(self) -> str:
         if self.need.startswith("precondition "):
             statement = self.need.removeprefix("precondition ")
             return (
@@ -410,7 +428,24 @@ class Composer:
         self, task: Task, plan: Plan | None, unsatisfied: tuple[Unsatisfied, ...], attempts: tuple[Attempt, ...]
     ) -> CompositionResult:
         status = PlanStatus.PLANNED if plan is not None else PlanStatus.UNSOLVABLE
+        if plan is None:
+            unsatisfied = tuple(self._undeclared(task.requirement, u) for u in unsatisfied)
         return CompositionResult(task.name, task.requirement.iri, status, plan, unsatisfied, attempts)
+
+    def _undeclared(self, requirement: Requirement, unsatisfied: Unsatisfied) -> Unsatisfied:
+        """``unsatisfied`` with the classes of the requirement it names that the ontology lacks (a task
+        about a home:Frisbee nobody declared): the likeliest reason nothing provides it."""
+        named = {p.type for p in (*requirement.inputs, *requirement.outputs)}
+        for statement in (*requirement.preconditions, *requirement.effects):
+            named |= {statement.subject, statement.object}
+        missing = tuple(
+            sorted(
+                c
+                for c in named
+                if c and c not in self.index and re.search(rf"\b{re.escape(shorten(c))}\b", unsatisfied.need)
+            )
+        )
+        return replace(unsatisfied, undeclared=missing) if missing else unsatisfied
 
 
 def store_plan(kb: KnowledgeBase, plan: Plan) -> None:

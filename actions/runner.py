@@ -130,16 +130,25 @@ def run_task(
     container = Container(environment.registry, environment.context, bus, policy)
     belief = BeliefState(kb)
     _perceive(environment)
+    before = belief.snapshot()
     belief.write(environment.observe())  # plan from what holds now, not from a past run's belief
     composition = composer.compose(task, belief=True)
+    if composition.plan is None:
+        belief.restore(before)  # nothing can be done and nothing was: the store is left as it was
+        return RunResult(composition, None)
     replans: list[Replan] = []
     report: ExecutionReport | None = None
     outputs: Mapping[int, Mapping[str, Any]] = {}
     try:
         while composition.plan is not None:
             plan = composition.plan
+            try:
+                given = environment.given(plan, _supplying(kb, plan))
+            except Exception:
+                if not replans:  # refused before anything moved: the store is left as it was
+                    belief.restore(before)
+                raise
             store_plan(kb, plan)
-            given = environment.given(plan, _supplying(kb, plan))
             executor = Executor(plan, container, given, environment.verify, environment.clock)
             done = 0
             _stop_if_cancelled(executor, cancelled, done)

@@ -454,6 +454,17 @@ class Arm:
         ok = motion.reached and error <= REACH_TOLERANCE
         return MotionResult(ok, error, "" if ok else f"stopped {error:.3f} m short")
 
+    def can_hold(self, position: Vec3, orientation: Quat, symmetric: bool = True) -> bool:
+        """Whether the hand can be at this pose at all (inverse kinematics from any seed posture, or from
+        the current one), without moving: a skill asks before it picks up what it could not set down."""
+        candidates = [orientation, flipped(orientation)] if symmetric else [orientation]
+        for candidate in candidates:
+            for seed in (*_SEEDS, self.joint_positions()):
+                solution = self._kinematics.solve(self.side, position, candidate, [seed])
+                if solution.position_error <= IK_TOLERANCE and solution.orientation_error <= 0.02:
+                    return True
+        return False
+
     def _others(self) -> dict[ArmSide, Sequence[float]]:
         return {side: arm.joint_positions() for side, arm in self.peers.items() if side is not self.side}
 

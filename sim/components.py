@@ -29,6 +29,7 @@ from cbrs.actions.components import Component, Registry, Status
 from cbrs.actions.plan import Plan, PlanStep
 from cbrs.actions.remote import RemoteComponent, Transport
 from cbrs.kb import KnowledgeBase, Requirement, Statement
+from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap, Thing, designate, local_name
 from cbrs.sim import predicates as pred
@@ -109,6 +110,29 @@ Work = Callable[[SimContext, Mapping[str, Any], str], dict[str, Any]]
 
 class SkillFailed(Exception):
     """A skill reported failure; the message is its reason."""
+
+
+class OutOfReachError(KnowledgeBaseError):
+    """A thing a task gives to a robot's arms is beyond the reach of every one of them, by the map: the
+    run is refused before anything moves. ``arms`` holds (arm IRI, mount x, y, reach, distance)."""
+
+    http_status = 422
+
+    def __init__(
+        self, robot: str, thing: str, where: tuple[float, float], arms: list[tuple[str, float, float, float, float]]
+    ) -> None:
+        self.robot = robot
+        self.thing = thing
+        self.where = where
+        self.arms = tuple(arms)
+        each = "; ".join(
+            f"{local_name(arm)} reaches {reach:.2f} m from ({x:.2f}, {y:.2f}), {distance:.2f} m away"
+            for arm, x, y, reach, distance in self.arms
+        )
+        super().__init__(
+            f"no arm of {local_name(robot)} reaches the {local_name(thing)} at ({where[0]:.2f}, {where[1]:.2f}): "
+            f"{each}; move it within reach in the map (home:x, home:y) or give the arms more home:reach"
+        )
 
 
 class SimComponent(Component):
@@ -195,19 +219,29 @@ def _dock(thing: Thing) -> Pose2D:
     return Pose2D(thing.dock.x, thing.dock.y, thing.dock.yaw)
 
 
-def _free_arm(ctx: SimContext, x: float, y: float, what: str) -> ArmSide:
-    """The free arm whose mount is nearest (x, y) and within its reach; on a tie, not the one that just acted."""
+def _reaching(ctx: SimContext, x: float, y: float) -> list[ArmSide]:
+    """The free arms whose mounts are within their reach of (x, y), best first: the nearest, and on a
+    tie not the one that just acted."""
     options = []
     for side, spec in ctx.world.arm_specs.items():
         distance = math.hypot(x - spec.mount[0], y - spec.mount[1])
         if ctx.world.arm(side).held is None and distance <= spec.reach:
             options.append((distance, side))
     if not options:
-        raise SkillFailed(f"no free arm reaches {what} at ({x:.2f}, {y:.2f})")
+        return []
     best = min(distance for distance, _ in options)
-    tied = [side for distance, side in options if distance - best <= ARM_TIE]
+    tied = sorted(side for distance, side in options if distance - best <= ARM_TIE)
     fresh = [side for side in tied if side != ctx.last_arm]
-    return sorted(fresh or tied)[0]
+    first = (fresh or tied)[0]
+    return [first, *(side for _, side in sorted(options) if side != first)]
+
+
+def _free_arm(ctx: SimContext, x: float, y: float, what: str) -> ArmSide:
+    """The free arm whose mount is nearest (x, y) and within its reach; on a tie, not the one that just acted."""
+    arms = _reaching(ctx, x, y)
+    if not arms:
+        raise SkillFailed(f"no free arm reaches {what} at ({x:.2f}, {y:.2f})")
+    return arms[0]
 
 
 # -- object knowledge and perception at the table -------------------------------------------------
@@ -298,8 +332,40 @@ def pick_up(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str
 
 
 def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
-    ctx.region = _region(_place(ctx, inputs["targetPlace"], "the target place"))
-    _check(skills.carry_object(ctx.world, ctx.arm, ctx.region))
+    """CarryObject to the target place by the arm holding the object; when the place is beyond that
+    arm's reach and the other arm reaches it, the object is first passed to the other arm."""
+    place = _place(ctx, inputs["targetPlace"], "the target place")
+    ctx.region = region = _region(place)
+    cx, cy, _ = region.center
+    spec = ctx.world.arm_specs[ctx.arm]
+    if math.hypot(cx - spec.mount[0], cy - spec.mount[1]) > spec.reach and ctx.grasp is not None:
+        takers = _reaching(ctx, cx, cy)
+        if not takers:
+            raise SkillFailed(
+                f"no arm reaches {place.name} at ({cx:.2f}, {cy:.2f}): the {ctx.arm.value} arm holding the "
+                f"{ctx.grasp.model.name} reaches {spec.reach:.2f} m from ({spec.mount[0]:.2f}, {spec.mount[1]:.2f})"
+            )
+        giver, taker, model = ctx.arm, takers[0], ctx.grasp.model
+        gx, gy, gz = ctx.grasp.position  # where it was taken from: its surface
+        taken = ObjectEstimate(
+            gx,
+            gy,
+            gz - model.grasp_height + model.height / 2.0,
+            None,
+            (0.0, 0.0, 0.0),
+            model.colour,
+            "hand",
+            ctx.world.time,
+            0,
+        )
+        spot = _relay_spot(ctx, taken, model, giver, taker)
+        found = _set_down_for(ctx, device, model, giver, taker, spot, None)
+        taker_spec = ctx.world.arm_specs[taker]
+        grasp = compute_grasp_pose(model, found.position, found.yaw, taker_spec.mount, taker_spec.yaw)
+        for move in (skills.approach_object, skills.pick_up_object):
+            _passing(move(ctx.world, taker, grasp), model, giver, taker)
+        ctx.arm, ctx.grasp, ctx.last_arm = taker, grasp, taker
+    _check(skills.carry_object(ctx.world, ctx.arm, region))
     return {}
 
 
@@ -322,15 +388,170 @@ def fill_from_tap(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> di
 
 
 def hand_over(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
+    """HandOverOntoPlatform by an arm that reaches both the object and the parked base's platform; when
+    one arm reaches the object and only the other the platform, the first sets the object down where
+    both reach (:func:`_relay`) and the second loads it."""
     estimate = decode(inputs["objectPosition"], ObjectEstimate)
     model = _model(ctx, inputs["graspPose"])
     x, y, _ = estimate.position
-    side = _free_arm(ctx, x, y, f"the {model.name}")
+    base = ctx.world.base_pose()  # the base parks against the place's docking mark, which the robot knows
+    takers = _reaching(ctx, x, y)
+    loaders = _reaching(ctx, base.x, base.y)
+    if not takers:
+        raise SkillFailed(f"no free arm reaches the {model.name} at ({x:.2f}, {y:.2f})")
+    if not loaders:
+        raise SkillFailed(
+            f"no free arm reaches the base's platform at ({base.x:.2f}, {base.y:.2f}): the docking pose is "
+            "beyond every arm's reach"
+        )
+    both = [side for side in takers if side in loaders]
+    if both:
+        side = both[0]
+    else:
+        estimate = _relay(ctx, device, estimate, model, takers[0], loaders[0])
+        side = loaders[0]
     ctx.last_arm, ctx.focus = side, model.name
-    # The base parks against the place's docking mark, which the dual-arm robot knows.
     reach = ctx.world.arm_specs[side].reach
-    _check(skills.hand_over_onto_platform(ctx.world, estimate, ctx.world.base_pose(), side, model, reach))
+    _check(skills.hand_over_onto_platform(ctx.world, estimate, base, side, model, reach))
     return {}
+
+
+RELAY_MARGIN = 0.05
+"""A relay spot is at least 5 cm inside both arms' reach."""
+RELAY_CLEARANCE = 0.06
+"""A relay spot keeps 6 cm between the object's footprint and any other object's or fixture's."""
+RELAY_EDGE = 0.02
+"""... and 2 cm between the object's footprint and the edge of the surface."""
+RELAY_STEP = 0.02
+"""The spots tried are a 2 cm grid over the surface."""
+RELAY_TRIES = 40
+"""How many spots, nearest the mounts first, are asked of the inverse kinematics (each asks take a few
+milliseconds) before passing is given up."""
+
+
+def _relay(
+    ctx: SimContext, device: str, estimate: ObjectEstimate, model: ObjectModel, giver: ArmSide, taker: ArmSide
+) -> ObjectEstimate:
+    """Pass an object from the arm that reaches it to the other arm: the first puts it down on the same
+    surface where both reach, and the object is found again there. Whether the other arm can then
+    load it onto the platform is asked first, so that nothing is left half done."""
+    world = ctx.world
+    spot = _relay_spot(ctx, estimate, model, giver, taker)
+    cx, cy, _ = spot.center
+    refused = skills.can_load(world, replace(estimate, x=cx, y=cy), world.base_pose(), taker, model)
+    if refused:
+        raise SkillFailed(
+            f"only the {giver.value} arm reaches the {model.name} and only the {taker.value} arm the platform, "
+            f"and {refused}"
+        )
+    spec = world.arm_specs[giver]
+    grasp = compute_grasp_pose(model, estimate.position, estimate.yaw, spec.mount, spec.yaw)
+    ctx.last_arm = giver
+    for move in (skills.approach_object, skills.pick_up_object):
+        _passing(move(world, giver, grasp), model, giver, taker)
+    return _set_down_for(ctx, device, model, giver, taker, spot, estimate.yaw)
+
+
+def _passing(outcome: skills.Outcome, model: ObjectModel, giver: ArmSide, taker: ArmSide) -> None:
+    if not outcome.succeeded:
+        raise SkillFailed(
+            f"passing the {model.name} from the {giver.value} arm to the {taker.value}: "
+            f"{outcome.skill}: {outcome.reason}"
+        )
+
+
+def _set_down_for(
+    ctx: SimContext, device: str, model: ObjectModel, giver: ArmSide, taker: ArmSide, spot: Region, yaw: float | None
+) -> ObjectEstimate:
+    """The giver, holding the object, sets it down on ``spot`` for the taker; where it is then (by the
+    robot's camera near where the hand let it go, else where the hand let it go)."""
+    world = ctx.world
+    _passing(skills.carry_object(world, giver, spot), model, giver, taker)
+    _passing(skills.put_down_object(world, giver, spot), model, giver, taker)
+    released = world.arm(giver).released
+    where = released[1] if released is not None else spot.center
+    try:
+        camera = _robot_camera(ctx, device)
+        _check(skills.clear_view(world))
+        return recognise_object(world.camera(camera).capture(), model.colour, near=(where[0], where[1]), radius=0.1)
+    except (SkillFailed, SimulationError):
+        size = world.objects[model.name].size
+        return ObjectEstimate(where[0], where[1], where[2], yaw, size, model.colour, "hand", world.time, 0)
+
+
+def _relay_spot(
+    ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, giver: ArmSide, taker: ArmSide
+) -> Region:
+    """Where on the surface the object rests on both arms reach it, clear of the other objects and of
+    the fixtures standing on it (a dispenser): of the spots nearest both mounts, the first where the
+    giver's hand can hold the object as it sets it down and the taker's hand can take it (asked of the
+    inverse kinematics: a side grasp close to the mount has none)."""
+    smap, world = ctx.map, ctx.world
+    x, y, z = estimate.position
+    surface = z - model.height / 2.0
+    supports = [
+        smap.things[iri]
+        for iri in sorted(smap.furniture)
+        if iri in smap.things
+        and smap.things[iri].box.contains_xy(x, y)
+        and abs(smap.things[iri].box.max_z - surface) <= 0.03
+    ]
+    if not supports:
+        raise SkillFailed(f"the {model.name} rests on nothing the map knows: no surface to pass it on")
+    top = supports[0].box
+    size = world.objects[model.name].size
+    radius = math.hypot(size[0], size[1]) / 2.0
+    others = []
+    for name, obj in world.objects.items():
+        if name == model.name:
+            continue
+        believed = ctx.belief.position(name) if ctx.belief is not None else None
+        ox_, oy = (believed[0], believed[1]) if believed is not None else (obj.start.x, obj.start.y)
+        others.append((ox_, oy, math.hypot(obj.size[0], obj.size[1]) / 2.0))
+    fixtures = [
+        (t.box.min_x, t.box.max_x, t.box.min_y, t.box.max_y)
+        for iri, t in smap.things.items()
+        if iri not in smap.rooms
+        and iri not in smap.regions
+        and iri != supports[0].iri
+        and t.box.max_z > surface + 0.005
+        and t.box.min_z < surface + 0.3
+        and t.box.min_x < top.max_x
+        and t.box.max_x > top.min_x
+        and t.box.min_y < top.max_y
+        and t.box.max_y > top.min_y
+    ]
+    arms = [world.arm_specs[giver], world.arm_specs[taker]]
+    spots: list[tuple[float, float, float, float]] = []
+    inset = radius + RELAY_EDGE
+    for i in range(int((top.max_x - top.min_x - 2 * inset) / RELAY_STEP) + 1):
+        cx = top.min_x + inset + i * RELAY_STEP
+        for j in range(int((top.max_y - top.min_y - 2 * inset) / RELAY_STEP) + 1):
+            cy = top.min_y + inset + j * RELAY_STEP
+            distances = [math.hypot(cx - a.mount[0], cy - a.mount[1]) for a in arms]
+            if any(d > a.reach - RELAY_MARGIN for d, a in zip(distances, arms, strict=True)):
+                continue
+            if any(math.hypot(cx - ox_, cy - oy) < radius + r + RELAY_CLEARANCE for ox_, oy, r in others):
+                continue
+            if any(_distance(box, (cx, cy)) < radius + RELAY_CLEARANCE for box in fixtures):
+                continue
+            spots.append((max(distances), math.hypot(cx - x, cy - y), cx, cy))
+    for *_, cx, cy in sorted(spots)[:RELAY_TRIES]:
+        centre = (cx, cy, surface + model.height / 2.0)
+        hands = [compute_grasp_pose(model, centre, estimate.yaw, a.mount, a.yaw) for a in arms]
+        if all(
+            world.arm(side).can_hold(hand.position, hand.orientation)
+            and world.arm(side).can_hold(hand.pregrasp, hand.orientation)
+            for side, hand in zip((giver, taker), hands, strict=True)
+        ):
+            half = RELAY_STEP * 2
+            return Region(
+                f"{supports[0].name}Relay", cx - half, cx + half, cy - half, cy + half, top.max_z, top.max_z + 0.3
+            )
+    raise SkillFailed(
+        f"there is no spot on {supports[0].name} where both the {giver.value} and the {taker.value} arm can hold "
+        f"the {model.name} by its {model.grasp.value} grasp, to pass it from one to the other"
+    )
 
 
 # -- the home server, the ceiling cameras and the mobile base -------------------------------------
@@ -515,6 +736,30 @@ def _named(work: Work, advertised: tuple[str, ...]) -> Work:
 # -- the environment ------------------------------------------------------------------------------
 
 
+def _distance(box: tuple[float, float, float, float], point: tuple[float, ...]) -> float:
+    """From a point to the nearest point of an extent (min x, max x, min y, max y), on the floor plan."""
+    dx = max(box[0] - point[0], 0.0, point[0] - box[1])
+    dy = max(box[2] - point[1], 0.0, point[1] - box[3])
+    return math.hypot(dx, dy)
+
+
+def _given_to(step: PlanStep, steps: Mapping[int, PlanStep]) -> set[str]:
+    """The task's inputs a step works on: those bound to its inputs, directly or through the steps
+    that compute them (an arm's grasp pose comes from the object the task names)."""
+    found: set[str] = set()
+    todo, seen = [step], {step.index}
+    while todo:
+        current = todo.pop()
+        for binding in current.inputs:
+            source = binding.source
+            if source.step is None:
+                found.add(source.name)
+            elif source.step not in seen and source.step in steps:
+                seen.add(source.step)
+                todo.append(steps[source.step])
+    return found
+
+
 def _grasped(inputs: Mapping[str, Any]) -> str | None:
     """The object a step's GraspPose input is about (its body name): the object at hand."""
     for value in inputs.values():
@@ -577,7 +822,50 @@ class SimEnvironment:
                         iri = designate(self.kb, parameter.type, prefer=requirement.requested_by)
                         values[source.name] = designator(iri, parameter.type)
         self.context.designated = frozenset(str(value["@id"]) for value in values.values())
+        self._check_reach(plan, values)
         return values
+
+    def _check_reach(self, plan: Plan, values: Mapping[str, Any]) -> None:
+        """Refuse a plan whose arm steps work on a thing the task gives that no arm of their robot
+        reaches (by the map's mounts and reaches, and where the thing is believed to be), before any
+        step runs: otherwise the base drives off and the failure comes later, from a camera that
+        cannot see it or an arm that cannot reach it."""
+        smap = self.world.map
+        arms: dict[str, list[Any]] = {}
+        for arm in smap.arms.values():
+            arms.setdefault(arm.robot, []).append(arm)
+        steps = {step.index: step for step in plan.steps}
+        for step in plan.steps:
+            robot_arms = arms.get(step.device or "")
+            if not robot_arms:
+                continue
+            for name in sorted(_given_to(step, steps)):
+                value = values.get(name)
+                iri = str(value["@id"]) if isinstance(value, dict) and "@id" in value else None
+                box = self._extent(iri) if iri is not None else None
+                if iri is None or box is None:
+                    continue
+                reaches = [(arm, _distance(box, arm.mount)) for arm in robot_arms]
+                if not any(distance <= arm.reach for arm, distance in reaches):
+                    report = [(arm.iri, arm.mount[0], arm.mount[1], arm.reach, d) for arm, d in reaches]
+                    where = ((box[0] + box[1]) / 2, (box[2] + box[3]) / 2)
+                    raise OutOfReachError(step.device or "", iri, where, report)
+
+    def _extent(self, iri: str) -> tuple[float, float, float, float] | None:
+        """Where a thing of the map is for an arm, as (min x, max x, min y, max y): an object at the point
+        where it is believed to be (else its start), a place, a piece of furniture or a tap lever its
+        extent (an arm reaches it if it reaches part of it); None for a room, a person or what has no place."""
+        smap = self.world.map
+        obj = smap.objects.get(iri)
+        if obj is not None:
+            believed = self.belief.position(obj.name)
+            x, y = (believed[0], believed[1]) if believed is not None else (obj.start.x, obj.start.y)
+            return (x, x, y, y)
+        thing = smap.things.get(iri)
+        if thing is None or iri in smap.rooms:
+            return None
+        box = thing.box
+        return (box.min_x, box.max_x, box.min_y, box.max_y)
 
     # -- verification: the generic test the store maps each predicate to ---------------------
 

@@ -40,6 +40,7 @@ __all__ = [
     "NAVIGATION_TOLERANCE",
     "Outcome",
     "approach_object",
+    "can_load",
     "carry_object",
     "clear_view",
     "deliver_object",
@@ -280,6 +281,43 @@ def platform_region(base: Pose2D | RobotPoseEstimate, height: float) -> Region:
     )
 
 
+def _loading(
+    world: HomeWorld, pen: ObjectEstimate, base: Pose2D | RobotPoseEstimate, side: ArmSide | str, model: ObjectModel
+) -> tuple[GraspPose, Region, float, str]:
+    """How an arm loads an object onto the platform: its grasp, the window on the platform, the axis it
+    turns a top-grasped object to, and why it cannot (empty if it can): the hand must be able to hold
+    the grasp where the object is let go on the platform, which is asked before anything moves."""
+    spec = world.arm_specs[ArmSide(side)]
+    grasp = compute_grasp_pose(model, pen.position, pen.yaw, spec.mount, spec.yaw)
+    region = platform_region(base, world.platform_height)
+    # The pen fits between the marker patches along or across the base: take the placement that
+    # needs the smaller turn of the wrist.
+    pen_yaw = pen.yaw or 0.0
+    along = abs(wrap_angle(2.0 * (base.theta - pen_yaw))) / 2.0
+    yaw = base.theta if along <= math.pi / 4.0 else base.theta + math.pi / 2.0
+    orientation = top_orientation(yaw + math.pi / 2.0) if model.grasp is GraspKind.TOP else grasp.orientation
+    cx, cy, _ = region.center
+    letting_go = (cx, cy, region.zmin + PLACE_CLEARANCE + grasp.bottom_offset)
+    if not world.arm(side).can_hold(letting_go, orientation):
+        return (
+            grasp,
+            region,
+            yaw,
+            (
+                f"the {ArmSide(side).value} arm cannot hold the {model.name} by its {model.grasp.value} grasp over the "
+                f"platform at ({cx:.2f}, {cy:.2f}) to set it down there"
+            ),
+        )
+    return grasp, region, yaw, ""
+
+
+def can_load(
+    world: HomeWorld, pen: ObjectEstimate, base: Pose2D | RobotPoseEstimate, side: ArmSide | str, model: ObjectModel
+) -> str:
+    """Why ``side`` cannot load the object onto the platform of the base parked at ``base`` (empty if it can)."""
+    return _loading(world, pen, base, side, model)[3]
+
+
 def hand_over_onto_platform(
     world: HomeWorld,
     pen: ObjectEstimate,
@@ -296,13 +334,9 @@ def hand_over_onto_platform(
         return _done(
             world, "HandOverOntoPlatform", start, False, f"the base's platform is out of the {side} arm's reach"
         )
-    grasp = compute_grasp_pose(model, pen.position, pen.yaw, mount, world.arm_specs[ArmSide(side)].yaw)
-    region = platform_region(base, world.platform_height)
-    # The pen fits between the marker patches along or across the base: take the placement that
-    # needs the smaller turn of the wrist.
-    pen_yaw = pen.yaw or 0.0
-    along = abs(wrap_angle(2.0 * (base.theta - pen_yaw))) / 2.0
-    yaw = base.theta if along <= math.pi / 4.0 else base.theta + math.pi / 2.0
+    grasp, region, yaw, reason = _loading(world, pen, base, side, model)
+    if reason:
+        return _done(world, "HandOverOntoPlatform", start, False, reason)
     steps: list[Callable[[], Outcome]] = [
         lambda: approach_object(world, side, grasp),
         lambda: pick_up_object(world, side, grasp),

@@ -1,0 +1,111 @@
+"""Which arm: an object written in Turtle where only one arm of the dual-arm robot reaches it, while only
+the other reaches the mobile base's platform at the table's docking pose."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from cbrs.actions.composer import Composer
+from cbrs.actions.runner import run_task
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.semantic_map import SemanticMap
+from cbrs.sim.arms import ArmSide
+from cbrs.sim.components import SimEnvironment
+from cbrs.sim.world import open_world
+
+TASKS = Path(__file__).parent / "data" / "tasks"
+HOME, WORLD = PREFIXES["home"], PREFIXES["world"]
+PENCIL_ON_THE_LEFT = """@prefix home: <https://w3id.org/cbrs/home#> . @prefix world: <https://w3id.org/cbrs/world#> .
+world:Pencil1 a home:Pencil ; home:shapeKind "box" ; home:sizeX 0.16 ; home:sizeY 0.012 ; home:sizeZ 0.012 ;
+    home:massKg 0.01 ; home:colourName "yellow" ; home:rgba "0.95 0.85 0.10 1" ;
+    home:isLocatedOn world:KitchenTable ; home:x 7.36 ; home:y 3.30 ; home:yaw 0.3 .
+"""
+FETCH_MY_CUP = """@prefix cbrs: <https://w3id.org/cbrs/core#> . @prefix home: <https://w3id.org/cbrs/home#> .
+@prefix req: <https://w3id.org/cbrs/requirement#> . @prefix svc: <https://w3id.org/cbrs/service#> .
+req:FetchMyCup a cbrs:Requirement ; cbrs:requestedBy svc:P3DX01 ; cbrs:deviceName "P3DX01" ;
+    cbrs:serviceName "FetchMyCup" ;
+    cbrs:hasOWLSModel [ a cbrs:OWLSModel ;
+        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "cup" ; cbrs:parameterType home:Cup ] ;
+        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "person" ; cbrs:parameterType home:Person ] ;
+        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "marker" ; cbrs:parameterType home:ColourOfMarker ] ;
+        cbrs:hasPrecondition [ a cbrs:Precondition ; cbrs:conditionSubject home:MobileRobot ;
+            cbrs:conditionPredicate home:hasMarker ; cbrs:conditionObject home:ColourMarker ] ;
+        cbrs:hasEffect [ a cbrs:Effect ; cbrs:conditionSubject home:Cup ; cbrs:conditionPredicate home:isWith ;
+            cbrs:conditionObject home:Person ] ] .
+"""
+PEN_TRAY_ON_THE_RIGHT = """@prefix home: <https://w3id.org/cbrs/home#> . @prefix world: <https://w3id.org/cbrs/world#> .
+@prefix owl: <http://www.w3.org/2002/07/owl#> . @prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .
+home:PenTray a owl:Class ; rdfs:subClassOf home:ObjectPlace .
+world:PenTray1 a home:PenTray ;
+    home:minX 8.20 ; home:maxX 8.32 ; home:minY 3.05 ; home:maxY 3.17 ; home:minZ 0.75 ; home:maxZ 0.75 .
+"""
+PUT_CUP_ON_PEN_TRAY = """@prefix cbrs: <https://w3id.org/cbrs/core#> . @prefix home: <https://w3id.org/cbrs/home#> .
+@prefix req: <https://w3id.org/cbrs/requirement#> . @prefix svc: <https://w3id.org/cbrs/service#> .
+req:PutCupOnPenTray a cbrs:Requirement ; cbrs:requestedBy svc:CytonDualArm01 ; cbrs:deviceName "CytonDualArm01" ;
+    cbrs:serviceName "PutCupOnPenTray" ;
+    cbrs:hasOWLSModel [ a cbrs:OWLSModel ;
+        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "cup" ; cbrs:parameterType home:Cup ] ;
+        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "place" ; cbrs:parameterType home:PenTray ] ;
+        cbrs:hasEffect [ a cbrs:Effect ; cbrs:conditionSubject home:Cup ; cbrs:conditionPredicate home:isLocated ;
+            cbrs:conditionObject home:PenTray ] ] .
+"""
+
+
+def knowledge(tmp_path: Path, *files: tuple[str, str | Path]) -> KnowledgeBase:
+    kb = KnowledgeBase.open(":memory:")
+    for index, (graph, text) in enumerate(files):
+        path = text if isinstance(text, Path) else tmp_path / f"file{index}.ttl"
+        if not isinstance(text, Path):
+            path.write_text(text, encoding="utf-8")
+        kb.load([path], graph=graph)
+    return kb
+
+
+def test_an_object_only_the_left_arm_reaches_is_passed_to_the_right_arm(tmp_path: Path) -> None:
+    kb = knowledge(tmp_path, ("map", PENCIL_ON_THE_LEFT), ("requirements", TASKS / "fetch_my_pencil.ttl"))
+    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
+        result = run_task(kb, "FetchMyPencil", SimEnvironment(world, kb), composer=Composer(kb))
+        left = world.arm(ArmSide.LEFT).released
+        assert left is not None and world.name_of(left[0]) == "Pencil1"  # the left hand set it down for the right
+    assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
+    assert not result.replans
+    facts = {(r["thing"].value, r["relation"].value, r["other"].value) for r in kb.select("world_facts")}
+    assert (WORLD + "Pencil1", HOME + "isWith", WORLD + "Person") in facts
+
+
+def test_a_cup_that_cannot_be_set_down_on_the_platform_is_not_lifted(tmp_path: Path) -> None:
+    """The left arm reaches the cup and only the right arm the platform, which it cannot load by the
+    cup's side grasp: the step fails saying so, before either arm moves the cup."""
+    kb = knowledge(tmp_path, ("requirements", FETCH_MY_CUP))
+    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
+        cup = world.pose("Cup").position
+        result = run_task(kb, "FetchMyCup", SimEnvironment(world, kb), composer=Composer(kb), max_replans=0)
+        assert world.pose("Cup").position[:2] == pytest.approx(cup[:2], abs=0.005)
+        assert all(arm.held is None for arm in world.arms.values())
+    assert not result.succeeded and result.report is not None
+    assert "only the left arm reaches the Cup and only the right arm the platform" in result.report.reason
+    assert "cannot hold the Cup by its side grasp over the platform" in result.report.reason
+
+
+def test_a_place_only_the_other_arm_reaches_gets_the_object_passed_to_that_arm(tmp_path: Path) -> None:
+    """The left arm takes the cup; the pen tray is beyond its reach and within the right arm's: the left
+    arm sets the cup down where both reach, and the right arm carries it on."""
+    kb = knowledge(
+        tmp_path,
+        ("ontology", PEN_TRAY_ON_THE_RIGHT),
+        ("map", PEN_TRAY_ON_THE_RIGHT),
+        ("requirements", PUT_CUP_ON_PEN_TRAY),
+    )
+    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
+        environment = SimEnvironment(world, kb)
+        result = run_task(kb, "PutCupOnPenTray", environment, composer=Composer(kb))
+        assert environment.context.arm is ArmSide.RIGHT
+        left = world.arm(ArmSide.LEFT).released
+        assert left is not None and world.name_of(left[0]) == "Cup"
+    assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
+    assert not result.replans
+    facts = {(r["thing"].value, r["relation"].value, r["other"].value) for r in kb.select("world_facts")}
+    assert (WORLD + "Cup", HOME + "isLocated", WORLD + "PenTray1") in facts
