@@ -89,6 +89,10 @@ def serve(
         click.echo(f"warning: listening on {config.host}, reachable from other machines", err=True)
     _check_free(config.host, config.port, "--port", "CBRS_PORT")
     _check_free(config.host, config.bridge_port, "--bridge-port", "CBRS_BRIDGE_PORT")
+    # One query before anything listens: a store that cannot answer as cbrs needs (a remote server whose
+    # default graph is not the union of its graphs, found only once the seed is in) stops the command
+    # with its reason, instead of a server that answers every request with that error.
+    app.kb.query("ASK { ?s ?p ?o }")
     server = Server(app.kb, config)
 
     def ready(running: Server) -> None:

@@ -12,8 +12,12 @@ from __future__ import annotations
 
 import http.client
 import json
+import os
+import subprocess
+import sys
 import urllib.parse
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -22,6 +26,7 @@ from websockets.sync.client import connect
 from cbrs.kb import KnowledgeBase
 from cbrs.server import ServeConfig, Server
 from cbrs.sparql_service import EndpointConfig
+from tests.conftest import OxigraphServer
 
 TOKEN = "clients-sparql-token"
 WAIT = 10.0
@@ -277,3 +282,17 @@ def test_a_charset_nobody_knows_is_a_400_naming_it(server: Server) -> None:
     content = {"Content-Type": "application/sparql-query; charset=klingon"}
     status, _, body = ask(server, "POST", "/sparql", b"ASK {}", content)
     assert status == 400 and "klingon" in json.loads(body)["message"]
+
+
+def test_serve_on_a_server_without_a_union_default_graph_stops_with_the_reason(
+    tmp_path: Path, oxigraph_servers: Callable[..., OxigraphServer]
+) -> None:
+    """The README's ``cbrs --store http://127.0.0.1:7878 serve`` on an ``oxigraph serve`` started without
+    ``--union-default-graph``: it seeded the store, then served an endpoint that failed every query."""
+    oxigraph = oxigraph_servers(union_default_graph=False, on_disk=False)
+    command = [sys.executable, "-m", "cbrs", "--store", oxigraph.url, "serve", "--port", "0", "--bridge-port", "0"]
+    environment = {**os.environ, "CBRS_SEED_CACHE": str(tmp_path), "CBRS_LOG_LEVEL": "ERROR"}
+    child = subprocess.run(command, capture_output=True, text=True, timeout=60, env=environment)
+    assert child.returncode == 1, child.stdout
+    assert "Error: " in child.stderr and "start Oxigraph with --union-default-graph" in child.stderr
+    assert "cbrs serving" not in child.stdout
