@@ -558,8 +558,18 @@ def _relay_spot(
 
 
 def infer_object_place(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
-    """Where the object is kept, from the belief state (else the semantic map), and where to park to reach it."""
+    """Where the object is kept, from the belief state (else the semantic map), and where to park to reach
+    it. Given a place rather than an object (a desk the task names as where to go), the place is where
+    it is: its own docking pose, and no object feature to look for."""
     iri = _iri(inputs["object"], "the object")
+    here = ctx.map.things.get(iri)
+    if iri not in ctx.map.objects and here is not None and here.dock is not None:
+        dock = _dock(here)
+        return {
+            "objectPlace": designator(here.iri, HOME + "ObjectPlace"),
+            "objectLocation": to_json(dock, OBJECT_LOCATION),
+            "approachPosition": to_json(dock, APPROACH_POSITION),
+        }
     model = _model(ctx, inputs["object"])
     believed = [o for _, p, o in _facts(ctx.kb, iri) if p in (HOME + "isLocatedOn", HOME + "isLocated")]
     known = ctx.map.facts.get(iri, {}).get(HOME + "isLocatedOn", [])
