@@ -269,7 +269,7 @@ def query(
     else:
         if values:
             raise click.UsageError("--bind works with --name, whose parameters are declared")
-        body = text if text else query_file.read()
+        body = (text if text else query_file.read()).removeprefix("\ufeff")  # a byte order mark the parser refuses
         update = _UPDATE_START.match(body)
         if update:
             raise click.ClickException(

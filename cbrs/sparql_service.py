@@ -316,20 +316,24 @@ class _BudgetWriter(io.BytesIO):
         return written
 
 
+BOM = "\ufeff"
 _P = ParamSpec("_P")
 _R = TypeVar("_R")
 
 
-def _explains(
+def _sparql_text(
     expected: Literal["query", "update"],
 ) -> Callable[[Callable[Concatenate[SparqlService, str, _P], _R]], Callable[Concatenate[SparqlService, str, _P], _R]]:
-    """Run a method taking the SPARQL text first, its syntax errors explained (:func:`explain_syntax_error`)."""
+    """Run a method taking the SPARQL text first: without a leading byte order mark (a file saved by a
+    Windows editor and posted as it is; the parser refuses it as a character it did not expect), and
+    with its syntax errors explained (:func:`explain_syntax_error`)."""
 
     def wrap(
         method: Callable[Concatenate[SparqlService, str, _P], _R],
     ) -> Callable[Concatenate[SparqlService, str, _P], _R]:
         @functools.wraps(method)
         def run(self: SparqlService, text: str, /, *args: _P.args, **kwargs: _P.kwargs) -> _R:
+            text = text.removeprefix(BOM)
             try:
                 return method(self, text, *args, **kwargs)
             except QuerySyntaxError as error:
@@ -370,7 +374,7 @@ class SparqlService:
     def writable(self) -> bool:
         return self.config.update_token is not None and not self.config.read_only
 
-    @_explains("query")
+    @_sparql_text("query")
     def query(
         self,
         text: str,
@@ -422,7 +426,7 @@ class SparqlService:
         except FutureTimeout:
             raise QueryTimeoutError(self.config.timeout) from None
 
-    @_explains("query")
+    @_sparql_text("query")
     def query_here(
         self, text: str, accept: str | None, short_format: str | None, client: str | None, budget: int
     ) -> Answer | None:
@@ -545,7 +549,7 @@ class SparqlService:
         if token is None or not hmac.compare_digest(token.encode("utf-8"), expected.encode("utf-8")):
             raise UpdateForbiddenError("updates need the server's token: Authorization: Bearer <token>")
 
-    @_explains("update")
+    @_sparql_text("update")
     def update(self, text: str, token: str | None) -> None:
         """Run a SPARQL update when ``token`` is the configured update token; one transaction."""
         self.check_token(token)

@@ -296,3 +296,28 @@ def test_serve_on_a_server_without_a_union_default_graph_stops_with_the_reason(
     assert child.returncode == 1, child.stdout
     assert "Error: " in child.stderr and "start Oxigraph with --union-default-graph" in child.stderr
     assert "cbrs serving" not in child.stdout
+
+
+def test_a_text_starting_with_a_byte_order_mark_is_read_without_it(server: Server) -> None:
+    """A query file saved by a Windows editor, posted as it is (curl --data-binary @query.rq)."""
+    bom = "\ufeff".encode()
+    direct = {"Content-Type": "application/sparql-query", "Accept": "application/json"}
+    status, _, body = ask(server, "POST", "/sparql", bom + b"ASK { home:Position2D ?p ?o }", direct)
+    assert status == 200 and json.loads(body)["boolean"] is True, body
+    status, _, body = get(server, "/sparql", "\ufeffSELECT ?p WHERE { home:Position2D ?p ?o } LIMIT 1")  # a lookup
+    assert status == 200, body
+    update = {"Content-Type": "application/sparql-update", "Authorization": f"Bearer {TOKEN}"}
+    insert = bom + b"INSERT DATA { GRAPH <urn:test:bom> { <urn:test:bom> <urn:test:p> 1 } }"
+    assert ask(server, "POST", "/update", insert, update)[0] == 204
+
+
+def test_cbrs_query_reads_a_file_with_a_byte_order_mark(tmp_path: Path) -> None:
+    from click.testing import CliRunner
+
+    from cbrs.cli import cli
+
+    query = tmp_path / "ask.rq"
+    query.write_bytes("\ufeffASK { home:Position2D ?p ?o }".encode())
+    result = CliRunner().invoke(cli, ["--store", ":memory:", "query", "--file", str(query), "--format", "json"])
+    assert result.exit_code == 0, result.output
+    assert json.loads(result.output)["boolean"] is True
