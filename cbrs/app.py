@@ -46,8 +46,11 @@ def _batch(value: int | str) -> int | None:
     return None if value == "auto" else int(value)
 
 
-def parse_iri(name: str, hint: str = "IRI") -> str:
-    """A full IRI from ``prefix:local`` or an absolute IRI, as a click usage error otherwise."""
+def parse_iri(name: str, hint: str = "IRI", default_prefix: str | None = None) -> str:
+    """A full IRI from ``prefix:local`` or an absolute IRI, as a click usage error otherwise; with
+    ``default_prefix``, a bare name is taken in it (``RobotSelfPosition`` as ``req:RobotSelfPosition``)."""
+    if default_prefix is not None and ":" not in name:
+        name = f"{default_prefix}:{name}"
     try:
         return expand(name)
     except ValueError as error:

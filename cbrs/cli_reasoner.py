@@ -67,9 +67,9 @@ _PARAM = click.option(
 def match(
     app: App, requirement: str, top: int, method: str, explain: bool, as_json: bool, params: tuple[str, ...]
 ) -> None:
-    """Rank the advertisements against REQUIREMENT (an IRI or prefix:name, e.g. req:RobotSelfPosition)."""
+    """Rank the advertisements against REQUIREMENT: an IRI, prefix:name, or a bare name in req: (RobotSelfPosition)."""
     config = match_config(params)
-    iri = parse_iri(requirement, "REQUIREMENT")
+    iri = parse_iri(requirement, "REQUIREMENT", default_prefix="req")  # a bare name, as /cbrs/match takes it
     if as_json:
         result = Matchmaker(app.kb, method, config).rank(iri, explain=top)
         click.echo(json.dumps(result.to_dict(top), indent=2))

@@ -290,3 +290,13 @@ def test_rosapi_names_the_bridge_as_the_node_at_either_end_of_a_clients_topic(br
         assert rosapi(talker, "subscribers", topic="/nobody") == {"subscribers": []}
         details = rosapi(talker, "node_details", node="/cbrs_rosbridge")
         assert details["publishing"] == ["/chatter"] and details["subscribing"] == ["/heard"]
+
+
+def test_cbrs_match_takes_a_bare_requirement_name_as_the_bridge_does() -> None:
+    from click.testing import CliRunner
+
+    from cbrs.cli import cli
+
+    bare = CliRunner().invoke(cli, ["--store", ":memory:", "match", "RobotSelfPosition", "--top", "1", "--json"])
+    assert bare.exit_code == 0, bare.output
+    assert json.loads(bare.output)["requirement"] == "https://w3id.org/cbrs/requirement#RobotSelfPosition"
