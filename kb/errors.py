@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from collections.abc import Sequence
 
 
@@ -166,7 +167,15 @@ class InvalidDescriptionError(KnowledgeBaseError):
     def __init__(self, iri: str, problems: Sequence[str]) -> None:
         self.iri = iri
         self.problems = list(problems)
-        super().__init__(f"<{iri}> is not a valid service description: {'; '.join(self.problems)}")
+        super().__init__(f"{_named(iri)} is not a valid service description: {'; '.join(self.problems)}")
+
+
+def _named(iri: str) -> str:
+    """``<iri>`` for an absolute IRI; a file name or ``<registration>`` as it is (not ``<<registration>>``)."""
+    return f"<{iri}>" if _ABSOLUTE_IRI.match(iri) and " " not in iri else iri
+
+
+_ABSOLUTE_IRI = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]*:[^\\]")
 
 
 class BlankNodeInsertError(KnowledgeBaseError):

@@ -720,6 +720,17 @@ def _unresolved(conversion: Conversion, vocabulary: Vocabulary) -> list[Unresolv
     return found
 
 
+def registration_format(source: str, raw: bytes) -> ox.RdfFormat:
+    """The format of a description given to the registry: by the source's extension when it names a
+    file of a known RDF format (``camera.rdf``, ``camera.jsonld``), else Turtle unless the text opens
+    as RDF/XML. A registration sent as text (``<registration>``) is Turtle."""
+    suffix = Path(source).suffix.lower() if not source.startswith("<") else ""
+    if suffix in FORMATS_BY_EXTENSION:
+        return _format_for(Path(source), raw)
+    head = _as_utf8(raw[:4096], source, strict=False).lstrip()
+    return ox.RdfFormat.RDF_XML if head.startswith((b"<?xml", b"<rdf:RDF")) else ox.RdfFormat.TURTLE
+
+
 def _format_for(path: Path, raw: bytes) -> ox.RdfFormat:
     head = _as_utf8(raw[:4096], str(path), strict=False).lstrip()
     looks_turtle = head.startswith((b"@prefix", b"@base", b"PREFIX", b"BASE", b"prefix"))

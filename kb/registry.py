@@ -9,10 +9,11 @@ import pyoxigraph as ox
 
 from cbrs.kb.conditions import CONDITION_PARTS, LEGACY_PARTS
 from cbrs.kb.errors import AlreadyRegisteredError, InvalidDescriptionError, NotFoundError
-from cbrs.kb.loader import parse_bytes
+from cbrs.kb.loader import parse_bytes, registration_format
 from cbrs.kb.namespaces import BASE, RDF, GraphName, shorten
+from cbrs.kb.owls import is_owls
 from cbrs.kb.shapes import check_descriptions
-from cbrs.kb.skolem import closure
+from cbrs.kb.skolem import closure, is_skolem
 from cbrs.kb.standard_terms import StandardTerms
 from cbrs.kb.store import Store
 from cbrs.kb.vocab import CBRS
@@ -72,19 +73,68 @@ class ComponentRegistry:
 
     def _parse(self, turtle: str | bytes, source: str) -> tuple[list[ox.Quad], list[str]]:
         raw = turtle.encode("utf-8") if isinstance(turtle, str) else turtle
-        parsed = parse_bytes(raw, source, ox.RdfFormat.TURTLE, graph=GraphName.SERVICES, base_iri=BASE)
+        rdf_format = registration_format(source, raw)  # Turtle, unless the file's name or XML head says otherwise
+        parsed = parse_bytes(raw, source, rdf_format, graph=GraphName.SERVICES, base_iri=BASE)
+        if is_owls(parsed.quads):
+            raise InvalidDescriptionError(
+                source,
+                [
+                    "it is an OWL-S description, which registration does not convert: load it with "
+                    "cbrs load (kb.load), which turns each OWL-S service into an advertisement"
+                ],
+            )
+        elsewhere = sorted({str(q.graph_name) for q in parsed.quads if q.graph_name != GraphName.SERVICES.node})
+        if elsewhere:
+            graph = elsewhere[0]
+            raise InvalidDescriptionError(
+                source, [f"it names the graph {graph}; registration writes graph:services only (use cbrs load)"]
+            )
         iris = _advertisements(self._store, parsed.quads)
         if not iris:
             check_descriptions(self._store, parsed.quads)  # a misspelt component kind gets its did-you-mean
-            raise InvalidDescriptionError(
-                source, ["it describes no advertisement (a subject typed with a cbrs component kind)"]
-            )
+            raise InvalidDescriptionError(source, [_no_advertisement(parsed.quads)])
+        fields = _fields(parsed.quads)
         for iri in iris:
-            problems = _problems(iri, parsed.quads)
+            problems = _problems(iri, fields)
             if problems:
                 raise InvalidDescriptionError(iri, problems)
         check_descriptions(self._store, parsed.quads)  # SHACL shapes and declared terms (kb/shapes.py)
         return parsed.quads, iris
+
+
+def _no_advertisement(quads: list[ox.Quad]) -> str:
+    """Why no advertisement was found, with the fix when a subject looks like a description."""
+    requirements = {
+        q.subject for q in quads if q.predicate.value == RDF + "type" and q.object == ox.NamedNode(CBRS.Requirement)
+    }
+    described = sorted(
+        {
+            q.subject.value
+            for q in quads
+            if q.predicate.value in (CBRS.hasOWLSModel, CBRS.serviceName, CBRS.deviceName)
+            and isinstance(q.subject, ox.NamedNode)
+        }
+    )
+    for iri in described:
+        if ox.NamedNode(iri) in requirements:
+            return (
+                f"it describes no advertisement: {shorten(iri)} is a requirement, which goes into the requirements "
+                "graph: cbrs load --graph requirements FILE"
+            )
+    if described:
+        return (
+            f"it describes no advertisement: {shorten(described[0])} has no component kind; type it "
+            f"{', '.join(shorten(k) for k in _KINDS[:-1])} or {shorten(_KINDS[-1])}"
+        )
+    return "it describes no advertisement (a subject typed with a cbrs component kind)"
+
+
+_KINDS = (
+    CBRS.DynamicPerceptionComponent,
+    CBRS.StaticDataComponent,
+    CBRS.PhysicalManipulationComponent,
+    CBRS.MethodInvocationComponent,
+)
 
 
 def _advertisements(store: Store, quads: Iterable[ox.Quad]) -> list[str]:
@@ -107,14 +157,22 @@ def _advertisement_classes(store: Store) -> set[str]:
     return {row["c"].value for row in result} | {CBRS.Advertisement}
 
 
-def _problems(iri: str, quads: list[ox.Quad]) -> list[str]:
-    """What the six-tuple lacks: checked on the triples before anything is written."""
-    by_subject: dict[str, dict[str, list[str]]] = {}
+_Fields = dict[ox.NamedNode, dict[str, list[ox.NamedNode | ox.BlankNode | ox.Literal]]]
+
+
+def _fields(quads: list[ox.Quad]) -> _Fields:
+    """Each named subject's values by property: built once for all the descriptions of an input."""
+    by_subject: _Fields = {}
     for q in quads:
         if isinstance(q.subject, ox.NamedNode) and not isinstance(q.object, ox.Triple):
-            fields = by_subject.setdefault(q.subject.value, {})
-            fields.setdefault(q.predicate.value, []).append(q.object.value)
-    own = by_subject.get(iri, {})
+            by_subject.setdefault(q.subject, {}).setdefault(q.predicate.value, []).append(q.object)
+    return by_subject
+
+
+def _problems(iri: str, by_subject: _Fields) -> list[str]:
+    """What the six-tuple lacks: checked on the triples before anything is written. Nodes are named by
+    their role (and a parameter by its name), not by the IRIs the loader made for them."""
+    own = by_subject.get(ox.NamedNode(iri), {})
     problems = []
     for prop, label in ((CBRS.serviceName, "service name (SN)"), (CBRS.deviceName, "device name (DN)")):
         if len(own.get(prop, [])) != 1:
@@ -122,23 +180,34 @@ def _problems(iri: str, quads: list[ox.Quad]) -> list[str]:
     models = own.get(CBRS.hasOWLSModel, [])
     if len(models) != 1:
         return [*problems, "needs exactly one cbrs:hasOWLSModel"]
-    model = by_subject.get(models[0], {})
+    model = by_subject.get(models[0], {}) if isinstance(models[0], ox.NamedNode) else {}
     if not model.get(CBRS.hasOutput) and not model.get(CBRS.hasEffect):
         problems.append("its OWLS model has neither an output nor an effect")
-    for prop in (CBRS.hasInput, CBRS.hasOutput):
+    for prop, role in ((CBRS.hasInput, "input"), (CBRS.hasOutput, "output")):
         for parameter in model.get(prop, []):
-            if not by_subject.get(parameter, {}).get(CBRS.parameterType):
-                problems.append(f"parameter {parameter} has no cbrs:parameterType")
-    for prop in (CBRS.hasPrecondition, CBRS.hasEffect):
+            fields = by_subject.get(parameter, {}) if isinstance(parameter, ox.NamedNode) else {}
+            if not fields.get(CBRS.parameterType):
+                problems.append(f"{_node(role, parameter, fields)} has no cbrs:parameterType")
+    for prop, role in ((CBRS.hasPrecondition, "precondition"), (CBRS.hasEffect, "effect")):
         for condition in model.get(prop, []):
-            fields = by_subject.get(condition, {})
+            fields = by_subject.get(condition, {}) if isinstance(condition, ox.NamedNode) else {}
             legacy = [shorten(p) for p in LEGACY_PARTS if fields.get(p)]
             missing = [shorten(p) for p in CONDITION_PARTS if not fields.get(p)]
             if legacy:
                 problems.append(
-                    f"condition {condition} uses {', '.join(legacy)}, the reified form of core 0.1.0 "
+                    f"{_node(role, condition, fields)} uses {', '.join(legacy)}, the reified form of core 0.1.0 "
                     "(outside OWL 2 DL): write cbrs:conditionSubject, cbrs:conditionPredicate and cbrs:conditionObject"
                 )
             elif missing:
-                problems.append(f"condition {condition} lacks {', '.join(missing)}")
+                problems.append(f"{_node(role, condition, fields)} lacks {', '.join(missing)}")
     return problems
+
+
+def _node(role: str, node: object, fields: dict[str, list[ox.NamedNode | ox.BlankNode | ox.Literal]]) -> str:
+    """``the input "markerColour"``, ``an effect`` or ``the output <iri>``: how a problem names a node."""
+    names = fields.get(CBRS.parameterName, [])
+    if names:
+        return f'the {role} "{names[0].value}"'
+    if isinstance(node, ox.NamedNode) and not is_skolem(node):
+        return f"the {role} {shorten(node.value)}"
+    return f"{'an' if role[0] in 'aeiou' else 'a'} {role}"

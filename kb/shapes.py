@@ -21,10 +21,12 @@ from __future__ import annotations
 
 import difflib
 import functools
+import logging
 import re
 from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
+from decimal import Decimal
 from typing import TYPE_CHECKING, Any
 
 import pyoxigraph as ox
@@ -246,6 +248,7 @@ def _shape_problems(closures: dict[str, list[ox.Quad]]) -> list[ShapeProblem]:
     import rdflib
     from pyshacl import validate
 
+    _quiet_ill_typed_literals()
     owner = {q.subject: root for root, quads in closures.items() for q in quads}
     triples = [ox.Triple(q.subject, q.predicate, q.object) for quads in closures.values() for q in quads]
     data = rdflib.Graph().parse(data=ox.serialize(triples, format=ox.RdfFormat.N_TRIPLES), format="nt")
@@ -260,6 +263,11 @@ def _shape_problems(closures: dict[str, list[ox.Quad]]) -> list[ShapeProblem]:
         path = results.value(result, sh.resultPath)
         value = results.value(result, sh.value)
         message = results.value(result, sh.resultMessage)
+        component = results.value(result, sh.sourceConstraintComponent)
+        if component == sh.LessThanOrEqualsConstraintComponent and not _is_number(value):
+            continue  # a bound that is no number is reported as such; "reversed" would be a second, wrong reason
+        if isinstance(value, rdflib.URIRef) and _is_inner(ox.NamedNode(str(value))):
+            value = None  # the node itself (a model the loader named): "got genid:..." says nothing to its author
         focus_term = _ox_term(focus)
         root = owner.get(focus_term, focus_term.value if focus_term is not None else "")
         problems.append(
@@ -288,6 +296,27 @@ def _node_text(term: Any) -> str:
     return "a blank node" if isinstance(term, ox.BlankNode) else shorten(term.value)
 
 
+def _quoted(text: str) -> str:
+    """A string as Turtle writes it, escapes and all: an error stays on one line and shows the quotes."""
+    escaped = text.replace("\\", "\\\\").replace('"', '\\"').replace("\n", "\\n").replace("\r", "\\r")
+    return f'"{escaped}"'
+
+
+def _is_number(value: Any) -> bool:
+    import rdflib
+
+    return isinstance(value, rdflib.Literal) and not value.ill_typed and isinstance(value.value, int | float | Decimal)
+
+
+@functools.cache
+def _quiet_ill_typed_literals() -> None:
+    """rdflib logs a warning with a traceback for every ill-typed literal it reads ("abc"^^xsd:double);
+    the problem is reported as a shape problem instead, so the log would only print a traceback at the user."""
+    logging.getLogger("rdflib.term").addFilter(
+        lambda record: not record.getMessage().startswith("Failed to convert Literal lexical form")
+    )
+
+
 def _literal_text(value: Any) -> str | None:
     import rdflib
 
@@ -295,10 +324,12 @@ def _literal_text(value: Any) -> str | None:
         return None
     if isinstance(value, rdflib.Literal):
         datatype = str(value.datatype) if value.datatype else None
+        if value.ill_typed:
+            return f"{_quoted(str(value))}^^{shorten(datatype or '')} (not a valid {shorten(datatype or '')})"
         if datatype in (XSD + "decimal", XSD + "integer", XSD + "double", XSD + "float"):
             return str(value)
         typed = f"^^{shorten(datatype)}" if datatype and datatype != XSD + "string" else ""
-        return f'"{value}"{typed}' + (f"@{value.language}" if value.language else "")
+        return _quoted(str(value)) + typed + (f"@{value.language}" if value.language else "")
     if isinstance(value, rdflib.BNode):
         return "a blank node"
     return shorten(str(value))

@@ -81,7 +81,7 @@ BAD = [
     ),
     pytest.param(
         ('cbrs:deviceName "CeilingCamera03"', "cbrs:deviceName svc:CeilingCamera03"),
-        "the device name (DN) is one string; got cbrs:deviceName svc:CeilingCamera03",
+        "the device name (DN) is one string, on one line and not empty; got cbrs:deviceName svc:CeilingCamera03",
         id="device-for-its-name",
     ),
 ]

@@ -1,0 +1,220 @@
+"""A lab registering its own components from docs/shapes.md alone: each mistake is refused with a
+message its author can act on (no names the loader made up, no traceback, one line), the store is
+unchanged, and the files a lab has (RDF/XML, JSON-LD, Protege's xsd:int) register as Turtle does."""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+import pyoxigraph as ox
+import pytest
+
+from cbrs.kb import InvalidDescriptionError, KnowledgeBase
+from cbrs.kb.namespaces import GENID
+
+EX = "http://example.org/mini#"
+HEAD = """@prefix cbrs: <https://w3id.org/cbrs/core#> .
+@prefix ex: <http://example.org/mini#> .
+@prefix xsd: <http://www.w3.org/2001/XMLSchema#> .
+"""
+INPUT = "cbrs:hasInput [ cbrs:parameterType ex:MarkerColour ]"
+OUTPUT = "cbrs:hasOutput [ cbrs:parameterType ex:Location ]"
+OWLS = Path(__file__).parent / "data" / "owls" / "services" / "open_door.owls"
+
+
+def _camera(
+    *,
+    kind: str = "cbrs:DynamicPerceptionComponent",
+    device: str = '"LabCam01"',
+    service: str = '"DetectDoor"',
+    qos: str = "cbrs:responseTime 0.2",
+    sea: str = "",
+    model: str = INPUT + " ; " + OUTPUT,
+) -> str:
+    sea_part = f" cbrs:hasSEAModel [ {sea} ] ;" if sea else ""
+    return (
+        HEAD
+        + f"""ex:DetectDoor_LabCam01 a {kind} ;
+    cbrs:deviceName {device} ; cbrs:serviceName {service} ;{sea_part}
+    cbrs:hasQoSModel [ {qos} ] ;
+    cbrs:hasOWLSModel [ {model} ] .
+"""
+    )
+
+
+def _refused(kb: KnowledgeBase, text: str | bytes, source: str = "<registration>") -> str:
+    before = kb.store.dump()
+    with pytest.raises(InvalidDescriptionError) as caught:
+        kb.registry.register(text, source)
+    assert kb.store.dump() == before
+    message = str(caught.value)
+    assert "\n" not in message
+    return message
+
+
+# -- messages that name what the author wrote ------------------------------------------------------
+
+
+def test_an_untyped_parameter_is_named_by_its_name_not_by_a_made_up_iri(mini_kb: KnowledgeBase) -> None:
+    message = _refused(mini_kb, _camera(model='cbrs:hasOutput [ cbrs:parameterName "doorPose" ]'))
+    assert 'the output "doorPose" has no cbrs:parameterType' in message
+    assert GENID not in message and "genid:" not in message
+
+
+def test_an_incomplete_condition_is_named_by_its_role(mini_kb: KnowledgeBase) -> None:
+    model = (
+        "cbrs:hasOutput [ cbrs:parameterType ex:Location ] ;"
+        " cbrs:hasEffect [ cbrs:conditionSubject ex:Door ; cbrs:conditionPredicate ex:hasStatus ]"
+    )
+    message = _refused(mini_kb, _camera(model=model))
+    assert "an effect lacks cbrs:conditionObject" in message
+    assert GENID not in message and "genid:" not in message
+
+
+def test_a_partial_sea_box_does_not_show_the_model_s_made_up_iri(mini_kb: KnowledgeBase) -> None:
+    message = _refused(mini_kb, _camera(sea="cbrs:effectiveArea ex:Kitchen ; cbrs:minX 0.0"))
+    assert "the SEA box needs all four" in message
+    assert "genid:" not in message and GENID not in message
+
+
+def test_an_ill_typed_number_is_reported_without_a_traceback(
+    mini_kb: KnowledgeBase, caplog: pytest.LogCaptureFixture
+) -> None:
+    with caplog.at_level(logging.WARNING):
+        message = _refused(mini_kb, _camera(qos='cbrs:responseTime "abc"^^xsd:double'))
+    assert 'got cbrs:responseTime "abc"^^xsd:double (not a valid xsd:double)' in message
+    assert not [r for r in caplog.records if r.name.startswith("rdflib")]
+
+
+def test_a_sea_bound_that_is_a_word_is_not_also_called_reversed(mini_kb: KnowledgeBase) -> None:
+    sea = 'cbrs:effectiveArea ex:Kitchen ; cbrs:minX "0" ; cbrs:maxX 1.0 ; cbrs:minY 0.0 ; cbrs:maxY 1.0'
+    message = _refused(mini_kb, _camera(sea=sea))
+    assert 'a bound of the SEA box is a finite number of metres; got "0"' in message
+    assert "reversed" not in message
+
+
+def test_a_string_value_is_quoted_with_its_escapes(mini_kb: KnowledgeBase) -> None:
+    message = _refused(mini_kb, _camera(service='"Detect \\"door\\"\\nnow"'))
+    assert r'got cbrs:serviceName "Detect \"door\"\nnow"' in message
+
+
+# -- what a description may say ----------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "qos",
+    [
+        'cbrs:responseTime "INF"^^xsd:double',
+        'cbrs:updateRate "INF"^^xsd:double',
+        'cbrs:responseTime "NaN"^^xsd:double',
+        'cbrs:cost "INF"^^xsd:float',
+    ],
+)
+def test_a_qos_value_is_finite(mini_kb: KnowledgeBase, qos: str) -> None:
+    metric = qos.split()[0]
+    assert f"got {metric}" in _refused(mini_kb, _camera(qos=qos))
+
+
+def test_a_sea_bound_is_finite(mini_kb: KnowledgeBase) -> None:
+    sea = 'cbrs:effectiveArea ex:Kitchen ; cbrs:minX "-INF"^^xsd:double ; cbrs:maxX 1.0 ; cbrs:minY 0.0 ; cbrs:maxY 1.0'
+    assert "a bound of the SEA box is a finite number of metres; got -inf" in _refused(mini_kb, _camera(sea=sea))
+
+
+@pytest.mark.parametrize(
+    ("number", "value"),
+    [('"2"^^xsd:int', 2.0), ('"2"^^xsd:nonNegativeInteger', 2.0), ('"2"^^xsd:long', 2.0), ('"2.5"^^xsd:float', 2.5)],
+)
+def test_numbers_of_any_xsd_numeric_type_are_taken(mini_kb: KnowledgeBase, number: str, value: float) -> None:
+    """Protege writes "2"^^xsd:int; the readers take any numeric literal (float of its lexical form)."""
+    assert mini_kb.registry.register(_camera(qos=f"cbrs:responseTime {number}")) == [EX + "DetectDoor_LabCam01"]
+    assert [q.value for q in mini_kb.description(EX + "DetectDoor_LabCam01").qos] == [value]
+
+
+@pytest.mark.parametrize(
+    ("field", "value"),
+    [("device", '""'), ("device", '"   "'), ("service", '"Detect\\ndoor"'), ("service", '"Detect\\rdoor"')],
+)
+def test_names_are_one_line_and_not_empty(mini_kb: KnowledgeBase, field: str, value: str) -> None:
+    label = "device name (DN)" if field == "device" else "service name (SN)"
+    message = _refused(mini_kb, _camera(**{field: value}))
+    assert f"the {label} is one string, on one line and not empty" in message
+
+
+def test_non_ascii_names_are_fine(mini_kb: KnowledgeBase) -> None:
+    mini_kb.registry.register(_camera(device='"Küchenkamera 東京"', service='"Tür finden"@de'))
+    ad = mini_kb.description(EX + "DetectDoor_LabCam01")
+    assert (ad.device_name, ad.service_name) == ("Küchenkamera 東京", "Tür finden")
+
+
+def test_an_advertisement_has_one_component_kind(mini_kb: KnowledgeBase) -> None:
+    message = _refused(mini_kb, _camera(kind="cbrs:DynamicPerceptionComponent, cbrs:StaticDataComponent"))
+    assert "a description has one kind" in message
+
+
+# -- what is not an advertisement ------------------------------------------------------------------------
+
+
+def test_a_file_with_no_advertisement_is_named_as_a_file(mini_kb: KnowledgeBase) -> None:
+    message = _refused(mini_kb, HEAD + "ex:T a ex:Camera .", "lab/cameras.ttl")
+    assert message.startswith("lab/cameras.ttl is not a valid service description: it describes no advertisement")
+
+
+def test_a_registration_sent_as_text_is_not_bracketed_twice(mini_kb: KnowledgeBase) -> None:
+    assert _refused(mini_kb, HEAD + "ex:T a ex:Camera .").startswith("<registration> is not")
+
+
+def test_a_description_without_a_kind_is_told_the_kinds(mini_kb: KnowledgeBase) -> None:
+    message = _refused(mini_kb, _camera(kind="ex:Camera"), "camera.ttl")
+    assert (
+        "ex:DetectDoor_LabCam01 has no component kind" in message
+        or f"{EX}DetectDoor_LabCam01 has no component kind" in message
+    )
+    assert "cbrs:DynamicPerceptionComponent" in message and "cbrs:MethodInvocationComponent" in message
+
+
+def test_a_requirement_is_sent_to_the_requirements_graph(mini_kb: KnowledgeBase) -> None:
+    message = _refused(mini_kb, _camera(kind="cbrs:Requirement"), "need.ttl")
+    assert "is a requirement" in message and "cbrs load --graph requirements" in message
+
+
+def test_an_owls_file_is_sent_to_cbrs_load(mini_kb: KnowledgeBase) -> None:
+    message = _refused(mini_kb, OWLS.read_bytes(), str(OWLS))
+    assert "OWL-S" in message and "cbrs load" in message
+
+
+def test_a_dataset_naming_another_graph_is_refused(mini_kb: KnowledgeBase) -> None:
+    trig = HEAD + "ex:g { " + _camera().split("\n", 3)[3] + " }"
+    message = _refused(mini_kb, trig, "camera.trig")
+    assert "names the graph <http://example.org/mini#g>" in message
+
+
+# -- the formats a lab's tools write -------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("suffix", "rdf_format"),
+    [
+        (".rdf", ox.RdfFormat.RDF_XML),
+        (".owl", ox.RdfFormat.RDF_XML),
+        (".jsonld", ox.RdfFormat.JSON_LD),
+        (".nt", ox.RdfFormat.N_TRIPLES),
+    ],
+)
+def test_a_description_registers_from_the_format_its_name_says(
+    mini_kb: KnowledgeBase, suffix: str, rdf_format: ox.RdfFormat
+) -> None:
+    triples = list(ox.parse(_camera().encode(), format=ox.RdfFormat.TURTLE))
+    data = ox.serialize(triples, format=rdf_format)
+    assert data is not None
+    assert mini_kb.registry.register(data, f"camera{suffix}") == [EX + "DetectDoor_LabCam01"]
+    ad = mini_kb.description(EX + "DetectDoor_LabCam01")
+    assert [p.type for p in ad.outputs] == [EX + "Location"]
+    assert mini_kb.registry.update(data, f"camera{suffix}") == [EX + "DetectDoor_LabCam01"]
+
+
+def test_rdf_xml_sent_as_text_is_recognised(mini_kb: KnowledgeBase) -> None:
+    data = ox.serialize(list(ox.parse(_camera().encode(), format=ox.RdfFormat.TURTLE)), format=ox.RdfFormat.RDF_XML)
+    assert data is not None
+    assert data.startswith(b"<?xml")
+    assert mini_kb.registry.register(data) == [EX + "DetectDoor_LabCam01"]
