@@ -667,12 +667,14 @@ def negotiate(
     than a point lookup's evaluation."""
     offered = list(only if only is not None else GRAPH_TYPES if graph else RESULT_TYPES)
     if short_format:
-        names = SHORT_NAMES.get(short_format.lower())
-        if names is None and short_format in offered:
-            return short_format
-        if names is None:
-            raise NotAcceptableError(short_format, sorted(SHORT_NAMES))
-        return names[1] if graph else names[0]
+        name = short_format.partition(";")[0].strip().lower()  # JSON, or a media type with its charset
+        names = SHORT_NAMES.get(name)
+        if names is not None:
+            return names[1] if graph else names[0]
+        media = _offered_alias(graph, name, offered)
+        if media in offered:
+            return media
+        raise NotAcceptableError(short_format, sorted(SHORT_NAMES))
     ranges = accept_ranges(accept) if accept else []
     if not ranges:  # no header, or nothing in it that reads as a media range: the default
         return offered[0]

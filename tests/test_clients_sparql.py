@@ -321,3 +321,19 @@ def test_cbrs_query_reads_a_file_with_a_byte_order_mark(tmp_path: Path) -> None:
     result = CliRunner().invoke(cli, ["--store", ":memory:", "query", "--file", str(query), "--format", "json"])
     assert result.exit_code == 0, result.output
     assert json.loads(result.output)["boolean"] is True
+
+
+@pytest.mark.parametrize(
+    ("given", "expected"),
+    [
+        ("JSON", "application/sparql-results+json"),
+        ("Text/CSV", "text/csv"),
+        ("application/sparql-results+xml; charset=utf-8", "application/sparql-results+xml"),
+        ("text/tsv", "text/tab-separated-values"),
+    ],
+)
+def test_a_format_parameter_is_read_as_leniently_as_accept(server: Server, given: str, expected: str) -> None:
+    query = urllib.parse.urlencode({"query": SELECT, "format": given})
+    status, headers, body = ask(server, "GET", f"/sparql?{query}")
+    assert status == 200, body
+    assert media(headers) == expected
