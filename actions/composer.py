@@ -477,6 +477,7 @@ class _Step:
     made_for: int | None
     bindings: list[_Bound] = field(default_factory=list)
     producers: list[int] = field(default_factory=list)
+    about: tuple[str, ...] = ()  # the classes of the statements this step serves, down from the goal
 
 
 class _Extraction:
@@ -496,6 +497,9 @@ class _Extraction:
             self.unsatisfied.append(Unsatisfied("an output or effect", GOAL, ("the requirement states none",)))
             return
         self._goal_needs = goal_needs
+        self._goal_concepts = {
+            c for _, n in goal_needs if n.statement is not None for c in (n.statement.subject, n.statement.object)
+        }
         blocked = [(node, n) for node, n in goal_needs if not self._ready(node, n)]
         if blocked:
             for node, need in blocked:
@@ -593,8 +597,14 @@ class _Extraction:
             for node, need in needs:
                 options = self._options(node, need, below)
                 given = [e for e in options if e.source == SRI]
+                if given and len(given) < len(options):
+                    # another goal's thing (the tray the cup goes to) is no value for the steps of this
+                    # one (where the base parks to load the pen), which have a provider of their own
+                    given = [e for e in given if not self._foreign(step, e)]
                 if given:
-                    step.bindings.append(_Bound(need, min(given, key=self._key), None))
+                    step.bindings.append(
+                        _Bound(need, min(given, key=lambda e: (self._aboutness(step, e), *self._key(e))), None)
+                    )
                     continue
                 mine = [(e, p) for p in step.producers for e in options if e.source == self.steps[p].node]
                 if mine:  # a step already made for this consumer meets this need too
@@ -612,9 +622,41 @@ class _Extraction:
                         step.bindings.append(_Bound(need, best, existing.id))
                         continue
                 producer = self._new(best.source, step.id)
+                served = (need.statement.subject, need.statement.object) if need.statement is not None else ()
+                producer.about = (*served, *step.about)
                 step.producers.append(producer.id)
                 step.bindings.append(_Bound(need, best, producer.id))
                 queue.append(producer.id)
+
+    def _aboutness(self, step: _Step, edge: Edge) -> int:
+        """How well a value the task gives fits what ``step`` is for: minus the depth of the most specific
+        class, among the statements it serves, that the value's class falls under (0 if none).
+
+        Descriptions link no input to a statement, so the data flow alone cannot tell which of the
+        task's things a step handles: given a mug and a tap, both physical objects, the grasp for
+        filling the mug must be the mug's, because the step serves (Drinkware, isLocated, BelowOfTap)
+        for (Mug, contains, Water). Goals name their things; this carries their classes down the plan."""
+        concept = edge.offer.concept
+        if concept is None or not step.about:
+            return 0
+        index = self.graph.pool.matcher.index
+        if concept not in index:
+            return 0
+        ancestors = index.is_a_ancestors(concept)
+        depths = [index.depth(c) for c in step.about if c in ancestors and c in index]
+        return -max(depths) if depths else 0
+
+    def _foreign(self, step: _Step, edge: Edge) -> bool:
+        """Whether a value the task gives belongs to another goal than the ones ``step`` serves: its class
+        falls under a class another goal names more specifically than under any class of the statements
+        ``step`` serves (a PenTray is an ObjectPlace, but the tray goal names it as a PenTray)."""
+        concept = edge.offer.concept
+        index = self.graph.pool.matcher.index
+        if concept is None or concept not in index or not step.about:
+            return False
+        ancestors = index.is_a_ancestors(concept)
+        others = [index.depth(c) for c in self._goal_concepts - set(step.about) if c in ancestors and c in index]
+        return bool(others) and max(others) > -self._aboutness(step, edge)
 
     def _sibling(self, step: _Step, node: str, need: Need) -> _Bound | None:
         """An output of a step made for the same consumer, if one meets this input."""
