@@ -10,7 +10,7 @@ describe each service in it (see ``docs/owls.md`` for the mapping):
 - the contact's ``actor:name`` gives ``cbrs:deviceName``, else the stem of the source file's name;
 - inputs and outputs come from the profile (or, when the profile lists none, the process), each a
   ``cbrs:Parameter`` whose ``cbrs:parameterType`` is the OWL-S ``process:parameterType``;
-- preconditions and effects written as PDDL or SWRL become ``cbrs:Precondition`` / ``cbrs:Effect``
+- preconditions and effects written as PDDL, KIF or SWRL become ``cbrs:Precondition`` / ``cbrs:Effect``
   statements where an atom can be read as one; every expression is also kept as ``cbrs:conditionText``.
 
 Nothing here reads files or the store: the caller passes the triples, and a :class:`Vocabulary` of
@@ -57,7 +57,8 @@ _OWLS_TERM = re.compile(
 _IRI_IN_TEXT = re.compile(r"(?<![?\w])[A-Za-z][A-Za-z0-9+.-]*://[^\s()<>\"'?]+")
 _RESOURCE_IN_XML = re.compile(r"""rdf:resource\s*=\s*["']([^"']+)["']""")
 _PDDL_TOKEN = re.compile(r"\(|\)|[^\s()]+")
-_NOT_TURNED = {"not", "or", "when", "imply", "forall", "exists", "either", "preference"}
+# Heads under which an atom says less than a positive statement: PDDL's and KIF's (=> and <=> are KIF's implications).
+_NOT_TURNED = {"not", "or", "when", "imply", "forall", "exists", "either", "preference", "=>", "<=", "<=>"}
 
 _CLASS_TYPES = {OWL + "Class", RDFS + "Class", DAML + "Class", OWL + "Restriction"}
 _PROPERTY_TYPES = {
@@ -562,11 +563,12 @@ class _Builder:
         if text.startswith("<") or language == "SWRL":
             atoms, kept = self.swrl_literal(text)
             return text, atoms, kept
-        if text.startswith("(") and language in ("PDDL", None):
+        if text.startswith("(") and language in ("PDDL", "KIF", None):  # KIF atoms are s-expressions as PDDL's
+            name = language or "PDDL"
             try:
                 tree = _parse_sexp(text)
             except ValueError as error:
-                self.note(f"{self.source}: PDDL expression kept as text ({error}): {_short(text)}")
+                self.note(f"{self.source}: {name} expression kept as text ({error}): {_short(text)}")
                 return text, [], 1
             atoms, kept = [], 0
             try:
@@ -575,7 +577,7 @@ class _Builder:
                     atoms.extend(found)
                     kept += skipped
             except RecursionError:
-                self.note(f"{self.source}: PDDL expression nested too deeply, kept as text: {_short(text)}")
+                self.note(f"{self.source}: {name} expression nested too deeply, kept as text: {_short(text)}")
                 return text, [], 1
             return text, atoms, kept
         return text, [], 1
