@@ -121,7 +121,8 @@ class BindingError(KnowledgeBaseError):
     def __init__(self, variable: str, value: object, reason: str) -> None:
         self.variable = variable
         self.value = value
-        super().__init__(f"binding {variable}={value!r}: {reason}")
+        given = "" if value is None else f"={value!r}"  # None: a required parameter left out, not a value of None
+        super().__init__(f"binding {variable}{given}: {reason}")
 
 
 class QuerySyntaxError(KnowledgeBaseError):

@@ -807,6 +807,14 @@ def _located(error: SyntaxError, source: str, data: bytes, rdf_format: ox.RdfFor
     if not_utf8:
         declare = " or declare its encoding in <?xml ... encoding=...?>" if rdf_format == ox.RdfFormat.RDF_XML else ""
         message += f"; the file is not UTF-8: save it as UTF-8{declare}"
+    if rdf_format == ox.RdfFormat.JSON_LD and "LoadDocumentCallback" in message:
+        # Oxigraph's words for a remote @context ("https://schema.org/"), which cbrs never fetches
+        remote = re.search(rb'"@context"\s*:\s*\[?\s*"([^"]+)"', data)
+        named = f" ({remote.group(1).decode('utf-8', 'replace')})" if remote else ""
+        message = (
+            f"the JSON-LD @context{named} is a remote document, and cbrs fetches nothing from the network: "
+            "put the context's terms in the file (an inline @context object) or convert the file to Turtle"
+        )
     return RdfParseError(source, message, line, column)
 
 

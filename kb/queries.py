@@ -53,9 +53,11 @@ class NamedQuery:
                 values[unknown[0]],
                 f"query {self.name!r} takes no such parameter (it takes: {declared})",
             )
-        missing = [p.name for p in self.parameters.values() if p.required and p.name not in values]
+        missing = [p for p in self.parameters.values() if p.required and p.name not in values]
         if missing:
-            raise BindingError(missing[0], None, f"query {self.name!r} needs this parameter")
+            first = missing[0]
+            what = f"{first.kind}: {first.description}" if first.description else first.kind
+            raise BindingError(first.name, None, f"query {self.name!r} needs this parameter ({what})")
         return {name: to_term(self.parameters[name], value) for name, value in values.items()}
 
 
