@@ -68,8 +68,28 @@ class ComponentRegistry:
         return any(True for _ in self._store.quads(node, ox.NamedNode(RDF + "type"), None, self._graph))
 
     def description_quads(self, iri: str) -> list[ox.Quad]:
-        """The advertisement's triples and, recursively, those of its skolemised nodes."""
-        return closure([ox.NamedNode(iri)], lambda node: self._store.quads(node, None, None, self._graph))  # type: ignore[arg-type]
+        """The advertisement's triples and, recursively, those of its parts: skolemised nodes, and models,
+        parameters, conditions and ports given IRIs of their own. A named part that something outside the
+        description points at too is shared, and stays with its triples."""
+        root = ox.NamedNode(iri)
+
+        def quads_of(
+            node: ox.NamedNode | ox.BlankNode | ox.Triple, skip: frozenset[object] = frozenset()
+        ) -> list[ox.Quad]:
+            return [] if node in skip else list(self._store.quads(node, None, None, self._graph))  # type: ignore[arg-type]
+
+        found = closure([root], quads_of, parts=True)
+        own = {q.subject for q in found}
+        shared = frozenset(
+            node
+            for node in own
+            if node != root
+            and not is_skolem(node)
+            and any(q.subject not in own for q in self._store.quads(None, None, node, self._graph))  # type: ignore[arg-type]
+        )
+        if not shared:
+            return found
+        return [q for q in closure([root], lambda node: quads_of(node, shared), parts=True) if q.subject not in shared]
 
     def _parse(self, turtle: str | bytes, source: str) -> tuple[list[ox.Quad], list[str]]:
         raw = turtle.encode("utf-8") if isinstance(turtle, str) else turtle

@@ -211,7 +211,8 @@ def _undo(store: Store, added: set[ox.Quad], removed: set[ox.Quad]) -> None:
 
 def _closures(quads: Iterable[ox.Quad]) -> dict[str, list[ox.Quad]]:
     """Each description (a subject with an OWLS model) with its own quads and those of the nodes hanging
-    off it (blank or skolemised), as the registry reads a description."""
+    off it: blank or skolemised, and its parts (models, parameters, conditions, ports) given IRIs of their
+    own, which an update must write (it may not insert blank nodes) and the shapes must see."""
     quads = list(quads)
     roots = {
         quad.subject
@@ -221,7 +222,10 @@ def _closures(quads: Iterable[ox.Quad]) -> dict[str, list[ox.Quad]]:
         and not _is_inner(quad.subject)
     }
     quads_of = quads_by_subject(quads)
-    return {root.value: closure([root], quads_of, _is_inner) for root in sorted(roots, key=lambda node: node.value)}
+    return {
+        root.value: closure([root], quads_of, _is_inner, parts=True)
+        for root in sorted(roots, key=lambda node: node.value)
+    }
 
 
 def _iri(term: Any) -> str:

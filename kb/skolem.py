@@ -12,10 +12,27 @@ from collections.abc import Callable, Iterable
 import pyoxigraph as ox
 
 from cbrs.kb.namespaces import GENID
+from cbrs.kb.vocab import CBRS
 
-__all__ = ["closure", "is_skolem", "quads_by_subject"]
+__all__ = ["DESCRIPTION_PARTS", "closure", "is_skolem", "quads_by_subject"]
 
 Node = ox.NamedNode | ox.BlankNode | ox.Triple
+
+DESCRIPTION_PARTS = frozenset(
+    {
+        CBRS.hasOWLSModel,
+        CBRS.hasSEAModel,
+        CBRS.hasQoSModel,
+        CBRS.hasPort,
+        CBRS.hasInput,
+        CBRS.hasOutput,
+        CBRS.hasPrecondition,
+        CBRS.hasEffect,
+        CBRS.hasDeleteEffect,
+    }
+)
+"""The properties whose values are parts of a description (its models, parameters, conditions, ports),
+whether blank, skolemised or given IRIs of their own (``<camera#output1>``, as an update must write them)."""
 
 
 def is_skolem(term: object) -> bool:
@@ -35,8 +52,10 @@ def closure(
     roots: Iterable[Node],
     quads_of: Callable[[Node], Iterable[ox.Quad]],
     inner: Callable[[object], bool] = is_skolem,
+    parts: bool = False,
 ) -> list[ox.Quad]:
-    """The quads about ``roots`` and, recursively, about the ``inner`` nodes they reach (each node once)."""
+    """The quads about ``roots`` and, recursively, about the ``inner`` nodes they reach (each node once);
+    with ``parts``, also about the named values of :data:`DESCRIPTION_PARTS` (a description's parts)."""
     found: list[ox.Quad] = []
     pending: list[Node] = list(roots)
     seen: set[Node] = set()
@@ -47,6 +66,8 @@ def closure(
         seen.add(node)
         for quad in quads_of(node):
             found.append(quad)
-            if inner(quad.object):
+            if inner(quad.object) or (
+                parts and quad.predicate.value in DESCRIPTION_PARTS and isinstance(quad.object, ox.NamedNode)
+            ):
                 pending.append(quad.object)  # type: ignore[arg-type]
     return found
