@@ -10,7 +10,7 @@ import pyoxigraph as ox
 from cbrs.kb.conditions import CONDITION_PARTS, LEGACY_PARTS
 from cbrs.kb.errors import AlreadyRegisteredError, InvalidDescriptionError, NotFoundError
 from cbrs.kb.loader import parse_bytes, registration_format
-from cbrs.kb.namespaces import BASE, RDF, GraphName, shorten
+from cbrs.kb.namespaces import BASE, RDF, RDFS, GraphName, shorten
 from cbrs.kb.owls import is_owls
 from cbrs.kb.shapes import check_descriptions
 from cbrs.kb.skolem import closure, is_skolem
@@ -158,7 +158,9 @@ _KINDS = (
 
 
 def _advertisements(store: Store, quads: Iterable[ox.Quad]) -> list[str]:
-    kinds = _advertisement_classes(store)
+    quads = list(quads)
+    stored = _advertisement_classes(store)
+    kinds = stored | _declared_kinds(quads, stored)
     return sorted(
         {
             q.subject.value
@@ -175,6 +177,26 @@ def _advertisement_classes(store: Store) -> set[str]:
     result = store.query("SELECT ?c WHERE { ?c rdfs:subClassOf* cbrs:Advertisement }")
     assert isinstance(result, ox.QuerySolutions)
     return {row["c"].value for row in result} | {CBRS.Advertisement}
+
+
+def _declared_kinds(quads: list[ox.Quad], kinds: set[str]) -> set[str]:
+    """Classes the input itself declares under a component kind (``lab:DoorCamera rdfs:subClassOf
+    cbrs:DynamicPerceptionComponent``), so that a description typed with one is an advertisement."""
+    parents: dict[str, set[str]] = {}
+    for q in quads:
+        subject, parent = q.subject, q.object
+        is_link = q.predicate.value == RDFS + "subClassOf"
+        if is_link and isinstance(subject, ox.NamedNode) and isinstance(parent, ox.NamedNode):
+            parents.setdefault(subject.value, set()).add(parent.value)
+    found: set[str] = set()
+    grew = True
+    while grew:
+        grew = False
+        for child, above in parents.items():
+            if child not in found and above & (kinds | found):
+                found.add(child)
+                grew = True
+    return found
 
 
 _Fields = dict[ox.NamedNode, dict[str, list[ox.NamedNode | ox.BlankNode | ox.Literal]]]

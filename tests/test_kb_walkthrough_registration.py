@@ -218,3 +218,15 @@ def test_rdf_xml_sent_as_text_is_recognised(mini_kb: KnowledgeBase) -> None:
     assert data is not None
     assert data.startswith(b"<?xml")
     assert mini_kb.registry.register(data) == [EX + "DetectDoor_LabCam01"]
+
+
+def test_a_kind_the_file_declares_itself_is_a_kind(mini_kb: KnowledgeBase) -> None:
+    """A lab's own subclass of a component kind, declared in the file that uses it, makes an advertisement."""
+    text = _camera(kind="ex:DoorCamera") + (
+        "ex:DoorCamera rdfs:subClassOf ex:Camera . ex:Camera rdfs:subClassOf cbrs:DynamicPerceptionComponent .\n"
+    )
+    text = "@prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .\n" + text
+    assert mini_kb.registry.register(text, "door_camera.ttl") == [EX + "DetectDoor_LabCam01"]
+    assert EX + "DetectDoor_LabCam01" in [ad.iri for ad in mini_kb.advertisements()]
+    mini_kb.registry.deregister(EX + "DetectDoor_LabCam01")
+    assert EX + "DetectDoor_LabCam01" not in [ad.iri for ad in mini_kb.advertisements()]
