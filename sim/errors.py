@@ -62,6 +62,23 @@ class NotVisibleError(PerceptionError):
         super().__init__(f"{target} not visible in {camera}: {pixels} matching pixels, at least {needed} needed")
 
 
+class CutByBorderError(NotVisibleError):
+    """What was looked for is in the image but cut by its border: its shape, hence any estimate, would be
+    wrong. ``pixels`` is how many of its pixels there are, ``on_border`` how many lie on the border."""
+
+    def __init__(self, camera: str, target: str, pixels: int, on_border: int) -> None:
+        self.camera = camera
+        self.target = target
+        self.pixels = pixels
+        self.needed = pixels
+        self.on_border = on_border
+        PerceptionError.__init__(
+            self,
+            f"{target} is cut by the border of {camera}'s image ({on_border} of its {pixels} pixels on the "
+            "border): it is partly out of view",
+        )
+
+
 class AmbiguousSightingError(PerceptionError):
     """Several separate things of the colour looked for are in view, and nothing says which is meant."""
 

@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cbrs.sim.cameras import Frame
-from cbrs.sim.errors import AmbiguousSightingError, NotVisibleError, UnknownColourError
+from cbrs.sim.errors import AmbiguousSightingError, CutByBorderError, NotVisibleError, UnknownColourError
 from cbrs.sim.layout import SHIRT_RADIUS, SHIRT_TOP
 
 __all__ = [
@@ -154,7 +154,7 @@ def _whole(frame: Frame, mask: NDArray[np.bool_], target: str) -> None:
     """Refuse a blob cut by the image's border: its shape, hence the estimate, would be wrong."""
     on_border = int(mask[0, :].sum() + mask[-1, :].sum() + mask[:, 0].sum() + mask[:, -1].sum())
     if on_border:
-        raise NotVisibleError(frame.camera, f"whole {target} (cut by the image border)", 0, 1)
+        raise CutByBorderError(frame.camera, target, int(mask.sum()), on_border)
 
 
 @dataclass(frozen=True)

@@ -15,14 +15,19 @@ from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
 from cbrs.sim.components import SimEnvironment
-from cbrs.sim.errors import AmbiguousSightingError
+from cbrs.sim.errors import AmbiguousSightingError, CutByBorderError
 from cbrs.sim.perception import locate_robot, recognise_object, track_person
 from cbrs.sim.world import open_world
 from tests.home_layout import HANDOVER_POSE
 
 EXAMPLES = Path(__file__).parent.parent / "docs" / "examples"
 HOME, WORLD = PREFIXES["home"], PREFIXES["world"]
-RGBA = {"green": "0.10 0.70 0.20 1", "blue": "0.10 0.20 0.85 1", "yellow": "0.95 0.85 0.10 1"}
+RGBA = {
+    "green": "0.10 0.70 0.20 1",
+    "blue": "0.10 0.20 0.85 1",
+    "yellow": "0.95 0.85 0.10 1",
+    "cyan": "0.05 0.80 0.80 1",
+}
 
 
 def remote_of(colour: str, task: bool = False) -> KnowledgeBase:
@@ -85,3 +90,14 @@ def test_a_task_runs_beside_an_object_of_a_shared_colour(colour: str, task: str)
     fetched, stayed = ("Remote1", "Pen") if task == "FetchMyRemote" else ("Pen", "Remote1")
     assert (WORLD + fetched, HOME + "isWith", WORLD + "Person") in facts
     assert (WORLD + stayed, HOME + "isLocatedOn", WORLD + "KitchenTable") in facts
+
+
+def test_an_object_at_the_edge_of_the_kinects_view_is_said_to_be_cut_by_it() -> None:
+    kb = remote_of("cyan")
+    remote = f"<{WORLD}Remote1>"
+    kb.update(f"DELETE WHERE {{ GRAPH graph:map {{ {remote} home:x ?x ; home:y ?y }} }}")
+    kb.update(f"INSERT DATA {{ GRAPH graph:map {{ {remote} home:x 7.15 ; home:y 3.30 }} }}")  # across the left edge
+    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world, pytest.raises(CutByBorderError) as cut:
+        recognise_object(world.camera("Kinect01").capture(), "cyan")
+    assert cut.value.camera == "Kinect01" and 0 < cut.value.on_border < cut.value.pixels
+    assert "cut by the border of Kinect01's image" in str(cut.value)
