@@ -160,6 +160,24 @@ class NotFoundError(KnowledgeBaseError):
         super().__init__(f"no {what} <{iri}> in the store")
 
 
+class OutsideRegistryError(NotFoundError):
+    """An advertisement that is in the store, but in another graph than the registry's (graph:services):
+    ``cbrs load`` put it there with a file that also declares classes. It keeps the graph it is in."""
+
+    def __init__(self, iri: str, graph: str) -> None:
+        super().__init__(iri, "registered advertisement")
+        self.graph = graph
+        self.args = (
+            f"<{iri}> is in the graph <{graph}>, not in graph:services, which the registry manages: "
+            "cbrs load puts a file that declares classes into the ontology graph, descriptions and all; "
+            "load the description with --graph services (or from a file of its own) to register, update "
+            "or deregister it",
+        )
+
+    def __str__(self) -> str:
+        return str(self.args[0])
+
+
 class InvalidDescriptionError(KnowledgeBaseError):
     """A service description lacks what the six-tuple requires; ``problems`` lists each gap."""
 

@@ -8,7 +8,7 @@ from collections.abc import Iterable
 import pyoxigraph as ox
 
 from cbrs.kb.conditions import CONDITION_PARTS, LEGACY_PARTS
-from cbrs.kb.errors import AlreadyRegisteredError, InvalidDescriptionError, NotFoundError
+from cbrs.kb.errors import AlreadyRegisteredError, InvalidDescriptionError, NotFoundError, OutsideRegistryError
 from cbrs.kb.loader import parse_bytes, registration_format
 from cbrs.kb.namespaces import BASE, RDF, RDFS, GraphName, shorten
 from cbrs.kb.owls import is_owls
@@ -45,7 +45,7 @@ class ComponentRegistry:
         old: list[ox.Quad] = []
         for iri in iris:
             if not self.is_registered(iri):
-                raise NotFoundError(iri, "registered advertisement")
+                raise self._not_found(iri)
             old.extend(self.description_quads(iri))
         new, kept = set(quads), set(old)
         before = self._standard_terms.begin()
@@ -56,12 +56,22 @@ class ComponentRegistry:
     def deregister(self, iri: str) -> int:
         """Remove one advertisement's description; returns the number of triples removed."""
         if not self.is_registered(iri):
-            raise NotFoundError(iri, "registered advertisement")
+            raise self._not_found(iri)
         old = self.description_quads(iri)
         before = self._standard_terms.begin()
         self._store.replace(old, [])
         self._standard_terms.changed(before, old, [])
         return len(old)
+
+    def _not_found(self, iri: str) -> NotFoundError:
+        """Not registered: said so, or where the advertisement is when another graph holds it."""
+        kinds = _advertisement_classes(self._store)
+        for quad in self._store.quads(ox.NamedNode(iri), ox.NamedNode(RDF + "type"), None):
+            if isinstance(quad.object, ox.NamedNode) and quad.object.value in kinds:
+                return OutsideRegistryError(
+                    iri, str(quad.graph_name.value) if isinstance(quad.graph_name, ox.NamedNode) else ""
+                )
+        return NotFoundError(iri, "registered advertisement")
 
     def is_registered(self, iri: str) -> bool:
         node = ox.NamedNode(iri)

@@ -10,7 +10,7 @@ from pathlib import Path
 import pyoxigraph as ox
 import pytest
 
-from cbrs.kb import InvalidDescriptionError, KnowledgeBase
+from cbrs.kb import InvalidDescriptionError, KnowledgeBase, NotFoundError
 from cbrs.kb.namespaces import GENID
 
 EX = "http://example.org/mini#"
@@ -230,3 +230,26 @@ def test_a_kind_the_file_declares_itself_is_a_kind(mini_kb: KnowledgeBase) -> No
     assert EX + "DetectDoor_LabCam01" in [ad.iri for ad in mini_kb.advertisements()]
     mini_kb.registry.deregister(EX + "DetectDoor_LabCam01")
     assert EX + "DetectDoor_LabCam01" not in [ad.iri for ad in mini_kb.advertisements()]
+
+
+def test_an_advertisement_loaded_into_the_ontology_graph_is_said_to_be_there(
+    mini_kb: KnowledgeBase, tmp_path: Path
+) -> None:
+    """cbrs load sends a file that declares classes to the ontology graph, its descriptions too; the
+    registry (graph:services) then says where the advertisement is and what to do, not "no advertisement"."""
+    path = tmp_path / "lab.ttl"
+    path.write_text(
+        "@prefix owl: <http://www.w3.org/2002/07/owl#> .\n" + _camera() + "ex:Location a owl:Class .\n",
+        encoding="utf-8",
+    )
+    mini_kb.load([path])
+    for attempt in (
+        lambda: mini_kb.registry.deregister(EX + "DetectDoor_LabCam01"),
+        lambda: mini_kb.registry.update(_camera()),
+    ):
+        with pytest.raises(NotFoundError) as caught:
+            attempt()
+        assert "is in the graph <https://w3id.org/cbrs/graph/ontology>" in str(caught.value)
+        assert "--graph services" in str(caught.value)
+    with pytest.raises(NotFoundError, match="no registered advertisement"):
+        mini_kb.registry.deregister(EX + "Nothing")
