@@ -88,6 +88,9 @@ SHORT_NAMES: dict[str, tuple[str, str]] = {
     "json-ld": ("application/sparql-results+json", "application/ld+json"),
     "rdfxml": ("application/sparql-results+xml", "application/rdf+xml"),
     "rdf+xml": ("application/sparql-results+xml", "application/rdf+xml"),
+    "rdf": ("application/sparql-results+xml", "application/rdf+xml"),  # SPARQLWrapper's RDF return format
+    "n-triples": ("text/tab-separated-values", "application/n-triples"),
+    "n-quads": ("text/tab-separated-values", "application/n-quads"),
     "nquads": ("text/tab-separated-values", "application/n-quads"),
     "nq": ("text/tab-separated-values", "application/n-quads"),
     "trig": ("application/sparql-results+json", "application/trig"),

@@ -16,6 +16,7 @@ import os
 import subprocess
 import sys
 import urllib.parse
+import warnings
 from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
@@ -169,6 +170,26 @@ def test_query_takes_post_bodies_and_updates_as_oxigraph_does(server: Server) ->
     assert ask(server, "POST", "/query", insert, {**update, "Authorization": f"Bearer {TOKEN}"})[0] == 204
     asked = get(server, "/query", "ASK { <urn:test:q> <urn:test:p> 1 }", "application/sparql-results+json")
     assert json.loads(asked[2])["boolean"] is True
+
+
+@pytest.mark.parametrize("path", ["/sparql", "/query"])
+def test_sparqlwrapper_with_every_return_format_it_has(server: Server, path: str) -> None:
+    """SPARQLWrapper sends its return format as format= and output= besides an Accept header; its RDF
+    format (format=rdf) was a 406."""
+    sparqlwrapper = pytest.importorskip("SPARQLWrapper")
+    names = {"SELECT": ("JSON", "XML", "CSV", "TSV"), "CONSTRUCT": ("TURTLE", "N3", "RDFXML", "JSONLD", "XML", "RDF")}
+    for form, query in (("SELECT", SELECT), ("CONSTRUCT", CONSTRUCT)):
+        for name in names[form]:
+            for method in (sparqlwrapper.GET, sparqlwrapper.POST):
+                client = sparqlwrapper.SPARQLWrapper(f"http://127.0.0.1:{server.http_port}{path}")
+                client.setTimeout(int(WAIT))
+                client.setQuery(query)
+                client.setReturnFormat(getattr(sparqlwrapper, name))
+                client.setMethod(method)
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")  # SPARQLWrapper's own about formats and rdflib's deprecations
+                    converted = client.query().convert()
+                assert converted, (form, name, method)
 
 
 def test_sparqlwrapper_at_the_query_path() -> None:
