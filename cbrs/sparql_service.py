@@ -198,7 +198,10 @@ class Dataset:
 
     @classmethod
     def from_parameters(cls, default_graphs: Sequence[str], named_graphs: Sequence[str]) -> Dataset | None:
-        """The dataset the parameters name, or ``None`` when there are none; refuses what is not an IRI."""
+        """The dataset the parameters name, or ``None`` when there are none; refuses what is not an IRI.
+        An empty value names nothing: it is what a query form's blank graph field sends."""
+        default_graphs = [value for value in default_graphs if value.strip()]
+        named_graphs = [value for value in named_graphs if value.strip()]
         if not default_graphs and not named_graphs:
             return None
         for parameter, values in (("default-graph-uri", default_graphs), ("named-graph-uri", named_graphs)):

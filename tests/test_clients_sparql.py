@@ -360,3 +360,13 @@ def test_a_format_parameter_is_read_as_leniently_as_accept(server: Server, given
     status, headers, body = ask(server, "GET", f"/sparql?{query}")
     assert status == 200, body
     assert media(headers) == expected
+
+
+def test_an_empty_dataset_parameter_names_no_graph(server: Server) -> None:
+    """A query form with a blank graph field sends default-graph-uri= (Virtuoso's page does): the union
+    default graph applies, as without the parameter."""
+    query = urllib.parse.urlencode(
+        {"query": "ASK { home:Position2D ?p ?o }", "default-graph-uri": "", "named-graph-uri": " "}
+    )
+    status, _, body = ask(server, "GET", f"/sparql?{query}", headers={"Accept": "application/json"})
+    assert status == 200 and json.loads(body)["boolean"] is True, body
