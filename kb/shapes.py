@@ -255,7 +255,7 @@ def _shape_problems(closures: dict[str, list[ox.Quad]]) -> list[ShapeProblem]:
     _quiet_ill_typed_literals()
     owner = {q.subject: root for root, quads in closures.items() for q in quads}
     triples = [ox.Triple(q.subject, q.predicate, q.object) for quads in closures.values() for q in quads]
-    data = rdflib.Graph().parse(data=ox.serialize(triples, format=ox.RdfFormat.N_TRIPLES), format="nt")
+    data = _rdflib_graph(triples)
     conforms, results, _ = validate(data, shacl_graph=_shapes_graph(), inference="none", allow_warnings=True)
     if conforms:
         return []
@@ -284,6 +284,30 @@ def _shape_problems(closures: dict[str, list[ox.Quad]]) -> list[ShapeProblem]:
             )
         )
     return sorted(set(problems), key=lambda p: (p.description, p.path or "", p.message))
+
+
+def _rdflib_graph(triples: Iterable[ox.Triple]) -> Any:
+    """The triples as an rdflib graph for pySHACL, term by term: rdflib's N-Triples parser takes time
+    quadratic in a line's length (a 5 MB rdfs:comment took 95 s to check), building the terms does not."""
+    import rdflib
+
+    def term(node: Any) -> Any:
+        if isinstance(node, ox.NamedNode):
+            return rdflib.URIRef(node.value)
+        if isinstance(node, ox.BlankNode):
+            return rdflib.BNode(node.value)
+        if isinstance(node, ox.Literal):
+            if node.language:
+                return rdflib.Literal(node.value, lang=node.language)
+            if node.datatype.value == XSD + "string":
+                return rdflib.Literal(node.value)  # as rdflib's parsers read "text"
+            return rdflib.Literal(node.value, datatype=rdflib.URIRef(node.datatype.value))
+        raise TypeError(f"no rdflib term for {node!r}")  # an RDF-star triple: the parsers cbrs uses give none
+
+    graph = rdflib.Graph()
+    for triple in triples:
+        graph.add((term(triple.subject), term(triple.predicate), term(triple.object)))
+    return graph
 
 
 def _ox_term(term: Any) -> Any:
