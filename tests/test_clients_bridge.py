@@ -28,7 +28,7 @@ from websockets.sync.client import ClientConnection, connect
 from cbrs import external_camera
 from cbrs.kb import KnowledgeBase
 from cbrs.rosbridge import Bridge, RunningBridge
-from cbrs.rosbridge.wire import MAX_PARTIAL, MIN_FRAGMENT
+from cbrs.rosbridge.wire import MAX_PARTIAL, MAX_PIECES, MIN_FRAGMENT
 from cbrs.server import ServeConfig, Server
 from cbrs.sparql_service import EndpointConfig
 
@@ -300,3 +300,17 @@ def test_cbrs_match_takes_a_bare_requirement_name_as_the_bridge_does() -> None:
     bare = CliRunner().invoke(cli, ["--store", ":memory:", "match", "RobotSelfPosition", "--top", "1", "--json"])
     assert bare.exit_code == 0, bare.output
     assert json.loads(bare.output)["requirement"] == "https://w3id.org/cbrs/requirement#RobotSelfPosition"
+
+
+def test_a_long_response_is_cut_in_at_most_max_pieces(bridge: RunningBridge) -> None:
+    """3 MB in pieces of 256 would be 11,719 replies, past the 10,000 a client may leave unread: the
+    pieces grow instead, and the client stays connected."""
+    with connect(bridge.url, open_timeout=WAIT) as ws:
+        call = {"op": "call_service", "service": "/test/big", "id": "long", "args": {"n": 3_000_000}}
+        ws.send(json.dumps({**call, "fragment_size": 256}))
+        first = json.loads(ws.recv(timeout=WAIT))
+        assert MAX_PIECES - 10 < first["total"] <= MAX_PIECES and len(first["data"]) > 256
+        pieces = [first, *(json.loads(ws.recv(timeout=WAIT)) for _ in range(first["total"] - 1))]
+        assert joined(pieces)["values"]["text"] == "y" * 3_000_000
+        ws.send(json.dumps({"op": "call_service", "service": "/rosapi/get_time", "id": "after"}))
+        assert json.loads(ws.recv(timeout=WAIT))["id"] == "after"

@@ -14,8 +14,8 @@
 Both are bounded: the pieces a client has pending hold at most ``max_message_bytes`` characters
 together, in at most one piece per :data:`PIECE_CHARS` of that (the oldest unfinished messages make way,
 then the message that still does not fit is refused), in at most :data:`MAX_PARTIAL` messages; and a
-``fragment_size`` below :data:`MIN_FRAGMENT` is raised to it, so one message never becomes millions
-of frames.
+``fragment_size`` below :data:`MIN_FRAGMENT` is raised to it, and one message is never cut in more than
+:data:`MAX_PIECES`.
 """
 
 from __future__ import annotations
@@ -35,6 +35,9 @@ from cbrs.rosbridge.protocol import Message, MessageId, dumps
 MAX_PARTIAL = 16
 #: The smallest piece the server sends: a smaller ``fragment_size`` is raised to it.
 MIN_FRAGMENT = 256
+#: The most pieces the server cuts one message into (the piece size grows for a longer one): the pieces
+#: of a reply are replies, and a client more than ``session.REPLY_BACKLOG`` (10,000) behind is dropped.
+MAX_PIECES = 4096
 #: A client's pending pieces number at most one per this many characters of ``max_message_bytes``
 #: (16,384 for 1 MiB): a piece costs its bookkeeping whatever its size, so tiny pieces are counted too.
 PIECE_CHARS = 64
@@ -121,8 +124,9 @@ class Reassembly:
 
 
 def fragments(text: str, size: int, message_id: MessageId) -> list[str]:
-    """``text`` as ``fragment`` ops of at most ``size`` characters of it each (``[text]`` if it fits)."""
-    size = max(size, MIN_FRAGMENT)
+    """``text`` as ``fragment`` ops of at most ``size`` characters of it each (``[text]`` if it fits); the
+    size is raised to :data:`MIN_FRAGMENT`, and so that no message takes more than :data:`MAX_PIECES`."""
+    size = max(size, MIN_FRAGMENT, math.ceil(len(text) / MAX_PIECES))
     if len(text) <= size:
         return [text]
     total = math.ceil(len(text) / size)
