@@ -166,6 +166,7 @@ def run_task(
             bus.publish(
                 "/cbrs/task_progress", {"event": "replanning", "plan": len(replans) + 1, "reason": report.reason}
             )
+            _settle(environment)  # leave nothing half done (an object held in a hand) before looking again
             _perceive(environment)  # look again
             belief.write(environment.observe())
             container.recover()  # what failed for the world's sake may be tried again; the broken stay broken
@@ -185,6 +186,15 @@ def _stop_if_cancelled(executor: Executor, cancelled: Callable[[], bool] | None,
     """Between steps: stop the run if asked to (a plan whose steps are all done just finishes)."""
     if cancelled is not None and done < len(executor.plan.steps) and cancelled():
         executor.cancel(f"cancelled on request after {done} of {len(executor.plan.steps)} steps")
+
+
+def _settle(environment: Environment) -> None:
+    """Let an environment put the world in a state a new plan can start from (the Environment
+    protocol's optional ``settle``): a plan that failed with an object in a robot's hand leaves it
+    there, and no plan starts by taking an object from a hand."""
+    settle = getattr(environment, "settle", None)
+    if callable(settle):
+        settle()
 
 
 def _perceive(environment: Environment) -> None:

@@ -812,6 +812,20 @@ class SimEnvironment:
         self.context.grid = None
         implementations(self.kb, self.world, self.registry, self.transport)
 
+    def settle(self) -> None:
+        """Before a re-plan: an arm still holding an object (its plan failed between picking it up and
+        putting it down) sets it down where it took it from, and the arms fold home. Nothing else moves."""
+        for side, arm in sorted(self.world.arms.items()):
+            grasp = arm.held_grasp
+            if arm.held is None or grasp is None:
+                continue
+            x, y, z = grasp.position  # where the hand closed on it, on the surface it stood on
+            surface = z - grasp.bottom_offset
+            spot = Region("TakenFrom", x - 0.02, x + 0.02, y - 0.02, y + 0.02, surface, surface + 0.3)
+            for move in (skills.carry_object, skills.put_down_object):
+                if not move(self.world, side, spot).succeeded:
+                    break
+
     def perceive(self) -> None:
         """Look at everything with every working camera (before a plan, and before a re-plan)."""
         self.belief.look()

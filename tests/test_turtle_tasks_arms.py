@@ -109,3 +109,24 @@ def test_a_place_only_the_other_arm_reaches_gets_the_object_passed_to_that_arm(t
     assert not result.replans
     facts = {(r["thing"].value, r["relation"].value, r["other"].value) for r in kb.select("world_facts")}
     assert (WORLD + "Cup", HOME + "isLocated", WORLD + "PenTray1") in facts
+
+
+def test_an_object_a_failed_plan_left_in_a_hand_is_set_down_before_the_next_plan() -> None:
+    """PutCupOnTray with the put-down broken: the first plan fails with the cup in the left hand; before
+    re-planning the arm sets it down where it took it, so the next plan finds and takes it again (it
+    used to look for the cup on the table while the hand held it up in the air)."""
+    kb = KnowledgeBase.open(":memory:")
+    kb.load([TASKS / "tray_place.ttl"], graph="map")
+    kb.load([TASKS / "put_cup_on_tray.ttl"], graph="requirements")
+    broken = PREFIXES["svc"] + "PutDownObject_CytonDualArm01"
+    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
+        environment = SimEnvironment(world, kb)
+        result = run_task(kb, "PutCupOnTray", environment, composer=Composer(kb), faults=[broken], max_replans=1)
+    assert not result.succeeded and len(result.replans) == 1
+    first, last = result.replans[0].report, result.report
+    assert last is not None
+    assert [s.outcome for s in first.steps][-1] == "failed"
+    outcomes = {step.planned.rsplit("#", 1)[-1]: step.outcome for step in last.steps}
+    assert outcomes["RecogniseObjectByColour_Kinect01"] == "succeeded"
+    assert outcomes["PickUpObject_CytonDualArm01"] == "succeeded"
+    assert outcomes["PutDownObject_CytonDualArm01"] == "failed"  # still broken
