@@ -60,8 +60,12 @@ PEN_HOLDER_OUT_OF_REACH = (
     + """home:PenHolderPlace a owl:Class ; rdfs:subClassOf home:Region .
 world:PenHolder a home:PenHolderPlace ;
     home:minX 8.15 ; home:maxX 8.30 ; home:minY 3.50 ; home:maxY 3.65 ; home:minZ 0.75 ; home:maxZ 0.75 .
-req:PutPenInHolder a cbrs:Requirement ; cbrs:requestedBy svc:CytonDualArm01 ; cbrs:deviceName "CytonDualArm01" ;
-    cbrs:serviceName "PutPenInHolder" ;
+"""
+)
+PUT_PEN_IN_HOLDER = (
+    TTL
+    + """req:PutPenInHolder a cbrs:Requirement ; cbrs:requestedBy svc:CytonDualArm01 ;
+    cbrs:deviceName "CytonDualArm01" ; cbrs:serviceName "PutPenInHolder" ;
     cbrs:hasOWLSModel [ a cbrs:OWLSModel ;
         cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "pen" ; cbrs:parameterType home:Pen ] ;
         cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "place" ; cbrs:parameterType home:PenHolderPlace ] ;
@@ -102,7 +106,12 @@ def test_an_object_no_arm_reaches_is_refused_before_anything_moves(tmp_path: Pat
 
 
 def test_a_place_no_arm_reaches_is_refused_before_the_pen_is_picked_up(tmp_path: Path) -> None:
-    kb = knowledge(tmp_path, ("map", PEN_HOLDER_OUT_OF_REACH), ("requirements", PEN_HOLDER_OUT_OF_REACH))
+    kb = knowledge(
+        tmp_path,
+        ("ontology", PEN_HOLDER_OUT_OF_REACH),
+        ("map", PEN_HOLDER_OUT_OF_REACH),
+        ("requirements", PUT_PEN_IN_HOLDER),
+    )
     before = store(kb)
     with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
         pen = world.pose("Pen").position

@@ -14,13 +14,16 @@ from cbrs.sim.components import SimEnvironment
 from cbrs.sim.world import open_world
 
 SVC, WORLD, HOME = PREFIXES["svc"], PREFIXES["world"], PREFIXES["home"]
-GO_TO_THE_DESK = """@prefix cbrs: <https://w3id.org/cbrs/core#> . @prefix home: <https://w3id.org/cbrs/home#> .
+THE_DESK = """@prefix cbrs: <https://w3id.org/cbrs/core#> . @prefix home: <https://w3id.org/cbrs/home#> .
 @prefix req: <https://w3id.org/cbrs/requirement#> . @prefix svc: <https://w3id.org/cbrs/service#> .
 @prefix world: <https://w3id.org/cbrs/world#> .
 world:Desk1 a home:Desk , home:ObjectPlace ;
     home:minX 3.8 ; home:maxX 4.6 ; home:minY 7.6 ; home:maxY 8.2 ; home:minZ 0.0 ; home:maxZ 0.72 ;
     home:dockingPose world:Desk1Dock .
 world:Desk1Dock a home:Pose2D ; home:x 4.2 ; home:y 7.0 ; home:yaw 1.5708 .
+"""
+GO_TO_THE_DESK_TASK = """@prefix cbrs: <https://w3id.org/cbrs/core#> . @prefix home: <https://w3id.org/cbrs/home#> .
+@prefix req: <https://w3id.org/cbrs/requirement#> . @prefix svc: <https://w3id.org/cbrs/service#> .
 req:GoToDesk a cbrs:Requirement ; cbrs:requestedBy svc:P3DX01 ; cbrs:deviceName "P3DX01" ; cbrs:serviceName "GoToDesk" ;
     cbrs:hasOWLSModel [ a cbrs:OWLSModel ;
         cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "desk" ; cbrs:parameterType home:Desk ] ;
@@ -33,11 +36,12 @@ req:GoToDesk a cbrs:Requirement ; cbrs:requestedBy svc:P3DX01 ; cbrs:deviceName 
 
 
 def test_the_base_is_sent_to_a_new_desk_by_its_docking_pose(tmp_path: Path) -> None:
-    path = tmp_path / "desk.ttl"
-    path.write_text(GO_TO_THE_DESK, encoding="utf-8")
+    desk, task = tmp_path / "desk.ttl", tmp_path / "go_to_the_desk.ttl"
+    desk.write_text(THE_DESK, encoding="utf-8")
+    task.write_text(GO_TO_THE_DESK_TASK, encoding="utf-8")
     kb = KnowledgeBase.open(":memory:")
-    kb.load([path], graph="map")
-    kb.load([path], graph="requirements")
+    kb.load([desk], graph="map")
+    kb.load([task], graph="requirements")
     with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
         result = run_task(kb, "GoToDesk", SimEnvironment(world, kb), composer=Composer(kb))
         parked = world.base_pose()
