@@ -18,7 +18,7 @@ from cbrs.kb.errors import QuerySyntaxError
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.sparql_lexemes import HIDING
 
-__all__ = ["FORMS", "TOKENS", "explain_syntax_error", "operation_kind", "undeclared_prefix"]
+__all__ = ["FORMS", "TOKENS", "explain_syntax_error", "first_keyword", "operation_kind", "undeclared_prefix"]
 
 TOKENS = re.compile(
     r'(?P<iri><[^<>"{}|^`\\\x00-\x20]*>)|'
@@ -33,20 +33,25 @@ them counts."""
 FORMS = frozenset({"SELECT", "CONSTRUCT", "DESCRIBE", "ASK"})
 _UPDATE_WORDS = frozenset({"INSERT", "DELETE", "LOAD", "CLEAR", "CREATE", "DROP", "COPY", "MOVE", "ADD", "WITH"})
 _PROLOGUE_WORDS = frozenset({"PREFIX", "BASE", "VERSION"})
-_ERROR_AT = re.compile(r"error at (\d+:\d+)")
+_ERROR_AT = re.compile(r"error at (\d+:\d+)(?::\s*)?")
+
+
+def first_keyword(text: str) -> str | None:
+    """The first word of ``text`` after its prologue, as written (None: there is none)."""
+    for match in TOKENS.finditer(text):
+        word = match.group("word")
+        if word and word.upper() not in _PROLOGUE_WORDS:
+            return word  # IRIs, prefixed names, strings and comments of the prologue are passed by
+    return None
 
 
 def operation_kind(text: str) -> Literal["query", "update"] | None:
     """Whether ``text`` reads as a query or an update, by its first keyword after the prologue (None:
     neither, or nothing to read). Only for explaining a syntax error: the parser decides what runs."""
-    for match in TOKENS.finditer(text):
-        word = (match.group("word") or "").upper()
-        if not word or word in _PROLOGUE_WORDS:
-            continue  # IRIs, prefixed names, strings and comments of the prologue
-        if word in FORMS:
-            return "query"
-        return "update" if word in _UPDATE_WORDS else None
-    return None
+    word = (first_keyword(text) or "").upper()
+    if word in FORMS:
+        return "query"
+    return "update" if word in _UPDATE_WORDS else None
 
 
 def undeclared_prefix(text: str) -> str | None:
@@ -59,6 +64,8 @@ def undeclared_prefix(text: str) -> str | None:
             prefix = name.partition(":")[0]
             if previous == "PREFIX":
                 declared.add(prefix)
+            elif text[match.start() - 1 : match.start()] == "<":  # an IRI the lexer could not read whole
+                pass  # (<http://x/has a space>): its scheme is no prefix
             elif prefix not in declared and prefix != "_":  # _: names a blank node
                 return prefix
         previous = (match.group("word") or "").upper()
@@ -67,11 +74,12 @@ def undeclared_prefix(text: str) -> str | None:
 
 def explain_syntax_error(error: QuerySyntaxError, text: str, expected: Literal["query", "update"]) -> QuerySyntaxError:
     """``error`` with a plain reason in front where the parser's list of expected tokens hides it: an
-    update sent as a query (or the other way round), or a prefix nobody declared."""
+    update sent as a query (or the other way round), a misspelt first keyword, or a prefix nobody declared."""
     if type(error) is not QuerySyntaxError:  # QueryTooComplexError and the like say what they mean
         return error
     at = _ERROR_AT.search(error.message)
     where = f"error at {at.group(1)}: " if at else ""
+    said = " ".join(_ERROR_AT.sub("", error.message, count=1).split())  # the parser's words, without the place
     kind = operation_kind(text)
     if kind is not None and kind != expected:
         how = {
@@ -80,11 +88,18 @@ def explain_syntax_error(error: QuerySyntaxError, text: str, expected: Literal["
         }[kind]
         article = "an" if expected == "update" else "a"
         return QuerySyntaxError(text, f"{where}this is a SPARQL {kind}, not {article} {expected}: {how}")
+    word = first_keyword(text) if kind is None else None
+    close = (
+        difflib.get_close_matches(word.upper(), FORMS if expected == "query" else _UPDATE_WORDS, n=1) if word else []
+    )
+    if close:  # SELEKT, INSRT: the parser says "expected CONSTRUCT", the last form it tried
+        return QuerySyntaxError(
+            text, f"{where}{word!r} begins no SPARQL {expected}: did you mean {close[0]}? (the parser: {said})"
+        )
     prefix = undeclared_prefix(text)
     if prefix is not None:
         # Oxigraph says "Prefix not found" among the tokens it expected, or (in a subject) nothing of it
         close = difflib.get_close_matches(prefix, PREFIXES, n=1)
-        said = " ".join(error.message.split())
         if close:
             known = f"did you mean '{close[0]}:'?"
         elif "Prefix not found" in said:

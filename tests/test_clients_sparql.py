@@ -237,6 +237,9 @@ def test_sparqlwrapper_at_the_query_path() -> None:
             "INSERT DATA { GRAPH <urn:g> { <urn:a> zzq:b <urn:c> } }",
             "the prefix 'zzq:' is not declared",
         ),
+        ("GET", "/sparql", "selct ?s WHERE { ?s ?p ?o }", "'selct' begins no SPARQL query: did you mean SELECT?"),
+        ("POST-update", "/update", "INSRT DATA { GRAPH <urn:g> { <urn:a> <urn:b> <urn:c> } }", "did you mean INSERT?"),
+        ("GET", "/sparql", "SELECT ?s WHERE { ?s <http://x.org/a space> ?o }", "1:44: expected IRI parsing failed"),
     ],
 )
 def test_a_mistaken_text_is_a_400_that_says_what_is_wrong(
