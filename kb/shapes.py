@@ -118,23 +118,60 @@ def check_descriptions(store: Store, quads: Iterable[ox.Quad], terms: bool = Tru
 
 
 def check_loaded(store: Store, report: LoadReport) -> None:
-    """The loader's check before it writes: RDF files in full, OWL-S conversions against the shapes only."""
+    """The loader's check before it writes: RDF files in full, OWL-S conversions against the shapes only.
+    A description the store holds already is checked as it will be after the load, its stored triples
+    and the new ones together: a load adds, so a changed file loaded again would give it a second OWLS
+    model (the blank nodes of a changed file get other names) unless refused."""
     owls = [q for item in report.files if item.owls is not None for q in item.quads]
     plain = [q for item in (*report.files, *report.imports) if item.owls is None for q in item.quads]
     context = plain + owls
+    stored_plain, stored_owls = _stored(store, plain), _stored(store, owls)
     try:
         if _closures(plain):
-            _check_with_context(store, plain, context)
-        check_descriptions(store, owls, terms=False)
-    except DescriptionShapeError as error:  # name the file the description came from
-        node = ox.NamedNode(error.iri)  # a description, or a node of one (a parameter) that may have no triples
-        items = [*report.files, *report.imports]
-        sources = [item.source for item in items if any(node in (q.subject, q.object) for q in item.quads)]
-        if not sources and len(items) == 1:
-            sources = [items[0].source]
-        if sources:
-            error.args = (f"{sources[0]}: {error.args[0]}",)
+            _check_with_context(store, plain + stored_plain, context)
+        check_descriptions(store, owls + stored_owls, terms=False)
+    except DescriptionShapeError as error:
+        if error.iri in {q.subject.value for q in (*stored_plain, *stored_owls) if isinstance(q.subject, ox.NamedNode)}:
+            error.args = (
+                f"{error.args[0]}; <{error.iri}> is in the store already and a load adds to it: replace an "
+                "advertisement with cbrs register --update (kb.registry.update), or remove the description first",
+            )
+        _name_the_source(error, report)
         raise
+
+
+def _stored(store: Store, quads: list[ox.Quad]) -> list[ox.Quad]:
+    """The stored quads of the descriptions ``quads`` add to, in the graphs they add to (none when they
+    are all new: one lookup). A copy in another graph (a task file loaded into the map and the
+    requirements) is another description's business."""
+    closures = _closures(quads)
+    if not closures:
+        return []
+    model = ox.NamedNode(CBRS.hasOWLSModel)
+    stored = {
+        (q.subject.value, q.graph_name) for q in store.quads(None, model, None) if isinstance(q.subject, ox.NamedNode)
+    }
+    found: list[ox.Quad] = []
+    for root, own in sorted(closures.items()):
+        for graph in sorted({q.graph_name for q in own if (root, q.graph_name) in stored}, key=str):
+            named = graph if isinstance(graph, ox.NamedNode) else None
+
+            def quads_of(node: Any, graph: ox.NamedNode | None = named) -> list[ox.Quad]:
+                return list(store.quads(node, None, None, graph))
+
+            found += closure([ox.NamedNode(root)], quads_of, _is_inner, parts=True)
+    return found
+
+
+def _name_the_source(error: InvalidDescriptionError, report: LoadReport) -> None:
+    """Put the name of the file the description came from before the error's message."""
+    node = ox.NamedNode(error.iri)  # a description, or a node of one (a parameter) that may have no triples
+    items = [*report.files, *report.imports]
+    sources = [item.source for item in items if any(node in (q.subject, q.object) for q in item.quads)]
+    if not sources and len(items) == 1:
+        sources = [items[0].source]
+    if sources:
+        error.args = (f"{sources[0]}: {error.args[0]}",)
 
 
 def _check_with_context(store: Store, quads: list[ox.Quad], context: list[ox.Quad]) -> None:

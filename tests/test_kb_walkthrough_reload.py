@@ -1,0 +1,51 @@
+"""A lab edits its description file and loads it again with cbrs load. A load adds, and the blank nodes
+of a changed file get other names, so the description would gain a second OWLS model and a second QoS
+model (both shown, both matched). The load is refused instead, naming the file and what to do; the same
+file loaded again still adds nothing."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from cbrs.kb import InvalidDescriptionError, KnowledgeBase
+
+pytestmark = pytest.mark.both_stores
+
+HEAD = """@prefix cbrs: <https://w3id.org/cbrs/core#> .
+@prefix ex: <http://example.org/mini#> .
+"""
+CAMERA = """ex:Cam a cbrs:DynamicPerceptionComponent ; cbrs:deviceName "LabCam" ; cbrs:serviceName "Detect" ;
+    cbrs:hasOWLSModel [ cbrs:hasOutput [ cbrs:parameterType ex:Location ] ] ;
+    cbrs:hasQoSModel [ cbrs:responseTime {time} ] .
+"""
+NEED = """ex:Need a cbrs:Requirement ; cbrs:deviceName "Robot" ; cbrs:serviceName "Need" ;
+    cbrs:hasOWLSModel [ cbrs:hasOutput [ cbrs:parameterType ex:Location ] ] ;
+    cbrs:hasQoSModel [ cbrs:responseTime {time} ] .
+"""
+
+
+@pytest.mark.parametrize(("text", "graph"), [(CAMERA, None), (NEED, "requirements")])
+def test_a_changed_file_loaded_again_is_refused(mini_kb: KnowledgeBase, tmp_path: Path, text: str, graph: str) -> None:
+    path = tmp_path / "lab.ttl"
+    path.write_text(HEAD + text.format(time="0.2"), encoding="utf-8")
+    mini_kb.load([path], graph=graph)
+    before = mini_kb.store.dump()
+    mini_kb.load([path], graph=graph)  # the same file: nothing new
+    assert mini_kb.store.dump() == before
+    path.write_text(HEAD + text.format(time="0.3"), encoding="utf-8")
+    with pytest.raises(InvalidDescriptionError) as caught:
+        mini_kb.load([path], graph=graph)
+    message = str(caught.value)
+    assert message.startswith(f"{path}: <http://example.org/mini#")
+    assert "a description has one OWLS model" in message
+    assert "is in the store already and a load adds to it" in message and "register --update" in message
+    assert mini_kb.store.dump() == before
+
+
+def test_a_description_the_store_does_not_hold_loads(mini_kb: KnowledgeBase, tmp_path: Path) -> None:
+    path = tmp_path / "lab.ttl"
+    path.write_text(HEAD + CAMERA.format(time="0.2"), encoding="utf-8")
+    mini_kb.load([path])
+    assert [q.value for q in mini_kb.description("http://example.org/mini#Cam").qos] == [0.2]
