@@ -70,6 +70,8 @@ _POSITION_PREFIX = re.compile(
 )
 _NCNAME = re.compile(r"^[A-Za-z_\u00c0-\uffff][\w.\-\u00b7\u00c0-\uffff]*$")
 
+_JSON_LD_KEY = re.compile(rb'"@(?:context|id|graph|type|value|base|vocab)"\s*:')
+
 BULK_BYTES = 16 * 1024 * 1024
 """The size from which a lone N-Triples or Turtle file is written by Oxigraph's bulk loader (see the
 module's docstring): below it the full path costs little, above it a transaction holds every quad in
@@ -330,7 +332,9 @@ def _stored(store: Store, quad: ox.Quad) -> bool:
 def expand_paths(paths: Sequence[str | Path]) -> list[Path]:
     """The files to load: each file as given, and for a directory the files directly inside it with an
     RDF extension, sorted by name. A ``.xml`` file in a directory counts only when it mentions the RDF
-    namespace near its start, so an OASIS catalogue or other XML beside the ontologies is passed over."""
+    namespace near its start, so an OASIS catalogue or other XML beside the ontologies is passed over; a
+    ``.json`` file only when it has a JSON-LD keyword (``"@context"``, ``"@id"``, ``"@graph"``...) near its
+    start, so a ``package.json`` or a robot's configuration is passed over too (``.jsonld`` always counts)."""
     files: list[Path] = []
     for given in paths:
         path = Path(given)
@@ -344,6 +348,8 @@ def expand_paths(paths: Sequence[str | Path]) -> list[Path]:
                 continue
             if suffix == ".xml" and RDF.encode("ascii") not in _as_utf8(child.read_bytes()[:4096], str(child), False):
                 continue
+            if suffix == ".json" and not _JSON_LD_KEY.search(child.read_bytes()[:65536]):
+                continue  # a configuration or data file beside the RDF, not JSON-LD
             files.append(child)
         if len(files) == found:
             known = ", ".join(sorted(FORMATS_BY_EXTENSION))
