@@ -66,8 +66,8 @@ def to_term(parameter: Parameter, value: Term | str | int | float) -> Term:
     if isinstance(value, ox.NamedNode | ox.BlankNode | ox.Literal):
         return value
     try:
-        if parameter.kind == "iri":
-            return ox.NamedNode(expand(str(value)))
+        if parameter.kind == "iri":  # white space around an IRI is a paste's, never the IRI's (IRIs have none)
+            return ox.NamedNode(expand(str(value).strip()))
         if parameter.kind == "integer":
             return ox.Literal(str(int(value)), datatype=ox.NamedNode(XSD + "integer"))
         if parameter.kind == "decimal":

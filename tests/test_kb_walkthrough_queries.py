@@ -38,3 +38,10 @@ def test_a_remote_json_ld_context_is_refused_in_plain_words(tmp_path: Path, cont
     assert "https://schema.org/" in message and "fetches nothing" in message
     assert "LoadDocumentCallback" not in message
     assert kb.store.dump() == before
+
+
+def test_white_space_around_a_bound_iri_is_a_paste_s(bundled_kb: KnowledgeBase) -> None:
+    rows = bundled_kb.select("description", {"description": " svc:LocateMobileRobot_CeilingCamera01\n"})
+    assert {row["description"].value for row in rows} == {
+        "https://w3id.org/cbrs/service#LocateMobileRobot_CeilingCamera01"
+    }
