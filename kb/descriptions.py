@@ -8,7 +8,7 @@ from typing import Any, Literal, cast
 
 import pyoxigraph as ox
 
-from cbrs.kb.errors import BlankNodeError, InvalidDescriptionError, NotFoundError
+from cbrs.kb.errors import BlankNodeError, InvalidDescriptionError, NotAnIriError, NotFoundError
 from cbrs.kb.model import (
     Advertisement,
     EffectiveArea,
@@ -93,6 +93,8 @@ class DescriptionReader:
             return self._read(rows, iri)
         except BlankNodeError as error:
             raise BlankNodeError(iri, error.node) from None
+        except NotAnIriError as error:
+            raise NotAnIriError(iri, error.value) from None
 
     def _read(self, rows: Source, iri: str) -> ServiceDescription:
         head = rows("description", iri)
@@ -152,8 +154,9 @@ class DescriptionReader:
         )
 
     def advertisements(self) -> list[Advertisement]:
-        """Every readable advertisement: one with a blank node inside is passed over (and logged), so
-        one bad update does not stop matching and planning for everyone."""
+        """Every readable advertisement: one with a blank node inside, or a literal where an IRI is
+        needed, is passed over (and logged), so one bad update does not stop matching and planning for
+        everyone."""
         return [cast(Advertisement, found) for found in self._readable(self.advertisement_iris())]
 
     def requirements(self) -> list[Requirement]:
@@ -165,7 +168,7 @@ class DescriptionReader:
         for iri in iris:
             try:
                 found.append(self._read_from(rows, iri))
-            except BlankNodeError as error:
+            except (BlankNodeError, NotAnIriError) as error:
                 log.warning("passed over: %s", error)
         return found
 
@@ -301,7 +304,7 @@ def _iri(term: Term) -> str:
     if isinstance(term, ox.BlankNode):
         raise BlankNodeError("(a description)", str(term))
     if not isinstance(term, ox.NamedNode):
-        raise TypeError(f"expected an IRI, got {term}")
+        raise NotAnIriError("(a description)", str(term))
     return term.value
 
 

@@ -220,6 +220,15 @@ class BlankNodeError(InvalidDescriptionError):
         self.node = node
 
 
+class NotAnIriError(InvalidDescriptionError):
+    """A stored description has a literal where an IRI is needed (a parameter type ``"x"``): the shapes
+    refuse it on every way in, so it got in before they covered that node or around cbrs."""
+
+    def __init__(self, iri: str, value: str) -> None:
+        super().__init__(iri, [f"{value} stands where an IRI is needed"])
+        self.value = value
+
+
 class AlreadyRegisteredError(KnowledgeBaseError):
     http_status = 409
 

@@ -86,3 +86,22 @@ ex:B a cbrs:StaticDataComponent ; cbrs:deviceName "Server" ; cbrs:serviceName "M
     mini_kb.registry.register(other)
     mini_kb.registry.deregister(A)
     assert [q.value for q in mini_kb.description("http://example.org/mini#B").qos] == [0.5]
+
+
+def test_a_stored_literal_where_an_iri_is_needed_is_passed_over(mini_kb: KnowledgeBase) -> None:
+    """Data written around cbrs (or before the shapes covered named parts): the listing goes on without
+    it, and reading it names it, instead of a TypeError from every kb.advertisements()."""
+    import pyoxigraph as ox
+
+    from cbrs.kb.errors import NotAnIriError
+    from cbrs.kb.namespaces import GraphName
+
+    count = len(mini_kb.advertisements())
+    turtle = _turtle('"x"').encode()
+    graph = GraphName.SERVICES.node
+    mini_kb.store.add(
+        ox.Quad(t.subject, t.predicate, t.object, graph) for t in ox.parse(turtle, format=ox.RdfFormat.TURTLE)
+    )
+    assert len(mini_kb.advertisements()) == count
+    with pytest.raises(NotAnIriError, match=r'<http://example.org/mini#A> .*"x" stands where an IRI is needed'):
+        mini_kb.description(A)
