@@ -502,7 +502,7 @@ def _describe(d: ServiceDescription) -> str:
             parts = "  parts: " + ", ".join(shorten(c.concept) for c in parameter.tree.children)
         name = f" {parameter.name}" if parameter.name else ""
         lines.append(f"  {parameter.direction:<12} {shorten(parameter.type)}{name}{parts}")
-    for role, statements in (("precondition", d.preconditions), ("effect", d.effects)):
+    for role, statements in (("precondition", d.preconditions), ("effect", d.effects), ("deletes", d.deletes)):
         for s in statements:
             lines.append(f"  {role:<12} ({shorten(s.subject)}, {shorten(s.predicate)}, {shorten(s.object)})")
     if d.area:

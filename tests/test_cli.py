@@ -175,6 +175,13 @@ def test_show_six_tuple(store: str) -> None:
     assert json.loads(out)["service_name"] == "LocateMobileRobot"
 
 
+def test_show_names_the_delete_effects(store: str) -> None:
+    code, out = run("show", "svc:PickUpObject_CytonDualArm01", store=store)
+    assert code == 0
+    assert "effect       (home:PhysicalObject, home:isGraspedBy, home:Gripper)" in out
+    assert "deletes      (home:PhysicalObject, home:isLocated, home:Place)" in out
+
+
 def test_show_any_resource(store: str) -> None:
     code, out = run("show", "home:Cup", store=store)
     assert code == 0

@@ -105,6 +105,19 @@ def test_a_written_requirement_is_ranked(client: FlaskClient) -> None:
     assert lin["method"] == "lin" and lin["candidates"][0]["name"] != semstr["candidates"][0]["name"]  # parts count
 
 
+def test_a_written_requirement_may_ask_for_a_delete_effect(client: FlaskClient) -> None:
+    written = {"deletes": "home:Cup home:isLocated home:Place"}
+    body = client.get("/match.json", query_string=written).get_json()
+    assert body["requirement"]["deletes"] == [[expand(t) for t in ("home:Cup", "home:isLocated", "home:Place")]]
+    best = body["rankings"][0]["candidates"][0]
+    assert best["name"] == "svc:PickUpObject_CytonDualArm01" and best["parts"]["deletes"] > 0.5
+    assert best["degree"] == "HasSubClass"  # the delete effect's pair: the offer deletes it of any object
+    page = client.get("/match", query_string=written).text
+    assert "<dt>delete effects</dt>" in page and 'name="deletes"' in page
+    bad = client.get("/match.json", query_string={"deletes": "home:Cup home:isLocated"})
+    assert bad.status_code == 400 and "subject predicate object" in bad.get_json()["fields"]["deletes"]
+
+
 @pytest.mark.parametrize(
     ("query", "field", "says"),
     [

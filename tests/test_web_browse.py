@@ -210,6 +210,14 @@ def test_service_page_carries_the_six_tuple(client: FlaskClient) -> None:
     assert {q["metric"] for q in body["qos"]} >= {expand("cbrs:availability"), expand("cbrs:responseTime")}
 
 
+def test_service_page_shows_the_delete_effects(client: FlaskClient) -> None:
+    page = client.get("/service", query_string={"iri": "svc:PickUpObject_CytonDualArm01"}).text
+    row = page[page.index("delete effects: what stops being true") :]
+    assert "isLocated" in row[: row.index("</tr>")]
+    camera = client.get("/service", query_string={"iri": CAMERA}).text
+    assert "delete effects" not in camera  # shown only where a service states them
+
+
 def test_service_page_of_a_requirement_and_of_something_else(client: FlaskClient) -> None:
     body = get_json(client, "/service.json", iri="req:RobotSelfPosition")
     assert body["role"] == "requirement" and [p["type"] for p in body["outputs"]] == [ROBOT_POSITION]

@@ -25,7 +25,7 @@ WRITTEN_IRI = "urn:cbrs:web:written-requirement"
 DEFAULT_TOP = 10
 MAX_TOP = 50
 CONCEPT_FIELDS = ("inputs", "outputs")
-STATEMENT_FIELDS = ("preconditions", "effects")
+STATEMENT_FIELDS = ("preconditions", "effects", "deletes")
 # Weakest first: a candidate's degree is the weakest degree among its output and effect pairs.
 DEGREE_ORDER = [Degree.FAIL.value, Degree.HAS_SUBCLASS.value, Degree.SUBCLASS_OF.value, Degree.EXACT.value]
 
@@ -136,6 +136,7 @@ def _requirement(form: dict[str, Any], any_matchmaker: Matchmaker, shown: Page) 
         outputs=parameters("output"),
         preconditions=tuple(statements["preconditions"]),
         effects=tuple(statements["effects"]),
+        deletes=tuple(statements["deletes"]),
     )
 
 
@@ -202,6 +203,7 @@ def _requirement_dict(requirement: Requirement) -> dict[str, Any]:
         "outputs": [p.type for p in requirement.outputs],
         "preconditions": [statement(s) for s in requirement.preconditions],
         "effects": [statement(s) for s in requirement.effects],
+        "deletes": [statement(s) for s in requirement.deletes],
     }
 
 
@@ -216,11 +218,13 @@ def _ranking(result: MatchResult, top: int, requirement: Requirement) -> dict[st
 
 
 def _candidate(rank: int, c: Candidate, outputs: set[str]) -> dict[str, Any]:
-    # The logic degree of the whole: the weakest over the requested outputs (not their parts) and effects.
+    # The logic degree of the whole: the weakest over the requested outputs (not their parts), effects and
+    # delete effects.
     degrees = [
         p.degree
         for p in c.pairs
-        if ((p.role == "output" and p.requested in outputs) or p.role == "effect") and p.degree in DEGREE_ORDER
+        if ((p.role == "output" and p.requested in outputs) or p.role in ("effect", "delete effect"))
+        and p.degree in DEGREE_ORDER
     ]
     return {
         "rank": rank,
