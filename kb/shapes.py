@@ -27,6 +27,7 @@ from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass
 from decimal import Decimal
+from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import pyoxigraph as ox
@@ -171,7 +172,47 @@ def _name_the_source(error: InvalidDescriptionError, report: LoadReport) -> None
     if not sources and len(items) == 1:
         sources = [items[0].source]
     if sources:
-        error.args = (f"{sources[0]}: {error.args[0]}",)
+        line = _line_of(sources[0], error.iri)
+        error.args = (f"{sources[0]}{f':{line}' if line else ''}: {error.args[0]}",)
+
+
+_PREFIX_LINE = re.compile(r"""(?:@prefix|PREFIX)\s+([\w.-]*):\s*<([^>]*)>""", re.IGNORECASE)
+_XMLNS = re.compile(r"""xmlns:([\w.-]+)\s*=\s*["']([^"']*)["']""")
+LOCATE_BYTES = 8 * 1024 * 1024
+"""Files up to this size are searched for the line of a refused description; a larger one is named alone."""
+
+
+def _line_of(source: str, iri: str) -> int | None:
+    """The line of the file ``source`` where ``iri`` is first written as a subject (at the start of a
+    line, as Turtle, N-Triples, RDF/XML and JSON-LD put one), else first written at all; None when the
+    file cannot be read or never spells it (an OWL-S service's description is made, not written)."""
+    path = Path(source)
+    try:
+        if not path.is_file() or path.stat().st_size > LOCATE_BYTES:
+            return None
+        text = path.read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        return None
+    cut = max(iri.rfind("#"), iri.rfind("/"))
+    namespace, local = iri[: cut + 1], iri[cut + 1 :]
+    spellings = [re.escape(f"<{iri}>"), re.escape(f'"{iri}"')]
+    if local:
+        prefixes = {p for p, ns in (*_PREFIX_LINE.findall(text), *_XMLNS.findall(text)) if ns == namespace}
+        spellings += [rf"(?<![\w.:-]){re.escape(p)}:{re.escape(local)}(?![\w.-])" for p in prefixes]
+        spellings += [rf'rdf:(?:about|ID)\s*=\s*["\']#?{re.escape(local)}["\']']
+    mention = re.compile("|".join(spellings))
+    first = None
+    for number, line in enumerate(text.splitlines(), start=1):
+        found = mention.search(line)
+        if found is None:
+            continue
+        before = line[: found.start()].strip()
+        if before in ("", "<rdf:Description", "{", '{"@id":', '"@id":') or before.endswith(
+            ("<rdf:Description", '"@id":')
+        ):
+            return number
+        first = first or number
+    return first
 
 
 def _check_with_context(store: Store, quads: list[ox.Quad], context: list[ox.Quad]) -> None:

@@ -8,7 +8,7 @@ from pathlib import Path
 import pyoxigraph as ox
 import pytest
 
-from cbrs.kb import KnowledgeBase
+from cbrs.kb import InvalidDescriptionError, KnowledgeBase
 from cbrs.kb.loader import expand_paths
 from cbrs.kb.namespaces import GENID, GraphName
 
@@ -63,3 +63,51 @@ def test_a_folder_s_stray_json_is_passed_over(tmp_path: Path) -> None:
     (tmp_path / "shelf.json").write_bytes(_write(tmp_path, ".jsonld").read_bytes())
     assert [p.name for p in expand_paths([tmp_path])] == ["shelf.json", "shelf.jsonld", "shelf.ttl"]
     assert expand_paths([tmp_path / "config.json"]) == [tmp_path / "config.json"]  # named: read as given
+
+
+BROKEN = """@prefix cbrs: <https://w3id.org/cbrs/core#> .
+@prefix ex: <https://example.org/lab#> .
+
+ex:Fine a cbrs:StaticDataComponent ; cbrs:deviceName "Server" ; cbrs:serviceName "Map" ;
+    cbrs:hasOWLSModel [ cbrs:hasOutput [ cbrs:parameterType ex:Map ] ] .
+# ex:Cam is the one at fault
+ex:Cam a cbrs:DynamicPerceptionComponent ;
+    cbrs:deviceName "Cam" ; cbrs:serviceName "Detect" ;
+    cbrs:hasQoSModel [ cbrs:responseTime "fast" ] ;
+    cbrs:hasOWLSModel [ cbrs:hasOutput [ cbrs:parameterType ex:Location ] ] .
+"""
+
+
+@pytest.mark.parametrize(
+    ("suffix", "rdf_format"),
+    [
+        (".ttl", None),
+        (".nt", ox.RdfFormat.N_TRIPLES),
+        (".rdf", ox.RdfFormat.RDF_XML),
+        (".jsonld", ox.RdfFormat.JSON_LD),
+    ],
+)
+def test_a_refused_description_is_named_with_its_file_and_line(
+    tmp_path: Path, suffix: str, rdf_format: ox.RdfFormat | None
+) -> None:
+    path = tmp_path / f"lab{suffix}"
+    if rdf_format is None:
+        path.write_text(BROKEN, encoding="utf-8")
+    else:
+        data = ox.serialize(list(ox.parse(BROKEN.encode(), format=ox.RdfFormat.TURTLE)), format=rdf_format)
+        assert data is not None
+        path.write_bytes(data)
+    lines = path.read_text(encoding="utf-8").splitlines()
+    kb = KnowledgeBase.open(":memory:")
+    with pytest.raises(InvalidDescriptionError) as caught:
+        kb.load([path])
+    where, _, rest = str(caught.value).partition(": <https://example.org/lab#Cam> is not a valid")
+    assert rest and where.startswith(f"{path}:")
+    line = lines[int(where.rsplit(":", 1)[1]) - 1].strip()
+    subject = {
+        ".ttl": "ex:Cam a cbrs:DynamicPerceptionComponent ;",
+        ".nt": "<https://example.org/lab#Cam> ",
+        ".rdf": "<DynamicPerceptionComponent ",
+        ".jsonld": "[{",
+    }[suffix]
+    assert line.startswith(subject) and ("Cam" in line)

@@ -38,7 +38,7 @@ def test_a_changed_file_loaded_again_is_refused(mini_kb: KnowledgeBase, tmp_path
     with pytest.raises(InvalidDescriptionError) as caught:
         mini_kb.load([path], graph=graph)
     message = str(caught.value)
-    assert message.startswith(f"{path}: <http://example.org/mini#")
+    assert message.startswith(f"{path}:3: <http://example.org/mini#")
     assert "a description has one OWLS model" in message
     assert "is in the store already and a load adds to it" in message and "register --update" in message
     assert mini_kb.store.dump() == before
