@@ -112,6 +112,20 @@ class SkillFailed(Exception):
     """A skill reported failure; the message is its reason."""
 
 
+class CannotLoadError(KnowledgeBaseError):
+    """A step would hand an object the task gives over onto the mobile base's platform, and no arm can
+    (the object out of every arm's reach, the docking pose behind the arms, a grasp no arm can hold over
+    the platform): the run is refused before anything moves."""
+
+    http_status = 422
+
+    def __init__(self, component: str, thing: str, reason: str) -> None:
+        self.component = component
+        self.thing = thing
+        self.reason = reason
+        super().__init__(f"{local_name(component)} cannot load the {local_name(thing)} onto the platform: {reason}")
+
+
 class OutOfReachError(KnowledgeBaseError):
     """A thing a task gives to a robot's arms is beyond the reach of every one of them, by the map: the
     run is refused before anything moves. ``arms`` holds (arm IRI, mount x, y, reach, distance)."""
@@ -393,8 +407,24 @@ def hand_over(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[s
     both reach (:func:`_relay`) and the second loads it."""
     estimate = decode(inputs["objectPosition"], ObjectEstimate)
     model = _model(ctx, inputs["graspPose"])
-    x, y, _ = estimate.position
     base = ctx.world.base_pose()  # the base parks against the place's docking mark, which the robot knows
+    side, giver, spot = _who_loads(ctx, estimate, model, base)
+    if giver is not None and spot is not None:
+        estimate = _relay(ctx, device, estimate, model, giver, side, spot)
+    ctx.last_arm, ctx.focus = side, model.name
+    reach = ctx.world.arm_specs[side].reach
+    _check(skills.hand_over_onto_platform(ctx.world, estimate, base, side, model, reach))
+    return {}
+
+
+def _who_loads(
+    ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, base: Pose2D
+) -> tuple[ArmSide, ArmSide | None, Region | None]:
+    """Which arm loads the object onto the platform of the base parked at ``base``, and, when another
+    arm must first pass it, that arm and the spot where it sets the object down; SkillFailed saying why
+    none can. Asked without moving (inverse kinematics on the private copies): by the hand-over, and
+    before a run, by the plan's check (:meth:`SimEnvironment.given`)."""
+    x, y, _ = estimate.position
     takers = _reaching(ctx, x, y)
     loaders = _reaching(ctx, base.x, base.y)
     if not takers:
@@ -406,14 +436,20 @@ def hand_over(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[s
         )
     both = [side for side in takers if side in loaders]
     if both:
-        side = both[0]
-    else:
-        estimate = _relay(ctx, device, estimate, model, takers[0], loaders[0])
-        side = loaders[0]
-    ctx.last_arm, ctx.focus = side, model.name
-    reach = ctx.world.arm_specs[side].reach
-    _check(skills.hand_over_onto_platform(ctx.world, estimate, base, side, model, reach))
-    return {}
+        refused = skills.can_load(ctx.world, estimate, base, both[0], model)
+        if refused:
+            raise SkillFailed(refused)
+        return both[0], None, None
+    giver, taker = takers[0], loaders[0]
+    spot = _relay_spot(ctx, estimate, model, giver, taker)
+    cx, cy, _ = spot.center
+    refused = skills.can_load(ctx.world, replace(estimate, x=cx, y=cy), base, taker, model)
+    if refused:
+        raise SkillFailed(
+            f"only the {giver.value} arm reaches the {model.name} and only the {taker.value} arm the platform, "
+            f"and {refused}"
+        )
+    return taker, giver, spot
 
 
 RELAY_MARGIN = 0.05
@@ -430,20 +466,17 @@ milliseconds) before passing is given up."""
 
 
 def _relay(
-    ctx: SimContext, device: str, estimate: ObjectEstimate, model: ObjectModel, giver: ArmSide, taker: ArmSide
+    ctx: SimContext,
+    device: str,
+    estimate: ObjectEstimate,
+    model: ObjectModel,
+    giver: ArmSide,
+    taker: ArmSide,
+    spot: Region,
 ) -> ObjectEstimate:
-    """Pass an object from the arm that reaches it to the other arm: the first puts it down on the same
-    surface where both reach, and the object is found again there. Whether the other arm can then
-    load it onto the platform is asked first, so that nothing is left half done."""
+    """Pass an object from the arm that reaches it to the other arm: the first puts it down on ``spot``,
+    on the same surface, where both reach, and the object is found again there."""
     world = ctx.world
-    spot = _relay_spot(ctx, estimate, model, giver, taker)
-    cx, cy, _ = spot.center
-    refused = skills.can_load(world, replace(estimate, x=cx, y=cy), world.base_pose(), taker, model)
-    if refused:
-        raise SkillFailed(
-            f"only the {giver.value} arm reaches the {model.name} and only the {taker.value} arm the platform, "
-            f"and {refused}"
-        )
     spec = world.arm_specs[giver]
     grasp = compute_grasp_pose(model, estimate.position, estimate.yaw, spec.mount, spec.yaw)
     ctx.last_arm = giver
@@ -847,7 +880,33 @@ class SimEnvironment:
                         values[source.name] = designator(iri, parameter.type)
         self.context.designated = frozenset(str(value["@id"]) for value in values.values())
         self._check_reach(plan, values)
+        self._check_loading(plan, values)
         return values
+
+    def _check_loading(self, plan: Plan, values: Mapping[str, Any]) -> None:
+        """Refuse a plan that hands an object the task gives over onto the base's platform when no arm
+        can load it there (by the map: the object where it is believed to be, the base at the docking
+        pose of what it stands on; the same decision the hand-over makes), before the base drives off."""
+        steps = {step.index: step for step in plan.steps}
+        smap = self.world.map
+        for step in plan.steps:
+            if step.action != PREFIXES["act"] + "HandingOverOntoPlatform":
+                continue
+            for name in sorted(_given_to(step, steps)):
+                value = values.get(name)
+                obj = smap.objects.get(str(value["@id"])) if isinstance(value, dict) and "@id" in value else None
+                support = smap.things.get(obj.support or "") if obj is not None else None
+                if obj is None or support is None or support.dock is None:
+                    continue
+                believed = self.belief.position(obj.name)
+                centre = believed or (obj.start.x, obj.start.y, support.box.max_z + obj.size[2] / 2)
+                estimate = ObjectEstimate(
+                    centre[0], centre[1], centre[2], obj.start.yaw, obj.size, obj.colour, "map", 0.0, 0
+                )
+                try:
+                    _who_loads(self.context, estimate, Manipulation.of(obj).model, _dock(support))
+                except SkillFailed as refused:
+                    raise CannotLoadError(step.component, obj.iri, str(refused)) from None
 
     def _check_reach(self, plan: Plan, values: Mapping[str, Any]) -> None:
         """Refuse a plan whose arm steps work on a thing the task gives that no arm of their robot

@@ -13,7 +13,7 @@ from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
 from cbrs.sim.arms import ArmSide
-from cbrs.sim.components import SimEnvironment
+from cbrs.sim.components import CannotLoadError, SimEnvironment
 from cbrs.sim.world import open_world
 
 TASKS = Path(__file__).parent / "data" / "tasks"
@@ -76,18 +76,22 @@ def test_an_object_only_the_left_arm_reaches_is_passed_to_the_right_arm(tmp_path
     assert (WORLD + "Pencil1", HOME + "isWith", WORLD + "Person") in facts
 
 
-def test_a_cup_that_cannot_be_set_down_on_the_platform_is_not_lifted(tmp_path: Path) -> None:
-    """The left arm reaches the cup and only the right arm the platform, which it cannot load by the
-    cup's side grasp: the step fails saying so, before either arm moves the cup."""
+def test_a_cup_that_cannot_be_set_down_on_the_platform_is_refused_before_anything_moves(tmp_path: Path) -> None:
+    """The left arm reaches the cup and only the right arm the platform at the table's docking pose,
+    which it cannot load by the cup's side grasp: the run is refused before the base drives off, with
+    the store as it was."""
     kb = knowledge(tmp_path, ("requirements", FETCH_MY_CUP))
+    before = set(kb.store.quads())
     with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
-        cup = world.pose("Cup").position
-        result = run_task(kb, "FetchMyCup", SimEnvironment(world, kb), composer=Composer(kb), max_replans=0)
+        cup, base = world.pose("Cup").position, world.base_pose()
+        with pytest.raises(CannotLoadError) as refused:
+            run_task(kb, "FetchMyCup", SimEnvironment(world, kb), composer=Composer(kb))
         assert world.pose("Cup").position[:2] == pytest.approx(cup[:2], abs=0.005)
-        assert all(arm.held is None for arm in world.arms.values())
-    assert not result.succeeded and result.report is not None
-    assert "only the left arm reaches the Cup and only the right arm the platform" in result.report.reason
-    assert "cannot hold the Cup by its side grasp over the platform" in result.report.reason
+        assert world.base_pose().distance_to(base.x, base.y) < 0.01
+    assert refused.value.thing == WORLD + "Cup"
+    assert "only the left arm reaches the Cup and only the right arm the platform" in str(refused.value)
+    assert "cannot hold the Cup by its side grasp over the platform" in str(refused.value)
+    assert set(kb.store.quads()) == before
 
 
 def test_a_place_only_the_other_arm_reaches_gets_the_object_passed_to_that_arm(tmp_path: Path) -> None:
