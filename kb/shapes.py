@@ -126,13 +126,13 @@ def check_loaded(store: Store, report: LoadReport) -> None:
     owls = [q for item in report.files if item.owls is not None for q in item.quads]
     plain = [q for item in (*report.files, *report.imports) if item.owls is None for q in item.quads]
     context = plain + owls
-    stored_plain, stored_owls = _stored(store, plain), _stored(store, owls)
+    stored_plain = _stored(store, plain)  # an OWL-S service the store holds already: the loader refuses it sooner
     try:
         if _closures(plain):
             _check_with_context(store, plain + stored_plain, context)
-        check_descriptions(store, owls + stored_owls, terms=False)
+        check_descriptions(store, owls, terms=False)
     except DescriptionShapeError as error:
-        if error.iri in {q.subject.value for q in (*stored_plain, *stored_owls) if isinstance(q.subject, ox.NamedNode)}:
+        if error.iri in {q.subject.value for q in stored_plain if isinstance(q.subject, ox.NamedNode)}:
             error.args = (
                 f"{error.args[0]}; <{error.iri}> is in the store already and a load adds to it: replace an "
                 "advertisement with cbrs register --update (kb.registry.update), or remove the description first",
