@@ -4,6 +4,7 @@ advertisements, each as one transaction on the services graph."""
 from __future__ import annotations
 
 from collections.abc import Iterable
+from pathlib import Path
 
 import pyoxigraph as ox
 
@@ -104,7 +105,7 @@ class ComponentRegistry:
     def _parse(self, turtle: str | bytes, source: str) -> tuple[list[ox.Quad], list[str]]:
         raw = turtle.encode("utf-8") if isinstance(turtle, str) else turtle
         rdf_format = registration_format(source, raw)  # Turtle, unless the file's name or XML head says otherwise
-        parsed = parse_bytes(raw, source, rdf_format, graph=GraphName.SERVICES, base_iri=BASE)
+        parsed = parse_bytes(raw, source, rdf_format, graph=GraphName.SERVICES, base_iri=_base(source))
         if is_owls(parsed.quads):
             raise InvalidDescriptionError(
                 source,
@@ -130,6 +131,14 @@ class ComponentRegistry:
                 raise InvalidDescriptionError(iri, problems)
         check_descriptions(self._store, parsed.quads)  # SHACL shapes and declared terms (kb/shapes.py)
         return parsed.quads, iris
+
+
+def _base(source: str) -> str:
+    """Relative IRIs (``<#Cam>``) of a file resolve against the file, as ``cbrs load`` resolves them, so
+    that registering and loading one file name the same things; those of a text sent without a file name
+    (``<registration>``) against cbrs's base."""
+    path = Path(source)
+    return path.resolve().as_uri() if not source.startswith("<") and path.is_file() else BASE
 
 
 def _no_advertisement(quads: list[ox.Quad]) -> str:

@@ -270,3 +270,17 @@ def test_the_shapes_see_the_terms_rdflib_s_parser_would_give() -> None:
     triples = list(ox.parse(text.encode(), format=ox.RdfFormat.TURTLE))
     parsed = rdflib.Graph().parse(data=ox.serialize(triples, format=ox.RdfFormat.N_TRIPLES), format="nt")
     assert isomorphic(_rdflib_graph(triples), parsed)
+
+
+def test_a_file_s_relative_iris_are_the_ones_cbrs_load_gives(mini_kb: KnowledgeBase, tmp_path: Path) -> None:
+    """<#Cam> in a registered file is the file's, as cbrs load reads it, not <https://w3id.org/cbrs/#Cam>
+    in cbrs's own namespace (where every lab's <#Cam> would be one thing)."""
+    path = tmp_path / "cam.ttl"
+    path.write_text(_camera().replace("ex:DetectDoor_LabCam01", "<#Cam>"), encoding="utf-8")
+    assert mini_kb.registry.register(path.read_bytes(), str(path)) == [path.resolve().as_uri() + "#Cam"]
+    before = mini_kb.store.dump()
+    mini_kb.load([path])  # the same file, the same IRIs: nothing new
+    assert mini_kb.store.dump() == before
+    assert mini_kb.registry.register(_camera().replace("ex:DetectDoor_LabCam01", "<#Cam>")) == [
+        "https://w3id.org/cbrs/#Cam"  # a text sent without a file name: cbrs's base, as before
+    ]
