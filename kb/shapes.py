@@ -129,7 +129,7 @@ def check_loaded(store: Store, report: LoadReport) -> None:
     stored_plain = _stored(store, plain)  # an OWL-S service the store holds already: the loader refuses it sooner
     try:
         if _closures(plain):
-            _check_with_context(store, plain + stored_plain, context)
+            _check_with_context(store, _as_stored(plain) + stored_plain if stored_plain else plain, context)
         check_descriptions(store, owls, terms=False)
     except DescriptionShapeError as error:
         if error.iri in {q.subject.value for q in stored_plain if isinstance(q.subject, ox.NamedNode)}:
@@ -162,6 +162,14 @@ def _stored(store: Store, quads: list[ox.Quad]) -> list[ox.Quad]:
 
             found += closure([ox.NamedNode(root)], quads_of, _is_inner, parts=True)
     return found
+
+
+def _as_stored(quads: list[ox.Quad]) -> list[ox.Quad]:
+    """``quads`` with their literals in the form the store keeps (``"0.0"^^xsd:decimal`` is stored as
+    ``"0"``): beside stored quads, the same value in two spellings would count as two values."""
+    memory = ox.Store()
+    memory.extend(quads)
+    return list(memory)
 
 
 def _name_the_source(error: InvalidDescriptionError, report: LoadReport) -> None:

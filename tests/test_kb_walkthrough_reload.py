@@ -49,3 +49,26 @@ def test_a_description_the_store_does_not_hold_loads(mini_kb: KnowledgeBase, tmp
     path.write_text(HEAD + CAMERA.format(time="0.2"), encoding="utf-8")
     mini_kb.load([path])
     assert [q.value for q in mini_kb.description("http://example.org/mini#Cam").qos] == [0.2]
+
+
+def test_the_same_file_with_non_canonical_numbers_loads_again(mini_kb: KnowledgeBase, tmp_path: Path) -> None:
+    """The store keeps "0.50"^^xsd:decimal as "0.5": read back beside the file's spelling, one value must
+    not count as two (a reload of the bundled services.ttl into a seeded store was refused so)."""
+    path = tmp_path / "lab.ttl"
+    sea = "cbrs:hasSEAModel [ cbrs:minX 0.0 ; cbrs:maxX 10.00 ; cbrs:minY 0.0 ; cbrs:maxY 5.0 ] ;"
+    path.write_text(
+        HEAD + CAMERA.format(time="0.50").replace("cbrs:hasQoSModel", sea + " cbrs:hasQoSModel"), encoding="utf-8"
+    )
+    mini_kb.load([path])
+    before = mini_kb.store.dump()
+    mini_kb.load([path])
+    assert mini_kb.store.dump() == before
+
+
+def test_the_bundled_services_load_again_into_a_seeded_store() -> None:
+    from cbrs.kb.resources import ontology_dir
+
+    kb = KnowledgeBase.open(":memory:")
+    before = kb.store.dump()
+    kb.load([ontology_dir() / "services.ttl", ontology_dir() / "requirements.ttl"])
+    assert kb.store.dump() == before
