@@ -34,7 +34,7 @@ from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap, Thing, designate, local_name
 from cbrs.sim import predicates as pred
 from cbrs.sim import skills
-from cbrs.sim.arms import ArmSide
+from cbrs.sim.arms import GRIPPER_OPEN, ArmSide
 from cbrs.sim.errors import SimulationError
 from cbrs.sim.geometry import Pose2D, Region
 from cbrs.sim.grasping import GraspPose, ObjectModel, compute_grasp_pose
@@ -76,6 +76,8 @@ LOCALISATION_TOLERANCE = 0.10
 distance (m)."""
 ARM_TIE = 0.01
 """Two arms whose mounts are within 1 cm as far from a target reach it equally well."""
+SETTLE_DISTANCE = 0.03
+"""Before a re-plan, an arm lets go of what it holds only with its hand within 3 cm of where it took it."""
 
 
 @dataclass
@@ -93,6 +95,7 @@ class SimContext:
     inputs: Mapping[str, Any] = field(default_factory=dict)  # what the running component was given
     belief: PerceivedWorld | None = None  # where the robots believe things are
     designated: frozenset[str] = frozenset()  # the things the running task's inputs name (IRIs)
+    acted: bool = False  # a component has run in this world (the checks before a run are done)
 
     @property
     def map(self) -> SemanticMap:
@@ -171,6 +174,7 @@ class SimComponent(Component):
 
     def update(self) -> Status:
         assert self._context is not None
+        self._context.acted = True
         try:
             self.outputs = self._work(self._context, self._inputs, self._device)
         except (SimulationError, SkillFailed) as error:
@@ -855,9 +859,16 @@ class SimEnvironment:
             x, y, z = grasp.position  # where the hand closed on it, on the surface it stood on
             surface = z - grasp.bottom_offset
             spot = Region("TakenFrom", x - 0.02, x + 0.02, y - 0.02, y + 0.02, surface, surface + 0.3)
-            for move in (skills.carry_object, skills.put_down_object):
-                if not move(self.world, side, spot).succeeded:
-                    break
+            skills.carry_object(self.world, side, spot)  # its verdict may fail on an object askew in the hand
+            hand = arm.ee_pose().position
+            if math.hypot(hand[0] - x, hand[1] - y) > SETTLE_DISTANCE:
+                continue  # not back over where it was taken: better held than dropped elsewhere
+            skills.put_down_object(self.world, side, spot)
+            if arm.held is not None:  # lowering it failed: let go just above the surface it came from
+                arm.detach()
+                arm.set_gripper(GRIPPER_OPEN)
+                self.world.step(skills.SETTLE_TIME)
+                arm.home()
 
     def perceive(self) -> None:
         """Look at everything with every working camera (before a plan, and before a re-plan)."""
@@ -879,8 +890,9 @@ class SimEnvironment:
                         iri = designate(self.kb, parameter.type, prefer=requirement.requested_by)
                         values[source.name] = designator(iri, parameter.type)
         self.context.designated = frozenset(str(value["@id"]) for value in values.values())
-        self._check_reach(plan, values)
-        self._check_loading(plan, values)
+        if not self.context.acted:  # checked before anything moved; a re-plan fails by its steps
+            self._check_reach(plan, values)
+            self._check_loading(plan, values)
         return values
 
     def _check_loading(self, plan: Plan, values: Mapping[str, Any]) -> None:
