@@ -117,6 +117,11 @@ class Unsatisfied:
         return self._remedy()
 
     def _remedy(self) -> str:
+        if self.consumer == GOAL:  # the task states nothing to plan towards
+            return (
+                "state what the task wants as an output (cbrs:hasOutput) or an effect (cbrs:hasEffect): "
+                "composition plans towards those; delete effects alone are no goal it plans for"
+            )
         if self.need.startswith("precondition "):
             statement = self.need.removeprefix("precondition ")
             return (

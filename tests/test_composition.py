@@ -154,3 +154,21 @@ def test_a_task_names_a_requirement_never_an_advertisement() -> None:
     with pytest.raises(UnknownTaskError) as error:
         composer.task(EX + "S1")
     assert error.value.known == ("Req",)
+
+
+def test_a_task_with_nothing_to_plan_towards_says_what_to_state(bundled_kb: KnowledgeBase) -> None:
+    """A task that wants only something to stop being true has no goal composition plans for: the
+    reason says so and what to state instead, not to register a component for 'an output or effect'."""
+    from cbrs.kb import Requirement, Statement
+
+    home = "https://w3id.org/cbrs/home#"
+    only_deletes = Requirement(
+        iri=EX + "PenOffItsPlace",
+        types=(),
+        deletes=(Statement(home + "Pen", home + "isLocated", home + "Place"),),
+    )
+    result = Composer(bundled_kb).compose(only_deletes)
+    assert result.status is PlanStatus.UNSOLVABLE
+    (reason,) = [u.text() for u in result.unsatisfied]
+    assert "cbrs:hasEffect" in reason and "delete effects alone" in reason
+    assert "register a component" not in reason
