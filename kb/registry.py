@@ -55,10 +55,16 @@ class ComponentRegistry:
         return iris
 
     def deregister(self, iri: str) -> int:
-        """Remove one advertisement's description; returns the number of triples removed."""
+        """Remove one advertisement's description, or a requirement's from the requirements graph (which
+        has no registry of its own: an edited requirement file is loaded again after this); returns the
+        number of triples removed."""
+        graph = self._graph
         if not self.is_registered(iri):
-            raise self._not_found(iri)
-        old = self.description_quads(iri)
+            requirement = (ox.NamedNode(iri), ox.NamedNode(RDF + "type"), ox.NamedNode(CBRS.Requirement))
+            graph = GraphName.REQUIREMENTS.node
+            if next(iter(self._store.quads(*requirement, graph)), None) is None:
+                raise self._not_found(iri)
+        old = self.description_quads(iri, graph)
         before = self._standard_terms.begin()
         self._store.replace(old, [])
         self._standard_terms.changed(before, old, [])
@@ -78,16 +84,17 @@ class ComponentRegistry:
         node = ox.NamedNode(iri)
         return any(True for _ in self._store.quads(node, ox.NamedNode(RDF + "type"), None, self._graph))
 
-    def description_quads(self, iri: str) -> list[ox.Quad]:
-        """The advertisement's triples and, recursively, those of its parts: skolemised nodes, and models,
-        parameters, conditions and ports given IRIs of their own. A named part that something outside the
-        description points at too is shared, and stays with its triples."""
+    def description_quads(self, iri: str, graph: ox.NamedNode | None = None) -> list[ox.Quad]:
+        """The advertisement's triples (in the services graph, or ``graph``) and, recursively, those of
+        its parts: skolemised nodes, and models, parameters, conditions and ports given IRIs of their own.
+        A named part that something outside the description points at too is shared, and stays."""
         root = ox.NamedNode(iri)
+        graph = graph or self._graph
 
         def quads_of(
             node: ox.NamedNode | ox.BlankNode | ox.Triple, skip: frozenset[object] = frozenset()
         ) -> list[ox.Quad]:
-            return [] if node in skip else list(self._store.quads(node, None, None, self._graph))  # type: ignore[arg-type]
+            return [] if node in skip else list(self._store.quads(node, None, None, graph))  # type: ignore[arg-type]
 
         found = closure([root], quads_of, parts=True)
         own = {q.subject for q in found}
@@ -96,7 +103,7 @@ class ComponentRegistry:
             for node in own
             if node != root
             and not is_skolem(node)
-            and any(q.subject not in own for q in self._store.quads(None, None, node, self._graph))  # type: ignore[arg-type]
+            and any(q.subject not in own for q in self._store.quads(None, None, node, graph))  # type: ignore[arg-type]
         )
         if not shared:
             return found

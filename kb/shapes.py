@@ -135,7 +135,8 @@ def check_loaded(store: Store, report: LoadReport) -> None:
         if error.iri in {q.subject.value for q in stored_plain if isinstance(q.subject, ox.NamedNode)}:
             error.args = (
                 f"{error.args[0]}; <{error.iri}> is in the store already and a load adds to it: replace an "
-                "advertisement with cbrs register --update (kb.registry.update), or remove the description first",
+                "advertisement with cbrs register --update (kb.registry.update), or remove the description first "
+                "(cbrs deregister IRI, which removes a requirement too) and load the file again",
             )
         _name_the_source(error, report)
         raise

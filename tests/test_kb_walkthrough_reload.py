@@ -72,3 +72,19 @@ def test_the_bundled_services_load_again_into_a_seeded_store() -> None:
     before = kb.store.dump()
     kb.load([ontology_dir() / "services.ttl", ontology_dir() / "requirements.ttl"])
     assert kb.store.dump() == before
+
+
+def test_an_edited_requirement_is_deregistered_then_loaded_again(mini_kb: KnowledgeBase, tmp_path: Path) -> None:
+    """Requirements have no registry of their own; deregister removes one from the requirements graph,
+    so the way the refusal names (remove it, load again) works for them too."""
+    path = tmp_path / "need.ttl"
+    path.write_text(HEAD + NEED.format(time="0.2"), encoding="utf-8")
+    before = mini_kb.store.dump()
+    mini_kb.load([path], graph="requirements")
+    path.write_text(HEAD + NEED.format(time="0.3"), encoding="utf-8")
+    with pytest.raises(InvalidDescriptionError, match="cbrs deregister IRI, which removes a requirement too"):
+        mini_kb.load([path], graph="requirements")
+    assert mini_kb.registry.deregister("http://example.org/mini#Need") == 8
+    assert mini_kb.store.dump() == before
+    mini_kb.load([path], graph="requirements")
+    assert [q.value for q in mini_kb.description("http://example.org/mini#Need").qos] == [0.3]
