@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from cbrs.kb import KnowledgeBase
+from cbrs.kb import KnowledgeBase, RdfParseError
 from cbrs.kb.catalog import Catalogue
 from cbrs.kb.namespaces import RDF
 
@@ -118,3 +118,19 @@ def test_process_only_and_profile_only_iopes(loaded: KnowledgeBase) -> None:
     assert _conditions(loaded, BASE + "find_door.owls#FindDoor") == {
         ("precondition", ROBOTS + "Door", ROBOTS + "isLocatedIn", ROBOTS + "Position")
     }
+
+
+def test_a_broken_imported_ontology_loads_nothing(tmp_path: Path) -> None:
+    """All or nothing, imports included: the catalogue maps the import to a file cut short."""
+    (tmp_path / "charge.owls").write_text(PROCESS_ONLY, encoding="utf-8")
+    ontology = tmp_path / "ontology"
+    ontology.mkdir()
+    (ontology / "places.owl").write_bytes((OWLS / "ontology" / "places.owl").read_bytes())
+    whole = (OWLS / "ontology" / "robots.owl").read_text(encoding="utf-8")
+    (ontology / "robots.owl").write_text(whole[: whole.index("</rdf:RDF>")], encoding="utf-8")
+    kb = KnowledgeBase.open(":memory:")
+    before = kb.store.dump()
+    with pytest.raises(RdfParseError) as caught:
+        kb.load([tmp_path / "charge.owls"], catalogue=Catalogue.open(ontology))
+    assert str(caught.value).startswith(str(ontology / "robots.owl"))
+    assert kb.store.dump() == before
