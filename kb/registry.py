@@ -13,7 +13,7 @@ from cbrs.kb.errors import AlreadyRegisteredError, InvalidDescriptionError, NotF
 from cbrs.kb.loader import parse_bytes, registration_format
 from cbrs.kb.namespaces import BASE, RDF, RDFS, GraphName, shorten
 from cbrs.kb.owls import is_owls
-from cbrs.kb.shapes import check_descriptions
+from cbrs.kb.shapes import check_descriptions, line_of
 from cbrs.kb.skolem import closure, is_skolem
 from cbrs.kb.standard_terms import StandardTerms
 from cbrs.kb.store import Store
@@ -110,6 +110,15 @@ class ComponentRegistry:
         return [q for q in closure([root], lambda node: quads_of(node, shared), parts=True) if q.subject not in shared]
 
     def _parse(self, turtle: str | bytes, source: str) -> tuple[list[ox.Quad], list[str]]:
+        try:
+            return self._parse_checked(turtle, source)
+        except InvalidDescriptionError as error:
+            if error.iri != source and not source.startswith("<") and Path(source).is_file():
+                line = line_of(source, error.iri)  # a file of many descriptions: where this one is
+                error.args = (f"{source}{f':{line}' if line else ''}: {error.args[0]}",)
+            raise
+
+    def _parse_checked(self, turtle: str | bytes, source: str) -> tuple[list[ox.Quad], list[str]]:
         raw = turtle.encode("utf-8") if isinstance(turtle, str) else turtle
         rdf_format = registration_format(source, raw)  # Turtle, unless the file's name or XML head says otherwise
         parsed = parse_bytes(raw, source, rdf_format, graph=GraphName.SERVICES, base_iri=_base(source))

@@ -181,7 +181,7 @@ def _name_the_source(error: InvalidDescriptionError, report: LoadReport) -> None
     if not sources and len(items) == 1:
         sources = [items[0].source]
     if sources:
-        line = _line_of(sources[0], error.iri)
+        line = line_of(sources[0], error.iri)
         error.args = (f"{sources[0]}{f':{line}' if line else ''}: {error.args[0]}",)
 
 
@@ -191,7 +191,7 @@ LOCATE_BYTES = 8 * 1024 * 1024
 """Files up to this size are searched for the line of a refused description; a larger one is named alone."""
 
 
-def _line_of(source: str, iri: str) -> int | None:
+def line_of(source: str, iri: str) -> int | None:
     """The line of the file ``source`` where ``iri`` is first written as a subject (at the start of a
     line, as Turtle, N-Triples, RDF/XML and JSON-LD put one), else first written at all; None when the
     file cannot be read or never spells it (an OWL-S service's description is made, not written)."""

@@ -284,3 +284,15 @@ def test_a_file_s_relative_iris_are_the_ones_cbrs_load_gives(mini_kb: KnowledgeB
     assert mini_kb.registry.register(_camera().replace("ex:DetectDoor_LabCam01", "<#Cam>")) == [
         "https://w3id.org/cbrs/#Cam"  # a text sent without a file name: cbrs's base, as before
     ]
+
+
+def test_a_registered_file_s_error_names_the_line(mini_kb: KnowledgeBase, tmp_path: Path) -> None:
+    """A file of many descriptions: the refusal says where the one at fault is written."""
+    fine = _camera().split("\n", 3)[3]
+    bad = fine.replace("DetectDoor_LabCam01", "Broken").replace("cbrs:responseTime 0.2", 'cbrs:responseTime "soon"')
+    path = tmp_path / "lab.ttl"
+    text = HEAD + "\n".join(fine.replace("DetectDoor_LabCam01", f"Cam{i}") for i in range(20)) + bad
+    path.write_text(text, encoding="utf-8")
+    line = text.splitlines().index("ex:Broken a cbrs:DynamicPerceptionComponent ;") + 1
+    message = _refused(mini_kb, path.read_bytes(), str(path))
+    assert message.startswith(f"{path}:{line}: <{EX}Broken> is not a valid service description: ")

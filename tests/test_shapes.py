@@ -128,7 +128,9 @@ def test_cli_register_names_the_term_meant(tmp_path: Path) -> None:
     path.write_text(bad(("home:MarkerColour", "home:MarkerColor")), encoding="utf-8")
     result = CliRunner().invoke(cli, ["--store", ":memory:", "register", str(path)])
     assert result.exit_code == 1
-    assert result.output.startswith("Error: <https://w3id.org/cbrs/service#LocateMobileRobot_CeilingCamera03>")
+    assert result.output.startswith(
+        f"Error: {path}:3: <https://w3id.org/cbrs/service#LocateMobileRobot_CeilingCamera03>"
+    )
     assert "did you mean home:MarkerColour?" in result.output and result.output.count("\n") == 1
 
 
@@ -239,13 +241,14 @@ def test_the_docs_show_one_error_of_each_kind() -> None:
 
 
 @pytest.mark.parametrize("index", range(6))
-def test_the_docs_errors_are_what_cbrs_prints(tmp_path: Path, index: int) -> None:
+def test_the_docs_errors_are_what_cbrs_prints(tmp_path: Path, index: int, monkeypatch: pytest.MonkeyPatch) -> None:
     examples = _doc_examples()
     if index >= len(examples):
         pytest.skip("fewer examples")
     turtle, name, error = examples[index]
     (tmp_path / name).write_text(turtle, encoding="utf-8")
-    result = CliRunner().invoke(cli, ["--store", ":memory:", "register", str(tmp_path / name)])
+    monkeypatch.chdir(tmp_path)  # the file as the docs give it, by its name: the error names it so
+    result = CliRunner().invoke(cli, ["--store", ":memory:", "register", name])
     assert result.exit_code == 1
     assert result.output.strip() == error.strip()
 
