@@ -37,7 +37,7 @@ _LAZY_COMMANDS: dict[str, tuple[str, str, str]] = {
     "match": (
         "cbrs.cli_reasoner",
         "match",
-        "Rank the advertisements against REQUIREMENT (an IRI or prefix:name, e.g. req:RobotSelfPosition).",
+        "Rank the advertisements against REQUIREMENT: an IRI, prefix:name, or a bare name in req: (RobotSelfPosition).",
     ),
     "plan": (
         "cbrs.cli_actions",
