@@ -263,7 +263,7 @@ def query(
     sources = [s for s in (text, query_file, name) if s]
     if len(sources) != 1:
         raise click.UsageError("give exactly one of TEXT, --file or --name")
-    values = dict(_split_binding(b) for b in bindings)
+    values = _bindings(bindings)
     if name:
         result = app.kb.run(name, values)
     else:
@@ -311,7 +311,7 @@ def register(app: App, file: Path, update: bool) -> None:
 @click.argument("iri")
 @pass_app
 def deregister(app: App, iri: str) -> None:
-    """Remove a registered advertisement and the nodes of its description (one transaction)."""
+    """Remove a registered advertisement, or a requirement, and the nodes of its description (one transaction)."""
     removed = app.kb.registry.deregister(parse_iri(iri))
     click.echo(f"deregistered {shorten(parse_iri(iri))} ({removed} triples)")
 
@@ -527,6 +527,19 @@ def _list_queries(app: App) -> None:
         params = ", ".join(f"{p.name}{'*' if p.required else ''}:{p.kind}" for p in q.parameters.values())
         body.append([name, params or "-", q.title])
     click.echo(table(["name", "parameters (* required)", "title"], body))
+
+
+def _bindings(texts: tuple[str, ...]) -> dict[str, str]:
+    """The --bind options by parameter; a parameter bound twice is refused: the query takes one value."""
+    values: dict[str, str] = {}
+    for name, value in map(_split_binding, texts):
+        if name in values and values[name] != value:
+            raise click.BadParameter(
+                f"{name} is bound twice ({values[name]!r} and {value!r}); a named query takes one value for it",
+                param_hint="--bind",
+            )
+        values[name] = value
+    return values
 
 
 def _split_binding(text: str) -> tuple[str, str]:

@@ -73,6 +73,13 @@ def test_named_query_with_binding(store: str) -> None:
     assert "home:RobotPosition" in out and "output" in out
 
 
+def test_a_parameter_bound_twice_is_refused(store: str) -> None:
+    code, out = run("query", "--name", "advertisements", "--bind", "kind=cbrs:A", "--bind", "kind=cbrs:B", store=store)
+    assert code == 2 and "kind is bound twice" in out
+    code, _ = run("query", "--name", "advertisements", "--bind", "kind=cbrs:A", "--bind", "kind=cbrs:A", store=store)
+    assert code == 0  # the same value twice says one thing
+
+
 @pytest.mark.parametrize(
     ("fmt", "expected"),
     [
