@@ -312,8 +312,12 @@ def register(app: App, file: Path, update: bool) -> None:
 @pass_app
 def deregister(app: App, iri: str) -> None:
     """Remove a registered advertisement, or a requirement, and the nodes of its description (one transaction)."""
-    removed = app.kb.registry.deregister(parse_iri(iri))
-    click.echo(f"deregistered {shorten(parse_iri(iri))} ({removed} triples)")
+    full = parse_iri(iri)
+    try:
+        removed = app.kb.registry.deregister(full)
+    except KnowledgeBaseError as error:
+        raise click.ClickException(f"{error}{_prefix_hint(full)}") from error
+    click.echo(f"deregistered {shorten(full)} ({removed} triples)")
 
 
 @cli.command()
@@ -348,11 +352,7 @@ def show(app: App, iri: str, as_json: bool) -> None:
     full = parse_iri(iri)
     kb = app.kb
     if not kb.describes(full):
-        hint = ""
-        scheme = full.split(":", 1)[0]
-        if "://" not in full and scheme not in ("urn", "tag", "mailto", "file"):
-            hint = f" (is {scheme!r} a mistyped prefix? known prefixes: {', '.join(PREFIXES)})"
-        raise click.ClickException(f"nothing in the store mentions <{full}>{hint}")
+        raise click.ClickException(f"nothing in the store mentions <{full}>{_prefix_hint(full)}")
     is_description = bool(kb.select("description", {"description": full}))
     if is_description:
         description = kb.description(full)
@@ -527,6 +527,14 @@ def _list_queries(app: App) -> None:
         params = ", ".join(f"{p.name}{'*' if p.required else ''}:{p.kind}" for p in q.parameters.values())
         body.append([name, params or "-", q.title])
     click.echo(table(["name", "parameters (* required)", "title"], body))
+
+
+def _prefix_hint(full: str) -> str:
+    """A hint when ``full`` looks like prefix:name with a prefix nobody declared (lab:Cam for a lab's own)."""
+    scheme = full.split(":", 1)[0]
+    if "://" in full or scheme in ("urn", "tag", "mailto", "file"):
+        return ""
+    return f" (is {scheme!r} a mistyped prefix? known prefixes: {', '.join(PREFIXES)})"
 
 
 def _bindings(texts: tuple[str, ...]) -> dict[str, str]:

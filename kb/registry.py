@@ -63,14 +63,14 @@ class ComponentRegistry:
             requirement = (ox.NamedNode(iri), ox.NamedNode(RDF + "type"), ox.NamedNode(CBRS.Requirement))
             graph = GraphName.REQUIREMENTS.node
             if next(iter(self._store.quads(*requirement, graph)), None) is None:
-                raise self._not_found(iri)
+                raise self._not_found(iri, "registered advertisement or requirement")
         old = self.description_quads(iri, graph)
         before = self._standard_terms.begin()
         self._store.replace(old, [])
         self._standard_terms.changed(before, old, [])
         return len(old)
 
-    def _not_found(self, iri: str) -> NotFoundError:
+    def _not_found(self, iri: str, what: str = "registered advertisement") -> NotFoundError:
         """Not registered: said so, or where the advertisement is when another graph holds it."""
         kinds = _advertisement_classes(self._store)
         for quad in self._store.quads(ox.NamedNode(iri), ox.NamedNode(RDF + "type"), None):
@@ -78,7 +78,7 @@ class ComponentRegistry:
                 return OutsideRegistryError(
                     iri, str(quad.graph_name.value) if isinstance(quad.graph_name, ox.NamedNode) else ""
                 )
-        return NotFoundError(iri, "registered advertisement")
+        return NotFoundError(iri, what)
 
     def is_registered(self, iri: str) -> bool:
         node = ox.NamedNode(iri)

@@ -73,6 +73,13 @@ def test_named_query_with_binding(store: str) -> None:
     assert "home:RobotPosition" in out and "output" in out
 
 
+def test_deregister_names_what_it_looked_for_and_a_mistyped_prefix(store: str) -> None:
+    code, out = run("deregister", "svc:NoSuchCamera", store=store)
+    assert code == 1 and "no registered advertisement or requirement" in out and "prefix" not in out
+    code, out = run("deregister", "lab:Cam", store=store)
+    assert code == 1 and "is 'lab' a mistyped prefix?" in out
+
+
 def test_a_parameter_bound_twice_is_refused(store: str) -> None:
     code, out = run("query", "--name", "advertisements", "--bind", "kind=cbrs:A", "--bind", "kind=cbrs:B", store=store)
     assert code == 2 and "kind is bound twice" in out
