@@ -135,15 +135,14 @@ class KnowledgeBase:
         stored map does not say yet is added: a statement joins unless the stored map already gives its
         subject a value for that property, so a thing a user moved stays moved.
         """
-        wanted = (GraphName.ONTOLOGY, GraphName.MAP)
-        parsed = [parse_file(item.path, item.graph) for item in bundled_files() if item.graph in wanted]
+        files = bundled_files()
+        ontology = [parse_file(item.path, item.graph) for item in files if item.graph is GraphName.ONTOLOGY]
+        world = [parse_file(item.path, item.graph) for item in files if item.graph is GraphName.MAP]
         known = {(quad.subject, quad.predicate) for quad in self.store.quads(graph=GraphName.MAP.node)}
-        ontology = [item for item in parsed if item.graph is not GraphName.MAP]
         added = [quad for item in ontology for quad in new_terms(self.store, item.quads)]
-        added += [
+        added += [  # (the map by the bundle's own graph name: a parsed file names its graph by IRI)
             quad
-            for item in parsed
-            if item.graph is GraphName.MAP
+            for item in world
             for quad in item.quads
             if (quad.subject, quad.predicate) not in known or quad.predicate == _VERSION_INFO
         ]

@@ -285,7 +285,7 @@ class SemanticMap:
         perception finds them and how the simulation shows them; None when none says."""
         for iri in self.of_type(concept):
             values = self.facts.get(iri, {})
-            name = _text(values, "colourName")
+            name = _text(values, "colourName", iri)
             if name:
                 return name, _rgba(iri, values)
         return None
@@ -339,18 +339,43 @@ def _number(values: dict[str, list[str]], name: str, iri: str, default: float | 
             raise MapError(iri, f"has no home:{name}")
         return default
     try:
-        return float(raw[0])
+        numbers = {float(text) for text in raw}
     except ValueError:
-        raise MapError(iri, f"has home:{name} {raw[0]!r}, not a number") from None
+        bad = next(text for text in raw if not _is_number(text))
+        raise MapError(iri, f"has home:{name} {bad!r}, not a number") from None
+    if len(numbers) > 1:
+        raise _two_values(iri, name, raw)
+    return numbers.pop()
 
 
-def _text(values: dict[str, list[str]], name: str) -> str | None:
+def _text(values: dict[str, list[str]], name: str, iri: str) -> str | None:
     raw = values.get(HOME + name)
+    if raw and len(set(raw)) > 1:
+        raise _two_values(iri, name, raw)
     return raw[0] if raw else None
 
 
+def _two_values(iri: str, name: str, raw: list[str]) -> MapError:
+    """A thing has one pose, size or colour: two values are a contradiction, not a choice to make
+    quietly (a load adds statements, so moving a thing by loading its new place leaves the old one)."""
+    shown = " and ".join(repr(text) for text in sorted(set(raw)))
+    return MapError(
+        iri,
+        f"has home:{name} {shown}: one value is needed; remove the old one (a load only adds: "
+        "update the map with DELETE/INSERT, docs/tasks.md)",
+    )
+
+
+def _is_number(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
 def _rgba(iri: str, values: dict[str, list[str]]) -> tuple[float, float, float, float]:
-    text = _text(values, "rgba") or "0.5 0.5 0.5 1"
+    text = _text(values, "rgba", iri) or "0.5 0.5 0.5 1"
     try:
         parts = [float(part) for part in text.split()]
     except ValueError:
@@ -398,14 +423,14 @@ def _classify(
         built.arms[iri] = Arm(
             iri,
             robots[0] if robots else "",
-            _text(values, "armSide") or "",
+            _text(values, "armSide", iri) or "",
             (_number(values, "x", iri), _number(values, "y", iri), _number(values, "z", iri)),
             _number(values, "yaw", iri, 0.0),
             _number(values, "reach", iri),
         )
         return
     if HOME + "shapeKind" in values:
-        shape = _text(values, "shapeKind") or ""
+        shape = _text(values, "shapeKind", iri) or ""
         if shape not in ("box", "cylinder"):
             raise MapError(iri, f'has home:shapeKind {shape!r}; use "box" or "cylinder"')
         grasp = next((affordances[t] for t in types if t in affordances), None)
@@ -425,7 +450,7 @@ def _classify(
             shape,
             size,
             _number(values, "massKg", iri),
-            _text(values, "colourName") or "",
+            _text(values, "colourName", iri) or "",
             _rgba(iri, values),
             Pose(_number(values, "x", iri), _number(values, "y", iri), _number(values, "yaw", iri, 0.0)),
             support,
@@ -437,7 +462,7 @@ def _classify(
         built.people[iri] = Person(
             iri,
             Pose(_number(values, "x", iri), _number(values, "y", iri), _number(values, "yaw", iri, 0.0)),
-            _text(values, "colourName") or "",
+            _text(values, "colourName", iri) or "",
             _rgba(iri, values),
         )
         return
@@ -453,7 +478,7 @@ def _classify(
             marker_values = facts.get(marker, {})
             colour_node = marker_values.get(HOME + "hasColour", [marker])[0]
             node = facts.get(colour_node, {})
-            front, rear = _text(node, "frontColourName"), _text(node, "rearColourName")
+            front, rear = _text(node, "frontColourName", colour_node), _text(node, "rearColourName", colour_node)
             colours = (front, rear) if front and rear else None
             if colours is not None:
                 patch = (_number(marker_values, "sizeX", marker), _number(marker_values, "sizeY", marker))

@@ -132,13 +132,22 @@ def test_a_store_with_an_older_map_gets_the_new_statements_and_keeps_what_the_us
     )
     kb.update("INSERT DATA { GRAPH graph:map { <https://w3id.org/cbrs/world> owl:versionInfo '0.1.0' } }")
     kb.update(f"DELETE WHERE {{ GRAPH graph:map {{ <{WORLD}Cup> home:x ?x }} }}")
-    kb.update(f"INSERT DATA {{ GRAPH graph:map {{ <{WORLD}Cup> home:x 7.3 }} }}")  # the user moved the cup
+    # the user moved the cup (to a value that sorts after the bundled 7.45: no reader may pick by order)
+    kb.update(f"INSERT DATA {{ GRAPH graph:map {{ <{WORLD}Cup> home:x 7.6 }} }}")
     with pytest.raises(MapError, match=r"P3DX01.*home:sizeX"):
         SemanticMap.read(kb)
     kb.store.close()
     reopened = SemanticMap.read(KnowledgeBase.open(tmp_path / "store"))
     assert reopened.robots[robot].footprint == (0.45, 0.38)
-    assert reopened.objects[WORLD + "Cup"].start.x == 7.3
+    assert reopened.objects[WORLD + "Cup"].start.x == 7.6
+
+
+def test_two_values_for_one_pose_are_refused_naming_both() -> None:
+    kb = KnowledgeBase.open(":memory:")
+    kb.update(f"INSERT DATA {{ GRAPH graph:map {{ <{WORLD}Cup> home:x 7.3 }} }}")  # a move that only adds
+    with pytest.raises(MapError, match=r"Cup.*home:x '7\.3\d*' and '7\.\d+'.*one value") as refused:
+        SemanticMap.read(kb)
+    assert refused.value.thing == WORLD + "Cup"
 
 
 def test_a_wall_written_in_turtle_is_built_and_mapped() -> None:
