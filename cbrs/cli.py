@@ -11,6 +11,7 @@ import os
 import re
 import sys
 import traceback
+from collections import Counter
 from pathlib import Path
 from typing import Any
 
@@ -145,7 +146,7 @@ def load(app: App, files: tuple[Path, ...], graph: str | None, catalogs: tuple[P
     report = app.kb.load(list(files), graph, catalogue)
     for item in report.files:
         what = _loaded_what(item)
-        click.echo(f"loaded {item.source}: {what}{item.triples} triples into {shorten(item.graph)}{_mended(item)}")
+        click.echo(f"loaded {item.source}: {what}{_into(item)}{_mended(item)}")
     for line in _load_summary(report):
         click.echo(line)
 
@@ -527,6 +528,17 @@ def _list_queries(app: App) -> None:
         params = ", ".join(f"{p.name}{'*' if p.required else ''}:{p.kind}" for p in q.parameters.values())
         body.append([name, params or "-", q.title])
     click.echo(table(["name", "parameters (* required)", "title"], body))
+
+
+def _into(item: ParsedFile) -> str:
+    """How many triples went into which graph: a TriG or N-Quads file may name graphs of its own."""
+    counts = Counter(
+        quad.graph_name.value if isinstance(quad.graph_name, ox.NamedNode) else item.graph for quad in item.quads
+    )
+    if item.bulk is not None or len(counts) <= 1:
+        return f"{item.triples} triples into {shorten(item.graph)}"
+    parts = ", ".join(f"{n} into {shorten(graph)}" for graph, n in sorted(counts.items()))
+    return f"{item.triples} triples: {parts}"
 
 
 def _prefix_hint(full: str) -> str:

@@ -167,6 +167,16 @@ def test_load_says_where_each_file_went(tmp_path: Path) -> None:
     assert "into graph:services" in out
 
 
+def test_load_counts_each_graph_a_trig_file_names(tmp_path: Path) -> None:
+    trig = tmp_path / "lab.trig"
+    trig.write_text(
+        "@prefix ex: <http://example.org/> .\nex:a ex:p ex:b .\nex:g1 { ex:c ex:p ex:d . ex:e ex:p ex:f . }\n"
+    )
+    code, out = run("load", str(trig), store=str(tmp_path / "s"))
+    assert code == 0
+    assert "lab.trig: 3 triples: 2 into http://example.org/g1, 1 into graph:services" in out
+
+
 def test_services_table(store: str) -> None:
     code, out = run("services", store=store)
     assert code == 0
