@@ -80,6 +80,12 @@ class KnowledgeBase:
         kb = cls(store)
         if seed and not kb.store.is_seeded():
             kb._seed_kept(seed_cache or SeedCache.default())
+            if not isinstance(store, EmbeddedStore):  # an empty server shows its default graph only now
+                try:
+                    store.query("ASK { ?s ?p ?o }")
+                except BaseException:
+                    store.close()
+                    raise
         elif seed:
             kb.upgrade()
             if kb._map_outdated():
