@@ -13,9 +13,11 @@ A parameter's value is substituted for the variable of the same name by Oxigraph
 from __future__ import annotations
 
 import re
-from collections.abc import Mapping
+import traceback
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import pyoxigraph as ox
 
@@ -114,8 +116,19 @@ class QueryLibrary:
 def _rows(name: str, result: QueryResult) -> list[dict[str, Term]]:
     if not isinstance(result, ox.QuerySolutions):
         raise TypeError(f"query {name!r} is not a SELECT query")
-    names = [v.value for v in result.variables]
-    return [{n: row[n] for n in names if row[n] is not None} for row in result]
+    return _read_rows([v.value for v in result.variables], result)
+
+
+def _read_rows(names: list[str], solutions: Iterable[Any]) -> list[dict[str, Term]]:
+    """Read ``solutions`` whole. A pyoxigraph result may only be dropped on the thread that made it: when
+    reading fails half way, the exception's frames would keep it alive until a garbage collection on
+    whatever thread runs next (a task's, a server's), where dropping it raises. So they let go of it here."""
+    try:
+        return [{n: row[n] for n in names if row[n] is not None} for row in solutions]
+    except BaseException as error:
+        traceback.clear_frames(error.__traceback__)
+        del solutions
+        raise
 
 
 def _read(path: Path) -> NamedQuery:
