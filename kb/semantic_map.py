@@ -338,11 +338,12 @@ def _number(values: dict[str, list[str]], name: str, iri: str, default: float | 
         if default is None:
             raise MapError(iri, f"has no home:{name}")
         return default
-    try:
-        numbers = {float(text) for text in raw}
-    except ValueError:
-        bad = next(text for text in raw if not _is_number(text))
-        raise MapError(iri, f"has home:{name} {bad!r}, not a number") from None
+    numbers = set()
+    for text in raw:
+        try:
+            numbers.add(float(text))
+        except ValueError:
+            raise MapError(iri, f"has home:{name} {text!r}, not a number") from None
     if len(numbers) > 1:
         raise _two_values(iri, name, raw)
     return numbers.pop()
@@ -364,14 +365,6 @@ def _two_values(iri: str, name: str, raw: list[str]) -> MapError:
         f"has home:{name} {shown}: one value is needed; remove the old one (a load only adds: "
         "update the map with DELETE/INSERT, docs/tasks.md)",
     )
-
-
-def _is_number(text: str) -> bool:
-    try:
-        float(text)
-    except ValueError:
-        return False
-    return True
 
 
 def _rgba(iri: str, values: dict[str, list[str]]) -> tuple[float, float, float, float]:

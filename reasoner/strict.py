@@ -80,22 +80,18 @@ class StrictScorer:
                 failed.append((f"output {_short(output.type)}", best <= 0))
             parts["outputs"] = np.mean(per, axis=0)
         self._inputs(requirement, parts)
-        if requirement.effects:
-            per = []
-            for effect in requirement.effects:
-                best = self._statements(effect, pool.effects, inverse=False)
-                per.append(best)
-                text = f"({_short(effect.subject)}, {_short(effect.predicate)}, {_short(effect.object)})"
-                failed.append((f"effect {text}", best <= 0))
-            parts["effects"] = np.mean(per, axis=0)
-        if requirement.deletes:
-            per = []
-            for deleted in requirement.deletes:
-                best = self._statements(deleted, pool.deletes, inverse=False)
-                per.append(best)
-                text = f"({_short(deleted.subject)}, {_short(deleted.predicate)}, {_short(deleted.object)})"
-                failed.append((f"delete effect {text}", best <= 0))
-            parts["deletes"] = np.mean(per, axis=0)
+        for part, role, wanted, offered in (
+            ("effects", "effect", requirement.effects, pool.effects),
+            ("deletes", "delete effect", requirement.deletes, pool.deletes),
+        ):
+            if wanted:  # each requested result needs an accepted match, as an output does
+                per = []
+                for statement in wanted:
+                    best = self._statements(statement, offered, inverse=False)
+                    per.append(best)
+                    text = f"({_short(statement.subject)}, {_short(statement.predicate)}, {_short(statement.object)})"
+                    failed.append((f"{role} {text}", best <= 0))
+                parts[part] = np.mean(per, axis=0)
         if requirement.preconditions:
             parts["preconditions"] = self._preconditions(requirement.preconditions)
         weights = cfg.part_weights
