@@ -33,6 +33,23 @@ log = logging.getLogger("cbrs.rosbridge")
 
 MIB = 1 << 20
 
+#: The status a binary frame that holds no UTF-8 JSON gets.
+BINARY_REFUSED = (
+    "binary frames are not supported unless they hold UTF-8 JSON text (as rosbridge_suite reads them):"
+    " CBOR or BSON from a client is not read; send the message as JSON"
+)
+
+
+def _json_in_binary(frame: bytes) -> str | None:
+    """A binary frame's text if it can be JSON: UTF-8 with no NUL (JSON has none; BSON ends with one,
+    and CBOR's maps start with a byte no UTF-8 text starts with)."""
+    if b"\x00" in frame:
+        return None
+    try:
+        return frame.decode("utf-8")
+    except UnicodeDecodeError:
+        return None
+
 
 def _api_name(name: str, what: str) -> str:
     if not isinstance(name, str) or not name.strip("/ "):
@@ -189,21 +206,31 @@ class Bridge:
             topic.type, topic.server, topic.latch = type, True, topic.latch or latch
 
     def publish(self, topic: str, msg: dict[str, Any]) -> None:
-        """Publish ``msg`` on a topic added with :meth:`add_topic`; may be called from any thread."""
+        """Publish ``msg`` on a topic added with :meth:`add_topic`; may be called from any thread.
+
+        Besides JSON values, ``msg`` may hold numeric arrays (``array.array``, 1-D numpy arrays) and
+        ``bytes``: JSON subscribers get them as lists and base64 text, ``compression: "cbor"`` ones as
+        RFC 8746 typed arrays and byte strings, as rosbridge_suite sends a ROS message's arrays.
+        """
         name = _api_name(topic, "topic")
         if not isinstance(msg, dict):
             raise TypeError(f"a message must be a dict, not {type(msg).__name__}")
-        text = protocol.dumps(msg)
+        values = None  # JSON holds all of it: a CBOR subscriber's values are read back from the text
+        try:
+            text = protocol.dumps(msg)
+        except TypeError:  # typed arrays or bytes (else the same TypeError again): kept for CBOR, copied
+            text = wire.typed_dumps(msg)
+            values = wire.cbor_values(msg)
         with self._graph.lock:
             entry = self._graph.topics.get(name)
             if entry is None or not entry.server:
                 raise UnknownTopicError(topic)
             if entry.latch:
-                entry.latched = text
+                entry.latched, entry.latched_values = text, values
             loop = self._loop
         if loop is not None:
             with contextlib.suppress(RuntimeError):  # the loop closed under us: the server is stopping
-                loop.call_soon_threadsafe(self._fan_out, name, text)
+                loop.call_soon_threadsafe(self._fan_out, name, text, None, values)
 
     def topics(self) -> list[tuple[str, str]]:
         """(name, type) of every topic: the server's, advertised and subscribed ones."""
@@ -270,11 +297,11 @@ class Bridge:
     def open_session(
         self,
         peer: str,
-        send: Callable[[str], Awaitable[None]],
+        send: Callable[[str | bytes], Awaitable[None]],
         abort: Callable[[str], None],
         origin: str | None = None,
         address: str | None = None,
-        send_many: Callable[[list[str]], Awaitable[None]] | None = None,
+        send_many: Callable[[list[str | bytes]], Awaitable[None]] | None = None,
     ) -> Session:
         """A new client (``peer`` names it in logs, ``address`` is its IP address, ``origin`` its
         handshake's Origin header); its writer task starts on the attached loop. ``send`` sends one
@@ -296,10 +323,17 @@ class Bridge:
         return session
 
     def receive(self, session: Session, frame: str | bytes) -> None:
-        """Handle one frame from a client; a bad one gets a status error, never an exception."""
+        """Handle one frame from a client; a bad one gets a status error, never an exception.
+
+        A binary frame is read as UTF-8 JSON, as rosbridge_suite reads one; CBOR or BSON is not read
+        (rosbridge_suite reads neither from a client, bar BSON in its bson_only_mode) and is refused.
+        """
         if not isinstance(frame, str):
-            session.report("error", "binary frames are not supported (no CBOR or BSON): send JSON text frames")
-            return
+            text = _json_in_binary(frame)
+            if text is None:
+                session.report("error", BINARY_REFUSED)
+                return
+            frame = text
         self._handle(session, frame)
 
     def _handle(self, session: Session, frame: str, whole: bool = False) -> None:
@@ -417,11 +451,12 @@ class Bridge:
             subscribers = list(topic.subscribers)
         if not (subscribers or latch):  # nobody to send it to, now or later: not even encoded
             return
-        text = protocol.dumps_decoded(message["msg"])
-        if latch:
+        values = message["msg"]
+        text = protocol.dumps_decoded(values)
+        if latch:  # the text only: a late CBOR subscriber's values are read back from it (a parsed map costs more)
             with self._graph.lock:
-                topic.latched = text
-        self._fan_out(name, text, subscribers)
+                topic.latched, topic.latched_values = text, None
+        self._fan_out(name, text, subscribers, values)
 
     def _subscribe(self, session: Session, message: Message) -> None:
         name, kind, message_id = protocol.resolve(message["topic"], "topic"), message.get("type"), message.get("id")
@@ -432,9 +467,19 @@ class Bridge:
             session.report("warning", f"queue_length {queue_length} lowered to {self.max_queue_length}", message_id)
             queue_length = self.max_queue_length
         compression = message.get("compression") or "none"
-        if compression not in ("none", "png"):
+        if compression == "cbor-raw":
+            raise ProtocolError(
+                f"compression 'cbor-raw' sends each message in its ROS serialization, and topic {name!r} has none"
+                " here: this server relays JSON values without ROS message definitions; subscribe with"
+                " compression 'cbor' (the same values as CBOR) or 'none'"
+            )
+        if compression not in ("none", "png", "cbor"):
             session.report("warning", f"compression {compression!r} is not supported; sending JSON", message_id)
+            compression = "none"
         fragment_size = self._fragment_size(session, message)
+        if compression == "cbor" and fragment_size is not None:
+            text = "fragment_size does not apply to compression 'cbor': fragments carry JSON text, so each CBOR"
+            session.report("warning", f"{text} message goes whole, in one binary frame", message_id)
         with self._graph.lock:
             topic = self._graph.topics.get(name)
             if topic is None:
@@ -443,12 +488,14 @@ class Bridge:
                 raise ProtocolError(f"topic {name!r} has type {topic.type!r}, not {kind!r}")
             topic.type = topic.type or kind or ""
             topic.subscribers.add(session)
-            latched = topic.latched
-        session.subscribe(
-            name, message["topic"], message_id, throttle_rate, queue_length, compression == "png", fragment_size
-        )
+            latched, latched_values = topic.latched, topic.latched_values
+        session.subscribe(name, message["topic"], message_id, throttle_rate, queue_length, compression, fragment_size)
         if latched is not None:
-            session.offer(name, protocol.publish_text(message["topic"], latched))
+            if name in session.cbor:
+                values = protocol.loads(latched) if latched_values is None else latched_values
+                session.offer(name, wire.cbor_publish(message["topic"], values))
+            else:
+                session.offer(name, protocol.publish_text(message["topic"], latched))
         session.report("info", f"subscribed to {name}", message_id)
 
     def _unsubscribe(self, session: Session, message: Message) -> None:
@@ -642,20 +689,29 @@ class Bridge:
             raise ProtocolError(f"level must be one of {', '.join(LEVELS)}, not {message['level']!r}")
         session.level = message["level"]
 
-    def _fan_out(self, name: str, text: str, subscribers: list[Session] | None = None) -> None:
+    def _fan_out(self, name: str, text: str, subscribers: list[Session] | None = None, values: Any = None) -> None:
         """Queue a message for every subscriber (those given, or the topic's now), under the name each
-        one subscribed with."""
+        one subscribed with: its JSON ``text``, or CBOR of its ``values`` (None: read back from the text)
+        for those that asked for it."""
         if subscribers is None:
             with self._graph.lock:
                 topic = self._graph.topics.get(name)
                 subscribers = list(topic.subscribers) if topic is not None else []
-        if len(subscribers) == 1:  # the usual case, with no table of spellings to keep
+        if len(subscribers) == 1 and name not in subscribers[0].cbor:  # the usual case: no table to keep
             session = subscribers[0]
             session.offer(name, protocol.publish_text(session.spelling.get(name, name), text))
             return
         framed: dict[str, str] = {}
+        binary: dict[str, bytes] = {}  # for the subscribers that asked for CBOR
         for session in subscribers:
             spelling = session.spelling.get(name, name)
+            if name in session.cbor:
+                if spelling not in binary:
+                    if values is None:
+                        values = protocol.loads(text)
+                    binary[spelling] = wire.cbor_publish(spelling, values)
+                session.offer(name, binary[spelling])
+                continue
             if spelling not in framed:
                 framed[spelling] = protocol.publish_text(spelling, text)
             session.offer(name, framed[spelling])

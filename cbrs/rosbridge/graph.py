@@ -26,6 +26,7 @@ class Topic:
     server: bool = False
     latch: bool = False
     latched: str | None = None
+    latched_values: Any = None  # its values for CBOR subscribers (None: read back from ``latched``)
     publishers: set[Session] = field(default_factory=set)
     subscribers: set[Session] = field(default_factory=set)
 

@@ -32,12 +32,12 @@ class TopicQueue:
     def __init__(self, backlog: int, max_bytes: int = 16 << 20) -> None:
         self.backlog = backlog
         self.max_bytes = max_bytes
-        self.size = 0  # bytes of the messages waiting
+        self.size = 0  # bytes of the messages waiting (characters of JSON text, bytes of CBOR)
         self.requests: dict[Request, tuple[int, int]] = {}
         self.throttle = 0.0
         self.dropped = 0
         self._last_sent = -math.inf
-        self._pending: deque[tuple[int, str]] = deque(maxlen=backlog)
+        self._pending: deque[tuple[int, str | bytes]] = deque(maxlen=backlog)
 
     def add(self, request: Request, throttle_rate: int, queue_length: int) -> None:
         """Add (or replace) the subscribe request ``request`` (its id; None for one without id)."""
@@ -58,8 +58,8 @@ class TopicQueue:
         """How many messages are kept waiting at most."""
         return self._pending.maxlen or self.backlog
 
-    def push(self, seq: int, text: str) -> None:
-        """Queue a message (``seq`` orders it among everything else the client receives)."""
+    def push(self, seq: int, text: str | bytes) -> None:
+        """Queue a message, JSON text or CBOR (``seq`` orders it among everything else the client receives)."""
         if len(self._pending) == self._pending.maxlen:
             self.dropped += 1
             self.size -= len(self._pending[0][1])
@@ -83,7 +83,7 @@ class TopicQueue:
         """The sequence number of the next message."""
         return self._pending[0][0]
 
-    def pop(self, now: float) -> str:
+    def pop(self, now: float) -> str | bytes:
         """Take the next message, sent at ``now``."""
         self._last_sent = now
         text = self._pending.popleft()[1]

@@ -201,6 +201,11 @@ def resolve(name: str, what: str = "name") -> str:
     return name if name.startswith("/") else "/" + name
 
 
+def loads(text: str) -> Any:
+    """Values back from JSON text this server wrote (a message's ``msg``, to send it again as CBOR)."""
+    return _parse(text)
+
+
 def dumps(value: Any) -> str:
     """Compact JSON; NaN and infinities are refused, since JSON has no such numbers."""
     return _ENCODER.encode(value)

@@ -1,9 +1,10 @@
 """The websocket transport: serve a :class:`Bridge` in an event loop, or in a thread of its own.
 
-Text frames carry rosbridge JSON messages. The websocket's own frame limit is set well above the
-bridge's ``max_message_bytes`` (16 MiB, or twice the bridge's limit if that is larger), so a message
-that is merely too large gets a status error and the connection stays up; only a frame beyond the
-transport limit closes the connection (code 1009, as websockets does).
+Text frames carry rosbridge JSON messages (and binary frames the topic messages a client asked for as
+CBOR; a client's binary frame is read as UTF-8 JSON, see ``Bridge.receive``). The websocket's own frame
+limit is set well above the bridge's ``max_message_bytes`` (16 MiB, or twice the bridge's limit if that
+is larger), so a message that is merely too large gets a status error and the connection stays up;
+only a frame beyond the transport limit closes the connection (code 1009, as websockets does).
 """
 
 from __future__ import annotations
@@ -45,18 +46,22 @@ def transport_limit(bridge: Bridge) -> int:
     return max(16 * MIB, 2 * bridge.max_message_bytes)
 
 
-async def send_frames(websocket: ServerConnection, texts: list[str]) -> None:
-    """Send ``texts`` as text frames, in order, with two socket writes instead of one per message.
+async def send_frames(websocket: ServerConnection, texts: list[str | bytes]) -> None:
+    """Send ``texts`` in order, ``str`` as text frames and ``bytes`` (CBOR) as binary ones, with two
+    socket writes instead of one per message.
 
-    All but the last are framed by the connection's own sans-I/O protocol (``send_text``, as
-    ``websocket.send`` frames them) and written to the transport joined; the last goes through
-    ``websocket.send``, which applies websockets' flow control and raises ``ConnectionClosed`` as usual.
-    A connection that is not open gets only that ``send`` (which raises).
+    All but the last are framed by the connection's own sans-I/O protocol (``send_text`` or
+    ``send_binary``, as ``websocket.send`` frames them) and written to the transport joined; the last
+    goes through ``websocket.send``, which applies websockets' flow control and raises
+    ``ConnectionClosed`` as usual. A connection that is not open gets only that ``send`` (which raises).
     """
     protocol = websocket.protocol
     if len(texts) > 1 and protocol.state is State.OPEN:
         for text in texts[:-1]:
-            protocol.send_text(text.encode())
+            if isinstance(text, str):
+                protocol.send_text(text.encode())
+            else:
+                protocol.send_binary(text)
         websocket.transport.write(b"".join(protocol.data_to_send()))
     await websocket.send(texts[-1])
 

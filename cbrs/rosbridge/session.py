@@ -3,9 +3,10 @@
 Everything the client receives goes through one writer task, in the order it was produced, except that
 a throttled topic waits for its window. Replies (statuses, service responses, forwarded calls) are never
 dropped; topic messages wait in their :class:`TopicQueue`, so a client that reads slowly only ever has
-its queues' worth of messages pending. The transport hands in ``send`` (await one text frame),
-optionally ``send_many`` (await several, in order: the writer hands it what is due at once), and
-``abort`` (drop the connection, with a reason); nothing here knows about websockets.
+its queues' worth of messages pending. The transport hands in ``send`` (await one frame: text for a
+``str``, binary for ``bytes``, which only a topic message sent as CBOR is), optionally ``send_many``
+(await several, in order: the writer hands it what is due at once), and ``abort`` (drop the
+connection, with a reason); nothing here knows about websockets.
 """
 
 from __future__ import annotations
@@ -21,6 +22,9 @@ from dataclasses import dataclass
 from cbrs.rosbridge.outbox import Request, TopicQueue
 from cbrs.rosbridge.protocol import LEVELS, MessageId, status
 from cbrs.rosbridge.wire import Reassembly, fragments, png_message
+
+#: What the writer sends: a text frame, or a binary one (a topic message as CBOR).
+Frame = str | bytes
 
 log = logging.getLogger("cbrs.rosbridge")
 
@@ -60,7 +64,7 @@ class Session:
     def __init__(
         self,
         name: str,
-        send: Callable[[str], Awaitable[None]],
+        send: Callable[[Frame], Awaitable[None]],
         abort: Callable[[str], None],
         backlog: int,
         clock: Callable[[], float] = time.monotonic,
@@ -68,7 +72,7 @@ class Session:
         peer: str = "",
         origin: str | None = None,
         backlog_bytes: int = 16 << 20,
-        send_many: Callable[[list[str]], Awaitable[None]] | None = None,
+        send_many: Callable[[list[Frame]], Awaitable[None]] | None = None,
     ) -> None:
         self.name = name
         self.peer = peer
@@ -84,10 +88,12 @@ class Session:
         self.spelling: dict[str, str] = {}
         self.queues: dict[str, TopicQueue] = {}
         #: how a subscribed topic's messages go out when a subscription asked (cbrs.rosbridge.wire): per
-        #: subscribe request (png, fragment_size), and merged per topic as rosbridge merges them (PNG if
-        #: any asks, the smallest fragment size); topics sent as plain JSON are not in ``wire``
-        self._wire_requests: dict[str, dict[Request, tuple[bool, int | None]]] = {}
-        self.wire: dict[str, tuple[bool, int | None]] = {}
+        #: subscribe request (compression, fragment_size), and merged per topic as rosbridge merges them
+        #: (CBOR if any asks, else PNG if any asks; the smallest fragment size); topics sent as plain JSON
+        #: are not in ``wire``, and those sent as CBOR are in ``cbor`` too (the bridge encodes them)
+        self._wire_requests: dict[str, dict[Request, tuple[str, int | None]]] = {}
+        self.wire: dict[str, tuple[str, int | None]] = {}
+        self.cbor: set[str] = set()
         self.reassembly: Reassembly | None = None  # the client's messages arriving in pieces, once it sends one
         self._pieces: deque[str] = deque()  # the rest of a topic message being sent in pieces
         self._piece_ids = 0
@@ -145,25 +151,31 @@ class Session:
         request: Request,
         throttle_rate: int,
         queue_length: int,
-        png: bool = False,
+        compression: str = "none",
         fragment_size: int | None = None,
     ) -> None:
+        """Add (or replace) a subscribe request; ``compression`` is "none", "png" or "cbor"."""
         queue = self.queues.get(topic)
         if queue is None:
             queue = self.queues[topic] = TopicQueue(self._backlog, self._backlog_bytes)
         queue.add(request, throttle_rate, queue_length)
         self.spelling[topic] = spelling
-        self._wire_requests.setdefault(topic, {})[request] = (png, fragment_size)
+        self._wire_requests.setdefault(topic, {})[request] = (compression, fragment_size)
         self._merge_wire(topic)
 
     def _merge_wire(self, topic: str) -> None:
         requests = self._wire_requests.get(topic, {}).values()
-        png = any(asked for asked, _ in requests)
+        asked = {compression for compression, _ in requests}
+        compression = "cbor" if "cbor" in asked else "png" if "png" in asked else "none"
         sizes = [size for _, size in requests if size is not None]
-        if png or sizes:
-            self.wire[topic] = (png, min(sizes) if sizes else None)
+        if compression != "none" or sizes:
+            self.wire[topic] = (compression, min(sizes) if sizes else None)
         else:
             self.wire.pop(topic, None)
+        if compression == "cbor":
+            self.cbor.add(topic)
+        else:
+            self.cbor.discard(topic)
 
     def unsubscribe(self, topic: str, request: Request | None, every: bool) -> bool:
         """Drop one subscribe request (or ``every`` one); True if the client no longer subscribes."""
@@ -183,8 +195,8 @@ class Session:
         self._wire_requests.pop(topic, None)
         return True
 
-    def offer(self, topic: str, text: str) -> None:
-        """Queue a ``publish`` message of a subscribed topic."""
+    def offer(self, topic: str, text: Frame) -> None:
+        """Queue a ``publish`` message of a subscribed topic (JSON text, or CBOR)."""
         queue = self.queues.get(topic)
         if queue is None or self.closed:
             return
@@ -237,10 +249,11 @@ class Session:
             log.debug("%s: writer stopped: %r", self.name, error)
             self.closed = True
 
-    async def _send_due(self, first: str, now: float) -> None:
+    async def _send_due(self, first: Frame, now: float) -> None:
         """Send ``first`` with the other messages due ``now`` (up to a batch) in one ``send_many`` call."""
         assert self._send_many is not None
-        batch, size = [first], len(first)
+        batch: list[Frame] = [first]
+        size = len(first)
         while len(batch) < WRITE_BATCH and size < WRITE_BATCH_CHARS:
             text, _ = self._take(now)
             if text is None:
@@ -249,7 +262,7 @@ class Session:
             size += len(text)
         await (self._send(first) if len(batch) == 1 else self._send_many(batch))
 
-    def _take(self, now: float) -> tuple[str | None, float | None]:
+    def _take(self, now: float) -> tuple[Frame | None, float | None]:
         """The next message due (oldest first), else how long until one is due (None: nothing waits)."""
         if self._pieces:  # a topic message in pieces goes out whole before anything else
             return self._pieces.popleft(), None
@@ -274,13 +287,14 @@ class Session:
             return text, None
         return None, wait
 
-    def _encoded(self, topic: str, text: str) -> str:
-        """A topic message as its subscription asked for it: PNG, in pieces, or as it is."""
+    def _encoded(self, topic: str, text: Frame) -> Frame:
+        """A topic message as its subscription asked for it: PNG, in pieces, or as it is (CBOR, already
+        encoded by the bridge, always goes whole: ``fragment`` ops carry text)."""
         wire = self.wire.get(topic)
-        if wire is None:
+        if wire is None or isinstance(text, bytes):
             return text
-        png, size = wire
-        if png:
+        compression, size = wire
+        if compression == "png":
             text = png_message(text)
         if size is None:
             return text

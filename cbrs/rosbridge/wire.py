@@ -16,16 +16,32 @@ together, in at most one piece per :data:`PIECE_CHARS` of that (the oldest unfin
 then the message that still does not fit is refused), in at most :data:`MAX_PARTIAL` messages; and a
 ``fragment_size`` below :data:`MIN_FRAGMENT` is raised to it, and one message is never cut in more than
 :data:`MAX_PIECES`.
+
+- A client may also ask for a subscription's messages as CBOR (``compression: "cbor"``,
+  :func:`cbor_publish`): the ``publish`` op as one binary frame, as rosbridge_suite's ``subscribe``
+  sends it. rosbridge_suite packs a message's numeric arrays as RFC 8746 typed arrays (little-endian)
+  and its ``uint8[]`` as a byte string because the ROS message definition says what each array holds.
+  Here no message has a definition: an array the server publishes says what it holds only by its
+  Python type (``array.array``, a 1-D numpy array, ``bytes``; :func:`cbor_values`), and only those go
+  as typed arrays or byte strings. A JSON array (what every client publishes) stays a CBOR array of
+  its numbers as JSON read them, ints and floats alike: guessing a type from the values would change
+  what a field decodes to from one message to the next (``[1.5, 2]`` against ``[1.5, 2.5]``).
 """
 
 from __future__ import annotations
 
+import array
 import base64
+import json
 import math
 import struct
+import sys
 import zlib
 from collections import OrderedDict
 from dataclasses import dataclass, field
+from typing import Any
+
+import cbor2
 
 from cbrs.rosbridge.errors import ProtocolError
 from cbrs.rosbridge.protocol import Message, MessageId, dumps
@@ -157,3 +173,115 @@ def png_message(text: str) -> str:
 
 def _chunk(kind: bytes, body: bytes) -> bytes:
     return struct.pack(">I", len(body)) + kind + body + struct.pack(">I", zlib.crc32(kind + body))
+
+
+# -- CBOR ---------------------------------------------------------------------------------------------
+
+#: RFC 8746 typed-array tags, little-endian (as rosbridge_suite writes them and roslibjs reads them), by
+#: element kind (numpy's letters: i signed, u unsigned, f float) and size in bytes. uint8 is no tag:
+#: rosbridge_suite sends ``uint8[]`` as a plain byte string (which roslibjs reads as a Uint8Array too).
+TYPED_ARRAY_TAGS: dict[tuple[str, int], int] = {
+    ("i", 1): 72,
+    ("u", 2): 69,
+    ("u", 4): 70,
+    ("u", 8): 71,
+    ("i", 2): 77,
+    ("i", 4): 78,
+    ("i", 8): 79,
+    ("f", 4): 85,
+    ("f", 8): 86,
+}
+
+
+def typed_json(value: Any) -> Any:
+    """The JSON form of a typed array or bytes in a message the server publishes (``json``'s ``default``):
+    an array's numbers as a list, bytes as base64 text (rosbridge's JSON for ``uint8[]``).
+    Raises TypeError for anything else, as ``json`` does."""
+    if isinstance(value, bytes | bytearray):
+        return base64.b64encode(value).decode("ascii")
+    if isinstance(value, array.array):
+        _array_kind(value)  # refuses unicode arrays
+        return value.tolist()
+    if _is_ndarray(value):
+        _ndarray_kind(value)
+        return value.tolist()
+    raise TypeError(f"Object of type {type(value).__name__} is not JSON serializable")
+
+
+def cbor_values(value: Any) -> Any:
+    """A copy of a message the server publishes with its typed arrays as CBOR tags and its bytes as byte
+    strings, and what is JSON as JSON would read it back (tuples as lists, keys as text): what a CBOR
+    subscriber decodes is what a JSON subscriber reads, bar the arrays' types. A copy, so the publisher may
+    change its dict once ``publish`` returns."""
+    if isinstance(value, dict):
+        return {_json_key(key): cbor_values(item) for key, item in value.items()}
+    if isinstance(value, list | tuple):
+        return [cbor_values(item) for item in value]
+    if isinstance(value, bytes | bytearray):
+        return bytes(value)
+    if isinstance(value, array.array):
+        return _tagged(_array_kind(value), value.itemsize, value.tobytes(), sys.byteorder == "big")
+    if _is_ndarray(value):
+        kind = _ndarray_kind(value)
+        if kind == "b":
+            return [bool(item) for item in value.tolist()]
+        little = value.astype(value.dtype.newbyteorder("<"), copy=False)
+        return _tagged(kind, value.dtype.itemsize, little.tobytes(), swap=False)
+    return value  # str, int, float, bool, None: the JSON dump that came first let nothing else through
+
+
+_TYPED_ENCODER = json.JSONEncoder(separators=(",", ":"), ensure_ascii=False, allow_nan=False, default=typed_json)
+
+
+def typed_dumps(value: Any) -> str:
+    """Compact JSON of a message the server publishes with typed arrays or bytes in it (:func:`typed_json`)."""
+    return _TYPED_ENCODER.encode(value)
+
+
+def cbor_publish(topic: str, msg: Any) -> bytes:
+    """A ``publish`` op as CBOR, the binary frame a ``compression: "cbor"`` subscriber gets."""
+    return cbor2.dumps({"op": "publish", "topic": topic, "msg": msg})
+
+
+def _tagged(kind: str, size: int, data: bytes, swap: bool) -> Any:
+    if kind == "u" and size == 1:
+        return data
+    if swap and size > 1:  # the machine is big-endian: the tags here say little-endian
+        swapped = array.array({2: "H", 4: "I", 8: "Q"}[size], data)
+        swapped.byteswap()
+        data = swapped.tobytes()
+    return cbor2.CBORTag(TYPED_ARRAY_TAGS[(kind, size)], data)
+
+
+def _array_kind(value: array.array[Any]) -> str:
+    code = value.typecode
+    if code in "fd":
+        return "f"
+    if code in "bhilq":
+        return "i"
+    if code in "BHILQ":
+        return "u"
+    raise TypeError(f"array.array of typecode {code!r} is no numeric array: publish text as a str")
+
+
+def _is_ndarray(value: Any) -> bool:
+    numpy = sys.modules.get("numpy")  # not imported: no value can be an array of it
+    return numpy is not None and isinstance(value, numpy.ndarray)
+
+
+def _ndarray_kind(value: Any) -> str:
+    kind, size = value.dtype.kind, value.dtype.itemsize
+    if value.ndim != 1:
+        raise TypeError(f"a numpy array in a message must have one dimension, not shape {value.shape}")
+    if kind != "b" and (kind, size) not in TYPED_ARRAY_TAGS and (kind, size) != ("u", 1):
+        raise TypeError(f"numpy dtype {value.dtype} has no typed array in rosbridge's CBOR: convert it first")
+    return str(kind)
+
+
+def _json_key(key: Any) -> str:
+    """A dict key as ``json`` writes it (only str, int, float, bool and None get past ``json``)."""
+    if isinstance(key, str):
+        return key
+    if key is None or isinstance(key, bool):
+        return dumps(key)
+    return dumps(key) if isinstance(key, float) else str(int(key))
