@@ -330,16 +330,25 @@ class Executor:
     def _attempt(self, iri: str, outcome: str, reason: str = "") -> Attempt:
         return Attempt(iri, outcome, reason, self.ticks - self._started_tick, self.clock() - self._started_at)
 
-    def _inputs(self, step: PlanStep) -> dict[str, Any]:
+    def inputs_for(self, step: PlanStep) -> dict[str, Any]:
+        """The values ``step`` is (or would be) invoked with; those not produced yet are left out."""
         values: dict[str, Any] = {}
         for binding in step.inputs:
             source = binding.source
-            if source.step is None:
-                if source.name not in self.given:
-                    raise KeyError(f"the task gives no value for {source.name!r}")
+            if source.step is None and source.name in self.given:
                 values[binding.name] = self.given[source.name]
-            else:
+            elif source.step is not None and source.name in self.results.get(source.step, {}):
                 values[binding.name] = self.results[source.step][source.name]
+        return values
+
+    def _inputs(self, step: PlanStep) -> dict[str, Any]:
+        values = self.inputs_for(step)
+        for binding in step.inputs:
+            if binding.name not in values:
+                source = binding.source
+                if source.step is None:
+                    raise KeyError(f"the task gives no value for {source.name!r}")
+                raise KeyError(f"step {source.step} gave no {source.name!r}")
         return values
 
     def _finish(self, status: RunStatus, reason: str = "") -> None:

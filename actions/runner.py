@@ -13,12 +13,13 @@ from typing import Any, Protocol
 
 from cbrs.actions.belief import BeliefState, Observation
 from cbrs.actions.components import Container, Registry
-from cbrs.actions.composer import Composer, CompositionResult, PlanStatus, store_plan
+from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, PlanStatus, store_plan
 from cbrs.actions.events import Event, EventBus
 from cbrs.actions.executor import ExecutionReport, Executor, RunStatus
 from cbrs.actions.faults import Combined, FaultPolicy, FixedFaults
 from cbrs.actions.graph import statement_text
 from cbrs.actions.plan import Plan, PlanStep
+from cbrs.actions.replanning import Failure, FailureMemory, ReplanPolicy
 from cbrs.kb import KnowledgeBase, NotFoundError, Requirement, Statement
 
 
@@ -46,9 +47,17 @@ class Replan:
     plan: Plan
     report: ExecutionReport
     reason: str
+    failures: tuple[Failure, ...] = ()  # the failed step's attempts, as the re-planning memory keys them
+    avoided: tuple[str, ...] = ()  # components the next plan was composed without (failed, nothing changed)
 
     def to_dict(self) -> dict[str, Any]:
-        return {"plan": self.plan.to_dict(), "execution": self.report.to_dict(), "reason": self.reason}
+        return {
+            "plan": self.plan.to_dict(),
+            "execution": self.report.to_dict(),
+            "reason": self.reason,
+            "failures": [failure.to_dict() for failure in self.failures],
+            "avoided": list(self.avoided),
+        }
 
 
 @dataclass(frozen=True)
@@ -70,6 +79,7 @@ class RunResult:
     report: ExecutionReport | None  # the last plan's execution; None when there was no plan to run
     replans: tuple[Replan, ...] = ()  # the plans replaced before it, in order
     goals: tuple[GoalCheck, ...] = ()  # the task's effects at the end, believed and in the world
+    stopped: str = ""  # why re-planning stopped before its budget: the next plan would repeat a failure
 
     @property
     def succeeded(self) -> bool:
@@ -95,6 +105,8 @@ class RunResult:
         if self.report is not None:
             found["execution"] = self.report.to_dict()
         found["replans"] = [replan.to_dict() for replan in self.replans]
+        if self.stopped:
+            found["stopped"] = self.stopped
         found["goals"] = [goal.to_dict() for goal in self.goals]
         return found
 
@@ -110,6 +122,7 @@ def run_task(
     fault_policy: FaultPolicy | None = None,
     max_replans: int = 2,
     cancelled: Callable[[], bool] | None = None,
+    replan_policy: ReplanPolicy | None = None,
 ) -> RunResult:
     """Perceive, compose ``task`` from what holds now, run it in ``environment``, keep the world graph current.
 
@@ -120,6 +133,10 @@ def run_task(
     reason. ``faults`` fail whenever invoked; ``fault_policy`` (e.g. ``RandomFaults``) may break others.
     ``cancelled`` is asked before the first step and after each step: once it says True the run stops
     there (status cancelled), without replanning; a step under way is never cut short.
+    ``replan_policy`` says what a re-plan does about a failure nothing has changed since (the same
+    component, inputs and kind of failure, with the things it depended on believed where they were):
+    compose without its component first, and repeat it at most ``max_repeats`` times, else stop with
+    ``RunResult.stopped`` saying why (``actions.replanning``).
     """
     composer = composer or Composer(kb)
     bus = EventBus()
@@ -137,6 +154,9 @@ def run_task(
         belief.restore(before)  # nothing can be done and nothing was: the store is left as it was
         return RunResult(composition, None)
     replans: list[Replan] = []
+    memory = FailureMemory(replan_policy or ReplanPolicy())
+    config = composer.config
+    stopped = ""
     report: ExecutionReport | None = None
     outputs: Mapping[int, Mapping[str, Any]] = {}
     try:
@@ -162,24 +182,39 @@ def run_task(
             outputs = executor.results
             if report.status is not RunStatus.FAILED or len(replans) >= max_replans:
                 break
-            replans.append(Replan(plan, report, report.reason))
-            bus.publish(
-                "/cbrs/task_progress", {"event": "replanning", "plan": len(replans) + 1, "reason": report.reason}
-            )
+            seen = environment.observe()  # the belief the failed step left, before anything is set down
+            failures = memory.failures(executor, report, seen)
             _settle(environment)  # leave nothing half done (an object held in a hand) before looking again
             _perceive(environment)  # look again
-            belief.write(environment.observe())
+            now = environment.observe()
+            belief.write(now)
             container.recover()  # what failed for the world's sake may be tried again; the broken stay broken
             refresh = getattr(environment, "refresh", None)
             if callable(refresh):
                 refresh()  # components registered since the last plan
-            composer = Composer(kb, composer.config)
-            composition = composer.compose(task, belief=True)
+            decision = memory.decide(failures, seen, now, lambda avoid: _compose(kb, config, task, avoid))
+            if decision.composition is None:
+                stopped = decision.stopped  # the result says why; listeners had the plan's failure
+                break
+            replans.append(Replan(plan, report, report.reason, tuple(failures), decision.avoided))
+            message = {"event": "replanning", "plan": len(replans) + 1, "reason": report.reason}
+            if decision.avoided:
+                message["avoiding"] = list(decision.avoided)
+            bus.publish("/cbrs/task_progress", message)
+            composition = decision.composition
     finally:
         container.finalise_all()
     belief.write(environment.observe())
     goals = _check_goals(environment, composition.plan, outputs) if report is not None else ()
-    return RunResult(composition, report, tuple(replans), goals)
+    return RunResult(composition, report, tuple(replans), goals, stopped)
+
+
+def _compose(kb: KnowledgeBase, config: ComposeConfig, task: str, avoid: frozenset[str]) -> CompositionResult:
+    """Compose ``task`` afresh from the belief, over every advertisement but those in ``avoid``."""
+    if not avoid:
+        return Composer(kb, config).compose(task, belief=True)
+    kept = [ad for ad in kb.advertisements() if ad.iri not in avoid]
+    return Composer(kb, config, advertisements=kept).compose(task, belief=True)
 
 
 def _stop_if_cancelled(executor: Executor, cancelled: Callable[[], bool] | None, done: int) -> None:

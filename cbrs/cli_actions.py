@@ -18,6 +18,7 @@ from cbrs.actions.events import Event
 from cbrs.actions.faults import RandomFaults, planned_faults
 from cbrs.actions.graph import statement_text
 from cbrs.actions.plan import Binding, Plan
+from cbrs.actions.replanning import ReplanPolicy
 from cbrs.actions.runner import RunResult, run_task
 from cbrs.app import App, parse_iri, pass_app
 from cbrs.extras import require
@@ -132,6 +133,16 @@ def _source(binding: Binding) -> str:
     type=int,
     help="Seed of the random faults (default: --seed); the same seed breaks the same components.",
 )
+@click.option(
+    "--repeat-failures",
+    type=click.IntRange(min=0),
+    default=1,
+    show_default=True,
+    help=(
+        "How many times a re-plan may run into the same failure (same component, inputs and kind) when nothing"
+        " it depends on has moved; a plan around the failed component is tried first."
+    ),
+)
 @click.option("--json", "as_json", is_flag=True, help="Print the plan and the execution report as JSON.")
 @click.option(
     "--record",
@@ -150,6 +161,7 @@ def run(
     faults: tuple[str, ...],
     fault_rate: float,
     fault_seed: int | None,
+    repeat_failures: int,
     as_json: bool,
     record: Path | None,
 ) -> None:
@@ -198,7 +210,15 @@ def run(
         if recorder is not None:
             recorder.start()
         try:
-            result = run_task(app.kb, iri, environment, failing, on_event=follow, fault_policy=policy)
+            result = run_task(
+                app.kb,
+                iri,
+                environment,
+                failing,
+                on_event=follow,
+                fault_policy=policy,
+                replan_policy=ReplanPolicy(max_repeats=repeat_failures),
+            )
         finally:
             if recorder is not None:
                 recorder.stop()
@@ -295,6 +315,11 @@ def run_text(result: RunResult, sim_seconds: float, wall_seconds: float) -> str:
     report = result.report
     replaced = [
         f"plan {n} replaced after {sum(1 for s in r.report.steps if s.outcome == 'succeeded')} step(s): {r.reason}"
+        + (
+            f"; the next plan avoids {', '.join(map(shorten, r.avoided))} (failed, nothing changed)"
+            if r.avoided
+            else ""
+        )
         for n, r in enumerate(result.replans, start=1)
     ]
     header = "\n".join(replaced) + ("\n" if replaced else "")
@@ -307,6 +332,8 @@ def run_text(result: RunResult, sim_seconds: float, wall_seconds: float) -> str:
     verdict = f"{shorten(report.task)}: {report.status.value}"
     if report.reason:
         verdict += f" ({report.reason})"
+    if result.stopped:
+        verdict += f"; {result.stopped}"
     if result.executed and result.refuted:  # the robots believed it done; the world says otherwise
         verdict = f"{shorten(report.task)}: failed (the robots believed it done, but in the world "
         verdict += "; ".join(f"{statement_text(goal.statement)} does not hold" for goal in result.refuted) + ")"
