@@ -19,13 +19,17 @@ from typing import Any
 import cbor2
 import numpy
 import pytest
+from websockets.asyncio.client import connect as ws_connect
+from websockets.asyncio.server import ServerConnection
+from websockets.asyncio.server import serve as ws_serve
 from websockets.sync.client import ClientConnection, connect
 
 from cbrs.rosbridge import Bridge, RunningBridge
 from cbrs.rosbridge.bridge import BINARY_REFUSED
 from cbrs.rosbridge.outbox import TopicQueue
+from cbrs.rosbridge.server import send_frames
 from cbrs.rosbridge.session import Session
-from cbrs.rosbridge.wire import cbor_values
+from cbrs.rosbridge.wire import _tagged, cbor_values
 
 WAIT = 10.0
 
@@ -56,6 +60,12 @@ def untag(value: Any) -> Any:
     if isinstance(value, list):
         return [untag(item) for item in value]
     return value
+
+
+def decoded(frame: str | bytes) -> Any:
+    """A binary frame's CBOR (a text frame fails the test)."""
+    assert isinstance(frame, bytes), frame
+    return cbor2.loads(frame)
 
 
 def frames(ws: ClientConnection, quiet: float = 0.3) -> list[str | bytes]:
@@ -216,12 +226,11 @@ def test_client_messages_reach_a_cbor_subscriber_with_their_values_and_types(
         sync(twice)
         send(talker, op="publish", topic="/chatter", msg=message)
         (png,) = frames(twice)
-    assert all(isinstance(frame, bytes) for frame in got + got_twice)
-    assert [cbor2.loads(frame) for frame in got] == [
+    assert [decoded(frame) for frame in got] == [
         {"op": "publish", "topic": "/chatter", "msg": {**message, "seq": n}} for n in range(3)
     ]
-    assert [cbor2.loads(frame)["topic"] for frame in got_twice] == ["chatter"] * 3
-    first = cbor2.loads(got[0])["msg"]
+    assert [decoded(frame)["topic"] for frame in got_twice] == ["chatter"] * 3
+    first = decoded(got[0])["msg"]
     assert type(first["x"]) is float and type(first["n"]) is int and first["big"] == 2**70
     assert isinstance(png, str) and json.loads(png)["op"] == "png"
 
@@ -372,3 +381,27 @@ def test_cbor_frames_count_their_bytes_in_the_queue_bound_and_go_out_as_binary()
     (batch,) = sent
     assert batch[0] == b"\xa1\x61a\x01"  # CBOR goes as it is, whole, as a binary frame
     assert isinstance(batch[1], str) and json.loads(batch[1])["op"] == "png"
+
+
+def test_send_frames_sends_text_and_cbor_in_order_each_as_its_kind_of_frame() -> None:
+    sent: list[str | bytes] = ['{"op":"status"}', b"\xa1\x61a\x01", b"\xa0", '{"op":"x"}']
+
+    async def main() -> list[str | bytes]:
+        async def handler(websocket: ServerConnection) -> None:
+            await send_frames(websocket, sent[:3])  # framed together, then the last through send
+            await send_frames(websocket, sent[3:])
+            await websocket.wait_closed()
+
+        async with ws_serve(handler, "127.0.0.1", 0, compression=None) as server:
+            port = server.sockets[0].getsockname()[1]
+            async with ws_connect(f"ws://127.0.0.1:{port}", compression=None) as client:
+                return [await asyncio.wait_for(client.recv(), WAIT) for _ in sent]
+
+    assert asyncio.run(main()) == sent  # str arrives as str (a text frame), bytes as bytes (binary)
+
+
+def test_typed_arrays_are_sent_little_endian_from_a_big_endian_machine_too() -> None:
+    big = struct.pack(">2d", 1.5, -2.0)
+    assert _tagged("f", 8, big, swap=True) == cbor2.CBORTag(86, struct.pack("<2d", 1.5, -2.0))
+    assert _tagged("i", 1, b"\xff\x01", swap=True) == cbor2.CBORTag(72, b"\xff\x01")
+    assert _tagged("u", 1, b"\xff", swap=True) == b"\xff"
