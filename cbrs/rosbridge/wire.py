@@ -1,4 +1,4 @@
-"""rosbridge's fragments and PNG compression, both ways a client may use them.
+"""rosbridge's fragments and its PNG and CBOR compression, both ways a client may use them.
 
 - A client with small buffers (a microcontroller) may send one message as ``fragment`` ops, ``{"op":
   "fragment", "id", "data", "num", "total"}``, ``data`` being consecutive pieces of the message's JSON
@@ -10,13 +10,6 @@
   (``compression: "png"``, :func:`png_message`): the message's UTF-8 JSON as the pixels of an 8-bit RGB
   image padded with newlines, base64 in ``{"op": "png", "data": ...}``, as rosbridge_suite's
   ``pngcompression.encode`` writes it and roslibjs decodes it.
-
-Both are bounded: the pieces a client has pending hold at most ``max_message_bytes`` characters
-together, in at most one piece per :data:`PIECE_CHARS` of that (the oldest unfinished messages make way,
-then the message that still does not fit is refused), in at most :data:`MAX_PARTIAL` messages; and a
-``fragment_size`` below :data:`MIN_FRAGMENT` is raised to it, and one message is never cut in more than
-:data:`MAX_PIECES`.
-
 - A client may also ask for a subscription's messages as CBOR (``compression: "cbor"``,
   :func:`cbor_publish`): the ``publish`` op as one binary frame, as rosbridge_suite's ``subscribe``
   sends it. rosbridge_suite packs a message's numeric arrays as RFC 8746 typed arrays (little-endian)
@@ -26,6 +19,12 @@ then the message that still does not fit is refused), in at most :data:`MAX_PART
   as typed arrays or byte strings. A JSON array (what every client publishes) stays a CBOR array of
   its numbers as JSON read them, ints and floats alike: guessing a type from the values would change
   what a field decodes to from one message to the next (``[1.5, 2]`` against ``[1.5, 2.5]``).
+
+Fragments are bounded: the pieces a client has pending hold at most ``max_message_bytes`` characters
+together, in at most one piece per :data:`PIECE_CHARS` of that (the oldest unfinished messages make way,
+then the message that still does not fit is refused), in at most :data:`MAX_PARTIAL` messages; and a
+``fragment_size`` below :data:`MIN_FRAGMENT` is raised to it, and one message is never cut in more than
+:data:`MAX_PIECES`. A CBOR message is never cut: ``fragment`` ops carry text.
 """
 
 from __future__ import annotations
