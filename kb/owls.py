@@ -100,6 +100,19 @@ def is_owls(quads: Iterable[ox.Quad]) -> bool:
     return False
 
 
+SERVICE_LINKS = frozenset(
+    f"Service:{local}"
+    for local in ("presents", "presentedBy", "isPresentedBy", "describedBy", "describes", "supports", "supportedBy")
+)
+"""The OWL-S links between a service and its profiles, processes and groundings (``owls_key`` form),
+either way round: what ties a service's own parts to it when they point at the service."""
+
+
+def is_owls_service(kinds: Iterable[str]) -> bool:
+    """Whether ``kinds`` (type IRIs) include an OWL-S ``Service`` of any version."""
+    return any(owls_key(kind) == "Service:Service" for kind in kinds)
+
+
 def requirement_iri(service_iri: str) -> str:
     """The IRI of the requirement made from the OWL-S service (request) ``service_iri``."""
     return service_iri + REQUEST_SUFFIX

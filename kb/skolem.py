@@ -14,7 +14,7 @@ import pyoxigraph as ox
 from cbrs.kb.namespaces import GENID
 from cbrs.kb.vocab import CBRS
 
-__all__ = ["DESCRIPTION_PARTS", "closure", "is_skolem", "quads_by_subject"]
+__all__ = ["DESCRIPTION_PARTS", "closure", "is_skolem", "quads_by_subject", "skolem_digest"]
 
 Node = ox.NamedNode | ox.BlankNode | ox.Triple
 
@@ -38,6 +38,15 @@ whether blank, skolemised or given IRIs of their own (``<camera#output1>``, as a
 def is_skolem(term: object) -> bool:
     """Whether ``term`` is a node the loader made from a blank node."""
     return isinstance(term, ox.NamedNode) and term.value.startswith(GENID)
+
+
+def skolem_digest(term: object) -> str | None:
+    """The digest of the input a skolemised node was named in (``GENID<digest>-c14n3``): nodes of one
+    loaded file share it, nodes of another file have another; None for other terms."""
+    if not is_skolem(term):
+        return None
+    digest, separator, _ = term.value[len(GENID) :].partition("-")  # type: ignore[attr-defined]
+    return digest if separator else None
 
 
 def quads_by_subject(quads: Iterable[ox.Quad]) -> Callable[[Node], list[ox.Quad]]:

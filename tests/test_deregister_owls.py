@@ -1,0 +1,195 @@
+"""Deregistering a description that ``cbrs load`` made from OWL-S removes the OWL-S triples it was made
+from too: its service, profile, process and grounding, their parameters, expressions and results, the
+file's stub class declarations and its ``owl:Ontology`` header, but nothing another description still
+uses. Before, only the cbrs description and the service node's own triples went: loading
+tests/data/owls/services/navigate.owls and deregistering it left 41 triples in graph:services (the
+profile, the process, the parameters, the expressions) and 7 in graph:entailed.
+
+Every test compares the store's triples graph by graph: before the load, after the deregistration, and
+after loading the same file again."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from cbrs.kb import KnowledgeBase, NotFoundError
+from cbrs.kb.namespaces import OWL, RDF, GraphName
+
+from .conftest import make_mini_kb
+
+pytestmark = pytest.mark.both_stores
+
+OWLS = Path(__file__).parent / "data" / "owls"
+CATALOG = OWLS / "catalog-v001.xml"
+NAVIGATE = "http://example.org/services/navigate.owls#NavigateService"
+OPEN_DOOR = "http://example.org/services/open_door.owls#OpenDoorService"
+LAB = "http://example.org/lab-services/pair.owls#"
+
+Snapshot = dict[str, set[str]]
+
+
+def triples_by_graph(kb: KnowledgeBase) -> Snapshot:
+    """Every triple of the store, by graph (the default graph included)."""
+    found: Snapshot = {}
+    for quad in kb.store.quads():
+        found.setdefault(str(quad.graph_name), set()).add(f"{quad.subject} {quad.predicate} {quad.object}")
+    return found
+
+
+@pytest.fixture
+def kb(store_location: str) -> Iterator[KnowledgeBase]:
+    """The core and the mini data, with the OWL-S test ontologies loaded beforehand (so the loads
+    below import nothing new)."""
+    kb = make_mini_kb(store_location)
+    kb.load([OWLS / "ontology"])
+    yield kb
+    kb.close()
+
+
+def _pair(stub_use: str = "Widget") -> str:
+    """One OWL-S file with two services that share a parameter (``#Robot``) and whose file declares
+    two stub classes: ``lab:Widget``, which service A takes, and ``lab:Gadget``, which both give."""
+    anyuri = 'rdf:datatype="http://www.w3.org/2001/XMLSchema#anyURI"'
+    return f"""<?xml version="1.0" encoding="UTF-8"?>
+<rdf:RDF xmlns:rdf="http://www.w3.org/1999/02/22-rdf-syntax-ns#"
+    xmlns:owl="http://www.w3.org/2002/07/owl#"
+    xmlns:service="http://www.daml.org/services/owl-s/1.1/Service.owl#"
+    xmlns:profile="http://www.daml.org/services/owl-s/1.1/Profile.owl#"
+    xmlns:process="http://www.daml.org/services/owl-s/1.1/Process.owl#"
+    xml:base="http://example.org/lab-services/pair.owls">
+  <owl:Ontology rdf:about=""/>
+  <service:Service rdf:ID="A">
+    <service:presents><profile:Profile rdf:ID="AProfile">
+      <profile:serviceName>A</profile:serviceName>
+      <profile:hasInput rdf:resource="#Robot"/>
+      <profile:hasInput><process:Input rdf:ID="Part">
+        <process:parameterType {anyuri}>http://example.org/lab#{stub_use}</process:parameterType>
+      </process:Input></profile:hasInput>
+      <profile:hasOutput><process:Output rdf:ID="AOut">
+        <process:parameterType {anyuri}>http://example.org/lab#Gadget</process:parameterType>
+      </process:Output></profile:hasOutput>
+    </profile:Profile></service:presents>
+  </service:Service>
+  <service:Service rdf:ID="B">
+    <service:presents><profile:Profile rdf:ID="BProfile">
+      <profile:serviceName>B</profile:serviceName>
+      <profile:hasInput rdf:resource="#Robot"/>
+      <profile:hasOutput><process:Output rdf:ID="BOut">
+        <process:parameterType {anyuri}>http://example.org/lab#Gadget</process:parameterType>
+      </process:Output></profile:hasOutput>
+    </profile:Profile></service:presents>
+  </service:Service>
+  <process:Input rdf:ID="Robot">
+    <process:parameterType {anyuri}>http://example.org/ontology/robots.owl#MobileRobot</process:parameterType>
+  </process:Input>
+  <owl:Class rdf:about="http://example.org/lab#Widget"/>
+  <owl:Class rdf:about="http://example.org/lab#Gadget"/>
+</rdf:RDF>
+"""
+
+
+def test_an_owls_advertisement_goes_whole_and_comes_back_the_same(kb: KnowledgeBase) -> None:
+    before = triples_by_graph(kb)
+    kb.load([OWLS / "services" / "navigate.owls"], catalogue=CATALOG)
+    loaded = triples_by_graph(kb)
+    removed = kb.registry.deregister(NAVIGATE)
+    assert triples_by_graph(kb) == before
+    assert removed == sum(len(loaded[g] - before.get(g, set())) for g in loaded if g != str(GraphName.ENTAILED.node))
+    kb.load([OWLS / "services" / "navigate.owls"], catalogue=CATALOG)
+    assert triples_by_graph(kb) == loaded
+    assert kb.description(NAVIGATE).service_name == "Navigate to room"
+
+
+def test_an_owls_requirement_goes_whole(kb: KnowledgeBase) -> None:
+    before = triples_by_graph(kb)
+    kb.load([OWLS / "services" / "open_door.owls"], graph="requirements", catalogue=CATALOG)
+    loaded = triples_by_graph(kb)
+    kb.registry.deregister(OPEN_DOOR + "-request")
+    assert triples_by_graph(kb) == before
+    kb.load([OWLS / "services" / "open_door.owls"], graph="requirements", catalogue=CATALOG)
+    assert triples_by_graph(kb) == loaded
+
+
+def test_deregistering_one_service_leaves_another_file_s_as_loaded(kb: KnowledgeBase) -> None:
+    kb.load([OWLS / "services" / "open_door.owls"], catalogue=CATALOG)
+    only_open_door = triples_by_graph(kb)
+    kb.load([OWLS / "services" / "navigate.owls"], catalogue=CATALOG)
+    kb.registry.deregister(NAVIGATE)
+    assert triples_by_graph(kb) == only_open_door
+
+
+def test_the_advertisement_and_the_requirement_of_one_file_go_separately(kb: KnowledgeBase) -> None:
+    """The same OWL-S file loaded as a service and as a request: its triples are in both graphs, and
+    deregistering the requirement touches graph:requirements only."""
+    kb.load([OWLS / "services" / "open_door.owls"], catalogue=CATALOG)
+    advertised = triples_by_graph(kb)
+    kb.load([OWLS / "services" / "open_door.owls"], graph="requirements", catalogue=CATALOG)
+    kb.registry.deregister(OPEN_DOOR + "-request")
+    assert triples_by_graph(kb) == advertised
+
+
+def test_what_two_services_of_one_file_share_stays_until_both_are_gone(kb: KnowledgeBase, tmp_path: Path) -> None:
+    before = triples_by_graph(kb)
+    pair = tmp_path / "pair.owls"
+    pair.write_text(_pair(), encoding="utf-8")
+    kb.load([pair])
+    services = str(GraphName.SERVICES.node)
+    kb.registry.deregister(LAB + "A")
+    left = triples_by_graph(kb)[services] - before.get(services, set())
+    subjects = {triple.split(" ", 1)[0] for triple in left}
+    # B, its profile and output, the shared #Robot, the Gadget stub B uses, and the file's header
+    assert f"<{LAB}Robot>" in subjects and "<http://example.org/lab#Gadget>" in subjects
+    assert f"<{LAB}B>" in subjects and "<http://example.org/lab-services/pair.owls>" in subjects
+    assert not {f"<{LAB}A>", f"<{LAB}AProfile>", f"<{LAB}Part>", "<http://example.org/lab#Widget>"} & subjects
+    assert [p.type for p in kb.description(LAB + "B").inputs] == ["http://example.org/ontology/robots.owl#MobileRobot"]
+    kb.registry.deregister(LAB + "B")
+    assert triples_by_graph(kb) == before
+
+
+def test_a_stub_class_another_file_uses_stays(kb: KnowledgeBase, tmp_path: Path) -> None:
+    """lab:Widget is declared by both files and taken by A of each: it goes with the second only."""
+    before = triples_by_graph(kb)
+    first, second = tmp_path / "pair.owls", tmp_path / "other.owls"
+    first.write_text(_pair(), encoding="utf-8")
+    second.write_text(_pair().replace("lab-services/pair.owls", "lab-services/other.owls"), encoding="utf-8")
+    kb.load([second])
+    only_second = triples_by_graph(kb)
+    kb.load([first])
+    for service in ("A", "B"):
+        kb.registry.deregister(LAB + service)
+    assert triples_by_graph(kb) == only_second
+    for service in ("A", "B"):
+        kb.registry.deregister(LAB.replace("pair", "other") + service)
+    assert triples_by_graph(kb) == before
+
+
+def test_a_stub_a_turtle_description_uses_stays(kb: KnowledgeBase, tmp_path: Path) -> None:
+    """A registered Turtle description that takes lab:Widget keeps the OWL-S file's declaration of it."""
+    pair = tmp_path / "pair.owls"
+    pair.write_text(_pair(), encoding="utf-8")
+    kb.load([pair])
+    kb.registry.register(
+        """@prefix cbrs: <https://w3id.org/cbrs/core#> .
+        <http://example.org/lab#Sorter> a cbrs:MethodInvocationComponent ; cbrs:deviceName "Arm" ;
+            cbrs:serviceName "Sort" ; cbrs:hasOWLSModel [
+                cbrs:hasInput [ cbrs:parameterType <http://example.org/lab#Widget> ] ;
+                cbrs:hasOutput [ cbrs:parameterType <http://example.org/lab#Gadget> ] ] ."""
+    )
+    for service in ("A", "B"):
+        kb.registry.deregister(LAB + service)
+    services = triples_by_graph(kb)[str(GraphName.SERVICES.node)]
+    assert f"<http://example.org/lab#Widget> <{RDF}type> <{OWL}Class>" in services
+    assert not [t for t in services if t.startswith(f"<{LAB}")]
+
+
+def test_deregistering_an_unknown_or_already_deregistered_service_changes_nothing(kb: KnowledgeBase) -> None:
+    kb.load([OWLS / "services" / "navigate.owls"], catalogue=CATALOG)
+    kb.registry.deregister(NAVIGATE)
+    after = triples_by_graph(kb)
+    for iri in (NAVIGATE, "http://example.org/services/navigate.owls#NavigateProfile"):
+        with pytest.raises(NotFoundError):
+            kb.registry.deregister(iri)
+    assert triples_by_graph(kb) == after
