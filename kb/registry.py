@@ -33,7 +33,7 @@ class ComponentRegistry:
         """Add the advertisements described in ``turtle``; refuses any that already exist."""
         quads, iris = self._parse(turtle, source)
         for iri in iris:
-            if self.is_registered(iri):
+            if self._types(iri):  # an advertisement, or another resource of the graph (a device) by that IRI
                 raise AlreadyRegisteredError(iri)
         before = self._standard_terms.begin()
         self._store.add(quads)
@@ -81,8 +81,16 @@ class ComponentRegistry:
         return NotFoundError(iri, what)
 
     def is_registered(self, iri: str) -> bool:
+        """Whether graph:services types ``iri`` as an advertisement (a component kind, or a lab's subclass
+        of one). Any type would do before, so ``cbrs deregister`` of a device removed the device."""
+        types = self._types(iri)
+        if not types:
+            return False
+        return bool(types & _KIND_SET) or bool(types & _advertisement_classes(self._store))
+
+    def _types(self, iri: str) -> set[str]:
         node = ox.NamedNode(iri)
-        return any(True for _ in self._store.quads(node, ox.NamedNode(RDF + "type"), None, self._graph))
+        return {q.object.value for q in self._store.quads(node, ox.NamedNode(RDF + "type"), None, self._graph)}  # type: ignore[union-attr]
 
     def description_quads(self, iri: str, graph: ox.NamedNode | None = None) -> list[ox.Quad]:
         """The advertisement's triples (in the services graph, or ``graph``) and, recursively, those of
@@ -318,6 +326,7 @@ _KINDS = (
     CBRS.PhysicalManipulationComponent,
     CBRS.MethodInvocationComponent,
 )
+_KIND_SET = frozenset({*_KINDS, CBRS.Advertisement})
 
 
 def _advertisements(store: Store, quads: Iterable[ox.Quad]) -> list[str]:
