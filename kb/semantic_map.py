@@ -136,12 +136,18 @@ class MapObject:
     rgba: tuple[float, float, float, float]
     start: Pose
     support: str | None
-    grasp_approach: str
+    grasp_approaches: tuple[str, ...]
+    """The approaches its class allows ("top", "side"), in the class's order of preference."""
     grasp_height: float
 
     @property
     def name(self) -> str:
         return local_name(self.iri)
+
+    @property
+    def grasp_approach(self) -> str:
+        """The approach its class prefers."""
+        return self.grasp_approaches[0]
 
 
 @dataclass(frozen=True)
@@ -306,9 +312,12 @@ class SemanticMap:
         types: dict[str, list[str]] = defaultdict(list)
         for row in kb.select("map_types"):
             types[row["thing"].value].append(row["type"].value)
-        affordances: dict[str, tuple[str, float]] = {}
+        affordances: dict[str, list[tuple[str, str]]] = {}
+        nearest: dict[str, int] = {}
         for row in kb.select("grasp_affordances"):  # nearest ancestor first
-            affordances.setdefault(row["class"].value, (row["approach"].value, float(row["ratio"].value)))
+            concept, distance = row["class"].value, int(row["distance"].value)
+            if nearest.setdefault(concept, distance) == distance:  # a farther ancestor's is overridden
+                affordances.setdefault(concept, []).append((row["approach"].value, row["ratio"].value))
 
         def things_of(concept: str) -> frozenset[str]:
             return frozenset(row["thing"].value for row in kb.select("designate", {"class": HOME + concept}))
@@ -385,7 +394,7 @@ def _classify(
     iri: str,
     values: dict[str, list[str]],
     types: tuple[str, ...],
-    affordances: dict[str, tuple[str, float]],
+    affordances: dict[str, list[tuple[str, str]]],
     facts: dict[str, dict[str, list[str]]],
     person: bool,
 ) -> None:
@@ -426,8 +435,8 @@ def _classify(
         shape = _text(values, "shapeKind", iri) or ""
         if shape not in ("box", "cylinder"):
             raise MapError(iri, f'has home:shapeKind {shape!r}; use "box" or "cylinder"')
-        grasp = next((affordances[t] for t in types if t in affordances), None)
-        if grasp is None:
+        concept = next((t for t in types if t in affordances), None)
+        if concept is None:
             raise MapError(
                 iri,
                 f"is a {', '.join(local_name(t) for t in types) or 'thing of no class'} and no class above it says how "
@@ -447,8 +456,7 @@ def _classify(
             _rgba(iri, values),
             Pose(_number(values, "x", iri), _number(values, "y", iri), _number(values, "yaw", iri, 0.0)),
             support,
-            grasp[0],
-            grasp[1] * size[2],
+            *_grasp(concept, affordances[concept], size[2]),
         )
         return
     if person:  # a home:Person by the taxonomy
@@ -505,6 +513,41 @@ def _classify(
             node = facts.get(dock_iri, {})
             dock = Pose(_number(node, "x", dock_iri), _number(node, "y", dock_iri), _number(node, "yaw", dock_iri, 0.0))
         built.things[iri] = Thing(iri, types, box, dock)
+
+
+GRASP_APPROACHES = ("top", "side")
+"""The approaches the arms' grasp planner computes (:class:`sim.grasping.GraspKind`)."""
+
+
+def _grasp(concept: str, stated: list[tuple[str, str]], height: float) -> tuple[tuple[str, ...], float]:
+    """The approaches (in order of preference) and the grasp height of an object of ``concept``, from
+    ``concept`` or its nearest superclass that states them. A class writes its approaches as one list,
+    best first ("side top"): two statements of either property give no order (nor one height), so they
+    are refused, naming both, as two values of any one property are."""
+    approaches = sorted({approach for approach, _ in stated})
+    ratios = sorted({ratio for _, ratio in stated})
+    if len(approaches) > 1:
+        raise MapError(
+            concept,
+            "has home:graspApproach " + " and ".join(repr(a) for a in approaches) + " (itself or from its nearest "
+            'class that says): they give no order of preference; write one list, best first ("side top")',
+        )
+    if len(ratios) > 1:
+        raise _two_values(concept, "graspHeightRatio", ratios)
+    kinds = tuple(approaches[0].split())
+    unknown = [kind for kind in kinds if kind not in GRASP_APPROACHES]
+    if not kinds or unknown or len(set(kinds)) != len(kinds):
+        raise MapError(
+            concept,
+            f"has home:graspApproach {approaches[0]!r}; write approaches from "
+            + ", ".join(repr(a) for a in GRASP_APPROACHES)
+            + ', each once, best first ("side top")',
+        )
+    try:
+        ratio = float(ratios[0])
+    except ValueError:
+        raise MapError(concept, f"has home:graspHeightRatio {ratios[0]!r}, not a number") from None
+    return kinds, ratio * height
 
 
 def _dispenser(built: SemanticMap, iri: str, tap: str, facts: dict[str, dict[str, list[str]]]) -> Dispenser:

@@ -36,8 +36,8 @@ from cbrs.sim import predicates as pred
 from cbrs.sim import skills
 from cbrs.sim.arms import GRIPPER_OPEN, ArmSide
 from cbrs.sim.errors import SimulationError
-from cbrs.sim.geometry import Pose2D, Region
-from cbrs.sim.grasping import GraspPose, ObjectModel, compute_grasp_pose
+from cbrs.sim.geometry import Pose2D, Region, Vec3
+from cbrs.sim.grasping import GraspKind, GraspPose, ObjectModel, compute_grasp_pose
 from cbrs.sim.mapping import OccupancyGrid, build_occupancy_grid
 from cbrs.sim.perceived import SEARCH_RADIUS, PerceivedWorld
 from cbrs.sim.perception import (
@@ -68,7 +68,7 @@ from cbrs.sim.values import (
 )
 from cbrs.sim.world import HomeWorld
 
-__all__ = ["GraspPlan", "SimContext", "SimEnvironment", "designator", "implementations", "simulated"]
+__all__ = ["GraspChoice", "GraspPlan", "SimContext", "SimEnvironment", "designator", "implementations", "simulated"]
 
 HOME = PREFIXES["home"]
 LOCALISATION_TOLERANCE = 0.10
@@ -78,6 +78,25 @@ ARM_TIE = 0.01
 """Two arms whose mounts are within 1 cm as far from a target reach it equally well."""
 SETTLE_DISTANCE = 0.03
 """Before a re-plan, an arm lets go of what it holds only with its hand within 3 cm of where it took it."""
+
+
+@dataclass(frozen=True)
+class GraspChoice:
+    """Which of an object's approaches an arm holds it by from where it takes it to where it lets it go
+    (``model.grasp``), and why each approach its class prefers to that one was passed over."""
+
+    arm: ArmSide
+    model: ObjectModel
+    purpose: str
+    """What the hold is for: "taking the Cup", "loading the Cup onto the platform"..."""
+    passed: tuple[tuple[GraspKind, str], ...] = ()
+
+    def __str__(self) -> str:
+        model = self.model
+        text = f"{self.purpose}: the {self.arm.value} arm holds the {model.name} by its {model.grasp.value} grasp"
+        if self.passed:
+            text += " (" + "; ".join(f"not by its {kind.value} grasp: {why}" for kind, why in self.passed) + ")"
+        return text
 
 
 @dataclass
@@ -96,6 +115,7 @@ class SimContext:
     belief: PerceivedWorld | None = None  # where the robots believe things are
     designated: frozenset[str] = frozenset()  # the things the running task's inputs name (IRIs)
     acted: bool = False  # a component has run in this world (the checks before a run are done)
+    choices: list[GraspChoice] = field(default_factory=list)  # the grasps chosen in this run, in order
 
     @property
     def map(self) -> SemanticMap:
@@ -207,10 +227,11 @@ def _knowledge(ctx: SimContext, value: Any) -> Manipulation:
             raise SkillFailed(f"the semantic map has no shape, size or grasp for {local_name(iri)}")
         return Manipulation.of(obj)
     found = from_json(value)
-    if isinstance(found, GraspPlan):
-        return Manipulation(found.object, found.model)
-    if isinstance(found, Manipulation):
-        return found
+    if isinstance(found, (GraspPlan, Manipulation)):
+        # The value names one approach; the map has the class's others to fall back on, after it.
+        obj = ctx.map.objects.get(found.object)
+        fallback = ObjectModel.of(obj).preference if obj is not None and not found.model.approaches else ()
+        return Manipulation(found.object, found.model.preferring(fallback) if fallback else found.model)
     raise SkillFailed(f"expected an object, its manipulation property or its grasp, got {value!r}")
 
 
@@ -335,6 +356,14 @@ def approach(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[st
     x, y, _ = estimate.position
     ctx.arm = _free_arm(ctx, x, y, f"the {model.name}")
     spec = ctx.world.arm_specs[ctx.arm]
+    if len(model.preference) > 1:  # where it goes is a later step's: the first approach it can be taken by
+        side = ctx.arm
+        taking = _Candidates.of(model, lambda held: skills.can_take(ctx.world, estimate, side, held))
+        if not taking.models:
+            raise SkillFailed(taking.refusal())
+        choice = taking.choice(side, taking.models[0], f"taking the {model.name}")
+        _note(ctx, choice)
+        model = choice.model
     ctx.grasp = compute_grasp_pose(model, estimate.position, estimate.yaw, spec.mount, spec.yaw)
     ctx.focus = model.name
     ctx.last_arm = ctx.arm
@@ -376,10 +405,20 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
             ctx.world.time,
             0,
         )
-        spot = _relay_spot(ctx, taken, model, giver, taker)
+        # The taker takes it anew: by an approach it can set it down over the place by (the first, with
+        # one approach: whether it can is its carry's to find, as before).
+        checks = [skills.can_grip, lambda held: skills.can_set_down(ctx.world, taken, taker, held, region)]
+        placing = _Candidates.of(model, *(checks if len(model.preference) > 1 else []))
+        if not placing.models:
+            raise SkillFailed(f"the {taker.value} arm reaches {place.name}, but {placing.refusal()}")
+        spot, _, taken_by = _relay_spot(ctx, taken, _Candidates([model]), placing, giver, taker)
         found = _set_down_for(ctx, device, model, giver, taker, spot, None)
         taker_spec = ctx.world.arm_specs[taker]
-        grasp = compute_grasp_pose(model, found.position, found.yaw, taker_spec.mount, taker_spec.yaw)
+        _note(
+            ctx,
+            placing.choice(taker, taken_by, f"carrying the {model.name} to {place.name}", "no spot to take it by it"),
+        )
+        grasp = compute_grasp_pose(taken_by, found.position, found.yaw, taker_spec.mount, taker_spec.yaw)
         for move in (skills.approach_object, skills.pick_up_object):
             _passing(move(ctx.world, taker, grasp), model, giver, taker)
         ctx.arm, ctx.grasp, ctx.last_arm = taker, grasp, taker
@@ -408,26 +447,80 @@ def fill_from_tap(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> di
 def hand_over(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     """HandOverOntoPlatform by an arm that reaches both the object and the parked base's platform; when
     one arm reaches the object and only the other the platform, the first sets the object down where
-    both reach (:func:`_relay`) and the second loads it."""
+    both reach (:func:`_relay`) and the second loads it, each by the first of the object's approaches
+    that works for its own hold (:func:`_who_loads`)."""
     estimate = decode(inputs["objectPosition"], ObjectEstimate)
     model = _model(ctx, inputs["graspPose"])
     base = ctx.world.base_pose()  # the base parks against the place's docking mark, which the robot knows
-    side, giver, spot = _who_loads(ctx, estimate, model, base)
-    if giver is not None and spot is not None:
-        estimate = _relay(ctx, device, estimate, model, giver, side, spot)
+    loading = _who_loads(ctx, estimate, model, base)
+    side = loading.loader.arm
+    if loading.giver is not None and loading.spot is not None:
+        _note(ctx, loading.giver)
+        estimate = _relay(ctx, device, estimate, loading.giver.model, loading.giver.arm, side, loading.spot)
+    _note(ctx, loading.loader)
     ctx.last_arm, ctx.focus = side, model.name
     reach = ctx.world.arm_specs[side].reach
-    _check(skills.hand_over_onto_platform(ctx.world, estimate, base, side, model, reach))
+    _check(skills.hand_over_onto_platform(ctx.world, estimate, base, side, loading.loader.model, reach))
     return {}
 
 
-def _who_loads(
-    ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, base: Pose2D
-) -> tuple[ArmSide, ArmSide | None, Region | None]:
-    """Which arm loads the object onto the platform of the base parked at ``base``, and, when another
-    arm must first pass it, that arm and the spot where it sets the object down; SkillFailed saying why
-    none can. Asked without moving (inverse kinematics on the private copies): by the hand-over, and
-    before a run, by the plan's check (:meth:`SimEnvironment.given`)."""
+def _note(ctx: SimContext, choice: GraspChoice) -> None:
+    """Keep a choice among several approaches, readable (``SimEnvironment.context.choices``)."""
+    if len(choice.model.preference) > 1:
+        ctx.choices.append(choice)
+
+
+@dataclass
+class _Candidates:
+    """The approaches an arm may hold an object by for one hold, best first, and why each other one is
+    ruled out (each check says why not, or nothing)."""
+
+    models: list[ObjectModel]
+    ruled_out: list[tuple[GraspKind, str]] = field(default_factory=list)
+
+    @classmethod
+    def of(cls, model: ObjectModel, *checks: Callable[[ObjectModel], str]) -> _Candidates:
+        found = cls([])
+        for kind in model.preference:
+            held = model.by(kind)
+            why = next((reason for reason in (check(held) for check in checks) if reason), "")
+            if why:
+                found.ruled_out.append((kind, why))
+            else:
+                found.models.append(held)
+        return found
+
+    def refusal(self) -> str:
+        return "; ".join(why for _, why in self.ruled_out)
+
+    def choice(self, side: ArmSide, held: ObjectModel, purpose: str, unplaced: str = "") -> GraspChoice:
+        """The choice of ``held`` among these, with why each approach preferred to it was not taken (a
+        candidate passed over for want of a spot says ``unplaced``)."""
+        order = held.preference
+        rank = order.index(held.grasp)
+        reasons = dict(self.ruled_out)
+        passed = tuple((kind, reasons.get(kind, unplaced)) for kind in order[:rank])
+        return GraspChoice(side, held, purpose, passed)
+
+
+@dataclass(frozen=True)
+class _Loading:
+    """Who loads the platform, by which grasp, and who passes the object first, by which, and where."""
+
+    loader: GraspChoice
+    giver: GraspChoice | None = None
+    spot: Region | None = None
+
+
+def _who_loads(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, base: Pose2D) -> _Loading:
+    """Which arm loads the object onto the platform of the base parked at ``base`` and by which of its
+    approaches, and, when another arm must first pass it, that arm, its approach and the spot where it
+    sets the object down; SkillFailed saying why none can. Each arm holds it by the first approach, in
+    its class's order, by which it can both take it and let it go where its hold ends (an arm that
+    passes it sets it down, so the loader may take it anew by another approach). Asked without moving
+    (inverse kinematics on the private copies): by the hand-over, and before a run, by the plan's check
+    (:meth:`SimEnvironment.given`). With one approach only the letting go on the platform is asked, as
+    before approaches could be chosen."""
     x, y, _ = estimate.position
     takers = _reaching(ctx, x, y)
     loaders = _reaching(ctx, base.x, base.y)
@@ -438,22 +531,34 @@ def _who_loads(
             f"no free arm reaches the base's platform at ({base.x:.2f}, {base.y:.2f}): the docking pose is "
             "beyond every arm's reach"
         )
+    world, choosing = ctx.world, len(model.preference) > 1
     both = [side for side in takers if side in loaders]
     if both:
-        refused = skills.can_load(ctx.world, estimate, base, both[0], model)
-        if refused:
-            raise SkillFailed(refused)
-        return both[0], None, None
+        side = both[0]
+        checks = [lambda held: skills.can_load(world, estimate, base, side, held)]
+        if choosing:
+            checks.insert(0, lambda held: skills.can_take(world, estimate, side, held))
+        found = _Candidates.of(model, *checks)
+        if not found.models:
+            raise SkillFailed(found.refusal())
+        return _Loading(found.choice(side, found.models[0], f"loading the {model.name} onto the platform"))
     giver, taker = takers[0], loaders[0]
-    spot = _relay_spot(ctx, estimate, model, giver, taker)
-    cx, cy, _ = spot.center
-    refused = skills.can_load(ctx.world, replace(estimate, x=cx, y=cy), base, taker, model)
-    if refused:
+    # Letting go on the platform does not depend on where the loader takes it from: asked first.
+    checks = [lambda held: skills.can_load(world, estimate, base, taker, held)]
+    loading = _Candidates.of(model, *([skills.can_grip, *checks] if choosing else checks))
+    if not loading.models:
         raise SkillFailed(
             f"only the {giver.value} arm reaches the {model.name} and only the {taker.value} arm the platform, "
-            f"and {refused}"
+            f"and {loading.refusal()}"
         )
-    return taker, giver, spot
+    giving = _Candidates.of(model, lambda held: skills.can_take(world, estimate, giver, held)) if choosing else None
+    if giving is not None and not giving.models:
+        raise SkillFailed(f"only the {giver.value} arm reaches the {model.name}, and {giving.refusal()}")
+    spot, given_by, taken_by = _relay_spot(ctx, estimate, giving or _Candidates([model]), loading, giver, taker)
+    passing = f"passing the {model.name} to the {taker.value} arm"
+    given = (giving or _Candidates([model])).choice(giver, given_by, passing, "no spot to set it down by it")
+    loaded = loading.choice(taker, taken_by, f"loading the {model.name} onto the platform", "no spot to take it by it")
+    return _Loading(loaded, given, spot)
 
 
 RELAY_MARGIN = 0.05
@@ -517,13 +622,20 @@ def _set_down_for(
 
 
 def _relay_spot(
-    ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, giver: ArmSide, taker: ArmSide
-) -> Region:
+    ctx: SimContext,
+    estimate: ObjectEstimate,
+    giving: _Candidates,
+    taking: _Candidates,
+    giver: ArmSide,
+    taker: ArmSide,
+) -> tuple[Region, ObjectModel, ObjectModel]:
     """Where on the surface the object rests on both arms reach it, clear of the other objects and of
-    the fixtures standing on it (a dispenser): of the spots nearest both mounts, the first where the
-    giver's hand can hold the object as it sets it down and the taker's hand can take it (asked of the
-    inverse kinematics: a side grasp close to the mount has none)."""
+    the fixtures standing on it (a dispenser), and by which approach each hand holds it there: of the
+    spots nearest both mounts, the first where the giver's hand can hold the object as it sets it down
+    and the taker's hand can take it, each by the first of its candidate approaches that it can hold
+    there (asked of the inverse kinematics: a side grasp close to the mount has none)."""
     smap, world = ctx.map, ctx.world
+    model = giving.models[0]
     x, y, z = estimate.position
     surface = z - model.height / 2.0
     supports = [
@@ -573,21 +685,31 @@ def _relay_spot(
             if any(_distance(box, (cx, cy)) < radius + RELAY_CLEARANCE for box in fixtures):
                 continue
             spots.append((max(distances), math.hypot(cx - x, cy - y), cx, cy))
+
+    def held_by(side: ArmSide, candidates: _Candidates, centre: Vec3) -> ObjectModel | None:
+        spec = world.arm_specs[side]
+        for held in candidates.models:
+            hand = compute_grasp_pose(held, centre, estimate.yaw, spec.mount, spec.yaw)
+            if world.arm(side).can_hold(hand.position, hand.orientation) and world.arm(side).can_hold(
+                hand.pregrasp, hand.orientation
+            ):
+                return held
+        return None
+
     for *_, cx, cy in sorted(spots)[:RELAY_TRIES]:
         centre = (cx, cy, surface + model.height / 2.0)
-        hands = [compute_grasp_pose(model, centre, estimate.yaw, a.mount, a.yaw) for a in arms]
-        if all(
-            world.arm(side).can_hold(hand.position, hand.orientation)
-            and world.arm(side).can_hold(hand.pregrasp, hand.orientation)
-            for side, hand in zip((giver, taker), hands, strict=True)
-        ):
+        given = held_by(giver, giving, centre)
+        taken = held_by(taker, taking, centre) if given is not None else None
+        if given is not None and taken is not None:
             half = RELAY_STEP * 2
-            return Region(
+            region = Region(
                 f"{supports[0].name}Relay", cx - half, cx + half, cy - half, cy + half, top.max_z, top.max_z + 0.3
             )
+            return region, given, taken
+    kinds = " or ".join(dict.fromkeys(held.grasp.value for held in [*giving.models, *taking.models]))
     raise SkillFailed(
         f"there is no spot on {supports[0].name} where both the {giver.value} and the {taker.value} arm can hold "
-        f"the {model.name} by its {model.grasp.value} grasp, to pass it from one to the other"
+        f"the {model.name} by its {kinds} grasp, to pass it from one to the other"
     )
 
 

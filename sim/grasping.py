@@ -8,7 +8,7 @@ used: never the simulator's ground truth.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from enum import StrEnum
 
 import numpy as np
@@ -16,7 +16,7 @@ import numpy as np
 from cbrs.kb.semantic_map import MapObject
 from cbrs.sim.geometry import Quat, Vec3, quat_from_matrix
 
-__all__ = ["GraspKind", "GraspPose", "ObjectModel", "compute_grasp_pose"]
+__all__ = ["PALM_DEPTH", "GraspKind", "GraspPose", "ObjectModel", "compute_grasp_pose"]
 
 
 class GraspKind(StrEnum):
@@ -36,16 +36,50 @@ class ObjectModel:
     width: float
     """Size across the fingers when grasped (diameter of a cup, thickness of a pen)."""
     grasp: GraspKind
+    """The approach the object is (to be) held by."""
     grasp_height: float
     """Height of the grasp point above the object's bottom."""
+    approaches: tuple[GraspKind, ...] = ()
+    """Every approach its class allows, best first, when it allows more than one (else empty: ``grasp``
+    alone). The grasp point is the same for each: the class says where the fingers close, an approach
+    only from where the hand comes."""
+
+    @property
+    def preference(self) -> tuple[GraspKind, ...]:
+        """The approaches to try, best first."""
+        return self.approaches or (self.grasp,)
+
+    def by(self, kind: GraspKind) -> ObjectModel:
+        """The same object held by ``kind`` (one of its approaches)."""
+        return self if kind is self.grasp else replace(self, grasp=kind)
+
+    def preferring(self, kinds: tuple[GraspKind, ...]) -> ObjectModel:
+        """This model with ``kinds`` (its class's approaches, best first) as the ones to fall back on after
+        the one it names: a value that says how to grasp keeps its approach first."""
+        order = (self.grasp, *(kind for kind in kinds if kind is not self.grasp))
+        return replace(self, approaches=order if len(order) > 1 else ())
 
     @classmethod
     def of(cls, obj: MapObject) -> ObjectModel:
         """The model of a semantic-map object: a side grasp closes across a cylinder's diameter, a top
         grasp across the object's width (its y size: the fingers close across its x axis)."""
-        kind = GraspKind(obj.grasp_approach)
+        kinds = tuple(GraspKind(approach) for approach in obj.grasp_approaches)
         width = min(obj.size[0], obj.size[1]) if obj.shape == "cylinder" else obj.size[1]
-        return cls(obj.name, obj.colour, obj.size[2], width, kind, obj.grasp_height)
+        return cls(
+            obj.name, obj.colour, obj.size[2], width, kinds[0], obj.grasp_height, kinds if len(kinds) > 1 else ()
+        )
+
+    def top_clearance(self) -> float:
+        """How far the hand's palm stays above the object's top in a top grasp (negative: it would press
+        on it, the grasp point being deeper than the fingers are long)."""
+        return PALM_DEPTH - (self.height - self.grasp_height)
+
+
+PALM_DEPTH = 0.034
+"""In a top grasp the hand's palm is 3.4 cm above the grasp point (the Panda's panda_hand link, gripper
+open, hand pointing down: its collision box's lowest point 3.46 cm above panda_grasptarget, the
+fingertips 1.1 cm below it): an object whose top is higher above the grasp point than that cannot be
+taken from the top."""
 
 
 SIDE_PITCH = math.radians(35.0)

@@ -20,6 +20,7 @@ from cbrs.sim import predicates as pred
 from cbrs.sim.arms import GRIPPER_OPEN, Arm, ArmSide
 from cbrs.sim.geometry import Pose2D, Region, Vec3, wrap_angle
 from cbrs.sim.grasping import (
+    PALM_DEPTH,
     PREGRASP_DISTANCE,
     GraspKind,
     GraspPose,
@@ -40,7 +41,10 @@ __all__ = [
     "NAVIGATION_TOLERANCE",
     "Outcome",
     "approach_object",
+    "can_grip",
     "can_load",
+    "can_set_down",
+    "can_take",
     "carry_object",
     "clear_view",
     "deliver_object",
@@ -316,6 +320,55 @@ def can_load(
 ) -> str:
     """Why ``side`` cannot load the object onto the platform of the base parked at ``base`` (empty if it can)."""
     return _loading(world, pen, base, side, model)[3]
+
+
+def can_grip(model: ObjectModel) -> str:
+    """Why the hand cannot close on the object by the approach ``model`` is held by, wherever it is
+    (empty if it can): a top grasp whose grasp point is deeper below the object's top than the palm
+    is above the fingers' grasp point would press the palm on it."""
+    if model.grasp is GraspKind.TOP and model.top_clearance() < 0.0:
+        depth = model.height - model.grasp_height
+        return (
+            f"a top grasp would hold the {model.name} {depth * 100:.1f} cm below its top, and the hand's palm is "
+            f"{PALM_DEPTH * 100:.1f} cm above the fingers' grasp point"
+        )
+    return ""
+
+
+def can_take(world: HomeWorld, pen: ObjectEstimate, side: ArmSide | str, model: ObjectModel) -> str:
+    """Why ``side`` cannot take the object where it is by the approach ``model`` is held by (empty if it
+    can), asked without moving: the hand cannot close on it so (:func:`can_grip`), or cannot hold the
+    pre-grasp or the grasp pose."""
+    arm = ArmSide(side)
+    x, y, _ = pen.position
+    refused = can_grip(model)
+    if refused:
+        return refused
+    spec = world.arm_specs[arm]
+    grasp = compute_grasp_pose(model, pen.position, pen.yaw, spec.mount, spec.yaw)
+    hand = world.arm(arm)
+    if not (hand.can_hold(grasp.pregrasp, grasp.orientation) and hand.can_hold(grasp.position, grasp.orientation)):
+        return (
+            f"the {arm.value} arm cannot hold the {model.name} by its {model.grasp.value} grasp at ({x:.2f}, {y:.2f})"
+        )
+    return ""
+
+
+def can_set_down(world: HomeWorld, pen: ObjectEstimate, side: ArmSide | str, model: ObjectModel, region: Region) -> str:
+    """Why ``side``, taking the object where it is by ``model``'s approach, cannot let it go over the
+    middle of ``region`` (empty if it can): the hand keeps the orientation it took it with, as
+    :func:`carry_object` and :func:`put_down_object` do."""
+    arm = ArmSide(side)
+    spec = world.arm_specs[arm]
+    grasp = compute_grasp_pose(model, pen.position, pen.yaw, spec.mount, spec.yaw)
+    cx, cy, _ = region.center
+    letting_go = (cx, cy, region.zmin + PLACE_CLEARANCE + grasp.bottom_offset)
+    if not world.arm(arm).can_hold(letting_go, grasp.orientation):
+        return (
+            f"the {arm.value} arm cannot hold the {model.name} by its {model.grasp.value} grasp over {region.name} "
+            f"at ({cx:.2f}, {cy:.2f}) to set it down there"
+        )
+    return ""
 
 
 def hand_over_onto_platform(
