@@ -21,12 +21,13 @@ import pyoxigraph as ox
 from cbrs import __version__
 from cbrs.app import App, parse_iri, pass_app
 from cbrs.extras import require
-from cbrs.kb import Advertisement, KnowledgeBaseError, Requirement, ServiceDescription
+from cbrs.kb import Advertisement, KnowledgeBase, KnowledgeBaseError, Requirement, ServiceDescription
 from cbrs.kb.catalog import Catalogue, merge
 from cbrs.kb.errors import QuerySyntaxError
 from cbrs.kb.loader import LoadReport, ParsedFile
 from cbrs.kb.namespaces import OWL, PREFIXES, GraphName, expand, shorten
-from cbrs.output import RESULT_FORMATS, render_result, table, term_text
+from cbrs.kb.store import Term
+from cbrs.output import RESULT_FORMATS, node_view, render_result, table, term_text
 from cbrs.settings import SETTINGS, setting
 from cbrs.sparql_hints import explain_syntax_error
 
@@ -363,15 +364,42 @@ def show(app: App, iri: str, as_json: bool) -> None:
             click.echo(_describe(description))
         return
     rows = kb.select("resource_triples", {"resource": full})
+    views = [_node_view(kb, row["other"], row["direction"].value) for row in rows]
     if as_json:
-        click.echo(json.dumps([{k: v.value for k, v in row.items() if k != "resource"} for row in rows], indent=2))
+        found = []
+        for row, view in zip(rows, views, strict=True):
+            item: dict[str, Any] = {k: v.value for k, v in row.items() if k != "resource"}
+            if view is not None:
+                item["other_text"] = view["text"]
+                item.update({key: view[key] for key in ("expression", "owner") if key in view})
+            found.append(item)
+        click.echo(json.dumps(found, indent=2))
         return
     click.echo(f"{shorten(full)}")
+    own = _node_view(kb, ox.NamedNode(full))
+    if own is not None:
+        click.echo(f"  = {own['text']}")
     body = [
-        [term_text(r["direction"]), term_text(r["predicate"]), term_text(r["other"]), term_text(r["graph"])]
-        for r in rows
+        [
+            term_text(r["direction"]),
+            term_text(r["predicate"]),
+            view["text"] if view is not None else term_text(r["other"]),
+            term_text(r["graph"]),
+        ]
+        for r, view in zip(rows, views, strict=True)
     ]
     click.echo(table(["direction", "predicate", "value", "graph"], body))
+
+
+def _node_view(kb: KnowledgeBase, term: Term, direction: str = "out") -> dict[str, Any] | None:
+    """How ``show`` names a skolemised node (a restriction, a description's parameter): ``cbrs.output.node_view``
+    over the stored triples, those graph:entailed derives left out."""
+    entailed = GraphName.ENTAILED.node
+
+    def into(node: ox.NamedNode) -> list[ox.Quad]:
+        return [q for q in kb.store.quads(None, None, node) if q.graph_name != entailed]
+
+    return node_view(lambda node: kb.store.quads(node), into, term, direction)
 
 
 @cli.command("check")

@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable
+from typing import Any
+
 import pyoxigraph as ox
 
-from cbrs.kb.namespaces import PREFIXES, shorten
+from cbrs.kb.namespaces import OWL, PREFIXES, RDF, XSD, shorten
+from cbrs.kb.skolem import is_skolem
 from cbrs.kb.store import QueryResult, Term
 
 RESULT_FORMATS = ("table", "json", "csv", "tsv")
@@ -57,3 +61,260 @@ def table(headers: list[str], rows: list[list[str]]) -> str:
     lines.append("  ".join("-" * w for w in widths))
     lines.extend("  ".join(c.ljust(w) for c, w in zip(row, widths, strict=True)).rstrip() for row in rows)
     return "\n".join(lines)
+
+
+# -- class expressions -------------------------------------------------------------------------
+
+Expression = dict[str, Any]
+"""A class expression as JSON: ``{"type": ...}`` with, by type, ``iri`` (``class``, ``property``,
+``individual``, ``node``: one not read), ``value`` (``literal``), ``property`` and ``filler`` (``some``, ``only``,
+``value``), ``property`` (``self``, ``inverse``), ``property``, ``cardinality`` and maybe ``filler``
+(``min``, ``max``, ``exactly``), ``operands`` (``and``, ``or``), ``operand`` (``not``), ``members``
+(``oneOf``), ``datatype`` and ``facets`` (``datatype``)."""
+
+EXPRESSION_DEPTH = 4
+"""Class expressions nested deeper than this are named by their node (``genid:...``): a restriction
+on an intersection of restrictions is as deep as an ontology of this kind goes, and a deeper (or
+cyclic) one would not be read on one line anyway."""
+
+_VALUE_RESTRICTIONS = {OWL + "someValuesFrom": "some", OWL + "allValuesFrom": "only", OWL + "hasValue": "value"}
+_CARDINALITIES = {
+    OWL + "minCardinality": "min",
+    OWL + "maxCardinality": "max",
+    OWL + "cardinality": "exactly",
+    OWL + "minQualifiedCardinality": "min",
+    OWL + "maxQualifiedCardinality": "max",
+    OWL + "qualifiedCardinality": "exactly",
+}
+_BOOLEANS = {OWL + "intersectionOf": "and", OWL + "unionOf": "or"}
+_FACETS = {"minInclusive": ">=", "maxInclusive": "<=", "minExclusive": ">", "maxExclusive": "<"}
+
+Object = ox.NamedNode | ox.BlankNode | ox.Literal | ox.Triple
+"""Any term a quad may have as its object."""
+
+QuadsOf = Callable[[ox.NamedNode], Iterable[ox.Quad]]
+"""The quads whose subject is a node, in any graph (``lambda n: store.quads(n)``)."""
+
+
+def class_expression(quads_of: QuadsOf, node: Object, depth: int = EXPRESSION_DEPTH) -> Expression | None:
+    """The OWL class expression a skolemised node (a blank node in the source) stands for: a restriction,
+    an intersection, union or complement, an enumeration or a datatype restriction. None when the node is
+    none of those (a service description's parameter, say)."""
+    if not is_skolem(node):
+        return None
+    found = _expression(quads_of, node, depth, frozenset())
+    return None if found["type"] == "node" else found
+
+
+def _expression(quads_of: QuadsOf, term: Object, depth: int, path: frozenset[str]) -> Expression:
+    """``term`` read as a class expression; a node it cannot read (or too deep) as ``{"type": "node"}``."""
+    if isinstance(term, ox.Literal):
+        return _literal(term)
+    if not isinstance(term, ox.NamedNode):
+        return {"type": "node", "iri": str(term)}
+    if not is_skolem(term):
+        return {"type": "class", "iri": term.value}
+    if depth <= 0 or term.value in path:
+        return {"type": "node", "iri": term.value}
+    here = path | {term.value}
+    values: dict[str, list[Object]] = {}
+    for quad in quads_of(term):
+        found = values.setdefault(quad.predicate.value, [])
+        if quad.object not in found:
+            found.append(quad.object)
+    first = {predicate: objects[0] for predicate, objects in values.items() if len(objects) == 1}
+
+    def inner(value: Object) -> Expression:
+        return _expression(quads_of, value, depth - 1, here)
+
+    if OWL + "onProperty" in first:
+        restriction = _restriction(first, inner)
+        if restriction is not None:
+            return restriction
+    for predicate, kind in _BOOLEANS.items():
+        if predicate in first:
+            members = _members(quads_of, first[predicate])
+            if members is not None:
+                return {"type": kind, "operands": [inner(m) for m in members]}
+    inverse = first.get(OWL + "inverseOf")
+    if isinstance(inverse, ox.NamedNode):
+        return {"type": "inverse", "property": {"type": "property", "iri": inverse.value}}
+    if OWL + "complementOf" in first:
+        return {"type": "not", "operand": inner(first[OWL + "complementOf"])}
+    if OWL + "oneOf" in first:
+        members = _members(quads_of, first[OWL + "oneOf"])
+        if members is not None:
+            return {"type": "oneOf", "members": [inner(m) for m in members]}
+    datatype = first.get(OWL + "onDatatype")
+    if isinstance(datatype, ox.NamedNode) and OWL + "withRestrictions" in first:
+        facets = _members(quads_of, first[OWL + "withRestrictions"])
+        if facets is not None:
+            read = [_facet(quads_of, facet) for facet in facets]
+            if all(item is not None for item in read):
+                return {"type": "datatype", "datatype": datatype.value, "facets": read}
+    return {"type": "node", "iri": term.value}
+
+
+def _restriction(first: dict[str, Object], inner: Callable[[Object], Expression]) -> Expression | None:
+    prop = inner(first[OWL + "onProperty"])
+    if prop["type"] == "node":
+        return None
+    if prop["type"] == "class":
+        prop = {"type": "property", "iri": prop["iri"]}
+    for predicate, kind in _VALUE_RESTRICTIONS.items():
+        if predicate in first:
+            value = first[predicate]
+            filler = _literal(value) if isinstance(value, ox.Literal) else inner(value)
+            if kind == "value" and filler["type"] == "class":
+                filler = {"type": "individual", "iri": filler["iri"]}
+            return {"type": kind, "property": prop, "filler": filler}
+    if OWL + "hasSelf" in first:
+        return {"type": "self", "property": prop}
+    for predicate, kind in _CARDINALITIES.items():
+        number = first.get(predicate)
+        if isinstance(number, ox.Literal):
+            try:
+                count = int(number.value)
+            except ValueError:
+                return None
+            found: Expression = {"type": kind, "property": prop, "cardinality": count}
+            qualifier = first.get(OWL + "onClass", first.get(OWL + "onDataRange"))
+            if qualifier is not None:
+                found["filler"] = inner(qualifier)
+            return found
+    return None
+
+
+def _literal(term: ox.Literal) -> Expression:
+    found: Expression = {"type": "literal", "value": term.value}
+    if term.language:
+        found["language"] = term.language
+    else:
+        found["datatype"] = term.datatype.value
+    return found
+
+
+def _members(quads_of: QuadsOf, head: Object) -> list[Object] | None:
+    """The members of the RDF list at ``head``; None when it is no well-formed list."""
+    members: list[Object] = []
+    seen: set[Object] = set()
+    node = head
+    while node != ox.NamedNode(RDF + "nil"):
+        if not isinstance(node, ox.NamedNode) or node in seen:
+            return None
+        seen.add(node)
+        links = {q.predicate.value: q.object for q in quads_of(node)}
+        if RDF + "first" not in links or RDF + "rest" not in links:
+            return None
+        members.append(links[RDF + "first"])
+        node = links[RDF + "rest"]
+    return members
+
+
+def _facet(quads_of: QuadsOf, node: Object) -> dict[str, Any] | None:
+    if not isinstance(node, ox.NamedNode):
+        return None
+    for quad in quads_of(node):
+        if quad.predicate.value.startswith(XSD) and isinstance(quad.object, ox.Literal):
+            return {"facet": quad.predicate.value, "value": _literal(quad.object)}
+    return None
+
+
+def manchester(expression: Expression, nested: bool = False) -> str:
+    """``expression`` in Manchester syntax with prefixed names: ``home:hasPart some home:Gripper``,
+    ``home:hasColour value home:Red``, ``home:hasWheel exactly 4 home:Wheel``; an operand that is
+    itself compound is put in parentheses."""
+    kind = expression["type"]
+    if kind in ("class", "property", "individual", "node"):
+        return shorten(expression["iri"])
+    if kind == "literal":
+        return _literal_text(expression)
+    if kind == "and" or kind == "or":
+        text = f" {kind} ".join(manchester(operand, True) for operand in expression["operands"])
+    elif kind == "inverse":
+        text = "inverse " + manchester(expression["property"], True)
+    elif kind == "not":
+        text = "not " + manchester(expression["operand"], True)
+    elif kind == "oneOf":
+        return "{" + ", ".join(manchester(member) for member in expression["members"]) + "}"
+    elif kind == "datatype":
+        facets = ", ".join(
+            f"{_FACETS.get(f['facet'].removeprefix(XSD), shorten(f['facet']))} {_literal_text(f['value'])}"
+            for f in expression["facets"]
+        )
+        return f"{shorten(expression['datatype'])}[{facets}]"
+    else:
+        prop = manchester(expression["property"], True)
+        if kind == "self":
+            text = f"{prop} Self"
+        elif "cardinality" in expression:
+            filler = f" {manchester(expression['filler'], True)}" if "filler" in expression else ""
+            text = f"{prop} {kind} {expression['cardinality']}{filler}"
+        else:
+            text = f"{prop} {kind} {manchester(expression['filler'], True)}"
+    return f"({text})" if nested else text
+
+
+def _literal_text(literal: Expression) -> str:
+    value = str(literal["value"])
+    if literal.get("datatype") in (XSD + "integer", XSD + "decimal", XSD + "double", XSD + "boolean"):
+        return value
+    quoted = '"' + value.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    if "language" in literal:
+        return f"{quoted}@{literal['language']}"
+    if literal.get("datatype") not in (None, XSD + "string"):
+        return f"{quoted}^^{shorten(literal['datatype'])}"
+    return quoted
+
+
+def node_view(quads_of: QuadsOf, quads_into: QuadsOf, node: Object, direction: str = "out") -> dict[str, Any] | None:
+    """How ``cbrs show`` names a skolemised node it lists: ``{"text"}`` with ``expression`` (a class
+    expression, :func:`class_expression`) and, for a node that points at the shown resource
+    (``direction`` "in"), ``owner`` (``{"iri", "path"}``: the named resource it hangs off and the
+    properties down to it). ``home:Cup rdfs:subClassOf home:hasPart some home:Handle`` for the restriction
+    that names a part, ``svc:Cam / cbrs:hasOWLSModel / cbrs:hasInput`` for a parameter. None for other terms."""
+    if not is_skolem(node) or not isinstance(node, ox.NamedNode):
+        return None
+    if direction != "in":
+        expression = class_expression(quads_of, node)
+        return None if expression is None else {"text": manchester(expression), "expression": expression}
+    owner = _owner(quads_into, node)
+    if owner is None:
+        expression = class_expression(quads_of, node)
+        return None if expression is None else {"text": manchester(expression), "expression": expression}
+    iri, path, top = owner
+    found: dict[str, Any] = {"owner": {"iri": iri, "path": path}}
+    expression = class_expression(quads_of, top)
+    if expression is not None:
+        found["expression"] = expression
+        found["text"] = f"{shorten(iri)} {shorten(path[0])} {manchester(expression)}"
+    else:
+        steps = [shorten(step) for step in path if step not in (RDF + "first", RDF + "rest")]
+        found["text"] = " / ".join([shorten(iri), *steps])
+    return found
+
+
+OWNER_DEPTH = 8
+"""How far up :func:`node_view` looks for the named resource a node hangs off."""
+
+
+def _owner(quads_into: QuadsOf, node: ox.NamedNode) -> tuple[str, list[str], ox.NamedNode] | None:
+    """The named resource above ``node``, the properties from it down to ``node``, and the topmost
+    skolemised node on the way (the class expression a nested one is part of)."""
+    path: list[str] = []
+    current = node
+    seen = {node}
+    for _ in range(OWNER_DEPTH):
+        links = sorted(quads_into(current), key=str)
+        if not links:
+            return None
+        link = links[0]  # a blank node of the source has one parent
+        path.insert(0, link.predicate.value)
+        parent = link.subject
+        if not isinstance(parent, ox.NamedNode) or parent in seen:
+            return None
+        if not is_skolem(parent):
+            return parent.value, path, current
+        seen.add(parent)
+        current = parent
+    return None
