@@ -21,6 +21,7 @@ each sub-action is composed in their partial order and the plans are concatenate
 
 from __future__ import annotations
 
+import difflib
 import re
 from collections import deque
 from collections.abc import Callable, Sequence
@@ -91,6 +92,7 @@ class Unsatisfied:
     chain: tuple[str, ...] = ()  # from the requirement's goal down to this need
     cycle: bool = False  # providers exist, but each needs (through others) what this need blocks
     undeclared: tuple[str, ...] = ()  # classes the need names that the ontology does not have
+    near: tuple[tuple[str, str], ...] = ()  # (undeclared class, the declared class its name is closest to)
 
     def text(self) -> str:
         consumer = "the requirement" if self.consumer in (SRO, SRE, GOAL) else shorten(self.consumer)
@@ -100,6 +102,8 @@ class Unsatisfied:
             need = "effect " + need.removeprefix("precondition ")
         if self.cycle:
             return f"only a cycle of components provides {need} of {consumer}{via}"
+        if self.consumer == SRI:  # the task gives it: nothing to provide, but its class is unknown
+            return f"the requirement gives {need}; {self.remedy()}"
         return f"no component provides {need} of {consumer}{via}; {self.remedy()}"
 
     def remedy(self) -> str:
@@ -108,8 +112,10 @@ class Unsatisfied:
         if self.undeclared:
             names = ", ".join(shorten(c) for c in self.undeclared)
             example = shorten(self.undeclared[0])
+            meant = "; ".join(f"{shorten(typed)}: did you mean {shorten(known)}?" for typed, known in self.near)
             return (
-                f"{names} {'is no class' if len(self.undeclared) == 1 else 'are no classes'} of the ontology: "
+                f"{names} {'is no class' if len(self.undeclared) == 1 else 'are no classes'} of the ontology"
+                f"{f' ({meant})' if meant else ''}: "
                 f"declare {'it' if len(self.undeclared) == 1 else 'them'} under a class the components know "
                 f"(e.g. {example} rdfs:subClassOf home:PersonalItem, loaded into the ontology graph), "
                 f"or {self._remedy()}"
@@ -117,6 +123,8 @@ class Unsatisfied:
         return self._remedy()
 
     def _remedy(self) -> str:
+        if self.consumer == SRI:
+            return "correct the input's cbrs:parameterType"
         if self.consumer == GOAL:  # the task states nothing to plan towards
             return (
                 "state what the task wants as an output (cbrs:hasOutput) or an effect (cbrs:hasEffect): "
@@ -242,6 +250,13 @@ class Composer:
         elif isinstance(task, Requirement):
             task = Task(task.iri, task, self.actions.actions.get(task.for_task or ""))
         direct = self.attempt(task.requirement, task)
+        unknown = [p for p in task.requirement.inputs if p.type and p.type not in self.index]
+        if unknown and direct.plan is not None:  # planned without the thing given: it fetches some other (a marker)
+            needs = tuple(Unsatisfied(f"input {p.name} ({shorten(p.type)})", SRI) for p in unknown)
+            return self._result(task, None, needs, (replace(direct, plan=None, unsatisfied=needs),))
+        holding = self._state if self._state is not None else []
+        if self._achieved(task.requirement, holding):
+            return self._result(task, _achieved_plan(task), (), (direct,))
         if direct.plan is not None:
             return self._result(task, direct.plan, direct.unsatisfied, (direct,))
         result = self._decomposed(task, direct) if self._decomposable(task) else None
@@ -420,7 +435,7 @@ class Composer:
                 return self._result(task, None, unsatisfied, tuple(attempts))
             plans.append(plan)
         if not plans:  # every part is achieved: nothing to do but check
-            return self._result(task, None, direct.unsatisfied, tuple(attempts))
+            return self._result(task, _achieved_plan(task), (), tuple(attempts))
         return self._result(task, _concatenate(task, plans), (), tuple(attempts))
 
     def _achieved(self, requirement: Requirement, holding: Sequence[Statement]) -> bool:
@@ -443,14 +458,28 @@ class Composer:
         named = {p.type for p in (*requirement.inputs, *requirement.outputs)}
         for statement in (*requirement.preconditions, *requirement.effects):
             named |= {statement.subject, statement.object}
+        given = {p.type for p in requirement.inputs}  # an input of no known class feeds no component at all
         missing = tuple(
             sorted(
                 c
                 for c in named
-                if c and c not in self.index and re.search(rf"\b{re.escape(shorten(c))}\b", unsatisfied.need)
+                if c
+                and c not in self.index
+                and (c in given or re.search(rf"\b{re.escape(shorten(c))}\b", unsatisfied.need))
             )
         )
-        return replace(unsatisfied, undeclared=missing) if missing else unsatisfied
+        if not missing:
+            return unsatisfied
+        near = tuple((c, found) for c in missing if (found := self._closest(c)) is not None)
+        return replace(unsatisfied, undeclared=missing, near=near)
+
+    def _closest(self, concept: str) -> str | None:
+        """The declared class of the same namespace whose name is closest to ``concept``'s (a typo:
+        home:Pne for home:Pen), if any is close."""
+        namespace, name = _split(concept)
+        names = {_split(c)[1]: c for c in self.index.nodes() if _split(c)[0] == namespace}
+        found = difflib.get_close_matches(name, list(names), n=1, cutoff=0.6)
+        return names[found[0]] if found else None
 
 
 def store_plan(kb: KnowledgeBase, plan: Plan) -> None:
@@ -842,6 +871,11 @@ class _Extraction:
         if not served:
             return []
         sources = {SRI} | {self.steps[b.source].node for b in step.bindings if b.source is not None}
+        given = {  # the values the executor passes, by input name: which vertex's which offer
+            b.need.name: (SRI if b.source is None else self.steps[b.source].node, b.edge.offer.name)
+            for b in step.bindings
+            if b.need.role == "input"
+        }
         into = [
             self._best_from(self._goal_node(need) if consumer.id == 0 else consumer.node, need)
             for consumer, need in served
@@ -858,10 +892,20 @@ class _Extraction:
                     break
                 feeds.append(edge.similarity)
             else:
-                fed = all(any(e.source in sources for e in self.graph.providers(iri, need)) for need in vertex.needs)
+                fed = all(self._fed(iri, need, sources, given) for need in vertex.needs)
                 if fed and feeds:
                     found.append(((-min(feeds), vertex.cost, iri), iri))
         return [iri for _, iri in sorted(found)]
+
+    def _fed(self, iri: str, need: Need, sources: set[str], given: dict[str, tuple[str, str]]) -> bool:
+        """Whether a would-be alternative gets ``need`` from the step as planned: an input by its name,
+        the very value the step is given under that name (the executor passes the planned component's
+        inputs as they are: InferObjectPlace's object is no position, however both come from the
+        requirement), a precondition from any of the step's sources."""
+        if need.role != "input":
+            return any(e.source in sources for e in self.graph.providers(iri, need))
+        origin = given.get(need.name)
+        return origin is not None and any((e.source, e.offer.name) == origin for e in self.graph.providers(iri, need))
 
     def _best_from(self, target: str, need: Need) -> dict[str, Edge]:
         """Each provider's most similar edge into ``need`` of ``target`` (every step's alternatives ask)."""
@@ -875,6 +919,12 @@ class _Extraction:
 
     def _goal_node(self, need: Need) -> str:
         return SRO if need.role == "input" else SRE
+
+
+def _split(iri: str) -> tuple[str, str]:
+    """An IRI's namespace and local name (after its last '#' or '/')."""
+    cut = max(iri.rfind("#"), iri.rfind("/")) + 1
+    return iri[:cut], iri[cut:]
 
 
 def _is_a(index: TaxonomyIndex, concept: str, ancestor: str) -> bool:
@@ -892,6 +942,18 @@ def _threatens(index: TaxonomyIndex, deleted: Statement, needed: Statement) -> b
         _is_a(index, a, b) or _is_a(index, b, a)
         for a, b in ((deleted.subject, needed.subject), (deleted.object, needed.object))
     )
+
+
+def _achieved_plan(task: Task) -> Plan:
+    """The plan of a task whose every effect holds already: no step, and its goals met by the world
+    (the runner still checks them). Planning towards them moved what was where it should be: the cup
+    asked to stand on the table top was picked up and carried to the table's centre, out of reach."""
+    requirement = task.requirement
+    goals = tuple(
+        Binding("precondition", f"goal{n}", Source("world", None, requirement.iri), "Exact", 1.0, None, effect)
+        for n, effect in enumerate(requirement.effects, start=1)
+    )
+    return Plan(task.name, requirement.iri, "achieved", (), goals, 1.0, 0.0)
 
 
 def _concatenate(task: Task, plans: list[Plan]) -> Plan:

@@ -34,3 +34,19 @@ class OrderingConflictError(ActionsError):
         super().__init__(
             f"ordering constraint {constraint} puts {before} before {after}, but the plan needs the opposite order"
         )
+
+
+class UngroundedGoalError(ActionsError):
+    """A task's goal is about a class of which nothing in the world is: it can never hold, and a plan
+    towards it would move things to another place of a wider class (the object's own)."""
+
+    http_status = 422
+
+    def __init__(self, goal: str, concept: str) -> None:
+        self.goal = goal
+        self.concept = concept
+        name = concept.rsplit("#", 1)[-1].rsplit("/", 1)[-1]
+        super().__init__(
+            f"the goal {goal} is about a {name} ({concept}), and nothing in the world is one: add an individual"
+            " of that class to the semantic map (see docs/tasks.md), or correct the goal"
+        )

@@ -109,7 +109,7 @@ class PlanStep:
 class Plan:
     task: str
     requirement: str
-    method: str  # "direct" (one composition) or "decomposed" (one composition per sub-action)
+    method: str  # "direct" (one composition), "decomposed" (one per sub-action), "achieved" (holds: no step)
     steps: tuple[PlanStep, ...]
     goals: tuple[Binding, ...]  # what meets the requirement's outputs and effects
     similarity: float  # mean Sem-Str similarity over every binding, goals included

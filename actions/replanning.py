@@ -128,7 +128,9 @@ class FailureMemory:
 
     def changed(self, failure: Failure, before: Observation, after: Observation) -> bool:
         """Whether the belief of what the failed step depended on differs after the re-perception (every
-        thing, when its inputs named none): a thing moved, appeared or went, or a relation of it changed."""
+        thing, when its inputs named none): a thing moved, appeared or went, or what is believed of it
+        changed (its relations as their subject: the table a carry failed to reach has not changed
+        because the cup that was in the hand is back on it)."""
         things = failure.things or frozenset(before.positions) | frozenset(after.positions)
         for thing in things:
             was, now = before.positions.get(thing), after.positions.get(thing)
@@ -216,4 +218,4 @@ def _bound(step: PlanStep, inputs: Mapping[str, Any], plan: Plan, known: set[str
 
 
 def _facts(facts: Iterable[tuple[str, str, str]], things: frozenset[str]) -> set[tuple[str, str, str]]:
-    return {fact for fact in facts if fact[0] in things or fact[2] in things}
+    return {fact for fact in facts if fact[0] in things}

@@ -14,6 +14,7 @@ from typing import Any, Protocol
 from cbrs.actions.belief import BeliefState, Observation
 from cbrs.actions.components import Container, Registry
 from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, PlanStatus, store_plan
+from cbrs.actions.errors import UngroundedGoalError
 from cbrs.actions.events import Event, EventBus
 from cbrs.actions.executor import ExecutionReport, Executor, RunStatus
 from cbrs.actions.faults import Combined, FaultPolicy, FixedFaults
@@ -21,6 +22,7 @@ from cbrs.actions.graph import statement_text
 from cbrs.actions.plan import Plan, PlanStep
 from cbrs.actions.replanning import Failure, FailureMemory, ReplanPolicy
 from cbrs.kb import KnowledgeBase, NotFoundError, Requirement, Statement
+from cbrs.kb.semantic_map import UnresolvedDesignatorError
 
 
 class Environment(Protocol):
@@ -150,12 +152,23 @@ def run_task(
     before = belief.snapshot()
     belief.write(environment.observe())  # plan from what holds now, not from a past run's belief
     composition = composer.compose(task, belief=True)
+    config = composer.config
+    composition = _runnable(kb, config, task, composition, environment.registry)
     if composition.plan is None:
         belief.restore(before)  # nothing can be done and nothing was: the store is left as it was
         return RunResult(composition, None)
+    try:
+        _check_grounded(kb, composition.plan)
+    except (UngroundedGoalError, UnresolvedDesignatorError):
+        belief.restore(before)
+        raise
     replans: list[Replan] = []
     memory = FailureMemory(replan_policy or ReplanPolicy())
-    config = composer.config
+
+    def compose(avoid: frozenset[str]) -> CompositionResult:
+        """A fresh composition from the belief, without ``avoid`` and what the environment cannot run."""
+        return _runnable(kb, config, task, _compose(kb, config, task, avoid), environment.registry, avoid)
+
     stopped = ""
     report: ExecutionReport | None = None
     outputs: Mapping[int, Mapping[str, Any]] = {}
@@ -192,7 +205,7 @@ def run_task(
             refresh = getattr(environment, "refresh", None)
             if callable(refresh):
                 refresh()  # components registered since the last plan
-            decision = memory.decide(failures, seen, now, lambda avoid: _compose(kb, config, task, avoid))
+            decision = memory.decide(failures, seen, now, compose)
             if decision.composition is None:
                 stopped = decision.stopped  # the result says why; listeners had the plan's failure
                 break
@@ -209,12 +222,54 @@ def run_task(
     return RunResult(composition, report, tuple(replans), goals, stopped)
 
 
+def _runnable(
+    kb: KnowledgeBase,
+    config: ComposeConfig,
+    task: str,
+    composition: CompositionResult,
+    registry: Registry,
+    avoid: frozenset[str] = frozenset(),
+) -> CompositionResult:
+    """``composition``, or when a step of its plan has no component the environment implements (the
+    store advertises services the simulation does not perform, LocateRoomOfPosition say), the
+    composition without them: such a step fails for sure, and only after the steps before it moved
+    things (a goal-only task picked the cup up, then found no room locator, three times over)."""
+    plan = composition.plan
+    if plan is None or all(any(c in registry for c in step.candidates) for step in plan.steps):
+        return composition
+    missing = frozenset(ad.iri for ad in kb.advertisements() if ad.iri not in registry)
+    return _compose(kb, config, task, avoid | missing)
+
+
 def _compose(kb: KnowledgeBase, config: ComposeConfig, task: str, avoid: frozenset[str]) -> CompositionResult:
     """Compose ``task`` afresh from the belief, over every advertisement but those in ``avoid``."""
     if not avoid:
         return Composer(kb, config).compose(task, belief=True)
     kept = [ad for ad in kb.advertisements() if ad.iri not in avoid]
     return Composer(kb, config, advertisements=kept).compose(task, belief=True)
+
+
+def _check_grounded(kb: KnowledgeBase, plan: Plan) -> None:
+    """Refuse, before anything moves, a task that names a class nothing in the world (map or belief) is.
+    In a goal: a place the home lacks (a dish rack) named by the goal alone was planned towards the
+    object's own place, and the arm carried the cup there. In an input, whether a step takes it or not
+    (the environment designates only those the plan uses): a suction cup no robot has was ignored,
+    and the pen fetched by a gripper."""
+    try:
+        requirement = kb.description(plan.requirement)
+    except NotFoundError:
+        requirement = None
+    if isinstance(requirement, Requirement):
+        for parameter in requirement.inputs:
+            if parameter.type and not kb.select("designate", {"class": parameter.type}):
+                raise UnresolvedDesignatorError(parameter.type)
+    for goal in plan.goals:
+        statement = goal.statement
+        if statement is None:
+            continue
+        for concept in (statement.subject, statement.object):
+            if not kb.select("designate", {"class": concept}):
+                raise UngroundedGoalError(statement_text(statement), concept)
 
 
 def _stop_if_cancelled(executor: Executor, cancelled: Callable[[], bool] | None, done: int) -> None:

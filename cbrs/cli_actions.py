@@ -77,10 +77,8 @@ def plan_text(result: CompositionResult) -> str:
         lines += [f"  - {u.text()}" for u in result.unsatisfied]
         return "\n".join(lines)
     plan: Plan = result.plan
-    how = (
-        "composed directly"
-        if plan.method == "direct"
-        else "decomposed into " + ", ".join(map(shorten, plan.sub_actions))
+    how = {"direct": "composed directly", "achieved": "nothing to do: every effect holds already"}.get(
+        plan.method, "decomposed into " + ", ".join(map(shorten, plan.sub_actions))
     )
     head = (
         f"{name}: planned ({how}), {len(plan.steps)} steps, mean similarity {plan.similarity:.3f}, cost {plan.cost:g} s"

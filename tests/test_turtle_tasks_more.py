@@ -1,0 +1,215 @@
+"""More tasks written only in Turtle, as a new lab would write them (tests/data/turtle_tasks_more): each
+runs to success, or is refused before anything moves with an error naming what is wrong.
+
+A new kind of object (an upright glue stick) fetched, loaded and put into a new kind of place; two
+effects at once, for one robot and for two; a goal that holds at the start; a place the home lacks,
+given as an input and named by the goal alone; a robot part no robot has; a mistyped class; a place
+only the other arm reaches. docs/tasks.md lists them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+import pyoxigraph as ox
+import pytest
+
+from cbrs.actions.composer import Composer, PlanStatus
+from cbrs.actions.errors import UngroundedGoalError
+from cbrs.actions.runner import RunResult, run_task
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.semantic_map import SemanticMap, UnresolvedDesignatorError
+from cbrs.sim.components import SimEnvironment
+from cbrs.sim.world import HomeWorld, open_world
+
+DATA = Path(__file__).parent / "data" / "turtle_tasks_more"
+HOME, WORLD, SVC = PREFIXES["home"], PREFIXES["world"], PREFIXES["svc"]
+GLUE_STICK = (("ontology", "glue_stick.ttl"), ("map", "glue_stick.ttl"))
+SUCTION_CUP = (("ontology", "suction_cup.ttl"),)
+
+
+def knowledge(*files: tuple[str, str]) -> KnowledgeBase:
+    kb = KnowledgeBase.open(":memory:")
+    for graph, name in files:
+        kb.load([DATA / name], graph=graph)
+    return kb
+
+
+@contextmanager
+def home(kb: KnowledgeBase) -> Iterator[tuple[HomeWorld, SimEnvironment]]:
+    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
+        yield world, SimEnvironment(world, kb)
+
+
+def run(kb: KnowledgeBase, task: str) -> RunResult:
+    with home(kb) as (_, environment):
+        return run_task(kb, task, environment, composer=Composer(kb))
+
+
+def facts(kb: KnowledgeBase) -> set[tuple[str, str, str]]:
+    return {(r["thing"].value, r["relation"].value, r["other"].value) for r in kb.select("world_facts")}
+
+
+def succeeded(result: RunResult) -> None:
+    assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
+    assert result.goals and all(goal.holds for goal in result.goals), result.goals
+
+
+def components(result: RunResult) -> list[str]:
+    plan = result.composition.plan
+    assert plan is not None
+    return [step.component.removeprefix(SVC) for step in plan.steps]
+
+
+def refused(kb: KnowledgeBase, task: str, error: type[Exception]) -> Exception:
+    """Run ``task`` expecting ``error`` before anything moves: the base where it started, the store as it was."""
+    before = set(kb.store.quads())
+    with home(kb) as (world, environment):
+        start = world.base_pose()
+        with pytest.raises(error) as raised:
+            run_task(kb, task, environment, composer=Composer(kb))
+        assert world.base_pose().distance_to(start.x, start.y) < 0.01
+    assert set(kb.store.quads()) == before
+    return raised.value
+
+
+def test_a_glue_stick_of_a_new_class_is_fetched_from_where_only_the_right_arm_reaches() -> None:
+    kb = knowledge(*GLUE_STICK, ("requirements", "fetch_my_glue_stick.ttl"))
+    result = run(kb, "FetchMyGlueStick")
+    succeeded(result)
+    assert (WORLD + "GlueStick1", HOME + "isWith", WORLD + "Person") in facts(kb)
+
+
+def test_two_effects_load_the_glue_stick_and_bring_the_base_without_delivering() -> None:
+    kb = knowledge(*GLUE_STICK, ("requirements", "glue_stick_on_the_platform_and_come.ttl"))
+    result = run(kb, "BringGlueStickAlong")
+    succeeded(result)
+    steps = components(result)
+    assert "DeliverObject_P3DX01" not in steps and steps[-1] == "NavigateToPerson_P3DX01"
+    assert steps.index("HandOverOntoPlatform_CytonDualArm01") < steps.index("NavigateToPerson_P3DX01")
+    assert {(WORLD + "GlueStick1", HOME + "isLocatedOn", WORLD + "P3DX01Platform")} <= facts(kb)
+
+
+def test_two_effects_for_two_robots_fill_the_cup_and_bring_the_base() -> None:
+    kb = knowledge(("requirements", "serve_water_and_come.ttl"))
+    result = run(kb, "FillCupAndComeToMe")
+    succeeded(result)
+    assert len(result.goals) == 2
+    assert (WORLD + "Cup", HOME + "contains", HOME + "Water") in facts(kb)
+
+
+def test_a_goal_that_holds_at_the_start_moves_nothing() -> None:
+    """The cup stands on the table top: the plan has no step (it used to pick the cup up and carry it to
+    the table's centre, out of reach, three times)."""
+    kb = knowledge(("requirements", "cup_on_the_table_top.ttl"))
+    with home(kb) as (world, environment):
+        cup = world.pose("Cup").position
+        result = run_task(kb, "KeepCupOnTableTop", environment, composer=Composer(kb))
+        assert world.pose("Cup").position == pytest.approx(cup, abs=1e-3)
+    succeeded(result)
+    plan = result.composition.plan
+    assert plan is not None and plan.method == "achieved" and not plan.steps and not result.replans
+    assert Composer(kb).compose("RobotArmServeACup").plan is not None  # a goal that does not hold is planned
+
+
+def test_a_place_the_home_lacks_is_refused_whether_given_or_named_by_the_goal_alone() -> None:
+    given = refused(
+        knowledge(("ontology", "dish_rack.ttl"), ("requirements", "put_cup_in_dish_rack.ttl")),
+        "PutCupInDishRack",
+        UnresolvedDesignatorError,
+    )
+    assert isinstance(given, UnresolvedDesignatorError) and given.concept == HOME + "DishRack"
+    goal = refused(
+        knowledge(("ontology", "dish_rack.ttl"), ("requirements", "put_cup_in_dish_rack_goal_only.ttl")),
+        "RackTheCup",
+        UngroundedGoalError,
+    )
+    assert isinstance(goal, UngroundedGoalError) and goal.concept == HOME + "DishRack"
+    assert goal.goal == "(home:Cup, home:isLocated, home:DishRack)"
+    assert "nothing in the world is one" in str(goal)
+
+
+def test_a_robot_part_no_robot_has_is_refused_and_a_part_of_another_robot_is_used() -> None:
+    unused = refused(
+        knowledge(*SUCTION_CUP, ("requirements", "fetch_my_pen_by_suction.ttl")),
+        "FetchMyPenBySuction",
+        UnresolvedDesignatorError,
+    )
+    assert isinstance(unused, UnresolvedDesignatorError) and unused.concept == HOME + "SuctionCup"
+    kb = knowledge(*SUCTION_CUP, ("requirements", "hold_pen_by_suction.ttl"))
+    before = set(kb.store.quads())
+    result = run(kb, "HoldPenBySuction")
+    assert result.report is None and result.composition.status is PlanStatus.UNSOLVABLE
+    assert "effect (home:Pen, home:isGraspedBy, home:SuctionCup)" in result.composition.unsatisfied[0].text()
+    assert set(kb.store.quads()) == before
+    kb = knowledge(("requirements", "platform_of_the_arms.ttl"))  # the arms ask; the base has the platform
+    result = run(kb, "PenOnMyPlatform")
+    succeeded(result)
+    assert (WORLD + "Pen", HOME + "isLocatedOn", WORLD + "P3DX01Platform") in facts(kb)
+
+
+def test_a_mistyped_class_is_named_with_the_class_meant() -> None:
+    """home:Pne for home:Pen: the plan used to fetch the base's colour marker (a physical object) instead."""
+    kb = knowledge(("requirements", "fetch_my_pen_typo.ttl"))
+    before = set(kb.store.quads())
+    result = run(kb, "FetchMyPenTypo")
+    assert result.report is None and result.composition.status is PlanStatus.UNSOLVABLE
+    [why] = result.composition.unsatisfied
+    assert why.undeclared == (HOME + "Pne",) and why.near == ((HOME + "Pne", HOME + "Pen"),)
+    assert why.text().startswith("the requirement gives input pen (home:Pne); home:Pne is no class of the ontology")
+    assert "did you mean home:Pen?" in why.text()
+    assert set(kb.store.quads()) == before
+
+
+def test_the_glue_stick_goes_into_a_new_kind_of_place() -> None:
+    kb = knowledge(
+        *GLUE_STICK,
+        ("ontology", "glue_stick_holder.ttl"),
+        ("map", "glue_stick_holder.ttl"),
+        ("requirements", "put_glue_stick_in_holder.ttl"),
+    )
+    result = run(kb, "PutGlueStickInHolder")
+    succeeded(result)
+    assert (WORLD + "GlueStick1", HOME + "isLocated", WORLD + "StationeryHolder1") in facts(kb)
+
+
+@pytest.mark.xfail(
+    reason="sim/perceived.py PerceivedWorld.feel: after the right arm lets go of the pen at the relay spot and"
+    " the left arm takes it on, the right arm's release (felt after the left arm's hold) puts the believed pen"
+    " back at the relay spot, so (Pen, isAbove, PenRest) is not believed though the pen is over the pen rest",
+    strict=False,
+)
+def test_a_pen_only_the_right_arm_reaches_goes_to_a_pen_rest_only_the_left_arm_reaches() -> None:
+    kb = knowledge(
+        ("ontology", "pen_rest_west.ttl"), ("map", "pen_rest_west.ttl"), ("requirements", "put_pen_on_pen_rest.ttl")
+    )
+    result = run(kb, "PutPenOnPenRest")
+    succeeded(result)
+
+
+def test_without_the_place_below_the_tap_the_carry_fails_twice_and_the_run_says_why() -> None:
+    """Nothing tells the carry where the cup must stand to be filled: the plan takes the cup's own place
+    (the kitchen table, whose centre no arm reaches). It is planned over the components the simulation
+    implements (it used to take the room of a position from LocateRoomOfPosition, which it does not,
+    and fail over to InferObjectPlace with a position for an object), and after the same failure with
+    nothing changed the run stops instead of a third identical plan."""
+    kb = knowledge(("requirements", "fill_cup_and_come_without_place.ttl"))
+    planned = Composer(kb).compose("FillCupAndComeToMeNoPlace").plan
+    assert planned is not None
+    locator = [s for s in planned.steps if s.component == SVC + "LocateRoomOfPosition_HomeServer01"]
+    assert locator and not locator[0].alternatives  # InferObjectPlace takes an object, not the position given
+    result = run(kb, "FillCupAndComeToMeNoPlace")
+    assert "LocateRoomOfPosition_HomeServer01" not in components(result)
+    assert not result.succeeded and len(result.replans) == 1
+    assert result.stopped.startswith(
+        "re-planning stopped: step 8 (CarryObject_CytonDualArm01 with targetPlace <- KitchenTable): no arm reaches"
+    )
+    assert "met 2 time(s) with nothing it depends on changed (KitchenTable)" in result.stopped
+
+
+def test_every_task_file_here_is_turtle_a_store_loads() -> None:
+    for path in sorted(DATA.glob("*.ttl")):
+        assert len(list(ox.parse(path=str(path), format=ox.RdfFormat.TURTLE))) > 0, path.name
