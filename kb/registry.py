@@ -41,13 +41,15 @@ class ComponentRegistry:
         return iris
 
     def update(self, turtle: str | bytes, source: str = "<update>") -> list[str]:
-        """Replace the descriptions of the advertisements in ``turtle``; each must exist."""
+        """Replace the descriptions of the advertisements in ``turtle``; each must exist. What goes is
+        what :meth:`deregister` would remove: one loaded from OWL-S loses its OWL-S triples too, which
+        no longer describe it (its service node's own went, its profile and process stayed)."""
         quads, iris = self._parse(turtle, source)
         old: list[ox.Quad] = []
         for iri in iris:
             if not self.is_registered(iri):
                 raise self._not_found(iri)
-            old.extend(self.description_quads(iri))
+            old.extend(self.owned_quads(iri))
         new, kept = set(quads), set(old)
         before = self._standard_terms.begin()
         self._store.replace([q for q in old if q not in new], [q for q in quads if q not in kept])

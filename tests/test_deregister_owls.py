@@ -193,3 +193,21 @@ def test_deregistering_an_unknown_or_already_deregistered_service_changes_nothin
         with pytest.raises(NotFoundError):
             kb.registry.deregister(iri)
     assert triples_by_graph(kb) == after
+
+
+def test_an_update_in_turtle_replaces_the_owls_source_too(kb: KnowledgeBase) -> None:
+    """Before, the update replaced the service node's own OWL-S triples and left its profile, process,
+    parameters and expressions, which pointed at a service no longer typed or linked as one."""
+    turtle = f"""@prefix cbrs: <https://w3id.org/cbrs/core#> .
+<{NAVIGATE}> a cbrs:MethodInvocationComponent ; cbrs:deviceName "P3DX01" ; cbrs:serviceName "Navigate" ;
+    cbrs:hasOWLSModel [ cbrs:hasOutput [ cbrs:parameterType <http://example.org/ontology/robots.owl#Position> ] ] .
+"""
+    before = triples_by_graph(kb)
+    kb.registry.register(turtle)
+    registered_alone = triples_by_graph(kb)
+    kb.registry.deregister(NAVIGATE)
+    kb.load([OWLS / "services" / "navigate.owls"], catalogue=CATALOG)
+    kb.registry.update(turtle)
+    assert triples_by_graph(kb) == registered_alone
+    kb.registry.deregister(NAVIGATE)
+    assert triples_by_graph(kb) == before
