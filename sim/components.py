@@ -533,31 +533,49 @@ def _who_loads(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, ba
         )
     world, choosing = ctx.world, len(model.preference) > 1
     both = [side for side in takers if side in loaders]
-    if both:
-        side = both[0]
-        checks = [lambda held: skills.can_load(world, estimate, base, side, held)]
-        if choosing:
-            checks.insert(0, lambda held: skills.can_take(world, estimate, side, held))
-        found = _Candidates.of(model, *checks)
-        if not found.models:
-            raise SkillFailed(found.refusal())
-        return _Loading(found.choice(side, found.models[0], f"loading the {model.name} onto the platform"))
-    giver, taker = takers[0], loaders[0]
-    # Letting go on the platform does not depend on where the loader takes it from: asked first.
-    checks = [lambda held: skills.can_load(world, estimate, base, taker, held)]
+    loader = both[0] if both else loaders[0]
+    purpose = f"loading the {model.name} onto the platform"
+    # Letting go on the platform does not depend on where the loader takes the object from.
+    checks = [lambda held: skills.can_load(world, estimate, base, loader, held)]
+    whole: _Candidates | None = None
+    if both:  # one hold, from where it is to the platform
+        whole = _Candidates.of(
+            model, *([lambda held: skills.can_take(world, estimate, loader, held), *checks] if choosing else checks)
+        )
+        if whole.models:
+            return _Loading(whole.choice(loader, whole.models[0], purpose))
+        if not choosing:
+            raise SkillFailed(whole.refusal())
+    # Two holds, the object set down between them where both reach: the arm that reaches it passes it to
+    # the loader, or, when one arm reaches both but no approach serves it all the way, that arm sets it
+    # down and takes it anew by an approach that loads (the re-grasp).
+    giver = loader if both else takers[0]
     loading = _Candidates.of(model, *([skills.can_grip, *checks] if choosing else checks))
+    giving = _Candidates.of(model, lambda held: skills.can_take(world, estimate, giver, held)) if choosing else None
+    if whole is not None and not (loading.models and giving is not None and giving.models):
+        raise SkillFailed(whole.refusal())
     if not loading.models:
         raise SkillFailed(
-            f"only the {giver.value} arm reaches the {model.name} and only the {taker.value} arm the platform, "
+            f"only the {giver.value} arm reaches the {model.name} and only the {loader.value} arm the platform, "
             f"and {loading.refusal()}"
         )
-    giving = _Candidates.of(model, lambda held: skills.can_take(world, estimate, giver, held)) if choosing else None
     if giving is not None and not giving.models:
         raise SkillFailed(f"only the {giver.value} arm reaches the {model.name}, and {giving.refusal()}")
-    spot, given_by, taken_by = _relay_spot(ctx, estimate, giving or _Candidates([model]), loading, giver, taker)
-    passing = f"passing the {model.name} to the {taker.value} arm"
-    given = (giving or _Candidates([model])).choice(giver, given_by, passing, "no spot to set it down by it")
-    loaded = loading.choice(taker, taken_by, f"loading the {model.name} onto the platform", "no spot to take it by it")
+    giving = giving or _Candidates([model])
+    try:
+        spot, given_by, taken_by = _relay_spot(ctx, estimate, giving, loading, giver, loader)
+    except SkillFailed as nowhere:
+        if whole is None:
+            raise
+        raise SkillFailed(f"{whole.refusal()}; and {nowhere}") from None
+    setting_down = (
+        f"setting the {model.name} down to take it anew, no one approach serving from where it is to the "
+        f"platform ({whole.refusal()})"
+        if whole is not None
+        else f"passing the {model.name} to the {loader.value} arm"
+    )
+    given = giving.choice(giver, given_by, setting_down, "no spot to set it down by it")
+    loaded = loading.choice(loader, taken_by, purpose, "no spot to take it by it")
     return _Loading(loaded, given, spot)
 
 
@@ -596,10 +614,12 @@ def _relay(
 
 def _passing(outcome: skills.Outcome, model: ObjectModel, giver: ArmSide, taker: ArmSide) -> None:
     if not outcome.succeeded:
-        raise SkillFailed(
-            f"passing the {model.name} from the {giver.value} arm to the {taker.value}: "
-            f"{outcome.skill}: {outcome.reason}"
+        what = (
+            f"setting the {model.name} down for the {giver.value} arm to take it anew"
+            if giver is taker
+            else f"passing the {model.name} from the {giver.value} arm to the {taker.value}"
         )
+        raise SkillFailed(f"{what}: {outcome.skill}: {outcome.reason}")
 
 
 def _set_down_for(
@@ -684,7 +704,8 @@ def _relay_spot(
                 continue
             if any(_distance(box, (cx, cy)) < radius + RELAY_CLEARANCE for box in fixtures):
                 continue
-            spots.append((max(distances), math.hypot(cx - x, cy - y), cx, cy))
+            here = math.hypot(cx - x, cy - y)  # a re-grasp moves it as little as the approaches allow
+            spots.append((here, max(distances), cx, cy) if giver is taker else (max(distances), here, cx, cy))
 
     def held_by(side: ArmSide, candidates: _Candidates, centre: Vec3) -> ObjectModel | None:
         spec = world.arm_specs[side]
@@ -706,6 +727,13 @@ def _relay_spot(
                 f"{supports[0].name}Relay", cx - half, cx + half, cy - half, cy + half, top.max_z, top.max_z + 0.3
             )
             return region, given, taken
+    if giver is taker:
+        down = " or ".join(held.grasp.value for held in giving.models)
+        anew = " or ".join(held.grasp.value for held in taking.models)
+        raise SkillFailed(
+            f"there is no spot on {supports[0].name} where the {giver.value} arm can set the {model.name} down by "
+            f"its {down} grasp and take it anew by its {anew} grasp"
+        )
     kinds = " or ".join(dict.fromkeys(held.grasp.value for held in [*giving.models, *taking.models]))
     raise SkillFailed(
         f"there is no spot on {supports[0].name} where both the {giver.value} and the {taker.value} arm can hold "

@@ -8,6 +8,7 @@ The bundled cup is taken from the side; these tests give ``home:Cup`` (nearer th
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from types import SimpleNamespace
 from typing import Any, cast
@@ -182,3 +183,28 @@ def test_an_approach_that_works_for_the_whole_hold_is_kept(tmp_path: Path) -> No
         (ArmSide.LEFT, GraspKind.SIDE, ()),
         (ArmSide.RIGHT, GraspKind.SIDE, ()),
     ]
+
+
+def test_a_cup_no_one_approach_serves_all_the_way_is_set_down_and_taken_anew(tmp_path: Path) -> None:
+    """At (8.02, 3.38) only the right arm reaches the cup, at the edge of its reach, where its hand holds
+    the side grasp but not the top one; over the platform it holds the top grasp, not the side one. It
+    takes the cup by its side grasp, sets it down nearer, takes it anew from the top and loads it."""
+    kb = knowledge(tmp_path, ("ontology", cup_grasps("side top")), ("requirements", FETCH_MY_CUP))
+    kb.update(
+        "DELETE { GRAPH graph:map { world:Cup home:x ?x ; home:y ?y } } "
+        "INSERT { GRAPH graph:map { world:Cup home:x 8.02 ; home:y 3.38 } } "
+        "WHERE { GRAPH graph:map { world:Cup home:x ?x ; home:y ?y } }"
+    )
+    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
+        environment = SimEnvironment(world, kb)
+        result = run_task(kb, "FetchMyCup", environment, composer=Composer(kb))
+        choices = environment.context.choices
+    assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
+    assert not result.replans
+    assert (WORLD + "Cup", HOME + "isWith", WORLD + "Person") in world_facts(kb)
+    right = ArmSide.RIGHT
+    assert [(c.arm, c.model.grasp) for c in choices] == [(right, GraspKind.SIDE), (right, GraspKind.TOP)]
+    first = str(choices[0])  # where the Kinect saw it (the seed moves it by up to 2 cm)
+    assert first.startswith("setting the Cup down to take it anew")
+    assert re.search(r"the right arm cannot hold the Cup by its top grasp at \(8\.0\d, 3\.[34]\d\)", first)
+    assert "cannot hold the Cup by its side grasp over the platform" in first
