@@ -144,7 +144,11 @@ def _expression(quads_of: QuadsOf, term: Object, depth: int, path: frozenset[str
     if OWL + "oneOf" in first:
         members = _members(quads_of, first[OWL + "oneOf"])
         if members is not None:
-            return {"type": "oneOf", "members": [inner(m) for m in members]}
+            individuals = [inner(m) for m in members]
+            for member in individuals:
+                if member["type"] == "class":
+                    member["type"] = "individual"
+            return {"type": "oneOf", "members": individuals}
     datatype = first.get(OWL + "onDatatype")
     if isinstance(datatype, ox.NamedNode) and OWL + "withRestrictions" in first:
         facets = _members(quads_of, first[OWL + "withRestrictions"])
@@ -220,38 +224,54 @@ def _facet(quads_of: QuadsOf, node: Object) -> dict[str, Any] | None:
     return None
 
 
-def manchester(expression: Expression, nested: bool = False) -> str:
+Namer = Callable[[str, str], str]
+"""How :func:`manchester` writes a name: given the kind (``class``, ``property``, ``individual``,
+``node``, ``datatype``) and the IRI."""
+
+
+def _prefixed(kind: str, iri: str) -> str:
+    return shorten(iri)
+
+
+def manchester(
+    expression: Expression, nested: bool = False, name: Namer = _prefixed, plain: Callable[[str], str] = str
+) -> str:
     """``expression`` in Manchester syntax with prefixed names: ``home:hasPart some home:Gripper``,
     ``home:hasColour value home:Red``, ``home:hasWheel exactly 4 home:Wheel``; an operand that is
-    itself compound is put in parentheses."""
+    itself compound is put in parentheses. ``name`` writes the names and ``plain`` the literals and
+    facets (the browser links the one and escapes the other)."""
+
+    def inner(part: Expression, parenthesised: bool = True) -> str:
+        return manchester(part, parenthesised, name, plain)
+
     kind = expression["type"]
     if kind in ("class", "property", "individual", "node"):
-        return shorten(expression["iri"])
+        return name(kind, expression["iri"])
     if kind == "literal":
-        return _literal_text(expression)
+        return plain(_literal_text(expression))
     if kind == "and" or kind == "or":
-        text = f" {kind} ".join(manchester(operand, True) for operand in expression["operands"])
+        text = f" {kind} ".join(inner(operand) for operand in expression["operands"])
     elif kind == "inverse":
-        text = "inverse " + manchester(expression["property"], True)
+        text = "inverse " + inner(expression["property"])
     elif kind == "not":
-        text = "not " + manchester(expression["operand"], True)
+        text = "not " + inner(expression["operand"])
     elif kind == "oneOf":
-        return "{" + ", ".join(manchester(member) for member in expression["members"]) + "}"
+        return "{" + ", ".join(inner(member, False) for member in expression["members"]) + "}"
     elif kind == "datatype":
         facets = ", ".join(
-            f"{_FACETS.get(f['facet'].removeprefix(XSD), shorten(f['facet']))} {_literal_text(f['value'])}"
+            plain(f"{_FACETS.get(f['facet'].removeprefix(XSD), shorten(f['facet']))} {_literal_text(f['value'])}")
             for f in expression["facets"]
         )
-        return f"{shorten(expression['datatype'])}[{facets}]"
+        return f"{name('datatype', expression['datatype'])}[{facets}]"
     else:
-        prop = manchester(expression["property"], True)
+        prop = inner(expression["property"])
         if kind == "self":
             text = f"{prop} Self"
         elif "cardinality" in expression:
-            filler = f" {manchester(expression['filler'], True)}" if "filler" in expression else ""
+            filler = f" {inner(expression['filler'])}" if "filler" in expression else ""
             text = f"{prop} {kind} {expression['cardinality']}{filler}"
         else:
-            text = f"{prop} {kind} {manchester(expression['filler'], True)}"
+            text = f"{prop} {kind} {inner(expression['filler'])}"
     return f"({text})" if nested else text
 
 

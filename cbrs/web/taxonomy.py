@@ -11,14 +11,17 @@ from collections.abc import Iterator, Set
 from dataclasses import dataclass, field
 from typing import Any
 
-from flask import Blueprint, request, url_for
+import pyoxigraph as ox
+from flask import Blueprint, g, request, url_for
 from markupsafe import Markup, escape
 
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import NotFoundError
-from cbrs.kb.namespaces import RDFS, shorten
+from cbrs.kb.namespaces import OWL, RDFS, GraphName, shorten
 from cbrs.kb.vocab import CBRS
+from cbrs.output import Expression, class_expression, manchester, node_view
 from cbrs.web import context, resource
+from cbrs.web.links import iri_link
 from cbrs.web.pages import Page, page
 
 blueprint = Blueprint("taxonomy", __name__)
@@ -32,6 +35,7 @@ _USE_LINKS = {
     CBRS.conditionPredicate: "condition",
     CBRS.conditionObject: "condition",
 }
+_EXPRESSION_LINKS = {RDFS + "subClassOf", OWL + "equivalentClass"}
 _ROLE_LINKS = {
     CBRS.hasInput: "input",
     CBRS.hasOutput: "output",
@@ -187,6 +191,7 @@ def concept() -> Page:
     found = Taxonomy.read(kb)
     if iri not in found:
         raise NotFoundError(iri, "class or property")
+    g.taxonomy_terms = found.kinds  # what expression_html links to a taxonomy page
     triples = kb.select("resource_triples", {"resource": iri})
     comment = next((r["other"].value for r in triples if _out(r, RDFS + "comment")), None)
     kind = found.kinds[iri]
@@ -200,10 +205,67 @@ def concept() -> Page:
         "equivalents": [found.term(t) for t in found.sorted(found.same.get(iri))],
         "parts": _parts(kb, iri) if kind == "class" else [],
         "part_of": [found.term(t) for t in found.sorted(found.wholes.get(iri))],
+        "restrictions": _restrictions(kb, triples) if kind == "class" else [],
+        "named_in": _named_in(kb, triples),
         "usage": _usage(kb, iri, triples),
     }
     noun = "Class" if kind == "class" else "Property"
     return Page("class.html", f"{noun} {shorten(iri)}", data)
+
+
+@blueprint.app_template_global("expression_html")
+def expression_html(expression: Expression) -> Markup:
+    """A class expression (:func:`cbrs.output.class_expression`) in Manchester syntax, its classes and
+    properties linked to their taxonomy pages (those the taxonomy has) and anything else to its triples."""
+
+    terms = g.get("taxonomy_terms", ())
+
+    def name(kind: str, iri: str) -> str:
+        return str(concept_link(iri) if kind in ("class", "property") and iri in terms else iri_link(iri))
+
+    return Markup(manchester(expression, name=name, plain=lambda text: str(escape(text))))
+
+
+def _restrictions(kb: KnowledgeBase, triples: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The class's anonymous superclasses and equivalents (restrictions, intersections...), every one,
+    where the parts table shows only the hasPart family's."""
+    found = []
+    for row in triples:
+        if row["direction"].value != "out" or row["predicate"].value not in _EXPRESSION_LINKS:
+            continue
+        expression = class_expression(lambda node: kb.store.quads(node), row["other"])
+        if expression is not None:
+            found.append(_expression_row(row["predicate"].value, expression))
+    return sorted(found, key=lambda r: (r["relation_name"], r["text"].casefold()))
+
+
+def _named_in(kb: KnowledgeBase, triples: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The classes whose restrictions (or other class expressions) name this term."""
+    entailed = GraphName.ENTAILED.node
+
+    def into(node: ox.NamedNode) -> list[ox.Quad]:
+        return [q for q in kb.store.quads(None, None, node) if q.graph_name != entailed]
+
+    found: dict[tuple[str, str, str], dict[str, Any]] = {}
+    for row in triples:
+        if row["direction"].value != "in":
+            continue
+        view = node_view(lambda node: kb.store.quads(node), into, row["other"], "in")
+        if view is None or "expression" not in view or "owner" not in view:
+            continue
+        owner = view["owner"]["iri"]
+        item = {"iri": owner, "name": shorten(owner), **_expression_row(view["owner"]["path"][0], view["expression"])}
+        found.setdefault((owner, item["relation"], item["text"]), item)
+    return sorted(found.values(), key=lambda r: (r["name"].casefold(), r["text"].casefold()))
+
+
+def _expression_row(relation: str, expression: Expression) -> dict[str, Any]:
+    return {
+        "relation": relation,
+        "relation_name": shorten(relation),
+        "text": manchester(expression),
+        "expression": expression,
+    }
 
 
 def _out(row: dict[str, Any], predicate: str) -> bool:
