@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from cbrs.kb import KnowledgeBase, NotFoundError
+from cbrs.kb import KnowledgeBase, NotFoundError, RdfParseError
 from cbrs.kb.namespaces import OWL, RDF, GraphName
 
 from .conftest import make_mini_kb
@@ -211,3 +211,23 @@ def test_an_update_in_turtle_replaces_the_owls_source_too(kb: KnowledgeBase) -> 
     assert triples_by_graph(kb) == registered_alone
     kb.registry.deregister(NAVIGATE)
     assert triples_by_graph(kb) == before
+
+
+def test_an_edited_file_loads_after_the_old_one_is_deregistered(kb: KnowledgeBase, tmp_path: Path) -> None:
+    """What the refusal to merge says to do ("Deregister it first") gives the store of the edited file
+    alone; before, the old profile, process and parameters stayed and merged with the new ones."""
+    edited = tmp_path / "navigate.owls"
+    text = (OWLS / "services" / "navigate.owls").read_text(encoding="utf-8")
+    edited.write_text(text.replace("Navigate to room", "Drive to room").replace("#Kitchen", "#Room"), encoding="utf-8")
+    before = triples_by_graph(kb)
+    kb.load([edited], catalogue=CATALOG)
+    edited_alone = triples_by_graph(kb)
+    kb.registry.deregister(NAVIGATE)
+    assert triples_by_graph(kb) == before
+    kb.load([OWLS / "services" / "navigate.owls"], catalogue=CATALOG)
+    with pytest.raises(RdfParseError, match="Deregister it first"):
+        kb.load([edited], catalogue=CATALOG)
+    kb.registry.deregister(NAVIGATE)
+    kb.load([edited], catalogue=CATALOG)
+    assert triples_by_graph(kb) == edited_alone
+    assert kb.description(NAVIGATE).service_name == "Drive to room"
