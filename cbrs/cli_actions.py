@@ -342,6 +342,8 @@ def run_text(result: RunResult, sim_seconds: float, wall_seconds: float) -> str:
     timing = f"{sim_seconds:.1f} s simulated, {wall_seconds:.1f} s wall, {failovers} failover(s)"
     timing += f", {len(result.replans)} re-plan(s)" if result.replans else ""
     steps = table(["#", "component", "sim s", "outcome", "effects checked"], rows)
+    if not report.steps:  # every effect held already: no table of no steps
+        steps = "nothing to do: every effect of the task holds already"
     return f"{header}{steps}\n{verdict}; {timing}"
 
 

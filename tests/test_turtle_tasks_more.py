@@ -19,6 +19,7 @@ import pytest
 from cbrs.actions.composer import Composer, PlanStatus
 from cbrs.actions.errors import UngroundedGoalError
 from cbrs.actions.runner import RunResult, run_task
+from cbrs.cli_actions import run_text
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap, UnresolvedDesignatorError
@@ -112,6 +113,7 @@ def test_a_goal_that_holds_at_the_start_moves_nothing() -> None:
     succeeded(result)
     plan = result.composition.plan
     assert plan is not None and plan.method == "achieved" and not plan.steps and not result.replans
+    assert run_text(result, 0.3, 1.0).startswith("nothing to do: every effect of the task holds already\n")
     assert Composer(kb).compose("RobotArmServeACup").plan is not None  # a goal that does not hold is planned
 
 
