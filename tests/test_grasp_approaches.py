@@ -141,6 +141,7 @@ def test_a_cup_allowed_only_its_side_grasp_is_still_refused_before_anything_move
             run_task(kb, "FetchMyCup", SimEnvironment(world, kb), composer=Composer(kb))
         assert world.pose("Cup").position[:2] == pytest.approx(cup[:2], abs=0.005)
         assert world.base_pose().distance_to(base.x, base.y) < 0.01
+    assert refused.value.thing == WORLD + "Cup"
     assert "only the left arm reaches the Cup and only the right arm the platform" in str(refused.value)
     assert "cannot hold the Cup by its side grasp over the platform" in str(refused.value)
     assert "top" not in str(refused.value)
