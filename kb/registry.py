@@ -94,26 +94,26 @@ class ComponentRegistry:
         node = ox.NamedNode(iri)
         return {q.object.value for q in self._store.quads(node, ox.NamedNode(RDF + "type"), None, self._graph)}  # type: ignore[union-attr]
 
-    def description_quads(self, iri: str, graph: ox.NamedNode | None = None) -> list[ox.Quad]:
+    def description_quads(
+        self, iri: str, graph: ox.NamedNode | None = None, lookup: _Lookup | None = None
+    ) -> list[ox.Quad]:
         """The advertisement's triples (in the services graph, or ``graph``) and, recursively, those of
         its parts: skolemised nodes, and models, parameters, conditions and ports given IRIs of their own.
         A named part that something outside the description points at too is shared, and stays."""
         root = ox.NamedNode(iri)
-        graph = graph or self._graph
+        lookup = lookup or _Lookup(self._store, graph or self._graph)
 
         def quads_of(
             node: ox.NamedNode | ox.BlankNode | ox.Triple, skip: frozenset[object] = frozenset()
         ) -> list[ox.Quad]:
-            return [] if node in skip else list(self._store.quads(node, None, None, graph))  # type: ignore[arg-type]
+            return [] if node in skip else lookup.out(node)  # type: ignore[arg-type]
 
         found = closure([root], quads_of, parts=True)
         own = {q.subject for q in found}
         shared = frozenset(
             node
             for node in own
-            if node != root
-            and not is_skolem(node)
-            and any(q.subject not in own for q in self._store.quads(None, None, node, graph))  # type: ignore[arg-type]
+            if node != root and not is_skolem(node) and any(q.subject not in own for q in lookup.into(node))  # type: ignore[arg-type]
         )
         if not shared:
             return found
@@ -122,34 +122,28 @@ class ComponentRegistry:
     def owned_quads(self, iri: str, graph: ox.NamedNode | None = None) -> list[ox.Quad]:
         """What deregistering ``iri`` removes: its description (:meth:`description_quads`) and, for one
         ``cbrs load`` made from OWL-S, the OWL-S triples of its service as well (:meth:`_owls_source`),
-        so that deregistering leaves the store as it was before the load."""
-        graph = graph or self._graph
-        services = self._owls_services(ox.NamedNode(iri), graph)
+        so that deregistering leaves the store as it was before the load. Each node's triples are read
+        from the store once (a remote store answers each read with a request)."""
+        lookup = _Lookup(self._store, graph or self._graph)
+        root = ox.NamedNode(iri)
+        services = self._owls_services(root, lookup)
         if not services:
-            return self.description_quads(iri, graph)
-        return self._owls_source(ox.NamedNode(iri), services, graph)
+            return self.description_quads(iri, lookup.graph, lookup)
+        return self._owls_source(root, services, lookup)
 
-    def _owls_services(self, root: ox.NamedNode, graph: ox.NamedNode) -> list[ox.NamedNode]:
+    def _owls_services(self, root: ox.NamedNode, lookup: _Lookup) -> list[ox.NamedNode]:
         """The OWL-S services ``root`` was made from: itself (an advertisement keeps the service's IRI)
         or its ``dcterms:source`` (a requirement's), when OWL-S triples are about it."""
         found = [root]
-        for quad in self._store.quads(root, ox.NamedNode(DCTERMS_SOURCE), None, graph):
-            if isinstance(quad.object, ox.NamedNode):
+        for quad in lookup.out(root):
+            if quad.predicate.value == DCTERMS_SOURCE and isinstance(quad.object, ox.NamedNode):
                 found.append(quad.object)
-        return [node for node in found if self._has_owls(node, graph)]
+        return [node for node in found if _has_owls(node, lookup)]
 
-    def _has_owls(self, node: ox.NamedNode, graph: ox.NamedNode) -> bool:
-        """Whether ``graph`` holds OWL-S triples about ``node`` (a Turtle description has none: one read)."""
-        for quad in self._store.quads(node, None, None, graph):
-            kind = quad.object if quad.predicate.value == RDF + "type" else None
-            if owls_key(quad.predicate.value) or (isinstance(kind, ox.NamedNode) and owls_key(kind.value)):
-                return True
-        return any(owls_key(q.predicate.value) in SERVICE_LINKS for q in self._store.quads(None, None, node, graph))
-
-    def _owls_source(self, root: ox.NamedNode, services: list[ox.NamedNode], graph: ox.NamedNode) -> list[ox.Quad]:
+    def _owls_source(self, root: ox.NamedNode, services: list[ox.NamedNode], lookup: _Lookup) -> list[ox.Quad]:
         """The description and the OWL-S triples of its services: what the load added for it.
 
-        From the description and its services, every node the store says something about in ``graph``
+        From the description and its services, every node the store says something about in the graph
         is followed (the profile, process and grounding, their parameters, expressions, results and
         contacts, and a class the file declared there, OWL-S files' stub ``owl:Class`` lines); so are
         the profiles, processes and groundings that point at the service. The walk stops at another
@@ -159,88 +153,46 @@ class ComponentRegistry:
         the file's last description."""
         kept: set[ox.NamedNode] = set()
         while True:
-            found = self._owls_walk(root, services, graph, kept)
+            found = _owls_walk(root, services, lookup, kept)
             own = {q.subject for q in found}
             shared = {
                 node
                 for node in own
-                if node != root and any(q.subject not in own for q in self._store.quads(None, None, node, graph))  # type: ignore[arg-type]
+                if node != root and any(q.subject not in own for q in lookup.into(node))  # type: ignore[arg-type]
             }
             if not shared:
                 break
             kept |= shared  # type: ignore[arg-type]
         for service in services:
-            found.extend(self._owls_header(root, service, graph, own))  # type: ignore[arg-type]
+            found.extend(self._owls_header(root, service, lookup, own))  # type: ignore[arg-type]
         return list(dict.fromkeys(found))
 
-    def _owls_walk(
-        self, root: ox.NamedNode, services: list[ox.NamedNode], graph: ox.NamedNode, kept: set[ox.NamedNode]
-    ) -> list[ox.Quad]:
-        """One walk of :meth:`_owls_source`, passing over the ``kept`` (shared) nodes."""
-        found: list[ox.Quad] = []
-        seen: set[ox.NamedNode] = set()
-        pending = [root, *services]
-        while pending:
-            node = pending.pop()
-            if node in seen or node in kept:
-                continue
-            seen.add(node)
-            for quad in self._store.quads(node, None, None, graph):
-                found.append(quad)
-                if (
-                    isinstance(quad.object, ox.NamedNode)
-                    and quad.object not in seen
-                    and self._part_of_source(quad.object, graph)
-                ):
-                    pending.append(quad.object)
-            if node in services:
-                for quad in self._store.quads(None, None, node, graph):
-                    if owls_key(quad.predicate.value) in SERVICE_LINKS and isinstance(quad.subject, ox.NamedNode):
-                        pending.append(quad.subject)
-        return found
-
-    def _part_of_source(self, node: ox.NamedNode, graph: ox.NamedNode) -> bool:
-        """Whether the walk goes on to ``node``: the graph says something about it, and it is neither
-        a description nor an OWL-S service (those are deregistered on their own)."""
-        has_type = ox.NamedNode(RDF + "type")
-        said = False
-        for quad in self._store.quads(node, None, None, graph):
-            said = True
-            if quad.predicate.value == CBRS.hasOWLSModel:
-                return False
-            if (
-                quad.predicate == has_type
-                and isinstance(quad.object, ox.NamedNode)
-                and is_owls_service([quad.object.value])
-            ):
-                return False
-        return said
-
     def _owls_header(
-        self, root: ox.NamedNode, service: ox.NamedNode, graph: ox.NamedNode, own: set[ox.NamedNode]
+        self, root: ox.NamedNode, service: ox.NamedNode, lookup: _Lookup, own: set[ox.NamedNode]
     ) -> list[ox.Quad]:
         """The ``owl:Ontology`` header of the file ``service`` is named in (``file.owls`` for
-        ``file.owls#Service``), when no other description of that file stays in ``graph``."""
+        ``file.owls#Service``), when no other description of that file stays in the graph."""
         document, separator, _ = service.value.partition("#")
         if not separator:
             return []
         header = ox.NamedNode(document)
-        ontology = (header, ox.NamedNode(RDF + "type"), ox.NamedNode(OWL + "Ontology"))
-        if header in own or next(iter(self._store.quads(*ontology, graph)), None) is None:
+        if header in own or not any(
+            q.predicate.value == RDF + "type" and q.object == ox.NamedNode(OWL + "Ontology") for q in lookup.out(header)
+        ):
             return []
-        if any(q.subject != header and q.subject not in own for q in self._store.quads(None, None, header, graph)):
+        if any(q.subject != header and q.subject not in own for q in lookup.into(header)):
             return []  # another file imports it
-        if self._more_of_file(root, document, graph, own):
+        if self._more_of_file(root, document, lookup, own):
             return []
-        return closure([header], lambda node: self._store.quads(node, None, None, graph))  # type: ignore[arg-type]
+        return closure([header], lookup.out)  # type: ignore[arg-type]
 
-    def _more_of_file(self, root: ox.NamedNode, document: str, graph: ox.NamedNode, own: set[ox.NamedNode]) -> bool:
-        """Whether another description in ``graph`` came from the file ``root`` came from: it is named
+    def _more_of_file(self, root: ox.NamedNode, document: str, lookup: _Lookup, own: set[ox.NamedNode]) -> bool:
+        """Whether another description in the graph came from the file ``root`` came from: it is named
         under ``document#``, or its model node was named in the same load (:func:`skolem_digest`). One
         pass over the models' links; a scan of the graph's subjects for the prefix took 140 ms on OWLS-TC."""
         model = ox.NamedNode(CBRS.hasOWLSModel)
-        digests = {skolem_digest(q.object) for q in self._store.quads(root, model, None, graph)} - {None}
-        for quad in self._store.quads(None, model, None, graph):
+        digests = {skolem_digest(q.object) for q in lookup.out(root) if q.predicate == model} - {None}
+        for quad in self._store.quads(None, model, None, lookup.graph):
             if quad.subject in own:
                 continue
             if quad.subject.value.startswith(document + "#") or skolem_digest(quad.object) in digests:  # type: ignore[union-attr]
@@ -285,6 +237,77 @@ class ComponentRegistry:
                 raise InvalidDescriptionError(iri, problems)
         check_descriptions(self._store, parsed.quads)  # SHACL shapes and declared terms (kb/shapes.py)
         return parsed.quads, iris
+
+
+class _Lookup:
+    """The quads of one graph about a node, each read from the store once for one deregistration."""
+
+    def __init__(self, store: Store, graph: ox.NamedNode) -> None:
+        self.store = store
+        self.graph = graph
+        self._out: dict[ox.NamedNode, list[ox.Quad]] = {}
+        self._into: dict[ox.NamedNode, list[ox.Quad]] = {}
+
+    def out(self, node: ox.NamedNode) -> list[ox.Quad]:
+        """The quads whose subject is ``node``."""
+        if node not in self._out:
+            self._out[node] = list(self.store.quads(node, None, None, self.graph))
+        return self._out[node]
+
+    def into(self, node: ox.NamedNode) -> list[ox.Quad]:
+        """The quads whose object is ``node``."""
+        if node not in self._into:
+            self._into[node] = list(self.store.quads(None, None, node, self.graph))
+        return self._into[node]
+
+
+def _has_owls(node: ox.NamedNode, lookup: _Lookup) -> bool:
+    """Whether the graph holds OWL-S triples about ``node`` (a Turtle description has none)."""
+    for quad in lookup.out(node):
+        kind = quad.object if quad.predicate.value == RDF + "type" else None
+        if owls_key(quad.predicate.value) or (isinstance(kind, ox.NamedNode) and owls_key(kind.value)):
+            return True
+    return any(owls_key(q.predicate.value) in SERVICE_LINKS for q in lookup.into(node))
+
+
+def _owls_walk(
+    root: ox.NamedNode, services: list[ox.NamedNode], lookup: _Lookup, kept: set[ox.NamedNode]
+) -> list[ox.Quad]:
+    """One walk of ``_owls_source``, passing over the ``kept`` (shared) nodes."""
+    found: list[ox.Quad] = []
+    seen: set[ox.NamedNode] = set()
+    pending = [root, *services]
+    while pending:
+        node = pending.pop()
+        if node in seen or node in kept:
+            continue
+        seen.add(node)
+        for quad in lookup.out(node):
+            found.append(quad)
+            if (
+                isinstance(quad.object, ox.NamedNode)
+                and quad.object not in seen
+                and _part_of_source(quad.object, lookup)
+            ):
+                pending.append(quad.object)
+        if node in services:
+            for quad in lookup.into(node):
+                if owls_key(quad.predicate.value) in SERVICE_LINKS and isinstance(quad.subject, ox.NamedNode):
+                    pending.append(quad.subject)
+    return found
+
+
+def _part_of_source(node: ox.NamedNode, lookup: _Lookup) -> bool:
+    """Whether the walk goes on to ``node``: the graph says something about it, and it is neither a
+    description nor an OWL-S service (those are deregistered on their own)."""
+    quads = lookup.out(node)
+    for quad in quads:
+        if quad.predicate.value == CBRS.hasOWLSModel:
+            return False
+        kind = quad.object if quad.predicate.value == RDF + "type" else None
+        if isinstance(kind, ox.NamedNode) and is_owls_service([kind.value]):
+            return False
+    return bool(quads)
 
 
 def _base(source: str) -> str:
