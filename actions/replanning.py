@@ -168,14 +168,14 @@ class FailureMemory:
         usual = compose(frozenset())
         if usual.plan is None:
             return Decision(usual)
-        used = set(usual.plan.components())
+        used = {component for step in usual.plan.steps for component in step.candidates}
         again = tuple(f for f in unchanged if f.component in used)
         over = [f for f in again if self.counts[f.key] > self.policy.max_repeats]
         if over:
-            return Decision(None, repeated=again, stopped=self._stopped(over[0], usual.plan))
+            return Decision(None, repeated=again, stopped=self._stopped(over[0]))
         return Decision(usual, repeated=again)
 
-    def _stopped(self, failure: Failure, plan: Plan) -> str:
+    def _stopped(self, failure: Failure) -> str:
         times = self.counts[failure.key]
         around = "no plan avoids it" if self.policy.avoid else "avoiding it is switched off"
         return (
