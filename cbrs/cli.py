@@ -26,7 +26,8 @@ from cbrs.kb.catalog import Catalogue, merge
 from cbrs.kb.errors import QuerySyntaxError
 from cbrs.kb.loader import LoadReport, ParsedFile
 from cbrs.kb.namespaces import OWL, PREFIXES, GraphName, expand, shorten
-from cbrs.kb.store import Term
+from cbrs.kb.skolem import is_skolem
+from cbrs.kb.store import EmbeddedStore, Term
 from cbrs.output import RESULT_FORMATS, node_view, render_result, table, term_text
 from cbrs.settings import SETTINGS, setting
 from cbrs.sparql_hints import explain_syntax_error
@@ -364,7 +365,9 @@ def show(app: App, iri: str, as_json: bool) -> None:
             click.echo(_describe(description))
         return
     rows = kb.select("resource_triples", {"resource": full})
-    views = [_node_view(kb, row["other"], row["direction"].value) for row in rows]
+    names = _NodeNames(kb)
+    own = names.view(ox.NamedNode(full))
+    views = [names.view(row["other"], row["direction"].value) for row in rows]
     if as_json:
         found = []
         for row, view in zip(rows, views, strict=True):
@@ -376,7 +379,6 @@ def show(app: App, iri: str, as_json: bool) -> None:
         click.echo(json.dumps(found, indent=2))
         return
     click.echo(f"{shorten(full)}")
-    own = _node_view(kb, ox.NamedNode(full))
     if own is not None:
         click.echo(f"  = {own['text']}")
     body = [
@@ -389,17 +391,42 @@ def show(app: App, iri: str, as_json: bool) -> None:
         for r, view in zip(rows, views, strict=True)
     ]
     click.echo(table(["direction", "predicate", "value", "graph"], body))
+    if names.left == 0 and any(is_skolem(r["other"]) and view is None for r, view in zip(rows, views, strict=True)):
+        click.echo(f"(the first {REMOTE_NAMED_NODES} anonymous nodes named; on a remote store each costs requests)")
 
 
-def _node_view(kb: KnowledgeBase, term: Term, direction: str = "out") -> dict[str, Any] | None:
-    """How ``show`` names a skolemised node (a restriction, a description's parameter): ``cbrs.output.node_view``
-    over the stored triples, those graph:entailed derives left out."""
-    entailed = GraphName.ENTAILED.node
+REMOTE_NAMED_NODES = 200
+"""How many anonymous nodes ``show`` names on a remote store, where each costs a few requests (the 195
+parameters pointing at cbrs:Parameter in the bundled store took 1.1 s); the rest keep their skolem IRIs."""
 
-    def into(node: ox.NamedNode) -> list[ox.Quad]:
-        return [q for q in kb.store.quads(None, None, node) if q.graph_name != entailed]
 
-    return node_view(lambda node: kb.store.quads(node), into, term, direction)
+class _NodeNames:
+    """Names the skolemised nodes of one ``show`` (``cbrs.output.node_view``) from the stored triples,
+    those graph:entailed derives left out; each node's triples are read once."""
+
+    def __init__(self, kb: KnowledgeBase) -> None:
+        self.store = kb.store
+        self.left = None if isinstance(kb.store, EmbeddedStore) else REMOTE_NAMED_NODES
+        self._out: dict[ox.NamedNode, list[ox.Quad]] = {}
+        self._into: dict[ox.NamedNode, list[ox.Quad]] = {}
+
+    def out(self, node: ox.NamedNode) -> list[ox.Quad]:
+        if node not in self._out:
+            self._out[node] = list(self.store.quads(node))
+        return self._out[node]
+
+    def into(self, node: ox.NamedNode) -> list[ox.Quad]:
+        if node not in self._into:
+            entailed = GraphName.ENTAILED.node
+            self._into[node] = [q for q in self.store.quads(None, None, node) if q.graph_name != entailed]
+        return self._into[node]
+
+    def view(self, term: Term, direction: str = "out") -> dict[str, Any] | None:
+        if not is_skolem(term) or self.left == 0:
+            return None
+        if self.left is not None:
+            self.left -= 1
+        return node_view(self.out, self.into, term, direction)
 
 
 @cli.command("check")

@@ -149,3 +149,17 @@ def test_a_parameter_that_takes_a_class_is_named_by_its_description(tmp_path: Pa
     assert "home:ObjectFeature rdfs:subClassOf home:hasColourFeature some home:ColourFeature" in out
     assert "home:hasHue some home:Hue" in out
     assert "genid:" not in out
+
+
+def test_a_remote_store_names_a_bounded_number_of_nodes(
+    remote_location: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Each named node costs a few requests to a remote store: show names the first
+    REMOTE_NAMED_NODES (the class's own node first) and says so."""
+    monkeypatch.setattr("cbrs.cli.REMOTE_NAMED_NODES", 3)
+    (tmp_path / "lab.ttl").write_text(ONTOLOGY, encoding="utf-8")
+    assert CliRunner().invoke(cli, ["--store", remote_location, "load", str(tmp_path / "lab.ttl")]).exit_code == 0
+    out = show(remote_location, LAB + "Robot")
+    values = [v for v in _values(out) if v.startswith("rdfs:subClassOf")]
+    assert len([v for v in values if "genid:" not in v]) == 3
+    assert out.rstrip().endswith("(the first 3 anonymous nodes named; on a remote store each costs requests)")
