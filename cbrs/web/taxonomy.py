@@ -17,7 +17,7 @@ from markupsafe import Markup, escape
 
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import NotFoundError
-from cbrs.kb.namespaces import OWL, RDFS, GraphName, shorten
+from cbrs.kb.namespaces import OWL, RDF, RDFS, GraphName, shorten
 from cbrs.kb.vocab import CBRS
 from cbrs.output import Expression, class_expression, manchester, node_view
 from cbrs.web import context, resource
@@ -36,6 +36,12 @@ _USE_LINKS = {
     CBRS.conditionObject: "condition",
 }
 _EXPRESSION_LINKS = {RDFS + "subClassOf", OWL + "equivalentClass"}
+# The links by which a class expression names a class or property.
+_IN_EXPRESSIONS = {
+    *(OWL + name for name in ("someValuesFrom", "allValuesFrom", "hasValue", "onClass", "onDataRange")),
+    *(OWL + name for name in ("onProperty", "inverseOf", "complementOf", "onDatatype")),
+    RDF + "first",
+}
 _ROLE_LINKS = {
     CBRS.hasInput: "input",
     CBRS.hasOutput: "output",
@@ -248,8 +254,8 @@ def _named_in(kb: KnowledgeBase, triples: list[dict[str, Any]]) -> list[dict[str
 
     found: dict[tuple[str, str, str], dict[str, Any]] = {}
     for row in triples:
-        if row["direction"].value != "in":
-            continue
+        if row["direction"].value != "in" or row["predicate"].value not in _IN_EXPRESSIONS:
+            continue  # a parameter's cbrs:parameterType, say: not read (on a remote store each costs requests)
         view = node_view(lambda node: kb.store.quads(node), into, row["other"], "in")
         if view is None or "expression" not in view or "owner" not in view:
             continue
