@@ -98,3 +98,17 @@ def test_a_lab_kind_counts_as_an_advertisement(mini_kb: KnowledgeBase) -> None:
     assert mini_kb.registry.is_registered(EX + "Tracker")
     mini_kb.registry.deregister(EX + "Tracker")
     assert not mini_kb.registry.is_registered(EX + "Tracker")
+
+
+def test_a_named_part_two_descriptions_share_goes_with_the_last(mini_kb: KnowledgeBase) -> None:
+    before = triples_by_graph(mini_kb)
+    other = NAMED.replace("ex:Tracker a", "ex:Follower a").replace('"TrackRobot"', '"FollowRobot"')
+    other = other.split("ex:Tracker-model cbrs:hasInput")[0].replace(
+        "ex:Tracker-model", "[ cbrs:hasOutput [ cbrs:parameterType ex:Location ] ]"
+    )
+    mini_kb.registry.register(NAMED)
+    mini_kb.registry.register(other)
+    mini_kb.registry.deregister(EX + "Tracker")
+    assert [q.value for q in mini_kb.description(EX + "Follower").qos] == [0.2]
+    mini_kb.registry.deregister(EX + "Follower")
+    assert triples_by_graph(mini_kb) == before
