@@ -133,11 +133,17 @@ class ComponentRegistry:
 
     def _owls_services(self, root: ox.NamedNode, lookup: _Lookup) -> list[ox.NamedNode]:
         """The OWL-S services ``root`` was made from: itself (an advertisement keeps the service's IRI)
-        or its ``dcterms:source`` (a requirement's), when OWL-S triples are about it."""
+        or its ``dcterms:source`` (a requirement's), when OWL-S triples are about it. A source that is a
+        description of its own (a lab's Turtle description citing a loaded OWL-S advertisement) is not."""
         found = [root]
         for quad in lookup.out(root):
-            if quad.predicate.value == DCTERMS_SOURCE and isinstance(quad.object, ox.NamedNode):
-                found.append(quad.object)
+            source = quad.object
+            if (
+                quad.predicate.value == DCTERMS_SOURCE
+                and isinstance(source, ox.NamedNode)
+                and not any(q.predicate.value == CBRS.hasOWLSModel for q in lookup.out(source))
+            ):
+                found.append(source)
         return [node for node in found if _has_owls(node, lookup)]
 
     def _owls_source(self, root: ox.NamedNode, services: list[ox.NamedNode], lookup: _Lookup) -> list[ox.Quad]:

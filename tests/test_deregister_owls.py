@@ -231,3 +231,20 @@ def test_an_edited_file_loads_after_the_old_one_is_deregistered(kb: KnowledgeBas
     kb.load([edited], catalogue=CATALOG)
     assert triples_by_graph(kb) == edited_alone
     assert kb.description(NAVIGATE).service_name == "Drive to room"
+
+
+def test_a_description_citing_an_owls_advertisement_leaves_it_alone(kb: KnowledgeBase) -> None:
+    """A lab's Turtle description whose dcterms:source is a loaded OWL-S advertisement: deregistering
+    the lab's removed the advertisement's own triples with it (a requirement's source is walked)."""
+    kb.load([OWLS / "services" / "navigate.owls"], catalogue=CATALOG)
+    loaded = triples_by_graph(kb)
+    kb.registry.register(
+        f"""@prefix cbrs: <https://w3id.org/cbrs/core#> .
+<http://example.org/lab#Drive> a cbrs:MethodInvocationComponent ; cbrs:deviceName "P3DX02" ;
+    cbrs:serviceName "Drive" ; <http://purl.org/dc/terms/source> <{NAVIGATE}> ;
+    cbrs:hasOWLSModel [ cbrs:hasOutput [ cbrs:parameterType <http://example.org/ontology/robots.owl#Position> ] ] .
+"""
+    )
+    kb.registry.deregister("http://example.org/lab#Drive")
+    assert triples_by_graph(kb) == loaded
+    assert kb.description(NAVIGATE).service_name == "Navigate to room"
