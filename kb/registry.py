@@ -283,6 +283,7 @@ def _owls_walk(
     found: list[ox.Quad] = []
     seen: set[ox.NamedNode] = set()
     pending = [root, *services]
+    files = {_file_of(service) for service in services}
     while pending:
         node = pending.pop()
         if node in seen or node in kept:
@@ -293,7 +294,7 @@ def _owls_walk(
             if (
                 isinstance(quad.object, ox.NamedNode)
                 and quad.object not in seen
-                and _part_of_source(quad.object, lookup)
+                and _part_of_source(quad.object, lookup, files)
             ):
                 pending.append(quad.object)
         if node in services:
@@ -303,17 +304,29 @@ def _owls_walk(
     return found
 
 
-def _part_of_source(node: ox.NamedNode, lookup: _Lookup) -> bool:
-    """Whether the walk goes on to ``node``: the graph says something about it, and it is neither a
-    description nor an OWL-S service (those are deregistered on their own)."""
+def _part_of_source(node: ox.NamedNode, lookup: _Lookup, files: set[str]) -> bool:
+    """Whether the walk goes on to ``node``: the graph says something about it; it is a node of the
+    service's file (named under the file's IRI, or skolemised) or a stub declaration (type triples
+    only, as an OWL-S file's ``<owl:Class rdf:about="...#Price"/>``); and it is neither a description
+    nor an OWL-S service (those are deregistered on their own). A resource of its own the file only
+    points at (a device another file describes) is not the file's to remove."""
     quads = lookup.out(node)
+    stub = True
     for quad in quads:
         if quad.predicate.value == CBRS.hasOWLSModel:
             return False
         kind = quad.object if quad.predicate.value == RDF + "type" else None
         if isinstance(kind, ox.NamedNode) and is_owls_service([kind.value]):
             return False
-    return bool(quads)
+        stub = stub and kind is not None
+    return bool(quads) and (stub or is_skolem(node) or _file_of(node) in files)
+
+
+def _file_of(node: ox.NamedNode) -> str:
+    """The IRI of the document ``node`` is named in: before its ``#``, else up to its last ``/``."""
+    if "#" in node.value:
+        return node.value.split("#", 1)[0]
+    return node.value.rsplit("/", 1)[0]
 
 
 def _base(source: str) -> str:

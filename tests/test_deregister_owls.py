@@ -248,3 +248,23 @@ def test_a_description_citing_an_owls_advertisement_leaves_it_alone(kb: Knowledg
     kb.registry.deregister("http://example.org/lab#Drive")
     assert triples_by_graph(kb) == loaded
     assert kb.description(NAVIGATE).service_name == "Navigate to room"
+
+
+def test_a_resource_described_elsewhere_that_only_the_file_points_at_stays(kb: KnowledgeBase, tmp_path: Path) -> None:
+    """An OWL-S contact that is a device another file describes in graph:services: the walk followed
+    every node the graph said something about, and removed the device with the service."""
+    devices = tmp_path / "devices.ttl"
+    devices.write_text(
+        '@prefix ex: <http://example.org/mini#> . ex:Cam9 a ex:Camera ; ex:modelName "camera 9" .',
+        encoding="utf-8",
+    )
+    kb.load([devices], graph="services")
+    before = triples_by_graph(kb)
+    navigate = tmp_path / "navigate.owls"
+    text = (OWLS / "services" / "navigate.owls").read_text(encoding="utf-8")
+    start, end = text.index("<profile:contactInformation>"), text.index("</profile:contactInformation>")
+    contact = '<profile:contactInformation rdf:resource="http://example.org/mini#Cam9"/>'
+    navigate.write_text(text[:start] + contact + text[end + len("</profile:contactInformation>") :], encoding="utf-8")
+    kb.load([navigate], catalogue=CATALOG)
+    kb.registry.deregister(NAVIGATE)
+    assert triples_by_graph(kb) == before
