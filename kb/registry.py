@@ -149,10 +149,10 @@ class ComponentRegistry:
     def _owls_source(self, root: ox.NamedNode, services: list[ox.NamedNode], lookup: _Lookup) -> list[ox.Quad]:
         """The description and the OWL-S triples of its services: what the load added for it.
 
-        From the description and its services, every node the store says something about in the graph
-        is followed (the profile, process and grounding, their parameters, expressions, results and
-        contacts, and a class the file declared there, OWL-S files' stub ``owl:Class`` lines); so are
-        the profiles, processes and groundings that point at the service. The walk stops at another
+        From the description and its services, the nodes of the service's file are followed
+        (:func:`_part_of_source`: the profile, process and grounding, their parameters, expressions,
+        results and contacts, and the file's stub ``owl:Class`` lines); so are the profiles, processes
+        and groundings that point at the service. The walk stops at another
         description or service. A node something else in the graph still points at (a parameter two
         services of one file share, a stub class another service uses as a parameter type) is shared:
         it stays, and so does what only it reaches. Last, the file's ``owl:Ontology`` header goes with
