@@ -79,18 +79,22 @@ class PerceivedWorld(Judge):
     def feel(self) -> None:
         """What the robots know of themselves: held objects, objects let go, the platform's load."""
         time = self.world.time
-        for arm in self.world.arms.values():
-            name = self._name(arm.held)
-            centre = arm.carried_centre()
-            if name is not None and centre is not None:
-                self.objects[name] = Sighting(centre, f"{arm.side.value} hand", time)
-                self.holders.pop(name, None)
+        arms = list(self.world.arms.values())
+        # Where a hand let go first, then what the hands hold now: an object one arm let go of and the
+        # other took on is where the taking hand holds it, whichever arm is felt first.
+        for arm in arms:
             release = arm.released
             if release is not None and release != self._releases.get(arm.side):
                 self._releases[arm.side] = release
                 let_go = self._name(release[0])
                 if let_go is not None:
                     self.objects[let_go] = Sighting(release[1], f"{arm.side.value} hand, let go", time)
+        for arm in arms:
+            name = self._name(arm.held)
+            centre = arm.carried_centre()
+            if name is not None and centre is not None:
+                self.objects[name] = Sighting(centre, f"{arm.side.value} hand", time)
+                self.holders.pop(name, None)
         base = self.world.base_pose()
         loaded = set(pred.objects_on_platform(self.world))  # the platform's load sensor
         for name in loaded:

@@ -178,12 +178,6 @@ def test_the_glue_stick_goes_into_a_new_kind_of_place() -> None:
     assert (WORLD + "GlueStick1", HOME + "isLocated", WORLD + "StationeryHolder1") in facts(kb)
 
 
-@pytest.mark.xfail(
-    reason="sim/perceived.py PerceivedWorld.feel: after the right arm lets go of the pen at the relay spot and"
-    " the left arm takes it on, the right arm's release (felt after the left arm's hold) puts the believed pen"
-    " back at the relay spot, so (Pen, isAbove, PenRest) is not believed though the pen is over the pen rest",
-    strict=False,
-)
 def test_a_pen_only_the_right_arm_reaches_goes_to_a_pen_rest_only_the_left_arm_reaches() -> None:
     kb = knowledge(
         ("ontology", "pen_rest_west.ttl"), ("map", "pen_rest_west.ttl"), ("requirements", "put_pen_on_pen_rest.ttl")
