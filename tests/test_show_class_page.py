@@ -77,3 +77,30 @@ def test_a_class_without_any_shows_no_section(client: FlaskClient) -> None:
     page = client.get("/taxonomy/class", query_string={"iri": LAB + "Wheel"}).text
     assert "Restrictions and other class expressions" not in page
     assert "Named in the class expressions of" in page
+
+
+def test_a_concept_no_ontology_declares_has_a_page_not_a_404() -> None:
+    """The service page links every parameter type to its class page; a lab's undeclared (here
+    misspelt) class led to a 404. Its page says so, names the declared term it is like, and what uses it."""
+    kb = KnowledgeBase.open(":memory:")
+    kb.registry.register(
+        """@prefix cbrs: <https://w3id.org/cbrs/core#> . @prefix home: <https://w3id.org/cbrs/home#> .
+<http://example.org/lab#DoorCam> a cbrs:DynamicPerceptionComponent ; cbrs:deviceName "DoorCam01" ;
+    cbrs:serviceName "DetectDoorState" ;
+    cbrs:hasOWLSModel [ cbrs:hasInput [ cbrs:parameterType home:Door ] ;
+                        cbrs:hasOutput [ cbrs:parameterType <http://example.org/lab#DoorStatte> ] ] ."""
+    )
+    client = create_app(SparqlService(kb)).test_client()
+    service = client.get("/service", query_string={"iri": "http://example.org/lab#DoorCam"}).text
+    links = {h.replace("&amp;", "&") for h in re.findall(r'href="(/taxonomy/class[^"#]*)"', service)}
+    assert links and all(client.get(link).status_code == 200 for link in links)
+    body = client.get("/taxonomy/class.json", query_string={"iri": LAB + "DoorStatte"}).get_json()
+    assert set(body) >= KEYS and body["kind"] == "undeclared"
+    assert [t["name"] for t in body["similar"]] == ["home:DoorStatus"]
+    assert [(a["iri"], a["roles"]) for a in body["usage"]["advertisements"]] == [(LAB + "DoorCam", ["output"])]
+    page = client.get("/taxonomy/class", query_string={"iri": LAB + "DoorStatte"}).text
+    assert "No ontology in the store declares" in page
+    # an IRI nothing uses as a concept is still not found
+    assert client.get("/taxonomy/class.json", query_string={"iri": LAB + "Nothing"}).status_code == 404
+    assert client.get("/taxonomy/class.json", query_string={"iri": "svc:CeilingCamera01"}).status_code == 404
+    kb.close()

@@ -7,6 +7,7 @@ Everything is read with the named queries the taxonomy index reads (``taxonomy_l
 
 from __future__ import annotations
 
+import difflib
 from collections.abc import Iterator, Set
 from dataclasses import dataclass, field
 from typing import Any
@@ -195,10 +196,10 @@ def concept() -> Page:
     iri = resource.iri_parameter()
     kb = context.kb()
     found = Taxonomy.read(kb)
-    if iri not in found:
-        raise NotFoundError(iri, "class or property")
-    g.taxonomy_terms = found.kinds  # what expression_html links to a taxonomy page
     triples = kb.select("resource_triples", {"resource": iri})
+    if iri not in found:
+        return _undeclared(kb, found, iri, triples)
+    g.taxonomy_terms = found.kinds  # what expression_html links to a taxonomy page
     comment = next((r["other"].value for r in triples if _out(r, RDFS + "comment")), None)
     kind = found.kinds[iri]
     data = {
@@ -217,6 +218,38 @@ def concept() -> Page:
     }
     noun = "Class" if kind == "class" else "Property"
     return Page("class.html", f"{noun} {shorten(iri)}", data)
+
+
+def _undeclared(kb: KnowledgeBase, found: Taxonomy, iri: str, triples: list[dict[str, Any]]) -> Page:
+    """The page of a concept that descriptions use but no ontology of the store declares (a lab's typo,
+    or a concept of its own): what uses it, and the declared classes with a name like it. Service pages
+    link every parameter type and statement term here, so such a term led to a 404."""
+    usage = _usage(kb, iri, triples)
+    if not (usage["advertisements"] or usage["requirements"] or usage["actions"]):
+        raise NotFoundError(iri, "class or property")
+    wanted = local_name(iri).casefold()
+    names: dict[str, list[str]] = {}
+    for term in found.kinds:
+        names.setdefault(local_name(term).casefold(), []).append(term)
+    close = difflib.get_close_matches(wanted, list(names), n=3, cutoff=0.75)
+    similar = [found.term(term) for name in close for term in found.sorted(set(names[name]))]
+    empty: list[Any] = []
+    data = {
+        **found.term(iri),
+        "kind": "undeclared",
+        "comment": None,
+        "paths": empty,
+        "superclasses": empty,
+        "subclasses": empty,
+        "equivalents": empty,
+        "parts": empty,
+        "part_of": empty,
+        "restrictions": empty,
+        "named_in": empty,
+        "similar": similar,
+        "usage": usage,
+    }
+    return Page("class.html", f"Undeclared concept {shorten(iri)}", data)
 
 
 @blueprint.app_template_global("expression_html")
