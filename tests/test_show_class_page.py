@@ -104,3 +104,14 @@ def test_a_concept_no_ontology_declares_has_a_page_not_a_404() -> None:
     assert client.get("/taxonomy/class.json", query_string={"iri": LAB + "Nothing"}).status_code == 404
     assert client.get("/taxonomy/class.json", query_string={"iri": "svc:CeilingCamera01"}).status_code == 404
     kb.close()
+
+
+def test_rdf_type_as_a_statement_s_predicate_is_a_built_in_term() -> None:
+    kb = KnowledgeBase.open(":memory:")
+    owls = Path(__file__).parent / "data" / "owls"
+    kb.load([owls / "services" / "navigate.owls"], catalogue=owls / "catalog-v001.xml")
+    client = create_app(SparqlService(kb)).test_client()
+    body = client.get("/taxonomy/class.json", query_string={"iri": "rdf:type"}).get_json()
+    assert body["kind"] == "built-in" and body["similar"] == []
+    assert "which every store knows" in client.get("/taxonomy/class", query_string={"iri": "rdf:type"}).text
+    kb.close()

@@ -17,6 +17,7 @@ from flask import Blueprint, g, request, url_for
 from markupsafe import Markup, escape
 
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.catalog import is_built_in
 from cbrs.kb.errors import NotFoundError
 from cbrs.kb.namespaces import OWL, RDF, RDFS, GraphName, shorten
 from cbrs.kb.vocab import CBRS
@@ -227,16 +228,18 @@ def _undeclared(kb: KnowledgeBase, found: Taxonomy, iri: str, triples: list[dict
     usage = _usage(kb, iri, triples)
     if not (usage["advertisements"] or usage["requirements"] or usage["actions"]):
         raise NotFoundError(iri, "class or property")
-    wanted = local_name(iri).casefold()
-    names: dict[str, list[str]] = {}
-    for term in found.kinds:
-        names.setdefault(local_name(term).casefold(), []).append(term)
-    close = difflib.get_close_matches(wanted, list(names), n=3, cutoff=0.75)
-    similar = [found.term(term) for name in close for term in found.sorted(set(names[name]))]
+    similar: list[dict[str, Any]] = []
+    built_in = is_built_in(iri)  # rdf:type, a statement's predicate: every store knows it
+    if not built_in:
+        names: dict[str, list[str]] = {}
+        for term in found.kinds:
+            names.setdefault(local_name(term).casefold(), []).append(term)
+        close = difflib.get_close_matches(local_name(iri).casefold(), list(names), n=3, cutoff=0.75)
+        similar = [found.term(term) for name in close for term in found.sorted(set(names[name]))]
     empty: list[Any] = []
     data = {
         **found.term(iri),
-        "kind": "undeclared",
+        "kind": "built-in" if built_in else "undeclared",
         "comment": None,
         "paths": empty,
         "superclasses": empty,
@@ -249,7 +252,8 @@ def _undeclared(kb: KnowledgeBase, found: Taxonomy, iri: str, triples: list[dict
         "similar": similar,
         "usage": usage,
     }
-    return Page("class.html", f"Undeclared concept {shorten(iri)}", data)
+    title = f"{'Built-in term' if built_in else 'Undeclared concept'} {shorten(iri)}"
+    return Page("class.html", title, data)
 
 
 @blueprint.app_template_global("expression_html")
