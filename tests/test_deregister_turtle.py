@@ -112,3 +112,24 @@ def test_a_named_part_two_descriptions_share_goes_with_the_last(mini_kb: Knowled
     assert [q.value for q in mini_kb.description(EX + "Follower").qos] == [0.2]
     mini_kb.registry.deregister(EX + "Follower")
     assert triples_by_graph(mini_kb) == before
+
+
+def test_a_loaded_requirement_goes_whole(mini_kb: KnowledgeBase, tmp_path: Path) -> None:
+    """Requirements have no registry of their own: a loaded one is deregistered from graph:requirements."""
+    before = triples_by_graph(mini_kb)
+    path = tmp_path / "need.ttl"
+    path.write_text(
+        """@prefix cbrs: <https://w3id.org/cbrs/core#> . @prefix ex: <http://example.org/mini#> .
+ex:Need2 a cbrs:Requirement ; cbrs:serviceName "FindRobot" ;
+    cbrs:hasOWLSModel [ cbrs:hasInput [ cbrs:parameterType ex:MarkerColour ] ;
+                        cbrs:hasOutput [ cbrs:parameterType ex:Location ] ] ;
+    cbrs:hasQoSModel [ cbrs:responseTime 0.5 ] .
+""",
+        encoding="utf-8",
+    )
+    mini_kb.load([path], graph="requirements")
+    loaded = triples_by_graph(mini_kb)
+    mini_kb.registry.deregister(EX + "Need2")
+    assert triples_by_graph(mini_kb) == before
+    mini_kb.load([path], graph="requirements")
+    assert triples_by_graph(mini_kb) == loaded
