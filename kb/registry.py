@@ -236,6 +236,16 @@ class ComponentRegistry:
         if not iris:
             check_descriptions(self._store, parsed.quads)  # a misspelt component kind gets its did-you-mean
             raise InvalidDescriptionError(source, [_no_advertisement(parsed.quads)])
+        requirements = _requirements(parsed.quads)
+        if requirements:
+            raise InvalidDescriptionError(
+                source,
+                [
+                    f"it describes the requirement {shorten(requirements[0])} besides advertisements; a requirement "
+                    "goes into the requirements graph (cbrs load --graph requirements FILE), so register the "
+                    "advertisements from a file of their own"
+                ],
+            )
         fields = _fields(parsed.quads)
         for iri in iris:
             problems = _problems(iri, fields)
@@ -371,6 +381,19 @@ _KINDS = (
     CBRS.MethodInvocationComponent,
 )
 _KIND_SET = frozenset({*_KINDS, CBRS.Advertisement})
+
+
+def _requirements(quads: list[ox.Quad]) -> list[str]:
+    """The requirements among ``quads``: registration wrote them into graph:services with the
+    advertisements, where no deregistration looks for them."""
+    kind = ox.NamedNode(CBRS.Requirement)
+    return sorted(
+        {
+            q.subject.value
+            for q in quads
+            if q.predicate.value == RDF + "type" and q.object == kind and isinstance(q.subject, ox.NamedNode)
+        }
+    )
 
 
 def _advertisements(store: Store, quads: Iterable[ox.Quad]) -> list[str]:

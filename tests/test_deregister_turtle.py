@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pytest
 
-from cbrs.kb import KnowledgeBase, NotFoundError
+from cbrs.kb import InvalidDescriptionError, KnowledgeBase, NotFoundError
 
 from .test_deregister_owls import triples_by_graph
 
@@ -133,3 +133,20 @@ ex:Need2 a cbrs:Requirement ; cbrs:serviceName "FindRobot" ;
     assert triples_by_graph(mini_kb) == before
     mini_kb.load([path], graph="requirements")
     assert triples_by_graph(mini_kb) == loaded
+
+
+def test_a_file_with_a_requirement_besides_advertisements_is_refused(mini_kb: KnowledgeBase) -> None:
+    """Registration wrote the requirement into graph:services with the advertisement, said only
+    'registered' for the advertisement, and no deregistration found the requirement there afterwards."""
+    before = triples_by_graph(mini_kb)
+    mixed = (
+        BLANK
+        + """ex:Need3 a cbrs:Requirement ; cbrs:serviceName "FindRobot" ;
+    cbrs:hasOWLSModel [ cbrs:hasOutput [ cbrs:parameterType ex:Location ] ] .
+"""
+    )
+    with pytest.raises(InvalidDescriptionError, match="requirement http://example.org/mini#Need3 besides advertisements"):
+        mini_kb.registry.register(mixed)
+    with pytest.raises(InvalidDescriptionError, match="cbrs load --graph requirements"):
+        mini_kb.registry.update(mixed)
+    assert triples_by_graph(mini_kb) == before
