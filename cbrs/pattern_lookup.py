@@ -32,6 +32,8 @@ from typing import Any
 
 import pyoxigraph as ox
 
+from cbrs.kb.results import releases_results
+
 _RDF_TYPE = ox.NamedNode("http://www.w3.org/1999/02/22-rdf-syntax-ns#type")
 _XSD_STRING = "http://www.w3.org/2001/XMLSchema#string"
 # SPARQL's VARNAME, PN_PREFIX and PN_LOCAL restricted to ASCII (no escapes): exactly the grammar's there.
@@ -103,6 +105,7 @@ def parse(match: re.Match[str], prefixes: Mapping[str, str]) -> Lookup | None:
                   None if limit is None else int(limit))  # fmt: skip
 
 
+@releases_results
 def json_results(store: ox.Store, lookup: Lookup, limit: int, deadline: float) -> bytes:
     """The SPARQL JSON results of ``lookup`` on ``store``, as Oxigraph writes them; raises
     :class:`Stopped` as soon as they pass ``limit`` bytes or the clock passes ``deadline``."""

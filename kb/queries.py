@@ -13,7 +13,6 @@ A parameter's value is substituted for the variable of the same name by Oxigraph
 from __future__ import annotations
 
 import re
-import traceback
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -23,6 +22,7 @@ import pyoxigraph as ox
 
 from cbrs.kb.errors import BindingError, UnknownQueryError
 from cbrs.kb.namespaces import XSD, expand
+from cbrs.kb.results import releases_results
 from cbrs.kb.store import QueryResult, Store, Term
 
 PARAMETER_KINDS = ("iri", "string", "integer", "decimal", "literal")
@@ -113,22 +113,17 @@ class QueryLibrary:
         return _rows(name, store.query(self.get(name).text, {}))
 
 
+@releases_results
 def _rows(name: str, result: QueryResult) -> list[dict[str, Term]]:
     if not isinstance(result, ox.QuerySolutions):
         raise TypeError(f"query {name!r} is not a SELECT query")
     return _read_rows([v.value for v in result.variables], result)
 
 
+@releases_results
 def _read_rows(names: list[str], solutions: Iterable[Any]) -> list[dict[str, Term]]:
-    """Read ``solutions`` whole. A pyoxigraph result may only be dropped on the thread that made it: when
-    reading fails half way, the exception's frames would keep it alive until a garbage collection on
-    whatever thread runs next (a task's, a server's), where dropping it raises. So they let go of it here."""
-    try:
-        return [{n: row[n] for n in names if row[n] is not None} for row in solutions]
-    except BaseException as error:
-        traceback.clear_frames(error.__traceback__)
-        del solutions
-        raise
+    """Read ``solutions`` whole, on this thread even when reading fails half way (:mod:`cbrs.kb.results`)."""
+    return [{n: row[n] for n in names if row[n] is not None} for row in solutions]
 
 
 def _read(path: Path) -> NamedQuery:

@@ -39,6 +39,7 @@ import pyoxigraph as ox
 from cbrs.kb.errors import BindingError, QuerySyntaxError, RemoteStoreError, StoreError, StoreEvaluationError
 from cbrs.kb.namespaces import PREFIXES, GraphName
 from cbrs.kb.remote_access import refuse_remote_access
+from cbrs.kb.results import releases_results
 from cbrs.kb.staged_writes import write_staged
 from cbrs.kb.store import QueryResult, Store, Term, data_block, refuse_deep_nesting
 
@@ -234,6 +235,7 @@ class RemoteStore(Store):
         params += [("named-graph-uri", iri) for iri in named_graphs or ()]
         return self._query(text, original=text, params=params)
 
+    @releases_results
     def quads(
         self,
         subject: ox.NamedNode | ox.BlankNode | None = None,
@@ -250,12 +252,14 @@ class RemoteStore(Store):
         assert isinstance(result, ox.QuerySolutions)
         return iter([ox.Quad(*row) for row in result])  # an unbound ?g is the default graph
 
+    @releases_results
     def count(self, graph: GraphName | ox.NamedNode | None = None) -> int:
         node = graph.node if isinstance(graph, GraphName) else graph
         result = self._query(f"SELECT (COUNT(*) AS ?n) WHERE {{ {_graph_pattern('?s ?p ?o', node)} }}")
         assert isinstance(result, ox.QuerySolutions)
         return int(next(iter(result))["n"].value)
 
+    @releases_results
     def graphs(self) -> list[str]:
         # Virtuoso 7 matches no graph with an empty pattern; it lists no empty graph either way
         pattern = "?s ?p ?o" if self._virtuoso else ""
@@ -317,6 +321,7 @@ class RemoteStore(Store):
         names = {token.text.upper() for token in _tokens(text) if token.kind == "name"}
         return not names & {"GROUP_CONCAT", "SAMPLE"}
 
+    @releases_results
     def _check_union(self) -> None:
         result = self._query(_UNION_PROBE)
         assert isinstance(result, ox.QuerySolutions)

@@ -32,6 +32,7 @@ import pyoxigraph as ox
 from cbrs.kb.errors import StoreError
 from cbrs.kb.namespaces import OWL, PREFIXES, RDF, RDFS, XSD, GraphName
 from cbrs.kb.resources import ontology_dir
+from cbrs.kb.results import releases_results
 from cbrs.kb.store import EmbeddedStore, Store
 from cbrs.kb.update_delta import DataUpdate
 
@@ -385,6 +386,7 @@ class StandardTerms:
                 triples.update(alignment.statement(row["s"], prop, row["o"]))
         return {_quad(t) for t in triples - asserted if _named(t)}, {_quad(t) for t in asserted}
 
+    @releases_results
     def _rule_conclusions(self, alignment: Alignment) -> set[ox.Quad]:
         """What the rules conclude from the store as it is now (graph:entailed included), closed."""
         found: set[ox.Quad] = set()
@@ -479,6 +481,7 @@ def _quad(triple: ox.Triple) -> ox.Quad:
     return ox.Quad(triple.subject, triple.predicate, triple.object, _GRAPH)
 
 
+@releases_results
 def _rows(store: Store, query: str, bindings: dict[str, ox.NamedNode] | None = None) -> list[ox.QuerySolution]:
     result = store.query(query, bindings)
     assert isinstance(result, ox.QuerySolutions)

@@ -30,6 +30,7 @@ from cbrs.kb.namespaces import GraphName
 from cbrs.kb.remote_store import OXIGRAPH_BATCH, Endpoints, RemoteStore, inject_values
 from cbrs.kb.staged_writes import STAGED, STAGING, batches, publication
 from tests.conftest import OxigraphServer
+from tests.helpers_unsendable import unsendable_kept_by
 
 DATA = Path(__file__).parent / "data"
 LOCATE = "https://w3id.org/cbrs/service#LocateMobileRobot_CeilingCamera01"
@@ -200,6 +201,8 @@ def test_a_server_without_a_union_default_graph_is_refused(plain_server: Oxigrap
         Store.open(plain_server.url)
     for message in (str(seeding.value), str(caught.value)):
         assert "--union-default-graph" in message and plain_server.url in message and "\n" not in message
+    # the probe's result is let go of here: a server hands such an error to another thread to report
+    assert unsendable_kept_by(seeding.value) == unsendable_kept_by(caught.value) == []
 
 
 def test_an_empty_server_is_checked_again_before_a_query(plain_server: OxigraphServer) -> None:
