@@ -99,7 +99,9 @@ class ComponentRegistry:
     ) -> list[ox.Quad]:
         """The advertisement's triples (in the services graph, or ``graph``) and, recursively, those of
         its parts: skolemised nodes, and models, parameters, conditions and ports given IRIs of their own.
-        A named part that something outside the description points at too is shared, and stays."""
+        A part that something outside the description points at too is shared, and stays: a named one,
+        or a blank node one file gives two descriptions (``cbrs:hasQoSModel _:q`` on both), which went
+        with the first description deregistered."""
         root = ox.NamedNode(iri)
         lookup = lookup or _Lookup(self._store, graph or self._graph)
 
@@ -113,7 +115,7 @@ class ComponentRegistry:
         shared = frozenset(
             node
             for node in own
-            if node != root and not is_skolem(node) and any(q.subject not in own for q in lookup.into(node))  # type: ignore[arg-type]
+            if node != root and any(q.subject not in own for q in lookup.into(node))  # type: ignore[arg-type]
         )
         if not shared:
             return found

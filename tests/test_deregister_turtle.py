@@ -5,6 +5,7 @@ typed subject for an advertisement), which left the advertisements that use it p
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -145,8 +146,27 @@ def test_a_file_with_a_requirement_besides_advertisements_is_refused(mini_kb: Kn
     cbrs:hasOWLSModel [ cbrs:hasOutput [ cbrs:parameterType ex:Location ] ] .
 """
     )
-    with pytest.raises(InvalidDescriptionError, match="requirement http://example.org/mini#Need3 besides advertisements"):
+    with pytest.raises(InvalidDescriptionError, match=re.escape(f"requirement {EX}Need3 besides advertisements")):
         mini_kb.registry.register(mixed)
     with pytest.raises(InvalidDescriptionError, match="cbrs load --graph requirements"):
         mini_kb.registry.update(mixed)
+    assert triples_by_graph(mini_kb) == before
+
+
+def test_a_blank_node_two_descriptions_of_one_file_share_stays_with_the_one_left(mini_kb: KnowledgeBase) -> None:
+    """``cbrs:hasQoSModel _:q`` on two descriptions of one file: deregistering the first took the QoS
+    model of the second with it."""
+    before = triples_by_graph(mini_kb)
+    mini_kb.registry.register(
+        """@prefix cbrs: <https://w3id.org/cbrs/core#> . @prefix ex: <http://example.org/mini#> .
+ex:A a cbrs:StaticDataComponent ; cbrs:deviceName "S" ; cbrs:serviceName "A" ; cbrs:hasQoSModel _:q ;
+    cbrs:hasOWLSModel [ cbrs:hasOutput [ cbrs:parameterType ex:Location ] ] .
+ex:B a cbrs:StaticDataComponent ; cbrs:deviceName "S" ; cbrs:serviceName "B" ; cbrs:hasQoSModel _:q ;
+    cbrs:hasOWLSModel [ cbrs:hasOutput [ cbrs:parameterType ex:Location ] ] .
+_:q cbrs:responseTime 0.5 .
+"""
+    )
+    mini_kb.registry.deregister(EX + "A")
+    assert [q.value for q in mini_kb.description(EX + "B").qos] == [0.5]
+    mini_kb.registry.deregister(EX + "B")
     assert triples_by_graph(mini_kb) == before
