@@ -13,6 +13,7 @@ from cbrs.kb.errors import AlreadyRegisteredError, InvalidDescriptionError, NotF
 from cbrs.kb.loader import parse_bytes, registration_format
 from cbrs.kb.namespaces import BASE, OWL, RDF, RDFS, GraphName, shorten
 from cbrs.kb.owls import DCTERMS_SOURCE, SERVICE_LINKS, is_owls, is_owls_service, owls_key
+from cbrs.kb.results import releases_results
 from cbrs.kb.shapes import check_descriptions, line_of
 from cbrs.kb.skolem import closure, is_skolem, skolem_digest
 from cbrs.kb.standard_terms import StandardTerms
@@ -414,6 +415,7 @@ def _advertisements(store: Store, quads: Iterable[ox.Quad]) -> list[str]:
     )
 
 
+@releases_results
 def _advertisement_classes(store: Store) -> set[str]:
     result = store.query("SELECT ?c WHERE { ?c rdfs:subClassOf* cbrs:Advertisement }")
     assert isinstance(result, ox.QuerySolutions)
