@@ -20,7 +20,7 @@ inputs first and encodes its outputs last.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -50,7 +50,7 @@ from cbrs.sim.perception import (
 )
 from cbrs.sim.planning import PlannedPath, plan_path
 from cbrs.sim.referee import Referee
-from cbrs.sim.relations import Grounded, Judge
+from cbrs.sim.relations import Grounded, Judge, region_of
 from cbrs.sim.values import (
     APPROACH_POSITION,
     GRASP_POSE,
@@ -110,6 +110,7 @@ class SimContext:
     grasp: GraspPose | None = None  # the grasp pose of the object the arm is working on
     arm: ArmSide = ArmSide.LEFT
     region: Region | None = None  # where the carried object goes
+    spot: Region | None = None  # the part of ``region`` the arm carrying the object sets it down on
     last_arm: ArmSide | None = None  # the arm that acted last, so a tie goes to the other
     inputs: Mapping[str, Any] = field(default_factory=dict)  # what the running component was given
     belief: PerceivedWorld | None = None  # where the robots believe things are
@@ -156,19 +157,27 @@ class OutOfReachError(KnowledgeBaseError):
     http_status = 422
 
     def __init__(
-        self, robot: str, thing: str, where: tuple[float, float], arms: list[tuple[str, float, float, float, float]]
+        self,
+        robot: str,
+        thing: str,
+        where: tuple[float, float],
+        arms: list[tuple[str, float, float, float, float]],
+        why: str = "",
     ) -> None:
         self.robot = robot
         self.thing = thing
         self.where = where
         self.arms = tuple(arms)
+        self.why = why
+        """For a place part of which is in reach: why none of it will do (empty otherwise)."""
         each = "; ".join(
             f"{local_name(arm)} reaches {reach:.2f} m from ({x:.2f}, {y:.2f}), {distance:.2f} m away"
             for arm, x, y, reach, distance in self.arms
         )
         super().__init__(
             f"no arm of {local_name(robot)} reaches the {local_name(thing)} at ({where[0]:.2f}, {where[1]:.2f}): "
-            f"{each}; move it within reach in the map (home:x, home:y) or give the arms more home:reach"
+            f"{each}{f'; {why}' if why else ''}; move it within reach in the map (home:x, home:y) or give the "
+            "arms more home:reach"
         )
 
 
@@ -379,20 +388,41 @@ def pick_up(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str
 
 
 def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
-    """CarryObject to the target place by the arm holding the object; when the place is beyond that
-    arm's reach and the other arm reaches it, the object is first passed to the other arm."""
+    """CarryObject to the target place by the arm holding the object, over the spot of the place nearest
+    its centre that the arm reaches and can hold the object over (:func:`_place_spots`): a table only
+    part of which is in reach is worked at that part. When no spot is in that arm's reach and the other
+    arm reaches one, the object is first passed to the other arm."""
+    world = ctx.world
     place = _place(ctx, inputs["targetPlace"], "the target place")
-    ctx.region = region = _region(place)
-    cx, cy, _ = region.center
-    spec = ctx.world.arm_specs[ctx.arm]
-    if math.hypot(cx - spec.mount[0], cy - spec.mount[1]) > spec.reach and ctx.grasp is not None:
-        takers = _reaching(ctx, cx, cy)
-        if not takers:
+    ctx.region = region_of(place, place.iri in ctx.map.furniture)
+    held = world.arm(ctx.arm).held
+    carried = (world.name_of(held) if held is not None else None) or ctx.object or ""
+    size = world.objects[carried].size if carried in world.objects else (0.0, 0.0, 0.0)
+    others = _others(world, ctx.belief, carried)
+
+    def spots(side: ArmSide) -> tuple[Region, list[tuple[float, float]]]:
+        spec = world.arm_specs[side]
+        return _place_spots(ctx.map, place, size, [(spec.mount[0], spec.mount[1], spec.reach)], others)
+
+    surface, mine = spots(ctx.arm)
+    spot = _holdable(ctx, ctx.arm, surface, mine)
+    if spot is None and ctx.grasp is not None:
+        giver, model = ctx.arm, ctx.grasp.model
+        cx, cy, _ = surface.center
+        options = []
+        for side in sorted(world.arm_specs):
+            theirs = spots(side)[1] if side is not giver and world.arm(side).held is None else []
+            if theirs:
+                options.append((math.hypot(theirs[0][0] - cx, theirs[0][1] - cy), side, theirs[0]))
+        if not options:
+            spec = world.arm_specs[giver]
             raise SkillFailed(
-                f"no arm reaches {place.name} at ({cx:.2f}, {cy:.2f}): the {ctx.arm.value} arm holding the "
-                f"{ctx.grasp.model.name} reaches {spec.reach:.2f} m from ({spec.mount[0]:.2f}, {spec.mount[1]:.2f})"
+                f"no arm reaches a spot of {place.name} to set the {model.name} down on (around ({cx:.2f}, "
+                f"{cy:.2f})): the {giver.value} arm holding it reaches {spec.reach:.2f} m from ({spec.mount[0]:.2f}, "
+                f"{spec.mount[1]:.2f}), and no other free arm reaches one"
             )
-        giver, taker, model = ctx.arm, takers[0], ctx.grasp.model
+        _, taker, (sx, sy) = min(options)
+        target = _spot_region(surface, sx, sy)
         gx, gy, gz = ctx.grasp.position  # where it was taken from: its surface
         taken = ObjectEstimate(
             gx,
@@ -402,34 +432,55 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
             (0.0, 0.0, 0.0),
             model.colour,
             "hand",
-            ctx.world.time,
+            world.time,
             0,
         )
-        # The taker takes it anew: by an approach it can set it down over the place by (the first, with
+        # The taker takes it anew: by an approach it can set it down over the spot by (the first, with
         # one approach: whether it can is its carry's to find, as before).
-        checks = [skills.can_grip, lambda held: skills.can_set_down(ctx.world, taken, taker, held, region)]
+        checks = [skills.can_grip, lambda held: skills.can_set_down(world, taken, taker, held, target)]
         placing = _Candidates.of(model, *(checks if len(model.preference) > 1 else []))
         if not placing.models:
             raise SkillFailed(f"the {taker.value} arm reaches {place.name}, but {placing.refusal()}")
-        spot, _, taken_by = _relay_spot(ctx, taken, _Candidates([model]), placing, giver, taker)
-        found = _set_down_for(ctx, device, model, giver, taker, spot, None)
-        taker_spec = ctx.world.arm_specs[taker]
+        relay, _, taken_by = _relay_spot(ctx, taken, _Candidates([model]), placing, giver, taker)
+        found = _set_down_for(ctx, device, model, giver, taker, relay, None)
+        taker_spec = world.arm_specs[taker]
         _note(
             ctx,
             placing.choice(taker, taken_by, f"carrying the {model.name} to {place.name}", "no spot to take it by it"),
         )
         grasp = compute_grasp_pose(taken_by, found.position, found.yaw, taker_spec.mount, taker_spec.yaw)
         for move in (skills.approach_object, skills.pick_up_object):
-            _passing(move(ctx.world, taker, grasp), model, giver, taker)
+            _passing(move(world, taker, grasp), model, giver, taker)
         ctx.arm, ctx.grasp, ctx.last_arm = taker, grasp, taker
-    _check(skills.carry_object(ctx.world, ctx.arm, region))
+    elif spot is None:
+        raise SkillFailed(f"the {ctx.arm.value} arm reaches no spot of {place.name} to set the {carried} down on")
+    else:
+        target = _spot_region(surface, *spot)
+    ctx.spot = target
+    _check(skills.carry_object(world, ctx.arm, target))
     return {}
+
+
+def _holdable(
+    ctx: SimContext, side: ArmSide, surface: Region, spots: Sequence[tuple[float, float]]
+) -> tuple[float, float] | None:
+    """The first of ``spots`` (of the first RELAY_TRIES) where the arm's hand, as it holds the object now,
+    can let it go on the surface (asked of the inverse kinematics); the first spot if it holds nothing."""
+    arm = ctx.world.arm(side)
+    grasp = arm.held_grasp
+    if grasp is None:
+        return spots[0] if spots else None
+    orientation = arm.ee_pose().orientation
+    for x, y in spots[:RELAY_TRIES]:
+        if arm.can_hold((x, y, surface.zmin + skills.PLACE_CLEARANCE + grasp.bottom_offset), orientation):
+            return (x, y)
+    return None
 
 
 def put_down(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     if ctx.region is None:
         raise SkillFailed("nothing is being carried to a place")
-    _check(skills.put_down_object(ctx.world, ctx.arm, ctx.region))
+    _check(skills.put_down_object(ctx.world, ctx.arm, ctx.spot or ctx.region))
     return {}
 
 
@@ -670,26 +721,8 @@ def _relay_spot(
     top = supports[0].box
     size = world.objects[model.name].size
     radius = math.hypot(size[0], size[1]) / 2.0
-    others = []
-    for name, obj in world.objects.items():
-        if name == model.name:
-            continue
-        believed = ctx.belief.position(name) if ctx.belief is not None else None
-        ox_, oy = (believed[0], believed[1]) if believed is not None else (obj.start.x, obj.start.y)
-        others.append((ox_, oy, math.hypot(obj.size[0], obj.size[1]) / 2.0))
-    fixtures = [
-        (t.box.min_x, t.box.max_x, t.box.min_y, t.box.max_y)
-        for iri, t in smap.things.items()
-        if iri not in smap.rooms
-        and iri not in smap.regions
-        and iri != supports[0].iri
-        and t.box.max_z > surface + 0.005
-        and t.box.min_z < surface + 0.3
-        and t.box.min_x < top.max_x
-        and t.box.max_x > top.min_x
-        and t.box.min_y < top.max_y
-        and t.box.max_y > top.min_y
-    ]
+    others = _others(world, ctx.belief, model.name)
+    fixtures = _fixtures(smap, supports[0], surface, 0.3)
     arms = [world.arm_specs[giver], world.arm_specs[taker]]
     spots: list[tuple[float, float, float, float]] = []
     inset = radius + RELAY_EDGE
@@ -739,6 +772,103 @@ def _relay_spot(
         f"there is no spot on {supports[0].name} where both the {giver.value} and the {taker.value} arm can hold "
         f"the {model.name} by its {kinds} grasp, to pass it from one to the other"
     )
+
+
+def _others(world: HomeWorld, belief: PerceivedWorld | None, *names: str) -> list[tuple[float, float, float]]:
+    """The objects other than ``names`` as (x, y, footprint radius): where each is believed to be, else
+    where the map puts it."""
+    found = []
+    for other, obj in world.objects.items():
+        if other in names:
+            continue
+        believed = belief.position(other) if belief is not None else None
+        x, y = (believed[0], believed[1]) if believed is not None else (obj.start.x, obj.start.y)
+        found.append((x, y, math.hypot(obj.size[0], obj.size[1]) / 2.0))
+    return found
+
+
+def _fixtures(
+    smap: SemanticMap, support: Thing, surface: float, up_to: float
+) -> list[tuple[float, float, float, float]]:
+    """The extents (min x, max x, min y, max y) of the things of the map standing on or hanging over the
+    support's top within ``up_to`` above its ``surface`` (a dispenser), not the rooms and regions."""
+    top = support.box
+    return [
+        (t.box.min_x, t.box.max_x, t.box.min_y, t.box.max_y)
+        for iri, t in smap.things.items()
+        if iri not in smap.rooms
+        and iri not in smap.regions
+        and iri != support.iri
+        and t.box.max_z > surface + 0.005
+        and t.box.min_z < surface + up_to
+        and t.box.min_x < top.max_x
+        and t.box.max_x > top.min_x
+        and t.box.min_y < top.max_y
+        and t.box.max_y > top.min_y
+    ]
+
+
+def _place_spots(
+    smap: SemanticMap,
+    place: Thing,
+    size: tuple[float, float, float],
+    mounts: Sequence[tuple[float, float, float]],
+    others: Sequence[tuple[float, float, float]],
+) -> tuple[Region, list[tuple[float, float]]]:
+    """Where on a place an object of ``size`` can be set down by an arm mounted at one of ``mounts``
+    (x, y, reach): the place's surface (a region's bottom, a piece of furniture's top), and the spots of
+    a grid over the place, from its centre out, nearest the centre first, where the object's centre is
+    over the place and at least RELAY_MARGIN inside a mount's reach, its footprint on the surface it
+    rests on (the furniture under a region) RELAY_EDGE inside the edge, RELAY_CLEARANCE clear of
+    ``others`` (x, y, radius) and of the fixtures it would meet on the way down (a dispenser's body; not
+    the spout high above it). The place's centre is the first spot where it is one: a place an arm only
+    partly reaches is worked at its reachable part, not at a centre no arm reaches."""
+    furniture = place.iri in smap.furniture
+    surface = region_of(place, furniture)
+    cx, cy, z = surface.center
+    if furniture:
+        support = place
+    else:
+        support = next(
+            (
+                smap.things[iri]
+                for iri in sorted(smap.furniture)
+                if iri in smap.things
+                and smap.things[iri].box.contains_xy(cx, cy)
+                and abs(smap.things[iri].box.max_z - z) <= 0.03
+            ),
+            place,
+        )
+    box = support.box
+    radius = math.hypot(size[0], size[1]) / 2.0
+    fixtures = _fixtures(smap, support, z, size[2] + skills.ABOVE_CLEARANCE)
+    inset = radius + RELAY_EDGE
+    spots: list[tuple[float, float, float]] = []
+    nx = int((surface.xmax - surface.xmin) / 2.0 / RELAY_STEP) + 1
+    ny = int((surface.ymax - surface.ymin) / 2.0 / RELAY_STEP) + 1
+    for i in range(-nx, nx + 1):
+        x = cx + i * RELAY_STEP
+        if not (surface.xmin - 1e-9 <= x <= surface.xmax + 1e-9 and box.min_x + inset <= x <= box.max_x - inset):
+            continue
+        for j in range(-ny, ny + 1):
+            y = cy + j * RELAY_STEP
+            if not (surface.ymin - 1e-9 <= y <= surface.ymax + 1e-9 and box.min_y + inset <= y <= box.max_y - inset):
+                continue
+            if not any(math.hypot(x - mx, y - my) <= reach - RELAY_MARGIN for mx, my, reach in mounts):
+                continue
+            if any(math.hypot(x - ox_, y - oy) < radius + r + RELAY_CLEARANCE for ox_, oy, r in others):
+                continue
+            if any(_distance(extent, (x, y)) < radius + RELAY_CLEARANCE for extent in fixtures):
+                continue
+            spots.append((math.hypot(x - cx, y - cy), x, y))
+    return surface, [(x, y) for _, x, y in sorted(spots)]
+
+
+def _spot_region(surface: Region, x: float, y: float) -> Region:
+    """Where around a spot of a place's surface an object is carried to and set down (its centre over
+    the spot, give or take a relay spot's tolerance): the place itself decides the step's effects."""
+    half = RELAY_STEP * 2
+    return Region(surface.name, x - half, x + half, y - half, y + half, surface.zmin, surface.zmin + 0.3)
 
 
 # -- the home server, the ceiling cameras and the mobile base -------------------------------------
@@ -1080,21 +1210,54 @@ class SimEnvironment:
         for arm in smap.arms.values():
             arms.setdefault(arm.robot, []).append(arm)
         steps = {step.index: step for step in plan.steps}
+        at_hand: dict[str, list[str]] = {}  # by robot: the objects its latest arm step given one works on
         for step in plan.steps:
             robot_arms = arms.get(step.device or "")
             if not robot_arms:
                 continue
-            for name in sorted(_given_to(step, steps)):
-                value = values.get(name)
-                iri = str(value["@id"]) if isinstance(value, dict) and "@id" in value else None
-                box = self._extent(iri) if iri is not None else None
-                if iri is None or box is None:
+            given = [values.get(name) for name in sorted(_given_to(step, steps))]
+            iris = [str(value["@id"]) for value in given if isinstance(value, dict) and "@id" in value]
+            objects = [iri for iri in iris if iri in smap.objects]
+            if objects:
+                at_hand[step.device or ""] = objects
+            for iri in iris:
+                box = self._extent(iri)
+                if box is None:
                     continue
                 reaches = [(arm, _distance(box, arm.mount)) for arm in robot_arms]
+                report = [(arm.iri, arm.mount[0], arm.mount[1], arm.reach, d) for arm, d in reaches]
+                where = ((box[0] + box[1]) / 2, (box[2] + box[3]) / 2)
                 if not any(distance <= arm.reach for arm, distance in reaches):
-                    report = [(arm.iri, arm.mount[0], arm.mount[1], arm.reach, d) for arm, d in reaches]
-                    where = ((box[0] + box[1]) / 2, (box[2] + box[3]) / 2)
                     raise OutOfReachError(step.device or "", iri, where, report)
+                if iri in smap.regions or iri in smap.furniture:
+                    self._check_spot(step, iri, at_hand.get(step.device or "", []), report)
+
+    def _check_spot(
+        self, step: PlanStep, iri: str, carried: list[str], report: list[tuple[str, float, float, float, float]]
+    ) -> None:
+        """Refuse a place an arm step is given, part of which the robot's arms reach, when no spot of it
+        will do (:func:`_place_spots`, by the map) for the object at hand: the one the step is given,
+        else the one the robot's latest arm step given one worked on (a carry's object comes from the
+        approach and pick-up before it); the largest, if there are several. The carry would aim at a
+        spot it then lacks."""
+        smap = self.world.map
+        objects = [smap.objects[other] for other in carried]
+        size = max(
+            (obj.size for obj in objects), key=lambda size: math.hypot(size[0], size[1]), default=(0.0, 0.0, 0.0)
+        )
+        names = [obj.name for obj in objects]
+        name = names[0] if len(names) == 1 else ""
+        mounts = [(x, y, reach) for _, x, y, reach, _ in report]
+        _, spots = _place_spots(smap, smap.things[iri], size, mounts, _others(self.world, self.belief, *names))
+        if not spots:
+            box = smap.things[iri].box
+            what = f"the {name}" if name else "an object"
+            why = (
+                f"no spot of it is {RELAY_MARGIN:.2f} m inside an arm's reach with {what} clear of the edge of the "
+                "surface, the other objects and the fixtures on it"
+            )
+            where = ((box.min_x + box.max_x) / 2, (box.min_y + box.max_y) / 2)
+            raise OutOfReachError(step.device or "", iri, where, report, why)
 
     def _extent(self, iri: str) -> tuple[float, float, float, float] | None:
         """Where a thing of the map is for an arm, as (min x, max x, min y, max y): an object at the point

@@ -32,9 +32,13 @@ class Grounded:
     name: str
 
 
-def region_of(thing: Thing) -> Region:
+def region_of(thing: Thing, furniture: bool = False) -> Region:
+    """Where an object is in or on ``thing``: its own box for a region or a room, whose bottom is where
+    things rest; the top of a piece of ``furniture`` (a table's box reaches down to the floor, and
+    nothing is put on the table's floor)."""
     box = thing.box
-    return Region(thing.name, box.min_x, box.max_x, box.min_y, box.max_y, box.min_z, box.max_z)
+    floor = box.max_z if furniture else box.min_z
+    return Region(thing.name, box.min_x, box.max_x, box.min_y, box.max_y, floor, box.max_z)
 
 
 class Judge(ABC):
@@ -74,7 +78,7 @@ class Judge(ABC):
         where = region if obj.role == "region" and region is not None else None
         if where is None:
             place = self.thing(obj)
-            where = region_of(place) if place is not None else None
+            where = region_of(place, place.iri in self.world.map.furniture) if place is not None else None
         if where is None:
             return None
         if test == "above":

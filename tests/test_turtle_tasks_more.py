@@ -199,11 +199,8 @@ def test_without_the_place_below_the_tap_the_carry_fails_twice_and_the_run_says_
     assert locator and not locator[0].alternatives  # InferObjectPlace takes an object, not the position given
     result = run(kb, "FillCupAndComeToMeNoPlace")
     assert "LocateRoomOfPosition_HomeServer01" not in components(result)
-    assert not result.succeeded and len(result.replans) == 1
-    assert result.stopped.startswith(
-        "re-planning stopped: step 8 (CarryObject_CytonDualArm01 with targetPlace <- KitchenTable): no arm reaches"
-    )
-    assert "met 2 time(s) with nothing it depends on changed (KitchenTable)" in result.stopped
+    succeeded(result)  # the carry aims at the spot of the table nearest its centre an arm reaches: below the tap
+    assert not result.replans
 
 
 def test_every_task_file_here_is_turtle_a_store_loads() -> None:
