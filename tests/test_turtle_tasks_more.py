@@ -186,12 +186,12 @@ def test_a_pen_only_the_right_arm_reaches_goes_to_a_pen_rest_only_the_left_arm_r
     succeeded(result)
 
 
-def test_without_the_place_below_the_tap_the_carry_fails_twice_and_the_run_says_why() -> None:
-    """Nothing tells the carry where the cup must stand to be filled: the plan takes the cup's own place
-    (the kitchen table, whose centre no arm reaches). It is planned over the components the simulation
+def test_without_the_place_below_the_tap_the_cup_is_carried_to_the_reachable_part_of_the_table() -> None:
+    """Nothing tells the carry where the cup must stand to be filled: the plan takes the cup's own place,
+    the kitchen table, whose centre no arm reaches. It is planned over the components the simulation
     implements (it used to take the room of a position from LocateRoomOfPosition, which it does not,
-    and fail over to InferObjectPlace with a position for an object), and after the same failure with
-    nothing changed the run stops instead of a third identical plan."""
+    and fail over to InferObjectPlace with a position for an object), and the carry aims at the spot of
+    the table nearest its centre that the holding arm reaches (it aimed at the centre and failed)."""
     kb = knowledge(("requirements", "fill_cup_and_come_without_place.ttl"))
     planned = Composer(kb).compose("FillCupAndComeToMeNoPlace").plan
     assert planned is not None
