@@ -14,12 +14,10 @@ from __future__ import annotations
 import base64
 import io
 import json
-import shutil
 import socket
 import subprocess
 import time
 from collections.abc import Iterator
-from pathlib import Path
 from typing import Any
 
 import pytest
@@ -31,11 +29,10 @@ from cbrs.rosbridge import Bridge, RunningBridge
 from cbrs.rosbridge.wire import MAX_PARTIAL, MAX_PIECES, MIN_FRAGMENT
 from cbrs.server import ServeConfig, Server
 from cbrs.sparql_service import EndpointConfig
+from tests.helpers_roslibjs import JS, NODE, needs_roslibjs
 
 TOKEN = "clients-bridge-token"
 WAIT = 10.0
-NODE = shutil.which("node")
-JS = Path(__file__).parent / "js"
 
 
 @pytest.fixture(scope="module")
@@ -258,7 +255,7 @@ process.exit(0);
 """
 
 
-@pytest.mark.skipif(NODE is None or not (JS / "node_modules" / "roslib").is_dir(), reason="roslibjs under node")
+@needs_roslibjs
 def test_roslibjs_decodes_png_and_fragments_from_the_bridge(bridge: RunningBridge) -> None:
     assert NODE is not None
     child = subprocess.run(

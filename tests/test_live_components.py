@@ -6,7 +6,6 @@ A server runs in this process on loopback ports; components connect to its bridg
 from __future__ import annotations
 
 import json
-import shutil
 import subprocess
 import time
 from collections.abc import Callable, Iterator
@@ -33,6 +32,7 @@ from cbrs.sim.components import SimEnvironment
 from cbrs.sim.values import check
 from cbrs.sim.world import open_world
 from cbrs.sparql_service import EndpointConfig
+from tests.helpers_roslibjs import needs_roslibjs, node_command
 
 TOKEN = "live-components-test-token"
 SVC, HOME, REQ = PREFIXES["svc"], PREFIXES["home"], PREFIXES["req"]
@@ -256,20 +256,12 @@ def test_a_description_in_json_ld_registers_like_turtle(server: Server) -> None:
     assert server.kb.description(THERMOMETER).outputs[0].type == HOME + "RoomTemperature"
 
 
-NODE = shutil.which("node")
-JS = Path(__file__).parent / "js"
-
-
-@pytest.mark.skipif(NODE is None, reason="node is not installed (roslibjs runs on node >= 20)")
-@pytest.mark.skipif(
-    not (JS / "node_modules" / "roslib").is_dir(), reason="roslibjs is not installed: run npm ci --prefix tests/js"
-)
+@needs_roslibjs
 def test_a_component_written_with_roslibjs_registers_and_is_invoked(server: Server, tmp_path: Path) -> None:
     kb = server.kb
     description = tmp_path / "thermometer.ttl"
     description.write_text(thermometer(), encoding="utf-8")
-    assert NODE is not None
-    command = [NODE, str(JS / "thermometer.mjs"), str(server.bridge_port), TOKEN, str(description), "60"]
+    command = node_command("thermometer.mjs", server.bridge_port, TOKEN, description, 60)
     child = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     try:
         assert child.stdout is not None

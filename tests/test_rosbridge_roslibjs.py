@@ -8,37 +8,18 @@ tests are skipped.
 
 from __future__ import annotations
 
-import json
-import shutil
-import subprocess
 import threading
 from collections.abc import Iterator
-from pathlib import Path
 from typing import Any
 
 import pytest
 
 from cbrs.rosbridge import Bridge, ServiceError
+from tests.helpers_roslibjs import ROSLIBJS_MARKS, node
 from tests.helpers_threads import assert_threads_end
 from tests.test_rosbridge_actions import TOKEN, count
 
-JS = Path(__file__).parent / "js"
-NODE = shutil.which("node")
-pytestmark = [
-    pytest.mark.skipif(NODE is None, reason="node is not installed (roslibjs runs on node >= 20)"),
-    pytest.mark.skipif(
-        not (JS / "node_modules" / "roslib").is_dir(), reason="roslibjs is not installed: run npm ci --prefix tests/js"
-    ),
-]
-
-
-def node(script: str, *args: object, timeout: float = 60) -> dict[str, Any]:
-    """Run a node script of tests/js; the one line of JSON it prints last."""
-    assert NODE is not None
-    child = subprocess.run([NODE, str(JS / script), *map(str, args)], capture_output=True, text=True, timeout=timeout)
-    assert child.returncode == 0, child.stderr
-    found: dict[str, Any] = json.loads(child.stdout.strip().splitlines()[-1])
-    return found
+pytestmark = ROSLIBJS_MARKS
 
 
 def test_roslibjs_round_trips() -> None:

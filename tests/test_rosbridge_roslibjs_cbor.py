@@ -11,37 +11,17 @@ on loopback, every wait in it bounded, killed by its PID if it outlives its time
 from __future__ import annotations
 
 import array
-import json
-import shutil
 import struct
-import subprocess
 import threading
-from pathlib import Path
 from typing import Any
 
 import numpy
-import pytest
 
 from cbrs.rosbridge import Bridge
+from tests.helpers_roslibjs import ROSLIBJS_MARKS, node
 from tests.helpers_threads import assert_threads_end
 
-JS = Path(__file__).parent / "js"
-NODE = shutil.which("node")
-pytestmark = [
-    pytest.mark.skipif(NODE is None, reason="node is not installed (roslibjs runs on node >= 20)"),
-    pytest.mark.skipif(
-        not (JS / "node_modules" / "roslib").is_dir(), reason="roslibjs is not installed: run npm ci --prefix tests/js"
-    ),
-]
-
-
-def node(script: str, *args: object, timeout: float = 60) -> dict[str, Any]:
-    """Run a node script of tests/js; the one line of JSON it prints last."""
-    assert NODE is not None
-    child = subprocess.run([NODE, str(JS / script), *map(str, args)], capture_output=True, text=True, timeout=timeout)
-    assert child.returncode == 0, child.stderr
-    found: dict[str, Any] = json.loads(child.stdout.strip().splitlines()[-1])
-    return found
+pytestmark = ROSLIBJS_MARKS
 
 
 def typed(kind: str, values: list[Any]) -> dict[str, Any]:
