@@ -23,7 +23,7 @@ from cbrs.app import App, parse_iri, pass_app
 from cbrs.extras import require
 from cbrs.kb import Advertisement, KnowledgeBase, KnowledgeBaseError, Requirement, ServiceDescription
 from cbrs.kb.catalog import Catalogue, merge
-from cbrs.kb.errors import QuerySyntaxError
+from cbrs.kb.errors import AlreadyRegisteredError, QuerySyntaxError
 from cbrs.kb.loader import LoadReport, ParsedFile
 from cbrs.kb.namespaces import OWL, PREFIXES, GraphName, expand, shorten
 from cbrs.kb.skolem import is_skolem
@@ -300,14 +300,27 @@ _UPDATE_START = re.compile(
 
 @cli.command()
 @click.argument("file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
-@click.option("--update", is_flag=True, help="Replace the descriptions of advertisements already registered.")
+@click.option(
+    "--update",
+    is_flag=True,
+    help="Bring the store in line with FILE: replace the descriptions of its advertisements already "
+    "registered and register the others (one transaction).",
+)
 @pass_app
 def register(app: App, file: Path, update: bool) -> None:
     """Register the advertisements in a Turtle FILE (checked first; one transaction)."""
     text = file.read_bytes()
-    iris = app.kb.registry.update(text, str(file)) if update else app.kb.registry.register(text, str(file))
+    if update:
+        added, updated = app.kb.registry.sync(text, str(file))
+        for iri in sorted(added + updated):
+            click.echo(f"{'registered' if iri in added else 'updated'} {shorten(iri)}")
+        return
+    try:
+        iris = app.kb.registry.register(text, str(file))
+    except AlreadyRegisteredError as error:  # some of the file's may be registered, some not: --update does both
+        raise click.ClickException(f"{error}: cbrs register --update {file}") from error
     for iri in iris:
-        click.echo(f"{'updated' if update else 'registered'} {shorten(iri)}")
+        click.echo(f"registered {shorten(iri)}")
 
 
 @cli.command()

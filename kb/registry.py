@@ -46,16 +46,44 @@ class ComponentRegistry:
         what :meth:`deregister` would remove: one loaded from OWL-S loses its OWL-S triples too, which
         no longer describe it (its service node's own went, its profile and process stayed)."""
         quads, iris = self._parse(turtle, source)
-        old: list[ox.Quad] = []
         for iri in iris:
             if not self.is_registered(iri):
                 raise self._not_found(iri)
+        self._write(quads, iris)
+        return iris
+
+    def sync(self, turtle: str | bytes, source: str = "<update>") -> tuple[list[str], list[str]]:
+        """Bring graph:services in line with ``turtle``: replace the descriptions of its advertisements
+        that are registered, register the others, in one transaction; returns (registered, updated).
+        A file of two advertisements one of which was deregistered could be neither registered again
+        (the other is registered) nor updated (one is not). What :meth:`register` refuses (another
+        resource by an advertisement's IRI) and :meth:`update` refuses (an advertisement held in another
+        graph, which this would register a second time) is refused here too, before anything is written."""
+        quads, iris = self._parse(turtle, source)
+        added = []
+        for iri in iris:
+            if self.is_registered(iri):
+                continue
+            if self._types(iri):
+                raise AlreadyRegisteredError(iri)  # a device of graph:services by that IRI: not the file's to replace
+            missing = self._not_found(iri)
+            if isinstance(missing, OutsideRegistryError):
+                raise missing
+            added.append(iri)
+        updated = [iri for iri in iris if iri not in added]
+        self._write(quads, updated)
+        return added, updated
+
+    def _write(self, quads: list[ox.Quad], registered: list[str]) -> None:
+        """Replace what the ``registered`` advertisements own with ``quads`` in one store transaction, and
+        bring graph:entailed up to date."""
+        old: list[ox.Quad] = []
+        for iri in registered:
             old.extend(self.owned_quads(iri))
         new, kept = set(quads), set(old)
         before = self._standard_terms.begin()
         self._store.replace([q for q in old if q not in new], [q for q in quads if q not in kept])
         self._standard_terms.changed(before, old, quads)
-        return iris
 
     def deregister(self, iri: str) -> int:
         """Remove one advertisement's description, or a requirement's from the requirements graph (which
@@ -208,6 +236,31 @@ class ComponentRegistry:
                 return True
         return False
 
+    def _loaded_already(self, quads: list[ox.Quad], source: str) -> str:
+        """For an OWL-S file some of whose services are advertisements already, the commands that bring the
+        store in line with it: ``cbrs load`` adds nothing for an unchanged file, and refuses one that
+        differs from what is stored (a service edited, or deregistered while another stayed), so those
+        go first; the load then converts every service of the file, in one transaction."""
+        services = sorted(
+            {
+                q.subject.value
+                for q in quads
+                if q.predicate.value == RDF + "type"
+                and isinstance(q.subject, ox.NamedNode)
+                and isinstance(q.object, ox.NamedNode)
+                and is_owls_service([q.object.value])
+            }
+        )
+        loaded = [iri for iri in services if self.is_registered(iri)]
+        if not loaded:
+            return ""
+        file = source if not source.startswith("<") else "FILE"
+        steps = "; ".join(f"cbrs deregister {shorten(iri)}" for iri in loaded)
+        return (
+            f"; {_count(len(loaded), 'of its services is', 'of its services are')} loaded already: to bring the "
+            f"store in line with the file, {steps}; then cbrs load {file}"
+        )
+
     def _parse(self, turtle: str | bytes, source: str) -> tuple[list[ox.Quad], list[str]]:
         try:
             return self._parse_checked(turtle, source)
@@ -227,6 +280,7 @@ class ComponentRegistry:
                 [
                     "it is an OWL-S description, which registration does not convert: load it with "
                     "cbrs load (kb.load), which turns each OWL-S service into an advertisement"
+                    + self._loaded_already(parsed.quads, source)
                 ],
             )
         elsewhere = sorted({str(q.graph_name) for q in parsed.quads if q.graph_name != GraphName.SERVICES.node})
@@ -333,6 +387,10 @@ def _part_of_source(node: ox.NamedNode, lookup: _Lookup, files: set[str]) -> boo
             return False
         stub = stub and kind is not None
     return bool(quads) and (stub or is_skolem(node) or _file_of(node) in files)
+
+
+def _count(count: int, one: str, many: str) -> str:
+    return f"{count} {one if count == 1 else many}"
 
 
 def _file_of(node: ox.NamedNode) -> str:
