@@ -25,7 +25,7 @@ from cbrs.kb import Advertisement, KnowledgeBase, KnowledgeBaseError, Requiremen
 from cbrs.kb.catalog import Catalogue, merge
 from cbrs.kb.errors import AlreadyRegisteredError, QuerySyntaxError
 from cbrs.kb.loader import LoadReport, ParsedFile
-from cbrs.kb.namespaces import OWL, PREFIXES, GraphName, expand, shorten
+from cbrs.kb.namespaces import OWL, PREFIXES, RDF, GraphName, expand, shorten
 from cbrs.kb.skolem import is_skolem
 from cbrs.kb.store import EmbeddedStore, Term
 from cbrs.output import RESULT_FORMATS, node_view, render_result, table, term_text
@@ -149,8 +149,40 @@ def load(app: App, files: tuple[Path, ...], graph: str | None, catalogs: tuple[P
     for item in report.files:
         what = _loaded_what(item)
         click.echo(f"loaded {item.source}: {what}{_into(item)}{_mended(item)}")
-    for line in _load_summary(report):
+    for line in _load_summary(report, app.kb.store):
         click.echo(line)
+    for line in _added_summary(report):
+        click.echo(line)
+
+
+def _added_summary(report: LoadReport) -> list[str]:
+    """What the load changed: the lines above count what the files gave, which a reload gives again
+    although the store held all of it already and nothing was added."""
+    graphs = sorted((graph, n) for graph, n in report.added.items() if n)
+    if len(graphs) == 1:
+        where = f" into {shorten(graphs[0][0])}"
+    else:
+        where = "".join(f"{', ' if i else ': '}{n} into {shorten(graph)}" for i, (graph, n) in enumerate(graphs))
+    lines = [f"added {_plural(report.added_quads, 'triple')}{where}; {report.already_present} already present"]
+    if not report.already_present:
+        return lines
+    for items, kind in ((report.files, "file"), (report.imports, "imported ontology")):
+        unchanged = [item.source for item in items if item.added_triples == 0]
+        if unchanged:
+            count = _plural(len(unchanged), kind).replace("ontologys", "ontologies")
+            lines.append(f"  all already present, nothing added: {count}{_few(unchanged)}")
+    partly = [item for item in (*report.files, *report.imports) if 0 < (item.added_triples or 0) < item.triples]
+    for item in partly[:_PARTLY_SHOWN]:
+        lines.append(
+            f"  {item.source}: added {item.added_triples} of {item.triples} triples, "
+            f"{item.triples - (item.added_triples or 0)} already present"
+        )
+    if len(partly) > _PARTLY_SHOWN:
+        lines.append(f"  ... and {len(partly) - _PARTLY_SHOWN} more files with some triples already present")
+    return lines
+
+
+_PARTLY_SHOWN = 20
 
 
 def _plural(count: int, word: str) -> str:
@@ -178,7 +210,7 @@ def _mended(item: ParsedFile) -> str:
     return f" (mended: {'; '.join(item.repairs)})" if item.repairs else ""
 
 
-def _load_summary(report: LoadReport) -> list[str]:
+def _load_summary(report: LoadReport, store: Any = None) -> list[str]:
     """The end of a load's output: imported ontologies, then what could not be resolved."""
     lines = []
     owls = [item for item in report.files if item.owls is not None]
@@ -191,7 +223,8 @@ def _load_summary(report: LoadReport) -> list[str]:
         )
         for item in report.imports:
             if item.repairs:
-                lines.append(f"  {item.source}{_mended(item)}")
+                unchanged = ", nothing added (all already present)" if item.added_triples == 0 else ""
+                lines.append(f"  {item.source}{_mended(item)}{unchanged}")
         unresolved = sorted({u.iri for u in report.unresolved_imports})
         lines.append(f"unresolved imports: {len(unresolved)}{_few(unresolved)}")
     elif owls:
@@ -205,6 +238,9 @@ def _load_summary(report: LoadReport) -> list[str]:
         )
         if imports:
             lines.append(f"imports not followed (no --catalog): {len(imports)}{_few(imports)}")
+            held = [iri for iri in imports if store is not None and _holds_ontology(store, iri)]
+            if held:  # "not followed" alone reads as missing after a reload
+                lines.append(f"  of which already in the store: {len(held)}{_few(held)}")
     if owls or report.catalogue is not None:
         for used_as in ("parameter type", "statement term"):
             concepts = sorted({u.iri for u in report.unresolved_concepts if u.used_as == used_as})
@@ -225,6 +261,12 @@ def _load_summary(report: LoadReport) -> list[str]:
 
 
 OWL_IMPORTS = OWL + "imports"
+
+
+def _holds_ontology(store: Any, iri: str) -> bool:
+    """Whether the store declares ``iri`` an owl:Ontology (a load of it, with a catalogue, says so)."""
+    found = store.quads(ox.NamedNode(iri), ox.NamedNode(RDF + "type"), ox.NamedNode(OWL + "Ontology"))
+    return next(iter(found), None) is not None
 
 
 def _few(iris: list[str], limit: int = 3) -> str:

@@ -29,7 +29,7 @@ import sys
 import xml.parsers.expat
 from collections import defaultdict, deque
 from collections.abc import Iterable, Iterator, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -94,11 +94,20 @@ class ParsedFile:
     ontology: str | None = None
     repairs: tuple[str, ...] = ()
     bulk: int | None = None  # a bulk-loaded file's triple count; its quads are not kept in memory
+    added: dict[str, int] | None = None
+    """Per graph IRI, how many of its triples the load added: the rest the store held already, or an
+    earlier file of the same load (or the file itself) gave them. ``None`` when not counted (a parse
+    without a load, or a store that cannot answer per triple cheaply: see :attr:`LoadReport.added`)."""
 
     @property
     def triples(self) -> int:
         """How many triples (quads) the file gave."""
         return len(self.quads) if self.bulk is None else self.bulk
+
+    @property
+    def added_triples(self) -> int | None:
+        """How many triples the load added for this file (``None`` when not counted)."""
+        return None if self.added is None else sum(self.added.values())
 
 
 @dataclass(frozen=True)
@@ -121,6 +130,11 @@ class LoadReport:
     unresolved_imports: list[Unresolved] = field(default_factory=list)
     unresolved_concepts: list[UnresolvedConcept] = field(default_factory=list)
     catalogue: Catalogue | None = None
+    added: dict[str, int] = field(default_factory=dict)
+    """Per graph IRI, how many triples the load added: :attr:`quads` counts what the files gave, and
+    loading what the store holds already adds nothing, so a reload gives the same ``quads`` and no
+    ``added``. Counted per triple in an embedded store, from each graph's size before and after in a
+    remote one (whose files then have ``added`` None)."""
 
     def __iter__(self) -> Iterator[ParsedFile]:
         return iter(self.files)
@@ -131,6 +145,16 @@ class LoadReport:
     @property
     def quads(self) -> int:
         return sum(item.triples for item in (*self.files, *self.imports))
+
+    @property
+    def added_quads(self) -> int:
+        """How many triples the load added to the store, over all graphs."""
+        return sum(self.added.values())
+
+    @property
+    def already_present(self) -> int:
+        """How many of the triples the files gave added nothing (held already, or given twice)."""
+        return self.quads - self.added_quads
 
 
 @dataclass
@@ -221,8 +245,46 @@ def load_files(
     ]
     _check_part_cycles(store, [*raws, *imported])
     check_loaded(store, report)  # descriptions against the SHACL shapes, and their terms (kb/shapes.py)
+    sizes = _count_added(store, report)
     store.add(quad for item in (*report.files, *report.imports) for quad in item.quads)
+    if sizes is not None:
+        report.added = {graph: store.count(ox.NamedNode(graph)) - size for graph, size in sizes.items()}
     return report
+
+
+def _count_added(store: Store, report: LoadReport) -> dict[str, int] | None:
+    """Fill in what each file of ``report`` will add, before the write: a load adds only the triples
+    the store does not hold, so the files' own counts would tell a user a reload changed something.
+
+    In an embedded store each triple is looked up (about 0.25 us each, a fifth of what writing it
+    costs); a triple an earlier file of the load gave counts for that file only. A remote store would
+    take a request per triple, so there only the graphs' sizes are returned, to compare after the write.
+    """
+    items = (*report.files, *report.imports)
+    if not isinstance(store, EmbeddedStore):
+        graphs = {_graph_of(quad, item.graph) for item in items for quad in item.quads}
+        return {graph: store.count(ox.NamedNode(graph)) for graph in sorted(graphs)}
+    held = store._backend  # membership in Oxigraph itself: a pattern lookup per triple costs 15 times more
+    seen: set[ox.Quad] = set()
+    total: defaultdict[str, int] = defaultdict(int)
+    counted: list[ParsedFile] = []
+    for item in items:
+        added: defaultdict[str, int] = defaultdict(int)
+        for quad in item.quads:
+            if quad in seen or quad in held:
+                continue
+            seen.add(quad)
+            added[_graph_of(quad, item.graph)] += 1
+        for graph, count in added.items():
+            total[graph] += count
+        counted.append(replace(item, added=dict(added)))
+    report.files, report.imports = counted[: len(report.files)], counted[len(report.files) :]
+    report.added = dict(total)
+    return None
+
+
+def _graph_of(quad: ox.Quad, default: str) -> str:
+    return quad.graph_name.value if isinstance(quad.graph_name, ox.NamedNode) else default
 
 
 @dataclass
@@ -255,7 +317,20 @@ def _bulk_load(store: EmbeddedStore, path: Path, graph: str | GraphName | None) 
         return None  # a failed bulk write could not be undone without undoing what was there
     _check_part_cycles(store, [_Raw(source, target, scan.part_shape, False, {}, ())])
     store.bulk_load(path, rdf_format, target, base)
-    return LoadReport(files=[ParsedFile(source, target.value, [], bulk=scan.triples)])
+    added = {target.value: _size(store, target)}  # the graph was empty; a file may give a triple twice
+    return LoadReport(files=[ParsedFile(source, target.value, [], bulk=scan.triples, added=added)], added=added)
+
+
+def _size(store: Store, graph: ox.NamedNode) -> int:
+    """How many triples ``graph`` holds, counted by the query engine: 0.4 s for a million triples,
+    where :meth:`Store.count` takes a Python step per triple (0.8 s)."""
+    rows = store.query(_GRAPH_SIZE, {"g": graph})
+    assert isinstance(rows, ox.QuerySolutions)
+    count = next(iter(rows), None)
+    return int(count["n"].value) if count is not None else 0
+
+
+_GRAPH_SIZE = "SELECT ?g (COUNT(*) AS ?n) WHERE { GRAPH ?g { ?s ?p ?o } } GROUP BY ?g"
 
 
 def _scan(path: Path, rdf_format: ox.RdfFormat, base: str) -> _Scan | None:
