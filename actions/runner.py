@@ -22,7 +22,9 @@ from cbrs.actions.graph import statement_text
 from cbrs.actions.plan import Plan, PlanStep
 from cbrs.actions.replanning import Failure, FailureMemory, ReplanPolicy
 from cbrs.kb import KnowledgeBase, NotFoundError, Requirement, Statement
+from cbrs.kb.namespaces import HOME
 from cbrs.kb.semantic_map import UnresolvedDesignatorError
+from cbrs.reasoner.taxonomy import ROOT, TaxonomyIndex
 
 
 class Environment(Protocol):
@@ -158,7 +160,7 @@ def run_task(
         belief.restore(before)  # nothing can be done and nothing was: the store is left as it was
         return RunResult(composition, None)
     try:
-        _check_grounded(kb, composition.plan)
+        _check_grounded(kb, composer.index, composition.plan)
     except (UngroundedGoalError, UnresolvedDesignatorError):
         belief.restore(before)
         raise
@@ -249,27 +251,50 @@ def _compose(kb: KnowledgeBase, config: ComposeConfig, task: str, avoid: frozens
     return Composer(kb, config, advertisements=kept).compose(task, belief=True)
 
 
-def _check_grounded(kb: KnowledgeBase, plan: Plan) -> None:
-    """Refuse, before anything moves, a task that names a class nothing in the world (map or belief) is.
-    In a goal: a place the home lacks (a dish rack) named by the goal alone was planned towards the
-    object's own place, and the arm carried the cup there. In an input, whether a step takes it or not
-    (the environment designates only those the plan uses): a suction cup no robot has was ignored,
-    and the pen fetched by a gripper."""
+_WHERE = {HOME + "x", HOME + "minX"}  # what places a thing in the map: a position or an extent
+
+
+def _check_grounded(kb: KnowledgeBase, index: TaxonomyIndex, plan: Plan) -> None:
+    """Refuse, before anything moves, a task that names a class of thing the world should hold and
+    does not (:func:`_missing`). In a goal: a place the home lacks (a dish rack) named by the goal alone
+    was planned towards the object's own place, and the arm carried the cup there. In an input, whether
+    a step takes it or not (the environment designates only those the plan uses): a suction cup no
+    robot has was ignored, and the pen fetched by a gripper."""
     try:
         requirement = kb.description(plan.requirement)
     except NotFoundError:
         requirement = None
+    placed = {row["thing"].value for row in kb.select("map_facts") if row["property"].value in _WHERE}
     if isinstance(requirement, Requirement):
         for parameter in requirement.inputs:
-            if parameter.type and not kb.select("designate", {"class": parameter.type}):
+            if parameter.type and _missing(kb, index, placed, parameter.type):
                 raise UnresolvedDesignatorError(parameter.type)
     for goal in plan.goals:
         statement = goal.statement
         if statement is None:
             continue
         for concept in (statement.subject, statement.object):
-            if not kb.select("designate", {"class": concept}):
+            if _missing(kb, index, placed, concept):
                 raise UngroundedGoalError(statement_text(statement), concept)
+
+
+def _missing(kb: KnowledgeBase, index: TaxonomyIndex, placed: set[str], concept: str) -> bool:
+    """Whether nothing in the world (map or belief) is a ``concept`` although it is a kind of thing the
+    map places: one of its topmost classes has things with a position or an extent in the map
+    (``placed``). A dish rack is a place, a suction cup a physical object: none being in the world
+    means one is missing. A door's status or a notification is of a kind the map places nothing of
+    (the world's qualities, a marker's colours, have no position): no thing to find, so it is left to
+    the plan. A concept the ontology does not declare counts as missing."""
+    if kb.select("designate", {"class": concept}):
+        return False
+    if concept not in index:
+        return True
+    tops = [
+        ancestor
+        for ancestor in index.is_a_ancestors(concept)
+        if all(parent == ROOT for parent, link in index.parents(ancestor).items() if link == "is-a")
+    ]
+    return any(row["thing"].value in placed for top in tops for row in kb.select("designate", {"class": top}))
 
 
 def _stop_if_cancelled(executor: Executor, cancelled: Callable[[], bool] | None, done: int) -> None:

@@ -18,7 +18,7 @@ import pytest
 
 from cbrs.actions.composer import Composer, PlanStatus
 from cbrs.actions.errors import UngroundedGoalError
-from cbrs.actions.runner import RunResult, run_task
+from cbrs.actions.runner import _WHERE, RunResult, _missing, run_task
 from cbrs.cli_actions import run_text
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
@@ -132,6 +132,21 @@ def test_a_place_the_home_lacks_is_refused_whether_given_or_named_by_the_goal_al
     assert isinstance(goal, UngroundedGoalError) and goal.concept == HOME + "DishRack"
     assert goal.goal == "(home:Cup, home:isLocated, home:DishRack)"
     assert "nothing in the world is one" in str(goal)
+
+
+def test_only_a_class_of_a_kind_the_world_holds_must_have_a_thing_in_it() -> None:
+    """A dish rack is a place, and the world holds places: none being a dish rack means one is missing.
+    A door's status, an alarm or a text are of kinds the world holds no thing of: a goal or input
+    naming them is left to the plan, not refused as a thing to find."""
+    kb = knowledge(("ontology", "dish_rack.ttl"), ("ontology", "suction_cup.ttl"))
+    index = Composer(kb).index
+    placed = {row["thing"].value for row in kb.select("map_facts") if row["property"].value in _WHERE}
+    for missing in ("DishRack", "SuctionCup", "Frisbee"):
+        assert _missing(kb, index, placed, HOME + missing), missing
+    assert not _missing(kb, index, placed, HOME + "Cup") and not _missing(kb, index, placed, HOME + "Water")
+    abstract = [HOME + "Opened", HOME + "DoorStatus"]  # the world has a quality (a marker's colours), unplaced
+    assert all(concept in index and not kb.select("designate", {"class": concept}) for concept in abstract)
+    assert not any(_missing(kb, index, placed, concept) for concept in abstract)
 
 
 def test_a_robot_part_no_robot_has_is_refused_and_a_part_of_another_robot_is_used() -> None:
