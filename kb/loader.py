@@ -121,8 +121,9 @@ class UnresolvedConcept:
 
 @dataclass
 class LoadReport:
-    """What one load added: the files asked for, the ontologies their imports brought in, and what
-    could not be resolved. Iterating it gives the files asked for."""
+    """What one load read and what it added: the files asked for, the ontologies their imports
+    brought in, what could not be resolved, and (:attr:`added`) what the store did not hold before.
+    Iterating it gives the files asked for."""
 
     files: list[ParsedFile] = field(default_factory=list)
     imports: list[ParsedFile] = field(default_factory=list)
