@@ -11,11 +11,12 @@ import pyoxigraph as ox
 from cbrs.kb.conditions import CONDITION_PARTS, LEGACY_PARTS
 from cbrs.kb.errors import AlreadyRegisteredError, InvalidDescriptionError, NotFoundError, OutsideRegistryError
 from cbrs.kb.loader import parse_bytes, registration_format
-from cbrs.kb.namespaces import BASE, OWL, RDF, RDFS, GraphName, shorten
-from cbrs.kb.owls import DCTERMS_SOURCE, SERVICE_LINKS, is_owls, is_owls_service, owls_key
+from cbrs.kb.namespaces import BASE, RDF, RDFS, GraphName, shorten
+from cbrs.kb.owls import is_owls, is_owls_service
+from cbrs.kb.owls_source import GraphReads, owls_services, owls_source
 from cbrs.kb.results import releases_results
 from cbrs.kb.shapes import check_descriptions, line_of
-from cbrs.kb.skolem import closure, is_skolem, skolem_digest
+from cbrs.kb.skolem import closure, is_skolem
 from cbrs.kb.standard_terms import StandardTerms
 from cbrs.kb.store import Store
 from cbrs.kb.vocab import CBRS
@@ -124,7 +125,7 @@ class ComponentRegistry:
         return {q.object.value for q in self._store.quads(node, ox.NamedNode(RDF + "type"), None, self._graph)}  # type: ignore[union-attr]
 
     def description_quads(
-        self, iri: str, graph: ox.NamedNode | None = None, lookup: _Lookup | None = None
+        self, iri: str, graph: ox.NamedNode | None = None, lookup: GraphReads | None = None
     ) -> list[ox.Quad]:
         """The advertisement's triples (in the services graph, or ``graph``) and, recursively, those of
         its parts: skolemised nodes, and models, parameters, conditions and ports given IRIs of their own.
@@ -132,7 +133,7 @@ class ComponentRegistry:
         or a blank node one file gives two descriptions (``cbrs:hasQoSModel _:q`` on both), which went
         with the first description deregistered."""
         root = ox.NamedNode(iri)
-        lookup = lookup or _Lookup(self._store, graph or self._graph)
+        lookup = lookup or GraphReads(self._store, graph or self._graph)
 
         def quads_of(
             node: ox.NamedNode | ox.BlankNode | ox.Triple, skip: frozenset[object] = frozenset()
@@ -152,89 +153,15 @@ class ComponentRegistry:
 
     def owned_quads(self, iri: str, graph: ox.NamedNode | None = None) -> list[ox.Quad]:
         """What deregistering ``iri`` removes: its description (:meth:`description_quads`) and, for one
-        ``cbrs load`` made from OWL-S, the OWL-S triples of its service as well (:meth:`_owls_source`),
+        ``cbrs load`` made from OWL-S, the OWL-S triples of its service as well (:func:`kb.owls_source.owls_source`),
         so that deregistering leaves the store as it was before the load. Each node's triples are read
         from the store once (a remote store answers each read with a request)."""
-        lookup = _Lookup(self._store, graph or self._graph)
+        lookup = GraphReads(self._store, graph or self._graph)
         root = ox.NamedNode(iri)
-        services = self._owls_services(root, lookup)
+        services = owls_services(root, lookup)
         if not services:
             return self.description_quads(iri, lookup.graph, lookup)
-        return self._owls_source(root, services, lookup)
-
-    def _owls_services(self, root: ox.NamedNode, lookup: _Lookup) -> list[ox.NamedNode]:
-        """The OWL-S services ``root`` was made from: itself (an advertisement keeps the service's IRI)
-        or its ``dcterms:source`` (a requirement's), when OWL-S triples are about it. A source that is a
-        description of its own (a lab's Turtle description citing a loaded OWL-S advertisement) is not."""
-        found = [root]
-        for quad in lookup.out(root):
-            source = quad.object
-            if (
-                quad.predicate.value == DCTERMS_SOURCE
-                and isinstance(source, ox.NamedNode)
-                and not any(q.predicate.value == CBRS.hasOWLSModel for q in lookup.out(source))
-            ):
-                found.append(source)
-        return [node for node in found if _has_owls(node, lookup)]
-
-    def _owls_source(self, root: ox.NamedNode, services: list[ox.NamedNode], lookup: _Lookup) -> list[ox.Quad]:
-        """The description and the OWL-S triples of its services: what the load added for it.
-
-        From the description and its services, the nodes of the service's file are followed
-        (:func:`_part_of_source`: the profile, process and grounding, their parameters, expressions,
-        results and contacts, and the file's stub ``owl:Class`` lines); so are the profiles, processes
-        and groundings that point at the service. The walk stops at another
-        description or service. A node something else in the graph still points at (a parameter two
-        services of one file share, a stub class another service uses as a parameter type) is shared:
-        it stays, and so does what only it reaches. Last, the file's ``owl:Ontology`` header goes with
-        the file's last description."""
-        kept: set[ox.NamedNode] = set()
-        while True:
-            found = _owls_walk(root, services, lookup, kept)
-            own = {q.subject for q in found}
-            shared = {
-                node
-                for node in own
-                if node != root and any(q.subject not in own for q in lookup.into(node))  # type: ignore[arg-type]
-            }
-            if not shared:
-                break
-            kept |= shared  # type: ignore[arg-type]
-        for service in services:
-            found.extend(self._owls_header(root, service, lookup, own))  # type: ignore[arg-type]
-        return list(dict.fromkeys(found))
-
-    def _owls_header(
-        self, root: ox.NamedNode, service: ox.NamedNode, lookup: _Lookup, own: set[ox.NamedNode]
-    ) -> list[ox.Quad]:
-        """The ``owl:Ontology`` header of the file ``service`` is named in (``file.owls`` for
-        ``file.owls#Service``), when no other description of that file stays in the graph."""
-        document, separator, _ = service.value.partition("#")
-        if not separator:
-            return []
-        header = ox.NamedNode(document)
-        if header in own or not any(
-            q.predicate.value == RDF + "type" and q.object == ox.NamedNode(OWL + "Ontology") for q in lookup.out(header)
-        ):
-            return []
-        if any(q.subject != header and q.subject not in own for q in lookup.into(header)):
-            return []  # another file imports it
-        if self._more_of_file(root, document, lookup, own):
-            return []
-        return closure([header], lookup.out)  # type: ignore[arg-type]
-
-    def _more_of_file(self, root: ox.NamedNode, document: str, lookup: _Lookup, own: set[ox.NamedNode]) -> bool:
-        """Whether another description in the graph came from the file ``root`` came from: it is named
-        under ``document#``, or its model node was named in the same load (:func:`skolem_digest`). One
-        pass over the models' links; a scan of the graph's subjects for the prefix took 140 ms on OWLS-TC."""
-        model = ox.NamedNode(CBRS.hasOWLSModel)
-        digests = {skolem_digest(q.object) for q in lookup.out(root) if q.predicate == model} - {None}
-        for quad in self._store.quads(None, model, None, lookup.graph):
-            if quad.subject in own:
-                continue
-            if quad.subject.value.startswith(document + "#") or skolem_digest(quad.object) in digests:  # type: ignore[union-attr]
-                return True
-        return False
+        return owls_source(root, services, lookup)
 
     def _loaded_already(self, quads: list[ox.Quad], source: str) -> str:
         """For an OWL-S file some of whose services are advertisements already, the commands that bring the
@@ -312,92 +239,8 @@ class ComponentRegistry:
         return parsed.quads, iris
 
 
-class _Lookup:
-    """The quads of one graph about a node, each read from the store once for one deregistration."""
-
-    def __init__(self, store: Store, graph: ox.NamedNode) -> None:
-        self.store = store
-        self.graph = graph
-        self._out: dict[ox.NamedNode, list[ox.Quad]] = {}
-        self._into: dict[ox.NamedNode, list[ox.Quad]] = {}
-
-    def out(self, node: ox.NamedNode) -> list[ox.Quad]:
-        """The quads whose subject is ``node``."""
-        if node not in self._out:
-            self._out[node] = list(self.store.quads(node, None, None, self.graph))
-        return self._out[node]
-
-    def into(self, node: ox.NamedNode) -> list[ox.Quad]:
-        """The quads whose object is ``node``."""
-        if node not in self._into:
-            self._into[node] = list(self.store.quads(None, None, node, self.graph))
-        return self._into[node]
-
-
-def _has_owls(node: ox.NamedNode, lookup: _Lookup) -> bool:
-    """Whether the graph holds OWL-S triples about ``node`` (a Turtle description has none)."""
-    for quad in lookup.out(node):
-        kind = quad.object if quad.predicate.value == RDF + "type" else None
-        if owls_key(quad.predicate.value) or (isinstance(kind, ox.NamedNode) and owls_key(kind.value)):
-            return True
-    return any(owls_key(q.predicate.value) in SERVICE_LINKS for q in lookup.into(node))
-
-
-def _owls_walk(
-    root: ox.NamedNode, services: list[ox.NamedNode], lookup: _Lookup, kept: set[ox.NamedNode]
-) -> list[ox.Quad]:
-    """One walk of ``_owls_source``, passing over the ``kept`` (shared) nodes."""
-    found: list[ox.Quad] = []
-    seen: set[ox.NamedNode] = set()
-    pending = [root, *services]
-    files = {_file_of(service) for service in services}
-    while pending:
-        node = pending.pop()
-        if node in seen or node in kept:
-            continue
-        seen.add(node)
-        for quad in lookup.out(node):
-            found.append(quad)
-            if (
-                isinstance(quad.object, ox.NamedNode)
-                and quad.object not in seen
-                and _part_of_source(quad.object, lookup, files)
-            ):
-                pending.append(quad.object)
-        if node in services:
-            for quad in lookup.into(node):
-                if owls_key(quad.predicate.value) in SERVICE_LINKS and isinstance(quad.subject, ox.NamedNode):
-                    pending.append(quad.subject)
-    return found
-
-
-def _part_of_source(node: ox.NamedNode, lookup: _Lookup, files: set[str]) -> bool:
-    """Whether the walk goes on to ``node``: the graph says something about it; it is a node of the
-    service's file (named under the file's IRI, or skolemised) or a stub declaration (type triples
-    only, as an OWL-S file's ``<owl:Class rdf:about="...#Price"/>``); and it is neither a description
-    nor an OWL-S service (those are deregistered on their own). A resource of its own the file only
-    points at (a device another file describes) is not the file's to remove."""
-    quads = lookup.out(node)
-    stub = True
-    for quad in quads:
-        if quad.predicate.value == CBRS.hasOWLSModel:
-            return False
-        kind = quad.object if quad.predicate.value == RDF + "type" else None
-        if isinstance(kind, ox.NamedNode) and is_owls_service([kind.value]):
-            return False
-        stub = stub and kind is not None
-    return bool(quads) and (stub or is_skolem(node) or _file_of(node) in files)
-
-
 def _count(count: int, one: str, many: str) -> str:
     return f"{count} {one if count == 1 else many}"
-
-
-def _file_of(node: ox.NamedNode) -> str:
-    """The IRI of the document ``node`` is named in: before its ``#``, else up to its last ``/``."""
-    if "#" in node.value:
-        return node.value.split("#", 1)[0]
-    return node.value.rsplit("/", 1)[0]
 
 
 def _base(source: str) -> str:
