@@ -21,7 +21,6 @@ each sub-action is composed in their partial order and the plans are concatenate
 
 from __future__ import annotations
 
-import difflib
 import re
 from collections import deque
 from collections.abc import Callable, Sequence
@@ -50,6 +49,7 @@ from cbrs.actions.plan import Binding, Plan, PlanStep, Source
 from cbrs.actions.search import SearchTrace, bidirectional_search
 from cbrs.kb import Advertisement, KnowledgeBase, Requirement, Statement
 from cbrs.kb.namespaces import GraphName, shorten
+from cbrs.kb.shapes import nearest_term
 from cbrs.reasoner.config import MatchConfig
 
 if TYPE_CHECKING:
@@ -470,16 +470,8 @@ class Composer:
         )
         if not missing:
             return unsatisfied
-        near = tuple((c, found) for c in missing if (found := self._closest(c)) is not None)
+        near = tuple((c, found) for c in missing if (found := nearest_term(c, self.index.nodes(), 0.6)) is not None)
         return replace(unsatisfied, undeclared=missing, near=near)
-
-    def _closest(self, concept: str) -> str | None:
-        """The declared class of the same namespace whose name is closest to ``concept``'s (a typo:
-        home:Pne for home:Pen), if any is close."""
-        namespace, name = _split(concept)
-        names = {_split(c)[1]: c for c in self.index.nodes() if _split(c)[0] == namespace}
-        found = difflib.get_close_matches(name, list(names), n=1, cutoff=0.6)
-        return names[found[0]] if found else None
 
 
 def store_plan(kb: KnowledgeBase, plan: Plan) -> None:
@@ -919,12 +911,6 @@ class _Extraction:
 
     def _goal_node(self, need: Need) -> str:
         return SRO if need.role == "input" else SRE
-
-
-def _split(iri: str) -> tuple[str, str]:
-    """An IRI's namespace and local name (after its last '#' or '/')."""
-    cut = max(iri.rfind("#"), iri.rfind("/")) + 1
-    return iri[:cut], iri[cut:]
 
 
 def _is_a(index: TaxonomyIndex, concept: str, ancestor: str) -> bool:

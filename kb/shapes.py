@@ -479,7 +479,7 @@ def _term_problems(store: Store, closures: dict[str, list[ox.Quad]], context: Se
         namespace = _namespace(term.value)
         if namespace not in candidates:
             candidates[namespace] = _candidates(store, namespace, declared_here)
-        near = _near(term.value, candidates[namespace])
+        near = nearest_term(term.value, candidates[namespace])
         if namespace not in closed_namespaces and (near is None or not _misspelt(term.value, near)):
             # A new concept, not a misspelt one: matchmaking compares undeclared concepts by name.
             continue
@@ -516,12 +516,13 @@ def _candidates(store: Store, namespace: str, declared_here: set[str]) -> list[s
     return sorted({row["term"].value for row in rows} | {t for t in declared_here if t.startswith(namespace)})
 
 
-def _near(iri: str, candidates: Sequence[str]) -> str | None:
-    """The candidate whose local name is closest to ``iri``'s, if any is close (case aside)."""
+def nearest_term(iri: str, candidates: Iterable[str], cutoff: float = 0.75) -> str | None:
+    """The candidate of ``iri``'s namespace whose local name is closest to ``iri``'s, if any is close
+    (``difflib``'s ratio at least ``cutoff``, case aside): the did-you-mean of a misspelt term."""
     namespace = _namespace(iri)
     local = iri[len(namespace) :]
     names = {c[len(namespace) :].lower(): c for c in candidates if c.startswith(namespace)}
-    close = difflib.get_close_matches(local.lower(), list(names), n=1, cutoff=0.75)
+    close = difflib.get_close_matches(local.lower(), list(names), n=1, cutoff=cutoff)
     return names[close[0]] if close else None
 
 
