@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from cbrs.kb import KnowledgeBaseError
+from cbrs.reasoner.names import local_name
 
 
 class ActionsError(KnowledgeBaseError):
@@ -45,8 +46,7 @@ class UngroundedGoalError(ActionsError):
     def __init__(self, goal: str, concept: str) -> None:
         self.goal = goal
         self.concept = concept
-        name = concept.rsplit("#", 1)[-1].rsplit("/", 1)[-1]
         super().__init__(
-            f"the goal {goal} is about a {name} ({concept}), and nothing in the world is one: add an individual"
-            " of that class to the semantic map (see docs/tasks.md), or correct the goal"
+            f"the goal {goal} is about a {local_name(concept)} ({concept}), and nothing in the world is one: add an"
+            " individual of that class to the semantic map (see docs/tasks.md), or correct the goal"
         )
