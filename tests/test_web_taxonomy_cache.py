@@ -1,0 +1,70 @@
+"""The taxonomy pages read the store's taxonomy once per store generation, not once per page (on
+OWLS-TC each read took about 1.5 s), and a write to the store shows on the next page."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+import pytest
+from flask.testing import FlaskClient
+
+from cbrs.kb import KnowledgeBase
+from cbrs.sparql_service import SparqlService
+from cbrs.web import create_app, taxonomy
+
+LAB = "http://example.org/cache-lab#"
+
+
+@pytest.fixture
+def kb() -> Iterator[KnowledgeBase]:
+    opened = KnowledgeBase.open(":memory:")
+    yield opened
+    opened.close()
+
+
+@pytest.fixture
+def reads(monkeypatch: pytest.MonkeyPatch) -> list[int]:
+    """One entry per read of the whole taxonomy."""
+    counted: list[int] = []
+    original = taxonomy.Taxonomy.read.__func__  # type: ignore[attr-defined]
+
+    def counting(cls: type[taxonomy.Taxonomy], kb: KnowledgeBase) -> taxonomy.Taxonomy:
+        counted.append(1)
+        found: taxonomy.Taxonomy = original(cls, kb)
+        return found
+
+    monkeypatch.setattr(taxonomy.Taxonomy, "read", classmethod(counting))
+    return counted
+
+
+def client_of(kb: KnowledgeBase) -> FlaskClient:
+    return create_app(SparqlService(kb)).test_client()
+
+
+def test_pages_share_one_read_until_the_store_is_written(kb: KnowledgeBase, reads: list[int]) -> None:
+    client = client_of(kb)
+    assert client.get("/taxonomy.json").status_code == 200
+    assert client.get("/taxonomy/class.json", query_string={"iri": "home:RobotPosition"}).status_code == 200
+    assert client.get("/taxonomy.json", query_string={"q": "position"}).status_code == 200
+    assert len(reads) == 1
+    assert LAB + "Gadget" not in client.get("/taxonomy.json", query_string={"q": "gadget"}).text
+
+    kb.update(
+        f"PREFIX owl: <http://www.w3.org/2002/07/owl#> PREFIX rdfs: <http://www.w3.org/2000/01/rdf-schema#>\n"
+        f"INSERT DATA {{ GRAPH <https://w3id.org/cbrs/graph#ontology> {{\n"
+        f"  <{LAB}Gadget> a owl:Class ; rdfs:subClassOf <https://w3id.org/cbrs/home#Device> }} }}"
+    )
+    found = client.get("/taxonomy.json", query_string={"q": "gadget"}).get_json()
+    assert [m["iri"] for m in found["matches"]] == [LAB + "Gadget"]
+    page = client.get("/taxonomy/class.json", query_string={"iri": LAB + "Gadget"})
+    assert page.status_code == 200 and page.get_json()["kind"] == "class"
+    assert len(reads) == 2
+
+
+def test_a_store_without_a_generation_is_read_every_time(kb: KnowledgeBase, reads: list[int]) -> None:
+    """A remote store counts no writes (another robot may write to it): nothing is kept."""
+    client = client_of(kb)
+    kb.store.generation = None  # type: ignore[attr-defined]  # as a remote store has none
+    for _ in range(2):
+        assert client.get("/taxonomy/class.json", query_string={"iri": "home:RobotPosition"}).status_code == 200
+    assert len(reads) == 2
