@@ -7,12 +7,16 @@ Services (request fields -> response values):
 - ``/cbrs/match`` ``{requirement, method="sem-str", top=10}`` -> the ranking with explanations.
 - ``/cbrs/plan`` ``{task, objective="similarity"}`` -> the plan (recorded in the plans graph when the
   caller may write) or what is unsatisfied.
-- ``/cbrs/run_task`` ``{task, seed=0, fail=[], wait=true}`` -> the run; with ``wait`` false it returns
-  at once and the run is followed on the topics, or with ``/cbrs/task_status`` ``{run}``.
+- ``/cbrs/tasks`` ``{}`` -> ``{tasks}``: every task the store can express, as ``task`` takes it.
+- ``/cbrs/run_task`` ``{task, seed=0, fail=[], fault_rate=0, repeat_failures=1, wait=true}`` -> the run;
+  with ``wait`` false it returns at once and the run is followed on the topics, or with
+  ``/cbrs/task_status`` ``{run}``. ``task`` is any requirement or action of the store, named as
+  ``cbrs run`` takes it; ``repeat_failures`` as ``cbrs run --repeat-failures``.
 
 Action (rosbridge's ROS 2 action ops, ``send_action_goal`` and the rest):
 
-- ``/cbrs/run_task`` (type ``cbrs/action/RunTask``), goal ``{task, seed=0, fail=[], fault_rate=0}``:
+- ``/cbrs/run_task`` (type ``cbrs/action/RunTask``), goal ``{task, seed=0, fail=[], fault_rate=0,
+  repeat_failures=1}``:
   one feedback ``{run, plan, step, action, component, status, reason, failover}`` per plan step that
   ends (``status`` succeeded or failed); the result is the run as the service returns it, with status
   SUCCEEDED, CANCELED (the client cancelled: the run stops after the step under way) or ABORTED (the
@@ -94,6 +98,7 @@ class KnowledgeServices:
             "/cbrs/match": ("cbrs/Match", self.match),
             "/cbrs/plan": ("cbrs/Plan", self.plan),
             "/cbrs/run_task": ("cbrs/RunTask", self.run_task),
+            "/cbrs/tasks": ("cbrs/Tasks", self.known_tasks),
             "/cbrs/task_status": ("cbrs/TaskStatus", self.task_status),
         }
 
@@ -134,12 +139,15 @@ class KnowledgeServices:
                 store_plan(self.sparql.kb, result.plan)
         return {**result.to_dict(), "recorded": recorded}
 
+    def known_tasks(self, args: dict[str, Any]) -> dict[str, Any]:
+        return {"tasks": _call(self.tasks.tasks)}
+
     def run_task(self, args: dict[str, Any]) -> dict[str, Any]:
-        task, seed, faults, rate = self._run_request(args)
+        request = self._run_request(args)
         if _field(args, "wait", bool, True):
-            run = _call(lambda: self.tasks.run(task, seed, faults, fault_rate=rate))
+            run = _call(lambda: self.tasks.run(**request))
         else:
-            run = _call(lambda: self.tasks.start(task, seed, faults, rate))
+            run = _call(lambda: self.tasks.start(**request))
         return run.to_dict(with_events=False)
 
     def run_task_goal(self, goal: GoalHandle) -> GoalResult:
@@ -148,13 +156,13 @@ class KnowledgeServices:
         A cancel asks the run to stop after the step under way. The wait has no deadline of its own:
         a run always ends (the executor's tick bound), and a server stopping cancels the goal.
         """
-        task, seed, faults, rate = self._run_request(goal.args)
+        request = self._run_request(goal.args)
         with self.sparql.lock:
             realises = {ad.iri: ad.realizes_action for ad in self.sparql.kb.advertisements(include_unavailable=True)}
         feed = StepFeed(goal, realises)
         unsubscribe = self.tasks.subscribe(feed)
         try:
-            run = _call(lambda: self.tasks.start(task, seed, faults, rate))
+            run = _call(lambda: self.tasks.start(**request))
             feed.follow(run.id)
 
             def cancel() -> None:
@@ -166,11 +174,13 @@ class KnowledgeServices:
             unsubscribe()
         return GoalResult(GOAL_STATUS.get(run.status, GoalStatus.ABORTED), run.to_dict(with_events=False))
 
-    def _run_request(self, args: dict[str, Any]) -> tuple[str, int, list[str], float]:
-        """A run's task, seed, failing components and fault rate, checked, from a client that may write."""
+    def _run_request(self, args: dict[str, Any]) -> dict[str, Any]:
+        """A run's task, seed, failing components, fault rate and repeat bound, checked, from a client
+        that may write: the keywords of ``TaskRunner.start``."""
         task = _field(args, "task", str)
         seed = _field(args, "seed", int, 0)
         faults = _field(args, "fail", list, [])
+        repeats = _field(args, "repeat_failures", int, 1)
         rate = args.get("fault_rate", 0.0)
         if not all(isinstance(f, str) for f in faults):
             raise ServiceError("fail must be a list of component IRIs (strings)")
@@ -181,7 +191,7 @@ class KnowledgeServices:
                 "a task run moves the robot and writes the store: send the update token first "
                 '({"op": "auth", "mac": "<token>"}), or start it from this server\'s tasks page'
             )
-        return task, seed, faults, float(rate)
+        return {"task": task, "seed": seed, "faults": faults, "fault_rate": float(rate), "repeat_failures": repeats}
 
     def task_status(self, args: dict[str, Any]) -> dict[str, Any]:
         run_id = _field(args, "run", str)

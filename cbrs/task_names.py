@@ -64,6 +64,12 @@ def task_iri(kb: KnowledgeBase, name: str, library: ActionLibrary | None = None)
     raise TaskNameError(name, _known(tasks), _suggestions(typed, tasks))
 
 
+def known_tasks(kb: KnowledgeBase, library: ActionLibrary | None = None) -> list[str]:
+    """Every task the store can express (its requirements and the actions with sub-actions), each
+    spelt as :func:`task_iri` takes it back: what a person is offered to choose from."""
+    return _known(_tasks(kb, library or ActionLibrary.from_kb(kb)))
+
+
 def _tasks(kb: KnowledgeBase, library: ActionLibrary) -> list[_Task]:
     requirements = [_Task(row["requirement"].value, True) for row in kb.select("requirements")]
     actions = [_Task(action.iri, bool(action.sub_actions)) for action in library]

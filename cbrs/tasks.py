@@ -94,6 +94,8 @@ class TaskRun:
     seed: int
     faults: tuple[str, ...]
     fault_rate: float = 0.0  # random faults, seeded with ``seed`` (actions.faults.RandomFaults)
+    repeat_failures: int = 1  # actions.replanning.ReplanPolicy.max_repeats
+    iri: str = ""  # the requirement or action ``task`` names
     status: str = "running"  # then succeeded, failed, cancelled, no-plan or error
     started: float = field(default_factory=time.time)
     finished: float | None = None
@@ -110,6 +112,8 @@ class TaskRun:
             "seed": self.seed,
             "faults": list(self.faults),
             "fault_rate": self.fault_rate,
+            "repeat_failures": self.repeat_failures,
+            "iri": self.iri,
             "status": self.status,
             "started": self.started,
             "finished": self.finished,
@@ -204,26 +208,49 @@ class TaskRunner:
 
         return simulated(self.kb)
 
-    def start(self, task: str, seed: int = 0, faults: Iterable[str] = (), fault_rate: float = 0.0) -> TaskRun:
+    def tasks(self) -> list[str]:
+        """Every task the store can express, as a person types it (``cbrs.task_names.known_tasks``)."""
+        from cbrs.task_names import known_tasks  # the planner loads with the first use, not at start-up
+
+        with self.lock:
+            return known_tasks(self.kb)
+
+    def start(
+        self,
+        task: str,
+        seed: int = 0,
+        faults: Iterable[str] = (),
+        fault_rate: float = 0.0,
+        repeat_failures: int = 1,
+    ) -> TaskRun:
         """Check ``task`` and ``faults``, then run the task in the background; returns at once.
 
+        ``task`` is any requirement or action of the store, named as ``cbrs run`` takes it (a bare local
+        name, a prefixed name or an IRI); an unknown one fails with a did-you-mean (``TaskNameError``).
         ``fault_rate`` breaks each component with that probability at a random moment, seeded by ``seed``.
+        ``repeat_failures`` bounds how often a re-plan may meet the same failure with nothing changed
+        (``ReplanPolicy.max_repeats``).
         """
         if self.read_only:
             raise TasksDisabledError()
         require("sim", "a task run")
         from cbrs.actions.faults import RandomFaults  # the planner loads with the first run, not at start-up
         from cbrs.actions.model import ActionLibrary, resolve_task
+        from cbrs.actions.replanning import ReplanPolicy
+        from cbrs.task_names import task_iri
 
         RandomFaults(seed, fault_rate)  # an impossible rate fails here (FaultSpecError), not in the thread
+        ReplanPolicy(max_repeats=repeat_failures)  # so does a negative bound (ReplanPolicyError)
         failing = tuple(expand(f) for f in faults)
         _check_components(self.kb, failing)
         self._refuse_if_busy()  # a second run is refused before its task is checked
         with self.lock:
-            resolve_task(self.kb, ActionLibrary.from_kb(self.kb), task)  # an unknown task fails here, not in the thread
+            library = ActionLibrary.from_kb(self.kb)
+            iri = task_iri(self.kb, task, library)  # an unknown task fails here, not in the thread
+            resolve_task(self.kb, library, iri)
         with self._guard:
             self._refuse_if_busy()
-            run = TaskRun(f"run-{next(self._ids)}", task, seed, failing, fault_rate)
+            run = TaskRun(f"run-{next(self._ids)}", task, seed, failing, fault_rate, repeat_failures, iri)
             thread = threading.Thread(target=self._run, args=(run,), name=f"cbrs-{run.id}", daemon=True)
             self._active = (run, thread)
             self._runs[run.id] = run
@@ -239,10 +266,16 @@ class TaskRunner:
             raise TaskBusyError(active[0].id)
 
     def run(
-        self, task: str, seed: int = 0, faults: Iterable[str] = (), timeout: float = 300.0, fault_rate: float = 0.0
+        self,
+        task: str,
+        seed: int = 0,
+        faults: Iterable[str] = (),
+        timeout: float = 300.0,
+        fault_rate: float = 0.0,
+        repeat_failures: int = 1,
     ) -> TaskRun:
         """Start ``task`` and wait (at most ``timeout`` seconds) until it ends."""
-        run = self.start(task, seed, faults, fault_rate)
+        run = self.start(task, seed, faults, fault_rate, repeat_failures)
         run.done.wait(timeout)
         return run
 
@@ -272,6 +305,7 @@ class TaskRunner:
         from cbrs.actions.composer import Composer
         from cbrs.actions.executor import RunStatus
         from cbrs.actions.faults import RandomFaults
+        from cbrs.actions.replanning import ReplanPolicy
         from cbrs.kb.semantic_map import SemanticMap
         from cbrs.sim.components import SimEnvironment  # pybullet loads only when a task runs
         from cbrs.sim.world import open_world
@@ -297,13 +331,14 @@ class TaskRunner:
                 policy = RandomFaults(run.seed, run.fault_rate) if run.fault_rate > 0 else None
                 result = run_task(
                     self.kb,
-                    run.task,
+                    run.iri,
                     environment,
                     run.faults,
                     composer,
                     follow,
                     fault_policy=policy,
                     cancelled=run.cancel_requested.is_set,
+                    replan_policy=ReplanPolicy(max_repeats=run.repeat_failures),
                 )
                 found = result.to_dict()
                 found["sim_seconds"] = round(world.time, 3)

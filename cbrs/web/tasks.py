@@ -1,4 +1,4 @@
-"""The tasks page: start one of the paper's scenarios in the simulated home and follow it live.
+"""The tasks page: start any task the store can express in the simulated home and follow it live.
 
 Live updates travel as server-sent events (``/tasks/events``) and the ceiling camera as an MJPEG
 stream (``/camera.mjpg``). Each open stream holds one of waitress's threads, so streams are counted
@@ -23,6 +23,7 @@ from flask import Blueprint, Response, current_app, request, url_for
 from flask.sansio.blueprints import BlueprintSetupState
 from werkzeug.exceptions import Forbidden, NotFound, ServiceUnavailable
 
+from cbrs.actions.errors import UnknownTaskError
 from cbrs.kb.namespaces import PREFIXES, expand, shorten
 from cbrs.tasks import CameraFrame, TaskBusyError, TaskRun, UnknownComponentError
 from cbrs.web import context
@@ -30,7 +31,7 @@ from cbrs.web.pages import FormError, Page, page, wants_json
 
 blueprint = Blueprint("tasks", __name__)
 
-TASKS = ("RobotArmServeACup", "FetchMyPen")  # the paper's scenarios; FetchMyPen is the web-initiated one
+PREFERRED_TASK = "FetchMyPen"  # the paper's web-initiated scenario, chosen first when the store has it
 DEFAULTS = {
     "CBRS_STREAM_SECONDS": 600.0,  # the longest a stream lives; EventSource reconnects after it ends
     "CBRS_STREAM_IDLE_SECONDS": 120.0,  # a stream with no event (no new frame) this long ends
@@ -51,7 +52,7 @@ def _defaults(state: BlueprintSetupState) -> None:
 
 @page(blueprint, "/tasks", methods=["GET", "POST"])
 def tasks() -> Page:
-    """The scenarios to start, the run going now (or the last one), the camera and the recent runs.
+    """The tasks to start, the run going now (or the last one), the camera and the recent runs.
 
     A POST starts a run (202); while one is going it is refused with 409 and says which.
     """
@@ -61,9 +62,10 @@ def tasks() -> Page:
     if request.method != "POST":
         return shown
     _may_act()
-    task, seed, faults, fault_rate = _checked(form, shown)
     try:
-        started = context.tasks().start(task, seed, faults, fault_rate)
+        started = context.tasks().start(**_checked(form, shown))
+    except UnknownTaskError as error:
+        raise FormError({"task": str(error)}, page=shown) from None
     except UnknownComponentError as error:
         raise FormError({"fail": str(error)}, page=shown) from None
     except TaskBusyError as error:
@@ -120,20 +122,24 @@ def _form() -> dict[str, Any]:
             "seed": str(body.get("seed", 0)),
             "fail": [str(f) for f in (fail if isinstance(fail, list) else [fail])],
             "fault_rate": str(body.get("fault_rate", 0)),
+            "repeat_failures": str(body.get("repeat_failures", 1)),
         }
     values = request.form if request.method == "POST" else request.args
     return {
-        "task": values.get("task", TASKS[-1]).strip(),
+        "task": values.get("task", "").strip(),
         "seed": values.get("seed", "0").strip(),
         "fail": [f.strip() for f in values.getlist("fail") if f.strip()],
         "fault_rate": values.get("fault_rate", "0").strip(),
+        "repeat_failures": values.get("repeat_failures", "1").strip(),
     }
 
 
-def _checked(form: dict[str, Any], shown: Page) -> tuple[str, int, list[str], float]:
+def _checked(form: dict[str, Any], shown: Page) -> dict[str, Any]:
+    """The form's fields as ``TaskRunner.start`` takes them; a FormError naming each bad one. The task
+    name itself is checked by the runner, against the store (with a did-you-mean)."""
     errors = {}
-    if form["task"] not in TASKS:
-        errors["task"] = f"{form['task']!r} is not one of {', '.join(TASKS)}"
+    if not form["task"]:
+        errors["task"] = "choose a task"
     seed = 0
     try:
         seed = int(form["seed"] or "0")
@@ -152,9 +158,22 @@ def _checked(form: dict[str, Any], shown: Page) -> tuple[str, int, list[str], fl
         errors["fault_rate"] = f"{form['fault_rate']!r} is not a number"
     if not 0.0 <= fault_rate <= 1.0:  # also refuses nan
         errors["fault_rate"] = f"{form['fault_rate']!r} is not a probability between 0 and 1"
+    repeats = 1
+    try:
+        repeats = int(form["repeat_failures"] or "1")
+    except ValueError:
+        errors["repeat_failures"] = f"{form['repeat_failures']!r} is not a whole number"
+    if repeats < 0:
+        errors["repeat_failures"] = f"{form['repeat_failures']!r} is negative: a number of repeats is 0 or more"
     if errors:
         raise FormError(errors, page=shown)
-    return form["task"], seed, faults, fault_rate
+    return {
+        "task": form["task"],
+        "seed": seed,
+        "faults": faults,
+        "fault_rate": fault_rate,
+        "repeat_failures": repeats,
+    }
 
 
 def _may_act(verb: str = "started") -> None:
@@ -192,9 +211,12 @@ def _overview(form: dict[str, Any]) -> dict[str, Any]:
     active = runner.active()
     runs = runner.runs()
     latest = active or (runs[-1] if runs else None)
+    known = runner.tasks()
+    if not form["task"]:
+        form = {**form, "task": PREFERRED_TASK if PREFERRED_TASK in known else next(iter(known), "")}
     return {
         "form": form,
-        "tasks": list(TASKS),
+        "tasks": known,
         "components": [shorten(c) for c in runner.components()],
         "active": _detail(latest) if latest is not None else None,
         "runs": [_summary(r) for r in reversed(runs)],

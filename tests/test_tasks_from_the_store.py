@@ -1,0 +1,117 @@
+"""The web page and the bridge run any task the store can express, named as ``cbrs run`` takes it.
+
+A task loaded from Turtle under a namespace of its own (``lab:``) is offered by the tasks page and by
+``/cbrs/tasks``, runs from either by its bare name, and a misspelt one is refused with a did-you-mean.
+Loopback only; every wait is bounded.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from flask.testing import FlaskClient
+
+from cbrs.kb import KnowledgeBase
+from cbrs.server import ServeConfig, Server
+from cbrs.sparql_service import EndpointConfig, SparqlService
+from cbrs.tasks import TaskRunner
+from cbrs.web import create_app
+from tests.helpers_threads import assert_threads_end
+from tests.test_serve import bridge, call
+
+TASKS = Path(__file__).parent / "data" / "tasks"
+LAB = "http://example.org/lab#"
+TOKEN = "tasks-test-token"
+WAIT = 10.0
+RUN_WAIT = 120.0
+
+
+def lab_task(tmp_path: Path) -> Path:
+    """The pencil-fetching task of tests/data/tasks, written under the lab's own namespace."""
+    text = (TASKS / "fetch_my_pencil.ttl").read_text(encoding="utf-8")
+    text = f"@prefix lab: <{LAB}> .\n" + text.replace("req:FetchMyPencil a", "lab:FetchMyPencil a")
+    assert "lab:FetchMyPencil a" in text
+    written = tmp_path / "lab_task.ttl"
+    written.write_text(text, encoding="utf-8")
+    return written
+
+
+@pytest.fixture
+def kb(tmp_path: Path) -> Iterator[KnowledgeBase]:
+    opened = KnowledgeBase.open(":memory:")
+    opened.load([TASKS / "pencil_on_the_table.ttl"], graph="map")
+    opened.load([lab_task(tmp_path)], graph="requirements")
+    yield opened
+    opened.close()
+
+
+@pytest.fixture
+def web(kb: KnowledgeBase) -> Iterator[tuple[FlaskClient, TaskRunner]]:
+    sparql = SparqlService(kb)
+    runner = TaskRunner(kb, sparql.lock, camera=None)
+    yield create_app(sparql, tasks=runner).test_client(), runner
+    runner.close(RUN_WAIT)
+
+
+@pytest.fixture
+def server(kb: KnowledgeBase) -> Iterator[Server]:
+    threads = threading.active_count()
+    running = Server(kb, ServeConfig(port=0, bridge_port=0, endpoint=EndpointConfig(update_token=TOKEN)))
+    running.start()
+    yield running
+    running.stop(timeout=WAIT)
+    assert_threads_end(threads, WAIT)
+
+
+def test_the_tasks_page_offers_every_task_of_the_store(web: tuple[FlaskClient, TaskRunner]) -> None:
+    client, _ = web
+    shown = client.get("/tasks.json").get_json()
+    assert {"FetchMyPencil", "FetchMyPen", "RobotArmServeACup"} <= set(shown["tasks"])
+    assert shown["form"]["task"] == "FetchMyPen"  # the paper's web-initiated scenario comes first
+    assert '<option value="FetchMyPencil">' in client.get("/tasks").text
+
+
+def test_a_misspelt_task_is_a_field_error_with_the_likely_one(web: tuple[FlaskClient, TaskRunner]) -> None:
+    client, runner = web
+    response = client.post("/tasks.json", data={"task": "FetchMyPencl"})
+    assert response.status_code == 400
+    assert "did you mean FetchMyPencil" in response.get_json()["fields"]["task"]
+    page = client.post("/tasks", data={"task": "FetchMyPencl"}).text
+    assert 'id="task-error"' in page and '<option value="FetchMyPencl" selected>' in page  # what was sent stays
+    assert runner.runs() == []
+
+
+@pytest.mark.parametrize("value", ["-1", "twice"])
+def test_a_bad_repeat_bound_is_a_field_error(web: tuple[FlaskClient, TaskRunner], value: str) -> None:
+    client, runner = web
+    response = client.post("/tasks.json", data={"task": "FetchMyPencil", "repeat_failures": value})
+    assert response.status_code == 400 and value in response.get_json()["fields"]["repeat_failures"]
+    assert runner.runs() == []
+
+
+def test_a_turtle_task_of_another_namespace_runs_from_the_page(web: tuple[FlaskClient, TaskRunner]) -> None:
+    client, runner = web
+    response = client.post("/tasks.json", json={"task": "FetchMyPencil", "repeat_failures": 0})
+    assert response.status_code == 202, response.get_json()
+    started = response.get_json()["started"]
+    assert started["iri"] == LAB + "FetchMyPencil" and started["repeat_failures"] == 0
+    assert runner.get(started["id"]).done.wait(RUN_WAIT), "the run did not end"
+    run = client.get(f"/tasks/{started['id']}.json").get_json()["run"]
+    assert run["status"] == "succeeded", run.get("error") or run["result"]["execution"]
+    assert run["result"]["plan"]["requirement"] == LAB + "FetchMyPencil"
+
+
+def test_the_bridge_lists_and_checks_the_stores_tasks(server: Server) -> None:
+    with bridge(server, TOKEN) as ws:
+        listed = call(ws, "/cbrs/tasks", {})
+        misspelt = call(ws, "/cbrs/run_task", {"task": "FetchMyPencl"})
+        negative = call(ws, "/cbrs/run_task", {"task": "FetchMyPencil", "repeat_failures": -1})
+        wrong_type = call(ws, "/cbrs/run_task", {"task": "FetchMyPencil", "repeat_failures": "1"})
+    assert listed["result"] is True and "FetchMyPencil" in listed["values"]["tasks"]
+    assert misspelt["result"] is False and "did you mean FetchMyPencil" in misspelt["values"]
+    assert negative["result"] is False and "max_repeats = -1" in negative["values"]
+    assert wrong_type["result"] is False and "'repeat_failures' must be int" in wrong_type["values"]
+    assert server.tasks.runs() == []
