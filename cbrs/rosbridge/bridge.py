@@ -13,6 +13,7 @@ import contextlib
 import hmac
 import itertools
 import logging
+import math
 from collections.abc import Awaitable, Callable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
@@ -70,6 +71,10 @@ class Bridge:
     ``reserved`` (and every topic added with :meth:`add_topic`) belong to the server: clients may
     subscribe, call and send goals, but not advertise, publish or provide them. One client address may hold
     ``connections_per_client`` connections; the next is closed at once (code 1013, try again later).
+    ``non_finite`` says how JSON text carries a NaN or an infinity, which JSON has no number for:
+    ``"null"`` (rosbridge_suite's way, which roslibjs can parse) or ``"tokens"`` (``NaN``, ``Infinity``,
+    ``-Infinity``, which roslibpy reads back as floats and roslibjs cannot parse); CBOR carries them as
+    they are (:data:`protocol.NON_FINITE`, docs/rosbridge.md).
     """
 
     def __init__(
@@ -85,6 +90,7 @@ class Bridge:
         reserved: Sequence[str] = (),
         connections_per_client: int = 64,
         action_workers: int = 4,
+        non_finite: str = "null",
     ) -> None:
         for label, value in [
             ("max_message_bytes", max_message_bytes),
@@ -105,10 +111,11 @@ class Bridge:
         self.connections_per_client = int(connections_per_client)
         self.action_workers = int(action_workers)
         self.token = token
+        self.non_finite = protocol.check_non_finite(non_finite)
         self.reserved = tuple(protocol.resolve(prefix) for prefix in reserved)
         self.params = ParamStore(params)
         self._graph = Graph()
-        for name, (kind, handler) in rosapi.services(self._graph, self.params).items():
+        for name, (kind, handler) in rosapi.services(self._graph, self.params, self.non_finite).items():
             self._graph.services[name] = Service(name, kind, handler, inline=True)
         self._loop: asyncio.AbstractEventLoop | None = None
         self._calls: Calls | None = None
@@ -210,16 +217,19 @@ class Bridge:
 
         Besides JSON values, ``msg`` may hold numeric arrays (``array.array``, 1-D numpy arrays) and
         ``bytes``: JSON subscribers get them as lists and base64 text, ``compression: "cbor"`` ones as
-        RFC 8746 typed arrays and byte strings, as rosbridge_suite sends a ROS message's arrays.
+        RFC 8746 typed arrays and byte strings, as rosbridge_suite sends a ROS message's arrays. NaNs and
+        infinities go to JSON subscribers as ``non_finite`` says and to CBOR ones as they are.
         """
         name = _api_name(topic, "topic")
         if not isinstance(msg, dict):
             raise TypeError(f"a message must be a dict, not {type(msg).__name__}")
         values = None  # JSON holds all of it: a CBOR subscriber's values are read back from the text
         try:
-            text = protocol.dumps(msg)
+            text, exact = protocol.encode(msg, self.non_finite)
         except TypeError:  # typed arrays or bytes (else the same TypeError again): kept for CBOR, copied
-            text = wire.typed_dumps(msg)
+            text, exact = wire.typed_encode(msg, self.non_finite)
+            values = wire.cbor_values(msg)
+        if not exact and values is None:  # NaN written as null: CBOR subscribers get the floats, copied
             values = wire.cbor_values(msg)
         with self._graph.lock:
             entry = self._graph.topics.get(name)
@@ -275,8 +285,8 @@ class Bridge:
             raise RosbridgeError("this bridge is already being served; stop it before serving it again")
         self._workers = WorkerPool(self.service_workers)
         self._goal_workers = WorkerPool(self.action_workers, name="cbrs-rosbridge-action")
-        self._calls = Calls(loop, self._workers)
-        self._goals = Goals(loop, self._goal_workers)
+        self._calls = Calls(loop, self._workers, self.non_finite)
+        self._goals = Goals(loop, self._goal_workers, self.non_finite)
         self._loop = loop
 
     async def detach(self) -> list[WorkerPool]:
@@ -452,10 +462,10 @@ class Bridge:
         if not (subscribers or latch):  # nobody to send it to, now or later: not even encoded
             return
         values = message["msg"]
-        text = protocol.dumps_decoded(values)
-        if latch:  # the text only: a late CBOR subscriber's values are read back from it (a parsed map costs more)
+        text, exact = protocol.encode_decoded(values, self.non_finite)
+        if latch:  # the text if it holds every number (a late CBOR subscriber reads it back): a map costs more
             with self._graph.lock:
-                topic.latched, topic.latched_values = text, None
+                topic.latched, topic.latched_values = text, None if exact else values
         self._fan_out(name, text, subscribers, values)
 
     def _subscribe(self, session: Session, message: Message) -> None:
@@ -516,6 +526,8 @@ class Bridge:
         name = protocol.resolve(message["service"], "service")
         args = message.get("args") or {}
         timeout = message.get("timeout") or 0.0
+        if not math.isfinite(timeout):  # JSON has no infinity, but a client may send Python's token for one
+            raise ProtocolError(f"timeout must be a finite number of seconds (0: the server's), not {timeout}")
         timeout = timeout if timeout > 0 else self.call_timeout
         call = Call(self._calls.new_key(name), name, session, message.get("id"), message["service"])
         call.fragment_size = self._fragment_size(session, message)
@@ -531,7 +543,7 @@ class Bridge:
             self._calls.finish(call, False, protocol.dumps(reason))
         elif service.inline:
             assert service.handler is not None
-            self._calls.finish(call, *run_handler(service.handler, args, name, session.identity()))
+            self._calls.finish(call, *run_handler(service.handler, args, name, session.identity(), self.non_finite))
         else:
             assert service.handler is not None
             self._calls.to_handler(call, service.handler, args, timeout)

@@ -39,15 +39,17 @@ class Call:
     fragment_size: int | None = None  # the caller asked for the response in pieces of this size
 
 
-def run_handler(handler: Handler, args: dict[str, Any], service: str, caller: Caller | None = None) -> tuple[bool, str]:
+def run_handler(
+    handler: Handler, args: dict[str, Any], service: str, caller: Caller | None = None, non_finite: str = "null"
+) -> tuple[bool, str]:
     """Run a handler (``caller`` is what :func:`current_caller` gives it); (result, encoded values), the
-    values being the error text on failure."""
+    values being the error text on failure, their NaNs written as ``non_finite`` says."""
     token = _CALLER.set(caller)
     try:
         values = handler(args)
         if not isinstance(values, dict):
             raise TypeError(f"the handler returned {type(values).__name__}, not a dict")
-        return True, protocol.dumps(values)
+        return True, protocol.dumps(values, non_finite)
     except ServiceError as error:
         log.info("service %s failed: %s", service, error)
         return False, protocol.dumps(str(error))
@@ -61,9 +63,10 @@ def run_handler(handler: Handler, args: dict[str, Any], service: str, caller: Ca
 class Calls:
     """The calls in flight on one running bridge."""
 
-    def __init__(self, loop: asyncio.AbstractEventLoop, workers: WorkerPool) -> None:
+    def __init__(self, loop: asyncio.AbstractEventLoop, workers: WorkerPool, non_finite: str = "null") -> None:
         self._loop = loop
         self._workers = workers
+        self._non_finite = non_finite  # how values' NaNs are written (protocol.NON_FINITE)
         self._pending: dict[str, Call] = {}
         self._keys = itertools.count(1)
 
@@ -78,7 +81,7 @@ class Calls:
         def job() -> None:
             if call.done:  # timed out while waiting for a free worker
                 return
-            result, values = run_handler(handler, args, call.service, caller)
+            result, values = run_handler(handler, args, call.service, caller, self._non_finite)
             with contextlib.suppress(RuntimeError):  # the loop has closed: the server stopped meanwhile
                 self._loop.call_soon_threadsafe(self.finish, call, result, values)
 
@@ -91,7 +94,7 @@ class Calls:
         """Forward the call to the client ``provider`` under a fresh id."""
         call.provider = provider
         self._start(call, timeout)
-        provider.reply(protocol.call_service(spelling, args, call.key))
+        provider.reply(protocol.call_service(spelling, args, call.key, self._non_finite))
 
     def answer(self, provider: Session, key: MessageId | None, result: bool, values: Any) -> bool:
         """A provider's ``service_response``; False if ``provider`` has no call with that id."""
@@ -104,7 +107,7 @@ class Calls:
             values = {} if result else f"service {call.service!r} failed (its provider gave no reason)"
         elif result:
             result, values = False, f"service {call.service!r} answered with values that are not an object"
-        self.finish(call, result, protocol.dumps(values))
+        self.finish(call, result, protocol.dumps(values, self._non_finite))
         return True
 
     def fail_provider(self, provider: Session, service: str | None, reason: str) -> None:

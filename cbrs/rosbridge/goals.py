@@ -63,8 +63,11 @@ class GoalHandle:
     loop (keep them short: set a flag, signal a thread), or at once if the cancel came first.
     """
 
-    def __init__(self, action: str, args: dict[str, Any], caller: Caller, send: Callable[[str], None]) -> None:
+    def __init__(
+        self, action: str, args: dict[str, Any], caller: Caller, send: Callable[[str], None], non_finite: str = "null"
+    ) -> None:
         self.action = action
+        self.non_finite = non_finite  # how feedback's NaNs are written (protocol.NON_FINITE)
         self.args = args
         self.caller = caller
         self._send = send
@@ -84,7 +87,7 @@ class GoalHandle:
         """Send one ``action_feedback`` to the goal's client (if it asked for feedback)."""
         if not isinstance(values, dict):
             raise TypeError(f"feedback must be a dict, not {type(values).__name__}")
-        self._send(protocol.dumps(values))
+        self._send(protocol.dumps(values, self.non_finite))
 
     def on_cancel(self, callback: Callable[[], None]) -> None:
         """Call ``callback()`` when the client cancels the goal (now, if it already has)."""
@@ -124,10 +127,10 @@ def run_action_handler(handler: ActionHandler, goal: GoalHandle) -> tuple[bool, 
         if isinstance(outcome, GoalResult):
             if outcome.status not in TERMINAL or not isinstance(outcome.values, dict):
                 raise TypeError(f"a GoalResult needs a terminal status and dict values, not {outcome!r}")
-            return True, GoalStatus(outcome.status), protocol.dumps(outcome.values)
+            return True, GoalStatus(outcome.status), protocol.dumps(outcome.values, goal.non_finite)
         if not isinstance(outcome, dict):
             raise TypeError(f"the handler returned {type(outcome).__name__}, not a dict or a GoalResult")
-        return True, GoalStatus.SUCCEEDED, protocol.dumps(outcome)
+        return True, GoalStatus.SUCCEEDED, protocol.dumps(outcome, goal.non_finite)
     except ServiceError as error:
         log.info("action %s: goal failed: %s", goal.action, error)
         return False, GoalStatus.UNKNOWN, protocol.dumps(str(error))
@@ -157,9 +160,10 @@ class Goal:
 class Goals:
     """The goals in flight on one running bridge."""
 
-    def __init__(self, loop: asyncio.AbstractEventLoop, workers: WorkerPool) -> None:
+    def __init__(self, loop: asyncio.AbstractEventLoop, workers: WorkerPool, non_finite: str = "null") -> None:
         self._loop = loop
         self._workers = workers
+        self._non_finite = non_finite  # how values' NaNs are written (protocol.NON_FINITE)
         self._pending: dict[str, Goal] = {}
         self._by_caller: dict[tuple[Session, MessageId], Goal] = {}
         self._keys = itertools.count(1)
@@ -183,7 +187,7 @@ class Goals:
             with contextlib.suppress(RuntimeError):  # the loop has closed: the server stopped meanwhile
                 self._loop.call_soon_threadsafe(self._feedback, goal, values_json)
 
-        goal.handle = GoalHandle(goal.action, args, goal.caller.identity(), send_feedback)
+        goal.handle = GoalHandle(goal.action, args, goal.caller.identity(), send_feedback, self._non_finite)
         self._start(goal)
         handle = goal.handle
 
@@ -206,7 +210,7 @@ class Goals:
         """Forward the goal to the client ``provider`` under its key; it always gets feedback."""
         goal.provider, goal.provider_spelling = provider, spelling
         self._start(goal)
-        provider.reply(protocol.send_action_goal(spelling, kind, args, goal.key))
+        provider.reply(protocol.send_action_goal(spelling, kind, args, goal.key, self._non_finite))
 
     def cancel(self, goal: Goal) -> None:
         """The caller asks its goal to stop: tell the handler, or forward to the provider."""
@@ -221,13 +225,13 @@ class Goals:
         return goal if goal is not None and goal.provider is provider else None
 
     def provider_feedback(self, goal: Goal, values: dict[str, Any]) -> None:
-        self._feedback(goal, protocol.dumps(values))
+        self._feedback(goal, protocol.dumps(values, self._non_finite))
 
     def provider_result(self, goal: Goal, result: bool, status: int, values: dict[str, Any] | None) -> None:
         """A provider's ``action_result``, mapped as ROS 2 ends the goal: SUCCEEDED and CANCELED stay,
         any other status, and ``result: false``, abort it."""
         ended = GoalStatus(status) if result and status in (GoalStatus.SUCCEEDED, GoalStatus.CANCELED) else None
-        self.finish(goal, True, ended or GoalStatus.ABORTED, protocol.dumps(values or {}))
+        self.finish(goal, True, ended or GoalStatus.ABORTED, protocol.dumps(values or {}, self._non_finite))
 
     def fail_provider(self, provider: Session, action: str | None, reason: str) -> None:
         """End the goals forwarded to ``provider`` (for ``action``, or all of them)."""

@@ -2,7 +2,9 @@
 
 ``/robot/speed`` is the ``speed`` child of the ``/robot`` namespace, so after ``set("/robot/speed", 1)``,
 ``get("/robot")`` is ``{"speed": 1}``; setting a dictionary sets a whole namespace. Values are copied in
-and out (as JSON), so callers never share mutable state with the store.
+and out (as JSON), so callers never share mutable state with the store. A float may be NaN or an
+infinity, as a ROS 2 double parameter may (``range_max: .inf``); the rosapi services write those as the
+bridge's ``non_finite`` says (cbrs.rosbridge.rosapi).
 """
 
 from __future__ import annotations
@@ -20,9 +22,10 @@ def _parts(name: str) -> list[str]:
 
 
 def _copy(value: Any) -> Any:
-    """A deep copy through JSON, which also refuses values JSON cannot hold."""
+    """A deep copy through JSON, which also refuses values JSON cannot hold (but for NaN and infinities,
+    which Python's json writes and reads back as the floats)."""
     try:
-        return json.loads(json.dumps(value, allow_nan=False))
+        return json.loads(json.dumps(value))
     except (TypeError, ValueError) as error:
         raise ValueError(f"a parameter must be JSON (numbers, strings, booleans, lists, dicts): {error}") from None
 

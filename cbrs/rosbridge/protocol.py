@@ -7,8 +7,10 @@ root namespace: ``chatter`` and ``/chatter`` are the same topic.
 
 from __future__ import annotations
 
+import array
 import functools
 import json
+import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -115,13 +117,19 @@ def json_type(value: Any) -> str:
     return "object"
 
 
-def _no_constants(name: str) -> Any:
-    raise ValueError(f"{name} is not JSON")
+#: How the server writes a NaN or an infinity in JSON text, which has no such numbers (``Bridge(non_finite=)``):
+#: ``null`` as rosbridge_suite writes a ROS float field (JSON.parse, so roslibjs, reads it; the value is
+#: lost), ``tokens`` as Python's json writes them, ``NaN``, ``Infinity``, ``-Infinity`` (roslibpy and
+#: rosbridge_suite read them back as the floats; JSON.parse, so roslibjs, refuses the whole message).
+#: CBOR carries them as they are, either way.
+NON_FINITE = ("null", "tokens")
 
-
-# Made once: json.loads and json.dumps with options build a new decoder or encoder on every call.
-_DECODER = json.JSONDecoder(parse_constant=_no_constants)
+# Made once: json.loads and json.dumps with options build a new decoder or encoder on every call. The
+# decoder reads NaN, Infinity and -Infinity as floats, as rosbridge_suite's (Python's json) does: what
+# roslibpy (Python's json.dumps) sends for them.
+_DECODER = json.JSONDecoder()
 _ENCODER = json.JSONEncoder(separators=(",", ":"), ensure_ascii=False, allow_nan=False)
+_TOKENS = json.JSONEncoder(separators=(",", ":"), ensure_ascii=False, allow_nan=True)
 _SCAN: Callable[[str, int], tuple[Any, int]] = getattr(_DECODER, "scan_once")  # noqa: B009 (not in typeshed)
 
 
@@ -206,20 +214,75 @@ def loads(text: str) -> Any:
     return _parse(text)
 
 
-def dumps(value: Any) -> str:
-    """Compact JSON; NaN and infinities are refused, since JSON has no such numbers."""
-    return _ENCODER.encode(value)
+def check_non_finite(non_finite: str) -> str:
+    """``non_finite`` if it is one of :data:`NON_FINITE`, else ValueError naming it."""
+    if non_finite not in NON_FINITE:
+        raise ValueError(f"non_finite must be one of {', '.join(NON_FINITE)}, not {non_finite!r}")
+    return non_finite
 
 
-def _decoded_encoder() -> Callable[[Any], str]:
-    """``dumps`` for values :func:`decode` made, which cannot hold a cycle or a NaN: the C encoder
-    made once, without the cycle check (``JSONEncoder.encode`` makes a new one on every call, about a
-    microsecond of each message a publisher sends)."""
+def encode(
+    value: Any,
+    non_finite: str = "null",
+    strict: Callable[[Any], str] = _ENCODER.encode,
+    tokens: Callable[[Any], str] = _TOKENS.encode,
+) -> tuple[str, bool]:
+    """Compact JSON of ``value`` with its NaNs and infinities written as ``non_finite`` says, and whether
+    the text holds every number of ``value`` (False: some became null; send CBOR from ``value`` itself).
+
+    ``strict`` (NaN refused) and ``tokens`` (NaN written) are the encoders to use. A value with nothing
+    but finite numbers, the usual one, is encoded once, at the strict encoder's speed."""
+    if non_finite == "tokens":
+        return tokens(value), True
+    try:
+        return strict(value), True
+    except ValueError as error:  # a NaN or infinity (or a cycle, whose copy recurses without end)
+        try:
+            copy = finite(value)
+        except RecursionError:
+            raise error from None
+        return strict(copy), False
+
+
+def dumps(value: Any, non_finite: str = "null") -> str:
+    """Compact JSON, NaNs and infinities written as ``non_finite`` says (:data:`NON_FINITE`)."""
+    return encode(value, non_finite)[0]
+
+
+def finite(value: Any) -> Any:
+    """A copy of ``value`` with every NaN and infinity in it as None (JSON's null), and its arrays of
+    floats (``array.array``, 1-D numpy arrays) as lists: what rosbridge_suite sends for a ROS float
+    field JSON cannot hold. Values of other types are kept as they are (the encoder judges them)."""
+    kind = type(value)
+    if kind is float:
+        return value if value - value == 0.0 else None  # inf - inf and NaN - NaN are NaN
+    if kind is dict:
+        return {key: finite(item) for key, item in value.items()}
+    if kind is list or kind is tuple:
+        return [finite(item) for item in value]
+    if isinstance(value, float):  # a subclass: numpy.float64
+        return float(value) if value - value == 0.0 else None
+    if isinstance(value, dict):
+        return {key: finite(item) for key, item in value.items()}
+    if isinstance(value, list | tuple):
+        return [finite(item) for item in value]
+    if isinstance(value, array.array) and value.typecode in "fd":
+        return [item if item - item == 0.0 else None for item in value.tolist()]
+    numpy = sys.modules.get("numpy")  # not imported: no value can be an array of it
+    if numpy is not None and isinstance(value, numpy.ndarray) and value.dtype.kind == "f":
+        return [finite(item) for item in value.tolist()]
+    return value
+
+
+def _decoded_encoder(allow_nan: bool) -> Callable[[Any], str]:
+    """An encoder for values :func:`decode` made, which cannot hold a cycle: the C encoder made once,
+    without the cycle check (``JSONEncoder.encode`` makes a new one on every call, about a microsecond of
+    each message a publisher sends)."""
     make: Any = getattr(json.encoder, "c_make_encoder", None)
     try:
-        encoder = make(None, _not_json, json.encoder.encode_basestring, None, ":", ",", False, False, False)
+        encoder = make(None, _not_json, json.encoder.encode_basestring, None, ":", ",", False, False, allow_nan)
     except TypeError:  # no C accelerator, or another signature: the ordinary encoder
-        return dumps
+        return _TOKENS.encode if allow_nan else _ENCODER.encode
     return lambda value: "".join(encoder(value, 0))
 
 
@@ -227,8 +290,18 @@ def _not_json(value: Any) -> Any:
     raise TypeError(f"Object of type {type(value).__name__} is not JSON serializable")
 
 
-dumps_decoded = _decoded_encoder()
-"""Compact JSON of a value that came out of :func:`decode` (what a client sent): as ``dumps``, faster."""
+#: The encoders :func:`encode_decoded` uses: NaN refused, NaN written.
+DECODED_STRICT, DECODED_TOKENS = _decoded_encoder(False), _decoded_encoder(True)
+
+
+def encode_decoded(value: Any, non_finite: str = "null") -> tuple[str, bool]:
+    """:func:`encode` of a value that came out of :func:`decode` (what a client sent), faster."""
+    return encode(value, non_finite, DECODED_STRICT, DECODED_TOKENS)
+
+
+def dumps_decoded(value: Any, non_finite: str = "null") -> str:
+    """Compact JSON of a value that came out of :func:`decode`: as ``dumps``, faster."""
+    return encode(value, non_finite, DECODED_STRICT, DECODED_TOKENS)[0]
 
 
 def status(level: str, text: str, message_id: MessageId | None) -> str:
@@ -257,9 +330,9 @@ def service_response(service: str, result: bool, values_json: str, message_id: M
     return f'{{"op":"service_response","service":{dumps(service)},"values":{values_json},"result":{flag}{tail}}}'
 
 
-def call_service(service: str, args: Any, message_id: str) -> str:
+def call_service(service: str, args: Any, message_id: str, non_finite: str = "null") -> str:
     """A ``call_service`` forwarded to the client that provides ``service``."""
-    return dumps({"op": "call_service", "id": message_id, "service": service, "args": args})
+    return dumps({"op": "call_service", "id": message_id, "service": service, "args": args}, non_finite)
 
 
 def action_result(action: str, result: bool, status: int, values_json: str, message_id: MessageId | None) -> str:
@@ -275,10 +348,10 @@ def action_feedback(action: str, values_json: str, message_id: MessageId | None)
     return f'{{"op":"action_feedback","action":{dumps(action)},"values":{values_json}{tail}}}'
 
 
-def send_action_goal(action: str, action_type: str, args: Any, message_id: str) -> str:
+def send_action_goal(action: str, action_type: str, args: Any, message_id: str, non_finite: str = "null") -> str:
     """A ``send_action_goal`` forwarded to the client that provides ``action`` (always with feedback)."""
     message = {"op": "send_action_goal", "id": message_id, "action": action, "action_type": action_type}
-    return dumps({**message, "args": args, "feedback": True})
+    return dumps({**message, "args": args, "feedback": True}, non_finite)
 
 
 def cancel_action_goal(action: str, message_id: str) -> str:

@@ -2,7 +2,9 @@
 
 Requests and responses follow the rosapi service types of ROS 1 (``rosapi/Topics`` and so on). Parameter
 values travel as JSON-encoded strings, as roslibpy and roslibjs send them; ``get_param`` also answers
-the ROS 2 fields ``successful`` and ``reason``, which roslibjs reads when present.
+the ROS 2 fields ``successful`` and ``reason``, which roslibjs reads when present. A value's NaNs and
+infinities are written as the bridge's ``non_finite`` says: roslibjs parses the value with JSON.parse too.
+``set_param`` reads ``NaN``, ``Infinity`` and ``-Infinity`` (Python's json, what roslibpy writes).
 """
 
 from __future__ import annotations
@@ -14,7 +16,7 @@ from typing import Any
 from cbrs.rosbridge.errors import ServiceError
 from cbrs.rosbridge.graph import Graph, Handler
 from cbrs.rosbridge.params import ParamStore
-from cbrs.rosbridge.protocol import json_type
+from cbrs.rosbridge.protocol import finite, json_type
 
 #: The node names rosapi reports: the bridge and rosapi itself.
 NODES = ["/cbrs_rosbridge", "/rosapi"]
@@ -40,8 +42,11 @@ def _decoded(text: str, what: str) -> Any:
         raise ServiceError(f"{what} must be JSON-encoded (e.g. '3', '\"text\"', '[1, 2]'), not {text!r}") from None
 
 
-def services(graph: Graph, params: ParamStore) -> dict[str, tuple[str, Handler]]:
-    """rosapi service name -> (type, handler)."""
+def services(graph: Graph, params: ParamStore, non_finite: str = "null") -> dict[str, tuple[str, Handler]]:
+    """rosapi service name -> (type, handler); parameter values' NaNs written as ``non_finite`` says."""
+
+    def encoded(value: Any) -> str:
+        return json.dumps(value if non_finite == "tokens" else finite(value))
 
     def topics(_: dict[str, Any]) -> dict[str, Any]:
         listed = graph.topic_list()
@@ -73,7 +78,7 @@ def services(graph: Graph, params: ParamStore) -> dict[str, tuple[str, Handler]]
         name = _global(_text(args, "name"))
         default = _text(args, "default", "")
         if params.has(name):
-            return {"value": json.dumps(params.get(name)), "successful": True, "reason": ""}
+            return {"value": encoded(params.get(name)), "successful": True, "reason": ""}
         if default:
             _decoded(default, "default")
             return {"value": default, "successful": True, "reason": ""}

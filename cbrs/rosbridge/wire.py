@@ -42,6 +42,7 @@ from typing import Any
 
 import cbor2
 
+from cbrs.rosbridge import protocol
 from cbrs.rosbridge.errors import ProtocolError
 from cbrs.rosbridge.protocol import Message, MessageId, dumps
 
@@ -211,7 +212,8 @@ def cbor_values(value: Any) -> Any:
     """A copy of a message the server publishes with its typed arrays as CBOR tags and its bytes as byte
     strings, and what is JSON as JSON would read it back (tuples as lists, keys as text): what a CBOR
     subscriber decodes is what a JSON subscriber reads, bar the arrays' types. A copy, so the publisher may
-    change its dict once ``publish`` returns."""
+    change its dict once ``publish`` returns. NaNs and infinities stay floats (CBOR has them; JSON text
+    gets them as ``Bridge(non_finite=)`` says)."""
     if isinstance(value, dict):
         return {_json_key(key): cbor_values(item) for key, item in value.items()}
     if isinstance(value, list | tuple):
@@ -226,15 +228,22 @@ def cbor_values(value: Any) -> Any:
             return [bool(item) for item in value.tolist()]
         little = value.astype(value.dtype.newbyteorder("<"), copy=False)
         return _tagged(kind, value.dtype.itemsize, little.tobytes(), swap=False)
-    return value  # str, int, float, bool, None: the JSON dump that came first let nothing else through
+    return value  # str, int, float (NaN too), bool, None: the JSON dump that came first let nothing else through
 
 
 _TYPED_ENCODER = json.JSONEncoder(separators=(",", ":"), ensure_ascii=False, allow_nan=False, default=typed_json)
+_TYPED_TOKENS = json.JSONEncoder(separators=(",", ":"), ensure_ascii=False, allow_nan=True, default=typed_json)
 
 
-def typed_dumps(value: Any) -> str:
-    """Compact JSON of a message the server publishes with typed arrays or bytes in it (:func:`typed_json`)."""
-    return _TYPED_ENCODER.encode(value)
+def typed_encode(value: Any, non_finite: str = "null") -> tuple[str, bool]:
+    """Compact JSON of a message the server publishes with typed arrays or bytes in it (:func:`typed_json`),
+    and whether it holds every number (:func:`cbrs.rosbridge.protocol.encode`)."""
+    return protocol.encode(value, non_finite, _TYPED_ENCODER.encode, _TYPED_TOKENS.encode)
+
+
+def typed_dumps(value: Any, non_finite: str = "null") -> str:
+    """:func:`typed_encode`'s text."""
+    return typed_encode(value, non_finite)[0]
 
 
 def cbor_publish(topic: str, msg: Any) -> bytes:
