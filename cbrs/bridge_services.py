@@ -126,6 +126,7 @@ class KnowledgeServices:
 
     def plan(self, args: dict[str, Any]) -> dict[str, Any]:
         from cbrs.actions.composer import Objective, store_plan  # the planner loads with the first plan
+        from cbrs.task_names import task_iri
 
         task = _field(args, "task", str)
         objective = _field(args, "objective", str, Objective.SIMILARITY.value)
@@ -133,7 +134,7 @@ class KnowledgeServices:
             raise ServiceError(f"objective {objective!r} is not one of {', '.join(o.value for o in Objective)}")
         with self.sparql.lock:
             composer = self.composers.get(Objective(objective))
-            result = _call(lambda: composer.compose(task))
+            result = _call(lambda: composer.compose(task_iri(self.sparql.kb, task)))
             recorded = result.plan is not None and not self.sparql.config.read_only and self.may_write()
             if result.plan is not None and recorded:
                 store_plan(self.sparql.kb, result.plan)

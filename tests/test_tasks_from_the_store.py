@@ -110,8 +110,12 @@ def test_the_bridge_lists_and_checks_the_stores_tasks(server: Server) -> None:
         misspelt = call(ws, "/cbrs/run_task", {"task": "FetchMyPencl"})
         negative = call(ws, "/cbrs/run_task", {"task": "FetchMyPencil", "repeat_failures": -1})
         wrong_type = call(ws, "/cbrs/run_task", {"task": "FetchMyPencil", "repeat_failures": "1"})
+        planned = call(ws, "/cbrs/plan", {"task": "FetchMyPencil"})
+        misplanned = call(ws, "/cbrs/plan", {"task": "FetchMyPencl"})
     assert listed["result"] is True and "FetchMyPencil" in listed["values"]["tasks"]
     assert misspelt["result"] is False and "did you mean FetchMyPencil" in misspelt["values"]
     assert negative["result"] is False and "max_repeats = -1" in negative["values"]
     assert wrong_type["result"] is False and "'repeat_failures' must be int" in wrong_type["values"]
+    assert planned["result"] is True and planned["values"]["requirement"] == LAB + "FetchMyPencil"
+    assert misplanned["result"] is False and "did you mean FetchMyPencil" in misplanned["values"]
     assert server.tasks.runs() == []
