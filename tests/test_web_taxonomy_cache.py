@@ -1,9 +1,11 @@
-"""The taxonomy pages read the store's taxonomy once per store generation, not once per page (on
-OWLS-TC each read took about 1.5 s), and a write to the store shows on the next page."""
+"""The taxonomy pages read what they need of the whole store (the taxonomy, the usage counts, the
+descriptions' labels) once per store generation, not once per page (on OWLS-TC the taxonomy alone took
+about 1.5 s a page), and a write to the store shows on the next page."""
 
 from __future__ import annotations
 
 from collections.abc import Iterator
+from pathlib import Path
 
 import pytest
 from flask.testing import FlaskClient
@@ -68,3 +70,26 @@ def test_a_store_without_a_generation_is_read_every_time(kb: KnowledgeBase, read
     for _ in range(2):
         assert client.get("/taxonomy/class.json", query_string={"iri": "home:RobotPosition"}).status_code == 200
     assert len(reads) == 2
+
+
+AD = f"""@prefix cbrs: <https://w3id.org/cbrs/core#> .
+@prefix home: <https://w3id.org/cbrs/home#> .
+@prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .
+<{LAB}Tracker> a cbrs:DynamicPerceptionComponent ; rdfs:label "lab tracker" ;
+    cbrs:deviceName "Tracker1" ; cbrs:serviceName "TrackRobot" ;
+    cbrs:hasOWLSModel [ a cbrs:OWLSModel ;
+        cbrs:hasOutput [ a cbrs:Parameter ; cbrs:parameterName "where" ; cbrs:parameterType home:RobotPosition ] ] .
+"""
+
+
+def test_a_new_advertisement_shows_in_the_usage_of_its_concepts(kb: KnowledgeBase, tmp_path: Path) -> None:
+    client = client_of(kb)
+    before = client.get("/taxonomy/class.json", query_string={"iri": "home:RobotPosition"}).get_json()["usage"]
+    assert LAB + "Tracker" not in {u["iri"] for u in before["advertisements"]}
+    path = tmp_path / "tracker.ttl"
+    path.write_text(AD, encoding="utf-8")
+    kb.load([path])
+    after = client.get("/taxonomy/class.json", query_string={"iri": "home:RobotPosition"}).get_json()["usage"]
+    tracker = next(u for u in after["advertisements"] if u["iri"] == LAB + "Tracker")
+    assert tracker["label"] == "lab tracker" and tracker["roles"] == ["output"]
+    assert after["uses"] == before["uses"] + 1

@@ -5,7 +5,7 @@ from __future__ import annotations
 import threading
 from collections import Counter, deque
 from collections.abc import Callable
-from typing import Any
+from typing import Any, TypeVar
 
 from flask import current_app
 
@@ -30,6 +30,39 @@ class EventLog:
     def recent(self, count: int = 20) -> list[dict[str, Any]]:
         with self._guard:
             return list(self._events)[-count:]
+
+
+T = TypeVar("T")
+
+
+class GenerationCache:
+    """Values computed from the whole store (the taxonomy, usage counts), kept until the store changes.
+
+    An embedded store counts the writes made through it (``generation``), so a value is current until
+    the next write. A remote store does not (another robot may write to it), so there a value is
+    computed every time it is asked for.
+    """
+
+    def __init__(self) -> None:
+        self._kept: dict[str, tuple[object, Any]] = {}
+        self._guards: dict[str, threading.Lock] = {}
+        self._guard = threading.Lock()
+
+    def get(self, kb: KnowledgeBase, key: str, compute: Callable[[], T]) -> T:
+        generation = getattr(kb.store, "generation", None)
+        if generation is None:
+            return compute()
+        with self._guard:
+            guard = self._guards.setdefault(key, threading.Lock())
+        with guard:  # two pages at once wait for one computation
+            kept = self._kept.get(key)
+            if kept is not None and kept[0] == generation:
+                found: T = kept[1]
+                return found
+            # read before computing: a write meanwhile bumps it again, so this value is never taken for newer
+            value = compute()
+            self._kept[key] = (generation, value)
+            return value
 
 
 class TooManyStreamsError(KnowledgeBaseError):
@@ -96,6 +129,12 @@ def kb() -> KnowledgeBase:
 def lock() -> threading.RLock:
     """Held while reading through caches the knowledge base keeps (descriptions, matchmakers)."""
     return sparql().lock
+
+
+def per_generation(key: str, compute: Callable[[], T]) -> T:
+    """``compute()``, kept under ``key`` until the store is written (:class:`GenerationCache`)."""
+    cache: GenerationCache = current_app.extensions.setdefault("cbrs.generation_cache", GenerationCache())
+    return cache.get(kb(), key, compute)
 
 
 def matchmakers() -> Matchmakers:

@@ -8,7 +8,6 @@ Everything is read with the named queries the taxonomy index reads (``taxonomy_l
 from __future__ import annotations
 
 import difflib
-import threading
 from collections.abc import Iterator, Set
 from dataclasses import dataclass, field
 from typing import Any
@@ -31,6 +30,10 @@ blueprint = Blueprint("taxonomy", __name__)
 blueprint.record_once(resource.attach)  # the page of any IRI comes with the taxonomy (it is not in the nav)
 
 MAX_PATHS = 12  # ancestor paths shown per search match
+# Tree nodes a taxonomy page shows at most, per tree: the levels that fit, the rest a link away. OWLS-TC's
+# class tree has 18,687 nodes, a page of 9 MB that took 2.5 s to serve and longer to lay out.
+MAX_TREE_NODES = 2000
+MAX_MATCHES = 200  # search matches listed with their paths; the count says how many there are
 # How a service description reaches a concept, walking incoming triples back to the description.
 _USE_LINKS = {
     CBRS.parameterType: "parameter",
@@ -117,18 +120,54 @@ class Taxonomy:
     def roots(self, kind: str) -> list[str]:
         return self.sorted({t for t, k in self.kinds.items() if k == kind and not self.parents.get(t)})
 
-    def tree(self, kind: str, keep: Set[str] | None = None, matches: Set[str] = frozenset()) -> list[dict[str, Any]]:
-        """Nested nodes from the roots down (a term with two parents appears under both); with ``keep``,
-        only those terms."""
-        return [self._node(root, (), keep, matches) for root in self.roots(kind) if keep is None or root in keep]
+    def tree(
+        self,
+        kind: str,
+        keep: Set[str] | None = None,
+        matches: Set[str] = frozenset(),
+        limit: int | None = None,
+        root: str | None = None,
+    ) -> list[dict[str, Any]]:
+        """Nested nodes from the roots (or from ``root``) down; a term with two parents appears under
+        both. With ``keep``, only those terms. With ``limit``, only the levels whose nodes fit in it:
+        a node cut off there has no ``children`` but ``more``, the number of its children not shown."""
+        tops = [root] if root is not None else [r for r in self.roots(kind) if keep is None or r in keep]
+        depth = self._depth_within(tops, keep, limit) if limit is not None else None
+        return [self._node(top, (), keep, matches, depth) for top in tops]
 
-    def _node(self, iri: str, path: tuple[str, ...], keep: Set[str] | None, matches: Set[str]) -> dict[str, Any]:
-        below = [c for c in self.sorted(self.children.get(iri)) if c not in path and (keep is None or c in keep)]
+    def _below(self, iri: str, path: tuple[str, ...], keep: Set[str] | None) -> list[str]:
+        return [c for c in self.sorted(self.children.get(iri)) if c not in path and (keep is None or c in keep)]
+
+    def _depth_within(self, tops: list[str], keep: Set[str] | None, limit: int) -> int | None:
+        """The deepest level (0 for the tops) down to which the tree has at most ``limit`` nodes, or
+        ``None`` when the whole tree fits. Walks level by level and stops once past the limit, so a
+        tree of any size costs at most about ``limit`` nodes' work."""
+        level: list[tuple[str, tuple[str, ...]]] = [(top, ()) for top in tops]
+        total = len(level)
+        depth = 0
+        while level:
+            below = [(c, (*path, iri)) for iri, path in level for c in self._below(iri, path, keep)]
+            if not below:
+                return None
+            total += len(below)
+            if total > limit:
+                return depth
+            level, depth = below, depth + 1
+        return None
+
+    def _node(
+        self, iri: str, path: tuple[str, ...], keep: Set[str] | None, matches: Set[str], depth: int | None
+    ) -> dict[str, Any]:
+        below = self._below(iri, path, keep)
         node = self.term(iri)
         node["parts"] = [self.term(part) for part in self.sorted(self.parts.get(iri))]
         if matches:
             node["match"] = iri in matches
-        node["children"] = [self._node(child, (*path, iri), keep, matches) for child in below]
+        if depth is not None and len(path) >= depth and below:
+            node["children"] = []
+            node["more"] = len(below)
+            return node
+        node["children"] = [self._node(child, (*path, iri), keep, matches, depth) for child in below]
         return node
 
     def search(self, text: str) -> list[str]:
@@ -170,60 +209,51 @@ class Taxonomy:
         return seen
 
 
-class TaxonomyCache:
-    """The taxonomy read once per store generation, not once per page.
-
-    Reading it runs two queries over every term: about 1.5 s a page on OWLS-TC (16,000 terms), which
-    every class page paid again. An embedded store counts its writes (``generation``), so a copy is
-    current until the next write. A remote store does not (another robot may write to it), so there
-    every page reads it anew.
-    """
-
-    def __init__(self) -> None:
-        self._kept: tuple[object, Taxonomy] | None = None
-        self._guard = threading.Lock()  # one read at a time: two pages at once wait for one read
-
-    def get(self, kb: KnowledgeBase) -> Taxonomy:
-        generation = getattr(kb.store, "generation", None)
-        if generation is None:
-            return Taxonomy.read(kb)
-        with self._guard:
-            kept = self._kept
-            if kept is not None and kept[0] == generation:
-                return kept[1]
-            found = Taxonomy.read(kb)
-            # a write during the read bumps the generation again, so this copy is never taken for newer
-            self._kept = (generation, found)
-            return found
-
-
 def current_taxonomy() -> Taxonomy:
-    """The store's taxonomy, from the app's cache (:class:`TaxonomyCache`)."""
-    cache: TaxonomyCache = current_app.extensions.setdefault("cbrs.taxonomy", TaxonomyCache())
-    return cache.get(context.kb())
+    """The store's taxonomy, read once per store generation (:func:`context.per_generation`): reading
+    it runs two queries over every term, about 1.5 s a page on OWLS-TC (16,000 terms), which every
+    class page paid again."""
+    kb = context.kb()
+    return context.per_generation("taxonomy", lambda: Taxonomy.read(kb))
 
 
 @page(blueprint, "/taxonomy")
 def taxonomy() -> Page:
     found = current_taxonomy()
     query = (request.args.get("q") or "").strip()
+    root = resource.iri_parameter("root") if (request.args.get("root") or "").strip() else None
+    if root is not None and root not in found:
+        raise NotFoundError(root, "class or property")
     kinds = list(found.kinds.values())
     counts = {"classes": kinds.count("class"), "properties": kinds.count("property")}
-    data: dict[str, Any] = {"q": query or None, "counts": counts}
+    limit = int(current_app.config.get("CBRS_TAXONOMY_NODES", MAX_TREE_NODES))
+    data: dict[str, Any] = {"q": query or None, "root": None, "counts": counts, "limit": limit}
+    keep: set[str] | None = None
+    matches: list[str] = []
     if query:
         matches = found.search(query)
         keep = set(matches).union(*(found.ancestors(m) for m in matches))
+        data["match_count"] = len(matches)
         data["matches"] = [
-            {**found.term(m), "kind": found.kinds[m], "paths": [[found.term(t) for t in p] for p in found.paths(m)]}
-            for m in matches
+            {**found.term(m), "kind": found.kinds[m], "paths": _paths(found, m)} for m in matches[:MAX_MATCHES]
         ]
-        data["classes"] = found.tree("class", keep, set(matches))
-        data["properties"] = found.tree("property", keep, set(matches))
-    else:
-        data["classes"] = found.tree("class")
-        data["properties"] = found.tree("property")
-    title = f"Taxonomy: “{query}”" if query else "Taxonomy"
+    if root is not None:
+        data["root"] = {**found.term(root), "kind": found.kinds[root], "paths": _paths(found, root)}
+        if keep is not None:
+            keep.add(root)
+    for kind, key in (("class", "classes"), ("property", "properties")):
+        shown = root is None or found.kinds[root] == kind
+        data[key] = found.tree(kind, keep, set(matches), limit, root) if shown else []
+    title = "Taxonomy"
+    if root is not None:
+        title += f" below {shorten(root)}"
+    if query:
+        title += f": “{query}”"
     return Page("taxonomy.html", title, data)
+
+
+def _paths(found: Taxonomy, iri: str) -> list[list[dict[str, Any]]]:
+    return [[found.term(t) for t in p] for p in found.paths(iri)]
 
 
 @page(blueprint, "/taxonomy/class")
@@ -241,7 +271,7 @@ def concept() -> Page:
         **found.term(iri),
         "kind": kind,
         "comment": comment,
-        "paths": [[found.term(t) for t in p] for p in found.paths(iri)],
+        "paths": _paths(found, iri),
         "superclasses": [found.term(t) for t in found.sorted(found.parents.get(iri))],
         "subclasses": [found.term(t) for t in found.sorted(found.children.get(iri))],
         "equivalents": [found.term(t) for t in found.sorted(found.same.get(iri))],
@@ -369,14 +399,13 @@ def _parts(kb: KnowledgeBase, iri: str) -> list[dict[str, Any]]:
 
 def _usage(kb: KnowledgeBase, iri: str, triples: list[dict[str, Any]]) -> dict[str, Any]:
     """Which advertisements, requirements and actions use the concept, and as what (input, effect, ...)."""
-    uses = next((int(r["uses"].value) for r in kb.select("concept_usage") if r["concept"].value == iri), 0)
+    uses = _usage_counts(kb).get(iri, 0)
     roles: dict[str, set[str]] = {}
     for row in triples:
         if row["direction"].value == "in" and row["predicate"].value in _USE_LINKS:
             for description, role in _descriptions_of(kb, row["other"].value):
                 roles.setdefault(description, set()).add(role)
-    advertisements = {r["service"].value: r.get("label") for r in kb.select("advertisements")}
-    requirements = {r["requirement"].value: r.get("label") for r in kb.select("requirements")}
+    advertisements, requirements = _description_labels(kb)
     groups: dict[str, list[dict[str, Any]]] = {"advertisements": [], "requirements": [], "actions": []}
     for description in sorted(roles, key=lambda d: shorten(d).casefold()):
         group = "actions"
@@ -384,16 +413,41 @@ def _usage(kb: KnowledgeBase, iri: str, triples: list[dict[str, Any]]) -> dict[s
             group = "advertisements"
         elif description in requirements:
             group = "requirements"
-        label = advertisements.get(description) or requirements.get(description)
         groups[group].append(
             {
                 "iri": description,
                 "name": shorten(description),
-                "label": label.value if label is not None else None,
+                "label": advertisements.get(description) or requirements.get(description),
                 "roles": sorted(roles[description]),
             }
         )
     return {"uses": uses, **groups}
+
+
+def _usage_counts(kb: KnowledgeBase) -> dict[str, int]:
+    """How often each concept is used (``concept_usage``, which counts every concept at once: read once
+    per store generation, as the taxonomy is)."""
+
+    def read() -> dict[str, int]:
+        return {row["concept"].value: int(row["uses"].value) for row in kb.select("concept_usage")}
+
+    return context.per_generation("concept_usage", read)
+
+
+def _description_labels(kb: KnowledgeBase) -> tuple[dict[str, str | None], dict[str, str | None]]:
+    """The advertisements' and the requirements' labels by IRI, once per store generation: on OWLS-TC
+    listing the 1,136 advertisements took half of a class page's time."""
+
+    def read() -> tuple[dict[str, str | None], dict[str, str | None]]:
+        def label(row: dict[str, Any]) -> str | None:
+            return row["label"].value if "label" in row else None
+
+        return (
+            {row["service"].value: label(row) for row in kb.select("advertisements")},
+            {row["requirement"].value: label(row) for row in kb.select("requirements")},
+        )
+
+    return context.per_generation("description_labels", read)
 
 
 def _descriptions_of(kb: KnowledgeBase, node: str) -> list[tuple[str, str]]:
