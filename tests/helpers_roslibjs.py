@@ -44,3 +44,14 @@ def node(script: str, *args: object, timeout: float = 60) -> dict[str, Any]:
     assert child.returncode == 0, child.stderr
     found: dict[str, Any] = json.loads(child.stdout.strip().splitlines()[-1])
     return found
+
+
+def node_inline(source: str, *args: object, timeout: float = 60) -> dict[str, Any]:
+    """Run an ES module given as text in tests/js (its imports resolve there, ``roslib`` too), with
+    ``args`` from ``process.argv[1]`` on, as :func:`node` runs a script: the one line of JSON it prints last."""
+    assert NODE is not None
+    command = [NODE, "--input-type=module", "-e", source, *map(str, args)]
+    child = subprocess.run(command, capture_output=True, text=True, timeout=timeout, cwd=JS)
+    assert child.returncode == 0, child.stderr
+    found: dict[str, Any] = json.loads(child.stdout.strip().splitlines()[-1])
+    return found
