@@ -21,7 +21,7 @@ import pybullet as p
 from numpy.typing import NDArray
 
 from cbrs.sim.geometry import Pose3D, Quat, Region, Vec3, quat_from_matrix, quat_to_matrix
-from cbrs.sim.grasping import GraspPose
+from cbrs.sim.grasping import JAW_OPENING, GraspPose
 from cbrs.sim.quiet import quiet_output
 
 __all__ = [
@@ -113,7 +113,8 @@ REACH_TOLERANCE = 0.01
 """A motion has reached its target when the grasp point is within 1 cm of it."""
 SETTLE_LIMIT = 1.0
 """At most this many simulated seconds of settling after the last piece."""
-GRIPPER_OPEN = 0.08
+GRIPPER_OPEN = JAW_OPENING
+"""The fingers' widest opening (m): the grasp planner's (:data:`sim.grasping.JAW_OPENING`)."""
 COLLISION_MARGIN = 0.01
 """Joint-space moves keep the arm's links 1 cm clear of the torso, the table, the dispenser, the
 Kinect and the other arm."""

@@ -35,7 +35,7 @@ from cbrs.kb.semantic_map import SemanticMap, Thing, designate, local_name
 from cbrs.sim import predicates as pred
 from cbrs.sim import skills
 from cbrs.sim.arms import GRIPPER_OPEN, ArmSide
-from cbrs.sim.errors import SimulationError
+from cbrs.sim.errors import GraspTooWideError, SimulationError
 from cbrs.sim.geometry import Pose2D, Region, Vec3
 from cbrs.sim.grasping import GraspKind, GraspPose, ObjectModel, compute_grasp_pose
 from cbrs.sim.mapping import OccupancyGrid, build_occupancy_grid
@@ -108,6 +108,7 @@ class SimContext:
     grid: OccupancyGrid | None = None
     focus: str | None = None  # the object an arm last took (by name)
     grasp: GraspPose | None = None  # the grasp pose of the object the arm is working on
+    seen: ObjectEstimate | None = None  # where and how it lay when ``grasp`` was computed for it
     arm: ArmSide = ArmSide.LEFT
     region: Region | None = None  # where the carried object goes
     spot: Region | None = None  # the part of ``region`` the arm carrying the object sets it down on
@@ -237,10 +238,14 @@ def _knowledge(ctx: SimContext, value: Any) -> Manipulation:
         return Manipulation.of(obj)
     found = from_json(value)
     if isinstance(found, (GraspPlan, Manipulation)):
-        # The value names one approach; the map has the class's others to fall back on, after it.
+        # The value names one approach; the map has the class's others to fall back on, after it, and a
+        # box's footprint (a value carries one width, which depends on how the hand turns to a box).
         obj = ctx.map.objects.get(found.object)
-        fallback = ObjectModel.of(obj).preference if obj is not None and not found.model.approaches else ()
-        return Manipulation(found.object, found.model.preferring(fallback) if fallback else found.model)
+        if obj is None:
+            return Manipulation(found.object, found.model)
+        known = ObjectModel.of(obj)
+        model = found.model if found.model.approaches else found.model.preferring(known.preference)
+        return Manipulation(found.object, replace(model, footprint=known.footprint))
     raise SkillFailed(f"expected an object, its manipulation property or its grasp, got {value!r}")
 
 
@@ -373,8 +378,8 @@ def approach(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[st
         choice = taking.choice(side, taking.models[0], f"taking the {model.name}")
         _note(ctx, choice)
         model = choice.model
-    ctx.grasp = compute_grasp_pose(model, estimate.position, estimate.yaw, spec.mount, spec.yaw)
-    ctx.focus = model.name
+    ctx.grasp = compute_grasp_pose(model, estimate.position, estimate.yaw, spec.mount, spec.yaw, _extent(estimate))
+    ctx.seen, ctx.focus = estimate, model.name
     ctx.last_arm = ctx.arm
     _check(skills.approach_object(ctx.world, ctx.arm, ctx.grasp))
     return {}
@@ -423,13 +428,14 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
             )
         _, taker, (sx, sy) = min(options)
         target = _spot_region(surface, sx, sy)
-        gx, gy, gz = ctx.grasp.position  # where it was taken from: its surface
+        gx, gy, gz = ctx.grasp.position  # where it was taken from: its surface, lying as it was seen there
+        seen = ctx.seen
         taken = ObjectEstimate(
             gx,
             gy,
             gz - model.grasp_height + model.height / 2.0,
-            None,
-            (0.0, 0.0, 0.0),
+            seen.yaw if seen is not None else None,
+            seen.size if seen is not None else (0.0, 0.0, 0.0),
             model.colour,
             "hand",
             world.time,
@@ -448,10 +454,12 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
             ctx,
             placing.choice(taker, taken_by, f"carrying the {model.name} to {place.name}", "no spot to take it by it"),
         )
-        grasp = compute_grasp_pose(taken_by, found.position, found.yaw, taker_spec.mount, taker_spec.yaw)
+        grasp = compute_grasp_pose(
+            taken_by, found.position, found.yaw, taker_spec.mount, taker_spec.yaw, _extent(found)
+        )
         for move in (skills.approach_object, skills.pick_up_object):
             _passing(move(world, taker, grasp), model, giver, taker)
-        ctx.arm, ctx.grasp, ctx.last_arm = taker, grasp, taker
+        ctx.arm, ctx.grasp, ctx.seen, ctx.last_arm = taker, grasp, found, taker
     elif spot is None:
         raise SkillFailed(f"the {ctx.arm.value} arm reaches no spot of {place.name} to set the {carried} down on")
     else:
@@ -513,6 +521,12 @@ def hand_over(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[s
     reach = ctx.world.arm_specs[side].reach
     _check(skills.hand_over_onto_platform(ctx.world, estimate, base, side, loading.loader.model, reach))
     return {}
+
+
+def _extent(estimate: ObjectEstimate) -> tuple[float, float]:
+    """What perception saw of an object along x and y: how wide a box whose long axis it did not see is
+    across jaws closing along x or y (:meth:`ObjectModel.across`)."""
+    return (estimate.size[0], estimate.size[1])
 
 
 def _note(ctx: SimContext, choice: GraspChoice) -> None:
@@ -656,7 +670,7 @@ def _relay(
     on the same surface, where both reach, and the object is found again there."""
     world = ctx.world
     spec = world.arm_specs[giver]
-    grasp = compute_grasp_pose(model, estimate.position, estimate.yaw, spec.mount, spec.yaw)
+    grasp = compute_grasp_pose(model, estimate.position, estimate.yaw, spec.mount, spec.yaw, _extent(estimate))
     ctx.last_arm = giver
     for move in (skills.approach_object, skills.pick_up_object):
         _passing(move(world, giver, grasp), model, giver, taker)
@@ -743,7 +757,10 @@ def _relay_spot(
     def held_by(side: ArmSide, candidates: _Candidates, centre: Vec3) -> ObjectModel | None:
         spec = world.arm_specs[side]
         for held in candidates.models:
-            hand = compute_grasp_pose(held, centre, estimate.yaw, spec.mount, spec.yaw)
+            try:
+                hand = compute_grasp_pose(held, centre, estimate.yaw, spec.mount, spec.yaw, _extent(estimate))
+            except GraspTooWideError:
+                continue  # the hand cannot close on it so, wherever it is
             if world.arm(side).can_hold(hand.position, hand.orientation) and world.arm(side).can_hold(
                 hand.pregrasp, hand.orientation
             ):
@@ -1192,9 +1209,9 @@ class SimEnvironment:
                     continue
                 believed = self.belief.position(obj.name)
                 centre = believed or (obj.start.x, obj.start.y, support.box.max_z + obj.size[2] / 2)
-                estimate = ObjectEstimate(
-                    centre[0], centre[1], centre[2], obj.start.yaw, obj.size, obj.colour, "map", 0.0, 0
-                )
+                # as perception gives it: the yaw of its long axis (a box's y axis when it is the longer)
+                axis = obj.start.yaw + (math.pi / 2.0 if obj.size[1] > obj.size[0] else 0.0)
+                estimate = ObjectEstimate(centre[0], centre[1], centre[2], axis, obj.size, obj.colour, "map", 0.0, 0)
                 try:
                     _who_loads(self.context, estimate, Manipulation.of(obj).model, _dock(support))
                 except SkillFailed as refused:

@@ -102,6 +102,22 @@ class UnknownColourError(PerceptionError):
         super().__init__(f"unknown colour {colour!r}; known: {', '.join(self.known)}")
 
 
+class GraspTooWideError(SimulationError):
+    """An object wider across the jaws than they open, for the approach and the way the hand is turned to
+    it (a long box taken from the side across its length): the hand could not close on it so, wherever
+    the arm reaches. ``width`` and ``opening`` are in metres."""
+
+    def __init__(self, name: str, approach: str, width: float, opening: float) -> None:
+        self.name = name
+        self.approach = approach
+        self.width = width
+        self.opening = opening
+        super().__init__(
+            f"the {name} is {width * 100:.1f} cm wide across the jaws by its {approach} grasp, and the hand "
+            f"opens {opening * 100:.1f} cm"
+        )
+
+
 class MapError(SimulationError):
     """Base of the map and planning failures."""
 

@@ -14,9 +14,14 @@ from enum import StrEnum
 import numpy as np
 
 from cbrs.kb.semantic_map import MapObject
+from cbrs.sim.errors import GraspTooWideError
 from cbrs.sim.geometry import Quat, Vec3, quat_from_matrix
 
-__all__ = ["PALM_DEPTH", "GraspKind", "GraspPose", "ObjectModel", "compute_grasp_pose"]
+__all__ = ["JAW_OPENING", "PALM_DEPTH", "GraspKind", "GraspPose", "ObjectModel", "compute_grasp_pose"]
+
+JAW_OPENING = 0.08
+"""How far apart the open jaws are (m): the Panda hand's fingers open 4 cm each. An object wider than
+this across the jaws, for the way the hand is turned to it, cannot be grasped so."""
 
 
 class GraspKind(StrEnum):
@@ -34,7 +39,8 @@ class ObjectModel:
     colour: str
     height: float
     width: float
-    """Size across the fingers when grasped (diameter of a cup, thickness of a pen)."""
+    """Size across the fingers when grasped (diameter of a cup, thickness of a pen) as a value between
+    components states it; with a ``footprint`` the grasp computes it for the way the hand is turned."""
     grasp: GraspKind
     """The approach the object is (to be) held by."""
     grasp_height: float
@@ -43,6 +49,10 @@ class ObjectModel:
     """Every approach its class allows, best first, when it allows more than one (else empty: ``grasp``
     alone). The grasp point is the same for each: the class says where the fingers close, an approach
     only from where the hand comes."""
+    footprint: tuple[float, float] | None = None
+    """A box's size along its own x and y axes (m), from the map: its width across the jaws depends on
+    the approach and on how it lies (:meth:`across`). None for a cylinder (its diameter whichever way)
+    and for a model a value gave with its width alone (that width is used whichever way)."""
 
     @property
     def preference(self) -> tuple[GraspKind, ...]:
@@ -59,14 +69,41 @@ class ObjectModel:
         order = (self.grasp, *(kind for kind in kinds if kind is not self.grasp))
         return replace(self, approaches=order if len(order) > 1 else ())
 
+    def across(self, closing: float, axis: float | None, seen: tuple[float, float] | None = None) -> float:
+        """How far apart the jaws are when they touch the object, closing along the horizontal direction
+        ``closing`` (its yaw), the object's long axis lying along ``axis`` (a perceived yaw, modulo pi;
+        None when perception saw no long axis): a box's extent along that direction (each side's share of
+        it: |sx cos| + |sy sin| of the angle between its x axis and the jaws). A box whose axis is not
+        known is at most as wide as what was ``seen`` of it along x and y (exactly, with the jaws along x
+        or y: its extent along x or y), and never wider than its diagonal."""
+        if self.footprint is None:
+            return self.width
+        sx, sy = self.footprint
+        if axis is None:
+            widest = math.hypot(sx, sy)
+            if seen is None or min(seen) <= 0.0:
+                return widest
+            return min(widest, abs(math.cos(closing)) * seen[0] + abs(math.sin(closing)) * seen[1])
+        x_axis = axis if sx >= sy else axis - math.pi / 2.0  # the long axis is its x axis or its y axis
+        turn = closing - x_axis
+        return abs(sx * math.cos(turn)) + abs(sy * math.sin(turn))
+
     @classmethod
     def of(cls, obj: MapObject) -> ObjectModel:
-        """The model of a semantic-map object: a side grasp closes across a cylinder's diameter, a top
-        grasp across the object's width (its y size: the fingers close across its x axis)."""
+        """The model of a semantic-map object: a cylinder's width is its diameter whichever way the hand
+        comes; a box keeps its footprint, its width across the jaws being the grasp's to compute, and
+        states as its width its narrower side (the most its jaws close to, as its top grasp does)."""
         kinds = tuple(GraspKind(approach) for approach in obj.grasp_approaches)
-        width = min(obj.size[0], obj.size[1]) if obj.shape == "cylinder" else obj.size[1]
+        box = obj.shape != "cylinder"
         return cls(
-            obj.name, obj.colour, obj.size[2], width, kinds[0], obj.grasp_height, kinds if len(kinds) > 1 else ()
+            obj.name,
+            obj.colour,
+            obj.size[2],
+            min(obj.size[0], obj.size[1]),
+            kinds[0],
+            obj.grasp_height,
+            kinds if len(kinds) > 1 else (),
+            (obj.size[0], obj.size[1]) if box else None,
         )
 
     def top_clearance(self) -> float:
@@ -103,6 +140,9 @@ class GraspPose:
     """Unit vector the gripper moves along to reach the grasp point."""
     bottom_offset: float
     """Grasp point height above the object's bottom: how far the object hangs below the hand."""
+    width: float
+    """How far apart the jaws are when they touch the object, for this approach and turn of the hand
+    (:meth:`ObjectModel.across`): what the fingers close to."""
 
     @property
     def pregrasp(self) -> Vec3:
@@ -128,19 +168,27 @@ def side_orientation(approach_yaw: float, pitch: float = SIDE_PITCH) -> Quat:
 
 
 def compute_grasp_pose(
-    model: ObjectModel, centre: Vec3, yaw: float | None, arm_mount: Vec3, facing: float
+    model: ObjectModel,
+    centre: Vec3,
+    yaw: float | None,
+    arm_mount: Vec3,
+    facing: float,
+    seen: tuple[float, float] | None = None,
 ) -> GraspPose:
-    """The grasp for an object whose centre (and, for long objects, axis yaw) perception estimated, by
-    an arm mounted at ``arm_mount`` facing ``facing`` (its yaw in the semantic map).
+    """The grasp for an object whose centre (and, for long objects, axis yaw; ``seen``: its extent along
+    x and y) perception estimated, by an arm mounted at ``arm_mount`` facing ``facing`` (its yaw in the
+    semantic map).
 
-    A side grasp comes in from the robot's side of the table; a top grasp closes the fingers across
-    the object's long axis.
+    A side grasp comes in from the robot's side of the table, its jaws closing across that direction;
+    a top grasp closes them across the object's long axis. GraspTooWideError when the object is wider
+    across the jaws than they open: the hand could not close on it so, whatever the arm can reach.
     """
     cx, cy, cz = centre
     bottom = cz - model.height / 2.0
     grasp_z = bottom + model.grasp_height
     if model.grasp is GraspKind.SIDE:
         # Straight in from the robot's side of the table, whatever the object's position.
+        closing = facing - math.pi / 2.0  # the grasp frame's y axis, across the approach
         orientation = side_orientation(facing)
         approach: Vec3 = (
             math.cos(facing) * math.cos(SIDE_PITCH),
@@ -148,13 +196,22 @@ def compute_grasp_pose(
             -math.sin(SIDE_PITCH),
         )
     else:
-        axis = 0.0 if yaw is None else yaw
+        if yaw is not None:
+            axis = yaw
+        elif model.footprint is not None and seen is not None and seen[1] > seen[0]:
+            axis = math.pi / 2.0  # no long axis seen: along the longer of what was, the jaws across the other
+        else:
+            axis = 0.0
         # Of the two finger directions across the axis, pick the one nearer the arm's natural wrist
         # yaw (fingers across the arm's reach), so the wrist does not run into its joint limit.
         reach_yaw = math.atan2(cy - arm_mount[1], cx - arm_mount[0])
         finger = axis + math.pi / 2.0
         if math.cos(finger - (reach_yaw + math.pi / 2.0)) < 0.0:
             finger += math.pi
+        closing = finger
         orientation = top_orientation(finger)
         approach = (0.0, 0.0, -1.0)
-    return GraspPose(model, (cx, cy, grasp_z), orientation, approach, model.grasp_height)
+    width = model.across(closing, yaw, seen)
+    if width > JAW_OPENING + 1e-9:
+        raise GraspTooWideError(model.name, model.grasp.value, width, JAW_OPENING)
+    return GraspPose(model, (cx, cy, grasp_z), orientation, approach, model.grasp_height, width)

@@ -18,6 +18,7 @@ import pybullet as p
 
 from cbrs.sim import predicates as pred
 from cbrs.sim.arms import GRIPPER_OPEN, Arm, ArmSide
+from cbrs.sim.errors import GraspTooWideError
 from cbrs.sim.geometry import Pose2D, Region, Vec3, wrap_angle
 from cbrs.sim.grasping import (
     PALM_DEPTH,
@@ -155,7 +156,7 @@ def pick_up_object(world: HomeWorld, side: ArmSide | str, grasp: GraspPose) -> O
     result = arm.move_to(grasp.position, grasp.orientation, speed=PLACE_SPEED)
     if not result.reached:
         return _done(world, "PickUpObject", start, False, result.reason)
-    arm.set_gripper(max(grasp.model.width - 0.004, 0.0), seconds=0.4)
+    arm.set_gripper(max(grasp.width - 0.004, 0.0), seconds=0.4)
     body = _between_fingers(world, arm)
     if body is None:
         arm.set_gripper(GRIPPER_OPEN)
@@ -285,15 +286,26 @@ def platform_region(base: Pose2D | RobotPoseEstimate, height: float) -> Region:
     )
 
 
+def _grasp(world: HomeWorld, pen: ObjectEstimate, side: ArmSide | str, model: ObjectModel) -> GraspPose | str:
+    """The grasp of ``side`` on the object where perception put it, by ``model``'s approach; or why the
+    hand cannot close on it so (too wide across the jaws: :class:`GraspTooWideError`'s words)."""
+    spec = world.arm_specs[ArmSide(side)]
+    try:
+        return compute_grasp_pose(model, pen.position, pen.yaw, spec.mount, spec.yaw, (pen.size[0], pen.size[1]))
+    except GraspTooWideError as wide:
+        return str(wide)
+
+
 def _loading(
     world: HomeWorld, pen: ObjectEstimate, base: Pose2D | RobotPoseEstimate, side: ArmSide | str, model: ObjectModel
-) -> tuple[GraspPose, Region, float, str]:
+) -> tuple[GraspPose | None, Region, float, str]:
     """How an arm loads an object onto the platform: its grasp, the window on the platform, the axis it
     turns a top-grasped object to, and why it cannot (empty if it can): the hand must be able to hold
     the grasp where the object is let go on the platform, which is asked before anything moves."""
-    spec = world.arm_specs[ArmSide(side)]
-    grasp = compute_grasp_pose(model, pen.position, pen.yaw, spec.mount, spec.yaw)
     region = platform_region(base, world.platform_height)
+    grasp = _grasp(world, pen, side, model)
+    if isinstance(grasp, str):
+        return None, region, 0.0, grasp
     # The pen fits between the marker patches along or across the base: take the placement that
     # needs the smaller turn of the wrist.
     pen_yaw = pen.yaw or 0.0
@@ -337,15 +349,17 @@ def can_grip(model: ObjectModel) -> str:
 
 def can_take(world: HomeWorld, pen: ObjectEstimate, side: ArmSide | str, model: ObjectModel) -> str:
     """Why ``side`` cannot take the object where it is by the approach ``model`` is held by (empty if it
-    can), asked without moving: the hand cannot close on it so (:func:`can_grip`), or cannot hold the
-    pre-grasp or the grasp pose."""
+    can), asked without moving: the hand cannot close on it so (:func:`can_grip`; or it is wider across
+    the jaws than they open, for the way the hand turns to it), or cannot hold the pre-grasp or the
+    grasp pose."""
     arm = ArmSide(side)
     x, y, _ = pen.position
     refused = can_grip(model)
     if refused:
         return refused
-    spec = world.arm_specs[arm]
-    grasp = compute_grasp_pose(model, pen.position, pen.yaw, spec.mount, spec.yaw)
+    grasp = _grasp(world, pen, arm, model)
+    if isinstance(grasp, str):
+        return grasp
     hand = world.arm(arm)
     if not (hand.can_hold(grasp.pregrasp, grasp.orientation) and hand.can_hold(grasp.position, grasp.orientation)):
         return (
@@ -359,8 +373,9 @@ def can_set_down(world: HomeWorld, pen: ObjectEstimate, side: ArmSide | str, mod
     middle of ``region`` (empty if it can): the hand keeps the orientation it took it with, as
     :func:`carry_object` and :func:`put_down_object` do."""
     arm = ArmSide(side)
-    spec = world.arm_specs[arm]
-    grasp = compute_grasp_pose(model, pen.position, pen.yaw, spec.mount, spec.yaw)
+    grasp = _grasp(world, pen, arm, model)
+    if isinstance(grasp, str):
+        return grasp
     cx, cy, _ = region.center
     letting_go = (cx, cy, region.zmin + PLACE_CLEARANCE + grasp.bottom_offset)
     if not world.arm(arm).can_hold(letting_go, grasp.orientation):
@@ -388,7 +403,7 @@ def hand_over_onto_platform(
             world, "HandOverOntoPlatform", start, False, f"the base's platform is out of the {side} arm's reach"
         )
     grasp, region, yaw, reason = _loading(world, pen, base, side, model)
-    if reason:
+    if reason or grasp is None:
         return _done(world, "HandOverOntoPlatform", start, False, reason)
     steps: list[Callable[[], Outcome]] = [
         lambda: approach_object(world, side, grasp),
