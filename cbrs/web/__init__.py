@@ -37,6 +37,8 @@ PAGES: tuple[tuple[str, str, str], ...] = (
     ("plans", "plans.plans", "Plans"),
     ("tasks", "tasks.tasks", "Tasks"),
 )
+# Page blueprints reached from every page's header or from links, not from the navigation.
+OTHER_PAGES: tuple[str, ...] = ("search",)
 
 
 # Where the pages may load from and be shown: this server only, never in another site's frame.
@@ -90,9 +92,9 @@ def create_app(
     )
     app.register_blueprint(blueprint)
     app.register_blueprint(graph_store_blueprint)
-    for module, _, _ in PAGES:
+    for module in (*(module for module, _, _ in PAGES), *OTHER_PAGES):
         app.register_blueprint(importlib.import_module(f"cbrs.web.{module}").blueprint)
-    page_blueprints = {module for module, _, _ in PAGES}
+    page_blueprints = {module for module, _, _ in PAGES} | set(OTHER_PAGES)
     allowed = frozenset(cors_origins)
     links.install(app)
 

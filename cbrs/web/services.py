@@ -22,7 +22,7 @@ MATCH_ENDPOINT = "matchmaking.matchmaking"
 @page(blueprint, "/services")
 def services() -> Page:
     kb = context.kb()
-    rows = [_advertisement_row(row) for row in kb.select("advertisements")]
+    rows = advertisement_rows(kb)
     kinds: dict[str, int] = {}
     for row in rows:
         kinds[row["kind"]] = kinds.get(row["kind"], 0) + 1
@@ -31,7 +31,7 @@ def services() -> Page:
         "kinds": [{"iri": k, "name": shorten(k), "count": n} for k, n in sorted(kinds.items())],
         "total": len(rows),
         "advertisements": rows,
-        "requirements": _requirement_rows(kb),
+        "requirements": requirement_rows(kb),
     }
     given = (request.args.get("kind") or "").strip()
     if not given:
@@ -93,6 +93,19 @@ def _advertisement_row(row: dict[str, Term]) -> dict[str, Any]:
     }
 
 
+def advertisement_rows(kb: KnowledgeBase) -> list[dict[str, Any]]:
+    """Every advertisement as a row of the services table, read once per store generation (the services
+    page and the search both list them; OWLS-TC has 1,136). The rows are shared: do not change them."""
+    return context.per_generation(
+        "advertisement_rows", lambda: [_advertisement_row(r) for r in kb.select("advertisements")]
+    )
+
+
+def requirement_rows(kb: KnowledgeBase) -> list[dict[str, Any]]:
+    """Every requirement as a row of the requirements table, shared as :func:`advertisement_rows` are."""
+    return context.per_generation("requirement_rows", lambda: _requirement_rows(kb))
+
+
 def _requirement_rows(kb: KnowledgeBase) -> list[dict[str, Any]]:
     return [
         {
@@ -111,7 +124,5 @@ def _requirement_rows(kb: KnowledgeBase) -> list[dict[str, Any]]:
 def _requirements_for(kb: KnowledgeBase, ad: Advertisement) -> list[dict[str, Any]]:
     """Every requirement, to pick one to match against; first those asking for an output this service gives."""
     offered = {p.type for p in ad.outputs}
-    rows = _requirement_rows(kb)
-    for row in rows:
-        row["shares_output"] = bool(offered & set(row["outputs"]))
+    rows = [{**row, "shares_output": bool(offered & set(row["outputs"]))} for row in requirement_rows(kb)]
     return sorted(rows, key=lambda r: (not r["shares_output"], r["name"].casefold()))

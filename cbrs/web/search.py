@@ -1,0 +1,130 @@
+"""One search over the store by name: classes and properties, advertisements and requirements.
+
+A lab user knows a name (``Price``, ``ceiling camera``, ``FetchMyPen``), not where it lives: before,
+each page had a filter of its own and none looked across them. The box in every page's header leads
+here. Matches are ranked: an exact name first, then names that start with the text, then the rest;
+a service whose inputs or outputs are of a matching concept comes last, saying which.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from typing import Any
+
+import pyoxigraph as ox
+from flask import Blueprint, request
+
+from cbrs.kb.namespaces import expand, shorten
+from cbrs.web import context, services
+from cbrs.web.pages import FormError, Page, page
+from cbrs.web.taxonomy import current_taxonomy, local_name
+
+blueprint = Blueprint("search", __name__)
+
+MAX_TEXT = 200  # characters of a search text
+SHOWN = 50  # matches listed per group; the count says how many there are
+
+EXACT, PREFIX, WORD, CONTAINS, BY_CONCEPT = range(5)
+
+
+def rank(needle: str, names: Iterable[str | None]) -> int | None:
+    """How well ``needle`` (case-folded) matches the best of ``names``: :data:`EXACT`, :data:`PREFIX`,
+    :data:`WORD` (a word in it starts with the text), :data:`CONTAINS`, or ``None``."""
+    best: int | None = None
+    for name in names:
+        if not name:
+            continue
+        folded = name.casefold()
+        if needle not in folded:
+            continue
+        if folded == needle:
+            return EXACT
+        if folded.startswith(needle):
+            found = PREFIX
+        elif any(word.startswith(needle) for word in _words(folded)):
+            found = WORD
+        else:
+            found = CONTAINS
+        best = found if best is None else min(best, found)
+    return best
+
+
+def _words(text: str) -> list[str]:
+    return "".join(c if c.isalnum() else " " for c in text).split()
+
+
+@page(blueprint, "/search")
+def search() -> Page:
+    text = (request.args.get("q") or "").strip()
+    data: dict[str, Any] = {"q": text or None, "shown": SHOWN}
+    shown = Page("search.html", "Search", data)
+    if not text:
+        return shown
+    if len(text) > MAX_TEXT:
+        raise FormError({"q": f"a search text has at most {MAX_TEXT} characters, not {len(text)}"}, page=shown)
+    shown.title = f"Search: “{text}”"
+    data["iri"] = _resource(text)
+    # a prefixed name or IRI is looked for by its local name too: home:Position finds home:Position2D
+    needle = (local_name(data["iri"]["iri"]) if data["iri"] else text).casefold()
+    data["terms"] = _terms(needle)
+    data["advertisements"] = _advertisements(needle, data["terms"]["all"])
+    data["requirements"] = _requirements(needle)
+    data["total"] = sum(data[group]["count"] for group in ("terms", "advertisements", "requirements"))
+    for group in ("terms", "advertisements", "requirements"):
+        del data[group]["all"]
+    return shown
+
+
+def _group(found: list[tuple[int, str, dict[str, Any]]]) -> dict[str, Any]:
+    found.sort(key=lambda item: (item[0], item[1].casefold()))
+    return {"count": len(found), "matches": [row for _, _, row in found[:SHOWN]], "all": found}
+
+
+def _resource(text: str) -> dict[str, str] | None:
+    """The search text as an IRI or prefixed name the store has triples about, to go straight to."""
+    if ":" not in text or any(c.isspace() for c in text):
+        return None
+    try:
+        iri = expand(text)
+        ox.NamedNode(iri)
+    except ValueError:
+        return None
+    if not context.kb().select("resource_triples", {"resource": iri}):
+        return None
+    return {"iri": iri, "name": shorten(iri)}
+
+
+def _terms(needle: str) -> dict[str, Any]:
+    found = current_taxonomy()
+    rows = []
+    for term, kind in found.kinds.items():
+        label = found.labels.get(term)
+        score = rank(needle, (local_name(term), label))
+        if score is not None:
+            rows.append((score, local_name(term), {**found.term(term), "kind": kind}))
+    return _group(rows)
+
+
+def _advertisements(needle: str, terms: list[tuple[int, str, dict[str, Any]]]) -> dict[str, Any]:
+    """Advertisements by name, and then those with an input or output of a concept the text names."""
+    concepts = {row["iri"] for score, _, row in terms if score <= PREFIX}
+    rows = []
+    for ad in services.advertisement_rows(context.kb()):
+        names = (ad["service_name"], ad["device_name"], ad["label"], local_name(ad["service"]))
+        score = rank(needle, names)
+        via = sorted({c for c in (*ad["inputs"], *ad["outputs"]) if c in concepts})
+        if score is None and via:
+            score = BY_CONCEPT
+        if score is not None:
+            row = {**ad, "via": [{"iri": c, "name": shorten(c)} for c in via] if score == BY_CONCEPT else []}
+            rows.append((score, ad["service_name"] or ad["name"], row))
+    return _group(rows)
+
+
+def _requirements(needle: str) -> dict[str, Any]:
+    rows = []
+    for requirement in services.requirement_rows(context.kb()):
+        score = rank(needle, (local_name(requirement["requirement"]), requirement["label"]))
+        if score is not None:
+            rows.append((score, requirement["name"], requirement))
+    return _group(rows)
