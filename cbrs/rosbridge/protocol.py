@@ -274,34 +274,45 @@ def finite(value: Any) -> Any:
     return value
 
 
-def _decoded_encoder(allow_nan: bool) -> Callable[[Any], str]:
+def _c_encoder(allow_nan: bool) -> Callable[[Any, int], Any]:
     """An encoder for values :func:`decode` made, which cannot hold a cycle: the C encoder made once,
     without the cycle check (``JSONEncoder.encode`` makes a new one on every call, about a microsecond of
-    each message a publisher sends)."""
+    each message a publisher sends). Called with (value, 0), it gives the text's pieces."""
     make: Any = getattr(json.encoder, "c_make_encoder", None)
     try:
-        encoder = make(None, _not_json, json.encoder.encode_basestring, None, ":", ",", False, False, allow_nan)
+        encoder: Callable[[Any, int], Any] = make(
+            None, _not_json, json.encoder.encode_basestring, None, ":", ",", False, False, allow_nan
+        )
     except TypeError:  # no C accelerator, or another signature: the ordinary encoder
-        return _TOKENS.encode if allow_nan else _ENCODER.encode
-    return lambda value: "".join(encoder(value, 0))
+        ordinary = _TOKENS if allow_nan else _ENCODER
+        return lambda value, _level: (ordinary.encode(value),)
+    return encoder
 
 
 def _not_json(value: Any) -> Any:
     raise TypeError(f"Object of type {type(value).__name__} is not JSON serializable")
 
 
-#: The encoders :func:`encode_decoded` uses: NaN refused, NaN written.
-DECODED_STRICT, DECODED_TOKENS = _decoded_encoder(False), _decoded_encoder(True)
+_STRICT_C, _TOKENS_C = _c_encoder(False), _c_encoder(True)
+
+
+def _decoded_strict(value: Any) -> str:
+    return "".join(_STRICT_C(value, 0))
+
+
+def _decoded_tokens(value: Any) -> str:
+    return "".join(_TOKENS_C(value, 0))
 
 
 def encode_decoded(value: Any, non_finite: str = "null") -> tuple[str, bool]:
-    """:func:`encode` of a value that came out of :func:`decode` (what a client sent), faster."""
-    return encode(value, non_finite, DECODED_STRICT, DECODED_TOKENS)
-
-
-def dumps_decoded(value: Any, non_finite: str = "null") -> str:
-    """Compact JSON of a value that came out of :func:`decode`: as ``dumps``, faster."""
-    return encode(value, non_finite, DECODED_STRICT, DECODED_TOKENS)[0]
+    """:func:`encode` of a value that came out of :func:`decode` (what a client sent), faster: every
+    message a publisher sends passes here (bench/rosbridge_relay.py)."""
+    if non_finite == "null":
+        try:
+            return "".join(_STRICT_C(value, 0)), True
+        except ValueError:  # a NaN or an infinity: encode writes a copy
+            pass
+    return encode(value, non_finite, _decoded_strict, _decoded_tokens)
 
 
 def status(level: str, text: str, message_id: MessageId | None) -> str:
