@@ -446,5 +446,48 @@ def test_roslibjs_gets_null_in_json_and_the_floats_in_cbor() -> None:
     assert_threads_end(threads, WAIT)
 
 
+#: Subscribes, calls /go (the server publishes a message with Infinity, then one without) and reports
+#: what its callback and its error listener got, and whether the connection still answers.
+ROSLIBJS_TOKENS = """
+import { Ros, Service, Topic } from "roslib";
+import { bounded } from "./bounded.mjs";
+setTimeout(() => { console.error("gave up after 30 s"); process.exit(2); }, 30000).unref();
+const ros = new Ros({ url: `ws://127.0.0.1:${Number(process.argv[1])}` });
+const errors = [];
+ros.on("error", (error) => errors.push(String(error?.message ?? error)));
+await bounded("connect", 5000, (resolve) => ros.on("connection", resolve));
+const got = [];
+new Topic({ ros, name: "/t", messageType: "x/Y" }).subscribe((message) => got.push(message));
+const call = (name) => bounded(`call ${name}`, 5000, (resolve, reject) =>
+  new Service({ ros, name, serviceType: "any" }).callService({}, resolve, reject));
+await call("/rosapi/get_time");
+await call("/go");
+const deadline = Date.now() + 5000;
+while (!got.length && Date.now() < deadline) await new Promise((resolve) => setTimeout(resolve, 20));
+await call("/rosapi/get_time");
+console.log(JSON.stringify({ got, errors }));
+process.exit(0);
+"""
+
+
+@needs_roslibjs
+def test_roslibjs_drops_a_message_with_tokens_and_says_so() -> None:
+    """Why ``null`` is the default: JSON.parse refuses the tokens, so roslibjs loses the whole message."""
+    bridge = Bridge(call_timeout=WAIT, non_finite="tokens")
+    bridge.add_topic("/t", "x/Y")
+
+    def go(args: dict[str, Any]) -> dict[str, Any]:
+        bridge.publish("/t", {"r": [1.0, INF]})
+        bridge.publish("/t", {"r": [2.0]})
+        return {}
+
+    bridge.add_service("/go", "x/Go", go)
+    with bridge.start(port=0) as running:
+        heard = node_inline(ROSLIBJS_TOKENS, running.port)
+    assert heard["got"] == [{"r": [2]}]  # the first is lost; the connection and later messages are not
+    (error,) = heard["errors"]
+    assert "Infinity" in error and "is not valid JSON" in error
+
+
 if __name__ == "__main__":
     print(json.dumps(run_client(int(sys.argv[1]))), flush=True)
