@@ -14,9 +14,31 @@ def iri_url(iri: str) -> str:
     return url_for(RESOURCE_ENDPOINT, iri=iri)
 
 
+def display_name(iri: str, label: str | None = None) -> Markup:
+    """How a link shows ``iri``: ``label`` if given, else its prefixed name. An IRI that no prefix
+    shortens (all of OWLS-TC's) shows the part after its last ``/``, the rest left to the link's title:
+    ``my_ontology.owl#Car`` rather than ``http://127.0.0.1/ontology/my_ontology.owl#Car``, which
+    filled table columns and hid the local name at the end. A label equal to the IRI counts as none
+    (pages pass the prefixed name along, which for such an IRI is the IRI itself)."""
+    if label and label != iri:
+        return escape(label)
+    short = shorten(iri)
+    if short != iri:
+        return escape(short)
+    _, scheme, rest = iri.partition("://")
+    _host, slash, path = rest.partition("/")
+    if not scheme or not slash or not path or iri.endswith("/"):  # no path to take a tail of
+        return escape(iri)
+    tail = path.rsplit("/", 1)[-1]
+    namespace, hash_, local = tail.rpartition("#")
+    if not hash_ or not local:
+        return escape(tail)
+    return Markup(f'<span class="ns">{escape(namespace)}#</span>{escape(local)}')
+
+
 def iri_link(iri: str, label: str | None = None) -> Markup:
     """``<a href="/resource?iri=...">prefix:name</a>``, or the short name alone if there is no such page."""
-    text = escape(label or shorten(iri))
+    text = display_name(iri, label)
     try:
         href = iri_url(iri)
     except Exception:  # the resource page is not registered (a reduced app)
@@ -27,4 +49,5 @@ def iri_link(iri: str, label: str | None = None) -> Markup:
 def install(app: Flask) -> None:
     app.add_template_global(iri_link, "iri_link")
     app.add_template_global(iri_url, "iri_url")
+    app.add_template_global(display_name, "display_name")
     app.add_template_filter(shorten, "short")

@@ -23,7 +23,7 @@ from cbrs.kb.namespaces import OWL, RDF, RDFS, GraphName, shorten
 from cbrs.kb.vocab import CBRS
 from cbrs.output import Expression, class_expression, manchester, node_view
 from cbrs.web import context, resource
-from cbrs.web.links import iri_link
+from cbrs.web.links import display_name, iri_link
 from cbrs.web.pages import Page, page
 
 blueprint = Blueprint("taxonomy", __name__)
@@ -67,7 +67,7 @@ def concept_url(iri: str) -> str:
 @blueprint.app_template_global("concept_link")
 def concept_link(iri: str, label: str | None = None) -> Markup:
     """A link to the taxonomy page of a class or property."""
-    return Markup(f'<a href="{escape(concept_url(iri))}" title="{escape(iri)}">{escape(label or shorten(iri))}</a>')
+    return Markup(f'<a href="{escape(concept_url(iri))}" title="{escape(iri)}">{display_name(iri, label)}</a>')
 
 
 @dataclass

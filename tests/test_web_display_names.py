@@ -1,0 +1,85 @@
+"""IRIs that no prefix shortens (all of OWLS-TC's) show their tail on the pages, the file part muted
+and the whole IRI in the link's title, instead of ``http://127.0.0.1/ontology/...`` in every cell."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from flask.testing import FlaskClient
+from markupsafe import Markup
+
+from cbrs.kb import KnowledgeBase
+from cbrs.sparql_service import SparqlService
+from cbrs.web import create_app
+from cbrs.web.links import display_name
+
+ONTO = "http://127.0.0.1/ontology/my_ontology.owl#"
+SERVICE = "http://127.0.0.1/services/1.1/car_price_service.owls#CAR_PRICE_SERVICE"
+TURTLE = f"""@prefix cbrs: <https://w3id.org/cbrs/core#> .
+@prefix owl: <http://www.w3.org/2002/07/owl#> .
+@prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .
+<{ONTO}Car> a owl:Class .
+<{ONTO}FourWheeledCar> a owl:Class ; rdfs:subClassOf <{ONTO}Car> .
+"""
+AD = f"""@prefix cbrs: <https://w3id.org/cbrs/core#> .
+@prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .
+<{SERVICE}> a cbrs:MethodInvocationComponent ; rdfs:label "car price" ;
+    cbrs:deviceName "car_price_service" ; cbrs:serviceName "CarPrice" ;
+    cbrs:hasOWLSModel [ a cbrs:OWLSModel ;
+        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "_CAR" ; cbrs:parameterType <{ONTO}FourWheeledCar> ] ] .
+"""
+
+
+@pytest.mark.parametrize(
+    ("iri", "label", "shown"),
+    [
+        ("https://w3id.org/cbrs/home#Position", None, "home:Position"),
+        (ONTO + "Car", None, '<span class="ns">my_ontology.owl#</span>Car'),
+        (ONTO + "Car", ONTO + "Car", '<span class="ns">my_ontology.owl#</span>Car'),  # the "short" name passed on
+        (ONTO + "Car", "a car", "a car"),
+        ("http://example.org/things/Widget", None, "Widget"),
+        ("http://example.org/", None, "http://example.org/"),
+        ("urn:x-lab:thing", None, "urn:x-lab:thing"),
+        ("http://example.org/a#<b>", None, '<span class="ns">a#</span>&lt;b&gt;'),
+    ],
+)
+def test_display_name(iri: str, label: str | None, shown: str) -> None:
+    assert display_name(iri, label) == Markup(shown)
+
+
+@pytest.fixture(scope="module")
+def client(tmp_path_factory: pytest.TempPathFactory) -> FlaskClient:
+    folder = Path(tmp_path_factory.mktemp("display"))
+    (folder / "onto.ttl").write_text(TURTLE, encoding="utf-8")
+    (folder / "ad.ttl").write_text(AD, encoding="utf-8")
+    kb = KnowledgeBase.open(":memory:")
+    kb.load([folder / "onto.ttl"])
+    kb.load([folder / "ad.ttl"])
+    return create_app(SparqlService(kb)).test_client()
+
+
+def test_pages_show_the_tail_and_keep_the_whole_iri_in_the_title(client: FlaskClient) -> None:
+    car = f'title="{ONTO}FourWheeledCar"><span class="ns">my_ontology.owl#</span>FourWheeledCar</a>'
+    for path, query in (
+        ("/services", {}),
+        ("/service", {"iri": SERVICE}),
+        ("/taxonomy", {}),
+        ("/taxonomy/class", {"iri": ONTO + "Car"}),
+        ("/search", {"q": "wheeled"}),
+    ):
+        response = client.get(path, query_string=query)
+        assert response.status_code == 200, path
+        assert car in response.text, path
+        assert f">{ONTO}FourWheeledCar<" not in response.text, path
+    twin = client.get("/services.json").get_json()
+    ad = next(a for a in twin["advertisements"] if a["service"] == SERVICE)
+    assert ad["inputs"] == [ONTO + "FourWheeledCar"]  # the twins keep whole IRIs
+
+
+def test_the_uses_of_a_class_and_the_paths_to_it_show_tails_too(client: FlaskClient) -> None:
+    page = client.get("/taxonomy/class", query_string={"iri": ONTO + "FourWheeledCar"}).text
+    assert '<span class="ns">car_price_service.owls#</span>CAR_PRICE_SERVICE</a>' in page
+    assert '<strong><span class="ns">my_ontology.owl#</span>FourWheeledCar</strong>' in page
+    services = client.get("/services").text
+    assert services.count(">car price<") == 1  # the label, beside the service name it differs from
