@@ -59,6 +59,7 @@ class ServeConfig:
         default_factory=lambda: setting("bridge_connections_per_client").resolve()
     )
     action_workers: int = field(default_factory=lambda: setting("action_workers").resolve())
+    bridge_non_finite: str = field(default_factory=lambda: setting("bridge_non_finite").resolve())
     component_lease: float = field(default_factory=lambda: setting("component_lease").resolve())
     match_params: tuple[str, ...] = field(default_factory=lambda: setting("match_params").resolve())
 
@@ -79,6 +80,7 @@ class Server:
             reserved=("/cbrs/",),
             connections_per_client=self.config.bridge_connections_per_client,
             action_workers=self.config.action_workers,
+            non_finite=self.config.bridge_non_finite,
         )
         # one taxonomy index for the pages and the bridge
         self.matchmakers = Matchmakers(self.sparql, tuple(self.config.match_params))

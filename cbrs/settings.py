@@ -92,6 +92,16 @@ def _event_loop(text: str) -> str:
     return kind
 
 
+NON_FINITE = ("null", "tokens")  # cbrs.rosbridge.protocol.NON_FINITE, kept here so settings load no bridge
+
+
+def _non_finite(text: str) -> str:
+    word = text.strip().lower()
+    if word not in NON_FINITE:
+        raise ValueError(f"{text!r} is not a way to write NaN and infinities ({', '.join(NON_FINITE)})")
+    return word
+
+
 LOG_LEVELS = ("DEBUG", "INFO", "WARNING", "ERROR", "CRITICAL")
 
 
@@ -245,6 +255,15 @@ SETTINGS: tuple[Setting, ...] = (
         "ends, so these are apart from the service threads and a long task never delays a service call.",
         "CBRS_ACTION_WORKERS",
         _positive(int),
+    ),
+    Setting(
+        "bridge_non_finite",
+        lambda: "null",
+        "How the bridge's JSON text frames write a NaN or an infinity, which JSON has no number for: null "
+        "(as rosbridge_suite does; every JSON parser reads it) or tokens (NaN, Infinity, as Python writes "
+        "them: roslibpy reads them, roslibjs drops the message). CBOR subscribers get the floats either way.",
+        "CBRS_BRIDGE_NON_FINITE",
+        _non_finite,
     ),
     Setting(
         "component_lease",
