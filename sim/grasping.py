@@ -70,7 +70,7 @@ class ObjectModel:
         return replace(self, approaches=order if len(order) > 1 else ())
 
     def across(self, closing: float, axis: float | None, seen: tuple[float, float] | None = None) -> float:
-        """How far apart the jaws are when they touch the object, closing along the horizontal direction
+        """How far apart the jaws must be to pass the object, closing along the horizontal direction
         ``closing`` (its yaw), the object's long axis lying along ``axis`` (a perceived yaw, modulo pi;
         None when perception saw no long axis): a box's extent along that direction (each side's share of
         it: |sx cos| + |sy sin| of the angle between its x axis and the jaws). A box whose axis is not
@@ -84,9 +84,23 @@ class ObjectModel:
             if seen is None or min(seen) <= 0.0:
                 return widest
             return min(widest, abs(math.cos(closing)) * seen[0] + abs(math.sin(closing)) * seen[1])
-        x_axis = axis if sx >= sy else axis - math.pi / 2.0  # the long axis is its x axis or its y axis
-        turn = closing - x_axis
+        turn = closing - _x_axis(self.footprint, axis)
         return abs(sx * math.cos(turn)) + abs(sy * math.sin(turn))
+
+    def grip(self, closing: float, axis: float | None) -> float:
+        """How far apart the jaws are where the fingers, narrow, touch the object, closing through its
+        grasp point along ``closing``: a box's chord that way through its centre (its extent along its x or
+        y axis, when the jaws close along it). A box whose axis is not known is at least its narrower
+        side across (the shortest chord through a rectangle's centre): the fingers, told to close to
+        that, stop where they touch it. A cylinder's diameter; a width given alone, that width."""
+        if self.footprint is None:
+            return self.width
+        sx, sy = self.footprint
+        if axis is None:
+            return min(sx, sy)
+        turn = closing - _x_axis(self.footprint, axis)
+        along, across = abs(math.cos(turn)), abs(math.sin(turn))
+        return min(sx / along if along > 1e-9 else math.inf, sy / across if across > 1e-9 else math.inf)
 
     @classmethod
     def of(cls, obj: MapObject) -> ObjectModel:
@@ -110,6 +124,11 @@ class ObjectModel:
         """How far the hand's palm stays above the object's top in a top grasp (negative: it would press
         on it, the grasp point being deeper than the fingers are long)."""
         return PALM_DEPTH - (self.height - self.grasp_height)
+
+
+def _x_axis(footprint: tuple[float, float], axis: float) -> float:
+    """The yaw of a box's x axis, its long axis (as perception gives it) lying along ``axis``."""
+    return axis if footprint[0] >= footprint[1] else axis - math.pi / 2.0
 
 
 PALM_DEPTH = 0.034
@@ -141,8 +160,8 @@ class GraspPose:
     bottom_offset: float
     """Grasp point height above the object's bottom: how far the object hangs below the hand."""
     width: float
-    """How far apart the jaws are when they touch the object, for this approach and turn of the hand
-    (:meth:`ObjectModel.across`): what the fingers close to."""
+    """How far apart the jaws are when the fingers touch the object, for this approach and turn of the
+    hand (:meth:`ObjectModel.grip`): what the fingers close to."""
 
     @property
     def pregrasp(self) -> Vec3:
@@ -214,4 +233,5 @@ def compute_grasp_pose(
     width = model.across(closing, yaw, seen)
     if width > JAW_OPENING + 1e-9:
         raise GraspTooWideError(model.name, model.grasp.value, width, JAW_OPENING)
-    return GraspPose(model, (cx, cy, grasp_z), orientation, approach, model.grasp_height, width)
+    grip = model.grip(closing, yaw)
+    return GraspPose(model, (cx, cy, grasp_z), orientation, approach, model.grasp_height, grip)

@@ -84,6 +84,19 @@ def test_a_box_whose_long_axis_was_not_seen_is_taken_across_the_narrower_of_what
     assert block.across(0.3, None, None) == pytest.approx(math.hypot(0.05, 0.07))  # nothing seen: its diagonal
 
 
+def test_the_fingers_close_to_the_chord_through_the_grasp_point_and_the_jaws_open_past_the_extent() -> None:
+    """Narrow fingers touch a box turned to them where its chord through the grasp point ends, inside its
+    extent: told to close to the extent, they stopped short of it. Not knowing how it lies, they close to
+    its narrower side, the shortest chord through its centre, and stop where they touch it."""
+    box = ObjectModel("Box", "green", 0.08, 0.04, GraspKind.SIDE, 0.06, (), (0.06, 0.04))
+    closing = FACING - math.pi / 2.0
+    grasp = compute_grasp_pose(box, CENTRE, closing + 0.3, LEFT, FACING)  # its x axis 0.3 rad off the jaws
+    assert grasp.width == pytest.approx(0.06 / math.cos(0.3))
+    assert box.across(closing, closing + 0.3) == pytest.approx(0.06 * math.cos(0.3) + 0.04 * math.sin(0.3))
+    assert box.grip(closing, None) == pytest.approx(0.04)
+    assert compute_grasp_pose(box, CENTRE, None, LEFT, FACING, seen=(0.07, 0.06)).width == pytest.approx(0.04)
+
+
 def test_a_cylinder_and_a_width_given_alone_are_as_wide_whichever_way() -> None:
     cup = ObjectModel("Cup", "red", 0.10, 0.06, GraspKind.SIDE, 0.07)
     for axis in (None, 0.0, 1.0):
