@@ -102,6 +102,7 @@ def test_a_concept_no_ontology_declares_has_a_page_not_a_404() -> None:
     assert [(a["iri"], a["roles"]) for a in body["usage"]["advertisements"]] == [(LAB + "DoorCam", ["output"])]
     page = client.get("/taxonomy/class", query_string={"iri": LAB + "DoorStatte"}).text
     assert "No ontology in the store declares" in page
+    assert '<svg class="diagram"' not in page  # nothing to draw: no ontology places it
     # an IRI nothing uses as a concept is still not found
     assert client.get("/taxonomy/class.json", query_string={"iri": LAB + "Nothing"}).status_code == 404
     assert client.get("/taxonomy/class.json", query_string={"iri": "svc:CeilingCamera01"}).status_code == 404

@@ -8,11 +8,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from flask import Blueprint, Response, request, url_for
+from markupsafe import Markup
 
 from cbrs.extras import require
 from cbrs.kb.namespaces import shorten
-from cbrs.web import context
-from cbrs.web.pages import FormError, Page, page
+from cbrs.web import context, diagram
+from cbrs.web.links import display_text
+from cbrs.web.pages import FormError, Page, page, wants_json
 
 if TYPE_CHECKING:  # the planner (and networkx) load with the first plan asked for, not at start-up
     from cbrs.actions.composer import CompositionResult
@@ -46,6 +48,8 @@ def plans() -> Page:
     with context.lock():  # a GET stays safe: the plan is shown, not recorded (cbrs plan and /cbrs/plan record)
         result = _compose(task, objective, shown)
     data["composition"] = _composition(result)
+    if not wants_json():  # markup, so not in the twin, which has the same steps as lists
+        data["flow"] = _flow(data["composition"])
     # The page only shows the plan; link the plans graph's copy only when one was recorded (cbrs plan).
     data["recorded"] = result.plan is not None and context.kb().describes(result.plan.iri)
     data["graph"] = url_for("plans.graph", task=task, objective=objective)
@@ -126,3 +130,64 @@ def _source(binding: dict[str, Any]) -> str:
     origin = binding["from"]
     where = "requirement" if "step" not in origin else f"#{origin['step']}"
     return f"{where}.{origin['name']}" if binding["role"] == "input" else where
+
+
+def _flow(composition: dict[str, Any]) -> Markup | None:
+    """The plan's data flow as a picture: the requirement on top, each step one row below the lowest
+    step it takes an input or a precondition from, the goals at the bottom. Solid arrows carry inputs
+    (the input's name beside the head), dashed ones preconditions and goals."""
+    steps = composition.get("steps") or []
+    if not steps:
+        return None
+    depth: dict[int, int] = {}
+    edges: list[diagram.Edge] = []
+    for step in steps:
+        index = step["index"]
+        sources = [b["from"].get("step") for b in (*step["inputs"], *step["preconditions"])]
+        depth[index] = 1 + max((depth.get(s, 0) for s in sources if s is not None), default=0)
+        for binding in (*step["inputs"], *step["preconditions"]):
+            source = binding["from"].get("step")
+            dashed = binding["role"] != "input"
+            edges.append(
+                diagram.Edge(
+                    f"step-{source}" if source is not None else "requirement",
+                    f"step-{index}",
+                    "" if dashed else binding["name"],
+                    dashed=dashed,
+                    note=f"{binding['name']} ← {binding['source']}"
+                    + (f" ({binding['degree']})" if binding.get("degree") else ""),
+                )
+            )
+    for goal in composition.get("goals") or []:
+        source = goal["from"].get("step")
+        key = f"step-{source}" if source is not None else "requirement"
+        edges.append(diagram.Edge(key, "goals", dashed=True, note=f"{goal['name']} ← {goal['source']}"))
+    task = display_text(composition["task"])
+    rows: list[list[diagram.Box]] = [
+        [diagram.Box("requirement", task, f"the requirement {composition['task']}", None, "end")]
+    ]
+    for level in range(1, max(depth.values()) + 1):
+        rows.append(
+            [
+                diagram.Box(
+                    f"step-{step['index']}",
+                    _step_text(step),
+                    f"{step['component']}" + (f": {step['label']}" if step.get("label") else ""),
+                    f"#step-{step['index']}",
+                )
+                for step in steps
+                if depth[step["index"]] == level
+            ]
+        )
+    if composition.get("goals"):
+        rows.append([diagram.Box("goals", "goals", "the effects the requirement asks for", None, "end")])
+    return diagram.layered(
+        rows, edges, f"Data flow of the plan for {task}", f"{len(steps)} steps in {len(rows) - 1} rows", "flow"
+    )
+
+
+def _step_text(step: dict[str, Any]) -> str:
+    """``#4 PlanPathAStar`` over ``HomeServer01``: a component's name is its service and its device."""
+    name = display_text(step["component"]).rpartition(":")[2]
+    service, _, device = name.rpartition("_")
+    return f"#{step['index']} {service}\n{device}" if service and device else f"#{step['index']} {name}"

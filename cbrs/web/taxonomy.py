@@ -8,6 +8,7 @@ Everything is read with the named queries the taxonomy index reads (``taxonomy_l
 from __future__ import annotations
 
 import difflib
+import itertools
 from collections.abc import Iterator, Set
 from dataclasses import dataclass, field
 from typing import Any
@@ -22,9 +23,9 @@ from cbrs.kb.errors import NotFoundError
 from cbrs.kb.namespaces import OWL, RDF, RDFS, GraphName, shorten
 from cbrs.kb.vocab import CBRS
 from cbrs.output import Expression, class_expression, manchester, node_view
-from cbrs.web import context, resource
-from cbrs.web.links import display_name, iri_link
-from cbrs.web.pages import Page, page
+from cbrs.web import context, diagram, resource
+from cbrs.web.links import display_name, display_text, iri_link
+from cbrs.web.pages import Page, page, wants_json
 
 blueprint = Blueprint("taxonomy", __name__)
 blueprint.record_once(resource.attach)  # the page of any IRI comes with the taxonomy (it is not in the nav)
@@ -33,6 +34,7 @@ MAX_PATHS = 12  # ancestor paths shown per search match
 # Tree nodes a taxonomy page shows at most, per tree: the levels that fit, the rest a link away. OWLS-TC's
 # class tree has 18,687 nodes, a page of 9 MB that took 2.5 s to serve and longer to lay out.
 MAX_TREE_NODES = 2000
+MAX_PICTURE_ROW = 10  # subclasses (and parts) drawn in a class's picture; the rest is one "N more" box
 MAX_MATCHES = 200  # search matches listed with their paths; the count says how many there are
 # How a service description reaches a concept, walking incoming triples back to the description.
 _USE_LINKS = {
@@ -281,8 +283,51 @@ def concept() -> Page:
         "named_in": _named_in(kb, triples),
         "usage": _usage(kb, iri, triples),
     }
+    if not wants_json():  # markup, so not in the twin, which has the same facts as lists
+        data["picture"] = _picture(found, iri, data["parts"])
     noun = "Class" if kind == "class" else "Property"
     return Page("class.html", f"{noun} {shorten(iri)}", data)
+
+
+def _picture(found: Taxonomy, iri: str, parts: list[dict[str, Any]]) -> Markup:
+    """The term among its ancestors (every is-a path up, as the breadcrumbs), its direct subclasses and
+    its parts, as a picture: arrows point from a class to its superclass, dashed ones to its parts."""
+    distance: dict[str, int] = {}
+    edges: list[diagram.Edge] = []
+    for path in found.paths(iri):
+        chain = [*path, iri]
+        for step, term in enumerate(path):
+            distance[term] = max(distance.get(term, 0), len(path) - step)
+        edges += [diagram.Edge(lower, upper) for upper, lower in itertools.pairwise(chain)]
+    edges = list(dict.fromkeys(edges))
+
+    def box(term: str, kind: str = "node") -> diagram.Box:
+        label = found.labels.get(term)
+        title = f"{term}" + (f" ({label})" if label else "")
+        return diagram.Box(term, display_text(term), title, concept_url(term), kind)
+
+    rows = [
+        [box(t) for t in found.sorted({t for t, d in distance.items() if d == level})]
+        for level in range(max(distance.values(), default=0), 0, -1)
+    ]
+    rows.append([box(iri, "focus")])
+    below = found.sorted(found.children.get(iri))
+    row = [box(t) for t in below[:MAX_PICTURE_ROW]]
+    edges += [diagram.Edge(t, iri) for t in below[:MAX_PICTURE_ROW]]
+    if len(below) > MAX_PICTURE_ROW:
+        rest = len(below) - MAX_PICTURE_ROW
+        href = url_for("taxonomy.taxonomy", root=shorten(iri))
+        row.append(diagram.Box("more", f"{rest} more", f"{rest} more: the tree below", href, "more"))
+        edges.append(diagram.Edge("more", iri))
+    for part in parts[:MAX_PICTURE_ROW]:  # beside the subclasses, reached by dashed arrows down
+        key = "part:" + part["iri"]
+        row.append(diagram.Box(key, display_text(part["iri"]), part["iri"], concept_url(part["iri"]), "part"))
+        edges.append(diagram.Edge(iri, key, local_name(part["property"]), dashed=True))
+    if row:
+        rows.append(row)
+    noun = "class" if found.kinds.get(iri) == "class" else "property"
+    what = f"{len(distance)} ancestors, {len(below)} direct sub{noun}{'es' if noun == 'class' else 'ies'}"
+    return diagram.layered(rows, edges, f"{display_text(iri)} in the taxonomy", f"{what} and {len(parts)} parts")
 
 
 def _undeclared(kb: KnowledgeBase, found: Taxonomy, iri: str, triples: list[dict[str, Any]]) -> Page:
