@@ -93,3 +93,17 @@ def test_a_new_advertisement_shows_in_the_usage_of_its_concepts(kb: KnowledgeBas
     tracker = next(u for u in after["advertisements"] if u["iri"] == LAB + "Tracker")
     assert tracker["label"] == "lab tracker" and tracker["roles"] == ["output"]
     assert after["uses"] == before["uses"] + 1
+
+
+def test_the_overview_counts_follow_a_write(kb: KnowledgeBase, tmp_path: Path) -> None:
+    client = client_of(kb)
+    before = client.get("/index.json").get_json()
+    assert client.get("/index.json").get_json()["counts"] == before["counts"]
+    path = tmp_path / "tracker.ttl"
+    path.write_text(AD, encoding="utf-8")
+    kb.load([path])
+    after = client.get("/index.json").get_json()
+    assert after["counts"]["services"] == before["counts"]["services"] + 1
+    assert after["counts"]["triples"] > before["counts"]["triples"]
+    services = {g["name"]: g["triples"] for g in after["graphs"]}
+    assert services["graph:services"] > {g["name"]: g["triples"] for g in before["graphs"]}["graph:services"]

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 from flask import Blueprint
 
+from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import GraphName, shorten
-from cbrs.web import context
+from cbrs.web import context, services
 from cbrs.web.pages import Page, page
 
 blueprint = Blueprint("overview", __name__)
@@ -14,18 +17,25 @@ blueprint = Blueprint("overview", __name__)
 @page(blueprint, "/")
 def overview() -> Page:
     kb = context.kb()
-    statistics = kb.statistics()
-    graphs = [
-        {"graph": graph.iri, "name": shorten(graph.iri), "triples": statistics.get(graph.iri, 0)} for graph in GraphName
-    ]
-    counts = {
-        "services": len(kb.select("advertisements")),
-        "requirements": len(kb.select("requirements")),
-        "actions": len({row["action"].value for row in kb.select("actions")}),
-        "triples": sum(statistics.values()),
-    }
+    graphs, counts = context.per_generation("overview", lambda: _store_at_a_glance(kb))
     return Page(
         "overview.html",
         "Overview",
         {"store": kb.store.location, "graphs": graphs, "counts": counts, "events": context.events().recent()},
     )
+
+
+def _store_at_a_glance(kb: KnowledgeBase) -> tuple[list[dict[str, Any]], dict[str, int]]:
+    """Triples per named graph and the counts of descriptions, once per store generation: the first
+    page a user opens took 0.5 s on OWLS-TC, counting 1,136 advertisements each time."""
+    statistics = kb.statistics()
+    graphs = [
+        {"graph": graph.iri, "name": shorten(graph.iri), "triples": statistics.get(graph.iri, 0)} for graph in GraphName
+    ]
+    counts = {
+        "services": len(services.advertisement_rows(kb)),
+        "requirements": len(services.requirement_rows(kb)),
+        "actions": len({row["action"].value for row in kb.select("actions")}),
+        "triples": sum(statistics.values()),
+    }
+    return graphs, counts
