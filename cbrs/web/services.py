@@ -67,7 +67,29 @@ def service() -> Page:
         data["match"] = url_for(MATCH_ENDPOINT, requirement=iri) if match else None
     elif isinstance(description, Advertisement):
         data["requirements"] = _requirements_for(kb, description) if match else []
+        data["similar"] = _similar_url(data) if match else None
     return Page("service.html", shorten(iri), data)
+
+
+def _similar_url(description: dict[str, Any]) -> str | None:
+    """The matchmaking page asked for what this advertisement offers, written as a requirement: its
+    inputs, outputs, preconditions and effects. It ranks the services like this one, itself first; before,
+    a service page could only rank the stored requirements."""
+
+    def statements(key: str) -> str:
+        return "\n".join(" ".join(shorten(s[k]) for k in ("subject", "predicate", "object")) for s in description[key])
+
+    asked = {
+        "inputs": " ".join(shorten(p["type"]) for p in description["inputs"]),
+        "outputs": " ".join(shorten(p["type"]) for p in description["outputs"]),
+        "preconditions": statements("preconditions"),
+        "effects": statements("effects"),
+        "deletes": statements("deletes"),
+    }
+    if not (asked["outputs"] or asked["effects"] or asked["deletes"]):  # nothing a requirement could ask for
+        return None
+    values: dict[str, Any] = {k: v for k, v in asked.items() if v}
+    return url_for(MATCH_ENDPOINT, **values)
 
 
 def _split(term: Term | None) -> list[str]:
