@@ -32,11 +32,15 @@ class ComponentRegistry:
         self._standard_terms = standard_terms or StandardTerms(store)  # graph:entailed kept up to date
 
     def register(self, turtle: str | bytes, source: str = "<registration>") -> list[str]:
-        """Add the advertisements described in ``turtle``; refuses any that already exist."""
+        """Add the advertisements described in ``turtle``; refuses any that already exist, in graph:services
+        or in another graph (:class:`OutsideRegistryError`: ``cbrs load`` of a file that declares classes
+        puts its descriptions into graph:ontology), where a second description would be read merged
+        with the first (two OWLS models' inputs and outputs, both QoS values), before anything is written."""
         quads, iris = self._parse(turtle, source)
         for iri in iris:
             if self._types(iri):  # an advertisement, or another resource of the graph (a device) by that IRI
                 raise AlreadyRegisteredError(iri)
+            self._refuse_elsewhere(iri)
         before = self._standard_terms.begin()
         self._store.add(quads)
         self._standard_terms.changed(before, [], quads)
@@ -67,13 +71,17 @@ class ComponentRegistry:
                 continue
             if self._types(iri):
                 raise AlreadyRegisteredError(iri)  # a device of graph:services by that IRI: not the file's to replace
-            missing = self._not_found(iri)
-            if isinstance(missing, OutsideRegistryError):
-                raise missing
+            self._refuse_elsewhere(iri)
             added.append(iri)
         updated = [iri for iri in iris if iri not in added]
         self._write(quads, updated)
         return added, updated
+
+    def _refuse_elsewhere(self, iri: str) -> None:
+        """Raise :class:`OutsideRegistryError` when another graph holds an advertisement by ``iri``."""
+        missing = self._not_found(iri)
+        if isinstance(missing, OutsideRegistryError):
+            raise missing
 
     def _write(self, quads: list[ox.Quad], registered: list[str]) -> None:
         """Replace what the ``registered`` advertisements own with ``quads`` in one store transaction, and
