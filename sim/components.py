@@ -71,6 +71,9 @@ from cbrs.sim.world import HomeWorld
 __all__ = ["GraspChoice", "GraspPlan", "SimContext", "SimEnvironment", "designator", "implementations", "simulated"]
 
 HOME = PREFIXES["home"]
+ACT = PREFIXES["act"]
+TAKING = frozenset({ACT + "ApproachToObject", ACT + "HandingOverOntoPlatform"})
+"""The actions with which an arm takes an object: a hold starts."""
 LOCALISATION_TOLERANCE = 0.10
 """A localisation is believed (isLocalisedIn holds) when it agrees with the base's odometry within this
 distance (m)."""
@@ -118,6 +121,9 @@ class SimContext:
     designated: frozenset[str] = frozenset()  # the things the running task's inputs name (IRIs)
     acted: bool = False  # a component has run in this world (the checks before a run are done)
     choices: list[GraspChoice] = field(default_factory=list)  # the grasps chosen in this run, in order
+    plan: Plan | None = None  # the plan being run, and the values the task gives its steps (``given``)
+    given: Mapping[str, Any] = field(default_factory=dict)
+    component: str | None = None  # the IRI of the running component
 
     @property
     def map(self) -> SemanticMap:
@@ -201,6 +207,7 @@ class SimComponent(Component):
         self._inputs = inputs
         if self._context is not None:
             self._context.inputs = inputs  # the step's verification grounds its statements in them
+            self._context.component = self.iri
 
     def update(self) -> Status:
         assert self._context is not None
@@ -370,12 +377,8 @@ def approach(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[st
     x, y, _ = estimate.position
     ctx.arm = _free_arm(ctx, x, y, f"the {model.name}")
     spec = ctx.world.arm_specs[ctx.arm]
-    if len(model.preference) > 1:  # where it goes is a later step's: the first approach it can be taken by
-        side = ctx.arm
-        taking = _Candidates.of(model, lambda held: skills.can_take(ctx.world, estimate, side, held))
-        if not taking.models:
-            raise SkillFailed(taking.refusal())
-        choice = taking.choice(side, taking.models[0], f"taking the {model.name}")
+    if len(model.preference) > 1:
+        choice = _taking(ctx, estimate, model, ctx.arm)
         _note(ctx, choice)
         model = choice.model
     ctx.grasp = compute_grasp_pose(model, estimate.position, estimate.yaw, spec.mount, spec.yaw, _extent(estimate))
@@ -383,6 +386,75 @@ def approach(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[st
     ctx.last_arm = ctx.arm
     _check(skills.approach_object(ctx.world, ctx.arm, ctx.grasp))
     return {}
+
+
+def _taking(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, side: ArmSide) -> GraspChoice:
+    """The approach ``side`` takes the object by, of several: the first it can take it by where it is and
+    let it go by where the hold ends, when that is known here (:func:`_hold_end`: a later carry of the
+    plan to a place the task gives), else the first it can take it by. Letting go is asked as the carry
+    will (:func:`_holdable`): over the spots of the place this arm reaches, nearest the centre first. An
+    arm that can let it go there by no approach takes it by the first it can, as where it is not known:
+    the carry passes it to the other arm."""
+    world, name = ctx.world, model.name
+
+    def take(held: ObjectModel) -> str:
+        return skills.can_take(world, estimate, side, held)
+
+    taking = _Candidates.of(model, take)
+    if not taking.models:
+        raise SkillFailed(taking.refusal())
+    end = _hold_end(ctx, name)
+    if end is None:
+        return taking.choice(side, taking.models[0], f"taking the {name}")
+    place, surface, spots = end
+
+    def letting_go(held: ObjectModel) -> str:
+        tried = spots[:RELAY_TRIES]
+        if any(not skills.can_set_down(world, estimate, side, held, _spot_region(surface, *at)) for at in tried):
+            return ""
+        spots_of = "the one spot" if len(tried) == 1 else f"any of the {len(tried)} spots"
+        where = f"{spots_of} of {place.name} it reaches" if tried else f"{place.name} (no spot in reach)"
+        return f"the {side.value} arm cannot hold the {name} by its {held.grasp.value} grasp over {where}"
+
+    both = _Candidates.of(model, take, letting_go)
+    if both.models:
+        return both.choice(side, both.models[0], f"taking the {name} to {place.name}")
+    unplaced = "; ".join(why for _, why in both.ruled_out)
+    return taking.choice(side, taking.models[0], f"taking the {name} (to {place.name}, to be passed on: {unplaced})")
+
+
+def _hold_end(ctx: SimContext, name: str) -> tuple[Thing, Region, list[tuple[float, float]]] | None:
+    """Where the hold the running component starts ends, when the plan and the task say: the place
+    given by the task to the first carry after the running step (the plan's one step of this component:
+    nothing else says which step runs), before any other step of its robot takes an object; and that
+    place's surface and spots (:func:`_place_spots`) for the arm ``ctx.arm``, as the carry will aim. None
+    when it is not known here (the place is another step's output, or no carry follows)."""
+    plan, iri, smap = ctx.plan, ctx.component, ctx.map
+    if plan is None or iri is None:
+        return None
+    mine = [position for position, step in enumerate(plan.steps) if iri in step.candidates]
+    if len(mine) != 1:
+        return None
+    device = plan.steps[mine[0]].device
+    for step in plan.steps[mine[0] + 1 :]:
+        if step.device != device:
+            continue
+        if step.action in TAKING:
+            return None  # another hold starts first
+        if step.action != ACT + "CarryingWhileLocomoting":
+            continue
+        values = [ctx.given.get(b.source.name) for b in step.inputs if b.source.step is None]
+        iris = [str(value["@id"]) for value in values if isinstance(value, dict) and "@id" in value]
+        places = [iri for iri in iris if iri in smap.regions or iri in smap.furniture]
+        if len(places) != 1:
+            return None
+        place = smap.things[places[0]]
+        spec = ctx.world.arm_specs[ctx.arm]
+        others = _others(ctx.world, ctx.belief, name)
+        size = ctx.world.objects[name].size if name in ctx.world.objects else (0.0, 0.0, 0.0)
+        surface, spots = _place_spots(smap, place, size, [(spec.mount[0], spec.mount[1], spec.reach)], others)
+        return place, surface, spots
+    return None
 
 
 def pick_up(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
@@ -1187,6 +1259,7 @@ class SimEnvironment:
                         iri = designate(self.kb, parameter.type, prefer=requirement.requested_by)
                         values[source.name] = designator(iri, parameter.type)
         self.context.designated = frozenset(str(value["@id"]) for value in values.values())
+        self.context.plan, self.context.given = plan, values  # where a hold ends, for the approach
         if not self.context.acted:  # checked before anything moved; a re-plan fails by its steps
             self._check_reach(plan, values)
             self._check_loading(plan, values)
