@@ -11,6 +11,8 @@ from pathlib import Path
 
 import pytest
 
+from cbrs.actions.composer import Composer
+from cbrs.actions.runner import run_task
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
 from cbrs.sim import skills
@@ -190,3 +192,41 @@ def test_a_box_allowed_only_an_approach_too_wide_for_the_jaws_is_refused_before_
     assert refused.value.width == pytest.approx(0.16, abs=0.01)
     for side in ArmSide:
         assert after[side] == pytest.approx(before[side], abs=1e-3)
+
+
+PUT_CARTON_ON_TRAY = """@prefix cbrs: <https://w3id.org/cbrs/core#> . @prefix home: <https://w3id.org/cbrs/home#> .
+@prefix req: <https://w3id.org/cbrs/requirement#> . @prefix svc: <https://w3id.org/cbrs/service#> .
+req:PutCartonOnTray a cbrs:Requirement ; cbrs:requestedBy svc:CytonDualArm01 ; cbrs:deviceName "CytonDualArm01" ;
+    cbrs:serviceName "PutCartonOnTray" ;
+    cbrs:hasOWLSModel [ a cbrs:OWLSModel ;
+        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "carton" ; cbrs:parameterType home:Carton ] ;
+        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "place" ; cbrs:parameterType home:ObjectPlace ] ;
+        cbrs:hasEffect [ a cbrs:Effect ; cbrs:conditionSubject home:Carton ; cbrs:conditionPredicate home:isLocated ;
+            cbrs:conditionObject home:ObjectPlace ] ] .
+"""
+TRAY = """@prefix home: <https://w3id.org/cbrs/home#> . @prefix world: <https://w3id.org/cbrs/world#> .
+world:TrayPlace a home:ObjectPlace ;
+    home:minX 7.25 ; home:maxX 7.40 ; home:minY 3.10 ; home:maxY 3.25 ; home:minZ 0.75 ; home:maxZ 0.75 .
+"""
+
+
+@pytest.mark.parametrize("approaches", ["side", "side top"])
+def test_a_task_on_a_box_too_wide_for_its_side_grasp_says_so(tmp_path: Path, approaches: str) -> None:
+    """Allowed only its side grasp, the box lying across the arms' facing stops the run at the approach
+    with the width, nothing moved (it was "no collision-free joint path"); allowed "side top", it is
+    carried to the tray from the top."""
+    carton = carton_in_the_map(approaches, 0.16, 0.04)
+    kb = knowledge(tmp_path, ("map", carton), ("map", TRAY), ("requirements", PUT_CARTON_ON_TRAY))
+    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
+        start = world.pose("Carton1").position
+        result = run_task(kb, "PutCartonOnTray", SimEnvironment(world, kb), composer=Composer(kb))
+        end = world.pose("Carton1").position
+    facts = {(r["thing"].value, r["relation"].value, r["other"].value) for r in kb.select("world_facts")}
+    on_the_tray = (WORLD + "Carton1", HOME + "isLocated", WORLD + "TrayPlace") in facts
+    if approaches == "side":
+        assert not result.succeeded and not on_the_tray
+        assert re.search(r"the Carton1 is 1[56]\.\d cm wide across the jaws by its side grasp", result.stopped)
+        assert end == pytest.approx(start, abs=0.002)
+    else:
+        assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
+        assert on_the_tray and not result.replans
