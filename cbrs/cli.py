@@ -346,11 +346,13 @@ _UPDATE_START = re.compile(
     "--update",
     is_flag=True,
     help="Bring the store in line with FILE: replace the descriptions of its advertisements already "
-    "registered and register the others (one transaction).",
+    "registered and register the others (one transaction). An OWL-S FILE is converted as cbrs load "
+    "converts it, and replaces what an earlier load of it gave.",
 )
 @pass_app
 def register(app: App, file: Path, update: bool) -> None:
-    """Register the advertisements in a Turtle FILE (checked first; one transaction)."""
+    """Register the advertisements in a Turtle FILE (or RDF/XML, JSON-LD, N-Triples; checked first; one
+    transaction)."""
     text = file.read_bytes()
     if update:
         added, updated = app.kb.registry.sync(text, str(file))

@@ -217,6 +217,47 @@ def load_files(
     imported: list[_Raw] = []
     if catalogue is not None:
         imported = _resolve_imports(store, raws, catalogue, report)
+    _prepare(store, raws, imported, report, graph)
+    if isinstance(store, EmbeddedStore):
+        new = _new_quads(store, report)
+        if new:  # a reload of what the store holds writes nothing, and leaves its generation as it was
+            store.add(new)
+        return report
+    items = (*report.files, *report.imports)
+    graphs = sorted({_graph_of(quad, item.graph) for item in items for quad in item.quads})
+    sizes = {graph: store.count(ox.NamedNode(graph)) for graph in graphs}
+    store.add(quad for item in items for quad in item.quads)
+    report.added = {graph: store.count(ox.NamedNode(graph)) - size for graph, size in sizes.items()}
+    return report
+
+
+def prepare_owls(store: Store, raw: bytes, source: str, rdf_format: ox.RdfFormat, base_iri: str) -> ParsedFile:
+    """One OWL-S file given in memory, parsed, converted into advertisements for graph:services and
+    checked as :func:`load_files` checks it, but not written: what the registry puts in place of the
+    advertisements an earlier version of the file gave (``cbrs register --update FILE``), in one
+    transaction. Unlike a load it does not refuse a service the store holds already (replacing it is
+    the point): the caller decides which services it replaces."""
+    data = _as_utf8(raw, source)
+    quads, prefixes, repairs = _parse_quads(data, source, rdf_format, base_iri)
+    if not is_owls(quads):
+        raise RdfParseError(source, "describes no OWL-S service or profile")
+    target = GraphName.SERVICES.node
+    report = LoadReport()
+    _prepare(store, [_Raw(source, target, _into(quads, target), True, prefixes, repairs)], [], report, None, False)
+    return report.files[0]
+
+
+def _prepare(
+    store: Store,
+    raws: list[_Raw],
+    imported: list[_Raw],
+    report: LoadReport,
+    graph: str | GraphName | None,
+    refuse_merges: bool = True,
+) -> None:
+    """Convert the OWL-S files among ``raws``, skolemise everything, and check it all against the store
+    (part cycles, shapes, and with ``refuse_merges`` an OWL-S service the store holds described
+    otherwise): what a load does before it writes, filling ``report``'s files and imports."""
     ontology = GraphName.ONTOLOGY.node
     vocabulary: Vocabulary | None = None
     if any(raw.is_owls for raw in raws):
@@ -235,7 +276,7 @@ def load_files(
         parsed = ParsedFile(
             raw.source, raw.target.value, skolemise(raw.quads, raw.source), conversion, repairs=raw.repairs
         )
-        if conversion is not None:
+        if conversion is not None and refuse_merges:
             _check_not_merged(store, parsed)
         report.files.append(parsed)
     report.imports = [
@@ -246,17 +287,6 @@ def load_files(
     ]
     _check_part_cycles(store, [*raws, *imported])
     check_loaded(store, report)  # descriptions against the SHACL shapes, and their terms (kb/shapes.py)
-    if isinstance(store, EmbeddedStore):
-        new = _new_quads(store, report)
-        if new:  # a reload of what the store holds writes nothing, and leaves its generation as it was
-            store.add(new)
-        return report
-    items = (*report.files, *report.imports)
-    graphs = sorted({_graph_of(quad, item.graph) for item in items for quad in item.quads})
-    sizes = {graph: store.count(ox.NamedNode(graph)) for graph in graphs}
-    store.add(quad for item in items for quad in item.quads)
-    report.added = {graph: store.count(ox.NamedNode(graph)) - size for graph, size in sizes.items()}
-    return report
 
 
 def _new_quads(store: EmbeddedStore, report: LoadReport) -> list[ox.Quad]:
@@ -388,10 +418,13 @@ def _check_not_merged(store: Store, parsed: ParsedFile) -> None:
             continue
         if all(store.contains(q) for q in parsed.quads):
             continue
+        # the advice first: the parser errors' one-line form keeps 240 characters, and OWL-S IRIs are long
+        advice = "cbrs deregister IRI first, or give the new one another IRI"
+        if parsed.graph == GraphName.SERVICES.iri:  # an advertisement: the registry replaces it in one transaction
+            advice = f"cbrs register --update FILE replaces it (or {advice})"
         raise RdfParseError(
             parsed.source,
-            f"<{converted.iri}> is already in the store, described differently; loading this file would merge "
-            "two descriptions into one. Deregister it first (cbrs deregister IRI), or give the new one another IRI",
+            f"<{converted.iri}> is already in the store, described differently; a load would merge the two: {advice}",
         )
 
 

@@ -10,6 +10,8 @@ by walking the file's nodes from the advertisement, keeping what another descrip
 
 from __future__ import annotations
 
+from collections.abc import Iterable
+
 import pyoxigraph as ox
 
 from cbrs.kb.namespaces import OWL, RDF
@@ -30,18 +32,34 @@ class GraphReads:
         self.graph = graph
         self._out: dict[ox.NamedNode, list[ox.Quad]] = {}
         self._into: dict[ox.NamedNode, list[ox.Quad]] = {}
+        self._gone: set[ox.Quad] = set()
 
     def out(self, node: ox.NamedNode) -> list[ox.Quad]:
         """The quads whose subject is ``node``."""
         if node not in self._out:
-            self._out[node] = list(self.store.quads(node, None, None, self.graph))
+            self._out[node] = self._kept(self.store.quads(node, None, None, self.graph))
         return self._out[node]
 
     def into(self, node: ox.NamedNode) -> list[ox.Quad]:
         """The quads whose object is ``node``."""
         if node not in self._into:
-            self._into[node] = list(self.store.quads(None, None, node, self.graph))
+            self._into[node] = self._kept(self.store.quads(None, None, node, self.graph))
         return self._into[node]
+
+    def with_predicate(self, predicate: ox.NamedNode) -> list[ox.Quad]:
+        """The quads of the graph with ``predicate`` (not kept: read once per deregistration)."""
+        return self._kept(self.store.quads(None, predicate, None, self.graph))
+
+    def drop(self, quads: Iterable[ox.Quad]) -> None:
+        """Read the graph from now on as if ``quads`` were gone: how deregistering several descriptions one
+        after the other reads it, when they are replaced in one transaction (:meth:`ComponentRegistry.sync`)."""
+        self._gone.update(quads)
+        for cache in (self._out, self._into):
+            for node, found in cache.items():
+                cache[node] = self._kept(found)
+
+    def _kept(self, quads: Iterable[ox.Quad]) -> list[ox.Quad]:
+        return [q for q in quads if q not in self._gone] if self._gone else list(quads)
 
 
 def owls_services(root: ox.NamedNode, lookup: GraphReads) -> list[ox.NamedNode]:
@@ -112,7 +130,7 @@ def _more_of_file(root: ox.NamedNode, document: str, lookup: GraphReads, own: se
     pass over the models' links; a scan of the graph's subjects for the prefix took 140 ms on OWLS-TC."""
     model = ox.NamedNode(CBRS.hasOWLSModel)
     digests = {skolem_digest(q.object) for q in lookup.out(root) if q.predicate == model} - {None}
-    for quad in lookup.store.quads(None, model, None, lookup.graph):
+    for quad in lookup.with_predicate(model):
         if quad.subject in own:
             continue
         if quad.subject.value.startswith(document + "#") or skolem_digest(quad.object) in digests:  # type: ignore[union-attr]

@@ -10,7 +10,7 @@ import pyoxigraph as ox
 
 from cbrs.kb.conditions import CONDITION_PARTS, LEGACY_PARTS
 from cbrs.kb.errors import AlreadyRegisteredError, InvalidDescriptionError, NotFoundError, OutsideRegistryError
-from cbrs.kb.loader import parse_bytes, registration_format
+from cbrs.kb.loader import parse_bytes, prepare_owls, registration_format
 from cbrs.kb.namespaces import BASE, RDF, RDFS, GraphName, shorten
 from cbrs.kb.owls import is_owls, is_owls_service
 from cbrs.kb.owls_source import GraphReads, owls_services, owls_source
@@ -63,8 +63,13 @@ class ComponentRegistry:
         A file of two advertisements one of which was deregistered could be neither registered again
         (the other is registered) nor updated (one is not). What :meth:`register` refuses (another
         resource by an advertisement's IRI) and :meth:`update` refuses (an advertisement held in another
-        graph, which this would register a second time) is refused here too, before anything is written."""
-        quads, iris = self._parse(turtle, source)
+        graph, which this would register a second time) is refused here too, before anything is written.
+
+        An OWL-S file is converted as ``cbrs load`` converts it (:func:`kb.loader.prepare_owls`), and what
+        an earlier load of it gave its registered services (:meth:`owned_quads`, OWL-S triples included)
+        is replaced by what it gives now: what ``cbrs deregister`` of each and ``cbrs load FILE`` did in
+        several transactions, of which a failed load left the services deregistered."""
+        quads, iris = self._parse(turtle, source, owls=True)
         added = []
         for iri in iris:
             if self.is_registered(iri):
@@ -85,10 +90,15 @@ class ComponentRegistry:
 
     def _write(self, quads: list[ox.Quad], registered: list[str]) -> None:
         """Replace what the ``registered`` advertisements own with ``quads`` in one store transaction, and
-        bring graph:entailed up to date."""
+        bring graph:entailed up to date. What they own is read as deregistering them one after the other
+        would remove it: a node only they share (a QoS model, an OWL-S file's header) goes with the last,
+        and comes back as ``quads`` give it now; read for each alone, it stayed, beside its new values."""
+        lookup = GraphReads(self._store, self._graph)
         old: list[ox.Quad] = []
         for iri in registered:
-            old.extend(self.owned_quads(iri))
+            owned = self._owned(iri, lookup)
+            lookup.drop(owned)
+            old.extend(owned)
         new, kept = set(quads), set(old)
         before = self._standard_terms.begin()
         self._store.replace([q for q in old if q not in new], [q for q in quads if q not in kept])
@@ -164,7 +174,9 @@ class ComponentRegistry:
         ``cbrs load`` made from OWL-S, the OWL-S triples of its service as well (:func:`kb.owls_source.owls_source`),
         so that deregistering leaves the store as it was before the load. Each node's triples are read
         from the store once (a remote store answers each read with a request)."""
-        lookup = GraphReads(self._store, graph or self._graph)
+        return self._owned(iri, GraphReads(self._store, graph or self._graph))
+
+    def _owned(self, iri: str, lookup: GraphReads) -> list[ox.Quad]:
         root = ox.NamedNode(iri)
         services = owls_services(root, lookup)
         if not services:
@@ -190,32 +202,38 @@ class ComponentRegistry:
         if not loaded:
             return ""
         file = source if not source.startswith("<") else "FILE"
-        steps = "; ".join(f"cbrs deregister {shorten(iri)}" for iri in loaded)
         return (
-            f"; {_count(len(loaded), 'of its services is', 'of its services are')} loaded already: to bring the "
-            f"store in line with the file, {steps}; then cbrs load {file}"
+            f"; {_count(len(loaded), 'of its services is', 'of its services are')} loaded already "
+            f"({', '.join(shorten(iri) for iri in loaded)}): cbrs register --update {file} replaces "
+            f"{'it' if len(loaded) == 1 else 'them'} and registers the others, in one transaction"
         )
 
-    def _parse(self, turtle: str | bytes, source: str) -> tuple[list[ox.Quad], list[str]]:
+    def _parse(self, turtle: str | bytes, source: str, owls: bool = False) -> tuple[list[ox.Quad], list[str]]:
+        """The input's quads, checked, and its advertisements' IRIs; with ``owls``, an OWL-S input is
+        converted into advertisements (:func:`kb.loader.prepare_owls`) instead of refused."""
         try:
-            return self._parse_checked(turtle, source)
+            return self._parse_checked(turtle, source, owls)
         except InvalidDescriptionError as error:
             if error.iri != source and not source.startswith("<") and Path(source).is_file():
                 line = line_of(source, error.iri)  # a file of many descriptions: where this one is
                 error.args = (f"{source}{f':{line}' if line else ''}: {error.args[0]}",)
             raise
 
-    def _parse_checked(self, turtle: str | bytes, source: str) -> tuple[list[ox.Quad], list[str]]:
+    def _parse_checked(self, turtle: str | bytes, source: str, owls: bool) -> tuple[list[ox.Quad], list[str]]:
         raw = turtle.encode("utf-8") if isinstance(turtle, str) else turtle
         rdf_format = registration_format(source, raw)  # Turtle, unless the file's name or XML head says otherwise
         parsed = parse_bytes(raw, source, rdf_format, graph=GraphName.SERVICES, base_iri=_base(source))
+        if is_owls(parsed.quads) and owls:
+            converted = prepare_owls(self._store, raw, source, rdf_format, _base(source))
+            assert converted.owls is not None
+            return converted.quads, sorted({service.iri for service in converted.owls.services})
         if is_owls(parsed.quads):
             raise InvalidDescriptionError(
                 source,
                 [
-                    "it is an OWL-S description, which registration does not convert: load it with "
-                    "cbrs load (kb.load), which turns each OWL-S service into an advertisement"
-                    + self._loaded_already(parsed.quads, source)
+                    "it is an OWL-S description, which registration converts only as an update (cbrs register "
+                    "--update, kb.registry.sync): load it with cbrs load (kb.load), which turns each OWL-S service "
+                    "into an advertisement" + self._loaded_already(parsed.quads, source)
                 ],
             )
         elsewhere = sorted({str(q.graph_name) for q in parsed.quads if q.graph_name != GraphName.SERVICES.node})

@@ -214,7 +214,7 @@ def test_an_update_in_turtle_replaces_the_owls_source_too(kb: KnowledgeBase) -> 
 
 
 def test_an_edited_file_loads_after_the_old_one_is_deregistered(kb: KnowledgeBase, tmp_path: Path) -> None:
-    """What the refusal to merge says to do ("Deregister it first") gives the store of the edited file
+    """What the refusal to merge says to do ("cbrs deregister IRI first") gives the store of the edited file
     alone; before, the old profile, process and parameters stayed and merged with the new ones."""
     edited = tmp_path / "navigate.owls"
     text = (OWLS / "services" / "navigate.owls").read_text(encoding="utf-8")
@@ -225,7 +225,7 @@ def test_an_edited_file_loads_after_the_old_one_is_deregistered(kb: KnowledgeBas
     kb.registry.deregister(NAVIGATE)
     assert triples_by_graph(kb) == before
     kb.load([OWLS / "services" / "navigate.owls"], catalogue=CATALOG)
-    with pytest.raises(RdfParseError, match="Deregister it first"):
+    with pytest.raises(RdfParseError, match="cbrs deregister IRI first"):
         kb.load([edited], catalogue=CATALOG)
     kb.registry.deregister(NAVIGATE)
     kb.load([edited], catalogue=CATALOG)

@@ -4,7 +4,8 @@ instead") and ``cbrs register --update FILE`` refused it too (the deregistered o
 the only way was to deregister the other and register the file again, in two transactions.
 ``kb.registry.sync`` (``cbrs register --update``) registers what is new and replaces what is registered,
 in one transaction; what it refuses leaves the store as it was. An OWL-S file (``cbrs load``) is not
-registered: the refusal names the commands that bring the store in line with it.
+registered as a sync only: the refusals name ``cbrs register --update FILE``, which brings the store in
+line with it in one transaction (tests/test_register_update_owls.py).
 
 Every test compares the store's triples graph by graph, on the embedded and the remote store."""
 
@@ -142,24 +143,40 @@ def test_the_command_says_which_it_registered_and_which_it_updated(tmp_path: Pat
     assert run("query", "SELECT (COUNT(*) AS ?n) WHERE { GRAPH ?g { ?s ?p ?o } }", store=location) == before
 
 
-def test_an_owls_file_names_the_commands_that_bring_the_store_in_line(kb: KnowledgeBase, tmp_path: Path) -> None:
+def test_an_owls_file_is_brought_in_line_by_one_command(kb: KnowledgeBase, tmp_path: Path) -> None:
     """``cbrs load`` of the file again is refused (the file's triples are not all stored: the merge check),
-    and registration does not convert OWL-S: the refusal names the deregistration of the service that
-    stayed and the load, and following it gives the store of the file loaded once."""
+    and so are registering and updating it (registration converts OWL-S only as a sync): each refusal
+    names ``cbrs register --update FILE``, and following it gives the store of the file loaded once
+    (tests/test_register_update_owls.py has the rest)."""
     pair = _file(tmp_path, _pair(), "pair.owls")
     kb.load([pair])
     loaded = triples_by_graph(kb)
     kb.registry.deregister(LAB + "A")
     partial = triples_by_graph(kb)
-    with pytest.raises(RdfParseError, match="Deregister it first"):
+    with pytest.raises(RdfParseError, match="cbrs register --update FILE replaces it"):
         kb.load([pair])
-    for attempt in (kb.registry.sync, kb.registry.update, kb.registry.register):
-        with pytest.raises(InvalidDescriptionError) as caught:
+    for attempt in (kb.registry.update, kb.registry.register):
+        with pytest.raises(InvalidDescriptionError, match=f"cbrs register --update {pair} replaces it"):
             attempt(pair.read_bytes(), str(pair))
-        message = str(caught.value)
-        assert "1 of its services is loaded already: to bring the store in line with the file, " in message
-        assert message.endswith(f"cbrs deregister {LAB}B; then cbrs load {pair}")
     assert triples_by_graph(kb) == partial
-    kb.registry.deregister(LAB + "B")
-    kb.load([pair])
+    assert kb.registry.sync(pair.read_bytes(), str(pair)) == ([LAB + "A"], [LAB + "B"])
     assert triples_by_graph(kb) == loaded
+
+
+def test_a_node_only_the_updated_advertisements_share_takes_its_new_values(kb: KnowledgeBase, tmp_path: Path) -> None:
+    """ex:SharedQoS is both advertisements' QoS model, and the file gives it a new response time. What
+    they own is read as deregistering them one after the other removes it, so the shared node goes with
+    the second and comes back as the file gives it now; read for each alone, it stayed, and the two
+    advertisements had two response times."""
+    _sync(kb, _file(tmp_path))
+    faster = _file(tmp_path, TWO.replace("cbrs:responseTime 0.2", "cbrs:responseTime 0.1"), "faster.ttl")
+    assert _sync(kb, faster) == ([], [EX + "TrackA", EX + "TrackB"])
+    for name in ("TrackA", "TrackB"):
+        assert [q.value for q in kb.description(EX + name).qos] == [0.1]
+    kb.registry.deregister(EX + "TrackA")
+    kb.registry.deregister(EX + "TrackB")
+    registered = triples_by_graph(kb)
+    _sync(kb, faster)
+    kb.registry.deregister(EX + "TrackA")
+    kb.registry.deregister(EX + "TrackB")
+    assert triples_by_graph(kb) == registered
