@@ -119,3 +119,15 @@ def test_hostile_search_texts_are_only_text(client: FlaskClient, bundled_kb: Kno
     page = client.get("/search", query_string={"q": "<script>alert(1)</script>"}).text
     assert "<script>alert(1)" not in page and "&lt;script&gt;alert(1)" in page
     assert bundled_kb.store.dump() == before
+
+
+def test_a_not_found_page_offers_to_search_for_the_name(client: FlaskClient) -> None:
+    missing = client.get("/service", query_string={"iri": "home:RobotPosition"})  # a class, not a service
+    assert missing.status_code == 404
+    assert '<input type="search" id="error-search" name="q" value="RobotPosition"' in missing.text
+    found = client.get("/search.json", query_string={"q": "RobotPosition"}).get_json()
+    assert found["terms"]["matches"][0]["name"] == "home:RobotPosition"
+    gone = client.get("/taxonomy/class", query_string={"iri": "http://example.org/lab#Nothing"})
+    assert gone.status_code == 404 and 'value="Nothing"' in gone.text
+    plain = client.get("/no-such-page", headers={"Accept": "text/html"})
+    assert plain.status_code == 404 and "error-search" not in plain.text
