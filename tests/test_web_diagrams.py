@@ -4,6 +4,7 @@ the JSON twins carry the same facts as lists, without the markup."""
 
 from __future__ import annotations
 
+import itertools
 import re
 import xml.etree.ElementTree as ET
 from html import unescape
@@ -46,11 +47,49 @@ def test_the_class_page_draws_the_class_among_its_ancestors_subclasses_and_parts
     assert {"owl:Thing", "home:SpatialData", "home:Position"} <= set(drawn)  # the path up, and itself
     assert {"home:RobotPosition", "home:Position2D"} <= set(drawn)  # its subclasses
     assert {"home:XCoordinate", "home:YCoordinate", "home:Theta"} <= set(drawn)  # its parts
-    dashed = [line for line in svg.iter(SVG + "line") if line.get("stroke-dasharray")]
+    dashed = [line for line in svg.iter(SVG + "polyline") if line.get("stroke-dasharray")]
     assert len(dashed) == 3  # one dashed arrow per part
+    assert_no_arrow_runs_under_a_box(svg)
     assert drawn["home:Position2D"] == "/taxonomy/class?iri=home:Position2D"
     for href in set(drawn.values()):
         assert client.get(unescape(href)).status_code == 200, href
+
+
+def rectangles(svg: ET.Element) -> list[tuple[float, float, float, float]]:
+    return [
+        (float(r.get("x", 0)), float(r.get("y", 0)), float(r.get("width", 0)), float(r.get("height", 0)))
+        for r in svg.iter(SVG + "rect")
+    ]
+
+
+def crosses(a: tuple[float, float], b: tuple[float, float], box: tuple[float, float, float, float]) -> bool:
+    """Whether the segment a-b passes through the inside of the box (its edges are where arrows end)."""
+    x, y, w, h = box
+    inset = 1.0
+    left, right, top, bottom = x + inset, x + w - inset, y + inset, y + h - inset
+    t0, t1 = 0.0, 1.0
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    for p, q in ((-dx, a[0] - left), (dx, right - a[0]), (-dy, a[1] - top), (dy, bottom - a[1])):
+        if p == 0:
+            if q < 0:
+                return False
+            continue
+        t = q / p
+        if p < 0:
+            t0 = max(t0, t)
+        else:
+            t1 = min(t1, t)
+        if t0 > t1:
+            return False
+    return True
+
+
+def assert_no_arrow_runs_under_a_box(svg: ET.Element) -> None:
+    boxes_drawn = rectangles(svg)
+    for line in svg.iter(SVG + "polyline"):
+        points = [tuple(map(float, p.split(","))) for p in line.get("points", "").split()]
+        for a, b in itertools.pairwise(points):
+            assert not any(crosses(a, b, box) for box in boxes_drawn), (a, b)  # type: ignore[arg-type]
 
 
 def test_the_twin_has_no_picture(client: FlaskClient) -> None:
@@ -81,7 +120,8 @@ def test_the_plan_page_draws_the_data_flow(client: FlaskClient) -> None:
         assert f'id="{href[1:]}"' in page  # each box opens its row of the table
     # one arrow per input, precondition and goal
     bindings = sum(len(s["inputs"]) + len(s["preconditions"]) for s in steps) + len(body["composition"]["goals"])
-    assert len(list(svg.iter(SVG + "line"))) == bindings
+    assert len(list(svg.iter(SVG + "polyline"))) == bindings
+    assert_no_arrow_runs_under_a_box(svg)
     # a step is drawn below every step it takes something from
     y = {a.get("href"): float(next(a.iter(SVG + "rect")).get("y", "0")) for a in svg.iter(SVG + "a")}
     for step in steps:
@@ -92,6 +132,18 @@ def test_the_plan_page_draws_the_data_flow(client: FlaskClient) -> None:
 
 def test_a_composition_without_steps_draws_nothing() -> None:
     assert _flow({"task": "urn:x", "steps": [], "goals": [], "unsatisfied": [{"text": "x"}]}) is None
+
+
+def test_an_arrow_that_spans_rows_bends_past_the_boxes_between() -> None:
+    rows = [[diagram.Box("top", "top", "t")], [diagram.Box(f"m{i}", f"middle {i}", "t") for i in range(3)]]
+    rows.append([diagram.Box("bottom", "bottom", "t")])
+    edges = [diagram.Edge("top", f"m{i}") for i in range(3)] + [diagram.Edge(f"m{i}", "bottom") for i in range(3)]
+    edges.append(diagram.Edge("top", "bottom", "straight down"))
+    svg = ET.fromstring(str(diagram.layered(rows, edges, "t", "d")))
+    long = [p for p in svg.iter(SVG + "polyline") if p.find(SVG + "title").text == "straight down"]  # type: ignore[union-attr]
+    assert len(long) == 1 and len(long[0].get("points", "").split()) == 4  # out, through the slot, in
+    assert len(rectangles(svg)) == 5  # the waypoint is not drawn
+    assert_no_arrow_runs_under_a_box(svg)
 
 
 def test_text_and_links_are_escaped() -> None:

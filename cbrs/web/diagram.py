@@ -6,12 +6,15 @@ had none, and the plan only the planner's search graph. Inline SVG needs no scri
 box is a link (keyboard-focusable), the picture has a title and a description for screen readers, and
 the colours are presentation attributes (the pages' CSP allows no inline styles in elements).
 
-The layout is layered: the caller gives the rows, top to bottom; boxes are ordered within a row by
-where their neighbours in the row above sit (one barycentre sweep), which keeps most edges uncrossed.
+The layout is layered: the caller gives the rows, top to bottom; an arrow that spans rows gets a
+waypoint (a narrow slot) in each row between, so that it bends past the boxes instead of under them;
+boxes and waypoints are ordered within a row by where their neighbours in the row above sit (one
+barycentre sweep), which keeps most arrows uncrossed.
 """
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -73,27 +76,54 @@ def _shown(text: str) -> str:
 LINE_HEIGHT = 14
 
 
-def _width(text: str) -> float:
-    return max(48.0, max(len(_shown(line)) for line in text.split("\n")) * CHAR_WIDTH + 18)
+VIRTUAL = "virtual"  # a waypoint of an edge that spans rows: a slot in each row between, not drawn
+VIRTUAL_WIDTH = 6.0
 
 
-def _centre(box: Box, above: dict[str, int], edges: Sequence[Edge]) -> float:
+def _width(box: Box) -> float:
+    if box.kind == VIRTUAL:
+        return VIRTUAL_WIDTH
+    return max(48.0, max(len(_shown(line)) for line in box.text.split("\n")) * CHAR_WIDTH + 18)
+
+
+def _centre(box: Box, above: dict[str, int], links: Sequence[tuple[str, str]]) -> float:
     """The mean position of the box's neighbours in the row above (past its end when it has none)."""
-    linked = [above[e.source] for e in edges if e.target == box.key and e.source in above]
-    linked += [above[e.target] for e in edges if e.source == box.key and e.target in above]
+    linked = [above[a] for a, b in links if b == box.key and a in above]
+    linked += [above[b] for a, b in links if a == box.key and b in above]
     return sum(linked) / len(linked) if linked else float(len(above))
 
 
-def _ordered(rows: Sequence[Sequence[Box]], edges: Sequence[Edge]) -> list[list[Box]]:
+def _ordered(rows: Sequence[Sequence[Box]], links: Sequence[tuple[str, str]]) -> list[list[Box]]:
     """Each row after the first sorted by the mean position of its boxes' neighbours in the row above."""
     ordered = [list(rows[0])] if rows else []
     for row in rows[1:]:
         above = {box.key: i for i, box in enumerate(ordered[-1])}
-
         fixed = [b for b in row if b.kind in ("more", "part")]  # "N more" and parts stay at the end
         movable = [b for b in row if b not in fixed]
-        ordered.append(sorted(movable, key=lambda box: _centre(box, above, edges)) + fixed)
+        ordered.append(sorted(movable, key=lambda box: _centre(box, above, links)) + fixed)
     return ordered
+
+
+def _routed(
+    rows: Sequence[Sequence[Box]], edges: Sequence[Edge]
+) -> tuple[list[list[Box]], list[tuple[Edge, list[str]]]]:
+    """The rows with a waypoint in every row an edge passes, and each edge's keys from end to end: an
+    arrow that spans rows bends through its waypoints instead of running under the boxes between."""
+    row_of = {box.key: depth for depth, row in enumerate(rows) for box in row}
+    grown = [list(row) for row in rows]
+    routes = []
+    for number, edge in enumerate(edges):
+        if edge.source not in row_of or edge.target not in row_of:
+            continue
+        first, last = row_of[edge.source], row_of[edge.target]
+        step = 1 if last > first else -1
+        keys = [edge.source]
+        for depth in range(first + step, last, step) if abs(last - first) > 1 else ():
+            waypoint = Box(f"~{number}-{depth}", "", "", None, VIRTUAL)
+            grown[depth].append(waypoint)
+            keys.append(waypoint.key)
+        routes.append((edge, [*keys, edge.target]))
+    return grown, routes
 
 
 def layered(
@@ -101,17 +131,18 @@ def layered(
 ) -> Markup:
     """The rows of boxes, top to bottom, with the edges between them, as an ``<svg>`` element whose ids
     start with ``ident`` (unique on its page)."""
-    ordered = _ordered(rows, edges)
+    grown, routes = _routed(rows, edges)
+    ordered = _ordered(grown, [pair for _, keys in routes for pair in itertools.pairwise(keys)])
     lines = max((b.text.count("\n") + 1 for row in ordered for b in row), default=1)
     box_height = BOX_HEIGHT + (lines - 1) * LINE_HEIGHT
-    widths = [sum(_width(b.text) for b in row) + BOX_GAP * max(len(row) - 1, 0) for row in ordered]
+    widths = [sum(_width(b) for b in row) + BOX_GAP * max(len(row) - 1, 0) for row in ordered]
     total = max([*widths, 200.0]) + 2 * MARGIN
     placed: dict[str, _Placed] = {}
     for depth, (row, row_width) in enumerate(zip(ordered, widths, strict=True)):
         x = (total - row_width) / 2
         y = MARGIN + depth * (box_height + ROW_GAP)
         for box in row:
-            width = _width(box.text)
+            width = _width(box)
             placed[box.key] = _Placed(box, x, y, width, box_height)
             x += width + BOX_GAP
     height = MARGIN * 2 + len(ordered) * box_height + max(len(ordered) - 1, 0) * ROW_GAP
@@ -123,37 +154,51 @@ def layered(
         f'<defs><marker id="{ident}-arrow" viewBox="0 0 10 10" refX="10" refY="5" markerWidth="7" markerHeight="7" '
         'orient="auto-start-reverse"><path d="M0,0 L10,5 L0,10 z" fill="#5d6778"/></marker></defs>',
     ]
-    for edge in edges:
-        source, target = placed.get(edge.source), placed.get(edge.target)
-        if source is None or target is None:
-            continue
-        parts.append(_edge(source, target, edge, f"{ident}-arrow"))
+    for edge, keys in routes:
+        parts.append(_edge([placed[key] for key in keys], edge, f"{ident}-arrow"))
     for item in placed.values():
-        parts.append(_box(item))
+        if item.box.kind != VIRTUAL:
+            parts.append(_box(item))
     parts.append("</svg>")
     return Markup("".join(parts))
 
 
-def _edge(source: _Placed, target: _Placed, edge: Edge, arrow: str) -> str:
-    if abs(source.y - target.y) < 1:  # the same row: side to side
-        left, right = (source, target) if source.x < target.x else (target, source)
-        x1, x2 = left.x + left.width, right.x
-        y1 = y2 = source.y + source.height / 2
-        if right is source:
-            x1, x2 = x2, x1
-    else:
-        x1 = source.x + source.width / 2
-        x2 = target.x + target.width / 2
-        y1 = source.y + (source.height if target.y > source.y else 0)
-        y2 = target.y + (0 if target.y > source.y else target.height)
+def _points(path: list[_Placed]) -> list[tuple[float, float]]:
+    """Where the arrow runs: out of the first box, through each waypoint's slot, into the last box."""
+    source, target = path[0], path[-1]
+    if len(path) == 2 and abs(source.y - target.y) < 1:  # the same row: side to side
+        y = source.y + source.height / 2
+        if source.x < target.x:
+            return [(source.x + source.width, y), (target.x, y)]
+        return [(source.x, y), (target.x + target.width, y)]
+    down = target.y > source.y
+    points = [(source.x + source.width / 2, source.y + (source.height if down else 0))]
+    for waypoint in path[1:-1]:
+        x = waypoint.x + waypoint.width / 2
+        points += (
+            [(x, waypoint.y), (x, waypoint.y + waypoint.height)]
+            if down
+            else [
+                (x, waypoint.y + waypoint.height),
+                (x, waypoint.y),
+            ]
+        )
+    points.append((target.x + target.width / 2, target.y + (0 if down else target.height)))
+    return points
+
+
+def _edge(path: list[_Placed], edge: Edge, arrow: str) -> str:
+    points = _points(path)
     dash = ' stroke-dasharray="5 3"' if edge.dashed else ""
+    drawn = " ".join(f"{x:.1f},{y:.1f}" for x, y in points)
     line = (
-        f'<line x1="{x1:.1f}" y1="{y1:.1f}" x2="{x2:.1f}" y2="{y2:.1f}" stroke="#8c96a8" stroke-width="1.3"'
-        f'{dash} marker-end="url(#{arrow})"><title>{escape(edge.note or edge.label)}</title></line>'
+        f'<polyline points="{drawn}" fill="none" stroke="#8c96a8" stroke-width="1.3"'
+        f'{dash} marker-end="url(#{arrow})"><title>{escape(edge.note or edge.label)}</title></polyline>'
     )
     if not edge.label:
         return line
     # beside the arrow's head: edges that fan out from one box keep their labels apart
+    (x1, y1), (x2, y2) = points[-2], points[-1]
     mx, my = x1 + (x2 - x1) * 0.8, y1 + (y2 - y1) * 0.8
     return line + (
         f'<text x="{mx:.1f}" y="{my - 3:.1f}" text-anchor="middle" font-size="10" fill="#5d6778" '
