@@ -103,13 +103,18 @@ class Store(ABC):
     def contains(self, quad: ox.Quad) -> bool:
         """Whether the store holds ``quad`` (in its graph: the default graph only for a default-graph quad).
 
-        Looked up by pattern here, a request for a remote store; a quoted triple or a blank graph name,
-        which a pattern cannot fix, is compared against what the rest of the pattern matches."""
+        Looked up by pattern here, a request for a remote store, so that the store matches a literal as it
+        keeps it (``"0.0"^^xsd:decimal`` is kept as ``"0"``, which would not compare equal); a quoted
+        triple or a blank graph name, which a pattern cannot fix, is compared against what the rest of
+        the pattern matches."""
         subject, obj, graph = quad.subject, quad.object, quad.graph_name
         fixed_subject = None if isinstance(subject, ox.Triple) else subject
         fixed_object = None if isinstance(obj, ox.Triple) else obj
         fixed_graph = None if isinstance(graph, ox.BlankNode) else graph
-        return any(found == quad for found in self.quads(fixed_subject, quad.predicate, fixed_object, fixed_graph))
+        found = self.quads(fixed_subject, quad.predicate, fixed_object, fixed_graph)
+        if (fixed_subject, fixed_object, fixed_graph) == (subject, obj, graph):
+            return next(found, None) is not None
+        return any(match == quad for match in found)
 
     @abstractmethod
     def count(self, graph: GraphName | ox.NamedNode | None = None) -> int:

@@ -21,9 +21,10 @@ pytestmark = pytest.mark.both_stores
 
 EX = "http://example.org/counts#"
 G1, G2 = ox.NamedNode("http://example.org/counts#g1"), ox.NamedNode("http://example.org/counts#g2")
-# a blank node: skolemised under a name made from the file's content, the same at every load
+# a blank node: skolemised under a name made from the file's content, the same at every load; and a
+# decimal the store keeps in another form ("0.5"), held all the same
 BLANK = """@prefix ex: <http://example.org/counts#> .
-ex:a ex:q [ ex:r ex:s ; ex:t "one" ] .
+ex:a ex:q [ ex:r ex:s ; ex:t "one" ; ex:u 0.50 ] .
 """
 
 
@@ -51,6 +52,10 @@ def test_the_store_says_whether_it_holds_a_quad(kb: KnowledgeBase) -> None:
     assert not kb.store.contains(ox.Quad(_node("a"), _node("p"), ox.Literal("x"), G2))  # another graph
     assert not kb.store.contains(ox.Quad(_node("a"), _node("p"), ox.Literal("y"), G1))
     assert not kb.store.contains(ox.Quad(_node("a"), _node("p"), ox.Literal("x", language="en"), G1))
+    decimal = ox.NamedNode("http://www.w3.org/2001/XMLSchema#decimal")
+    kb.store.add([ox.Quad(_node("a"), _node("q"), ox.Literal("0.50", datatype=decimal), G1)])  # kept as "0.5"
+    assert kb.store.contains(ox.Quad(_node("a"), _node("q"), ox.Literal("0.50", datatype=decimal), G1))
+    assert kb.store.contains(ox.Quad(_node("a"), _node("q"), ox.Literal("0.5", datatype=decimal), G1))
 
 
 def test_a_reload_leaves_the_store_as_it_was(kb: KnowledgeBase, tmp_path: Path) -> None:
