@@ -167,3 +167,55 @@ def test_plans_page_shows_the_plan_and_draws_the_graph(page: Any, shots: Path) -
         page.wait_for_timeout(100)
     assert drawing.evaluate("image => image.naturalWidth") > 0  # the SVG arrived and decoded
     snap(page, shots, "plans")
+
+
+NARROW_PAGES = (
+    "/",
+    "/taxonomy",
+    "/taxonomy/class?iri=home:Position",
+    "/services",
+    "/service?iri=svc:LocateMobileRobot_CeilingCamera01",
+    "/search?q=camera",
+    "/match?requirement=req:FetchMyPen",
+    "/plans?task=FetchMyPen",
+)
+
+
+def test_pages_fit_a_phone_and_pictures_open_on_their_middle(browser: Any, server: Server, shots: Path) -> None:
+    """At 400 px no page scrolls sideways (wide tables and pictures scroll in their own box), and a
+    picture wider than its box opens scrolled to its middle, where the class is drawn."""
+    context = browser.new_context(
+        base_url=f"http://127.0.0.1:{server.http_port}", viewport={"width": 400, "height": 800}
+    )
+    context.set_default_timeout(WAIT_MS)
+    opened = context.new_page()
+    try:
+        for path in NARROW_PAGES:
+            opened.goto(path)
+            assert opened.evaluate("document.documentElement.scrollWidth") <= 400, path
+        opened.goto("/taxonomy/class?iri=home:Position")
+        scroller = opened.locator(".diagram-scroll")
+        assert scroller.evaluate("e => e.scrollWidth > e.clientWidth")
+        assert scroller.evaluate("e => Math.abs(e.scrollLeft - (e.scrollWidth - e.clientWidth) / 2) <= 1")
+        focus = opened.locator("svg.diagram a.box").filter(has_text="home:Position").first
+        assert focus.is_visible() and focus.bounding_box()["x"] >= 0
+        snap(opened, shots, "class-narrow")
+    finally:
+        context.close()
+
+
+def test_search_from_the_header_with_the_slash_key(page: Any, shots: Path) -> None:
+    page.goto("/services")
+    page.locator("body").press("Escape")
+    page.keyboard.press("/")
+    assert page.evaluate("document.activeElement.id") == "filter"  # the page's own search box first
+    page.goto("/")
+    page.keyboard.press("/")
+    assert page.evaluate("document.activeElement.id") == "site-search"
+    page.keyboard.type("ceiling camera")
+    page.keyboard.press("Enter")
+    page.wait_for_url("**/search?q=ceiling+camera")
+    page.get_by_role("link", name="LocateMobileRobot").first.click()
+    page.wait_for_url("**/service?iri=*")
+    assert "CeilingCamera" in page.locator("main").inner_text()
+    snap(page, shots, "search")

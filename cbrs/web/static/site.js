@@ -11,4 +11,9 @@
     box.focus();
     box.select();
   });
+  // A picture wider than the page opens on its middle, where the class or the plan's trunk is drawn,
+  // not on its empty left edge.
+  for (const scroller of document.querySelectorAll(".diagram-scroll")) {
+    scroller.scrollLeft = (scroller.scrollWidth - scroller.clientWidth) / 2;
+  }
 })();
