@@ -296,10 +296,10 @@ def _new_quads(store: EmbeddedStore, report: LoadReport) -> list[ox.Quad]:
     143,268 triples again, seconds of work that changed nothing (docs/architecture.md).
 
     It also fills in what each file adds, before the write: the files' own counts would tell a user a
-    reload changed something. Each triple is looked up (:meth:`EmbeddedStore.contains`, about 0.25 us,
-    a fifth of what writing it costs); a triple an earlier file of the load gave counts for that file
-    only. A remote store would take a request per triple, so :func:`load_files` writes all there and
-    compares the graphs' sizes before and after.
+    reload changed something. Each triple is looked up (:meth:`EmbeddedStore.contains`, 0.4 us: 81 ms
+    for 200,000, against 70 ms for Oxigraph's membership test called directly); a triple an earlier
+    file of the load gave counts for that file only. A remote store would take a request per triple, so
+    :func:`load_files` writes all there and compares the graphs' sizes before and after.
     """
     items = (*report.files, *report.imports)
     new: list[ox.Quad] = []

@@ -364,8 +364,8 @@ class EmbeddedStore(Store):
         return iter(self._backend.quads_for_pattern(subject, predicate, object, graph))
 
     def contains(self, quad: ox.Quad) -> bool:
-        """Whether the store holds ``quad``: Oxigraph's own membership test, about 0.25 us a quad, 15 times
-        less than a pattern lookup (what the loader asks of every triple it is given)."""
+        """Whether the store holds ``quad``: Oxigraph's own membership test, 0.4 us a quad through this
+        method (81 ms for 200,000), 15 times less than a pattern lookup: the loader asks it of every triple."""
         return quad in self._backend
 
     def count(self, graph: GraphName | ox.NamedNode | None = None) -> int:
