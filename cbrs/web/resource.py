@@ -25,6 +25,9 @@ from cbrs.web.pages import Page, page, wants_json
 blueprint = Blueprint("resource", __name__)
 
 RDF_TYPE = RDF + "type"
+# Values listed per predicate and direction: owl:Class on OWLS-TC is the object of 13,000 rdf:type
+# triples, a page of 3.8 MB; the count says how many there are, the SPARQL endpoint has them all.
+MAX_VALUES = 500
 # Types whose members have a page in the taxonomy.
 TERM_TYPES = frozenset(
     {OWL + "Class", RDFS + "Class", OWL + "ObjectProperty", OWL + "DatatypeProperty", RDF + "Property"}
@@ -125,11 +128,12 @@ def _is(row: dict[str, Any], direction: str, predicate: str) -> bool:
 
 
 def _count(groups: list[dict[str, Any]]) -> int:
-    return sum(len(group["values"]) for group in groups)
+    return sum(group["count"] for group in groups)
 
 
 def _grouped(rows: Iterable[dict[str, Any]]) -> list[dict[str, Any]]:
-    """Rows of one direction as ``[{"predicate", "name", "values": [{"term", "graph"}]}]``, rdf:type first."""
+    """Rows of one direction as ``[{"predicate", "name", "count", "values": [{"term", "graph"}]}]``,
+    rdf:type first; at most :data:`MAX_VALUES` values a predicate, ``count`` says how many there are."""
     groups: dict[str, list[dict[str, Any]]] = {}
     for row in rows:
         groups.setdefault(row["predicate"].value, []).append(
@@ -138,7 +142,9 @@ def _grouped(rows: Iterable[dict[str, Any]]) -> list[dict[str, Any]]:
     for values in groups.values():  # what the store states first, then what the alignments entail from it
         values.sort(key=lambda value: value["graph"] == GraphName.ENTAILED.iri)
     order = sorted(groups, key=lambda p: (p != RDF_TYPE, shorten(p).casefold()))
-    return [{"predicate": p, "name": shorten(p), "values": groups[p]} for p in order]
+    return [
+        {"predicate": p, "name": shorten(p), "count": len(groups[p]), "values": groups[p][:MAX_VALUES]} for p in order
+    ]
 
 
 # The resource blueprint is not in PAGES, so the app's handlers would answer its errors in JSON; these
