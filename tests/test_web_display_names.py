@@ -85,3 +85,13 @@ def test_the_uses_of_a_class_and_the_paths_to_it_show_tails_too(client: FlaskCli
     assert '<strong><span class="ns">my_ontology.owl#</span>FourWheeledCar</strong>' in page
     services = client.get("/services").text
     assert services.count(">car price<") == 1  # the label, beside the service name it differs from
+
+
+def test_page_titles_name_the_iri_by_its_tail(client: FlaskClient) -> None:
+    for path, query, title in (
+        ("/taxonomy/class", {"iri": ONTO + "Car"}, "Class my_ontology.owl#Car"),
+        ("/service", {"iri": SERVICE}, "car_price_service.owls#CAR_PRICE_SERVICE"),
+        ("/resource", {"iri": ONTO + "Car"}, "my_ontology.owl#Car"),
+    ):
+        page = client.get(path, query_string=query).text
+        assert f"<title>{title} · cbrs</title>" in page and f"<h1>{title}</h1>" in page, path

@@ -19,7 +19,7 @@ from werkzeug.exceptions import BadRequest, HTTPException
 from cbrs.kb.errors import KnowledgeBaseError, NotFoundError
 from cbrs.kb.namespaces import OWL, RDF, RDFS, XSD, GraphName, expand, shorten
 from cbrs.web import context
-from cbrs.web.links import iri_link
+from cbrs.web.links import display_text, iri_link
 from cbrs.web.pages import Page, page, wants_json
 
 blueprint = Blueprint("resource", __name__)
@@ -120,7 +120,7 @@ def resource() -> Page:
         "outgoing": outgoing,
         "incoming": incoming,
     }
-    return Page("resource.html", shorten(iri), data)
+    return Page("resource.html", display_text(iri), data)
 
 
 def _is(row: dict[str, Any], direction: str, predicate: str) -> bool:

@@ -12,6 +12,7 @@ from cbrs.kb.model import Advertisement, Requirement
 from cbrs.kb.namespaces import expand, shorten
 from cbrs.kb.store import Term
 from cbrs.web import context, resource
+from cbrs.web.links import display_text
 from cbrs.web.pages import FormError, Page, page
 
 blueprint = Blueprint("services", __name__)
@@ -90,7 +91,7 @@ def service() -> Page:
     elif isinstance(description, Advertisement):
         data["requirements"] = _requirements_for(kb, description) if match else []
         data["similar"] = _similar_url(data) if match else None
-    return Page("service.html", shorten(iri), data)
+    return Page("service.html", display_text(iri), data)
 
 
 def _similar_url(description: dict[str, Any]) -> str | None:

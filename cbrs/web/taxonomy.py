@@ -286,7 +286,7 @@ def concept() -> Page:
     if not wants_json():  # markup, so not in the twin, which has the same facts as lists
         data["picture"] = _picture(found, iri, data["parts"])
     noun = "Class" if kind == "class" else "Property"
-    return Page("class.html", f"{noun} {shorten(iri)}", data)
+    return Page("class.html", f"{noun} {display_text(iri)}", data)
 
 
 def _picture(found: Taxonomy, iri: str, parts: list[dict[str, Any]]) -> Markup:
@@ -361,7 +361,7 @@ def _undeclared(kb: KnowledgeBase, found: Taxonomy, iri: str, triples: list[dict
         "similar": similar,
         "usage": usage,
     }
-    title = f"{'Built-in term' if built_in else 'Undeclared concept'} {shorten(iri)}"
+    title = f"{'Built-in term' if built_in else 'Undeclared concept'} {display_text(iri)}"
     return Page("class.html", title, data)
 
 
