@@ -92,6 +92,7 @@ def test_page_titles_name_the_iri_by_its_tail(client: FlaskClient) -> None:
         ("/taxonomy/class", {"iri": ONTO + "Car"}, "Class my_ontology.owl#Car"),
         ("/service", {"iri": SERVICE}, "car_price_service.owls#CAR_PRICE_SERVICE"),
         ("/resource", {"iri": ONTO + "Car"}, "my_ontology.owl#Car"),
+        ("/taxonomy", {"root": ONTO + "Car"}, "Taxonomy below my_ontology.owl#Car"),
     ):
         page = client.get(path, query_string=query).text
         assert f"<title>{title} · cbrs</title>" in page and f"<h1>{title}</h1>" in page, path

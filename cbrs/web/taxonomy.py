@@ -248,7 +248,7 @@ def taxonomy() -> Page:
         data[key] = found.tree(kind, keep, set(matches), limit, root) if shown else []
     title = "Taxonomy"
     if root is not None:
-        title += f" below {shorten(root)}"
+        title += f" below {display_text(root)}"
     if query:
         title += f": “{query}”"
     return Page("taxonomy.html", title, data)
