@@ -312,12 +312,13 @@ class SemanticMap:
         types: dict[str, list[str]] = defaultdict(list)
         for row in kb.select("map_types"):
             types[row["thing"].value].append(row["type"].value)
-        affordances: dict[str, list[tuple[str, str]]] = {}
+        affordances: dict[str, list[tuple[str, str, str]]] = {}
         nearest: dict[str, int] = {}
         for row in kb.select("grasp_affordances"):  # nearest ancestor first
             concept, distance = row["class"].value, int(row["distance"].value)
             if nearest.setdefault(concept, distance) == distance:  # a farther ancestor's is overridden
-                affordances.setdefault(concept, []).append((row["approach"].value, row["ratio"].value))
+                stated = (row["approach"].value, row["ratio"].value, row["ancestor"].value)
+                affordances.setdefault(concept, []).append(stated)
 
         def things_of(concept: str) -> frozenset[str]:
             return frozenset(row["thing"].value for row in kb.select("designate", {"class": HOME + concept}))
@@ -519,21 +520,17 @@ GRASP_APPROACHES = ("top", "side")
 """The approaches the arms' grasp planner computes (:class:`sim.grasping.GraspKind`)."""
 
 
-def _grasp(concept: str, stated: list[tuple[str, str]], height: float) -> tuple[tuple[str, ...], float]:
+def _grasp(concept: str, stated: list[tuple[str, str, str]], height: float) -> tuple[tuple[str, ...], float]:
     """The approaches (in order of preference) and the grasp height of an object of ``concept``, from
-    ``concept`` or its nearest superclass that states them. A class writes its approaches as one list,
-    best first ("side top"): two statements of either property give no order (nor one height), so they
-    are refused, naming both, as two values of any one property are."""
-    approaches = sorted({approach for approach, _ in stated})
-    ratios = sorted({ratio for _, ratio in stated})
-    if len(approaches) > 1:
-        raise MapError(
-            concept,
-            "has home:graspApproach " + " and ".join(repr(a) for a in approaches) + " (itself or from its nearest "
-            'class that says): they give no order of preference; write one list, best first ("side top")',
-        )
-    if len(ratios) > 1:
-        raise _two_values(concept, "graspHeightRatio", ratios)
+    ``concept`` or its nearest superclass that states them (``stated``: approach, ratio, the class that
+    states them). A class writes its approaches as one list, best first ("side top"): two statements of
+    either property give no order (nor one height), so they are refused, naming the class (or classes,
+    as near) that stated them and both values, as two values of any one property are."""
+    approaches = sorted({approach for approach, _, _ in stated})
+    ratios = sorted({ratio for _, ratio, _ in stated})
+    for name, values, index in (("graspApproach", approaches, 0), ("graspHeightRatio", ratios, 1)):
+        if len(values) > 1:
+            raise _stated_twice(concept, name, stated, index)
     kinds = tuple(approaches[0].split())
     unknown = [kind for kind in kinds if kind not in GRASP_APPROACHES]
     if not kinds or unknown or len(set(kinds)) != len(kinds):
@@ -548,6 +545,29 @@ def _grasp(concept: str, stated: list[tuple[str, str]], height: float) -> tuple[
     except ValueError:
         raise MapError(concept, f"has home:graspHeightRatio {ratios[0]!r}, not a number") from None
     return kinds, ratio * height
+
+
+def _stated_twice(concept: str, name: str, stated: list[tuple[str, str, str]], index: int) -> MapError:
+    """Two values of a grasp property for ``concept``'s objects, named by the class that stated them
+    (an object's class inherits them): the map author fixes that class, not the object's."""
+    said: dict[str, set[str]] = {}
+    for row in stated:
+        said.setdefault(row[2], set()).add(row[index])
+    owner = sorted(said)[0]
+    inherited = "" if owner == concept else f" (the nearest class above {local_name(concept)} that says)"
+    order = ' they give no order of preference; write one list, best first ("side top")'
+    how = order if index == 0 else " one value is needed"
+    if len(said) == 1:
+        shown = " and ".join(repr(value) for value in sorted(said[owner]))
+        return MapError(owner, f"has home:{name} {shown}{inherited}:{how}")
+    each = "; ".join(
+        f"{local_name(cls)} has {' and '.join(repr(v) for v in sorted(values))}" for cls, values in sorted(said.items())
+    )
+    return MapError(
+        owner,
+        f"and {', '.join(local_name(cls) for cls in sorted(said)[1:])} are as near above {local_name(concept)} and "
+        f"give home:{name} ({each}):{how}, on one class",
+    )
 
 
 def _dispenser(built: SemanticMap, iri: str, tap: str, facts: dict[str, dict[str, list[str]]]) -> Dispenser:
