@@ -15,6 +15,7 @@ import cbrs.sim.quiet  # noqa: F401  (first: keeps pybullet's banner off stdout)
 from cbrs.sim.arms import ArmSide
 from cbrs.sim.errors import (
     CameraUnavailableError,
+    GraspTooWideError,
     ImageSizeError,
     MapError,
     NoFreeCellError,
@@ -47,6 +48,7 @@ __all__ = [
     "ArmSide",
     "CameraUnavailableError",
     "GraspPose",
+    "GraspTooWideError",
     "HomeWorld",
     "ImageSizeError",
     "MapError",
