@@ -154,3 +154,10 @@ def test_text_and_links_are_escaped() -> None:
     assert next(tree.iter(SVG + "a")).get("href") == '/p?a=1&b="2"'
     light = [t for t in tree.iter(SVG + "tspan") if t.get("fill-opacity")]
     assert ["".join(t.itertext()) for t in light] == ["lab.owl#"]  # the file part drawn lighter
+
+
+def test_a_subtree_page_draws_its_root(client: FlaskClient) -> None:
+    drawn = boxes(picture(client.get("/taxonomy", query_string={"root": "home:Position"}).text))
+    assert {"home:SpatialData", "home:Position", "home:RobotPosition"} <= set(drawn)
+    assert "picture" not in client.get("/taxonomy.json", query_string={"root": "home:Position"}).get_json()
+    assert '<svg class="diagram"' not in client.get("/taxonomy").text

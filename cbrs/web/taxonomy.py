@@ -241,6 +241,8 @@ def taxonomy() -> Page:
         ]
     if root is not None:
         data["root"] = {**found.term(root), "kind": found.kinds[root], "paths": _paths(found, root)}
+        if not wants_json():  # the root among its ancestors and children, as on its class page
+            data["picture"] = _picture(found, root, [])
         if keep is not None:
             keep.add(root)
     for kind, key in (("class", "classes"), ("property", "properties")):
