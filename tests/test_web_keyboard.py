@@ -44,3 +44,33 @@ def test_every_script_and_stylesheet_comes_from_this_server(client: FlaskClient)
             served.close()
     script = client.get("/static/site.js")
     assert script.mimetype in ("text/javascript", "application/javascript") and b'"/"' in script.data
+
+
+REFERENCES = re.compile(r'(?:for|aria-describedby|aria-labelledby)="([^"]+)"')
+LABELLED_PAGES = (
+    *PAGES[:-1],
+    "/taxonomy?root=home:Position",
+    "/taxonomy/class?iri=home:Position",
+    "/resource?iri=home:Position",
+    "/service?iri=svc:LocateMobileRobot_CeilingCamera01",
+    "/match?requirement=req:FetchMyPen",
+    "/plans?task=FetchMyPen",
+    "/services?kind=cbrs:Toaster",
+    "/services?page=9",
+)
+
+
+@pytest.mark.parametrize("path", LABELLED_PAGES)
+def test_ids_are_unique_and_every_reference_and_field_label_resolves(client: FlaskClient, path: str) -> None:
+    page = client.get(path).text
+    ids = re.findall(r'\sid="([^"]+)"', page)
+    assert len(ids) == len(set(ids)), path
+    missing = [name for found in REFERENCES.findall(page) for name in found.split() if name not in ids]
+    assert missing == [], (path, missing)  # a description that is not there (the services' kind-error was)
+    anchors = [name for name in re.findall(r'href="#([^"]+)"', page) if name not in ids]
+    assert anchors == [], (path, anchors)
+    for field in re.findall(r"<(?:input|select|textarea)\b[^>]*>", page):
+        if 'type="hidden"' in field or "aria-label=" in field:
+            continue
+        named = re.search(r'\sid="([^"]+)"', field)
+        assert named is not None and f'for="{named.group(1)}"' in page, (path, field)
