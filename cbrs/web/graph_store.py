@@ -1,9 +1,10 @@
 """``/store``: the SPARQL 1.1 Graph Store HTTP Protocol, as Oxigraph's server and Fuseki offer it.
 
 ``GET``/``HEAD`` ``/store?graph=IRI`` (or ``?default``) answer the graph in the format the Accept header
-asks (Turtle by default); ``GET /store`` answers the whole dataset (TriG or N-Quads). ``PUT`` replaces
-a graph with the body, ``POST`` adds the body to it (or, with no graph, adds a TriG or N-Quads body to
-the store), ``DELETE`` drops it. Writes need ``Authorization: Bearer <token>``.
+asks (Turtle by default, and for a browser, whose Accept prefers HTML and then XML); ``GET /store``
+answers the whole dataset (TriG or N-Quads). ``PUT`` replaces a graph with the body, ``POST`` adds the
+body to it (or, with no graph, adds a TriG or N-Quads body to the store), ``DELETE`` drops it. Writes
+need ``Authorization: Bearer <token>``.
 """
 
 from __future__ import annotations
@@ -39,7 +40,10 @@ def _store() -> GraphStore:
 
 @blueprint.route("/store", methods=["GET", "HEAD"])
 def read() -> Response:
-    data, media_type = _store().read(_target(), request.headers.get("Accept"))
+    accept = request.headers.get("Accept")
+    if request.accept_mimetypes.best == "text/html":  # a browser following a link: Turtle, not RDF/XML
+        accept = "text/turtle"
+    data, media_type = _store().read(_target(), accept)
     return Response(b"" if request.method == "HEAD" else data, content_type=media_type, headers={"Vary": "Accept"})
 
 

@@ -96,7 +96,8 @@ def resource() -> Page:
     iri = iri_parameter()
     kb = context.kb()
     rows = kb.select("resource_triples", {"resource": iri})
-    if not rows:
+    graph = _named_graph(iri)
+    if not rows and graph is None:
         raise NotFoundError(iri)
     outgoing = _grouped(row for row in rows if row["direction"].value == "out")
     incoming = _grouped(row for row in rows if row["direction"].value == "in")
@@ -105,8 +106,10 @@ def resource() -> Page:
     pages = []
     if types & TERM_TYPES:
         pages.append({"text": "In the taxonomy", "href": url_for("taxonomy.concept", iri=iri)})
-    if kb.select("description", {"description": iri}):
+    if rows and kb.select("description", {"description": iri}):
         pages.append({"text": "Service description (six-tuple)", "href": url_for("services.service", iri=iri)})
+    if graph is not None and graph["triples"]:
+        pages.append({"text": "The graph's triples (Turtle)", "href": url_for("graph_store.read", graph=iri)})
     data = {
         "iri": iri,
         "name": shorten(iri),
@@ -119,8 +122,19 @@ def resource() -> Page:
         },
         "outgoing": outgoing,
         "incoming": incoming,
+        "graph": graph,
     }
     return Page("resource.html", display_text(iri), data)
+
+
+def _named_graph(iri: str) -> dict[str, int] | None:
+    """``{"triples": n}`` if ``iri`` names a graph of the store (one of cbrs's, even empty, or any other
+    that holds triples). Every page links graph names here: the overview's table, the graph column of
+    every triple; a graph is the subject of no triple, so each such link was a 404."""
+    statistics = context.per_generation("graph_statistics", context.kb().statistics)
+    if iri in statistics or iri in {graph.iri for graph in GraphName}:
+        return {"triples": statistics.get(iri, 0)}
+    return None
 
 
 def _is(row: dict[str, Any], direction: str, predicate: str) -> bool:
