@@ -16,12 +16,14 @@ from cbrs.web import create_app
 from cbrs.web.links import display_name
 
 ONTO = "http://127.0.0.1/ontology/my_ontology.owl#"
+OTHER = "http://example.com/copy/my_ontology.owl#"  # the same tail as ONTO's
 SERVICE = "http://127.0.0.1/services/1.1/car_price_service.owls#CAR_PRICE_SERVICE"
 TURTLE = f"""@prefix cbrs: <https://w3id.org/cbrs/core#> .
 @prefix owl: <http://www.w3.org/2002/07/owl#> .
 @prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .
 <{ONTO}Car> a owl:Class .
 <{ONTO}FourWheeledCar> a owl:Class ; rdfs:subClassOf <{ONTO}Car> .
+<{OTHER}Car> a owl:Class .
 """
 AD = f"""@prefix cbrs: <https://w3id.org/cbrs/core#> .
 @prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .
@@ -96,3 +98,15 @@ def test_page_titles_name_the_iri_by_its_tail(client: FlaskClient) -> None:
     ):
         page = client.get(path, query_string=query).text
         assert f"<title>{title} · cbrs</title>" in page and f"<h1>{title}</h1>" in page, path
+
+
+def test_the_match_form_takes_a_concept_as_the_pages_name_it(client: FlaskClient) -> None:
+    asked = client.get("/match.json", query_string={"inputs": "my_ontology.owl#FourWheeledCar", "outputs": "car"})
+    assert asked.status_code == 400 and "outputs" in asked.get_json()["fields"]  # "car" is no concept
+    ranked = client.get("/match.json", query_string={"effects": "", "outputs": "my_ontology.owl#FourWheeledCar"})
+    assert ranked.status_code == 200, ranked.text[:300]
+    assert ranked.get_json()["requirement"]["outputs"] == [ONTO + "FourWheeledCar"]
+    same = client.get("/match.json", query_string={"outputs": "my_ontology.owl#Car"}).get_json()
+    assert "2 concepts" in same["fields"]["outputs"] and OTHER + "Car" in same["fields"]["outputs"]
+    typo = client.get("/match.json", query_string={"outputs": "my_ontology.owl#FourWheeledCra"}).get_json()
+    assert "did you mean my_ontology.owl#FourWheeledCar" in typo["fields"]["outputs"]

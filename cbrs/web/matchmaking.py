@@ -17,6 +17,7 @@ from cbrs.reasoner.matchmaker import Candidate, Matchmaker, MatchResult
 from cbrs.reasoner.methods import METHODS
 from cbrs.reasoner.taxonomy import TaxonomyIndex
 from cbrs.web import context
+from cbrs.web.links import display_text
 from cbrs.web.pages import FormError, Page, page, wants_json
 
 blueprint = Blueprint("matchmaking", __name__)
@@ -156,15 +157,39 @@ def _terms(text: str) -> list[str]:
 
 
 def _concept(term: str, index: TaxonomyIndex) -> str:
+    if ":" not in term and "#" in term:  # as the pages show an IRI no prefix shortens: file.owl#Name
+        return _by_tail(term, index)
     prefix = term.partition(":")[0]
     if not term.startswith("<") and prefix not in PREFIXES and prefix not in ("http", "https", "urn"):
         raise ValueError(f"{term}: {prefix}: is not a known prefix; use one of {', '.join(PREFIXES)}")
     iri = expand(term)
     if iri not in index:
-        near = difflib.get_close_matches(term, [shorten(n) for n in index.nodes()], n=3, cutoff=0.75)
+        near = difflib.get_close_matches(term, [display_text(n) for n in index.nodes()], n=3, cutoff=0.75)
         hint = f"; did you mean {' or '.join(near)}?" if near else "; concepts are prefixed names, e.g. home:Cup"
         raise ValueError(f"{term} is not a concept or property of the ontology{hint}")
     return iri
+
+
+def _by_tail(term: str, index: TaxonomyIndex) -> str:
+    """The concept a page names ``term`` (``my_ontology.owl#Car``, ``links.name_parts``): OWLS-TC's IRIs
+    have no prefix, so before, a user had to type ``http://127.0.0.1/ontology/my_ontology.owl#Car``."""
+
+    def read() -> dict[str, list[str]]:
+        tails: dict[str, list[str]] = {}
+        for node in index.nodes():
+            if shorten(node) == node:
+                tails.setdefault(display_text(node), []).append(node)
+        return tails
+
+    found = sorted(context.per_generation("concept_tails", read).get(term, []))
+    if len(found) == 1:
+        return found[0]
+    if found:
+        raise ValueError(f"{term} names {len(found)} concepts, {', '.join(found)}: give the whole IRI")
+    tails = list(context.per_generation("concept_tails", read))
+    near = difflib.get_close_matches(term, tails, n=3, cutoff=0.75)
+    hint = f"; did you mean {' or '.join(near)}?" if near else ""
+    raise ValueError(f"{term} is not a concept or property of the ontology{hint}")
 
 
 def _statements(text: str, index: TaxonomyIndex) -> list[Statement]:
