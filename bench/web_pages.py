@@ -31,6 +31,8 @@ PAGES = {
     "class Price (OWLS-TC)": f"/taxonomy/class?iri={OWLS_TC}concept.owl%23Price",
     "service (bundled)": "/service?iri=svc:LocateMobileRobot_CeilingCamera01",
     "search": "/search?q=price",
+    "resource owl:Class": "/resource?iri=owl:Class",
+    "plan (bundled)": "/plans?task=FetchMyPen",
 }
 
 
