@@ -3,14 +3,17 @@ service description with its six-tuple ⟨DN, SN, SC, IOPE, SEA, QoS⟩ as ``cbr
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from typing import Any
 
+import pyoxigraph as ox
 from flask import Blueprint, current_app, request, url_for
 
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.model import Advertisement, Requirement
-from cbrs.kb.namespaces import expand, shorten
+from cbrs.kb.namespaces import RDF, RDFS, expand, shorten
 from cbrs.kb.store import Term
+from cbrs.kb.vocab import CBRS
 from cbrs.web import context, resource
 from cbrs.web.links import display_text
 from cbrs.web.pages import FormError, Page, page
@@ -84,7 +87,7 @@ def service() -> Page:
     with context.lock():
         description = kb.description(iri)
     role = "requirement" if isinstance(description, Requirement) else "advertisement"
-    data: dict[str, Any] = {"role": role, **description.to_dict()}
+    data: dict[str, Any] = {"role": role, **description.to_dict(), "conditions_as_text": _text_only(kb, iri)}
     match = MATCH_ENDPOINT in current_app.view_functions
     if isinstance(description, Requirement):
         data["match"] = url_for(MATCH_ENDPOINT, requirement=iri) if match else None
@@ -92,6 +95,33 @@ def service() -> Page:
         data["requirements"] = _requirements_for(kb, description) if match else []
         data["similar"] = _similar_url(data) if match else None
     return Page("service.html", display_text(iri), data)
+
+
+_TEXT_ROLES = {CBRS.Precondition: "precondition", CBRS.Effect: "effect", CBRS.DeleteEffect: "delete effect"}
+
+
+def _text_only(kb: KnowledgeBase, iri: str) -> list[dict[str, str]]:
+    """The conditions an OWL-S description gave that the loader could not make statements of, kept as
+    their text (``rdfs:seeAlso`` of the model, :mod:`cbrs.kb.owls`): matching does not use them, but
+    the page said "No preconditions." of a service that has one (33 of OWLS-TC's 212 expressions)."""
+    store = kb.store
+    found = []
+    for model in _nodes(store.quads(ox.NamedNode(iri), ox.NamedNode(CBRS.hasOWLSModel))):
+        for kept in _nodes(store.quads(model, ox.NamedNode(RDFS + "seeAlso"))):
+            kinds = {
+                q.object.value
+                for q in store.quads(kept, ox.NamedNode(RDF + "type"))
+                if isinstance(q.object, ox.NamedNode)
+            }
+            role = next((_TEXT_ROLES[k] for k in sorted(kinds) if k in _TEXT_ROLES), None)
+            texts = [q.object for q in store.quads(kept, ox.NamedNode(CBRS.conditionText))]
+            if role is not None:
+                found += [{"role": role, "text": t.value} for t in texts if isinstance(t, ox.Literal)]
+    return sorted(found, key=lambda c: (c["role"], c["text"]))
+
+
+def _nodes(quads: Iterator[ox.Quad]) -> list[ox.NamedNode | ox.BlankNode]:
+    return [q.object for q in quads if isinstance(q.object, ox.NamedNode | ox.BlankNode)]
 
 
 def _similar_url(description: dict[str, Any]) -> str | None:
