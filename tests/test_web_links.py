@@ -74,3 +74,21 @@ def test_a_graph_name_has_a_page_with_its_size_and_its_triples(client: FlaskClie
 def test_a_sparql_client_still_gets_what_it_asks_for(client: FlaskClient) -> None:
     xml = client.get("/store", query_string={"graph": GraphName.MAP.iri}, headers={"Accept": "application/rdf+xml"})
     assert xml.status_code == 200 and xml.mimetype == "application/rdf+xml"
+
+
+def test_each_figure_of_the_overview_opens_its_list(client: FlaskClient) -> None:
+    body = client.get("/index.json").get_json()
+    links, counts = body["card_links"], body["counts"]
+    services = client.get(links["services"].replace("/services", "/services.json", 1)).get_json()
+    assert services["count"] == counts["services"]
+    path, _, anchor = links["requirements"].partition("#")
+    assert f'id="{anchor}"' in client.get(path).text
+    assert len(client.get("/services.json").get_json()["requirements"]) == counts["requirements"]
+    tree = client.get(links["actions"].replace("/taxonomy", "/taxonomy.json", 1)).get_json()
+
+    def walk(nodes: list[dict[str, object]]) -> set[object]:
+        return {n["iri"] for n in nodes} | {i for n in nodes for i in walk(n["children"])}  # type: ignore[arg-type]
+
+    assert len(walk(tree["classes"])) == counts["actions"] + 1  # the actions, below act:Action
+    page = client.get("/").text
+    assert all(f'<a class="card-link" href="{href}">' in page for href in links.values())

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from flask import Blueprint
+from flask import Blueprint, url_for
 
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import GraphName, shorten
@@ -21,8 +21,24 @@ def overview() -> Page:
     return Page(
         "overview.html",
         "Overview",
-        {"store": kb.store.location, "graphs": graphs, "counts": counts, "events": context.events().recent()},
+        {
+            "store": kb.store.location,
+            "graphs": graphs,
+            "counts": counts,
+            "events": context.events().recent(),
+            "card_links": _card_links(),
+        },
     )
+
+
+def _card_links() -> dict[str, str]:
+    """Where each count of the overview leads: the first page a user opens names what the store holds,
+    and each figure opens the list of it (the services and requirements tables, the action tree)."""
+    return {
+        "services": url_for("services.services"),
+        "requirements": url_for("services.services", _anchor="requirements"),
+        "actions": url_for("taxonomy.taxonomy", root="act:Action"),
+    }
 
 
 def _store_at_a_glance(kb: KnowledgeBase) -> tuple[list[dict[str, Any]], dict[str, int]]:
