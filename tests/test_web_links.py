@@ -7,6 +7,7 @@ from __future__ import annotations
 import re
 from collections import deque
 from html import unescape
+from typing import Any
 
 import pytest
 from flask.testing import FlaskClient
@@ -27,7 +28,9 @@ def client(bundled_kb: KnowledgeBase) -> FlaskClient:
 
 
 def test_a_crawl_from_the_overview_finds_no_broken_link(client: FlaskClient) -> None:
-    pending, seen, broken = deque(["/"]), set(), []
+    pending: deque[str] = deque(["/"])
+    seen: set[str] = set()
+    broken: list[tuple[int, str]] = []
     starts = [
         "/taxonomy",
         "/services",
@@ -86,8 +89,8 @@ def test_each_figure_of_the_overview_opens_its_list(client: FlaskClient) -> None
     assert len(client.get("/services.json").get_json()["requirements"]) == counts["requirements"]
     tree = client.get(links["actions"].replace("/taxonomy", "/taxonomy.json", 1)).get_json()
 
-    def walk(nodes: list[dict[str, object]]) -> set[object]:
-        return {n["iri"] for n in nodes} | {i for n in nodes for i in walk(n["children"])}  # type: ignore[arg-type]
+    def walk(nodes: list[dict[str, Any]]) -> set[str]:
+        return {n["iri"] for n in nodes} | {i for n in nodes for i in walk(n["children"])}
 
     assert len(walk(tree["classes"])) == counts["actions"] + 1  # the actions, below act:Action
     page = client.get("/").text
