@@ -42,7 +42,9 @@ def boxes(svg: ET.Element) -> dict[str, str]:
 def test_the_class_page_draws_the_class_among_its_ancestors_subclasses_and_parts(client: FlaskClient) -> None:
     page = client.get("/taxonomy/class", query_string={"iri": "home:Position"}).text
     svg = picture(page)
-    assert svg.get("role") == "img" and svg.find(SVG + "title") is not None
+    # a group, not role="img", which would hide the links inside from screen readers
+    assert svg.get("role") == "group" and svg.find(SVG + "title") is not None
+    assert all(a.find(SVG + "title") is not None for a in svg.iter(SVG + "a"))  # each link has a name
     drawn = boxes(svg)
     assert {"owl:Thing", "home:SpatialData", "home:Position"} <= set(drawn)  # the path up, and itself
     assert {"home:RobotPosition", "home:Position2D"} <= set(drawn)  # its subclasses

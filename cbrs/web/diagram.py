@@ -3,8 +3,9 @@ plan's data flow from step to step.
 
 A lab user reads a hierarchy or a plan faster as a picture than as nested lists or a table; the taxonomy
 had none, and the plan only the planner's search graph. Inline SVG needs no script and no library: each
-box is a link (keyboard-focusable), the picture has a title and a description for screen readers, and
-the colours are presentation attributes (the pages' CSP allows no inline styles in elements).
+box is a link (keyboard-focusable, named by its title), the picture a group with a title and a
+description for screen readers (not role="img", which would hide the links inside from them), and
+the colours are presentation attributes, so the picture needs no stylesheet of its own.
 
 The layout is layered: the caller gives the rows, top to bottom; an arrow that spans rows gets a
 waypoint (a narrow slot) in each row between, so that it bends past the boxes instead of under them;
@@ -148,7 +149,7 @@ def layered(
     height = MARGIN * 2 + len(ordered) * box_height + max(len(ordered) - 1, 0) * ROW_GAP
     parts = [
         f'<svg class="diagram" xmlns="http://www.w3.org/2000/svg" viewBox="0 0 {total:.0f} {height:.0f}" '
-        f'width="{total:.0f}" height="{height:.0f}" role="img" aria-labelledby="{ident}-title {ident}-desc" '
+        f'width="{total:.0f}" height="{height:.0f}" role="group" aria-labelledby="{ident}-title {ident}-desc" '
         'font-family="DejaVu Sans, system-ui, sans-serif" font-size="12">',
         f'<title id="{ident}-title">{escape(title)}</title><desc id="{ident}-desc">{escape(description)}</desc>',
         f'<defs><marker id="{ident}-arrow" viewBox="0 0 10 10" refX="10" refY="5" markerWidth="7" markerHeight="7" '
