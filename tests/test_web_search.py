@@ -131,3 +131,12 @@ def test_a_not_found_page_offers_to_search_for_the_name(client: FlaskClient) -> 
     assert gone.status_code == 404 and 'value="Nothing"' in gone.text
     plain = client.get("/no-such-page", headers={"Accept": "text/html"})
     assert plain.status_code == 404 and "error-search" not in plain.text
+
+
+def test_a_name_that_has_the_text_comes_before_a_label_that_has_it_further_in() -> None:
+    in_name = search.rank("price", ("EuropeTaxedPrice",), ("taxed price in Europe",))
+    in_label = search.rank("price", ("arbitrage",), ("the purchase of a commodity at a price discrepancy",))
+    assert in_name == search.CONTAINS and in_label == search.IN_LABEL
+    assert search.rank("position", ("Pos",), ("position",)) == search.EXACT  # a label that is the text
+    assert search.rank("robot pos", ("Thing",), ("robot position",)) == search.PREFIX
+    assert search.rank("zzz", ("Thing",), ("label",)) is None

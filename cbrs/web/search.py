@@ -24,12 +24,23 @@ blueprint = Blueprint("search", __name__)
 MAX_TEXT = 200  # characters of a search text
 SHOWN = 50  # matches listed per group; the count says how many there are
 
-EXACT, PREFIX, WORD, CONTAINS, BY_CONCEPT = range(5)
+EXACT, PREFIX, WORD, CONTAINS, IN_LABEL, BY_CONCEPT = range(6)
 
 
-def rank(needle: str, names: Iterable[str | None]) -> int | None:
+def rank(needle: str, names: Iterable[str | None], labels: Iterable[str | None] = ()) -> int | None:
     """How well ``needle`` (case-folded) matches the best of ``names``: :data:`EXACT`, :data:`PREFIX`,
-    :data:`WORD` (a word in it starts with the text), :data:`CONTAINS`, or ``None``."""
+    :data:`WORD` (a word in it starts with the text), :data:`CONTAINS`, or ``None``. A label that is
+    the text or starts with it counts as a name; one that has it further in comes after every name
+    (:data:`IN_LABEL`): on OWLS-TC, "price" found ``arbitrage`` by its comment-like label before
+    ``EuropeTaxedPrice``."""
+    found = [_rank(needle, names)]
+    by_label = _rank(needle, labels)
+    if by_label is not None:
+        found.append(by_label if by_label <= PREFIX else IN_LABEL)
+    return min((r for r in found if r is not None), default=None)
+
+
+def _rank(needle: str, names: Iterable[str | None]) -> int | None:
     best: int | None = None
     for name in names:
         if not name:
@@ -99,7 +110,7 @@ def _terms(needle: str) -> dict[str, Any]:
     rows = []
     for term, kind in found.kinds.items():
         label = found.labels.get(term)
-        score = rank(needle, (local_name(term), label))
+        score = rank(needle, (local_name(term),), (label,))
         if score is not None:
             rows.append((score, local_name(term), {**found.term(term), "kind": kind}))
     return _group(rows)
@@ -110,8 +121,7 @@ def _advertisements(needle: str, terms: list[tuple[int, str, dict[str, Any]]]) -
     concepts = {row["iri"] for score, _, row in terms if score <= PREFIX}
     rows = []
     for ad in services.advertisement_rows(context.kb()):
-        names = (ad["service_name"], ad["device_name"], ad["label"], local_name(ad["service"]))
-        score = rank(needle, names)
+        score = rank(needle, (ad["service_name"], ad["device_name"], local_name(ad["service"])), (ad["label"],))
         via = sorted({c for c in (*ad["inputs"], *ad["outputs"]) if c in concepts})
         if score is None and via:
             score = BY_CONCEPT
@@ -124,7 +134,7 @@ def _advertisements(needle: str, terms: list[tuple[int, str, dict[str, Any]]]) -
 def _requirements(needle: str) -> dict[str, Any]:
     rows = []
     for requirement in services.requirement_rows(context.kb()):
-        score = rank(needle, (local_name(requirement["requirement"]), requirement["label"]))
+        score = rank(needle, (local_name(requirement["requirement"]),), (requirement["label"],))
         if score is not None:
             rows.append((score, requirement["name"], requirement))
     return _group(rows)
