@@ -13,7 +13,7 @@ from flask.testing import FlaskClient
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import expand
 from cbrs.sparql_service import SparqlService
-from cbrs.web import create_app, search
+from cbrs.web import create_app, ranking, search
 
 from .test_access import HOSTILE
 
@@ -134,9 +134,9 @@ def test_a_not_found_page_offers_to_search_for_the_name(client: FlaskClient) -> 
 
 
 def test_a_name_that_has_the_text_comes_before_a_label_that_has_it_further_in() -> None:
-    in_name = search.rank("price", ("EuropeTaxedPrice",), ("taxed price in Europe",))
-    in_label = search.rank("price", ("arbitrage",), ("the purchase of a commodity at a price discrepancy",))
-    assert in_name == search.CONTAINS and in_label == search.IN_LABEL
-    assert search.rank("position", ("Pos",), ("position",)) == search.EXACT  # a label that is the text
-    assert search.rank("robot pos", ("Thing",), ("robot position",)) == search.PREFIX
-    assert search.rank("zzz", ("Thing",), ("label",)) is None
+    in_name = ranking.rank("price", ("EuropeTaxedPrice",), ("taxed price in Europe",))
+    in_label = ranking.rank("price", ("arbitrage",), ("the purchase of a commodity at a price discrepancy",))
+    assert in_name == ranking.CONTAINS and in_label == ranking.IN_LABEL
+    assert ranking.rank("position", ("Pos",), ("position",)) == ranking.EXACT  # a label that is the text
+    assert ranking.rank("robot pos", ("Thing",), ("robot position",)) == ranking.PREFIX
+    assert ranking.rank("zzz", ("Thing",), ("label",)) is None

@@ -116,3 +116,11 @@ def test_the_class_page_links_its_subtree(whole: FlaskClient) -> None:
     page = whole.get("/taxonomy/class", query_string={"iri": "home:Position"}).text
     assert 'href="/taxonomy?root=home:Position"' in page
     assert whole.get("/taxonomy?root=home:Position").status_code == 200
+
+
+def test_the_match_list_puts_the_best_matches_first(client: FlaskClient, monkeypatch: pytest.MonkeyPatch) -> None:
+    """In name order, an exact match could fall past the listed ones (OWLS-TC's Car came after 200 others)."""
+    monkeypatch.setattr(taxonomy, "MAX_MATCHES", 3)
+    body = client.get("/taxonomy.json", query_string={"q": "position"}).get_json()
+    assert [m["name"] for m in body["matches"]][0] == "home:Position"
+    assert body["match_count"] > 3

@@ -8,7 +8,6 @@ a service whose inputs or outputs are of a matching concept comes last, saying w
 
 from __future__ import annotations
 
-from collections.abc import Iterable
 from typing import Any
 
 import pyoxigraph as ox
@@ -17,6 +16,7 @@ from flask import Blueprint, request
 from cbrs.kb.namespaces import expand, shorten
 from cbrs.web import context, services
 from cbrs.web.pages import FormError, Page, page
+from cbrs.web.ranking import IN_LABEL, PREFIX, rank
 from cbrs.web.taxonomy import current_taxonomy, local_name
 
 blueprint = Blueprint("search", __name__)
@@ -24,44 +24,7 @@ blueprint = Blueprint("search", __name__)
 MAX_TEXT = 200  # characters of a search text
 SHOWN = 50  # matches listed per group; the count says how many there are
 
-EXACT, PREFIX, WORD, CONTAINS, IN_LABEL, BY_CONCEPT = range(6)
-
-
-def rank(needle: str, names: Iterable[str | None], labels: Iterable[str | None] = ()) -> int | None:
-    """How well ``needle`` (case-folded) matches the best of ``names``: :data:`EXACT`, :data:`PREFIX`,
-    :data:`WORD` (a word in it starts with the text), :data:`CONTAINS`, or ``None``. A label that is
-    the text or starts with it counts as a name; one that has it further in comes after every name
-    (:data:`IN_LABEL`): on OWLS-TC, "price" found ``arbitrage`` by its comment-like label before
-    ``EuropeTaxedPrice``."""
-    found = [_rank(needle, names)]
-    by_label = _rank(needle, labels)
-    if by_label is not None:
-        found.append(by_label if by_label <= PREFIX else IN_LABEL)
-    return min((r for r in found if r is not None), default=None)
-
-
-def _rank(needle: str, names: Iterable[str | None]) -> int | None:
-    best: int | None = None
-    for name in names:
-        if not name:
-            continue
-        folded = name.casefold()
-        if needle not in folded:
-            continue
-        if folded == needle:
-            return EXACT
-        if folded.startswith(needle):
-            found = PREFIX
-        elif any(word.startswith(needle) for word in _words(folded)):
-            found = WORD
-        else:
-            found = CONTAINS
-        best = found if best is None else min(best, found)
-    return best
-
-
-def _words(text: str) -> list[str]:
-    return "".join(c if c.isalnum() else " " for c in text).split()
+BY_CONCEPT = IN_LABEL + 1  # an advertisement found by the concept of an input or output
 
 
 @page(blueprint, "/search")

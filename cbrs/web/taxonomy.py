@@ -23,7 +23,7 @@ from cbrs.kb.errors import NotFoundError
 from cbrs.kb.namespaces import OWL, RDF, RDFS, GraphName, shorten
 from cbrs.kb.vocab import CBRS
 from cbrs.output import Expression, class_expression, manchester, node_view
-from cbrs.web import context, diagram, resource
+from cbrs.web import context, diagram, ranking, resource
 from cbrs.web.links import display_name, display_text, iri_link
 from cbrs.web.pages import Page, page, wants_json
 
@@ -183,6 +183,17 @@ class Taxonomy:
             }
         )
 
+    def ranked(self, text: str) -> list[str]:
+        """:meth:`search`'s terms, best match first (:func:`ranking.rank`): the list shows the first
+        ``MAX_MATCHES``, and in name order OWLS-TC's ``Car`` came after 200 others containing "car"."""
+        needle = text.casefold()
+
+        def score(term: str) -> int:
+            found = ranking.rank(needle, (local_name(term),), (self.labels.get(term),))
+            return ranking.IN_LABEL if found is None else found
+
+        return sorted(self.search(text), key=score)  # stable: in name order within a score
+
     def paths(self, iri: str) -> list[list[str]]:
         """The is-a paths from a root down to ``iri`` (``iri`` excluded), at most ``MAX_PATHS``."""
         found: list[list[str]] = []
@@ -233,7 +244,7 @@ def taxonomy() -> Page:
     keep: set[str] | None = None
     matches: list[str] = []
     if query:
-        matches = found.search(query)
+        matches = found.ranked(query)
         keep = set(matches).union(*(found.ancestors(m) for m in matches))
         data["match_count"] = len(matches)
         data["matches"] = [
