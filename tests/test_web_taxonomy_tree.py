@@ -119,7 +119,7 @@ def test_the_class_page_links_its_subtree(whole: FlaskClient) -> None:
 
 
 def test_the_match_list_puts_the_best_matches_first(client: FlaskClient, monkeypatch: pytest.MonkeyPatch) -> None:
-    """In name order, an exact match could fall past the listed ones (OWLS-TC's Car came after 200 others)."""
+    """In name order an exact match could fall past the listed ones (OWLS-TC's Car was 72nd of 406)."""
     monkeypatch.setattr(taxonomy, "MAX_MATCHES", 3)
     body = client.get("/taxonomy.json", query_string={"q": "position"}).get_json()
     assert [m["name"] for m in body["matches"]][0] == "home:Position"

@@ -185,7 +185,7 @@ class Taxonomy:
 
     def ranked(self, text: str) -> list[str]:
         """:meth:`search`'s terms, best match first (:func:`ranking.rank`): the list shows the first
-        ``MAX_MATCHES``, and in name order OWLS-TC's ``Car`` came after 200 others containing "car"."""
+        ``MAX_MATCHES``, and in name order OWLS-TC's ``Car`` was 72nd of 406 terms containing "car"."""
         needle = text.casefold()
 
         def score(term: str) -> int:
