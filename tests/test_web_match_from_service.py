@@ -48,3 +48,12 @@ def test_each_candidate_links_its_service_page(client: FlaskClient) -> None:
     assert len(services) == 3
     for href in services:
         assert client.get(unescape(href)).status_code == 200, href
+
+
+def test_a_requirement_page_links_its_plan(client: FlaskClient) -> None:
+    body = client.get("/service.json", query_string={"iri": "req:FetchMyPen"}).get_json()
+    assert body["plan"] == "/plans?task=req:FetchMyPen"
+    assert f'<a class="button" href="{body["plan"]}">Plan it</a>' in client.get("/service?iri=req:FetchMyPen").text
+    plan = client.get(body["plan"].replace("/plans", "/plans.json", 1)).get_json()
+    assert plan["composition"]["status"] == "planned" and plan["composition"]["steps"]
+    assert "plan" not in client.get("/service.json", query_string={"iri": CAMERA}).get_json()

@@ -21,6 +21,7 @@ from cbrs.web.pages import FormError, Page, page
 blueprint = Blueprint("services", __name__)
 
 MATCH_ENDPOINT = "matchmaking.matchmaking"
+PLAN_ENDPOINT = "plans.plans"
 PAGE_ROWS = 200  # advertisements a services page shows (CBRS_SERVICES_ROWS); ?page= gives the others
 
 
@@ -91,6 +92,8 @@ def service() -> Page:
     match = MATCH_ENDPOINT in current_app.view_functions
     if isinstance(description, Requirement):
         data["match"] = url_for(MATCH_ENDPOINT, requirement=iri) if match else None
+        planned = PLAN_ENDPOINT in current_app.view_functions  # compose it into services, as cbrs plan does
+        data["plan"] = url_for(PLAN_ENDPOINT, task=shorten(iri)) if planned else None
     elif isinstance(description, Advertisement):
         data["requirements"] = _requirements_for(kb, description) if match else []
         data["similar"] = _similar_url(data) if match else None
