@@ -4,7 +4,6 @@ about 1.5 s a page), and a write to the store shows on the next page."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -18,10 +17,9 @@ LAB = "http://example.org/cache-lab#"
 
 
 @pytest.fixture
-def kb() -> Iterator[KnowledgeBase]:
-    opened = KnowledgeBase.open(":memory:")
-    yield opened
-    opened.close()
+def kb(fresh_bundled_kb: KnowledgeBase) -> KnowledgeBase:
+    """A store of its own: the tests write to it."""
+    return fresh_bundled_kb
 
 
 @pytest.fixture
