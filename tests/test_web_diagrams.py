@@ -44,6 +44,8 @@ def test_the_class_page_draws_the_class_among_its_ancestors_subclasses_and_parts
     svg = picture(page)
     # a group, not role="img", which would hide the links inside from screen readers
     assert svg.get("role") == "group" and svg.find(SVG + "title") is not None
+    description = svg.find(SVG + "desc")
+    assert description is not None and "direct subclasses" in (description.text or "")
     assert all(a.find(SVG + "title") is not None for a in svg.iter(SVG + "a"))  # each link has a name
     drawn = boxes(svg)
     assert {"owl:Thing", "home:SpatialData", "home:Position"} <= set(drawn)  # the path up, and itself
@@ -163,3 +165,9 @@ def test_a_subtree_page_draws_its_root(client: FlaskClient) -> None:
     assert {"home:SpatialData", "home:Position", "home:RobotPosition"} <= set(drawn)
     assert "picture" not in client.get("/taxonomy.json", query_string={"root": "home:Position"}).get_json()
     assert '<svg class="diagram"' not in client.get("/taxonomy").text
+
+
+def test_a_property_s_picture_speaks_of_subproperties(client: FlaskClient) -> None:
+    svg = picture(client.get("/taxonomy/class", query_string={"iri": "home:hasXCoordinate"}).text)
+    description = svg.find(SVG + "desc")
+    assert description is not None and "direct subproperties" in (description.text or "")
