@@ -126,6 +126,8 @@ def test_the_plan_page_draws_the_data_flow(client: FlaskClient) -> None:
     bindings = sum(len(s["inputs"]) + len(s["preconditions"]) for s in steps) + len(body["composition"]["goals"])
     assert len(list(svg.iter(SVG + "polyline"))) == bindings
     assert_no_arrow_runs_under_a_box(svg)
+    heads = [line.get("points", "").split()[-1] for line in svg.iter(SVG + "polyline")]
+    assert len(set(heads)) == len(heads)  # arrows into one box spread over its side, not onto one point
     # a step is drawn below every step it takes something from
     y = {a.get("href"): float(next(a.iter(SVG + "rect")).get("y", "0")) for a in svg.iter(SVG + "a")}
     for step in steps:

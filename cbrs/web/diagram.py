@@ -155,8 +155,10 @@ def layered(
         f'<defs><marker id="{ident}-arrow" viewBox="0 0 10 10" refX="10" refY="5" markerWidth="7" markerHeight="7" '
         'orient="auto-start-reverse"><path d="M0,0 L10,5 L0,10 z" fill="#5d6778"/></marker></defs>',
     ]
-    for edge, keys in routes:
-        parts.append(_edge([placed[key] for key in keys], edge, f"{ident}-arrow"))
+    paths = [[placed[key] for key in keys] for _, keys in routes]
+    ends = _spread(paths)
+    for (edge, _), path, (start, end) in zip(routes, paths, ends, strict=True):
+        parts.append(_edge(_points(path, start, end), edge, f"{ident}-arrow"))
     for item in placed.values():
         if item.box.kind != VIRTUAL:
             parts.append(_box(item))
@@ -164,8 +166,30 @@ def layered(
     return Markup("".join(parts))
 
 
-def _points(path: list[_Placed]) -> list[tuple[float, float]]:
-    """Where the arrow runs: out of the first box, through each waypoint's slot, into the last box."""
+def _spread(paths: list[list[_Placed]]) -> list[tuple[float | None, float | None]]:
+    """Where each arrow leaves its first box and enters its last, along the box's top or bottom side:
+    the arrows at one side spread over it in the order of where their other ends are, instead of all
+    meeting at its middle, where their heads and names lay on one another."""
+    sides: dict[tuple[str, bool], list[tuple[float, int, int]]] = {}
+    for number, path in enumerate(paths):
+        source, target = path[0], path[-1]
+        if len(path) == 2 and abs(source.y - target.y) < 1:
+            continue  # side to side, in one row
+        down = target.y > source.y
+        after, before = path[1], path[-2]
+        sides.setdefault((source.box.key, down), []).append((after.x + after.width / 2, number, 0))
+        sides.setdefault((target.box.key, not down), []).append((before.x + before.width / 2, number, 1))
+    found: list[list[float | None]] = [[None, None] for _ in paths]
+    for (key, _), attached in sides.items():
+        box = next(p for path in paths for p in (path[0], path[-1]) if p.box.key == key)
+        for place, (_, number, end) in enumerate(sorted(attached)):
+            found[number][end] = box.x + box.width * (place + 1) / (len(attached) + 1)
+    return [(start, end) for start, end in found]
+
+
+def _points(path: list[_Placed], start: float | None = None, end: float | None = None) -> list[tuple[float, float]]:
+    """Where the arrow runs: out of the first box (at ``start`` along its side, else its middle),
+    through each waypoint's slot, into the last box (at ``end``)."""
     source, target = path[0], path[-1]
     if len(path) == 2 and abs(source.y - target.y) < 1:  # the same row: side to side
         y = source.y + source.height / 2
@@ -173,7 +197,9 @@ def _points(path: list[_Placed]) -> list[tuple[float, float]]:
             return [(source.x + source.width, y), (target.x, y)]
         return [(source.x, y), (target.x + target.width, y)]
     down = target.y > source.y
-    points = [(source.x + source.width / 2, source.y + (source.height if down else 0))]
+    first = source.x + source.width / 2 if start is None else start
+    last = target.x + target.width / 2 if end is None else end
+    points = [(first, source.y + (source.height if down else 0))]
     for waypoint in path[1:-1]:
         x = waypoint.x + waypoint.width / 2
         points += (
@@ -184,12 +210,11 @@ def _points(path: list[_Placed]) -> list[tuple[float, float]]:
                 (x, waypoint.y),
             ]
         )
-    points.append((target.x + target.width / 2, target.y + (0 if down else target.height)))
+    points.append((last, target.y + (0 if down else target.height)))
     return points
 
 
-def _edge(path: list[_Placed], edge: Edge, arrow: str) -> str:
-    points = _points(path)
+def _edge(points: list[tuple[float, float]], edge: Edge, arrow: str) -> str:
     dash = ' stroke-dasharray="5 3"' if edge.dashed else ""
     drawn = " ".join(f"{x:.1f},{y:.1f}" for x, y in points)
     line = (
