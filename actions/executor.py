@@ -36,6 +36,12 @@ class Verifier(Protocol):
         """Whether ``statement`` holds now (None: it cannot be checked)."""
 
 
+class StepStart(Protocol):
+    def __call__(self, step: PlanStep, known: Mapping[int, Mapping[str, Any]]) -> None:
+        """``step`` is about to start; ``known`` holds, by step index, the inputs of every step of the plan
+        known now (the task's values, outputs already produced): what an environment may look ahead at."""
+
+
 @dataclass
 class Attempt:
     component: str
@@ -157,8 +163,10 @@ class Executor:
         verifier: Verifier | None = None,
         clock: Callable[[], float] | None = None,
         step_timeout: int = 10_000,
+        on_start: StepStart | None = None,
     ) -> None:
         self.plan = plan
+        self.on_start = on_start
         self.container = container
         self.given = dict(given)
         self.verifier = verifier
@@ -247,6 +255,8 @@ class Executor:
         self._started_at = self.clock()
         self._publish("step_started", step, iri)
         try:
+            if self.on_start is not None:
+                self.on_start(step, {other.index: self.inputs_for(other) for other in self.plan.steps})
             self.container.start(iri, self._inputs(step))
         except Exception as error:  # a component may raise anything: it is a violation, not a crash
             self._violation(step, iri, f"{type(error).__name__}: {error}")

@@ -43,6 +43,9 @@ class Environment(Protocol):
     def clock(self) -> float:
         """Seconds on the environment's clock (simulated time)."""
 
+    # Optional: ``starting(step, known)`` (``executor.StepStart``), called before each step starts with
+    # the inputs of every step known by then, for an environment that looks ahead (where a hold ends).
+
 
 @dataclass(frozen=True)
 class Replan:
@@ -184,7 +187,8 @@ def run_task(
                     belief.restore(before)
                 raise
             store_plan(kb, plan)
-            executor = Executor(plan, container, given, environment.verify, environment.clock)
+            starting = getattr(environment, "starting", None)  # optional: a look-ahead at the plan's values
+            executor = Executor(plan, container, given, environment.verify, environment.clock, on_start=starting)
             done = 0
             _stop_if_cancelled(executor, cancelled, done)
             while executor.status is RunStatus.RUNNING and executor.ticks < max_ticks:

@@ -124,6 +124,8 @@ class SimContext:
     plan: Plan | None = None  # the plan being run, and the values the task gives its steps (``given``)
     given: Mapping[str, Any] = field(default_factory=dict)
     component: str | None = None  # the IRI of the running component
+    step: PlanStep | None = None  # the plan's step being run, and every step's inputs known at its start
+    known: Mapping[int, Mapping[str, Any]] = field(default_factory=dict)
 
     @property
     def map(self) -> SemanticMap:
@@ -424,15 +426,20 @@ def _taking(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, side:
 
 
 def _hold_end(ctx: SimContext, name: str) -> tuple[Thing, Region, list[tuple[float, float]]] | None:
-    """Where the hold the running component starts ends, when the plan and the task say: the place
-    given by the task to the first carry after the running step (the plan's one step of this component:
-    nothing else says which step runs), before any other step of its robot takes an object; and that
-    place's surface and spots (:func:`_place_spots`) for the arm ``ctx.arm``, as the carry will aim. None
-    when it is not known here (the place is another step's output, or no carry follows)."""
+    """Where the hold the running component starts ends, when the plan says: the place the first carry
+    after the running step is given, before any other step of its robot takes an object; and that
+    place's surface and spots (:func:`_place_spots`) for the arm ``ctx.arm``, as the carry will aim.
+    The running step is the one the executor said it starts (``SimEnvironment.starting``), else the
+    plan's one step of this component; the carry's place is what the executor knows of its inputs then
+    (the task's value, or an earlier step's output), else the task's value. None when it is not known
+    here (the place is a later step's output, or no carry follows)."""
     plan, iri, smap = ctx.plan, ctx.component, ctx.map
     if plan is None or iri is None:
         return None
-    mine = [position for position, step in enumerate(plan.steps) if iri in step.candidates]
+    if ctx.step is not None and iri in ctx.step.candidates:
+        mine = [position for position, step in enumerate(plan.steps) if step.index == ctx.step.index]
+    else:
+        mine = [position for position, step in enumerate(plan.steps) if iri in step.candidates]
     if len(mine) != 1:
         return None
     device = plan.steps[mine[0]].device
@@ -443,7 +450,10 @@ def _hold_end(ctx: SimContext, name: str) -> tuple[Thing, Region, list[tuple[flo
             return None  # another hold starts first
         if step.action != ACT + "CarryingWhileLocomoting":
             continue
-        values = [ctx.given.get(b.source.name) for b in step.inputs if b.source.step is None]
+        if step.index in ctx.known:
+            values = list(ctx.known[step.index].values())
+        else:
+            values = [ctx.given.get(b.source.name) for b in step.inputs if b.source.step is None]
         iris = [str(value["@id"]) for value in values if isinstance(value, dict) and "@id" in value]
         places = [iri for iri in iris if iri in smap.regions or iri in smap.furniture]
         if len(places) != 1:
@@ -1260,10 +1270,16 @@ class SimEnvironment:
                         values[source.name] = designator(iri, parameter.type)
         self.context.designated = frozenset(str(value["@id"]) for value in values.values())
         self.context.plan, self.context.given = plan, values  # where a hold ends, for the approach
+        self.context.step, self.context.known = None, {}
         if not self.context.acted:  # checked before anything moved; a re-plan fails by its steps
             self._check_reach(plan, values)
             self._check_loading(plan, values)
         return values
+
+    def starting(self, step: PlanStep, known: Mapping[int, Mapping[str, Any]]) -> None:
+        """The executor starts ``step``; ``known`` holds every step's inputs known now. Kept so that a
+        component knows which step of the plan it runs and where a later step takes what it holds."""
+        self.context.step, self.context.known = step, known
 
     def _check_loading(self, plan: Plan, values: Mapping[str, Any]) -> None:
         """Refuse a plan that hands an object the task gives over onto the base's platform when no arm

@@ -123,6 +123,35 @@ def test_a_plan_runs_step_by_step_and_passes_data() -> None:
     ]
 
 
+def test_each_start_tells_what_the_plans_steps_are_known_to_take_by_then() -> None:
+    """The look-ahead hook (an environment's ``starting``): before each step, every step's inputs known
+    then, the task's values first and each output as soon as it is produced."""
+    seen: list[tuple[int, dict[int, dict[str, Any]]]] = []
+
+    def starting(started: PlanStep, known: Mapping[int, Mapping[str, Any]]) -> None:
+        seen.append((started.index, {index: dict(values) for index, values in known.items()}))
+
+    stubs = {n: Stub(EX + n) for n in "ABC"}
+    report = Executor(chain(), setup(stubs), {"given": "g"}, on_start=starting).run(max_ticks=100)
+    assert report.status is RunStatus.SUCCEEDED
+    assert seen == [
+        (1, {1: {"in": "g"}, 2: {}, 3: {}}),
+        (2, {1: {"in": "g"}, 2: {"in": "A(g)"}, 3: {}}),
+        (3, {1: {"in": "g"}, 2: {"in": "A(g)"}, 3: {"in": "B(A(g))"}}),
+    ]
+
+
+def test_a_look_ahead_that_raises_is_the_steps_violation_not_a_crash() -> None:
+    def starting(started: PlanStep, known: Mapping[int, Mapping[str, Any]]) -> None:
+        if started.index == 2:
+            raise RuntimeError("cannot look ahead")
+
+    stubs = {n: Stub(EX + n) for n in "ABC"}
+    report = Executor(chain(), setup(stubs), {"given": "g"}, on_start=starting).run(max_ticks=100)
+    assert report.status is RunStatus.FAILED and "cannot look ahead" in report.steps[1].attempts[0].reason
+    assert stubs["C"].seen == []
+
+
 @pytest.mark.parametrize("mode", ["fail", "raise", "raise-on-begin", "hang"])
 def test_a_violation_fails_over_to_the_alternative(mode: str) -> None:
     stubs = {"A": Stub(EX + "A"), "B": Stub(EX + "B", mode=mode), "B2": Stub(EX + "B2"), "C": Stub(EX + "C")}

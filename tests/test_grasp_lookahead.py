@@ -101,3 +101,34 @@ def test_where_the_hold_ends_is_the_carrys_place_when_the_task_gives_it_and_else
 
         ctx.plan = replace(plan, steps=tuple(s for s in plan.steps if s is not carry))
         assert _hold_end(ctx, "Cup") is None  # no carry follows
+
+
+def test_the_executor_says_which_step_runs_and_what_an_earlier_step_gave_the_carry(tmp_path: Path) -> None:
+    """What the IRI alone leaves open, the executor's start of a step settles (SimEnvironment.starting):
+    which of two steps of one component runs, and a place an earlier step output for the carry."""
+    kb = cup_to_the_tray(tmp_path)
+    plan = Composer(kb).compose("PutCupOnTray").plan
+    assert plan is not None
+    cup, place = designator(WORLD + "Cup", HOME + "Cup"), designator(WORLD + "TrayPlace", HOME + "ObjectPlace")
+    carry = next(s for s in plan.steps if s.action == PREFIXES["act"] + "CarryingWhileLocomoting")
+    approach = next(s for s in plan.steps if APPROACH in s.candidates)
+    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
+        environment = SimEnvironment(world, kb)
+        ctx = environment.context
+        ctx.given, ctx.component = {"cup": cup}, APPROACH
+        from_a_step = replace(
+            carry, bindings=tuple(replace(b, source=Source("objectPlace", step=1)) for b in carry.bindings)
+        )
+        later = replace(approach, index=len(plan.steps) + 1)  # the same component again, after the carry
+        ctx.plan = replace(plan, steps=(*(from_a_step if s is carry else s for s in plan.steps), later))
+        assert _hold_end(ctx, "Cup") is None  # neither which step runs nor the place is known
+
+        environment.starting(approach, {carry.index: {"object": cup, "place": place}})
+        found = _hold_end(ctx, "Cup")
+        assert found is not None and found[0].iri == WORLD + "TrayPlace"
+
+        environment.starting(later, {carry.index: {"object": cup, "place": place}})
+        assert _hold_end(ctx, "Cup") is None  # no carry follows the later step
+
+        environment.starting(approach, {carry.index: {"object": cup}})
+        assert _hold_end(ctx, "Cup") is None  # the place is not produced yet
