@@ -395,7 +395,7 @@ def _classify(
     iri: str,
     values: dict[str, list[str]],
     types: tuple[str, ...],
-    affordances: dict[str, list[tuple[str, str]]],
+    affordances: dict[str, list[tuple[str, str, str]]],
     facts: dict[str, dict[str, list[str]]],
     person: bool,
 ) -> None:
