@@ -14,6 +14,8 @@ from collections import defaultdict
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
+from pyoxigraph import NamedNode
+
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import PREFIXES
 
@@ -603,7 +605,12 @@ def designate(kb: KnowledgeBase, concept: str, prefer: str | None = None) -> str
 
 
 def _linked(kb: KnowledgeBase, owner: str, thing: str) -> bool:
-    first = {row["value"].value for row in kb.select("map_facts", {"thing": owner})}
-    if thing in first:
-        return True
-    return any(thing in {row["value"].value for row in kb.select("map_facts", {"thing": hop})} for hop in first)
+    """Whether ``thing`` is one of ``owner``'s things, one or two links away. Only things are followed:
+    a fact's literal value (a robot's ``home:y 1.5``) is no thing to look up."""
+
+    def linked(subject: str) -> set[str]:
+        rows = kb.select("map_facts", {"thing": subject})
+        return {row["value"].value for row in rows if isinstance(row["value"], NamedNode)}
+
+    first = linked(owner)
+    return thing in first or any(thing in linked(hop) for hop in first)

@@ -103,6 +103,17 @@ def test_an_input_is_resolved_by_its_class_and_ambiguity_names_the_candidates() 
         designate(kb, HOME + "Bottle")
 
 
+def test_a_robots_preference_follows_its_things_not_its_numbers() -> None:
+    """With two pens, the requesting robot's own things win; its literal facts (``home:y 1.5``) are no
+    things to follow: looking them up as IRIs broke every task with two things of an input's class."""
+    kb = KnowledgeBase.open(":memory:")
+    kb.update("INSERT DATA { GRAPH graph:map { world:Pen2 a home:Pen ; home:x 7.9 ; home:y 3.4 } }")
+    with pytest.raises(AmbiguousDesignatorError) as ambiguous:
+        designate(kb, HOME + "Pen", prefer=PREFIXES["svc"] + "P3DX01")
+    assert ambiguous.value.candidates == [WORLD + "Pen", WORLD + "Pen2"]
+    assert designate(kb, HOME + "ColourMarker", prefer=PREFIXES["svc"] + "P3DX01")  # its own marker, as before
+
+
 def test_a_task_whose_input_has_no_thing_in_the_world_says_which(tmp_path: Path) -> None:
     kb = KnowledgeBase.open(":memory:")
     task = (TASKS / "fetch_my_pencil.ttl").read_text(encoding="utf-8")
