@@ -57,6 +57,7 @@ from cbrs.sim.values import (
     OBJECT_LOCATION,
     ColourFeature,
     GraspPlan,
+    IsA,
     MalformedValueError,
     Manipulation,
     ObjectFeature,
@@ -64,6 +65,7 @@ from cbrs.sim.values import (
     decode,
     designator,
     from_json,
+    taxonomy,
     to_json,
 )
 from cbrs.sim.world import HomeWorld
@@ -1114,12 +1116,13 @@ def implementations(
     type (when there is a ``transport`` to reach it), else a simulated one where the simulation can
     perform its service on its device (cameras must exist in the world)."""
     registry = registry if registry is not None else Registry()
+    is_a = _store_taxonomy(kb)
     for ad in kb.advertisements():
         remote = next((p for p in ad.ports if p.kind == "service" and p.topic and p.message_type), None)
         if remote is not None:
             if transport is not None and remote.topic is not None:
                 outputs = {p.name: p.type for p in ad.outputs if p.name}
-                registry.add(ad.iri, _remote(transport, remote.topic, outputs))
+                registry.add(ad.iri, _remote(transport, remote.topic, outputs, is_a))
             continue
         work = SKILLS.get(ad.service_name or "")
         device = ad.device_name or ""
@@ -1136,8 +1139,25 @@ REMOTE_TIMEOUT = 10.0
 """Seconds a remote component has to answer one call (a perception or a computation, not a motion)."""
 
 
-def _remote(transport: Transport, service: str, outputs: Mapping[str, str]) -> Callable[[str], Component]:
-    return lambda iri: RemoteComponent(iri, transport, service, outputs, check, REMOTE_TIMEOUT)
+def _store_taxonomy(kb: KnowledgeBase) -> IsA:
+    """The store's taxonomy, read at the first remote answer that needs it: a remote answer's ``@type``
+    may be a subclass of its port's class, also one a lab registered (docs/values.md)."""
+    table: IsA | None = None
+
+    def is_a(concept: str, superclass: str) -> bool:
+        nonlocal table
+        if table is None:
+            table = taxonomy((row["class"].value, row["superclass"].value) for row in kb.select("subclasses"))
+        return table(concept, superclass)
+
+    return is_a
+
+
+def _remote(transport: Transport, service: str, outputs: Mapping[str, str], is_a: IsA) -> Callable[[str], Component]:
+    def checked(concept: str, value: Any) -> dict[str, Any]:
+        return check(concept, value, is_a)
+
+    return lambda iri: RemoteComponent(iri, transport, service, outputs, checked, REMOTE_TIMEOUT)
 
 
 def _maker(work: Work, device: str, outputs: tuple[str, ...]) -> Callable[[str], Component]:

@@ -15,10 +15,11 @@ from __future__ import annotations
 
 import base64
 import binascii
+import functools
 import itertools
 import math
 import weakref
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any, NoReturn, TypeAlias, TypeVar
 
@@ -55,15 +56,18 @@ __all__ = [
     "ColourFeature",
     "Designator",
     "GraspPlan",
+    "IsA",
     "MalformedValueError",
     "Manipulation",
     "ObjectFeature",
     "Value",
+    "bundled_taxonomy",
     "check",
     "concepts_of",
     "decode",
     "designator",
     "from_json",
+    "taxonomy",
     "to_json",
 ]
 
@@ -566,32 +570,102 @@ def decode(data: object, kind: type[V]) -> V:
     return value
 
 
-def check(concept: str, data: object) -> dict[str, Any]:
-    """A value another process sent for a port of type ``concept``, checked: a JSON object whose
-    ``"@type"`` is the port's class (a prefixed name is expanded) or, for a class with a shape here,
-    one that decodes to the same kind. A class with no shape here takes any JSON object of that
-    ``@type`` (a thermometer's reading). Returns the value with its ``@type`` written in full;
-    ``MalformedValueError`` (a ``ValueError``) says what was wrong."""
+IsA = Callable[[str, str], bool]
+"""``is_a(class, superclass)``: whether the first class is the second or a subclass of it (a taxonomy)."""
+
+RDFS_SUBCLASS_OF = "http://www.w3.org/2000/01/rdf-schema#subClassOf"
+
+
+def taxonomy(pairs: Iterable[tuple[str, str]]) -> IsA:
+    """The ``is_a`` of a taxonomy given as (class, superclass) pairs, closed here under transitivity
+    (the store's ``subclasses`` query gives the closure already; a file's axioms do not)."""
+    parents: dict[str, set[str]] = {}
+    for sub, sup in pairs:
+        parents.setdefault(sub, set()).add(sup)
+    closure: dict[str, frozenset[str]] = {}
+
+    def ancestors(concept: str) -> frozenset[str]:
+        found = closure.get(concept)
+        if found is None:
+            seen: set[str] = set()
+            todo = [concept]
+            while todo:
+                for sup in parents.get(todo.pop(), ()):
+                    if sup not in seen:
+                        seen.add(sup)
+                        todo.append(sup)
+            found = closure[concept] = frozenset(seen)
+        return found
+
+    return lambda concept, superclass: concept == superclass or superclass in ancestors(concept)
+
+
+@functools.cache
+def bundled_taxonomy() -> IsA:
+    """The home ontology's taxonomy (``ontologies/home.ttl``, read once): what :func:`check` uses when
+    it is given no store's. A run checks remote answers against its store's, which also knows the
+    classes a lab registered."""
+    import pyoxigraph as ox
+
+    from cbrs.kb.resources import ontology_dir
+
+    quads = ox.parse(path=str(ontology_dir() / "home.ttl"), format=ox.RdfFormat.TURTLE)
+    return taxonomy(
+        (q.subject.value, q.object.value)
+        for q in quads
+        if q.predicate.value == RDFS_SUBCLASS_OF
+        and isinstance(q.subject, ox.NamedNode)
+        and isinstance(q.object, ox.NamedNode)
+    )
+
+
+def check(concept: str, data: object, is_a: IsA | None = None) -> dict[str, Any]:
+    """A value another process sent for a port of type ``concept``, checked against docs/values.md:
+    a JSON object whose ``"@type"`` (a prefixed name is expanded) is the port's class or a subclass of
+    it by ``is_a`` (default: :func:`bundled_taxonomy`).
+
+    - A port whose class has a JSON shape here takes a value of that shape: one of the classes of the
+      port's row, or a subclass of the port's class with no shape of its own (read as the port's shape
+      and passed on as the port's class, so that its consumer can decode it). A designator (``"@id"``)
+      is refused: a position or a map is data, not a thing of the world.
+    - A port of any other class (a thing, a status, a thermometer's reading) takes any JSON object of
+      its class or a subclass (``home:Opened`` for ``home:DoorStatus``), a designator of one included.
+
+    Returns the value with its ``@type`` written in full; ``MalformedValueError`` (a ``ValueError``)
+    names the port's class, what was given and what was expected."""
+    named = local_name(concept)
     if not isinstance(data, dict):
-        raise MalformedValueError(concept, "(value)", data, f"a JSON object with '@type' {local_name(concept)}")
+        raise MalformedValueError(concept, "(value)", data, f"a JSON object with '@type' {named}")
     written = data.get("@type", MISSING)
     if not isinstance(written, str) or not written:
-        raise MalformedValueError(concept, "@type", written, f"the class of the value ({local_name(concept)})")
+        raise MalformedValueError(concept, "@type", written, f"the class of the value ({named})")
     try:
         full = expand(written)
     except ValueError:
         raise MalformedValueError(concept, "@type", written, "an IRI or a prefixed name") from None
+    is_a = is_a if is_a is not None else bundled_taxonomy()
     value = {**data, "@type": full}
+    codec = _BY_CONCEPT.get(concept)
     if "@id" in value:
+        if codec is not None:
+            raise MalformedValueError(
+                concept, "(value)", data, f"the JSON shape of {named} (docs/values.md), not a designator (@id)"
+            )
+        if not is_a(full, concept):
+            raise MalformedValueError(concept, "@type", written, f"a designator of {named} or a subclass of it")
         from_json(value)  # a designator: an IRI and a class
         return value
-    codec = _BY_CONCEPT.get(concept)
     if codec is None:
-        if full != concept:
-            raise MalformedValueError(concept, "@type", written, local_name(concept))
+        if not is_a(full, concept):
+            raise MalformedValueError(concept, "@type", written, f"{named} or a subclass of it")
         return value
+    expected = "one of " + ", ".join(local_name(c) for c in codec.concepts) + " or a subclass of " + named
+    if full not in _BY_CONCEPT:
+        if not is_a(full, concept):
+            raise MalformedValueError(concept, "@type", written, expected)
+        codec.decode(_Fields(concept, data))  # a subclass with no shape of its own: the port's shape
+        return {**data, "@type": concept}
     decoded = from_json(value)
     if not isinstance(decoded, codec.kind):
-        expected = "one of " + ", ".join(local_name(c) for c in codec.concepts)
         raise MalformedValueError(concept, "@type", written, expected)
     return value
