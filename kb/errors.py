@@ -5,6 +5,8 @@ from __future__ import annotations
 import re
 from collections.abc import Sequence
 
+from cbrs.kb.namespaces import shorten
+
 
 class KnowledgeBaseError(Exception):
     """Base of every error cbrs raises on purpose; ``str(error)`` is one line fit for a person."""
@@ -187,6 +189,30 @@ class InvalidDescriptionError(KnowledgeBaseError):
         self.iri = iri
         self.problems = list(problems)
         super().__init__(f"{_named(iri)} is not a valid service description: {'; '.join(self.problems)}")
+
+
+class ForeignStatementError(InvalidDescriptionError):
+    """A registration states something new about a term another graph describes (``home:Cup
+    rdfs:subClassOf home:Door``): written to graph:services it would change that term for every reader
+    of the union graph, and stay after the component went. ``statement`` is the triple as Turtle."""
+
+    def __init__(self, source: str, subject: str, graph: str, statement: str) -> None:
+        self.subject = subject
+        self.graph = graph
+        self.statement = statement
+        super().__init__(
+            source,
+            [
+                f"it states {statement}, about {_shortened(subject)}, which {_shortened(graph)} describes: a "
+                "registration adds descriptions and terms of its own, not statements about the store's other "
+                "terms (change those with cbrs load into their graph)"
+            ],
+        )
+
+
+def _shortened(iri: str) -> str:
+    short = shorten(iri)
+    return short if short != iri else f"<{iri}>"
 
 
 def _named(iri: str) -> str:

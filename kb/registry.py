@@ -9,7 +9,13 @@ from pathlib import Path
 import pyoxigraph as ox
 
 from cbrs.kb.conditions import CONDITION_PARTS, LEGACY_PARTS
-from cbrs.kb.errors import AlreadyRegisteredError, InvalidDescriptionError, NotFoundError, OutsideRegistryError
+from cbrs.kb.errors import (
+    AlreadyRegisteredError,
+    ForeignStatementError,
+    InvalidDescriptionError,
+    NotFoundError,
+    OutsideRegistryError,
+)
 from cbrs.kb.loader import parse_bytes, prepare_owls, registration_format
 from cbrs.kb.namespaces import BASE, RDF, RDFS, GraphName, shorten
 from cbrs.kb.owls import is_owls, is_owls_service
@@ -262,7 +268,50 @@ class ComponentRegistry:
             if problems:
                 raise InvalidDescriptionError(iri, problems)
         check_descriptions(self._store, parsed.quads)  # SHACL shapes and declared terms (kb/shapes.py)
+        self._refuse_foreign(parsed.quads, iris, source)
         return parsed.quads, iris
+
+    @releases_results
+    def _refuse_foreign(self, quads: list[ox.Quad], iris: list[str], source: str) -> None:
+        """Refuse a statement, new to the store, about a term another graph than graph:services (and the
+        derived graph:entailed) describes: a registration is read through the union graph by everyone, so
+        one stray ``home:Cup rdfs:subClassOf home:Door`` would make every robot's cup a door, and stay
+        after deregistration. The advertisements, their own nodes and the input's new terms (a lab's
+        device kind) are its own; repeating what the store already holds changes nothing and passes."""
+        own = {GraphName.SERVICES.node, GraphName.ENTAILED.node}
+        subjects = sorted(
+            {q.subject for q in quads if isinstance(q.subject, ox.NamedNode)} - {ox.NamedNode(iri) for iri in iris},
+            key=str,
+        )
+        for subject in subjects:
+            if is_skolem(subject.value):
+                continue
+            graphs = sorted({q.graph_name for q in self._store.quads(subject, None, None, None)} - own, key=str)
+            if not graphs:
+                continue
+            for quad in quads:
+                if quad.subject != subject or self._held_anywhere(quad):
+                    continue
+                shown = " ".join(_turtle(term) for term in (quad.subject, quad.predicate, quad.object))
+                graph = graphs[0]
+                raise ForeignStatementError(source, subject.value, getattr(graph, "value", str(graph)), shown)
+
+    def _held_anywhere(self, quad: ox.Quad) -> bool:
+        """Whether the store holds ``quad``'s triple in any graph: matched by the store, which matches a
+        literal as it keeps it ("0.50"^^xsd:decimal as "0.5"); a quoted triple, which a pattern cannot fix,
+        compared."""
+        assert isinstance(quad.subject, ox.NamedNode | ox.BlankNode)
+        if isinstance(quad.object, ox.Triple):
+            return any(held.object == quad.object for held in self._store.quads(quad.subject, quad.predicate))
+        return next(self._store.quads(quad.subject, quad.predicate, quad.object), None) is not None
+
+
+def _turtle(term: object) -> str:
+    """A term as a statement in an error shows it: a prefixed name where one fits, else as Turtle."""
+    if isinstance(term, ox.NamedNode):
+        short = shorten(term.value)
+        return short if short != term.value else str(term)
+    return str(term)
 
 
 def _count(count: int, one: str, many: str) -> str:

@@ -11,7 +11,8 @@ import pyoxigraph as ox
 import pytest
 
 from cbrs.kb import InvalidDescriptionError, KnowledgeBase, NotFoundError
-from cbrs.kb.namespaces import GENID
+from cbrs.kb.errors import ForeignStatementError
+from cbrs.kb.namespaces import GENID, GraphName
 
 EX = "http://example.org/mini#"
 HEAD = """@prefix cbrs: <https://w3id.org/cbrs/core#> .
@@ -223,13 +224,32 @@ def test_rdf_xml_sent_as_text_is_recognised(mini_kb: KnowledgeBase) -> None:
 def test_a_kind_the_file_declares_itself_is_a_kind(mini_kb: KnowledgeBase) -> None:
     """A lab's own subclass of a component kind, declared in the file that uses it, makes an advertisement."""
     text = _camera(kind="ex:DoorCamera") + (
-        "ex:DoorCamera rdfs:subClassOf ex:Camera . ex:Camera rdfs:subClassOf cbrs:DynamicPerceptionComponent .\n"
+        "ex:DoorCamera rdfs:subClassOf ex:LabCamera . ex:LabCamera rdfs:subClassOf cbrs:DynamicPerceptionComponent .\n"
     )
     text = "@prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .\n" + text
     assert mini_kb.registry.register(text, "door_camera.ttl") == [EX + "DetectDoor_LabCam01"]
     assert EX + "DetectDoor_LabCam01" in [ad.iri for ad in mini_kb.advertisements()]
     mini_kb.registry.deregister(EX + "DetectDoor_LabCam01")
     assert EX + "DetectDoor_LabCam01" not in [ad.iri for ad in mini_kb.advertisements()]
+
+
+def test_a_registration_cannot_restate_a_term_the_ontology_describes(mini_kb: KnowledgeBase) -> None:
+    """ex:Camera is the ontology's: making it a component kind from a registration would change it for every
+    reader of the union graph and outlive the component, so it is refused, and nothing is written."""
+    before = mini_kb.store.dump()
+    text = (
+        "@prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .\n"
+        + _camera(kind="ex:DoorCamera")
+        + ("ex:DoorCamera rdfs:subClassOf ex:Camera . ex:Camera rdfs:subClassOf cbrs:DynamicPerceptionComponent .\n")
+    )
+    with pytest.raises(ForeignStatementError) as refused:
+        mini_kb.registry.register(text, "door_camera.ttl")
+    assert refused.value.subject == EX + "Camera" and refused.value.graph == GraphName.ONTOLOGY.iri
+    assert "rdfs:subClassOf cbrs:DynamicPerceptionComponent" in str(refused.value)
+    assert mini_kb.store.dump() == before
+    restated = "@prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .\n" + _camera()
+    restated += "ex:Camera rdfs:subClassOf cbrs:Device .\n"  # what the ontology says already: changes nothing
+    assert mini_kb.registry.register(restated, "door_camera.ttl") == [EX + "DetectDoor_LabCam01"]
 
 
 def test_an_advertisement_loaded_into_the_ontology_graph_is_said_to_be_there(
