@@ -1238,6 +1238,7 @@ class SimEnvironment:
         """Relations believed because a step with that effect succeeded, where no test decides them."""
         self._superclasses: dict[str, set[str]] | None = None
         self._computables: dict[str, str] | None = None
+        self.effects |= self._untestable_beliefs()
 
     def clock(self) -> float:
         return self.world.time
@@ -1456,20 +1457,45 @@ class SimEnvironment:
 
     def verify(self, step: PlanStep, statement: Statement, outputs: Mapping[str, Any]) -> bool | None:
         """Decide a (class-level) statement by its predicate's computable, for the things at hand, on
-        what the robots perceive now; None when the store maps the predicate to no test or the things
-        cannot be told."""
+        what the robots perceive now. A statement the store maps to no test is believed from the step
+        with that effect on (:meth:`_believe_effect`): True once it is (the task's goal checked at the
+        end, a later step's), None at that step itself (no test decided it) and when its things cannot
+        be told."""
         found = self._judge(self.belief, statement, outputs, look=True)
-        if found is None:
-            self._believe_effect(statement)
-        return found
+        if found is not None:
+            return found
+        fact = self._believe_effect(statement)
+        if fact is None or fact not in self.effects:
+            if fact is not None:
+                self.effects.add(fact)
+            return None
+        return True
 
-    def _believe_effect(self, statement: Statement) -> None:
-        """A relation no test decides is believed because a step that has it as its effect succeeded:
-        it joins the world graph, grounded in the things at hand."""
+    def _believe_effect(self, statement: Statement) -> tuple[str, str, str] | None:
+        """The relation no test decides that a step with it as its effect makes believed: it joins the
+        world graph, grounded in the things at hand. Its object may be a status or another quality
+        (``home:Opened`` in (Door, hasStatus, Opened)): a class no thing of the world stands for, which is
+        then the object itself, as ``home:Water`` is in (Cup, contains, Water)."""
         sides = [self._ground(concept, self.context.inputs) for concept in (statement.subject, statement.object)]
-        iris = [self._iri_of(side) for side in sides if side is not None]
-        if len(iris) == 2 and iris[0] is not None and iris[1] is not None:
-            self.effects.add((iris[0], statement.predicate, iris[1]))
+        subject = self._iri_of(sides[0]) if sides[0] is not None else None
+        if sides[1] is not None:
+            obj = self._iri_of(sides[1])
+        else:
+            obj = statement.object if self.is_a(statement.object, HOME + "Quality") else None
+        if subject is None or obj is None:
+            return None
+        return (subject, statement.predicate, obj)
+
+    def _untestable_beliefs(self) -> set[tuple[str, str, str]]:
+        """The relations about things of this world that the world graph (an earlier run's belief) holds
+        and no test decides: no sense can see them again (a door a remote motor opened), so they stay
+        believed; the relations a test decides are perceived afresh."""
+        kept = set()
+        for row in self.kb.select("world_facts"):
+            fact = (row["thing"].value, row["relation"].value, row["other"].value)
+            if fact[0] in self.world.map.types and self.computable(fact[1]) is None:
+                kept.add(fact)
+        return kept
 
     def _iri_of(self, grounded: Grounded) -> str | None:
         world = self.world
