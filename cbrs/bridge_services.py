@@ -10,8 +10,10 @@ Services (request fields -> response values):
 - ``/cbrs/tasks`` ``{}`` -> ``{tasks}``: every task the store can express, as ``task`` takes it.
 - ``/cbrs/run_task`` ``{task, seed=0, fail=[], fault_rate=0, repeat_failures=1, wait=true}`` -> the run;
   with ``wait`` false it returns at once and the run is followed on the topics, or with
-  ``/cbrs/task_status`` ``{run}``. ``task`` is any requirement or action of the store, named as
-  ``cbrs run`` takes it; ``repeat_failures`` as ``cbrs run --repeat-failures``.
+  ``/cbrs/task_status`` ``{run}``; with ``wait`` it answers when the run ends or, at the latest, two
+  seconds before the bridge's call timeout, with the run as it is then (``running``). ``task`` is any
+  requirement or action of the store, named as ``cbrs run`` takes it; ``repeat_failures`` as
+  ``cbrs run --repeat-failures``.
 
 Action (rosbridge's ROS 2 action ops, ``send_action_goal`` and the rest):
 
@@ -82,6 +84,9 @@ class KnowledgeServices:
         self.matchmakers = matchmakers or Matchmakers(sparql)
         self.composers = Composers(sparql, self.matchmakers)
         self.own_origins = own_origins
+        self.wait_limit = 28.0
+        """Seconds ``/cbrs/run_task`` with ``wait`` waits for the run at most, then answers with the run as it
+        is (``running``): under the bridge's call timeout, so a long run is no failed call (:func:`attach`)."""
 
     def may_write(self) -> bool:
         """Whether the client whose call is answered may write: it sent the token, or it is one of this
@@ -146,7 +151,7 @@ class KnowledgeServices:
     def run_task(self, args: dict[str, Any]) -> dict[str, Any]:
         request = self._run_request(args)
         if _field(args, "wait", bool, True):
-            run = _call(lambda: self.tasks.run(**request))
+            run = _call(lambda: self.tasks.run(**request, timeout=self.wait_limit))
         else:
             run = _call(lambda: self.tasks.start(**request))
         return run.to_dict(with_events=False)
@@ -295,6 +300,7 @@ class Composers:
 
 def attach(bridge: Bridge, services: KnowledgeServices) -> Callable[[], None]:
     """Offer ``services`` on ``bridge`` and relay task events to its topics; returns the detach call."""
+    services.wait_limit = max(0.5, min(services.wait_limit, bridge.call_timeout - 2.0))
     for name, (kind, handler) in services.handlers().items():
         bridge.add_service(name, kind, handler)
     for topic, kind in TOPICS.items():

@@ -119,3 +119,21 @@ def test_the_bridge_lists_and_checks_the_stores_tasks(server: Server) -> None:
     assert planned["result"] is True and planned["values"]["requirement"] == LAB + "FetchMyPencil"
     assert misplanned["result"] is False and "did you mean FetchMyPencil" in misplanned["values"]
     assert server.tasks.runs() == []
+
+
+def test_a_run_longer_than_the_wait_is_answered_running_not_failed(kb: KnowledgeBase) -> None:
+    """/cbrs/run_task with wait answers before the bridge's call timeout would fail the call, with the run
+    as it is then; the run goes on to its end."""
+    from cbrs.bridge_services import KnowledgeServices
+
+    sparql = SparqlService(kb)
+    runner = TaskRunner(kb, sparql.lock, camera=None)
+    services = KnowledgeServices(sparql, runner)
+    services.wait_limit = 0.2  # the run takes seconds
+    try:
+        answer = services.run_task({"task": "FetchMyPencil", "wait": True})
+        assert answer["status"] == "running"
+        assert runner.get(answer["id"]).done.wait(RUN_WAIT), "the run did not end"
+        assert services.task_status({"run": answer["id"]})["status"] == "succeeded"
+    finally:
+        runner.close(RUN_WAIT)
