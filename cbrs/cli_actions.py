@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import socket
@@ -9,10 +10,11 @@ import sys
 import time
 from collections import Counter
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import click
 
+from cbrs.actions.components import Registry
 from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, Objective, PlanStatus, store_plan
 from cbrs.actions.events import Event
 from cbrs.actions.faults import RandomFaults, planned_faults
@@ -25,7 +27,11 @@ from cbrs.extras import require
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import shorten
 from cbrs.output import table
+from cbrs.settings import setting
 from cbrs.task_names import task_iri
+
+if TYPE_CHECKING:
+    from cbrs.bridge_client import BridgeClient
 
 
 @click.command()
@@ -141,6 +147,15 @@ def _source(binding: Binding) -> str:
         " it depends on has moved; a plan around the failed component is tried first."
     ),
 )
+@click.option(
+    "--bridge",
+    metavar="URL",
+    help=(
+        "The rosbridge websocket of the cbrs server live components are connected to (ws://127.0.0.1:9090):"
+        " the run calls them through it. Without it only the simulated components run; sends"
+        " CBRS_UPDATE_TOKEN, when set, to be authorised."
+    ),
+)
 @click.option("--json", "as_json", is_flag=True, help="Print the plan and the execution report as JSON.")
 @click.option(
     "--record",
@@ -160,6 +175,7 @@ def run(
     fault_rate: float,
     fault_seed: int | None,
     repeat_failures: int,
+    bridge: str | None,
     as_json: bool,
     record: Path | None,
 ) -> None:
@@ -188,10 +204,13 @@ def run(
     failing = [parse_iri(f, "--fail") for f in faults]
     iri = task_iri(app.kb, task)  # an unknown task fails before the world is built
 
+    transport = _bridge(bridge) if bridge else None
     start = time.perf_counter()
     recorder: Recorder | None = None
-    with open_world(seed=seed, gui=gui, semantic_map=SemanticMap.read(app.kb)) as world:
-        environment = SimEnvironment(world, app.kb)
+    with contextlib.ExitStack() as held, open_world(seed=seed, gui=gui, semantic_map=SemanticMap.read(app.kb)) as world:
+        if transport is not None:
+            held.callback(transport.close)
+        environment = SimEnvironment(world, app.kb, transport)
         unknown = [f for f in failing if f not in environment.registry]
         if unknown:
             raise click.BadParameter(f"no simulated component {', '.join(map(shorten, unknown))}", param_hint="--fail")
@@ -248,7 +267,37 @@ def run(
                 f" simulated); paths drawn to {recorded.path_map}"
             )
     if not result.succeeded:
+        unreached = [] if transport is not None else _live_unreached(app.kb, environment.registry)
+        if unreached:
+            kind = "is a component" if len(unreached) == 1 else "are components"
+            click.echo(
+                f"note: {', '.join(map(shorten, unreached))} {kind} in another process, which this run could not"
+                " call: pass --bridge ws://HOST:PORT of the cbrs server it is connected to",
+                err=True,
+            )
         raise SystemExit(1)
+
+
+def _bridge(url: str) -> BridgeClient:
+    """A connection to the bridge live components answer on; a clear error when there is none."""
+    from cbrs.bridge_client import BridgeClient, BridgeClosedError
+
+    if not url.startswith(("ws://", "wss://")):
+        raise click.BadParameter(f"{url!r} is not a websocket URL (ws://HOST:PORT)", param_hint="--bridge")
+    try:
+        return BridgeClient(url, setting("update_token").resolve())
+    except BridgeClosedError as error:
+        raise click.BadParameter(str(error), param_hint="--bridge") from None
+
+
+def _live_unreached(kb: KnowledgeBase, registry: Registry) -> list[str]:
+    """The advertisements invoked through a bridge service (components in other processes) that the run
+    had no implementation of: what ``--bridge`` would have let it call."""
+    return sorted(
+        ad.iri
+        for ad in kb.advertisements()
+        if ad.iri not in registry and any(p.kind == "service" and p.topic and p.message_type for p in ad.ports)
+    )
 
 
 def display_problem(environ: dict[str, str] | os._Environ[str]) -> str | None:

@@ -1,0 +1,49 @@
+"""``cbrs run --bridge``: a run from the command line calls components that live in other processes.
+
+A live thermometer (the SDK, in this process) is connected to a server's bridge; ``cbrs run`` against the
+server's store reaches it only through that bridge, and says so when it was not given one. Loopback only.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from click.testing import CliRunner
+
+from cbrs.cli import cli
+from cbrs.server import Server
+from tests.test_live_components import READING, TOKEN, sdk_thermometer, server, url
+
+__all__ = ["server"]  # the fixture, used by name
+
+
+def run(server: Server, *options: str) -> Any:
+    store = f"http://127.0.0.1:{server.http_port}"
+    arguments = ["--store", store, "run", "req:RoomTemperature", *options]
+    return CliRunner().invoke(cli, arguments, env={"CBRS_UPDATE_TOKEN": TOKEN})
+
+
+def test_a_run_calls_a_live_component_through_the_bridge_it_is_given(server: Server) -> None:
+    calls: list[dict[str, Any]] = []
+
+    def read(request: dict[str, Any]) -> dict[str, Any]:
+        calls.append(request)
+        return READING
+
+    with sdk_thermometer(read).connect(url(server), TOKEN):
+        without = run(server)
+        assert without.exit_code == 1 and calls == []
+        assert "svc:ReadRoomTemperature_Thermometer07 is a component in another process" in without.output
+        assert "--bridge ws://HOST:PORT" in without.output
+
+        through = run(server, "--bridge", url(server))
+        assert through.exit_code == 0, through.output
+        assert calls == [{}]
+        assert "svc:ReadRoomTemperature_Thermometer07" in through.output and "succeeded" in through.output
+
+
+def test_a_bridge_that_is_no_websocket_or_does_not_answer_is_a_usage_error(server: Server) -> None:
+    not_ws = run(server, "--bridge", f"http://127.0.0.1:{server.bridge_port}")
+    assert not_ws.exit_code == 2 and "is not a websocket URL" in not_ws.output
+    nobody = run(server, "--bridge", "ws://127.0.0.1:9")  # the discard port: nothing listens
+    assert nobody.exit_code == 2 and "cannot reach the bridge at ws://127.0.0.1:9" in nobody.output
