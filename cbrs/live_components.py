@@ -9,6 +9,12 @@ renewed by ``/cbrs/heartbeat``. When its session closes or its lease lapses, the
 unavailable in the store's liveness graph (:mod:`kb.liveness`): its description stays, matchmaking
 and planning pass it over, a step waiting on it fails over. Registering again brings it back.
 The same registration is offered over HTTP (``POST /components``, with the bearer token).
+
+A registration holds the bridge service it is grounded on: a second registration naming a service a
+live component of another session holds is refused (:class:`ServiceHeldError`), so a program started
+twice, or a copy-pasted description, cannot take another device's calls; a service of the server's own
+namespaces (``/cbrs/``, ``/rosapi/``) is refused as a grounding. A component deregistered while live
+loses its lease at its next store write, and its heartbeat says so (:data:`DEREGISTERED`).
 """
 
 from __future__ import annotations
@@ -16,6 +22,7 @@ from __future__ import annotations
 import logging
 import threading
 import time
+from collections import OrderedDict
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -23,13 +30,24 @@ from typing import Any
 import pyoxigraph as ox
 
 from cbrs.kb.errors import AlreadyRegisteredError, InvalidDescriptionError, KnowledgeBaseError
+from cbrs.kb.liveness import ComponentState
 from cbrs.kb.loader import parse_bytes
 from cbrs.kb.namespaces import BASE, RDF, GraphName
 from cbrs.kb.vocab import CBRS
 from cbrs.rosbridge import ServiceError, current_caller
 from cbrs.sparql_service import SparqlService
 
-__all__ = ["DEFAULT_TTL", "MAX_DESCRIPTION_BYTES", "LiveComponents", "grounding"]
+__all__ = [
+    "DEFAULT_TTL",
+    "DEREGISTERED",
+    "MAX_DESCRIPTION_BYTES",
+    "NO_LIVE_COMPONENT",
+    "SERVER_NAMESPACES",
+    "LiveComponents",
+    "ServerServiceError",
+    "ServiceHeldError",
+    "grounding",
+]
 
 log = logging.getLogger("cbrs.live_components")
 
@@ -38,11 +56,49 @@ DEFAULT_TTL = 3.0
 MAX_DESCRIPTION_BYTES = 256 << 10
 """A six-tuple description is a few kilobytes; anything near this is not one."""
 FORMATS = {"turtle": ox.RdfFormat.TURTLE, "json-ld": ox.RdfFormat.JSON_LD}
+SERVER_NAMESPACES = ("/cbrs/", "/rosapi/")
+"""Service namespaces the server answers itself: no component is grounded on them."""
+NO_LIVE_COMPONENT = "this session has no live component"
+"""How a heartbeat says the session's registration is gone (its lease lapsed): register again."""
+DEREGISTERED = "was deregistered"
+"""How a heartbeat says a component was deregistered (``cbrs deregister``): do not register it again."""
+ENDED_SESSIONS = 1024
+"""Sessions whose ended components a heartbeat can still name (an HTTP lease never disconnects)."""
+
+
+class ServiceHeldError(KnowledgeBaseError):
+    """A registration names a bridge service another live component (of another session) holds."""
+
+    http_status = 409
+
+    def __init__(self, component: str, service: str, holder: str, holder_session: str) -> None:
+        self.component, self.service, self.holder, self.holder_session = component, service, holder, holder_session
+        if component == holder:
+            text = (
+                f"<{component}> is live already, in another session ({holder_session}) that provides {service}: "
+                "is its program running twice? Stop that one, or wait for its lease to end"
+            )
+        else:
+            text = (
+                f"<{component}> names the bridge service {service}, which the live component <{holder}> "
+                f"({holder_session}) holds: give each component a service of its own"
+            )
+        super().__init__(text)
+
+
+class ServerServiceError(InvalidDescriptionError):
+    """A registration is grounded on a service the server answers itself (``/cbrs/...``, ``/rosapi/...``)."""
+
+    def __init__(self, component: str, service: str) -> None:
+        self.service = service
+        owned = ", ".join(SERVER_NAMESPACES)
+        super().__init__(component, [f"its bridge service {service} is the server's own ({owned}): name one of yours"])
 
 
 @dataclass
 class _Lease:
     session: str
+    service: str  # the bridge service it is grounded on (resolved: a leading slash)
     deadline: float  # monotonic seconds
     ttl: float
     written_until: float  # the monotonic time the stored leaseUntil corresponds to
@@ -78,6 +134,7 @@ class LiveComponents:
         self.name = name
         self._clock = clock
         self._leases: dict[str, _Lease] = {}
+        self._ended: OrderedDict[str, dict[str, str]] = OrderedDict()  # session -> {component: why it ended}
         self._guard = threading.Lock()
         self._stop = threading.Event()
         self._watchdog: threading.Thread | None = None
@@ -112,9 +169,14 @@ class LiveComponents:
         caller = current_caller()
         session = caller.session if caller is not None else "in-process"
         renewed = self.renew(session)
+        ended = self.ended(session)
         if not renewed:
-            raise ServiceError("this session has no live component: register first")
-        return {"components": renewed}
+            deregistered = sorted(iri for iri, why in ended.items() if why == "it was deregistered")
+            if deregistered:
+                raise ServiceError(f"{', '.join(deregistered)} {DEREGISTERED}: it is no longer registered")
+            lapsed = "".join(f"; {iri}: {why}" for iri, why in sorted(ended.items()))
+            raise ServiceError(f"{NO_LIVE_COMPONENT}: register first{lapsed}")
+        return {"components": renewed, "ended": ended} if ended else {"components": renewed}
 
     # -- the library ---------------------------------------------------------------------------
 
@@ -132,8 +194,10 @@ class LiveComponents:
             for q in parsed.quads
             if q.predicate.value == CBRS.serviceName and isinstance(q.subject, ox.NamedNode)
         }
+        services: dict[str, str] = {}
         for iri in sorted(named):
-            if grounding(parsed.quads, iri) is None:
+            found = grounding(parsed.quads, iri)
+            if found is None:
                 raise InvalidDescriptionError(
                     iri,
                     [
@@ -141,18 +205,23 @@ class LiveComponents:
                         "service (cbrs:topic) and its type (cbrs:messageType)"
                     ],
                 )
+            service = service_name(found[0])
+            if service.startswith(SERVER_NAMESPACES):
+                raise ServerServiceError(iri, service)
+            other = next((known for known, held in services.items() if held == service), None)
+            if other is not None:
+                raise ServiceHeldError(iri, service, other, "this registration")
+            services[iri] = service
         kb = self.sparql.kb
         with self.sparql.lock:
             states = kb.liveness.states()
+            self._refuse_held(services, session, states)
             returning = []
             for iri in sorted(named):
                 if not kb.registry.is_registered(iri):
                     continue
-                owner = self._leases.get(iri)
                 if iri not in states:
                     raise AlreadyRegisteredError(iri)  # a component of the store, not a live one
-                if owner is not None and owner.session != session and states[iri].live:
-                    raise AlreadyRegisteredError(iri)  # another live session holds the name
                 returning.append(iri)
             if returning and len(returning) != len(named):
                 raise ValueError("register the components coming back apart from the new ones")
@@ -164,13 +233,28 @@ class LiveComponents:
             for iri in iris:
                 kb.liveness.renew(iri, ttl, registered_by=f"{self.name} session {session}")
                 with self._guard:
-                    self._leases[iri] = _Lease(session, now + ttl, ttl, now + ttl)
+                    self._leases[iri] = _Lease(session, services[iri], now + ttl, ttl, now + ttl)
+                    self._ended.get(session, {}).pop(iri, None)
             self.sparql.changed()
         log.info("%s registered %s (lease %g s)", session, ", ".join(iris), ttl)
         return iris
 
+    def _refuse_held(self, services: dict[str, str], session: str, states: dict[str, ComponentState]) -> None:
+        """Raise :class:`ServiceHeldError` when a live component of another session holds a component's
+        name or its bridge service: the second registration would take the first one's calls."""
+        with self._guard:
+            leases = dict(self._leases)
+        for iri, service in services.items():
+            owner = leases.get(iri)
+            if owner is not None and owner.session != session and iri in states and states[iri].live:
+                raise ServiceHeldError(iri, owner.service, iri, owner.session)
+            for held, lease in sorted(leases.items()):
+                if held != iri and lease.service == service and lease.session != session:
+                    raise ServiceHeldError(iri, service, held, lease.session)
+
     def renew(self, session: str) -> list[str]:
-        """Renew the leases of ``session``'s components; the store is written when half a lease has passed."""
+        """Renew the leases of ``session``'s components; the store is written when half a lease has passed,
+        and then a component deregistered meanwhile (``cbrs deregister``) loses its lease and its state."""
         now = self._clock()
         renewed, stale = [], []
         with self._guard:
@@ -182,22 +266,53 @@ class LiveComponents:
                         lease.written_until = lease.deadline
                         stale.append((iri, lease.ttl))
         if stale:
+            gone = []
             with self.sparql.lock:
+                kb = self.sparql.kb
                 for iri, ttl in stale:
-                    self.sparql.kb.liveness.renew(iri, ttl)
+                    if kb.registry.is_registered(iri):
+                        kb.liveness.renew(iri, ttl)
+                    else:
+                        kb.liveness.forget(iri)
+                        gone.append(iri)
+                if gone:
+                    self.sparql.changed()
+            if gone:
+                with self._guard:
+                    for iri in gone:
+                        self._leases.pop(iri, None)
+                self._remember_ended(session, gone, "it was deregistered")
+                log.info("%s deregistered: its lease ended", ", ".join(gone))
+                renewed = [iri for iri in renewed if iri not in gone]
         return sorted(renewed)
+
+    def ended(self, session: str) -> dict[str, str]:
+        """The components of ``session`` whose lease ended while it stayed open, with why."""
+        with self._guard:
+            return dict(self._ended.get(session, {}))
+
+    def _remember_ended(self, session: str, components: list[str], reason: str) -> None:
+        with self._guard:
+            self._ended.setdefault(session, {}).update(dict.fromkeys(components, reason))
+            self._ended.move_to_end(session)
+            while len(self._ended) > ENDED_SESSIONS:
+                self._ended.popitem(last=False)
 
     def disconnected(self, session: str) -> None:
         """``session`` closed: its components become unavailable at once."""
         self._end([iri for iri, lease in self._leases_of(session)], "its session closed")
+        with self._guard:
+            self._ended.pop(session, None)
 
     def expire_lapsed(self) -> list[str]:
         """End the leases not renewed in time; returns the components made unavailable."""
         now = self._clock()
         with self._guard:
-            lapsed = [iri for iri, lease in self._leases.items() if lease.deadline < now]
-        self._end(lapsed, "its lease lapsed")
-        return lapsed
+            lapsed = [(iri, lease.session) for iri, lease in self._leases.items() if lease.deadline < now]
+        self._end([iri for iri, _ in lapsed], "its lease lapsed")
+        for iri, session in lapsed:
+            self._remember_ended(session, [iri], "its lease lapsed")
+        return [iri for iri, _ in lapsed]
 
     def live(self) -> list[str]:
         with self._guard:
@@ -240,6 +355,11 @@ class LiveComponents:
                 self.expire_lapsed()
             except Exception:  # the watchdog must outlive a failed write
                 log.exception("ending lapsed leases failed")
+
+
+def service_name(name: str) -> str:
+    """A service's global name, as the bridge resolves it (``door/open`` -> ``/door/open``)."""
+    return name if name.startswith("/") else "/" + name
 
 
 def _to_turtle(text: str, fmt: ox.RdfFormat) -> str:
