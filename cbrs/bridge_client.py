@@ -22,7 +22,7 @@ from websockets.sync.client import ClientConnection, connect
 
 from cbrs.actions.remote import RemoteCallError
 
-__all__ = ["BridgeClient", "BridgeClosedError", "ServiceHandler"]
+__all__ = ["BridgeClient", "BridgeClosedError", "HandlerAnswerError", "ServiceHandler"]
 
 log = logging.getLogger("cbrs.bridge_client")
 
@@ -54,6 +54,9 @@ class BridgeClient:
         self._listeners: dict[str, list[Callable[[dict[str, Any]], None]]] = {}
         self._pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="cbrs-provide")
         self._closed = threading.Event()
+        self._closing = False  # close() was called: the end is this client's, not the server's
+        self.close_reason: str | None = None
+        """Why the connection closed, once it has."""
         self.statuses: list[dict[str, Any]] = []
         """The status messages the server sent (its errors and warnings about this client's ops)."""
         self._reader = threading.Thread(target=self._read, name="cbrs-bridge-reader", daemon=True)
@@ -69,6 +72,7 @@ class BridgeClient:
 
     def close(self) -> None:
         """Close the connection; calls still waiting fail with :class:`BridgeClosedError`."""
+        self._closing = True
         self._exit.close()
         self._reader.join(timeout=self.timeout)
         self._shutdown("the connection was closed by this client")
@@ -78,6 +82,11 @@ class BridgeClient:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+    @property
+    def closed_by_server(self) -> bool:
+        """Whether the connection ended from the server's side (it stopped, restarted or dropped us)."""
+        return self.closed and not self._closing
 
     def wait_closed(self, timeout: float | None = None) -> bool:
         return self._closed.wait(timeout)
@@ -134,6 +143,7 @@ class BridgeClient:
                 raise BridgeClosedError(f"the connection to {self.url} is closed") from error
 
     def _read(self) -> None:
+        reason = f"the connection to {self.url} closed"
         try:
             while True:
                 frame = self._socket.recv()
@@ -144,10 +154,10 @@ class BridgeClient:
                     continue
                 if isinstance(message, dict):
                     self._dispatch(message)
-        except ConnectionClosed:
-            pass
+        except ConnectionClosed as error:
+            reason += f" ({error})"
         finally:
-            self._shutdown(f"the connection to {self.url} closed")
+            self._shutdown(reason)
 
     def _dispatch(self, message: dict[str, Any]) -> None:
         op = message.get("op")
@@ -178,10 +188,10 @@ class BridgeClient:
         try:
             if handler is None:
                 raise LookupError(f"this client does not provide {service}")
-            values = dict(handler(args if isinstance(args, dict) else {}))
-            json.dumps(values)  # what cannot be sent is the handler's error, answered as such
+            values = _response(service, handler(args if isinstance(args, dict) else {}))
             reply |= {"result": True, "values": values}
         except Exception as error:  # the handler's failure is the call's answer, not this client's crash
+            log.exception("the handler of %s failed; the call is answered with the error", service)
             reply |= {"result": False, "values": f"{type(error).__name__}: {error}"}
         with contextlib.suppress(BridgeClosedError):
             self.send(reply)
@@ -189,9 +199,34 @@ class BridgeClient:
     def _shutdown(self, reason: str) -> None:
         if self._closed.is_set():
             return
+        self.close_reason = reason
         self._closed.set()
         for key in list(self._waiting):
             future = self._waiting.pop(key, None)
             if future is not None and not future.done():
                 future.set_exception(BridgeClosedError(reason))
         self._pool.shutdown(wait=False, cancel_futures=True)
+
+
+class HandlerAnswerError(TypeError):
+    """A handler answered something a service response cannot carry; ``answer`` is what it returned."""
+
+    def __init__(self, service: str, answer: object, why: str) -> None:
+        self.service, self.answer = service, answer
+        shown = repr(answer)
+        shown = shown if len(shown) <= 80 else shown[:77] + "..."
+        super().__init__(f"the handler of {service} returned {shown}: {why}")
+
+
+def _response(service: str, answer: object) -> dict[str, Any]:
+    """A handler's answer as the response's values: a dict of the response's fields, JSON all through."""
+    if not isinstance(answer, Mapping):
+        raise HandlerAnswerError(
+            service, answer, f"a {type(answer).__name__}, not a dict of the response's fields ({{field: value}})"
+        )
+    values = dict(answer)
+    try:
+        json.dumps(values, allow_nan=False)
+    except (TypeError, ValueError) as error:  # NaN and infinities are not JSON: the server refuses the frame
+        raise HandlerAnswerError(service, answer, f"not JSON ({error})") from None
+    return values
