@@ -3,14 +3,16 @@
 A component is its six-tuple description (Turtle or JSON-LD) with a service port that names the
 rosbridge service doing its work (``cbrs:topic``) and the service's type (``cbrs:messageType``), plus
 one handler for that service. ``connect`` opens a bridge session, authenticates with the update
-token, provides the service, registers the description and keeps its lease with a heartbeat; the
+token, registers the description, then provides the service (in that order, so a refused
+registration, a second copy of a running program say, provides nothing and takes no other
+program's calls) and keeps its lease with a heartbeat, registering again if the lease lapsed; the
 server then matches, plans and invokes it like any other component. See docs/components.md::
 
     thermometer = Component(DESCRIPTION)
 
     @thermometer.handler
     def read(request):
-        return {"temperature": {"@type": "home:RoomTemperature", "celsius": 21.5}}
+        return {"roomTemperature": {"@type": "home:RoomTemperature", "celsius": 21.5}}
 
     thermometer.run("ws://127.0.0.1:9090", token=os.environ["CBRS_UPDATE_TOKEN"])
 """
@@ -18,23 +20,54 @@ server then matches, plans and invokes it like any other component. See docs/com
 from __future__ import annotations
 
 import logging
+import signal
 import threading
 from collections.abc import Callable
+from types import FrameType
+from typing import Any
 
 import pyoxigraph as ox
 
+from cbrs.actions.remote import RemoteCallError
 from cbrs.bridge_client import BridgeClient, BridgeClosedError, ServiceHandler
 from cbrs.kb.errors import InvalidDescriptionError
 from cbrs.kb.loader import parse_bytes
-from cbrs.kb.namespaces import BASE, GraphName
+from cbrs.kb.namespaces import BASE, RDF, GraphName, shorten
+from cbrs.kb.shapes import nearest_term
 from cbrs.kb.vocab import CBRS
-from cbrs.live_components import DEFAULT_TTL, FORMATS, grounding
+from cbrs.live_components import DEFAULT_TTL, DEREGISTERED, FORMATS, NO_LIVE_COMPONENT, grounding
 
-__all__ = ["Component", "ConnectedComponent"]
+__all__ = ["Component", "ComponentEndedError", "ConnectedComponent", "RegistrationRefusedError"]
 
 log = logging.getLogger("cbrs.component")
 
 Hook = Callable[[], None]
+
+REREGISTER_ATTEMPTS = 5
+"""Registrations tried after the server says the lease is gone, before the component gives up."""
+REREGISTER_BACKOFF = 2.0
+"""Each failed try waits this many times longer than the one before (from one heartbeat period)."""
+
+
+class RegistrationRefusedError(RemoteCallError):
+    """The server refused the component's registration; ``reason`` is the server's own words."""
+
+    def __init__(self, component: str, reason: str) -> None:
+        self.component, self.reason = component, reason
+        super().__init__(f"{shorten(component)} was not registered: {reason}")
+
+
+class ComponentEndedError(ConnectionError):
+    """A connected component ended without being stopped: the server closed its connection (it stopped
+    or restarted), deregistered it, or it could not register again; ``reason`` says which."""
+
+    def __init__(self, component: str, reason: str) -> None:
+        self.component, self.reason = component, reason
+        super().__init__(f"{shorten(component)} stopped serving: {reason}")
+
+
+class _Terminated(Exception):
+    """SIGTERM arrived: stop as Ctrl-C does (the on_stop hooks run)."""
 
 
 class Component:
@@ -62,8 +95,10 @@ class Component:
         self.iri = named[0]
         found = grounding(quads, self.iri)
         if found is None:
+            hints = "".join(f"; {hint}" for hint in _grounding_slips(quads))
             raise InvalidDescriptionError(
-                self.iri, ["it needs a cbrs:ServicePort with the service (cbrs:topic) and its type (cbrs:messageType)"]
+                self.iri,
+                ["it needs a cbrs:ServicePort with the service (cbrs:topic) and its type (cbrs:messageType)" + hints],
             )
         self.service, self.service_type = found
         self._handler: ServiceHandler | None = None
@@ -88,39 +123,75 @@ class Component:
     def connect(
         self, url: str, token: str | None, heartbeat: float = 1.0, ttl: float = DEFAULT_TTL
     ) -> ConnectedComponent:
-        """Connect to the bridge at ``url``, provide the service, register and start the heartbeat."""
+        """Connect to the bridge at ``url``, register, provide the service and start the heartbeat.
+
+        Raises :class:`RegistrationRefusedError` with the server's reason when it refuses the
+        registration; nothing was provided then, so a refused second copy harms the first."""
         if self._handler is None:
             raise ValueError(f"{self.iri} has no handler: decorate one with @component.handler")
         if not 0 < heartbeat < ttl:
             raise ValueError(f"the heartbeat ({heartbeat} s) must be shorter than the lease ({ttl} s)")
         client = BridgeClient(url, token)
         try:
+            registered = self._register(client, ttl)
             client.provide(self.service, self.service_type, self._handler)
-            answer = client.call_sync(
-                "/cbrs/register", {"description": self.description, "format": self.format, "ttl": ttl}
-            )
         except BaseException:
             client.close()
             raise
-        connected = ConnectedComponent(self, client, heartbeat, list(answer.get("components", [])))
+        connected = ConnectedComponent(self, client, heartbeat, registered, ttl)
         for hook in self._on_start:
             hook()
         return connected
 
+    def _register(self, client: BridgeClient, ttl: float) -> list[str]:
+        args = {"description": self.description, "format": self.format, "ttl": ttl}
+        try:
+            answer = client.call_sync("/cbrs/register", args)
+        except RemoteCallError as error:
+            raise RegistrationRefusedError(self.iri, _servers_reason(client, str(error))) from None
+        return list(answer.get("components", []))
+
     def run(self, url: str, token: str | None, heartbeat: float = 1.0, ttl: float = DEFAULT_TTL) -> None:
-        """Connect and serve until the connection closes or the process is interrupted."""
-        self.connect(url, token, heartbeat, ttl).serve()
+        """Connect and serve until the process is interrupted (Ctrl-C, SIGTERM): then the on_stop hooks
+        run and this returns. When the component cannot serve (its registration refused, the server
+        gone or restarted, the component deregistered) the process exits with status 1 and the reason,
+        so a supervisor (systemd ``Restart=on-failure``, a container's restart policy) starts it again."""
+        early = threading.Event()  # SIGTERM while connecting: serve() stops at once, its hooks run
+        previous: Any = None
+        if threading.current_thread() is threading.main_thread():
+            previous = signal.signal(signal.SIGTERM, lambda signum, frame: early.set())
+        try:
+            connected = self.connect(url, token, heartbeat, ttl)
+            connected._early = early
+            connected.serve()
+        except (RegistrationRefusedError, ComponentEndedError, BridgeClosedError) as error:
+            log.error("%s", error)
+            raise SystemExit(f"cbrs component: {error}") from None
+        finally:
+            if previous is not None:
+                signal.signal(signal.SIGTERM, previous)
 
 
 class ConnectedComponent:
     """A component serving through a bridge session; ``stop()`` disconnects it (it becomes unavailable)."""
 
-    def __init__(self, component: Component, client: BridgeClient, heartbeat: float, registered: list[str]) -> None:
+    def __init__(
+        self,
+        component: Component,
+        client: BridgeClient,
+        heartbeat: float,
+        registered: list[str],
+        ttl: float = DEFAULT_TTL,
+    ) -> None:
         self.component = component
         self.client = client
         self.registered = registered
         self.heartbeat = heartbeat
+        self.ttl = ttl
+        self.ended: str | None = None
+        """Why the component ended by itself (None while it serves or after ``stop()``)."""
         self._stop = threading.Event()
+        self._early = threading.Event()  # run() sets it on a SIGTERM before serve() took the signal over
         self._beat = threading.Thread(target=self._beat_loop, name="cbrs-heartbeat", daemon=True)
         self._beat.start()
 
@@ -130,24 +201,81 @@ class ConnectedComponent:
                 self.client.call_sync("/cbrs/heartbeat", {}, timeout=self.heartbeat)
             except BridgeClosedError:
                 return
+            except RemoteCallError as error:
+                text = str(error)
+                if DEREGISTERED in text:
+                    self._end(f"the server says {text}; start the program again to register it again")
+                    return
+                if NO_LIVE_COMPONENT not in text:
+                    log.warning("heartbeat of %s failed: %s", self.component.iri, text)
+                elif not self._register_again(text):
+                    return
             except Exception as error:  # a missed beat is the server's to count, not a reason to stop
                 log.warning("heartbeat of %s failed: %s", self.component.iri, error)
 
+    def _register_again(self, why: str) -> bool:
+        """The lease is gone (the program hung, the network dropped): register again, a bounded number of
+        times with growing waits; give up (end the component) if none is accepted."""
+        log.warning("%s lost its registration (%s): registering again", self.component.iri, why)
+        wait = self.heartbeat
+        for attempt in range(1, REREGISTER_ATTEMPTS + 1):
+            try:
+                self.registered = self.component._register(self.client, self.ttl)
+            except BridgeClosedError:
+                return False
+            except Exception as error:
+                log.warning(
+                    "registering %s again failed (try %d of %d): %s",
+                    self.component.iri,
+                    attempt,
+                    REREGISTER_ATTEMPTS,
+                    error,
+                )
+                if attempt == REREGISTER_ATTEMPTS:
+                    self._end(f"it could not register again after {attempt} tries: {error}")
+                    return False
+                if self._stop.wait(wait):
+                    return False
+                wait *= REREGISTER_BACKOFF
+            else:
+                log.warning("%s registered again (try %d)", self.component.iri, attempt)
+                return True
+        return False
+
+    def _end(self, reason: str) -> None:
+        """End the component from the heartbeat thread; ``serve`` then raises :class:`ComponentEndedError`."""
+        log.error("%s ends: %s", self.component.iri, reason)
+        self.ended = reason
+        self.client.close()
+
     def serve(self) -> None:
-        """Serve until the connection closes or the process is interrupted; then stop."""
+        """Serve until the process is interrupted (Ctrl-C or SIGTERM, when called in the main thread) or
+        the connection ends; then stop (the on_stop hooks run). Raises :class:`ComponentEndedError` when
+        the component ended without being stopped: the server closed the connection, say."""
+        previous: Any = None
+        if threading.current_thread() is threading.main_thread():
+            previous = signal.signal(signal.SIGTERM, _terminate)
         try:
-            self.client.wait_closed()
-        except KeyboardInterrupt:
+            if not self._early.is_set():
+                self.client.wait_closed()
+        except (KeyboardInterrupt, _Terminated):
             pass
         finally:
+            ended = not self._stop.is_set() and (self.ended is not None or self.client.closed_by_server)
             self.stop()
+            if previous is not None:
+                signal.signal(signal.SIGTERM, previous)
+        if ended:
+            reason = self.ended or f"the server closed the connection ({self.client.close_reason})"
+            raise ComponentEndedError(self.component.iri, reason)
 
     def stop(self) -> None:
         if self._stop.is_set():
             return
         self._stop.set()
         self.client.close()
-        self._beat.join(timeout=self.heartbeat + 1.0)
+        if self._beat is not threading.current_thread():
+            self._beat.join(timeout=self.heartbeat + 1.0)
         for hook in self.component._on_stop:
             hook()
 
@@ -156,3 +284,36 @@ class ConnectedComponent:
 
     def __exit__(self, *exc: object) -> None:
         self.stop()
+
+
+def _terminate(signum: int, frame: FrameType | None) -> None:
+    raise _Terminated(signum)
+
+
+def _servers_reason(client: BridgeClient, refusal: str) -> str:
+    """The server's refusal, with the reason it gave for refusing the token when that was the cause (a
+    wrong token is answered on the auth op; the registration only sees an unauthorised session)."""
+    refused = [
+        str(status.get("msg", ""))
+        for status in client.statuses
+        if status.get("level") == "error" and str(status.get("msg", "")).startswith("auth")
+    ]
+    return f"{refused[-1]} (so: {refusal})" if refused else refusal
+
+
+def _grounding_slips(quads: list[ox.Quad]) -> list[str]:
+    """Did-you-means (the shapes' own) for a service port the description misspelt: a property near
+    cbrs:topic, cbrs:messageType or cbrs:hasPort, a class near cbrs:ServicePort."""
+    wanted = [CBRS.topic, CBRS.messageType, CBRS.hasPort]
+    slips = set()
+    for quad in quads:
+        used = quad.predicate.value
+        if used not in wanted:
+            near = nearest_term(used, wanted)
+            if near is not None:
+                slips.add(f"{shorten(used)}: did you mean {shorten(near)}?")
+        if used == RDF + "type" and isinstance(quad.object, ox.NamedNode) and quad.object.value != CBRS.ServicePort:
+            near = nearest_term(quad.object.value, [CBRS.ServicePort])
+            if near is not None:
+                slips.add(f"{shorten(quad.object.value)}: did you mean {shorten(near)}?")
+    return sorted(slips)

@@ -1,0 +1,290 @@
+"""The component SDK against a real server on loopback: a registration holds its bridge service, a lapsed
+lease is registered again, the component ends loudly when it cannot serve, and its messages say what
+went wrong. Every wait is a bounded poll; child processes are stopped by their PID."""
+
+from __future__ import annotations
+
+import logging
+import math
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import threading
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import httpx
+import pytest
+
+from cbrs.actions.remote import RemoteCallError
+from cbrs.bridge_client import BridgeClient
+from cbrs.component import Component, ComponentEndedError, RegistrationRefusedError
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.errors import InvalidDescriptionError
+from cbrs.server import ServeConfig, Server
+from cbrs.sparql_service import EndpointConfig
+from tests.test_live_components import READING, THERMOMETER, TOKEN, eventually, thermometer, url
+
+ROOT = Path(__file__).resolve().parents[1]
+OTHER = THERMOMETER.replace("Thermometer07", "Thermometer08")
+
+
+def other_thermometer(service: str = "/thermometer07/read") -> str:
+    """A second device whose description was copied from the first and names the same service."""
+    return thermometer(service).replace("Thermometer07", "Thermometer08")
+
+
+@pytest.fixture
+def server() -> Iterator[Server]:
+    endpoint = EndpointConfig(update_token=TOKEN, isolate=False)
+    running = Server(KnowledgeBase.open(":memory:"), ServeConfig(port=0, bridge_port=0, endpoint=endpoint))
+    running.start()
+    try:
+        yield running
+    finally:
+        running.stop()
+
+
+def component(description: str, answer: dict[str, Any] | None = None, name: str = "") -> Component:
+    made = Component(description)
+    made.handler(lambda request: {**(answer or READING), **({"by": name} if name else {})})
+    return made
+
+
+def serve_in_thread(connected: Any) -> tuple[threading.Thread, list[BaseException]]:
+    """``connected.serve()`` in a thread; what it raised lands in the list."""
+    raised: list[BaseException] = []
+
+    def serve() -> None:
+        try:
+            connected.serve()
+        except BaseException as error:  # the test looks at it
+            raised.append(error)
+
+    thread = threading.Thread(target=serve, daemon=True)
+    thread.start()
+    return thread, raised
+
+
+# -- a registration holds its service ----------------------------------------------------------------
+
+
+def test_a_second_copy_of_a_running_component_is_refused_and_takes_nothing_from_the_first(server: Server) -> None:
+    with component(thermometer(), name="first").connect(url(server), TOKEN) as first:
+        second = component(thermometer(), name="second")
+        with pytest.raises(RegistrationRefusedError, match="running twice") as refused:
+            second.connect(url(server), TOKEN)
+        assert refused.value.component == THERMOMETER
+        with BridgeClient(url(server), TOKEN) as caller:  # the first still answers its service
+            assert caller.call_sync("/thermometer07/read", {})["by"] == "first"
+        assert server.kb.liveness.states()[THERMOMETER].live
+        assert first.registered == [THERMOMETER]
+
+
+def test_two_components_naming_one_service_the_second_is_refused_naming_both(server: Server) -> None:
+    with component(thermometer(), name="seven").connect(url(server), TOKEN):
+        with pytest.raises(RegistrationRefusedError) as refused:
+            component(other_thermometer(), name="eight").connect(url(server), TOKEN)
+        assert "Thermometer07" in refused.value.reason and "Thermometer08" in refused.value.reason
+        assert "/thermometer07/read" in refused.value.reason
+        assert not server.kb.registry.is_registered(OTHER)
+        with BridgeClient(url(server), TOKEN) as caller:
+            assert caller.call_sync("/thermometer07/read", {})["by"] == "seven"
+    # once the first has gone, the service is free for another component
+    with component(other_thermometer(), name="eight").connect(url(server), TOKEN) as eight:
+        assert eight.registered == [OTHER]
+
+
+def test_a_service_held_over_http_is_refused_over_the_bridge_and_the_other_way(server: Server) -> None:
+    headers = {"Content-Type": "text/turtle", "Authorization": f"Bearer {TOKEN}"}
+    base = f"http://127.0.0.1:{server.http_port}"
+    created = httpx.post(f"{base}/components?ttl=30", content=thermometer(), headers=headers)
+    assert created.status_code == 201, created.text
+    with pytest.raises(RegistrationRefusedError, match="Thermometer07"):
+        component(other_thermometer()).connect(url(server), TOKEN)
+    refused = httpx.post(f"{base}/components?ttl=30", content=other_thermometer(), headers=headers)
+    assert refused.status_code == 409 and "Thermometer08" in refused.text and "Thermometer07" in refused.text
+
+
+@pytest.mark.parametrize("service", ["/cbrs/run_task", "cbrs/register", "/rosapi/topics"])
+def test_a_service_of_the_server_is_refused_as_a_components_grounding(server: Server, service: str) -> None:
+    before = server.kb.store.count()
+    with BridgeClient(url(server), TOKEN) as client, pytest.raises(RemoteCallError, match="server's own"):
+        client.call_sync("/cbrs/register", {"description": thermometer(service)})
+    assert server.kb.store.count() == before
+
+
+# -- the lease -------------------------------------------------------------------------------------
+
+
+def test_a_component_whose_lease_lapsed_registers_again(server: Server, caplog: pytest.LogCaptureFixture) -> None:
+    caplog.set_level(logging.WARNING, logger="cbrs.component")
+    kb = server.kb
+    with component(thermometer()).connect(url(server), TOKEN, heartbeat=0.1, ttl=0.5) as connected:
+        connected.heartbeat = 2.0  # the program hangs: no heartbeat for four lease periods
+        assert eventually(lambda: not kb.liveness.states()[THERMOMETER].live)
+        assert kb.liveness.states()[THERMOMETER].reason == "its lease lapsed"
+        connected.heartbeat = 0.1  # it runs again
+        assert eventually(lambda: kb.liveness.states()[THERMOMETER].live, seconds=10)
+        assert eventually(lambda: "registered again" in caplog.text)  # logged once its answer is back
+        with BridgeClient(url(server), TOKEN) as caller:
+            assert caller.call_sync("/thermometer07/read", {}) == READING
+
+
+def test_a_component_deregistered_while_live_is_told_and_ends(server: Server) -> None:
+    kb = server.kb
+    stopped: list[str] = []
+    made = component(thermometer())
+    made.on_stop(lambda: stopped.append("on_stop"))
+    connected = made.connect(url(server), TOKEN, heartbeat=0.1, ttl=0.5)
+    thread, raised = serve_in_thread(connected)
+    with server.sparql.lock:
+        kb.registry.deregister(THERMOMETER)
+    thread.join(timeout=10)
+    assert not thread.is_alive()
+    assert len(raised) == 1 and isinstance(raised[0], ComponentEndedError)
+    assert "deregistered" in str(raised[0])
+    assert stopped == ["on_stop"]
+    assert THERMOMETER not in kb.liveness.states()  # GET /components no longer lists it
+    assert server.live.live() == []
+
+
+# -- ending ----------------------------------------------------------------------------------------
+
+
+def test_when_the_server_goes_the_component_ends_with_the_reason_and_its_hooks_run() -> None:
+    endpoint = EndpointConfig(update_token=TOKEN, isolate=False)
+    server = Server(KnowledgeBase.open(":memory:"), ServeConfig(port=0, bridge_port=0, endpoint=endpoint))
+    server.start()
+    stopped: list[str] = []
+    try:
+        made = component(thermometer())
+        made.on_stop(lambda: stopped.append("on_stop"))
+        connected = made.connect(url(server), TOKEN)
+        thread, raised = serve_in_thread(connected)
+    finally:
+        server.stop()
+    thread.join(timeout=10)
+    assert not thread.is_alive()
+    assert len(raised) == 1 and isinstance(raised[0], ComponentEndedError)
+    assert "the server closed the connection" in str(raised[0])
+    assert stopped == ["on_stop"]
+
+
+HOOKED = """
+import sys
+from cbrs.component import Component
+from tests.test_live_components import READING, thermometer
+made = Component(thermometer())
+made.handler(lambda request: READING)
+made.on_stop(lambda: print("on_stop ran", flush=True))
+made.on_start(lambda: print("started", flush=True))
+made.run(sys.argv[1], token=sys.argv[2])
+print("run returned", flush=True)
+"""
+
+
+def start_hooked(bridge: str) -> subprocess.Popen[str]:
+    command = [sys.executable, "-c", textwrap.dedent(HOOKED), bridge, TOKEN]
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    return subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT, env=env)
+
+
+def test_sigterm_stops_a_component_like_ctrl_c_running_its_on_stop_hooks(server: Server) -> None:
+    child = start_hooked(url(server))
+    try:
+        assert child.stdout is not None
+        assert child.stdout.readline().strip() == "started"  # the child gives up by itself if it cannot connect
+        child.send_signal(signal.SIGTERM)  # by its PID
+        out, err = child.communicate(timeout=20)
+    finally:
+        child.kill()
+        child.wait(timeout=10)
+    assert child.returncode == 0, err
+    assert out.splitlines() == ["on_stop ran", "run returned"]
+
+
+def test_a_server_restart_ends_a_run_component_with_status_1_and_the_reason() -> None:
+    endpoint = EndpointConfig(update_token=TOKEN, isolate=False)
+    server = Server(KnowledgeBase.open(":memory:"), ServeConfig(port=0, bridge_port=0, endpoint=endpoint))
+    server.start()
+    try:
+        child = start_hooked(url(server))
+        assert child.stdout is not None
+        assert child.stdout.readline().strip() == "started"
+    finally:
+        server.stop()
+    try:
+        out, err = child.communicate(timeout=20)
+    finally:
+        child.kill()  # by its PID
+        child.wait(timeout=10)
+    assert child.returncode == 1
+    assert "on_stop ran" in out and "run returned" not in out
+    assert "the server closed the connection" in err
+
+
+# -- what the SDK says -------------------------------------------------------------------------------
+
+
+def test_a_wrong_token_is_reported_in_the_servers_words(server: Server) -> None:
+    with pytest.raises(RegistrationRefusedError, match="the token is not this server's update token"):
+        component(thermometer()).connect(url(server), "not-the-token")
+
+
+@pytest.mark.parametrize(
+    ("answer", "expected"),
+    [
+        (["opened"], r"returned \['opened'\]: a list, not a dict of the response's fields"),
+        ({"roomTemperature": {"celsius": math.nan}}, "not JSON"),
+    ],
+)
+def test_a_handler_answer_that_is_no_response_says_what_was_wrong_and_is_logged(
+    server: Server, caplog: pytest.LogCaptureFixture, answer: Any, expected: str
+) -> None:
+    made = Component(thermometer())
+    made.handler(lambda request: answer)
+    with (
+        made.connect(url(server), TOKEN),
+        BridgeClient(url(server), TOKEN) as caller,
+        pytest.raises(RemoteCallError, match=expected),
+    ):
+        caller.call_sync("/thermometer07/read", {})
+    assert "the handler of /thermometer07/read failed" in caplog.text
+
+
+def test_a_handler_that_raises_is_logged_in_the_components_process(
+    server: Server, caplog: pytest.LogCaptureFixture
+) -> None:
+    def stall(request: dict[str, Any]) -> dict[str, Any]:
+        raise RuntimeError("motor stalled")
+
+    made = Component(thermometer())
+    made.handler(stall)
+    with (
+        made.connect(url(server), TOKEN),
+        BridgeClient(url(server), TOKEN) as caller,
+        pytest.raises(RemoteCallError, match="RuntimeError: motor stalled"),
+    ):
+        caller.call_sync("/thermometer07/read", {})
+    failed = [record for record in caplog.records if "the handler of /thermometer07/read failed" in record.message]
+    assert failed and failed[0].exc_info is not None and "motor stalled" in str(failed[0].exc_info[1])
+
+
+@pytest.mark.parametrize(
+    ("slip", "near"),
+    [("cbrs:messageType", "cbrs:messageType"), ("cbrs:topic", "cbrs:topic"), ("cbrs:ServicePort", "cbrs:ServicePort")],
+)
+def test_a_misspelt_grounding_gets_a_did_you_mean(slip: str, near: str) -> None:
+    misspelt = slip[:-2] + slip[-1]  # cbrs:messageTye, cbrs:topc, cbrs:ServicePot
+    with pytest.raises(InvalidDescriptionError, match=f"{misspelt}: did you mean {near}\\?"):
+        Component(thermometer().replace(slip, misspelt))
+
+
+def test_a_right_description_gets_no_did_you_mean() -> None:
+    with pytest.raises(InvalidDescriptionError) as refused:
+        Component(thermometer(port=False))
+    assert "did you mean" not in str(refused.value)
