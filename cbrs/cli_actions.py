@@ -24,7 +24,7 @@ from cbrs.actions.replanning import ReplanPolicy
 from cbrs.actions.runner import RunResult, run_task
 from cbrs.app import App, parse_iri, pass_app
 from cbrs.extras import require
-from cbrs.kb import KnowledgeBase
+from cbrs.kb import KnowledgeBase, RemoteStoreError
 from cbrs.kb.namespaces import shorten
 from cbrs.output import table
 from cbrs.settings import setting
@@ -62,7 +62,15 @@ def plan(app: App, task: str, as_json: bool, drawing: Path | None, objective: st
     composer = Composer(app.kb, ComposeConfig(objective=Objective(objective)))
     result = composer.compose(task_iri(app.kb, task))
     if result.plan is not None and not no_store:
-        store_plan(app.kb, result.plan)
+        try:
+            store_plan(app.kb, result.plan)
+        except RemoteStoreError as error:
+            if error.status not in (401, 403):
+                raise
+            raise click.ClickException(
+                f"{error}\nthe plan was composed but the server refused to record it: send its update token"
+                " (CBRS_UPDATE_TOKEN), or add --no-store to only see the plan"
+            ) from None
     if drawing is not None:
         require("eval", "cbrs plan --draw")
         from cbrs.actions.draw import draw  # matplotlib is slow to import; only when asked
