@@ -44,6 +44,7 @@ __all__ = [
     "NO_LIVE_COMPONENT",
     "SERVER_NAMESPACES",
     "LiveComponents",
+    "NotProvidedError",
     "ServerServiceError",
     "ServiceHeldError",
     "grounding",
@@ -95,10 +96,25 @@ class ServerServiceError(InvalidDescriptionError):
         super().__init__(component, [f"its bridge service {service} is the server's own ({owned}): name one of yours"])
 
 
+class NotProvidedError(KnowledgeBaseError):
+    """A component registered other than over the bridge (``POST /components``) names a service no bridge
+    client provides: nobody would answer its calls, so it is not made available."""
+
+    http_status = 409
+
+    def __init__(self, component: str, service: str) -> None:
+        self.component, self.service = component, service
+        super().__init__(
+            f"<{component}>'s bridge service {service} is provided by no bridge client: start the program that "
+            "answers it, then register (a component registered over HTTP is available while its service is provided)"
+        )
+
+
 @dataclass
 class _Lease:
     session: str
     service: str  # the bridge service it is grounded on (resolved: a leading slash)
+    bridge: bool  # registered through a bridge session (which provides the service), not over HTTP
     deadline: float  # monotonic seconds
     ttl: float
     written_until: float  # the monotonic time the stored leaseUntil corresponds to
@@ -126,6 +142,7 @@ class LiveComponents:
         ttl: float = DEFAULT_TTL,
         name: str = "cbrs",
         clock: Callable[[], float] = time.monotonic,
+        provided: Callable[[str], bool] | None = None,
     ) -> None:
         if ttl <= 0:
             raise ValueError(f"a lease must last a positive time, not {ttl!r} s")
@@ -133,6 +150,8 @@ class LiveComponents:
         self.ttl = ttl
         self.name = name
         self._clock = clock
+        self.provided = provided
+        """Whether a bridge client provides a service (the server's bridge); None: not checked."""
         self._leases: dict[str, _Lease] = {}
         self._ended: OrderedDict[str, dict[str, str]] = OrderedDict()  # session -> {component: why it ended}
         self._guard = threading.Lock()
@@ -160,7 +179,7 @@ class LiveComponents:
         if isinstance(ttl, bool) or not isinstance(ttl, int | float) or not 0.1 <= ttl <= 3600:
             raise ServiceError(f"field 'ttl' must be a number of seconds from 0.1 to 3600, not {ttl!r}")
         try:
-            components = self.register(description, session, str(fmt), float(ttl))
+            components = self.register(description, session, str(fmt), float(ttl), over_bridge=caller is not None)
         except (KnowledgeBaseError, ValueError) as error:
             raise ServiceError(str(error)) from error
         return {"components": components, "ttl": float(ttl)}
@@ -180,8 +199,17 @@ class LiveComponents:
 
     # -- the library ---------------------------------------------------------------------------
 
-    def register(self, description: str, session: str, fmt: str = "turtle", ttl: float | None = None) -> list[str]:
-        """Register (or bring back) the components ``description`` describes, for ``session``."""
+    def register(
+        self,
+        description: str,
+        session: str,
+        fmt: str = "turtle",
+        ttl: float | None = None,
+        over_bridge: bool = False,
+    ) -> list[str]:
+        """Register (or bring back) the components ``description`` describes, for ``session``. Registered
+        other than ``over_bridge`` (over HTTP), each needs a bridge client providing its service now, when
+        :attr:`provided` can tell; a bridge session provides its own, after registering."""
         ttl = self.ttl if ttl is None else ttl
         if len(description.encode("utf-8")) > MAX_DESCRIPTION_BYTES:
             raise InvalidDescriptionError("<registration>", [f"it is larger than {MAX_DESCRIPTION_BYTES} bytes"])
@@ -212,6 +240,8 @@ class LiveComponents:
             if other is not None:
                 raise ServiceHeldError(iri, service, other, "this registration")
             services[iri] = service
+            if not over_bridge and self.provided is not None and not self.provided(service):
+                raise NotProvidedError(iri, service)
         kb = self.sparql.kb
         with self.sparql.lock:
             states = kb.liveness.states()
@@ -233,7 +263,7 @@ class LiveComponents:
             for iri in iris:
                 kb.liveness.renew(iri, ttl, registered_by=f"{self.name} session {session}")
                 with self._guard:
-                    self._leases[iri] = _Lease(session, services[iri], now + ttl, ttl, now + ttl)
+                    self._leases[iri] = _Lease(session, services[iri], over_bridge, now + ttl, ttl, now + ttl)
                     self._ended.get(session, {}).pop(iri, None)
             self.sparql.changed()
         log.info("%s registered %s (lease %g s)", session, ", ".join(iris), ttl)
@@ -256,7 +286,7 @@ class LiveComponents:
         """Renew the leases of ``session``'s components; the store is written when half a lease has passed,
         and then a component deregistered meanwhile (``cbrs deregister``) loses its lease and its state."""
         now = self._clock()
-        renewed, stale = [], []
+        renewed, stale, unprovided = [], [], []
         with self._guard:
             for iri, lease in self._leases.items():
                 if lease.session == session and lease.deadline >= now:
@@ -265,6 +295,12 @@ class LiveComponents:
                     if lease.written_until - now < lease.ttl / 2:
                         lease.written_until = lease.deadline
                         stale.append((iri, lease.ttl))
+                        if not lease.bridge and self.provided is not None and not self.provided(lease.service):
+                            unprovided.append(iri)
+        if unprovided:
+            self._end(unprovided, "no bridge client provides its service")
+            stale = [(iri, ttl) for iri, ttl in stale if iri not in unprovided]
+            renewed = [iri for iri in renewed if iri not in unprovided]
         if stale:
             gone = []
             with self.sparql.lock:

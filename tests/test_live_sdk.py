@@ -288,3 +288,41 @@ def test_a_right_description_gets_no_did_you_mean() -> None:
     with pytest.raises(InvalidDescriptionError) as refused:
         Component(thermometer(port=False))
     assert "did you mean" not in str(refused.value)
+
+
+# -- registered over HTTP: available while a bridge client provides the service ---------------------
+
+
+def provided_by_the_bridge(server: Server) -> None:
+    """What cbrs/server.py is to wire: a service is provided when the bridge lists it."""
+    server.live.provided = lambda name: name in dict(server.bridge.services())
+
+
+def test_a_component_registered_over_http_needs_a_bridge_client_providing_its_service(server: Server) -> None:
+    provided_by_the_bridge(server)
+    headers = {"Content-Type": "text/turtle", "Authorization": f"Bearer {TOKEN}"}
+    with httpx.Client(base_url=f"http://127.0.0.1:{server.http_port}", timeout=10) as http:
+        nobody = http.post("/components?ttl=30", content=thermometer(), headers=headers)
+        assert nobody.status_code == 409 and "/thermometer07/read is provided by no bridge client" in nobody.text
+        assert not server.kb.registry.is_registered(THERMOMETER)
+        with BridgeClient(url(server), TOKEN) as firmware:  # answers the service, registers nothing
+            firmware.provide("/thermometer07/read", "cbrs_msgs/RoomTemperature", lambda request: READING)
+            assert eventually(lambda: "/thermometer07/read" in dict(server.bridge.services()))
+            created = http.post("/components?ttl=0.4", content=thermometer(), headers=headers)
+            assert created.status_code == 201, created.text
+            lease = created.json()["lease"]
+            assert http.post(f"/components/leases/{lease}", headers=headers).status_code == 200
+        # the firmware went: the lease ends at its next renewal that writes the store
+        assert eventually(lambda: http.post(f"/components/leases/{lease}", headers=headers).status_code == 404)
+        state = server.kb.liveness.states()[THERMOMETER]
+        assert not state.live and state.reason == "no bridge client provides its service"
+
+
+def test_the_sdk_registers_before_it_provides_so_the_provider_check_does_not_refuse_it(server: Server) -> None:
+    provided_by_the_bridge(server)
+    with component(thermometer()).connect(url(server), TOKEN, heartbeat=0.1, ttl=0.5) as connected:
+        assert connected.registered == [THERMOMETER]
+        with BridgeClient(url(server), TOKEN) as caller:
+            assert eventually(lambda: "/thermometer07/read" in dict(server.bridge.services()))
+            assert caller.call_sync("/thermometer07/read", {}) == READING
+        assert server.kb.liveness.states()[THERMOMETER].live
