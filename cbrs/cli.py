@@ -24,6 +24,7 @@ from cbrs.extras import require
 from cbrs.kb import Advertisement, KnowledgeBase, KnowledgeBaseError, Requirement, ServiceDescription
 from cbrs.kb.catalog import Catalogue, merge
 from cbrs.kb.errors import AlreadyRegisteredError, QuerySyntaxError
+from cbrs.kb.liveness import ComponentState
 from cbrs.kb.loader import LoadReport, ParsedFile
 from cbrs.kb.namespaces import OWL, PREFIXES, RDF, GraphName, expand, shorten
 from cbrs.kb.skolem import is_skolem
@@ -384,10 +385,19 @@ def deregister(app: App, iri: str) -> None:
 @click.option("--json", "as_json", is_flag=True, help="Print the advertisements as JSON.")
 @pass_app
 def services(app: App, as_json: bool) -> None:
-    """List the registered advertisements with their kind, device and inputs -> outputs."""
+    """List the registered advertisements with their kind, device and inputs -> outputs, and whether a
+    component registered live (in another process) can be invoked now."""
     rows = app.kb.select("advertisements")
+    live = app.kb.liveness.states()
     if as_json:
-        click.echo(json.dumps([{k: v.value for k, v in row.items()} for row in rows], indent=2))
+        found = []
+        for row in rows:
+            item: dict[str, object] = {k: v.value for k, v in row.items()}
+            state = live.get(row["service"].value)
+            if state is not None:
+                item["live"] = {"available": state.live, "reason": state.reason}
+            found.append(item)
+        click.echo(json.dumps(found, indent=2))
         return
     body = [
         [
@@ -397,10 +407,19 @@ def services(app: App, as_json: bool) -> None:
             term_text(row.get("inputs")) or "-",
             term_text(row.get("outputs")) or "-",
         ]
+        + ([_live_state(live.get(row["service"].value))] if live else [])
         for row in rows
     ]
-    click.echo(table(["service", "kind", "device", "inputs", "outputs"], body))
-    click.echo(f"({len(rows)} advertisements)")
+    click.echo(table(["service", "kind", "device", "inputs", "outputs"] + (["live"] if live else []), body))
+    gone = sum(1 for row in rows if row["service"].value in live and not live[row["service"].value].live)
+    click.echo(f"({len(rows)} advertisements{f'; {gone} live component(s) unavailable now' if gone else ''})")
+
+
+def _live_state(state: ComponentState | None) -> str:
+    """'-' for a component not registered live; else available, or unavailable and why."""
+    if state is None:
+        return "-"
+    return "available" if state.live else f"unavailable: {state.reason or 'no reason recorded'}"
 
 
 @cli.command()

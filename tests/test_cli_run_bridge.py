@@ -6,13 +6,14 @@ server's store reaches it only through that bridge, and says so when it was not 
 
 from __future__ import annotations
 
+import json
 from typing import Any
 
 from click.testing import CliRunner
 
 from cbrs.cli import cli
 from cbrs.server import Server
-from tests.test_live_components import READING, TOKEN, sdk_thermometer, server, url
+from tests.test_live_components import READING, THERMOMETER, TOKEN, eventually, sdk_thermometer, server, url
 
 __all__ = ["server"]  # the fixture, used by name
 
@@ -47,3 +48,19 @@ def test_a_bridge_that_is_no_websocket_or_does_not_answer_is_a_usage_error(serve
     assert not_ws.exit_code == 2 and "is not a websocket URL" in not_ws.output
     nobody = run(server, "--bridge", "ws://127.0.0.1:9")  # the discard port: nothing listens
     assert nobody.exit_code == 2 and "cannot reach the bridge at ws://127.0.0.1:9" in nobody.output
+
+
+def test_services_says_whether_a_live_component_can_be_invoked_now(server: Server) -> None:
+    store = f"http://127.0.0.1:{server.http_port}"
+    listed = CliRunner().invoke(cli, ["--store", store, "services"])
+    assert listed.exit_code == 0 and " live" not in listed.output.splitlines()[0]  # none yet: no column
+    with sdk_thermometer().connect(url(server), TOKEN):
+        while_connected = CliRunner().invoke(cli, ["--store", store, "services"]).output
+        as_json = CliRunner().invoke(cli, ["--store", store, "services", "--json"]).output
+    line = next(x for x in while_connected.splitlines() if "Thermometer07" in x)
+    assert line.rstrip().endswith("available")
+    assert {"available": True, "reason": None} in [item.get("live") for item in json.loads(as_json)]
+    assert eventually(lambda: not server.kb.liveness.states()[THERMOMETER].live)  # the session closed
+    after = CliRunner().invoke(cli, ["--store", store, "services"]).output
+    line = next(x for x in after.splitlines() if "Thermometer07" in x)
+    assert "unavailable: " in line and "1 live component(s) unavailable now" in after
