@@ -23,7 +23,7 @@ from cbrs.rosbridge.errors import ProtocolError, RosbridgeError, UnknownTopicErr
 from cbrs.rosbridge.goals import ActionHandler, Goal, Goals, GoalStatus
 from cbrs.rosbridge.graph import Action, Graph, Handler, Service, Topic
 from cbrs.rosbridge.params import ParamStore
-from cbrs.rosbridge.protocol import LEVELS, Message
+from cbrs.rosbridge.protocol import LEVELS, Message, MessageId
 from cbrs.rosbridge.session import Session
 from cbrs.rosbridge.workers import WorkerPool
 
@@ -363,11 +363,25 @@ class Bridge:
             text = f"{op}: {error.reason}" if op else error.reason
             log.info("%s: %s", session.name, text)
             session.report("error", text, error.message_id if error.message_id is not None else message_id)
+            self._refuse_answer(session, frame, op, message_id, error.reason)
             if op == "send_action_goal" and message is not None:  # the goal's callbacks hear of it too
                 self._refuse_goal(session, message, text)
         except Exception as error:
             log.exception("%s: %s failed", session.name, op)
             session.report("error", f"{op or 'message'}: internal error: {type(error).__name__}: {error}", message_id)
+
+    def _refuse_answer(
+        self, session: Session, frame: str, op: str | None, message_id: MessageId | None, reason: str
+    ) -> None:
+        """A provider's answer the bridge refused (a field of the wrong type, too large to read) fails the
+        call it answers at once, with the reason the provider is told: the caller would otherwise wait
+        for the call's timeout with the reason known here."""
+        if self._calls is None or not session.provided:
+            return
+        if op == "service_response":
+            self._calls.refuse(session, message_id, reason)
+        elif op is None and message_id is None:  # not read at all: over max_message_bytes
+            self._calls.refuse_unread(session, frame, reason)
 
     def close_session(self, session: Session) -> None:
         """The client has gone: drop its topics, services and subscriptions, fail calls waiting on it."""

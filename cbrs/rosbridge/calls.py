@@ -110,6 +110,28 @@ class Calls:
         self.finish(call, result, protocol.dumps(values, self._non_finite))
         return True
 
+    def refuse(self, provider: Session, key: MessageId | None, reason: str) -> bool:
+        """A provider's ``service_response`` that could not be read (``"result": "yes"``, ``"values": 42``):
+        the call it answers, when ``provider`` has one with that id, fails at once with ``reason``, as the
+        caller would otherwise wait for its timeout. False if there is no such call."""
+        call = self._pending.get(str(key)) if key is not None else None
+        if call is None or call.provider is not provider:
+            return False
+        self.finish(call, False, protocol.dumps(_malformed(call, reason)))
+        return True
+
+    def refuse_unread(self, provider: Session, text: str, reason: str) -> bool:
+        """A message from ``provider`` too large to read at all: when it is a ``service_response`` that
+        carries the id of one of ``provider``'s calls (looked for as the JSON string the bridge sent, not
+        parsed), that call fails at once with ``reason``. False if it names none."""
+        if '"service_response"' not in text:
+            return False
+        for call in list(self._pending.values()):
+            if call.provider is provider and protocol.dumps(call.key) in text:
+                self.finish(call, False, protocol.dumps(_malformed(call, reason)))
+                return True
+        return False
+
     def fail_provider(self, provider: Session, service: str | None, reason: str) -> None:
         """Fail the calls waiting on ``provider`` (for ``service``, or all of them)."""
         for call in list(self._pending.values()):
@@ -142,3 +164,7 @@ class Calls:
 
     def new_key(self, service: str) -> str:
         return f"cbrs:{service}:{next(self._keys)}"
+
+
+def _malformed(call: Call, reason: str) -> str:
+    return f"service {call.service!r} answered with a service_response that could not be read: {reason}"
