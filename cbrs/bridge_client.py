@@ -155,6 +155,7 @@ class BridgeClient:
                 if isinstance(message, dict):
                     self._dispatch(message)
         except ConnectionClosed as error:
+            self.close_reason = str(error)  # the close frames: "received 1001 (going away); ..."
             reason += f" ({error})"
         finally:
             self._shutdown(reason)
@@ -199,7 +200,8 @@ class BridgeClient:
     def _shutdown(self, reason: str) -> None:
         if self._closed.is_set():
             return
-        self.close_reason = reason
+        if self.close_reason is None:
+            self.close_reason = reason
         self._closed.set()
         for key in list(self._waiting):
             future = self._waiting.pop(key, None)

@@ -165,8 +165,7 @@ class Component:
             connected._early = early
             connected.serve()
         except (RegistrationRefusedError, ComponentEndedError, BridgeClosedError) as error:
-            log.error("%s", error)
-            raise SystemExit(f"cbrs component: {error}") from None
+            raise SystemExit(f"cbrs component: {error}") from None  # printed on stderr, status 1
         finally:
             if previous is not None:
                 signal.signal(signal.SIGTERM, previous)
@@ -244,7 +243,6 @@ class ConnectedComponent:
 
     def _end(self, reason: str) -> None:
         """End the component from the heartbeat thread; ``serve`` then raises :class:`ComponentEndedError`."""
-        log.error("%s ends: %s", self.component.iri, reason)
         self.ended = reason
         self.client.close()
 
