@@ -160,6 +160,19 @@ def test_load_accepts_a_class_declared_in_the_same_load(tmp_path: Path) -> None:
     assert CAMERA in kb.registry.description_quads(CAMERA)[0].subject.value
 
 
+def test_a_task_written_without_its_type_is_refused_not_loaded_as_nothing(tmp_path: Path) -> None:
+    """Without ``a cbrs:Requirement`` a task file loaded quietly and the task then "did not exist"."""
+    task = (Path(__file__).parent / "data" / "tasks" / "fetch_my_pencil.ttl").read_text(encoding="utf-8")
+    untyped = tmp_path / "untyped.ttl"
+    untyped.write_text(task.replace("req:FetchMyPencil a cbrs:Requirement ;", "req:FetchMyPencil"), encoding="utf-8")
+    kb = KnowledgeBase.open(":memory:")
+    before = kb.store.dump()
+    with pytest.raises(DescriptionShapeError, match="a description says what it is: a cbrs:Requirement") as refused:
+        kb.load([untyped], graph="requirements")
+    assert "untyped.ttl:11: <https://w3id.org/cbrs/requirement#FetchMyPencil>" in str(refused.value)
+    assert kb.store.dump() == before
+
+
 def test_an_update_inserting_a_broken_description_is_refused() -> None:
     kb = KnowledgeBase.open(":memory:")
     before = kb.store.dump()
