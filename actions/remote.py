@@ -9,6 +9,7 @@ with a reason; nothing it sends can reach the plan unchecked.
 
 from __future__ import annotations
 
+import threading
 import time
 from collections.abc import Callable, Mapping
 from concurrent.futures import Future
@@ -17,10 +18,22 @@ from typing import Any, Protocol
 
 from cbrs.actions.components import Component, Status
 
-__all__ = ["POLL_SECONDS", "RemoteCallError", "RemoteComponent", "Transport"]
+__all__ = ["LATE_WINDOW", "MAX_POLLS", "POLL_SECONDS", "RemoteCallError", "RemoteComponent", "Transport", "given_up"]
 
 POLL_SECONDS = 0.005
-"""How long one tick waits for the answer: short, so a run's other work is not held up."""
+"""How long one tick waits for the answer at least: short, so a run's other work is not held up."""
+MAX_POLLS = 1000
+"""A call's timeout is spread over at most this many ticks (a tick waits ``timeout / MAX_POLLS`` when
+that is longer than POLL_SECONDS), so that the executor's bound on a step's ticks (10,000) never cuts
+a call short before its own timeout, however long the timeout."""
+LATE_WINDOW = 2.0
+"""The transport is given this many times the component's timeout: a call the component has given up
+stays open at the bridge for as long again, so that the provider's late answer is still heard and,
+until it is, no new call is sent to a service that may still be executing the last one (an actuator)."""
+
+_given_up: dict[tuple[int, str], tuple[Future[dict[str, Any]], float, float]] = {}
+"""By (transport, service): the call given up last, when it was sent, and its timeout."""
+_given_up_lock = threading.Lock()
 
 
 class RemoteCallError(Exception):
@@ -42,7 +55,10 @@ class RemoteComponent(Component):
     """An advertised service provided by ``service`` over ``transport``.
 
     ``outputs`` maps each output's name to its type (the advertisement's); ``check`` validates each
-    answered value against its type (for example :func:`sim.values.check`); ``timeout`` bounds one call.
+    answered value against its type (for example :func:`sim.values.check`); ``timeout`` bounds one call
+    (the transport is given ``LATE_WINDOW`` times as long, so that its own timeout never comes first and
+    a timeout has one reason). ``exclusive`` (an actuator): no new call is sent while a call given up
+    unanswered may still be executing (:func:`given_up`); the invocation fails saying so instead.
     """
 
     def __init__(
@@ -54,6 +70,7 @@ class RemoteComponent(Component):
         check: OutputCheck | None = None,
         timeout: float = 10.0,
         clock: Callable[[], float] = time.monotonic,
+        exclusive: bool = False,
     ) -> None:
         super().__init__(iri)
         self.transport = transport
@@ -62,27 +79,37 @@ class RemoteComponent(Component):
         self.check = check
         self.timeout = timeout
         self._clock = clock
+        self.exclusive = exclusive
         self._pending: Future[dict[str, Any]] | None = None
+        self._sent = 0.0
         self._deadline = 0.0
 
     def begin(self, inputs: Mapping[str, Any]) -> None:
+        """Send the call, unless this transport's last call to the service was given up unanswered and
+        may still be executing: then the invocation fails with that reason and nothing is sent."""
         self.outputs = {}
         self.reason = ""
-        self._deadline = self._clock() + self.timeout
-        self._pending = self.transport.call(self.service, dict(inputs), self.timeout)
+        self._pending = None
+        busy = given_up(self.transport, self.service, self._clock) if self.exclusive else ""
+        if busy:
+            self.reason = busy
+            return
+        self._sent = self._clock()
+        self._deadline = self._sent + self.timeout
+        self._pending = self.transport.call(self.service, dict(inputs), self.timeout * LATE_WINDOW)
 
     def update(self) -> Status:
         pending = self._pending
         if pending is None:
-            self.reason = "not started"
+            self.reason = self.reason or "not started"
             return Status.FAILED
         try:
-            values = pending.result(timeout=POLL_SECONDS)
+            values = pending.result(timeout=max(POLL_SECONDS, self.timeout / MAX_POLLS))
         except FutureTimeout:
             if self._clock() < self._deadline:
                 return Status.RUNNING
             self.reason = f"{self.service} did not answer within {self.timeout:g} s"
-            return self._fail()
+            return self._give_up()
         except RemoteCallError as error:
             self.reason = f"{self.service} failed: {error}"
             return self._fail()
@@ -115,10 +142,38 @@ class RemoteComponent(Component):
         return Status.SUCCEEDED
 
     def _fail(self) -> Status:
-        if self._pending is not None:
-            self._pending.cancel()
         self._pending = None
         return Status.FAILED
 
+    def _give_up(self) -> Status:
+        """Stop waiting for a call that has not answered; the provider may still be executing it (a door
+        motor cannot be told to stop by a dropped call), so it is kept until it answers (``given_up``)."""
+        pending = self._pending
+        if self.exclusive and pending is not None and not pending.done():
+            with _given_up_lock:
+                _given_up[(id(self.transport), self.service)] = (pending, self._sent, self.timeout)
+        return self._fail()
+
     def halt(self) -> None:
-        self._fail()
+        self._give_up()
+
+
+def given_up(transport: Transport, service: str, clock: Callable[[], float] = time.monotonic) -> str:
+    """Why no new call may be sent to ``service`` over ``transport`` now: its last call was given up
+    (it timed out, or its step was halted) and has not answered yet, so the provider may still be
+    executing it. Empty when the service is free: it answered late, or the transport ended the call
+    (after ``LATE_WINDOW`` times the timeout, or the connection closed)."""
+    key = (id(transport), service)
+    with _given_up_lock:
+        entry = _given_up.get(key)
+        if entry is None:
+            return ""
+        pending, sent, timeout = entry
+        if pending.done():
+            del _given_up[key]
+            return ""
+    return (
+        f"{service} is still executing the call sent {clock() - sent:.1f} s ago, given up after {timeout:g} s"
+        f" without an answer: no new call is sent until it answers (or {timeout * LATE_WINDOW:g} s after it was"
+        " sent, when the bridge ends it)"
+    )

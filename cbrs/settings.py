@@ -297,6 +297,15 @@ SETTINGS: tuple[Setting, ...] = (
         _positive(float),
     ),
     Setting(
+        "remote_call_timeout",
+        lambda: 10.0,
+        "Seconds a component in another process (invoked over the bridge) has to answer one call of a "
+        "task run, unless its advertisement states a cbrs:responseTime three times which is longer "
+        "(docs/execution.md).",
+        "CBRS_REMOTE_CALL_TIMEOUT",
+        _positive(float),
+    ),
+    Setting(
         "remote_batch",
         lambda: "auto",
         "Most quads one write request to a remote store carries; a larger write (the seed, a load) is "

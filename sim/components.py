@@ -30,8 +30,11 @@ from cbrs.actions.plan import Plan, PlanStep
 from cbrs.actions.remote import RemoteComponent, Transport
 from cbrs.kb import KnowledgeBase, Requirement, Statement
 from cbrs.kb.errors import KnowledgeBaseError
+from cbrs.kb.model import Advertisement
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap, Thing, designate, local_name
+from cbrs.kb.vocab import CBRS
+from cbrs.settings import setting
 from cbrs.sim import predicates as pred
 from cbrs.sim import skills
 from cbrs.sim.arms import GRIPPER_OPEN, ArmSide
@@ -1122,7 +1125,8 @@ def implementations(
         if remote is not None:
             if transport is not None and remote.topic is not None:
                 outputs = {p.name: p.type for p in ad.outputs if p.name}
-                registry.add(ad.iri, _remote(transport, remote.topic, outputs, is_a))
+                exclusive = ad.kind == CBRS.PhysicalManipulationComponent
+                registry.add(ad.iri, _remote(transport, remote.topic, outputs, is_a, call_timeout(ad), exclusive))
             continue
         work = SKILLS.get(ad.service_name or "")
         device = ad.device_name or ""
@@ -1135,8 +1139,18 @@ def implementations(
     return registry
 
 
-REMOTE_TIMEOUT = 10.0
-"""Seconds a remote component has to answer one call (a perception or a computation, not a motion)."""
+RESPONSE_TIME_MARGIN = 3.0
+"""A remote component may take three times the ``cbrs:responseTime`` its advertisement states before a
+call is given up: a stated time is a typical one, and a loaded machine or network stretches it."""
+
+
+def call_timeout(ad: Advertisement, least: float | None = None) -> float:
+    """Seconds a remote component has to answer one call: RESPONSE_TIME_MARGIN times the response time
+    its advertisement states, but never less than ``least`` (the ``remote_call_timeout`` setting by
+    default), which is also the time of one that states none (docs/execution.md, "Remote components")."""
+    floor = least if least is not None else float(setting("remote_call_timeout").resolve())
+    stated = [q.value for q in ad.qos if q.metric == CBRS.responseTime and math.isfinite(q.value) and q.value > 0]
+    return max([floor, *(RESPONSE_TIME_MARGIN * value for value in stated)])
 
 
 def _store_taxonomy(kb: KnowledgeBase) -> IsA:
@@ -1153,11 +1167,13 @@ def _store_taxonomy(kb: KnowledgeBase) -> IsA:
     return is_a
 
 
-def _remote(transport: Transport, service: str, outputs: Mapping[str, str], is_a: IsA) -> Callable[[str], Component]:
+def _remote(
+    transport: Transport, service: str, outputs: Mapping[str, str], is_a: IsA, timeout: float, exclusive: bool
+) -> Callable[[str], Component]:
     def checked(concept: str, value: Any) -> dict[str, Any]:
         return check(concept, value, is_a)
 
-    return lambda iri: RemoteComponent(iri, transport, service, outputs, checked, REMOTE_TIMEOUT)
+    return lambda iri: RemoteComponent(iri, transport, service, outputs, checked, timeout, exclusive=exclusive)
 
 
 def _maker(work: Work, device: str, outputs: tuple[str, ...]) -> Callable[[str], Component]:
