@@ -72,6 +72,7 @@ class Failure:
     inputs: tuple[tuple[str, str], ...]  # (input name, the thing it named or the step output it came from)
     reason: str
     things: frozenset[str]  # the things of the world the inputs named: what the step depended on
+    producers: tuple[str, ...] = ()  # the components whose outputs the step was given (a wrong one may be to blame)
 
     @property
     def kind(self) -> str:
@@ -92,6 +93,7 @@ class Failure:
             "inputs": {name: value for name, value in self.inputs},
             "reason": self.reason,
             "things": sorted(self.things),
+            "producers": list(self.producers),
         }
 
 
@@ -124,7 +126,13 @@ class FailureMemory:
         known = set(seen.types) | set(seen.positions)
         things = frozenset(name for value in inputs.values() for name in _names(value) if name in known)
         bound = _bound(step, inputs, executor.plan, known)
-        return [Failure(step.index, attempt.component, bound, attempt.reason, things) for attempt in unmet.tried]
+        done = {report.index: report.component for report in report.steps}
+        producers = tuple(
+            sorted({done[b.source.step] for b in step.inputs if b.source.step is not None and b.source.step in done})
+        )
+        return [
+            Failure(step.index, attempt.component, bound, attempt.reason, things, producers) for attempt in unmet.tried
+        ]
 
     def changed(self, failure: Failure, before: Observation, after: Observation) -> bool:
         """Whether the belief of what the failed step depended on differs after the re-perception (every
@@ -165,6 +173,13 @@ class FailureMemory:
             around = compose(frozenset(self.avoided))
             if around.plan is not None:
                 return Decision(around, tuple(sorted(self.avoided)))
+            # No way round the step that failed: what it was given may be what was wrong (a camera that
+            # placed the object half a metre off fails the arm, not itself). Try without its producers.
+            upstream = frozenset(p for f in unchanged for p in f.producers) - {f.component for f in unchanged}
+            if upstream:
+                around = compose(upstream | (self.avoided - {f.component for f in unchanged}))
+                if around.plan is not None:
+                    return Decision(around, tuple(sorted(upstream)))
         usual = compose(frozenset())
         if usual.plan is None:
             return Decision(usual)

@@ -193,3 +193,45 @@ def test_the_pencil_taken_askew_at_seed_6_is_still_fetched_by_the_same_plan(tmp_
     assert failure.component.endswith("HandOverOntoPlatform_CytonDualArm01")
     assert failure.things == frozenset({PREFIXES["world"] + "Pencil1"})
     assert [s.planned for s in result.replans[0].report.steps] == [s.planned for s in result.report.steps]
+
+
+class Producer(Worker):
+    """Answers with the B it is named after: ``Locate`` a wrong one, ``Locate2`` a right one."""
+
+    def update(self) -> Status:
+        self.outputs = {"b": "wrong" if self.iri.endswith("#Locate") else "right"}
+        return Status.SUCCEEDED
+
+
+class Consumer(Worker):
+    """Fails on a wrong B, as an arm fails on a position a camera gave half a metre off."""
+
+    def begin(self, inputs: Mapping[str, Any]) -> None:
+        super().begin(inputs)
+        self.given = dict(inputs)
+
+    def update(self) -> Status:
+        if self.given.get("b") == "wrong":
+            self.reason = "no free arm reaches the block at (8.57, 3.30)"
+            return Status.FAILED
+        self.outputs = {"d": "d1"}
+        return Status.SUCCEEDED
+
+
+def test_when_no_plan_avoids_the_failed_step_the_next_avoids_what_it_was_given(tmp_path: Path) -> None:
+    """The consumer is the only way to D, and failed on what the best producer gave it: the re-plan
+    composes without that producer, so the other one is tried instead of the same plan again."""
+    producers = component("Locate", "A", "B", 1.0) + component("Locate2", "A", "B", 3.0)
+    kb = kb_with(producers + component("Use", "B", "D", 1.0), tmp_path)
+    home = Home({})
+    home.registry = Registry()
+    for name in ("Locate", "Locate2"):
+        home.registry.add(EX + name, lambda iri: Producer(iri, home))
+    home.registry.add(EX + "Use", lambda iri: Consumer(iri, home))
+    result = run(kb, home)
+    assert result.succeeded, result.stopped or (result.report.reason if result.report else "")
+    assert len(result.replans) == 1 and planned(result) == ["Locate2", "Use"]
+    failure = result.replans[0].failures[0]
+    assert failure.component == EX + "Use" and failure.producers == (EX + "Locate",)
+    assert result.replans[0].avoided == (EX + "Locate",)
+    assert home.calls[EX + "Locate"] == 1 and home.calls[EX + "Use"] == 2
