@@ -72,7 +72,7 @@ class Failure:
     inputs: tuple[tuple[str, str], ...]  # (input name, the thing it named or the step output it came from)
     reason: str
     things: frozenset[str]  # the things of the world the inputs named: what the step depended on
-    producers: tuple[str, ...] = ()  # the components whose outputs the step was given (a wrong one may be to blame)
+    producers: tuple[str, ...] = ()  # the components whose outputs the step was given, in plan order
 
     @property
     def kind(self) -> str:
@@ -127,9 +127,8 @@ class FailureMemory:
         things = frozenset(name for value in inputs.values() for name in _names(value) if name in known)
         bound = _bound(step, inputs, executor.plan, known)
         done = {report.index: report.component for report in report.steps}
-        producers = tuple(
-            sorted({done[b.source.step] for b in step.inputs if b.source.step is not None and b.source.step in done})
-        )
+        sources = sorted({b.source.step for b in step.inputs if b.source.step is not None and b.source.step in done})
+        producers = tuple(dict.fromkeys(done[index] for index in sources))  # in plan order
         return [
             Failure(step.index, attempt.component, bound, attempt.reason, things, producers) for attempt in unmet.tried
         ]
@@ -174,12 +173,14 @@ class FailureMemory:
             if around.plan is not None:
                 return Decision(around, tuple(sorted(self.avoided)))
             # No way round the step that failed: what it was given may be what was wrong (a camera that
-            # placed the object half a metre off fails the arm, not itself). Try without its producers.
-            upstream = frozenset(p for f in unchanged for p in f.producers) - {f.component for f in unchanged}
-            if upstream:
-                around = compose(upstream | (self.avoided - {f.component for f in unchanged}))
+            # placed the object half a metre off fails the arm, not itself). Try without one of its
+            # producers at a time, the latest first (the grasp planner before it may have no stand-in).
+            failed = {f.component for f in unchanged}
+            producers = dict.fromkeys(p for f in unchanged for p in reversed(f.producers) if p not in failed)
+            for producer in producers:
+                around = compose(frozenset({producer}) | (self.avoided - failed))
                 if around.plan is not None:
-                    return Decision(around, tuple(sorted(upstream)))
+                    return Decision(around, (producer,))
         usual = compose(frozenset())
         if usual.plan is None:
             return Decision(usual)

@@ -199,7 +199,7 @@ class Producer(Worker):
     """Answers with the B it is named after: ``Locate`` a wrong one, ``Locate2`` a right one."""
 
     def update(self) -> Status:
-        self.outputs = {"b": "wrong" if self.iri.endswith("#Locate") else "right"}
+        self.outputs = {"b": "wrong" if self.iri.endswith("#Locate") else "right", "c": "c1"}
         return Status.SUCCEEDED
 
 
@@ -221,17 +221,23 @@ class Consumer(Worker):
 def test_when_no_plan_avoids_the_failed_step_the_next_avoids_what_it_was_given(tmp_path: Path) -> None:
     """The consumer is the only way to D, and failed on what the best producer gave it: the re-plan
     composes without that producer, so the other one is tried instead of the same plan again."""
-    producers = component("Locate", "A", "B", 1.0) + component("Locate2", "A", "B", 3.0)
-    kb = kb_with(producers + component("Use", "B", "D", 1.0), tmp_path)
+    producers = component("Grasp", "A", "C", 1.0) + component("Locate", "A", "B", 1.0)
+    producers += component("Locate2", "A", "B", 3.0)  # a stand-in for Locate; the grasp planner has none
+    use = component("Use", "B", "D", 1.0).replace(
+        "cbrs:hasOutput",
+        'cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "c" ; cbrs:parameterType ex:C ] ;\n'
+        "        cbrs:hasOutput",
+    )
+    kb = kb_with("ex:C a owl:Class .\n" + producers + use, tmp_path)
     home = Home({})
     home.registry = Registry()
-    for name in ("Locate", "Locate2"):
+    for name in ("Grasp", "Locate", "Locate2"):
         home.registry.add(EX + name, lambda iri: Producer(iri, home))
     home.registry.add(EX + "Use", lambda iri: Consumer(iri, home))
     result = run(kb, home)
     assert result.succeeded, result.stopped or (result.report.reason if result.report else "")
-    assert len(result.replans) == 1 and planned(result) == ["Locate2", "Use"]
+    assert len(result.replans) == 1 and sorted(planned(result)) == ["Grasp", "Locate2", "Use"]
     failure = result.replans[0].failures[0]
-    assert failure.component == EX + "Use" and failure.producers == (EX + "Locate",)
+    assert failure.component == EX + "Use" and set(failure.producers) == {EX + "Grasp", EX + "Locate"}
     assert result.replans[0].avoided == (EX + "Locate",)
     assert home.calls[EX + "Locate"] == 1 and home.calls[EX + "Use"] == 2
