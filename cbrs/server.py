@@ -87,6 +87,7 @@ class Server:
         services = KnowledgeServices(self.sparql, self.tasks, self.matchmakers, self.own_origins)
         self._detach = attach(self.bridge, services)
         self.live = LiveComponents(self.sparql, ttl=self.config.component_lease)
+        self.live.provided = lambda name: name in dict(self.bridge.services())  # HTTP registrations need a provider
         for name, (kind, handler) in self.live.handlers().items():
             self.bridge.add_service(name, kind, handler)
         self.bridge.on_disconnect(self.live.disconnected)

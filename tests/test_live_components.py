@@ -230,15 +230,18 @@ def test_a_component_registers_renews_and_ends_its_lease_over_http(server: Serve
         bearer = {**turtle, "Authorization": f"Bearer {TOKEN}"}
         wrong_type = http.post("/components", content=thermometer(), headers={**bearer, "Content-Type": "text/plain"})
         assert wrong_type.status_code == 415
-        created = http.post("/components?ttl=30", content=thermometer(), headers=bearer)
-        assert created.status_code == 201, created.text
-        lease = created.json()["lease"]
-        assert created.json()["components"] == [THERMOMETER]
-        listed = {row["component"]: row for row in http.get("/components").json()}
-        assert listed[THERMOMETER]["available"] is True
-        renewed = http.post(f"/components/leases/{lease}", headers=bearer)
-        assert renewed.json() == {"components": [THERMOMETER]}
-        assert http.delete(f"/components/leases/{lease}", headers=bearer).status_code == 204
+        with BridgeClient(url(server), TOKEN) as firmware:  # the program answering the service
+            firmware.provide("/thermometer07/read", "cbrs_msgs/RoomTemperature", lambda request: READING)
+            assert eventually(lambda: "/thermometer07/read" in dict(server.bridge.services()))
+            created = http.post("/components?ttl=30", content=thermometer(), headers=bearer)
+            assert created.status_code == 201, created.text
+            lease = created.json()["lease"]
+            assert created.json()["components"] == [THERMOMETER]
+            listed = {row["component"]: row for row in http.get("/components").json()}
+            assert listed[THERMOMETER]["available"] is True
+            renewed = http.post(f"/components/leases/{lease}", headers=bearer)
+            assert renewed.json() == {"components": [THERMOMETER]}
+            assert http.delete(f"/components/leases/{lease}", headers=bearer).status_code == 204
         assert not kb.liveness.states()[THERMOMETER].live
         assert http.post(f"/components/leases/{lease}", headers=bearer).status_code == 404
         listed = {row["component"]: row for row in http.get("/components").json()}
@@ -250,9 +253,12 @@ def test_a_description_in_json_ld_registers_like_turtle(server: Server) -> None:
     json_ld = ox.serialize(triples, format=ox.RdfFormat.JSON_LD)
     assert json_ld is not None
     headers = {"Content-Type": "application/ld+json", "Authorization": f"Bearer {TOKEN}"}
-    created = httpx.post(f"http://127.0.0.1:{server.http_port}/components", content=json_ld, headers=headers)
-    assert created.status_code == 201, created.text
-    assert server.kb.liveness.states()[THERMOMETER].live
+    with BridgeClient(url(server), TOKEN) as firmware:  # the program answering the service
+        firmware.provide("/thermometer07/read", "cbrs_msgs/RoomTemperature", lambda request: READING)
+        assert eventually(lambda: "/thermometer07/read" in dict(server.bridge.services()))
+        created = httpx.post(f"http://127.0.0.1:{server.http_port}/components", content=json_ld, headers=headers)
+        assert created.status_code == 201, created.text
+        assert server.kb.liveness.states()[THERMOMETER].live
     assert server.kb.description(THERMOMETER).outputs[0].type == HOME + "RoomTemperature"
 
 

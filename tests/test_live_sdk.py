@@ -101,12 +101,15 @@ def test_two_components_naming_one_service_the_second_is_refused_naming_both(ser
 def test_a_service_held_over_http_is_refused_over_the_bridge_and_the_other_way(server: Server) -> None:
     headers = {"Content-Type": "text/turtle", "Authorization": f"Bearer {TOKEN}"}
     base = f"http://127.0.0.1:{server.http_port}"
-    created = httpx.post(f"{base}/components?ttl=30", content=thermometer(), headers=headers)
-    assert created.status_code == 201, created.text
-    with pytest.raises(RegistrationRefusedError, match="Thermometer07"):
-        component(other_thermometer()).connect(url(server), TOKEN)
-    refused = httpx.post(f"{base}/components?ttl=30", content=other_thermometer(), headers=headers)
-    assert refused.status_code == 409 and "Thermometer08" in refused.text and "Thermometer07" in refused.text
+    with BridgeClient(url(server), TOKEN) as firmware:  # answers the service, registers nothing
+        firmware.provide("/thermometer07/read", "cbrs_msgs/RoomTemperature", lambda request: READING)
+        assert eventually(lambda: "/thermometer07/read" in dict(server.bridge.services()))
+        created = httpx.post(f"{base}/components?ttl=30", content=thermometer(), headers=headers)
+        assert created.status_code == 201, created.text
+        with pytest.raises(RegistrationRefusedError, match="Thermometer07"):
+            component(other_thermometer()).connect(url(server), TOKEN)
+        refused = httpx.post(f"{base}/components?ttl=30", content=other_thermometer(), headers=headers)
+        assert refused.status_code == 409 and "Thermometer08" in refused.text and "Thermometer07" in refused.text
 
 
 @pytest.mark.parametrize("service", ["/cbrs/run_task", "cbrs/register", "/rosapi/topics"])
@@ -294,8 +297,9 @@ def test_a_right_description_gets_no_did_you_mean() -> None:
 
 
 def provided_by_the_bridge(server: Server) -> None:
-    """What cbrs/server.py is to wire: a service is provided when the bridge lists it."""
-    server.live.provided = lambda name: name in dict(server.bridge.services())
+    """The server wires it: a service is provided when its bridge lists it."""
+    assert server.live.provided is not None
+    assert not server.live.provided("/thermometer07/read")
 
 
 def test_a_component_registered_over_http_needs_a_bridge_client_providing_its_service(server: Server) -> None:
