@@ -12,7 +12,6 @@ import subprocess
 import sys
 import textwrap
 import threading
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -26,7 +25,9 @@ from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import InvalidDescriptionError
 from cbrs.server import ServeConfig, Server
 from cbrs.sparql_service import EndpointConfig
-from tests.test_live_components import READING, THERMOMETER, TOKEN, eventually, thermometer, url
+from tests.test_live_components import READING, THERMOMETER, TOKEN, eventually, server, thermometer, url
+
+__all__ = ["server"]  # the fixture, used by name
 
 ROOT = Path(__file__).resolve().parents[1]
 OTHER = THERMOMETER.replace("Thermometer07", "Thermometer08")
@@ -35,17 +36,6 @@ OTHER = THERMOMETER.replace("Thermometer07", "Thermometer08")
 def other_thermometer(service: str = "/thermometer07/read") -> str:
     """A second device whose description was copied from the first and names the same service."""
     return thermometer(service).replace("Thermometer07", "Thermometer08")
-
-
-@pytest.fixture
-def server() -> Iterator[Server]:
-    endpoint = EndpointConfig(update_token=TOKEN, isolate=False)
-    running = Server(KnowledgeBase.open(":memory:"), ServeConfig(port=0, bridge_port=0, endpoint=endpoint))
-    running.start()
-    try:
-        yield running
-    finally:
-        running.stop()
 
 
 def component(description: str, answer: dict[str, Any] | None = None, name: str = "") -> Component:

@@ -15,7 +15,9 @@ import pytest
 from cbrs.kb import KnowledgeBase, RdfParseError, Store
 from cbrs.kb.store import EmbeddedStore
 
-from .test_load_counts import NAVIGATE, ONTOLOGY, OVERLAP, THREE
+from .test_load_counts import NAVIGATE, ONTOLOGY, OVERLAP, THREE, _write, kb
+
+__all__ = ["kb"]  # the fixture, used by name
 
 pytestmark = pytest.mark.both_stores
 
@@ -29,13 +31,6 @@ ex:a ex:q [ ex:r ex:s ; ex:t "one" ; ex:u 0.50 ] .
 
 
 @pytest.fixture
-def kb(store_location: str) -> Iterator[KnowledgeBase]:
-    kb = KnowledgeBase(Store.open(store_location))
-    yield kb
-    kb.close()
-
-
-@pytest.fixture
 def embedded_kb() -> Iterator[KnowledgeBase]:
     """Only an embedded store writes what it lacks: a remote store's load writes every triple (asking the
     server per triple would cost a request each), so the write-counting tests have no remote variant."""
@@ -43,12 +38,6 @@ def embedded_kb() -> Iterator[KnowledgeBase]:
     assert isinstance(kb.store, EmbeddedStore)
     yield kb
     kb.close()
-
-
-def _write(tmp_path: Path, name: str, text: str) -> Path:
-    path = tmp_path / name
-    path.write_text(text, encoding="utf-8")
-    return path
 
 
 def _node(name: str) -> ox.NamedNode:

@@ -9,7 +9,6 @@ file was loaded once, on the embedded and the remote store."""
 
 from __future__ import annotations
 
-from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -17,20 +16,13 @@ import pytest
 from cbrs.kb import InvalidDescriptionError, KnowledgeBase, RdfParseError
 from cbrs.kb.errors import AlreadyRegisteredError
 
-from .conftest import make_mini_kb
 from .test_cli import run
 from .test_deregister_owls import LAB, OWLS, _pair, triples_by_graph
-from .test_register_update_partial import _file
+from .test_register_update_partial import _file, kb
+
+__all__ = ["kb"]  # the fixture, used by name
 
 pytestmark = pytest.mark.both_stores
-
-
-@pytest.fixture
-def kb(store_location: str) -> Iterator[KnowledgeBase]:
-    kb = make_mini_kb(store_location)
-    kb.load([OWLS / "ontology"])
-    yield kb
-    kb.close()
 
 
 def _sync(kb: KnowledgeBase, path: Path) -> tuple[list[str], list[str]]:

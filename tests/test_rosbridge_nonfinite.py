@@ -35,6 +35,7 @@ from websockets.sync.client import ClientConnection, connect
 from cbrs.rosbridge import Bridge, RunningBridge, protocol, wire
 from tests.helpers_roslibjs import needs_roslibjs, node_inline
 from tests.helpers_threads import assert_threads_end
+from tests.test_rosbridge_roslibpy import _until
 
 WAIT = 5.0  # seconds any single step may take
 ROOT = Path(__file__).parent.parent
@@ -50,17 +51,6 @@ def spelled(value: Any) -> Any:
     if isinstance(value, list | tuple):
         return [spelled(item) for item in value]
     return value
-
-
-def _until(condition: Callable[[], bool], step: Callable[[], None] | None = None) -> bool:
-    deadline = time.monotonic() + WAIT
-    while not condition():
-        if time.monotonic() > deadline:
-            return False
-        if step is not None:
-            step()
-        time.sleep(0.05)
-    return True
 
 
 # -- roslibpy, in a child process -----------------------------------------------------------------
