@@ -149,7 +149,8 @@ def layered(
     height = MARGIN * 2 + len(ordered) * box_height + max(len(ordered) - 1, 0) * ROW_GAP
     parts = [
         f'<svg class="diagram" xmlns="http://www.w3.org/2000/svg" viewBox="0 0 {total:.0f} {height:.0f}" '
-        f'width="{total:.0f}" height="{height:.0f}" role="group" aria-labelledby="{ident}-title {ident}-desc" '
+        f'width="{total:.0f}" height="{height:.0f}" style="{_fitted(total)}" role="group" '
+        f'aria-labelledby="{ident}-title {ident}-desc" '
         'font-family="DejaVu Sans, system-ui, sans-serif" font-size="12">',
         f'<title id="{ident}-title">{escape(title)}</title><desc id="{ident}-desc">{escape(description)}</desc>',
         f'<defs><marker id="{ident}-arrow" viewBox="0 0 10 10" refX="10" refY="5" markerWidth="7" markerHeight="7" '
@@ -257,3 +258,13 @@ def _box(item: _Placed) -> str:
     if item.box.href is None:
         return f'<g class="box">{body}</g>'
     return f'<a class="box" href="{escape(item.box.href)}">{body}</a>'
+
+
+FIT_SCALE = 0.7
+"""The smallest a picture is drawn to fit its column (its 12 px labels at 8.4 px); wider, it scrolls."""
+
+
+def _fitted(width: float) -> str:
+    """Inline sizing: the picture's own width at most, shrunk to its column down to FIT_SCALE of it, so a
+    plan of seven boxes a row fits the page instead of being cut at both sides."""
+    return f"width:100%;height:auto;max-width:{width:.0f}px;min-width:{width * FIT_SCALE:.0f}px"
