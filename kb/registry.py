@@ -276,11 +276,14 @@ class ComponentRegistry:
         """Refuse a statement, new to the store, about a term another graph than graph:services (and the
         derived graph:entailed) describes: a registration is read through the union graph by everyone, so
         one stray ``home:Cup rdfs:subClassOf home:Door`` would make every robot's cup a door, and stay
-        after deregistration. The advertisements, their own nodes and the input's new terms (a lab's
-        device kind) are its own; repeating what the store already holds changes nothing and passes."""
+        after deregistration. The advertisements, their own nodes, the devices they name (a lab's door
+        motor placed in the map first) and the input's new terms (a lab's device kind) are its own;
+        repeating what the store already holds changes nothing and passes."""
         own = {GraphName.SERVICES.node, GraphName.ENTAILED.node}
+        ads = {ox.NamedNode(iri) for iri in iris}
+        devices = {q.object for q in quads if q.subject in ads and q.predicate.value == CBRS.device}
         subjects = sorted(
-            {q.subject for q in quads if isinstance(q.subject, ox.NamedNode)} - {ox.NamedNode(iri) for iri in iris},
+            {q.subject for q in quads if isinstance(q.subject, ox.NamedNode)} - ads - devices,
             key=str,
         )
         for subject in subjects:

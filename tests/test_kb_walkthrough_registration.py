@@ -12,7 +12,7 @@ import pytest
 
 from cbrs.kb import InvalidDescriptionError, KnowledgeBase, NotFoundError
 from cbrs.kb.errors import ForeignStatementError
-from cbrs.kb.namespaces import GENID, GraphName
+from cbrs.kb.namespaces import GENID, PREFIXES, GraphName
 
 EX = "http://example.org/mini#"
 HEAD = """@prefix cbrs: <https://w3id.org/cbrs/core#> .
@@ -316,3 +316,20 @@ def test_a_registered_file_s_error_names_the_line(mini_kb: KnowledgeBase, tmp_pa
     line = text.splitlines().index("ex:Broken a cbrs:DynamicPerceptionComponent ;") + 1
     message = _refused(mini_kb, path.read_bytes(), str(path))
     assert message.startswith(f"{path}:{line}: <{EX}Broken> is not a valid service description: ")
+
+
+def test_a_registration_may_describe_its_own_device_placed_in_the_map_first() -> None:
+    """A lab places its door motor in the map, then registers the motor's component: the device is the
+    component's own (named by cbrs:device), so its label and type go in; the map's door does not."""
+    kb = KnowledgeBase.open(":memory:")
+    kb.update(
+        "INSERT DATA { GRAPH graph:map { svc:DoorMotor05 home:x 7.0 ; home:y 1.0 . world:KitchenDoor a home:Door } }"
+    )
+    motor = (Path(__file__).parent / "data" / "door_motor.ttl").read_text(encoding="utf-8")
+    assert kb.registry.register(motor) == [PREFIXES["svc"] + "OpenDoor_DoorMotor05"]
+    with pytest.raises(ForeignStatementError) as refused:
+        door = "@prefix world: <https://w3id.org/cbrs/world#> .\nworld:KitchenDoor rdfs:label 'x' .\n"
+        kb.registry.register(
+            motor.replace("DoorMotor05", "DoorMotor06").replace("door_motor_05", "door_motor_06") + door
+        )
+    assert refused.value.subject == PREFIXES["world"] + "KitchenDoor" and refused.value.graph == GraphName.MAP.iri
