@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import threading
 import time
+import weakref
 from collections.abc import Callable, Mapping
 from concurrent.futures import Future
 from concurrent.futures import TimeoutError as FutureTimeout
@@ -31,8 +32,11 @@ LATE_WINDOW = 2.0
 stays open at the bridge for as long again, so that the provider's late answer is still heard and,
 until it is, no new call is sent to a service that may still be executing the last one (an actuator)."""
 
-_given_up: dict[tuple[int, str], tuple[Future[dict[str, Any]], float, float]] = {}
-"""By (transport, service): the call given up last, when it was sent, and its timeout."""
+_given_up: weakref.WeakKeyDictionary[Transport, dict[str, tuple[Future[dict[str, Any]], float, float]]] = (
+    weakref.WeakKeyDictionary()
+)
+"""By transport (kept only while it lives), by service: the call given up last, when it was sent, and
+its timeout."""
 _given_up_lock = threading.Lock()
 
 
@@ -151,7 +155,7 @@ class RemoteComponent(Component):
         pending = self._pending
         if self.exclusive and pending is not None and not pending.done():
             with _given_up_lock:
-                _given_up[(id(self.transport), self.service)] = (pending, self._sent, self.timeout)
+                _given_up.setdefault(self.transport, {})[self.service] = (pending, self._sent, self.timeout)
         return self._fail()
 
     def halt(self) -> None:
@@ -163,14 +167,14 @@ def given_up(transport: Transport, service: str, clock: Callable[[], float] = ti
     (it timed out, or its step was halted) and has not answered yet, so the provider may still be
     executing it. Empty when the service is free: it answered late, or the transport ended the call
     (after ``LATE_WINDOW`` times the timeout, or the connection closed)."""
-    key = (id(transport), service)
     with _given_up_lock:
-        entry = _given_up.get(key)
+        calls = _given_up.get(transport, {})
+        entry = calls.get(service)
         if entry is None:
             return ""
         pending, sent, timeout = entry
         if pending.done():
-            del _given_up[key]
+            del calls[service]
             return ""
     return (
         f"{service} is still executing the call sent {clock() - sent:.1f} s ago, given up after {timeout:g} s"
