@@ -378,6 +378,8 @@ def deregister(app: App, iri: str) -> None:
         removed = app.kb.registry.deregister(full)
     except KnowledgeBaseError as error:
         raise click.ClickException(f"{error}{_prefix_hint(full)}") from error
+    if full in app.kb.liveness.states():  # a live component: not listed as available until its next heartbeat
+        app.kb.liveness.forget(full)
     click.echo(f"deregistered {shorten(full)} ({removed} triples)")
 
 

@@ -64,3 +64,16 @@ def test_services_says_whether_a_live_component_can_be_invoked_now(server: Serve
     after = CliRunner().invoke(cli, ["--store", store, "services"]).output
     line = next(x for x in after.splitlines() if "Thermometer07" in x)
     assert "unavailable: " in line and "1 live component(s) unavailable now" in after
+
+
+def test_a_live_component_deregistered_from_the_command_line_is_listed_no_more_at_once(server: Server) -> None:
+    store = f"http://127.0.0.1:{server.http_port}"
+    with sdk_thermometer().connect(url(server), TOKEN):
+        assert server.kb.liveness.states()[THERMOMETER].live
+        removed = CliRunner().invoke(
+            cli, ["--store", store, "deregister", THERMOMETER], env={"CBRS_UPDATE_TOKEN": TOKEN}
+        )
+        assert removed.exit_code == 0, removed.output
+        assert THERMOMETER not in server.kb.liveness.states()  # before its next heartbeat
+        listed = CliRunner().invoke(cli, ["--store", store, "services"]).output
+        assert "Thermometer07" not in listed
