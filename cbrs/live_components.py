@@ -152,6 +152,10 @@ class LiveComponents:
         self._clock = clock
         self.provided = provided
         """Whether a bridge client provides a service (the server's bridge); None: not checked."""
+        self.on_lapse: Callable[[str, str], None] | None = None
+        """Called with the bridge service and the reason when a component's lease lapses: the server fails
+        the calls waiting on it (``Bridge.fail_calls``), since its late answer would act on a plan that
+        has moved on, and a lapse is the server giving up on it as a disconnect is."""
         self._leases: dict[str, _Lease] = {}
         self._ended: OrderedDict[str, dict[str, str]] = OrderedDict()  # session -> {component: why it ended}
         self._guard = threading.Lock()
@@ -344,11 +348,15 @@ class LiveComponents:
         """End the leases not renewed in time; returns the components made unavailable."""
         now = self._clock()
         with self._guard:
-            lapsed = [(iri, lease.session) for iri, lease in self._leases.items() if lease.deadline < now]
-        self._end([iri for iri, _ in lapsed], "its lease lapsed")
-        for iri, session in lapsed:
+            lapsed = [
+                (iri, lease.session, lease.service) for iri, lease in self._leases.items() if lease.deadline < now
+            ]
+        self._end([iri for iri, _, _ in lapsed], "its lease lapsed")
+        for iri, session, service in lapsed:
             self._remember_ended(session, [iri], "its lease lapsed")
-        return [iri for iri, _ in lapsed]
+            if self.on_lapse is not None and service:
+                self.on_lapse(service, f"<{iri}>'s lease lapsed while {{service!r}} was executing the call")
+        return [iri for iri, _, _ in lapsed]
 
     def live(self) -> list[str]:
         with self._guard:

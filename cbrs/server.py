@@ -88,6 +88,7 @@ class Server:
         self._detach = attach(self.bridge, services)
         self.live = LiveComponents(self.sparql, ttl=self.config.component_lease)
         self.live.provided = lambda name: name in dict(self.bridge.services())  # HTTP registrations need a provider
+        self.live.on_lapse = self.bridge.fail_calls  # a late answer of a lapsed component acts on nothing
         for name, (kind, handler) in self.live.handlers().items():
             self.bridge.add_service(name, kind, handler)
         self.bridge.on_disconnect(self.live.disconnected)

@@ -242,6 +242,21 @@ class Bridge:
             with contextlib.suppress(RuntimeError):  # the loop closed under us: the server is stopping
                 loop.call_soon_threadsafe(self._fan_out, name, text, None, values)
 
+    def fail_calls(self, service: str, reason: str) -> None:
+        """Fail every call waiting on the client that provides ``service``, with ``reason``; from any
+        thread. What a disconnect does, for a provider the server has given up on while it stays
+        connected (a live component whose lease lapsed: its late answer would act on a plan that has
+        moved on). Nothing when no client provides the service or the bridge is not serving."""
+        name = protocol.resolve(service, "service")
+        with self._graph.lock:
+            found = self._graph.services.get(name)
+            provider = found.provider if found is not None else None
+            loop, calls = self._loop, self._calls
+        if provider is None or loop is None or calls is None:
+            return
+        with contextlib.suppress(RuntimeError):  # the loop closed under us: the server is stopping
+            loop.call_soon_threadsafe(calls.fail_provider, provider, name, reason)
+
     def topics(self) -> list[tuple[str, str]]:
         """(name, type) of every topic: the server's, advertised and subscribed ones."""
         return self._graph.topic_list()
