@@ -49,17 +49,25 @@ class ReplanPolicy:
     remote one's connection), and the bundled tests rely on a second try of a broken component.
     ``tolerance``: metres a thing must have moved in the belief to count as changed (the cameras place
     a centre within about 1 cm; a hand lets go up to 2 cm above a surface).
+    ``reconnect_grace``: seconds (wall clock) a re-plan waits for a failed live component that went
+    unavailable (its program exited or hung) to register again before planning without it: a
+    supervisor restarts a program in about a second, and a plan around a device that is back a moment
+    later is worse than the wait; the default lease (3 s) is the time cbrs already gives a component to
+    answer its heartbeat.
     """
 
     avoid: bool = True
     max_repeats: int = 1
     tolerance: float = 0.03
+    reconnect_grace: float = 3.0
 
     def __post_init__(self) -> None:
         if self.max_repeats < 0:
             raise ReplanPolicyError("max_repeats", self.max_repeats, "a number of repeats cannot be negative")
         if not self.tolerance >= 0.0:
             raise ReplanPolicyError("tolerance", self.tolerance, "a distance cannot be negative")
+        if not 0.0 <= self.reconnect_grace <= 600.0:
+            raise ReplanPolicyError("reconnect_grace", self.reconnect_grace, "a wait is 0 to 600 seconds")
 
 
 @dataclass(frozen=True)

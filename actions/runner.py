@@ -7,6 +7,7 @@ simulation provides one (``sim.components``); tests provide stubs.
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass
 from typing import Any, Protocol
@@ -208,9 +209,10 @@ def run_task(
             now = environment.observe()
             belief.write(now)
             container.recover()  # what failed for the world's sake may be tried again; the broken stay broken
+            _await_return(kb, failures, memory.policy.reconnect_grace, bus)
             refresh = getattr(environment, "refresh", None)
             if callable(refresh):
-                refresh()  # components registered since the last plan
+                refresh()  # components registered since the last plan (or again, after a restart)
             decision = memory.decide(failures, seen, now, compose)
             if decision.composition is None:
                 stopped = decision.stopped  # the result says why; listeners had the plan's failure
@@ -226,6 +228,23 @@ def run_task(
     belief.write(environment.observe())
     goals = _check_goals(environment, composition.plan, outputs) if report is not None else ()
     return RunResult(composition, report, tuple(replans), goals, stopped)
+
+
+def _await_return(kb: KnowledgeBase, failures: Iterable[Failure], grace: float, bus: EventBus) -> None:
+    """Wait up to ``grace`` seconds for the failed live components that are unavailable now (their
+    program exited or hung) to register again, saying so on the progress topic. Components not
+    registered live, and runs with no grace, do not wait."""
+    states = kb.liveness.states()
+    gone = sorted({f.component for f in failures if f.component in states and not states[f.component].live})
+    if not gone or grace <= 0:
+        return
+    bus.publish("/cbrs/task_progress", {"event": "awaiting", "components": gone, "seconds": grace})
+    deadline = time.monotonic() + grace
+    while time.monotonic() < deadline:
+        time.sleep(min(0.1, max(0.0, deadline - time.monotonic())))
+        states = kb.liveness.states()
+        if all(c in states and states[c].live for c in gone):
+            return
 
 
 def _runnable(

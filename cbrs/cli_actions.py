@@ -354,6 +354,9 @@ def _planned(policy: RandomFaults, result: RunResult) -> list[dict[str, Any]]:
 def _progress(message: dict[str, Any]) -> str:
     if message["event"] == "replanning":
         return f"  re-planning (plan {message['plan']}) from what holds now: {message.get('reason', '')}"
+    if message["event"] == "awaiting":
+        gone = ", ".join(map(shorten, message["components"]))
+        return f"  waiting up to {message['seconds']:g} s for {gone} to register again before re-planning"
     kind, step, component = message["event"], message["step"], shorten(message["component"])
     if kind == "step_started":
         return f"  step {step:>2}  {component} ..."

@@ -35,3 +35,51 @@ def test_a_call_in_flight_fails_when_its_components_lease_lapses(server: Server)
             assert not server.kb.liveness.states()[THERMOMETER].live
         finally:
             release.set()
+
+
+def test_a_run_waits_for_a_component_whose_program_restarts_and_uses_it_again(server: Server) -> None:
+    """The thermometer's program dies in the middle of its call and its supervisor starts it again a
+    moment later: the re-plan waits for it (ReplanPolicy.reconnect_grace) instead of finding no plan."""
+    from cbrs.actions.composer import Composer
+    from cbrs.actions.events import Event
+    from cbrs.actions.runner import run_task
+    from cbrs.kb.namespaces import PREFIXES
+    from cbrs.kb.semantic_map import SemanticMap
+    from cbrs.sim.components import SimEnvironment
+    from cbrs.sim.world import open_world
+    from tests.test_live_components import sdk_thermometer
+
+    kb, restarted = server.kb, threading.Event()
+    first = BridgeClient(url(server), TOKEN)
+
+    def dies(request: dict[str, Any]) -> dict[str, Any]:
+        def crash_and_restart() -> None:
+            first.close()  # the program is killed: its call fails "the provider ... disconnected"
+            restarted.wait(0.5)  # the supervisor's delay
+            program = sdk_thermometer().connect(url(server), TOKEN)
+            programs.append(program)
+
+        threading.Thread(target=crash_and_restart, daemon=True).start()
+        release.wait(5.0)
+        return READING
+
+    release, programs, events = threading.Event(), [], []
+    first.provide("/thermometer07/read", "cbrs_msgs/RoomTemperature", dies)
+    first.call_sync("/cbrs/register", {"description": thermometer()})
+    try:
+        with open_world(semantic_map=SemanticMap.read(kb)) as world, BridgeClient(url(server), TOKEN) as bridge:
+            result = run_task(
+                kb,
+                PREFIXES["req"] + "RoomTemperature",
+                SimEnvironment(world, kb, bridge),
+                composer=Composer(kb),
+                on_event=lambda event: events.append(event.message) if isinstance(event, Event) else None,
+            )
+    finally:
+        release.set()
+        for program in programs:
+            program.stop()
+    assert result.succeeded, result.report
+    assert len(result.replans) == 1 and "disconnected" in result.replans[0].reason
+    awaited = [m for m in events if m.get("event") == "awaiting"]
+    assert awaited and awaited[0]["components"] == [THERMOMETER]

@@ -169,6 +169,8 @@ def test_a_policy_refuses_impossible_bounds_and_a_failure_kind_ignores_measureme
     assert refused.value.name == "max_repeats" and refused.value.value == -1
     with pytest.raises(ReplanPolicyError, match="tolerance"):
         ReplanPolicy(tolerance=-0.5)
+    with pytest.raises(ReplanPolicyError, match="reconnect_grace"):
+        ReplanPolicy(reconnect_grace=float("nan"))
     one = Failure(3, EX + "Direct", (), "taken askew (0.42 rad) at (7.36, 3.30)", frozenset())
     other = Failure(5, EX + "Direct", (), "taken askew (0.40 rad) at (7.35, 3.31)", frozenset())
     assert one.key == other.key and one.kind == "taken askew (# rad) at (#, #)"
