@@ -192,6 +192,8 @@ class KnowledgeBase:
         if catalogue is not None and not isinstance(catalogue, Catalogue):
             catalogue = Catalogue.open(catalogue)
         report = load_files(self.store, paths, graph, catalogue)
+        if isinstance(self.store, EmbeddedStore) and not any(report.added.values()):
+            return report  # a reload of what the store holds wrote nothing: nothing to read or entail afresh
         self._reader.clear_cache()
         self._entail()
         return report

@@ -112,3 +112,17 @@ def test_a_failed_load_of_partly_held_files_leaves_the_store_as_it_was(kb: Knowl
     with pytest.raises(RdfParseError, match=r"z_broken\.ttl"):
         kb.load([_write(tmp_path, "overlap.ttl", OVERLAP), broken])
     assert kb.store.dump() == before
+
+
+def test_a_reload_that_adds_nothing_leaves_the_entailed_graph_alone(
+    embedded_kb: KnowledgeBase, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    kb = embedded_kb
+    files = [_write(tmp_path, "three.ttl", THREE)]
+    kb.load(files)
+    refreshed: list[bool] = []
+    monkeypatch.setattr(kb.standard_terms, "refresh", lambda: refreshed.append(True))
+    kb.load(files)
+    assert refreshed == []
+    kb.load([_write(tmp_path, "overlap.ttl", OVERLAP)])  # one new triple: entailed again
+    assert refreshed == [True]
