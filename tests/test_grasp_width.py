@@ -17,7 +17,7 @@ from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
 from cbrs.sim import skills
 from cbrs.sim.arms import ArmSide
-from cbrs.sim.components import SimEnvironment, _knowledge, approach, pick_up
+from cbrs.sim.components import SimContext, SimEnvironment, _knowledge, approach, pick_up
 from cbrs.sim.errors import GraspTooWideError
 from cbrs.sim.geometry import quat_to_matrix
 from cbrs.sim.grasping import JAW_OPENING, GraspKind, ObjectModel, compute_grasp_pose
@@ -130,6 +130,16 @@ def _seen(environment: SimEnvironment) -> ObjectEstimate:
     return recognise_object(world.camera("Kinect01").capture(), "green", near=CENTRE[:2], radius=0.1)
 
 
+def _approach_the_carton(environment: SimEnvironment) -> SimContext:
+    """ApproachToObject on the carton as the plan gives it: its grasp plan and where the Kinect sees it."""
+    world, context = environment.world, environment.context
+    seen = _seen(environment)
+    carton = world.map.objects[WORLD + "Carton1"]
+    plan = to_json(GraspPlan(carton.iri, ObjectModel.of(carton)), HOME + "GraspPose")
+    approach(context, {"graspPose": plan, "objectPosition": to_json(seen)}, DEVICE)
+    return context
+
+
 @pytest.mark.parametrize(("size_x", "size_y"), [(0.04, 0.16), (0.16, 0.04)])
 def test_a_long_box_is_taken_from_the_top_across_its_narrow_side_lying_either_way(
     tmp_path: Path, size_x: float, size_y: float
@@ -138,12 +148,7 @@ def test_a_long_box_is_taken_from_the_top_across_its_narrow_side_lying_either_wa
     lying along y, 16 cm, wider than they open, and the hand came up with nothing between its fingers."""
     kb = knowledge(tmp_path, ("map", carton_in_the_map("top", size_x, size_y)))
     with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
-        environment = SimEnvironment(world, kb)
-        seen = _seen(environment)
-        carton = world.map.objects[WORLD + "Carton1"]
-        plan = to_json(GraspPlan(carton.iri, ObjectModel.of(carton)), HOME + "GraspPose")
-        context = environment.context
-        approach(context, {"graspPose": plan, "objectPosition": to_json(seen)}, DEVICE)
+        context = _approach_the_carton(SimEnvironment(world, kb))
         assert context.grasp is not None and context.grasp.width == pytest.approx(0.04, abs=0.002)
         pick_up(context, {}, DEVICE)
         assert world.arm(context.arm).held == world.body("Carton1")
@@ -155,12 +160,7 @@ def test_an_approach_too_wide_for_the_jaws_is_passed_over_saying_so(tmp_path: Pa
     across its 16 cm; the arm takes it from the top, and the choice says why not from the side."""
     kb = knowledge(tmp_path, ("map", carton_in_the_map("side top", 0.16, 0.04)))
     with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
-        environment = SimEnvironment(world, kb)
-        seen = _seen(environment)
-        carton = world.map.objects[WORLD + "Carton1"]
-        plan = to_json(GraspPlan(carton.iri, ObjectModel.of(carton)), HOME + "GraspPose")
-        context = environment.context
-        approach(context, {"graspPose": plan, "objectPosition": to_json(seen)}, DEVICE)
+        context = _approach_the_carton(SimEnvironment(world, kb))
         assert context.grasp is not None and context.grasp.model.grasp is GraspKind.TOP
         pick_up(context, {}, DEVICE)
         assert world.arm(context.arm).held == world.body("Carton1")
