@@ -301,11 +301,7 @@ def _bridge(url: str) -> BridgeClient:
 def _live_unreached(kb: KnowledgeBase, registry: Registry) -> list[str]:
     """The advertisements invoked through a bridge service (components in other processes) that the run
     had no implementation of: what ``--bridge`` would have let it call."""
-    return sorted(
-        ad.iri
-        for ad in kb.advertisements()
-        if ad.iri not in registry and any(p.kind == "service" and p.topic and p.message_type for p in ad.ports)
-    )
+    return sorted(ad.iri for ad in kb.advertisements() if ad.iri not in registry and ad.bridge_port is not None)
 
 
 def display_problem(environ: dict[str, str] | os._Environ[str]) -> str | None:

@@ -82,34 +82,26 @@ def _batch(text: str) -> int | str:
     return parsed
 
 
+def _one_of(choices: tuple[str, ...], what: str, case: Callable[[str], str] = str.lower) -> Callable[[str], str]:
+    """A parser of one word among ``choices`` (compared in ``case``), refusing another naming ``what``."""
+
+    def parse(text: str) -> str:
+        word = case(text.strip())
+        if word not in choices:
+            raise ValueError(f"{text!r} is not {what} ({', '.join(choices)})")
+        return word
+
+    return parse
+
+
 EVENT_LOOPS = ("auto", "uvloop", "asyncio")
-
-
-def _event_loop(text: str) -> str:
-    kind = text.strip().lower()
-    if kind not in EVENT_LOOPS:
-        raise ValueError(f"{text!r} is not an event loop ({', '.join(EVENT_LOOPS)})")
-    return kind
-
+_event_loop = _one_of(EVENT_LOOPS, "an event loop")
 
 NON_FINITE = ("null", "tokens")  # cbrs.rosbridge.protocol.NON_FINITE, kept here so settings load no bridge
-
-
-def _non_finite(text: str) -> str:
-    word = text.strip().lower()
-    if word not in NON_FINITE:
-        raise ValueError(f"{text!r} is not a way to write NaN and infinities ({', '.join(NON_FINITE)})")
-    return word
-
+_non_finite = _one_of(NON_FINITE, "a way to write NaN and infinities")
 
 LOG_LEVELS = ("DEBUG", "INFO", "WARNING", "ERROR", "CRITICAL")
-
-
-def _log_level(text: str) -> str:
-    level = text.strip().upper()
-    if level not in LOG_LEVELS:
-        raise ValueError(f"{text!r} is not a log level ({', '.join(LOG_LEVELS)})")
-    return level
+_log_level = _one_of(LOG_LEVELS, "a log level", str.upper)
 
 
 @dataclass(frozen=True)

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from cbrs.actions.errors import UnknownTaskError
 from cbrs.actions.model import ActionLibrary
 from cbrs.kb import KnowledgeBase
-from cbrs.kb.namespaces import expand, shorten
+from cbrs.kb.namespaces import expand, written
 from cbrs.kb.owls import local_name
 
 
@@ -92,8 +92,7 @@ def _typed(iri: str, tasks: Sequence[_Task]) -> str:
     bare = local_name(iri)
     if _bare(bare, tasks) == iri:
         return bare
-    short = shorten(iri)
-    return short if short != iri else f"<{iri}>"
+    return written(iri)
 
 
 def _known(tasks: Sequence[_Task]) -> list[str]:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import re
 from collections.abc import Sequence
 
-from cbrs.kb.namespaces import shorten
+from cbrs.kb.namespaces import written
 
 
 class KnowledgeBaseError(Exception):
@@ -203,16 +203,11 @@ class ForeignStatementError(InvalidDescriptionError):
         super().__init__(
             source,
             [
-                f"it states {statement}, about {_shortened(subject)}, which {_shortened(graph)} describes: a "
+                f"it states {statement}, about {written(subject)}, which {written(graph)} describes: a "
                 "registration adds descriptions and terms of its own, not statements about the store's other "
                 "terms (change those with cbrs load into their graph)"
             ],
         )
-
-
-def _shortened(iri: str) -> str:
-    short = shorten(iri)
-    return short if short != iri else f"<{iri}>"
 
 
 def _named(iri: str) -> str:

@@ -116,6 +116,12 @@ class Advertisement(ServiceDescription):
     realizes_action: str | None = None
     ports: tuple[Port, ...] = field(default=())
 
+    @property
+    def bridge_port(self) -> Port | None:
+        """The service port naming the bridge service and type it is invoked by (a component in another
+        process), if it has one."""
+        return next((p for p in self.ports if p.kind == "service" and p.topic and p.message_type), None)
+
 
 @dataclass(frozen=True)
 class Requirement(ServiceDescription):

@@ -111,3 +111,9 @@ def shorten(iri: str) -> str:
         if local and all(ch.isalnum() or ch in "_-." for ch in local):
             return f"{best}:{local}"
     return iri
+
+
+def written(iri: str) -> str:
+    """``iri`` as Turtle writes it: its prefixed form when a table prefix covers it, else ``<iri>``."""
+    short = shorten(iri)
+    return short if short != iri else f"<{iri}>"

@@ -17,7 +17,7 @@ from cbrs.kb.errors import (
     OutsideRegistryError,
 )
 from cbrs.kb.loader import parse_bytes, prepare_owls, registration_format
-from cbrs.kb.namespaces import BASE, RDF, RDFS, GraphName, shorten
+from cbrs.kb.namespaces import BASE, RDF, RDFS, GraphName, shorten, written
 from cbrs.kb.owls import is_owls, is_owls_service
 from cbrs.kb.owls_source import GraphReads, owls_services, owls_source
 from cbrs.kb.results import releases_results
@@ -295,7 +295,8 @@ class ComponentRegistry:
             for quad in quads:
                 if quad.subject != subject or self._held_anywhere(quad):
                     continue
-                shown = " ".join(_turtle(term) for term in (quad.subject, quad.predicate, quad.object))
+                terms = (quad.subject, quad.predicate, quad.object)
+                shown = " ".join(written(t.value) if isinstance(t, ox.NamedNode) else str(t) for t in terms)
                 graph = graphs[0]
                 raise ForeignStatementError(source, subject.value, getattr(graph, "value", str(graph)), shown)
 
@@ -307,14 +308,6 @@ class ComponentRegistry:
         if isinstance(quad.object, ox.Triple):
             return any(held.object == quad.object for held in self._store.quads(quad.subject, quad.predicate))
         return next(self._store.quads(quad.subject, quad.predicate, quad.object), None) is not None
-
-
-def _turtle(term: object) -> str:
-    """A term as a statement in an error shows it: a prefixed name where one fits, else as Turtle."""
-    if isinstance(term, ox.NamedNode):
-        short = shorten(term.value)
-        return short if short != term.value else str(term)
-    return str(term)
 
 
 def _count(count: int, one: str, many: str) -> str:

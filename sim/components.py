@@ -1121,7 +1121,7 @@ def implementations(
     registry = registry if registry is not None else Registry()
     is_a = _store_taxonomy(kb)
     for ad in kb.advertisements():
-        remote = next((p for p in ad.ports if p.kind == "service" and p.topic and p.message_type), None)
+        remote = ad.bridge_port
         if remote is not None:
             if transport is not None and remote.topic is not None:
                 outputs = {p.name: p.type for p in ad.outputs if p.name}
