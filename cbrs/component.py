@@ -19,12 +19,12 @@ server then matches, plans and invokes it like any other component. See docs/com
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import signal
 import threading
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from types import FrameType
-from typing import Any
 
 import pyoxigraph as ox
 
@@ -47,6 +47,8 @@ REREGISTER_ATTEMPTS = 5
 """Registrations tried after the server says the lease is gone, before the component gives up."""
 REREGISTER_BACKOFF = 2.0
 """Each failed try waits this many times longer than the one before (from one heartbeat period)."""
+SIGNAL_POLL = 0.1
+"""Seconds between looks at whether a signal asked a serving component to stop."""
 
 
 class RegistrationRefusedError(RemoteCallError):
@@ -66,8 +68,30 @@ class ComponentEndedError(ConnectionError):
         super().__init__(f"{shorten(component)} stopped serving: {reason}")
 
 
-class _Terminated(Exception):
-    """SIGTERM arrived: stop as Ctrl-C does (the on_stop hooks run)."""
+class _StopRequest:
+    """A signal handler that only notes the signal. Raising from the handler instead let a SIGTERM that
+    landed while the handler was being installed, or inside a library's lock, escape the code meant to
+    catch it: the on_stop hooks were skipped and the process could hang on exit."""
+
+    def __init__(self) -> None:
+        self.signal: int | None = None
+
+    def __call__(self, signum: int, frame: FrameType | None) -> None:
+        self.signal = signum
+
+
+@contextlib.contextmanager
+def _handling(request: _StopRequest, *signals: signal.Signals) -> Iterator[None]:
+    """Let ``request`` take ``signals`` for the block; only the main thread may install handlers."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = {number: signal.signal(number, request) for number in signals}
+    try:
+        yield
+    finally:
+        for number, handler in previous.items():
+            signal.signal(number, handler)
 
 
 class Component:
@@ -156,19 +180,17 @@ class Component:
         run and this returns. When the component cannot serve (its registration refused, the server
         gone or restarted, the component deregistered) the process exits with status 1 and the reason,
         so a supervisor (systemd ``Restart=on-failure``, a container's restart policy) starts it again."""
-        early = threading.Event()  # SIGTERM while connecting: serve() stops at once, its hooks run
-        previous: Any = None
-        if threading.current_thread() is threading.main_thread():
-            previous = signal.signal(signal.SIGTERM, lambda signum, frame: early.set())
+        request = _StopRequest()  # a SIGTERM while connecting: serving stops at once, the hooks run
+        connected: ConnectedComponent | None = None
         try:
-            connected = self.connect(url, token, heartbeat, ttl)
-            connected._early = early
-            connected.serve()
+            with _handling(request, signal.SIGTERM):
+                connected = self.connect(url, token, heartbeat, ttl)
+                connected._serve(request)
+        except KeyboardInterrupt:  # Ctrl-C outside the serving wait (while connecting, say): stop all the same
+            if connected is not None:
+                connected.stop()
         except (RegistrationRefusedError, ComponentEndedError, BridgeClosedError) as error:
             raise SystemExit(f"cbrs component: {error}") from None  # printed on stderr, status 1
-        finally:
-            if previous is not None:
-                signal.signal(signal.SIGTERM, previous)
 
 
 class ConnectedComponent:
@@ -190,7 +212,6 @@ class ConnectedComponent:
         self.ended: str | None = None
         """Why the component ended by itself (None while it serves or after ``stop()``)."""
         self._stop = threading.Event()
-        self._early = threading.Event()  # run() sets it on a SIGTERM before serve() took the signal over
         self._beat = threading.Thread(target=self._beat_loop, name="cbrs-heartbeat", daemon=True)
         self._beat.start()
 
@@ -250,19 +271,19 @@ class ConnectedComponent:
         """Serve until the process is interrupted (Ctrl-C or SIGTERM, when called in the main thread) or
         the connection ends; then stop (the on_stop hooks run). Raises :class:`ComponentEndedError` when
         the component ended without being stopped: the server closed the connection, say."""
-        previous: Any = None
-        if threading.current_thread() is threading.main_thread():
-            previous = signal.signal(signal.SIGTERM, _terminate)
+        request = _StopRequest()
+        with _handling(request, signal.SIGTERM, signal.SIGINT):
+            self._serve(request)
+
+    def _serve(self, request: _StopRequest) -> None:
         try:
-            if not self._early.is_set():
-                self.client.wait_closed()
-        except (KeyboardInterrupt, _Terminated):
+            while request.signal is None and not self.client.wait_closed(SIGNAL_POLL):
+                pass
+        except KeyboardInterrupt:  # Ctrl-C where no handler of ours took SIGINT (run() takes SIGTERM only)
             pass
         finally:
             ended = not self._stop.is_set() and (self.ended is not None or self.client.closed_by_server)
             self.stop()
-            if previous is not None:
-                signal.signal(signal.SIGTERM, previous)
         if ended:
             reason = self.ended or f"the server closed the connection ({self.client.close_reason})"
             raise ComponentEndedError(self.component.iri, reason)
@@ -282,10 +303,6 @@ class ConnectedComponent:
 
     def __exit__(self, *exc: object) -> None:
         self.stop()
-
-
-def _terminate(signum: int, frame: FrameType | None) -> None:
-    raise _Terminated(signum)
 
 
 def _servers_reason(client: BridgeClient, refusal: str) -> str:

@@ -12,6 +12,7 @@ import subprocess
 import sys
 import textwrap
 import threading
+import time
 from pathlib import Path
 from typing import Any
 
@@ -186,18 +187,25 @@ def start_hooked(bridge: str) -> subprocess.Popen[str]:
     return subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT, env=env)
 
 
-def test_sigterm_stops_a_component_like_ctrl_c_running_its_on_stop_hooks(server: Server) -> None:
-    child = start_hooked(url(server))
-    try:
-        assert child.stdout is not None
-        assert child.stdout.readline().strip() == "started"  # the child gives up by itself if it cannot connect
-        child.send_signal(signal.SIGTERM)  # by its PID
-        out, err = child.communicate(timeout=20)
-    finally:
-        child.kill()
-        child.wait(timeout=10)
-    assert child.returncode == 0, err
-    assert out.splitlines() == ["on_stop ran", "run returned"]
+@pytest.mark.parametrize("stop", [signal.SIGTERM, signal.SIGINT], ids=["SIGTERM", "Ctrl-C"])
+def test_a_stop_signal_at_any_moment_after_start_runs_the_hooks_and_exits_cleanly(
+    server: Server, stop: signal.Signals
+) -> None:
+    """Signals landing at different points of the hand-over from connecting to serving (a SIGTERM raised
+    from its handler once escaped there, skipping the hooks, or hung the exit)."""
+    for delay in [0.0, 0.002, 0.02]:  # one at a time: copies of one program may not serve together
+        child = start_hooked(url(server))
+        try:
+            assert child.stdout is not None
+            assert child.stdout.readline().strip() == "started"  # it gives up by itself if it cannot connect
+            time.sleep(delay)
+            child.send_signal(stop)  # by its PID
+            out, err = child.communicate(timeout=20)
+        finally:
+            child.kill()
+            child.wait(timeout=10)
+        assert child.returncode == 0, err
+        assert out.splitlines() == ["on_stop ran", "run returned"], err
 
 
 def test_a_server_restart_ends_a_run_component_with_status_1_and_the_reason() -> None:
