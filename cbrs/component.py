@@ -19,12 +19,10 @@ server then matches, plans and invokes it like any other component. See docs/com
 
 from __future__ import annotations
 
-import contextlib
 import logging
 import signal
 import threading
-from collections.abc import Callable, Iterator
-from types import FrameType
+from collections.abc import Callable
 
 import pyoxigraph as ox
 
@@ -36,6 +34,7 @@ from cbrs.kb.namespaces import BASE, RDF, GraphName, shorten
 from cbrs.kb.shapes import nearest_term
 from cbrs.kb.vocab import CBRS
 from cbrs.live_components import DEFAULT_TTL, DEREGISTERED, FORMATS, NO_LIVE_COMPONENT, grounding
+from cbrs.stop_signals import StopRequest, handling
 
 __all__ = ["Component", "ComponentEndedError", "ConnectedComponent", "RegistrationRefusedError"]
 
@@ -47,8 +46,6 @@ REREGISTER_ATTEMPTS = 5
 """Registrations tried after the server says the lease is gone, before the component gives up."""
 REREGISTER_BACKOFF = 2.0
 """Each failed try waits this many times longer than the one before (from one heartbeat period)."""
-SIGNAL_POLL = 0.1
-"""Seconds between looks at whether a signal asked a serving component to stop."""
 
 
 class RegistrationRefusedError(RemoteCallError):
@@ -66,32 +63,6 @@ class ComponentEndedError(ConnectionError):
     def __init__(self, component: str, reason: str) -> None:
         self.component, self.reason = component, reason
         super().__init__(f"{shorten(component)} stopped serving: {reason}")
-
-
-class _StopRequest:
-    """A signal handler that only notes the signal. Raising from the handler instead let a SIGTERM that
-    landed while the handler was being installed, or inside a library's lock, escape the code meant to
-    catch it: the on_stop hooks were skipped and the process could hang on exit."""
-
-    def __init__(self) -> None:
-        self.signal: int | None = None
-
-    def __call__(self, signum: int, frame: FrameType | None) -> None:
-        self.signal = signum
-
-
-@contextlib.contextmanager
-def _handling(request: _StopRequest, *signals: signal.Signals) -> Iterator[None]:
-    """Let ``request`` take ``signals`` for the block; only the main thread may install handlers."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = {number: signal.signal(number, request) for number in signals}
-    try:
-        yield
-    finally:
-        for number, handler in previous.items():
-            signal.signal(number, handler)
 
 
 class Component:
@@ -180,10 +151,10 @@ class Component:
         run and this returns. When the component cannot serve (its registration refused, the server
         gone or restarted, the component deregistered) the process exits with status 1 and the reason,
         so a supervisor (systemd ``Restart=on-failure``, a container's restart policy) starts it again."""
-        request = _StopRequest()  # a SIGTERM while connecting: serving stops at once, the hooks run
+        request = StopRequest()  # a SIGTERM while connecting: serving stops at once, the hooks run
         connected: ConnectedComponent | None = None
         try:
-            with _handling(request, signal.SIGTERM):
+            with handling(request, signal.SIGTERM):
                 connected = self.connect(url, token, heartbeat, ttl)
                 connected._serve(request)
         except KeyboardInterrupt:  # Ctrl-C outside the serving wait (while connecting, say): stop all the same
@@ -271,14 +242,13 @@ class ConnectedComponent:
         """Serve until the process is interrupted (Ctrl-C or SIGTERM, when called in the main thread) or
         the connection ends; then stop (the on_stop hooks run). Raises :class:`ComponentEndedError` when
         the component ended without being stopped: the server closed the connection, say."""
-        request = _StopRequest()
-        with _handling(request, signal.SIGTERM, signal.SIGINT):
+        request = StopRequest()
+        with handling(request, signal.SIGTERM, signal.SIGINT):
             self._serve(request)
 
-    def _serve(self, request: _StopRequest) -> None:
+    def _serve(self, request: StopRequest) -> None:
         try:
-            while request.signal is None and not self.client.wait_closed(SIGNAL_POLL):
-                pass
+            request.wait(until=self.client.wait_closed)
         except KeyboardInterrupt:  # Ctrl-C where no handler of ours took SIGINT (run() takes SIGTERM only)
             pass
         finally:

@@ -13,7 +13,6 @@ import signal
 import threading
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from types import FrameType
 from typing import TYPE_CHECKING, Any
 
 from cbrs.asgi_front import SparqlFront
@@ -27,6 +26,7 @@ from cbrs.rosbridge import Bridge
 from cbrs.rosbridge.rosout import RosoutHandler
 from cbrs.settings import setting
 from cbrs.sparql_service import EndpointConfig, SparqlService
+from cbrs.stop_signals import StopRequest, handling
 from cbrs.tasks import TaskRunner
 from cbrs.web import create_app, host_names
 from cbrs.web.components import blueprint as components_blueprint
@@ -199,21 +199,14 @@ class Server:
 
     def serve_forever(self, ready: Callable[[Server], None] | None = None) -> None:
         """Start, report through ``ready``, and serve until SIGINT or SIGTERM; then stop."""
-        stopping = threading.Event()
-
-        def on_signal(signum: int, frame: FrameType | None) -> None:
-            stopping.set()
-
-        previous = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
+        request = StopRequest()
         try:
-            self.start()
-            if ready is not None:
-                ready(self)
-            while not stopping.wait(0.5):
-                pass
+            with handling(request, signal.SIGINT, signal.SIGTERM):
+                self.start()
+                if ready is not None:
+                    ready(self)
+                request.wait()
         finally:
-            for signum, handler in previous.items():
-                signal.signal(signum, handler)
             self.stop()
 
     def _host_names(self) -> frozenset[str | None] | None:
