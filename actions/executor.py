@@ -42,6 +42,13 @@ class StepStart(Protocol):
         known now (the task's values, outputs already produced): what an environment may look ahead at."""
 
 
+class StepDone(Protocol):
+    def __call__(self, step: PlanStep, component: str) -> None:
+        """``component`` did ``step`` and its effects were checked: what an environment that keeps beliefs
+        no sense can check (a door a remote motor opened) updates them from (the component's effects
+        added, its delete effects removed)."""
+
+
 @dataclass
 class Attempt:
     component: str
@@ -164,9 +171,11 @@ class Executor:
         clock: Callable[[], float] | None = None,
         step_timeout: int = 10_000,
         on_start: StepStart | None = None,
+        on_done: StepDone | None = None,
     ) -> None:
         self.plan = plan
         self.on_start = on_start
+        self.on_done = on_done
         self.container = container
         self.given = dict(given)
         self.verifier = verifier
@@ -283,6 +292,12 @@ class Executor:
             self.reports[self._position].effects = checks
             self._violation(step, iri, "effect not reached: " + ", ".join(missed))
             return
+        if self.on_done is not None:
+            try:
+                self.on_done(step, iri)
+            except Exception as error:  # the environment's bookkeeping failed: the step did not count
+                self._violation(step, iri, f"{type(error).__name__}: {error}")
+                return
         report = self.reports[self._position]
         report.attempts.append(self._attempt(iri, "succeeded"))
         report.effects = checks

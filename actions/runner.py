@@ -45,7 +45,9 @@ class Environment(Protocol):
         """Seconds on the environment's clock (simulated time)."""
 
     # Optional: ``starting(step, known)`` (``executor.StepStart``), called before each step starts with
-    # the inputs of every step known by then, for an environment that looks ahead (where a hold ends).
+    # the inputs of every step known by then, for an environment that looks ahead (where a hold ends);
+    # ``succeeded(step, component)`` (``executor.StepDone``), called when a step succeeded, for an
+    # environment that keeps beliefs no sense can check (a door a remote motor opened).
 
 
 @dataclass(frozen=True)
@@ -189,7 +191,10 @@ def run_task(
                 raise
             store_plan(kb, plan)
             starting = getattr(environment, "starting", None)  # optional: a look-ahead at the plan's values
-            executor = Executor(plan, container, given, environment.verify, environment.clock, on_start=starting)
+            keeping = getattr(environment, "succeeded", None)  # optional: beliefs no sense can check
+            executor = Executor(
+                plan, container, given, environment.verify, environment.clock, on_start=starting, on_done=keeping
+            )
             done = 0
             _stop_if_cancelled(executor, cancelled, done)
             while executor.status is RunStatus.RUNNING and executor.ticks < max_ticks:

@@ -19,6 +19,7 @@ inputs first and encodes its outputs last.
 
 from __future__ import annotations
 
+import logging
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
@@ -29,7 +30,7 @@ from cbrs.actions.components import Component, Registry, Status
 from cbrs.actions.plan import Plan, PlanStep
 from cbrs.actions.remote import RemoteComponent, Transport
 from cbrs.kb import KnowledgeBase, Requirement, Statement
-from cbrs.kb.errors import KnowledgeBaseError
+from cbrs.kb.errors import KnowledgeBaseError, NotFoundError
 from cbrs.kb.model import Advertisement
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap, Thing, designate, local_name
@@ -77,6 +78,9 @@ __all__ = ["GraspChoice", "GraspPlan", "SimContext", "SimEnvironment", "designat
 
 HOME = PREFIXES["home"]
 ACT = PREFIXES["act"]
+
+log = logging.getLogger("cbrs.sim")
+
 TAKING = frozenset({ACT + "ApproachToObject", ACT + "HandingOverOntoPlatform"})
 """The actions with which an arm takes an object: a hold starts."""
 LOCALISATION_TOLERANCE = 0.10
@@ -1254,6 +1258,7 @@ class SimEnvironment:
         """Relations believed because a step with that effect succeeded, where no test decides them."""
         self._superclasses: dict[str, set[str]] | None = None
         self._computables: dict[str, str] | None = None
+        self._exclusions: tuple[frozenset[str], tuple[tuple[str, str], ...]] | None = None
         self.effects |= self._untestable_beliefs()
 
     def clock(self) -> float:
@@ -1483,9 +1488,53 @@ class SimEnvironment:
         fact = self._believe_effect(statement)
         if fact is None or fact not in self.effects:
             if fact is not None:
-                self.effects.add(fact)
+                self._believe(fact)
             return None
         return True
+
+    def succeeded(self, step: PlanStep, component: str) -> None:
+        """``component`` did ``step``: of the relations no test decides, what its description deletes stops
+        being believed, then what it adds is believed (in that order, as in STRIPS, so a statement both
+        deleted and added stays). Effects nobody relied on count too: the door a step opened on the way
+        is open for the next task."""
+        try:
+            description = self.kb.description(component)
+        except NotFoundError:  # deregistered while it ran: what it did is no longer described
+            log.warning("%s did a step but is no longer described: its effects are not believed", component)
+            return
+        for statement in description.deletes:
+            fact = self._untestable(statement)
+            if fact is not None:
+                self.effects.discard(fact)
+        for statement in description.effects:
+            fact = self._untestable(statement)
+            if fact is not None:
+                self._believe(fact)
+
+    def _untestable(self, statement: Statement) -> tuple[str, str, str] | None:
+        """The statement grounded in the things at hand, when the store maps its relation to no test."""
+        return self._believe_effect(statement) if self.computable(statement.predicate) is None else None
+
+    def _believe(self, fact: tuple[str, str, str]) -> None:
+        """Believe ``fact`` and stop believing what it contradicts: another value of the same relation of
+        the same thing, when the two values are classes declared disjoint (a door Closed is no longer
+        Opened) or the relation is functional (owl:FunctionalProperty: one value at a time)."""
+        subject, predicate, value = fact
+        self.effects = {
+            (s, p, o)
+            for s, p, o in self.effects
+            if not (s == subject and p == predicate and o != value and self._exclusive(predicate, o, value))
+        }
+        self.effects.add(fact)
+
+    def _exclusive(self, predicate: str, first: str, second: str) -> bool:
+        """Whether a thing cannot have both values of ``predicate`` at once."""
+        if self._exclusions is None:
+            functional = frozenset(row["property"].value for row in self.kb.select("functional_properties"))
+            disjoint = tuple((row["first"].value, row["second"].value) for row in self.kb.select("taxonomy_disjoint"))
+            self._exclusions = (functional, disjoint)
+        functional, disjoint = self._exclusions
+        return predicate in functional or any(self.is_a(first, a) and self.is_a(second, b) for a, b in disjoint)
 
     def _believe_effect(self, statement: Statement) -> tuple[str, str, str] | None:
         """The relation no test decides that a step with it as its effect makes believed: it joins the

@@ -1,5 +1,7 @@
 """A status effect no test decides is believed once the step with it succeeds (docs/tasks.md), and stays
-believed into the next run, which then has nothing to do: a remote motor opening the kitchen door."""
+believed into the next run, which then has nothing to do: a remote motor opening the kitchen door. It
+stops being believed when a later step deletes it or makes a contradicting status believed (closing the
+door), so that opening the door again is planned again."""
 
 from __future__ import annotations
 
@@ -39,16 +41,41 @@ req:OpenKitchenDoor a cbrs:Requirement ;
 """
 
 
+CLOSER = PREFIXES["svc"] + "CloseDoor_DoorMotor05"
+
+
+def task(name: str, status: str) -> str:
+    """A task in the shape of OpenKitchenDoor that brings the door to another status."""
+    return OPEN_KITCHEN_DOOR.replace("OpenKitchenDoor", name).replace("home:Opened", status)
+
+
+def closing_motor(status: str = "home:Closed", deletes: str = "") -> str:
+    """The same motor's second service: the door to ``status``, with delete effects ``deletes``."""
+    text = (
+        MOTOR_TTL.replace("OpenDoor_DoorMotor05", "CloseDoor_DoorMotor05")
+        .replace('"OpenDoor"', '"CloseDoor"')
+        .replace("Open door", "Close door")
+        .replace("home:Opened", status)
+        .replace('"open"', '"close"')
+        .replace("/door_motor_05/open", "/door_motor_05/close")
+        .replace("lab_msgs/OpenDoor", "lab_msgs/CloseDoor")
+        .replace("svc:DoorMotor05 a owl:NamedIndividual , home:Actuator ; rdfs:label \"Kitchen door motor 5\"@en .", "")
+    )
+    return text.replace("cbrs:conditionObject " + status + " ] ] ;", "cbrs:conditionObject " + status + " ]" + deletes + " ] ;")
+
+
 class DoorMotor:
-    """The motor's service, answered in this process: the door's new status, counting the calls."""
+    """The motor's services, answered in this process: the door's new status, counting the calls."""
 
     def __init__(self) -> None:
         self.calls: list[dict[str, Any]] = []
+        self.services: list[str] = []
 
     def call(self, service: str, args: Mapping[str, Any], timeout: float) -> Future[dict[str, Any]]:
         self.calls.append(dict(args))
+        self.services.append(service)
         future: Future[dict[str, Any]] = Future()
-        future.set_result({"doorStatus": {"@type": "home:Opened"}})
+        future.set_result({"doorStatus": {"@type": "home:Closed" if service.endswith("close") else "home:Opened"}})
         return future
 
 
@@ -62,9 +89,9 @@ def _kb(tmp_path: Path) -> KnowledgeBase:
     return kb
 
 
-def _run(kb: KnowledgeBase, motor: DoorMotor) -> RunResult:
+def _run(kb: KnowledgeBase, motor: DoorMotor, name: str = "OpenKitchenDoor") -> RunResult:
     with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
-        return run_task(kb, REQ + "OpenKitchenDoor", SimEnvironment(world, kb, motor), composer=Composer(kb))
+        return run_task(kb, REQ + name, SimEnvironment(world, kb, motor), composer=Composer(kb))
 
 
 def test_opening_the_door_is_believed_and_the_next_run_has_nothing_to_do(tmp_path: Path) -> None:
@@ -103,3 +130,60 @@ def test_a_status_object_is_a_quality_and_only_relations_no_test_decides_are_kep
     with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
         kept = SimEnvironment(world, kb, DoorMotor()).effects
     assert kept == {OPENED}
+
+
+LAB = "https://example.org/lab#"
+AJAR = (DOOR, HOME + "hasStatus", LAB + "Ajar")
+AJAR_TTL = f"""
+@prefix lab: <{LAB}> . @prefix home: <{HOME}> .
+@prefix owl: <http://www.w3.org/2002/07/owl#> . @prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .
+lab:Ajar a owl:Class ; rdfs:subClassOf home:DoorStatus ; rdfs:label "ajar"@en .
+"""
+DELETES_OPENED = (
+    " ; cbrs:hasDeleteEffect [ a cbrs:DeleteEffect ; cbrs:conditionSubject home:Door ;"
+    " cbrs:conditionPredicate home:hasStatus ; cbrs:conditionObject home:Opened ]"
+)
+
+
+def _with_closing(tmp_path: Path, status: str = "home:Closed", deletes: str = "") -> KnowledgeBase:
+    """The opening motor and its task, plus the motor's closing service and a task to reach ``status``."""
+    kb = _kb(tmp_path)
+    kb.registry.register((AJAR_TTL if status.startswith("lab:") else "") + closing_motor(status, deletes))
+    (tmp_path / "close.ttl").write_text(
+        (f"@prefix lab: <{LAB}> .\n" if status.startswith("lab:") else "") + task("CloseKitchenDoor", status),
+        encoding="utf-8",
+    )
+    kb.load([tmp_path / "close.ttl"], graph="requirements")
+    return kb
+
+
+def test_closing_the_door_ends_the_belief_that_it_is_open_so_opening_it_is_planned_again(tmp_path: Path) -> None:
+    kb = _with_closing(tmp_path)  # Opened and Closed are declared disjoint (ontologies/home.ttl)
+    motor = DoorMotor()
+    closed = (DOOR, HOME + "hasStatus", HOME + "Closed")
+    assert _run(kb, motor).succeeded
+    assert OPENED in BeliefState(kb).facts()
+    assert _run(kb, motor, "CloseKitchenDoor").succeeded
+    assert closed in BeliefState(kb).facts() and OPENED not in BeliefState(kb).facts()
+    again = _run(kb, motor)
+    assert again.succeeded, again.report
+    assert again.composition.plan is not None and [s.component for s in again.composition.plan.steps] == [MOTOR]
+    assert motor.services == ["/door_motor_05/open", "/door_motor_05/close", "/door_motor_05/open"]
+    assert OPENED in BeliefState(kb).facts() and closed not in BeliefState(kb).facts()
+
+
+def test_a_delete_effect_ends_a_belief_the_ontology_does_not_say_is_contradicted(tmp_path: Path) -> None:
+    kb = _with_closing(tmp_path, "lab:Ajar", DELETES_OPENED)
+    motor = DoorMotor()
+    assert _run(kb, motor).succeeded
+    assert _run(kb, motor, "CloseKitchenDoor").succeeded
+    facts = BeliefState(kb).facts()
+    assert AJAR in facts and OPENED not in facts  # Ajar is not declared disjoint with Opened: the delete did it
+
+
+def test_without_a_delete_or_a_contradiction_both_statuses_stay_believed(tmp_path: Path) -> None:
+    kb = _with_closing(tmp_path, "lab:Ajar")
+    motor = DoorMotor()
+    assert _run(kb, motor).succeeded
+    assert _run(kb, motor, "CloseKitchenDoor").succeeded
+    assert {OPENED, AJAR} <= BeliefState(kb).facts()
