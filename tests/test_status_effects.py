@@ -59,9 +59,10 @@ def closing_motor(status: str = "home:Closed", deletes: str = "") -> str:
         .replace('"open"', '"close"')
         .replace("/door_motor_05/open", "/door_motor_05/close")
         .replace("lab_msgs/OpenDoor", "lab_msgs/CloseDoor")
-        .replace("svc:DoorMotor05 a owl:NamedIndividual , home:Actuator ; rdfs:label \"Kitchen door motor 5\"@en .", "")
+        .replace('svc:DoorMotor05 a owl:NamedIndividual , home:Actuator ; rdfs:label "Kitchen door motor 5"@en .', "")
     )
-    return text.replace("cbrs:conditionObject " + status + " ] ] ;", "cbrs:conditionObject " + status + " ]" + deletes + " ] ;")
+    effect = f"cbrs:conditionObject {status} ]"
+    return text.replace(f"{effect} ] ;", f"{effect}{deletes} ] ;")
 
 
 class DoorMotor:
