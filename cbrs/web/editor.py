@@ -1,6 +1,9 @@
 """The SPARQL editor: write or pick a named query, run it with the endpoint's limits, read the result as a
 table (or Turtle), and download it from ``/sparql`` in CSV or JSON. The query travels in the URL, so a
-result can be linked to."""
+result can be linked to.
+
+A SELECT is run with a ``LIMIT`` of one row more than the page shows (:mod:`cbrs.web.row_limit`): the
+engine stops there, the extra row says the result was cut, and the downloads run the query as written."""
 
 from __future__ import annotations
 
@@ -8,16 +11,18 @@ import json
 import time
 from typing import Any
 
-from flask import Blueprint, Response, request, url_for
+from flask import Blueprint, Response, current_app, request, url_for
 
 from cbrs.kb.errors import KnowledgeBaseError, QuerySyntaxError, UnknownQueryError
+from cbrs.sparql_service import Answer
 from cbrs.web import context
 from cbrs.web.pages import FormError, Page, page, wants_json
+from cbrs.web.row_limit import bounded
 from cbrs.web.sparql import protocol_answer, wants_protocol
 
 blueprint = Blueprint("editor", __name__)
 
-MAX_ROWS = 1000  # rows shown (and in the twin); the downloads carry all of them
+MAX_ROWS = 1000  # rows shown (and in the twin), CBRS_EDITOR_ROWS; the downloads carry all of them
 FIRST_EXAMPLE = "advertisements"
 # Download formats offered for each result form: (label, the endpoint's format= short name).
 DOWNLOADS = {
@@ -48,7 +53,15 @@ def editor() -> Page:
     examples = [_example(name) for name in kb.queries.names()]
     chosen = request.values.get("example")
     text = request.values.get("query")
-    data: dict[str, Any] = {"query": text, "example": chosen, "result": None, "downloads": [], "examples": examples}
+    rows = int(current_app.config.get("CBRS_EDITOR_ROWS", MAX_ROWS))
+    data: dict[str, Any] = {
+        "query": text,
+        "example": chosen,
+        "result": None,
+        "downloads": [],
+        "examples": examples,
+        "max_rows": rows,
+    }
     shown = Page("editor.html", "SPARQL", data)
     if text is None:
         try:
@@ -61,8 +74,7 @@ def editor() -> Page:
         raise FormError({"query": "write a query, or pick one of the examples"}, page=shown)
     started = time.perf_counter()
     try:
-        # SELECT and ASK come back as SPARQL JSON results, CONSTRUCT and DESCRIBE as Turtle
-        answer = context.sparql().query(text, short_format="turtle", client=request.remote_addr)
+        answer = _run(text, rows)
     except QuerySyntaxError as error:
         raise FormError({"query": str(error)}, page=shown) from error
     except KnowledgeBaseError as error:  # a timeout, a result too large, busy workers, an evaluation error
@@ -72,13 +84,27 @@ def editor() -> Page:
         shown.status = error.http_status
         return shown
     data["elapsed_ms"] = round((time.perf_counter() - started) * 1000, 1)
-    data["result"] = _result(answer.body, answer.media_type)
+    data["result"] = _result(answer.body, answer.media_type, rows)
     form = "graph" if data["result"]["kind"] == "graph" else "select"
     data["downloads"] = [
         {"label": label, "format": short, "href": url_for("sparql.sparql", query=text, format=short)}
         for label, short in DOWNLOADS[form]
     ]
     return shown
+
+
+def _run(text: str, rows: int) -> Answer:
+    """The answer to ``text``; a SELECT's cut at ``rows`` + 1 rows, so that the engine stops producing
+    and serialising solutions past what the page shows (SELECT and ASK come back as SPARQL JSON results,
+    CONSTRUCT and DESCRIBE as Turtle)."""
+    sparql = context.sparql()
+    limited = bounded(text, rows + 1)
+    if limited is not None and limited.changed:
+        try:
+            return sparql.query(limited.text, short_format="turtle", client=request.remote_addr)
+        except QuerySyntaxError:
+            pass  # the error as the parser reports it for the text the user wrote, lines and columns included
+    return sparql.query(text, short_format="turtle", client=request.remote_addr)
 
 
 def _example(name: str) -> dict[str, Any]:
@@ -90,9 +116,11 @@ def _example(name: str) -> dict[str, Any]:
     return {"name": name, "title": query.title, "text": query.text, "parameters": parameters}
 
 
-def _result(body: bytes, media_type: str) -> dict[str, Any]:
+def _result(body: bytes, media_type: str, shown: int) -> dict[str, Any]:
     """The answer as the page shows it: ``{"kind": "select", "vars", "rows", "count", "truncated"}``,
-    ``{"kind": "ask", "boolean"}`` or ``{"kind": "graph", "turtle"}``."""
+    ``{"kind": "ask", "boolean"}`` or ``{"kind": "graph", "turtle"}``. ``rows`` are the first ``shown``;
+    ``count`` is how many the page shows, and ``truncated`` says the result has more (then the
+    page read ``shown`` + 1, not all)."""
     if media_type == "text/turtle":
         return {"kind": "graph", "turtle": body.decode("utf-8")}
     parsed = json.loads(body)
@@ -102,7 +130,7 @@ def _result(body: bytes, media_type: str) -> dict[str, Any]:
     return {
         "kind": "select",
         "vars": parsed["head"].get("vars", []),
-        "rows": rows[:MAX_ROWS],
-        "count": len(rows),
-        "truncated": len(rows) > MAX_ROWS,
+        "rows": rows[:shown],
+        "count": min(len(rows), shown),
+        "truncated": len(rows) > shown,
     }
