@@ -15,6 +15,8 @@ import cbrs.sim.quiet  # noqa: F401  (first: keeps pybullet's banner off stdout)
 from cbrs.sim.arms import ArmSide
 from cbrs.sim.errors import (
     CameraUnavailableError,
+    GraspMisfitError,
+    GraspTooDeepError,
     GraspTooWideError,
     ImageSizeError,
     MapError,
@@ -47,7 +49,9 @@ from cbrs.sim.world import HomeWorld, open_world
 __all__ = [
     "ArmSide",
     "CameraUnavailableError",
+    "GraspMisfitError",
     "GraspPose",
+    "GraspTooDeepError",
     "GraspTooWideError",
     "HomeWorld",
     "ImageSizeError",

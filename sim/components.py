@@ -39,7 +39,7 @@ from cbrs.settings import setting
 from cbrs.sim import predicates as pred
 from cbrs.sim import skills
 from cbrs.sim.arms import GRIPPER_OPEN, ArmSide
-from cbrs.sim.errors import GraspTooWideError, SimulationError
+from cbrs.sim.errors import GraspMisfitError, SimulationError
 from cbrs.sim.geometry import Pose2D, Region, Vec3
 from cbrs.sim.grasping import GraspKind, GraspPose, ObjectModel, compute_grasp_pose
 from cbrs.sim.mapping import OccupancyGrid, build_occupancy_grid
@@ -850,8 +850,8 @@ def _relay_spot(
         for held in candidates.models:
             try:
                 hand = compute_grasp_pose(held, centre, estimate.yaw, spec.mount, spec.yaw, _extent(estimate))
-            except GraspTooWideError:
-                continue  # the hand cannot close on it so, wherever it is
+            except GraspMisfitError:
+                continue  # the hand cannot hold it so, wherever it is
             if world.arm(side).can_hold(hand.position, hand.orientation) and world.arm(side).can_hold(
                 hand.pregrasp, hand.orientation
             ):

@@ -102,7 +102,15 @@ class UnknownColourError(PerceptionError):
         super().__init__(f"unknown colour {colour!r}; known: {', '.join(self.known)}")
 
 
-class GraspTooWideError(SimulationError):
+class GraspMisfitError(SimulationError):
+    """The hand could not hold the object by this approach, wherever the arm reaches: the object does not
+    fit the hand that way. An approach so refused is passed over for the next its class allows."""
+
+    name: str
+    approach: str
+
+
+class GraspTooWideError(GraspMisfitError):
     """An object wider across the jaws than they open, for the approach and the way the hand is turned to
     it (a long box taken from the side across its length): the hand could not close on it so, wherever
     the arm reaches. ``width`` and ``opening`` are in metres."""
@@ -115,6 +123,26 @@ class GraspTooWideError(SimulationError):
         super().__init__(
             f"the {name} is {width * 100:.1f} cm wide across the jaws by its {approach} grasp, and the hand "
             f"opens {opening * 100:.1f} cm"
+        )
+
+
+class GraspTooDeepError(GraspMisfitError):
+    """An object deeper along a side grasp's approach than the fingers can hold: pushed against the palm,
+    less than ``least`` of its ``depth`` would lie between them (``held``, the fingers' ``finger_length``
+    along the hand's axis, tilted down, measured along the approach), its centre of mass beyond the
+    fingertips at the default half. The jaws would close on its near part only. Lengths in metres."""
+
+    def __init__(self, name: str, approach: str, depth: float, finger_length: float, held: float, least: float) -> None:
+        self.name = name
+        self.approach = approach
+        self.depth = depth
+        self.finger_length = finger_length
+        self.held = held
+        self.least = least
+        super().__init__(
+            f"the {name} is {depth * 100:.1f} cm deep along the hand's approach by its {approach} grasp, and the "
+            f"fingers are {finger_length * 100:.1f} cm long: {held * 100:.1f} cm of it would lie between them, "
+            f"less than the {least:.0%} a hold needs"
         )
 
 

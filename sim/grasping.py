@@ -14,10 +14,20 @@ from enum import StrEnum
 import numpy as np
 
 from cbrs.kb.semantic_map import MapObject
-from cbrs.sim.errors import GraspTooWideError
+from cbrs.sim.errors import GraspTooDeepError, GraspTooWideError
 from cbrs.sim.geometry import Quat, Vec3, quat_from_matrix
 
-__all__ = ["JAW_OPENING", "PALM_DEPTH", "GraspKind", "GraspPose", "ObjectModel", "compute_grasp_pose"]
+__all__ = [
+    "FINGER_LENGTH",
+    "JAW_OPENING",
+    "PALM_DEPTH",
+    "SIDE_HOLD",
+    "GraspKind",
+    "GraspPose",
+    "ObjectModel",
+    "compute_grasp_pose",
+    "side_held",
+]
 
 JAW_OPENING = 0.08
 """How far apart the open jaws are (m): the Panda hand's fingers open 4 cm each. An object wider than
@@ -138,12 +148,34 @@ fingertips 1.1 cm below it): an object whose top is higher above the grasp point
 taken from the top."""
 
 
+FINGER_LENGTH = 0.046
+"""How long the fingers are from the palm to their tips (m), along the hand's axis: what of an object can
+lie between them. The Panda's collision meshes: panda_hand's lowest point 6.60 cm from the hand's
+origin, the fingers' tips 11.22 cm (their joint at 5.84 cm, finger.obj 5.38 cm long): 4.62 cm; pybullet's
+bounding boxes, 4 mm margins included, put the palm 3.5 cm above the grasp point and the tips 1.1 cm
+below it, the same length. tests/test_grasp16_depth.py measures it again from the URDF."""
+SIDE_HOLD = 0.5
+"""The least fraction of an object's depth along a side grasp's approach that must lie between the
+fingers, its near face pushed against the palm (:func:`side_held`). At a half its centre of mass lies
+within the fingertips; a box deeper than twice what the fingers span along the approach is refused
+(:class:`GraspTooDeepError`). Raise it for a firmer hold, lower it to allow deeper boxes."""
+
+
 SIDE_PITCH = math.radians(35.0)
 """A side grasp comes in tilted down by 35 degrees: with the arms mounted below the grasp height, a
 level hand would need the wrist at its joint limit, while a tilted one keeps it mid-range."""
 PREGRASP_DISTANCE = 0.10
 """The pre-grasp pose is this far back along the approach direction: far enough that opening the
 fingers there touches nothing, near enough that the final approach is a short straight move."""
+
+
+def side_held(depth: float) -> float:
+    """How much of an object ``depth`` deep along a side grasp's horizontal approach lies between the
+    fingers: they come in tilted down by SIDE_PITCH, so they span FINGER_LENGTH * cos(SIDE_PITCH) of it
+    (3.8 cm); a deeper object meets the palm and is pushed until its near face rests against it, the rest
+    of it beyond the fingertips (measured: a 4 x 10 cm box taken so ended with its centre 1.9 cm beyond
+    the grasp point, 1 cm beyond the fingertips)."""
+    return min(depth, FINGER_LENGTH * math.cos(SIDE_PITCH))
 
 
 @dataclass(frozen=True)
@@ -200,7 +232,9 @@ def compute_grasp_pose(
 
     A side grasp comes in from the robot's side of the table, its jaws closing across that direction;
     a top grasp closes them across the object's long axis. GraspTooWideError when the object is wider
-    across the jaws than they open: the hand could not close on it so, whatever the arm can reach.
+    across the jaws than they open, GraspTooDeepError when a side grasp would hold less than SIDE_HOLD
+    of its depth along the approach (:func:`side_held`): the hand could not hold it so, whatever the arm
+    can reach.
     """
     cx, cy, cz = centre
     bottom = cz - model.height / 2.0
@@ -233,5 +267,10 @@ def compute_grasp_pose(
     width = model.across(closing, yaw, seen)
     if width > JAW_OPENING + 1e-9:
         raise GraspTooWideError(model.name, model.grasp.value, width, JAW_OPENING)
+    if model.grasp is GraspKind.SIDE:
+        depth = model.across(facing, yaw, seen)  # its extent along the approach, as across the jaws
+        held = side_held(depth)
+        if held < SIDE_HOLD * depth - 1e-9:
+            raise GraspTooDeepError(model.name, model.grasp.value, depth, FINGER_LENGTH, held, SIDE_HOLD)
     grip = model.grip(closing, yaw)
     return GraspPose(model, (cx, cy, grasp_z), orientation, approach, model.grasp_height, grip)

@@ -18,7 +18,7 @@ import pybullet as p
 
 from cbrs.sim import predicates as pred
 from cbrs.sim.arms import GRIPPER_OPEN, Arm, ArmSide
-from cbrs.sim.errors import GraspTooWideError
+from cbrs.sim.errors import GraspMisfitError
 from cbrs.sim.geometry import Pose2D, Region, Vec3, wrap_angle
 from cbrs.sim.grasping import (
     PALM_DEPTH,
@@ -288,12 +288,13 @@ def platform_region(base: Pose2D | RobotPoseEstimate, height: float) -> Region:
 
 def _grasp(world: HomeWorld, pen: ObjectEstimate, side: ArmSide | str, model: ObjectModel) -> GraspPose | str:
     """The grasp of ``side`` on the object where perception put it, by ``model``'s approach; or why the
-    hand cannot close on it so (too wide across the jaws: :class:`GraspTooWideError`'s words)."""
+    hand cannot hold it so (too wide across the jaws, too deep along a side grasp's approach: the words of
+    :class:`GraspTooWideError` or :class:`GraspTooDeepError`)."""
     spec = world.arm_specs[ArmSide(side)]
     try:
         return compute_grasp_pose(model, pen.position, pen.yaw, spec.mount, spec.yaw, (pen.size[0], pen.size[1]))
-    except GraspTooWideError as wide:
-        return str(wide)
+    except GraspMisfitError as misfit:
+        return str(misfit)
 
 
 def _loading(
@@ -350,8 +351,8 @@ def can_grip(model: ObjectModel) -> str:
 def can_take(world: HomeWorld, pen: ObjectEstimate, side: ArmSide | str, model: ObjectModel) -> str:
     """Why ``side`` cannot take the object where it is by the approach ``model`` is held by (empty if it
     can), asked without moving: the hand cannot close on it so (:func:`can_grip`; or it is wider across
-    the jaws than they open, for the way the hand turns to it), or cannot hold the pre-grasp or the
-    grasp pose."""
+    the jaws than they open, for the way the hand turns to it, or too deep along a side grasp's approach
+    for the fingers), or cannot hold the pre-grasp or the grasp pose."""
     arm = ArmSide(side)
     x, y, _ = pen.position
     refused = can_grip(model)
