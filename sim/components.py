@@ -405,7 +405,9 @@ def _taking(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, side:
     plan to a place the task gives), else the first it can take it by. Letting go is asked as the carry
     will (:func:`_holdable`): over the spots of the place this arm reaches, nearest the centre first. An
     arm that can let it go there by no approach takes it by the first it can, as where it is not known:
-    the carry passes it to the other arm."""
+    the carry passes it to the other arm. Of the approaches that pass those checks (the inverse
+    kinematics' of the end poses), the first whose moves the arm's planning would make (:func:`_clear`)
+    is taken; when none would, the first, as before."""
     world, name = ctx.world, model.name
 
     def take(held: ObjectModel) -> str:
@@ -416,22 +418,45 @@ def _taking(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, side:
         raise SkillFailed(taking.refusal())
     end = _hold_end(ctx, name)
     if end is None:
-        return taking.choice(side, taking.models[0], f"taking the {name}")
+        return _clear(taking, side, f"taking the {name}", lambda held: skills.can_carry(world, estimate, side, held))
     place, surface, spots = end
+    first: dict[GraspKind, Region] = {}  # the spot the carry will aim at, by each approach that lets go there
 
     def letting_go(held: ObjectModel) -> str:
         tried = spots[:RELAY_TRIES]
-        if any(not skills.can_set_down(world, estimate, side, held, _spot_region(surface, *at)) for at in tried):
-            return ""
+        for at in tried:
+            spot = _spot_region(surface, *at)
+            if not skills.can_set_down(world, estimate, side, held, spot):
+                first[held.grasp] = spot
+                return ""
         spots_of = "the one spot" if len(tried) == 1 else f"any of the {len(tried)} spots"
         where = f"{spots_of} of {place.name} it reaches" if tried else f"{place.name} (no spot in reach)"
         return f"the {side.value} arm cannot hold the {name} by its {held.grasp.value} grasp over {where}"
 
     both = _Candidates.of(model, take, letting_go)
     if both.models:
-        return both.choice(side, both.models[0], f"taking the {name} to {place.name}")
+        return _clear(
+            both,
+            side,
+            f"taking the {name} to {place.name}",
+            lambda held: skills.can_carry(world, estimate, side, held, first[held.grasp]),
+        )
     unplaced = "; ".join(why for _, why in both.ruled_out)
     return taking.choice(side, taking.models[0], f"taking the {name} (to {place.name}, to be passed on: {unplaced})")
+
+
+def _clear(candidates: _Candidates, side: ArmSide, purpose: str, moves: Callable[[ObjectModel], str]) -> GraspChoice:
+    """The first of ``candidates`` whose ``moves`` the arm's planning would make, as they are asked (a dry
+    run: :func:`skills.can_carry`): one it would refuse is ranked after those it would not, and passed over
+    saying why. When it would refuse every one, the first: the dry run sees no physics and the real moves
+    may still do (a failed step is re-planned), so nothing is refused on its word alone."""
+    passed = list(candidates.ruled_out)
+    for held in candidates.models:
+        why = moves(held)
+        if not why:
+            return _Candidates([held], passed).choice(side, held, purpose)
+        passed.append((held.grasp, why))
+    return candidates.choice(side, candidates.models[0], purpose)
 
 
 def _hold_end(ctx: SimContext, name: str) -> tuple[Thing, Region, list[tuple[float, float]]] | None:
@@ -1534,7 +1559,10 @@ class SimEnvironment:
             disjoint = tuple((row["first"].value, row["second"].value) for row in self.kb.select("taxonomy_disjoint"))
             self._exclusions = (functional, disjoint)
         functional, disjoint = self._exclusions
-        return predicate in functional or any(self.is_a(first, a) and self.is_a(second, b) for a, b in disjoint)
+        return predicate in functional or any(
+            (self.is_a(first, a) and self.is_a(second, b)) or (self.is_a(first, b) and self.is_a(second, a))
+            for a, b in disjoint
+        )
 
     def _believe_effect(self, statement: Statement) -> tuple[str, str, str] | None:
         """The relation no test decides that a step with it as its effect makes believed: it joins the
