@@ -33,6 +33,16 @@ def test_part_cycle_is_broken_not_fatal() -> None:
     assert index.distance_down(E + "B", E + "A") == 1
 
 
+def test_every_part_cycle_is_broken_at_a_part_link_and_the_rest_of_the_graph_is_left_alone() -> None:
+    chain = [isa(f"N{i}", f"N{i - 1}" if i else "Thing") for i in range(50)]  # acyclic, with parts
+    chain += [part(f"N{i}", f"N{i + 10}") for i in range(0, 30, 10)]
+    cycles = [isa("A", "Thing"), isa("B", "A"), part("A", "B"), isa("C", "Thing"), isa("D", "C"), part("C", "D")]
+    index = TaxonomyIndex.from_links(chain + cycles)
+    assert index.distance_down(E + "B", E + "A") == 1 and index.distance_down(E + "D", E + "C") == 1  # is-a kept
+    assert index.depth(E + "B") == 2 and index.depth(E + "D") == 2
+    assert index.depth(E + "N49") == 50
+
+
 def test_multiple_parents_use_the_shortest_path() -> None:
     index = TaxonomyIndex.from_links([isa("A", "Thing"), isa("B", "A"), isa("C", "B"), isa("C", "Thing")])
     assert index.depth(E + "C") == 1
