@@ -34,6 +34,7 @@ __all__ = [
     "ArmSide",
     "Kinematics",
     "MotionResult",
+    "PlannedArm",
     "panda_urdf",
 ]
 
@@ -154,6 +155,12 @@ def quat_angle(a: Quat, b: Quat) -> float:
     """Angle of the rotation between two orientations (rad)."""
     dot = abs(float(np.dot(np.asarray(a), np.asarray(b))))
     return 2.0 * math.acos(min(1.0, dot))
+
+
+def nearer(current: Quat, orientation: Quat) -> Quat:
+    """Of a grasp orientation and its half-turn twin, the one nearer the hand's ``current`` orientation."""
+    twin = flipped(orientation)
+    return twin if quat_angle(current, twin) < quat_angle(current, orientation) else orientation
 
 
 def flipped(q: Quat) -> Quat:
@@ -277,6 +284,65 @@ class Kinematics:
                 break
         return _Solution(q, error, turn)
 
+    def line(
+        self, side: ArmSide, start: Sequence[float], position: Vec3, orientation: Quat, begin: Pose3D | None = None
+    ) -> list[tuple[float, ...]] | str:
+        """The joint angles of a straight-line move of the grasp point from where the arm at ``start`` has
+        it (``begin``, when known) to ``position``, turning the hand to ``orientation``: one per 1 cm (or
+        0.05 rad) piece, each solved from the one before; or why there is none (a piece without a solution)."""
+        begin = begin or self.forward(side, start)
+        start_pos = np.asarray(begin.position)
+        goal = np.asarray(position, dtype=np.float64)
+        distance = float(np.linalg.norm(goal - start_pos))
+        angle = quat_angle(begin.orientation, orientation)
+        pieces = max(1, math.ceil(max(distance / CARTESIAN_STEP, angle / ANGULAR_STEP)))
+        chain: list[tuple[float, ...]] = []
+        seed = tuple(start)
+        for i in range(1, pieces + 1):
+            t = i / pieces
+            point = start_pos + (goal - start_pos) * t
+            target = (float(point[0]), float(point[1]), float(point[2]))
+            solution = self.solve(side, target, _slerp(begin.orientation, orientation, t), [seed])
+            if solution.position_error > IK_TOLERANCE or solution.orientation_error > 0.02:
+                return f"no inverse kinematics at {i}/{pieces} of the line to {_fmt(position)}"
+            chain.append(solution.q)
+            seed = solution.q
+        return chain
+
+    def joint_path(
+        self,
+        side: ArmSide,
+        current: Sequence[float],
+        others: dict[ArmSide, Sequence[float]],
+        position: Vec3,
+        orientation: Quat,
+        symmetric: bool = True,
+        min_height: float | None = None,
+    ) -> _Solution | None:
+        """Where a joint-space move to a pose ends (:meth:`Arm.reach`): of the inverse-kinematics solutions
+        (one per seed posture, and from ``current``), the nearest whose straight joint-space path from
+        ``current`` is collision-free (and, with ``min_height``, keeps the grasp point at or above it);
+        None when there is none."""
+        candidates = [orientation, flipped(orientation)] if symmetric else [orientation]
+        best: _Solution | None = None
+        for candidate in candidates:
+            found = []
+            for seed in (*_SEEDS, current):
+                solution = self.solve(side, position, candidate, [seed])
+                if solution.position_error <= IK_TOLERANCE and solution.orientation_error <= 0.02:
+                    found.append(solution)
+            # Nearest first (a stable sort keeps the seeds' order among equals): the first whose path is
+            # clear is the nearest clear one, so the farther ones' paths need no checking.
+            for solution in sorted(found, key=lambda s: _joint_distance(current, s.q)):
+                if best is not None and not _joint_distance(current, solution.q) < _joint_distance(current, best.q):
+                    break
+                if self.path_clear(side, current, solution.q, others, min_height):
+                    best = solution
+                    break
+            if best is not None and min_height is None:
+                break
+        return best
+
     def solve(self, side: ArmSide, position: Vec3, orientation: Quat, seeds: Sequence[Sequence[float]]) -> _Solution:
         """The best solution over the seeds; the first seed wins when it is good (keeps motions smooth)."""
         best: _Solution | None = None
@@ -368,12 +434,6 @@ class Arm:
             physicsClientId=self.client,
         )
 
-    def _nearer(self, orientation: Quat) -> Quat:
-        """Of a grasp orientation and its half-turn twin, the one nearer the hand's current orientation."""
-        current = self.ee_pose().orientation
-        twin = flipped(orientation)
-        return twin if quat_angle(current, twin) < quat_angle(current, orientation) else orientation
-
     def move_to(
         self,
         position: Vec3,
@@ -387,28 +447,16 @@ class Arm:
         With ``symmetric`` the hand may end half a turn about its approach axis from ``orientation``
         (a parallel gripper grasps the same either way), whichever is the smaller turn.
         """
-        if symmetric:
-            orientation = self._nearer(orientation)
         start = self.ee_pose()
-        start_pos = np.asarray(start.position)
+        if symmetric:
+            orientation = nearer(start.orientation, orientation)
         goal = np.asarray(position, dtype=np.float64)
-        distance = float(np.linalg.norm(goal - start_pos))
+        distance = float(np.linalg.norm(goal - np.asarray(start.position)))
         angle = quat_angle(start.orientation, orientation)
-        pieces = max(1, math.ceil(max(distance / CARTESIAN_STEP, angle / ANGULAR_STEP)))
-        piece_time = max(distance / speed, angle / ARM_TURN_SPEED, 1e-3) / pieces
-        chain: list[tuple[float, ...]] = []
-        seed = self.joint_positions()
-        for i in range(1, pieces + 1):
-            t = i / pieces
-            point = start_pos + (goal - start_pos) * t
-            target = (float(point[0]), float(point[1]), float(point[2]))
-            solution = self._kinematics.solve(self.side, target, _slerp(start.orientation, orientation, t), [seed])
-            if solution.position_error > IK_TOLERANCE or solution.orientation_error > 0.02:
-                return MotionResult(
-                    False, math.inf, f"no inverse kinematics at {i}/{pieces} of the line to {_fmt(position)}"
-                )
-            chain.append(solution.q)
-            seed = solution.q
+        chain = self._kinematics.line(self.side, self.joint_positions(), position, orientation, start)
+        if isinstance(chain, str):
+            return MotionResult(False, math.inf, chain)
+        piece_time = max(distance / speed, angle / ARM_TURN_SPEED, 1e-3) / len(chain)
         for q in chain:
             self._targets = q
             self._command()
@@ -427,29 +475,12 @@ class Arm:
         at or above that height all the way: a held object then passes over the table and the torso
         instead of through them.
         """
-        candidates = [orientation, flipped(orientation)] if symmetric else [orientation]
         current = self.joint_positions()
-        others = self._others()
-        best: _Solution | None = None
-        for candidate in candidates:
-            found = []
-            for seed in (*_SEEDS, current):
-                solution = self._kinematics.solve(self.side, position, candidate, [seed])
-                if solution.position_error <= IK_TOLERANCE and solution.orientation_error <= 0.02:
-                    found.append(solution)
-            # Nearest first (a stable sort keeps the seeds' order among equals): the first whose path is
-            # clear is the nearest clear one, so the farther ones' paths need no checking.
-            for solution in sorted(found, key=lambda s: _joint_distance(current, s.q)):
-                if best is not None and not _joint_distance(current, solution.q) < _joint_distance(current, best.q):
-                    break
-                if self._kinematics.path_clear(self.side, current, solution.q, others, min_height):
-                    best = solution
-                    break
-            if best is not None and min_height is None:
-                break
+        best = self._kinematics.joint_path(
+            self.side, current, self._others(), position, orientation, symmetric, min_height
+        )
         if best is None:
-            where = "" if min_height is None else f" above {min_height:.2f} m"
-            return MotionResult(False, math.inf, f"no collision-free joint path to {_fmt(position)}{where}")
+            return _no_joint_path(position, min_height)
         motion = self.move_joints(best.q)
         error = float(np.linalg.norm(np.asarray(self.ee_pose().position) - np.asarray(position)))
         ok = motion.reached and error <= REACH_TOLERANCE
@@ -468,6 +499,10 @@ class Arm:
 
     def _others(self) -> dict[ArmSide, Sequence[float]]:
         return {side: arm.joint_positions() for side, arm in self.peers.items() if side is not self.side}
+
+    def dry_run(self) -> PlannedArm:
+        """A stand-in for this arm, from its posture now, whose moves are planned and not made."""
+        return PlannedArm(self.side, self._kinematics, self.joint_positions(), self._others())
 
     def _settle(self, goal: NDArray[np.float64]) -> float:
         waited = 0.0
@@ -557,6 +592,63 @@ class Arm:
         self.held = None
         self.held_grasp = None
         return held
+
+
+class PlannedArm:
+    """An arm's moves planned on the kinematics copies and not made (a dry run): each straight line and
+    joint-space reach is planned as :class:`Arm` plans it (:meth:`Kinematics.line`,
+    :meth:`Kinematics.joint_path`) and ends where that plan ends, the other arm kept where it was. It
+    asks whether the arm's own planning would refuse a sequence of moves before any is made; it knows
+    nothing of the physics (how the motors track, what the hand or the held object touches)."""
+
+    def __init__(
+        self, side: ArmSide, kinematics: Kinematics, q: Sequence[float], others: dict[ArmSide, Sequence[float]]
+    ) -> None:
+        self.side = side
+        self._kinematics = kinematics
+        self._q = tuple(q)
+        self._others = others
+
+    def joint_positions(self) -> tuple[float, ...]:
+        return self._q
+
+    def ee_pose(self) -> Pose3D:
+        return self._kinematics.forward(self.side, self._q)
+
+    def move_to(
+        self,
+        position: Vec3,
+        orientation: Quat,
+        speed: float = ARM_SPEED,
+        tolerance: float = REACH_TOLERANCE,
+        symmetric: bool = True,
+    ) -> MotionResult:
+        """:meth:`Arm.move_to`, planned (``speed`` and ``tolerance`` are the real move's)."""
+        start = self.ee_pose()
+        if symmetric:
+            orientation = nearer(start.orientation, orientation)
+        chain = self._kinematics.line(self.side, self._q, position, orientation, start)
+        if isinstance(chain, str):
+            return MotionResult(False, math.inf, chain)
+        self._q = chain[-1]
+        return MotionResult(True, 0.0)
+
+    def reach(
+        self, position: Vec3, orientation: Quat, symmetric: bool = True, min_height: float | None = None
+    ) -> MotionResult:
+        """:meth:`Arm.reach`, planned."""
+        best = self._kinematics.joint_path(
+            self.side, self._q, self._others, position, orientation, symmetric, min_height
+        )
+        if best is None:
+            return _no_joint_path(position, min_height)
+        self._q = best.q
+        return MotionResult(True, 0.0)
+
+
+def _no_joint_path(position: Vec3, min_height: float | None) -> MotionResult:
+    where = "" if min_height is None else f" above {min_height:.2f} m"
+    return MotionResult(False, math.inf, f"no collision-free joint path to {_fmt(position)}{where}")
 
 
 def _joint_distance(a: Sequence[float], b: Sequence[float]) -> float:

@@ -12,14 +12,15 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 import pybullet as p
 
 from cbrs.sim import predicates as pred
-from cbrs.sim.arms import GRIPPER_OPEN, Arm, ArmSide
+from cbrs.sim.arms import GRIPPER_OPEN, Arm, ArmSide, MotionResult
 from cbrs.sim.errors import GraspMisfitError
-from cbrs.sim.geometry import Pose2D, Region, Vec3, wrap_angle
+from cbrs.sim.geometry import Pose2D, Pose3D, Quat, Region, Vec3, wrap_angle
 from cbrs.sim.grasping import (
     PALM_DEPTH,
     PREGRASP_DISTANCE,
@@ -42,6 +43,7 @@ __all__ = [
     "NAVIGATION_TOLERANCE",
     "Outcome",
     "approach_object",
+    "can_carry",
     "can_grip",
     "can_load",
     "can_set_down",
@@ -180,6 +182,31 @@ def carry_object(world: HomeWorld, side: ArmSide | str, region: Region, yaw: flo
     if arm.held is None or grasp is None:
         return _done(world, "CarryObject", start, False, f"the {arm.side} gripper holds nothing")
     name = world.name_of(arm.held) or "?"
+    result = _carry(arm, grasp, region, yaw)
+    if not result.reached:
+        return _done(world, "CarryObject", start, False, result.reason)
+    ok = pred.object_above_region(world, name, region)
+    return _done(world, "CarryObject", start, ok, f"the {name} is not above {region.name}")
+
+
+class _Moving(Protocol):
+    """What moves a hand: the arm itself, or its dry run (:class:`cbrs.sim.arms.PlannedArm`)."""
+
+    def ee_pose(self) -> Pose3D: ...
+
+    def move_to(
+        self, position: Vec3, orientation: Quat, speed: float = ..., tolerance: float = ..., symmetric: bool = ...
+    ) -> MotionResult: ...
+
+    def reach(
+        self, position: Vec3, orientation: Quat, symmetric: bool = ..., min_height: float | None = ...
+    ) -> MotionResult: ...
+
+
+def _carry(arm: _Moving, grasp: GraspPose, region: Region, yaw: float | None) -> MotionResult:
+    """carry_object's moves: up to the transit height, across to over the region's centre, down to
+    ABOVE_CLEARANCE over its surface; the move across through joint space, the object kept up, when the
+    straight line leaves the arm's reach."""
     ee = arm.ee_pose()
     orientation = ee.orientation
     if yaw is not None and grasp.model.grasp is GraspKind.TOP:
@@ -193,6 +220,7 @@ def carry_object(world: HomeWorld, side: ArmSide | str, region: Region, yaw: flo
         (cx, cy, transit),
         (cx, cy, above + grasp.bottom_offset),
     ]
+    result = MotionResult(True, 0.0)
     for index, leg in enumerate(legs):
         if math.dist(leg, arm.ee_pose().position) < 1e-3:
             continue
@@ -202,9 +230,8 @@ def carry_object(world: HomeWorld, side: ArmSide | str, region: Region, yaw: flo
             # way): go through joint space instead, keeping the object at the transit height.
             result = arm.reach(leg, orientation, min_height=transit - TRANSIT_SAG)
         if not result.reached:
-            return _done(world, "CarryObject", start, False, result.reason)
-    ok = pred.object_above_region(world, name, region)
-    return _done(world, "CarryObject", start, ok, f"the {name} is not above {region.name}")
+            return result
+    return result
 
 
 def put_down_object(world: HomeWorld, side: ArmSide | str, region: Region) -> Outcome:
@@ -384,6 +411,39 @@ def can_set_down(world: HomeWorld, pen: ObjectEstimate, side: ArmSide | str, mod
             f"the {arm.value} arm cannot hold the {model.name} by its {model.grasp.value} grasp over {region.name} "
             f"at ({cx:.2f}, {cy:.2f}) to set it down there"
         )
+    return ""
+
+
+def can_carry(
+    world: HomeWorld, pen: ObjectEstimate, side: ArmSide | str, model: ObjectModel, region: Region | None = None
+) -> str:
+    """Why ``side``'s own motion planning would refuse to take the object where it is by ``model``'s
+    approach and, given a ``region``, carry it over its middle (empty if it would not): the moves of
+    approach_object, pick_up_object and carry_object planned one after the other on the kinematics copies
+    from the arm's posture now, without moving (a dry run, :meth:`Arm.dry_run`). The inverse kinematics
+    of the end poses alone (:func:`can_take`, :func:`can_set_down`) misses a joint-space move whose every
+    path collides or lets the held object dip, and a straight line that leaves the arm's reach."""
+    arm = ArmSide(side)
+    grasp = _grasp(world, pen, arm, model)
+    if isinstance(grasp, str):
+        return grasp
+    hand = world.arm(arm).dry_run()
+    x, y, z = grasp.position
+    moves: list[tuple[str, Callable[[], MotionResult]]] = [
+        ("reaching the pre-grasp pose", lambda: hand.reach(grasp.pregrasp, grasp.orientation)),
+        ("moving in to grasp it", lambda: hand.move_to(grasp.position, grasp.orientation)),
+        ("lifting it", lambda: hand.move_to((x, y, z + LIFT_HEIGHT), hand.ee_pose().orientation, symmetric=False)),
+    ]
+    if region is not None:
+        cx, cy, _ = region.center
+        moves.append((f"carrying it to ({cx:.2f}, {cy:.2f})", lambda: _carry(hand, grasp, region, None)))
+    for what, move in moves:
+        result = move()
+        if not result.reached:
+            return (
+                f"the {arm.value} arm would not get the {model.name} by its {model.grasp.value} grasp past {what}: "
+                f"{result.reason}"
+            )
     return ""
 
 
