@@ -1,5 +1,7 @@
-"""IRIs that no prefix shortens (all of OWLS-TC's) show their tail on the pages, the file part muted
-and the whole IRI in the link's title, instead of ``http://127.0.0.1/ontology/...`` in every cell."""
+"""IRIs that no declared prefix shortens (all of OWLS-TC's) show a prefix derived for their namespace on
+the pages (``my_ontology1:Car``, cbrs.web.prefixes), the whole IRI in the link's title, instead of
+``http://127.0.0.1/ontology/...`` in every cell; one that no prefix shortens at all shows its tail, the
+file part muted."""
 
 from __future__ import annotations
 
@@ -62,8 +64,8 @@ def client(tmp_path_factory: pytest.TempPathFactory) -> FlaskClient:
     return create_app(SparqlService(kb)).test_client()
 
 
-def test_pages_show_the_tail_and_keep_the_whole_iri_in_the_title(client: FlaskClient) -> None:
-    car = f'title="{ONTO}FourWheeledCar"><span class="ns">my_ontology.owl#</span>FourWheeledCar</a>'
+def test_pages_show_the_derived_name_and_keep_the_whole_iri_in_the_title(client: FlaskClient) -> None:
+    car = f'title="{ONTO}FourWheeledCar">my_ontology1:FourWheeledCar</a>'
     for path, query in (
         ("/services", {}),
         ("/service", {"iri": SERVICE}),
@@ -81,20 +83,21 @@ def test_pages_show_the_tail_and_keep_the_whole_iri_in_the_title(client: FlaskCl
     assert ad["inputs"] == [ONTO + "FourWheeledCar"]  # the twins keep whole IRIs
 
 
-def test_the_uses_of_a_class_and_the_paths_to_it_show_tails_too(client: FlaskClient) -> None:
+def test_the_uses_of_a_class_and_the_paths_to_it_show_derived_names_too(client: FlaskClient) -> None:
     page = client.get("/taxonomy/class", query_string={"iri": ONTO + "FourWheeledCar"}).text
-    assert '<span class="ns">car_price_service.owls#</span>CAR_PRICE_SERVICE</a>' in page
-    assert '<strong><span class="ns">my_ontology.owl#</span>FourWheeledCar</strong>' in page
+    assert ">car_price_service:CAR_PRICE_SERVICE</a>" in page
+    assert "<strong>my_ontology1:FourWheeledCar</strong>" in page
     services = client.get("/services").text
     assert services.count(">car price<") == 1  # the label, beside the service name it differs from
 
 
-def test_page_titles_name_the_iri_by_its_tail(client: FlaskClient) -> None:
+def test_page_titles_name_the_iri_by_its_derived_name(client: FlaskClient) -> None:
     for path, query, title in (
-        ("/taxonomy/class", {"iri": ONTO + "Car"}, "Class my_ontology.owl#Car"),
-        ("/service", {"iri": SERVICE}, "car_price_service.owls#CAR_PRICE_SERVICE"),
-        ("/resource", {"iri": ONTO + "Car"}, "my_ontology.owl#Car"),
-        ("/taxonomy", {"root": ONTO + "Car"}, "Taxonomy below my_ontology.owl#Car"),
+        ("/taxonomy/class", {"iri": ONTO + "Car"}, "Class my_ontology1:Car"),
+        ("/service", {"iri": SERVICE}, "car_price_service:CAR_PRICE_SERVICE"),
+        ("/resource", {"iri": ONTO + "Car"}, "my_ontology1:Car"),
+        ("/resource", {"iri": OTHER + "Car"}, "my_ontology2:Car"),  # the same tail: another prefix
+        ("/taxonomy", {"root": ONTO + "Car"}, "Taxonomy below my_ontology1:Car"),
     ):
         page = client.get(path, query_string=query).text
         assert f"<title>{title} · cbrs</title>" in page and f"<h1>{title}</h1>" in page, path
@@ -110,3 +113,7 @@ def test_the_match_form_takes_a_concept_as_the_pages_name_it(client: FlaskClient
     assert "2 concepts" in same["fields"]["outputs"] and OTHER + "Car" in same["fields"]["outputs"]
     typo = client.get("/match.json", query_string={"outputs": "my_ontology.owl#FourWheeledCra"}).get_json()
     assert "did you mean my_ontology.owl#FourWheeledCar" in typo["fields"]["outputs"]
+    named = client.get("/match.json", query_string={"outputs": "my_ontology1:FourWheeledCar"})  # as pages show it
+    assert named.status_code == 200 and named.get_json()["requirement"]["outputs"] == [ONTO + "FourWheeledCar"]
+    typo = client.get("/match.json", query_string={"outputs": "my_ontology1:FourWheeledCra"}).get_json()
+    assert "did you mean my_ontology1:FourWheeledCar" in typo["fields"]["outputs"]

@@ -14,9 +14,12 @@ from typing import Any
 from flask import Blueprint, Response, current_app, request, url_for
 
 from cbrs.kb.errors import KnowledgeBaseError, QuerySyntaxError, UnknownQueryError
-from cbrs.sparql_service import Answer
+from cbrs.kb.namespaces import PREFIXES
+from cbrs.sparql_hints import TOKENS
+from cbrs.sparql_service import BOM, Answer
 from cbrs.web import context
 from cbrs.web.pages import FormError, Page, page, wants_json
+from cbrs.web.prefixes import derived
 from cbrs.web.row_limit import bounded
 from cbrs.web.sparql import protocol_answer, wants_protocol
 
@@ -72,11 +75,17 @@ def editor() -> Page:
         return shown
     if not text.strip():
         raise FormError({"query": "write a query, or pick one of the examples"}, page=shown)
+    run, added = with_store_prefixes(text)
+    data["added_prefixes"] = [{"prefix": prefix, "namespace": namespace} for prefix, namespace in added.items()]
+    data["full_query"] = run
     started = time.perf_counter()
     try:
-        answer = _run(text, rows)
+        answer = _run(run, rows)
     except QuerySyntaxError as error:
-        raise FormError({"query": str(error)}, page=shown) from error
+        message = str(error)
+        if added:
+            message += f" (lines counted with the {len(added)} PREFIX lines put above the query)"
+        raise FormError({"query": message}, page=shown) from error
     except KnowledgeBaseError as error:  # a timeout, a result too large, busy workers, an evaluation error
         if wants_json():
             raise
@@ -87,10 +96,35 @@ def editor() -> Page:
     data["result"] = _result(answer.body, answer.media_type, rows)
     form = "graph" if data["result"]["kind"] == "graph" else "select"
     data["downloads"] = [
-        {"label": label, "format": short, "href": url_for("sparql.sparql", query=text, format=short)}
+        {"label": label, "format": short, "href": url_for("sparql.sparql", query=run, format=short)}
         for label, short in DOWNLOADS[form]
     ]
     return shown
+
+
+def with_store_prefixes(text: str) -> tuple[str, dict[str, str]]:
+    """``text`` with a ``PREFIX`` line put above it for each prefix derived for the store
+    (:mod:`cbrs.web.prefixes`) that it uses and does not declare, and those prefixes: the results show
+    ``books:Novel``, and a query may name it so, although the endpoint knows only cbrs's own prefixes.
+    The namespaces come from the store's IRIs, which hold no ``>`` or space."""
+    text = text.removeprefix(BOM)
+    declared_here: set[str] = set()
+    used: list[str] = []
+    previous = ""
+    for match in TOKENS.finditer(text):
+        name = match.group("pname")
+        if name is not None:
+            prefix = name.partition(":")[0]
+            if previous == "PREFIX":
+                declared_here.add(prefix)
+            elif prefix not in PREFIXES and prefix not in used:
+                used.append(prefix)
+        previous = (match.group("word") or "").upper()
+    wanted = [prefix for prefix in used if prefix not in declared_here]
+    table = derived() if wanted else {}  # read only for a query that may use one
+    added = {prefix: table[prefix] for prefix in wanted if prefix in table}
+    lines = "".join(f"PREFIX {prefix}: <{namespace}>\n" for prefix, namespace in added.items())
+    return lines + text, added
 
 
 def _run(text: str, rows: int) -> Answer:

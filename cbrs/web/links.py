@@ -5,7 +5,8 @@ from __future__ import annotations
 from flask import Flask, url_for
 from markupsafe import Markup, escape
 
-from cbrs.kb.namespaces import shorten
+from cbrs.kb.namespaces import PREFIXES, expand, shorten
+from cbrs.web.prefixes import by_namespace, derived, namespace
 
 RESOURCE_ENDPOINT = "resource.resource"
 
@@ -14,14 +15,46 @@ def iri_url(iri: str) -> str:
     return url_for(RESOURCE_ENDPOINT, iri=iri)
 
 
+def short(iri: str) -> str:
+    """``iri`` as a prefixed name wherever the browser shortens one: with cbrs's declared prefixes first,
+    then with the prefixes derived for the store's other namespaces (:mod:`cbrs.web.prefixes`:
+    ``books:Novel``); else the IRI itself."""
+    declared = shorten(iri)
+    if declared != iri:
+        return declared
+    ns = namespace(iri)
+    prefix = by_namespace().get(ns) if ns is not None else None
+    local = iri[len(ns) :] if ns is not None else ""
+    if prefix is not None and local and all(ch.isalnum() or ch in "_-." for ch in local):
+        return f"{prefix}:{local}"
+    return iri
+
+
+def expand_name(name: str) -> str:
+    """A prefixed name the pages show (declared or derived prefix) or an IRI, as an IRI; ``ValueError``
+    for a name that is neither (as :func:`cbrs.kb.namespaces.expand`)."""
+    prefix, sep, local = name.partition(":")
+    if sep and prefix not in PREFIXES:
+        ns = derived().get(prefix)
+        if ns is not None:
+            return ns + local
+    return expand(name)
+
+
 def name_parts(iri: str) -> tuple[str, str]:
-    """``iri`` as it is shown: ``("", prefixed name)``; for an IRI that no prefix shortens (all of
-    OWLS-TC's), the part after its last ``/`` split at ``#``: ``("my_ontology.owl#", "Car")`` rather
+    """``iri`` as it is shown: ``("", prefixed name)`` with a declared or derived prefix
+    (:func:`short`); for an IRI that neither shortens, its tail (:func:`tail_parts`)."""
+    short_name = short(iri)
+    if short_name != iri:
+        return "", short_name
+    return tail_parts(iri)
+
+
+def tail_parts(iri: str) -> tuple[str, str]:
+    """The part of ``iri`` after its last ``/`` split at ``#``: ``("my_ontology.owl#", "Car")`` rather
     than ``http://127.0.0.1/ontology/my_ontology.owl#Car``, which filled table columns and hid the
-    local name at the end. An IRI without such a tail is shown whole."""
-    short = shorten(iri)
-    if short != iri:
-        return "", short
+    local name at the end (the pages showed OWLS-TC's IRIs so before they had derived prefixes, and the
+    match form still takes a concept so named). An IRI without such a tail is ``("", iri)``."""
     _, scheme, rest = iri.partition("://")
     _host, slash, path = rest.partition("/")
     if not scheme or not slash or not path or iri.endswith("/"):  # no path to take a tail of
@@ -63,4 +96,4 @@ def install(app: Flask) -> None:
     app.add_template_global(iri_link, "iri_link")
     app.add_template_global(iri_url, "iri_url")
     app.add_template_global(display_name, "display_name")
-    app.add_template_filter(shorten, "short")
+    app.add_template_filter(short, "short")

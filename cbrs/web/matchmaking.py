@@ -10,15 +10,16 @@ from typing import Any, Literal
 from flask import Blueprint, request
 
 from cbrs.kb import NotFoundError, Parameter, Requirement, Statement
-from cbrs.kb.namespaces import PREFIXES, expand, shorten
+from cbrs.kb.namespaces import PREFIXES, shorten
 from cbrs.kb.vocab import CBRS
 from cbrs.reasoner.degrees import Degree
 from cbrs.reasoner.matchmaker import Candidate, Matchmaker, MatchResult
 from cbrs.reasoner.methods import METHODS
 from cbrs.reasoner.taxonomy import TaxonomyIndex
 from cbrs.web import context
-from cbrs.web.links import display_text
+from cbrs.web.links import display_text, expand_name, short, tail_parts
 from cbrs.web.pages import FormError, Page, page, wants_json
+from cbrs.web.prefixes import derived
 
 blueprint = Blueprint("matchmaking", __name__)
 
@@ -143,7 +144,7 @@ def _requirement(form: dict[str, Any], any_matchmaker: Matchmaker, shown: Page) 
 
 def _stored(name: str, shown: Page) -> Requirement:
     try:
-        iri = expand(name if ":" in name else f"req:{name}")
+        iri = expand_name(name if ":" in name else f"req:{name}")
         found = context.kb().description(iri)
     except (ValueError, NotFoundError) as error:
         raise FormError({"requirement": str(error)}, page=shown) from None
@@ -160,9 +161,10 @@ def _concept(term: str, index: TaxonomyIndex) -> str:
     if ":" not in term and "#" in term:  # as the pages show an IRI no prefix shortens: file.owl#Name
         return _by_tail(term, index)
     prefix = term.partition(":")[0]
-    if not term.startswith("<") and prefix not in PREFIXES and prefix not in ("http", "https", "urn"):
+    known = prefix in PREFIXES or prefix in derived()  # the prefixes the pages show, the store's own included
+    if not term.startswith("<") and not known and prefix not in ("http", "https", "urn"):
         raise ValueError(f"{term}: {prefix}: is not a known prefix; use one of {', '.join(PREFIXES)}")
-    iri = expand(term)
+    iri = expand_name(term)
     if iri not in index:
         near = difflib.get_close_matches(term, [display_text(n) for n in index.nodes()], n=3, cutoff=0.75)
         hint = f"; did you mean {' or '.join(near)}?" if near else "; concepts are prefixed names, e.g. home:Cup"
@@ -171,14 +173,14 @@ def _concept(term: str, index: TaxonomyIndex) -> str:
 
 
 def _by_tail(term: str, index: TaxonomyIndex) -> str:
-    """The concept a page names ``term`` (``my_ontology.owl#Car``, ``links.name_parts``): OWLS-TC's IRIs
+    """The concept named ``term`` by its tail (``my_ontology.owl#Car``, ``links.tail_parts``): OWLS-TC's IRIs
     have no prefix, so before, a user had to type ``http://127.0.0.1/ontology/my_ontology.owl#Car``."""
 
     def read() -> dict[str, list[str]]:
         tails: dict[str, list[str]] = {}
         for node in index.nodes():
             if shorten(node) == node:
-                tails.setdefault(display_text(node), []).append(node)
+                tails.setdefault("".join(tail_parts(node)), []).append(node)
         return tails
 
     found = sorted(context.per_generation("concept_tails", read).get(term, []))
@@ -209,7 +211,7 @@ def _statements(text: str, index: TaxonomyIndex) -> list[Statement]:
 def _requirements() -> list[dict[str, str | None]]:
     with context.lock():
         found = context.kb().requirements()
-    return [{"iri": r.iri, "name": shorten(r.iri), "label": r.label} for r in sorted(found, key=lambda r: r.iri)]
+    return [{"iri": r.iri, "name": short(r.iri), "label": r.label} for r in sorted(found, key=lambda r: r.iri)]
 
 
 # -- the answer ----------------------------------------------------------------------------------
@@ -221,7 +223,7 @@ def _requirement_dict(requirement: Requirement) -> dict[str, Any]:
 
     return {
         "iri": requirement.iri,
-        "name": shorten(requirement.iri),
+        "name": short(requirement.iri),
         "label": requirement.label,
         "written": requirement.iri == WRITTEN_IRI,
         "inputs": [p.type for p in requirement.inputs],
@@ -254,7 +256,7 @@ def _candidate(rank: int, c: Candidate, outputs: set[str]) -> dict[str, Any]:
     return {
         "rank": rank,
         "advertisement": c.advertisement,
-        "name": shorten(c.advertisement),
+        "name": short(c.advertisement),
         "label": c.label,
         "score": c.score,
         "parts": c.parts,

@@ -7,8 +7,9 @@ from typing import Any
 from flask import Blueprint, url_for
 
 from cbrs.kb import KnowledgeBase
-from cbrs.kb.namespaces import GraphName, shorten
+from cbrs.kb.namespaces import GraphName
 from cbrs.web import context, services
+from cbrs.web.links import short
 from cbrs.web.pages import Page, page
 
 blueprint = Blueprint("overview", __name__)
@@ -46,7 +47,7 @@ def _store_at_a_glance(kb: KnowledgeBase) -> tuple[list[dict[str, Any]], dict[st
     page a user opens took 0.5 s on OWLS-TC, counting 1,136 advertisements each time."""
     statistics = kb.statistics()
     graphs = [
-        {"graph": graph.iri, "name": shorten(graph.iri), "triples": statistics.get(graph.iri, 0)} for graph in GraphName
+        {"graph": graph.iri, "name": short(graph.iri), "triples": statistics.get(graph.iri, 0)} for graph in GraphName
     ]
     counts = {
         "services": len(services.advertisement_rows(kb)),

@@ -101,6 +101,7 @@ def _tasks() -> dict[str, list[dict[str, str | None]]]:
     with context.lock():
         requirements = kb.requirements()
         library = ActionLibrary.from_kb(kb)
+    # the names go back as ?task=, which the planner reads with the declared prefixes only
     return {
         "requirements": [{"name": shorten(r.iri), "label": r.label} for r in sorted(requirements, key=lambda r: r.iri)],
         "actions": [

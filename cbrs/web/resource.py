@@ -17,9 +17,9 @@ from markupsafe import Markup, escape
 from werkzeug.exceptions import BadRequest, HTTPException
 
 from cbrs.kb.errors import KnowledgeBaseError, NotFoundError
-from cbrs.kb.namespaces import OWL, RDF, RDFS, XSD, GraphName, expand, shorten
+from cbrs.kb.namespaces import OWL, RDF, RDFS, XSD, GraphName
 from cbrs.web import context
-from cbrs.web.links import display_text, iri_link
+from cbrs.web.links import display_text, expand_name, iri_link, short
 from cbrs.web.pages import Page, page, wants_json
 
 blueprint = Blueprint("resource", __name__)
@@ -40,7 +40,7 @@ def iri_parameter(name: str = "iri") -> str:
     if not given:
         raise BadRequest(f"the {name!r} parameter is missing: give an IRI, e.g. ?{name}=home:RobotPosition")
     try:
-        full = expand(given)
+        full = expand_name(given)
         ox.NamedNode(full)  # pyoxigraph checks the IRI's syntax
     except ValueError as error:
         raise BadRequest(f"{name}={given!r} is not an IRI: {error}") from error
@@ -50,7 +50,7 @@ def iri_parameter(name: str = "iri") -> str:
 def term_data(term: ox.NamedNode | ox.BlankNode | ox.Literal | ox.Triple) -> dict[str, Any]:
     """A term as JSON: ``{"type": "iri" | "bnode" | "literal", "value", "name"?, "datatype"?, "language"?}``."""
     if isinstance(term, ox.NamedNode):
-        return {"type": "iri", "value": term.value, "name": shorten(term.value)}
+        return {"type": "iri", "value": term.value, "name": short(term.value)}
     if isinstance(term, ox.Literal):
         found: dict[str, Any] = {"type": "literal", "value": term.value}
         if term.language:
@@ -78,7 +78,7 @@ def term_html(term: dict[str, Any]) -> Markup:
     if language:
         return text + Markup(f' <span class="lang">@{escape(language)}</span>')
     if datatype and datatype != XSD + "string":
-        return text + Markup(f' <span class="datatype" title="{escape(datatype)}">{escape(shorten(datatype))}</span>')
+        return text + Markup(f' <span class="datatype" title="{escape(datatype)}">{escape(short(datatype))}</span>')
     return text
 
 
@@ -112,7 +112,7 @@ def resource() -> Page:
         pages.append({"text": "The graph's triples (Turtle)", "href": url_for("graph_store.read", graph=iri)})
     data = {
         "iri": iri,
-        "name": shorten(iri),
+        "name": short(iri),
         "label": label,
         "pages": pages,
         "counts": {
@@ -155,9 +155,9 @@ def _grouped(rows: Iterable[dict[str, Any]]) -> list[dict[str, Any]]:
         )
     for values in groups.values():  # what the store states first, then what the alignments entail from it
         values.sort(key=lambda value: value["graph"] == GraphName.ENTAILED.iri)
-    order = sorted(groups, key=lambda p: (p != RDF_TYPE, shorten(p).casefold()))
+    order = sorted(groups, key=lambda p: (p != RDF_TYPE, short(p).casefold()))
     return [
-        {"predicate": p, "name": shorten(p), "count": len(groups[p]), "values": groups[p][:MAX_VALUES]} for p in order
+        {"predicate": p, "name": short(p), "count": len(groups[p]), "values": groups[p][:MAX_VALUES]} for p in order
     ]
 
 

@@ -13,8 +13,8 @@ from typing import Any
 import pyoxigraph as ox
 from flask import Blueprint, request
 
-from cbrs.kb.namespaces import expand, shorten
 from cbrs.web import context, services
+from cbrs.web.links import expand_name, short
 from cbrs.web.pages import FormError, Page, page
 from cbrs.web.ranking import IN_LABEL, PREFIX, rank
 from cbrs.web.taxonomy import current_taxonomy, local_name
@@ -59,13 +59,13 @@ def _resource(text: str) -> dict[str, str] | None:
     if ":" not in text or any(c.isspace() for c in text):
         return None
     try:
-        iri = expand(text)
+        iri = expand_name(text)
         ox.NamedNode(iri)
     except ValueError:
         return None
     if not context.kb().select("resource_triples", {"resource": iri}):
         return None
-    return {"iri": iri, "name": shorten(iri)}
+    return {"iri": iri, "name": short(iri)}
 
 
 def _terms(needle: str) -> dict[str, Any]:
@@ -89,7 +89,7 @@ def _advertisements(needle: str, terms: list[tuple[int, str, dict[str, Any]]]) -
         if score is None and via:
             score = BY_CONCEPT
         if score is not None:
-            row = {**ad, "via": [{"iri": c, "name": shorten(c)} for c in via] if score == BY_CONCEPT else []}
+            row = {**ad, "via": [{"iri": c, "name": short(c)} for c in via] if score == BY_CONCEPT else []}
             rows.append((score, ad["service_name"] or ad["name"], row))
     return _group(rows)
 

@@ -11,11 +11,11 @@ from flask import Blueprint, current_app, request, url_for
 
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.model import Advertisement, Requirement
-from cbrs.kb.namespaces import RDF, RDFS, expand, shorten
+from cbrs.kb.namespaces import RDF, RDFS, expand
 from cbrs.kb.store import Term
 from cbrs.kb.vocab import CBRS
 from cbrs.web import context, resource
-from cbrs.web.links import display_text
+from cbrs.web.links import display_text, short
 from cbrs.web.pages import FormError, Page, page
 
 blueprint = Blueprint("services", __name__)
@@ -34,7 +34,7 @@ def services() -> Page:
         kinds[row["kind"]] = kinds.get(row["kind"], 0) + 1
     data: dict[str, Any] = {
         "kind": None,
-        "kinds": [{"iri": k, "name": shorten(k), "count": n} for k, n in sorted(kinds.items())],
+        "kinds": [{"iri": k, "name": short(k), "count": n} for k, n in sorted(kinds.items())],
         "total": len(rows),
         "count": len(rows),
         "page": 1,
@@ -48,13 +48,13 @@ def services() -> Page:
     if given:
         kind = _kind(given)
         if kind not in kinds:
-            known = ", ".join(shorten(k) for k in sorted(kinds))
+            known = ", ".join(short(k) for k in sorted(kinds))
             message = f"no advertisement is of kind {given!r}; the kinds are {known}"
             data["kind"] = given
             raise FormError({"kind": message}, page=shown)
         data["kind"] = kind
         rows = [row for row in rows if row["kind"] == kind]
-        shown.title = f"Services: {shorten(kind)}"
+        shown.title = f"Services: {short(kind)}"
     _paged(data, rows, shown)
     return shown
 
@@ -93,7 +93,7 @@ def service() -> Page:
     if isinstance(description, Requirement):
         data["match"] = url_for(MATCH_ENDPOINT, requirement=iri) if match else None
         planned = PLAN_ENDPOINT in current_app.view_functions  # compose it into services, as cbrs plan does
-        data["plan"] = url_for(PLAN_ENDPOINT, task=shorten(iri)) if planned else None
+        data["plan"] = url_for(PLAN_ENDPOINT, task=short(iri)) if planned else None
     elif isinstance(description, Advertisement):
         data["requirements"] = _requirements_for(kb, description) if match else []
         data["similar"] = _similar_url(data) if match else None
@@ -133,11 +133,11 @@ def _similar_url(description: dict[str, Any]) -> str | None:
     a service page could only rank the stored requirements."""
 
     def statements(key: str) -> str:
-        return "\n".join(" ".join(shorten(s[k]) for k in ("subject", "predicate", "object")) for s in description[key])
+        return "\n".join(" ".join(short(s[k]) for k in ("subject", "predicate", "object")) for s in description[key])
 
     asked = {
-        "inputs": " ".join(shorten(p["type"]) for p in description["inputs"]),
-        "outputs": " ".join(shorten(p["type"]) for p in description["outputs"]),
+        "inputs": " ".join(short(p["type"]) for p in description["inputs"]),
+        "outputs": " ".join(short(p["type"]) for p in description["outputs"]),
         "preconditions": statements("preconditions"),
         "effects": statements("effects"),
         "deletes": statements("deletes"),
@@ -160,7 +160,7 @@ def _advertisement_row(row: dict[str, Term]) -> dict[str, Any]:
     iri = row["service"].value
     return {
         "service": iri,
-        "name": shorten(iri),
+        "name": short(iri),
         "label": _value(row.get("label")),
         "kind": _value(row.get("kind")),
         "device_name": _value(row.get("deviceName")),
@@ -188,7 +188,7 @@ def _requirement_rows(kb: KnowledgeBase) -> list[dict[str, Any]]:
     return [
         {
             "requirement": row["requirement"].value,
-            "name": shorten(row["requirement"].value),
+            "name": short(row["requirement"].value),
             "label": _value(row.get("label")),
             "requested_by": _value(row.get("requestedBy")),
             "task": _value(row.get("task")),

@@ -24,10 +24,12 @@ from flask.sansio.blueprints import BlueprintSetupState
 from werkzeug.exceptions import Forbidden, NotFound, ServiceUnavailable
 
 from cbrs.actions.errors import UnknownTaskError
-from cbrs.kb.namespaces import PREFIXES, expand, shorten
+from cbrs.kb.namespaces import PREFIXES
 from cbrs.tasks import CameraFrame, TaskBusyError, TaskRun, UnknownComponentError
 from cbrs.web import context
+from cbrs.web.links import expand_name, short
 from cbrs.web.pages import FormError, Page, page, wants_json
+from cbrs.web.prefixes import derived
 
 blueprint = Blueprint("tasks", __name__)
 
@@ -109,7 +111,7 @@ def cancel(run_id: str) -> Page:
 
 def _for_script(shown: Page) -> Page:
     if not wants_json():
-        shown.data["prefixes"] = PREFIXES  # tasks.js shortens IRIs as the server does
+        shown.data["prefixes"] = {**derived(), **PREFIXES}  # tasks.js shortens IRIs as the server does
     return shown
 
 
@@ -148,7 +150,7 @@ def _checked(form: dict[str, Any], shown: Page) -> dict[str, Any]:
     faults = []
     for name in form["fail"]:
         try:
-            faults.append(expand(name))
+            faults.append(expand_name(name))
         except ValueError as error:
             errors["fail"] = str(error)
     fault_rate = 0.0
@@ -217,7 +219,7 @@ def _overview(form: dict[str, Any]) -> dict[str, Any]:
     return {
         "form": form,
         "tasks": known,
-        "components": [shorten(c) for c in runner.components()],
+        "components": [short(c) for c in runner.components()],
         "active": _detail(latest) if latest is not None else None,
         "runs": [_summary(r) for r in reversed(runs)],
         **_live(),
@@ -237,7 +239,7 @@ def _live() -> dict[str, Any]:
 def _summary(found: TaskRun) -> dict[str, Any]:
     data = found.to_dict(with_events=False)
     data.pop("result", None)
-    data["faults"] = [shorten(f) for f in found.faults]
+    data["faults"] = [short(f) for f in found.faults]
     data["url"] = url_for("tasks.run", run_id=found.id)
     return data
 

@@ -20,11 +20,11 @@ from markupsafe import Markup, escape
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.catalog import is_built_in
 from cbrs.kb.errors import NotFoundError
-from cbrs.kb.namespaces import OWL, RDF, RDFS, GraphName, shorten
+from cbrs.kb.namespaces import OWL, RDF, RDFS, GraphName
 from cbrs.kb.vocab import CBRS
 from cbrs.output import Expression, class_expression, manchester, node_view
 from cbrs.web import context, diagram, ranking, resource, services
-from cbrs.web.links import display_name, display_text, iri_link
+from cbrs.web.links import display_name, display_text, iri_link, short
 from cbrs.web.pages import Page, page, wants_json
 
 blueprint = Blueprint("taxonomy", __name__)
@@ -63,7 +63,7 @@ def local_name(iri: str) -> str:
 
 
 def concept_url(iri: str) -> str:
-    return url_for("taxonomy.concept", iri=shorten(iri))  # expanded again by iri_parameter
+    return url_for("taxonomy.concept", iri=short(iri))  # expanded again by iri_parameter
 
 
 @blueprint.app_template_global("concept_link")
@@ -114,10 +114,10 @@ class Taxonomy:
         return term in self.kinds
 
     def sorted(self, terms: set[str] | None) -> list[str]:
-        return sorted(terms or (), key=lambda t: (shorten(t).casefold(), t))
+        return sorted(terms or (), key=lambda t: (short(t).casefold(), t))
 
     def term(self, iri: str) -> dict[str, Any]:
-        return {"iri": iri, "name": shorten(iri), "label": self.labels.get(iri)}
+        return {"iri": iri, "name": short(iri), "label": self.labels.get(iri)}
 
     def roots(self, kind: str) -> list[str]:
         return self.sorted({t for t, k in self.kinds.items() if k == kind and not self.parents.get(t)})
@@ -329,7 +329,7 @@ def _picture(found: Taxonomy, iri: str, parts: list[dict[str, Any]]) -> Markup:
     edges += [diagram.Edge(t, iri) for t in below[:MAX_PICTURE_ROW]]
     if len(below) > MAX_PICTURE_ROW:
         rest = len(below) - MAX_PICTURE_ROW
-        href = url_for("taxonomy.taxonomy", root=shorten(iri))
+        href = url_for("taxonomy.taxonomy", root=short(iri))
         row.append(diagram.Box("more", f"{rest} more", f"{rest} more: the tree below", href, "more"))
         edges.append(diagram.Edge("more", iri))
     for part in parts[:MAX_PICTURE_ROW]:  # beside the subclasses, reached by dashed arrows down
@@ -419,7 +419,7 @@ def _named_in(kb: KnowledgeBase, triples: list[dict[str, Any]]) -> list[dict[str
         if view is None or "expression" not in view or "owner" not in view:
             continue
         owner = view["owner"]["iri"]
-        item = {"iri": owner, "name": shorten(owner), **_expression_row(view["owner"]["path"][0], view["expression"])}
+        item = {"iri": owner, "name": short(owner), **_expression_row(view["owner"]["path"][0], view["expression"])}
         found.setdefault((owner, item["relation"], item["text"]), item)
     return sorted(found.values(), key=lambda r: (r["name"].casefold(), r["text"].casefold()))
 
@@ -427,7 +427,7 @@ def _named_in(kb: KnowledgeBase, triples: list[dict[str, Any]]) -> list[dict[str
 def _expression_row(relation: str, expression: Expression) -> dict[str, Any]:
     return {
         "relation": relation,
-        "relation_name": shorten(relation),
+        "relation_name": short(relation),
         "text": manchester(expression),
         "expression": expression,
     }
@@ -447,9 +447,9 @@ def _parts(kb: KnowledgeBase, iri: str) -> list[dict[str, Any]]:
             continue
         parts[key] = {
             "iri": key[1],
-            "name": shorten(key[1]),
+            "name": short(key[1]),
             "property": key[0],
-            "property_name": shorten(key[0]),
+            "property_name": short(key[0]),
             "inherited_from": None if owner == iri else owner,
         }
     return sorted(parts.values(), key=lambda p: (p["inherited_from"] is not None, p["name"].casefold()))
@@ -465,7 +465,7 @@ def _usage(kb: KnowledgeBase, iri: str, triples: list[dict[str, Any]]) -> dict[s
                 roles.setdefault(description, set()).add(role)
     advertisements, requirements = _description_labels(kb)
     groups: dict[str, list[dict[str, Any]]] = {"advertisements": [], "requirements": [], "actions": []}
-    for description in sorted(roles, key=lambda d: shorten(d).casefold()):
+    for description in sorted(roles, key=lambda d: short(d).casefold()):
         group = "actions"
         if description in advertisements:
             group = "advertisements"
@@ -474,7 +474,7 @@ def _usage(kb: KnowledgeBase, iri: str, triples: list[dict[str, Any]]) -> dict[s
         groups[group].append(
             {
                 "iri": description,
-                "name": shorten(description),
+                "name": short(description),
                 "label": advertisements.get(description) or requirements.get(description),
                 "roles": sorted(roles[description]),
             }
