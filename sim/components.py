@@ -449,9 +449,10 @@ def _clear(candidates: _Candidates, side: ArmSide, purpose: str, moves: Callable
     """The first of ``candidates`` whose ``moves`` the arm's planning would make, as they are asked (a dry
     run: :func:`skills.can_carry`): one it would refuse is ranked after those it would not, and passed over
     saying why. When it would refuse every one, the first: the dry run sees no physics and the real moves
-    may still do (a failed step is re-planned), so nothing is refused on its word alone."""
+    may still do (a failed step is re-planned), so nothing is refused on its word alone; and one
+    candidate alone is taken without asking."""
     passed = list(candidates.ruled_out)
-    for held in candidates.models:
+    for held in candidates.models if len(candidates.models) > 1 else ():
         why = moves(held)
         if not why:
             return _Candidates([held], passed).choice(side, held, purpose)

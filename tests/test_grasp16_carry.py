@@ -116,3 +116,20 @@ def test_an_approach_the_dry_run_refuses_is_ranked_after_not_refused(
         side_refused = components._taking(context, seen, cup, ArmSide.LEFT)
     assert everything_refused.model.grasp is GraspKind.SIDE and everything_refused.passed == ()
     assert side_refused.model.grasp is GraspKind.TOP and side_refused.passed == ((GraspKind.SIDE, "no"),)
+
+
+def test_no_dry_run_when_one_approach_is_left_to_choose(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Ranking one candidate changes nothing, so its moves are not planned twice (once here, once made)."""
+    kb = cup_to_the_larger_tray(tmp_path)
+    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
+        seen, cup = _cup(world)
+        context = SimEnvironment(world, kb).context
+        asked: list[GraspKind] = []
+        monkeypatch.setattr(skills, "can_carry", lambda w, e, s, held, *r: asked.append(held.grasp) or "")
+        both = components._taking(context, seen, cup, ArmSide.LEFT)
+    assert both.model.grasp is GraspKind.SIDE and asked == [GraspKind.SIDE]
+    asked.clear()
+    alone = components._Candidates([cup.by(GraspKind.TOP)], [(GraspKind.SIDE, "ruled out")])
+    choice = components._clear(alone, ArmSide.LEFT, "taking the Cup", lambda held: asked.append(held.grasp) or "")
+    assert choice.model.grasp is GraspKind.TOP and choice.passed == ((GraspKind.SIDE, "ruled out"),)
+    assert asked == []
