@@ -260,7 +260,12 @@ class Kinematics:
         pos, orn = state[4], state[5]
         return Pose3D((pos[0], pos[1], pos[2]), (orn[0], orn[1], orn[2], orn[3]))
 
-    def _refine(self, side: ArmSide, position: Vec3, orientation: Quat, seed: Sequence[float]) -> _Solution:
+    def _refine(
+        self, side: ArmSide, position: Vec3, orientation: Quat, seed: Sequence[float], loose: bool = False
+    ) -> _Solution:
+        """Inverse kinematics from ``seed``, called again until the hand is within 0.1 mm and 0.001 rad of
+        the pose (at most ten calls); ``loose``: only until it is within what a solution must be
+        (IK_TOLERANCE, 0.02 rad), all a check of whether there is one needs."""
         body = self._bodies[side]
         self._set(body, seed)
         goal = np.asarray(position)
@@ -280,12 +285,18 @@ class Kinematics:
             pose = self.forward(side, q)
             error = float(np.linalg.norm(np.asarray(pose.position) - goal))
             turn = quat_angle(pose.orientation, orientation)
-            if error < 1e-4 and turn < 1e-3:
+            if (error < 1e-4 and turn < 1e-3) or (loose and error <= IK_TOLERANCE and turn <= 0.02):
                 break
         return _Solution(q, error, turn)
 
     def line(
-        self, side: ArmSide, start: Sequence[float], position: Vec3, orientation: Quat, begin: Pose3D | None = None
+        self,
+        side: ArmSide,
+        start: Sequence[float],
+        position: Vec3,
+        orientation: Quat,
+        begin: Pose3D | None = None,
+        loose: bool = False,
     ) -> list[tuple[float, ...]] | str:
         """The joint angles of a straight-line move of the grasp point from where the arm at ``start`` has
         it (``begin``, when known) to ``position``, turning the hand to ``orientation``: one per 1 cm (or
@@ -302,7 +313,7 @@ class Kinematics:
             t = i / pieces
             point = start_pos + (goal - start_pos) * t
             target = (float(point[0]), float(point[1]), float(point[2]))
-            solution = self.solve(side, target, _slerp(begin.orientation, orientation, t), [seed])
+            solution = self.solve(side, target, _slerp(begin.orientation, orientation, t), [seed], loose)
             if solution.position_error > IK_TOLERANCE or solution.orientation_error > 0.02:
                 return f"no inverse kinematics at {i}/{pieces} of the line to {_fmt(position)}"
             chain.append(solution.q)
@@ -318,6 +329,7 @@ class Kinematics:
         orientation: Quat,
         symmetric: bool = True,
         min_height: float | None = None,
+        loose: bool = False,
     ) -> _Solution | None:
         """Where a joint-space move to a pose ends (:meth:`Arm.reach`): of the inverse-kinematics solutions
         (one per seed posture, and from ``current``), the nearest whose straight joint-space path from
@@ -328,7 +340,7 @@ class Kinematics:
         for candidate in candidates:
             found = []
             for seed in (*_SEEDS, current):
-                solution = self.solve(side, position, candidate, [seed])
+                solution = self.solve(side, position, candidate, [seed], loose)
                 if solution.position_error <= IK_TOLERANCE and solution.orientation_error <= 0.02:
                     found.append(solution)
             # Nearest first (a stable sort keeps the seeds' order among equals): the first whose path is
@@ -343,11 +355,18 @@ class Kinematics:
                 break
         return best
 
-    def solve(self, side: ArmSide, position: Vec3, orientation: Quat, seeds: Sequence[Sequence[float]]) -> _Solution:
+    def solve(
+        self,
+        side: ArmSide,
+        position: Vec3,
+        orientation: Quat,
+        seeds: Sequence[Sequence[float]],
+        loose: bool = False,
+    ) -> _Solution:
         """The best solution over the seeds; the first seed wins when it is good (keeps motions smooth)."""
         best: _Solution | None = None
         for seed in seeds:
-            solution = self._refine(side, position, orientation, seed)
+            solution = self._refine(side, position, orientation, seed, loose)
             if solution.position_error < 1e-4 and solution.orientation_error < 1e-3:
                 return solution
             score = solution.position_error + 0.1 * solution.orientation_error
@@ -627,7 +646,7 @@ class PlannedArm:
         start = self.ee_pose()
         if symmetric:
             orientation = nearer(start.orientation, orientation)
-        chain = self._kinematics.line(self.side, self._q, position, orientation, start)
+        chain = self._kinematics.line(self.side, self._q, position, orientation, start, loose=True)
         if isinstance(chain, str):
             return MotionResult(False, math.inf, chain)
         self._q = chain[-1]
@@ -638,7 +657,7 @@ class PlannedArm:
     ) -> MotionResult:
         """:meth:`Arm.reach`, planned."""
         best = self._kinematics.joint_path(
-            self.side, self._q, self._others, position, orientation, symmetric, min_height
+            self.side, self._q, self._others, position, orientation, symmetric, min_height, loose=True
         )
         if best is None:
             return _no_joint_path(position, min_height)
