@@ -9,7 +9,8 @@ the same transaction.
 
 Blank nodes are skolemised (RDF 1.1, section 3.5) to IRIs under ``GENID`` that are derived from
 the canonical form of the file (RDFC-1.0): loading the same file twice adds nothing the second
-time (and, in an embedded store, writes nothing), and every stored node can be named in an update.
+time (and writes nothing: a load writes only the triples the store lacks), and every stored node can be
+named in an update.
 
 A large plain data file (``BULK_BYTES`` or more of N-Triples or Turtle, loaded alone, without a
 catalogue, into a graph that holds nothing yet) takes a faster way that keeps the same promise: a
@@ -28,7 +29,7 @@ import subprocess
 import sys
 import xml.parsers.expat
 from collections import defaultdict, deque
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -97,7 +98,7 @@ class ParsedFile:
     added: dict[str, int] | None = None
     """Per graph IRI, how many of its triples the load added: the rest the store held already, or an
     earlier file of the same load (or the file itself) gave them. ``None`` when not counted (a parse
-    without a load, or a store that cannot answer per triple cheaply: see :attr:`LoadReport.added`)."""
+    without a load)."""
 
     @property
     def triples(self) -> int:
@@ -134,8 +135,8 @@ class LoadReport:
     added: dict[str, int] = field(default_factory=dict)
     """Per graph IRI, how many triples the load added: :attr:`quads` counts what the files gave, and
     loading what the store holds already adds nothing, so a reload gives the same ``quads`` and no
-    ``added``. Counted per triple in an embedded store, from each graph's size before and after in a
-    remote one (whose files then have ``added`` None)."""
+    ``added``. Counted per triple, before the write, which then carries only what was added
+    (:func:`_new_quads`)."""
 
     def __iter__(self) -> Iterator[ParsedFile]:
         return iter(self.files)
@@ -217,17 +218,10 @@ def load_files(
     imported: list[_Raw] = []
     if catalogue is not None:
         imported = _resolve_imports(store, raws, catalogue, report)
-    _prepare(store, raws, imported, report, graph)
-    if isinstance(store, EmbeddedStore):
-        new = _new_quads(store, report)
-        if new:  # a reload of what the store holds writes nothing, and leaves its generation as it was
-            store.add(new)
-        return report
-    items = (*report.files, *report.imports)
-    graphs = sorted({_graph_of(quad, item.graph) for item in items for quad in item.quads})
-    sizes = {graph: store.count(ox.NamedNode(graph)) for graph in graphs}
-    store.add(quad for item in items for quad in item.quads)
-    report.added = {graph: store.count(ox.NamedNode(graph)) - size for graph, size in sizes.items()}
+    held = _prepare(store, raws, imported, report, graph)
+    new = _new_quads(held, report)
+    if new:  # a reload of what the store holds writes nothing (and leaves an embedded store's generation)
+        store.add(new)
     return report
 
 
@@ -254,10 +248,11 @@ def _prepare(
     report: LoadReport,
     graph: str | GraphName | None,
     refuse_merges: bool = True,
-) -> None:
+) -> Held:
     """Convert the OWL-S files among ``raws``, skolemise everything, and check it all against the store
     (part cycles, shapes, and with ``refuse_merges`` an OWL-S service the store holds described
-    otherwise): what a load does before it writes, filling ``report``'s files and imports."""
+    otherwise): what a load does before it writes, filling ``report``'s files and imports. Returns
+    which of their quads the store holds (:func:`_held`), what the merge check and the write ask."""
     ontology = GraphName.ONTOLOGY.node
     vocabulary: Vocabulary | None = None
     if any(raw.is_owls for raw in raws):
@@ -276,8 +271,6 @@ def _prepare(
         parsed = ParsedFile(
             raw.source, raw.target.value, skolemise(raw.quads, raw.source), conversion, repairs=raw.repairs
         )
-        if conversion is not None and refuse_merges:
-            _check_not_merged(store, parsed)
         report.files.append(parsed)
     report.imports = [
         ParsedFile(
@@ -285,26 +278,45 @@ def _prepare(
         )
         for raw in imported
     ]
+    held = _held(store, report) if refuse_merges else store.contains  # not asked without a merge check
+    if refuse_merges:
+        for parsed in report.files:
+            if parsed.owls is not None:
+                _check_not_merged(store, parsed, held)
     _check_part_cycles(store, [*raws, *imported])
     check_loaded(store, report)  # descriptions against the SHACL shapes, and their terms (kb/shapes.py)
+    return held
 
 
-def _new_quads(store: EmbeddedStore, report: LoadReport) -> list[ox.Quad]:
+Held = Callable[[ox.Quad], bool]
+"""Whether the store held a quad of the load before it was written."""
+
+
+def _held(store: Store, report: LoadReport) -> Held:
+    """Which quads of ``report`` the store holds: an embedded store is asked per quad when needed
+    (:meth:`EmbeddedStore.contains`, 0.4 us), a remote one once for them all (:meth:`Store.contains_each`,
+    a query per chunk), since a request per quad took a reload of OWLS-TC 4 minutes."""
+    if isinstance(store, EmbeddedStore):
+        return store.contains
+    unique = list(dict.fromkeys(quad for item in (*report.files, *report.imports) for quad in item.quads))
+    found = {quad for quad, held in zip(unique, store.contains_each(unique), strict=True) if held}
+    return found.__contains__
+
+
+def _new_quads(held: Held, report: LoadReport) -> list[ox.Quad]:
     """The quads of ``report`` the store does not hold, each once, in the files' order: what the load
     writes. A load only adds, and the loader names every node from its file's content (skolemisation),
     so writing these alone leaves the store as writing them all would; a reload of OWLS-TC 4 wrote its
-    143,268 triples again, seconds of work that changed nothing (docs/architecture.md).
+    143,268 triples again, seconds of work that changed nothing (docs/architecture.md), and on a remote
+    store as many quads sent again (docs/remote-store.md).
 
     It also fills in what each file adds, before the write: the files' own counts would tell a user a
-    reload changed something. Each triple is looked up (:meth:`EmbeddedStore.contains`, 0.4 us: 81 ms
-    for 200,000, against 70 ms for Oxigraph's membership test called directly); a triple an earlier
-    file of the load gave counts for that file only. A remote store would take a request per triple, so
-    :func:`load_files` writes all there and compares the graphs' sizes before and after.
+    reload changed something. ``held`` says whether the store held a quad (:func:`_held`); a triple an
+    earlier file of the load gave counts for that file only.
     """
     items = (*report.files, *report.imports)
     new: list[ox.Quad] = []
     seen: set[ox.Quad] = set()
-    held = store.contains
     total: defaultdict[str, int] = defaultdict(int)
     counted: list[ParsedFile] = []
     for item in items:
@@ -407,7 +419,7 @@ def _check_whole(conversion: Conversion, source: str) -> None:
             )
 
 
-def _check_not_merged(store: Store, parsed: ParsedFile) -> None:
+def _check_not_merged(store: Store, parsed: ParsedFile, held: Held) -> None:
     """Loading an OWL-S file whose service is already in the store adds nothing when it is the same
     file (its nodes are named from its content); a different file under the same IRI is refused rather
     than merged into the first description."""
@@ -416,7 +428,7 @@ def _check_not_merged(store: Store, parsed: ParsedFile) -> None:
         node = ox.NamedNode(converted.iri)
         if next(iter(store.quads(node, ox.NamedNode(RDF + "type"))), None) is None:
             continue
-        if all(store.contains(q) for q in parsed.quads):
+        if all(held(q) for q in parsed.quads):
             continue
         # the advice first: the parser errors' one-line form keeps 240 characters, and OWL-S IRIs are long
         advice = "cbrs deregister IRI first, or give the new one another IRI"

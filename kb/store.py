@@ -14,7 +14,7 @@ import hashlib
 import re
 from abc import ABC, abstractmethod
 from collections import defaultdict
-from collections.abc import Iterable, Iterator, Mapping
+from collections.abc import Iterable, Iterator, Mapping, Sequence
 from pathlib import Path
 
 import pyoxigraph as ox
@@ -115,6 +115,12 @@ class Store(ABC):
         if (fixed_subject, fixed_object, fixed_graph) == (subject, obj, graph):
             return next(found, None) is not None
         return any(match == quad for match in found)
+
+    def contains_each(self, quads: Sequence[ox.Quad]) -> list[bool]:
+        """Whether the store holds each of ``quads``, as :meth:`contains` says: for a caller that asks of
+        many at once (the loader asks of every triple it read), which a remote store answers with one
+        query per chunk of them instead of a request per quad."""
+        return [self.contains(quad) for quad in quads]
 
     @abstractmethod
     def count(self, graph: GraphName | ox.NamedNode | None = None) -> int:
