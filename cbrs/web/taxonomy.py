@@ -20,7 +20,7 @@ from markupsafe import Markup, escape
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.catalog import is_built_in
 from cbrs.kb.errors import NotFoundError
-from cbrs.kb.namespaces import OWL, RDF, RDFS, GraphName
+from cbrs.kb.namespaces import OWL, RDF, RDFS, GraphName, shorten
 from cbrs.kb.vocab import CBRS
 from cbrs.output import Expression, class_expression, manchester, node_view
 from cbrs.web import context, diagram, ranking, resource, services
@@ -63,7 +63,9 @@ def local_name(iri: str) -> str:
 
 
 def concept_url(iri: str) -> str:
-    return url_for("taxonomy.concept", iri=short(iri))  # expanded again by iri_parameter
+    # expanded again by iri_parameter; declared prefixes only, so that a link stays good when a derived
+    # prefix is renumbered (a namespace deriving the same name added to the store)
+    return url_for("taxonomy.concept", iri=shorten(iri))
 
 
 @blueprint.app_template_global("concept_link")
