@@ -13,6 +13,8 @@ from pathlib import Path
 import pybullet as p
 import pytest
 
+from cbrs.actions.composer import Composer
+from cbrs.actions.runner import run_task
 from cbrs.kb.semantic_map import SemanticMap
 from cbrs.sim import grasping, skills
 from cbrs.sim.arms import EE_LINK, PYBULLET_DATA, ArmSide, panda_urdf
@@ -21,7 +23,16 @@ from cbrs.sim.errors import GraspMisfitError, GraspTooDeepError
 from cbrs.sim.grasping import FINGER_LENGTH, SIDE_HOLD, SIDE_PITCH, GraspKind, ObjectModel, compute_grasp_pose
 from cbrs.sim.world import open_world
 from tests.home_layout import ARM_FACING, ARM_MOUNTS
-from tests.test_grasp_width import CENTRE, DEVICE, _approach_the_carton, carton_in_the_map
+from tests.test_grasp_width import (
+    CENTRE,
+    DEVICE,
+    HOME,
+    PUT_CARTON_ON_TRAY,
+    TRAY,
+    WORLD,
+    _approach_the_carton,
+    carton_in_the_map,
+)
 from tests.test_turtle_tasks_arms import knowledge
 
 LEFT = ARM_MOUNTS["left"]
@@ -163,3 +174,28 @@ def test_a_box_the_fingers_hold_enough_of_is_still_taken_from_the_side(tmp_path:
         pick_up(context, {}, DEVICE)
         assert world.arm(context.arm).held == world.body("Carton1")
     assert context.choices[0].passed == ()
+
+
+@pytest.mark.parametrize(("approaches", "at"), [("side", BESIDE_THE_CUP), ("side top", CENTRE)])
+def test_a_task_on_a_deep_box_stops_saying_so_or_takes_it_from_the_top(
+    tmp_path: Path, approaches: str, at: tuple[float, float, float]
+) -> None:
+    """Allowed only its side grasp, the run stops at the approach with the depth, nothing moved (1.1 s
+    simulated at seed 0); allowed "side top", the box is carried to the tray from the top, no re-plan."""
+    carton = carton_in_the_map(approaches, 0.04, 0.10, at=at)
+    kb = knowledge(tmp_path, ("map", carton), ("map", TRAY), ("requirements", PUT_CARTON_ON_TRAY))
+    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
+        start = world.pose("Carton1").position
+        environment = SimEnvironment(world, kb)
+        result = run_task(kb, "PutCartonOnTray", environment, composer=Composer(kb))
+        end = world.pose("Carton1").position
+    facts = {(r["thing"].value, r["relation"].value, r["other"].value) for r in kb.select("world_facts")}
+    on_the_tray = (WORLD + "Carton1", HOME + "isLocated", WORLD + "TrayPlace") in facts
+    if approaches == "side":
+        assert not result.succeeded and not on_the_tray
+        assert re.search(r"the Carton1 is 10\.\d cm deep along the hand's approach by its side grasp", result.stopped)
+        assert end == pytest.approx(start, abs=0.002)
+    else:
+        assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
+        assert on_the_tray and not result.replans
+        assert [c.model.grasp for c in environment.context.choices] == [GraspKind.TOP]
