@@ -38,7 +38,7 @@ import pyoxigraph as ox
 
 from cbrs.kb.catalog import Catalogue, Unresolved, is_built_in, ontology_iri
 from cbrs.kb.errors import PartCycleError, RdfParseError, UnknownFormatError, UnknownGraphError
-from cbrs.kb.namespaces import CBRS, DUL, GENID, OWL, RDF, RDFS, GraphName
+from cbrs.kb.namespaces import CBRS, DUL, GENID, OWL, RDF, RDFS, GraphName, shorten
 from cbrs.kb.owls import Conversion, Role, Vocabulary, convert, is_owls, owls_key, referenced_ontologies
 from cbrs.kb.shapes import check_loaded
 from cbrs.kb.store import EmbeddedStore, Store
@@ -420,24 +420,38 @@ def _check_whole(conversion: Conversion, source: str) -> None:
 
 
 def _check_not_merged(store: Store, parsed: ParsedFile, held: Held) -> None:
-    """Loading an OWL-S file whose service is already in the store adds nothing when it is the same
-    file (its nodes are named from its content); a different file under the same IRI is refused rather
-    than merged into the first description."""
+    """Refuse an OWL-S file whose service the store describes otherwise, rather than merge the two
+    descriptions: in the graph the file goes to (the same file again adds nothing, its nodes being named
+    from its content), or as a cbrs description in another graph, since queries read the union of the
+    graphs. A graph that holds only the OWL-S triples of the IRI (a request copy of the service, loaded
+    into graph:requirements as the requirement ``<IRI>-request``: OWLS-TC's query files are copies of
+    service files) describes another resource and does not stop the load (docs/owls.md)."""
     assert parsed.owls is not None
+    rdf_type = ox.NamedNode(RDF + "type")
     for converted in parsed.owls.services:
         node = ox.NamedNode(converted.iri)
-        if next(iter(store.quads(node, ox.NamedNode(RDF + "type"))), None) is None:
-            continue
-        if all(held(q) for q in parsed.quads):
-            continue
-        # the advice first: the parser errors' one-line form keeps 240 characters, and OWL-S IRIs are long
-        advice = "cbrs deregister IRI first, or give the new one another IRI"
-        if parsed.graph == GraphName.SERVICES.iri:  # an advertisement: the registry replaces it in one transaction
-            advice = f"cbrs register --update FILE replaces it (or {advice})"
-        raise RdfParseError(
-            parsed.source,
-            f"<{converted.iri}> is already in the store, described differently; a load would merge the two: {advice}",
-        )
+        types: defaultdict[str, set[str]] = defaultdict(set)
+        for quad in store.quads(node, rdf_type):
+            if isinstance(quad.graph_name, ox.NamedNode) and isinstance(quad.object, ox.NamedNode):
+                types[quad.graph_name.value].add(quad.object.value)
+        if parsed.graph in types and not all(held(q) for q in parsed.quads):
+            # the advice first: the parser errors' one-line form keeps 240 characters, and OWL-S IRIs are long
+            advice = "cbrs deregister IRI first, or give the new one another IRI"
+            if parsed.graph == GraphName.SERVICES.iri:  # an advertisement: the registry replaces it in one transaction
+                advice = f"cbrs register --update FILE replaces it (or {advice})"
+            raise RdfParseError(
+                parsed.source,
+                f"<{converted.iri}> is already in the store, described differently in {shorten(parsed.graph)}; a "
+                f"load would merge the two: {advice}",
+            )
+        for graph, kinds in sorted(types.items()):
+            if graph != parsed.graph and any(owls_key(kind) is None for kind in kinds):
+                raise RdfParseError(
+                    parsed.source,
+                    f"<{converted.iri}> is described in {shorten(graph)} already, and queries read all graphs as "
+                    f"one: loading it into {shorten(parsed.graph)} too would merge the two descriptions; "
+                    f"cbrs deregister IRI first, or give the new one another IRI",
+                )
 
 
 def expand_paths(paths: Sequence[str | Path]) -> list[Path]:
