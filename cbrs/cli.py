@@ -356,9 +356,15 @@ def register(app: App, file: Path, update: bool) -> None:
     transaction)."""
     text = file.read_bytes()
     if update:
-        added, updated = app.kb.registry.sync(text, str(file))
-        for iri in sorted(added + updated):
-            click.echo(f"{'registered' if iri in added else 'updated'} {shorten(iri)}")
+        done = app.kb.registry.synced(text, str(file))
+        for iri in sorted(done.registered + done.updated):
+            click.echo(f"{'registered' if iri in done.registered else 'updated'} {shorten(iri)}")
+        if done.conversion is not None:  # an OWL-S file: what cbrs load of it says besides its counts
+            for item in done.conversion.files:
+                if item.repairs:
+                    click.echo(f"read {item.source}{_mended(item)}")
+            for line in _load_summary(done.conversion, app.kb.store):
+                click.echo(line)
         return
     try:
         iris = app.kb.registry.register(text, str(file))

@@ -225,12 +225,14 @@ def load_files(
     return report
 
 
-def prepare_owls(store: Store, raw: bytes, source: str, rdf_format: ox.RdfFormat, base_iri: str) -> ParsedFile:
+def prepare_owls(store: Store, raw: bytes, source: str, rdf_format: ox.RdfFormat, base_iri: str) -> LoadReport:
     """One OWL-S file given in memory, parsed, converted into advertisements for graph:services and
     checked as :func:`load_files` checks it, but not written: what the registry puts in place of the
     advertisements an earlier version of the file gave (``cbrs register --update FILE``), in one
     transaction. Unlike a load it does not refuse a service the store holds already (replacing it is
-    the point): the caller decides which services it replaces."""
+    the point): the caller decides which services it replaces. The report's one file is the converted
+    file; the report carries what a load of the file notes too (unresolved concepts, conversion notes,
+    mended parts), for the caller to say as ``cbrs load`` says it."""
     data = _as_utf8(raw, source)
     quads, prefixes, repairs = _parse_quads(data, source, rdf_format, base_iri)
     if not is_owls(quads):
@@ -238,7 +240,7 @@ def prepare_owls(store: Store, raw: bytes, source: str, rdf_format: ox.RdfFormat
     target = GraphName.SERVICES.node
     report = LoadReport()
     _prepare(store, [_Raw(source, target, _into(quads, target), True, prefixes, repairs)], [], report, None, False)
-    return report.files[0]
+    return report
 
 
 def _prepare(

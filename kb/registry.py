@@ -4,6 +4,7 @@ advertisements, each as one transaction on the services graph."""
 from __future__ import annotations
 
 from collections.abc import Iterable
+from dataclasses import dataclass
 from pathlib import Path
 
 import pyoxigraph as ox
@@ -16,7 +17,7 @@ from cbrs.kb.errors import (
     NotFoundError,
     OutsideRegistryError,
 )
-from cbrs.kb.loader import parse_bytes, prepare_owls, registration_format
+from cbrs.kb.loader import LoadReport, parse_bytes, prepare_owls, registration_format
 from cbrs.kb.namespaces import BASE, RDF, RDFS, GraphName, shorten, written
 from cbrs.kb.owls import is_owls, is_owls_service
 from cbrs.kb.owls_source import GraphReads, owls_services, owls_source
@@ -26,6 +27,17 @@ from cbrs.kb.skolem import closure, is_skolem
 from cbrs.kb.standard_terms import StandardTerms
 from cbrs.kb.store import Store
 from cbrs.kb.vocab import CBRS
+
+
+@dataclass(frozen=True)
+class Synced:
+    """What :meth:`ComponentRegistry.synced` did: the advertisements it registered and those it updated,
+    and for an OWL-S input the report of its conversion (what ``cbrs load`` of the file would note:
+    unresolved imports and concepts, conversion notes, mended parts); ``None`` for any other input."""
+
+    registered: list[str]
+    updated: list[str]
+    conversion: LoadReport | None = None
 
 
 class ComponentRegistry:
@@ -64,6 +76,11 @@ class ComponentRegistry:
         return iris
 
     def sync(self, turtle: str | bytes, source: str = "<update>") -> tuple[list[str], list[str]]:
+        """:meth:`synced`'s registered and updated IRIs."""
+        done = self.synced(turtle, source)
+        return done.registered, done.updated
+
+    def synced(self, turtle: str | bytes, source: str = "<update>") -> Synced:
         """Bring graph:services in line with ``turtle``: replace the descriptions of its advertisements
         that are registered, register the others, in one transaction; returns (registered, updated).
         A file of two advertisements one of which was deregistered could be neither registered again
@@ -74,8 +91,10 @@ class ComponentRegistry:
         An OWL-S file is converted as ``cbrs load`` converts it (:func:`kb.loader.prepare_owls`), and what
         an earlier load of it gave its registered services (:meth:`owned_quads`, OWL-S triples included)
         is replaced by what it gives now: what ``cbrs deregister`` of each and ``cbrs load FILE`` did in
-        several transactions, of which a failed load left the services deregistered."""
-        quads, iris = self._parse(turtle, source, owls=True)
+        several transactions, of which a failed load left the services deregistered. Its report says what
+        the conversion noted, as a load of the file would (``cbrs register --update`` prints it)."""
+        conversion: list[LoadReport] = []
+        quads, iris = self._parse(turtle, source, owls=True, conversion=conversion)
         added = []
         for iri in iris:
             if self.is_registered(iri):
@@ -86,7 +105,7 @@ class ComponentRegistry:
             added.append(iri)
         updated = [iri for iri in iris if iri not in added]
         self._write(quads, updated)
-        return added, updated
+        return Synced(added, updated, conversion[0] if conversion else None)
 
     def _refuse_elsewhere(self, iri: str) -> None:
         """Raise :class:`OutsideRegistryError` when another graph holds an advertisement by ``iri``."""
@@ -214,23 +233,31 @@ class ComponentRegistry:
             f"{'it' if len(loaded) == 1 else 'them'} and registers the others, in one transaction"
         )
 
-    def _parse(self, turtle: str | bytes, source: str, owls: bool = False) -> tuple[list[ox.Quad], list[str]]:
+    def _parse(
+        self, turtle: str | bytes, source: str, owls: bool = False, conversion: list[LoadReport] | None = None
+    ) -> tuple[list[ox.Quad], list[str]]:
         """The input's quads, checked, and its advertisements' IRIs; with ``owls``, an OWL-S input is
-        converted into advertisements (:func:`kb.loader.prepare_owls`) instead of refused."""
+        converted into advertisements (:func:`kb.loader.prepare_owls`) instead of refused, and the
+        conversion's report is appended to ``conversion``."""
         try:
-            return self._parse_checked(turtle, source, owls)
+            return self._parse_checked(turtle, source, owls, conversion)
         except InvalidDescriptionError as error:
             if error.iri != source and not source.startswith("<") and Path(source).is_file():
                 line = line_of(source, error.iri)  # a file of many descriptions: where this one is
                 error.args = (f"{source}{f':{line}' if line else ''}: {error.args[0]}",)
             raise
 
-    def _parse_checked(self, turtle: str | bytes, source: str, owls: bool) -> tuple[list[ox.Quad], list[str]]:
+    def _parse_checked(
+        self, turtle: str | bytes, source: str, owls: bool, conversion: list[LoadReport] | None
+    ) -> tuple[list[ox.Quad], list[str]]:
         raw = turtle.encode("utf-8") if isinstance(turtle, str) else turtle
         rdf_format = registration_format(source, raw)  # Turtle, unless the file's name or XML head says otherwise
         parsed = parse_bytes(raw, source, rdf_format, graph=GraphName.SERVICES, base_iri=_base(source))
         if is_owls(parsed.quads) and owls:
-            converted = prepare_owls(self._store, raw, source, rdf_format, _base(source))
+            report = prepare_owls(self._store, raw, source, rdf_format, _base(source))
+            if conversion is not None:
+                conversion.append(report)
+            converted = report.files[0]
             assert converted.owls is not None
             return converted.quads, sorted({service.iri for service in converted.owls.services})
         if is_owls(parsed.quads):
