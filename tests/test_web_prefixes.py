@@ -223,3 +223,14 @@ def test_one_read_a_store_generation_and_a_new_namespace_shows_after_a_write(
     assert response.status_code == 204
     assert _json(client, "/resource.json", iri="http://example.org/lab/films.owl#Film")["name"] == "films:Film"
     assert len(reads) == 2
+
+
+def test_a_store_without_a_generation_reads_them_once_a_page(
+    client: FlaskClient, kb: KnowledgeBase, reads: list[int]
+) -> None:
+    """A remote store counts no writes: the table is read again for each page, but once for all the
+    IRIs a page shortens (the taxonomy page shortens every class)."""
+    kb.store.generation = None  # type: ignore[attr-defined]  # as a remote store has none
+    for path in ("/taxonomy", "/taxonomy/class?iri=books1:Book"):
+        assert client.get(path).status_code == 200, path
+    assert len(reads) == 2
