@@ -73,6 +73,9 @@ class PerceivedWorld(Judge):
         water = world.map.appearance(PREFIXES["home"] + "Water")
         self.water_colour: str | None = water[0] if water is not None else None
         """The colour water is seen by (the semantic map's water), if the map says."""
+        self.colour_owners: dict[str, frozenset[str]] = _colour_owners(world)
+        """Who shows each colour, by the map (objects, markers' patches, shirts, water): an object is
+        looked for anywhere only when nothing else is of its colour."""
 
     # -- updating the belief ---------------------------------------------------------------------
 
@@ -163,11 +166,15 @@ class PerceivedWorld(Judge):
 
     def _find(self, frame: Frame, name: str) -> bool:
         """Look for an object in a frame near where it is believed to be (anywhere, if its colour is its
-        own and it is not there); whether it was found, and then the belief is what the frame shows."""
+        own and it is not there); whether it was found, and then the belief is what the frame shows.
+
+        A colour is the object's own only when nothing else of the map shows it: not another object, a
+        base's marker patch, a person's shirt or the water. Searched for anywhere, such a patch would be
+        taken for the object (a magenta remote found on the base's rear patch)."""
         obj = self.world.objects[name]
         prior = self.objects.get(name)
         near = prior.position[:2] if prior is not None else (obj.start.x, obj.start.y)
-        unique = [o.colour for o in self.world.objects.values()].count(obj.colour) == 1
+        unique = self.colour_owners.get(obj.colour, frozenset()) <= {obj.iri}
         for where in (near, None) if unique else (near,):
             try:
                 estimate = recognise_object(frame, obj.colour, near=where, radius=SEARCH_RADIUS)
@@ -273,6 +280,25 @@ class PerceivedWorld(Judge):
             return False
         bottom = where[2] - self.world.objects[name].size[2] / 2
         return region.contains_xy(where[0], where[1]) and abs(bottom - region.zmin) <= PERCEIVED_RESTING
+
+
+_COLOUR_PROPERTIES = tuple(PREFIXES["home"] + name for name in ("colourName", "frontColourName", "rearColourName"))
+
+
+def _colour_owners(world: HomeWorld) -> dict[str, frozenset[str]]:
+    """Each colour the map gives anything (objects, people, robots' markers, any individual with a colour
+    name) and the IRIs of what shows it."""
+    owners: dict[str, set[str]] = {}
+    shown = [(obj.iri, obj.colour) for obj in world.map.objects.values()]
+    shown += [(person.iri, person.colour) for person in world.map.people.values()]
+    for robot in world.map.robots.values():
+        shown += [(robot.iri, colour) for colour in robot.marker_colours or ()]
+    for iri, values in world.map.facts.items():
+        shown += [(iri, colour) for name in _COLOUR_PROPERTIES for colour in values.get(name, [])]
+    for iri, colour in shown:
+        if colour:
+            owners.setdefault(colour, set()).add(iri)
+    return {colour: frozenset(iris) for colour, iris in owners.items()}
 
 
 def _looks_down(camera: Camera) -> bool:
