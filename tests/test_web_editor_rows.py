@@ -1,5 +1,5 @@
 """The SPARQL editor reads no more rows than it shows (``CBRS_EDITOR_ROWS``, plus one to know there are
-more): ``SELECT * WHERE { ?s ?p ?o }`` on OWLS-TC serialised all 143,000 solutions to show 1,000. A cut
+more): ``SELECT * WHERE { ?s ?p ?o }`` on OWLS-TC serialised all 178,000 solutions to show 1,000. A cut
 result says so and offers the whole one from ``/sparql``, which runs the query as it was written."""
 
 from __future__ import annotations
