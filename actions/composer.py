@@ -51,6 +51,7 @@ from cbrs.kb import Advertisement, KnowledgeBase, Requirement, Statement
 from cbrs.kb.namespaces import GraphName, shorten
 from cbrs.kb.shapes import nearest_term
 from cbrs.reasoner.config import MatchConfig
+from cbrs.reasoner.degrees import Degree, degree_of_match
 
 if TYPE_CHECKING:
     from cbrs.reasoner.matchmaker import EntityPair, Matchmaker
@@ -58,6 +59,9 @@ from cbrs.reasoner.taxonomy import TaxonomyIndex
 
 GOAL = "GOAL"  # the extraction's virtual consumer: SRO's and SRE's needs together
 MAX_DEPTH = 4  # how many levels of sub-actions a task may be decomposed into
+
+_AT_OR_BELOW = frozenset({Degree.EXACT, Degree.SUBCLASS_OF})
+"""Degrees at which a fact is as specific as a goal, side by side (a subclass, a subproperty)."""
 
 
 class Objective(Enum):
@@ -439,10 +443,17 @@ class Composer:
         return self._result(task, _concatenate(task, plans), (), tuple(attempts))
 
     def _achieved(self, requirement: Requirement, holding: Sequence[Statement]) -> bool:
-        """Whether a sub-task is done: it wants effects only, and each holds in the world now."""
+        """Whether a sub-task is done: it wants effects only, and each holds in the world now. A fact holds
+        a goal when it is as specific on every side (the remote on a side table holds "on a table"), not
+        when it is more general: a remote on the kitchen table, a home:Table, is not on a lab:SideTable,
+        although the two would match as services do (a superclass is an accepted degree there)."""
         if requirement.outputs or not requirement.effects:
             return False
-        return all(any(self.matcher.statement(e, h) is not None for h in holding) for e in requirement.effects)
+        return all(any(self._entails(h, e) for h in holding) for e in requirement.effects)
+
+    def _entails(self, fact: Statement, goal: Statement) -> bool:
+        sides = ((goal.subject, fact.subject), (goal.predicate, fact.predicate), (goal.object, fact.object))
+        return all(degree_of_match(self.index, wanted, held) in _AT_OR_BELOW for wanted, held in sides)
 
     def _result(
         self, task: Task, plan: Plan | None, unsatisfied: tuple[Unsatisfied, ...], attempts: tuple[Attempt, ...]

@@ -16,6 +16,7 @@ from pathlib import Path
 import pyoxigraph as ox
 import pytest
 
+from cbrs.actions.belief import BeliefState, Observation
 from cbrs.actions.composer import Composer, PlanStatus
 from cbrs.actions.errors import UngroundedGoalError
 from cbrs.actions.runner import _WHERE, RunResult, _missing, run_task
@@ -221,3 +222,38 @@ def test_without_the_place_below_the_tap_the_cup_is_carried_to_the_reachable_par
 def test_every_task_file_here_is_turtle_a_store_loads() -> None:
     for path in sorted(DATA.glob("*.ttl")):
         assert len(list(ox.parse(path=str(path), format=ox.RdfFormat.TURTLE))) > 0, path.name
+
+
+def _cup_goal(tmp_path: Path, place: str) -> str:
+    """KeepCupOnTableTop with the goal's place (and the input's class) replaced by ``place``."""
+    text = (DATA / "cup_on_the_table_top.ttl").read_text(encoding="utf-8")
+    (tmp_path / "goal.ttl").write_text(
+        "@prefix lab: <https://example.org/lab#> .\n" + text.replace("home:TableTop", place), encoding="utf-8"
+    )
+    return str(tmp_path / "goal.ttl")
+
+
+@pytest.mark.parametrize(
+    ("place", "achieved"),
+    [("home:TableTop", True), ("home:Region", True), ("lab:CounterTop", False)],
+    ids=["the same class", "a superclass", "a subclass"],
+)
+def test_a_goal_holds_at_the_start_only_when_a_fact_is_as_specific_as_it(
+    tmp_path: Path, place: str, achieved: bool
+) -> None:
+    """The cup stands on the kitchen table's top, a home:TableTop: that is on a place, but not on a
+    lab:CounterTop, a kind of table top the cup is not known to be on (the check took it as done)."""
+    kb = knowledge()
+    (tmp_path / "onto.ttl").write_text(
+        "@prefix lab: <https://example.org/lab#> . @prefix home: <https://w3id.org/cbrs/home#> .\n"
+        "@prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> . @prefix owl: <http://www.w3.org/2002/07/owl#> .\n"
+        "lab:CounterTop a owl:Class ; rdfs:subClassOf home:TableTop .\n",
+        encoding="utf-8",
+    )
+    kb.load([tmp_path / "onto.ttl"], graph="ontology")
+    kb.load([Path(_cup_goal(tmp_path, place))], graph="requirements")
+    cup, top = WORLD + "Cup", WORLD + "KitchenTableTop"  # what the robots perceive at the start
+    types = {cup: HOME + "Cup", top: HOME + "TableTop"}
+    BeliefState(kb).write(Observation(types, frozenset({(cup, HOME + "isLocated", top)}), {}, 0.0))
+    plan = Composer(kb).compose("KeepCupOnTableTop", belief=True).plan
+    assert (plan is not None and plan.method == "achieved") is achieved
