@@ -233,7 +233,8 @@ class PerceivedWorld(Judge):
     def gripper_near(self, side: ArmSide, name: str) -> bool:
         where = self.position(name)
         hand = self.world.arm(side).ee_pose().position
-        return where is not None and math.dist(hand, where) <= pred.GRIPPER_NEAR_DISTANCE
+        size = self.world.objects[name].size
+        return where is not None and pred.distance_to_extent(hand, where, size) <= pred.GRIPPER_NEAR_DISTANCE
 
     def base_near_person(self, person: str) -> bool | None:
         sighting = self.people.get(person)

@@ -16,13 +16,15 @@ import pybullet as p
 
 from cbrs.sim.arms import ArmSide
 from cbrs.sim.cameras import project
-from cbrs.sim.geometry import Pose2D, Region, quat_to_matrix
+from cbrs.sim.geometry import Pose2D, Region, Vec3, quat_to_matrix
+from cbrs.sim.grasping import PREGRASP_DISTANCE
 from cbrs.sim.layout import PERSON_HAND_HEIGHT
 from cbrs.sim.world import HomeWorld
 
 __all__ = [
     "ABOVE_MAX",
     "ABOVE_MIN",
+    "APPROACH_SLACK",
     "BASE_NEAR_DISTANCE",
     "BASE_NEAR_HEADING",
     "GRASP_DISTANCE",
@@ -37,6 +39,7 @@ __all__ = [
     "base_near",
     "base_near_person",
     "contains_water",
+    "distance_to_extent",
     "gripper_near",
     "is_grasped",
     "object_above_region",
@@ -59,11 +62,18 @@ ABOVE_MAX = 0.30
 """An object is above a region when its centre is over the region and its bottom is 0.5 cm to
 30 cm over the surface: free of it, yet close enough that putting it down is a short straight move."""
 GRASP_DISTANCE = 0.03
-"""A grasped object's centre is within 3 cm of the grasp point (the grasp is at most 2 cm off the
-centre of the objects here); more means the object slipped."""
-GRIPPER_NEAR_DISTANCE = 0.15
-"""The gripper is near an object when its grasp point is within 15 cm of the object's centre: the
-pre-grasp pose is 10 cm back, so an approach made within 5 cm of the plan counts."""
+"""A grasped object's centre is within 3 cm of where the grasp holds it (``Arm.carried_centre``: the
+grasp point less the grasp's height above the object's centre); more means the object slipped. It was
+measured to the grasp point itself, which a grasp high on a tall object is far from (7 cm for an 18 cm
+bottle held at 0.88 of its height), so such a pick-up was said to slip."""
+APPROACH_SLACK = 0.05
+"""How far from its planned pre-grasp pose an approach may end and still count (5 cm)."""
+GRIPPER_NEAR_DISTANCE = PREGRASP_DISTANCE + APPROACH_SLACK
+"""The gripper is near an object when its grasp point is within 15 cm of the object's extent
+(:func:`distance_to_extent`), not of its centre: the pre-grasp pose is 10 cm back from a grasp point
+in the object, wherever on it the class grasps it (an 18 cm bottle held at 0.88 of its height is
+grasped 7 cm above its centre, and its pre-grasp pose was 12 cm from the centre: a centre-based 15 cm
+failed it), so an approach made within 5 cm of the plan counts."""
 BASE_NEAR_DISTANCE = 0.10
 """The base is near a place (for a hand-over) within 10 cm: the arm plans its put-down on the
 localised platform, and 10 cm keeps the pen well inside the platform's 20 cm middle strip."""
@@ -99,21 +109,33 @@ def _speed(world: HomeWorld, name: str) -> float:
 
 
 def is_grasped(world: HomeWorld, name: str, side: ArmSide | str | None = None) -> bool:
-    """(object, isGraspedBy, gripper): an arm holds it and it is still between the fingers."""
+    """(object, isGraspedBy, gripper): an arm holds it and it is still where the fingers took it."""
     body = world.body(name)
     sides = [ArmSide(side)] if side is not None else list(ArmSide)
     for s in sides:
         arm = world.arm(s)
         if arm.held == body:
-            distance = float(np.linalg.norm(_position(world, name) - np.asarray(arm.ee_pose().position)))
+            held = arm.carried_centre() or arm.ee_pose().position  # where the grasp holds its centre
+            distance = float(np.linalg.norm(_position(world, name) - np.asarray(held)))
             return distance <= GRASP_DISTANCE
     return False
 
 
+def distance_to_extent(point: Vec3, centre: Vec3, size: Vec3) -> float:
+    """How far ``point`` is from an object of ``size`` (x, y, z) centred at ``centre``, taking its extent
+    as an upright cylinder of its half height and its longer half side: the same whether the object's
+    yaw is known (the referee) or not (the robots' belief); 0 inside it."""
+    radius = max(size[0], size[1]) / 2.0
+    across = max(math.hypot(point[0] - centre[0], point[1] - centre[1]) - radius, 0.0)
+    up = max(abs(point[2] - centre[2]) - size[2] / 2.0, 0.0)
+    return math.hypot(across, up)
+
+
 def gripper_near(world: HomeWorld, side: ArmSide | str, name: str) -> bool:
-    """(gripper, isNear, object)."""
-    ee = np.asarray(world.arm(side).ee_pose().position)
-    return float(np.linalg.norm(ee - _position(world, name))) <= GRIPPER_NEAR_DISTANCE
+    """(gripper, isNear, object): its grasp point within ``GRIPPER_NEAR_DISTANCE`` of the object's extent."""
+    ee = world.arm(side).ee_pose().position
+    x, y, z = (float(v) for v in _position(world, name))
+    return distance_to_extent(ee, (x, y, z), world.objects[name].size) <= GRIPPER_NEAR_DISTANCE
 
 
 def object_above_region(world: HomeWorld, name: str, region: Region) -> bool:
