@@ -72,8 +72,8 @@ GRIPPER_NEAR_DISTANCE = PREGRASP_DISTANCE + APPROACH_SLACK
 """The gripper is near an object when its grasp point is within 15 cm of the object's extent
 (:func:`distance_to_extent`), not of its centre: the pre-grasp pose is 10 cm back from a grasp point
 in the object, wherever on it the class grasps it (an 18 cm bottle held at 0.88 of its height is
-grasped 7 cm above its centre, and its pre-grasp pose was 12 cm from the centre: a centre-based 15 cm
-failed it), so an approach made within 5 cm of the plan counts."""
+grasped 7 cm above its centre, and its pre-grasp pose is then 15.0 cm from the centre: a centre-based
+15 cm left no slack and failed it), so an approach made within 5 cm of the plan counts."""
 BASE_NEAR_DISTANCE = 0.10
 """The base is near a place (for a hand-over) within 10 cm: the arm plans its put-down on the
 localised platform, and 10 cm keeps the pen well inside the platform's 20 cm middle strip."""
