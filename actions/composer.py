@@ -261,6 +261,8 @@ class Composer:
         holding = self._state if self._state is not None else []
         if self._achieved(task.requirement, holding):
             return self._result(task, _achieved_plan(task), (), (direct,))
+        if direct.plan is not None and _shared_goals(direct.plan, self.index):
+            return self._per_goal(task, direct)
         if direct.plan is not None:
             return self._result(task, direct.plan, direct.unsatisfied, (direct,))
         result = self._decomposed(task, direct) if self._decomposable(task) else None
@@ -441,6 +443,47 @@ class Composer:
         if not plans:  # every part is achieved: nothing to do but check
             return self._result(task, _achieved_plan(task), (), tuple(attempts))
         return self._result(task, _concatenate(task, plans), (), tuple(attempts))
+
+    def _per_goal(self, task: Task, direct: Attempt) -> CompositionResult:
+        """Plan each goal on its own, in the requirement's order, and concatenate the plans: the direct
+        plan credited one step's effect with goals about different things (the cup on the tray and the
+        remote on its spot, both to one put-down), and one step moves one thing. Each goal's part takes
+        the inputs of its own things (a class at or below the goal's subject or object) and those of no
+        goal's (the robot's), so the cup's part fetches the cup; a goal that holds already is skipped."""
+        requirement = task.requirement
+        goals = requirement.effects
+        attempts = [direct]
+        plans: list[Plan] = []
+        holding = self._state if self._state is not None else []
+        for n, goal in enumerate(goals, start=1):
+            others = [g for g in goals if g != goal]
+            inputs = tuple(
+                p
+                for p in requirement.inputs
+                if self._about(p.type, goal) or not any(self._about(p.type, other) for other in others)
+            )
+            part = replace(requirement, inputs=inputs, outputs=(), effects=(goal,))
+            if self._achieved(part, holding):
+                continue
+            sub_task = Task(f"{task.name}/goal{n}", part, None)
+            attempt = self.attempt(part, sub_task)
+            attempts.append(attempt)
+            if attempt.plan is None:
+                unsatisfied = tuple(
+                    Unsatisfied(u.need, u.consumer, (f"goal {n} {statement_text(goal)}", *u.chain[1:]), u.cycle)
+                    for u in attempt.unsatisfied
+                )
+                return self._result(task, None, unsatisfied, tuple(attempts))
+            plans.append(attempt.plan)
+        if not plans:
+            return self._result(task, _achieved_plan(task), (), tuple(attempts))
+        return self._result(task, _concatenate(task, plans), (), tuple(attempts))
+
+    def _about(self, concept: str | None, goal: Statement) -> bool:
+        """Whether an input of class ``concept`` names a thing of ``goal``: at or below its subject or object."""
+        if not concept:
+            return False
+        return any(degree_of_match(self.index, side, concept) in _AT_OR_BELOW for side in (goal.subject, goal.object))
 
     def _achieved(self, requirement: Requirement, holding: Sequence[Statement]) -> bool:
         """Whether a sub-task is done: it wants effects only, and each holds in the world now. A fact holds
@@ -939,6 +982,22 @@ def _threatens(index: TaxonomyIndex, deleted: Statement, needed: Statement) -> b
         _is_a(index, a, b) or _is_a(index, b, a)
         for a, b in ((deleted.subject, needed.subject), (deleted.object, needed.object))
     )
+
+
+def _shared_goals(plan: Plan, index: TaxonomyIndex) -> list[tuple[Binding, Binding]]:
+    """Pairs of goals the plan credits to the same effect of the same step although they are about
+    different things: subjects of classes neither of which is the other's (a Cup, a RemoteControl)."""
+    shared = []
+    goals = [g for g in plan.goals if g.source.step is not None and g.statement is not None]
+    for i, first in enumerate(goals):
+        for second in goals[i + 1 :]:
+            if (first.source.step, first.source.name) != (second.source.step, second.source.name):
+                continue
+            assert first.statement is not None and second.statement is not None
+            a, b = first.statement.subject, second.statement.subject
+            if degree_of_match(index, a, b) is Degree.FAIL:
+                shared.append((first, second))
+    return shared
 
 
 def _achieved_plan(task: Task) -> Plan:

@@ -17,10 +17,13 @@ class UnknownTaskError(ActionsError):
 
     http_status = 404
 
-    def __init__(self, name: str, known: Sequence[str]) -> None:
+    def __init__(self, name: str, known: Sequence[str], ambiguous: bool = False) -> None:
         self.name = name
         self.known = tuple(known)
-        super().__init__(f"no requirement or action named {name!r}; known tasks: {', '.join(known)}")
+        if ambiguous:  # ``known``: the IRIs the bare name could mean
+            super().__init__(f"{name!r} names more than one task; name it by its IRI: {', '.join(known)}")
+        else:
+            super().__init__(f"no requirement or action named {name!r}; known tasks: {', '.join(known)}")
 
 
 class OrderingConflictError(ActionsError):

@@ -152,6 +152,13 @@ def resolve_task(kb: KnowledgeBase, library: ActionLibrary, name: str) -> Task:
             stated = sorted((r for r in requirements() if r.for_task == iri), key=lambda r: r.iri)
             requirement = stated[0] if stated else kb.action_requirement(iri, action.label)
             return Task(iri, requirement, action)
+    if ":" not in name:  # a bare name of the lab's own namespace (lab:TidyUp): one requirement or action of that name
+        named = sorted({r.iri for r in requirements() if local_name(r.iri) == name})
+        named = named or sorted(a.iri for a in library if local_name(a.iri) == name)
+        if len(named) == 1:
+            return resolve_task(kb, library, named[0])
+        if named:
+            raise UnknownTaskError(name, named, ambiguous=True)
     known = sorted({local_name(r.iri) for r in requirements()} | {local_name(a.iri) for a in library if a.sub_actions})
     raise UnknownTaskError(name, known)
 

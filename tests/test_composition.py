@@ -156,6 +156,22 @@ def test_a_task_names_a_requirement_never_an_advertisement() -> None:
     assert error.value.known == ("Req",)
 
 
+def test_a_bare_name_finds_a_task_of_any_namespace_and_says_when_it_is_ambiguous() -> None:
+    """ex:Req is no req: or act: name: a bare "Req" found it only through the CLI, and the error listed
+    "Req" among the known tasks it had just refused."""
+    from cbrs.actions.errors import UnknownTaskError
+
+    kb = problem_kb("chain.ttl")
+    assert Composer(kb).task("Req").requirement.iri == EX + "Req"
+    kb.update(
+        "INSERT DATA { GRAPH <https://w3id.org/cbrs/graph/requirements> {"
+        " <http://example.org/other#Req> a <https://w3id.org/cbrs/core#Requirement> } }"
+    )
+    with pytest.raises(UnknownTaskError, match="names more than one task") as error:
+        Composer(kb).task("Req")
+    assert error.value.known == ("http://example.org/comp#Req", "http://example.org/other#Req")
+
+
 def test_a_task_with_nothing_to_plan_towards_says_what_to_state(bundled_kb: KnowledgeBase) -> None:
     """A task that wants only something to stop being true has no goal composition plans for: the
     reason says so and what to state instead, not to register a component for 'an output or effect'."""

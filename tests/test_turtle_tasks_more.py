@@ -257,3 +257,26 @@ def test_a_goal_holds_at_the_start_only_when_a_fact_is_as_specific_as_it(
     BeliefState(kb).write(Observation(types, frozenset({(cup, HOME + "isLocated", top)}), {}, 0.0))
     plan = Composer(kb).compose("KeepCupOnTableTop", belief=True).plan
     assert (plan is not None and plan.method == "achieved") is achieved
+
+
+def test_two_things_in_one_task_are_moved_each_in_turn() -> None:
+    """One put-down's effect matched both goals, so the plan picked the cup up once and credited both
+    goals to it; each goal about a thing of its own is now planned on its own, its inputs with it."""
+    kb = knowledge(("map", "two_things_places.ttl"), ("requirements", "tidy_cup_and_pen.ttl"))
+    result = run(kb, "TidyCupAndPen")
+    succeeded(result)
+    plan = result.composition.plan
+    assert plan is not None and len(plan.sub_actions) == 2
+    assert len({goal.source.step for goal in plan.goals}) == 2  # a put-down for each
+    given = {
+        part: {
+            b.source.name for step in plan.steps if step.part_of == part for b in step.inputs if b.source.step is None
+        }
+        for part in plan.sub_actions
+    }
+    assert sorted(given.values(), key=sorted) == [{"cup", "cupSpot"}, {"pen", "penSpot"}]  # each part its things
+    moved = {
+        (WORLD + "Cup", HOME + "isLocated", WORLD + "CupSpot1"),
+        (WORLD + "Pen", HOME + "isLocated", WORLD + "PenSpot1"),
+    }
+    assert moved <= facts(kb)
