@@ -52,8 +52,9 @@ def test_the_page_links_the_names_and_escapes_the_literals(client: FlaskClient) 
     assert "Restrictions and other class expressions" in page
     assert "genid" not in page
     text = re.sub(r"<[^>]+>", "", page)
-    # an IRI no prefix shortens shows its tail, the whole IRI in the link's title (links.display_name)
-    assert "lab#hasPart exactly 4 lab#Wheel" in text
+    # a namespace cbrs declares no prefix for gets one from its name (cbrs.web.prefixes), the whole IRI
+    # in the link's title
+    assert "lab:hasPart exactly 4 lab:Wheel" in text
     assert f'title="{LAB}Wheel"' in page
     assert "&gt;= 1.5, &lt; 80" in page and "&#34;Robbie&#34;@en" in page
     # a class the taxonomy has links to its class page, an individual to its triples
