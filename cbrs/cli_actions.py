@@ -25,6 +25,7 @@ from cbrs.actions.runner import RunResult, run_task
 from cbrs.app import App, parse_iri, pass_app
 from cbrs.extras import require
 from cbrs.kb import KnowledgeBase, RemoteStoreError
+from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import shorten
 from cbrs.output import table
 from cbrs.settings import setting
@@ -244,6 +245,14 @@ def run(
                 fault_policy=policy,
                 replan_policy=ReplanPolicy(max_repeats=repeat_failures),
             )
+        except KnowledgeBaseError as error:  # refused before anything moved (out of reach, ambiguous...)
+            if not as_json:
+                raise
+            # a script asked for JSON: it gets JSON for a refusal too, as /cbrs/run_task words it
+            refused = {"task": iri, "status": "error", "error": f"{type(error).__name__}: {error}", "seed": seed}
+            click.echo(json.dumps(refused, indent=2))
+            click.echo(f"Error: {error}", err=True)
+            raise SystemExit(1) from None
         finally:
             if recorder is not None:
                 recorder.stop()
