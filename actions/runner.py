@@ -35,8 +35,9 @@ class Environment(Protocol):
     def given(self, plan: Plan, requirements: Mapping[str, Requirement]) -> dict[str, Any]:
         """Values for the inputs the task's requirement(s) give, by parameter name."""
 
-    def verify(self, step: PlanStep, statement: Statement, outputs: Mapping[str, Any]) -> bool | None:
-        """Whether ``statement`` holds now in the environment."""
+    def verify(self, step: PlanStep | None, statement: Statement, outputs: Mapping[str, Any]) -> bool | None:
+        """Whether ``statement`` holds now in the environment; ``step`` None for a goal no step made (it
+        held when the run started), which is about the things the task gives."""
 
     def observe(self) -> Observation:
         """The belief state to write to the world graph now."""
@@ -361,7 +362,7 @@ def _check_goals(
             continue
         step = plan.step(goal.source.step) if goal.source.step is not None else None
         made = outputs.get(step.index, {}) if step is not None else {}
-        believed = environment.verify(step, goal.statement, made) if step is not None else None
+        believed = environment.verify(step, goal.statement, made)
         holds = audit(goal.statement) if callable(audit) else None
         checks.append(GoalCheck(goal.statement, believed, holds if holds is None else bool(holds)))
     return tuple(checks)

@@ -1502,12 +1502,14 @@ class SimEnvironment:
             return Grounded("region", ctx.region.name)
         return None
 
-    def verify(self, step: PlanStep, statement: Statement, outputs: Mapping[str, Any]) -> bool | None:
+    def verify(self, step: PlanStep | None, statement: Statement, outputs: Mapping[str, Any]) -> bool | None:
         """Decide a (class-level) statement by its predicate's computable, for the things at hand, on
         what the robots perceive now. A statement the store maps to no test is believed from the step
         with that effect on (:meth:`_believe_effect`): True once it is (the task's goal checked at the
         end, a later step's), None at that step itself (no test decided it) and when its things cannot
-        be told."""
+        be told. Without a step (a goal that held at the start) the things at hand are the task's."""
+        if step is None:
+            self.context.inputs = dict(self.context.given)
         found = self._judge(self.belief, statement, outputs, look=True)
         if found is not None:
             return found

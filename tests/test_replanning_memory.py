@@ -82,7 +82,7 @@ class Home:
     def given(self, plan: Plan, requirements: Mapping[str, Requirement]) -> dict[str, Any]:
         return {"a": {"@id": EX + "a1"}}
 
-    def verify(self, step: PlanStep, statement: Statement, outputs: Mapping[str, Any]) -> bool | None:
+    def verify(self, step: PlanStep | None, statement: Statement, outputs: Mapping[str, Any]) -> bool | None:
         return None
 
     def perceive(self) -> None:

@@ -108,6 +108,7 @@ def test_opening_the_door_is_believed_and_the_next_run_has_nothing_to_do(tmp_pat
     second = _run(kb, motor)
     assert second.succeeded, second.report
     assert second.composition.plan is not None and second.composition.plan.steps == ()
+    assert [(g.believed, g.holds) for g in second.goals] == [(True, None)]  # it held at the start: believed
     assert len(motor.calls) == 1  # the door was not opened again
     assert OPENED in BeliefState(kb).facts()
 
