@@ -97,8 +97,15 @@ class Unsatisfied:
     cycle: bool = False  # providers exist, but each needs (through others) what this need blocks
     undeclared: tuple[str, ...] = ()  # classes the need names that the ontology does not have
     near: tuple[tuple[str, str], ...] = ()  # (undeclared class, the declared class its name is closest to)
+    unrunnable: tuple[tuple[str, str], ...] = ()  # (component, why): planned for it, but cannot run here
 
     def text(self) -> str:
+        found = self._text()
+        for component, why in self.unrunnable:
+            found += f"; {shorten(component)} was planned for it but cannot run here: {why}"
+        return found
+
+    def _text(self) -> str:
         consumer = "the requirement" if self.consumer in (SRO, SRE, GOAL) else shorten(self.consumer)
         via = f" (on the way to {' <- '.join(self.chain)})" if len(self.chain) > 1 else ""
         need = self.need

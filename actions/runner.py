@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Protocol
 
 from cbrs.actions.belief import BeliefState, Observation
@@ -22,7 +22,7 @@ from cbrs.actions.faults import Combined, FaultPolicy, FixedFaults
 from cbrs.actions.graph import statement_text
 from cbrs.actions.plan import Plan, PlanStep
 from cbrs.actions.replanning import Failure, FailureMemory, ReplanPolicy
-from cbrs.kb import KnowledgeBase, NotFoundError, Requirement, Statement
+from cbrs.kb import Advertisement, KnowledgeBase, NotFoundError, Requirement, Statement
 from cbrs.kb.namespaces import HOME
 from cbrs.kb.semantic_map import UnresolvedDesignatorError
 from cbrs.reasoner.taxonomy import ROOT, TaxonomyIndex
@@ -268,8 +268,27 @@ def _runnable(
     plan = composition.plan
     if plan is None or all(any(c in registry for c in step.candidates) for step in plan.steps):
         return composition
-    missing = frozenset(ad.iri for ad in kb.advertisements() if ad.iri not in registry)
-    return _compose(kb, config, task, avoid | missing)
+    advertisements = kb.advertisements()
+    missing = frozenset(ad.iri for ad in advertisements if ad.iri not in registry)
+    again = _compose(kb, config, task, avoid | missing)
+    if again.plan is not None:
+        return again
+    # Say which components the first plan wanted: "no component provides" alone hid a registered one.
+    wanted = {c for step in plan.steps for c in step.candidates if c not in registry}
+    why = [(ad.iri, _cannot_run(ad)) for ad in sorted(advertisements, key=lambda ad: ad.iri) if ad.iri in wanted]
+    return replace(again, unsatisfied=tuple(replace(u, unrunnable=tuple(why)) for u in again.unsatisfied))
+
+
+def _cannot_run(ad: Advertisement) -> str:
+    if ad.bridge_port is not None:
+        return (
+            f"it is a component in another process, answering {ad.bridge_port.topic} on a cbrs server's bridge,"
+            " and this run reaches no bridge (cbrs run --bridge ws://HOST:PORT)"
+        )
+    return (
+        f"the simulation has no skill for its service name {ad.service_name!r}, and it names no service port"
+        " (cbrs:ServicePort with cbrs:topic and cbrs:messageType) to call it through (docs/components.md)"
+    )
 
 
 def _compose(kb: KnowledgeBase, config: ComposeConfig, task: str, avoid: frozenset[str]) -> CompositionResult:

@@ -189,3 +189,22 @@ def test_without_a_delete_or_a_contradiction_both_statuses_stay_believed(tmp_pat
     assert _run(kb, motor).succeeded
     assert _run(kb, motor, "CloseKitchenDoor").succeeded
     assert {OPENED, AJAR} <= BeliefState(kb).facts()
+
+
+def test_a_component_nothing_here_can_run_is_named_when_no_plan_is_left(tmp_path: Path) -> None:
+    """The motor without a service port, and no simulated skill of its name: the run said only that no
+    component provides the effect, though the motor is registered and plans (new-user walkthrough)."""
+    kb = KnowledgeBase.open(":memory:")
+    (tmp_path / "door.ttl").write_text(KITCHEN_DOOR, encoding="utf-8")
+    (tmp_path / "task.ttl").write_text(OPEN_KITCHEN_DOOR, encoding="utf-8")
+    kb.load([tmp_path / "door.ttl"], graph="map")
+    kb.load([tmp_path / "task.ttl"], graph="requirements")
+    port = MOTOR_TTL.index("    cbrs:hasPort [")
+    kb.registry.register(MOTOR_TTL[:port].rstrip().removesuffix(";") + " .\n")
+    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
+        result = run_task(kb, REQ + "OpenKitchenDoor", SimEnvironment(world, kb), composer=Composer(kb))
+    assert not result.succeeded and result.composition.plan is None
+    (unsatisfied,) = result.composition.unsatisfied
+    assert unsatisfied.unrunnable and unsatisfied.unrunnable[0][0] == MOTOR
+    assert "OpenDoor_DoorMotor05 was planned for it but cannot run here" in unsatisfied.text()
+    assert "no skill for its service name 'OpenDoor'" in unsatisfied.text()
