@@ -181,10 +181,28 @@ class CompositionResult:
     unsatisfied: tuple[Unsatisfied, ...]
     attempts: tuple[Attempt, ...]  # the direct attempt, then one per sub-action when decomposed
 
+    @property
+    def unused_inputs(self) -> tuple[tuple[str, str], ...]:
+        """The (name, class) of inputs the task gives that no step of its plan takes: the plan does something
+        other than asked with what it was given (a side table given as the destination, of a class no
+        component takes for one, while the carry went to the object's own place). Empty for a plan with
+        nothing to do, and for one decomposed into sub-actions, whose requirements give their own."""
+        plan = self.plan
+        if plan is None or not plan.steps or not self.attempts:
+            return ()
+        given = [b.source for step in plan.steps for b in step.bindings if b.source.step is None]
+        if any(source.requirement != self.requirement for source in given):
+            return ()
+        used = {source.name for source in given}
+        inputs = self.attempts[0].requirement.inputs
+        named = zip(parameter_names(inputs), inputs, strict=True)
+        return tuple((name, parameter.type) for name, parameter in named if name not in used)
+
     def to_dict(self) -> dict[str, Any]:
         found: dict[str, Any] = {"task": self.task, "requirement": self.requirement, "status": self.status.value}
         if self.plan is not None:
             found.update(self.plan.to_dict())
+            found["unused_inputs"] = [{"name": name, "type": type_} for name, type_ in self.unused_inputs]
         found["unsatisfied"] = [u.to_dict() for u in self.unsatisfied]
         return found
 

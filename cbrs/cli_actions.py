@@ -113,7 +113,19 @@ def plan_text(result: CompositionResult) -> str:
         )
     goals = "\n".join(f"  {_source(g)}" for g in plan.goals)
     columns = ["#", "component", "action", "inputs and preconditions from", "alternatives"]
-    return f"{head}\n{table(columns, rows)}\nGoals:\n{goals}"
+    return f"{head}\n{table(columns, rows)}\nGoals:\n{goals}{_unused_note(result)}"
+
+
+def _unused_note(result: CompositionResult) -> str:
+    """A note naming the task's inputs the plan leaves unused (docs/composition.md)."""
+    unused = result.unused_inputs
+    if not unused:
+        return ""
+    named = ", ".join(f"{name} ({shorten(type_)})" for name, type_ in unused)
+    return (
+        f"\nnote: no step takes the task's input {named}: no component takes a thing of that class (a"
+        " destination must be a home:Place, say), so the plan does without it"
+    )
 
 
 def _source(binding: Binding) -> str:
@@ -409,7 +421,7 @@ def run_text(result: RunResult, sim_seconds: float, wall_seconds: float) -> str:
     steps = table(["#", "component", "sim s", "outcome", "effects checked"], rows)
     if not report.steps:  # every effect held already: no table of no steps
         steps = "nothing to do: every effect of the task holds already"
-    return f"{header}{steps}\n{verdict}; {timing}"
+    return f"{header}{steps}\n{verdict}; {timing}{_unused_note(result.composition)}"
 
 
 DEMO_RUNS = (

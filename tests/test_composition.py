@@ -188,3 +188,21 @@ def test_a_task_with_nothing_to_plan_towards_says_what_to_state(bundled_kb: Know
     (reason,) = [u.text() for u in result.unsatisfied]
     assert "cbrs:hasEffect" in reason and "delete effects alone" in reason
     assert "register a component" not in reason
+
+
+def test_a_plan_names_the_inputs_the_task_gives_that_no_step_takes(bundled_kb: KnowledgeBase) -> None:
+    """A destination given as furniture, a class no component takes for a place: the plan went to the
+    object's own place and said nothing of the input it left aside (new-user walkthrough)."""
+    from dataclasses import replace
+
+    from cbrs.cli_actions import plan_text
+    from cbrs.kb.model import Parameter
+
+    home = "https://w3id.org/cbrs/home#"
+    fetch = Composer(bundled_kb).task("FetchMyPen").requirement
+    assert Composer(bundled_kb).compose(fetch).unused_inputs == ()
+    table = Parameter(fetch.iri + "/table", fetch.inputs[0].direction, home + "Table", "table")
+    result = Composer(bundled_kb).compose(replace(fetch, inputs=(*fetch.inputs, table)))
+    assert result.plan is not None and result.unused_inputs == (("table", home + "Table"),)
+    assert result.to_dict()["unused_inputs"] == [{"name": "table", "type": home + "Table"}]
+    assert "note: no step takes the task's input table (home:Table)" in plan_text(result)
