@@ -74,7 +74,17 @@ from cbrs.sim.values import (
 )
 from cbrs.sim.world import HomeWorld
 
-__all__ = ["GraspChoice", "GraspPlan", "SimContext", "SimEnvironment", "designator", "implementations", "simulated"]
+__all__ = [
+    "GraspChoice",
+    "GraspPlan",
+    "OutOfReachError",
+    "PlaceCrowdedError",
+    "SimContext",
+    "SimEnvironment",
+    "designator",
+    "implementations",
+    "simulated",
+]
 
 HOME = PREFIXES["home"]
 ACT = PREFIXES["act"]
@@ -196,6 +206,23 @@ class OutOfReachError(KnowledgeBaseError):
             f"no arm of {local_name(robot)} reaches the {local_name(thing)} at ({where[0]:.2f}, {where[1]:.2f}): "
             f"{each}{f'; {why}' if why else ''}; move it within reach in the map (home:x, home:y) or give the "
             "arms more home:reach"
+        )
+
+
+class PlaceCrowdedError(KnowledgeBaseError):
+    """A place an arm step is given has spots its arms reach, but the objects on it leave none clear for
+    the object at hand: the run is refused before anything moves. ``blockers`` holds (object IRI, x, y)."""
+
+    http_status = 422
+
+    def __init__(self, place: str, what: str, blockers: list[tuple[str, float, float]], clearance: float) -> None:
+        self.place = place
+        self.blockers = tuple(blockers)
+        each = ", ".join(f"the {local_name(iri)} at ({x:.2f}, {y:.2f})" for iri, x, y in self.blockers)
+        super().__init__(
+            f"no spot of the {local_name(place)} holds {what} {clearance:.2f} m clear of the other objects, though"
+            f" its arms reach it: {each} {'leaves' if len(self.blockers) == 1 else 'leave'} no room; move"
+            f" {'it' if len(self.blockers) == 1 else 'them'} in the map (home:x, home:y) or make the place larger"
         )
 
 
@@ -1422,16 +1449,41 @@ class SimEnvironment:
         names = [obj.name for obj in objects]
         name = names[0] if len(names) == 1 else ""
         mounts = [(x, y, reach) for _, x, y, reach, _ in report]
-        _, spots = _place_spots(smap, smap.things[iri], size, mounts, _others(self.world, self.belief, *names))
+        others = _others(self.world, self.belief, *names)
+        _, spots = _place_spots(smap, smap.things[iri], size, mounts, others)
         if not spots:
             box = smap.things[iri].box
             what = f"the {name}" if name else "an object"
+            blockers = self._blockers(iri, size, mounts, names, others)
+            if blockers:
+                raise PlaceCrowdedError(iri, what, blockers, RELAY_CLEARANCE)
             why = (
                 f"no spot of it is {RELAY_MARGIN:.2f} m inside an arm's reach with {what} clear of the edge of the "
                 "surface, the other objects and the fixtures on it"
             )
             where = ((box.min_x + box.max_x) / 2, (box.min_y + box.max_y) / 2)
             raise OutOfReachError(step.device or "", iri, where, report, why)
+
+    def _blockers(
+        self,
+        place: str,
+        size: tuple[float, float, float],
+        mounts: list[tuple[float, float, float]],
+        carried: list[str],
+        others: list[tuple[float, float, float]],
+    ) -> list[tuple[str, float, float]]:
+        """The objects without which a place would have a spot for the object at hand, one left out at a
+        time (else all together); empty when it has none even then (out of reach, too small, fixtures)."""
+        smap = self.world.map
+        thing = smap.things[place]
+        if not _place_spots(smap, thing, size, mounts, [])[1]:
+            return []
+        names = [name for name in self.world.objects if name not in carried]  # in the order of ``others``
+        single = [
+            n for n in range(len(names)) if _place_spots(smap, thing, size, mounts, others[:n] + others[n + 1 :])[1]
+        ]
+        chosen = single or list(range(len(names)))
+        return [(self.world.objects[names[n]].iri, others[n][0], others[n][1]) for n in chosen]
 
     def _extent(self, iri: str) -> tuple[float, float, float, float] | None:
         """Where a thing of the map is for an arm, as (min x, max x, min y, max y): an object at the point

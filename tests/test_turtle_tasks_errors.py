@@ -14,7 +14,7 @@ from cbrs.actions.runner import run_task
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap, UnresolvedDesignatorError
-from cbrs.sim.components import OutOfReachError, SimEnvironment
+from cbrs.sim.components import OutOfReachError, PlaceCrowdedError, SimEnvironment
 from cbrs.sim.world import open_world
 
 HOME, WORLD, SVC = PREFIXES["home"], PREFIXES["world"], PREFIXES["svc"]
@@ -144,4 +144,29 @@ def test_a_thing_declared_outside_the_map_is_not_in_the_world_and_the_store_is_k
         pytest.raises(UnresolvedDesignatorError, match="Book"),
     ):
         run_task(kb, "FetchMyBook", SimEnvironment(world, kb), composer=Composer(kb))
+    assert store(kb) == before
+
+
+PEN_HOLDER_UNDER_THE_CUP = PEN_HOLDER_OUT_OF_REACH.replace(
+    "home:minX 8.15 ; home:maxX 8.30 ; home:minY 3.50 ; home:maxY 3.65",
+    "home:minX 7.38 ; home:maxX 7.52 ; home:minY 3.25 ; home:maxY 3.39",  # around the cup, within reach
+)
+
+
+def test_a_place_the_arms_reach_but_another_object_fills_is_refused_naming_that_object(tmp_path: Path) -> None:
+    """The refusal said no arm reaches the place and to move it within reach, though an arm reaches it:
+    what leaves no spot is the cup standing on it."""
+    kb = knowledge(
+        tmp_path,
+        ("ontology", PEN_HOLDER_UNDER_THE_CUP),
+        ("map", PEN_HOLDER_UNDER_THE_CUP),
+        ("requirements", PUT_PEN_IN_HOLDER),
+    )
+    before = store(kb)
+    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world, pytest.raises(PlaceCrowdedError) as refused:
+        run_task(kb, "PutPenInHolder", SimEnvironment(world, kb), composer=Composer(kb))
+    assert [iri for iri, _, _ in refused.value.blockers] == [WORLD + "Cup"]
+    said = str(refused.value)
+    assert "the Cup at (7.4" in said and "leaves no room; move it in the map" in said  # where it is believed
+    assert "home:reach" not in said and "within reach" not in said
     assert store(kb) == before
