@@ -424,10 +424,11 @@ def _check_whole(conversion: Conversion, source: str) -> None:
 def _check_not_merged(store: Store, parsed: ParsedFile, held: Held) -> None:
     """Refuse an OWL-S file whose service the store describes otherwise, rather than merge the two
     descriptions: in the graph the file goes to (the same file again adds nothing, its nodes being named
-    from its content), or as a cbrs description in another graph, since queries read the union of the
-    graphs. A graph that holds only the OWL-S triples of the IRI (a request copy of the service, loaded
-    into graph:requirements as the requirement ``<IRI>-request``: OWLS-TC's query files are copies of
-    service files) describes another resource and does not stop the load (docs/owls.md)."""
+    from its content), or as a cbrs description in another graph (:func:`_describes`), since queries
+    read the union of the graphs. A graph that holds only the OWL-S triples of the IRI (a request copy
+    of the service, loaded into graph:requirements as the requirement ``<IRI>-request``: OWLS-TC's query
+    files are copies of service files) describes another resource and does not stop the load
+    (docs/owls.md)."""
     assert parsed.owls is not None
     rdf_type = ox.NamedNode(RDF + "type")
     for converted in parsed.owls.services:
@@ -447,13 +448,20 @@ def _check_not_merged(store: Store, parsed: ParsedFile, held: Held) -> None:
                 f"load would merge the two: {advice}",
             )
         for graph, kinds in sorted(types.items()):
-            if graph != parsed.graph and any(owls_key(kind) is None for kind in kinds):
+            if graph != parsed.graph and any(_describes(kind) for kind in kinds):
                 raise RdfParseError(
                     parsed.source,
                     f"<{converted.iri}> is described in {shorten(graph)} already, and queries read all graphs as "
                     f"one: loading it into {shorten(parsed.graph)} too would merge the two descriptions; "
                     f"cbrs deregister IRI first, or give the new one another IRI",
                 )
+
+
+def _describes(kind: str) -> bool:
+    """Whether a type makes its node a description (a component kind, cbrs:Requirement, a lab's class), as
+    an OWL-S class (``service:Service``) or OWL's and RDF's own (``owl:NamedIndividual``, which editors
+    add to every individual) do not."""
+    return owls_key(kind) is None and not kind.startswith((OWL, RDFS, RDF))
 
 
 def expand_paths(paths: Sequence[str | Path]) -> list[Path]:

@@ -63,6 +63,22 @@ def test_a_service_loads_after_its_request_copy_as_before_it(
         other.close()
 
 
+def test_an_owl_individual_type_on_the_copy_does_not_stop_the_service(kb: KnowledgeBase, tmp_path: Path) -> None:
+    """Ontology editors type every individual owl:NamedIndividual; on the request copy's service node that
+    is OWL's own type, not a description of it."""
+    query = _copy(tmp_path, "queries")
+    text = query.read_text(encoding="utf-8").replace(
+        '<service:Service rdf:ID="NavigateService">',
+        '<service:Service rdf:ID="NavigateService">\n    '
+        '<rdf:type rdf:resource="http://www.w3.org/2002/07/owl#NamedIndividual"/>',
+    )
+    assert "NamedIndividual" in text
+    query.write_text(text, encoding="utf-8")
+    kb.load([query], graph="requirements")
+    kb.load([_copy(tmp_path, "services")])
+    assert kb.description(SERVICE).iri == SERVICE
+
+
 def test_the_same_graph_described_otherwise_is_refused_naming_the_graph(kb: KnowledgeBase, tmp_path: Path) -> None:
     kb.load([_copy(tmp_path, "services")])
     before = triples_by_graph(kb)
