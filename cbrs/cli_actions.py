@@ -21,7 +21,7 @@ from cbrs.actions.faults import RandomFaults, planned_faults
 from cbrs.actions.graph import statement_text
 from cbrs.actions.plan import Binding, Plan
 from cbrs.actions.replanning import ReplanPolicy
-from cbrs.actions.runner import RunResult, run_task
+from cbrs.actions.runner import Replan, RunResult, run_task
 from cbrs.app import App, parse_iri, pass_app
 from cbrs.extras import require
 from cbrs.kb import KnowledgeBase, RemoteStoreError
@@ -390,11 +390,7 @@ def run_text(result: RunResult, sim_seconds: float, wall_seconds: float) -> str:
     report = result.report
     replaced = [
         f"plan {n} replaced after {sum(1 for s in r.report.steps if s.outcome == 'succeeded')} step(s): {r.reason}"
-        + (
-            f"; the next plan avoids {', '.join(map(shorten, r.avoided))} (failed, nothing changed)"
-            if r.avoided
-            else ""
-        )
+        + _avoided_text(r)
         for n, r in enumerate(result.replans, start=1)
     ]
     header = "\n".join(replaced) + ("\n" if replaced else "")
@@ -422,6 +418,20 @@ def run_text(result: RunResult, sim_seconds: float, wall_seconds: float) -> str:
     if not report.steps:  # every effect held already: no table of no steps
         steps = "nothing to do: every effect of the task holds already"
     return f"{header}{steps}\n{verdict}; {timing}{_unused_note(result.composition)}"
+
+
+def _avoided_text(replan: Replan) -> str:
+    """Which components the next plan goes without, and why: a component that failed, or one that gave
+    the failed step its inputs (it may have worked; what it gave may be what failed)."""
+    if not replan.avoided:
+        return ""
+    failed = {failure.component for failure in replan.failures}
+    own = [c for c in replan.avoided if c in failed]
+    producers = [c for c in replan.avoided if c not in failed]
+    parts = [f"{', '.join(map(shorten, own))} (failed, nothing changed)"] if own else []
+    if producers:
+        parts.append(f"{', '.join(map(shorten, producers))} (gave the failed step its inputs)")
+    return f"; the next plan avoids {' and '.join(parts)}"
 
 
 DEMO_RUNS = (

@@ -21,8 +21,9 @@ from cbrs.actions.components import Component, Registry, Status
 from cbrs.actions.plan import Plan, PlanStep
 from cbrs.actions.replanning import Failure, ReplanPolicy, ReplanPolicyError
 from cbrs.actions.runner import RunResult, run_task
+from cbrs.cli_actions import run_text
 from cbrs.kb import KnowledgeBase, Requirement, Statement
-from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.namespaces import PREFIXES, shorten
 from cbrs.kb.resources import ontology_dir
 
 EX = "http://example.org/replan#"
@@ -243,3 +244,7 @@ def test_when_no_plan_avoids_the_failed_step_the_next_avoids_what_it_was_given(t
     assert failure.component == EX + "Use" and set(failure.producers) == {EX + "Grasp", EX + "Locate"}
     assert result.replans[0].avoided == (EX + "Locate",)
     assert home.calls[EX + "Locate"] == 1 and home.calls[EX + "Use"] == 2
+    # said as what it was: Locate gave the failed step its input; it is not said to have failed
+    text = run_text(result, 0.0, 0.0)
+    assert f"avoids {shorten(EX + 'Locate')} (gave the failed step its inputs)" in text, text
+    assert "failed, nothing changed" not in text
