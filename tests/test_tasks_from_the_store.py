@@ -7,6 +7,7 @@ Loopback only; every wait is bounded.
 
 from __future__ import annotations
 
+import logging
 import threading
 from collections.abc import Iterator
 from pathlib import Path
@@ -137,3 +138,28 @@ def test_a_run_longer_than_the_wait_is_answered_running_not_failed(kb: Knowledge
         assert services.task_status({"run": answer["id"]})["status"] == "succeeded"
     finally:
         runner.close(RUN_WAIT)
+
+
+def test_a_refused_run_is_one_warning_not_a_traceback(
+    kb: KnowledgeBase, tmp_path: Path, caplog: pytest.LogCaptureFixture
+) -> None:
+    """A run refused on purpose (two pens: which to fetch?) ends with status error and the reason, logged
+    as one line; the server logged a full traceback at ERROR for it."""
+    second_pen = tmp_path / "second_pen.ttl"
+    second_pen.write_text(
+        "@prefix home: <https://w3id.org/cbrs/home#> . @prefix world: <https://w3id.org/cbrs/world#> .\n"
+        'world:Pen2 a home:Pen ; home:shapeKind "box" ; home:sizeX 0.14 ; home:sizeY 0.016 ; home:sizeZ 0.016 ;\n'
+        '    home:massKg 0.02 ; home:colourName "blue" ; home:rgba "0.10 0.20 0.85 1" ;\n'
+        "    home:isLocatedOn world:KitchenTable ; home:x 7.80 ; home:y 3.30 ; home:yaw 0.0 .\n",
+        encoding="utf-8",
+    )
+    kb.load([second_pen], graph="map")
+    runner = TaskRunner(kb, threading.RLock(), camera=None)
+    try:
+        with caplog.at_level(logging.INFO, logger="cbrs"):
+            run = runner.run("FetchMyPen", timeout=RUN_WAIT)
+    finally:
+        runner.close(RUN_WAIT)
+    assert run.status == "error" and run.error is not None and run.error.startswith("AmbiguousDesignatorError")
+    refused = [r for r in caplog.records if run.id in r.getMessage()]
+    assert refused and all(r.levelno == logging.WARNING and r.exc_info is None for r in refused)
