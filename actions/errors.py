@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from cbrs.kb import KnowledgeBaseError
+from cbrs.kb.namespaces import shorten
 from cbrs.reasoner.names import local_name
 
 
@@ -46,10 +47,17 @@ class UngroundedGoalError(ActionsError):
 
     http_status = 422
 
-    def __init__(self, goal: str, concept: str) -> None:
+    def __init__(self, goal: str, concept: str, elsewhere: Sequence[tuple[str, str]] = ()) -> None:
         self.goal = goal
         self.concept = concept
+        self.elsewhere = tuple(elsewhere)
+        """(thing, graph): things of the class the store states in graphs the world is not read from."""
+        remedy = (
+            "add an individual of that class to the semantic map (see docs/tasks.md), or correct the goal"
+            if not self.elsewhere
+            else "; ".join(f"{shorten(thing)} is one, but in {shorten(graph)}" for thing, graph in self.elsewhere)
+            + ", which the world is not read from: load its file with --graph map"
+        )
         super().__init__(
-            f"the goal {goal} is about a {local_name(concept)} ({concept}), and nothing in the world is one: add an"
-            " individual of that class to the semantic map (see docs/tasks.md), or correct the goal"
+            f"the goal {goal} is about a {local_name(concept)} ({concept}), and nothing in the world is one: {remedy}"
         )

@@ -323,7 +323,9 @@ def _check_grounded(kb: KnowledgeBase, index: TaxonomyIndex, plan: Plan) -> None
             continue
         for concept in (statement.subject, statement.object):
             if _missing(kb, index, placed, concept):
-                raise UngroundedGoalError(statement_text(statement), concept)
+                rows = kb.select("things_elsewhere", {"class": concept})
+                elsewhere = [(row["thing"].value, row["graph"].value) for row in rows]
+                raise UngroundedGoalError(statement_text(statement), concept, elsewhere)
 
 
 def _missing(kb: KnowledgeBase, index: TaxonomyIndex, placed: set[str], concept: str) -> bool:

@@ -135,6 +135,24 @@ def test_a_place_the_home_lacks_is_refused_whether_given_or_named_by_the_goal_al
     assert "nothing in the world is one" in str(goal)
 
 
+def test_a_thing_stated_outside_the_map_is_named_with_the_graph_it_is_in(tmp_path: Path) -> None:
+    """The rack's individual loaded without --graph went to the ontology graph: the refusal said only
+    that nothing in the world is a dish rack, and a new user looked for a typo."""
+    kb = knowledge(("ontology", "dish_rack.ttl"), ("requirements", "put_cup_in_dish_rack_goal_only.ttl"))
+    rack = tmp_path / "rack.ttl"
+    rack.write_text(
+        "@prefix home: <https://w3id.org/cbrs/home#> . @prefix world: <https://w3id.org/cbrs/world#> .\n"
+        "world:Rack1 a home:DishRack ; home:minX 7.2 ; home:maxX 7.4 ; home:minY 3.1 ; home:maxY 3.3 ;\n"
+        "    home:minZ 0.75 ; home:maxZ 0.75 .\n",
+        encoding="utf-8",
+    )
+    kb.load([rack], graph="ontology")
+    goal = refused(kb, "RackTheCup", UngroundedGoalError)
+    assert isinstance(goal, UngroundedGoalError)
+    assert goal.elsewhere == ((WORLD + "Rack1", "https://w3id.org/cbrs/graph/ontology"),)
+    assert "world:Rack1 is one, but in graph:ontology" in str(goal) and "--graph map" in str(goal)
+
+
 def test_only_a_class_of_a_kind_the_world_holds_must_have_a_thing_in_it() -> None:
     """A dish rack is a place, and the world holds places: none being a dish rack means one is missing.
     A door's status, an alarm or a text are of kinds the world holds no thing of: a goal or input
