@@ -127,5 +127,10 @@ def test_the_command(tmp_path: Path) -> None:
     count = "SELECT (COUNT(*) AS ?n) WHERE { GRAPH ?g { ?s ?p ?o } }"
     loaded = run("query", count, store=location)
     assert run("deregister", LAB + "A", store=location)[0] == 0
-    assert run("register", "--update", str(pair), store=location) == (0, f"registered {LAB}A\nupdated {LAB}B\n")
+    code, said = run("register", "--update", str(pair), store=location)
+    lines = said.splitlines()
+    assert code == 0 and lines[:2] == [f"registered {LAB}A", f"updated {LAB}B"]
+    # and the notes a load of the file prints (its made-up classes, its service without a process)
+    assert "unresolved parameter types (declared by no loaded ontology): 2" in lines[2]
+    assert any(line.startswith("conversion notes: ") and "has no process" in line for line in lines[3:])
     assert run("query", count, store=location) == loaded
