@@ -32,8 +32,8 @@ ex:a ex:q [ ex:r ex:s ; ex:t "one" ; ex:u 0.50 ] .
 
 @pytest.fixture
 def embedded_kb() -> Iterator[KnowledgeBase]:
-    """Only an embedded store writes what it lacks: a remote store's load writes every triple (asking the
-    server per triple would cost a request each), so the write-counting tests have no remote variant."""
+    """The write-counting tests watch the embedded store's writes; a remote store's load, which asks the
+    server in batches what it lacks, is tested in tests/test_kb16_remote_load.py."""
     kb = KnowledgeBase(Store.open(":memory:"))
     assert isinstance(kb.store, EmbeddedStore)
     yield kb
