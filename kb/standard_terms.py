@@ -301,7 +301,10 @@ class StandardTerms:
         new = {_quad(t) for q in added for t in alignment.triple(ox.Triple(q.subject, q.predicate, q.object))} - own
         nodes = {q.subject for q in removed}
         old = {_quad(t) for q in removed for t in alignment.triple(ox.Triple(q.subject, q.predicate, q.object))}
-        first = self._write({q for q in old if q.subject in nodes} - new - before, new)
+        # what another graph's statements still entail about those nodes stays (a service's request copy
+        # shares its OWL-S parameters: deregistering one copy took <#Goal> a process:Parameter from both)
+        kept = self._wanted(alignment, {n for n in nodes if isinstance(n, ox.NamedNode)}) if old else set()
+        first = self._write({q for q in old if q.subject in nodes} - new - before - kept, new)
         after = self._rule_conclusions(alignment) - own
         second = self._write(set(before) - after - new, after)
         return Refresh(first.added + second.added, first.removed + second.removed, -1)
