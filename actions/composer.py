@@ -73,7 +73,7 @@ class Objective(Enum):
 class ComposeConfig:
     objective: Objective = Objective.SIMILARITY
     default_cost: float = 1.0  # seconds, for components that advertise no response time
-    decompose: bool = True  # fall back to the task's sub-actions when the requirement alone fails
+    decompose: bool = True  # plan a task whose sub-actions are each stated as a requirement part by part
     # A step is one invocation, made per use; past this many steps, uses share an existing invocation
     # of the same component, so deep pools cannot make the plan grow exponentially.
     max_steps: int = 200
@@ -286,13 +286,16 @@ class Composer:
         holding = self._state if self._state is not None else []
         if self._achieved(task.requirement, holding):
             return self._result(task, _achieved_plan(task), (), (direct,))
+        # A task its author split into sub-actions, each stated as a requirement, is planned part by part:
+        # the author said how it decomposes (two cups, one after the other), which a direct plan may not
+        # follow (it credited both cups' goals to one put-down). Without a plan that way, directly.
+        result = self._decomposed(task, direct) if self._decomposable(task) else None
+        if result is not None and result.plan is not None:
+            return result
         if direct.plan is not None and _shared_goals(direct.plan, self.index):
             return self._per_goal(task, direct)
         if direct.plan is not None:
             return self._result(task, direct.plan, direct.unsatisfied, (direct,))
-        result = self._decomposed(task, direct) if self._decomposable(task) else None
-        if result is not None and result.plan is not None:
-            return result
         if self.config.matched:
             plan = self._matched(task)
             if plan is not None:

@@ -298,3 +298,12 @@ def test_two_things_in_one_task_are_moved_each_in_turn() -> None:
         (WORLD + "Pen", HOME + "isLocated", WORLD + "PenSpot1"),
     }
     assert moved <= facts(kb)
+
+
+def test_a_task_its_author_decomposed_is_planned_part_by_part_in_the_stated_order() -> None:
+    """A direct plan exists (goal by goal, the cup first), but the action class says the pen comes first,
+    each part a task of its own: that is the plan. The direct plan was returned and the parts ignored."""
+    kb = knowledge(("map", "two_things_places.ttl"), ("requirements", "tidy_pen_then_cup.ttl"))
+    plan = Composer(kb).compose("TidyPenThenCup").plan
+    assert plan is not None and plan.method == "decomposed"
+    assert plan.sub_actions == ("https://example.org/lab#PenToItsSpot", "https://example.org/lab#CupToItsSpot")
