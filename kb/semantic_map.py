@@ -18,6 +18,7 @@ from pyoxigraph import NamedNode
 
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.shapes import nearest_term
 
 if TYPE_CHECKING:
     from cbrs.kb.knowledge_base import KnowledgeBase
@@ -25,6 +26,7 @@ if TYPE_CHECKING:
 HOME = PREFIXES["home"]
 
 __all__ = [
+    "OVERLAP_TOLERANCE",
     "AmbiguousDesignatorError",
     "Arm",
     "Box",
@@ -40,6 +42,7 @@ __all__ = [
     "UnresolvedDesignatorError",
     "designate",
     "local_name",
+    "overlaps",
 ]
 
 
@@ -341,6 +344,8 @@ class SemanticMap:
         for iri, values in facts.items():
             for tap in values.get(HOME + "hasTap", []):
                 built.dispensers[iri] = _dispenser(built, iri, tap, facts)
+        _check_supports(built)
+        _check_overlaps(built)
         return built
 
 
@@ -348,7 +353,7 @@ def _number(values: dict[str, list[str]], name: str, iri: str, default: float | 
     raw = values.get(HOME + name)
     if not raw:
         if default is None:
-            raise MapError(iri, f"has no home:{name}")
+            raise _missing(values, name, iri)
         return default
     numbers = set()
     for text in raw:
@@ -361,11 +366,29 @@ def _number(values: dict[str, list[str]], name: str, iri: str, default: float | 
     return numbers.pop()
 
 
+def _missing(values: dict[str, list[str]], name: str, iri: str, why: str = "") -> MapError:
+    """A required property the thing lacks, with the property of its own it may be a slip of (home:colorName
+    for home:colourName): a misspelt property is declared nowhere, so the load took it silently."""
+    slip = nearest_term(HOME + name, [prop for prop in values if prop != HOME + name])
+    hint = f" (did you mean home:{name} for its home:{local_name(slip)} {values[slip][0]!r}?)" if slip else ""
+    return MapError(iri, f"has no home:{name}{why}{hint}")
+
+
 def _text(values: dict[str, list[str]], name: str, iri: str) -> str | None:
     raw = values.get(HOME + name)
     if raw and len(set(raw)) > 1:
         raise _two_values(iri, name, raw)
     return raw[0] if raw else None
+
+
+def _colour(values: dict[str, list[str]], iri: str, why: str) -> str:
+    """The thing's home:colourName; "" when it has none and no property of its own reads as a slip of it
+    (home:colorName), which is refused (``why`` it is needed). A thing with no colour at all is taken
+    as before: the simulation builds it, and perception says it cannot look for it when asked to."""
+    colour = _text(values, "colourName", iri)
+    if not colour and nearest_term(HOME + "colourName", [prop for prop in values if prop != HOME + "colourName"]):
+        raise _missing(values, "colourName", iri, f": {why}")
+    return colour or ""
 
 
 def _two_values(iri: str, name: str, raw: list[str]) -> MapError:
@@ -455,7 +478,7 @@ def _classify(
             shape,
             size,
             _number(values, "massKg", iri),
-            _text(values, "colourName", iri) or "",
+            _colour(values, iri, "perception finds an object by its colour"),
             _rgba(iri, values),
             Pose(_number(values, "x", iri), _number(values, "y", iri), _number(values, "yaw", iri, 0.0)),
             support,
@@ -466,7 +489,7 @@ def _classify(
         built.people[iri] = Person(
             iri,
             Pose(_number(values, "x", iri), _number(values, "y", iri), _number(values, "yaw", iri, 0.0)),
-            _text(values, "colourName", iri) or "",
+            _colour(values, iri, "the cameras find a person by the colour of their shirt"),
             _rgba(iri, values),
         )
         return
@@ -570,6 +593,99 @@ def _stated_twice(concept: str, name: str, stated: list[tuple[str, str, str]], i
         f"and {', '.join(local_name(cls) for cls in sorted(said)[1:])} are as near above {local_name(concept)} and "
         f"give home:{name} ({each}):{how}, on one class",
     )
+
+
+def _check_supports(built: SemanticMap) -> None:
+    """Each object's support (home:isLocatedOn) is a thing of the map with an extent, and the object's
+    centre is over it: the simulation stands the object on the support's top, and an unknown support
+    (a misspelt IRI) stood it on the floor, an object beyond its support's edge was moved onto it."""
+    for iri, obj in sorted(built.objects.items()):
+        if obj.support is None:
+            continue
+        support = built.things.get(obj.support)
+        if support is None:
+            known = obj.support in built.facts or obj.support in built.types
+            what = "has no extent (home:minX .. home:maxZ) to stand on" if known else "is nothing in the map"
+            near = nearest_term(obj.support, built.things)
+            hint = f" (did you mean {local_name(near)}, {near}?)" if near else ""
+            raise MapError(iri, f"has home:isLocatedOn {obj.support}, which {what}{hint}")
+        box = support.box
+        if not box.contains_xy(obj.start.x, obj.start.y):
+            raise MapError(
+                iri,
+                f"has home:x {obj.start.x:g}, home:y {obj.start.y:g}, not over its support {support.name} "
+                f"(home:isLocatedOn; x {box.min_x:g} .. {box.max_x:g}, y {box.min_y:g} .. {box.max_y:g}): "
+                "move it onto the support or name the support it is on",
+            )
+
+
+def _footprint(obj: MapObject) -> list[tuple[float, float]]:
+    """The corners of an object's footprint on its support (a cylinder's: the square around its circle,
+    turned by its yaw)."""
+    c, s = math.cos(obj.start.yaw), math.sin(obj.start.yaw)
+    hx, hy = obj.size[0] / 2, obj.size[1] / 2
+    return [
+        (obj.start.x + c * u - s * v, obj.start.y + s * u + c * v)
+        for u, v in ((-hx, -hy), (hx, -hy), (hx, hy), (-hx, hy))
+    ]
+
+
+def _overlap(a: MapObject, b: MapObject) -> float:
+    """How far two objects' footprints overlap (m; 0 or less: apart). Two cylinders by their circles,
+    anything else by separating axes of the turned rectangles."""
+    if a.shape == b.shape == "cylinder":
+        gap = math.hypot(a.start.x - b.start.x, a.start.y - b.start.y)
+        return min(a.size[:2]) / 2 + min(b.size[:2]) / 2 - gap
+    corners = (_footprint(a), _footprint(b))
+    depth = math.inf
+    for shape in corners:
+        for i in range(4):
+            (x0, y0), (x1, y1) = shape[i], shape[(i + 1) % 4]
+            axis = (y0 - y1, x1 - x0)
+            norm = math.hypot(*axis) or 1.0
+            spans = [[(x * axis[0] + y * axis[1]) / norm for x, y in points] for points in corners]
+            depth = min(depth, min(max(spans[0]), max(spans[1])) - max(min(spans[0]), min(spans[1])))
+    return depth
+
+
+OVERLAP_TOLERANCE = 0.002
+"""Two objects on one support whose footprints overlap by more than 2 mm touch where the map puts them:
+pybullet pushes them apart as the world settles (the simulation says so, ``sim.world``)."""
+
+
+def _inside(point: tuple[float, float], obj: MapObject) -> bool:
+    """Whether a point of the floor plan is within an object's footprint."""
+    dx, dy = point[0] - obj.start.x, point[1] - obj.start.y
+    if obj.shape == "cylinder":
+        return math.hypot(dx, dy) < min(obj.size[:2]) / 2
+    c, s = math.cos(obj.start.yaw), math.sin(obj.start.yaw)
+    return abs(c * dx + s * dy) < obj.size[0] / 2 and abs(-s * dx + c * dy) < obj.size[1] / 2
+
+
+def overlaps(built: SemanticMap) -> list[tuple[MapObject, MapObject, float]]:
+    """The pairs of objects on one support whose footprints overlap where the map puts them, and by how
+    much (m), by IRI."""
+    objects = sorted(built.objects.values(), key=lambda obj: obj.iri)
+    found = []
+    for i, a in enumerate(objects):
+        for b in objects[i + 1 :]:
+            if a.support is not None and a.support == b.support and (depth := _overlap(a, b)) > OVERLAP_TOLERANCE:
+                found.append((a, b, depth))
+    return found
+
+
+def _check_overlaps(built: SemanticMap) -> None:
+    """No object's centre is in another's footprint: such objects are one in the other, and settling
+    would throw them apart anywhere. A lesser overlap (a pencil's end against a cup) is left to the
+    simulation, which says what settling moved."""
+    for a, b, depth in overlaps(built):
+        if _inside((a.start.x, a.start.y), b) or _inside((b.start.x, b.start.y), a):
+            raise MapError(
+                a.iri,
+                f"at home:x {a.start.x:g}, home:y {a.start.y:g} is in {b.name} ({b.iri}) at home:x "
+                f"{b.start.x:g}, home:y {b.start.y:g} on {local_name(a.support or '')} (their footprints overlap by "
+                f"{depth * 100:.1f} cm): move one of them",
+            )
 
 
 def _dispenser(built: SemanticMap, iri: str, tap: str, facts: dict[str, dict[str, list[str]]]) -> Dispenser:

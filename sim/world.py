@@ -8,6 +8,8 @@ world and, since stepping is deterministic, the same outcome for the same calls.
 
 from __future__ import annotations
 
+import difflib
+import logging
 import math
 from collections.abc import Callable, Hashable, Iterator, Mapping
 from contextlib import contextmanager
@@ -19,7 +21,7 @@ import pybullet as p
 
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import Arm as ArmSpec
-from cbrs.kb.semantic_map import Box, Dispenser, MapObject, MobileRobot, SemanticMap, Thing
+from cbrs.kb.semantic_map import Box, Dispenser, MapError, MapObject, MobileRobot, SemanticMap, Thing, overlaps
 from cbrs.sim import layout as L
 from cbrs.sim.arms import PYBULLET_DATA, Arm, ArmDetail, ArmSide, Kinematics, panda_urdf
 from cbrs.sim.base import MobileBase
@@ -27,11 +29,17 @@ from cbrs.sim.cameras import Camera
 from cbrs.sim.errors import ImageSizeError, UnknownEntityError, WorldClosedError
 from cbrs.sim.geometry import Pose2D, Pose3D, Quat, Region, Vec3, quat_from_yaw
 from cbrs.sim.layout import CameraSpec
-from cbrs.sim.perception import MarkerModel
+from cbrs.sim.perception import COLOURS, MarkerModel
 from cbrs.sim.quiet import quiet_output
 from cbrs.sim.scene import bundled_map
 
-__all__ = ["TIME_STEP", "HomeWorld", "Perturbation", "Spread", "marker_model", "open_world"]
+__all__ = ["SETTLE_NOTICE", "TIME_STEP", "HomeWorld", "Perturbation", "Spread", "marker_model", "open_world"]
+
+log = logging.getLogger("cbrs.sim")
+SETTLE_NOTICE = 0.005
+"""An object that settling moves more than 5 mm across from where it was built (pushed by another it
+was built in, after the seed moved them together) is said so in the log and in ``HomeWorld.settled``:
+resting objects move less than 1 mm as they settle."""
 
 TIME_STEP = 1.0 / 240.0
 """Physics step (s): pybullet's default, at which the Panda's controllers and contacts are stable."""
@@ -165,6 +173,7 @@ class HomeWorld:
         self.arm_detail = ArmDetail(arm_detail)
         """The arms' visual meshes, for every camera and recording of this world (``ArmDetail``)."""
         self.map = semantic_map if semantic_map is not None else bundled_map()
+        _check_colours(self.map)
         self.image_sizes = _image_sizes(self.map, image_sizes or {})
         """Each camera's image width and height in pixels (``layout.DOWNWARD_IMAGE_SIZE`` and
         ``OTHER_IMAGE_SIZE`` unless ``image_sizes`` named the camera)."""
@@ -206,11 +215,42 @@ class HomeWorld:
             self._taps = [(d, self._bodies[d.name]) for d in self.dispensers]
             self._joints = self._moving_joints()
             self.base = MobileBase(client, self._bodies[self.base_name], self.step)
+            for a, b, depth in overlaps(self.map):
+                log.warning(
+                    "%s and %s overlap by %.1f cm where the semantic map puts them: settling pushes them apart",
+                    a.name,
+                    b.name,
+                    depth * 100,
+                )
+            built = {name: self.pose(name).position for name in self.objects}
             self.step(0.3)  # let the objects settle on the table
+            self.settled = self._settled(built)
         except BaseException:
             if self._kinematics is not None:
                 self._kinematics.close()
             raise
+
+    def _settled(self, built: Mapping[str, Vec3]) -> dict[str, tuple[Vec3, Vec3]]:
+        """The objects settling moved across by more than ``SETTLE_NOTICE``: name -> (where built, where
+        they came to rest), each said in the log."""
+        moved = {}
+        for name, start in sorted(built.items()):
+            rest = self.pose(name).position
+            shift = math.hypot(rest[0] - start[0], rest[1] - start[1])
+            if shift > SETTLE_NOTICE:
+                moved[name] = (start, rest)
+                log.warning(
+                    "%s was built at (%.3f, %.3f) and settling moved it %.1f cm to (%.3f, %.3f) (seed %d): it was "
+                    "built in another object or off balance",
+                    name,
+                    start[0],
+                    start[1],
+                    shift * 100,
+                    rest[0],
+                    rest[1],
+                    self.seed,
+                )
+        return moved
 
     # --- life cycle -----------------------------------------------------------------------------
 
@@ -669,10 +709,11 @@ class HomeWorld:
         dx, dy, dyaw = self.perturbation.objects.get(obj.name, (0.0, 0.0, 0.0))
         length, width, height = obj.size
         x, y = obj.start.x + dx, obj.start.y + dy
-        if support is not None:  # moved, it stays on what it stands on
+        if support is not None:  # moved by the seed, it stays on what it stands on; where the map puts it, it is
             edge = max(length, width) / 2.0
-            x = min(max(x, support.box.min_x + edge), support.box.max_x - edge)
-            y = min(max(y, support.box.min_y + edge), support.box.max_y - edge)
+            box = support.box
+            x = min(max(x, min(box.min_x + edge, obj.start.x)), max(box.max_x - edge, obj.start.x))
+            y = min(max(y, min(box.min_y + edge, obj.start.y)), max(box.max_y - edge, obj.start.y))
         if obj.shape == "cylinder":
             radius = min(length, width) / 2.0
             parts = [_cylinder(radius, height, (0, 0, 0), obj.rgba)]
@@ -828,6 +869,24 @@ class HomeWorld:
             ],
             (self.person.start.x + dx, self.person.start.y + dy, legs / 2),
         )
+
+
+def _check_colours(semantic_map: SemanticMap) -> None:
+    """Every colour name of the map's objects, people, markers and water is one perception can find
+    (``perception.COLOURS``): one it cannot was found only as the task looked for the thing, after the
+    base had driven off. A ``MapError`` names the thing, the property and the value."""
+    named: list[tuple[str, str, str]] = [(obj.iri, "colourName", obj.colour) for obj in semantic_map.objects.values()]
+    named += [(person.iri, "colourName", person.colour) for person in semantic_map.people.values()]
+    for iri, values in semantic_map.facts.items():
+        for name in ("colourName", "frontColourName", "rearColourName"):
+            named += [(iri, name, colour) for colour in values.get(HOME + name, [])]
+    for iri, name, colour in sorted(set(named)):
+        if colour and colour not in COLOURS:  # none at all: the thing is not looked for
+            near = difflib.get_close_matches(colour.lower(), list(COLOURS), n=1, cutoff=0.6)
+            hint = f" (did you mean {near[0]!r}?)" if near else ""
+            raise MapError(
+                iri, f"has home:{name} {colour!r}, a colour perception cannot find{hint}; known: {', '.join(COLOURS)}"
+            )
 
 
 def marker_model(robot: MobileRobot) -> MarkerModel:
