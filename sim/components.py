@@ -41,7 +41,7 @@ from cbrs.sim import skills
 from cbrs.sim.arms import GRIPPER_OPEN, ArmSide
 from cbrs.sim.errors import GraspMisfitError, SimulationError
 from cbrs.sim.geometry import Pose2D, Region, Vec3
-from cbrs.sim.grasping import GraspKind, GraspPose, ObjectModel, compute_grasp_pose
+from cbrs.sim.grasping import PREGRASP_DISTANCE, GraspKind, GraspPose, ObjectModel, compute_grasp_pose
 from cbrs.sim.mapping import OccupancyGrid, build_occupancy_grid
 from cbrs.sim.perceived import SEARCH_RADIUS, PerceivedWorld
 from cbrs.sim.perception import (
@@ -1337,12 +1337,27 @@ class SimEnvironment:
             hand = arm.ee_pose().position
             if math.hypot(hand[0] - x, hand[1] - y) > SETTLE_DISTANCE:
                 continue  # not back over where it was taken: better held than dropped elsewhere
-            skills.put_down_object(self.world, side, spot)
-            if arm.held is not None:  # lowering it failed: let go just above the surface it came from
+            put = skills.put_down_object(self.world, side, spot)
+            if arm.held is not None:  # lowering it failed: lower it into the hand's pose of the taking instead
+                taken = arm.move_to(grasp.position, grasp.orientation, speed=skills.PLACE_SPEED, symmetric=False)
                 arm.detach()
                 arm.set_gripper(GRIPPER_OPEN)
+                # back off along the approach before folding: folded from beside it, the arm swept a
+                # side-grasped bottle over and 34 cm away (nu16 repro 18)
+                let_go = arm.ee_pose()
+                (px, py, pz), (ax, ay, az) = let_go.position, grasp.approach
+                back = (px - ax * PREGRASP_DISTANCE, py - ay * PREGRASP_DISTANCE, pz - az * PREGRASP_DISTANCE)
+                arm.move_to(back, let_go.orientation, speed=skills.PLACE_SPEED, symmetric=False)
                 self.world.step(skills.SETTLE_TIME)
                 arm.home()
+                log.warning(
+                    "settling before a re-plan: putting the %s down failed (%s); %s, let go and backed off",
+                    grasp.model.name,
+                    put.reason,
+                    "lowered it where it was taken"
+                    if taken.reached
+                    else f"lowering it where it was taken failed too ({taken.reason})",
+                )
 
     def perceive(self) -> None:
         """Look at everything with every working camera (before a plan, and before a re-plan)."""
