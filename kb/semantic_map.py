@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING
 from pyoxigraph import NamedNode
 
 from cbrs.kb.errors import KnowledgeBaseError
-from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.namespaces import PREFIXES, shorten
 from cbrs.kb.shapes import nearest_term
 
 if TYPE_CHECKING:
@@ -78,9 +78,11 @@ class AmbiguousDesignatorError(KnowledgeBaseError):
         self.concept = concept
         self.candidates = candidates
         names = ", ".join(local_name(c) for c in candidates)
+        kind = local_name(concept)
+        example = f"{shorten(candidates[0])} a lab:My{kind} . lab:My{kind} rdfs:subClassOf {shorten(concept)}"
         super().__init__(
-            f"{local_name(concept)} is ambiguous: {names} are all {local_name(concept)}s; name the individual "
-            "in the task or make the input's class more specific"
+            f"{kind} is ambiguous: {names} are all {kind}s; give the one the task means a class of its own in "
+            f"the map ({example}) and name that class in the task (its input's cbrs:parameterType and its goals)"
         )
 
 

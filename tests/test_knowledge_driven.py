@@ -114,6 +114,23 @@ def test_a_robots_preference_follows_its_things_not_its_numbers() -> None:
     assert designate(kb, HOME + "ColourMarker", prefer=PREFIXES["svc"] + "P3DX01")  # its own marker, as before
 
 
+def test_the_ambiguity_advice_can_be_followed_a_class_of_its_own_names_one_thing() -> None:
+    """The refusal said to "name the individual in the task", which a task cannot (an input names a
+    class); it now says to give the thing a class of its own, and that class designates it."""
+    kb = KnowledgeBase.open(":memory:")
+    kb.update("INSERT DATA { GRAPH graph:map { world:Pen2 a home:Pen ; home:x 7.9 ; home:y 3.4 } }")
+    with pytest.raises(AmbiguousDesignatorError) as ambiguous:
+        designate(kb, HOME + "Pen")
+    said = str(ambiguous.value)
+    assert "world:Pen a lab:MyPen . lab:MyPen rdfs:subClassOf home:Pen" in said and "cbrs:parameterType" in said
+    lab = "https://example.org/lab#"
+    kb.update(
+        f"INSERT DATA {{ GRAPH graph:map {{ <{lab}MyPen> a owl:Class ; rdfs:subClassOf home:Pen . "
+        f"world:Pen2 a <{lab}MyPen> }} }}"
+    )
+    assert designate(kb, lab + "MyPen") == WORLD + "Pen2"
+
+
 def test_a_task_whose_input_has_no_thing_in_the_world_says_which(tmp_path: Path) -> None:
     kb = KnowledgeBase.open(":memory:")
     task = (TASKS / "fetch_my_pencil.ttl").read_text(encoding="utf-8")
