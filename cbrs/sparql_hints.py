@@ -56,7 +56,15 @@ def operation_kind(text: str) -> Literal["query", "update"] | None:
 
 def undeclared_prefix(text: str) -> str | None:
     """The first prefix ``text`` uses that neither its own ``PREFIX`` lines nor cbrs's table declare."""
-    declared = set(PREFIXES)
+    found = undeclared_prefixes(text)
+    return found[0] if found else None
+
+
+def undeclared_prefixes(text: str) -> list[str]:
+    """Every prefix ``text`` uses that neither its own ``PREFIX`` lines nor cbrs's table declare, in the
+    order they are first used."""
+    declared: set[str] = set()
+    used: list[str] = []
     previous = ""
     for match in TOKENS.finditer(text):
         name = match.group("pname")
@@ -66,10 +74,10 @@ def undeclared_prefix(text: str) -> str | None:
                 declared.add(prefix)
             elif text[match.start() - 1 : match.start()] == "<":  # an IRI the lexer could not read whole
                 pass  # (<http://x/has a space>): its scheme is no prefix
-            elif prefix not in declared and prefix != "_":  # _: names a blank node
-                return prefix
+            elif prefix not in PREFIXES and prefix != "_" and prefix not in used:  # _: names a blank node
+                used.append(prefix)
         previous = (match.group("word") or "").upper()
-    return None
+    return [prefix for prefix in used if prefix not in declared]
 
 
 def explain_syntax_error(error: QuerySyntaxError, text: str, expected: Literal["query", "update"]) -> QuerySyntaxError:

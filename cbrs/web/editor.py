@@ -14,8 +14,7 @@ from typing import Any
 from flask import Blueprint, Response, current_app, request, url_for
 
 from cbrs.kb.errors import KnowledgeBaseError, QuerySyntaxError, UnknownQueryError
-from cbrs.kb.namespaces import PREFIXES
-from cbrs.sparql_hints import TOKENS
+from cbrs.sparql_hints import undeclared_prefixes
 from cbrs.sparql_service import BOM, Answer
 from cbrs.web import context
 from cbrs.web.pages import FormError, Page, page, wants_json
@@ -108,19 +107,7 @@ def with_store_prefixes(text: str) -> tuple[str, dict[str, str]]:
     ``books:Novel``, and a query may name it so, although the endpoint knows only cbrs's own prefixes.
     The namespaces come from the store's IRIs, which hold no ``>`` or space."""
     text = text.removeprefix(BOM)
-    declared_here: set[str] = set()
-    used: list[str] = []
-    previous = ""
-    for match in TOKENS.finditer(text):
-        name = match.group("pname")
-        if name is not None:
-            prefix = name.partition(":")[0]
-            if previous == "PREFIX":
-                declared_here.add(prefix)
-            elif prefix not in PREFIXES and prefix not in used:
-                used.append(prefix)
-        previous = (match.group("word") or "").upper()
-    wanted = [prefix for prefix in used if prefix not in declared_here]
+    wanted = undeclared_prefixes(text)
     table = derived() if wanted else {}  # read only for a query that may use one
     added = {prefix: table[prefix] for prefix in wanted if prefix in table}
     lines = "".join(f"PREFIX {prefix}: <{namespace}>\n" for prefix, namespace in added.items())
