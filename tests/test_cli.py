@@ -394,14 +394,7 @@ def test_every_listed_task_name_resolves(lab_store: str) -> None:
 def test_a_refused_run_with_json_prints_json(tmp_path: Path) -> None:
     """A script that asks for JSON gets a JSON document for a run refused before anything moved (two
     pens in the map: which one to fetch?), as for one that ran; it got nothing on stdout."""
-    second_pen = tmp_path / "second_pen.ttl"
-    second_pen.write_text(
-        "@prefix home: <https://w3id.org/cbrs/home#> . @prefix world: <https://w3id.org/cbrs/world#> .\n"
-        'world:Pen2 a home:Pen ; home:shapeKind "box" ; home:sizeX 0.14 ; home:sizeY 0.016 ; home:sizeZ 0.016 ;\n'
-        '    home:massKg 0.02 ; home:colourName "blue" ; home:rgba "0.10 0.20 0.85 1" ;\n'
-        "    home:isLocatedOn world:KitchenTable ; home:x 7.80 ; home:y 3.30 ; home:yaw 0.0 .\n",
-        encoding="utf-8",
-    )
+    second_pen = Path(__file__).parent / "data" / "second_pen.ttl"
     location = str(tmp_path / "store")
     assert run("load", "--graph", "map", str(second_pen), store=location)[0] == 0
     result = CliRunner().invoke(cli, ["--store", location, "run", "FetchMyPen", "--json"])

@@ -140,19 +140,10 @@ def test_a_run_longer_than_the_wait_is_answered_running_not_failed(kb: Knowledge
         runner.close(RUN_WAIT)
 
 
-def test_a_refused_run_is_one_warning_not_a_traceback(
-    kb: KnowledgeBase, tmp_path: Path, caplog: pytest.LogCaptureFixture
-) -> None:
+def test_a_refused_run_is_one_warning_not_a_traceback(kb: KnowledgeBase, caplog: pytest.LogCaptureFixture) -> None:
     """A run refused on purpose (two pens: which to fetch?) ends with status error and the reason, logged
     as one line; the server logged a full traceback at ERROR for it."""
-    second_pen = tmp_path / "second_pen.ttl"
-    second_pen.write_text(
-        "@prefix home: <https://w3id.org/cbrs/home#> . @prefix world: <https://w3id.org/cbrs/world#> .\n"
-        'world:Pen2 a home:Pen ; home:shapeKind "box" ; home:sizeX 0.14 ; home:sizeY 0.016 ; home:sizeZ 0.016 ;\n'
-        '    home:massKg 0.02 ; home:colourName "blue" ; home:rgba "0.10 0.20 0.85 1" ;\n'
-        "    home:isLocatedOn world:KitchenTable ; home:x 7.80 ; home:y 3.30 ; home:yaw 0.0 .\n",
-        encoding="utf-8",
-    )
+    second_pen = Path(__file__).parent / "data" / "second_pen.ttl"
     kb.load([second_pen], graph="map")
     runner = TaskRunner(kb, threading.RLock(), camera=None)
     try:
