@@ -158,6 +158,7 @@ class Unsatisfied:
             "cycle": self.cycle,
             "text": self.text(),
             "remedy": self.remedy(),
+            "unrunnable": [{"component": component, "why": why} for component, why in self.unrunnable],
         }
 
 
@@ -292,8 +293,8 @@ class Composer:
         result = self._decomposed(task, direct) if self._decomposable(task) else None
         if result is not None and result.plan is not None:
             return result
-        if direct.plan is not None and _shared_goals(direct.plan, self.index):
-            return self._per_goal(task, direct)
+        if direct.plan is not None and not task.requirement.outputs and _shared_goals(direct.plan, self.index):
+            return self._per_goal(task, direct)  # (outputs are no goal's: a task asking for one stays whole)
         if direct.plan is not None:
             return self._result(task, direct.plan, direct.unsatisfied, (direct,))
         if self.config.matched:

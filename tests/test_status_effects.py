@@ -208,3 +208,4 @@ def test_a_component_nothing_here_can_run_is_named_when_no_plan_is_left(tmp_path
     assert unsatisfied.unrunnable and unsatisfied.unrunnable[0][0] == MOTOR
     assert "OpenDoor_DoorMotor05 was planned for it but cannot run here" in unsatisfied.text()
     assert "no skill for its service name 'OpenDoor'" in unsatisfied.text()
+    assert [entry["component"] for entry in unsatisfied.to_dict()["unrunnable"]] == [MOTOR]
