@@ -36,6 +36,7 @@ __all__ = [
     "MapObject",
     "Marker",
     "MobileRobot",
+    "NotGraspableError",
     "Person",
     "Pose",
     "SemanticMap",
@@ -54,6 +55,20 @@ class MapError(KnowledgeBaseError):
     def __init__(self, thing: str, problem: str) -> None:
         self.thing = thing
         super().__init__(f"semantic map: {local_name(thing)} ({thing}) {problem}")
+
+
+class NotGraspableError(MapError):
+    """An object a task has an arm handle has no grasp knowledge: no class above it states how to grasp it.
+    An object nothing handles may lack it (a bowl on a shelf): the map is read, and only a task that
+    would take it is refused."""
+
+    def __init__(self, thing: str, types: tuple[str, ...]) -> None:
+        kinds = ", ".join(local_name(t) for t in types) or "thing of no class"
+        super().__init__(
+            thing,
+            f"is a {kinds} and no class above it says how to grasp it: give one home:graspApproach and "
+            "home:graspHeightRatio",
+        )
 
 
 class UnresolvedDesignatorError(KnowledgeBaseError):
@@ -144,7 +159,8 @@ class MapObject:
     start: Pose
     support: str | None
     grasp_approaches: tuple[str, ...]
-    """The approaches its class allows ("top", "side"), in the class's order of preference."""
+    """The approaches its class allows ("top", "side"), in the class's order of preference; none when no
+    class above it states them (it cannot be taken: :class:`NotGraspableError` when a task would)."""
     grasp_height: float
 
     @property
@@ -154,6 +170,8 @@ class MapObject:
     @property
     def grasp_approach(self) -> str:
         """The approach its class prefers."""
+        if not self.grasp_approaches:
+            raise NotGraspableError(self.iri, self.types)
         return self.grasp_approaches[0]
 
 
@@ -463,13 +481,7 @@ def _classify(
         shape = _text(values, "shapeKind", iri) or ""
         if shape not in ("box", "cylinder"):
             raise MapError(iri, f'has home:shapeKind {shape!r}; use "box" or "cylinder"')
-        concept = next((t for t in types if t in affordances), None)
-        if concept is None:
-            raise MapError(
-                iri,
-                f"is a {', '.join(local_name(t) for t in types) or 'thing of no class'} and no class above it says how "
-                "to grasp it: give one home:graspApproach and home:graspHeightRatio",
-            )
+        concept = next((t for t in types if t in affordances), None)  # None: it cannot be taken (a decoration)
         size = (_number(values, "sizeX", iri), _number(values, "sizeY", iri), _number(values, "sizeZ", iri))
         if min(size) <= 0:
             raise MapError(iri, f"has a size of {size}; every size must be positive")
@@ -484,7 +496,7 @@ def _classify(
             _rgba(iri, values),
             Pose(_number(values, "x", iri), _number(values, "y", iri), _number(values, "yaw", iri, 0.0)),
             support,
-            *_grasp(concept, affordances[concept], size[2]),
+            *(_grasp(concept, affordances[concept], size[2]) if concept is not None else ((), 0.0)),
         )
         return
     if person:  # a home:Person by the taxonomy

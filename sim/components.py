@@ -33,7 +33,7 @@ from cbrs.kb import KnowledgeBase, Requirement, Statement
 from cbrs.kb.errors import KnowledgeBaseError, NotFoundError
 from cbrs.kb.model import Advertisement
 from cbrs.kb.namespaces import PREFIXES
-from cbrs.kb.semantic_map import SemanticMap, Thing, designate, local_name
+from cbrs.kb.semantic_map import NotGraspableError, SemanticMap, Thing, designate, local_name
 from cbrs.kb.vocab import CBRS
 from cbrs.settings import setting
 from cbrs.sim import predicates as pred
@@ -1434,6 +1434,9 @@ class SimEnvironment:
             given = [values.get(name) for name in sorted(_given_to(step, steps))]
             iris = [str(value["@id"]) for value in given if isinstance(value, dict) and "@id" in value]
             objects = [iri for iri in iris if iri in smap.objects]
+            for iri in objects:  # an arm would take it: its class must say how (a decoration need not)
+                if not smap.objects[iri].grasp_approaches:
+                    raise NotGraspableError(iri, smap.objects[iri].types)
             if objects:
                 at_hand[step.device or ""] = objects
             for iri in iris:

@@ -13,7 +13,7 @@ from enum import StrEnum
 
 import numpy as np
 
-from cbrs.kb.semantic_map import MapObject
+from cbrs.kb.semantic_map import MapObject, NotGraspableError
 from cbrs.sim.errors import GraspTooDeepError, GraspTooWideError
 from cbrs.sim.geometry import Quat, Vec3, quat_from_matrix
 
@@ -118,6 +118,8 @@ class ObjectModel:
         comes; a box keeps its footprint, its width across the jaws being the grasp's to compute, and
         states as its width its narrower side (the most its jaws close to, as its top grasp does)."""
         kinds = tuple(GraspKind(approach) for approach in obj.grasp_approaches)
+        if not kinds:
+            raise NotGraspableError(obj.iri, obj.types)
         box = obj.shape != "cylinder"
         return cls(
             obj.name,

@@ -79,8 +79,10 @@ def test_a_book_added_without_a_grasp_says_what_to_add() -> None:
         "home:sizeY 0.15 ; home:sizeZ 0.03 ; home:massKg 0.4 ; home:x 8.2 ; home:y 4.0 ; "
         "home:isLocatedOn world:KitchenTable } }"
     )
+    ungraspable = SemanticMap.read(kb).objects[WORLD + "Book1"]  # read: what nothing takes may lack a grasp
+    assert ungraspable.grasp_approaches == ()
     with pytest.raises(MapError, match="graspApproach") as refused:
-        SemanticMap.read(kb)
+        _ = ungraspable.grasp_approach
     assert refused.value.thing == WORLD + "Book1"
     affordance = "home:graspApproach 'top' ; home:graspHeightRatio 0.5"
     kb.update(f"INSERT DATA {{ GRAPH graph:ontology {{ <{HOME}Book> {affordance} }} }}")

@@ -13,7 +13,7 @@ from cbrs.actions.composer import Composer, PlanStatus
 from cbrs.actions.runner import run_task
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
-from cbrs.kb.semantic_map import SemanticMap, UnresolvedDesignatorError
+from cbrs.kb.semantic_map import NotGraspableError, SemanticMap, UnresolvedDesignatorError
 from cbrs.sim.components import OutOfReachError, PlaceCrowdedError, SimEnvironment
 from cbrs.sim.world import open_world
 
@@ -169,4 +169,36 @@ def test_a_place_the_arms_reach_but_another_object_fills_is_refused_naming_that_
     said = str(refused.value)
     assert "the Cup at (7.4" in said and "leaves no room; move it in the map" in said  # where it is believed
     assert "home:reach" not in said and "within reach" not in said
+    assert store(kb) == before
+
+
+BOWL_AND_BOOK_WITHOUT_GRASPS = (
+    TTL
+    + """world:Bowl9 a home:Bowl ; home:shapeKind "cylinder" ; home:sizeX 0.14 ; home:sizeY 0.14 ; home:sizeZ 0.06 ;
+    home:massKg 0.3 ; home:colourName "magenta" ; home:rgba "0.8 0.1 0.8 1" ;
+    home:isLocatedOn world:KitchenTable ; home:x 8.30 ; home:y 4.20 .
+world:Book1 a home:Book ; home:shapeKind "box" ; home:sizeX 0.2 ; home:sizeY 0.14 ; home:sizeZ 0.03 ;
+    home:massKg 0.4 ; home:colourName "cyan" ; home:rgba "0.1 0.8 0.8 1" ;
+    home:isLocatedOn world:KitchenTable ; home:x 7.70 ; home:y 3.30 .
+"""
+)
+
+
+def test_an_object_without_a_grasp_stops_only_the_task_that_would_take_it(tmp_path: Path) -> None:
+    """A bowl no class says how to grasp blocked every task, FetchMyPen too, when the map was read; now the
+    map is read, FetchMyPen plans, and only fetching the book without a grasp is refused, before anything
+    moves, with what to add."""
+    kb = knowledge(tmp_path, ("map", BOWL_AND_BOOK_WITHOUT_GRASPS), ("requirements", fetch("Book", "FetchMyBook")))
+    smap = SemanticMap.read(kb)
+    assert smap.objects[WORLD + "Bowl9"].grasp_approaches == ()
+    assert Composer(kb).compose("FetchMyPen").plan is not None
+    before = store(kb)
+    with open_world(seed=0, semantic_map=smap) as world, pytest.raises(NotGraspableError) as refused:
+        start = world.base_pose()
+        try:
+            run_task(kb, "FetchMyBook", SimEnvironment(world, kb), composer=Composer(kb))
+        finally:
+            assert world.base_pose().distance_to(start.x, start.y) < 0.01  # refused before the base moved
+    assert refused.value.thing == WORLD + "Book1"
+    assert "home:graspApproach and home:graspHeightRatio" in str(refused.value)
     assert store(kb) == before
