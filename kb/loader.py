@@ -220,6 +220,8 @@ def load_files(
         imported = _resolve_imports(store, raws, catalogue, report)
     held = _prepare(store, raws, imported, report, graph)
     new = _new_quads(held, report)
+    if getattr(store, "rewrites_held", False):  # its reads may lag its writes: write every quad, as a load did
+        new = list(dict.fromkeys(quad for item in (*report.files, *report.imports) for quad in item.quads))
     if new:  # a reload of what the store holds writes nothing (and leaves an embedded store's generation)
         store.add(new)
     return report

@@ -131,8 +131,11 @@ def test_a_reload_writes_nothing_and_asks_per_chunk(
     sent = _requests(kb.store, monkeypatch)
     adds = _adds(kb.store, monkeypatch)
     again = load_files(kb.store, files, catalogue=Catalogue.open(ONTOLOGY))
-    assert adds == []
-    assert [url for url, _, _ in sent if url != kb.store.endpoints.query] == []  # no update at all
+    if kb.store.rewrites_held:  # Virtuoso: every quad written again (a read may lag a drop), counted as held
+        assert [len(added) for added in adds] == [again.quads]
+    else:
+        assert adds == []
+        assert [url for url, _, _ in sent if url != kb.store.endpoints.query] == []  # no update at all
     checks = [body for _, body, _ in sent if "VALUES (?i ?s ?p ?o)" in unquote_plus(body)]
     assert 1 <= len(checks) <= 3  # one per graph the files write (graph:services, graph:ontology)
     assert len(sent) < 30 < again.quads  # not a request per triple
@@ -147,7 +150,11 @@ def test_a_partly_held_file_writes_only_its_new_triple(
     kb.load([_write(tmp_path, "three.ttl", THREE)])
     adds = _adds(kb.store, monkeypatch)
     report = kb.load([_write(tmp_path, "overlap.ttl", OVERLAP)])
-    assert adds == [[ox.Quad(_node("g"), _node("p"), _node("h"), SERVICES)]]
+    new = ox.Quad(_node("g"), _node("p"), _node("h"), SERVICES)
+    if kb.store.rewrites_held:  # Virtuoso: the whole file written (a read may lag a drop); counted the same
+        assert len(adds) == 1 and new in adds[0] and len(adds[0]) == report.quads
+    else:
+        assert adds == [[new]]
     assert report.added == {SERVICES.value: 1}
     assert report.files[0].added == {SERVICES.value: 1}
 
