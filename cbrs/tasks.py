@@ -349,11 +349,11 @@ class TaskRunner:
                 run.status = "cancelled"
             else:
                 run.status = "succeeded" if result.succeeded else "failed"
-        except KnowledgeBaseError as error:  # refused on purpose (out of reach, ambiguous): one line, no trace
-            log.warning("task run %s refused: %s", run.id, error)
-            run.status, run.error = "error", f"{type(error).__name__}: {error}"
         except Exception as error:  # a run must end with a status, whatever broke
-            log.exception("task run %s failed", run.id)
+            if isinstance(error, KnowledgeBaseError):  # refused on purpose (out of reach, ambiguous): one line
+                log.warning("task run %s refused: %s", run.id, error)
+            else:
+                log.exception("task run %s failed", run.id)
             run.status, run.error = "error", f"{type(error).__name__}: {error}"
         finally:
             run.finished = time.time()
