@@ -258,19 +258,29 @@ def test_the_named_queries_answer_as_on_the_embedded_store(server: str) -> None:
         "namespace": "https://w3id.org/cbrs/world#",
     }
     virtuoso = "/sparql" in server
-    differing = []
+    differing: dict[str, str] = {}
     for name in embedded.queries.names():
         parameters = embedded.queries.get(name).parameters
         for bound in [{}] if not parameters else [{p: values.get(p, LOCATE)} for p in parameters]:
+            expected = _rows(embedded, name, bound)
             try:
-                same = _rows(remote, name, bound) == _rows(embedded, name, bound)
-            except StoreError:
-                same = False
-            if not same:
-                differing.append(name)
+                found: list[tuple[str, ...]] | str = _rows(remote, name, bound)
+            except StoreError as error:
+                found = str(error)
+            if found != expected:
+                differing[name] = _difference(expected, found)
     allowed = set(VIRTUOSO_DEVIATIONS) if virtuoso else set()
-    assert set(differing) <= allowed, differing
+    unexpected = {name: why for name, why in differing.items() if name not in allowed}
+    assert not unexpected, unexpected
     remote.close()
+
+
+def _difference(expected: list[tuple[str, ...]], found: list[tuple[str, ...]] | str) -> str:
+    """What a remote answer lacks and adds, or the error it gave: what a failure must show to be diagnosed."""
+    if isinstance(found, str):
+        return f"error: {found}"
+    lacks, adds = sorted(set(expected) - set(found)), sorted(set(found) - set(expected))
+    return f"{len(found)} rows for {len(expected)}; lacks {lacks[:5]}; adds {adds[:5]}"
 
 
 def _rows(kb: KnowledgeBase, name: str, values: dict[str, str]) -> list[tuple[str, ...]]:
