@@ -42,6 +42,7 @@ from cbrs.reasoner.config import MatchConfig
 from cbrs.reasoner.degrees import Degree, degree_of_match
 from cbrs.reasoner.methods import REFINED, Method, make_method
 from cbrs.reasoner.names import local_name
+from cbrs.reasoner.sea import uncovered
 from cbrs.reasoner.similarity import SemStr, Similarity
 from cbrs.reasoner.spans import PairMatch, SpanMatch, conceptual_span_similarity, span
 from cbrs.reasoner.statements import StatementMatch, best_statement_matches, contradiction_factor, reported, undoes
@@ -659,16 +660,7 @@ class Matchmaker:
 
     def filters(self, requirement: Requirement, offered: EffectiveArea | None, qos: tuple[QoSValue, ...]) -> list[str]:
         """Why an advertisement with this SEA and QoS fails the requirement's filters (empty: it passes)."""
-        reasons = []
-        wanted = requirement.area
-        if wanted and offered:
-            if wanted.bounds and offered.bounds:
-                if not _within(wanted.bounds, offered.bounds):
-                    reasons.append(f"SEA: effective area {offered.bounds} does not cover {wanted.bounds}")
-            elif wanted.areas and offered.areas:
-                for area in wanted.areas:
-                    if not any(self._covers(place, area) for place in offered.areas):
-                        reasons.append(f"SEA: {_short(area)} is outside {', '.join(map(_short, offered.areas))}")
+        reasons = uncovered(self.index, requirement.area, offered)
         offered_qos = {q.metric: q.value for q in qos}
         for bound in requirement.qos:
             value = offered_qos.get(bound.metric)
@@ -682,12 +674,6 @@ class Matchmaker:
             elif bound.better_when == "higher" and value < bound.value:
                 reasons.append(f"QoS: {name} {value:g} < {bound.value:g}")
         return reasons
-
-    def _covers(self, place: str, area: str) -> bool:
-        """``place`` covers ``area`` when it is the same, a superclass, or a whole it is part of."""
-        if place == area:
-            return True
-        return area in self.index and place in self.index and self.index.distance_down(area, place) is not None
 
 
 class _Ranking(Sequence[Candidate]):
@@ -759,16 +745,6 @@ def _mix(score: FloatArray, text: FloatArray, weight: float) -> FloatArray:
     import numpy as np
 
     return np.round((1 - weight) * score + weight * text, 6).astype(np.float64)
-
-
-def _within(inner: tuple[float, float, float, float], outer: tuple[float, float, float, float]) -> bool:
-    eps = 1e-9
-    return (
-        inner[0] >= outer[0] - eps
-        and inner[1] <= outer[1] + eps
-        and inner[2] >= outer[2] - eps
-        and inner[3] <= outer[3] + eps
-    )
 
 
 def _statement_text(statement: Statement) -> str:
