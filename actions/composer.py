@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING, Any
 import networkx as nx
 import pyoxigraph as ox
 
+from cbrs.actions.areas import AreaRule, locate
 from cbrs.actions.errors import OrderingConflictError
 from cbrs.actions.graph import (
     SRE,
@@ -80,6 +81,8 @@ class ComposeConfig:
     match: MatchConfig = field(default_factory=MatchConfig)
     world_state: bool = True  # preconditions may be met by what holds in the map and belief graphs
     matched: bool = True  # when nothing composes, one advertisement the matchmaker accepts for the whole requirement
+    # a step's component must be effective where the task's things it handles are (SEA; actions.areas)
+    respect_area: bool = True
 
 
 class PlanStatus(Enum):
@@ -98,9 +101,12 @@ class Unsatisfied:
     undeclared: tuple[str, ...] = ()  # classes the need names that the ontology does not have
     near: tuple[tuple[str, str], ...] = ()  # (undeclared class, the declared class its name is closest to)
     unrunnable: tuple[tuple[str, str], ...] = ()  # (component, why): planned for it, but cannot run here
+    out_of_area: tuple[tuple[str, str], ...] = ()  # (component, why): provides it, but not where it is needed
 
     def text(self) -> str:
         found = self._text()
+        for component, why in self.out_of_area:
+            found += f"; {shorten(component)} was passed over: {why}"
         for component, why in self.unrunnable:
             found += f"; {shorten(component)} was planned for it but cannot run here: {why}"
         return found
@@ -115,6 +121,8 @@ class Unsatisfied:
             return f"only a cycle of components provides {need} of {consumer}{via}"
         if self.consumer == SRI:  # the task gives it: nothing to provide, but its class is unknown
             return f"the requirement gives {need}; {self.remedy()}"
+        if self.out_of_area:
+            return f"no component effective where it is needed provides {need} of {consumer}{via}; {self.remedy()}"
         return f"no component provides {need} of {consumer}{via}; {self.remedy()}"
 
     def remedy(self) -> str:
@@ -134,6 +142,11 @@ class Unsatisfied:
         return self._remedy()
 
     def _remedy(self) -> str:
+        if self.out_of_area:
+            return (
+                "register a component that provides it whose effective area (cbrs:hasSEAModel) covers the things "
+                "named, or compose without the area rule (ComposeConfig.respect_area)"
+            )
         if self.consumer == SRI:
             return "correct the input's cbrs:parameterType"
         if self.consumer == GOAL:  # the task states nothing to plan towards
@@ -159,6 +172,7 @@ class Unsatisfied:
             "text": self.text(),
             "remedy": self.remedy(),
             "unrunnable": [{"component": component, "why": why} for component, why in self.unrunnable],
+            "out_of_area": [{"component": component, "why": why} for component, why in self.out_of_area],
         }
 
 
@@ -329,7 +343,10 @@ class Composer:
             if any(p.role != "output" or p.requested not in top_level for p in failed) or (failed and not parts):
                 continue
             plan = self._single_step(task, requirement, ad, candidate.pairs, candidate.score)
-            if plan is not None:
+            if plan is None:
+                continue
+            areas = self.area_rule(requirement)  # the matchmaker's filter compared its area with the task's only
+            if areas is None or areas.why_not(ad, {b.source.name for b in plan.steps[0].inputs}) is None:
                 return plan
         return None
 
@@ -428,12 +445,22 @@ class Composer:
     def attempt(self, requirement: Requirement, task: Task | None = None) -> Attempt:
         graph = self.graph(requirement)
         trace = bidirectional_search(graph)
-        extraction = _Extraction(graph, trace, self.config.objective, self.config.max_steps)
+        areas = self.area_rule(requirement)
+        extraction = _Extraction(graph, trace, self.config.objective, self.config.max_steps, areas)
         if not extraction.solved:
             return Attempt(requirement, graph, trace, None, tuple(extraction.unsatisfied))
         orderings = self._orderings(task)
         plan = extraction.plan(task.name if task else requirement.iri, self.index, orderings)
         return Attempt(requirement, graph, trace, plan, ())
+
+    def area_rule(self, requirement: Requirement) -> AreaRule | None:
+        """The SEA rule for ``requirement``'s steps: where its things are (the belief's positions when
+        composing for a run), and its own area; None when it is off or can refuse none of the components."""
+        if not self.config.respect_area:
+            return None
+        places = locate(self.kb, requirement, parameter_names(requirement.inputs), self._belief)
+        rule = AreaRule(self.index, places, requirement.area)
+        return rule if rule.relevant(self.advertisements) else None
 
     def _orderings(self, task: Task | None) -> list[tuple[str, str, str]]:
         if task is None or task.action is None:
@@ -462,8 +489,11 @@ class Composer:
                 plan, unsatisfied = nested.plan, nested.unsatisfied or unsatisfied
             if plan is None:
                 unsatisfied = direct.unsatisfied + tuple(
-                    Unsatisfied(
-                        u.need, u.consumer, (f"sub-action {shorten(sub)}", *u.chain[1:], shorten(u.consumer)), u.cycle
+                    replace(
+                        u,
+                        chain=(f"sub-action {shorten(sub)}", *u.chain[1:], shorten(u.consumer)),
+                        undeclared=(),
+                        near=(),
                     )
                     for u in unsatisfied
                 )
@@ -499,7 +529,7 @@ class Composer:
             attempts.append(attempt)
             if attempt.plan is None:
                 unsatisfied = tuple(
-                    Unsatisfied(u.need, u.consumer, (f"goal {n} {statement_text(goal)}", *u.chain[1:]), u.cycle)
+                    replace(u, chain=(f"goal {n} {statement_text(goal)}", *u.chain[1:]), undeclared=(), near=())
                     for u in attempt.unsatisfied
                 )
                 return self._result(task, None, unsatisfied, tuple(attempts))
@@ -589,14 +619,33 @@ class _Step:
     about: tuple[str, ...] = ()  # the classes of the statements this step serves, down from the goal
 
 
+@dataclass(frozen=True)
+class _Judged:
+    """What a component would handle as a new step (requirement input names), and why it cannot (None: it can)."""
+
+    things: frozenset[str]
+    why: str | None
+    blocked: Need | None = None  # the need none of whose providers can serve (else its own area is the why)
+
+
 class _Extraction:
     """Backward extraction of one plan from a searched SRG."""
 
-    def __init__(self, graph: ServiceResourceGraph, trace: SearchTrace, objective: Objective, max_steps: int) -> None:
+    def __init__(
+        self,
+        graph: ServiceResourceGraph,
+        trace: SearchTrace,
+        objective: Objective,
+        max_steps: int,
+        areas: AreaRule | None = None,
+    ) -> None:
         self.graph = graph
         self.trace = trace
         self.objective = objective
         self.max_steps = max_steps
+        self.areas = areas
+        self._judged: dict[tuple[str, tuple[str, ...]], _Judged] = {}  # see _judge
+        self._things: dict[int, frozenset[str]] = {}  # see _handled
         self._explained: set[str] = set()  # vertices whose blocked needs _why has followed
         self._best: dict[tuple[str, str], dict[str, Edge]] = {}  # see _best_from
         self.steps: dict[int, _Step] = {}
@@ -620,6 +669,8 @@ class _Extraction:
                         self.unsatisfied.append(cause)
             return
         self._expand()
+        if self.areas is not None and not self.unsatisfied:
+            self._check_areas()
 
     @property
     def solved(self) -> bool:
@@ -724,15 +775,23 @@ class _Extraction:
                 if sibling is not None:
                     step.bindings.append(sibling)
                     continue
-                best = min((e for e in options if e.source != SRI), key=self._key)
+                served = (need.statement.subject, need.statement.object) if need.statement is not None else ()
+                about = (*served, *step.about)
+                candidates = [e for e in options if e.source != SRI]
+                if self.areas is not None:
+                    fit = [e for e in candidates if self._judge(e.source, about).why is None]
+                    if not fit:
+                        self._pass_over(step, node, need, candidates, about)
+                        continue
+                    candidates = fit
+                best = min(candidates, key=self._key)
                 if len(self.steps) > self.max_steps:
                     existing = next((other for other in self.steps.values() if other.node == best.source), None)
                     if existing is not None:
                         step.bindings.append(_Bound(need, best, existing.id))
                         continue
                 producer = self._new(best.source, step.id)
-                served = (need.statement.subject, need.statement.object) if need.statement is not None else ()
-                producer.about = (*served, *step.about)
+                producer.about = about
                 step.producers.append(producer.id)
                 step.bindings.append(_Bound(need, best, producer.id))
                 queue.append(producer.id)
@@ -781,6 +840,111 @@ class _Extraction:
                 if edge.source == other.node and edge.offer.role == "output":
                     found.append(((-edge.similarity, other.id, edge.offer.name), _Bound(need, edge, other.id)))
         return min(found, key=lambda item: item[0])[1] if found else None
+
+    # -- service effective areas (actions.areas) --------------------------------------------------
+
+    def _judge(self, vertex: str, about: tuple[str, ...]) -> _Judged:
+        """What ``vertex`` would handle as a new step serving ``about``, by the extraction's own preferences
+        (a value the task gives first, else the best provider that fits), and why it cannot serve (its
+        area, or none of a need's providers fits): a component is passed over before it is chosen."""
+        key = (vertex, about)
+        found = self._judged.get(key)
+        if found is not None:
+            return found
+        assert self.areas is not None
+        probe = _Step(-1, vertex, None, about=about)
+        things: set[str] = set()
+        why: str | None = None
+        blocked: Need | None = None
+        for need in self.graph.needs(vertex):
+            options = self._options(vertex, need, self._level(vertex))
+            given = [e for e in options if e.source == SRI]
+            if given and len(given) < len(options):
+                given = [e for e in given if not self._foreign(probe, e)]
+            if given:
+                if need.role == "input":
+                    things.add(min(given, key=lambda e: (self._aboutness(probe, e), *self._key(e))).offer.name)
+                continue
+            served = (need.statement.subject, need.statement.object) if need.statement is not None else ()
+            below = (*served, *about)
+            fit = [e for e in options if e.source != SRI and self._judge(e.source, below).why is None]
+            if not fit:
+                why, blocked = f"no provider of its {need.text()} is effective where it is needed", need
+                break
+            if need.role == "input":
+                things |= self._judge(min(fit, key=self._key).source, below).things
+        if why is None:
+            why = self.areas.why_not(self.graph.vertices[vertex].advertisement, things)
+        judged = self._judged[key] = _Judged(frozenset(things), why, blocked)
+        return judged
+
+    def _pass_over(self, step: _Step, node: str, need: Need, candidates: list[Edge], about: tuple[str, ...]) -> None:
+        """``need`` of ``step`` has providers, none of which can serve: an unmet need naming each and why.
+        While every one fails only for want of a provider of its own, the best is followed down (as ``_why``
+        does), so the report names the components whose areas do not cover the things."""
+        chain = self._path(step, need)
+        while True:
+            judged = {e.source: self._judge(e.source, about) for e in sorted(candidates, key=self._key)}
+            best = next(iter(judged))
+            lower = judged[best].blocked
+            if lower is None or any(j.blocked is None for j in judged.values()):
+                break
+            served = (lower.statement.subject, lower.statement.object) if lower.statement is not None else ()
+            node, need, about = best, lower, (*served, *about)
+            candidates = [e for e in self._options(node, need, self._level(node)) if e.source != SRI]
+            chain = (*chain, shorten(node))
+        passed = tuple(sorted((iri, j.why or "") for iri, j in judged.items()))
+        self.unsatisfied.append(Unsatisfied(need.text(), node, chain, out_of_area=passed))
+
+    def _check_areas(self) -> None:
+        """Refuse the plan if a step's component is not effective where the things it handles are: the
+        choice predicted them, and a step given an existing step's value may handle others."""
+        assert self.areas is not None
+        for step in sorted(self.steps.values(), key=lambda s: s.id):
+            if step.made_for is None:
+                continue
+            why = self.areas.why_not(self.graph.vertices[step.node].advertisement, self._handled(step.id))
+            if why is None:
+                continue
+            consumer = self.steps[step.made_for]
+            bound = next(b for b in consumer.bindings if b.source == step.id)
+            node = self._goal_node(bound.need) if consumer.node == GOAL else consumer.node
+            chain = self._path(consumer, bound.need)
+            self.unsatisfied.append(Unsatisfied(bound.need.text(), node, chain, out_of_area=((step.node, why),)))
+
+    def _handled(self, step_id: int) -> frozenset[str]:
+        """The requirement inputs whose things ``step_id`` handles: those it is given, directly or through
+        the steps that feed its inputs (on a stack of its own: a plan can be thousands of steps deep)."""
+        stack = [step_id]
+        while stack:
+            current = stack[-1]
+            if current in self._things:
+                stack.pop()
+                continue
+            inputs = [b for b in self.steps[current].bindings if b.need.role == "input"]
+            missing = [b.source for b in inputs if b.source is not None and b.source not in self._things]
+            if missing:
+                stack += missing
+                continue
+            found: set[str] = set()
+            for b in inputs:
+                found |= {b.edge.offer.name} if b.source is None else self._things[b.source]
+            self._things[current] = frozenset(found)
+            stack.pop()
+        return self._things[step_id]
+
+    def _path(self, step: _Step, need: Need) -> tuple[str, ...]:
+        """The chain from the requirement's goal down to ``need`` of ``step``, as ``_why`` reports one."""
+        below: list[str] = []
+        current = step
+        while current.made_for is not None:
+            below.append(shorten(current.node))
+            parent = self.steps[current.made_for]
+            if parent.node == GOAL:
+                goal = next(b.need for b in parent.bindings if b.source == current.id)
+                return (_goal_text(goal), *reversed(below))
+            current = parent
+        return (_goal_text(need),)  # ``step`` is the goal: ``need`` is the requirement's
 
     # -- from the extraction to a Plan -----------------------------------------------------------
 
@@ -956,10 +1120,13 @@ class _Extraction:
             for consumer, need in served
         ]
         found: list[tuple[tuple[Any, ...], str]] = []
+        handled = self._handled(step.id) if self.areas is not None else frozenset()
         for iri in self.trace.levels:
             vertex = self.graph.vertices[iri]
             if iri == step.node or vertex.advertisement is None:
                 continue
+            if self.areas is not None and self.areas.why_not(vertex.advertisement, handled) is not None:
+                continue  # it would get the same values, for things it is not effective where they are
             feeds = []
             for best in into:
                 edge = best.get(iri)
@@ -994,6 +1161,11 @@ class _Extraction:
 
     def _goal_node(self, need: Need) -> str:
         return SRO if need.role == "input" else SRE
+
+
+def _goal_text(need: Need) -> str:
+    """A need of SRO or SRE as the requirement's goal: its output or effect."""
+    return "the requirement's " + need.text().replace("precondition", "effect", 1).replace("input", "output", 1)
 
 
 def _is_a(index: TaxonomyIndex, concept: str, ancestor: str) -> bool:
