@@ -21,6 +21,7 @@ from cbrs.kb.namespaces import PREFIXES, shorten
 from cbrs.kb.shapes import nearest_term
 
 if TYPE_CHECKING:
+    from cbrs.kb.hands import Hand
     from cbrs.kb.knowledge_base import KnowledgeBase
 
 HOME = PREFIXES["home"]
@@ -294,6 +295,8 @@ class SemanticMap:
     bodies: frozenset[str] = frozenset()
     """Robots with an extent of their own (a torso standing on the floor), by the taxonomy (home:Robot)."""
     dispensers: dict[str, Dispenser] = field(default_factory=dict)
+    hands: dict[str, Hand] = field(default_factory=dict)
+    """Each arm's hand, by the arm's IRI (:func:`kb.hands.read_hands`)."""
 
     def extent(self) -> Box:
         """The box around every room: the home's floor."""
@@ -348,8 +351,11 @@ class SemanticMap:
         def things_of(concept: str) -> frozenset[str]:
             return frozenset(row["thing"].value for row in kb.select("designate", {"class": HOME + concept}))
 
+        from cbrs.kb.hands import read_hands  # kb.hands builds on this module's MapError
+
         people = things_of("Person")
         built = cls(
+            hands=read_hands(kb),
             types={k: tuple(v) for k, v in types.items()},
             facts={k: dict(v) for k, v in facts.items()},
             containers=things_of("Container"),

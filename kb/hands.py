@@ -1,0 +1,188 @@
+"""A robot's hands: the gripper at the end of each arm, as the semantic map describes it.
+
+KnowRob style, a hand is a part of its arm in the store (``home:hasGripper``), and what the grasp planner
+needs of it is stated on it: how far its jaws open, how far its palm sits above the grasp point, how long
+its fingers are (its geometry, required of a gripper the map names), and how it is used (its policy: the
+side grasp's tilt and least hold, the pre-grasp distance; each a default here unless the store states
+one, and then the store's). The named query ``robot_hands`` reads them; an arm the map gives no gripper
+has :data:`PANDA_HAND`, the hand of the simulated arms (docs/simulation.md, "The hand").
+"""
+
+from __future__ import annotations
+
+import math
+from collections import defaultdict
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from pyoxigraph import Literal
+
+from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.semantic_map import MapError, local_name
+from cbrs.kb.shapes import nearest_term
+
+if TYPE_CHECKING:
+    from cbrs.kb.knowledge_base import KnowledgeBase
+
+__all__ = [
+    "PANDA_HAND",
+    "PREGRASP_DISTANCE",
+    "SIDE_HOLD",
+    "SIDE_PITCH",
+    "Hand",
+    "HandError",
+    "read_hands",
+]
+
+HOME = PREFIXES["home"]
+
+SIDE_HOLD = 0.5
+"""The least fraction of an object's depth along a side grasp's approach that must lie between the
+fingers, its near face pushed against the palm (:attr:`Hand.side_span`). At a half its centre of mass lies
+within the fingertips; a box deeper than twice what the fingers span along the approach is refused. The
+default of ``home:sideHoldFraction``: raise it for a firmer hold, lower it to allow deeper boxes."""
+
+SIDE_PITCH = math.radians(35.0)
+"""A side grasp comes in tilted down by 35 degrees: with the arms mounted below the grasp height, a level
+hand would need the wrist at its joint limit, while a tilted one keeps it mid-range. The default of
+``home:sideGraspPitch`` (radians)."""
+
+PREGRASP_DISTANCE = 0.10
+"""The pre-grasp pose is this far back along the approach direction (m): far enough that opening the
+fingers there touches nothing, near enough that the final approach is a short straight move. The default
+of ``home:pregraspDistance``."""
+
+
+@dataclass(frozen=True)
+class Hand:
+    """What the grasp planner knows of a two-finger hand (metres, radians)."""
+
+    jaw_opening: float
+    """How far apart the open jaws are: an object wider than this across them, for the way the hand is
+    turned to it, cannot be grasped so."""
+    palm_depth: float
+    """How far the palm is above the grasp point (between the fingertips), the hand pointing down: an
+    object whose top is higher above the grasp point than that cannot be taken from the top."""
+    finger_length: float
+    """How long the fingers are from the palm to their tips, along the hand's axis: what of an object can
+    lie between them."""
+    side_hold: float = SIDE_HOLD
+    side_pitch: float = SIDE_PITCH
+    pregrasp_distance: float = PREGRASP_DISTANCE
+    iri: str = ""
+    """The gripper in the store; empty for a hand the store does not describe."""
+
+    @property
+    def side_span(self) -> float:
+        """How much of an object along a side grasp's horizontal approach the fingers span: tilted down by
+        ``side_pitch``, ``finger_length * cos(side_pitch)`` of it (3.8 cm for the Panda's)."""
+        return self.finger_length * math.cos(self.side_pitch)
+
+
+PANDA_HAND = Hand(jaw_opening=0.08, palm_depth=0.034, finger_length=0.046)
+"""The Franka Panda's hand, the hand of every simulated arm (pybullet_data's ``franka_panda/panda.urdf``):
+the hand of an arm the store gives no ``home:hasGripper``. ``ontologies/world.ttl`` states the same values
+on the bundled robot's hands, with where each comes from; tests/test_grasp16_depth.py measures them again
+from the URDF."""
+
+_PROPERTIES = ("jawOpening", "palmDepth", "fingerLength", "sideHoldFraction", "sideGraspPitch", "pregraspDistance")
+"""The store's properties (local names in the home namespace) of :class:`Hand`'s values, in its order."""
+_GEOMETRY = ("jawOpening", "palmDepth", "fingerLength")
+"""What a gripper the map names must state: there is no other hand's geometry to assume for it."""
+
+
+class HandError(MapError):
+    """A gripper's description lacks or contradicts what the grasp planner needs: names the gripper, its
+    arm and robot, the property and the value (None when missing)."""
+
+    def __init__(self, hand: str, arm: str, robot: str, prop: str, value: str | None, problem: str) -> None:
+        self.hand, self.arm, self.robot, self.property, self.value = hand, arm, robot, prop, value
+        whose = f"the gripper of {local_name(arm)}" + (f" of {local_name(robot)}" if robot else "")
+        said = f"has no home:{prop}" if value is None else f"has home:{prop} {value!r}"
+        super().__init__(hand, f"({whose}) {said}: {problem}")
+
+
+def _limits(name: str, number: float) -> str:
+    """Why ``number`` cannot be the ``name`` of a hand (empty if it can)."""
+    if not math.isfinite(number):
+        return "write a finite number"
+    if name == "sideHoldFraction":
+        return "" if 0.0 < number <= 1.0 else "a fraction of the object's depth, more than 0 and at most 1"
+    if name == "sideGraspPitch":
+        return "" if 0.0 <= number < math.pi / 2.0 else "radians down from level, at least 0 and below pi/2"
+    return "" if number > 0.0 else "a length in metres, more than 0"
+
+
+def _hand(hand: str, arm: str, robot: str, stated: dict[str, list[str]]) -> Hand:
+    """The :class:`Hand` of what the store states of ``hand`` (property IRI -> values)."""
+    values: dict[str, float] = {}
+    for name in _PROPERTIES:
+        raw = sorted(set(stated.get(HOME + name, [])))
+        if not raw:
+            if name in _GEOMETRY:
+                raise HandError(hand, arm, robot, name, None, f"a gripper states its geometry{_slip(name, stated)}")
+            continue
+        if len(raw) > 1:
+            raise HandError(hand, arm, robot, name, " and ".join(raw), "one value is needed")
+        try:
+            number = float(raw[0])
+        except ValueError:
+            raise HandError(hand, arm, robot, name, raw[0], "not a number") from None
+        problem = _limits(name, number)
+        if problem:
+            raise HandError(hand, arm, robot, name, raw[0], problem)
+        values[name] = number
+    if values["palmDepth"] >= values["fingerLength"]:
+        raise HandError(
+            hand,
+            arm,
+            robot,
+            "palmDepth",
+            f"{values['palmDepth']:g}",
+            f"the grasp point is between the fingertips, so the palm is nearer to it than the fingers are long "
+            f"(home:fingerLength {values['fingerLength']:g})",
+        )
+    return Hand(
+        values["jawOpening"],
+        values["palmDepth"],
+        values["fingerLength"],
+        values.get("sideHoldFraction", SIDE_HOLD),
+        values.get("sideGraspPitch", SIDE_PITCH),
+        values.get("pregraspDistance", PREGRASP_DISTANCE),
+        hand,
+    )
+
+
+def _slip(name: str, stated: dict[str, list[str]]) -> str:
+    """A did-you-mean for a missing ``name``: the gripper's own property it may be a misspelling of
+    (home:jawOpenning), which the load took silently, being declared nowhere."""
+    known = {HOME + other for other in _PROPERTIES}
+    slip = nearest_term(HOME + name, [prop for prop in stated if prop not in known])
+    return f" (did you mean home:{name} for its home:{local_name(slip)} {stated[slip][0]!r}?)" if slip else ""
+
+
+def read_hands(kb: KnowledgeBase, robot: str | None = None) -> dict[str, Hand]:
+    """Each arm's hand (by arm IRI) that the semantic map gives ``robot`` (every robot by default), by the
+    named query ``robot_hands``: an arm with no ``home:hasGripper`` has :data:`PANDA_HAND`.
+    :class:`HandError` for a gripper missing its geometry or stating a value no hand can have."""
+    arms: dict[str, tuple[str, set[str]]] = {}
+    stated: dict[str, dict[str, list[str]]] = defaultdict(lambda: defaultdict(list))
+    for row in kb.select("robot_hands", {"robot": robot} if robot is not None else None):
+        arm = row["arm"].value
+        owner, grippers = arms.setdefault(arm, (row["robot"].value, set()))
+        if "hand" in row:
+            grippers.add(row["hand"].value)
+            if "property" in row:
+                value = row["value"]
+                shown = value.value if isinstance(value, Literal) else f"<{value.value}>"
+                stated[row["hand"].value][row["property"].value].append(shown)
+    hands = {}
+    for arm, (owner, grippers) in sorted(arms.items()):
+        if len(grippers) > 1:
+            raise HandError(arm, arm, owner, "hasGripper", " and ".join(sorted(grippers)), "an arm ends in one gripper")
+        if not grippers:
+            hands[arm] = PANDA_HAND
+            continue
+        hand = grippers.pop()
+        hands[arm] = _hand(hand, arm, owner, stated.get(hand, {}))
+    return hands
