@@ -20,8 +20,9 @@ import numpy as np
 import pybullet as p
 from numpy.typing import NDArray
 
+from cbrs.kb.hands import PANDA_HAND, Hand
 from cbrs.sim.geometry import Pose3D, Quat, Region, Vec3, quat_from_matrix, quat_to_matrix
-from cbrs.sim.grasping import JAW_OPENING, GraspPose
+from cbrs.sim.grasping import GraspPose
 from cbrs.sim.quiet import quiet_output
 
 __all__ = [
@@ -114,8 +115,6 @@ REACH_TOLERANCE = 0.01
 """A motion has reached its target when the grasp point is within 1 cm of it."""
 SETTLE_LIMIT = 1.0
 """At most this many simulated seconds of settling after the last piece."""
-GRIPPER_OPEN = JAW_OPENING
-"""The fingers' widest opening (m): the grasp planner's (:data:`sim.grasping.JAW_OPENING`)."""
 COLLISION_MARGIN = 0.01
 """Joint-space moves keep the arm's links 1 cm clear of the torso, the table, the dispenser, the
 Kinect and the other arm."""
@@ -378,14 +377,26 @@ class Kinematics:
 
 
 class Arm:
-    """One Panda arm of the dual-arm robot, bound to its world's pybullet client."""
+    """One Panda arm of the dual-arm robot, bound to its world's pybullet client, ending in ``hand`` (what
+    the store says of its gripper, :class:`kb.hands.Hand`: the grasp planner's; its fingers open as far as
+    the hand's jaws, at most as far as the URDF's finger joints allow)."""
 
     def __init__(
-        self, client: int, side: ArmSide, body: int, kinematics: Kinematics, step: Callable[[float], None]
+        self,
+        client: int,
+        side: ArmSide,
+        body: int,
+        kinematics: Kinematics,
+        step: Callable[[float], None],
+        hand: Hand = PANDA_HAND,
     ) -> None:
         self.client = client
         self.side = side
         self.body = body
+        self.hand = hand
+        limits = sum(p.getJointInfo(body, joint, physicsClientId=client)[9] for joint in FINGER_JOINTS)
+        self.open_width = min(hand.jaw_opening, limits)
+        """How far apart the fingers open (m): the hand's jaw opening, within the fingers' joint limits."""
         self._kinematics = kinematics
         self._step = step
         self._grasp_constraint: int | None = None
@@ -397,13 +408,13 @@ class Arm:
         """The last object let go and where its centre was by the hand's pose then (proprioception: the
         arm knows where it put a thing down without seeing it)."""
         self._targets: tuple[float, ...] = HOME_CONFIGURATIONS[side]
-        self._gripper_width = GRIPPER_OPEN
+        self._gripper_width = self.open_width
         self.peers: dict[ArmSide, Arm] = {}
         """Both arms of the robot (set by the world), for collision checks against the other arm."""
         for joint, q in zip(ARM_JOINTS, self._targets, strict=True):
             p.resetJointState(body, joint, q, physicsClientId=client)
         for joint in FINGER_JOINTS:
-            p.resetJointState(body, joint, GRIPPER_OPEN / 2.0, physicsClientId=client)
+            p.resetJointState(body, joint, self.open_width / 2.0, physicsClientId=client)
         self._command()
 
     # --- state --------------------------------------------------------------------------------
@@ -568,10 +579,14 @@ class Arm:
         return self.move_joints(home)
 
     def set_gripper(self, width: float, seconds: float = 0.3) -> None:
-        """Open the fingers to ``width`` (m, 0 to 0.08) and give them time to move."""
-        self._gripper_width = min(max(width, 0.0), GRIPPER_OPEN)
+        """Open the fingers to ``width`` (m, 0 to :attr:`open_width`) and give them time to move."""
+        self._gripper_width = min(max(width, 0.0), self.open_width)
         self._command()
         self._step(seconds)
+
+    def open_gripper(self, seconds: float = 0.3) -> None:
+        """Open the fingers as far as they go (:attr:`open_width`)."""
+        self.set_gripper(self.open_width, seconds)
 
     # --- grasping -----------------------------------------------------------------------------
 

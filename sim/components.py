@@ -38,10 +38,10 @@ from cbrs.kb.vocab import CBRS
 from cbrs.settings import setting
 from cbrs.sim import predicates as pred
 from cbrs.sim import skills
-from cbrs.sim.arms import GRIPPER_OPEN, ArmSide
+from cbrs.sim.arms import ArmSide
 from cbrs.sim.errors import GraspMisfitError, SimulationError
 from cbrs.sim.geometry import Pose2D, Region, Vec3
-from cbrs.sim.grasping import PREGRASP_DISTANCE, GraspKind, GraspPose, ObjectModel, compute_grasp_pose
+from cbrs.sim.grasping import GraspKind, GraspPose, ObjectModel, compute_grasp_pose
 from cbrs.sim.mapping import OccupancyGrid, build_occupancy_grid
 from cbrs.sim.perceived import SEARCH_RADIUS, PerceivedWorld
 from cbrs.sim.perception import (
@@ -419,7 +419,10 @@ def approach(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[st
         choice = _taking(ctx, estimate, model, ctx.arm)
         _note(ctx, choice)
         model = choice.model
-    ctx.grasp = compute_grasp_pose(model, estimate.position, estimate.yaw, spec.mount, spec.yaw, _extent(estimate))
+    hand = ctx.world.arm(ctx.arm).hand
+    ctx.grasp = compute_grasp_pose(
+        model, estimate.position, estimate.yaw, spec.mount, spec.yaw, _extent(estimate), hand
+    )
     ctx.seen, ctx.focus = estimate, model.name
     ctx.last_arm = ctx.arm
     _check(skills.approach_object(ctx.world, ctx.arm, ctx.grasp))
@@ -587,7 +590,10 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
         )
         # The taker takes it anew: by an approach it can set it down over the spot by (the first, with
         # one approach: whether it can is its carry's to find, as before).
-        checks = [skills.can_grip, lambda held: skills.can_set_down(world, taken, taker, held, target)]
+        checks = [
+            lambda held: skills.can_grip(held, world.arm(taker).hand),
+            lambda held: skills.can_set_down(world, taken, taker, held, target),
+        ]
         placing = _Candidates.of(model, *(checks if len(model.preference) > 1 else []))
         if not placing.models:
             raise SkillFailed(f"the {taker.value} arm reaches {place.name}, but {placing.refusal()}")
@@ -599,7 +605,7 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
             placing.choice(taker, taken_by, f"carrying the {model.name} to {place.name}", "no spot to take it by it"),
         )
         grasp = compute_grasp_pose(
-            taken_by, found.position, found.yaw, taker_spec.mount, taker_spec.yaw, _extent(found)
+            taken_by, found.position, found.yaw, taker_spec.mount, taker_spec.yaw, _extent(found), world.arm(taker).hand
         )
         for move in (skills.approach_object, skills.pick_up_object):
             _passing(move(world, taker, grasp), model, giver, taker)
@@ -759,7 +765,8 @@ def _who_loads(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, ba
     # the loader, or, when one arm reaches both but no approach serves it all the way, that arm sets it
     # down and takes it anew by an approach that loads (the re-grasp).
     giver = loader if both else takers[0]
-    loading = _Candidates.of(model, *([skills.can_grip, *checks] if choosing else checks))
+    gripping = [lambda held: skills.can_grip(held, world.arm(loader).hand)]
+    loading = _Candidates.of(model, *([*gripping, *checks] if choosing else checks))
     giving = _Candidates.of(model, lambda held: skills.can_take(world, estimate, giver, held)) if choosing else None
     if whole is not None and not (loading.models and giving is not None and giving.models):
         raise SkillFailed(whole.refusal())
@@ -813,8 +820,8 @@ def _relay(
     """Pass an object from the arm that reaches it to the other arm: the first puts it down on ``spot``,
     on the same surface, where both reach, and the object is found again there."""
     world = ctx.world
-    spec = world.arm_specs[giver]
-    grasp = compute_grasp_pose(model, estimate.position, estimate.yaw, spec.mount, spec.yaw, _extent(estimate))
+    spec, hand = world.arm_specs[giver], world.arm(giver).hand
+    grasp = compute_grasp_pose(model, estimate.position, estimate.yaw, spec.mount, spec.yaw, _extent(estimate), hand)
     ctx.last_arm = giver
     for move in (skills.approach_object, skills.pick_up_object):
         _passing(move(world, giver, grasp), model, giver, taker)
@@ -902,7 +909,9 @@ def _relay_spot(
         spec = world.arm_specs[side]
         for held in candidates.models:
             try:
-                hand = compute_grasp_pose(held, centre, estimate.yaw, spec.mount, spec.yaw, _extent(estimate))
+                hand = compute_grasp_pose(
+                    held, centre, estimate.yaw, spec.mount, spec.yaw, _extent(estimate), world.arm(side).hand
+                )
             except GraspMisfitError:
                 continue  # the hand cannot hold it so, wherever it is
             if world.arm(side).can_hold(hand.position, hand.orientation) and world.arm(side).can_hold(
@@ -1341,12 +1350,11 @@ class SimEnvironment:
             if arm.held is not None:  # lowering it failed: lower it into the hand's pose of the taking instead
                 taken = arm.move_to(grasp.position, grasp.orientation, speed=skills.PLACE_SPEED, symmetric=False)
                 arm.detach()
-                arm.set_gripper(GRIPPER_OPEN)
+                arm.open_gripper()
                 # back off along the approach before folding: folded from beside it, the arm swept a
                 # side-grasped bottle over and 34 cm away (nu16 repro 18)
                 let_go = arm.ee_pose()
-                (px, py, pz), (ax, ay, az) = let_go.position, grasp.approach
-                back = (px - ax * PREGRASP_DISTANCE, py - ay * PREGRASP_DISTANCE, pz - az * PREGRASP_DISTANCE)
+                back = grasp.backed_off(let_go.position)
                 arm.move_to(back, let_go.orientation, speed=skills.PLACE_SPEED, symmetric=False)
                 self.world.step(skills.SETTLE_TIME)
                 arm.home()

@@ -1,8 +1,9 @@
 """Object models (the manipulation properties the knowledge base holds) and grasp poses computed from them.
 
 A grasp pose is where the gripper's grasp point (between the fingertips) goes, how the hand is turned,
-and from which direction it comes in. Only what perception estimated and the object's model are
-used: never the simulator's ground truth.
+and from which direction it comes in. Only what perception estimated, the object's model and the hand
+of the arm that grasps (:class:`kb.hands.Hand`, from the store) are used: never the simulator's ground
+truth.
 """
 
 from __future__ import annotations
@@ -13,25 +14,18 @@ from enum import StrEnum
 
 import numpy as np
 
+from cbrs.kb.hands import PANDA_HAND, Hand
 from cbrs.kb.semantic_map import MapObject, NotGraspableError
 from cbrs.sim.errors import GraspTooDeepError, GraspTooWideError
 from cbrs.sim.geometry import Quat, Vec3, quat_from_matrix
 
 __all__ = [
-    "FINGER_LENGTH",
-    "JAW_OPENING",
-    "PALM_DEPTH",
-    "SIDE_HOLD",
     "GraspKind",
     "GraspPose",
     "ObjectModel",
     "compute_grasp_pose",
     "side_held",
 ]
-
-JAW_OPENING = 0.08
-"""How far apart the open jaws are (m): the Panda hand's fingers open 4 cm each. An object wider than
-this across the jaws, for the way the hand is turned to it, cannot be grasped so."""
 
 
 class GraspKind(StrEnum):
@@ -132,10 +126,10 @@ class ObjectModel:
             (obj.size[0], obj.size[1]) if box else None,
         )
 
-    def top_clearance(self) -> float:
-        """How far the hand's palm stays above the object's top in a top grasp (negative: it would press
-        on it, the grasp point being deeper than the fingers are long)."""
-        return PALM_DEPTH - (self.height - self.grasp_height)
+    def top_clearance(self, hand: Hand) -> float:
+        """How far ``hand``'s palm stays above the object's top in a top grasp (negative: it would press
+        on it, the grasp point being deeper below the top than the palm is above the grasp point)."""
+        return hand.palm_depth - (self.height - self.grasp_height)
 
 
 def _x_axis(footprint: tuple[float, float], axis: float) -> float:
@@ -143,41 +137,13 @@ def _x_axis(footprint: tuple[float, float], axis: float) -> float:
     return axis if footprint[0] >= footprint[1] else axis - math.pi / 2.0
 
 
-PALM_DEPTH = 0.034
-"""In a top grasp the hand's palm is 3.4 cm above the grasp point (the Panda's panda_hand link, gripper
-open, hand pointing down: its collision box's lowest point 3.46 cm above panda_grasptarget, the
-fingertips 1.1 cm below it): an object whose top is higher above the grasp point than that cannot be
-taken from the top."""
-
-
-FINGER_LENGTH = 0.046
-"""How long the fingers are from the palm to their tips (m), along the hand's axis: what of an object can
-lie between them. The Panda's collision meshes: panda_hand's lowest point 6.60 cm from the hand's
-origin, the fingers' tips 11.22 cm (their joint at 5.84 cm, finger.obj 5.38 cm long): 4.62 cm; pybullet's
-bounding boxes, 4 mm margins included, put the palm 3.5 cm above the grasp point and the tips 1.1 cm
-below it, the same length. tests/test_grasp16_depth.py measures it again from the URDF."""
-SIDE_HOLD = 0.5
-"""The least fraction of an object's depth along a side grasp's approach that must lie between the
-fingers, its near face pushed against the palm (:func:`side_held`). At a half its centre of mass lies
-within the fingertips; a box deeper than twice what the fingers span along the approach is refused
-(:class:`GraspTooDeepError`). Raise it for a firmer hold, lower it to allow deeper boxes."""
-
-
-SIDE_PITCH = math.radians(35.0)
-"""A side grasp comes in tilted down by 35 degrees: with the arms mounted below the grasp height, a
-level hand would need the wrist at its joint limit, while a tilted one keeps it mid-range."""
-PREGRASP_DISTANCE = 0.10
-"""The pre-grasp pose is this far back along the approach direction: far enough that opening the
-fingers there touches nothing, near enough that the final approach is a short straight move."""
-
-
-def side_held(depth: float) -> float:
-    """How much of an object ``depth`` deep along a side grasp's horizontal approach lies between the
-    fingers: they come in tilted down by SIDE_PITCH, so they span FINGER_LENGTH * cos(SIDE_PITCH) of it
-    (3.8 cm); a deeper object meets the palm and is pushed until its near face rests against it, the rest
-    of it beyond the fingertips (measured: a 4 x 10 cm box taken so ended with its centre 1.9 cm beyond
-    the grasp point, 1 cm beyond the fingertips)."""
-    return min(depth, FINGER_LENGTH * math.cos(SIDE_PITCH))
+def side_held(depth: float, hand: Hand) -> float:
+    """How much of an object ``depth`` deep along a side grasp's horizontal approach lies between
+    ``hand``'s fingers: they come in tilted down by its side pitch, so they span its ``side_span`` of it
+    (3.8 cm for the Panda's); a deeper object meets the palm and is pushed until its near face rests
+    against it, the rest of it beyond the fingertips (measured with the Panda: a 4 x 10 cm box taken so
+    ended with its centre 1.9 cm beyond the grasp point, 1 cm beyond the fingertips)."""
+    return min(depth, hand.side_span)
 
 
 @dataclass(frozen=True)
@@ -196,12 +162,21 @@ class GraspPose:
     width: float
     """How far apart the jaws are when the fingers touch the object, for this approach and turn of the
     hand (:meth:`ObjectModel.grip`): what the fingers close to."""
+    hand: Hand = PANDA_HAND
+    """The hand that grasps so."""
 
     @property
     def pregrasp(self) -> Vec3:
-        x, y, z = self.position
+        """The pre-grasp pose: the hand's pre-grasp distance back along the approach."""
+        return self.backed_off(self.position)
+
+    def backed_off(self, point: Vec3) -> Vec3:
+        """``point`` moved the hand's pre-grasp distance back along the approach: where the hand comes
+        in from, and where it backs off to after letting go."""
+        x, y, z = point
         ax, ay, az = self.approach
-        return (x - ax * PREGRASP_DISTANCE, y - ay * PREGRASP_DISTANCE, z - az * PREGRASP_DISTANCE)
+        back = self.hand.pregrasp_distance
+        return (x - ax * back, y - ay * back, z - az * back)
 
 
 def top_orientation(finger_axis_yaw: float) -> Quat:
@@ -212,7 +187,7 @@ def top_orientation(finger_axis_yaw: float) -> Quat:
     return quat_from_matrix(np.column_stack([x, y, z]))
 
 
-def side_orientation(approach_yaw: float, pitch: float = SIDE_PITCH) -> Quat:
+def side_orientation(approach_yaw: float, pitch: float) -> Quat:
     """Hand coming in along ``approach_yaw``, tilted down by ``pitch``, fingers closing horizontally."""
     z = np.array([math.cos(approach_yaw) * math.cos(pitch), math.sin(approach_yaw) * math.cos(pitch), -math.sin(pitch)])
     y = np.array([math.sin(approach_yaw), -math.cos(approach_yaw), 0.0])
@@ -227,16 +202,17 @@ def compute_grasp_pose(
     arm_mount: Vec3,
     facing: float,
     seen: tuple[float, float] | None = None,
+    hand: Hand = PANDA_HAND,
 ) -> GraspPose:
     """The grasp for an object whose centre (and, for long objects, axis yaw; ``seen``: its extent along
     x and y) perception estimated, by an arm mounted at ``arm_mount`` facing ``facing`` (its yaw in the
-    semantic map).
+    semantic map) that ends in ``hand`` (the arm's :class:`kb.hands.Hand`; the Panda's by default).
 
-    A side grasp comes in from the robot's side of the table, its jaws closing across that direction;
-    a top grasp closes them across the object's long axis. GraspTooWideError when the object is wider
-    across the jaws than they open, GraspTooDeepError when a side grasp would hold less than SIDE_HOLD
-    of its depth along the approach (:func:`side_held`): the hand could not hold it so, whatever the arm
-    can reach.
+    A side grasp comes in from the robot's side of the table, tilted down by the hand's side pitch, its
+    jaws closing across that direction; a top grasp closes them across the object's long axis.
+    GraspTooWideError when the object is wider across the jaws than the hand opens them,
+    GraspTooDeepError when a side grasp would hold less than the hand's side-hold fraction of its depth
+    along the approach (:func:`side_held`): the hand could not hold it so, whatever the arm can reach.
     """
     cx, cy, cz = centre
     bottom = cz - model.height / 2.0
@@ -244,12 +220,9 @@ def compute_grasp_pose(
     if model.grasp is GraspKind.SIDE:
         # Straight in from the robot's side of the table, whatever the object's position.
         closing = facing - math.pi / 2.0  # the grasp frame's y axis, across the approach
-        orientation = side_orientation(facing)
-        approach: Vec3 = (
-            math.cos(facing) * math.cos(SIDE_PITCH),
-            math.sin(facing) * math.cos(SIDE_PITCH),
-            -math.sin(SIDE_PITCH),
-        )
+        pitch = hand.side_pitch
+        orientation = side_orientation(facing, pitch)
+        approach: Vec3 = (math.cos(facing) * math.cos(pitch), math.sin(facing) * math.cos(pitch), -math.sin(pitch))
     else:
         if yaw is not None:
             axis = yaw
@@ -267,12 +240,12 @@ def compute_grasp_pose(
         orientation = top_orientation(finger)
         approach = (0.0, 0.0, -1.0)
     width = model.across(closing, yaw, seen)
-    if width > JAW_OPENING + 1e-9:
-        raise GraspTooWideError(model.name, model.grasp.value, width, JAW_OPENING)
+    if width > hand.jaw_opening + 1e-9:
+        raise GraspTooWideError(model.name, model.grasp.value, width, hand.jaw_opening)
     if model.grasp is GraspKind.SIDE:
         depth = model.across(facing, yaw, seen)  # its extent along the approach, as across the jaws
-        held = side_held(depth)
-        if held < SIDE_HOLD * depth - 1e-9:
-            raise GraspTooDeepError(model.name, model.grasp.value, depth, FINGER_LENGTH, held, SIDE_HOLD)
+        held = side_held(depth, hand)
+        if held < hand.side_hold * depth - 1e-9:
+            raise GraspTooDeepError(model.name, model.grasp.value, depth, hand.finger_length, held, hand.side_hold)
     grip = model.grip(closing, yaw)
-    return GraspPose(model, (cx, cy, grasp_z), orientation, approach, model.grasp_height, grip)
+    return GraspPose(model, (cx, cy, grasp_z), orientation, approach, model.grasp_height, grip, hand)

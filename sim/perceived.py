@@ -232,9 +232,10 @@ class PerceivedWorld(Judge):
 
     def gripper_near(self, side: ArmSide, name: str) -> bool:
         where = self.position(name)
-        hand = self.world.arm(side).ee_pose().position
+        arm = self.world.arm(side)
         size = self.world.objects[name].size
-        return where is not None and pred.distance_to_extent(hand, where, size) <= pred.GRIPPER_NEAR_DISTANCE
+        near = pred.gripper_near_distance(arm.hand)
+        return where is not None and pred.distance_to_extent(arm.ee_pose().position, where, size) <= near
 
     def base_near_person(self, person: str) -> bool | None:
         sighting = self.people.get(person)

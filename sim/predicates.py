@@ -14,10 +14,10 @@ import math
 import numpy as np
 import pybullet as p
 
+from cbrs.kb.hands import Hand
 from cbrs.sim.arms import ArmSide
 from cbrs.sim.cameras import project
 from cbrs.sim.geometry import Pose2D, Region, Vec3, quat_to_matrix
-from cbrs.sim.grasping import PREGRASP_DISTANCE
 from cbrs.sim.layout import PERSON_HAND_HEIGHT
 from cbrs.sim.world import HomeWorld
 
@@ -28,7 +28,6 @@ __all__ = [
     "BASE_NEAR_DISTANCE",
     "BASE_NEAR_HEADING",
     "GRASP_DISTANCE",
-    "GRIPPER_NEAR_DISTANCE",
     "HAND_HEIGHT_TOLERANCE",
     "NEAR_PERSON_DISTANCE",
     "PERSON_REACH",
@@ -41,6 +40,7 @@ __all__ = [
     "contains_water",
     "distance_to_extent",
     "gripper_near",
+    "gripper_near_distance",
     "is_grasped",
     "object_above_region",
     "object_bottom",
@@ -68,12 +68,6 @@ measured to the grasp point itself, which a grasp high on a tall object is far f
 bottle held at 0.88 of its height), so such a pick-up was said to slip."""
 APPROACH_SLACK = 0.05
 """How far from its planned pre-grasp pose an approach may end and still count (5 cm)."""
-GRIPPER_NEAR_DISTANCE = PREGRASP_DISTANCE + APPROACH_SLACK
-"""The gripper is near an object when its grasp point is within 15 cm of the object's extent
-(:func:`distance_to_extent`), not of its centre: the pre-grasp pose is 10 cm back from a grasp point
-in the object, wherever on it the class grasps it (an 18 cm bottle held at 0.88 of its height is
-grasped 7 cm above its centre, and its pre-grasp pose is then 15.0 cm from the centre: a centre-based
-15 cm left no slack and failed it), so an approach made within 5 cm of the plan counts."""
 BASE_NEAR_DISTANCE = 0.10
 """The base is near a place (for a hand-over) within 10 cm: the arm plans its put-down on the
 localised platform, and 10 cm keeps the pen well inside the platform's 20 cm middle strip."""
@@ -90,6 +84,16 @@ PLATFORM_MARGIN = 0.01
 """The pen's centre must be 1 cm inside the platform's edge to be on it."""
 WATER_MIN = 0.5
 """The cup contains water once at least half full (a full cup takes 4 s of open tap)."""
+
+
+def gripper_near_distance(hand: Hand) -> float:
+    """How near an object a gripper is near it: its grasp point within the hand's pre-grasp distance and
+    APPROACH_SLACK of the object's extent (:func:`distance_to_extent`; 15 cm for the Panda hand), not of
+    its centre: the pre-grasp pose is that distance back from a grasp point in the object, wherever on it
+    the class grasps it (an 18 cm bottle held at 0.88 of its height is grasped 7 cm above its centre, and
+    its pre-grasp pose is then 15.0 cm from the centre: a centre-based 15 cm left no slack and failed it),
+    so an approach made within 5 cm of the plan counts."""
+    return hand.pregrasp_distance + APPROACH_SLACK
 
 
 def _position(world: HomeWorld, name: str) -> np.ndarray:
@@ -132,10 +136,11 @@ def distance_to_extent(point: Vec3, centre: Vec3, size: Vec3) -> float:
 
 
 def gripper_near(world: HomeWorld, side: ArmSide | str, name: str) -> bool:
-    """(gripper, isNear, object): its grasp point within ``GRIPPER_NEAR_DISTANCE`` of the object's extent."""
-    ee = world.arm(side).ee_pose().position
+    """(gripper, isNear, object): its grasp point within :func:`gripper_near_distance` of the object's extent."""
+    arm = world.arm(side)
+    ee = arm.ee_pose().position
     x, y, z = (float(v) for v in _position(world, name))
-    return distance_to_extent(ee, (x, y, z), world.objects[name].size) <= GRIPPER_NEAR_DISTANCE
+    return distance_to_extent(ee, (x, y, z), world.objects[name].size) <= gripper_near_distance(arm.hand)
 
 
 def object_above_region(world: HomeWorld, name: str, region: Region) -> bool:

@@ -17,13 +17,12 @@ from typing import Protocol
 import numpy as np
 import pybullet as p
 
+from cbrs.kb.hands import Hand
 from cbrs.sim import predicates as pred
-from cbrs.sim.arms import GRIPPER_OPEN, Arm, ArmSide, MotionResult
+from cbrs.sim.arms import Arm, ArmSide, MotionResult
 from cbrs.sim.errors import GraspMisfitError
 from cbrs.sim.geometry import Pose2D, Pose3D, Quat, Region, Vec3, wrap_angle
 from cbrs.sim.grasping import (
-    PALM_DEPTH,
-    PREGRASP_DISTANCE,
     GraspKind,
     GraspPose,
     ObjectModel,
@@ -125,7 +124,7 @@ def approach_object(world: HomeWorld, side: ArmSide | str, grasp: GraspPose) -> 
     arm = _arm(world, side)
     if arm.held is not None:
         return _done(world, "ApproachToObject", start, False, f"the {arm.side} gripper is holding something")
-    arm.set_gripper(GRIPPER_OPEN)
+    arm.open_gripper()
     result = arm.reach(grasp.pregrasp, grasp.orientation)
     if not result.reached:
         return _done(world, "ApproachToObject", start, False, result.reason)
@@ -161,7 +160,7 @@ def pick_up_object(world: HomeWorld, side: ArmSide | str, grasp: GraspPose) -> O
     arm.set_gripper(max(grasp.width - 0.004, 0.0), seconds=0.4)
     body = _between_fingers(world, arm)
     if body is None:
-        arm.set_gripper(GRIPPER_OPEN)
+        arm.open_gripper()
         return _done(world, "PickUpObject", start, False, "nothing between the fingers")
     arm.attach(body, grasp)
     x, y, z = grasp.position
@@ -248,10 +247,8 @@ def put_down_object(world: HomeWorld, side: ArmSide | str, region: Region) -> Ou
     if not result.reached:
         return _done(world, "PutDownObject", start, False, result.reason)
     arm.detach()
-    arm.set_gripper(GRIPPER_OPEN)
-    ax, ay, az = grasp.approach
-    back = (place[0] - ax * PREGRASP_DISTANCE, place[1] - ay * PREGRASP_DISTANCE, place[2] - az * PREGRASP_DISTANCE)
-    retreat = arm.move_to(back, ee.orientation, speed=PLACE_SPEED, symmetric=False)
+    arm.open_gripper()
+    retreat = arm.move_to(grasp.backed_off(place), ee.orientation, speed=PLACE_SPEED, symmetric=False)
     world.step(SETTLE_TIME)
     folded = arm.home()
     ok = pred.object_located_in(world, name, region)
@@ -273,7 +270,7 @@ def fill_cup_from_tap(world: HomeWorld, side: ArmSide | str, lever: Region, cont
     if arm.held is not None:
         return _done(world, "FillCupFromTap", start, False, f"the {arm.side} gripper is holding something")
     facing = world.arm_specs[ArmSide(side)].yaw  # the way the arm faces, from the semantic map
-    orientation = side_orientation(facing)
+    orientation = side_orientation(facing, arm.hand.side_pitch)
     approach = np.array([math.cos(facing), math.sin(facing), 0.0])
     x, z = (lever.xmin + lever.xmax) / 2.0, (lever.zmin + lever.zmax) / 2.0
     press = np.array([x, lever.ymin + LEVER_PUSH, z])
@@ -292,7 +289,7 @@ def fill_cup_from_tap(world: HomeWorld, side: ArmSide | str, lever: Region, cont
         if world.water_spilled - spilled >= SPILL_LIMIT:
             break
     arm.move_to((float(pre[0]), float(pre[1]), float(pre[2])), arm.ee_pose().orientation, speed=PLACE_SPEED)
-    arm.set_gripper(GRIPPER_OPEN)
+    arm.open_gripper()
     arm.home()
     if not opened:
         return _done(world, "FillCupFromTap", start, False, "the lever did not open the tap")
@@ -318,8 +315,9 @@ def _grasp(world: HomeWorld, pen: ObjectEstimate, side: ArmSide | str, model: Ob
     hand cannot hold it so (too wide across the jaws, too deep along a side grasp's approach: the words of
     :class:`GraspTooWideError` or :class:`GraspTooDeepError`)."""
     spec = world.arm_specs[ArmSide(side)]
+    hand = world.arm(side).hand
     try:
-        return compute_grasp_pose(model, pen.position, pen.yaw, spec.mount, spec.yaw, (pen.size[0], pen.size[1]))
+        return compute_grasp_pose(model, pen.position, pen.yaw, spec.mount, spec.yaw, (pen.size[0], pen.size[1]), hand)
     except GraspMisfitError as misfit:
         return str(misfit)
 
@@ -362,15 +360,15 @@ def can_load(
     return _loading(world, pen, base, side, model)[3]
 
 
-def can_grip(model: ObjectModel) -> str:
-    """Why the hand cannot close on the object by the approach ``model`` is held by, wherever it is
+def can_grip(model: ObjectModel, hand: Hand) -> str:
+    """Why ``hand`` cannot close on the object by the approach ``model`` is held by, wherever it is
     (empty if it can): a top grasp whose grasp point is deeper below the object's top than the palm
     is above the fingers' grasp point would press the palm on it."""
-    if model.grasp is GraspKind.TOP and model.top_clearance() < 0.0:
+    if model.grasp is GraspKind.TOP and model.top_clearance(hand) < 0.0:
         depth = model.height - model.grasp_height
         return (
             f"a top grasp would hold the {model.name} {depth * 100:.1f} cm below its top, and the hand's palm is "
-            f"{PALM_DEPTH * 100:.1f} cm above the fingers' grasp point"
+            f"{hand.palm_depth * 100:.1f} cm above the fingers' grasp point"
         )
     return ""
 
@@ -382,7 +380,7 @@ def can_take(world: HomeWorld, pen: ObjectEstimate, side: ArmSide | str, model: 
     for the fingers), or cannot hold the pre-grasp or the grasp pose."""
     arm = ArmSide(side)
     x, y, _ = pen.position
-    refused = can_grip(model)
+    refused = can_grip(model, world.arm(arm).hand)
     if refused:
         return refused
     grasp = _grasp(world, pen, arm, model)

@@ -19,6 +19,7 @@ from types import TracebackType
 import numpy as np
 import pybullet as p
 
+from cbrs.kb.hands import PANDA_HAND
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import Arm as ArmSpec
 from cbrs.kb.semantic_map import Box, Dispenser, MapError, MapObject, MobileRobot, SemanticMap, Thing, overlaps
@@ -766,7 +767,8 @@ class HomeWorld:
             self._bodies[f"{side.value.capitalize()}Arm"] = body
             for link in (9, 10):
                 p.changeDynamics(body, link, lateralFriction=1.5, physicsClientId=self.client)
-            self.arms[side] = Arm(self.client, side, body, self._kinematics, self.step)
+            hand = self.map.hands.get(arms[side].iri, PANDA_HAND)  # the store's, by kb.hands
+            self.arms[side] = Arm(self.client, side, body, self._kinematics, self.step, hand)
         for arm in self.arms.values():
             arm.peers = self.arms
 

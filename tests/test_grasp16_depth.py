@@ -1,13 +1,15 @@
 """How deep an object may be along a side grasp's approach: the fingers, 4.6 cm from the palm to their tips
 and tilted down 35 degrees, span 3.8 cm of it; a deeper object meets the palm and is pushed until its near
 face rests against it. A side grasp is refused (GraspTooDeepError: the object, its depth, the finger
-length) when less than SIDE_HOLD (a half: its centre of mass within the fingertips) would lie between
-them, and the approach choice takes the object from the top instead (sim/grasping.py)."""
+length) when less than the hand's side-hold fraction (a half: its centre of mass within the fingertips) would
+lie between them, and the approach choice takes the object from the top instead (sim/grasping.py). The hand is
+the store's (ontologies/world.ttl, kb/hands.py)."""
 
 from __future__ import annotations
 
 import math
 import re
+from dataclasses import replace
 from pathlib import Path
 
 import pybullet as p
@@ -16,11 +18,12 @@ import pytest
 from cbrs.actions.composer import Composer
 from cbrs.actions.runner import run_task
 from cbrs.kb.semantic_map import SemanticMap
-from cbrs.sim import grasping, skills
+from cbrs.sim import skills
 from cbrs.sim.arms import EE_LINK, PYBULLET_DATA, ArmSide, panda_urdf
 from cbrs.sim.components import SimEnvironment, pick_up
 from cbrs.sim.errors import GraspMisfitError, GraspTooDeepError
-from cbrs.sim.grasping import FINGER_LENGTH, SIDE_HOLD, SIDE_PITCH, GraspKind, ObjectModel, compute_grasp_pose
+from cbrs.sim.grasping import GraspKind, ObjectModel, compute_grasp_pose
+from cbrs.sim.scene import bundled_map
 from cbrs.sim.world import open_world
 from tests.home_layout import ARM_FACING, ARM_MOUNTS
 from tests.test_grasp_width import (
@@ -37,7 +40,9 @@ from tests.test_turtle_tasks_arms import knowledge
 
 LEFT = ARM_MOUNTS["left"]
 FACING = ARM_FACING["left"]  # +y: a box lying along y lies along a side grasp's approach
-SPAN = FINGER_LENGTH * math.cos(SIDE_PITCH)  # what the tilted fingers span along the approach
+HAND = bundled_map().hands[WORLD + "CytonDualArm01LeftArm"]
+"""The left arm's hand as the shipped map describes it (the Panda hand)."""
+SPAN = HAND.finger_length * math.cos(HAND.side_pitch)  # what the tilted fingers span along the approach
 BESIDE_THE_CUP = (7.35, 3.30, 0.79)
 """Where the left hand takes a box from the side (the carton tests' own spot, 7.55 x 3.15, it cannot)."""
 
@@ -49,7 +54,7 @@ def deep_box(depth: float, approaches: tuple[GraspKind, ...] = (GraspKind.SIDE, 
 
 def test_the_finger_length_is_the_robots_hand_from_the_palm_to_the_fingertips() -> None:
     """Measured on the Panda's URDF (its collision meshes, the hand pointing down): the palm's lowest
-    point to the fingertips. The constant stands for the robot's description; this keeps them one."""
+    point to the fingertips. The shipped map describes the robot's hands; this keeps them the URDF's."""
     client = p.connect(p.DIRECT)
     try:
         p.setAdditionalSearchPath(PYBULLET_DATA, physicsClientId=client)
@@ -68,8 +73,8 @@ def test_the_finger_length_is_the_robots_hand_from_the_palm_to_the_fingertips() 
     finally:
         p.disconnect(physicsClientId=client)
     assert abs(target[2] - 0.4) < 0.005  # the hand is where it was put, pointing down
-    assert palm - tips == pytest.approx(FINGER_LENGTH, abs=0.002)
-    assert palm - target[2] == pytest.approx(grasping.PALM_DEPTH, abs=0.002)
+    assert palm - tips == pytest.approx(HAND.finger_length, abs=0.002)
+    assert palm - target[2] == pytest.approx(HAND.palm_depth, abs=0.002)
 
 
 # -- the rule, by the model alone ----------------------------------------------------------------------
@@ -80,23 +85,25 @@ def test_a_box_deeper_than_the_fingers_hold_is_refused_from_the_side_naming_it_i
     depth: float,
 ) -> None:
     with pytest.raises(GraspTooDeepError) as refused:
-        compute_grasp_pose(deep_box(depth), BESIDE_THE_CUP, math.pi / 2.0, LEFT, FACING)
+        compute_grasp_pose(deep_box(depth), BESIDE_THE_CUP, math.pi / 2.0, LEFT, FACING, hand=HAND)
     error = refused.value
     assert isinstance(error, GraspMisfitError)  # passed over like a box too wide for the jaws
     assert error.name == "Carton" and error.approach == "side"
-    assert error.depth == pytest.approx(depth) and error.finger_length == FINGER_LENGTH
-    assert error.held == pytest.approx(SPAN) and error.least == SIDE_HOLD
+    assert error.depth == pytest.approx(depth) and error.finger_length == HAND.finger_length
+    assert error.held == pytest.approx(SPAN) and error.least == HAND.side_hold
     assert f"the Carton is {depth * 100:.1f} cm deep along the hand's approach by its side grasp" in str(error)
     assert "the fingers are 4.6 cm long: 3.8 cm of it would lie between them, less than the 50%" in str(error)
 
 
 def test_the_limit_is_where_the_centre_of_mass_reaches_the_fingertips() -> None:
-    """At SIDE_HOLD a half, a box up to twice the fingers' span along the approach is held from the side."""
-    limit = SPAN / SIDE_HOLD
+    """At a side hold of a half, a box up to twice the fingers' span along the approach is held from the side."""
+    limit = SPAN / HAND.side_hold
     assert 0.07 < limit < 0.08
-    assert compute_grasp_pose(deep_box(limit - 1e-4), BESIDE_THE_CUP, math.pi / 2.0, LEFT, FACING).width == 0.04
+    assert (
+        compute_grasp_pose(deep_box(limit - 1e-4), BESIDE_THE_CUP, math.pi / 2.0, LEFT, FACING, hand=HAND).width == 0.04
+    )
     with pytest.raises(GraspTooDeepError):
-        compute_grasp_pose(deep_box(limit + 1e-3), BESIDE_THE_CUP, math.pi / 2.0, LEFT, FACING)
+        compute_grasp_pose(deep_box(limit + 1e-3), BESIDE_THE_CUP, math.pi / 2.0, LEFT, FACING, hand=HAND)
 
 
 def test_depth_is_along_the_approach_and_a_top_grasp_is_not_limited_by_it() -> None:
@@ -106,24 +113,25 @@ def test_depth_is_along_the_approach_and_a_top_grasp_is_not_limited_by_it() -> N
     across = compute_grasp_pose(box, BESIDE_THE_CUP, 0.0, LEFT, FACING)  # its long axis along x
     assert across.model.grasp is GraspKind.SIDE and across.width == pytest.approx(0.078)
     with pytest.raises(GraspTooDeepError) as along:
-        compute_grasp_pose(box, BESIDE_THE_CUP, math.pi / 2.0, LEFT, FACING)
+        compute_grasp_pose(box, BESIDE_THE_CUP, math.pi / 2.0, LEFT, FACING, hand=HAND)
     assert along.value.depth == pytest.approx(0.078)
     with pytest.raises(GraspTooDeepError) as askew:  # 0.2 rad off the approach
         compute_grasp_pose(box, BESIDE_THE_CUP, math.pi / 2.0 - 0.2, LEFT, FACING)
     assert askew.value.depth == pytest.approx(0.078 * math.cos(0.2) + 0.04 * math.sin(0.2))
-    top = compute_grasp_pose(deep_box(0.16).by(GraspKind.TOP), BESIDE_THE_CUP, math.pi / 2.0, LEFT, FACING)
+    top = compute_grasp_pose(deep_box(0.16).by(GraspKind.TOP), BESIDE_THE_CUP, math.pi / 2.0, LEFT, FACING, hand=HAND)
     assert top.width == pytest.approx(0.04)
     cup = ObjectModel("Cup", "red", 0.10, 0.06, GraspKind.SIDE, 0.07)  # 6 cm across: 3.8 of it held
     assert compute_grasp_pose(cup, CENTRE, None, LEFT, FACING).width == pytest.approx(0.06)
 
 
-def test_the_fraction_a_hold_needs_is_a_parameter(monkeypatch: pytest.MonkeyPatch) -> None:
+def test_the_fraction_a_hold_needs_is_the_hands() -> None:
     box = deep_box(0.10)
-    monkeypatch.setattr(grasping, "SIDE_HOLD", 0.3)
-    assert compute_grasp_pose(box, BESIDE_THE_CUP, math.pi / 2.0, LEFT, FACING).model.grasp is GraspKind.SIDE
-    monkeypatch.setattr(grasping, "SIDE_HOLD", 0.7)
+    loose, firm = replace(HAND, side_hold=0.3), replace(HAND, side_hold=0.7)
+    assert (
+        compute_grasp_pose(box, BESIDE_THE_CUP, math.pi / 2.0, LEFT, FACING, hand=loose).model.grasp is GraspKind.SIDE
+    )
     with pytest.raises(GraspTooDeepError) as refused:
-        compute_grasp_pose(deep_box(0.06), BESIDE_THE_CUP, math.pi / 2.0, LEFT, FACING)
+        compute_grasp_pose(deep_box(0.06), BESIDE_THE_CUP, math.pi / 2.0, LEFT, FACING, hand=firm)
     assert refused.value.least == 0.7 and "less than the 70% a hold needs" in str(refused.value)
 
 

@@ -18,12 +18,13 @@ import pytest
 from cbrs.actions.composer import Composer
 from cbrs.actions.runner import run_task
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.hands import PANDA_HAND
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import GRASP_APPROACHES, MapError, SemanticMap
 from cbrs.sim import skills
 from cbrs.sim.arms import ArmSide
 from cbrs.sim.components import CannotLoadError, SimContext, SimEnvironment, _knowledge
-from cbrs.sim.grasping import PALM_DEPTH, GraspKind, ObjectModel
+from cbrs.sim.grasping import GraspKind, ObjectModel
 from cbrs.sim.values import GraspPlan, Manipulation, to_json
 from cbrs.sim.world import open_world
 from tests.test_turtle_tasks_arms import FETCH_MY_CUP, PEN_TRAY_ON_THE_RIGHT, PUT_CUP_ON_PEN_TRAY, knowledge
@@ -100,11 +101,11 @@ def test_a_grasp_value_keeps_its_own_approach_first_and_gets_the_classes_others_
 
 def test_a_top_grasp_deeper_below_the_top_than_the_palm_is_ruled_out() -> None:
     cup = ObjectModel("Cup", "red", 0.10, 0.06, GraspKind.TOP, 0.07)
-    assert skills.can_grip(cup) == ""  # 3.0 cm below its top, the palm 3.4 cm above the grasp point
-    assert cup.top_clearance() == pytest.approx(PALM_DEPTH - 0.03)
+    assert skills.can_grip(cup, PANDA_HAND) == ""  # 3.0 cm below its top, the palm 3.4 cm above the grasp point
+    assert cup.top_clearance(PANDA_HAND) == pytest.approx(PANDA_HAND.palm_depth - 0.03)
     glass = ObjectModel("Glass", "cyan", 0.16, 0.06, GraspKind.TOP, 0.08)
-    assert "8.0 cm below its top" in skills.can_grip(glass)
-    assert skills.can_grip(glass.by(GraspKind.SIDE)) == ""  # a side grasp has no palm above the object
+    assert "8.0 cm below its top" in skills.can_grip(glass, PANDA_HAND)
+    assert skills.can_grip(glass.by(GraspKind.SIDE), PANDA_HAND) == ""  # a side grasp has no palm above the object
 
 
 # -- choosing, and acting on the choice --------------------------------------------------------------

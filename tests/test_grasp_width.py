@@ -14,6 +14,7 @@ import pytest
 
 from cbrs.actions.composer import Composer
 from cbrs.actions.runner import run_task
+from cbrs.kb.hands import PANDA_HAND
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
 from cbrs.sim import skills
@@ -21,7 +22,7 @@ from cbrs.sim.arms import ArmSide
 from cbrs.sim.components import SimContext, SimEnvironment, _knowledge, approach, pick_up
 from cbrs.sim.errors import GraspTooWideError
 from cbrs.sim.geometry import quat_to_matrix
-from cbrs.sim.grasping import JAW_OPENING, GraspKind, ObjectModel, compute_grasp_pose
+from cbrs.sim.grasping import GraspKind, ObjectModel, compute_grasp_pose
 from cbrs.sim.perception import ObjectEstimate, recognise_object
 from cbrs.sim.values import GraspPlan, to_json
 from cbrs.sim.world import open_world
@@ -72,7 +73,7 @@ def test_a_side_grasp_across_a_long_box_is_refused_naming_it_and_its_width(axis:
     with pytest.raises(GraspTooWideError) as refused:
         compute_grasp_pose(CARTON, CENTRE, axis, LEFT, FACING)
     assert refused.value.name == "Carton" and refused.value.approach == "side"
-    assert refused.value.width == pytest.approx(width) and refused.value.opening == JAW_OPENING
+    assert refused.value.width == pytest.approx(width) and refused.value.opening == PANDA_HAND.jaw_opening
     assert f"the Carton is {width * 100:.1f} cm wide across the jaws by its side grasp" in str(refused.value)
     assert "the hand opens 8.0 cm" in str(refused.value)
 
