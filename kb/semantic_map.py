@@ -372,7 +372,28 @@ class SemanticMap:
                 built.dispensers[iri] = _dispenser(built, iri, tap, facts)
         _check_supports(built)
         _check_overlaps(built)
+        _check_properties(kb, facts)
         return built
+
+
+def _check_properties(kb: KnowledgeBase, facts: dict[str, dict[str, list[str]]]) -> None:
+    """Every property of the home namespace the map's statements use is one the vocabulary declares: a
+    misspelt optional property (home:yaww for home:yaw) is declared nowhere, so the load took it and the
+    reader ignored it, the thing keeping its default. Checked after the required properties, whose own
+    checks say what is missing. A store without the home vocabulary has nothing to check against."""
+    declared = {row["property"].value for row in kb.select("declared_properties", {"namespace": HOME})}
+    if not declared:
+        return
+    for thing in sorted(facts):
+        for prop in sorted(facts[thing]):
+            if prop.startswith(HOME) and prop not in declared:
+                near = nearest_term(prop, declared)
+                hint = f" (did you mean home:{local_name(near)}?)" if near else ""
+                raise MapError(
+                    thing,
+                    f"has home:{local_name(prop)} {facts[thing][prop][0]!r}, a property the home vocabulary does "
+                    f"not declare, which would be ignored{hint}",
+                )
 
 
 def _number(values: dict[str, list[str]], name: str, iri: str, default: float | None = None) -> float:
