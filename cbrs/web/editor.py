@@ -3,7 +3,9 @@ table (or Turtle), and download it from ``/sparql`` in CSV or JSON. The query tr
 result can be linked to.
 
 A SELECT is run with a ``LIMIT`` of one row more than the page shows (:mod:`cbrs.web.row_limit`): the
-engine stops there, the extra row says the result was cut, and the downloads run the query as written."""
+engine stops there, the extra row says the result was cut, and the downloads run the query as written.
+A CONSTRUCT or DESCRIBE shows as many triples as a SELECT shows rows: on OWLS-TC, ``CONSTRUCT WHERE
+{ ?s ?p ?o }`` made a page of 21 MB that Chromium had not drawn after a minute."""
 
 from __future__ import annotations
 
@@ -11,9 +13,11 @@ import json
 import time
 from typing import Any
 
+import pyoxigraph as ox
 from flask import Blueprint, Response, current_app, request, url_for
 
 from cbrs.kb.errors import KnowledgeBaseError, QuerySyntaxError, UnknownQueryError
+from cbrs.kb.namespaces import PREFIXES
 from cbrs.sparql_hints import undeclared_prefixes
 from cbrs.sparql_service import BOM, Answer
 from cbrs.web import context
@@ -79,7 +83,7 @@ def editor() -> Page:
     data["full_query"] = run
     started = time.perf_counter()
     try:
-        answer = _run(run, rows)
+        data["result"] = _answer(run, rows)
     except QuerySyntaxError as error:
         message = str(error)
         if added:
@@ -92,7 +96,6 @@ def editor() -> Page:
         shown.status = error.http_status
         return shown
     data["elapsed_ms"] = round((time.perf_counter() - started) * 1000, 1)
-    data["result"] = _result(answer.body, answer.media_type, rows)
     form = "graph" if data["result"]["kind"] == "graph" else "select"
     data["downloads"] = [
         {"label": label, "format": short, "href": url_for("sparql.sparql", query=run, format=short)}
@@ -114,18 +117,32 @@ def with_store_prefixes(text: str) -> tuple[str, dict[str, str]]:
     return lines + text, added
 
 
-def _run(text: str, rows: int) -> Answer:
-    """The answer to ``text``; a SELECT's cut at ``rows`` + 1 rows, so that the engine stops producing
-    and serialising solutions past what the page shows (SELECT and ASK come back as SPARQL JSON results,
-    CONSTRUCT and DESCRIBE as Turtle)."""
+def _answer(text: str, rows: int) -> dict[str, Any]:
+    """The result of ``text`` as the page shows it (:func:`_result`), read no further than it needs.
+
+    A graph's ``LIMIT`` counts solutions, and a solution may add no new triple: when the bounded
+    solutions gave no more triples than the page shows, only the whole result can say whether it has
+    more, so it is read then (a small result, or one whose solutions repeat triples)."""
+    answer, cut = _run(text, rows)
+    result = _result(answer.body, answer.media_type, rows)
+    if cut and result["kind"] == "graph" and not result["truncated"]:
+        answer = context.sparql().query(text, short_format="turtle", client=request.remote_addr)
+        result = _result(answer.body, answer.media_type, rows)
+    return result
+
+
+def _run(text: str, rows: int) -> tuple[Answer, bool]:
+    """The answer to ``text``, cut at ``rows`` + 1 solutions so that the engine stops producing and
+    serialising solutions past what the page shows, and whether it was cut so (SELECT and ASK come back
+    as SPARQL JSON results, CONSTRUCT and DESCRIBE as Turtle)."""
     sparql = context.sparql()
     limited = bounded(text, rows + 1)
     if limited is not None and limited.changed:
         try:
-            return sparql.query(limited.text, short_format="turtle", client=request.remote_addr)
+            return sparql.query(limited.text, short_format="turtle", client=request.remote_addr), True
         except QuerySyntaxError:
             pass  # the error as the parser reports it for the text the user wrote, lines and columns included
-    return sparql.query(text, short_format="turtle", client=request.remote_addr)
+    return sparql.query(text, short_format="turtle", client=request.remote_addr), False
 
 
 def _example(name: str) -> dict[str, Any]:
@@ -139,11 +156,13 @@ def _example(name: str) -> dict[str, Any]:
 
 def _result(body: bytes, media_type: str, shown: int) -> dict[str, Any]:
     """The answer as the page shows it: ``{"kind": "select", "vars", "rows", "count", "truncated"}``,
-    ``{"kind": "ask", "boolean"}`` or ``{"kind": "graph", "turtle"}``. ``rows`` are the first ``shown``;
-    ``count`` is how many the page shows, and ``truncated`` says the result has more (then the
-    page read ``shown`` + 1, not all)."""
+    ``{"kind": "ask", "boolean"}`` or ``{"kind": "graph", "turtle", "count", "truncated"}``. ``rows``
+    are the first ``shown`` (a graph's ``turtle``, its first ``shown`` triples); ``count`` is how many
+    the page shows, and ``truncated`` says the result has more."""
     if media_type == "text/turtle":
-        return {"kind": "graph", "turtle": body.decode("utf-8")}
+        triples = list(dict.fromkeys(ox.parse(body, ox.RdfFormat.TURTLE)))
+        first = triples[:shown]
+        return {"kind": "graph", "turtle": _turtle(first), "count": len(first), "truncated": len(triples) > shown}
     parsed = json.loads(body)
     if "boolean" in parsed:
         return {"kind": "ask", "boolean": bool(parsed["boolean"])}
@@ -155,3 +174,20 @@ def _result(body: bytes, media_type: str, shown: int) -> dict[str, Any]:
         "count": min(len(rows), shown),
         "truncated": len(rows) > shown,
     }
+
+
+def _turtle(triples: list[ox.Triple]) -> str:
+    """``triples`` as Turtle, with the prefixes the pages show for the namespaces they use (declared, and
+    derived for the store's own namespaces, :mod:`cbrs.web.prefixes`)."""
+    namespaces = {namespace: prefix for prefix, namespace in {**derived(), **PREFIXES}.items()}
+    used: dict[str, str] = {}
+    for triple in triples:
+        for term in (triple.subject, triple.predicate, triple.object):
+            if isinstance(term, ox.NamedNode):
+                iri = term.value
+                for end in (iri.rfind("#"), iri.rfind("/")):
+                    prefix = namespaces.get(iri[: end + 1]) if end >= 0 else None
+                    if prefix is not None:
+                        used[prefix] = iri[: end + 1]
+    text = ox.serialize(triples, format=ox.RdfFormat.TURTLE, prefixes=dict(sorted(used.items())))
+    return text.decode("utf-8") if text is not None else ""

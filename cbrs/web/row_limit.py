@@ -1,4 +1,4 @@
-"""A SELECT query's text with its result cut at so many rows, so that the editor reads no more than it shows.
+"""A query's text with its result cut at so many solutions, so that the editor reads no more than it shows.
 
 The editor shows the first rows of a result. Run as written, ``SELECT * WHERE { ?s ?p ?o }`` on OWLS-TC
 had the engine produce and serialise all 178,000 solutions (50 MB of JSON, 18 to 22 s at load 5) to show 1,000.
@@ -10,6 +10,9 @@ The text is read with the lexemes that can hide a brace or a keyword (strings, I
 names: :data:`cbrs.sparql_hints.TOKENS`), never parsed here: only a ``LIMIT`` clause is added or
 lowered, and the parser still decides what the text means. A text this reading does not understand is
 left as it is (:func:`bounded` answers ``None``), and the caller runs it whole.
+
+A CONSTRUCT or DESCRIBE is bounded the same way, after its template: its ``LIMIT`` counts solutions,
+not triples, so the editor counts the triples that come back (:mod:`cbrs.web.editor`).
 """
 
 from __future__ import annotations
@@ -25,6 +28,9 @@ _LEXEMES = re.compile(
     re.DOTALL,
 )
 _PROLOGUE = frozenset({"PREFIX", "BASE", "VERSION"})
+# The forms a LIMIT bounds, and how many top-level blocks come before the solution modifiers: a
+# CONSTRUCT's template and then its WHERE block (one block in its short form, CONSTRUCT WHERE { }).
+_BLOCKS = {"SELECT": 1, "CONSTRUCT": 2, "DESCRIBE": 1}
 
 
 @dataclass(frozen=True)
@@ -38,14 +44,16 @@ class Bounded:
 
 
 def bounded(text: str, limit: int) -> Bounded | None:
-    """``text`` with a ``LIMIT`` of at most ``limit`` solutions, if it is a SELECT query this reading
-    understands; ``None`` for any other text (ASK, CONSTRUCT, DESCRIBE, an update, unbalanced brackets).
+    """``text`` with a ``LIMIT`` of at most ``limit`` solutions, if it is a SELECT, CONSTRUCT or DESCRIBE
+    query with a ``WHERE`` block that this reading understands; ``None`` for any other text (ASK, a
+    DESCRIBE of named resources alone, an update, unbalanced brackets).
 
     The ``LIMIT`` goes after the ``WHERE`` block's solution modifiers and before a closing ``VALUES``
     block, where the grammar puts it (``SelectQuery ... SolutionModifier ValuesClause``); a ``LIMIT``
     the query has is lowered to ``limit`` when greater, and kept when not."""
     depth = 0
     form: str | None = None
+    blocks = 0  # top-level blocks still to close before the solution modifiers
     where_closed = False
     values_at: int | None = None
     limit_word = False
@@ -58,15 +66,18 @@ def bounded(text: str, limit: int) -> Bounded | None:
             if depth < 0:
                 return None
             if depth == 0 and form is not None and not where_closed and match.group() == "}":
-                where_closed = True
+                blocks -= 1
+                where_closed = blocks == 0
         elif kind == "word":
             word = match.group().upper()
             if form is None:
                 if word in _PROLOGUE:
                     continue
-                if word != "SELECT":
+                if word not in _BLOCKS:
                     return None
-                form = word
+                form, blocks = word, _BLOCKS[word]
+            elif form == "CONSTRUCT" and word == "WHERE" and blocks == 2 and depth == 0:
+                blocks = 1  # the short form: no template block before this one
             elif where_closed and depth == 0:
                 if word == "VALUES" and values_at is None:
                     values_at = match.start()
