@@ -44,61 +44,89 @@ class Whereabouts:
         return f"{shorten(self.thing)} (the task's {self.given_as}) {at}{room}"
 
 
-def locate(kb: KnowledgeBase, requirement: Requirement, names: Iterable[str], belief: bool) -> dict[str, Whereabouts]:
-    """The whereabouts of the things ``requirement``'s inputs (called ``names``) designate, by input name.
+@dataclass(frozen=True)
+class WorldPlaces:
+    """Where the world graph puts things (the semantic map's positions and extents, and with ``belief``
+    the perceived positions over them) and their classes: read once per composition, in three queries."""
 
-    An input whose class designates no one thing (none, or several the requester does not own), or a
-    thing the world graph does not place, has none: nothing is known to cover, so nothing is filtered."""
-    rooms = _rooms(kb)
-    found: dict[str, Whereabouts] = {}
-    for name, parameter in zip(names, requirement.inputs, strict=True):
-        if not parameter.type:
-            continue
-        try:
-            thing = designate(kb, parameter.type, prefer=requirement.requested_by)
-        except KnowledgeBaseError:  # none or ambiguous: the run refuses it with its own reason
-            continue
-        bounds = _position(kb, thing, belief)
-        if bounds is not None:
-            found[name] = Whereabouts(name, thing, bounds, _room_of(bounds, rooms))
-    return found
+    types: Mapping[str, tuple[str, ...]]
+    bounds: Mapping[str, Bounds]
+    rooms: tuple[tuple[str, Bounds], ...]  # (room class, extent)
+
+    @classmethod
+    def read(cls, kb: KnowledgeBase, index: TaxonomyIndex, belief: bool) -> WorldPlaces:
+        facts: dict[str, dict[str, str]] = {}
+        for row in kb.select("map_facts"):
+            facts.setdefault(row["thing"].value, {}).setdefault(row["property"].value, row["value"].value)
+        types: dict[str, list[str]] = {}
+        for row in kb.select("map_types"):
+            types.setdefault(row["thing"].value, []).append(row["type"].value)
+        bounds = {thing: found for thing, values in facts.items() if (found := _bounds(values)) is not None}
+        if belief:
+            for row in kb.select("world_positions"):
+                thing, x, y = row["thing"].value, float(row["x"].value), float(row["y"].value)
+                bounds[thing] = (x, x, y, y)
+                if "type" in row and row["type"].value not in types.get(thing, []):
+                    types.setdefault(thing, []).append(row["type"].value)
+        rooms = tuple(
+            sorted(
+                (concept, bounds[thing])
+                for thing, concepts in types.items()
+                if thing in facts and thing in bounds
+                for concept in concepts
+                if _is_a(index, concept, _HOME + "Room")
+            )
+        )
+        return cls({k: tuple(v) for k, v in types.items()}, bounds, rooms)
+
+    def locate(
+        self, kb: KnowledgeBase, index: TaxonomyIndex, requirement: Requirement, names: Iterable[str]
+    ) -> dict[str, Whereabouts]:
+        """The whereabouts of the things ``requirement``'s inputs (called ``names``) designate, by input name.
+
+        An input whose class designates no one thing (none, or several the requester does not own), or a
+        thing the world graph does not place, has none: nothing is known to cover, so nothing is filtered.
+        """
+        found: dict[str, Whereabouts] = {}
+        for name, parameter in zip(names, requirement.inputs, strict=True):
+            concept = parameter.type
+            if not concept:
+                continue
+            things = [t for t, types in self.types.items() if any(_is_a(index, c, concept) for c in types)]
+            if len(things) > 1:  # several: the executor's choice (those the requester owns), or none
+                try:
+                    things = [designate(kb, concept, prefer=requirement.requested_by)]
+                except KnowledgeBaseError:
+                    continue
+            if len(things) == 1 and things[0] in self.bounds:
+                where = self.bounds[things[0]]
+                found[name] = Whereabouts(name, things[0], where, self.room_of(where))
+        return found
+
+    def room_of(self, bounds: Bounds) -> str | None:
+        """The class of the room whose extent holds ``bounds`` (all of it; the first by class name)."""
+        return next((concept for concept, extent in self.rooms if within(bounds, extent)), None)
 
 
-def _position(kb: KnowledgeBase, thing: str, belief: bool) -> Bounds | None:
-    """Where ``thing`` is: its perceived position (with ``belief``), its map position, or its extent."""
-    if belief:
-        for row in kb.select("world_positions", {"thing": thing}):
-            x, y = float(row["x"].value), float(row["y"].value)
-            return (x, x, y, y)
-    facts: dict[str, str] = {}
-    for row in kb.select("map_facts", {"thing": thing}):
-        facts.setdefault(row["property"].value, row["value"].value)
+def _bounds(values: Mapping[str, str]) -> Bounds | None:
+    """A thing's map position (a point) or else its extent; None when the map places it nowhere."""
     try:
-        if _HOME + "x" in facts and _HOME + "y" in facts:
-            x, y = float(facts[_HOME + "x"]), float(facts[_HOME + "y"])
+        if _HOME + "x" in values and _HOME + "y" in values:
+            x, y = float(values[_HOME + "x"]), float(values[_HOME + "y"])
             return (x, x, y, y)
-        corners = [facts.get(_HOME + axis) for axis in ("minX", "maxX", "minY", "maxY")]
+        corners = [values.get(_HOME + axis) for axis in ("minX", "maxX", "minY", "maxY")]
         if all(corner is not None for corner in corners):
             x0, x1, y0, y1 = (float(c) for c in corners if c is not None)
             return (x0, x1, y0, y1)
-    except ValueError:  # the map checks say so when the map is read; here it is just not placed
+    except ValueError:  # the map checks say so when the map is read for a run; here it is just not placed
         return None
     return None
 
 
-def _rooms(kb: KnowledgeBase) -> list[tuple[str, Bounds]]:
-    """The map's rooms as (class, extent)."""
-    found = []
-    for row in kb.select("designate", {"class": _HOME + "Room"}):
-        extent = _position(kb, row["thing"].value, belief=False)
-        if extent is not None:
-            found.append((row["type"].value, extent))
-    return sorted(found)
-
-
-def _room_of(bounds: Bounds, rooms: list[tuple[str, Bounds]]) -> str | None:
-    """The class of the room whose extent holds the thing (all of it; the first by class name)."""
-    return next((concept for concept, extent in rooms if within(bounds, extent)), None)
+def _is_a(index: TaxonomyIndex, concept: str, ancestor: str) -> bool:
+    if concept == ancestor:
+        return True
+    return concept in index and ancestor in index and index.canonical(ancestor) in index.is_a_ancestors(concept)
 
 
 class AreaRule:
@@ -106,12 +134,21 @@ class AreaRule:
 
     ``task`` (the requirement's SEA) is where the whole task happens: no one step need cover it (the
     robot crosses the home while each camera sees one room), but a component effective only outside it
-    cannot serve it."""
+    cannot serve it. With ``boxes`` off, two areas that both name area concepts are compared by those
+    alone (the thing's room against the component's rooms), and boxes only when a side names none."""
 
-    def __init__(self, index: TaxonomyIndex, places: Mapping[str, Whereabouts], task: EffectiveArea | None) -> None:
+    def __init__(
+        self,
+        index: TaxonomyIndex,
+        places: Mapping[str, Whereabouts],
+        task: EffectiveArea | None,
+        boxes: bool = False,
+    ) -> None:
         self.index = index
         self.places = dict(places)
         self.task = task
+        self.boxes = boxes
+        self._why: dict[tuple[str, frozenset[str]], str | None] = {}  # asked for every step's alternatives
 
     def relevant(self, advertisements: Iterable[Advertisement]) -> bool:
         """Whether the rule can refuse any of ``advertisements`` (if not, composition need not ask it)."""
@@ -121,13 +158,25 @@ class AreaRule:
         """Why ``ad`` cannot serve a step handling ``things`` (requirement input names); None: it can."""
         if ad is None or ad.area is None:
             return None
-        if self.task is not None and not reaches(self.index, self.task, ad.area):
-            return f"its effective area ({area_text(ad.area)}) lies outside the task's ({area_text(self.task)})"
-        for name in sorted(set(things)):
-            place = self.places.get(name)
-            if place is not None and uncovered(self.index, place.area, ad.area):
-                return f"its effective area ({area_text(ad.area)}) does not cover {place.text()}"
+        key = (ad.iri, frozenset(t for t in things if t in self.places))
+        if key not in self._why:
+            self._why[key] = self._why_not(ad.area, key[1])
+        return self._why[key]
+
+    def _why_not(self, area: EffectiveArea, things: frozenset[str]) -> str | None:
+        if self.task is not None and not reaches(self.index, *self._compared(self.task, area)):
+            return f"its effective area ({area_text(area)}) lies outside the task's ({area_text(self.task)})"
+        for name in sorted(things):
+            place = self.places[name]
+            if uncovered(self.index, *self._compared(place.area, area)):
+                return f"its effective area ({area_text(area)}) does not cover {place.text()}"
         return None
+
+    def _compared(self, wanted: EffectiveArea, offered: EffectiveArea) -> tuple[EffectiveArea, EffectiveArea]:
+        """The two areas as compared: by their concepts alone when both name some and boxes are off."""
+        if self.boxes or not (wanted.areas and offered.areas):
+            return wanted, offered
+        return EffectiveArea(wanted.areas), EffectiveArea(offered.areas)
 
 
 def area_text(area: EffectiveArea) -> str:
@@ -138,4 +187,4 @@ def area_text(area: EffectiveArea) -> str:
     return "; ".join(parts) or "unstated"
 
 
-__all__ = ["AreaRule", "Whereabouts", "area_text", "locate"]
+__all__ = ["AreaRule", "Whereabouts", "WorldPlaces", "area_text"]

@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING, Any
 import networkx as nx
 import pyoxigraph as ox
 
-from cbrs.actions.areas import AreaRule, locate
+from cbrs.actions.areas import AreaRule, WorldPlaces
 from cbrs.actions.errors import OrderingConflictError
 from cbrs.actions.graph import (
     SRE,
@@ -83,6 +83,8 @@ class ComposeConfig:
     matched: bool = True  # when nothing composes, one advertisement the matchmaker accepts for the whole requirement
     # a step's component must be effective where the task's things it handles are (SEA; actions.areas)
     respect_area: bool = True
+    # ... compared by their rooms when both name one; with area_boxes, by bounding boxes first (matchmaking's order)
+    area_boxes: bool = False
 
 
 class PlanStatus(Enum):
@@ -243,6 +245,7 @@ class Composer:
         self._pool: ServicePool | None = None
         self._belief = False
         self._state: list[Statement] | None = None  # what holds, read once per compose
+        self._places: WorldPlaces | None = None  # where things are, read once per compose (if needed)
         self._matchmaker: Matchmaker | None = None  # for _matched, made on first use
 
     @property
@@ -281,12 +284,12 @@ class Composer:
 
     def compose(self, task: str | Task | Requirement, belief: bool = False) -> CompositionResult:
         """Plan ``task``; with ``belief``, from what the belief graph says holds now as well."""
-        self._belief, self._state = belief, None
+        self._belief, self._state, self._places = belief, None, None
         try:
             self._state = self.world_state() if self.config.world_state else []
             return self._compose(task)
         finally:
-            self._belief, self._state = False, None
+            self._belief, self._state, self._places = False, None, None
 
     def _compose(self, task: str | Task | Requirement) -> CompositionResult:
         if isinstance(task, str):
@@ -456,10 +459,13 @@ class Composer:
     def area_rule(self, requirement: Requirement) -> AreaRule | None:
         """The SEA rule for ``requirement``'s steps: where its things are (the belief's positions when
         composing for a run), and its own area; None when it is off or can refuse none of the components."""
-        if not self.config.respect_area:
+        if not self.config.respect_area or not any(ad.area for ad in self.advertisements):
             return None
-        places = locate(self.kb, requirement, parameter_names(requirement.inputs), self._belief)
-        rule = AreaRule(self.index, places, requirement.area)
+        world = self._places or WorldPlaces.read(self.kb, self.index, self._belief)
+        if self._state is not None:  # composing: kept for its other attempts
+            self._places = world
+        places = world.locate(self.kb, self.index, requirement, parameter_names(requirement.inputs))
+        rule = AreaRule(self.index, places, requirement.area, self.config.area_boxes)
         return rule if rule.relevant(self.advertisements) else None
 
     def _orderings(self, task: Task | None) -> list[tuple[str, str, str]]:
@@ -1125,8 +1131,6 @@ class _Extraction:
             vertex = self.graph.vertices[iri]
             if iri == step.node or vertex.advertisement is None:
                 continue
-            if self.areas is not None and self.areas.why_not(vertex.advertisement, handled) is not None:
-                continue  # it would get the same values, for things it is not effective where they are
             feeds = []
             for best in into:
                 edge = best.get(iri)
@@ -1135,7 +1139,9 @@ class _Extraction:
                 feeds.append(edge.similarity)
             else:
                 fed = all(self._fed(iri, need, sources, given) for need in vertex.needs)
-                if fed and feeds:
+                # it would get the same values, so handle the same things: it must be effective where they are
+                fits = self.areas is None or self.areas.why_not(vertex.advertisement, handled) is None
+                if fed and feeds and fits:
                     found.append(((-min(feeds), vertex.cost, iri), iri))
         return [iri for _, iri in sorted(found)]
 
