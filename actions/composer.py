@@ -852,37 +852,61 @@ class _Extraction:
     def _judge(self, vertex: str, about: tuple[str, ...]) -> _Judged:
         """What ``vertex`` would handle as a new step serving ``about``, by the extraction's own preferences
         (a value the task gives first, else the best provider that fits), and why it cannot serve (its
-        area, or none of a need's providers fits): a component is passed over before it is chosen."""
-        key = (vertex, about)
-        found = self._judged.get(key)
-        if found is not None:
-            return found
-        assert self.areas is not None
+        area, or none of a need's providers fits): a component is passed over before it is chosen.
+
+        Providers are judged first, on a stack of its own (a chain of providers can be thousands long)."""
+        stack = [(vertex, about)]
+        while stack:
+            key = stack[-1]
+            if key in self._judged:
+                stack.pop()
+                continue
+            missing = [
+                (e.source, below)
+                for _, given, below, providers in self._ways(*key)
+                if given is None
+                for e in providers
+                if (e.source, below) not in self._judged
+            ]
+            if missing:
+                stack += missing
+                continue
+            self._judged[key] = self._judge_now(*key)
+            stack.pop()
+        return self._judged[(vertex, about)]
+
+    def _ways(self, vertex: str, about: tuple[str, ...]) -> list[tuple[Need, Edge | None, tuple[str, ...], list[Edge]]]:
+        """For each need of ``vertex`` serving ``about``: the value the task gives that a new step would take
+        (None: none), the classes its providers would serve, and its providers other than the task."""
         probe = _Step(-1, vertex, None, about=about)
-        things: set[str] = set()
-        why: str | None = None
-        blocked: Need | None = None
+        ways: list[tuple[Need, Edge | None, tuple[str, ...], list[Edge]]] = []
         for need in self.graph.needs(vertex):
             options = self._options(vertex, need, self._level(vertex))
             given = [e for e in options if e.source == SRI]
             if given and len(given) < len(options):
                 given = [e for e in given if not self._foreign(probe, e)]
-            if given:
-                if need.role == "input":
-                    things.add(min(given, key=lambda e: (self._aboutness(probe, e), *self._key(e))).offer.name)
-                continue
+            chosen = min(given, key=lambda e: (self._aboutness(probe, e), *self._key(e))) if given else None
             served = (need.statement.subject, need.statement.object) if need.statement is not None else ()
-            below = (*served, *about)
-            fit = [e for e in options if e.source != SRI and self._judge(e.source, below).why is None]
+            ways.append((need, chosen, (*served, *about), [e for e in options if e.source != SRI]))
+        return ways
+
+    def _judge_now(self, vertex: str, about: tuple[str, ...]) -> _Judged:
+        """``_judge`` once every provider of ``vertex``'s needs has been judged."""
+        assert self.areas is not None
+        things: set[str] = set()
+        for need, given, below, providers in self._ways(vertex, about):
+            if given is not None:
+                if need.role == "input":
+                    things.add(given.offer.name)
+                continue
+            fit = [e for e in providers if self._judged[(e.source, below)].why is None]
             if not fit:
-                why, blocked = f"no provider of its {need.text()} is effective where it is needed", need
-                break
+                why = f"no provider of its {need.text()} is effective where it is needed"
+                return _Judged(frozenset(things), why, need)
             if need.role == "input":
-                things |= self._judge(min(fit, key=self._key).source, below).things
-        if why is None:
-            why = self.areas.why_not(self.graph.vertices[vertex].advertisement, things)
-        judged = self._judged[key] = _Judged(frozenset(things), why, blocked)
-        return judged
+                things |= self._judged[(min(fit, key=self._key).source, below)].things
+        why_not = self.areas.why_not(self.graph.vertices[vertex].advertisement, things)
+        return _Judged(frozenset(things), why_not)
 
     def _pass_over(self, step: _Step, node: str, need: Need, candidates: list[Edge], about: tuple[str, ...]) -> None:
         """``need`` of ``step`` has providers, none of which can serve: an unmet need naming each and why.
