@@ -159,6 +159,8 @@ def test_plans_page_shows_the_plan_and_draws_the_graph(page: Any, shots: Path) -
     page.get_by_role("button", name="Plan").click()
     page.wait_for_url("**/plans?*")
     assert page.locator("tr[id^=step-]").count() == 15
+    table = page.locator(".plan-scroll")  # all six columns in view at 1280 px: the alternatives were not
+    assert table.evaluate("e => e.scrollWidth <= e.clientWidth")
     drawing = page.locator("img.drawing")
     drawing.scroll_into_view_if_needed()
     for _ in range(300):  # bounded: 30 s for the SVG to arrive and decode
@@ -178,6 +180,9 @@ NARROW_PAGES = (
     "/search?q=camera",
     "/match?requirement=req:FetchMyPen",
     "/plans?task=FetchMyPen",
+    "/resource?iri=svc:LocateMobileRobot_CeilingCamera01",  # its "Out:" heading scrolled 57 px sideways
+    "/resource?iri=http://example.org/" + "a" * 400,  # a 404 whose message held the IRI unbroken: 3,700 px
+    "/query?query=CONSTRUCT+WHERE+{+?s+?p+?o+}",
 )
 
 
