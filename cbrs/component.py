@@ -20,9 +20,14 @@ server then matches, plans and invokes it like any other component. See docs/com
 from __future__ import annotations
 
 import logging
+import math
 import signal
 import threading
+import time
+from collections import deque
 from collections.abc import Callable
+from concurrent.futures import Future
+from typing import Any
 
 import pyoxigraph as ox
 
@@ -42,6 +47,7 @@ log = logging.getLogger("cbrs.component")
 
 Hook = Callable[[], None]
 
+HEARTBEAT = "/cbrs/heartbeat"
 REREGISTER_ATTEMPTS = 5
 """Registrations tried after the server says the lease is gone, before the component gives up."""
 REREGISTER_BACKOFF = 2.0
@@ -183,26 +189,78 @@ class ConnectedComponent:
         self.ended: str | None = None
         """Why the component ended by itself (None while it serves or after ``stop()``)."""
         self._stop = threading.Event()
+        self._registered_at = time.monotonic()  # beats sent before it speak of an older registration
+        self._unanswered_since: float | None = None  # sent time of the oldest beat failed since one was answered
+        self._warned = False
         self._beat = threading.Thread(target=self._beat_loop, name="cbrs-heartbeat", daemon=True)
         self._beat.start()
 
     def _beat_loop(self) -> None:
-        while not self._stop.wait(self.heartbeat):
-            try:
-                self.client.call_sync("/cbrs/heartbeat", {}, timeout=self.heartbeat)
-            except BridgeClosedError:
+        """Beat every ``heartbeat`` seconds on a fixed schedule, whatever the server's answers take.
+
+        A beat is not waited for before the next is sent: a server busy with a simulation may answer
+        after more than a heartbeat, and it renews the lease when it reads the beat, not when the
+        answer arrives. Waiting for each answer (as this loop once did, for at most one heartbeat)
+        stretched the period to twice the heartbeat, two thirds of the default lease, and logged a
+        warning for each slow answer although the lease held. Answers are read in the order sent; at
+        most a lease's worth of beats wait at once."""
+        beats: deque[tuple[float, Future[dict[str, Any]]]] = deque()
+        in_flight = max(2, math.ceil(self.ttl / self.heartbeat) + 1)
+        due = time.monotonic()
+        while True:
+            now = time.monotonic()
+            due = max(due + self.heartbeat, now)  # after a hang, one beat now rather than a burst
+            if self._stop.wait(due - now) or not self._read_answers(beats):
                 return
+            if len(beats) < in_flight:
+                beats.append((time.monotonic(), self.client.call(HEARTBEAT, {}, timeout=self.ttl)))
+            self._watch_unanswered(beats)
+
+    def _read_answers(self, beats: deque[tuple[float, Future[dict[str, Any]]]]) -> bool:
+        """Act on the beats answered so far, oldest first; False when the component ends."""
+        while beats and beats[0][1].done():
+            sent, answer = beats.popleft()
+            try:
+                answer.result()
+            except BridgeClosedError:
+                return False
             except RemoteCallError as error:
                 text = str(error)
                 if DEREGISTERED in text:
                     self._end(f"the server says {text}; start the program again to register it again")
-                    return
-                if NO_LIVE_COMPONENT not in text:
+                    return False
+                if NO_LIVE_COMPONENT in text:
+                    if sent < self._registered_at:
+                        continue  # it speaks of the registration before the last one
+                    beats.clear()  # all sent before registering again: their answers say the same
+                    return self._register_again(text)
+                self._unanswered_since = min(self._unanswered_since or sent, sent)
+                if not text.startswith(f"service {HEARTBEAT!r} did not answer within"):
                     log.warning("heartbeat of %s failed: %s", self.component.iri, text)
-                elif not self._register_again(text):
-                    return
             except Exception as error:  # a missed beat is the server's to count, not a reason to stop
+                self._unanswered_since = min(self._unanswered_since or sent, sent)
                 log.warning("heartbeat of %s failed: %s", self.component.iri, error)
+            else:
+                if self._warned:
+                    log.warning("heartbeats of %s are answered again", self.component.iri)
+                self._unanswered_since, self._warned = None, False
+        return True
+
+    def _watch_unanswered(self, beats: deque[tuple[float, Future[dict[str, Any]]]]) -> None:
+        """Warn once when no beat has been answered for half the lease: the lease lapses if it goes on."""
+        waiting = [sent for sent in (self._unanswered_since, beats[0][0] if beats else None) if sent is not None]
+        if not waiting or self._warned:
+            return
+        silent = time.monotonic() - min(waiting)
+        if silent > self.ttl / 2:
+            self._warned = True
+            log.warning(
+                "no heartbeat of %s answered for %.1f s (its lease lasts %g s): the server is busy or unreachable;"
+                " the lease lapses if this goes on",
+                self.component.iri,
+                silent,
+                self.ttl,
+            )
 
     def _register_again(self, why: str) -> bool:
         """The lease is gone (the program hung, the network dropped): register again, a bounded number of
@@ -229,6 +287,8 @@ class ConnectedComponent:
                     return False
                 wait *= REREGISTER_BACKOFF
             else:
+                self._registered_at = time.monotonic()
+                self._unanswered_since, self._warned = None, False
                 log.warning("%s registered again (try %d)", self.component.iri, attempt)
                 return True
         return False
