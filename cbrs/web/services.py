@@ -16,6 +16,7 @@ from cbrs.kb.store import Term
 from cbrs.kb.vocab import CBRS
 from cbrs.web import context, resource
 from cbrs.web.links import display_text, short
+from cbrs.web.meets import requirements_met
 from cbrs.web.pages import FormError, Page, page
 
 blueprint = Blueprint("services", __name__)
@@ -97,6 +98,7 @@ def service() -> Page:
     elif isinstance(description, Advertisement):
         data["requirements"] = _requirements_for(kb, description) if match else []
         data["similar"] = _similar_url(data) if match else None
+        data["meets"] = [m.to_dict() for m in requirements_met(iri)] if match else []
     return Page("service.html", display_text(iri), data)
 
 
