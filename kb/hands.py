@@ -97,7 +97,8 @@ class HandError(MapError):
 
     def __init__(self, hand: str, arm: str, robot: str, prop: str, value: str | None, problem: str) -> None:
         self.hand, self.arm, self.robot, self.property, self.value = hand, arm, robot, prop, value
-        whose = f"the gripper of {local_name(arm)}" + (f" of {local_name(robot)}" if robot else "")
+        whose = "an arm" if hand == arm else f"the gripper of {local_name(arm)}"
+        whose += f" of {local_name(robot)}" if robot else ""
         said = f"has no home:{prop}" if value is None else f"has home:{prop} {value!r}"
         super().__init__(hand, f"({whose}) {said}: {problem}")
 

@@ -150,6 +150,7 @@ def test_an_arm_with_two_grippers_is_refused(tmp_path: Path) -> None:
     with pytest.raises(HandError) as refused:
         hands_of(tmp_path, f"home:jawOpening 0.08 ; {GEOMETRY}", arms=arms)
     assert refused.value.property == "hasGripper" and refused.value.value == f"{LAB}Hand and {LAB}Other"
+    assert "Arm (http://example.org/lab#Arm) (an arm of Robot) has home:hasGripper" in str(refused.value)
     assert "an arm ends in one gripper" in str(refused.value)
 
 
