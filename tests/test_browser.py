@@ -118,6 +118,15 @@ def test_sparql_editor_runs_a_query_into_a_table(page: Any, shots: Path) -> None
     page.locator("#query").fill("SELECT ?x WHERE {")
     page.get_by_role("button", name="Run").click()
     assert page.locator("#query-error").is_visible()  # the parser's message beside the editor
+    # Tab indents in the editor, so a keyboard user leaves it with Esc then Tab; the help (which describes
+    # the editor to a screen reader) says so: a user tabbing forward was held in the editor, unaware.
+    assert "Esc then Tab leaves the editor" in page.locator("#query-help").inner_text()
+    page.locator("#query").focus()
+    page.keyboard.press("Tab")
+    assert page.evaluate("document.activeElement.id") == "query"
+    page.keyboard.press("Escape")
+    page.keyboard.press("Tab")
+    assert page.evaluate("document.activeElement.textContent") == "Run"
 
 
 def test_matchmaking_ranks_the_ceiling_camera_first(page: Any, shots: Path) -> None:
