@@ -102,6 +102,7 @@ def serve(
         else:
             access = "read-write with the update token" if running.sparql.writable else "read-only"
         click.echo(f"cbrs serving {app.kb.store.location} ({access})")
+        click.echo(f"  browser   http://{host_text}:{running.http_port}/")  # the knowledge browser (docs/web.md)
         click.echo(
             f"  SPARQL    http://{host_text}:{running.http_port}/sparql "
             f"({config.endpoint.workers} query workers, {config.endpoint.timeout:g} s timeout)"

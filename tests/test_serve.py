@@ -247,6 +247,8 @@ def test_cbrs_serve_command_serves_until_ctrl_c(tmp_path: Any) -> None:
         assert sparql_url.startswith("http://127.0.0.1:") and bridge_url.startswith("ws://127.0.0.1:")
         answer = httpx.get(sparql_url, params={"query": "ASK { ?s ?p ?o }"}, timeout=WAIT)
         assert answer.json()["boolean"] is True
+        browser_url = next(line.split()[-1] for line in lines if line.strip().startswith("browser"))
+        assert "<h1>Overview</h1>" in httpx.get(browser_url, timeout=WAIT).text  # where a new user looks first
         with connect(bridge_url, open_timeout=WAIT) as ws:
             assert call(ws, "/rosapi/get_param_names", {})["result"] is True
         process.send_signal(signal.SIGINT)
