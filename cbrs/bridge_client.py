@@ -13,6 +13,7 @@ import itertools
 import json
 import logging
 import threading
+from collections import deque
 from collections.abc import Callable, Mapping
 from concurrent.futures import Future, ThreadPoolExecutor
 from typing import Any
@@ -25,6 +26,9 @@ from cbrs.actions.remote import RemoteCallError
 __all__ = ["BridgeClient", "BridgeClosedError", "HandlerAnswerError", "ServiceHandler"]
 
 log = logging.getLogger("cbrs.bridge_client")
+
+STATUSES_KEPT = 100
+"""Status messages a client keeps (a long-running component must not grow without bound)."""
 
 ServiceHandler = Callable[[dict[str, Any]], Mapping[str, Any]]
 """A provided service: the request's fields -> the response's fields (raise to answer result: false)."""
@@ -57,8 +61,10 @@ class BridgeClient:
         self._closing = False  # close() was called: the end is this client's, not the server's
         self.close_reason: str | None = None
         """Why the connection closed, once it has."""
-        self.statuses: list[dict[str, Any]] = []
-        """The status messages the server sent (its errors and warnings about this client's ops)."""
+        self.statuses: deque[dict[str, Any]] = deque(maxlen=STATUSES_KEPT)
+        """The last status messages the server sent (its errors and warnings about this client's ops);
+        each error is also logged as a warning, since it means a message of ours was refused (a service
+        response too large or malformed, say) and its caller got a failure in our place."""
         self._reader = threading.Thread(target=self._read, name="cbrs-bridge-reader", daemon=True)
         self._reader.start()
         if token is not None:
@@ -175,6 +181,8 @@ class BridgeClient:
             self._pool.submit(self._answer, message)
         elif op == "status":
             self.statuses.append(message)
+            if message.get("level") == "error":  # the server refused one of our messages: say so here
+                log.warning("the bridge at %s refused a message of this client: %s", self.url, message.get("msg"))
         elif op == "publish":
             msg = message.get("msg")
             for listener in self._listeners.get(str(message.get("topic")), []):

@@ -127,7 +127,9 @@ class Component:
         """Connect to the bridge at ``url``, register, provide the service and start the heartbeat.
 
         Raises :class:`RegistrationRefusedError` with the server's reason when it refuses the
-        registration; nothing was provided then, so a refused second copy harms the first."""
+        registration; nothing was provided then, so a refused second copy harms the first. An
+        ``on_start`` hook that raises disconnects the component (it is unavailable at once, and no
+        ``on_stop`` hook runs) before its error propagates."""
         if self._handler is None:
             raise ValueError(f"{self.iri} has no handler: decorate one with @component.handler")
         if not 0 < heartbeat < ttl:
@@ -140,8 +142,12 @@ class Component:
             client.close()
             raise
         connected = ConnectedComponent(self, client, heartbeat, registered, ttl)
-        for hook in self._on_start:
-            hook()
+        try:
+            for hook in self._on_start:
+                hook()
+        except BaseException:  # a component that did not start must not serve: its session closes
+            connected._close()
+            raise
         return connected
 
     def _register(self, client: BridgeClient, ttl: float) -> list[str]:
@@ -319,14 +325,19 @@ class ConnectedComponent:
             raise ComponentEndedError(self.component.iri, reason)
 
     def stop(self) -> None:
+        if self._close():
+            for hook in self.component._on_stop:
+                hook()
+
+    def _close(self) -> bool:
+        """Disconnect (the server marks the component unavailable at once); False if already done."""
         if self._stop.is_set():
-            return
+            return False
         self._stop.set()
         self.client.close()
         if self._beat is not threading.current_thread():
             self._beat.join(timeout=self.heartbeat + 1.0)
-        for hook in self.component._on_stop:
-            hook()
+        return True
 
     def __enter__(self) -> ConnectedComponent:
         return self

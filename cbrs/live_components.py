@@ -173,6 +173,12 @@ class LiveComponents:
     def register_call(self, args: dict[str, Any]) -> dict[str, Any]:
         caller = current_caller()
         if caller is not None and not caller.authorised:
+            config = self.sparql.config
+            if config.read_only or config.update_token is None:  # no token would help: say what would
+                raise ServiceError(
+                    "this server is read-only, so it registers no component: start cbrs serve with an update token "
+                    "(CBRS_UPDATE_TOKEN or --update-token-file, without --read-only) and give the component that token"
+                )
             raise ServiceError("registering a component needs the update token: send it first with the auth op")
         session = caller.session if caller is not None else "in-process"
         description = args.get("description")
