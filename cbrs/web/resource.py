@@ -1,4 +1,6 @@
-"""The page of any IRI: every triple it is the subject or the object of, grouped by predicate, with its graph.
+"""The page of any IRI: every triple it is the subject or the object of, grouped by predicate, with its graph,
+and the first triples that use it as their predicate (a link to a property was a 404 when the store said
+nothing about the property itself: rdf:type and rdfs:label, linked from every resource page).
 
 Every IRI link of the browser leads here (``links.py``). The resource page is not in the navigation, so
 it is registered by the taxonomy blueprint (:func:`attach`) rather than through ``PAGES``; its own error
@@ -97,7 +99,8 @@ def resource() -> Page:
     kb = context.kb()
     rows = kb.select("resource_triples", {"resource": iri})
     graph = _named_graph(iri)
-    if not rows and graph is None:
+    uses = kb.select("predicate_uses", {"predicate": iri})  # the query reads MAX_VALUES + 1
+    if not rows and graph is None and not uses:
         raise NotFoundError(iri)
     outgoing = _grouped(row for row in rows if row["direction"].value == "out")
     incoming = _grouped(row for row in rows if row["direction"].value == "in")
@@ -123,8 +126,22 @@ def resource() -> Page:
         "outgoing": outgoing,
         "incoming": incoming,
         "graph": graph,
+        "as_predicate": {
+            "triples": [
+                {"subject": term_data(row["subject"]), "object": term_data(row["object"]), "graph": row["graph"].value}
+                for row in uses[:MAX_VALUES]
+            ],
+            "more": len(uses) > MAX_VALUES,
+            "query": _uses_query(iri) if uses else None,
+        },
     }
     return Page("resource.html", display_text(iri), data)
+
+
+def _uses_query(iri: str) -> str:
+    """The SPARQL editor's text that lists every triple with ``iri`` as its predicate (shown to the user
+    and run only by the editor; ``iri`` passed :func:`iri_parameter`, so it holds no ``>``)."""
+    return f"SELECT ?subject ?object ?graph\nWHERE {{ GRAPH ?graph {{ ?subject <{iri}> ?object }} }}"
 
 
 def _named_graph(iri: str) -> dict[str, int] | None:
