@@ -303,9 +303,11 @@ class ComponentRegistry:
         """Refuse a statement, new to the store, about a term another graph than graph:services (and the
         derived graph:entailed) describes: a registration is read through the union graph by everyone, so
         one stray ``home:Cup rdfs:subClassOf home:Door`` would make every robot's cup a door, and stay
-        after deregistration. The advertisements, their own nodes, the devices they name (a lab's door
-        motor placed in the map first) and the input's new terms (a lab's device kind) are its own;
-        repeating what the store already holds changes nothing and passes."""
+        after deregistration. Another advertisement is foreign too: a second device name stated for a
+        camera by a kitchen light's registration renamed the camera and outlived the light. The
+        advertisements, their own nodes, the devices they name (a lab's door motor placed in the map
+        first) and the input's new terms (a lab's device kind) are its own; repeating what the store
+        already holds changes nothing and passes."""
         own = {GraphName.SERVICES.node, GraphName.ENTAILED.node}
         ads = {ox.NamedNode(iri) for iri in iris}
         devices = {q.object for q in quads if q.subject in ads and q.predicate.value == CBRS.device}
@@ -317,6 +319,8 @@ class ComponentRegistry:
             if is_skolem(subject.value):
                 continue
             graphs = sorted({q.graph_name for q in self._store.quads(subject, None, None, None)} - own, key=str)
+            if not graphs and self.is_registered(subject.value):  # another advertisement: its own registration's
+                graphs = [GraphName.SERVICES.node]
             if not graphs:
                 continue
             for quad in quads:
