@@ -18,7 +18,7 @@ from cbrs.kb import Advertisement, EffectiveArea, KnowledgeBase, Requirement
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import PREFIXES, shorten
 from cbrs.kb.semantic_map import designate
-from cbrs.reasoner.sea import Bounds, reaches, uncovered, within
+from cbrs.reasoner.sea import Bounds, covers_concept, overlap, reaches, within
 from cbrs.reasoner.taxonomy import TaxonomyIndex
 
 _HOME = PREFIXES["home"]
@@ -26,22 +26,23 @@ _HOME = PREFIXES["home"]
 
 @dataclass(frozen=True)
 class Whereabouts:
-    """Where the thing a requirement input names is: its position (a point) or extent, and its room."""
+    """Where the thing a requirement input names is: its position (a point) or extent, and its rooms (the
+    classes of those its point is in or its extent overlaps: a door in the wall between two is in both)."""
 
     given_as: str  # the requirement input's name
     thing: str
     bounds: Bounds
-    room: str | None  # the class of the room it is in (home:Kitchen)
+    rooms: tuple[str, ...]
 
     @property
-    def area(self) -> EffectiveArea:
-        return EffectiveArea((self.room,) if self.room else (), self.bounds)
+    def point(self) -> bool:
+        return self.bounds[0] == self.bounds[1] and self.bounds[2] == self.bounds[3]
 
     def text(self) -> str:
         x0, x1, y0, y1 = self.bounds
-        at = f"at ({x0:.2f}, {y0:.2f})" if (x0, y0) == (x1, y1) else f"over x {x0:g}..{x1:g}, y {y0:g}..{y1:g}"
-        room = f" in {shorten(self.room)}" if self.room else ""
-        return f"{shorten(self.thing)} (the task's {self.given_as}) {at}{room}"
+        at = f"at ({x0:.2f}, {y0:.2f})" if self.point else f"over x {x0:g}..{x1:g}, y {y0:g}..{y1:g}"
+        rooms = f" in {' and '.join(shorten(r) for r in self.rooms)}" if self.rooms else ""
+        return f"{shorten(self.thing)} (the task's {self.given_as}) {at}{rooms}"
 
 
 @dataclass(frozen=True)
@@ -100,12 +101,13 @@ class WorldPlaces:
                     continue
             if len(things) == 1 and things[0] in self.bounds:
                 where = self.bounds[things[0]]
-                found[name] = Whereabouts(name, things[0], where, self.room_of(where))
+                found[name] = Whereabouts(name, things[0], where, self.rooms_of(where))
         return found
 
-    def room_of(self, bounds: Bounds) -> str | None:
-        """The class of the room whose extent holds ``bounds`` (all of it; the first by class name)."""
-        return next((concept for concept, extent in self.rooms if within(bounds, extent)), None)
+    def rooms_of(self, bounds: Bounds) -> tuple[str, ...]:
+        """The classes of the rooms that hold a point, or that an extent overlaps."""
+        point = bounds[0] == bounds[1] and bounds[2] == bounds[3]
+        return tuple(dict.fromkeys(c for c, extent in self.rooms if (within if point else overlap)(bounds, extent)))
 
 
 def _bounds(values: Mapping[str, str]) -> Bounds | None:
@@ -168,9 +170,20 @@ class AreaRule:
             return f"its effective area ({area_text(area)}) lies outside the task's ({area_text(self.task)})"
         for name in sorted(things):
             place = self.places[name]
-            if uncovered(self.index, *self._compared(place.area, area)):
+            if not self._reaches(place, area):
                 return f"its effective area ({area_text(area)}) does not cover {place.text()}"
         return None
+
+    def _reaches(self, place: Whereabouts, area: EffectiveArea) -> bool:
+        """Whether a component effective in ``area`` can act on or perceive the thing at ``place``: one of
+        its rooms is an area the component names or below one (by boxes, or when a side names no area:
+        its point is in the component's box, its extent overlaps it). Nothing to compare: it can."""
+        by_rooms = bool(place.rooms and area.areas)
+        if by_rooms and not (self.boxes and area.bounds):
+            return any(covers_concept(self.index, offered, room) for offered in area.areas for room in place.rooms)
+        if area.bounds:
+            return (within if place.point else overlap)(place.bounds, area.bounds)
+        return True
 
     def _compared(self, wanted: EffectiveArea, offered: EffectiveArea) -> tuple[EffectiveArea, EffectiveArea]:
         """The two areas as compared: by their concepts alone when both name some and boxes are off."""

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 
-from cbrs.actions.areas import AreaRule, WorldPlaces
+from cbrs.actions.areas import AreaRule, Whereabouts, WorldPlaces
 from cbrs.actions.belief import BeliefState, Observation
 from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, PlanStatus
 from cbrs.actions.graph import parameter_names
@@ -188,3 +188,21 @@ def test_the_sea_rule_is_matchmakings(bundled_kb: KnowledgeBase) -> None:
     assert overlap((0, 6, 0, 5), (5, 7, 1, 2))
     assert not overlap((0, 6, 0, 5), (6, 10, 0, 5))  # rooms that share a wall
     assert overlap((0, 6, 0, 5), (6, 6, 2, 2))  # a point on the wall is in
+
+
+def test_a_thing_in_the_wall_between_two_rooms_is_in_both(bundled_kb: KnowledgeBase) -> None:
+    """A door in the wall between the living room and the kitchen: a kitchen door motor reaches it."""
+    composer = Composer(bundled_kb)
+    world = WorldPlaces.read(bundled_kb, composer.index, belief=False)
+    extents = dict(world.rooms)
+    kitchen, living = extents[HOME + "Kitchen"], extents[HOME + "LivingRoom"]
+    assert kitchen[0] == living[1]  # the map's kitchen lies east of the living room, wall to wall
+    y = (max(kitchen[2], living[2]) + min(kitchen[3], living[3])) / 2
+    door = (kitchen[0] - 0.05, kitchen[0] + 0.05, y - 0.5, y + 0.5)
+    rooms = world.rooms_of(door)
+    assert set(rooms) == {HOME + "Kitchen", HOME + "LivingRoom"}
+    rule = AreaRule(composer.index, {"door": Whereabouts("door", "door", door, rooms)}, None)
+    assert rule.why_not(_ad("motor", EffectiveArea((HOME + "Kitchen",), kitchen)), {"door"}) is None
+    assert rule.why_not(_ad("bedroom", EffectiveArea((HOME + "Bedroom",))), {"door"}) is not None
+    by_boxes = AreaRule(composer.index, {"door": Whereabouts("door", "door", door, rooms)}, None, boxes=True)
+    assert by_boxes.why_not(_ad("motor", EffectiveArea((HOME + "Kitchen",), kitchen)), {"door"}) is None
