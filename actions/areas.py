@@ -5,8 +5,10 @@ thing is: a ceiling camera over the bedroom cannot find a pen on the kitchen tab
 requirement's inputs that name something the world graph places (the belief's perceived position when
 composing for a run, else the semantic map's); a step's things are those of the inputs it is given,
 directly or through the steps that feed it (the pen's colour feature leads the recogniser to the pen).
-A component with no SEA model is effective everywhere. The rule that compares the two areas is
-matchmaking's (``reasoner.sea``); docs/composition.md says why this one and not covering the task's.
+A component with no SEA model is effective everywhere. The comparison's parts are matchmaking's
+(``reasoner.sea``: an area concept covers the rooms at or below it by is-a or has-part links; boxes hold
+or overlap); docs/composition.md says why rooms come before boxes here, and why no step need cover the
+task's whole area.
 """
 
 from __future__ import annotations
