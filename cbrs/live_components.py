@@ -20,6 +20,7 @@ loses its lease at its next store write, and its heartbeat says so (:data:`DEREG
 from __future__ import annotations
 
 import logging
+import math
 import threading
 import time
 from collections import OrderedDict
@@ -63,6 +64,9 @@ NO_LIVE_COMPONENT = "this session has no live component"
 """How a heartbeat says the session's registration is gone (its lease lapsed): register again."""
 DEREGISTERED = "was deregistered"
 """How a heartbeat says a component was deregistered (``cbrs deregister``): do not register it again."""
+STALL_PERIODS = 4
+"""A gap of more than this many watchdog periods (1 s at the default lease) between two moments this
+server kept time means it stood still (stopped, suspended, starved): no lease is charged for it."""
 ENDED_SESSIONS = 1024
 """Sessions whose ended components a heartbeat can still name (an HTTP lease never disconnects)."""
 
@@ -161,6 +165,9 @@ class LiveComponents:
         self._guard = threading.Lock()
         self._stop = threading.Event()
         self._watchdog: threading.Thread | None = None
+        self._period = min(0.25, ttl / 4)  # the watchdog's
+        self._seen = clock()  # when this server last kept time (the watchdog, a registration, a heartbeat)
+        self._stood_still = 0.0  # seconds this server did not run, which no lease is charged
 
     # -- the bridge services ------------------------------------------------------------------
 
@@ -269,7 +276,7 @@ class LiveComponents:
                 iris = kb.registry.update(turtle, "<registration>")
             else:
                 iris = kb.registry.register(turtle, "<registration>")
-            now = self._clock()
+            now = self._now()
             for iri in iris:
                 kb.liveness.renew(iri, ttl, registered_by=f"{self.name} session {session}")
                 with self._guard:
@@ -295,7 +302,7 @@ class LiveComponents:
     def renew(self, session: str) -> list[str]:
         """Renew the leases of ``session``'s components; the store is written when half a lease has passed,
         and then a component deregistered meanwhile (``cbrs deregister``) loses its lease and its state."""
-        now = self._clock()
+        now = self._now()
         renewed, stale, unprovided = [], [], []
         with self._guard:
             for iri, lease in self._leases.items():
@@ -352,7 +359,7 @@ class LiveComponents:
 
     def expire_lapsed(self) -> list[str]:
         """End the leases not renewed in time; returns the components made unavailable."""
-        now = self._clock()
+        now = self._now()
         with self._guard:
             lapsed = [
                 (iri, lease.session, lease.service) for iri, lease in self._leases.items() if lease.deadline < now
@@ -367,6 +374,25 @@ class LiveComponents:
     def live(self) -> list[str]:
         with self._guard:
             return sorted(self._leases)
+
+    def _now(self) -> float:
+        """The time leases are kept in: the clock, less the time this server stood still.
+
+        While the server process does not run (stopped with SIGSTOP, its host suspended, or every thread
+        held up by one long call that keeps the GIL) no heartbeat can be read, so the components beating
+        all along would find their leases lapsed when it runs again: a gap of more than STALL_PERIODS
+        watchdog periods in the server's own timekeeping is not counted against any lease, and the
+        leases are written to the store again at their next renewal (other servers read them by time)."""
+        with self._guard:
+            now = self._clock()
+            gap = now - self._seen
+            self._seen = now
+            if self._watchdog is not None and gap > STALL_PERIODS * self._period:
+                self._stood_still += gap - STALL_PERIODS * self._period
+                for lease in self._leases.values():
+                    lease.written_until = -math.inf
+                log.info("this server stood still for %.1f s: the leases are not charged for it", gap)
+            return now - self._stood_still
 
     def _leases_of(self, session: str) -> list[tuple[str, _Lease]]:
         with self._guard:
@@ -389,6 +415,7 @@ class LiveComponents:
     def start(self) -> None:
         if self._watchdog is None:
             self._stop.clear()
+            self._now()  # time kept from here
             self._watchdog = threading.Thread(target=self._watch, name="cbrs-leases", daemon=True)
             self._watchdog.start()
 
@@ -399,8 +426,7 @@ class LiveComponents:
             self._watchdog = None
 
     def _watch(self) -> None:
-        period = min(0.25, self.ttl / 4)
-        while not self._stop.wait(period):
+        while not self._stop.wait(self._period):
             try:
                 self.expire_lapsed()
             except Exception:  # the watchdog must outlive a failed write
