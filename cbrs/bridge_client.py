@@ -18,7 +18,7 @@ from collections.abc import Callable, Mapping
 from concurrent.futures import Future, ThreadPoolExecutor
 from typing import Any
 
-from websockets.exceptions import ConnectionClosed
+from websockets.exceptions import ConnectionClosed, InvalidHandshake, InvalidURI
 from websockets.sync.client import ClientConnection, connect
 
 from cbrs.actions.remote import RemoteCallError
@@ -51,6 +51,16 @@ class BridgeClient:
             )
         except (OSError, TimeoutError) as error:
             raise BridgeClosedError(f"cannot reach the bridge at {url}: {error}") from error
+        except InvalidURI:
+            raise BridgeClosedError(
+                f"{url} is not a websocket URL: give the bridge as ws://HOST:PORT (cbrs serve's --bridge-port, 9090"
+                " by default)"
+            ) from None
+        except InvalidHandshake as error:  # something answered, but no websocket: the HTTP port, say
+            raise BridgeClosedError(
+                f"{url} is no rosbridge websocket ({error}): is it cbrs serve's HTTP port? Its bridge is on"
+                " --bridge-port, 9090 by default, as cbrs serve prints on start"
+            ) from None
         self._send_lock = threading.Lock()
         self._ids = itertools.count(1)
         self._waiting: dict[str, Future[dict[str, Any]]] = {}

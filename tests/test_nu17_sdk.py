@@ -6,7 +6,7 @@ every wait is a bounded poll."""
 from __future__ import annotations
 
 import logging
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 
 import pytest
 
@@ -69,3 +69,19 @@ def test_an_answer_the_server_refuses_is_logged_in_the_components_process(
         assert eventually(lambda: "refused a message of this client" in caplog.text)
     refusals = [r for r in caplog.records if "refused a message" in r.getMessage()]
     assert "exceeds the limit" in refusals[0].getMessage()
+
+
+@pytest.mark.parametrize(
+    ("wrong", "said"),
+    [
+        pytest.param(lambda s: f"ws://127.0.0.1:{s.http_port}", "HTTP port", id="the-http-port"),
+        pytest.param(lambda s: f"http://127.0.0.1:{s.bridge_port}", "not a websocket URL", id="an-http-url"),
+    ],
+)
+def test_a_wrong_bridge_url_is_one_line_saying_which_to_give(
+    server: Server, wrong: Callable[[Server], str], said: str
+) -> None:
+    with pytest.raises(SystemExit) as ended:
+        sdk_thermometer().run(wrong(server), TOKEN)
+    assert said in str(ended.value.code) and "--bridge-port" in str(ended.value.code)
+    assert str(ended.value.code).startswith("cbrs component: ")
