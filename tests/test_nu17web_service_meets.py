@@ -97,3 +97,22 @@ def test_a_requirement_taken_away_leaves_the_list_at_the_next_page() -> None:
     assert "req:RobotSelfPosition" in [m["name"] for m in _service(client, CAMERA)["meets"]]
     kb.registry.deregister(expand("req:RobotSelfPosition"))
     assert "req:RobotSelfPosition" not in [m["name"] for m in _service(client, CAMERA)["meets"]]
+
+
+def test_on_a_big_store_the_page_offers_the_list_until_the_rankings_are_read() -> None:
+    """Past CBRS_MEETS_INLINE advertisements a service page does not wait for the matchmaker (on OWLS-TC
+    the first service page took 7 to 12 s); it links the list, and shows it once the rankings are read."""
+    kb = KnowledgeBase.open(":memory:")
+    app = create_app(SparqlService(kb))
+    app.config["CBRS_MEETS_INLINE"] = 10  # the bundled store has 53
+    client = app.test_client()
+    offered = _service(client, CAMERA)
+    assert offered["meets"] is None and offered["meets_url"].endswith("meets=all#meets-heading")
+    page = client.get("/service", query_string={"iri": CAMERA}).get_data(as_text=True)
+    assert "List the requirements it meets" in page and 'id="meets"' not in page
+    asked = client.get(offered["meets_url"].replace("/service", "/service.json", 1)).get_json()
+    assert "req:RobotSelfPosition" in [m["name"] for m in asked["meets"]]
+    other = _service(client, "svc:LocateMobileRobot_CeilingCamera02")  # read now: shown at once
+    assert other["meets"] is not None and other["meets_url"] is None
+    kb.registry.deregister(expand("svc:DeadReckoning_P3DX01"))  # a write: the rankings are stale
+    assert _service(client, CAMERA)["meets"] is None

@@ -67,6 +67,12 @@ class GenerationCache:
             self._kept[key] = (generation, value)
             return value
 
+    def holds(self, kb: KnowledgeBase, key: str) -> bool:
+        """Whether :meth:`get` would answer ``key`` without computing it."""
+        kept = self._kept.get(key)
+        generation = getattr(kb.store, "generation", None)
+        return kept is not None and generation is not None and kept[0] == generation
+
 
 class TooManyStreamsError(KnowledgeBaseError):
     """Every stream slot is taken, or this client holds as many streams as one client may."""
@@ -136,8 +142,17 @@ def lock() -> threading.RLock:
 
 def per_generation(key: str, compute: Callable[[], T]) -> T:
     """``compute()``, kept under ``key`` until the store is written (:class:`GenerationCache`)."""
-    cache: GenerationCache = current_app.extensions.setdefault("cbrs.generation_cache", GenerationCache())
-    return cache.get(kb(), key, compute)
+    return _generation_cache().get(kb(), key, compute)
+
+
+def kept(key: str) -> bool:
+    """Whether :func:`per_generation` holds ``key`` for the store as it is now."""
+    return _generation_cache().holds(kb(), key)
+
+
+def _generation_cache() -> GenerationCache:
+    found: GenerationCache = current_app.extensions.setdefault("cbrs.generation_cache", GenerationCache())
+    return found
 
 
 def matchmakers() -> Matchmakers:

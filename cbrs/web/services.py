@@ -16,7 +16,7 @@ from cbrs.kb.store import Term
 from cbrs.kb.vocab import CBRS
 from cbrs.web import context, resource
 from cbrs.web.links import display_text, short
-from cbrs.web.meets import requirements_met
+from cbrs.web.meets import INLINE_ADVERTISEMENTS, requirements_met, shown_inline
 from cbrs.web.pages import FormError, Page, page
 
 blueprint = Blueprint("services", __name__)
@@ -98,8 +98,17 @@ def service() -> Page:
     elif isinstance(description, Advertisement):
         data["requirements"] = _requirements_for(kb, description) if match else []
         data["similar"] = _similar_url(data) if match else None
-        data["meets"] = [m.to_dict() for m in requirements_met(iri)] if match else []
+        data["meets"], data["meets_url"] = _meets(kb, iri) if match else ([], None)
     return Page("service.html", display_text(iri), data)
+
+
+def _meets(kb: KnowledgeBase, iri: str) -> tuple[list[dict[str, Any]] | None, str | None]:
+    """The requirements the advertisement meets, or ``None`` and the link that lists them on a big store
+    (:func:`cbrs.web.meets.shown_inline`)."""
+    limit = int(current_app.config.get("CBRS_MEETS_INLINE", INLINE_ADVERTISEMENTS))
+    if shown_inline(len(advertisement_rows(kb)), limit, request.args.get("meets") == "all"):
+        return [m.to_dict() for m in requirements_met(iri)], None
+    return None, url_for("services.service", iri=iri, meets="all", _anchor="meets-heading")
 
 
 _TEXT_ROLES = {CBRS.Precondition: "precondition", CBRS.Effect: "effect", CBRS.DeleteEffect: "delete effect"}
