@@ -140,6 +140,9 @@ def test_matchmaking_ranks_the_ceiling_camera_first(page: Any, shots: Path) -> N
     first.locator("summary").click()  # its explanation: the entity pairs
     assert "home:RobotLocation" in first.locator(".explanation").inner_text()
     assert page.locator("#ranking-wu-palmer").is_visible()  # the baseline beside it
+    heights = page.locator("#ranking-sem-str ~ ol summary.candidate .rank, #ranking-sem-str ~ * summary .rank")
+    tall = heights.evaluate_all("marks => marks.map(mark => mark.getBoundingClientRect().height)")
+    assert len(tall) == 10 and len(set(tall)) == 1  # "10 ▸" on one line, as "1 ▸" is (it wrapped)
     snap(page, shots, "matchmaking")
 
 
