@@ -246,6 +246,7 @@ class Composer:
         self._belief = False
         self._state: list[Statement] | None = None  # what holds, read once per compose
         self._places: WorldPlaces | None = None  # where things are, read once per compose (if needed)
+        self._places_at: tuple[tuple[object, bool], WorldPlaces] | None = None  # and kept while the store is unchanged
         self._matchmaker: Matchmaker | None = None  # for _matched, made on first use
 
     @property
@@ -461,12 +462,24 @@ class Composer:
         composing for a run), and its own area; None when it is off or can refuse none of the components."""
         if not self.config.respect_area or not any(ad.area for ad in self.advertisements):
             return None
-        world = self._places or WorldPlaces.read(self.kb, self.index, self._belief)
+        world = self._places or self._world_places()
         if self._state is not None:  # composing: kept for its other attempts
             self._places = world
         places = world.locate(self.kb, self.index, requirement, parameter_names(requirement.inputs))
         rule = AreaRule(self.index, places, requirement.area, self.config.area_boxes)
         return rule if rule.relevant(self.advertisements) else None
+
+    def _world_places(self) -> WorldPlaces:
+        """Where things are, read again only when an embedded store has been written since (a remote
+        store's writes are not counted: it is read for every composition)."""
+        generation = getattr(self.kb.store, "generation", None)
+        key = (generation, self._belief)
+        if generation is not None and self._places_at is not None and self._places_at[0] == key:
+            return self._places_at[1]
+        world = WorldPlaces.read(self.kb, self.index, self._belief)
+        if generation is not None:
+            self._places_at = (key, world)
+        return world
 
     def _orderings(self, task: Task | None) -> list[tuple[str, str, str]]:
         if task is None or task.action is None:
