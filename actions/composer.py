@@ -933,8 +933,10 @@ class _Extraction:
             if lower is None or any(j.blocked is None for j in judged.values()):
                 break
             served = (lower.statement.subject, lower.statement.object) if lower.statement is not None else ()
-            node, need, about = best, lower, (*served, *about)
-            candidates = [e for e in self._options(node, need, self._level(node)) if e.source != SRI]
+            deeper = [e for e in self._options(best, lower, self._level(best)) if e.source != SRI]
+            if not deeper:
+                break
+            node, need, about, candidates = best, lower, (*served, *about), deeper
             chain = (*chain, shorten(node))
         passed = tuple(sorted((iri, j.why or "") for iri, j in judged.items()))
         self.unsatisfied.append(Unsatisfied(need.text(), node, chain, out_of_area=passed))
