@@ -221,6 +221,13 @@ def test_pages_fit_a_phone_and_pictures_open_on_their_middle(browser: Any, serve
         context.close()
 
 
+def test_the_services_table_keeps_each_kind_on_one_line(page: Any) -> None:
+    page.goto("/services")
+    kinds = page.locator("table#advertisements tbody td:nth-child(1) a")
+    lines = kinds.evaluate_all("links => links.map(link => link.getClientRects().length)")
+    assert len(lines) == 53 and set(lines) == {1}  # "PhysicalManipulation" broke after its 19th letter
+
+
 def test_search_from_the_header_with_the_slash_key(page: Any, shots: Path) -> None:
     page.goto("/services")
     page.locator("body").press("Escape")
