@@ -173,6 +173,11 @@ def test_plans_page_shows_the_plan_and_draws_the_graph(page: Any, shots: Path) -
     assert page.locator("tr[id^=step-]").count() == 15
     table = page.locator(".plan-scroll")  # all six columns in view at 1280 px: the alternatives were not
     assert table.evaluate("e => e.scrollWidth <= e.clientWidth")
+    lines = (
+        "cells => cells.map(cell => { const r = document.createRange(); r.selectNodeContents(cell);"
+        " return r.getClientRects().length; })"
+    )
+    assert set(table.locator("td.num").evaluate_all(lines)) == {1}  # "10" to "15" on one line, as "1" is
     drawing = page.locator("img.drawing")
     drawing.scroll_into_view_if_needed()
     for _ in range(300):  # bounded: 30 s for the SVG to arrive and decode
