@@ -105,9 +105,7 @@ def main() -> None:
     print("|---|---:|---:|---:|---:|")
     for folder, queries in collections.items():
         own = statistics.fmean(q.own for q in queries)
-        held_out = statistics.fmean(
-            learned_map([o for o in queries if o is not q], [q], args.c) for q in queries
-        )
+        held_out = statistics.fmean(learned_map([o for o in queries if o is not q], [q], args.c) for q in queries)
         others = [q for f, qs in collections.items() if f != folder for q in qs]
         across = learned_map(others, queries, args.c) if others else float("nan")
         print(f"| {folder.name} | {len(queries)} | {own:.4f} | {held_out:.4f} | {across:.4f} |", flush=True)

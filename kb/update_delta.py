@@ -208,7 +208,6 @@ class DataUpdate:
         removed = frozenset(q for q, present in after.items() if not present and self._present[q])
         return added, removed
 
-
     def undo(self, store: Store) -> None:
         """Put every quad the text names back as it was before the update ran, in one transaction: a
         refused update (kb/shapes.py puts back only the description graphs) leaves no other write behind."""

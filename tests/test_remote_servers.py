@@ -157,7 +157,7 @@ def test_a_batch_virtuoso_refuses_leaves_the_store_as_it_was(virtuoso_server: Vi
 def test_a_load_too_large_for_one_virtuoso_request_lands(virtuoso_server: VirtuosoServer, tmp_path: Path) -> None:
     virtuoso_server.clear()
     data = tmp_path / "big.nt"
-    data.write_text("".join(f"<http://e/s{i}> <http://e/p> \"{i}\" .\n" for i in range(5000)), encoding="utf-8")
+    data.write_text("".join(f'<http://e/s{i}> <http://e/p> "{i}" .\n' for i in range(5000)), encoding="utf-8")
     result = CliRunner().invoke(cli, ["--store", virtuoso_server.url, "load", str(data), "--graph", "world"])
     assert result.exit_code == 0, result.output
     store = RemoteStore.open(virtuoso_server.url)

@@ -66,9 +66,7 @@ def test_without_a_folder_nothing_is_written_and_the_process_keeps_its_copy(tmp_
     assert list(tmp_path.iterdir()) == []
 
 
-def test_the_environment_chooses_the_folder_or_turns_it_off(
-    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
-) -> None:
+def test_the_environment_chooses_the_folder_or_turns_it_off(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("CBRS_SEED_CACHE", str(tmp_path))
     assert SeedCache.default().folder == tmp_path
     monkeypatch.setenv("CBRS_SEED_CACHE", "off")
@@ -103,4 +101,3 @@ def test_the_digest_follows_the_bundled_files(monkeypatch: pytest.MonkeyPatch, t
 
     monkeypatch.setattr(seed_cache, "bundled_files", files)
     assert bundle_digest() != before
-
