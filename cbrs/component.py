@@ -136,7 +136,7 @@ class Component:
             raise ValueError(f"the heartbeat ({heartbeat} s) must be shorter than the lease ({ttl} s)")
         client = BridgeClient(url, token)
         try:
-            registered = self._register(client, ttl)
+            registered = self._register(client, ttl, token_given=token is not None)
             client.provide(self.service, self.service_type, self._handler)
         except BaseException:
             client.close()
@@ -150,12 +150,15 @@ class Component:
             raise
         return connected
 
-    def _register(self, client: BridgeClient, ttl: float) -> list[str]:
+    def _register(self, client: BridgeClient, ttl: float, token_given: bool = True) -> list[str]:
         args = {"description": self.description, "format": self.format, "ttl": ttl}
         try:
             answer = client.call_sync("/cbrs/register", args)
         except RemoteCallError as error:
-            raise RegistrationRefusedError(self.iri, _servers_reason(client, str(error))) from None
+            reason = _servers_reason(client, str(error))
+            if not token_given and "needs the update token" in reason:  # the protocol's words, and the SDK's fix
+                reason += "; this component was given no token (token=None): pass the server's update token"
+            raise RegistrationRefusedError(self.iri, reason) from None
         return list(answer.get("components", []))
 
     def run(self, url: str, token: str | None, heartbeat: float = 1.0, ttl: float = DEFAULT_TTL) -> None:

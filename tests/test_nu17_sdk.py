@@ -85,3 +85,10 @@ def test_a_wrong_bridge_url_is_one_line_saying_which_to_give(
         sdk_thermometer().run(wrong(server), TOKEN)
     assert said in str(ended.value.code) and "--bridge-port" in str(ended.value.code)
     assert str(ended.value.code).startswith("cbrs component: ")
+
+
+def test_a_component_given_no_token_is_told_so_in_the_sdks_words(server: Server) -> None:
+    with pytest.raises(RegistrationRefusedError) as refused:
+        sdk_thermometer().connect(url(server), None)
+    assert "needs the update token" in refused.value.reason and "token=None" in refused.value.reason
+    assert not server.kb.registry.is_registered(THERMOMETER)
