@@ -77,7 +77,7 @@ class WorldPlaces:
                 for thing, concepts in types.items()
                 if thing in facts and thing in bounds
                 for concept in concepts
-                if _is_a(index, concept, _HOME + "Room")
+                if index.is_a(concept, _HOME + "Room")
             )
         )
         return cls({k: tuple(v) for k, v in types.items()}, bounds, rooms)
@@ -95,7 +95,7 @@ class WorldPlaces:
             concept = parameter.type
             if not concept:
                 continue
-            things = [t for t, types in self.types.items() if any(_is_a(index, c, concept) for c in types)]
+            things = [t for t, types in self.types.items() if any(index.is_a(c, concept) for c in types)]
             if len(things) > 1:  # several: the executor's choice (those the requester owns), or none
                 try:
                     things = [designate(kb, concept, prefer=requirement.requested_by)]
@@ -125,12 +125,6 @@ def _bounds(values: Mapping[str, str]) -> Bounds | None:
     except ValueError:  # the map checks say so when the map is read for a run; here it is just not placed
         return None
     return None
-
-
-def _is_a(index: TaxonomyIndex, concept: str, ancestor: str) -> bool:
-    if concept == ancestor:
-        return True
-    return concept in index and ancestor in index and index.canonical(ancestor) in index.is_a_ancestors(concept)
 
 
 class AreaRule:

@@ -304,6 +304,12 @@ class TaxonomyIndex:
         best = max(common, key=lambda c: (self._depth[c], -(up_first[c] + up_second[c]), c))
         return best, up_first[best], up_second[best]
 
+    def is_a(self, concept: str, ancestor: str) -> bool:
+        """Whether ``concept`` is ``ancestor`` or below it by is-a links alone (not as a part of it)."""
+        if concept == ancestor:
+            return True
+        return concept in self and ancestor in self and self.canonical(ancestor) in self.is_a_ancestors(concept)
+
     def distance_down(self, lower: str, upper: str) -> int | None:
         """Links (is-a or has-part) from ``lower`` up to ``upper`` when it is above, else None."""
         return self.ancestors(lower).get(self.canonical(upper))

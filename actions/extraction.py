@@ -1,0 +1,639 @@
+"""Backward extraction of one plan from a searched service resource graph (paper section 4).
+
+From SRO and SRE down, each need of a step is bound, in this order of preference, to what the
+requirement supplies (SRI); for an input, the output of a sibling (a step made for the same consumer);
+otherwise a new step of the best qualified provider of a lower forward level, so the extraction cannot
+loop. Then identical invocations of static-data and method components are merged, the steps ordered
+(producers first, the action ontology's orderings respected, each step as late as it can be) and every
+step's drop-in alternatives listed. ``actions.composer`` says when and for what it is run.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass, field
+from enum import Enum
+from typing import Any
+
+import networkx as nx
+
+from cbrs.actions.areas import AreaRule
+from cbrs.actions.errors import OrderingConflictError
+from cbrs.actions.graph import SRE, SRI, SRO, Edge, Need, ServiceResourceGraph
+from cbrs.actions.plan import Binding, Plan, PlanStep, Source
+from cbrs.actions.search import SearchTrace
+from cbrs.actions.unmet import GOAL, Unsatisfied
+from cbrs.kb import Statement
+from cbrs.kb.namespaces import shorten
+from cbrs.reasoner.taxonomy import TaxonomyIndex
+
+
+class Objective(Enum):
+    SIMILARITY = "similarity"  # highest similarity first, cost breaks ties
+    COST = "cost"  # lowest cost first, similarity breaks ties
+
+
+@dataclass
+class _Bound:
+    need: Need
+    edge: Edge
+    source: int | None  # producing step id; None: the requirement
+
+
+@dataclass
+class _Step:
+    id: int
+    node: str
+    made_for: int | None
+    bindings: list[_Bound] = field(default_factory=list)
+    producers: list[int] = field(default_factory=list)
+    about: tuple[str, ...] = ()  # the classes of the statements this step serves, down from the goal
+
+
+@dataclass(frozen=True)
+class _Judged:
+    """What a component would handle as a new step (requirement input names), and why it cannot (None: it can)."""
+
+    things: frozenset[str]
+    why: str | None
+    blocked: Need | None = None  # the need none of whose providers can serve (else its own area is the why)
+
+
+class Extraction:
+    """Backward extraction of one plan from a searched SRG."""
+
+    def __init__(
+        self,
+        graph: ServiceResourceGraph,
+        trace: SearchTrace,
+        objective: Objective,
+        max_steps: int,
+        areas: AreaRule | None = None,
+    ) -> None:
+        self.graph = graph
+        self.trace = trace
+        self.objective = objective
+        self.max_steps = max_steps
+        self.areas = areas
+        self._judged: dict[tuple[str, tuple[str, ...]], _Judged] = {}  # see _judge
+        self._things: dict[int, frozenset[str]] = {}  # see _handled
+        self._explained: set[str] = set()  # vertices whose blocked needs _why has followed
+        self._best: dict[tuple[str, str], dict[str, Edge]] = {}  # see _best_from
+        self.steps: dict[int, _Step] = {}
+        self.unsatisfied: list[Unsatisfied] = []
+        goal_needs = [(SRO, n) for n in graph.needs(SRO)] + [(SRE, n) for n in graph.needs(SRE)]
+        if not goal_needs:
+            self.unsatisfied.append(Unsatisfied("an output or effect", GOAL, ("the requirement states none",)))
+            return
+        self._goal_needs = goal_needs
+        self._goal_concepts = {
+            c for _, n in goal_needs if n.statement is not None for c in (n.statement.subject, n.statement.object)
+        }
+        blocked = [(node, n) for node, n in goal_needs if not self._ready(node, n)]
+        if blocked:
+            for node, need in blocked:
+                wanted = need.text()
+                if node in (SRO, SRE):
+                    wanted = wanted.replace("precondition", "effect", 1).replace("input", "output", 1)
+                for cause in self._why(node, need, (f"the requirement's {wanted}",)):
+                    if all((cause.need, cause.consumer) != (u.need, u.consumer) for u in self.unsatisfied):
+                        self.unsatisfied.append(cause)
+            return
+        self._expand()
+        if self.areas is not None and not self.unsatisfied:
+            self._check_areas()
+
+    @property
+    def solved(self) -> bool:
+        return not self.unsatisfied
+
+    # a need is ready when some enabled vertex (below the consumer's level) meets it
+    def _ready(self, node: str, need: Need) -> bool:
+        return bool(self._options(node, need, self._level(node)))
+
+    def _level(self, node: str) -> int:
+        return self.trace.levels.get(node, len(self.graph.vertices) + 1) if node not in (SRO, SRE) else 10**9
+
+    def _options(self, node: str, need: Need, below: int) -> list[Edge]:
+        return [
+            e
+            for e in self.graph.providers(node, need)
+            if e.source in self.trace.levels and self.trace.levels[e.source] < below
+        ]
+
+    def _why(self, node: str, need: Need, chain: tuple[str, ...]) -> list[Unsatisfied]:
+        """Why ``need`` of ``node`` cannot be met: follow the best blocked provider down to a root cause.
+
+        Depth first, on a stack of its own: a chain of blocked providers can be thousands long."""
+        causes: list[Unsatisfied] = []
+        followed: list[str] = []  # the providers followed down to the need on top of the stack
+        on_path: set[str] = set()
+        stack: list[tuple[str, Need] | None] = [(node, need)]  # None: back up from the last provider followed
+        while stack:
+            item = stack.pop()
+            if item is None:
+                on_path.discard(followed.pop())
+                continue
+            node, need = item
+            providers = [e for e in self.graph.providers(node, need) if e.source != node]
+            if not providers:
+                causes.append(Unsatisfied(need.text(), node, self._chain(chain, followed)))
+                continue
+            best = providers[0]
+            if best.source in on_path:
+                causes.append(Unsatisfied(need.text(), node, self._chain(chain, followed), cycle=True))
+                continue
+            if best.source in self._explained:  # its causes are reported already, down another chain
+                continue
+            self._explained.add(best.source)
+            blocked = [
+                sub
+                for sub in self.graph.needs(best.source)
+                if not self._options(best.source, sub, self._level(best.source))
+            ]
+            if not blocked:
+                causes.append(Unsatisfied(need.text(), node, self._chain(chain, followed)))
+                continue
+            followed.append(best.source)
+            on_path.add(best.source)
+            stack.append(None)
+            stack.extend((best.source, sub) for sub in reversed(blocked))
+        return causes
+
+    @staticmethod
+    def _chain(start: tuple[str, ...], followed: list[str]) -> tuple[str, ...]:
+        return (*start, *map(shorten, followed))
+
+    def _key(self, edge: Edge) -> tuple[Any, ...]:
+        cost = self.trace.costs[edge.source]
+        level = self.trace.levels[edge.source]
+        if self.objective is Objective.COST:
+            return (round(cost, 9), -round(edge.similarity, 9), level, edge.source, edge.offer.name)
+        return (-round(edge.similarity, 9), round(cost, 9), level, edge.source, edge.offer.name)
+
+    def _new(self, node: str, made_for: int | None) -> _Step:
+        step = _Step(len(self.steps), node, made_for)
+        self.steps[step.id] = step
+        return step
+
+    def _expand(self) -> None:
+        goal = self._new(GOAL, None)
+        queue: deque[int] = deque([goal.id])
+        while queue:
+            step = self.steps[queue.popleft()]
+            needs = self._goal_needs if step.node == GOAL else [(step.node, n) for n in self.graph.needs(step.node)]
+            # pre-actions (P-E) first, then pre-services (I-O), as in the paper's backward search
+            needs.sort(key=lambda item: item[1].role != "precondition")
+            below = 10**9 if step.node == GOAL else self.trace.levels[step.node]
+            for node, need in needs:
+                options = self._options(node, need, below)
+                given = [e for e in options if e.source == SRI]
+                if given and len(given) < len(options):
+                    # another goal's thing (the tray the cup goes to) is no value for the steps of this
+                    # one (where the base parks to load the pen), which have a provider of their own
+                    given = [e for e in given if not self._foreign(step, e)]
+                if given:
+                    step.bindings.append(
+                        _Bound(need, min(given, key=lambda e: (self._aboutness(step, e), *self._key(e))), None)
+                    )
+                    continue
+                mine = [(e, p) for p in step.producers for e in options if e.source == self.steps[p].node]
+                if mine:  # a step already made for this consumer meets this need too
+                    edge, producer_id = min(mine, key=lambda item: (self._key(item[0]), item[1]))
+                    step.bindings.append(_Bound(need, edge, producer_id))
+                    continue
+                sibling = self._sibling(step, node, need)
+                if sibling is not None:
+                    step.bindings.append(sibling)
+                    continue
+                served = (need.statement.subject, need.statement.object) if need.statement is not None else ()
+                about = (*served, *step.about)
+                candidates = [e for e in options if e.source != SRI]
+                if self.areas is not None:
+                    fit = [e for e in candidates if self._judge(e.source, about).why is None]
+                    if not fit:
+                        self._pass_over(step, node, need, candidates, about)
+                        continue
+                    candidates = fit
+                best = min(candidates, key=self._key)
+                if len(self.steps) > self.max_steps:
+                    existing = next((other for other in self.steps.values() if other.node == best.source), None)
+                    if existing is not None:
+                        step.bindings.append(_Bound(need, best, existing.id))
+                        continue
+                producer = self._new(best.source, step.id)
+                producer.about = about
+                step.producers.append(producer.id)
+                step.bindings.append(_Bound(need, best, producer.id))
+                queue.append(producer.id)
+
+    def _aboutness(self, step: _Step, edge: Edge) -> int:
+        """How well a value the task gives fits what ``step`` is for: minus the depth of the most specific
+        class, among the statements it serves, that the value's class falls under (0 if none).
+
+        Descriptions link no input to a statement, so the data flow alone cannot tell which of the
+        task's things a step handles: given a mug and a tap, both physical objects, the grasp for
+        filling the mug must be the mug's, because the step serves (Drinkware, isLocated, BelowOfTap)
+        for (Mug, contains, Water). Goals name their things; this carries their classes down the plan."""
+        concept = edge.offer.concept
+        if concept is None or not step.about:
+            return 0
+        index = self.graph.pool.matcher.index
+        if concept not in index:
+            return 0
+        ancestors = index.is_a_ancestors(concept)
+        depths = [index.depth(c) for c in step.about if c in ancestors and c in index]
+        return -max(depths) if depths else 0
+
+    def _foreign(self, step: _Step, edge: Edge) -> bool:
+        """Whether a value the task gives belongs to another goal than the ones ``step`` serves: its class
+        falls under a class another goal names more specifically than under any class of the statements
+        ``step`` serves (a PenTray is an ObjectPlace, but the tray goal names it as a PenTray)."""
+        concept = edge.offer.concept
+        index = self.graph.pool.matcher.index
+        if concept is None or concept not in index or not step.about:
+            return False
+        ancestors = index.is_a_ancestors(concept)
+        others = [index.depth(c) for c in self._goal_concepts - set(step.about) if c in ancestors and c in index]
+        return bool(others) and max(others) > -self._aboutness(step, edge)
+
+    def _sibling(self, step: _Step, node: str, need: Need) -> _Bound | None:
+        """An output of a step made for the same consumer, if one meets this input."""
+        if need.role != "input" or step.made_for is None:
+            return None
+        level = self.trace.levels[step.node]
+        found: list[tuple[tuple[Any, ...], _Bound]] = []
+        for other_id in self.steps[step.made_for].producers:
+            other = self.steps[other_id]
+            if other.id == step.id or self.trace.levels[other.node] >= level:
+                continue
+            for edge in self.graph.providers(node, need):
+                if edge.source == other.node and edge.offer.role == "output":
+                    found.append(((-edge.similarity, other.id, edge.offer.name), _Bound(need, edge, other.id)))
+        return min(found, key=lambda item: item[0])[1] if found else None
+
+    # -- service effective areas (actions.areas) --------------------------------------------------
+
+    def _judge(self, vertex: str, about: tuple[str, ...]) -> _Judged:
+        """What ``vertex`` would handle as a new step serving ``about``, by the extraction's own preferences
+        (a value the task gives first, else the best provider that fits), and why it cannot serve (its
+        area, or none of a need's providers fits): a component is passed over before it is chosen.
+
+        Providers are judged first, on a stack of its own (a chain of providers can be thousands long)."""
+        stack = [(vertex, about)]
+        while stack:
+            key = stack[-1]
+            if key in self._judged:
+                stack.pop()
+                continue
+            missing = [
+                (e.source, below)
+                for _, given, below, providers in self._ways(*key)
+                if given is None
+                for e in providers
+                if (e.source, below) not in self._judged
+            ]
+            if missing:
+                stack += missing
+                continue
+            self._judged[key] = self._judge_now(*key)
+            stack.pop()
+        return self._judged[(vertex, about)]
+
+    def _ways(self, vertex: str, about: tuple[str, ...]) -> list[tuple[Need, Edge | None, tuple[str, ...], list[Edge]]]:
+        """For each need of ``vertex`` serving ``about``: the value the task gives that a new step would take
+        (None: none), the classes its providers would serve, and its providers other than the task."""
+        probe = _Step(-1, vertex, None, about=about)
+        ways: list[tuple[Need, Edge | None, tuple[str, ...], list[Edge]]] = []
+        for need in self.graph.needs(vertex):
+            options = self._options(vertex, need, self._level(vertex))
+            given = [e for e in options if e.source == SRI]
+            if given and len(given) < len(options):
+                given = [e for e in given if not self._foreign(probe, e)]
+            chosen = min(given, key=lambda e: (self._aboutness(probe, e), *self._key(e))) if given else None
+            served = (need.statement.subject, need.statement.object) if need.statement is not None else ()
+            ways.append((need, chosen, (*served, *about), [e for e in options if e.source != SRI]))
+        return ways
+
+    def _judge_now(self, vertex: str, about: tuple[str, ...]) -> _Judged:
+        """``_judge`` once every provider of ``vertex``'s needs has been judged."""
+        assert self.areas is not None
+        things: set[str] = set()
+        for need, given, below, providers in self._ways(vertex, about):
+            if given is not None:
+                if need.role == "input":
+                    things.add(given.offer.name)
+                continue
+            fit = [e for e in providers if self._judged[(e.source, below)].why is None]
+            if not fit:
+                why = f"no provider of its {need.text()} is effective where it is needed"
+                return _Judged(frozenset(things), why, need)
+            if need.role == "input":
+                things |= self._judged[(min(fit, key=self._key).source, below)].things
+        why_not = self.areas.why_not(self.graph.vertices[vertex].advertisement, things)
+        return _Judged(frozenset(things), why_not)
+
+    def _pass_over(self, step: _Step, node: str, need: Need, candidates: list[Edge], about: tuple[str, ...]) -> None:
+        """``need`` of ``step`` has providers, none of which can serve: an unmet need naming each and why.
+        While every one fails only for want of a provider of its own, the best is followed down (as ``_why``
+        does), so the report names the components whose areas do not cover the things."""
+        chain = self._path(step, need)
+        while True:
+            judged = {e.source: self._judge(e.source, about) for e in sorted(candidates, key=self._key)}
+            best = next(iter(judged))
+            lower = judged[best].blocked
+            if lower is None or any(j.blocked is None for j in judged.values()):
+                break
+            served = (lower.statement.subject, lower.statement.object) if lower.statement is not None else ()
+            deeper = [e for e in self._options(best, lower, self._level(best)) if e.source != SRI]
+            if not deeper:
+                break
+            node, need, about, candidates = best, lower, (*served, *about), deeper
+            chain = (*chain, shorten(node))
+        passed = tuple(sorted((iri, j.why or "") for iri, j in judged.items()))
+        self.unsatisfied.append(Unsatisfied(need.text(), node, chain, out_of_area=passed))
+
+    def _check_areas(self) -> None:
+        """Refuse the plan if a step's component is not effective where the things it handles are: the
+        choice predicted them, and a step given an existing step's value may handle others."""
+        assert self.areas is not None
+        for step in sorted(self.steps.values(), key=lambda s: s.id):
+            if step.made_for is None:
+                continue
+            why = self.areas.why_not(self.graph.vertices[step.node].advertisement, self._handled(step.id))
+            if why is None:
+                continue
+            consumer = self.steps[step.made_for]
+            bound = next(b for b in consumer.bindings if b.source == step.id)
+            node = self._goal_node(bound.need) if consumer.node == GOAL else consumer.node
+            chain = self._path(consumer, bound.need)
+            self.unsatisfied.append(Unsatisfied(bound.need.text(), node, chain, out_of_area=((step.node, why),)))
+
+    def _handled(self, step_id: int) -> frozenset[str]:
+        """The requirement inputs whose things ``step_id`` handles: those it is given, directly or through
+        the steps that feed its inputs (on a stack of its own: a plan can be thousands of steps deep)."""
+        stack = [step_id]
+        while stack:
+            current = stack[-1]
+            if current in self._things:
+                stack.pop()
+                continue
+            inputs = [b for b in self.steps[current].bindings if b.need.role == "input"]
+            missing = [b.source for b in inputs if b.source is not None and b.source not in self._things]
+            if missing:
+                stack += missing
+                continue
+            found: set[str] = set()
+            for b in inputs:
+                found |= {b.edge.offer.name} if b.source is None else self._things[b.source]
+            self._things[current] = frozenset(found)
+            stack.pop()
+        return self._things[step_id]
+
+    def _path(self, step: _Step, need: Need) -> tuple[str, ...]:
+        """The chain from the requirement's goal down to ``need`` of ``step``, as ``_why`` reports one."""
+        below: list[str] = []
+        current = step
+        while current.made_for is not None:
+            below.append(shorten(current.node))
+            parent = self.steps[current.made_for]
+            if parent.node == GOAL:
+                goal = next(b.need for b in parent.bindings if b.source == current.id)
+                return (_goal_text(goal), *reversed(below))
+            current = parent
+        return (_goal_text(need),)  # ``step`` is the goal: ``need`` is the requirement's
+
+    # -- from the extraction to a Plan -----------------------------------------------------------
+
+    def plan(self, task: str, index: TaxonomyIndex, orderings: list[tuple[str, str, str]]) -> Plan:
+        self._merge_shared()
+        order = self._order(index, orderings)
+        number = {step_id: n for n, step_id in enumerate(order, start=1)}
+        requirement = self.graph.requirement
+        steps: list[PlanStep] = []
+        for step_id in order:
+            step = self.steps[step_id]
+            vertex = self.graph.vertices[step.node]
+            ad = vertex.advertisement
+            assert ad is not None
+            steps.append(
+                PlanStep(
+                    index=number[step_id],
+                    component=ad.iri,
+                    label=ad.label,
+                    kind=ad.kind,
+                    device=ad.device,
+                    action=ad.realizes_action,
+                    bindings=tuple(self._binding(b, number, requirement.iri) for b in step.bindings),
+                    outputs=tuple((o.name, o.concept or "") for o in vertex.offers if o.role == "output"),
+                    effects=tuple(o.statement for o in vertex.offers if o.statement is not None),
+                    cost=vertex.cost,
+                    alternatives=tuple(self._alternatives(step)),
+                )
+            )
+        goals = tuple(self._binding(b, number, requirement.iri) for b in self.steps[0].bindings)
+        everything = [b for s in steps for b in s.bindings] + list(goals)
+        similarity = sum(b.similarity for b in everything) / len(everything)
+        return Plan(task, requirement.iri, "direct", tuple(steps), goals, similarity, sum(s.cost for s in steps))
+
+    def _binding(self, bound: _Bound, number: dict[int, int], requirement: str) -> Binding:
+        need, edge = bound.need, bound.edge
+        if bound.source is None:
+            source = Source(edge.offer.name, None, requirement)
+        else:
+            source = Source(edge.offer.name, number[bound.source])
+        return Binding(need.role, need.name, source, edge.degree.value, edge.similarity, need.concept, need.statement)
+
+    def _merge_shared(self) -> None:
+        """One invocation for shareable components bound to the same sources."""
+        signatures: dict[int, tuple[Any, ...]] = {}
+
+        def signature(step_id: int) -> tuple[Any, ...]:
+            # producers before consumers, on a stack of its own: a plan can be thousands of steps deep
+            stack = [step_id]
+            while stack:
+                current = stack[-1]
+                if current in signatures:
+                    stack.pop()
+                    continue
+                step = self.steps[current]
+                if not self.graph.vertices[step.node].shareable:
+                    signatures[current] = ("unique", current)
+                    continue
+                missing = [b.source for b in step.bindings if b.source is not None and b.source not in signatures]
+                if missing:
+                    stack += missing
+                    continue
+                parts = sorted(
+                    (b.need.key, b.edge.offer.name, signatures[b.source] if b.source is not None else ("SRI",))
+                    for b in step.bindings
+                )
+                signatures[current] = (step.node, tuple(parts))
+            return signatures[step_id]
+
+        keep: dict[tuple[Any, ...], int] = {}
+        alias: dict[int, int] = {}
+        for step_id in sorted(self.steps):
+            if step_id == 0:
+                continue
+            sig = signature(step_id)
+            alias[step_id] = keep.setdefault(sig, step_id)
+        for step in self.steps.values():
+            for bound in step.bindings:
+                if bound.source is not None:
+                    bound.source = alias[bound.source]
+        for step_id, kept in alias.items():
+            if kept != step_id:
+                del self.steps[step_id]
+
+    def _order(self, index: TaxonomyIndex, orderings: list[tuple[str, str, str]]) -> list[int]:
+        """Producers before consumers, ordering constraints kept, each step as late as possible."""
+        dag: nx.DiGraph[int] = nx.DiGraph()
+        dag.add_nodes_from(s for s in self.steps if s != 0)
+        for step in self.steps.values():
+            for bound in step.bindings:
+                if bound.source is not None and step.id != 0:
+                    dag.add_edge(bound.source, step.id)
+        actions = {
+            s.id: ad.realizes_action
+            for s in self.steps.values()
+            if s.id != 0 and (ad := self.graph.vertices[s.node].advertisement) is not None and ad.realizes_action
+        }
+        for constraint, before, after in orderings:
+            firsts = [s for s, a in actions.items() if index.is_a(a, before)]
+            seconds = [s for s, a in actions.items() if index.is_a(a, after)]
+            for first in firsts:
+                for second in seconds:
+                    if first == second or dag.has_edge(first, second):
+                        continue
+                    if nx.has_path(dag, second, first):
+                        raise OrderingConflictError(
+                            shorten(constraint),
+                            shorten(self.steps[first].node),
+                            shorten(self.steps[second].node),
+                        )
+                    dag.add_edge(first, second)
+        self._protect(index, dag)
+        placed: dict[int, int] = {}  # step -> position counted from the end
+        reverse: list[int] = []
+        waiting = {s: set(dag.successors(s)) for s in dag.nodes}
+        while len(reverse) < len(waiting):
+            ready = [s for s, after in waiting.items() if s not in placed and after <= placed.keys()]
+            # right before the consumer placed most recently; later-created steps first on ties,
+            # so a consumer's inputs end up in their declared order
+            chosen = max(ready, key=lambda s: (max((placed[c] for c in waiting[s]), default=-1), s))
+            placed[chosen] = len(reverse)
+            reverse.append(chosen)
+        return list(reversed(reverse))
+
+    def _protect(self, index: TaxonomyIndex, dag: nx.DiGraph[int]) -> None:
+        """Order every step that deletes a statement a consumer relies on outside the span from its
+        producer to its consumer: before the producer, or else after the consumer (a goal must still
+        hold at the end, so its threats go before its producer). A threat that fits neither way is
+        left, and execution's verification catches it."""
+        deleting = {
+            s.id: ad.deletes
+            for s in self.steps.values()
+            if s.id != 0 and (ad := self.graph.vertices[s.node].advertisement) is not None and ad.deletes
+        }
+        for consumer in sorted(self.steps.values(), key=lambda s: s.id):
+            for bound in consumer.bindings:
+                needed = bound.need.statement
+                if needed is None:
+                    continue
+                for threat, deletes in sorted(deleting.items()):
+                    if threat in (consumer.id, bound.source) or not any(
+                        _threatens(index, deleted, needed) for deleted in deletes
+                    ):
+                        continue
+                    options = []
+                    if bound.source is not None:
+                        options.append((threat, bound.source))
+                    if consumer.id != 0:
+                        options.append((consumer.id, threat))
+                    for before, after in options:
+                        if dag.has_edge(before, after) or not nx.has_path(dag, after, before):
+                            dag.add_edge(before, after)
+                            break
+
+    def _alternatives(self, step: _Step) -> list[str]:
+        """Components that accept this step's bindings and meet every need it serves."""
+        served = [
+            (consumer, bound.need)
+            for consumer in self.steps.values()
+            for bound in consumer.bindings
+            if bound.source == step.id
+        ]
+        if not served:
+            return []
+        sources = {SRI} | {self.steps[b.source].node for b in step.bindings if b.source is not None}
+        given = {  # the values the executor passes, by input name: which vertex's which offer
+            b.need.name: (SRI if b.source is None else self.steps[b.source].node, b.edge.offer.name)
+            for b in step.bindings
+            if b.need.role == "input"
+        }
+        into = [
+            self._best_from(self._goal_node(need) if consumer.id == 0 else consumer.node, need)
+            for consumer, need in served
+        ]
+        found: list[tuple[tuple[Any, ...], str]] = []
+        handled = self._handled(step.id) if self.areas is not None else frozenset()
+        for iri in self.trace.levels:
+            vertex = self.graph.vertices[iri]
+            if iri == step.node or vertex.advertisement is None:
+                continue
+            feeds = []
+            for best in into:
+                edge = best.get(iri)
+                if edge is None:
+                    break
+                feeds.append(edge.similarity)
+            else:
+                fed = all(self._fed(iri, need, sources, given) for need in vertex.needs)
+                # it would get the same values, so handle the same things: it must be effective where they are
+                fits = self.areas is None or self.areas.why_not(vertex.advertisement, handled) is None
+                if fed and feeds and fits:
+                    found.append(((-min(feeds), vertex.cost, iri), iri))
+        return [iri for _, iri in sorted(found)]
+
+    def _fed(self, iri: str, need: Need, sources: set[str], given: dict[str, tuple[str, str]]) -> bool:
+        """Whether a would-be alternative gets ``need`` from the step as planned: an input by its name,
+        the very value the step is given under that name (the executor passes the planned component's
+        inputs as they are: InferObjectPlace's object is no position, however both come from the
+        requirement), a precondition from any of the step's sources."""
+        if need.role != "input":
+            return any(e.source in sources for e in self.graph.providers(iri, need))
+        origin = given.get(need.name)
+        return origin is not None and any((e.source, e.offer.name) == origin for e in self.graph.providers(iri, need))
+
+    def _best_from(self, target: str, need: Need) -> dict[str, Edge]:
+        """Each provider's most similar edge into ``need`` of ``target`` (every step's alternatives ask)."""
+        key = (target, need.key)
+        best = self._best.get(key)
+        if best is None:
+            best = self._best[key] = {}
+            for edge in self.graph.providers(target, need):  # most similar first
+                best.setdefault(edge.source, edge)
+        return best
+
+    def _goal_node(self, need: Need) -> str:
+        return SRO if need.role == "input" else SRE
+
+
+def _goal_text(need: Need) -> str:
+    """A need of SRO or SRE as the requirement's goal: its output or effect."""
+    return "the requirement's " + need.text().replace("precondition", "effect", 1).replace("input", "output", 1)
+
+
+def _threatens(index: TaxonomyIndex, deleted: Statement, needed: Statement) -> bool:
+    """Whether deleting ``deleted`` may falsify ``needed``: the same relation, between things of which
+    one is a kind of the other on both ends."""
+    if deleted.predicate != needed.predicate:
+        return False
+    return all(
+        index.is_a(a, b) or index.is_a(b, a)
+        for a, b in ((deleted.subject, needed.subject), (deleted.object, needed.object))
+    )
+
+
+__all__ = ["Extraction", "Objective"]

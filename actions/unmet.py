@@ -1,0 +1,106 @@
+"""Why composition found no plan: the unmet needs, each with the chain that led to it and what to do.
+
+A need is met by the requirement (SRI), by a step's output or effect, or not at all; the report names
+the need, its consumer and the way down to it from the goal, and suggests the remedy a user can act on
+(declare a class, register a component, state a fact), the components that were passed over for their
+effective area and those planned for it that cannot run here.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from cbrs.actions.graph import SRE, SRI, SRO
+from cbrs.kb.namespaces import shorten
+
+GOAL = "GOAL"  # the extraction's virtual consumer: SRO's and SRE's needs together
+
+
+@dataclass(frozen=True)
+class Unsatisfied:
+    """A need no qualified vertex meets, and the chain of needs that led to it."""
+
+    need: str
+    consumer: str
+    chain: tuple[str, ...] = ()  # from the requirement's goal down to this need
+    cycle: bool = False  # providers exist, but each needs (through others) what this need blocks
+    undeclared: tuple[str, ...] = ()  # classes the need names that the ontology does not have
+    near: tuple[tuple[str, str], ...] = ()  # (undeclared class, the declared class its name is closest to)
+    unrunnable: tuple[tuple[str, str], ...] = ()  # (component, why): planned for it, but cannot run here
+    out_of_area: tuple[tuple[str, str], ...] = ()  # (component, why): provides it, but not where it is needed
+
+    def text(self) -> str:
+        found = self._text()
+        for component, why in self.out_of_area:
+            found += f"; {shorten(component)} was passed over: {why}"
+        for component, why in self.unrunnable:
+            found += f"; {shorten(component)} was planned for it but cannot run here: {why}"
+        return found
+
+    def _text(self) -> str:
+        consumer = "the requirement" if self.consumer in (SRO, SRE, GOAL) else shorten(self.consumer)
+        via = f" (on the way to {' <- '.join(self.chain)})" if len(self.chain) > 1 else ""
+        need = self.need
+        if self.consumer == SRE and need.startswith("precondition "):  # the goal is the end's precondition
+            need = "effect " + need.removeprefix("precondition ")
+        if self.cycle:
+            return f"only a cycle of components provides {need} of {consumer}{via}"
+        if self.consumer == SRI:  # the task gives it: nothing to provide, but its class is unknown
+            return f"the requirement gives {need}; {self.remedy()}"
+        if self.out_of_area:
+            return f"no component effective where it is needed provides {need} of {consumer}{via}; {self.remedy()}"
+        return f"no component provides {need} of {consumer}{via}; {self.remedy()}"
+
+    def remedy(self) -> str:
+        """What to register or state so that this need is met (first, a class to declare: no component
+        can be matched against a class the ontology does not have)."""
+        if self.undeclared:
+            names = ", ".join(shorten(c) for c in self.undeclared)
+            example = shorten(self.undeclared[0])
+            meant = "; ".join(f"{shorten(typed)}: did you mean {shorten(known)}?" for typed, known in self.near)
+            return (
+                f"{names} {'is no class' if len(self.undeclared) == 1 else 'are no classes'} of the ontology"
+                f"{f' ({meant})' if meant else ''}: "
+                f"declare {'it' if len(self.undeclared) == 1 else 'them'} under a class the components know "
+                f"(e.g. {example} rdfs:subClassOf home:PersonalItem, loaded into the ontology graph), "
+                f"or {self._remedy()}"
+            )
+        return self._remedy()
+
+    def _remedy(self) -> str:
+        if self.out_of_area:
+            return (
+                "register a component that provides it whose effective area (cbrs:hasSEAModel) covers the things "
+                "named, or compose without the area rule (ComposeConfig.respect_area)"
+            )
+        if self.consumer == SRI:
+            return "correct the input's cbrs:parameterType"
+        if self.consumer == GOAL:  # the task states nothing to plan towards
+            return (
+                "state what the task wants as an output (cbrs:hasOutput) or an effect (cbrs:hasEffect): "
+                "composition plans towards those; delete effects alone are no goal it plans for"
+            )
+        if self.need.startswith("precondition "):
+            statement = self.need.removeprefix("precondition ")
+            return (
+                f"register a component whose effect is {statement}, or state it as a precondition of the task "
+                "or a fact of the semantic map"
+            )
+        concept = self.need.rsplit("(", 1)[-1].rstrip(")") if "(" in self.need else self.need
+        return f"register a component whose output is a {concept}, or give one as an input of the task"
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "need": self.need,
+            "consumer": self.consumer,
+            "chain": list(self.chain),
+            "cycle": self.cycle,
+            "text": self.text(),
+            "remedy": self.remedy(),
+            "unrunnable": [{"component": component, "why": why} for component, why in self.unrunnable],
+            "out_of_area": [{"component": component, "why": why} for component, why in self.out_of_area],
+        }
+
+
+__all__ = ["GOAL", "Unsatisfied"]
