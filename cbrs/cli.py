@@ -448,7 +448,7 @@ def show(app: App, iri: str, as_json: bool) -> None:
         else:
             click.echo(_describe(description))
         return
-    rows = kb.select("resource_triples", {"resource": full})
+    rows = sorted(kb.select("resource_triples", {"resource": full}), key=_triple_order)
     names = _NodeNames(kb)
     own = names.view(ox.NamedNode(full))
     views = [names.view(row["other"], row["direction"].value) for row in rows]
@@ -477,6 +477,14 @@ def show(app: App, iri: str, as_json: bool) -> None:
     click.echo(table(["direction", "predicate", "value", "graph"], body))
     if names.left == 0 and any(is_skolem(r["other"]) and view is None for r, view in zip(rows, views, strict=True)):
         click.echo(f"(the first {REMOTE_NAMED_NODES} anonymous nodes named; on a remote store each costs requests)")
+
+
+def _triple_order(row: dict[str, ox.NamedNode | ox.BlankNode | ox.Literal]) -> tuple[bool, str, int, str]:
+    """A resource's triples as ``show`` lists them: out before in, then by predicate, then by the other term
+    (blank nodes, IRIs, literals, as SPARQL orders them)."""
+    other = row["other"]
+    kind = 0 if isinstance(other, ox.BlankNode) else 1 if isinstance(other, ox.NamedNode) else 2
+    return row["direction"].value != "out", row["predicate"].value, kind, other.value
 
 
 REMOTE_NAMED_NODES = 200

@@ -104,7 +104,7 @@ def resource() -> Page:
         raise NotFoundError(iri)
     outgoing = _grouped(row for row in rows if row["direction"].value == "out")
     incoming = _grouped(row for row in rows if row["direction"].value == "in")
-    label = next((row["other"].value for row in rows if _is(row, "out", RDFS + "label")), None)
+    label = min((row["other"].value for row in rows if _is(row, "out", RDFS + "label")), default=None)
     types = {row["other"].value for row in rows if _is(row, "out", RDF_TYPE)}
     pages = []
     if types & TERM_TYPES:
@@ -164,18 +164,33 @@ def _count(groups: list[dict[str, Any]]) -> int:
 
 def _grouped(rows: Iterable[dict[str, Any]]) -> list[dict[str, Any]]:
     """Rows of one direction as ``[{"predicate", "name", "count", "values": [{"term", "graph"}]}]``,
-    rdf:type first; at most :data:`MAX_VALUES` values a predicate, ``count`` says how many there are."""
+    rdf:type first; at most :data:`MAX_VALUES` values a predicate, ``count`` says how many there are.
+    Only the values shown are made into JSON (owl:Class on OWLS-TC has 13,362 under rdf:type)."""
     groups: dict[str, list[dict[str, Any]]] = {}
     for row in rows:
-        groups.setdefault(row["predicate"].value, []).append(
-            {"term": term_data(row["other"]), "graph": row["graph"].value}
-        )
-    for values in groups.values():  # what the store states first, then what the alignments entail from it
-        values.sort(key=lambda value: value["graph"] == GraphName.ENTAILED.iri)
+        groups.setdefault(row["predicate"].value, []).append(row)
     order = sorted(groups, key=lambda p: (p != RDF_TYPE, short(p).casefold()))
     return [
-        {"predicate": p, "name": short(p), "count": len(groups[p]), "values": groups[p][:MAX_VALUES]} for p in order
+        {
+            "predicate": p,
+            "name": short(p),
+            "count": len(groups[p]),
+            "values": [
+                {"term": term_data(row["other"]), "graph": row["graph"].value}
+                for row in sorted(groups[p], key=_row_order)[:MAX_VALUES]
+            ],
+        }
+        for p in order
     ]
+
+
+def _row_order(row: dict[str, Any]) -> tuple[bool, int, str]:
+    """What the store states before what the alignments entail from it, then the other term as SPARQL
+    orders terms (the named query does not sort: on OWLS-TC sorting owl:Class's 13,362 rows took 2.5 to
+    4 s, reading them 0.14 s)."""
+    other = row["other"]
+    kind = 0 if isinstance(other, ox.BlankNode) else 1 if isinstance(other, ox.NamedNode) else 2
+    return row["graph"].value == GraphName.ENTAILED.iri, kind, other.value
 
 
 # The resource blueprint is not in PAGES, so the app's handlers would answer its errors in JSON; these

@@ -282,7 +282,7 @@ def concept() -> Page:
     if iri not in found:
         return _undeclared(kb, found, iri, triples)
     g.taxonomy_terms = found.kinds  # what expression_html links to a taxonomy page
-    comment = next((r["other"].value for r in triples if _out(r, RDFS + "comment")), None)
+    comment = min((r["other"].value for r in triples if _out(r, RDFS + "comment")), default=None)  # rows unordered
     kind = found.kinds[iri]
     data = {
         **found.term(iri),
