@@ -92,3 +92,10 @@ def test_a_resource_pages_values_come_in_order(client: FlaskClient, iri: str) ->
         ]
         assert keys == sorted(keys), (iri, group["name"])
         assert len(group["values"]) == min(group["count"], MAX_VALUES)
+
+
+def test_a_property_only_used_as_a_predicate_shows_its_uses_first(client: FlaskClient) -> None:
+    page = client.get("/resource", query_string={"iri": "rdf:type"}).get_data(as_text=True)
+    assert page.index('id="as-predicate-heading"') < page.index("<h2>Out:")  # not below two empty sections
+    page = client.get("/resource", query_string={"iri": "cbrs:deviceName"}).get_data(as_text=True)
+    assert page.index("<h2>In:") < page.index('id="as-predicate-heading"')  # declared: its own triples first
