@@ -18,7 +18,7 @@ from flask import Blueprint, Response, current_app, request, url_for
 
 from cbrs.kb.errors import KnowledgeBaseError, QuerySyntaxError, UnknownQueryError
 from cbrs.kb.namespaces import PREFIXES
-from cbrs.sparql_hints import undeclared_prefixes
+from cbrs.sparql_hints import operation_kind, undeclared_prefixes
 from cbrs.sparql_service import BOM, Answer
 from cbrs.web import context
 from cbrs.web.pages import FormError, Page, page, wants_json
@@ -85,8 +85,8 @@ def editor() -> Page:
     try:
         data["result"] = _answer(run, rows)
     except QuerySyntaxError as error:
-        message = str(error)
-        if added:
+        message = _update_refused() if operation_kind(text) == "update" else str(error)
+        if added and operation_kind(text) != "update":
             message += f" (lines counted with the {len(added)} PREFIX lines put above the query)"
         raise FormError({"query": message}, page=shown) from error
     except KnowledgeBaseError as error:  # a timeout, a result too large, busy workers, an evaluation error
@@ -102,6 +102,15 @@ def editor() -> Page:
         for label, short in DOWNLOADS[form]
     ]
     return shown
+
+
+def _update_refused() -> str:
+    """What the editor says of an update: it was "SPARQL syntax error: ... POST it as update= ... with the
+    update token", which a new user read as a fault of the text, and on a read-only server there is no token."""
+    said = "This is a SPARQL update; the editor runs queries and changes nothing."
+    if context.sparql().writable:
+        return f"{said} POST the update to /update (form field update=) with the update token (docs/serving.md)."
+    return f"{said} This server takes no updates: it was started read-only (no update token set)."
 
 
 def with_store_prefixes(text: str) -> tuple[str, dict[str, str]]:
