@@ -248,6 +248,28 @@ def is_remote(location: str) -> bool:
     return location.strip().lower().startswith(REMOTE_SCHEMES)
 
 
+# What reads as a server rather than a directory: another scheme's URL, or a host and port.
+_OTHER_SCHEME = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]*://")
+_HOST_PORT = re.compile(r"^(?:\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9._-]+):\d{1,5}(?:/\S*)?$")
+
+
+def _refuse_url_like(text: str, path: Path) -> None:
+    """A location that reads as a server but is no directory yet is refused, not created: with
+    ``--store localhost:7878`` (``http://`` left out) a new store was made and seeded in the working
+    directory, and every command answered from it as if from the server. An existing directory of
+    that name opens; ``./localhost:7878`` makes one on purpose."""
+    if path.exists():
+        return
+    if _OTHER_SCHEME.match(text):
+        raise StoreError(text, "is a URL cbrs cannot use: a remote store is an http:// or https:// URL")
+    if _HOST_PORT.match(text):
+        raise StoreError(
+            text,
+            f"reads as a server's host and port, and no such directory exists: give the URL, http://{text}, "
+            f"or ./{text} for a new store directory of that name",
+        )
+
+
 class EmbeddedStore(Store):
     """An Oxigraph store in this process, on disk or in memory.
 
@@ -286,6 +308,7 @@ class EmbeddedStore(Store):
         if is_remote(text):
             raise StoreError(text, "is a SPARQL endpoint, not a directory; open it with Store.open")
         path = Path(text).expanduser()
+        _refuse_url_like(text, path)
         if path.exists() and not path.is_dir():
             raise StoreError(text, "exists and is not a directory")
         try:
