@@ -91,9 +91,16 @@ class _Group(click.Group):
         try:
             return super().invoke(ctx)
         except KnowledgeBaseError as error:
-            raise click.ClickException(str(error)) from error
+            raise click.ClickException(_with_notes(error)) from error
         except ValueError as error:  # settings from the environment
-            raise click.ClickException(str(error)) from error
+            raise click.ClickException(_with_notes(error)) from error
+
+
+def _with_notes(error: BaseException) -> str:
+    """The error's message with the notes added to it on its way up (what a failed write left behind,
+    kb/staged_writes.py), which ``str`` leaves out."""
+    notes = [str(note) for note in getattr(error, "__notes__", ())]
+    return "; ".join([str(error), *notes])
 
 
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})

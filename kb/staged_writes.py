@@ -132,7 +132,7 @@ def _wrapped(location: str, predicate: ox.NamedNode) -> ox.NamedNode:
 
 
 def _drops(stages: Iterable[ox.NamedNode]) -> str:
-    return " ;\n".join(f"DROP SILENT GRAPH {stage}" for stage in stages)
+    return " ; ".join(f"DROP SILENT GRAPH {stage}" for stage in stages)
 
 
 def _drop(stages: Iterable[ox.NamedNode], send: Send, cause: BaseException) -> None:
@@ -143,4 +143,8 @@ def _drop(stages: Iterable[ox.NamedNode], send: Send, cause: BaseException) -> N
     try:
         send(_drops(names))
     except StoreError as error:
-        cause.add_note(f"the staging graphs {', '.join(str(n) for n in names)} could not be dropped ({error})")
+        cause.add_note(
+            f"the staging graphs {', '.join(str(n) for n in names)} could not be dropped ({error.reason}); they "
+            f"are inert (nothing reads them as data): remove them when the server is back, with the update "
+            f"{_drops(names)}"
+        )
