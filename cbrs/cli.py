@@ -23,7 +23,7 @@ from cbrs.app import App, parse_iri, pass_app
 from cbrs.extras import require
 from cbrs.kb import Advertisement, KnowledgeBase, KnowledgeBaseError, Requirement, ServiceDescription
 from cbrs.kb.catalog import Catalogue, merge
-from cbrs.kb.errors import AlreadyRegisteredError, QuerySyntaxError
+from cbrs.kb.errors import AlreadyRegisteredError, QuerySyntaxError, without_password
 from cbrs.kb.liveness import ComponentState
 from cbrs.kb.loader import LoadReport, ParsedFile
 from cbrs.kb.namespaces import OWL, PREFIXES, RDF, GraphName, expand, shorten
@@ -124,7 +124,7 @@ def init(app: App) -> None:
     """Create the store and seed it with the bundled ontologies, advertisements and requirements."""
     kb = app.kb  # opening seeds a new store
     stats = kb.statistics()
-    click.echo(f"store: {kb.store.location}")
+    click.echo(f"store: {without_password(kb.store.location)}")
     for graph in GraphName:
         click.echo(f"  {shorten(graph.iri):<20} {stats.get(graph.iri, 0):>7} triples")
     click.echo(f"{len(kb.select('advertisements'))} advertisements, {len(kb.select('requirements'))} requirements")
@@ -595,7 +595,7 @@ def demo(app: App, external: bool, seed: int) -> None:
         _external_demo(seed)
         return
     kb = app.kb
-    click.echo(f"cbrs {__version__} -- store: {kb.store.location}\n")
+    click.echo(f"cbrs {__version__} -- store: {without_password(kb.store.location)}\n")
     stats = kb.statistics()
     click.echo("Named graphs:")
     for graph in GraphName:

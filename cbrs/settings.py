@@ -14,6 +14,8 @@ from typing import Any
 
 from platformdirs import user_cache_dir, user_data_dir
 
+from cbrs.kb.errors import without_password
+
 
 def _default_store() -> str:
     return str(Path(user_data_dir("cbrs", appauthor=False)) / "store")
@@ -119,7 +121,7 @@ class Setting:
             return "(set)" if value else "(not set)"
         if isinstance(value, tuple):
             return ", ".join(value) or "(none)"
-        return "" if value is None else str(value)
+        return "" if value is None else without_password(str(value))  # a store URL's basic credentials
 
     def resolve(self, given: Any = None, environ: Mapping[str, str] | None = None) -> Any:
         if given is not None:

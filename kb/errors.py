@@ -15,12 +15,21 @@ class KnowledgeBaseError(Exception):
 
 
 class StoreError(KnowledgeBaseError):
-    """The store could not be opened or written."""
+    """The store could not be opened or written. Its message shows no password a URL carries."""
 
     def __init__(self, location: str, reason: str) -> None:
         self.location = location
         self.reason = reason
-        super().__init__(f"store {location}: {reason}")
+        super().__init__(without_password(f"store {location}: {reason}"))
+
+
+_USERINFO = re.compile(r"(\b[A-Za-z][A-Za-z0-9+.-]*://)([^/\s@:]*):(?!PASSWORD@)[^/\s@]*@")
+
+
+def without_password(text: str) -> str:
+    """``text`` with the password of every URL in it masked (``http://robot:***@host``): a remote store's
+    URL may carry HTTP basic credentials, and messages end up in terminals and logs."""
+    return _USERINFO.sub(r"\1\2:***@", text)
 
 
 def _one_line(message: str, limit: int = 240) -> str:

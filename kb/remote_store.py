@@ -153,6 +153,7 @@ class RemoteStore(Store):
         headers = {"User-Agent": "cbrs-kb"}
         if token:  # a cbrs server takes updates with its bearer token; Oxigraph's server ignores it
             headers["Authorization"] = f"Bearer {token}"
+        self._token_sent = bool(token)
         self._client: httpx.Client | None = httpx.Client(
             timeout=httpx.Timeout(timeout, connect=min(timeout, CONNECT_TIMEOUT)),
             headers=headers,
@@ -476,10 +477,30 @@ class RemoteStore(Store):
         too_large = status == 413 or "limited to" in message
         if status == 400 and original is not None and not too_large:
             raise QuerySyntaxError(original, message)
+        if status in (401, 403):
+            media = response.headers.get("content-type", "").split(";")[0].strip().lower()
+            message = self._refusal(status, url, "" if media == "text/html" else message)
         if status == 500:  # Oxigraph's (and Fuseki's) answer to an evaluation error; it rolled back
             operation = "query" if url == self.endpoints.query else "update"
             raise StoreEvaluationError(self.location, operation, message, url, status, original or readable or body)
         raise RemoteStoreError(self.location, url, status, message, original or readable or body)
+
+    def _refusal(self, status: int, url: str, said: str) -> str:
+        """What to do about a 401 or 403, before what the server said (an HTML page is left out): a
+        newcomer got a proxy's login page quoted back and no word of how cbrs sends credentials."""
+        if status == 401 and httpx.URL(url).username:
+            hint = "the server refused the user name and password in the store URL"
+        elif status == 401:
+            hint = (
+                "the server asks for credentials: put them in the store URL, http://USER:PASSWORD@HOST:PORT "
+                "(HTTP basic authentication; set CBRS_STORE rather than --store, which others can see), "
+                "or a bearer token in CBRS_UPDATE_TOKEN"
+            )
+        elif self._token_sent:
+            hint = "the server refused the token in CBRS_UPDATE_TOKEN"
+        else:
+            hint = "the server refused the request: set CBRS_UPDATE_TOKEN to its update token (a cbrs serve's)"
+        return f"{hint}; it said: {said}" if said else hint
 
 
 @functools.cache
