@@ -34,6 +34,7 @@ from cbrs.kb.errors import AlreadyRegisteredError, InvalidDescriptionError, Know
 from cbrs.kb.liveness import ComponentState
 from cbrs.kb.loader import parse_bytes
 from cbrs.kb.namespaces import BASE, RDF, GraphName
+from cbrs.kb.store import EmbeddedStore
 from cbrs.kb.vocab import CBRS
 from cbrs.rosbridge import ServiceError, current_caller
 from cbrs.sparql_service import SparqlService
@@ -291,10 +292,16 @@ class LiveComponents:
         name or its bridge service: the second registration would take the first one's calls."""
         with self._guard:
             leases = dict(self._leases)
+        shared = not isinstance(self.sparql.kb.store, EmbeddedStore)  # other servers may keep leases on it
         for iri, service in services.items():
             owner = leases.get(iri)
             if owner is not None and owner.session != session and iri in states and states[iri].live:
                 raise ServiceHeldError(iri, owner.service, iri, owner.session)
+            state = states.get(iri)
+            if owner is None and shared and state is not None and state.live:  # live through another server
+                raise ServiceHeldError(
+                    iri, service, iri, f"{state.registered_by}, through another server of this store"
+                )
             for held, lease in sorted(leases.items()):
                 if held != iri and lease.service == service and lease.session != session:
                     raise ServiceHeldError(iri, service, held, lease.session)
