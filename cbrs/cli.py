@@ -88,12 +88,35 @@ class _Group(click.Group):
             formatter.write_dl([(name, command.get_short_help_str(limit)) for name, command in shown])
 
     def invoke(self, ctx: click.Context) -> Any:
+        args = list(ctx.args)  # the subcommand's own, before they are parsed (or fail to be)
         try:
-            return super().invoke(ctx)
-        except KnowledgeBaseError as error:
-            raise click.ClickException(_with_notes(error)) from error
-        except ValueError as error:  # settings from the environment
-            raise click.ClickException(_with_notes(error)) from error
+            try:
+                return super().invoke(ctx)
+            except KnowledgeBaseError as error:
+                raise click.ClickException(_with_notes(error)) from error
+            except ValueError as error:  # settings from the environment
+                raise click.ClickException(_with_notes(error)) from error
+        except click.ClickException as error:
+            if _wants_json(args, ctx.invoked_subcommand):
+                click.echo(json.dumps({"error": error.format_message(), "exit_code": error.exit_code}))
+            raise
+
+
+def _wants_json(args: list[str], command: str | None) -> bool:
+    """Whether the command was asked for JSON (--json, --format json, or CBRS_FORMAT=json for cbrs query):
+    then an error is a JSON object on standard output too, beside the line on standard error, so that a
+    program reading the output always gets JSON (it got nothing)."""
+    if "--json" in args or "--format=json" in args:
+        return True
+    if "--format" in args:
+        given = args.index("--format") + 1
+        return given < len(args) and args[given] == "json"
+    if command != "query":
+        return False
+    try:
+        return bool(setting("format").resolve() == "json")
+    except ValueError:
+        return False
 
 
 def _with_notes(error: BaseException) -> str:
