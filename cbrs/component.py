@@ -46,6 +46,8 @@ __all__ = ["Component", "ComponentEndedError", "ConnectedComponent", "Registrati
 log = logging.getLogger("cbrs.component")
 
 Hook = Callable[[], None]
+_Beats = deque[tuple[float, Future[dict[str, Any]]]]
+"""Heartbeats waiting for their answers: when each was sent, and its answer."""
 
 HEARTBEAT = "/cbrs/heartbeat"
 REREGISTER_ATTEMPTS = 5
@@ -213,7 +215,7 @@ class ConnectedComponent:
         stretched the period to twice the heartbeat, two thirds of the default lease, and logged a
         warning for each slow answer although the lease held. Answers are read in the order sent; at
         most a lease's worth of beats wait at once."""
-        beats: deque[tuple[float, Future[dict[str, Any]]]] = deque()
+        beats: _Beats = deque()
         in_flight = max(2, math.ceil(self.ttl / self.heartbeat) + 1)
         due = time.monotonic()
         while True:
@@ -225,7 +227,7 @@ class ConnectedComponent:
                 beats.append((time.monotonic(), self.client.call(HEARTBEAT, {}, timeout=self.ttl)))
             self._watch_unanswered(beats)
 
-    def _read_answers(self, beats: deque[tuple[float, Future[dict[str, Any]]]]) -> bool:
+    def _read_answers(self, beats: _Beats) -> bool:
         """Act on the beats answered so far, oldest first; False when the component ends."""
         while beats and beats[0][1].done():
             sent, answer = beats.popleft()
@@ -255,7 +257,7 @@ class ConnectedComponent:
                 self._unanswered_since, self._warned = None, False
         return True
 
-    def _watch_unanswered(self, beats: deque[tuple[float, Future[dict[str, Any]]]]) -> None:
+    def _watch_unanswered(self, beats: _Beats) -> None:
         """Warn once when no beat has been answered for half the lease: the lease lapses if it goes on."""
         waiting = [sent for sent in (self._unanswered_since, beats[0][0] if beats else None) if sent is not None]
         if not waiting or self._warned:
