@@ -29,7 +29,7 @@ from cbrs.kb.loader import LoadReport, ParsedFile
 from cbrs.kb.namespaces import OWL, PREFIXES, RDF, GraphName, expand, shorten
 from cbrs.kb.skolem import is_skolem
 from cbrs.kb.store import EmbeddedStore, Term
-from cbrs.output import RESULT_FORMATS, node_view, render_result, table, term_text
+from cbrs.output import RESULT_FORMATS, ProgressLine, node_view, render_result, table, term_text
 from cbrs.settings import SETTINGS, setting
 from cbrs.sparql_hints import explain_syntax_error
 
@@ -176,7 +176,11 @@ def load(app: App, files: tuple[Path, ...], graph: str | None, catalogs: tuple[P
     """Load RDF files (Turtle, RDF/XML, OWL, N-Triples, N-Quads, TriG, JSON-LD) and OWL-S services, all
     or nothing. A directory stands for the RDF and OWL-S files directly inside it."""
     catalogue = merge([Catalogue.open(path) for path in catalogs]) if catalogs else None
-    report = app.kb.load(list(files), graph, catalogue)
+    progress = ProgressLine()
+    try:
+        report = app.kb.load(list(files), graph, catalogue, progress)
+    finally:
+        progress.clear()
     for item in report.files:
         what = _loaded_what(item)
         click.echo(f"loaded {item.source}: {what}{_into(item)}{_mended(item)}")

@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import shutil
+import sys
+import time
 from collections.abc import Callable, Iterable
-from typing import Any
+from typing import IO, Any
 
 import pyoxigraph as ox
 
@@ -338,3 +341,37 @@ def _owner(quads_into: QuadsOf, node: ox.NamedNode) -> tuple[str, list[str], ox.
         seen.add(parent)
         current = parent
     return None
+
+
+class ProgressLine:
+    """One line on standard error, rewritten as a long command goes (``reading 412/1083``) and cleared at
+    the end; nothing unless the stream is a terminal, so piped output and logs stay as they were. A load
+    of OWLS-TC printed nothing for half a minute, a 100 MB file nothing for minutes."""
+
+    def __init__(self, stream: IO[str] | None = None, interval: float = 0.1) -> None:
+        self.stream = stream if stream is not None else sys.stderr
+        self.active = self.stream.isatty()
+        self.interval = interval
+        self._shown = 0
+        self._stage = ""
+        self._last = 0.0
+
+    def __call__(self, stage: str, done: int, total: int) -> None:
+        if not self.active:
+            return
+        now = time.monotonic()
+        if stage == self._stage and now - self._last < self.interval:
+            return  # many files a second: a terminal need not redraw for each
+        self._stage, self._last = stage, now
+        text = f"{stage} {done}/{total} ..." if total else f"{stage} ..."
+        text = text[: max(shutil.get_terminal_size().columns - 1, 20)]
+        self.stream.write("\r" + text.ljust(self._shown))
+        self.stream.flush()
+        self._shown = len(text)
+
+    def clear(self) -> None:
+        """Remove the line, so that what the command prints next starts on a clean line."""
+        if self.active and self._shown:
+            self.stream.write("\r" + " " * self._shown + "\r")
+            self.stream.flush()
+            self._shown = 0

@@ -13,7 +13,7 @@ from cbrs.kb.catalog import Catalogue
 from cbrs.kb.descriptions import DescriptionReader
 from cbrs.kb.errors import StoreError
 from cbrs.kb.liveness import Liveness
-from cbrs.kb.loader import LoadReport, ParsedFile, load_files, parse_file
+from cbrs.kb.loader import LoadReport, ParsedFile, Progress, load_files, parse_file
 from cbrs.kb.model import Advertisement, PartNode, Requirement, ServiceDescription
 from cbrs.kb.namespaces import GraphName
 from cbrs.kb.queries import QueryLibrary
@@ -182,8 +182,10 @@ class KnowledgeBase:
         paths: Sequence[str | Path],
         graph: str | GraphName | None = None,
         catalogue: Catalogue | str | Path | None = None,
+        progress: Progress | None = None,
     ) -> LoadReport:
-        """Load RDF and OWL-S files (or every RDF file of a directory) all-or-nothing.
+        """Load RDF and OWL-S files (or every RDF file of a directory) all-or-nothing; ``progress`` is told
+        each stage as it goes (:data:`kb.loader.Progress`).
 
         OWL-S files are converted into cbrs advertisements, or requirements when ``graph`` is
         ``requirements`` (see :mod:`kb.owls`). With a ``catalogue`` (a :class:`Catalogue`, a folder or
@@ -191,10 +193,12 @@ class KnowledgeBase:
         """
         if catalogue is not None and not isinstance(catalogue, Catalogue):
             catalogue = Catalogue.open(catalogue)
-        report = load_files(self.store, paths, graph, catalogue)
+        report = load_files(self.store, paths, graph, catalogue, progress)
         if isinstance(self.store, EmbeddedStore) and not any(report.added.values()):
             return report  # a reload of what the store holds wrote nothing: nothing to read or entail afresh
         self._reader.clear_cache()
+        if progress is not None:
+            progress("updating graph:entailed", 0, 0)
         self._entail()
         return report
 

@@ -79,6 +79,15 @@ module's docstring): below it the full path costs little, above it a transaction
 memory and writes them twice (log and tables)."""
 _BULK_FORMATS = (ox.RdfFormat.N_TRIPLES, ox.RdfFormat.TURTLE)
 
+Progress = Callable[[str, int, int], None]
+"""Told how a load goes, for a person waiting on it: the stage (``reading``, ``reading imports``,
+``converting OWL-S``, ``checking``, ``writing N triples``), how many of its items are done and of how
+many (0 when it is not counted). A load of OWLS-TC takes half a minute, of a 100 MB file minutes."""
+
+
+def _quiet(stage: str, done: int, total: int) -> None:
+    """The progress of a load nobody watches."""
+
 
 @dataclass(frozen=True)
 class ParsedFile:
@@ -199,30 +208,38 @@ def load_files(
     paths: Sequence[str | Path],
     graph: str | GraphName | None = None,
     catalogue: Catalogue | None = None,
+    progress: Progress | None = None,
 ) -> LoadReport:
     """Parse every file (and, with a catalogue, every ontology they import), convert OWL-S files,
     then add everything in one transaction; nothing is written if any file fails to parse.
+    ``progress`` is told each stage as it goes.
 
     OWL-S files (``.owls``, or any file describing an OWL-S service or profile) keep their own
     triples and gain the cbrs description made from them, in the same graph: the requirements graph
     and the requirement role when ``graph`` is ``requirements``, else the services graph (or
     ``graph``) and the advertisement role.
     """
+    tell = progress or _quiet
     files = expand_paths(paths)
     if len(files) == 1 and catalogue is None and isinstance(store, EmbeddedStore):
-        bulk = _bulk_load(store, files[0], graph)
+        tell("reading", 0, 1)
+        bulk = _bulk_load(store, files[0], graph, tell)
         if bulk is not None:
             return bulk
-    raws = [_read(path, graph, base_iri=catalogue.iri_for(path) if catalogue is not None else None) for path in files]
+    raws = []
+    for done, path in enumerate(files):
+        tell("reading", done, len(files))
+        raws.append(_read(path, graph, base_iri=catalogue.iri_for(path) if catalogue is not None else None))
     report = LoadReport(catalogue=catalogue)
     imported: list[_Raw] = []
     if catalogue is not None:
-        imported = _resolve_imports(store, raws, catalogue, report)
-    held = _prepare(store, raws, imported, report, graph)
+        imported = _resolve_imports(store, raws, catalogue, report, tell)
+    held = _prepare(store, raws, imported, report, graph, tell=tell)
     new = _new_quads(held, report)
     if getattr(store, "rewrites_held", False):  # its reads may lag its writes: write every quad, as a load did
         new = list(dict.fromkeys(quad for item in (*report.files, *report.imports) for quad in item.quads))
     if new:  # a reload of what the store holds writes nothing (and leaves an embedded store's generation)
+        tell(f"writing {len(new)} triples", 0, 0)
         store.add(new)
     return report
 
@@ -252,6 +269,7 @@ def _prepare(
     report: LoadReport,
     graph: str | GraphName | None,
     refuse_merges: bool = True,
+    tell: Progress = _quiet,
 ) -> Held:
     """Convert the OWL-S files among ``raws``, skolemise everything, and check it all against the store
     (part cycles, shapes, and with ``refuse_merges`` an OWL-S service the store holds described
@@ -264,9 +282,13 @@ def _prepare(
         vocabulary.add(q for raw in (*raws, *imported) if raw.target == ontology for q in raw.quads)
     requirements = graph is not None and resolve_graph(graph) == GraphName.REQUIREMENTS.node
     role: Role = "requirement" if requirements else "advertisement"
+    owls = sum(raw.is_owls for raw in raws)
+    converted = 0
     for raw in raws:
         conversion = None
         if raw.is_owls:
+            tell("converting OWL-S", converted, owls)
+            converted += 1
             conversion = convert(raw.quads, raw.source, role, raw.target, vocabulary, raw.prefixes)
             _check_whole(conversion, raw.source)
             raw.quads.extend(conversion.quads)
@@ -282,6 +304,7 @@ def _prepare(
         )
         for raw in imported
     ]
+    tell("checking", 0, 0)
     held = _held(store, report) if refuse_merges else store.contains  # not asked without a merge check
     if refuse_merges:
         for parsed in report.files:
@@ -352,7 +375,7 @@ class _Scan:
     part_shape: list[ox.Quad] = field(default_factory=list)  # what the part-cycle check reads
 
 
-def _bulk_load(store: EmbeddedStore, path: Path, graph: str | GraphName | None) -> LoadReport | None:
+def _bulk_load(store: EmbeddedStore, path: Path, graph: str | GraphName | None, tell: Progress) -> LoadReport | None:
     """Load one large plain file with Oxigraph's bulk loader, all or nothing; ``None`` when the file
     must take the full path (too small, another format, something to convert, or a graph in use)."""
     rdf_format = FORMATS_BY_EXTENSION.get(path.suffix.lower())
@@ -372,6 +395,7 @@ def _bulk_load(store: EmbeddedStore, path: Path, graph: str | GraphName | None) 
     if next(iter(store.quads(graph=target)), None) is not None:
         return None  # a failed bulk write could not be undone without undoing what was there
     _check_part_cycles(store, [_Raw(source, target, scan.part_shape, False, {}, ())])
+    tell(f"writing {scan.triples} triples", 0, 0)
     store.bulk_load(path, rdf_format, target, base)
     added = {target.value: store.count(target)}  # the graph was empty; a file may give a triple twice
     return LoadReport(files=[ParsedFile(source, target.value, [], bulk=scan.triples, added=added)], added=added)
@@ -711,7 +735,9 @@ def _xml_prefixes(data: bytes) -> dict[str, str]:
     return prefixes
 
 
-def _resolve_imports(store: Store, raws: list[_Raw], catalogue: Catalogue, report: LoadReport) -> list[_Raw]:
+def _resolve_imports(
+    store: Store, raws: list[_Raw], catalogue: Catalogue, report: LoadReport, tell: Progress = _quiet
+) -> list[_Raw]:
     """Parse, once each, the ontologies the files import (and, for OWL-S files, those their concepts'
     namespaces name), transitively, from local files only; what the catalogue cannot resolve is
     reported, not fatal."""
@@ -738,6 +764,7 @@ def _resolve_imports(store: Store, raws: list[_Raw], catalogue: Catalogue, repor
         if path.resolve() in loaded:
             continue
         loaded.add(path.resolve())
+        tell("reading imports", len(imported), 0)
         raw = _read(path, GraphName.ONTOLOGY, base_iri=document, ontology=document)
         imported.append(raw)
         pending.extend((target, raw.source, "owl:imports") for target in _imports(raw.quads))
