@@ -218,14 +218,18 @@ class ConnectedComponent:
         beats: _Beats = deque()
         in_flight = max(2, math.ceil(self.ttl / self.heartbeat) + 1)
         due = time.monotonic()
-        while True:
-            now = time.monotonic()
-            due = max(due + self.heartbeat, now)  # after a hang, one beat now rather than a burst
-            if self._stop.wait(due - now) or not self._read_answers(beats):
-                return
-            if len(beats) < in_flight:
-                beats.append((time.monotonic(), self.client.call(HEARTBEAT, {}, timeout=self.ttl)))
-            self._watch_unanswered(beats)
+        try:
+            while True:
+                now = time.monotonic()
+                due = max(due + self.heartbeat, now)  # after a hang, one beat now rather than a burst
+                if self._stop.wait(due - now) or not self._read_answers(beats):
+                    return
+                if len(beats) < in_flight:
+                    beats.append((time.monotonic(), self.client.call(HEARTBEAT, {}, timeout=self.ttl)))
+                self._watch_unanswered(beats)
+        except Exception as error:  # a dead heartbeat would lapse the lease for good: end loudly instead
+            log.exception("the heartbeat of %s broke", self.component.iri)
+            self._end(f"its heartbeat broke: {type(error).__name__}: {error}")
 
     def _read_answers(self, beats: _Beats) -> bool:
         """Act on the beats answered so far, oldest first; False when the component ends."""

@@ -101,3 +101,19 @@ def test_a_lease_half_unanswered_is_warned_once_and_its_end_said(
         assert "lease lasts 0.1 s" in warnings(caplog)[0]
         slow.answer_all()
         assert eventually(lambda: any("answered again" in text for text in warnings(caplog)))
+
+
+class BrokenClient(SlowServer):
+    """A client whose heartbeat call raises: a bug in it, or in a wrapper a lab put around it."""
+
+    def call(self, service: str, args: Mapping[str, Any], timeout: float | None = None) -> Future[dict[str, Any]]:
+        raise RuntimeError("the wrapper dropped the call")
+
+
+def test_a_heartbeat_that_breaks_ends_the_component_loudly(caplog: pytest.LogCaptureFixture) -> None:
+    client = BrokenClient()
+    connected = beating(client, heartbeat=0.01, ttl=1.0)
+    assert eventually(lambda: connected.ended is not None)
+    assert "heartbeat broke: RuntimeError: the wrapper dropped the call" in str(connected.ended)
+    assert client.closed  # serve() then raises ComponentEndedError, and run() exits with status 1
+    assert "the heartbeat of" in caplog.text
