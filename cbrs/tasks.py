@@ -442,7 +442,8 @@ def _check_components(kb: KnowledgeBase, failing: tuple[str, ...]) -> None:
         return
     from cbrs.sim.components import simulated
 
-    known = set(simulated(kb))
+    known = set(simulated(kb))  # and the live components a run reaches over the bridge, as cbrs run --fail takes
+    known |= {ad.iri for ad in kb.advertisements(include_unavailable=True) if ad.bridge_port is not None}
     unknown = [shorten(f) for f in failing if f not in known]
     if unknown:
         raise UnknownComponentError(unknown)
