@@ -299,9 +299,8 @@ class LiveComponents:
                 raise ServiceHeldError(iri, owner.service, iri, owner.session)
             state = states.get(iri)
             if owner is None and shared and state is not None and state.live:  # live through another server
-                raise ServiceHeldError(
-                    iri, service, iri, f"{state.registered_by}, through another server of this store"
-                )
+                holder = f"{state.registered_by or 'a session'}, through another server of this store"
+                raise ServiceHeldError(iri, service, iri, holder)
             for held, lease in sorted(leases.items()):
                 if held != iri and lease.service == service and lease.session != session:
                     raise ServiceHeldError(iri, service, held, lease.session)
