@@ -20,6 +20,7 @@ import pyoxigraph as ox
 
 from cbrs import __version__
 from cbrs.app import App, parse_iri, pass_app
+from cbrs.cli_interrupts import HeldInterrupts
 from cbrs.extras import require
 from cbrs.kb import Advertisement, KnowledgeBase, KnowledgeBaseError, Requirement, ServiceDescription
 from cbrs.kb.catalog import Catalogue, merge
@@ -176,11 +177,20 @@ def load(app: App, files: tuple[Path, ...], graph: str | None, catalogs: tuple[P
     """Load RDF files (Turtle, RDF/XML, OWL, N-Triples, N-Quads, TriG, JSON-LD) and OWL-S services, all
     or nothing. A directory stands for the RDF and OWL-S files directly inside it."""
     catalogue = merge([Catalogue.open(path) for path in catalogs]) if catalogs else None
-    progress = ProgressLine()
-    try:
-        report = app.kb.load(list(files), graph, catalogue, progress)
-    finally:
-        progress.clear()
+    shown = ProgressLine()
+    with HeldInterrupts() as interrupts:
+
+        def progress(stage: str, done: int, total: int) -> None:
+            if stage.startswith("writing"):
+                interrupts.hold(stage)
+            shown(stage, done, total)
+
+        try:
+            report = app.kb.load(list(files), graph, catalogue, progress)
+        finally:
+            shown.clear()
+    if interrupts.interrupted:
+        click.echo("cbrs: the Ctrl-C came after the write had begun: the load stands, as follows", err=True)
     for item in report.files:
         what = _loaded_what(item)
         click.echo(f"loaded {item.source}: {what}{_into(item)}{_mended(item)}")
