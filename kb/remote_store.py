@@ -70,6 +70,11 @@ _ACCEPT_RESULTS = "application/sparql-results+json, application/sparql-results+x
 _ACCEPT_GRAPH = "application/n-triples, text/turtle;q=0.9"
 _FORM = "application/x-www-form-urlencoded"
 _POSITION = re.compile(r"\berror at (\d+):(\d+)")
+# Virtuoso's SR186 "No permission to execute procedure": its SPARQL user may not update until granted.
+_VIRTUOSO_GRANT = (
+    "Virtuoso's SPARQL user may not update: grant it SPARQL_UPDATE "
+    """(isql-vt 1111 dba PASSWORD 'exec=grant SPARQL_UPDATE to "SPARQL";', docs/remote-store.md)"""
+)
 
 # Whether the server's default graph is the union: a quad from a named graph, and whether the
 # default graph shows it. No row: the server holds no named-graph data yet, so it cannot tell.
@@ -481,7 +486,9 @@ class RemoteStore(Store):
             media = response.headers.get("content-type", "").split(";")[0].strip().lower()
             message = self._refusal(status, url, "" if media == "text/html" else message)
         if status == 500:  # Oxigraph's (and Fuseki's) answer to an evaluation error; it rolled back
-            operation = "query" if url == self.endpoints.query else "update"
+            operation = "update" if content_type == "application/sparql-update" else "query"  # one URL on Virtuoso
+            if operation == "update" and self._virtuoso and "SR186" in message:
+                message = f"{_VIRTUOSO_GRANT}; it said: {message}"
             raise StoreEvaluationError(self.location, operation, message, url, status, original or readable or body)
         raise RemoteStoreError(self.location, url, status, message, original or readable or body)
 

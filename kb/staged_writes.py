@@ -28,7 +28,7 @@ from collections.abc import Callable, Iterable, Sequence
 
 import pyoxigraph as ox
 
-from cbrs.kb.errors import StoreError
+from cbrs.kb.errors import RemoteStoreError, StoreError, StoreEvaluationError
 from cbrs.kb.namespaces import BASE, GRAPH
 from cbrs.kb.store import data_block
 
@@ -57,12 +57,21 @@ def write_staged(location: str, quads: Sequence[ox.Quad], batch: int, send: Send
             )
         stage = stages.setdefault(target, ox.NamedNode(f"{run}{len(stages) + 1}"))
         staged.append(ox.Quad(quad.subject, _wrapped(location, quad.predicate), quad.object, stage))
+    written: set[ox.NamedNode | ox.BlankNode | ox.DefaultGraph] = set()  # staging graphs a batch may have reached
     try:
         for part in batches(staged, batch):
-            send("INSERT DATA {\n" + data_block(part, blank_nodes=True) + "}")
+            touched = {quad.graph_name for quad in part}
+            try:
+                send("INSERT DATA {\n" + data_block(part, blank_nodes=True) + "}")
+            except (RemoteStoreError, StoreEvaluationError):
+                raise  # the server answered that it refused the batch: it wrote none of it
+            except BaseException:
+                written.update(touched)  # no answer (a timeout, a lost connection): it may be written
+                raise
+            written.update(touched)
         send(publication(stages))
     except BaseException as error:
-        _drop(stages.values(), send, error)
+        _drop([stage for stage in stages.values() if stage in written], send, error)
         raise
     try:
         send(_drops(stages.values()))
