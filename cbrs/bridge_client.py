@@ -124,8 +124,8 @@ class BridgeClient:
         try:
             self.send(message)
         except BridgeClosedError as error:
-            self._waiting.pop(key, None)
-            future.set_exception(error)
+            if self._waiting.pop(key, None) is not None:  # else the reader's shutdown failed it already
+                future.set_exception(error)
         return future
 
     def call_sync(self, service: str, args: Mapping[str, Any], timeout: float | None = None) -> dict[str, Any]:

@@ -20,7 +20,7 @@ import httpx
 import pytest
 
 from cbrs.actions.remote import RemoteCallError
-from cbrs.bridge_client import BridgeClient
+from cbrs.bridge_client import BridgeClient, BridgeClosedError
 from cbrs.component import Component, ComponentEndedError, RegistrationRefusedError
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import InvalidDescriptionError
@@ -328,3 +328,22 @@ def test_the_sdk_registers_before_it_provides_so_the_provider_check_does_not_ref
             assert eventually(lambda: "/thermometer07/read" in dict(server.bridge.services()))
             assert caller.call_sync("/thermometer07/read", {}) == READING
         assert server.kb.liveness.states()[THERMOMETER].live
+
+
+def test_a_call_whose_send_loses_the_race_with_the_connection_ending_fails_once(
+    server: Server, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The reader's shutdown may fail a waiting call just before the call's own send finds the socket
+    closed: the heartbeat thread then died of "future already finished" instead of getting its error."""
+    with BridgeClient(url(server), TOKEN) as client:
+        sent = client.send
+
+        def closed_under_the_send(message: Any) -> None:
+            client._shutdown("the server went while this call was sent")  # the reader got there first
+            sent({"op": "status"})  # the socket itself is still open: only the order of events is forced
+            raise BridgeClosedError("the connection is closed")
+
+        monkeypatch.setattr(client, "send", closed_under_the_send)
+        future = client.call("/cbrs/heartbeat", {})
+        with pytest.raises(BridgeClosedError, match="went while this call was sent"):
+            future.result(timeout=5)
