@@ -189,6 +189,8 @@ class RemoteStore(Store):
                 store._check_union()
             except StoreError as error:
                 store.close()
+                if isinstance(error.__cause__, httpx.TransportError):
+                    raise  # nothing answered at that host and port: the next layout is no nearer
                 first_error = first_error or error
                 continue
             except BaseException:
@@ -467,6 +469,13 @@ class RemoteStore(Store):
                 self.location,
                 f"cannot connect to {url} ({error}); is the SPARQL server running? Start one with: "
                 f"oxigraph serve --location DIR --bind {target.host}:{target.port or 80} --union-default-graph",
+            ) from error
+        except httpx.ConnectTimeout as error:
+            connect = min(self.timeout, CONNECT_TIMEOUT)
+            tls = " (an https:// URL needs a server that speaks TLS; oxigraph serve speaks http://)"
+            raise StoreError(
+                self.location,
+                f"no connection to {url} within {connect:g} s{tls if url.startswith('https:') else ''}",
             ) from error
         except httpx.TimeoutException as error:
             raise StoreError(self.location, f"{url} did not answer within {self.timeout:g} s") from error
