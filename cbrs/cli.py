@@ -356,6 +356,7 @@ def query(
     values = _bindings(bindings)
     if name:
         result = app.kb.run(name, values)
+        _note_unknown_bindings(app.kb, name, values)
     else:
         if values:
             raise click.UsageError("--bind works with --name, whose parameters are declared")
@@ -374,6 +375,20 @@ def query(
                 raise
             raise explained from error
     click.echo(render_result(result, fmt))
+
+
+def _note_unknown_bindings(kb: KnowledgeBase, name: str, values: dict[str, str]) -> None:
+    """Say on standard error which bound IRIs the store mentions nowhere: a misspelt class or prefix
+    (``kind=cbrs:DynamicPerceptonComponent``) gave "(0 rows)" and no word of why."""
+    parameters = kb.queries.get(name).parameters
+    for parameter, value in values.items():
+        if parameters[parameter].kind != "iri":
+            continue
+        full = expand(value.strip())
+        if not kb.describes(full):
+            click.echo(
+                f"note: nothing in the store mentions <{full}> (bound to {parameter}){_prefix_hint(full)}", err=True
+            )
 
 
 # An update, after its prologue (PREFIX and BASE declarations, comments): the query parser's own
