@@ -386,6 +386,9 @@ def _bulk_load(store: EmbeddedStore, path: Path, graph: str | GraphName | None, 
             return None
     except OSError:
         return None  # the full path reports it
+    possible = [resolve_graph(graph)] if graph is not None else [g.node for g in _DEFAULT_TARGETS]
+    if all(next(iter(store.quads(graph=target)), None) is not None for target in possible):
+        return None  # every graph it could go to holds data (a seeded store's do): the scan would be wasted
     source = str(path)
     base = _base_for(source, None)
     scan = _scan(path, rdf_format, base)
@@ -1031,6 +1034,10 @@ def _graph_for(quads: list[ox.Quad]) -> ox.NamedNode:
     return _graph_for_types(
         {q.object.value for q in quads if q.predicate.value == RDF + "type" and isinstance(q.object, ox.NamedNode)}
     )
+
+
+_DEFAULT_TARGETS = (GraphName.ONTOLOGY, GraphName.REQUIREMENTS, GraphName.SERVICES)
+"""The graphs :func:`_graph_for_types` chooses from."""
 
 
 def _graph_for_types(types: set[str]) -> ox.NamedNode:

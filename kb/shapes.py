@@ -308,6 +308,8 @@ def _closures(quads: Iterable[ox.Quad]) -> dict[str, list[ox.Quad]]:
         and isinstance(quad.subject, ox.NamedNode)
         and not _is_inner(quad.subject)
     }
+    if not roots:
+        return {}  # a file of plain data: no index of its quads to build (2.6 s for 600,000)
     quads_of = quads_by_subject(quads)
     return {
         root.value: closure([root], quads_of, _is_inner, parts=True)
