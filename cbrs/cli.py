@@ -29,6 +29,7 @@ from cbrs.kb.liveness import ComponentState
 from cbrs.kb.loader import LoadReport, ParsedFile
 from cbrs.kb.namespaces import OWL, PREFIXES, RDF, GraphName, expand, shorten
 from cbrs.kb.skolem import is_skolem
+from cbrs.kb.staged_writes import STAGING
 from cbrs.kb.store import EmbeddedStore, Term
 from cbrs.output import RESULT_FORMATS, ProgressLine, node_view, render_result, table, term_text
 from cbrs.settings import SETTINGS, setting
@@ -151,7 +152,19 @@ def init(app: App) -> None:
     click.echo(f"store: {without_password(kb.store.location)}")
     for graph in GraphName:
         click.echo(f"  {shorten(graph.iri):<20} {stats.get(graph.iri, 0):>7} triples")
+    known = {graph.iri for graph in GraphName}
+    for other, count in sorted(stats.items()):
+        if other not in known:
+            click.echo(f"  {shorten(other)}  {count} triples{_left_behind(other)}")
     click.echo(f"{len(kb.select('advertisements'))} advertisements, {len(kb.select('requirements'))} requirements")
+
+
+def _left_behind(graph: str) -> str:
+    """What to do about a staging graph a remote write left when it failed with its server gone
+    (kb/staged_writes.py): it holds only wrapped statements, so nothing reads it, but it stays."""
+    if not graph.startswith(STAGING):
+        return ""
+    return f" (left by a write that failed: inert; the update DROP SILENT GRAPH <{graph}> removes it)"
 
 
 @cli.command()

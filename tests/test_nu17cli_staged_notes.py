@@ -61,3 +61,26 @@ def test_cli_shows_the_note(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> 
     result = CliRunner().invoke(cli, ["--store", ":memory:", "load", str(data)])
     assert result.exit_code == 1
     assert "request failed; the staging graphs <g> could not be dropped" in result.output
+
+
+def test_init_lists_a_staging_graph_left_behind(tmp_path: Path) -> None:
+    store = tmp_path / "store"
+    kb = KnowledgeBase.open(store)
+    left = ox.NamedNode(f"{STAGING}0123/1")
+    kb.store.add(
+        [
+            ox.Quad(
+                ox.NamedNode("https://example.org/lab#a"),
+                ox.NamedNode("https://w3id.org/cbrs/staged/x"),
+                ox.Literal("1"),
+                left,
+            )
+        ]
+    )
+    kb.close()
+    result = CliRunner().invoke(cli, ["--store", str(store), "init"])
+    assert result.exit_code == 0
+    assert (
+        f"{left.value}  1 triples (left by a write that failed: inert; the update DROP SILENT GRAPH {left} removes it)"
+        in result.output
+    )
