@@ -13,7 +13,7 @@ from cbrs.kb.catalog import Catalogue
 from cbrs.kb.descriptions import DescriptionReader
 from cbrs.kb.errors import StoreError
 from cbrs.kb.liveness import Liveness
-from cbrs.kb.loader import LoadReport, ParsedFile, Progress, load_files, parse_file
+from cbrs.kb.loader import LoadReport, ParsedFile, Progress, expand_paths, load_files, parse_file, resolve_graph
 from cbrs.kb.model import Advertisement, PartNode, Requirement, ServiceDescription
 from cbrs.kb.namespaces import GraphName
 from cbrs.kb.queries import QueryLibrary
@@ -23,7 +23,7 @@ from cbrs.kb.resources import bundled_files, query_dir
 from cbrs.kb.seed_cache import SeedCache, bundle_digest
 from cbrs.kb.shapes import CHECKED_GRAPHS, DescriptionShapeError, checked_update, may_write_descriptions
 from cbrs.kb.standard_terms import PendingUpdate, Refresh, StandardTerms
-from cbrs.kb.store import EmbeddedStore, QueryResult, Store, Term, is_remote
+from cbrs.kb.store import MEMORY, EmbeddedStore, QueryResult, Store, Term, is_remote
 from cbrs.kb.update_delta import DataUpdate
 from cbrs.kb.upgrade import UpgradeReport, new_terms, upgrade_store
 
@@ -93,6 +93,41 @@ class KnowledgeBase:
             if next(kb.store.quads(graph=GraphName.ENTAILED.node), None) is None:
                 kb._entail()  # a store seeded before the alignments existed
         return kb
+
+    def _check_map_load(self, paths: Sequence[str | Path]) -> None:
+        """Refuse a load into graph:map that would leave a readable semantic map unreadable (a support that
+        names nothing, a misspelt property: kb.semantic_map's checks), before anything is written. Those
+        checks ran only when a task read the map; by then the load was in, every run failed on it, and
+        nothing but a SPARQL update could take it out again. A map that was unreadable before is no
+        load's fault, and is left to the reader's error; an empty one may be built a file at a time."""
+        if next(iter(self.store.quads(graph=GraphName.MAP.node)), None) is None:
+            return  # a map being built from nothing may be partial until its last file
+        files = expand_paths(paths)
+        added = [quad for path in files for quad in parse_file(path, GraphName.MAP).quads]
+        if self._map_problem([]) is not None:
+            return
+        problem = self._map_problem(added)
+        if problem is not None:
+            problem.add_note(
+                f"nothing was loaded from {', '.join(map(str, files))} (a load into graph:map is checked as a "
+                "task reads the map)"
+            )
+            raise problem
+
+    def _map_problem(self, added: list[ox.Quad]) -> Exception | None:
+        """What reading the semantic map says is wrong with it, with ``added`` in graph:map, or None.
+        Read from a scratch copy of the graphs the reader asks (ontology, map, entailed), in memory."""
+        from cbrs.kb.semantic_map import MapError, SemanticMap  # it imports this module
+
+        scratch = ox.Store()
+        for graph in (GraphName.ONTOLOGY, GraphName.MAP, GraphName.ENTAILED):
+            scratch.extend(self.store.quads(graph=graph.node))
+        scratch.extend(added)
+        try:
+            SemanticMap.read(KnowledgeBase(EmbeddedStore(scratch, MEMORY), self.queries))
+        except MapError as error:
+            return error
+        return None
 
     def refresh_standard_terms(self) -> Refresh:
         """Rewrite graph:entailed: what the alignments entail in standard vocabularies (:mod:`kb.standard_terms`).
@@ -193,6 +228,8 @@ class KnowledgeBase:
         """
         if catalogue is not None and not isinstance(catalogue, Catalogue):
             catalogue = Catalogue.open(catalogue)
+        if graph is not None and resolve_graph(graph) == GraphName.MAP.node:
+            self._check_map_load(paths)
         report = load_files(self.store, paths, graph, catalogue, progress)
         if isinstance(self.store, EmbeddedStore) and not any(report.added.values()):
             return report  # a reload of what the store holds wrote nothing: nothing to read or entail afresh
