@@ -83,7 +83,7 @@ class _Virtuoso(http.server.BaseHTTPRequestHandler):
 @pytest.fixture
 def virtuoso_without_grant() -> Iterator[str]:
     server = http.server.HTTPServer(("127.0.0.1", 0), _Virtuoso)
-    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread = threading.Thread(target=server.serve_forever, args=(0.05,), daemon=True)
     thread.start()
     yield f"http://127.0.0.1:{server.server_port}/sparql"
     server.shutdown()
