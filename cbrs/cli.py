@@ -27,7 +27,7 @@ from cbrs.kb.catalog import Catalogue, merge
 from cbrs.kb.errors import AlreadyRegisteredError, QuerySyntaxError, without_password
 from cbrs.kb.liveness import ComponentState
 from cbrs.kb.loader import LoadReport, ParsedFile
-from cbrs.kb.namespaces import OWL, PREFIXES, RDF, GraphName, expand, shorten
+from cbrs.kb.namespaces import CBRS, OWL, PREFIXES, RDF, GraphName, expand, shorten
 from cbrs.kb.skolem import is_skolem
 from cbrs.kb.staged_writes import STAGING
 from cbrs.kb.store import EmbeddedStore, Term
@@ -152,18 +152,15 @@ def init(app: App) -> None:
     click.echo(f"store: {without_password(kb.store.location)}")
     for graph in GraphName:
         click.echo(f"  {shorten(graph.iri):<20} {stats.get(graph.iri, 0):>7} triples")
-    known = {graph.iri for graph in GraphName}
-    for other, count in sorted(stats.items()):
-        if other not in known:
-            click.echo(f"  {shorten(other)}  {count} triples{_left_behind(other)}")
+    for left, count in sorted(stats.items()):
+        if left.startswith(STAGING):  # not every other graph: Virtuoso lists its own system graphs
+            click.echo(f"  {left}  {count} triples{_left_behind(left)}")
     click.echo(f"{len(kb.select('advertisements'))} advertisements, {len(kb.select('requirements'))} requirements")
 
 
 def _left_behind(graph: str) -> str:
     """What to do about a staging graph a remote write left when it failed with its server gone
     (kb/staged_writes.py): it holds only wrapped statements, so nothing reads it, but it stays."""
-    if not graph.startswith(STAGING):
-        return ""
     return f" (left by a write that failed: inert; the update DROP SILENT GRAPH <{graph}> removes it)"
 
 
@@ -207,10 +204,25 @@ def load(app: App, files: tuple[Path, ...], graph: str | None, catalogs: tuple[P
     for item in report.files:
         what = _loaded_what(item)
         click.echo(f"loaded {item.source}: {what}{_into(item)}{_mended(item)}")
+    if graph is None:
+        _note_defaulted(report)
     for line in _load_summary(report, app.kb.store):
         click.echo(line)
     for line in _added_summary(report):
         click.echo(line)
+
+
+def _note_defaulted(report: LoadReport) -> None:
+    """Name the files that went to graph:services by default though they describe no service: a map
+    file loaded without --graph map went there without a word, and its objects were in no map."""
+    model = CBRS + "hasOWLSModel"
+    for item in report.files:
+        if item.graph == GraphName.SERVICES.iri and item.quads and all(q.predicate.value != model for q in item.quads):
+            click.echo(
+                f"note: {item.source} describes no service and went to graph:services, the default; "
+                "the semantic map is --graph map, a task --graph requirements (docs/tasks.md)",
+                err=True,
+            )
 
 
 def _added_summary(report: LoadReport) -> list[str]:
