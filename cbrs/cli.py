@@ -373,7 +373,7 @@ def query(
     if fmt not in RESULT_FORMATS:
         raise click.BadParameter(f"{fmt!r} is not one of {', '.join(RESULT_FORMATS)}", param_hint="CBRS_FORMAT")
     if list_queries:
-        _list_queries(app)
+        _list_queries(app, fmt)
         return
     sources = [s for s in (text, query_file, name) if s]
     if len(sources) != 1:
@@ -752,12 +752,19 @@ def _describe(d: ServiceDescription) -> str:
     return "\n".join(lines)
 
 
-def _list_queries(app: App) -> None:
+def _list_queries(app: App, fmt: str) -> None:
+    """The named queries as a table, or as JSON when asked (a script listing them got the table)."""
+    queries = [app.kb.queries.get(name) for name in app.kb.queries.names()]
+    if fmt == "json":
+        listed = [
+            {"name": q.name, "title": q.title, "parameters": [vars(p) for p in q.parameters.values()]} for q in queries
+        ]
+        click.echo(json.dumps(listed, indent=2))
+        return
     body = []
-    for name in app.kb.queries.names():
-        q = app.kb.queries.get(name)
+    for q in queries:
         params = ", ".join(f"{p.name}{'*' if p.required else ''}:{p.kind}" for p in q.parameters.values())
-        body.append([name, params or "-", q.title])
+        body.append([q.name, params or "-", q.title])
     click.echo(table(["name", "parameters (* required)", "title"], body))
 
 

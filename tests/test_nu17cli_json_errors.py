@@ -40,3 +40,12 @@ def test_without_json_an_error_is_one_line_on_stderr_only() -> None:
     result = CliRunner().invoke(cli, ["--store", ":memory:", "show", "svc:NoSuch"])
     assert result.exit_code == 1
     assert result.stdout == ""
+
+
+def test_the_list_of_named_queries_is_json_when_asked() -> None:
+    result = CliRunner().invoke(cli, ["--store", ":memory:", "query", "--list", "--format", "json"])
+    assert result.exit_code == 0
+    listed = {q["name"]: q for q in json.loads(result.stdout)}
+    assert {"name": "kind", "kind": "iri", "required": False}.items() <= listed["advertisements"]["parameters"][
+        1
+    ].items()
