@@ -30,7 +30,7 @@ from cbrs.kb.loader import LoadReport, ParsedFile
 from cbrs.kb.namespaces import CBRS, OWL, PREFIXES, RDF, GraphName, expand, shorten
 from cbrs.kb.skolem import is_skolem
 from cbrs.kb.staged_writes import STAGING
-from cbrs.kb.store import EmbeddedStore, Term
+from cbrs.kb.store import MEMORY, EmbeddedStore, Term, is_remote
 from cbrs.output import RESULT_FORMATS, ProgressLine, node_view, render_result, table, term_text
 from cbrs.settings import SETTINGS, setting
 from cbrs.sparql_hints import explain_syntax_error
@@ -138,9 +138,32 @@ def _with_notes(error: BaseException) -> str:
 @click.pass_context
 def cli(ctx: click.Context, store: str | None) -> None:
     """cbrs: a knowledge base that lets service robots find and use the services around them."""
-    app = App(store_location=setting("store").resolve(store))
+    location = setting("store").resolve(store)
+    app = App(store_location=location)
     ctx.obj = app
     ctx.call_on_close(app.close)
+    if ctx.invoked_subcommand not in (None, "init", "settings") and _no_store_at(location):
+        ctx.call_on_close(lambda: _note_new_store(location))
+
+
+def _at_terminal() -> bool:
+    return sys.stderr.isatty()
+
+
+def _no_store_at(location: str) -> bool:
+    return location != MEMORY and not is_remote(location) and not Path(location).expanduser().exists()
+
+
+def _note_new_store(location: str) -> None:
+    """Say that the command made the store it used: a mistyped path (CBRS_STORE=~/cbrs-stroe) gave a new
+    store of the bundled data without a word, and the user's own looked lost. To a person at a terminal
+    only, as the progress line: a script that starts from a fresh directory means to."""
+    if _at_terminal() and Path(location).expanduser().is_dir():
+        click.echo(
+            f"note: there was no store at {location}: a new one was made there, seeded with the bundled data "
+            "(is the path right? cbrs init makes one on purpose)",
+            err=True,
+        )
 
 
 @cli.command()
