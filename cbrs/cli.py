@@ -21,6 +21,7 @@ import pyoxigraph as ox
 from cbrs import __version__
 from cbrs.app import App, parse_iri, pass_app
 from cbrs.cli_interrupts import HeldInterrupts
+from cbrs.cli_notes import no_store_at, note_new_store, wants_json, with_notes
 from cbrs.extras import require
 from cbrs.kb import Advertisement, KnowledgeBase, KnowledgeBaseError, Requirement, ServiceDescription
 from cbrs.kb.catalog import Catalogue, merge
@@ -30,7 +31,7 @@ from cbrs.kb.loader import LoadReport, ParsedFile
 from cbrs.kb.namespaces import CBRS, OWL, PREFIXES, RDF, GraphName, expand, shorten
 from cbrs.kb.skolem import is_skolem
 from cbrs.kb.staged_writes import STAGING
-from cbrs.kb.store import MEMORY, EmbeddedStore, Term, is_remote
+from cbrs.kb.store import EmbeddedStore, Term
 from cbrs.output import RESULT_FORMATS, ProgressLine, node_view, render_result, table, term_text
 from cbrs.settings import SETTINGS, setting
 from cbrs.sparql_hints import explain_syntax_error
@@ -95,37 +96,13 @@ class _Group(click.Group):
             try:
                 return super().invoke(ctx)
             except KnowledgeBaseError as error:
-                raise click.ClickException(_with_notes(error)) from error
+                raise click.ClickException(with_notes(error)) from error
             except ValueError as error:  # settings from the environment
-                raise click.ClickException(_with_notes(error)) from error
+                raise click.ClickException(with_notes(error)) from error
         except click.ClickException as error:
-            if _wants_json(args, ctx.invoked_subcommand):
+            if wants_json(args, ctx.invoked_subcommand):
                 click.echo(json.dumps({"error": error.format_message(), "exit_code": error.exit_code}))
             raise
-
-
-def _wants_json(args: list[str], command: str | None) -> bool:
-    """Whether the command was asked for JSON (--json, --format json, or CBRS_FORMAT=json for cbrs query):
-    then an error is a JSON object on standard output too, beside the line on standard error, so that a
-    program reading the output always gets JSON (it got nothing)."""
-    if "--json" in args or "--format=json" in args:
-        return True
-    if "--format" in args:
-        given = args.index("--format") + 1
-        return given < len(args) and args[given] == "json"
-    if command != "query":
-        return False
-    try:
-        return bool(setting("format").resolve() == "json")
-    except ValueError:
-        return False
-
-
-def _with_notes(error: BaseException) -> str:
-    """The error's message with the notes added to it on its way up (what a failed write left behind,
-    kb/staged_writes.py), which ``str`` leaves out."""
-    notes = [str(note) for note in getattr(error, "__notes__", ())]
-    return "; ".join([str(error), *notes])
 
 
 @click.group(cls=_Group, context_settings={"help_option_names": ["-h", "--help"]})
@@ -142,28 +119,8 @@ def cli(ctx: click.Context, store: str | None) -> None:
     app = App(store_location=location)
     ctx.obj = app
     ctx.call_on_close(app.close)
-    if ctx.invoked_subcommand not in (None, "init", "settings") and _no_store_at(location):
-        ctx.call_on_close(lambda: _note_new_store(location))
-
-
-def _at_terminal() -> bool:
-    return sys.stderr.isatty()
-
-
-def _no_store_at(location: str) -> bool:
-    return location != MEMORY and not is_remote(location) and not Path(location).expanduser().exists()
-
-
-def _note_new_store(location: str) -> None:
-    """Say that the command made the store it used: a mistyped path (CBRS_STORE=~/cbrs-stroe) gave a new
-    store of the bundled data without a word, and the user's own looked lost. To a person at a terminal
-    only, as the progress line: a script that starts from a fresh directory means to."""
-    if _at_terminal() and Path(location).expanduser().is_dir():
-        click.echo(
-            f"note: there was no store at {location}: a new one was made there, seeded with the bundled data "
-            "(is the path right? cbrs init makes one on purpose)",
-            err=True,
-        )
+    if ctx.invoked_subcommand not in (None, "init", "settings") and no_store_at(location):
+        ctx.call_on_close(lambda: note_new_store(location))
 
 
 @cli.command()

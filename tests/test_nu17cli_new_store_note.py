@@ -8,12 +8,12 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from cbrs import cli as cli_module
+from cbrs import cli_notes
 from cbrs.cli import cli
 
 
 def test_a_new_store_is_named_at_a_terminal(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(cli_module, "_at_terminal", lambda: True)
+    monkeypatch.setattr(cli_notes, "_at_terminal", lambda: True)
     typo = tmp_path / "stroe"
     made = CliRunner().invoke(cli, ["--store", str(typo), "services"])
     assert made.exit_code == 0
