@@ -26,15 +26,16 @@ def match_config(params: tuple[str, ...], base: MatchConfig | None = None) -> Ma
     return (base or MatchConfig()).with_params(given)
 
 
-def _list_params(ctx: click.Context, _: click.Parameter, value: bool) -> None:
-    """``--params``: every matchmaking parameter with its default, then exit."""
-    if not value or ctx.resilient_parsing:
-        return
+def _list_params(as_json: bool) -> None:
+    """``--params``: every matchmaking parameter with its default; as JSON with ``--json`` (it printed the
+    table, which a script asking for JSON cannot read)."""
     defaults = MatchConfig()
+    if as_json:
+        click.echo(json.dumps({name: getattr(defaults, name) for name in MatchConfig.parameter_names()}, indent=2))
+        return
     rows = [[name, repr(getattr(defaults, name))] for name in MatchConfig.parameter_names()]
     click.echo(table(["parameter", "default"], rows))
     click.echo("(docs/matchmaking.md section 9.1 says what each does; set them with --param NAME=VALUE)")
-    ctx.exit()
 
 
 _PARAM = click.option(
@@ -48,7 +49,7 @@ _PARAM = click.option(
 
 
 @click.command()
-@click.argument("requirement")
+@click.argument("requirement", required=False)  # not with --params; checked below
 @click.option("--top", default=10, show_default=True, type=click.IntRange(min=1), help="How many candidates to show.")
 @click.option("--method", type=click.Choice(METHODS), default="sem-str", show_default=True, help="Matching method.")
 @click.option("--explain", is_flag=True, help="Show, for each shown candidate, the entity pairs and what it lacks.")
@@ -58,16 +59,25 @@ _PARAM = click.option(
     "--params",
     "list_params",
     is_flag=True,
-    expose_value=False,
-    is_eager=True,
-    callback=_list_params,
-    help="List the matchmaking parameters and their defaults, then exit.",
+    help="List the matchmaking parameters and their defaults (as JSON with --json), then exit.",
 )
 @pass_app
 def match(
-    app: App, requirement: str, top: int, method: str, explain: bool, as_json: bool, params: tuple[str, ...]
+    app: App,
+    requirement: str | None,
+    top: int,
+    method: str,
+    explain: bool,
+    as_json: bool,
+    params: tuple[str, ...],
+    list_params: bool,
 ) -> None:
     """Rank the advertisements against REQUIREMENT: an IRI, prefix:name, or a bare name in req: (RobotSelfPosition)."""
+    if list_params:
+        _list_params(as_json)
+        return
+    if requirement is None:
+        raise click.MissingParameter(param_type="argument", param_hint="'REQUIREMENT'")
     config = match_config(params)
     iri = parse_iri(requirement, "REQUIREMENT", default_prefix="req")  # a bare name, as /cbrs/match takes it
     if as_json:

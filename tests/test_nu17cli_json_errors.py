@@ -10,6 +10,7 @@ import pytest
 from click.testing import CliRunner
 
 from cbrs.cli import cli
+from cbrs.reasoner.config import MatchConfig
 
 
 @pytest.mark.parametrize(
@@ -49,3 +50,12 @@ def test_the_list_of_named_queries_is_json_when_asked() -> None:
     assert {"name": "kind", "kind": "iri", "required": False}.items() <= listed["advertisements"]["parameters"][
         1
     ].items()
+
+
+def test_the_matchmaking_parameters_are_json_when_asked() -> None:
+    result = CliRunner().invoke(cli, ["--store", ":memory:", "match", "--params", "--json"])
+    assert result.exit_code == 0
+    assert json.loads(result.stdout) == {name: getattr(MatchConfig(), name) for name in MatchConfig.parameter_names()}
+    missing = CliRunner().invoke(cli, ["--store", ":memory:", "match", "--json"])
+    assert missing.exit_code == 2 and "Missing argument 'REQUIREMENT'" in missing.stderr
+    assert json.loads(missing.stdout)["exit_code"] == 2
