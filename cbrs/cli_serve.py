@@ -11,6 +11,7 @@ from pathlib import Path
 import click
 
 from cbrs.app import App, pass_app
+from cbrs.kb.errors import without_password
 from cbrs.settings import LOG_LEVELS, setting
 from cbrs.sparql_service import EndpointConfig
 
@@ -101,7 +102,7 @@ def serve(
             access = "read-only: no updates, task runs or recorded plans"
         else:
             access = "read-write with the update token" if running.sparql.writable else "read-only"
-        click.echo(f"cbrs serving {app.kb.store.location} ({access})")
+        click.echo(f"cbrs serving {without_password(app.kb.store.location)} ({access})")
         click.echo(f"  browser   http://{host_text}:{running.http_port}/")  # the knowledge browser (docs/web.md)
         click.echo(
             f"  SPARQL    http://{host_text}:{running.http_port}/sparql "

@@ -360,3 +360,19 @@ def test_the_bridge_gets_its_action_workers_from_the_setting(monkeypatch: pytest
     with pytest.raises(ValueError, match="CBRS_ACTION_WORKERS='none'"):
         ServeConfig()
     kb.close()
+
+
+def test_cbrs_serve_on_a_store_url_with_a_password_does_not_print_it(tmp_path: Any, remote_location: str) -> None:
+    """The banner names the store; a remote store's URL may carry HTTP basic credentials (Oxigraph's
+    server ignores them), and the banner ends up in terminals and logs."""
+    with_password = remote_location.replace("http://", "http://robot:s3cret@", 1)
+    env = dict(os.environ, CBRS_STORE=with_password, HOME=str(tmp_path), CBRS_QUERY_WORKERS="1")
+    env.pop("CBRS_UPDATE_TOKEN", None)
+    command = [sys.executable, "-m", "cbrs", "serve", "--port", "0", "--bridge-port", "0"]
+    process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env=env)
+    try:
+        lines = Output(process).until("Ctrl-C stops", timeout=120)
+        assert "robot:***@" in lines[0] and "s3cret" not in "\n".join(lines)
+    finally:
+        process.terminate()
+        process.wait(timeout=30)
