@@ -1,5 +1,6 @@
 from __future__ import annotations
 
+import contextlib
 import re
 import shutil
 import socket
@@ -196,15 +197,14 @@ def _free_port() -> int:
         return port
 
 
-@pytest.fixture(scope="session")
-def virtuoso_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[VirtuosoServer]:
-    """One Virtuoso for the session, its SPARQL user allowed to update; skipped when not installed (CI
-    installs it). Stopped by its PID."""
+@contextlib.contextmanager
+def virtuoso_running(directory: Path) -> Iterator[VirtuosoServer]:
+    """A Virtuoso with its database in ``directory``, its SPARQL user allowed to update; skipped when not
+    installed (CI installs it). Stopped by its PID."""
     server, isql = shutil.which("virtuoso-t"), shutil.which("isql-vt")
     template = Path("/etc/virtuoso-opensource-7/virtuoso.ini")
     if server is None or isql is None or not template.is_file():
         pytest.skip("Virtuoso is not installed (apt-get install virtuoso-opensource)")
-    directory = tmp_path_factory.mktemp("virtuoso")
     sql_port, http_port = _free_port(), _free_port()
     ini = template.read_text()
     ini = ini.replace("/var/lib/virtuoso-opensource-7/db/", f"{directory}/")
@@ -244,6 +244,13 @@ def virtuoso_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Virtuo
             process.kill()
             process.wait(timeout=10)
         log.close()
+
+
+@pytest.fixture(scope="session")
+def virtuoso_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[VirtuosoServer]:
+    """One Virtuoso for the session (see :func:`virtuoso_running`)."""
+    with virtuoso_running(tmp_path_factory.mktemp("virtuoso")) as server:
+        yield server
 
 
 # -- knowledge bases ---------------------------------------------------------------------------------

@@ -23,7 +23,7 @@ from cbrs.kb import KnowledgeBase, Store, StoreError
 from cbrs.kb.namespaces import GraphName
 from cbrs.kb.remote_store import RemoteStore
 from cbrs.kb.staged_writes import STAGING
-from tests.conftest import OxigraphServer, VirtuosoServer
+from tests.conftest import OxigraphServer, VirtuosoServer, virtuoso_running
 
 DATA = Path(__file__).parent / "data"
 LOCATE = "https://w3id.org/cbrs/service#LocateMobileRobot_CeilingCamera01"
@@ -237,7 +237,23 @@ VIRTUOSO_DEVIATIONS = {
 }
 
 
-def test_the_named_queries_answer_as_on_the_embedded_store(server: str) -> None:
+@pytest.fixture(params=SERVERS)
+def fresh_server(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[str]:
+    """The ``--store`` URL of an emptied Oxigraph, or of a Virtuoso of its own: on the session's Virtuoso,
+    after earlier tests had filled and emptied it, a query with a transitive path (concept_parts,
+    description_qos) now and then answered fewer rows, with no error, in full-suite runs only; every
+    rerun on a fresh one gave all of them (docs/remote-store.md)."""
+    if request.param == "oxigraph":
+        oxigraph: OxigraphServer = request.getfixturevalue("oxigraph_server")
+        oxigraph.clear()
+        yield oxigraph.url
+        return
+    with virtuoso_running(tmp_path) as virtuoso:
+        yield virtuoso.url
+
+
+def test_the_named_queries_answer_as_on_the_embedded_store(fresh_server: str) -> None:
+    server = fresh_server
     embedded, remote = KnowledgeBase.open(":memory:"), KnowledgeBase.open(server)
     for kb in (embedded, remote):
         kb.load([DATA / "mini_world.ttl"], graph="world")
