@@ -16,6 +16,7 @@ matplotlib.use("Agg")
 
 import matplotlib.pyplot as plt
 from matplotlib.axes import Axes
+from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
 
 from cbrs.actions.composer import Attempt, CompositionResult
@@ -30,29 +31,61 @@ def draw(result: CompositionResult, path: str | Path) -> Path:
     target = Path(path)
     if target.suffix.lower() not in FORMATS:
         raise ValueError(f"cannot draw to {target.name!r}: use a file name ending in {' or '.join(FORMATS)}")
+    drawn = figure(result)
+    target.parent.mkdir(parents=True, exist_ok=True)
+    drawn.savefig(target)
+    plt.close(drawn)
+    return target
+
+
+def figure(result: CompositionResult) -> Figure:
+    """The drawing as a matplotlib figure (closed by the caller). Its size follows what it holds: a
+    column is as wide as its longest name, and the titles and legend get room of their own
+    (constrained layout), so that no two labels lie on one another."""
     attempts = [a for a in result.attempts if a.plan is not None] or list(result.attempts[:1])
     heights = [_rows(a) for a in attempts]
-    figure, axes = plt.subplots(
-        len(attempts), 1, figsize=(16, 1.2 + 0.75 * sum(heights)), squeeze=False, height_ratios=heights
+    columns = max(max(attempt.trace.levels.values(), default=0) + 2 for attempt in attempts)
+    width = max(16.0, (columns + 0.4) * (_widest(attempts) + COLUMN_GAP))
+    drawn, axes = plt.subplots(
+        len(attempts),
+        1,
+        figsize=(width, 1.2 + ROW_HEIGHT * sum(heights)),
+        squeeze=False,
+        height_ratios=heights,
+        layout="constrained",
     )
     for axis, attempt in zip(axes[:, 0], attempts, strict=True):
         _draw_attempt(axis, attempt)
-    figure.legend(
+    drawn.legend(
         handles=[
             Line2D([0], [0], color=FORWARD, lw=1.2, label="forward search (qualified post-service)"),
             Line2D([0], [0], color=BACKWARD, lw=1.2, label="backward search (qualified pre-service / pre-action)"),
             Line2D([0], [0], color=PLAN, lw=2.6, label="chosen plan"),
         ],
-        loc="lower center",
+        loc="outside lower center",
         ncol=3,
         frameon=False,
     )
-    figure.suptitle(f"Service resource graph for {_short(result.task)}: {result.status.value}")
-    figure.subplots_adjust(left=0.02, right=0.98, top=0.93, bottom=0.08, hspace=0.25)
-    target.parent.mkdir(parents=True, exist_ok=True)
-    figure.savefig(target)
-    plt.close(figure)
-    return target
+    drawn.suptitle(f"Service resource graph for {_short(result.task)}: {result.status.value}")
+    return drawn
+
+
+FONT_SIZE = 7.5  # points, of a vertex's name
+ROW_HEIGHT = 0.75  # inches a vertex of the busiest column takes
+COLUMN_GAP = 0.35  # inches between the widest names of two columns
+
+
+def _widest(attempts: list[Attempt]) -> float:
+    """Inches the longest line of a drawn vertex name takes (0.6 em a character, and the box's padding)."""
+    names = [
+        line
+        for attempt in attempts
+        if attempt.plan is not None
+        for step in attempt.plan.steps
+        for iri in (step.component, *step.alternatives)
+        for line in _short(iri).split("\n")
+    ]
+    return max((len(line) for line in names), default=3) * FONT_SIZE * 0.6 / 72 + 0.15
 
 
 def _rows(attempt: Attempt) -> int:
@@ -108,7 +141,7 @@ def _draw_attempt(axis: Axes, attempt: Attempt) -> None:
             _short(iri),
             ha="center",
             va="center",
-            fontsize=7.5,
+            fontsize=FONT_SIZE,
             bbox={
                 "boxstyle": "round,pad=0.3",
                 "fc": "#ffe9a8" if virtual else ("#d8f0d8" if iri in chosen else "#f2f2f2"),

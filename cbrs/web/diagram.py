@@ -158,8 +158,10 @@ def layered(
     ]
     paths = [[placed[key] for key in keys] for _, keys in routes]
     ends = _spread(paths)
-    for (edge, _), path, (start, end) in zip(routes, paths, ends, strict=True):
-        parts.append(_edge(_points(path, start, end), edge, f"{ident}-arrow"))
+    runs = [_points(path, start, end) for path, (start, end) in zip(paths, ends, strict=True)]
+    taken = [_rect(item) for item in placed.values() if item.box.kind != VIRTUAL]
+    for (edge, _), points in zip(routes, runs, strict=True):
+        parts.append(_edge(points, edge, f"{ident}-arrow", _label_place(points, edge.label, taken)))
     for item in placed.values():
         if item.box.kind != VIRTUAL:
             parts.append(_box(item))
@@ -215,20 +217,55 @@ def _points(path: list[_Placed], start: float | None = None, end: float | None =
     return points
 
 
-def _edge(points: list[tuple[float, float]], edge: Edge, arrow: str) -> str:
+Rect = tuple[float, float, float, float]  # left, top, right, bottom
+
+LABEL_CHAR_WIDTH = 6.2  # px per character of an arrow's 10 px label, DejaVu Sans's widest lower case is 6.5
+LABEL_HEIGHT = 12.0  # px from the label's top to a little below its baseline
+LABEL_SPOTS = (0.8, 0.6, 0.4, 0.2)  # where along a segment a label may sit, nearest the head first
+
+
+def _rect(item: _Placed) -> Rect:
+    return item.x, item.y, item.x + item.width, item.y + item.height
+
+
+def _label_rect(x: float, baseline: float, label: str) -> Rect:
+    width = len(_shown(label)) * LABEL_CHAR_WIDTH
+    return x - width / 2, baseline - LABEL_HEIGHT + 2, x + width / 2, baseline + 2
+
+
+def _overlap(a: Rect, b: Rect) -> bool:
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
+
+
+def _label_place(points: list[tuple[float, float]], label: str, taken: list[Rect]) -> tuple[float, float] | None:
+    """Where an arrow's label goes (the middle of its baseline): the spot nearest its head, along its last
+    segment and then the ones before, whose box meets no box and no label placed before it; ``taken``
+    gains it. Labels at one fixed spot lay on one another where arrows converge on a box. With no free
+    spot, the one nearest the head."""
+    if not label:
+        return None
+    spots = [
+        (x1 + (x2 - x1) * t, y1 + (y2 - y1) * t - 3)
+        for (x1, y1), (x2, y2) in reversed(list(itertools.pairwise(points)))
+        for t in LABEL_SPOTS
+    ]
+    found = next((s for s in spots if not any(_overlap(_label_rect(*s, label), r) for r in taken)), spots[0])
+    taken.append(_label_rect(*found, label))
+    return found
+
+
+def _edge(points: list[tuple[float, float]], edge: Edge, arrow: str, place: tuple[float, float] | None) -> str:
     dash = ' stroke-dasharray="5 3"' if edge.dashed else ""
     drawn = " ".join(f"{x:.1f},{y:.1f}" for x, y in points)
     line = (
         f'<polyline points="{drawn}" fill="none" stroke="#8c96a8" stroke-width="1.3"'
         f'{dash} marker-end="url(#{arrow})"><title>{escape(edge.note or edge.label)}</title></polyline>'
     )
-    if not edge.label:
+    if place is None:
         return line
-    # beside the arrow's head: edges that fan out from one box keep their labels apart
-    (x1, y1), (x2, y2) = points[-2], points[-1]
-    mx, my = x1 + (x2 - x1) * 0.8, y1 + (y2 - y1) * 0.8
+    x, y = place
     return line + (
-        f'<text x="{mx:.1f}" y="{my - 3:.1f}" text-anchor="middle" font-size="10" fill="#5d6778" '
+        f'<text x="{x:.1f}" y="{y:.1f}" text-anchor="middle" font-size="10" fill="#5d6778" '
         f'stroke="#ffffff" stroke-width="3" paint-order="stroke">{escape(_shown(edge.label))}</text>'
     )
 
