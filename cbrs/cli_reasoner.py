@@ -10,7 +10,7 @@ import click
 from cbrs.app import App, parse_iri, pass_app
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import shorten
-from cbrs.output import table
+from cbrs.output import ProgressLine, table
 from cbrs.reasoner.config import MatchConfig
 from cbrs.reasoner.matchmaker import Candidate, Matchmaker, MatchResult, MatchStatus
 from cbrs.reasoner.methods import METHODS
@@ -196,7 +196,11 @@ def eval_owls_tc(
     config = match_config(params, MatchConfig(text_weight=text_weight))
     if not as_json:
         click.echo(f"loading {folder} and ranking every service for every query ...", err=True)
-    report = evaluate_collection(folder, methods or METHODS, config)
+    shown = ProgressLine()  # on a terminal only: the --json output is as it was
+    try:
+        report = evaluate_collection(folder, methods or METHODS, config, shown)
+    finally:
+        shown.clear()
     click.echo(json.dumps(report.to_json(), indent=2) if as_json else report.text())
     if plot is not None:
         click.echo(f"chart written to {plot_curves(report, plot)}", err=as_json)

@@ -13,7 +13,16 @@ from cbrs.kb.catalog import Catalogue
 from cbrs.kb.descriptions import DescriptionReader
 from cbrs.kb.errors import StoreError
 from cbrs.kb.liveness import Liveness
-from cbrs.kb.loader import LoadReport, ParsedFile, Progress, expand_paths, load_files, parse_file, resolve_graph
+from cbrs.kb.loader import (
+    LoadReport,
+    ParsedFile,
+    Progress,
+    ReadFiles,
+    load_files,
+    parse_file,
+    read_files,
+    resolve_graph,
+)
 from cbrs.kb.model import Advertisement, PartNode, Requirement, ServiceDescription
 from cbrs.kb.namespaces import GraphName
 from cbrs.kb.queries import QueryLibrary
@@ -43,6 +52,7 @@ class KnowledgeBase:
         self.standard_terms = StandardTerms(store)
         self.registry = ComponentRegistry(store, self.standard_terms)
         self._reader = DescriptionReader(store, self.queries)
+        self._map_read: tuple[int, bool] | None = None  # (store generation, whether the map read then)
 
     @classmethod
     def open(
@@ -94,34 +104,55 @@ class KnowledgeBase:
                 kb._entail()  # a store seeded before the alignments existed
         return kb
 
-    def _check_map_load(self, paths: Sequence[str | Path]) -> None:
+    def _check_map_load(
+        self, paths: Sequence[str | Path], catalogue: Catalogue | None, progress: Progress | None = None
+    ) -> ReadFiles | None:
         """Refuse a load into graph:map that would leave a readable semantic map unreadable (a support that
         names nothing, a misspelt property: kb.semantic_map's checks), before anything is written. Those
         checks ran only when a task read the map; by then the load was in, every run failed on it, and
         nothing but a SPARQL update could take it out again. A map that was unreadable before is no
-        load's fault, and is left to the reader's error; an empty one may be built a file at a time."""
+        load's fault, and is left to the reader's error; an empty one may be built a file at a time.
+        Returns the files read, for the load to write without parsing them again (None: not read)."""
         if next(iter(self.store.quads(graph=GraphName.MAP.node)), None) is None:
-            return  # a map being built from nothing may be partial until its last file
-        files = expand_paths(paths)
-        added = [quad for path in files for quad in parse_file(path, GraphName.MAP).quads]
-        if self._map_problem([]) is not None:
-            return
-        problem = self._map_problem(added)
+            return None  # a map being built from nothing may be partial until its last file
+        read = read_files(paths, GraphName.MAP, catalogue, progress)
+        scratch = self._map_scratch()
+        if not self._map_readable_before(scratch):
+            return read
+        problem = self._map_problem(scratch, read.quads())
         if problem is not None:
             problem.add_note(
-                f"nothing was loaded from {', '.join(map(str, files))} (a load into graph:map is checked as a "
-                "task reads the map)"
+                f"nothing was loaded from {', '.join(map(str, read.paths))} (a load into graph:map is checked as "
+                "a task reads the map)"
             )
             raise problem
+        return read
 
-    def _map_problem(self, added: list[ox.Quad]) -> Exception | None:
-        """What reading the semantic map says is wrong with it, with ``added`` in graph:map, or None.
-        Read from a scratch copy of the graphs the reader asks (ontology, map, entailed), in memory."""
-        from cbrs.kb.semantic_map import MapError, SemanticMap  # it imports this module
+    def _map_readable_before(self, scratch: ox.Store) -> bool:
+        """Whether the stored map reads without error (``scratch`` holds its graphs). An embedded store
+        counts its writes (:attr:`EmbeddedStore.generation`), so the answer is kept until the next one: a
+        load refused for its map, then retried with the file mended, reads the stored map once; a remote
+        store has no such count, and is read each time."""
+        generation = getattr(self.store, "generation", None)
+        if generation is not None and self._map_read is not None and self._map_read[0] == generation:
+            return self._map_read[1]
+        readable = self._map_problem(scratch, []) is None
+        if generation is not None:
+            self._map_read = (generation, readable)
+        return readable
 
+    def _map_scratch(self) -> ox.Store:
+        """A scratch copy of the graphs the map reader asks (ontology, map, entailed), in memory."""
         scratch = ox.Store()
         for graph in (GraphName.ONTOLOGY, GraphName.MAP, GraphName.ENTAILED):
             scratch.extend(self.store.quads(graph=graph.node))
+        return scratch
+
+    def _map_problem(self, scratch: ox.Store, added: list[ox.Quad]) -> Exception | None:
+        """What reading the semantic map of ``scratch`` says is wrong with it, with ``added`` in it too
+        (added to ``scratch`` itself), or None."""
+        from cbrs.kb.semantic_map import MapError, SemanticMap  # it imports this module
+
         scratch.extend(added)
         try:
             SemanticMap.read(KnowledgeBase(EmbeddedStore(scratch, MEMORY), self.queries))
@@ -228,9 +259,10 @@ class KnowledgeBase:
         """
         if catalogue is not None and not isinstance(catalogue, Catalogue):
             catalogue = Catalogue.open(catalogue)
+        read = None
         if graph is not None and resolve_graph(graph) == GraphName.MAP.node:
-            self._check_map_load(paths)
-        report = load_files(self.store, paths, graph, catalogue, progress)
+            read = self._check_map_load(paths, catalogue, progress)
+        report = load_files(self.store, paths, graph, catalogue, progress, read)
         if isinstance(self.store, EmbeddedStore) and not any(report.added.values()):
             return report  # a reload of what the store holds wrote nothing: nothing to read or entail afresh
         self._reader.clear_cache()

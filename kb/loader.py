@@ -203,12 +203,43 @@ def parse_bytes(
     return ParsedFile(source, target.value, skolemise(_into(parsed, target), source), repairs=repairs)
 
 
+@dataclass(frozen=True)
+class ReadFiles:
+    """The files of one load, parsed but not yet converted or written (:func:`read_files`): what a caller
+    that checks a load first (:meth:`KnowledgeBase.load` into graph:map) reads once and hands on to
+    :func:`load_files`, which would otherwise parse every file again."""
+
+    paths: tuple[Path, ...]
+    raws: tuple[_Raw, ...]
+
+    def quads(self) -> list[ox.Quad]:
+        """Every quad the files gave, skolemised as a load writes them (OWL-S files unconverted)."""
+        return [quad for raw in self.raws for quad in skolemise(raw.quads, raw.source)]
+
+
+def read_files(
+    paths: Sequence[str | Path],
+    graph: str | GraphName | None = None,
+    catalogue: Catalogue | None = None,
+    progress: Progress | None = None,
+) -> ReadFiles:
+    """Parse the files of a load (a directory stands for its RDF files) as :func:`load_files` does."""
+    tell = progress or _quiet
+    files = expand_paths(paths)
+    raws = []
+    for done, path in enumerate(files):
+        tell("reading", done, len(files))
+        raws.append(_read(path, graph, base_iri=catalogue.iri_for(path) if catalogue is not None else None))
+    return ReadFiles(tuple(files), tuple(raws))
+
+
 def load_files(
     store: Store,
     paths: Sequence[str | Path],
     graph: str | GraphName | None = None,
     catalogue: Catalogue | None = None,
     progress: Progress | None = None,
+    read: ReadFiles | None = None,
 ) -> LoadReport:
     """Parse every file (and, with a catalogue, every ontology they import), convert OWL-S files,
     then add everything in one transaction; nothing is written if any file fails to parse.
@@ -217,19 +248,19 @@ def load_files(
     OWL-S files (``.owls``, or any file describing an OWL-S service or profile) keep their own
     triples and gain the cbrs description made from them, in the same graph: the requirements graph
     and the requirement role when ``graph`` is ``requirements``, else the services graph (or
-    ``graph``) and the advertisement role.
+    ``graph``) and the advertisement role. ``read`` is these files read already (:func:`read_files`,
+    with the same ``graph`` and ``catalogue``): they are not read again, nor bulk-loaded.
     """
     tell = progress or _quiet
-    files = expand_paths(paths)
-    if len(files) == 1 and catalogue is None and isinstance(store, EmbeddedStore):
-        tell("reading", 0, 1)
-        bulk = _bulk_load(store, files[0], graph, tell)
-        if bulk is not None:
-            return bulk
-    raws = []
-    for done, path in enumerate(files):
-        tell("reading", done, len(files))
-        raws.append(_read(path, graph, base_iri=catalogue.iri_for(path) if catalogue is not None else None))
+    if read is None:
+        files = expand_paths(paths)
+        if len(files) == 1 and catalogue is None and isinstance(store, EmbeddedStore):
+            tell("reading", 0, 1)
+            bulk = _bulk_load(store, files[0], graph, tell)
+            if bulk is not None:
+                return bulk
+        read = read_files(files, graph, catalogue, tell)
+    raws = [replace(raw, quads=list(raw.quads)) for raw in read.raws]  # an OWL-S conversion extends its quads
     report = LoadReport(catalogue=catalogue)
     imported: list[_Raw] = []
     if catalogue is not None:

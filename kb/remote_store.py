@@ -464,12 +464,8 @@ class RemoteStore(Store):
         try:
             response = self._http().post(url, content=body.encode("utf-8"), headers=headers)
         except httpx.ConnectError as error:
-            target = httpx.URL(url)
-            raise StoreError(
-                self.location,
-                f"cannot connect to {url} ({error}); is the SPARQL server running? Start one with: "
-                f"oxigraph serve --location DIR --bind {target.host}:{target.port or 80} --union-default-graph",
-            ) from error
+            hint = start_hint(self.location)
+            raise StoreError(self.location, f"cannot connect to {url} ({error}); {hint}") from error
         except httpx.ConnectTimeout as error:
             connect = min(self.timeout, CONNECT_TIMEOUT)
             tls = " (an https:// URL needs a server that speaks TLS; oxigraph serve speaks http://)"
@@ -517,6 +513,35 @@ class RemoteStore(Store):
         else:
             hint = "the server refused the request: set CBRS_UPDATE_TOKEN to its update token (a cbrs serve's)"
         return f"{hint}; it said: {said}" if said else hint
+
+
+CBRS_SERVE_PORT = 8080
+"""``cbrs serve``'s default HTTP port (setting ``port``): a bare URL there is taken for a cbrs server."""
+_SERVER_PORTS = {7878: "oxigraph", 8890: "virtuoso", 3030: "fuseki", CBRS_SERVE_PORT: "cbrs"}
+"""The usual port of each kind of server: what a bare URL's port suggests is meant to answer there."""
+
+
+def start_hint(location: str) -> str:
+    """What to start when nothing answers at ``location``, judged from what the URL looks like: a path
+    names the layout (``/query``: Oxigraph; ``/sparql``: a cbrs server, or Virtuoso on port 8890), a bare
+    URL its port (8080: cbrs serve's default; 7878: Oxigraph's; 3030: Fuseki's). A user pointing at a
+    stopped ``cbrs serve`` was told to start ``oxigraph serve``, another server holding other data."""
+    url = httpx.URL(location.split()[0])
+    port = url.port or (443 if url.scheme == "https" else 80)
+    path = url.path.rstrip("/")
+    oxigraph = f"oxigraph serve --location DIR --bind {url.host}:{port} --union-default-graph"
+    cbrs = f"cbrs --store DIR serve --port {port}"
+    kind = _SERVER_PORTS.get(port, "either") if path in ("", "/sparql") else None
+    if path.endswith("/query") or (path == "" and kind == "oxigraph"):
+        return f"is the SPARQL server running? Start one with: {oxigraph}"
+    if kind == "virtuoso":
+        return f"is Virtuoso running (one SPARQL endpoint at {url.host}:{port}/sparql; docs/remote-store.md)?"
+    if path == "/sparql" or kind == "cbrs":
+        also = f" (or, for an Oxigraph server at that address, {oxigraph})" if path == "" else ""
+        return f"is the cbrs server running? Start one with: {cbrs}{also}"
+    if kind == "fuseki" or path:
+        return "is the SPARQL server running? (docs/remote-store.md lists the endpoints cbrs reaches)"
+    return f"is the SPARQL server running? Start one with: {oxigraph}; or, for a cbrs server, {cbrs}"
 
 
 @functools.cache

@@ -12,7 +12,7 @@ from __future__ import annotations
 import statistics
 import time
 import xml.etree.ElementTree as ET
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -105,15 +105,21 @@ def check_layout(root: Path) -> None:
             )
 
 
-def load_collection(root: Path) -> LoadedCollection:
+Progress = Callable[[str, int, int], None]
+"""Told how an evaluation goes (stage, items done, of how many; 0 when not counted): for a person waiting."""
+
+
+def load_collection(root: Path, progress: Progress | None = None) -> LoadedCollection:
     """Load services, requests and ontologies of a collection folder into a fresh in-memory store."""
     check_layout(root)
     start = time.perf_counter()
     kb = KnowledgeBase(Store.open(":memory:"))
     kb.load([ontology_dir() / "core.ttl"], graph="ontology")  # the service model only, not the home domain
     catalogue = Catalogue.open(root / "ontology")
-    services = kb.load([root / "services"], catalogue=catalogue)
-    queries = kb.load([root / "queries"], graph="requirements", catalogue=catalogue)
+    services = kb.load([root / "services"], catalogue=catalogue, progress=_stage(progress, "services: "))
+    queries = kb.load(
+        [root / "queries"], graph="requirements", catalogue=catalogue, progress=_stage(progress, "queries: ")
+    )
 
     def by_file(report: Any) -> dict[str, list[str]]:
         return {
@@ -172,14 +178,23 @@ class CollectionReport:
         return "\n".join(lines)
 
 
+def _stage(progress: Progress | None, prefix: str) -> Progress | None:
+    """``progress`` with ``prefix`` in front of each stage it is told."""
+    if progress is None:
+        return None
+    told = progress
+    return lambda stage, done, total: told(prefix + stage, done, total)
+
+
 def evaluate_collection(
-    root: Path, methods: Sequence[str] = METHODS, config: MatchConfig | None = None
+    root: Path, methods: Sequence[str] = METHODS, config: MatchConfig | None = None, progress: Progress | None = None
 ) -> CollectionReport:
     """Load the collection and score every method on every judged request (``config``: the matching
-    parameters, MatchConfig's defaults when None)."""
+    parameters, MatchConfig's defaults when None); ``progress`` is told each load stage, and each query
+    as each method ranks for it."""
     check_layout(root)
     judgements = read_relevance(root / "relevance.xml")
-    loaded = load_collection(root)
+    loaded = load_collection(root, progress)
 
     def to_iris(uri: str, table: dict[str, list[str]]) -> list[str]:
         return table.get(_file_key(uri), [])
@@ -206,7 +221,10 @@ def evaluate_collection(
     first: Matchmaker | None = None
     figures: dict[str, dict[str, float]] = {}
     curves: dict[str, list[float]] = {}
-    for method in methods:
+    for number, method in enumerate(methods, 1):
+        stage = f"{method} ({number}/{len(methods)}): ranking for query"
+        if progress is not None:
+            progress(f"{method} ({number}/{len(methods)}): reading the advertisements", 0, 0)
         matcher = (
             Matchmaker(loaded.kb, method, config, index=first.index, advertisements=first.advertisements)
             if first is not None
@@ -216,7 +234,9 @@ def evaluate_collection(
         matcher.prepare()  # reading the pool is loading, not answering a query
         values: dict[str, list[float]] = {metric: [] for metric in METRICS}
         curve = [0.0] * len(RECALL_LEVELS)
-        for requirement, (binary, grades) in requests.items():
+        for done, (requirement, (binary, grades)) in enumerate(requests.items()):
+            if progress is not None:
+                progress(stage, done, len(requests))
             start = time.perf_counter()
             result = matcher.rank(requirement, explain=0)
             values["query_ms"].append((time.perf_counter() - start) * 1000)
