@@ -9,17 +9,21 @@ with a reason; nothing it sends can reach the plan unchecked.
 
 from __future__ import annotations
 
-import threading
+import logging
 import time
-import weakref
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from concurrent.futures import Future
 from concurrent.futures import TimeoutError as FutureTimeout
 from typing import Any, Protocol
 
+from cbrs.actions.answers import Classes, ContradictedEffectError, read_answer
+from cbrs.actions.breaker import BreakerPolicy, busy, calls_of
 from cbrs.actions.components import Component, Status
+from cbrs.kb import Statement
 
 __all__ = ["LATE_WINDOW", "MAX_POLLS", "POLL_SECONDS", "RemoteCallError", "RemoteComponent", "Transport", "given_up"]
+
+log = logging.getLogger("cbrs.actions.remote")
 
 POLL_SECONDS = 0.005
 """How long one tick waits for the answer at least: short, so a run's other work is not held up."""
@@ -31,13 +35,6 @@ LATE_WINDOW = 2.0
 """The transport is given this many times the component's timeout: a call the component has given up
 stays open at the bridge for as long again, so that the provider's late answer is still heard and,
 until it is, no new call is sent to a service that may still be executing the last one (an actuator)."""
-
-_given_up: weakref.WeakKeyDictionary[Transport, dict[str, tuple[Future[dict[str, Any]], float, float]]] = (
-    weakref.WeakKeyDictionary()
-)
-"""By transport (kept only while it lives), by service: the call given up last, when it was sent, and
-its timeout."""
-_given_up_lock = threading.Lock()
 
 
 class RemoteCallError(Exception):
@@ -63,6 +60,13 @@ class RemoteComponent(Component):
     (the transport is given ``LATE_WINDOW`` times as long, so that its own timeout never comes first and
     a timeout has one reason). ``exclusive`` (an actuator): no new call is sent while a call given up
     unanswered may still be executing (:func:`given_up`); the invocation fails saying so instead.
+
+    ``effects`` (the advertisement's) with ``classes`` (the store's, :class:`actions.answers.StoreClasses`):
+    an answer whose value the store says the effect excludes fails the invocation with
+    :class:`~actions.answers.ContradictedEffectError` (``contradictions="warn"``: it is logged and taken).
+    ``breaker``: after calls time out the service is passed over for a cool-down (:mod:`actions.breaker`);
+    None, as before it, calls it whenever asked. ``session``: the registration the component is live
+    under now, so that a restarted program is not held to its predecessor's timeouts.
     """
 
     def __init__(
@@ -75,6 +79,11 @@ class RemoteComponent(Component):
         timeout: float = 10.0,
         clock: Callable[[], float] = time.monotonic,
         exclusive: bool = False,
+        effects: Iterable[Statement] = (),
+        classes: Classes | None = None,
+        contradictions: str = "fail",
+        breaker: BreakerPolicy | None = None,
+        session: str | None = None,
     ) -> None:
         super().__init__(iri)
         self.transport = transport
@@ -84,23 +93,34 @@ class RemoteComponent(Component):
         self.timeout = timeout
         self._clock = clock
         self.exclusive = exclusive
+        self.effects = tuple(effects)
+        self.classes = classes
+        self.contradictions = contradictions
+        self.breaker = breaker
+        self.session = session
+        self._calls = calls_of(transport)
         self._pending: Future[dict[str, Any]] | None = None
         self._sent = 0.0
         self._deadline = 0.0
 
     def begin(self, inputs: Mapping[str, Any]) -> None:
-        """Send the call, unless this transport's last call to the service was given up unanswered and
-        may still be executing: then the invocation fails with that reason and nothing is sent."""
+        """Send the call, unless the service is passed over now (its breaker is open, or an actuator's call
+        given up may still be executing): then the invocation fails with that reason and nothing is sent."""
         self.outputs = {}
         self.reason = ""
         self._pending = None
-        busy = given_up(self.transport, self.service, self._clock) if self.exclusive else ""
-        if busy:
-            self.reason = busy
+        now = self._clock()
+        why = self._calls.admit(self.service, self.iri, now, self.timeout * LATE_WINDOW, self.exclusive, self.session)
+        if why:
+            self.reason = why
             return
-        self._sent = self._clock()
+        self._sent = now
         self._deadline = self._sent + self.timeout
-        self._pending = self.transport.call(self.service, dict(inputs), self.timeout * LATE_WINDOW)
+        try:
+            self._pending = self.transport.call(self.service, dict(inputs), self.timeout * LATE_WINDOW)
+        except BaseException:
+            self._calls.released(self.service)
+            raise
 
     def update(self) -> Status:
         pending = self._pending
@@ -113,14 +133,17 @@ class RemoteComponent(Component):
             if self._clock() < self._deadline:
                 return Status.RUNNING
             self.reason = f"{self.service} did not answer within {self.timeout:g} s"
-            return self._give_up()
+            return self._timed_out()
         except RemoteCallError as error:
+            self._calls.answered(self.service)  # at once, if with an error: it does not hang
             self.reason = f"{self.service} failed: {error}"
             return self._fail()
         except Exception as error:  # the transport broke (the connection closed, the provider left)
+            self._calls.released(self.service)
             self.reason = f"{self.service}: {type(error).__name__}: {error}"
             return self._fail()
         self._pending = None
+        self._calls.answered(self.service)
         return self._accept(values)
 
     def _accept(self, values: Any) -> Status:
@@ -142,24 +165,53 @@ class RemoteComponent(Component):
                     self.reason = f"{self.service} answered a wrong {name}: {error}"
                     return Status.FAILED
             outputs[name] = value
+        self._against_effects(outputs)
         self.outputs = outputs
         return Status.SUCCEEDED
+
+    def _against_effects(self, outputs: Mapping[str, Any]) -> None:
+        """Raise :class:`ContradictedEffectError` when an answered value contradicts the effects
+        (:mod:`actions.answers`); a class the store does not know is only noted."""
+        if self.classes is None or not self.effects:
+            return
+        reading = read_answer(outputs, self.output_types, self.effects, self.classes)
+        for name, concept in reading.unknown:
+            log.info(
+                "%s answered %s = %s, a class the store does not know: not checked against its effects",
+                self.service,
+                name,
+                concept,
+            )
+        if reading.contradiction is None:
+            return
+        name, answered, effect = reading.contradiction
+        error = ContradictedEffectError(self.iri, self.service, name, answered, effect)
+        if self.contradictions != "warn":
+            raise error
+        log.warning("%s (taken, remote_contradictions=warn)", error)
 
     def _fail(self) -> Status:
         self._pending = None
         return Status.FAILED
 
-    def _give_up(self) -> Status:
-        """Stop waiting for a call that has not answered; the provider may still be executing it (a door
-        motor cannot be told to stop by a dropped call), so it is kept until it answers (``given_up``)."""
-        pending = self._pending
-        if self.exclusive and pending is not None and not pending.done():
-            with _given_up_lock:
-                _given_up.setdefault(self.transport, {})[self.service] = (pending, self._sent, self.timeout)
+    def _timed_out(self) -> Status:
+        """Stop waiting for a call that has not answered: the breaker counts it, and an actuator's call is
+        kept until it answers, since the provider may still be executing it (a door motor cannot be told
+        to stop by a dropped call)."""
+        pending = self._pending if self.exclusive else None
+        self._calls.timed_out(
+            self.service, self.iri, self._clock(), self.timeout, self.breaker, self.session, pending, self._sent
+        )
         return self._fail()
 
     def halt(self) -> None:
-        self._give_up()
+        """The step was stopped while the call was out (a cancelled run, the executor's tick bound)."""
+        pending = self._pending
+        if pending is not None and not pending.done():
+            self._calls.released(self.service)
+            if self.exclusive:
+                self._calls.given_up(self.service, self.iri, pending, self._sent, self.timeout)
+        self._fail()
 
 
 def given_up(transport: Transport, service: str, clock: Callable[[], float] = time.monotonic) -> str:
@@ -167,17 +219,4 @@ def given_up(transport: Transport, service: str, clock: Callable[[], float] = ti
     (it timed out, or its step was halted) and has not answered yet, so the provider may still be
     executing it. Empty when the service is free: it answered late, or the transport ended the call
     (after ``LATE_WINDOW`` times the timeout, or the connection closed)."""
-    with _given_up_lock:
-        calls = _given_up.get(transport, {})
-        entry = calls.get(service)
-        if entry is None:
-            return ""
-        pending, sent, timeout = entry
-        if pending.done():
-            del calls[service]
-            return ""
-    return (
-        f"{service} is still executing the call sent {clock() - sent:.1f} s ago, given up after {timeout:g} s"
-        f" without an answer: no new call is sent until it answers (or {timeout * LATE_WINDOW:g} s after it was"
-        " sent, when the bridge ends it)"
-    )
+    return busy(transport, service, clock())

@@ -48,7 +48,8 @@ class Environment(Protocol):
     # Optional: ``starting(step, known)`` (``executor.StepStart``), called before each step starts with
     # the inputs of every step known by then, for an environment that looks ahead (where a hold ends);
     # ``succeeded(step, component)`` (``executor.StepDone``), called when a step succeeded, for an
-    # environment that keeps beliefs no sense can check (a door a remote motor opened).
+    # environment that keeps beliefs no sense can check (a door a remote motor opened); ``passed_over()``,
+    # the components to compose without now, with why (remote ones whose calls timed out).
 
 
 @dataclass(frozen=True)
@@ -60,10 +61,11 @@ class Replan:
     reason: str
     failures: tuple[Failure, ...] = ()  # the failed step's attempts, as the re-planning memory keys them
     avoided: tuple[str, ...] = ()  # components the next plan was composed without (failed, nothing changed)
+    passed_over: tuple[tuple[str, str], ...] = ()  # (component, why) the plan was composed without
 
     def to_dict(self) -> dict[str, Any]:
         return {
-            "plan": self.plan.to_dict(),
+            "plan": {**self.plan.to_dict(), "passed_over": _passed_dicts(self.passed_over)},
             "execution": self.report.to_dict(),
             "reason": self.reason,
             "failures": [failure.to_dict() for failure in self.failures],
@@ -91,6 +93,7 @@ class RunResult:
     replans: tuple[Replan, ...] = ()  # the plans replaced before it, in order
     goals: tuple[GoalCheck, ...] = ()  # the task's effects at the end, believed and in the world
     stopped: str = ""  # why re-planning stopped before its budget: the next plan would repeat a failure
+    passed_over: tuple[tuple[str, str], ...] = ()  # (component, why) the last composition was made without
 
     @property
     def succeeded(self) -> bool:
@@ -112,7 +115,8 @@ class RunResult:
         status = self.report.status.value if self.report else PlanStatus.UNSOLVABLE.value
         if self.executed and self.refuted:
             status = RunStatus.FAILED.value
-        found: dict[str, Any] = {"task": self.composition.task, "status": status, "plan": self.composition.to_dict()}
+        plan = {**self.composition.to_dict(), "passed_over": _passed_dicts(self.passed_over)}
+        found: dict[str, Any] = {"task": self.composition.task, "status": status, "plan": plan}
         if self.report is not None:
             found["execution"] = self.report.to_dict()
         found["replans"] = [replan.to_dict() for replan in self.replans]
@@ -162,10 +166,11 @@ def run_task(
     belief.write(environment.observe())  # plan from what holds now, not from a past run's belief
     composition = composer.compose(task, belief=True)
     config = composer.config
-    composition = _runnable(kb, config, task, composition, environment.registry)
+    passed = _passed_over(environment, bus, {})
+    composition = _runnable(kb, config, task, composition, environment.registry, passed=passed)
     if composition.plan is None:
         belief.restore(before)  # nothing can be done and nothing was: the store is left as it was
-        return RunResult(composition, None)
+        return RunResult(composition, None, passed_over=_pairs(passed))
     try:
         _check_grounded(kb, composer.index, composition.plan)
     except (UngroundedGoalError, UnresolvedDesignatorError):
@@ -175,10 +180,14 @@ def run_task(
     memory = FailureMemory(replan_policy or ReplanPolicy())
 
     def compose(avoid: frozenset[str]) -> CompositionResult:
-        """A fresh composition from the belief, without ``avoid`` and what the environment cannot run."""
-        return _runnable(kb, config, task, _compose(kb, config, task, avoid), environment.registry, avoid)
+        """A fresh composition from the belief, without ``avoid``, what the environment cannot run and what
+        it passes over now."""
+        nonlocal passed
+        passed = _passed_over(environment, bus, passed)
+        return _runnable(kb, config, task, _compose(kb, config, task, avoid), environment.registry, avoid, passed)
 
     stopped = ""
+    composed_without = _pairs(passed)
     report: ExecutionReport | None = None
     outputs: Mapping[int, Mapping[str, Any]] = {}
     try:
@@ -223,7 +232,9 @@ def run_task(
             if decision.composition is None:
                 stopped = decision.stopped  # the result says why; listeners had the plan's failure
                 break
-            replans.append(Replan(plan, report, report.reason, tuple(failures), decision.avoided))
+            replaced = Replan(plan, report, report.reason, tuple(failures), decision.avoided, composed_without)
+            replans.append(replaced)
+            composed_without = _pairs(passed)
             message = {"event": "replanning", "plan": len(replans) + 1, "reason": report.reason}
             if decision.avoided:
                 message["avoiding"] = list(decision.avoided)
@@ -233,7 +244,7 @@ def run_task(
         container.finalise_all()
     belief.write(environment.observe())
     goals = _check_goals(environment, composition.plan, outputs) if report is not None else ()
-    return RunResult(composition, report, tuple(replans), goals, stopped)
+    return RunResult(composition, report, tuple(replans), goals, stopped, composed_without)
 
 
 def _await_return(kb: KnowledgeBase, failures: Iterable[Failure], grace: float, bus: EventBus) -> None:
@@ -260,23 +271,53 @@ def _runnable(
     composition: CompositionResult,
     registry: Registry,
     avoid: frozenset[str] = frozenset(),
+    passed: Mapping[str, str] | None = None,
 ) -> CompositionResult:
     """``composition``, or when a step of its plan has no component the environment implements (the
     store advertises services the simulation does not perform, LocateRoomOfPosition say), the
     composition without them: such a step fails for sure, and only after the steps before it moved
-    things (a goal-only task picked the cup up, then found no room locator, three times over)."""
+    things (a goal-only task picked the cup up, then found no room locator, three times over). So too
+    without the components the environment ``passed`` over (component -> why): a remote one whose
+    calls timed out would make the run wait its timeout again (``actions.breaker``)."""
     plan = composition.plan
-    if plan is None or all(any(c in registry for c in step.candidates) for step in plan.steps):
+    passed = passed or {}
+    used = {c for step in plan.steps for c in step.candidates} if plan is not None else set()
+    if plan is None or (
+        all(any(c in registry for c in step.candidates) for step in plan.steps) and not used & set(passed)
+    ):
         return composition
     advertisements = kb.advertisements()
-    missing = frozenset(ad.iri for ad in advertisements if ad.iri not in registry)
+    missing = frozenset(ad.iri for ad in advertisements if ad.iri not in registry) | frozenset(passed)
     again = _compose(kb, config, task, avoid | missing)
     if again.plan is not None:
         return again
     # Say which components the first plan wanted: "no component provides" alone hid a registered one.
-    wanted = {c for step in plan.steps for c in step.candidates if c not in registry}
-    why = [(ad.iri, _cannot_run(ad)) for ad in sorted(advertisements, key=lambda ad: ad.iri) if ad.iri in wanted]
+    wanted = {c for c in used if c not in registry or c in passed}
+    why = [
+        (ad.iri, passed.get(ad.iri) or _cannot_run(ad))
+        for ad in sorted(advertisements, key=lambda ad: ad.iri)
+        if ad.iri in wanted
+    ]
     return replace(again, unsatisfied=tuple(replace(u, unrunnable=tuple(why)) for u in again.unsatisfied))
+
+
+def _passed_over(environment: Environment, bus: EventBus, before: Mapping[str, str]) -> dict[str, str]:
+    """The components the environment passes over now, with why (the Environment protocol's optional
+    ``passed_over``: remote components whose calls timed out, ``actions.breaker``); said on the progress
+    topic when they are not the ones passed over ``before``."""
+    find = getattr(environment, "passed_over", None)
+    passed = dict(find()) if callable(find) else {}
+    if passed and set(passed) != set(before):
+        bus.publish("/cbrs/task_progress", {"event": "passed_over", "components": passed})
+    return passed
+
+
+def _pairs(passed: Mapping[str, str]) -> tuple[tuple[str, str], ...]:
+    return tuple(sorted(passed.items()))
+
+
+def _passed_dicts(passed: Iterable[tuple[str, str]]) -> list[dict[str, str]]:
+    return [{"component": component, "why": why} for component, why in passed]
 
 
 def _cannot_run(ad: Advertisement) -> str:

@@ -102,6 +102,9 @@ _event_loop = _one_of(EVENT_LOOPS, "an event loop")
 NON_FINITE = ("null", "tokens")  # cbrs.rosbridge.protocol.NON_FINITE, kept here so settings load no bridge
 _non_finite = _one_of(NON_FINITE, "a way to write NaN and infinities")
 
+CONTRADICTIONS = ("fail", "warn")  # cbrs.actions.answers.CONTRADICTIONS, kept here so settings load no planner
+_contradictions = _one_of(CONTRADICTIONS, "a way to treat an answer that contradicts its step's effect")
+
 LOG_LEVELS = ("DEBUG", "INFO", "WARNING", "ERROR", "CRITICAL")
 _log_level = _one_of(LOG_LEVELS, "a log level", str.upper)
 
@@ -298,6 +301,32 @@ SETTINGS: tuple[Setting, ...] = (
         "(docs/execution.md).",
         "CBRS_REMOTE_CALL_TIMEOUT",
         _positive(float),
+    ),
+    Setting(
+        "remote_breaker_timeouts",
+        lambda: 1,
+        "Calls in a row to a component in another process that time out before task runs pass it over for "
+        "remote_breaker_cooldown seconds (its circuit breaker opens; then one trial call); 0 never passes one "
+        "over (docs/execution.md).",
+        "CBRS_REMOTE_BREAKER_TIMEOUTS",
+        _non_negative,
+    ),
+    Setting(
+        "remote_breaker_cooldown",
+        lambda: 30.0,
+        "Seconds task runs pass over a component in another process whose calls timed out, before one trial "
+        "call: an answer in time brings it back, another timeout passes it over again (docs/execution.md).",
+        "CBRS_REMOTE_BREAKER_COOLDOWN",
+        _positive(float),
+    ),
+    Setting(
+        "remote_contradictions",
+        lambda: "fail",
+        "What a task run does with an answer of a component in another process that the store says contradicts "
+        "its step's effect (a light asked to switch on answering SwitchedOff): fail (the step fails and nothing "
+        "of it is believed) or warn (taken, and logged; docs/execution.md).",
+        "CBRS_REMOTE_CONTRADICTIONS",
+        _contradictions,
     ),
     Setting(
         "remote_batch",

@@ -21,11 +21,14 @@ from __future__ import annotations
 
 import logging
 import math
+import time
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
+from cbrs.actions.answers import StoreClasses
 from cbrs.actions.belief import Observation
+from cbrs.actions.breaker import BreakerPolicy, passed_over
 from cbrs.actions.components import Component, Registry, Status
 from cbrs.actions.plan import Plan, PlanStep
 from cbrs.actions.remote import RemoteComponent, Transport
@@ -1186,13 +1189,12 @@ def implementations(
     perform its service on its device (cameras must exist in the world)."""
     registry = registry if registry is not None else Registry()
     is_a = _store_taxonomy(kb)
+    calls = _RemoteCalls.read(kb) if transport is not None else None
     for ad in kb.advertisements():
         remote = ad.bridge_port
         if remote is not None:
-            if transport is not None and remote.topic is not None:
-                outputs = {p.name: p.type for p in ad.outputs if p.name}
-                exclusive = ad.kind == CBRS.PhysicalManipulationComponent
-                registry.add(ad.iri, _remote(transport, remote.topic, outputs, is_a, call_timeout(ad), exclusive))
+            if transport is not None and calls is not None and remote.topic is not None:
+                registry.add(ad.iri, _remote(transport, remote.topic, ad, is_a, calls))
             continue
         work = SKILLS.get(ad.service_name or "")
         device = ad.device_name or ""
@@ -1233,13 +1235,50 @@ def _store_taxonomy(kb: KnowledgeBase) -> IsA:
     return is_a
 
 
+@dataclass(frozen=True)
+class _RemoteCalls:
+    """What every remote component of one environment shares: the store's classes (read at the first
+    answer that needs them), the settings a run reads when it starts, and who is live under which session."""
+
+    classes: StoreClasses
+    breaker: BreakerPolicy
+    contradictions: str
+    sessions: Mapping[str, str | None]
+
+    @classmethod
+    def read(cls, kb: KnowledgeBase) -> _RemoteCalls:
+        breaker = BreakerPolicy(
+            setting("remote_breaker_timeouts").resolve(), setting("remote_breaker_cooldown").resolve()
+        )
+        sessions = {iri: state.registered_by for iri, state in kb.liveness.states().items()}
+        return cls(StoreClasses(kb), breaker, setting("remote_contradictions").resolve(), sessions)
+
+
 def _remote(
-    transport: Transport, service: str, outputs: Mapping[str, str], is_a: IsA, timeout: float, exclusive: bool
+    transport: Transport, service: str, ad: Advertisement, is_a: IsA, calls: _RemoteCalls
 ) -> Callable[[str], Component]:
+    """A remote component for ``ad`` (docs/execution.md, "Remote components")."""
+    outputs = {p.name: p.type for p in ad.outputs if p.name}
+    timeout = call_timeout(ad)
+    exclusive = ad.kind == CBRS.PhysicalManipulationComponent
+
     def checked(concept: str, value: Any) -> dict[str, Any]:
         return check(concept, value, is_a)
 
-    return lambda iri: RemoteComponent(iri, transport, service, outputs, checked, timeout, exclusive=exclusive)
+    return lambda iri: RemoteComponent(
+        iri,
+        transport,
+        service,
+        outputs,
+        checked,
+        timeout,
+        exclusive=exclusive,
+        effects=ad.effects,
+        classes=calls.classes,
+        contradictions=calls.contradictions,
+        breaker=calls.breaker,
+        session=calls.sessions.get(ad.iri),
+    )
 
 
 def _maker(work: Work, device: str, outputs: tuple[str, ...]) -> Callable[[str], Component]:
@@ -1325,6 +1364,14 @@ class SimEnvironment:
 
     def clock(self) -> float:
         return self.world.time
+
+    def passed_over(self) -> dict[str, str]:
+        """The remote components a plan leaves out now, with why (``actions.breaker``): their calls timed
+        out and the cool-down is on, or an actuator is still executing a call given up."""
+        if self.transport is None:
+            return {}
+        sessions = {iri: state.registered_by for iri, state in self.kb.liveness.states().items()}
+        return passed_over(self.transport, time.monotonic(), sessions)
 
     def refresh(self) -> None:
         """Before a new plan: forget the measured map (the world may have changed) and add the

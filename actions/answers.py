@@ -1,0 +1,145 @@
+"""Whether a remote component's answer contradicts the effect its step was chosen for.
+
+A component in another process reports what it did in its outputs: a kitchen light's ``lampStatus``.
+The type check (``sim.values.check``) only asks whether a value is of the output's class
+(``home:DeviceStatus``); an answer of ``home:SwitchedOff`` to a step whose effect is ``(home:Lamp,
+home:hasStatus, home:SwitchedOn)`` passes it, and the lamp would be believed on. Here an answer is
+read against the effects as well (docs/execution.md, "An answer that contradicts the effect"):
+
+- an output *reports* an effect when the effect's object is a class at or below the output's class
+  (``home:SwitchedOn`` is a ``home:DeviceStatus``): the value could be the effect's outcome;
+- the answered value *contradicts* that effect when the store says its class shares no instance with
+  the effect's object: the two, or a superclass of each, are declared disjoint (``owl:disjointWith``,
+  ``owl:AllDisjointClasses``; the named query ``taxonomy_disjoint``), so a subclass of
+  ``home:SwitchedOff`` contradicts ``home:SwitchedOn`` too;
+- an output that reports several effects contradicts only when it contradicts every one of them (some
+  reading of the answer agrees with the step otherwise);
+- the same class, a subclass or a superclass of the effect's object is no contradiction (a superclass
+  says less, not otherwise), nor is a class the store does not know: nothing proves it is not the
+  effect's, so the step is believed as before and the answer noted (:attr:`Reading.unknown`).
+
+The store's classes are read by two named queries (``subclasses``, ``taxonomy_disjoint``), once, at the
+first answer that needs them.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from typing import Any, Protocol
+
+from cbrs.actions.errors import ActionsError
+from cbrs.kb import KnowledgeBase, Statement
+from cbrs.kb.namespaces import expand, shorten
+
+__all__ = ["CONTRADICTIONS", "Classes", "ContradictedEffectError", "Reading", "StoreClasses", "read_answer"]
+
+CONTRADICTIONS = ("fail", "warn")
+"""What a run does with an answer that contradicts its step's effect (setting ``remote_contradictions``):
+fail the step (the default), or take the answer as before and log a warning."""
+
+
+class Classes(Protocol):
+    """What the store knows of classes: enough to tell whether two share no instance."""
+
+    def known(self, concept: str) -> bool:
+        """Whether the store declares ``concept`` a class."""
+
+    def is_a(self, concept: str, superclass: str) -> bool:
+        """Whether ``concept`` is ``superclass`` or below it."""
+
+    def disjoint(self, first: str, second: str) -> bool:
+        """Whether the store says no instance of ``first`` is one of ``second``."""
+
+
+class ContradictedEffectError(ActionsError):
+    """A remote component answered a value the store says its step's effect excludes: a light asked to
+    switch on answering that it is off. Keeps the component, its service, the output, the class
+    answered and the effect contradicted."""
+
+    def __init__(self, component: str, service: str, output: str, answered: str, effect: Statement) -> None:
+        self.component, self.service, self.output = component, service, output
+        self.answered, self.effect = answered, effect
+        super().__init__(
+            f"{shorten(component)} ({service}) answered {output} = {shorten(answered)}, which contradicts its"
+            f" effect ({_text(effect)}): the store declares {shorten(answered)} disjoint with"
+            f" {shorten(effect.object)}; nothing of the answer is believed (a handler that could not act should"
+            " raise instead; docs/execution.md)"
+        )
+
+
+def _text(statement: Statement) -> str:
+    return f"{shorten(statement.subject)}, {shorten(statement.predicate)}, {shorten(statement.object)}"
+
+
+@dataclass(frozen=True)
+class Reading:
+    """What an answer says about the step's effects: the first output that contradicts them (with the
+    class answered and the effect), and the answered classes the store does not know (output, class)."""
+
+    contradiction: tuple[str, str, Statement] | None = None
+    unknown: tuple[tuple[str, str], ...] = ()
+
+
+def read_answer(
+    outputs: Mapping[str, Any], types: Mapping[str, str], effects: Iterable[Statement], classes: Classes
+) -> Reading:
+    """Read each output's value (``outputs``, checked, with its ``@type``) of class ``types[name]``
+    against the ``effects`` it reports (the module's definition)."""
+    effects = tuple(effects)
+    unknown: list[tuple[str, str]] = []
+    for name, concept in types.items():
+        answered = _class_of(outputs.get(name))
+        reported = [e for e in effects if classes.known(e.object) and classes.is_a(e.object, concept)]
+        if answered is None or not reported:
+            continue
+        if not classes.known(answered):
+            unknown.append((name, answered))
+            continue
+        against = [e for e in reported if classes.disjoint(answered, e.object)]
+        if len(against) == len(reported):
+            return Reading((name, answered, against[0]), tuple(unknown))
+    return Reading(None, tuple(unknown))
+
+
+def _class_of(value: Any) -> str | None:
+    """The class a value names by its ``@type`` (expanded), if it names one."""
+    written = value.get("@type") if isinstance(value, dict) else None
+    if not isinstance(written, str) or not written:
+        return None
+    try:
+        return expand(written)
+    except ValueError:
+        return written
+
+
+@dataclass
+class StoreClasses:
+    """:class:`Classes` from a store, read by two named queries at the first question."""
+
+    kb: KnowledgeBase
+    _up: dict[str, frozenset[str]] | None = field(default=None, repr=False)
+    _declared: dict[str, set[str]] = field(default_factory=dict, repr=False)
+
+    def _read(self) -> dict[str, frozenset[str]]:
+        if self._up is None:
+            up: dict[str, set[str]] = {}
+            for row in self.kb.select("subclasses"):
+                up.setdefault(row["class"].value, {row["class"].value}).add(row["superclass"].value)
+            for row in self.kb.select("taxonomy_disjoint"):
+                first, second = row["first"].value, row["second"].value
+                self._declared.setdefault(first, set()).add(second)
+                self._declared.setdefault(second, set()).add(first)
+            self._up = {concept: frozenset(above) for concept, above in up.items()}
+        return self._up
+
+    def known(self, concept: str) -> bool:
+        return concept in self._read()
+
+    def is_a(self, concept: str, superclass: str) -> bool:
+        return concept == superclass or superclass in self._read().get(concept, ())
+
+    def disjoint(self, first: str, second: str) -> bool:
+        up = self._read()
+        above_second = up.get(second, frozenset({second}))
+        return any(self._declared.get(a, set()) & above_second for a in up.get(first, frozenset({first})))

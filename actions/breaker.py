@@ -1,0 +1,255 @@
+"""What this process knows of each remote service's calls: a circuit breaker, and an actuator's call given up.
+
+A handler that hangs keeps its registration: its SDK sends heartbeats on a schedule of its own, so the
+lease cannot see the hang, and every run planned onto it (every re-plan too) waited a whole call
+timeout before failing over. A breaker per service remembers the timeouts instead
+(docs/execution.md, "A component that hangs is passed over"):
+
+- *closed*: calls go out. ``BreakerPolicy.timeouts`` calls in a row that time out (1 by default) open it.
+- *open*: for ``BreakerPolicy.cooldown`` seconds the component is passed over: composition leaves it
+  out (:func:`passed_over`, saying why), and an invocation of it fails at once, sending nothing.
+- *half-open*: after the cool-down one trial call goes out; any other waits for its verdict (passed
+  over meanwhile). An answer in time closes the breaker (an error answer too: it came at once, and the
+  breaker is about the time lost waiting); a timeout opens it again for another cool-down. A late
+  answer closes nothing: the handler is still slower than its timeout.
+- A component registered again from another session (its program restarted) starts closed.
+
+An actuator (``RemoteComponent(exclusive=True)``) keeps the rule it had before the breaker: while a call
+given up unanswered may still be executing, no new call goes to its service (:func:`given_up`), and
+composition passes it over with that reason. Both facts live in one table per transport, kept only
+while the transport lives (a server's own bridge connection outlives its runs).
+"""
+
+from __future__ import annotations
+
+import threading
+import weakref
+from collections.abc import Mapping
+from concurrent.futures import Future
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+from cbrs.actions.errors import ActionsError
+from cbrs.kb.namespaces import shorten
+
+__all__ = ["BreakerPolicy", "BreakerPolicyError", "ServiceCalls", "busy", "calls_of", "passed_over"]
+
+
+class _Transport(Protocol):
+    def call(self, service: str, args: Mapping[str, Any], timeout: float) -> Future[dict[str, Any]]: ...
+
+
+class BreakerPolicyError(ActionsError, ValueError):
+    """A breaker was given an impossible parameter (a negative count or cool-down)."""
+
+    def __init__(self, name: str, value: object, why: str) -> None:
+        super().__init__(f"{name} = {value!r}: {why}")
+        self.name, self.value = name, value
+
+
+@dataclass(frozen=True)
+class BreakerPolicy:
+    """``timeouts``: calls in a row that time out before the component is passed over (0: never);
+    ``cooldown``: seconds it is passed over before one trial call (settings ``remote_breaker_timeouts``,
+    ``remote_breaker_cooldown``)."""
+
+    timeouts: int = 1
+    cooldown: float = 30.0
+
+    def __post_init__(self) -> None:
+        if self.timeouts < 0:
+            raise BreakerPolicyError("timeouts", self.timeouts, "a number of timeouts cannot be negative")
+        if not 0.0 <= self.cooldown <= 86_400.0:
+            raise BreakerPolicyError("cooldown", self.cooldown, "a cool-down is 0 to 86400 seconds")
+
+
+@dataclass
+class _Service:
+    component: str
+    session: str | None = None  # the registration its timeouts were met under
+    timeouts: int = 0  # in a row
+    timeout: float = 0.0  # the last call's timeout
+    opened: float | None = None  # when the breaker last opened
+    cooldown: float = 0.0
+    trial: tuple[float, float] | None = None  # the trial call out: when it was sent, how long it may be out
+    given_up: tuple[Future[dict[str, Any]], float, float] | None = None  # an actuator's call: future, sent, timeout
+
+
+class ServiceCalls:
+    """One transport's services: their breakers and the actuators' calls given up."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._services: dict[str, _Service] = {}
+
+    def admit(
+        self, service: str, component: str, now: float, window: float, exclusive: bool, session: str | None
+    ) -> str:
+        """Why no call may go to ``service`` now ("" when one may). A call let through a half-open breaker
+        is its trial, out for at most ``window`` seconds unless its verdict comes first."""
+        with self._lock:
+            entry = self._current(service, component, session)
+            if entry is None:
+                return ""
+            if exclusive and (busy := _busy(service, entry, now)):
+                return busy
+            why = _open(service, entry, now)
+            if not why and entry.opened is not None:  # half-open: this call is the trial
+                entry.trial = (now, window)
+            return why
+
+    def timed_out(
+        self,
+        service: str,
+        component: str,
+        now: float,
+        timeout: float,
+        policy: BreakerPolicy | None,
+        session: str | None,
+        pending: Future[dict[str, Any]] | None = None,
+        sent: float = 0.0,
+    ) -> None:
+        """A call to ``service`` got no answer within ``timeout``; ``pending``: an actuator's call, kept
+        until it answers."""
+        with self._lock:
+            entry = self._current(service, component, session) or self._services.setdefault(
+                service, _Service(component, session)
+            )
+            entry.timeouts += 1
+            entry.timeout = timeout
+            if pending is not None and not pending.done():
+                entry.given_up = (pending, sent, timeout)
+            if (
+                policy is not None
+                and policy.timeouts
+                and (entry.trial is not None or entry.timeouts >= policy.timeouts)
+            ):
+                entry.opened, entry.cooldown = now, policy.cooldown
+            entry.trial = None
+
+    def answered(self, service: str) -> None:
+        """``service`` answered a call in time: its breaker closes."""
+        with self._lock:
+            entry = self._services.get(service)
+            if entry is not None:
+                entry.timeouts, entry.opened, entry.trial = 0, None, None
+                self._forget_if_idle(service, entry)
+
+    def released(self, service: str) -> None:
+        """A call ended with no verdict on the service's speed (the connection broke, the step was halted):
+        a trial it was is no longer out."""
+        with self._lock:
+            entry = self._services.get(service)
+            if entry is not None:
+                entry.trial = None
+
+    def given_up(
+        self, service: str, component: str, pending: Future[dict[str, Any]], sent: float, timeout: float
+    ) -> None:
+        """An actuator's call that is still out was given up (its step was halted)."""
+        with self._lock:
+            entry = self._services.setdefault(service, _Service(component))
+            entry.given_up = (pending, sent, timeout)
+
+    def busy(self, service: str, now: float) -> str:
+        with self._lock:
+            entry = self._services.get(service)
+            return _busy(service, entry, now) if entry is not None else ""
+
+    def passed_over(self, now: float, sessions: Mapping[str, str | None] | None = None) -> dict[str, str]:
+        """The components not to plan with now, by IRI, with why: an open breaker, a trial call out, an
+        actuator still executing a call given up. ``sessions``: each live component's registration, so a
+        component registered again by a restarted program is not held to its predecessor's timeouts."""
+        found: dict[str, str] = {}
+        with self._lock:
+            for service, entry in list(self._services.items()):
+                session = sessions.get(entry.component) if sessions is not None else None
+                current = self._current(service, entry.component, session)
+                if current is None:
+                    continue
+                why = _busy(service, current, now) or _open(service, current, now)
+                if why:
+                    found[current.component] = why
+        return found
+
+    def _current(self, service: str, component: str, session: str | None) -> _Service | None:
+        """The entry of ``service``, forgotten first if another component or registration holds it now."""
+        entry = self._services.get(service)
+        if entry is None:
+            return None
+        if entry.component != component or (session is not None and entry.session not in (None, session)):
+            del self._services[service]
+            return None
+        if session is not None:
+            entry.session = session
+        return entry
+
+    def _forget_if_idle(self, service: str, entry: _Service) -> None:
+        if entry.given_up is None or entry.given_up[0].done():
+            del self._services[service]
+
+
+def _busy(service: str, entry: _Service, now: float) -> str:
+    from cbrs.actions.remote import LATE_WINDOW
+
+    if entry.given_up is None:
+        return ""
+    pending, sent, timeout = entry.given_up
+    if pending.done():
+        entry.given_up = None
+        return ""
+    return (
+        f"{service} is still executing the call sent {now - sent:.1f} s ago, given up after {timeout:g} s"
+        f" without an answer: no new call is sent until it answers (or {timeout * LATE_WINDOW:g} s after it was"
+        " sent, when the bridge ends it)"
+    )
+
+
+def _open(service: str, entry: _Service, now: float) -> str:
+    """Why the breaker of ``service`` keeps calls off it now ("" when a call may go)."""
+    if entry.opened is None:
+        return ""
+    name = shorten(entry.component)
+    if entry.trial is not None:
+        sent, window = entry.trial
+        if now < sent + window:
+            return (
+                f"{name} is passed over: a trial call to {service} is out since {now - sent:.1f} s ago, after its"
+                " calls timed out; no other call goes to it until that one answers or times out"
+            )
+        entry.trial = None  # a trial nobody followed to its end (its run broke off): another may go
+    left = entry.opened + entry.cooldown - now
+    if left <= 0:
+        return ""
+    return (
+        f"{name} is passed over: its last {entry.timeouts} call(s) to {service} timed out (no answer within"
+        f" {entry.timeout:g} s), the last {now - entry.opened:.1f} s ago; one trial call goes to it in {left:.1f} s"
+        f" (a cool-down of {entry.cooldown:g} s, setting remote_breaker_cooldown)"
+    )
+
+
+_tables: weakref.WeakKeyDictionary[_Transport, ServiceCalls] = weakref.WeakKeyDictionary()
+_tables_lock = threading.Lock()
+
+
+def calls_of(transport: _Transport) -> ServiceCalls:
+    """The table of ``transport``'s services (made at first use, kept while the transport lives)."""
+    with _tables_lock:
+        table = _tables.get(transport)
+        if table is None:
+            table = _tables[transport] = ServiceCalls()
+        return table
+
+
+def passed_over(transport: _Transport, now: float, sessions: Mapping[str, str | None] | None = None) -> dict[str, str]:
+    """The components reached over ``transport`` that composition passes over now, with why."""
+    with _tables_lock:
+        table = _tables.get(transport)
+    return table.passed_over(now, sessions) if table is not None else {}
+
+
+def busy(transport: _Transport, service: str, now: float) -> str:
+    """Why no new call may go to the actuator ``service`` over ``transport`` now (``remote.given_up``)."""
+    with _tables_lock:
+        table = _tables.get(transport)
+    return table.busy(service, now) if table is not None else ""
