@@ -235,21 +235,30 @@ _tables_lock = threading.Lock()
 def calls_of(transport: _Transport) -> ServiceCalls:
     """The table of ``transport``'s services (made at first use, kept while the transport lives)."""
     with _tables_lock:
-        table = _tables.get(transport)
-        if table is None:
-            table = _tables[transport] = ServiceCalls()
+        try:
+            table = _tables.get(transport)
+            if table is None:
+                table = _tables[transport] = ServiceCalls()
+        except TypeError:  # a transport that cannot be referred to weakly: a table for this caller alone
+            return ServiceCalls()
         return table
 
 
 def passed_over(transport: _Transport, now: float, sessions: Mapping[str, str | None] | None = None) -> dict[str, str]:
     """The components reached over ``transport`` that composition passes over now, with why."""
-    with _tables_lock:
-        table = _tables.get(transport)
+    table = _table(transport)
     return table.passed_over(now, sessions) if table is not None else {}
 
 
 def busy(transport: _Transport, service: str, now: float) -> str:
     """Why no new call may go to the actuator ``service`` over ``transport`` now (``remote.given_up``)."""
-    with _tables_lock:
-        table = _tables.get(transport)
+    table = _table(transport)
     return table.busy(service, now) if table is not None else ""
+
+
+def _table(transport: _Transport) -> ServiceCalls | None:
+    with _tables_lock:
+        try:
+            return _tables.get(transport)
+        except TypeError:
+            return None

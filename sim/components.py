@@ -64,7 +64,6 @@ from cbrs.sim.values import (
     OBJECT_LOCATION,
     ColourFeature,
     GraspPlan,
-    IsA,
     MalformedValueError,
     Manipulation,
     ObjectFeature,
@@ -72,7 +71,6 @@ from cbrs.sim.values import (
     decode,
     designator,
     from_json,
-    taxonomy,
     to_json,
 )
 from cbrs.sim.world import HomeWorld
@@ -1188,13 +1186,12 @@ def implementations(
     type (when there is a ``transport`` to reach it), else a simulated one where the simulation can
     perform its service on its device (cameras must exist in the world)."""
     registry = registry if registry is not None else Registry()
-    is_a = _store_taxonomy(kb)
     calls = _RemoteCalls.read(kb) if transport is not None else None
     for ad in kb.advertisements():
         remote = ad.bridge_port
         if remote is not None:
             if transport is not None and calls is not None and remote.topic is not None:
-                registry.add(ad.iri, _remote(transport, remote.topic, ad, is_a, calls))
+                registry.add(ad.iri, _remote(transport, remote.topic, ad, calls))
             continue
         work = SKILLS.get(ad.service_name or "")
         device = ad.device_name or ""
@@ -1221,24 +1218,12 @@ def call_timeout(ad: Advertisement, least: float | None = None) -> float:
     return max([floor, *(RESPONSE_TIME_MARGIN * value for value in stated)])
 
 
-def _store_taxonomy(kb: KnowledgeBase) -> IsA:
-    """The store's taxonomy, read at the first remote answer that needs it: a remote answer's ``@type``
-    may be a subclass of its port's class, also one a lab registered (docs/values.md)."""
-    table: IsA | None = None
-
-    def is_a(concept: str, superclass: str) -> bool:
-        nonlocal table
-        if table is None:
-            table = taxonomy((row["class"].value, row["superclass"].value) for row in kb.select("subclasses"))
-        return table(concept, superclass)
-
-    return is_a
-
-
 @dataclass(frozen=True)
 class _RemoteCalls:
     """What every remote component of one environment shares: the store's classes (read at the first
-    answer that needs them), the settings a run reads when it starts, and who is live under which session."""
+    answer that needs them: an answer's ``@type`` may be a subclass of its port's class, also one a lab
+    registered, docs/values.md), the settings a run reads when it starts, and who is live under which
+    session."""
 
     classes: StoreClasses
     breaker: BreakerPolicy
@@ -1254,16 +1239,14 @@ class _RemoteCalls:
         return cls(StoreClasses(kb), breaker, setting("remote_contradictions").resolve(), sessions)
 
 
-def _remote(
-    transport: Transport, service: str, ad: Advertisement, is_a: IsA, calls: _RemoteCalls
-) -> Callable[[str], Component]:
+def _remote(transport: Transport, service: str, ad: Advertisement, calls: _RemoteCalls) -> Callable[[str], Component]:
     """A remote component for ``ad`` (docs/execution.md, "Remote components")."""
     outputs = {p.name: p.type for p in ad.outputs if p.name}
     timeout = call_timeout(ad)
     exclusive = ad.kind == CBRS.PhysicalManipulationComponent
 
     def checked(concept: str, value: Any) -> dict[str, Any]:
-        return check(concept, value, is_a)
+        return check(concept, value, calls.classes.is_a)
 
     return lambda iri: RemoteComponent(
         iri,
