@@ -31,6 +31,7 @@ from cbrs.tasks import TaskRunner
 from cbrs.web import create_app, host_names
 from cbrs.web.components import blueprint as components_blueprint
 from cbrs.web.context import StreamSlots
+from cbrs.web.warmup import warm_up
 
 if TYPE_CHECKING:
     from cbrs.bridge_client import BridgeClient  # its websocket client loads with the first task run
@@ -150,6 +151,7 @@ class Server:
             mark_served(self.kb.store.location, f"http://{host}:{self.http_port}")
         for name in LOGGERS:
             logging.getLogger(name).addHandler(self._rosout)
+        warm_up(self.app)  # a big store's first pages: read in the background now (cbrs.web.warmup)
 
     def _own_bridge(self) -> BridgeClient | None:
         """A connection to this server's own bridge, through which task runs call live components."""

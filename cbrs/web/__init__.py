@@ -23,7 +23,7 @@ from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.matchmakers import Matchmakers
 from cbrs.sparql_service import SparqlService
 from cbrs.tasks import TaskRunner
-from cbrs.web import links
+from cbrs.web import links, warmup
 from cbrs.web.context import EventLog, StreamSlots
 from cbrs.web.sparql_wsgi import SparqlHotPath
 
@@ -75,6 +75,7 @@ def create_app(
     app.debug = False  # whatever FLASK_DEBUG says: the debugger runs code and tracebacks show internals
     app.config["MAX_CONTENT_LENGTH"] = 3 * sparql.config.max_query_bytes + 4096  # form encoding triples bytes
     app.json.sort_keys = False  # type: ignore[attr-defined]
+    app.config["CBRS_WARM_UP_TRIPLES"] = warmup.DEFAULT_TRIPLES
     runner = tasks or TaskRunner(sparql.kb, sparql.lock, read_only=sparql.config.read_only)
     log = EventLog()
     runner.subscribe(log.add)
@@ -123,6 +124,7 @@ def create_app(
             "version": __version__,
             "store_location": sparql.kb.store.location,
             "csp_nonce": _nonce(),
+            "warming": warming.note() if (warming := warmup.current(app)) is not None else None,
         }
 
     def as_page() -> bool:

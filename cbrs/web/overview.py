@@ -18,7 +18,7 @@ blueprint = Blueprint("overview", __name__)
 @page(blueprint, "/")
 def overview() -> Page:
     kb = context.kb()
-    graphs, counts = context.per_generation("overview", lambda: _store_at_a_glance(kb))
+    graphs, counts = at_a_glance()
     return Page(
         "overview.html",
         "Overview",
@@ -30,6 +30,12 @@ def overview() -> Page:
             "card_links": _card_links(),
         },
     )
+
+
+def at_a_glance() -> tuple[list[dict[str, Any]], dict[str, int]]:
+    """The triples per named graph and the counts of descriptions, once per store generation."""
+    kb = context.kb()
+    return context.per_generation("overview", lambda: _store_at_a_glance(kb))
 
 
 def _card_links() -> dict[str, str]:

@@ -38,7 +38,7 @@ def _default_objective() -> str:
 def plans() -> Page:
     task = request.args.get("task", "").strip()
     objective = request.args.get("objective", "").strip() or _default_objective()
-    options = _tasks()
+    options = task_options()
     data: dict[str, Any] = {"task": task, "objective": objective, "objectives": _objectives(), "tasks": options}
     data["selected"] = _selected(task, options)
     shown = Page("plans.html", "Plans", data)
@@ -93,7 +93,7 @@ def _svg(result: CompositionResult) -> bytes:
         return draw(result, Path(folder) / "graph.svg").read_bytes()
 
 
-def _tasks() -> dict[str, list[dict[str, str | None]]]:
+def task_options() -> dict[str, list[dict[str, str | None]]]:
     """What can be planned: the requirements, and the action classes that have sub-actions; read once per
     store generation (reading every requirement took 1.5 s of each plans page on OWLS-TC)."""
     return context.per_generation("plan_tasks", _read_tasks)

@@ -24,7 +24,8 @@ from flask.sansio.blueprints import BlueprintSetupState
 from werkzeug.exceptions import Forbidden, NotFound, ServiceUnavailable
 
 from cbrs.actions.errors import UnknownTaskError
-from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.namespaces import PREFIXES, written
+from cbrs.kb.owls import local_name
 from cbrs.tasks import CameraFrame, TaskBusyError, TaskRun, UnknownComponentError
 from cbrs.web import context
 from cbrs.web.links import expand_name, short
@@ -32,7 +33,6 @@ from cbrs.web.pages import FormError, Page, page, wants_json
 
 blueprint = Blueprint("tasks", __name__)
 
-PREFERRED_TASK = "FetchMyPen"  # the paper's web-initiated scenario, chosen first when the store has it
 DEFAULTS = {
     "CBRS_STREAM_SECONDS": 600.0,  # the longest a stream lives; EventSource reconnects after it ends
     "CBRS_STREAM_IDLE_SECONDS": 120.0,  # a stream with no event (no new frame) this long ends
@@ -214,17 +214,58 @@ def _overview(form: dict[str, Any]) -> dict[str, Any]:
     active = runner.active()
     runs = runner.runs()
     latest = active or (runs[-1] if runs else None)
-    known = runner.tasks()
+    offered = choices()
     if not form["task"]:
-        form = {**form, "task": PREFERRED_TASK if PREFERRED_TASK in known else next(iter(known), "")}
+        form = {**form, "task": _first_choice(offered, latest)}
     return {
         "form": form,
-        "tasks": known,
-        "components": [short(c) for c in runner.components()],
+        "tasks": offered["tasks"],
+        "components": offered["components"],
         "active": _detail(latest) if latest is not None else None,
         "runs": [_summary(r) for r in reversed(runs)],
         **_live(),
     }
+
+
+def choices() -> dict[str, Any]:
+    """What the start form offers, read once per store generation (on OWLS-TC the tasks and components
+    took 0.3 and 0.6 s of every tasks page): the tasks as a person types them, the components a run may
+    be told to fail, and the tasks of several steps (below), the first of which the form starts with."""
+
+    def read() -> dict[str, Any]:
+        from cbrs.actions.model import ActionLibrary  # the planner loads with the first use
+
+        runner, kb = context.tasks(), context.kb()
+        with context.lock():
+            known = runner.tasks()
+            composite = {action.iri for action in ActionLibrary.from_kb(kb) if action.sub_actions}
+            rows = kb.select("requirements")
+        stated = sorted({row["requirement"].value for row in rows if "task" in row and row["task"].value in composite})
+        several = sorted(name for name in (_typed(iri, known) for iri in stated) if name is not None)
+        return {"tasks": known, "components": [short(c) for c in runner.components()], "several": several}
+
+    return context.per_generation("task_choices", read)
+
+
+def _typed(iri: str, known: list[str]) -> str | None:
+    """How the list spells the task ``iri`` (``cbrs.task_names``: its bare name when that means it, else its
+    prefixed name or ``<IRI>``); None when it is not listed."""
+    for name in (written(iri), local_name(iri)):
+        if name in known:
+            return name
+    return None
+
+
+def _first_choice(offered: dict[str, Any], latest: TaskRun | None) -> str:
+    """The task the form starts with, when the URL names none: the latest run's, so that a user trying a
+    task again after a failure or a change finds it chosen; else the first by name of the requirements
+    that ask for an action of several steps (``cbrs:forTask`` an action with sub-actions), a task that
+    shows this page's steps, failovers and camera (FetchMyPen in the bundled store); else the first task."""
+    if latest is not None:
+        again = _typed(latest.iri, offered["tasks"]) if latest.iri else None
+        if again is not None:
+            return again
+    return str(next(iter(offered["several"] or offered["tasks"]), ""))
 
 
 def _live() -> dict[str, Any]:
@@ -387,6 +428,9 @@ def camera() -> Response:
 
     def stream(frame: CameraFrame) -> Iterator[bytes]:
         started = last = sent = time.monotonic()
+        # twice: a browser shows a part once the next one begins, so the picture (and the page's load
+        # event) waited for the repeat CBRS_CAMERA_REPEAT_SECONDS later
+        yield _part(frame)
         yield _part(frame)
         while True:
             now = time.monotonic()
