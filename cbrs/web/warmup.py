@@ -30,13 +30,21 @@ DEFAULT_TRIPLES = 50_000  # CBRS_WARM_UP_TRIPLES: a store this big or bigger is 
 
 def _steps() -> list[tuple[str, Callable[[], object]]]:
     """What is read, in the order a user opens the pages: every page's prefixes, the overview, the
-    matchmaking page, the tasks page (its camera last: the picture holds the store lock for seconds),
-    then the taxonomy and plans pages."""
+    matchmaking page and its first ranking, the tasks and plans pages, the taxonomy, and last the
+    camera's picture, which holds the store lock for seconds."""
     from cbrs.web import matchmaking, overview, plans, prefixes, tasks, taxonomy
 
     def matchmaker() -> object:
         with context.lock():
             return matchmaking.matchmaker("sem-str")
+
+    def ranking() -> object:
+        """One ranking reads and compiles every advertisement, which the first ranking page paid for."""
+        stored = matchmaking.requirements()
+        if not stored:
+            return None
+        with context.lock():
+            return matchmaking.matchmaker("sem-str").rank(str(stored[0]["iri"]), explain=0)
 
     return [
         ("the store's namespaces", prefixes.by_namespace),
@@ -44,6 +52,7 @@ def _steps() -> list[tuple[str, Callable[[], object]]]:
         ("the stored requirements", matchmaking.requirements),
         ("the taxonomy index", matchmaker),
         ("the concepts", matchmaking.concepts),
+        ("the advertisements", ranking),
         ("the tasks and components", tasks.choices),
         ("the plans page's tasks", plans.task_options),
         ("the taxonomy", taxonomy.current_taxonomy),
