@@ -22,6 +22,7 @@ from cbrs import __version__
 from cbrs.app import App, parse_iri, pass_app
 from cbrs.cli_interrupts import HeldInterrupts
 from cbrs.cli_notes import no_store_at, note_new_store, wants_json, with_notes
+from cbrs.cli_store import export, restore, update
 from cbrs.extras import require
 from cbrs.kb import Advertisement, KnowledgeBase, KnowledgeBaseError, Requirement, ServiceDescription
 from cbrs.kb.catalog import Catalogue, merge
@@ -370,7 +371,7 @@ def query(
         if update:
             raise click.ClickException(
                 f"this is a SPARQL update ({update.group(1).upper()}); cbrs query runs queries only: "
-                "send updates to /update of cbrs serve (with its update token)"
+                "run it with cbrs update (or send it to /update of cbrs serve, with its update token)"
             )
         try:
             result = app.kb.query(body)
@@ -785,6 +786,11 @@ def _split_binding(text: str) -> tuple[str, str]:
     if not sep or not name:
         raise click.BadParameter(f"{text!r} is not VAR=VALUE", param_hint="--bind")
     return name.lstrip("?$"), value
+
+
+cli.add_command(export)
+cli.add_command(restore)
+cli.add_command(update)
 
 
 def main() -> None:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import logging
 from collections.abc import Mapping, Sequence
 from contextlib import AbstractContextManager, nullcontext
@@ -9,6 +10,7 @@ from pathlib import Path
 
 import pyoxigraph as ox
 
+from cbrs.kb.backup import Backup, ExportReport, RestoreReport, export_store, read_backup, restore_store
 from cbrs.kb.catalog import Catalogue
 from cbrs.kb.descriptions import DescriptionReader
 from cbrs.kb.errors import StoreError
@@ -34,6 +36,7 @@ from cbrs.kb.shapes import CHECKED_GRAPHS, DescriptionShapeError, checked_update
 from cbrs.kb.standard_terms import PendingUpdate, Refresh, StandardTerms
 from cbrs.kb.store import MEMORY, EmbeddedStore, QueryResult, Store, Term, is_remote
 from cbrs.kb.update_delta import DataUpdate
+from cbrs.kb.update_report import GraphChange, UpdateReport, exact_changes, graph_sizes, net_changes, refuse_split
 from cbrs.kb.upgrade import UpgradeReport, new_terms, upgrade_store
 
 _log = logging.getLogger(__name__)
@@ -165,16 +168,16 @@ class KnowledgeBase:
         Every write method here calls it; call it after writing to the store by other means."""
         return self.standard_terms.refresh()
 
-    def _entail(self, update: PendingUpdate | None = None) -> None:
-        """After a write that stands: bring graph:entailed up to date, or say why it lags. After an update
-        :meth:`StandardTerms.prepare` read, from the nodes it changed; otherwise from the whole store."""
+    def _entail(self, update: PendingUpdate | None = None) -> Refresh | None:
+        """After a write that stands: bring graph:entailed up to date, or say why it lags (None). After an
+        update :meth:`StandardTerms.prepare` read, from the nodes it changed; otherwise from the whole store."""
         try:
             if update is None:
-                self.standard_terms.refresh()
-            else:
-                self.standard_terms.updated(update)
+                return self.standard_terms.refresh()
+            return self.standard_terms.updated(update)
         except StoreError as error:
             _log.warning("graph:entailed not brought up to date (it lags until the next write): %s", error)
+            return None
 
     def upgrade(self) -> UpgradeReport:
         """Bring a store seeded by an older cbrs up to the bundled ontologies (:mod:`kb.upgrade`): its
@@ -271,13 +274,75 @@ class KnowledgeBase:
         self._entail()
         return report
 
+    def export(
+        self,
+        target: str | Path,
+        rdf_format: ox.RdfFormat | None = None,
+        graphs: Sequence[str] | None = None,
+        progress: Progress | None = None,
+    ) -> ExportReport:
+        """Write the store (every named graph, or ``graphs``) to the file ``target`` (``-``: standard
+        output) as N-Quads or TriG by its extension, with a manifest that makes it a cbrs export
+        (:mod:`kb.backup`)."""
+        return export_store(self.store, target, rdf_format, graphs, progress)
+
+    def restore(
+        self,
+        backup: Backup | str | Path,
+        graphs: Sequence[str] | None = None,
+        force: bool = False,
+        progress: Progress | None = None,
+    ) -> RestoreReport:
+        """Replace the store's contents (or only ``graphs``) with an export's, all or nothing
+        (:mod:`kb.backup`); a file that is not a whole cbrs export is refused unless ``force``.
+        graph:entailed comes from the file, or is worked out afresh when the file does not give all of it."""
+        if not isinstance(backup, Backup):
+            backup = read_backup(backup, progress=progress)
+        report = restore_store(self.store, backup, graphs, force, progress)
+        self._reader.clear_cache()
+        self._map_read = None
+        if graphs or not backup.quads.get(GraphName.ENTAILED.iri):
+            if progress is not None:
+                progress("updating graph:entailed", 0, 0)
+            self._entail()
+            report = dataclasses.replace(report, entailed_refreshed=True)
+        return report
+
     def query(self, text: str, bindings: Mapping[str, Term] | None = None) -> QueryResult:
         return self.store.query(text, bindings)
 
     def update(self, text: str) -> None:
         """Run a SPARQL update in one transaction; the cached descriptions are read afresh afterwards, and
         graph:entailed follows (node by node after a data update: :meth:`StandardTerms.prepare`)."""
-        data = DataUpdate.read(text, self.store) if isinstance(self.store, EmbeddedStore) else None
+        self._update(text, self._data_update(text))
+
+    def update_counted(self, text: str) -> UpdateReport:
+        """:meth:`update`, saying what it changed graph by graph (:mod:`kb.update_report`): quad by quad for
+        a data update, else each graph's net change, which costs counting the graphs before and after. An
+        update of several operations is refused on a store that does not run a request whole (Virtuoso)."""
+        refuse_split(self.store, text)
+        data = self._data_update(text)
+        before = graph_sizes(self.store) if data is None else None
+        entailed = self._update(text, data)
+        if before is not None:
+            changes, exact = net_changes(before, graph_sizes(self.store)), False
+        else:
+            assert data is not None
+            delta = data.delta(self.store)
+            changes, exact = (exact_changes(*delta), True) if delta is not None else ([], False)
+        if entailed is not None and (entailed.added or entailed.removed):
+            net = entailed.added - entailed.removed
+            changes.append(GraphChange(GraphName.ENTAILED.iri, net, entailed.added, entailed.removed))
+        return UpdateReport(tuple(changes), exact, counted=before is not None or exact)
+
+    def _data_update(self, text: str) -> DataUpdate | None:
+        """``text`` read as an update of ground data about to run (:mod:`kb.update_delta`), on an embedded
+        store; None for any other update or store."""
+        return DataUpdate.read(text, self.store) if isinstance(self.store, EmbeddedStore) else None
+
+    def _update(self, text: str, data: DataUpdate | None) -> Refresh | None:
+        """:meth:`update` of ``text``, read as ``data``; returns what graph:entailed's refresh changed (None:
+        it lags)."""
         pending = self.standard_terms.prepare(data)
         checking: AbstractContextManager[None] = nullcontext()
         if data is None:  # what else it writes is unknown: keep the whole store if it might be refused
@@ -294,7 +359,7 @@ class KnowledgeBase:
             raise
         finally:
             self._reader.clear_cache()
-        self._entail(pending)
+        return self._entail(pending)
 
     def run(self, name: str, values: Mapping[str, Term | str | int | float] | None = None) -> QueryResult:
         """Run the named query ``queries/<name>.rq`` with ``values`` bound to its parameters."""

@@ -334,6 +334,19 @@ class RemoteStore(Store):
         return self._virtuoso
 
     @property
+    def server(self) -> str:
+        """Which server answers, from the ``Server`` header of its last answer: ``oxigraph``, ``virtuoso``,
+        or ``other``."""
+        return "oxigraph" if self._oxigraph else "virtuoso" if self._virtuoso else "other"
+
+    @property
+    def keeps_requests_whole(self) -> bool:
+        """Whether the server runs an update request of several operations as one transaction: not Virtuoso
+        7, which keeps what the first wrote when a later one fails (:mod:`kb.update_report` refuses such a
+        text there)."""
+        return not self._virtuoso
+
+    @property
     def check_batch(self) -> int:
         """The most quads one :meth:`contains_each` query asks about: :attr:`batch`, at most
         :data:`CHECK_BATCH` (on Oxigraph, a larger chunk took no less time)."""
@@ -366,6 +379,11 @@ class RemoteStore(Store):
             self._update("DELETE DATA {\n" + removing + "}", original=None)
         elif adding:
             self._update("INSERT DATA {\n" + adding + "}", original=None)
+
+    def _apply_own_update(self, text: str) -> None:
+        """An update cbrs wrote itself from validated terms (a staged batch, a publication): sent as it is,
+        and a 400 for it is the server's refusal (:class:`RemoteStoreError`), not the caller's syntax."""
+        self._update(text, original=None)
 
     def update(self, text: str) -> None:
         """Run a SPARQL update on the server in one request, hence one transaction."""
@@ -500,7 +518,9 @@ class RemoteStore(Store):
     def _refusal(self, status: int, url: str, said: str) -> str:
         """What to do about a 401 or 403, before what the server said (an HTML page is left out): a
         newcomer got a proxy's login page quoted back and no word of how cbrs sends credentials."""
-        if status == 401 and httpx.URL(url).username:
+        if status == 403 and "read-only" in said:  # a cbrs serve started --read-only, or without a token
+            hint = "the server takes no updates (it is read-only), token or not"
+        elif status == 401 and httpx.URL(url).username:
             hint = "the server refused the user name and password in the store URL"
         elif status == 401:
             hint = (

@@ -42,8 +42,17 @@ _log = logging.getLogger(__name__)
 Send = Callable[[str], None]
 
 
-def write_staged(location: str, quads: Sequence[ox.Quad], batch: int, send: Send) -> None:
-    """Write ``quads`` through staging graphs with ``send`` (one update request per call)."""
+def write_staged(
+    location: str,
+    quads: Sequence[ox.Quad],
+    batch: int,
+    send: Send,
+    replacing: Sequence[ox.NamedNode] = (),
+    progress: Callable[[int, int], None] | None = None,
+) -> None:
+    """Write ``quads`` through staging graphs with ``send`` (one update request per call). The graphs in
+    ``replacing`` are emptied by the publishing operation itself (a restore, :mod:`kb.backup`), so that
+    readers see the old contents or the new, never neither; ``progress`` is told each batch sent."""
     run = f"{STAGING}{uuid.uuid4().hex}/"
     stages: dict[ox.NamedNode, ox.NamedNode] = {}
     staged = []
@@ -58,8 +67,11 @@ def write_staged(location: str, quads: Sequence[ox.Quad], batch: int, send: Send
         stage = stages.setdefault(target, ox.NamedNode(f"{run}{len(stages) + 1}"))
         staged.append(ox.Quad(quad.subject, _wrapped(location, quad.predicate), quad.object, stage))
     written: set[ox.NamedNode | ox.BlankNode | ox.DefaultGraph] = set()  # staging graphs a batch may have reached
+    parts = batches(staged, batch)
     try:
-        for part in batches(staged, batch):
+        for done, part in enumerate(parts):
+            if progress is not None:
+                progress(done, len(parts))
             touched = {quad.graph_name for quad in part}
             try:
                 send("INSERT DATA {\n" + data_block(part, blank_nodes=True) + "}")
@@ -69,7 +81,7 @@ def write_staged(location: str, quads: Sequence[ox.Quad], batch: int, send: Send
                 written.update(touched)  # no answer (a timeout, a lost connection): it may be written
                 raise
             written.update(touched)
-        send(publication(stages))
+        send(publication(stages, replacing))
     except BaseException as error:
         _drop([stage for stage in stages.values() if stage in written], send, error)
         raise
@@ -79,14 +91,24 @@ def write_staged(location: str, quads: Sequence[ox.Quad], batch: int, send: Send
         _log.warning("store %s: staging graphs under %s were not dropped: %s", location, run, error)
 
 
-def publication(stages: dict[ox.NamedNode, ox.NamedNode]) -> str:
-    """The one operation that copies each staging graph into its target graph, predicates unwrapped."""
+def publication(stages: dict[ox.NamedNode, ox.NamedNode], replacing: Sequence[ox.NamedNode] = ()) -> str:
+    """The one operation that copies each staging graph into its target graph, predicates unwrapped; and
+    empties the graphs in ``replacing`` (a solution of the first branch instantiates only the DELETE
+    template, one of the second only the INSERT template, and SPARQL deletes before it inserts)."""
     pairs = " ".join(f"({stage} {target})" for target, stage in stages.items())
-    return (
-        "INSERT { GRAPH ?target { ?s ?p ?o } }\n"
-        f"WHERE {{ VALUES (?stage ?target) {{ {pairs} }}\n"
+    copied = (
+        f"VALUES (?stage ?target) {{ {pairs} }}\n"
         "  GRAPH ?stage { ?s ?wrapped ?o }\n"
-        f'  BIND (IRI(STRAFTER(STR(?wrapped), "{STAGED}")) AS ?p) }}'
+        f'  BIND (IRI(STRAFTER(STR(?wrapped), "{STAGED}")) AS ?p)'
+    )
+    if not replacing:
+        return f"INSERT {{ GRAPH ?target {{ ?s ?p ?o }} }}\nWHERE {{ {copied} }}"
+    emptied = f"VALUES ?old {{ {' '.join(map(str, replacing))} }} GRAPH ?old {{ ?os ?op ?oo }}"
+    if not stages:
+        return f"DELETE {{ GRAPH ?old {{ ?os ?op ?oo }} }}\nWHERE {{ {emptied} }}"
+    return (
+        "DELETE { GRAPH ?old { ?os ?op ?oo } }\nINSERT { GRAPH ?target { ?s ?p ?o } }\n"
+        f"WHERE {{ {{ {emptied} }}\n  UNION\n  {{ {copied} }} }}"
     )
 
 

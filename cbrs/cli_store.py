@@ -1,0 +1,170 @@
+"""The ``cbrs`` commands that keep a store over months: ``export`` and ``restore`` (:mod:`kb.backup`), and
+``update``, a SPARQL update with what it changed said graph by graph (:mod:`kb.update_report`)."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+import click
+
+from cbrs.app import App, pass_app
+from cbrs.cli_interrupts import HeldInterrupts
+from cbrs.kb.backup import DEFAULT, Backup, export_format, read_backup
+from cbrs.kb.errors import QuerySyntaxError, without_password
+from cbrs.kb.namespaces import GraphName, shorten
+from cbrs.kb.store import refuse_inserted_blank_nodes
+from cbrs.output import ProgressLine
+from cbrs.sparql_hints import explain_syntax_error, operation_kind
+
+_GRAPH_HELP = "A graph to take (repeatable): " + ", ".join(g.value for g in GraphName) + ", or a full IRI."
+_FORMAT_CHOICE = click.Choice(["nquads", "trig"])
+
+
+@click.command()
+@click.argument("file", metavar="FILE|-")
+@click.option("--graph", "graphs", multiple=True, metavar="NAME|IRI", help=_GRAPH_HELP + " Default: every graph.")
+@click.option(
+    "--format",
+    "fmt",
+    type=_FORMAT_CHOICE,
+    help="Override the format the name says (.nq N-Quads, .trig TriG, either with .gz); - is N-Quads.",
+)
+@pass_app
+def export(app: App, file: str, graphs: tuple[str, ...], fmt: str | None) -> None:
+    """Write the whole store (every named graph) to FILE, or - for standard output, as a cbrs export: the
+    quads, then a manifest that cbrs restore checks (docs/backup.md)."""
+    rdf_format = export_format(file, fmt)
+    shown = ProgressLine()
+    try:
+        report = app.kb.export(file, rdf_format, list(graphs) or None, shown)
+    finally:
+        shown.clear()
+    where = "standard output" if file == "-" else file
+    counts = ", ".join(f"{n} in {_graph_name(graph)}" for graph, n in sorted(report.triples.items()))
+    click.echo(
+        f"exported {report.total} triples from {without_password(app.kb.store.location)} to {where}: {counts}",
+        err=file == "-",
+    )
+
+
+@click.command()
+@click.argument("file", type=click.Path(dir_okay=False, path_type=Path))
+@click.option(
+    "--graph",
+    "graphs",
+    multiple=True,
+    metavar="NAME|IRI",
+    help=_GRAPH_HELP + " Only these graphs are replaced, by the file's; the others are left. Default: the "
+    "whole store is replaced.",
+)
+@click.option("--format", "fmt", type=_FORMAT_CHOICE, help="Override the format the file's name says.")
+@click.option("--yes", is_flag=True, help="Do not ask for confirmation (a terminal is asked; a script is not).")
+@click.option(
+    "--force",
+    is_flag=True,
+    help="Restore a file that is not a whole cbrs export (no manifest, counts that differ, cbrs's own "
+    "graphs missing) as it is.",
+)
+@pass_app
+def restore(app: App, file: Path, graphs: tuple[str, ...], fmt: str | None, yes: bool, force: bool) -> None:
+    """Replace the store's contents with those of FILE, a cbrs export, all or nothing: a file that does not
+    parse, or a write that fails, leaves the store as it was (docs/backup.md)."""
+    shown = ProgressLine()
+    try:
+        backup = read_backup(file, export_format(str(file), fmt), shown)
+    finally:
+        shown.clear()
+    problems = backup.problems(list(graphs) or None)
+    kb = app.kb
+    if problems and force:
+        click.echo(f"note: {file}: {'; '.join(problems)}; restored all the same (--force)", err=True)
+    if not problems or force:
+        _confirm(app, backup, graphs, yes)
+    shown = ProgressLine()
+    with HeldInterrupts() as interrupts:
+
+        def progress(stage: str, done: int, total: int) -> None:
+            if stage.startswith("writing"):
+                interrupts.hold("restoring the store")
+            shown(stage, done, total)
+
+        try:
+            report = kb.restore(backup, list(graphs) or None, force, progress)
+        finally:
+            shown.clear()
+    if interrupts.interrupted:
+        click.echo("cbrs: the Ctrl-C came after the write had begun: the restore stands, as follows", err=True)
+    restored = sum(report.restored.values())
+    click.echo(f"restored {restored} triples from {file} into {without_password(kb.store.location)}")
+    for graph in sorted(set(report.before) | set(report.restored)):
+        was, now = report.before.get(graph), report.restored.get(graph, 0)
+        was_text = "absent" if was is None else f"{was} triples"
+        click.echo(f"  {_graph_name(graph):<22} {now:>8} triples (was {was_text})")
+    for graph, count in sorted(report.skipped.items()):
+        click.echo(f"  {_graph_name(graph):<22} left as it was ({count} triples in the file not restored)")
+    if report.entailed_refreshed:
+        click.echo("graph:entailed worked out afresh from the restored graphs")
+
+
+def _confirm(app: App, backup: Backup, graphs: tuple[str, ...], yes: bool) -> None:
+    """Ask a person at a terminal before a restore replaces what the store holds; a script is not asked."""
+    if yes or not sys.stdin.isatty():
+        return
+    manifest = backup.manifest
+    said = (
+        f" (exported {manifest.exported_at} by cbrs {manifest.cbrs_version} from {manifest.source})" if manifest else ""
+    )
+    what = f"graphs {', '.join(graphs)} of" if graphs else "everything in"
+    click.confirm(
+        f"Replace {what} {without_password(app.kb.store.location)} with the {sum(backup.triples.values())} "
+        f"triples of {backup.source}{said}?",
+        abort=True,
+        err=True,
+    )
+
+
+@click.command()
+@click.argument("text", required=False)
+@click.option(
+    "--file",
+    "update_file",
+    type=click.File("r", encoding="utf-8"),
+    help="Read the update from a .ru file (- for standard input).",
+)
+@click.option("--json", "as_json", is_flag=True, help="Print what changed as JSON.")
+@pass_app
+def update(app: App, text: str | None, update_file: Any, as_json: bool) -> None:
+    """Run a SPARQL update given as TEXT or from --file, all or nothing; graph:entailed follows, and what
+    changed is said graph by graph."""
+    if (text is None) == (update_file is None):
+        raise click.UsageError("give exactly one of TEXT or --file")
+    body = (text if text is not None else update_file.read()).removeprefix("\ufeff")
+    if operation_kind(body) == "query":
+        raise click.ClickException("this is a SPARQL query, not an update: run it with cbrs query")
+    refuse_inserted_blank_nodes(body)  # what cbrs stores it must be able to read back by name
+    with HeldInterrupts() as interrupts:
+        interrupts.hold("running the update")
+        try:
+            report = app.kb.update_counted(body)
+        except QuerySyntaxError as error:
+            explained = explain_syntax_error(error, body, "update")
+            explained.add_note("nothing was changed")
+            if explained is error:
+                raise
+            raise explained from error
+    if as_json:
+        changes = [
+            {"graph": change.graph or None, "net": change.net, "added": change.added, "removed": change.removed}
+            for change in report.changes
+        ]
+        click.echo(json.dumps({"exact": report.exact, "counted": report.counted, "changes": changes}, indent=2))
+        return
+    for line in report.lines():
+        click.echo(line)
+
+
+def _graph_name(graph: str) -> str:
+    return shorten(graph) if graph != DEFAULT else "(default graph)"

@@ -1,0 +1,186 @@
+"""cbrs export and cbrs restore (kb/backup.py): a store written to a file and put back quad for quad, on the
+embedded store and on an Oxigraph server and Virtuoso; a file that is not a whole export, does not parse, or
+whose write fails leaves the store as it was."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+
+import pyoxigraph as ox
+import pytest
+from click.testing import CliRunner
+
+from cbrs.cli import cli
+from cbrs.kb import KnowledgeBase, RdfParseError, Store, StoreError
+from cbrs.kb.backup import EXPORT_GRAPH, REQUIRED, NotAnExportError, UnknownExportFormatError, read_backup, store_graphs
+from cbrs.kb.namespaces import GraphName
+from cbrs.kb.remote_store import RemoteStore
+from cbrs.kb.staged_writes import STAGING
+from tests.conftest import DATA, MINI_FILES, OxigraphServer, VirtuosoServer
+
+CHANGE = 'INSERT DATA { GRAPH graph:services { <http://example.org/lab#Cam9> rdfs:label "a ninth camera" } }'
+
+
+@pytest.fixture(scope="module")
+def seeded() -> Iterator[KnowledgeBase]:
+    """One seeded in-memory store for the module; each test puts it back as it found it."""
+    kb = KnowledgeBase.open(":memory:")
+    yield kb
+    kb.close()
+
+
+@pytest.fixture(scope="module")
+def exported(seeded: KnowledgeBase, tmp_path_factory: pytest.TempPathFactory) -> Path:
+    path = tmp_path_factory.mktemp("backup") / "store.nq"
+    seeded.export(path)
+    return path
+
+
+def _change(kb: KnowledgeBase) -> None:
+    kb.update(CHANGE)
+    kb.update("DROP GRAPH graph:map")
+
+
+@pytest.mark.parametrize("name", ["store.nq", "store.trig", "store.nq.gz", "store.trig.gz"])
+def test_export_change_restore_gives_the_same_quads(seeded: KnowledgeBase, tmp_path: Path, name: str) -> None:
+    before = seeded.store.dump()
+    report = seeded.export(tmp_path / name)
+    assert report.total == seeded.store.count() and set(report.triples) == {
+        g.iri for g in (*REQUIRED, GraphName.ENTAILED)
+    }
+    _change(seeded)
+    assert seeded.store.dump() != before
+    restored = seeded.restore(tmp_path / name)
+    assert seeded.store.dump() == before
+    assert restored.restored == report.triples and not restored.entailed_refreshed
+    assert EXPORT_GRAPH.value not in seeded.store.graphs()
+    assert [p.name for p in tmp_path.iterdir()] == [name]  # written beside its name, then moved into place
+
+
+def test_a_file_cut_short_or_not_an_export_is_refused_and_the_store_left(
+    seeded: KnowledgeBase, exported: Path, tmp_path: Path
+) -> None:
+    before = seeded.store.dump()
+    lines = exported.read_bytes().splitlines(keepends=True)
+    cut = tmp_path / "cut.nq"
+    cut.write_bytes(b"".join(lines[: len(lines) // 2]))
+    with pytest.raises(NotAnExportError, match=r"cut\.nq: not a cbrs export: it has no manifest"):
+        seeded.restore(cut)
+    holed = tmp_path / "holed.nq"
+    holed.write_bytes(b"".join(lines[:10] + lines[20:]))
+    with pytest.raises(NotAnExportError, match=r"the manifest says \d+ \(lines lost\?\)"):
+        seeded.restore(holed)
+    broken = tmp_path / "broken.nq"
+    broken.write_bytes(b"".join(lines[:5]) + b"<http://x> <http://y> .\n" + b"".join(lines[5:]))
+    with pytest.raises(RdfParseError, match=r"broken\.nq: .*nothing was restored"):
+        seeded.restore(broken)
+    with pytest.raises(UnknownExportFormatError, match=r"use one of \.nq, \.nq\.gz, \.trig, \.trig\.gz"):
+        seeded.restore(tmp_path / "store.ttl")
+    assert seeded.store.dump() == before
+
+
+def test_a_partial_export_restores_its_graphs_only_or_whole_when_forced(
+    seeded: KnowledgeBase, exported: Path, tmp_path: Path
+) -> None:
+    before = seeded.store.dump()
+    services = tmp_path / "services.nq"
+    seeded.export(services, graphs=["services"])
+    _change(seeded)
+    with pytest.raises(NotAnExportError, match="lacks cbrs's own graphs graph:ontology, graph:requirements, graph:map"):
+        seeded.restore(services)
+    assert read_backup(services).manifest is not None and read_backup(services).manifest.partial  # type: ignore[union-attr]
+    report = seeded.restore(services, graphs=["services"])  # graph:map stays dropped; services put back
+    assert report.entailed_refreshed and GraphName.MAP.iri not in seeded.store.graphs()
+    assert seeded.store.count(GraphName.SERVICES) == before.count(b"/graph/services> .\n")
+    forced = seeded.restore(services, force=True)
+    assert set(seeded.store.graphs()) <= {GraphName.SERVICES.iri, GraphName.ENTAILED.iri} and forced.entailed_refreshed
+    seeded.restore(exported)
+    assert seeded.store.dump() == before
+
+
+def test_the_cli_exports_asks_and_restores(tmp_path: Path) -> None:
+    store, backup = tmp_path / "store", tmp_path / "lab.trig"
+    runner = CliRunner()
+    exported = runner.invoke(cli, ["--store", str(store), "export", str(backup)])
+    assert exported.exit_code == 0, exported.output
+    assert f"to {backup}: " in exported.output and "in graph:services" in exported.output
+    kb = KnowledgeBase.open(store)
+    before = kb.store.dump()
+    kb.update(CHANGE)
+    kb.close()
+    restored = runner.invoke(cli, ["--store", str(store), "restore", str(backup), "--yes"])
+    assert restored.exit_code == 0, restored.output
+    assert "graph:services" in restored.output and "(was 2006 triples)" in restored.output
+    kb = KnowledgeBase.open(store)
+    assert kb.store.dump() == before
+    kb.close()
+    plain = tmp_path / "plain.nq"
+    plain.write_text("<http://example.org/a> <http://example.org/b> <http://example.org/c> <http://example.org/g> .\n")
+    refused = runner.invoke(cli, ["--store", str(store), "restore", str(plain), "--yes"])
+    assert refused.exit_code == 1 and "not a cbrs export" in refused.output and "--force" in refused.output
+    out = runner.invoke(cli, ["--store", str(store), "export", "-", "--graph", "requirements"])
+    assert out.exit_code == 0 and "<https://w3id.org/cbrs/graph/export> ." in out.stdout
+
+
+def _contents(kb: KnowledgeBase) -> list[str]:
+    """The store's quads, sorted, but for the graphs its server keeps (Virtuoso's, whose blank node labels
+    pyoxigraph refuses, so that dump() fails there)."""
+    return sorted(str(q) for graph in store_graphs(kb.store) for q in kb.store.quads(graph=ox.NamedNode(graph)))
+
+
+def _remote_store(location: str) -> KnowledgeBase:
+    """A small store on a server, with every graph a restore asks for (the seed would take Virtuoso some
+    10 s to write, and as long to restore)."""
+    kb = KnowledgeBase(Store.open(location))
+    kb.load(MINI_FILES)
+    kb.load([DATA / "mini_map.ttl"], graph="map")
+    return kb
+
+
+def test_a_remote_oxigraph_store_round_trips_and_a_failed_publication_leaves_it(
+    oxigraph_server: OxigraphServer, tmp_path: Path
+) -> None:
+    oxigraph_server.clear()
+    kb = _remote_store(oxigraph_server.url)
+    assert isinstance(kb.store, RemoteStore)
+    kb.store.batch = 20  # several staging batches, as a large store sends
+    before = _contents(kb)
+    backup = tmp_path / "remote.nq"
+    kb.export(backup)
+    kb.update(CHANGE)
+    kb.update("DELETE WHERE { GRAPH graph:map { ?thing home:x ?x } }")
+    sent: list[str] = []
+    send = kb.store._apply_own_update
+
+    def failing(text: str) -> None:
+        sent.append(text)
+        if text.startswith("DELETE {"):
+            raise StoreError(oxigraph_server.url, "publication failed (test)")
+        send(text)
+
+    changed = _contents(kb)
+    kb.store._apply_own_update = failing  # type: ignore[method-assign]
+    with pytest.raises(StoreError, match="publication failed"):
+        kb.restore(backup)
+    del kb.store._apply_own_update
+    assert _contents(kb) == changed and not [g for g in kb.store.graphs() if g.startswith(STAGING)]
+    assert len(sent) > 3  # batches, the publication, the drop of the staging graphs
+    kb.restore(backup)
+    assert _contents(kb) == before
+    kb.close()
+
+
+def test_a_virtuoso_store_round_trips_leaving_its_own_graphs(virtuoso_server: VirtuosoServer, tmp_path: Path) -> None:
+    virtuoso_server.clear()
+    kb = _remote_store(virtuoso_server.url)
+    before = _contents(kb)
+    backup = tmp_path / "remote.nq"
+    kb.export(backup)
+    kb.update(CHANGE)
+    kb.restore(backup)
+    assert _contents(kb) == before
+    kb.close()
+    assert virtuoso_server.own_graphs <= virtuoso_server.graphs()
+    text = backup.read_text(encoding="utf-8")
+    assert not any(f"<{graph}> ." in text for graph in virtuoso_server.own_graphs)

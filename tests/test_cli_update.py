@@ -1,0 +1,115 @@
+"""cbrs update (kb/update_report.py): a SPARQL update from the command line, all or nothing, graph:entailed
+brought up to date, and what changed said graph by graph; a syntax error, a query, a read-only server and a
+split update on Virtuoso refused with nothing changed."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from cbrs.cli import cli
+from cbrs.kb import KnowledgeBase, QuerySyntaxError, Store, StoreEvaluationError
+from cbrs.kb.remote_store import Endpoints, RemoteStore
+from cbrs.kb.update_report import UpdateSplitError, operations, refuse_split
+from tests.conftest import MINI_FILES, OxigraphServer
+
+CAMERA = "INSERT DATA { GRAPH graph:services { <http://example.org/lab#Cam9> a cbrs:DynamicPerceptionComponent } }"
+
+
+@pytest.fixture(scope="module")
+def kb() -> Iterator[KnowledgeBase]:
+    """One seeded in-memory store for the module's updates."""
+    found = KnowledgeBase.open(":memory:")
+    yield found
+    found.close()
+
+
+def _cbrs(*args: str, given: str | None = None) -> tuple[int, str, str]:
+    """A command on a fresh in-memory store (each command has its own)."""
+    result = CliRunner().invoke(cli, ["--store", ":memory:", *args], input=given)
+    return result.exit_code, result.stdout, result.stderr
+
+
+def test_the_cli_says_what_a_data_update_changed_per_graph(tmp_path: Path) -> None:
+    code, out, _ = _cbrs("update", CAMERA)
+    assert code == 0
+    assert out.splitlines() == ["graph:services: 1 added, 0 removed", "graph:entailed: 1 added, 0 removed"]
+    code, out, _ = _cbrs("update", "--json", CAMERA)
+    assert code == 0 and json.loads(out)["exact"] is True
+    changes = {c["graph"].rsplit("/", 1)[1]: (c["added"], c["removed"], c["net"]) for c in json.loads(out)["changes"]}
+    assert changes == {"services": (1, 0, 1), "entailed": (1, 0, 1)}
+    text = tmp_path / "clear.ru"
+    text.write_text("CLEAR SILENT GRAPH graph:plans\n", encoding="utf-8")
+    assert _cbrs("update", "--file", str(text))[:2] == (0, "nothing changed\n")
+    assert _cbrs("update", "--file", "-", given="DELETE WHERE { GRAPH graph:map { world:Cup home:yaw ?yaw } }")[:2] == (
+        0,
+        "graph:map: -1 triples (net: the size before and after)\n",
+    )
+
+
+def test_updates_in_a_row_are_counted_and_another_update_by_the_graphs_sizes(kb: KnowledgeBase) -> None:
+    assert kb.update_counted(CAMERA).lines() == [
+        "graph:services: 1 added, 0 removed",
+        "graph:entailed: 1 added, 0 removed",
+    ]
+    assert kb.update_counted(CAMERA).lines() == ["nothing changed"]
+    assert kb.update_counted(CAMERA.replace("INSERT", "DELETE")).lines() == [
+        "graph:services: 0 added, 1 removed",
+        "graph:entailed: 0 added, 1 removed",
+    ]
+    moved = kb.update_counted(
+        "DELETE { GRAPH graph:map { ?thing home:yaw ?yaw } } INSERT { GRAPH graph:map { ?thing home:yaw 1.0 } }\n"
+        "WHERE { GRAPH graph:map { ?thing home:yaw ?yaw FILTER (?yaw = 0) } }"
+    )
+    assert not moved.exact and moved.lines() == ["nothing changed"]  # as many removed as added: no net change
+
+
+@pytest.mark.parametrize(
+    ("text", "said"),
+    [
+        pytest.param("INSERT DATA { GRAPH graph:services { <http://e.org/a> a }", "nothing was changed", id="syntax"),
+        pytest.param("SELECT * WHERE { ?s ?p ?o }", "this is a SPARQL query, not an update", id="query"),
+        pytest.param("INSERT DATA { GRAPH graph:services { _:b a cbrs:Camera } }", "_:b", id="blank-node"),
+    ],
+)
+def test_a_refused_update_is_one_line(text: str, said: str) -> None:
+    code, _, err = _cbrs("update", text)
+    assert code == 1 and said in err and "\n" not in err.strip()
+
+
+def test_an_update_that_fails_changes_nothing(kb: KnowledgeBase) -> None:
+    before = kb.store.dump()
+    with pytest.raises(QuerySyntaxError):
+        kb.update_counted("INSERT DATA { GRAPH graph:services { <http://e.org/a> a } }")
+    with pytest.raises(StoreEvaluationError):  # the first operation would have written, the second fails
+        kb.update_counted(CAMERA + " ; CREATE GRAPH graph:services")
+    assert kb.store.dump() == before
+
+
+def test_an_update_on_a_remote_store_is_counted_by_sizes(oxigraph_server: OxigraphServer) -> None:
+    oxigraph_server.clear()
+    kb = KnowledgeBase(Store.open(oxigraph_server.url))
+    kb.load(MINI_FILES)
+    report = kb.update_counted(CAMERA)
+    assert not report.exact and report.lines()[0] == "graph:services: +1 triples (net: the size before and after)"
+    kb.close()
+
+
+def test_several_operations_are_refused_where_a_request_is_not_one_transaction() -> None:
+    assert operations("INSERT DATA { <a:b> <a:c> 'x;y' ; <a:d> <a:e> } ;") == 1
+    assert operations("CLEAR ALL ; # a comment ; \n CLEAR ALL") == 2
+    store = RemoteStore("http://127.0.0.1:1/sparql", Endpoints.discover("http://127.0.0.1:1/sparql"))
+    store._virtuoso = True
+    try:
+        refuse_split(store, "DROP SILENT GRAPH <a:b>")
+        with pytest.raises(UpdateSplitError, match="this update has 2: send them one at a time") as refused:
+            refuse_split(store, "DROP SILENT GRAPH <a:b> ; INSERT DATA { GRAPH <a:g> { <a:b> <a:c> <a:d> } }")
+        assert refused.value.operations == 2
+        said = "updates are disabled: this server was started read-only"
+        assert store._refusal(403, store.endpoints.update, said).startswith("the server takes no updates")
+    finally:
+        store.close()
