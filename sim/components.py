@@ -42,7 +42,7 @@ from cbrs.settings import setting
 from cbrs.sim import predicates as pred
 from cbrs.sim import skills
 from cbrs.sim.arms import ArmSide
-from cbrs.sim.errors import GraspMisfitError, SimulationError
+from cbrs.sim.errors import GraspMisfitError, MovesRefusedError, SimulationError
 from cbrs.sim.geometry import Pose2D, Region, Vec3
 from cbrs.sim.grasping import GraspKind, GraspPose, ObjectModel, compute_grasp_pose
 from cbrs.sim.mapping import OccupancyGrid, build_occupancy_grid
@@ -416,14 +416,16 @@ def approach(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[st
     x, y, _ = estimate.position
     ctx.arm = _free_arm(ctx, x, y, f"the {model.name}")
     spec = ctx.world.arm_specs[ctx.arm]
-    if len(model.preference) > 1:
-        choice = _taking(ctx, estimate, model, ctx.arm)
-        _note(ctx, choice)
-        model = choice.model
     hand = ctx.world.arm(ctx.arm).hand
-    ctx.grasp = compute_grasp_pose(
-        model, estimate.position, estimate.yaw, spec.mount, spec.yaw, _extent(estimate), hand
-    )
+
+    def grasp(held: ObjectModel) -> GraspPose:
+        return compute_grasp_pose(held, estimate.position, estimate.yaw, spec.mount, spec.yaw, _extent(estimate), hand)
+
+    if len(model.preference) == 1:  # its one approach's misfit is its own typed error (GraspTooDeepError...)
+        grasp(model)
+    choice = _taking(ctx, estimate, model, ctx.arm)  # one approach too: its moves are dry-run (_clear)
+    _note(ctx, choice)
+    ctx.grasp = grasp(choice.model)
     ctx.seen, ctx.focus = estimate, model.name
     ctx.last_arm = ctx.arm
     _check(skills.approach_object(ctx.world, ctx.arm, ctx.grasp))
@@ -438,7 +440,7 @@ def _taking(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, side:
     arm that can let it go there by no approach takes it by the first it can, as where it is not known:
     the carry passes it to the other arm. Of the approaches that pass those checks (the inverse
     kinematics' of the end poses), the first whose moves the arm's planning would make (:func:`_clear`)
-    is taken; when none would, the first, as before."""
+    is taken; when none would, :class:`MovesRefusedError` before anything moves."""
     world, name = ctx.world, model.name
 
     def take(held: ObjectModel) -> str:
@@ -471,24 +473,36 @@ def _taking(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, side:
             side,
             f"taking the {name} to {place.name}",
             lambda held: skills.can_carry(world, estimate, side, held, first[held.grasp]),
+            first,
         )
     unplaced = "; ".join(why for _, why in both.ruled_out)
     return taking.choice(side, taking.models[0], f"taking the {name} (to {place.name}, to be passed on: {unplaced})")
 
 
-def _clear(candidates: _Candidates, side: ArmSide, purpose: str, moves: Callable[[ObjectModel], str]) -> GraspChoice:
+def _clear(
+    candidates: _Candidates,
+    side: ArmSide,
+    purpose: str,
+    moves: Callable[[ObjectModel], str],
+    spots: Mapping[GraspKind, Region] | None = None,
+) -> GraspChoice:
     """The first of ``candidates`` whose ``moves`` the arm's planning would make, as they are asked (a dry
-    run: :func:`skills.can_carry`): one it would refuse is ranked after those it would not, and passed over
-    saying why. When it would refuse every one, the first: the dry run sees no physics and the real moves
-    may still do (a failed step is re-planned), so nothing is refused on its word alone; and one
-    candidate alone is taken without asking."""
+    run: :func:`skills.can_carry`, over the spot of ``spots`` the carry by that approach will aim at): one
+    it would refuse is passed over saying why. A lone candidate is asked too. :class:`MovesRefusedError`
+    when it would refuse every one: the real moves are planned by the same planning from the same
+    posture, so they would fail the same way, only after the arm has moved (nu16 repro 04)."""
     passed = list(candidates.ruled_out)
-    for held in candidates.models if len(candidates.models) > 1 else ():
+    refused: list[tuple[str, tuple[float, float] | None, str]] = []
+    for held in candidates.models:
         why = moves(held)
         if not why:
             return _Candidates([held], passed).choice(side, held, purpose)
         passed.append((held.grasp, why))
-    return candidates.choice(side, candidates.models[0], purpose)
+        spot = (spots or {}).get(held.grasp)
+        refused.append((held.grasp.value, (spot.center[0], spot.center[1]) if spot is not None else None, why))
+    name = candidates.models[0].name if candidates.models else ""
+    ruled_out = [(kind.value, why) for kind, why in candidates.ruled_out]
+    raise MovesRefusedError(name, side.value, purpose, refused, ruled_out)
 
 
 def _hold_end(ctx: SimContext, name: str) -> tuple[Thing, Region, list[tuple[float, float]]] | None:

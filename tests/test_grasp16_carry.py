@@ -1,7 +1,8 @@
 """The approach choice asks whether the arm's own motion planning would make the moves of the hold, not only
 whether the hand can be at its end poses: a dry run of the approach, the pick-up and the carry on the
 kinematics copies (skills.can_carry, arms.PlannedArm). An approach whose moves it would refuse is ranked
-after one whose moves it would make (sim/components.py: _taking, _clear)."""
+after one whose moves it would make; when it would refuse every one, the step fails before anything moves
+(sim/components.py: _taking, _clear)."""
 
 from __future__ import annotations
 
@@ -17,6 +18,7 @@ from cbrs.kb.semantic_map import SemanticMap
 from cbrs.sim import components, skills
 from cbrs.sim.arms import ArmSide
 from cbrs.sim.components import SimEnvironment
+from cbrs.sim.errors import MovesRefusedError
 from cbrs.sim.geometry import Region
 from cbrs.sim.grasping import GraspKind, ObjectModel, compute_grasp_pose
 from cbrs.sim.perception import ObjectEstimate, recognise_object
@@ -104,22 +106,26 @@ def test_the_dry_run_plans_the_moves_the_arm_makes(tmp_path: Path) -> None:
 def test_an_approach_the_dry_run_refuses_is_ranked_after_not_refused(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """With every approach's moves refused by the dry run, the choice is what the end poses alone gave:
-    the dry run sees no physics, so it reorders and never stops a hold on its own."""
+    """With every approach's moves refused by the dry run, the step fails before anything moves, naming
+    each approach: the real moves, planned the same way, would fail after moving (nu16 repro 04)."""
     kb = cup_to_the_larger_tray(tmp_path)
     with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
         seen, cup = _cup(world)
         context = SimEnvironment(world, kb).context
         monkeypatch.setattr(skills, "can_carry", lambda *args: "refused by the stand-in")
-        everything_refused = components._taking(context, seen, cup, ArmSide.LEFT)
+        with pytest.raises(MovesRefusedError) as everything_refused:
+            components._taking(context, seen, cup, ArmSide.LEFT)
         monkeypatch.setattr(skills, "can_carry", lambda w, e, s, held, *r: "no" if held.grasp is GraspKind.SIDE else "")
         side_refused = components._taking(context, seen, cup, ArmSide.LEFT)
-    assert everything_refused.model.grasp is GraspKind.SIDE and everything_refused.passed == ()
+    refused = everything_refused.value
+    assert (refused.name, refused.arm) == ("Cup", "left")
+    assert refused.refused == (("side", None, "refused by the stand-in"), ("top", None, "refused by the stand-in"))
     assert side_refused.model.grasp is GraspKind.TOP and side_refused.passed == ((GraspKind.SIDE, "no"),)
 
 
-def test_no_dry_run_when_one_approach_is_left_to_choose(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    """Ranking one candidate changes nothing, so its moves are not planned twice (once here, once made)."""
+def test_one_approach_left_to_choose_is_dry_run_too(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A lone candidate's moves are planned before it is taken: refused, the step fails before anything
+    moves, naming the object, the arm, the approach and the spot the carry would aim at."""
     kb = cup_to_the_larger_tray(tmp_path)
     with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
         seen, cup = _cup(world)
@@ -132,4 +138,16 @@ def test_no_dry_run_when_one_approach_is_left_to_choose(tmp_path: Path, monkeypa
     alone = components._Candidates([cup.by(GraspKind.TOP)], [(GraspKind.SIDE, "ruled out")])
     choice = components._clear(alone, ArmSide.LEFT, "taking the Cup", lambda held: asked.append(held.grasp) or "")
     assert choice.model.grasp is GraspKind.TOP and choice.passed == ((GraspKind.SIDE, "ruled out"),)
-    assert asked == []
+    assert asked == [GraspKind.TOP]
+    with pytest.raises(MovesRefusedError) as refused:
+        components._clear(
+            alone, ArmSide.LEFT, "taking the Cup to TrayPlace", lambda held: "no path", {GraspKind.TOP: SPOT}
+        )
+    error = refused.value
+    assert (error.name, error.arm, error.refused, error.ruled_out) == (
+        "Cup",
+        "left",
+        (("top", pytest.approx((7.54, 3.10)), "no path"),),
+        (("side", "ruled out"),),
+    )
+    assert str(error).startswith("taking the Cup to TrayPlace: refused before anything moved")
