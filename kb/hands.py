@@ -4,8 +4,10 @@ KnowRob style, a hand is a part of its arm in the store (``home:hasGripper``), a
 needs of it is stated on it: how far its jaws open, how far its palm sits above the grasp point, how long
 its fingers are (its geometry, required of a gripper the map names), and how it is used (its policy: the
 side grasp's tilt and least hold, the pre-grasp distance; each a default here unless the store states
-one, and then the store's). The named query ``robot_hands`` reads them; an arm the map gives no gripper
-has :data:`PANDA_HAND`, the hand of the simulated arms (docs/simulation.md, "The hand").
+one, and then the store's). A value is stated on the gripper, or once on a class of grippers (a model) it is
+an individual of: its own value wins, else the nearest class's (:func:`read_hands`). The named query
+``robot_hands`` reads them; an arm the map gives no gripper has :data:`PANDA_HAND`, the hand of the
+simulated arms (docs/simulation.md, "The hand").
 """
 
 from __future__ import annotations
@@ -93,14 +95,30 @@ _GEOMETRY = ("jawOpening", "palmDepth", "fingerLength")
 
 class HandError(MapError):
     """A gripper's description lacks or contradicts what the grasp planner needs: names the gripper, its
-    arm and robot, the property and the value (None when missing)."""
+    arm and robot, the property and the value (None when missing), and the class it has the value from
+    (``source``; empty for its own value, or for classes equally near that disagree, which ``problem``
+    names)."""
 
-    def __init__(self, hand: str, arm: str, robot: str, prop: str, value: str | None, problem: str) -> None:
+    def __init__(
+        self, hand: str, arm: str, robot: str, prop: str, value: str | None, problem: str, source: str = ""
+    ) -> None:
         self.hand, self.arm, self.robot, self.property, self.value = hand, arm, robot, prop, value
+        self.source = source
         whose = "an arm" if hand == arm else f"the gripper of {local_name(arm)}"
         whose += f" of {local_name(robot)}" if robot else ""
         said = f"has no home:{prop}" if value is None else f"has home:{prop} {value!r}"
+        said += f" from its class {local_name(source)}" if source else ""
         super().__init__(hand, f"({whose}) {said}: {problem}")
+
+
+@dataclass(frozen=True)
+class _Stated:
+    """A value the store states for a gripper: on it (``distance`` 0), or on ``source``, a class of it
+    ``distance`` classes up from the gripper's own class (1)."""
+
+    value: str
+    source: str
+    distance: int
 
 
 def _limits(name: str, number: float) -> str:
@@ -114,24 +132,47 @@ def _limits(name: str, number: float) -> str:
     return "" if number > 0.0 else "a length in metres, more than 0"
 
 
-def _hand(hand: str, arm: str, robot: str, stated: dict[str, list[str]]) -> Hand:
-    """The :class:`Hand` of what the store states of ``hand`` (property IRI -> values)."""
+def _nearest(hand: str, arm: str, robot: str, name: str, stated: list[_Stated]) -> tuple[str, str] | None:
+    """The value of ``name`` a gripper has, and the class it has it from (empty for its own): its own,
+    else its nearest class's. :class:`HandError` for two values at the nearest distance."""
+    if not stated:
+        return None
+    near = min(each.distance for each in stated)
+    nearest = sorted({(each.value, each.source) for each in stated if each.distance == near})
+    values = sorted({value for value, _ in nearest})
+    if len(values) > 1:
+        if near == 0:
+            raise HandError(hand, arm, robot, name, " and ".join(values), "one value is needed")
+        said = " and ".join(f"{local_name(source)} ({value})" for value, source in nearest)
+        raise HandError(
+            hand,
+            arm,
+            robot,
+            name,
+            " and ".join(values),
+            f"its classes {said}, equally near it, disagree: state the value on the gripper, or on a class of it "
+            "nearer than those",
+        )
+    return values[0], "" if near == 0 else nearest[0][1]
+
+
+def _hand(hand: str, arm: str, robot: str, stated: dict[str, list[_Stated]]) -> Hand:
+    """The :class:`Hand` of what the store states of ``hand`` and its classes (property IRI -> values)."""
     values: dict[str, float] = {}
     for name in _PROPERTIES:
-        raw = sorted(set(stated.get(HOME + name, [])))
-        if not raw:
+        found = _nearest(hand, arm, robot, name, stated.get(HOME + name, []))
+        if found is None:
             if name in _GEOMETRY:
                 raise HandError(hand, arm, robot, name, None, f"a gripper states its geometry{_slip(name, stated)}")
             continue
-        if len(raw) > 1:
-            raise HandError(hand, arm, robot, name, " and ".join(raw), "one value is needed")
+        raw, source = found
         try:
-            number = float(raw[0])
+            number = float(raw)
         except ValueError:
-            raise HandError(hand, arm, robot, name, raw[0], "not a number") from None
+            raise HandError(hand, arm, robot, name, raw, "not a number", source) from None
         problem = _limits(name, number)
         if problem:
-            raise HandError(hand, arm, robot, name, raw[0], problem)
+            raise HandError(hand, arm, robot, name, raw, problem, source)
         values[name] = number
     if values["palmDepth"] >= values["fingerLength"]:
         raise HandError(
@@ -154,20 +195,27 @@ def _hand(hand: str, arm: str, robot: str, stated: dict[str, list[str]]) -> Hand
     )
 
 
-def _slip(name: str, stated: dict[str, list[str]]) -> str:
-    """A did-you-mean for a missing ``name``: the gripper's own property it may be a misspelling of
-    (home:jawOpenning), which the load took silently, being declared nowhere."""
+def _slip(name: str, stated: dict[str, list[_Stated]]) -> str:
+    """A did-you-mean for a missing ``name``: the property of the gripper or its classes it may be a
+    misspelling of (home:jawOpenning), which the load took silently, being declared nowhere."""
     known = {HOME + other for other in _PROPERTIES}
     slip = nearest_term(HOME + name, [prop for prop in stated if prop not in known])
-    return f" (did you mean home:{name} for its home:{local_name(slip)} {stated[slip][0]!r}?)" if slip else ""
+    if not slip:
+        return ""
+    first = min(stated[slip], key=lambda each: (each.distance, each.source, each.value))
+    whose = f"its class {local_name(first.source)}'s" if first.distance else "its"
+    return f" (did you mean home:{name} for {whose} home:{local_name(slip)} {first.value!r}?)"
 
 
 def read_hands(kb: KnowledgeBase, robot: str | None = None) -> dict[str, Hand]:
     """Each arm's hand (by arm IRI) that the semantic map gives ``robot`` (every robot by default), by the
-    named query ``robot_hands``: an arm with no ``home:hasGripper`` has :data:`PANDA_HAND`.
-    :class:`HandError` for a gripper missing its geometry or stating a value no hand can have."""
+    named query ``robot_hands``: an arm with no ``home:hasGripper`` has :data:`PANDA_HAND`. Each value is
+    the gripper's own, else the one of the nearest of its classes (``rdf:type``, then ``rdfs:subClassOf``)
+    that states it, so a gripper model's geometry is stated once on its class.
+    :class:`HandError` for a gripper missing its geometry, stating a value no hand can have, or having two
+    values of a property from equally near classes."""
     arms: dict[str, tuple[str, set[str]]] = {}
-    stated: dict[str, dict[str, list[str]]] = defaultdict(lambda: defaultdict(list))
+    stated: dict[str, dict[str, list[_Stated]]] = defaultdict(lambda: defaultdict(list))
     for row in kb.select("robot_hands", {"robot": robot} if robot is not None else None):
         arm = row["arm"].value
         owner, grippers = arms.setdefault(arm, (row["robot"].value, set()))
@@ -176,7 +224,8 @@ def read_hands(kb: KnowledgeBase, robot: str | None = None) -> dict[str, Hand]:
             if "property" in row:
                 value = row["value"]
                 shown = value.value if isinstance(value, Literal) else f"<{value.value}>"
-                stated[row["hand"].value][row["property"].value].append(shown)
+                said = _Stated(shown, row["source"].value, int(row["distance"].value))
+                stated[row["hand"].value][row["property"].value].append(said)
     hands = {}
     for arm, (owner, grippers) in sorted(arms.items()):
         if len(grippers) > 1:
