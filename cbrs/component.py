@@ -27,6 +27,7 @@ import time
 from collections import deque
 from collections.abc import Callable
 from concurrent.futures import Future
+from concurrent.futures import TimeoutError as FutureTimeout
 from typing import Any
 
 import pyoxigraph as ox
@@ -39,7 +40,7 @@ from cbrs.kb.namespaces import BASE, RDF, GraphName, shorten
 from cbrs.kb.shapes import nearest_term
 from cbrs.kb.vocab import CBRS
 from cbrs.live_components import DEFAULT_TTL, DEREGISTERED, FORMATS, NO_LIVE_COMPONENT, grounding
-from cbrs.stop_signals import StopRequest, handling
+from cbrs.stop_signals import POLL, StopRequest, handling
 
 __all__ = ["Component", "ComponentEndedError", "ConnectedComponent", "RegistrationRefusedError"]
 
@@ -50,6 +51,7 @@ _Beats = deque[tuple[float, Future[dict[str, Any]]]]
 """Heartbeats waiting for their answers: when each was sent, and its answer."""
 
 HEARTBEAT = "/cbrs/heartbeat"
+REGISTER = "/cbrs/register"
 REREGISTER_ATTEMPTS = 5
 """Registrations tried after the server says the lease is gone, before the component gives up."""
 REREGISTER_BACKOFF = 2.0
@@ -132,13 +134,22 @@ class Component:
         registration; nothing was provided then, so a refused second copy harms the first. An
         ``on_start`` hook that raises disconnects the component (it is unavailable at once, and no
         ``on_stop`` hook runs) before its error propagates."""
+        return self._connect(url, token, heartbeat, ttl, StopRequest())
+
+    def _connect(
+        self, url: str, token: str | None, heartbeat: float, ttl: float, stop: StopRequest
+    ) -> ConnectedComponent:
+        """:meth:`connect`, giving up with :class:`_Stopped` (nothing provided, no hook run) once ``stop``
+        notes a signal before the on_start hooks begin."""
         if self._handler is None:
             raise ValueError(f"{self.iri} has no handler: decorate one with @component.handler")
         if not 0 < heartbeat < ttl:
             raise ValueError(f"the heartbeat ({heartbeat} s) must be shorter than the lease ({ttl} s)")
         client = BridgeClient(url, token)
         try:
-            registered = self._register(client, ttl, token_given=token is not None)
+            registered = self._register(client, ttl, token_given=token is not None, stop=stop)
+            if stop.signal is not None:
+                raise _Stopped
             client.provide(self.service, self.service_type, self._handler)
         except BaseException:
             client.close()
@@ -152,10 +163,12 @@ class Component:
             raise
         return connected
 
-    def _register(self, client: BridgeClient, ttl: float, token_given: bool = True) -> list[str]:
+    def _register(
+        self, client: BridgeClient, ttl: float, token_given: bool = True, stop: StopRequest | None = None
+    ) -> list[str]:
         args = {"description": self.description, "format": self.format, "ttl": ttl}
         try:
-            answer = client.call_sync("/cbrs/register", args)
+            answer = _answer(client.call(REGISTER, args, client.timeout), client.timeout, stop)
         except RemoteCallError as error:
             reason = _servers_reason(client, str(error))
             if not token_given and "needs the update token" in reason:  # the protocol's words, and the SDK's fix
@@ -168,15 +181,12 @@ class Component:
         run and this returns. When the component cannot serve (its registration refused, the server
         gone or restarted, the component deregistered) the process exits with status 1 and the reason,
         so a supervisor (systemd ``Restart=on-failure``, a container's restart policy) starts it again."""
-        request = StopRequest()  # a SIGTERM while connecting: serving stops at once, the hooks run
-        connected: ConnectedComponent | None = None
+        request = StopRequest()  # taken for the whole run: a signal never raises between two statements
         try:
-            with handling(request, signal.SIGTERM):
-                connected = self.connect(url, token, heartbeat, ttl)
-                connected._serve(request)
-        except KeyboardInterrupt:  # Ctrl-C outside the serving wait (while connecting, say): stop all the same
-            if connected is not None:
-                connected.stop()
+            with handling(request, signal.SIGTERM, signal.SIGINT):
+                self._connect(url, token, heartbeat, ttl, request)._serve(request)
+        except _Stopped:  # stopped while connecting: nothing was provided, no hook ran
+            pass
         except (RegistrationRefusedError, ComponentEndedError, BridgeClosedError) as error:
             raise SystemExit(f"cbrs component: {error}") from None  # printed on stderr, status 1
 
@@ -324,7 +334,7 @@ class ConnectedComponent:
     def _serve(self, request: StopRequest) -> None:
         try:
             request.wait(until=self.client.wait_closed)
-        except KeyboardInterrupt:  # Ctrl-C where no handler of ours took SIGINT (run() takes SIGTERM only)
+        except KeyboardInterrupt:  # Ctrl-C where no handler of ours took SIGINT (serve() outside the main thread)
             pass
         finally:
             ended = not self._stop.is_set() and (self.ended is not None or self.client.closed_by_server)
@@ -353,6 +363,26 @@ class ConnectedComponent:
 
     def __exit__(self, *exc: object) -> None:
         self.stop()
+
+
+class _Stopped(Exception):
+    """A stop signal arrived while the component was connecting (:meth:`Component.run`)."""
+
+
+def _answer(answer: Future[dict[str, Any]], timeout: float, stop: StopRequest | None) -> dict[str, Any]:
+    """The answer within ``timeout``; looked at every :data:`POLL` seconds so that a stop signal noted in
+    ``stop`` meanwhile ends the wait (with :class:`_Stopped`) instead of the call's timeout."""
+    if stop is None:
+        return answer.result(timeout=timeout + 1.0)
+    deadline = time.monotonic() + timeout + 1.0
+    while True:
+        if stop.signal is not None:
+            raise _Stopped
+        try:
+            return answer.result(timeout=min(POLL, max(0.0, deadline - time.monotonic())))
+        except FutureTimeout:
+            if time.monotonic() >= deadline:
+                raise
 
 
 def _servers_reason(client: BridgeClient, refusal: str) -> str:

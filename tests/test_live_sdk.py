@@ -347,3 +347,38 @@ def test_a_call_whose_send_loses_the_race_with_the_connection_ending_fails_once(
         future = client.call("/cbrs/heartbeat", {})
         with pytest.raises(BridgeClosedError, match="went while this call was sent"):
             future.result(timeout=5)
+
+
+INTERRUPTED_IN_ON_START = """
+import os, signal, sys
+from cbrs.component import Component
+from tests.test_live_components import READING, thermometer
+made = Component(thermometer())
+made.handler(lambda request: READING)
+made.on_stop(lambda: print("on_stop ran", flush=True))
+
+@made.on_start
+def start():
+    print("started", flush=True)
+    os.kill(os.getpid(), signal.SIGINT)  # Ctrl-C while the hook still runs
+    print("start done", flush=True)
+
+made.run(sys.argv[1], token=sys.argv[2])
+print("run returned", flush=True)
+"""
+
+
+def test_ctrl_c_during_on_start_lets_the_hook_finish_then_stops_with_on_stop(server: Server) -> None:
+    """run() takes Ctrl-C as a note for its whole length: it raised KeyboardInterrupt wherever it landed
+    while connecting, so a hook was cut short and taken for a failed start (no on_stop), or, landing
+    between the hooks and the serving wait, nothing stopped the component at all."""
+    command = [sys.executable, "-c", textwrap.dedent(INTERRUPTED_IN_ON_START), url(server), TOKEN]
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    child = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=ROOT, env=env)
+    try:
+        out, err = child.communicate(timeout=30)
+    finally:
+        child.kill()
+        child.wait(timeout=10)
+    assert child.returncode == 0, err
+    assert out.splitlines() == ["started", "start done", "on_stop ran", "run returned"], err
