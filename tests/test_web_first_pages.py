@@ -106,3 +106,8 @@ def test_the_start_form_chooses_the_latest_run_s_task_again(bundled_kb: Knowledg
         ran = TaskRun("run-1", "req:RoomTemperature", 0, (), iri="https://w3id.org/cbrs/requirement#RoomTemperature")
         assert tasks._first_choice(offered, ran) == "RoomTemperature"  # as the list spells it
         assert tasks._first_choice(offered, None) == "FetchMyPen"
+
+
+def test_the_tasks_page_says_there_is_no_run_yet(bundled_kb: KnowledgeBase) -> None:
+    page = app_over(bundled_kb).test_client().get("/tasks").text
+    assert "No run yet: start one above" in page  # the steps table stood empty under "Latest run none yet"
