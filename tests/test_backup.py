@@ -17,7 +17,10 @@ from cbrs.kb.backup import EXPORT_GRAPH, REQUIRED, NotAnExportError, UnknownExpo
 from cbrs.kb.namespaces import GraphName
 from cbrs.kb.remote_store import RemoteStore
 from cbrs.kb.staged_writes import STAGING
+from cbrs.server import ServeConfig, Server
+from cbrs.sparql_service import EndpointConfig
 from tests.conftest import DATA, MINI_FILES, OxigraphServer, VirtuosoServer
+from tests.test_live_components import TOKEN
 
 CHANGE = 'INSERT DATA { GRAPH graph:services { <http://example.org/lab#Cam9> rdfs:label "a ninth camera" } }'
 
@@ -184,3 +187,30 @@ def test_a_virtuoso_store_round_trips_leaving_its_own_graphs(virtuoso_server: Vi
     assert virtuoso_server.own_graphs <= virtuoso_server.graphs()
     text = backup.read_text(encoding="utf-8")
     assert not any(f"<{graph}> ." in text for graph in virtuoso_server.own_graphs)
+
+
+def test_a_store_behind_cbrs_serve_is_exported_and_restored_with_its_token(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Through a running cbrs server's /sparql and /update (its token from CBRS_UPDATE_TOKEN), as a lab whose
+    store a server holds (and locks) must do; without the token an update is refused, saying how."""
+    endpoint = EndpointConfig(update_token=TOKEN, isolate=False)
+    running = Server(KnowledgeBase.open(":memory:"), ServeConfig(port=0, bridge_port=0, endpoint=endpoint))
+    running.start()
+    try:
+        location = f"http://127.0.0.1:{running.http_port}"
+        monkeypatch.setenv("CBRS_UPDATE_TOKEN", TOKEN)
+        runner = CliRunner()
+        backup = tmp_path / "served.nq"
+        exported = runner.invoke(cli, ["--store", location, "export", str(backup), "--graph", "requirements"])
+        assert exported.exit_code == 0, exported.output  # one graph: each staged batch costs the server a check
+        before = running.kb.store.dump()
+        running.kb.update(CHANGE.replace("services", "requirements"))
+        restored = runner.invoke(cli, ["--store", location, "restore", str(backup), "--graph", "requirements"])
+        assert restored.exit_code == 0, restored.output
+        assert running.kb.store.dump() == before
+        monkeypatch.delenv("CBRS_UPDATE_TOKEN")
+        refused = runner.invoke(cli, ["--store", location, "update", CHANGE])
+        assert refused.exit_code == 1 and "CBRS_UPDATE_TOKEN" in refused.stderr
+    finally:
+        running.stop()
