@@ -111,7 +111,7 @@ def restore(app: App, file: Path, graphs: tuple[str, ...], fmt: str | None, yes:
 
 def _confirm(app: App, backup: Backup, graphs: tuple[str, ...], yes: bool) -> None:
     """Ask a person at a terminal before a restore replaces what the store holds; a script is not asked."""
-    if yes or not sys.stdin.isatty():
+    if yes or not _at_terminal():
         return
     manifest = backup.manifest
     said = (
@@ -164,6 +164,10 @@ def update(app: App, text: str | None, update_file: Any, as_json: bool) -> None:
         return
     for line in report.lines():
         click.echo(line)
+
+
+def _at_terminal() -> bool:
+    return sys.stdin.isatty()
 
 
 def _graph_name(graph: str) -> str:

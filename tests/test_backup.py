@@ -11,6 +11,7 @@ import pyoxigraph as ox
 import pytest
 from click.testing import CliRunner
 
+from cbrs import cli_store
 from cbrs.cli import cli
 from cbrs.kb import KnowledgeBase, RdfParseError, Store, StoreError
 from cbrs.kb.backup import EXPORT_GRAPH, REQUIRED, NotAnExportError, UnknownExportFormatError, read_backup, store_graphs
@@ -111,10 +112,12 @@ def test_the_cli_exports_asks_and_restores(tmp_path: Path) -> None:
     kb = KnowledgeBase.open(store)
     before = kb.store.dump()
     kb.update(CHANGE)
+    services = kb.store.count(GraphName.SERVICES)
     kb.close()
     restored = runner.invoke(cli, ["--store", str(store), "restore", str(backup), "--yes"])
     assert restored.exit_code == 0, restored.output
-    assert "graph:services" in restored.output and "(was 2006 triples)" in restored.output
+    line = next(line for line in restored.stdout.splitlines() if "graph:services" in line)
+    assert line.split() == ["graph:services", str(services - 1), "triples", "(was", str(services), "triples)"]
     kb = KnowledgeBase.open(store)
     assert kb.store.dump() == before
     kb.close()
@@ -124,6 +127,18 @@ def test_the_cli_exports_asks_and_restores(tmp_path: Path) -> None:
     assert refused.exit_code == 1 and "not a cbrs export" in refused.output and "--force" in refused.output
     out = runner.invoke(cli, ["--store", str(store), "export", "-", "--graph", "requirements"])
     assert out.exit_code == 0 and "<https://w3id.org/cbrs/graph/export> ." in out.stdout
+
+
+@pytest.mark.parametrize(("answer", "code"), [("n\n", 1), ("y\n", 0)])
+def test_a_person_at_a_terminal_is_asked_first(
+    exported: Path, monkeypatch: pytest.MonkeyPatch, answer: str, code: int
+) -> None:
+    monkeypatch.setattr(cli_store, "_at_terminal", lambda: True)
+    result = CliRunner().invoke(cli, ["--store", ":memory:", "restore", str(exported)], input=answer)
+    assert result.exit_code == code, result.output
+    triples = sum(read_backup(exported).triples.values())
+    assert f"Replace everything in :memory: with the {triples} triples of {exported} (exported " in result.stderr
+    assert (f"restored {triples} triples" in result.stdout) == (code == 0)
 
 
 def _contents(kb: KnowledgeBase) -> list[str]:
