@@ -42,7 +42,8 @@ from cbrs.kb.staged_writes import STAGING, write_staged
 from cbrs.kb.store import BULK_LOADING, EmbeddedStore, Store, data_block
 
 Progress = Callable[[str, int, int], None]
-"""Told how an export or restore goes: the stage, items done, of how many (0: not counted)."""
+"""Told how an export or restore goes: the stage, items done, of how many (0: not counted; the stage's
+text then says how far it is, ``exporting graph:services (2/5): 40000 triples``)."""
 
 EXPORT_GRAPH = ox.NamedNode(GRAPH + "export")
 """The graph an export's manifest is in; never written to a store."""
@@ -316,7 +317,7 @@ def export_store(
             for quad in store.quads(graph=_node(graph)):
                 counts[graph] += 1
                 if counts[graph] % _PROGRESS_EVERY == 0:
-                    tell(stage, counts[graph], 0)
+                    tell(f"{stage}: {counts[graph]} triples", 0, 0)
                 yield quad
         exported = {graph: counts[graph] for graph in chosen}
         stamp = datetime.datetime.now(datetime.UTC).replace(microsecond=0).isoformat().replace("+00:00", "Z")
@@ -378,7 +379,7 @@ def read_backup(path: str | Path, rdf_format: ox.RdfFormat | None = None, progre
                 data = gzip.GzipFile(fileobj=raw)  # type: ignore[assignment]
             for number, quad in enumerate(ox.parse(data, rdf_format), 1):
                 if number % _PROGRESS_EVERY == 0:
-                    tell(f"reading {source}", number, 0)
+                    tell(f"reading {source}: {number} quads", 0, 0)
                 if quad.graph_name == EXPORT_GRAPH:
                     manifest.append(quad)
                 elif quad not in seen:
