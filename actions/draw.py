@@ -1,9 +1,9 @@
 """Draw the service resource graph of a composition (like the paper's Figure 15).
 
-Vertices are laid out left to right by their forward-search level (SRI first, SRO/SRE last). Blue
-arrows are edges the forward search used, magenta arcs the edges the backward search walked, thick
-black arrows the bindings of the chosen plan. Only the vertices of the plan, their alternatives
-and the virtual nodes are drawn; the full graph of a home has thousands of edges.
+Vertices are laid out left to right by their forward-search level (SRI first, SRO/SRE last; a level with
+no vertex drawn takes no column). Blue arrows are edges the forward search used, magenta arcs the edges
+the backward search walked, thick black arrows the bindings of the chosen plan. Only the vertices of the
+plan, their alternatives and the virtual nodes are drawn; the full graph of a home has thousands of edges.
 """
 
 from __future__ import annotations
@@ -44,7 +44,7 @@ def figure(result: CompositionResult) -> Figure:
     (constrained layout), so that no two labels lie on one another."""
     attempts = [a for a in result.attempts if a.plan is not None] or list(result.attempts[:1])
     heights = [_rows(a) for a in attempts]
-    columns = max(max(attempt.trace.levels.values(), default=0) + 2 for attempt in attempts)
+    columns = max(_columns(attempt) for attempt in attempts)
     width = max(16.0, (columns + 0.4) * (_widest(attempts) + COLUMN_GAP))
     drawn, axes = plt.subplots(
         len(attempts),
@@ -66,7 +66,7 @@ def figure(result: CompositionResult) -> Figure:
         ncol=3,
         frameon=False,
     )
-    drawn.suptitle(f"Service resource graph for {_short(result.task)}: {result.status.value}")
+    drawn.suptitle(f"Service resource graph for {_name(result.task)}: {result.status.value}")
     return drawn
 
 
@@ -86,6 +86,15 @@ def _widest(attempts: list[Attempt]) -> float:
         for line in _short(iri).split("\n")
     ]
     return max((len(line) for line in names), default=3) * FONT_SIZE * 0.6 / 72 + 0.15
+
+
+def _columns(attempt: Attempt) -> int:
+    """How many columns the drawing has: the forward-search levels its vertices are on, and the goals'."""
+    last = max(attempt.trace.levels.values(), default=0) + 1
+    drawn = {attempt.trace.levels.get(SRI, last)}
+    if attempt.plan is not None:
+        drawn |= {attempt.trace.levels.get(c, last) for s in attempt.plan.steps for c in (s.component, *s.alternatives)}
+    return len(drawn | {last})
 
 
 def _rows(attempt: Attempt) -> int:
@@ -119,7 +128,7 @@ def _draw_attempt(axis: Axes, attempt: Attempt) -> None:
     for iri in sorted(shown, key=lambda i: (level[i], _short(i))):
         columns.setdefault(level[iri], []).append(iri)
     position = {}
-    for column, members in columns.items():
+    for column, (_, members) in enumerate(sorted(columns.items())):  # levels no vertex shown is on take no room
         for row, iri in enumerate(members):
             position[iri] = (float(column), (len(members) - 1) / 2 - row)
     for edges, colour, rad in ((trace.forward, FORWARD, 0.0), (trace.backward, BACKWARD, 0.25)):
@@ -148,9 +157,9 @@ def _draw_attempt(axis: Axes, attempt: Attempt) -> None:
                 "ec": PLAN if iri in chosen or virtual else "#999999",
             },
         )
-    axis.set_title(_short(attempt.requirement.iri), fontsize=10)
+    axis.set_title(_name(attempt.requirement.iri), fontsize=10)
     ys = [y for _, y in position.values()]
-    axis.set_xlim(-0.7, last + 0.7)
+    axis.set_xlim(-0.7, len(columns) - 1 + 0.7)
     axis.set_ylim(min(ys) - 0.8, max(ys) + 0.8)
     axis.axis("off")
 
@@ -174,6 +183,10 @@ def _arrow(
     )
 
 
+def _name(iri: str) -> str:
+    return iri.rsplit("#", 1)[-1].rsplit("/", 1)[-1]
+
+
 def _short(iri: str) -> str:
-    name = iri.rsplit("#", 1)[-1].rsplit("/", 1)[-1]
-    return name.replace("_", "\n", 1)
+    """A vertex's name in two lines: a component's service, then its device (``PlanPathAStar_HomeServer01``)."""
+    return _name(iri).replace("_", "\n", 1)

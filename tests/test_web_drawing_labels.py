@@ -91,3 +91,16 @@ def test_the_service_resource_graph_s_texts_lie_apart(bundled_kb: KnowledgeBase)
         assert len(rects) > 10 and overlapping(rects) == []
     finally:
         plt.close(drawn)
+
+
+def test_the_service_resource_graph_gives_no_room_to_levels_with_nothing_drawn(bundled_kb: KnowledgeBase) -> None:
+    """RobotSelfPosition's vertices are on 2 of the search's 10 levels; the drawing spread them over all
+    10, so that most of it was empty, and columns as wide as their names made such a drawing wider still."""
+    drawn = figure(Composer(bundled_kb).compose("RobotSelfPosition"))
+    try:
+        (axis,) = drawn.axes
+        columns = sorted({text.get_position()[0] for text in axis.texts})
+        assert columns == list(range(len(columns))) and len(columns) <= 3
+        assert axis.get_xlim() == pytest.approx((-0.7, len(columns) - 1 + 0.7))
+    finally:
+        plt.close(drawn)
