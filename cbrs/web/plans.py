@@ -28,7 +28,7 @@ def _objectives() -> list[str]:
     return [o.value for o in Objective]
 
 
-def _default_objective() -> str:
+def default_objective() -> str:
     from cbrs.actions.composer import Objective
 
     return Objective.SIMILARITY.value
@@ -37,7 +37,7 @@ def _default_objective() -> str:
 @page(blueprint, "/plans")
 def plans() -> Page:
     task = request.args.get("task", "").strip()
-    objective = request.args.get("objective", "").strip() or _default_objective()
+    objective = request.args.get("objective", "").strip() or default_objective()
     options = task_options()
     data: dict[str, Any] = {"task": task, "objective": objective, "objectives": _objectives(), "tasks": options}
     data["selected"] = _selected(task, options)
@@ -60,7 +60,7 @@ def plans() -> Page:
 def graph() -> Response:
     """The service resource graph of the task's composition, with the chosen plan, as SVG."""
     task = request.args.get("task", "").strip()
-    objective = request.args.get("objective", "").strip() or _default_objective()
+    objective = request.args.get("objective", "").strip() or default_objective()
     with context.lock():  # pyplot is not thread-safe either
         result = _compose(task, objective, None)
         svg = _svg(result)

@@ -46,6 +46,13 @@ def _steps() -> list[tuple[str, Callable[[], object]]]:
         with context.lock():
             return matchmaking.matchmaker("sem-str").rank(str(stored[0]["iri"]), explain=0)
 
+    def composer() -> object:
+        """The plans page's composer and its pool of services (the first plan paid 1.7 s for them on OWLS-TC)."""
+        from cbrs.actions.composer import Objective
+
+        with context.lock():
+            return context.composers().get(Objective(plans.default_objective())).pool
+
     return [
         ("the store's namespaces", prefixes.by_namespace),
         ("the overview's counts", overview.at_a_glance),
@@ -55,6 +62,7 @@ def _steps() -> list[tuple[str, Callable[[], object]]]:
         ("the advertisements", ranking),
         ("the tasks and components", tasks.choices),
         ("the plans page's tasks", plans.task_options),
+        ("the plans page's services", composer),
         ("the taxonomy", taxonomy.current_taxonomy),
         ("the camera's first picture", lambda: context.tasks().frame()),
     ]
