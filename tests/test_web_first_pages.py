@@ -70,7 +70,7 @@ def camera_app(bundled_kb: KnowledgeBase) -> Iterator[tuple[Flask, TaskRunner]]:
     app = app_over(bundled_kb, camera="a camera")
     runner: TaskRunner = app.extensions["cbrs.tasks"]
     runner._publish_frame(b"\xff\xd8 a picture \xff\xd9", None)  # as the idle home's render gives it
-    app.config.update(CBRS_STREAM_IDLE_SECONDS=0.5, CBRS_CAMERA_REPEAT_SECONDS=3600.0)
+    app.config.update(CBRS_STREAM_IDLE_SECONDS=0.2, CBRS_CAMERA_REPEAT_SECONDS=3600.0)
     yield app, runner
     runner.close(5)
 
