@@ -53,7 +53,6 @@ def test_ctrl_c_before_the_write_stops_the_load_and_writes_nothing(
 
     monkeypatch.setattr(loader, "check_loaded", interrupted_check)
     store = tmp_path / "store"
-    before = signal.getsignal(signal.SIGINT)  # SIG_IGN where pytest was started in the background
     result = CliRunner().invoke(cli, ["--store", str(store), "load", str(data)])
     assert result.exit_code == 1 and "Aborted!" in result.output
     monkeypatch.undo()
