@@ -787,12 +787,18 @@ def test_stop_closes_connections_and_a_second_serve_is_refused(bridge: Bridge) -
 
 def test_stop_does_not_wait_for_ever_on_a_stuck_handler() -> None:
     bridge = Bridge()
-    release = threading.Event()
-    bridge.add_service("/stuck", "x/Stuck", lambda args: release.wait(WAIT) and {})
+    release, entered = threading.Event(), threading.Event()
+
+    def stuck(args: object) -> dict[str, object]:
+        entered.set()
+        release.wait(WAIT)
+        return {}
+
+    bridge.add_service("/stuck", "x/Stuck", stuck)
     running = bridge.start(port=0)
     me = Client(running.url)
     me.send(op="call_service", service="/stuck", id=1)
-    me.sync()
+    assert entered.wait(WAIT)  # the handler runs (a read call may still wait for its worker under load)
     start = time.monotonic()
     assert running.stop(timeout=0.3) is False  # the handler thread is still busy
     assert time.monotonic() - start < 1.5
