@@ -60,6 +60,8 @@ _WHITE = (0.93, 0.93, 0.95, 1.0)
 _STEEL = (0.55, 0.56, 0.58, 1.0)
 _DARK = (0.15, 0.15, 0.17, 1.0)
 _TORSO = (0.45, 0.46, 0.50, 1.0)
+_STATIC_GROUP, _NOT_STATIC = 2, -1 ^ 2
+"""Bullet's collision filter group of static things, and a mask of every group but that one."""
 WATER_CYAN = (0.05, 0.80, 0.80, 1.0)
 HOME = PREFIXES["home"]
 _NAMED_COLOURS = {
@@ -560,6 +562,12 @@ class HomeWorld:
         )
         if parts[0].offset != (0.0, 0.0, 0.0):
             raise ValueError("the base part of a body must sit at its origin")
+        if mass == 0.0 and joints is None:
+            # A fixed body's fixed links are as static as its base, but pybullet files them as dynamic
+            # (they have a mass): the table's legs stood on the floor as 16 contact points solved at
+            # every step that could move nothing. Filed as static, they meet only what moves.
+            for link in range(len(links)):
+                p.setCollisionFilterGroupMask(body, link, _STATIC_GROUP, _NOT_STATIC, physicsClientId=c)
         self._bodies[name] = int(body)
         return int(body)
 
