@@ -348,8 +348,12 @@ class SemanticMap:
                 stated = (row["approach"].value, row["ratio"].value, row["ancestor"].value)
                 affordances.setdefault(concept, []).append(stated)
 
+        designated: dict[str, set[str]] = defaultdict(set)  # one query for every class, not one per class
+        for row in kb.queries.select_every(kb.store, "designate"):
+            designated[row["class"].value].add(row["thing"].value)
+
         def things_of(concept: str) -> frozenset[str]:
-            return frozenset(row["thing"].value for row in kb.select("designate", {"class": HOME + concept}))
+            return frozenset(designated.get(HOME + concept, ()))
 
         from cbrs.kb.hands import read_hands  # kb.hands builds on this module's MapError
 
