@@ -393,7 +393,8 @@ def run_text(result: RunResult, sim_seconds: float, wall_seconds: float) -> str:
         + _avoided_text(r)
         for n, r in enumerate(result.replans, start=1)
     ]
-    header = "\n".join(replaced) + ("\n" if replaced else "")
+    header = "\n".join(replaced + _passed_over_lines(result.passed_over))
+    header += "\n" if header else ""
     rows = []
     for step in report.steps:
         tried = " -> ".join(shorten(a.component) for a in step.attempts) or shorten(step.planned)
@@ -418,6 +419,18 @@ def run_text(result: RunResult, sim_seconds: float, wall_seconds: float) -> str:
     if not report.steps:  # every effect held already: no table of no steps
         steps = "nothing to do: every effect of the task holds already"
     return f"{header}{steps}\n{verdict}; {timing}{_unused_note(result.composition)}"
+
+
+def _passed_over_lines(passed: tuple[tuple[str, str], ...]) -> list[str]:
+    """The components the last plan was composed without (a circuit breaker's or an actuator's rule), a
+    line each with why; the reason names the component itself when it starts with its name."""
+    if not passed:
+        return []
+    lines = ["the plan was composed without:"]
+    for component, why in passed:
+        name = shorten(component)
+        lines.append(f"  {why}" if why.startswith(name) else f"  {name}: {why}")
+    return lines
 
 
 def _avoided_text(replan: Replan) -> str:
