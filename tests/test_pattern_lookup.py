@@ -147,7 +147,7 @@ def bindings(body: bytes) -> tuple[Any, Counter[str]]:
     return answer["head"], Counter(json.dumps(row, sort_keys=True) for row in rows)
 
 
-@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.randoms(use_true_random=False))
 def test_a_direct_lookup_answers_the_bytes_oxigraph_writes(rng: random.Random) -> None:
     store = ox.Store()

@@ -136,7 +136,7 @@ def kb() -> Iterator[KnowledgeBase]:
     opened.close()
 
 
-@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(sequence=st.lists(updates, min_size=1, max_size=6))
 def test_data_updates_leave_graph_entailed_as_the_whole_computation_does(
     sequence: list[tuple[list[tuple[bool, list[ox.Quad]]], int]], monkeypatch: pytest.MonkeyPatch
