@@ -12,27 +12,16 @@ from __future__ import annotations
 import argparse
 import os
 import platform
-import statistics
 import sys
 import tempfile
-import time
-from collections.abc import Callable
 from pathlib import Path
 
 import pyoxigraph as ox
+from timing import median_ms
 
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.backup import read_backup
 from cbrs.kb.catalog import Catalogue
-
-
-def median_ms(action: Callable[[], object], repeat: int) -> float:
-    samples = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        action()
-        samples.append((time.perf_counter() - start) * 1000)
-    return statistics.median(samples)
 
 
 def measure(kb: KnowledgeBase, folder: Path, repeat: int) -> None:

@@ -9,10 +9,9 @@ import argparse
 import os
 import platform
 import statistics
-import time
-from collections.abc import Callable
 
 import pyoxigraph
+from timing import samples_ms
 
 from cbrs.kb import KnowledgeBase, Store
 from cbrs.kb.resources import bundled_files
@@ -31,15 +30,6 @@ SAMPLES = {
 TIMED_BOUND = {"action_ordering"}
 
 
-def timed(action: Callable[[], object], repeat: int) -> list[float]:
-    samples = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        action()
-        samples.append((time.perf_counter() - start) * 1000)
-    return samples
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--repeat", type=int, default=50, help="runs per measured operation")
@@ -51,7 +41,7 @@ def main() -> None:
     )
     print(f"inputs: bundled files {', '.join(f.path.name for f in bundled_files())}; repeat {args.repeat}")
 
-    seed = timed(lambda: KnowledgeBase(Store.open(":memory:")).seed(), max(3, args.repeat // 10))
+    seed = samples_ms(lambda: KnowledgeBase(Store.open(":memory:")).seed(), max(3, args.repeat // 10))
     kb = KnowledgeBase.open(":memory:")
     stats = kb.statistics()
     print(f"store: {sum(stats.values())} triples, {len(kb.select('advertisements'))} advertisements")
@@ -62,7 +52,7 @@ def main() -> None:
         kb._reader.clear_cache()
         return kb.advertisements()
 
-    rows = timed(read_all, max(3, args.repeat // 10))
+    rows = samples_ms(read_all, max(3, args.repeat // 10))
     print(f"{'read all advertisements (cold)':<34} {statistics.median(rows):>9.2f} {max(rows):>9.2f}")
     for name in kb.queries.names():
         query = kb.queries.get(name)
@@ -75,7 +65,7 @@ def main() -> None:
         if missing:
             print(f"{'query ' + name:<34} skipped: no sample value for {', '.join(missing)}")
             continue
-        samples = sorted(timed(lambda n=name, v=values: kb.select(n, v), args.repeat))  # type: ignore[misc]
+        samples = sorted(samples_ms(lambda n=name, v=values: kb.select(n, v), args.repeat))  # type: ignore[misc]
         p95 = samples[min(len(samples) - 1, int(len(samples) * 0.95))]
         print(f"{'query ' + name:<34} {statistics.median(samples):>9.2f} {p95:>9.2f}")
 

@@ -11,26 +11,16 @@ import argparse
 import os
 import platform
 import statistics
-import time
 from collections.abc import Callable
 
 import pyoxigraph
+from timing import samples_ms
 
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
 
 HOME = PREFIXES["home"]
-
-
-def timed(action: Callable[[], object], repeat: int) -> list[float]:
-    action()  # the first read warms the store's caches
-    samples = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        action()
-        samples.append((time.perf_counter() - start) * 1000)
-    return samples
 
 
 def main() -> None:
@@ -53,7 +43,7 @@ def main() -> None:
     ]
     print(f"\n{'operation':<26} {'p50 ms':>9} {'max ms':>9}")
     for name, action in operations:
-        samples = timed(action, args.repeat)
+        samples = samples_ms(action, args.repeat, warm=True)
         print(f"{name:<26} {statistics.median(samples):>9.2f} {max(samples):>9.2f}")
     kb.close()
 

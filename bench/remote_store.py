@@ -24,6 +24,7 @@ from pathlib import Path
 
 import httpx
 import pyoxigraph
+from timing import samples_ms
 
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.resources import bundled_files
@@ -38,12 +39,7 @@ CAMERA3 = """@prefix cbrs: <https://w3id.org/cbrs/core#> . @prefix home: <https:
 
 
 def timed(action: Callable[[], object], repeat: int) -> list[float]:
-    samples = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        action()
-        samples.append((time.perf_counter() - start) * 1000)
-    return sorted(samples)
+    return sorted(samples_ms(action, repeat))
 
 
 @contextmanager

@@ -14,12 +14,11 @@ import argparse
 import json
 import os
 import platform
-import statistics
 import time
-from collections.abc import Callable
 from pathlib import Path
 
 import pyoxigraph as ox
+from timing import median_ms
 
 from cbrs.kb import KnowledgeBase, Store
 from cbrs.kb.namespaces import GraphName
@@ -47,15 +46,6 @@ class _NoTerms(StandardTerms):
 
     def changed(self, before: object, removed: object, added: object) -> object:  # type: ignore[override]
         return None
-
-
-def median_ms(action: Callable[[], object], repeat: int) -> float:
-    samples = []
-    for _ in range(repeat):
-        start = time.perf_counter()
-        action()
-        samples.append((time.perf_counter() - start) * 1000)
-    return statistics.median(samples)
 
 
 def measure(kb: KnowledgeBase, repeat: int) -> dict[str, float]:
