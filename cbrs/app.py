@@ -20,9 +20,15 @@ class App:
 
     @property
     def kb(self) -> KnowledgeBase:
+        return self.open_kb()
+
+    def open_kb(self, seed: bool = True) -> KnowledgeBase:
+        """The knowledge base, opened on first use; ``seed=False`` for a command that replaces the store's
+        contents whole (``cbrs restore``): a new store is not seeded, an old one not upgraded, first."""
         if self._kb is None:
             self._kb = KnowledgeBase.open(
                 self.store_location,
+                seed=seed,
                 remote_timeout=setting("remote_timeout").resolve(),
                 check_timeout=setting("query_check_timeout").resolve(),
                 remote_access=setting("federation_allow").resolve(),

@@ -120,7 +120,8 @@ def cli(ctx: click.Context, store: str | None) -> None:
     app = App(store_location=location)
     ctx.obj = app
     ctx.call_on_close(app.close)
-    if ctx.invoked_subcommand not in (None, "init", "settings") and no_store_at(location):
+    # a restore into a new directory means to make it, and seeds nothing: it says each graph was absent
+    if ctx.invoked_subcommand not in (None, "init", "settings", "restore") and no_store_at(location):
         ctx.call_on_close(lambda: note_new_store(location))
 
 

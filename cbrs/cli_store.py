@@ -12,7 +12,7 @@ import click
 
 from cbrs.app import App, pass_app
 from cbrs.cli_interrupts import HeldInterrupts
-from cbrs.kb.backup import DEFAULT, Backup, export_format, read_backup
+from cbrs.kb.backup import DEFAULT, Backup, NotAnExportError, export_format, read_backup
 from cbrs.kb.errors import QuerySyntaxError, without_password
 from cbrs.kb.namespaces import GraphName, shorten
 from cbrs.kb.store import refuse_inserted_blank_nodes
@@ -78,11 +78,13 @@ def restore(app: App, file: Path, graphs: tuple[str, ...], fmt: str | None, yes:
     finally:
         shown.clear()
     problems = backup.problems(list(graphs) or None)
-    kb = app.kb
-    if problems and force:
+    if problems and not force:  # before the store is opened: a new one is not created for nothing
+        raise NotAnExportError(backup.source, problems)
+    # a whole restore replaces everything: a new store is not seeded first, an old one not upgraded first
+    kb = app.open_kb(seed=bool(graphs))
+    if problems:
         click.echo(f"note: {file}: {'; '.join(problems)}; restored all the same (--force)", err=True)
-    if not problems or force:
-        _confirm(app, backup, graphs, yes)
+    _confirm(app, backup, graphs, yes)
     shown = ProgressLine()
     with HeldInterrupts() as interrupts:
 

@@ -78,9 +78,12 @@ class NotAnExportError(BackupError):
     def __init__(self, source: str, problems: Sequence[str]) -> None:
         self.source = source
         self.problems = tuple(problems)
-        super().__init__(
-            f"{source}: {'; '.join(problems)}; nothing was restored (cbrs restore --force takes it as it is)"
-        )
+        forced = "cbrs restore --force takes it as it is, replacing the whole store"
+        if not problems or not problems[0].startswith("not a cbrs export"):
+            forced = "cbrs restore --force takes it as it is"
+        else:  # a Turtle or N-Quads file of one's own is most often meant to be added
+            forced += "; cbrs load FILE adds a file's triples to the store"
+        super().__init__(f"{source}: {'; '.join(problems)}; nothing was restored ({forced})")
 
 
 class UnknownExportFormatError(BackupError):
@@ -89,7 +92,13 @@ class UnknownExportFormatError(BackupError):
     def __init__(self, name: str) -> None:
         self.name = name
         known = ", ".join(f"{ext}, {ext}.gz" for ext in FORMATS)
-        super().__init__(f"{name}: cannot tell the format from the name; use one of {known} (or --format)")
+        suffix = Path(name).suffix.lower()
+        other = f" (a {suffix} file is no cbrs export: cbrs load adds it to the store)" if suffix in _RDF_FILES else ""
+        super().__init__(f"{name}: cannot tell the format from the name; use one of {known} (or --format){other}")
+
+
+_RDF_FILES = frozenset({".ttl", ".nt", ".n3", ".rdf", ".owl", ".xml", ".jsonld"})
+"""Extensions of RDF files that cbrs load reads and an export never has."""
 
 
 @dataclass(frozen=True)
@@ -175,14 +184,14 @@ class Backup:
 
     def problems(self, graphs: Sequence[str] | None = None) -> list[str]:
         """Why the file is not a whole cbrs export (for ``graphs``: one that holds them), or nothing."""
-        if self.manifest is None:
-            return [
+        found: list[str] = []
+        if self.manifest is None:  # what else it lacks is said too: --force would restore it as it is
+            found.append(
                 "not a cbrs export: it has no manifest (graph:export, which cbrs export writes last; "
                 "a file cut short lacks it too)"
-            ]
-        found: list[str] = []
-        said = self.manifest.triples
-        for graph in sorted(set(said) | set(self.quads)):
+            )
+        said = self.manifest.triples if self.manifest is not None else {}
+        for graph in sorted(set(said) | set(self.quads)) if self.manifest is not None else ():
             held, expected = len(self.quads.get(graph, ())), said.get(graph)
             if expected is None:
                 found.append(f"{_name(graph)} holds {held} triples the manifest does not list")
@@ -388,8 +397,9 @@ def read_backup(path: str | Path, rdf_format: ox.RdfFormat | None = None, progre
                     by_graph.setdefault(graph, []).append(quad)
     except FileNotFoundError as error:
         raise RdfParseError(source, "no such file") from error
-    except SyntaxError as error:
-        raise RdfParseError(source, f"{error}; nothing was restored") from error
+    except SyntaxError as error:  # args[0] is the parser's words alone (str() adds "(line N)" again)
+        said = str(error.args[0]) if error.args else str(error)
+        raise RdfParseError(source, f"{said}; nothing was restored") from error
     except (OSError, EOFError) as error:  # a broken gzip stream as well
         raise RdfParseError(source, f"cannot read: {error}; nothing was restored") from error
     return Backup(source, by_graph, Manifest.read(manifest))

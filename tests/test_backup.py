@@ -11,7 +11,7 @@ import pyoxigraph as ox
 import pytest
 from click.testing import CliRunner
 
-from cbrs import cli_store
+from cbrs import cli_notes, cli_store
 from cbrs.cli import cli
 from cbrs.kb import KnowledgeBase, RdfParseError, Store, StoreError
 from cbrs.kb.backup import EXPORT_GRAPH, REQUIRED, NotAnExportError, UnknownExportFormatError, read_backup, store_graphs
@@ -229,3 +229,48 @@ def test_a_store_behind_cbrs_serve_is_exported_and_restored_with_its_token(
         assert refused.exit_code == 1 and "CBRS_UPDATE_TOKEN" in refused.stderr
     finally:
         running.stop()
+
+
+def test_a_restore_into_a_new_directory_does_not_seed_it_first(
+    exported: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    seeded: list[str] = []
+    monkeypatch.setattr(KnowledgeBase, "_seed_kept", lambda kb, cache: seeded.append(kb.store.location))
+    refused = CliRunner().invoke(cli, ["--store", str(tmp_path / "bad"), "restore", str(DATA / "mini_map.ttl")])
+    assert refused.exit_code == 1 and not (tmp_path / "bad").exists()  # refused before a store was made
+    plain = tmp_path / "plain.nq"
+    plain.write_text("<http://example.org/a> <http://example.org/b> <http://example.org/c> <http://example.org/g> .\n")
+    refused = CliRunner().invoke(cli, ["--store", str(tmp_path / "bad"), "restore", str(plain)])
+    assert refused.exit_code == 1 and not (tmp_path / "bad").exists()
+    assert "it lacks cbrs's own graphs graph:ontology" in refused.stderr and "cbrs load FILE adds" in refused.stderr
+    monkeypatch.setattr(cli_notes, "_at_terminal", lambda: True)  # no "a new store, seeded" note for a person
+    result = CliRunner().invoke(cli, ["--store", str(tmp_path / "new"), "restore", str(exported), "--yes"])
+    assert result.exit_code == 0, result.output
+    assert seeded == [] and "graph:services" in result.stdout and "(was absent)" in result.stdout
+    assert "there was no store" not in result.stderr
+    store = Store.open(tmp_path / "new")
+    assert store.count() == sum(read_backup(exported).triples.values())
+    store.close()
+
+
+def test_a_restore_says_what_is_wrong_in_words_a_person_reads(
+    seeded: KnowledgeBase, exported: Path, tmp_path: Path
+) -> None:
+    with pytest.raises(UnknownExportFormatError, match=r"a \.ttl file is no cbrs export: cbrs load adds it"):
+        read_backup(DATA / "mini_map.ttl")
+    cut = tmp_path / "cut.nq"
+    cut.write_bytes(exported.read_bytes()[:-40])  # the last line cut in the middle
+    with pytest.raises(RdfParseError) as broken:
+        read_backup(cut)
+    assert str(broken.value).count("line") == 1 and str(broken.value).endswith("nothing was restored")
+    before = seeded.store.dump()
+    lines = exported.read_bytes().splitlines(keepends=True)
+    no_entailed = tmp_path / "no-entailed.nq"
+    no_entailed.write_bytes(b"".join(line for line in lines if b"/graph/entailed> ." not in line))
+    report = seeded.restore(no_entailed, force=True)  # its manifest still lists graph:entailed
+    assert report.entailed_refreshed and report.restored[GraphName.ENTAILED.iri] == seeded.store.count(
+        GraphName.ENTAILED
+    )
+    assert report.restored[GraphName.ENTAILED.iri] > 0
+    seeded.restore(exported)
+    assert seeded.store.dump() == before
