@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import logging
+import re
 from collections.abc import Mapping, Sequence
 from contextlib import AbstractContextManager, nullcontext
 from pathlib import Path
@@ -41,6 +42,9 @@ from cbrs.kb.upgrade import UpgradeReport, new_terms, upgrade_store
 
 _log = logging.getLogger(__name__)
 _VERSION_INFO = ox.NamedNode("http://www.w3.org/2002/07/owl#versionInfo")
+# An update that might write graph:map, read loosely (its name, an escape, a variable graph, ALL or NAMED):
+# only such an update, and a data update that names a quad in it, has the map checked afterwards.
+_MAY_WRITE_MAP = re.compile(r"map|\\[uU]|GRAPH(?:\s|#[^\n]*\n)*[?$]|\b(?:ALL|NAMED)\b", re.IGNORECASE)
 # The graphs whose descriptions kb.shapes.checked_update checks (tests/test_standard_terms_updates.py pins
 # it): a data update naming no quad in them leaves them as they are, so it skips the check, which reads
 # both graphs whole twice (1.5 s a write on a store of OWLS-TC's services).
@@ -305,7 +309,8 @@ class KnowledgeBase:
             if progress is not None:
                 progress("updating graph:entailed", 0, 0)
             self._entail()
-            report = dataclasses.replace(report, entailed_refreshed=True)
+            entailed = {GraphName.ENTAILED.iri: self.store.count(GraphName.ENTAILED.node)}  # not the file's count
+            report = dataclasses.replace(report, restored={**report.restored, **entailed}, entailed_refreshed=True)
         return report
 
     def query(self, text: str, bindings: Mapping[str, Term] | None = None) -> QueryResult:
@@ -314,16 +319,18 @@ class KnowledgeBase:
     def update(self, text: str) -> None:
         """Run a SPARQL update in one transaction; the cached descriptions are read afresh afterwards, and
         graph:entailed follows (node by node after a data update: :meth:`StandardTerms.prepare`)."""
-        self._update(text, self._data_update(text))
+        self._update(text, self._data_update(text), check_map=False)
 
     def update_counted(self, text: str) -> UpdateReport:
         """:meth:`update`, saying what it changed graph by graph (:mod:`kb.update_report`): quad by quad for
         a data update, else each graph's net change, which costs counting the graphs before and after. An
-        update of several operations is refused on a store that does not run a request whole (Virtuoso)."""
+        update of several operations is refused on a store that does not run a request whole (Virtuoso), and
+        one that leaves the semantic map unreadable is put back, as a load into graph:map is refused (the
+        library's :meth:`update` leaves that to the map's reader: tests break a map on purpose)."""
         refuse_split(self.store, text)
         data = self._data_update(text)
         before = graph_sizes(self.store) if data is None else None
-        entailed = self._update(text, data)
+        entailed = self._update(text, data, check_map=True)
         if before is not None:
             changes, exact = net_changes(before, graph_sizes(self.store)), False
         else:
@@ -340,26 +347,69 @@ class KnowledgeBase:
         store; None for any other update or store."""
         return DataUpdate.read(text, self.store) if isinstance(self.store, EmbeddedStore) else None
 
-    def _update(self, text: str, data: DataUpdate | None) -> Refresh | None:
-        """:meth:`update` of ``text``, read as ``data``; returns what graph:entailed's refresh changed (None:
-        it lags)."""
+    def _update(self, text: str, data: DataUpdate | None, check_map: bool) -> Refresh | None:
+        """:meth:`update` of ``text``, read as ``data``, with the semantic map checked (``check_map``) as well
+        as the descriptions; returns what graph:entailed's refresh changed (None: it lags)."""
+        from cbrs.kb.semantic_map import MapError  # it imports this module
+
         pending = self.standard_terms.prepare(data)
         checking: AbstractContextManager[None] = nullcontext()
+        old_map = self._map_before_update(text, data) if check_map else None
+        everything: set[ox.Quad] | None = None  # the store before, kept here to put back whatever it wrote
         if data is None:  # what else it writes is unknown: keep the whole store if it might be refused
-            whole = isinstance(self.store, EmbeddedStore) and may_write_descriptions(text)
-            checking = checked_update(self.store, whole)  # a description it breaks is put back (kb/shapes.py)
+            keep = isinstance(self.store, EmbeddedStore) and (old_map is not None or may_write_descriptions(text))
+            if keep and old_map is not None:  # one copy for both checks
+                everything = set(self.store.quads())
+            checking = checked_update(self.store, keep and everything is None)  # kb/shapes.py puts back
         elif data.names_graph(CHECKED_GRAPHS):
             checking = checked_update(self.store)
         try:
             with checking:
                 self.store.update(text)
-        except DescriptionShapeError:
+            if old_map is not None:
+                self._check_updated_map(old_map)
+        except (DescriptionShapeError, MapError):
             if data is not None:
                 data.undo(self.store)  # its writes to the other graphs go too: all or nothing
+            else:
+                self._put_back(everything, old_map)
             raise
         finally:
             self._reader.clear_cache()
         return self._entail(pending)
+
+    def _map_before_update(self, text: str, data: DataUpdate | None) -> set[ox.Quad] | None:
+        """graph:map's quads before an update that may write it, when the map reads (an update is checked
+        as a load into graph:map is: :meth:`_check_map_load`); None: nothing to check."""
+        may = data.names_graph((GraphName.MAP.node,)) if data is not None else bool(_MAY_WRITE_MAP.search(text))
+        if not may:
+            return None
+        quads = set(self.store.quads(graph=GraphName.MAP.node))
+        if not quads or not self._map_readable_before(self._map_scratch()):
+            return None  # a map being built, or one unreadable already: left to the reader's error
+        return quads
+
+    def _check_updated_map(self, old_map: set[ox.Quad]) -> None:
+        """Raise the semantic map's error when the update just run left graph:map unreadable (an emptied map
+        is left: the next open puts the bundled one back)."""
+        now = set(self.store.quads(graph=GraphName.MAP.node))
+        if now == old_map or not now:
+            return
+        problem = self._map_problem(self._map_scratch(), [])
+        if problem is not None:
+            problem.add_note("nothing was changed (an update of graph:map is checked as a task reads the map)")
+            raise problem
+
+    def _put_back(self, everything: set[ox.Quad] | None, old_map: set[ox.Quad] | None) -> None:
+        """Undo a refused update that was not data: all it wrote when the store was kept (``everything``),
+        else graph:map's part (kb/shapes.py has put back the descriptions' part)."""
+        graphs: tuple[ox.NamedNode, ...] | None = None if everything is not None else (GraphName.MAP.node,)
+        before = everything if everything is not None else old_map
+        if before is None:
+            return
+        now = set(self.store.quads()) if graphs is None else set(self.store.quads(graph=graphs[0]))
+        if now != before:
+            self.store.replace(now - before, before - now)  # one transaction
 
     def run(self, name: str, values: Mapping[str, Term | str | int | float] | None = None) -> QueryResult:
         """Run the named query ``queries/<name>.rq`` with ``values`` bound to its parameters."""

@@ -14,6 +14,7 @@ from click.testing import CliRunner
 from cbrs.cli import cli
 from cbrs.kb import KnowledgeBase, QuerySyntaxError, Store, StoreEvaluationError
 from cbrs.kb.remote_store import Endpoints, RemoteStore
+from cbrs.kb.semantic_map import MapError
 from cbrs.kb.update_report import UpdateSplitError, operations, refuse_split
 from tests.conftest import MINI_FILES, OxigraphServer
 
@@ -113,3 +114,27 @@ def test_several_operations_are_refused_where_a_request_is_not_one_transaction()
         assert store._refusal(403, store.endpoints.update, said).startswith("the server takes no updates")
     finally:
         store.close()
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        pytest.param('INSERT DATA { GRAPH graph:map { world:Pen home:shapeKind "sphere" } }', id="data"),
+        pytest.param(
+            "INSERT DATA { GRAPH <urn:example:lab> { <urn:example:a> <urn:example:b> <urn:example:c> } } ;\n"
+            "DELETE WHERE { GRAPH graph:map { world:Pen home:sizeX ?x } }",
+            id="where-after-data",
+        ),
+    ],
+)
+def test_an_update_that_breaks_the_semantic_map_is_refused_as_a_load_is(kb: KnowledgeBase, text: str) -> None:
+    before = kb.store.dump()
+    with pytest.raises(MapError) as refused:
+        kb.update_counted(text)
+    assert "world#Pen" in str(refused.value) and "nothing was changed" in "\n".join(refused.value.__notes__)
+    assert kb.store.dump() == before  # the other graph's write is gone too
+
+
+def test_the_cli_names_the_map_problem_of_a_refused_update() -> None:
+    code, _, err = _cbrs("update", "DELETE WHERE { GRAPH graph:map { world:Pen home:sizeX ?x } }")
+    assert code == 1 and "Pen" in err and "has no home:sizeX" in err and "nothing was changed" in err
