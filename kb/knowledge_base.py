@@ -368,11 +368,19 @@ class KnowledgeBase:
                 self.store.update(text)
             if old_map is not None:
                 self._check_updated_map(old_map)
-        except (DescriptionShapeError, MapError):
+        except (DescriptionShapeError, MapError) as error:
             if data is not None:
                 data.undo(self.store)  # its writes to the other graphs go too: all or nothing
             else:
                 self._put_back(everything, old_map)
+            if isinstance(error, MapError):
+                whole = data is not None or everything is not None
+                error.add_note(
+                    "nothing was changed (an update of graph:map is checked as a task reads the map)"
+                    if whole
+                    else "graph:map was put back as it was (a remote store is not copied to undo an update: what it "
+                    "wrote to other graphs, if anything, stands; send a change of the map on its own)"
+                )
             raise
         finally:
             self._reader.clear_cache()
@@ -397,7 +405,6 @@ class KnowledgeBase:
             return
         problem = self._map_problem(self._map_scratch(), [])
         if problem is not None:
-            problem.add_note("nothing was changed (an update of graph:map is checked as a task reads the map)")
             raise problem
 
     def _put_back(self, everything: set[ox.Quad] | None, old_map: set[ox.Quad] | None) -> None:

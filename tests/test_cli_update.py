@@ -138,3 +138,16 @@ def test_an_update_that_breaks_the_semantic_map_is_refused_as_a_load_is(kb: Know
 def test_the_cli_names_the_map_problem_of_a_refused_update() -> None:
     code, _, err = _cbrs("update", "DELETE WHERE { GRAPH graph:map { world:Pen home:sizeX ?x } }")
     assert code == 1 and "Pen" in err and "has no home:sizeX" in err and "nothing was changed" in err
+
+
+def test_a_remote_store_puts_the_map_back_and_says_what_it_could_not(oxigraph_server: OxigraphServer) -> None:
+    oxigraph_server.clear()
+    kb = KnowledgeBase.open(oxigraph_server.url)
+    try:
+        before = kb.store.dump()
+        with pytest.raises(MapError) as refused:
+            kb.update_counted("DELETE WHERE { GRAPH graph:map { world:Pen home:sizeX ?x } }")
+        assert "graph:map was put back as it was" in "\n".join(refused.value.__notes__)
+        assert kb.store.dump() == before
+    finally:
+        kb.close()
