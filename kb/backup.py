@@ -443,21 +443,6 @@ def restore_store(
     return RestoreReport(backup.source, before, restored, skipped=skipped)
 
 
-_DECIMAL = ox.NamedNode("http://www.w3.org/2001/XMLSchema#decimal")
-
-
-def _decimal_kept(quad: ox.Quad) -> ox.Quad:
-    """``quad`` with an ``xsd:decimal`` object written with a point: Virtuoso 7 keeps ``"0"^^xsd:decimal``
-    as an integer (its answers give it back as ``"0"^^xsd:integer``), and ``"0.0"^^xsd:decimal`` as the
-    decimal it is (given back as ``"0"^^xsd:decimal``, as it answered before the export)."""
-    term = quad.object
-    if not isinstance(term, ox.Literal) or term.datatype != _DECIMAL or "." in term.value:
-        return quad
-    if not term.value.lstrip("+-").isdigit():
-        return quad
-    return ox.Quad(quad.subject, quad.predicate, ox.Literal(term.value + ".0", datatype=_DECIMAL), quad.graph_name)
-
-
 def _size(store: Store, graph: str) -> int:
     if graph == DEFAULT:
         return sum(1 for _ in store.quads(graph=ox.DefaultGraph()))
@@ -480,7 +465,9 @@ def _replace_embedded(store: EmbeddedStore, graphs: Sequence[str], quads: Sequen
 def _replace_remote(store: Store, graphs: Sequence[str], quads: Sequence[ox.Quad], tell: Progress) -> None:
     """Staged, and published by one operation that empties ``graphs`` too (:mod:`kb.staged_writes`)."""
     if getattr(store, "server", None) == "virtuoso":
-        quads = [_decimal_kept(quad) for quad in quads]
+        from cbrs.kb.remote_store import decimal_kept  # only a remote store needs httpx
+
+        quads = [decimal_kept(quad) for quad in quads]
     batch = getattr(store, "batch", 250)
     write_staged(
         store.location,

@@ -360,7 +360,7 @@ class RemoteStore(Store):
 
         Blank nodes become fresh nodes on the server (the loader skolemises them before this).
         """
-        quads = list(quads)
+        quads = self._as_kept(quads)
         if len(quads) > self.batch:
             write_staged(self.location, quads, self.batch, lambda text: self._update(text, original=None))
             return
@@ -371,14 +371,19 @@ class RemoteStore(Store):
     def replace(self, remove: Iterable[ox.Quad], add: Iterable[ox.Quad]) -> None:
         """Remove and add quads in one ``DELETE { } INSERT { } WHERE { }`` operation, which a server keeps
         whole even where it does not keep a request of two operations whole (Virtuoso 7)."""
-        removing = data_block(remove)
-        adding = data_block(add)
+        removing = data_block(self._as_kept(remove))
+        adding = data_block(self._as_kept(add))
         if removing and adding:
             self._update(f"DELETE {{\n{removing}}}\nINSERT {{\n{adding}}}\nWHERE {{ }}", original=None)
         elif removing:
             self._update("DELETE DATA {\n" + removing + "}", original=None)
         elif adding:
             self._update("INSERT DATA {\n" + adding + "}", original=None)
+
+    def _as_kept(self, quads: Iterable[ox.Quad]) -> list[ox.Quad]:
+        """``quads`` as the server keeps them when written: on Virtuoso, an ``xsd:decimal`` with a point
+        (:func:`decimal_kept`)."""
+        return [decimal_kept(quad) for quad in quads] if self._virtuoso else list(quads)
 
     def _apply_own_update(self, text: str) -> None:
         """An update cbrs wrote itself from validated terms (a staged batch, a publication): sent as it is,
@@ -573,6 +578,21 @@ def _tls_context() -> ssl.SSLContext:
 def _one_line_up(match: re.Match[str]) -> str:
     line = int(match.group(1))
     return f"error at {line - 1 if line > 1 else line}:{match.group(2)}"
+
+
+_DECIMAL = ox.NamedNode("http://www.w3.org/2001/XMLSchema#decimal")
+
+
+def decimal_kept(quad: ox.Quad) -> ox.Quad:
+    """``quad`` with an ``xsd:decimal`` object written with a point: Virtuoso 7 keeps ``"0"^^xsd:decimal``
+    as an integer (its answers give it back as ``"0"^^xsd:integer``, so a load or a restore changed the
+    datatype), and ``"0.0"^^xsd:decimal`` as the decimal it is (given back as ``"0"^^xsd:decimal``)."""
+    term = quad.object
+    if not isinstance(term, ox.Literal) or term.datatype != _DECIMAL or "." in term.value:
+        return quad
+    if not term.value.lstrip("+-").isdigit():
+        return quad
+    return ox.Quad(quad.subject, quad.predicate, ox.Literal(term.value + ".0", datatype=_DECIMAL), quad.graph_name)
 
 
 def _query_triples(quads: Iterable[ox.Quad]) -> ox.QueryTriples:

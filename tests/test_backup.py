@@ -204,6 +204,31 @@ def test_a_virtuoso_store_round_trips_leaving_its_own_graphs(virtuoso_server: Vi
     assert not any(f"<{graph}> ." in text for graph in virtuoso_server.own_graphs)
 
 
+def test_a_load_into_virtuoso_keeps_a_decimal_without_a_point_a_decimal(
+    virtuoso_server: VirtuosoServer, tmp_path: Path
+) -> None:
+    """Virtuoso keeps "0"^^xsd:decimal as an integer: a restore wrote "0.0", a load did not (the query after
+    it answered xsd:integer where the embedded store answers xsd:decimal)."""
+    virtuoso_server.clear()
+    data = tmp_path / "values.ttl"
+    data.write_text(
+        '<http://example.org/lab#a> <http://example.org/lab#zero> "0"^^<http://www.w3.org/2001/XMLSchema#decimal> ;\n'
+        '  <http://example.org/lab#five> "-5"^^<http://www.w3.org/2001/XMLSchema#decimal> .\n',
+        encoding="utf-8",
+    )
+    kb = KnowledgeBase(Store.open(virtuoso_server.url))
+    try:
+        kb.load([data], graph="urn:example:values")
+        rows = kb.query("SELECT ?v WHERE { GRAPH <urn:example:values> { ?s ?p ?v } }")
+        assert isinstance(rows, ox.QuerySolutions)
+        types = {row["v"].datatype.value for row in rows}  # type: ignore[union-attr]
+        assert types == {"http://www.w3.org/2001/XMLSchema#decimal"}
+        again = kb.load([data], graph="urn:example:values")
+        assert again.added_quads == 0  # found as held: the existence check asks as it was written
+    finally:
+        kb.close()
+
+
 def test_a_store_behind_cbrs_serve_is_exported_and_restored_with_its_token(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
