@@ -97,9 +97,10 @@ def restore(app: App, file: Path, graphs: tuple[str, ...], fmt: str | None, yes:
             report = kb.restore(backup, list(graphs) or None, force, progress)
         finally:
             shown.clear()
+    refreshed = report.entailed_refreshed  # graph:entailed worked out, not restored
     if interrupts.interrupted:
         click.echo("cbrs: the Ctrl-C came after the write had begun: the restore stands, as follows", err=True)
-    restored = sum(report.restored.values())
+    restored = sum(n for graph, n in report.restored.items() if graph != GraphName.ENTAILED.iri or not refreshed)
     click.echo(f"restored {restored} triples from {file} into {without_password(kb.store.location)}")
     for graph in sorted(set(report.before) | set(report.restored)):
         was, now = report.before.get(graph), report.restored.get(graph, 0)

@@ -62,6 +62,7 @@ REQUIRED = (GraphName.ONTOLOGY, GraphName.SERVICES, GraphName.REQUIREMENTS, Grap
 forced (without graph:ontology the next command reseeds the store; without graph:map it adds the bundled
 map back). graph:entailed is derived: a restore of a file without it works it out afresh."""
 
+_GZIP_MAGIC = b"\x1f\x8b"
 _RDF_TYPE = ox.NamedNode("http://www.w3.org/1999/02/22-rdf-syntax-ns#type")
 _PROGRESS_EVERY = 10_000  # quads between progress reports
 
@@ -373,8 +374,8 @@ def _quiet(stage: str, done: int, total: int) -> None:
 
 
 def read_backup(path: str | Path, rdf_format: ox.RdfFormat | None = None, progress: Progress | None = None) -> Backup:
-    """Parse an export file whole (``.gz`` unpacked): nothing is written, and a parse error names the
-    file and line."""
+    """Parse an export file whole (gzip unpacked, whatever its name): nothing is written, and a parse error
+    names the file and line."""
     source = str(path)
     rdf_format = rdf_format or export_format(source)
     tell = progress or _quiet
@@ -384,8 +385,9 @@ def read_backup(path: str | Path, rdf_format: ox.RdfFormat | None = None, progre
     try:
         with open(source, "rb") as raw:
             data: IO[bytes] = raw
-            if source.lower().endswith(".gz"):
+            if raw.read(2) == _GZIP_MAGIC:  # by content, not name: `cbrs export - > lab.nq.gz` is plain text
                 data = gzip.GzipFile(fileobj=raw)  # type: ignore[assignment]
+            raw.seek(0)
             for number, quad in enumerate(ox.parse(data, rdf_format), 1):
                 if number % _PROGRESS_EVERY == 0:
                     tell(f"reading {source}: {number} quads", 0, 0)

@@ -302,15 +302,20 @@ class KnowledgeBase:
         graph:entailed comes from the file, or is worked out afresh when the file does not give all of it."""
         if not isinstance(backup, Backup):
             backup = read_backup(backup, progress=progress)
+        entailed = GraphName.ENTAILED
+        refresh = bool(graphs) or not backup.quads.get(entailed.iri)
+        was = self.store.count(entailed.node) if refresh and entailed.iri in self.store.graphs() else None
         report = restore_store(self.store, backup, graphs, force, progress)
         self._reader.clear_cache()
         self._map_read = None
-        if graphs or not backup.quads.get(GraphName.ENTAILED.iri):
+        if refresh:
             if progress is not None:
                 progress("updating graph:entailed", 0, 0)
             self._entail()
-            entailed = {GraphName.ENTAILED.iri: self.store.count(GraphName.ENTAILED.node)}  # not the file's count
-            report = dataclasses.replace(report, restored={**report.restored, **entailed}, entailed_refreshed=True)
+            # the report's graph:entailed is what it holds now, worked out afresh, and held before
+            before = report.before if was is None else {**report.before, entailed.iri: was}
+            now = {**report.restored, entailed.iri: self.store.count(entailed.node)}
+            report = dataclasses.replace(report, before=before, restored=now, entailed_refreshed=True)
         return report
 
     def query(self, text: str, bindings: Mapping[str, Term] | None = None) -> QueryResult:

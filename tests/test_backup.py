@@ -299,3 +299,19 @@ def test_a_restore_says_what_is_wrong_in_words_a_person_reads(
     assert report.restored[GraphName.ENTAILED.iri] > 0
     seeded.restore(exported)
     assert seeded.store.dump() == before
+
+
+def test_gzip_is_told_by_content_and_a_graph_restore_counts_entailed_before_and_after(
+    seeded: KnowledgeBase, exported: Path, tmp_path: Path
+) -> None:
+    plain = tmp_path / "piped.nq.gz"  # what `cbrs export - > piped.nq.gz` leaves: N-Quads, not gzip
+    plain.write_bytes(exported.read_bytes())
+    packed = tmp_path / "packed.nq"
+    seeded.export(tmp_path / "packed.nq.gz")
+    packed.write_bytes((tmp_path / "packed.nq.gz").read_bytes())
+    assert read_backup(plain).triples == read_backup(packed).triples == read_backup(exported).triples
+    before = seeded.store.dump()
+    entailed = seeded.store.count(GraphName.ENTAILED)
+    report = seeded.restore(exported, graphs=["map"])
+    assert report.entailed_refreshed and report.before[GraphName.ENTAILED.iri] == entailed
+    assert report.restored[GraphName.ENTAILED.iri] == entailed and seeded.store.dump() == before
