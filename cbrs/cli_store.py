@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 import click
+import pyoxigraph as ox
 
 from cbrs.app import App, pass_app
 from cbrs.cli_interrupts import HeldInterrupts
@@ -32,8 +33,9 @@ _FORMAT_CHOICE = click.Choice(["nquads", "trig"])
     type=_FORMAT_CHOICE,
     help="Override the format the name says (.nq N-Quads, .trig TriG, either with .gz); - is N-Quads.",
 )
+@click.option("--json", "as_json", is_flag=True, help="Print what was exported as JSON (on standard error with -).")
 @pass_app
-def export(app: App, file: str, graphs: tuple[str, ...], fmt: str | None) -> None:
+def export(app: App, file: str, graphs: tuple[str, ...], fmt: str | None, as_json: bool) -> None:
     """Write the whole store (every named graph) to FILE, or - for standard output, as a cbrs export: the
     quads, then a manifest that cbrs restore checks (docs/backup.md)."""
     rdf_format = export_format(file, fmt)
@@ -42,6 +44,12 @@ def export(app: App, file: str, graphs: tuple[str, ...], fmt: str | None) -> Non
         report = app.kb.export(file, rdf_format, list(graphs) or None, shown)
     finally:
         shown.clear()
+    if as_json:
+        said: dict[str, Any] = {"file": file, "format": "trig" if rdf_format == ox.RdfFormat.TRIG else "nquads"}
+        said["total"] = report.total
+        said["graphs"] = [{"graph": g or None, "triples": n} for g, n in report.triples.items()]
+        click.echo(json.dumps(said, indent=2), err=file == "-")
+        return
     where = "standard output" if file == "-" else file
     counts = ", ".join(f"{n} in {_graph_name(graph)}" for graph, n in sorted(report.triples.items()))
     click.echo(
@@ -68,8 +76,11 @@ def export(app: App, file: str, graphs: tuple[str, ...], fmt: str | None) -> Non
     help="Restore a file that is not a whole cbrs export (no manifest, counts that differ, cbrs's own "
     "graphs missing) as it is.",
 )
+@click.option("--json", "as_json", is_flag=True, help="Print what was restored as JSON.")
 @pass_app
-def restore(app: App, file: Path, graphs: tuple[str, ...], fmt: str | None, yes: bool, force: bool) -> None:
+def restore(
+    app: App, file: Path, graphs: tuple[str, ...], fmt: str | None, yes: bool, force: bool, as_json: bool
+) -> None:
     """Replace the store's contents with those of FILE, a cbrs export, all or nothing: a file that does not
     parse, or a write that fails, leaves the store as it was (docs/backup.md)."""
     shown = ProgressLine()
@@ -101,6 +112,15 @@ def restore(app: App, file: Path, graphs: tuple[str, ...], fmt: str | None, yes:
     if interrupts.interrupted:
         click.echo("cbrs: the Ctrl-C came after the write had begun: the restore stands, as follows", err=True)
     restored = sum(n for graph, n in report.restored.items() if graph != GraphName.ENTAILED.iri or not refreshed)
+    if as_json:
+        rows = [
+            {"graph": graph or None, "triples": report.restored.get(graph, 0), "before": report.before.get(graph)}
+            for graph in sorted(set(report.before) | set(report.restored))
+        ]
+        left = [{"graph": graph or None, "triples_in_file": n} for graph, n in sorted(report.skipped.items())]
+        said = {"file": str(file), "restored": restored, "graphs": rows, "left": left}
+        click.echo(json.dumps(said | {"entailed_refreshed": refreshed}, indent=2))
+        return
     click.echo(f"restored {restored} triples from {file} into {without_password(kb.store.location)}")
     for graph in sorted(set(report.before) | set(report.restored)):
         was, now = report.before.get(graph), report.restored.get(graph, 0)

@@ -4,6 +4,7 @@ whose write fails leaves the store as it was."""
 
 from __future__ import annotations
 
+import json
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -315,3 +316,17 @@ def test_gzip_is_told_by_content_and_a_graph_restore_counts_entailed_before_and_
     report = seeded.restore(exported, graphs=["map"])
     assert report.entailed_refreshed and report.before[GraphName.ENTAILED.iri] == entailed
     assert report.restored[GraphName.ENTAILED.iri] == entailed and seeded.store.dump() == before
+
+
+def test_export_and_restore_say_what_they_did_as_json(exported: Path, tmp_path: Path) -> None:
+    runner = CliRunner()
+    out = runner.invoke(cli, ["--store", ":memory:", "export", "--json", str(tmp_path / "lab.trig")])
+    assert out.exit_code == 0, out.output
+    said = json.loads(out.stdout)
+    assert said["format"] == "trig" and said["total"] == sum(g["triples"] for g in said["graphs"])
+    back = runner.invoke(cli, ["--store", ":memory:", "restore", "--json", str(exported), "--graph", "map"])
+    assert back.exit_code == 0, back.output
+    restored = json.loads(back.stdout)
+    rows = {row["graph"].rsplit("/", 1)[1]: (row["triples"], row["before"]) for row in restored["graphs"]}
+    assert restored["entailed_refreshed"] and rows["map"] == (rows["map"][1], rows["map"][1])
+    assert restored["restored"] == rows["map"][0] and {g["graph"] for g in restored["left"]} >= {GraphName.SERVICES.iri}
