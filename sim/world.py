@@ -34,7 +34,16 @@ from cbrs.sim.perception import COLOURS, MarkerModel
 from cbrs.sim.quiet import quiet_output
 from cbrs.sim.scene import bundled_map
 
-__all__ = ["SETTLE_NOTICE", "TIME_STEP", "HomeWorld", "Perturbation", "Spread", "marker_model", "open_world"]
+__all__ = [
+    "SETTLE_NOTICE",
+    "SOLVER_RESIDUAL",
+    "TIME_STEP",
+    "HomeWorld",
+    "Perturbation",
+    "Spread",
+    "marker_model",
+    "open_world",
+]
 
 log = logging.getLogger("cbrs.sim")
 SETTLE_NOTICE = 0.005
@@ -44,6 +53,10 @@ resting objects move less than 1 mm as they settle."""
 
 TIME_STEP = 1.0 / 240.0
 """Physics step (s): pybullet's default, at which the Panda's controllers and contacts are stable."""
+SOLVER_RESIDUAL = 1e-5
+"""The constraint solver stops iterating within a step once the squares of an iteration's corrections of
+its rows sum to less than this (Bullet's least-squares residual; at pybullet's default, 1e-7, the arms'
+joint motors ran all 50 iterations of every step). See docs/simulation.md, "Speed"."""
 FILL_RATE = 0.25
 """Fraction of the cup filled per second of open tap (a full cup takes 4 s)."""
 TAP_OPEN_TRAVEL = 0.006
@@ -168,11 +181,13 @@ class HomeWorld:
         spread: Spread = Spread(),
         arm_detail: ArmDetail | str = ArmDetail.REDUCED,
         image_sizes: Mapping[str, tuple[int, int]] | None = None,
+        solver_residual: float = SOLVER_RESIDUAL,
     ) -> None:
         self.client = client
         self.seed = seed
         self.gui = gui
         self.time_step = time_step
+        self.solver_residual = solver_residual
         self.arm_detail = ArmDetail(arm_detail)
         """The arms' visual meshes, for every camera and recording of this world (``ArmDetail``)."""
         self.map = semantic_map if semantic_map is not None else bundled_map()
@@ -267,17 +282,22 @@ class HomeWorld:
         spread: Spread = Spread(),
         arm_detail: ArmDetail | str = ArmDetail.REDUCED,
         image_sizes: Mapping[str, tuple[int, int]] | None = None,
+        solver_residual: float = SOLVER_RESIDUAL,
     ) -> HomeWorld:
         """Connect a new pybullet client (DIRECT unless ``gui``) and build the home of ``semantic_map`` in
         it (the bundled map by default). ``arm_detail`` picks the arms' visual meshes (``ArmDetail``:
         reduced, the default, or full); physics is the same with either. ``image_sizes`` gives cameras,
-        by name, another image size (width, height) than the layout's default for their kind."""
+        by name, another image size (width, height) than the layout's default for their kind.
+        ``solver_residual`` is when the constraint solver stops iterating (``SOLVER_RESIDUAL``; 1e-7,
+        pybullet's own, steps as cbrs did before)."""
+        if not (isinstance(solver_residual, int | float) and 0.0 < solver_residual < math.inf):
+            raise ValueError(f"solver_residual must be a positive number, not {solver_residual!r}")
         if image_sizes:  # a bad size is refused before a client is connected
             _image_sizes(semantic_map if semantic_map is not None else bundled_map(), image_sizes)
         with quiet_output():
             client = p.connect(p.GUI if gui else p.DIRECT)
         try:
-            return cls(client, seed, gui, time_step, semantic_map, spread, arm_detail, image_sizes)
+            return cls(client, seed, gui, time_step, semantic_map, spread, arm_detail, image_sizes, solver_residual)
         except BaseException:
             p.disconnect(physicsClientId=client)
             raise
@@ -574,7 +594,12 @@ class HomeWorld:
     def _build(self) -> None:
         c = self.client
         p.resetSimulation(physicsClientId=c)
-        p.setPhysicsEngineParameter(fixedTimeStep=self.time_step, deterministicOverlappingPairs=1, physicsClientId=c)
+        p.setPhysicsEngineParameter(
+            fixedTimeStep=self.time_step,
+            deterministicOverlappingPairs=1,
+            solverResidualThreshold=self.solver_residual,
+            physicsClientId=c,
+        )
         p.setGravity(0.0, 0.0, -9.81, physicsClientId=c)
         p.setAdditionalSearchPath(PYBULLET_DATA, physicsClientId=c)
         if self.gui:
@@ -951,10 +976,17 @@ def open_world(
     spread: Spread = Spread(),
     arm_detail: ArmDetail | str = ArmDetail.REDUCED,
     image_sizes: Mapping[str, tuple[int, int]] | None = None,
+    solver_residual: float = SOLVER_RESIDUAL,
 ) -> Iterator[HomeWorld]:
     """``with open_world(seed) as world:`` builds a world and always disconnects it."""
     world = HomeWorld.create(
-        seed, gui, semantic_map=semantic_map, spread=spread, arm_detail=arm_detail, image_sizes=image_sizes
+        seed,
+        gui,
+        semantic_map=semantic_map,
+        spread=spread,
+        arm_detail=arm_detail,
+        image_sizes=image_sizes,
+        solver_residual=solver_residual,
     )
     try:
         yield world
