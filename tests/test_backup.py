@@ -7,7 +7,9 @@ from __future__ import annotations
 import json
 from collections.abc import Iterator
 from pathlib import Path
+from urllib.parse import parse_qs
 
+import httpx
 import pyoxigraph as ox
 import pytest
 from click.testing import CliRunner
@@ -15,9 +17,17 @@ from click.testing import CliRunner
 from cbrs import cli_notes, cli_store
 from cbrs.cli import cli
 from cbrs.kb import KnowledgeBase, RdfParseError, Store, StoreError
-from cbrs.kb.backup import EXPORT_GRAPH, REQUIRED, NotAnExportError, UnknownExportFormatError, read_backup, store_graphs
+from cbrs.kb.backup import (
+    EXPORT_GRAPH,
+    REQUIRED,
+    NotAnExportError,
+    UnknownExportFormatError,
+    export_store,
+    read_backup,
+    store_graphs,
+)
 from cbrs.kb.namespaces import GraphName
-from cbrs.kb.remote_store import RemoteStore
+from cbrs.kb.remote_store import Endpoints, RemoteStore
 from cbrs.kb.staged_writes import STAGING
 from cbrs.server import ServeConfig, Server
 from cbrs.sparql_service import EndpointConfig
@@ -330,3 +340,40 @@ def test_export_and_restore_say_what_they_did_as_json(exported: Path, tmp_path: 
     rows = {row["graph"].rsplit("/", 1)[1]: (row["triples"], row["before"]) for row in restored["graphs"]}
     assert restored["entailed_refreshed"] and rows["map"] == (rows["map"][1], rows["map"][1])
     assert restored["restored"] == rows["map"][0] and {g["graph"] for g in restored["left"]} >= {GraphName.SERVICES.iri}
+
+
+def _cutting_server(data: ox.Store, most: int) -> httpx.MockTransport:
+    """A SPARQL endpoint that, as Virtuoso does with ResultSetMaxRows, sends at most ``most`` rows of an
+    answer and says so only in its X-SPARQL-MaxRows header."""
+
+    def answer(request: httpx.Request) -> httpx.Response:
+        text = parse_qs(request.content.decode("utf-8"))["query"][0]
+        result = data.query(text)
+        assert isinstance(result, ox.QuerySolutions)
+        said = json.loads(result.serialize(format=ox.QueryResultsFormat.JSON) or b"{}")
+        headers = {"Server": "Virtuoso/07.20.3229 (Linux)", "Content-Type": "application/sparql-results+json"}
+        if len(said["results"]["bindings"]) > most:
+            said["results"]["bindings"] = said["results"]["bindings"][:most]
+            headers["X-SPARQL-MaxRows"] = str(most)
+        return httpx.Response(200, headers=headers, content=json.dumps(said).encode("utf-8"))
+
+    return httpx.MockTransport(answer)
+
+
+def test_an_export_from_a_server_that_cuts_answers_short_holds_every_triple(tmp_path: Path) -> None:
+    data = ox.Store()
+    graph = ox.NamedNode("urn:example:lab")
+    data.extend(
+        ox.Quad(ox.NamedNode(f"urn:example:s{i}"), ox.NamedNode("urn:example:p"), ox.Literal(i), graph)
+        for i in range(25)
+    )
+    store = RemoteStore(
+        "http://virtuoso.test/sparql", Endpoints("http://virtuoso.test/sparql", "http://virtuoso.test/sparql")
+    )
+    store._client = httpx.Client(transport=_cutting_server(data, 10))
+    try:
+        report = export_store(store, tmp_path / "lab.nq")
+    finally:
+        store.close()
+    assert report.triples == {graph.value: 25}
+    assert sorted(read_backup(tmp_path / "lab.nq").quads[graph.value], key=str) == sorted(data, key=str)
