@@ -319,6 +319,7 @@ def export_store(
             raise BackupError(f"the store has no graph {', '.join(_name(g) for g in unknown)}; nothing was exported")
     counts: Counter[str] = Counter()
     tell = progress or _quiet
+    checked = not isinstance(store, EmbeddedStore)  # a server may cut an answer short: its count says so
 
     def quads() -> Iterator[ox.Quad]:
         for number, graph in enumerate(chosen, 1):
@@ -329,6 +330,11 @@ def export_store(
                 if counts[graph] % _PROGRESS_EVERY == 0:
                     tell(f"{stage}: {counts[graph]} triples", 0, 0)
                 yield quad
+            if checked and graph != DEFAULT and store.count(ox.NamedNode(graph)) != counts[graph]:
+                raise BackupError(
+                    f"{store.location} sent {counts[graph]} of the {store.count(ox.NamedNode(graph))} triples of "
+                    f"{_name(graph)} (it cuts answers short, or the store changed meanwhile); nothing was exported"
+                )
         exported = {graph: counts[graph] for graph in chosen}
         stamp = datetime.datetime.now(datetime.UTC).replace(microsecond=0).isoformat().replace("+00:00", "Z")
         yield from Manifest(__version__, stamp, without_password(store.location), exported, bool(graphs)).quads()

@@ -20,6 +20,7 @@ from cbrs.kb import KnowledgeBase, RdfParseError, Store, StoreError
 from cbrs.kb.backup import (
     EXPORT_GRAPH,
     REQUIRED,
+    BackupError,
     NotAnExportError,
     UnknownExportFormatError,
     export_store,
@@ -377,3 +378,21 @@ def test_an_export_from_a_server_that_cuts_answers_short_holds_every_triple(tmp_
         store.close()
     assert report.triples == {graph.value: 25}
     assert sorted(read_backup(tmp_path / "lab.nq").quads[graph.value], key=str) == sorted(data, key=str)
+
+
+def test_an_export_that_a_server_sent_short_is_refused(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    data = ox.Store()
+    graph = ox.NamedNode("urn:example:lab")
+    data.extend(
+        ox.Quad(ox.NamedNode(f"urn:example:s{i}"), ox.NamedNode("urn:example:p"), ox.Literal(i), graph)
+        for i in range(5)
+    )
+    store = RemoteStore("http://other.test/sparql", Endpoints("http://other.test/sparql", "http://other.test/sparql"))
+    store._client = httpx.Client(transport=_cutting_server(data, 100))
+    monkeypatch.setattr(store, "count", lambda graph=None: 6)  # one triple more than it sends: a silent cut
+    try:
+        with pytest.raises(BackupError, match=r"sent 5 of the 6 triples of urn:example:lab .* nothing was exported"):
+            export_store(store, tmp_path / "lab.nq")
+    finally:
+        store.close()
+    assert list(tmp_path.iterdir()) == []
