@@ -73,6 +73,7 @@ def test_updates_in_a_row_are_counted_and_another_update_by_the_graphs_sizes(kb:
     ("text", "said"),
     [
         pytest.param("INSERT DATA { GRAPH graph:services { <http://e.org/a> a }", "nothing was changed", id="syntax"),
+        pytest.param('INSERT DATA { GRAPH graph:map { world:Pen rdfs:comment "}" }', "1 '{' not closed", id="unclosed"),
         pytest.param("SELECT * WHERE { ?s ?p ?o }", "this is a SPARQL query, not an update", id="query"),
         pytest.param("INSERT DATA { GRAPH graph:services { _:b a cbrs:Camera } }", "_:b", id="blank-node"),
     ],
