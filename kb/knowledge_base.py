@@ -361,6 +361,7 @@ class KnowledgeBase:
         checking: AbstractContextManager[None] = nullcontext()
         old_map = self._map_before_update(text, data) if check_map else None
         everything: set[ox.Quad] | None = None  # the store before, kept here to put back whatever it wrote
+        keep = data is not None  # whether a refused update is undone whole (a data update undoes itself)
         if data is None:  # what else it writes is unknown: keep the whole store if it might be refused
             keep = isinstance(self.store, EmbeddedStore) and (old_map is not None or may_write_descriptions(text))
             if keep and old_map is not None:  # one copy for both checks
@@ -378,14 +379,7 @@ class KnowledgeBase:
                 data.undo(self.store)  # its writes to the other graphs go too: all or nothing
             else:
                 self._put_back(everything, old_map)
-            if isinstance(error, MapError):
-                whole = data is not None or everything is not None
-                error.add_note(
-                    "nothing was changed (an update of graph:map is checked as a task reads the map)"
-                    if whole
-                    else "graph:map was put back as it was (a remote store is not copied to undo an update: what it "
-                    "wrote to other graphs, if anything, stands; send a change of the map on its own)"
-                )
+            error.add_note(_refused(isinstance(error, MapError), keep))
             raise
         finally:
             self._reader.clear_cache()
@@ -469,3 +463,15 @@ class KnowledgeBase:
 
     def close(self) -> None:
         self.store.close()
+
+
+def _refused(map_error: bool, whole: bool) -> str:
+    """What a refused update left: nothing, or (a remote store, not copied beforehand) the checked graphs
+    put back and what it wrote elsewhere, if anything."""
+    if whole:
+        return "nothing was changed" + (" (an update of graph:map is checked as a task reads the map)" * map_error)
+    what = "graph:map was" if map_error else "graph:services and graph:requirements were"
+    return (
+        f"{what} put back as before (a remote store is not copied to undo an update: what it wrote to other "
+        "graphs, if anything, stands; send that change on its own)"
+    )

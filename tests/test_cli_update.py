@@ -74,6 +74,12 @@ def test_updates_in_a_row_are_counted_and_another_update_by_the_graphs_sizes(kb:
     [
         pytest.param("INSERT DATA { GRAPH graph:services { <http://e.org/a> a }", "nothing was changed", id="syntax"),
         pytest.param('INSERT DATA { GRAPH graph:map { world:Pen rdfs:comment "}" }', "1 '{' not closed", id="unclosed"),
+        pytest.param(
+            "DELETE WHERE { GRAPH graph:services { ?p cbrs:parameterType home:VideoStream } }",
+            "parameterType, the IRI of a class (or a property used as a concept) (and 1 other description with "
+            "problems); nothing was changed",
+            id="shape",
+        ),
         pytest.param("SELECT * WHERE { ?s ?p ?o }", "this is a SPARQL query, not an update", id="query"),
         pytest.param("INSERT DATA { GRAPH graph:services { _:b a cbrs:Camera } }", "_:b", id="blank-node"),
     ],
@@ -148,7 +154,7 @@ def test_a_remote_store_puts_the_map_back_and_says_what_it_could_not(oxigraph_se
         before = kb.store.dump()
         with pytest.raises(MapError) as refused:
             kb.update_counted("DELETE WHERE { GRAPH graph:map { world:Pen home:sizeX ?x } }")
-        assert "graph:map was put back as it was" in "\n".join(refused.value.__notes__)
+        assert "graph:map was put back as before" in "\n".join(refused.value.__notes__)
         assert kb.store.dump() == before
     finally:
         kb.close()
