@@ -14,7 +14,7 @@ import pyoxigraph as ox
 from cbrs.app import App, pass_app
 from cbrs.cli_interrupts import HeldInterrupts
 from cbrs.kb.backup import DEFAULT, Backup, NotAnExportError, export_format, read_backup
-from cbrs.kb.errors import QuerySyntaxError, without_password
+from cbrs.kb.errors import QuerySyntaxError, StoreEvaluationError, without_password
 from cbrs.kb.namespaces import GraphName, shorten
 from cbrs.kb.store import refuse_inserted_blank_nodes
 from cbrs.kb.update_report import unclosed
@@ -185,6 +185,9 @@ def update(app: App, text: str | None, update_file: Any, as_json: bool) -> None:
             if explained is error:
                 raise
             raise explained from error
+        except StoreEvaluationError as error:  # the store refused the request whole (one transaction)
+            error.add_note("nothing was changed")
+            raise
     if as_json:
         changes = [
             {"graph": change.graph or None, "net": change.net, "added": change.added, "removed": change.removed}

@@ -80,6 +80,11 @@ def test_updates_in_a_row_are_counted_and_another_update_by_the_graphs_sizes(kb:
             "problems); nothing was changed",
             id="shape",
         ),
+        pytest.param(
+            CAMERA + " ; DROP GRAPH <urn:example:none>",
+            "The graph <urn:example:none> does not exist; nothing was changed",
+            id="evaluation",
+        ),
         pytest.param("SELECT * WHERE { ?s ?p ?o }", "this is a SPARQL query, not an update", id="query"),
         pytest.param("INSERT DATA { GRAPH graph:services { _:b a cbrs:Camera } }", "_:b", id="blank-node"),
     ],
