@@ -342,8 +342,13 @@ def export_store(
     with _output(name) as out:
         try:
             ox.serialize(quads(), out, rdf_format, prefixes=PREFIXES if rdf_format == ox.RdfFormat.TRIG else None)
+        except BrokenPipeError as error:  # `cbrs export - | head`: the reader stopped
+            where = "standard output" if name == "-" else name
+            raise BackupError(
+                f"{where} was closed before the export ended (its reader stopped): what it got is no whole export"
+            ) from error
         except OSError as error:
-            raise BackupError(f"{name}: cannot write: {error}") from error
+            raise BackupError(f"{name}: cannot write: {error.strerror or error}") from error
     return ExportReport(name, rdf_format, {graph: counts[graph] for graph in chosen})
 
 

@@ -4,9 +4,12 @@ whose write fails leaves the store as it was."""
 
 from __future__ import annotations
 
+import io
 import json
+import sys
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 from urllib.parse import parse_qs
 
 import httpx
@@ -396,3 +399,16 @@ def test_an_export_that_a_server_sent_short_is_refused(tmp_path: Path, monkeypat
     finally:
         store.close()
     assert list(tmp_path.iterdir()) == []
+
+
+def test_an_export_to_a_reader_that_stops_says_so(seeded: KnowledgeBase, monkeypatch: pytest.MonkeyPatch) -> None:
+    class Stopped(io.RawIOBase):  # `cbrs export - | head`: the pipe closes after a few lines
+        def writable(self) -> bool:
+            return True
+
+        def write(self, data: Any) -> int:
+            raise BrokenPipeError(32, "Broken pipe")
+
+    monkeypatch.setattr(sys, "stdout", io.TextIOWrapper(io.BufferedWriter(Stopped())))
+    with pytest.raises(BackupError, match=r"standard output was closed before the export ended .* no whole export"):
+        seeded.export("-")
