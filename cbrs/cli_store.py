@@ -11,6 +11,7 @@ from typing import Any
 import click
 import pyoxigraph as ox
 
+from cbrs import __version__
 from cbrs.app import App, pass_app
 from cbrs.cli_interrupts import HeldInterrupts
 from cbrs.kb.backup import DEFAULT, Backup, NotAnExportError, export_format, read_backup
@@ -131,6 +132,11 @@ def restore(
         click.echo(f"  {_graph_name(graph):<22} left as it was ({count} triples in the file not restored)")
     if report.entailed_refreshed:
         click.echo("graph:entailed worked out afresh from the restored graphs")
+    if backup.manifest is not None and backup.manifest.cbrs_version not in ("", __version__):
+        click.echo(
+            f"the file was exported by cbrs {backup.manifest.cbrs_version}, this is {__version__}: the next command "
+            "that opens the store brings it up to the bundled ontologies (docs/backup.md)"
+        )
 
 
 def _confirm(app: App, backup: Backup, graphs: tuple[str, ...], yes: bool) -> None:

@@ -17,7 +17,7 @@ import pyoxigraph as ox
 import pytest
 from click.testing import CliRunner
 
-from cbrs import cli_notes, cli_store
+from cbrs import __version__, cli_notes, cli_store
 from cbrs.cli import cli
 from cbrs.kb import KnowledgeBase, RdfParseError, Store, StoreError
 from cbrs.kb.backup import (
@@ -412,3 +412,16 @@ def test_an_export_to_a_reader_that_stops_says_so(seeded: KnowledgeBase, monkeyp
     monkeypatch.setattr(sys, "stdout", io.TextIOWrapper(io.BufferedWriter(Stopped())))
     with pytest.raises(BackupError, match=r"standard output was closed before the export ended .* no whole export"):
         seeded.export("-")
+
+
+def test_a_file_of_another_cbrs_version_is_restored_and_said_so(exported: Path, tmp_path: Path) -> None:
+    older = tmp_path / "older.nq"
+    text = exported.read_text(encoding="utf-8")
+    version = f'<https://w3id.org/cbrs/export#cbrsVersion> "{__version__}"'
+    assert version in text
+    older.write_text(text.replace(version, '<https://w3id.org/cbrs/export#cbrsVersion> "0.0.9"'), encoding="utf-8")
+    result = CliRunner().invoke(cli, ["--store", ":memory:", "restore", str(older)])
+    assert result.exit_code == 0, result.output
+    assert f"exported by cbrs 0.0.9, this is {__version__}: the next command" in result.stdout
+    same = CliRunner().invoke(cli, ["--store", ":memory:", "restore", str(exported)])
+    assert same.exit_code == 0 and "exported by cbrs" not in same.stdout
