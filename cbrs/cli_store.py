@@ -203,6 +203,12 @@ def update(app: App, text: str | None, update_file: Any, as_json: bool) -> None:
         return
     for line in report.lines():
         click.echo(line)
+    if report.changed and not app.kb.store.is_seeded():  # CLEAR ALL, DROP GRAPH graph:ontology
+        click.echo(
+            "note: graph:ontology is empty now: the next command that opens the store seeds it again with the "
+            "bundled data (cbrs restore FILE puts a backup back)",
+            err=True,
+        )
 
 
 def _at_terminal() -> bool:

@@ -336,15 +336,23 @@ class KnowledgeBase:
         data = self._data_update(text)
         before = graph_sizes(self.store) if data is None else None
         entailed = self._update(text, data, check_map=True)
+        iri = GraphName.ENTAILED.iri
+        refreshed = (
+            GraphChange(iri, entailed.added - entailed.removed, entailed.added, entailed.removed)
+            if entailed is not None
+            else GraphChange(iri, 0, 0, 0)
+        )
         if before is not None:
-            changes, exact = net_changes(before, graph_sizes(self.store)), False
+            after = graph_sizes(self.store)
+            changes, exact = net_changes(before, after), False
+            if after[iri] - before[iri] != refreshed.net:  # the update wrote it too (CLEAR ALL): its net alone
+                refreshed = GraphChange(iri, after[iri] - before[iri])
         else:
             assert data is not None
             delta = data.delta(self.store)
             changes, exact = (exact_changes(*delta), True) if delta is not None else ([], False)
-        if entailed is not None and (entailed.added or entailed.removed):
-            net = entailed.added - entailed.removed
-            changes.append(GraphChange(GraphName.ENTAILED.iri, net, entailed.added, entailed.removed))
+        if refreshed.net or refreshed.added or refreshed.removed:
+            changes.append(refreshed)
         return UpdateReport(tuple(changes), exact, counted=before is not None or exact)
 
     def _data_update(self, text: str) -> DataUpdate | None:

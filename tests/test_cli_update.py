@@ -163,3 +163,11 @@ def test_a_remote_store_puts_the_map_back_and_says_what_it_could_not(oxigraph_se
         assert kb.store.dump() == before
     finally:
         kb.close()
+
+
+def test_clear_all_counts_graph_entailed_and_says_the_store_will_be_seeded_again() -> None:
+    code, out, err = _cbrs("update", "CLEAR ALL")
+    assert code == 0 and "graph:ontology: -" in out
+    entailed = next(line for line in out.splitlines() if line.startswith("graph:entailed"))
+    assert entailed.startswith("graph:entailed: -") and entailed.endswith("(net: the size before and after)")
+    assert "the next command that opens the store seeds it again" in err
