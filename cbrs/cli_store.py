@@ -88,6 +88,8 @@ def restore(
     shown = ProgressLine()
     try:
         backup = read_backup(file, export_format(str(file), fmt), shown)
+    except KeyboardInterrupt:  # click would say "Aborted!", and a person would wonder what was written
+        raise click.ClickException(f"{file}: Ctrl-C while reading it; nothing was restored") from None
     finally:
         shown.clear()
     problems = backup.problems(list(graphs) or None)
@@ -108,6 +110,8 @@ def restore(
 
         try:
             report = kb.restore(backup, list(graphs) or None, force, progress)
+        except KeyboardInterrupt:
+            raise click.ClickException(_stopped(kb.store.location, interrupts.held)) from None
         finally:
             shown.clear()
     refreshed = report.entailed_refreshed  # graph:entailed worked out, not restored
@@ -209,6 +213,18 @@ def update(app: App, text: str | None, update_file: Any, as_json: bool) -> None:
             "bundled data (cbrs restore FILE puts a backup back)",
             err=True,
         )
+
+
+def _stopped(location: str, writing: bool) -> str:
+    """What a Ctrl-C left of a restore: nothing before the write; during it (a second Ctrl-C, which stops
+    waiting for a remote store), the staging was undone, but a request on its way may still be carried out."""
+    if not writing:
+        return "Ctrl-C before the write began; nothing was restored"
+    return (
+        f"Ctrl-C again during the write to {without_password(location)}: the restore was stopped and its staged "
+        "batches dropped, but a request the server had already taken may still be carried out: see what the "
+        "store holds (cbrs query); a graph under graph:staging/ is inert and cbrs init lists it"
+    )
 
 
 def _at_terminal() -> bool:

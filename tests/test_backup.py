@@ -425,3 +425,30 @@ def test_a_file_of_another_cbrs_version_is_restored_and_said_so(exported: Path, 
     assert f"exported by cbrs 0.0.9, this is {__version__}: the next command" in result.stdout
     same = CliRunner().invoke(cli, ["--store", ":memory:", "restore", str(exported)])
     assert same.exit_code == 0 and "exported by cbrs" not in same.stdout
+
+
+@pytest.mark.parametrize(
+    ("stage", "said"),
+    [
+        pytest.param("reading", "Ctrl-C while reading it; nothing was restored", id="reading"),
+        pytest.param(
+            "counting what the store holds", "Ctrl-C before the write began; nothing was restored", id="count"
+        ),
+        pytest.param("writing batch", "a request the server had already taken may still be carried out", id="write"),
+    ],
+)
+def test_ctrl_c_during_a_restore_says_what_it_left(
+    exported: Path, monkeypatch: pytest.MonkeyPatch, stage: str, said: str
+) -> None:
+    def interrupted(*args: Any, **kwargs: Any) -> Any:
+        if stage == "reading":
+            raise KeyboardInterrupt
+        args[-1](stage, 0, 0)  # the progress callback, as kb.backup tells it
+        raise KeyboardInterrupt
+
+    if stage == "reading":
+        monkeypatch.setattr(cli_store, "read_backup", interrupted)
+    else:
+        monkeypatch.setattr(KnowledgeBase, "restore", interrupted)
+    result = CliRunner().invoke(cli, ["--store", ":memory:", "restore", str(exported)])
+    assert result.exit_code == 1 and said in result.stderr and "Aborted!" not in result.output
