@@ -45,6 +45,8 @@ _VERSION_INFO = ox.NamedNode("http://www.w3.org/2002/07/owl#versionInfo")
 # An update that might write graph:map, read loosely (its name, an escape, a variable graph, ALL or NAMED):
 # only such an update, and a data update that names a quad in it, has the map checked afterwards.
 _MAY_WRITE_MAP = re.compile(r"map|\\[uU]|GRAPH(?:\s|#[^\n]*\n)*[?$]|\b(?:ALL|NAMED)\b", re.IGNORECASE)
+# A LOAD of a quad format may write any graph the file names.
+_LOADS = re.compile(r"\bLOAD\b", re.IGNORECASE)
 # The graphs whose descriptions kb.shapes.checked_update checks (tests/test_standard_terms_updates.py pins
 # it): a data update naming no quad in them leaves them as they are, so it skips the check, which reads
 # both graphs whole twice (1.5 s a write on a store of OWLS-TC's services).
@@ -371,10 +373,12 @@ class KnowledgeBase:
         everything: set[ox.Quad] | None = None  # the store before, kept here to put back whatever it wrote
         keep = data is not None  # whether a refused update is undone whole (a data update undoes itself)
         if data is None:  # what else it writes is unknown: keep the whole store if it might be refused
-            keep = isinstance(self.store, EmbeddedStore) and (old_map is not None or may_write_descriptions(text))
+            described = may_write_descriptions(text) or _LOADS.search(text) is not None
+            keep = isinstance(self.store, EmbeddedStore) and (old_map is not None or described)
             if keep and old_map is not None:  # one copy for both checks
                 everything = set(self.store.quads())
-            checking = checked_update(self.store, keep and everything is None)  # kb/shapes.py puts back
+            if described:  # else it cannot reach them: the check read both graphs twice for nothing
+                checking = checked_update(self.store, keep and everything is None)  # kb/shapes.py puts back
         elif data.names_graph(CHECKED_GRAPHS):
             checking = checked_update(self.store)
         try:

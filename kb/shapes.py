@@ -274,9 +274,9 @@ _MAY_REACH = re.compile(
 def may_write_descriptions(text: str) -> bool:
     """Whether the SPARQL update ``text`` might write graph:services or graph:requirements: it names one of
     them (or a word of theirs), declares a prefix or a base that could spell them, has an escape, a
-    variable graph or CLEAR/DROP ALL/NAMED. Deliberately loose: it only decides whether
-    :func:`checked_update` keeps the whole store to undo a refused update everywhere; the check itself
-    runs for every update that is not data outside those graphs."""
+    variable graph or CLEAR/DROP ALL/NAMED. Deliberately loose: it decides whether :func:`checked_update`
+    keeps the whole store to undo a refused update everywhere, and whether an update that is not data is
+    checked at all (KnowledgeBase: an update it says cannot reach them, and no LOAD, is not)."""
     return _MAY_REACH.search(text) is not None
 
 

@@ -452,3 +452,31 @@ def test_ctrl_c_during_a_restore_says_what_it_left(
         monkeypatch.setattr(KnowledgeBase, "restore", interrupted)
     result = CliRunner().invoke(cli, ["--store", ":memory:", "restore", str(exported)])
     assert result.exit_code == 1 and said in result.stderr and "Aborted!" not in result.output
+
+
+def test_a_cut_answer_is_refused_to_a_query_and_paged_only_as_far_as_quads_are_read() -> None:
+    data = ox.Store()
+    graph = ox.NamedNode("urn:example:lab")
+    data.extend(
+        ox.Quad(ox.NamedNode(f"urn:example:s{i}"), ox.NamedNode("urn:example:p"), ox.Literal(i), graph)
+        for i in range(25)
+    )
+    sent: list[httpx.Request] = []
+    server = _cutting_server(data, 10)
+
+    def counted(request: httpx.Request) -> httpx.Response:
+        sent.append(request)
+        return server.handle_request(request)
+
+    url = "http://virtuoso.test/sparql"
+    store = RemoteStore(url, Endpoints(url, url))
+    store._client = httpx.Client(transport=httpx.MockTransport(counted))
+    store._union_verified = True
+    try:
+        with pytest.raises(StoreError, match=r"sent only the first 10 rows of an answer .* ResultSetMaxRows"):
+            store.query("SELECT ?s WHERE { GRAPH ?g { ?s ?p ?o } }")
+        sent.clear()
+        assert next(store.quads(graph=graph)).graph_name == graph and len(sent) == 1  # no page read
+        assert len(list(store.quads(graph=graph))) == 25
+    finally:
+        store.close()
