@@ -18,7 +18,6 @@ from cbrs.kb.backup import DEFAULT, Backup, NotAnExportError, export_format, rea
 from cbrs.kb.errors import QuerySyntaxError, StoreEvaluationError, without_password
 from cbrs.kb.namespaces import GraphName, shorten
 from cbrs.kb.store import refuse_inserted_blank_nodes
-from cbrs.kb.update_report import unclosed
 from cbrs.output import ProgressLine
 from cbrs.sparql_hints import explain_syntax_error, operation_kind
 
@@ -185,12 +184,6 @@ def update(app: App, text: str | None, update_file: Any, as_json: bool) -> None:
             report = app.kb.update_counted(body)
         except QuerySyntaxError as error:
             explained = explain_syntax_error(error, body, "update")
-            open_blocks = unclosed(body) if explained is error and type(error) is QuerySyntaxError else 0
-            if open_blocks:
-                where = error.message.split(": ", 1)[0] if error.message.startswith("error at") else "at the end"
-                explained = QuerySyntaxError(
-                    body, f"{where}: the text ends with {open_blocks} '{{' not closed: add '}}' where each block ends"
-                )
             explained.add_note("nothing was changed")
             if explained is error:
                 raise

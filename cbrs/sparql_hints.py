@@ -17,6 +17,7 @@ from typing import Literal
 from cbrs.kb.errors import QuerySyntaxError
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.sparql_lexemes import HIDING
+from cbrs.kb.update_report import unclosed
 
 __all__ = ["FORMS", "TOKENS", "explain_syntax_error", "first_keyword", "operation_kind", "undeclared_prefix"]
 
@@ -82,7 +83,8 @@ def undeclared_prefixes(text: str) -> list[str]:
 
 def explain_syntax_error(error: QuerySyntaxError, text: str, expected: Literal["query", "update"]) -> QuerySyntaxError:
     """``error`` with a plain reason in front where the parser's list of expected tokens hides it: an
-    update sent as a query (or the other way round), a misspelt first keyword, or a prefix nobody declared."""
+    update sent as a query (or the other way round), a misspelt first keyword, a prefix nobody declared,
+    or a text that ends inside a block."""
     if type(error) is not QuerySyntaxError:  # QueryTooComplexError and the like say what they mean
         return error
     at = _ERROR_AT.search(error.message)
@@ -116,4 +118,11 @@ def explain_syntax_error(error: QuerySyntaxError, text: str, expected: Literal["
             known = f"the parser: {said}"
         reason = f"the prefix '{prefix}:' is not declared: add PREFIX {prefix}: <IRI>; {known}"
         return QuerySyntaxError(text, where + reason)
+    open_blocks = unclosed(text)
+    if open_blocks:  # the parser lists every token that could have come next
+        return QuerySyntaxError(
+            text,
+            f"{where or 'at the end: '}the text ends with {open_blocks} '{{' not closed: add '}}' where each "
+            "block ends",
+        )
     return error

@@ -124,6 +124,7 @@ def test_syntax_error_is_one_line(store: str) -> None:
     assert code == 1
     assert out.startswith("Error: SPARQL syntax error")
     assert out.count("\n") == 1 and "Traceback" not in out
+    assert "the text ends with 1 '{' not closed" in out  # not the parser's list of every token
 
 
 @pytest.mark.parametrize(

@@ -240,6 +240,13 @@ def test_sparqlwrapper_at_the_query_path() -> None:
         ("GET", "/sparql", "selct ?s WHERE { ?s ?p ?o }", "'selct' begins no SPARQL query: did you mean SELECT?"),
         ("POST-update", "/update", "INSRT DATA { GRAPH <urn:g> { <urn:a> <urn:b> <urn:c> } }", "did you mean INSERT?"),
         ("GET", "/sparql", "SELECT ?s WHERE { ?s <http://x.org/a space> ?o }", "1:44: expected IRI parsing failed"),
+        ("GET", "/sparql", "SELECT ?s WHERE { ?s ?p ?o", "the text ends with 1 '{' not closed"),
+        (
+            "POST-update",
+            "/update",
+            'INSERT DATA { GRAPH <urn:g> { <urn:a> <urn:b> "}" }',
+            "the text ends with 1 '{' not closed",
+        ),
     ],
 )
 def test_a_mistaken_text_is_a_400_that_says_what_is_wrong(
