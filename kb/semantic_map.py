@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from collections import defaultdict
+from contextvars import ContextVar
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -46,6 +47,10 @@ __all__ = [
     "local_name",
     "overlaps",
 ]
+
+
+_DECLARED: ContextVar[frozenset[str]] = ContextVar("declared_home_properties", default=frozenset())
+"""The home properties the vocabulary declares, while :meth:`SemanticMap.read` reads a map."""
 
 
 class MapError(KnowledgeBaseError):
@@ -334,6 +339,15 @@ class SemanticMap:
 
     @classmethod
     def read(cls, kb: KnowledgeBase) -> SemanticMap:
+        declared = frozenset(row["property"].value for row in kb.select("declared_properties", {"namespace": HOME}))
+        said = _DECLARED.set(declared)  # a missing property's hint proposes no declared one as its slip
+        try:
+            return cls._read(kb, declared)
+        finally:
+            _DECLARED.reset(said)
+
+    @classmethod
+    def _read(cls, kb: KnowledgeBase, declared: frozenset[str]) -> SemanticMap:
         facts: dict[str, dict[str, list[str]]] = defaultdict(lambda: defaultdict(list))
         for row in kb.select("map_facts"):
             facts[row["thing"].value][row["property"].value].append(row["value"].value)
@@ -376,16 +390,15 @@ class SemanticMap:
                 built.dispensers[iri] = _dispenser(built, iri, tap, facts)
         _check_supports(built)
         _check_overlaps(built)
-        _check_properties(kb, facts)
+        _check_properties(declared, facts)
         return built
 
 
-def _check_properties(kb: KnowledgeBase, facts: dict[str, dict[str, list[str]]]) -> None:
+def _check_properties(declared: frozenset[str], facts: dict[str, dict[str, list[str]]]) -> None:
     """Every property of the home namespace the map's statements use is one the vocabulary declares: a
     misspelt optional property (home:yaww for home:yaw) is declared nowhere, so the load took it and the
     reader ignored it, the thing keeping its default. Checked after the required properties, whose own
     checks say what is missing. A store without the home vocabulary has nothing to check against."""
-    declared = {row["property"].value for row in kb.select("declared_properties", {"namespace": HOME})}
     if not declared:
         return
     for thing in sorted(facts):
@@ -419,8 +432,10 @@ def _number(values: dict[str, list[str]], name: str, iri: str, default: float | 
 
 def _missing(values: dict[str, list[str]], name: str, iri: str, why: str = "") -> MapError:
     """A required property the thing lacks, with the property of its own it may be a slip of (home:colorName
-    for home:colourName): a misspelt property is declared nowhere, so the load took it silently."""
-    slip = nearest_term(HOME + name, [prop for prop in values if prop != HOME + name])
+    for home:colourName): a misspelt property is declared nowhere, so the load took it silently, and a
+    declared one (home:sizeZ beside a missing home:sizeX) is no slip."""
+    declared = _DECLARED.get()
+    slip = nearest_term(HOME + name, [prop for prop in values if prop != HOME + name and prop not in declared])
     hint = f" (did you mean home:{name} for its home:{local_name(slip)} {values[slip][0]!r}?)" if slip else ""
     return MapError(iri, f"has no home:{name}{why}{hint}")
 

@@ -54,6 +54,15 @@ def test_a_misspelt_colour_property_is_refused_with_the_property_it_may_mean(tmp
     assert "did you mean home:colourName for its home:colorName 'green'?" in str(error)
 
 
+def test_a_missing_size_proposes_no_declared_property_as_its_slip(tmp_path: Path) -> None:
+    """home:sizeZ is declared: it is no slip of a missing home:sizeX ("did you mean home:sizeX for its
+    home:sizeZ 0.18?" was said); an undeclared home:sizeXX still is."""
+    error = refusal(store(tmp_path, bottle().replace("home:sizeX 0.06 ; ", "")))
+    assert "has no home:sizeX" in str(error) and "did you mean" not in str(error), str(error)
+    error = refusal(store(tmp_path, bottle().replace("home:sizeX 0.06", "home:sizeXX 0.06")))
+    assert "did you mean home:sizeX for its home:sizeXX '0.06'?" in str(error), str(error)
+
+
 def test_an_object_with_no_colour_at_all_is_taken_as_before(tmp_path: Path) -> None:
     """No property of its own reads as a slip of home:colourName: it is built, and not looked for
     (tests/test_knowledge_driven.py builds such a book)."""
