@@ -125,10 +125,9 @@ class KnowledgeBase:
         if next(iter(self.store.quads(graph=GraphName.MAP.node)), None) is None:
             return None  # a map being built from nothing may be partial until its last file
         read = read_files(paths, GraphName.MAP, catalogue, progress)
-        scratch = self._map_scratch()
-        if not self._map_readable_before(scratch):
+        if not self._stored_map_reads():
             return read
-        problem = self._map_problem(scratch, read.quads())
+        problem = self._map_problem(read.quads())
         if problem is not None:
             problem.add_note(
                 f"nothing was loaded from {', '.join(map(str, read.paths))} (a load into graph:map is checked as "
@@ -137,31 +136,27 @@ class KnowledgeBase:
             raise problem
         return read
 
-    def _map_readable_before(self, scratch: ox.Store) -> bool:
-        """Whether the stored map reads without error (``scratch`` holds its graphs). An embedded store
-        counts its writes (:attr:`EmbeddedStore.generation`), so the answer is kept until the next one: a
-        load refused for its map, then retried with the file mended, reads the stored map once; a remote
-        store has no such count, and is read each time."""
+    def _stored_map_reads(self) -> bool:
+        """Whether the stored map reads without error, as a task reads it. An embedded store counts its
+        writes (:attr:`EmbeddedStore.generation`), so the answer is kept until the next one: a load refused
+        for its map, then retried with the file mended, reads the stored map once; a remote store has no
+        such count, and is read each time."""
         generation = getattr(self.store, "generation", None)
         if generation is not None and self._map_read is not None and self._map_read[0] == generation:
             return self._map_read[1]
-        readable = self._map_problem(scratch, []) is None
+        readable = self._map_error() is None
         if generation is not None:
             self._map_read = (generation, readable)
         return readable
 
-    def _map_scratch(self) -> ox.Store:
-        """A scratch copy of the graphs the map reader asks (ontology, map, entailed), in memory."""
+    def _map_problem(self, added: list[ox.Quad]) -> Exception | None:
+        """What reading the semantic map says would be wrong with it with ``added`` in graph:map, or None:
+        read from a scratch copy, in memory, of the graphs the reader asks (ontology, map, entailed)."""
+        from cbrs.kb.semantic_map import MapError, SemanticMap  # it imports this module
+
         scratch = ox.Store()
         for graph in (GraphName.ONTOLOGY, GraphName.MAP, GraphName.ENTAILED):
             scratch.extend(self.store.quads(graph=graph.node))
-        return scratch
-
-    def _map_problem(self, scratch: ox.Store, added: list[ox.Quad]) -> Exception | None:
-        """What reading the semantic map of ``scratch`` says is wrong with it, with ``added`` in it too
-        (added to ``scratch`` itself), or None."""
-        from cbrs.kb.semantic_map import MapError, SemanticMap  # it imports this module
-
         scratch.extend(added)
         try:
             SemanticMap.read(KnowledgeBase(EmbeddedStore(scratch, MEMORY), self.queries))
@@ -406,10 +401,7 @@ class KnowledgeBase:
         quads = set(self.store.quads(graph=GraphName.MAP.node))
         if not quads:
             return None  # a map being built
-        generation = getattr(self.store, "generation", None)  # unchanged since the last read: as it was then
-        if generation is None or self._map_read is None or self._map_read[0] != generation:
-            self._map_read = (generation if generation is not None else -1, self._map_error() is None)
-        return quads if self._map_read[1] else None  # one unreadable already: left to the reader's error
+        return quads if self._stored_map_reads() else None  # one unreadable already: left to the reader's error
 
     def _check_updated_map(self, old_map: set[ox.Quad]) -> None:
         """Raise the semantic map's error when the update just run left graph:map unreadable (an emptied map
