@@ -17,7 +17,6 @@ from typing import Literal
 from cbrs.kb.errors import QuerySyntaxError
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.sparql_lexemes import HIDING
-from cbrs.kb.update_report import unclosed
 
 __all__ = ["FORMS", "TOKENS", "explain_syntax_error", "first_keyword", "operation_kind", "undeclared_prefix"]
 
@@ -126,3 +125,18 @@ def explain_syntax_error(error: QuerySyntaxError, text: str, expected: Literal["
             "block ends",
         )
     return error
+
+
+_BRACE = re.compile(HIDING + r"|[{}]", re.DOTALL)
+"""Strings, IRIs and comments, which hide the braces inside them; then the braces that count."""
+
+
+def unclosed(text: str) -> int:
+    """How many ``{`` of ``text`` (outside strings, IRIs and comments) no ``}`` closes: the parser's answer
+    to a text that ends inside a block is a list of every token it could have read."""
+    depth = 0
+    for match in _BRACE.finditer(text):
+        token = match.group()
+        depth += 1 if token == "{" else -1 if token == "}" else 0
+        depth = max(depth, 0)
+    return depth

@@ -102,17 +102,6 @@ def operations(text: str) -> int:
     return sum(1 for part in parts if any(not m.group().startswith("#") for m in _CONTENT.finditer(part.rstrip(";"))))
 
 
-def unclosed(text: str) -> int:
-    """How many ``{`` of the update ``text`` (outside strings, IRIs and comments) no ``}`` closes: the
-    parser's answer to a text that ends inside a block is a list of every token it could have read."""
-    depth = 0
-    for match in _SEPARATOR.finditer(text):
-        token = match.group()
-        depth += 1 if token == "{" else -1 if token == "}" else 0
-        depth = max(depth, 0)
-    return depth
-
-
 def refuse_split(store: Store, text: str) -> None:
     """Raise :class:`UpdateSplitError` for an update of several operations to a store that does not keep a
     request whole (``keeps_requests_whole``, :mod:`kb.remote_store`)."""
