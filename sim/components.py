@@ -476,7 +476,12 @@ def _taking(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, side:
             first,
         )
     unplaced = "; ".join(why for _, why in both.ruled_out)
-    return taking.choice(side, taking.models[0], f"taking the {name} (to {place.name}, to be passed on: {unplaced})")
+    return _clear(  # to be passed on: the take's moves are dry-run, as where the hold's end is not known
+        taking,
+        side,
+        f"taking the {name} (to {place.name}, to be passed on: {unplaced})",
+        lambda held: skills.can_carry(world, estimate, side, held),
+    )
 
 
 def _clear(
@@ -613,6 +618,12 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
         if not placing.models:
             raise SkillFailed(f"the {taker.value} arm reaches {place.name}, but {placing.refusal()}")
         relay, _, taken_by = _relay_spot(ctx, taken, _Candidates([model]), placing, giver, taker)
+        # Both arms' moves of the pass are dry-run before the giver sets the object down (it holds it now).
+        passing = f"passing the {model.name} from the {giver.value} arm to the {taker.value} for {place.name}"
+        before = "the pass moved anything"
+        _refuse(skills.can_carry_held(world, giver, relay), model, giver, passing, relay, before)
+        there = _resting(relay, model, taken, world.time)
+        _refuse(skills.can_carry(world, there, taker, taken_by, target), taken_by, taker, passing, target, before)
         found = _set_down_for(ctx, device, model, giver, taker, relay, None)
         taker_spec = world.arm_specs[taker]
         _note(
@@ -749,8 +760,10 @@ def _who_loads(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, ba
     its class's order, by which it can both take it and let it go where its hold ends (an arm that
     passes it sets it down, so the loader may take it anew by another approach). Asked without moving
     (inverse kinematics on the private copies): by the hand-over, and before a run, by the plan's check
-    (:meth:`SimEnvironment.given`). With one approach only the letting go on the platform is asked, as
-    before approaches could be chosen."""
+    (:meth:`SimEnvironment.given`). With one approach only the letting go on the platform is asked of the
+    end poses, as before approaches could be chosen. The moves of each hold are then dry-run, one approach
+    alone too, as the approach choice's are (:func:`_clear`, :func:`_refuse`): :class:`MovesRefusedError`
+    when the arm's planning would refuse them."""
     x, y, _ = estimate.position
     takers = _reaching(ctx, x, y)
     loaders = _reaching(ctx, base.x, base.y)
@@ -765,6 +778,7 @@ def _who_loads(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, ba
     both = [side for side in takers if side in loaders]
     loader = both[0] if both else loaders[0]
     purpose = f"loading the {model.name} onto the platform"
+    platform = skills.platform_region(base, world.platform_height)
     # Letting go on the platform does not depend on where the loader takes the object from.
     checks = [lambda held: skills.can_load(world, estimate, base, loader, held)]
     whole: _Candidates | None = None
@@ -772,8 +786,10 @@ def _who_loads(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, ba
         whole = _Candidates.of(
             model, *([lambda held: skills.can_take(world, estimate, loader, held), *checks] if choosing else checks)
         )
-        if whole.models:
-            return _Loading(whole.choice(loader, whole.models[0], purpose))
+        if whole.models:  # the first whose moves the loader's planning would make, one alone too (_clear)
+            spots = {held.grasp: platform for held in whole.models}
+            loads = _clear(whole, loader, purpose, lambda held: _loads(ctx, estimate, base, loader, held), spots)
+            return _Loading(loads)
         if not choosing:
             raise SkillFailed(whole.refusal())
     # Two holds, the object set down between them where both reach: the arm that reaches it passes it to
@@ -805,9 +821,37 @@ def _who_loads(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, ba
         if whole is not None
         else f"passing the {model.name} to the {loader.value} arm"
     )
+    # Both holds' moves are dry-run before the first moves: the giver's from where the object is to the
+    # spot, the loader's from the spot to the platform (from its posture now; a re-grasping arm will have
+    # folded home, where it starts a task).
+    _refuse(skills.can_carry(world, estimate, giver, given_by, spot), given_by, giver, setting_down, spot)
+    there = _resting(spot, model, estimate, world.time)
+    _refuse(_loads(ctx, there, base, loader, taken_by), taken_by, loader, purpose, platform)
     given = giving.choice(giver, given_by, setting_down, "no spot to set it down by it")
     loaded = loading.choice(loader, taken_by, purpose, "no spot to take it by it")
     return _Loading(loaded, given, spot)
+
+
+def _loads(ctx: SimContext, estimate: ObjectEstimate, base: Pose2D, side: ArmSide, held: ObjectModel) -> str:
+    """Why ``side``'s planning would refuse the hand-over's moves by ``held``'s approach (a dry run)."""
+    return skills.can_hand_over(ctx.world, estimate, base, side, held)
+
+
+def _refuse(
+    why: str, held: ObjectModel, side: ArmSide, purpose: str, spot: Region, before: str = "anything moved"
+) -> None:
+    """A hold of a relay whose moves the arm's planning would refuse (``why``, from a dry run) fails the
+    step before the relay moves anything, as a refused hold of the approach choice does (:func:`_clear`)."""
+    if why:
+        cx, cy, _ = spot.center
+        raise MovesRefusedError(held.name, side.value, purpose, [(held.grasp.value, (cx, cy), why)], before=before)
+
+
+def _resting(spot: Region, model: ObjectModel, seen: ObjectEstimate, now: float) -> ObjectEstimate:
+    """Where an object set down on ``spot`` is expected to be, lying as it was ``seen``: what a dry run of
+    taking it from there asks about before it is there."""
+    cx, cy, _ = spot.center
+    return ObjectEstimate(cx, cy, spot.zmin + model.height / 2.0, seen.yaw, seen.size, model.colour, "map", now, 0)
 
 
 RELAY_MARGIN = 0.05
@@ -1465,7 +1509,7 @@ class SimEnvironment:
                 estimate = ObjectEstimate(centre[0], centre[1], centre[2], axis, obj.size, obj.colour, "map", 0.0, 0)
                 try:
                     _who_loads(self.context, estimate, Manipulation.of(obj).model, _dock(support))
-                except SkillFailed as refused:
+                except (SkillFailed, MovesRefusedError) as refused:
                     raise CannotLoadError(step.component, obj.iri, str(refused)) from None
 
     def _check_reach(self, plan: Plan, values: Mapping[str, Any]) -> None:

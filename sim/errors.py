@@ -150,7 +150,8 @@ class MovesRefusedError(SimulationError):
     """The arm's own motion planning would refuse the moves of a hold by every approach left to it (a dry
     run of the approach, the pick-up and, when known, the carry over the spot it will aim at), so the step
     fails before anything moves. ``refused`` holds (approach, the spot's centre (x, y) or None, why) for
-    each approach dry-run; ``ruled_out`` (approach, why) those its end poses or its fit ruled out first."""
+    each approach dry-run; ``ruled_out`` (approach, why) those its end poses or its fit ruled out first;
+    ``before`` what had not moved yet (a pass between the arms is refused with the object already in hand)."""
 
     def __init__(
         self,
@@ -159,6 +160,7 @@ class MovesRefusedError(SimulationError):
         purpose: str,
         refused: Sequence[tuple[str, tuple[float, float] | None, str]],
         ruled_out: Sequence[tuple[str, str]] = (),
+        before: str = "anything moved",
     ) -> None:
         self.name = name
         self.arm = arm
@@ -168,7 +170,7 @@ class MovesRefusedError(SimulationError):
         reasons = "; ".join(why for _, _, why in self.refused)
         others = "".join(f"; not by its {approach} grasp: {why}" for approach, why in self.ruled_out)
         super().__init__(
-            f"{purpose}: refused before anything moved, the {arm} arm's planning making the moves by no approach: "
+            f"{purpose}: refused before {before}, the {arm} arm's planning making the moves by no approach: "
             f"{reasons}{others};"
             f" set the {name} or its place nearer the arm, or allow it another approach (home:graspApproach)"
         )

@@ -43,7 +43,9 @@ __all__ = [
     "Outcome",
     "approach_object",
     "can_carry",
+    "can_carry_held",
     "can_grip",
+    "can_hand_over",
     "can_load",
     "can_set_down",
     "can_take",
@@ -413,14 +415,20 @@ def can_set_down(world: HomeWorld, pen: ObjectEstimate, side: ArmSide | str, mod
 
 
 def can_carry(
-    world: HomeWorld, pen: ObjectEstimate, side: ArmSide | str, model: ObjectModel, region: Region | None = None
+    world: HomeWorld,
+    pen: ObjectEstimate,
+    side: ArmSide | str,
+    model: ObjectModel,
+    region: Region | None = None,
+    yaw: float | None = None,
 ) -> str:
     """Why ``side``'s own motion planning would refuse to take the object where it is by ``model``'s
     approach and, given a ``region``, carry it over its middle (empty if it would not): the moves of
     approach_object, pick_up_object and carry_object planned one after the other on the kinematics copies
     from the arm's posture now, without moving (a dry run, :meth:`Arm.dry_run`). The inverse kinematics
     of the end poses alone (:func:`can_take`, :func:`can_set_down`) misses a joint-space move whose every
-    path collides or lets the held object dip, and a straight line that leaves the arm's reach."""
+    path collides or lets the held object dip, and a straight line that leaves the arm's reach. ``yaw``
+    turns a top-grasped object on the way, as :func:`carry_object` does."""
     arm = ArmSide(side)
     grasp = _grasp(world, pen, arm, model)
     if isinstance(grasp, str):
@@ -434,7 +442,7 @@ def can_carry(
     ]
     if region is not None:
         cx, cy, _ = region.center
-        moves.append((f"carrying it to ({cx:.2f}, {cy:.2f})", lambda: _carry(hand, grasp, region, None)))
+        moves.append((f"carrying it to ({cx:.2f}, {cy:.2f})", lambda: _carry(hand, grasp, region, yaw)))
     for what, move in moves:
         result = move()
         if not result.reached:
@@ -443,6 +451,35 @@ def can_carry(
                 f"{result.reason}"
             )
     return ""
+
+
+def can_hand_over(
+    world: HomeWorld, pen: ObjectEstimate, base: Pose2D | RobotPoseEstimate, side: ArmSide | str, model: ObjectModel
+) -> str:
+    """Why ``side`` cannot load the object onto the platform of the base parked at ``base`` by
+    :func:`hand_over_onto_platform`'s moves (empty if it can): the end poses (:func:`can_load`), then a dry
+    run of the take and of the carry over the platform with the wrist turned as the hand-over turns it
+    (:func:`can_carry`)."""
+    _, region, yaw, reason = _loading(world, pen, base, side, model)
+    return reason or can_carry(world, pen, side, model, region, yaw)
+
+
+def can_carry_held(world: HomeWorld, side: ArmSide | str, region: Region) -> str:
+    """Why ``side``'s planning would refuse to carry what it holds over the middle of ``region`` as
+    :func:`carry_object` moves it (empty if it would not): a dry run from the arm's posture now."""
+    arm = _arm(world, side)
+    grasp = arm.held_grasp
+    if arm.held is None or grasp is None:
+        return f"the {arm.side} gripper holds nothing"
+    result = _carry(arm.dry_run(), grasp, region, None)
+    if result.reached:
+        return ""
+    cx, cy, _ = region.center
+    model = grasp.model
+    return (
+        f"the {ArmSide(side).value} arm would not get the {model.name} by its {model.grasp.value} grasp past carrying "
+        f"it to ({cx:.2f}, {cy:.2f}): {result.reason}"
+    )
 
 
 def hand_over_onto_platform(
