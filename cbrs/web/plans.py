@@ -3,7 +3,10 @@ its service resource graph."""
 
 from __future__ import annotations
 
+import functools
+import importlib
 import tempfile
+import threading
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -11,10 +14,11 @@ from typing import TYPE_CHECKING, Any
 from flask import Blueprint, Response, request, url_for
 from markupsafe import Markup
 
-from cbrs.extras import require
+from cbrs.actions.shown_names import file_qualifier, shown_names, two_lines
+from cbrs.extras import installed, require
 from cbrs.kb.namespaces import shorten
 from cbrs.web import context, diagram
-from cbrs.web.links import display_text
+from cbrs.web.links import display_text, short, tail_parts
 from cbrs.web.pages import FormError, Page, page, wants_json
 
 if TYPE_CHECKING:  # the planner (and networkx) load with the first plan asked for, not at start-up
@@ -51,6 +55,7 @@ def plans() -> Page:
     data["composition"] = _composition(result)
     if not wants_json():  # markup, so not in the twin, which has the same steps as lists
         data["flow"] = _flow(data["composition"])
+        _load_drawing_library()  # the page asks for the drawing next
     # The page only shows the plan; link the plans graph's copy only when one was recorded (cbrs plan).
     data["recorded"] = result.plan is not None and context.kb().describes(result.plan.iri)
     data["graph"] = url_for("plans.graph", task=task, objective=objective)
@@ -110,12 +115,36 @@ def _composed(task: str, objective: str, shown: Page | None) -> _Composed:
         raise FormError({"task": str(error)}, page=shown) from None
 
 
+DRAWING_MODULE = "cbrs.actions.draw"
+
+
+@functools.cache
+def _load_drawing_library() -> threading.Thread | None:
+    """Import the drawing's module, and matplotlib with it, in the background once a plan is shown. The
+    import took 1.1 to 1.5 s of the first drawing, with the store lock held; the page's ``<img>`` (lazy:
+    asked when scrolled to) now finds it done or under way. Once a process; None without matplotlib."""
+    if not installed("eval"):
+        return None
+    thread = threading.Thread(target=importlib.import_module, args=(DRAWING_MODULE,), name="cbrs-drawing", daemon=True)
+    thread.start()
+    return thread
+
+
 def _svg(result: CompositionResult) -> bytes:
     require("eval", "the plan's drawing")
     from cbrs.actions.draw import draw  # matplotlib is slow to import; only when a drawing is asked for
 
     with tempfile.TemporaryDirectory(prefix="cbrs-srg-") as folder:
-        return draw(result, Path(folder) / "graph.svg").read_bytes()
+        return draw(result, Path(folder) / "graph.svg", qualifier).read_bytes()
+
+
+def qualifier(iri: str) -> str:
+    """What tells apart two components of one local name in the plans' pictures: the prefix the pages
+    show (declared or derived, ``mapGerman_service``), else the file part of the IRI."""
+    prefix, colon, _ = short(iri).partition(":")
+    if colon and short(iri) != iri:
+        return prefix
+    return tail_parts(iri)[0].rstrip("#") or file_qualifier(iri)
 
 
 def task_options() -> dict[str, list[dict[str, str | None]]]:
@@ -170,6 +199,7 @@ def _flow(composition: dict[str, Any]) -> Markup | None:
     steps = composition.get("steps") or []
     if not steps:
         return None
+    names = shown_names({c for step in steps for c in (step["component"], *step["alternatives"])}, qualifier)
     depth: dict[int, int] = {}
     edges: list[diagram.Edge] = []
     for step in steps:
@@ -202,7 +232,7 @@ def _flow(composition: dict[str, Any]) -> Markup | None:
             [
                 diagram.Box(
                     f"step-{step['index']}",
-                    _step_text(step),
+                    f"#{step['index']} {two_lines(names[step['component']])}",
                     f"{step['component']}" + (f": {step['label']}" if step.get("label") else ""),
                     f"#step-{step['index']}",
                 )
@@ -215,10 +245,3 @@ def _flow(composition: dict[str, Any]) -> Markup | None:
     return diagram.layered(
         rows, edges, f"Data flow of the plan for {task}", f"{len(steps)} steps in {len(rows) - 1} rows", "flow"
     )
-
-
-def _step_text(step: dict[str, Any]) -> str:
-    """``#4 PlanPathAStar`` over ``HomeServer01``: a component's name is its service and its device."""
-    name = display_text(step["component"]).rpartition(":")[2]
-    service, _, device = name.rpartition("_")
-    return f"#{step['index']} {service}\n{device}" if service and device else f"#{step['index']} {name}"
