@@ -9,7 +9,10 @@ times ``KnowledgeBase.update`` for:
 * a one-triple ``INSERT DATA`` of a new, unaligned statement (a robot's observation), then the
   ``DELETE DATA`` of it;
 * the same for an aligned one (``a home:Sensor``, which entails ``a sosa:Sensor``);
-* a ``DELETE/INSERT ... WHERE`` changing one such statement, which always takes the whole refresh.
+* a ``DELETE/INSERT ... WHERE`` changing one such statement, which always takes the whole refresh;
+* a one-triple ``INSERT DATA`` (then ``DELETE DATA``) in graph:map (a comment on world:Cup), with the
+  semantic map checked as ``KnowledgeBase.update`` checks it and without (``check_map=False``): what the
+  check costs an update that touches the map. The rows above touch no map, so they pay nothing for it.
 
 Each data update is timed both ways, in turn (a run of RUN as cbrs runs it, then one as the anchor): as
 cbrs runs it, graph:entailed followed node by node (kb/standard_terms.py StandardTerms.prepare/updated)
@@ -35,7 +38,7 @@ import pyoxigraph as ox
 
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.catalog import Catalogue
-from cbrs.kb.namespaces import GraphName
+from cbrs.kb.namespaces import WORLD, GraphName
 from cbrs.kb.shapes import checked_update
 
 DEFAULT_OWLS_TC = Path(__file__).resolve().parents[2] / "shared" / "owls-tc4"
@@ -56,6 +59,15 @@ def texts(kind: str, n: int) -> tuple[str, str]:
     return (
         f"INSERT DATA {{ GRAPH <{GRAPH}> {{ {statement} }} }}",
         f"DELETE DATA {{ GRAPH <{GRAPH}> {{ {statement} }} }}",
+    )
+
+
+def map_texts(n: int) -> tuple[str, str]:
+    """The INSERT DATA and DELETE DATA of the n-th comment on world:Cup in graph:map."""
+    statement = f'<{WORLD}Cup> <http://www.w3.org/2000/01/rdf-schema#comment> "bench {n}"'
+    return (
+        f"INSERT DATA {{ GRAPH <{GraphName.MAP.iri}> {{ {statement} }} }}",
+        f"DELETE DATA {{ GRAPH <{GraphName.MAP.iri}> {{ {statement} }} }}",
     )
 
 
@@ -123,6 +135,12 @@ def measure(kb: KnowledgeBase, repeat: int) -> dict[str, dict[str, float]]:
             sample(f"{kind} INSERT DATA, whole", lambda: whole(kb, insert))  # noqa: B023
             sample(f"{kind} DELETE DATA, whole", lambda: whole(kb, delete))  # noqa: B023
         sample("DELETE/INSERT WHERE (whole)", lambda: kb.update(where_text(n)))  # noqa: B023
+        for checked in (True, False):
+            n += 1
+            insert, delete = map_texts(n)
+            how = "map checked" if checked else "check_map=False"
+            sample(f"map INSERT DATA, {how}", lambda: kb.update(insert, check_map=checked))  # noqa: B023
+            sample(f"map DELETE DATA, {how}", lambda: kb.update(delete, check_map=checked))  # noqa: B023
     entailed = set(kb.store.quads(graph=GraphName.ENTAILED.node))
     kb.refresh_standard_terms()
     assert entailed == set(kb.store.quads(graph=GraphName.ENTAILED.node)), "graph:entailed drifted from a whole refresh"

@@ -563,7 +563,9 @@ class SparqlService:
         refuse_inserted_blank_nodes(text)  # what cbrs stores it must be able to read back by name
         with self.lock:
             try:
-                self.kb.update(text)  # a refused update raises StoreEvaluationError (400); nothing changed
+                # refused, nothing changed: StoreEvaluationError (400), a description the shapes refuse (400),
+                # a semantic map it would leave unreadable (MapError, 422: KnowledgeBase.update checks it)
+                self.kb.update(text)
             finally:
                 self.generation += 1
         for listener in list(self._listeners):

@@ -318,17 +318,22 @@ class KnowledgeBase:
     def query(self, text: str, bindings: Mapping[str, Term] | None = None) -> QueryResult:
         return self.store.query(text, bindings)
 
-    def update(self, text: str) -> None:
+    def update(self, text: str, check_map: bool = True) -> None:
         """Run a SPARQL update in one transaction; the cached descriptions are read afresh afterwards, and
-        graph:entailed follows (node by node after a data update: :meth:`StandardTerms.prepare`)."""
-        self._update(text, self._data_update(text), check_map=False)
+        graph:entailed follows (node by node after a data update: :meth:`StandardTerms.prepare`).
+
+        An update that leaves a readable semantic map unreadable is put back and refused with the map
+        reader's error (:class:`kb.semantic_map.MapError`), as a load into graph:map is: else it stays in and every task
+        fails on it. Only an update that may write graph:map is checked; the rest pay nothing for it.
+        ``check_map=False`` skips the check, for a caller that builds or breaks a map on purpose (a test
+        of the map reader's errors): the map's reader then says what is wrong when a task reads it."""
+        self._update(text, self._data_update(text), check_map)
 
     def update_counted(self, text: str) -> UpdateReport:
         """:meth:`update`, saying what it changed graph by graph (:mod:`kb.update_report`): quad by quad for
         a data update, else each graph's net change, which costs counting the graphs before and after. An
         update of several operations is refused on a store that does not run a request whole (Virtuoso), and
-        one that leaves the semantic map unreadable is put back, as a load into graph:map is refused (the
-        library's :meth:`update` leaves that to the map's reader: tests break a map on purpose)."""
+        one that leaves the semantic map unreadable is put back and refused, as :meth:`update` does."""
         refuse_split(self.store, text)
         data = self._data_update(text)
         before = graph_sizes(self.store) if data is None else None

@@ -162,7 +162,8 @@ def test_reading_the_semantic_map_refuses_a_bad_hand() -> None:
             f"DELETE {{ GRAPH <{GRAPH}map> {{ ?hand <{HOME}jawOpening> ?old }} }} "
             f"INSERT {{ GRAPH <{GRAPH}map> {{ ?hand <{HOME}jawOpening> -0.08 }} }} "
             f"WHERE {{ GRAPH <{GRAPH}map> {{ <{WORLD}CytonDualArm01LeftArm> <{HOME}hasGripper> ?hand . "
-            f"?hand <{HOME}jawOpening> ?old }} }}"
+            f"?hand <{HOME}jawOpening> ?old }} }}",
+            check_map=False,  # broken on purpose, for the reader to refuse (an update checked is refused)
         )
         with pytest.raises(HandError) as refused:
             SemanticMap.read(kb)

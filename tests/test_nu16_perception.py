@@ -24,10 +24,8 @@ def remote_of(colour: str, x: float = 7.95, y: float = 3.13) -> KnowledgeBase:
     kb = KnowledgeBase.open(":memory:")
     kb.load([EXAMPLES / "remote_on_the_table.ttl"], graph="map")
     remote = f"<{WORLD}Remote1>"
-    kb.update(
-        f"DELETE WHERE {{ GRAPH graph:map {{ {remote} home:colourName ?c ; home:rgba ?r ; home:x ?x ; home:y ?y }} }}"
-    )
-    kb.update(
+    kb.update(  # one request: the remote without a pose in between is a map no task reads, and is refused
+        f"DELETE WHERE {{ GRAPH graph:map {{ {remote} home:colourName ?c ; home:rgba ?r ; home:x ?x ; home:y ?y }} }};"
         f"INSERT DATA {{ GRAPH graph:map {{ {remote} home:colourName '{colour}' ; home:rgba '{RGBA[colour]}' ; "
         f"home:x {x} ; home:y {y} }} }}"
     )

@@ -1,0 +1,113 @@
+"""An update through the library or the endpoint's /update that would leave a readable semantic map
+unreadable is refused and changes nothing, as ``cbrs update`` and a load into graph:map are; an update
+that cannot write graph:map is not checked at all (docs/serving.md)."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+from flask.testing import FlaskClient
+
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.semantic_map import MapError, SemanticMap
+from cbrs.sparql_service import EndpointConfig, SparqlService
+from cbrs.web import create_app
+
+TOKEN = "map trial token"
+BREAKS = {
+    "data": 'INSERT DATA { GRAPH graph:map { world:Pen home:shapeKind "sphere" } }',
+    "where": "DELETE WHERE { GRAPH graph:map { world:Pen home:sizeX ?x } }",
+    "where-after-data": (
+        "INSERT DATA { GRAPH <urn:example:lab> { <urn:example:a> <urn:example:b> <urn:example:c> } } ;\n"
+        "DELETE WHERE { GRAPH graph:map { world:Pen home:sizeX ?x } }"
+    ),
+}
+LAB = "<urn:example:a> <urn:example:b> 1"
+MOVE = (
+    "DELETE { GRAPH graph:map { world:Pen home:yaw ?y } } INSERT { GRAPH graph:map { world:Pen home:yaw 0.5 } } "
+    "WHERE { GRAPH graph:map { world:Pen home:yaw ?y } }"
+)
+
+
+@pytest.fixture(scope="module")
+def kb() -> Iterator[KnowledgeBase]:
+    """One seeded store for the module: its tests leave its map readable."""
+    kb = KnowledgeBase.open(":memory:")
+    yield kb
+    kb.close()
+
+
+@pytest.fixture(scope="module")
+def client(kb: KnowledgeBase) -> FlaskClient:
+    return create_app(SparqlService(kb, EndpointConfig(update_token=TOKEN))).test_client()
+
+
+def _post(client: FlaskClient, text: str) -> Any:
+    headers = {"Authorization": f"Bearer {TOKEN}"}
+    return client.post("/update", data=text.encode(), content_type="application/sparql-update", headers=headers)
+
+
+@pytest.mark.parametrize("text", BREAKS.values(), ids=BREAKS.keys())
+def test_the_endpoint_refuses_an_update_that_breaks_the_map_and_changes_nothing(
+    kb: KnowledgeBase, client: FlaskClient, text: str
+) -> None:
+    before = kb.store.dump()
+    response = _post(client, text)
+    assert response.status_code == 422
+    body = response.get_json()
+    assert body["error"] == "MapError" and body["message"].startswith("semantic map: Pen (")
+    assert kb.store.dump() == before  # the other graph's write in the same request is gone too
+    with pytest.raises(MapError) as direct:  # the message is the one the map's reader gives
+        kb.update(text)
+    assert body["message"] == str(direct.value)
+
+
+def test_the_endpoint_takes_a_map_update_that_leaves_it_readable(kb: KnowledgeBase, client: FlaskClient) -> None:
+    assert _post(client, MOVE).status_code == 204
+    assert SemanticMap.read(kb).objects[PREFIXES["world"] + "Pen"].start.yaw == 0.5
+
+
+def test_the_library_refuses_it_unless_told_not_to_check() -> None:
+    kb = KnowledgeBase.open(":memory:")
+    before = kb.store.dump()
+    with pytest.raises(MapError) as refused:
+        kb.update(BREAKS["where"])
+    assert "nothing was changed" in "\n".join(refused.value.__notes__)
+    assert kb.store.dump() == before
+    kb.update(BREAKS["where"], check_map=False)  # a map broken on purpose: the reader says what is wrong
+    with pytest.raises(MapError, match="has no home:sizeX"):
+        SemanticMap.read(kb)
+
+
+@pytest.mark.parametrize(
+    ("text", "read"),
+    [
+        pytest.param(f"INSERT DATA {{ GRAPH <urn:example:lab> {{ {LAB} }} }}", False, id="data"),
+        pytest.param(f"DELETE DATA {{ GRAPH <urn:example:lab> {{ {LAB} }} }}", False, id="delete"),
+        pytest.param(
+            "DELETE { GRAPH <urn:example:lab> { ?s ?p ?o } } WHERE { GRAPH <urn:example:lab> { ?s ?p ?o } }",
+            False,
+            id="where",
+        ),
+        pytest.param(MOVE, True, id="map-where"),
+        pytest.param("INSERT DATA { GRAPH graph:map { world:Pen rdfs:comment 'x' } }", True, id="map-data"),
+        pytest.param("DELETE DATA { GRAPH graph:map { world:Pen rdfs:comment 'x' } }", True, id="map-delete"),
+    ],
+)
+def test_only_an_update_that_may_write_the_map_reads_it(
+    kb: KnowledgeBase, monkeypatch: pytest.MonkeyPatch, text: str, read: bool
+) -> None:
+    reads: list[KnowledgeBase] = []
+    real = SemanticMap.read.__func__  # type: ignore[attr-defined]
+
+    def counted(cls: type[SemanticMap], base: KnowledgeBase) -> SemanticMap:
+        reads.append(base)
+        return real(cls, base)  # type: ignore[no-any-return]
+
+    kb._map_read = None  # no answer kept from an earlier test
+    monkeypatch.setattr(SemanticMap, "read", classmethod(counted))
+    kb.update(text)
+    assert bool(reads) is read
