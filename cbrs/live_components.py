@@ -19,6 +19,7 @@ loses its lease at its next store write, and its heartbeat says so (:data:`DEREG
 
 from __future__ import annotations
 
+import difflib
 import logging
 import math
 import threading
@@ -37,6 +38,7 @@ from cbrs.kb.namespaces import BASE, RDF, GraphName
 from cbrs.kb.store import EmbeddedStore
 from cbrs.kb.vocab import CBRS
 from cbrs.rosbridge import ServiceError, current_caller
+from cbrs.rosbridge.protocol import json_type
 from cbrs.sparql_service import SparqlService
 
 __all__ = [
@@ -187,11 +189,20 @@ class LiveComponents:
                     "this server is read-only, so it registers no component: start cbrs serve with an update token "
                     "(CBRS_UPDATE_TOKEN or --update-token-file, without --read-only) and give the component that token"
                 )
-            raise ServiceError("registering a component needs the update token: send it first with the auth op")
+            raise ServiceError(
+                "registering a component needs the update token: send it first with the auth op "
+                '({"op": "auth", "mac": TOKEN}; roslibpy sends Ros.authenticate() only as it connects, so call '
+                "it before run())"
+            )
         session = caller.session if caller is not None else "in-process"
+        _check_fields(args)
         description = args.get("description")
-        if not isinstance(description, str):
+        if description is None:
             raise ServiceError("missing field 'description' (the component's description, as text)")
+        if not isinstance(description, str):
+            raise ServiceError(
+                f"field 'description' must be the description as text (Turtle or JSON-LD), not {json_type(description)}"
+            )
         fmt = args.get("format", "turtle")
         ttl = args.get("ttl", self.ttl)
         if isinstance(ttl, bool) or not isinstance(ttl, int | float) or not 0.1 <= ttl <= 3600:
@@ -304,6 +315,24 @@ class LiveComponents:
             for held, lease in sorted(leases.items()):
                 if held != iri and lease.service == service and lease.session != session:
                     raise ServiceHeldError(iri, service, held, lease.session)
+
+    def holder(self, service: str, session: str) -> str | None:
+        """Why the bridge session ``session`` may not provide ``service``: a live component another bridge
+        session registered is grounded on it, and that session's program answers its calls. None if it may.
+        (A component registered over HTTP holds no provider: any bridge client may answer for it.)"""
+        with self._guard:
+            held = [
+                (iri, lease.session)
+                for iri, lease in self._leases.items()
+                if lease.bridge and lease.service == service and lease.session != session
+            ]
+        if not held:
+            return None
+        iri, owner = held[0]
+        return (
+            f"service {service!r} is held by the live component <{iri}>, which {owner} registered: only that "
+            "session provides it while its lease lasts (a component of your own needs a service of its own)"
+        )
 
     def renew(self, session: str) -> list[str]:
         """Renew the leases of ``session``'s components; the store is written when half a lease has passed,
@@ -437,6 +466,22 @@ class LiveComponents:
                 self.expire_lapsed()
             except Exception:  # the watchdog must outlive a failed write
                 log.exception("ending lapsed leases failed")
+
+
+REGISTER_FIELDS = ("description", "format", "ttl")
+"""The fields of a ``/cbrs/register`` call."""
+
+
+def _check_fields(args: dict[str, Any]) -> None:
+    """Refuse a field ``/cbrs/register`` does not take: a misspelt ``tll`` would otherwise give the
+    component the default lease without a word."""
+    unknown = sorted(set(args) - set(REGISTER_FIELDS))
+    if unknown:
+        close = difflib.get_close_matches(unknown[0], REGISTER_FIELDS, n=1)
+        hint = f"; did you mean {close[0]!r}?" if close else ""
+        raise ServiceError(
+            f"/cbrs/register takes no field {unknown[0]!r} (its fields: {', '.join(REGISTER_FIELDS)}){hint}"
+        )
 
 
 def service_name(name: str) -> str:

@@ -93,6 +93,7 @@ class Server:
         for name, (kind, handler) in self.live.handlers().items():
             self.bridge.add_service(name, kind, handler)
         self.bridge.on_disconnect(self.live.disconnected)
+        self.bridge.hold_services(self.live.holder)  # a live component's calls go to its own program only
         self._rosout = RosoutHandler(self.bridge)
         self.tasks.transport = self._own_bridge
         self._transport: BridgeClient | None = None

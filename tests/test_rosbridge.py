@@ -420,6 +420,10 @@ def test_a_bad_message_gets_a_status_error_and_the_connection_stays_up(
     assert status["level"] == "error"
     assert reason in status["msg"]
     assert status.get("id") == message_id
+    if '"call_service"' in str(frame) and message_id is not None:  # the caller waits for an answer: it gets one
+        answer = me.expect("service_response")
+        assert (answer["id"], answer["result"]) == (message_id, False)
+        assert reason in answer["values"]
     assert me.call("/test/add", {"a": 1, "b": 2})["values"] == {"sum": 3}  # the same connection still works
 
 

@@ -52,6 +52,11 @@ def _json_in_binary(frame: bytes) -> str | None:
         return None
 
 
+def _message_id(value: Any) -> MessageId | None:
+    """``value`` if it can be a message's id (a string or an integer), else None."""
+    return value if isinstance(value, str | int) and not isinstance(value, bool) else None
+
+
 def _api_name(name: str, what: str) -> str:
     if not isinstance(name, str) or not name.strip("/ "):
         raise ValueError(f"{what} name must be a non-empty string like '/cbrs/query', not {name!r}")
@@ -125,6 +130,7 @@ class Bridge:
         self._writers: dict[Session, asyncio.Task[None]] = {}
         self._clients = itertools.count(1)
         self._disconnect_listeners: list[Callable[[str], None]] = []
+        self._holders: list[Callable[[str, str], str | None]] = []
         self._ops: dict[str, Callable[[Session, Message], None]] = {
             "advertise": self._advertise,
             "unadvertise": self._unadvertise,
@@ -374,29 +380,42 @@ class Bridge:
                 raise ProtocolError("the pieces of a message put together must not be a fragment again", op)
             self._ops[op](session, message)
         except ProtocolError as error:
+            request = message if message is not None else protocol.leading_fields(frame)
+            if message is None:  # not read (too large, not JSON): its leading fields may still say what it was
+                op = request["op"] if isinstance(request.get("op"), str) else None
+                message_id = _message_id(request.get("id"))
             op = error.op or op
             text = f"{op}: {error.reason}" if op else error.reason
             log.info("%s: %s", session.name, text)
             session.report("error", text, error.message_id if error.message_id is not None else message_id)
-            self._refuse_answer(session, frame, op, message_id, error.reason)
-            if op == "send_action_goal" and message is not None:  # the goal's callbacks hear of it too
-                self._refuse_goal(session, message, text)
+            self._refuse_answer(session, frame, op, message_id, error.reason, read=message is not None)
+            if op == "call_service" and message_id is not None:  # its caller waits for an answer: this is it
+                self._refuse_call(session, request, message_id, text)
+            if op == "send_action_goal":  # the goal's callbacks hear of it too
+                self._refuse_goal(session, request, text)
         except Exception as error:
             log.exception("%s: %s failed", session.name, op)
             session.report("error", f"{op or 'message'}: internal error: {type(error).__name__}: {error}", message_id)
 
     def _refuse_answer(
-        self, session: Session, frame: str, op: str | None, message_id: MessageId | None, reason: str
+        self, session: Session, frame: str, op: str | None, message_id: MessageId | None, reason: str, read: bool
     ) -> None:
         """A provider's answer the bridge refused (a field of the wrong type, too large to read) fails the
         call it answers at once, with the reason the provider is told: the caller would otherwise wait
         for the call's timeout with the reason known here."""
         if self._calls is None or not session.provided:
             return
-        if op == "service_response":
+        if op == "service_response" and message_id is not None:
             self._calls.refuse(session, message_id, reason)
-        elif op is None and message_id is None:  # not read at all: over max_message_bytes
+        elif op in (None, "service_response") and message_id is None and not read:  # its id comes late, if at all
             self._calls.refuse_unread(session, frame, reason)
+
+    def _refuse_call(self, session: Session, request: Message, message_id: MessageId, reason: str) -> None:
+        """Answer a ``call_service`` that could not be read or checked (too large, a field of the wrong
+        type) with a failed ``service_response``: roslibjs waits for the answer without a timeout."""
+        spelling = request.get("service")
+        spelling = spelling if isinstance(spelling, str) else ""
+        session.reply(protocol.service_response(spelling, False, protocol.dumps(reason), message_id))
 
     def close_session(self, session: Session) -> None:
         """The client has gone: drop its topics, services and subscriptions, fail calls waiting on it."""
@@ -429,6 +448,13 @@ class Bridge:
                 listener(session.name)
             except Exception:  # a listener's bug must not keep the session open
                 log.exception("a disconnect listener failed for %s", session.name)
+
+    def hold_services(self, holder: Callable[[str, str], str | None]) -> None:
+        """Ask ``holder(service, session name)`` on the bridge's loop (keep it short) whenever a client
+        advertises a service: a text refuses the advertisement with that reason. ``cbrs serve`` keeps a
+        live component's service for the session that registered it; another client would otherwise take
+        its calls (a client may take a service over from another, as in rosbridge_suite)."""
+        self._holders.append(holder)
 
     def on_disconnect(self, listener: Callable[[str], None]) -> None:
         """Call ``listener(session name)`` on the bridge's loop when a client disconnects (a live
@@ -580,6 +606,13 @@ class Bridge:
     def _service_response(self, session: Session, message: Message) -> None:
         assert self._calls is not None
         message_id = message.get("id")
+        if message_id is None:
+            name = protocol.resolve(message["service"], "service")
+            failed = self._calls.refuse_sole(session, name, "it has no 'id'")
+            raise ProtocolError(
+                "missing field 'id': a service_response carries the id of the call_service it answers"
+                + (f" (the one call of {name} waiting on this client failed)" if failed else "")
+            )
         if not self._calls.answer(session, message_id, message["result"], message.get("values")):
             raise ProtocolError(f"no call with id {message_id!r} is waiting for this client's answer")
 
@@ -587,6 +620,10 @@ class Bridge:
         name, kind = protocol.resolve(message["service"], "service"), message["type"]
         if self._owned(name):
             raise ProtocolError(f"service {name!r} is in a namespace of this server; clients cannot provide it")
+        for holder in self._holders:
+            held = holder(name, session.name)
+            if held is not None:
+                raise ProtocolError(held)
         with self._graph.lock:
             service = self._graph.services.get(name)
             if service is not None and service.provider is None:

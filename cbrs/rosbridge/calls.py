@@ -132,6 +132,16 @@ class Calls:
                 return True
         return False
 
+    def refuse_sole(self, provider: Session, service: str, reason: str) -> bool:
+        """A ``service_response`` for ``service`` without an id: when ``provider`` has exactly one call of
+        ``service`` in flight, the answer can only be meant for it, and it fails at once with ``reason``
+        (several: none can be told apart, and they wait). False if none failed."""
+        calls = [call for call in self._pending.values() if call.provider is provider and call.service == service]
+        if len(calls) != 1:
+            return False
+        self.finish(calls[0], False, protocol.dumps(_malformed(calls[0], reason)))
+        return True
+
     def fail_provider(self, provider: Session, service: str | None, reason: str) -> None:
         """Fail the calls waiting on ``provider`` (for ``service``, or all of them)."""
         for call in list(self._pending.values()):

@@ -10,6 +10,7 @@ from __future__ import annotations
 import array
 import functools
 import json
+import re
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -155,6 +156,32 @@ def decode(text: str, limit: int) -> Message:
     if not isinstance(op, str):
         raise ProtocolError(f"field 'op' must be a string, not {json_type(op)}", message_id=message_id)
     return message
+
+
+_MEMBER = re.compile(
+    r'\s*"((?:[^"\\]|\\.)*)"\s*:\s*("(?:[^"\\]|\\.)*"|-?\d+(?:\.\d+)?(?:[eE][+-]?\d+)?|true|false|null)\s*([,}])'
+)
+
+
+def leading_fields(text: str) -> Message:
+    """The members of a message that could not be decoded (too large, or not JSON further on) that stand
+    at its top level before its first object or array: ``op``, ``id`` and ``service`` as roslibpy and
+    roslibjs write them, before ``args``. Enough to answer the call the message was, by its id; nothing
+    nested is read, so a field of ``args`` named ``id`` is never taken for the message's."""
+    fields: Message = {}
+    start = text.find("{", 0, 64)
+    if start < 0 or text[:start].strip():
+        return fields
+    position = start + 1
+    while (match := _MEMBER.match(text, position)) is not None:
+        try:
+            fields.setdefault(json.loads(f'"{match[1]}"'), json.loads(match[2]))
+        except ValueError:  # an escape JSON does not have: read no further
+            break
+        if match[3] == "}":
+            break
+        position = match.end()
+    return fields
 
 
 def _parse(text: str) -> Any:

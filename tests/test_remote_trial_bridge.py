@@ -1,0 +1,234 @@
+"""What a buggy remote component or caller does to the bridge, found by writing components from the docs
+alone (roslibpy, roslibjs, a raw websocket): each mistake is answered at once, naming it, and harms no
+other client. Loopback only; every wait is bounded."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+from contextlib import ExitStack
+from typing import Any
+
+import pytest
+from websockets.sync.client import ClientConnection, connect
+
+from cbrs.actions.remote import RemoteCallError
+from cbrs.bridge_client import BridgeClient
+from cbrs.component import Component
+from cbrs.kb import KnowledgeBase
+from cbrs.rosbridge import Bridge, RunningBridge
+from cbrs.rosbridge.protocol import leading_fields
+from cbrs.server import ServeConfig, Server
+from cbrs.sparql_service import EndpointConfig
+from tests.test_live_components import READING, THERMOMETER, TOKEN, eventually, thermometer
+
+WAIT = 5.0
+LIMIT = 4096  # the test bridge's max_message_bytes: a "huge" message is small here
+
+
+class Raw:
+    """A websocket client that writes frames as they are, to send what a buggy client sends."""
+
+    def __init__(self, url: str) -> None:
+        self._stack = ExitStack()
+        self.ws: ClientConnection = self._stack.enter_context(connect(url, max_size=None, open_timeout=WAIT))
+
+    def send(self, message: dict[str, Any] | str) -> None:
+        self.ws.send(message if isinstance(message, str) else json.dumps(message))
+
+    def expect(self, op: str, **fields: Any) -> dict[str, Any]:
+        """The next message of ``op`` (whose ``fields`` have those values), skipping others; bounded."""
+        for _ in range(50):
+            message = json.loads(self.ws.recv(timeout=WAIT))
+            if message["op"] == op and all(message.get(k) == v for k, v in fields.items()):
+                return dict(message)
+        raise AssertionError(f"no {op} {fields} among 50 messages")
+
+    def nothing(self, op: str, wait: float = 0.3) -> None:
+        """No message of ``op`` comes within ``wait`` seconds (others may)."""
+        while True:
+            try:
+                message = json.loads(self.ws.recv(timeout=wait))
+            except TimeoutError:
+                return
+            assert message["op"] != op, message
+
+    def close(self) -> None:
+        self._stack.close()
+
+
+@pytest.fixture(scope="module")
+def bridge() -> Iterator[RunningBridge]:
+    with Bridge(max_message_bytes=LIMIT).start(port=0) as running:
+        yield running
+
+
+def test_leading_fields_reads_only_the_top_level_before_the_first_nested_value() -> None:
+    head = '{"op": "call_service", "id": 7, "service": "/a", "args": {"id": "inner"}, "x": '
+    assert leading_fields(head + '"' + "y" * 10_000) == {"op": "call_service", "id": 7, "service": "/a"}
+    assert leading_fields('{"args": {"id": "inner"}, "op": "call_service", "id": "late"}') == {}
+    assert leading_fields('{"op": "call_service", "service": "a\\"b", "id": "q", oops') == {
+        "op": "call_service",
+        "service": 'a"b',
+        "id": "q",
+    }
+    assert leading_fields("[1, 2]") == leading_fields("not json") == {}
+
+
+@pytest.mark.parametrize(
+    ("frame", "reason"),
+    [
+        pytest.param(
+            json.dumps({"op": "call_service", "id": "big", "service": "/cbrs/register", "args": {"d": "x" * LIMIT}}),
+            f"exceeds the limit of {LIMIT} bytes",
+            id="too-large",
+        ),
+        pytest.param(
+            '{"op": "call_service", "id": "big", "service": "/cbrs/register", "args": {"d": oops}}',
+            "not valid JSON",
+            id="not-json-after-its-head",
+        ),
+        pytest.param(
+            '{"op": "call_service", "id": "big", "service": 5}', "field 'service' must be a string", id="bad-field"
+        ),
+    ],
+)
+def test_a_call_that_cannot_be_read_is_answered_failed_by_its_id(
+    bridge: RunningBridge, frame: str, reason: str
+) -> None:
+    """roslibjs's callService waits for its answer without a timeout: a call the bridge refuses gets one,
+    not only a status message, which roslibjs does not read."""
+    caller = Raw(bridge.url)
+    try:
+        caller.send(frame)
+        assert reason in caller.expect("status", id="big")["msg"]  # the status carries the id it found
+        answer = caller.expect("service_response", id="big")
+        assert answer["result"] is False
+        assert reason in answer["values"]
+    finally:
+        caller.close()
+
+
+def test_a_call_whose_id_comes_only_after_its_args_gets_no_answer_in_its_name(bridge: RunningBridge) -> None:
+    caller = Raw(bridge.url)
+    try:
+        caller.send('{"op": "call_service", "service": "/a", "args": {"id": "inner", "d": "' + "x" * LIMIT + '"}}')
+        assert "exceeds the limit" in caller.expect("status")["msg"]
+        caller.nothing("service_response")
+    finally:
+        caller.close()
+
+
+def test_an_answer_without_an_id_fails_the_one_call_it_can_be_for_at_once(bridge: RunningBridge) -> None:
+    provider, caller = Raw(bridge.url), Raw(bridge.url)
+    try:
+        provider.send({"op": "advertise_service", "service": "/trial/read", "type": "lab_msgs/Read"})
+        provider.send({"op": "call_service", "service": "/rosapi/get_time", "id": "sync"})
+        provider.expect("service_response", id="sync")  # the advertisement is in
+        caller.send({"op": "call_service", "service": "/trial/read", "id": "c1", "timeout": 60})
+        call = provider.expect("call_service")
+        provider.send({"op": "service_response", "service": call["service"], "result": True, "values": {}})
+        status = provider.expect("status")
+        assert "missing field 'id'" in status["msg"] and "the one call of /trial/read" in status["msg"]
+        answer = caller.expect("service_response", id="c1")  # at once, not after its 60 s
+        assert answer["result"] is False and "it has no 'id'" in answer["values"]
+    finally:
+        provider.close()
+        caller.close()
+
+
+def test_an_answer_without_an_id_fails_no_call_when_several_wait(bridge: RunningBridge) -> None:
+    provider, caller = Raw(bridge.url), Raw(bridge.url)
+    try:
+        provider.send({"op": "advertise_service", "service": "/trial/two", "type": "lab_msgs/Read"})
+        provider.send({"op": "call_service", "service": "/rosapi/get_time", "id": "sync"})
+        provider.expect("service_response", id="sync")
+        for key in ("a", "b"):
+            caller.send({"op": "call_service", "service": "/trial/two", "id": key, "timeout": 60})
+        calls = [provider.expect("call_service"), provider.expect("call_service")]
+        provider.send({"op": "service_response", "service": "/trial/two", "result": True, "values": {}})
+        assert "missing field 'id'" in provider.expect("status")["msg"]
+        caller.nothing("service_response")
+        for call, value in zip(calls, (1, 2), strict=True):
+            provider.send(
+                {
+                    "op": "service_response",
+                    "service": "/trial/two",
+                    "id": call["id"],
+                    "result": True,
+                    "values": {"n": value},
+                }
+            )
+        assert caller.expect("service_response", id="a")["values"] == {"n": 1}
+        assert caller.expect("service_response", id="b")["values"] == {"n": 2}
+    finally:
+        provider.close()
+        caller.close()
+
+
+# -- through cbrs serve: a live component's service, and /cbrs/register's fields -----------------------
+
+
+@pytest.fixture(scope="module")
+def server() -> Iterator[Server]:
+    endpoint = EndpointConfig(update_token=TOKEN, isolate=False)
+    running = Server(KnowledgeBase.open(":memory:"), ServeConfig(port=0, bridge_port=0, endpoint=endpoint))
+    running.start()
+    try:
+        yield running
+    finally:
+        running.stop()
+
+
+def url(server: Server) -> str:
+    return f"ws://127.0.0.1:{server.bridge_port}"
+
+
+@pytest.mark.parametrize("authorised", [True, False], ids=["authorised", "anonymous"])
+def test_another_client_cannot_take_the_service_a_live_component_holds(server: Server, authorised: bool) -> None:
+    """The bridge lets a client take a service over from another (as rosbridge_suite does); a live
+    component's service is kept for the program that registered it, else any page or script on the
+    bridge would answer the plan's calls in its place."""
+    component = Component(thermometer())
+    component.handler(lambda request: {**READING, "by": "the thermometer"})
+    with component.connect(url(server), TOKEN):
+        intruder = Raw(url(server))
+        try:
+            if authorised:
+                intruder.send({"op": "auth", "mac": TOKEN})
+            intruder.send({"op": "advertise_service", "service": "thermometer07/read", "type": "x/Y", "id": "a"})
+            refused = intruder.expect("status", id="a")
+            assert refused["level"] == "error"
+            assert f"held by the live component <{THERMOMETER}>" in refused["msg"]
+            with BridgeClient(url(server), TOKEN) as caller:
+                assert caller.call_sync("/thermometer07/read", {})["by"] == "the thermometer"
+        finally:
+            intruder.close()
+    assert eventually(lambda: server.live.holder("/thermometer07/read", "anyone") is None)  # its program gone
+
+
+@pytest.mark.parametrize(
+    ("args", "reason"),
+    [
+        pytest.param({"description": "x", "tll": 10}, "takes no field 'tll'", id="misspelt-field"),
+        pytest.param({"description": 5}, "field 'description' must be the description as text", id="not-text"),
+        pytest.param({}, "missing field 'description'", id="missing"),
+    ],
+)
+def test_a_registration_with_a_wrong_field_is_refused_naming_it(
+    server: Server, args: dict[str, Any], reason: str
+) -> None:
+    with BridgeClient(url(server), TOKEN) as client, pytest.raises(RemoteCallError, match=reason) as refused:
+        client.call_sync("/cbrs/register", args)
+    if "tll" in args:
+        assert "did you mean 'ttl'?" in str(refused.value)
+
+
+def test_a_registration_too_large_to_read_is_refused_at_once(server: Server) -> None:
+    with BridgeClient(url(server), TOKEN) as client, pytest.raises(RemoteCallError, match="exceeds the limit"):
+        client.call_sync("/cbrs/register", {"description": "#" * (2 << 20)}, timeout=30)
+
+
+def test_registering_without_the_token_says_how_to_send_it(server: Server) -> None:
+    with BridgeClient(url(server)) as client, pytest.raises(RemoteCallError, match="call it before run"):
+        client.call_sync("/cbrs/register", {"description": thermometer()})
