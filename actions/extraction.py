@@ -89,6 +89,7 @@ class Extraction:
         self._goal_concepts = {
             c for _, n in goal_needs if n.statement is not None for c in (n.statement.subject, n.statement.object)
         }
+        self._goal_subjects = {n.statement.subject for _, n in goal_needs if n.statement is not None}
         blocked = [(node, n) for node, n in goal_needs if not self._ready(node, n)]
         if blocked:
             for node, need in blocked:
@@ -194,7 +195,7 @@ class Extraction:
                     given = [e for e in given if not self._foreign(step, e)]
                 if given:
                     step.bindings.append(
-                        _Bound(need, min(given, key=lambda e: (self._aboutness(step, e), *self._key(e))), None)
+                        _Bound(need, min(given, key=lambda e: (*self._fit(step, e), *self._key(e))), None)
                     )
                     continue
                 mine = [(e, p) for p in step.producers for e in options if e.source == self.steps[p].node]
@@ -226,6 +227,21 @@ class Extraction:
                 step.producers.append(producer.id)
                 step.bindings.append(_Bound(need, best, producer.id))
                 queue.append(producer.id)
+
+    def _fit(self, step: _Step, edge: Edge) -> tuple[int, int]:
+        """The order of the values the task gives for a need of ``step``: the most about what it serves
+        first (:meth:`_aboutness`), then, of two as much about it, one whose class falls under a goal's
+        subject (0) before one that does not (1). A statement is about its subject: in (TeaTin, isLocated,
+        Counter) the tin is what is moved and the counter where to, and a counter that is furniture as
+        well as a place is as much a physical object as the tin, at the same depth. The tie used to go
+        to the input whose name sorts first."""
+        about = self._aboutness(step, edge)
+        concept = edge.offer.concept
+        index = self.graph.pool.matcher.index
+        if concept is None or concept not in index:
+            return (about, 1)
+        ancestors = index.is_a_ancestors(concept)
+        return (about, 0 if any(c in ancestors for c in self._goal_subjects.intersection(step.about)) else 1)
 
     def _aboutness(self, step: _Step, edge: Edge) -> int:
         """How well a value the task gives fits what ``step`` is for: minus the depth of the most specific
@@ -310,7 +326,7 @@ class Extraction:
             given = [e for e in options if e.source == SRI]
             if given and len(given) < len(options):
                 given = [e for e in given if not self._foreign(probe, e)]
-            chosen = min(given, key=lambda e: (self._aboutness(probe, e), *self._key(e))) if given else None
+            chosen = min(given, key=lambda e: (*self._fit(probe, e), *self._key(e))) if given else None
             served = (need.statement.subject, need.statement.object) if need.statement is not None else ()
             ways.append((need, chosen, (*served, *about), [e for e in options if e.source != SRI]))
         return ways

@@ -1,0 +1,72 @@
+"""An object put onto a piece of furniture that is a place too (new-user trial A): a tea tin, a class of
+its own with its grasp, onto a counter typed ``home:Furniture`` and ``home:ObjectPlace``. Both are
+physical objects as deep in the taxonomy, and both are the goal's, so which one the arm's steps take
+(QueryManipulationProperty's ``objectType``) was decided by which input's name sorts first: with the
+counter's input named ``counter`` and the tin's ``tin``, the plan took the counter's shape and grasp,
+left the tin out, and the run failed ("the semantic map has no shape, size or grasp for Counter1").
+Now the goal's subject decides the tie (actions/extraction.py, ``Extraction._fit``)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from cbrs.actions.composer import Composer
+from cbrs.kb import KnowledgeBase
+
+LAB = "https://example.org/lab#"
+TIN_AND_COUNTER = """@prefix home: <https://w3id.org/cbrs/home#> . @prefix world: <https://w3id.org/cbrs/world#> .
+@prefix lab: <https://example.org/lab#> . @prefix owl: <http://www.w3.org/2002/07/owl#> .
+@prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .
+lab:TeaTin a owl:Class ; rdfs:subClassOf home:Container ; home:graspApproach "side top" ; home:graspHeightRatio 0.5 .
+lab:Counter a owl:Class ; rdfs:subClassOf home:Furniture , home:ObjectPlace .
+lab:TeaTin1 a lab:TeaTin ; home:shapeKind "cylinder" ; home:sizeX 0.065 ; home:sizeY 0.065 ; home:sizeZ 0.09 ;
+    home:massKg 0.12 ; home:colourName "green" ; home:rgba "0.10 0.60 0.25 1" ;
+    home:isLocatedOn world:KitchenTable ; home:x 7.90 ; home:y 3.18 ; home:yaw 0.0 .
+lab:Counter1 a lab:Counter ; home:isLocated world:Kitchen ;
+    home:minX 8.12 ; home:maxX 8.45 ; home:minY 2.72 ; home:maxY 2.98 ; home:minZ 0.0 ; home:maxZ 0.85 .
+"""
+
+
+def put_tin_on_counter(tin: str, counter: str) -> str:
+    return f"""@prefix cbrs: <https://w3id.org/cbrs/core#> . @prefix home: <https://w3id.org/cbrs/home#> .
+@prefix svc: <https://w3id.org/cbrs/service#> . @prefix lab: <https://example.org/lab#> .
+lab:PutTinOnCounter a cbrs:Requirement ; cbrs:requestedBy svc:CytonDualArm01 ; cbrs:deviceName "CytonDualArm01" ;
+    cbrs:serviceName "PutTinOnCounter" ;
+    cbrs:hasOWLSModel [ a cbrs:OWLSModel ;
+        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "{tin}" ; cbrs:parameterType lab:TeaTin ] ;
+        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "{counter}" ; cbrs:parameterType lab:Counter ] ;
+        cbrs:hasEffect [ a cbrs:Effect ; cbrs:conditionSubject lab:TeaTin ; cbrs:conditionPredicate home:isLocated ;
+            cbrs:conditionObject lab:Counter ] ] .
+"""
+
+
+@pytest.mark.parametrize(
+    ("tin", "counter"),
+    [pytest.param("tin", "counter", id="the-counter-sorts-first"), pytest.param("aTin", "counter", id="the-tin-does")],
+)
+def test_the_arm_takes_the_goals_subject_not_the_furniture_it_goes_onto(tmp_path: Path, tin: str, counter: str) -> None:
+    kb = KnowledgeBase.open(":memory:")
+    for graph, text in (
+        ("ontology", TIN_AND_COUNTER),
+        ("map", TIN_AND_COUNTER),
+        ("requirements", put_tin_on_counter(tin, counter)),
+    ):
+        path = tmp_path / f"{graph}.ttl"
+        path.write_text(text, encoding="utf-8")
+        kb.load([path], graph=graph)
+    result = Composer(kb).compose(LAB + "PutTinOnCounter")
+    assert result.plan is not None, result.unsatisfied
+    given = {
+        (step.component.rsplit("#", 1)[-1], binding.name): binding.source.name
+        for step in result.plan.steps
+        for binding in step.inputs
+        if binding.source.step is None
+    }
+    assert given == {
+        ("QueryManipulationProperty_HomeServer01", "objectType"): tin,
+        ("InferObjectProperty_HomeServer01", "objectType"): tin,
+        ("CarryObject_CytonDualArm01", "targetPlace"): counter,
+    }
+    assert result.unused_inputs == ()
