@@ -33,7 +33,7 @@ from cbrs.kb.namespaces import CBRS, OWL, PREFIXES, RDF, GraphName, expand, shor
 from cbrs.kb.skolem import is_skolem
 from cbrs.kb.staged_writes import STAGING
 from cbrs.kb.store import EmbeddedStore, Term
-from cbrs.output import RESULT_FORMATS, ProgressLine, node_view, render_result, table, term_text
+from cbrs.output import RESULT_FORMATS, ProgressLine, node_view, render_result, sorted_lists, table, term_text
 from cbrs.settings import SETTINGS, setting
 from cbrs.sparql_hints import explain_syntax_error
 
@@ -459,9 +459,9 @@ def deregister(app: App, iri: str) -> None:
 @click.option("--json", "as_json", is_flag=True, help="Print the advertisements as JSON.")
 @pass_app
 def services(app: App, as_json: bool) -> None:
-    """List the registered advertisements with their kind, device and inputs -> outputs, and whether a
-    component registered live (in another process) can be invoked now."""
-    rows = app.kb.select("advertisements")
+    """List the registered advertisements with their kind, device and inputs -> outputs (each list in IRI
+    order), and whether a component registered live (in another process) can be invoked now."""
+    rows = sorted_lists(app.kb.select("advertisements"), ("inputs", "outputs"))  # the store's order varies
     live = app.kb.liveness.states()
     if as_json:
         found = []

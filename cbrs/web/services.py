@@ -160,7 +160,9 @@ def _similar_url(description: dict[str, Any]) -> str | None:
 
 
 def _split(term: Term | None) -> list[str]:
-    return term.value.split() if term is not None else []
+    """A ``GROUP_CONCAT`` of IRIs as a list in IRI order, as ``cbrs services`` gives it: the store's
+    order differs between stores (:func:`cbrs.output.sorted_lists`)."""
+    return sorted(term.value.split()) if term is not None else []
 
 
 def _value(term: Term | None) -> str | None:
