@@ -195,7 +195,10 @@ def test_streams_have_their_own_threads_and_one_client_gets_one(served: Server) 
         first.stream("GET", base + "/tasks/events") as stream,
     ):
         assert stream.status_code == 200
-        next(stream.iter_lines())
+        # Keep the iterator: httpx closes the connection when a dropped one is collected, and the server
+        # then rightly frees the slot at its next heartbeat (under load, before the checks below ran).
+        lines = stream.iter_lines()
+        next(lines)
         refused = third.get(base + "/tasks/events")
         assert refused.status_code == 503 and "streams_per_client" in refused.text
         answer = second.get(base + "/sparql", params={"query": POINT})
@@ -205,6 +208,7 @@ def test_streams_have_their_own_threads_and_one_client_gets_one(served: Server) 
             full = client("127.0.0.3").get(base + "/tasks/events")
             assert full.status_code == 503 and "stream_limit" in full.text
             assert third.get(base + "/sparql", params={"query": POINT}).json()["boolean"] is True
+            assert served.app.extensions["cbrs.streams"].open == 2  # both streams still held
     deadline = time.monotonic() + WAIT  # closed streams give their slots back
     while served.app.extensions["cbrs.streams"].open and time.monotonic() < deadline:
         time.sleep(0.05)
