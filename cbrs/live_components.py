@@ -66,6 +66,9 @@ SERVER_NAMESPACES = ("/cbrs/", "/rosapi/")
 NO_LIVE_COMPONENT = "this session has no live component"
 """How a heartbeat says the session's registration is gone (its lease lapsed): register again."""
 DEREGISTERED = "was deregistered"
+UNPROVIDED = "no bridge client provides its service"
+"""How a lease ended because nobody answers the component's service: a bridge registration whose program
+never advertised the service its description names (a misspelt name), or an HTTP one whose provider left."""
 """How a heartbeat says a component was deregistered (``cbrs deregister``): do not register it again."""
 STALL_PERIODS = 4
 """A gap of more than this many watchdog periods (1 s at the default lease) between two moments this
@@ -222,6 +225,12 @@ class LiveComponents:
             deregistered = sorted(iri for iri, why in ended.items() if why == "it was deregistered")
             if deregistered:
                 raise ServiceError(f"{', '.join(deregistered)} {DEREGISTERED}: it is no longer registered")
+            unanswered = sorted(f"<{iri}>: {why}" for iri, why in ended.items() if why.startswith(UNPROVIDED))
+            if unanswered:  # registering again would not help: say what would
+                raise ServiceError(
+                    f"{'; '.join(unanswered)}, so it is unavailable: advertise the service its cbrs:topic names "
+                    "(advertise_service, after registering), then register again"
+                )
             lapsed = "".join(f"; {iri}: {why}" for iri, why in sorted(ended.items()))
             raise ServiceError(f"{NO_LIVE_COMPONENT}: register first{lapsed}")
         return {"components": renewed, "ended": ended} if ended else {"components": renewed}
@@ -334,6 +343,11 @@ class LiveComponents:
             "session provides it while its lease lasts (a component of your own needs a service of its own)"
         )
 
+    def holds(self, service: str) -> bool:
+        """Whether a live component is grounded on the bridge ``service`` (its ``result`` is a verdict)."""
+        with self._guard:
+            return any(lease.service == service for lease in self._leases.values())
+
     def renew(self, session: str) -> list[str]:
         """Renew the leases of ``session``'s components; the store is written when half a lease has passed,
         and then a component deregistered meanwhile (``cbrs deregister``) loses its lease and its state."""
@@ -347,12 +361,18 @@ class LiveComponents:
                     if lease.written_until - now < lease.ttl / 2:
                         lease.written_until = lease.deadline
                         stale.append((iri, lease.ttl))
-                        if not lease.bridge and self.provided is not None and not self.provided(lease.service):
-                            unprovided.append(iri)
+                        if self.provided is not None and not self.provided(lease.service):
+                            unprovided.append((iri, lease))
+        for iri, lease in unprovided:  # nobody would answer its calls: plans must not count on it
+            if lease.bridge:
+                self._end([iri], f"{UNPROVIDED} {lease.service} (its program registered it but does not answer it)")
+                self._remember_ended(session, [iri], f"{UNPROVIDED} {lease.service}")
+            else:
+                self._end([iri], "no bridge client provides its service")
         if unprovided:
-            self._end(unprovided, "no bridge client provides its service")
-            stale = [(iri, ttl) for iri, ttl in stale if iri not in unprovided]
-            renewed = [iri for iri in renewed if iri not in unprovided]
+            dropped = {iri for iri, _ in unprovided}
+            stale = [(iri, ttl) for iri, ttl in stale if iri not in dropped]
+            renewed = [iri for iri in renewed if iri not in dropped]
         if stale:
             gone = []
             with self.sparql.lock:

@@ -94,6 +94,7 @@ class Server:
             self.bridge.add_service(name, kind, handler)
         self.bridge.on_disconnect(self.live.disconnected)
         self.bridge.hold_services(self.live.holder)  # a live component's calls go to its own program only
+        self.bridge.strict_results(self.live.holds)  # and its `result: false` is a failure, values or not
         self._rosout = RosoutHandler(self.bridge)
         self.tasks.transport = self._own_bridge
         self._transport: BridgeClient | None = None

@@ -5,6 +5,7 @@ other client. Loopback only; every wait is bounded."""
 from __future__ import annotations
 
 import json
+import time
 from collections.abc import Iterator
 from contextlib import ExitStack
 from typing import Any
@@ -16,6 +17,7 @@ from cbrs.actions.remote import RemoteCallError
 from cbrs.bridge_client import BridgeClient
 from cbrs.component import Component
 from cbrs.kb import KnowledgeBase
+from cbrs.live_components import NO_LIVE_COMPONENT
 from cbrs.rosbridge import Bridge, RunningBridge
 from cbrs.rosbridge.protocol import leading_fields
 from cbrs.server import ServeConfig, Server
@@ -232,3 +234,54 @@ def test_a_registration_too_large_to_read_is_refused_at_once(server: Server) -> 
 def test_registering_without_the_token_says_how_to_send_it(server: Server) -> None:
     with BridgeClient(url(server)) as client, pytest.raises(RemoteCallError, match="call it before run"):
         client.call_sync("/cbrs/register", {"description": thermometer()})
+
+
+def test_a_component_whose_program_answers_another_service_than_it_registered_is_made_unavailable(
+    server: Server,
+) -> None:
+    """A misspelt service name (the description says /trial07/read, the program advertises /trial_07/read):
+    every call of a plan would fail 'does not exist', so at the lease's first store write it is unavailable,
+    and its heartbeat says what to fix rather than 'register again', which would not help."""
+    description = thermometer("/trial07/read").replace("Thermometer07", "Thermometer77")
+    iri = THERMOMETER.replace("Thermometer07", "Thermometer77")
+    with BridgeClient(url(server), TOKEN) as program:
+        program.call_sync("/cbrs/register", {"description": description, "ttl": 1.0})
+        program.provide("/trial_07/read", "cbrs_msgs/RoomTemperature", lambda request: READING)
+        answers: list[str] = []
+        for _ in range(40):  # a heartbeat every 0.1 s, 4 s at most
+            try:
+                program.call_sync("/cbrs/heartbeat", {})
+            except RemoteCallError as error:
+                answers.append(str(error))
+                break
+            time.sleep(0.1)
+        assert answers, "the heartbeat kept the component available"
+        assert "no bridge client provides its service /trial07/read" in answers[0]
+        assert "advertise the service its cbrs:topic names" in answers[0]
+        assert NO_LIVE_COMPONENT not in answers[0]  # the SDK would register again, to no avail
+        state = server.kb.liveness.states()[iri]
+        assert not state.live and "/trial07/read" in (state.reason or "")
+
+
+def test_a_live_components_result_false_fails_the_call_though_it_sent_an_object(server: Server) -> None:
+    """roslibpy answers a handler's ``return False`` with ``values: {}``, which rosbridge_suite (and the
+    bridge, for any other service) takes as the answer: a door motor with no outputs would have opened."""
+    description = thermometer("/trial08/read").replace("Thermometer07", "Thermometer78")
+    program = Raw(url(server))
+    try:
+        program.send({"op": "auth", "mac": TOKEN})
+        program.send(
+            {"op": "call_service", "service": "/cbrs/register", "id": "r", "args": {"description": description}}
+        )
+        assert program.expect("service_response", id="r")["result"] is True
+        program.send({"op": "advertise_service", "service": "/trial08/read", "type": "cbrs_msgs/RoomTemperature"})
+        with BridgeClient(url(server), TOKEN) as caller:
+            answer = caller.call("/trial08/read", {}, timeout=10)
+            call = program.expect("call_service")
+            program.send(
+                {"op": "service_response", "service": call["service"], "id": call["id"], "result": False, "values": {}}
+            )
+            with pytest.raises(RemoteCallError, match="'/trial08/read' answered result: false"):
+                answer.result(timeout=WAIT)
+    finally:
+        program.close()

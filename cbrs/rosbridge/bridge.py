@@ -131,6 +131,7 @@ class Bridge:
         self._clients = itertools.count(1)
         self._disconnect_listeners: list[Callable[[str], None]] = []
         self._holders: list[Callable[[str, str], str | None]] = []
+        self._verdicts: list[Callable[[str], bool]] = []
         self._ops: dict[str, Callable[[Session, Message], None]] = {
             "advertise": self._advertise,
             "unadvertise": self._unadvertise,
@@ -306,7 +307,7 @@ class Bridge:
             raise RosbridgeError("this bridge is already being served; stop it before serving it again")
         self._workers = WorkerPool(self.service_workers)
         self._goal_workers = WorkerPool(self.action_workers, name="cbrs-rosbridge-action")
-        self._calls = Calls(loop, self._workers, self.non_finite)
+        self._calls = Calls(loop, self._workers, self.non_finite, self._strict)
         self._goals = Goals(loop, self._goal_workers, self.non_finite)
         self._loop = loop
 
@@ -455,6 +456,16 @@ class Bridge:
         live component's service for the session that registered it; another client would otherwise take
         its calls (a client may take a service over from another, as in rosbridge_suite)."""
         self._holders.append(holder)
+
+    def strict_results(self, predicate: Callable[[str], bool]) -> None:
+        """A provider's ``result: false`` fails the call of a service ``predicate(service)`` is true for,
+        even with an object of values, which rosbridge_suite takes as the answer (below): roslibpy
+        answers ``{}`` with a handler's ``False``, and a live component that cannot act must not be
+        taken for one that acted. Asked on the bridge's loop: keep it short."""
+        self._verdicts.append(predicate)
+
+    def _strict(self, service: str) -> bool:
+        return any(predicate(service) for predicate in self._verdicts)
 
     def on_disconnect(self, listener: Callable[[str], None]) -> None:
         """Call ``listener(session name)`` on the bridge's loop when a client disconnects (a live

@@ -11,6 +11,7 @@ import asyncio
 import contextlib
 import itertools
 import logging
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -63,8 +64,15 @@ def run_handler(
 class Calls:
     """The calls in flight on one running bridge."""
 
-    def __init__(self, loop: asyncio.AbstractEventLoop, workers: WorkerPool, non_finite: str = "null") -> None:
+    def __init__(
+        self,
+        loop: asyncio.AbstractEventLoop,
+        workers: WorkerPool,
+        non_finite: str = "null",
+        strict: Callable[[str], bool] = lambda service: False,
+    ) -> None:
         self._loop = loop
+        self._strict = strict  # services whose provider's `result: false` fails the call, values or not
         self._workers = workers
         self._non_finite = non_finite  # how values' NaNs are written (protocol.NON_FINITE)
         self._pending: dict[str, Call] = {}
@@ -101,7 +109,13 @@ class Calls:
         call = self._pending.get(str(key))
         if call is None or call.provider is not provider:
             return False
-        if isinstance(values, dict):
+        if isinstance(values, dict) and not result and self._strict(call.service):
+            given = protocol.dumps(values, self._non_finite)
+            result, values = (
+                False,
+                f"service {call.service!r} answered result: false" + (f" (values {given[:200]})" if values else ""),
+            )
+        elif isinstance(values, dict):
             result = True  # rosbridge_suite's rule: an object of values is the response, whatever `result` says
         elif values is None:
             values = {} if result else f"service {call.service!r} failed (its provider gave no reason)"
