@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import difflib
 import re
+from collections import Counter
+from dataclasses import dataclass
 from typing import Literal
 
 from cbrs.kb.errors import QuerySyntaxError
@@ -83,7 +85,7 @@ def undeclared_prefixes(text: str) -> list[str]:
 def explain_syntax_error(error: QuerySyntaxError, text: str, expected: Literal["query", "update"]) -> QuerySyntaxError:
     """``error`` with a plain reason in front where the parser's list of expected tokens hides it: an
     update sent as a query (or the other way round), a misspelt first keyword, a prefix nobody declared,
-    or a text that ends inside a block."""
+    a bracket closed by the wrong kind, or a text that ends inside brackets."""
     if type(error) is not QuerySyntaxError:  # QueryTooComplexError and the like say what they mean
         return error
     at = _ERROR_AT.search(error.message)
@@ -117,26 +119,88 @@ def explain_syntax_error(error: QuerySyntaxError, text: str, expected: Literal["
             known = f"the parser: {said}"
         reason = f"the prefix '{prefix}:' is not declared: add PREFIX {prefix}: <IRI>; {known}"
         return QuerySyntaxError(text, where + reason)
-    open_blocks = unclosed(text)
-    if open_blocks:  # the parser lists every token that could have come next
+    nesting = _nesting(text)
+    if nesting.wrong is not None and (at is None or _offset(text, at.group(1)) >= nesting.wrong.closed_at):
+        wrong = nesting.wrong  # the parser's list would name what may follow, not which bracket is wrong
         return QuerySyntaxError(
             text,
-            f"{where or 'at the end: '}the text ends with {open_blocks} '{{' not closed: add '}}' where each "
-            "block ends",
+            f"{where}the {wrong.closer!r} at {_place(text, wrong.closed_at)} comes while the {wrong.opener!r} "
+            f"opened at {_place(text, wrong.opened_at)} is open: close it with {_CLOSERS[wrong.opener]!r} first, "
+            f"or remove the {wrong.closer!r}",
         )
+    if nesting.wrong is None and nesting.open:  # the parser lists every token that could have come next
+        return QuerySyntaxError(text, f"{where or 'at the end: '}the text ends with {_still_open(nesting.open)}")
     return error
 
 
-_BRACE = re.compile(HIDING + r"|[{}]", re.DOTALL)
-"""Strings, IRIs and comments, which hide the braces inside them; then the braces that count."""
+_CLOSERS = {"{": "}", "(": ")", "[": "]"}
+_OPENERS = {closer: opener for opener, closer in _CLOSERS.items()}
+_BRACKET = re.compile(HIDING + r"|\\.|[{}()\[\]]", re.DOTALL)
+"""Strings, IRIs, comments and escaped characters (``ex:a\\(``), which hide the brackets inside them; then
+the brackets that count."""
 
 
-def unclosed(text: str) -> int:
-    """How many ``{`` of ``text`` (outside strings, IRIs and comments) no ``}`` closes: the parser's answer
-    to a text that ends inside a block is a list of every token it could have read."""
-    depth = 0
-    for match in _BRACE.finditer(text):
+@dataclass(frozen=True)
+class WrongBracket:
+    """A closing bracket that closes a different kind than the innermost one open (offsets into the text)."""
+
+    closer: str
+    closed_at: int
+    opener: str
+    opened_at: int
+
+
+@dataclass(frozen=True)
+class Nesting:
+    """How a text's brackets nest: the first wrongly closed one, and those still open at its end
+    (outermost first, as ``(bracket, offset)``) — read up to the first wrong one."""
+
+    wrong: WrongBracket | None
+    open: tuple[tuple[str, int], ...]
+
+
+def _nesting(text: str) -> Nesting:
+    """How the ``{}``, ``()`` and ``[]`` of ``text`` (outside strings, IRIs and comments) nest. A closer
+    with nothing open is left to the parser, whose message names it well."""
+    stack: list[tuple[str, int]] = []
+    for match in _BRACKET.finditer(text):
         token = match.group()
-        depth += 1 if token == "{" else -1 if token == "}" else 0
-        depth = max(depth, 0)
-    return depth
+        if token in _CLOSERS:
+            stack.append((token, match.start()))
+        elif token in _OPENERS and stack:
+            opener, opened_at = stack[-1]
+            if _CLOSERS[opener] != token:
+                return Nesting(WrongBracket(token, match.start(), opener, opened_at), tuple(stack))
+            stack.pop()
+    return Nesting(None, tuple(stack))
+
+
+def _still_open(stack: tuple[tuple[str, int], ...]) -> str:
+    """What is still open: for blocks alone (the common case) their count and where to close them;
+    otherwise each kind counted and the closers to add, innermost first."""
+    kinds = Counter(bracket for bracket, _ in stack)
+    if set(kinds) == {"{"}:
+        return f"{kinds['{']} '{{' not closed: add '}}' where each block ends"
+    counted = " and ".join(f"{n} {bracket!r}" for bracket, n in kinds.items())
+    closers = "".join(_CLOSERS[bracket] for bracket, _ in reversed(stack))
+    add = f"add {closers!r} (innermost first)" if len(closers) <= 12 else "close each where it ends"
+    return f"{counted} not closed: {add}"
+
+
+def _place(text: str, offset: int) -> str:
+    """``line:column`` of ``offset``, both from 1 as the parser counts them."""
+    line = text.count("\n", 0, offset) + 1
+    column = offset - (text.rfind("\n", 0, offset) + 1) + 1
+    return f"{line}:{column}"
+
+
+def _offset(text: str, place: str) -> int:
+    """The offset of the parser's ``line:column``, the inverse of :func:`_place`."""
+    line, column = (int(part) for part in place.split(":"))
+    start = 0
+    for _ in range(line - 1):
+        found = text.find("\n", start)
+        if found < 0:
+            return len(text)
+        start = found + 1
+    return start + column - 1
