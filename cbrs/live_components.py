@@ -251,8 +251,10 @@ class LiveComponents:
         ttl = self.ttl if ttl is None else ttl
         if len(description.encode("utf-8")) > MAX_DESCRIPTION_BYTES:
             raise InvalidDescriptionError("<registration>", [f"it is larger than {MAX_DESCRIPTION_BYTES} bytes"])
+        fmt = fmt.lower()
         if fmt not in FORMATS:
             raise ValueError(f"unknown description format {fmt!r}; use {' or '.join(FORMATS)}")
+        _check_format(description, fmt)
         turtle = description if fmt == "turtle" else _to_turtle(description, FORMATS[fmt])
         parsed = parse_bytes(turtle.encode("utf-8"), "<registration>", ox.RdfFormat.TURTLE, GraphName.SERVICES, BASE)
         named = {
@@ -501,6 +503,24 @@ def _check_fields(args: dict[str, Any]) -> None:
         hint = f"; did you mean {close[0]!r}?" if close else ""
         raise ServiceError(
             f"/cbrs/register takes no field {unknown[0]!r} (its fields: {', '.join(REGISTER_FIELDS)}){hint}"
+        )
+
+
+def _check_format(description: str, fmt: str) -> None:
+    """Refuse a description sent as the other format, saying so: the parser's own error ("{ is not a
+    valid predicate", "Unexpected char: '@'") does not say that the format was the mistake."""
+    text = description.lstrip()
+    head = text[:1]
+    if head == "[":  # a JSON array of objects, or a Turtle blank node ("[ a cbrs:...")
+        head = "{" if text[1:].lstrip()[:1] in ("{", "]") else ""
+    written = {"{": "json-ld", "@": "turtle", "<": "turtle", "#": "turtle"}.get(head)
+    if written is not None and written != fmt:
+        raise InvalidDescriptionError(
+            "<registration>",
+            [
+                f"it reads as {written}, not {fmt}: say so (format {written!r} on the bridge, or its Content-Type "
+                "over HTTP: text/turtle, application/ld+json)"
+            ],
         )
 
 

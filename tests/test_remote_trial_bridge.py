@@ -10,6 +10,7 @@ from collections.abc import Iterator
 from contextlib import ExitStack
 from typing import Any
 
+import pyoxigraph as ox
 import pytest
 from websockets.sync.client import ClientConnection, connect
 
@@ -285,3 +286,24 @@ def test_a_live_components_result_false_fails_the_call_though_it_sent_an_object(
                 answer.result(timeout=WAIT)
     finally:
         program.close()
+
+
+@pytest.mark.parametrize(
+    ("fmt", "as_json", "reason"),
+    [
+        pytest.param("turtle", True, "it reads as json-ld, not turtle", id="json-ld-sent-as-turtle"),
+        pytest.param("json-ld", False, "it reads as turtle, not json-ld", id="turtle-sent-as-json-ld"),
+    ],
+)
+def test_a_description_sent_as_the_other_format_is_refused_saying_so(
+    server: Server, fmt: str, as_json: bool, reason: str
+) -> None:
+    text = thermometer("/trial09/read").replace("Thermometer07", "Thermometer79")
+    if as_json:
+        text = ox.serialize(list(ox.parse(text.encode(), format=ox.RdfFormat.TURTLE)), format=ox.RdfFormat.JSON_LD)
+        text = text.decode("utf-8")
+    with BridgeClient(url(server), TOKEN) as client, pytest.raises(RemoteCallError, match=reason):
+        client.call_sync("/cbrs/register", {"description": text, "format": fmt})
+    with BridgeClient(url(server), TOKEN) as client:  # said so, in either spelling, it registers
+        right = "json-ld" if as_json else "turtle"
+        assert client.call_sync("/cbrs/register", {"description": text, "format": right.upper()})["components"]
