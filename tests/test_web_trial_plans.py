@@ -166,15 +166,18 @@ def test_saving_the_drawing_draws_each_arrow_once(composed: CompositionResult, m
 
 
 def test_a_plan_page_loads_the_drawing_library_once(client: FlaskClient, monkeypatch: pytest.MonkeyPatch) -> None:
-    """The page starts importing what its drawing needs (matplotlib, 1.1 s and more), once a process;
-    the JSON twin, which has no drawing, does not. A small module stands for the drawing's here."""
+    """The page (its form, or a plan) starts importing what a drawing needs (matplotlib, 1.1 s and more),
+    once a process; the JSON twin, which has no drawing, does not. A small module stands for the
+    drawing's here."""
     monkeypatch.setattr(plans, "DRAWING_MODULE", "colorsys")
     monkeypatch.delitem(sys.modules, "colorsys", raising=False)
     plans._load_drawing_library.cache_clear()
     try:
         assert client.get("/plans.json", query_string={"task": "RobotSelfPosition"}).status_code == 200
+        assert client.get("/plans.json").status_code == 200
         assert plans._load_drawing_library.cache_info().currsize == 0
-        client.get("/plans", query_string={"task": "RobotSelfPosition"})
+        client.get("/plans")  # the form: the user is about to choose a task
+        assert plans._load_drawing_library.cache_info().currsize == 1
         started = plans._load_drawing_library()
         assert started is not None
         started.join(timeout=10)

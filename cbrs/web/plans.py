@@ -48,6 +48,8 @@ def plans() -> Page:
     data["selected"] = _selected(task, options)
     shown = Page("plans.html", "Plans", data)
     if "task" not in request.args:
+        if not wants_json():
+            _load_drawing_library()  # while the user chooses a task
         return shown
     shown.title = f"Plan for {task}" if task else "Plans"
     with context.lock():  # a GET stays safe: the plan is shown, not recorded (cbrs plan and /cbrs/plan record)
@@ -120,9 +122,10 @@ DRAWING_MODULE = "cbrs.actions.draw"
 
 @functools.cache
 def _load_drawing_library() -> threading.Thread | None:
-    """Import the drawing's module, and matplotlib with it, in the background once a plan is shown. The
-    import took 1.1 to 1.5 s of the first drawing, with the store lock held; the page's ``<img>`` (lazy:
-    asked when scrolled to) now finds it done or under way. Once a process; None without matplotlib."""
+    """Import the drawing's module, and matplotlib with it, in the background once the plans page is
+    shown (its form, or a plan after it is composed). The import took 1.1 to 1.5 s of the first drawing,
+    with the store lock held; the page's ``<img>`` (lazy: asked when scrolled to) now finds it done or
+    under way. Once a process; None without matplotlib."""
     if not installed("eval"):
         return None
     thread = threading.Thread(target=importlib.import_module, args=(DRAWING_MODULE,), name="cbrs-drawing", daemon=True)
