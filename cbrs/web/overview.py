@@ -9,6 +9,7 @@ from flask import Blueprint, url_for
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import GraphName
 from cbrs.web import context, services
+from cbrs.web.graphs import about as graph_note
 from cbrs.web.links import short
 from cbrs.web.pages import Page, page
 
@@ -53,7 +54,13 @@ def _store_at_a_glance(kb: KnowledgeBase) -> tuple[list[dict[str, Any]], dict[st
     page a user opens took 0.5 s on OWLS-TC, counting 1,136 advertisements each time."""
     statistics = kb.statistics()
     graphs = [
-        {"graph": graph.iri, "name": short(graph.iri), "triples": statistics.get(graph.iri, 0)} for graph in GraphName
+        {
+            "graph": graph.iri,
+            "name": short(graph.iri),
+            "triples": statistics.get(graph.iri, 0),
+            **(graph_note(graph.iri) or {}),
+        }
+        for graph in GraphName
     ]
     counts = {
         "services": len(services.advertisement_rows(kb)),

@@ -21,6 +21,7 @@ from werkzeug.exceptions import BadRequest, HTTPException
 from cbrs.kb.errors import KnowledgeBaseError, NotFoundError
 from cbrs.kb.namespaces import OWL, RDF, RDFS, XSD, GraphName
 from cbrs.web import context
+from cbrs.web.graphs import about as graph_note
 from cbrs.web.links import display_text, expand_name, iri_link, short
 from cbrs.web.pages import Page, page, wants_json
 
@@ -144,13 +145,14 @@ def _uses_query(iri: str) -> str:
     return f"SELECT ?subject ?object ?graph\nWHERE {{ GRAPH ?graph {{ ?subject <{iri}> ?object }} }}"
 
 
-def _named_graph(iri: str) -> dict[str, int] | None:
+def _named_graph(iri: str) -> dict[str, Any] | None:
     """``{"triples": n}`` if ``iri`` names a graph of the store (one of cbrs's, even empty, or any other
-    that holds triples). Every page links graph names here: the overview's table, the graph column of
-    every triple; a graph is the subject of no triple, so each such link was a 404."""
+    that holds triples), with ``holds`` and ``written_by`` for one of cbrs's (:mod:`cbrs.web.graphs`).
+    Every page links graph names here: the overview's table, the graph column of every triple; a graph
+    is the subject of no triple, so each such link was a 404."""
     statistics = context.per_generation("graph_statistics", context.kb().statistics)
     if iri in statistics or iri in {graph.iri for graph in GraphName}:
-        return {"triples": statistics.get(iri, 0)}
+        return {"triples": statistics.get(iri, 0), **(graph_note(iri) or {})}
     return None
 
 
