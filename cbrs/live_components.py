@@ -34,7 +34,7 @@ import pyoxigraph as ox
 from cbrs.kb.errors import AlreadyRegisteredError, InvalidDescriptionError, KnowledgeBaseError
 from cbrs.kb.liveness import ComponentState
 from cbrs.kb.loader import parse_bytes
-from cbrs.kb.namespaces import BASE, RDF, GraphName
+from cbrs.kb.namespaces import BASE, RDF, GraphName, shorten
 from cbrs.kb.store import EmbeddedStore
 from cbrs.kb.vocab import CBRS
 from cbrs.rosbridge import ServiceError, current_caller
@@ -51,6 +51,7 @@ __all__ = [
     "NotProvidedError",
     "ServerServiceError",
     "ServiceHeldError",
+    "StoredComponentError",
     "grounding",
 ]
 
@@ -104,6 +105,20 @@ class ServerServiceError(InvalidDescriptionError):
         self.service = service
         owned = ", ".join(SERVER_NAMESPACES)
         super().__init__(component, [f"its bridge service {service} is the server's own ({owned}): name one of yours"])
+
+
+class StoredComponentError(AlreadyRegisteredError):
+    """A registration names a component the store has as its own (a bundled one, or one registered with
+    ``cbrs register``): a program may serve it only once it is removed, since its simulated or stored
+    implementation would otherwise be replaced behind the store's back."""
+
+    def __init__(self, iri: str) -> None:  # its own message, not the parent's
+        self.iri = iri
+        KnowledgeBaseError.__init__(
+            self,
+            f"<{iri}> is a component of the store, not a live one: to serve it from your program, remove it "
+            f"first (cbrs deregister {shorten(iri)}), or give your component a name of its own",
+        )
 
 
 class NotProvidedError(KnowledgeBaseError):
@@ -291,7 +306,7 @@ class LiveComponents:
                 if not kb.registry.is_registered(iri):
                     continue
                 if iri not in states:
-                    raise AlreadyRegisteredError(iri)  # a component of the store, not a live one
+                    raise StoredComponentError(iri)  # a component of the store, not a live one
                 returning.append(iri)
             if returning and len(returning) != len(named):
                 raise ValueError("register the components coming back apart from the new ones")

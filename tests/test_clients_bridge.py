@@ -70,7 +70,8 @@ def test_the_camera_program_refused_says_why_in_one_line(
     monkeypatch.setenv("CBRS_UPDATE_TOKEN", TOKEN)
     assert external_camera.main(["--url", url, "CeilingCamera01"]) == 1
     err = capsys.readouterr().err
-    assert "LocateMobileRobot_CeilingCamera01> is already registered" in err and err.count("\n") == 1, err
+    assert "LocateMobileRobot_CeilingCamera01> is a component of the store, not a live one" in err, err
+    assert err.count("\n") == 1, err
 
 
 # -- rosbridge's fragments and PNG compression ------------------------------------------------------

@@ -307,3 +307,14 @@ def test_a_description_sent_as_the_other_format_is_refused_saying_so(
     with BridgeClient(url(server), TOKEN) as client:  # said so, in either spelling, it registers
         right = "json-ld" if as_json else "turtle"
         assert client.call_sync("/cbrs/register", {"description": text, "format": right.upper()})["components"]
+
+
+def test_a_component_of_the_store_is_refused_saying_how_to_serve_it_from_a_program(server: Server) -> None:
+    """A lab replacing a bundled component with its own program: "update it instead" did not say how."""
+    description = thermometer("/trial10/read").replace("Thermometer07", "Thermometer80")
+    with server.sparql.lock:
+        server.kb.registry.register(description, "stored.ttl")  # as cbrs register does
+    with BridgeClient(url(server), TOKEN) as client, pytest.raises(RemoteCallError) as refused:
+        client.call_sync("/cbrs/register", {"description": description})
+    assert "is a component of the store, not a live one" in str(refused.value)
+    assert "cbrs deregister svc:ReadRoomTemperature_Thermometer80" in str(refused.value)
