@@ -39,7 +39,7 @@ from cbrs.kb.loader import parse_bytes
 from cbrs.kb.namespaces import BASE, RDF, GraphName, shorten
 from cbrs.kb.shapes import nearest_term
 from cbrs.kb.vocab import CBRS
-from cbrs.live_components import DEFAULT_TTL, DEREGISTERED, FORMATS, NO_LIVE_COMPONENT, grounding
+from cbrs.live_components import DEFAULT_TTL, DEREGISTERED, FORMATS, NO_LIVE_COMPONENT, UNPROVIDED, grounding
 from cbrs.stop_signals import POLL, StopRequest, handling
 
 __all__ = ["Component", "ComponentEndedError", "ConnectedComponent", "RegistrationRefusedError"]
@@ -253,6 +253,9 @@ class ConnectedComponent:
                 text = str(error)
                 if DEREGISTERED in text:
                     self._end(f"the server says {text}; start the program again to register it again")
+                    return False
+                if UNPROVIDED in text:  # nobody answers its service: registering again would not help
+                    self._end(f"the server says {text}")
                     return False
                 if NO_LIVE_COMPONENT in text:
                     if sent < self._registered_at:

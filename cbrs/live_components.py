@@ -47,6 +47,7 @@ __all__ = [
     "MAX_DESCRIPTION_BYTES",
     "NO_LIVE_COMPONENT",
     "SERVER_NAMESPACES",
+    "UNPROVIDED",
     "LiveComponents",
     "NotProvidedError",
     "ServerServiceError",

@@ -166,7 +166,7 @@ def test_heartbeats_keep_a_short_lease_alive(server: Server) -> None:
         (
             thermometer().replace("ReadRoomTemperature_Thermometer07", "LocateMobileRobot_CeilingCamera01"),
             TOKEN,
-            "already",
+            "is a component of the store, not a live one",
         ),
         ("this is not turtle", TOKEN, "registration"),
     ],

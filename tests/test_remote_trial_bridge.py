@@ -16,7 +16,7 @@ from websockets.sync.client import ClientConnection, connect
 
 from cbrs.actions.remote import RemoteCallError
 from cbrs.bridge_client import BridgeClient
-from cbrs.component import Component
+from cbrs.component import Component, ComponentEndedError
 from cbrs.kb import KnowledgeBase
 from cbrs.live_components import NO_LIVE_COMPONENT
 from cbrs.rosbridge import Bridge, RunningBridge
@@ -318,3 +318,14 @@ def test_a_component_of_the_store_is_refused_saying_how_to_serve_it_from_a_progr
         client.call_sync("/cbrs/register", {"description": description})
     assert "is a component of the store, not a live one" in str(refused.value)
     assert "cbrs deregister svc:ReadRoomTemperature_Thermometer80" in str(refused.value)
+
+
+def test_the_sdk_ends_when_the_server_says_nobody_answers_its_service(server: Server) -> None:
+    """Its program stopped providing the service (here: unadvertised behind the SDK's back): the SDK ends
+    with the server's reason instead of logging a failed heartbeat every second, unavailable for good."""
+    component = Component(thermometer("/trial11/read").replace("Thermometer07", "Thermometer81"))
+    component.handler(lambda request: READING)
+    connected = component.connect(url(server), TOKEN, heartbeat=0.1, ttl=0.6)
+    connected.client.send({"op": "unadvertise_service", "service": "/trial11/read"})
+    with pytest.raises(ComponentEndedError, match="no bridge client provides its service /trial11/read"):
+        connected.serve()  # the lease's next store write comes within half of its 0.6 s

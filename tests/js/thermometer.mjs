@@ -93,6 +93,7 @@ setInterval(() => {
     (error) => {
       const reason = String(error);
       if (reason.includes("was deregistered")) stop(reason); // removed on purpose: do not come back
+      if (reason.includes("advertise the service")) stop(reason); // it provides another service than it registered
       if (sentFor !== registration || registering) return;
       if (reason.includes("this session has no live component")) registerAgain(reason); // the lease lapsed
       else console.error(`thermometer: heartbeat: ${reason}`);
