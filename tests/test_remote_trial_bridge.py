@@ -169,6 +169,24 @@ def test_an_answer_without_an_id_fails_no_call_when_several_wait(bridge: Running
         caller.close()
 
 
+def test_an_answer_without_result_says_what_roslibjs_users_forgot(bridge: RunningBridge) -> None:
+    """roslibjs's advertise callback must return true: one that returns nothing sends no result."""
+    provider, caller = Raw(bridge.url), Raw(bridge.url)
+    try:
+        provider.send({"op": "advertise_service", "service": "/trial/noreturn", "type": "x/Y"})
+        provider.send({"op": "call_service", "service": "/rosapi/get_time", "id": "sync"})
+        provider.expect("service_response", id="sync")
+        caller.send({"op": "call_service", "service": "/trial/noreturn", "id": "c", "timeout": 60})
+        call = provider.expect("call_service")
+        provider.send({"op": "service_response", "service": call["service"], "id": call["id"]})
+        answer = caller.expect("service_response", id="c")
+        assert answer["result"] is False
+        assert "missing required field 'result' (roslibjs sends none when an advertise callback" in answer["values"]
+    finally:
+        provider.close()
+        caller.close()
+
+
 # -- through cbrs serve: a live component's service, and /cbrs/register's fields -----------------------
 
 

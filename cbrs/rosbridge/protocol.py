@@ -21,6 +21,13 @@ from cbrs.rosbridge.errors import ProtocolError
 Message = dict[str, Any]
 MessageId = str | int
 
+#: What a missing field most often means, for the clients that leave it out.
+MISSING_HINTS = {
+    ("service_response", "result"): (
+        " (roslibjs sends none when an advertise callback returns nothing: return true, or false to fail)"
+    ),
+}
+
 #: Status levels, least verbose first; a client at level L receives statuses of levels up to L.
 LEVELS = ("none", "error", "warning", "info")
 
@@ -208,7 +215,8 @@ def check(message: Message) -> str:
             continue
         if value is None:
             if field.required:
-                raise ProtocolError(f"missing required field {field.name!r}", op, message_id)
+                hint = MISSING_HINTS.get((op, field.name), "")
+                raise ProtocolError(f"missing required field {field.name!r}{hint}", op, message_id)
             continue
         converted = _convert(value, field.kinds)
         if converted is None:
