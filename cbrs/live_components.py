@@ -265,6 +265,8 @@ class LiveComponents:
         other than ``over_bridge`` (over HTTP), each needs a bridge client providing its service now, when
         :attr:`provided` can tell; a bridge session provides its own, after registering."""
         ttl = self.ttl if ttl is None else ttl
+        if not description.strip():  # an empty file sent, or the body forgotten (curl -d without @)
+            raise InvalidDescriptionError("<registration>", ["it is empty: send the description's text"])
         if len(description.encode("utf-8")) > MAX_DESCRIPTION_BYTES:
             raise InvalidDescriptionError("<registration>", [f"it is larger than {MAX_DESCRIPTION_BYTES} bytes"])
         fmt = fmt.lower()

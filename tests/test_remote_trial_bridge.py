@@ -234,6 +234,7 @@ def test_another_client_cannot_take_the_service_a_live_component_holds(server: S
         pytest.param({"description": "x", "tll": 10}, "takes no field 'tll'", id="misspelt-field"),
         pytest.param({"description": 5}, "field 'description' must be the description as text", id="not-text"),
         pytest.param({}, "missing field 'description'", id="missing"),
+        pytest.param({"description": " \n"}, "it is empty: send the description's text", id="empty"),
     ],
 )
 def test_a_registration_with_a_wrong_field_is_refused_naming_it(
