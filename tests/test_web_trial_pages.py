@@ -88,3 +88,19 @@ def test_serving_any_store_imports_the_first_pages_libraries_in_the_background(
     assert "not preloading no_such_module_here" in caplog.text
     app.config["CBRS_PRELOAD_MODULES"] = ()
     assert warmup.preload(app) is None
+
+
+@pytest.mark.parametrize(
+    ("asked", "meant"),
+    [("req:RobotSelfPositon", "req:RobotSelfPosition"), ("FetchMyPne", "req:FetchMyPen"), ("req:Nothing", None)],
+)
+def test_an_unknown_stored_requirement_is_named_with_the_ones_meant(
+    client: FlaskClient, asked: str, meant: str | None
+) -> None:
+    """The match form said "no service description <https://w3id.org/cbrs/requirement#...> in the
+    store" for a stored requirement it does not have, and nothing of the list the user chose from."""
+    answer = client.get("/match.json", query_string={"requirement": asked})
+    count = len(client.get("/match.json").get_json()["requirements"])
+    message = answer.get_json()["fields"]["requirement"]
+    assert answer.status_code == 400 and f"no stored requirement {asked};" in message
+    assert (f"did you mean {meant}?" in message) == (meant is not None) and f"the {count} in the list" in message

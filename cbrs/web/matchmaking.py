@@ -152,11 +152,20 @@ def _stored(name: str, shown: Page) -> Requirement:
     try:
         iri = expand_name(name if ":" in name else f"req:{name}")
         found = context.kb().description(iri)
-    except (ValueError, NotFoundError) as error:
+    except ValueError as error:
         raise FormError({"requirement": str(error)}, page=shown) from None
+    except NotFoundError:  # it said "no service description <...>", and nothing of the list above it
+        raise FormError({"requirement": _no_such_requirement(name)}, page=shown) from None
     if not isinstance(found, Requirement):
         raise FormError({"requirement": f"{name} is an advertisement, not a requirement"}, page=shown)
     return found
+
+
+def _no_such_requirement(name: str) -> str:
+    names = [str(r["name"]) for r in requirements()]
+    near = difflib.get_close_matches(name if ":" in name else f"req:{name}", names, n=3, cutoff=0.75)
+    hint = f"did you mean {' or '.join(near)}? " if near else ""
+    return f"no stored requirement {name}; {hint}choose one of the {len(names)} in the list, or write one below"
 
 
 def _terms(text: str) -> list[str]:
