@@ -293,9 +293,15 @@ class RemoteStore(Store):
 
     @releases_results
     def graphs(self) -> list[str]:
-        # Virtuoso 7 matches no graph with an empty pattern; it lists no empty graph either way
-        pattern = "?s ?p ?o" if self._virtuoso else ""
-        result = self._query(f"SELECT DISTINCT ?g WHERE {{ GRAPH ?g {{ {pattern} }} }}")
+        # Virtuoso 7 matches no graph with an empty pattern, and lists no empty graph either way; it answers
+        # GROUP BY ?g from its graph index, but DISTINCT ?g by reading every quad (0.2 s against 10 s on the
+        # OWLS-TC store, docs/remote-store.md). Oxigraph lists its empty graphs too, from the empty pattern.
+        text = (
+            "SELECT ?g WHERE { GRAPH ?g { ?s ?p ?o } } GROUP BY ?g"
+            if self._virtuoso
+            else "SELECT DISTINCT ?g WHERE { GRAPH ?g { } }"
+        )
+        result = self._query(text)
         assert isinstance(result, ox.QuerySolutions)
         return sorted(row["g"].value for row in result if isinstance(row["g"], ox.NamedNode))
 
