@@ -2,8 +2,8 @@
 
 One named graph (``graph=IRI``), the store's own default graph (``default``), or, for reading and for
 adding quads, the whole dataset. Writes take the update token, parse the body whole before anything
-is written (a broken body changes nothing), pass the description shapes like every other way in, and
-are one transaction each.
+is written (a broken body changes nothing), pass the description shapes like every other way in, leave
+a readable semantic map readable (as a load or an update into graph:map must), and are one transaction each.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ import pyoxigraph as ox
 
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.loader import parse_bytes
-from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.namespaces import PREFIXES, GraphName
 from cbrs.kb.shapes import check_descriptions
 from cbrs.sparql_service import NotAcceptableError, SparqlService, negotiate
 
@@ -100,6 +100,7 @@ class GraphStore:
         node = self._graph_node(target, "PUT")
         new = self._parse(body, media_type, node)
         with self.sparql.lock:
+            self.sparql.kb.check_map_write(new, replaces_map=node == GraphName.MAP.node)
             store = self.sparql.kb.store
             created = isinstance(node, ox.NamedNode) and node.value not in store.graphs()
             store.replace(list(store.quads(graph=node)), new)
@@ -112,6 +113,7 @@ class GraphStore:
         node = target.node
         new = self._parse(body, media_type, node)
         with self.sparql.lock:
+            self.sparql.kb.check_map_write(new)
             self.sparql.kb.store.add(new)
             self._written()
 

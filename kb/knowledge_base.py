@@ -136,6 +136,21 @@ class KnowledgeBase:
             raise problem
         return read
 
+    def check_map_write(self, added: Sequence[ox.Quad], replaces_map: bool = False) -> None:
+        """Refuse a write of ``added`` that would leave a readable semantic map unreadable, with the map
+        reader's error, before anything is written: ``added`` joins the store, or (``replaces_map``) its
+        quads become graph:map. A write that names no quad of graph:map, and one into an empty or already
+        unreadable map, pass unread, as a load into graph:map does (:meth:`_check_map_load`). For writes
+        that do not go through :meth:`load` or :meth:`update` (the Graph Store Protocol's PUT and POST)."""
+        if not any(quad.graph_name == GraphName.MAP.node for quad in added):
+            return  # (a map emptied by a PUT is left as an emptied one is: the next open puts the bundled one back)
+        if next(iter(self.store.quads(graph=GraphName.MAP.node)), None) is None or not self._stored_map_reads():
+            return
+        problem = self._map_problem(list(added), keep_map=not replaces_map)
+        if problem is not None:
+            problem.add_note("nothing was written (a write into graph:map is checked as a task reads the map)")
+            raise problem
+
     def _stored_map_reads(self) -> bool:
         """Whether the stored map reads without error, as a task reads it. An embedded store counts its
         writes (:attr:`EmbeddedStore.generation`), so the answer is kept until the next one: a load refused
@@ -149,14 +164,16 @@ class KnowledgeBase:
             self._map_read = (generation, readable)
         return readable
 
-    def _map_problem(self, added: list[ox.Quad]) -> Exception | None:
-        """What reading the semantic map says would be wrong with it with ``added`` in graph:map, or None:
-        read from a scratch copy, in memory, of the graphs the reader asks (ontology, map, entailed)."""
+    def _map_problem(self, added: list[ox.Quad], keep_map: bool = True) -> Exception | None:
+        """What reading the semantic map says would be wrong with it with ``added`` in the store (and, unless
+        ``keep_map``, nothing else in graph:map), or None: read from a scratch copy, in memory, of the graphs
+        the reader asks (ontology, map, entailed)."""
         from cbrs.kb.semantic_map import MapError, SemanticMap  # it imports this module
 
         scratch = ox.Store()
         for graph in (GraphName.ONTOLOGY, GraphName.MAP, GraphName.ENTAILED):
-            scratch.extend(self.store.quads(graph=graph.node))
+            if keep_map or graph is not GraphName.MAP:
+                scratch.extend(self.store.quads(graph=graph.node))
         scratch.extend(added)
         try:
             SemanticMap.read(KnowledgeBase(EmbeddedStore(scratch, MEMORY), self.queries))

@@ -111,3 +111,43 @@ def test_only_an_update_that_may_write_the_map_reads_it(
     monkeypatch.setattr(SemanticMap, "read", classmethod(counted))
     kb.update(text)
     assert bool(reads) is read
+
+
+MAP = "https://w3id.org/cbrs/graph/map"
+TURTLE = "text/turtle"
+WORLD_PREFIX = f"@prefix world: <{PREFIXES['world']}> . @prefix home: <{PREFIXES['home']}> . "
+
+
+@pytest.mark.parametrize(
+    ("method", "target", "body", "media_type"),
+    [
+        pytest.param("put", f"?graph={MAP}", WORLD_PREFIX + 'world:Pen home:shapeKind "box" .', TURTLE, id="put"),
+        pytest.param("post", f"?graph={MAP}", WORLD_PREFIX + 'world:Pen home:shapeKind "sphere" .', TURTLE, id="post"),
+        pytest.param(
+            "post",
+            "",
+            f"<urn:example:lab> {{ <urn:example:a> <urn:example:b> 1 }} <{MAP}> {{ <{PREFIXES['world']}Pen> "
+            f'<{PREFIXES["home"]}shapeKind> "sphere" }}',
+            "application/trig",
+            id="post-dataset",
+        ),
+    ],
+)
+def test_the_graph_store_refuses_a_write_that_breaks_the_map_and_writes_nothing(
+    kb: KnowledgeBase, client: FlaskClient, method: str, target: str, body: str, media_type: str
+) -> None:
+    before = kb.store.dump()
+    send = getattr(client, method)
+    response = send(f"/store{target}", data=body, content_type=media_type, headers={"Authorization": f"Bearer {TOKEN}"})
+    assert response.status_code == 422
+    assert response.get_json()["message"].startswith("semantic map: Pen (")
+    assert kb.store.dump() == before
+
+
+def test_the_graph_store_takes_a_map_that_reads(kb: KnowledgeBase, client: FlaskClient) -> None:
+    auth = {"Authorization": f"Bearer {TOKEN}"}
+    stored = client.get(f"/store?graph={MAP}", headers={"Accept": TURTLE}).data
+    assert client.put(f"/store?graph={MAP}", data=stored, content_type=TURTLE, headers=auth).status_code == 204
+    comment = WORLD_PREFIX + 'world:Pen <http://www.w3.org/2000/01/rdf-schema#comment> "the blue one" .'
+    assert client.post(f"/store?graph={MAP}", data=comment, content_type=TURTLE, headers=auth).status_code == 204
+    assert PREFIXES["world"] + "Pen" in SemanticMap.read(kb).objects
