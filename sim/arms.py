@@ -337,11 +337,13 @@ class Kinematics:
         symmetric: bool = True,
         min_height: float | None = None,
         loose: bool = False,
+        down_to: float | None = None,
     ) -> _Solution | None:
         """Where a joint-space move to a pose ends (:meth:`Arm.reach`): of the inverse-kinematics solutions
         (one per seed posture, and from ``current``), the nearest whose straight joint-space path from
-        ``current`` is collision-free (and, with ``min_height``, keeps the grasp point at or above it);
-        None when there is none."""
+        ``current`` is collision-free (and, with ``min_height``, keeps the grasp point at or above it;
+        with ``down_to``, from which the grasp point can go straight down to that height, as a put-down
+        lowers it); None when there is none."""
         candidates = [orientation, flipped(orientation)] if symmetric else [orientation]
         best: _Solution | None = None
         for candidate in candidates:
@@ -355,12 +357,21 @@ class Kinematics:
             for solution in sorted(found, key=lambda s: _joint_distance(current, s.q)):
                 if best is not None and not _joint_distance(current, solution.q) < _joint_distance(current, best.q):
                     break
-                if self.path_clear(side, current, solution.q, others, min_height):
+                if self.path_clear(side, current, solution.q, others, min_height) and (
+                    down_to is None or self._goes_down(side, solution.q, down_to, loose)
+                ):
                     best = solution
                     break
             if best is not None and min_height is None:
                 break
         return best
+
+    def _goes_down(self, side: ArmSide, q: Sequence[float], height: float, loose: bool) -> bool:
+        """Whether the grasp point goes straight down from the posture ``q`` to ``height``, the hand kept
+        as it is (:meth:`line`)."""
+        pose = self.forward(side, q)
+        below = (pose.position[0], pose.position[1], height)
+        return not isinstance(self.line(side, q, below, pose.orientation, pose, loose), str)
 
     def solve(
         self,
@@ -503,7 +514,12 @@ class Arm:
         return MotionResult(error <= tolerance, error, "" if error <= tolerance else f"stopped {error:.3f} m short")
 
     def reach(
-        self, position: Vec3, orientation: Quat, symmetric: bool = True, min_height: float | None = None
+        self,
+        position: Vec3,
+        orientation: Quat,
+        symmetric: bool = True,
+        min_height: float | None = None,
+        down_to: float | None = None,
     ) -> MotionResult:
         """Go to a pose through joint space (from the home posture to a pre-grasp pose, or across the
         workspace when a straight line would leave the arm's reach).
@@ -511,14 +527,15 @@ class Arm:
         Of the inverse-kinematics solutions (one per seed posture), the nearest one whose straight
         joint-space path is collision-free is taken. With ``min_height`` the grasp point must also stay
         at or above that height all the way: a held object then passes over the table and the torso
-        instead of through them.
+        instead of through them. With ``down_to``, the posture must let the hand go straight down to
+        that height afterwards (:meth:`Kinematics.joint_path`).
         """
         current = self.joint_positions()
         best = self._kinematics.joint_path(
-            self.side, current, self._others(), position, orientation, symmetric, min_height
+            self.side, current, self._others(), position, orientation, symmetric, min_height, down_to=down_to
         )
         if best is None:
-            return _no_joint_path(position, min_height)
+            return _no_joint_path(position, min_height, down_to)
         motion = self.move_joints(best.q)
         error = float(np.linalg.norm(np.asarray(self.ee_pose().position) - np.asarray(position)))
         ok = motion.reached and error <= REACH_TOLERANCE
@@ -654,6 +671,10 @@ class PlannedArm:
     def joint_positions(self) -> tuple[float, ...]:
         return self._q
 
+    def dry_run(self) -> PlannedArm:
+        """A copy from the posture planned so far, to plan moves on without changing this one."""
+        return PlannedArm(self.side, self._kinematics, self._q, self._others)
+
     def ee_pose(self) -> Pose3D:
         return self._kinematics.forward(self.side, self._q)
 
@@ -676,20 +697,27 @@ class PlannedArm:
         return MotionResult(True, 0.0)
 
     def reach(
-        self, position: Vec3, orientation: Quat, symmetric: bool = True, min_height: float | None = None
+        self,
+        position: Vec3,
+        orientation: Quat,
+        symmetric: bool = True,
+        min_height: float | None = None,
+        down_to: float | None = None,
     ) -> MotionResult:
         """:meth:`Arm.reach`, planned."""
         best = self._kinematics.joint_path(
-            self.side, self._q, self._others, position, orientation, symmetric, min_height, loose=True
+            self.side, self._q, self._others, position, orientation, symmetric, min_height, True, down_to
         )
         if best is None:
-            return _no_joint_path(position, min_height)
+            return _no_joint_path(position, min_height, down_to)
         self._q = best.q
         return MotionResult(True, 0.0)
 
 
-def _no_joint_path(position: Vec3, min_height: float | None) -> MotionResult:
+def _no_joint_path(position: Vec3, min_height: float | None, down_to: float | None = None) -> MotionResult:
     where = "" if min_height is None else f" above {min_height:.2f} m"
+    if down_to is not None:
+        where += f" from which the hand goes straight down to {down_to:.3f} m"
     return MotionResult(False, math.inf, f"no collision-free joint path to {_fmt(position)}{where}")
 
 

@@ -19,7 +19,7 @@ import pybullet as p
 
 from cbrs.kb.hands import Hand
 from cbrs.sim import predicates as pred
-from cbrs.sim.arms import Arm, ArmSide, MotionResult
+from cbrs.sim.arms import Arm, ArmSide, MotionResult, PlannedArm
 from cbrs.sim.errors import GraspMisfitError
 from cbrs.sim.geometry import Pose2D, Pose3D, Quat, Region, Vec3, wrap_angle
 from cbrs.sim.grasping import (
@@ -200,14 +200,22 @@ class _Moving(Protocol):
     ) -> MotionResult: ...
 
     def reach(
-        self, position: Vec3, orientation: Quat, symmetric: bool = ..., min_height: float | None = ...
+        self,
+        position: Vec3,
+        orientation: Quat,
+        symmetric: bool = ...,
+        min_height: float | None = ...,
+        down_to: float | None = ...,
     ) -> MotionResult: ...
+
+    def dry_run(self) -> PlannedArm: ...
 
 
 def _carry(arm: _Moving, grasp: GraspPose, region: Region, yaw: float | None) -> MotionResult:
     """carry_object's moves: up to the transit height, across to over the region's centre, down to
     ABOVE_CLEARANCE over its surface; the move across through joint space, the object kept up, when the
-    straight line leaves the arm's reach."""
+    straight line leaves the arm's reach; the way down through joint space too when the straight one
+    would leave the hand where put_down_object cannot lower the object (:func:`_down`)."""
     ee = arm.ee_pose()
     orientation = ee.orientation
     if yaw is not None and grasp.model.grasp is GraspKind.TOP:
@@ -225,7 +233,7 @@ def _carry(arm: _Moving, grasp: GraspPose, region: Region, yaw: float | None) ->
     for index, leg in enumerate(legs):
         if math.dist(leg, arm.ee_pose().position) < 1e-3:
             continue
-        result = arm.move_to(leg, orientation)
+        result = _down(arm, grasp, region, leg, orientation) if index == 2 else arm.move_to(leg, orientation)
         if not result.reached and index == 1 and math.isinf(result.error):
             # The straight line leaves the arm's reach (it would have to change posture on the
             # way): go through joint space instead, keeping the object at the transit height.
@@ -233,6 +241,31 @@ def _carry(arm: _Moving, grasp: GraspPose, region: Region, yaw: float | None) ->
         if not result.reached:
             return result
     return result
+
+
+def _down(arm: _Moving, grasp: GraspPose, region: Region, leg: Vec3, orientation: Quat) -> MotionResult:
+    """The carry's way down to ``leg``, over the region: a straight line, unless, planned first (a dry
+    run), it would fail or end in a posture from which the hand cannot lower the object the rest of the
+    way in a straight line (:func:`_lower`: its inverse kinematics run out there; reading glasses taken
+    from a shelf 10 cm above the table came down over the base's platform with the elbow at the end of
+    its range). Then through joint space, the object kept within TRANSIT_SAG below ``leg``, to the
+    nearest posture from which it can (:meth:`Arm.reach`'s ``down_to``); the straight line when there is
+    none, to fail as before."""
+    line = arm.dry_run()
+    if line.move_to(leg, orientation).reached and _lower(line, grasp, region)[0].reached:
+        return arm.move_to(leg, orientation)
+    low = region.zmin + PLACE_CLEARANCE + grasp.bottom_offset
+    if arm.dry_run().reach(leg, orientation, min_height=leg[2] - TRANSIT_SAG, down_to=low).reached:
+        return arm.reach(leg, orientation, min_height=leg[2] - TRANSIT_SAG, down_to=low)
+    return arm.move_to(leg, orientation)
+
+
+def _lower(arm: _Moving, grasp: GraspPose, region: Region) -> tuple[MotionResult, Vec3]:
+    """put_down_object's way down: straight down from where the hand is until the held object's bottom
+    is PLACE_CLEARANCE over the region's surface; and where the hand lets go."""
+    ee = arm.ee_pose()
+    place = (ee.position[0], ee.position[1], region.zmin + PLACE_CLEARANCE + grasp.bottom_offset)
+    return arm.move_to(place, ee.orientation, speed=PLACE_SPEED, symmetric=False), place
 
 
 def put_down_object(world: HomeWorld, side: ArmSide | str, region: Region) -> Outcome:
@@ -244,8 +277,7 @@ def put_down_object(world: HomeWorld, side: ArmSide | str, region: Region) -> Ou
         return _done(world, "PutDownObject", start, False, f"the {arm.side} gripper holds nothing")
     name = world.name_of(arm.held) or "?"
     ee = arm.ee_pose()
-    place = (ee.position[0], ee.position[1], region.zmin + PLACE_CLEARANCE + grasp.bottom_offset)
-    result = arm.move_to(place, ee.orientation, speed=PLACE_SPEED, symmetric=False)
+    result, place = _lower(arm, grasp, region)
     if not result.reached:
         return _done(world, "PutDownObject", start, False, result.reason)
     arm.detach()
@@ -424,8 +456,9 @@ def can_carry(
 ) -> str:
     """Why ``side``'s own motion planning would refuse to take the object where it is by ``model``'s
     approach and, given a ``region``, carry it over its middle (empty if it would not): the moves of
-    approach_object, pick_up_object and carry_object planned one after the other on the kinematics copies
-    from the arm's posture now, without moving (a dry run, :meth:`Arm.dry_run`). The inverse kinematics
+    approach_object, pick_up_object and carry_object, and put_down_object's way down, planned one after
+    the other on the kinematics copies from the arm's posture now, without moving (a dry run,
+    :meth:`Arm.dry_run`). The inverse kinematics
     of the end poses alone (:func:`can_take`, :func:`can_set_down`) misses a joint-space move whose every
     path collides or lets the held object dip, and a straight line that leaves the arm's reach. ``yaw``
     turns a top-grasped object on the way, as :func:`carry_object` does."""
@@ -443,6 +476,8 @@ def can_carry(
     if region is not None:
         cx, cy, _ = region.center
         moves.append((f"carrying it to ({cx:.2f}, {cy:.2f})", lambda: _carry(hand, grasp, region, yaw)))
+        lowering = f"lowering it onto {region.name} at ({cx:.2f}, {cy:.2f})"
+        moves.append((lowering, lambda: _lower(hand, grasp, region)[0]))
     for what, move in moves:
         result = move()
         if not result.reached:
@@ -465,21 +500,28 @@ def can_hand_over(
 
 
 def can_carry_held(world: HomeWorld, side: ArmSide | str, region: Region) -> str:
-    """Why ``side``'s planning would refuse to carry what it holds over the middle of ``region`` as
-    :func:`carry_object` moves it (empty if it would not): a dry run from the arm's posture now."""
+    """Why ``side``'s planning would refuse to carry what it holds over the middle of ``region`` and lower
+    it there, as :func:`carry_object` and :func:`put_down_object` move it (empty if it would not): a dry
+    run from the arm's posture now."""
     arm = _arm(world, side)
     grasp = arm.held_grasp
     if arm.held is None or grasp is None:
         return f"the {arm.side} gripper holds nothing"
-    result = _carry(arm.dry_run(), grasp, region, None)
-    if result.reached:
-        return ""
+    hand = arm.dry_run()
     cx, cy, _ = region.center
     model = grasp.model
-    return (
-        f"the {ArmSide(side).value} arm would not get the {model.name} by its {model.grasp.value} grasp past carrying "
-        f"it to ({cx:.2f}, {cy:.2f}): {result.reason}"
-    )
+    moves: list[tuple[str, Callable[[], MotionResult]]] = [
+        (f"carrying it to ({cx:.2f}, {cy:.2f})", lambda: _carry(hand, grasp, region, None)),
+        (f"lowering it onto {region.name} at ({cx:.2f}, {cy:.2f})", lambda: _lower(hand, grasp, region)[0]),
+    ]
+    for what, move in moves:
+        result = move()
+        if not result.reached:
+            return (
+                f"the {ArmSide(side).value} arm would not get the {model.name} by its {model.grasp.value} grasp past "
+                f"{what}: {result.reason}"
+            )
+    return ""
 
 
 def hand_over_onto_platform(
