@@ -11,6 +11,7 @@ from __future__ import annotations
 import logging
 import re
 import sys
+import threading
 import tomllib
 from html import unescape
 
@@ -72,22 +73,37 @@ def test_the_plans_page_says_what_it_does_until_a_task_is_chosen(client: FlaskCl
     assert refused.status_code == 400 and intro not in refused.text
 
 
-def test_serving_any_store_imports_the_first_pages_libraries_in_the_background(
+def test_serving_any_store_imports_the_first_pages_libraries_once_a_page_is_asked(
     bundled_kb: KnowledgeBase, monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
 ) -> None:
     """The bundled store is not warmed up (it reads fast), but its first service, plans and tasks pages
-    each paid 0.4 to 0.7 s importing networkx and numpy. Small modules stand for them here."""
+    each paid 0.4 to 0.7 s importing networkx and numpy. They are imported with the first page, not at
+    start: a server only programs query has no use for their 30 MB. Small modules stand for them here."""
     app = create_app(SparqlService(bundled_kb))
     app.config["CBRS_PRELOAD_MODULES"] = ("colorsys", "no_such_module_here")
     monkeypatch.delitem(sys.modules, "colorsys", raising=False)
+    assert warmup.warm_up(app) is None  # nothing of the store is read
+    client = app.test_client()
+    assert client.get("/sparql", query_string={"query": "ASK {}"}).status_code == 200
+    assert client.get("/healthz").status_code == 200
+    assert "cbrs.preload" not in app.extensions  # no page yet
     with caplog.at_level(logging.INFO, logger="cbrs.web"):
-        assert warmup.warm_up(app) is None  # nothing of the store is read
+        assert client.get("/").status_code == 200
         thread = app.extensions["cbrs.preload"]
+        assert isinstance(thread, threading.Thread)
         thread.join(timeout=10)
+        client.get("/services")
+    assert app.extensions["cbrs.preload"] is thread  # once
     assert not thread.is_alive() and "colorsys" in sys.modules
     assert "not preloading no_such_module_here" in caplog.text
     app.config["CBRS_PRELOAD_MODULES"] = ()
     assert warmup.preload(app) is None
+
+
+def test_an_app_no_server_started_imports_nothing_ahead(bundled_kb: KnowledgeBase) -> None:
+    app = create_app(SparqlService(bundled_kb))
+    assert app.test_client().get("/").status_code == 200
+    assert "cbrs.preload" not in app.extensions
 
 
 @pytest.mark.parametrize(

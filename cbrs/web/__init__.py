@@ -132,6 +132,11 @@ def create_app(
             return False
         return request.blueprint in page_blueprints and not request.path.endswith(".json")
 
+    @app.before_request
+    def first_page() -> None:
+        if as_page():  # a person is browsing: import what the next pages need (cbrs.web.warmup)
+            warmup.preload_once(app)
+
     @app.get("/healthz")
     def health() -> Response:
         return jsonify(status="ok", version=__version__, store=sparql.kb.store.location, writable=sparql.writable)

@@ -10,10 +10,12 @@ A store under ``CBRS_WARM_UP_TRIPLES`` triples (the bundled one has 7,800) reads
 and a remote store keeps nothing between pages, so neither is warmed up. Until it is done, every page
 says what is being read (:meth:`WarmUp.note`), and the log has a line for each step.
 
-Whatever the store, :func:`warm_up` also imports, in a thread of its own, the libraries the first
-service, matchmaking, plans and tasks pages load (the planner and networkx, the matchmaker, the
-simulation's list of skills): on the bundled store they were 0.4 to 0.7 s of each of those first pages
-(``CBRS_PRELOAD_MODULES``; an empty list imports nothing).
+Whatever the store, the first page anyone opens of a server :func:`warm_up` started also starts
+importing, in a thread of its own, the libraries the first service, matchmaking, plans and tasks pages
+load (the planner and networkx, the matchmaker, the simulation's list of skills): on the bundled store
+they were 0.4 to 0.7 s of each of those first pages (``CBRS_PRELOAD_MODULES``; an empty list imports
+nothing). Not at start: they take about 30 MB, which a server only programs query (``/sparql``, the
+graph store, component registrations) never needs.
 """
 
 from __future__ import annotations
@@ -99,8 +101,8 @@ class WarmUp:
 def warm_up(app: Flask) -> WarmUp | None:
     """Start reading in the background what the first pages need (``app.extensions["cbrs.warm_up"]``);
     None when the store is remote or smaller than ``CBRS_WARM_UP_TRIPLES``. The libraries are imported
-    for every store (:func:`preload`)."""
-    preload(app)
+    for every store, once a page is asked (:func:`preload_once`)."""
+    app.extensions["cbrs.preload_armed"] = True
     threshold = int(app.config.get("CBRS_WARM_UP_TRIPLES", DEFAULT_TRIPLES))
     with app.app_context():
         kb = context.kb()
@@ -125,6 +127,19 @@ def preload(app: Flask) -> threading.Thread | None:
     app.extensions["cbrs.preload"] = thread
     thread.start()
     return thread
+
+
+_PRELOAD_GUARD = threading.Lock()
+
+
+def preload_once(app: Flask) -> None:
+    """:func:`preload`, the first time a page of a server whose warm-up started is asked."""
+    if not app.extensions.get("cbrs.preload_armed") or "cbrs.preload" in app.extensions:
+        return
+    with _PRELOAD_GUARD:
+        if "cbrs.preload" not in app.extensions:
+            app.extensions["cbrs.preload"] = None  # asked once, even when the list is empty
+            preload(app)
 
 
 def _import(modules: tuple[str, ...]) -> None:
