@@ -20,7 +20,7 @@ from cbrs.component import Component, ComponentEndedError
 from cbrs.kb import KnowledgeBase
 from cbrs.live_components import NO_LIVE_COMPONENT
 from cbrs.rosbridge import Bridge, RunningBridge
-from cbrs.rosbridge.protocol import leading_fields
+from cbrs.rosbridge.protocol import LEADING_CHARS, leading_fields
 from cbrs.server import ServeConfig, Server
 from cbrs.sparql_service import EndpointConfig
 from tests.test_live_components import READING, THERMOMETER, TOKEN, eventually, thermometer
@@ -76,6 +76,9 @@ def test_leading_fields_reads_only_the_top_level_before_the_first_nested_value()
         "id": "q",
     }
     assert leading_fields("[1, 2]") == leading_fields("not json") == {}
+    # only the head is looked at, whatever the message's size: a member past it is not read
+    late = '{"op": "call_service", "pad": "' + "x" * LEADING_CHARS + '", "id": "late"}'
+    assert leading_fields(late) == {"op": "call_service"}
 
 
 @pytest.mark.parametrize(

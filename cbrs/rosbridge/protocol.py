@@ -165,6 +165,8 @@ def decode(text: str, limit: int) -> Message:
     return message
 
 
+LEADING_CHARS = 4096
+"""How far into an unreadable message :func:`leading_fields` looks: ids and service names are short."""
 _MEMBER = re.compile(
     r'\s*"((?:[^"\\]|\\.)*)"\s*:\s*("(?:[^"\\]|\\.)*"|-?\d+(?:\.\d+)?(?:[eE][+-]?\d+)?|true|false|null)\s*([,}])'
 )
@@ -179,8 +181,8 @@ def leading_fields(text: str) -> Message:
     start = text.find("{", 0, 64)
     if start < 0 or text[:start].strip():
         return fields
-    position = start + 1
-    while (match := _MEMBER.match(text, position)) is not None:
+    position, end = start + 1, min(len(text), LEADING_CHARS)  # the head only: a huge message costs nothing more
+    while (match := _MEMBER.match(text, position, end)) is not None:
         try:
             fields.setdefault(json.loads(f'"{match[1]}"'), json.loads(match[2]))
         except ValueError:  # an escape JSON does not have: read no further
