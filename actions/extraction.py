@@ -19,12 +19,13 @@ import networkx as nx
 
 from cbrs.actions.areas import AreaRule
 from cbrs.actions.errors import OrderingConflictError
-from cbrs.actions.graph import SRE, SRI, SRO, Edge, Need, ServiceResourceGraph
+from cbrs.actions.graph import SRE, SRI, SRO, Edge, Need, ServiceResourceGraph, statement_text
 from cbrs.actions.plan import Binding, Plan, PlanStep, Source
 from cbrs.actions.search import SearchTrace
 from cbrs.actions.unmet import GOAL, Unsatisfied
 from cbrs.kb import Statement
 from cbrs.kb.namespaces import shorten
+from cbrs.reasoner.degrees import degree_of_match
 from cbrs.reasoner.taxonomy import TaxonomyIndex
 
 
@@ -138,7 +139,9 @@ class Extraction:
             node, need = item
             providers = [e for e in self.graph.providers(node, need) if e.source != node]
             if not providers:
-                causes.append(Unsatisfied(need.text(), node, self._chain(chain, followed)))
+                causes.append(
+                    Unsatisfied(need.text(), node, self._chain(chain, followed), provided=self._provided(need))
+                )
                 continue
             best = providers[0]
             if best.source in on_path:
@@ -160,6 +163,36 @@ class Extraction:
             stack.append(None)
             stack.extend((best.source, sub) for sub in reversed(blocked))
         return causes
+
+    def _provided(self, need: Need, most: int = 4) -> tuple[tuple[str, str], ...]:
+        """For a statement no component provides: the effects components do provide about things of its
+        subject's class (their subject the same or above it), those whose predicate, then whose object,
+        would match first, at most ``most``. A goal ``(TeaTin, isLocatedOn, Counter)`` then shows
+        ``(PhysicalObject, isLocated, Place)`` by PutDownObject: what the counter must also be."""
+        wanted = need.statement
+        index = self.graph.matcher.index
+        if wanted is None or wanted.subject not in index:
+            return ()
+        above = {*index.is_a_ancestors(wanted.subject), index.canonical(wanted.subject)}
+
+        def differs(wanted_term: str, offered_term: str) -> bool:
+            return not degree_of_match(index, wanted_term, offered_term).accepted
+
+        found = {
+            (
+                differs(wanted.predicate, offer.statement.predicate),
+                differs(wanted.object, offer.statement.object),
+                vertex.iri,
+                statement_text(offer.statement),
+            )
+            for vertex in self.graph.pool.vertices.values()
+            for offer in vertex.offers
+            if offer.statement is not None
+            and offer.role == "effect"
+            and offer.statement.subject in index
+            and index.canonical(offer.statement.subject) in above
+        }
+        return tuple((iri, text) for *_, iri, text in sorted(found)[:most])
 
     @staticmethod
     def _chain(start: tuple[str, ...], followed: list[str]) -> tuple[str, ...]:

@@ -29,6 +29,7 @@ class Unsatisfied:
     near: tuple[tuple[str, str], ...] = ()  # (undeclared class, the declared class its name is closest to)
     unrunnable: tuple[tuple[str, str], ...] = ()  # (component, why): planned for it, but cannot run here
     out_of_area: tuple[tuple[str, str], ...] = ()  # (component, why): provides it, but not where it is needed
+    provided: tuple[tuple[str, str], ...] = ()  # (component, effect): what is provided about the need's subject
 
     def text(self) -> str:
         found = self._text()
@@ -36,6 +37,9 @@ class Unsatisfied:
             found += f"; {shorten(component)} was passed over: {why}"
         for component, why in self.unrunnable:
             found += f"; {shorten(component)} was planned for it but cannot run here: {why}"
+        if self.provided:
+            each = "; ".join(f"{effect} by {shorten(component)}" for component, effect in self.provided)
+            found += f"; what components provide about it: {each}"
         return found
 
     def _text(self) -> str:
@@ -100,6 +104,7 @@ class Unsatisfied:
             "remedy": self.remedy(),
             "unrunnable": [{"component": component, "why": why} for component, why in self.unrunnable],
             "out_of_area": [{"component": component, "why": why} for component, why in self.out_of_area],
+            "provided": [{"component": component, "effect": effect} for component, effect in self.provided],
         }
 
 

@@ -70,3 +70,32 @@ def test_the_arm_takes_the_goals_subject_not_the_furniture_it_goes_onto(tmp_path
         ("CarryObject_CytonDualArm01", "targetPlace"): counter,
     }
     assert result.unused_inputs == ()
+
+
+def test_a_goal_no_component_provides_lists_what_they_provide_about_its_subject(tmp_path: Path) -> None:
+    """The counter declared as furniture only and the goal `isLocatedOn` it (a user's first try): no plan.
+    The refusal said only to register a component with that effect; it now lists what components provide
+    about a tin, nearest first: the put-down's (PhysicalObject, isLocated, Place) tells what is missing."""
+    furniture_only = TIN_AND_COUNTER.replace("home:Furniture , home:ObjectPlace", "home:Furniture")
+    on_counter = put_tin_on_counter("tin", "counter").replace("home:isLocated ;", "home:isLocatedOn ;")
+    kb = KnowledgeBase.open(":memory:")
+    for graph, text in (("ontology", furniture_only), ("map", furniture_only), ("requirements", on_counter)):
+        path = tmp_path / f"{graph}.ttl"
+        path.write_text(text, encoding="utf-8")
+        kb.load([path], graph=graph)
+    result = Composer(kb).compose(LAB + "PutTinOnCounter")
+    assert result.plan is None and len(result.unsatisfied) == 1
+    provided = [
+        (entry["component"].rsplit("#", 1)[-1], entry["effect"])
+        for entry in result.unsatisfied[0].to_dict()["provided"]
+    ]
+    assert provided[:2] == [
+        ("HandOverOntoPlatform_CytonDualArm01", "(home:PhysicalObject, home:isLocatedOn, home:RobotPlatform)"),
+        ("PutDownObject_CytonDualArm01", "(home:PhysicalObject, home:isLocated, home:Place)"),
+    ]
+    assert len(provided) == 4
+    assert (
+        "what components provide about it: (home:PhysicalObject, home:isLocatedOn, home:RobotPlatform) by "
+        "svc:HandOverOntoPlatform_CytonDualArm01; (home:PhysicalObject, home:isLocated, home:Place) by "
+        "svc:PutDownObject_CytonDualArm01" in result.unsatisfied[0].text()
+    )
