@@ -95,8 +95,19 @@ class Component:
                 if q.predicate.value == CBRS.serviceName and isinstance(q.subject, ox.NamedNode)
             }
         )
-        if len(named) != 1:
-            raise InvalidDescriptionError("<component>", [f"it must describe one component, not {len(named)}"])
+        if not named:
+            raise InvalidDescriptionError(
+                "<component>", ["it describes no component (a subject with cbrs:serviceName)"]
+            )
+        if len(named) > 1:  # one handler each: an on and an off switch are two Components in one program
+            names = ", ".join(shorten(iri) for iri in named)
+            raise InvalidDescriptionError(
+                "<component>",
+                [
+                    f"it must describe one component, not {len(named)} ({names}): give each a Component of its "
+                    "own; one program serves several (connect() each but the last, run() that one)"
+                ],
+            )
         self.iri = named[0]
         found = grounding(quads, self.iri)
         if found is None:

@@ -18,6 +18,7 @@ from cbrs.actions.remote import RemoteCallError
 from cbrs.bridge_client import BridgeClient
 from cbrs.component import Component, ComponentEndedError
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.errors import InvalidDescriptionError
 from cbrs.live_components import NO_LIVE_COMPONENT
 from cbrs.rosbridge import Bridge, RunningBridge
 from cbrs.rosbridge.protocol import LEADING_CHARS, leading_fields
@@ -351,3 +352,11 @@ def test_the_sdk_ends_when_the_server_says_nobody_answers_its_service(server: Se
     connected.client.send({"op": "unadvertise_service", "service": "/trial11/read"})
     with pytest.raises(ComponentEndedError, match="no bridge client provides its service /trial11/read"):
         connected.serve()  # the lease's next store write comes within half of its 0.6 s
+
+
+def test_the_sdk_refuses_two_components_in_one_description_saying_how_to_serve_both() -> None:
+    on = thermometer("/trial12/read").replace("Thermometer07", "Thermometer82")
+    off = thermometer("/trial13/read").replace("Thermometer07", "Thermometer83")
+    with pytest.raises(InvalidDescriptionError, match=r"not 2 \(svc:ReadRoomTemperature_Thermometer82, ") as refused:
+        Component(on + off)
+    assert "give each a Component of its own; one program serves several" in str(refused.value)
