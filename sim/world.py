@@ -201,9 +201,15 @@ class HomeWorld:
         robots = list(self.map.robots.values())
         people = list(self.map.people.values())
         if len(robots) != 1 or len(people) != 1:
+            # Every run builds the whole map, so this stops every task, not only one about the second person.
+            named = "; ".join(
+                f"{what}: {', '.join(thing.iri for thing in things) or 'none'}"
+                for what, things in (("mobile robots", robots), ("people", people))
+            )
             raise ValueError(
                 f"the simulated home takes one mobile robot and one person; the semantic map has {len(robots)} "
-                f"and {len(people)}"
+                f"and {len(people)} ({named}); take the extra ones out of graph:map (a SPARQL update, or the "
+                "map's files loaded into a fresh store), whatever task runs"
             )
         self.robot, self.person = robots[0], people[0]
         self.base_name, self.person_name = self.robot.name, self.person.name
