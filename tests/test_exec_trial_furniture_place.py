@@ -29,11 +29,11 @@ lab:Counter1 a lab:Counter ; home:isLocated world:Kitchen ;
 """
 
 
-def put_tin_on_counter(tin: str, counter: str) -> str:
+def put_tin_on_counter(tin: str, counter: str, task: str = "PutTinOnCounter") -> str:
     return f"""@prefix cbrs: <https://w3id.org/cbrs/core#> . @prefix home: <https://w3id.org/cbrs/home#> .
 @prefix svc: <https://w3id.org/cbrs/service#> . @prefix lab: <https://example.org/lab#> .
-lab:PutTinOnCounter a cbrs:Requirement ; cbrs:requestedBy svc:CytonDualArm01 ; cbrs:deviceName "CytonDualArm01" ;
-    cbrs:serviceName "PutTinOnCounter" ;
+lab:{task} a cbrs:Requirement ; cbrs:requestedBy svc:CytonDualArm01 ; cbrs:deviceName "CytonDualArm01" ;
+    cbrs:serviceName "{task}" ;
     cbrs:hasOWLSModel [ a cbrs:OWLSModel ;
         cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "{tin}" ; cbrs:parameterType lab:TeaTin ] ;
         cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "{counter}" ; cbrs:parameterType lab:Counter ] ;
@@ -42,21 +42,26 @@ lab:PutTinOnCounter a cbrs:Requirement ; cbrs:requestedBy svc:CytonDualArm01 ; c
 """
 
 
-@pytest.mark.parametrize(
-    ("tin", "counter"),
-    [pytest.param("tin", "counter", id="the-counter-sorts-first"), pytest.param("aTin", "counter", id="the-tin-does")],
-)
-def test_the_arm_takes_the_goals_subject_not_the_furniture_it_goes_onto(tmp_path: Path, tin: str, counter: str) -> None:
-    kb = KnowledgeBase.open(":memory:")
-    for graph, text in (
-        ("ontology", TIN_AND_COUNTER),
-        ("map", TIN_AND_COUNTER),
-        ("requirements", put_tin_on_counter(tin, counter)),
-    ):
-        path = tmp_path / f"{graph}.ttl"
+NAMES = {"PutTinOnCounter": ("tin", "counter"), "PutATinOnCounter": ("aTin", "counter")}
+"""The inputs' names: the counter's sorts first, or the tin's."""
+
+
+@pytest.fixture(scope="module")
+def kb(tmp_path_factory: pytest.TempPathFactory) -> KnowledgeBase:
+    folder = tmp_path_factory.mktemp("furniture")
+    store = KnowledgeBase.open(":memory:")
+    tasks = "".join(put_tin_on_counter(tin, counter, task) for task, (tin, counter) in NAMES.items())
+    for graph, text in (("ontology", TIN_AND_COUNTER), ("map", TIN_AND_COUNTER), ("requirements", tasks)):
+        path = folder / f"{graph}.ttl"
         path.write_text(text, encoding="utf-8")
-        kb.load([path], graph=graph)
-    result = Composer(kb).compose(LAB + "PutTinOnCounter")
+        store.load([path], graph=graph)
+    return store
+
+
+@pytest.mark.parametrize("task", sorted(NAMES))
+def test_the_arm_takes_the_goals_subject_not_the_furniture_it_goes_onto(kb: KnowledgeBase, task: str) -> None:
+    tin, counter = NAMES[task]
+    result = Composer(kb).compose(LAB + task)
     assert result.plan is not None, result.unsatisfied
     given = {
         (step.component.rsplit("#", 1)[-1], binding.name): binding.source.name
