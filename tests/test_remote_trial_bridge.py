@@ -360,3 +360,17 @@ def test_the_sdk_refuses_two_components_in_one_description_saying_how_to_serve_b
     with pytest.raises(InvalidDescriptionError, match=r"not 2 \(svc:ReadRoomTemperature_Thermometer82, ") as refused:
         Component(on + off)
     assert "give each a Component of its own; one program serves several" in str(refused.value)
+
+
+def test_a_goal_too_large_to_read_is_answered_by_its_id(bridge: RunningBridge) -> None:
+    client = Raw(bridge.url)
+    try:
+        client.send(
+            json.dumps(
+                {"op": "send_action_goal", "id": "g", "action": "/x", "action_type": "a/B", "args": {"d": "x" * LIMIT}}
+            )
+        )
+        result = client.expect("action_result", id="g")
+        assert result["result"] is False and "exceeds the limit" in result["values"]
+    finally:
+        client.close()

@@ -392,8 +392,8 @@ class Bridge:
             self._refuse_answer(session, frame, op, message_id, error.reason, read=message is not None)
             if op == "call_service" and message_id is not None:  # its caller waits for an answer: this is it
                 self._refuse_call(session, request, message_id, text)
-            if op == "send_action_goal":  # the goal's callbacks hear of it too
-                self._refuse_goal(session, request, text)
+            if op == "send_action_goal" and (message is not None or message_id is not None):  # its callbacks too
+                self._refuse_goal(session, {**request, "id": message_id}, text)
         except Exception as error:
             log.exception("%s: %s failed", session.name, op)
             session.report("error", f"{op or 'message'}: internal error: {type(error).__name__}: {error}", message_id)
