@@ -139,6 +139,14 @@ def resource() -> Page:
     return Page("resource.html", display_text(iri), data)
 
 
+def has_page(iri: str) -> bool:
+    """Whether :func:`resource` shows ``iri`` rather than answering 404: a triple names it as subject or
+    object, it names a graph, or triples use it as their predicate (the page's own three reads, cheapest
+    first). Other pages use it to link an IRI they cannot show themselves (the service page of a class)."""
+    kb = context.kb()
+    return _named_graph(iri) is not None or kb.describes(iri) or bool(kb.select("predicate_uses", {"predicate": iri}))
+
+
 def _uses_query(iri: str) -> str:
     """The SPARQL editor's text that lists every triple with ``iri`` as its predicate (shown to the user
     and run only by the editor; ``iri`` passed :func:`iri_parameter`, so it holds no ``>``)."""

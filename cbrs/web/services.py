@@ -3,6 +3,7 @@ service description with its six-tuple ⟨DN, SN, SC, IOPE, SEA, QoS⟩ as ``cbr
 
 from __future__ import annotations
 
+import difflib
 from collections.abc import Iterator
 from typing import Any
 
@@ -10,12 +11,13 @@ import pyoxigraph as ox
 from flask import Blueprint, current_app, request, url_for
 
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.errors import NotFoundError
 from cbrs.kb.model import Advertisement, Requirement
 from cbrs.kb.namespaces import RDF, RDFS, expand
 from cbrs.kb.store import Term
 from cbrs.kb.vocab import CBRS
 from cbrs.web import context, resource
-from cbrs.web.links import display_text, short
+from cbrs.web.links import RESOURCE_ENDPOINT, display_text, short
 from cbrs.web.meets import INLINE_ADVERTISEMENTS, requirements_met, shown_inline
 from cbrs.web.pages import FormError, Page, page
 
@@ -86,8 +88,13 @@ def _kind(given: str) -> str:
 def service() -> Page:
     iri = resource.iri_parameter()
     kb = context.kb()
-    with context.lock():
-        description = kb.description(iri)
+    try:
+        with context.lock():
+            description = kb.description(iri)
+    except NotFoundError as error:
+        if error.iri != iri:
+            raise
+        return _not_a_description(kb, iri)
     role = "requirement" if isinstance(description, Requirement) else "advertisement"
     data: dict[str, Any] = {"role": role, **description.to_dict(), "conditions_as_text": _text_only(kb, iri)}
     match = MATCH_ENDPOINT in current_app.view_functions
@@ -100,6 +107,46 @@ def service() -> Page:
         data["similar"] = _similar_url(data) if match else None
         data["meets"], data["meets_url"] = _meets(kb, iri) if match else ([], None)
     return Page("service.html", display_text(iri), data)
+
+
+NEAR_MISS = 0.75  # how close (difflib's ratio) a service's name must be to the one asked to be proposed
+
+
+def _not_a_description(kb: KnowledgeBase, iri: str) -> Page:
+    """404 for an IRI that is no advertisement or requirement, with the ways on: the IRI's own page if
+    the store names it (a class, an individual: the page answered only "no service description"), and
+    the services whose names are close to it (a typo)."""
+    name = short(iri)
+    shown = RESOURCE_ENDPOINT in current_app.view_functions and resource.has_page(iri)
+    if shown:
+        message = f"{name} is in the store, but not as a service description (an advertisement or a requirement)"
+    else:
+        message = f"no service description {name} in the store, and nothing else of that name"
+    data = {
+        "error": "NotFoundError",
+        "message": message,
+        "iri": iri,
+        "name": name,
+        "resource": url_for(RESOURCE_ENDPOINT, iri=name) if shown else None,
+        "meant": _near_misses(kb, iri),
+        "services": url_for("services.services"),
+    }
+    return Page("service_missing.html", "Not a service description", data, status=404)
+
+
+def _near_misses(kb: KnowledgeBase, iri: str, count: int = 3) -> list[dict[str, str]]:
+    """The advertisements and requirements whose names are closest to ``iri``'s, closest first."""
+    rows = [(row["service"], row["name"], "advertisement") for row in advertisement_rows(kb)]
+    rows += [(row["requirement"], row["name"], "requirement") for row in requirement_rows(kb)]
+    asked = short(iri)
+    by_name = {(name if asked != iri else full).casefold(): (full, name, role) for full, name, role in rows}
+    near = difflib.get_close_matches(asked.casefold(), list(by_name), n=count, cutoff=NEAR_MISS)
+    found = [by_name[key] for key in near]
+    return [
+        {"iri": full, "name": name, "role": role, "href": url_for("services.service", iri=name)}
+        for full, name, role in found
+        if full != iri
+    ]
 
 
 def _meets(kb: KnowledgeBase, iri: str) -> tuple[list[dict[str, Any]] | None, str | None]:
