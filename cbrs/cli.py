@@ -33,7 +33,18 @@ from cbrs.kb.namespaces import CBRS, OWL, PREFIXES, RDF, GraphName, expand, shor
 from cbrs.kb.skolem import is_skolem
 from cbrs.kb.staged_writes import STAGING
 from cbrs.kb.store import EmbeddedStore, Term
-from cbrs.output import RESULT_FORMATS, ProgressLine, node_view, render_result, sorted_lists, table, term_text
+from cbrs.output import (
+    RESULT_FORMATS,
+    Cell,
+    ProgressLine,
+    fitted_table,
+    node_view,
+    output_width,
+    render_result,
+    sorted_lists,
+    table,
+    term_text,
+)
 from cbrs.settings import SETTINGS, setting
 from cbrs.sparql_hints import explain_syntax_error
 
@@ -456,11 +467,23 @@ def deregister(app: App, iri: str) -> None:
 
 
 @cli.command()
-@click.option("--json", "as_json", is_flag=True, help="Print the advertisements as JSON.")
+@click.option("--json", "as_json", is_flag=True, help="Print the advertisements as JSON (lists whole).")
+@click.option("--full", is_flag=True, help="Print every list whole, however wide the lines.")
+@click.option(
+    "--width",
+    type=click.IntRange(min=0),
+    help="Cut the lists to lines of this many columns (0: whole). Default: on a terminal its width "
+    "(COLUMNS if set); to a pipe or a file, whole lines.",
+)
 @pass_app
-def services(app: App, as_json: bool) -> None:
+def services(app: App, as_json: bool, full: bool, width: int | None) -> None:
     """List the registered advertisements with their kind, device and inputs -> outputs (each list in IRI
-    order), and whether a component registered live (in another process) can be invoked now."""
+    order), and whether a component registered live (in another process) can be invoked now.
+
+    On a terminal each list is cut to its width with the count of the names left out ("home:A +3 more");
+    when the other columns leave the lists too little room, each row takes two lines: the service, then,
+    indented, the rest. Names are not cut unless one alone is too wide ("http://127.0.0.1/…#Car"). A pipe
+    or a file gets whole lines, one a row, as do --full and --width 0; --json is never cut."""
     rows = sorted_lists(app.kb.select("advertisements"), ("inputs", "outputs"))  # the store's order varies
     live = app.kb.liveness.states()
     if as_json:
@@ -473,20 +496,27 @@ def services(app: App, as_json: bool) -> None:
             found.append(item)
         click.echo(json.dumps(found, indent=2))
         return
-    body = [
-        [
+    body: list[list[Cell]] = []
+    for row in rows:
+        cells: list[Cell] = [
             term_text(row["service"]),
             term_text(row.get("kind")).replace("cbrs:", "").replace("Component", ""),
             term_text(row.get("deviceName")),
-            term_text(row.get("inputs")) or "-",
-            term_text(row.get("outputs")) or "-",
+            term_text(row.get("inputs")).split(),
+            term_text(row.get("outputs")).split(),
         ]
-        + ([_live_state(live.get(row["service"].value))] if live else [])
-        for row in rows
-    ]
-    click.echo(table(["service", "kind", "device", "inputs", "outputs"] + (["live"] if live else []), body))
+        body.append(cells + ([_live_state(live.get(row["service"].value))] if live else []))
+    limit = None if full else output_width(width)
+    headers = ["service", "kind", "device", "inputs", "outputs"] + (["live"] if live else [])
+    text, cut = fitted_table(headers, body, limit)
+    click.echo(text)
     gone = sum(1 for row in rows if row["service"].value in live and not live[row["service"].value].live)
-    click.echo(f"({len(rows)} advertisements{f'; {gone} live component(s) unavailable now' if gone else ''})")
+    notes = [f"{len(rows)} advertisements"]
+    if gone:
+        notes.append(f"{gone} live component(s) unavailable now")
+    if cut:
+        notes.append(f"{cut} list{'s' if cut != 1 else ''} cut to {limit} columns: --full prints them whole")
+    click.echo(f"({'; '.join(notes)})")
 
 
 def _live_state(state: ComponentState | None) -> str:

@@ -83,6 +83,139 @@ def table(headers: list[str], rows: list[list[str]]) -> str:
     return "\n".join(lines)
 
 
+# -- tables cut to a width ----------------------------------------------------------------------
+
+LEAST_LIST = 24
+"""Columns a list cut to a width keeps at least: a prefixed name and the count of the others
+(``home:ObjectPosition3D +2 more``). With less room beside the other columns, the lists go on a line of
+their own under the row."""
+
+LEAST_CUT = 12
+"""Columns a list keeps at least on a line of its own: the end of a name and a count (``…Car +1 more``);
+a line is wider than the width only where the cells before the lists leave less."""
+
+LIST_INDENT = "    "
+LIST_JOINER = " -> "
+
+
+def output_width(given: int | None, stream: IO[str] | None = None) -> int | None:
+    """The width to cut lines to: ``given`` (0 for none); else, when ``stream`` (standard output) is a
+    terminal, its width (``COLUMNS`` if set, as :func:`shutil.get_terminal_size` reads it); else ``None``,
+    whole lines: a pipe or a file gets what programs and ``grep`` read, one whole line a row."""
+    if given is not None:
+        return given or None
+    stream = stream if stream is not None else sys.stdout
+    return shutil.get_terminal_size().columns if stream.isatty() else None
+
+
+def elided(names: list[str], width: int) -> tuple[str, int]:
+    """``names`` joined by spaces, cut to ``width`` columns at a name, with the count of those left out
+    (``home:A home:B +3 more``); the first name is cut short (``…``) if even it does not fit. Returns the
+    text and how many names are not shown whole."""
+    whole = " ".join(names)
+    if len(whole) <= width:
+        return whole, 0
+    shown: list[str] = []
+    for name in names:
+        rest = len(names) - len(shown) - 1
+        if len(" ".join([*shown, name])) + len(f" +{rest} more") > width:
+            break
+        shown.append(name)
+    if not shown:
+        tail = f" +{len(names) - 1} more" if len(names) > 1 else ""
+        return shortened(names[0], width - len(tail)) + tail, len(names)
+    return f"{' '.join(shown)} +{len(names) - len(shown)} more", len(names) - len(shown)
+
+
+def shortened(name: str, width: int) -> str:
+    """``name`` in ``width`` columns (at least its local name's last few): what it names is at its end
+    (``http://127.0.0.1/ontology/my_ontology.owl#FourWheeledCar``), so the cut is before its local name,
+    with ``…`` (``http://127.…#FourWheeledCar``), or in the local name's start if that is too long."""
+    if len(name) <= width:
+        return name
+    local = max(name.rfind("#"), name.rfind("/"), name.rfind(":"))
+    keep = max(width - 1, 4)
+    tail = name[local:] if local >= 0 and len(name) - local <= keep else name[-keep:]
+    return name[: keep - len(tail)] + "…" + tail
+
+
+def _shares(needs: list[int], room: int) -> list[int]:
+    """``room`` columns shared among lists that need ``needs``: the shorter ones get all they need,
+    the longer ones split what is left evenly."""
+    given = [0] * len(needs)
+    left, waiting = room, len(needs)
+    for index in sorted(range(len(needs)), key=lambda i: needs[i]):
+        given[index] = min(needs[index], max(left // waiting, 0))
+        left -= given[index]
+        waiting -= 1
+    return given
+
+
+Cell = str | list[str]
+
+
+def fitted_table(headers: list[str], rows: list[list[Cell]], width: int | None) -> tuple[str, int]:
+    """:func:`table` of ``rows`` whose list cells (lists of names) are cut to ``width`` columns (or
+    joined whole for ``None``); other cells are kept whole. When they leave each list fewer than
+    :data:`LEAST_LIST` columns, the lists go on a line of their own under each row (``inputs ->
+    outputs``, indented). Empty lists show ``-``. Returns the text and how many lists were cut."""
+    lists = [i for i, cell in enumerate(rows[0]) if isinstance(cell, list)] if rows else []
+    if width is None or not lists:
+        return table(headers, [[_joined(c) for c in row] for row in rows]), 0
+    plain = [i for i in range(len(headers)) if i not in lists]
+    plain_widths = [max([len(headers[i])] + [len(str(row[i])) for row in rows]) for i in plain]
+    needs = [max([len(headers[i])] + [len(_joined(row[i])) for row in rows]) for i in lists]
+    room = width - sum(plain_widths) - 2 * (len(headers) - 1)
+    beside = _shares(needs, room)
+    if all(share >= min(need, LEAST_LIST) for share, need in zip(beside, needs, strict=True)):
+        cells = [
+            [_cut(c, beside[lists.index(i)]) if i in lists else (str(c), 0) for i, c in enumerate(row)] for row in rows
+        ]
+        cut = sum(1 for row in cells for _, lost in row if lost)
+        return table(headers, [[text for text, _ in row] for row in cells]), cut
+    return _two_lines(headers, rows, plain, lists, width)
+
+
+def _joined(cell: Cell) -> str:
+    return (" ".join(cell) or "-") if isinstance(cell, list) else cell
+
+
+def _cut(cell: Cell, width: int) -> tuple[str, int]:
+    if not isinstance(cell, list) or not cell:
+        return _joined(cell), 0
+    return elided(cell, width)
+
+
+def _two_lines(
+    headers: list[str], rows: list[list[Cell]], plain: list[int], lists: list[int], width: int
+) -> tuple[str, int]:
+    """Each row as two lines: its first cell alone (a name, kept whole), then, indented, its other cells
+    and its lists cut to ``width``. The other cells are aligned in columns when that leaves the lists
+    at most half the width, and otherwise follow one another (OWLS-TC's device names run to 79 columns)."""
+    first, rest = plain[0], plain[1:]
+    widths = [max([len(headers[i])] + [len(str(row[i])) for row in rows]) for i in rest]
+    aligned = len(LIST_INDENT) + sum(w + 2 for w in widths) <= width // 2  # the lists keep half the line
+
+    def second(cells: list[str], named: list[Cell], cut: bool) -> tuple[str, int]:
+        front = LIST_INDENT + "".join((c.ljust(w) if aligned else c) + "  " for c, w in zip(cells, widths, strict=True))
+        floor = sum(min(len(_joined(cell)), LEAST_CUT) for cell in named)
+        room = max(width - len(front) - len(LIST_JOINER) * (len(lists) - 1), floor)
+        shares = _shares([len(_joined(cell)) for cell in named], room)  # a short list leaves the others room
+        parts = [
+            _cut(cell, max(share, 1)) if cut else (_joined(cell), 0) for cell, share in zip(named, shares, strict=True)
+        ]
+        return (front + LIST_JOINER.join(text for text, _ in parts)).rstrip(), sum(1 for _, lost in parts if lost)
+
+    head = [headers[first], second([headers[i] for i in rest], [headers[i] for i in lists], False)[0]]
+    lines = [*head, "-" * max(len(line) for line in head)]
+    cut = 0
+    for row in rows:
+        text, lost = second([str(row[i]) for i in rest], [row[i] for i in lists], True)
+        lines += [str(row[first]), text]
+        cut += lost
+    return "\n".join(lines), cut
+
+
 # -- class expressions -------------------------------------------------------------------------
 
 Expression = dict[str, Any]
