@@ -273,19 +273,26 @@ def _runnable(
     avoid: frozenset[str] = frozenset(),
     passed: Mapping[str, str] | None = None,
 ) -> CompositionResult:
-    """``composition``, or when a step of its plan has no component the environment implements (the
-    store advertises services the simulation does not perform, LocateRoomOfPosition say), the
-    composition without them: such a step fails for sure, and only after the steps before it moved
-    things (a goal-only task picked the cup up, then found no room locator, three times over). So too
-    without the components the environment ``passed`` over (component -> why): a remote one whose
-    calls timed out would make the run wait its timeout again (``actions.breaker``)."""
+    """``composition`` without the alternatives the environment cannot run; or, when a step's component
+    is one it does not implement (the store advertises services the simulation does not perform,
+    LocateRoomOfPosition say), the composition without those: such a step fails for sure, and only
+    after the steps before it moved things (a goal-only task picked the cup up, then found no room
+    locator, three times over). So too without the components the environment ``passed`` over
+    (component -> why): a remote one whose calls timed out would make the run wait its timeout again
+    (``actions.breaker``)."""
     plan = composition.plan
     passed = passed or {}
-    used = {c for step in plan.steps for c in step.candidates} if plan is not None else set()
-    if plan is None or (
-        all(any(c in registry for c in step.candidates) for step in plan.steps) and not used & set(passed)
-    ):
+    if plan is None:
         return composition
+    used = {c for step in plan.steps for c in step.candidates}
+    if all(step.component in registry and step.component not in passed for step in plan.steps):
+        # Each step's first choice can run; an alternative that cannot would fail a failover for sure
+        # (NoImplementationError after the others timed out), so the run keeps only those that can.
+        steps = tuple(
+            replace(step, alternatives=tuple(c for c in step.alternatives if c in registry and c not in passed))
+            for step in plan.steps
+        )
+        return composition if steps == plan.steps else replace(composition, plan=replace(plan, steps=steps))
     advertisements = kb.advertisements()
     missing = frozenset(ad.iri for ad in advertisements if ad.iri not in registry) | frozenset(passed)
     again = _compose(kb, config, task, avoid | missing)

@@ -237,6 +237,20 @@ def test_a_later_run_is_planned_without_the_hanging_component_and_says_why(lab_k
     assert lab.calls == ["/thermometer31/read", "/thermometer32/read", "/thermometer32/read"]
 
 
+def test_a_failover_goes_only_to_alternatives_the_run_can_call(lab_kb: KnowledgeBase, quick: None) -> None:
+    """The bundled sensor board also gives a room temperature, but nothing here implements it: after both
+    thermometers timed out, the run failed over to it and failed again with NoImplementationError."""
+    lab = Lab("/thermometer31/read")
+    lab.answers = False  # both hang
+    result = _run(lab_kb, Room(lab_kb, lab), max_replans=0)
+    assert not result.succeeded and result.report is not None and result.composition.plan is not None
+    assert result.composition.plan.steps[0].candidates == (FIRST, SECOND)
+    assert [a.component for a in result.report.steps[0].attempts] == [FIRST, SECOND]
+    assert "NoImplementationError" not in (result.report.reason or "")
+    for call in lab.open:
+        call.set_exception(RuntimeError("the bridge ended the call"))
+
+
 def test_with_no_other_component_there_is_no_plan_and_the_unsatisfied_need_names_why(
     lab_kb: KnowledgeBase, quick: None
 ) -> None:
