@@ -156,13 +156,21 @@ class KnowledgeBase:
         writes (:attr:`EmbeddedStore.generation`), so the answer is kept until the next one: a load refused
         for its map, then retried with the file mended, reads the stored map once; a remote store has no
         such count, and is read each time."""
+        known = self._known_map_reads()
+        if known is not None:
+            return known
         generation = getattr(self.store, "generation", None)
-        if generation is not None and self._map_read is not None and self._map_read[0] == generation:
-            return self._map_read[1]
         readable = self._map_error() is None
         if generation is not None:
             self._map_read = (generation, readable)
         return readable
+
+    def _known_map_reads(self) -> bool | None:
+        """:meth:`_stored_map_reads`'s kept answer, if the store has not been written since (None: unknown)."""
+        generation = getattr(self.store, "generation", None)
+        if generation is not None and self._map_read is not None and self._map_read[0] == generation:
+            return self._map_read[1]
+        return None
 
     def _map_problem(self, added: list[ox.Quad], keep_map: bool = True) -> Exception | None:
         """What reading the semantic map says would be wrong with it with ``added`` in the store (and, unless
@@ -388,7 +396,8 @@ class KnowledgeBase:
 
         pending = self.standard_terms.prepare(data)
         checking: AbstractContextManager[None] = nullcontext()
-        old_map = self._map_before_update(text, data) if check_map else None
+        before = self._map_before_update(text, data) if check_map else None
+        old_map = before.quads if before is not None else None
         everything: set[ox.Quad] | None = None  # the store before, kept here to put back whatever it wrote
         keep = data is not None  # whether a refused update is undone whole (a data update undoes itself)
         if data is None:  # what else it writes is unknown: keep the whole store if it might be refused
@@ -406,26 +415,46 @@ class KnowledgeBase:
             if old_map is not None:
                 self._check_updated_map(old_map)
         except (DescriptionShapeError, MapError) as error:
+            unasked = isinstance(error, MapError) and before is not None and not before.read
+            after = set(self.store.quads()) if unasked and data is None else None  # to redo it, if it stands
             if data is not None:
                 data.undo(self.store)  # its writes to the other graphs go too: all or nothing
             else:
                 self._put_back(everything, old_map)
-            error.add_note(_refused(isinstance(error, MapError), keep))
-            raise
+            if not unasked or self._stored_map_reads():
+                error.add_note(_refused(isinstance(error, MapError), keep))
+                raise
+            self._redo(text, data, everything, after)  # the map did not read before either: the update stands
         finally:
             self._reader.clear_cache()
         return self._entail(pending)
 
-    def _map_before_update(self, text: str, data: DataUpdate | None) -> set[ox.Quad] | None:
-        """graph:map's quads before an update that may write it, when the map reads (an update is checked
-        as a load into graph:map is: :meth:`_check_map_load`); None: nothing to check."""
+    def _redo(
+        self, text: str, data: DataUpdate | None, before: set[ox.Quad] | None, after: set[ox.Quad] | None
+    ) -> None:
+        """Write again an update undone for the map it left unreadable, once the map proved unreadable before
+        it too: a data update by running it again, another by putting back what it left (``after``)."""
+        if data is not None:
+            self.store.update(text)
+        elif before is not None and after is not None:
+            self.store.replace(before - after, after - before)
+
+    def _map_before_update(self, text: str, data: DataUpdate | None) -> _MapBefore | None:
+        """graph:map before an update that may write it (an update is checked as a load into graph:map is:
+        :meth:`_check_map_load`); None: nothing to check, the map being empty (being built) or known not to
+        read (left to the reader's error). Whether it reads is asked now on a remote store only; on an
+        embedded one, only if the update leaves it unreadable (the update undone first, and redone if the
+        map did not read before either), so an update that leaves it readable reads it once, not twice."""
         may = data.names_graph((GraphName.MAP.node,)) if data is not None else bool(_MAY_WRITE_MAP.search(text))
         if not may:
             return None
         quads = set(self.store.quads(graph=GraphName.MAP.node))
         if not quads:
-            return None  # a map being built
-        return quads if self._stored_map_reads() else None  # one unreadable already: left to the reader's error
+            return None
+        known = self._known_map_reads()
+        if known is None and not isinstance(self.store, EmbeddedStore):
+            known = self._stored_map_reads()
+        return None if known is False else _MapBefore(quads, read=known is True)
 
     def _check_updated_map(self, old_map: set[ox.Quad]) -> None:
         """Raise the semantic map's error when the update just run left graph:map unreadable (an emptied map
@@ -505,6 +534,14 @@ class KnowledgeBase:
 
     def close(self) -> None:
         self.store.close()
+
+
+@dataclasses.dataclass(frozen=True)
+class _MapBefore:
+    """graph:map's quads before an update, and whether they were read (and read without error) then."""
+
+    quads: set[ox.Quad]
+    read: bool
 
 
 def _refused(map_error: bool, whole: bool) -> str:

@@ -11,12 +11,15 @@ import pytest
 from flask.testing import FlaskClient
 
 from cbrs.kb import KnowledgeBase
-from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.namespaces import PREFIXES, GraphName
 from cbrs.kb.semantic_map import MapError, SemanticMap
 from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.web import create_app
 
 TOKEN = "map trial token"
+MAP = "https://w3id.org/cbrs/graph/map"
+TURTLE = "text/turtle"
+WORLD_PREFIX = f"@prefix world: <{PREFIXES['world']}> . @prefix home: <{PREFIXES['home']}> . "
 BREAKS = {
     "data": 'INSERT DATA { GRAPH graph:map { world:Pen home:shapeKind "sphere" } }',
     "where": "DELETE WHERE { GRAPH graph:map { world:Pen home:sizeX ?x } }",
@@ -92,7 +95,7 @@ def test_the_library_refuses_it_unless_told_not_to_check() -> None:
             False,
             id="where",
         ),
-        pytest.param(MOVE, True, id="map-where"),
+        pytest.param(MOVE.replace("0.5", "0.25"), True, id="map-where"),  # a value it did not have
         pytest.param("INSERT DATA { GRAPH graph:map { world:Pen rdfs:comment 'x' } }", True, id="map-data"),
         pytest.param("DELETE DATA { GRAPH graph:map { world:Pen rdfs:comment 'x' } }", True, id="map-delete"),
     ],
@@ -110,12 +113,31 @@ def test_only_an_update_that_may_write_the_map_reads_it(
     kb._map_read = None  # no answer kept from an earlier test
     monkeypatch.setattr(SemanticMap, "read", classmethod(counted))
     kb.update(text)
-    assert bool(reads) is read
+    assert len(reads) == int(read)  # once, after the update: whether it read before is asked only if not now
 
 
-MAP = "https://w3id.org/cbrs/graph/map"
-TURTLE = "text/turtle"
-WORLD_PREFIX = f"@prefix world: <{PREFIXES['world']}> . @prefix home: <{PREFIXES['home']}> . "
+@pytest.mark.parametrize(
+    "text",
+    [
+        pytest.param("INSERT DATA { GRAPH graph:map { world:Cup rdfs:comment 'still broken' } }", id="data"),
+        pytest.param(
+            "DELETE { GRAPH graph:map { world:Cup home:yaw ?y } } INSERT { GRAPH graph:map { world:Cup home:yaw 0.3 } }"
+            " WHERE { GRAPH graph:map { world:Cup home:yaw ?y } }",
+            id="where",
+        ),
+    ],
+)
+def test_an_update_of_a_map_that_did_not_read_before_stands(text: str) -> None:
+    """Left to the reader's error, as a load into such a map is: it was not this update that broke it."""
+    kb = KnowledgeBase.open(":memory:")
+    kb.update(BREAKS["where"], check_map=False)
+    graph = GraphName.MAP.node
+    broken = set(kb.store.quads(graph=graph))
+    kb.update(text)  # undone to see whether the map read before, then written again
+    changed = set(kb.store.quads(graph=graph)) ^ broken
+    assert changed and {quad.subject.value for quad in changed} == {PREFIXES["world"] + "Cup"}
+    with pytest.raises(MapError, match="has no home:sizeX"):
+        SemanticMap.read(kb)
 
 
 @pytest.mark.parametrize(
