@@ -350,8 +350,9 @@ class KnowledgeBase:
         graph:entailed follows (node by node after a data update: :meth:`StandardTerms.prepare`).
 
         An update that leaves a readable semantic map unreadable is put back and refused with the map
-        reader's error (:class:`kb.semantic_map.MapError`), as a load into graph:map is: else it stays in and every task
-        fails on it. Only an update that may write graph:map is checked; the rest pay nothing for it.
+        reader's error (:class:`kb.semantic_map.MapError`), as a load into graph:map is: else it stays in
+        and every task fails on it. Only an update that may write graph:map is checked; the rest pay
+        nothing for it.
         ``check_map=False`` skips the check, for a caller that builds or breaks a map on purpose (a test
         of the map reader's errors): the map's reader then says what is wrong when a task reads it."""
         self._update(text, self._data_update(text), check_map)
