@@ -48,6 +48,8 @@ class Unsatisfied:
         need = self.need
         if self.consumer == SRE and need.startswith("precondition "):  # the goal is the end's precondition
             need = "effect " + need.removeprefix("precondition ")
+        if self.consumer == SRO and need.startswith("input "):  # the requirement's output is the end's input
+            need = "output " + need.removeprefix("input ")
         if self.cycle:
             return f"only a cycle of components provides {need} of {consumer}{via}"
         if self.consumer == SRI:  # the task gives it: nothing to provide, but its class is unknown
@@ -92,6 +94,8 @@ class Unsatisfied:
                 "or a fact of the semantic map"
             )
         concept = self.need.rsplit("(", 1)[-1].rstrip(")") if "(" in self.need else self.need
+        if self.consumer == SRO:  # what the task asks for: giving it as an input would be no answer
+            return f"register a component whose output is a {concept}"
         return f"register a component whose output is a {concept}, or give one as an input of the task"
 
     def to_dict(self) -> dict[str, Any]:

@@ -263,6 +263,9 @@ def test_with_no_other_component_there_is_no_plan_and_the_unsatisfied_need_names
     why = dict(unsatisfied.unrunnable)  # the sensor board has no implementation here: it says so too
     assert "is passed over" in why[FIRST] and "is passed over" in why[SECOND]
     assert f"{SECOND.split('#')[1]} was planned for it but cannot run here" in unsatisfied.text()
+    # what the task asks for is named as its output, and not proposed as an input it could give
+    assert unsatisfied.text().startswith("no component provides output roomTemperature (home:RoomTemperature) of")
+    assert "as an input" not in unsatisfied.remedy()
     assert {p["component"] for p in second.to_dict()["plan"]["passed_over"]} == {FIRST, SECOND}
     assert lab.calls == ["/thermometer31/read", "/thermometer32/read"]  # each waited for once
 
