@@ -65,7 +65,9 @@ def test_a_run_waits_for_a_component_whose_program_restarts_and_uses_it_again(se
 
     release, programs, events = threading.Event(), [], []
     first.provide("/thermometer07/read", "cbrs_msgs/RoomTemperature", dies)
-    first.call_sync("/cbrs/register", {"description": thermometer()})
+    # A lease long enough for building the world under load (no heartbeats here): it is the disconnect,
+    # not a lapse, that the run must live through.
+    first.call_sync("/cbrs/register", {"description": thermometer(), "ttl": 60.0})
     try:
         with open_world(semantic_map=SemanticMap.read(kb)) as world, BridgeClient(url(server), TOKEN) as bridge:
             result = run_task(
