@@ -146,6 +146,9 @@ class ExecutionReport:
     ticks: int = 0
     seconds: float = 0.0
     unmet: Unmet | None = None
+    # What each step that succeeded gave, by step index: the values a task asking for outputs wants
+    # (``RunResult.answers``); left out of ``to_dict``, where a map's cells would swell every report.
+    outputs: Mapping[int, Mapping[str, Any]] = field(default_factory=dict)
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -237,7 +240,14 @@ class Executor:
 
     def report(self) -> ExecutionReport:
         return ExecutionReport(
-            self.plan.task, self.status, self.reports, self.reason, self.ticks, self.clock() - self._began, self.unmet
+            self.plan.task,
+            self.status,
+            self.reports,
+            self.reason,
+            self.ticks,
+            self.clock() - self._began,
+            self.unmet,
+            {index: dict(given) for index, given in self.results.items()},
         )
 
     # -- one step ----------------------------------------------------------------------------------

@@ -7,6 +7,7 @@ simulation provides one (``sim.components``); tests provide stubs.
 
 from __future__ import annotations
 
+import json
 import time
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, replace
@@ -19,11 +20,11 @@ from cbrs.actions.errors import UngroundedGoalError
 from cbrs.actions.events import Event, EventBus
 from cbrs.actions.executor import ExecutionReport, Executor, RunStatus
 from cbrs.actions.faults import Combined, FaultPolicy, FixedFaults
-from cbrs.actions.graph import statement_text
+from cbrs.actions.graph import parameter_names, statement_text
 from cbrs.actions.plan import Plan, PlanStep
 from cbrs.actions.replanning import Failure, FailureMemory, ReplanPolicy
 from cbrs.kb import Advertisement, KnowledgeBase, NotFoundError, Requirement, Statement
-from cbrs.kb.namespaces import HOME
+from cbrs.kb.namespaces import HOME, shorten
 from cbrs.kb.semantic_map import UnresolvedDesignatorError
 from cbrs.reasoner.taxonomy import ROOT, TaxonomyIndex
 
@@ -87,6 +88,44 @@ class GoalCheck:
 
 
 @dataclass(frozen=True)
+class Answer:
+    """One output the task's requirement asks for, as the run found it: the requirement's name and class
+    for it, the value (the JSON a component gives, ``docs/values.md``) and the step and component that
+    gave it under the name ``output``. ``value`` is None when that component gave nothing by that name."""
+
+    name: str
+    concept: str | None
+    value: Any
+    step: int
+    component: str
+    output: str
+
+    def text(self, width: int = 160) -> str:
+        """One line: ``roomTemperature (home:RoomTemperature) = {"celsius": 21.5} from svc:...``; the value
+        as compact JSON without the ``@type`` the class already says, numbers to a millimetre or a
+        millisecond, cut at ``width`` characters (``to_dict`` keeps it whole and exact)."""
+        what = f"{self.name} ({shorten(self.concept)})" if self.concept else self.name
+        source = f"from {shorten(self.component)} (step {self.step})"
+        if self.value is None:
+            return f"{what}: no value; {shorten(self.component)} gave none named {self.output!r} (step {self.step})"
+        shown = _compact(self.value, self.concept)
+        if len(shown) > width:
+            shown = f"{shown[: width - 1]}\u2026 ({len(shown)} characters in all)"
+        return f"{what} = {shown} {source}"
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "name": self.name,
+            "class": self.concept,
+            "value": _plain(self.value),
+            "step": self.step,
+            "component": self.component,
+            "output": self.output,
+            "text": self.text(),
+        }
+
+
+@dataclass(frozen=True)
 class RunResult:
     composition: CompositionResult  # the last composition: of the plan that ran last, or the one that failed
     report: ExecutionReport | None  # the last plan's execution; None when there was no plan to run
@@ -111,6 +150,29 @@ class RunResult:
         """The goals the world contradicts (the robots may believe them)."""
         return tuple(goal for goal in self.goals if goal.holds is False)
 
+    @property
+    def answers(self) -> tuple[Answer, ...]:
+        """The requirement's outputs the last plan's steps gave, in the plan's order: what a task that asks
+        a question (a room's temperature, where the robot is) asked for. An output whose step did not
+        succeed has none; a sub-action's output (a decomposed task's cup position) is none, nor is one
+        the requirement gives itself."""
+        plan = self.composition.plan
+        if plan is None or self.report is None or not self.composition.attempts:
+            return ()
+        outputs = self.composition.attempts[0].requirement.outputs  # the task's own requirement
+        asked = {(name, p.type) for name, p in zip(parameter_names(outputs), outputs, strict=True)}
+        found = []
+        for goal in plan.goals:
+            step = goal.source.step
+            if goal.statement is not None or step is None or step not in self.report.outputs:
+                continue
+            if (goal.name, goal.concept) not in asked:
+                continue
+            component = next((s.component for s in self.report.steps if s.index == step), plan.step(step).component)
+            value = self.report.outputs[step].get(goal.source.name)
+            found.append(Answer(goal.name, goal.concept, value, step, component, goal.source.name))
+        return tuple(found)
+
     def to_dict(self) -> dict[str, Any]:
         status = self.report.status.value if self.report else PlanStatus.UNSOLVABLE.value
         if self.executed and self.refuted:
@@ -123,7 +185,39 @@ class RunResult:
         if self.stopped:
             found["stopped"] = self.stopped
         found["goals"] = [goal.to_dict() for goal in self.goals]
+        found["answers"] = [answer.to_dict() for answer in self.answers]
         return found
+
+
+def _plain(value: Any) -> Any:
+    """``value`` as JSON can carry it: as it is (the values between steps are JSON), else its ``repr``
+    (a component in this process may give a Python object)."""
+    try:
+        json.dumps(value, allow_nan=False)
+    except (TypeError, ValueError):
+        return repr(value)
+    return value
+
+
+def _compact(value: Any, concept: str | None) -> str:
+    """``value`` as one line of JSON for a person: without an ``@type`` equal to ``concept``, another
+    one prefixed (``home:RobotLocation``)."""
+    if isinstance(value, dict) and isinstance(value.get("@type"), str):
+        kind = value["@type"]
+        value = {key: item for key, item in value.items() if key != "@type"}
+        if not concept or kind not in (concept, shorten(concept)):
+            value = {"@type": shorten(kind), **value}
+    return json.dumps(_rounded(_plain(value)), separators=(", ", ": "), ensure_ascii=False)
+
+
+def _rounded(value: Any) -> Any:
+    if isinstance(value, float):
+        return round(value, 3) if abs(value) >= 1e-3 else float(f"{value:.3g}")
+    if isinstance(value, dict):
+        return {key: _rounded(item) for key, item in value.items()}
+    if isinstance(value, list):
+        return [_rounded(item) for item in value]
+    return value
 
 
 def run_task(

@@ -13,7 +13,8 @@ Services (request fields -> response values):
   ``/cbrs/task_status`` ``{run}``; with ``wait`` it answers when the run ends or, at the latest, two
   seconds before the bridge's call timeout, with the run as it is then (``running``). ``task`` is any
   requirement or action of the store, named as ``cbrs run`` takes it; ``repeat_failures`` as
-  ``cbrs run --repeat-failures``.
+  ``cbrs run --repeat-failures``. Its ``result`` holds ``answers``: the values of the outputs the task asks
+  for (a room's temperature), with the component that gave each (docs/execution.md, "Answers").
 
 Action (rosbridge's ROS 2 action ops, ``send_action_goal`` and the rest):
 

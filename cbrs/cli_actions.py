@@ -418,7 +418,16 @@ def run_text(result: RunResult, sim_seconds: float, wall_seconds: float) -> str:
     steps = table(["#", "component", "sim s", "outcome", "effects checked"], rows)
     if not report.steps:  # every effect held already: no table of no steps
         steps = "nothing to do: every effect of the task holds already"
-    return f"{header}{steps}\n{verdict}; {timing}{_unused_note(result.composition)}"
+    return f"{header}{steps}\n{verdict}; {timing}{_answers_text(result)}{_unused_note(result.composition)}"
+
+
+def _answers_text(result: RunResult) -> str:
+    """The values the task's requirement asked for (its outputs), a line each: the answer to a task that
+    asks a question (``req:RoomTemperature``), which the steps table alone does not show."""
+    answers = result.answers
+    if not answers:
+        return ""
+    return "\n" + ("Answer:" if len(answers) == 1 else "Answers:") + "".join(f"\n  {a.text()}" for a in answers)
 
 
 def _passed_over_lines(passed: tuple[tuple[str, str], ...]) -> list[str]:

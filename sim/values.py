@@ -168,6 +168,8 @@ class _Missing:
 
 
 MISSING: Any = _Missing()
+WHOLE = "(value)"
+"""The ``key`` of a ``MalformedValueError`` about the value itself rather than one of its fields."""
 
 
 class MalformedValueError(SimulationError, ValueError):
@@ -183,7 +185,10 @@ class MalformedValueError(SimulationError, ValueError):
         if len(shown) > 80:
             shown = shown[:77] + "..."
         what = f"home:{local_name(concept)}" if concept and concept.startswith(HOME) else (concept or "value")
-        where = f"{key!r} is {shown}" if value is not MISSING else f"{key!r} is missing"
+        if key == WHOLE:  # not a field: the value itself has the wrong shape (a bare 21.5, a list)
+            where = f"the whole value is {shown}"
+        else:
+            where = f"{key!r} is {shown}" if value is not MISSING else f"{key!r} is missing"
         super().__init__(f"malformed {what}: {where}, expected {expected}")
 
 
@@ -541,7 +546,7 @@ def to_json(value: Value, concept: str | None = None) -> dict[str, Any]:
 def from_json(data: object) -> Value:
     """The value a JSON object stands for, by its ``"@type"`` (a designator when it has an ``"@id"``)."""
     if not isinstance(data, dict):
-        raise MalformedValueError(None, "(value)", data, "a JSON object with an '@type'")
+        raise MalformedValueError(None, WHOLE, data, "a JSON object with an '@type'")
     concept = data.get("@type", MISSING)
     if not isinstance(concept, str) or not concept:
         raise MalformedValueError(None, "@type", concept, "the IRI of the value's class")
@@ -635,7 +640,7 @@ def check(concept: str, data: object, is_a: IsA | None = None) -> dict[str, Any]
     names the port's class, what was given and what was expected."""
     named = local_name(concept)
     if not isinstance(data, dict):
-        raise MalformedValueError(concept, "(value)", data, f"a JSON object with '@type' {named}")
+        raise MalformedValueError(concept, WHOLE, data, f"a JSON object with '@type' {named}")
     written = data.get("@type", MISSING)
     if not isinstance(written, str) or not written:
         raise MalformedValueError(concept, "@type", written, f"the class of the value ({named})")
@@ -649,7 +654,7 @@ def check(concept: str, data: object, is_a: IsA | None = None) -> dict[str, Any]
     if "@id" in value:
         if codec is not None:
             raise MalformedValueError(
-                concept, "(value)", data, f"the JSON shape of {named} (docs/values.md), not a designator (@id)"
+                concept, WHOLE, data, f"the JSON shape of {named} (docs/values.md), not a designator (@id)"
             )
         if not is_a(full, concept):
             raise MalformedValueError(concept, "@type", written, f"a designator of {named} or a subclass of it")
