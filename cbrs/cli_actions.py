@@ -177,7 +177,12 @@ def _source(binding: Binding) -> str:
         " CBRS_UPDATE_TOKEN, when set, to be authorised."
     ),
 )
-@click.option("--json", "as_json", is_flag=True, help="Print the plan and the execution report as JSON.")
+@click.option(
+    "--json",
+    "as_json",
+    is_flag=True,
+    help="Print the plan, the execution report and the answers (the values of the task's outputs) as JSON.",
+)
 @click.option(
     "--record",
     type=click.Path(dir_okay=False, path_type=Path),
