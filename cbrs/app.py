@@ -37,6 +37,11 @@ class App:
             )
         return self._kb
 
+    @property
+    def opened_kb(self) -> KnowledgeBase | None:
+        """The knowledge base if a command has opened it, else None (nothing is opened)."""
+        return self._kb
+
     def close(self) -> None:
         """Flush and release the store, so the next command (even in this process) can open it."""
         if self._kb is not None:

@@ -26,10 +26,11 @@ from cbrs.cli_store import export, restore, update
 from cbrs.extras import require
 from cbrs.kb import Advertisement, KnowledgeBase, KnowledgeBaseError, Requirement, ServiceDescription
 from cbrs.kb.catalog import Catalogue, merge
-from cbrs.kb.errors import AlreadyRegisteredError, QuerySyntaxError, without_password
+from cbrs.kb.derived_prefixes import StoreNames
+from cbrs.kb.errors import AlreadyRegisteredError, NotFoundError, QuerySyntaxError, without_password
 from cbrs.kb.liveness import ComponentState
 from cbrs.kb.loader import LoadReport, ParsedFile
-from cbrs.kb.namespaces import CBRS, OWL, PREFIXES, RDF, GraphName, expand, shorten
+from cbrs.kb.namespaces import CBRS, OWL, PREFIXES, RDF, GraphName, expand, near_prefixes, shorten, store_names
 from cbrs.kb.skolem import is_skolem
 from cbrs.kb.staged_writes import STAGING
 from cbrs.kb.store import EmbeddedStore, Term
@@ -74,6 +75,15 @@ _LAZY_COMMANDS: dict[str, tuple[str, str, str]] = {
         "Serve the knowledge base: SPARQL 1.1 at /sparql on the HTTP port, rosbridge v2 on the bridge port.",
     ),
 }
+
+
+_DECLARED_NAMES_ONLY = frozenset({"serve", "query"})
+"""Commands that print and take names with the declared prefixes only: the server's threads name IRIs
+for their clients, and a query's text declares its own prefixes (the endpoint knows only cbrs's)."""
+
+_TAKE_NAMES = frozenset({"deregister", "match", "plan", "run", "show"})
+"""Commands whose arguments name resources: a name with a derived prefix opens the store to read it.
+The others use the derived prefixes only once they have opened the store themselves."""
 
 
 class _Group(click.Group):
@@ -131,6 +141,9 @@ def cli(ctx: click.Context, store: str | None) -> None:
     app = App(store_location=location)
     ctx.obj = app
     ctx.call_on_close(app.close)
+    if ctx.invoked_subcommand not in _DECLARED_NAMES_ONLY:  # names as the browser shows them (docs/owls.md)
+        takes_names = ctx.invoked_subcommand in _TAKE_NAMES
+        ctx.with_resource(store_names(StoreNames(lambda: app.kb if takes_names else app.opened_kb)))
     # a restore into a new directory means to make it, and seeds nothing: it says each graph was absent
     if ctx.invoked_subcommand not in (None, "init", "settings", "restore") and no_store_at(location):
         ctx.call_on_close(lambda: note_new_store(location))
@@ -460,7 +473,8 @@ def deregister(app: App, iri: str) -> None:
     try:
         removed = app.kb.registry.deregister(full)
     except KnowledgeBaseError as error:
-        raise click.ClickException(f"{error}{_prefix_hint(full)}") from error
+        hint = not_found_hint(app.kb, full) if type(error) is NotFoundError else _prefix_hint(full)
+        raise click.ClickException(f"{error}{hint}") from error
     if full in app.kb.liveness.states():  # a live component: not listed as available until its next heartbeat
         app.kb.liveness.forget(full)
     click.echo(f"deregistered {shorten(full)} ({removed} triples)")
@@ -535,7 +549,7 @@ def show(app: App, iri: str, as_json: bool) -> None:
     full = parse_iri(iri)
     kb = app.kb
     if not kb.describes(full):
-        raise click.ClickException(f"nothing in the store mentions <{full}>{_prefix_hint(full)}")
+        raise click.ClickException(f"nothing in the store mentions <{full}>{not_found_hint(kb, full)}")
     is_description = bool(kb.select("description", {"description": full}))
     if is_description:
         description = kb.description(full)
@@ -792,11 +806,23 @@ def _into(item: ParsedFile) -> str:
 
 
 def _prefix_hint(full: str) -> str:
-    """A hint when ``full`` looks like prefix:name with a prefix nobody declared (lab:Cam for a lab's own)."""
-    scheme = full.split(":", 1)[0]
+    """A hint when ``full`` looks like prefix:name with a prefix nobody declared (lab:Cam for a lab's own);
+    the closest prefixes first, the store's derived ones among them (docs/owls.md)."""
+    scheme, _, local = full.partition(":")
     if "://" in full or scheme in ("urn", "tag", "mailto", "file"):
         return ""
-    return f" (is {scheme!r} a mistyped prefix? known prefixes: {', '.join(PREFIXES)})"
+    near = near_prefixes(scheme)
+    meant = f"; did you mean {' or '.join(f'{p}:{local}' for p in near)}?" if near else ""
+    return f" (is {scheme!r} a mistyped prefix? known prefixes: {', '.join(PREFIXES)}{meant})"
+
+
+def not_found_hint(kb: KnowledgeBase, full: str, among: list[str] | None = None) -> str:
+    """What to say after "no such resource": the names nearest ``full`` (:func:`cbrs.task_names.near_names`),
+    else a hint at a mistyped prefix."""
+    from cbrs.task_names import near_names  # imports the action model: only when a name named nothing
+
+    near = near_names(kb, full, among) if "://" in full else []
+    return f"; did you mean {' or '.join(near)}?" if near else _prefix_hint(full)
 
 
 def _bindings(texts: tuple[str, ...]) -> dict[str, str]:

@@ -9,6 +9,7 @@ import click
 
 from cbrs.app import App, parse_iri, pass_app
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.errors import NotFoundError
 from cbrs.kb.namespaces import shorten
 from cbrs.output import ProgressLine, table
 from cbrs.reasoner.config import MatchConfig
@@ -80,11 +81,19 @@ def match(
         raise click.MissingParameter(param_type="argument", param_hint="'REQUIREMENT'")
     config = match_config(params)
     iri = parse_iri(requirement, "REQUIREMENT", default_prefix="req")  # a bare name, as /cbrs/match takes it
-    if as_json:
-        result = Matchmaker(app.kb, method, config).rank(iri, explain=top)
-        click.echo(json.dumps(result.to_dict(top), indent=2))
-        return
-    click.echo(ranking_text(app.kb, iri, top, top if explain else 0, method, config))
+    try:
+        if as_json:
+            result = Matchmaker(app.kb, method, config).rank(iri, explain=top)
+            click.echo(json.dumps(result.to_dict(top), indent=2))
+            return
+        click.echo(ranking_text(app.kb, iri, top, top if explain else 0, method, config))
+    except NotFoundError as error:  # a mistyped requirement: the nearest stored ones
+        if error.iri != iri:
+            raise
+        from cbrs.cli import not_found_hint
+
+        stored = [row["requirement"].value for row in app.kb.select("requirements")]
+        raise click.ClickException(f"{error}{not_found_hint(app.kb, iri, stored)}") from error
 
 
 def ranking_text(

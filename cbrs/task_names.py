@@ -1,20 +1,24 @@
-"""Task names as a person types them: a bare local name of any namespace, a prefixed name or an IRI.
+"""Names as a person types them: a bare local name of any namespace, a prefixed name or an IRI.
 
 The composer resolves a bare name in the bundled namespaces only (``req:NAME``, then ``act:NAME``); a
 task loaded under its own namespace (``lab:FetchMyCup``) is listed by its local name, so a listed name
 must resolve too. :func:`task_iri` turns what was typed into the IRI the composer is given, or fails
-with a did-you-mean and every known task spelt as it can be typed.
+with a did-you-mean and every known task spelt as it can be typed. :func:`near_names` offers the
+like of that did-you-mean for any name that names nothing (``cbrs show``, ``cbrs match``).
 """
 
 from __future__ import annotations
 
 import difflib
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
+
+import pyoxigraph as ox
 
 from cbrs.actions.errors import UnknownTaskError
 from cbrs.actions.model import ActionLibrary
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.derived_prefixes import namespace
 from cbrs.kb.namespaces import expand, written
 from cbrs.kb.owls import local_name
 
@@ -100,16 +104,39 @@ def _known(tasks: Sequence[_Task]) -> list[str]:
 
 
 def _suggestions(typed: str, tasks: Sequence[_Task]) -> list[str]:
-    """The closest spellings, compared by local name with case aside: a name differing only in case
-    alone, else the best few difflib finds."""
+    return sorted({_typed(iri, tasks) for iri in _closest(typed, [task.iri for task in tasks])})
+
+
+def _closest(typed: str, iris: Iterable[str]) -> list[str]:
+    """The IRIs whose local names are the closest spellings of ``typed``'s, with case aside: those
+    differing only in case alone, else the best few difflib finds."""
     key = (local_name(typed) if ":" in typed else typed).lower()
     by_name: dict[str, list[str]] = {}
-    for task in tasks:
-        by_name.setdefault(local_name(task.iri).lower(), []).append(task.iri)
+    for iri in iris:
+        by_name.setdefault(local_name(iri).lower(), []).append(iri)
     if key in by_name:
         close = [key]
     else:
         scored = sorted(((difflib.SequenceMatcher(None, key, n).ratio(), n) for n in by_name), reverse=True)
         best = scored[0][0] if scored else 0.0
         close = [n for score, n in scored[:3] if score >= max(0.75, best - 0.05)]
-    return sorted({_typed(iri, tasks) for name in close for iri in by_name[name]})
+    return [iri for name in close for iri in by_name[name]]
+
+
+# The resources described in one namespace, bound as a string: read only when a name named nothing.
+_IN_NAMESPACE = "SELECT DISTINCT ?s ?namespace WHERE { ?s ?p ?o FILTER(STRSTARTS(STR(?s), ?namespace)) }"
+
+
+def near_names(kb: KnowledgeBase, iri: str, among: Iterable[str] | None = None) -> list[str]:
+    """The names a person who typed ``iri`` (which names nothing) likely meant, written as they can be
+    typed back (prefixed, with the store's derived prefixes within ``store_names``): the closest local
+    names ``among`` the IRIs given, by default the subjects of the store in ``iri``'s namespace."""
+    if among is None:
+        ns = namespace(iri)
+        if ns is None:
+            return []
+        rows = kb.query(_IN_NAMESPACE, {"namespace": ox.Literal(ns)})
+        if not isinstance(rows, ox.QuerySolutions):  # a SELECT's answer always is
+            return []
+        among = [row[0].value for row in rows if isinstance(row[0], ox.NamedNode)]
+    return sorted({written(found) for found in _closest(iri, among) if found != iri})

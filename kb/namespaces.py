@@ -5,8 +5,13 @@ Every IRI cbrs mints lives under ``BASE``.
 
 from __future__ import annotations
 
+import difflib
 import re
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
+from contextvars import ContextVar
 from enum import StrEnum
+from typing import Protocol
 
 from pyoxigraph import NamedNode
 
@@ -83,8 +88,34 @@ class GraphName(StrEnum):
         return NamedNode(self.iri)
 
 
+class StoreNames(Protocol):
+    """A store's own prefixes for the namespaces the table leaves out (:mod:`cbrs.kb.derived_prefixes`)."""
+
+    @property
+    def prefixes(self) -> Mapping[str, str]: ...
+
+    def shorten(self, iri: str) -> str | None: ...
+
+    def namespace_of(self, prefix: str) -> str | None: ...
+
+
+_store_names: ContextVar[StoreNames | None] = ContextVar("cbrs_store_names", default=None)
+
+
+@contextmanager
+def store_names(names: StoreNames) -> Iterator[None]:
+    """Within the block, :func:`expand` and :func:`shorten` also use ``names`` (a CLI command's store's
+    derived prefixes, so that it prints and takes the names the browser shows)."""
+    token = _store_names.set(names)
+    try:
+        yield
+    finally:
+        _store_names.reset(token)
+
+
 def expand(name: str) -> str:
-    """Expand ``prefix:local`` with the prefix table; absolute IRIs pass through unchanged.
+    """Expand ``prefix:local`` with the prefix table (and the store's derived prefixes within
+    :func:`store_names`); absolute IRIs pass through unchanged.
 
     Raises ``ValueError`` for a name that is neither.
     """
@@ -93,15 +124,33 @@ def expand(name: str) -> str:
     prefix, sep, local = name.partition(":")
     if sep and prefix in PREFIXES:
         return PREFIXES[prefix] + local
+    names = _store_names.get()
+    if sep and names is not None and not local.startswith("//"):  # http://... is an IRI, never a name
+        found = names.namespace_of(prefix)
+        if found is not None:
+            return found + local
     if sep and _SCHEME.fullmatch(prefix):
         return name
-    raise ValueError(
-        f"{name!r} is neither an absolute IRI nor a prefixed name with a known prefix ({', '.join(PREFIXES)})"
-    )
+    known = ", ".join(PREFIXES)
+    if names is not None and names.prefixes:
+        known += f", or one of the store's {len(names.prefixes)} derived prefixes"
+    near = near_prefixes(prefix) if sep else []
+    hint = f"; did you mean {' or '.join(f'{p}:{local}' for p in near)}?" if near else ""
+    raise ValueError(f"{name!r} is neither an absolute IRI nor a prefixed name with a known prefix ({known}){hint}")
+
+
+def near_prefixes(prefix: str) -> list[str]:
+    """The declared prefixes (and, within :func:`store_names`, the store's derived ones) closest to
+    ``prefix``, a mistyped one: the best three, case aside."""
+    names = _store_names.get()
+    known = [*PREFIXES, *(names.prefixes if names is not None else ())]
+    by_folded = {name.casefold(): name for name in reversed(known)}
+    return [by_folded[n] for n in difflib.get_close_matches(prefix.casefold(), list(by_folded), n=3)]
 
 
 def shorten(iri: str) -> str:
-    """The prefixed form of ``iri`` when a table prefix covers it, else the IRI itself."""
+    """The prefixed form of ``iri`` when a table prefix covers it (or, within :func:`store_names`, one
+    of the store's derived prefixes), else the IRI itself."""
     best = ""
     for prefix, namespace in PREFIXES.items():
         if iri.startswith(namespace) and len(namespace) > len(PREFIXES.get(best, "")):
@@ -110,7 +159,9 @@ def shorten(iri: str) -> str:
         local = iri[len(PREFIXES[best]) :]
         if local and all(ch.isalnum() or ch in "_-." for ch in local):
             return f"{best}:{local}"
-    return iri
+        return iri
+    names = _store_names.get()
+    return (names.shorten(iri) or iri) if names is not None else iri
 
 
 def written(iri: str) -> str:
