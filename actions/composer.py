@@ -260,7 +260,10 @@ class Composer:
     def _single_step(
         self, task: Task, requirement: Requirement, ad: Advertisement, pairs: Sequence[EntityPair], score: float
     ) -> Plan | None:
-        """The plan of ``ad`` alone for ``requirement``, its inputs and outputs bound as the matchmaker paired them."""
+        """The plan of ``ad`` alone for ``requirement``, its inputs and outputs bound as the matchmaker paired
+        them, each with the degree its explanation shows ("Similar" for a pair Sem-Str matched without an
+        is-a link, the paper's Position for Location, not the logic's "Fail")."""
+        threshold = (self._matchmaker.config if self._matchmaker is not None else MatchConfig()).pair_threshold
         bindings: list[Binding] = []
         requirement_inputs = list(zip(parameter_names(requirement.inputs), requirement.inputs, strict=True))
         for name, parameter in zip(parameter_names(ad.inputs), ad.inputs, strict=True):
@@ -273,7 +276,7 @@ class Composer:
                     "input",
                     name,
                     Source(source, None, requirement.iri),
-                    given.degree,
+                    given.shown_degree(threshold),
                     given.similarity,
                     parameter.type,
                 )
@@ -296,7 +299,7 @@ class Composer:
                     "input",
                     wanted_name,
                     Source(output, 1),
-                    pair.degree,
+                    pair.shown_degree(threshold),
                     pair.similarity,
                     wanted_output.type,
                 )

@@ -109,7 +109,9 @@ class PlanStep:
 class Plan:
     task: str
     requirement: str
-    method: str  # "direct" (one composition), "decomposed" (one per sub-action), "achieved" (holds: no step)
+    # "direct" (one composition), "decomposed" (one per sub-action), "matched" (one advertisement the
+    # matchmaker ranked, when composition found nothing), "achieved" (holds: no step)
+    method: str
     steps: tuple[PlanStep, ...]
     goals: tuple[Binding, ...]  # what meets the requirement's outputs and effects
     similarity: float  # mean Sem-Str similarity over every binding, goals included

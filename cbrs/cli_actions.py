@@ -92,12 +92,13 @@ def plan_text(result: CompositionResult) -> str:
         lines += [f"  - {u.text()}" for u in result.unsatisfied]
         return "\n".join(lines)
     plan: Plan = result.plan
-    how = {"direct": "composed directly", "achieved": "nothing to do: every effect holds already"}.get(
-        plan.method, "decomposed into " + ", ".join(map(shorten, plan.sub_actions))
-    )
-    head = (
-        f"{name}: planned ({how}), {len(plan.steps)} steps, mean similarity {plan.similarity:.3f}, cost {plan.cost:g} s"
-    )
+    how = {
+        "direct": "composed directly",
+        "matched": "matched to one component by the matchmaker",
+        "achieved": "nothing to do: every effect holds already",
+    }.get(plan.method, "decomposed into " + ", ".join(map(shorten, plan.sub_actions)))
+    steps = f"{len(plan.steps)} step{'' if len(plan.steps) == 1 else 's'}"
+    head = f"{name}: planned ({how}), {steps}, mean similarity {plan.similarity:.3f}, cost {plan.cost:g} s"
     rows = []
     for step in plan.steps:
         sources = "; ".join(_source(b) for b in step.bindings) or "-"

@@ -405,3 +405,19 @@ def test_a_refused_run_with_json_prints_json(tmp_path: Path) -> None:
     assert refused["status"] == "error" and refused["task"].endswith("FetchMyPen")
     assert refused["error"].startswith("AmbiguousDesignatorError") and "Pen2" in refused["error"]
     assert "Pen2" in result.stderr
+
+
+def test_a_plan_the_matchmaker_found_says_so_and_shows_its_pairs_as_the_explanation_does(store: str) -> None:
+    """RobotSelfPosition is met by one advertisement the matchmaker ranks (the paper's Position for
+    Location): the text said "decomposed into " with nothing after it, and the goal's degree "Fail"
+    where `cbrs match --explain` shows the same pair as "Similar"."""
+    code, out = run("plan", "RobotSelfPosition", store=store)
+    assert code == 0, out
+    assert "planned (matched to one component by the matchmaker), 1 step," in out.splitlines()[0]
+    code, out = run("plan", "RobotSelfPosition", "--json", store=store)
+    plan = json.loads(out)
+    assert plan["method"] == "matched"
+    explained = run("match", "req:RobotSelfPosition", "--explain", store=store)[1]
+    for goal in plan["goals"]:
+        assert goal["degree"] != "Fail"
+        assert f"{goal['degree']} " in explained  # the explanation's word for the same pair
