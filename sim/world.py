@@ -9,6 +9,7 @@ world and, since stepping is deterministic, the same outcome for the same calls.
 from __future__ import annotations
 
 import difflib
+import hashlib
 import logging
 import math
 from collections.abc import Callable, Hashable, Iterator, Mapping
@@ -126,21 +127,31 @@ class Perturbation:
     base: tuple[float, float, float]
 
     @classmethod
-    def from_seed(cls, seed: int, objects: Mapping[str, bool] | None = None, spread: Spread = Spread()) -> Perturbation:
-        """``objects`` maps each object's name to whether it is round (no yaw offset), in any order."""
+    def from_seed(
+        cls, seed: int, objects: Mapping[str, tuple[str, bool]] | None = None, spread: Spread = Spread()
+    ) -> Perturbation:
+        """``objects`` maps each object's name to its IRI and whether it is round (no yaw offset)."""
         rng = np.random.default_rng(seed)
         person = rng.uniform(-spread.person, spread.person, 2)
         base = rng.uniform([-spread.base, -spread.base, -spread.base_yaw], [spread.base, spread.base, spread.base_yaw])
-        moved = {}
-        for name in sorted(objects or {}):
-            limits = [spread.object, spread.object, spread.yaw]
-            dx, dy, dyaw = rng.uniform([-v for v in limits], limits)
-            moved[name] = (float(dx), float(dy), 0.0 if (objects or {})[name] else float(dyaw))
+        moved = {name: cls.of_object(seed, iri, round_, spread) for name, (iri, round_) in (objects or {}).items()}
         return cls(
             moved,
             (float(person[0]), float(person[1])),
             (float(base[0]), float(base[1]), float(base[2])),
         )
+
+    @staticmethod
+    def of_object(seed: int, iri: str, round_: bool = False, spread: Spread = Spread()) -> tuple[float, float, float]:
+        """One object's offsets (dx, dy, dyaw) at ``seed``: drawn from a generator of its own, seeded by the
+        seed and the SHA-256 of its IRI, so that adding or removing another object moves nothing else.
+        Drawn in the order of the names, an object added to the map moved every object whose name sorted
+        after it (docs/simulation.md, "Determinism"). A round object draws its yaw too, and drops it."""
+        words = np.frombuffer(hashlib.sha256(iri.encode("utf-8")).digest(), dtype="<u4")
+        rng = np.random.default_rng([seed, *(int(word) for word in words)])
+        limits = [spread.object, spread.object, spread.yaw]
+        dx, dy, dyaw = rng.uniform([-v for v in limits], limits)
+        return (float(dx), float(dy), 0.0 if round_ else float(dyaw))
 
 
 @dataclass(frozen=True)
@@ -214,7 +225,7 @@ class HomeWorld:
         self.robot, self.person = robots[0], people[0]
         self.base_name, self.person_name = self.robot.name, self.person.name
         self.perturbation = Perturbation.from_seed(
-            seed, {name: obj.shape == "cylinder" for name, obj in self.objects.items()}, spread
+            seed, {name: (obj.iri, obj.shape == "cylinder") for name, obj in self.objects.items()}, spread
         )
         self._steps = 0
         self._watchers: list[tuple[int, Callable[[], None]]] = []
