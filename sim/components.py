@@ -40,7 +40,7 @@ from cbrs.kb.semantic_map import NotGraspableError, SemanticMap, Thing, designat
 from cbrs.kb.vocab import CBRS
 from cbrs.settings import setting
 from cbrs.sim import predicates as pred
-from cbrs.sim import skills
+from cbrs.sim import sight, skills
 from cbrs.sim.arms import ArmSide
 from cbrs.sim.errors import GraspMisfitError, MovesRefusedError, SimulationError
 from cbrs.sim.geometry import Pose2D, Region, Vec3
@@ -1224,6 +1224,9 @@ SKILLS: dict[str, Work] = {
     "DeliverObject": deliver,
 }
 """The simulated skill behind each service name; the device comes from the advertisement."""
+_MOVING = (pick_up, carry, put_down, fill_from_tap, hand_over, deliver)
+"""The skills that may move an object they are given: where a step after one looks for it is not known
+before the run."""
 
 
 def simulated(kb: KnowledgeBase) -> list[str]:
@@ -1479,6 +1482,7 @@ class SimEnvironment:
         self.context.step, self.context.known = None, {}
         if not self.context.acted:  # checked before anything moved; a re-plan fails by its steps
             self._check_reach(plan, values)
+            self._check_sight(plan, values)
             self._check_loading(plan, values)
         return values
 
@@ -1511,6 +1515,53 @@ class SimEnvironment:
                     _who_loads(self.context, estimate, Manipulation.of(obj).model, _dock(support))
                 except (SkillFailed, MovesRefusedError) as refused:
                     raise CannotLoadError(step.component, obj.iri, str(refused)) from None
+
+    def _check_sight(self, plan: Plan, values: Mapping[str, Any]) -> None:
+        """Refuse a plan whose recognition step would look for an object the task gives with a camera that
+        cannot see it whole where it is believed to be (by the map: ``sight.unseen``), nor could the camera
+        of any component that may stand in for the step's: else the base drives off and the step fails when
+        it looks. An object an earlier step may have moved is not checked (it may be elsewhere by then), nor
+        a step a component of unknown camera may do (one in another process)."""
+        smap = self.world.map
+        steps = {step.index: step for step in plan.steps}
+        ads = {ad.iri: ad for ad in self.kb.advertisements()}
+        handled: set[str] = set()
+        for step in plan.steps:
+            given = [values.get(name) for name in sorted(_given_to(step, steps))]
+            iris = [str(value["@id"]) for value in given if isinstance(value, dict) and "@id" in value]
+            objects = [smap.objects[iri] for iri in iris if iri in smap.objects and iri not in handled]
+            cameras = [self._camera_of(ads.get(candidate)) for candidate in step.candidates]
+            if cameras[0] is None:
+                ad = ads.get(step.component)
+                if ad is None or ad.bridge_port is not None or SKILLS.get(ad.service_name or "") in _MOVING:
+                    handled.update(obj.iri for obj in objects)
+                continue
+            if not all(cameras):
+                continue  # a camera the simulation does not have may see it
+            for obj in objects:
+                support = smap.things.get(obj.support or "")
+                rest = support.box.max_z if support is not None else 0.0
+                centre = self.belief.position(obj.name) or (obj.start.x, obj.start.y, rest + obj.size[2] / 2)
+                outline = sight.object_outline(obj, centre)
+                why = [
+                    (name, sight.unseen(self.world.cameras[name], outline)) for name in dict.fromkeys(cameras) if name
+                ]
+                if all(reason for _, reason in why):
+                    raise sight.OutOfViewError(step.component, obj.iri, centre, why)
+
+    def _camera_of(self, ad: Advertisement | None) -> str | None:
+        """The camera of the world a recognition component looks with; None for a component that is none,
+        "" for one whose camera the simulation does not have (a component in another process)."""
+        work = SKILLS.get(ad.service_name or "") if ad is not None else None
+        if ad is None or work not in (recognise_by_colour, find_object_on_table):
+            return None
+        if ad.bridge_port is not None:
+            return ""
+        device = ad.device_name or ""
+        if work is find_object_on_table:
+            rows = self.kb.select("mounted_cameras", {"robot": PREFIXES["svc"] + device})
+            device = next((local_name(row["device"].value) for row in rows), "")
+        return device if device in self.world.cameras else ""
 
     def _check_reach(self, plan: Plan, values: Mapping[str, Any]) -> None:
         """Refuse a plan whose arm steps work on a thing the task gives that no arm of their robot

@@ -1,0 +1,81 @@
+"""Whether a camera sees an object whole, from the map alone: its pose, size and shape projected through
+the camera's model (pose, field of view, image size, range). The check before a run asks it of the
+camera each recognition step would look with, so that an object the camera cannot see is refused before
+the base drives off, not when the step looks (docs/execution.md, "The simulated components")."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numpy.typing import NDArray
+
+from cbrs.kb.errors import KnowledgeBaseError
+from cbrs.kb.semantic_map import MapObject, local_name
+from cbrs.sim.cameras import Camera, project
+from cbrs.sim.geometry import Vec3
+
+__all__ = ["OutOfViewError", "object_outline", "unseen"]
+
+RIM_POINTS = 24
+"""Points taken round each rim of a cylinder: its silhouette is then under 1% of its radius larger
+than theirs (1 - cos(pi / 24)), well under a pixel of any camera of the home."""
+
+
+def object_outline(obj: MapObject, centre: Vec3) -> NDArray[np.float64]:
+    """Points whose image bounds the object's (N x 3): a box's eight corners, turned by its map yaw, or
+    points round a cylinder's two rims, the object centred at ``centre``."""
+    sx, sy, sz = obj.size
+    if obj.shape == "cylinder":
+        angles = np.linspace(0.0, 2.0 * math.pi, RIM_POINTS, endpoint=False)
+        flat = np.stack([np.cos(angles) * sx / 2, np.sin(angles) * sx / 2], axis=-1)
+    else:
+        c, s = math.cos(obj.start.yaw), math.sin(obj.start.yaw)
+        corners = np.array([[x, y] for x in (-sx / 2, sx / 2) for y in (-sy / 2, sy / 2)])
+        flat = corners @ np.array([[c, s], [-s, c]])
+    rows = [[centre[0] + dx, centre[1] + dy, centre[2] + dz] for dz in (-sz / 2, sz / 2) for dx, dy in flat]
+    return np.array(rows, dtype=np.float64)
+
+
+def unseen(camera: Camera, points: NDArray[np.float64]) -> str:
+    """Why ``camera`` would not see the whole of what ``points`` outline; empty when it would. Whole
+    means every point nearer than the camera's far range and beyond its near one, and on a pixel off the
+    image's border: perception refuses a blob touching the border (``CutByBorderError``)."""
+    spec = camera.spec
+    depth = (points - camera.camera_to_world[:3, 3]) @ camera.camera_to_world[:3, 2]
+    if float(depth.min()) < spec.near or float(depth.max()) > spec.far:
+        return (
+            f"{depth.min():.2f}-{depth.max():.2f} m along its axis, outside its range {spec.near:.2f}-{spec.far:.2f} m"
+        )
+    pixels = np.floor(project(camera.intrinsics, camera.camera_to_world, points))
+    us, vs = pixels[:, 0], pixels[:, 1]
+    out = (us < 1) | (us > spec.width - 2) | (vs < 1) | (vs > spec.height - 2)
+    if not out.any():
+        return ""
+    return (
+        f"{int(out.sum())} of the {len(points)} points outlining it fall on or past the border of its "
+        f"{spec.width} x {spec.height} image (columns {us.min():.0f} to {us.max():.0f}, rows {vs.min():.0f} to "
+        f"{vs.max():.0f})"
+    )
+
+
+class OutOfViewError(KnowledgeBaseError):
+    """A recognition step would look for an object the task gives with a camera that cannot see it
+    whole from where it is believed to be, and no camera that could stand in for it can either: the run
+    is refused before anything moves. ``cameras`` holds (camera name, why it does not see it)."""
+
+    http_status = 422
+
+    def __init__(self, component: str, thing: str, where: Vec3, cameras: list[tuple[str, str]]) -> None:
+        self.component = component
+        self.thing = thing
+        self.where = where
+        self.cameras = tuple(cameras)
+        each = "; ".join(f"{camera}: {why}" for camera, why in self.cameras)
+        names = " or ".join(camera for camera, _ in self.cameras)
+        super().__init__(
+            f"{local_name(component)} would look for the {local_name(thing)} at ({where[0]:.2f}, {where[1]:.2f}, "
+            f"{where[2]:.2f}) with {names}, which cannot see it whole ({each}); move it in the map (home:x, home:y) "
+            f"to where {names} sees it, or hang a camera over it and register a recogniser for that camera "
+            "(docs/tasks.md, 'Which arm')"
+        )
