@@ -29,7 +29,9 @@ nothing but its physics cost anything (cProfile is not on then: it cools the cac
 
 Every run also gets a digest of what it did, so that a change made for speed can be shown to leave
 the runs as they were: SHA-256 over every observation written to the world graph (the belief after
-each step: types, relations, positions, time), the run's report (``RunResult.to_dict``), the poses of
+each step: types, relations, positions, time), what each plan executed (per step the components
+tried, their outcomes, ticks and simulated times, the effects verified: not the report's words nor the
+plan's JSON, so that a reworded message or a new key leaves the digests as they are), the poses of
 everything that moves, every moving joint's angle, the water in each container and spilled, and who
 holds what. The frames taken are counted beside it but not in it (a cost, not an outcome).
 ``--digests FILE`` writes them (task, seed -> digest); ``--check FILE`` compares them with such a file
@@ -144,8 +146,33 @@ def observations() -> Iterator[list[Observation]]:
         BeliefState.write = original  # type: ignore[method-assign]
 
 
+def what_ran(result: RunResult) -> list[Any]:
+    """Each plan's execution as facts: its status and ticks, and per step the components tried, their
+    outcomes, ticks and simulated times (exact) and the effects verified. Not the reports' words nor the
+    plans' presentation: a reworded message or a key added to the JSON changes no run."""
+    reports = [replan.report for replan in result.replans] + ([result.report] if result.report else [])
+    return [
+        [
+            report.status.value,
+            report.ticks,
+            report.seconds,
+            [
+                [
+                    step.index,
+                    step.outcome,
+                    [[a.component, a.outcome, a.ticks, a.seconds] for a in step.attempts],
+                    [[repr(statement), verified] for statement, verified in step.effects],
+                ]
+                for step in report.steps
+            ],
+        ]
+        for report in reports
+    ]
+
+
 def digest(world: HomeWorld, result: RunResult, written: list[Observation]) -> str:
-    """SHA-256 of what a run did: its beliefs, its report and the world's end state (floats exact)."""
+    """SHA-256 of what a run did: its beliefs, what each plan executed (:func:`what_ran`) and the world's
+    end state (floats exact)."""
     beliefs = [
         [sorted(o.types.items()), sorted(o.facts), sorted((k, list(v)) for k, v in o.positions.items()), o.time]
         for o in written
@@ -161,7 +188,7 @@ def digest(world: HomeWorld, result: RunResult, written: list[Observation]) -> s
     }
     state = {
         "beliefs": beliefs,
-        "report": result.to_dict(),
+        "ran": what_ran(result),
         "poses": {name: [list(pose.position), list(pose.orientation)] for name, pose in world.snapshot().items()},
         "joints": joints,
         "water": sorted(world.water.items()),
