@@ -9,6 +9,7 @@ import json
 import subprocess
 import time
 from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -65,8 +66,9 @@ svc:ReadRoomTemperature_Thermometer07 a cbrs:DynamicPerceptionComponent ;
 READING = {"roomTemperature": {"@type": "home:RoomTemperature", "celsius": 21.5}}
 
 
-@pytest.fixture
-def server() -> Iterator[Server]:
+@contextmanager
+def live_server() -> Iterator[Server]:
+    """A server over a fresh in-memory store, its endpoint in-process, stopped on leaving."""
     endpoint = EndpointConfig(update_token=TOKEN, isolate=False)
     running = Server(KnowledgeBase.open(":memory:"), ServeConfig(port=0, bridge_port=0, endpoint=endpoint))
     running.start()
@@ -74,6 +76,12 @@ def server() -> Iterator[Server]:
         yield running
     finally:
         running.stop()
+
+
+@pytest.fixture
+def server() -> Iterator[Server]:
+    with live_server() as running:
+        yield running
 
 
 def url(server: Server) -> str:

@@ -17,14 +17,12 @@ from websockets.sync.client import ClientConnection, connect
 from cbrs.actions.remote import RemoteCallError
 from cbrs.bridge_client import BridgeClient
 from cbrs.component import Component, ComponentEndedError
-from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import InvalidDescriptionError
 from cbrs.live_components import NO_LIVE_COMPONENT
 from cbrs.rosbridge import Bridge, RunningBridge
 from cbrs.rosbridge.protocol import LEADING_CHARS, leading_fields
-from cbrs.server import ServeConfig, Server
-from cbrs.sparql_service import EndpointConfig
-from tests.test_live_components import READING, THERMOMETER, TOKEN, eventually, thermometer
+from cbrs.server import Server
+from tests.test_live_components import READING, THERMOMETER, TOKEN, eventually, live_server, thermometer, url
 
 WAIT = 5.0
 LIMIT = 4096  # the test bridge's max_message_bytes: a "huge" message is small here
@@ -196,17 +194,8 @@ def test_an_answer_without_result_says_what_roslibjs_users_forgot(bridge: Runnin
 
 @pytest.fixture(scope="module")
 def server() -> Iterator[Server]:
-    endpoint = EndpointConfig(update_token=TOKEN, isolate=False)
-    running = Server(KnowledgeBase.open(":memory:"), ServeConfig(port=0, bridge_port=0, endpoint=endpoint))
-    running.start()
-    try:
+    with live_server() as running:
         yield running
-    finally:
-        running.stop()
-
-
-def url(server: Server) -> str:
-    return f"ws://127.0.0.1:{server.bridge_port}"
 
 
 @pytest.mark.parametrize("authorised", [True, False], ids=["authorised", "anonymous"])

@@ -16,10 +16,8 @@ from pathlib import Path
 import pytest
 
 from cbrs.bridge_client import BridgeClient
-from cbrs.kb import KnowledgeBase
-from cbrs.server import ServeConfig, Server
-from cbrs.sparql_service import EndpointConfig
-from tests.test_live_components import THERMOMETER, TOKEN, eventually, thermometer
+from cbrs.server import Server
+from tests.test_live_components import THERMOMETER, TOKEN, eventually, live_server, thermometer
 
 pytest.importorskip("roslibpy")
 
@@ -39,13 +37,8 @@ def docs_program(port: int) -> str:
 
 @pytest.fixture(scope="module")
 def server() -> Iterator[Server]:
-    endpoint = EndpointConfig(update_token=TOKEN, isolate=False)
-    running = Server(KnowledgeBase.open(":memory:"), ServeConfig(port=0, bridge_port=0, endpoint=endpoint))
-    running.start()
-    try:
+    with live_server() as running:
         yield running
-    finally:
-        running.stop()
 
 
 def test_the_roslibpy_component_of_the_docs_serves_comes_back_and_ends_loudly(server: Server, tmp_path: Path) -> None:
