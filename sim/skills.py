@@ -478,14 +478,7 @@ def can_carry(
         moves.append((f"carrying it to ({cx:.2f}, {cy:.2f})", lambda: _carry(hand, grasp, region, yaw)))
         lowering = f"lowering it onto {region.name} at ({cx:.2f}, {cy:.2f})"
         moves.append((lowering, lambda: _lower(hand, grasp, region)[0]))
-    for what, move in moves:
-        result = move()
-        if not result.reached:
-            return (
-                f"the {arm.value} arm would not get the {model.name} by its {model.grasp.value} grasp past {what}: "
-                f"{result.reason}"
-            )
-    return ""
+    return _first_refused(moves, arm, model)
 
 
 def can_hand_over(
@@ -514,12 +507,17 @@ def can_carry_held(world: HomeWorld, side: ArmSide | str, region: Region) -> str
         (f"carrying it to ({cx:.2f}, {cy:.2f})", lambda: _carry(hand, grasp, region, None)),
         (f"lowering it onto {region.name} at ({cx:.2f}, {cy:.2f})", lambda: _lower(hand, grasp, region)[0]),
     ]
+    return _first_refused(moves, ArmSide(side), model)
+
+
+def _first_refused(moves: list[tuple[str, Callable[[], MotionResult]]], arm: ArmSide, model: ObjectModel) -> str:
+    """Plan ``moves`` (what each does, the planning) in turn; why the first refused one was (empty: none)."""
     for what, move in moves:
         result = move()
         if not result.reached:
             return (
-                f"the {ArmSide(side).value} arm would not get the {model.name} by its {model.grasp.value} grasp past "
-                f"{what}: {result.reason}"
+                f"the {arm.value} arm would not get the {model.name} by its {model.grasp.value} grasp past {what}: "
+                f"{result.reason}"
             )
     return ""
 

@@ -5,7 +5,7 @@ page. Stub thermometers answer through a transport of the test's: no simulation,
 from __future__ import annotations
 
 import json
-from collections.abc import Iterator, Mapping
+from collections.abc import Mapping
 from concurrent.futures import Future
 from typing import Any
 
@@ -22,7 +22,9 @@ from cbrs.sparql_service import SparqlService
 from cbrs.tasks import TaskRun, TaskRunner
 from cbrs.web import create_app
 from tests.test_live_components import REQ
-from tests.test_remote_breaker import CAMERA_TTL, FIRST, READING, SECOND, Room
+from tests.test_remote_breaker import FIRST, READING, SECOND, Room, lab_kb
+
+__all__ = ["lab_kb"]  # the two thermometers' store, a module fixture of its own here too
 
 TEMPERATURE = HOME + "RoomTemperature"
 
@@ -42,15 +44,6 @@ class Answering:
         else:
             future.set_result(answer)
         return future
-
-
-@pytest.fixture(scope="module")
-def lab_kb() -> Iterator[KnowledgeBase]:
-    kb = KnowledgeBase.open(":memory:")
-    kb.registry.register(CAMERA_TTL.format(name="Thermometer31", service="thermometer31", accuracy=0.99))
-    kb.registry.register(CAMERA_TTL.format(name="Thermometer32", service="thermometer32", accuracy=0.9))
-    yield kb
-    kb.close()
 
 
 def _run(kb: KnowledgeBase, transport: Answering, max_replans: int = 2) -> RunResult:
