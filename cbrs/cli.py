@@ -81,6 +81,8 @@ _DECLARED_NAMES_ONLY = frozenset({"serve", "query"})
 """Commands that print and take names with the declared prefixes only: the server's threads name IRIs
 for their clients, and a query's text declares its own prefixes (the endpoint knows only cbrs's)."""
 
+_ARGS = "cbrs.subcommand_args"  # ctx.meta: the subcommand's arguments, as typed
+
 _TAKE_NAMES = frozenset({"deregister", "match", "plan", "run", "show"})
 """Commands whose arguments name resources: a name with a derived prefix opens the store to read it.
 The others use the derived prefixes only once they have opened the store themselves."""
@@ -114,6 +116,7 @@ class _Group(click.Group):
 
     def invoke(self, ctx: click.Context) -> Any:
         args = list(ctx.args)  # the subcommand's own, before they are parsed (or fail to be)
+        ctx.meta[_ARGS] = args
         try:
             try:
                 return super().invoke(ctx)
@@ -143,7 +146,9 @@ def cli(ctx: click.Context, store: str | None) -> None:
     ctx.call_on_close(app.close)
     if ctx.invoked_subcommand not in _DECLARED_NAMES_ONLY:  # names as the browser shows them (docs/owls.md)
         takes_names = ctx.invoked_subcommand in _TAKE_NAMES
-        ctx.with_resource(store_names(StoreNames(lambda: app.kb if takes_names else app.opened_kb)))
+        json_out = wants_json(ctx.meta.get(_ARGS, []), ctx.invoked_subcommand)
+        names = StoreNames(lambda: app.kb if takes_names else app.opened_kb, shortens=not json_out)
+        ctx.with_resource(store_names(names))
     # a restore into a new directory means to make it, and seeds nothing: it says each graph was absent
     if ctx.invoked_subcommand not in (None, "init", "settings", "restore") and no_store_at(location):
         ctx.call_on_close(lambda: note_new_store(location))
@@ -346,9 +351,12 @@ def _holds_ontology(store: Any, iri: str) -> bool:
 
 
 def _few(iris: list[str], limit: int = 3) -> str:
+    """The first IRIs of a list of what a load could not find: whole but for a declared prefix, as where
+    to look for it (a derived prefix, ``ontology:books.owl``, would hide the host)."""
     if not iris:
         return ""
-    shown = ", ".join(shorten(i) for i in iris[:limit])
+    with store_names(None):
+        shown = ", ".join(shorten(i) for i in iris[:limit])
     return f" ({shown}{', ...' if len(iris) > limit else ''})"
 
 
@@ -470,6 +478,7 @@ def register(app: App, file: Path, update: bool) -> None:
 def deregister(app: App, iri: str) -> None:
     """Remove a registered advertisement, or a requirement, and the nodes of its description (one transaction)."""
     full = parse_iri(iri)
+    name = shorten(full)  # as it was named: its prefix may be the store's own, gone with it
     try:
         removed = app.kb.registry.deregister(full)
     except KnowledgeBaseError as error:
@@ -477,7 +486,7 @@ def deregister(app: App, iri: str) -> None:
         raise click.ClickException(f"{error}{hint}") from error
     if full in app.kb.liveness.states():  # a live component: not listed as available until its next heartbeat
         app.kb.liveness.forget(full)
-    click.echo(f"deregistered {shorten(full)} ({removed} triples)")
+    click.echo(f"deregistered {name} ({removed} triples)")
 
 
 @cli.command()

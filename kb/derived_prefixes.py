@@ -200,10 +200,12 @@ def _keep(folder: Path, key: str, table: dict[str, str]) -> None:
 class StoreNames:
     """A store's derived prefixes in both directions, read on first use (:func:`for_store`): a command
     whose names all have declared prefixes never reads them. ``opened`` gives the knowledge base, or
-    None while it is not open (then there are none: naming an IRI never opens a store)."""
+    None while it is not open (then there are none: naming an IRI never opens a store). With
+    ``shortens=False`` they are taken but never printed (JSON keeps whole IRIs, its text included)."""
 
-    def __init__(self, opened: Callable[[], KnowledgeBase | None]) -> None:
+    def __init__(self, opened: Callable[[], KnowledgeBase | None], shortens: bool = True) -> None:
         self._opened = opened
+        self._shortens = shortens
         self._tables: tuple[dict[str, str], dict[str, str]] | None = None
 
     @property
@@ -213,7 +215,7 @@ class StoreNames:
 
     def shorten(self, iri: str) -> str | None:
         """``prefix:local`` for ``iri`` when a derived prefix covers it and its local part is a name."""
-        ns = namespace(iri)
+        ns = namespace(iri) if self._shortens else None
         if ns is None:
             return None
         prefix = self._both()[1].get(ns)

@@ -103,9 +103,9 @@ _store_names: ContextVar[StoreNames | None] = ContextVar("cbrs_store_names", def
 
 
 @contextmanager
-def store_names(names: StoreNames) -> Iterator[None]:
+def store_names(names: StoreNames | None) -> Iterator[None]:
     """Within the block, :func:`expand` and :func:`shorten` also use ``names`` (a CLI command's store's
-    derived prefixes, so that it prints and takes the names the browser shows)."""
+    derived prefixes, so that it prints and takes the names the browser shows); None: the table's alone."""
     token = _store_names.set(names)
     try:
         yield

@@ -80,6 +80,11 @@ def show(store: str, *args: str) -> str:
     return result.output
 
 
+def _printed(text: str) -> str:
+    """``text`` as the table prints it: lab# by the prefix the browser derives for it (--json keeps IRIs)."""
+    return text.replace(LAB, "lab:")
+
+
 def _values(out: str) -> list[str]:
     """The value column of show's table (between the predicate and the graph)."""
     return [line.split("  ", 2)[-1].rsplit("  ", 1)[0].strip() for line in out.splitlines()[3:]]
@@ -87,20 +92,20 @@ def _values(out: str) -> list[str]:
 
 def test_each_restriction_reads_in_manchester_syntax(store: str) -> None:
     values = [v.split(maxsplit=1)[1] for v in _values(show(store, LAB + "Robot")) if v.startswith("rdfs:subClassOf")]
-    assert sorted(v for v in values if "genid:" not in v) == sorted(ROBOT)
+    assert sorted(v for v in values if "genid:" not in v) == sorted(map(_printed, ROBOT))
     # a restriction without a filler is no class expression: it keeps its node's name
     assert len([v for v in values if v.startswith("genid:")]) == 1
 
 
 def test_an_intersection_with_nested_restrictions(store: str) -> None:
     values = _values(show(store, LAB + "RedGripperRobot"))
-    assert f"owl:equivalentClass  {RED_GRIPPER_ROBOT}" in [" ".join(v.split(" ", 1)) for v in values]
+    assert f"owl:equivalentClass  {_printed(RED_GRIPPER_ROBOT)}" in [" ".join(v.split(" ", 1)) for v in values]
 
 
 def test_a_class_a_restriction_names_shows_where(store: str) -> None:
     out = show(store, LAB + "Gripper")
-    assert f"{LAB}Robot rdfs:subClassOf {LAB}hasPart some {LAB}Gripper" in out
-    assert f"{LAB}RedGripperRobot owl:equivalentClass {RED_GRIPPER_ROBOT}" in out
+    assert _printed(f"{LAB}Robot rdfs:subClassOf {LAB}hasPart some {LAB}Gripper") in out
+    assert _printed(f"{LAB}RedGripperRobot owl:equivalentClass {RED_GRIPPER_ROBOT}") in out
     assert "genid:" not in out
 
 
@@ -138,7 +143,7 @@ def test_a_restriction_s_own_node_says_what_it_is(store: str) -> None:
     rows = json.loads(show(store, LAB + "Robot", "--json"))
     node = next(row["other"] for row in rows if row.get("other_text") == f"{LAB}touches Self")
     out = show(store, node)
-    assert out.splitlines()[1] == f"  = {LAB}touches Self"
+    assert out.splitlines()[1] == _printed(f"  = {LAB}touches Self")
 
 
 def test_a_parameter_that_takes_a_class_is_named_by_its_description(tmp_path: Path) -> None:
