@@ -144,7 +144,7 @@ def cli(ctx: click.Context, store: str | None) -> None:
     app = App(store_location=location)
     ctx.obj = app
     ctx.call_on_close(app.close)
-    if ctx.invoked_subcommand not in _DECLARED_NAMES_ONLY:  # names as the browser shows them (docs/owls.md)
+    if ctx.invoked_subcommand not in _DECLARED_NAMES_ONLY:  # names as the browser shows them (docs/web.md)
         takes_names = ctx.invoked_subcommand in _TAKE_NAMES
         json_out = wants_json(ctx.meta.get(_ARGS, []), ctx.invoked_subcommand)
         names = StoreNames(lambda: app.kb if takes_names else app.opened_kb, shortens=not json_out)
@@ -816,7 +816,7 @@ def _into(item: ParsedFile) -> str:
 
 def _prefix_hint(full: str) -> str:
     """A hint when ``full`` looks like prefix:name with a prefix nobody declared (lab:Cam for a lab's own);
-    the closest prefixes first, the store's derived ones among them (docs/owls.md)."""
+    the closest prefixes first, the store's derived ones among them (docs/web.md)."""
     scheme, _, local = full.partition(":")
     if "://" in full or scheme in ("urn", "tag", "mailto", "file"):
         return ""

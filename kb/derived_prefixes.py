@@ -3,7 +3,7 @@
 OWLS-TC's IRIs (``http://127.0.0.1/ontology/books.owl#Novel``) have no prefix. One prefix is derived per
 such namespace from its last path segment that has a letter, without its file extension: ``books:Novel``.
 The browser shows names so and the CLI prints and takes them so (docs/web.md, "Names, pictures,
-keyboard"; docs/owls.md, "Names in the CLI"). The rule:
+keyboard", and "Names in the CLI" there). The rule:
 
 - a namespace is an IRI up to its last ``#``, or up to its last ``/`` when it has no ``#``; one that a
   declared namespace (:data:`cbrs.kb.namespaces.PREFIXES`) starts is left to the declared prefix, and

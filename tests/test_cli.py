@@ -175,7 +175,7 @@ def test_load_counts_each_graph_a_trig_file_names(tmp_path: Path) -> None:
     )
     code, out = run("load", str(trig), store=str(tmp_path / "s"))
     assert code == 0
-    # the store's own namespace, by the prefix the browser derives for it (docs/owls.md)
+    # the store's own namespace, by the prefix the browser derives for it (docs/web.md)
     assert "lab.trig: 3 triples: 2 into example:g1, 1 into graph:services" in out
 
 
