@@ -13,7 +13,6 @@ from .test_cli import run
 from .test_load_counts import NAVIGATE
 from .test_register_update_partial import TWO
 
-SERVICE = "http://example.org/services/navigate.owls#NavigateService"
 NOTES = ("imports not followed", "  of which", "unresolved ", "conversion notes: ", "preconditions and effects: ")
 
 
@@ -51,7 +50,7 @@ def test_register_update_prints_the_notes_a_load_prints(tmp_path: Path) -> None:
     ]
     assert "PDDL expression kept as text (1 unclosed '(')" in expected[3]
     assert _notes(registered) == expected
-    assert registered.splitlines()[0] == f"registered {SERVICE}"
+    assert registered.splitlines()[0] == "registered navigate:NavigateService"  # as the browser names it
     mended = "(mended: rdf:ID values that are not XML names, read as rdf:about)"
     assert mended in loaded
     assert f"read {path} {mended}" in registered.splitlines()
@@ -62,7 +61,7 @@ def test_an_update_of_a_loaded_file_prints_them_too(tmp_path: Path) -> None:
     assert run("load", str(NAVIGATE), store=store)[0] == 0
     code, output = run("register", "--update", str(_noted(tmp_path)), store=store)
     assert code == 0, output
-    assert output.splitlines()[0] == f"updated {SERVICE}"
+    assert output.splitlines()[0] == "updated navigate:NavigateService"
     assert any(line.startswith("conversion notes: ") and "unclosed" in line for line in output.splitlines())
 
 

@@ -129,7 +129,7 @@ def test_the_command(tmp_path: Path) -> None:
     assert run("deregister", LAB + "A", store=location)[0] == 0
     code, said = run("register", "--update", str(pair), store=location)
     lines = said.splitlines()
-    assert code == 0 and lines[:2] == [f"registered {LAB}A", f"updated {LAB}B"]
+    assert code == 0 and lines[:2] == ["registered pair:A", "updated pair:B"]  # the browser's derived names
     # and the notes a load of the file prints (its made-up classes, its service without a process)
     assert "unresolved parameter types (declared by no loaded ontology): 2" in lines[2]
     assert any(line.startswith("conversion notes: ") and "has no process" in line for line in lines[3:])

@@ -134,12 +134,15 @@ def test_the_command_says_which_it_registered_and_which_it_updated(tmp_path: Pat
     location = str(tmp_path / "store")
     assert run("load", str(ontology_dir() / "core.ttl"), *map(str, MINI_FILES), store=location)[0] == 0
     path = _file(tmp_path)
-    assert run("register", str(path), store=location) == (0, f"registered {EX}TrackA\nregistered {EX}TrackB\n")
+    # the names as the browser shows them (no prefix is declared for the file's namespace), and they name them
+    assert run("register", str(path), store=location) == (0, "registered mini:TrackA\nregistered mini:TrackB\n")
+    assert EX + "TrackA" in run("show", "mini:TrackA", "--json", store=location)[1]
     before = run("query", "SELECT (COUNT(*) AS ?n) WHERE { GRAPH ?g { ?s ?p ?o } }", store=location)
     assert run("deregister", EX + "TrackA", store=location)[0] == 0
     code, out = run("register", str(path), store=location)
     assert code == 1 and f"already registered; update it instead: cbrs register --update {path}" in out
-    assert run("register", "--update", str(path), store=location) == (0, f"registered {EX}TrackA\nupdated {EX}TrackB\n")
+    synced = run("register", "--update", str(path), store=location)
+    assert synced == (0, "registered mini:TrackA\nupdated mini:TrackB\n")
     assert run("query", "SELECT (COUNT(*) AS ?n) WHERE { GRAPH ?g { ?s ?p ?o } }", store=location) == before
 
 
