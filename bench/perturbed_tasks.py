@@ -5,8 +5,8 @@ Run: python bench/perturbed_tasks.py [--seeds 20] [--object 0.04] [--person 0.8]
 tasks are the paper's two scenarios and the Turtle-only tasks of tests/data/tasks (a new object
 fetched by a goal-only task and through FetchMyPen's hierarchy, the cup put on a new place, a new
 object class, a two-level task). Prints the machine, the inputs, one row per
-run (seed, outcome, re-plans, simulated seconds, the reason of a failure) and per task the success
-rate; with --json, the same as a record.
+run (seed, outcome, re-plans, simulated seconds, the reason of a failure; "refused" when the check
+before a run refused it, before anything moved) and per task the success rate; with --json, the same as a record.
 """
 
 from __future__ import annotations
@@ -22,8 +22,9 @@ from pathlib import Path
 from typing import Any
 
 from cbrs.actions.composer import Composer
-from cbrs.actions.runner import run_task
+from cbrs.actions.runner import RunResult, run_task
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.semantic_map import SemanticMap
 from cbrs.sim.components import SimEnvironment
 from cbrs.sim.world import Spread, open_world
@@ -71,12 +72,19 @@ def main() -> None:
         runs = []
         for seed in range(args.seeds):
             with open_world(seed=seed, semantic_map=SemanticMap.read(kb), spread=spread) as world:
-                result = run_task(kb, task, SimEnvironment(world, kb), composer=composer)
+                try:
+                    result: RunResult | None = run_task(kb, task, SimEnvironment(world, kb), composer=composer)
+                except KnowledgeBaseError as refused:  # the check before a run: nothing moved
+                    result, reason = None, f"{type(refused).__name__}: {refused}"
                 seconds = world.time
-            status = "succeeded" if result.succeeded else ("failed" if result.report else "unsolvable")
-            reason = "" if result.succeeded else (result.report.reason if result.report else "no plan")
-            runs.append({"seed": seed, "status": status, "replans": len(result.replans), "sim_seconds": seconds})
-            print(f"{task:<18} {seed:>4} {status:<10} {len(result.replans):>8} {seconds:>6.1f}  {reason[:110]}")
+            if result is None:
+                status, replans = "refused", 0
+            else:
+                status = "succeeded" if result.succeeded else ("failed" if result.report else "unsolvable")
+                reason = "" if result.succeeded else (result.report.reason if result.report else "no plan")
+                replans = len(result.replans)
+            runs.append({"seed": seed, "status": status, "replans": replans, "sim_seconds": seconds, "reason": reason})
+            print(f"{task:<18} {seed:>4} {status:<10} {replans:>8} {seconds:>6.1f}  {reason[:110]}")
         record["tasks"][task] = runs
     print(f"\n{'task':<18} {'succeeded':>9} {'rate':>6} {'re-planned':>10}")
     for task, runs in record["tasks"].items():
