@@ -24,7 +24,8 @@ from matplotlib.lines import Line2D
 
 from cbrs.actions.composer import Attempt, CompositionResult
 from cbrs.actions.graph import SRE, SRI, SRO, VIRTUAL
-from cbrs.actions.shown_names import local_name, shown_names, two_lines
+from cbrs.actions.shown_names import shown_names, two_lines
+from cbrs.kb.owls import local_name
 
 FORMATS = (".svg", ".png")
 FORWARD, BACKWARD, PLAN = "#1f77b4", "#d62ad0", "#111111"

@@ -22,12 +22,9 @@ from __future__ import annotations
 from collections import defaultdict
 from collections.abc import Callable, Iterable
 
-__all__ = ["file_qualifier", "local_name", "shown_names", "two_lines"]
+from cbrs.kb.owls import local_name
 
-
-def local_name(iri: str) -> str:
-    """The part of ``iri`` after its last ``#``, else after its last ``/``."""
-    return iri.rsplit("#", 1)[-1].rsplit("/", 1)[-1]
+__all__ = ["file_qualifier", "shown_names", "two_lines"]
 
 
 def file_qualifier(iri: str) -> str:
