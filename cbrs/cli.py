@@ -79,7 +79,8 @@ _LAZY_COMMANDS: dict[str, tuple[str, str, str]] = {
 
 _DECLARED_NAMES_ONLY = frozenset({"serve", "query"})
 """Commands that print and take names with the declared prefixes only: the server's threads name IRIs
-for their clients, and a query's text declares its own prefixes (the endpoint knows only cbrs's)."""
+for their clients, and a query's text declares its own prefixes (the endpoint knows only cbrs's). A
+named query's --bind values are names typed like any command's, so they take the derived ones too."""
 
 _ARGS = "cbrs.subcommand_args"  # ctx.meta: the subcommand's arguments, as typed
 
@@ -394,8 +395,11 @@ def query(
         raise click.UsageError("give exactly one of TEXT, --file or --name")
     values = _bindings(bindings)
     if name:
-        result = app.kb.run(name, values)
-        _note_unknown_bindings(app.kb, name, values)
+        # --bind takes the names the browser shows (books1:Novel), and its notes print them; the rows,
+        # printed after, keep the declared prefixes, as the endpoint's do
+        with store_names(StoreNames(lambda: app.kb)):
+            result = app.kb.run(name, values)
+            _note_unknown_bindings(app.kb, name, values)
     else:
         if values:
             raise click.UsageError("--bind works with --name, whose parameters are declared")
@@ -425,9 +429,8 @@ def _note_unknown_bindings(kb: KnowledgeBase, name: str, values: dict[str, str])
             continue
         full = expand(value.strip())
         if not kb.describes(full):
-            click.echo(
-                f"note: nothing in the store mentions <{full}> (bound to {parameter}){_prefix_hint(full)}", err=True
-            )
+            hint = not_found_hint(kb, full)
+            click.echo(f"note: nothing in the store mentions <{full}> (bound to {parameter}){hint}", err=True)
 
 
 # An update, after its prologue (PREFIX and BASE declarations, comments): the query parser's own

@@ -170,3 +170,15 @@ def test_a_write_makes_the_kept_table_new(store: Path, tmp_path: Path, browser: 
     code, out = run(store, "show", "extra:Shelf")
     assert code == 0, out
     assert out.splitlines()[0] == "extra:Shelf"
+
+
+def test_a_named_querys_bind_takes_a_derived_name_and_its_rows_keep_whole_iris(
+    store: Path, browser: dict[str, str]
+) -> None:
+    service = browser[SERVICE + "NOVEL_PRICE"]
+    code, out = run(store, "query", "--name", "description_parameters", "--bind", f"description={service}")
+    assert code == 0, out
+    assert "_NOVEL" in out and BOOKS + "Novel" in out and browser[BOOKS + "Novel"] not in out
+    code, out = run(store, "query", "--name", "description_parameters", "--bind", f"description={service[:-1]}")
+    assert code == 0, out
+    assert "(0 rows)" in out and f"did you mean {service}?" in out

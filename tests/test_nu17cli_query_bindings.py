@@ -23,7 +23,8 @@ def test_a_misspelt_class_is_named() -> None:
     out, err = _query("kind=cbrs:DynamicPerceptonComponent")
     assert out.endswith("(0 rows)\n")
     assert err == (
-        "note: nothing in the store mentions <https://w3id.org/cbrs/core#DynamicPerceptonComponent> (bound to kind)\n"
+        "note: nothing in the store mentions <https://w3id.org/cbrs/core#DynamicPerceptonComponent> (bound to kind)"
+        "; did you mean cbrs:DynamicPerceptionComponent?\n"
     )
 
 
