@@ -9,20 +9,24 @@ where they are allowed (docs/remote-store.md, "Virtuoso 7").
 
 from __future__ import annotations
 
+import contextlib
 import decimal
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
 from pathlib import Path
 
 import httpx
 import pyoxigraph as ox
 import pytest
-from click.testing import CliRunner
+from click.testing import CliRunner, Result
 
+from cbrs.actions.composer import Composer, store_plan
 from cbrs.cli import cli
 from cbrs.kb import KnowledgeBase, Store, StoreError
 from cbrs.kb.namespaces import GraphName
 from cbrs.kb.remote_store import RemoteStore
 from cbrs.kb.staged_writes import STAGING
+from cbrs.task_names import task_iri
 from tests.conftest import OxigraphServer, VirtuosoServer, virtuoso_running
 
 DATA = Path(__file__).parent / "data"
@@ -67,21 +71,66 @@ def _quads(count: int, graph: GraphName = GraphName.WORLD, tag: str = "") -> lis
 
 
 @pytest.fixture
-def seeded(server: str) -> Iterator[RemoteStore]:
-    kb = KnowledgeBase.open(server)
-    assert isinstance(kb.store, RemoteStore)
-    yield kb.store
-    kb.close()
+def filled(server: str) -> Iterator[RemoteStore]:
+    """The emptied server holding quads of its own, in the graph the tests write and in another: what a
+    failed write must leave (a seed would do as well, and takes Virtuoso some 10 s to write)."""
+    store = RemoteStore.open(server)
+    store.add(_quads(20, tag="kept") + _quads(5, GraphName.MAP, tag="kept"))
+    yield store
+    store.close()
+
+
+@dataclass
+class Initialised:
+    """A server of its own after ``cbrs init``, and what the CLI said there and on the embedded store; then
+    ``remote`` and ``embedded``, each with the plan the CLI recorded and mini_world.ttl loaded."""
+
+    url: str
+    inits: list[Result]
+    answers: list[Result]
+    plans: list[Result]
+    seeds: list[list[str]]  # _ours() of the server and of an embedded store, right after the seed
+    remote: KnowledgeBase
+    embedded: KnowledgeBase
+
+
+@pytest.fixture(scope="module", params=SERVERS)
+def initialised(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory) -> Iterator[Initialised]:
+    """An Oxigraph, or a Virtuoso of its own, initialised and asked once for the tests below, which only read:
+    on the session's Virtuoso, after earlier tests had filled and emptied it, a query with a transitive
+    path (concept_parts, description_qos) now and then answered fewer rows, with no error, in full-suite
+    runs only; every rerun on a fresh one gave all of them (docs/remote-store.md). So nothing here is
+    ever cleared."""
+    with contextlib.ExitStack() as stack:
+        if request.param == "oxigraph":
+            servers: Callable[..., OxigraphServer] = request.getfixturevalue("oxigraph_servers")
+            url = servers(on_disk=False).url
+        else:
+            url = stack.enter_context(virtuoso_running(tmp_path_factory.mktemp("virtuoso-own"))).url
+        runner = CliRunner()
+        locations = (url, ":memory:")
+        inits = [runner.invoke(cli, ["--store", location, "init"]) for location in locations]
+        remote, embedded = KnowledgeBase.open(url), KnowledgeBase.open(":memory:")
+        stack.callback(remote.close)
+        seeds = [_ours(remote.store), _ours(embedded.store)]
+        named = ["query", "--name", "advertisements", "--bind", "kind=cbrs:DynamicPerceptionComponent"]
+        answers = [runner.invoke(cli, ["--store", location, *named]) for location in locations]
+        plans = [runner.invoke(cli, ["--store", location, "plan", "req:RobotSelfPosition"]) for location in locations]
+        planned = Composer(embedded).compose(task_iri(embedded, "req:RobotSelfPosition")).plan
+        if planned is not None:  # recorded on the server by the command: the embedded store gets it too
+            store_plan(embedded, planned)
+        for kb in (embedded, remote):
+            kb.load([DATA / "mini_world.ttl"], graph="world")
+        yield Initialised(url, inits, answers, plans, seeds, remote, embedded)
 
 
 # -- the seed and large writes -------------------------------------------------------------------------
 
 
-def test_the_seed_lands_whole(server: str) -> None:
-    embedded, remote = KnowledgeBase.open(":memory:"), KnowledgeBase.open(server)
-    assert remote.store.is_seeded()
-    assert _ours(remote.store) == _ours(embedded.store)  # every quad, no staging graph left
-    remote.close()
+def test_the_seed_lands_whole(initialised: Initialised) -> None:
+    assert initialised.remote.store.is_seeded()
+    remote, embedded = initialised.seeds
+    assert remote == embedded  # every quad, no staging graph left
 
 
 def test_the_graphs_are_listed_as_their_quads_show_them(server: str) -> None:
@@ -139,10 +188,10 @@ def test_a_write_within_one_batch_is_one_request(server: str) -> None:
 
 
 @pytest.mark.parametrize("failing", [1, 3, 4], ids=["first-batch", "last-batch", "publication"])
-def test_a_write_that_fails_part_way_leaves_the_store_as_it_was(seeded: RemoteStore, failing: int) -> None:
+def test_a_write_that_fails_part_way_leaves_the_store_as_it_was(filled: RemoteStore, failing: int) -> None:
     """The connection drops at the n-th write request (three batches, then the publication)."""
-    seeded.batch = 100
-    before = _ours(seeded)
+    filled.batch = 100
+    before = _ours(filled)
     writes = 0
 
     def drop(request: httpx.Request) -> None:
@@ -152,10 +201,10 @@ def test_a_write_that_fails_part_way_leaves_the_store_as_it_was(seeded: RemoteSt
             if writes == failing:
                 raise httpx.ConnectError("connection dropped (injected by the test)", request=request)
 
-    seeded._http().event_hooks["request"].append(drop)
+    filled._http().event_hooks["request"].append(drop)
     with pytest.raises(StoreError, match="injected by the test"):
-        seeded.add(_quads(300))
-    assert _ours(seeded) == before  # the staged batches were dropped again
+        filled.add(_quads(300))
+    assert _ours(filled) == before  # the staged batches were dropped again
     assert writes == failing + 1  # the failing request, then one that dropped the staging graphs
 
 
@@ -229,20 +278,13 @@ def test_virtuoso_takes_updates_at_its_one_url(virtuoso_server: VirtuosoServer) 
 # -- the command line and the named queries ------------------------------------------------------------
 
 
-def test_the_cli_initialises_queries_and_plans(fresh_server: str) -> None:
-    server = fresh_server  # its plan once found no camera on the session's Virtuoso, as concept_parts below
-    runner = CliRunner()
-    inits = [runner.invoke(cli, ["--store", location, "init"]) for location in (server, ":memory:")]
+def test_the_cli_initialises_queries_and_plans(initialised: Initialised) -> None:
+    inits, answers, plans = initialised.inits, initialised.answers, initialised.plans  # the server's, then :memory:'s
     assert inits[0].exit_code == 0, inits[0].output
     assert inits[0].output.splitlines()[1:] == inits[1].output.splitlines()[1:]  # graph sizes, descriptions
-    named = ["query", "--name", "advertisements", "--bind", "kind=cbrs:DynamicPerceptionComponent"]
-    answers = [runner.invoke(cli, ["--store", location, *named]) for location in (server, ":memory:")]
     assert answers[0].exit_code == 0, answers[0].output
     assert "svc:LocateMobileRobot_CeilingCamera01" in answers[0].output
     assert answers[0].output.count("\n") == answers[1].output.count("\n")  # one row per advertisement
-    plans = [
-        runner.invoke(cli, ["--store", location, "plan", "req:RobotSelfPosition"]) for location in (server, ":memory:")
-    ]
     assert plans[0].exit_code == 0, plans[0].output
     assert plans[0].output == plans[1].output and "svc:LocateMobileRobot_CeilingCamera01" in plans[0].output
 
@@ -257,26 +299,8 @@ VIRTUOSO_DEVIATIONS = {
 }
 
 
-@pytest.fixture(params=SERVERS)
-def fresh_server(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[str]:
-    """The ``--store`` URL of an emptied Oxigraph, or of a Virtuoso of its own: on the session's Virtuoso,
-    after earlier tests had filled and emptied it, a query with a transitive path (concept_parts,
-    description_qos) now and then answered fewer rows, with no error, in full-suite runs only; every
-    rerun on a fresh one gave all of them (docs/remote-store.md)."""
-    if request.param == "oxigraph":
-        oxigraph: OxigraphServer = request.getfixturevalue("oxigraph_server")
-        oxigraph.clear()
-        yield oxigraph.url
-        return
-    with virtuoso_running(tmp_path) as virtuoso:
-        yield virtuoso.url
-
-
-def test_the_named_queries_answer_as_on_the_embedded_store(fresh_server: str) -> None:
-    server = fresh_server
-    embedded, remote = KnowledgeBase.open(":memory:"), KnowledgeBase.open(server)
-    for kb in (embedded, remote):
-        kb.load([DATA / "mini_world.ttl"], graph="world")
+def test_the_named_queries_answer_as_on_the_embedded_store(initialised: Initialised) -> None:
+    embedded, remote = initialised.embedded, initialised.remote
     values = {
         "action": "act:PuttingSomethingSomewhere",
         "service": LOCATE,
@@ -293,7 +317,7 @@ def test_the_named_queries_answer_as_on_the_embedded_store(fresh_server: str) ->
         "component": LOCATE,
         "namespace": "https://w3id.org/cbrs/world#",
     }
-    virtuoso = "/sparql" in server
+    virtuoso = "/sparql" in initialised.url
     differing: dict[str, str] = {}
     for name in embedded.queries.names():
         parameters = embedded.queries.get(name).parameters
@@ -308,7 +332,6 @@ def test_the_named_queries_answer_as_on_the_embedded_store(fresh_server: str) ->
     allowed = set(VIRTUOSO_DEVIATIONS) if virtuoso else set()
     unexpected = {name: why for name, why in differing.items() if name not in allowed}
     assert not unexpected, unexpected
-    remote.close()
 
 
 def _difference(expected: list[tuple[str, ...]], found: list[tuple[str, ...]] | str) -> str:
