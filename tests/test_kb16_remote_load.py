@@ -6,7 +6,7 @@ server took minutes of single-quad requests. Each test runs on ``oxigraph serve`
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from urllib.parse import unquote_plus
 
@@ -19,11 +19,10 @@ from cbrs.kb.loader import load_files
 from cbrs.kb.namespaces import GraphName
 from cbrs.kb.remote_store import RemoteStore
 from cbrs.kb.staged_writes import STAGING
-from tests.test_remote_servers import server
+from tests.conftest import OxigraphServer, VirtuosoServer
+from tests.test_remote_servers import SERVERS
 
 from .test_load_counts import NAVIGATE, ONTOLOGY, OVERLAP, THREE, _write
-
-__all__ = ["server"]  # the fixture, used by name
 
 EX = "http://example.org/counts#"
 FORM = "application/x-www-form-urlencoded"
@@ -38,6 +37,22 @@ AWKWARD = [
     ox.Literal("0.50", datatype=DECIMAL),  # kept as "0.5" by Oxigraph
     ox.NamedNode("http://example.org/counts#odd?q=1&r=%7B"),
 ]
+
+
+@pytest.fixture(scope="module", params=SERVERS)
+def server(request: pytest.FixtureRequest) -> str:
+    """The ``--store`` URL of a server seeded once for the module: Oxigraph's base URL, Virtuoso's one
+    ``/sparql`` URL. Each test writes triples of its own (``ex:``, OWL-S's navigate service) and reads
+    what its own writes did, so that they can share the seed (Virtuoso takes some 10 s to write it)."""
+    if request.param == "oxigraph":
+        servers: Callable[..., OxigraphServer] = request.getfixturevalue("oxigraph_servers")
+        url = servers(on_disk=False).url
+    else:
+        virtuoso: VirtuosoServer = request.getfixturevalue("virtuoso_server")
+        virtuoso.clear()
+        url = virtuoso.url
+    KnowledgeBase.open(url).close()
+    return url
 
 
 @pytest.fixture
