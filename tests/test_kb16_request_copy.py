@@ -14,6 +14,7 @@ import pytest
 
 from cbrs.kb import GraphName, KnowledgeBase, RdfParseError
 from cbrs.kb.owls import requirement_iri
+from tests.conftest import OxigraphServer
 
 from .test_deregister_owls import triples_by_graph
 from .test_load_counts import NAVIGATE, ONTOLOGY
@@ -24,10 +25,29 @@ SERVICE = "http://example.org/services/navigate.owls#NavigateService"
 OTHER_GRAPH = "http://example.org/lab/graph"
 
 
-@pytest.fixture
-def kb(store_location: str) -> Iterator[KnowledgeBase]:
-    kb = KnowledgeBase.open(store_location)  # seeded: the core ontology tells what a description is
+@pytest.fixture(scope="module")
+def start() -> bytes:
+    """The store each test starts from, as N-Quads: seeded (the core ontology tells what a description is),
+    the OWL-S ontologies loaded."""
+    kb = KnowledgeBase.open(":memory:")
     kb.load([ONTOLOGY])
+    return kb.store.dump()
+
+
+@pytest.fixture
+def kb(store_location: str, start: bytes, request: pytest.FixtureRequest) -> Iterator[KnowledgeBase]:
+    """On the server, the start is put in one request: seeding and loading through cbrs would take some
+    3 s of queries each time (what a remote seed and load write is checked in test_remote_store.py)."""
+    if store_location != ":memory:":
+        server: OxigraphServer = request.getfixturevalue("oxigraph_server")  # cleared for the test already
+        put = server.client.post(
+            store_location + "/store", content=start, headers={"Content-Type": "application/n-quads"}
+        )
+        put.raise_for_status()
+    kb = KnowledgeBase.open(store_location)
+    if store_location == ":memory:":
+        kb.load([ONTOLOGY])
+    assert kb.store.dump() == start
     yield kb
     kb.close()
 
