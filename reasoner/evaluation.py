@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from cbrs.kb import KnowledgeBase
 from cbrs.reasoner.config import MatchConfig
 from cbrs.reasoner.matchmaker import Matchmaker
 from cbrs.reasoner.methods import METHODS
@@ -209,13 +210,17 @@ def evaluate_paper(
     testbed: Path = TESTBED_FILE,
     truth_file: Path = TRUTH_FILE,
     config: MatchConfig | None = None,
+    kb: KnowledgeBase | None = None,
 ) -> Report:
     """Rank every testbed advertisement for every testbed requirement with each method, and score.
-    ``config``: the matching parameters (the defaults of MatchConfig when None)."""
+    ``config``: the matching parameters (the defaults of MatchConfig when None). ``kb``: the testbed
+    already loaded (by :func:`open_testbed_kb`), ranked in and left open, so that a caller holding it
+    does not check and load the file again; when None, ``testbed`` is loaded into a fresh store."""
     start = time.perf_counter()
     truth = load_truth(truth_file)
     relevant = relevant_sets(truth)
-    kb = open_testbed_kb(testbed)
+    given = kb
+    kb = open_testbed_kb(testbed) if given is None else given
     try:
         requirements = {req.iri: req for req in kb.requirements()}
         missing = set(relevant) - set(requirements)
@@ -234,7 +239,7 @@ def evaluate_paper(
             groups: dict[str, frozenset[str]] = {}
             sums = dict.fromkeys(METRICS, 0.0)
             for iri, wanted in relevant.items():
-                result = matcher.rank(requirements[iri])
+                result = matcher.rank(requirements[iri], explain=0)  # the batch scores: no pairs to read
                 ranking = tuple(candidate.advertisement for candidate in result.candidates)
                 per_requirement[iri] = ranking
                 if result.candidates:
@@ -252,7 +257,8 @@ def evaluate_paper(
             scores[method] = {metric: total / len(relevant) for metric, total in sums.items()}
         services = len(first.advertisements) if first is not None else len(kb.advertisements())
     finally:
-        kb.close()
+        if given is None:
+            kb.close()
     return Report(
         methods=scores,
         requirements=len(relevant),

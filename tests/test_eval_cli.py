@@ -4,25 +4,47 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import pytest
-from click.testing import CliRunner
+from click.testing import CliRunner, Result
 
 from cbrs.cli import cli
-from cbrs.reasoner.evaluation import Report, evaluate_paper
+from cbrs.reasoner import evaluation
+from cbrs.reasoner.evaluation import Report
 from cbrs.reasoner.methods import METHODS
 
 
 @pytest.fixture(scope="module")
-def report() -> Report:
-    return evaluate_paper()
+def paper_run(tmp_path_factory: pytest.TempPathFactory) -> tuple[Result, Path, Report]:
+    """``cbrs eval paper --json --plot`` run once, with the Report the command printed: the figure tests
+    read that Report rather than evaluating the testbed again."""
+    chart = tmp_path_factory.mktemp("eval") / "chart.png"
+    printed: list[Report] = []
+    evaluate = evaluation.evaluate_paper
 
+    def keep(*args: Any, **kwargs: Any) -> Report:
+        printed.append(evaluate(*args, **kwargs))
+        return printed[-1]
 
-def test_json_shape(tmp_path: Path) -> None:
-    chart = tmp_path / "chart.png"
-    result = CliRunner().invoke(cli, ["eval", "paper", "--json", "--plot", str(chart)])
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(evaluation, "evaluate_paper", keep)
+        patch.delenv("CBRS_MATCH_PARAMS", raising=False)  # the figures are the defaults'
+        result = CliRunner().invoke(cli, ["eval", "paper", "--json", "--plot", str(chart)])
     assert result.exit_code == 0, result.output
+    assert len(printed) == 1
+    return result, chart, printed[0]
+
+
+@pytest.fixture(scope="module")
+def report(paper_run: tuple[Result, Path, Report]) -> Report:
+    return paper_run[2]
+
+
+def test_json_shape(paper_run: tuple[Result, Path, Report]) -> None:
+    result, chart, printed = paper_run
     data = json.loads(result.stdout)
+    assert data == printed.to_json()
     assert data["requirements"] == 20 and data["services"] == 100
     assert set(data["methods"]) == set(METHODS)
     for figures in data["methods"].values():

@@ -213,8 +213,12 @@ def test_testbed_leaves_the_bundled_services_out(testbed_kb: KnowledgeBase) -> N
 
 
 @pytest.fixture(scope="module")
-def report() -> Report:
-    return evaluate_paper()
+def report(testbed_kb: KnowledgeBase) -> Report:
+    return evaluate_paper(kb=testbed_kb)  # the module's testbed, not loaded a second time
+
+
+def test_a_given_testbed_is_left_open(report: Report, testbed_kb: KnowledgeBase) -> None:
+    assert len(testbed_kb.advertisements()) == report.services
 
 
 def test_report_json_has_the_agreed_shape(report: Report) -> None:
