@@ -6,13 +6,16 @@ import json
 import math
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from typing import Any
 
 import pytest
-from click.testing import CliRunner
+from click.testing import CliRunner, Result
 
 from cbrs.cli import cli
+from cbrs.reasoner import owlstc
+from cbrs.reasoner.methods import METHODS
 from cbrs.reasoner.metrics import average_precision, interpolated_precision, ndcg, precision_at_k, r_precision
-from cbrs.reasoner.owlstc import CollectionError, evaluate_collection, read_relevance
+from cbrs.reasoner.owlstc import CollectionError, CollectionReport, evaluate_collection, read_relevance
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "owls-tc4"
 needs_collection = pytest.mark.skipif(
@@ -93,9 +96,31 @@ def subset(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return root
 
 
+@pytest.fixture(scope="module")
+def subset_run(subset: Path, tmp_path_factory: pytest.TempPathFactory) -> tuple[Result, Path, CollectionReport]:
+    """``cbrs eval owls-tc SUBSET --json --plot`` (every method) run once, with the CollectionReport the
+    command printed: the end-to-end test reads that report rather than evaluating the subset again."""
+    chart = tmp_path_factory.mktemp("owlstc-plot") / "pr.png"
+    printed: list[CollectionReport] = []
+    evaluate = owlstc.evaluate_collection
+
+    def keep(*args: Any, **kwargs: Any) -> CollectionReport:
+        printed.append(evaluate(*args, **kwargs))
+        return printed[-1]
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(owlstc, "evaluate_collection", keep)
+        patch.delenv("CBRS_MATCH_PARAMS", raising=False)  # the figures are the defaults'
+        result = CliRunner().invoke(cli, ["eval", "owls-tc", str(subset), "--json", "--plot", str(chart)])
+    assert result.exit_code == 0, result.output
+    assert len(printed) == 1
+    return result, chart, printed[0]
+
+
 @needs_collection
-def test_subset_end_to_end(subset: Path) -> None:
-    report = evaluate_collection(subset)
+def test_subset_end_to_end(subset: Path, subset_run: tuple[Result, Path, CollectionReport]) -> None:
+    report = subset_run[2]
+    assert set(report.methods) == set(METHODS)
     assert report.queries == 2 and report.services == len(list((subset / "services").iterdir()))
     assert report.unmatched_requests == [] and report.unmatched_offers == 0
     for figures in report.methods.values():
@@ -106,21 +131,31 @@ def test_subset_end_to_end(subset: Path) -> None:
 
 
 @needs_collection
-def test_cbrs_eval_owls_tc_json_and_plot(subset: Path, tmp_path: Path) -> None:
-    chart = tmp_path / "pr.png"
-    result = CliRunner().invoke(
-        cli,
-        ["eval", "owls-tc", str(subset), "--json", "--method", "sem-str", "--method", "logic", "--plot", str(chart)],
-    )
-    assert result.exit_code == 0, result.output
+def test_cbrs_eval_owls_tc_json_and_plot(subset: Path, subset_run: tuple[Result, Path, CollectionReport]) -> None:
+    result, chart, printed = subset_run
     data = json.loads(result.stdout)
-    assert data["queries"] == 2 and set(data["methods"]) == {"sem-str", "logic"}
-    # the hybrid's text weight is a setting: at 0 it ranks as Sem-Str does
+    assert data == printed.to_json()
+    assert data["queries"] == 2 and set(data["methods"]) == set(METHODS)
+    # --method picks the methods; the hybrid's text weight is a setting: at 0 it ranks as Sem-Str does
     plain = CliRunner().invoke(
-        cli, ["eval", "owls-tc", str(subset), "--json", "--method", "sem-str-text", "--text-weight", "0"]
+        cli,
+        [
+            "eval",
+            "owls-tc",
+            str(subset),
+            "--json",
+            "--method",
+            "sem-str-text",
+            "--method",
+            "logic",
+            "--text-weight",
+            "0",
+        ],
     )
     assert plain.exit_code == 0, plain.output
-    figures = json.loads(plain.stdout)["methods"]["sem-str-text"]
+    methods = json.loads(plain.stdout)["methods"]
+    assert set(methods) == {"sem-str-text", "logic"}
+    figures = methods["sem-str-text"]
     assert {k: figures[k] for k in ("map", "ndcg")} == {k: data["methods"]["sem-str"][k] for k in ("map", "ndcg")}
     assert set(data["methods"]["sem-str"]) == {"map", "ndcg", "p_at_1", "p_at_10", "r_precision", "query_ms"}
     assert chart.read_bytes()[:4] == b"\x89PNG"
