@@ -21,6 +21,7 @@ import numpy as np
 import pybullet as p
 
 from cbrs.kb.hands import PANDA_HAND
+from cbrs.kb.home_check import check_home
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import Arm as ArmSpec
 from cbrs.kb.semantic_map import Box, Dispenser, MapError, MapObject, MobileRobot, SemanticMap, Thing, overlaps
@@ -209,19 +210,9 @@ class HomeWorld:
         self.objects: dict[str, MapObject] = {obj.name: obj for obj in self.map.objects.values()}
         """The movable objects by body name (the local name of their IRI)."""
         self.containers = {name for name, obj in self.objects.items() if obj.iri in self.map.containers}
+        check_home(self.map)  # rooms, one base, one person, two arms, starts on a room's floor (kb.home_check)
         robots = list(self.map.robots.values())
         people = list(self.map.people.values())
-        if len(robots) != 1 or len(people) != 1:
-            # Every run builds the whole map, so this stops every task, not only one about the second person.
-            named = "; ".join(
-                f"{what}: {', '.join(thing.iri for thing in things) or 'none'}"
-                for what, things in (("mobile robots", robots), ("people", people))
-            )
-            raise ValueError(
-                f"the simulated home takes one mobile robot and one person; the semantic map has {len(robots)} "
-                f"and {len(people)} ({named}); take the extra ones out of graph:map (a SPARQL update, or the "
-                "map's files loaded into a fresh store), whatever task runs"
-            )
         self.robot, self.person = robots[0], people[0]
         self.base_name, self.person_name = self.robot.name, self.person.name
         self.perturbation = Perturbation.from_seed(
@@ -792,10 +783,6 @@ class HomeWorld:
         arms = {ArmSide(arm.side): arm for arm in self.map.arms.values()}
         arms = {ArmSide(arm.side): arm for arm in self.map.arms.values()}
         self.arm_specs = arms
-        if set(arms) != set(ArmSide):
-            raise ValueError(
-                f"the dual-arm robot needs a left and a right arm in the semantic map; it has {sorted(arms)}"
-            )
         mounts = {side: (arms[side].mount, quat_from_yaw(arms[side].yaw)) for side in ArmSide}
         tops = [
             Region(thing.name, b.min_x, b.max_x, b.min_y, b.max_y, b.max_z - 0.04, b.max_z)
