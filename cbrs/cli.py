@@ -194,8 +194,15 @@ def _left_behind(graph: str) -> str:
     help="Resolve owl:imports (and the ontologies of OWL-S parameter types) to local files: a folder of "
     "ontologies, an OASIS catalog-v001.xml or a two-column TSV. Nothing is fetched from the network.",
 )
+@click.option(
+    "--replace",
+    is_flag=True,
+    help="With --graph map: the files become the whole semantic map, your own home in place of the bundled "
+    "one, in one transaction; refused, the map as it was, unless they make a home the simulation can build "
+    '(docs/tasks.md, "A home of your own").',
+)
 @pass_app
-def load(app: App, files: tuple[Path, ...], graph: str | None, catalogs: tuple[Path, ...]) -> None:
+def load(app: App, files: tuple[Path, ...], graph: str | None, catalogs: tuple[Path, ...], replace: bool) -> None:
     """Load RDF files (Turtle, RDF/XML, OWL, N-Triples, N-Quads, TriG, JSON-LD) and OWL-S services, all
     or nothing. A directory stands for the RDF and OWL-S files directly inside it."""
     catalogue = merge([Catalogue.open(path) for path in catalogs]) if catalogs else None
@@ -208,7 +215,7 @@ def load(app: App, files: tuple[Path, ...], graph: str | None, catalogs: tuple[P
             shown(stage, done, total)
 
         try:
-            report = app.kb.load(list(files), graph, catalogue, progress)
+            report = app.kb.load(list(files), graph, catalogue, progress, replace=replace)
         finally:
             shown.clear()
     if interrupts.interrupted:
@@ -222,6 +229,8 @@ def load(app: App, files: tuple[Path, ...], graph: str | None, catalogs: tuple[P
         click.echo(line)
     for line in _added_summary(report):
         click.echo(line)
+    for graph, count in report.removed.items():
+        click.echo(f"replaced {shorten(graph)}: took out {_plural(count, 'triple')} the files do not give")
 
 
 def _note_defaulted(report: LoadReport) -> None:

@@ -116,6 +116,20 @@ class UnknownGraphError(KnowledgeBaseError):
         super().__init__(f"unknown graph {graph!r}; use one of {', '.join(known)} or a full graph IRI")
 
 
+class ReplaceError(KnowledgeBaseError):
+    """A load asked to replace a graph other than graph:map: the map is the one graph a lab replaces whole
+    (its own home); services and requirements are deregistered one by one, a backup restored by graph."""
+
+    http_status = 400
+
+    def __init__(self, graph: str) -> None:
+        self.graph = graph
+        super().__init__(
+            f"a load replaces only graph:map (a home of your own), not {graph!r}: load into graph:map with "
+            "--graph map, deregister services or requirements, or restore a backup's graph (cbrs restore --graph)"
+        )
+
+
 class UnknownQueryError(KnowledgeBaseError):
     http_status = 404
 

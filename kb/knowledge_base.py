@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import functools
 import logging
 import re
 from collections.abc import Mapping, Sequence
@@ -14,7 +15,7 @@ import pyoxigraph as ox
 from cbrs.kb.backup import Backup, ExportReport, RestoreReport, export_store, read_backup, restore_store
 from cbrs.kb.catalog import Catalogue
 from cbrs.kb.descriptions import DescriptionReader
-from cbrs.kb.errors import StoreError
+from cbrs.kb.errors import ReplaceError, StoreError
 from cbrs.kb.liveness import Liveness
 from cbrs.kb.loader import (
     LoadReport,
@@ -42,6 +43,8 @@ from cbrs.kb.upgrade import UpgradeReport, new_terms, upgrade_store
 
 _log = logging.getLogger(__name__)
 _VERSION_INFO = ox.NamedNode("http://www.w3.org/2002/07/owl#versionInfo")
+_TYPE = ox.NamedNode("http://www.w3.org/1999/02/22-rdf-syntax-ns#type")
+_ONTOLOGY = ox.NamedNode("http://www.w3.org/2002/07/owl#Ontology")
 # An update that might write graph:map, read loosely (its name, an escape, a variable graph, ALL or NAMED):
 # only such an update, and a data update that names a quad in it, has the map checked afterwards.
 _MAY_WRITE_MAP = re.compile(r"map|\\[uU]|GRAPH(?:\s|#[^\n]*\n)*[?$]|\b(?:ALL|NAMED)\b", re.IGNORECASE)
@@ -50,6 +53,23 @@ _LOADS = re.compile(r"\bLOAD\b", re.IGNORECASE)
 # The graphs whose descriptions kb.shapes.checked_update checks (tests/test_standard_terms_updates.py pins
 # it): a data update naming no quad in them leaves them as they are, so it skips the check, which reads
 # both graphs whole twice (1.5 s a write on a store of OWLS-TC's services).
+
+
+@functools.cache
+def _bundled_map_versions() -> tuple[tuple[ox.NamedNode, frozenset[str]], ...]:
+    """(ontology IRI, versions) of each bundled file of graph:map: what marks a stored map as the bundled
+    home (read once per process)."""
+    found = []
+    for item in bundled_files():
+        if item.graph is GraphName.MAP:
+            triples = list(ox.parse(path=str(item.path), format=ox.RdfFormat.TURTLE))
+            for head in {t.subject for t in triples if t.predicate == _TYPE and t.object == _ONTOLOGY}:
+                if isinstance(head, ox.NamedNode):
+                    versions = frozenset(
+                        str(t.object) for t in triples if t.subject == head and t.predicate == _VERSION_INFO
+                    )
+                    found.append((head, versions))
+    return tuple(found)
 
 
 class KnowledgeBase:
@@ -136,6 +156,37 @@ class KnowledgeBase:
             raise problem
         return read
 
+    def _check_new_home(
+        self, paths: Sequence[str | Path], catalogue: Catalogue | None, progress: Progress | None = None
+    ) -> ReadFiles:
+        """Refuse files that would not make a whole home as graph:map (a load with ``replace``): the map
+        they make alone must read as a task reads it and hold what the simulated home is built from
+        (:func:`kb.home_check.check_home`), or nothing is written. Unlike a load that adds, the map is
+        whole at once, so an empty or partial one is no step of a build: an emptied map is the bundled
+        one again on the next open."""
+        from cbrs.kb.home_check import check_home
+        from cbrs.kb.semantic_map import MapError, SemanticMap  # they import this module
+
+        read = read_files(paths, GraphName.MAP, catalogue, progress)
+        home = read.quads()
+        scratch = ox.Store()
+        for graph in (GraphName.ONTOLOGY, GraphName.ENTAILED):
+            scratch.extend(self.store.quads(graph=graph.node))
+        scratch.extend(home)
+        for subject in {quad.subject for quad in home if isinstance(quad.subject, ox.NamedNode)}:
+            # the class a thing of the map has where it is described (a robot's, in graph:services)
+            stated = self.store.quads(subject, _TYPE, None, None)
+            scratch.extend(quad for quad in stated if quad.graph_name != GraphName.MAP.node)
+        try:
+            check_home(SemanticMap.read(KnowledgeBase(EmbeddedStore(scratch, MEMORY), self.queries)))
+        except MapError as problem:
+            problem.add_note(
+                f"nothing was loaded from {', '.join(map(str, read.paths))} and the map is as it was (a map "
+                "that replaces the home is checked as the simulation builds it)"
+            )
+            raise
+        return read
+
     def check_map_write(self, added: Sequence[ox.Quad], replaces_map: bool = False) -> None:
         """Refuse a write of ``added`` that would leave a readable semantic map unreadable, with the map
         reader's error, before anything is written: ``added`` joins the store, or (``replaces_map``) its
@@ -215,20 +266,20 @@ class KnowledgeBase:
         return report
 
     def _map_outdated(self) -> bool:
-        """Whether the store's semantic map is missing or of an older version than the bundled one. Every
-        open asks, so it reads the map's version statements, not the list of graphs (6.9 s of a 7.7 s open
-        of the OWLS-TC store on Virtuoso, docs/remote-store.md); a map without them is looked for by one quad."""
-        stored = {str(quad.object) for quad in self.store.quads(predicate=_VERSION_INFO, graph=GraphName.MAP.node)}
-        if not stored and next(iter(self.store.quads(graph=GraphName.MAP.node)), None) is None:
-            return True
-        bundled = {
-            str(quad.object)
-            for item in bundled_files()
-            if item.graph is GraphName.MAP
-            for quad in parse_file(item.path, item.graph).quads
-            if quad.predicate == _VERSION_INFO
-        }
-        return not bundled <= stored
+        """Whether the store's semantic map is missing, or is the bundled one at an older version. A map
+        that does not name the bundled map's ontology is a lab's own home (``cbrs load --graph map
+        --replace``): it is left alone, where the bundled home's statements used to join it on the next
+        open (its kitchen table, cup and person beside the lab's own). Every open asks, so it reads the
+        bundled header's version statements, not the list of graphs (6.9 s of a 7.7 s open of the
+        OWLS-TC store on Virtuoso, docs/remote-store.md); an empty map is looked for by one quad."""
+        found = False
+        for head, bundled in _bundled_map_versions():
+            stored = {str(quad.object) for quad in self.store.quads(head, _VERSION_INFO, None, GraphName.MAP.node)}
+            if stored or next(iter(self.store.quads(head, _TYPE, _ONTOLOGY, GraphName.MAP.node)), None) is not None:
+                found = True
+                if not bundled <= stored:
+                    return True
+        return not found and next(iter(self.store.quads(graph=GraphName.MAP.node)), None) is None
 
     def add_semantic_map(self) -> None:
         """Bring a store seeded before the semantic map (or its current version) existed up to date.
@@ -280,9 +331,11 @@ class KnowledgeBase:
         graph: str | GraphName | None = None,
         catalogue: Catalogue | str | Path | None = None,
         progress: Progress | None = None,
+        replace: bool = False,
     ) -> LoadReport:
         """Load RDF and OWL-S files (or every RDF file of a directory) all-or-nothing; ``progress`` is told
-        each stage as it goes (:data:`kb.loader.Progress`).
+        each stage as it goes (:data:`kb.loader.Progress`). With ``replace`` (graph:map only) the files
+        become the semantic map, a lab's own home in place of the bundled one (:meth:`_check_new_home`).
 
         OWL-S files are converted into cbrs advertisements, or requirements when ``graph`` is
         ``requirements`` (see :mod:`kb.owls`). With a ``catalogue`` (a :class:`Catalogue`, a folder or
@@ -291,9 +344,14 @@ class KnowledgeBase:
         if catalogue is not None and not isinstance(catalogue, Catalogue):
             catalogue = Catalogue.open(catalogue)
         read = None
-        if graph is not None and resolve_graph(graph) == GraphName.MAP.node:
+        into_map = graph is not None and resolve_graph(graph) == GraphName.MAP.node
+        if replace and not into_map:
+            raise ReplaceError(str(graph))
+        if replace:
+            read = self._check_new_home(paths, catalogue, progress)
+        elif into_map:
             read = self._check_map_load(paths, catalogue, progress)
-        report = load_files(self.store, paths, graph, catalogue, progress, read)
+        report = load_files(self.store, paths, graph, catalogue, progress, read, GraphName.MAP if replace else None)
         if isinstance(self.store, EmbeddedStore) and not any(report.added.values()):
             return report  # a reload of what the store holds wrote nothing: nothing to read or entail afresh
         self._reader.clear_cache()
