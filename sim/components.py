@@ -1517,11 +1517,12 @@ class SimEnvironment:
                     raise CannotLoadError(step.component, obj.iri, str(refused)) from None
 
     def _check_sight(self, plan: Plan, values: Mapping[str, Any]) -> None:
-        """Refuse a plan whose recognition step would look for an object the task gives with a camera that
-        cannot see it whole where it is believed to be (by the map: ``sight.unseen``), nor could the camera
-        of any component that may stand in for the step's: else the base drives off and the step fails when
-        it looks. An object an earlier step may have moved is not checked (it may be elsewhere by then), nor
-        a step a component of unknown camera may do (one in another process)."""
+        """Refuse a plan whose recognition step would look for an object the task gives (or whose tracking
+        step for the person it gives) with a camera that cannot see it whole where it is believed to be (by
+        the map: ``sight.unseen``), nor could the camera of any component that may stand in for the step's:
+        else the base drives off and the step fails when it looks. An object an earlier step may have moved
+        is not checked (it may be elsewhere by then), nor a step a component of unknown camera may do (one
+        in another process). The person is taken where the map starts them (nothing moves them)."""
         smap = self.world.map
         steps = {step.index: step for step in plan.steps}
         ads = {ad.iri: ad for ad in self.kb.advertisements()}
@@ -1538,22 +1539,30 @@ class SimEnvironment:
                 continue
             if not all(cameras):
                 continue  # a camera the simulation does not have may see it
+            ad = ads.get(step.component)
+            if ad is not None and SKILLS.get(ad.service_name or "") is track:  # the person, by their shirt
+                people = [smap.people[iri] for iri in iris if iri in smap.people]
+                looked_for = [(who.iri, sight.person_centre(who), sight.person_outline(who)) for who in people]
+                objects = []
+            else:
+                looked_for = []
             for obj in objects:
                 support = smap.things.get(obj.support or "")
                 rest = support.box.max_z if support is not None else 0.0
                 centre = self.belief.position(obj.name) or (obj.start.x, obj.start.y, rest + obj.size[2] / 2)
-                outline = sight.object_outline(obj, centre)
+                looked_for.append((obj.iri, centre, sight.object_outline(obj, centre)))
+            for iri, centre, outline in looked_for:
                 why = [
                     (name, sight.unseen(self.world.cameras[name], outline)) for name in dict.fromkeys(cameras) if name
                 ]
                 if all(reason for _, reason in why):
-                    raise sight.OutOfViewError(step.component, obj.iri, centre, why)
+                    raise sight.OutOfViewError(step.component, iri, centre, why)
 
     def _camera_of(self, ad: Advertisement | None) -> str | None:
         """The camera of the world a recognition component looks with; None for a component that is none,
         "" for one whose camera the simulation does not have (a component in another process)."""
         work = SKILLS.get(ad.service_name or "") if ad is not None else None
-        if ad is None or work not in (recognise_by_colour, find_object_on_table):
+        if ad is None or work not in (recognise_by_colour, find_object_on_table, track):
             return None
         if ad.bridge_port is not None:
             return ""

@@ -11,11 +11,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from cbrs.kb.errors import KnowledgeBaseError
-from cbrs.kb.semantic_map import MapObject, local_name
+from cbrs.kb.semantic_map import MapObject, Person, local_name
+from cbrs.sim import layout as L
 from cbrs.sim.cameras import Camera, project
 from cbrs.sim.geometry import Vec3
 
-__all__ = ["OutOfViewError", "object_outline", "unseen"]
+__all__ = ["OutOfViewError", "object_outline", "person_centre", "person_outline", "unseen"]
 
 RIM_POINTS = 24
 """Points taken round each rim of a cylinder: its silhouette is then under 1% of its radius larger
@@ -34,6 +35,24 @@ def object_outline(obj: MapObject, centre: Vec3) -> NDArray[np.float64]:
         corners = np.array([[x, y] for x in (-sx / 2, sx / 2) for y in (-sy / 2, sy / 2)])
         flat = corners @ np.array([[c, s], [-s, c]])
     rows = [[centre[0] + dx, centre[1] + dy, centre[2] + dz] for dz in (-sz / 2, sz / 2) for dx, dy in flat]
+    return np.array(rows, dtype=np.float64)
+
+
+def person_centre(person: Person) -> Vec3:
+    """The middle of the person's shirt, standing at their map pose: where a tracker looks for them."""
+    return (person.start.x, person.start.y, (L.SHIRT_BOTTOM + L.SHIRT_TOP) / 2)
+
+
+def person_outline(person: Person) -> NDArray[np.float64]:
+    """Points round the two rims of the person's shirt (the mannequin's, :mod:`sim.layout`) at their map
+    pose: the person tracker refuses a shirt cut by the image's border, as perception does an object."""
+    angles = np.linspace(0.0, 2.0 * math.pi, RIM_POINTS, endpoint=False)
+    x, y = person.start.x, person.start.y
+    rows = [
+        [x + math.cos(a) * L.SHIRT_RADIUS, y + math.sin(a) * L.SHIRT_RADIUS, z]
+        for z in (L.SHIRT_BOTTOM, L.SHIRT_TOP)
+        for a in angles
+    ]
     return np.array(rows, dtype=np.float64)
 
 
@@ -60,9 +79,10 @@ def unseen(camera: Camera, points: NDArray[np.float64]) -> str:
 
 
 class OutOfViewError(KnowledgeBaseError):
-    """A recognition step would look for an object the task gives with a camera that cannot see it
-    whole from where it is believed to be, and no camera that could stand in for it can either: the run
-    is refused before anything moves. ``cameras`` holds (camera name, why it does not see it)."""
+    """A recognition step would look for an object the task gives (or a tracking step for the person)
+    with a camera that cannot see it whole from where it is believed to be, and no camera that could
+    stand in for it can either: the run is refused before anything moves. ``cameras`` holds (camera
+    name, why it does not see it)."""
 
     http_status = 422
 
@@ -76,6 +96,6 @@ class OutOfViewError(KnowledgeBaseError):
         super().__init__(
             f"{local_name(component)} would look for the {local_name(thing)} at ({where[0]:.2f}, {where[1]:.2f}, "
             f"{where[2]:.2f}) with {names}, which cannot see it whole ({each}); move it in the map (home:x, home:y) "
-            f"to where {names} sees it, or hang a camera over it and register a recogniser for that camera "
-            "(docs/tasks.md, 'Which arm')"
+            f"to where {names} sees it, or hang a camera over it and register a component that looks with that "
+            "camera (docs/tasks.md, 'Which arm')"
         )
