@@ -39,7 +39,7 @@ Listener = Callable[[str, dict[str, Any]], None]
 RUN_TOPIC = "/cbrs/events"
 
 
-CAMERA = "CeilingCamera01"  # the view the browser shows: it covers the rooms both scenarios use
+CAMERA = "CeilingCamera01"  # the view the browser shows (in the bundled home it covers both scenarios' rooms; _view)
 JPEG_QUALITY = 80
 
 
@@ -125,6 +125,16 @@ class TaskRun:
         if self.result is not None:
             found["result"] = self.result
         return found
+
+
+def _view(world: Any, wanted: str) -> str:
+    """The camera whose frames the browser shows: ``wanted`` when the home has it, else the first by name
+    of the home's cameras that look straight down (a lab's own home names its own ceiling cameras), else
+    ``wanted`` (the world then says it has no such camera)."""
+    if wanted in world.cameras:
+        return wanted
+    down = sorted(camera.name for camera in world.map.cameras.values() if camera.looks_down)
+    return down[0] if down else wanted
 
 
 class TaskRunner:
@@ -365,7 +375,7 @@ class TaskRunner:
         if self.camera is None:
             return
         try:
-            jpeg = _jpeg(world.camera(self.camera).capture().rgb)
+            jpeg = _jpeg(world.camera(_view(world, self.camera)).capture().rgb)
         except Exception:
             log.exception("camera frame of %s failed", run_id or "the idle home")
             return
@@ -400,7 +410,7 @@ class TaskRunner:
                 with self.lock:
                     semantic_map = SemanticMap.read(self.kb)
                 with open_world(seed=0, semantic_map=semantic_map) as world:
-                    jpeg = _jpeg(world.camera(self.camera).capture().rgb)
+                    jpeg = _jpeg(world.camera(_view(world, self.camera)).capture().rgb)
             except Exception:
                 log.exception("camera frame of the idle home failed")
                 return
