@@ -187,14 +187,20 @@ def _stage(progress: Progress | None, prefix: str) -> Progress | None:
 
 
 def evaluate_collection(
-    root: Path, methods: Sequence[str] = METHODS, config: MatchConfig | None = None, progress: Progress | None = None
+    root: Path,
+    methods: Sequence[str] = METHODS,
+    config: MatchConfig | None = None,
+    progress: Progress | None = None,
+    loaded: LoadedCollection | None = None,
 ) -> CollectionReport:
     """Load the collection and score every method on every judged request (``config``: the matching
     parameters, MatchConfig's defaults when None); ``progress`` is told each load stage, and each query
-    as each method ranks for it."""
+    as each method ranks for it. ``loaded``: ``root`` as :func:`load_collection` loaded it, ranked in
+    without loading again (one load for several configurations; only read)."""
     check_layout(root)
     judgements = read_relevance(root / "relevance.xml")
-    loaded = load_collection(root, progress)
+    if loaded is None:
+        loaded = load_collection(root, progress)
 
     def to_iris(uri: str, table: dict[str, list[str]]) -> list[str]:
         return table.get(_file_key(uri), [])

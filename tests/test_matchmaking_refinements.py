@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 
@@ -13,7 +14,7 @@ from cbrs.reasoner.antonyms import forms, opposite
 from cbrs.reasoner.config import MatchConfig
 from cbrs.reasoner.lexicon import DATA_FILE, Lexicon
 from cbrs.reasoner.matchmaker import EntityPair, Matchmaker
-from cbrs.reasoner.owlstc import evaluate_collection, load_collection
+from cbrs.reasoner.owlstc import CollectionReport, LoadedCollection, evaluate_collection, load_collection
 from cbrs.reasoner.similarity import SemStr
 from cbrs.reasoner.statements import statement_similarity
 from cbrs.reasoner.taxonomy import Link, TaxonomyIndex
@@ -153,16 +154,29 @@ def test_empty_lexicon_knows_only_equal_words(tmp_path: Path) -> None:
 
 
 @pytest.fixture(scope="module")
-def robot_report():  # type: ignore[no-untyped-def]
-    return evaluate_collection(ROBOT, ["sem-str", "wu-palmer", "logic"])
+def collections() -> Callable[[Path], LoadedCollection]:
+    """Each collection folder loaded once for the module; the tests only rank in it."""
+    loaded: dict[Path, LoadedCollection] = {}
+
+    def load(root: Path) -> LoadedCollection:
+        if root not in loaded:
+            loaded[root] = load_collection(root)
+        return loaded[root]
+
+    return load
 
 
-def test_robot_collection_has_the_size_the_issue_asks(robot_report) -> None:  # type: ignore[no-untyped-def]
+@pytest.fixture(scope="module")
+def robot_report(collections: Callable[[Path], LoadedCollection]) -> CollectionReport:
+    return evaluate_collection(ROBOT, ["sem-str", "wu-palmer", "logic"], loaded=collections(ROBOT))
+
+
+def test_robot_collection_has_the_size_the_issue_asks(robot_report: CollectionReport) -> None:
     assert robot_report.services >= 60 and robot_report.queries >= 15
     assert robot_report.unmatched_requests == [] and robot_report.unmatched_offers == 0
 
 
-def test_sem_str_ranks_the_robot_collection_above_the_baselines(robot_report) -> None:  # type: ignore[no-untyped-def]
+def test_sem_str_ranks_the_robot_collection_above_the_baselines(robot_report: CollectionReport) -> None:
     figures = robot_report.methods
     assert figures["sem-str"]["map"] > max(figures["wu-palmer"]["map"], figures["logic"]["map"]) - 0.03
     assert figures["sem-str"]["map"] > figures["wu-palmer"]["map"]
@@ -172,22 +186,29 @@ BLIND = ["robot_heldout", "robot_validation", "robot_final", "robot_blind5", "ro
 
 
 @pytest.mark.parametrize("folder", BLIND)
-def test_sem_str_stays_first_on_the_collections_written_blind(folder: str) -> None:
+def test_sem_str_stays_first_on_the_collections_written_blind(
+    folder: str, collections: Callable[[Path], LoadedCollection]
+) -> None:
     """The refinements were found on the development collection; on the collections other engineers
     wrote and graded before any matchmaker ran (docs/matchmaking.md 9.7) Sem-Str must stay above every
     baseline and above its own published frame, or a rule fits one grader rather than the task."""
     root = Path(__file__).parent / "data" / folder
-    figures = evaluate_collection(root, ["sem-str", "wu-palmer", "lin", "logic", "string"]).methods
-    published = evaluate_collection(root, ["sem-str"], MatchConfig().published()).methods["sem-str"]["map"]
+    loaded = collections(root)
+    figures = evaluate_collection(root, ["sem-str", "wu-palmer", "lin", "logic", "string"], loaded=loaded).methods
+    published = evaluate_collection(root, ["sem-str"], MatchConfig().published(), loaded=loaded).methods["sem-str"][
+        "map"
+    ]
     best_baseline = max(figures[m]["map"] for m in ("wu-palmer", "lin", "logic", "string"))
     assert figures["sem-str"]["map"] > best_baseline
     assert figures["sem-str"]["map"] > published
 
 
-def test_the_best_match_of_every_robot_query_is_explained_without_fail() -> None:
+def test_the_best_match_of_every_robot_query_is_explained_without_fail(
+    collections: Callable[[Path], LoadedCollection],
+) -> None:
     """Issue 19: the explanation of the best match says how each pair matched; "Fail" only below the
     pair threshold with no rule, which the best match of a query never shows."""
-    loaded = load_collection(ROBOT)
+    loaded = collections(ROBOT)
     matcher = Matchmaker(loaded.kb)
     shown = {
         iri: [pair.shown_degree() for pair in matcher.rank(iri, explain=1).candidates[0].pairs]
@@ -424,8 +445,10 @@ def test_only_a_kind_of_the_requested_value_reports_it(defined_kb) -> None:  # t
     assert old.score(wanted, ads[1]).score == old_ranked[M + "GivesOpened"].score
 
 
-def test_equal_scores_are_ordered_by_what_was_asked_for_before_the_iri() -> None:
-    loaded = load_collection(ROBOT)
+def test_equal_scores_are_ordered_by_what_was_asked_for_before_the_iri(
+    collections: Callable[[Path], LoadedCollection],
+) -> None:
+    loaded = collections(ROBOT)
     wanted = loaded.requirements["room_temperature.owls"][0]
     on = Matchmaker(loaded.kb).rank(wanted, explain=0).candidates
     names = [c.advertisement.rsplit("#", 1)[-1] for c in on]
@@ -559,8 +582,10 @@ def test_an_offer_that_takes_what_an_achiever_lacks_works_towards_the_same_goal(
     assert MatchConfig().published().consumer_steps is False
 
 
-def test_the_planners_that_take_an_achievers_goal_rank_as_steps_on_the_robot_collection() -> None:
-    loaded = load_collection(ROBOT)
+def test_the_planners_that_take_an_achievers_goal_rank_as_steps_on_the_robot_collection(
+    collections: Callable[[Path], LoadedCollection],
+) -> None:
+    loaded = collections(ROBOT)
 
     def place(query: str, config: MatchConfig, name: str) -> int:
         wanted = loaded.requirements[query][0]
@@ -643,10 +668,12 @@ def test_a_step_whose_effect_clashes_with_the_request_is_not_an_offer_that_undoe
     assert off.score(wanted, ads[1]).score == 0.0  # without the step, opening contradicts leaving it ajar
 
 
-def test_docking_ranks_as_a_step_of_recharging_on_the_held_out_collection() -> None:
+def test_docking_ranks_as_a_step_of_recharging_on_the_held_out_collection(
+    collections: Callable[[Path], LoadedCollection],
+) -> None:
     # The charge controller charges only a docked robot; the requester's robot is not docked, so a service
     # that docks it (grade 2) is a step and ranks above a fuel gauge (grade 0).
-    loaded = load_collection(HELDOUT)
+    loaded = collections(HELDOUT)
     wanted = loaded.requirements["recharge_battery.owls"][0]
 
     def place(config: MatchConfig, name: str) -> int:
@@ -658,8 +685,10 @@ def test_docking_ranks_as_a_step_of_recharging_on_the_held_out_collection() -> N
     assert place(off, "RETURN_TO_CHARGER_SERVICE") > place(off, "FUEL_GAUGE_SERVICE")
 
 
-def test_the_grasp_planner_ranks_as_a_step_on_the_robot_collection() -> None:
-    loaded = load_collection(ROBOT)
+def test_the_grasp_planner_ranks_as_a_step_on_the_robot_collection(
+    collections: Callable[[Path], LoadedCollection],
+) -> None:
+    loaded = collections(ROBOT)
     wanted = loaded.requirements["grasp_cup.owls"][0]
 
     def place(config: MatchConfig, name: str) -> int:
