@@ -3,8 +3,8 @@
 With stubs (no simulator): a component that fails the same way every time, with the thing its input
 names believed where it was, is planned around when another route exists, and otherwise repeated at
 most ``ReplanPolicy.max_repeats`` times; a failure after which the thing moved is tried again. In
-the simulated home: the pencil taken askew at seed 6 is still fetched by the same plan, after the
-re-perception found it moved.
+the simulated home, the pencil taken askew at seed 6 is still fetched by the same plan, after the
+re-perception found it moved: tests/test_turtle_tasks_arms.py checks that of its run.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from cbrs.actions.replanning import Failure, ReplanPolicy, ReplanPolicyError
 from cbrs.actions.runner import RunResult, run_task
 from cbrs.cli_actions import run_text
 from cbrs.kb import KnowledgeBase, Requirement, Statement
-from cbrs.kb.namespaces import PREFIXES, shorten
+from cbrs.kb.namespaces import shorten
 from cbrs.kb.resources import ontology_dir
 
 EX = "http://example.org/replan#"
@@ -175,27 +175,6 @@ def test_a_policy_refuses_impossible_bounds_and_a_failure_kind_ignores_measureme
     one = Failure(3, EX + "Direct", (), "taken askew (0.42 rad) at (7.36, 3.30)", frozenset())
     other = Failure(5, EX + "Direct", (), "taken askew (0.40 rad) at (7.35, 3.31)", frozenset())
     assert one.key == other.key and one.kind == "taken askew (# rad) at (#, #)"
-
-
-def test_the_pencil_taken_askew_at_seed_6_is_still_fetched_by_the_same_plan(tmp_path: Path) -> None:
-    """docs/execution.md's seeds 3 and 6 (tests/test_turtle_tasks_arms.py runs seed 3): the pass fails with
-    the pencil in the left hand; set down and seen again on the table, it has moved, so the same plan runs
-    again (nothing avoided) and fetches it."""
-    from cbrs.actions.composer import Composer
-    from cbrs.kb.semantic_map import SemanticMap
-    from cbrs.sim.components import SimEnvironment
-    from cbrs.sim.world import open_world
-    from tests.test_turtle_tasks_arms import PENCIL_ON_THE_LEFT, TASKS, knowledge
-
-    kb = knowledge(tmp_path, ("map", PENCIL_ON_THE_LEFT), ("requirements", TASKS / "fetch_my_pencil.ttl"))
-    with open_world(seed=6, semantic_map=SemanticMap.read(kb)) as world:
-        result = run_task(kb, "FetchMyPencil", SimEnvironment(world, kb), composer=Composer(kb))
-    assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
-    assert len(result.replans) == 1 and not result.replans[0].avoided and not result.stopped
-    (failure,) = result.replans[0].failures
-    assert failure.component.endswith("HandOverOntoPlatform_CytonDualArm01")
-    assert failure.things == frozenset({PREFIXES["world"] + "Pencil1"})
-    assert [s.planned for s in result.replans[0].report.steps] == [s.planned for s in result.report.steps]
 
 
 class Producer(Worker):

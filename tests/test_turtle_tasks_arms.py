@@ -12,6 +12,7 @@ from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
 from cbrs.sim.arms import ArmSide
 from cbrs.sim.components import SimEnvironment
+from cbrs.sim.grasping import GraspKind
 from cbrs.sim.world import open_world
 
 TASKS = Path(__file__).parent / "data" / "tasks"
@@ -77,38 +78,59 @@ def test_an_object_only_the_left_arm_reaches_is_passed_to_the_right_arm(tmp_path
 def test_the_cup_is_passed_by_its_side_grasp_and_loaded_by_its_top_grasp(tmp_path: Path) -> None:
     """The left arm reaches the cup and only the right arm the platform at the table's docking pose,
     which it cannot load by the cup's side grasp: home:Drinkware allows "side top", so the left arm
-    passes the cup by its side grasp and the right arm takes it from the top and loads it (a cup allowed
-    only its side grasp is refused before anything moves: tests/test_grasp_approaches.py)."""
+    passes the cup by its side grasp (its first) and the right arm takes it from the top and loads it,
+    and the base brings it to the person. Each choice says why the approaches before it were passed
+    over (a cup allowed only its side grasp is refused before anything moves:
+    tests/test_grasp_approaches.py)."""
     kb = knowledge(tmp_path, ("requirements", FETCH_MY_CUP))
-    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
+    smap = SemanticMap.read(kb)
+    assert smap.objects[WORLD + "Cup"].grasp_approaches == ("side", "top")
+    with open_world(seed=0, semantic_map=smap) as world:
         environment = SimEnvironment(world, kb)
         result = run_task(kb, "FetchMyCup", environment, composer=Composer(kb))
-        grasps = [(choice.arm, choice.model.grasp.value) for choice in environment.context.choices]
+        choices = environment.context.choices
+        left = world.arm(ArmSide.LEFT).released
+        assert left is not None and world.name_of(left[0]) == "Cup"  # set down by the left hand for the right
     assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
-    assert grasps == [(ArmSide.LEFT, "side"), (ArmSide.RIGHT, "top")]
+    assert not result.replans
     facts = {(r["thing"].value, r["relation"].value, r["other"].value) for r in kb.select("world_facts")}
     assert (WORLD + "Cup", HOME + "isWith", WORLD + "Person") in facts
+    assert [(c.arm, c.model.grasp) for c in choices] == [(ArmSide.LEFT, GraspKind.SIDE), (ArmSide.RIGHT, GraspKind.TOP)]
+    assert choices[0].passed == ()
+    assert [kind for kind, _ in choices[1].passed] == [GraspKind.SIDE]
+    why = str(choices[1])
+    assert why.startswith("loading the Cup onto the platform: the right arm holds the Cup by its top grasp")
+    assert "not by its side grasp: the right arm cannot hold the Cup by its side grasp over the platform" in why
 
 
 def test_a_place_only_the_other_arm_reaches_gets_the_object_passed_to_that_arm(tmp_path: Path) -> None:
     """The left arm takes the cup; the pen tray is beyond its reach and within the right arm's: the left
-    arm sets the cup down where both reach, and the right arm carries it on."""
+    arm sets the cup down where both reach, and the right arm carries it on. The cup allows "side top"
+    (home:Drinkware): the right arm can set it down on the tray by its side grasp, its first, so each
+    arm takes it so, as with one approach (an approach that works for the whole hold is kept)."""
     kb = knowledge(
         tmp_path,
         ("ontology", PEN_TRAY_ON_THE_RIGHT),
         ("map", PEN_TRAY_ON_THE_RIGHT),
         ("requirements", PUT_CUP_ON_PEN_TRAY),
     )
-    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
+    smap = SemanticMap.read(kb)
+    assert smap.objects[WORLD + "Cup"].grasp_approaches == ("side", "top")
+    with open_world(seed=0, semantic_map=smap) as world:
         environment = SimEnvironment(world, kb)
         result = run_task(kb, "PutCupOnPenTray", environment, composer=Composer(kb))
         assert environment.context.arm is ArmSide.RIGHT
         left = world.arm(ArmSide.LEFT).released
         assert left is not None and world.name_of(left[0]) == "Cup"
+        choices = list(environment.context.choices)
     assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
     assert not result.replans
     facts = {(r["thing"].value, r["relation"].value, r["other"].value) for r in kb.select("world_facts")}
     assert (WORLD + "Cup", HOME + "isLocated", WORLD + "PenTray1") in facts
+    assert [(c.arm, c.model.grasp, c.passed) for c in choices] == [
+        (ArmSide.LEFT, GraspKind.SIDE, ()),
+        (ArmSide.RIGHT, GraspKind.SIDE, ()),
+    ]
 
 
 def test_an_object_a_failed_plan_left_in_a_hand_is_set_down_before_the_next_plan() -> None:
@@ -136,9 +158,16 @@ def test_a_pencil_taken_askew_is_let_go_where_it_was_taken_and_taken_again(tmp_p
     """Seed 6 (seed 3 before each object's start offsets were drawn from its IRI): the left hand takes the
     pencil askew at the edge of its reach, so the pass to the right arm fails with the pencil in the hand;
     lowering it back fails too, so the hand lets go of it just above the table where it took it, and the
-    re-plan fetches it."""
+    re-plan fetches it. Set down and seen again on the table, the pencil has moved, so the re-plan is the
+    same plan (nothing avoided: actions.replanning, tests/test_replanning_memory.py)."""
     kb = knowledge(tmp_path, ("map", PENCIL_ON_THE_LEFT), ("requirements", TASKS / "fetch_my_pencil.ttl"))
     with open_world(seed=6, semantic_map=SemanticMap.read(kb)) as world:
         result = run_task(kb, "FetchMyPencil", SimEnvironment(world, kb), composer=Composer(kb))
     assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
     assert len(result.replans) == 1 and "passing the Pencil1 from the left arm" in result.replans[0].reason
+    assert not result.replans[0].avoided and not result.stopped
+    (failure,) = result.replans[0].failures
+    assert failure.component.endswith("HandOverOntoPlatform_CytonDualArm01")
+    assert failure.things == frozenset({WORLD + "Pencil1"})
+    assert result.report is not None
+    assert [s.planned for s in result.replans[0].report.steps] == [s.planned for s in result.report.steps]
