@@ -125,7 +125,9 @@ def bridge_query(url: str, text: str) -> dict[str, Any]:
 @pytest.fixture(scope="module")
 def served(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Served]:
     home = tmp_path_factory.mktemp("hostile")
-    env = dict(os.environ, CBRS_STORE=":memory:", HOME=str(home), CBRS_UPDATE_TOKEN=TOKEN)
+    # on disk, as cbrs serve keeps a store by default: in memory, the query after each accepted update
+    # waited half a second for the store to be copied for the query workers
+    env = dict(os.environ, CBRS_STORE=str(home / "store"), HOME=str(home), CBRS_UPDATE_TOKEN=TOKEN)
     env["CBRS_QUERY_CHECK_TIMEOUT"] = "2"  # some chains parse for ever; a shorter check keeps the budget
     command = [sys.executable, "-m", "cbrs", "serve", "--port", "0", "--bridge-port", "0"]
     process = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, text=True, env=env)
