@@ -76,6 +76,7 @@ def served(tmp_path_factory: pytest.TempPathFactory) -> Recorded:
 
 
 def test_the_gif_is_at_least_640x480_with_a_frame_every_half_simulated_second(served: Recorded) -> None:
+    assert served.gif.read_bytes()[:6] in (b"GIF87a", b"GIF89a")
     with Image.open(served.gif) as image:
         assert image.size[0] >= 640 and image.size[1] >= 480
     shown = durations_of(served.gif)
