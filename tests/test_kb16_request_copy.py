@@ -14,7 +14,7 @@ import pytest
 
 from cbrs.kb import GraphName, KnowledgeBase, RdfParseError
 from cbrs.kb.owls import requirement_iri
-from tests.conftest import OxigraphServer
+from tests.helpers_seeded import put_quads
 
 from .test_deregister_owls import triples_by_graph
 from .test_load_counts import NAVIGATE, ONTOLOGY
@@ -39,11 +39,7 @@ def kb(store_location: str, start: bytes, request: pytest.FixtureRequest) -> Ite
     """On the server, the start is put in one request: seeding and loading through cbrs would take some
     3 s of queries each time (what a remote seed and load write is checked in test_remote_store.py)."""
     if store_location != ":memory:":
-        server: OxigraphServer = request.getfixturevalue("oxigraph_server")  # cleared for the test already
-        put = server.client.post(
-            store_location + "/store", content=start, headers={"Content-Type": "application/n-quads"}
-        )
-        put.raise_for_status()
+        put_quads(request.getfixturevalue("oxigraph_server"), start)  # cleared for the test already
     kb = KnowledgeBase.open(store_location)
     if store_location == ":memory:":
         kb.load([ONTOLOGY])

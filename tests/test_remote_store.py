@@ -30,6 +30,7 @@ from cbrs.kb.namespaces import GraphName
 from cbrs.kb.remote_store import OXIGRAPH_BATCH, Endpoints, RemoteStore, inject_values
 from cbrs.kb.staged_writes import STAGED, STAGING, batches, publication
 from tests.conftest import OxigraphServer
+from tests.helpers_seeded import put_quads, seeded_quads
 from tests.helpers_unsendable import unsendable_kept_by
 
 DATA = Path(__file__).parent / "data"
@@ -125,8 +126,11 @@ def test_blank_nodes_and_bad_names_cannot_be_bound() -> None:
         inject_values("INSERT DATA { }", X)
 
 
-def test_every_named_query_with_parameters_gives_the_embedded_answer(remote_location: str) -> None:
+def test_every_named_query_with_parameters_gives_the_embedded_answer(
+    remote_location: str, oxigraph_server: OxigraphServer
+) -> None:
     """VALUES pre-binding against Oxigraph substitution, on the bundled data, for every parameter."""
+    put_quads(oxigraph_server, seeded_quads())  # what a seed writes: test_dumps_are_byte_for_byte_...
     embedded, remote = KnowledgeBase.open(":memory:"), KnowledgeBase.open(remote_location)
     for kb in (embedded, remote):
         kb.load([DATA / "mini_world.ttl"], graph="world")
@@ -369,7 +373,8 @@ def test_the_publication_is_one_operation_naming_every_staging_graph() -> None:
     assert f"(<{STAGING}run/0> <https://w3id.org/cbrs/graph/a>)" in text and f'"{STAGED}"' in text
 
 
-def test_one_store_serves_many_threads(remote_location: str) -> None:
+def test_one_store_serves_many_threads(remote_location: str, oxigraph_server: OxigraphServer) -> None:
+    put_quads(oxigraph_server, seeded_quads())
     kb = KnowledgeBase.open(remote_location)
     expected = kb.select("description", {"description": LOCATE})
     failures: list[BaseException] = []
@@ -393,7 +398,8 @@ def test_one_store_serves_many_threads(remote_location: str) -> None:
 # -- the command line ---------------------------------------------------------------------------------
 
 
-def test_the_cli_works_against_a_server(remote_location: str) -> None:
+def test_the_cli_works_against_a_server(remote_location: str, oxigraph_server: OxigraphServer) -> None:
+    put_quads(oxigraph_server, seeded_quads())  # as cbrs init leaves a server (test_remote_servers.py)
     runner = CliRunner()
     services = runner.invoke(cli, ["--store", remote_location, "services"])
     assert services.exit_code == 0, services.output
