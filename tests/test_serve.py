@@ -31,6 +31,8 @@ from cbrs.kb.namespaces import expand
 from cbrs.reasoner.matchmaker import Matchmaker
 from cbrs.server import ServeConfig, Server
 from cbrs.sparql_service import EndpointConfig
+from tests.conftest import OxigraphServer
+from tests.helpers_seeded import put_quads, seeded_quads
 from tests.helpers_threads import assert_threads_end
 
 WAIT = 10.0
@@ -362,9 +364,12 @@ def test_the_bridge_gets_its_action_workers_from_the_setting(monkeypatch: pytest
     kb.close()
 
 
-def test_cbrs_serve_on_a_store_url_with_a_password_does_not_print_it(tmp_path: Any, remote_location: str) -> None:
+def test_cbrs_serve_on_a_store_url_with_a_password_does_not_print_it(
+    tmp_path: Any, remote_location: str, oxigraph_server: OxigraphServer
+) -> None:
     """The banner names the store; a remote store's URL may carry HTTP basic credentials (Oxigraph's
     server ignores them), and the banner ends up in terminals and logs."""
+    put_quads(oxigraph_server, seeded_quads())  # a seeded server: the child need not seed it (some 3 s)
     with_password = remote_location.replace("http://", "http://robot:s3cret@", 1)
     env = dict(os.environ, CBRS_STORE=with_password, HOME=str(tmp_path), CBRS_QUERY_WORKERS="1")
     env.pop("CBRS_UPDATE_TOKEN", None)
