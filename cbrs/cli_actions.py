@@ -60,8 +60,9 @@ def plan(app: App, task: str, as_json: bool, drawing: Path | None, objective: st
     """
     if drawing is not None and drawing.suffix.lower() not in (".svg", ".png"):
         raise click.BadParameter(f"{drawing.name!r} must end in .svg or .png", param_hint="--draw")
+    requested = task_iri(app.kb, task)  # a name that names no task is refused before the composer reads the store
     composer = Composer(app.kb, ComposeConfig(objective=Objective(objective)))
-    result = composer.compose(task_iri(app.kb, task))
+    result = composer.compose(requested)
     if result.plan is not None and not no_store:
         try:
             store_plan(app.kb, result.plan)
