@@ -49,10 +49,16 @@ def test_batch_equals_scalar_on_random_pools(seed: int, method: str) -> None:
         _assert_same(matchmaker, requirement)
 
 
+@pytest.fixture(scope="module")
+def robot_kb() -> KnowledgeBase:
+    """The robot collection, loaded once for both methods (they only read it)."""
+    return load_collection(ROBOT).kb
+
+
 @pytest.mark.parametrize("method", ["sem-str", "logic"])
-def test_batch_equals_scalar_on_the_robot_collection(method: str) -> None:
+def test_batch_equals_scalar_on_the_robot_collection(robot_kb: KnowledgeBase, method: str) -> None:
     # OWL-S services with effects, and requests with effects and inputs only
-    kb = load_collection(ROBOT).kb
+    kb = robot_kb
     matchmaker = Matchmaker(kb, method)
     for requirement in kb.requirements():
         _assert_same(matchmaker, requirement)
