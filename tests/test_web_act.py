@@ -292,9 +292,25 @@ def sse_messages(chunks: Iterator[bytes]) -> list[dict[str, Any]]:
     return [json.loads(line[6:]) for line in text.splitlines() if line.startswith("data: ")]
 
 
-def test_event_stream_delivers_the_steps_live_and_ends_by_itself(live: tuple[Flask, TaskRunner]) -> None:
+def test_the_event_and_camera_streams_follow_one_run_and_end_by_themselves(live: tuple[Flask, TaskRunner]) -> None:
+    """Both streams open on one run: the event stream delivers its steps live, the camera stream sends
+    JPEG parts whose frame numbers rise; each ends by itself once idle after the run."""
     app, runner = live
+    app.config["CBRS_STREAM_IDLE_SECONDS"] = 3.0  # from the camera stream's start until the run's first frame
     client = app.test_client()
+    camera = client.get("/camera.mjpg", buffered=False)
+    assert camera.status_code == 200
+    assert camera.headers["Content-Type"] == "multipart/x-mixed-replace; boundary=frame"
+    body, numbers = b"", []
+    parts = iter(camera.response)
+    while len(numbers) < 2 and len(body) < 2_000_000:
+        part = next(parts)
+        body += part
+        assert part.startswith(b"--frame\r\nContent-Type: image/jpeg\r\n")
+        head, _, jpeg = part.partition(b"\r\n\r\n")
+        assert jpeg.startswith(b"\xff\xd8") and jpeg.endswith(b"\xff\xd9\r\n")
+        numbers.append(int(head.split(b"X-Frame: ")[1]))
+    assert numbers == [1, 1]  # the idle home, then the same again (no run yet)
     stream = client.get("/tasks/events", buffered=False)
     assert stream.status_code == 200 and stream.mimetype == "text/event-stream"
     chunks = iter(stream.response)
@@ -302,10 +318,13 @@ def test_event_stream_delivers_the_steps_live_and_ends_by_itself(live: tuple[Fla
     hello = json.loads(next(chunks).decode()[6:])
     assert hello["event"] == "hello" and hello["active"] is None
     run_id = start(client, "RobotArmServeACup").get_json()["started"]["id"]
+    seen: list[int] = []
+    reader = threading.Thread(target=lambda: seen.extend(int(p.split(b"X-Frame: ")[1].split(b"\r")[0]) for p in parts))
+    reader.start()
     wait_done(runner, run_id)
     started = time.monotonic()
     messages = sse_messages(chunks)
-    assert time.monotonic() - started < 10  # idle for 1.5 s after the run: ends
+    assert time.monotonic() - started < 10  # idle for 3 s after the run: ends
     kinds = [m.get("event") for m in messages]
     assert kinds[0] == "run_started" and "run_finished" in kinds and kinds[-1] == "end"
     steps = [m for m in messages if m.get("topic") == "/cbrs/task_progress"]
@@ -314,34 +333,10 @@ def test_event_stream_delivers_the_steps_live_and_ends_by_itself(live: tuple[Fla
     frames = [m["frame"] for m in messages if m.get("event") == "frame"]
     assert len(frames) >= 2 and frames == sorted(frames)
     stream.close()
-    assert not runner._listeners[1:] and not runner._frame_listeners  # the stream unsubscribed (the event log stays)
-
-
-def test_camera_stream_sends_jpeg_parts_and_frames_rise_during_a_run(live: tuple[Flask, TaskRunner]) -> None:
-    app, runner = live
-    app.config["CBRS_STREAM_IDLE_SECONDS"] = 3.0  # from the stream's start until the run's first frame
-    client = app.test_client()
-    stream = client.get("/camera.mjpg", buffered=False)
-    assert stream.status_code == 200
-    assert stream.headers["Content-Type"] == "multipart/x-mixed-replace; boundary=frame"
-    body, numbers = b"", []
-    chunks = iter(stream.response)
-    while len(numbers) < 2 and len(body) < 2_000_000:
-        part = next(chunks)
-        body += part
-        assert part.startswith(b"--frame\r\nContent-Type: image/jpeg\r\n")
-        head, _, jpeg = part.partition(b"\r\n\r\n")
-        assert jpeg.startswith(b"\xff\xd8") and jpeg.endswith(b"\xff\xd9\r\n")
-        numbers.append(int(head.split(b"X-Frame: ")[1]))
-    assert numbers == [1, 1]  # the idle home, then the same again (no run yet)
-    run_id = start(client, "RobotArmServeACup").get_json()["started"]["id"]
-    seen: list[int] = []
-    reader = threading.Thread(target=lambda: seen.extend(int(p.split(b"X-Frame: ")[1].split(b"\r")[0]) for p in chunks))
-    reader.start()
-    wait_done(runner, run_id)
     reader.join(30)
     assert not reader.is_alive(), "the camera stream did not end by itself"
-    stream.close()
+    camera.close()
+    assert not runner._listeners[1:] and not runner._frame_listeners  # both unsubscribed (the event log stays)
     assert max(seen) > 2 and seen == sorted(seen)
     still = client.get("/camera.jpg")
     assert still.mimetype == "image/jpeg" and int(still.headers["X-Frame"]) == max(seen)
