@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import tomllib
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -11,6 +12,8 @@ import pytest
 from cbrs.kb import BindingError, KnowledgeBase, Store, UnknownQueryError
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.resources import ontology_dir, query_dir
+
+from .conftest import BACKENDS, OxigraphServer
 
 DATA = Path(__file__).parent / "data"
 MANIFEST = tomllib.loads((DATA / "queries" / "manifest.toml").read_text(encoding="utf-8"))["case"]
@@ -31,11 +34,66 @@ def _normalise(value: str) -> str:
     return " ".join(sorted(_expand(v) for v in value.split(" "))) if " " in value else _expand(value)
 
 
-@pytest.mark.parametrize("case", [pytest.param(c, id=c["id"]) for c in MANIFEST])
-def test_named_query_known_answer(case: dict[str, Any], store_location: str) -> None:
-    kb = KnowledgeBase(Store.open(store_location))
-    kb.load([ontology_dir() / "core.ttl"], graph="ontology")
-    kb.load([DATA / name for name in case["data"]], graph=case.get("graph"))
+DataSet = tuple[tuple[str, ...], str | None]  # a case's data files and the graph they go into
+
+
+def _data_set(case: dict[str, Any]) -> DataSet:
+    return tuple(case["data"]), case.get("graph")
+
+
+class KnownAnswerStores:
+    """The cases' stores, each data set loaded once: the named queries only read. Embedded stores are
+    kept; the remote one (a server of this module's own) holds the last data set asked for and is
+    cleared and loaded again when another is asked for (the cases are ordered by data set)."""
+
+    def __init__(self, start: Callable[..., OxigraphServer]) -> None:
+        self._start = start
+        self._embedded: dict[DataSet, KnowledgeBase] = {}
+        self._server: OxigraphServer | None = None
+        self._remote: tuple[DataSet, KnowledgeBase] | None = None
+
+    def get(self, backend: str, data: DataSet) -> KnowledgeBase:
+        if backend == "embedded":
+            if data not in self._embedded:
+                self._embedded[data] = self._load(":memory:", data)
+            return self._embedded[data]
+        if self._remote is None or self._remote[0] != data:
+            if self._server is None:
+                self._server = self._start(on_disk=False)
+            if self._remote is not None:
+                self._remote[1].close()
+                self._remote = None
+            self._server.clear()
+            self._remote = data, self._load(self._server.url, data)
+        return self._remote[1]
+
+    @staticmethod
+    def _load(location: str, data: DataSet) -> KnowledgeBase:
+        kb = KnowledgeBase(Store.open(location))
+        kb.load([ontology_dir() / "core.ttl"], graph="ontology")
+        kb.load([DATA / name for name in data[0]], graph=data[1])
+        return kb
+
+    def close(self) -> None:
+        for kb in [*self._embedded.values(), *([self._remote[1]] if self._remote else [])]:
+            kb.close()
+        if self._server is not None:
+            self._server.stop()  # stopped by its PID now, not at the end of the session
+
+
+@pytest.fixture(scope="module")
+def known_answer_stores(oxigraph_servers: Callable[..., OxigraphServer]) -> Iterator[KnownAnswerStores]:
+    stores = KnownAnswerStores(oxigraph_servers)
+    yield stores
+    stores.close()
+
+
+@pytest.mark.parametrize(
+    "case", [pytest.param(c, id=c["id"]) for c in sorted(MANIFEST, key=lambda c: repr(_data_set(c)))]
+)
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_named_query_known_answer(case: dict[str, Any], backend: str, known_answer_stores: KnownAnswerStores) -> None:
+    kb = known_answer_stores.get(backend, _data_set(case))
     rows = kb.select(case["query"], {k: _expand(v) for k, v in case.get("bind", {}).items()})
     if "only_prefix" in case:  # the case lists only rows whose first variable starts with this
         first = next(iter(case["rows"][0]))
