@@ -293,7 +293,8 @@ class KnowledgeBase:
         ontology = [parse_file(item.path, item.graph) for item in files if item.graph is GraphName.ONTOLOGY]
         world = [parse_file(item.path, item.graph) for item in files if item.graph is GraphName.MAP]
         known = {(quad.subject, quad.predicate) for quad in self.store.quads(graph=GraphName.MAP.node)}
-        added = [quad for item in ontology for quad in new_terms(self.store, item.quads)]
+        # the ontology files at once: one scan of the stored graph for what it describes, not one per file
+        added = new_terms(self.store, [quad for item in ontology for quad in item.quads])
         added += [  # (the map by the bundle's own graph name: a parsed file names its graph by IRI)
             quad
             for item in world
