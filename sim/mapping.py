@@ -25,12 +25,13 @@ from cbrs.sim.errors import OutsideMapError
 from cbrs.sim.layout import MAP_RESOLUTION
 from cbrs.sim.world import HomeWorld
 
-__all__ = ["OBSTACLE_HEIGHT", "OccupancyGrid", "build_occupancy_grid", "inflate"]
+__all__ = ["OBSTACLE_HEIGHT", "OccupancyGrid", "build_occupancy_grid", "inflate", "overhead"]
 
 OBSTACLE_HEIGHT = 0.03
 """Anything taller than 3 cm blocks the base (the floor is at 0)."""
 RAY_TOP = 3.0
-"""Rays start above everything in the home (walls 1 m, the person 1.66 m) and end below the floor."""
+"""Rays start above everything in the home (walls 1 m, the person 1.66 m) and end below the floor; a
+ceiling camera hung lower is seen through when the loaded base passes under it (:func:`overhead`)."""
 RAY_BATCH = 8192
 """pybullet caps one rayTestBatch call; stay well below the cap."""
 
@@ -102,7 +103,9 @@ def build_occupancy_grid(
     ignore: Sequence[str] | None = None,
 ) -> OccupancyGrid:
     """Measure the home's occupancy grid now; the bodies in ``ignore`` (by default the mobile base) are
-    seen through. Obstacles are inflated by ``inflation_radius``, by default the base's (``world.base_radius``)."""
+    seen through, and so is a ceiling camera's housing above what the loaded base reaches (:func:`overhead`:
+    one under a 2.7 m ceiling marked the floor below it occupied). Obstacles are
+    inflated by ``inflation_radius``, by default the base's (``world.base_radius``)."""
     if inflation_radius is None:
         inflation_radius = world.base_radius
     home = world.extent
@@ -115,6 +118,7 @@ def build_occupancy_grid(
     tops = np.full(xs.shape, RAY_TOP)
     heights = np.full(xs.shape, -1.0)
     ignored = [world.body(name) for name in (ignore if ignore is not None else (world.base_name,))]
+    ignored += [body for body in overhead(world) if body not in ignored]
     # A ray outside every other body's bounding box can only meet the floor: it is not cast.
     floor = world.bodies.get("Floor")
     standing = [body for body in world.bodies.values() if body != floor and body not in ignored]
@@ -144,6 +148,24 @@ def build_occupancy_grid(
     # An obstacle may reach the edge of its cell, half a cell nearer than the cell's centre.
     radius_cells = (inflation_radius + resolution / 2.0) / resolution
     return OccupancyGrid(resolution, origin, occupied, inflate(occupied, radius_cells), inflation_radius)
+
+
+def overhead(world: HomeWorld) -> list[int]:
+    """The housings of the cameras hung from the ceiling (on no robot) whose every part is higher than the
+    base reaches loaded (its platform's top and the tallest object of the map on it): no obstacle to it.
+    In the bundled home the ceiling cameras hang 4.5 m up, above the rays' start, and have no housing; a
+    lab's housing under a 2.7 m ceiling marked the floor below it occupied. What stands (furniture, walls)
+    or moves (the arms, which may come down) stays an obstacle wherever it reaches."""
+    clearance = (world.robot.platform_height or 0.0) + max((o.size[2] for o in world.objects.values()), default=0.0)
+    above = []
+    for camera in world.map.cameras.values():
+        body = world.bodies.get(camera.name)
+        if body is None or camera.mount is not None:
+            continue
+        links = range(-1, p.getNumJoints(body, physicsClientId=world.client))
+        if all(p.getAABB(body, link, physicsClientId=world.client)[0][2] > clearance for link in links):
+            above.append(body)
+    return above
 
 
 def _under_any(

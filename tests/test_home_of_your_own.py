@@ -80,6 +80,26 @@ def test_the_simulation_builds_the_flat_and_the_base_can_drive_to_the_worktop(fl
     assert any(4.8 < x < 5.2 and 1.2 < y < 2.2 for x, y in path.waypoints) or path.length > 3.0
 
 
+def test_a_ceiling_camera_housing_under_a_low_ceiling_is_no_obstacle_on_the_grid(tmp_path: Path) -> None:
+    """The grid's rays start 3 m up, above the bundled home's cameras (4.5 m, no housing); a housing the
+    flat's camera is given at 2.55 m marked the floor under it occupied, across the way to the worktop."""
+    (tmp_path / "home.ttl").write_text(
+        _variant(
+            "svc:CeilingCamera02 home:x 6.2 ; home:y 2.0 ; home:z 2.7 ; home:fieldOfView 90.0 .",
+            "svc:CeilingCamera02 home:x 6.2 ; home:y 2.0 ; home:z 2.55 ; home:fieldOfView 90.0 ; "
+            "home:sizeX 0.12 ; home:sizeY 0.12 ; home:sizeZ 0.08 .",
+        ),
+        encoding="utf-8",
+    )
+    kb = KnowledgeBase.open(":memory:")
+    kb.load([tmp_path / "home.ttl"], graph="map", replace=True)
+    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
+        assert "CeilingCamera02" in world.bodies
+        grid = build_occupancy_grid(world)
+        seen = build_occupancy_grid(world, ignore=())  # the base no longer seen through: the housing still is
+    assert not grid.is_occupied(6.2, 2.0) and not seen.is_occupied(6.2, 2.0)
+
+
 def test_the_ceiling_camera_of_the_flat_locates_the_base_where_the_flat_starts_it(flat_store: str) -> None:
     kb = KnowledgeBase.open(flat_store)
     with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
