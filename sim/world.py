@@ -612,7 +612,10 @@ class HomeWorld:
         p.setAdditionalSearchPath(PYBULLET_DATA, physicsClientId=c)
         if self.gui:
             p.configureDebugVisualizer(p.COV_ENABLE_GUI, 0, physicsClientId=c)
-            p.resetDebugVisualizerCamera(9.0, 0.0, -60.0, (5.0, 4.0, 0.0), physicsClientId=c)
+            home = self.map.extent()  # the window looks at the whole home, whatever its size (was the bundled one's)
+            middle = ((home.min_x + home.max_x) / 2, (home.min_y + home.max_y) / 2, 0.0)
+            span = max(home.max_x - home.min_x, home.max_y - home.min_y)
+            p.resetDebugVisualizerCamera(0.9 * span, 0.0, -60.0, middle, physicsClientId=c)
         render = p.COV_ENABLE_RENDERING
         if self.gui:
             p.configureDebugVisualizer(render, 0, physicsClientId=c)
