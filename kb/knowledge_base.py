@@ -164,15 +164,26 @@ class KnowledgeBase:
         (:func:`kb.home_check.check_home`), or nothing is written. Unlike a load that adds, the map is
         whole at once, so an empty or partial one is no step of a build: an emptied map is the bundled
         one again on the next open."""
+        read = read_files(paths, GraphName.MAP, catalogue, progress)
+        problem = self._home_problem(read.quads())
+        if problem is not None:
+            problem.add_note(
+                f"nothing was loaded from {', '.join(map(str, read.paths))} and the map is as it was (a map "
+                "that replaces the home is checked as the simulation builds it)"
+            )
+            raise problem
+        return read
+
+    def _home_problem(self, home: Sequence[ox.Quad]) -> Exception | None:
+        """Why ``home``, as the whole of graph:map, is no home the simulation can build (None: it is one),
+        read with the store's ontology and the classes its things have in other graphs."""
         from cbrs.kb.home_check import check_home
         from cbrs.kb.semantic_map import MapError, SemanticMap  # they import this module
 
-        read = read_files(paths, GraphName.MAP, catalogue, progress)
-        home = read.quads()
         scratch = ox.Store()
         for graph in (GraphName.ONTOLOGY, GraphName.ENTAILED):
             scratch.extend(self.store.quads(graph=graph.node))
-        scratch.extend(home)
+        scratch.extend(ox.Quad(q.subject, q.predicate, q.object, GraphName.MAP.node) for q in home)
         for subject in {quad.subject for quad in home if isinstance(quad.subject, ox.NamedNode)}:
             # the class a thing of the map has where it is described (a robot's, in graph:services)
             stated = self.store.quads(subject, _TYPE, None, None)
@@ -180,12 +191,8 @@ class KnowledgeBase:
         try:
             check_home(SemanticMap.read(KnowledgeBase(EmbeddedStore(scratch, MEMORY), self.queries)))
         except MapError as problem:
-            problem.add_note(
-                f"nothing was loaded from {', '.join(map(str, read.paths))} and the map is as it was (a map "
-                "that replaces the home is checked as the simulation builds it)"
-            )
-            raise
-        return read
+            return problem
+        return None
 
     def check_map_write(self, added: Sequence[ox.Quad], replaces_map: bool = False) -> None:
         """Refuse a write of ``added`` that would leave a readable semantic map unreadable, with the map
@@ -195,9 +202,17 @@ class KnowledgeBase:
         that do not go through :meth:`load` or :meth:`update` (the Graph Store Protocol's PUT and POST)."""
         if not any(quad.graph_name == GraphName.MAP.node for quad in added):
             return  # (a map emptied by a PUT is left as an emptied one is: the next open puts the bundled one back)
+        if replaces_map:  # the whole home at once, as a load with replace (:meth:`_check_new_home`)
+            problem = self._home_problem([quad for quad in added if quad.graph_name == GraphName.MAP.node])
+            if problem is not None:
+                problem.add_note(
+                    "nothing was written (a map that replaces the home is checked as the simulation builds it)"
+                )
+                raise problem
+            return
         if next(iter(self.store.quads(graph=GraphName.MAP.node)), None) is None or not self._stored_map_reads():
             return
-        problem = self._map_problem(list(added), keep_map=not replaces_map)
+        problem = self._map_problem(list(added))
         if problem is not None:
             problem.add_note("nothing was written (a write into graph:map is checked as a task reads the map)")
             raise problem
@@ -223,16 +238,14 @@ class KnowledgeBase:
             return self._map_read[1]
         return None
 
-    def _map_problem(self, added: list[ox.Quad], keep_map: bool = True) -> Exception | None:
-        """What reading the semantic map says would be wrong with it with ``added`` in the store (and, unless
-        ``keep_map``, nothing else in graph:map), or None: read from a scratch copy, in memory, of the graphs
-        the reader asks (ontology, map, entailed)."""
+    def _map_problem(self, added: list[ox.Quad]) -> Exception | None:
+        """What reading the semantic map says would be wrong with it with ``added`` in the store, or None:
+        read from a scratch copy, in memory, of the graphs the reader asks (ontology, map, entailed)."""
         from cbrs.kb.semantic_map import MapError, SemanticMap  # it imports this module
 
         scratch = ox.Store()
         for graph in (GraphName.ONTOLOGY, GraphName.MAP, GraphName.ENTAILED):
-            if keep_map or graph is not GraphName.MAP:
-                scratch.extend(self.store.quads(graph=graph.node))
+            scratch.extend(self.store.quads(graph=graph.node))
         scratch.extend(added)
         try:
             SemanticMap.read(KnowledgeBase(EmbeddedStore(scratch, MEMORY), self.queries))
