@@ -166,8 +166,8 @@ def test_run_task_streams_progress_and_ends_succeeded(server: Server) -> None:
 
 
 def test_run_task_without_waiting_then_status_and_one_at_a_time(server: Server) -> None:
-    with bridge(server, TOKEN) as ws:
-        started = call(ws, "/cbrs/run_task", {"task": "RobotArmServeACup", "wait": False})
+    with bridge(server, TOKEN) as ws:  # a one-step task: its world takes a second to build, long enough to be busy
+        started = call(ws, "/cbrs/run_task", {"task": "FindCupOnTable", "wait": False})
         assert started["result"] is True
         run_id = started["values"]["id"]
         busy = call(ws, "/cbrs/run_task", {"task": "FetchMyPen", "wait": False})
