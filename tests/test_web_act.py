@@ -186,6 +186,15 @@ def test_a_started_run_succeeds_and_a_second_is_refused_while_it_goes(live: tupl
     assert any(e["event"] == "step_failed" and e.get("failover") for e in run["events"] if "event" in e)
     failed_over = [s for s in run["steps"] if s["failed_over"]]
     assert failed_over and failed_over[0]["tried"][-1] == expand("svc:LocateMobileRobot_CeilingCamera02")
+    # the failed localiser fails over to the other camera, which the later localisation takes directly
+    cam1, cam2 = expand(CAMERA), expand("svc:LocateMobileRobot_CeilingCamera02")
+    located = [s for s in run["result"]["execution"]["steps"] if s["planned"] == cam1]
+    assert len(located) == 2
+    first, second = located
+    assert [(a["component"], a["outcome"]) for a in first["attempts"]] == [(cam1, "failed"), (cam2, "succeeded")]
+    assert "injected failure" in first["attempts"][0]["reason"]
+    assert [a["component"] for a in second["attempts"]] == [cam2]  # the broken camera is not tried again
+    assert first["failover"] and second["failover"]
     assert len(run["steps"]) == len(run["result"]["plan"]["steps"])
     listing = client.get("/tasks.json").get_json()
     assert listing["runs"][0]["id"] == run_id and listing["runs"][0]["url"] == f"/tasks/{run_id}"
