@@ -191,15 +191,21 @@ def test_unknown_suffix_and_missing_video_writer_are_usage_errors(
     assert path_map_name(Path("out/run.gif")) == Path("out/run-path.png")
 
 
+@pytest.fixture(scope="module")
+def demo() -> Recorder:
+    """A second of the home recorded once; each video test writes it in its own format."""
+    with open_world(seed=0) as built, Recorder(built, title="Demo") as recorder:
+        recorder.on_event(progress("step_started", 1, "Wait_Somebody"))
+        built.step(1.0)
+        recorder.on_event(progress("step_succeeded", 1, "Wait_Somebody"))
+    return recorder
+
+
 @pytest.mark.skipif(find_ffmpeg() is None, reason="no ffmpeg: pip install 'cbrs[video]' to test video recordings")
 @pytest.mark.parametrize("suffix", [".mp4", ".webm"])
-def test_videos_are_written_with_ffmpeg(world: HomeWorld, tmp_path: Path, suffix: str) -> None:
-    with Recorder(world, title="Demo") as recorder:
-        recorder.on_event(progress("step_started", 1, "Wait_Somebody"))
-        world.step(1.0)
-        recorder.on_event(progress("step_succeeded", 1, "Wait_Somebody"))
+def test_videos_are_written_with_ffmpeg(demo: Recorder, tmp_path: Path, suffix: str) -> None:
     target = tmp_path / f"demo{suffix}"
-    recorder.save(target)
+    demo.save(target)
     ffmpeg = find_ffmpeg()
     assert ffmpeg is not None
     first = subprocess.run(
