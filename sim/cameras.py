@@ -8,7 +8,6 @@ from pybullet's non-linear depth buffer.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Hashable
 from dataclasses import dataclass, field, replace
 from typing import Any, Protocol
@@ -17,6 +16,7 @@ import numpy as np
 import pybullet as p
 from numpy.typing import NDArray
 
+from cbrs.kb.camera_view import focal_length
 from cbrs.sim.errors import CameraUnavailableError
 from cbrs.sim.layout import CameraSpec
 
@@ -42,7 +42,7 @@ class Intrinsics:
     @classmethod
     def from_fov(cls, width: int, height: int, fov_deg: float) -> Intrinsics:
         """Intrinsics of pybullet's projection for a vertical field of view and the image's aspect ratio."""
-        f = (height / 2.0) / math.tan(math.radians(fov_deg) / 2.0)
+        f = focal_length(height, fov_deg)
         return cls(width, height, f, f, width / 2.0, height / 2.0)
 
 

@@ -20,6 +20,7 @@ from types import TracebackType
 import numpy as np
 import pybullet as p
 
+from cbrs.kb.camera_view import default_image_size, image_up
 from cbrs.kb.hands import PANDA_HAND
 from cbrs.kb.home_check import check_home
 from cbrs.kb.namespaces import PREFIXES
@@ -205,7 +206,7 @@ class HomeWorld:
         self.map = semantic_map if semantic_map is not None else bundled_map()
         _check_colours(self.map)
         self.image_sizes = _image_sizes(self.map, image_sizes or {})
-        """Each camera's image width and height in pixels (``layout.DOWNWARD_IMAGE_SIZE`` and
+        """Each camera's image width and height in pixels (``kb.camera_view.DOWNWARD_IMAGE_SIZE`` and
         ``OTHER_IMAGE_SIZE`` unless ``image_sizes`` named the camera)."""
         self.objects: dict[str, MapObject] = {obj.name: obj for obj in self.map.objects.values()}
         """The movable objects by body name (the local name of their IRI)."""
@@ -629,8 +630,7 @@ class HomeWorld:
             cam = self.map.cameras[iri]
             direction = cam.direction
             target = tuple(e + d for e, d in zip(cam.position, direction, strict=True))
-            # looking straight down, the top of the image faces the camera's yaw; otherwise up is up
-            up = (math.cos(cam.yaw), math.sin(cam.yaw), 0.0) if cam.looks_down else (0.0, 0.0, 1.0)
+            up = image_up(cam)  # looking straight down, the top of the image faces the camera's yaw
             width, height = self.image_sizes[cam.name]
             spec = CameraSpec(
                 cam.name,
@@ -969,8 +969,7 @@ def _image_sizes(semantic_map: SemanticMap, given: Mapping[str, tuple[int, int]]
             raise ImageSizeError(name, size)
     sizes = {}
     for name, cam in cameras.items():
-        default = L.DOWNWARD_IMAGE_SIZE if cam.looks_down else L.OTHER_IMAGE_SIZE
-        width, height = given.get(name, default)
+        width, height = given.get(name, default_image_size(cam))
         sizes[name] = (int(width), int(height))
     return sizes
 
