@@ -54,6 +54,11 @@ from cbrs.sparql_hints import explain_syntax_error
 # first paragraph of their help, kept here (tests/test_scale.py checks it against the commands).
 _LAZY_COMMANDS: dict[str, tuple[str, str, str]] = {
     "eval": ("cbrs.cli_reasoner", "eval_group", "Evaluate the matching methods on a test collection."),
+    "home": (
+        "cbrs.cli_home",
+        "home",
+        "Summarise the home of the semantic map (graph:map) and check it as the simulation builds it.",
+    ),
     "match": (
         "cbrs.cli_reasoner",
         "match",

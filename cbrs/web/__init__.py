@@ -35,6 +35,7 @@ PAGES: tuple[tuple[str, str, str], ...] = (
     ("editor", "editor.editor", "SPARQL"),
     ("matchmaking", "matchmaking.matchmaking", "Matchmaking"),
     ("plans", "plans.plans", "Plans"),
+    ("home", "home.home", "Home map"),
     ("tasks", "tasks.tasks", "Tasks"),
 )
 # Page blueprints reached from every page's header or from links, not from the navigation.

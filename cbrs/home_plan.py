@@ -1,0 +1,828 @@
+"""A picture of the home drawn from the store, before anything runs: the semantic map seen from above.
+
+The only top-down picture of a home was drawn after a simulated run (``cbrs run --record``), which
+needs pybullet; a lab building its own home (``cbrs load --graph map --replace``) wants to see what it
+wrote first. :func:`draw_home` draws a :class:`SemanticMap` as SVG text by hand (no matplotlib, no
+pybullet): rooms, walls, furniture with its top's height, appliances, objects by shape, size, yaw and
+colour, the mobile base with its heading and marker, the dual-arm robot with each arm's reach, the
+person, each camera and the floor a ceiling camera sees (:mod:`kb.camera_view`, the simulation's camera
+model), and docking poses. Where the world graph believes a thing is elsewhere than its start (after a
+run), the believed place is drawn too, with an arrow from the start. Each thing is a link to its page
+in the browser with a tooltip. :func:`survey` reads the map and checks it as the simulation would
+(:func:`kb.home_check.check_home`), so the browser's ``/home`` and ``cbrs home`` say what is wrong with
+a home instead of failing. docs/web.md, "The home".
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from html import escape
+from urllib.parse import quote
+
+from cbrs.kb.camera_view import floor_view
+from cbrs.kb.errors import KnowledgeBaseError
+from cbrs.kb.home_check import check_home
+from cbrs.kb.knowledge_base import KnowledgeBase
+from cbrs.kb.namespaces import RDFS, shorten
+from cbrs.kb.semantic_map import HOME, Box, MapObject, SemanticMap, Thing, local_name
+
+__all__ = ["DEFAULT_WIDTH", "MOVED", "Entry", "HomePicture", "HomeSurvey", "draw_home", "resource_link", "survey"]
+
+DEFAULT_WIDTH = 960
+"""Pixels across the picture; the height follows the home's shape."""
+MOVED = 0.05
+"""How far (m) the world graph must believe a thing to be from its start in the map for the picture to
+draw it at both places: less is the simulation's settling and a seed's scatter, not a move."""
+
+_MARGIN = 44  # px around the plan: the metre ticks on the left and below
+_PAD = 0.3  # m of floor shown around the outermost thing
+_LEGEND_ROW = 26
+_FONT = "DejaVu Sans, Helvetica, Arial, sans-serif"
+_INK, _MUTED = "#1d2330", "#5d6778"
+_ROOM_FILLS = ("#eaf2fb", "#f1edf9", "#eaf6ee", "#fbf3e6", "#f8ebf0", "#e8f5f5")
+_CAMERA_INKS = ("#c2410c", "#7c3aed", "#0e7490", "#be185d", "#4d7c0f")
+_FURNITURE = ("#ead8b9", "#8a5a2b")
+_APPLIANCE = ("#d5dde8", "#4b5563")
+_ROBOT = ("#b9cbe4", "#2f4f7a")
+_BASE = ("#5b6b82", "#1d2330")
+_DOCK = "#1a7f37"
+_BELIEF = "#b42318"
+_PERSON_PX = 9.0  # the person is drawn as a mark, not to scale: the map gives no body's size
+
+
+def resource_link(iri: str) -> str:
+    """The browser's page of ``iri`` (``/resource?iri=``), relative to the server's root."""
+    return "/resource?iri=" + quote(iri, safe="")
+
+
+@dataclass(frozen=True)
+class Entry:
+    """One thing of the picture, as the table under it lists it."""
+
+    iri: str
+    name: str
+    kind: str
+    classes: tuple[str, ...]
+    where: str
+    room: str | None = None
+    believed: tuple[float, float] | None = None
+
+    def to_dict(self) -> dict[str, object]:
+        return {
+            "iri": self.iri,
+            "name": self.name,
+            "kind": self.kind,
+            "classes": list(self.classes),
+            "where": self.where,
+            "room": self.room,
+            "believed": list(self.believed) if self.believed else None,
+        }
+
+
+@dataclass(frozen=True)
+class HomePicture:
+    svg: str
+    width: int
+    height: int
+    entries: tuple[Entry, ...]
+
+
+@dataclass(frozen=True)
+class HomeSurvey:
+    """What the store says of the home: the map (None when it cannot be read), the problem that stops
+    the simulation building it (unreadable, or refused by the home check), and the world graph's
+    believed positions (x, y) by IRI."""
+
+    semantic_map: SemanticMap | None
+    problem: KnowledgeBaseError | None
+    believed: dict[str, tuple[float, float]] = field(default_factory=dict)
+
+    @property
+    def verdict(self) -> str:
+        if self.semantic_map is None:
+            return "unreadable"
+        return "refused" if self.problem is not None else "ok"
+
+    def counts(self) -> dict[str, int]:
+        smap = self.semantic_map
+        if smap is None:
+            return {}
+        return {
+            "rooms": len(smap.rooms & smap.things.keys()),
+            "walls": len(smap.walls & smap.things.keys()),
+            "furniture": len(smap.furniture & smap.things.keys()),
+            "objects": len(smap.objects),
+            "mobile robots": len(smap.robots),
+            "dual-arm robots": len(_bodies(smap)),
+            "arms": len(smap.arms),
+            "people": len(smap.people),
+            "cameras": len(smap.cameras),
+            "docking poses": sum(1 for thing in smap.things.values() if thing.dock is not None),
+        }
+
+
+def survey(kb: KnowledgeBase) -> HomeSurvey:
+    """Read the map and check it as the simulation builds the home; a map that cannot be read or built
+    is reported, not raised, so that its picture or its message can be shown."""
+    try:
+        smap = SemanticMap.read(kb)
+    except KnowledgeBaseError as error:
+        return HomeSurvey(None, error)
+    believed = {
+        row["thing"].value: (float(row["x"].value), float(row["y"].value)) for row in kb.select("world_positions")
+    }
+    try:
+        check_home(smap)
+    except KnowledgeBaseError as error:
+        return HomeSurvey(smap, error, believed)
+    return HomeSurvey(smap, None, believed)
+
+
+# -- the drawing ------------------------------------------------------------------------------------
+
+
+@dataclass
+class _Canvas:
+    """Metres to pixels: x to the right, y up (the SVG's y runs down), ``scale`` px a metre."""
+
+    extent: Box
+    scale: float
+    left: float = _MARGIN
+    top: float = 16.0
+    taken: list[tuple[float, float, float, float]] = field(default_factory=list)
+    """Pixel boxes (left, top, right, bottom) labels keep off: other labels, furniture, robots, marks."""
+
+    def x(self, x: float) -> float:
+        return self.left + (x - self.extent.min_x) * self.scale
+
+    def y(self, y: float) -> float:
+        return self.top + (self.extent.max_y - y) * self.scale
+
+    def point(self, x: float, y: float) -> str:
+        return f"{self.x(x):.1f},{self.y(y):.1f}"
+
+    def rect(self, box: Box, **attributes: object) -> str:
+        x, y = self.x(box.min_x), self.y(box.max_y)
+        w, h = (box.max_x - box.min_x) * self.scale, (box.max_y - box.min_y) * self.scale
+        return f'<rect x="{x:.1f}" y="{y:.1f}" width="{w:.1f}" height="{h:.1f}"{_attributes(attributes)}/>'
+
+    def polygon(self, points: list[tuple[float, float]], **attributes: object) -> str:
+        shown = " ".join(self.point(px, py) for px, py in points)
+        return f'<polygon points="{shown}"{_attributes(attributes)}/>'
+
+    def block(self, left: float, top: float, right: float, bottom: float) -> None:
+        self.taken.append((left, top, right, bottom))
+
+    def block_box(self, box: Box) -> None:
+        self.block(self.x(box.min_x), self.y(box.max_y), self.x(box.max_x), self.y(box.min_y))
+
+    def label(self, px: float, py: float, gap: float, text: str, size: float = 11, **attributes: object) -> str:
+        """``text`` beside the mark at pixel (``px``, ``py``) of radius ``gap``: below it, else above, right
+        or left, the first place no other label or blocked box takes (below when none is free)."""
+        width, height = _CHAR * size * len(text), size
+        spots = (
+            (px, py + gap + size + 1, "middle"),
+            (px, py - gap - 4, "middle"),
+            (px + gap + 4, py + size / 2 - 1, "start"),
+            (px - gap - 4, py + size / 2 - 1, "end"),
+        )
+        chosen = spots[0]
+        for spot in spots:
+            if not any(_overlap(_text_box(spot, width, height), box) for box in self.taken):
+                chosen = spot
+                break
+        self.block(*_text_box(chosen, width, height))
+        return self.text(chosen[0], chosen[1], text, size, text_anchor=chosen[2], **attributes)
+
+    def text(self, x: float, y: float, text: str, size: float = 11, **attributes: object) -> str:
+        """``text`` at pixel (``x``, ``y``), escaped."""
+        attributes.setdefault("fill", _INK)
+        shown = escape(text, quote=False)
+        return f'<text x="{x:.1f}" y="{y:.1f}" font-size="{size:g}"{_attributes(attributes)}>{shown}</text>'
+
+
+_CHAR = 0.6  # a character's mean width, in font sizes
+
+
+def _text_box(spot: tuple[float, float, str], width: float, height: float) -> tuple[float, float, float, float]:
+    x, y, anchor = spot
+    left = x - width / 2 if anchor == "middle" else x - width if anchor == "end" else x
+    return (left, y - height, left + width, y + 2)
+
+
+def _overlap(a: tuple[float, float, float, float], b: tuple[float, float, float, float]) -> bool:
+    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
+
+
+def _attributes(attributes: dict[str, object]) -> str:
+    return "".join(f' {name.replace("_", "-")}="{escape(str(value))}"' for name, value in attributes.items())
+
+
+def _linked(href: str, title: str, body: list[str], kind: str) -> str:
+    """A thing of the picture: its shapes inside a link to its page, its tooltip the link's title."""
+    return (
+        f'<a href="{escape(href)}" class="home-{kind}"><title>{escape(title, quote=False)}</title>'
+        + "".join(body)
+        + "</a>"
+    )
+
+
+def draw_home(
+    semantic_map: SemanticMap,
+    believed: dict[str, tuple[float, float]] | None = None,
+    width: int = DEFAULT_WIDTH,
+    link: Callable[[str], str] = resource_link,
+    moved: float = MOVED,
+) -> HomePicture:
+    """The home from above as SVG text, ``width`` pixels across, and the things drawn; ``believed``
+    gives where the world graph believes things are (x, y by IRI), drawn where they are ``moved`` or
+    more from their start; ``link`` gives each thing's address."""
+    smap, believed = semantic_map, believed or {}
+    extent = _extent(smap, believed)
+    scale = (width - 2 * _MARGIN) / max(extent.max_x - extent.min_x, 0.5)
+    canvas = _Canvas(extent, scale)
+    plan_height = (extent.max_y - extent.min_y) * scale
+    entries: list[Entry] = []
+    layers: list[Iterator[str]] = [
+        _grid(canvas),
+        _rooms(canvas, smap, link, entries),
+        _walls(canvas, smap, link, entries),
+        _cameras_views(canvas, smap, link),
+        _furniture(canvas, smap, link, entries),
+        _robot_bodies(canvas, smap, link, entries),
+        _docks(canvas, smap, link, entries),
+        _objects(canvas, smap, link, entries, believed, moved),
+        _mobile_robots(canvas, smap, link, entries, believed, moved),
+        _people(canvas, smap, link, entries, believed, moved),
+        _cameras(canvas, smap, link, entries),
+    ]
+    body = [part for layer in layers for part in layer]
+    legend_top = canvas.top + plan_height + 84
+    legend, legend_height = _legend(canvas, legend_top, width)
+    height = int(legend_top + legend_height + 8)
+    rooms = ", ".join(_name(smap, iri) for iri in sorted(smap.rooms) if iri in smap.things)
+    svg = "".join(
+        [
+            f'<svg xmlns="http://www.w3.org/2000/svg" class="home-plan" width="{width}" height="{height}" '
+            f'viewBox="0 0 {width} {height}" font-family="{_FONT}" aria-labelledby="home-plan-title home-plan-desc">',
+            '<title id="home-plan-title">The home from above, from the semantic map</title>',
+            f'<desc id="home-plan-desc">{escape(_description(smap, rooms), quote=False)}</desc>',
+            _defs(canvas),
+            f'<rect width="{width}" height="{height}" fill="#ffffff"/>',
+            *body,
+            *_scale_bar(canvas, canvas.top + plan_height + 44),
+            *legend,
+            "</svg>",
+        ]
+    )
+    return HomePicture(svg, width, height, tuple(entries))
+
+
+def _description(smap: SemanticMap, rooms: str) -> str:
+    return (
+        f"{len(smap.rooms)} rooms ({rooms}), {len(smap.furniture)} pieces of furniture, {len(smap.objects)} objects, "
+        f"{len(smap.robots) + len(_bodies(smap))} robots, {len(smap.people)} people and {len(smap.cameras)} cameras; "
+        "x to the east (right), y to the north (up), in metres."
+    )
+
+
+def _defs(canvas: _Canvas) -> str:
+    e = canvas.extent
+    return (
+        "<defs>"
+        f'<clipPath id="home-plan-floor">{canvas.rect(e)}</clipPath>'
+        '<marker id="home-plan-arrow" viewBox="0 0 10 10" refX="9" refY="5" markerWidth="7" markerHeight="7" '
+        f'orient="auto-start-reverse"><path d="M0,0 L10,5 L0,10 z" fill="{_BELIEF}"/></marker>'
+        "</defs>"
+    )
+
+
+def _extent(smap: SemanticMap, believed: dict[str, tuple[float, float]]) -> Box:
+    """The box around every thing drawn (not around the cameras' views), with some floor around it."""
+    xs: list[float] = []
+    ys: list[float] = []
+    for thing in smap.things.values():
+        xs += [thing.box.min_x, thing.box.max_x]
+        ys += [thing.box.min_y, thing.box.max_y]
+    points = [(o.start.x, o.start.y) for o in smap.objects.values()]
+    points += [(r.start.x, r.start.y) for r in smap.robots.values()]
+    points += [(p.start.x, p.start.y) for p in smap.people.values()]
+    points += [(c.position[0], c.position[1]) for c in smap.cameras.values()]
+    points += [(a.mount[0], a.mount[1]) for a in smap.arms.values()]
+    points += [(t.dock.x, t.dock.y) for t in smap.things.values() if t.dock is not None]
+    points += [where for iri, where in believed.items() if _drawn_at(smap, iri) is not None]
+    xs += [x for x, _ in points]
+    ys += [y for _, y in points]
+    if not xs:
+        return Box(-1.0, 1.0, -1.0, 1.0)
+    return Box(min(xs) - _PAD, max(xs) + _PAD, min(ys) - _PAD, max(ys) + _PAD)
+
+
+def _drawn_at(smap: SemanticMap, iri: str) -> tuple[float, float] | None:
+    """The start of a thing that moves (an object, a mobile robot, a person), None for any other."""
+    for group in (smap.objects, smap.robots, smap.people):
+        if iri in group:
+            start = group[iri].start
+            return start.x, start.y
+    return None
+
+
+def _name(smap: SemanticMap, iri: str) -> str:
+    return local_name(iri)
+
+
+def _label(smap: SemanticMap, iri: str) -> str:
+    """The thing's name, with its rdfs:label where the map gives one."""
+    labels = smap.facts.get(iri, {}).get(RDFS + "label", [])
+    return f"{local_name(iri)} ({labels[0]})" if labels else local_name(iri)
+
+
+def _classes(smap: SemanticMap, iri: str) -> tuple[str, ...]:
+    return tuple(shorten(t) for t in smap.types.get(iri, ()))
+
+
+def _room_of(smap: SemanticMap, x: float, y: float) -> str | None:
+    for iri in sorted(smap.rooms):
+        thing = smap.things.get(iri)
+        if thing is not None and thing.box.contains_xy(x, y):
+            return local_name(iri)
+    return None
+
+
+def _span(box: Box) -> str:
+    return f"x {box.min_x:g} to {box.max_x:g}, y {box.min_y:g} to {box.max_y:g}"
+
+
+def _bodies(smap: SemanticMap) -> list[Thing]:
+    """The robots with a body of their own on the floor (the dual-arm robot's torso)."""
+    return [smap.things[iri] for iri in sorted(smap.bodies) if iri in smap.things and iri not in smap.robots]
+
+
+def _grid(canvas: _Canvas) -> Iterator[str]:
+    """Faint metre lines under the plan, numbered along its left and bottom edges."""
+    e = canvas.extent
+    step = 1.0 if (e.max_x - e.min_x) <= 16 else 2.0
+    yield '<g stroke="#eef0f3" stroke-width="1">'
+    lines: list[tuple[float | None, float | None]] = []
+    x = math.ceil(e.min_x / step) * step
+    while x <= e.max_x:
+        lines.append((x, None))
+        x += step
+    y = math.ceil(e.min_y / step) * step
+    while y <= e.max_y:
+        lines.append((None, y))
+        y += step
+    labels = []
+    for gx, gy in lines:
+        if gx is not None:
+            px = canvas.x(gx)
+            yield f'<line x1="{px:.1f}" y1="{canvas.y(e.max_y):.1f}" x2="{px:.1f}" y2="{canvas.y(e.min_y):.1f}"/>'
+            labels.append(canvas.text(px, canvas.y(e.min_y) + 14, f"{gx:g}", 10, fill=_MUTED, text_anchor="middle"))
+        elif gy is not None:
+            py = canvas.y(gy)
+            yield f'<line x1="{canvas.x(e.min_x):.1f}" y1="{py:.1f}" x2="{canvas.x(e.max_x):.1f}" y2="{py:.1f}"/>'
+            labels.append(canvas.text(canvas.x(e.min_x) - 6, py + 3.5, f"{gy:g}", 10, fill=_MUTED, text_anchor="end"))
+    yield "</g>"
+    yield from labels
+
+
+def _rooms(canvas: _Canvas, smap: SemanticMap, link: Callable[[str], str], entries: list[Entry]) -> Iterator[str]:
+    for index, iri in enumerate(sorted(iri for iri in smap.rooms if iri in smap.things)):
+        box = smap.things[iri].box
+        classes = _classes(smap, iri)
+        kind = ", ".join(classes) or "room"
+        x, y = canvas.x(box.min_x) + 8, canvas.y(box.max_y) + 20
+        body = [
+            canvas.rect(box, fill=_ROOM_FILLS[index % len(_ROOM_FILLS)], stroke="#9aa7b8", stroke_width=1),
+            canvas.text(x, y, local_name(iri), 14, font_weight="bold"),
+            canvas.text(x, y + 15, kind, 11, fill=_MUTED),
+        ]
+        yield _linked(link(iri), f"{_label(smap, iri)}: {kind}, {_span(box)}", body, "room")
+        entries.append(Entry(iri, local_name(iri), "room", classes, _span(box)))
+
+
+def _walls(canvas: _Canvas, smap: SemanticMap, link: Callable[[str], str], entries: list[Entry]) -> Iterator[str]:
+    for iri in sorted(iri for iri in smap.walls if iri in smap.things):
+        box = smap.things[iri].box
+        where = f"{_span(box)}, {box.max_z - box.min_z:g} m high"
+        yield _linked(link(iri), f"{_label(smap, iri)}: wall, {where}", [canvas.rect(box, fill="#4b5563")], "wall")
+        entries.append(Entry(iri, local_name(iri), "wall", _classes(smap, iri), where))
+
+
+def _furniture(canvas: _Canvas, smap: SemanticMap, link: Callable[[str], str], entries: list[Entry]) -> Iterator[str]:
+    appliances = {d.iri for d in smap.dispensers.values()}
+    for iri in sorted(iri for iri in smap.furniture | appliances if iri in smap.things):
+        thing = smap.things[iri]
+        box = thing.box
+        appliance = iri in appliances and iri not in smap.furniture
+        fill, stroke = _APPLIANCE if appliance else _FURNITURE
+        where = f"{_span(box)}, top at {box.max_z:g} m"
+        body = [canvas.rect(box, fill=fill, stroke=stroke, stroke_width=1.2)]
+        canvas.block_box(box)
+        if appliance:
+            outlet = smap.dispensers[iri].outlet
+            body.append(_dot(canvas, outlet[0], outlet[1], 2.5, "#0e7490"))
+            where += f", water leaves at ({outlet[0]:g}, {outlet[1]:g}, {outlet[2]:g})"
+        else:
+            cx = canvas.x((box.min_x + box.max_x) / 2)
+            top = canvas.y(box.max_y)
+            body.append(canvas.text(cx, top + 14, local_name(iri), 11, text_anchor="middle", font_weight="bold"))
+            body.append(canvas.text(cx, top + 27, f"top {box.max_z:g} m", 10, fill=_MUTED, text_anchor="middle"))
+        kind = "appliance" if appliance else "furniture"
+        support = smap.facts.get(iri, {}).get(HOME + "isLocatedOn", [])
+        if support:
+            where += f", on {local_name(support[0])}"
+        yield _linked(link(iri), f"{_label(smap, iri)}: {kind}, {where}", body, kind)
+        centre = box.centre
+        entries.append(Entry(iri, local_name(iri), kind, _classes(smap, iri), where, _room_of(smap, *centre[:2])))
+
+
+def _robot_bodies(
+    canvas: _Canvas, smap: SemanticMap, link: Callable[[str], str], entries: list[Entry]
+) -> Iterator[str]:
+    arms_of: dict[str, list[str]] = {}
+    for arm in smap.arms.values():
+        arms_of.setdefault(arm.robot, []).append(arm.iri)
+    for thing in _bodies(smap):
+        box = thing.box
+        canvas.block_box(box)
+        cx, cy = canvas.x(box.centre[0]), canvas.y(box.centre[1])
+        half = (box.max_y - box.min_y) / 2 * canvas.scale
+        body = [
+            canvas.rect(box, fill=_ROBOT[0], stroke=_ROBOT[1], stroke_width=1.5),
+            canvas.label(cx, cy, half + 1, thing.name, 11, font_weight="bold", fill=_ROBOT[1]),
+        ]
+        where = f"{_span(box)}, {box.max_z:g} m high"
+        yield _linked(link(thing.iri), f"{_label(smap, thing.iri)}: robot, {where}", body, "robot")
+        entries.append(
+            Entry(thing.iri, thing.name, "robot", _classes(smap, thing.iri), where, _room_of(smap, *box.centre[:2]))
+        )
+    for iri in sorted(smap.arms):
+        arm = smap.arms[iri]
+        mx, my, mz = arm.mount
+        r = arm.reach * canvas.scale
+        tip = (mx + 0.12 * math.cos(arm.yaw), my + 0.12 * math.sin(arm.yaw))
+        body = [
+            f'<circle cx="{canvas.x(mx):.1f}" cy="{canvas.y(my):.1f}" r="{r:.1f}" fill="{_ROBOT[1]}" '
+            f'fill-opacity="0.05" stroke="{_ROBOT[1]}" stroke-width="1" stroke-dasharray="5 4"/>',
+            f'<line x1="{canvas.x(mx):.1f}" y1="{canvas.y(my):.1f}" x2="{canvas.x(tip[0]):.1f}" '
+            f'y2="{canvas.y(tip[1]):.1f}" stroke="{_ROBOT[1]}" stroke-width="2"/>',
+            _dot(canvas, mx, my, 4, _ROBOT[1]),
+            canvas.text(
+                canvas.x(mx - 0.1 * math.cos(arm.yaw)),
+                canvas.y(my - 0.1 * math.sin(arm.yaw)) + 3.5,
+                arm.side[:1].upper(),
+                9,
+                text_anchor="middle",
+                fill=_ROBOT[1],
+                font_weight="bold",
+            ),
+        ]
+        where = f"mounted at ({mx:g}, {my:g}, {mz:g}), reaches {arm.reach:g} m"
+        title = f"{_label(smap, iri)}: {arm.side} arm of {local_name(arm.robot)}, {where}"
+        yield _linked(link(iri), title, body, "arm")
+        entries.append(Entry(iri, local_name(iri), "arm", _classes(smap, iri), where, _room_of(smap, mx, my)))
+
+
+def _docks(canvas: _Canvas, smap: SemanticMap, link: Callable[[str], str], entries: list[Entry]) -> Iterator[str]:
+    for iri in sorted(smap.things):
+        dock = smap.things[iri].dock
+        if dock is None:
+            continue
+        dock_iri = smap.facts.get(iri, {}).get(HOME + "dockingPose", [iri])[0]
+        body = [_arrow(canvas, dock.x, dock.y, dock.yaw, 0.32, _DOCK)]
+        where = f"({dock.x:g}, {dock.y:g}), heading {math.degrees(dock.yaw):.0f}°"
+        title = f"{_label(smap, dock_iri)}: where the mobile base parks at {local_name(iri)}, {where}"
+        yield _linked(link(dock_iri), title, body, "dock")
+        entries.append(
+            Entry(
+                dock_iri,
+                local_name(dock_iri),
+                "docking pose",
+                _classes(smap, dock_iri),
+                where,
+                _room_of(smap, dock.x, dock.y),
+            )
+        )
+
+
+def _objects(
+    canvas: _Canvas,
+    smap: SemanticMap,
+    link: Callable[[str], str],
+    entries: list[Entry],
+    believed: dict[str, tuple[float, float]],
+    moved: float,
+) -> Iterator[str]:
+    for iri in sorted(smap.objects):
+        obj = smap.objects[iri]
+        x, y = obj.start.x, obj.start.y
+        fill, opacity = _colour(obj.rgba)
+        body = [
+            _object_shape(
+                canvas, obj, x, y, {"fill": fill, "fill_opacity": opacity, "stroke": _INK, "stroke_width": 0.8}
+            )
+        ]
+        body.append(canvas.label(canvas.x(x), canvas.y(y), max(obj.size[:2]) / 2 * canvas.scale + 2, obj.name, 10))
+        size = " x ".join(f"{s * 100:g}" for s in obj.size)
+        where = f"({x:g}, {y:g})" + (f" on {local_name(obj.support)}" if obj.support else "")
+        kinds = ", ".join(_classes(smap, iri))
+        title = f"{_label(smap, iri)}: {kinds}, {obj.shape} {size} cm, {obj.colour or 'no colour'}, {where}"
+        there = _elsewhere(believed, iri, x, y, moved)
+        if there is not None:
+            body += _belief(canvas, (x, y), there, [_object_shape(canvas, obj, there[0], there[1], _GHOST)])
+            title += f"; believed at ({there[0]:.2f}, {there[1]:.2f})"
+        yield _linked(link(iri), title, body, "object")
+        entries.append(Entry(iri, obj.name, "object", _classes(smap, iri), where, _room_of(smap, x, y), there))
+
+
+_GHOST: dict[str, object] = {"fill": "none", "stroke": _BELIEF, "stroke_width": 1.5, "stroke_dasharray": "3 2"}
+
+
+def _object_shape(canvas: _Canvas, obj: MapObject, x: float, y: float, attributes: dict[str, object]) -> str:
+    """An object's footprint at (``x``, ``y``): a cylinder's circle, a box's rectangle turned by its yaw;
+    at least 3 px across, so that a pen stays visible."""
+    if obj.shape == "cylinder":
+        r = max(obj.size[0] / 2 * canvas.scale, 2.0)
+        return f'<circle cx="{canvas.x(x):.1f}" cy="{canvas.y(y):.1f}" r="{r:.1f}"{_attributes(attributes)}/>'
+    least = 3.0 / canvas.scale
+    length, width = max(obj.size[0], least), max(obj.size[1], least)
+    return canvas.polygon(_turned(x, y, obj.start.yaw, length, width), **attributes)
+
+
+def _turned(x: float, y: float, yaw: float, length: float, width: float) -> list[tuple[float, float]]:
+    c, s = math.cos(yaw), math.sin(yaw)
+    half = ((length / 2, width / 2), (-length / 2, width / 2), (-length / 2, -width / 2), (length / 2, -width / 2))
+    return [(x + c * u - s * v, y + s * u + c * v) for u, v in half]
+
+
+def _mobile_robots(
+    canvas: _Canvas,
+    smap: SemanticMap,
+    link: Callable[[str], str],
+    entries: list[Entry],
+    believed: dict[str, tuple[float, float]],
+    moved: float,
+) -> Iterator[str]:
+    for iri in sorted(smap.robots):
+        robot = smap.robots[iri]
+        x, y, yaw = robot.start.x, robot.start.y, robot.start.yaw
+        length, width = robot.footprint
+        body = [canvas.polygon(_turned(x, y, yaw, length, width), fill=_BASE[0], stroke=_BASE[1], stroke_width=1.5)]
+        if robot.marker is not None:
+            for sign, colour in ((1, robot.marker.front), (-1, robot.marker.rear)):
+                cx = x + sign * robot.marker.separation / 2 * math.cos(yaw)
+                cy = y + sign * robot.marker.separation / 2 * math.sin(yaw)
+                patch = _turned(cx, cy, yaw, *robot.marker.patch)
+                body.append(canvas.polygon(patch, fill=_css_colour(colour), stroke=_BASE[1], stroke_width=0.5))
+        body.append(_arrow(canvas, x, y, yaw, length * 0.9, "#ffffff", stroke_width=2.5))
+        reach = math.hypot(length, width) / 2 * canvas.scale
+        body.append(canvas.label(canvas.x(x), canvas.y(y), reach + 2, robot.name, 11, font_weight="bold"))
+        canvas.block(canvas.x(x) - reach, canvas.y(y) - reach, canvas.x(x) + reach, canvas.y(y) + reach)
+        where = f"starts at ({x:g}, {y:g}), heading {math.degrees(yaw):.0f}°, {length:g} x {width:g} m"
+        if robot.platform_height is not None:
+            where += f", platform at {robot.platform_height:g} m"
+        title = f"{_label(smap, iri)}: mobile robot, {where}"
+        there = _elsewhere(believed, iri, x, y, moved)
+        if there is not None:
+            ghost = canvas.polygon(_turned(*there, yaw, length, width), **_GHOST)
+            body += _belief(canvas, (x, y), there, [ghost])
+            title += f"; believed at ({there[0]:.2f}, {there[1]:.2f})"
+        yield _linked(link(iri), title, body, "base")
+        entries.append(Entry(iri, robot.name, "mobile robot", _classes(smap, iri), where, _room_of(smap, x, y), there))
+
+
+def _people(
+    canvas: _Canvas,
+    smap: SemanticMap,
+    link: Callable[[str], str],
+    entries: list[Entry],
+    believed: dict[str, tuple[float, float]],
+    moved: float,
+) -> Iterator[str]:
+    for iri in sorted(smap.people):
+        person = smap.people[iri]
+        x, y, yaw = person.start.x, person.start.y, person.start.yaw
+        fill, _ = _colour(person.rgba)
+        nose = (canvas.x(x) + 1.6 * _PERSON_PX * math.cos(yaw), canvas.y(y) - 1.6 * _PERSON_PX * math.sin(yaw))
+        body = [
+            f'<line x1="{canvas.x(x):.1f}" y1="{canvas.y(y):.1f}" x2="{nose[0]:.1f}" y2="{nose[1]:.1f}" '
+            f'stroke="{_INK}" stroke-width="2"/>',
+            _circle(canvas.x(x), canvas.y(y), _PERSON_PX, fill=fill, stroke=_INK, stroke_width=1.5),
+            _circle(canvas.x(x), canvas.y(y), _PERSON_PX / 2.4, fill="#f2d2b6", stroke=_INK, stroke_width=1),
+            canvas.label(canvas.x(x), canvas.y(y), _PERSON_PX + 2, person.name, 11, font_weight="bold"),
+        ]
+        canvas.block(
+            canvas.x(x) - _PERSON_PX, canvas.y(y) - _PERSON_PX, canvas.x(x) + _PERSON_PX, canvas.y(y) + _PERSON_PX
+        )
+        where = f"starts at ({x:g}, {y:g}), facing {math.degrees(yaw):.0f}°, {person.colour or 'no'} shirt"
+        title = f"{_label(smap, iri)}: person, {where}"
+        there = _elsewhere(believed, iri, x, y, moved)
+        if there is not None:
+            ghost = _circle(canvas.x(there[0]), canvas.y(there[1]), _PERSON_PX, **_GHOST)
+            body += _belief(canvas, (x, y), there, [ghost])
+            title += f"; believed at ({there[0]:.2f}, {there[1]:.2f})"
+        yield _linked(link(iri), title, body, "person")
+        entries.append(Entry(iri, person.name, "person", _classes(smap, iri), where, _room_of(smap, x, y), there))
+
+
+def _camera_ink(index: int) -> str:
+    return _CAMERA_INKS[index % len(_CAMERA_INKS)]
+
+
+def _cameras_views(canvas: _Canvas, smap: SemanticMap, link: Callable[[str], str]) -> Iterator[str]:
+    """The floor each camera looking down sees, under everything but the rooms and walls."""
+    for index, iri in enumerate(sorted(smap.cameras)):
+        camera = smap.cameras[iri]
+        corners = floor_view(camera)
+        if corners is None or not camera.looks_down:
+            continue
+        ink = _camera_ink(index)
+        shape = canvas.polygon(
+            corners,
+            fill="none",
+            stroke=ink,
+            stroke_width=2,
+            stroke_dasharray="8 5",
+            clip_path="url(#home-plan-floor)",
+        )
+        xs, ys = [c[0] for c in corners], [c[1] for c in corners]
+        title = (
+            f"what {camera.name} sees of the floor: x {min(xs):.2f} to {max(xs):.2f}, y {min(ys):.2f} to {max(ys):.2f}"
+        )
+        yield _linked(link(iri), title, [shape], "camera-view")
+
+
+def _cameras(canvas: _Canvas, smap: SemanticMap, link: Callable[[str], str], entries: list[Entry]) -> Iterator[str]:
+    for index, iri in enumerate(sorted(smap.cameras)):
+        camera = smap.cameras[iri]
+        x, y, z = camera.position
+        ink = _camera_ink(index) if camera.looks_down else _ROBOT[1]
+        px, py = canvas.x(x), canvas.y(y)
+        body = [
+            f'<rect x="{px - 7:.1f}" y="{py - 6:.1f}" width="14" height="12" rx="2" fill="{ink}" '
+            'stroke="#ffffff" stroke-width="1"/>',
+            f'<circle cx="{px:.1f}" cy="{py:.1f}" r="3.2" fill="#ffffff"/>',
+        ]
+        if not camera.looks_down:  # which way it looks, flat on the floor plan
+            dx, dy = math.cos(camera.yaw), math.sin(camera.yaw)
+            body.insert(
+                0,
+                f'<line x1="{px:.1f}" y1="{py:.1f}" x2="{px + 22 * dx:.1f}" y2="{py - 22 * dy:.1f}" '
+                f'stroke="{ink}" stroke-width="2"/>',
+            )
+        if camera.mount is None:  # one on a robot is named in its tooltip: the robot's own label is there
+            body.append(canvas.label(px, py, 8, camera.name, 11, fill=ink, font_weight="bold"))
+            canvas.block(px - 7, py - 6, px + 7, py + 6)
+        corners = floor_view(camera)
+        where = f"at ({x:g}, {y:g}, {z:g}), field of view {camera.fov:g}°"
+        if camera.looks_down:
+            where += ", looking straight down"
+            if corners is not None:
+                xs, ys = [c[0] for c in corners], [c[1] for c in corners]
+                where += f", sees the floor x {min(xs):.2f} to {max(xs):.2f}, y {min(ys):.2f} to {max(ys):.2f}"
+            else:
+                where += ", too high for its range to reach the floor"
+        if camera.mount:
+            where += f", on {local_name(camera.mount)}"
+        yield _linked(link(iri), f"{_label(smap, iri)}: camera {where}", body, "camera")
+        entries.append(Entry(iri, camera.name, "camera", _classes(smap, iri), where, _room_of(smap, x, y)))
+
+
+def _elsewhere(
+    believed: dict[str, tuple[float, float]], iri: str, x: float, y: float, moved: float
+) -> tuple[float, float] | None:
+    there = believed.get(iri)
+    if there is None or math.hypot(there[0] - x, there[1] - y) < moved:
+        return None
+    return there
+
+
+def _belief(canvas: _Canvas, start: tuple[float, float], there: tuple[float, float], ghost: list[str]) -> list[str]:
+    """An arrow from a thing's start to where it is believed to be, and its outline there."""
+    return [
+        f'<line x1="{canvas.x(start[0]):.1f}" y1="{canvas.y(start[1]):.1f}" x2="{canvas.x(there[0]):.1f}" '
+        f'y2="{canvas.y(there[1]):.1f}" stroke="{_BELIEF}" stroke-width="1.5" stroke-dasharray="6 3" '
+        'marker-end="url(#home-plan-arrow)" class="home-belief"/>',
+        *ghost,
+    ]
+
+
+def _circle(px: float, py: float, r: float, **attributes: object) -> str:
+    """A circle at pixel (``px``, ``py``)."""
+    return f'<circle cx="{px:.1f}" cy="{py:.1f}" r="{r:.1f}"{_attributes(attributes)}/>'
+
+
+def _dot(canvas: _Canvas, x: float, y: float, r: float, fill: str) -> str:
+    return f'<circle cx="{canvas.x(x):.1f}" cy="{canvas.y(y):.1f}" r="{r:g}" fill="{fill}"/>'
+
+
+def _arrow(canvas: _Canvas, x: float, y: float, yaw: float, length: float, ink: str, stroke_width: float = 2) -> str:
+    """An arrow of ``length`` m centred at (``x``, ``y``) pointing along ``yaw``."""
+    c, s = math.cos(yaw), math.sin(yaw)
+    tail = (x - c * length / 2, y - s * length / 2)
+    head = (x + c * length / 2, y + s * length / 2)
+    barb = length * 0.35
+    left = (head[0] - barb * math.cos(yaw - 0.5), head[1] - barb * math.sin(yaw - 0.5))
+    right = (head[0] - barb * math.cos(yaw + 0.5), head[1] - barb * math.sin(yaw + 0.5))
+    tip = canvas.point(*head)
+    path = f"M{canvas.point(*tail)} L{tip} M{canvas.point(*left)} L{tip} L{canvas.point(*right)}"
+    return (
+        f'<path d="{path}" fill="none" stroke="{ink}" stroke-width="{stroke_width:g}" stroke-linecap="round" '
+        'stroke-linejoin="round"/>'
+    )
+
+
+def _colour(rgba: tuple[float, float, float, float]) -> tuple[str, float]:
+    r, g, b, a = (max(0.0, min(1.0, v)) for v in rgba)
+    return f"#{round(r * 255):02x}{round(g * 255):02x}{round(b * 255):02x}", a
+
+
+_COLOUR_NAMES = {"red", "yellow", "green", "cyan", "blue", "magenta"}
+
+
+def _css_colour(name: str) -> str:
+    """A marker patch's colour name as SVG paints it; an unknown name grey (it is data, not markup)."""
+    return name if name in _COLOUR_NAMES else "#9aa7b8"
+
+
+def _scale_bar(canvas: _Canvas, y: float) -> Iterator[str]:
+    """A scale bar of a round length about a sixth of the width, and the axes: x east, y north."""
+    width_m = canvas.extent.max_x - canvas.extent.min_x
+    length = next((n for n in (0.5, 1, 2, 5, 10, 20, 50) if n * canvas.scale >= (width_m * canvas.scale) / 7), 50)
+    x0 = canvas.left
+    x1 = x0 + length * canvas.scale
+    yield f'<g stroke="{_INK}" stroke-width="1.5" fill="none">'
+    yield f'<path d="M{x0:.1f},{y - 5:.1f} L{x0:.1f},{y:.1f} L{x1:.1f},{y:.1f} L{x1:.1f},{y - 5:.1f}"/>'
+    yield "</g>"
+    yield canvas.text(x0, y + 13, "0", 10)
+    yield canvas.text(x1, y + 13, f"{length:g} m", 10, text_anchor="middle")
+    ax, ay = x1 + 70, y + 4
+    yield (
+        f'<path d="M{ax:.1f},{ay:.1f} L{ax + 34:.1f},{ay:.1f} M{ax + 28:.1f},{ay - 4:.1f} L{ax + 34:.1f},{ay:.1f} '
+        f"L{ax + 28:.1f},{ay + 4:.1f} M{ax:.1f},{ay:.1f} L{ax:.1f},{ay - 34:.1f} M{ax - 4:.1f},{ay - 28:.1f} "
+        f'L{ax:.1f},{ay - 34:.1f} L{ax + 4:.1f},{ay - 28:.1f}" stroke="{_INK}" stroke-width="1.5" fill="none"/>'
+    )
+    yield canvas.text(ax + 38, ay + 4, "x (east)", 10)
+    yield canvas.text(ax + 6, ay - 30, "y (north)", 10)
+    yield canvas.text(ax + 100, ay + 4, "metres; the origin at the home's south-west corner", 10, fill=_MUTED)
+
+
+_LEGEND = (
+    ("room", "room"),
+    ("wall", "wall"),
+    ("furniture", "furniture (top height)"),
+    ("appliance", "appliance"),
+    ("object", "object (its colour)"),
+    ("robot", "dual-arm robot, arm reach"),
+    ("base", "mobile base, heading"),
+    ("person", "person"),
+    ("camera", "camera, floor it sees"),
+    ("dock", "docking pose"),
+    ("belief", "believed now (world graph)"),
+)
+
+
+def _legend(canvas: _Canvas, top: float, width: int) -> tuple[list[str], float]:
+    """The legend's swatches in rows below the plan, and its height."""
+    column = 176
+    per_row = max(1, int((width - 2 * _MARGIN) // column))
+    parts: list[str] = []
+    for index, (kind, text) in enumerate(_LEGEND):
+        x = canvas.left + (index % per_row) * column
+        y = top + (index // per_row) * _LEGEND_ROW
+        parts.append(_swatch(kind, x, y))
+        parts.append(canvas.text(x + 26, y + 4, text, 11))
+    rows = -(-len(_LEGEND) // per_row)
+    return parts, rows * _LEGEND_ROW
+
+
+def _swatch(kind: str, x: float, y: float) -> str:
+    box = f'x="{x:.1f}" y="{y - 7:.1f}" width="20" height="14"'
+    swatches = {
+        "room": f'<rect {box} fill="{_ROOM_FILLS[0]}" stroke="#9aa7b8"/>',
+        "wall": f'<rect x="{x:.1f}" y="{y - 3:.1f}" width="20" height="6" fill="#4b5563"/>',
+        "furniture": f'<rect {box} fill="{_FURNITURE[0]}" stroke="{_FURNITURE[1]}"/>',
+        "appliance": f'<rect {box} fill="{_APPLIANCE[0]}" stroke="{_APPLIANCE[1]}"/>',
+        "object": f'<circle cx="{x + 6:.1f}" cy="{y:.1f}" r="5" fill="#d91414" stroke="{_INK}" stroke-width="0.8"/>'
+        f'<rect x="{x + 12:.1f}" y="{y - 1.5:.1f}" width="9" height="3" fill="#1a33d9"/>',
+        "robot": f'<circle cx="{x + 10:.1f}" cy="{y:.1f}" r="9" fill="{_ROBOT[1]}" fill-opacity="0.05" '
+        f'stroke="{_ROBOT[1]}" '
+        f'stroke-dasharray="3 2"/><rect x="{x + 5:.1f}" y="{y - 3:.1f}" width="10" height="6" fill="{_ROBOT[0]}" '
+        f'stroke="{_ROBOT[1]}"/>',
+        "base": f'<rect {box} fill="{_BASE[0]}" stroke="{_BASE[1]}"/>'
+        f'<path d="M{x + 4:.1f},{y:.1f} L{x + 16:.1f},{y:.1f} '
+        f'M{x + 12:.1f},{y - 3:.1f} L{x + 16:.1f},{y:.1f} L{x + 12:.1f},{y + 3:.1f}" '
+        'stroke="#ffffff" stroke-width="2" fill="none"/>',
+        "person": f'<circle cx="{x + 10:.1f}" cy="{y:.1f}" r="7" fill="#f2d91a" stroke="{_INK}" stroke-width="1.5"/>',
+        "camera": f'<rect {box} fill="{_CAMERA_INKS[0]}" fill-opacity="0.08" stroke="{_CAMERA_INKS[0]}" '
+        'stroke-dasharray="4 3"/>'
+        f'<rect x="{x + 5:.1f}" y="{y - 4:.1f}" width="10" height="8" rx="1.5" fill="{_CAMERA_INKS[0]}"/>',
+        "dock": f'<path d="M{x + 2:.1f},{y:.1f} L{x + 18:.1f},{y:.1f} M{x + 12:.1f},{y - 4:.1f} L{x + 18:.1f},{y:.1f} '
+        f'L{x + 12:.1f},{y + 4:.1f}" stroke="{_DOCK}" stroke-width="2" fill="none"/>',
+        "belief": f'<path d="M{x:.1f},{y:.1f} L{x + 14:.1f},{y:.1f}" stroke="{_BELIEF}" stroke-width="1.5" '
+        f'stroke-dasharray="4 2" marker-end="url(#home-plan-arrow)"/>',
+    }
+    return swatches[kind]
