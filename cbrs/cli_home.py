@@ -84,20 +84,11 @@ def _rooms(found: HomeSurvey) -> list[dict[str, object]]:
     return rooms
 
 
-_ONE = {"people": "person", "furniture": "piece of furniture", "pieces of furniture": "piece of furniture"}
-
-
-def _counted(count: int, name: str) -> str:
-    if count == 1:
-        return f"1 {_ONE.get(name, name.removesuffix('s').replace('poses', 'pose'))}"
-    return f"{count} {'pieces of furniture' if name == 'furniture' else name}"
-
-
 def _text(found: HomeSurvey, written: str | None) -> str:
     smap = found.semantic_map
     if smap is None:
         return f"the semantic map cannot be read: {found.problem}"
-    lines = ["home: " + ", ".join(_counted(n, name) for name, n in found.counts().items())]
+    lines = ["home: " + ", ".join(found.counted())]
     for room in _rooms(found):
         classes = room["classes"]
         kinds = ", ".join(classes) if isinstance(classes, list) else ""

@@ -122,6 +122,20 @@ class HomeSurvey:
             "docking poses": sum(1 for thing in smap.things.values() if thing.dock is not None),
         }
 
+    def counted(self) -> list[str]:
+        """:meth:`counts` in words: "3 rooms", "1 piece of furniture", "1 person"."""
+        return [_counted(n, name) for name, n in self.counts().items()]
+
+
+_ONE = {"people": "person", "furniture": "piece of furniture"}
+_MANY = {"furniture": "pieces of furniture"}
+
+
+def _counted(count: int, name: str) -> str:
+    if count == 1:
+        return f"1 {_ONE.get(name, name.removesuffix('s'))}"
+    return f"{count} {_MANY.get(name, name)}"
+
 
 def survey(kb: KnowledgeBase) -> HomeSurvey:
     """Read the map and check it as the simulation builds the home; a map that cannot be read or built
@@ -245,6 +259,9 @@ def draw_home(
     canvas = _Canvas(extent, scale)
     plan_height = (extent.max_y - extent.min_y) * scale
     entries: list[Entry] = []
+    solid = smap.furniture | {d.iri for d in smap.dispensers.values()} | {t.iri for t in _bodies(smap)}
+    for iri in sorted(solid & smap.things.keys()):  # labels keep off them, the rooms' too
+        canvas.block_box(smap.things[iri].box)
     layers: list[Iterator[str]] = [
         _grid(canvas),
         _rooms(canvas, smap, link, entries),
@@ -393,14 +410,28 @@ def _rooms(canvas: _Canvas, smap: SemanticMap, link: Callable[[str], str], entri
         box = smap.things[iri].box
         classes = _classes(smap, iri)
         kind = ", ".join(classes) or "room"
-        x, y = canvas.x(box.min_x) + 8, canvas.y(box.max_y) + 20
+        x, y, anchor = _room_corner(canvas, box, max(_CHAR * 14 * len(local_name(iri)), _CHAR * 11 * len(kind)))
         body = [
             canvas.rect(box, fill=_ROOM_FILLS[index % len(_ROOM_FILLS)], stroke="#9aa7b8", stroke_width=1),
-            canvas.text(x, y, local_name(iri), 14, font_weight="bold"),
-            canvas.text(x, y + 15, kind, 11, fill=_MUTED),
+            canvas.text(x, y, local_name(iri), 14, font_weight="bold", text_anchor=anchor),
+            canvas.text(x, y + 15, kind, 11, fill=_MUTED, text_anchor=anchor),
         ]
         yield _linked(link(iri), f"{_label(smap, iri)}: {kind}, {_span(box)}", body, "room")
         entries.append(Entry(iri, local_name(iri), "room", classes, _span(box)))
+
+
+def _room_corner(canvas: _Canvas, box: Box, width: float) -> tuple[float, float, str]:
+    """Where a room's name and class go: the first corner of the room, from its north-west one, where
+    they cover no furniture or robot (the north-west one when every corner is taken)."""
+    left, right = canvas.x(box.min_x) + 8, canvas.x(box.max_x) - 8
+    top, bottom = canvas.y(box.max_y) + 20, canvas.y(box.min_y) - 23
+    spots = ((left, top, "start"), (right, top, "end"), (left, bottom, "start"), (right, bottom, "end"))
+    for x, y, anchor in spots:
+        x0 = x if anchor == "start" else x - width
+        if not any(_overlap((x0, y - 14, x0 + width, y + 18), taken) for taken in canvas.taken):
+            canvas.block(x0, y - 14, x0 + width, y + 18)
+            return x, y, anchor
+    return spots[0]
 
 
 def _walls(canvas: _Canvas, smap: SemanticMap, link: Callable[[str], str], entries: list[Entry]) -> Iterator[str]:
@@ -413,14 +444,16 @@ def _walls(canvas: _Canvas, smap: SemanticMap, link: Callable[[str], str], entri
 
 def _furniture(canvas: _Canvas, smap: SemanticMap, link: Callable[[str], str], entries: list[Entry]) -> Iterator[str]:
     appliances = {d.iri for d in smap.dispensers.values()}
-    for iri in sorted(iri for iri in smap.furniture | appliances if iri in smap.things):
+    drawn = sorted(
+        (smap.furniture | appliances) & smap.things.keys(), key=lambda iri: (smap.things[iri].box.max_z, iri)
+    )
+    for iri in drawn:  # lowest first: what stands on a piece of furniture is drawn over it
         thing = smap.things[iri]
         box = thing.box
         appliance = iri in appliances and iri not in smap.furniture
         fill, stroke = _APPLIANCE if appliance else _FURNITURE
         where = f"{_span(box)}, top at {box.max_z:g} m"
         body = [canvas.rect(box, fill=fill, stroke=stroke, stroke_width=1.2)]
-        canvas.block_box(box)
         if appliance:
             outlet = smap.dispensers[iri].outlet
             body.append(_dot(canvas, outlet[0], outlet[1], 2.5, "#0e7490"))
@@ -447,7 +480,6 @@ def _robot_bodies(
         arms_of.setdefault(arm.robot, []).append(arm.iri)
     for thing in _bodies(smap):
         box = thing.box
-        canvas.block_box(box)
         cx, cy = canvas.x(box.centre[0]), canvas.y(box.centre[1])
         half = (box.max_y - box.min_y) / 2 * canvas.scale
         body = [
@@ -532,7 +564,8 @@ def _objects(
         title = f"{_label(smap, iri)}: {kinds}, {obj.shape} {size} cm, {obj.colour or 'no colour'}, {where}"
         there = _elsewhere(believed, iri, x, y, moved)
         if there is not None:
-            body += _belief(canvas, (x, y), there, [_object_shape(canvas, obj, there[0], there[1], _GHOST)])
+            ghost = _object_shape(canvas, obj, there[0], there[1], _GHOST)
+            body += _belief(canvas, (x, y), there, [ghost], max(obj.size[:2]) / 2 * canvas.scale)
             title += f"; believed at ({there[0]:.2f}, {there[1]:.2f})"
         yield _linked(link(iri), title, body, "object")
         entries.append(Entry(iri, obj.name, "object", _classes(smap, iri), where, _room_of(smap, x, y), there))
@@ -587,8 +620,8 @@ def _mobile_robots(
         title = f"{_label(smap, iri)}: mobile robot, {where}"
         there = _elsewhere(believed, iri, x, y, moved)
         if there is not None:
-            ghost = canvas.polygon(_turned(*there, yaw, length, width), **_GHOST)
-            body += _belief(canvas, (x, y), there, [ghost])
+            ghost = _circle(canvas.x(there[0]), canvas.y(there[1]), reach, **_GHOST)  # the world graph gives no heading
+            body += _belief(canvas, (x, y), there, [ghost], reach)
             title += f"; believed at ({there[0]:.2f}, {there[1]:.2f})"
         yield _linked(link(iri), title, body, "base")
         entries.append(Entry(iri, robot.name, "mobile robot", _classes(smap, iri), where, _room_of(smap, x, y), there))
@@ -622,7 +655,7 @@ def _people(
         there = _elsewhere(believed, iri, x, y, moved)
         if there is not None:
             ghost = _circle(canvas.x(there[0]), canvas.y(there[1]), _PERSON_PX, **_GHOST)
-            body += _belief(canvas, (x, y), there, [ghost])
+            body += _belief(canvas, (x, y), there, [ghost], _PERSON_PX)
             title += f"; believed at ({there[0]:.2f}, {there[1]:.2f})"
         yield _linked(link(iri), title, body, "person")
         entries.append(Entry(iri, person.name, "person", _classes(smap, iri), where, _room_of(smap, x, y), there))
@@ -700,12 +733,18 @@ def _elsewhere(
     return there
 
 
-def _belief(canvas: _Canvas, start: tuple[float, float], there: tuple[float, float], ghost: list[str]) -> list[str]:
-    """An arrow from a thing's start to where it is believed to be, and its outline there."""
+def _belief(
+    canvas: _Canvas, start: tuple[float, float], there: tuple[float, float], ghost: list[str], size: float = 0.0
+) -> list[str]:
+    """An arrow from a thing's start to where it is believed to be, its head ``size`` px short of the
+    middle (the thing's outline there), and the outline."""
+    x0, y0, x1, y1 = canvas.x(start[0]), canvas.y(start[1]), canvas.x(there[0]), canvas.y(there[1])
+    length = math.hypot(x1 - x0, y1 - y0)
+    cut = min(size + 2, length / 2) / length if length else 0.0
+    x1, y1 = x1 - (x1 - x0) * cut, y1 - (y1 - y0) * cut
     return [
-        f'<line x1="{canvas.x(start[0]):.1f}" y1="{canvas.y(start[1]):.1f}" x2="{canvas.x(there[0]):.1f}" '
-        f'y2="{canvas.y(there[1]):.1f}" stroke="{_BELIEF}" stroke-width="1.5" stroke-dasharray="6 3" '
-        'marker-end="url(#home-plan-arrow)" class="home-belief"/>',
+        f'<line x1="{x0:.1f}" y1="{y0:.1f}" x2="{x1:.1f}" y2="{y1:.1f}" stroke="{_BELIEF}" stroke-width="1.5" '
+        'stroke-dasharray="6 3" marker-end="url(#home-plan-arrow)" class="home-belief"/>',
         *ghost,
     ]
 

@@ -198,20 +198,23 @@ def test_cbrs_home_summarises_the_home_and_draws_it(tmp_path: Path) -> None:
     assert "3 rooms, 10 walls, 1 piece of furniture, 2 objects, 1 mobile robot, 1 dual-arm robot" in done.output
     assert "1 person, 3 cameras, 1 docking pose" in done.output
     assert "check: the simulation can build this home" in done.output
+    said = json.loads(CliRunner().invoke(cli, ["--store", ":memory:", "home", "--json"]).output)
+    assert said["verdict"] == "ok" and said["counts"]["cameras"] == 3 and said["problem"] is None
     drawn = links(drawing.read_text(encoding="utf-8"))
     assert drawn[WORLD + "Cup"][0].get("href") == "http://127.0.0.1:8080/resource?iri=" + quote(WORLD + "Cup", safe="")
 
 
-def test_the_studio_flat_replaced_as_a_lab_does_draws_too(tmp_path: Path) -> None:
-    location, drawing = str(tmp_path / "store"), tmp_path / "flat.svg"
-    loaded = CliRunner().invoke(cli, ["--store", location, "load", "--graph", "map", "--replace", str(FLAT_FILE)])
-    assert loaded.exit_code == 0, loaded.output
-    done = CliRunner().invoke(cli, ["--store", location, "home", "--json", "--draw", str(drawing)])
-    assert done.exit_code == 0, done.output
-    said = json.loads(done.output)
-    assert said["verdict"] == "ok" and said["counts"]["rooms"] == 2
-    assert [room["name"] for room in said["rooms"]] == ["Kitchenette", "Studio"]
-    drawn = links(drawing.read_text(encoding="utf-8"))
-    for name in ("Studio", "Kitchenette", "Sofa", "Worktop", "Mug", "Biro", "Novel", "Resident"):
+def test_the_studio_flat_replacing_the_home_draws_too() -> None:
+    """The flat loaded as ``cbrs load --graph map --replace`` loads it (the same call, in memory: the
+    command's own test is tests/test_home_of_your_own.py), then the page and its picture."""
+    kb = KnowledgeBase.open(":memory:")
+    kb.load([FLAT_FILE], "map", replace=True)
+    body = create_app(SparqlService(kb)).test_client().get("/home.json").get_json()
+    assert body["verdict"] == "ok" and body["counts"]["rooms"] == 2
+    assert {t["name"] for t in body["things"] if t["kind"] == "room"} == {"Kitchenette", "Studio"}
+    found = survey(kb)
+    assert found.semantic_map is not None
+    drawn = links(draw_home(found.semantic_map).svg)
+    for name in ("Studio", "Kitchenette", "Sofa", "Worktop", "Dispenser", "Mug", "Biro", "Novel", "Resident"):
         assert FLAT + name in drawn, name
     assert WORLD + "Cup" not in drawn, "the bundled home is gone"

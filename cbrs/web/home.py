@@ -30,6 +30,7 @@ def home() -> Page:
         "verdict": found.verdict,
         "problem": _problem(found),
         "counts": found.counts(),
+        "counted": found.counted(),
         "things": [],
         "picture": None,
         "moved": MOVED,
