@@ -21,6 +21,31 @@ from dataclasses import dataclass, field
 from html import escape
 from urllib.parse import quote
 
+from cbrs.home_canvas import (
+    APPLIANCE,
+    BASE,
+    BELIEF,
+    CAMERA_INKS,
+    CHAR,
+    DOCK,
+    FONT,
+    FURNITURE,
+    INK,
+    MARGIN,
+    MUTED,
+    PERSON_PX,
+    ROBOT,
+    ROOM_FILLS,
+    Canvas,
+    arrow,
+    circle,
+    dot,
+    grid,
+    legend,
+    overlap,
+    scale_bar,
+    svg_attributes,
+)
 from cbrs.kb.camera_view import floor_view
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.home_check import check_home
@@ -36,20 +61,7 @@ MOVED = 0.05
 """How far (m) the world graph must believe a thing to be from its start in the map for the picture to
 draw it at both places: less is the simulation's settling and a seed's scatter, not a move."""
 
-_MARGIN = 44  # px around the plan: the metre ticks on the left and below
 _PAD = 0.3  # m of floor shown around the outermost thing
-_LEGEND_ROW = 26
-_FONT = "DejaVu Sans, Helvetica, Arial, sans-serif"
-_INK, _MUTED = "#1d2330", "#5d6778"
-_ROOM_FILLS = ("#eaf2fb", "#f1edf9", "#eaf6ee", "#fbf3e6", "#f8ebf0", "#e8f5f5")
-_CAMERA_INKS = ("#c2410c", "#7c3aed", "#0e7490", "#be185d", "#4d7c0f")
-_FURNITURE = ("#ead8b9", "#8a5a2b")
-_APPLIANCE = ("#d5dde8", "#4b5563")
-_ROBOT = ("#b9cbe4", "#2f4f7a")
-_BASE = ("#5b6b82", "#1d2330")
-_DOCK = "#1a7f37"
-_BELIEF = "#b42318"
-_PERSON_PX = 9.0  # the person is drawn as a mark, not to scale: the map gives no body's size
 
 
 def resource_link(iri: str) -> str:
@@ -157,83 +169,6 @@ def survey(kb: KnowledgeBase) -> HomeSurvey:
 # -- the drawing ------------------------------------------------------------------------------------
 
 
-@dataclass
-class _Canvas:
-    """Metres to pixels: x to the right, y up (the SVG's y runs down), ``scale`` px a metre."""
-
-    extent: Box
-    scale: float
-    left: float = _MARGIN
-    top: float = 16.0
-    taken: list[tuple[float, float, float, float]] = field(default_factory=list)
-    """Pixel boxes (left, top, right, bottom) labels keep off: other labels, furniture, robots, marks."""
-
-    def x(self, x: float) -> float:
-        return self.left + (x - self.extent.min_x) * self.scale
-
-    def y(self, y: float) -> float:
-        return self.top + (self.extent.max_y - y) * self.scale
-
-    def point(self, x: float, y: float) -> str:
-        return f"{self.x(x):.1f},{self.y(y):.1f}"
-
-    def rect(self, box: Box, **attributes: object) -> str:
-        x, y = self.x(box.min_x), self.y(box.max_y)
-        w, h = (box.max_x - box.min_x) * self.scale, (box.max_y - box.min_y) * self.scale
-        return f'<rect x="{x:.1f}" y="{y:.1f}" width="{w:.1f}" height="{h:.1f}"{_attributes(attributes)}/>'
-
-    def polygon(self, points: list[tuple[float, float]], **attributes: object) -> str:
-        shown = " ".join(self.point(px, py) for px, py in points)
-        return f'<polygon points="{shown}"{_attributes(attributes)}/>'
-
-    def block(self, left: float, top: float, right: float, bottom: float) -> None:
-        self.taken.append((left, top, right, bottom))
-
-    def block_box(self, box: Box) -> None:
-        self.block(self.x(box.min_x), self.y(box.max_y), self.x(box.max_x), self.y(box.min_y))
-
-    def label(self, px: float, py: float, gap: float, text: str, size: float = 11, **attributes: object) -> str:
-        """``text`` beside the mark at pixel (``px``, ``py``) of radius ``gap``: below it, else above, right
-        or left, the first place no other label or blocked box takes (below when none is free)."""
-        width, height = _CHAR * size * len(text), size
-        spots = (
-            (px, py + gap + size + 1, "middle"),
-            (px, py - gap - 4, "middle"),
-            (px + gap + 4, py + size / 2 - 1, "start"),
-            (px - gap - 4, py + size / 2 - 1, "end"),
-        )
-        chosen = spots[0]
-        for spot in spots:
-            if not any(_overlap(_text_box(spot, width, height), box) for box in self.taken):
-                chosen = spot
-                break
-        self.block(*_text_box(chosen, width, height))
-        return self.text(chosen[0], chosen[1], text, size, text_anchor=chosen[2], **attributes)
-
-    def text(self, x: float, y: float, text: str, size: float = 11, **attributes: object) -> str:
-        """``text`` at pixel (``x``, ``y``), escaped."""
-        attributes.setdefault("fill", _INK)
-        shown = escape(text, quote=False)
-        return f'<text x="{x:.1f}" y="{y:.1f}" font-size="{size:g}"{_attributes(attributes)}>{shown}</text>'
-
-
-_CHAR = 0.6  # a character's mean width, in font sizes
-
-
-def _text_box(spot: tuple[float, float, str], width: float, height: float) -> tuple[float, float, float, float]:
-    x, y, anchor = spot
-    left = x - width / 2 if anchor == "middle" else x - width if anchor == "end" else x
-    return (left, y - height, left + width, y + 2)
-
-
-def _overlap(a: tuple[float, float, float, float], b: tuple[float, float, float, float]) -> bool:
-    return a[0] < b[2] and b[0] < a[2] and a[1] < b[3] and b[1] < a[3]
-
-
-def _attributes(attributes: dict[str, object]) -> str:
-    return "".join(f' {name.replace("_", "-")}="{escape(str(value))}"' for name, value in attributes.items())
-
-
 def _linked(href: str, title: str, body: list[str], kind: str) -> str:
     """A thing of the picture: its shapes inside a link to its page, its tooltip the link's title."""
     return (
@@ -255,15 +190,15 @@ def draw_home(
     more from their start; ``link`` gives each thing's address."""
     smap, believed = semantic_map, believed or {}
     extent = _extent(smap, believed)
-    scale = (width - 2 * _MARGIN) / max(extent.max_x - extent.min_x, 0.5)
-    canvas = _Canvas(extent, scale)
+    scale = (width - 2 * MARGIN) / max(extent.max_x - extent.min_x, 0.5)
+    canvas = Canvas(extent, scale)
     plan_height = (extent.max_y - extent.min_y) * scale
     entries: list[Entry] = []
     solid = smap.furniture | {d.iri for d in smap.dispensers.values()} | {t.iri for t in _bodies(smap)}
     for iri in sorted(solid & smap.things.keys()):  # labels keep off them, the rooms' too
         canvas.block_box(smap.things[iri].box)
     layers: list[Iterator[str]] = [
-        _grid(canvas),
+        grid(canvas),
         _rooms(canvas, smap, link, entries),
         _walls(canvas, smap, link, entries),
         _cameras_views(canvas, smap, link),
@@ -277,20 +212,20 @@ def draw_home(
     ]
     body = [part for layer in layers for part in layer]
     legend_top = canvas.top + plan_height + 84
-    legend, legend_height = _legend(canvas, legend_top, width)
+    key, legend_height = legend(canvas, legend_top, width)
     height = int(legend_top + legend_height + 8)
     rooms = ", ".join(_name(smap, iri) for iri in sorted(smap.rooms) if iri in smap.things)
     svg = "".join(
         [
             f'<svg xmlns="http://www.w3.org/2000/svg" class="home-plan" width="{width}" height="{height}" '
-            f'viewBox="0 0 {width} {height}" font-family="{_FONT}" aria-labelledby="home-plan-title home-plan-desc">',
+            f'viewBox="0 0 {width} {height}" font-family="{FONT}" aria-labelledby="home-plan-title home-plan-desc">',
             '<title id="home-plan-title">The home from above, from the semantic map</title>',
             f'<desc id="home-plan-desc">{escape(_description(smap, rooms), quote=False)}</desc>',
             _defs(canvas),
             f'<rect width="{width}" height="{height}" fill="#ffffff"/>',
             *body,
-            *_scale_bar(canvas, canvas.top + plan_height + 44),
-            *legend,
+            *scale_bar(canvas, canvas.top + plan_height + 44),
+            *key,
             "</svg>",
         ]
     )
@@ -305,13 +240,13 @@ def _description(smap: SemanticMap, rooms: str) -> str:
     )
 
 
-def _defs(canvas: _Canvas) -> str:
+def _defs(canvas: Canvas) -> str:
     e = canvas.extent
     return (
         "<defs>"
         f'<clipPath id="home-plan-floor">{canvas.rect(e)}</clipPath>'
         '<marker id="home-plan-arrow" viewBox="0 0 10 10" refX="9" refY="5" markerWidth="7" markerHeight="7" '
-        f'orient="auto-start-reverse"><path d="M0,0 L10,5 L0,10 z" fill="{_BELIEF}"/></marker>'
+        f'orient="auto-start-reverse"><path d="M0,0 L10,5 L0,10 z" fill="{BELIEF}"/></marker>'
         "</defs>"
     )
 
@@ -377,50 +312,22 @@ def _bodies(smap: SemanticMap) -> list[Thing]:
     return [smap.things[iri] for iri in sorted(smap.bodies) if iri in smap.things and iri not in smap.robots]
 
 
-def _grid(canvas: _Canvas) -> Iterator[str]:
-    """Faint metre lines under the plan, numbered along its left and bottom edges."""
-    e = canvas.extent
-    step = 1.0 if (e.max_x - e.min_x) <= 16 else 2.0
-    yield '<g stroke="#eef0f3" stroke-width="1">'
-    lines: list[tuple[float | None, float | None]] = []
-    x = math.ceil(e.min_x / step) * step
-    while x <= e.max_x:
-        lines.append((x, None))
-        x += step
-    y = math.ceil(e.min_y / step) * step
-    while y <= e.max_y:
-        lines.append((None, y))
-        y += step
-    labels = []
-    for gx, gy in lines:
-        if gx is not None:
-            px = canvas.x(gx)
-            yield f'<line x1="{px:.1f}" y1="{canvas.y(e.max_y):.1f}" x2="{px:.1f}" y2="{canvas.y(e.min_y):.1f}"/>'
-            labels.append(canvas.text(px, canvas.y(e.min_y) + 14, f"{gx:g}", 10, fill=_MUTED, text_anchor="middle"))
-        elif gy is not None:
-            py = canvas.y(gy)
-            yield f'<line x1="{canvas.x(e.min_x):.1f}" y1="{py:.1f}" x2="{canvas.x(e.max_x):.1f}" y2="{py:.1f}"/>'
-            labels.append(canvas.text(canvas.x(e.min_x) - 6, py + 3.5, f"{gy:g}", 10, fill=_MUTED, text_anchor="end"))
-    yield "</g>"
-    yield from labels
-
-
-def _rooms(canvas: _Canvas, smap: SemanticMap, link: Callable[[str], str], entries: list[Entry]) -> Iterator[str]:
+def _rooms(canvas: Canvas, smap: SemanticMap, link: Callable[[str], str], entries: list[Entry]) -> Iterator[str]:
     for index, iri in enumerate(sorted(iri for iri in smap.rooms if iri in smap.things)):
         box = smap.things[iri].box
         classes = _classes(smap, iri)
         kind = ", ".join(classes) or "room"
-        x, y, anchor = _room_corner(canvas, box, max(_CHAR * 14 * len(local_name(iri)), _CHAR * 11 * len(kind)))
+        x, y, anchor = _room_corner(canvas, box, max(CHAR * 14 * len(local_name(iri)), CHAR * 11 * len(kind)))
         body = [
-            canvas.rect(box, fill=_ROOM_FILLS[index % len(_ROOM_FILLS)], stroke="#9aa7b8", stroke_width=1),
+            canvas.rect(box, fill=ROOM_FILLS[index % len(ROOM_FILLS)], stroke="#9aa7b8", stroke_width=1),
             canvas.text(x, y, local_name(iri), 14, font_weight="bold", text_anchor=anchor),
-            canvas.text(x, y + 15, kind, 11, fill=_MUTED, text_anchor=anchor),
+            canvas.text(x, y + 15, kind, 11, fill=MUTED, text_anchor=anchor),
         ]
         yield _linked(link(iri), f"{_label(smap, iri)}: {kind}, {_span(box)}", body, "room")
         entries.append(Entry(iri, local_name(iri), "room", classes, _span(box)))
 
 
-def _room_corner(canvas: _Canvas, box: Box, width: float) -> tuple[float, float, str]:
+def _room_corner(canvas: Canvas, box: Box, width: float) -> tuple[float, float, str]:
     """Where a room's name and class go: the first corner of the room, from its north-west one, where
     they cover no furniture or robot (the north-west one when every corner is taken)."""
     left, right = canvas.x(box.min_x) + 8, canvas.x(box.max_x) - 8
@@ -428,13 +335,13 @@ def _room_corner(canvas: _Canvas, box: Box, width: float) -> tuple[float, float,
     spots = ((left, top, "start"), (right, top, "end"), (left, bottom, "start"), (right, bottom, "end"))
     for x, y, anchor in spots:
         x0 = x if anchor == "start" else x - width
-        if not any(_overlap((x0, y - 14, x0 + width, y + 18), taken) for taken in canvas.taken):
+        if not any(overlap((x0, y - 14, x0 + width, y + 18), taken) for taken in canvas.taken):
             canvas.block(x0, y - 14, x0 + width, y + 18)
             return x, y, anchor
     return spots[0]
 
 
-def _walls(canvas: _Canvas, smap: SemanticMap, link: Callable[[str], str], entries: list[Entry]) -> Iterator[str]:
+def _walls(canvas: Canvas, smap: SemanticMap, link: Callable[[str], str], entries: list[Entry]) -> Iterator[str]:
     for iri in sorted(iri for iri in smap.walls if iri in smap.things):
         box = smap.things[iri].box
         where = f"{_span(box)}, {box.max_z - box.min_z:g} m high"
@@ -442,7 +349,7 @@ def _walls(canvas: _Canvas, smap: SemanticMap, link: Callable[[str], str], entri
         entries.append(Entry(iri, local_name(iri), "wall", _classes(smap, iri), where))
 
 
-def _furniture(canvas: _Canvas, smap: SemanticMap, link: Callable[[str], str], entries: list[Entry]) -> Iterator[str]:
+def _furniture(canvas: Canvas, smap: SemanticMap, link: Callable[[str], str], entries: list[Entry]) -> Iterator[str]:
     appliances = {d.iri for d in smap.dispensers.values()}
     drawn = sorted(
         (smap.furniture | appliances) & smap.things.keys(), key=lambda iri: (smap.things[iri].box.max_z, iri)
@@ -451,18 +358,18 @@ def _furniture(canvas: _Canvas, smap: SemanticMap, link: Callable[[str], str], e
         thing = smap.things[iri]
         box = thing.box
         appliance = iri in appliances and iri not in smap.furniture
-        fill, stroke = _APPLIANCE if appliance else _FURNITURE
+        fill, stroke = APPLIANCE if appliance else FURNITURE
         where = f"{_span(box)}, top at {box.max_z:g} m"
         body = [canvas.rect(box, fill=fill, stroke=stroke, stroke_width=1.2)]
         if appliance:
             outlet = smap.dispensers[iri].outlet
-            body.append(_dot(canvas, outlet[0], outlet[1], 2.5, "#0e7490"))
+            body.append(dot(canvas, outlet[0], outlet[1], 2.5, "#0e7490"))
             where += f", water leaves at ({outlet[0]:g}, {outlet[1]:g}, {outlet[2]:g})"
         else:
             cx = canvas.x((box.min_x + box.max_x) / 2)
             top = canvas.y(box.max_y)
             body.append(canvas.text(cx, top + 14, local_name(iri), 11, text_anchor="middle", font_weight="bold"))
-            body.append(canvas.text(cx, top + 27, f"top {box.max_z:g} m", 10, fill=_MUTED, text_anchor="middle"))
+            body.append(canvas.text(cx, top + 27, f"top {box.max_z:g} m", 10, fill=MUTED, text_anchor="middle"))
         kind = "appliance" if appliance else "furniture"
         support = smap.facts.get(iri, {}).get(HOME + "isLocatedOn", [])
         if support:
@@ -472,9 +379,7 @@ def _furniture(canvas: _Canvas, smap: SemanticMap, link: Callable[[str], str], e
         entries.append(Entry(iri, local_name(iri), kind, _classes(smap, iri), where, _room_of(smap, *centre[:2])))
 
 
-def _robot_bodies(
-    canvas: _Canvas, smap: SemanticMap, link: Callable[[str], str], entries: list[Entry]
-) -> Iterator[str]:
+def _robot_bodies(canvas: Canvas, smap: SemanticMap, link: Callable[[str], str], entries: list[Entry]) -> Iterator[str]:
     arms_of: dict[str, list[str]] = {}
     for arm in smap.arms.values():
         arms_of.setdefault(arm.robot, []).append(arm.iri)
@@ -483,8 +388,8 @@ def _robot_bodies(
         cx, cy = canvas.x(box.centre[0]), canvas.y(box.centre[1])
         half = (box.max_y - box.min_y) / 2 * canvas.scale
         body = [
-            canvas.rect(box, fill=_ROBOT[0], stroke=_ROBOT[1], stroke_width=1.5),
-            canvas.label(cx, cy, half + 1, thing.name, 11, font_weight="bold", fill=_ROBOT[1]),
+            canvas.rect(box, fill=ROBOT[0], stroke=ROBOT[1], stroke_width=1.5),
+            canvas.label(cx, cy, half + 1, thing.name, 11, font_weight="bold", fill=ROBOT[1]),
         ]
         where = f"{_span(box)}, {box.max_z:g} m high"
         yield _linked(link(thing.iri), f"{_label(smap, thing.iri)}: robot, {where}", body, "robot")
@@ -497,18 +402,18 @@ def _robot_bodies(
         r = arm.reach * canvas.scale
         tip = (mx + 0.12 * math.cos(arm.yaw), my + 0.12 * math.sin(arm.yaw))
         body = [
-            f'<circle cx="{canvas.x(mx):.1f}" cy="{canvas.y(my):.1f}" r="{r:.1f}" fill="{_ROBOT[1]}" '
-            f'fill-opacity="0.05" stroke="{_ROBOT[1]}" stroke-width="1" stroke-dasharray="5 4"/>',
+            f'<circle cx="{canvas.x(mx):.1f}" cy="{canvas.y(my):.1f}" r="{r:.1f}" fill="{ROBOT[1]}" '
+            f'fill-opacity="0.05" stroke="{ROBOT[1]}" stroke-width="1" stroke-dasharray="5 4"/>',
             f'<line x1="{canvas.x(mx):.1f}" y1="{canvas.y(my):.1f}" x2="{canvas.x(tip[0]):.1f}" '
-            f'y2="{canvas.y(tip[1]):.1f}" stroke="{_ROBOT[1]}" stroke-width="2"/>',
-            _dot(canvas, mx, my, 4, _ROBOT[1]),
+            f'y2="{canvas.y(tip[1]):.1f}" stroke="{ROBOT[1]}" stroke-width="2"/>',
+            dot(canvas, mx, my, 4, ROBOT[1]),
             canvas.text(
                 canvas.x(mx - 0.1 * math.cos(arm.yaw)),
                 canvas.y(my - 0.1 * math.sin(arm.yaw)) + 3.5,
                 arm.side[:1].upper(),
                 9,
                 text_anchor="middle",
-                fill=_ROBOT[1],
+                fill=ROBOT[1],
                 font_weight="bold",
             ),
         ]
@@ -518,13 +423,13 @@ def _robot_bodies(
         entries.append(Entry(iri, local_name(iri), "arm", _classes(smap, iri), where, _room_of(smap, mx, my)))
 
 
-def _docks(canvas: _Canvas, smap: SemanticMap, link: Callable[[str], str], entries: list[Entry]) -> Iterator[str]:
+def _docks(canvas: Canvas, smap: SemanticMap, link: Callable[[str], str], entries: list[Entry]) -> Iterator[str]:
     for iri in sorted(smap.things):
         dock = smap.things[iri].dock
         if dock is None:
             continue
         dock_iri = smap.facts.get(iri, {}).get(HOME + "dockingPose", [iri])[0]
-        body = [_arrow(canvas, dock.x, dock.y, dock.yaw, 0.32, _DOCK)]
+        body = [arrow(canvas, dock.x, dock.y, dock.yaw, 0.32, DOCK)]
         where = f"({dock.x:g}, {dock.y:g}), heading {math.degrees(dock.yaw):.0f}°"
         title = f"{_label(smap, dock_iri)}: where the mobile base parks at {local_name(iri)}, {where}"
         yield _linked(link(dock_iri), title, body, "dock")
@@ -541,7 +446,7 @@ def _docks(canvas: _Canvas, smap: SemanticMap, link: Callable[[str], str], entri
 
 
 def _objects(
-    canvas: _Canvas,
+    canvas: Canvas,
     smap: SemanticMap,
     link: Callable[[str], str],
     entries: list[Entry],
@@ -554,7 +459,7 @@ def _objects(
         fill, opacity = _colour(obj.rgba)
         body = [
             _object_shape(
-                canvas, obj, x, y, {"fill": fill, "fill_opacity": opacity, "stroke": _INK, "stroke_width": 0.8}
+                canvas, obj, x, y, {"fill": fill, "fill_opacity": opacity, "stroke": INK, "stroke_width": 0.8}
             )
         ]
         body.append(canvas.label(canvas.x(x), canvas.y(y), max(obj.size[:2]) / 2 * canvas.scale + 2, obj.name, 10))
@@ -571,15 +476,15 @@ def _objects(
         entries.append(Entry(iri, obj.name, "object", _classes(smap, iri), where, _room_of(smap, x, y), there))
 
 
-_GHOST: dict[str, object] = {"fill": "none", "stroke": _BELIEF, "stroke_width": 1.5, "stroke_dasharray": "3 2"}
+_GHOST: dict[str, object] = {"fill": "none", "stroke": BELIEF, "stroke_width": 1.5, "stroke_dasharray": "3 2"}
 
 
-def _object_shape(canvas: _Canvas, obj: MapObject, x: float, y: float, attributes: dict[str, object]) -> str:
+def _object_shape(canvas: Canvas, obj: MapObject, x: float, y: float, attributes: dict[str, object]) -> str:
     """An object's footprint at (``x``, ``y``): a cylinder's circle, a box's rectangle turned by its yaw;
     at least 3 px across, so that a pen stays visible."""
     if obj.shape == "cylinder":
         r = max(obj.size[0] / 2 * canvas.scale, 2.0)
-        return f'<circle cx="{canvas.x(x):.1f}" cy="{canvas.y(y):.1f}" r="{r:.1f}"{_attributes(attributes)}/>'
+        return f'<circle cx="{canvas.x(x):.1f}" cy="{canvas.y(y):.1f}" r="{r:.1f}"{svg_attributes(attributes)}/>'
     least = 3.0 / canvas.scale
     length, width = max(obj.size[0], least), max(obj.size[1], least)
     return canvas.polygon(_turned(x, y, obj.start.yaw, length, width), **attributes)
@@ -592,7 +497,7 @@ def _turned(x: float, y: float, yaw: float, length: float, width: float) -> list
 
 
 def _mobile_robots(
-    canvas: _Canvas,
+    canvas: Canvas,
     smap: SemanticMap,
     link: Callable[[str], str],
     entries: list[Entry],
@@ -603,14 +508,14 @@ def _mobile_robots(
         robot = smap.robots[iri]
         x, y, yaw = robot.start.x, robot.start.y, robot.start.yaw
         length, width = robot.footprint
-        body = [canvas.polygon(_turned(x, y, yaw, length, width), fill=_BASE[0], stroke=_BASE[1], stroke_width=1.5)]
+        body = [canvas.polygon(_turned(x, y, yaw, length, width), fill=BASE[0], stroke=BASE[1], stroke_width=1.5)]
         if robot.marker is not None:
             for sign, colour in ((1, robot.marker.front), (-1, robot.marker.rear)):
                 cx = x + sign * robot.marker.separation / 2 * math.cos(yaw)
                 cy = y + sign * robot.marker.separation / 2 * math.sin(yaw)
                 patch = _turned(cx, cy, yaw, *robot.marker.patch)
-                body.append(canvas.polygon(patch, fill=_css_colour(colour), stroke=_BASE[1], stroke_width=0.5))
-        body.append(_arrow(canvas, x, y, yaw, length * 0.9, "#ffffff", stroke_width=2.5))
+                body.append(canvas.polygon(patch, fill=_css_colour(colour), stroke=BASE[1], stroke_width=0.5))
+        body.append(arrow(canvas, x, y, yaw, length * 0.9, "#ffffff", stroke_width=2.5))
         reach = math.hypot(length, width) / 2 * canvas.scale
         body.append(canvas.label(canvas.x(x), canvas.y(y), reach + 2, robot.name, 11, font_weight="bold"))
         canvas.block(canvas.x(x) - reach, canvas.y(y) - reach, canvas.x(x) + reach, canvas.y(y) + reach)
@@ -620,7 +525,7 @@ def _mobile_robots(
         title = f"{_label(smap, iri)}: mobile robot, {where}"
         there = _elsewhere(believed, iri, x, y, moved)
         if there is not None:
-            ghost = _circle(canvas.x(there[0]), canvas.y(there[1]), reach, **_GHOST)  # the world graph gives no heading
+            ghost = circle(canvas.x(there[0]), canvas.y(there[1]), reach, **_GHOST)  # the world graph gives no heading
             body += _belief(canvas, (x, y), there, [ghost], reach)
             title += f"; believed at ({there[0]:.2f}, {there[1]:.2f})"
         yield _linked(link(iri), title, body, "base")
@@ -628,7 +533,7 @@ def _mobile_robots(
 
 
 def _people(
-    canvas: _Canvas,
+    canvas: Canvas,
     smap: SemanticMap,
     link: Callable[[str], str],
     entries: list[Entry],
@@ -639,33 +544,31 @@ def _people(
         person = smap.people[iri]
         x, y, yaw = person.start.x, person.start.y, person.start.yaw
         fill, _ = _colour(person.rgba)
-        nose = (canvas.x(x) + 1.6 * _PERSON_PX * math.cos(yaw), canvas.y(y) - 1.6 * _PERSON_PX * math.sin(yaw))
+        nose = (canvas.x(x) + 1.6 * PERSON_PX * math.cos(yaw), canvas.y(y) - 1.6 * PERSON_PX * math.sin(yaw))
         body = [
             f'<line x1="{canvas.x(x):.1f}" y1="{canvas.y(y):.1f}" x2="{nose[0]:.1f}" y2="{nose[1]:.1f}" '
-            f'stroke="{_INK}" stroke-width="2"/>',
-            _circle(canvas.x(x), canvas.y(y), _PERSON_PX, fill=fill, stroke=_INK, stroke_width=1.5),
-            _circle(canvas.x(x), canvas.y(y), _PERSON_PX / 2.4, fill="#f2d2b6", stroke=_INK, stroke_width=1),
-            canvas.label(canvas.x(x), canvas.y(y), _PERSON_PX + 2, person.name, 11, font_weight="bold"),
+            f'stroke="{INK}" stroke-width="2"/>',
+            circle(canvas.x(x), canvas.y(y), PERSON_PX, fill=fill, stroke=INK, stroke_width=1.5),
+            circle(canvas.x(x), canvas.y(y), PERSON_PX / 2.4, fill="#f2d2b6", stroke=INK, stroke_width=1),
+            canvas.label(canvas.x(x), canvas.y(y), PERSON_PX + 2, person.name, 11, font_weight="bold"),
         ]
-        canvas.block(
-            canvas.x(x) - _PERSON_PX, canvas.y(y) - _PERSON_PX, canvas.x(x) + _PERSON_PX, canvas.y(y) + _PERSON_PX
-        )
+        canvas.block(canvas.x(x) - PERSON_PX, canvas.y(y) - PERSON_PX, canvas.x(x) + PERSON_PX, canvas.y(y) + PERSON_PX)
         where = f"starts at ({x:g}, {y:g}), facing {math.degrees(yaw):.0f}°, {person.colour or 'no'} shirt"
         title = f"{_label(smap, iri)}: person, {where}"
         there = _elsewhere(believed, iri, x, y, moved)
         if there is not None:
-            ghost = _circle(canvas.x(there[0]), canvas.y(there[1]), _PERSON_PX, **_GHOST)
-            body += _belief(canvas, (x, y), there, [ghost], _PERSON_PX)
+            ghost = circle(canvas.x(there[0]), canvas.y(there[1]), PERSON_PX, **_GHOST)
+            body += _belief(canvas, (x, y), there, [ghost], PERSON_PX)
             title += f"; believed at ({there[0]:.2f}, {there[1]:.2f})"
         yield _linked(link(iri), title, body, "person")
         entries.append(Entry(iri, person.name, "person", _classes(smap, iri), where, _room_of(smap, x, y), there))
 
 
 def _camera_ink(index: int) -> str:
-    return _CAMERA_INKS[index % len(_CAMERA_INKS)]
+    return CAMERA_INKS[index % len(CAMERA_INKS)]
 
 
-def _cameras_views(canvas: _Canvas, smap: SemanticMap, link: Callable[[str], str]) -> Iterator[str]:
+def _cameras_views(canvas: Canvas, smap: SemanticMap, link: Callable[[str], str]) -> Iterator[str]:
     """The floor each camera looking down sees, under everything but the rooms and walls."""
     for index, iri in enumerate(sorted(smap.cameras)):
         camera = smap.cameras[iri]
@@ -688,11 +591,11 @@ def _cameras_views(canvas: _Canvas, smap: SemanticMap, link: Callable[[str], str
         yield _linked(link(iri), title, [shape], "camera-view")
 
 
-def _cameras(canvas: _Canvas, smap: SemanticMap, link: Callable[[str], str], entries: list[Entry]) -> Iterator[str]:
+def _cameras(canvas: Canvas, smap: SemanticMap, link: Callable[[str], str], entries: list[Entry]) -> Iterator[str]:
     for index, iri in enumerate(sorted(smap.cameras)):
         camera = smap.cameras[iri]
         x, y, z = camera.position
-        ink = _camera_ink(index) if camera.looks_down else _ROBOT[1]
+        ink = _camera_ink(index) if camera.looks_down else ROBOT[1]
         px, py = canvas.x(x), canvas.y(y)
         body = [
             f'<rect x="{px - 7:.1f}" y="{py - 6:.1f}" width="14" height="12" rx="2" fill="{ink}" '
@@ -734,7 +637,7 @@ def _elsewhere(
 
 
 def _belief(
-    canvas: _Canvas, start: tuple[float, float], there: tuple[float, float], ghost: list[str], size: float = 0.0
+    canvas: Canvas, start: tuple[float, float], there: tuple[float, float], ghost: list[str], size: float = 0.0
 ) -> list[str]:
     """An arrow from a thing's start to where it is believed to be, its head ``size`` px short of the
     middle (the thing's outline there), and the outline."""
@@ -743,35 +646,10 @@ def _belief(
     cut = min(size + 2, length / 2) / length if length else 0.0
     x1, y1 = x1 - (x1 - x0) * cut, y1 - (y1 - y0) * cut
     return [
-        f'<line x1="{x0:.1f}" y1="{y0:.1f}" x2="{x1:.1f}" y2="{y1:.1f}" stroke="{_BELIEF}" stroke-width="1.5" '
+        f'<line x1="{x0:.1f}" y1="{y0:.1f}" x2="{x1:.1f}" y2="{y1:.1f}" stroke="{BELIEF}" stroke-width="1.5" '
         'stroke-dasharray="6 3" marker-end="url(#home-plan-arrow)" class="home-belief"/>',
         *ghost,
     ]
-
-
-def _circle(px: float, py: float, r: float, **attributes: object) -> str:
-    """A circle at pixel (``px``, ``py``)."""
-    return f'<circle cx="{px:.1f}" cy="{py:.1f}" r="{r:.1f}"{_attributes(attributes)}/>'
-
-
-def _dot(canvas: _Canvas, x: float, y: float, r: float, fill: str) -> str:
-    return f'<circle cx="{canvas.x(x):.1f}" cy="{canvas.y(y):.1f}" r="{r:g}" fill="{fill}"/>'
-
-
-def _arrow(canvas: _Canvas, x: float, y: float, yaw: float, length: float, ink: str, stroke_width: float = 2) -> str:
-    """An arrow of ``length`` m centred at (``x``, ``y``) pointing along ``yaw``."""
-    c, s = math.cos(yaw), math.sin(yaw)
-    tail = (x - c * length / 2, y - s * length / 2)
-    head = (x + c * length / 2, y + s * length / 2)
-    barb = length * 0.35
-    left = (head[0] - barb * math.cos(yaw - 0.5), head[1] - barb * math.sin(yaw - 0.5))
-    right = (head[0] - barb * math.cos(yaw + 0.5), head[1] - barb * math.sin(yaw + 0.5))
-    tip = canvas.point(*head)
-    path = f"M{canvas.point(*tail)} L{tip} M{canvas.point(*left)} L{tip} L{canvas.point(*right)}"
-    return (
-        f'<path d="{path}" fill="none" stroke="{ink}" stroke-width="{stroke_width:g}" stroke-linecap="round" '
-        'stroke-linejoin="round"/>'
-    )
 
 
 def _colour(rgba: tuple[float, float, float, float]) -> tuple[str, float]:
@@ -785,83 +663,3 @@ _COLOUR_NAMES = {"red", "yellow", "green", "cyan", "blue", "magenta"}
 def _css_colour(name: str) -> str:
     """A marker patch's colour name as SVG paints it; an unknown name grey (it is data, not markup)."""
     return name if name in _COLOUR_NAMES else "#9aa7b8"
-
-
-def _scale_bar(canvas: _Canvas, y: float) -> Iterator[str]:
-    """A scale bar of a round length about a sixth of the width, and the axes: x east, y north."""
-    width_m = canvas.extent.max_x - canvas.extent.min_x
-    length = next((n for n in (0.5, 1, 2, 5, 10, 20, 50) if n * canvas.scale >= (width_m * canvas.scale) / 7), 50)
-    x0 = canvas.left
-    x1 = x0 + length * canvas.scale
-    yield f'<g stroke="{_INK}" stroke-width="1.5" fill="none">'
-    yield f'<path d="M{x0:.1f},{y - 5:.1f} L{x0:.1f},{y:.1f} L{x1:.1f},{y:.1f} L{x1:.1f},{y - 5:.1f}"/>'
-    yield "</g>"
-    yield canvas.text(x0, y + 13, "0", 10)
-    yield canvas.text(x1, y + 13, f"{length:g} m", 10, text_anchor="middle")
-    ax, ay = x1 + 70, y + 4
-    yield (
-        f'<path d="M{ax:.1f},{ay:.1f} L{ax + 34:.1f},{ay:.1f} M{ax + 28:.1f},{ay - 4:.1f} L{ax + 34:.1f},{ay:.1f} '
-        f"L{ax + 28:.1f},{ay + 4:.1f} M{ax:.1f},{ay:.1f} L{ax:.1f},{ay - 34:.1f} M{ax - 4:.1f},{ay - 28:.1f} "
-        f'L{ax:.1f},{ay - 34:.1f} L{ax + 4:.1f},{ay - 28:.1f}" stroke="{_INK}" stroke-width="1.5" fill="none"/>'
-    )
-    yield canvas.text(ax + 38, ay + 4, "x (east)", 10)
-    yield canvas.text(ax + 6, ay - 30, "y (north)", 10)
-    yield canvas.text(ax + 100, ay + 4, "metres; the origin at the home's south-west corner", 10, fill=_MUTED)
-
-
-_LEGEND = (
-    ("room", "room"),
-    ("wall", "wall"),
-    ("furniture", "furniture (top height)"),
-    ("appliance", "appliance"),
-    ("object", "object (its colour)"),
-    ("robot", "dual-arm robot, arm reach"),
-    ("base", "mobile base, heading"),
-    ("person", "person"),
-    ("camera", "camera, floor it sees"),
-    ("dock", "docking pose"),
-    ("belief", "believed now (world graph)"),
-)
-
-
-def _legend(canvas: _Canvas, top: float, width: int) -> tuple[list[str], float]:
-    """The legend's swatches in rows below the plan, and its height."""
-    column = 176
-    per_row = max(1, int((width - 2 * _MARGIN) // column))
-    parts: list[str] = []
-    for index, (kind, text) in enumerate(_LEGEND):
-        x = canvas.left + (index % per_row) * column
-        y = top + (index // per_row) * _LEGEND_ROW
-        parts.append(_swatch(kind, x, y))
-        parts.append(canvas.text(x + 26, y + 4, text, 11))
-    rows = -(-len(_LEGEND) // per_row)
-    return parts, rows * _LEGEND_ROW
-
-
-def _swatch(kind: str, x: float, y: float) -> str:
-    box = f'x="{x:.1f}" y="{y - 7:.1f}" width="20" height="14"'
-    swatches = {
-        "room": f'<rect {box} fill="{_ROOM_FILLS[0]}" stroke="#9aa7b8"/>',
-        "wall": f'<rect x="{x:.1f}" y="{y - 3:.1f}" width="20" height="6" fill="#4b5563"/>',
-        "furniture": f'<rect {box} fill="{_FURNITURE[0]}" stroke="{_FURNITURE[1]}"/>',
-        "appliance": f'<rect {box} fill="{_APPLIANCE[0]}" stroke="{_APPLIANCE[1]}"/>',
-        "object": f'<circle cx="{x + 6:.1f}" cy="{y:.1f}" r="5" fill="#d91414" stroke="{_INK}" stroke-width="0.8"/>'
-        f'<rect x="{x + 12:.1f}" y="{y - 1.5:.1f}" width="9" height="3" fill="#1a33d9"/>',
-        "robot": f'<circle cx="{x + 10:.1f}" cy="{y:.1f}" r="9" fill="{_ROBOT[1]}" fill-opacity="0.05" '
-        f'stroke="{_ROBOT[1]}" '
-        f'stroke-dasharray="3 2"/><rect x="{x + 5:.1f}" y="{y - 3:.1f}" width="10" height="6" fill="{_ROBOT[0]}" '
-        f'stroke="{_ROBOT[1]}"/>',
-        "base": f'<rect {box} fill="{_BASE[0]}" stroke="{_BASE[1]}"/>'
-        f'<path d="M{x + 4:.1f},{y:.1f} L{x + 16:.1f},{y:.1f} '
-        f'M{x + 12:.1f},{y - 3:.1f} L{x + 16:.1f},{y:.1f} L{x + 12:.1f},{y + 3:.1f}" '
-        'stroke="#ffffff" stroke-width="2" fill="none"/>',
-        "person": f'<circle cx="{x + 10:.1f}" cy="{y:.1f}" r="7" fill="#f2d91a" stroke="{_INK}" stroke-width="1.5"/>',
-        "camera": f'<rect {box} fill="{_CAMERA_INKS[0]}" fill-opacity="0.08" stroke="{_CAMERA_INKS[0]}" '
-        'stroke-dasharray="4 3"/>'
-        f'<rect x="{x + 5:.1f}" y="{y - 4:.1f}" width="10" height="8" rx="1.5" fill="{_CAMERA_INKS[0]}"/>',
-        "dock": f'<path d="M{x + 2:.1f},{y:.1f} L{x + 18:.1f},{y:.1f} M{x + 12:.1f},{y - 4:.1f} L{x + 18:.1f},{y:.1f} '
-        f'L{x + 12:.1f},{y + 4:.1f}" stroke="{_DOCK}" stroke-width="2" fill="none"/>',
-        "belief": f'<path d="M{x:.1f},{y:.1f} L{x + 14:.1f},{y:.1f}" stroke="{_BELIEF}" stroke-width="1.5" '
-        f'stroke-dasharray="4 2" marker-end="url(#home-plan-arrow)"/>',
-    }
-    return swatches[kind]
