@@ -218,3 +218,15 @@ def test_the_studio_flat_replacing_the_home_draws_too() -> None:
     for name in ("Studio", "Kitchenette", "Sofa", "Worktop", "Dispenser", "Mug", "Biro", "Novel", "Resident"):
         assert FLAT + name in drawn, name
     assert WORLD + "Cup" not in drawn, "the bundled home is gone"
+
+
+def test_cbrs_home_exits_1_with_the_check_s_message_and_draws_what_is_there(tmp_path: Path) -> None:
+    location, drawing = str(tmp_path / "store"), tmp_path / "home.svg"
+    kb = KnowledgeBase.open(location)
+    kb.update(f"DELETE WHERE {{ GRAPH graph:map {{ <{WORLD}Person> ?p ?o }} }}", check_map=False)
+    kb.close()
+    done = CliRunner().invoke(cli, ["--store", location, "home", "--draw", str(drawing)])
+    assert done.exit_code == 1
+    assert "0 people" in done.output and "check: the simulation would refuse this home" in done.output
+    assert "add a home:Person with home:x, home:y" in done.output
+    assert WORLD + "Cup" in links(drawing.read_text(encoding="utf-8"))
