@@ -17,7 +17,9 @@ import pytest
 from click.testing import CliRunner
 
 from cbrs.actions.belief import BeliefState, Observation
+from cbrs.app import App
 from cbrs.cli import cli
+from cbrs.cli_home import home
 from cbrs.home_plan import draw_home, resource_link, survey
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.camera_view import default_image_size, floor_view, image_up
@@ -221,11 +223,10 @@ def test_the_studio_flat_replacing_the_home_draws_too() -> None:
 
 
 def test_cbrs_home_exits_1_with_the_check_s_message_and_draws_what_is_there(tmp_path: Path) -> None:
-    location, drawing = str(tmp_path / "store"), tmp_path / "home.svg"
-    kb = KnowledgeBase.open(location)
+    kb = KnowledgeBase.open(":memory:")
     kb.update(f"DELETE WHERE {{ GRAPH graph:map {{ <{WORLD}Person> ?p ?o }} }}", check_map=False)
-    kb.close()
-    done = CliRunner().invoke(cli, ["--store", location, "home", "--draw", str(drawing)])
+    drawing = tmp_path / "home.svg"
+    done = CliRunner().invoke(home, ["--draw", str(drawing)], obj=App(":memory:", kb))  # this store, as opened
     assert done.exit_code == 1
     assert "0 people" in done.output and "check: the simulation would refuse this home" in done.output
     assert "add a home:Person with home:x, home:y" in done.output
