@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 import xml.etree.ElementTree as ET
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -15,7 +16,13 @@ from cbrs.cli import cli
 from cbrs.reasoner import owlstc
 from cbrs.reasoner.methods import METHODS
 from cbrs.reasoner.metrics import average_precision, interpolated_precision, ndcg, precision_at_k, r_precision
-from cbrs.reasoner.owlstc import CollectionError, CollectionReport, evaluate_collection, read_relevance
+from cbrs.reasoner.owlstc import (
+    CollectionError,
+    CollectionReport,
+    LoadedCollection,
+    evaluate_collection,
+    read_relevance,
+)
 
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "owls-tc4"
 needs_collection = pytest.mark.skipif(
@@ -96,30 +103,47 @@ def subset(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return root
 
 
+@dataclass
+class SubsetRun:
+    """``cbrs eval owls-tc SUBSET --json --plot`` (every method): what it printed and wrote, the
+    CollectionReport behind it, and the collection as it loaded it."""
+
+    result: Result
+    chart: Path
+    report: CollectionReport
+    loaded: LoadedCollection
+
+
 @pytest.fixture(scope="module")
-def subset_run(subset: Path, tmp_path_factory: pytest.TempPathFactory) -> tuple[Result, Path, CollectionReport]:
-    """``cbrs eval owls-tc SUBSET --json --plot`` (every method) run once, with the CollectionReport the
-    command printed: the end-to-end test reads that report rather than evaluating the subset again."""
+def subset_run(subset: Path, tmp_path_factory: pytest.TempPathFactory) -> SubsetRun:
+    """The command run once: the end-to-end test reads its report rather than evaluating the subset
+    again, and the --text-weight run ranks in the collection it loaded (ranking only reads it)."""
     chart = tmp_path_factory.mktemp("owlstc-plot") / "pr.png"
     printed: list[CollectionReport] = []
-    evaluate = owlstc.evaluate_collection
+    loaded: list[LoadedCollection] = []
+    evaluate, load = owlstc.evaluate_collection, owlstc.load_collection
 
     def keep(*args: Any, **kwargs: Any) -> CollectionReport:
         printed.append(evaluate(*args, **kwargs))
         return printed[-1]
 
+    def keep_loaded(*args: Any, **kwargs: Any) -> LoadedCollection:
+        loaded.append(load(*args, **kwargs))
+        return loaded[-1]
+
     with pytest.MonkeyPatch.context() as patch:
         patch.setattr(owlstc, "evaluate_collection", keep)
+        patch.setattr(owlstc, "load_collection", keep_loaded)
         patch.delenv("CBRS_MATCH_PARAMS", raising=False)  # the figures are the defaults'
         result = CliRunner().invoke(cli, ["eval", "owls-tc", str(subset), "--json", "--plot", str(chart)])
     assert result.exit_code == 0, result.output
-    assert len(printed) == 1
-    return result, chart, printed[0]
+    assert len(printed) == len(loaded) == 1
+    return SubsetRun(result, chart, printed[0], loaded[0])
 
 
 @needs_collection
-def test_subset_end_to_end(subset: Path, subset_run: tuple[Result, Path, CollectionReport]) -> None:
-    report = subset_run[2]
+def test_subset_end_to_end(subset: Path, subset_run: SubsetRun) -> None:
+    report = subset_run.report
     assert set(report.methods) == set(METHODS)
     assert report.queries == 2 and report.services == len(list((subset / "services").iterdir()))
     assert report.unmatched_requests == [] and report.unmatched_offers == 0
@@ -131,12 +155,12 @@ def test_subset_end_to_end(subset: Path, subset_run: tuple[Result, Path, Collect
 
 
 @needs_collection
-def test_cbrs_eval_owls_tc_json_and_plot(subset: Path, subset_run: tuple[Result, Path, CollectionReport]) -> None:
-    result, chart, printed = subset_run
-    data = json.loads(result.stdout)
-    assert data == printed.to_json()
+def test_cbrs_eval_owls_tc_json_and_plot(subset: Path, subset_run: SubsetRun, monkeypatch: pytest.MonkeyPatch) -> None:
+    data = json.loads(subset_run.result.stdout)
+    assert data == subset_run.report.to_json()
     assert data["queries"] == 2 and set(data["methods"]) == set(METHODS)
     # --method picks the methods; the hybrid's text weight is a setting: at 0 it ranks as Sem-Str does
+    monkeypatch.setattr(owlstc, "load_collection", lambda *_, **__: subset_run.loaded)  # loaded by the run above
     plain = CliRunner().invoke(
         cli,
         [
@@ -158,7 +182,7 @@ def test_cbrs_eval_owls_tc_json_and_plot(subset: Path, subset_run: tuple[Result,
     figures = methods["sem-str-text"]
     assert {k: figures[k] for k in ("map", "ndcg")} == {k: data["methods"]["sem-str"][k] for k in ("map", "ndcg")}
     assert set(data["methods"]["sem-str"]) == {"map", "ndcg", "p_at_1", "p_at_10", "r_precision", "query_ms"}
-    assert chart.read_bytes()[:4] == b"\x89PNG"
+    assert subset_run.chart.read_bytes()[:4] == b"\x89PNG"
 
 
 def test_cbrs_eval_owls_tc_refuses_a_folder_of_the_wrong_shape(tmp_path: Path) -> None:
