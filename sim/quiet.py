@@ -1,8 +1,15 @@
 """Keep pybullet's start-up banner off the terminal.
 
-pybullet's C code prints "pybullet build time: ..." when it is imported and when a client connects,
-which spoils machine-readable output such as ``cbrs run --json``. The banner is written to the file
-descriptors directly, so they are redirected there, not at the Python level.
+pybullet's C code prints "pybullet build time: ..." when it is imported (and a GUI client may print
+when it connects), which spoils machine-readable output such as ``cbrs run --json``. The banner is
+written to the file descriptors directly, so they are redirected there, not at the Python level.
+
+A redirection of descriptors 1 and 2 is the whole process's, not the calling thread's: in ``cbrs
+serve`` pybullet is first imported on a thread (a task run, the first page's preload), and while it
+was, the server's own output went to the null device; a Ctrl-C then lost "stopped" for good, the
+thread being stopped before it could put the descriptors back. So the banner is kept off only while
+the calling thread is the process's only one (a CLI command); with other threads running it is let
+through: one line in a server's log is harmless, its own lines lost are not.
 """
 
 from __future__ import annotations
@@ -11,6 +18,7 @@ import contextlib
 import ctypes
 import os
 import sys
+import threading
 from collections.abc import Iterator
 
 __all__ = ["quiet_output"]
@@ -18,7 +26,11 @@ __all__ = ["quiet_output"]
 
 @contextlib.contextmanager
 def quiet_output() -> Iterator[None]:
-    """Send what C code writes to file descriptors 1 and 2 to the null device for the duration."""
+    """Send what C code writes to file descriptors 1 and 2 to the null device for the duration, when
+    no other thread runs (their output would go there too)."""
+    if threading.active_count() > 1:
+        yield
+        return
     sys.stdout.flush()
     sys.stderr.flush()
     try:
