@@ -1,39 +1,87 @@
 """The cbrs knowledge base: an Oxigraph store (embedded, or a SPARQL server) of ontologies, advertisements and
-requirements."""
+requirements.
 
-from cbrs.kb.catalog import Catalogue
-from cbrs.kb.errors import (
-    AlreadyRegisteredError,
-    BindingError,
-    CatalogueError,
-    InvalidDescriptionError,
-    KnowledgeBaseError,
-    NotFoundError,
-    QuerySyntaxError,
-    RdfParseError,
-    RemoteStoreError,
-    ReplaceError,
-    StoreError,
-    StoreEvaluationError,
-    UnknownFormatError,
-    UnknownGraphError,
-    UnknownQueryError,
-)
-from cbrs.kb.knowledge_base import KnowledgeBase
-from cbrs.kb.loader import LoadReport
-from cbrs.kb.model import (
-    Advertisement,
-    EffectiveArea,
-    Parameter,
-    PartNode,
-    Port,
-    QoSValue,
-    Requirement,
-    ServiceDescription,
-    Statement,
-)
-from cbrs.kb.namespaces import PREFIXES, GraphName
-from cbrs.kb.store import EmbeddedStore, Store
+The names below load their modules on first use, as :mod:`cbrs.actions`'s do: a program that needs
+only a light module of the package (a component program's ``cbrs.kb.errors``) does not pay for the
+store, the loader and backup.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from cbrs.kb.catalog import Catalogue
+    from cbrs.kb.errors import (
+        AlreadyRegisteredError,
+        BindingError,
+        CatalogueError,
+        InvalidDescriptionError,
+        KnowledgeBaseError,
+        NotFoundError,
+        QuerySyntaxError,
+        RdfParseError,
+        RemoteStoreError,
+        ReplaceError,
+        StoreError,
+        StoreEvaluationError,
+        UnknownFormatError,
+        UnknownGraphError,
+        UnknownQueryError,
+    )
+    from cbrs.kb.knowledge_base import KnowledgeBase
+    from cbrs.kb.loader import LoadReport
+    from cbrs.kb.model import (
+        Advertisement,
+        EffectiveArea,
+        Parameter,
+        PartNode,
+        Port,
+        QoSValue,
+        Requirement,
+        ServiceDescription,
+        Statement,
+    )
+    from cbrs.kb.namespaces import PREFIXES, GraphName
+    from cbrs.kb.store import EmbeddedStore, Store
+
+_HOMES = {
+    "cbrs.kb.catalog": ("Catalogue",),
+    "cbrs.kb.errors": (
+        "AlreadyRegisteredError",
+        "BindingError",
+        "CatalogueError",
+        "InvalidDescriptionError",
+        "KnowledgeBaseError",
+        "NotFoundError",
+        "QuerySyntaxError",
+        "RdfParseError",
+        "RemoteStoreError",
+        "ReplaceError",
+        "StoreError",
+        "StoreEvaluationError",
+        "UnknownFormatError",
+        "UnknownGraphError",
+        "UnknownQueryError",
+    ),
+    "cbrs.kb.knowledge_base": ("KnowledgeBase",),
+    "cbrs.kb.loader": ("LoadReport",),
+    "cbrs.kb.model": (
+        "Advertisement",
+        "EffectiveArea",
+        "Parameter",
+        "PartNode",
+        "Port",
+        "QoSValue",
+        "Requirement",
+        "ServiceDescription",
+        "Statement",
+    ),
+    "cbrs.kb.namespaces": ("PREFIXES", "GraphName"),
+    "cbrs.kb.store": ("EmbeddedStore", "Store"),
+}
+_WHERE = {name: module for module, names in _HOMES.items() for name in names}
 
 __all__ = [
     "PREFIXES",
@@ -68,3 +116,12 @@ __all__ = [
     "UnknownGraphError",
     "UnknownQueryError",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    module = _WHERE.get(name)
+    if module is None:
+        raise AttributeError(f"module 'cbrs.kb' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
