@@ -19,6 +19,7 @@ from typing import Any, Protocol
 from cbrs.actions.answers import Classes, ContradictedEffectError, read_answer
 from cbrs.actions.breaker import BreakerPolicy, busy, calls_of
 from cbrs.actions.components import Component, Status
+from cbrs.actions.remote_errors import RemoteCallError
 from cbrs.kb import Statement
 
 __all__ = ["LATE_WINDOW", "MAX_POLLS", "POLL_SECONDS", "RemoteCallError", "RemoteComponent", "Transport", "given_up"]
@@ -35,10 +36,6 @@ LATE_WINDOW = 2.0
 """The transport is given this many times the component's timeout: a call the component has given up
 stays open at the bridge for as long again, so that the provider's late answer is still heard and,
 until it is, no new call is sent to a service that may still be executing the last one (an actuator)."""
-
-
-class RemoteCallError(Exception):
-    """A remote service answered with ``result: false``; the message is its reason."""
 
 
 class Transport(Protocol):

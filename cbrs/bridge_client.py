@@ -21,7 +21,7 @@ from typing import Any
 from websockets.exceptions import ConnectionClosed, InvalidHandshake, InvalidURI
 from websockets.sync.client import ClientConnection, connect
 
-from cbrs.actions.remote import RemoteCallError
+from cbrs.actions.remote_errors import RemoteCallError
 
 __all__ = ["BridgeClient", "BridgeClosedError", "HandlerAnswerError", "ServiceHandler"]
 
