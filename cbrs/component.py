@@ -32,14 +32,12 @@ from typing import Any
 
 import pyoxigraph as ox
 
-from cbrs.actions.remote import RemoteCallError
+from cbrs.actions.remote_errors import RemoteCallError
 from cbrs.bridge_client import BridgeClient, BridgeClosedError, ServiceHandler
+from cbrs.component_protocol import DEFAULT_TTL, DEREGISTERED, FORMATS, NO_LIVE_COMPONENT, UNPROVIDED, grounding
 from cbrs.kb.errors import InvalidDescriptionError
-from cbrs.kb.loader import parse_bytes
 from cbrs.kb.namespaces import BASE, RDF, GraphName, shorten
-from cbrs.kb.shapes import nearest_term
 from cbrs.kb.vocab import CBRS
-from cbrs.live_components import DEFAULT_TTL, DEREGISTERED, FORMATS, NO_LIVE_COMPONENT, UNPROVIDED, grounding
 from cbrs.stop_signals import POLL, StopRequest, handling
 
 __all__ = ["Component", "ComponentEndedError", "ConnectedComponent", "RegistrationRefusedError"]
@@ -83,11 +81,7 @@ class Component:
             raise ValueError(f"unknown description format {format!r}; use {' or '.join(FORMATS)}")
         self.description = description
         self.format = format
-        raw = description.encode("utf-8")
-        if format == "turtle":
-            quads = parse_bytes(raw, "<component>", ox.RdfFormat.TURTLE, GraphName.SERVICES, BASE).quads
-        else:
-            quads = [ox.Quad(t.subject, t.predicate, t.object) for t in ox.parse(raw, format=FORMATS[format])]
+        quads = _quads(description.encode("utf-8"), format)
         named = sorted(
             {
                 q.subject.value
@@ -410,9 +404,32 @@ def _servers_reason(client: BridgeClient, refusal: str) -> str:
     return f"{refused[-1]} (so: {refusal})" if refused else refusal
 
 
+def _quads(raw: bytes, format: str) -> list[ox.Quad]:
+    """The description's triples, for finding its component and service port.
+
+    A Turtle description that Oxigraph parses as it is is read here; only one it refuses (or with NUL
+    bytes, which the loader refuses) goes through the loader (:func:`cbrs.kb.loader.parse_bytes`), whose
+    error names the line and the fault, as it did when every description went that way. The loader's
+    other work (blank nodes named, the graph set) only matters to a store, and importing it would
+    bring the store, the shapes and the SPARQL queries into every component's program. The server
+    validates the whole description again when it registers it."""
+    if format != "turtle":
+        return [ox.Quad(t.subject, t.predicate, t.object) for t in ox.parse(raw, format=FORMATS[format])]
+    if b"\x00" not in raw:
+        try:
+            return list(ox.parse(raw, format=ox.RdfFormat.TURTLE, base_iri=BASE))
+        except (SyntaxError, ValueError):
+            pass
+    from cbrs.kb.loader import parse_bytes  # here: only a faulty description needs the loader
+
+    return parse_bytes(raw, "<component>", ox.RdfFormat.TURTLE, GraphName.SERVICES, BASE).quads
+
+
 def _grounding_slips(quads: list[ox.Quad]) -> list[str]:
     """Did-you-means (the shapes' own) for a service port the description misspelt: a property near
     cbrs:topic, cbrs:messageType or cbrs:hasPort, a class near cbrs:ServicePort."""
+    from cbrs.kb.shapes import nearest_term  # here: only a faulty description needs the shapes
+
     wanted = [CBRS.topic, CBRS.messageType, CBRS.hasPort]
     slips = set()
     for quad in quads:

@@ -31,10 +31,11 @@ from typing import Any
 
 import pyoxigraph as ox
 
+from cbrs.component_protocol import DEFAULT_TTL, DEREGISTERED, FORMATS, NO_LIVE_COMPONENT, UNPROVIDED, grounding
 from cbrs.kb.errors import AlreadyRegisteredError, InvalidDescriptionError, KnowledgeBaseError
 from cbrs.kb.liveness import ComponentState
 from cbrs.kb.loader import parse_bytes
-from cbrs.kb.namespaces import BASE, RDF, GraphName, shorten
+from cbrs.kb.namespaces import BASE, GraphName, shorten
 from cbrs.kb.store import EmbeddedStore
 from cbrs.kb.vocab import CBRS
 from cbrs.rosbridge import ServiceError, current_caller
@@ -58,20 +59,10 @@ __all__ = [
 
 log = logging.getLogger("cbrs.live_components")
 
-DEFAULT_TTL = 3.0
-"""Seconds a lease lasts unless renewed: three missed one-second heartbeats."""
 MAX_DESCRIPTION_BYTES = 256 << 10
 """A six-tuple description is a few kilobytes; anything near this is not one."""
-FORMATS = {"turtle": ox.RdfFormat.TURTLE, "json-ld": ox.RdfFormat.JSON_LD}
 SERVER_NAMESPACES = ("/cbrs/", "/rosapi/")
 """Service namespaces the server answers itself: no component is grounded on them."""
-NO_LIVE_COMPONENT = "this session has no live component"
-"""How a heartbeat says the session's registration is gone (its lease lapsed): register again."""
-DEREGISTERED = "was deregistered"
-UNPROVIDED = "no bridge client provides its service"
-"""How a lease ended because nobody answers the component's service: a bridge registration whose program
-never advertised the service its description names (a misspelt name), or an HTTP one whose provider left."""
-"""How a heartbeat says a component was deregistered (``cbrs deregister``): do not register it again."""
 STALL_PERIODS = 4
 """A gap of more than this many watchdog periods (1 s at the default lease) between two moments this
 server kept time means it stood still (stopped, suspended, starved): no lease is charged for it."""
@@ -144,19 +135,6 @@ class _Lease:
     deadline: float  # monotonic seconds
     ttl: float
     written_until: float  # the monotonic time the stored leaseUntil corresponds to
-
-
-def grounding(quads: list[ox.Quad], component: str) -> tuple[str, str] | None:
-    """The rosbridge service and its type a description's service port names, if one does."""
-    ports = [q.object for q in quads if q.subject == ox.NamedNode(component) and q.predicate.value == CBRS.hasPort]
-    for port in ports:
-        facts: dict[str, str] = {}
-        for q in quads:
-            if q.subject == port and isinstance(q.object, ox.NamedNode | ox.Literal):
-                facts.setdefault(q.predicate.value, q.object.value)
-        if facts.get(RDF + "type") == CBRS.ServicePort and CBRS.topic in facts and CBRS.messageType in facts:
-            return facts[CBRS.topic], facts[CBRS.messageType]
-    return None
 
 
 class LiveComponents:
