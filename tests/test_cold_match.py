@@ -105,9 +105,10 @@ def _cbrs(*args: str) -> str:
     return done.stdout
 
 
-def _load(*args: str) -> None:
-    """``cbrs load`` in this process: the loads are not what is compared, the fresh process's match is."""
-    result = CliRunner().invoke(cli, ["--store", *args[:1], "load", *args[1:]])
+def _load(store: str, *args: str) -> None:
+    """``cbrs --store STORE load ARGS`` in this process: the loads are not what is compared, the fresh
+    process's match is."""
+    result = CliRunner().invoke(cli, ["--store", store, "load", *args])
     assert result.exit_code == 0, result.output
 
 
