@@ -16,7 +16,8 @@ What is entailed, each conclusion in a standard namespace (``align:standardNames
 - the **domains, ranges and inverses** of those standard properties (RDFS rules 2 and 3, ``owl:inverseOf``);
 - **rules**: the answers of the CONSTRUCT queries in ``align:rule`` annotations of the bundled alignments.
 
-Statements about blank nodes are not materialised (cbrs names every node it loads).
+Statements about blank nodes are not materialised (cbrs names every node it loads). The statements are
+read all terms at once (:mod:`kb.statement_reads`), so a refresh costs a remote store a few requests.
 """
 
 from __future__ import annotations
@@ -33,6 +34,7 @@ from cbrs.kb.errors import StoreError
 from cbrs.kb.namespaces import OWL, PREFIXES, RDF, RDFS, XSD, GraphName
 from cbrs.kb.resources import ontology_dir
 from cbrs.kb.results import releases_results
+from cbrs.kb.statement_reads import statements
 from cbrs.kb.store import EmbeddedStore, Store
 from cbrs.kb.update_delta import DataUpdate
 
@@ -55,10 +57,8 @@ _LINK_QUERY = (
 )
 _LINK_SET = frozenset(_LINKS) | {ALIGN + "standardNamespace"}
 _NAMESPACE_QUERY = "SELECT DISTINCT ?namespace WHERE { ?vocabulary align:standardNamespace ?namespace }"
-_TYPE_QUERY = "SELECT ?s ?c WHERE { GRAPH ?g { ?s a ?c } FILTER (?g != graph:entailed && isIRI(?s)) }"
-_STATEMENT_QUERY = "SELECT ?s ?p ?o WHERE { GRAPH ?g { ?s ?p ?o } FILTER (?g != graph:entailed && isIRI(?s)) }"
 #: The query texts above: cbrs's own, so they skip the query guard's checker (:func:`kb.store.bundled_query_texts`).
-OWN_QUERIES = (_LINK_QUERY, _NAMESPACE_QUERY, _TYPE_QUERY, _STATEMENT_QUERY)
+OWN_QUERIES = (_LINK_QUERY, _NAMESPACE_QUERY)
 
 
 @dataclass(frozen=True)
@@ -344,24 +344,19 @@ class StandardTerms:
         return Refresh(first.added + second.added, first.removed + second.removed, -1)
 
     def _wanted(self, alignment: Alignment, nodes: Iterable[ox.NamedNode]) -> set[ox.Quad]:
-        """What the statements of the store entail one by one about ``nodes`` (:meth:`_closure`'s part)."""
-        found: set[ox.Quad] = set()
+        """What the statements of the store entail one by one about ``nodes`` (:meth:`_closure`'s part), from
+        the statements about them, and those they are the object of whose property reaches its object (a
+        range, an inverse): read for all the nodes at once, so what one node's statements entail about
+        another is among what that one's own reading would give."""
+        about = set(nodes)
+        if not about:
+            return set()
         reaching = [ox.NamedNode(p) for p in sorted(alignment.object_reaching)]
-        for node in nodes:
-            triples: set[ox.Triple] = set()
-            asserted: set[ox.Triple] = set()
-            for quad in self.store.quads(node):
-                if _read(quad):
-                    triple = ox.Triple(quad.subject, quad.predicate, quad.object)
-                    if alignment.is_read(triple):
-                        asserted.add(triple)
-                        triples.update(alignment.entailments(triple))
-            for predicate in reaching:
-                for quad in self.store.quads(None, predicate, node):
-                    if _read(quad):
-                        triples.update(alignment.entailments(ox.Triple(quad.subject, quad.predicate, quad.object)))
-            found.update(_quad(t) for t in triples - asserted if t.subject == node and _named(t))
-        return found
+        listed = sorted(about, key=str)
+        read = statements(self.store, [{"s": listed}, {"o": listed, "p": reaching}])
+        asserted = {t for t in read if alignment.is_read(t)}
+        triples = {t for statement in read for t in alignment.entailments(statement)}
+        return {_quad(t) for t in triples - asserted if t.subject in about and _named(t)}
 
     def _asserted(self, alignment: Alignment, quad: ox.Quad) -> bool:
         """Whether :meth:`_closure` reads ``quad``'s statement from the store (so it is no conclusion)."""
@@ -377,16 +372,10 @@ class StandardTerms:
         """What the statements of the store entail one by one, and the statements read for it."""
         if not alignment.namespaces:
             return set(), set()
-        triples: set[ox.Triple] = set()
-        asserted: set[ox.Triple] = set()
-        for cls in sorted(alignment.classes()):
-            for row in _rows(self.store, _TYPE_QUERY, {"c": ox.NamedNode(cls)}):
-                asserted.add(ox.Triple(row["s"], _TYPE, row["c"]))
-                triples.update(alignment.typed(row["s"], cls))
-        for prop in sorted(alignment.properties()):
-            for row in _rows(self.store, _STATEMENT_QUERY, {"p": ox.NamedNode(prop)}):
-                asserted.add(ox.Triple(row["s"], row["p"], row["o"]))
-                triples.update(alignment.statement(row["s"], prop, row["o"]))
+        classes = [ox.NamedNode(c) for c in sorted(alignment.classes())]
+        properties = [ox.NamedNode(p) for p in sorted(alignment.properties())]
+        asserted = statements(self.store, [{"p": [_TYPE], "o": classes}, {"p": properties}])
+        triples = {t for statement in asserted for t in alignment.entailments(statement)}
         return {_quad(t) for t in triples - asserted if _named(t)}, {_quad(t) for t in asserted}
 
     @releases_results
