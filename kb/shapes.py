@@ -19,6 +19,7 @@ shapes only: their unresolved concepts are reported by the loader, not refused.
 
 from __future__ import annotations
 
+import datetime
 import difflib
 import functools
 import logging
@@ -330,9 +331,13 @@ def _is_inner(term: object) -> bool:
 
 @functools.cache
 def _shapes_graph() -> Any:
-    import rdflib
-
-    return rdflib.Graph().parse(ontology_dir() / SHAPES_FILE, format="turtle")
+    """The shapes file as pySHACL reads it, an rdflib graph, parsed once a process. Oxigraph parses it
+    in a quarter of rdflib's time (48 -> 13 ms, in every command that checks a description)."""
+    parser = ox.parse(path=ontology_dir() / SHAPES_FILE, format=ox.RdfFormat.TURTLE)
+    graph = _rdflib_graph(ox.Triple(q.subject, q.predicate, q.object) for q in parser)
+    for prefix, namespace in parser.prefixes.items():  # known once the file is read
+        graph.bind(prefix, namespace)
+    return graph
 
 
 def _shape_problems(closures: dict[str, list[ox.Quad]]) -> list[ShapeProblem]:
@@ -345,7 +350,7 @@ def _shape_problems(closures: dict[str, list[ox.Quad]]) -> list[ShapeProblem]:
     owner = {q.subject: root for root, quads in closures.items() for q in quads}
     triples = [ox.Triple(q.subject, q.predicate, q.object) for quads in closures.values() for q in quads]
     data = _rdflib_graph(triples)
-    conforms, results, _ = validate(data, shacl_graph=_shapes_graph(), inference="none", allow_warnings=True)
+    conforms, results, _ = validate(data, shacl_graph=_shapes_for(data), inference="none", allow_warnings=True)
     if conforms:
         return []
     problems = []
@@ -373,6 +378,161 @@ def _shape_problems(closures: dict[str, list[ox.Quad]]) -> list[ShapeProblem]:
             )
         )
     return sorted(set(problems), key=lambda p: (p.description, p.path or "", p.message))
+
+
+@dataclass(frozen=True)
+class _DatatypeChoice:
+    """A node shape whose one test is an ``sh:or`` of bare ``sh:datatype`` branches (shape:Number's
+    numeric types, shape:Text's string types), and the properties whose objects include every value it
+    is given (through ``sh:node`` from property shapes with those paths, directly or by way of other
+    node shapes such as shape:Name)."""
+
+    shape: Any
+    datatypes: frozenset[str]
+    properties: frozenset[Any]
+
+
+@functools.cache
+def _datatype_choices() -> tuple[_DatatypeChoice, ...]:
+    """The datatype choices of the shapes file that a check may settle before pySHACL runs
+    (:func:`_shapes_for`). A shape reached in any other way (a target of its own, an ``sh:or`` member,
+    a path other than a property or a choice of properties) is left to pySHACL."""
+    import rdflib
+
+    graph = _shapes_graph()
+    either = rdflib.URIRef(SH + "or")
+    choices = []
+    for shape in sorted(set(graph.subjects(either, None)), key=str):
+        branches = list(graph.objects(shape, either))
+        datatypes = _bare_datatypes(graph, branches[0]) if len(branches) == 1 else None
+        properties = _reached_through(graph, shape, frozenset())
+        if datatypes and properties is not None:
+            choices.append(_DatatypeChoice(shape, datatypes, properties))
+    return tuple(choices)
+
+
+def _bare_datatypes(graph: Any, branches: Any) -> frozenset[str] | None:
+    """The datatypes of an ``sh:or`` list each of whose members is a blank node saying ``sh:datatype``
+    and nothing else; None for any other list."""
+    import rdflib
+
+    datatypes = set()
+    for member in graph.items(branches):
+        said = list(graph.predicate_objects(member))
+        if not isinstance(member, rdflib.BNode) or len(said) != 1 or said[0][0] != rdflib.URIRef(SH + "datatype"):
+            return None
+        datatypes.add(str(said[0][1]))
+    return frozenset(datatypes) or None
+
+
+_TARGETS = ("target", "targetNode", "targetClass", "targetSubjectsOf", "targetObjectsOf")
+
+
+def _reached_through(graph: Any, shape: Any, seen: frozenset[Any]) -> frozenset[Any] | None:
+    """The properties whose objects include every value ``shape`` is checked on, or None when it is
+    reached otherwise than by ``sh:node`` (or has targets of its own, or is a class: an implicit target)."""
+    import rdflib
+
+    if shape in seen or any(graph.value(shape, rdflib.URIRef(SH + t)) is not None for t in _TARGETS):
+        return None
+    if any((shape, rdflib.RDF.type, kind) in graph for kind in (rdflib.RDFS.Class, rdflib.OWL.Class)):
+        return None
+    properties: set[Any] = set()
+    for referrer, link in graph.subject_predicates(shape):
+        if link != rdflib.URIRef(SH + "node"):
+            return None
+        path = graph.value(referrer, rdflib.URIRef(SH + "path"))
+        found = _reached_through(graph, referrer, seen | {shape}) if path is None else _path_properties(graph, path)
+        if found is None:
+            return None
+        properties |= found
+    return frozenset(properties)
+
+
+def _path_properties(graph: Any, path: Any) -> frozenset[Any] | None:
+    """The properties of a path that is one property or an ``sh:alternativePath`` of properties; else None."""
+    import rdflib
+
+    if isinstance(path, rdflib.URIRef):
+        return frozenset({path})
+    said = list(graph.predicate_objects(path))
+    if len(said) != 1 or said[0][0] != rdflib.URIRef(SH + "alternativePath"):
+        return None
+    properties = list(graph.items(said[0][1]))
+    return frozenset(properties) if properties and all(isinstance(p, rdflib.URIRef) for p in properties) else None
+
+
+def _shapes_for(data: Any) -> Any:
+    """The shapes to check ``data`` against: the shapes file, less each datatype choice that every value
+    it could be given in ``data`` already passes. pySHACL tries every branch of an ``sh:or`` and builds
+    a report for each one that fails, to throw it away: 15 for every number against shape:Number's 16
+    types, 70% of the paper testbed's check. A choice is left out only when no value of its properties
+    could fail it, so no verdict changes; with one value that might (a word, "abc"^^xsd:double, an
+    IRI), that choice is checked by pySHACL for the whole input, as before."""
+    settled = frozenset(
+        choice.shape
+        for choice in _datatype_choices()
+        if all(_has_datatype(value, choice.datatypes) for p in choice.properties for value in data.objects(None, p))
+    )
+    return _shapes_without(settled) if settled else _shapes_graph()
+
+
+# The Python value rdflib gives a well-typed literal of a datatype that SHACL's sh:datatype test of
+# pySHACL also checks the value of; for any other datatype, not being ill-typed is enough.
+_PYTHON_VALUES: dict[str, type | tuple[type, ...]] = {
+    XSD + "string": str,
+    RDF + "langString": str,
+    XSD + "integer": int,
+    XSD + "float": float,
+    XSD + "decimal": Decimal,
+    XSD + "boolean": bool,
+    XSD + "date": datetime.date,
+    XSD + "time": datetime.time,
+    XSD + "dateTime": datetime.datetime,
+}
+
+
+def _has_datatype(value: Any, datatypes: frozenset[str]) -> bool:
+    """Whether ``value`` passes ``sh:datatype`` for one of ``datatypes``: a literal of that datatype, not
+    ill-typed ("abc"^^xsd:double is no xsd:double); a literal without a tag is an xsd:string, one with a
+    language tag an rdf:langString. Saying no when unsure costs time, not a verdict: pySHACL decides."""
+    import rdflib
+
+    if not isinstance(value, rdflib.Literal) or value.ill_typed:
+        return False
+    datatype = RDF + "langString" if value.language else str(value.datatype or XSD + "string")
+    return datatype in datatypes and isinstance(value.value, _PYTHON_VALUES.get(datatype, object))
+
+
+@functools.cache
+def _shapes_without(settled: frozenset[Any]) -> Any:
+    """The shapes graph without the ``sh:or`` of the ``settled`` choices, and without the ``sh:node``
+    links to a shape then left with no test (shape:Text): an empty shape passes every value."""
+    import rdflib
+
+    graph = _shapes_graph()
+    either = rdflib.URIRef(SH + "or")
+    dropped = set()
+    for shape in settled:
+        for branches in graph.objects(shape, either):
+            dropped.add((shape, either, branches))
+            cells = [branches]
+            while cells[-1] != rdflib.RDF.nil:
+                cells.append(graph.value(cells[-1], rdflib.RDF.rest))
+            for cell in cells[:-1]:
+                dropped |= set(graph.triples((cell, None, None)))
+                dropped |= set(graph.triples((graph.value(cell, rdflib.RDF.first), None, None)))
+    untested = {rdflib.RDF.type, rdflib.RDFS.comment, rdflib.RDFS.label}
+    for shape in settled:
+        if {p for p, _ in graph.predicate_objects(shape)} <= untested | {either}:
+            dropped |= set(graph.triples((None, rdflib.URIRef(SH + "node"), shape)))
+    lighter = rdflib.Graph()
+    for prefix, namespace in graph.namespaces():
+        lighter.bind(prefix, namespace)
+    for triple in graph:
+        if triple not in dropped:
+            lighter.add(triple)
+    return lighter
 
 
 def _rdflib_graph(triples: Iterable[ox.Triple]) -> Any:
