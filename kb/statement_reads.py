@@ -26,7 +26,6 @@ from collections.abc import Iterator, Mapping, Sequence
 import pyoxigraph as ox
 
 from cbrs.kb.namespaces import GraphName
-from cbrs.kb.remote_store import RemoteStore, sparql_term
 from cbrs.kb.results import releases_results
 from cbrs.kb.store import EmbeddedStore, Store
 
@@ -48,6 +47,8 @@ def statements(store: Store, patterns: Sequence[Pattern]) -> set[ox.Triple]:
     patterns = [p for p in patterns if all(p.values())]
     if isinstance(store, EmbeddedStore):
         return _looked_up(store, patterns)
+    from cbrs.kb.remote_store import RemoteStore  # the HTTP client: only for a remote store (a CLI start)
+
     found: set[ox.Triple] = set()
     pages = not (isinstance(store, RemoteStore) and store.server == "oxigraph")
     for text in queries(patterns):
@@ -60,6 +61,8 @@ def queries(patterns: Sequence[Pattern]) -> Iterator[str]:
     block per position it names, or several for a pattern of more than :data:`TERMS_PER_QUERY` terms.
     Patterns are not joined by ``UNION``: Virtuoso 7 answered ``?p`` as a string literal, in an ordered
     (so a paged) query, when every branch bound it to the same IRI (a class list split in two)."""
+    from cbrs.kb.remote_store import sparql_term
+
     for pattern in patterns:
         for part in _split(pattern):
             blocks = " ".join(
