@@ -22,6 +22,7 @@ from pathlib import Path
 
 import pyoxigraph as ox
 from remote_store import oxigraph_server
+from standard_terms import CAMERA, REGISTRATION  # the same registration as the embedded bench's
 from timing import median_ms
 
 from cbrs.kb import KnowledgeBase
@@ -29,16 +30,6 @@ from cbrs.kb.namespaces import GraphName
 from cbrs.kb.remote_store import RemoteStore
 
 DATA = Path(__file__).resolve().parents[1] / "tests" / "data"
-CAMERA = "https://w3id.org/cbrs/service#BenchCamera"
-REGISTRATION = f"""@prefix cbrs: <https://w3id.org/cbrs/core#> . @prefix home: <https://w3id.org/cbrs/home#> .
-<{CAMERA}> a cbrs:DynamicPerceptionComponent ;
-    cbrs:device <https://w3id.org/cbrs/service#CeilingCamera02> ;
-    cbrs:deviceName "CeilingCamera02" ; cbrs:serviceName "LocateMobileRobot" ;
-    cbrs:hasOWLSModel [ a cbrs:OWLSModel ;
-        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterType home:MarkerColour ] ;
-        cbrs:hasOutput [ a cbrs:Parameter ; cbrs:parameterType home:RobotLocation ] ] ;
-    cbrs:hasQoSModel [ a cbrs:QoSModel ; cbrs:updateRate 5.0 ] .
-"""
 UPDATE = "INSERT DATA { GRAPH <urn:bench:g> { <urn:bench:s> a home:Sensor } }"
 
 
