@@ -5,12 +5,11 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from urllib.parse import quote
 
 import click
 
 from cbrs.app import App, pass_app
-from cbrs.home_plan import DEFAULT_WIDTH, HomeSurvey, draw_home, survey
+from cbrs.home_plan import DEFAULT_WIDTH, HomeSurvey, draw_home, resource_link, survey
 from cbrs.kb.namespaces import shorten
 from cbrs.kb.semantic_map import local_name
 from cbrs.settings import setting
@@ -45,9 +44,7 @@ def home(app: App, drawing: Path | None, width: int, browser: str | None, as_jso
     written = None
     entries = []
     if drawing is not None and found.semantic_map is not None:
-        picture = draw_home(
-            found.semantic_map, found.believed, width, link=lambda iri: f"{root}/resource?iri={quote(iri, safe='')}"
-        )
+        picture = draw_home(found.semantic_map, found.believed, width, link=lambda iri: root + resource_link(iri))
         drawing.write_text(picture.svg, encoding="utf-8")
         written = str(drawing)
         entries = [entry.to_dict() for entry in picture.entries]
