@@ -12,10 +12,24 @@ and :data:`OTHER_IMAGE_SIZE` otherwise (the top of the image up). ``sim.world`` 
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
 
-from cbrs.kb.semantic_map import Camera
+from cbrs.kb.semantic_map import Box, Camera, SemanticMap, local_name
 
-__all__ = ["DOWNWARD_IMAGE_SIZE", "OTHER_IMAGE_SIZE", "default_image_size", "floor_view", "focal_length", "image_up"]
+__all__ = [
+    "DOWNWARD_IMAGE_SIZE",
+    "MAX_HIDDEN",
+    "OTHER_IMAGE_SIZE",
+    "Occluder",
+    "default_image_size",
+    "floor_view",
+    "focal_length",
+    "hidden",
+    "image_up",
+    "occluders",
+    "sight_blocked",
+]
 
 DOWNWARD_IMAGE_SIZE = (320, 240)
 """Width and height (pixels) of a camera that looks straight down: the ceiling cameras, 4.5 m up
@@ -28,7 +42,100 @@ the cup within 0.72 cm, the pen within 0.19 cm and the pen's yaw within 0.021 ra
 and 0.018 rad at 320 x 240; at 160 x 120 the yaw was off by up to 0.047 rad, near the tests' 0.05),
 and a frame costs about 15 ms instead of 33-38."""
 
+MAX_HIDDEN = 0.0
+"""The largest fraction of the sight lines to a thing's outline that the map's solid boxes may cut for a
+camera still to see the thing whole (:func:`hidden`). None, by default: perception refuses a blob the
+image's border cuts, and a blob a cupboard cuts is as wrong a measure of where the thing is (its centre
+moves towards the part in view). A box of the map is its piece's bounding box (a table's legs and the
+space between them are one solid block), so a lab whose map boxes are coarser than what they stand for
+may allow a part."""
+SURFACE = 0.001
+"""How far (m) a sight line may run inside a box at its far end and still pass: an object's bottom rests
+on its support's top face, where the line to a point of its bottom rim ends."""
+
 Vec3 = tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class Occluder:
+    """A solid box of the map that a camera cannot see through: a wall, a piece of furniture, an
+    appliance or a robot's body (``iri``, its extent)."""
+
+    iri: str
+    box: Box
+
+
+def occluders(semantic_map: SemanticMap) -> list[Occluder]:
+    """The map's solid boxes, which hide what is behind them from a camera: its walls, furniture,
+    appliances (a dispenser's body) and robots' bodies (the dual-arm robot's torso). Not the movable
+    objects (small, and wherever a run has put them), the person, the mobile base (it drives) or a
+    camera's housing (its own eye is inside it)."""
+    smap = semantic_map
+    solid = smap.walls | smap.furniture | smap.bodies | {d.iri for d in smap.dispensers.values()}
+    solid -= smap.robots.keys() | smap.cameras.keys()
+    return [Occluder(iri, smap.things[iri].box) for iri in sorted(solid) if iri in smap.things]
+
+
+def sight_blocked(eye: Sequence[float], point: Sequence[float], boxes: Iterable[Occluder]) -> list[str]:
+    """The occluders the straight line from ``eye`` to ``point`` runs through, in the map's order: an
+    occluder counts when the line enters its box's inside (a slab test, axis by axis) more than
+    :data:`SURFACE` before the point. A line that only grazes a face, or ends on one, passes."""
+    delta = [p - e for p, e in zip(point, eye, strict=True)]
+    length = math.sqrt(sum(d * d for d in delta))
+    if length == 0.0:
+        return []
+    end = 1.0 - SURFACE / length
+    cut = []
+    for occluder in boxes:
+        b = occluder.box
+        low, high = 0.0, end
+        for start, step, lo, hi in zip(
+            eye, delta, (b.min_x, b.min_y, b.min_z), (b.max_x, b.max_y, b.max_z), strict=True
+        ):
+            if step == 0.0:
+                if not lo < start < hi:
+                    low, high = 1.0, 0.0
+                    break
+                continue
+            t0, t1 = sorted(((lo - start) / step, (hi - start) / step))
+            low, high = max(low, t0), min(high, t1)
+            if low >= high:
+                break
+        if low < high:
+            cut.append(occluder.iri)
+    return cut
+
+
+def hidden(
+    eye: Sequence[float],
+    points: Iterable[Sequence[float]],
+    boxes: Sequence[Occluder],
+    max_hidden: float = MAX_HIDDEN,
+) -> str:
+    """Why a camera whose eye is at ``eye`` does not see whole what ``points`` outline (the points the
+    border check projects), because solid boxes of the map stand between: empty when it does. Each
+    point's sight line is tested (:func:`sight_blocked`); the thing is hidden when more than
+    ``max_hidden`` of the lines (a fraction, :data:`MAX_HIDDEN` by default) are cut. The reason names
+    the boxes that cut them, the most first."""
+    if not 0.0 <= max_hidden < 1.0:
+        raise ValueError(f"max_hidden is a fraction from 0 up to (not including) 1, not {max_hidden!r}")
+    outline = list(points)
+    cutting: dict[str, int] = {}
+    blocked = 0
+    for point in outline:
+        cut = sight_blocked(eye, point, boxes)
+        blocked += bool(cut)
+        for iri in cut:
+            cutting[iri] = cutting.get(iri, 0) + 1
+    if not outline or blocked <= max_hidden * len(outline):
+        return ""
+    named = ", ".join(
+        f"{local_name(iri)} ({count})" for iri, count in sorted(cutting.items(), key=lambda item: (-item[1], item[0]))
+    )
+    return (
+        f"{blocked} of the {len(outline)} sight lines to the points outlining it pass through {named}, "
+        f"more than the {max_hidden:.0%} allowed"
+    )
 
 
 def default_image_size(camera: Camera) -> tuple[int, int]:

@@ -1,22 +1,28 @@
 """Whether a camera sees an object whole, from the map alone: its pose, size and shape projected through
-the camera's model (pose, field of view, image size, range). The check before a run asks it of the
-camera each recognition step would look with, so that an object the camera cannot see is refused before
-the base drives off, not when the step looks (docs/execution.md, "The simulated components")."""
+the camera's model (pose, field of view, image size, range), and the sight lines to it tested against
+the map's solid boxes (walls, furniture, appliances, robots' bodies: :func:`kb.camera_view.hidden`). The
+check before a run asks it of the camera each recognition step would look with, so that an object the
+camera cannot see is refused before the base drives off, not when the step looks (docs/execution.md,
+"The simulated components"). The person is outlined wherever the seed may put them
+(:class:`sim.world.Spread`), so that a person the check accepts is seen at every seed."""
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import NDArray
 
+from cbrs.kb.camera_view import MAX_HIDDEN, Occluder, hidden, occluders
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.semantic_map import MapObject, Person, local_name
 from cbrs.sim import layout as L
 from cbrs.sim.cameras import Camera, project
 from cbrs.sim.geometry import Vec3
+from cbrs.sim.world import Spread
 
-__all__ = ["OutOfViewError", "object_outline", "person_centre", "person_outline", "unseen"]
+__all__ = ["OutOfViewError", "object_outline", "occluders", "person_centre", "person_outline", "unseen"]
 
 RIM_POINTS = 24
 """Points taken round each rim of a cylinder: its silhouette is then under 1% of its radius larger
@@ -43,23 +49,36 @@ def person_centre(person: Person) -> Vec3:
     return (person.start.x, person.start.y, (L.SHIRT_BOTTOM + L.SHIRT_TOP) / 2)
 
 
-def person_outline(person: Person) -> NDArray[np.float64]:
-    """Points round the two rims of the person's shirt (the mannequin's, :mod:`sim.layout`) at their map
-    pose: the person tracker refuses a shirt cut by the image's border, as perception does an object."""
+def person_outline(person: Person, spread: float = Spread().person) -> NDArray[np.float64]:
+    """Points round the two rims of the person's shirt (the mannequin's, :mod:`sim.layout`) wherever the
+    seed may put them: at their map pose moved by each corner of the square of side 2 ``spread`` the
+    world draws their offset from (:class:`sim.world.Spread`; 0: the map pose alone). The person tracker
+    refuses a shirt cut by the image's border, as perception does an object; a shirt whose rims are on the
+    image at the four corners is on it at every offset between them (the image is a convex cone from
+    the eye). Before, the rims were taken at the map pose alone, and a seed could move the person up to
+    15 cm each way out of a view the check had accepted."""
     angles = np.linspace(0.0, 2.0 * math.pi, RIM_POINTS, endpoint=False)
-    x, y = person.start.x, person.start.y
+    corners = [(0.0, 0.0)] if spread == 0.0 else [(sx * spread, sy * spread) for sx in (-1, 1) for sy in (-1, 1)]
     rows = [
-        [x + math.cos(a) * L.SHIRT_RADIUS, y + math.sin(a) * L.SHIRT_RADIUS, z]
+        [person.start.x + dx + math.cos(a) * L.SHIRT_RADIUS, person.start.y + dy + math.sin(a) * L.SHIRT_RADIUS, z]
+        for dx, dy in corners
         for z in (L.SHIRT_BOTTOM, L.SHIRT_TOP)
         for a in angles
     ]
     return np.array(rows, dtype=np.float64)
 
 
-def unseen(camera: Camera, points: NDArray[np.float64]) -> str:
+def unseen(
+    camera: Camera,
+    points: NDArray[np.float64],
+    blockers: Sequence[Occluder] = (),
+    max_hidden: float = MAX_HIDDEN,
+) -> str:
     """Why ``camera`` would not see the whole of what ``points`` outline; empty when it would. Whole
     means every point nearer than the camera's far range and beyond its near one, and on a pixel off the
-    image's border: perception refuses a blob touching the border (``CutByBorderError``)."""
+    image's border: perception refuses a blob touching the border (``CutByBorderError``); and no more than
+    ``max_hidden`` of the sight lines from the camera's eye to the points passing through one of
+    ``blockers`` (the map's solid boxes, :func:`occluders`; none given, none tested)."""
     spec = camera.spec
     depth = (points - camera.camera_to_world[:3, 3]) @ camera.camera_to_world[:3, 2]
     if float(depth.min()) < spec.near or float(depth.max()) > spec.far:
@@ -70,7 +89,7 @@ def unseen(camera: Camera, points: NDArray[np.float64]) -> str:
     us, vs = pixels[:, 0], pixels[:, 1]
     out = (us < 1) | (us > spec.width - 2) | (vs < 1) | (vs > spec.height - 2)
     if not out.any():
-        return ""
+        return hidden(camera.spec.eye, points.tolist(), blockers, max_hidden)
     return (
         f"{int(out.sum())} of the {len(points)} points outlining it fall on or past the border of its "
         f"{spec.width} x {spec.height} image (columns {us.min():.0f} to {us.max():.0f}, rows {vs.min():.0f} to "
