@@ -236,6 +236,9 @@ def load(app: App, files: tuple[Path, ...], graph: str | None, catalogs: tuple[P
         click.echo(line)
     for graph, count in report.removed.items():
         click.echo(f"replaced {shorten(graph)}: took out {_plural(count, 'triple')} the files do not give")
+    for graph, count in report.kept.items():
+        robots = ", ".join(shorten(iri) for iri in report.kept_robots)
+        click.echo(f"kept in {shorten(graph)}: the robots' own descriptions ({robots}; {_plural(count, 'triple')})")
 
 
 def _note_defaulted(report: LoadReport) -> None:
@@ -703,8 +706,17 @@ def _check_text(result: Any) -> str:
 
 
 @cli.command("settings")
-def settings_command() -> None:
+@click.option(
+    "--json", "as_json", is_flag=True, help="Print the settings as JSON (the update token only as set or not)."
+)
+def settings_command(as_json: bool) -> None:
     """List the settings, their environment variables and current values."""
+    if as_json:
+        listed = [
+            {"setting": s.name, "environment": s.env, "value": s.plain(s.resolve()), "help": s.help} for s in SETTINGS
+        ]
+        click.echo(json.dumps(listed, indent=2))
+        return
     body = [[s.name, s.env, s.shown(s.resolve()), s.help] for s in SETTINGS]
     click.echo(table(["setting", "environment", "value", "help"], body))
 

@@ -24,7 +24,9 @@ def _help(name: str) -> str:
 @click.command()
 @click.option("--host", help=_help("host"))
 @click.option("--port", type=click.IntRange(0, 65535), help=_help("port") + " [default 8080; 0 picks a free port]")
-@click.option("--bridge-port", type=click.IntRange(0, 65535), help=_help("bridge_port") + " [default 9090]")
+@click.option(
+    "--bridge-port", type=click.IntRange(0, 65535), help=_help("bridge_port") + " [default 9090; 0 picks a free port]"
+)
 @click.option(
     "--update-token-file",
     type=click.Path(exists=True, dir_okay=False, path_type=Path),

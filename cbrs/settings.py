@@ -126,6 +126,16 @@ class Setting:
             return ", ".join(value) or "(none)"
         return "" if value is None else without_password(str(value))  # a store URL's basic credentials
 
+    def plain(self, value: Any) -> Any:
+        """The value as ``cbrs settings --json`` gives it: JSON's own types, a secret only whether it is set."""
+        if self.secret:
+            return bool(value)
+        if isinstance(value, tuple):
+            return list(value)
+        if isinstance(value, str):
+            return without_password(value)
+        return value if value is None or isinstance(value, bool | int | float) else str(value)
+
     def resolve(self, given: Any = None, environ: Mapping[str, str] | None = None) -> Any:
         if given is not None:
             return given
