@@ -15,7 +15,7 @@ from collections.abc import Callable, Collection, Sequence
 from typing import Any
 from urllib.parse import urlsplit
 
-from flask import Flask, Response, g, jsonify, render_template, request
+from flask import Flask, Response, g, jsonify, make_response, render_template, request
 from werkzeug.exceptions import HTTPException, MisdirectedRequest
 
 from cbrs import __version__
@@ -25,6 +25,7 @@ from cbrs.sparql_service import SparqlService
 from cbrs.tasks import TaskRunner
 from cbrs.web import links, warmup
 from cbrs.web.context import EventLog, StreamSlots
+from cbrs.web.pages import http_error_message, keep_error_headers
 from cbrs.web.sparql_wsgi import SparqlHotPath
 
 # The page blueprints, in navigation order: (module under cbrs.web, endpoint of its nav link, label).
@@ -155,13 +156,17 @@ def create_app(
         return path.endswith(".json") or path in PROGRAM_PATHS or path.startswith(PROGRAM_PREFIXES)
 
     @app.errorhandler(HTTPException)
-    def http_error(error: HTTPException) -> tuple[Response | str, int]:
+    def http_error(error: HTTPException) -> Response:
         status = error.code or 500
-        if g.get("sparql_protocol") or for_programs():
-            return _error(error.name.lower().replace(" ", "-"), error.description or error.name), status
-        if as_page() or (request.blueprint is None and request.accept_mimetypes.accept_html):
-            return render_template("error.html", title=error.name, message=error.description), status
-        return _error(error.name.lower().replace(" ", "-"), error.description or error.name), status
+        message = http_error_message(error)
+        shown: str | Response
+        if not (g.get("sparql_protocol") or for_programs()) and (
+            as_page() or (request.blueprint is None and request.accept_mimetypes.accept_html)
+        ):
+            shown = render_template("error.html", title=error.name, message=message)
+        else:
+            shown = _error(error.name.lower().replace(" ", "-"), message)
+        return keep_error_headers(make_response(shown, status), error)
 
     @app.before_request
     def preflight() -> Response | None:
@@ -173,8 +178,8 @@ def create_app(
 
     @app.after_request
     def cors(response: Response) -> Response:
-        if response.status_code == 204:  # no content, so no type (Flask would label it text/html)
-            response.headers.pop("Content-Type", None)
+        if response.status_code == 204 or (response.status_code == 201 and response.calculate_content_length() == 0):
+            response.headers.pop("Content-Type", None)  # no content, so no type (Flask would label it text/html)
         response.headers["X-Content-Type-Options"] = "nosniff"
         response.headers.setdefault("Referrer-Policy", "same-origin")
         if response.mimetype == "text/html":

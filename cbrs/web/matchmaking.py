@@ -81,7 +81,9 @@ def _form() -> dict[str, Any]:
     form: dict[str, Any] = {name: args.get(name, "").strip() for name in ("requirement", "top")}
     for name in (*CONCEPT_FIELDS, *STATEMENT_FIELDS):
         form[name] = args.get(name, "").strip()
-    form["methods"] = [m for m in args.getlist("methods") if m] or ["sem-str"]
+    # ``method``, as `cbrs match --method` and the bridge's /cbrs/match spell it, is read too: it was ignored
+    asked = args.getlist("methods") + args.getlist("method")
+    form["methods"] = [m for m in asked if m] or ["sem-str"]
     return form
 
 

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from flask import Blueprint, Response, jsonify, render_template, request
+from werkzeug.exceptions import HTTPException, MethodNotAllowed
 
 from cbrs.kb.errors import KnowledgeBaseError
 
@@ -70,3 +71,21 @@ def page(blueprint: Blueprint, rule: str, **options: Any) -> Callable[[View], Vi
         return view
 
     return register
+
+
+def http_error_message(error: HTTPException) -> str:
+    """What to tell the client of a Werkzeug error; a 405 names the methods the path takes (Werkzeug's
+    own text, "The method is not allowed for the requested URL.", leaves a client to guess them)."""
+    if isinstance(error, MethodNotAllowed) and error.valid_methods:
+        allowed = sorted(set(error.valid_methods) - {"OPTIONS"})
+        return f"{request.method} is not allowed on {request.path}: use {' or '.join(allowed)}"
+    return error.description or error.name
+
+
+def keep_error_headers(response: Response, error: HTTPException) -> Response:
+    """Give an error answered with our own body the headers Werkzeug's answer would carry: a 405's
+    ``Allow`` (RFC 9110 requires it), a 401's ``WWW-Authenticate``."""
+    for name, value in error.get_headers():
+        if name.lower() != "content-type":
+            response.headers[name] = value
+    return response

@@ -13,7 +13,7 @@ from collections.abc import Iterable
 from typing import Any
 
 import pyoxigraph as ox
-from flask import Blueprint, Response, jsonify, render_template, request, url_for
+from flask import Blueprint, Response, jsonify, make_response, render_template, request, url_for
 from flask.blueprints import BlueprintSetupState
 from markupsafe import Markup, escape
 from werkzeug.exceptions import BadRequest, HTTPException
@@ -23,7 +23,7 @@ from cbrs.kb.namespaces import OWL, RDF, RDFS, XSD, GraphName
 from cbrs.web import context
 from cbrs.web.graphs import about as graph_note
 from cbrs.web.links import display_text, expand_name, iri_link, short
-from cbrs.web.pages import Page, page, wants_json
+from cbrs.web.pages import Page, http_error_message, keep_error_headers, page, wants_json
 
 blueprint = Blueprint("resource", __name__)
 
@@ -213,9 +213,9 @@ def _library_error(error: KnowledgeBaseError) -> tuple[Response | str, int]:
 
 
 @blueprint.errorhandler(HTTPException)
-def _http_error(error: HTTPException) -> tuple[Response | str, int]:
-    message = error.description or error.name
-    return _failure(error.code or 500, error.name.lower().replace(" ", "-"), error.name, message)
+def _http_error(error: HTTPException) -> Response:
+    shown = _failure(error.code or 500, error.name.lower().replace(" ", "-"), error.name, http_error_message(error))
+    return keep_error_headers(make_response(*shown), error)
 
 
 def _failure(status: int, kind: str, title: str, message: str) -> tuple[Response | str, int]:

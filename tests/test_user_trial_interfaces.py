@@ -1,0 +1,85 @@
+"""What a new user tripped on over HTTP and the CLI, trying every interface from the docs.
+
+A 405 came without the ``Allow`` header and said only "The method is not allowed for the requested
+URL."; a ``PUT /store`` that created a graph answered 201 labelled ``text/html`` with a page's security
+headers and no body; the matchmaking page ignored ``method=`` (the spelling of ``cbrs match --method``
+and of ``/cbrs/match``) and ranked by Sem-Str alone; ``cbrs settings`` had no ``--json``.
+"""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from click.testing import CliRunner
+from flask.testing import FlaskClient
+
+from cbrs.cli import cli
+from cbrs.kb import KnowledgeBase
+from cbrs.sparql_service import EndpointConfig, SparqlService
+from cbrs.web import create_app
+
+TOKEN = "trial-token"
+
+
+@pytest.fixture(scope="module")
+def client() -> FlaskClient:
+    kb = KnowledgeBase.open(":memory:")
+    return create_app(SparqlService(kb, EndpointConfig(update_token=TOKEN, isolate=False))).test_client()
+
+
+@pytest.mark.parametrize(
+    ("method", "path", "allowed"),
+    [
+        pytest.param("PATCH", "/store?graph=urn:x", {"GET", "HEAD", "PUT", "POST", "DELETE"}, id="graph-store"),
+        pytest.param("DELETE", "/sparql", {"GET", "HEAD", "POST"}, id="sparql"),
+        pytest.param("PUT", "/update", {"POST"}, id="update"),
+        pytest.param("PUT", "/index.json", {"GET", "HEAD"}, id="json-twin"),
+    ],
+)
+def test_a_405_names_the_methods_the_path_takes_in_allow_and_in_its_message(
+    client: FlaskClient, method: str, path: str, allowed: set[str]
+) -> None:
+    answer = client.open(path, method=method, headers={"Accept": "*/*"})
+    assert answer.status_code == 405
+    assert {m.strip() for m in answer.headers["Allow"].split(",")} - {"OPTIONS"} == allowed
+    body = answer.get_json()
+    assert body["error"] == "method-not-allowed"
+    assert body["message"] == f"{method} is not allowed on {path.split('?')[0]}: use {' or '.join(sorted(allowed))}"
+
+
+@pytest.mark.parametrize("path", ["/tasks/run-9/cancel", "/resource?iri=home:Cup"], ids=["page", "resource-page"])
+def test_a_405_on_a_page_is_a_page_with_allow_and_what_to_use(client: FlaskClient, path: str) -> None:
+    answer = client.open(path, method="PUT", headers={"Accept": "text/html"})
+    assert answer.status_code == 405 and answer.mimetype == "text/html"
+    assert "Allow" in answer.headers
+    assert f"PUT is not allowed on {path.split('?')[0]}: use " in answer.text
+
+
+def test_a_graph_created_by_put_is_a_201_without_a_content_type(client: FlaskClient) -> None:
+    headers = {"Authorization": f"Bearer {TOKEN}", "Content-Type": "text/turtle"}
+    created = client.put("/store?graph=urn:trial:created", data="<urn:a> <urn:b> <urn:c> .", headers=headers)
+    assert created.status_code == 201 and created.data == b""
+    assert "Content-Type" not in created.headers and "Content-Security-Policy" not in created.headers
+
+
+def test_the_matchmaking_page_reads_method_as_the_cli_and_the_bridge_spell_it(client: FlaskClient) -> None:
+    asked = {"requirement": "req:RobotSelfPosition", "top": "2"}
+    one = client.get("/match.json", query_string={**asked, "method": "wu-palmer"}).get_json()
+    assert one["form"]["methods"] == ["wu-palmer"] and [r["method"] for r in one["rankings"]] == ["wu-palmer"]
+    both = client.get("/match.json", query_string={**asked, "methods": "lin", "method": "logic"}).get_json()
+    assert [r["method"] for r in both["rankings"]] == ["lin", "logic"]
+    wrong = client.get("/match.json", query_string={**asked, "method": "wu_palmer"})
+    assert wrong.status_code == 400 and "no method 'wu_palmer'" in wrong.get_json()["fields"]["methods"]
+
+
+def test_cbrs_settings_json_gives_typed_values_and_hides_the_token() -> None:
+    env = {"CBRS_UPDATE_TOKEN": "s3cret", "CBRS_STORE": "http://robot:pw@127.0.0.1:7878", "CBRS_PORT": "8181"}
+    result = CliRunner().invoke(cli, ["settings", "--json"], env=env)
+    assert result.exit_code == 0, result.output
+    assert "s3cret" not in result.output and ":pw@" not in result.output
+    listed = {item["setting"]: item for item in json.loads(result.output)}
+    assert listed["update_token"]["value"] is True and listed["port"]["value"] == 8181
+    assert listed["port"]["environment"] == "CBRS_PORT" and listed["port"]["help"]
+    assert listed["store"]["value"] == "http://robot:***@127.0.0.1:7878"
+    assert listed["cors_origins"]["value"] == [] and listed["read_only"]["value"] is False
