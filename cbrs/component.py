@@ -22,6 +22,7 @@ from __future__ import annotations
 import logging
 import math
 import signal
+import sys
 import threading
 import time
 from collections import deque
@@ -189,7 +190,15 @@ class Component:
         request = StopRequest()  # taken for the whole run: a signal never raises between two statements
         try:
             with handling(request, signal.SIGTERM, signal.SIGINT):
-                self._connect(url, token, heartbeat, ttl, request)._serve(request)
+                connected = self._connect(url, token, heartbeat, ttl, request)
+                # a program started in the background otherwise says nothing until it ends
+                print(
+                    f"cbrs component: {shorten(self.iri)} registered at {url}; serving {self.service} "
+                    "until Ctrl-C or SIGTERM",
+                    file=sys.stderr,
+                    flush=True,
+                )
+                connected._serve(request)
         except _Stopped:  # stopped while connecting: nothing was provided, no hook ran
             pass
         except (RegistrationRefusedError, ComponentEndedError, BridgeClosedError) as error:
@@ -401,7 +410,10 @@ def _servers_reason(client: BridgeClient, refusal: str) -> str:
         for status in client.statuses
         if status.get("level") == "error" and str(status.get("msg", "")).startswith("auth")
     ]
-    return f"{refused[-1]} (so: {refusal})" if refused else refusal
+    if not refused:
+        return refusal
+    # the refusal itself tells a hand-written client to send the auth op, which the SDK did: the token is wrong
+    return f"{refused[-1]}: give the component the token cbrs serve was started with (CBRS_UPDATE_TOKEN)"
 
 
 def _quads(raw: bytes, format: str) -> list[ox.Quad]:

@@ -217,6 +217,9 @@ def test_a_stop_signal_at_any_moment_after_start_runs_the_hooks_and_exits_cleanl
             child.wait(timeout=10)
         assert child.returncode == 0, err
         assert out.splitlines() == ["on_stop ran", "run returned"], err
+        # run() says it is up, naming the component, the bridge and the service, before it serves
+        assert f"cbrs component: svc:ReadRoomTemperature_Thermometer07 registered at {url(server)}" in err
+        assert "serving /thermometer07/read until Ctrl-C or SIGTERM" in err
 
 
 def test_a_server_restart_ends_a_run_component_with_status_1_and_the_reason() -> None:
@@ -243,8 +246,10 @@ def test_a_server_restart_ends_a_run_component_with_status_1_and_the_reason() ->
 
 
 def test_a_wrong_token_is_reported_in_the_servers_words(server: Server) -> None:
-    with pytest.raises(RegistrationRefusedError, match="the token is not this server's update token"):
+    with pytest.raises(RegistrationRefusedError, match="the token is not this server's update token") as refused:
         component(thermometer()).connect(url(server), "not-the-token")
+    # the SDK sent the auth op itself: the advice for hand-written clients (send auth first) is not repeated
+    assert "CBRS_UPDATE_TOKEN" in str(refused.value) and "roslibpy" not in str(refused.value)
 
 
 @pytest.mark.parametrize(
