@@ -468,13 +468,17 @@ _UPDATE_START = re.compile(
     "registered and register the others (one transaction). An OWL-S FILE is converted as cbrs load "
     "converts it, and replaces what an earlier load of it gave.",
 )
+@click.option("--json", "as_json", is_flag=True, help='Print {"registered": [IRI...], "updated": [IRI...]} as JSON.')
 @pass_app
-def register(app: App, file: Path, update: bool) -> None:
+def register(app: App, file: Path, update: bool, as_json: bool) -> None:
     """Register the advertisements in a Turtle FILE (or RDF/XML, JSON-LD, N-Triples; checked first; one
     transaction)."""
     text = file.read_bytes()
     if update:
         done = app.kb.registry.synced(text, str(file))
+        if as_json:
+            click.echo(json.dumps({"registered": sorted(done.registered), "updated": sorted(done.updated)}, indent=2))
+            return
         for iri in sorted(done.registered + done.updated):
             click.echo(f"{'registered' if iri in done.registered else 'updated'} {shorten(iri)}")
         if done.conversion is not None:  # an OWL-S file: what cbrs load of it says besides its counts
@@ -488,14 +492,18 @@ def register(app: App, file: Path, update: bool) -> None:
         iris = app.kb.registry.register(text, str(file))
     except AlreadyRegisteredError as error:  # some of the file's may be registered, some not: --update does both
         raise click.ClickException(f"{error}: cbrs register --update {file}") from error
+    if as_json:
+        click.echo(json.dumps({"registered": list(iris), "updated": []}, indent=2))
+        return
     for iri in iris:
         click.echo(f"registered {shorten(iri)}")
 
 
 @cli.command()
 @click.argument("iri")
+@click.option("--json", "as_json", is_flag=True, help='Print {"deregistered": IRI, "triples": N} as JSON.')
 @pass_app
-def deregister(app: App, iri: str) -> None:
+def deregister(app: App, iri: str, as_json: bool) -> None:
     """Remove a registered advertisement, or a requirement, and the nodes of its description (one transaction)."""
     full = parse_iri(iri)
     name = shorten(full)  # as it was named: its prefix may be the store's own, gone with it
@@ -506,6 +514,9 @@ def deregister(app: App, iri: str) -> None:
         raise click.ClickException(f"{error}{hint}") from error
     if full in app.kb.liveness.states():  # a live component: not listed as available until its next heartbeat
         app.kb.liveness.forget(full)
+    if as_json:
+        click.echo(json.dumps({"deregistered": full, "triples": removed}, indent=2))
+        return
     click.echo(f"deregistered {name} ({removed} triples)")
 
 

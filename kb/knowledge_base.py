@@ -9,6 +9,7 @@ import re
 from collections.abc import Mapping, Sequence
 from contextlib import AbstractContextManager, nullcontext
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pyoxigraph as ox
 
@@ -40,6 +41,9 @@ from cbrs.kb.store import MEMORY, EmbeddedStore, QueryResult, Store, Term, is_re
 from cbrs.kb.update_delta import DataUpdate
 from cbrs.kb.update_report import GraphChange, UpdateReport, exact_changes, graph_sizes, net_changes, refuse_split
 from cbrs.kb.upgrade import UpgradeReport, new_terms, upgrade_store
+
+if TYPE_CHECKING:
+    from cbrs.kb.kept_robots import KeptRobots
 
 _log = logging.getLogger(__name__)
 _VERSION_INFO = ox.NamedNode("http://www.w3.org/2002/07/owl#versionInfo")
@@ -158,21 +162,31 @@ class KnowledgeBase:
 
     def _check_new_home(
         self, paths: Sequence[str | Path], catalogue: Catalogue | None, progress: Progress | None = None
-    ) -> ReadFiles:
+    ) -> tuple[ReadFiles, KeptRobots]:
         """Refuse files that would not make a whole home as graph:map (a load with ``replace``): the map
-        they make alone must read as a task reads it and hold what the simulated home is built from
-        (:func:`kb.home_check.check_home`), or nothing is written. Unlike a load that adds, the map is
-        whole at once, so an empty or partial one is no step of a build: an emptied map is the bundled
-        one again on the next open."""
+        they make, with the robots they keep of the stored one (:func:`kb.kept_robots.kept_robots`: all
+        of them when the files describe none, placed where the files say), must read as a task reads it
+        and hold what the simulated home is built from (:func:`kb.home_check.check_home`), or nothing is
+        written. Unlike a load that adds, the map is whole at once, so an empty or partial one is no step
+        of a build: an emptied map is the bundled one again on the next open."""
+        from cbrs.kb.kept_robots import kept_robots
+        from cbrs.kb.semantic_map import HOME, MapError  # it imports this module
+
         read = read_files(paths, GraphName.MAP, catalogue, progress)
-        problem = self._home_problem(read.quads())
+        given = read.quads()
+        kept = kept_robots(self.store.quads(graph=GraphName.MAP.node), given)
+        problem = self._home_problem([*given, *kept.quads])
+        if kept.unplaced is not None:  # files that give no rooms are no home at all: that is said first
+            whole = self._home_problem([*given, *kept.quads, *kept.stood])
+            rooms = isinstance(whole, MapError) and whole.thing == HOME + "Room"
+            problem = whole if rooms else kept.unplaced
         if problem is not None:
             problem.add_note(
                 f"nothing was loaded from {', '.join(map(str, read.paths))} and the map is as it was (a map "
                 "that replaces the home is checked as the simulation builds it)"
             )
             raise problem
-        return read
+        return read, kept
 
     def _home_problem(self, home: Sequence[ox.Quad]) -> Exception | None:
         """Why ``home``, as the whole of graph:map, is no home the simulation can build (None: it is one),
@@ -349,7 +363,8 @@ class KnowledgeBase:
     ) -> LoadReport:
         """Load RDF and OWL-S files (or every RDF file of a directory) all-or-nothing; ``progress`` is told
         each stage as it goes (:data:`kb.loader.Progress`). With ``replace`` (graph:map only) the files
-        become the semantic map, a lab's own home in place of the bundled one (:meth:`_check_new_home`).
+        become the semantic map, a lab's own home in place of the bundled one (:meth:`_check_new_home`),
+        with the stored map's robots when the files describe none (:mod:`kb.kept_robots`).
 
         OWL-S files are converted into cbrs advertisements, or requirements when ``graph`` is
         ``requirements`` (see :mod:`kb.owls`). With a ``catalogue`` (a :class:`Catalogue`, a folder or
@@ -361,11 +376,23 @@ class KnowledgeBase:
         into_map = graph is not None and resolve_graph(graph) == GraphName.MAP.node
         if replace and not into_map:
             raise ReplaceError(str(graph))
+        kept = None
         if replace:
-            read = self._check_new_home(paths, catalogue, progress)
+            read, kept = self._check_new_home(paths, catalogue, progress)
         elif into_map:
             read = self._check_map_load(paths, catalogue, progress)
-        report = load_files(self.store, paths, graph, catalogue, progress, read, GraphName.MAP if replace else None)
+        report = load_files(
+            self.store,
+            paths,
+            graph,
+            catalogue,
+            progress,
+            read,
+            GraphName.MAP if replace else None,
+            kept.quads if kept is not None else (),
+        )
+        if kept is not None and kept.robots:
+            report.kept_robots = kept.robots
         if isinstance(self.store, EmbeddedStore) and not any(report.added.values()):
             return report  # a reload of what the store holds wrote nothing: nothing to read or entail afresh
         self._reader.clear_cache()

@@ -148,6 +148,11 @@ class LoadReport:
     (:func:`_new_quads`)."""
     removed: dict[str, int] = field(default_factory=dict)
     """Per graph IRI, how many triples a replacing load took out (those of the graph the files did not give)."""
+    kept: dict[str, int] = field(default_factory=dict)
+    """Per graph IRI, how many triples of the graph a replacing load kept though the files did not give
+    them (the robots' own descriptions, :mod:`kb.kept_robots`)."""
+    kept_robots: tuple[str, ...] = ()
+    """The robots whose descriptions a replacing load kept (their IRIs)."""
 
     def __iter__(self) -> Iterator[ParsedFile]:
         return iter(self.files)
@@ -243,11 +248,13 @@ def load_files(
     progress: Progress | None = None,
     read: ReadFiles | None = None,
     replacing: GraphName | None = None,
+    kept: Sequence[ox.Quad] = (),
 ) -> LoadReport:
     """Parse every file (and, with a catalogue, every ontology they import), convert OWL-S files,
     then add everything in one transaction; nothing is written if any file fails to parse.
     ``progress`` is told each stage as it goes. With ``replacing``, that graph's triples the files do not
-    give are taken out in the same transaction: the files become the graph.
+    give are taken out in the same transaction: the files become the graph, with the stored quads ``kept``
+    (of that graph) left in it.
 
     OWL-S files (``.owls``, or any file describing an OWL-S service or profile) keep their own
     triples and gain the cbrs description made from them, in the same graph: the requirements graph
@@ -276,8 +283,11 @@ def load_files(
     if replacing is not None:
         given = ox.Store()  # compared as a store compares: "2.30"^^xsd:decimal is the stored "2.3"
         given.extend(quad for item in (*report.files, *report.imports) for quad in item.quads)
+        given.extend(ox.Quad(q.subject, q.predicate, q.object, replacing.node) for q in kept)
         old = [quad for quad in store.quads(graph=replacing.node) if quad not in given]
         report.removed[replacing.iri] = len(old)
+        if kept:
+            report.kept[replacing.iri] = len(kept)
         if old or new:
             tell(f"writing {len(new)} triples, taking out {len(old)}", 0, 0)
             store.replace(old, new)

@@ -1,7 +1,8 @@
 """A lab's own home in place of the bundled one (new-user trial, docs/tasks.md "A home of your own").
 
 The studio flat of ``docs/examples/studio_flat/home.ttl`` (other rooms, shape, worktop height, starts and
-ceiling cameras; the bundled robots moved) replaces graph:map with ``cbrs load --graph map --replace``.
+ceiling cameras; the bundled robots kept and moved, ``kb.kept_robots``) replaces graph:map with
+``cbrs load --graph map --replace``.
 Before, nothing could replace the map: a load only adds (the flat's camera poses beside the bundled
 ones were refused), an emptied map was the bundled one again on the next command, and a map replaced
 by other means had the bundled home's kitchen table, cup, pen and person added back on the next open.
@@ -158,7 +159,7 @@ def _variant(old: str, new: str) -> str:
             id="no-person",
         ),
         pytest.param(
-            _variant('home:armSide "left"', 'home:armSide "right"'),
+            _variant("world:CytonDualArm01LeftArm home:x", 'world:CytonDualArm01LeftArm home:armSide "right" ; home:x'),
             r"Arm .* the map's arms have the sides right, right, and the dual-arm robot needs one \"left\"",
             id="two-right-arms",
         ),
