@@ -3,12 +3,14 @@
 A 405 came without the ``Allow`` header and said only "The method is not allowed for the requested
 URL."; a ``PUT /store`` that created a graph answered 201 labelled ``text/html`` with a page's security
 headers and no body; the matchmaking page ignored ``method=`` (the spelling of ``cbrs match --method``
-and of ``/cbrs/match``) and ranked by Sem-Str alone; ``cbrs settings`` had no ``--json``.
+and of ``/cbrs/match``) and ranked by Sem-Str alone; ``cbrs settings``, ``register`` and
+``deregister`` had no ``--json``.
 """
 
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
@@ -20,6 +22,7 @@ from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.web import create_app
 
 TOKEN = "trial-token"
+ROOT = Path(__file__).resolve().parents[1]
 
 
 @pytest.fixture(scope="module")
@@ -83,3 +86,18 @@ def test_cbrs_settings_json_gives_typed_values_and_hides_the_token() -> None:
     assert listed["port"]["environment"] == "CBRS_PORT" and listed["port"]["help"]
     assert listed["store"]["value"] == "http://robot:***@127.0.0.1:7878"
     assert listed["cors_origins"]["value"] == [] and listed["read_only"]["value"] is False
+
+
+def test_register_and_deregister_json_name_what_they_did(tmp_path: Path) -> None:
+    store = ["--store", str(tmp_path / "store")]
+    camera = str(ROOT / "docs" / "examples" / "camera3.ttl")
+    iri = "https://w3id.org/cbrs/service#LocateMobileRobot_CeilingCamera03"
+    runner = CliRunner()
+    registered = runner.invoke(cli, [*store, "register", camera, "--json"])
+    assert registered.exit_code == 0, registered.output
+    assert json.loads(registered.output) == {"registered": [iri], "updated": []}
+    updated = runner.invoke(cli, [*store, "register", "--update", camera, "--json"])
+    assert json.loads(updated.output) == {"registered": [], "updated": [iri]}
+    removed = runner.invoke(cli, [*store, "deregister", "svc:LocateMobileRobot_CeilingCamera03", "--json"])
+    answer = json.loads(removed.output)
+    assert removed.exit_code == 0 and answer["deregistered"] == iri and answer["triples"] > 0
