@@ -1,7 +1,7 @@
 """A ceiling camera's robot localiser as a program of its own: ``python -m cbrs.external_camera CAMERA``.
 
 It is what a lab's camera would run: it takes the camera's bundled LocateMobileRobot description,
-grounds it in a bridge service of its own, registers it with the server at ``--url`` (the update
+grounds it in a bridge service of its own, registers it with the server at ``--bridge`` (the update
 token from ``CBRS_UPDATE_TOKEN``), and answers each call by taking a frame from the camera (the
 simulation's ``/sim/capture``, standing in for the camera's hardware) and finding the robot's marker
 in it. ``cbrs demo --external`` starts two of them and kills one mid-run.
@@ -83,9 +83,15 @@ def localiser(camera: str, capture: BridgeClient, smap: SemanticMap) -> Any:
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m cbrs.external_camera", description=__doc__.splitlines()[0])
     parser.add_argument("camera", help="the ceiling camera, e.g. CeilingCamera01")
-    parser.add_argument("--url", default="ws://127.0.0.1:9090", help="the server's bridge")
-    parser.add_argument("--heartbeat", type=float, default=1.0, help="seconds between heartbeats")
-    parser.add_argument("--lease", type=float, default=3.0, help="seconds the lease lasts")
+    parser.add_argument(  # --bridge as cbrs run spells it; --url as the external demo passes it
+        "--bridge",
+        "--url",
+        dest="url",
+        default="ws://127.0.0.1:9090",
+        help="the server's rosbridge websocket (%(default)s)",
+    )
+    parser.add_argument("--heartbeat", type=float, default=1.0, help="seconds between heartbeats (%(default)s)")
+    parser.add_argument("--lease", type=float, default=3.0, help="seconds the lease lasts (%(default)s)")
     args = parser.parse_args(argv)
     token = os.environ.get("CBRS_UPDATE_TOKEN")
     kb = KnowledgeBase.open(":memory:")  # the bundled descriptions and map: the camera's own knowledge

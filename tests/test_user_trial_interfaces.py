@@ -4,18 +4,21 @@ A 405 came without the ``Allow`` header and said only "The method is not allowed
 URL."; a ``PUT /store`` that created a graph answered 201 labelled ``text/html`` with a page's security
 headers and no body; the matchmaking page ignored ``method=`` (the spelling of ``cbrs match --method``
 and of ``/cbrs/match``) and ranked by Sem-Str alone; ``cbrs settings``, ``register`` and
-``deregister`` had no ``--json``.
+``deregister`` had no ``--json``; the camera program took its bridge as ``--url``, not ``--bridge``
+as ``cbrs run`` does.
 """
 
 from __future__ import annotations
 
 import json
+import socket
 from pathlib import Path
 
 import pytest
 from click.testing import CliRunner
 from flask.testing import FlaskClient
 
+from cbrs import external_camera
 from cbrs.cli import cli
 from cbrs.kb import KnowledgeBase
 from cbrs.sparql_service import EndpointConfig, SparqlService
@@ -101,3 +104,11 @@ def test_register_and_deregister_json_name_what_they_did(tmp_path: Path) -> None
     removed = runner.invoke(cli, [*store, "deregister", "svc:LocateMobileRobot_CeilingCamera03", "--json"])
     answer = json.loads(removed.output)
     assert removed.exit_code == 0 and answer["deregistered"] == iri and answer["triples"] > 0
+
+
+def test_the_camera_program_takes_its_bridge_as_cbrs_run_does(capsys: pytest.CaptureFixture[str]) -> None:
+    with socket.socket() as probe:  # a port nothing listens on
+        probe.bind(("127.0.0.1", 0))
+        url = f"ws://127.0.0.1:{probe.getsockname()[1]}"
+    assert external_camera.main(["--bridge", url, "CeilingCamera01"]) == 1
+    assert f"cannot reach the bridge at {url}" in capsys.readouterr().err
