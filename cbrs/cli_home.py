@@ -9,7 +9,7 @@ from pathlib import Path
 import click
 
 from cbrs.app import App, pass_app
-from cbrs.home_plan import DEFAULT_WIDTH, HomeSurvey, draw_home, resource_link, survey
+from cbrs.home_plan import DEFAULT_WIDTH, NO_ROOMS, HomeSurvey, draw_home, resource_link, survey
 from cbrs.kb.namespaces import shorten
 from cbrs.kb.semantic_map import local_name
 from cbrs.settings import setting
@@ -50,6 +50,7 @@ def home(app: App, drawing: Path | None, width: int, browser: str | None, as_jso
         entries = [entry.to_dict() for entry in picture.entries]
     if as_json:
         said = {"verdict": found.verdict, "counts": found.counts(), "rooms": _rooms(found), "drawing": written}
+        said["notice"] = NO_ROOMS if found.semantic_map is not None and not _rooms(found) else None
         said["problem"] = str(found.problem) if found.problem is not None else None
         if entries:
             said["things"] = entries
@@ -86,10 +87,13 @@ def _text(found: HomeSurvey, written: str | None) -> str:
     if smap is None:
         return f"the semantic map cannot be read: {found.problem}"
     lines = ["home: " + ", ".join(found.counted())]
-    for room in _rooms(found):
+    rooms = _rooms(found)
+    for room in rooms:
         classes = room["classes"]
         kinds = ", ".join(classes) if isinstance(classes, list) else ""
         lines.append(f"  {room['name']} ({kinds}): {room['text']}")
+    if not rooms:
+        lines.append(f"  {NO_ROOMS}")
     moved = [iri for iri in found.believed if iri in smap.objects or iri in smap.robots or iri in smap.people]
     if moved:
         lines.append(f"the world graph places {len(moved)} of its things after a run: a drawing shows those that moved")
@@ -97,6 +101,8 @@ def _text(found: HomeSurvey, written: str | None) -> str:
         lines.append("check: the simulation can build this home")
     else:
         lines.append(f"check: the simulation would refuse this home: {found.problem}")
-    if written:
+    if written and not rooms:
+        lines.append(f"drew what the map places, under that notice, to {written}")
+    elif written:
         lines.append(f"drew the home from above to {written}")
     return "\n".join(lines)

@@ -16,6 +16,7 @@ a home instead of failing. docs/web.md, "The home".
 from __future__ import annotations
 
 import math
+import textwrap
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from html import escape
@@ -53,7 +54,17 @@ from cbrs.kb.knowledge_base import KnowledgeBase
 from cbrs.kb.namespaces import RDFS, shorten
 from cbrs.kb.semantic_map import HOME, Box, MapObject, SemanticMap, Thing, local_name
 
-__all__ = ["DEFAULT_WIDTH", "MOVED", "Entry", "HomePicture", "HomeSurvey", "draw_home", "resource_link", "survey"]
+__all__ = [
+    "DEFAULT_WIDTH",
+    "MOVED",
+    "NO_ROOMS",
+    "Entry",
+    "HomePicture",
+    "HomeSurvey",
+    "draw_home",
+    "resource_link",
+    "survey",
+]
 
 DEFAULT_WIDTH = 960
 """Pixels across the picture; the height follows the home's shape."""
@@ -61,7 +72,16 @@ MOVED = 0.05
 """How far (m) the world graph must believe a thing to be from its start in the map for the picture to
 draw it at both places: less is the simulation's settling and a seed's scatter, not a move."""
 
+NO_ROOMS = (
+    "The map has no rooms (no home:Room with home:minX, home:maxX, home:minY and home:maxY): there is no "
+    "floor to draw, and the simulation cannot build a home from it. Load a home's rooms into graph:map "
+    "(docs/tasks.md, 'A home of your own')."
+)
+"""What the picture of a map without rooms says, above what else the map places (or alone)."""
+
 _PAD = 0.3  # m of floor shown around the outermost thing
+_MIN_SPAN = 2.0  # m across and up the picture shows at least: one thing alone is not drawn a metre wide
+_NOTICE_LINE = 17  # px between the lines of the picture's notice
 
 
 def resource_link(iri: str) -> str:
@@ -99,6 +119,8 @@ class HomePicture:
     width: int
     height: int
     entries: tuple[Entry, ...]
+    notice: str | None = None
+    """What the picture says above the plan instead of drawing it right (:data:`NO_ROOMS`), or None."""
 
 
 @dataclass(frozen=True)
@@ -190,8 +212,12 @@ def draw_home(
     more from their start; ``link`` gives each thing's address."""
     smap, believed = semantic_map, believed or {}
     extent = _extent(smap, believed)
-    scale = (width - 2 * MARGIN) / max(extent.max_x - extent.min_x, 0.5)
-    canvas = Canvas(extent, scale)
+    notice = None if smap.rooms & smap.things.keys() else NO_ROOMS
+    if extent is None:  # nothing placed at all: the notice alone, not an empty grid
+        return _notice_only(notice or NO_ROOMS, width)
+    lines = _wrapped(notice, width)
+    scale = (width - 2 * MARGIN) / (extent.max_x - extent.min_x)
+    canvas = Canvas(extent, scale, top=16.0 + len(lines) * _NOTICE_LINE + (12 if lines else 0))
     plan_height = (extent.max_y - extent.min_y) * scale
     entries: list[Entry] = []
     solid = smap.furniture | {d.iri for d in smap.dispensers.values()} | {t.iri for t in _bodies(smap)}
@@ -223,13 +249,46 @@ def draw_home(
             f'<desc id="home-plan-desc">{escape(_description(smap, rooms), quote=False)}</desc>',
             _defs(canvas),
             f'<rect width="{width}" height="{height}" fill="#ffffff"/>',
+            *_notice(canvas, lines),
             *body,
             *scale_bar(canvas, canvas.top + plan_height + 44),
             *key,
             "</svg>",
         ]
     )
-    return HomePicture(svg, width, height, tuple(entries))
+    return HomePicture(svg, width, height, tuple(entries), notice)
+
+
+def _wrapped(notice: str | None, width: int) -> list[str]:
+    """The notice in lines that fit the picture's width (SVG text does not wrap)."""
+    if notice is None:
+        return []
+    return textwrap.wrap(notice, max(20, int((width - 2 * MARGIN) / (CHAR * 13))))
+
+
+def _notice(canvas: Canvas, lines: list[str]) -> Iterator[str]:
+    for index, line in enumerate(lines):
+        y = 16.0 + (index + 1) * _NOTICE_LINE
+        yield canvas.text(canvas.left, y, line, 13, fill=BELIEF, **{"class": "home-notice"})
+
+
+def _notice_only(notice: str, width: int) -> HomePicture:
+    """The picture of a map that places nothing: its notice, and no plan."""
+    lines = _wrapped(notice, width)
+    height = int(16 + (len(lines) + 1) * _NOTICE_LINE + 8)
+    canvas = Canvas(Box(0.0, 1.0, 0.0, 1.0), 1.0)
+    svg = "".join(
+        [
+            f'<svg xmlns="http://www.w3.org/2000/svg" class="home-plan" width="{width}" height="{height}" '
+            f'viewBox="0 0 {width} {height}" font-family="{FONT}" aria-labelledby="home-plan-title home-plan-desc">',
+            '<title id="home-plan-title">The home from above, from the semantic map</title>',
+            f'<desc id="home-plan-desc">{escape(notice, quote=False)}</desc>',
+            f'<rect width="{width}" height="{height}" fill="#ffffff"/>',
+            *_notice(canvas, lines),
+            "</svg>",
+        ]
+    )
+    return HomePicture(svg, width, height, (), notice)
 
 
 def _description(smap: SemanticMap, rooms: str) -> str:
@@ -251,8 +310,9 @@ def _defs(canvas: Canvas) -> str:
     )
 
 
-def _extent(smap: SemanticMap, believed: dict[str, tuple[float, float]]) -> Box:
-    """The box around every thing drawn (not around the cameras' views), with some floor around it."""
+def _extent(smap: SemanticMap, believed: dict[str, tuple[float, float]]) -> Box | None:
+    """The box around every thing drawn (not around the cameras' views), with some floor around it, and
+    at least :data:`_MIN_SPAN` across and up; None when the map places nothing."""
     xs: list[float] = []
     ys: list[float] = []
     for thing in smap.things.values():
@@ -268,8 +328,16 @@ def _extent(smap: SemanticMap, believed: dict[str, tuple[float, float]]) -> Box:
     xs += [x for x, _ in points]
     ys += [y for _, y in points]
     if not xs:
-        return Box(-1.0, 1.0, -1.0, 1.0)
-    return Box(min(xs) - _PAD, max(xs) + _PAD, min(ys) - _PAD, max(ys) + _PAD)
+        return None
+    x0, x1 = _spanned(min(xs) - _PAD, max(xs) + _PAD)
+    y0, y1 = _spanned(min(ys) - _PAD, max(ys) + _PAD)
+    return Box(x0, x1, y0, y1)
+
+
+def _spanned(low: float, high: float) -> tuple[float, float]:
+    """``low`` to ``high`` widened about its middle to :data:`_MIN_SPAN` when it is narrower."""
+    grow = max(0.0, _MIN_SPAN - (high - low)) / 2
+    return low - grow, high + grow
 
 
 def _drawn_at(smap: SemanticMap, iri: str) -> tuple[float, float] | None:
