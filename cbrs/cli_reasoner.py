@@ -166,7 +166,12 @@ def eval_paper(methods: tuple[str, ...], as_json: bool, plot: Path | None, param
     """The paper-style testbed: 20 requirements against 100 components (reasoner/data/)."""
     from cbrs.reasoner.evaluation import evaluate_paper, plot_report
 
-    report = evaluate_paper(methods or METHODS, config=match_config(params))
+    config = match_config(params)
+    if not as_json:  # several seconds of ranking: say what is going on, as eval owls-tc does
+        click.echo(
+            f"ranking the testbed's components for each requirement with {', '.join(methods or METHODS)} ...", err=True
+        )
+    report = evaluate_paper(methods or METHODS, config=config)
     if as_json:
         click.echo(json.dumps(report.to_json(), indent=2))
     else:

@@ -4,8 +4,8 @@ A 405 came without the ``Allow`` header and said only "The method is not allowed
 URL."; a ``PUT /store`` that created a graph answered 201 labelled ``text/html`` with a page's security
 headers and no body; the matchmaking page ignored ``method=`` (the spelling of ``cbrs match --method``
 and of ``/cbrs/match``) and ranked by Sem-Str alone; ``cbrs settings``, ``register`` and
-``deregister`` had no ``--json``; the camera program took its bridge as ``--url``, not ``--bridge``
-as ``cbrs run`` does.
+``deregister`` had no ``--json``; ``cbrs eval paper`` said nothing for its seconds of ranking; the
+camera program took its bridge as ``--url``, not ``--bridge`` as ``cbrs run`` does.
 """
 
 from __future__ import annotations
@@ -112,3 +112,25 @@ def test_the_camera_program_takes_its_bridge_as_cbrs_run_does(capsys: pytest.Cap
         url = f"ws://127.0.0.1:{probe.getsockname()[1]}"
     assert external_camera.main(["--bridge", url, "CeilingCamera01"]) == 1
     assert f"cannot reach the bridge at {url}" in capsys.readouterr().err
+
+
+class _Figures:
+    """Stands in for the evaluation's report: the seconds of ranking are not what is tested."""
+
+    def text(self) -> str:
+        return "figures"
+
+    def to_json(self) -> dict[str, str]:
+        return {"figures": "json"}
+
+
+def test_eval_paper_says_what_it_is_doing_before_its_seconds_of_ranking(monkeypatch: pytest.MonkeyPatch) -> None:
+    from cbrs.reasoner import evaluation
+
+    monkeypatch.setattr(evaluation, "evaluate_paper", lambda methods, config: _Figures())
+    shown = CliRunner().invoke(cli, ["eval", "paper", "--method", "sem-str", "--method", "lin"])
+    assert shown.exit_code == 0, shown.output
+    assert shown.stderr == "ranking the testbed's components for each requirement with sem-str, lin ...\n"
+    assert shown.stdout == "figures\n"
+    as_json = CliRunner().invoke(cli, ["eval", "paper", "--json"])
+    assert as_json.stderr == "" and json.loads(as_json.stdout) == {"figures": "json"}
