@@ -216,6 +216,9 @@ class HomeWorld:
         people = list(self.map.people.values())
         self.robot, self.person = robots[0], people[0]
         self.base_name, self.person_name = self.robot.name, self.person.name
+        self.spread = spread
+        """How far the seed may move things from the map's start poses: the check before a run asks the
+        person tracker's camera to see the person wherever it may put them (``sight.person_outline``)."""
         self.perturbation = Perturbation.from_seed(
             seed, {name: (obj.iri, obj.shape == "cylinder") for name, obj in self.objects.items()}, spread
         )
