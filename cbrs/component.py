@@ -19,6 +19,7 @@ server then matches, plans and invokes it like any other component. See docs/com
 
 from __future__ import annotations
 
+import inspect
 import logging
 import math
 import signal
@@ -118,6 +119,15 @@ class Component:
 
     def handler(self, function: ServiceHandler) -> ServiceHandler:
         """Decorate the function that answers the service: request fields -> response fields."""
+        try:
+            inspect.signature(function).bind({})
+        except ValueError:  # no signature to read (some builtins): its first call will tell
+            pass
+        except TypeError as error:  # said now, not as the first call's failure on the caller's side
+            raise TypeError(
+                f"the handler of {self.service} must take one argument, the request's fields "
+                f"(def read(request): ...): {error}"
+            ) from None
         self._handler = function
         return function
 

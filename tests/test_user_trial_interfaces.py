@@ -20,6 +20,7 @@ from flask.testing import FlaskClient
 
 from cbrs import external_camera
 from cbrs.cli import cli
+from cbrs.component import Component
 from cbrs.kb import KnowledgeBase
 from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.web import create_app
@@ -134,3 +135,26 @@ def test_eval_paper_says_what_it_is_doing_before_its_seconds_of_ranking(monkeypa
     assert shown.stdout == "figures\n"
     as_json = CliRunner().invoke(cli, ["eval", "paper", "--json"])
     assert as_json.stderr == "" and json.loads(as_json.stdout) == {"figures": "json"}
+
+
+DESCRIPTION = """
+@prefix svc: <https://w3id.org/cbrs/service#> . @prefix home: <https://w3id.org/cbrs/home#> .
+@prefix cbrs: <https://w3id.org/cbrs/core#> .
+svc:ReadRoomTemperature_Thermometer31 a cbrs:DynamicPerceptionComponent ;
+    cbrs:deviceName "Thermometer31" ; cbrs:serviceName "ReadRoomTemperature" ;
+    cbrs:serviceCategory "EnvironmentalSensing" ;
+    cbrs:hasPort [ a cbrs:ServicePort ; cbrs:portName "read" ;
+        cbrs:topic "/thermometer31/read" ; cbrs:messageType "cbrs_msgs/RoomTemperature" ] .
+"""
+
+
+def test_a_handler_that_cannot_take_the_request_is_refused_when_decorated() -> None:
+    """It failed each call instead, with "<lambda>() takes 0 positional arguments but 1 was given"
+    on the caller's side and in the component's log."""
+    made = Component(DESCRIPTION)
+    with pytest.raises(TypeError, match=r"the handler of /thermometer31/read must take one argument"):
+        made.handler(lambda: {"celsius": 21.5})
+    with pytest.raises(TypeError, match="must take one argument"):
+        made.handler(lambda request, unit: {"celsius": 21.5})
+    for fine in (lambda request: {}, lambda request, unit="C": {}, lambda *args: {}, dict):
+        assert made.handler(fine) is fine
