@@ -1,7 +1,7 @@
 """A home of one's own keeps the robots (``kb.kept_robots``): ``cbrs load --graph map --replace`` with files
 that describe no robot keeps what the stored map says the robots are, and the files say where they stand.
 
-Before, the studio flat (docs/examples/studio_flat/home.ttl) copied 33 lines of the robots' descriptions
+Before, the studio flat (docs/examples/studio_flat/home.ttl) copied 26 lines of the robots' descriptions
 from ontologies/world.ttl to change only their poses. No simulation: the map is read and checked."""
 
 from __future__ import annotations
