@@ -8,6 +8,9 @@ furniture or a robot's body. A map that lacks one of them, or puts a start where
 is refused with a :class:`HomeError` naming what it lacks and where, before anything is built or moves:
 before, a missing person or arm was a bare ``ValueError`` (and a missing person was told to "take the
 extra ones out"), and a base starting outside every room was built there, to fail when it first drove.
+Whether a camera sees the person or an object (in frame, and not behind a wall or furniture) is not asked
+here but before each run, of the camera the run's steps look with (``sim.sight``): a home whose cameras
+do not see its person still runs every task that does not track them.
 """
 
 from __future__ import annotations
