@@ -19,6 +19,7 @@ from cbrs.kb.semantic_map import Box, Camera, SemanticMap, local_name
 
 __all__ = [
     "DOWNWARD_IMAGE_SIZE",
+    "HIDDEN_BY",
     "MAX_HIDDEN",
     "OTHER_IMAGE_SIZE",
     "Occluder",
@@ -49,6 +50,8 @@ image's border cuts, and a blob a cupboard cuts is as wrong a measure of where t
 moves towards the part in view). A box of the map is its piece's bounding box (a table's legs and the
 space between them are one solid block), so a lab whose map boxes are coarser than what they stand for
 may allow a part."""
+HIDDEN_BY = "sight lines to the points outlining it pass through"
+"""The words of :func:`hidden`'s reason before the boxes it names: how a caller tells that reason."""
 SURFACE = 0.001
 """How far (m) a sight line may run inside a box at its far end and still pass: an object's bottom rests
 on its support's top face, where the line to a point of its bottom rim ends."""
@@ -132,10 +135,7 @@ def hidden(
     named = ", ".join(
         f"{local_name(iri)} ({count})" for iri, count in sorted(cutting.items(), key=lambda item: (-item[1], item[0]))
     )
-    return (
-        f"{blocked} of the {len(outline)} sight lines to the points outlining it pass through {named}, "
-        f"more than the {max_hidden:.0%} allowed"
-    )
+    return f"{blocked} of the {len(outline)} {HIDDEN_BY} {named}, more than the {max_hidden:.0%} allowed"
 
 
 def default_image_size(camera: Camera) -> tuple[int, int]:

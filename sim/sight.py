@@ -14,7 +14,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from cbrs.kb.camera_view import MAX_HIDDEN, Occluder, hidden, occluders
+from cbrs.kb.camera_view import HIDDEN_BY, MAX_HIDDEN, Occluder, hidden, occluders
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.semantic_map import MapObject, Person, local_name
 from cbrs.sim import layout as L
@@ -115,6 +115,11 @@ class OutOfViewError(KnowledgeBaseError):
         super().__init__(
             f"{local_name(component)} would look for the {local_name(thing)} at ({where[0]:.2f}, {where[1]:.2f}, "
             f"{where[2]:.2f}) with {names}, which cannot see it whole ({each}); move it in the map (home:x, home:y) "
-            f"to where {names} sees it, or hang a camera over it and register a component that looks with that "
-            "camera (docs/tasks.md, 'Which arm')"
+            f"to where {names} sees it{_or_what_hides(self.cameras)}, or hang a camera over it and register a "
+            "component that looks with that camera (docs/tasks.md, 'Which arm')"
         )
+
+
+def _or_what_hides(cameras: tuple[tuple[str, str], ...]) -> str:
+    """The advice for a thing the map's boxes hide: moving what hides it is a fix too."""
+    return ", or what hides it out of the way" if any(HIDDEN_BY in why for _, why in cameras) else ""

@@ -9,6 +9,7 @@ One world (the glasses' home, built, not run)."""
 from __future__ import annotations
 
 import dataclasses
+import re
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -84,6 +85,10 @@ def test_the_pen_behind_the_shelf_is_hidden_as_the_kinects_image_shows(glasses_w
     assert "sight lines to the points outlining it pass through TableShelf1" in why
     with pytest.raises(NotVisibleError):
         recognise_object(frame, pen.colour)
+    refused = str(sight.OutOfViewError(LAB + "RecognisePen_Kinect01", pen.iri, where, [("Kinect01", why)]))
+    assert "RecognisePen_Kinect01 would look for the Pen at (8.06, 3.30, 0.76) with Kinect01" in refused
+    assert re.search(r"Kinect01: \d of the 8 sight lines .* pass through TableShelf1 \(\d\)", refused)
+    assert "or what hides it out of the way" in refused
     glasses = world.map.objects[LAB + "Glasses1"]  # on the shelf: in plain view, and found
     assert sight.unseen(camera, sight.object_outline(glasses, world.pose("Glasses1").position), blockers) == ""
     recognise_object(frame, glasses.colour)
