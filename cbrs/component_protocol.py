@@ -14,7 +14,7 @@ import pyoxigraph as ox
 from cbrs.kb.namespaces import RDF
 from cbrs.kb.vocab import CBRS
 
-__all__ = ["DEFAULT_TTL", "DEREGISTERED", "FORMATS", "NO_LIVE_COMPONENT", "UNPROVIDED", "grounding"]
+__all__ = ["DEFAULT_TTL", "DEREGISTERED", "FORMATS", "NO_LIVE_COMPONENT", "READ_ONLY", "UNPROVIDED", "grounding"]
 
 DEFAULT_TTL = 3.0
 """Seconds a lease lasts unless renewed: three missed one-second heartbeats."""
@@ -26,6 +26,12 @@ DEREGISTERED = "was deregistered"
 UNPROVIDED = "no bridge client provides its service"
 """How a lease ended because nobody answers the component's service: a bridge registration whose program
 never advertised the service its description names (a misspelt name), or an HTTP one whose provider left."""
+READ_ONLY = (
+    "this server is read-only, so it registers no component: start cbrs serve with an update token "
+    "(CBRS_UPDATE_TOKEN or --update-token-file, without --read-only) and give the component that token"
+)
+"""Why a server without an update token, or started ``--read-only``, refuses a registration, over the
+bridge and over HTTP alike: no token the component could send would help."""
 
 
 def grounding(quads: list[ox.Quad], component: str) -> tuple[str, str] | None:

@@ -31,7 +31,15 @@ from typing import Any
 
 import pyoxigraph as ox
 
-from cbrs.component_protocol import DEFAULT_TTL, DEREGISTERED, FORMATS, NO_LIVE_COMPONENT, UNPROVIDED, grounding
+from cbrs.component_protocol import (
+    DEFAULT_TTL,
+    DEREGISTERED,
+    FORMATS,
+    NO_LIVE_COMPONENT,
+    READ_ONLY,
+    UNPROVIDED,
+    grounding,
+)
 from cbrs.kb.errors import AlreadyRegisteredError, InvalidDescriptionError, KnowledgeBaseError
 from cbrs.kb.liveness import ComponentState
 from cbrs.kb.loader import parse_bytes
@@ -182,10 +190,7 @@ class LiveComponents:
         if caller is not None and not caller.authorised:
             config = self.sparql.config
             if config.read_only or config.update_token is None:  # no token would help: say what would
-                raise ServiceError(
-                    "this server is read-only, so it registers no component: start cbrs serve with an update token "
-                    "(CBRS_UPDATE_TOKEN or --update-token-file, without --read-only) and give the component that token"
-                )
+                raise ServiceError(READ_ONLY)
             raise ServiceError(
                 "registering a component needs the update token: send it first with the auth op "
                 '({"op": "auth", "mac": TOKEN}; roslibpy sends Ros.authenticate() only as it connects, so call '

@@ -21,9 +21,11 @@ from flask.testing import FlaskClient
 from cbrs import external_camera
 from cbrs.cli import cli
 from cbrs.component import Component
+from cbrs.component_protocol import READ_ONLY
 from cbrs.kb import KnowledgeBase
 from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.web import create_app
+from cbrs.web.components import blueprint as components_blueprint
 
 TOKEN = "trial-token"
 ROOT = Path(__file__).resolve().parents[1]
@@ -158,3 +160,45 @@ def test_a_handler_that_cannot_take_the_request_is_refused_when_decorated() -> N
         made.handler(lambda request, unit: {"celsius": 21.5})
     for fine in (lambda request: {}, lambda request, unit="C": {}, lambda *args: {}, dict):
         assert made.handler(fine) is fine
+
+
+def _server_app(config: EndpointConfig) -> FlaskClient:
+    """An app as cbrs serve builds it (its own origins known, /components served), over a fresh store."""
+    app = create_app(
+        SparqlService(KnowledgeBase.open(":memory:"), config), own_origins=lambda: ["http://127.0.0.1:8080"]
+    )
+    app.register_blueprint(components_blueprint)
+    return app.test_client()
+
+
+@pytest.fixture(scope="module")
+def read_only() -> FlaskClient:
+    return _server_app(EndpointConfig(update_token=TOKEN, read_only=True, isolate=False))
+
+
+@pytest.fixture(scope="module")
+def tokenless() -> FlaskClient:
+    return _server_app(EndpointConfig(isolate=False))
+
+
+@pytest.mark.parametrize("app", ["read_only", "tokenless"])
+def test_a_server_that_takes_no_writes_registers_no_component_over_http(
+    app: str, request: pytest.FixtureRequest
+) -> None:
+    """A --read-only server with a token took a registration over HTTP (the bridge refused it), and one
+    without a token asked for the token it does not have."""
+    client: FlaskClient = request.getfixturevalue(app)
+    sent = client.post(
+        "/components", data=DESCRIPTION, content_type="text/turtle", headers={"Authorization": f"Bearer {TOKEN}"}
+    )
+    assert sent.status_code == 403
+    assert sent.get_json()["message"] == READ_ONLY
+    assert client.get("/components").get_json() == []
+
+
+def test_starting_a_task_says_what_would_work_on_this_server(read_only: FlaskClient, tokenless: FlaskClient) -> None:
+    headers = {"Authorization": f"Bearer {TOKEN}"}
+    disabled = read_only.post("/tasks/run-1/cancel.json")  # no token: none would help
+    assert disabled.status_code == 403 and "this server is read-only" in disabled.get_json()["message"]
+    no_token = tokenless.post("/tasks/run-1/cancel.json", headers=headers).get_json()["message"]
+    assert "this server has no update token, so a run may be stopped only from its own tasks page" in no_token

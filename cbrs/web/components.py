@@ -18,6 +18,7 @@ import secrets
 from flask import Blueprint, Response, current_app, jsonify, request
 from werkzeug.exceptions import BadRequest, Forbidden, NotFound, UnsupportedMediaType
 
+from cbrs.component_protocol import READ_ONLY
 from cbrs.live_components import LiveComponents
 from cbrs.web import context
 
@@ -34,10 +35,12 @@ def _live() -> LiveComponents:
 
 
 def _authorised() -> None:
-    expected = context.sparql().config.update_token
+    config = context.sparql().config
+    if config.read_only or config.update_token is None:  # a registration writes the store: none, token or not
+        raise Forbidden(READ_ONLY)
     header = request.headers.get("Authorization", "")
     given = header[7:].strip() if header.lower().startswith("bearer ") else ""
-    if expected is None or not given or not hmac.compare_digest(given.encode("utf-8"), expected.encode("utf-8")):
+    if not given or not hmac.compare_digest(given.encode("utf-8"), config.update_token.encode("utf-8")):
         raise Forbidden("registering a component needs the server's update token: Authorization: Bearer <token>")
 
 

@@ -26,7 +26,7 @@ from werkzeug.exceptions import Forbidden, NotFound, ServiceUnavailable
 from cbrs.actions.errors import UnknownTaskError
 from cbrs.kb.namespaces import PREFIXES, written
 from cbrs.kb.owls import local_name
-from cbrs.tasks import CameraFrame, TaskBusyError, TaskRun, UnknownComponentError
+from cbrs.tasks import CameraFrame, TaskBusyError, TaskRun, TasksDisabledError, UnknownComponentError
 from cbrs.web import context
 from cbrs.web.links import expand_name, short
 from cbrs.web.pages import FormError, Page, page, wants_json
@@ -195,6 +195,14 @@ def _may_act(verb: str = "started") -> None:
             raise Forbidden(f"a task may be {verb} only from this server's own pages, not from {origin}")
         return
     if not _has_token():
+        config = context.sparql().config
+        if config.read_only:  # no page and no token would help
+            raise TasksDisabledError()
+        if config.update_token is None:  # no token to send: say the one way there is
+            raise Forbidden(
+                f"a task run moves the robot: this server has no update token, so a run may be {verb} only from "
+                "its own tasks page (or start cbrs serve with CBRS_UPDATE_TOKEN and send Authorization: Bearer <token>)"
+            )
         raise Forbidden(
             f"a task run moves the robot: it may be {verb} from this server's tasks page, or with the update token "
             "(Authorization: Bearer <token>)"
