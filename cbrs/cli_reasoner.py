@@ -21,7 +21,10 @@ from cbrs.settings import setting
 def match_config(params: tuple[str, ...], base: MatchConfig | None = None) -> MatchConfig:
     """``base`` (MatchConfig's defaults) with the ``--param`` options, else the match_params setting; says
     on standard error which are set, so that no figure is read as the defaults' by mistake."""
-    given = setting("match_params").resolve(params or None)
+    try:
+        given = setting("match_params").resolve(setting("match_params").from_options(params))
+    except ValueError as error:
+        raise click.BadParameter(str(error), param_hint="--param") from None
     if given:
         click.echo(f"matchmaking parameters: {', '.join(given)}", err=True)
     return (base or MatchConfig()).with_params(given)

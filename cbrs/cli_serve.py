@@ -7,6 +7,7 @@ import ipaddress
 import logging
 import socket
 from pathlib import Path
+from typing import Any
 
 import click
 
@@ -81,17 +82,17 @@ def serve(
             read_only=setting("read_only").resolve(read_only),
             isolate_memory=True,  # a query past its deadline is stopped whatever the store
         ),
-        cors_origins=setting("cors_origins").resolve(cors_origins or None),
-        match_params=setting("match_params").resolve(match_params or None),
+        cors_origins=setting("cors_origins").resolve(_option("cors_origins", cors_origins, "--cors-origin")),
+        match_params=setting("match_params").resolve(_option("match_params", match_params, "--match-param")),
     )
     if config.match_params:  # a wrong name or value fails now, not at the first ranking
         from cbrs.reasoner.config import MatchConfig
 
         MatchConfig().with_params(config.match_params)
-    if not _is_loopback(config.host):
-        click.echo(f"warning: listening on {config.host}, reachable from other machines", err=True)
     _check_free(config.host, config.port, "--port", "CBRS_PORT")
     _check_free(config.host, config.bridge_port, "--bridge-port", "CBRS_BRIDGE_PORT")
+    if not _is_loopback(config.host):  # after the checks: a host it cannot listen on is no warning but an error
+        click.echo(f"warning: listening on {config.host}, reachable from other machines", err=True)
     # One query before anything listens: a store that cannot answer as cbrs needs (a remote server whose
     # default graph is not the union of its graphs, found only once the seed is in) stops the command
     # with its reason, instead of a server that answers every request with that error.
@@ -125,10 +126,16 @@ def serve(
     click.echo("stopped")
 
 
+def _option(name: str, values: tuple[str, ...], option: str) -> Any:
+    try:
+        return setting(name).from_options(values)
+    except ValueError as error:
+        raise click.BadParameter(str(error), param_hint=option) from None
+
+
 def _check_free(host: str, port: int, option: str, env: str) -> None:
-    """Fail with a message naming the port when it cannot be listened on (port 0 always can)."""
-    if port == 0:
-        return
+    """Fail with a message naming the port, or the host, when it cannot be listened on. Port 0 is probed too:
+    it tells whether the host is an address of this machine (Granian's bind said so with a Rust backtrace)."""
     try:
         family, kind, proto, _, address = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)[0]
     except socket.gaierror as error:
@@ -142,6 +149,12 @@ def _check_free(host: str, port: int, option: str, env: str) -> None:
                 raise click.ClickException(
                     f"port {port} on {host} is already in use (another cbrs serve?); stop that process or "
                     f"choose another port with {option} or {env} (0 picks a free one)"
+                ) from None
+            if error.errno == errno.EADDRNOTAVAIL:
+                raise click.BadParameter(
+                    f"{host} is no address of this machine ({error.strerror}): give one of its own, 127.0.0.1 "
+                    "(the default) or 0.0.0.0 for all of them",
+                    param_hint="--host or CBRS_HOST",
                 ) from None
             raise click.ClickException(f"cannot listen on {host} port {port}: {error.strerror or error}") from None
 

@@ -11,6 +11,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+from urllib.parse import urlsplit
 
 from platformdirs import user_cache_dir, user_data_dir
 
@@ -63,6 +64,19 @@ def _origins(text: str) -> tuple[str, ...]:
 
 
 _prefixes = _origins  # a comma-separated list of IRI prefixes reads the same way
+
+
+def _web_origins(text: str) -> tuple[str, ...]:
+    """Origins as a browser sends them in ``Origin`` (``https://lab.example:8443``); a trailing slash is
+    dropped. Anything else would never match a request, and the page it was meant for would be refused."""
+    found = []
+    for origin in _origins(text):
+        origin = origin.rstrip("/")
+        parts = urlsplit(origin)
+        if parts.scheme not in ("http", "https") or not parts.hostname or parts.path or parts.query:
+            raise ValueError(f"{origin!r} is not a web origin: give scheme://host[:port], e.g. https://lab.example")
+        found.append(origin)
+    return tuple(found)
 
 
 def _match_params(text: str) -> tuple[str, ...]:
@@ -135,6 +149,13 @@ class Setting:
         if isinstance(value, str):
             return without_password(value)
         return value if value is None or isinstance(value, bool | int | float) else str(value)
+
+    def from_options(self, values: tuple[str, ...]) -> Any:
+        """The value of a repeatable CLI option, each occurrence read as the environment variable is (a
+        comma-separated list split, its form checked); None when the option was not given. Taken as they
+        came, ``--match-param a=1,b=2`` was one parameter whose value was ``1,b=2``, though the help says
+        comma-separated."""
+        return self.parse(",".join(values)) if values else None
 
     def resolve(self, given: Any = None, environ: Mapping[str, str] | None = None) -> Any:
         if given is not None:
@@ -375,7 +396,7 @@ SETTINGS: tuple[Setting, ...] = (
         "Comma-separated origins of web pages allowed to call the HTTP API (CORS) and open the rosbridge "
         "websocket, besides the server's own pages; none by default.",
         "CBRS_CORS_ORIGINS",
-        _origins,
+        _web_origins,
     ),
     Setting(
         "match_params",

@@ -20,9 +20,11 @@ from flask.testing import FlaskClient
 
 from cbrs import external_camera
 from cbrs.cli import cli
+from cbrs.cli_reasoner import match_config
 from cbrs.component import Component
 from cbrs.component_protocol import READ_ONLY
 from cbrs.kb import KnowledgeBase
+from cbrs.settings import setting
 from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.web import create_app
 from cbrs.web.components import blueprint as components_blueprint
@@ -202,3 +204,26 @@ def test_starting_a_task_says_what_would_work_on_this_server(read_only: FlaskCli
     assert disabled.status_code == 403 and "this server is read-only" in disabled.get_json()["message"]
     no_token = tokenless.post("/tasks/run-1/cancel.json", headers=headers).get_json()["message"]
     assert "this server has no update token, so a run may be stopped only from its own tasks page" in no_token
+
+
+def test_serve_on_an_address_not_of_this_machine_is_a_usage_error_not_a_backtrace() -> None:
+    """With --port 0 the free-port check was skipped and Granian's bind failed with a Rust backtrace,
+    after a warning that the server was "listening on" the address, reachable from other machines."""
+    result = CliRunner().invoke(
+        cli, ["--store", ":memory:", "serve", "--host", "192.0.2.1", "--port", "0", "--bridge-port", "0"]
+    )
+    assert result.exit_code == 2
+    assert "192.0.2.1 is no address of this machine" in result.stderr and "--host" in result.stderr
+    assert "warning: listening" not in result.stderr and "Traceback" not in result.stderr
+
+
+def test_list_options_read_commas_as_their_help_and_environment_variables_do() -> None:
+    """`--match-param a=off,b=0` was one parameter whose value was 'off,b=0'; `--cors-origin lab.example`
+    (no scheme, so never an Origin a browser sends) was taken and matched nothing."""
+    config = match_config(("consumer_steps=off,undone_state_factor=0",))
+    assert config.consumer_steps is False and config.undone_state_factor == 0
+    origins = setting("cors_origins").from_options(("https://lab.example/,http://10.0.0.5:8081", "https://b.example"))
+    assert origins == ("https://lab.example", "http://10.0.0.5:8081", "https://b.example")
+    refused = CliRunner().invoke(cli, ["--store", ":memory:", "serve", "--cors-origin", "lab.example"])
+    assert refused.exit_code == 2 and "'lab.example' is not a web origin" in refused.stderr
+    assert setting("cors_origins").from_options(()) is None  # not given: the environment or the default
