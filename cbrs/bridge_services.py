@@ -37,6 +37,7 @@ store updates).
 
 from __future__ import annotations
 
+import difflib
 import json
 import threading
 from collections.abc import Callable, Collection
@@ -65,6 +66,18 @@ ACTIONS = {"/cbrs/run_task": "cbrs/action/RunTask"}
 
 #: A run's end status (TaskRun.status) -> the action goal's status; anything else aborted the goal.
 GOAL_STATUS = {"succeeded": GoalStatus.SUCCEEDED, "cancelled": GoalStatus.CANCELED}
+
+#: The fields each service (and the run_task action's goal) reads. Another is refused, as rosbridge refuses
+#: a field its message type lacks: a misspelt optional one ("metod") was ignored and the default used.
+_RUN = ("task", "seed", "fail", "fault_rate", "repeat_failures")
+FIELDS: dict[str, tuple[str, ...]] = {
+    "/cbrs/query": ("query",),
+    "/cbrs/match": ("requirement", "method", "top"),
+    "/cbrs/plan": ("task", "objective"),
+    "/cbrs/run_task": (*_RUN, "wait"),
+    "/cbrs/tasks": (),
+    "/cbrs/task_status": ("run",),
+}
 
 T = TypeVar("T")
 Handler = Callable[[dict[str, Any]], dict[str, Any]]
@@ -98,8 +111,8 @@ class KnowledgeServices:
         return caller.origin is not None and caller.origin.rstrip("/") in self.own_origins()
 
     def handlers(self) -> dict[str, tuple[str, Handler]]:
-        """Service name -> (type, handler)."""
-        return {
+        """Service name -> (type, handler); each handler refuses a field its service does not read."""
+        handlers: dict[str, tuple[str, Handler]] = {
             "/cbrs/query": ("cbrs/Query", self.query),
             "/cbrs/match": ("cbrs/Match", self.match),
             "/cbrs/plan": ("cbrs/Plan", self.plan),
@@ -107,6 +120,7 @@ class KnowledgeServices:
             "/cbrs/tasks": ("cbrs/Tasks", self.known_tasks),
             "/cbrs/task_status": ("cbrs/TaskStatus", self.task_status),
         }
+        return {name: (kind, _known_fields(name, FIELDS[name], handler)) for name, (kind, handler) in handlers.items()}
 
     def query(self, args: dict[str, Any]) -> dict[str, Any]:
         text = _field(args, "query", str)
@@ -163,6 +177,7 @@ class KnowledgeServices:
         A cancel asks the run to stop after the step under way. The wait has no deadline of its own:
         a run always ends (the executor's tick bound), and a server stopping cancels the goal.
         """
+        _check_fields("/cbrs/run_task", _RUN, goal.args)
         request = self._run_request(goal.args)
         with self.sparql.lock:
             realises = {ad.iri: ad.realizes_action for ad in self.sparql.kb.advertisements(include_unavailable=True)}
@@ -332,6 +347,24 @@ def _field(args: dict[str, Any], name: str, kind: type, default: Any = ...) -> A
     if (kind is int and isinstance(value, bool)) or not isinstance(value, kind):
         raise ServiceError(f"field {name!r} must be {kind.__name__}, not {type(value).__name__}")
     return value
+
+
+def _known_fields(service: str, fields: tuple[str, ...], handler: Handler) -> Handler:
+    def checked(args: dict[str, Any]) -> dict[str, Any]:
+        _check_fields(service, fields, args)
+        return handler(args)
+
+    return checked
+
+
+def _check_fields(service: str, fields: tuple[str, ...], args: dict[str, Any]) -> None:
+    unknown = [name for name in args if name not in fields]
+    if not unknown:
+        return
+    close = difflib.get_close_matches(unknown[0], fields, n=1)
+    meant = f" (did you mean {close[0]!r}?)" if close else ""
+    takes = f"it takes {', '.join(fields)}" if fields else "it takes no field"
+    raise ServiceError(f"{service} has no field {unknown[0]!r}{meant}: {takes}")
 
 
 def _iri(name: str, default_prefix: str) -> str:

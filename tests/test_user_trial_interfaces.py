@@ -19,13 +19,16 @@ from click.testing import CliRunner
 from flask.testing import FlaskClient
 
 from cbrs import external_camera
+from cbrs.bridge_services import KnowledgeServices
 from cbrs.cli import cli
 from cbrs.cli_reasoner import match_config
 from cbrs.component import Component
 from cbrs.component_protocol import READ_ONLY
 from cbrs.kb import KnowledgeBase
+from cbrs.rosbridge import ServiceError
 from cbrs.settings import setting
 from cbrs.sparql_service import EndpointConfig, SparqlService
+from cbrs.tasks import TaskRunner
 from cbrs.web import create_app
 from cbrs.web.components import blueprint as components_blueprint
 
@@ -227,3 +230,24 @@ def test_list_options_read_commas_as_their_help_and_environment_variables_do() -
     refused = CliRunner().invoke(cli, ["--store", ":memory:", "serve", "--cors-origin", "lab.example"])
     assert refused.exit_code == 2 and "'lab.example' is not a web origin" in refused.stderr
     assert setting("cors_origins").from_options(()) is None  # not given: the environment or the default
+
+
+def test_the_knowledge_services_refuse_a_field_they_do_not_read() -> None:
+    """A misspelt optional field was ignored: /cbrs/match with "metod": "lin" ranked by Sem-Str. rosbridge
+    refuses a field that the service's message type lacks."""
+    sparql = SparqlService(KnowledgeBase.open(":memory:"))
+    handlers = {
+        name: handler
+        for name, (_, handler) in KnowledgeServices(sparql, TaskRunner(sparql.kb, sparql.lock)).handlers().items()
+    }
+    with pytest.raises(
+        ServiceError,
+        match=r"/cbrs/match has no field 'metod' \(did you mean 'method'\?\): it takes requirement, method, top",
+    ):
+        handlers["/cbrs/match"]({"requirement": "RobotSelfPosition", "metod": "lin"})
+    with pytest.raises(ServiceError, match="/cbrs/tasks has no field 'all': it takes no field"):
+        handlers["/cbrs/tasks"]({"all": True})
+    with pytest.raises(ServiceError, match="/cbrs/query has no field 'format'"):
+        handlers["/cbrs/query"]({"query": "ASK {}", "format": "csv"})
+    assert handlers["/cbrs/match"]({"requirement": "RobotSelfPosition", "method": "lin", "top": 1})["method"] == "lin"
+    assert handlers["/cbrs/query"]({"query": "ASK {}"})["result"]["boolean"] is True
