@@ -187,8 +187,12 @@ class Component:
             answer = _answer(client.call(REGISTER, args, client.timeout), client.timeout, stop)
         except RemoteCallError as error:
             reason = _servers_reason(client, str(error))
-            if not token_given and "needs the update token" in reason:  # the protocol's words, and the SDK's fix
-                reason += "; this component was given no token (token=None): pass the server's update token"
+            if not token_given and "needs the update token" in reason:  # the protocol's words; the SDK's own fix
+                # (the server goes on to tell a hand-written client to send the auth op, which the SDK does itself)
+                reason = (
+                    "registering a component needs the update token, and this component was given none (token=None): "
+                    "pass the token cbrs serve was started with, e.g. token=os.environ['CBRS_UPDATE_TOKEN']"
+                )
             raise RegistrationRefusedError(self.iri, reason) from None
         return list(answer.get("components", []))
 

@@ -91,4 +91,5 @@ def test_a_component_given_no_token_is_told_so_in_the_sdks_words(server: Server)
     with pytest.raises(RegistrationRefusedError) as refused:
         sdk_thermometer().connect(url(server), None)
     assert "needs the update token" in refused.value.reason and "token=None" in refused.value.reason
+    assert "roslibpy" not in refused.value.reason  # the advice for hand-written clients is not the SDK's
     assert not server.kb.registry.is_registered(THERMOMETER)
