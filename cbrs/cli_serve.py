@@ -69,6 +69,7 @@ def serve(
     level = setting("log_level").resolve(log_level.upper() if log_level else None)
     logging.basicConfig(format="%(asctime)s %(name)s %(levelname)s: %(message)s")
     logging.getLogger().setLevel(level)  # also when something has configured logging before
+    logging.getLogger("websockets").setLevel(_websockets_level(level))
     config = ServeConfig(
         host=setting("host").resolve(host),
         port=setting("port").resolve(port),
@@ -124,6 +125,13 @@ def serve(
             f"{error.strerror or error}"
         ) from None
     click.echo("stopped")
+
+
+def _websockets_level(level: str) -> int:
+    """websockets' own INFO lines ("connection open", "connection closed") double cbrs.rosbridge's, which
+    name the client: four lines a connection. They show at DEBUG; its warnings as the level says."""
+    chosen = int(logging.getLevelName(level))
+    return chosen if chosen <= logging.DEBUG else max(chosen, logging.WARNING)
 
 
 def _option(name: str, values: tuple[str, ...], option: str) -> Any:

@@ -11,6 +11,7 @@ camera program took its bridge as ``--url``, not ``--bridge`` as ``cbrs run`` do
 from __future__ import annotations
 
 import json
+import logging
 import socket
 from pathlib import Path
 
@@ -22,6 +23,7 @@ from cbrs import external_camera
 from cbrs.bridge_services import KnowledgeServices
 from cbrs.cli import cli
 from cbrs.cli_reasoner import match_config
+from cbrs.cli_serve import _websockets_level
 from cbrs.component import Component
 from cbrs.component_protocol import READ_ONLY
 from cbrs.kb import KnowledgeBase
@@ -251,3 +253,11 @@ def test_the_knowledge_services_refuse_a_field_they_do_not_read() -> None:
         handlers["/cbrs/query"]({"query": "ASK {}", "format": "csv"})
     assert handlers["/cbrs/match"]({"requirement": "RobotSelfPosition", "method": "lin", "top": 1})["method"] == "lin"
     assert handlers["/cbrs/query"]({"query": "ASK {}"})["result"]["boolean"] is True
+
+
+@pytest.mark.parametrize(
+    ("level", "expected"), [("DEBUG", logging.DEBUG), ("INFO", logging.WARNING), ("ERROR", logging.ERROR)]
+)
+def test_websockets_own_connection_lines_show_only_when_debugging(level: str, expected: int) -> None:
+    """cbrs.rosbridge logs each client's connection with its number; websockets' INFO lines said it again."""
+    assert _websockets_level(level) == expected
