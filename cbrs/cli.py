@@ -742,7 +742,9 @@ def settings_command(as_json: bool) -> None:
 @click.option("--seed", type=int, default=0, show_default=True, help="World seed of the external demo's run.")
 @pass_app
 def demo(app: App, external: bool, seed: int) -> None:
-    """A tour of the knowledge base: what is stored, an advertisement, a requirement, a query."""
+    """A tour of the knowledge base: what is stored, an advertisement, a requirement, a query, a ranking;
+    then the paper's two scenarios planned and run in the simulated home (the [sim] extra), FetchMyPen again
+    with a camera failed. About 10 s."""
     if external:
         _external_demo(seed)
         return
