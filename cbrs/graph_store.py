@@ -15,8 +15,9 @@ import pyoxigraph as ox
 
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.loader import parse_bytes
-from cbrs.kb.namespaces import PREFIXES, GraphName
+from cbrs.kb.namespaces import GraphName
 from cbrs.kb.shapes import check_descriptions
+from cbrs.output import used_prefixes
 from cbrs.sparql_service import NotAcceptableError, SparqlService, negotiate
 
 __all__ = ["GraphStore", "GraphStoreError", "Target", "UnknownGraphError"]
@@ -84,14 +85,14 @@ class GraphStore:
         fmt = _negotiate(accept, DATASET_FORMATS if whole else GRAPH_FORMATS)
         if whole:
             quads = list(store.quads())
-            data = ox.serialize(quads, format=fmt, prefixes=PREFIXES)
+            data = ox.serialize(quads, format=fmt, prefixes=used_prefixes(quads))
         else:
             node = target.node
             assert node is not None
             if isinstance(node, ox.NamedNode) and node.value not in store.graphs():
                 raise UnknownGraphError(node.value)
             triples = [ox.Triple(q.subject, q.predicate, q.object) for q in store.quads(graph=node)]
-            data = ox.serialize(triples, format=fmt, prefixes=PREFIXES)
+            data = ox.serialize(triples, format=fmt, prefixes=used_prefixes(triples))
         return data or b"", fmt.media_type
 
     def replace(self, target: Target, body: bytes, media_type: str, token: str | None) -> bool:

@@ -30,10 +30,37 @@ _GRAPH_FORMATS = {
 }
 
 
+def used_prefixes(statements: Iterable[ox.Triple | ox.Quad]) -> dict[str, str]:
+    """The declared prefixes of the namespaces ``statements`` name (an IRI's namespace ends at its last
+    ``#`` or ``/``; a literal's datatype counts), for Turtle and TriG that declare what they abbreviate:
+    two triples came after 25 ``@prefix`` lines."""
+    namespaces = {namespace: prefix for prefix, namespace in PREFIXES.items()}
+    used: dict[str, str] = {}
+    seen: set[str] = set()
+    for statement in statements:
+        for term in (statement.subject, statement.predicate, statement.object, getattr(statement, "graph_name", None)):
+            iri = (
+                term.value
+                if isinstance(term, ox.NamedNode)
+                else term.datatype.value
+                if isinstance(term, ox.Literal)
+                else None
+            )
+            if iri is None or iri in seen:
+                continue
+            seen.add(iri)
+            for end in (iri.rfind("#"), iri.rfind("/")):
+                prefix = namespaces.get(iri[: end + 1]) if end >= 0 else None
+                if prefix is not None:
+                    used[prefix] = iri[: end + 1]
+    return dict(sorted(used.items()))
+
+
 def render_result(result: QueryResult, fmt: str) -> str:
     """The text for a query result in one of ``RESULT_FORMATS``."""
     if isinstance(result, ox.QueryTriples):
-        data = ox.serialize(list(result), format=_GRAPH_FORMATS[fmt], prefixes=PREFIXES)
+        triples = list(result)
+        data = ox.serialize(triples, format=_GRAPH_FORMATS[fmt], prefixes=used_prefixes(triples))
         return data.decode("utf-8") if data else ""
     if fmt in _SOLUTION_FORMATS:
         data = result.serialize(format=_SOLUTION_FORMATS[fmt])

@@ -12,9 +12,11 @@ from __future__ import annotations
 
 import json
 import logging
+import re
 import socket
 from pathlib import Path
 
+import pyoxigraph as ox
 import pytest
 from click.testing import CliRunner
 from flask.testing import FlaskClient
@@ -261,3 +263,20 @@ def test_the_knowledge_services_refuse_a_field_they_do_not_read() -> None:
 def test_websockets_own_connection_lines_show_only_when_debugging(level: str, expected: int) -> None:
     """cbrs.rosbridge logs each client's connection with its number; websockets' INFO lines said it again."""
     assert _websockets_level(level) == expected
+
+
+def test_turtle_declares_only_the_prefixes_it_uses(client: FlaskClient) -> None:
+    """`cbrs query 'CONSTRUCT ...'` and GET /store printed the 25 declared prefixes before any triple."""
+    shown = CliRunner().invoke(
+        cli, ["--store", ":memory:", "query", "CONSTRUCT { home:Cup ?p ?o } WHERE { home:Cup ?p ?o }"]
+    )
+    assert shown.exit_code == 0, shown.output
+    declared = set(re.findall(r"^@prefix (\w+):", shown.stdout, re.M))
+    assert {"home", "owl", "rdfs"} <= declared and not declared & {"svc", "req", "world", "qudt", "sosa"}
+    assert len(list(ox.parse(shown.stdout.encode(), format=ox.RdfFormat.TURTLE))) >= 3
+    headers = {"Authorization": f"Bearer {TOKEN}", "Content-Type": "text/turtle"}
+    client.put("/store?graph=urn:trial:plain", data="<urn:a> <urn:b> <urn:c> .", headers=headers)
+    plain = client.get("/store?graph=urn:trial:plain").text
+    assert "@prefix" not in plain and "<urn:a> <urn:b> <urn:c>" in plain
+    typed = client.get("/store?graph=https://w3id.org/cbrs/graph/map").text
+    assert "@prefix world:" in typed and "@prefix req:" not in typed
