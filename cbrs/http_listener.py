@@ -68,9 +68,9 @@ class _Server(_Embedded):
 def _refuse_taken(host: str, port: int) -> None:
     """Raise EADDRINUSE when something listens on ``host:port``. Granian's socket sets SO_REUSEPORT, so
     its own bind would succeed beside another server of this user (a second cbrs serve) and the two
-    would share the connections; a plain bind first says the port is taken, as waitress's did."""
-    if port == 0:
-        return
+    would share the connections; a plain bind first says the port is taken, as waitress's did. Port 0 is
+    probed too: a host that is no address of this machine is then an OSError (EADDRNOTAVAIL), where
+    Granian's bind raised a RuntimeError with a Rust backtrace."""
     family, kind, proto, _, address = socket.getaddrinfo(host, port, type=socket.SOCK_STREAM)[0]
     with socket.socket(family, kind, proto) as probe:
         probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
@@ -190,7 +190,7 @@ class HttpListener:
             if not self._listening.is_set():
                 self._failed = error
                 self._listening.set()
-            else:
+            elif self._failed is None:  # a failure of start-up is start()'s to raise, not to log as well
                 log.exception("the HTTP listener failed")
         finally:
             try:

@@ -10,6 +10,7 @@ camera program took its bridge as ``--url``, not ``--bridge`` as ``cbrs run`` do
 
 from __future__ import annotations
 
+import errno
 import json
 import logging
 import re
@@ -30,6 +31,7 @@ from cbrs.component import Component
 from cbrs.component_protocol import READ_ONLY
 from cbrs.kb import KnowledgeBase
 from cbrs.rosbridge import ServiceError
+from cbrs.server import ServeConfig, Server
 from cbrs.settings import setting
 from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.tasks import TaskRunner
@@ -280,3 +282,15 @@ def test_turtle_declares_only_the_prefixes_it_uses(client: FlaskClient) -> None:
     assert "@prefix" not in plain and "<urn:a> <urn:b> <urn:c>" in plain
     typed = client.get("/store?graph=https://w3id.org/cbrs/graph/map").text
     assert "@prefix world:" in typed and "@prefix req:" not in typed
+
+
+def test_a_server_on_an_address_not_of_this_machine_fails_to_start_with_an_oserror(
+    caplog: pytest.LogCaptureFixture,
+) -> None:
+    """Library use (tests, a lab's own launcher): Granian's bind raised a RuntimeError with a Rust
+    backtrace, logged as well as raised."""
+    server = Server(KnowledgeBase.open(":memory:"), ServeConfig(host="192.0.2.1", port=0, bridge_port=0))
+    with pytest.raises(OSError) as failed:
+        server.start()
+    assert failed.value.errno == errno.EADDRNOTAVAIL
+    assert not [r for r in caplog.records if r.levelno >= logging.ERROR]
