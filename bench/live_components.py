@@ -36,7 +36,7 @@ from cbrs.actions.components import Component, Status  # noqa: E402
 from cbrs.actions.remote import RemoteComponent  # noqa: E402
 from cbrs.bridge_client import BridgeClient  # noqa: E402
 from cbrs.component import Component as SdkComponent  # noqa: E402
-from cbrs.external_demo import run_external_demo  # noqa: E402
+from cbrs.external_demo import ExternalRun, run_external_demo  # noqa: E402
 from cbrs.kb import KnowledgeBase  # noqa: E402
 from cbrs.kb.namespaces import PREFIXES  # noqa: E402
 from cbrs.reasoner.matchmaker import Matchmaker  # noqa: E402
@@ -211,11 +211,18 @@ def main() -> None:
     else:
         print("fleet: skipped (no oxigraph binary: pip install oxigraph)")
 
-    finished, noticed = 0, []
+    finished, noticed, unfinished = 0, [], []
     started = time.perf_counter()
     for seed in range(args.trials):
-        run = run_external_demo(seed=seed, say=lambda line: None)
-        finished += bool(run.result is not None and run.result.succeeded)
+        try:
+            run = run_external_demo(seed=seed, say=lambda line: None)
+        except Exception as error:  # the trial itself broke (a camera program that never registered)
+            unfinished.append(f"seed {seed}: {type(error).__name__}: {error}")
+            continue
+        if run.result is not None and run.result.succeeded:
+            finished += 1
+        else:
+            unfinished.append(f"seed {seed}: killed {run.killed}; {_why(run)}")
         if run.detected_after is not None:
             noticed.append(run.detected_after)
     print(
@@ -223,6 +230,20 @@ def main() -> None:
         f"({100 * finished / max(1, args.trials):.0f} %; goal >= 95 %); the kill seen in "
         f"{ms(noticed) if noticed else 'no run'}; {time.perf_counter() - started:.0f} s"
     )
+    for line in unfinished:  # what to reproduce with `cbrs demo --external --seed N`
+        print(f"  not finished: {line[:300]}")
+
+
+def _why(run: ExternalRun) -> str:
+    """Why a kill-mid-run trial did not finish, from its result: the re-planning stop or the last
+    plan's reason, with the plans it replaced."""
+    result = run.result
+    if result is None:
+        return "no result"
+    if result.report is None:
+        return "no plan"
+    reason = result.stopped or result.report.reason or f"goals refuted: {len(result.refuted)}"
+    return f"{len(result.replans)} re-plan(s); {reason}"
 
 
 if __name__ == "__main__":
