@@ -769,7 +769,11 @@ def demo(app: App, external: bool, seed: int) -> None:
     click.echo("\nPaper Table 3: the advertisements ranked for the requirement (cbrs match ... --explain):")
     click.echo(ranking_text(kb, expand("req:RobotSelfPosition"), top=4, explain=1))
     click.echo("\nPaper section 6.2: the two scenarios, planned and run in the simulated home (cbrs run TASK):")
-    text, succeeded = scenario_runs(kb)
+    shown = ProgressLine()  # on a terminal only, as cbrs load's: the runs take 10-15 s
+    try:
+        text, succeeded = scenario_runs(kb, progress=shown)
+    finally:
+        shown.clear()
     click.echo(text)
     if not succeeded:
         raise SystemExit(1)  # a tour that reports a failed run must not tell a script all went well

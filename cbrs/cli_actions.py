@@ -9,6 +9,7 @@ import socket
 import sys
 import time
 from collections import Counter
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -470,9 +471,12 @@ DEMO_RUNS = (
 )
 
 
-def scenario_runs(kb: KnowledgeBase, seed: int = 0) -> tuple[str, bool]:
+def scenario_runs(
+    kb: KnowledgeBase, seed: int = 0, progress: Callable[[str, int, int], None] | None = None
+) -> tuple[str, bool]:
     """Run the paper's two scenarios headless (FetchMyPen also with its localiser failed): one row
-    each, then the world graph; and whether every run succeeded."""
+    each, then the world graph; and whether every run succeeded. ``progress(stage, done, total)`` hears
+    of each run before it starts (the three take 10-15 s, which the demo spent saying nothing)."""
     require("sim", "the demo's runs in the simulated home")
     from cbrs.kb.semantic_map import SemanticMap
     from cbrs.sim.components import SimEnvironment
@@ -481,7 +485,10 @@ def scenario_runs(kb: KnowledgeBase, seed: int = 0) -> tuple[str, bool]:
     rows = []
     failed = 0
     composer = Composer(kb)
-    for task, faults in DEMO_RUNS:
+    for done, (task, faults) in enumerate(DEMO_RUNS):
+        injected = f" (fail {', '.join(faults)})" if faults else ""
+        if progress is not None:
+            progress(f"running {task}{injected}", done, len(DEMO_RUNS))
         start = time.perf_counter()
         with open_world(seed=seed, semantic_map=SemanticMap.read(kb)) as world:
             result = run_task(kb, task, SimEnvironment(world, kb), [parse_iri(f) for f in faults], composer=composer)
@@ -496,7 +503,6 @@ def scenario_runs(kb: KnowledgeBase, seed: int = 0) -> tuple[str, bool]:
         verified = sum(1 for s in (report.steps if report else []) for _, ok in s.effects if ok)
         status = report.status.value if report else "no plan"
         failed += 0 if result.succeeded else 1
-        injected = f" (fail {', '.join(faults)})" if faults else ""
         rows.append(
             [task + injected, str(steps), status, str(verified), f"{simulated:.1f}", f"{wall:.1f}", failovers or "-"]
         )

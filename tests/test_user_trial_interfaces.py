@@ -11,11 +11,13 @@ camera program took its bridge as ``--url``, not ``--bridge`` as ``cbrs run`` do
 from __future__ import annotations
 
 import errno
+import io
 import json
 import logging
 import re
 import socket
 from pathlib import Path
+from typing import Any
 
 import pyoxigraph as ox
 import pytest
@@ -25,11 +27,13 @@ from flask.testing import FlaskClient
 from cbrs import external_camera
 from cbrs.bridge_services import KnowledgeServices
 from cbrs.cli import cli
+from cbrs.cli_actions import scenario_runs
 from cbrs.cli_reasoner import match_config
 from cbrs.cli_serve import _websockets_level
 from cbrs.component import Component
 from cbrs.component_protocol import READ_ONLY
 from cbrs.kb import KnowledgeBase
+from cbrs.output import ProgressLine
 from cbrs.rosbridge import ServiceError
 from cbrs.server import ServeConfig, Server
 from cbrs.settings import setting
@@ -294,3 +298,23 @@ def test_a_server_on_an_address_not_of_this_machine_fails_to_start_with_an_oserr
         server.start()
     assert failed.value.errno == errno.EADDRNOTAVAIL
     assert not [r for r in caplog.records if r.levelno >= logging.ERROR]
+
+
+def test_the_demo_says_which_scenario_it_runs_before_each_run(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The demo's three runs took 10-15 s after "the two scenarios, planned and run ..." with nothing on
+    the screen. The world is refused here: what is tested is what is said before it opens."""
+    from cbrs.sim import world
+
+    class Opened(Exception):
+        pass
+
+    def refuse(**_: Any) -> None:
+        raise Opened
+
+    monkeypatch.setattr(world, "open_world", refuse)
+    screen = io.StringIO()
+    screen.isatty = lambda: True  # type: ignore[method-assign]
+    shown = ProgressLine(screen, interval=0)
+    with pytest.raises(Opened):
+        scenario_runs(KnowledgeBase.open(":memory:"), progress=shown)
+    assert screen.getvalue() == "\rrunning RobotArmServeACup 0/3 ..."
