@@ -795,7 +795,9 @@ class HomeWorld:
             for iri in sorted(self.map.furniture)
             if (thing := self.map.things.get(iri)) is not None and (b := thing.box) is not None
         ]
-        appliances = [_region(d.name, d.body.box) for d in self.dispensers]
+        # the spout too: it sticks out over the worktop, where a hand coming down on an object below it
+        # would meet it (the lever, which a hand pushes, is not one)
+        appliances = [_region(t.name, t.box) for d in self.dispensers for t in (d.body, d.spout)]
         self._kinematics = Kinematics(mounts, [*obstacles, *tops, *appliances])
         for side in ArmSide:
             mount, orientation = mounts[side]
