@@ -19,6 +19,7 @@ inputs first and encodes its outputs last.
 
 from __future__ import annotations
 
+import functools
 import logging
 import math
 import time
@@ -36,7 +37,7 @@ from cbrs.kb import KnowledgeBase, Requirement, Statement
 from cbrs.kb.errors import KnowledgeBaseError, NotFoundError
 from cbrs.kb.model import Advertisement
 from cbrs.kb.namespaces import PREFIXES
-from cbrs.kb.semantic_map import NotGraspableError, SemanticMap, Thing, designate, local_name
+from cbrs.kb.semantic_map import MapObject, NotGraspableError, SemanticMap, Thing, designate, local_name
 from cbrs.kb.vocab import CBRS
 from cbrs.settings import setting
 from cbrs.sim import predicates as pred
@@ -413,23 +414,63 @@ def _robot_camera(ctx: SimContext, robot: str) -> str:
 def approach(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     model = _model(ctx, inputs["graspPose"])
     estimate = decode(inputs["objectPosition"], ObjectEstimate)
-    x, y, _ = estimate.position
-    ctx.arm = _free_arm(ctx, x, y, f"the {model.name}")
-    spec = ctx.world.arm_specs[ctx.arm]
-    hand = ctx.world.arm(ctx.arm).hand
-
-    def grasp(held: ObjectModel) -> GraspPose:
-        return compute_grasp_pose(held, estimate.position, estimate.yaw, spec.mount, spec.yaw, _extent(estimate), hand)
-
-    if len(model.preference) == 1:  # its one approach's misfit is its own typed error (GraspTooDeepError...)
-        grasp(model)
-    choice = _taking(ctx, estimate, model, ctx.arm)  # one approach too: its moves are dry-run (_clear)
+    choice = _who_takes(ctx, estimate, model)
     _note(ctx, choice)
-    ctx.grasp = grasp(choice.model)
+    ctx.arm = choice.arm
+    ctx.grasp = _grasp_pose(ctx, estimate, choice.arm, choice.model)
     ctx.seen, ctx.focus = estimate, model.name
     ctx.last_arm = ctx.arm
     _check(skills.approach_object(ctx.world, ctx.arm, ctx.grasp))
     return {}
+
+
+def _grasp_pose(ctx: SimContext, estimate: ObjectEstimate, side: ArmSide, held: ObjectModel) -> GraspPose:
+    spec = ctx.world.arm_specs[side]
+    hand = ctx.world.arm(side).hand
+    return compute_grasp_pose(held, estimate.position, estimate.yaw, spec.mount, spec.yaw, _extent(estimate), hand)
+
+
+def _who_takes(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel) -> GraspChoice:
+    """Which arm takes the object where it is, and by which approach: of the free arms that reach it,
+    nearest first (:func:`_reaching`), the first that can (:func:`_taking`: its inverse kinematics and its
+    planning's dry run of the moves). The nearest arm is not the only one asked: where its hand cannot
+    get to the object (its joints' range, the dispenser in the way) the other arm may. When none can,
+    the nearest arm's refusal, as it is when it is the only one asked or every arm's is a misfit (a
+    typed error: the object does not fit the hand so), else a SkillFailed starting with it and saying
+    why each other arm could not either."""
+    x, y, _ = estimate.position
+    arms = _reaching(ctx, x, y)
+    if not arms:
+        raise SkillFailed(f"no free arm reaches the {model.name} at ({x:.2f}, {y:.2f})")
+    fits = _fitting(ctx, model, arms) if len(model.preference) > 1 else ""  # one approach: its typed misfit
+    if fits:
+        raise SkillFailed(fits)
+    refused: list[tuple[ArmSide, Exception]] = []
+    for side in arms:
+        try:
+            if len(model.preference) == 1:  # its one approach's misfit is its own typed error (GraspTooDeepError...)
+                _grasp_pose(ctx, estimate, side, model)
+            return _taking(ctx, estimate, model, side)  # one approach too: its moves are dry-run (_clear)
+        except (SkillFailed, SimulationError) as why:
+            refused.append((side, why))
+    first = refused[0][1]
+    if len(refused) == 1 or all(isinstance(why, GraspMisfitError) for _, why in refused):
+        raise first
+    others = "; ".join(f"nor could the {side.value} arm take it: {why}" for side, why in refused[1:])
+    raise SkillFailed(f"{first}; {others}")
+
+
+def _fitting(ctx: SimContext, model: ObjectModel, sides: Sequence[ArmSide]) -> str:
+    """Why the hand of none of ``sides`` can close on the object by any of its approaches, wherever it is
+    (:func:`skills.can_grip`: wider than the jaws open, a top grasp deeper than the palm allows); empty
+    when one can. Said once, not once for each arm and each way of passing it between them."""
+    why = ""
+    for side in sides:
+        gripping = _Candidates.of(model, functools.partial(skills.can_grip, hand=ctx.world.arm(side).hand))
+        if gripping.models:
+            return ""
+        why = why or gripping.refusal()
+    return why
 
 
 def _taking(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, side: ArmSide) -> GraspChoice:
@@ -449,7 +490,7 @@ def _taking(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, side:
     taking = _Candidates.of(model, take)
     if not taking.models:
         raise SkillFailed(taking.refusal())
-    end = _hold_end(ctx, name)
+    end = _hold_end(ctx, name, side)
     if end is None:
         return _clear(taking, side, f"taking the {name}", lambda held: skills.can_carry(world, estimate, side, held))
     place, surface, spots = end
@@ -472,7 +513,14 @@ def _taking(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, side:
             both,
             side,
             f"taking the {name} to {place.name}",
-            lambda held: skills.can_carry(world, estimate, side, held, first[held.grasp]),
+            lambda held: skills.can_carry(
+                world,
+                estimate,
+                side,
+                held,
+                first[held.grasp],
+                floor=_floor(ctx, held, side, estimate.position, first[held.grasp]),
+            ),
             first,
         )
     unplaced = "; ".join(why for _, why in both.ruled_out)
@@ -510,10 +558,13 @@ def _clear(
     raise MovesRefusedError(name, side.value, purpose, refused, ruled_out)
 
 
-def _hold_end(ctx: SimContext, name: str) -> tuple[Thing, Region, list[tuple[float, float]]] | None:
+def _hold_end(
+    ctx: SimContext, name: str, side: ArmSide | None = None
+) -> tuple[Thing, Region, list[tuple[float, float]]] | None:
     """Where the hold the running component starts ends, when the plan says: the place the first carry
     after the running step is given, before any other step of its robot takes an object; and that
-    place's surface and spots (:func:`_place_spots`) for the arm ``ctx.arm``, as the carry will aim.
+    place's surface and spots (:func:`_place_spots`) for the arm ``side`` (else ``ctx.arm``), as the carry
+    will aim.
     The running step is the one the executor said it starts (``SimEnvironment.starting``), else the
     plan's one step of this component; the carry's place is what the executor knows of its inputs then
     (the task's value, or an earlier step's output), else the task's value. None when it is not known
@@ -544,7 +595,7 @@ def _hold_end(ctx: SimContext, name: str) -> tuple[Thing, Region, list[tuple[flo
         if len(places) != 1:
             return None
         place = smap.things[places[0]]
-        spec = ctx.world.arm_specs[ctx.arm]
+        spec = ctx.world.arm_specs[side or ctx.arm]
         others = _others(ctx.world, ctx.belief, name)
         size = ctx.world.objects[name].size if name in ctx.world.objects else (0.0, 0.0, 0.0)
         surface, spots = _place_spots(smap, place, size, [(spec.mount[0], spec.mount[1], spec.reach)], others)
@@ -621,9 +672,25 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
         # Both arms' moves of the pass are dry-run before the giver sets the object down (it holds it now).
         passing = f"passing the {model.name} from the {giver.value} arm to the {taker.value} for {place.name}"
         before = "the pass moved anything"
-        _refuse(skills.can_carry_held(world, giver, relay), model, giver, passing, relay, before)
+        holding = world.arm(giver).ee_pose().position
+        _refuse(
+            skills.can_carry_held(world, giver, relay, _floor(ctx, model, giver, holding, relay)),
+            model,
+            giver,
+            passing,
+            relay,
+            before,
+        )
         there = _resting(relay, model, taken, world.time)
-        _refuse(skills.can_carry(world, there, taker, taken_by, target), taken_by, taker, passing, target, before)
+        floor = _floor(ctx, taken_by, taker, there.position, target)
+        _refuse(
+            skills.can_carry(world, there, taker, taken_by, target, floor=floor),
+            taken_by,
+            taker,
+            passing,
+            target,
+            before,
+        )
         found = _set_down_for(ctx, device, model, giver, taker, relay, None)
         taker_spec = world.arm_specs[taker]
         _note(
@@ -641,7 +708,10 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
     else:
         target = _spot_region(surface, *spot)
     ctx.spot = target
-    _check(skills.carry_object(world, ctx.arm, target))
+    grasped = world.arm(ctx.arm).held_grasp
+    hand = world.arm(ctx.arm).ee_pose().position
+    floor = None if grasped is None else _floor(ctx, grasped.model, ctx.arm, hand, target)
+    _check(skills.carry_object(world, ctx.arm, target, floor=floor))
     return {}
 
 
@@ -763,7 +833,12 @@ def _who_loads(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, ba
     (:meth:`SimEnvironment.given`). With one approach only the letting go on the platform is asked of the
     end poses, as before approaches could be chosen. The moves of each hold are then dry-run, one approach
     alone too, as the approach choice's are (:func:`_clear`, :func:`_refuse`): :class:`MovesRefusedError`
-    when the arm's planning would refuse them."""
+    when the arm's planning would refuse them.
+
+    The arms are asked in turn, as the approach is (:func:`_who_takes`): each arm that reaches both the
+    object and the platform, nearest the object first (one hold, else a re-grasp), then each pass from an
+    arm that reaches the object to another that reaches the platform. The first way that serves is
+    taken; when none does, the first way's refusal, followed by why each other way did not serve."""
     x, y, _ = estimate.position
     takers = _reaching(ctx, x, y)
     loaders = _reaching(ctx, base.x, base.y)
@@ -774,59 +849,120 @@ def _who_loads(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, ba
             f"no free arm reaches the base's platform at ({base.x:.2f}, {base.y:.2f}): the docking pose is "
             "beyond every arm's reach"
         )
+    fits = _fitting(ctx, model, takers)
+    if fits:
+        raise SkillFailed(fits)
+    ways = [(side, side) for side in takers if side in loaders]
+    ways += [(giver, loader) for giver in takers for loader in loaders if giver is not loader]
+    refused: list[tuple[ArmSide, ArmSide, Exception]] = []
+    for giver, loader in ways:
+        try:
+            only = giver not in loaders and loader not in takers
+            return _loading_by(ctx, estimate, model, base, giver, loader, only)
+        except (SkillFailed, MovesRefusedError) as why:
+            refused.append((giver, loader, why))
+    first = refused[0][2]
+    if len(refused) == 1:
+        raise first
+    others = "; ".join(
+        f"nor by the {giver.value} arm alone: {why}"
+        if giver is loader
+        else f"nor passed from the {giver.value} arm to the {loader.value}: {why}"
+        for giver, loader, why in refused[1:]
+    )
+    raise SkillFailed(f"{first}; {others}")
+
+
+def _loading_by(
+    ctx: SimContext,
+    estimate: ObjectEstimate,
+    model: ObjectModel,
+    base: Pose2D,
+    giver: ArmSide,
+    loader: ArmSide,
+    only: bool,
+) -> _Loading:
+    """The loading of :func:`_who_loads` one way: ``loader`` alone (``giver`` the same arm: one hold, else a
+    re-grasp), or ``giver`` passing the object to ``loader`` (``only``: the giver does not reach the
+    platform)."""
     world, choosing = ctx.world, len(model.preference) > 1
-    both = [side for side in takers if side in loaders]
-    loader = both[0] if both else loaders[0]
+    both = [giver] if giver is loader else []
     purpose = f"loading the {model.name} onto the platform"
     platform = skills.platform_region(base, world.platform_height)
     # Letting go on the platform does not depend on where the loader takes the object from.
     checks = [lambda held: skills.can_load(world, estimate, base, loader, held)]
     whole: _Candidates | None = None
+    unserved = ""  # why no one hold serves from where the object is to the platform
+    refused: MovesRefusedError | None = None
     if both:  # one hold, from where it is to the platform
         whole = _Candidates.of(
             model, *([lambda held: skills.can_take(world, estimate, loader, held), *checks] if choosing else checks)
         )
+        unserved = whole.refusal()
         if whole.models:  # the first whose moves the loader's planning would make, one alone too (_clear)
             spots = {held.grasp: platform for held in whole.models}
-            loads = _clear(whole, loader, purpose, lambda held: _loads(ctx, estimate, base, loader, held), spots)
-            return _Loading(loads)
+            try:
+                loads = _clear(whole, loader, purpose, lambda held: _loads(ctx, estimate, base, loader, held), spots)
+            except MovesRefusedError as moves:
+                if not choosing:
+                    raise
+                # the hold's moves refused by every approach whose end poses pass: a re-grasp may serve, as
+                # where the end poses rule every approach out
+                refused, unserved = (
+                    moves,
+                    "; ".join(why for _, _, why in moves.refused) + (f"; {unserved}" if unserved else ""),
+                )
+            else:
+                return _Loading(loads)
         if not choosing:
             raise SkillFailed(whole.refusal())
     # Two holds, the object set down between them where both reach: the arm that reaches it passes it to
     # the loader, or, when one arm reaches both but no approach serves it all the way, that arm sets it
     # down and takes it anew by an approach that loads (the re-grasp).
-    giver = loader if both else takers[0]
     gripping = [lambda held: skills.can_grip(held, world.arm(loader).hand)]
     loading = _Candidates.of(model, *([*gripping, *checks] if choosing else checks))
     giving = _Candidates.of(model, lambda held: skills.can_take(world, estimate, giver, held)) if choosing else None
     if whole is not None and not (loading.models and giving is not None and giving.models):
+        if refused is not None:
+            raise refused
         raise SkillFailed(whole.refusal())
     if not loading.models:
-        raise SkillFailed(
-            f"only the {giver.value} arm reaches the {model.name} and only the {loader.value} arm the platform, "
-            f"and {loading.refusal()}"
-        )
+        if only:
+            raise SkillFailed(
+                f"only the {giver.value} arm reaches the {model.name} and only the {loader.value} arm the platform, "
+                f"and {loading.refusal()}"
+            )
+        raise SkillFailed(f"the {loader.value} arm would load the {model.name}, but {loading.refusal()}")
     if giving is not None and not giving.models:
-        raise SkillFailed(f"only the {giver.value} arm reaches the {model.name}, and {giving.refusal()}")
+        if only:
+            raise SkillFailed(f"only the {giver.value} arm reaches the {model.name}, and {giving.refusal()}")
+        raise SkillFailed(f"the {giver.value} arm would pass the {model.name}, but {giving.refusal()}")
     giving = giving or _Candidates([model])
-    try:
-        spot, given_by, taken_by = _relay_spot(ctx, estimate, giving, loading, giver, loader)
-    except SkillFailed as nowhere:
-        if whole is None:
-            raise
-        raise SkillFailed(f"{whole.refusal()}; and {nowhere}") from None
     setting_down = (
         f"setting the {model.name} down to take it anew, no one approach serving from where it is to the "
-        f"platform ({whole.refusal()})"
+        f"platform ({unserved})"
         if whole is not None
         else f"passing the {model.name} to the {loader.value} arm"
     )
-    # Both holds' moves are dry-run before the first moves: the giver's from where the object is to the
-    # spot, the loader's from the spot to the platform (from its posture now; a re-grasping arm will have
-    # folded home, where it starts a task).
-    _refuse(skills.can_carry(world, estimate, giver, given_by, spot), given_by, giver, setting_down, spot)
-    there = _resting(spot, model, estimate, world.time)
-    _refuse(_loads(ctx, there, base, loader, taken_by), taken_by, loader, purpose, platform)
+
+    def holds(spot: Region, given_by: ObjectModel, taken_by: ObjectModel) -> None:
+        # Both holds' moves are dry-run before the first moves: the giver's from where the object is to the
+        # spot, the loader's from the spot to the platform (from its posture now; a re-grasping arm will
+        # have folded home, where it starts a task).
+        floor = _floor(ctx, given_by, giver, estimate.position, spot)
+        why = skills.can_carry(world, estimate, giver, given_by, spot, floor=floor)
+        _refuse(why, given_by, giver, setting_down, spot)
+        there = _resting(spot, model, estimate, world.time)
+        _refuse(_loads(ctx, there, base, loader, taken_by), taken_by, loader, purpose, platform)
+
+    try:
+        spot, given_by, taken_by = _relay_spot(ctx, estimate, giving, loading, giver, loader, holds)
+    except SkillFailed as nowhere:
+        if whole is None:
+            raise
+        if refused is not None:
+            raise SkillFailed(f"{refused}; and {nowhere}") from None
+        raise SkillFailed(f"{whole.refusal()}; and {nowhere}") from None
     given = giving.choice(giver, given_by, setting_down, "no spot to set it down by it")
     loaded = loading.choice(loader, taken_by, purpose, "no spot to take it by it")
     return _Loading(loaded, given, spot)
@@ -862,6 +998,9 @@ RELAY_EDGE = 0.02
 """... and 2 cm between the object's footprint and the edge of the surface."""
 RELAY_STEP = 0.02
 """The spots tried are a 2 cm grid over the surface."""
+RELAY_MOVES_TRIES = 3
+"""How many spots whose end poses serve a pass or a re-grasp may have its holds' moves refused by the
+arms' planning (a dry run) before the pass is refused with the first refusal."""
 RELAY_TRIES = 40
 """How many spots, nearest the mounts first, are asked of the inverse kinematics (each asks take a few
 milliseconds) before passing is given up."""
@@ -903,7 +1042,8 @@ def _set_down_for(
     """The giver, holding the object, sets it down on ``spot`` for the taker; where it is then (by the
     robot's camera near where the hand let it go, else where the hand let it go)."""
     world = ctx.world
-    _passing(skills.carry_object(world, giver, spot), model, giver, taker)
+    floor = _floor(ctx, model, giver, world.arm(giver).ee_pose().position, spot)
+    _passing(skills.carry_object(world, giver, spot, floor=floor), model, giver, taker)
     _passing(skills.put_down_object(world, giver, spot), model, giver, taker)
     released = world.arm(giver).released
     where = released[1] if released is not None else spot.center
@@ -923,12 +1063,16 @@ def _relay_spot(
     taking: _Candidates,
     giver: ArmSide,
     taker: ArmSide,
+    moves: Callable[[Region, ObjectModel, ObjectModel], None] | None = None,
 ) -> tuple[Region, ObjectModel, ObjectModel]:
     """Where on the surface the object rests on both arms reach it, clear of the other objects and of
     the fixtures standing on it (a dispenser), and by which approach each hand holds it there: of the
     spots nearest both mounts, the first where the giver's hand can hold the object as it sets it down
     and the taker's hand can take it, each by the first of its candidate approaches that it can hold
-    there (asked of the inverse kinematics: a side grasp close to the mount has none)."""
+    there (asked of the inverse kinematics: a side grasp close to the mount has none), and, given
+    ``moves``, whose holds' moves the arms' planning would make (a dry run raising
+    :class:`MovesRefusedError`): a spot so refused is passed over for the next, as a refused approach is
+    for the next approach, up to RELAY_MOVES_TRIES of them; then the first refusal."""
     smap, world = ctx.map, ctx.world
     model = giving.models[0]
     x, y, z = estimate.position
@@ -979,6 +1123,7 @@ def _relay_spot(
                 return held
         return None
 
+    refused: list[MovesRefusedError] = []
     for *_, cx, cy in sorted(spots)[:RELAY_TRIES]:
         centre = (cx, cy, surface + model.height / 2.0)
         given = held_by(giver, giving, centre)
@@ -988,7 +1133,17 @@ def _relay_spot(
             region = Region(
                 f"{supports[0].name}Relay", cx - half, cx + half, cy - half, cy + half, top.max_z, top.max_z + 0.3
             )
+            try:
+                if moves is not None:
+                    moves(region, given, taken)
+            except MovesRefusedError as why:
+                refused.append(why)
+                if len(refused) >= RELAY_MOVES_TRIES:
+                    break
+                continue
             return region, given, taken
+    if refused:
+        raise refused[0]
     if giver is taker:
         down = " or ".join(held.grasp.value for held in giving.models)
         anew = " or ".join(held.grasp.value for held in taking.models)
@@ -1001,6 +1156,66 @@ def _relay_spot(
         f"there is no spot on {supports[0].name} where both the {giver.value} and the {taker.value} arm can hold "
         f"the {model.name} by its {kinds} grasp, to pass it from one to the other"
     )
+
+
+TRANSIT_CORRIDOR = 0.10
+"""The hand's palm passes over another thing standing within 10 cm of the way, footprint to footprint (the
+Panda hand is about 20 cm across along its fingers' axis)..."""
+TRANSIT_CLEARANCE = 0.02
+"""... 2 cm above its top; so does the carried object's bottom over a thing standing within 2 cm of the
+fingers' or the object's footprint."""
+
+
+def _transit_floor(
+    ctx: SimContext, held: ObjectModel, side: ArmSide, start: tuple[float, float], end: tuple[float, float]
+) -> float | None:
+    """How high the bottom of the object ``held`` (by its approach, in ``side``'s hand) must stay on its way
+    from ``start`` to ``end`` (x, y) for it and the hand to pass over the other objects standing by the way,
+    where each is believed to be (else where the map puts it): TRANSIT_CLEARANCE over the top of any whose
+    footprint comes within that of the object's or the fingers' (the jaws' opening across), and the palm
+    (the grasp height and the hand's palm depth above the object's bottom) as far over the top of any within
+    TRANSIT_CORRIDOR; None when no object stands by the way. Without it, a pill box passed between the arms
+    was carried 4 cm above the table, and the hand swept the cup beside its way off the table."""
+    world = ctx.world
+    hand = world.arm(side).hand
+    size = world.objects[held.name].size if held.name in world.objects else (held.width, held.width, held.height)
+    near = max(math.hypot(size[0], size[1]) / 2.0, hand.jaw_opening / 2.0)
+    palm = held.grasp_height + hand.palm_depth
+    floor: float | None = None
+    for name, obj in world.objects.items():
+        if name == held.name or any(arm.held == world.body(name) for arm in world.arms.values()):
+            continue
+        believed = ctx.belief.position(name) if ctx.belief is not None else None
+        if believed is None:
+            support = ctx.map.things.get(obj.support or "")
+            rest = support.box.max_z if support is not None else 0.0
+            believed = (obj.start.x, obj.start.y, rest + obj.size[2] / 2.0)
+        x, y, z = believed
+        apart = _segment_distance(start, end, (x, y)) - math.hypot(obj.size[0], obj.size[1]) / 2.0
+        top = z + obj.size[2] / 2.0 + TRANSIT_CLEARANCE
+        if apart < near + TRANSIT_CLEARANCE:
+            needed: float | None = top
+        elif apart < near + TRANSIT_CORRIDOR:
+            needed = top - palm
+        else:
+            needed = None
+        if needed is not None:
+            floor = needed if floor is None else max(floor, needed)
+    return floor
+
+
+def _floor(ctx: SimContext, held: ObjectModel, side: ArmSide, start: Sequence[float], to: Region) -> float | None:
+    """:func:`_transit_floor` from ``start`` (x, y, ...) to over the middle of ``to``."""
+    cx, cy, _ = to.center
+    return _transit_floor(ctx, held, side, (start[0], start[1]), (cx, cy))
+
+
+def _segment_distance(a: tuple[float, float], b: tuple[float, float], point: tuple[float, float]) -> float:
+    """How far ``point`` is from the segment from ``a`` to ``b`` (all x, y)."""
+    dx, dy = b[0] - a[0], b[1] - a[1]
+    length = dx * dx + dy * dy
+    t = 0.0 if length <= 0.0 else max(0.0, min(1.0, ((point[0] - a[0]) * dx + (point[1] - a[1]) * dy) / length))
+    return math.hypot(point[0] - (a[0] + t * dx), point[1] - (a[1] + t * dy))
 
 
 def _others(world: HomeWorld, belief: PerceivedWorld | None, *names: str) -> list[tuple[float, float, float]]:
@@ -1491,6 +1706,14 @@ class SimEnvironment:
         component knows which step of the plan it runs and where a later step takes what it holds."""
         self.context.step, self.context.known = step, known
 
+    def _estimate(self, obj: MapObject, support: Thing) -> ObjectEstimate:
+        """Where the plan's checks take an object to be: where it is believed to be, else where the map
+        puts it on its support, lying as the map says (as perception gives it: the yaw of its long axis)."""
+        believed = self.belief.position(obj.name)
+        centre = believed or (obj.start.x, obj.start.y, support.box.max_z + obj.size[2] / 2)
+        axis = obj.start.yaw + (math.pi / 2.0 if obj.size[1] > obj.size[0] else 0.0)
+        return ObjectEstimate(centre[0], centre[1], centre[2], axis, obj.size, obj.colour, "map", 0.0, 0)
+
     def _check_loading(self, plan: Plan, values: Mapping[str, Any]) -> None:
         """Refuse a plan that hands an object the task gives over onto the base's platform when no arm
         can load it there (by the map: the object where it is believed to be, the base at the docking
@@ -1506,13 +1729,8 @@ class SimEnvironment:
                 support = smap.things.get(obj.support or "") if obj is not None else None
                 if obj is None or support is None or support.dock is None:
                     continue
-                believed = self.belief.position(obj.name)
-                centre = believed or (obj.start.x, obj.start.y, support.box.max_z + obj.size[2] / 2)
-                # as perception gives it: the yaw of its long axis (a box's y axis when it is the longer)
-                axis = obj.start.yaw + (math.pi / 2.0 if obj.size[1] > obj.size[0] else 0.0)
-                estimate = ObjectEstimate(centre[0], centre[1], centre[2], axis, obj.size, obj.colour, "map", 0.0, 0)
                 try:
-                    _who_loads(self.context, estimate, Manipulation.of(obj).model, _dock(support))
+                    _who_loads(self.context, self._estimate(obj, support), Manipulation.of(obj).model, _dock(support))
                 except (SkillFailed, MovesRefusedError) as refused:
                     raise CannotLoadError(step.component, obj.iri, str(refused)) from None
 

@@ -20,7 +20,7 @@ import pybullet as p
 from cbrs.kb.hands import Hand
 from cbrs.sim import predicates as pred
 from cbrs.sim.arms import Arm, ArmSide, MotionResult, PlannedArm
-from cbrs.sim.errors import GraspMisfitError
+from cbrs.sim.errors import GraspMisfitError, GraspTooWideError
 from cbrs.sim.geometry import Pose2D, Pose3D, Quat, Region, Vec3, wrap_angle
 from cbrs.sim.grasping import (
     GraspKind,
@@ -174,16 +174,19 @@ def pick_up_object(world: HomeWorld, side: ArmSide | str, grasp: GraspPose) -> O
     return _done(world, "PickUpObject", start, ok, f"holding {held}, not the {name}" if held != name else "slipped")
 
 
-def carry_object(world: HomeWorld, side: ArmSide | str, region: Region, yaw: float | None = None) -> Outcome:
+def carry_object(
+    world: HomeWorld, side: ArmSide | str, region: Region, yaw: float | None = None, floor: float | None = None
+) -> Outcome:
     """CarryObject: take the held object over ``region`` (its centre over the region's centre, its
-    bottom ABOVE_CLEARANCE over the surface), turning a top-grasped object's axis to ``yaw``."""
+    bottom ABOVE_CLEARANCE over the surface), turning a top-grasped object's axis to ``yaw``; on the way
+    its bottom stays at or above ``floor`` (over the other things standing by the way)."""
     start = world.time
     arm = _arm(world, side)
     grasp = arm.held_grasp
     if arm.held is None or grasp is None:
         return _done(world, "CarryObject", start, False, f"the {arm.side} gripper holds nothing")
     name = world.name_of(arm.held) or "?"
-    result = _carry(arm, grasp, region, yaw)
+    result = _carry(arm, grasp, region, yaw, floor)
     if not result.reached:
         return _done(world, "CarryObject", start, False, result.reason)
     ok = pred.object_above_region(world, name, region)
@@ -211,8 +214,11 @@ class _Moving(Protocol):
     def dry_run(self) -> PlannedArm: ...
 
 
-def _carry(arm: _Moving, grasp: GraspPose, region: Region, yaw: float | None) -> MotionResult:
-    """carry_object's moves: up to the transit height, across to over the region's centre, down to
+def _carry(
+    arm: _Moving, grasp: GraspPose, region: Region, yaw: float | None, floor: float | None = None
+) -> MotionResult:
+    """carry_object's moves: up to the transit height (the object's bottom where it is, ABOVE_CLEARANCE
+    over the region, or ``floor``, whichever is highest), across to over the region's centre, down to
     ABOVE_CLEARANCE over its surface; the move across through joint space, the object kept up, when the
     straight line leaves the arm's reach; the way down through joint space too when the straight one
     would leave the hand where put_down_object cannot lower the object (:func:`_down`)."""
@@ -222,7 +228,7 @@ def _carry(arm: _Moving, grasp: GraspPose, region: Region, yaw: float | None) ->
         orientation = top_orientation(yaw + math.pi / 2.0)
     bottom = ee.position[2] - grasp.bottom_offset
     above = region.zmin + ABOVE_CLEARANCE
-    transit = max(bottom, above) + grasp.bottom_offset
+    transit = max(bottom, above, bottom if floor is None else floor) + grasp.bottom_offset
     cx, cy, _ = region.center
     legs: list[Vec3] = [
         (ee.position[0], ee.position[1], transit),
@@ -402,12 +408,17 @@ def can_load(
 def can_grip(model: ObjectModel, hand: Hand) -> str:
     """Why ``hand`` cannot close on the object by the approach ``model`` is held by, wherever it is
     (empty if it can): a top grasp whose grasp point is deeper below the object's top than the palm
-    is above the fingers' grasp point would press the palm on it."""
+    is above the fingers' grasp point would press the palm on it; an object whose narrowest width (a
+    cylinder's diameter, a box's narrower side) is wider than the jaws open fits no approach."""
+    if model.width > hand.jaw_opening:
+        return str(GraspTooWideError(model.name, model.grasp.value, model.width, hand.jaw_opening))
     if model.grasp is GraspKind.TOP and model.top_clearance(hand) < 0.0:
         depth = model.height - model.grasp_height
+        least = math.ceil((1.0 - hand.palm_depth / model.height) * 100.0) / 100.0 if model.height > 0.0 else 1.0
         return (
             f"a top grasp would hold the {model.name} {depth * 100:.1f} cm below its top, and the hand's palm is "
-            f"{hand.palm_depth * 100:.1f} cm above the fingers' grasp point"
+            f"{hand.palm_depth * 100:.1f} cm above the fingers' grasp point (a home:graspHeightRatio of at least "
+            f"{least:.2f} on its class lets the hand take it from the top)"
         )
     return ""
 
@@ -458,6 +469,7 @@ def can_carry(
     model: ObjectModel,
     region: Region | None = None,
     yaw: float | None = None,
+    floor: float | None = None,
 ) -> str:
     """Why ``side``'s own motion planning would refuse to take the object where it is by ``model``'s
     approach and, given a ``region``, carry it over its middle (empty if it would not): the moves of
@@ -466,7 +478,8 @@ def can_carry(
     :meth:`Arm.dry_run`). The inverse kinematics
     of the end poses alone (:func:`can_take`, :func:`can_set_down`) misses a joint-space move whose every
     path collides or lets the held object dip, and a straight line that leaves the arm's reach. ``yaw``
-    turns a top-grasped object on the way, as :func:`carry_object` does."""
+    turns a top-grasped object on the way, and ``floor`` keeps its bottom up on the way, as
+    :func:`carry_object` does."""
     arm = ArmSide(side)
     grasp = _grasp(world, pen, arm, model)
     if isinstance(grasp, str):
@@ -480,7 +493,7 @@ def can_carry(
     ]
     if region is not None:
         cx, cy, _ = region.center
-        moves.append((f"carrying it to ({cx:.2f}, {cy:.2f})", lambda: _carry(hand, grasp, region, yaw)))
+        moves.append((f"carrying it to ({cx:.2f}, {cy:.2f})", lambda: _carry(hand, grasp, region, yaw, floor)))
         lowering = f"lowering it onto {region.name} at ({cx:.2f}, {cy:.2f})"
         moves.append((lowering, lambda: _lower(hand, grasp, region)[0]))
     return _first_refused(moves, arm, model)
@@ -497,7 +510,7 @@ def can_hand_over(
     return reason or can_carry(world, pen, side, model, region, yaw)
 
 
-def can_carry_held(world: HomeWorld, side: ArmSide | str, region: Region) -> str:
+def can_carry_held(world: HomeWorld, side: ArmSide | str, region: Region, floor: float | None = None) -> str:
     """Why ``side``'s planning would refuse to carry what it holds over the middle of ``region`` and lower
     it there, as :func:`carry_object` and :func:`put_down_object` move it (empty if it would not): a dry
     run from the arm's posture now."""
@@ -509,7 +522,7 @@ def can_carry_held(world: HomeWorld, side: ArmSide | str, region: Region) -> str
     cx, cy, _ = region.center
     model = grasp.model
     moves: list[tuple[str, Callable[[], MotionResult]]] = [
-        (f"carrying it to ({cx:.2f}, {cy:.2f})", lambda: _carry(hand, grasp, region, None)),
+        (f"carrying it to ({cx:.2f}, {cy:.2f})", lambda: _carry(hand, grasp, region, None, floor)),
         (f"lowering it onto {region.name} at ({cx:.2f}, {cy:.2f})", lambda: _lower(hand, grasp, region)[0]),
     ]
     return _first_refused(moves, ArmSide(side), model)
