@@ -318,3 +318,14 @@ def test_the_demo_says_which_scenario_it_runs_before_each_run(monkeypatch: pytes
     with pytest.raises(Opened):
         scenario_runs(KnowledgeBase.open(":memory:"), progress=shown)
     assert screen.getvalue() == "\rrunning RobotArmServeACup 0/3 ..."
+
+
+def test_a_path_nothing_serves_names_the_nearest_that_do(client: FlaskClient) -> None:
+    """A 404 said "... If you entered the URL manually please check your spelling and try again."."""
+    twin = client.get("/taxonmy.json")
+    assert twin.status_code == 404
+    assert twin.get_json()["message"].startswith("nothing is served at /taxonmy.json; did you mean /taxonomy.json")
+    page = client.get("/sparq", headers={"Accept": "text/html"})
+    assert page.status_code == 404 and "did you mean /sparql?" in page.text
+    assert "did you mean" not in client.get("/zzzz.json").get_json()["message"]
+    assert client.get("/tasks/run-9.json").get_json()["message"] == "no task run 'run-9'"  # a view's own 404 stays

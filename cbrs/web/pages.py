@@ -7,13 +7,14 @@ the field (status 400), and the twin answers ``{"error": "invalid-form", "fields
 
 from __future__ import annotations
 
+import difflib
 import functools
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from flask import Blueprint, Response, jsonify, render_template, request
-from werkzeug.exceptions import HTTPException, MethodNotAllowed
+from flask import Blueprint, Response, current_app, jsonify, render_template, request
+from werkzeug.exceptions import HTTPException, MethodNotAllowed, NotFound
 
 from cbrs.kb.errors import KnowledgeBaseError
 
@@ -74,11 +75,17 @@ def page(blueprint: Blueprint, rule: str, **options: Any) -> Callable[[View], Vi
 
 
 def http_error_message(error: HTTPException) -> str:
-    """What to tell the client of a Werkzeug error; a 405 names the methods the path takes (Werkzeug's
-    own text, "The method is not allowed for the requested URL.", leaves a client to guess them)."""
+    """What to tell the client of a Werkzeug error. A 405 names the methods the path takes, and a path
+    that no route serves the nearest that do (Werkzeug's own texts, "The method is not allowed for the
+    requested URL." and "... please check your spelling", leave a client to guess them)."""
     if isinstance(error, MethodNotAllowed) and error.valid_methods:
         allowed = sorted(set(error.valid_methods) - {"OPTIONS"})
         return f"{request.method} is not allowed on {request.path}: use {' or '.join(allowed)}"
+    if isinstance(error, NotFound) and request.url_rule is None:
+        paths = {rule.rule for rule in current_app.url_map.iter_rules() if "<" not in rule.rule}
+        near = difflib.get_close_matches(request.path, sorted(paths - {"/static"}), n=3, cutoff=0.7)
+        meant = f"; did you mean {' or '.join(near)}?" if near else ""
+        return f"nothing is served at {request.path}{meant} (the pages start at /, the SPARQL endpoint is /sparql)"
     return error.description or error.name
 
 
