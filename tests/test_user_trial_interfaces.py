@@ -11,6 +11,7 @@ camera program took its bridge as ``--url``, not ``--bridge`` as ``cbrs run`` do
 from __future__ import annotations
 
 import errno
+import functools
 import io
 import json
 import logging
@@ -329,3 +330,18 @@ def test_a_path_nothing_serves_names_the_nearest_that_do(client: FlaskClient) ->
     assert page.status_code == 404 and "did you mean /sparql?" in page.text
     assert "did you mean" not in client.get("/zzzz.json").get_json()["message"]
     assert client.get("/tasks/run-9.json").get_json()["message"] == "no task run 'run-9'"  # a view's own 404 stays
+
+
+def test_a_run_asked_for_in_json_refuses_a_body_it_cannot_read(client: FlaskClient) -> None:
+    """Broken JSON or a list read as an empty form ("task: choose a task"); a misspelt field was dropped
+    and the run started with the default."""
+    post = functools.partial(client.post, "/tasks.json", content_type="application/json")
+    broken = post(data="{bad")
+    assert broken.status_code == 400 and broken.get_json()["message"].startswith("the body is not JSON")
+    assert "a JSON list" in post(data="[1]").get_json()["message"]
+    misspelt = post(data=json.dumps({"task": "PersonWhereabouts", "sed": 3}))
+    assert misspelt.status_code == 400
+    assert misspelt.get_json()["fields"] == {
+        "sed": "no such field; did you mean 'seed'? a run takes task, seed, fail, fault_rate, repeat_failures"
+    }
+    assert client.get("/tasks.json").get_json()["runs"] == []  # nothing started

@@ -11,6 +11,7 @@ the camera stream when a run starts.
 
 from __future__ import annotations
 
+import difflib
 import hmac
 import json
 import queue
@@ -21,7 +22,7 @@ from typing import Any, Generic, TypeVar
 
 from flask import Blueprint, Response, current_app, request, url_for
 from flask.sansio.blueprints import BlueprintSetupState
-from werkzeug.exceptions import Forbidden, NotFound, ServiceUnavailable
+from werkzeug.exceptions import BadRequest, Forbidden, NotFound, ServiceUnavailable
 
 from cbrs.actions.errors import UnknownTaskError
 from cbrs.kb.namespaces import PREFIXES, written
@@ -116,9 +117,12 @@ def _for_script(shown: Page) -> Page:
     return shown
 
 
+RUN_FIELDS = ("task", "seed", "fail", "fault_rate", "repeat_failures")
+
+
 def _form() -> dict[str, Any]:
-    body = request.get_json(silent=True) if request.is_json else None
-    if isinstance(body, dict):
+    body = _json_body() if request.is_json and request.method == "POST" else None
+    if body is not None:
         fail = body.get("fail", [])
         return {
             "task": str(body.get("task", "")),
@@ -135,6 +139,22 @@ def _form() -> dict[str, Any]:
         "fault_rate": values.get("fault_rate", "0").strip(),
         "repeat_failures": values.get("repeat_failures", "1").strip(),
     }
+
+
+def _json_body() -> dict[str, Any]:
+    """A run asked for in JSON: an object of ``RUN_FIELDS``. Broken JSON, another value, or a field the run
+    does not take is refused, naming it: they were read as an empty form ("choose a task"), and a
+    misspelt field ("sed") was dropped, the run started with its default."""
+    body = request.get_json(silent=True)
+    if not isinstance(body, dict):
+        found = "not JSON" if body is None else f"a JSON {type(body).__name__}"
+        raise BadRequest(f'the body is {found}: send an object of the run\'s fields, e.g. {{"task": "FetchMyPen"}}')
+    unknown = [name for name in body if name not in RUN_FIELDS]
+    if unknown:
+        near = difflib.get_close_matches(unknown[0], RUN_FIELDS, n=1)
+        meant = f"did you mean {near[0]!r}? " if near else ""
+        raise FormError({unknown[0]: f"no such field; {meant}a run takes {', '.join(RUN_FIELDS)}"})
+    return body
 
 
 def _checked(form: dict[str, Any], shown: Page) -> dict[str, Any]:
