@@ -20,6 +20,8 @@ from cbrs.kb.semantic_map import SemanticMap
 from cbrs.sim import components, skills
 from cbrs.sim.arms import ArmSide
 from cbrs.sim.components import CannotLoadError, SimEnvironment, SkillFailed
+from cbrs.sim.errors import MovesRefusedError
+from cbrs.sim.geometry import Region
 from cbrs.sim.grasping import GraspKind, ObjectModel
 from cbrs.sim.perception import ObjectEstimate
 from cbrs.sim.world import HomeWorld, open_world
@@ -144,3 +146,34 @@ def test_a_loader_whose_one_hold_the_planning_refuses_sets_the_object_down_and_t
     assert str(loading.giver).startswith("setting the Cup down to take it anew")
     assert "the stand-in refuses the one hold" in str(loading.giver)
     assert loading.giver.model.grasp in (GraspKind.SIDE, GraspKind.TOP)
+
+
+def test_a_pass_whose_holds_are_refused_at_one_relay_spot_tries_the_next(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The bundled cup, which only the left arm reaches, passed to the right arm, which loads the platform:
+    with the left arm's carry to the first relay spot refused by the stand-in, the pass goes by the next
+    spot; with every carry refused, by none, naming the first refusal (before, the first spot's refusal
+    refused the pass)."""
+    kb = KnowledgeBase.open(":memory:")
+    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
+        context = SimEnvironment(world, kb).context
+        seen, cup = _seen(world)
+        base = components._dock(world.map.things[WORLD + "KitchenTable"])
+        first = components._who_loads(context, seen, cup, base)
+        assert first.giver is not None and first.giver.arm is LEFT and first.spot is not None
+        refused_at = first.spot.center
+        real = skills.can_carry
+
+        def can_carry(world: HomeWorld, seen: ObjectEstimate, side: ArmSide | str, *rest: object, **kw: object) -> str:
+            region = rest[1] if len(rest) > 1 else None
+            if ArmSide(side) is LEFT and isinstance(region, Region) and region.center == refused_at:
+                return "the stand-in refuses this spot"
+            return real(world, seen, side, *rest, **kw)  # type: ignore[arg-type]
+
+        monkeypatch.setattr(skills, "can_carry", can_carry)
+        second = components._who_loads(context, seen, cup, base)
+        monkeypatch.setattr(skills, "can_carry", lambda *args, **kw: "the stand-in refuses every spot")
+        with pytest.raises(MovesRefusedError) as refused:
+            components._who_loads(context, seen, cup, base)
+    assert second.spot is not None and second.spot.center != refused_at
+    assert second.giver is not None and second.giver.arm is LEFT and second.loader.arm is RIGHT
+    assert "the stand-in refuses every spot" in str(refused.value) and refused.value.arm == "left"
