@@ -299,6 +299,8 @@ def _surfaces(
     """A blob's pixels split into the pieces whose neighbouring pixels' points (8-connected) lie within
     SAME_THING_GAP of each other: the surfaces seen, apart where the depth jumps."""
     index = {(int(v), int(u)): n for n, (v, u) in enumerate(zip(vs, us, strict=True))}
+    at_pixel = [(int(v), int(u)) for v, u in zip(vs, us, strict=True)]
+    xyz = [(float(x), float(y), float(z)) for x, y, z in points]
     label = [-1] * len(index)
     pieces: list[list[int]] = []
     for first in range(len(label)):
@@ -310,11 +312,14 @@ def _surfaces(
         while at < len(members):
             n = members[at]
             at += 1
-            v, u = int(vs[n]), int(us[n])
+            (v, u), (x, y, z) = at_pixel[n], xyz[n]
             for dv in (-1, 0, 1):
                 for du in (-1, 0, 1):
                     m = index.get((v + dv, u + du))
-                    if m is not None and label[m] < 0 and np.abs(points[m] - points[n]).max() <= SAME_THING_GAP:
+                    if m is None or label[m] >= 0:
+                        continue
+                    mx, my, mz = xyz[m]
+                    if max(abs(mx - x), abs(my - y), abs(mz - z)) <= SAME_THING_GAP:
                         label[m] = len(pieces)
                         members.append(m)
         pieces.append(members)
