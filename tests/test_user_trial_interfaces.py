@@ -345,3 +345,14 @@ def test_a_run_asked_for_in_json_refuses_a_body_it_cannot_read(client: FlaskClie
         "sed": "no such field; did you mean 'seed'? a run takes task, seed, fail, fault_rate, repeat_failures"
     }
     assert client.get("/tasks.json").get_json()["runs"] == []  # nothing started
+
+
+def test_a_misspelt_query_parameter_is_named_not_answered_with_the_service_description(client: FlaskClient) -> None:
+    """GET /sparql?qeury=... answered 200 with the endpoint's service description, as if no query was sent."""
+    misspelt = client.get("/sparql", query_string={"qeury": "ASK {}"})
+    assert misspelt.status_code == 400
+    assert misspelt.get_json()["message"].startswith("GET /sparql has no parameter 'qeury': did you mean query=?")
+    posted = client.post("/sparql", data={"updat": "CLEAR ALL"})
+    assert posted.status_code == 400 and "(it has 'updat': did you mean update=?)" in posted.get_json()["message"]
+    described = client.get("/sparql", query_string={"format": "json"})  # no query at all: the description
+    assert described.status_code == 200 and "sparql-service-description" in described.text

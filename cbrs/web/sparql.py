@@ -8,6 +8,9 @@ to statuses.
 
 from __future__ import annotations
 
+import difflib
+from collections.abc import Iterable
+
 import pyoxigraph as ox
 from flask import Blueprint, Response, g, request
 from werkzeug.datastructures import MIMEAccept, MultiDict
@@ -48,6 +51,9 @@ def sparql() -> Response:
     if update is not None:
         return _update(update)
     if query is None:
+        misspelt = _misspelt_operation(request.args)
+        if misspelt:  # "qeury=" would have been answered with the service description, as if no query was sent
+            raise BadProtocolRequest(f"GET /sparql has no parameter {misspelt}; without one it describes the endpoint")
         return _service_description()
     dataset = Dataset.from_parameters(
         request.values.getlist(QUERY_DATASET[0]), request.values.getlist(QUERY_DATASET[1])
@@ -112,6 +118,16 @@ def protocol_answer() -> Response:
     return response
 
 
+def _misspelt_operation(fields: Iterable[str]) -> str:
+    """``'qeury=': did you mean query=?`` for the first field that reads as a misspelt ``query`` or
+    ``update``, else empty."""
+    for name in fields:
+        near = difflib.get_close_matches(name.lower(), ("query", "update"), n=1, cutoff=0.6)
+        if near and name != near[0]:
+            return f"{name!r}: did you mean {near[0]}=?"
+    return ""
+
+
 def _operation() -> tuple[str | None, str | None]:
     """The query or the update text of the request, whichever it carries; never both."""
     if request.method in ("GET", "HEAD"):
@@ -131,7 +147,10 @@ def _operation() -> tuple[str | None, str | None]:
         if query is not None and update is not None:
             raise BadProtocolRequest("a request carries a query or an update, not both")
         if query is None and update is None:
-            raise BadProtocolRequest("the POST carries neither query= nor update=")
+            misspelt = _misspelt_operation(request.form) if media_type == FORM_TYPE else ""
+            raise BadProtocolRequest(
+                "the POST carries neither query= nor update=" + (f" (it has {misspelt})" if misspelt else "")
+            )
     _check_dataset_parameters(update is not None)
     return query, update
 
