@@ -356,3 +356,13 @@ def test_a_misspelt_query_parameter_is_named_not_answered_with_the_service_descr
     assert posted.status_code == 400 and "(it has 'updat': did you mean update=?)" in posted.get_json()["message"]
     described = client.get("/sparql", query_string={"format": "json"})  # no query at all: the description
     assert described.status_code == 200 and "sparql-service-description" in described.text
+
+
+def test_a_misspelt_graph_parameter_on_the_graph_store_writes_nothing(client: FlaskClient) -> None:
+    """POST /store?grpah=IRI named no graph: a Turtle body went where cbrs load puts it."""
+    before = client.get("/store", headers={"Accept": "application/n-quads"}).data
+    headers = {"Authorization": f"Bearer {TOKEN}", "Content-Type": "text/turtle"}
+    sent = client.post("/store?grpah=urn:trial:typo", data="<urn:typo> <urn:b> <urn:c> .", headers=headers)
+    assert sent.status_code == 400
+    assert sent.get_json()["message"] == "/store has no parameter 'grpah': did you mean graph=?"
+    assert client.get("/store", headers={"Accept": "application/n-quads"}).data == before

@@ -14,7 +14,7 @@ from werkzeug.exceptions import BadRequest
 
 from cbrs.graph_store import GraphStore, Target
 from cbrs.web import context
-from cbrs.web.sparql import bearer_token
+from cbrs.web.sparql import bearer_token, misspelt_parameter
 
 __all__ = ["blueprint"]
 
@@ -22,6 +22,9 @@ blueprint = Blueprint("graph_store", __name__)
 
 
 def _target() -> Target:
+    misspelt = misspelt_parameter(request.args, ("graph", "default"))
+    if misspelt:  # "?grpah=" named the whole store: a GET read it all, a POST wrote where cbrs load would
+        raise BadRequest(f"/store has no parameter {misspelt}")
     graphs = request.args.getlist("graph")
     default = "default" in request.args
     if len(graphs) > 1 or (graphs and default):

@@ -51,7 +51,7 @@ def sparql() -> Response:
     if update is not None:
         return _update(update)
     if query is None:
-        misspelt = _misspelt_operation(request.args)
+        misspelt = misspelt_parameter(request.args)
         if misspelt:  # "qeury=" would have been answered with the service description, as if no query was sent
             raise BadProtocolRequest(f"GET /sparql has no parameter {misspelt}; without one it describes the endpoint")
         return _service_description()
@@ -118,11 +118,12 @@ def protocol_answer() -> Response:
     return response
 
 
-def _misspelt_operation(fields: Iterable[str]) -> str:
-    """``'qeury=': did you mean query=?`` for the first field that reads as a misspelt ``query`` or
-    ``update``, else empty."""
+def misspelt_parameter(fields: Iterable[str], known: Iterable[str] = ("query", "update")) -> str:
+    """``'qeury': did you mean query=?`` for the first field that reads as a misspelt one of ``known``
+    (by default a SPARQL operation's), else empty. Fields far from all of them (a client's own) pass."""
+    names = tuple(known)
     for name in fields:
-        near = difflib.get_close_matches(name.lower(), ("query", "update"), n=1, cutoff=0.6)
+        near = difflib.get_close_matches(name.lower(), names, n=1, cutoff=0.6)
         if near and name != near[0]:
             return f"{name!r}: did you mean {near[0]}=?"
     return ""
@@ -147,7 +148,7 @@ def _operation() -> tuple[str | None, str | None]:
         if query is not None and update is not None:
             raise BadProtocolRequest("a request carries a query or an update, not both")
         if query is None and update is None:
-            misspelt = _misspelt_operation(request.form) if media_type == FORM_TYPE else ""
+            misspelt = misspelt_parameter(request.form) if media_type == FORM_TYPE else ""
             raise BadProtocolRequest(
                 "the POST carries neither query= nor update=" + (f" (it has {misspelt})" if misspelt else "")
             )
