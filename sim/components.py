@@ -1740,11 +1740,13 @@ class SimEnvironment:
         the map: ``sight.unseen``), nor could the camera of any component that may stand in for the step's:
         else the base drives off and the step fails when it looks. An object an earlier step may have moved
         is not checked (it may be elsewhere by then), nor a step a component of unknown camera may do (one
-        in another process). The person is taken where the map starts them (nothing moves them)."""
+        in another process). The person is outlined wherever the seed may put them (``sight.person_outline``),
+        and a camera sees nothing through the map's solid boxes (``sight.occluders``)."""
         smap = self.world.map
         steps = {step.index: step for step in plan.steps}
         ads = {ad.iri: ad for ad in self.kb.advertisements()}
         handled: set[str] = set()
+        blockers = sight.occluders(smap)  # walls, furniture, appliances, robots' bodies hide what is behind them
         for step in plan.steps:
             given = [values.get(name) for name in sorted(_given_to(step, steps))]
             iris = [str(value["@id"]) for value in given if isinstance(value, dict) and "@id" in value]
@@ -1760,7 +1762,8 @@ class SimEnvironment:
             ad = ads.get(step.component)
             if ad is not None and SKILLS.get(ad.service_name or "") is track:  # the person, by their shirt
                 people = [smap.people[iri] for iri in iris if iri in smap.people]
-                looked_for = [(who.iri, sight.person_centre(who), sight.person_outline(who)) for who in people]
+                spread = self.world.spread.person  # where the seed may have put them
+                looked_for = [(who.iri, sight.person_centre(who), sight.person_outline(who, spread)) for who in people]
                 objects = []
             else:
                 looked_for = []
@@ -1771,7 +1774,9 @@ class SimEnvironment:
                 looked_for.append((obj.iri, centre, sight.object_outline(obj, centre)))
             for iri, centre, outline in looked_for:
                 why = [
-                    (name, sight.unseen(self.world.cameras[name], outline)) for name in dict.fromkeys(cameras) if name
+                    (name, sight.unseen(self.world.cameras[name], outline, blockers))
+                    for name in dict.fromkeys(cameras)
+                    if name
                 ]
                 if all(reason for _, reason in why):
                     raise sight.OutOfViewError(step.component, iri, centre, why)
