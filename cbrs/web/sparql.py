@@ -53,7 +53,9 @@ def sparql() -> Response:
     if query is None:
         misspelt = misspelt_parameter(request.args)
         if misspelt:  # "qeury=" would have been answered with the service description, as if no query was sent
-            raise BadProtocolRequest(f"GET {request.path} has no parameter {misspelt}; without one it describes the endpoint")
+            raise BadProtocolRequest(
+                f"GET {request.path} has no parameter {misspelt}; without one it describes the endpoint"
+            )
         return _service_description()
     dataset = Dataset.from_parameters(
         request.values.getlist(QUERY_DATASET[0]), request.values.getlist(QUERY_DATASET[1])
