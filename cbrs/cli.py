@@ -744,7 +744,7 @@ def settings_command(as_json: bool) -> None:
 def demo(app: App, external: bool, seed: int) -> None:
     """A tour of the knowledge base: what is stored, an advertisement, a requirement, a query, a ranking;
     then the paper's two scenarios planned and run in the simulated home (the [sim] extra), FetchMyPen again
-    with a camera failed. About 10 s."""
+    with a camera failed. 10-20 s."""
     if external:
         _external_demo(seed)
         return
