@@ -543,6 +543,12 @@ class RemoteStore(Store):
             ) from error
         except httpx.TimeoutException as error:
             raise StoreError(self.location, f"{url} did not answer within {self.timeout:g} s") from error
+        except httpx.RemoteProtocolError as error:  # a listener that speaks no HTTP, as a rosbridge websocket
+            raise StoreError(
+                self.location,
+                f"{url} closed the connection without an HTTP answer ({error}): is it a SPARQL endpoint? A cbrs "
+                "serve's is on its HTTP port (8080 by default), not its bridge port (9090)",
+            ) from error
         except httpx.HTTPError as error:
             raise StoreError(self.location, f"request to {url} failed: {error}") from error
         server = response.headers.get("server", "").lower()

@@ -34,8 +34,9 @@ from cbrs.cli_serve import _websockets_level
 from cbrs.component import Component
 from cbrs.component_protocol import READ_ONLY
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.output import ProgressLine
-from cbrs.rosbridge import ServiceError
+from cbrs.rosbridge import Bridge, ServiceError
 from cbrs.server import ServeConfig, Server
 from cbrs.settings import setting
 from cbrs.sparql_service import EndpointConfig, SparqlService
@@ -366,3 +367,12 @@ def test_a_misspelt_graph_parameter_on_the_graph_store_writes_nothing(client: Fl
     assert sent.status_code == 400
     assert sent.get_json()["message"] == "/store has no parameter 'grpah': did you mean graph=?"
     assert client.get("/store", headers={"Accept": "application/n-quads"}).data == before
+
+
+def test_a_store_url_that_is_a_rosbridge_port_says_which_port_to_give() -> None:
+    """`cbrs --store http://127.0.0.1:9090 ...` (the bridge, not the endpoint) said only "request to
+    .../query failed: Server disconnected without sending a response."."""
+    with Bridge().start(host="127.0.0.1", port=0) as running, pytest.raises(KnowledgeBaseError) as failed:
+        KnowledgeBase.open(f"http://127.0.0.1:{running.port}")
+    assert "closed the connection without an HTTP answer" in str(failed.value)
+    assert "not its bridge port (9090)" in str(failed.value)
