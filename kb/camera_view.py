@@ -49,7 +49,7 @@ camera still to see the thing whole (:func:`hidden`). None, by default: percepti
 image's border cuts, and a blob a cupboard cuts is as wrong a measure of where the thing is (its centre
 moves towards the part in view). A box of the map is its piece's bounding box (a table's legs and the
 space between them are one solid block), so a lab whose map boxes are coarser than what they stand for
-may allow a part."""
+may allow a part, camera by camera (``home:occlusionTolerance``, :attr:`Camera.occlusion_tolerance`)."""
 HIDDEN_BY = "sight lines to the points outlining it pass through"
 """The words of :func:`hidden`'s reason before the boxes it names: how a caller tells that reason."""
 SURFACE = 0.001

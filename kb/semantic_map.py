@@ -218,6 +218,9 @@ class Camera:
     far: float = 8.0
     size: tuple[float, float, float] | None = None
     mount: str | None = None
+    occlusion_tolerance: float = 0.0
+    """The largest fraction of the sight lines to a thing's outline that the map's solid boxes may cut for
+    the camera still to see it whole (``home:occlusionTolerance``; ``kb.camera_view.hidden``)."""
 
     @property
     def looks_down(self) -> bool:
@@ -505,11 +508,18 @@ def _classify(
             far=_number(values, "maxRange", iri, 8.0),
             size=size,
             mount=values.get(HOME + "mountedOn", [None])[0],
+            occlusion_tolerance=_number(values, "occlusionTolerance", iri, 0.0),
         )
         if not 0.0 < camera.near < camera.far:
             raise MapError(iri, f"has a range of {camera.near}..{camera.far} m; need 0 < home:minRange < home:maxRange")
         if not 0.0 < camera.fov < 180.0:
             raise MapError(iri, f"has a field of view of {camera.fov} degrees; it must be between 0 and 180")
+        if not 0.0 <= camera.occlusion_tolerance < 1.0:
+            raise MapError(
+                iri,
+                f"has a home:occlusionTolerance of {camera.occlusion_tolerance}; it is a fraction of sight lines, "
+                "from 0 up to (not including) 1",
+            )
         built.cameras[iri] = camera
         return
     if HOME + "armSide" in values:

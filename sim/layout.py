@@ -10,7 +10,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from cbrs.kb.camera_view import DOWNWARD_IMAGE_SIZE, OTHER_IMAGE_SIZE  # the camera model, shared
+from cbrs.kb.camera_view import DOWNWARD_IMAGE_SIZE, MAX_HIDDEN, OTHER_IMAGE_SIZE  # the camera model, shared
 from cbrs.sim.geometry import Vec3
 
 __all__ = [
@@ -51,6 +51,8 @@ class CameraSpec:
     fov_deg: float = 90.0
     near: float = 0.2
     far: float = 8.0
+    max_hidden: float = MAX_HIDDEN
+    """The fraction of sight lines to a thing the map's boxes may cut with the thing still seen whole."""
 
 
 MAP_RESOLUTION = 0.05

@@ -14,7 +14,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from cbrs.kb.camera_view import HIDDEN_BY, MAX_HIDDEN, Occluder, hidden, occluders
+from cbrs.kb.camera_view import HIDDEN_BY, Occluder, hidden, occluders
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.semantic_map import MapObject, Person, local_name
 from cbrs.sim import layout as L
@@ -72,13 +72,14 @@ def unseen(
     camera: Camera,
     points: NDArray[np.float64],
     blockers: Sequence[Occluder] = (),
-    max_hidden: float = MAX_HIDDEN,
+    max_hidden: float | None = None,
 ) -> str:
     """Why ``camera`` would not see the whole of what ``points`` outline; empty when it would. Whole
     means every point nearer than the camera's far range and beyond its near one, and on a pixel off the
     image's border: perception refuses a blob touching the border (``CutByBorderError``); and no more than
     ``max_hidden`` of the sight lines from the camera's eye to the points passing through one of
-    ``blockers`` (the map's solid boxes, :func:`occluders`; none given, none tested)."""
+    ``blockers`` (the map's solid boxes, :func:`occluders`; none given, none tested). ``max_hidden``
+    defaults to the camera's own ``home:occlusionTolerance`` (``kb.camera_view.MAX_HIDDEN`` unless the map says)."""
     spec = camera.spec
     depth = (points - camera.camera_to_world[:3, 3]) @ camera.camera_to_world[:3, 2]
     if float(depth.min()) < spec.near or float(depth.max()) > spec.far:
@@ -89,7 +90,8 @@ def unseen(
     us, vs = pixels[:, 0], pixels[:, 1]
     out = (us < 1) | (us > spec.width - 2) | (vs < 1) | (vs > spec.height - 2)
     if not out.any():
-        return hidden(camera.spec.eye, points.tolist(), blockers, max_hidden)
+        allowed = camera.spec.max_hidden if max_hidden is None else max_hidden
+        return hidden(camera.spec.eye, points.tolist(), blockers, allowed)
     return (
         f"{int(out.sum())} of the {len(points)} points outlining it fall on or past the border of its "
         f"{spec.width} x {spec.height} image (columns {us.min():.0f} to {us.max():.0f}, rows {vs.min():.0f} to "

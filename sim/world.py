@@ -645,6 +645,7 @@ class HomeWorld:
                 fov_deg=cam.fov,
                 near=cam.near,
                 far=cam.far,
+                max_hidden=cam.occlusion_tolerance,
             )
             self.cameras[spec.name] = Camera(c, spec, self, self.scene_key)
         if self.gui:

@@ -16,8 +16,8 @@ from pathlib import Path
 import pytest
 
 from cbrs.kb import KnowledgeBase
-from cbrs.kb.camera_view import Occluder, hidden, sight_blocked
-from cbrs.kb.semantic_map import Box, Pose, SemanticMap
+from cbrs.kb.camera_view import MAX_HIDDEN, Occluder, hidden, sight_blocked
+from cbrs.kb.semantic_map import Box, Camera, MapError, Pose, SemanticMap
 from cbrs.sim import sight
 from cbrs.sim.errors import NotVisibleError
 from cbrs.sim.perception import recognise_object
@@ -112,3 +112,39 @@ def test_a_person_the_check_accepts_is_in_view_at_every_seed(glasses_world: Home
     inside = Pose(0.72 + Spread().person, 3.6)  # as far in as the spread reaches
     assert sight.unseen(camera, sight.person_outline(dataclasses.replace(person, start=inside))) == ""
     assert not any(cut_at(inside, seed) for seed in range(200))
+
+
+def test_a_camera_of_the_map_may_allow_part_of_a_thing_hidden(glasses_world: HomeWorld) -> None:
+    """``home:occlusionTolerance`` is the camera's own fraction: read from the map, handed to the simulated
+    camera and used by ``sight.unseen``; a value that is no fraction is refused naming the camera."""
+    assert Camera("c", (0.0, 0.0, 1.0), 45.0).occlusion_tolerance == MAX_HIDDEN
+    camera, blockers = glasses_world.cameras["Kinect01"], sight.occluders(glasses_world.map)
+    pen = glasses_world.map.objects[WORLD + "Pen"]
+    outline = sight.object_outline(pen, glasses_world.pose("Pen").position)
+    why = sight.unseen(camera, outline, blockers)
+    cut, lines = (int(n) for n in re.findall(r"(\d+) of the (\d+) sight lines", why)[0])
+    assert 0 < cut < lines  # where it settled, part of the pen shows over the shelf's edge
+    strict = camera.spec
+    try:
+        camera.spec = dataclasses.replace(strict, max_hidden=cut / lines)
+        assert sight.unseen(camera, outline, blockers) == ""
+        assert sight.unseen(camera, outline, blockers, max_hidden=0.0) == why  # one call's own fraction
+        camera.spec = dataclasses.replace(strict, max_hidden=(cut - 1) / lines)
+        assert sight.unseen(camera, outline, blockers).startswith(f"{cut} of the {lines} sight lines")
+    finally:
+        camera.spec = strict
+
+    kb = KnowledgeBase.open(":memory:")
+    kinect = "https://w3id.org/cbrs/service#Kinect01"
+    told = (
+        "PREFIX home: <https://w3id.org/cbrs/home#> "
+        "INSERT DATA { GRAPH <https://w3id.org/cbrs/graph/map> { <%s> home:occlusionTolerance %s } }"
+    )
+    kb.update(told % (kinect, "0.5"))
+    assert SemanticMap.read(kb).cameras[kinect].occlusion_tolerance == 0.5
+    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
+        assert world.cameras["Kinect01"].spec.max_hidden == 0.5
+    kb.update(told.replace("INSERT", "DELETE") % (kinect, "0.5"))
+    with pytest.raises(MapError, match=r"(?s)Kinect01.*home:occlusionTolerance of 1\.0.*nothing was changed"):
+        kb.update(told % (kinect, "1.0"))  # an update of the map is checked as a run reads it
+    assert SemanticMap.read(kb).cameras[kinect].occlusion_tolerance == MAX_HIDDEN
