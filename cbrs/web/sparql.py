@@ -12,7 +12,7 @@ import difflib
 from collections.abc import Iterable
 
 import pyoxigraph as ox
-from flask import Blueprint, Response, g, request
+from flask import Blueprint, Response, g, request, url_for
 from werkzeug.datastructures import MIMEAccept, MultiDict
 
 from cbrs.sparql_service import GRAPH_TYPES, RESULT_TYPES, Dataset, EndpointError, accept_ranges, negotiate
@@ -56,6 +56,9 @@ def sparql() -> Response:
             raise BadProtocolRequest(
                 f"GET {request.path} has no parameter {misspelt}; without one it describes the endpoint"
             )
+        if request.path == "/sparql" and request.method in ("GET", "HEAD") and _person_asks():
+            # a person gets the editor, a client the description
+            return Response(status=303, headers={"Location": url_for("editor.editor")})
         return _service_description()
     dataset = Dataset.from_parameters(
         request.values.getlist(QUERY_DATASET[0]), request.values.getlist(QUERY_DATASET[1])
@@ -110,6 +113,18 @@ def wants_protocol() -> bool:
         return best > html
     named_html = any(media in _HTML for media, _ in ranges)
     return best > 0 and not named_html and "query" in request.values
+
+
+def _person_asks() -> bool:
+    """Whether a request without a query ranks HTML above every type the service description comes in:
+    a browser (``text/html`` first, ``*/*`` after). A SPARQL client naming an RDF type, ``*/*`` alone, no
+    ``Accept`` or a ``format`` parameter keep the description."""
+    accept = request.headers.get("Accept")
+    ranges = accept_ranges(accept) if accept else []
+    if not ranges or _short_format():
+        return False
+    parsed = MIMEAccept(ranges)
+    return max(parsed.quality(media) for media in _HTML) > max(parsed.quality(media) for media in GRAPH_TYPES)
 
 
 def protocol_answer() -> Response:
@@ -211,7 +226,8 @@ def _with_charset(media_type: str) -> str:
 
 
 def _service_description() -> Response:
-    """A GET without a query describes the endpoint (SPARQL 1.1 Service Description), as RDF."""
+    """A GET without a query describes the endpoint (SPARQL 1.1 Service Description), as RDF, to a client
+    (a browser is sent to the editor: :func:`_person_asks`)."""
     sd = "http://www.w3.org/ns/sparql-service-description#"
     formats = "http://www.w3.org/ns/formats/"
     endpoint = ox.NamedNode(request.base_url)
