@@ -31,6 +31,7 @@ from collections.abc import Callable
 from concurrent.futures import Future
 from concurrent.futures import TimeoutError as FutureTimeout
 from typing import Any
+from urllib.parse import urlsplit
 
 import pyoxigraph as ox
 
@@ -161,7 +162,7 @@ class Component:
             raise ValueError(f"{self.iri} has no handler: decorate one with @component.handler")
         if not 0 < heartbeat < ttl:
             raise ValueError(f"the heartbeat ({heartbeat} s) must be shorter than the lease ({ttl} s)")
-        client = BridgeClient(url, token)
+        client = _bridge_client(url, token)
         try:
             registered = self._register(client, ttl, token_given=token is not None, stop=stop)
             if stop.signal is not None:
@@ -217,6 +218,32 @@ class Component:
             pass
         except (RegistrationRefusedError, ComponentEndedError, BridgeClosedError) as error:
             raise SystemExit(f"cbrs component: {error}") from None  # printed on stderr, status 1
+
+
+def _bridge_client(url: str, token: str | None) -> BridgeClient:
+    """A client of the bridge at ``url``. Refused at a URL with no port, which tried the scheme's port (80
+    for ws://), the error says so and names the bridge's default port: "connection refused" alone does not."""
+    try:
+        return BridgeClient(url, token)
+    except BridgeClosedError as error:
+        if not isinstance(error.__cause__, ConnectionRefusedError) or _port_of(url) is not None:
+            raise
+        from cbrs.settings import setting  # here: only a refused connection needs the default
+
+        default = setting("bridge_port").default()
+        tried = 443 if url.lower().startswith("wss:") else 80
+        raise BridgeClosedError(
+            f"{error}. {url} names no port, so port {tried} was tried; cbrs serve's bridge listens on port "
+            f"{default} by default (--bridge-port): give ws://HOST:{default}"
+        ) from error
+
+
+def _port_of(url: str) -> int | None:
+    """The port ``url`` names; None when it names none, -1 when it cannot be read (then no advice is given)."""
+    try:
+        return urlsplit(url).port
+    except ValueError:
+        return -1
 
 
 class ConnectedComponent:
