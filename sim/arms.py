@@ -555,9 +555,12 @@ class Arm:
     def _others(self) -> dict[ArmSide, Sequence[float]]:
         return {side: arm.joint_positions() for side, arm in self.peers.items() if side is not self.side}
 
-    def dry_run(self) -> PlannedArm:
-        """A stand-in for this arm, from its posture now, whose moves are planned and not made."""
-        return PlannedArm(self.side, self._kinematics, self.joint_positions(), self._others())
+    def dry_run(self, folded: Sequence[ArmSide] = ()) -> PlannedArm:
+        """A stand-in for this arm, from its posture now, whose moves are planned and not made; the other
+        arms where they are, or those of ``folded`` in their home posture (where they will be by then: an
+        arm that sets an object down for this one folds home after)."""
+        others = {side: HOME_CONFIGURATIONS[side] if side in folded else q for side, q in self._others().items()}
+        return PlannedArm(self.side, self._kinematics, self.joint_positions(), others)
 
     def _settle(self, goal: NDArray[np.float64]) -> float:
         waited = 0.0

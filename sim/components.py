@@ -432,9 +432,11 @@ def _grasp_pose(ctx: SimContext, estimate: ObjectEstimate, side: ArmSide, held: 
 
 def _who_takes(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel) -> GraspChoice:
     """Which arm takes the object where it is, and by which approach: of the free arms that reach it,
-    nearest first (:func:`_reaching`), the first that can (:func:`_taking`: its inverse kinematics and its
-    planning's dry run of the moves). The nearest arm is not the only one asked: where its hand cannot
-    get to the object (its joints' range, the dispenser in the way) the other arm may. When none can,
+    nearest first (:func:`_reaching`), the first that can (:func:`_taking_to`: its inverse kinematics and
+    its planning's dry run of the moves) and can also let it go where the hold ends; else the first that
+    can take it, to pass it on there. The nearest arm is not the only one asked: where its hand cannot
+    get to the object (its joints' range, the dispenser in the way) or cannot set it down where it goes,
+    the other arm may. When none can,
     the nearest arm's refusal, as it is when it is the only one asked or every arm's is a misfit (a
     typed error: the object does not fit the hand so), else a SkillFailed starting with it and saying
     why each other arm could not either."""
@@ -446,13 +448,20 @@ def _who_takes(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel) ->
     if fits:
         raise SkillFailed(fits)
     refused: list[tuple[ArmSide, Exception]] = []
+    passing_on: GraspChoice | None = None  # the first arm that can take it but not let it go where it goes
     for side in arms:
         try:
             if len(model.preference) == 1:  # its one approach's misfit is its own typed error (GraspTooDeepError...)
                 _grasp_pose(ctx, estimate, side, model)
-            return _taking(ctx, estimate, model, side)  # one approach too: its moves are dry-run (_clear)
+            choice, served = _taking_to(ctx, estimate, model, side)  # one approach too: its moves are dry-run
         except (SkillFailed, SimulationError) as why:
             refused.append((side, why))
+            continue
+        if served:
+            return choice
+        passing_on = passing_on or choice
+    if passing_on is not None:
+        return passing_on  # the carry passes it to the arm that reaches where it goes
     first = refused[0][1]
     if len(refused) == 1 or all(isinstance(why, GraspMisfitError) for _, why in refused):
         raise first
@@ -474,7 +483,15 @@ def _fitting(ctx: SimContext, model: ObjectModel, sides: Sequence[ArmSide]) -> s
 
 
 def _taking(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, side: ArmSide) -> GraspChoice:
-    """The approach ``side`` takes the object by, of several: the first it can take it by where it is and
+    """The approach ``side`` takes the object by (:func:`_taking_to`)."""
+    return _taking_to(ctx, estimate, model, side)[0]
+
+
+def _taking_to(
+    ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, side: ArmSide
+) -> tuple[GraspChoice, bool]:
+    """The approach ``side`` takes the object by, and whether it can also let it go where the hold ends
+    (True too where that is not known here), of several: the first it can take it by where it is and
     let it go by where the hold ends, when that is known here (:func:`_hold_end`: a later carry of the
     plan to a place the task gives), else the first it can take it by. Letting go is asked as the carry
     will (:func:`_holdable`): over the spots of the place this arm reaches, nearest the centre first. An
@@ -492,7 +509,8 @@ def _taking(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, side:
         raise SkillFailed(taking.refusal())
     end = _hold_end(ctx, name, side)
     if end is None:
-        return _clear(taking, side, f"taking the {name}", lambda held: skills.can_carry(world, estimate, side, held))
+        moves = functools.partial(skills.can_carry, world, estimate, side)
+        return _clear(taking, side, f"taking the {name}", moves), True
     place, surface, spots = end
     first: dict[GraspKind, Region] = {}  # the spot the carry will aim at, by each approach that lets go there
 
@@ -509,7 +527,7 @@ def _taking(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, side:
 
     both = _Candidates.of(model, take, letting_go)
     if both.models:
-        return _clear(
+        served = _clear(
             both,
             side,
             f"taking the {name} to {place.name}",
@@ -523,13 +541,15 @@ def _taking(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, side:
             ),
             first,
         )
+        return served, True
     unplaced = "; ".join(why for _, why in both.ruled_out)
-    return _clear(  # to be passed on: the take's moves are dry-run, as where the hold's end is not known
+    passed_on = _clear(  # to be passed on: the take's moves are dry-run, as where the hold's end is not known
         taking,
         side,
         f"taking the {name} (to {place.name}, to be passed on: {unplaced})",
         lambda held: skills.can_carry(world, estimate, side, held),
     )
+    return passed_on, False
 
 
 def _clear(
@@ -668,29 +688,22 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
         placing = _Candidates.of(model, *(checks if len(model.preference) > 1 else []))
         if not placing.models:
             raise SkillFailed(f"the {taker.value} arm reaches {place.name}, but {placing.refusal()}")
-        relay, _, taken_by = _relay_spot(ctx, taken, _Candidates([model]), placing, giver, taker)
-        # Both arms' moves of the pass are dry-run before the giver sets the object down (it holds it now).
+        # Both arms' moves of the pass are dry-run before the giver sets the object down (it holds it now);
+        # a spot whose moves are refused is passed over for the next (_relay_spot).
         passing = f"passing the {model.name} from the {giver.value} arm to the {taker.value} for {place.name}"
         before = "the pass moved anything"
         holding = world.arm(giver).ee_pose().position
-        _refuse(
-            skills.can_carry_held(world, giver, relay, _floor(ctx, model, giver, holding, relay)),
-            model,
-            giver,
-            passing,
-            relay,
-            before,
-        )
-        there = _resting(relay, model, taken, world.time)
-        floor = _floor(ctx, taken_by, taker, there.position, target)
-        _refuse(
-            skills.can_carry(world, there, taker, taken_by, target, floor=floor),
-            taken_by,
-            taker,
-            passing,
-            target,
-            before,
-        )
+
+        def holds(spot: Region, _: ObjectModel, taken_by: ObjectModel) -> None:
+            why = skills.can_carry_held(world, giver, spot, _floor(ctx, model, giver, holding, spot))
+            _refuse(why, model, giver, passing, spot, before)
+            there = _resting(spot, model, taken, world.time)
+            floor = _floor(ctx, taken_by, taker, there.position, target)
+            # the giver will have folded home by the time the taker moves
+            why = skills.can_carry(world, there, taker, taken_by, target, floor=floor, folded=(giver,))
+            _refuse(why, taken_by, taker, passing, target, before)
+
+        relay, _, taken_by = _relay_spot(ctx, taken, _Candidates([model]), placing, giver, taker, holds)
         found = _set_down_for(ctx, device, model, giver, taker, relay, None)
         taker_spec = world.arm_specs[taker]
         _note(

@@ -470,6 +470,7 @@ def can_carry(
     region: Region | None = None,
     yaw: float | None = None,
     floor: float | None = None,
+    folded: Sequence[ArmSide] = (),
 ) -> str:
     """Why ``side``'s own motion planning would refuse to take the object where it is by ``model``'s
     approach and, given a ``region``, carry it over its middle (empty if it would not): the moves of
@@ -479,12 +480,12 @@ def can_carry(
     of the end poses alone (:func:`can_take`, :func:`can_set_down`) misses a joint-space move whose every
     path collides or lets the held object dip, and a straight line that leaves the arm's reach. ``yaw``
     turns a top-grasped object on the way, and ``floor`` keeps its bottom up on the way, as
-    :func:`carry_object` does."""
+    :func:`carry_object` does; the arms of ``folded`` are taken to be home (:meth:`Arm.dry_run`)."""
     arm = ArmSide(side)
     grasp = _grasp(world, pen, arm, model)
     if isinstance(grasp, str):
         return grasp
-    hand = world.arm(arm).dry_run()
+    hand = world.arm(arm).dry_run(folded)
     x, y, z = grasp.position
     moves: list[tuple[str, Callable[[], MotionResult]]] = [
         ("reaching the pre-grasp pose", lambda: hand.reach(grasp.pregrasp, grasp.orientation)),

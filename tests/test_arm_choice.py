@@ -24,6 +24,7 @@ from cbrs.sim.errors import MovesRefusedError
 from cbrs.sim.geometry import Region
 from cbrs.sim.grasping import GraspKind, ObjectModel
 from cbrs.sim.perception import ObjectEstimate
+from cbrs.sim.values import designator
 from cbrs.sim.world import HomeWorld, open_world
 from tests.test_turtle_tasks_arms import FETCH_MY_CUP
 
@@ -177,3 +178,29 @@ def test_a_pass_whose_holds_are_refused_at_one_relay_spot_tries_the_next(monkeyp
     assert second.spot is not None and second.spot.center != refused_at
     assert second.giver is not None and second.giver.arm is LEFT and second.loader.arm is RIGHT
     assert "the stand-in refuses every spot" in str(refused.value) and refused.value.arm == "left"
+
+
+def test_of_two_arms_that_can_take_it_the_one_that_can_also_set_it_down_where_it_goes_takes_it() -> None:
+    """The cup at (7.70, 3.20), the left mount nearer; a tray east of it only the right arm reaches. The
+    left arm could take the cup only to pass it on; the right one takes it to the tray itself."""
+    tasks = Path(__file__).parent / "data" / "tasks"
+    kb = _cup_at(7.70, 3.20)
+    kb.update(
+        "INSERT DATA { GRAPH graph:map { world:TrayPlace a home:ObjectPlace ; home:minX 8.15 ; home:maxX 8.30 ; "
+        "home:minY 3.15 ; home:maxY 3.30 ; home:minZ 0.75 ; home:maxZ 0.75 } }"
+    )
+    kb.load([tasks / "put_cup_on_tray.ttl"], graph="requirements")
+    plan = Composer(kb).compose("PutCupOnTray").plan
+    assert plan is not None
+    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
+        context = SimEnvironment(world, kb).context
+        seen, cup = _seen(world)
+        assert components._reaching(context, seen.x, seen.y) == [LEFT, RIGHT]
+        assert components._who_takes(context, seen, cup).arm is LEFT  # no plan: where it goes is not known
+        context.plan, context.component = plan, PREFIXES["svc"] + "ApproachToObject_CytonDualArm01"
+        context.given = {
+            "cup": designator(WORLD + "Cup", PREFIXES["home"] + "Cup"),
+            "place": designator(WORLD + "TrayPlace", PREFIXES["home"] + "ObjectPlace"),
+        }
+        chosen = components._who_takes(context, seen, cup)
+    assert chosen.arm is RIGHT and chosen.purpose == "taking the Cup to TrayPlace"
