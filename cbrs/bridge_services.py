@@ -7,6 +7,10 @@ Services (request fields -> response values):
 - ``/cbrs/match`` ``{requirement, method="sem-str", top=10}`` -> the ranking with explanations.
 - ``/cbrs/plan`` ``{task, objective="similarity"}`` -> the plan (recorded in the plans graph when the
   caller may write) or what is unsatisfied.
+
+Each type is defined in ``cbrs/interfaces`` (``srv/Match.srv``, ``msg/Candidate.msg``...), which rosapi's
+details services describe. A ROS client fills every field of a request, an unset one with its type's
+zero value: an empty ``method`` or ``objective`` and a ``top`` of 0 mean the default.
 - ``/cbrs/tasks`` ``{}`` -> ``{tasks}``: every task the store can express, as ``task`` takes it.
 - ``/cbrs/run_task`` ``{task, seed=0, fail=[], fault_rate=0, repeat_failures=1, wait=true}`` -> the run;
   with ``wait`` false it returns at once and the run is followed on the topics, or with
@@ -41,6 +45,7 @@ import difflib
 import json
 import threading
 from collections.abc import Callable, Collection
+from importlib.resources import files
 from typing import TYPE_CHECKING, Any, TypeVar
 
 from cbrs.kb.errors import KnowledgeBaseError
@@ -61,6 +66,16 @@ TOPICS = {
     RUN_TOPIC: "cbrs/Event",
 }
 
+#: The services offered: name -> type (defined in INTERFACES, as the topics' types are).
+SERVICES = {
+    "/cbrs/query": "cbrs/Query",
+    "/cbrs/match": "cbrs/Match",
+    "/cbrs/plan": "cbrs/Plan",
+    "/cbrs/run_task": "cbrs/RunTask",
+    "/cbrs/tasks": "cbrs/Tasks",
+    "/cbrs/task_status": "cbrs/TaskStatus",
+}
+
 #: The actions offered: name -> type. /cbrs/run_task is also a service; ROS 2 keeps the two apart.
 ACTIONS = {"/cbrs/run_task": "cbrs/action/RunTask"}
 
@@ -78,6 +93,10 @@ FIELDS: dict[str, tuple[str, ...]] = {
     "/cbrs/tasks": (),
     "/cbrs/task_status": ("run",),
 }
+
+#: The definitions of the services' and topics' types (one .msg/.srv file each), package ``cbrs``: what
+#: rosapi's message_details and service_request/response_details describe.
+INTERFACES = files("cbrs") / "interfaces"
 
 T = TypeVar("T")
 Handler = Callable[[dict[str, Any]], dict[str, Any]]
@@ -112,15 +131,17 @@ class KnowledgeServices:
 
     def handlers(self) -> dict[str, tuple[str, Handler]]:
         """Service name -> (type, handler); each handler refuses a field its service does not read."""
-        handlers: dict[str, tuple[str, Handler]] = {
-            "/cbrs/query": ("cbrs/Query", self.query),
-            "/cbrs/match": ("cbrs/Match", self.match),
-            "/cbrs/plan": ("cbrs/Plan", self.plan),
-            "/cbrs/run_task": ("cbrs/RunTask", self.run_task),
-            "/cbrs/tasks": ("cbrs/Tasks", self.known_tasks),
-            "/cbrs/task_status": ("cbrs/TaskStatus", self.task_status),
+        handlers: dict[str, Handler] = {
+            "/cbrs/query": self.query,
+            "/cbrs/match": self.match,
+            "/cbrs/plan": self.plan,
+            "/cbrs/run_task": self.run_task,
+            "/cbrs/tasks": self.known_tasks,
+            "/cbrs/task_status": self.task_status,
         }
-        return {name: (kind, _known_fields(name, FIELDS[name], handler)) for name, (kind, handler) in handlers.items()}
+        return {
+            name: (SERVICES[name], _known_fields(name, FIELDS[name], handler)) for name, handler in handlers.items()
+        }
 
     def query(self, args: dict[str, Any]) -> dict[str, Any]:
         text = _field(args, "query", str)
@@ -131,8 +152,8 @@ class KnowledgeServices:
 
     def match(self, args: dict[str, Any]) -> dict[str, Any]:
         requirement = _iri(_field(args, "requirement", str), "req")
-        method = _field(args, "method", str, "sem-str")
-        top = _field(args, "top", int, 10)
+        method = _field(args, "method", str, "") or "sem-str"  # "" and 0: what a ROS client sends for "unset"
+        top = _field(args, "top", int, 0) or 10
         from cbrs.reasoner.methods import METHODS  # the reasoner loads with the first match, not at start-up
 
         if method not in METHODS:
@@ -149,7 +170,7 @@ class KnowledgeServices:
         from cbrs.task_names import task_iri
 
         task = _field(args, "task", str)
-        objective = _field(args, "objective", str, Objective.SIMILARITY.value)
+        objective = _field(args, "objective", str, "") or Objective.SIMILARITY.value
         if objective not in {o.value for o in Objective}:
             raise ServiceError(f"objective {objective!r} is not one of {', '.join(o.value for o in Objective)}")
         with self.sparql.lock:
@@ -317,6 +338,7 @@ class Composers:
 def attach(bridge: Bridge, services: KnowledgeServices) -> Callable[[], None]:
     """Offer ``services`` on ``bridge`` and relay task events to its topics; returns the detach call."""
     services.wait_limit = max(0.5, min(services.wait_limit, bridge.call_timeout - 2.0))
+    bridge.interfaces.load(INTERFACES, "cbrs")
     for name, (kind, handler) in services.handlers().items():
         bridge.add_service(name, kind, handler)
     for topic, kind in TOPICS.items():

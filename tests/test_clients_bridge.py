@@ -312,3 +312,97 @@ def test_a_long_response_is_cut_in_at_most_max_pieces(bridge: RunningBridge) -> 
         assert joined(pieces)["values"]["text"] == "y" * 3_000_000
         ws.send(json.dumps({"op": "call_service", "service": "/rosapi/get_time", "id": "after"}))
         assert json.loads(ws.recv(timeout=WAIT))["id"] == "after"
+
+
+def _call(ws: ClientConnection, service: str, args: dict[str, Any]) -> dict[str, Any]:
+    ws.send(json.dumps({"op": "call_service", "service": service, "args": args, "id": service}))
+    while True:  # status messages (a log level's) may come first: bounded by the timeout of each recv
+        answer: dict[str, Any] = json.loads(ws.recv(timeout=WAIT))
+        if answer.get("op") == "service_response" and answer.get("id") == service:
+            return answer
+
+
+def _examples(typedef: dict[str, Any]) -> dict[str, Any]:
+    """A request as a form built from a typedef sends it untouched: every field at its example (default)."""
+    zero = {"": "", "0": 0, "0.0": 0.0, "False": False, "[]": [], "{}": {}}
+    return {name: zero[example] for name, example in zip(typedef["fieldnames"], typedef["examples"], strict=True)}
+
+
+def test_rosapi_describes_the_knowledge_base_services_and_topics(server: Server) -> None:
+    from cbrs.bridge_services import SERVICES, TOPICS
+    from tests.test_rosapi_typedefs import cbrs_types
+
+    types = cbrs_types()
+    with connect(f"ws://127.0.0.1:{server.bridge_port}", open_timeout=WAIT) as ws:
+        for service, kind in SERVICES.items():
+            assert _call(ws, "/rosapi/service_type", {"service": service})["values"] == {"type": kind}
+            assert service in _call(ws, "/rosapi/services_for_type", {"type": kind})["values"]["services"]
+            request = _call(ws, "/rosapi/service_request_details", {"type": kind})["values"]["typedefs"]
+            response = _call(ws, "/rosapi/service_response_details", {"type": kind})["values"]["typedefs"]
+            assert request == types.request(kind) and request[0]["type"] == kind + "Request"
+            assert response == types.response(kind) and response[0]["type"] == kind + "Response"
+        listed = _call(ws, "/rosapi/services", {})["values"]["services"]
+        for service in listed:  # every cbrs type the server offers, the live components' too
+            kind = _call(ws, "/rosapi/service_type", {"service": service})["values"]["type"]
+            if kind.startswith("cbrs/"):
+                assert types.request(kind) and types.response(kind), f"{service}: {kind} has no definition"
+        assert {"/cbrs/register", "/cbrs/heartbeat"} <= set(listed)
+        raw = _call(ws, "/rosapi/topics_and_raw_types", {})["values"]
+        texts = dict(zip(raw["topics"], raw["typedefs_full_text"], strict=True))
+        for topic, kind in TOPICS.items():
+            details = _call(ws, "/rosapi/message_details", {"type": kind})["values"]["typedefs"]
+            assert details[0]["type"] == kind and details == types.message(kind)
+            assert texts[topic] == types.full_text(kind) != ""
+        assert texts["/rosout"].startswith("# /rosout")
+        assert _call(ws, "/rosapi/message_details", {"type": "cbrs/NoSuch"})["values"] == {"typedefs": []}
+
+
+def test_the_services_answer_what_their_definitions_say(server: Server) -> None:
+    """Each reply's fields are its response definition's, recursively; a request built from the request
+    definition's defaults (what a typedef-driven form sends) is accepted."""
+    from tests.test_rosapi_typedefs import cbrs_types, mismatches
+
+    types = cbrs_types()
+    calls = [
+        ("cbrs/Query", "/cbrs/query", {"query": "SELECT ?s WHERE { ?s a ?c } LIMIT 2"}),
+        ("cbrs/Query", "/cbrs/query", {"query": "CONSTRUCT WHERE { ?s a ?c } LIMIT 2"}),
+        ("cbrs/Match", "/cbrs/match", {"requirement": "RobotSelfPosition", "top": 3}),
+        ("cbrs/Match", "/cbrs/match", {"requirement": "RobotSelfPosition"}),
+        ("cbrs/Plan", "/cbrs/plan", {"task": "FetchMyPen"}),
+        ("cbrs/Plan", "/cbrs/plan", {"task": "RouteToGoal"}),  # unsolvable in the bundled store
+        ("cbrs/Tasks", "/cbrs/tasks", {}),
+    ]
+    replies = []
+    with connect(f"ws://127.0.0.1:{server.bridge_port}", open_timeout=WAIT) as ws:
+        for kind, service, args in calls:
+            answer = _call(ws, service, args)
+            assert answer["result"] is True, answer
+            assert mismatches(types.response(kind), answer["values"], service) == []
+            replies.append(answer["values"])
+            as_a_form = {**_examples(types.request(kind)[0]), **args}
+            again = _call(ws, service, as_a_form)
+            assert again["result"] is True, (as_a_form, again)
+    planned, unsolvable = replies[4], replies[5]  # both branches of a plan's reply were checked
+    assert planned["status"] == "planned" and planned["steps"] and unsolvable["status"] == "unsolvable"
+    assert replies[2]["candidates"][0]["pairs"]  # explained candidates: their pairs were checked too
+
+
+@needs_roslibjs
+def test_roslibjs_reads_and_decodes_the_typedefs_and_calls_with_a_form_built_from_them(server: Server) -> None:
+    from tests.test_rosapi_typedefs import cbrs_types
+
+    types = cbrs_types()
+    assert NODE is not None
+    child = subprocess.run(
+        [NODE, str(JS / "typedefs.mjs"), str(server.bridge_port)], capture_output=True, text=True, timeout=60
+    )
+    assert child.returncode == 0, child.stderr
+    found = json.loads(child.stdout.strip().splitlines()[-1])
+    assert found["request"] == types.request("cbrs/Match") and found["response"] == types.response("cbrs/Match")
+    assert found["progress"] == types.message("cbrs/TaskProgress")
+    assert found["decodedRequest"] == {"requirement": "string", "method": "string", "top": "int32"}
+    candidate = found["decodedResponse"]["candidates"][0]
+    assert candidate["pairs"][0]["similarity"] == "float64" and candidate["parts"] == {}  # cbrs/Json: no fields
+    assert found["decodedProgress"]["avoiding"] == ["string"]
+    assert found["form"] == {"requirement": "RobotSelfPosition", "method": "", "top": 0}
+    assert found["ranked"] == 10  # method "" and top 0, a form's defaults, mean the service's defaults

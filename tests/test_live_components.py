@@ -34,6 +34,7 @@ from cbrs.sim.values import check
 from cbrs.sim.world import open_world
 from cbrs.sparql_service import EndpointConfig
 from tests.helpers_roslibjs import needs_roslibjs, node_command
+from tests.test_rosapi_typedefs import cbrs_types, mismatches
 
 TOKEN = "live-components-test-token"
 SVC, HOME, REQ = PREFIXES["svc"], PREFIXES["home"], PREFIXES["req"]
@@ -151,7 +152,12 @@ def test_a_component_that_stops_renewing_its_lease_lapses(server: Server) -> Non
     kb = server.kb
     with BridgeClient(url(server), TOKEN) as client:  # registers, provides, but sends no heartbeat
         client.provide("/thermometer07/read", "cbrs_msgs/RoomTemperature", lambda request: READING)
-        client.call_sync("/cbrs/register", {"description": thermometer(), "ttl": 0.3})
+        registered = client.call_sync("/cbrs/register", {"description": thermometer(), "ttl": 0.3})
+        beat = client.call_sync("/cbrs/heartbeat", {})  # one beat, then none
+        assert registered["components"] == beat["components"] == [THERMOMETER]
+        types = cbrs_types()  # the replies are what rosapi's typedefs say (tests/test_rosapi_typedefs.py)
+        assert mismatches(types.response("cbrs/Register"), registered) == []
+        assert mismatches(types.response("cbrs/Heartbeat"), beat) == []
         assert kb.liveness.states()[THERMOMETER].live
         assert eventually(lambda: not kb.liveness.states()[THERMOMETER].live)
         assert kb.liveness.states()[THERMOMETER].reason == "its lease lapsed"
@@ -307,7 +313,8 @@ def test_rosout_carries_the_servers_log_and_rosapi_describes_the_bridge(
         details = listener.call_sync("/rosapi/node_details", {"node": "/cbrs_rosbridge"})
         assert "/rosout" in details["publishing"] and "/cbrs/register" in details["services"]
         assert listener.call_sync("/rosapi/service_node", {"service": "/cbrs/register"}) == {"node": "/cbrs_rosbridge"}
-        assert listener.call_sync("/rosapi/message_details", {"type": "rosgraph_msgs/Log"}) == {"typedefs": []}
+        log = listener.call_sync("/rosapi/message_details", {"type": "rosgraph_msgs/Log"})["typedefs"]
+        assert log[0]["type"] == "rosgraph_msgs/Log" and mismatches(log, record) == []  # what /rosout sends
         raw = listener.call_sync("/rosapi/topics_and_raw_types", {})
         assert "/rosout" in raw["topics"] and len(raw["typedefs_full_text"]) == len(raw["topics"])
 

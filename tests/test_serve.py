@@ -26,6 +26,7 @@ from websockets.exceptions import InvalidStatus
 from websockets.sync.client import ClientConnection, connect
 from websockets.typing import Origin
 
+from cbrs.bridge_services import TOPICS
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import expand
 from cbrs.reasoner.matchmaker import Matchmaker
@@ -34,6 +35,7 @@ from cbrs.sparql_service import EndpointConfig
 from tests.conftest import OxigraphServer
 from tests.helpers_seeded import put_quads, seeded_quads
 from tests.helpers_threads import assert_threads_end
+from tests.test_rosapi_typedefs import cbrs_types, mismatches
 
 WAIT = 10.0
 TOKEN = "serve-test-token"
@@ -141,7 +143,7 @@ def test_plan_service_plans_and_records_the_plan(server: Server) -> None:
 
 def test_run_task_streams_progress_and_ends_succeeded(server: Server) -> None:
     with bridge(server) as watcher, bridge(server, TOKEN) as caller:
-        for topic in ("/cbrs/task_progress", "/cbrs/lifecycle", "/cbrs/events"):
+        for topic in ("/cbrs/task_progress", "/cbrs/lifecycle", "/cbrs/events", "/cbrs/task"):
             watcher.send(json.dumps({"op": "subscribe", "topic": topic}))
         time.sleep(0.2)  # let the subscriptions land before the run starts
         response = call(caller, "/cbrs/run_task", {"task": "RobotArmServeACup", "seed": 1}, timeout=120)
@@ -163,6 +165,10 @@ def test_run_task_streams_progress_and_ends_succeeded(server: Server) -> None:
     finished = [m["msg"] for m in heard if m["topic"] == "/cbrs/events"]
     ending = {"event": "run_finished", "run": run["id"], "task": "RobotArmServeACup", "status": run["status"]}
     assert finished[-1] == ending
+    types = cbrs_types()  # every message and the reply are what rosapi's typedefs say
+    assert mismatches(types.response("cbrs/RunTask"), run) == []
+    assert {"/cbrs/task_progress", "/cbrs/lifecycle", "/cbrs/events"} <= {m["topic"] for m in heard} <= set(TOPICS)
+    assert [p for m in heard for p in mismatches(types.message(TOPICS[m["topic"]]), m["msg"], m["topic"])] == []
 
 
 def test_run_task_without_waiting_then_status_and_one_at_a_time(server: Server) -> None:
@@ -183,6 +189,7 @@ def test_run_task_without_waiting_then_status_and_one_at_a_time(server: Server) 
     assert bad_fault["result"] is False and "NoSuchThing" in str(bad_fault["values"])
     assert status["status"] == "succeeded"
     assert any(e.get("event") == "step_succeeded" for e in status["events"])
+    assert mismatches(cbrs_types().response("cbrs/TaskStatus"), status) == []
 
 
 def test_update_over_http_is_announced_on_the_bridge(server: Server) -> None:

@@ -58,6 +58,12 @@ def run_client(port: int, token: str) -> dict[str, Any]:
         time.sleep(0.05)
     found["steps"] = steps
     found["progress"] = sum(1 for p in progress if p["event"] == "step_succeeded")
+    found["heard"] = progress
+    found["run_reply"] = run
+    # the typedefs a form-building tool reads (roslibpy's blocking rosapi calls)
+    found["match_request"] = ros.get_service_request_details("cbrs/Match")["typedefs"]
+    found["run_response"] = ros.get_service_response_details("cbrs/RunTask")["typedefs"]
+    found["progress_details"] = ros.get_message_details("cbrs/TaskProgress")["typedefs"]
     ros.close()
     return found
 
@@ -93,6 +99,14 @@ def test_roslibpy_uses_the_knowledge_base_services(served: tuple[int, Any]) -> N
     assert found["best"] == best
     assert found["run"] == "succeeded"
     assert found["progress"] == found["steps"] > 0
+    from tests.test_rosapi_typedefs import cbrs_types, mismatches  # here: the child runs this file as a script
+
+    types = cbrs_types()  # roslibpy reads the typedefs, and what it was sent is what they say
+    assert found["match_request"] == types.request("cbrs/Match")
+    assert found["run_response"] == types.response("cbrs/RunTask")
+    assert found["progress_details"] == types.message("cbrs/TaskProgress")
+    assert mismatches(found["run_response"], found["run_reply"]) == []
+    assert [m for message in found["heard"] for m in mismatches(found["progress_details"], message)] == []
 
 
 @pytest.mark.skipif(NODE is None, reason="node is not installed (roslibjs runs on node >= 20)")

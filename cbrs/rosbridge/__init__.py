@@ -32,7 +32,8 @@ The Python API the rest of cbrs uses::
 
 Any other exception in a handler fails the call with ``internal error: <type>: <message>`` and is
 logged. ``await bridge.serve(host, port)`` serves in the running event loop instead, until cancelled.
-``bridge.params`` is the thread-safe parameter store rosapi's ``get_param``/``set_param`` use.
+``bridge.params`` is the thread-safe parameter store rosapi's ``get_param``/``set_param`` use;
+``bridge.interfaces.load(directory, package)`` reads ``.msg``/``.srv`` files for rosapi's typedefs.
 ``remove_service``, ``remove_action``, ``topics()``, ``services()`` and ``actions()`` complete the server
 side. Logging goes to the ``cbrs.rosbridge`` logger.
 """
@@ -40,6 +41,7 @@ side. Logging goes to the ``cbrs.rosbridge`` logger.
 from cbrs.rosbridge.bridge import Bridge
 from cbrs.rosbridge.errors import ProtocolError, RosbridgeError, ServiceError, UnknownTopicError
 from cbrs.rosbridge.goals import GoalHandle, GoalResult, GoalStatus
+from cbrs.rosbridge.interfaces import InterfaceError, Interfaces
 from cbrs.rosbridge.params import ParamStore
 from cbrs.rosbridge.server import RunningBridge, serve, start
 from cbrs.rosbridge.session import Caller, current_caller
@@ -50,6 +52,8 @@ __all__ = [
     "GoalHandle",
     "GoalResult",
     "GoalStatus",
+    "InterfaceError",
+    "Interfaces",
     "ParamStore",
     "ProtocolError",
     "RosbridgeError",

@@ -22,6 +22,7 @@ from cbrs.rosbridge.calls import Call, Calls, run_handler
 from cbrs.rosbridge.errors import ProtocolError, RosbridgeError, UnknownTopicError
 from cbrs.rosbridge.goals import ActionHandler, Goal, Goals, GoalStatus
 from cbrs.rosbridge.graph import Action, Graph, Handler, Service, Topic
+from cbrs.rosbridge.interfaces import Interfaces
 from cbrs.rosbridge.params import ParamStore
 from cbrs.rosbridge.protocol import LEVELS, Message, MessageId
 from cbrs.rosbridge.session import Session
@@ -119,8 +120,11 @@ class Bridge:
         self.non_finite = protocol.check_non_finite(non_finite)
         self.reserved = tuple(protocol.resolve(prefix) for prefix in reserved)
         self.params = ParamStore(params)
+        self.interfaces = Interfaces()
+        """The message and service types rosapi describes: add a package's with ``interfaces.load``."""
         self._graph = Graph()
-        for name, (kind, handler) in rosapi.services(self._graph, self.params, self.non_finite).items():
+        services = rosapi.services(self._graph, self.params, self.non_finite, self.interfaces)
+        for name, (kind, handler) in services.items():
             self._graph.services[name] = Service(name, kind, handler, inline=True)
         self._loop: asyncio.AbstractEventLoop | None = None
         self._calls: Calls | None = None

@@ -15,6 +15,7 @@ from typing import Any
 
 from cbrs.rosbridge.errors import ServiceError
 from cbrs.rosbridge.graph import Graph, Handler
+from cbrs.rosbridge.interfaces import Interfaces
 from cbrs.rosbridge.params import ParamStore
 from cbrs.rosbridge.protocol import finite, json_type
 
@@ -42,8 +43,13 @@ def _decoded(text: str, what: str) -> Any:
         raise ServiceError(f"{what} must be JSON-encoded (e.g. '3', '\"text\"', '[1, 2]'), not {text!r}") from None
 
 
-def services(graph: Graph, params: ParamStore, non_finite: str = "null") -> dict[str, tuple[str, Handler]]:
-    """rosapi service name -> (type, handler); parameter values' NaNs written as ``non_finite`` says."""
+def services(
+    graph: Graph, params: ParamStore, non_finite: str = "null", interfaces: Interfaces | None = None
+) -> dict[str, tuple[str, Handler]]:
+    """rosapi service name -> (type, handler); parameter values' NaNs written as ``non_finite`` says; the
+    details services describe the types in ``interfaces`` (others get no typedef, as rosapi answers a
+    type it cannot load)."""
+    known = interfaces if interfaces is not None else Interfaces()
 
     def encoded(value: Any) -> str:
         return json.dumps(value if non_finite == "tokens" else finite(value))
@@ -146,12 +152,17 @@ def services(graph: Graph, params: ParamStore, non_finite: str = "null") -> dict
         return {
             "topics": [name for name, _ in listed],
             "types": [kind for _, kind in listed],
-            "typedefs_full_text": ["" for _ in listed],  # the bridge's messages are JSON with no .msg file
+            "typedefs_full_text": [known.full_text(kind) for _, kind in listed],
         }
 
-    def no_typedefs(args: dict[str, Any]) -> dict[str, Any]:
-        _text(args, "type")
-        return {"typedefs": []}  # JSON messages: no ROS message definitions to describe
+    def message_details(args: dict[str, Any]) -> dict[str, Any]:
+        return {"typedefs": known.message(_text(args, "type"))}
+
+    def request_details(args: dict[str, Any]) -> dict[str, Any]:
+        return {"typedefs": known.request(_text(args, "type"))}
+
+    def response_details(args: dict[str, Any]) -> dict[str, Any]:
+        return {"typedefs": known.response(_text(args, "type"))}
 
     def action_servers(_: dict[str, Any]) -> dict[str, Any]:
         return {"action_servers": [name for name, _ in graph.action_list()]}
@@ -161,9 +172,9 @@ def services(graph: Graph, params: ParamStore, non_finite: str = "null") -> dict
         "/rosapi/service_node": ("rosapi/ServiceNode", service_node),
         "/rosapi/service_providers": ("rosapi/ServiceProviders", service_providers),
         "/rosapi/topics_and_raw_types": ("rosapi/TopicsAndRawTypes", topics_and_raw_types),
-        "/rosapi/message_details": ("rosapi/MessageDetails", no_typedefs),
-        "/rosapi/service_request_details": ("rosapi/ServiceRequestDetails", no_typedefs),
-        "/rosapi/service_response_details": ("rosapi/ServiceResponseDetails", no_typedefs),
+        "/rosapi/message_details": ("rosapi/MessageDetails", message_details),
+        "/rosapi/service_request_details": ("rosapi/ServiceRequestDetails", request_details),
+        "/rosapi/service_response_details": ("rosapi/ServiceResponseDetails", response_details),
         "/rosapi/action_servers": ("rosapi/GetActionServers", action_servers),
         "/rosapi/topics": ("rosapi/Topics", topics),
         "/rosapi/publishers": ("rosapi/Publishers", publishers),

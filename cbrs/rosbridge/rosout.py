@@ -9,12 +9,15 @@ from __future__ import annotations
 
 import logging
 import threading
+from importlib.resources import files
 
 from cbrs.rosbridge.bridge import Bridge
 
 __all__ = ["ROSOUT", "RosoutHandler"]
 
 ROSOUT = "/rosout"
+#: The definitions of /rosout's message type and the header it uses, for rosapi's message_details.
+INTERFACES = files("cbrs.rosbridge") / "definitions"
 _LEVELS = ((logging.CRITICAL, 16), (logging.ERROR, 8), (logging.WARNING, 4), (logging.INFO, 2))
 
 
@@ -26,6 +29,8 @@ class RosoutHandler(logging.Handler):
         self.bridge = bridge
         self._inside = threading.local()
         bridge.add_topic(ROSOUT, "rosgraph_msgs/Log")
+        for package in ("std_msgs", "rosgraph_msgs"):  # Log uses std_msgs/Header
+            bridge.interfaces.load(INTERFACES / package, package)
 
     def emit(self, record: logging.LogRecord) -> None:
         if getattr(self._inside, "busy", False):
