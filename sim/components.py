@@ -98,6 +98,9 @@ TAKING = frozenset({ACT + "ApproachToObject", ACT + "HandingOverOntoPlatform"})
 LOCALISATION_TOLERANCE = 0.10
 """A localisation is believed (isLocalisedIn holds) when it agrees with the base's odometry within this
 distance (m)."""
+LOADING_SLACK = 0.01
+"""The plan's loading check refuses an object only if no arm could load it this far from where it is
+believed to be either (the cameras' estimates of one object differ by millimetres to a centimetre)."""
 ARM_TIE = 0.01
 """Two arms whose mounts are within 1 cm as far from a target reach it equally well."""
 SETTLE_DISTANCE = 0.03
@@ -1742,10 +1745,28 @@ class SimEnvironment:
                 support = smap.things.get(obj.support or "") if obj is not None else None
                 if obj is None or support is None or support.dock is None:
                     continue
+                estimate, model, dock = self._estimate(obj, support), Manipulation.of(obj).model, _dock(support)
                 try:
-                    _who_loads(self.context, self._estimate(obj, support), Manipulation.of(obj).model, _dock(support))
+                    _who_loads(self.context, estimate, model, dock)
                 except (SkillFailed, MovesRefusedError) as refused:
-                    raise CannotLoadError(step.component, obj.iri, str(refused)) from None
+                    if not self._loads_nearby(estimate, model, dock):
+                        raise CannotLoadError(step.component, obj.iri, str(refused)) from None
+
+    def _loads_nearby(self, estimate: ObjectEstimate, model: ObjectModel, dock: Pose2D) -> bool:
+        """Whether some arm could load the object were it LOADING_SLACK away from where it is believed to be
+        (in x or y): the hand-over decides again from the camera's estimate, and a refusal at the believed
+        centre alone is no refusal of the task. The pen at the edge of the right arm's planning, refused at
+        (8.1015, 3.3317) before the run, was loaded from the Kinect's (8.0973, 3.3273) 6 mm away (the
+        perturbation benchmark's world seed 19)."""
+        for dx, dy in ((LOADING_SLACK, 0.0), (-LOADING_SLACK, 0.0), (0.0, LOADING_SLACK), (0.0, -LOADING_SLACK)):
+            moved = replace(estimate, x=estimate.x + dx, y=estimate.y + dy)
+            try:
+                _who_loads(self.context, moved, model, dock)
+            except (SkillFailed, MovesRefusedError):
+                continue
+            log.info("loading check: the %s loads %+.3f, %+.3f m from where it is believed to be", model.name, dx, dy)
+            return True
+        return False
 
     def _check_sight(self, plan: Plan, values: Mapping[str, Any]) -> None:
         """Refuse a plan whose recognition step would look for an object the task gives (or whose tracking
