@@ -205,8 +205,10 @@ class LiveComponents:
             raise ServiceError(
                 f"field 'description' must be the description as text (Turtle or JSON-LD), not {json_type(description)}"
             )
-        fmt = args.get("format", "turtle")
+        fmt = args.get("format") or "turtle"  # "" and 0 are what a client built from the typedefs sends unset
         ttl = args.get("ttl", self.ttl)
+        if ttl == 0 and not isinstance(ttl, bool):
+            ttl = self.ttl
         if isinstance(ttl, bool) or not isinstance(ttl, int | float) or not 0.1 <= ttl <= 3600:
             raise ServiceError(f"field 'ttl' must be a number of seconds from 0.1 to 3600, not {ttl!r}")
         try:

@@ -163,6 +163,16 @@ def test_a_component_that_stops_renewing_its_lease_lapses(server: Server) -> Non
         assert kb.liveness.states()[THERMOMETER].reason == "its lease lapsed"
 
 
+def test_a_registration_with_unset_fields_as_a_ros_client_sends_them_takes_the_defaults(server: Server) -> None:
+    """A form built from cbrs/Register's typedef sends "" and 0 for the format and lease it leaves unset."""
+    with BridgeClient(url(server), TOKEN) as client:
+        client.provide("/thermometer07/read", "cbrs_msgs/RoomTemperature", lambda request: READING)
+        registered = client.call_sync("/cbrs/register", {"description": thermometer(), "format": "", "ttl": 0})
+        assert registered == {"components": [THERMOMETER], "ttl": server.live.ttl}
+        with pytest.raises(RemoteCallError, match="ttl"):
+            client.call_sync("/cbrs/register", {"description": thermometer(), "ttl": 0.01})
+
+
 def test_heartbeats_keep_a_short_lease_alive(server: Server) -> None:
     kb = server.kb
     with sdk_thermometer().connect(url(server), TOKEN, heartbeat=0.1, ttl=0.5):
