@@ -459,15 +459,26 @@ def _check_grounded(kb: KnowledgeBase, index: TaxonomyIndex, plan: Plan) -> None
         for parameter in requirement.inputs:
             if parameter.type and _missing(kb, index, placed, parameter.type):
                 raise UnresolvedDesignatorError(parameter.type)
+    produced = {kind for step in plan.steps for _, kind in step.outputs if kind}
     for goal in plan.goals:
         statement = goal.statement
         if statement is None:
             continue
         for concept in (statement.subject, statement.object):
+            if _produced(index, produced, concept):
+                continue  # a step of the plan answers one (a scale's weight): it is made, not found
             if _missing(kb, index, placed, concept):
                 rows = kb.select("things_elsewhere", {"class": concept})
                 elsewhere = [(row["thing"].value, row["graph"].value) for row in rows]
                 raise UngroundedGoalError(statement_text(statement), concept, elsewhere)
+
+
+def _produced(index: TaxonomyIndex, produced: set[str], concept: str) -> bool:
+    """Whether a step of the plan outputs a ``concept`` (its class or a subclass): information a step
+    brings into being (a scale's weight, a reading) is no thing the world must hold before the run.
+    Before, a goal about one (a person told an object's weight) was refused as "nothing in the world is
+    one" whenever the map placed some other information entity (the docking poses)."""
+    return any(index.is_a(kind, concept) for kind in produced)
 
 
 def _missing(kb: KnowledgeBase, index: TaxonomyIndex, placed: set[str], concept: str) -> bool:

@@ -1,0 +1,84 @@
+"""A lab's own device, as docs/components.md's "A lab's own device" runs it: the kitchen scale of
+docs/examples/lab_kitchen_scale.py in a child process, a speaker written with the SDK in this one,
+both registered on a loopback server whose store has the examples' ontology, map and task loaded.
+One run of TellMeMyCupsWeight through /cbrs/run_task: the arm puts the cup on the scale, the scale
+weighs it, and the speaker is told the weight the scale answered."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from cbrs.bridge_client import BridgeClient
+from cbrs.component import Component
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import HOME, PREFIXES
+from cbrs.server import ServeConfig, Server
+from cbrs.sparql_service import EndpointConfig
+from tests.test_live_components import eventually
+
+TOKEN = "lab-kitchen-scale-token"
+EXAMPLES = Path(__file__).resolve().parents[1] / "docs" / "examples"
+LAB = "https://example.org/lab#"
+SCALE = LAB + "WeighObject_KitchenScale01"
+WORLD = PREFIXES["world"]
+
+
+@pytest.fixture(scope="module")
+def server() -> Iterator[Server]:
+    kb = KnowledgeBase.open(":memory:")
+    kb.load([EXAMPLES / "lab_kitchen_scale.ttl"], graph="ontology")
+    kb.load([EXAMPLES / "lab_kitchen_scale.ttl"], graph="map")
+    kb.load([EXAMPLES / "lab_tell_me_my_cups_weight.ttl"], graph="requirements")
+    endpoint = EndpointConfig(update_token=TOKEN, isolate=False)
+    running = Server(kb, ServeConfig(port=0, bridge_port=0, endpoint=endpoint))
+    running.start()
+    try:
+        yield running
+    finally:
+        running.stop()
+
+
+def test_the_scale_s_weight_is_the_answer_and_reaches_the_speaker(server: Server) -> None:
+    bridge = f"ws://127.0.0.1:{server.bridge_port}"
+    program = [sys.executable, str(EXAMPLES / "lab_kitchen_scale.py"), "--bridge", bridge]
+    program += ["--url", f"http://127.0.0.1:{server.http_port}"]
+    scale = subprocess.Popen(program, env={**os.environ, "CBRS_UPDATE_TOKEN": TOKEN}, stderr=subprocess.PIPE)
+    heard: list[dict[str, Any]] = []
+    speaker = Component((EXAMPLES / "lab_living_room_speaker.ttl").read_text(encoding="utf-8"))
+
+    @speaker.handler
+    def announce(request: dict[str, Any]) -> dict[str, Any]:
+        heard.append(request)
+        return {}
+
+    try:
+        states = server.kb.liveness.states
+        assert eventually(lambda: SCALE in states() and states()[SCALE].live, 20.0), "the scale never registered"
+        with speaker.connect(bridge, TOKEN), BridgeClient(bridge, TOKEN, timeout=120.0) as client:
+            run = client.call_sync("/cbrs/run_task", {"task": "TellMeMyCupsWeight"}, timeout=120.0)
+    finally:
+        scale.terminate()
+        _, errors = scale.communicate(timeout=10)
+    assert scale.returncode == 0, errors.decode()
+    assert run["status"] == "succeeded", run
+    result = run["result"]
+    components = [step["component"] for step in result["plan"]["steps"]]
+    weighing = components.index(SCALE)
+    assert components.index(PREFIXES["svc"] + "PutDownObject_CytonDualArm01") < weighing
+    assert components.index(LAB + "AnnounceWeight_LivingRoomSpeaker01") > weighing
+    (mass,) = [row["value"].value for row in server.kb.select("map_facts") if _is_cup_mass(row)]
+    (answer,) = result["answers"]
+    assert answer["component"] == SCALE
+    assert answer["value"] == {"@type": HOME + "ObjectWeight", "object": WORLD + "Cup", "grams": float(mass) * 1000}
+    assert heard == [{"weight": answer["value"], "listener": {"@id": WORLD + "Person", "@type": HOME + "Person"}}]
+
+
+def _is_cup_mass(row: Any) -> bool:
+    return bool(row["thing"].value == WORLD + "Cup" and row["property"].value == HOME + "massKg")
