@@ -9,6 +9,7 @@ import importlib
 import json
 import os
 import re
+import shlex
 import sys
 import traceback
 from collections import Counter
@@ -460,38 +461,42 @@ _UPDATE_START = re.compile(
 
 
 @cli.command()
-@click.argument("file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.argument("files", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False, path_type=Path))
 @click.option(
     "--update",
     is_flag=True,
-    help="Bring the store in line with FILE: replace the descriptions of its advertisements already "
-    "registered and register the others (one transaction). An OWL-S FILE is converted as cbrs load "
+    help="Bring the store in line with the FILES: replace the descriptions of their advertisements already "
+    "registered and register the others (one transaction). An OWL-S file is converted as cbrs load "
     "converts it, and replaces what an earlier load of it gave.",
 )
 @click.option("--json", "as_json", is_flag=True, help='Print {"registered": [IRI...], "updated": [IRI...]} as JSON.')
 @pass_app
-def register(app: App, file: Path, update: bool, as_json: bool) -> None:
-    """Register the advertisements in a Turtle FILE (or RDF/XML, JSON-LD, N-Triples; checked first; one
-    transaction)."""
-    text = file.read_bytes()
+def register(app: App, files: tuple[Path, ...], update: bool, as_json: bool) -> None:
+    """Register the advertisements in Turtle FILES (or RDF/XML, JSON-LD, N-Triples; all checked first; one
+    transaction: a bad file registers none of them)."""
+    inputs = [(file.read_bytes(), str(file)) for file in files]
     if update:
-        done = app.kb.registry.synced(text, str(file))
+        synced = app.kb.registry.synced_all(inputs)
+        registered = [iri for done in synced for iri in done.registered]
+        updated = [iri for done in synced for iri in done.updated]
         if as_json:
-            click.echo(json.dumps({"registered": sorted(done.registered), "updated": sorted(done.updated)}, indent=2))
+            click.echo(json.dumps({"registered": sorted(registered), "updated": sorted(updated)}, indent=2))
             return
-        for iri in sorted(done.registered + done.updated):
-            click.echo(f"{'registered' if iri in done.registered else 'updated'} {shorten(iri)}")
-        if done.conversion is not None:  # an OWL-S file: what cbrs load of it says besides its counts
-            for item in done.conversion.files:
-                if item.repairs:
-                    click.echo(f"read {item.source}{_mended(item)}")
-            for line in _load_summary(done.conversion, app.kb.store):
-                click.echo(line)
+        for iri in sorted(registered + updated):
+            click.echo(f"{'registered' if iri in registered else 'updated'} {shorten(iri)}")
+        for done in synced:
+            if done.conversion is not None:  # an OWL-S file: what cbrs load of it says besides its counts
+                for item in done.conversion.files:
+                    if item.repairs:
+                        click.echo(f"read {item.source}{_mended(item)}")
+                for line in _load_summary(done.conversion, app.kb.store):
+                    click.echo(line)
         return
     try:
-        iris = app.kb.registry.register(text, str(file))
-    except AlreadyRegisteredError as error:  # some of the file's may be registered, some not: --update does both
-        raise click.ClickException(f"{error}: cbrs register --update {file}") from error
+        iris = app.kb.registry.register_all(inputs)
+    except AlreadyRegisteredError as error:  # some of the files' may be registered, some not: --update does both
+        again = " ".join(shlex.quote(str(file)) for file in files)
+        raise click.ClickException(f"{error}: cbrs register --update {again}") from error
     if as_json:
         click.echo(json.dumps({"registered": list(iris), "updated": []}, indent=2))
         return

@@ -3,7 +3,7 @@ advertisements, each as one transaction on the services graph."""
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -54,7 +54,25 @@ class ComponentRegistry:
         or in another graph (:class:`OutsideRegistryError`: ``cbrs load`` of a file that declares classes
         puts its descriptions into graph:ontology), where a second description would be read merged
         with the first (two OWLS models' inputs and outputs, both QoS values), before anything is written."""
-        quads, iris = self._parse(turtle, source)
+        return self.register_all([(turtle, source)])
+
+    def register_all(self, inputs: Sequence[tuple[str | bytes, str]]) -> list[str]:
+        """:meth:`register` for several inputs, each ``(text, source)``, in one transaction: every one is
+        checked before anything is written, so a bad file registers none of the others (a lab's component
+        and the devices it needs, in files of their own). An advertisement two inputs describe is
+        refused (:class:`InvalidDescriptionError` naming the second): read together, its two
+        descriptions would merge."""
+        quads: list[ox.Quad] = []
+        iris: list[str] = []
+        first: dict[str, str] = {}
+        for turtle, source in inputs:
+            these, named = self._parse(turtle, source)
+            for iri in named:
+                if iri in first:
+                    raise _described_twice(iri, first[iri], source)
+                first[iri] = source
+            quads.extend(these)
+            iris.extend(named)
         for iri in iris:
             if self._types(iri):  # an advertisement, or another resource of the graph (a device) by that IRI
                 raise AlreadyRegisteredError(iri)
@@ -93,19 +111,33 @@ class ComponentRegistry:
         is replaced by what it gives now: what ``cbrs deregister`` of each and ``cbrs load FILE`` did in
         several transactions, of which a failed load left the services deregistered. Its report says what
         the conversion noted, as a load of the file would (``cbrs register --update`` prints it)."""
-        conversion: list[LoadReport] = []
-        quads, iris = self._parse(turtle, source, owls=True, conversion=conversion)
-        added = []
-        for iri in iris:
-            if self.is_registered(iri):
-                continue
-            if self._types(iri):
-                raise AlreadyRegisteredError(iri)  # a device of graph:services by that IRI: not the file's to replace
-            self._refuse_elsewhere(iri)
-            added.append(iri)
-        updated = [iri for iri in iris if iri not in added]
-        self._write(quads, updated)
-        return Synced(added, updated, conversion[0] if conversion else None)
+        return self.synced_all([(turtle, source)])[0]
+
+    def synced_all(self, inputs: Sequence[tuple[str | bytes, str]]) -> list[Synced]:
+        """:meth:`synced` for several inputs, each ``(text, source)``, in one transaction (all or none),
+        one :class:`Synced` per input; an advertisement two inputs describe is refused, as by
+        :meth:`register_all`."""
+        quads: list[ox.Quad] = []
+        done: list[Synced] = []
+        first: dict[str, str] = {}
+        for turtle, source in inputs:
+            conversion: list[LoadReport] = []
+            these, iris = self._parse(turtle, source, owls=True, conversion=conversion)
+            added = []
+            for iri in iris:
+                if iri in first:
+                    raise _described_twice(iri, first[iri], source)
+                first[iri] = source
+                if self.is_registered(iri):
+                    continue
+                if self._types(iri):
+                    raise AlreadyRegisteredError(iri)  # a device by that IRI: not the file's to replace
+                self._refuse_elsewhere(iri)
+                added.append(iri)
+            quads.extend(these)
+            done.append(Synced(added, [iri for iri in iris if iri not in added], conversion[0] if conversion else None))
+        self._write(quads, [iri for synced in done for iri in synced.updated])
+        return done
 
     def _refuse_elsewhere(self, iri: str) -> None:
         """Raise :class:`OutsideRegistryError` when another graph holds an advertisement by ``iri``."""
@@ -499,3 +531,13 @@ def _node(role: str, node: object, fields: dict[str, list[ox.NamedNode | ox.Blan
     if isinstance(node, ox.NamedNode) and not is_skolem(node):
         return f"the {role} {shorten(node.value)}"
     return f"{'an' if role[0] in 'aeiou' else 'a'} {role}"
+
+
+def _described_twice(iri: str, first: str, source: str) -> InvalidDescriptionError:
+    return InvalidDescriptionError(
+        source,
+        [
+            f"it describes {shorten(iri)}, which {first} describes too: registered together, the two "
+            "descriptions would be read as one; keep one of them"
+        ],
+    )
