@@ -30,7 +30,6 @@ from cbrs.kb.semantic_map import SemanticMap
 from cbrs.server import ServeConfig, Server
 from cbrs.sim.components import SimEnvironment
 from cbrs.sim.world import open_world
-from cbrs.sim_sensors import offer_cameras
 from cbrs.sparql_service import EndpointConfig
 
 __all__ = ["IN_USE", "ExternalRun", "run_external_demo"]
@@ -71,8 +70,7 @@ def run_external_demo(
     server.start()
     try:
         url = f"ws://127.0.0.1:{server.bridge_port}"
-        with open_world(seed=seed, semantic_map=SemanticMap.read(kb)) as world:
-            offer_cameras(server.bridge, world)
+        with open_world(seed=seed, semantic_map=SemanticMap.read(kb)) as world, server.sensors.watching(world):
             environment = {**os.environ, "CBRS_UPDATE_TOKEN": token}
             for camera in sorted(components):
                 command = [sys.executable, "-m", "cbrs.external_camera", camera, "--url", url]

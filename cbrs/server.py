@@ -25,6 +25,7 @@ from cbrs.matchmakers import Matchmakers
 from cbrs.rosbridge import Bridge
 from cbrs.rosbridge.rosout import RosoutHandler
 from cbrs.settings import setting
+from cbrs.sim_sensors import SimSensors
 from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.stop_signals import StopRequest, handling
 from cbrs.tasks import TaskRunner
@@ -97,6 +98,9 @@ class Server:
         self.bridge.strict_results(self.live.holds)  # and its `result: false` is a failure, values or not
         self._rosout = RosoutHandler(self.bridge)
         self.tasks.transport = self._own_bridge
+        self.sensors = SimSensors()  # /sim/capture, /sim/load: a run's world as devices' hardware
+        self.sensors.offer(self.bridge)
+        self.tasks.sensors = self.sensors
         self._transport: BridgeClient | None = None
         self.app = create_app(self.sparql, self.config.cors_origins, self.tasks, self.matchmakers, self.own_origins)
         self.app.extensions["cbrs.live"] = self.live

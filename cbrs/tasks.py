@@ -18,6 +18,7 @@ import threading
 import time
 from collections import OrderedDict
 from collections.abc import Callable, Iterable
+from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
@@ -30,6 +31,7 @@ if TYPE_CHECKING:
     from cbrs.actions.events import Event
     from cbrs.actions.remote import Transport
     from cbrs.actions.runner import RunResult
+    from cbrs.sim_sensors import SimSensors
 
 log = logging.getLogger("cbrs.tasks")
 
@@ -164,6 +166,9 @@ class TaskRunner:
         self._ids = itertools.count(1)
         self.transport: Callable[[], Transport | None] | None = None
         """How a run reaches components in other processes (the server's own bridge connection)."""
+        self.sensors: SimSensors | None = None
+        """The simulation's sensors on the bridge (``/sim/capture``, ``/sim/load``): they answer from each
+        run's world while it runs."""
 
     def subscribe(self, listener: Listener) -> Callable[[], None]:
         """Call ``listener(topic, message)`` for every event of every run; returns the unsubscribe call."""
@@ -335,7 +340,7 @@ class TaskRunner:
                 composer = Composer(self.kb)
                 _ = composer.pool  # built now, under the lock
                 semantic_map = SemanticMap.read(self.kb)
-            with open_world(seed=run.seed, semantic_map=semantic_map) as world:
+            with open_world(seed=run.seed, semantic_map=semantic_map) as world, self._sensing(world):
                 self._capture(world, run.id)
                 environment = SimEnvironment(world, self.kb, self.transport() if self.transport else None)
                 policy = RandomFaults(run.seed, run.fault_rate) if run.fault_rate > 0 else None
@@ -369,6 +374,10 @@ class TaskRunner:
             run.finished = time.time()
             run.done.set()
             self._emit(RUN_TOPIC, {"event": "run_finished", "run": run.id, "task": run.task, "status": run.status})
+
+    def _sensing(self, world: Any) -> AbstractContextManager[Any]:
+        """The simulation's sensors answering from ``world`` for the run (none offered: nothing to do)."""
+        return self.sensors.watching(world) if self.sensors is not None else nullcontext()
 
     def _capture(self, world: Any, run_id: str | None) -> None:
         """Take the camera's view of ``world`` as the latest frame (a camera failure only costs the frame)."""

@@ -30,6 +30,7 @@ from cbrs.sim.errors import (
     UnknownAlgorithmError,
     UnknownColourError,
     UnknownEntityError,
+    UnknownPlaceError,
     WorldClosedError,
 )
 from cbrs.sim.geometry import Pose2D, Pose3D, Region
@@ -77,6 +78,7 @@ __all__ = [
     "UnknownAlgorithmError",
     "UnknownColourError",
     "UnknownEntityError",
+    "UnknownPlaceError",
     "WorldClosedError",
     "build_occupancy_grid",
     "compute_grasp_pose",

@@ -30,6 +30,18 @@ class UnknownEntityError(SimulationError):
         super().__init__(f"no entity named {name!r}; known: {', '.join(self.known)}")
 
 
+class UnknownPlaceError(SimulationError, ValueError):
+    """A place to weigh (``sim.load``) that is neither a body of the home nor a thing of its map with an
+    extent."""
+
+    def __init__(self, place: str) -> None:
+        self.place = place
+        super().__init__(
+            f"nothing of the simulated home is named {place!r}: name a body (a table, the tray) or a place of"
+            " the map with an extent (a scale's plate, a region), by its IRI or its local name"
+        )
+
+
 class ImageSizeError(SimulationError, ValueError):
     """An image size for a camera that is not two positive whole numbers of pixels."""
 

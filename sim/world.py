@@ -38,6 +38,7 @@ from cbrs.sim.quiet import quiet_output
 from cbrs.sim.scene import bundled_map
 
 __all__ = [
+    "GRAVITY",
     "SETTLE_NOTICE",
     "SOLVER_RESIDUAL",
     "TIME_STEP",
@@ -54,6 +55,8 @@ SETTLE_NOTICE = 0.005
 was built in, after the seed moved them together) is said so in the log and in ``HomeWorld.settled``:
 resting objects move less than 1 mm as they settle."""
 
+GRAVITY = 9.81
+"""m/s², downwards: what a load cell divides the force it measures by (``sim.load``)."""
 TIME_STEP = 1.0 / 240.0
 """Physics step (s): pybullet's default, at which the Panda's controllers and contacts are stable."""
 SOLVER_RESIDUAL = 1e-5
@@ -612,7 +615,7 @@ class HomeWorld:
             solverResidualThreshold=self.solver_residual,
             physicsClientId=c,
         )
-        p.setGravity(0.0, 0.0, -9.81, physicsClientId=c)
+        p.setGravity(0.0, 0.0, -GRAVITY, physicsClientId=c)
         p.setAdditionalSearchPath(PYBULLET_DATA, physicsClientId=c)
         if self.gui:
             p.configureDebugVisualizer(p.COV_ENABLE_GUI, 0, physicsClientId=c)
