@@ -6,6 +6,7 @@ weighs it, and the speaker is told the weight the scale answered."""
 
 from __future__ import annotations
 
+import importlib.util
 import os
 import subprocess
 import sys
@@ -15,6 +16,7 @@ from typing import Any
 
 import pytest
 
+from cbrs.actions.remote_errors import RemoteCallError
 from cbrs.bridge_client import BridgeClient
 from cbrs.component import Component
 from cbrs.kb import KnowledgeBase
@@ -48,14 +50,16 @@ def server() -> Iterator[Server]:
 def test_the_scale_s_weight_is_the_answer_and_reaches_the_speaker(server: Server) -> None:
     bridge = f"ws://127.0.0.1:{server.bridge_port}"
     program = [sys.executable, str(EXAMPLES / "lab_kitchen_scale.py"), "--bridge", bridge]
-    program += ["--url", f"http://127.0.0.1:{server.http_port}"]
     scale = subprocess.Popen(program, env={**os.environ, "CBRS_UPDATE_TOKEN": TOKEN}, stderr=subprocess.PIPE)
     heard: list[dict[str, Any]] = []
+    plate: list[dict[str, Any]] = []  # what the simulation's load cell under the plate read meanwhile
     speaker = Component((EXAMPLES / "lab_living_room_speaker.ttl").read_text(encoding="utf-8"))
+    sensor = BridgeClient(bridge, TOKEN)
 
     @speaker.handler
     def announce(request: dict[str, Any]) -> dict[str, Any]:
         heard.append(request)
+        plate.append(sensor.call_sync("/sim/load", {"place": LAB + "KitchenScale01Plate"}))
         return {}
 
     try:
@@ -64,6 +68,7 @@ def test_the_scale_s_weight_is_the_answer_and_reaches_the_speaker(server: Server
         with speaker.connect(bridge, TOKEN), BridgeClient(bridge, TOKEN, timeout=120.0) as client:
             run = client.call_sync("/cbrs/run_task", {"task": "TellMeMyCupsWeight"}, timeout=120.0)
     finally:
+        sensor.close()
         scale.terminate()
         _, errors = scale.communicate(timeout=10)
     assert scale.returncode == 0, errors.decode()
@@ -76,8 +81,40 @@ def test_the_scale_s_weight_is_the_answer_and_reaches_the_speaker(server: Server
     (mass,) = [row["value"].value for row in server.kb.select("map_facts") if _is_cup_mass(row)]
     (answer,) = result["answers"]
     assert answer["component"] == SCALE
-    assert answer["value"] == {"@type": HOME + "ObjectWeight", "object": WORLD + "Cup", "grams": float(mass) * 1000}
-    assert heard == [{"weight": answer["value"], "listener": {"@id": WORLD + "Person", "@type": HOME + "Person"}}]
+    weight = answer["value"]
+    assert weight == {"@type": HOME + "ObjectWeight", "object": WORLD + "Cup", "grams": weight["grams"]}
+    # the scale read the physics (/sim/load), not the map: the plate bore the cup, and the reading is the
+    # load its contacts bear (the simulated cup weighs its map mass and its 1 g water surface)
+    (reading,) = plate
+    assert reading["resting"] == [WORLD + "Cup"]
+    assert weight["grams"] == round(reading["load_kg"] * 1000, 1) == pytest.approx(float(mass) * 1000, rel=0.01)
+    assert heard == [{"weight": weight, "listener": {"@id": WORLD + "Person", "@type": HOME + "Person"}}]
+
+
+def test_the_scale_refuses_an_empty_plate_and_another_plate() -> None:
+    program = _example("lab_kitchen_scale")
+    weigh = program.weigher(lambda: 0.04)  # the load cell reads next to nothing
+    cup = {"object": {"@id": WORLD + "Cup"}, "plate": {"@id": program.PLATE}}
+    with pytest.raises(program.EmptyPlateError, match=r"reads 0\.0 g: nothing is on it"):
+        weigh(cup)
+    with pytest.raises(ValueError, match="not on urn:other-plate"):
+        program.weigher(lambda: 150.0)({**cup, "plate": {"@id": "urn:other-plate"}})
+    assert program.weigher(lambda: 150.04)(cup)["weight"]["grams"] == 150.0
+
+
+def test_the_simulation_s_sensors_answer_only_while_a_world_runs(server: Server) -> None:
+    with BridgeClient(f"ws://127.0.0.1:{server.bridge_port}", TOKEN) as client:
+        for service, args in (("/sim/load", {"place": "KitchenTable"}), ("/sim/capture", {"camera": "Kinect01"})):
+            with pytest.raises(RemoteCallError, match="no simulated home is running"):
+                client.call_sync(service, args)
+
+
+def _example(name: str) -> Any:
+    spec = importlib.util.spec_from_file_location(name, EXAMPLES / f"{name}.py")
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
 
 
 def _is_cup_mass(row: Any) -> bool:

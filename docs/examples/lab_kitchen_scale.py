@@ -1,59 +1,70 @@
 """A kitchen scale as a cbrs component of its own process (docs/components.md, "A lab's own device").
 
 It registers docs/examples/lab_weigh_object.ttl over the bridge and answers /kitchen_scale_01/weigh
-with the weight of the object the plan put on its plate. The simulated home has no load cell, so this
-stand-in reads the object's home:massKg from the server's map (GET /store, one graph, matched by
-pattern: nothing of the request goes into a query). A real scale reads its load cell here instead.
+with what its plate bears. Its load cell is the simulation's: ``/sim/load`` on the same bridge (the
+simulated home's sensor service, answered from the physics of the run going on, docs/components.md
+"The simulation's sensors"). A real scale reads its own load cell in ``read_plate`` instead. An empty
+plate is no weight: the call fails saying so, and the run re-plans or fails naming the scale.
 
-    CBRS_UPDATE_TOKEN=secret python docs/examples/lab_kitchen_scale.py \
-        [--bridge ws://127.0.0.1:9090] [--url http://127.0.0.1:8080]
+    CBRS_UPDATE_TOKEN=secret python docs/examples/lab_kitchen_scale.py [--bridge ws://127.0.0.1:9090]
 """
 
 from __future__ import annotations
 
 import argparse
 import os
-import urllib.parse
-import urllib.request
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-import pyoxigraph as ox
-
+from cbrs.bridge_client import BridgeClient
 from cbrs.component import Component
 
 HERE = Path(__file__).resolve().parent
-MAP_GRAPH = "https://w3id.org/cbrs/graph/map"
-MASS = ox.NamedNode("https://w3id.org/cbrs/home#massKg")
+PLATE = "https://example.org/lab#KitchenScale01Plate"
+"""The scale's own plate (docs/examples/lab_kitchen_scale.ttl): what its load cell is under."""
+LOAD_SERVICE = "/sim/load"
+EMPTY_BELOW = 1.0
+"""Grams: a reading below this is an empty plate (the scale's resolution)."""
 
 
-def mass_of(server: str, thing: str) -> float:
-    """The object's mass as the server's map states it; raises when the map states none."""
-    query = urllib.parse.urlencode({"graph": MAP_GRAPH})
-    request = urllib.request.Request(f"{server}/store?{query}", headers={"Accept": "application/n-triples"})
-    with urllib.request.urlopen(request, timeout=5) as answer:
-        triples = ox.parse(answer.read(), format=ox.RdfFormat.N_TRIPLES)
-    for triple in triples:
-        if triple.subject == ox.NamedNode(thing) and triple.predicate == MASS:
-            return float(triple.object.value)
-    raise LookupError(f"the map states no home:massKg of <{thing}>: nothing to read off the scale")
+class EmptyPlateError(Exception):
+    """The plate bears nothing to weigh; keeps the reading in grams."""
+
+    def __init__(self, grams: float) -> None:
+        self.grams = grams
+        super().__init__(f"the plate reads {grams:.1f} g: nothing is on it to weigh")
 
 
-def scale(server: str) -> Component:
-    component = Component((HERE / "lab_weigh_object.ttl").read_text(encoding="utf-8"))
+def read_plate(sensor: BridgeClient) -> float:
+    """Grams on the plate, from the load cell (here: the simulation's, through the bridge)."""
+    reading = sensor.call_sync(LOAD_SERVICE, {"place": PLATE})
+    return float(reading["load_kg"]) * 1000.0
 
-    @component.handler
+
+def weigher(read: Callable[[], float]) -> Callable[[dict[str, Any]], dict[str, Any]]:
+    """The handler: the weight of what stands on the plate, answered for the object the plan put there."""
+
     def weigh(request: dict[str, Any]) -> dict[str, Any]:
-        thing = request["object"]["@id"]  # the designator the plan sends: {"@id": ..., "@type": ...}
-        grams = round(mass_of(server, thing) * 1000.0, 1)
-        return {"weight": {"@type": "home:ObjectWeight", "object": thing, "grams": grams}}
+        plate = request.get("plate", {}).get("@id", PLATE)  # the designators the plan sends: {"@id", "@type"}
+        if plate != PLATE:
+            raise ValueError(f"this scale weighs on {PLATE}, not on {plate}")
+        grams = round(read(), 1)
+        if grams < EMPTY_BELOW:
+            raise EmptyPlateError(grams)
+        return {"weight": {"@type": "home:ObjectWeight", "object": request["object"]["@id"], "grams": grams}}
 
-    return component
+    return weigh
+
+
+def run(bridge: str, token: str | None) -> None:
+    component = Component((HERE / "lab_weigh_object.ttl").read_text(encoding="utf-8"))
+    with BridgeClient(bridge, token) as sensor:
+        component.handler(weigher(lambda: read_plate(sensor)))
+        component.run(bridge, token=token)
 
 
 if __name__ == "__main__":
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--bridge", default="ws://127.0.0.1:9090", help="the bridge of cbrs serve")
-    parser.add_argument("--url", default="http://127.0.0.1:8080", help="the HTTP base URL of cbrs serve")
-    options = parser.parse_args()
-    scale(options.url).run(options.bridge, token=os.environ.get("CBRS_UPDATE_TOKEN"))
+    run(parser.parse_args().bridge, os.environ.get("CBRS_UPDATE_TOKEN"))
