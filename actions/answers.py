@@ -18,8 +18,15 @@ read against the effects as well (docs/execution.md, "An answer that contradicts
   says less, not otherwise), nor is a class the store does not know: nothing proves it is not the
   effect's, so the step is believed as before and the answer noted (:attr:`Reading.unknown`).
 
+An answer may also *designate* a thing of the world (``{"@id": ..., "@type": ...}``), and its ``@type`` is
+the component's word only. A thing the semantic map states classes of is checked against them
+(:func:`check_designation`): one of them must be the answered class or below it (so, as the type check
+already asked that of the answered class, of the port's), or the answer points at the wrong thing, the
+pen for a weight, and is refused with :class:`WrongThingError`. A thing the map does not know, or
+states no class of, is taken on the component's word, as before.
+
 The store's classes are read by two named queries (``subclasses``, ``taxonomy_disjoint``), once, at the
-first answer that needs them.
+first answer that needs them; a designated thing's by ``map_types``, once per thing.
 """
 
 from __future__ import annotations
@@ -28,11 +35,22 @@ from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
+from pyoxigraph import NamedNode
+
 from cbrs.actions.errors import ActionsError
 from cbrs.kb import KnowledgeBase, Statement
 from cbrs.kb.namespaces import expand, shorten
 
-__all__ = ["CONTRADICTIONS", "Classes", "ContradictedEffectError", "Reading", "StoreClasses", "read_answer"]
+__all__ = [
+    "CONTRADICTIONS",
+    "Classes",
+    "ContradictedEffectError",
+    "Reading",
+    "StoreClasses",
+    "WrongThingError",
+    "check_designation",
+    "read_answer",
+]
 
 CONTRADICTIONS = ("fail", "warn")
 """What a run does with an answer that contradicts its step's effect (setting ``remote_contradictions``):
@@ -66,6 +84,34 @@ class ContradictedEffectError(ActionsError):
             f" {shorten(effect.object)}; nothing of the answer is believed (a handler that could not act should"
             " raise instead; docs/execution.md)"
         )
+
+
+class WrongThingError(ActionsError, ValueError):
+    """A remote answer designates a thing the store knows as no instance of the class answered: the pen
+    as a weight. Keeps the port's class, the thing, the class answered and the thing's stated classes;
+    a ``ValueError``, so the answer check fails the step that produced it (``actions.remote``)."""
+
+    def __init__(self, concept: str, thing: str, answered: str, classes: Iterable[str]) -> None:
+        self.concept, self.thing, self.answered = concept, thing, answered
+        self.classes = tuple(sorted(classes))
+        stated = ", ".join(shorten(c) for c in self.classes)
+        super().__init__(
+            f"it designates {shorten(thing)}, a {stated} by the store's map and no {shorten(answered)}: a value of"
+            f' {shorten(concept)} was expected, not another thing (docs/execution.md, "An answer that points at'
+            ' the wrong thing")'
+        )
+
+
+def check_designation(concept: str, value: Any, classes: StoreClasses) -> None:
+    """Refuse (:class:`WrongThingError`) a checked value of port class ``concept`` that designates a
+    thing of the map stated to be of no class at or below its ``@type`` (the module's rule)."""
+    if not isinstance(value, dict) or not isinstance(value.get("@id"), str):
+        return
+    thing, answered = value["@id"], _class_of(value)
+    stated = classes.classes_of(thing)
+    if answered is None or not stated or any(classes.is_a(c, answered) for c in stated):
+        return
+    raise WrongThingError(concept, thing, answered, stated)
 
 
 def _text(statement: Statement) -> str:
@@ -120,6 +166,7 @@ class StoreClasses:
     kb: KnowledgeBase
     _up: dict[str, frozenset[str]] | None = field(default=None, repr=False)
     _declared: dict[str, set[str]] = field(default_factory=dict, repr=False)
+    _things: dict[str, frozenset[str]] = field(default_factory=dict, repr=False)
 
     def _read(self) -> dict[str, frozenset[str]]:
         if self._up is None:
@@ -135,6 +182,14 @@ class StoreClasses:
 
     def known(self, concept: str) -> bool:
         return concept in self._read()
+
+    def classes_of(self, thing: str) -> frozenset[str]:
+        """The classes the semantic map's graph states ``thing`` is (none for a thing it does not hold)."""
+        found = self._things.get(thing)
+        if found is None:
+            rows = self.kb.select("map_types", {"thing": NamedNode(thing)})
+            found = self._things[thing] = frozenset(row["type"].value for row in rows)
+        return found
 
     def is_a(self, concept: str, superclass: str) -> bool:
         return concept == superclass or superclass in self._read().get(concept, ())

@@ -27,7 +27,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
-from cbrs.actions.answers import StoreClasses
+from cbrs.actions.answers import StoreClasses, check_designation
 from cbrs.actions.belief import Observation
 from cbrs.actions.breaker import BreakerPolicy, passed_over
 from cbrs.actions.components import Component, Registry, Status
@@ -1538,7 +1538,9 @@ def _remote(transport: Transport, service: str, ad: Advertisement, calls: _Remot
     exclusive = ad.kind == CBRS.PhysicalManipulationComponent
 
     def checked(concept: str, value: Any) -> dict[str, Any]:
-        return check(concept, value, calls.classes.is_a)
+        found = check(concept, value, calls.classes.is_a)
+        check_designation(concept, found, calls.classes)  # the pen answered as a weight
+        return found
 
     return lambda iri: RemoteComponent(
         iri,
