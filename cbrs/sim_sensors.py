@@ -153,5 +153,8 @@ class SimSensors:
     def _present(self) -> HomeWorld:
         world = self._world
         if world is None or world.closed:
-            raise ServiceError("no simulated home is running: the simulation's sensors answer while a task runs")
+            raise ServiceError(
+                "no simulated home is running on this server: its sensors answer during its own task runs (the"
+                " tasks page, /cbrs/run_task), not during a cbrs run in another process"
+            )
         return world
