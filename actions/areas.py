@@ -3,12 +3,16 @@
 A step that acts on or perceives a thing of the task must use a component whose SEA covers where that
 thing is: a ceiling camera over the bedroom cannot find a pen on the kitchen table. The things are the
 requirement's inputs that name something the world graph places (the belief's perceived position when
-composing for a run, else the semantic map's); a step's things are those of the inputs it is given,
-directly or through the steps that feed it (the pen's colour feature leads the recogniser to the pen).
-A component with no SEA model is effective everywhere. The comparison's parts are matchmaking's
-(``reasoner.sea``: an area concept covers the rooms at or below it by is-a or has-part links; boxes hold
-or overlap); docs/composition.md says why rooms come before boxes here, and why no step need cover the
-task's whole area.
+composing for a run, else the semantic map's). A step's things are those of the inputs it is given
+directly, and those a value another step derived from them is about, when that value leads to the thing:
+a thing itself (a place), where it is (spatial data) or how to recognise it (a feature) is what a
+component perceives or acts on the thing with (the pen's colour feature leads the recogniser to the
+pen); other information only tells the step about it (a speaker given the weight a scale measured of
+the cup need not be where the cup is). ``Leads`` decides by the taxonomy, from the classes
+``ComposeConfig.area_informs`` and ``area_leads`` name. A component with no SEA model is effective
+everywhere. The comparison's parts are matchmaking's (``reasoner.sea``: an area concept covers the
+rooms at or below it by is-a or has-part links; boxes hold or overlap); docs/composition.md says why
+rooms come before boxes here, and why no step need cover the task's whole area.
 """
 
 from __future__ import annotations
@@ -16,6 +20,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
+from cbrs.actions.errors import ActionsError
 from cbrs.kb import Advertisement, EffectiveArea, KnowledgeBase, Requirement
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import PREFIXES, shorten
@@ -127,6 +132,42 @@ def _bounds(values: Mapping[str, str]) -> Bounds | None:
     return None
 
 
+class UnknownAreaClassError(ActionsError):
+    """``ComposeConfig.area_informs`` or ``area_leads`` names a class the store's taxonomy does not hold."""
+
+    http_status = 400
+
+    def __init__(self, concept: str) -> None:
+        self.concept = concept
+        super().__init__(
+            f"ComposeConfig.area_informs or area_leads names {concept}, which is no class of the taxonomy: "
+            "correct it or load the ontology that declares it"
+        )
+
+
+@dataclass(frozen=True)
+class Leads:
+    """Which values a step is given lead it to the thing they were derived from: those of a class at or
+    below one of ``leads``, or at or below none of ``informs`` (what only informs of a thing)."""
+
+    index: TaxonomyIndex
+    informs: tuple[str, ...]
+    leads: tuple[str, ...]
+
+    def __post_init__(self) -> None:
+        for concept in (*self.informs, *self.leads):  # a misspelt class would silently change every plan
+            if concept not in self.index:
+                raise UnknownAreaClassError(concept)
+
+    def __call__(self, concept: str | None) -> bool:
+        """Whether a value of class ``concept`` (None: untyped, so unknown) leads to its thing."""
+        if not concept:
+            return True
+        if any(self.index.is_a(concept, c) for c in self.leads):
+            return True
+        return not any(self.index.is_a(concept, c) for c in self.informs)
+
+
 class AreaRule:
     """Which components may serve a step, by the things it handles and the task's own area.
 
@@ -141,8 +182,10 @@ class AreaRule:
         places: Mapping[str, Whereabouts],
         task: EffectiveArea | None,
         boxes: bool = False,
+        leads: Leads | None = None,
     ) -> None:
         self.index = index
+        self.leads = leads or Leads(index, (), ())  # by default every value leads to its thing
         self.places = dict(places)
         self.task = task
         self.boxes = boxes
@@ -151,6 +194,11 @@ class AreaRule:
     def relevant(self, advertisements: Iterable[Advertisement]) -> bool:
         """Whether the rule can refuse any of ``advertisements`` (if not, composition need not ask it)."""
         return any(self.why_not(ad, self.places) is not None for ad in advertisements)
+
+    def passes_on(self, concept: str | None) -> bool:
+        """Whether a step given a value as a ``concept`` (its input's class) must be where the things the
+        value is about are: it leads to them, rather than only informing of them (docs/composition.md)."""
+        return self.leads(concept)
 
     def why_not(self, ad: Advertisement | None, things: Iterable[str]) -> str | None:
         """Why ``ad`` cannot serve a step handling ``things`` (requirement input names); None: it can."""
@@ -196,4 +244,4 @@ def area_text(area: EffectiveArea) -> str:
     return "; ".join(parts) or "unstated"
 
 
-__all__ = ["AreaRule", "Whereabouts", "WorldPlaces", "area_text"]
+__all__ = ["AreaRule", "Leads", "UnknownAreaClassError", "Whereabouts", "WorldPlaces", "area_text"]

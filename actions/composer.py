@@ -29,7 +29,7 @@ from typing import TYPE_CHECKING, Any
 
 import pyoxigraph as ox
 
-from cbrs.actions.areas import AreaRule, WorldPlaces
+from cbrs.actions.areas import AreaRule, Leads, WorldPlaces
 from cbrs.actions.extraction import Extraction, Objective
 from cbrs.actions.graph import (
     SRI,
@@ -44,7 +44,7 @@ from cbrs.actions.plan import Binding, Plan, PlanStep, Source
 from cbrs.actions.search import SearchTrace, bidirectional_search
 from cbrs.actions.unmet import Unsatisfied
 from cbrs.kb import Advertisement, KnowledgeBase, Requirement, Statement
-from cbrs.kb.namespaces import GraphName, shorten
+from cbrs.kb.namespaces import PREFIXES, GraphName, shorten
 from cbrs.kb.shapes import nearest_term
 from cbrs.reasoner.config import MatchConfig
 from cbrs.reasoner.degrees import Degree, degree_of_match
@@ -74,6 +74,10 @@ class ComposeConfig:
     respect_area: bool = True
     # ... compared by their rooms when both name one; with area_boxes, by bounding boxes first (matchmaking's order)
     area_boxes: bool = False
+    # a step given a value derived from a thing must be where the thing is when the value leads to it: unless
+    # the value's class is at or below one of area_informs and none of area_leads (docs/composition.md)
+    area_informs: tuple[str, ...] = (PREFIXES["home"] + "InformationEntity",)
+    area_leads: tuple[str, ...] = (PREFIXES["home"] + "SpatialData", PREFIXES["home"] + "Feature")
 
 
 class PlanStatus(Enum):
@@ -372,7 +376,8 @@ class Composer:
         if self._state is not None:  # composing: kept for its other attempts
             self._places = world
         places = world.locate(self.kb, self.index, requirement, parameter_names(requirement.inputs))
-        rule = AreaRule(self.index, places, requirement.area, self.config.area_boxes)
+        leads = Leads(self.index, self.config.area_informs, self.config.area_leads)
+        rule = AreaRule(self.index, places, requirement.area, self.config.area_boxes, leads)
         return rule if rule.relevant(self.advertisements) else None
 
     def _world_places(self) -> WorldPlaces:

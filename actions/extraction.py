@@ -77,7 +77,7 @@ class Extraction:
         self.max_steps = max_steps
         self.areas = areas
         self._judged: dict[tuple[str, tuple[str, ...]], _Judged] = {}  # see _judge
-        self._things: dict[int, frozenset[str]] = {}  # see _handled
+        self._things: dict[int, frozenset[str]] = {}  # see _about
         self._explained: set[str] = set()  # vertices whose blocked needs _why has followed
         self._best: dict[tuple[str, str], dict[str, Edge]] = {}  # see _best_from
         self.steps: dict[int, _Step] = {}
@@ -368,18 +368,23 @@ class Extraction:
         """``_judge`` once every provider of ``vertex``'s needs has been judged."""
         assert self.areas is not None
         things: set[str] = set()
+        bound: set[str] = set()  # those of its things it must be where they are (see _handled)
         for need, given, below, providers in self._ways(vertex, about):
             if given is not None:
                 if need.role == "input":
                     things.add(given.offer.name)
+                    bound.add(given.offer.name)
                 continue
             fit = [e for e in providers if self._judged[(e.source, below)].why is None]
             if not fit:
                 why = f"no provider of its {need.text()} is effective where it is needed"
                 return _Judged(frozenset(things), why, need)
             if need.role == "input":
-                things |= self._judged[(min(fit, key=self._key).source, below)].things
-        why_not = self.areas.why_not(self.graph.vertices[vertex].advertisement, things)
+                fed = self._judged[(min(fit, key=self._key).source, below)].things
+                things |= fed
+                if self.areas.passes_on(need.concept):
+                    bound |= fed
+        why_not = self.areas.why_not(self.graph.vertices[vertex].advertisement, bound)
         return _Judged(frozenset(things), why_not)
 
     def _pass_over(self, step: _Step, node: str, need: Need, candidates: list[Edge], about: tuple[str, ...]) -> None:
@@ -419,8 +424,23 @@ class Extraction:
             self.unsatisfied.append(Unsatisfied(bound.need.text(), node, chain, out_of_area=((step.node, why),)))
 
     def _handled(self, step_id: int) -> frozenset[str]:
-        """The requirement inputs whose things ``step_id`` handles: those it is given, directly or through
-        the steps that feed its inputs (on a stack of its own: a plan can be thousands of steps deep)."""
+        """The requirement inputs whose things ``step_id`` handles, so must be effective where they are:
+        those it is given directly, and those its other inputs are about when the input's class leads to
+        its thing (``AreaRule.passes_on``: a position, a feature; not a weight, which only informs)."""
+        assert self.areas is not None
+        inputs = [b for b in self.steps[step_id].bindings if b.need.role == "input"]
+        found: set[str] = set()
+        for b in inputs:
+            if b.source is None:
+                found.add(b.edge.offer.name)
+            elif self.areas.passes_on(b.need.concept):
+                found |= self._about(b.source)
+        return frozenset(found)
+
+    def _about(self, step_id: int) -> frozenset[str]:
+        """The requirement inputs whose things the values ``step_id`` puts out are about: those it is given,
+        directly or through the steps that feed its inputs, whatever their class (a grasp pose computed
+        from a pen's grasp type is the pen's). On a stack of its own: a plan can be thousands of steps deep."""
         stack = [step_id]
         while stack:
             current = stack[-1]

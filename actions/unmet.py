@@ -78,7 +78,8 @@ class Unsatisfied:
         if self.out_of_area:
             return (
                 "register a component that provides it whose effective area (cbrs:hasSEAModel) covers the things "
-                "named, or compose without the area rule (ComposeConfig.respect_area)"
+                "named, or compose without the area rule (cbrs plan or cbrs run --ignore-areas; "
+                "ComposeConfig(respect_area=False) from Python)"
             )
         if self.consumer == SRI:
             return "correct the input's cbrs:parameterType"

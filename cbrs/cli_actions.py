@@ -35,6 +35,15 @@ from cbrs.task_names import task_iri
 if TYPE_CHECKING:
     from cbrs.bridge_client import BridgeClient
 
+_IGNORE_AREAS = click.option(  # cbrs plan and cbrs run alike
+    "--ignore-areas",
+    is_flag=True,
+    help=(
+        "Compose without the service effective area rule: any component may serve a step, wherever the"
+        " task's things are (ComposeConfig.respect_area off)."
+    ),
+)
+
 
 @click.command()
 @click.argument("task")
@@ -53,8 +62,11 @@ if TYPE_CHECKING:
     help="Choose providers by highest similarity (cost breaks ties) or by lowest cost.",
 )
 @click.option("--no-store", is_flag=True, help="Do not record the plan in the plans graph.")
+@_IGNORE_AREAS
 @pass_app
-def plan(app: App, task: str, as_json: bool, drawing: Path | None, objective: str, no_store: bool) -> None:
+def plan(
+    app: App, task: str, as_json: bool, drawing: Path | None, objective: str, no_store: bool, ignore_areas: bool
+) -> None:
     """Compose a plan for TASK: a requirement or action (req:FetchMyPen, act:RobotArmServeACup, or a bare name).
 
     Exits with status 1 when no plan exists, after saying which need no component meets.
@@ -62,7 +74,7 @@ def plan(app: App, task: str, as_json: bool, drawing: Path | None, objective: st
     if drawing is not None and drawing.suffix.lower() not in (".svg", ".png"):
         raise click.BadParameter(f"{drawing.name!r} must end in .svg or .png", param_hint="--draw")
     requested = task_iri(app.kb, task)  # a name that names no task is refused before the composer reads the store
-    composer = Composer(app.kb, ComposeConfig(objective=Objective(objective)))
+    composer = Composer(app.kb, ComposeConfig(objective=Objective(objective), respect_area=not ignore_areas))
     result = composer.compose(requested)
     if result.plan is not None and not no_store:
         try:
@@ -194,6 +206,7 @@ def _source(binding: Binding) -> str:
         " each captioned with the step; also draws the paths top-down to FILE-path.png."
     ),
 )
+@_IGNORE_AREAS
 @pass_app
 def run(
     app: App,
@@ -207,6 +220,7 @@ def run(
     bridge: str | None,
     as_json: bool,
     record: Path | None,
+    ignore_areas: bool,
 ) -> None:
     """Plan TASK, then execute it in the simulated home, step by step, failing over where needed.
 
@@ -261,6 +275,7 @@ def run(
                 iri,
                 environment,
                 failing,
+                composer=Composer(app.kb, ComposeConfig(respect_area=False)) if ignore_areas else None,
                 on_event=follow,
                 fault_policy=policy,
                 replan_policy=ReplanPolicy(max_repeats=repeat_failures),
