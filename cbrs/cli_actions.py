@@ -435,6 +435,7 @@ def run_text(result: RunResult, sim_seconds: float, wall_seconds: float) -> str:
     elif result.goals and all(goal.holds for goal in result.goals if goal.holds is not None):
         checked = sum(1 for goal in result.goals if goal.holds is not None)
         verdict += f"; {checked} goal(s) confirmed in the world" if checked else ""
+        verdict += _unchecked_text(result) if result.executed else ""
     failovers = sum(1 for s in report.steps if s.failed_over)
     timing = f"{sim_seconds:.1f} s simulated, {wall_seconds:.1f} s wall, {failovers} failover(s)"
     timing += f", {len(result.replans)} re-plan(s)" if result.replans else ""
@@ -442,6 +443,20 @@ def run_text(result: RunResult, sim_seconds: float, wall_seconds: float) -> str:
     if not report.steps:  # every effect held already: no table of no steps
         steps = "nothing to do: every effect of the task holds already"
     return f"{header}{steps}\n{verdict}; {timing}{_answers_text(result)}{_unused_note(result.composition)}"
+
+
+def _unchecked_text(result: RunResult) -> str:
+    """The goals nothing could check, said as such: a goal about a relation the environment has no test
+    for (a lab's ``isInformedOf``) read as plainly "succeeded" as one the world confirmed."""
+    unchecked = [goal for goal in result.goals if goal.holds is None]
+    if not unchecked:
+        return ""
+    said = "; ".join(
+        statement_text(goal.statement)
+        + (": the robots believe it" if goal.believed else ": nothing checked it, its step's effect says it")
+        for goal in unchecked
+    )
+    return f"; {len(unchecked)} goal(s) the world cannot check ({said})"
 
 
 def _answers_text(result: RunResult) -> str:

@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 from collections.abc import Mapping
 from concurrent.futures import Future
+from dataclasses import replace
 from typing import Any
 
 import pytest
@@ -14,9 +15,9 @@ from markupsafe import escape
 
 from cbrs.actions.composer import Composer
 from cbrs.actions.executor import ExecutionReport, RunStatus, StepReport
-from cbrs.actions.runner import Answer, RunResult, run_task
+from cbrs.actions.runner import Answer, GoalCheck, RunResult, run_task
 from cbrs.cli_actions import run_text
-from cbrs.kb import KnowledgeBase
+from cbrs.kb import KnowledgeBase, Statement
 from cbrs.kb.namespaces import HOME
 from cbrs.sparql_service import SparqlService
 from cbrs.tasks import TaskRun, TaskRunner
@@ -168,3 +169,19 @@ def test_only_the_task_s_own_outputs_are_answers(bundled_kb: KnowledgeBase, task
     report = ExecutionReport(task, RunStatus.SUCCEEDED, [StepReport(s.index, s.component) for s in plan.steps])
     report.outputs = gave
     assert [a.name for a in RunResult(composition, report).answers] == answered
+
+
+def test_a_goal_the_world_cannot_check_is_said_so_not_passed_over(lab_kb: KnowledgeBase) -> None:
+    """A lab's goal (a person informed of a weight) has no test in the environment: ``holds`` is None. The
+    verdict said "succeeded" as for a goal the world confirmed, with no word that nothing checked it."""
+    result = _run(lab_kb, Answering())
+    told = Statement(HOME + "Person", "https://example.org/lab#isInformedOf", HOME + "ObjectWeight")
+    near = Statement(HOME + "MobileRobot", HOME + "isNear", HOME + "Person")
+    verdict = run_text(replace(result, goals=(GoalCheck(near, True, True), GoalCheck(told, True, None))), 0.0, 0.0)
+    assert "succeeded; 1 goal(s) confirmed in the world; 1 goal(s) the world cannot check" in verdict
+    assert "(home:Person, https://example.org/lab#isInformedOf, home:ObjectWeight): the robots believe it" in verdict
+    unknown = run_text(replace(result, goals=(GoalCheck(told, None, None),)), 0.0, 0.0)
+    assert "cannot check ((home:Person, https://example.org/lab#isInformedOf, home:ObjectWeight): nothing" in unknown
+    assert "cannot check" not in run_text(replace(result, goals=(GoalCheck(near, True, True),)), 0.0, 0.0)
+    refuted = run_text(replace(result, goals=(GoalCheck(near, True, False), GoalCheck(told, None, None))), 0.0, 0.0)
+    assert "does not hold" in refuted and "cannot check" not in refuted  # a refuted run says only that
