@@ -8,11 +8,12 @@ directly, and those a value another step derived from them is about, when that v
 a thing itself (a place), where it is (spatial data) or how to recognise it (a feature) is what a
 component perceives or acts on the thing with (the pen's colour feature leads the recogniser to the
 pen); other information only tells the step about it (a speaker given the weight a scale measured of
-the cup need not be where the cup is). ``Leads`` decides by the taxonomy, from the classes
-``ComposeConfig.area_informs`` and ``area_leads`` name. A component with no SEA model is effective
-everywhere. The comparison's parts are matchmaking's (``reasoner.sea``: an area concept covers the
-rooms at or below it by is-a or has-part links; boxes hold or overlap); docs/composition.md says why
-rooms come before boxes here, and why no step need cover the task's whole area.
+the cup need not be where the cup is). ``Leads`` decides by the taxonomy, from the classes the store
+marks with ``cbrs:areaRole`` (or ``ComposeConfig.area_informs`` and ``area_leads`` name). A component
+with no SEA model is effective everywhere. The comparison's parts are matchmaking's (``reasoner.sea``:
+an area concept covers the rooms at or below it by is-a or has-part links; boxes hold or overlap);
+docs/composition.md says why rooms come before boxes here, and why no step need cover the task's whole
+area.
 """
 
 from __future__ import annotations
@@ -133,39 +134,53 @@ def _bounds(values: Mapping[str, str]) -> Bounds | None:
 
 
 class UnknownAreaClassError(ActionsError):
-    """``ComposeConfig.area_informs`` or ``area_leads`` names a class the store's taxonomy does not hold."""
+    """A class marked with an area role (``cbrs:areaRole`` in the store, or ``ComposeConfig.area_informs`` /
+    ``area_leads``) is no class of the store's taxonomy, or a mark is no role."""
 
     http_status = 400
 
-    def __init__(self, concept: str) -> None:
+    def __init__(self, concept: str, why: str = "which is no class of the taxonomy") -> None:
         self.concept = concept
         super().__init__(
-            f"ComposeConfig.area_informs or area_leads names {concept}, which is no class of the taxonomy: "
+            f"an area role (cbrs:areaRole, or ComposeConfig.area_informs / area_leads) marks {concept}, {why}: "
             "correct it or load the ontology that declares it"
         )
 
 
+LEADS = PREFIXES["cbrs"] + "LeadsToThing"
+INFORMS = PREFIXES["cbrs"] + "InformsOfThing"
+
+
 @dataclass(frozen=True)
 class Leads:
-    """Which values a step is given lead it to the thing they were derived from: those of a class at or
-    below one of ``leads``, or at or below none of ``informs`` (what only informs of a thing)."""
+    """Which values a step is given lead it to the thing they were derived from, by the classes marked
+    with a role (``roles``: class -> :data:`LEADS` or :data:`INFORMS`): a value's class takes the role of
+    its nearest marked classes (a mark below another wins), leading when any of those leads; a class
+    below no mark leads (the rule that ties a step to more things is the safe one)."""
 
     index: TaxonomyIndex
-    informs: tuple[str, ...]
-    leads: tuple[str, ...]
+    roles: Mapping[str, str]
+
+    @classmethod
+    def of(cls, index: TaxonomyIndex, informs: Iterable[str], leads: Iterable[str]) -> Leads:
+        """The rule from two lists of marked classes (``ComposeConfig.area_informs`` and ``area_leads``)."""
+        return cls(index, {**{c: INFORMS for c in informs}, **{c: LEADS for c in leads}})
 
     def __post_init__(self) -> None:
-        for concept in (*self.informs, *self.leads):  # a misspelt class would silently change every plan
+        for concept, role in self.roles.items():  # a misspelt class would silently change every plan
             if concept not in self.index:
                 raise UnknownAreaClassError(concept)
+            if role not in (LEADS, INFORMS):
+                why = f"with {shorten(role)}, which is no area role (cbrs:LeadsToThing or cbrs:InformsOfThing)"
+                raise UnknownAreaClassError(concept, why)
 
     def __call__(self, concept: str | None) -> bool:
         """Whether a value of class ``concept`` (None: untyped, so unknown) leads to its thing."""
         if not concept:
             return True
-        if any(self.index.is_a(concept, c) for c in self.leads):
-            return True
-        return not any(self.index.is_a(concept, c) for c in self.informs)
+        marked = [c for c in self.roles if self.index.is_a(concept, c)]
+        nearest = [c for c in marked if not any(o != c and self.index.is_a(o, c) for o in marked)]
+        return not nearest or any(self.roles[c] == LEADS for c in nearest)
 
 
 class AreaRule:
@@ -185,7 +200,7 @@ class AreaRule:
         leads: Leads | None = None,
     ) -> None:
         self.index = index
-        self.leads = leads or Leads(index, (), ())  # by default every value leads to its thing
+        self.leads = leads or Leads(index, {})  # by default every value leads to its thing
         self.places = dict(places)
         self.task = task
         self.boxes = boxes
@@ -244,4 +259,4 @@ def area_text(area: EffectiveArea) -> str:
     return "; ".join(parts) or "unstated"
 
 
-__all__ = ["AreaRule", "Leads", "UnknownAreaClassError", "Whereabouts", "WorldPlaces", "area_text"]
+__all__ = ["INFORMS", "LEADS", "AreaRule", "Leads", "UnknownAreaClassError", "Whereabouts", "WorldPlaces", "area_text"]

@@ -44,7 +44,7 @@ from cbrs.actions.plan import Binding, Plan, PlanStep, Source
 from cbrs.actions.search import SearchTrace, bidirectional_search
 from cbrs.actions.unmet import Unsatisfied
 from cbrs.kb import Advertisement, KnowledgeBase, Requirement, Statement
-from cbrs.kb.namespaces import PREFIXES, GraphName, shorten
+from cbrs.kb.namespaces import GraphName, shorten
 from cbrs.kb.shapes import nearest_term
 from cbrs.reasoner.config import MatchConfig
 from cbrs.reasoner.degrees import Degree, degree_of_match
@@ -74,10 +74,11 @@ class ComposeConfig:
     respect_area: bool = True
     # ... compared by their rooms when both name one; with area_boxes, by bounding boxes first (matchmaking's order)
     area_boxes: bool = False
-    # a step given a value derived from a thing must be where the thing is when the value leads to it: unless
-    # the value's class is at or below one of area_informs and none of area_leads (docs/composition.md)
-    area_informs: tuple[str, ...] = (PREFIXES["home"] + "InformationEntity",)
-    area_leads: tuple[str, ...] = (PREFIXES["home"] + "SpatialData", PREFIXES["home"] + "Feature")
+    # a step given a value derived from a thing must be where the thing is when the value leads to it
+    # (docs/composition.md): None reads which classes lead and which only inform from the store's
+    # cbrs:areaRole marks (home.ttl marks home:InformationEntity, home:SpatialData, home:Feature); lists override
+    area_informs: tuple[str, ...] | None = None
+    area_leads: tuple[str, ...] | None = None
 
 
 class PlanStatus(Enum):
@@ -376,9 +377,18 @@ class Composer:
         if self._state is not None:  # composing: kept for its other attempts
             self._places = world
         places = world.locate(self.kb, self.index, requirement, parameter_names(requirement.inputs))
-        leads = Leads(self.index, self.config.area_informs, self.config.area_leads)
-        rule = AreaRule(self.index, places, requirement.area, self.config.area_boxes, leads)
+        rule = AreaRule(self.index, places, requirement.area, self.config.area_boxes, self.area_roles())
         return rule if rule.relevant(self.advertisements) else None
+
+    def area_roles(self) -> Leads:
+        """Which values given to a step lead it to their thing: the classes ``ComposeConfig.area_informs`` and
+        ``area_leads`` list when set, else those the store marks with ``cbrs:areaRole`` (read each time:
+        a lab's ontology may mark its own classes between compositions)."""
+        informs, leads = self.config.area_informs, self.config.area_leads
+        if informs is not None or leads is not None:
+            return Leads.of(self.index, informs or (), leads or ())
+        roles = {row["class"].value: row["role"].value for row in self.kb.select("area_roles")}
+        return Leads(self.index, roles)
 
     def _world_places(self) -> WorldPlaces:
         """Where things are, read again only when an embedded store has been written since (a remote

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from cbrs.actions.areas import Leads, UnknownAreaClassError
+from cbrs.actions.areas import INFORMS, LEADS, Leads, UnknownAreaClassError
 from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, PlanStatus
 from cbrs.app import App
 from cbrs.cli_actions import plan, run
@@ -159,9 +159,23 @@ def test_what_a_value_that_informs_is_about_still_leads_further() -> None:
     ],
 )
 def test_what_leads_is_read_from_the_taxonomy(kb: KnowledgeBase, concept: str | None, leads: bool) -> None:
-    config = ComposeConfig()
-    rule = Leads(Composer(kb).index, config.area_informs, config.area_leads)
+    rule = Composer(kb).area_roles()  # the store's cbrs:areaRole marks (ontologies/home.ttl)
     assert rule(HOME + concept if concept else None) is leads
+
+
+def test_the_roles_are_the_stores_marks_and_the_nearer_mark_wins(kb: KnowledgeBase) -> None:
+    """A lab marks its own classes in Turtle (``cbrs:areaRole``): a mark below another wins for the classes
+    below it, so a position a lab reads as a figure only (marked to inform) stops tying the step given it."""
+    composer = Composer(kb)
+    assert composer.area_roles().roles == {
+        HOME + "InformationEntity": INFORMS,
+        HOME + "SpatialData": LEADS,
+        HOME + "Feature": LEADS,
+    }
+    marked = Leads(composer.index, {**composer.area_roles().roles, HOME + "ObjectPosition3D": INFORMS})
+    assert not marked(HOME + "ObjectPosition3D") and marked(HOME + "GraspPose")  # a sibling keeps SpatialData's
+    with pytest.raises(UnknownAreaClassError, match="no area role"):
+        Leads(composer.index, {HOME + "Feature": HOME + "Feature"})
 
 
 def test_a_class_the_taxonomy_does_not_hold_is_refused(kb: KnowledgeBase) -> None:
