@@ -13,6 +13,7 @@ heights of the marker and the shirt (calibration knowledge a real system would h
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -114,34 +115,39 @@ def blobs(mask: NDArray[np.bool_]) -> list[tuple[NDArray[np.float64], NDArray[np
     """The 8-connected blobs of a mask as (us, vs) pixel coordinates, the largest first.
 
     Colours are shared: an object of the marker's green or of the person's yellow is a blob of its
-    own, which must not be averaged into what is looked for. Masks hold a few hundred pixels, so a
-    breadth-first walk over them is cheap.
+    own, which must not be averaged into what is looked for.
     """
     vs, us = np.nonzero(mask)
-    label = {(int(v), int(u)): -1 for v, u in zip(vs, us, strict=True)}
-    found: list[list[tuple[int, int]]] = []
-    for start in label:
-        if label[start] >= 0:
+    found = sorted(_connected([(int(v), int(u)) for v, u in zip(vs, us, strict=True)]), key=len, reverse=True)
+    return [(us[group].astype(np.float64), vs[group].astype(np.float64)) for group in map(np.array, found)]
+
+
+def _connected(pixels: Sequence[tuple[int, int]], joined: Callable[[int, int], bool] | None = None) -> list[list[int]]:
+    """The 8-connected groups of ``pixels`` (each (v, u)) as lists of their indices, each in the order a
+    breadth-first walk meets them: two neighbouring pixels ``n`` and ``m`` are of one group when
+    ``joined(n, m)`` (always, when None). Masks hold a few hundred pixels, so the walk is cheap."""
+    index = {pixel: n for n, pixel in enumerate(pixels)}
+    label = [-1] * len(pixels)
+    groups: list[list[int]] = []
+    for first in range(len(pixels)):
+        if label[first] >= 0:
             continue
-        label[start] = len(found)
-        members = [start]
-        index = 0
-        while index < len(members):
-            v, u = members[index]
-            index += 1
+        label[first] = len(groups)
+        members = [first]
+        at = 0
+        while at < len(members):
+            n = members[at]
+            at += 1
+            v, u = pixels[n]
             for dv in (-1, 0, 1):
                 for du in (-1, 0, 1):
-                    key = (v + dv, u + du)
-                    if label.get(key) == -1:
-                        label[key] = len(found)
-                        members.append(key)
-        found.append(members)
-    found.sort(key=len, reverse=True)
-    result = []
-    for members in found:
-        pixels = np.array(members, dtype=np.float64)
-        result.append((pixels[:, 1], pixels[:, 0]))
-    return result
+                    m = index.get((v + dv, u + du))
+                    if m is None or label[m] >= 0 or (joined is not None and not joined(n, m)):
+                        continue
+                    label[m] = len(groups)
+                    members.append(m)
+        groups.append(members)
+    return groups
 
 
 def _mask_of(shape: tuple[int, ...], us: NDArray[np.float64], vs: NDArray[np.float64]) -> NDArray[np.bool_]:
@@ -298,31 +304,13 @@ def _surfaces(
 ) -> list[tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]]:
     """A blob's pixels split into the pieces whose neighbouring pixels' points (8-connected) lie within
     SAME_THING_GAP of each other: the surfaces seen, apart where the depth jumps."""
-    index = {(int(v), int(u)): n for n, (v, u) in enumerate(zip(vs, us, strict=True))}
-    at_pixel = [(int(v), int(u)) for v, u in zip(vs, us, strict=True)]
     xyz = [(float(x), float(y), float(z)) for x, y, z in points]
-    label = [-1] * len(index)
-    pieces: list[list[int]] = []
-    for first in range(len(label)):
-        if label[first] >= 0:
-            continue
-        label[first] = len(pieces)
-        members = [first]
-        at = 0
-        while at < len(members):
-            n = members[at]
-            at += 1
-            (v, u), (x, y, z) = at_pixel[n], xyz[n]
-            for dv in (-1, 0, 1):
-                for du in (-1, 0, 1):
-                    m = index.get((v + dv, u + du))
-                    if m is None or label[m] >= 0:
-                        continue
-                    mx, my, mz = xyz[m]
-                    if max(abs(mx - x), abs(my - y), abs(mz - z)) <= SAME_THING_GAP:
-                        label[m] = len(pieces)
-                        members.append(m)
-        pieces.append(members)
+
+    def near(n: int, m: int) -> bool:
+        (x, y, z), (mx, my, mz) = xyz[n], xyz[m]
+        return max(abs(mx - x), abs(my - y), abs(mz - z)) <= SAME_THING_GAP
+
+    pieces = _connected([(int(v), int(u)) for v, u in zip(vs, us, strict=True)], near)
     if len(pieces) == 1:
         return [(us, vs, points)]
     return [(us[members], vs[members], points[members]) for members in (np.array(p) for p in pieces)]
