@@ -23,7 +23,7 @@ from websockets.sync.client import ClientConnection, connect
 
 from cbrs.actions.remote_errors import RemoteCallError
 
-__all__ = ["BridgeClient", "BridgeClosedError", "HandlerAnswerError", "ServiceHandler"]
+__all__ = ["AdvertiseRefusedError", "BridgeClient", "BridgeClosedError", "HandlerAnswerError", "ServiceHandler"]
 
 log = logging.getLogger("cbrs.bridge_client")
 
@@ -36,6 +36,14 @@ ServiceHandler = Callable[[dict[str, Any]], Mapping[str, Any]]
 
 class BridgeClosedError(ConnectionError):
     """The connection to the bridge is closed; calls waiting on it fail with this."""
+
+
+class AdvertiseRefusedError(RuntimeError):
+    """The bridge refused to let this client provide ``service``; ``reason`` is the bridge's."""
+
+    def __init__(self, service: str, reason: str) -> None:
+        self.service, self.reason = service, reason
+        super().__init__(f"the bridge refused to let this client provide {service}: {reason}")
 
 
 class BridgeClient:
@@ -139,6 +147,30 @@ class BridgeClient:
         """Advertise ``service`` and answer the server's calls to it with ``handler``."""
         self._handlers[service] = handler
         self.send({"op": "advertise_service", "service": service, "type": service_type})
+
+    def advertise(self, service: str, service_type: str, handler: ServiceHandler) -> None:
+        """:meth:`provide`, and wait until the bridge has read the advertisement: AdvertiseRefusedError
+        with its reason if it refused it (the server provides the service itself, say)."""
+        key = f"advertise:{service}:{next(self._ids)}"
+        self._handlers[service] = handler
+        self.send({"op": "advertise_service", "id": key, "service": service, "type": service_type})
+        # the bridge answers one client's messages in order: once this call is answered, a refusal of the
+        # advertisement (a status with its id) has arrived before it
+        self.call_sync("/rosapi/get_time", {})
+        for status in list(self.statuses):
+            if status.get("id") == key and status.get("level") == "error":
+                self._handlers.pop(service, None)
+                raise AdvertiseRefusedError(service, str(status.get("msg")))
+
+    def withdraw(self, *services: str) -> None:
+        """Stop providing ``services`` and wait until the bridge has read that (at most the client's
+        timeout); nothing if the connection has closed, as the bridge has dropped them then."""
+        for service in services:
+            self._handlers.pop(service, None)
+        with contextlib.suppress(BridgeClosedError, RemoteCallError, TimeoutError):
+            for service in services:
+                self.send({"op": "unadvertise_service", "service": service})
+            self.call_sync("/rosapi/get_time", {})
 
     def publish(self, topic: str, msg: Mapping[str, Any]) -> None:
         self.send({"op": "publish", "topic": topic, "msg": dict(msg)})

@@ -232,6 +232,7 @@ def run(
     from cbrs.sim.components import SimEnvironment  # pybullet loads only for this command
     from cbrs.sim.recording import Recorder, RecordingError, check_target
     from cbrs.sim.world import open_world
+    from cbrs.sim_sensors import SensorsTakenError, provide_sensors
 
     if gui:
         missing = display_problem(os.environ)
@@ -250,9 +251,15 @@ def run(
     transport = _bridge(bridge) if bridge else None
     start = time.perf_counter()
     recorder: Recorder | None = None
-    with contextlib.ExitStack() as held, open_world(seed=seed, gui=gui, semantic_map=SemanticMap.read(app.kb)) as world:
+    with contextlib.ExitStack() as held:
         if transport is not None:
             held.callback(transport.close)
+        world = held.enter_context(open_world(seed=seed, gui=gui, semantic_map=SemanticMap.read(app.kb)))
+        if transport is not None:  # devices' programs read this world's sensors on the bridge until it ends
+            try:
+                held.enter_context(provide_sensors(transport, world))
+            except SensorsTakenError as error:  # the server runs a task of its own: nothing has moved yet
+                raise click.ClickException(str(error)) from None
         environment = SimEnvironment(world, app.kb, transport)
         unknown = [f for f in failing if f not in environment.registry]
         if unknown:

@@ -11,9 +11,12 @@ map (docs/components.md, "The simulation's sensors"):
   a place of the map with an extent such as a scale's plate): the weight it bears and the bodies resting
   on it with their masses (:mod:`sim.load`).
 
-:class:`SimSensors` offers both on a bridge for as long as the bridge runs and answers them from the
-world it is :meth:`~SimSensors.watching` (``cbrs serve``: each task run's); with none, a call fails
-saying so. The simulation is imported at the first answer: ``cbrs serve`` starts without pybullet.
+:class:`SimSensors` answers both from the world it is :meth:`~SimSensors.watching` (``cbrs serve``:
+each task run's; ``cbrs run --bridge``: its own). On the bridge given to :meth:`~SimSensors.offer` it
+offers them only while it watches a world: the rest of the time the names are free, for a ``cbrs run
+--bridge`` in another process to provide from its world (:func:`provide_sensors`). Whoever comes
+second is refused with :class:`SensorsTakenError`, naming the one who holds them. The simulation is imported at the first
+answer: ``cbrs serve`` starts without pybullet.
 """
 
 from __future__ import annotations
@@ -21,13 +24,14 @@ from __future__ import annotations
 import base64
 import io
 import threading
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from typing import TYPE_CHECKING, Any
 
-from cbrs.rosbridge import Bridge, ServiceError
+from cbrs.rosbridge import Bridge, RosbridgeError, ServiceError
 
 if TYPE_CHECKING:
+    from cbrs.bridge_client import BridgeClient
     from cbrs.sim.cameras import Frame
     from cbrs.sim.load import Load
     from cbrs.sim.world import HomeWorld
@@ -36,16 +40,31 @@ __all__ = [
     "CAPTURE_SERVICE",
     "LOAD_FIELDS",
     "LOAD_SERVICE",
+    "SENSOR_TYPES",
+    "SensorsTakenError",
     "SimSensors",
     "frame_from_json",
     "frame_to_json",
     "load_to_json",
+    "provide_sensors",
 ]
 
 CAPTURE_SERVICE = "/sim/capture"
 LOAD_SERVICE = "/sim/load"
 LOAD_FIELDS = ("place",)
 """The fields a ``/sim/load`` request reads (``cbrs/interfaces/srv/MeasureLoad.srv``); another is refused."""
+SENSOR_TYPES = {CAPTURE_SERVICE: "cbrs/CaptureFrame", LOAD_SERVICE: "cbrs/MeasureLoad"}
+
+
+class SensorsTakenError(RuntimeError):
+    """The simulation's sensors on a bridge answer from another world now; ``reason`` says whose."""
+
+    def __init__(self, service: str, reason: str) -> None:
+        self.service, self.reason = service, reason
+        super().__init__(
+            f"the simulation's sensors ({service}) on the bridge are taken: {reason}; one simulated home at a"
+            " time answers them (a task run of the server's own, or one cbrs run --bridge): wait for it to end"
+        )
 
 
 def frame_to_json(frame: Frame) -> dict[str, Any]:
@@ -95,28 +114,57 @@ def load_to_json(load: Load) -> dict[str, Any]:
 
 
 class SimSensors:
-    """The simulation's sensor services on a bridge, answered from the world being watched (or failing
-    with why not when none is)."""
+    """The simulation's sensor services, answered from the world being watched (or failing with why not
+    when none is); on a bridge given to :meth:`offer`, offered only while a world is watched."""
 
     def __init__(self) -> None:
         self._world: HomeWorld | None = None
+        self._bridge: Bridge | None = None
         self._lock = threading.Lock()  # a call in flight holds the world open until it has answered
 
     def offer(self, bridge: Bridge) -> None:
-        """Add ``/sim/capture`` and ``/sim/load`` to ``bridge``."""
-        bridge.add_service(CAPTURE_SERVICE, "cbrs/CaptureFrame", self.capture)
-        bridge.add_service(LOAD_SERVICE, "cbrs/MeasureLoad", self.load)
+        """Add ``/sim/capture`` and ``/sim/load`` to ``bridge`` whenever a world is watched, and keep them
+        for the client that provides them meanwhile (a client may take a service over from another)."""
+        self._bridge = bridge
+        bridge.hold_services(self._holder)
+
+    def _holder(self, service: str, client: str) -> str | None:
+        """Why ``client`` may not provide ``service`` now: another client does (its run's home)."""
+        if service not in SENSOR_TYPES or self._bridge is None:
+            return None
+        holder = self._bridge.provider(service)
+        if holder is None or holder == client:
+            return None
+        return f"{holder} provides {service} from a simulated home of its own (a cbrs run --bridge)"
+
+    def handlers(self) -> dict[str, Callable[[dict[str, Any]], dict[str, Any]]]:
+        """The services' handlers by name (what :meth:`offer` adds, or a client provides)."""
+        return {CAPTURE_SERVICE: self.capture, LOAD_SERVICE: self.load}
 
     @contextmanager
     def watching(self, world: HomeWorld) -> Iterator[HomeWorld]:
-        """Answer from ``world`` until the block ends (before the world closes)."""
-        with self._lock:
-            self._world = world
+        """Answer from ``world`` until the block ends (before the world closes); SensorsTakenError when a
+        client of the bridge provides the sensors (a ``cbrs run --bridge`` in another process)."""
+        added: list[str] = []
         try:
-            yield world
-        finally:
+            if self._bridge is not None:
+                for name, handler in self.handlers().items():
+                    try:
+                        self._bridge.add_service(name, SENSOR_TYPES[name], handler)
+                    except RosbridgeError as error:
+                        raise SensorsTakenError(name, str(error)) from None
+                    added.append(name)
             with self._lock:
-                self._world = None
+                self._world = world
+            try:
+                yield world
+            finally:
+                with self._lock:
+                    self._world = None
+        finally:
+            for name in added:
+                assert self._bridge is not None
+                self._bridge.remove_service(name)
 
     def capture(self, args: dict[str, Any]) -> dict[str, Any]:
         """``/sim/capture``: a frame of the camera ``args["camera"]``."""
@@ -153,8 +201,27 @@ class SimSensors:
     def _present(self) -> HomeWorld:
         world = self._world
         if world is None or world.closed:
-            raise ServiceError(
-                "no simulated home is running on this server: its sensors answer during its own task runs (the"
-                " tasks page, /cbrs/run_task), not during a cbrs run in another process"
-            )
+            raise ServiceError("no simulated home is running: the run whose sensors these were has ended")
         return world
+
+
+@contextmanager
+def provide_sensors(client: BridgeClient, world: HomeWorld) -> Iterator[SimSensors]:
+    """Provide ``/sim/capture`` and ``/sim/load`` of ``world`` on the bridge ``client`` is connected to,
+    until the block ends (withdrawn before it ends, however it ends); SensorsTakenError, having provided
+    nothing, when the bridge refuses them (its server runs a task of its own, or another client holds them)."""
+    from cbrs.bridge_client import AdvertiseRefusedError
+
+    sensors = SimSensors()
+    provided: list[str] = []
+    with sensors.watching(world):
+        try:
+            for name, handler in sensors.handlers().items():
+                provided.append(name)  # withdrawn even if refused: one refusal can follow the other's success
+                try:
+                    client.advertise(name, SENSOR_TYPES[name], handler)
+                except AdvertiseRefusedError as error:
+                    raise SensorsTakenError(name, error.reason) from None
+            yield sensors
+        finally:
+            client.withdraw(*provided)

@@ -9,13 +9,18 @@ from __future__ import annotations
 import json
 from typing import Any
 
+import pytest
 from click.testing import CliRunner
 
+from cbrs.actions.remote_errors import RemoteCallError
+from cbrs.bridge_client import BridgeClient
 from cbrs.cli import cli
+from cbrs.kb.namespaces import PREFIXES
 from cbrs.server import Server
 from tests.test_live_components import READING, THERMOMETER, TOKEN, eventually, sdk_thermometer, server, url
 
 __all__ = ["server"]  # the fixture, used by name
+WORLD = PREFIXES["world"]
 
 
 def run(server: Server, *options: str) -> Any:
@@ -26,12 +31,15 @@ def run(server: Server, *options: str) -> Any:
 
 def test_a_run_calls_a_live_component_through_the_bridge_it_is_given(server: Server) -> None:
     calls: list[dict[str, Any]] = []
+    tables: list[dict[str, Any]] = []  # what a device's program read from the run's load cell meanwhile
+    device = BridgeClient(url(server), TOKEN)
 
     def read(request: dict[str, Any]) -> dict[str, Any]:
         calls.append(request)
+        tables.append(device.call_sync("/sim/load", {"place": "KitchenTable"}))
         return READING
 
-    with sdk_thermometer(read).connect(url(server), TOKEN):
+    with device, sdk_thermometer(read).connect(url(server), TOKEN):
         without = run(server)
         assert without.exit_code == 1 and calls == []
         assert "svc:ReadRoomTemperature_Thermometer07 is a component in another process" in without.output
@@ -41,6 +49,12 @@ def test_a_run_calls_a_live_component_through_the_bridge_it_is_given(server: Ser
         assert through.exit_code == 0, through.output
         assert calls == [{}]
         assert "svc:ReadRoomTemperature_Thermometer07" in through.output and "succeeded" in through.output
+        # the run's own world answered the device on the server's bridge (docs/components.md), and only
+        # while it ran
+        (table,) = tables
+        assert table["resting"] == [WORLD + "Cup", WORLD + "Pen"] and table["load_kg"] > 0
+        with pytest.raises(RemoteCallError, match="does not exist"):
+            device.call_sync("/sim/load", {"place": "KitchenTable"})
 
 
 def test_a_bridge_that_is_no_websocket_or_does_not_answer_is_a_usage_error(server: Server) -> None:

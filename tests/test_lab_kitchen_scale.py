@@ -12,7 +12,7 @@ import subprocess
 import sys
 from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any, cast
 
 import pytest
 
@@ -22,8 +22,12 @@ from cbrs.component import Component
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import HOME, PREFIXES
 from cbrs.server import ServeConfig, Server
+from cbrs.sim_sensors import SensorsTakenError, provide_sensors
 from cbrs.sparql_service import EndpointConfig
 from tests.test_live_components import eventually
+
+if TYPE_CHECKING:
+    from cbrs.sim.world import HomeWorld
 
 TOKEN = "lab-kitchen-scale-token"
 EXAMPLES = Path(__file__).resolve().parents[1] / "docs" / "examples"
@@ -105,8 +109,26 @@ def test_the_scale_refuses_an_empty_plate_and_another_plate() -> None:
 def test_the_simulation_s_sensors_answer_only_while_a_world_runs(server: Server) -> None:
     with BridgeClient(f"ws://127.0.0.1:{server.bridge_port}", TOKEN) as client:
         for service, args in (("/sim/load", {"place": "KitchenTable"}), ("/sim/capture", {"camera": "Kinect01"})):
-            with pytest.raises(RemoteCallError, match="no simulated home is running"):
+            with pytest.raises(RemoteCallError, match=f"service '{service}' does not exist"):
                 client.call_sync(service, args)
+
+
+def test_one_world_at_a_time_answers_the_sensors_and_the_second_is_told_whose_they_are(server: Server) -> None:
+    """A cbrs run --bridge (here its provide_sensors) holds them against the server's run, and the other
+    way round; neither waits. No world is simulated: neither side reads it before being refused."""
+    world = cast("HomeWorld", object())
+    bridge = f"ws://127.0.0.1:{server.bridge_port}"
+    with BridgeClient(bridge, TOKEN) as client, BridgeClient(bridge, TOKEN) as other:
+        with provide_sensors(client, world):
+            with pytest.raises(SensorsTakenError, match=r"/sim/capture.*already provided by client"):
+                server.sensors.watching(world).__enter__()
+            with pytest.raises(SensorsTakenError, match=r"client \d+ \(.*\) provides /sim/capture from a"):
+                provide_sensors(other, world).__enter__()  # another cbrs run --bridge does not take them over
+        with server.sensors.watching(world):  # withdrawn: the server's run takes them
+            with pytest.raises(SensorsTakenError, match="provided by the server and cannot be advertised"):
+                provide_sensors(client, world).__enter__()
+            assert dict(server.bridge.services())["/sim/load"] == "cbrs/MeasureLoad"
+        assert "/sim/load" not in dict(server.bridge.services())
 
 
 def _example(name: str) -> Any:

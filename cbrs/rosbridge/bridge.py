@@ -268,6 +268,14 @@ class Bridge:
         with contextlib.suppress(RuntimeError):  # the loop closed under us: the server is stopping
             loop.call_soon_threadsafe(calls.fail_provider, provider, name, reason)
 
+    def provider(self, service: str) -> str | None:
+        """The name of the client that provides ``service`` (its session's, as logs and holders name
+        it); None when the server does or nobody."""
+        name = protocol.resolve(service, "service")
+        with self._graph.lock:
+            found = self._graph.services.get(name)
+            return found.provider.name if found is not None and found.provider is not None else None
+
     def topics(self) -> list[tuple[str, str]]:
         """(name, type) of every topic: the server's, advertised and subscribed ones."""
         return self._graph.topic_list()
