@@ -15,8 +15,8 @@ map (docs/components.md, "The simulation's sensors"):
 each task run's; ``cbrs run --bridge``: its own). On the bridge given to :meth:`~SimSensors.offer` it
 offers them only while it watches a world: the rest of the time the names are free, for a ``cbrs run
 --bridge`` in another process to provide from its world (:func:`provide_sensors`). Whoever comes
-second is refused with :class:`SensorsTakenError`, naming the one who holds them. The simulation is imported at the first
-answer: ``cbrs serve`` starts without pybullet.
+second is refused with :class:`SensorsTakenError`, naming the one who holds them. The simulation is
+imported at the first answer: ``cbrs serve`` starts without pybullet.
 """
 
 from __future__ import annotations
