@@ -2,9 +2,10 @@
 
 It registers docs/examples/lab_weigh_object.ttl over the bridge and answers /kitchen_scale_01/weigh
 with what its plate bears. Its load cell is the simulation's: ``/sim/load`` on the same bridge (the
-simulated home's sensor service, answered from the physics of the run going on, docs/components.md
-"The simulation's sensors"). A real scale reads its own load cell in ``read_plate`` instead. An empty
-plate is no weight: the call fails saying so, and the run re-plans or fails naming the scale.
+simulated home's sensor service, answered from the physics of the run going on, a task run of the
+server's or a ``cbrs run --bridge``'s, docs/components.md "The simulation's sensors"). A real scale
+reads its own load cell in ``read_plate`` instead. An empty plate is no weight: the call fails saying
+so, and the run re-plans or fails naming the scale.
 
     CBRS_UPDATE_TOKEN=secret python docs/examples/lab_kitchen_scale.py [--bridge ws://127.0.0.1:9090]
 """
