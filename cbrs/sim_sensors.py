@@ -14,15 +14,18 @@ map (docs/components.md, "The simulation's sensors"):
 :class:`SimSensors` answers both from the world it is :meth:`~SimSensors.watching` (``cbrs serve``:
 each task run's; ``cbrs run --bridge``: its own). On the bridge given to :meth:`~SimSensors.offer` it
 offers them only while it watches a world: the rest of the time the names are free, for a ``cbrs run
---bridge`` in another process to provide from its world (:func:`provide_sensors`). Whoever comes
-second is refused with :class:`SensorsTakenError`, naming the one who holds them. The simulation is
-imported at the first answer: ``cbrs serve`` starts without pybullet.
+--bridge`` in another process to provide from its world (:func:`provide_sensors`). One home at a time
+answers them: whoever comes second runs without offering its own (the server's run logs a warning, a
+``cbrs run`` says so; :func:`provide_sensors` raises :class:`SensorsTakenError` naming the holder), since
+a run needs the sensors only if one of its devices reads the simulation, and refusing it would stop
+runs that do not. The simulation is imported at the first answer: ``cbrs serve`` starts without pybullet.
 """
 
 from __future__ import annotations
 
 import base64
 import io
+import logging
 import threading
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -35,6 +38,8 @@ if TYPE_CHECKING:
     from cbrs.sim.cameras import Frame
     from cbrs.sim.load import Load
     from cbrs.sim.world import HomeWorld
+
+log = logging.getLogger("cbrs.sim_sensors")
 
 __all__ = [
     "CAPTURE_SERVICE",
@@ -63,7 +68,8 @@ class SensorsTakenError(RuntimeError):
         self.service, self.reason = service, reason
         super().__init__(
             f"the simulation's sensors ({service}) on the bridge are taken: {reason}; one simulated home at a"
-            " time answers them (a task run of the server's own, or one cbrs run --bridge): wait for it to end"
+            " time answers them (a task run of the server's own, or one cbrs run --bridge), so this run does not"
+            " offer its own: a device's program reading them meanwhile reads the other home"
         )
 
 
@@ -143,16 +149,22 @@ class SimSensors:
 
     @contextmanager
     def watching(self, world: HomeWorld) -> Iterator[HomeWorld]:
-        """Answer from ``world`` until the block ends (before the world closes); SensorsTakenError when a
-        client of the bridge provides the sensors (a ``cbrs run --bridge`` in another process)."""
+        """Answer from ``world`` until the block ends (before the world closes). When a client of the bridge
+        provides the sensors (a ``cbrs run --bridge`` in another process) they stay its: the block runs
+        without offering them, and a warning says so (the run goes on; only a device reading the
+        simulation would miss them)."""
         added: list[str] = []
         try:
             if self._bridge is not None:
                 for name, handler in self.handlers().items():
                     try:
                         self._bridge.add_service(name, SENSOR_TYPES[name], handler)
-                    except RosbridgeError as error:
-                        raise SensorsTakenError(name, str(error)) from None
+                    except RosbridgeError as error:  # all or none: the other home keeps both
+                        log.warning("%s", SensorsTakenError(name, str(error)))
+                        for offered in added:
+                            self._bridge.remove_service(offered)
+                        added.clear()
+                        break
                     added.append(name)
             with self._lock:
                 self._world = world

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import importlib.util
 import os
+import re
 import subprocess
 import sys
 from collections.abc import Iterator
@@ -113,15 +114,21 @@ def test_the_simulation_s_sensors_answer_only_while_a_world_runs(server: Server)
                 client.call_sync(service, args)
 
 
-def test_one_world_at_a_time_answers_the_sensors_and_the_second_is_told_whose_they_are(server: Server) -> None:
+def test_one_world_at_a_time_answers_the_sensors_and_the_second_is_told_whose_they_are(
+    server: Server, caplog: pytest.LogCaptureFixture
+) -> None:
     """A cbrs run --bridge (here its provide_sensors) holds them against the server's run, and the other
-    way round; neither waits. No world is simulated: neither side reads it before being refused."""
+    way round; neither waits, and the second runs on without offering its own (a run needs them only if
+    a device reads the simulation). No world is simulated: neither side reads it."""
     world = cast("HomeWorld", object())
     bridge = f"ws://127.0.0.1:{server.bridge_port}"
     with BridgeClient(bridge, TOKEN) as client, BridgeClient(bridge, TOKEN) as other:
         with provide_sensors(client, world):
-            with pytest.raises(SensorsTakenError, match=r"/sim/capture.*already provided by client"):
-                server.sensors.watching(world).__enter__()
+            holder = server.bridge.provider("/sim/load")
+            assert holder is not None
+            with caplog.at_level("WARNING", logger="cbrs.sim_sensors"), server.sensors.watching(world):
+                assert server.bridge.provider("/sim/load") == server.bridge.provider("/sim/capture") == holder
+            assert re.search(r"/sim/capture.*already provided by client.*does not offer its own", caplog.text)
             with pytest.raises(SensorsTakenError, match=r"client \d+ \(.*\) provides /sim/capture from a"):
                 provide_sensors(other, world).__enter__()  # another cbrs run --bridge does not take them over
         with server.sensors.watching(world):  # withdrawn: the server's run takes them
