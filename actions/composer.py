@@ -156,6 +156,7 @@ class Composer:
         self._places: WorldPlaces | None = None  # where things are, read once per compose (if needed)
         self._places_at: tuple[tuple[object, bool], WorldPlaces] | None = None  # and kept while the store is unchanged
         self._matchmaker: Matchmaker | None = None  # for _matched, made on first use
+        self._roles: Leads | None = None  # area_roles, read on first use
 
     @property
     def advertisements(self) -> list[Advertisement]:
@@ -382,13 +383,16 @@ class Composer:
 
     def area_roles(self) -> Leads:
         """Which values given to a step lead it to their thing: the classes ``ComposeConfig.area_informs`` and
-        ``area_leads`` list when set, else those the store marks with ``cbrs:areaRole`` (read each time:
-        a lab's ontology may mark its own classes between compositions)."""
-        informs, leads = self.config.area_informs, self.config.area_leads
-        if informs is not None or leads is not None:
-            return Leads.of(self.index, informs or (), leads or ())
-        roles = {row["class"].value: row["role"].value for row in self.kb.select("area_roles")}
-        return Leads(self.index, roles)
+        ``area_leads`` list when set, else those the store marks with ``cbrs:areaRole``, read once, as the
+        taxonomy index they are checked against is (a class marked later is not in that index either)."""
+        if self._roles is None:
+            informs, leads = self.config.area_informs, self.config.area_leads
+            if informs is not None or leads is not None:
+                self._roles = Leads.of(self.index, informs or (), leads or ())
+            else:
+                roles = {row["class"].value: row["role"].value for row in self.kb.select("area_roles")}
+                self._roles = Leads(self.index, roles)
+        return self._roles
 
     def _world_places(self) -> WorldPlaces:
         """Where things are, read again only when an embedded store has been written since (a remote
