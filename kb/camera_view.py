@@ -43,7 +43,7 @@ the cup within 0.72 cm, the pen within 0.19 cm and the pen's yaw within 0.021 ra
 and 0.018 rad at 320 x 240; at 160 x 120 the yaw was off by up to 0.047 rad, near the tests' 0.05),
 and a frame costs about 15 ms instead of 33-38."""
 
-MAX_HIDDEN = 0.0
+MAX_HIDDEN = Camera.occlusion_tolerance  # the default of a camera whose map says nothing: 0
 """The largest fraction of the sight lines to a thing's outline that the map's solid boxes may cut for a
 camera still to see the thing whole (:func:`hidden`). None, by default: perception refuses a blob the
 image's border cuts, and a blob a cupboard cuts is as wrong a measure of where the thing is (its centre

@@ -508,7 +508,7 @@ def _classify(
             far=_number(values, "maxRange", iri, 8.0),
             size=size,
             mount=values.get(HOME + "mountedOn", [None])[0],
-            occlusion_tolerance=_number(values, "occlusionTolerance", iri, 0.0),
+            occlusion_tolerance=_number(values, "occlusionTolerance", iri, Camera.occlusion_tolerance),
         )
         if not 0.0 < camera.near < camera.far:
             raise MapError(iri, f"has a range of {camera.near}..{camera.far} m; need 0 < home:minRange < home:maxRange")
