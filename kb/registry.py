@@ -62,17 +62,9 @@ class ComponentRegistry:
         and the devices it needs, in files of their own). An advertisement two inputs describe is
         refused (:class:`InvalidDescriptionError` naming the second): read together, its two
         descriptions would merge."""
-        quads: list[ox.Quad] = []
-        iris: list[str] = []
-        first: dict[str, str] = {}
-        for turtle, source in inputs:
-            these, named = self._parse(turtle, source)
-            for iri in named:
-                if iri in first:
-                    raise _described_twice(iri, first[iri], source)
-                first[iri] = source
-            quads.extend(these)
-            iris.extend(named)
+        parsed = self._parse_all(inputs, owls=False)
+        quads = [quad for these, _, _ in parsed for quad in these]
+        iris = [iri for _, named, _ in parsed for iri in named]
         for iri in iris:
             if self._types(iri):  # an advertisement, or another resource of the graph (a device) by that IRI
                 raise AlreadyRegisteredError(iri)
@@ -117,27 +109,37 @@ class ComponentRegistry:
         """:meth:`synced` for several inputs, each ``(text, source)``, in one transaction (all or none),
         one :class:`Synced` per input; an advertisement two inputs describe is refused, as by
         :meth:`register_all`."""
-        quads: list[ox.Quad] = []
         done: list[Synced] = []
-        first: dict[str, str] = {}
-        for turtle, source in inputs:
-            conversion: list[LoadReport] = []
-            these, iris = self._parse(turtle, source, owls=True, conversion=conversion)
+        parsed = self._parse_all(inputs, owls=True)
+        for _, iris, conversion in parsed:
             added = []
             for iri in iris:
-                if iri in first:
-                    raise _described_twice(iri, first[iri], source)
-                first[iri] = source
                 if self.is_registered(iri):
                     continue
                 if self._types(iri):
                     raise AlreadyRegisteredError(iri)  # a device by that IRI: not the file's to replace
                 self._refuse_elsewhere(iri)
                 added.append(iri)
-            quads.extend(these)
-            done.append(Synced(added, [iri for iri in iris if iri not in added], conversion[0] if conversion else None))
-        self._write(quads, [iri for synced in done for iri in synced.updated])
+            done.append(Synced(added, [iri for iri in iris if iri not in added], conversion))
+        self._write([quad for these, _, _ in parsed for quad in these], [iri for d in done for iri in d.updated])
         return done
+
+    def _parse_all(
+        self, inputs: Sequence[tuple[str | bytes, str]], owls: bool
+    ) -> list[tuple[list[ox.Quad], list[str], LoadReport | None]]:
+        """Each input's quads, advertisements and (``owls``: an OWL-S input's) conversion report, checked as
+        :meth:`_parse` checks one; an advertisement two inputs describe is refused naming the second."""
+        parsed: list[tuple[list[ox.Quad], list[str], LoadReport | None]] = []
+        first: dict[str, str] = {}
+        for turtle, source in inputs:
+            conversion: list[LoadReport] = []
+            quads, iris = self._parse(turtle, source, owls=owls, conversion=conversion)
+            for iri in iris:
+                if iri in first:
+                    raise _described_twice(iri, first[iri], source)
+                first[iri] = source
+            parsed.append((quads, iris, conversion[0] if conversion else None))
+        return parsed
 
     def _refuse_elsewhere(self, iri: str) -> None:
         """Raise :class:`OutsideRegistryError` when another graph holds an advertisement by ``iri``."""
