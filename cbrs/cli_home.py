@@ -34,10 +34,10 @@ from cbrs.settings import setting
 def home(app: App, drawing: Path | None, width: int, browser: str | None, as_json: bool) -> None:
     """Summarise the home of the semantic map (graph:map) and check it as the simulation builds it.
 
-    Prints the counts of its rooms, furniture, objects, robots, people and cameras, its rooms, and the
-    home check's verdict; with --draw, writes the home from above as SVG. Exits with status 1 when the
-    map cannot be read or the simulation would refuse it (the drawing is written all the same when the
-    map can be read: it shows what is there).
+    Prints the counts of its rooms, furniture, objects, robots, people and cameras, its rooms, its people
+    (with what none or several allow), and the home check's verdict; with --draw, writes the home from
+    above as SVG. Exits with status 1 when the map cannot be read or the simulation would refuse it (the
+    drawing is written all the same when the map can be read: it shows what is there).
     """
     found = survey(app.kb)
     root = (browser or f"http://127.0.0.1:{setting('port').resolve()}").rstrip("/")
@@ -50,6 +50,7 @@ def home(app: App, drawing: Path | None, width: int, browser: str | None, as_jso
         entries = [entry.to_dict() for entry in picture.entries]
     if as_json:
         said = {"verdict": found.verdict, "counts": found.counts(), "rooms": _rooms(found), "drawing": written}
+        said["people"] = found.people()
         said["notice"] = NO_ROOMS if found.semantic_map is not None and not _rooms(found) else None
         said["problem"] = str(found.problem) if found.problem is not None else None
         if entries:
@@ -94,6 +95,7 @@ def _text(found: HomeSurvey, written: str | None) -> str:
         lines.append(f"  {room['name']} ({kinds}): {room['text']}")
     if not rooms:
         lines.append(f"  {NO_ROOMS}")
+    lines.append(f"people: {found.people()}")
     moved = [iri for iri in found.believed if iri in smap.objects or iri in smap.robots or iri in smap.people]
     if moved:
         lines.append(f"the world graph places {len(moved)} of its things after a run: a drawing shows those that moved")

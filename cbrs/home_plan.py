@@ -1,16 +1,16 @@
 """A picture of the home drawn from the store, before anything runs: the semantic map seen from above.
 
-The only top-down picture of a home was drawn after a simulated run (``cbrs run --record``), which
-needs pybullet; a lab building its own home (``cbrs load --graph map --replace``) wants to see what it
-wrote first. :func:`draw_home` draws a :class:`SemanticMap` as SVG text by hand (no matplotlib, no
-pybullet): rooms, walls, furniture with its top's height, appliances, objects by shape, size, yaw and
-colour, the mobile base with its heading and marker, the dual-arm robot with each arm's reach, the
-person, each camera and the floor a ceiling camera sees (:mod:`kb.camera_view`, the simulation's camera
-model), and docking poses. Where the world graph believes a thing is elsewhere than its start (after a
-run), the believed place is drawn too, with an arrow from the start. Each thing is a link to its page
-in the browser with a tooltip. :func:`survey` reads the map and checks it as the simulation would
-(:func:`kb.home_check.check_home`), so the browser's ``/home`` and ``cbrs home`` say what is wrong with
-a home instead of failing. docs/web.md, "The home".
+The only top-down picture of a home was drawn after a simulated run (``cbrs run --record``), which needs
+pybullet; a lab building its own home (``cbrs load --graph map --replace``) wants to see what it wrote
+first. :func:`draw_home` draws a :class:`SemanticMap` as SVG text by hand (no matplotlib, no pybullet):
+rooms, walls, furniture with its top's height, appliances, objects by shape, size, yaw and colour, the
+mobile base with its heading and marker, the dual-arm robot with each arm's reach, the people (none, one
+or several), each camera and the floor a ceiling camera sees (:mod:`kb.camera_view`, the simulation's
+camera model), and docking poses. Where the world graph believes a thing is elsewhere than its start
+(after a run), the believed place is drawn too, with an arrow from the start. Each thing is a link to
+its page in the browser with a tooltip. :func:`survey` reads the map and checks it as the simulation
+would (:func:`kb.home_check.check_home`), so the browser's ``/home`` and ``cbrs home`` say what is wrong
+with a home instead of failing. docs/web.md, "The home".
 """
 
 from __future__ import annotations
@@ -49,7 +49,7 @@ from cbrs.home_canvas import (
 )
 from cbrs.kb.camera_view import floor_view
 from cbrs.kb.errors import KnowledgeBaseError
-from cbrs.kb.home_check import check_home
+from cbrs.kb.home_check import check_home, look_alikes
 from cbrs.kb.knowledge_base import KnowledgeBase
 from cbrs.kb.namespaces import RDFS, shorten
 from cbrs.kb.semantic_map import HOME, Box, MapObject, SemanticMap, Thing, local_name
@@ -159,6 +159,24 @@ class HomeSurvey:
     def counted(self) -> list[str]:
         """:meth:`counts` in words: "3 rooms", "1 piece of furniture", "1 person"."""
         return [_counted(n, name) for name, n in self.counts().items()]
+
+    def people(self) -> str | None:
+        """Who lives in the home and what that allows, in words (None when the map cannot be read): a home
+        of nobody runs only the tasks that need no person, a home of several needs the task to name its
+        person, and people in one shirt colour cannot be told apart by the tracker (kb.home_check)."""
+        smap = self.semantic_map
+        if smap is None:
+            return None
+        people = [smap.people[iri] for iri in sorted(smap.people)]
+        if not people:
+            return "none: a task that tracks, goes to or hands something to a person is refused; the others run"
+        said = ", ".join(f"{person.name} ({person.colour or 'no'} shirt)" for person in people)
+        if len(people) > 1:
+            said += "; a task for one names them (an input of a class of theirs), else it is refused as ambiguous"
+        for colour, iris in look_alikes(smap):
+            names = " and ".join(local_name(iri) for iri in iris)
+            said += f"; {names} wear {colour}: the tracker cannot tell them apart, so a task for either is refused"
+        return said
 
 
 _ONE = {"people": "person", "furniture": "piece of furniture"}
@@ -622,6 +640,9 @@ def _people(
         ]
         canvas.block(canvas.x(x) - PERSON_PX, canvas.y(y) - PERSON_PX, canvas.x(x) + PERSON_PX, canvas.y(y) + PERSON_PX)
         where = f"starts at ({x:g}, {y:g}), facing {math.degrees(yaw):.0f}°, {person.colour or 'no'} shirt"
+        twins = [local_name(other) for _, iris in look_alikes(smap) if iri in iris for other in iris if other != iri]
+        if twins:
+            where += f" as {' and '.join(twins)}'s (the tracker cannot tell them apart)"
         title = f"{_label(smap, iri)}: person, {where}"
         there = _elsewhere(believed, iri, x, y, moved)
         if there is not None:

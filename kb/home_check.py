@@ -1,25 +1,39 @@
-"""What a semantic map must hold for the simulated home to be built from it, checked as one.
+"""What a semantic map must hold for the simulated home to be built from it, and which person a step means.
 
 A lab that replaces the bundled home with its own (``cbrs load --graph map --replace``, docs/tasks.md "A
 home of your own") writes every room, robot and person itself. The simulation takes rooms to make the
-floor of, one mobile robot, one person and a dual-arm robot with a left and a right arm; the base and
-the person start on the floor of a room, and so does every docking pose, none inside a wall, a piece of
-furniture or a robot's body. A map that lacks one of them, or puts a start where nothing could stand,
-is refused with a :class:`HomeError` naming what it lacks and where, before anything is built or moves:
-before, a missing person or arm was a bare ``ValueError`` (and a missing person was told to "take the
-extra ones out"), and a base starting outside every room was built there, to fail when it first drove.
-Whether a camera sees the person or an object (in frame, and not behind a wall or furniture) is not asked
-here but before each run, of the camera the run's steps look with (``sim.sight``): a home whose cameras
-do not see its person still runs every task that does not track them.
+floor of, one mobile robot and a dual-arm robot with a left and a right arm, and any number of people
+(none: a home where the robots only move things; several: a resident and a caregiver); the base, each
+person and every docking pose start on the floor of a room, none inside a wall, a piece of furniture or
+a robot's body. A map that lacks one of them, or puts a start where nothing could stand, is refused
+with a :class:`HomeError` naming what it lacks and where, before anything is built or moves. Before, a
+map had to hold exactly one person: a home with nobody modelled, or two residents, stopped every task,
+also those that never look for a person.
+
+Which person a step tracks, drives to or hands things to is asked per run (:func:`person_for`): the one
+the task designates, else the only one; none, several with nothing saying which, or one whose shirt
+another shares (the tracker finds a person by its colour alone) is a :class:`PersonError` naming the
+step, before anything moves. Whether a camera sees the person or an object is asked before each run
+too, of the camera the run's steps look with (``sim.sight``): a home whose cameras do not see its
+people still runs every task that does not track them.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 
-from cbrs.kb.semantic_map import HOME, MapError, Pose, SemanticMap, local_name
+from cbrs.kb.semantic_map import HOME, MapError, Person, Pose, SemanticMap, local_name
 
-__all__ = ["HomeError", "check_home"]
+__all__ = [
+    "AmbiguousPersonError",
+    "HomeError",
+    "LookAlikePeopleError",
+    "NoPersonError",
+    "PersonError",
+    "check_home",
+    "look_alikes",
+    "person_for",
+]
 
 _ARM_SIDES = ("left", "right")
 
@@ -28,6 +42,65 @@ class HomeError(MapError, ValueError):
     """The semantic map lacks, or has too many of, what the simulated home is built from, or starts a
     robot or person where nothing can stand. ``thing`` is what is missing (a class) or misplaced.
     Also a ``ValueError``, which the simulation raised for some of these before."""
+
+
+_ADD_PERSON = "a home:Person with home:x, home:y and the home:colourName of their shirt"
+
+
+class PersonError(HomeError):
+    """A step needs a person the map cannot give it. ``step`` is what needs them (a component's IRI or a
+    statement's class), ``people`` the people the choice was among (IRIs)."""
+
+    def __init__(self, thing: str, step: str, people: list[str], problem: str) -> None:
+        self.step = step
+        self.people = tuple(people)
+        super().__init__(thing, problem)
+
+
+class NoPersonError(PersonError):
+    """The map has no ``home:Person`` and a step tracks, drives to or hands something to one."""
+
+    def __init__(self, step: str) -> None:
+        super().__init__(
+            HOME + "Person",
+            step,
+            [],
+            f"has no individual in the map, and {local_name(step)} needs one (it tracks, goes to or hands "
+            f"something to a person): add {_ADD_PERSON} to graph:map, or run a task that needs no person",
+        )
+
+
+class AmbiguousPersonError(PersonError):
+    """Several people, and nothing in the task says which one a step means."""
+
+    def __init__(self, step: str, people: list[str]) -> None:
+        names = ", ".join(local_name(iri) for iri in people)
+        super().__init__(
+            HOME + "Person",
+            step,
+            people,
+            f"is ambiguous for {local_name(step)}: the map has {len(people)} people ({names}) and the task "
+            "designates none of them; give the task an input of the class of the one it means (home:Person "
+            "designates a person only in a home of one; a class of their own, e.g. home:Caregiver or a lab's "
+            "subclass of home:Person, tells them apart)",
+        )
+
+
+class LookAlikePeopleError(PersonError):
+    """The person a step means wears the shirt colour of another: the tracker, which finds a person by that
+    colour alone, could follow either."""
+
+    def __init__(self, step: str, person: Person, twins: list[str]) -> None:
+        self.colour = person.colour
+        names = ", ".join(local_name(iri) for iri in twins)
+        super().__init__(
+            person.iri,
+            step,
+            [person.iri, *twins],
+            f"wears a {person.colour} shirt, as {names} does, and {local_name(step)} finds a person by the colour "
+            "of their shirt alone: give each person a home:colourName of their own (and home:rgba to match), "
+            "or take the other out of graph:map",
+        )
 
 
 def check_home(semantic_map: SemanticMap) -> None:
@@ -47,33 +120,59 @@ def check_home(semantic_map: SemanticMap) -> None:
 
 
 def _check_counts(semantic_map: SemanticMap) -> None:
-    robots, people = list(semantic_map.robots), list(semantic_map.people)
-    for concept, found, needs in (
-        (
-            "MobileRobot",
-            robots,
-            "a robot with home:hasPlatform, home:hasMarker, home:x, home:y, home:sizeX and home:sizeY",
-        ),
-        ("Person", people, "a home:Person with home:x, home:y and the home:colourName of their shirt"),
-    ):
-        if not found:
-            raise HomeError(
-                HOME + concept,
-                f"has no individual in the map, and the simulated home takes one: add {needs} to graph:map "
-                "(the bundled home's are in ontologies/world.ttl)",
-            )
-    if len(robots) != 1 or len(people) != 1:
-        # Every run builds the whole map, so this stops every task, not only one about the second person.
-        named = "; ".join(
-            f"{what}: {', '.join(sorted(things))}" for what, things in (("mobile robots", robots), ("people", people))
-        )
-        concept, count = ("MobileRobot", len(robots)) if len(robots) != 1 else ("Person", len(people))
+    robots = sorted(semantic_map.robots)
+    needs = "a robot with home:hasPlatform, home:hasMarker, home:x, home:y, home:sizeX and home:sizeY"
+    if not robots:
         raise HomeError(
-            HOME + concept,
-            f"has {count} individuals in the map: the simulated home takes one mobile robot and one person; "
-            f"the semantic map has {len(robots)} and {len(people)} ({named}); take the extra ones out of graph:map "
-            "(a SPARQL update, or the map's files loaded into a fresh store), whatever task runs",
+            HOME + "MobileRobot",
+            f"has no individual in the map, and the simulated home takes one: add {needs} to graph:map "
+            "(the bundled home's are in ontologies/world.ttl)",
         )
+    if len(robots) != 1:
+        # Every run builds the whole map, so this stops every task, not only one about the second robot.
+        raise HomeError(
+            HOME + "MobileRobot",
+            f"has {len(robots)} individuals in the map ({', '.join(robots)}): the simulated home takes one mobile "
+            "robot; take the extra ones out of graph:map (a SPARQL update, or the map's files loaded into a fresh "
+            "store), whatever task runs",
+        )
+
+
+def person_for(semantic_map: SemanticMap, step: str, designated: Iterable[str] = ()) -> Person:
+    """The person ``step`` tracks, drives to or hands something to: the one of the map's people among
+    ``designated`` (the things the task's inputs name), else the map's only person. A :class:`PersonError`
+    when the map has none, or several and the task names not exactly one, or that person's shirt colour
+    is another's: refused rather than guessed, since the robot would otherwise serve whoever the camera
+    happened to see first."""
+    people = semantic_map.people
+    if not people:
+        raise NoPersonError(step)
+    named = sorted({iri for iri in designated if iri in people})
+    if len(named) == 1:
+        chosen = people[named[0]]
+    elif not named and len(people) == 1:
+        chosen = next(iter(people.values()))
+    else:
+        raise AmbiguousPersonError(step, named or sorted(people))
+    twins = sorted(iri for iri, other in people.items() if iri != chosen.iri and _same_shirt(chosen, other))
+    if twins:
+        raise LookAlikePeopleError(step, chosen, twins)
+    return chosen
+
+
+def look_alikes(semantic_map: SemanticMap) -> list[tuple[str, list[str]]]:
+    """Each shirt colour worn by more than one of the map's people, with their IRIs: the tracker cannot
+    tell them apart, so a task for one of them is refused (:class:`LookAlikePeopleError`)."""
+    worn: dict[str, list[str]] = {}
+    for iri in sorted(semantic_map.people):
+        colour = semantic_map.people[iri].colour
+        if colour:
+            worn.setdefault(colour.lower(), []).append(iri)
+    return [(colour, iris) for colour, iris in sorted(worn.items()) if len(iris) > 1]
+
+
+def _same_shirt(one: Person, other: Person) -> bool:
+    return bool(one.colour) and one.colour.lower() == other.colour.lower()
 
 
 def _starts(semantic_map: SemanticMap) -> Iterator[tuple[str, str, Pose]]:

@@ -35,9 +35,10 @@ from cbrs.actions.plan import Plan, PlanStep
 from cbrs.actions.remote import RemoteComponent, Transport
 from cbrs.kb import KnowledgeBase, Requirement, Statement
 from cbrs.kb.errors import KnowledgeBaseError, NotFoundError
+from cbrs.kb.home_check import PersonError, person_for
 from cbrs.kb.model import Advertisement
 from cbrs.kb.namespaces import PREFIXES
-from cbrs.kb.semantic_map import MapObject, NotGraspableError, SemanticMap, Thing, designate, local_name
+from cbrs.kb.semantic_map import MapObject, NotGraspableError, Person, SemanticMap, Thing, designate, local_name
 from cbrs.kb.vocab import CBRS
 from cbrs.settings import setting
 from cbrs.sim import predicates as pred
@@ -1388,9 +1389,27 @@ def locate(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str,
     return {"robotLocation": to_json(locate_robot(ctx.world.camera(device).capture(), marker))}
 
 
+def _meant(ctx: SimContext) -> Person:
+    """The person the running step means (``kb.home_check.person_for``): the one given to it or to a step
+    it takes a value from, else the one the task designates, else the home's only person."""
+    plan, step = ctx.plan, ctx.step
+    given = _people_given(ctx.map, plan, step, ctx.given) if plan is not None and step is not None else []
+    try:
+        return person_for(ctx.map, ctx.component or "the running step", given or ctx.designated)
+    except PersonError as error:  # refused before the run (``SimEnvironment.given``); a re-plan fails the step
+        raise SkillFailed(str(error)) from None
+
+
+def _people_given(smap: SemanticMap, plan: Plan, step: PlanStep, values: Mapping[str, Any]) -> list[str]:
+    """The map's people among the task's inputs a step works on (directly or through earlier steps)."""
+    steps = {each.index: each for each in plan.steps}
+    found = [values.get(name) for name in sorted(_given_to(step, steps))]
+    return [str(v["@id"]) for v in found if isinstance(v, dict) and str(v.get("@id")) in smap.people]
+
+
 def track(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     value = inputs.get("person")
-    person = ctx.map.people.get(_iri(value, "the person")) if value is not None else ctx.world.person
+    person = ctx.map.people.get(_iri(value, "the person")) if value is not None else _meant(ctx)
     if person is None or not person.colour:
         raise SkillFailed("the semantic map gives no colour to find the person by (home:colourName)")
     shirt = person.colour
@@ -1421,13 +1440,14 @@ def navigate_to_place(ctx: SimContext, inputs: Mapping[str, Any], device: str) -
 
 def navigate_to_person(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     path = decode(inputs["path"], PlannedPath)
-    _check(skills.navigate_to_person(ctx.world, path, decode(inputs["personPosition"], PersonEstimate)))
+    estimate = decode(inputs["personPosition"], PersonEstimate)
+    _check(skills.navigate_to_person(ctx.world, path, estimate, _meant(ctx).name))
     return {}
 
 
 def deliver(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     value = inputs.get("receiver")
-    receiver = local_name(_iri(value, "the receiver")) if value is not None else None
+    receiver = local_name(_iri(value, "the receiver")) if value is not None else _meant(ctx).name
     _check(skills.deliver_object(ctx.world, receiver))
     return {}
 
@@ -1455,6 +1475,8 @@ SKILLS: dict[str, Work] = {
     "DeliverObject": deliver,
 }
 """The simulated skill behind each service name; the device comes from the advertisement."""
+_WITH_PERSON = (track, navigate_to_person, deliver)
+"""The skills that look for, go to or hand something to a person: the home must say which one."""
 _MOVING = (pick_up, carry, put_down, fill_from_tap, hand_over, deliver)
 """The skills that may move an object they are given: where a step after one looks for it is not known
 before the run."""
@@ -1714,6 +1736,7 @@ class SimEnvironment:
         self.context.plan, self.context.given = plan, values  # where a hold ends, for the approach
         self.context.step, self.context.known = None, {}
         if not self.context.acted:  # checked before anything moved; a re-plan fails by its steps
+            self._people_of(plan, values)  # a step needing a person the home cannot give (nobody, who?)
             self._check_reach(plan, values)
             self._check_sight(plan, values)
             self._check_loading(plan, values)
@@ -1770,6 +1793,23 @@ class SimEnvironment:
             return True
         return False
 
+    def _people_of(self, plan: Plan, values: Mapping[str, Any]) -> dict[str, Person]:
+        """The person each step of ``plan`` that needs one means, by component: a step whose skill tracks,
+        goes to or hands something to a person, or that takes a ``home:Person`` input. A
+        :class:`kb.home_check.PersonError` (none in the map, several and the task names not one, or one the
+        tracker cannot tell from another) names the first step that needs one."""
+        ads = {ad.iri: ad for ad in self.kb.advertisements()}
+        designated = [str(v["@id"]) for v in values.values() if isinstance(v, dict) and "@id" in v]
+        meant: dict[str, Person] = {}
+        for step in plan.steps:
+            ad = ads.get(step.component)
+            person_input = any(b.concept and self.is_a(b.concept, HOME + "Person") for b in step.bindings)
+            if not person_input and (ad is None or SKILLS.get(ad.service_name or "") not in _WITH_PERSON):
+                continue
+            given = _people_given(self.world.map, plan, step, values)
+            meant[step.component] = person_for(self.world.map, step.component, given or designated)
+        return meant
+
     def _check_sight(self, plan: Plan, values: Mapping[str, Any]) -> None:
         """Refuse a plan whose recognition step would look for an object the task gives (or whose tracking
         step for the person it gives) with a camera that cannot see it whole where it is believed to be (by
@@ -1781,6 +1821,7 @@ class SimEnvironment:
         smap = self.world.map
         steps = {step.index: step for step in plan.steps}
         ads = {ad.iri: ad for ad in self.kb.advertisements()}
+        meant = self._people_of(plan, values)
         handled: set[str] = set()
         blockers = sight.occluders(smap)  # walls, furniture, appliances, robots' bodies hide what is behind them
         for step in plan.steps:
@@ -1797,7 +1838,7 @@ class SimEnvironment:
                 continue  # a camera the simulation does not have may see it
             ad = ads.get(step.component)
             if ad is not None and SKILLS.get(ad.service_name or "") is track:  # the person, by their shirt
-                people = [smap.people[iri] for iri in iris if iri in smap.people]
+                people = [meant[step.component]] if step.component in meant else []
                 spread = self.world.spread.person  # where the seed may have put them
                 looked_for = [(who.iri, sight.person_centre(who), sight.person_outline(who, spread)) for who in people]
                 objects = []
@@ -1955,12 +1996,13 @@ class SimEnvironment:
     def _ground(self, concept: str, inputs: Mapping[str, Any]) -> Grounded | None:
         """The thing a class-level statement means at this step: a thing the step was given, else what
         is at hand (the arm's object, its gripper, the base, the person, the target)."""
+        people = self.world.map.people
         for value in inputs.values():
             if isinstance(value, dict) and "@id" in value:
                 iri = str(value["@id"])
                 types = (*self.world.map.types.get(iri, ()), str(value.get("@type", "")))
                 if any(self.is_a(t, concept) for t in types):
-                    return Grounded("thing", iri)
+                    return Grounded("person", people[iri].name) if iri in people else Grounded("thing", iri)
         ctx = self.context
         if self.is_a(concept, HOME + "Gripper") or self.is_a(concept, HOME + "Arm"):
             return Grounded("gripper", ctx.arm.value)
@@ -1971,7 +2013,10 @@ class SimEnvironment:
         if self.is_a(concept, HOME + "Robot"):
             return Grounded("robot", "")
         if self.is_a(concept, HOME + "Person"):
-            return Grounded("person", self.world.person_name)
+            classes = self.world.map.types
+            kind = sorted(iri for iri in people if any(self.is_a(t, concept) for t in classes.get(iri, ())))
+            meant = [iri for iri in kind if iri in self.context.designated] or kind
+            return Grounded("person", people[meant[0]].name) if len(meant) == 1 else None  # nobody, or who?
         if self.is_a(concept, HOME + "Substance"):
             return Grounded("substance", concept)
         held = _grasped(inputs) if self.is_a(concept, HOME + "PhysicalObject") else None
@@ -2085,7 +2130,8 @@ class SimEnvironment:
         if grounded.role == "object":
             return world.objects[grounded.name].iri if grounded.name in world.objects else None
         if grounded.role == "person":
-            return world.person.iri
+            person = world.people.get(grounded.name)
+            return person.iri if person is not None else None
         if grounded.role == "base":
             return world.robot.iri
         if grounded.role == "platform":
@@ -2146,7 +2192,7 @@ class SimEnvironment:
         supports = [smap.things[iri] for iri in sorted(smap.furniture) if iri in smap.things]
         regions = [smap.things[iri] for iri in sorted(smap.regions) if iri in smap.things]
         base_iri = world.robot.iri
-        person_iri = world.person.iri
+        people = world.people
         for obj in smap.objects.values():
             name = obj.name
             here = Grounded("object", name)
@@ -2160,12 +2206,14 @@ class SimEnvironment:
                     facts.add((obj.iri, HOME + "isLocatedOn", support.iri))
             if world.robot.platform is not None and belief.on_platform(name):
                 facts.add((obj.iri, HOME + "isLocatedOn", world.robot.platform))
-            if belief.with_person(name, None):
-                facts.add((obj.iri, HOME + "isWith", person_iri))
+            for person in people.values():
+                if belief.with_person(name, person.name):
+                    facts.add((obj.iri, HOME + "isWith", person.iri))
             if name in world.containers and belief.contains_water(name):
                 facts.add((obj.iri, HOME + "contains", HOME + "Water"))
-        if belief.base_near_person(world.person_name):
-            facts.add((base_iri, HOME + "isNear", person_iri))
+        for person in people.values():
+            if belief.base_near_person(person.name):
+                facts.add((base_iri, HOME + "isNear", person.iri))
         odometry = world.base_pose()
         for support in supports:
             if (
@@ -2178,12 +2226,13 @@ class SimEnvironment:
             where = belief.position(obj.name)
             if where is not None:
                 positions[obj.iri] = where
-        seen = belief.people.get(world.person_name)
-        if seen is not None:
-            positions[person_iri] = seen.position
+        for person in people.values():
+            seen = belief.people.get(person.name)
+            if seen is not None:
+                positions[person.iri] = seen.position
         rooms = [smap.things[iri] for iri in sorted(smap.rooms) if iri in smap.things]
         for iri, (x, y, _) in positions.items():
-            if iri in (base_iri, person_iri):
+            if iri == base_iri or iri in smap.people:
                 for room in rooms:
                     if room.box.contains_xy(x, y):
                         facts.add((iri, HOME + "isLocated", room.iri))

@@ -20,7 +20,7 @@ import itertools
 import math
 import shutil
 import subprocess
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import lru_cache
 from pathlib import Path
@@ -323,7 +323,7 @@ class Recorder:
         self._unsubscribe: list[Callable[[], None]] = []
         self._floor = _Floor()
         self._base = ""
-        self._person = ""
+        self._people: list[str] = []
         self._movable: list[str] = []
         self._fixed: list[str] = []
         self._starts: dict[str, tuple[float, float]] = {}
@@ -344,8 +344,8 @@ class Recorder:
             return
         world = self.world
         self._base = world.name_of(world.base.body) or "base"
-        self._person = world.person_name
-        self._movable = [name for name in world.snapshot() if name != self._person]
+        self._people = list(world.people)  # none, one or several
+        self._movable = [name for name in world.snapshot() if name not in self._people]
         robots = {arm.robot.rsplit("#", 1)[-1] for arm in world.arm_specs.values()}
         self._fixed = [*world.furniture, *sorted(robots)]  # where the arms work: framed from the start
         self._floor = self._read_floor()
@@ -382,7 +382,7 @@ class Recorder:
 
     def _sample(self) -> None:
         now = self.world.time
-        for name in (*self._movable, self._person):
+        for name in (*self._movable, *self._people):
             x, y = self._xy(name)
             points = self.track.setdefault(name, [])
             if not points or points[-1][0] != now:
@@ -447,11 +447,11 @@ class Recorder:
             start = self._starts[name]
             if math.hypot(here[0] - start[0], here[1] - start[1]) > MOVED:
                 points += [start, here]
-        person = self._xy(self._person)
         start = self._starts.get(self._base, base)
         driven = math.hypot(base[0] - start[0], base[1] - start[1]) > MOVED
-        if driven and math.hypot(person[0] - base[0], person[1] - base[1]) < PERSON_NEAR:
-            points.append(person)
+        for person in (self._xy(name) for name in self._people):
+            if driven and math.hypot(person[0] - base[0], person[1] - base[1]) < PERSON_NEAR:
+                points.append(person)
         if not points:
             points = [base]
         wanted = Box.around(points, PAD)
@@ -486,7 +486,7 @@ class Recorder:
     def _read_floor(self) -> _Floor:
         world = self.world
         floor = _Floor(labelled=frozenset(self._fixed))
-        tracked = {*self._movable, self._person}
+        tracked = {*self._movable, *self._people}
         for name, body in world.bodies.items():
             data = p.getVisualShapeData(body, physicsClientId=world.client)
             rgba = max(data, key=lambda shape: sum(shape[7][:3]) - 2 * min(shape[7][:3]))[7] if data else (0.5,) * 4
@@ -531,7 +531,7 @@ class Recorder:
         title = f"{self.caption.task or 'run'}: {self.verdict or 'not finished'}"
         title += f", {self.times[-1] - self.times[0]:.1f} s simulated"
         path_map = path_map_name(target)
-        draw_path_map(self.track, self._floor, path_map, title, self._base, self._person)
+        draw_path_map(self.track, self._floor, path_map, title, self._base, self._people)
         return Recording(target, path_map, len(self.frames), self.times[-1] - self.times[0])
 
 
@@ -597,7 +597,7 @@ def draw_path_map(
     target: Path,
     title: str,
     base: str,
-    person: str,
+    people: Collection[str],
 ) -> None:
     """A top-down map: walls and furniture, the base's path coloured by time, and an arrow from each
     object's start to its end position; moves of a few centimetres get a magnified inset."""
@@ -611,7 +611,7 @@ def draw_path_map(
     bounds = [(b.xmin, b.ymin) for b in floor.walls] + [(b.xmax, b.ymax) for b in floor.walls]
     bounds += [(x, y) for points in track.values() for _, x, y in points]
     home = Box.around(bounds or [(0.0, 0.0)], 0.3)
-    lines = _draw_layer(axes, track, floor, base, person, labels=True)
+    lines = _draw_layer(axes, track, floor, base, people, labels=True)
     axes.set_xlim(home.xmin, home.xmax)
     axes.set_ylim(home.ymin, home.ymax)
     axes.set_aspect("equal")
@@ -623,7 +623,7 @@ def draw_path_map(
     moves = [
         (x, y)
         for name, points in track.items()
-        if name not in (base, person) and points
+        if name != base and name not in people and points
         for _, x, y in (points[0], points[-1])
     ]
     if moves:
@@ -633,7 +633,7 @@ def draw_path_map(
             right = (near.xmin + near.xmax) / 2 < (home.xmin + home.xmax) / 2
             top = (near.ymin + near.ymax) / 2 < (home.ymin + home.ymax) / 2
             inset = axes.inset_axes((0.58 if right else 0.02, 0.58 if top else 0.02, 0.4, 0.4))
-            _draw_layer(inset, track, floor, base, person, labels=False)
+            _draw_layer(inset, track, floor, base, people, labels=False)
             inset.set_xlim(near.xmin, near.xmax)
             inset.set_ylim(near.ymin, near.ymax)
             inset.set_aspect("equal")
@@ -653,7 +653,7 @@ def _draw_layer(
     track: Mapping[str, Sequence[tuple[float, float, float]]],
     floor: _Floor,
     base: str,
-    person: str,
+    people: Collection[str],
     labels: bool,
 ) -> Any:
     """Draw the floor and the tracks on ``axes``; returns the base's path (for a colour bar) or None."""
@@ -692,7 +692,7 @@ def _draw_layer(
         colour = floor.colours.get(name, (0.3, 0.3, 0.3))
         (_, x0, y0), (_, x1, y1) = points[0], points[-1]
         label = name if labels else None
-        if name == person:
+        if name in people:
             axes.plot(x1, y1, marker="o", markersize=12, color=colour, markeredgecolor="black", ls="", label=label)
             continue
         axes.plot(x0, y0, marker="o", markersize=7, markerfacecolor="none", markeredgecolor=colour, linestyle="")

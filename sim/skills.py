@@ -597,15 +597,16 @@ def navigate_to_place(world: HomeWorld, path: PlannedPath, place: Pose2D) -> Out
     return _done(world, "NavigateToPlace", start, ok, "the base is not at the place")
 
 
-def navigate_to_person(world: HomeWorld, path: PlannedPath, person: PersonEstimate) -> Outcome:
-    """NavigateToPerson: follow a planned path that ends next to the tracked person, facing them."""
+def navigate_to_person(world: HomeWorld, path: PlannedPath, person: PersonEstimate, name: str | None = None) -> Outcome:
+    """NavigateToPerson: follow a planned path that ends next to the tracked person (``name``, the
+    home's only person by default), facing them."""
     start = world.time
     gx, gy = path.waypoints[-1]
     outcome = navigate(world, path.waypoints, math.atan2(person.y - gy, person.x - gx))
     if not outcome.succeeded:
         return _done(world, "NavigateToPerson", start, False, outcome.reason)
-    ok = pred.base_near_person(world)
-    return _done(world, "NavigateToPerson", start, ok, "the base stopped too far from the person")
+    ok = pred.base_near_person(world, name)
+    return _done(world, "NavigateToPerson", start, ok, f"the base stopped too far from {name or 'the person'}")
 
 
 def deliver_object(world: HomeWorld, receiver: str | None = None) -> Outcome:

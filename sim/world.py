@@ -12,9 +12,9 @@ import difflib
 import hashlib
 import logging
 import math
-from collections.abc import Callable, Hashable, Iterator, Mapping
+from collections.abc import Callable, Hashable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from types import TracebackType
 
 import numpy as np
@@ -22,10 +22,10 @@ import pybullet as p
 
 from cbrs.kb.camera_view import default_image_size, image_up
 from cbrs.kb.hands import PANDA_HAND
-from cbrs.kb.home_check import check_home
+from cbrs.kb.home_check import check_home, person_for
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import Arm as ArmSpec
-from cbrs.kb.semantic_map import Box, Dispenser, MapError, MapObject, MobileRobot, SemanticMap, Thing, overlaps
+from cbrs.kb.semantic_map import Box, Dispenser, MapError, MapObject, MobileRobot, Person, SemanticMap, Thing, overlaps
 from cbrs.sim import layout as L
 from cbrs.sim.arms import PYBULLET_DATA, Arm, ArmDetail, ArmSide, Kinematics, panda_urdf
 from cbrs.sim.base import MobileBase
@@ -112,7 +112,7 @@ _IDENTITY: Quat = (0.0, 0.0, 0.0, 1.0)
 @dataclass(frozen=True)
 class Spread:
     """How far a seed moves things from the semantic map's start poses: each object up to ``object``
-    metres in x and y (and, if it is not round, ``yaw`` radians), kept on its support; the person up to
+    metres in x and y (and, if it is not round, ``yaw`` radians), kept on its support; each person up to
     ``person`` metres; the base up to ``base`` metres and ``base_yaw`` radians. The default is the small
     jitter of a real home; the perturbation benchmark moves things much further."""
 
@@ -125,26 +125,44 @@ class Spread:
 
 @dataclass(frozen=True)
 class Perturbation:
-    """The seed's deterministic offsets from the semantic map's start poses (metres, radians)."""
+    """The seed's deterministic offsets from the semantic map's start poses (metres, radians).
+    ``person`` is the seed's shared draw, the offset of a map's only person; ``people`` each person's
+    offset by IRI."""
 
     objects: Mapping[str, tuple[float, float, float]]
     person: tuple[float, float]
     base: tuple[float, float, float]
+    people: Mapping[str, tuple[float, float]] = field(default_factory=dict)
 
     @classmethod
     def from_seed(
-        cls, seed: int, objects: Mapping[str, tuple[str, bool]] | None = None, spread: Spread = Spread()
+        cls,
+        seed: int,
+        objects: Mapping[str, tuple[str, bool]] | None = None,
+        spread: Spread = Spread(),
+        people: Sequence[str] = (),
     ) -> Perturbation:
-        """``objects`` maps each object's name to its IRI and whether it is round (no yaw offset)."""
+        """``objects`` maps each object's name to its IRI and whether it is round (no yaw offset);
+        ``people`` are the map's people's IRIs. A map's only person takes the seed's shared draw, as before
+        people were counted, so a home of one person is where it was at every seed; with several, each
+        draws their own (:meth:`of_person`), and adding or removing one moves nobody else."""
         rng = np.random.default_rng(seed)
         person = rng.uniform(-spread.person, spread.person, 2)
         base = rng.uniform([-spread.base, -spread.base, -spread.base_yaw], [spread.base, spread.base, spread.base_yaw])
         moved = {name: cls.of_object(seed, iri, round_, spread) for name, (iri, round_) in (objects or {}).items()}
-        return cls(
-            moved,
-            (float(person[0]), float(person[1])),
-            (float(base[0]), float(base[1]), float(base[2])),
-        )
+        shared = (float(person[0]), float(person[1]))
+        alone = len(people) == 1
+        offsets = {iri: shared if alone else cls.of_person(seed, iri, spread) for iri in people}
+        return cls(moved, shared, (float(base[0]), float(base[1]), float(base[2])), offsets)
+
+    @staticmethod
+    def of_person(seed: int, iri: str, spread: Spread = Spread()) -> tuple[float, float]:
+        """One person's offsets (dx, dy) at ``seed`` in a home of several: drawn, as an object's are, from a
+        generator seeded by the seed and the SHA-256 of their IRI."""
+        words = np.frombuffer(hashlib.sha256(iri.encode("utf-8")).digest(), dtype="<u4")
+        rng = np.random.default_rng([seed, *(int(word) for word in words)])
+        dx, dy = rng.uniform(-spread.person, spread.person, 2)
+        return (float(dx), float(dy))
 
     @staticmethod
     def of_object(seed: int, iri: str, round_: bool = False, spread: Spread = Spread()) -> tuple[float, float, float]:
@@ -214,16 +232,19 @@ class HomeWorld:
         self.objects: dict[str, MapObject] = {obj.name: obj for obj in self.map.objects.values()}
         """The movable objects by body name (the local name of their IRI)."""
         self.containers = {name for name, obj in self.objects.items() if obj.iri in self.map.containers}
-        check_home(self.map)  # rooms, one base, one person, two arms, starts on a room's floor (kb.home_check)
-        robots = list(self.map.robots.values())
-        people = list(self.map.people.values())
-        self.robot, self.person = robots[0], people[0]
-        self.base_name, self.person_name = self.robot.name, self.person.name
+        check_home(self.map)  # rooms, one base, two arms, starts on a room's floor (kb.home_check)
+        self.robot = next(iter(self.map.robots.values()))
+        self.base_name = self.robot.name
+        self.people: dict[str, Person] = {person.name: person for _, person in sorted(self.map.people.items())}
+        """The map's people by body name (the local name of their IRI), in IRI order: none, one or several."""
         self.spread = spread
         """How far the seed may move things from the map's start poses: the check before a run asks the
         person tracker's camera to see the person wherever it may put them (``sight.person_outline``)."""
         self.perturbation = Perturbation.from_seed(
-            seed, {name: (obj.iri, obj.shape == "cylinder") for name, obj in self.objects.items()}, spread
+            seed,
+            {name: (obj.iri, obj.shape == "cylinder") for name, obj in self.objects.items()},
+            spread,
+            [person.iri for person in self.people.values()],
         )
         self._steps = 0
         self._watchers: list[tuple[int, Callable[[], None]]] = []
@@ -445,8 +466,19 @@ class HomeWorld:
         return found
 
     def snapshot(self) -> dict[str, Pose3D]:
-        """Poses of everything that can move (objects, base, person), for comparing runs."""
-        return {name: self.pose(name) for name in (*sorted(self.objects), self.base_name, self.person_name)}
+        """Poses of everything that can move (objects, base, people), for comparing runs."""
+        return {name: self.pose(name) for name in (*sorted(self.objects), self.base_name, *self.people)}
+
+    @property
+    def person(self) -> Person:
+        """The map's only person, for a caller that names none (a :class:`kb.home_check.PersonError` when the
+        map has none or several: which one a step means is the task's to say, ``person_for``)."""
+        return person_for(self.map, "the simulation's default person")
+
+    @property
+    def person_name(self) -> str:
+        """The body name of :attr:`person`."""
+        return self.person.name
 
     def aabb(self, name: str) -> tuple[Vec3, Vec3]:
         """The axis-aligned bounds of a body (all its links), low and high corners."""
@@ -630,7 +662,8 @@ class HomeWorld:
         self._build_kitchen()
         self._build_robot()
         self._build_base()
-        self._build_person()
+        for person in self.people.values():
+            self._build_person(person)
         self._draw_floor_last()
         for iri in sorted(self.map.cameras):
             cam = self.map.cameras[iri]
@@ -903,22 +936,22 @@ class HomeWorld:
         )
         p.changeDynamics(body, 0, lateralFriction=1.0, physicsClientId=self.client)
 
-    def _build_person(self) -> None:
-        dx, dy = self.perturbation.person
+    def _build_person(self, person: Person) -> None:
+        dx, dy = self.perturbation.people[person.iri]
         legs = L.SHIRT_BOTTOM
         self._multibody(
-            self.person_name,
+            person.name,
             [
                 _cylinder(L.PERSON_RADIUS, legs, (0, 0, 0), _TROUSERS),
                 _cylinder(
                     L.SHIRT_RADIUS,
                     L.SHIRT_TOP - L.SHIRT_BOTTOM,
                     (0, 0, (L.SHIRT_TOP + legs) / 2 - legs / 2),
-                    self.person.rgba,
+                    person.rgba,
                 ),
                 _Part(p.GEOM_SPHERE, (0.10,), (0.0, 0.0, L.SHIRT_TOP + 0.11 - legs / 2), _SKIN),
             ],
-            (self.person.start.x + dx, self.person.start.y + dy, legs / 2),
+            (person.start.x + dx, person.start.y + dy, legs / 2),
         )
 
 

@@ -164,10 +164,10 @@ def _variant(old: str, new: str) -> str:
 @pytest.mark.parametrize(
     ("text", "expected"),
     [
-        pytest.param(
-            _variant("flat:Resident a home:Person", "flat:Resident a home:Sofa"),
-            r"Person \(.*\) has no individual in the map, and the simulated home takes one: add a home:Person",
-            id="no-person",
+        pytest.param(  # a home of nobody is taken (tests/test_home_people.py); where a person stands is not
+            _variant("home:x 1.5 ; home:y 2.2", "home:x 1.5 ; home:y 6.2"),
+            r"Resident .* starts at \(1\.50, 6\.20\), in no room of the map",
+            id="person-outside",
         ),
         pytest.param(
             _variant("world:CytonDualArm01LeftArm home:x", 'world:CytonDualArm01LeftArm home:armSide "right" ; home:x'),
