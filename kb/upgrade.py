@@ -1,17 +1,25 @@
 """A store seeded by an older cbrs, brought up to the bundled ontologies when it is opened.
 
 :meth:`KnowledgeBase.open` calls :func:`upgrade_store` on every seeded store; it writes only when
-something is out of date, and then in one transaction. Three rules, each about what cbrs owns:
+something is out of date, and then in one transaction. An ontology is out of date when the store holds
+it at another version (``owl:versionInfo``) than the bundled file, unless the store's is newer. The
+rules, each about what cbrs owns (docs/ontologies.md, "Upgrading a store"):
 
 - conditions: in every graph, a condition written in the reified form of core 0.1.0 (``rdf:subject``,
   ``rdf:predicate``, ``rdf:object``, ``rdf:type rdf:Statement``) is rewritten with
   ``cbrs:conditionSubject``, ``cbrs:conditionPredicate`` and ``cbrs:conditionObject``
   (:mod:`kb.conditions`), keeping its node, type and text;
-- the core vocabulary: in the ontology graph, what the store says about the terms ``core.ttl``
-  describes (and any other ``cbrs:`` term) is replaced by what the bundled ``core.ttl`` says, so
-  ``cbrs:Condition`` is no longer an ``rdf:Statement`` and ``cbrs:hasOWLSModel`` gets its new domain;
-- ontology headers: the header (version, description) of each bundled ontology the store holds is
-  replaced by the bundled one, so that the next open finds nothing to do;
+- the core vocabulary, when out of date: in the ontology graph, what the store says about the terms
+  ``core.ttl`` describes (and any other ``cbrs:`` term) is replaced by what the bundled ``core.ttl``
+  says: the code relies on it as it is;
+- the other ontologies of the ontology graph, when out of date: a three-way merge of their statements,
+  the store's against the bundled file's, with the file as the store's version had it (``history.toml``)
+  as the base. What the file says and that version did not is added, what that version said and no
+  bundled file says now is removed; the rest of the store (a lab's own statements about a bundled
+  class, a bundled statement the lab deleted) stays as it is. Statements are compared up to the names
+  of their skolemised nodes, so a restriction is one statement with its nodes;
+- ontology headers: the header (version, description) of each out-of-date bundled ontology is replaced
+  by the bundled one, so that the next open finds nothing to do;
 - new ontologies: a bundled file of the ontology graph whose ontology the store does not name at all
   (the standard vocabularies and the alignments, for a store seeded before they were bundled) is
   added whole, as a seed would have stored it.
@@ -26,7 +34,8 @@ from __future__ import annotations
 
 import functools
 import logging
-from collections.abc import Sequence
+import tomllib
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -36,17 +45,21 @@ from cbrs.kb.conditions import LEGACY_PARTS
 from cbrs.kb.loader import parse_file
 from cbrs.kb.namespaces import CBRS, OWL, RDF, GraphName
 from cbrs.kb.queries import QueryLibrary
-from cbrs.kb.resources import bundled_files
+from cbrs.kb.resources import bundled_files, ontology_dir
 from cbrs.kb.skolem import closure, is_skolem, quads_by_subject
 from cbrs.kb.store import Store
 
-__all__ = ["UpgradeReport", "new_terms", "upgrade_store"]
+__all__ = ["UpgradeReport", "new_terms", "statement_keys", "upgrade_store"]
 
 log = logging.getLogger(__name__)
 
 UPGRADED_GRAPHS = (GraphName.ONTOLOGY, GraphName.SERVICES, GraphName.REQUIREMENTS)
 CORE_FILE = "core.ttl"
+HISTORY = "history.toml"
 _VERSION_INFO = OWL + "versionInfo"
+
+Node = ox.NamedNode | ox.BlankNode | ox.Triple
+Key = tuple[object, ...]  # a statement up to the names of its skolemised nodes
 
 
 @dataclass(frozen=True)
@@ -56,6 +69,7 @@ class UpgradeReport:
     conditions: int = 0  # condition nodes rewritten from the reified form
     removed: int = 0  # quads removed, all rules together
     added: int = 0
+    merged: tuple[str, ...] = ()  # the bundled files merged into the store (their names)
 
     @property
     def changed(self) -> bool:
@@ -63,22 +77,39 @@ class UpgradeReport:
 
 
 def upgrade_store(store: Store, queries: QueryLibrary) -> UpgradeReport:
-    """Bring ``store`` up to the bundled ontologies (the three rules above), in one transaction."""
+    """Bring ``store`` up to the bundled ontologies (the rules above), in one transaction."""
     remove, add, conditions = _condition_changes(store, queries)
     add += _missing_ontologies(store)
-    if _headers_outdated(store):
-        core_remove, core_add = _core_changes(store)
-        header_remove, header_add = _header_changes(store)
-        remove += core_remove + header_remove
-        add += core_add + header_add
+    outdated = _outdated(store)
+    merged: list[str] = []
+    if outdated:
+        if any(path.name == CORE_FILE for path, _ in _ontology_files(outdated)):
+            core_remove, core_add = _core_changes(store)
+            remove += core_remove
+            add += core_add
+        files = [(path, stored) for path, stored in _ontology_files(outdated) if path.name != CORE_FILE]
+        if files:
+            merge_remove, merge_add = _merge_changes(store, files, remove, add)
+            remove += merge_remove
+            add += merge_add
+            merged = [path.name for path, _ in files]
+        header_remove, header_add = _header_changes(store, outdated)
+        remove += header_remove
+        add += header_add
     removing = set(remove) - set(add)
     adding = set(add) - set(remove)
     adding = {quad for quad in adding if not _stored(store, quad)}
     if not removing and not adding:
         return UpgradeReport()
     store.replace(sorted(removing, key=str), sorted(adding, key=str))
-    log.info("upgraded the store: %d conditions rewritten, %d quads out, %d in", conditions, len(removing), len(adding))
-    return UpgradeReport(conditions, len(removing), len(adding))
+    log.info(
+        "upgraded the store: %d conditions rewritten, %s merged, %d quads out, %d in",
+        conditions,
+        ", ".join(merged) or "no ontology",
+        len(removing),
+        len(adding),
+    )
+    return UpgradeReport(conditions, len(removing), len(adding), tuple(merged))
 
 
 def _condition_changes(store: Store, queries: QueryLibrary) -> tuple[list[ox.Quad], list[ox.Quad], int]:
@@ -135,14 +166,14 @@ def _bundled_versions() -> tuple[tuple[ox.NamedNode, GraphName, frozenset[str]],
             if head is not None and triple.subject != head:
                 break
             if head is not None and triple.predicate.value == _VERSION_INFO:
-                versions.add(str(triple.object))
+                versions.add(_text(triple.object))
         if isinstance(head, ox.NamedNode) and versions:
             found.append((head, item.graph, frozenset(versions)))
             continue
         for head, graph, quads in _bundled_headers():
             if graph is item.graph:
                 found.append(
-                    (head, graph, frozenset(str(q.object) for q in quads if q.predicate.value == _VERSION_INFO))
+                    (head, graph, frozenset(_text(q.object) for q in quads if q.predicate.value == _VERSION_INFO))
                 )
     return tuple(dict.fromkeys(found))
 
@@ -178,23 +209,52 @@ def _is_header(triple: ox.Triple) -> bool:
     return triple.predicate.value == RDF + "type" and triple.object == ox.NamedNode(OWL + "Ontology")
 
 
-def _headers_outdated(store: Store) -> bool:
-    """Whether a bundled ontology the store holds has another version there than in its file."""
+def _text(term: ox.NamedNode | ox.BlankNode | ox.Literal | ox.Triple) -> str:
+    """A version's text (a literal's value, whatever its datatype or language)."""
+    return term.value if isinstance(term, ox.Literal) else str(term)
+
+
+def _version(text: str) -> tuple[int, ...] | None:
+    """``"0.2.0"`` as (0, 2, 0); None for a version that is not dotted numbers."""
+    parts = text.split(".")
+    return tuple(int(part) for part in parts) if all(part.isdigit() for part in parts) else None
+
+
+def _newer(stored: frozenset[str], bundled: frozenset[str]) -> bool:
+    """Whether every stored version is newer than every bundled one (a store a newer cbrs upgraded)."""
+    mine = [number for number in map(_version, bundled) if number is not None]
+    theirs = [number for number in map(_version, stored) if number is not None]
+    if len(mine) < len(bundled) or len(theirs) < len(stored):
+        return False
+    return min(theirs) > max(mine)
+
+
+def _outdated(store: Store) -> dict[ox.NamedNode, frozenset[str]]:
+    """The bundled ontologies the store holds at another, not newer, version, with their stored versions.
+    Every open asks: one lookup of a header's versions per bundled ontology."""
     version = ox.NamedNode(_VERSION_INFO)
+    found = {}
     for head, graph, bundled in _bundled_versions():
-        stored = {str(q.object) for q in store.quads(head, version, None, graph.node)}
+        stored = frozenset(_text(q.object) for q in store.quads(head, version, None, graph.node))
         if stored and stored != bundled:
-            return True
-    return False
+            if _newer(stored, bundled):
+                log.info("%s is at %s in the store, newer than this cbrs's %s: left alone", head.value, stored, bundled)
+                continue
+            found[head] = stored
+    return found
 
 
-def _header_changes(store: Store) -> tuple[list[ox.Quad], list[ox.Quad]]:
+def _ontology_files(outdated: dict[ox.NamedNode, frozenset[str]]) -> list[tuple[Path, frozenset[str]]]:
+    """(file, stored versions) of the out-of-date ontologies of the ontology graph."""
+    return [(path, outdated[head]) for path, _, head in _bundled_ontology_files() if head in outdated]
+
+
+def _header_changes(store: Store, outdated: dict[ox.NamedNode, frozenset[str]]) -> tuple[list[ox.Quad], list[ox.Quad]]:
     remove: list[ox.Quad] = []
     add: list[ox.Quad] = []
     for head, graph, quads in _bundled_headers():
-        stored = list(store.quads(head, None, None, graph.node))
-        if stored:  # an ontology the store never held is not added by an upgrade
-            remove += stored
+        if head in outdated:
+            remove += store.quads(head, None, None, graph.node)
             add += quads
     return remove, add
 
@@ -214,6 +274,113 @@ def _core_changes(store: Store) -> tuple[list[ox.Quad], list[ox.Quad]]:
     }
     remove = [q for q in closure(terms, quads_by_subject(stored)) if q not in others]
     return remove, list(core)
+
+
+def statement_keys(quads: Iterable[ox.Quad]) -> dict[Key, list[ox.Quad]]:
+    """The statements of ``quads`` (one graph), each by a key that does not depend on the names of its
+    skolemised nodes, with its quads: a quad between named terms, a quad whose object is a skolemised
+    structure (a restriction, a list, an action model) with that structure's quads, or a structure nothing
+    points to (an ``owl:AllDisjointClasses``). Equal keys are equal statements, whatever file digest
+    named their nodes."""
+    quads = list(quads)
+    quads_of = quads_by_subject(quads)
+    pointed = {q.object for q in quads if is_skolem(q.object)}
+    found: dict[Key, list[ox.Quad]] = {}
+    roots: set[object] = set()
+    for quad in quads:
+        if is_skolem(quad.subject):
+            if quad.subject not in pointed and quad.subject not in roots:
+                roots.add(quad.subject)
+                key: Key = ("structure", _shape(quad.subject, quads_of, ()))
+                found.setdefault(key, []).extend(closure([quad.subject], quads_of))
+            continue
+        if is_skolem(quad.object):
+            shape = _shape(quad.object, quads_of, ())  # type: ignore[arg-type]
+            found.setdefault((quad.subject, quad.predicate, shape), []).extend(
+                [quad, *closure([quad.object], quads_of)]  # type: ignore[list-item]
+            )
+        else:
+            found.setdefault((quad.subject, quad.predicate, quad.object), []).append(quad)
+    return found
+
+
+def _shape(node: Node, quads_of: Callable[[Node], list[ox.Quad]], path: tuple[Node, ...]) -> frozenset[object]:
+    """What hangs off a skolemised node, its own name left out (a cycle through skolemised nodes, which
+    Turtle's brackets cannot write, is cut where it closes)."""
+    if node in path:
+        return frozenset({"cycle"})
+    inner = (*path, node)
+    return frozenset(
+        (q.predicate, _shape(q.object, quads_of, inner) if is_skolem(q.object) else q.object)  # type: ignore[arg-type]
+        for q in quads_of(node)
+    )
+
+
+@functools.cache
+def _history() -> dict[tuple[str, str], tuple[Path, Path | None]]:
+    """(bundled file name, version) -> (what every file of that version said, what only some said)."""
+    folder = ontology_dir()
+    manifest = tomllib.loads((folder / HISTORY).read_text(encoding="utf-8"))
+    found: dict[tuple[str, str], tuple[Path, Path | None]] = {}
+    for entry in manifest.get("version", []):
+        sometimes = entry.get("sometimes")
+        found[(entry["file"], entry["version"])] = (folder / entry["said"], folder / sometimes if sometimes else None)
+    return found
+
+
+@functools.cache
+def _said(path: Path) -> frozenset[Key]:
+    """The statement keys of a history file (parsed once per process, as an upgrade reads it)."""
+    return frozenset(statement_keys(parse_file(path, GraphName.ONTOLOGY).quads))
+
+
+def _base(name: str, stored: frozenset[str]) -> tuple[frozenset[Key], frozenset[Key]]:
+    """What the store's version(s) of bundled file ``name`` said, as (what every file of it said, what
+    any said). An unrecorded version says nothing, and the merge then only adds."""
+    every: frozenset[Key] | None = None
+    some: frozenset[Key] = frozenset()
+    for version in stored:
+        record = _history().get((name, version))
+        if record is None:
+            log.warning("%s: version %s is not in %s: what the store lacks of it is added", name, version, HISTORY)
+            return frozenset(), some
+        said, sometimes = _said(record[0]), _said(record[1]) if record[1] else frozenset()
+        every = said if every is None else every & said
+        some |= said | sometimes
+    return every or frozenset(), some
+
+
+def _merge_changes(
+    store: Store, files: Sequence[tuple[Path, frozenset[str]]], removing: list[ox.Quad], adding: list[ox.Quad]
+) -> tuple[list[ox.Quad], list[ox.Quad]]:
+    """The three-way merge of the out-of-date ``files`` into the ontology graph as the other rules
+    (``removing``, ``adding``) leave it: add what a file says and its stored version did not, remove what
+    that version said and no bundled file says now. Headers are the header rule's."""
+    graph = GraphName.ONTOLOGY
+    heads = {head for _, _, head in _bundled_ontology_files()}
+    view = set(store.quads(graph=graph.node)) - {q for q in removing if q.graph_name == graph.node}
+    view |= {q for q in adding if q.graph_name == graph.node}
+    stored = statement_keys(view)
+    current: dict[Key, list[ox.Quad]] = {}
+    for item in bundled_files():
+        if item.graph is graph:
+            current.update(statement_keys(_bundled(item.path, item.graph)))
+    remove: list[ox.Quad] = []
+    add: list[ox.Quad] = []
+    for path, versions in files:
+        theirs = statement_keys(_bundled(path, graph))
+        every, some = _base(path.name, versions)
+        for key, quads in theirs.items():
+            if key not in every and key not in stored and not _about(key, heads):
+                add += quads
+        for key in some - current.keys():
+            if key in stored and not _about(key, heads):
+                remove += stored[key]
+    return remove, add
+
+
+def _about(key: Key, heads: set[ox.NamedNode]) -> bool:
+    return key[0] in heads
 
 
 def new_terms(store: Store, quads: Sequence[ox.Quad]) -> list[ox.Quad]:

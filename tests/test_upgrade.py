@@ -1,0 +1,156 @@
+"""A store seeded with an older bundled ontology gets what the file says now when it is opened, and keeps
+the lab's own statements (kb/upgrade.py, docs/ontologies.md#upgrading-a-store).
+
+The old store is a fresh seed whose home.ttl statements are those of home.ttl 0.1.0 as commit ea502cf
+had it (tests/data/legacy/home-0.1.0.ttl): before the area roles, the disjoint statuses, the hands'
+geometry, and with the cup taken from the side only."""
+
+from __future__ import annotations
+
+import hashlib
+import tomllib
+from collections.abc import Iterable, Iterator
+from pathlib import Path
+
+import pyoxigraph as ox
+import pytest
+
+from cbrs.actions.composer import Composer
+from cbrs.kb import GraphName, KnowledgeBase, Store
+from cbrs.kb.loader import parse_file
+from cbrs.kb.namespaces import GENID, OWL, PREFIXES, RDFS
+from cbrs.kb.resources import bundled_files, ontology_dir
+from cbrs.kb.upgrade import statement_keys
+from cbrs.kb.vocab import CBRS
+
+OLD_HOME = Path(__file__).parent / "data" / "legacy" / "home-0.1.0.ttl"
+HOME = PREFIXES["home"]
+LAB = "https://example.org/lab#"
+ONTOLOGY = GraphName.ONTOLOGY.node
+HOME_FILE = next(item.path for item in bundled_files() if item.path.name == "home.ttl")
+
+
+def _q(subject: str, predicate: str, obj: ox.NamedNode | ox.Literal) -> ox.Quad:
+    return ox.Quad(ox.NamedNode(subject), ox.NamedNode(predicate), obj, ONTOLOGY)
+
+
+# the lab's own statements: its class marked to inform, and a comment on a bundled class
+LAB_ADDED = [
+    _q(LAB + "Reading", PREFIXES["rdf"] + "type", ox.NamedNode(OWL + "Class")),
+    _q(LAB + "Reading", RDFS + "subClassOf", ox.NamedNode(HOME + "SpatialData")),
+    _q(LAB + "Reading", CBRS.areaRole, ox.NamedNode(CBRS.InformsOfThing)),
+    _q(HOME + "Cup", RDFS + "comment", ox.Literal("Our lab's cups are the blue ones.", language="en")),
+]
+# a bundled statement the lab deleted, which every home.ttl 0.1.0 said and 0.2.0 still says
+LAB_DELETED = _q(HOME + "Cupboard", RDFS + "comment", ox.Literal("A cabinet with doors.", language="en"))
+
+
+def _canonical(quads: Iterable[ox.Quad]) -> set[str]:
+    """The quads with their skolem IRIs as blank nodes, canonicalised: equal whatever file digest named them."""
+
+    def blank(term: ox.NamedNode | ox.BlankNode | ox.Literal | ox.Triple) -> ox.NamedNode | ox.BlankNode | ox.Literal:
+        if isinstance(term, ox.NamedNode) and term.value.startswith(GENID):
+            return ox.BlankNode(hashlib.sha256(term.value.encode()).hexdigest()[:24])
+        assert not isinstance(term, ox.Triple)
+        return term
+
+    dataset = ox.Dataset(ox.Quad(blank(q.subject), q.predicate, blank(q.object)) for q in quads)
+    dataset.canonicalize(ox.CanonicalizationAlgorithm.RDFC_1_0)
+    return {str(quad) for quad in dataset}
+
+
+def _roles(kb: KnowledgeBase) -> dict[str, str]:
+    return {row["class"].value: row["role"].value for row in kb.select("area_roles")}
+
+
+@pytest.fixture(scope="module")
+def fresh() -> Iterator[KnowledgeBase]:
+    kb = KnowledgeBase.open(":memory:")
+    yield kb
+    kb.close()
+
+
+@pytest.fixture
+def location(store_location: str, tmp_path: Path) -> str:
+    """A store that outlives one handle: a directory for the embedded store, the cleared server for the remote."""
+    return str(tmp_path / "store") if store_location == ":memory:" else store_location
+
+
+def _seed_with_old_home(location: str) -> None:
+    """A current seed whose home.ttl statements are 0.1.0's, with the lab's edits."""
+    KnowledgeBase.open(location).close()
+    old = Store.open(location)
+    assert LAB_DELETED in set(old.quads(graph=ONTOLOGY))  # (the lab deletes a statement the store holds)
+    old.replace(parse_file(HOME_FILE, GraphName.ONTOLOGY).quads, parse_file(OLD_HOME, GraphName.ONTOLOGY).quads)
+    assert not list(old.quads(None, ox.NamedNode(CBRS.areaRole), None, ONTOLOGY))  # 0.1.0 had no area roles
+    old.replace([LAB_DELETED], LAB_ADDED)
+    old.close()
+
+
+@pytest.mark.both_stores
+def test_a_store_seeded_with_an_older_home_gets_what_home_says_now(location: str, fresh: KnowledgeBase) -> None:
+    _seed_with_old_home(location)
+    kb = KnowledgeBase.open(location)
+    # the area roles are there, the bundle's and the lab's, and composition's area rule reads them
+    assert _roles(kb) == {**_roles(fresh), LAB + "Reading": CBRS.InformsOfThing}
+    rule = Composer(kb).area_roles()
+    assert not rule(HOME + "Temperature") and rule(HOME + "ObjectPosition3D") and not rule(LAB + "Reading")
+    # a value the bundle changed is replaced, not doubled; the lab's edits stand
+    drinkware = kb.store.quads(ox.NamedNode(HOME + "Drinkware"), ox.NamedNode(HOME + "graspApproach"), None, ONTOLOGY)
+    assert [quad.object.value for quad in drinkware] == ["side top"]
+    # the ontology graph is a fresh seed's, with the lab's statements and without the one it deleted
+    expected = (set(fresh.store.quads(graph=ONTOLOGY)) | set(LAB_ADDED)) - {LAB_DELETED}
+    assert _canonical(kb.store.quads(graph=ONTOLOGY)) == _canonical(expected)
+    assert not kb.upgrade().changed
+    kb.close()
+
+
+def test_a_second_open_writes_nothing(tmp_path: Path) -> None:
+    location = str(tmp_path / "store")
+    _seed_with_old_home(location)
+    KnowledgeBase.open(location).close()
+    before = Store.open(location)
+    dump = before.dump()
+    before.close()
+    kb = KnowledgeBase.open(location)
+    assert kb.store.generation == 0  # type: ignore[attr-defined]
+    assert kb.store.dump() == dump
+    kb.close()
+
+
+def test_an_ontology_the_store_holds_at_a_newer_version_is_left_alone(tmp_path: Path) -> None:
+    """A store a newer cbrs upgraded, opened by this one: its home stays as the newer cbrs left it."""
+    location = str(tmp_path / "store")
+    KnowledgeBase.open(location).close()
+    store = Store.open(location)
+    head, version = ox.NamedNode("https://w3id.org/cbrs/home"), ox.NamedNode(OWL + "versionInfo")
+    store.replace(
+        list(store.quads(head, version, None, ONTOLOGY)), [ox.Quad(head, version, ox.Literal("9.0.0"), ONTOLOGY)]
+    )
+    store.replace([LAB_DELETED], [])  # (as if the newer version had withdrawn it)
+    dump = store.dump()
+    store.close()
+    kb = KnowledgeBase.open(location)
+    assert kb.store.dump() == dump
+    kb.close()
+
+
+def _history() -> list[dict[str, str]]:
+    return list(tomllib.loads((ontology_dir() / "history.toml").read_text(encoding="utf-8"))["version"])
+
+
+def _bundled_version(name: str) -> tuple[int, ...]:
+    path = next(item.path for item in bundled_files() if item.path.name == name)
+    graph = parse_file(path, GraphName.ONTOLOGY).quads
+    (version,) = [q.object.value for q in graph if q.predicate.value == OWL + "versionInfo"]
+    return tuple(int(part) for part in version.split("."))
+
+
+@pytest.mark.parametrize("entry", _history(), ids=lambda e: f"{e['file']}-{e['version']}")
+def test_each_recorded_version_is_older_than_the_bundled_file(entry: dict[str, str]) -> None:
+    """An upgrade to the bundled file merges against the version the store holds: it must be an older one,
+    and its record must read."""
+    assert tuple(int(part) for part in entry["version"].split(".")) < _bundled_version(entry["file"])
+    for name in (entry["said"], entry.get("sometimes")):
+        if name:
+            assert statement_keys(parse_file(ontology_dir() / name, GraphName.ONTOLOGY).quads)
