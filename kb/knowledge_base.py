@@ -285,7 +285,8 @@ class KnowledgeBase:
 
     def upgrade(self) -> UpgradeReport:
         """Bring a store seeded by an older cbrs up to the bundled ontologies (:mod:`kb.upgrade`): its
-        conditions out of the reified form, the core vocabulary and the ontology headers replaced."""
+        conditions out of the reified form, the core vocabulary replaced, the other ontologies merged
+        (what the lab said of them stays), the headers replaced."""
         report = upgrade_store(self.store, self.queries)
         if report.changed:
             self._reader.clear_cache()
