@@ -139,11 +139,14 @@ def _history() -> list[dict[str, str]]:
     return list(tomllib.loads((ontology_dir() / "history.toml").read_text(encoding="utf-8"))["version"])
 
 
+def _version_of(path: Path) -> str:
+    (version,) = [t.object.value for t in ox.parse(path=str(path)) if t.predicate.value == OWL + "versionInfo"]
+    return str(version)
+
+
 def _bundled_version(name: str) -> tuple[int, ...]:
     path = next(item.path for item in bundled_files() if item.path.name == name)
-    graph = parse_file(path, GraphName.ONTOLOGY).quads
-    (version,) = [q.object.value for q in graph if q.predicate.value == OWL + "versionInfo"]
-    return tuple(int(part) for part in version.split("."))
+    return tuple(int(part) for part in _version_of(path).split("."))
 
 
 @pytest.mark.parametrize("entry", _history(), ids=lambda e: f"{e['file']}-{e['version']}")
@@ -154,3 +157,38 @@ def test_each_recorded_version_is_older_than_the_bundled_file(entry: dict[str, s
     for name in (entry["said"], entry.get("sometimes")):
         if name:
             assert statement_keys(parse_file(ontology_dir() / name, GraphName.ONTOLOGY).quads)
+
+
+VERSIONS = Path(__file__).parent / "data" / "ontology_versions.toml"
+ONTOLOGY_FILES = [item.path for item in bundled_files() if item.graph is GraphName.ONTOLOGY]
+
+
+def _statements_digest(path: Path) -> str:
+    """A digest of what a file says (not how it is written: comments, order, blank node labels)."""
+    dataset = ox.Dataset(ox.Quad(t.subject, t.predicate, t.object) for t in ox.parse(path=str(path)))
+    dataset.canonicalize(ox.CanonicalizationAlgorithm.RDFC_1_0)
+    return hashlib.sha256("".join(sorted(f"{quad} .\n" for quad in dataset)).encode()).hexdigest()[:16]
+
+
+@pytest.mark.parametrize("path", ONTOLOGY_FILES, ids=lambda p: str(p.relative_to(ontology_dir())))
+def test_a_bundled_ontology_changes_only_with_a_new_version(path: Path) -> None:
+    """A store is upgraded only when a file's version rises (docs/ontologies.md#upgrading-a-store): a
+    changed file under its old version would never reach the stores seeded with that version."""
+    name = str(path.relative_to(ontology_dir()))
+    record = tomllib.loads(VERSIONS.read_text(encoding="utf-8"))["file"].get(name)
+    version = _version_of(path)
+    digest = _statements_digest(path)
+    fix = f'record it in {VERSIONS.name}: "{name}" = {{ version = "{version}", statements = "{digest}" }}'
+    assert record is not None, f"{name} is not in {VERSIONS.name}: {fix}"
+    if record["version"] == version:
+        assert record["statements"] == digest, (
+            f"{name} says something else than version {version} did: raise its owl:versionInfo and record the "
+            f"old file in ontologies/history.toml (docs/ontologies.md, Changing a bundled ontology), then {fix}"
+        )
+    else:
+        recorded = {(entry["file"], entry["version"]) for entry in _history()}
+        assert path.name == "core.ttl" or (path.name, record["version"]) in recorded, (
+            f"{name} rose from {record['version']} to {version}: list the file as {record['version']} had it in "
+            "ontologies/history.toml, the base of the stores seeded with it"
+        )
+        pytest.fail(f"{name} is at a new version: {fix}")
