@@ -118,6 +118,10 @@ SETTLE_LIMIT = 1.0
 COLLISION_MARGIN = 0.01
 """Joint-space moves keep the arm's links 1 cm clear of the torso, the table, the dispenser, the
 Kinect and the other arm."""
+STRIKE_DEPTH = 0.002
+"""A pose the hand is asked to hold (:meth:`Arm.can_hold`) is refused when a link other than the
+fingers would be more than 2 mm into a fixed thing or the other arm: the hand cannot be there without
+pushing it (a top-grasped cup under the dispenser's spout, a jar carried past it)."""
 
 
 @dataclass(frozen=True)
@@ -216,6 +220,22 @@ class Kinematics:
         for target in targets:
             for point in p.getClosestPoints(body, target, COLLISION_MARGIN, physicsClientId=self.client):
                 if point[3] > 0:
+                    return True
+        return False
+
+    def strikes(self, side: ArmSide, q: Sequence[float], others: dict[ArmSide, Sequence[float]]) -> bool:
+        """Whether the arm at ``q``, its fingers aside, is more than STRIKE_DEPTH into a fixed thing or the
+        other arm (set to ``others``). Unlike :meth:`collides`, no margin: the fingers may touch the surface
+        an object is taken from or set down on, and the hand may come close to what it works by."""
+        body = self._bodies[side]
+        self._set(body, q)
+        for other, configuration in others.items():
+            if other is not side:
+                self._set(self._bodies[other], configuration)
+        targets = [*self._obstacles, *(b for s, b in self._bodies.items() if s is not side)]
+        for target in targets:
+            for point in p.getClosestPoints(body, target, 0.0, physicsClientId=self.client):
+                if point[3] > 0 and point[3] not in FINGER_JOINTS and point[8] < -STRIKE_DEPTH:
                     return True
         return False
 
@@ -543,12 +563,19 @@ class Arm:
 
     def can_hold(self, position: Vec3, orientation: Quat, symmetric: bool = True) -> bool:
         """Whether the hand can be at this pose at all (inverse kinematics from any seed posture, or from
-        the current one), without moving: a skill asks before it picks up what it could not set down."""
+        the current one, in a posture that does not push into a fixed thing: :meth:`Kinematics.strikes`),
+        without moving: a skill asks before it picks up what it could not set down. Before, a posture in
+        the dispenser's spout counted, and a cup taken from the top was carried into the spout."""
         candidates = [orientation, flipped(orientation)] if symmetric else [orientation]
+        others = self._others()
         for candidate in candidates:
             for seed in (*_SEEDS, self.joint_positions()):
                 solution = self._kinematics.solve(self.side, position, candidate, [seed])
-                if solution.position_error <= IK_TOLERANCE and solution.orientation_error <= 0.02:
+                if (
+                    solution.position_error <= IK_TOLERANCE
+                    and solution.orientation_error <= 0.02
+                    and not self._kinematics.strikes(self.side, solution.q, others)
+                ):
                     return True
         return False
 
