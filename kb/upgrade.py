@@ -230,8 +230,8 @@ def _newer(stored: frozenset[str], bundled: frozenset[str]) -> bool:
 
 
 def _outdated(store: Store) -> dict[ox.NamedNode, frozenset[str]]:
-    """The bundled ontologies the store holds at another, not newer, version, with their stored versions.
-    Every open asks: one lookup of a header's versions per bundled ontology."""
+    """The bundled ontologies the store holds at another, not newer, version, with their stored versions
+    other than the bundled one. Every open asks: one lookup of a header's versions per bundled ontology."""
     version = ox.NamedNode(_VERSION_INFO)
     found = {}
     for head, graph, bundled in _bundled_versions():
@@ -240,7 +240,7 @@ def _outdated(store: Store) -> dict[ox.NamedNode, frozenset[str]]:
             if _newer(stored, bundled):
                 log.info("%s is at %s in the store, newer than this cbrs's %s: left alone", head.value, stored, bundled)
                 continue
-            found[head] = stored
+            found[head] = stored - bundled or stored  # (the bundled version beside an older: the older is the base)
     return found
 
 
