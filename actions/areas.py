@@ -65,14 +65,16 @@ class WorldPlaces:
     @classmethod
     def read(cls, kb: KnowledgeBase, index: TaxonomyIndex, belief: bool) -> WorldPlaces:
         facts: dict[str, dict[str, str]] = {}
-        for row in kb.select("map_facts"):
+        reads = ("map_facts", "map_types", "world_positions") if belief else ("map_facts", "map_types")
+        fact_rows, type_rows, *positions = kb.select_each(reads)  # one request to a remote store
+        for row in fact_rows:
             facts.setdefault(row["thing"].value, {}).setdefault(row["property"].value, row["value"].value)
         types: dict[str, list[str]] = {}
-        for row in kb.select("map_types"):
+        for row in type_rows:
             types.setdefault(row["thing"].value, []).append(row["type"].value)
         bounds = {thing: found for thing, values in facts.items() if (found := _bounds(values)) is not None}
         if belief:
-            for row in kb.select("world_positions"):
+            for row in positions[0]:
                 thing, x, y = row["thing"].value, float(row["x"].value), float(row["y"].value)
                 bounds[thing] = (x, x, y, y)
                 if "type" in row and row["type"].value not in types.get(thing, []):

@@ -38,9 +38,9 @@ class BeliefState:
         self.kb = kb
 
     def write(self, observation: Observation) -> None:
-        """Replace the world graph with ``observation``, atomically."""
+        """Replace the world graph with ``observation``, atomically, in one request to a remote store (the
+        graph is not read first: a run writes it after every step)."""
         graph = GraphName.WORLD.node
-        old = list(self.kb.store.quads(graph=graph))
         new = [ox.Quad(ox.NamedNode(t), _TYPE, ox.NamedNode(c), graph) for t, c in sorted(observation.types.items())]
         new += [
             ox.Quad(ox.NamedNode(s), ox.NamedNode(p), ox.NamedNode(o), graph) for s, p, o in sorted(observation.facts)
@@ -49,7 +49,7 @@ class BeliefState:
             for axis, value in zip((CBRS.positionX, CBRS.positionY, CBRS.positionZ), xyz, strict=True):
                 new.append(ox.Quad(ox.NamedNode(thing), ox.NamedNode(axis), _double(value), graph))
         new.append(ox.Quad(ox.NamedNode(STATE), ox.NamedNode(CBRS.believedAt), _double(observation.time), graph))
-        self.kb.store.replace(old, new)
+        self.kb.store.replace_graph(graph, new)
 
     def snapshot(self) -> list[ox.Quad]:
         """The world graph as it is, for :meth:`restore`."""
@@ -57,7 +57,7 @@ class BeliefState:
 
     def restore(self, quads: list[ox.Quad]) -> None:
         """Put the world graph back as a :meth:`snapshot` found it (a run refused before it acted)."""
-        self.kb.store.replace(self.snapshot(), quads)
+        self.kb.store.replace_graph(GraphName.WORLD.node, quads)
 
     def facts(self, thing: str | None = None) -> set[tuple[str, str, str]]:
         rows = self.kb.select("world_facts", {"thing": thing} if thing else None)

@@ -54,7 +54,8 @@ class ActionLibrary:
         parents: dict[str, set[str]] = {}
         subs: dict[str, list[str]] = {}
         labels: dict[str, str | None] = {}
-        for row in kb.select("actions"):
+        action_rows, ordering_rows = kb.select_each(("actions", "action_ordering"))  # one request to a remote store
+        for row in action_rows:
             iri = row["action"].value
             labels[iri] = row["label"].value if "label" in row else None
             parents.setdefault(iri, set())
@@ -63,7 +64,7 @@ class ActionLibrary:
             if "subActions" in row and row["subActions"].value:
                 subs[iri] = sorted(set(row["subActions"].value.split()))
         orderings: dict[str, list[Ordering]] = {}
-        for row in kb.select("action_ordering"):
+        for row in ordering_rows:
             orderings.setdefault(row["action"].value, []).append(
                 Ordering(row["constraint"].value, row["before"].value, row["after"].value)
             )

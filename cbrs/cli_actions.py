@@ -20,6 +20,7 @@ from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, Ob
 from cbrs.actions.events import Event
 from cbrs.actions.faults import RandomFaults, planned_faults
 from cbrs.actions.graph import statement_text
+from cbrs.actions.model import ActionLibrary
 from cbrs.actions.plan import Binding, Plan
 from cbrs.actions.replanning import ReplanPolicy
 from cbrs.actions.runner import Replan, RunResult, run_task
@@ -73,8 +74,10 @@ def plan(
     """
     if drawing is not None and drawing.suffix.lower() not in (".svg", ".png"):
         raise click.BadParameter(f"{drawing.name!r} must end in .svg or .png", param_hint="--draw")
-    requested = task_iri(app.kb, task)  # a name that names no task is refused before the composer reads the store
-    composer = Composer(app.kb, ComposeConfig(objective=Objective(objective), respect_area=not ignore_areas))
+    actions = ActionLibrary.from_kb(app.kb)  # read once: the task's name and the composer take it
+    requested = task_iri(app.kb, task, actions)  # an unknown name is refused before the composer reads the store
+    config = ComposeConfig(objective=Objective(objective), respect_area=not ignore_areas)
+    composer = Composer(app.kb, config, actions=actions)
     result = composer.compose(requested)
     if result.plan is not None and not no_store:
         try:
@@ -246,7 +249,8 @@ def run(
         except RecordingError as error:
             raise click.BadParameter(str(error), param_hint="--record") from None
     failing = [parse_iri(f, "--fail") for f in faults]
-    iri = task_iri(app.kb, task)  # an unknown task fails before the world is built
+    actions = ActionLibrary.from_kb(app.kb)  # read once: the task's name and the composer take it
+    iri = task_iri(app.kb, task, actions)  # an unknown task fails before the world is built
 
     transport = _bridge(bridge) if bridge else None
     start = time.perf_counter()
@@ -282,7 +286,7 @@ def run(
                 iri,
                 environment,
                 failing,
-                composer=Composer(app.kb, ComposeConfig(respect_area=False)) if ignore_areas else None,
+                composer=Composer(app.kb, ComposeConfig(respect_area=not ignore_areas), actions=actions),
                 on_event=follow,
                 fault_policy=policy,
                 replan_policy=ReplanPolicy(max_repeats=repeat_failures),

@@ -596,6 +596,13 @@ class KnowledgeBase:
     def select(self, name: str, values: Mapping[str, Term | str | int | float] | None = None) -> list[dict[str, Term]]:
         return self.queries.select(self.store, name, values)
 
+    def select_each(
+        self, names: Sequence[str], values: Mapping[str, Term | str | int | float] | None = None
+    ) -> list[list[dict[str, Term]]]:
+        """:meth:`select` of each of ``names`` with the same ``values`` (none: every value), asked for at
+        once: one request to a remote store instead of one per query."""
+        return self.queries.select_each(self.store, [(name, values or {}) for name in names])
+
     def description(self, iri: str) -> ServiceDescription:
         return self._reader.read(iri)
 

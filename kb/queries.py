@@ -13,7 +13,7 @@ A parameter's value is substituted for the variable of the same name by Oxigraph
 from __future__ import annotations
 
 import re
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -104,6 +104,15 @@ class QueryLibrary:
     ) -> list[dict[str, Term]]:
         """Rows of a SELECT query as dicts from variable name to term (unbound variables left out)."""
         return _rows(name, self.run(store, name, values))
+
+    def select_each(
+        self, store: Store, asked: Sequence[tuple[str, Mapping[str, Term | str | int | float]]]
+    ) -> list[list[dict[str, Term]]]:
+        """The rows of each named SELECT query with its values, as :meth:`select` gives them, asked for
+        at once (:meth:`Store.select_each`: one request to a remote store). Values of none bound give a
+        query's rows for every value, as :meth:`select_every`."""
+        bound = [(self.get(name).text, self.get(name).bind(values) if values else {}) for name, values in asked]
+        return store.select_each(bound)
 
     def select_every(self, store: Store, name: str) -> list[dict[str, Term]]:
         """Rows of a SELECT query for every value of its parameters at once: the query run with none

@@ -24,6 +24,7 @@ from cbrs.kb.namespaces import BASE, GENID, GRAPH, PREFIXES, GraphName
 from cbrs.kb.query_guard import QueryGuard
 from cbrs.kb.recent_keys import RecentKeys
 from cbrs.kb.remote_access import loads, refuse_remote_access
+from cbrs.kb.results import releases_results
 from cbrs.kb.sparql_lexemes import HIDING
 
 MEMORY = ":memory:"
@@ -122,6 +123,12 @@ class Store(ABC):
         query per chunk of them instead of a request per quad."""
         return [self.contains(quad) for quad in quads]
 
+    def select_each(self, queries: Sequence[tuple[str, Mapping[str, Term]]]) -> list[list[dict[str, Term]]]:
+        """The rows of each SELECT query with its bindings (as :meth:`query` binds them), each row a dict
+        from variable name to term, unbound variables left out: for a caller that needs several answers
+        at once, which a remote store asks for in one request instead of one per query."""
+        return [solution_rows(self.query(text, bindings)) for text, bindings in queries]
+
     @abstractmethod
     def count(self, graph: GraphName | ox.NamedNode | None = None) -> int:
         """The number of quads in ``graph``, or in the whole dataset."""
@@ -166,6 +173,21 @@ class Store(ABC):
         if parts:
             self._apply_own_update(" ;\n".join(parts))
 
+    def replace_graph(self, graph: ox.NamedNode, quads: Iterable[ox.Quad]) -> None:
+        """Make ``graph`` hold exactly ``quads`` (which must be in it), in one update operation: what the
+        graph held is not read first, so it costs one request on a remote store, and a statement another
+        client added to it meanwhile goes too (the graph is replaced, not patched). The new quads go in as
+        a template that only the one solution binding ``?cbrs__graph`` fills (once, not once per old quad)."""
+        quads = list(quads)
+        if any(quad.graph_name != graph for quad in quads):
+            raise ValueError(f"replace_graph({graph}) was given a quad of another graph")
+        data_block(quads)  # refuses blank nodes, which a template would make fresh
+        adding = "".join(f"{quad.subject} {quad.predicate} {quad.object} .\n" for quad in quads)
+        self._apply_own_update(
+            f"DELETE {{ GRAPH {graph} {{ ?s ?p ?o }} }}\nINSERT {{ GRAPH ?cbrs__graph {{\n{adding}}} }}\n"
+            f"WHERE {{ {{ GRAPH {graph} {{ ?s ?p ?o }} }} UNION {{ BIND ({graph} AS ?cbrs__graph) }} }}"
+        )
+
     def clear_graph(self, graph: ox.NamedNode) -> None:
         """Empty one named graph, blank nodes included (which a data block cannot name), in one transaction."""
         self._apply_own_update(f"DROP SILENT GRAPH {graph}")  # the IRI as Oxigraph's serialiser writes it
@@ -197,6 +219,15 @@ def bundled_query_texts() -> frozenset[str]:
 
     named = {path.read_text(encoding="utf-8") for path in query_dir().glob("*.rq")}
     return frozenset(named | set(standard_terms.OWN_QUERIES) | set(standard_terms.rules()))
+
+
+@releases_results
+def solution_rows(result: QueryResult) -> list[dict[str, Term]]:
+    """A SELECT query's rows as dicts from variable name to term, unbound variables left out."""
+    if not isinstance(result, ox.QuerySolutions):
+        raise TypeError("not a SELECT query")
+    names = [variable.value for variable in result.variables]
+    return [{name: row[name] for name in names if row[name] is not None} for row in result]
 
 
 def nesting_depth(text: str) -> int:

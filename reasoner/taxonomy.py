@@ -54,13 +54,15 @@ class TaxonomyIndex:
 
     @classmethod
     def from_kb(cls, kb: KnowledgeBase) -> TaxonomyIndex:
-        """Read every term and link with two named queries, then build the DAG in memory."""
-        links = [
-            Link(row["child"].value, row["parent"].value, row["link"].value) for row in kb.select("taxonomy_links")
-        ]
-        terms = {row["term"].value: row.get("label") for row in kb.select("taxonomy_terms")}
-        usage = {row["concept"].value: int(row["uses"].value) for row in kb.select("concept_usage")}
-        disjoint = [(row["first"].value, row["second"].value) for row in kb.select("taxonomy_disjoint")]
+        """Read every term, link, use and disjointness with four named queries asked for at once (one
+        request to a remote store), then build the DAG in memory."""
+        link_rows, term_rows, usage_rows, disjoint_rows = kb.select_each(
+            ("taxonomy_links", "taxonomy_terms", "concept_usage", "taxonomy_disjoint")
+        )
+        links = [Link(row["child"].value, row["parent"].value, row["link"].value) for row in link_rows]
+        terms = {row["term"].value: row.get("label") for row in term_rows}
+        usage = {row["concept"].value: int(row["uses"].value) for row in usage_rows}
+        disjoint = [(row["first"].value, row["second"].value) for row in disjoint_rows]
         index = cls.from_links(links, terms=terms, disjoint=disjoint)
         index.labels = {term: label.value for term, label in terms.items() if label is not None}
         index.frequency = {index.canonical(c): n for c, n in usage.items() if c in index}

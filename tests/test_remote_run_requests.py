@@ -1,0 +1,224 @@
+"""The requests a plan and a run make against a remote store: a description, every advertisement, the
+taxonomy, the action library and the map are read with one request each, the belief graph is written
+with one, and the answers are those of the separate queries (docs/remote-store.md, "Requests of a plan
+and a run"). Counting requests is deterministic: no timing here (bench/remote_run.py times them)."""
+
+from __future__ import annotations
+
+import collections
+from collections.abc import Callable, Iterator
+from typing import Any
+
+import pyoxigraph as ox
+import pytest
+from click.testing import CliRunner
+
+from cbrs.actions.belief import BeliefState, Observation
+from cbrs.cli import cli
+from cbrs.kb import GraphName, KnowledgeBase
+from cbrs.kb.descriptions import PER_DESCRIPTION
+from cbrs.kb.errors import NotFoundError
+from cbrs.kb.queries import QueryLibrary
+from cbrs.kb.remote_store import RemoteStore, _order_keys, union_of_selects
+from cbrs.kb.resources import query_dir
+from tests.conftest import OxigraphServer
+
+LOCATE = "https://w3id.org/cbrs/service#LocateMobileRobot_CeilingCamera01"
+FETCH = "https://w3id.org/cbrs/requirement#FetchMyPen"
+HOME = "https://w3id.org/cbrs/home#"
+
+
+@pytest.fixture(scope="module")
+def served(oxigraph_servers: Callable[..., OxigraphServer]) -> OxigraphServer:
+    """A server of this module's own, seeded once (the session's is cleared before other tests)."""
+    server = oxigraph_servers(on_disk=False)
+    KnowledgeBase.open(server.url).close()
+    return server
+
+
+@pytest.fixture
+def remote(served: OxigraphServer) -> Iterator[KnowledgeBase]:
+    kb = KnowledgeBase.open(served.url)
+    yield kb
+    kb.close()
+
+
+class Requests:
+    """The requests a remote store sends, by kind: a named query asked alone by its name, else
+    ``combined``, ``other`` or ``update``."""
+
+    def __init__(self, kb: KnowledgeBase) -> None:
+        self.kinds: collections.Counter[str] = collections.Counter()
+        names = {kb.queries.get(name).text: name for name in kb.queries.names()}
+        store = kb.store
+        assert isinstance(store, RemoteStore)
+        post = store._post
+
+        def counted(url: str, body: str, content_type: str, original: str | None, *args: Any, **kw: Any) -> Any:
+            if content_type == "application/sparql-update":
+                self.kinds["update"] += 1
+            elif original in names:
+                self.kinds[names[original]] += 1
+            else:
+                self.kinds["combined" if "cbrs__part" in body else "other"] += 1
+            return post(url, body, content_type, original, *args, **kw)
+
+        store._post = counted  # type: ignore[method-assign]
+
+    @property
+    def total(self) -> int:
+        return sum(self.kinds.values())
+
+
+def test_a_description_is_read_from_the_store_in_one_request_as_the_embedded_store_reads_it(
+    remote: KnowledgeBase, bundled_kb: KnowledgeBase
+) -> None:
+    remote.description(LOCATE)  # the part trees of the concepts, read once per knowledge base (concept_parts)
+    for iri in (LOCATE, FETCH):
+        sent = Requests(remote)
+        assert remote.description(iri) == bundled_kb.description(iri)
+        assert sent.kinds == {"combined": 1}
+
+
+BENCH_CAMERA = """@prefix cbrs: <https://w3id.org/cbrs/core#> . @prefix home: <https://w3id.org/cbrs/home#> .
+<https://w3id.org/cbrs/service#RequestsCamera> a cbrs:DynamicPerceptionComponent ;
+    cbrs:deviceName "RequestsCamera" ; cbrs:serviceName "LocateMobileRobot" ;
+    cbrs:hasOWLSModel [ cbrs:hasInput [ cbrs:parameterType home:MarkerColour ] ;
+                        cbrs:hasOutput [ cbrs:parameterType home:RobotLocation ] ] .
+"""
+
+
+def test_a_description_deregistered_meanwhile_is_not_found_by_the_next_read(remote: KnowledgeBase) -> None:
+    """Read again each time, in one request: a run reads a step's description after the step, so a
+    component deregistered mid-run is noticed (its effects are not believed)."""
+    (iri,) = remote.registry.register(BENCH_CAMERA)
+    assert remote.description(iri).outputs[0].type == HOME + "RobotLocation"
+    remote.registry.deregister(iri)
+    sent = Requests(remote)
+    with pytest.raises(NotFoundError):
+        remote.description(iri)
+    assert sent.kinds == {"combined": 1}
+
+
+def test_every_advertisement_is_read_with_three_requests(remote: KnowledgeBase, bundled_kb: KnowledgeBase) -> None:
+    remote.description(LOCATE)  # the part trees, read once per knowledge base
+    sent = Requests(remote)
+    assert remote.advertisements() == bundled_kb.advertisements()
+    assert sent.kinds == {"advertisements": 1, "other": 1, "combined": 1}  # the other: the components' liveness
+
+
+def test_queries_asked_together_give_the_rows_and_order_each_gives_alone(remote: KnowledgeBase) -> None:
+    free = [
+        name
+        for name in remote.queries.names()
+        if not any(p.required for p in remote.queries.get(name).parameters.values())
+        and remote.queries.get(name).text.lstrip("# \n").find("SELECT") >= 0
+        and union_of_selects([remote.queries.get(name).text]) is not None
+    ]
+    assert {"taxonomy_links", "taxonomy_terms", "actions", "map_facts", "map_types"} <= set(free)
+    alone = [remote.select(name) for name in free]
+    sent = Requests(remote)
+    together = remote.select_each(free)
+    assert sent.kinds == {"combined": 1}
+    for name, rows, expected in zip(free, together, alone, strict=True):
+        assert _rows(rows) == _rows(expected), name
+        keys = [variable.lstrip("?") for _, variable in _order_keys(remote.queries.get(name).text) or []]
+        assert [[row.get(key) for key in keys] for row in rows] == [[row.get(key) for key in keys] for row in expected]
+    bound = {"description": LOCATE}
+    assert remote.select_each(PER_DESCRIPTION, bound) == [remote.select(name, bound) for name in PER_DESCRIPTION]
+
+
+def _rows(rows: list[dict[str, Any]]) -> list[str]:
+    """The rows in an order of their own: a query without ORDER BY has none, and ties are in any order."""
+    return sorted(repr(sorted((name, str(term)) for name, term in row.items())) for row in rows)
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        pytest.param("ASK { ?s ?p ?o }", id="ask"),
+        pytest.param("PREFIX x: <http://example.org/> SELECT ?s WHERE { ?s ?p x:o }", id="own-prefix"),
+        pytest.param("SELECT ?s WHERE { ?s ?p ?o } ORDER BY DESC(STR(?s))", id="order-by-expression"),
+        pytest.param("SELECT ?s WHERE { ?s ?p ?o } ORDER BY ?o", id="order-by-unprojected"),
+        pytest.param("SELECT ?cbrs__x WHERE { ?cbrs__x ?p ?o }", id="own-variable"),
+    ],
+)
+def test_a_query_that_cannot_be_a_branch_is_asked_alone(remote: KnowledgeBase, text: str) -> None:
+    assert union_of_selects(["SELECT ?s WHERE { ?s ?p ?o } LIMIT 1", text]) is None
+    if not text.startswith("ASK"):
+        sent = Requests(remote)
+        both = remote.store.select_each([("SELECT ?s WHERE { ?s a owl:Ontology } ORDER BY ?s", {}), (text, {})])
+        assert sent.kinds == {"other": 2} and both[0]
+
+
+def test_order_by_descending_keys_is_kept(remote: KnowledgeBase) -> None:
+    texts = [
+        "SELECT ?s WHERE { ?s a owl:Ontology } ORDER BY DESC(?s)",
+        "SELECT ?s WHERE { ?s a owl:Class } ORDER BY ?s",
+    ]
+    separate = [[row["s"] for row in remote.store.select_each([(text, {})])[0]] for text in texts]
+    together = [[row["s"] for row in rows] for rows in remote.store.select_each([(text, {}) for text in texts])]
+    assert together == separate and len(separate[0]) > 1
+
+
+@pytest.mark.parametrize("where", ["embedded", "remote"])
+def test_the_belief_replaces_the_world_graph_with_one_request(
+    where: str, remote: KnowledgeBase, fresh_embedded: Callable[[], KnowledgeBase]
+) -> None:
+    kb = remote if where == "remote" else fresh_embedded()
+    world = GraphName.WORLD.node
+    stray = ox.Quad(ox.NamedNode(HOME + "Stray"), ox.NamedNode(HOME + "isOn"), ox.NamedNode(HOME + "Table"), world)
+    kb.store.add([stray])  # another client's statement in the world graph: the belief replaces the graph
+    observation = Observation({HOME + "Pen1": HOME + "Pen"}, frozenset({(HOME + "Pen1", HOME + "isOn", HOME + "Desk")}))
+    sent = Requests(kb) if where == "remote" else None
+    BeliefState(kb).write(observation)
+    if sent is not None:
+        assert sent.kinds == {"update": 1}
+    held = set(kb.store.quads(graph=world))
+    assert stray not in held
+    assert {
+        (q.subject.value, q.predicate.value, q.object.value) for q in held if q.predicate.value.startswith(HOME)
+    } == {(HOME + "Pen1", HOME + "isOn", HOME + "Desk")}
+    assert len(held) == 3  # the type, the relation, and when it was believed
+    with pytest.raises(ValueError, match="another graph"):
+        kb.store.replace_graph(world, [ox.Quad(stray.subject, stray.predicate, stray.object, GraphName.MAP.node)])
+
+
+@pytest.fixture
+def fresh_embedded() -> Iterator[Callable[[], KnowledgeBase]]:
+    opened: list[KnowledgeBase] = []
+
+    def make() -> KnowledgeBase:
+        opened.append(KnowledgeBase.open(":memory:"))
+        return opened[-1]
+
+    yield make
+    for kb in opened:
+        kb.close()
+
+
+PLAN_REQUESTS = 45
+"""What ``cbrs plan req:RobotSelfPosition --no-store`` sent on 2026-11-27 (42, of which 19 were the
+upgrade's checks), and a margin; it sent 51 before."""
+
+
+def test_a_plan_reads_the_taxonomy_actions_and_descriptions_in_combined_requests(served: OxigraphServer) -> None:
+    kinds: collections.Counter[str] = collections.Counter()
+    post = RemoteStore._post
+
+    def counted(
+        self: RemoteStore, url: str, body: str, content_type: str, original: str | None, *a: Any, **k: Any
+    ) -> Any:
+        kinds["update" if content_type == "application/sparql-update" else original or "cbrs's own"] += 1
+        return post(self, url, body, content_type, original, *a, **k)
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(RemoteStore, "_post", counted)
+        result = CliRunner().invoke(cli, ["--store", served.url, "plan", "req:RobotSelfPosition", "--no-store"])
+    assert result.exit_code == 0, result.output
+    library = QueryLibrary(query_dir())
+    alone = {library.get(name).text: name for name in library.names()}
+    asked = collections.Counter({alone[text]: n for text, n in kinds.items() if text in alone})
+    for name in ("taxonomy_links", "taxonomy_terms", "actions", "action_ordering", "map_facts", *PER_DESCRIPTION):
+        assert asked[name] == 0, f"{name} asked alone: {asked}"
+    assert sum(kinds.values()) <= PLAN_REQUESTS, kinds
