@@ -2,7 +2,7 @@
 
 Everything is built from primitives except the two Panda arms (pybullet_data). Each world owns its
 own physics client and passes its id on every call, so several worlds can live in one process. The
-seed moves the cup, the pen, the person and the base's start a little; the same seed gives the same
+seed moves the cup, the pen, each person and the base's start a little; the same seed gives the same
 world and, since stepping is deterministic, the same outcome for the same calls.
 """
 
