@@ -10,6 +10,7 @@ import click
 
 from cbrs.app import App, pass_app
 from cbrs.home_plan import DEFAULT_WIDTH, NO_ROOMS, HomeSurvey, draw_home, resource_link, survey
+from cbrs.kb.home_check import people_check
 from cbrs.kb.namespaces import shorten
 from cbrs.kb.semantic_map import local_name
 from cbrs.settings import setting
@@ -51,6 +52,9 @@ def home(app: App, drawing: Path | None, width: int, browser: str | None, as_jso
     if as_json:
         said = {"verdict": found.verdict, "counts": found.counts(), "rooms": _rooms(found), "drawing": written}
         said["people"] = found.people()
+        said["persons"] = (
+            [c.to_dict() for c in people_check(found.semantic_map)] if found.semantic_map is not None else []
+        )
         said["notice"] = NO_ROOMS if found.semantic_map is not None and not _rooms(found) else None
         said["problem"] = str(found.problem) if found.problem is not None else None
         if entries:

@@ -49,7 +49,7 @@ from cbrs.home_canvas import (
 )
 from cbrs.kb.camera_view import floor_view
 from cbrs.kb.errors import KnowledgeBaseError
-from cbrs.kb.home_check import check_home, look_alikes
+from cbrs.kb.home_check import check_home, look_alikes, shirt_clashes
 from cbrs.kb.knowledge_base import KnowledgeBase
 from cbrs.kb.namespaces import RDFS, shorten
 from cbrs.kb.semantic_map import HOME, Box, MapObject, SemanticMap, Thing, local_name
@@ -163,7 +163,8 @@ class HomeSurvey:
     def people(self) -> str | None:
         """Who lives in the home and what that allows, in words (None when the map cannot be read): a home
         of nobody runs only the tasks that need no person, a home of several needs the task to name its
-        person, and people in one shirt colour cannot be told apart by the tracker (kb.home_check)."""
+        person, and people in one shirt colour cannot be told apart by the tracker, nor a shirt from the
+        marker's patch of its colour (kb.home_check)."""
         smap = self.semantic_map
         if smap is None:
             return None
@@ -176,6 +177,8 @@ class HomeSurvey:
         for colour, iris in look_alikes(smap):
             names = " and ".join(local_name(iri) for iri in iris)
             said += f"; {names} wear {colour}: the tracker cannot tell them apart, so a task for either is refused"
+        for clash in shirt_clashes(smap):  # the marker's colours, objects in a camera's view with them
+            said += f"; {clash.said}"
         return said
 
 

@@ -1,5 +1,6 @@
 """The home page of the semantic map: the home drawn from above (:mod:`cbrs.home_plan`), a table of its
-things, and what stops the simulation building it, before anything runs."""
+things, its people with whether a task for each runs (:func:`kb.home_check.people_check`, what ``cbrs
+home`` says), and what stops the simulation building it, before anything runs."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ from flask import Blueprint, Response
 from markupsafe import Markup
 
 from cbrs.home_plan import MOVED, HomeSurvey, draw_home, survey
+from cbrs.kb.home_check import people_check
 from cbrs.kb.semantic_map import local_name
 from cbrs.web import context
 from cbrs.web.links import iri_url, short
@@ -31,11 +33,14 @@ def home() -> Page:
         "problem": _problem(found),
         "counts": found.counts(),
         "counted": found.counted(),
+        "people": found.people(),
+        "persons": [],
         "things": [],
         "picture": None,
         "moved": MOVED,
     }
     if found.semantic_map is not None:
+        data["persons"] = [checked.to_dict() for checked in people_check(found.semantic_map)]
         picture = draw_home(found.semantic_map, found.believed, link=iri_url)
         data["things"] = [entry.to_dict() | {"shown": short(entry.iri)} for entry in picture.entries]
         data["picture"] = {"svg": "/home.svg", "width": picture.width, "height": picture.height}
