@@ -157,6 +157,8 @@ class Composer:
         self._places_at: tuple[tuple[object, bool], WorldPlaces] | None = None  # and kept while the store is unchanged
         self._matchmaker: Matchmaker | None = None  # for _matched, made on first use
         self._roles: Leads | None = None  # area_roles, read on first use
+        self._composing = False
+        self._requirements: list[Requirement] | None = None  # every requirement, read once per compose
 
     @property
     def advertisements(self) -> list[Advertisement]:
@@ -173,7 +175,7 @@ class Composer:
         return self._pool
 
     def task(self, name: str) -> Task:
-        return resolve_task(self.kb, self.actions, name)
+        return resolve_task(self.kb, self.actions, name, self.requirements)
 
     def graph(self, requirement: Requirement) -> ServiceResourceGraph:
         holding = self.world_state() if self.config.world_state else ()
@@ -195,11 +197,24 @@ class Composer:
     def compose(self, task: str | Task | Requirement, belief: bool = False) -> CompositionResult:
         """Plan ``task``; with ``belief``, from what the belief graph says holds now as well."""
         self._belief, self._state, self._places = belief, None, None
+        self._composing, self._requirements = True, None
         try:
             self._state = self.world_state() if self.config.world_state else []
             return self._compose(task)
         finally:
             self._belief, self._state, self._places = False, None, None
+            self._composing, self._requirements = False, None
+
+    def requirements(self) -> list[Requirement]:
+        """Every requirement: read once per composition, for the task, its sub-actions and every attempt
+        (as what holds is; a requirement registered meanwhile counts from the next composition, as a
+        component does), else read each time."""
+        if self._requirements is not None:
+            return self._requirements
+        found = self.kb.requirements()
+        if self._composing:
+            self._requirements = found
+        return found
 
     def _compose(self, task: str | Task | Requirement) -> CompositionResult:
         if isinstance(task, str):
@@ -325,6 +340,7 @@ class Composer:
             bindings=tuple(bindings),
             outputs=tuple((n, o.type) for n, o in offered_outputs),
             effects=ad.effects,
+            deletes=ad.deletes,
             cost=self.pool.vertices[ad.iri].cost if ad.iri in self.pool.vertices else self.config.default_cost,
         )
         return Plan(task.name, requirement.iri, "matched", (step,), tuple(goals), score, step.cost)
@@ -355,7 +371,7 @@ class Composer:
         """
         if not (self.config.decompose and task.action and task.action.sub_actions):
             return False
-        stated = {r.for_task for r in self.kb.requirements()}
+        stated = {r.for_task for r in self.requirements()}
         return all(sub in stated for sub in task.action.sub_actions)
 
     def attempt(self, requirement: Requirement, task: Task | None = None) -> Attempt:
@@ -420,7 +436,7 @@ class Composer:
         plans: list[Plan] = []
         holding = self.world_state() if self.config.world_state else []
         for sub in task.action.ordered_sub_actions():
-            sub_task = resolve_task(self.kb, self.actions, sub)
+            sub_task = resolve_task(self.kb, self.actions, sub, self.requirements)
             if self._achieved(sub_task.requirement, holding):
                 continue  # its effects hold already (a re-plan keeps what the last plan achieved)
             attempt = self.attempt(sub_task.requirement, sub_task)
@@ -592,6 +608,7 @@ def _concatenate(task: Task, plans: list[Plan]) -> Plan:
                     cost=step.cost,
                     part_of=step.part_of or plan.task,
                     alternatives=step.alternatives,
+                    deletes=step.deletes,
                 )
             )
         goals += [_shift(g, offset) for g in plan.goals]

@@ -6,7 +6,7 @@ engines can change without touching what an action is.
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 
 import networkx as nx
@@ -123,19 +123,26 @@ class Task:
     action: ActionClass | None = None
 
 
-def resolve_task(kb: KnowledgeBase, library: ActionLibrary, name: str) -> Task:
+def resolve_task(
+    kb: KnowledgeBase,
+    library: ActionLibrary,
+    name: str,
+    requirements: Callable[[], list[Requirement]] | None = None,
+) -> Task:
     """A task from a requirement or action IRI, a prefixed name, or a bare local name.
 
     A bare name is tried as a requirement first (``req:NAME``), then as an action (``act:NAME``). An
     action is planned through the requirement that names it with ``cbrs:forTask`` when there is one,
     otherwise from the inputs, outputs, preconditions and effects the action class carries.
+    ``requirements`` gives every requirement when one is needed (a composer reads them once per
+    composition); by default they are read here.
     """
     listed: list[Requirement] | None = None
 
-    def requirements() -> list[Requirement]:  # every requirement: only for an action or an unknown name
+    def every() -> list[Requirement]:  # every requirement: only for an action or an unknown name
         nonlocal listed
         if listed is None:
-            listed = kb.requirements()
+            listed = requirements() if requirements is not None else kb.requirements()
         return listed
 
     candidates = [name] if ":" in name else [f"req:{name}", f"act:{name}"]
@@ -144,23 +151,23 @@ def resolve_task(kb: KnowledgeBase, library: ActionLibrary, name: str) -> Task:
             iri = expand(candidate)
         except ValueError:
             continue
-        requirement = _stated(kb, iri) or next((r for r in requirements() if r.iri == iri), None)
+        requirement = _stated(kb, iri) or next((r for r in every() if r.iri == iri), None)
         if requirement is not None:
             action = library.actions.get(requirement.for_task or "")
             return Task(iri, requirement, action)
         if iri in library:
             action = library.get(iri)
-            stated = sorted((r for r in requirements() if r.for_task == iri), key=lambda r: r.iri)
+            stated = sorted((r for r in every() if r.for_task == iri), key=lambda r: r.iri)
             requirement = stated[0] if stated else kb.action_requirement(iri, action.label)
             return Task(iri, requirement, action)
     if ":" not in name:  # a bare name of the lab's own namespace (lab:TidyUp): one requirement or action of that name
-        named = sorted({r.iri for r in requirements() if local_name(r.iri) == name})
+        named = sorted({r.iri for r in every() if local_name(r.iri) == name})
         named = named or sorted(a.iri for a in library if local_name(a.iri) == name)
         if len(named) == 1:
-            return resolve_task(kb, library, named[0])
+            return resolve_task(kb, library, named[0], requirements)
         if named:
             raise UnknownTaskError(name, named, ambiguous=True)
-    known = sorted({local_name(r.iri) for r in requirements()} | {local_name(a.iri) for a in library if a.sub_actions})
+    known = sorted({local_name(r.iri) for r in every()} | {local_name(a.iri) for a in library if a.sub_actions})
     raise UnknownTaskError(name, known)
 
 
