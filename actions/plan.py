@@ -73,6 +73,7 @@ class PlanStep:
     cost: float
     part_of: str | None = None  # the sub-action of a decomposed task this step belongs to
     alternatives: tuple[str, ...] = ()  # components that can replace this one with the same bindings
+    deletes: tuple[Statement, ...] = ()  # what stops being true when it has run (cbrs:hasDeleteEffect)
 
     @property
     def candidates(self) -> tuple[str, ...]:
@@ -100,6 +101,7 @@ class PlanStep:
             "preconditions": [b.to_dict() for b in self.preconditions],
             "outputs": [{"name": name, "type": concept} for name, concept in self.outputs],
             "effects": [_statement(s) for s in self.effects],
+            "deletes": [_statement(s) for s in self.deletes],
             "cost": self.cost,
             "alternatives": list(self.alternatives),
         }
