@@ -34,8 +34,9 @@ __all__ = [
 
 DOWNWARD_IMAGE_SIZE = (320, 240)
 """Width and height (pixels) of a camera that looks straight down: the ceiling cameras, 4.5 m up
-with a 90 degree lens, where a pixel is 2.8 cm of floor. Locating the base's marker needs that: at
-240 x 180 the heading at seed 2's start came out 0.12 rad off (0.09 at this size), past the tests' 0.10."""
+with a 90 degree lens, where a pixel is 3.75 cm of floor (4.5 m over a focal length of 120 pixels).
+Locating the base's marker needs that: at 240 x 180 the heading at seed 2's start came out 0.12 rad off
+(0.09 at this size), past the tests' 0.10."""
 OTHER_IMAGE_SIZE = (192, 144)
 """Width and height (pixels) of any other camera: the robot's RGB-D camera over the table, 1-1.5 m
 from what it looks at with a 45 degree lens, where a pixel is 3.5-5 mm. Over seeds 0-19 it finds

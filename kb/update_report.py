@@ -4,7 +4,8 @@ pyoxigraph tells nothing of what an update did. An update of ground data (``INSE
 read for certain by :mod:`kb.update_delta`) is counted quad by quad: what it added and removed in each
 graph. Any other update (``DELETE { } INSERT { } WHERE { }``, ``DROP GRAPH``, ``LOAD``) is counted by each
 graph's size before and after, which gives the net change only (a quad removed and another added in one
-graph count as nothing). graph:entailed, which follows every write, is counted by its refresh.
+graph count as nothing, and such a report says no size changed rather than that nothing did).
+graph:entailed, which follows every write, is counted by its refresh.
 
 A request of several operations is one transaction on Oxigraph (embedded or served), but not on every
 server: Virtuoso 7 keeps what the first operation wrote when the second fails (docs/remote-store.md). There
@@ -23,6 +24,13 @@ from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import GraphName, shorten
 from cbrs.kb.sparql_lexemes import HIDING
 from cbrs.kb.store import EmbeddedStore, Store
+
+NO_SIZE_CHANGED = (
+    "no graph changed in size (a statement replaced by another is not seen this way: only INSERT DATA and "
+    "DELETE DATA are counted statement by statement)"
+)
+"""What an update counted by the graphs' sizes says when none changed: it may still have replaced values,
+so "nothing changed" would claim what was not measured."""
 
 DEFAULT_GRAPH = ""
 """How a report names the default graph (an update whose data names no ``GRAPH`` writes there)."""
@@ -82,7 +90,7 @@ class UpdateReport:
         if not self.counted:
             return ["the update ran; what it changed could not be counted (the store changed meanwhile)"]
         if not self.changed:
-            return ["nothing changed"]
+            return ["nothing changed" if self.exact else NO_SIZE_CHANGED]
         return [change.text() for change in self.changes]
 
 
