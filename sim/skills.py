@@ -68,6 +68,9 @@ ABOVE_CLEARANCE = 0.03
 """Carrying ends with the object's bottom 3 cm above the target surface."""
 TRANSIT_SAG = 0.02
 """A joint-space transit may let the grasp point dip 2 cm below the transit height, no more."""
+APPROACH_OVER = 0.03
+"""A hand coming in to an object whose top stands above the pre-grasp pose goes first to 3 cm over that
+top, above the pose (:func:`_approach`)."""
 PLACE_CLEARANCE = 0.003
 """Putting down lowers the object to 3 mm above the surface, then lets go: it drops onto it."""
 PLACE_SPEED = 0.10
@@ -127,11 +130,29 @@ def approach_object(world: HomeWorld, side: ArmSide | str, grasp: GraspPose) -> 
     if arm.held is not None:
         return _done(world, "ApproachToObject", start, False, f"the {arm.side} gripper is holding something")
     arm.open_gripper()
-    result = arm.reach(grasp.pregrasp, grasp.orientation)
+    result = _approach(arm, grasp)
     if not result.reached:
         return _done(world, "ApproachToObject", start, False, result.reason)
     ok = pred.gripper_near(world, side, grasp.model.name)
     return _done(world, "ApproachToObject", start, ok, f"the gripper is not near the {grasp.model.name}")
+
+
+def _approach(arm: _Moving, grasp: GraspPose) -> MotionResult:
+    """approach_object's move to the pre-grasp pose: through joint space, which keeps the arm clear of
+    the fixed things but not of the objects; so for an object whose top stands above that pose (a vase
+    25 cm tall taken at half its height), first to above the pose, APPROACH_OVER over the object's top,
+    then straight down to it. Before, the hand swept into the vase's top on its way there and pushed it
+    over. Where the arm has no way to above the pose, straight to it as before."""
+    px, py, pz = grasp.pregrasp
+    top = grasp.position[2] - grasp.bottom_offset + grasp.model.height
+    if pz >= top:
+        return arm.reach(grasp.pregrasp, grasp.orientation)
+    above = arm.reach((px, py, top + APPROACH_OVER), grasp.orientation)
+    if not above.reached and math.isinf(above.error):
+        return arm.reach(grasp.pregrasp, grasp.orientation)
+    if not above.reached:
+        return above
+    return arm.move_to(grasp.pregrasp, grasp.orientation)
 
 
 def _between_fingers(world: HomeWorld, arm: Arm) -> int | None:
@@ -221,7 +242,10 @@ def _carry(
     over the region, or ``floor``, whichever is highest), across to over the region's centre, down to
     ABOVE_CLEARANCE over its surface; the move across through joint space, the object kept up, when the
     straight line leaves the arm's reach; the way down through joint space too when the straight one
-    would leave the hand where put_down_object cannot lower the object (:func:`_down`)."""
+    would leave the hand where put_down_object cannot lower the object (:func:`_down`). Through joint
+    space the hand keeps its turn about its approach axis unless that axis is vertical (a top grasp): a
+    half turn about a side grasp's axis turns the object over. Before, a 15 cm vase reached a sill
+    tilted 109 degrees and fell over as the hand opened."""
     ee = arm.ee_pose()
     orientation = ee.orientation
     if yaw is not None and grasp.model.grasp is GraspKind.TOP:
@@ -230,6 +254,7 @@ def _carry(
     above = region.zmin + ABOVE_CLEARANCE
     transit = max(bottom, above, bottom if floor is None else floor) + grasp.bottom_offset
     cx, cy, _ = region.center
+    turnable = grasp.model.grasp is GraspKind.TOP
     legs: list[Vec3] = [
         (ee.position[0], ee.position[1], transit),
         (cx, cy, transit),
@@ -243,7 +268,7 @@ def _carry(
         if not result.reached and index == 1 and math.isinf(result.error):
             # The straight line leaves the arm's reach (it would have to change posture on the
             # way): go through joint space instead, keeping the object at the transit height.
-            result = arm.reach(leg, orientation, min_height=transit - TRANSIT_SAG)
+            result = arm.reach(leg, orientation, symmetric=turnable, min_height=transit - TRANSIT_SAG)
         if not result.reached:
             return result
     return result
@@ -261,8 +286,9 @@ def _down(arm: _Moving, grasp: GraspPose, region: Region, leg: Vec3, orientation
     if line.move_to(leg, orientation).reached and _lower(line, grasp, region)[0].reached:
         return arm.move_to(leg, orientation)
     low = region.zmin + PLACE_CLEARANCE + grasp.bottom_offset
-    if arm.dry_run().reach(leg, orientation, min_height=leg[2] - TRANSIT_SAG, down_to=low).reached:
-        return arm.reach(leg, orientation, min_height=leg[2] - TRANSIT_SAG, down_to=low)
+    turnable = grasp.model.grasp is GraspKind.TOP  # a half turn about a side grasp's axis turns it over
+    if arm.dry_run().reach(leg, orientation, turnable, min_height=leg[2] - TRANSIT_SAG, down_to=low).reached:
+        return arm.reach(leg, orientation, turnable, min_height=leg[2] - TRANSIT_SAG, down_to=low)
     return arm.move_to(leg, orientation)
 
 
@@ -488,7 +514,7 @@ def can_carry(
     hand = world.arm(arm).dry_run(folded)
     x, y, z = grasp.position
     moves: list[tuple[str, Callable[[], MotionResult]]] = [
-        ("reaching the pre-grasp pose", lambda: hand.reach(grasp.pregrasp, grasp.orientation)),
+        ("reaching the pre-grasp pose", lambda: _approach(hand, grasp)),
         ("moving in to grasp it", lambda: hand.move_to(grasp.position, grasp.orientation)),
         ("lifting it", lambda: hand.move_to((x, y, z + LIFT_HEIGHT), hand.ee_pose().orientation, symmetric=False)),
     ]
