@@ -14,6 +14,9 @@
    data is fresh when it is used).
 5. For every step, list the drop-in alternatives: components that accept the same bindings and meet
    the same needs (the executor fails over to them).
+6. Check the plan by progression over its steps' add and delete effects (``actions.progression``): a
+   statement a step or goal needs that an earlier step deleted is achieved again after it, by a new
+   step, or the plan is refused naming it (``ComposeConfig.protect``).
 
 When the requirement alone cannot be composed and its action class has KnowRob-style sub-actions,
 each sub-action is composed in their partial order and the plans are concatenated ("decomposed").
@@ -79,6 +82,10 @@ class ComposeConfig:
     # cbrs:areaRole marks (home.ttl marks home:InformationEntity, home:SpatialData, home:Feature); lists override
     area_informs: tuple[str, ...] | None = None
     area_leads: tuple[str, ...] | None = None
+    # check each extracted plan by progression over its add and delete effects: a statement a step needs
+    # (or a goal) that an earlier step deletes is achieved again after it, or the plan is refused naming it
+    protect: bool = True
+    max_reachieved: int = 8  # statements achieved again per extraction before the plan is refused
 
 
 class PlanStatus(Enum):
@@ -378,12 +385,15 @@ class Composer:
         graph = self.graph(requirement)
         trace = bidirectional_search(graph)
         areas = self.area_rule(requirement)
-        extraction = Extraction(graph, trace, self.config.objective, self.config.max_steps, areas)
+        config = self.config
+        extraction = Extraction(
+            graph, trace, config.objective, config.max_steps, areas, config.protect, config.max_reachieved
+        )
         if not extraction.solved:
             return Attempt(requirement, graph, trace, None, tuple(extraction.unsatisfied))
         orderings = self._orderings(task)
         plan = extraction.plan(task.name if task else requirement.iri, self.index, orderings)
-        return Attempt(requirement, graph, trace, plan, ())
+        return Attempt(requirement, graph, trace, plan, tuple(extraction.unsatisfied) if plan is None else ())
 
     def area_rule(self, requirement: Requirement) -> AreaRule | None:
         """The SEA rule for ``requirement``'s steps: where its things are (the belief's positions when

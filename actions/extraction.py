@@ -5,7 +5,9 @@ requirement supplies (SRI); for an input, the output of a sibling (a step made f
 otherwise a new step of the best qualified provider of a lower forward level, so the extraction cannot
 loop. Then identical invocations of static-data and method components are merged, the steps ordered
 (producers first, the action ontology's orderings respected, each step as late as it can be) and every
-step's drop-in alternatives listed. ``actions.composer`` says when and for what it is run.
+step's drop-in alternatives listed; a statement a step needs that an earlier one deletes is achieved
+again by a new step after it (``actions.progression`` finds it). ``actions.composer`` says when and for
+what it is run.
 """
 
 from __future__ import annotations
@@ -21,9 +23,9 @@ from cbrs.actions.areas import AreaRule
 from cbrs.actions.errors import OrderingConflictError
 from cbrs.actions.graph import SRE, SRI, SRO, Edge, Need, ServiceResourceGraph, statement_text
 from cbrs.actions.plan import Binding, Plan, PlanStep, Source
+from cbrs.actions.progression import Clobbered, progress, threatens
 from cbrs.actions.search import SearchTrace
 from cbrs.actions.unmet import GOAL, Unsatisfied
-from cbrs.kb import Statement
 from cbrs.kb.namespaces import shorten
 from cbrs.reasoner.degrees import degree_of_match
 from cbrs.reasoner.taxonomy import TaxonomyIndex
@@ -70,8 +72,14 @@ class Extraction:
         objective: Objective,
         max_steps: int,
         areas: AreaRule | None = None,
+        protect: bool = True,
+        max_reachieved: int = 8,
     ) -> None:
         self.graph = graph
+        self.protect = protect  # check the plan by progression and achieve again what a step undoes
+        self.max_reachieved = max_reachieved
+        self._after: list[tuple[int, int]] = []  # (deleter, step achieving again what it deleted, or a feeder)
+        self._number: dict[int, int] = {}  # step id -> its index in the last draft
         self.trace = trace
         self.objective = objective
         self.max_steps = max_steps
@@ -81,6 +89,7 @@ class Extraction:
         self._explained: set[str] = set()  # vertices whose blocked needs _why has followed
         self._best: dict[tuple[str, str], dict[str, Edge]] = {}  # see _best_from
         self.steps: dict[int, _Step] = {}
+        self._next_id = 0
         self.unsatisfied: list[Unsatisfied] = []
         goal_needs = [(SRO, n) for n in graph.needs(SRO)] + [(SRE, n) for n in graph.needs(SRE)]
         if not goal_needs:
@@ -101,7 +110,7 @@ class Extraction:
                     if all((cause.need, cause.consumer) != (u.need, u.consumer) for u in self.unsatisfied):
                         self.unsatisfied.append(cause)
             return
-        self._expand()
+        self._expand(deque([self._new(GOAL, None).id]))
         if self.areas is not None and not self.unsatisfied:
             self._check_areas()
 
@@ -206,60 +215,67 @@ class Extraction:
         return (-round(edge.similarity, 9), round(cost, 9), level, edge.source, edge.offer.name)
 
     def _new(self, node: str, made_for: int | None) -> _Step:
-        step = _Step(len(self.steps), node, made_for)
+        step = _Step(self._next_id, node, made_for)
+        self._next_id += 1  # not len(steps): merging shared invocations removes steps
         self.steps[step.id] = step
         return step
 
-    def _expand(self) -> None:
-        goal = self._new(GOAL, None)
-        queue: deque[int] = deque([goal.id])
+    def _expand(self, queue: deque[int]) -> None:
         while queue:
             step = self.steps[queue.popleft()]
             needs = self._goal_needs if step.node == GOAL else [(step.node, n) for n in self.graph.needs(step.node)]
             # pre-actions (P-E) first, then pre-services (I-O), as in the paper's backward search
             needs.sort(key=lambda item: item[1].role != "precondition")
-            below = 10**9 if step.node == GOAL else self.trace.levels[step.node]
             for node, need in needs:
-                options = self._options(node, need, below)
-                given = [e for e in options if e.source == SRI]
-                if given and len(given) < len(options):
-                    # another goal's thing (the tray the cup goes to) is no value for the steps of this
-                    # one (where the base parks to load the pen), which have a provider of their own
-                    given = [e for e in given if not self._foreign(step, e)]
-                if given:
-                    step.bindings.append(
-                        _Bound(need, min(given, key=lambda e: (*self._fit(step, e), *self._key(e))), None)
-                    )
-                    continue
-                mine = [(e, p) for p in step.producers for e in options if e.source == self.steps[p].node]
-                if mine:  # a step already made for this consumer meets this need too
-                    edge, producer_id = min(mine, key=lambda item: (self._key(item[0]), item[1]))
-                    step.bindings.append(_Bound(need, edge, producer_id))
-                    continue
-                sibling = self._sibling(step, node, need)
-                if sibling is not None:
-                    step.bindings.append(sibling)
-                    continue
-                served = (need.statement.subject, need.statement.object) if need.statement is not None else ()
-                about = (*served, *step.about)
-                candidates = [e for e in options if e.source != SRI]
-                if self.areas is not None:
-                    fit = [e for e in candidates if self._judge(e.source, about).why is None]
-                    if not fit:
-                        self._pass_over(step, node, need, candidates, about)
-                        continue
-                    candidates = fit
-                best = min(candidates, key=self._key)
-                if len(self.steps) > self.max_steps:
-                    existing = next((other for other in self.steps.values() if other.node == best.source), None)
-                    if existing is not None:
-                        step.bindings.append(_Bound(need, best, existing.id))
-                        continue
-                producer = self._new(best.source, step.id)
-                producer.about = about
-                step.producers.append(producer.id)
-                step.bindings.append(_Bound(need, best, producer.id))
-                queue.append(producer.id)
+                self._bind(step, node, need, queue)
+
+    def _bind(self, step: _Step, node: str, need: Need, queue: deque[int], again: bool = False) -> bool:
+        """Bind ``need`` of ``step`` by the preferences above; ``again``: to a new step, never to what the
+        task gives or an existing step (the need was undone after those: see :meth:`_achieve_again`).
+        False when no provider can serve (the reason is in ``unsatisfied``, unless ``again``)."""
+        below = 10**9 if step.node == GOAL else self.trace.levels[step.node]
+        options = self._options(node, need, below)
+        if not again:
+            given = [e for e in options if e.source == SRI]
+            if given and len(given) < len(options):
+                # another goal's thing (the tray the cup goes to) is no value for the steps of this
+                # one (where the base parks to load the pen), which have a provider of their own
+                given = [e for e in given if not self._foreign(step, e)]
+            if given:
+                step.bindings.append(_Bound(need, min(given, key=lambda e: (*self._fit(step, e), *self._key(e))), None))
+                return True
+            mine = [(e, p) for p in step.producers for e in options if e.source == self.steps[p].node]
+            if mine:  # a step already made for this consumer meets this need too
+                edge, producer_id = min(mine, key=lambda item: (self._key(item[0]), item[1]))
+                step.bindings.append(_Bound(need, edge, producer_id))
+                return True
+            sibling = self._sibling(step, node, need)
+            if sibling is not None:
+                step.bindings.append(sibling)
+                return True
+        served = (need.statement.subject, need.statement.object) if need.statement is not None else ()
+        about = (*served, *step.about)
+        candidates = [e for e in options if e.source != SRI]
+        if not candidates:
+            return False
+        if self.areas is not None:
+            fit = [e for e in candidates if self._judge(e.source, about).why is None]
+            if not fit:
+                self._pass_over(step, node, need, candidates, about)
+                return False
+            candidates = fit
+        best = min(candidates, key=self._key)
+        if len(self.steps) > self.max_steps and not again:
+            existing = next((other for other in self.steps.values() if other.node == best.source), None)
+            if existing is not None:
+                step.bindings.append(_Bound(need, best, existing.id))
+                return True
+        producer = self._new(best.source, step.id)
+        producer.about = about
+        step.producers.append(producer.id)
+        step.bindings.append(_Bound(need, best, producer.id))
+        queue.append(producer.id)
+        return True
 
     def _fit(self, step: _Step, edge: Edge) -> tuple[int, int]:
         """The order of the values the task gives for a need of ``step``: the most about what it serves
@@ -474,10 +490,30 @@ class Extraction:
 
     # -- from the extraction to a Plan -----------------------------------------------------------
 
-    def plan(self, task: str, index: TaxonomyIndex, orderings: list[tuple[str, str, str]]) -> Plan:
+    def plan(self, task: str, index: TaxonomyIndex, orderings: list[tuple[str, str, str]]) -> Plan | None:
+        """The plan, checked by progression from what SRI offers (the requirement's preconditions and the
+        world state) when ``protect`` is set: a statement a step needs that an earlier step deletes is
+        achieved again after that step, at most ``max_reachieved`` times. None when it cannot be (the
+        statement and its deleter are in ``unsatisfied``)."""
+        initial = [o.statement for o in self.graph.vertices[SRI].offers if o.statement is not None]
+        achieved_again = 0
+        while True:
+            plan = self._draft(task, index, orderings)
+            if not self.protect:
+                return plan
+            # only what a step deletes is this rule's: the extraction binds every need to what meets it
+            undone = [u for u in progress(plan, initial, self.graph.matcher) if u.deleter is not None]
+            if not undone:
+                return plan
+            if achieved_again >= self.max_reachieved or not self._achieve_again(undone[0]):
+                self.unsatisfied.insert(0, self._undone(plan, undone[0]))
+                return None
+            achieved_again += 1
+
+    def _draft(self, task: str, index: TaxonomyIndex, orderings: list[tuple[str, str, str]]) -> Plan:
         self._merge_shared()
         order = self._order(index, orderings)
-        number = {step_id: n for n, step_id in enumerate(order, start=1)}
+        number = self._number = {step_id: n for n, step_id in enumerate(order, start=1)}
         requirement = self.graph.requirement
         steps: list[PlanStep] = []
         for step_id in order:
@@ -498,12 +534,61 @@ class Extraction:
                     effects=tuple(o.statement for o in vertex.offers if o.statement is not None),
                     cost=vertex.cost,
                     alternatives=tuple(self._alternatives(step)),
+                    deletes=ad.deletes,
                 )
             )
         goals = tuple(self._binding(b, number, requirement.iri) for b in self.steps[0].bindings)
         everything = [b for s in steps for b in s.bindings] + list(goals)
         similarity = sum(b.similarity for b in everything) / len(everything)
         return Plan(task, requirement.iri, "direct", tuple(steps), goals, similarity, sum(s.cost for s in steps))
+
+    def _achieve_again(self, undone: Clobbered) -> bool:
+        """Bind the need ``undone`` names to a new step of its best provider, ordered after the step that
+        deleted it, with the new steps that feed it (a perception step then sees the world after the
+        deletion); a step that fed only the undone need is dropped. False when no provider can."""
+        assert undone.deleter is not None
+        by_index = {n: step_id for step_id, n in self._number.items()}
+        consumer = self.steps[0 if undone.consumer is None else by_index[undone.consumer]]
+        deleter = by_index[undone.deleter]
+        position, bound = next((n, b) for n, b in enumerate(consumer.bindings) if b.need.statement == undone.statement)
+        node = self._goal_node(bound.need) if consumer.id == 0 else consumer.node
+        unmet, first_new = len(self.unsatisfied), self._next_id
+        del consumer.bindings[position]
+        queue: deque[int] = deque()
+        if not self._bind(consumer, node, bound.need, queue, again=True):
+            consumer.bindings.insert(position, bound)
+            return False
+        consumer.bindings.insert(position, consumer.bindings.pop())  # where the need was declared
+        self._expand(queue)
+        self._prune()
+        self._things.clear()  # what each step handles: the consumer's sources changed
+        if self.areas is not None:
+            self._check_areas()
+        new = [s for s in self.steps if s >= first_new and not self.graph.vertices[self.steps[s].node].shareable]
+        self._after += [(deleter, step_id) for step_id in new]
+        return len(self.unsatisfied) == unmet
+
+    def _prune(self) -> None:
+        """Drop the steps no other step or goal takes anything from (the achiever an undone need had)."""
+        while True:
+            used = {b.source for s in self.steps.values() for b in s.bindings if b.source is not None}
+            unused = [step_id for step_id in self.steps if step_id != 0 and step_id not in used]
+            if not unused:
+                return
+            for step_id in unused:
+                del self.steps[step_id]
+            for step in self.steps.values():
+                step.producers = [p for p in step.producers if p in self.steps]
+
+    def _undone(self, plan: Plan, undone: Clobbered) -> Unsatisfied:
+        """``undone`` (in the draft ``plan``) as an unmet need: the statement, its consumer, its deleter."""
+        by_index = {n: step_id for step_id, n in self._number.items()}
+        consumer = self.steps[0 if undone.consumer is None else by_index[undone.consumer]]
+        need = next(b.need for b in consumer.bindings if b.need.statement == undone.statement)
+        node = self._goal_node(need) if consumer.id == 0 else consumer.node
+        assert undone.deleter is not None
+        deleter = plan.step(undone.deleter).component
+        return Unsatisfied(need.text(), node, self._path(consumer, need), deleted_by=(deleter,))
 
     def _binding(self, bound: _Bound, number: dict[int, int], requirement: str) -> Binding:
         need, edge = bound.need, bound.edge
@@ -582,6 +667,9 @@ class Extraction:
                             shorten(self.steps[second].node),
                         )
                     dag.add_edge(first, second)
+        for deleter, later in self._after:  # a step that achieves again what ``deleter`` deleted, and its feeders
+            if deleter in dag and later in dag and not nx.has_path(dag, later, deleter):
+                dag.add_edge(deleter, later)
         self._protect(index, dag)
         placed: dict[int, int] = {}  # step -> position counted from the end
         reverse: list[int] = []
@@ -599,7 +687,7 @@ class Extraction:
         """Order every step that deletes a statement a consumer relies on outside the span from its
         producer to its consumer: before the producer, or else after the consumer (a goal must still
         hold at the end, so its threats go before its producer). A threat that fits neither way is
-        left, and execution's verification catches it."""
+        left to :meth:`plan`, whose check by progression achieves the statement again after it."""
         deleting = {
             s.id: ad.deletes
             for s in self.steps.values()
@@ -612,7 +700,7 @@ class Extraction:
                     continue
                 for threat, deletes in sorted(deleting.items()):
                     if threat in (consumer.id, bound.source) or not any(
-                        _threatens(index, deleted, needed) for deleted in deletes
+                        threatens(index, deleted, needed) for deleted in deletes
                     ):
                         continue
                     options = []
@@ -692,17 +780,6 @@ class Extraction:
 def _goal_text(need: Need) -> str:
     """A need of SRO or SRE as the requirement's goal: its output or effect."""
     return "the requirement's " + need.text().replace("precondition", "effect", 1).replace("input", "output", 1)
-
-
-def _threatens(index: TaxonomyIndex, deleted: Statement, needed: Statement) -> bool:
-    """Whether deleting ``deleted`` may falsify ``needed``: the same relation, between things of which
-    one is a kind of the other on both ends."""
-    if deleted.predicate != needed.predicate:
-        return False
-    return all(
-        index.is_a(a, b) or index.is_a(b, a)
-        for a, b in ((deleted.subject, needed.subject), (deleted.object, needed.object))
-    )
 
 
 __all__ = ["Extraction", "Objective"]

@@ -30,6 +30,7 @@ class Unsatisfied:
     unrunnable: tuple[tuple[str, str], ...] = ()  # (component, why): planned for it, but cannot run here
     out_of_area: tuple[tuple[str, str], ...] = ()  # (component, why): provides it, but not where it is needed
     provided: tuple[tuple[str, str], ...] = ()  # (component, effect): what is provided about the need's subject
+    deleted_by: tuple[str, ...] = ()  # components whose delete effect undoes it before it is needed
 
     def text(self) -> str:
         found = self._text()
@@ -50,6 +51,12 @@ class Unsatisfied:
             need = "effect " + need.removeprefix("precondition ")
         if self.consumer == SRO and need.startswith("input "):  # the requirement's output is the end's input
             need = "output " + need.removeprefix("input ")
+        if self.deleted_by:
+            by = ", ".join(shorten(c) for c in self.deleted_by)
+            return (
+                f"{need} of {consumer}{via} is deleted by {by} before it is needed, and no component can "
+                f"achieve it again after that; {self.remedy()}"
+            )
         if self.cycle:
             return f"only a cycle of components provides {need} of {consumer}{via}"
         if self.consumer == SRI:  # the task gives it: nothing to provide, but its class is unknown
@@ -75,6 +82,13 @@ class Unsatisfied:
         return self._remedy()
 
     def _remedy(self) -> str:
+        if self.deleted_by:
+            statement = self.need.split(" ", 1)[-1]
+            return (
+                f"register a component whose effect is {statement} and that can run after "
+                f"{', '.join(shorten(c) for c in self.deleted_by)}, or compose without protecting what steps "
+                "need (ComposeConfig(protect=False) from Python)"
+            )
         if self.out_of_area:
             return (
                 "register a component that provides it whose effective area (cbrs:hasSEAModel) covers the things "
@@ -110,6 +124,7 @@ class Unsatisfied:
             "unrunnable": [{"component": component, "why": why} for component, why in self.unrunnable],
             "out_of_area": [{"component": component, "why": why} for component, why in self.out_of_area],
             "provided": [{"component": component, "effect": effect} for component, effect in self.provided],
+            "deleted_by": list(self.deleted_by),
         }
 
 

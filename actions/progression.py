@@ -1,0 +1,91 @@
+"""A plan checked by progression: its steps' add and delete effects applied in order from the state it
+starts in, every precondition and every goal must hold when it is needed.
+
+The statements are between classes, as composition's are. A precondition or a goal holds when a fact of
+the state meets it as an effect would (``Matcher.statement``: the degrees composition accepts); a delete
+effect removes every fact it may falsify (the same relation between things of which one is a kind of the
+other on both ends, the rule the extraction orders threats by). A step's deletes apply before its adds,
+as in STRIPS, so a step that deletes and adds the same statement leaves it true.
+
+Composition checks each plan it extracts this way (``actions.extraction``): a statement that held at the
+start, or that a step made, and that a later step deletes before it is needed, is achieved again or the
+plan is refused naming it (docs/composition.md, "A statement a later step undoes").
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+from cbrs.actions.graph import Matcher, statement_text
+from cbrs.actions.plan import Plan
+from cbrs.kb import Statement
+from cbrs.reasoner.taxonomy import TaxonomyIndex
+
+
+@dataclass(frozen=True)
+class Clobbered:
+    """A statement needed when it no longer holds: a precondition of step ``consumer`` (None: a goal of the
+    plan, needed at its end), deleted by step ``deleter`` (None: no step deleted it; it never held)."""
+
+    statement: Statement
+    consumer: int | None
+    deleter: int | None
+
+    def text(self, plan: Plan) -> str:
+        need = f"goal {statement_text(self.statement)}"
+        if self.consumer is not None:
+            need = f"precondition {statement_text(self.statement)} of step {self.consumer}"
+            need += f" ({plan.step(self.consumer).component})"
+        if self.deleter is None:
+            return f"the {need} does not hold when it is needed"
+        deleter = plan.step(self.deleter).component
+        return f"the {need} was deleted by step {self.deleter} ({deleter}) and not achieved again"
+
+
+def threatens(index: TaxonomyIndex, deleted: Statement, needed: Statement) -> bool:
+    """Whether deleting ``deleted`` may falsify ``needed``: the same relation, between things of which
+    one is a kind of the other on both ends."""
+    if deleted.predicate != needed.predicate:
+        return False
+    return all(
+        index.is_a(a, b) or index.is_a(b, a)
+        for a, b in ((deleted.subject, needed.subject), (deleted.object, needed.object))
+    )
+
+
+def progress(plan: Plan, initial: Iterable[Statement], matcher: Matcher) -> list[Clobbered]:
+    """Every precondition and goal of ``plan`` that does not hold when it is needed, in plan order, with
+    the step that deleted it; ``initial``: what holds when the plan starts (the requirement's
+    preconditions and the world state composition offered)."""
+    state: list[Statement] = list(dict.fromkeys(initial))
+    deleted_by: dict[Statement, int] = {}  # fact -> the step that deleted it last
+    found: list[Clobbered] = []
+    for step in plan.steps:
+        for binding in step.preconditions:
+            if binding.statement is not None and not _holds(binding.statement, state, matcher):
+                found.append(_clobbered(binding.statement, step.index, deleted_by, matcher))
+        removed = [f for f in state if any(threatens(matcher.index, d, f) for d in step.deletes)]
+        for fact in removed:
+            deleted_by[fact] = step.index
+        state = [f for f in state if f not in removed]
+        state += [e for e in step.effects if e not in state]
+    for goal in plan.goals:
+        if goal.statement is not None and not _holds(goal.statement, state, matcher):
+            found.append(_clobbered(goal.statement, None, deleted_by, matcher))
+    return found
+
+
+def _holds(needed: Statement, state: Sequence[Statement], matcher: Matcher) -> bool:
+    return any(matcher.statement(needed, fact) is not None for fact in state)
+
+
+def _clobbered(
+    needed: Statement, consumer: int | None, deleted_by: dict[Statement, int], matcher: Matcher
+) -> Clobbered:
+    """The latest step that deleted a fact which would have met ``needed``."""
+    deleters = [step for fact, step in deleted_by.items() if matcher.statement(needed, fact) is not None]
+    return Clobbered(needed, consumer, max(deleters) if deleters else None)
+
+
+__all__ = ["Clobbered", "progress", "threatens"]
