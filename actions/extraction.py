@@ -505,8 +505,9 @@ class Extraction:
             undone = [u for u in progress(plan, initial, self.graph.matcher) if u.deleter is not None]
             if not undone:
                 return plan
-            if achieved_again >= self.max_reachieved or not self._achieve_again(undone[0]):
-                self.unsatisfied.insert(0, self._undone(plan, undone[0]))
+            exhausted = achieved_again >= self.max_reachieved
+            if exhausted or not self._achieve_again(undone[0]):
+                self.unsatisfied.insert(0, self._undone(plan, undone[0], exhausted))
                 return None
             achieved_again += 1
 
@@ -580,15 +581,16 @@ class Extraction:
             for step in self.steps.values():
                 step.producers = [p for p in step.producers if p in self.steps]
 
-    def _undone(self, plan: Plan, undone: Clobbered) -> Unsatisfied:
-        """``undone`` (in the draft ``plan``) as an unmet need: the statement, its consumer, its deleter."""
+    def _undone(self, plan: Plan, undone: Clobbered, exhausted: bool) -> Unsatisfied:
+        """``undone`` (in the draft ``plan``) as an unmet need: the statement, its consumer, its deleter, and
+        whether achieving statements again went round in circles (``exhausted``: ``max_reachieved`` times)."""
         by_index = {n: step_id for step_id, n in self._number.items()}
         consumer = self.steps[0 if undone.consumer is None else by_index[undone.consumer]]
         need = next(b.need for b in consumer.bindings if b.need.statement == undone.statement)
         node = self._goal_node(need) if consumer.id == 0 else consumer.node
         assert undone.deleter is not None
         deleter = plan.step(undone.deleter).component
-        return Unsatisfied(need.text(), node, self._path(consumer, need), deleted_by=(deleter,))
+        return Unsatisfied(need.text(), node, self._path(consumer, need), cycle=exhausted, deleted_by=(deleter,))
 
     def _binding(self, bound: _Bound, number: dict[int, int], requirement: str) -> Binding:
         need, edge = bound.need, bound.edge

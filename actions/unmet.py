@@ -24,7 +24,8 @@ class Unsatisfied:
     need: str
     consumer: str
     chain: tuple[str, ...] = ()  # from the requirement's goal down to this need
-    cycle: bool = False  # providers exist, but each needs (through others) what this need blocks
+    cycle: bool = False  # providers exist, but each needs (through others) what this need blocks; with
+    # deleted_by: each step achieving it again undid another need, up to ComposeConfig.max_reachieved times
     undeclared: tuple[str, ...] = ()  # classes the need names that the ontology does not have
     near: tuple[tuple[str, str], ...] = ()  # (undeclared class, the declared class its name is closest to)
     unrunnable: tuple[tuple[str, str], ...] = ()  # (component, why): planned for it, but cannot run here
@@ -53,10 +54,12 @@ class Unsatisfied:
             need = "output " + need.removeprefix("input ")
         if self.deleted_by:
             by = ", ".join(shorten(c) for c in self.deleted_by)
-            return (
-                f"{need} of {consumer}{via} is deleted by {by} before it is needed, and no component can "
-                f"achieve it again after that; {self.remedy()}"
+            again = (
+                "each step that achieves it again undoes in turn another statement the plan needs"
+                if self.cycle
+                else "no component can achieve it again after that"
             )
+            return f"{need} of {consumer}{via} is deleted by {by} before it is needed, and {again}; {self.remedy()}"
         if self.cycle:
             return f"only a cycle of components provides {need} of {consumer}{via}"
         if self.consumer == SRI:  # the task gives it: nothing to provide, but its class is unknown
@@ -82,6 +85,11 @@ class Unsatisfied:
         return self._remedy()
 
     def _remedy(self) -> str:
+        if self.deleted_by and self.cycle:
+            return (
+                "ask for the statements that undo each other in separate tasks, or allow more of them to be "
+                "achieved again (ComposeConfig.max_reachieved from Python)"
+            )
         if self.deleted_by:
             statement = self.need.split(" ", 1)[-1]
             return (

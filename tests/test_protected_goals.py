@@ -16,6 +16,7 @@ from dataclasses import replace
 import pytest
 
 from cbrs.actions.composer import ComposeConfig, Composer, PlanStatus
+from cbrs.actions.graph import SRE
 from cbrs.actions.plan import Plan
 from cbrs.actions.progression import progress
 from cbrs.kb import KnowledgeBase, Requirement, Statement
@@ -149,3 +150,21 @@ def test_a_plan_nothing_undoes_is_the_same_with_and_without_protection(bundled_k
     )
     for task in ("FetchMyPen", "RobotArmServeACup"):
         assert protected.compose(task).to_dict() == unprotected.compose(task).to_dict(), task
+
+
+def test_goals_that_undo_each_other_are_refused_after_the_bound(bundled_kb: KnowledgeBase) -> None:
+    """Near the person and near the pen's place at once: each drive deletes the other's goal, so each
+    achieved again undoes the other, until ``max_reachieved``; before, the plan was accepted and its run
+    failed one goal."""
+    composer = Composer(bundled_kb, ComposeConfig(matched=False, max_reachieved=3))
+    fetch = composer.task("FetchMyPen").requirement
+    near_place = Statement(HOME + "MobileRobot", HOME + "isNear", HOME + "ObjectPlace")
+    both = replace(fetch, iri="urn:test:NearBoth", for_task=None, effects=(NEAR_PERSON, near_place))
+    result = composer.compose(both)
+    assert result.status is PlanStatus.UNSOLVABLE
+    [undone] = result.unsatisfied
+    drives = {(SVC + "NavigateToPerson_P3DX01",), (SVC + "NavigateToPlace_P3DX01",)}
+    assert undone.cycle and undone.deleted_by in drives and undone.consumer == SRE
+    assert undone.text().startswith("effect (home:MobileRobot, home:isNear, home:")
+    assert "each step that achieves it again undoes in turn another statement" in undone.text()
+    assert "ComposeConfig.max_reachieved" in undone.remedy()
