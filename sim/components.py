@@ -24,7 +24,7 @@ import logging
 import math
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 from typing import Any
 
 from cbrs.actions.answers import StoreClasses, check_designation
@@ -35,7 +35,7 @@ from cbrs.actions.plan import Plan, PlanStep
 from cbrs.actions.remote import RemoteComponent, Transport
 from cbrs.kb import KnowledgeBase, Requirement, Statement
 from cbrs.kb.errors import KnowledgeBaseError, NotFoundError
-from cbrs.kb.home_check import PersonError, person_for
+from cbrs.kb.home_check import person_for
 from cbrs.kb.model import Advertisement
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import MapObject, NotGraspableError, Person, SemanticMap, Thing, designate, local_name
@@ -44,9 +44,22 @@ from cbrs.settings import setting
 from cbrs.sim import predicates as pred
 from cbrs.sim import sight, skills
 from cbrs.sim.arms import ArmSide
+from cbrs.sim.context import SimContext, SkillFailed, Work, check_outcome, robot_camera
 from cbrs.sim.errors import GraspMisfitError, MovesRefusedError, SimulationError
 from cbrs.sim.geometry import Pose2D, Region, Vec3
 from cbrs.sim.grasping import GraspKind, GraspPose, ObjectModel, compute_grasp_pose
+from cbrs.sim.grounding import (
+    docking_pose,
+    manipulation_of,
+    meant_person,
+    model_of,
+    people_given,
+    place_of,
+    task_inputs_of,
+    thing_iri,
+    thing_region,
+)
+from cbrs.sim.hold_choice import Candidates, GraspChoice, first_clear, refuse_moves, seen_extent
 from cbrs.sim.mapping import OccupancyGrid, build_occupancy_grid
 from cbrs.sim.perceived import SEARCH_RADIUS, PerceivedWorld
 from cbrs.sim.perception import (
@@ -106,68 +119,6 @@ ARM_TIE = 0.01
 """Two arms whose mounts are within 1 cm as far from a target reach it equally well."""
 SETTLE_DISTANCE = 0.03
 """Before a re-plan, an arm lets go of what it holds only with its hand within 3 cm of where it took it."""
-
-
-@dataclass(frozen=True)
-class GraspChoice:
-    """Which of an object's approaches an arm holds it by from where it takes it to where it lets it go
-    (``model.grasp``), and why each approach its class prefers to that one was passed over."""
-
-    arm: ArmSide
-    model: ObjectModel
-    purpose: str
-    """What the hold is for: "taking the Cup", "loading the Cup onto the platform"..."""
-    passed: tuple[tuple[GraspKind, str], ...] = ()
-
-    def __str__(self) -> str:
-        model = self.model
-        text = f"{self.purpose}: the {self.arm.value} arm holds the {model.name} by its {model.grasp.value} grasp"
-        if self.passed:
-            text += " (" + "; ".join(f"not by its {kind.value} grasp: {why}" for kind, why in self.passed) + ")"
-        return text
-
-
-@dataclass
-class SimContext:
-    """What sim components share: the world, the knowledge base, and what the arms are doing."""
-
-    world: HomeWorld
-    kb: KnowledgeBase
-    grid: OccupancyGrid | None = None
-    focus: str | None = None  # the object an arm last took (by name)
-    grasp: GraspPose | None = None  # the grasp pose of the object the arm is working on
-    seen: ObjectEstimate | None = None  # where and how it lay when ``grasp`` was computed for it
-    arm: ArmSide = ArmSide.LEFT
-    region: Region | None = None  # where the carried object goes
-    spot: Region | None = None  # the part of ``region`` the arm carrying the object sets it down on
-    last_arm: ArmSide | None = None  # the arm that acted last, so a tie goes to the other
-    inputs: Mapping[str, Any] = field(default_factory=dict)  # what the running component was given
-    belief: PerceivedWorld | None = None  # where the robots believe things are
-    designated: frozenset[str] = frozenset()  # the things the running task's inputs name (IRIs)
-    acted: bool = False  # a component has run in this world (the checks before a run are done)
-    choices: list[GraspChoice] = field(default_factory=list)  # the grasps chosen in this run, in order
-    plan: Plan | None = None  # the plan being run, and the values the task gives its steps (``given``)
-    given: Mapping[str, Any] = field(default_factory=dict)
-    component: str | None = None  # the IRI of the running component
-    step: PlanStep | None = None  # the plan's step being run, and every step's inputs known at its start
-    known: Mapping[int, Mapping[str, Any]] = field(default_factory=dict)
-
-    @property
-    def map(self) -> SemanticMap:
-        return self.world.map
-
-    @property
-    def object(self) -> str | None:
-        """The object an arm last took in hand."""
-        return self.focus or (self.grasp.model.name if self.grasp is not None else None)
-
-
-Work = Callable[[SimContext, Mapping[str, Any], str], dict[str, Any]]
-"""A skill as a component: (context, inputs, the component's device name) -> outputs."""
-
-
-class SkillFailed(Exception):
-    """A skill reported failure; the message is its reason."""
 
 
 class CannotLoadError(KnowledgeBaseError):
@@ -264,65 +215,6 @@ class SimComponent(Component):
         return Status.SUCCEEDED
 
 
-def _check(outcome: skills.Outcome) -> None:
-    if not outcome.succeeded:
-        raise SkillFailed(f"{outcome.skill}: {outcome.reason}")
-
-
-# -- what a value between steps means ------------------------------------------------------------
-
-
-def _iri(value: Any, what: str) -> str:
-    if isinstance(value, dict) and isinstance(value.get("@id"), str):
-        return str(value["@id"])
-    raise SkillFailed(f"expected a thing of the world for {what}, got {value!r}")
-
-
-def _knowledge(ctx: SimContext, value: Any) -> Manipulation:
-    """How to handle an object: from the semantic map for a designator, else as a ManipulationProperty
-    or GraspPose value carries it (an earlier step, maybe a remote one, looked it up)."""
-    if isinstance(value, dict) and "@id" in value:
-        iri = _iri(value, "an object")
-        obj = ctx.map.objects.get(iri)
-        if obj is None:
-            raise SkillFailed(f"the semantic map has no shape, size or grasp for {local_name(iri)}")
-        return Manipulation.of(obj)
-    found = from_json(value)
-    if isinstance(found, (GraspPlan, Manipulation)):
-        # The value names one approach; the map has the class's others to fall back on, after it, and a
-        # box's footprint (a value carries one width, which depends on how the hand turns to a box).
-        obj = ctx.map.objects.get(found.object)
-        if obj is None:
-            return Manipulation(found.object, found.model)
-        known = ObjectModel.of(obj)
-        model = found.model if found.model.approaches else found.model.preferring(known.preference)
-        return Manipulation(found.object, replace(model, footprint=known.footprint))
-    raise SkillFailed(f"expected an object, its manipulation property or its grasp, got {value!r}")
-
-
-def _model(ctx: SimContext, value: Any) -> ObjectModel:
-    return _knowledge(ctx, value).model
-
-
-def _place(ctx: SimContext, value: Any, what: str) -> Thing:
-    iri = _iri(value, what)
-    thing = ctx.map.things.get(iri)
-    if thing is None:
-        raise SkillFailed(f"the semantic map gives no extent for {local_name(iri)} ({what})")
-    return thing
-
-
-def _region(thing: Thing) -> Region:
-    box = thing.box
-    return Region(thing.name, box.min_x, box.max_x, box.min_y, box.max_y, box.min_z, box.max_z)
-
-
-def _dock(thing: Thing) -> Pose2D:
-    if thing.dock is None:
-        raise SkillFailed(f"the semantic map gives no docking pose at {thing.name}")
-    return Pose2D(thing.dock.x, thing.dock.y, thing.dock.yaw)
-
-
 def _reaching(ctx: SimContext, x: float, y: float) -> list[ArmSide]:
     """The free arms whose mounts are within their reach of (x, y), best first: the nearest, and on a
     tie not the one that just acted."""
@@ -352,15 +244,15 @@ def _free_arm(ctx: SimContext, x: float, y: float, what: str) -> ArmSide:
 
 
 def infer_object_property(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
-    return {"colourFeature": to_json(ColourFeature(_model(ctx, inputs["objectType"]).colour))}
+    return {"colourFeature": to_json(ColourFeature(model_of(ctx, inputs["objectType"]).colour))}
 
 
 def query_manipulation_property(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
-    return {"manipulationProperty": to_json(_knowledge(ctx, inputs["objectType"]))}
+    return {"manipulationProperty": to_json(manipulation_of(ctx, inputs["objectType"]))}
 
 
 def compute_grasp(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
-    known = _knowledge(ctx, inputs["manipulationProperty"])
+    known = manipulation_of(ctx, inputs["manipulationProperty"])
     return {"graspPose": to_json(GraspPlan(known.object, known.model))}
 
 
@@ -368,7 +260,7 @@ def _recognise(ctx: SimContext, camera: str, colour: str) -> ObjectEstimate:
     """The object of ``colour`` in the camera's image. Where several things of the home share the
     colour, it is the one the task names (else the one thing of that colour), looked for where it is
     believed to be: another thing of its colour is not it."""
-    _check(skills.clear_view(ctx.world))  # the camera between the arms: fold them first
+    check_outcome(skills.clear_view(ctx.world))  # the camera between the arms: fold them first
     frame = ctx.world.camera(camera).capture()
     alike = sorted(name for name, obj in ctx.world.objects.items() if obj.colour == colour)
     meant = [name for name in alike if ctx.world.objects[name].iri in ctx.designated] if len(alike) > 1 else alike
@@ -393,9 +285,9 @@ def recognise_by_colour(ctx: SimContext, inputs: Mapping[str, Any], device: str)
 
 def find_object_on_table(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     """FindCupOnTable, for whatever object its input names: by the object's colour, with the robot's camera."""
-    camera = _robot_camera(ctx, device)
+    camera = robot_camera(ctx, device)
     if "cup" in inputs:
-        colour = _model(ctx, inputs["cup"]).colour
+        colour = model_of(ctx, inputs["cup"]).colour
     elif "colourFeature" in inputs:  # standing in for a recogniser: it was given the colour itself
         colour = decode(inputs["colourFeature"], ColourFeature).colour
     else:
@@ -403,20 +295,11 @@ def find_object_on_table(ctx: SimContext, inputs: Mapping[str, Any], device: str
     return {"cupPosition": to_json(_recognise(ctx, camera, colour))}
 
 
-def _robot_camera(ctx: SimContext, robot: str) -> str:
-    """The camera mounted on a robot (home:mountedOn in the store)."""
-    rows = ctx.kb.select("mounted_cameras", {"robot": PREFIXES["svc"] + robot})
-    cameras = [local_name(row["device"].value) for row in rows if local_name(row["device"].value) in ctx.world.cameras]
-    if not cameras:
-        raise SkillFailed(f"no camera is mounted on {robot}")
-    return cameras[0]
-
-
 # -- the dual-arm robot ---------------------------------------------------------------------------
 
 
 def approach(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
-    model = _model(ctx, inputs["graspPose"])
+    model = model_of(ctx, inputs["graspPose"])
     estimate = decode(inputs["objectPosition"], ObjectEstimate)
     choice = _who_takes(ctx, estimate, model)
     _note(ctx, choice)
@@ -424,14 +307,14 @@ def approach(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[st
     ctx.grasp = _grasp_pose(ctx, estimate, choice.arm, choice.model)
     ctx.seen, ctx.focus = estimate, model.name
     ctx.last_arm = ctx.arm
-    _check(skills.approach_object(ctx.world, ctx.arm, ctx.grasp))
+    check_outcome(skills.approach_object(ctx.world, ctx.arm, ctx.grasp))
     return {}
 
 
 def _grasp_pose(ctx: SimContext, estimate: ObjectEstimate, side: ArmSide, held: ObjectModel) -> GraspPose:
     spec = ctx.world.arm_specs[side]
     hand = ctx.world.arm(side).hand
-    return compute_grasp_pose(held, estimate.position, estimate.yaw, spec.mount, spec.yaw, _extent(estimate), hand)
+    return compute_grasp_pose(held, estimate.position, estimate.yaw, spec.mount, spec.yaw, seen_extent(estimate), hand)
 
 
 def _who_takes(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel) -> GraspChoice:
@@ -479,7 +362,7 @@ def _fitting(ctx: SimContext, model: ObjectModel, sides: Sequence[ArmSide]) -> s
     when one can. Said once, not once for each arm and each way of passing it between them."""
     why = ""
     for side in sides:
-        gripping = _Candidates.of(model, functools.partial(skills.can_grip, hand=ctx.world.arm(side).hand))
+        gripping = Candidates.of(model, functools.partial(skills.can_grip, hand=ctx.world.arm(side).hand))
         if gripping.models:
             return ""
         why = why or gripping.refusal()
@@ -501,20 +384,20 @@ def _taking_to(
     will (:func:`_holdable`): over the spots of the place this arm reaches, nearest the centre first. An
     arm that can let it go there by no approach takes it by the first it can, as where it is not known:
     the carry passes it to the other arm. Of the approaches that pass those checks (the inverse
-    kinematics' of the end poses), the first whose moves the arm's planning would make (:func:`_clear`)
+    kinematics' of the end poses), the first whose moves the arm's planning would make (:func:`first_clear`)
     is taken; when none would, :class:`MovesRefusedError` before anything moves."""
     world, name = ctx.world, model.name
 
     def take(held: ObjectModel) -> str:
         return skills.can_take(world, estimate, side, held)
 
-    taking = _Candidates.of(model, take)
+    taking = Candidates.of(model, take)
     if not taking.models:
         raise SkillFailed(taking.refusal())
     end = _hold_end(ctx, name, side)
     if end is None:
         moves = functools.partial(skills.can_carry, world, estimate, side)
-        return _clear(taking, side, f"taking the {name}", moves), True
+        return first_clear(taking, side, f"taking the {name}", moves), True
     place, surface, spots = end
     first: dict[GraspKind, Region] = {}  # the spot the carry will aim at, by each approach that lets go there
 
@@ -529,9 +412,9 @@ def _taking_to(
         where = f"{spots_of} of {place.name} it reaches" if tried else f"{place.name} (no spot in reach)"
         return f"the {side.value} arm cannot hold the {name} by its {held.grasp.value} grasp over {where}"
 
-    both = _Candidates.of(model, take, letting_go)
+    both = Candidates.of(model, take, letting_go)
     if both.models:
-        served = _clear(
+        served = first_clear(
             both,
             side,
             f"taking the {name} to {place.name}",
@@ -547,39 +430,13 @@ def _taking_to(
         )
         return served, True
     unplaced = "; ".join(why for _, why in both.ruled_out)
-    passed_on = _clear(  # to be passed on: the take's moves are dry-run, as where the hold's end is not known
+    passed_on = first_clear(  # to be passed on: the take's moves are dry-run, as where the hold's end is not known
         taking,
         side,
         f"taking the {name} (to {place.name}, to be passed on: {unplaced})",
         lambda held: skills.can_carry(world, estimate, side, held),
     )
     return passed_on, False
-
-
-def _clear(
-    candidates: _Candidates,
-    side: ArmSide,
-    purpose: str,
-    moves: Callable[[ObjectModel], str],
-    spots: Mapping[GraspKind, Region] | None = None,
-) -> GraspChoice:
-    """The first of ``candidates`` whose ``moves`` the arm's planning would make, as they are asked (a dry
-    run: :func:`skills.can_carry`, over the spot of ``spots`` the carry by that approach will aim at): one
-    it would refuse is passed over saying why. A lone candidate is asked too. :class:`MovesRefusedError`
-    when it would refuse every one: the real moves are planned by the same planning from the same
-    posture, so they would fail the same way, only after the arm has moved (nu16 repro 04)."""
-    passed = list(candidates.ruled_out)
-    refused: list[tuple[str, tuple[float, float] | None, str]] = []
-    for held in candidates.models:
-        why = moves(held)
-        if not why:
-            return _Candidates([held], passed).choice(side, held, purpose)
-        passed.append((held.grasp, why))
-        spot = (spots or {}).get(held.grasp)
-        refused.append((held.grasp.value, (spot.center[0], spot.center[1]) if spot is not None else None, why))
-    name = candidates.models[0].name if candidates.models else ""
-    ruled_out = [(kind.value, why) for kind, why in candidates.ruled_out]
-    raise MovesRefusedError(name, side.value, purpose, refused, ruled_out)
 
 
 def _hold_end(
@@ -630,7 +487,7 @@ def _hold_end(
 def pick_up(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     if ctx.grasp is None:
         raise SkillFailed("no object was approached")
-    _check(skills.pick_up_object(ctx.world, ctx.arm, ctx.grasp))
+    check_outcome(skills.pick_up_object(ctx.world, ctx.arm, ctx.grasp))
     return {}
 
 
@@ -640,7 +497,7 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
     part of which is in reach is worked at that part. When no spot is in that arm's reach and the other
     arm reaches one, the object is first passed to the other arm."""
     world = ctx.world
-    place = _place(ctx, inputs["targetPlace"], "the target place")
+    place = place_of(ctx, inputs["targetPlace"], "the target place")
     ctx.region = region_of(place, place.iri in ctx.map.furniture)
     held = world.arm(ctx.arm).held
     carried = (world.name_of(held) if held is not None else None) or ctx.object or ""
@@ -689,7 +546,7 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
             lambda held: skills.can_grip(held, world.arm(taker).hand),
             lambda held: skills.can_set_down(world, taken, taker, held, target),
         ]
-        placing = _Candidates.of(model, *(checks if len(model.preference) > 1 else []))
+        placing = Candidates.of(model, *(checks if len(model.preference) > 1 else []))
         if not placing.models:
             raise SkillFailed(f"the {taker.value} arm reaches {place.name}, but {placing.refusal()}")
         # Both arms' moves of the pass are dry-run before the giver sets the object down (it holds it now);
@@ -700,14 +557,14 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
 
         def holds(spot: Region, _: ObjectModel, taken_by: ObjectModel) -> None:
             why = skills.can_carry_held(world, giver, spot, _floor(ctx, model, giver, holding, spot))
-            _refuse(why, model, giver, passing, spot, before)
+            refuse_moves(why, model, giver, passing, spot, before)
             there = _resting(spot, model, taken, world.time)
             floor = _floor(ctx, taken_by, taker, there.position, target)
             # the giver will have folded home by the time the taker moves
             why = skills.can_carry(world, there, taker, taken_by, target, floor=floor, folded=(giver,))
-            _refuse(why, taken_by, taker, passing, target, before)
+            refuse_moves(why, taken_by, taker, passing, target, before)
 
-        relay, _, taken_by = _relay_spot(ctx, taken, _Candidates([model]), placing, giver, taker, holds)
+        relay, _, taken_by = _relay_spot(ctx, taken, Candidates([model]), placing, giver, taker, holds)
         found = _set_down_for(ctx, device, model, giver, taker, relay, None)
         taker_spec = world.arm_specs[taker]
         _note(
@@ -715,7 +572,13 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
             placing.choice(taker, taken_by, f"carrying the {model.name} to {place.name}", "no spot to take it by it"),
         )
         grasp = compute_grasp_pose(
-            taken_by, found.position, found.yaw, taker_spec.mount, taker_spec.yaw, _extent(found), world.arm(taker).hand
+            taken_by,
+            found.position,
+            found.yaw,
+            taker_spec.mount,
+            taker_spec.yaw,
+            seen_extent(found),
+            world.arm(taker).hand,
         )
         for move in (skills.approach_object, skills.pick_up_object):
             _passing(move(world, taker, grasp), model, giver, taker)
@@ -728,7 +591,7 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
     grasped = world.arm(ctx.arm).held_grasp
     hand = world.arm(ctx.arm).ee_pose().position
     floor = None if grasped is None else _floor(ctx, grasped.model, ctx.arm, hand, target)
-    _check(skills.carry_object(world, ctx.arm, target, floor=floor))
+    check_outcome(skills.carry_object(world, ctx.arm, target, floor=floor))
     return {}
 
 
@@ -751,18 +614,18 @@ def _holdable(
 def put_down(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     if ctx.region is None:
         raise SkillFailed("nothing is being carried to a place")
-    _check(skills.put_down_object(ctx.world, ctx.arm, ctx.spot or ctx.region))
+    check_outcome(skills.put_down_object(ctx.world, ctx.arm, ctx.spot or ctx.region))
     return {}
 
 
 def fill_from_tap(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     """FillCupFromTap: the container its input names, from the tap its input names, by the free arm."""
-    container = _model(ctx, inputs["cup"]).name
-    lever = _region(_place(ctx, inputs["tap"], "the tap"))
+    container = model_of(ctx, inputs["cup"]).name
+    lever = thing_region(place_of(ctx, inputs["tap"], "the tap"))
     cx, cy, _ = (lever.xmin + lever.xmax) / 2, (lever.ymin + lever.ymax) / 2, 0.0
     side = _free_arm(ctx, cx, cy, "the tap")
     ctx.last_arm = side
-    _check(skills.fill_cup_from_tap(ctx.world, side, lever, container))
+    check_outcome(skills.fill_cup_from_tap(ctx.world, side, lever, container))
     return {}
 
 
@@ -772,7 +635,7 @@ def hand_over(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[s
     both reach (:func:`_relay`) and the second loads it, each by the first of the object's approaches
     that works for its own hold (:func:`_who_loads`)."""
     estimate = decode(inputs["objectPosition"], ObjectEstimate)
-    model = _model(ctx, inputs["graspPose"])
+    model = model_of(ctx, inputs["graspPose"])
     base = ctx.world.base_pose()  # the base parks against the place's docking mark, which the robot knows
     loading = _who_loads(ctx, estimate, model, base)
     side = loading.loader.arm
@@ -782,53 +645,14 @@ def hand_over(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[s
     _note(ctx, loading.loader)
     ctx.last_arm, ctx.focus = side, model.name
     reach = ctx.world.arm_specs[side].reach
-    _check(skills.hand_over_onto_platform(ctx.world, estimate, base, side, loading.loader.model, reach))
+    check_outcome(skills.hand_over_onto_platform(ctx.world, estimate, base, side, loading.loader.model, reach))
     return {}
-
-
-def _extent(estimate: ObjectEstimate) -> tuple[float, float]:
-    """What perception saw of an object along x and y: how wide a box whose long axis it did not see is
-    across jaws closing along x or y (:meth:`ObjectModel.across`)."""
-    return (estimate.size[0], estimate.size[1])
 
 
 def _note(ctx: SimContext, choice: GraspChoice) -> None:
     """Keep a choice among several approaches, readable (``SimEnvironment.context.choices``)."""
     if len(choice.model.preference) > 1:
         ctx.choices.append(choice)
-
-
-@dataclass
-class _Candidates:
-    """The approaches an arm may hold an object by for one hold, best first, and why each other one is
-    ruled out (each check says why not, or nothing)."""
-
-    models: list[ObjectModel]
-    ruled_out: list[tuple[GraspKind, str]] = field(default_factory=list)
-
-    @classmethod
-    def of(cls, model: ObjectModel, *checks: Callable[[ObjectModel], str]) -> _Candidates:
-        found = cls([])
-        for kind in model.preference:
-            held = model.by(kind)
-            why = next((reason for reason in (check(held) for check in checks) if reason), "")
-            if why:
-                found.ruled_out.append((kind, why))
-            else:
-                found.models.append(held)
-        return found
-
-    def refusal(self) -> str:
-        return "; ".join(why for _, why in self.ruled_out)
-
-    def choice(self, side: ArmSide, held: ObjectModel, purpose: str, unplaced: str = "") -> GraspChoice:
-        """The choice of ``held`` among these, with why each approach preferred to it was not taken (a
-        candidate passed over for want of a spot says ``unplaced``)."""
-        order = held.preference
-        rank = order.index(held.grasp)
-        reasons = dict(self.ruled_out)
-        passed = tuple((kind, reasons.get(kind, unplaced)) for kind in order[:rank])
-        return GraspChoice(side, held, purpose, passed)
 
 
 @dataclass(frozen=True)
@@ -849,7 +673,7 @@ def _who_loads(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, ba
     (inverse kinematics on the private copies): by the hand-over, and before a run, by the plan's check
     (:meth:`SimEnvironment.given`). With one approach only the letting go on the platform is asked of the
     end poses, as before approaches could be chosen. The moves of each hold are then dry-run, one approach
-    alone too, as the approach choice's are (:func:`_clear`, :func:`_refuse`): :class:`MovesRefusedError`
+    alone too, as the approach choice's are (:func:`first_clear`, :func:`refuse_moves`): :class:`MovesRefusedError`
     when the arm's planning would refuse them.
 
     The arms are asked in turn, as the approach is (:func:`_who_takes`): each arm that reaches both the
@@ -908,18 +732,20 @@ def _loading_by(
     platform = skills.platform_region(base, world.platform_height)
     # Letting go on the platform does not depend on where the loader takes the object from.
     checks = [lambda held: skills.can_load(world, estimate, base, loader, held)]
-    whole: _Candidates | None = None
+    whole: Candidates | None = None
     unserved = ""  # why no one hold serves from where the object is to the platform
     refused: MovesRefusedError | None = None
     if both:  # one hold, from where it is to the platform
-        whole = _Candidates.of(
+        whole = Candidates.of(
             model, *([lambda held: skills.can_take(world, estimate, loader, held), *checks] if choosing else checks)
         )
         unserved = whole.refusal()
-        if whole.models:  # the first whose moves the loader's planning would make, one alone too (_clear)
+        if whole.models:  # the first whose moves the loader's planning would make, one alone too (first_clear)
             spots = {held.grasp: platform for held in whole.models}
             try:
-                loads = _clear(whole, loader, purpose, lambda held: _loads(ctx, estimate, base, loader, held), spots)
+                loads = first_clear(
+                    whole, loader, purpose, lambda held: _loads(ctx, estimate, base, loader, held), spots
+                )
             except MovesRefusedError as moves:
                 if not choosing:
                     raise
@@ -937,8 +763,8 @@ def _loading_by(
     # the loader, or, when one arm reaches both but no approach serves it all the way, that arm sets it
     # down and takes it anew by an approach that loads (the re-grasp).
     gripping = [lambda held: skills.can_grip(held, world.arm(loader).hand)]
-    loading = _Candidates.of(model, *([*gripping, *checks] if choosing else checks))
-    giving = _Candidates.of(model, lambda held: skills.can_take(world, estimate, giver, held)) if choosing else None
+    loading = Candidates.of(model, *([*gripping, *checks] if choosing else checks))
+    giving = Candidates.of(model, lambda held: skills.can_take(world, estimate, giver, held)) if choosing else None
     if whole is not None and not (loading.models and giving is not None and giving.models):
         if refused is not None:
             raise refused
@@ -954,7 +780,7 @@ def _loading_by(
         if only:
             raise SkillFailed(f"only the {giver.value} arm reaches the {model.name}, and {giving.refusal()}")
         raise SkillFailed(f"the {giver.value} arm would pass the {model.name}, but {giving.refusal()}")
-    giving = giving or _Candidates([model])
+    giving = giving or Candidates([model])
     setting_down = (
         f"setting the {model.name} down to take it anew, no one approach serving from where it is to the "
         f"platform ({unserved})"
@@ -968,9 +794,9 @@ def _loading_by(
         # have folded home, where it starts a task).
         floor = _floor(ctx, given_by, giver, estimate.position, spot)
         why = skills.can_carry(world, estimate, giver, given_by, spot, floor=floor)
-        _refuse(why, given_by, giver, setting_down, spot)
+        refuse_moves(why, given_by, giver, setting_down, spot)
         there = _resting(spot, model, estimate, world.time)
-        _refuse(_loads(ctx, there, base, loader, taken_by), taken_by, loader, purpose, platform)
+        refuse_moves(_loads(ctx, there, base, loader, taken_by), taken_by, loader, purpose, platform)
 
     try:
         spot, given_by, taken_by = _relay_spot(ctx, estimate, giving, loading, giver, loader, holds)
@@ -988,16 +814,6 @@ def _loading_by(
 def _loads(ctx: SimContext, estimate: ObjectEstimate, base: Pose2D, side: ArmSide, held: ObjectModel) -> str:
     """Why ``side``'s planning would refuse the hand-over's moves by ``held``'s approach (a dry run)."""
     return skills.can_hand_over(ctx.world, estimate, base, side, held)
-
-
-def _refuse(
-    why: str, held: ObjectModel, side: ArmSide, purpose: str, spot: Region, before: str = "anything moved"
-) -> None:
-    """A hold of a relay whose moves the arm's planning would refuse (``why``, from a dry run) fails the
-    step before the relay moves anything, as a refused hold of the approach choice does (:func:`_clear`)."""
-    if why:
-        cx, cy, _ = spot.center
-        raise MovesRefusedError(held.name, side.value, purpose, [(held.grasp.value, (cx, cy), why)], before=before)
 
 
 def _resting(spot: Region, model: ObjectModel, seen: ObjectEstimate, now: float) -> ObjectEstimate:
@@ -1036,7 +852,9 @@ def _relay(
     on the same surface, where both reach, and the object is found again there."""
     world = ctx.world
     spec, hand = world.arm_specs[giver], world.arm(giver).hand
-    grasp = compute_grasp_pose(model, estimate.position, estimate.yaw, spec.mount, spec.yaw, _extent(estimate), hand)
+    grasp = compute_grasp_pose(
+        model, estimate.position, estimate.yaw, spec.mount, spec.yaw, seen_extent(estimate), hand
+    )
     ctx.last_arm = giver
     for move in (skills.approach_object, skills.pick_up_object):
         _passing(move(world, giver, grasp), model, giver, taker)
@@ -1065,8 +883,8 @@ def _set_down_for(
     released = world.arm(giver).released
     where = released[1] if released is not None else spot.center
     try:
-        camera = _robot_camera(ctx, device)
-        _check(skills.clear_view(world))
+        camera = robot_camera(ctx, device)
+        check_outcome(skills.clear_view(world))
         return recognise_object(world.camera(camera).capture(), model.colour, near=(where[0], where[1]), radius=0.1)
     except (SkillFailed, SimulationError):
         size = world.objects[model.name].size
@@ -1076,8 +894,8 @@ def _set_down_for(
 def _relay_spot(
     ctx: SimContext,
     estimate: ObjectEstimate,
-    giving: _Candidates,
-    taking: _Candidates,
+    giving: Candidates,
+    taking: Candidates,
     giver: ArmSide,
     taker: ArmSide,
     moves: Callable[[Region, ObjectModel, ObjectModel], None] | None = None,
@@ -1125,12 +943,12 @@ def _relay_spot(
             here = math.hypot(cx - x, cy - y)  # a re-grasp moves it as little as the approaches allow
             spots.append((here, max(distances), cx, cy) if giver is taker else (max(distances), here, cx, cy))
 
-    def held_by(side: ArmSide, candidates: _Candidates, centre: Vec3) -> ObjectModel | None:
+    def held_by(side: ArmSide, candidates: Candidates, centre: Vec3) -> ObjectModel | None:
         spec = world.arm_specs[side]
         for held in candidates.models:
             try:
                 hand = compute_grasp_pose(
-                    held, centre, estimate.yaw, spec.mount, spec.yaw, _extent(estimate), world.arm(side).hand
+                    held, centre, estimate.yaw, spec.mount, spec.yaw, seen_extent(estimate), world.arm(side).hand
                 )
             except GraspMisfitError:
                 continue  # the hand cannot hold it so, wherever it is
@@ -1339,23 +1157,23 @@ def infer_object_place(ctx: SimContext, inputs: Mapping[str, Any], device: str) 
     """Where the object is kept, from the belief state (else the semantic map), and where to park to reach
     it. Given a place rather than an object (a desk the task names as where to go), the place is where
     it is: its own docking pose, and no object feature to look for."""
-    iri = _iri(inputs["object"], "the object")
+    iri = thing_iri(inputs["object"], "the object")
     here = ctx.map.things.get(iri)
     if iri not in ctx.map.objects and here is not None and here.dock is not None:
-        dock = _dock(here)
+        dock = docking_pose(here)
         return {
             "objectPlace": designator(here.iri, HOME + "ObjectPlace"),
             "objectLocation": to_json(dock, OBJECT_LOCATION),
             "approachPosition": to_json(dock, APPROACH_POSITION),
         }
-    model = _model(ctx, inputs["object"])
+    model = model_of(ctx, inputs["object"])
     believed = [o for _, p, o in _facts(ctx.kb, iri) if p in (HOME + "isLocatedOn", HOME + "isLocated")]
     known = ctx.map.facts.get(iri, {}).get(HOME + "isLocatedOn", [])
     places = [o for o in [*believed, *known] if o in ctx.map.things and ctx.map.things[o].dock is not None]
     if not places:
         raise SkillFailed(f"the knowledge base does not say where the {model.name} is kept, or how to reach it")
     place = ctx.map.things[places[0]]
-    dock = _dock(place)
+    dock = docking_pose(place)
     return {
         "objectPlace": designator(place.iri, HOME + "ObjectPlace"),
         "objectLocation": to_json(dock, OBJECT_LOCATION),
@@ -1377,7 +1195,7 @@ def provide_grid_map(ctx: SimContext, inputs: Mapping[str, Any], device: str) ->
 
 def locate(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     value = inputs.get("markerColour")
-    colours = ctx.map.marker_colours(_iri(value, "the marker colour")) if value is not None else None
+    colours = ctx.map.marker_colours(thing_iri(value, "the marker colour")) if value is not None else None
     if colours is None:
         colours = ctx.world.robot.marker_colours
     if colours is None:
@@ -1389,27 +1207,9 @@ def locate(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str,
     return {"robotLocation": to_json(locate_robot(ctx.world.camera(device).capture(), marker))}
 
 
-def _meant(ctx: SimContext) -> Person:
-    """The person the running step means (``kb.home_check.person_for``): the one given to it or to a step
-    it takes a value from, else the one the task designates, else the home's only person."""
-    plan, step = ctx.plan, ctx.step
-    given = _people_given(ctx.map, plan, step, ctx.given) if plan is not None and step is not None else []
-    try:
-        return person_for(ctx.map, ctx.component or "the running step", given or ctx.designated)
-    except PersonError as error:  # refused before the run (``SimEnvironment.given``); a re-plan fails the step
-        raise SkillFailed(str(error)) from None
-
-
-def _people_given(smap: SemanticMap, plan: Plan, step: PlanStep, values: Mapping[str, Any]) -> list[str]:
-    """The map's people among the task's inputs a step works on (directly or through earlier steps)."""
-    steps = {each.index: each for each in plan.steps}
-    found = [values.get(name) for name in sorted(_given_to(step, steps))]
-    return [str(v["@id"]) for v in found if isinstance(v, dict) and str(v.get("@id")) in smap.people]
-
-
 def track(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     value = inputs.get("person")
-    person = ctx.map.people.get(_iri(value, "the person")) if value is not None else _meant(ctx)
+    person = ctx.map.people.get(thing_iri(value, "the person")) if value is not None else meant_person(ctx)
     if person is None or not person.colour:
         raise SkillFailed("the semantic map gives no colour to find the person by (home:colourName)")
     shirt = person.colour
@@ -1433,22 +1233,22 @@ def planner(algorithm: str) -> Work:
 
 
 def navigate_to_place(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
-    place = _place(ctx, inputs["objectPlace"], "the place")
-    _check(skills.navigate_to_place(ctx.world, decode(inputs["path"], PlannedPath), _dock(place)))
+    place = place_of(ctx, inputs["objectPlace"], "the place")
+    check_outcome(skills.navigate_to_place(ctx.world, decode(inputs["path"], PlannedPath), docking_pose(place)))
     return {}
 
 
 def navigate_to_person(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     path = decode(inputs["path"], PlannedPath)
     estimate = decode(inputs["personPosition"], PersonEstimate)
-    _check(skills.navigate_to_person(ctx.world, path, estimate, _meant(ctx).name))
+    check_outcome(skills.navigate_to_person(ctx.world, path, estimate, meant_person(ctx).name))
     return {}
 
 
 def deliver(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     value = inputs.get("receiver")
-    receiver = local_name(_iri(value, "the receiver")) if value is not None else _meant(ctx).name
-    _check(skills.deliver_object(ctx.world, receiver))
+    receiver = local_name(thing_iri(value, "the receiver")) if value is not None else meant_person(ctx).name
+    check_outcome(skills.deliver_object(ctx.world, receiver))
     return {}
 
 
@@ -1609,23 +1409,6 @@ def _distance(box: tuple[float, float, float, float], point: tuple[float, ...]) 
     return math.hypot(dx, dy)
 
 
-def _given_to(step: PlanStep, steps: Mapping[int, PlanStep]) -> set[str]:
-    """The task's inputs a step works on: those bound to its inputs, directly or through the steps
-    that compute them (an arm's grasp pose comes from the object the task names)."""
-    found: set[str] = set()
-    todo, seen = [step], {step.index}
-    while todo:
-        current = todo.pop()
-        for binding in current.inputs:
-            source = binding.source
-            if source.step is None:
-                found.add(source.name)
-            elif source.step not in seen and source.step in steps:
-                seen.add(source.step)
-                todo.append(steps[source.step])
-    return found
-
-
 def _grasped(inputs: Mapping[str, Any]) -> str | None:
     """The object a step's GraspPose input is about (its body name): the object at hand."""
     for value in inputs.values():
@@ -1764,13 +1547,13 @@ class SimEnvironment:
         for step in plan.steps:
             if step.action != PREFIXES["act"] + "HandingOverOntoPlatform":
                 continue
-            for name in sorted(_given_to(step, steps)):
+            for name in sorted(task_inputs_of(step, steps)):
                 value = values.get(name)
                 obj = smap.objects.get(str(value["@id"])) if isinstance(value, dict) and "@id" in value else None
                 support = smap.things.get(obj.support or "") if obj is not None else None
                 if obj is None or support is None or support.dock is None:
                     continue
-                estimate, model, dock = self._estimate(obj, support), Manipulation.of(obj).model, _dock(support)
+                estimate, model, dock = self._estimate(obj, support), Manipulation.of(obj).model, docking_pose(support)
                 try:
                     _who_loads(self.context, estimate, model, dock)
                 except (SkillFailed, MovesRefusedError) as refused:
@@ -1806,7 +1589,7 @@ class SimEnvironment:
             person_input = any(b.concept and self.is_a(b.concept, HOME + "Person") for b in step.bindings)
             if not person_input and (ad is None or SKILLS.get(ad.service_name or "") not in _WITH_PERSON):
                 continue
-            given = _people_given(self.world.map, plan, step, values)
+            given = people_given(self.world.map, plan, step, values)
             meant[step.component] = person_for(self.world.map, step.component, given or designated)
         return meant
 
@@ -1825,7 +1608,7 @@ class SimEnvironment:
         handled: set[str] = set()
         blockers = sight.occluders(smap)  # walls, furniture, appliances, robots' bodies hide what is behind them
         for step in plan.steps:
-            given = [values.get(name) for name in sorted(_given_to(step, steps))]
+            given = [values.get(name) for name in sorted(task_inputs_of(step, steps))]
             iris = [str(value["@id"]) for value in given if isinstance(value, dict) and "@id" in value]
             objects = [smap.objects[iri] for iri in iris if iri in smap.objects and iri not in handled]
             cameras = [self._camera_of(ads.get(candidate)) for candidate in step.candidates]
@@ -1887,7 +1670,7 @@ class SimEnvironment:
             robot_arms = arms.get(step.device or "")
             if not robot_arms:
                 continue
-            given = [values.get(name) for name in sorted(_given_to(step, steps))]
+            given = [values.get(name) for name in sorted(task_inputs_of(step, steps))]
             iris = [str(value["@id"]) for value in given if isinstance(value, dict) and "@id" in value]
             objects = [iri for iri in iris if iri in smap.objects]
             for iri in objects:  # an arm would take it: its class must say how (a decoration need not)

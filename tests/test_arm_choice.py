@@ -18,9 +18,10 @@ from cbrs.actions.composer import Composer
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
-from cbrs.sim import components, skills
+from cbrs.sim import components, grounding, skills
 from cbrs.sim.arms import ArmSide
-from cbrs.sim.components import CannotLoadError, SimEnvironment, SkillFailed
+from cbrs.sim.components import CannotLoadError, SimEnvironment
+from cbrs.sim.context import SimContext, SkillFailed
 from cbrs.sim.errors import MovesRefusedError
 from cbrs.sim.geometry import Region
 from cbrs.sim.grasping import GraspKind, ObjectModel
@@ -135,13 +136,13 @@ def test_a_loader_whose_one_hold_the_planning_refuses_sets_the_object_down_and_t
         seen, cup = _seen(world)
         real = components._loads
 
-        def loads(ctx: components.SimContext, estimate: ObjectEstimate, *rest: object) -> str:
+        def loads(ctx: SimContext, estimate: ObjectEstimate, *rest: object) -> str:
             if estimate is seen:
                 return "the stand-in refuses the one hold"
             return real(ctx, estimate, *rest)  # type: ignore[arg-type]
 
         monkeypatch.setattr(components, "_loads", loads)
-        base = components._dock(world.map.things[WORLD + "KitchenTable"])
+        base = grounding.docking_pose(world.map.things[WORLD + "KitchenTable"])
         loading = components._who_loads(context, seen, cup, base)
     assert loading.giver is not None and loading.spot is not None
     assert loading.giver.arm is RIGHT and loading.loader.arm is RIGHT
@@ -159,7 +160,7 @@ def test_a_pass_whose_holds_are_refused_at_one_relay_spot_tries_the_next(monkeyp
     with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
         context = SimEnvironment(world, kb).context
         seen, cup = _seen(world)
-        base = components._dock(world.map.things[WORLD + "KitchenTable"])
+        base = grounding.docking_pose(world.map.things[WORLD + "KitchenTable"])
         first = components._who_loads(context, seen, cup, base)
         assert first.giver is not None and first.giver.arm is LEFT and first.spot is not None
         refused_at = first.spot.center

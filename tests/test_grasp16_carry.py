@@ -15,7 +15,7 @@ from cbrs.actions.runner import run_task
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
-from cbrs.sim import components, skills
+from cbrs.sim import components, hold_choice, skills
 from cbrs.sim.arms import ArmSide
 from cbrs.sim.components import SimEnvironment
 from cbrs.sim.errors import MovesRefusedError
@@ -135,12 +135,12 @@ def test_one_approach_left_to_choose_is_dry_run_too(tmp_path: Path, monkeypatch:
         both = components._taking(context, seen, cup, ArmSide.LEFT)
     assert both.model.grasp is GraspKind.SIDE and asked == [GraspKind.SIDE]
     asked.clear()
-    alone = components._Candidates([cup.by(GraspKind.TOP)], [(GraspKind.SIDE, "ruled out")])
-    choice = components._clear(alone, ArmSide.LEFT, "taking the Cup", lambda held: asked.append(held.grasp) or "")
+    alone = hold_choice.Candidates([cup.by(GraspKind.TOP)], [(GraspKind.SIDE, "ruled out")])
+    choice = hold_choice.first_clear(alone, ArmSide.LEFT, "taking the Cup", lambda held: asked.append(held.grasp) or "")
     assert choice.model.grasp is GraspKind.TOP and choice.passed == ((GraspKind.SIDE, "ruled out"),)
     assert asked == [GraspKind.TOP]
     with pytest.raises(MovesRefusedError) as refused:
-        components._clear(
+        hold_choice.first_clear(
             alone, ArmSide.LEFT, "taking the Cup to TrayPlace", lambda held: "no path", {GraspKind.TOP: SPOT}
         )
     error = refused.value

@@ -26,8 +26,9 @@ from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import GRASP_APPROACHES, MapError, SemanticMap
 from cbrs.sim import skills
 from cbrs.sim.arms import ArmSide
-from cbrs.sim.components import CannotLoadError, SimContext, SimEnvironment, _knowledge
+from cbrs.sim.components import CannotLoadError, SimContext, SimEnvironment
 from cbrs.sim.grasping import GraspKind, ObjectModel
+from cbrs.sim.grounding import manipulation_of
 from cbrs.sim.values import GraspPlan, Manipulation, to_json
 from cbrs.sim.world import open_world
 from tests.test_turtle_tasks_arms import FETCH_MY_CUP, knowledge
@@ -95,11 +96,11 @@ def test_a_grasp_value_keeps_its_own_approach_first_and_gets_the_classes_others_
     ctx = cast(SimContext, SimpleNamespace(map=smap))
     cup = ObjectModel.of(smap.objects[WORLD + "Cup"])
     given_top = to_json(GraspPlan(WORLD + "Cup", cup.by(GraspKind.TOP)), HOME + "GraspPose")
-    assert _knowledge(ctx, given_top).model.preference == (GraspKind.TOP, GraspKind.SIDE)
+    assert manipulation_of(ctx, given_top).model.preference == (GraspKind.TOP, GraspKind.SIDE)
     given_side = to_json(Manipulation(WORLD + "Cup", cup), HOME + "ManipulationProperty")
-    assert _knowledge(ctx, given_side).model.preference == (GraspKind.SIDE, GraspKind.TOP)
+    assert manipulation_of(ctx, given_side).model.preference == (GraspKind.SIDE, GraspKind.TOP)
     pen = ObjectModel.of(smap.objects[WORLD + "Pen"])
-    assert _knowledge(ctx, to_json(GraspPlan(WORLD + "Pen", pen), HOME + "GraspPose")).model.approaches == ()
+    assert manipulation_of(ctx, to_json(GraspPlan(WORLD + "Pen", pen), HOME + "GraspPose")).model.approaches == ()
 
 
 def test_a_top_grasp_deeper_below_the_top_than_the_palm_is_ruled_out() -> None:

@@ -19,10 +19,11 @@ from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
 from cbrs.sim import skills
 from cbrs.sim.arms import ArmSide
-from cbrs.sim.components import SimContext, SimEnvironment, _knowledge, approach, pick_up
+from cbrs.sim.components import SimContext, SimEnvironment, approach, pick_up
 from cbrs.sim.errors import GraspTooWideError
 from cbrs.sim.geometry import quat_to_matrix
 from cbrs.sim.grasping import GraspKind, ObjectModel, compute_grasp_pose
+from cbrs.sim.grounding import manipulation_of
 from cbrs.sim.perception import ObjectEstimate, recognise_object
 from cbrs.sim.values import GraspPlan, to_json
 from cbrs.sim.world import open_world
@@ -123,7 +124,7 @@ def test_the_map_gives_a_box_its_footprint_and_a_value_about_it_gets_it_back(tmp
     class Context:
         map = smap
 
-    known = _knowledge(Context(), value).model  # type: ignore[arg-type]
+    known = manipulation_of(Context(), value).model  # type: ignore[arg-type]
     assert known.footprint == (0.16, 0.04) and known.preference == (GraspKind.SIDE, GraspKind.TOP)
 
 
