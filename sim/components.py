@@ -38,7 +38,7 @@ from cbrs.kb.errors import KnowledgeBaseError, NotFoundError
 from cbrs.kb.home_check import person_for
 from cbrs.kb.model import Advertisement
 from cbrs.kb.namespaces import PREFIXES
-from cbrs.kb.semantic_map import MapObject, NotGraspableError, Person, SemanticMap, Thing, designate, local_name
+from cbrs.kb.semantic_map import MapObject, NotGraspableError, Person, Thing, designate, local_name
 from cbrs.kb.vocab import CBRS
 from cbrs.settings import setting
 from cbrs.sim import predicates as pred
@@ -70,9 +70,21 @@ from cbrs.sim.perception import (
     recognise_object,
     track_person,
 )
+from cbrs.sim.place_spots import (
+    RELAY_CLEARANCE,
+    RELAY_EDGE,
+    RELAY_MARGIN,
+    RELAY_STEP,
+    distance_to_extent,
+    fixtures_on,
+    other_objects,
+    place_spots,
+    spot_region,
+)
 from cbrs.sim.planning import PlannedPath, plan_path
 from cbrs.sim.referee import Referee
 from cbrs.sim.relations import Grounded, Judge, region_of
+from cbrs.sim.transit import floor_to
 from cbrs.sim.values import (
     APPROACH_POSITION,
     GRASP_POSE,
@@ -404,7 +416,7 @@ def _taking_to(
     def letting_go(held: ObjectModel) -> str:
         tried = spots[:RELAY_TRIES]
         for at in tried:
-            spot = _spot_region(surface, *at)
+            spot = spot_region(surface, *at)
             if not skills.can_set_down(world, estimate, side, held, spot):
                 first[held.grasp] = spot
                 return ""
@@ -424,7 +436,7 @@ def _taking_to(
                 side,
                 held,
                 first[held.grasp],
-                floor=_floor(ctx, held, side, estimate.position, first[held.grasp]),
+                floor=floor_to(ctx, held, side, estimate.position, first[held.grasp]),
             ),
             first,
         )
@@ -444,7 +456,7 @@ def _hold_end(
 ) -> tuple[Thing, Region, list[tuple[float, float]]] | None:
     """Where the hold the running component starts ends, when the plan says: the place the first carry
     after the running step is given, before any other step of its robot takes an object; and that
-    place's surface and spots (:func:`_place_spots`) for the arm ``side`` (else ``ctx.arm``), as the carry
+    place's surface and spots (:func:`place_spots`) for the arm ``side`` (else ``ctx.arm``), as the carry
     will aim.
     The running step is the one the executor said it starts (``SimEnvironment.starting``), else the
     plan's one step of this component; the carry's place is what the executor knows of its inputs then
@@ -477,9 +489,9 @@ def _hold_end(
             return None
         place = smap.things[places[0]]
         spec = ctx.world.arm_specs[side or ctx.arm]
-        others = _others(ctx.world, ctx.belief, name)
+        others = other_objects(ctx.world, ctx.belief, name)
         size = ctx.world.objects[name].size if name in ctx.world.objects else (0.0, 0.0, 0.0)
-        surface, spots = _place_spots(smap, place, size, [(spec.mount[0], spec.mount[1], spec.reach)], others)
+        surface, spots = place_spots(smap, place, size, [(spec.mount[0], spec.mount[1], spec.reach)], others)
         return place, surface, spots
     return None
 
@@ -493,7 +505,7 @@ def pick_up(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str
 
 def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     """CarryObject to the target place by the arm holding the object, over the spot of the place nearest
-    its centre that the arm reaches and can hold the object over (:func:`_place_spots`): a table only
+    its centre that the arm reaches and can hold the object over (:func:`place_spots`): a table only
     part of which is in reach is worked at that part. When no spot is in that arm's reach and the other
     arm reaches one, the object is first passed to the other arm."""
     world = ctx.world
@@ -502,11 +514,11 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
     held = world.arm(ctx.arm).held
     carried = (world.name_of(held) if held is not None else None) or ctx.object or ""
     size = world.objects[carried].size if carried in world.objects else (0.0, 0.0, 0.0)
-    others = _others(world, ctx.belief, carried)
+    others = other_objects(world, ctx.belief, carried)
 
     def spots(side: ArmSide) -> tuple[Region, list[tuple[float, float]]]:
         spec = world.arm_specs[side]
-        return _place_spots(ctx.map, place, size, [(spec.mount[0], spec.mount[1], spec.reach)], others)
+        return place_spots(ctx.map, place, size, [(spec.mount[0], spec.mount[1], spec.reach)], others)
 
     surface, mine = spots(ctx.arm)
     spot = _holdable(ctx, ctx.arm, surface, mine)
@@ -526,7 +538,7 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
                 f"{spec.mount[1]:.2f}), and no other free arm reaches one"
             )
         _, taker, (sx, sy) = min(options)
-        target = _spot_region(surface, sx, sy)
+        target = spot_region(surface, sx, sy)
         gx, gy, gz = ctx.grasp.position  # where it was taken from: its surface, lying as it was seen there
         seen = ctx.seen
         taken = ObjectEstimate(
@@ -556,10 +568,10 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
         holding = world.arm(giver).ee_pose().position
 
         def holds(spot: Region, _: ObjectModel, taken_by: ObjectModel) -> None:
-            why = skills.can_carry_held(world, giver, spot, _floor(ctx, model, giver, holding, spot))
+            why = skills.can_carry_held(world, giver, spot, floor_to(ctx, model, giver, holding, spot))
             refuse_moves(why, model, giver, passing, spot, before)
             there = _resting(spot, model, taken, world.time)
-            floor = _floor(ctx, taken_by, taker, there.position, target)
+            floor = floor_to(ctx, taken_by, taker, there.position, target)
             # the giver will have folded home by the time the taker moves
             why = skills.can_carry(world, there, taker, taken_by, target, floor=floor, folded=(giver,))
             refuse_moves(why, taken_by, taker, passing, target, before)
@@ -586,11 +598,11 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
     elif spot is None:
         raise SkillFailed(f"the {ctx.arm.value} arm reaches no spot of {place.name} to set the {carried} down on")
     else:
-        target = _spot_region(surface, *spot)
+        target = spot_region(surface, *spot)
     ctx.spot = target
     grasped = world.arm(ctx.arm).held_grasp
     hand = world.arm(ctx.arm).ee_pose().position
-    floor = None if grasped is None else _floor(ctx, grasped.model, ctx.arm, hand, target)
+    floor = None if grasped is None else floor_to(ctx, grasped.model, ctx.arm, hand, target)
     check_outcome(skills.carry_object(world, ctx.arm, target, floor=floor))
     return {}
 
@@ -792,7 +804,7 @@ def _loading_by(
         # Both holds' moves are dry-run before the first moves: the giver's from where the object is to the
         # spot, the loader's from the spot to the platform (from its posture now; a re-grasping arm will
         # have folded home, where it starts a task).
-        floor = _floor(ctx, given_by, giver, estimate.position, spot)
+        floor = floor_to(ctx, given_by, giver, estimate.position, spot)
         why = skills.can_carry(world, estimate, giver, given_by, spot, floor=floor)
         refuse_moves(why, given_by, giver, setting_down, spot)
         there = _resting(spot, model, estimate, world.time)
@@ -823,14 +835,6 @@ def _resting(spot: Region, model: ObjectModel, seen: ObjectEstimate, now: float)
     return ObjectEstimate(cx, cy, spot.zmin + model.height / 2.0, seen.yaw, seen.size, model.colour, "map", now, 0)
 
 
-RELAY_MARGIN = 0.05
-"""A relay spot is at least 5 cm inside both arms' reach."""
-RELAY_CLEARANCE = 0.06
-"""A relay spot keeps 6 cm between the object's footprint and any other object's or fixture's."""
-RELAY_EDGE = 0.02
-"""... and 2 cm between the object's footprint and the edge of the surface."""
-RELAY_STEP = 0.02
-"""The spots tried are a 2 cm grid over the surface."""
 RELAY_MOVES_TRIES = 3
 """How many spots whose end poses serve a pass or a re-grasp may have its holds' moves refused by the
 arms' planning (a dry run) before the pass is refused with the first refusal."""
@@ -877,7 +881,7 @@ def _set_down_for(
     """The giver, holding the object, sets it down on ``spot`` for the taker; where it is then (by the
     robot's camera near where the hand let it go, else where the hand let it go)."""
     world = ctx.world
-    floor = _floor(ctx, model, giver, world.arm(giver).ee_pose().position, spot)
+    floor = floor_to(ctx, model, giver, world.arm(giver).ee_pose().position, spot)
     _passing(skills.carry_object(world, giver, spot, floor=floor), model, giver, taker)
     _passing(skills.put_down_object(world, giver, spot), model, giver, taker)
     released = world.arm(giver).released
@@ -924,8 +928,8 @@ def _relay_spot(
     top = supports[0].box
     size = world.objects[model.name].size
     radius = math.hypot(size[0], size[1]) / 2.0
-    others = _others(world, ctx.belief, model.name)
-    fixtures = _fixtures(smap, supports[0], surface, 0.3)
+    others = other_objects(world, ctx.belief, model.name)
+    fixtures = fixtures_on(smap, supports[0], surface, 0.3)
     arms = [world.arm_specs[giver], world.arm_specs[taker]]
     spots: list[tuple[float, float, float, float]] = []
     inset = radius + RELAY_EDGE
@@ -938,7 +942,7 @@ def _relay_spot(
                 continue
             if any(math.hypot(cx - ox_, cy - oy) < radius + r + RELAY_CLEARANCE for ox_, oy, r in others):
                 continue
-            if any(_distance(box, (cx, cy)) < radius + RELAY_CLEARANCE for box in fixtures):
+            if any(distance_to_extent(box, (cx, cy)) < radius + RELAY_CLEARANCE for box in fixtures):
                 continue
             here = math.hypot(cx - x, cy - y)  # a re-grasp moves it as little as the approaches allow
             spots.append((here, max(distances), cx, cy) if giver is taker else (max(distances), here, cx, cy))
@@ -991,163 +995,6 @@ def _relay_spot(
         f"there is no spot on {supports[0].name} where both the {giver.value} and the {taker.value} arm can hold "
         f"the {model.name} by its {kinds} grasp, to pass it from one to the other"
     )
-
-
-TRANSIT_CORRIDOR = 0.10
-"""The hand's palm passes over another thing standing within 10 cm of the way, footprint to footprint (the
-Panda hand is about 20 cm across along its fingers' axis)..."""
-TRANSIT_CLEARANCE = 0.02
-"""... 2 cm above its top; so does the carried object's bottom over a thing standing within 2 cm of the
-fingers' or the object's footprint."""
-
-
-def _transit_floor(
-    ctx: SimContext, held: ObjectModel, side: ArmSide, start: tuple[float, float], end: tuple[float, float]
-) -> float | None:
-    """How high the bottom of the object ``held`` (by its approach, in ``side``'s hand) must stay on its way
-    from ``start`` to ``end`` (x, y) for it and the hand to pass over the other objects standing by the way,
-    where each is believed to be (else where the map puts it): TRANSIT_CLEARANCE over the top of any whose
-    footprint comes within that of the object's or the fingers' (the jaws' opening across), and the palm
-    (the grasp height and the hand's palm depth above the object's bottom) as far over the top of any within
-    TRANSIT_CORRIDOR; None when no object stands by the way. Without it, a pill box passed between the arms
-    was carried 4 cm above the table, and the hand swept the cup beside its way off the table."""
-    world = ctx.world
-    hand = world.arm(side).hand
-    size = world.objects[held.name].size if held.name in world.objects else (held.width, held.width, held.height)
-    near = max(math.hypot(size[0], size[1]) / 2.0, hand.jaw_opening / 2.0)
-    palm = held.grasp_height + hand.palm_depth
-    floor: float | None = None
-    for name, obj in world.objects.items():
-        if name == held.name or any(arm.held == world.body(name) for arm in world.arms.values()):
-            continue
-        believed = ctx.belief.position(name) if ctx.belief is not None else None
-        if believed is None:
-            support = ctx.map.things.get(obj.support or "")
-            rest = support.box.max_z if support is not None else 0.0
-            believed = (obj.start.x, obj.start.y, rest + obj.size[2] / 2.0)
-        x, y, z = believed
-        apart = _segment_distance(start, end, (x, y)) - math.hypot(obj.size[0], obj.size[1]) / 2.0
-        top = z + obj.size[2] / 2.0 + TRANSIT_CLEARANCE
-        if apart < near + TRANSIT_CLEARANCE:
-            needed: float | None = top
-        elif apart < near + TRANSIT_CORRIDOR:
-            needed = top - palm
-        else:
-            needed = None
-        if needed is not None:
-            floor = needed if floor is None else max(floor, needed)
-    return floor
-
-
-def _floor(ctx: SimContext, held: ObjectModel, side: ArmSide, start: Sequence[float], to: Region) -> float | None:
-    """:func:`_transit_floor` from ``start`` (x, y, ...) to over the middle of ``to``."""
-    cx, cy, _ = to.center
-    return _transit_floor(ctx, held, side, (start[0], start[1]), (cx, cy))
-
-
-def _segment_distance(a: tuple[float, float], b: tuple[float, float], point: tuple[float, float]) -> float:
-    """How far ``point`` is from the segment from ``a`` to ``b`` (all x, y)."""
-    dx, dy = b[0] - a[0], b[1] - a[1]
-    length = dx * dx + dy * dy
-    t = 0.0 if length <= 0.0 else max(0.0, min(1.0, ((point[0] - a[0]) * dx + (point[1] - a[1]) * dy) / length))
-    return math.hypot(point[0] - (a[0] + t * dx), point[1] - (a[1] + t * dy))
-
-
-def _others(world: HomeWorld, belief: PerceivedWorld | None, *names: str) -> list[tuple[float, float, float]]:
-    """The objects other than ``names`` as (x, y, footprint radius): where each is believed to be, else
-    where the map puts it."""
-    found = []
-    for other, obj in world.objects.items():
-        if other in names:
-            continue
-        believed = belief.position(other) if belief is not None else None
-        x, y = (believed[0], believed[1]) if believed is not None else (obj.start.x, obj.start.y)
-        found.append((x, y, math.hypot(obj.size[0], obj.size[1]) / 2.0))
-    return found
-
-
-def _fixtures(
-    smap: SemanticMap, support: Thing, surface: float, up_to: float
-) -> list[tuple[float, float, float, float]]:
-    """The extents (min x, max x, min y, max y) of the things of the map standing on or hanging over the
-    support's top within ``up_to`` above its ``surface`` (a dispenser), not the rooms and regions."""
-    top = support.box
-    return [
-        (t.box.min_x, t.box.max_x, t.box.min_y, t.box.max_y)
-        for iri, t in smap.things.items()
-        if iri not in smap.rooms
-        and iri not in smap.regions
-        and iri != support.iri
-        and t.box.max_z > surface + 0.005
-        and t.box.min_z < surface + up_to
-        and t.box.min_x < top.max_x
-        and t.box.max_x > top.min_x
-        and t.box.min_y < top.max_y
-        and t.box.max_y > top.min_y
-    ]
-
-
-def _place_spots(
-    smap: SemanticMap,
-    place: Thing,
-    size: tuple[float, float, float],
-    mounts: Sequence[tuple[float, float, float]],
-    others: Sequence[tuple[float, float, float]],
-) -> tuple[Region, list[tuple[float, float]]]:
-    """Where on a place an object of ``size`` can be set down by an arm mounted at one of ``mounts``
-    (x, y, reach): the place's surface (a region's bottom, a piece of furniture's top), and the spots of
-    a grid over the place, from its centre out, nearest the centre first, where the object's centre is
-    over the place and at least RELAY_MARGIN inside a mount's reach, its footprint on the surface it
-    rests on (the furniture under a region) RELAY_EDGE inside the edge, RELAY_CLEARANCE clear of
-    ``others`` (x, y, radius) and of the fixtures it would meet on the way down (a dispenser's body; not
-    the spout high above it). The place's centre is the first spot where it is one: a place an arm only
-    partly reaches is worked at its reachable part, not at a centre no arm reaches."""
-    furniture = place.iri in smap.furniture
-    surface = region_of(place, furniture)
-    cx, cy, z = surface.center
-    if furniture:
-        support = place
-    else:
-        support = next(
-            (
-                smap.things[iri]
-                for iri in sorted(smap.furniture)
-                if iri in smap.things
-                and smap.things[iri].box.contains_xy(cx, cy)
-                and abs(smap.things[iri].box.max_z - z) <= 0.03
-            ),
-            place,
-        )
-    box = support.box
-    radius = math.hypot(size[0], size[1]) / 2.0
-    fixtures = _fixtures(smap, support, z, size[2] + skills.ABOVE_CLEARANCE)
-    inset = radius + RELAY_EDGE
-    spots: list[tuple[float, float, float]] = []
-    nx = int((surface.xmax - surface.xmin) / 2.0 / RELAY_STEP) + 1
-    ny = int((surface.ymax - surface.ymin) / 2.0 / RELAY_STEP) + 1
-    for i in range(-nx, nx + 1):
-        x = cx + i * RELAY_STEP
-        if not (surface.xmin - 1e-9 <= x <= surface.xmax + 1e-9 and box.min_x + inset <= x <= box.max_x - inset):
-            continue
-        for j in range(-ny, ny + 1):
-            y = cy + j * RELAY_STEP
-            if not (surface.ymin - 1e-9 <= y <= surface.ymax + 1e-9 and box.min_y + inset <= y <= box.max_y - inset):
-                continue
-            if not any(math.hypot(x - mx, y - my) <= reach - RELAY_MARGIN for mx, my, reach in mounts):
-                continue
-            if any(math.hypot(x - ox_, y - oy) < radius + r + RELAY_CLEARANCE for ox_, oy, r in others):
-                continue
-            if any(_distance(extent, (x, y)) < radius + RELAY_CLEARANCE for extent in fixtures):
-                continue
-            spots.append((math.hypot(x - cx, y - cy), x, y))
-    return surface, [(x, y) for _, x, y in sorted(spots)]
-
-
-def _spot_region(surface: Region, x: float, y: float) -> Region:
-    """Where around a spot of a place's surface an object is carried to and set down (its centre over
-    the spot, give or take a relay spot's tolerance): the place itself decides the step's effects."""
-    half = RELAY_STEP * 2
-    return Region(surface.name, x - half, x + half, y - half, y + half, surface.zmin, surface.zmin + 0.3)
 
 
 # -- the home server, the ceiling cameras and the mobile base -------------------------------------
@@ -1400,13 +1247,6 @@ def _named(work: Work, advertised: tuple[str, ...]) -> Work:
 
 
 # -- the environment ------------------------------------------------------------------------------
-
-
-def _distance(box: tuple[float, float, float, float], point: tuple[float, ...]) -> float:
-    """From a point to the nearest point of an extent (min x, max x, min y, max y), on the floor plan."""
-    dx = max(box[0] - point[0], 0.0, point[0] - box[1])
-    dy = max(box[2] - point[1], 0.0, point[1] - box[3])
-    return math.hypot(dx, dy)
 
 
 def _grasped(inputs: Mapping[str, Any]) -> str | None:
@@ -1682,7 +1522,7 @@ class SimEnvironment:
                 box = self._extent(iri)
                 if box is None:
                     continue
-                reaches = [(arm, _distance(box, arm.mount)) for arm in robot_arms]
+                reaches = [(arm, distance_to_extent(box, arm.mount)) for arm in robot_arms]
                 report = [(arm.iri, arm.mount[0], arm.mount[1], arm.reach, d) for arm, d in reaches]
                 where = ((box[0] + box[1]) / 2, (box[2] + box[3]) / 2)
                 if not any(distance <= arm.reach for arm, distance in reaches):
@@ -1694,7 +1534,7 @@ class SimEnvironment:
         self, step: PlanStep, iri: str, carried: list[str], report: list[tuple[str, float, float, float, float]]
     ) -> None:
         """Refuse a place an arm step is given, part of which the robot's arms reach, when no spot of it
-        will do (:func:`_place_spots`, by the map) for the object at hand: the one the step is given,
+        will do (:func:`place_spots`, by the map) for the object at hand: the one the step is given,
         else the one the robot's latest arm step given one worked on (a carry's object comes from the
         approach and pick-up before it); the largest, if there are several. The carry would aim at a
         spot it then lacks."""
@@ -1706,8 +1546,8 @@ class SimEnvironment:
         names = [obj.name for obj in objects]
         name = names[0] if len(names) == 1 else ""
         mounts = [(x, y, reach) for _, x, y, reach, _ in report]
-        others = _others(self.world, self.belief, *names)
-        _, spots = _place_spots(smap, smap.things[iri], size, mounts, others)
+        others = other_objects(self.world, self.belief, *names)
+        _, spots = place_spots(smap, smap.things[iri], size, mounts, others)
         if not spots:
             box = smap.things[iri].box
             what = f"the {name}" if name else "an object"
@@ -1733,11 +1573,11 @@ class SimEnvironment:
         time (else all together); empty when it has none even then (out of reach, too small, fixtures)."""
         smap = self.world.map
         thing = smap.things[place]
-        if not _place_spots(smap, thing, size, mounts, [])[1]:
+        if not place_spots(smap, thing, size, mounts, [])[1]:
             return []
         names = [name for name in self.world.objects if name not in carried]  # in the order of ``others``
         single = [
-            n for n in range(len(names)) if _place_spots(smap, thing, size, mounts, others[:n] + others[n + 1 :])[1]
+            n for n in range(len(names)) if place_spots(smap, thing, size, mounts, others[:n] + others[n + 1 :])[1]
         ]
         chosen = single or list(range(len(names)))
         return [(self.world.objects[names[n]].iri, others[n][0], others[n][1]) for n in chosen]

@@ -16,19 +16,10 @@ from cbrs.actions.runner import run_task
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
-from cbrs.sim.components import (
-    RELAY_CLEARANCE,
-    RELAY_MARGIN,
-    OutOfReachError,
-    SimEnvironment,
-    _place_spots,
-    approach,
-    carry,
-    pick_up,
-    put_down,
-)
+from cbrs.sim.components import OutOfReachError, SimEnvironment, approach, carry, pick_up, put_down
 from cbrs.sim.grasping import ObjectModel
 from cbrs.sim.perception import ObjectEstimate
+from cbrs.sim.place_spots import RELAY_CLEARANCE, RELAY_MARGIN, place_spots
 from cbrs.sim.relations import Grounded
 from cbrs.sim.values import GraspPlan, designator, to_json
 from cbrs.sim.world import HomeWorld, open_world
@@ -106,11 +97,11 @@ def test_the_spot_keeps_clear_of_an_object_where_the_nearest_spot_was() -> None:
         table = smap.things[WORLD + "KitchenTable"]
         cup = world.objects["Cup"]
         mounts = [(spec.mount[0], spec.mount[1], spec.reach) for spec in world.arm_specs.values()]
-        _, free = _place_spots(smap, table, cup.size, mounts, [])
+        _, free = place_spots(smap, table, cup.size, mounts, [])
         x, y = free[0]
         pen = world.objects["Pen"]
         pen_radius = math.hypot(pen.size[0], pen.size[1]) / 2
-        _, spots = _place_spots(smap, table, cup.size, mounts, [(x, y, pen_radius)])
+        _, spots = place_spots(smap, table, cup.size, mounts, [(x, y, pen_radius)])
         assert spots and spots[0] != (x, y)
         cup_radius = math.hypot(cup.size[0], cup.size[1]) / 2
         assert math.dist(spots[0], (x, y)) >= cup_radius + pen_radius + RELAY_CLEARANCE
@@ -126,7 +117,7 @@ def test_a_place_whose_centre_an_arm_reaches_is_aimed_at_its_centre() -> None:
         mounts = [(spec.mount[0], spec.mount[1], spec.reach) for spec in world.arm_specs.values()]
         for place, thing in (("BelowOfTap", "Cup"), ("PenRest1", "Pen")):
             region = smap.things[WORLD + place]
-            surface, spots = _place_spots(smap, region, world.objects[thing].size, mounts, [])
+            surface, spots = place_spots(smap, region, world.objects[thing].size, mounts, [])
             assert spots[0] == pytest.approx(surface.center[:2])
             assert surface.zmin == pytest.approx(0.75)
 

@@ -1,0 +1,138 @@
+"""Where on a place, or on the surface an object rests on, an object can be set down.
+
+A grid of spots over the surface, each far enough inside an arm's reach, from the edge, from the other
+objects (where they are believed to be) and from the fixtures standing on the surface: the carry aims
+at the first of them, the pass between arms looks among them, and the check before a run refuses a
+place that has none.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+from cbrs.kb.semantic_map import SemanticMap, Thing
+from cbrs.sim import skills
+from cbrs.sim.geometry import Region
+from cbrs.sim.perceived import PerceivedWorld
+from cbrs.sim.relations import region_of
+from cbrs.sim.world import HomeWorld
+
+RELAY_MARGIN = 0.05
+"""A relay spot is at least 5 cm inside both arms' reach."""
+
+
+RELAY_CLEARANCE = 0.06
+"""A relay spot keeps 6 cm between the object's footprint and any other object's or fixture's."""
+
+
+RELAY_EDGE = 0.02
+"""... and 2 cm between the object's footprint and the edge of the surface."""
+
+
+RELAY_STEP = 0.02
+"""The spots tried are a 2 cm grid over the surface."""
+
+
+def distance_to_extent(box: tuple[float, float, float, float], point: tuple[float, ...]) -> float:
+    """From a point to the nearest point of an extent (min x, max x, min y, max y), on the floor plan."""
+    dx = max(box[0] - point[0], 0.0, point[0] - box[1])
+    dy = max(box[2] - point[1], 0.0, point[1] - box[3])
+    return math.hypot(dx, dy)
+
+
+def other_objects(world: HomeWorld, belief: PerceivedWorld | None, *names: str) -> list[tuple[float, float, float]]:
+    """The objects other than ``names`` as (x, y, footprint radius): where each is believed to be, else
+    where the map puts it."""
+    found = []
+    for other, obj in world.objects.items():
+        if other in names:
+            continue
+        believed = belief.position(other) if belief is not None else None
+        x, y = (believed[0], believed[1]) if believed is not None else (obj.start.x, obj.start.y)
+        found.append((x, y, math.hypot(obj.size[0], obj.size[1]) / 2.0))
+    return found
+
+
+def fixtures_on(
+    smap: SemanticMap, support: Thing, surface: float, up_to: float
+) -> list[tuple[float, float, float, float]]:
+    """The extents (min x, max x, min y, max y) of the things of the map standing on or hanging over the
+    support's top within ``up_to`` above its ``surface`` (a dispenser), not the rooms and regions."""
+    top = support.box
+    return [
+        (t.box.min_x, t.box.max_x, t.box.min_y, t.box.max_y)
+        for iri, t in smap.things.items()
+        if iri not in smap.rooms
+        and iri not in smap.regions
+        and iri != support.iri
+        and t.box.max_z > surface + 0.005
+        and t.box.min_z < surface + up_to
+        and t.box.min_x < top.max_x
+        and t.box.max_x > top.min_x
+        and t.box.min_y < top.max_y
+        and t.box.max_y > top.min_y
+    ]
+
+
+def place_spots(
+    smap: SemanticMap,
+    place: Thing,
+    size: tuple[float, float, float],
+    mounts: Sequence[tuple[float, float, float]],
+    others: Sequence[tuple[float, float, float]],
+) -> tuple[Region, list[tuple[float, float]]]:
+    """Where on a place an object of ``size`` can be set down by an arm mounted at one of ``mounts``
+    (x, y, reach): the place's surface (a region's bottom, a piece of furniture's top), and the spots of
+    a grid over the place, from its centre out, nearest the centre first, where the object's centre is
+    over the place and at least RELAY_MARGIN inside a mount's reach, its footprint on the surface it
+    rests on (the furniture under a region) RELAY_EDGE inside the edge, RELAY_CLEARANCE clear of
+    ``others`` (x, y, radius) and of the fixtures it would meet on the way down (a dispenser's body; not
+    the spout high above it). The place's centre is the first spot where it is one: a place an arm only
+    partly reaches is worked at its reachable part, not at a centre no arm reaches."""
+    furniture = place.iri in smap.furniture
+    surface = region_of(place, furniture)
+    cx, cy, z = surface.center
+    if furniture:
+        support = place
+    else:
+        support = next(
+            (
+                smap.things[iri]
+                for iri in sorted(smap.furniture)
+                if iri in smap.things
+                and smap.things[iri].box.contains_xy(cx, cy)
+                and abs(smap.things[iri].box.max_z - z) <= 0.03
+            ),
+            place,
+        )
+    box = support.box
+    radius = math.hypot(size[0], size[1]) / 2.0
+    fixtures = fixtures_on(smap, support, z, size[2] + skills.ABOVE_CLEARANCE)
+    inset = radius + RELAY_EDGE
+    spots: list[tuple[float, float, float]] = []
+    nx = int((surface.xmax - surface.xmin) / 2.0 / RELAY_STEP) + 1
+    ny = int((surface.ymax - surface.ymin) / 2.0 / RELAY_STEP) + 1
+    for i in range(-nx, nx + 1):
+        x = cx + i * RELAY_STEP
+        if not (surface.xmin - 1e-9 <= x <= surface.xmax + 1e-9 and box.min_x + inset <= x <= box.max_x - inset):
+            continue
+        for j in range(-ny, ny + 1):
+            y = cy + j * RELAY_STEP
+            if not (surface.ymin - 1e-9 <= y <= surface.ymax + 1e-9 and box.min_y + inset <= y <= box.max_y - inset):
+                continue
+            if not any(math.hypot(x - mx, y - my) <= reach - RELAY_MARGIN for mx, my, reach in mounts):
+                continue
+            if any(math.hypot(x - ox_, y - oy) < radius + r + RELAY_CLEARANCE for ox_, oy, r in others):
+                continue
+            if any(distance_to_extent(extent, (x, y)) < radius + RELAY_CLEARANCE for extent in fixtures):
+                continue
+            spots.append((math.hypot(x - cx, y - cy), x, y))
+    return surface, [(x, y) for _, x, y in sorted(spots)]
+
+
+def spot_region(surface: Region, x: float, y: float) -> Region:
+    """Where around a spot of a place's surface an object is carried to and set down (its centre over
+    the spot, give or take a relay spot's tolerance): the place itself decides the step's effects."""
+    half = RELAY_STEP * 2
+    return Region(surface.name, x - half, x + half, y - half, y + half, surface.zmin, surface.zmin + 0.3)
