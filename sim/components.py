@@ -19,11 +19,10 @@ inputs first and encodes its outputs last.
 
 from __future__ import annotations
 
-import functools
 import logging
 import math
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 from typing import Any
 
@@ -43,11 +42,12 @@ from cbrs.kb.vocab import CBRS
 from cbrs.settings import setting
 from cbrs.sim import predicates as pred
 from cbrs.sim import sight, skills
+from cbrs.sim.arm_choice import free_arm, grasp_pose_for, holdable_spot, note_choice, who_loads, who_takes
 from cbrs.sim.arms import ArmSide
 from cbrs.sim.context import SimContext, SkillFailed, Work, check_outcome, robot_camera
-from cbrs.sim.errors import GraspMisfitError, MovesRefusedError, SimulationError
-from cbrs.sim.geometry import Pose2D, Region, Vec3
-from cbrs.sim.grasping import GraspKind, GraspPose, ObjectModel, compute_grasp_pose
+from cbrs.sim.errors import MovesRefusedError, SimulationError
+from cbrs.sim.geometry import Pose2D, Region
+from cbrs.sim.grasping import ObjectModel, compute_grasp_pose
 from cbrs.sim.grounding import (
     docking_pose,
     manipulation_of,
@@ -59,7 +59,7 @@ from cbrs.sim.grounding import (
     thing_iri,
     thing_region,
 )
-from cbrs.sim.hold_choice import Candidates, GraspChoice, first_clear, refuse_moves, seen_extent
+from cbrs.sim.hold_choice import Candidates, GraspChoice, refuse_moves, seen_extent
 from cbrs.sim.mapping import OccupancyGrid, build_occupancy_grid
 from cbrs.sim.perceived import SEARCH_RADIUS, PerceivedWorld
 from cbrs.sim.perception import (
@@ -72,11 +72,8 @@ from cbrs.sim.perception import (
 )
 from cbrs.sim.place_spots import (
     RELAY_CLEARANCE,
-    RELAY_EDGE,
     RELAY_MARGIN,
-    RELAY_STEP,
     distance_to_extent,
-    fixtures_on,
     other_objects,
     place_spots,
     spot_region,
@@ -84,6 +81,7 @@ from cbrs.sim.place_spots import (
 from cbrs.sim.planning import PlannedPath, plan_path
 from cbrs.sim.referee import Referee
 from cbrs.sim.relations import Grounded, Judge, region_of
+from cbrs.sim.relay import check_passing, relay_object, relay_spot, resting_at, set_down_for
 from cbrs.sim.transit import floor_to
 from cbrs.sim.values import (
     APPROACH_POSITION,
@@ -115,20 +113,15 @@ __all__ = [
 ]
 
 HOME = PREFIXES["home"]
-ACT = PREFIXES["act"]
 
 log = logging.getLogger("cbrs.sim")
 
-TAKING = frozenset({ACT + "ApproachToObject", ACT + "HandingOverOntoPlatform"})
-"""The actions with which an arm takes an object: a hold starts."""
 LOCALISATION_TOLERANCE = 0.10
 """A localisation is believed (isLocalisedIn holds) when it agrees with the base's odometry within this
 distance (m)."""
 LOADING_SLACK = 0.01
 """The plan's loading check refuses an object only if no arm could load it this far from where it is
 believed to be either (the cameras' estimates of one object differ by millimetres to a centimetre)."""
-ARM_TIE = 0.01
-"""Two arms whose mounts are within 1 cm as far from a target reach it equally well."""
 SETTLE_DISTANCE = 0.03
 """Before a re-plan, an arm lets go of what it holds only with its hand within 3 cm of where it took it."""
 
@@ -227,31 +220,6 @@ class SimComponent(Component):
         return Status.SUCCEEDED
 
 
-def _reaching(ctx: SimContext, x: float, y: float) -> list[ArmSide]:
-    """The free arms whose mounts are within their reach of (x, y), best first: the nearest, and on a
-    tie not the one that just acted."""
-    options = []
-    for side, spec in ctx.world.arm_specs.items():
-        distance = math.hypot(x - spec.mount[0], y - spec.mount[1])
-        if ctx.world.arm(side).held is None and distance <= spec.reach:
-            options.append((distance, side))
-    if not options:
-        return []
-    best = min(distance for distance, _ in options)
-    tied = sorted(side for distance, side in options if distance - best <= ARM_TIE)
-    fresh = [side for side in tied if side != ctx.last_arm]
-    first = (fresh or tied)[0]
-    return [first, *(side for _, side in sorted(options) if side != first)]
-
-
-def _free_arm(ctx: SimContext, x: float, y: float, what: str) -> ArmSide:
-    """The free arm whose mount is nearest (x, y) and within its reach; on a tie, not the one that just acted."""
-    arms = _reaching(ctx, x, y)
-    if not arms:
-        raise SkillFailed(f"no free arm reaches {what} at ({x:.2f}, {y:.2f})")
-    return arms[0]
-
-
 # -- object knowledge and perception at the table -------------------------------------------------
 
 
@@ -313,187 +281,14 @@ def find_object_on_table(ctx: SimContext, inputs: Mapping[str, Any], device: str
 def approach(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     model = model_of(ctx, inputs["graspPose"])
     estimate = decode(inputs["objectPosition"], ObjectEstimate)
-    choice = _who_takes(ctx, estimate, model)
-    _note(ctx, choice)
+    choice = who_takes(ctx, estimate, model)
+    note_choice(ctx, choice)
     ctx.arm = choice.arm
-    ctx.grasp = _grasp_pose(ctx, estimate, choice.arm, choice.model)
+    ctx.grasp = grasp_pose_for(ctx, estimate, choice.arm, choice.model)
     ctx.seen, ctx.focus = estimate, model.name
     ctx.last_arm = ctx.arm
     check_outcome(skills.approach_object(ctx.world, ctx.arm, ctx.grasp))
     return {}
-
-
-def _grasp_pose(ctx: SimContext, estimate: ObjectEstimate, side: ArmSide, held: ObjectModel) -> GraspPose:
-    spec = ctx.world.arm_specs[side]
-    hand = ctx.world.arm(side).hand
-    return compute_grasp_pose(held, estimate.position, estimate.yaw, spec.mount, spec.yaw, seen_extent(estimate), hand)
-
-
-def _who_takes(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel) -> GraspChoice:
-    """Which arm takes the object where it is, and by which approach: of the free arms that reach it,
-    nearest first (:func:`_reaching`), the first that can (:func:`_taking_to`: its inverse kinematics and
-    its planning's dry run of the moves) and can also let it go where the hold ends; else the first that
-    can take it, to pass it on there. The nearest arm is not the only one asked: where its hand cannot
-    get to the object (its joints' range, the dispenser in the way) or cannot set it down where it goes,
-    the other arm may. When none can,
-    the nearest arm's refusal, as it is when it is the only one asked or every arm's is a misfit (a
-    typed error: the object does not fit the hand so), else a SkillFailed starting with it and saying
-    why each other arm could not either."""
-    x, y, _ = estimate.position
-    arms = _reaching(ctx, x, y)
-    if not arms:
-        raise SkillFailed(f"no free arm reaches the {model.name} at ({x:.2f}, {y:.2f})")
-    fits = _fitting(ctx, model, arms) if len(model.preference) > 1 else ""  # one approach: its typed misfit
-    if fits:
-        raise SkillFailed(fits)
-    refused: list[tuple[ArmSide, Exception]] = []
-    passing_on: GraspChoice | None = None  # the first arm that can take it but not let it go where it goes
-    for side in arms:
-        try:
-            if len(model.preference) == 1:  # its one approach's misfit is its own typed error (GraspTooDeepError...)
-                _grasp_pose(ctx, estimate, side, model)
-            choice, served = _taking_to(ctx, estimate, model, side)  # one approach too: its moves are dry-run
-        except (SkillFailed, SimulationError) as why:
-            refused.append((side, why))
-            continue
-        if served:
-            return choice
-        passing_on = passing_on or choice
-    if passing_on is not None:
-        return passing_on  # the carry passes it to the arm that reaches where it goes
-    first = refused[0][1]
-    if len(refused) == 1 or all(isinstance(why, GraspMisfitError) for _, why in refused):
-        raise first
-    others = "; ".join(f"nor could the {side.value} arm take it: {why}" for side, why in refused[1:])
-    raise SkillFailed(f"{first}; {others}")
-
-
-def _fitting(ctx: SimContext, model: ObjectModel, sides: Sequence[ArmSide]) -> str:
-    """Why the hand of none of ``sides`` can close on the object by any of its approaches, wherever it is
-    (:func:`skills.can_grip`: wider than the jaws open, a top grasp deeper than the palm allows); empty
-    when one can. Said once, not once for each arm and each way of passing it between them."""
-    why = ""
-    for side in sides:
-        gripping = Candidates.of(model, functools.partial(skills.can_grip, hand=ctx.world.arm(side).hand))
-        if gripping.models:
-            return ""
-        why = why or gripping.refusal()
-    return why
-
-
-def _taking(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, side: ArmSide) -> GraspChoice:
-    """The approach ``side`` takes the object by (:func:`_taking_to`)."""
-    return _taking_to(ctx, estimate, model, side)[0]
-
-
-def _taking_to(
-    ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, side: ArmSide
-) -> tuple[GraspChoice, bool]:
-    """The approach ``side`` takes the object by, and whether it can also let it go where the hold ends
-    (True too where that is not known here), of several: the first it can take it by where it is and
-    let it go by where the hold ends, when that is known here (:func:`_hold_end`: a later carry of the
-    plan to a place the task gives), else the first it can take it by. Letting go is asked as the carry
-    will (:func:`_holdable`): over the spots of the place this arm reaches, nearest the centre first. An
-    arm that can let it go there by no approach takes it by the first it can, as where it is not known:
-    the carry passes it to the other arm. Of the approaches that pass those checks (the inverse
-    kinematics' of the end poses), the first whose moves the arm's planning would make (:func:`first_clear`)
-    is taken; when none would, :class:`MovesRefusedError` before anything moves."""
-    world, name = ctx.world, model.name
-
-    def take(held: ObjectModel) -> str:
-        return skills.can_take(world, estimate, side, held)
-
-    taking = Candidates.of(model, take)
-    if not taking.models:
-        raise SkillFailed(taking.refusal())
-    end = _hold_end(ctx, name, side)
-    if end is None:
-        moves = functools.partial(skills.can_carry, world, estimate, side)
-        return first_clear(taking, side, f"taking the {name}", moves), True
-    place, surface, spots = end
-    first: dict[GraspKind, Region] = {}  # the spot the carry will aim at, by each approach that lets go there
-
-    def letting_go(held: ObjectModel) -> str:
-        tried = spots[:RELAY_TRIES]
-        for at in tried:
-            spot = spot_region(surface, *at)
-            if not skills.can_set_down(world, estimate, side, held, spot):
-                first[held.grasp] = spot
-                return ""
-        spots_of = "the one spot" if len(tried) == 1 else f"any of the {len(tried)} spots"
-        where = f"{spots_of} of {place.name} it reaches" if tried else f"{place.name} (no spot in reach)"
-        return f"the {side.value} arm cannot hold the {name} by its {held.grasp.value} grasp over {where}"
-
-    both = Candidates.of(model, take, letting_go)
-    if both.models:
-        served = first_clear(
-            both,
-            side,
-            f"taking the {name} to {place.name}",
-            lambda held: skills.can_carry(
-                world,
-                estimate,
-                side,
-                held,
-                first[held.grasp],
-                floor=floor_to(ctx, held, side, estimate.position, first[held.grasp]),
-            ),
-            first,
-        )
-        return served, True
-    unplaced = "; ".join(why for _, why in both.ruled_out)
-    passed_on = first_clear(  # to be passed on: the take's moves are dry-run, as where the hold's end is not known
-        taking,
-        side,
-        f"taking the {name} (to {place.name}, to be passed on: {unplaced})",
-        lambda held: skills.can_carry(world, estimate, side, held),
-    )
-    return passed_on, False
-
-
-def _hold_end(
-    ctx: SimContext, name: str, side: ArmSide | None = None
-) -> tuple[Thing, Region, list[tuple[float, float]]] | None:
-    """Where the hold the running component starts ends, when the plan says: the place the first carry
-    after the running step is given, before any other step of its robot takes an object; and that
-    place's surface and spots (:func:`place_spots`) for the arm ``side`` (else ``ctx.arm``), as the carry
-    will aim.
-    The running step is the one the executor said it starts (``SimEnvironment.starting``), else the
-    plan's one step of this component; the carry's place is what the executor knows of its inputs then
-    (the task's value, or an earlier step's output), else the task's value. None when it is not known
-    here (the place is a later step's output, or no carry follows)."""
-    plan, iri, smap = ctx.plan, ctx.component, ctx.map
-    if plan is None or iri is None:
-        return None
-    if ctx.step is not None and iri in ctx.step.candidates:
-        mine = [position for position, step in enumerate(plan.steps) if step.index == ctx.step.index]
-    else:
-        mine = [position for position, step in enumerate(plan.steps) if iri in step.candidates]
-    if len(mine) != 1:
-        return None
-    device = plan.steps[mine[0]].device
-    for step in plan.steps[mine[0] + 1 :]:
-        if step.device != device:
-            continue
-        if step.action in TAKING:
-            return None  # another hold starts first
-        if step.action != ACT + "CarryingWhileLocomoting":
-            continue
-        if step.index in ctx.known:
-            values = list(ctx.known[step.index].values())
-        else:
-            values = [ctx.given.get(b.source.name) for b in step.inputs if b.source.step is None]
-        iris = [str(value["@id"]) for value in values if isinstance(value, dict) and "@id" in value]
-        places = [iri for iri in iris if iri in smap.regions or iri in smap.furniture]
-        if len(places) != 1:
-            return None
-        place = smap.things[places[0]]
-        spec = ctx.world.arm_specs[side or ctx.arm]
-        others = other_objects(ctx.world, ctx.belief, name)
-        size = ctx.world.objects[name].size if name in ctx.world.objects else (0.0, 0.0, 0.0)
-        surface, spots = place_spots(smap, place, size, [(spec.mount[0], spec.mount[1], spec.reach)], others)
-        return place, surface, spots
-    return None
 
 
 def pick_up(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
@@ -521,7 +316,7 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
         return place_spots(ctx.map, place, size, [(spec.mount[0], spec.mount[1], spec.reach)], others)
 
     surface, mine = spots(ctx.arm)
-    spot = _holdable(ctx, ctx.arm, surface, mine)
+    spot = holdable_spot(ctx, ctx.arm, surface, mine)
     if spot is None and ctx.grasp is not None:
         giver, model = ctx.arm, ctx.grasp.model
         cx, cy, _ = surface.center
@@ -562,7 +357,7 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
         if not placing.models:
             raise SkillFailed(f"the {taker.value} arm reaches {place.name}, but {placing.refusal()}")
         # Both arms' moves of the pass are dry-run before the giver sets the object down (it holds it now);
-        # a spot whose moves are refused is passed over for the next (_relay_spot).
+        # a spot whose moves are refused is passed over for the next (relay_spot).
         passing = f"passing the {model.name} from the {giver.value} arm to the {taker.value} for {place.name}"
         before = "the pass moved anything"
         holding = world.arm(giver).ee_pose().position
@@ -570,16 +365,16 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
         def holds(spot: Region, _: ObjectModel, taken_by: ObjectModel) -> None:
             why = skills.can_carry_held(world, giver, spot, floor_to(ctx, model, giver, holding, spot))
             refuse_moves(why, model, giver, passing, spot, before)
-            there = _resting(spot, model, taken, world.time)
+            there = resting_at(spot, model, taken, world.time)
             floor = floor_to(ctx, taken_by, taker, there.position, target)
             # the giver will have folded home by the time the taker moves
             why = skills.can_carry(world, there, taker, taken_by, target, floor=floor, folded=(giver,))
             refuse_moves(why, taken_by, taker, passing, target, before)
 
-        relay, _, taken_by = _relay_spot(ctx, taken, Candidates([model]), placing, giver, taker, holds)
-        found = _set_down_for(ctx, device, model, giver, taker, relay, None)
+        relay, _, taken_by = relay_spot(ctx, taken, Candidates([model]), placing, giver, taker, holds)
+        found = set_down_for(ctx, device, model, giver, taker, relay, None)
         taker_spec = world.arm_specs[taker]
-        _note(
+        note_choice(
             ctx,
             placing.choice(taker, taken_by, f"carrying the {model.name} to {place.name}", "no spot to take it by it"),
         )
@@ -593,7 +388,7 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
             world.arm(taker).hand,
         )
         for move in (skills.approach_object, skills.pick_up_object):
-            _passing(move(world, taker, grasp), model, giver, taker)
+            check_passing(move(world, taker, grasp), model, giver, taker)
         ctx.arm, ctx.grasp, ctx.seen, ctx.last_arm = taker, grasp, found, taker
     elif spot is None:
         raise SkillFailed(f"the {ctx.arm.value} arm reaches no spot of {place.name} to set the {carried} down on")
@@ -605,22 +400,6 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
     floor = None if grasped is None else floor_to(ctx, grasped.model, ctx.arm, hand, target)
     check_outcome(skills.carry_object(world, ctx.arm, target, floor=floor))
     return {}
-
-
-def _holdable(
-    ctx: SimContext, side: ArmSide, surface: Region, spots: Sequence[tuple[float, float]]
-) -> tuple[float, float] | None:
-    """The first of ``spots`` (of the first RELAY_TRIES) where the arm's hand, as it holds the object now,
-    can let it go on the surface (asked of the inverse kinematics); the first spot if it holds nothing."""
-    arm = ctx.world.arm(side)
-    grasp = arm.held_grasp
-    if grasp is None:
-        return spots[0] if spots else None
-    orientation = arm.ee_pose().orientation
-    for x, y in spots[:RELAY_TRIES]:
-        if arm.can_hold((x, y, surface.zmin + skills.PLACE_CLEARANCE + grasp.bottom_offset), orientation):
-            return (x, y)
-    return None
 
 
 def put_down(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
@@ -635,7 +414,7 @@ def fill_from_tap(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> di
     container = model_of(ctx, inputs["cup"]).name
     lever = thing_region(place_of(ctx, inputs["tap"], "the tap"))
     cx, cy, _ = (lever.xmin + lever.xmax) / 2, (lever.ymin + lever.ymax) / 2, 0.0
-    side = _free_arm(ctx, cx, cy, "the tap")
+    side = free_arm(ctx, cx, cy, "the tap")
     ctx.last_arm = side
     check_outcome(skills.fill_cup_from_tap(ctx.world, side, lever, container))
     return {}
@@ -644,357 +423,21 @@ def fill_from_tap(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> di
 def hand_over(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     """HandOverOntoPlatform by an arm that reaches both the object and the parked base's platform; when
     one arm reaches the object and only the other the platform, the first sets the object down where
-    both reach (:func:`_relay`) and the second loads it, each by the first of the object's approaches
-    that works for its own hold (:func:`_who_loads`)."""
+    both reach (:func:`relay_object`) and the second loads it, each by the first of the object's approaches
+    that works for its own hold (:func:`who_loads`)."""
     estimate = decode(inputs["objectPosition"], ObjectEstimate)
     model = model_of(ctx, inputs["graspPose"])
     base = ctx.world.base_pose()  # the base parks against the place's docking mark, which the robot knows
-    loading = _who_loads(ctx, estimate, model, base)
+    loading = who_loads(ctx, estimate, model, base)
     side = loading.loader.arm
     if loading.giver is not None and loading.spot is not None:
-        _note(ctx, loading.giver)
-        estimate = _relay(ctx, device, estimate, loading.giver.model, loading.giver.arm, side, loading.spot)
-    _note(ctx, loading.loader)
+        note_choice(ctx, loading.giver)
+        estimate = relay_object(ctx, device, estimate, loading.giver.model, loading.giver.arm, side, loading.spot)
+    note_choice(ctx, loading.loader)
     ctx.last_arm, ctx.focus = side, model.name
     reach = ctx.world.arm_specs[side].reach
     check_outcome(skills.hand_over_onto_platform(ctx.world, estimate, base, side, loading.loader.model, reach))
     return {}
-
-
-def _note(ctx: SimContext, choice: GraspChoice) -> None:
-    """Keep a choice among several approaches, readable (``SimEnvironment.context.choices``)."""
-    if len(choice.model.preference) > 1:
-        ctx.choices.append(choice)
-
-
-@dataclass(frozen=True)
-class _Loading:
-    """Who loads the platform, by which grasp, and who passes the object first, by which, and where."""
-
-    loader: GraspChoice
-    giver: GraspChoice | None = None
-    spot: Region | None = None
-
-
-def _who_loads(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, base: Pose2D) -> _Loading:
-    """Which arm loads the object onto the platform of the base parked at ``base`` and by which of its
-    approaches, and, when another arm must first pass it, that arm, its approach and the spot where it
-    sets the object down; SkillFailed saying why none can. Each arm holds it by the first approach, in
-    its class's order, by which it can both take it and let it go where its hold ends (an arm that
-    passes it sets it down, so the loader may take it anew by another approach). Asked without moving
-    (inverse kinematics on the private copies): by the hand-over, and before a run, by the plan's check
-    (:meth:`SimEnvironment.given`). With one approach only the letting go on the platform is asked of the
-    end poses, as before approaches could be chosen. The moves of each hold are then dry-run, one approach
-    alone too, as the approach choice's are (:func:`first_clear`, :func:`refuse_moves`): :class:`MovesRefusedError`
-    when the arm's planning would refuse them.
-
-    The arms are asked in turn, as the approach is (:func:`_who_takes`): each arm that reaches both the
-    object and the platform, nearest the object first (one hold, else a re-grasp), then each pass from an
-    arm that reaches the object to another that reaches the platform. The first way that serves is
-    taken; when none does, the first way's refusal, followed by why each other way did not serve."""
-    x, y, _ = estimate.position
-    takers = _reaching(ctx, x, y)
-    loaders = _reaching(ctx, base.x, base.y)
-    if not takers:
-        raise SkillFailed(f"no free arm reaches the {model.name} at ({x:.2f}, {y:.2f})")
-    if not loaders:
-        raise SkillFailed(
-            f"no free arm reaches the base's platform at ({base.x:.2f}, {base.y:.2f}): the docking pose is "
-            "beyond every arm's reach"
-        )
-    fits = _fitting(ctx, model, takers)
-    if fits:
-        raise SkillFailed(fits)
-    ways = [(side, side) for side in takers if side in loaders]
-    ways += [(giver, loader) for giver in takers for loader in loaders if giver is not loader]
-    refused: list[tuple[ArmSide, ArmSide, Exception]] = []
-    for giver, loader in ways:
-        try:
-            only = giver not in loaders and loader not in takers
-            return _loading_by(ctx, estimate, model, base, giver, loader, only)
-        except (SkillFailed, MovesRefusedError) as why:
-            refused.append((giver, loader, why))
-    first = refused[0][2]
-    if len(refused) == 1:
-        raise first
-    others = "; ".join(
-        f"nor by the {giver.value} arm alone: {why}"
-        if giver is loader
-        else f"nor passed from the {giver.value} arm to the {loader.value}: {why}"
-        for giver, loader, why in refused[1:]
-    )
-    raise SkillFailed(f"{first}; {others}")
-
-
-def _loading_by(
-    ctx: SimContext,
-    estimate: ObjectEstimate,
-    model: ObjectModel,
-    base: Pose2D,
-    giver: ArmSide,
-    loader: ArmSide,
-    only: bool,
-) -> _Loading:
-    """The loading of :func:`_who_loads` one way: ``loader`` alone (``giver`` the same arm: one hold, else a
-    re-grasp), or ``giver`` passing the object to ``loader`` (``only``: the giver does not reach the
-    platform)."""
-    world, choosing = ctx.world, len(model.preference) > 1
-    both = [giver] if giver is loader else []
-    purpose = f"loading the {model.name} onto the platform"
-    platform = skills.platform_region(base, world.platform_height)
-    # Letting go on the platform does not depend on where the loader takes the object from.
-    checks = [lambda held: skills.can_load(world, estimate, base, loader, held)]
-    whole: Candidates | None = None
-    unserved = ""  # why no one hold serves from where the object is to the platform
-    refused: MovesRefusedError | None = None
-    if both:  # one hold, from where it is to the platform
-        whole = Candidates.of(
-            model, *([lambda held: skills.can_take(world, estimate, loader, held), *checks] if choosing else checks)
-        )
-        unserved = whole.refusal()
-        if whole.models:  # the first whose moves the loader's planning would make, one alone too (first_clear)
-            spots = {held.grasp: platform for held in whole.models}
-            try:
-                loads = first_clear(
-                    whole, loader, purpose, lambda held: _loads(ctx, estimate, base, loader, held), spots
-                )
-            except MovesRefusedError as moves:
-                if not choosing:
-                    raise
-                # the hold's moves refused by every approach whose end poses pass: a re-grasp may serve, as
-                # where the end poses rule every approach out
-                refused, unserved = (
-                    moves,
-                    "; ".join(why for _, _, why in moves.refused) + (f"; {unserved}" if unserved else ""),
-                )
-            else:
-                return _Loading(loads)
-        if not choosing:
-            raise SkillFailed(whole.refusal())
-    # Two holds, the object set down between them where both reach: the arm that reaches it passes it to
-    # the loader, or, when one arm reaches both but no approach serves it all the way, that arm sets it
-    # down and takes it anew by an approach that loads (the re-grasp).
-    gripping = [lambda held: skills.can_grip(held, world.arm(loader).hand)]
-    loading = Candidates.of(model, *([*gripping, *checks] if choosing else checks))
-    giving = Candidates.of(model, lambda held: skills.can_take(world, estimate, giver, held)) if choosing else None
-    if whole is not None and not (loading.models and giving is not None and giving.models):
-        if refused is not None:
-            raise refused
-        raise SkillFailed(whole.refusal())
-    if not loading.models:
-        if only:
-            raise SkillFailed(
-                f"only the {giver.value} arm reaches the {model.name} and only the {loader.value} arm the platform, "
-                f"and {loading.refusal()}"
-            )
-        raise SkillFailed(f"the {loader.value} arm would load the {model.name}, but {loading.refusal()}")
-    if giving is not None and not giving.models:
-        if only:
-            raise SkillFailed(f"only the {giver.value} arm reaches the {model.name}, and {giving.refusal()}")
-        raise SkillFailed(f"the {giver.value} arm would pass the {model.name}, but {giving.refusal()}")
-    giving = giving or Candidates([model])
-    setting_down = (
-        f"setting the {model.name} down to take it anew, no one approach serving from where it is to the "
-        f"platform ({unserved})"
-        if whole is not None
-        else f"passing the {model.name} to the {loader.value} arm"
-    )
-
-    def holds(spot: Region, given_by: ObjectModel, taken_by: ObjectModel) -> None:
-        # Both holds' moves are dry-run before the first moves: the giver's from where the object is to the
-        # spot, the loader's from the spot to the platform (from its posture now; a re-grasping arm will
-        # have folded home, where it starts a task).
-        floor = floor_to(ctx, given_by, giver, estimate.position, spot)
-        why = skills.can_carry(world, estimate, giver, given_by, spot, floor=floor)
-        refuse_moves(why, given_by, giver, setting_down, spot)
-        there = _resting(spot, model, estimate, world.time)
-        refuse_moves(_loads(ctx, there, base, loader, taken_by), taken_by, loader, purpose, platform)
-
-    try:
-        spot, given_by, taken_by = _relay_spot(ctx, estimate, giving, loading, giver, loader, holds)
-    except SkillFailed as nowhere:
-        if whole is None:
-            raise
-        if refused is not None:
-            raise SkillFailed(f"{refused}; and {nowhere}") from None
-        raise SkillFailed(f"{whole.refusal()}; and {nowhere}") from None
-    given = giving.choice(giver, given_by, setting_down, "no spot to set it down by it")
-    loaded = loading.choice(loader, taken_by, purpose, "no spot to take it by it")
-    return _Loading(loaded, given, spot)
-
-
-def _loads(ctx: SimContext, estimate: ObjectEstimate, base: Pose2D, side: ArmSide, held: ObjectModel) -> str:
-    """Why ``side``'s planning would refuse the hand-over's moves by ``held``'s approach (a dry run)."""
-    return skills.can_hand_over(ctx.world, estimate, base, side, held)
-
-
-def _resting(spot: Region, model: ObjectModel, seen: ObjectEstimate, now: float) -> ObjectEstimate:
-    """Where an object set down on ``spot`` is expected to be, lying as it was ``seen``: what a dry run of
-    taking it from there asks about before it is there."""
-    cx, cy, _ = spot.center
-    return ObjectEstimate(cx, cy, spot.zmin + model.height / 2.0, seen.yaw, seen.size, model.colour, "map", now, 0)
-
-
-RELAY_MOVES_TRIES = 3
-"""How many spots whose end poses serve a pass or a re-grasp may have its holds' moves refused by the
-arms' planning (a dry run) before the pass is refused with the first refusal."""
-RELAY_TRIES = 40
-"""How many spots, nearest the mounts first, are asked of the inverse kinematics (each asks take a few
-milliseconds) before passing is given up."""
-
-
-def _relay(
-    ctx: SimContext,
-    device: str,
-    estimate: ObjectEstimate,
-    model: ObjectModel,
-    giver: ArmSide,
-    taker: ArmSide,
-    spot: Region,
-) -> ObjectEstimate:
-    """Pass an object from the arm that reaches it to the other arm: the first puts it down on ``spot``,
-    on the same surface, where both reach, and the object is found again there."""
-    world = ctx.world
-    spec, hand = world.arm_specs[giver], world.arm(giver).hand
-    grasp = compute_grasp_pose(
-        model, estimate.position, estimate.yaw, spec.mount, spec.yaw, seen_extent(estimate), hand
-    )
-    ctx.last_arm = giver
-    for move in (skills.approach_object, skills.pick_up_object):
-        _passing(move(world, giver, grasp), model, giver, taker)
-    return _set_down_for(ctx, device, model, giver, taker, spot, estimate.yaw)
-
-
-def _passing(outcome: skills.Outcome, model: ObjectModel, giver: ArmSide, taker: ArmSide) -> None:
-    if not outcome.succeeded:
-        what = (
-            f"setting the {model.name} down for the {giver.value} arm to take it anew"
-            if giver is taker
-            else f"passing the {model.name} from the {giver.value} arm to the {taker.value}"
-        )
-        raise SkillFailed(f"{what}: {outcome.skill}: {outcome.reason}")
-
-
-def _set_down_for(
-    ctx: SimContext, device: str, model: ObjectModel, giver: ArmSide, taker: ArmSide, spot: Region, yaw: float | None
-) -> ObjectEstimate:
-    """The giver, holding the object, sets it down on ``spot`` for the taker; where it is then (by the
-    robot's camera near where the hand let it go, else where the hand let it go)."""
-    world = ctx.world
-    floor = floor_to(ctx, model, giver, world.arm(giver).ee_pose().position, spot)
-    _passing(skills.carry_object(world, giver, spot, floor=floor), model, giver, taker)
-    _passing(skills.put_down_object(world, giver, spot), model, giver, taker)
-    released = world.arm(giver).released
-    where = released[1] if released is not None else spot.center
-    try:
-        camera = robot_camera(ctx, device)
-        check_outcome(skills.clear_view(world))
-        return recognise_object(world.camera(camera).capture(), model.colour, near=(where[0], where[1]), radius=0.1)
-    except (SkillFailed, SimulationError):
-        size = world.objects[model.name].size
-        return ObjectEstimate(where[0], where[1], where[2], yaw, size, model.colour, "hand", world.time, 0)
-
-
-def _relay_spot(
-    ctx: SimContext,
-    estimate: ObjectEstimate,
-    giving: Candidates,
-    taking: Candidates,
-    giver: ArmSide,
-    taker: ArmSide,
-    moves: Callable[[Region, ObjectModel, ObjectModel], None] | None = None,
-) -> tuple[Region, ObjectModel, ObjectModel]:
-    """Where on the surface the object rests on both arms reach it, clear of the other objects and of
-    the fixtures standing on it (a dispenser), and by which approach each hand holds it there: of the
-    spots nearest both mounts, the first where the giver's hand can hold the object as it sets it down
-    and the taker's hand can take it, each by the first of its candidate approaches that it can hold
-    there (asked of the inverse kinematics: a side grasp close to the mount has none), and, given
-    ``moves``, whose holds' moves the arms' planning would make (a dry run raising
-    :class:`MovesRefusedError`): a spot so refused is passed over for the next, as a refused approach is
-    for the next approach, up to RELAY_MOVES_TRIES of them; then the first refusal."""
-    smap, world = ctx.map, ctx.world
-    model = giving.models[0]
-    x, y, z = estimate.position
-    surface = z - model.height / 2.0
-    supports = [
-        smap.things[iri]
-        for iri in sorted(smap.furniture)
-        if iri in smap.things
-        and smap.things[iri].box.contains_xy(x, y)
-        and abs(smap.things[iri].box.max_z - surface) <= 0.03
-    ]
-    if not supports:
-        raise SkillFailed(f"the {model.name} rests on nothing the map knows: no surface to pass it on")
-    top = supports[0].box
-    size = world.objects[model.name].size
-    radius = math.hypot(size[0], size[1]) / 2.0
-    others = other_objects(world, ctx.belief, model.name)
-    fixtures = fixtures_on(smap, supports[0], surface, 0.3)
-    arms = [world.arm_specs[giver], world.arm_specs[taker]]
-    spots: list[tuple[float, float, float, float]] = []
-    inset = radius + RELAY_EDGE
-    for i in range(int((top.max_x - top.min_x - 2 * inset) / RELAY_STEP) + 1):
-        cx = top.min_x + inset + i * RELAY_STEP
-        for j in range(int((top.max_y - top.min_y - 2 * inset) / RELAY_STEP) + 1):
-            cy = top.min_y + inset + j * RELAY_STEP
-            distances = [math.hypot(cx - a.mount[0], cy - a.mount[1]) for a in arms]
-            if any(d > a.reach - RELAY_MARGIN for d, a in zip(distances, arms, strict=True)):
-                continue
-            if any(math.hypot(cx - ox_, cy - oy) < radius + r + RELAY_CLEARANCE for ox_, oy, r in others):
-                continue
-            if any(distance_to_extent(box, (cx, cy)) < radius + RELAY_CLEARANCE for box in fixtures):
-                continue
-            here = math.hypot(cx - x, cy - y)  # a re-grasp moves it as little as the approaches allow
-            spots.append((here, max(distances), cx, cy) if giver is taker else (max(distances), here, cx, cy))
-
-    def held_by(side: ArmSide, candidates: Candidates, centre: Vec3) -> ObjectModel | None:
-        spec = world.arm_specs[side]
-        for held in candidates.models:
-            try:
-                hand = compute_grasp_pose(
-                    held, centre, estimate.yaw, spec.mount, spec.yaw, seen_extent(estimate), world.arm(side).hand
-                )
-            except GraspMisfitError:
-                continue  # the hand cannot hold it so, wherever it is
-            if world.arm(side).can_hold(hand.position, hand.orientation) and world.arm(side).can_hold(
-                hand.pregrasp, hand.orientation
-            ):
-                return held
-        return None
-
-    refused: list[MovesRefusedError] = []
-    for *_, cx, cy in sorted(spots)[:RELAY_TRIES]:
-        centre = (cx, cy, surface + model.height / 2.0)
-        given = held_by(giver, giving, centre)
-        taken = held_by(taker, taking, centre) if given is not None else None
-        if given is not None and taken is not None:
-            half = RELAY_STEP * 2
-            region = Region(
-                f"{supports[0].name}Relay", cx - half, cx + half, cy - half, cy + half, top.max_z, top.max_z + 0.3
-            )
-            try:
-                if moves is not None:
-                    moves(region, given, taken)
-            except MovesRefusedError as why:
-                refused.append(why)
-                if len(refused) >= RELAY_MOVES_TRIES:
-                    break
-                continue
-            return region, given, taken
-    if refused:
-        raise refused[0]
-    if giver is taker:
-        down = " or ".join(held.grasp.value for held in giving.models)
-        anew = " or ".join(held.grasp.value for held in taking.models)
-        raise SkillFailed(
-            f"there is no spot on {supports[0].name} where the {giver.value} arm can set the {model.name} down by "
-            f"its {down} grasp and take it anew by its {anew} grasp"
-        )
-    kinds = " or ".join(dict.fromkeys(held.grasp.value for held in [*giving.models, *taking.models]))
-    raise SkillFailed(
-        f"there is no spot on {supports[0].name} where both the {giver.value} and the {taker.value} arm can hold "
-        f"the {model.name} by its {kinds} grasp, to pass it from one to the other"
-    )
 
 
 # -- the home server, the ceiling cameras and the mobile base -------------------------------------
@@ -1395,7 +838,7 @@ class SimEnvironment:
                     continue
                 estimate, model, dock = self._estimate(obj, support), Manipulation.of(obj).model, docking_pose(support)
                 try:
-                    _who_loads(self.context, estimate, model, dock)
+                    who_loads(self.context, estimate, model, dock)
                 except (SkillFailed, MovesRefusedError) as refused:
                     if not self._loads_nearby(estimate, model, dock):
                         raise CannotLoadError(step.component, obj.iri, str(refused)) from None
@@ -1409,7 +852,7 @@ class SimEnvironment:
         for dx, dy in ((LOADING_SLACK, 0.0), (-LOADING_SLACK, 0.0), (0.0, LOADING_SLACK), (0.0, -LOADING_SLACK)):
             moved = replace(estimate, x=estimate.x + dx, y=estimate.y + dy)
             try:
-                _who_loads(self.context, moved, model, dock)
+                who_loads(self.context, moved, model, dock)
             except (SkillFailed, MovesRefusedError):
                 continue
             log.info("loading check: the %s loads %+.3f, %+.3f m from where it is believed to be", model.name, dx, dy)

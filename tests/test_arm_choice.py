@@ -18,7 +18,7 @@ from cbrs.actions.composer import Composer
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
-from cbrs.sim import components, grounding, skills
+from cbrs.sim import arm_choice, components, grounding, skills
 from cbrs.sim.arms import ArmSide
 from cbrs.sim.components import CannotLoadError, SimEnvironment
 from cbrs.sim.context import SimContext, SkillFailed
@@ -76,10 +76,10 @@ def test_the_nearest_arm_that_cannot_take_the_object_leaves_it_to_the_other(
     kb, world = both_reach
     context = SimEnvironment(world, kb).context
     seen, cup = _seen(world)
-    assert components._reaching(context, seen.x, seen.y) == [LEFT, RIGHT]  # the left is nearer
-    assert components._who_takes(context, seen, cup).arm is LEFT
+    assert arm_choice.reaching(context, seen.x, seen.y) == [LEFT, RIGHT]  # the left is nearer
+    assert arm_choice.who_takes(context, seen, cup).arm is LEFT
     monkeypatch.setattr(skills, "can_take", _refusing(LEFT))
-    chosen = components._who_takes(context, seen, cup)
+    chosen = arm_choice.who_takes(context, seen, cup)
     assert chosen.arm is RIGHT
 
 
@@ -91,7 +91,7 @@ def test_no_arm_that_can_take_it_is_refused_saying_why_for_each(
     seen, cup = _seen(world)
     monkeypatch.setattr(skills, "can_take", _refusing(LEFT, RIGHT))
     with pytest.raises(SkillFailed) as refused:
-        components._who_takes(context, seen, cup)
+        arm_choice.who_takes(context, seen, cup)
     message = str(refused.value)
     assert message.startswith("the stand-in refuses the left arm")  # the nearest arm's refusal first
     assert "nor could the right arm take it: the stand-in refuses the right arm" in message
@@ -134,16 +134,16 @@ def test_a_loader_whose_one_hold_the_planning_refuses_sets_the_object_down_and_t
     with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
         context = SimEnvironment(world, kb).context
         seen, cup = _seen(world)
-        real = components._loads
+        real = arm_choice._loads
 
         def loads(ctx: SimContext, estimate: ObjectEstimate, *rest: object) -> str:
             if estimate is seen:
                 return "the stand-in refuses the one hold"
             return real(ctx, estimate, *rest)  # type: ignore[arg-type]
 
-        monkeypatch.setattr(components, "_loads", loads)
+        monkeypatch.setattr(arm_choice, "_loads", loads)
         base = grounding.docking_pose(world.map.things[WORLD + "KitchenTable"])
-        loading = components._who_loads(context, seen, cup, base)
+        loading = arm_choice.who_loads(context, seen, cup, base)
     assert loading.giver is not None and loading.spot is not None
     assert loading.giver.arm is RIGHT and loading.loader.arm is RIGHT
     assert str(loading.giver).startswith("setting the Cup down to take it anew")
@@ -161,7 +161,7 @@ def test_a_pass_whose_holds_are_refused_at_one_relay_spot_tries_the_next(monkeyp
         context = SimEnvironment(world, kb).context
         seen, cup = _seen(world)
         base = grounding.docking_pose(world.map.things[WORLD + "KitchenTable"])
-        first = components._who_loads(context, seen, cup, base)
+        first = arm_choice.who_loads(context, seen, cup, base)
         assert first.giver is not None and first.giver.arm is LEFT and first.spot is not None
         refused_at = first.spot.center
         real = skills.can_carry
@@ -173,10 +173,10 @@ def test_a_pass_whose_holds_are_refused_at_one_relay_spot_tries_the_next(monkeyp
             return real(world, seen, side, *rest, **kw)  # type: ignore[arg-type]
 
         monkeypatch.setattr(skills, "can_carry", can_carry)
-        second = components._who_loads(context, seen, cup, base)
+        second = arm_choice.who_loads(context, seen, cup, base)
         monkeypatch.setattr(skills, "can_carry", lambda *args, **kw: "the stand-in refuses every spot")
         with pytest.raises(MovesRefusedError) as refused:
-            components._who_loads(context, seen, cup, base)
+            arm_choice.who_loads(context, seen, cup, base)
     assert second.spot is not None and second.spot.center != refused_at
     assert second.giver is not None and second.giver.arm is LEFT and second.loader.arm is RIGHT
     assert "the stand-in refuses every spot" in str(refused.value) and refused.value.arm == "left"
@@ -197,14 +197,14 @@ def test_of_two_arms_that_can_take_it_the_one_that_can_also_set_it_down_where_it
     with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
         context = SimEnvironment(world, kb).context
         seen, cup = _seen(world)
-        assert components._reaching(context, seen.x, seen.y) == [LEFT, RIGHT]
-        assert components._who_takes(context, seen, cup).arm is LEFT  # no plan: where it goes is not known
+        assert arm_choice.reaching(context, seen.x, seen.y) == [LEFT, RIGHT]
+        assert arm_choice.who_takes(context, seen, cup).arm is LEFT  # no plan: where it goes is not known
         context.plan, context.component = plan, PREFIXES["svc"] + "ApproachToObject_CytonDualArm01"
         context.given = {
             "cup": designator(WORLD + "Cup", PREFIXES["home"] + "Cup"),
             "place": designator(WORLD + "TrayPlace", PREFIXES["home"] + "ObjectPlace"),
         }
-        chosen = components._who_takes(context, seen, cup)
+        chosen = arm_choice.who_takes(context, seen, cup)
     assert chosen.arm is RIGHT and chosen.purpose == "taking the Cup to TrayPlace"
 
 

@@ -15,7 +15,7 @@ from cbrs.actions.runner import run_task
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
-from cbrs.sim import components, hold_choice, skills
+from cbrs.sim import arm_choice, hold_choice, skills
 from cbrs.sim.arms import ArmSide
 from cbrs.sim.components import SimEnvironment
 from cbrs.sim.errors import MovesRefusedError
@@ -114,9 +114,9 @@ def test_an_approach_the_dry_run_refuses_is_ranked_after_not_refused(
         context = SimEnvironment(world, kb).context
         monkeypatch.setattr(skills, "can_carry", lambda *args: "refused by the stand-in")
         with pytest.raises(MovesRefusedError) as everything_refused:
-            components._taking(context, seen, cup, ArmSide.LEFT)
+            arm_choice.taking(context, seen, cup, ArmSide.LEFT)
         monkeypatch.setattr(skills, "can_carry", lambda w, e, s, held, *r: "no" if held.grasp is GraspKind.SIDE else "")
-        side_refused = components._taking(context, seen, cup, ArmSide.LEFT)
+        side_refused = arm_choice.taking(context, seen, cup, ArmSide.LEFT)
     refused = everything_refused.value
     assert (refused.name, refused.arm) == ("Cup", "left")
     assert refused.refused == (("side", None, "refused by the stand-in"), ("top", None, "refused by the stand-in"))
@@ -132,7 +132,7 @@ def test_one_approach_left_to_choose_is_dry_run_too(tmp_path: Path, monkeypatch:
         context = SimEnvironment(world, kb).context
         asked: list[GraspKind] = []
         monkeypatch.setattr(skills, "can_carry", lambda w, e, s, held, *r: asked.append(held.grasp) or "")
-        both = components._taking(context, seen, cup, ArmSide.LEFT)
+        both = arm_choice.taking(context, seen, cup, ArmSide.LEFT)
     assert both.model.grasp is GraspKind.SIDE and asked == [GraspKind.SIDE]
     asked.clear()
     alone = hold_choice.Candidates([cup.by(GraspKind.TOP)], [(GraspKind.SIDE, "ruled out")])

@@ -1,7 +1,7 @@
 """ApproachToObject looks ahead to where the hold it starts ends, when the plan and the task say: the place
 a later CarryObject is given by the task. An arm then takes the object by the first approach that serves
 both ends (taking it where it is, letting it go at a spot of the place it reaches), and falls back to the
-first it can take it by when where it goes is not known here (sim/components.py: _taking, _hold_end)."""
+first it can take it by when where it goes is not known here (sim/components.py: _taking, hold_end)."""
 
 from __future__ import annotations
 
@@ -16,8 +16,9 @@ from cbrs.actions.runner import run_task
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
+from cbrs.sim.arm_choice import hold_end
 from cbrs.sim.arms import ArmSide
-from cbrs.sim.components import SimContext, SimEnvironment, _hold_end
+from cbrs.sim.components import SimContext, SimEnvironment
 from cbrs.sim.grasping import GraspKind
 from cbrs.sim.values import designator
 from cbrs.sim.world import open_world
@@ -79,9 +80,9 @@ def test_where_the_hold_ends_is_the_carrys_place_when_the_task_gives_it_and_else
     cup, place = designator(WORLD + "Cup", HOME + "Cup"), designator(WORLD + "TrayPlace", HOME + "ObjectPlace")
     with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
         ctx = SimContext(world, kb)
-        assert _hold_end(ctx, "Cup") is None  # no plan: a component run on its own
+        assert hold_end(ctx, "Cup") is None  # no plan: a component run on its own
         ctx.plan, ctx.given, ctx.component = plan, {"cup": cup, "place": place}, APPROACH
-        found = _hold_end(ctx, "Cup")
+        found = hold_end(ctx, "Cup")
         assert found is not None
         where, surface, spots = found
         assert where.iri == WORLD + "TrayPlace" and spots[0] == pytest.approx((7.56, 3.08))
@@ -92,15 +93,15 @@ def test_where_the_hold_ends_is_the_carrys_place_when_the_task_gives_it_and_else
             carry, bindings=tuple(replace(b, source=Source("objectPlace", step=1)) for b in carry.bindings)
         )
         ctx.plan = replace(plan, steps=tuple(from_a_step if s is carry else s for s in plan.steps))
-        assert _hold_end(ctx, "Cup") is None  # the place is another step's output: not known here
+        assert hold_end(ctx, "Cup") is None  # the place is another step's output: not known here
 
         approach = next(s for s in plan.steps if APPROACH in s.candidates)
         twice = replace(approach, index=len(plan.steps) + 1)
         ctx.plan = replace(plan, steps=(*plan.steps, twice))
-        assert _hold_end(ctx, "Cup") is None  # two steps of the component: which one runs is not passed
+        assert hold_end(ctx, "Cup") is None  # two steps of the component: which one runs is not passed
 
         ctx.plan = replace(plan, steps=tuple(s for s in plan.steps if s is not carry))
-        assert _hold_end(ctx, "Cup") is None  # no carry follows
+        assert hold_end(ctx, "Cup") is None  # no carry follows
 
 
 def test_the_executor_says_which_step_runs_and_what_an_earlier_step_gave_the_carry(tmp_path: Path) -> None:
@@ -121,14 +122,14 @@ def test_the_executor_says_which_step_runs_and_what_an_earlier_step_gave_the_car
         )
         later = replace(approach, index=len(plan.steps) + 1)  # the same component again, after the carry
         ctx.plan = replace(plan, steps=(*(from_a_step if s is carry else s for s in plan.steps), later))
-        assert _hold_end(ctx, "Cup") is None  # neither which step runs nor the place is known
+        assert hold_end(ctx, "Cup") is None  # neither which step runs nor the place is known
 
         environment.starting(approach, {carry.index: {"object": cup, "place": place}})
-        found = _hold_end(ctx, "Cup")
+        found = hold_end(ctx, "Cup")
         assert found is not None and found[0].iri == WORLD + "TrayPlace"
 
         environment.starting(later, {carry.index: {"object": cup, "place": place}})
-        assert _hold_end(ctx, "Cup") is None  # no carry follows the later step
+        assert hold_end(ctx, "Cup") is None  # no carry follows the later step
 
         environment.starting(approach, {carry.index: {"object": cup}})
-        assert _hold_end(ctx, "Cup") is None  # the place is not produced yet
+        assert hold_end(ctx, "Cup") is None  # the place is not produced yet

@@ -1,0 +1,417 @@
+"""Which arm takes an object, which loads it onto the platform, and by which approach.
+
+Of the free arms that reach the object, nearest first, the first that can take it and also let it go
+where its hold ends (a later carry's place) takes it; else the first that can take it, to pass it on.
+Loading the platform is asked the same way: one arm that reaches both, else a re-grasp, else a pass
+from an arm that reaches the object to one that reaches the platform. Each is asked without moving
+(inverse kinematics and dry runs of the arms' planning), by the skill and by the check before a run.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.semantic_map import Thing
+from cbrs.sim import skills
+from cbrs.sim.arms import ArmSide
+from cbrs.sim.context import SimContext, SkillFailed
+from cbrs.sim.errors import GraspMisfitError, MovesRefusedError, SimulationError
+from cbrs.sim.geometry import Pose2D, Region
+from cbrs.sim.grasping import GraspKind, GraspPose, ObjectModel, compute_grasp_pose
+from cbrs.sim.hold_choice import Candidates, GraspChoice, first_clear, refuse_moves, seen_extent
+from cbrs.sim.perception import ObjectEstimate
+from cbrs.sim.place_spots import other_objects, place_spots, spot_region
+from cbrs.sim.relay import RELAY_TRIES, relay_spot, resting_at
+from cbrs.sim.transit import floor_to
+
+ACT = PREFIXES["act"]
+
+TAKING = frozenset({ACT + "ApproachToObject", ACT + "HandingOverOntoPlatform"})
+"""The actions with which an arm takes an object: a hold starts."""
+
+
+ARM_TIE = 0.01
+"""Two arms whose mounts are within 1 cm as far from a target reach it equally well."""
+
+
+def reaching(ctx: SimContext, x: float, y: float) -> list[ArmSide]:
+    """The free arms whose mounts are within their reach of (x, y), best first: the nearest, and on a
+    tie not the one that just acted."""
+    options = []
+    for side, spec in ctx.world.arm_specs.items():
+        distance = math.hypot(x - spec.mount[0], y - spec.mount[1])
+        if ctx.world.arm(side).held is None and distance <= spec.reach:
+            options.append((distance, side))
+    if not options:
+        return []
+    best = min(distance for distance, _ in options)
+    tied = sorted(side for distance, side in options if distance - best <= ARM_TIE)
+    fresh = [side for side in tied if side != ctx.last_arm]
+    first = (fresh or tied)[0]
+    return [first, *(side for _, side in sorted(options) if side != first)]
+
+
+def free_arm(ctx: SimContext, x: float, y: float, what: str) -> ArmSide:
+    """The free arm whose mount is nearest (x, y) and within its reach; on a tie, not the one that just acted."""
+    arms = reaching(ctx, x, y)
+    if not arms:
+        raise SkillFailed(f"no free arm reaches {what} at ({x:.2f}, {y:.2f})")
+    return arms[0]
+
+
+def grasp_pose_for(ctx: SimContext, estimate: ObjectEstimate, side: ArmSide, held: ObjectModel) -> GraspPose:
+    spec = ctx.world.arm_specs[side]
+    hand = ctx.world.arm(side).hand
+    return compute_grasp_pose(held, estimate.position, estimate.yaw, spec.mount, spec.yaw, seen_extent(estimate), hand)
+
+
+def who_takes(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel) -> GraspChoice:
+    """Which arm takes the object where it is, and by which approach: of the free arms that reach it,
+    nearest first (:func:`reaching`), the first that can (:func:`taking_to`: its inverse kinematics and
+    its planning's dry run of the moves) and can also let it go where the hold ends; else the first that
+    can take it, to pass it on there. The nearest arm is not the only one asked: where its hand cannot
+    get to the object (its joints' range, the dispenser in the way) or cannot set it down where it goes,
+    the other arm may. When none can,
+    the nearest arm's refusal, as it is when it is the only one asked or every arm's is a misfit (a
+    typed error: the object does not fit the hand so), else a SkillFailed starting with it and saying
+    why each other arm could not either."""
+    x, y, _ = estimate.position
+    arms = reaching(ctx, x, y)
+    if not arms:
+        raise SkillFailed(f"no free arm reaches the {model.name} at ({x:.2f}, {y:.2f})")
+    fits = _fitting(ctx, model, arms) if len(model.preference) > 1 else ""  # one approach: its typed misfit
+    if fits:
+        raise SkillFailed(fits)
+    refused: list[tuple[ArmSide, Exception]] = []
+    passing_on: GraspChoice | None = None  # the first arm that can take it but not let it go where it goes
+    for side in arms:
+        try:
+            if len(model.preference) == 1:  # its one approach's misfit is its own typed error (GraspTooDeepError...)
+                grasp_pose_for(ctx, estimate, side, model)
+            choice, served = taking_to(ctx, estimate, model, side)  # one approach too: its moves are dry-run
+        except (SkillFailed, SimulationError) as why:
+            refused.append((side, why))
+            continue
+        if served:
+            return choice
+        passing_on = passing_on or choice
+    if passing_on is not None:
+        return passing_on  # the carry passes it to the arm that reaches where it goes
+    first = refused[0][1]
+    if len(refused) == 1 or all(isinstance(why, GraspMisfitError) for _, why in refused):
+        raise first
+    others = "; ".join(f"nor could the {side.value} arm take it: {why}" for side, why in refused[1:])
+    raise SkillFailed(f"{first}; {others}")
+
+
+def _fitting(ctx: SimContext, model: ObjectModel, sides: Sequence[ArmSide]) -> str:
+    """Why the hand of none of ``sides`` can close on the object by any of its approaches, wherever it is
+    (:func:`skills.can_grip`: wider than the jaws open, a top grasp deeper than the palm allows); empty
+    when one can. Said once, not once for each arm and each way of passing it between them."""
+    why = ""
+    for side in sides:
+        gripping = Candidates.of(model, functools.partial(skills.can_grip, hand=ctx.world.arm(side).hand))
+        if gripping.models:
+            return ""
+        why = why or gripping.refusal()
+    return why
+
+
+def taking(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, side: ArmSide) -> GraspChoice:
+    """The approach ``side`` takes the object by (:func:`taking_to`)."""
+    return taking_to(ctx, estimate, model, side)[0]
+
+
+def taking_to(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, side: ArmSide) -> tuple[GraspChoice, bool]:
+    """The approach ``side`` takes the object by, and whether it can also let it go where the hold ends
+    (True too where that is not known here), of several: the first it can take it by where it is and
+    let it go by where the hold ends, when that is known here (:func:`hold_end`: a later carry of the
+    plan to a place the task gives), else the first it can take it by. Letting go is asked as the carry
+    will (:func:`holdable_spot`): over the spots of the place this arm reaches, nearest the centre first. An
+    arm that can let it go there by no approach takes it by the first it can, as where it is not known:
+    the carry passes it to the other arm. Of the approaches that pass those checks (the inverse
+    kinematics' of the end poses), the first whose moves the arm's planning would make (:func:`first_clear`)
+    is taken; when none would, :class:`MovesRefusedError` before anything moves."""
+    world, name = ctx.world, model.name
+
+    def take(held: ObjectModel) -> str:
+        return skills.can_take(world, estimate, side, held)
+
+    taking = Candidates.of(model, take)
+    if not taking.models:
+        raise SkillFailed(taking.refusal())
+    end = hold_end(ctx, name, side)
+    if end is None:
+        moves = functools.partial(skills.can_carry, world, estimate, side)
+        return first_clear(taking, side, f"taking the {name}", moves), True
+    place, surface, spots = end
+    first: dict[GraspKind, Region] = {}  # the spot the carry will aim at, by each approach that lets go there
+
+    def letting_go(held: ObjectModel) -> str:
+        tried = spots[:RELAY_TRIES]
+        for at in tried:
+            spot = spot_region(surface, *at)
+            if not skills.can_set_down(world, estimate, side, held, spot):
+                first[held.grasp] = spot
+                return ""
+        spots_of = "the one spot" if len(tried) == 1 else f"any of the {len(tried)} spots"
+        where = f"{spots_of} of {place.name} it reaches" if tried else f"{place.name} (no spot in reach)"
+        return f"the {side.value} arm cannot hold the {name} by its {held.grasp.value} grasp over {where}"
+
+    both = Candidates.of(model, take, letting_go)
+    if both.models:
+        served = first_clear(
+            both,
+            side,
+            f"taking the {name} to {place.name}",
+            lambda held: skills.can_carry(
+                world,
+                estimate,
+                side,
+                held,
+                first[held.grasp],
+                floor=floor_to(ctx, held, side, estimate.position, first[held.grasp]),
+            ),
+            first,
+        )
+        return served, True
+    unplaced = "; ".join(why for _, why in both.ruled_out)
+    passed_on = first_clear(  # to be passed on: the take's moves are dry-run, as where the hold's end is not known
+        taking,
+        side,
+        f"taking the {name} (to {place.name}, to be passed on: {unplaced})",
+        lambda held: skills.can_carry(world, estimate, side, held),
+    )
+    return passed_on, False
+
+
+def hold_end(
+    ctx: SimContext, name: str, side: ArmSide | None = None
+) -> tuple[Thing, Region, list[tuple[float, float]]] | None:
+    """Where the hold the running component starts ends, when the plan says: the place the first carry
+    after the running step is given, before any other step of its robot takes an object; and that
+    place's surface and spots (:func:`place_spots`) for the arm ``side`` (else ``ctx.arm``), as the carry
+    will aim.
+    The running step is the one the executor said it starts (``SimEnvironment.starting``), else the
+    plan's one step of this component; the carry's place is what the executor knows of its inputs then
+    (the task's value, or an earlier step's output), else the task's value. None when it is not known
+    here (the place is a later step's output, or no carry follows)."""
+    plan, iri, smap = ctx.plan, ctx.component, ctx.map
+    if plan is None or iri is None:
+        return None
+    if ctx.step is not None and iri in ctx.step.candidates:
+        mine = [position for position, step in enumerate(plan.steps) if step.index == ctx.step.index]
+    else:
+        mine = [position for position, step in enumerate(plan.steps) if iri in step.candidates]
+    if len(mine) != 1:
+        return None
+    device = plan.steps[mine[0]].device
+    for step in plan.steps[mine[0] + 1 :]:
+        if step.device != device:
+            continue
+        if step.action in TAKING:
+            return None  # another hold starts first
+        if step.action != ACT + "CarryingWhileLocomoting":
+            continue
+        if step.index in ctx.known:
+            values = list(ctx.known[step.index].values())
+        else:
+            values = [ctx.given.get(b.source.name) for b in step.inputs if b.source.step is None]
+        iris = [str(value["@id"]) for value in values if isinstance(value, dict) and "@id" in value]
+        places = [iri for iri in iris if iri in smap.regions or iri in smap.furniture]
+        if len(places) != 1:
+            return None
+        place = smap.things[places[0]]
+        spec = ctx.world.arm_specs[side or ctx.arm]
+        others = other_objects(ctx.world, ctx.belief, name)
+        size = ctx.world.objects[name].size if name in ctx.world.objects else (0.0, 0.0, 0.0)
+        surface, spots = place_spots(smap, place, size, [(spec.mount[0], spec.mount[1], spec.reach)], others)
+        return place, surface, spots
+    return None
+
+
+def holdable_spot(
+    ctx: SimContext, side: ArmSide, surface: Region, spots: Sequence[tuple[float, float]]
+) -> tuple[float, float] | None:
+    """The first of ``spots`` (of the first RELAY_TRIES) where the arm's hand, as it holds the object now,
+    can let it go on the surface (asked of the inverse kinematics); the first spot if it holds nothing."""
+    arm = ctx.world.arm(side)
+    grasp = arm.held_grasp
+    if grasp is None:
+        return spots[0] if spots else None
+    orientation = arm.ee_pose().orientation
+    for x, y in spots[:RELAY_TRIES]:
+        if arm.can_hold((x, y, surface.zmin + skills.PLACE_CLEARANCE + grasp.bottom_offset), orientation):
+            return (x, y)
+    return None
+
+
+def note_choice(ctx: SimContext, choice: GraspChoice) -> None:
+    """Keep a choice among several approaches, readable (``SimEnvironment.context.choices``)."""
+    if len(choice.model.preference) > 1:
+        ctx.choices.append(choice)
+
+
+@dataclass(frozen=True)
+class Loading:
+    """Who loads the platform, by which grasp, and who passes the object first, by which, and where."""
+
+    loader: GraspChoice
+    giver: GraspChoice | None = None
+    spot: Region | None = None
+
+
+def who_loads(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, base: Pose2D) -> Loading:
+    """Which arm loads the object onto the platform of the base parked at ``base`` and by which of its
+    approaches, and, when another arm must first pass it, that arm, its approach and the spot where it
+    sets the object down; SkillFailed saying why none can. Each arm holds it by the first approach, in
+    its class's order, by which it can both take it and let it go where its hold ends (an arm that
+    passes it sets it down, so the loader may take it anew by another approach). Asked without moving
+    (inverse kinematics on the private copies): by the hand-over, and before a run, by the plan's check
+    (:meth:`SimEnvironment.given`). With one approach only the letting go on the platform is asked of the
+    end poses, as before approaches could be chosen. The moves of each hold are then dry-run, one approach
+    alone too, as the approach choice's are (:func:`first_clear`, :func:`refuse_moves`): :class:`MovesRefusedError`
+    when the arm's planning would refuse them.
+
+    The arms are asked in turn, as the approach is (:func:`who_takes`): each arm that reaches both the
+    object and the platform, nearest the object first (one hold, else a re-grasp), then each pass from an
+    arm that reaches the object to another that reaches the platform. The first way that serves is
+    taken; when none does, the first way's refusal, followed by why each other way did not serve."""
+    x, y, _ = estimate.position
+    takers = reaching(ctx, x, y)
+    loaders = reaching(ctx, base.x, base.y)
+    if not takers:
+        raise SkillFailed(f"no free arm reaches the {model.name} at ({x:.2f}, {y:.2f})")
+    if not loaders:
+        raise SkillFailed(
+            f"no free arm reaches the base's platform at ({base.x:.2f}, {base.y:.2f}): the docking pose is "
+            "beyond every arm's reach"
+        )
+    fits = _fitting(ctx, model, takers)
+    if fits:
+        raise SkillFailed(fits)
+    ways = [(side, side) for side in takers if side in loaders]
+    ways += [(giver, loader) for giver in takers for loader in loaders if giver is not loader]
+    refused: list[tuple[ArmSide, ArmSide, Exception]] = []
+    for giver, loader in ways:
+        try:
+            only = giver not in loaders and loader not in takers
+            return _loading_by(ctx, estimate, model, base, giver, loader, only)
+        except (SkillFailed, MovesRefusedError) as why:
+            refused.append((giver, loader, why))
+    first = refused[0][2]
+    if len(refused) == 1:
+        raise first
+    others = "; ".join(
+        f"nor by the {giver.value} arm alone: {why}"
+        if giver is loader
+        else f"nor passed from the {giver.value} arm to the {loader.value}: {why}"
+        for giver, loader, why in refused[1:]
+    )
+    raise SkillFailed(f"{first}; {others}")
+
+
+def _loading_by(
+    ctx: SimContext,
+    estimate: ObjectEstimate,
+    model: ObjectModel,
+    base: Pose2D,
+    giver: ArmSide,
+    loader: ArmSide,
+    only: bool,
+) -> Loading:
+    """The loading of :func:`who_loads` one way: ``loader`` alone (``giver`` the same arm: one hold, else a
+    re-grasp), or ``giver`` passing the object to ``loader`` (``only``: the giver does not reach the
+    platform)."""
+    world, choosing = ctx.world, len(model.preference) > 1
+    both = [giver] if giver is loader else []
+    purpose = f"loading the {model.name} onto the platform"
+    platform = skills.platform_region(base, world.platform_height)
+    # Letting go on the platform does not depend on where the loader takes the object from.
+    checks = [lambda held: skills.can_load(world, estimate, base, loader, held)]
+    whole: Candidates | None = None
+    unserved = ""  # why no one hold serves from where the object is to the platform
+    refused: MovesRefusedError | None = None
+    if both:  # one hold, from where it is to the platform
+        whole = Candidates.of(
+            model, *([lambda held: skills.can_take(world, estimate, loader, held), *checks] if choosing else checks)
+        )
+        unserved = whole.refusal()
+        if whole.models:  # the first whose moves the loader's planning would make, one alone too (first_clear)
+            spots = {held.grasp: platform for held in whole.models}
+            try:
+                loads = first_clear(
+                    whole, loader, purpose, lambda held: _loads(ctx, estimate, base, loader, held), spots
+                )
+            except MovesRefusedError as moves:
+                if not choosing:
+                    raise
+                # the hold's moves refused by every approach whose end poses pass: a re-grasp may serve, as
+                # where the end poses rule every approach out
+                refused, unserved = (
+                    moves,
+                    "; ".join(why for _, _, why in moves.refused) + (f"; {unserved}" if unserved else ""),
+                )
+            else:
+                return Loading(loads)
+        if not choosing:
+            raise SkillFailed(whole.refusal())
+    # Two holds, the object set down between them where both reach: the arm that reaches it passes it to
+    # the loader, or, when one arm reaches both but no approach serves it all the way, that arm sets it
+    # down and takes it anew by an approach that loads (the re-grasp).
+    gripping = [lambda held: skills.can_grip(held, world.arm(loader).hand)]
+    loading = Candidates.of(model, *([*gripping, *checks] if choosing else checks))
+    giving = Candidates.of(model, lambda held: skills.can_take(world, estimate, giver, held)) if choosing else None
+    if whole is not None and not (loading.models and giving is not None and giving.models):
+        if refused is not None:
+            raise refused
+        raise SkillFailed(whole.refusal())
+    if not loading.models:
+        if only:
+            raise SkillFailed(
+                f"only the {giver.value} arm reaches the {model.name} and only the {loader.value} arm the platform, "
+                f"and {loading.refusal()}"
+            )
+        raise SkillFailed(f"the {loader.value} arm would load the {model.name}, but {loading.refusal()}")
+    if giving is not None and not giving.models:
+        if only:
+            raise SkillFailed(f"only the {giver.value} arm reaches the {model.name}, and {giving.refusal()}")
+        raise SkillFailed(f"the {giver.value} arm would pass the {model.name}, but {giving.refusal()}")
+    giving = giving or Candidates([model])
+    setting_down = (
+        f"setting the {model.name} down to take it anew, no one approach serving from where it is to the "
+        f"platform ({unserved})"
+        if whole is not None
+        else f"passing the {model.name} to the {loader.value} arm"
+    )
+
+    def holds(spot: Region, given_by: ObjectModel, taken_by: ObjectModel) -> None:
+        # Both holds' moves are dry-run before the first moves: the giver's from where the object is to the
+        # spot, the loader's from the spot to the platform (from its posture now; a re-grasping arm will
+        # have folded home, where it starts a task).
+        floor = floor_to(ctx, given_by, giver, estimate.position, spot)
+        why = skills.can_carry(world, estimate, giver, given_by, spot, floor=floor)
+        refuse_moves(why, given_by, giver, setting_down, spot)
+        there = resting_at(spot, model, estimate, world.time)
+        refuse_moves(_loads(ctx, there, base, loader, taken_by), taken_by, loader, purpose, platform)
+
+    try:
+        spot, given_by, taken_by = relay_spot(ctx, estimate, giving, loading, giver, loader, holds)
+    except SkillFailed as nowhere:
+        if whole is None:
+            raise
+        if refused is not None:
+            raise SkillFailed(f"{refused}; and {nowhere}") from None
+        raise SkillFailed(f"{whole.refusal()}; and {nowhere}") from None
+    given = giving.choice(giver, given_by, setting_down, "no spot to set it down by it")
+    loaded = loading.choice(loader, taken_by, purpose, "no spot to take it by it")
+    return Loading(loaded, given, spot)
+
+
+def _loads(ctx: SimContext, estimate: ObjectEstimate, base: Pose2D, side: ArmSide, held: ObjectModel) -> str:
+    """Why ``side``'s planning would refuse the hand-over's moves by ``held``'s approach (a dry run)."""
+    return skills.can_hand_over(ctx.world, estimate, base, side, held)

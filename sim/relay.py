@@ -1,0 +1,201 @@
+"""Passing an object between the arms, or setting it down to take it anew (a re-grasp).
+
+When the arm that reaches an object cannot take it where it goes, it sets it down on a relay spot of
+the surface it rests on where the other arm (or itself, by another approach) can take it; the spot is
+chosen so that both holds' end poses pass the inverse kinematics and both holds' moves pass the arms'
+planning, before anything moves.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+
+from cbrs.sim import skills
+from cbrs.sim.arms import ArmSide
+from cbrs.sim.context import SimContext, SkillFailed, check_outcome, robot_camera
+from cbrs.sim.errors import GraspMisfitError, MovesRefusedError, SimulationError
+from cbrs.sim.geometry import Region, Vec3
+from cbrs.sim.grasping import ObjectModel, compute_grasp_pose
+from cbrs.sim.hold_choice import Candidates, seen_extent
+from cbrs.sim.perception import ObjectEstimate, recognise_object
+from cbrs.sim.place_spots import (
+    RELAY_CLEARANCE,
+    RELAY_EDGE,
+    RELAY_MARGIN,
+    RELAY_STEP,
+    distance_to_extent,
+    fixtures_on,
+    other_objects,
+)
+from cbrs.sim.transit import floor_to
+
+RELAY_MOVES_TRIES = 3
+"""How many spots whose end poses serve a pass or a re-grasp may have its holds' moves refused by the
+arms' planning (a dry run) before the pass is refused with the first refusal."""
+
+
+RELAY_TRIES = 40
+"""How many spots, nearest the mounts first, are asked of the inverse kinematics (each asks take a few
+milliseconds) before passing is given up."""
+
+
+def relay_object(
+    ctx: SimContext,
+    device: str,
+    estimate: ObjectEstimate,
+    model: ObjectModel,
+    giver: ArmSide,
+    taker: ArmSide,
+    spot: Region,
+) -> ObjectEstimate:
+    """Pass an object from the arm that reaches it to the other arm: the first puts it down on ``spot``,
+    on the same surface, where both reach, and the object is found again there."""
+    world = ctx.world
+    spec, hand = world.arm_specs[giver], world.arm(giver).hand
+    grasp = compute_grasp_pose(
+        model, estimate.position, estimate.yaw, spec.mount, spec.yaw, seen_extent(estimate), hand
+    )
+    ctx.last_arm = giver
+    for move in (skills.approach_object, skills.pick_up_object):
+        check_passing(move(world, giver, grasp), model, giver, taker)
+    return set_down_for(ctx, device, model, giver, taker, spot, estimate.yaw)
+
+
+def check_passing(outcome: skills.Outcome, model: ObjectModel, giver: ArmSide, taker: ArmSide) -> None:
+    if not outcome.succeeded:
+        what = (
+            f"setting the {model.name} down for the {giver.value} arm to take it anew"
+            if giver is taker
+            else f"passing the {model.name} from the {giver.value} arm to the {taker.value}"
+        )
+        raise SkillFailed(f"{what}: {outcome.skill}: {outcome.reason}")
+
+
+def set_down_for(
+    ctx: SimContext, device: str, model: ObjectModel, giver: ArmSide, taker: ArmSide, spot: Region, yaw: float | None
+) -> ObjectEstimate:
+    """The giver, holding the object, sets it down on ``spot`` for the taker; where it is then (by the
+    robot's camera near where the hand let it go, else where the hand let it go)."""
+    world = ctx.world
+    floor = floor_to(ctx, model, giver, world.arm(giver).ee_pose().position, spot)
+    check_passing(skills.carry_object(world, giver, spot, floor=floor), model, giver, taker)
+    check_passing(skills.put_down_object(world, giver, spot), model, giver, taker)
+    released = world.arm(giver).released
+    where = released[1] if released is not None else spot.center
+    try:
+        camera = robot_camera(ctx, device)
+        check_outcome(skills.clear_view(world))
+        return recognise_object(world.camera(camera).capture(), model.colour, near=(where[0], where[1]), radius=0.1)
+    except (SkillFailed, SimulationError):
+        size = world.objects[model.name].size
+        return ObjectEstimate(where[0], where[1], where[2], yaw, size, model.colour, "hand", world.time, 0)
+
+
+def relay_spot(
+    ctx: SimContext,
+    estimate: ObjectEstimate,
+    giving: Candidates,
+    taking: Candidates,
+    giver: ArmSide,
+    taker: ArmSide,
+    moves: Callable[[Region, ObjectModel, ObjectModel], None] | None = None,
+) -> tuple[Region, ObjectModel, ObjectModel]:
+    """Where on the surface the object rests on both arms reach it, clear of the other objects and of
+    the fixtures standing on it (a dispenser), and by which approach each hand holds it there: of the
+    spots nearest both mounts, the first where the giver's hand can hold the object as it sets it down
+    and the taker's hand can take it, each by the first of its candidate approaches that it can hold
+    there (asked of the inverse kinematics: a side grasp close to the mount has none), and, given
+    ``moves``, whose holds' moves the arms' planning would make (a dry run raising
+    :class:`MovesRefusedError`): a spot so refused is passed over for the next, as a refused approach is
+    for the next approach, up to RELAY_MOVES_TRIES of them; then the first refusal."""
+    smap, world = ctx.map, ctx.world
+    model = giving.models[0]
+    x, y, z = estimate.position
+    surface = z - model.height / 2.0
+    supports = [
+        smap.things[iri]
+        for iri in sorted(smap.furniture)
+        if iri in smap.things
+        and smap.things[iri].box.contains_xy(x, y)
+        and abs(smap.things[iri].box.max_z - surface) <= 0.03
+    ]
+    if not supports:
+        raise SkillFailed(f"the {model.name} rests on nothing the map knows: no surface to pass it on")
+    top = supports[0].box
+    size = world.objects[model.name].size
+    radius = math.hypot(size[0], size[1]) / 2.0
+    others = other_objects(world, ctx.belief, model.name)
+    fixtures = fixtures_on(smap, supports[0], surface, 0.3)
+    arms = [world.arm_specs[giver], world.arm_specs[taker]]
+    spots: list[tuple[float, float, float, float]] = []
+    inset = radius + RELAY_EDGE
+    for i in range(int((top.max_x - top.min_x - 2 * inset) / RELAY_STEP) + 1):
+        cx = top.min_x + inset + i * RELAY_STEP
+        for j in range(int((top.max_y - top.min_y - 2 * inset) / RELAY_STEP) + 1):
+            cy = top.min_y + inset + j * RELAY_STEP
+            distances = [math.hypot(cx - a.mount[0], cy - a.mount[1]) for a in arms]
+            if any(d > a.reach - RELAY_MARGIN for d, a in zip(distances, arms, strict=True)):
+                continue
+            if any(math.hypot(cx - ox_, cy - oy) < radius + r + RELAY_CLEARANCE for ox_, oy, r in others):
+                continue
+            if any(distance_to_extent(box, (cx, cy)) < radius + RELAY_CLEARANCE for box in fixtures):
+                continue
+            here = math.hypot(cx - x, cy - y)  # a re-grasp moves it as little as the approaches allow
+            spots.append((here, max(distances), cx, cy) if giver is taker else (max(distances), here, cx, cy))
+
+    def held_by(side: ArmSide, candidates: Candidates, centre: Vec3) -> ObjectModel | None:
+        spec = world.arm_specs[side]
+        for held in candidates.models:
+            try:
+                hand = compute_grasp_pose(
+                    held, centre, estimate.yaw, spec.mount, spec.yaw, seen_extent(estimate), world.arm(side).hand
+                )
+            except GraspMisfitError:
+                continue  # the hand cannot hold it so, wherever it is
+            if world.arm(side).can_hold(hand.position, hand.orientation) and world.arm(side).can_hold(
+                hand.pregrasp, hand.orientation
+            ):
+                return held
+        return None
+
+    refused: list[MovesRefusedError] = []
+    for *_, cx, cy in sorted(spots)[:RELAY_TRIES]:
+        centre = (cx, cy, surface + model.height / 2.0)
+        given = held_by(giver, giving, centre)
+        taken = held_by(taker, taking, centre) if given is not None else None
+        if given is not None and taken is not None:
+            half = RELAY_STEP * 2
+            region = Region(
+                f"{supports[0].name}Relay", cx - half, cx + half, cy - half, cy + half, top.max_z, top.max_z + 0.3
+            )
+            try:
+                if moves is not None:
+                    moves(region, given, taken)
+            except MovesRefusedError as why:
+                refused.append(why)
+                if len(refused) >= RELAY_MOVES_TRIES:
+                    break
+                continue
+            return region, given, taken
+    if refused:
+        raise refused[0]
+    if giver is taker:
+        down = " or ".join(held.grasp.value for held in giving.models)
+        anew = " or ".join(held.grasp.value for held in taking.models)
+        raise SkillFailed(
+            f"there is no spot on {supports[0].name} where the {giver.value} arm can set the {model.name} down by "
+            f"its {down} grasp and take it anew by its {anew} grasp"
+        )
+    kinds = " or ".join(dict.fromkeys(held.grasp.value for held in [*giving.models, *taking.models]))
+    raise SkillFailed(
+        f"there is no spot on {supports[0].name} where both the {giver.value} and the {taker.value} arm can hold "
+        f"the {model.name} by its {kinds} grasp, to pass it from one to the other"
+    )
+
+
+def resting_at(spot: Region, model: ObjectModel, seen: ObjectEstimate, now: float) -> ObjectEstimate:
+    """Where an object set down on ``spot`` is expected to be, lying as it was ``seen``: what a dry run of
+    taking it from there asks about before it is there."""
+    cx, cy, _ = spot.center
+    return ObjectEstimate(cx, cy, spot.zmin + model.height / 2.0, seen.yaw, seen.size, model.colour, "map", now, 0)
