@@ -16,11 +16,12 @@ from cbrs.actions.runner import run_task
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
-from cbrs.sim.components import OutOfReachError, SimEnvironment, approach, carry, pick_up, put_down
+from cbrs.sim.components import OutOfReachError, SimEnvironment
 from cbrs.sim.grasping import ObjectModel
 from cbrs.sim.perception import ObjectEstimate
 from cbrs.sim.place_spots import RELAY_CLEARANCE, RELAY_MARGIN, place_spots
 from cbrs.sim.relations import Grounded
+from cbrs.sim.services import approach, carry, pick_up, put_down
 from cbrs.sim.values import GraspPlan, designator, to_json
 from cbrs.sim.world import HomeWorld, open_world
 

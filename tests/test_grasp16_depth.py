@@ -20,10 +20,11 @@ from cbrs.actions.runner import run_task
 from cbrs.kb.semantic_map import SemanticMap
 from cbrs.sim import skills
 from cbrs.sim.arms import EE_LINK, PYBULLET_DATA, ArmSide, panda_urdf
-from cbrs.sim.components import SimEnvironment, pick_up
+from cbrs.sim.components import SimEnvironment
 from cbrs.sim.errors import GraspMisfitError, GraspTooDeepError
 from cbrs.sim.grasping import GraspKind, ObjectModel, compute_grasp_pose
 from cbrs.sim.scene import bundled_map
+from cbrs.sim.services import pick_up
 from cbrs.sim.world import open_world
 from tests.home_layout import ARM_FACING, ARM_MOUNTS
 from tests.test_grasp_width import (

@@ -19,12 +19,13 @@ from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
 from cbrs.sim import skills
 from cbrs.sim.arms import ArmSide
-from cbrs.sim.components import SimContext, SimEnvironment, approach, pick_up
+from cbrs.sim.components import SimContext, SimEnvironment
 from cbrs.sim.errors import GraspTooWideError
 from cbrs.sim.geometry import quat_to_matrix
 from cbrs.sim.grasping import GraspKind, ObjectModel, compute_grasp_pose
 from cbrs.sim.grounding import manipulation_of
 from cbrs.sim.perception import ObjectEstimate, recognise_object
+from cbrs.sim.services import approach, pick_up
 from cbrs.sim.values import GraspPlan, to_json
 from cbrs.sim.world import open_world
 from tests.home_layout import ARM_FACING, ARM_MOUNTS

@@ -20,13 +20,14 @@ from cbrs.actions.runner import RunResult, run_task
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
-from cbrs.sim.components import SKILLS, SimComponent, SimContext, SimEnvironment
+from cbrs.sim.components import SimComponent, SimContext, SimEnvironment
 from cbrs.sim.errors import SimulationError
 from cbrs.sim.geometry import Pose2D
 from cbrs.sim.grasping import GraspKind, ObjectModel
 from cbrs.sim.mapping import OccupancyGrid, inflate
 from cbrs.sim.perception import ObjectEstimate, PersonEstimate, RobotPoseEstimate
 from cbrs.sim.planning import PlannedPath
+from cbrs.sim.services import SKILLS
 from cbrs.sim.values import (
     APPROACH_POSITION,
     COLOUR_FEATURE,
