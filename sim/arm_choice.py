@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import Thing
 from cbrs.sim import skills
-from cbrs.sim.arms import ArmSide
+from cbrs.sim.arms import CARRY_CLEARANCE, ArmSide
 from cbrs.sim.context import SimContext, SkillFailed
 from cbrs.sim.errors import GraspMisfitError, MovesRefusedError, SimulationError
 from cbrs.sim.geometry import Pose2D, Region
@@ -237,17 +237,38 @@ def hold_end(
 def holdable_spot(
     ctx: SimContext, side: ArmSide, surface: Region, spots: Sequence[tuple[float, float]]
 ) -> tuple[float, float] | None:
-    """The first of ``spots`` (of the first RELAY_TRIES) where the arm's hand, as it holds the object now,
-    can let it go on the surface (asked of the inverse kinematics); the first spot if it holds nothing."""
+    """Of ``spots`` (the first RELAY_TRIES) where the arm's hand, as it holds the object now, can let it go
+    on the surface (asked of the inverse kinematics), the first whose carry keeps clear of the appliances
+    (:func:`carry_clear`), else the first; the first spot if it holds nothing. Before, the first spot the
+    hand could hold was taken, and a jar carried at the height it was lifted off a rack to the table's
+    spot beside the dispenser met the tap's lever and the spout and stopped 1.5-2 cm short."""
     arm = ctx.world.arm(side)
     grasp = arm.held_grasp
     if grasp is None:
         return spots[0] if spots else None
     orientation = arm.ee_pose().orientation
+    first: tuple[float, float] | None = None
     for x, y in spots[:RELAY_TRIES]:
         if arm.can_hold((x, y, surface.zmin + skills.PLACE_CLEARANCE + grasp.bottom_offset), orientation):
-            return (x, y)
-    return None
+            if not carry_clear(ctx, side, spot_region(surface, x, y)):
+                return (x, y)
+            first = first or (x, y)
+    return first  # no carry there keeps clear (a cup carried below the tap, which it aims at): as before
+
+
+def carry_clear(ctx: SimContext, side: ArmSide, spot: Region) -> str:
+    """Why the carry of what ``side`` holds over ``spot`` and its way down would not keep CARRY_CLEARANCE
+    from the appliances standing on the furniture, the taps' levers too (empty: it would), or would be
+    refused by the arm's planning: a dry run of the carry's moves (:func:`skills.can_carry_held`), its
+    floor as the carry's (:func:`floor_to`). The arms' planning does not avoid a lever, which a hand
+    pushes to fill a cup, nor a fixed thing a hand comes less than STRIKE_DEPTH into; a carry means to
+    touch neither."""
+    arm = ctx.world.arm(side)
+    grasp = arm.held_grasp
+    if grasp is None:
+        return f"the {side.value} gripper holds nothing"
+    floor = floor_to(ctx, grasp.model, side, arm.ee_pose().position, spot)
+    return skills.can_carry_held(ctx.world, side, spot, floor, clear_by=CARRY_CLEARANCE)
 
 
 def note_choice(ctx: SimContext, choice: GraspChoice) -> None:

@@ -27,6 +27,7 @@ from cbrs.sim.quiet import quiet_output
 
 __all__ = [
     "ARM_JOINTS",
+    "CARRY_CLEARANCE",
     "EE_LINK",
     "HOME_CONFIGURATIONS",
     "REACH_TOLERANCE",
@@ -122,6 +123,11 @@ STRIKE_DEPTH = 0.002
 """A pose the hand is asked to hold (:meth:`Arm.can_hold`) is refused when a link other than the
 fingers would be more than 2 mm into a fixed thing or the other arm: the hand cannot be there without
 pushing it (a top-grasped cup under the dispenser's spout, a jar carried past it)."""
+CARRY_CLEARANCE = 0.01
+"""A carry's moves planned to choose where an object is set down (:meth:`Arm.dry_run`'s ``clear_by``)
+keep the arm, fingers included, this far from the appliances standing on the furniture (a dispenser's
+body and spout, and its tap's lever, which the arms' planning does not avoid since a hand pushes it):
+the margin the joint-space moves keep from the fixed things (COLLISION_MARGIN)."""
 
 
 @dataclass(frozen=True)
@@ -177,7 +183,14 @@ class Kinematics:
     standing for the fixed things around them (torso, table top, dispenser, Kinect), so that a
     joint-space move can be checked for collisions before the real arm makes it."""
 
-    def __init__(self, mounts: dict[ArmSide, tuple[Vec3, Quat]], obstacles: Sequence[Region] = ()) -> None:
+    def __init__(
+        self,
+        mounts: dict[ArmSide, tuple[Vec3, Quat]],
+        obstacles: Sequence[Region] = (),
+        fixtures: Sequence[Region] = (),
+    ) -> None:
+        """``fixtures``: what a carry keeps clear of (:meth:`brushes`), the appliances standing on the
+        furniture, some of them (a tap's lever, which a hand pushes) not among ``obstacles``."""
         with quiet_output():
             self.client = p.connect(p.DIRECT)
         try:
@@ -196,6 +209,7 @@ class Kinematics:
                 for side, (pos, orn) in mounts.items()
             }
             self._obstacles = [self._box(region) for region in obstacles]
+            self._fixtures = [(region.name, self._box(region)) for region in fixtures]
             self._at: dict[int, tuple[float, ...]] = {}  # where each copy's joints were last put
         except BaseException:
             p.disconnect(physicsClientId=self.client)
@@ -239,6 +253,16 @@ class Kinematics:
                     return True
         return False
 
+    def brushes(self, side: ArmSide, q: Sequence[float], margin: float) -> str:
+        """The name of the first fixture (``fixtures``) the arm at ``q``, fingers included, comes within
+        ``margin`` of; empty when it keeps clear of them all."""
+        body = self._bodies[side]
+        self._set(body, q)
+        for name, target in self._fixtures:
+            if p.getClosestPoints(body, target, margin, physicsClientId=self.client):
+                return name
+        return ""
+
     def path_clear(
         self,
         side: ArmSide,
@@ -249,10 +273,7 @@ class Kinematics:
     ) -> bool:
         """Whether the straight joint-space path from ``start`` to ``goal`` is free of collisions (and
         keeps the grasp point at or above ``min_height``), checked every 0.05 rad."""
-        a, b = np.asarray(start), np.asarray(goal)
-        samples = max(2, math.ceil(float(np.max(np.abs(b - a))) / 0.05))
-        for i in range(samples + 1):
-            q = [float(v) for v in a + (b - a) * (i / samples)]
+        for q in _joint_samples(start, goal):
             if self.collides(side, q, others):
                 return False
             if min_height is not None and self.forward(side, q).position[2] < min_height:
@@ -582,12 +603,13 @@ class Arm:
     def _others(self) -> dict[ArmSide, Sequence[float]]:
         return {side: arm.joint_positions() for side, arm in self.peers.items() if side is not self.side}
 
-    def dry_run(self, folded: Sequence[ArmSide] = ()) -> PlannedArm:
+    def dry_run(self, folded: Sequence[ArmSide] = (), clear_by: float | None = None) -> PlannedArm:
         """A stand-in for this arm, from its posture now, whose moves are planned and not made; the other
         arms where they are, or those of ``folded`` in their home posture (where they will be by then: an
-        arm that sets an object down for this one folds home after)."""
+        arm that sets an object down for this one folds home after). With ``clear_by`` it notes where its
+        moves first come within that distance of a fixture (:attr:`PlannedArm.brushed`)."""
         others = {side: HOME_CONFIGURATIONS[side] if side in folded else q for side, q in self._others().items()}
-        return PlannedArm(self.side, self._kinematics, self.joint_positions(), others)
+        return PlannedArm(self.side, self._kinematics, self.joint_positions(), others, clear_by)
 
     def _settle(self, goal: NDArray[np.float64]) -> float:
         waited = 0.0
@@ -691,19 +713,44 @@ class PlannedArm:
     nothing of the physics (how the motors track, what the hand or the held object touches)."""
 
     def __init__(
-        self, side: ArmSide, kinematics: Kinematics, q: Sequence[float], others: dict[ArmSide, Sequence[float]]
+        self,
+        side: ArmSide,
+        kinematics: Kinematics,
+        q: Sequence[float],
+        others: dict[ArmSide, Sequence[float]],
+        clear_by: float | None = None,
     ) -> None:
         self.side = side
         self._kinematics = kinematics
         self._q = tuple(q)
         self._others = others
+        self._clear_by = clear_by
+        self.brushed = ""
+        """Where the moves planned on it first came within ``clear_by`` of a fixture
+        (:meth:`Kinematics.brushes`), which they are not refused for, as the arm's own planning does not
+        refuse them; empty when they kept clear or no clearance is asked."""
 
     def joint_positions(self) -> tuple[float, ...]:
         return self._q
 
     def dry_run(self) -> PlannedArm:
-        """A copy from the posture planned so far, to plan moves on without changing this one."""
+        """A copy from the posture planned so far, to plan moves on without changing this one (and
+        without noting what they brush: a probe)."""
         return PlannedArm(self.side, self._kinematics, self._q, self._others)
+
+    def _note(self, postures: Sequence[Sequence[float]], target: Vec3) -> None:
+        """Note the first of ``postures`` (a move to ``target``) within ``clear_by`` of a fixture."""
+        if self._clear_by is None or self.brushed:
+            return
+        for q in postures:
+            name = self._kinematics.brushes(self.side, q, self._clear_by)
+            if name:
+                at = self._kinematics.forward(self.side, q).position
+                self.brushed = (
+                    f"on the way to {_fmt(target)} the arm would come within {self._clear_by * 100:.0f} cm of "
+                    f"the {name} (the hand at {_fmt(at)})"
+                )
+                return
 
     def ee_pose(self) -> Pose3D:
         return self._kinematics.forward(self.side, self._q)
@@ -723,6 +770,7 @@ class PlannedArm:
         chain = self._kinematics.line(self.side, self._q, position, orientation, start, loose=True)
         if isinstance(chain, str):
             return MotionResult(False, math.inf, chain)
+        self._note(chain, position)
         self._q = chain[-1]
         return MotionResult(True, 0.0)
 
@@ -740,6 +788,7 @@ class PlannedArm:
         )
         if best is None:
             return _no_joint_path(position, min_height, down_to)
+        self._note(_joint_samples(self._q, best.q), position)
         self._q = best.q
         return MotionResult(True, 0.0)
 
@@ -749,6 +798,13 @@ def _no_joint_path(position: Vec3, min_height: float | None, down_to: float | No
     if down_to is not None:
         where += f" from which the hand goes straight down to {down_to:.3f} m"
     return MotionResult(False, math.inf, f"no collision-free joint path to {_fmt(position)}{where}")
+
+
+def _joint_samples(start: Sequence[float], goal: Sequence[float]) -> list[list[float]]:
+    """The postures of a straight joint-space path, every 0.05 rad, as :meth:`Kinematics.path_clear` checks it."""
+    a, b = np.asarray(start), np.asarray(goal)
+    samples = max(2, math.ceil(float(np.max(np.abs(b - a))) / 0.05))
+    return [[float(v) for v in a + (b - a) * (i / samples)] for i in range(samples + 1)]
 
 
 def _joint_distance(a: Sequence[float], b: Sequence[float]) -> float:

@@ -537,22 +537,28 @@ def can_hand_over(
     return reason or can_carry(world, pen, side, model, region, yaw)
 
 
-def can_carry_held(world: HomeWorld, side: ArmSide | str, region: Region, floor: float | None = None) -> str:
+def can_carry_held(
+    world: HomeWorld, side: ArmSide | str, region: Region, floor: float | None = None, clear_by: float | None = None
+) -> str:
     """Why ``side``'s planning would refuse to carry what it holds over the middle of ``region`` and lower
     it there, as :func:`carry_object` and :func:`put_down_object` move it (empty if it would not): a dry
-    run from the arm's posture now."""
+    run from the arm's posture now; with ``clear_by``, also where those moves would bring the arm within
+    that distance of an appliance, a tap's lever too (:attr:`PlannedArm.brushed`)."""
     arm = _arm(world, side)
     grasp = arm.held_grasp
     if arm.held is None or grasp is None:
         return f"the {arm.side} gripper holds nothing"
-    hand = arm.dry_run()
+    hand = arm.dry_run(clear_by=clear_by)
     cx, cy, _ = region.center
     model = grasp.model
     moves: list[tuple[str, Callable[[], MotionResult]]] = [
         (f"carrying it to ({cx:.2f}, {cy:.2f})", lambda: _carry(hand, grasp, region, None, floor)),
         (f"lowering it onto {region.name} at ({cx:.2f}, {cy:.2f})", lambda: _lower(hand, grasp, region)[0]),
     ]
-    return _first_refused(moves, ArmSide(side), model)
+    refused = _first_refused(moves, ArmSide(side), model)
+    if refused or not hand.brushed:
+        return refused
+    return f"the {arm.side} arm carrying the {model.name} to ({cx:.2f}, {cy:.2f}): {hand.brushed}"
 
 
 def _first_refused(moves: list[tuple[str, Callable[[], MotionResult]]], arm: ArmSide, model: ObjectModel) -> str:

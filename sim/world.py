@@ -835,7 +835,10 @@ class HomeWorld:
         # the spout too: it sticks out over the worktop, where a hand coming down on an object below it
         # would meet it (the lever, which a hand pushes, is not one)
         appliances = [_region(t.name, t.box) for d in self.dispensers for t in (d.body, d.spout)]
-        self._kinematics = Kinematics(mounts, [*obstacles, *tops, *appliances])
+        # what a carry keeps clear of, the levers too: a hand means to push a lever to fill a cup, never
+        # to carry a thing into it (Arm.dry_run's clear_by)
+        levers = [_region(d.lever.name, d.lever.box) for d in self.dispensers]
+        self._kinematics = Kinematics(mounts, [*obstacles, *tops, *appliances], [*appliances, *levers])
         for side in ArmSide:
             mount, orientation = mounts[side]
             body = p.loadURDF(
