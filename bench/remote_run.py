@@ -47,6 +47,7 @@ def _child(out: Path, argv: list[str], latency: float) -> None:
     library = QueryLibrary(query_dir())
     names = {library.get(name).text: name for name in library.names()}
     counts: collections.Counter[str] = collections.Counter()
+    spent: collections.Counter[str] = collections.Counter()  # ms waited for the answers, by kind
     post = remote_store.RemoteStore._post
 
     def counted(
@@ -58,9 +59,14 @@ def _child(out: Path, argv: list[str], latency: float) -> None:
         *args: object,
         **kwargs: object,
     ) -> object:
-        counts[_kind(body, content_type, original, names)] += 1
+        kind = _kind(body, content_type, original, names)
+        counts[kind] += 1
+        start = time.perf_counter()
         time.sleep(latency)
-        return post(self, url, body, content_type, original, *args, **kwargs)  # type: ignore[arg-type]
+        try:
+            return post(self, url, body, content_type, original, *args, **kwargs)  # type: ignore[arg-type]
+        finally:
+            spent[kind] += (time.perf_counter() - start) * 1000
 
     remote_store.RemoteStore._post = counted  # type: ignore[method-assign]
     code = 0
@@ -68,8 +74,11 @@ def _child(out: Path, argv: list[str], latency: float) -> None:
         cli.main(argv, prog_name="cbrs", standalone_mode=False)
     except SystemExit as stop:
         code = stop.code if isinstance(stop.code, int) else 1
+    except Exception:  # a crash is no figure: the parent stops, naming the command
+        code = 2
+        raise
     finally:
-        out.write_text(json.dumps({"counts": counts, "exit": code}))
+        out.write_text(json.dumps({"counts": counts, "ms": spent, "exit": code}))
 
 
 def _kind(body: str, content_type: str, original: str | None, names: dict[str, str]) -> str:
@@ -134,15 +143,18 @@ def _round_trip_ms(url: str, repeat: int = 50) -> float:
     return statistics.median(times)
 
 
-def measure(argv: list[str], env: dict[str, str], scratch: Path, latency: float) -> tuple[float, dict[str, int], int]:
-    """Wall seconds of ``cbrs ARGV`` in a process of its own, the requests it sent by kind, its exit status."""
+def measure(
+    argv: list[str], env: dict[str, str], scratch: Path, latency: float
+) -> tuple[float, dict[str, int], dict[str, float], int]:
+    """Wall seconds of ``cbrs ARGV`` in a process of its own, the requests it sent by kind and the ms it
+    waited for their answers, its exit status."""
     out = scratch / "counts.json"
     command = [sys.executable, __file__, "--child", str(out), "--latency", str(latency), "--", *argv]
     start = time.perf_counter()
     subprocess.run(command, env=env, check=False, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     wall = time.perf_counter() - start
     found = json.loads(out.read_text())
-    return wall, found["counts"], found["exit"]
+    return wall, found["counts"], found["ms"], found["exit"]
 
 
 def main() -> None:
@@ -192,28 +204,36 @@ def main() -> None:
         for task in tasks:
             for command in (["plan", task, "--no-store"], ["run", task, "--seed", "0"]):
                 walls: dict[tuple[str, str], list[float]] = collections.defaultdict(list)
+                waits: dict[str, list[float]] = collections.defaultdict(list)
                 kinds: dict[str, dict[str, int]] = {}
+                kind_ms: dict[str, dict[str, float]] = {}
                 for _ in range(arguments.repeat):
                     for label, env, url, embedded in versions:  # the versions alternate
                         for where, store in (("remote", url), ("embedded", str(embedded))):
                             delay = arguments.latency if where == "remote" else 0.0
-                            wall, counts, code = measure(["--store", store, *command], env, scratch, delay)
+                            wall, counts, ms, code = measure(["--store", store, *command], env, scratch, delay)
                             if code:
                                 raise SystemExit(f"{label}: cbrs --store {store} {' '.join(command)} exited {code}")
                             walls[(label, where)].append(wall)
                             if where == "remote":
-                                kinds[label] = counts
+                                kinds[label], kind_ms[label] = counts, ms
+                                waits[label].append(sum(ms.values()) / 1000)
                 for label, *_ in versions:
                     remote = statistics.median(walls[(label, "remote")])
                     anchor = statistics.median(walls[(label, "embedded")])
-                    rows.append((" ".join(command[:2]), label, sum(kinds[label].values()), remote, anchor))
+                    waited = statistics.median(waits[label])
+                    rows.append((" ".join(command[:2]), label, sum(kinds[label].values()), waited, remote, anchor))
                     if arguments.kinds:
                         ranked = sorted(kinds[label].items(), key=lambda kind: -kind[1])
-                        print(f"  {' '.join(command[:2])} [{label}]: {', '.join(f'{k} {n}' for k, n in ranked)}")
+                        shown = ", ".join(f"{k} {n} ({kind_ms[label][k]:.0f} ms)" for k, n in ranked)
+                        print(f"  {' '.join(command[:2])} [{label}]: {shown}")
     print()
-    print(f"{'command':<32} {'version':<24} {'requests':>8} {'remote s':>9} {'embedded s':>11} {'ratio':>6}")
-    for text, label, requests, remote, anchor in rows:
-        print(f"{text:<32} {label[-24:]:<24} {requests:>8} {remote:>9.2f} {anchor:>11.2f} {remote / anchor:>6.2f}")
+    head = f"{'requests':>8} {'waited s':>8} {'remote s':>8} {'embedded s':>10} {'ratio':>5}"
+    print(f"{'command':<28} {'version':<20} {head}")
+    for text, label, requests, waited, remote, anchor in rows:
+        figures = f"{requests:>8} {waited:>8.2f} {remote:>8.2f} {anchor:>10.2f} {remote / anchor:>5.2f}"
+        print(f"{text:<28} {label[-20:]:<20} {figures}")
+    print("waited: the time the command waited for the server's answers (median); remote, embedded: its wall time")
     print(f"load average at the end: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
 
 

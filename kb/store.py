@@ -176,16 +176,24 @@ class Store(ABC):
     def replace_graph(self, graph: ox.NamedNode, quads: Iterable[ox.Quad]) -> None:
         """Make ``graph`` hold exactly ``quads`` (which must be in it), in one update operation: what the
         graph held is not read first, so it costs one request on a remote store, and a statement another
-        client added to it meanwhile goes too (the graph is replaced, not patched). The new quads go in as
-        a template that only the one solution binding ``?cbrs__graph`` fills (once, not once per old quad)."""
+        client added to it meanwhile goes too (the graph is replaced, not patched).
+
+        The new statements are a template whose predicates are variables that only the ``UNION``'s second
+        branch binds, once: so they are written once, not once per old statement, and the text names no
+        graph but ``graph`` (after an update with a variable graph, a cbrs server checks its map)."""
         quads = list(quads)
         if any(quad.graph_name != graph for quad in quads):
             raise ValueError(f"replace_graph({graph}) was given a quad of another graph")
         data_block(quads)  # refuses blank nodes, which a template would make fresh
-        adding = "".join(f"{quad.subject} {quad.predicate} {quad.object} .\n" for quad in quads)
+        if not quads:  # an empty template and branch, which Virtuoso 7 refuses
+            self.clear_graph(graph)
+            return
+        names = {predicate: f"?cbrs__p{n}" for n, predicate in enumerate(sorted({q.predicate for q in quads}, key=str))}
+        template = "".join(f"{q.subject} {names[q.predicate]} {q.object} .\n" for q in quads)
+        binds = " ".join(f"BIND ({predicate} AS {name})" for predicate, name in names.items())
         self._apply_own_update(
-            f"DELETE {{ GRAPH {graph} {{ ?s ?p ?o }} }}\nINSERT {{ GRAPH ?cbrs__graph {{\n{adding}}} }}\n"
-            f"WHERE {{ {{ GRAPH {graph} {{ ?s ?p ?o }} }} UNION {{ BIND ({graph} AS ?cbrs__graph) }} }}"
+            f"DELETE {{ GRAPH {graph} {{ ?s ?p ?o }} }}\nINSERT {{ GRAPH {graph} {{\n{template}}} }}\n"
+            f"WHERE {{ {{ GRAPH {graph} {{ ?s ?p ?o }} }} UNION {{ {binds} }} }}"
         )
 
     def clear_graph(self, graph: ox.NamedNode) -> None:

@@ -180,6 +180,8 @@ def test_the_belief_replaces_the_world_graph_with_one_request(
         (q.subject.value, q.predicate.value, q.object.value) for q in held if q.predicate.value.startswith(HOME)
     } == {(HOME + "Pen1", HOME + "isOn", HOME + "Desk")}
     assert len(held) == 3  # the type, the relation, and when it was believed
+    kb.store.replace_graph(world, [])
+    assert next(kb.store.quads(graph=world), None) is None
     with pytest.raises(ValueError, match="another graph"):
         kb.store.replace_graph(world, [ox.Quad(stray.subject, stray.predicate, stray.object, GraphName.MAP.node)])
 
