@@ -116,6 +116,8 @@ REACH_TOLERANCE = 0.01
 """A motion has reached its target when the grasp point is within 1 cm of it."""
 SETTLE_LIMIT = 1.0
 """At most this many simulated seconds of settling after the last piece."""
+_SOLVED_KEPT = 4096
+"""At most this many inverse-kinematics answers are kept for asking again (a run asks a few hundred)."""
 COLLISION_MARGIN = 0.01
 """Joint-space moves keep the arm's links 1 cm clear of the torso, the table, the dispenser, the
 Kinect and the other arm."""
@@ -211,6 +213,7 @@ class Kinematics:
             self._obstacles = [self._box(region) for region in obstacles]
             self._fixtures = [(region.name, self._box(region)) for region in fixtures]
             self._at: dict[int, tuple[float, ...]] = {}  # where each copy's joints were last put
+            self._solved: dict[tuple[object, ...], _Solution] = {}  # _refine's answers, by their inputs
         except BaseException:
             p.disconnect(physicsClientId=self.client)
             raise
@@ -313,7 +316,13 @@ class Kinematics:
     ) -> _Solution:
         """Inverse kinematics from ``seed``, called again until the hand is within 0.1 mm and 0.001 rad of
         the pose (at most ten calls); ``loose``: only until it is within what a solution must be
-        (IK_TOLERANCE, 0.02 rad), all a check of whether there is one needs."""
+        (IK_TOLERANCE, 0.02 rad), all a check of whether there is one needs. The answer depends on nothing
+        but these inputs (each call starts by putting the copy at ``seed``), so one asked again is looked up:
+        the same pose is asked from the same seed postures again and again while spots are tried."""
+        key = (side, loose, np.asarray([*position, *orientation, *seed], dtype=np.float64).tobytes())  # bit-exact
+        known = self._solved.get(key)
+        if known is not None:
+            return known
         body = self._bodies[side]
         self._set(body, seed)
         goal = np.asarray(position)
@@ -335,7 +344,11 @@ class Kinematics:
             turn = quat_angle(pose.orientation, orientation)
             if (error < 1e-4 and turn < 1e-3) or (loose and error <= IK_TOLERANCE and turn <= 0.02):
                 break
-        return _Solution(q, error, turn)
+        solution = _Solution(q, error, turn)
+        if len(self._solved) >= _SOLVED_KEPT:
+            self._solved.clear()
+        self._solved[key] = solution
+        return solution
 
     def line(
         self,
@@ -591,7 +604,7 @@ class Arm:
         others = self._others()
         for candidate in candidates:
             for seed in (*_SEEDS, self.joint_positions()):
-                solution = self._kinematics.solve(self.side, position, candidate, [seed])
+                solution = self._kinematics.solve(self.side, position, candidate, [seed], loose=True)
                 if (
                     solution.position_error <= IK_TOLERANCE
                     and solution.orientation_error <= 0.02
