@@ -1,16 +1,19 @@
 """The simulation as an execution environment: components for the home's advertised services.
 
 Each advertised component that acts in the home is implemented by the skill its service names
-(``LocateMobileRobot``, ``ApproachToObject``...), on the device the store says it runs on: a
-ceiling camera's localiser uses that camera, wherever it hangs. One tick of a component runs one
-whole skill (the skill steps the physics itself), so an executor tick is a unit of work, not of time;
-durations are reported in simulated seconds.
+(``LocateMobileRobot``, ``ApproachToObject``...: :data:`sim.services.SKILLS`), on the device the store
+says it runs on: a ceiling camera's localiser uses that camera, wherever it hangs. One tick of a
+component runs one whole skill (the skill steps the physics itself), so an executor tick is a unit of
+work, not of time; durations are reported in simulated seconds. A component the store says how to call
+in another process is a remote one instead.
 
 Nothing here names an object, a place or an arm. ``SimEnvironment`` resolves a task's inputs to
-things of the semantic map by SPARQL (:func:`kb.semantic_map.designate`), components read what they
-need of a thing (its size, colour, grasp, docking pose) from the map, the arm is the free one that
-reaches, and a statement is verified by the generic test the store maps its predicate to
-(``home:computedBy``: inside, on, near, above, grasped-by, with, contains, localised-in, perceived).
+things of the semantic map by SPARQL (:func:`kb.semantic_map.designate`) and refuses a plan the home
+cannot carry out before anything moves (:mod:`sim.run_checks`); components read what they need of a
+thing (its size, colour, grasp, docking pose) from the map (:mod:`sim.grounding`), the arm is the one
+that reaches and can (:mod:`sim.arm_choice`), and a statement is verified by the generic test the store
+maps its predicate to (``home:computedBy``: inside, on, near, above, grasped-by, with, contains,
+localised-in, perceived).
 
 Every value a component gives or takes is plain JSON of its port's type (:mod:`sim.values`), so that
 a component outside this process could stand in for any of these: each work function decodes its
@@ -23,7 +26,7 @@ import logging
 import math
 import time
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any
 
 from cbrs.actions.answers import StoreClasses, check_designation
@@ -33,32 +36,29 @@ from cbrs.actions.components import Component, Registry, Status
 from cbrs.actions.plan import Plan, PlanStep
 from cbrs.actions.remote import RemoteComponent, Transport
 from cbrs.kb import KnowledgeBase, Requirement, Statement
-from cbrs.kb.errors import KnowledgeBaseError, NotFoundError
-from cbrs.kb.home_check import person_for
+from cbrs.kb.errors import NotFoundError
 from cbrs.kb.model import Advertisement
 from cbrs.kb.namespaces import PREFIXES
-from cbrs.kb.semantic_map import MapObject, NotGraspableError, Person, Thing, designate, local_name
+from cbrs.kb.semantic_map import designate
 from cbrs.kb.vocab import CBRS
 from cbrs.settings import setting
 from cbrs.sim import predicates as pred
-from cbrs.sim import sight, skills
-from cbrs.sim.arm_choice import who_loads
+from cbrs.sim import skills
 from cbrs.sim.context import SimContext, SkillFailed, Work
-from cbrs.sim.errors import MovesRefusedError, SimulationError
-from cbrs.sim.geometry import Pose2D, Region
-from cbrs.sim.grasping import ObjectModel
-from cbrs.sim.grounding import docking_pose, people_given, task_inputs_of
+from cbrs.sim.errors import SimulationError
+from cbrs.sim.geometry import Region
 from cbrs.sim.hold_choice import GraspChoice
 from cbrs.sim.perceived import PerceivedWorld
-from cbrs.sim.perception import ObjectEstimate, RobotPoseEstimate
-from cbrs.sim.place_spots import RELAY_CLEARANCE, RELAY_MARGIN, distance_to_extent, other_objects, place_spots
+from cbrs.sim.perception import RobotPoseEstimate
 from cbrs.sim.referee import Referee
 from cbrs.sim.relations import Grounded, Judge
-from cbrs.sim.services import MOVING, SKILLS, WITH_PERSON, find_object_on_table, locate, recognise_by_colour, track
-from cbrs.sim.values import GRASP_POSE, GraspPlan, MalformedValueError, Manipulation, check, decode, designator
+from cbrs.sim.run_checks import CannotLoadError, OutOfReachError, PlaceCrowdedError, PlanChecks
+from cbrs.sim.services import SKILLS, locate, recognise_by_colour, track
+from cbrs.sim.values import GRASP_POSE, GraspPlan, MalformedValueError, check, decode, designator
 from cbrs.sim.world import HomeWorld
 
 __all__ = [
+    "CannotLoadError",
     "GraspChoice",
     "GraspPlan",
     "OutOfReachError",
@@ -77,73 +77,8 @@ log = logging.getLogger("cbrs.sim")
 LOCALISATION_TOLERANCE = 0.10
 """A localisation is believed (isLocalisedIn holds) when it agrees with the base's odometry within this
 distance (m)."""
-LOADING_SLACK = 0.01
-"""The plan's loading check refuses an object only if no arm could load it this far from where it is
-believed to be either (the cameras' estimates of one object differ by millimetres to a centimetre)."""
 SETTLE_DISTANCE = 0.03
 """Before a re-plan, an arm lets go of what it holds only with its hand within 3 cm of where it took it."""
-
-
-class CannotLoadError(KnowledgeBaseError):
-    """A step would hand an object the task gives over onto the mobile base's platform, and no arm can
-    (the object out of every arm's reach, the docking pose behind the arms, a grasp no arm can hold over
-    the platform): the run is refused before anything moves."""
-
-    http_status = 422
-
-    def __init__(self, component: str, thing: str, reason: str) -> None:
-        self.component = component
-        self.thing = thing
-        self.reason = reason
-        super().__init__(f"{local_name(component)} cannot load the {local_name(thing)} onto the platform: {reason}")
-
-
-class OutOfReachError(KnowledgeBaseError):
-    """A thing a task gives to a robot's arms is beyond the reach of every one of them, by the map: the
-    run is refused before anything moves. ``arms`` holds (arm IRI, mount x, y, reach, distance)."""
-
-    http_status = 422
-
-    def __init__(
-        self,
-        robot: str,
-        thing: str,
-        where: tuple[float, float],
-        arms: list[tuple[str, float, float, float, float]],
-        why: str = "",
-    ) -> None:
-        self.robot = robot
-        self.thing = thing
-        self.where = where
-        self.arms = tuple(arms)
-        self.why = why
-        """For a place part of which is in reach: why none of it will do (empty otherwise)."""
-        each = "; ".join(
-            f"{local_name(arm)} reaches {reach:.2f} m from ({x:.2f}, {y:.2f}), {distance:.2f} m away"
-            for arm, x, y, reach, distance in self.arms
-        )
-        super().__init__(
-            f"no arm of {local_name(robot)} reaches the {local_name(thing)} at ({where[0]:.2f}, {where[1]:.2f}): "
-            f"{each}{f'; {why}' if why else ''}; move it within reach in the map (home:x, home:y) or give the "
-            "arms more home:reach"
-        )
-
-
-class PlaceCrowdedError(KnowledgeBaseError):
-    """A place an arm step is given has spots its arms reach, but the objects on it leave none clear for
-    the object at hand: the run is refused before anything moves. ``blockers`` holds (object IRI, x, y)."""
-
-    http_status = 422
-
-    def __init__(self, place: str, what: str, blockers: list[tuple[str, float, float]], clearance: float) -> None:
-        self.place = place
-        self.blockers = tuple(blockers)
-        each = ", ".join(f"the {local_name(iri)} at ({x:.2f}, {y:.2f})" for iri, x, y in self.blockers)
-        super().__init__(
-            f"no spot of the {local_name(place)} holds {what} {clearance:.2f} m clear of the other objects, though"
-            f" its arms reach it: {each} {'leaves' if len(self.blockers) == 1 else 'leave'} no room; move"
-            f" {'it' if len(self.blockers) == 1 else 'them'} in the map (home:x, home:y) or make the place larger"
-        )
 
 
 class SimComponent(Component):
@@ -408,244 +343,13 @@ class SimEnvironment:
         self.context.plan, self.context.given = plan, values  # where a hold ends, for the approach
         self.context.step, self.context.known = None, {}
         if not self.context.acted:  # checked before anything moved; a re-plan fails by its steps
-            self._people_of(plan, values)  # a step needing a person the home cannot give (nobody, who?)
-            self._check_reach(plan, values)
-            self._check_sight(plan, values)
-            self._check_loading(plan, values)
+            PlanChecks(self.world, self.kb, self.belief, self.context, self.is_a).check(plan, values)
         return values
 
     def starting(self, step: PlanStep, known: Mapping[int, Mapping[str, Any]]) -> None:
         """The executor starts ``step``; ``known`` holds every step's inputs known now. Kept so that a
         component knows which step of the plan it runs and where a later step takes what it holds."""
         self.context.step, self.context.known = step, known
-
-    def _estimate(self, obj: MapObject, support: Thing) -> ObjectEstimate:
-        """Where the plan's checks take an object to be: where it is believed to be, else where the map
-        puts it on its support, lying as the map says (as perception gives it: the yaw of its long axis)."""
-        believed = self.belief.position(obj.name)
-        centre = believed or (obj.start.x, obj.start.y, support.box.max_z + obj.size[2] / 2)
-        axis = obj.start.yaw + (math.pi / 2.0 if obj.size[1] > obj.size[0] else 0.0)
-        return ObjectEstimate(centre[0], centre[1], centre[2], axis, obj.size, obj.colour, "map", 0.0, 0)
-
-    def _check_loading(self, plan: Plan, values: Mapping[str, Any]) -> None:
-        """Refuse a plan that hands an object the task gives over onto the base's platform when no arm
-        can load it there (by the map: the object where it is believed to be, the base at the docking
-        pose of what it stands on; the same decision the hand-over makes), before the base drives off."""
-        steps = {step.index: step for step in plan.steps}
-        smap = self.world.map
-        for step in plan.steps:
-            if step.action != PREFIXES["act"] + "HandingOverOntoPlatform":
-                continue
-            for name in sorted(task_inputs_of(step, steps)):
-                value = values.get(name)
-                obj = smap.objects.get(str(value["@id"])) if isinstance(value, dict) and "@id" in value else None
-                support = smap.things.get(obj.support or "") if obj is not None else None
-                if obj is None or support is None or support.dock is None:
-                    continue
-                estimate, model, dock = self._estimate(obj, support), Manipulation.of(obj).model, docking_pose(support)
-                try:
-                    who_loads(self.context, estimate, model, dock)
-                except (SkillFailed, MovesRefusedError) as refused:
-                    if not self._loads_nearby(estimate, model, dock):
-                        raise CannotLoadError(step.component, obj.iri, str(refused)) from None
-
-    def _loads_nearby(self, estimate: ObjectEstimate, model: ObjectModel, dock: Pose2D) -> bool:
-        """Whether some arm could load the object were it LOADING_SLACK away from where it is believed to be
-        (in x or y): the hand-over decides again from the camera's estimate, and a refusal at the believed
-        centre alone is no refusal of the task. The pen at the edge of the right arm's planning, refused at
-        (8.1015, 3.3317) before the run, was loaded from the Kinect's (8.0973, 3.3273) 6 mm away (the
-        perturbation benchmark's world seed 19)."""
-        for dx, dy in ((LOADING_SLACK, 0.0), (-LOADING_SLACK, 0.0), (0.0, LOADING_SLACK), (0.0, -LOADING_SLACK)):
-            moved = replace(estimate, x=estimate.x + dx, y=estimate.y + dy)
-            try:
-                who_loads(self.context, moved, model, dock)
-            except (SkillFailed, MovesRefusedError):
-                continue
-            log.info("loading check: the %s loads %+.3f, %+.3f m from where it is believed to be", model.name, dx, dy)
-            return True
-        return False
-
-    def _people_of(self, plan: Plan, values: Mapping[str, Any]) -> dict[str, Person]:
-        """The person each step of ``plan`` that needs one means, by component: a step whose skill tracks,
-        goes to or hands something to a person, or that takes a ``home:Person`` input. A
-        :class:`kb.home_check.PersonError` (none in the map, several and the task names not one, or one the
-        tracker cannot tell from another) names the first step that needs one."""
-        ads = {ad.iri: ad for ad in self.kb.advertisements()}
-        designated = [str(v["@id"]) for v in values.values() if isinstance(v, dict) and "@id" in v]
-        meant: dict[str, Person] = {}
-        for step in plan.steps:
-            ad = ads.get(step.component)
-            person_input = any(b.concept and self.is_a(b.concept, HOME + "Person") for b in step.bindings)
-            if not person_input and (ad is None or SKILLS.get(ad.service_name or "") not in WITH_PERSON):
-                continue
-            given = people_given(self.world.map, plan, step, values)
-            meant[step.component] = person_for(self.world.map, step.component, given or designated)
-        return meant
-
-    def _check_sight(self, plan: Plan, values: Mapping[str, Any]) -> None:
-        """Refuse a plan whose recognition step would look for an object the task gives (or whose tracking
-        step for the person it gives) with a camera that cannot see it whole where it is believed to be (by
-        the map: ``sight.unseen``), nor could the camera of any component that may stand in for the step's:
-        else the base drives off and the step fails when it looks. An object an earlier step may have moved
-        is not checked (it may be elsewhere by then), nor a step a component of unknown camera may do (one
-        in another process). The person is outlined wherever the seed may put them (``sight.person_outline``),
-        and a camera sees nothing through the map's solid boxes (``sight.occluders``)."""
-        smap = self.world.map
-        steps = {step.index: step for step in plan.steps}
-        ads = {ad.iri: ad for ad in self.kb.advertisements()}
-        meant = self._people_of(plan, values)
-        handled: set[str] = set()
-        blockers = sight.occluders(smap)  # walls, furniture, appliances, robots' bodies hide what is behind them
-        for step in plan.steps:
-            given = [values.get(name) for name in sorted(task_inputs_of(step, steps))]
-            iris = [str(value["@id"]) for value in given if isinstance(value, dict) and "@id" in value]
-            objects = [smap.objects[iri] for iri in iris if iri in smap.objects and iri not in handled]
-            cameras = [self._camera_of(ads.get(candidate)) for candidate in step.candidates]
-            if cameras[0] is None:
-                ad = ads.get(step.component)
-                if ad is None or ad.bridge_port is not None or SKILLS.get(ad.service_name or "") in MOVING:
-                    handled.update(obj.iri for obj in objects)
-                continue
-            if not all(cameras):
-                continue  # a camera the simulation does not have may see it
-            ad = ads.get(step.component)
-            if ad is not None and SKILLS.get(ad.service_name or "") is track:  # the person, by their shirt
-                people = [meant[step.component]] if step.component in meant else []
-                spread = self.world.spread.person  # where the seed may have put them
-                looked_for = [(who.iri, sight.person_centre(who), sight.person_outline(who, spread)) for who in people]
-                objects = []
-            else:
-                looked_for = []
-            for obj in objects:
-                support = smap.things.get(obj.support or "")
-                rest = support.box.max_z if support is not None else 0.0
-                centre = self.belief.position(obj.name) or (obj.start.x, obj.start.y, rest + obj.size[2] / 2)
-                looked_for.append((obj.iri, centre, sight.object_outline(obj, centre)))
-            for iri, centre, outline in looked_for:
-                why = [
-                    (name, sight.unseen(self.world.cameras[name], outline, blockers))
-                    for name in dict.fromkeys(cameras)
-                    if name
-                ]
-                if all(reason for _, reason in why):
-                    raise sight.OutOfViewError(step.component, iri, centre, why)
-
-    def _camera_of(self, ad: Advertisement | None) -> str | None:
-        """The camera of the world a recognition component looks with; None for a component that is none,
-        "" for one whose camera the simulation does not have (a component in another process)."""
-        work = SKILLS.get(ad.service_name or "") if ad is not None else None
-        if ad is None or work not in (recognise_by_colour, find_object_on_table, track):
-            return None
-        if ad.bridge_port is not None:
-            return ""
-        device = ad.device_name or ""
-        if work is find_object_on_table:
-            rows = self.kb.select("mounted_cameras", {"robot": PREFIXES["svc"] + device})
-            device = next((local_name(row["device"].value) for row in rows), "")
-        return device if device in self.world.cameras else ""
-
-    def _check_reach(self, plan: Plan, values: Mapping[str, Any]) -> None:
-        """Refuse a plan whose arm steps work on a thing the task gives that no arm of their robot
-        reaches (by the map's mounts and reaches, and where the thing is believed to be), before any
-        step runs: otherwise the base drives off and the failure comes later, from a camera that
-        cannot see it or an arm that cannot reach it."""
-        smap = self.world.map
-        arms: dict[str, list[Any]] = {}
-        for arm in smap.arms.values():
-            arms.setdefault(arm.robot, []).append(arm)
-        steps = {step.index: step for step in plan.steps}
-        at_hand: dict[str, list[str]] = {}  # by robot: the objects its latest arm step given one works on
-        for step in plan.steps:
-            robot_arms = arms.get(step.device or "")
-            if not robot_arms:
-                continue
-            given = [values.get(name) for name in sorted(task_inputs_of(step, steps))]
-            iris = [str(value["@id"]) for value in given if isinstance(value, dict) and "@id" in value]
-            objects = [iri for iri in iris if iri in smap.objects]
-            for iri in objects:  # an arm would take it: its class must say how (a decoration need not)
-                if not smap.objects[iri].grasp_approaches:
-                    raise NotGraspableError(iri, smap.objects[iri].types)
-            if objects:
-                at_hand[step.device or ""] = objects
-            for iri in iris:
-                box = self._extent(iri)
-                if box is None:
-                    continue
-                reaches = [(arm, distance_to_extent(box, arm.mount)) for arm in robot_arms]
-                report = [(arm.iri, arm.mount[0], arm.mount[1], arm.reach, d) for arm, d in reaches]
-                where = ((box[0] + box[1]) / 2, (box[2] + box[3]) / 2)
-                if not any(distance <= arm.reach for arm, distance in reaches):
-                    raise OutOfReachError(step.device or "", iri, where, report)
-                if iri in smap.regions or iri in smap.furniture:
-                    self._check_spot(step, iri, at_hand.get(step.device or "", []), report)
-
-    def _check_spot(
-        self, step: PlanStep, iri: str, carried: list[str], report: list[tuple[str, float, float, float, float]]
-    ) -> None:
-        """Refuse a place an arm step is given, part of which the robot's arms reach, when no spot of it
-        will do (:func:`place_spots`, by the map) for the object at hand: the one the step is given,
-        else the one the robot's latest arm step given one worked on (a carry's object comes from the
-        approach and pick-up before it); the largest, if there are several. The carry would aim at a
-        spot it then lacks."""
-        smap = self.world.map
-        objects = [smap.objects[other] for other in carried]
-        size = max(
-            (obj.size for obj in objects), key=lambda size: math.hypot(size[0], size[1]), default=(0.0, 0.0, 0.0)
-        )
-        names = [obj.name for obj in objects]
-        name = names[0] if len(names) == 1 else ""
-        mounts = [(x, y, reach) for _, x, y, reach, _ in report]
-        others = other_objects(self.world, self.belief, *names)
-        _, spots = place_spots(smap, smap.things[iri], size, mounts, others)
-        if not spots:
-            box = smap.things[iri].box
-            what = f"the {name}" if name else "an object"
-            blockers = self._blockers(iri, size, mounts, names, others)
-            if blockers:
-                raise PlaceCrowdedError(iri, what, blockers, RELAY_CLEARANCE)
-            why = (
-                f"no spot of it is {RELAY_MARGIN:.2f} m inside an arm's reach with {what} clear of the edge of the "
-                "surface, the other objects and the fixtures on it"
-            )
-            where = ((box.min_x + box.max_x) / 2, (box.min_y + box.max_y) / 2)
-            raise OutOfReachError(step.device or "", iri, where, report, why)
-
-    def _blockers(
-        self,
-        place: str,
-        size: tuple[float, float, float],
-        mounts: list[tuple[float, float, float]],
-        carried: list[str],
-        others: list[tuple[float, float, float]],
-    ) -> list[tuple[str, float, float]]:
-        """The objects without which a place would have a spot for the object at hand, one left out at a
-        time (else all together); empty when it has none even then (out of reach, too small, fixtures)."""
-        smap = self.world.map
-        thing = smap.things[place]
-        if not place_spots(smap, thing, size, mounts, [])[1]:
-            return []
-        names = [name for name in self.world.objects if name not in carried]  # in the order of ``others``
-        single = [
-            n for n in range(len(names)) if place_spots(smap, thing, size, mounts, others[:n] + others[n + 1 :])[1]
-        ]
-        chosen = single or list(range(len(names)))
-        return [(self.world.objects[names[n]].iri, others[n][0], others[n][1]) for n in chosen]
-
-    def _extent(self, iri: str) -> tuple[float, float, float, float] | None:
-        """Where a thing of the map is for an arm, as (min x, max x, min y, max y): an object at the point
-        where it is believed to be (else its start), a place, a piece of furniture or a tap lever its
-        extent (an arm reaches it if it reaches part of it); None for a room, a person or what has no place."""
-        smap = self.world.map
-        obj = smap.objects.get(iri)
-        if obj is not None:
-            believed = self.belief.position(obj.name)
-            x, y = (believed[0], believed[1]) if believed is not None else (obj.start.x, obj.start.y)
-            return (x, x, y, y)
-        thing = smap.things.get(iri)
-        if thing is None or iri in smap.rooms:
-            return None
-        box = thing.box
-        return (box.min_x, box.max_x, box.min_y, box.max_y)
 
     # -- verification: the generic test the store maps each predicate to ---------------------
 

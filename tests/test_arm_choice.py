@@ -18,7 +18,7 @@ from cbrs.actions.composer import Composer
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
-from cbrs.sim import arm_choice, components, grounding, skills
+from cbrs.sim import arm_choice, grounding, run_checks, skills
 from cbrs.sim.arms import ArmSide
 from cbrs.sim.components import CannotLoadError, SimEnvironment
 from cbrs.sim.context import SimContext, SkillFailed
@@ -223,7 +223,7 @@ def test_the_loading_check_does_not_refuse_an_object_loadable_a_centimetre_from_
         environment = SimEnvironment(world, kb)
         environment.perceive()
         environment.given(plan, requirements)  # not refused
-        monkeypatch.setattr(components, "LOADING_SLACK", 0.0)
+        monkeypatch.setattr(run_checks, "LOADING_SLACK", 0.0)
         with pytest.raises(CannotLoadError) as refused:
             environment.given(plan, requirements)
     assert "no collision-free joint path" in str(refused.value)
