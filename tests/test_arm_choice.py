@@ -1,7 +1,7 @@
-"""Which arm takes an object, and how it reaches the platform, by what each arm can do (sim/components.py:
-_who_takes, _who_loads, _loading_by): the nearest arm that reaches an object is asked first, and when its
+"""Which arm takes an object, and how it reaches the platform, by what each arm can do (sim/arm_choice.py:
+who_takes, who_loads, _loading_by): the nearest arm that reaches an object is asked first, and when its
 hand cannot take it the other arm that reaches it is asked; loading the platform asks each way in turn,
-and so does the plan's loading check before anything moves (SimEnvironment._check_loading). A loader
+and so does the plan's loading check before anything moves (run_checks.PlanChecks). A loader
 whose one hold's moves its planning refuses sets the object down and takes it anew, as where the end
 poses rule every approach out. The arms' refusals are stand-ins (monkeypatched skills), so no task runs:
 the cup is put where both arms reach it."""

@@ -40,7 +40,7 @@ def _store(things: str, *tasks: str) -> KnowledgeBase:
 def test_the_evening_routine_puts_the_pill_box_away_and_fills_the_cup_beside_it() -> None:
     """Before, the left arm carried the pill box to the spot where it passed it to the right arm 4 cm
     above the table, its hand swept the cup beside the way off the table, and FindCupOnTable found no
-    cup (seed 0); the carry now lifts it over the cup (sim/components.py: _transit_floor)."""
+    cup (seed 0); the carry now lifts it over the cup (sim/transit.py: transit_floor)."""
     kb = _store("pill_box_and_side_shelf.ttl", "evening_routine.ttl")
     with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
         cup = world.pose("Cup").position

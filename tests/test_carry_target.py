@@ -1,6 +1,7 @@
 """CarryObject aims at a spot of its target place that an arm reaches (the reachable spot of the place
 nearest its centre, the object's footprint on the surface and clear of the other objects and the
-fixtures), and the check before a run refuses a place only when no such spot exists (sim/components.py)."""
+fixtures), and the check before a run refuses a place only when no such spot exists (sim/place_spots.py,
+sim/run_checks.py)."""
 
 from __future__ import annotations
 

@@ -1,9 +1,10 @@
-"""The hand-over dry-runs the loader's moves as the approach choice does (sim/components.py: _who_loads,
-_clear; skills.can_hand_over), a lone approach too. The pen (one approach, top) set at (7.72, 3.30): the
-right arm, the one that reaches the platform, can hold the pre-grasp, grasp and letting-go poses, but its
-planning finds no collision-free joint path to the pre-grasp pose. Before, the plan's check passed, the
-base drove 5.6 m to the table and the hand-over failed there twice after moving; now the run is refused
-by the plan's check, before the base drives off, naming the pen, the arm and the move."""
+"""The hand-over dry-runs the loader's moves as the approach choice does (arm_choice.who_loads,
+hold_choice.first_clear; skills.can_hand_over), a lone approach too. The pen (one approach, top) set
+at (7.72, 3.30): the right arm, the one that reaches the platform, can hold the pre-grasp, grasp and
+letting-go poses, but its planning finds no collision-free joint path to the pre-grasp pose. Before,
+the plan's check passed, the base drove 5.6 m to the table and the hand-over failed there twice after
+moving; now the run is refused by the plan's check, before the base drives off, naming the pen, the
+arm and the move."""
 
 from __future__ import annotations
 

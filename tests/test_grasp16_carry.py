@@ -2,7 +2,7 @@
 whether the hand can be at its end poses: a dry run of the approach, the pick-up and the carry on the
 kinematics copies (skills.can_carry, arms.PlannedArm). An approach whose moves it would refuse is ranked
 after one whose moves it would make; when it would refuse every one, the step fails before anything moves
-(sim/components.py: _taking, _clear)."""
+(sim/arm_choice.py: taking; sim/hold_choice.py: first_clear)."""
 
 from __future__ import annotations
 

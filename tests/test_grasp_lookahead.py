@@ -1,7 +1,7 @@
 """ApproachToObject looks ahead to where the hold it starts ends, when the plan and the task say: the place
 a later CarryObject is given by the task. An arm then takes the object by the first approach that serves
 both ends (taking it where it is, letting it go at a spot of the place it reaches), and falls back to the
-first it can take it by when where it goes is not known here (sim/components.py: _taking, hold_end)."""
+first it can take it by when where it goes is not known here (sim/arm_choice.py: taking, hold_end)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""An object with one approach gets the approach choice's dry run too (sim/components.py: approach, _clear):
+"""An object with one approach gets the approach choice's dry run too (services.approach, hold_choice.first_clear):
 nu16 repro 04's 18 cm bottle, held by its side, cannot be carried to the front spot (the straight line
 there leaves the left arm's reach). Before, its one approach skipped the dry run: the arm took the bottle,
 the carry failed after moving, and the bottle had to be set down again before a re-plan. Now the approach
