@@ -142,7 +142,11 @@ def _approach(arm: _Moving, grasp: GraspPose) -> MotionResult:
     the fixed things but not of the objects; so for an object whose top stands above that pose (a vase
     25 cm tall taken at half its height), first to above the pose, APPROACH_OVER over the object's top,
     then straight down to it. Before, the hand swept into the vase's top on its way there and pushed it
-    over. Where the arm has no way to above the pose, straight to it as before."""
+    over. Where the arm has no way to above the pose, straight to it as before; where it has no straight
+    line down from there (each piece of the line solved from the one before can lead the arm's posture
+    to none at the pose, as for an 18 cm bottle at the edge of the left arm's reach), to the pose through
+    joint space from above it: still clear of the object's top, which a hand coming in from its rest
+    posture is not."""
     px, py, pz = grasp.pregrasp
     top = grasp.position[2] - grasp.bottom_offset + grasp.model.height
     if pz >= top:
@@ -152,7 +156,10 @@ def _approach(arm: _Moving, grasp: GraspPose) -> MotionResult:
         return arm.reach(grasp.pregrasp, grasp.orientation)
     if not above.reached:
         return above
-    return arm.move_to(grasp.pregrasp, grasp.orientation)
+    down = arm.move_to(grasp.pregrasp, grasp.orientation)
+    if down.reached or not math.isinf(down.error):  # an infinite error: no line, nothing moved
+        return down
+    return arm.reach(grasp.pregrasp, grasp.orientation)
 
 
 def _between_fingers(world: HomeWorld, arm: Arm) -> int | None:
