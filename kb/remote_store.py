@@ -534,14 +534,15 @@ class RemoteStore(Store):
         raise StoreError(self.location, f"{self.endpoints.query} answered in an unexpected format {media!r}")
 
     def _update(self, text: str, original: str | None) -> None:
+        body = _prologued(text, original)
         try:
-            self._post(self.endpoints.update, PROLOGUE + text, "application/sparql-update", original)
+            self._post(self.endpoints.update, body, "application/sparql-update", original)
         except RemoteStoreError as error:
             # nothing listens at a guessed update URL: the query URL takes updates too (Virtuoso's /sparql)
             if error.status != 404 or not self.endpoints.update_guessed:
                 raise
             self.endpoints = Endpoints(self.endpoints.query, self.endpoints.query)
-            self._post(self.endpoints.update, PROLOGUE + text, "application/sparql-update", original)
+            self._post(self.endpoints.update, body, "application/sparql-update", original)
 
     def _post(
         self,
@@ -652,6 +653,17 @@ def start_hint(location: str) -> str:
 def _tls_context() -> ssl.SSLContext:
     """httpx's default TLS context, built once per process (building it costs some 20 ms)."""
     return httpx.create_ssl_context()
+
+
+def _prologued(text: str, original: str | None) -> str:
+    """The update as sent: after the prefixes, unless cbrs wrote it (``original`` None) with no prefixed
+    name, every term a full IRI (its data blocks), which then goes after an empty line (errors' line
+    numbers are corrected for one). A cbrs server checks the descriptions after an update that declares
+    a prefix, which could spell their graphs' names (``kb.shapes.may_write_descriptions``): with the
+    prefixes, every belief write a run makes had the server read graph:services and graph:requirements."""
+    if original is None and not any(token.kind == "name" and ":" in token.text for token in _tokens(text)):
+        return "\n" + text
+    return PROLOGUE + text
 
 
 def _one_line_up(match: re.Match[str]) -> str:

@@ -107,15 +107,23 @@ def test_every_advertisement_is_read_with_three_requests(remote: KnowledgeBase, 
     assert sent.kinds == {"advertisements": 1, "other": 1, "combined": 1}  # the other: the components' liveness
 
 
+TOGETHER = (
+    "taxonomy_links",
+    "taxonomy_terms",
+    "concept_usage",
+    "taxonomy_disjoint",
+    "actions",
+    "action_ordering",
+    "map_facts",
+    "map_types",
+    "world_positions",
+)
+
+
 def test_queries_asked_together_give_the_rows_and_order_each_gives_alone(remote: KnowledgeBase) -> None:
-    free = [
-        name
-        for name in remote.queries.names()
-        if not any(p.required for p in remote.queries.get(name).parameters.values())
-        and remote.queries.get(name).text.lstrip("# \n").find("SELECT") >= 0
-        and union_of_selects([remote.queries.get(name).text]) is not None
-    ]
-    assert {"taxonomy_links", "taxonomy_terms", "actions", "map_facts", "map_types"} <= set(free)
+    """The queries the readers ask together (aggregates, GROUP_CONCAT, ORDER BY or none), and two more."""
+    free = [*TOGETHER, "advertisements", "requirements"]
+    assert all(union_of_selects([remote.queries.get(name).text]) is not None for name in free)
     alone = [remote.select(name) for name in free]
     sent = Requests(remote)
     together = remote.select_each(free)
@@ -228,3 +236,23 @@ def test_a_plan_reads_the_taxonomy_actions_requirements_and_descriptions_in_few_
         assert asked[name] == 0, f"{name} asked alone: {asked}"
     assert asked["requirements"] <= 2, asked  # the task's name, and once for the whole composition
     assert sum(kinds.values()) <= PLAN_REQUESTS[task], kinds
+
+
+def test_a_write_cbrs_spells_in_full_iris_goes_without_the_prefixes(remote: KnowledgeBase) -> None:
+    """A cbrs server checks the descriptions after an update declaring prefixes (which could spell their
+    graphs' names): a belief write, all full IRIs, goes without them; an update given as text keeps them."""
+    store = remote.store
+    assert isinstance(store, RemoteStore)
+    bodies: list[str] = []
+    post = store._post
+
+    def kept(url: str, body: str, content_type: str, original: str | None, *args: Any, **kw: Any) -> Any:
+        bodies.append(body)
+        return post(url, body, content_type, original, *args, **kw)
+
+    store._post = kept  # type: ignore[method-assign]
+    BeliefState(remote).write(Observation({HOME + "Pen1": HOME + "Pen"}))
+    remote.store.update("INSERT DATA { GRAPH graph:world { home:Pen1 home:isOn home:Desk } }")
+    assert "PREFIX" not in bodies[0] and bodies[0].startswith("\n")  # one line, as the prefixes are
+    assert bodies[1].startswith("PREFIX")
+    assert len(list(remote.store.quads(graph=GraphName.WORLD.node))) == 3
