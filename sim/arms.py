@@ -116,6 +116,11 @@ REACH_TOLERANCE = 0.01
 """A motion has reached its target when the grasp point is within 1 cm of it."""
 SETTLE_LIMIT = 1.0
 """At most this many simulated seconds of settling after the last piece."""
+WRIST_SLACK = 0.005
+"""How much deeper than it must be the arm's last link is to refuse a pose before solving it
+(:meth:`Kinematics.wrist_strikes`): room for the contact query's own error."""
+_WRIST_LINK = 6
+"""The arm's last link (panda_link7): the hand and the grasp point are fixed to it, so the pose places it."""
 _SOLVED_KEPT = 4096
 """At most this many inverse-kinematics answers are kept for asking again (a run asks a few hundred)."""
 COLLISION_MARGIN = 0.01
@@ -214,10 +219,48 @@ class Kinematics:
             self._fixtures = [(region.name, self._box(region)) for region in fixtures]
             self._at: dict[int, tuple[float, ...]] = {}  # where each copy's joints were last put
             self._solved: dict[tuple[object, ...], _Solution] = {}  # _refine's answers, by their inputs
+            self._wrist, self._wrist_at, self._wrist_reach = self._wrist_probe()
         except BaseException:
             p.disconnect(physicsClientId=self.client)
             raise
         self._closed = False
+
+    def _wrist_probe(self) -> tuple[int, dict[ArmSide, tuple[Vec3, Quat]], float]:
+        """A body of the last link's collision shape alone, where that link sits relative to the grasp
+        point on each arm, and how far from the grasp point the link reaches."""
+        mesh = str(files("cbrs.sim") / "meshes" / "panda_lod" / "meshes" / "collision" / "link7.obj")
+        shape = p.createCollisionShape(p.GEOM_MESH, fileName=mesh, physicsClientId=self.client)
+        probe = int(p.createMultiBody(0.0, shape, -1, (0.0, 0.0, 0.0), physicsClientId=self.client))
+        offsets: dict[ArmSide, tuple[Vec3, Quat]] = {}
+        for side, body in self._bodies.items():
+            self._set(body, [0.0] * len(ARM_JOINTS))
+            link = p.getLinkState(body, _WRIST_LINK, computeForwardKinematics=True, physicsClientId=self.client)
+            ee = p.getLinkState(body, EE_LINK, computeForwardKinematics=True, physicsClientId=self.client)
+            pos, orn = p.multiplyTransforms(*p.invertTransform(ee[4], ee[5]), link[4], link[5])
+            offsets[side] = ((pos[0], pos[1], pos[2]), (orn[0], orn[1], orn[2], orn[3]))
+        reach = 0.0
+        for pos, orn in offsets.values():  # the link's bounding box with the grasp point at the origin
+            p.resetBasePositionAndOrientation(probe, pos, orn, physicsClientId=self.client)
+            low, high = p.getAABB(probe, physicsClientId=self.client)
+            corners = [(x, y, z) for x in (low[0], high[0]) for y in (low[1], high[1]) for z in (low[2], high[2])]
+            reach = max(reach, *(math.dist(corner, (0.0, 0.0, 0.0)) for corner in corners))
+        return probe, offsets, reach
+
+    def wrist_strikes(self, side: ArmSide, position: Vec3, orientation: Quat) -> bool:
+        """Whether every posture that holds the hand at this pose as closely as a solution must (within
+        IK_TOLERANCE and 0.02 rad) pushes the arm's last link more than STRIKE_DEPTH into a fixed thing,
+        so that :meth:`Arm.can_hold` may refuse the pose without solving it. The pose places that link
+        (the hand is fixed to it), and a posture within the tolerances moves none of its points farther
+        than IK_TOLERANCE + 0.02 rad times its reach from the grasp point; the link must be that much
+        (and WRIST_SLACK) deeper than STRIKE_DEPTH."""
+        pos, orn = p.multiplyTransforms(position, orientation, *self._wrist_at[side])
+        p.resetBasePositionAndOrientation(self._wrist, pos, orn, physicsClientId=self.client)
+        depth = STRIKE_DEPTH + IK_TOLERANCE + 0.02 * self._wrist_reach + WRIST_SLACK
+        for target in self._obstacles:
+            for point in p.getClosestPoints(self._wrist, target, 0.0, physicsClientId=self.client):
+                if point[8] < -depth:
+                    return True
+        return False
 
     def _box(self, region: Region) -> int:
         half = ((region.xmax - region.xmin) / 2, (region.ymax - region.ymin) / 2, (region.zmax - region.zmin) / 2)
@@ -603,6 +646,8 @@ class Arm:
         candidates = [orientation, flipped(orientation)] if symmetric else [orientation]
         others = self._others()
         for candidate in candidates:
+            if self._kinematics.wrist_strikes(self.side, position, candidate):
+                continue  # every solution would push into it: no need to solve
             for seed in (*_SEEDS, self.joint_positions()):
                 solution = self._kinematics.solve(self.side, position, candidate, [seed], loose=True)
                 if (

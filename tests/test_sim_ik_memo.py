@@ -12,6 +12,7 @@ import pytest
 
 from cbrs.sim import arms
 from cbrs.sim.arms import ArmSide, Kinematics
+from cbrs.sim.geometry import Region
 
 MOUNTS = {
     ArmSide.LEFT: ((0.0, 0.2, 0.8), (0.0, 0.0, 0.0, 1.0)),
@@ -75,3 +76,25 @@ def test_a_loose_answer_is_kept_apart_from_a_tight_one(kinematics: Kinematics) -
     assert 1e-4 <= loose.position_error <= arms.IK_TOLERANCE  # stopped short of the tight 0.1 mm
     assert tight.position_error < 1e-4
     assert kinematics.solve(ArmSide.LEFT, *TARGET, [seed], loose=True) == loose
+
+
+def test_a_pose_whose_last_link_is_deep_in_a_fixed_thing_is_refused_without_solving(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """Kinematics.wrist_strikes: the pose places the arm's last link; deep inside a box, every solution
+    would push into it, so can_hold refuses it without a single inverse-kinematics call."""
+    position, orientation = TARGET
+    box = Region("Block", position[0] - 0.1, position[0] + 0.1, position[1] - 0.1, position[1] + 0.1, 0.9, 1.4)
+    free = Kinematics(MOUNTS)
+    blocked = Kinematics(MOUNTS, obstacles=[box])
+    try:
+        assert not free.wrist_strikes(ArmSide.LEFT, position, orientation)
+        assert blocked.wrist_strikes(ArmSide.LEFT, position, orientation)
+        solution = blocked.solve(ArmSide.LEFT, position, orientation, [arms.HOME_CONFIGURATIONS[ArmSide.LEFT]])
+        assert solution.position_error <= arms.IK_TOLERANCE  # there is a posture; it pushes into the box
+        assert blocked.strikes(ArmSide.LEFT, solution.q, {})
+        above = (position[0], position[1], 1.6)  # the link clear of the box
+        assert not blocked.wrist_strikes(ArmSide.LEFT, above, orientation)
+    finally:
+        free.close()
+        blocked.close()
