@@ -177,16 +177,15 @@ def test_the_graph_store_takes_a_map_that_reads(kb: KnowledgeBase, client: Flask
 
 def test_a_put_of_the_map_is_checked_as_a_whole_home(kb: KnowledgeBase, client: FlaskClient) -> None:
     """A PUT replaces the home, as ``cbrs load --graph map --replace`` does, and is checked as one:
-    a map without a person (which reads, thing by thing) is refused, and nothing is written."""
+    a map without the mobile robot (which reads, thing by thing) is refused, and nothing is written."""
     auth = {"Authorization": f"Bearer {TOKEN}"}
     stored = client.get(f"/store?graph={MAP}", headers={"Accept": "application/n-triples"}).data.decode()
-    person = f"<{PREFIXES['world']}Person>"
-    without_person = "\n".join(line for line in stored.splitlines() if not line.startswith(person))
-    assert len(without_person) < len(stored)
+    base = f"<{PREFIXES['svc']}P3DX01>"
+    without_base = "\n".join(line for line in stored.splitlines() if not line.startswith(base))
+    assert len(without_base) < len(stored)
     before = kb.store.dump()
-    response = client.put(
-        f"/store?graph={MAP}", data=without_person, content_type="application/n-triples", headers=auth
-    )
+    response = client.put(f"/store?graph={MAP}", data=without_base, content_type="application/n-triples", headers=auth)
     assert response.status_code == 422
-    assert "Person" in response.get_json()["message"] and "simulated home" in response.get_json()["message"]
+    message = response.get_json()["message"]
+    assert "MobileRobot" in message and "simulated home" in message
     assert kb.store.dump() == before
