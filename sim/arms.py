@@ -271,12 +271,7 @@ class Kinematics:
     def collides(self, side: ArmSide, q: Sequence[float], others: dict[ArmSide, Sequence[float]]) -> bool:
         """Whether the arm at ``q`` comes within COLLISION_MARGIN of a fixed thing or of the other arm
         (set to ``others``). The base links standing on the torso do not count."""
-        body = self._bodies[side]
-        self._set(body, q)
-        for other, configuration in others.items():
-            if other is not side:
-                self._set(self._bodies[other], configuration)
-        targets = [*self._obstacles, *(b for s, b in self._bodies.items() if s is not side)]
+        body, targets = self._posed(side, q, others)
         for target in targets:
             for point in p.getClosestPoints(body, target, COLLISION_MARGIN, physicsClientId=self.client):
                 if point[3] > 0:
@@ -287,17 +282,24 @@ class Kinematics:
         """Whether the arm at ``q``, its fingers aside, is more than STRIKE_DEPTH into a fixed thing or the
         other arm (set to ``others``). Unlike :meth:`collides`, no margin: the fingers may touch the surface
         an object is taken from or set down on, and the hand may come close to what it works by."""
-        body = self._bodies[side]
-        self._set(body, q)
-        for other, configuration in others.items():
-            if other is not side:
-                self._set(self._bodies[other], configuration)
-        targets = [*self._obstacles, *(b for s, b in self._bodies.items() if s is not side)]
+        body, targets = self._posed(side, q, others)
         for target in targets:
             for point in p.getClosestPoints(body, target, 0.0, physicsClientId=self.client):
                 if point[3] > 0 and point[3] not in FINGER_JOINTS and point[8] < -STRIKE_DEPTH:
                     return True
         return False
+
+    def _posed(
+        self, side: ArmSide, q: Sequence[float], others: dict[ArmSide, Sequence[float]]
+    ) -> tuple[int, list[int]]:
+        """The arm's copy put at ``q`` and the other arm's at its configuration in ``others``: the copy's body
+        and what it may run into (the fixed things and the other arm)."""
+        body = self._bodies[side]
+        self._set(body, q)
+        for other, configuration in others.items():
+            if other is not side:
+                self._set(self._bodies[other], configuration)
+        return body, [*self._obstacles, *(b for s, b in self._bodies.items() if s is not side)]
 
     def brushes(self, side: ArmSide, q: Sequence[float], margin: float) -> str:
         """The name of the first fixture (``fixtures``) the arm at ``q``, fingers included, comes within
