@@ -36,10 +36,17 @@ class Observation:
 class BeliefState:
     def __init__(self, kb: KnowledgeBase) -> None:
         self.kb = kb
+        self._written: frozenset[ox.Quad] | None = None  # what this object last wrote, while it may trust it
 
-    def write(self, observation: Observation) -> None:
-        """Replace the world graph with ``observation``, atomically, in one request to a remote store (the
-        graph is not read first: a run writes it after every step)."""
+    def write(self, observation: Observation, whole: bool = False) -> None:
+        """Make the world graph ``observation``, atomically, in at most one request to a remote store (the
+        graph is not read first: a run writes it after every step).
+
+        The first write, one after a failed write or :meth:`restore`, and one asked ``whole`` replace the
+        graph (:meth:`Store.replace_graph`), whatever another client put in it. Any other sends only the
+        difference from the last write, as ``DELETE DATA`` and ``INSERT DATA``, which a cbrs server follows
+        in graph:entailed statement by statement instead of working it out again from the whole store (a
+        statement another client wrote meanwhile stays until the next whole write; docs/remote-store.md)."""
         graph = GraphName.WORLD.node
         new = [ox.Quad(ox.NamedNode(t), _TYPE, ox.NamedNode(c), graph) for t, c in sorted(observation.types.items())]
         new += [
@@ -49,7 +56,12 @@ class BeliefState:
             for axis, value in zip((CBRS.positionX, CBRS.positionY, CBRS.positionZ), xyz, strict=True):
                 new.append(ox.Quad(ox.NamedNode(thing), ox.NamedNode(axis), _double(value), graph))
         new.append(ox.Quad(ox.NamedNode(STATE), ox.NamedNode(CBRS.believedAt), _double(observation.time), graph))
-        self.kb.store.replace_graph(graph, new)
+        written, self._written = self._written, None  # forgotten until this write is known to have gone through
+        if written is None or whole:
+            self.kb.store.replace_graph(graph, new)
+        else:
+            self.kb.store.replace(sorted(written.difference(new), key=str), [q for q in new if q not in written])
+        self._written = frozenset(new)
 
     def snapshot(self) -> list[ox.Quad]:
         """The world graph as it is, for :meth:`restore`."""
@@ -57,6 +69,7 @@ class BeliefState:
 
     def restore(self, quads: list[ox.Quad]) -> None:
         """Put the world graph back as a :meth:`snapshot` found it (a run refused before it acted)."""
+        self._written = None
         self.kb.store.replace_graph(GraphName.WORLD.node, quads)
 
     def facts(self, thing: str | None = None) -> set[tuple[str, str, str]]:

@@ -418,11 +418,15 @@ class RemoteStore(Store):
             self._update("INSERT DATA {\n" + block + "}", original=None)
 
     def replace(self, remove: Iterable[ox.Quad], add: Iterable[ox.Quad]) -> None:
-        """Remove and add quads in one ``DELETE { } INSERT { } WHERE { }`` operation, which a server keeps
-        whole even where it does not keep a request of two operations whole (Virtuoso 7)."""
+        """Remove and add quads in one request: ``DELETE DATA`` then ``INSERT DATA``, which a cbrs server reads
+        as a data update (it follows it in graph:entailed statement by statement, :mod:`kb.update_delta`); on
+        a server that does not keep a request of two operations whole (Virtuoso 7), one ``DELETE { } INSERT
+        { } WHERE { }`` operation, which it does keep whole."""
         removing = data_block(self._as_kept(remove))
         adding = data_block(self._as_kept(add))
-        if removing and adding:
+        if removing and adding and self.keeps_requests_whole:
+            self._update(f"DELETE DATA {{\n{removing}}} ;\nINSERT DATA {{\n{adding}}}", original=None)
+        elif removing and adding:
             self._update(f"DELETE {{\n{removing}}}\nINSERT {{\n{adding}}}\nWHERE {{ }}", original=None)
         elif removing:
             self._update("DELETE DATA {\n" + removing + "}", original=None)

@@ -21,6 +21,9 @@ from cbrs.kb.errors import NotFoundError
 from cbrs.kb.queries import QueryLibrary
 from cbrs.kb.remote_store import RemoteStore, _order_keys, union_of_selects
 from cbrs.kb.resources import query_dir
+from cbrs.kb.store import EmbeddedStore
+from cbrs.kb.update_delta import DataUpdate, data_operations
+from cbrs.kb.vocab import CBRS
 from tests.conftest import OxigraphServer
 
 LOCATE = "https://w3id.org/cbrs/service#LocateMobileRobot_CeilingCamera01"
@@ -256,3 +259,62 @@ def test_a_write_cbrs_spells_in_full_iris_goes_without_the_prefixes(remote: Know
     assert "PREFIX" not in bodies[0] and bodies[0].startswith("\n")  # one line, as the prefixes are
     assert bodies[1].startswith("PREFIX")
     assert len(list(remote.store.quads(graph=GraphName.WORLD.node))) == 3
+
+
+@pytest.mark.parametrize("where", ["embedded", "remote"])
+def test_a_later_belief_write_sends_only_the_difference_as_a_data_update(
+    where: str, remote: KnowledgeBase, fresh_embedded: Callable[[], KnowledgeBase]
+) -> None:
+    """After its first write, a belief sends what changed as ``DELETE DATA`` then ``INSERT DATA`` in one
+    request, which a cbrs server reads as a data update (graph:entailed followed statement by statement);
+    a write asked whole, and the first after a restore, replace the graph, another client's statement too."""
+    kb = remote if where == "remote" else fresh_embedded()
+    world = GraphName.WORLD.node
+    texts: list[str] = []
+    store = kb.store
+    if isinstance(store, RemoteStore):
+        sent_update = store._update
+
+        def sent_text(text: str, original: str | None) -> None:
+            texts.append(text)
+            sent_update(text, original)
+
+        store._update = sent_text  # type: ignore[method-assign]
+    else:
+        applied = store._apply_own_update
+
+        def applied_text(text: str) -> None:
+            texts.append(text)
+            applied(text)
+
+        store._apply_own_update = applied_text  # type: ignore[method-assign]
+    belief = BeliefState(kb)
+    pen, desk, table = HOME + "Pen1", HOME + "Desk", HOME + "Table"
+    belief.write(Observation({pen: HOME + "Pen"}, frozenset({(pen, HOME + "isOn", desk)}), time=1.0))
+    assert data_operations(texts[-1]) is None  # the first write replaces the graph
+    stray = ox.Quad(ox.NamedNode(HOME + "Stray"), ox.NamedNode(HOME + "isOn"), ox.NamedNode(table), world)
+    kb.store.add([stray])
+    sent = Requests(kb) if where == "remote" else None
+    moved = Observation({pen: HOME + "Pen"}, frozenset({(pen, HOME + "isOn", table)}), time=2.0)
+    belief.write(moved)
+    if sent is not None:
+        assert sent.kinds == {"update": 1}
+    operations = data_operations(texts[-1])
+    assert operations is not None and [op.insert for op in operations] == [False, True]
+    changed = {(q.predicate.value, q.object.value) for op in operations for q in op.quads}
+    assert changed == {
+        (HOME + "isOn", desk),
+        (HOME + "isOn", table),
+        (CBRS.believedAt, "1.0"),
+        (CBRS.believedAt, "2.0"),
+    }  # the type of the pen, unchanged, is not sent
+    assert DataUpdate.read(texts[-1], EmbeddedStore.open(":memory:")) is not None  # a server reads it as data
+    held = set(kb.store.quads(graph=world))
+    assert stray in held and len(held) == 4  # left until a whole write
+    belief.write(moved, whole=True)
+    assert stray not in set(kb.store.quads(graph=world)) and len(set(kb.store.quads(graph=world))) == 3
+    kb.store.add([stray])
+    belief.restore(belief.snapshot())
+    belief.write(moved)  # after a restore, what the graph holds is not what this belief last wrote
+    assert data_operations(texts[-1]) is None
+    assert set(kb.store.quads(graph=world)) == {q for q in held if q != stray}
