@@ -316,7 +316,7 @@ def run_task(
             _settle(environment)  # leave nothing half done (an object held in a hand) before looking again
             _perceive(environment)  # look again
             now = environment.observe()
-            belief.write(now)
+            belief.write(now, whole=True)  # a re-plan reads it: exactly the belief, whoever wrote meanwhile
             container.recover()  # what failed for the world's sake may be tried again; the broken stay broken
             _await_return(kb, failures, memory.policy.reconnect_grace, bus)
             refresh = getattr(environment, "refresh", None)
@@ -336,7 +336,7 @@ def run_task(
             composition = decision.composition
     finally:
         container.finalise_all()
-    belief.write(environment.observe())
+    belief.write(environment.observe(), whole=True)  # what a run leaves is exactly its belief
     goals = _check_goals(environment, composition.plan, outputs) if report is not None else ()
     return RunResult(composition, report, tuple(replans), goals, stopped, composed_without)
 
