@@ -10,8 +10,8 @@ import click
 
 from cbrs.app import App, pass_app
 from cbrs.home_plan import DEFAULT_WIDTH, NO_ROOMS, HomeSurvey, draw_home, resource_link, survey
-from cbrs.kb.home_check import people_check
 from cbrs.kb.namespaces import shorten
+from cbrs.kb.person_choice import people_check
 from cbrs.kb.semantic_map import local_name
 from cbrs.settings import setting
 

@@ -49,9 +49,10 @@ from cbrs.home_canvas import (
 )
 from cbrs.kb.camera_view import floor_view
 from cbrs.kb.errors import KnowledgeBaseError
-from cbrs.kb.home_check import check_home, look_alikes, shirt_clashes
+from cbrs.kb.home_check import check_home
 from cbrs.kb.knowledge_base import KnowledgeBase
 from cbrs.kb.namespaces import RDFS, shorten
+from cbrs.kb.person_choice import look_alikes, shirt_clashes
 from cbrs.kb.semantic_map import HOME, Box, MapObject, SemanticMap, Thing, local_name
 
 __all__ = [

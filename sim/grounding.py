@@ -13,7 +13,7 @@ from dataclasses import replace
 from typing import Any
 
 from cbrs.actions.plan import Plan, PlanStep
-from cbrs.kb.home_check import PersonError, person_for
+from cbrs.kb.person_choice import PersonError, person_for
 from cbrs.kb.semantic_map import Person, SemanticMap, Thing, local_name
 from cbrs.sim.context import SimContext, SkillFailed
 from cbrs.sim.geometry import Pose2D, Region
@@ -97,7 +97,7 @@ def people_given(smap: SemanticMap, plan: Plan, step: PlanStep, values: Mapping[
 
 
 def meant_person(ctx: SimContext) -> Person:
-    """The person the running step means (``kb.home_check.person_for``): the one given to it or to a step
+    """The person the running step means (``kb.person_choice.person_for``): the one given to it or to a step
     it takes a value from, else the one the task designates, else the home's only person."""
     plan, step = ctx.plan, ctx.step
     given = people_given(ctx.map, plan, step, ctx.given) if plan is not None and step is not None else []

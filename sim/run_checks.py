@@ -17,9 +17,9 @@ from typing import Any
 from cbrs.actions.plan import Plan, PlanStep
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import KnowledgeBaseError
-from cbrs.kb.home_check import person_for
 from cbrs.kb.model import Advertisement
 from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.person_choice import person_for
 from cbrs.kb.semantic_map import MapObject, NotGraspableError, Person, Thing, local_name
 from cbrs.sim import sight
 from cbrs.sim.arm_choice import who_loads
@@ -128,7 +128,7 @@ class PlanChecks:
         """Whether a class is another or a subclass of it (``SimEnvironment.is_a``, which keeps the table)."""
 
     def check(self, plan: Plan, values: Mapping[str, Any]) -> None:
-        """Refuse ``plan`` with the first check's typed error (:class:`kb.home_check.PersonError`,
+        """Refuse ``plan`` with the first check's typed error (:class:`kb.person_choice.PersonError`,
         :class:`OutOfReachError`, :class:`PlaceCrowdedError`, :class:`sight.OutOfViewError`,
         :class:`CannotLoadError`); nothing when every check passes."""
         ads = {ad.iri: ad for ad in self.kb.advertisements()}  # read once: 23-26 ms each on the bundled store
@@ -186,7 +186,7 @@ class PlanChecks:
     def _people_of(self, plan: Plan, values: Mapping[str, Any], ads: Mapping[str, Advertisement]) -> dict[str, Person]:
         """The person each step of ``plan`` that needs one means, by component: a step whose skill tracks,
         goes to or hands something to a person, or that takes a ``home:Person`` input. A
-        :class:`kb.home_check.PersonError` (none in the map, several and the task names not one, or one the
+        :class:`kb.person_choice.PersonError` (none in the map, several and the task names not one, or one the
         tracker cannot tell from another) names the first step that needs one."""
         designated = [str(v["@id"]) for v in values.values() if isinstance(v, dict) and "@id" in v]
         meant: dict[str, Person] = {}

@@ -22,8 +22,9 @@ import pybullet as p
 
 from cbrs.kb.camera_view import default_image_size, image_up
 from cbrs.kb.hands import PANDA_HAND
-from cbrs.kb.home_check import check_home, person_for
+from cbrs.kb.home_check import check_home
 from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.person_choice import person_for
 from cbrs.kb.semantic_map import Arm as ArmSpec
 from cbrs.kb.semantic_map import Box, Dispenser, MapError, MapObject, MobileRobot, Person, SemanticMap, Thing, overlaps
 from cbrs.sim import layout as L
@@ -471,7 +472,7 @@ class HomeWorld:
 
     @property
     def person(self) -> Person:
-        """The map's only person, for a caller that names none (a :class:`kb.home_check.PersonError` when the
+        """The map's only person, for a caller that names none (a :class:`kb.person_choice.PersonError` when the
         map has none or several: which one a step means is the task's to say, ``person_for``)."""
         return person_for(self.map, "the simulation's default person")
 

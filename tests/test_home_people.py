@@ -23,14 +23,8 @@ from cbrs.app import App
 from cbrs.cli import cli
 from cbrs.cli_home import home
 from cbrs.kb import KnowledgeBase
-from cbrs.kb.home_check import (
-    AmbiguousPersonError,
-    LookAlikePeopleError,
-    NoPersonError,
-    check_home,
-    look_alikes,
-    person_for,
-)
+from cbrs.kb.home_check import check_home
+from cbrs.kb.person_choice import AmbiguousPersonError, LookAlikePeopleError, NoPersonError, look_alikes, person_for
 from cbrs.kb.semantic_map import Person, Pose, SemanticMap, UnresolvedDesignatorError
 from cbrs.sim import sight
 from cbrs.sim.components import SimEnvironment

@@ -1,5 +1,5 @@
 """The browser's home page (/home and its twin /home.json) says who lives in the home and whether a task
-for each of them runs, as ``cbrs home`` does (kb.home_check.people_check; docs/web.md "The home"). No
+for each of them runs, as ``cbrs home`` does (kb.person_choice.people_check; docs/web.md "The home"). No
 simulation: in-memory stores."""
 
 from __future__ import annotations

@@ -15,14 +15,8 @@ import dataclasses
 import pytest
 
 from cbrs.kb import KnowledgeBase
-from cbrs.kb.home_check import (
-    LookAlikeMarkerError,
-    LookAlikePeopleError,
-    check_home,
-    people_check,
-    person_for,
-    shirt_clashes,
-)
+from cbrs.kb.home_check import check_home
+from cbrs.kb.person_choice import LookAlikeMarkerError, LookAlikePeopleError, people_check, person_for, shirt_clashes
 from cbrs.kb.semantic_map import Pose, SemanticMap
 
 WORLD = "https://w3id.org/cbrs/world#"

@@ -1,5 +1,5 @@
 """The home page of the semantic map: the home drawn from above (:mod:`cbrs.home_plan`), a table of its
-things, its people with whether a task for each runs (:func:`kb.home_check.people_check`, what ``cbrs
+things, its people with whether a task for each runs (:func:`kb.person_choice.people_check`, what ``cbrs
 home`` says), and what stops the simulation building it, before anything runs."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from flask import Blueprint, Response
 from markupsafe import Markup
 
 from cbrs.home_plan import MOVED, HomeSurvey, draw_home, survey
-from cbrs.kb.home_check import people_check
+from cbrs.kb.person_choice import people_check
 from cbrs.kb.semantic_map import local_name
 from cbrs.web import context
 from cbrs.web.links import iri_url, short
