@@ -10,18 +10,22 @@ from __future__ import annotations
 import hashlib
 import shutil
 import tomllib
+import urllib.parse
 from collections.abc import Iterable, Iterator
 from pathlib import Path
+from typing import Any
 
 import pyoxigraph as ox
 import pytest
 
 from cbrs.actions.composer import Composer
-from cbrs.kb import GraphName, KnowledgeBase, Store
+from cbrs.kb import GraphName, KnowledgeBase, Store, knowledge_base
 from cbrs.kb.loader import parse_file
 from cbrs.kb.namespaces import GENID, OWL, PREFIXES, RDFS
+from cbrs.kb.queries import QueryLibrary
+from cbrs.kb.remote_store import RemoteStore
 from cbrs.kb.resources import bundled_files, ontology_dir
-from cbrs.kb.upgrade import statement_keys
+from cbrs.kb.upgrade import UpgradeReport, statement_keys
 from cbrs.kb.vocab import CBRS
 
 OLD_HOME = Path(__file__).parent / "data" / "legacy" / "home-0.1.0.ttl"
@@ -223,3 +227,51 @@ def test_a_bundled_ontology_changes_only_with_a_new_version(path: Path) -> None:
             "ontologies/history.toml, the base of the stores seeded with it"
         )
         pytest.fail(f"{name} is at a new version: {fix}")
+
+
+@pytest.mark.both_stores
+def test_a_bundled_ontology_whose_header_is_gone_is_added_back_and_a_newer_one_left_alone(
+    fresh_bundled_kb: KnowledgeBase,
+) -> None:
+    """The check's two findings, on either store (a remote one is asked them in one request): an
+    ontology its graph does not declare comes back whole, one at a newer version stays as it is."""
+    kb = fresh_bundled_kb
+    sosa, home = ox.NamedNode("https://w3id.org/cbrs/standards/sosa"), ox.NamedNode(HOME.rstrip("#"))
+    header = list(kb.store.quads(sosa, None, None, ONTOLOGY))
+    assert header
+    version = ox.NamedNode(OWL + "versionInfo")
+    newer = ox.Quad(home, version, ox.Literal("9.0.0"), ONTOLOGY)
+    kb.store.replace([*header, *kb.store.quads(home, version, None, ONTOLOGY)], [newer])
+    report = kb.upgrade()
+    assert report.added >= len(header) and not report.merged
+    assert set(kb.store.quads(sosa, None, None, ONTOLOGY)) == set(header)
+    assert list(kb.store.quads(home, version, None, ONTOLOGY)) == [newer]
+    assert not kb.upgrade().changed
+
+
+def test_opening_an_up_to_date_remote_store_checks_it_with_one_request(remote_location: str) -> None:
+    """The upgrade check of every open asks a remote store once (it asked 19 times: docs/remote-store.md,
+    "Requests of a plan and a run"); the whole open asked 5 times on 2026-11-27."""
+    KnowledgeBase.open(remote_location).close()  # seeded
+    sent: list[tuple[str, bool]] = []
+    checking = [False]
+    post, check = RemoteStore._post, knowledge_base.upgrade_store
+
+    def counted(self: RemoteStore, url: str, body: str, content_type: str, *args: Any, **kw: Any) -> Any:
+        sent.append((urllib.parse.unquote_plus(body), checking[0]))
+        return post(self, url, body, content_type, *args, **kw)
+
+    def checked(store: Store, queries: QueryLibrary) -> UpgradeReport:
+        checking[0] = True
+        try:
+            return check(store, queries)
+        finally:
+            checking[0] = False
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(RemoteStore, "_post", counted)
+        patch.setattr(knowledge_base, "upgrade_store", checked)
+        KnowledgeBase.open(remote_location).close()
+    by_check = [body for body, during in sent if during]
+    assert len(by_check) == 1 and "cbrs__part" in by_check[0] and "owl:versionInfo" in by_check[0]
+    assert len(sent) <= 7, [body[:80] for body, _ in sent]
