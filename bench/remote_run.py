@@ -1,15 +1,16 @@
 """Benchmark: the HTTP requests a ``cbrs plan`` and a ``cbrs run`` make against a remote store, and their wall time.
 
 Run: python bench/remote_run.py [--repeat N] [--task TASK ...] [--source DIR ...]. It seeds a scratch
-store, starts ``cbrs serve`` over it on a free loopback port with an update token, and runs each
-command as its own process, ``cbrs --store http://127.0.0.1:PORT plan TASK`` (``--no-store``: a plan
-writes nothing, so every repeat reads the same store) and ``cbrs --store ... run TASK --seed 0``,
-counting the requests it sends by kind: the named query (``queries/<name>.rq``), ``quads()`` and the
-other queries cbrs writes itself, or an update. The anchor is the same command on an embedded copy of
-the store, measured in the same run. ``--source DIR`` (repeatable) measures that version of cbrs instead
-of this checkout (a ``git archive COMMIT | tar -x -C DIR`` export), each with a store it seeded and a
-``cbrs serve`` of its own, the versions' commands alternating, so a before and an after are back to
-back. The servers are stopped by their PIDs at the end.
+store, starts ``cbrs serve`` over it on a free loopback port with an update token, and runs each command
+as its own process, ``cbrs --store http://127.0.0.1:PORT plan TASK`` (``--no-store``: a plan writes
+nothing, so every repeat reads the same store) and ``cbrs --store ... run TASK --seed 0``, counting the
+requests it sends by kind: the named query (``queries/<name>.rq``), ``quads()`` and the other queries
+cbrs writes itself, a belief write (whole, or data operations only) or another update. The anchor is the
+same command on an embedded copy of the store, measured in the same run. ``--source DIR`` (repeatable)
+measures that version of cbrs instead of this checkout (a ``git archive COMMIT | tar -x -C DIR``
+export), each with a store it seeded and a ``cbrs serve`` of its own, the versions' commands
+alternating, so a before and an after are back to back. The servers are stopped by their PIDs at the
+end.
 """
 
 from __future__ import annotations
@@ -84,7 +85,10 @@ def _child(out: Path, argv: list[str], latency: float) -> None:
 def _kind(body: str, content_type: str, original: str | None, names: dict[str, str]) -> str:
     """What a request is: an update, a named query asked alone, several asked at once, a pattern lookup."""
     if content_type == "application/sparql-update":
-        return "update"
+        if "<https://w3id.org/cbrs/graph/world>" not in body:
+            return "update"  # the plan's, say
+        data = body.lstrip().startswith(("DELETE DATA", "INSERT DATA"))
+        return "belief write, data" if data else "belief write, whole"
     if original is not None and original in names:
         return names[original]
     text = original or (parse_qs(body).get("query", [body])[0] if content_type.endswith("urlencoded") else body)
@@ -225,7 +229,9 @@ def main() -> None:
                     rows.append((" ".join(command[:2]), label, sum(kinds[label].values()), waited, remote, anchor))
                     if arguments.kinds:
                         ranked = sorted(kinds[label].items(), key=lambda kind: -kind[1])
-                        shown = ", ".join(f"{k} {n} ({kind_ms[label][k]:.0f} ms)" for k, n in ranked)
+                        shown = ", ".join(
+                            f"{k} {n} ({kind_ms[label][k]:.0f} ms, {kind_ms[label][k] / n:.0f} each)" for k, n in ranked
+                        )
                         print(f"  {' '.join(command[:2])} [{label}]: {shown}")
     print()
     head = f"{'requests':>8} {'waited s':>8} {'remote s':>8} {'embedded s':>10} {'ratio':>5}"

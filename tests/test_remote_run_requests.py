@@ -13,7 +13,7 @@ import pyoxigraph as ox
 import pytest
 from click.testing import CliRunner
 
-from cbrs.actions.belief import BeliefState, Observation
+from cbrs.actions.belief import STATE, BeliefState, Observation
 from cbrs.cli import cli
 from cbrs.kb import GraphName, KnowledgeBase
 from cbrs.kb.descriptions import PER_DESCRIPTION
@@ -318,3 +318,26 @@ def test_a_later_belief_write_sends_only_the_difference_as_a_data_update(
     belief.write(moved)  # after a restore, what the graph holds is not what this belief last wrote
     assert data_operations(texts[-1]) is None
     assert set(kb.store.quads(graph=world)) == {q for q in held if q != stray}
+
+
+def test_a_belief_write_after_a_failed_one_replaces_the_graph(
+    fresh_embedded: Callable[[], KnowledgeBase], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A write that failed may or may not have reached the store: the next one does not trust its memory."""
+    kb = fresh_embedded()
+    belief = BeliefState(kb)
+    pen = HOME + "Pen1"
+    belief.write(Observation({pen: HOME + "Pen"}, time=1.0))
+    stray = ox.Quad(ox.NamedNode(HOME + "Stray"), ox.NamedNode(HOME + "isOn"), ox.NamedNode(HOME + "Table"))
+    kb.store.add([ox.Quad(stray.subject, stray.predicate, stray.object, GraphName.WORLD.node)])
+
+    def refused(remove: Any, add: Any) -> None:
+        raise OSError("the store went away")
+
+    with monkeypatch.context() as patch:
+        patch.setattr(kb.store, "replace", refused)
+        with pytest.raises(OSError):
+            belief.write(Observation({pen: HOME + "Pen"}, time=2.0))
+    belief.write(Observation({pen: HOME + "Pen"}, time=3.0))
+    held = {(q.subject.value, q.object.value) for q in kb.store.quads(graph=GraphName.WORLD.node)}
+    assert held == {(pen, HOME + "Pen"), (STATE, "3")}  # the stray is gone (Oxigraph writes the double so)
