@@ -15,7 +15,7 @@ import pytest
 from click.testing import CliRunner
 
 from cbrs.cli import cli
-from cbrs.kb import KnowledgeBase
+from cbrs.kb import KnowledgeBase, descriptions
 from cbrs.kb.catalog import Catalogue
 from cbrs.kb.namespaces import GraphName
 from cbrs.kb.store import Term
@@ -25,15 +25,7 @@ pytestmark = pytest.mark.both_stores
 
 OWLS = Path(__file__).parent / "data" / "owls"
 SHARED = Path(__file__).resolve().parents[2] / "shared" / "owls-tc4"
-PER_DESCRIPTION = (
-    "description",
-    "description_parameters",
-    "description_conditions",
-    "description_sea",
-    "description_qos",
-    "description_ports",
-    "description_model",
-)
+PER_DESCRIPTION = (*descriptions.PER_DESCRIPTION, "description_model")  # and the OWL-S model's link
 
 
 def _key(row: dict[str, Term]) -> tuple[tuple[str, str], ...]:
