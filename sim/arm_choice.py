@@ -10,9 +10,12 @@ from an arm that reaches the object to one that reaches the platform. Each is as
 from __future__ import annotations
 
 import functools
+import itertools
+import logging
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
+from typing import NamedTuple
 
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import Thing
@@ -25,10 +28,12 @@ from cbrs.sim.grasping import GraspKind, GraspPose, ObjectModel, compute_grasp_p
 from cbrs.sim.hold_choice import Candidates, GraspChoice, first_clear, refuse_moves, seen_extent
 from cbrs.sim.perception import ObjectEstimate
 from cbrs.sim.place_spots import other_objects, place_spots, spot_region
-from cbrs.sim.relay import RELAY_TRIES, relay_spot, resting_at
+from cbrs.sim.relay import CLEAR_TRIES, RELAY_TRIES, relay_spot, resting_at
 from cbrs.sim.transit import floor_to
 
 ACT = PREFIXES["act"]
+
+log = logging.getLogger("cbrs.sim")
 
 TAKING = frozenset({ACT + "ApproachToObject", ACT + "HandingOverOntoPlatform"})
 """The actions with which an arm takes an object: a hold starts."""
@@ -75,7 +80,8 @@ def who_takes(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel) -> 
     its planning's dry run of the moves) and can also let it go where the hold ends; else the first that
     can take it, to pass it on there. The nearest arm is not the only one asked: where its hand cannot
     get to the object (its joints' range, the dispenser in the way) or cannot set it down where it goes,
-    the other arm may. When none can,
+    the other arm may; nor where its carry there would not keep CARRY_CLEARANCE from the appliances
+    (:func:`carry_clear`) and the other arm's would (else the first arm that can, as before). When none can,
     the nearest arm's refusal, as it is when it is the only one asked or every arm's is a misfit (a
     typed error: the object does not fit the hand so), else a SkillFailed starting with it and saying
     why each other arm could not either."""
@@ -88,17 +94,24 @@ def who_takes(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel) -> 
         raise SkillFailed(fits)
     refused: list[tuple[ArmSide, Exception]] = []
     passing_on: GraspChoice | None = None  # the first arm that can take it but not let it go where it goes
+    unclear: _Taking | None = None  # the first that can, its carry not keeping clear
     for side in arms:
         try:
             if len(model.preference) == 1:  # its one approach's misfit is its own typed error (GraspTooDeepError...)
                 grasp_pose_for(ctx, estimate, side, model)
-            choice, served = taking_to(ctx, estimate, model, side)  # one approach too: its moves are dry-run
+            taken = _taking_to(ctx, estimate, model, side)  # one approach too: its moves are dry-run
         except (SkillFailed, SimulationError) as why:
             refused.append((side, why))
             continue
-        if served:
-            return choice
-        passing_on = passing_on or choice
+        if taken.served and not taken.unclear:
+            return taken.choice
+        if taken.served:
+            unclear = unclear or taken
+        else:
+            passing_on = passing_on or taken.choice
+    if unclear is not None:
+        log.info("%s, though its carry keeps no spot's clearance, as before: %s", unclear.choice, unclear.unclear)
+        return unclear.choice
     if passing_on is not None:
         return passing_on  # the carry passes it to the arm that reaches where it goes
     first = refused[0][1]
@@ -126,16 +139,34 @@ def taking(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, side: 
     return taking_to(ctx, estimate, model, side)[0]
 
 
+class _Taking(NamedTuple):
+    """How an arm takes an object (:func:`taking_to`): by which approach, whether it can let it go where the
+    hold ends, and why no spot's take and carry there keeps CARRY_CLEARANCE (empty: one does, or nothing
+    is known of where it goes)."""
+
+    choice: GraspChoice
+    served: bool
+    unclear: str = ""
+
+
 def taking_to(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, side: ArmSide) -> tuple[GraspChoice, bool]:
     """The approach ``side`` takes the object by, and whether it can also let it go where the hold ends
     (True too where that is not known here), of several: the first it can take it by where it is and
     let it go by where the hold ends, when that is known here (:func:`hold_end`: a later carry of the
     plan to a place the task gives), else the first it can take it by. Letting go is asked as the carry
-    will (:func:`holdable_spot`): over the spots of the place this arm reaches, nearest the centre first. An
+    will (:func:`holdable_spot`): over the spots of the place this arm reaches, nearest the centre first,
+    the first whose take and carry keep CARRY_CLEARANCE from the appliances (:func:`carry_clear`, up to
+    CLEAR_TRIES spots an approach), by the first approach that has one; when none has, the first spot the
+    hand can let it go over, as before. An
     arm that can let it go there by no approach takes it by the first it can, as where it is not known:
     the carry passes it to the other arm. Of the approaches that pass those checks (the inverse
     kinematics' of the end poses), the first whose moves the arm's planning would make (:func:`first_clear`)
     is taken; when none would, :class:`MovesRefusedError` before anything moves."""
+    taken = _taking_to(ctx, estimate, model, side)
+    return taken.choice, taken.served
+
+
+def _taking_to(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, side: ArmSide) -> _Taking:
     world, name = ctx.world, model.name
 
     def take(held: ObjectModel) -> str:
@@ -147,16 +178,17 @@ def taking_to(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, sid
     end = hold_end(ctx, name, side)
     if end is None:
         moves = functools.partial(skills.can_carry, world, estimate, side)
-        return first_clear(taking, side, f"taking the {name}", moves), True
+        return _Taking(first_clear(taking, side, f"taking the {name}", moves), True)
     place, surface, spots = end
     first: dict[GraspKind, Region] = {}  # the spot the carry will aim at, by each approach that lets go there
+    after: dict[GraspKind, int] = {}  # the index in ``spots`` of the next spot to ask for its clearance
 
     def letting_go(held: ObjectModel) -> str:
         tried = spots[:RELAY_TRIES]
-        for at in tried:
+        for index, at in enumerate(tried):
             spot = spot_region(surface, *at)
             if not skills.can_set_down(world, estimate, side, held, spot):
-                first[held.grasp] = spot
+                first[held.grasp], after[held.grasp] = spot, index + 1
                 return ""
         spots_of = "the one spot" if len(tried) == 1 else f"any of the {len(tried)} spots"
         where = f"{spots_of} of {place.name} it reaches" if tried else f"{place.name} (no spot in reach)"
@@ -164,21 +196,33 @@ def taking_to(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, sid
 
     both = Candidates.of(model, take, letting_go)
     if both.models:
+        purpose = f"taking the {name} to {place.name}"
+        passed = list(both.ruled_out)
+        refusals: dict[GraspKind, str] = {}  # of the carry to the first spot, when its clearance was asked
+        for held in both.models:
+
+            def others(since: int, held: ObjectModel = held) -> Iterator[Region]:  # the next it can let go over
+                regions = (spot_region(surface, *at) for at in spots[since:RELAY_TRIES])
+                return (spot for spot in regions if not skills.can_set_down(world, estimate, side, held, spot))
+
+            found = _clear_spot(
+                ctx, side, first[held.grasp], functools.partial(others, after[held.grasp]), (estimate, held)
+            )
+            if isinstance(found, Region):
+                first[held.grasp] = found
+                return _Taking(Candidates([held], passed).choice(side, held, purpose), True)
+            refused, unclear = found
+            refusals[held.grasp] = refused
+            passed.append((held.grasp, unclear))
         served = first_clear(
             both,
             side,
-            f"taking the {name} to {place.name}",
-            lambda held: skills.can_carry(
-                world,
-                estimate,
-                side,
-                held,
-                first[held.grasp],
-                floor=floor_to(ctx, held, side, estimate.position, first[held.grasp]),
-            ),
+            purpose,
+            lambda held: refusals[held.grasp],
             first,
         )
-        return served, True
+        unclear = "; ".join(why for _, why in passed[len(both.ruled_out) :])
+        return _Taking(served, True, unclear)
     unplaced = "; ".join(why for _, why in both.ruled_out)
     passed_on = first_clear(  # to be passed on: the take's moves are dry-run, as where the hold's end is not known
         taking,
@@ -186,7 +230,7 @@ def taking_to(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, sid
         f"taking the {name} (to {place.name}, to be passed on: {unplaced})",
         lambda held: skills.can_carry(world, estimate, side, held),
     )
-    return passed_on, False
+    return _Taking(passed_on, False)
 
 
 def hold_end(
@@ -256,19 +300,79 @@ def holdable_spot(
     return first  # no carry there keeps clear (a cup carried below the tap, which it aims at): as before
 
 
-def carry_clear(ctx: SimContext, side: ArmSide, spot: Region) -> str:
+def carry_clear(
+    ctx: SimContext, side: ArmSide, spot: Region, taking: tuple[ObjectEstimate, ObjectModel] | None = None
+) -> str:
     """Why the carry of what ``side`` holds over ``spot`` and its way down would not keep CARRY_CLEARANCE
     from the appliances standing on the furniture, the taps' levers too (empty: it would), or would be
-    refused by the arm's planning: a dry run of the carry's moves (:func:`skills.can_carry_held`), its
-    floor as the carry's (:func:`floor_to`). The arms' planning does not avoid a lever, which a hand
-    pushes to fill a cup, nor a fixed thing a hand comes less than STRIKE_DEPTH into; a carry means to
-    touch neither."""
-    arm = ctx.world.arm(side)
-    grasp = arm.held_grasp
-    if grasp is None:
-        return f"the {side.value} gripper holds nothing"
-    floor = floor_to(ctx, grasp.model, side, arm.ee_pose().position, spot)
-    return skills.can_carry_held(ctx.world, side, spot, floor, clear_by=CARRY_CLEARANCE)
+    refused by the arm's planning (:func:`carry_check`). The arms' planning does not avoid a lever, which
+    a hand pushes to fill a cup, nor a fixed thing a hand comes less than STRIKE_DEPTH into; a carry
+    means to touch neither."""
+    refused, brushed = carry_check(ctx, side, spot, taking)
+    return refused or brushed
+
+
+def carry_check(
+    ctx: SimContext, side: ArmSide, spot: Region, taking: tuple[ObjectEstimate, ObjectModel] | None = None
+) -> tuple[str, str]:
+    """Why the arm's planning would refuse the carry over ``spot`` and its way down, and where those moves
+    would come within CARRY_CLEARANCE of an appliance (each empty when not): a dry run
+    (:meth:`Arm.keeping_clear`) of the carry of what ``side`` holds, from its posture now
+    (:func:`skills.can_carry_held`), or, given ``taking`` (an object where it lies, the approach), of its
+    take and carry from where it lies (:func:`skills.can_carry`); the floor as the carry's
+    (:func:`floor_to`). Told apart, so a choice can pass over the spot that does not keep clear and
+    still take it, as before, when none does."""
+    world = ctx.world
+    if taking is None:
+        grasp = world.arm(side).held_grasp
+        if grasp is None:
+            return f"the {side.value} gripper holds nothing", ""
+        held, start = grasp.model, world.arm(side).ee_pose().position
+        floor = floor_to(ctx, held, side, start, spot)
+        refused, brushed = _keeping_clear(ctx, side, lambda: skills.can_carry_held(world, side, spot, floor))
+    else:
+        seen, held = taking
+        floor = floor_to(ctx, held, side, seen.position, spot)
+        refused, brushed = _keeping_clear(
+            ctx, side, lambda: skills.can_carry(world, seen, side, held, spot, floor=floor)
+        )
+    cx, cy, _ = spot.center
+    return refused, brushed and f"the {side.value} arm carrying the {held.name} to ({cx:.2f}, {cy:.2f}): {brushed}"
+
+
+def _keeping_clear(ctx: SimContext, side: ArmSide, dry_run: Callable[[], str]) -> tuple[str, str]:
+    """What ``dry_run`` says (why the arm's planning would refuse its moves) and where its moves first came
+    within CARRY_CLEARANCE of an appliance (:attr:`PlannedArm.brushed`; empty: they kept clear)."""
+    with ctx.world.arm(side).keeping_clear(CARRY_CLEARANCE) as planned:
+        refused = dry_run()
+    return refused, next((run.brushed for run in planned if run.brushed), "")
+
+
+def _clear_spot(
+    ctx: SimContext,
+    side: ArmSide,
+    first: Region,
+    others: Callable[[], Iterator[Region]],
+    taking: tuple[ObjectEstimate, ObjectModel],
+) -> Region | tuple[str, str]:
+    """Of ``first`` and then ``others`` (asked only when ``first``'s carry does not keep clear), the first
+    spot whose take and carry (:func:`carry_check`) the arm's planning would make keeping CARRY_CLEARANCE,
+    up to CLEAR_TRIES of them; else why the arm's planning would refuse the take and carry to ``first``
+    (empty: it would make them) and why no spot's keeps clear. Where the take itself comes that near (an
+    object below a tap's spout), no spot's can: the others are not asked."""
+    refused, brushed = carry_check(ctx, side, first, taking)
+    if not refused and not brushed:
+        return first
+    unclear = refused or brushed
+    if brushed:
+        seen, held = taking
+        at_take = _keeping_clear(ctx, side, lambda: skills.can_carry(ctx.world, seen, side, held))[1]
+        if at_take:
+            return refused, f"taking the {held.name}: {at_take}"
+    for spot in itertools.islice(others(), CLEAR_TRIES - 1):
+        if not carry_clear(ctx, side, spot, taking):
+            return spot
+    return refused, unclear
 
 
 def note_choice(ctx: SimContext, choice: GraspChoice) -> None:
@@ -410,15 +514,17 @@ def _loading_by(
         else f"passing the {model.name} to the {loader.value} arm"
     )
 
-    def holds(spot: Region, given_by: ObjectModel, taken_by: ObjectModel) -> None:
+    def holds(spot: Region, given_by: ObjectModel, taken_by: ObjectModel) -> str:
         # Both holds' moves are dry-run before the first moves: the giver's from where the object is to the
         # spot, the loader's from the spot to the platform (from its posture now; a re-grasping arm will
-        # have folded home, where it starts a task).
-        floor = floor_to(ctx, given_by, giver, estimate.position, spot)
-        why = skills.can_carry(world, estimate, giver, given_by, spot, floor=floor)
+        # have folded home, where it starts a task); and where either comes within CARRY_CLEARANCE of an
+        # appliance, which relay_spot passes the spot over for.
+        why, brushed = carry_check(ctx, giver, spot, (estimate, given_by))
         refuse_moves(why, given_by, giver, setting_down, spot)
         there = resting_at(spot, model, estimate, world.time)
-        refuse_moves(_loads(ctx, there, base, loader, taken_by), taken_by, loader, purpose, platform)
+        why, loading_brushed = _keeping_clear(ctx, loader, lambda: _loads(ctx, there, base, loader, taken_by))
+        refuse_moves(why, taken_by, loader, purpose, platform)
+        return brushed or (loading_brushed and f"the {loader.value} arm loading the {model.name}: {loading_brushed}")
 
     try:
         spot, given_by, taken_by = relay_spot(ctx, estimate, giving, loading, giver, loader, holds)

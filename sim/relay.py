@@ -8,11 +8,12 @@ planning, before anything moves.
 
 from __future__ import annotations
 
+import logging
 import math
 from collections.abc import Callable
 
 from cbrs.sim import skills
-from cbrs.sim.arms import ArmSide
+from cbrs.sim.arms import CARRY_CLEARANCE, ArmSide
 from cbrs.sim.context import SimContext, SkillFailed, check_outcome, robot_camera
 from cbrs.sim.errors import GraspMisfitError, MovesRefusedError, SimulationError
 from cbrs.sim.geometry import Region, Vec3
@@ -38,6 +39,14 @@ arms' planning (a dry run) before the pass is refused with the first refusal."""
 RELAY_TRIES = 40
 """How many spots, nearest the mounts first, are asked of the inverse kinematics (each asks take a few
 milliseconds) before passing is given up."""
+
+
+CLEAR_TRIES = 6
+"""How many spots whose holds' moves serve but come within CARRY_CLEARANCE of an appliance (a tap's
+lever) a pass, or an arm's choice of where it takes an object, passes over for the next before it takes
+the first of them, as before the clearance was asked: each is a dry run of a take and a carry (50-100 ms)."""
+
+log = logging.getLogger("cbrs.sim")
 
 
 def relay_object(
@@ -99,7 +108,7 @@ def relay_spot(
     taking: Candidates,
     giver: ArmSide,
     taker: ArmSide,
-    moves: Callable[[Region, ObjectModel, ObjectModel], None] | None = None,
+    moves: Callable[[Region, ObjectModel, ObjectModel], str | None] | None = None,
 ) -> tuple[Region, ObjectModel, ObjectModel]:
     """Where on the surface the object rests on both arms reach it, clear of the other objects and of
     the fixtures standing on it (a dispenser), and by which approach each hand holds it there: of the
@@ -108,7 +117,10 @@ def relay_spot(
     there (asked of the inverse kinematics: a side grasp close to the mount has none), and, given
     ``moves``, whose holds' moves the arms' planning would make (a dry run raising
     :class:`MovesRefusedError`): a spot so refused is passed over for the next, as a refused approach is
-    for the next approach, up to RELAY_MOVES_TRIES of them; then the first refusal."""
+    for the next approach, up to RELAY_MOVES_TRIES of them; then the first refusal. ``moves`` returns where
+    the holds' moves would come within CARRY_CLEARANCE of an appliance (``arm_choice.carry_check``; empty
+    or None: they keep clear): such a spot is passed over for the next whose moves keep clear, up to
+    CLEAR_TRIES of them; when none does, the first of them, as before, and the log says so."""
     smap, world = ctx.map, ctx.world
     model = giving.models[0]
     x, y, z = estimate.position
@@ -160,6 +172,7 @@ def relay_spot(
         return None
 
     refused: list[MovesRefusedError] = []
+    near: list[tuple[Region, ObjectModel, ObjectModel, str]] = []  # served, not keeping clear
     for *_, cx, cy in sorted(spots)[:RELAY_TRIES]:
         centre = (cx, cy, surface + model.height / 2.0)
         given = held_by(giver, giving, centre)
@@ -170,14 +183,31 @@ def relay_spot(
                 f"{supports[0].name}Relay", cx - half, cx + half, cy - half, cy + half, top.max_z, top.max_z + 0.3
             )
             try:
-                if moves is not None:
-                    moves(region, given, taken)
+                brushed = moves(region, given, taken) if moves is not None else None
             except MovesRefusedError as why:
                 refused.append(why)
                 if len(refused) >= RELAY_MOVES_TRIES:
                     break
                 continue
-            return region, given, taken
+            if not brushed:
+                return region, given, taken
+            near.append((region, given, taken, brushed))
+            if len(near) >= CLEAR_TRIES:
+                break
+    if near:
+        region, given, taken, brushed = near[0]
+        cx, cy, _ = region.center
+        log.info(
+            "passing the %s: the holds at none of the %d relay spots asked keep %.0f cm clear of the appliances; "
+            "it is set down at (%.2f, %.2f), the first whose holds serve, as before: %s",
+            model.name,
+            len(near),
+            CARRY_CLEARANCE * 100,
+            cx,
+            cy,
+            brushed,
+        )
+        return region, given, taken
     if refused:
         raise refused[0]
     if giver is taker:
