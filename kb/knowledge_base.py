@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import dataclasses
-import functools
 import logging
 import re
 from collections.abc import Mapping, Sequence
@@ -40,15 +39,13 @@ from cbrs.kb.standard_terms import PendingUpdate, Refresh, StandardTerms
 from cbrs.kb.store import MEMORY, EmbeddedStore, QueryResult, Store, Term, is_remote
 from cbrs.kb.update_delta import DataUpdate
 from cbrs.kb.update_report import GraphChange, UpdateReport, exact_changes, graph_sizes, net_changes, refuse_split
-from cbrs.kb.upgrade import UpgradeReport, new_terms, upgrade_store
+from cbrs.kb.upgrade import StoreCheck, UpgradeReport, check_store, upgrade_store
 
 if TYPE_CHECKING:
     from cbrs.kb.kept_robots import KeptRobots
 
 _log = logging.getLogger(__name__)
-_VERSION_INFO = ox.NamedNode("http://www.w3.org/2002/07/owl#versionInfo")
 _TYPE = ox.NamedNode("http://www.w3.org/1999/02/22-rdf-syntax-ns#type")
-_ONTOLOGY = ox.NamedNode("http://www.w3.org/2002/07/owl#Ontology")
 # An update that might write graph:map, read loosely (its name, an escape, a variable graph, ALL or NAMED):
 # only such an update, and a data update that names a quad in it, has the map checked afterwards.
 _MAY_WRITE_MAP = re.compile(r"map|\\[uU]|GRAPH(?:\s|#[^\n]*\n)*[?$]|\b(?:ALL|NAMED)\b", re.IGNORECASE)
@@ -57,23 +54,6 @@ _LOADS = re.compile(r"\bLOAD\b", re.IGNORECASE)
 # The graphs whose descriptions kb.shapes.checked_update checks (tests/test_standard_terms_updates.py pins
 # it): a data update naming no quad in them leaves them as they are, so it skips the check, which reads
 # both graphs whole twice (1.5 s a write on a store of OWLS-TC's services).
-
-
-@functools.cache
-def _bundled_map_versions() -> tuple[tuple[ox.NamedNode, frozenset[str]], ...]:
-    """(ontology IRI, versions) of each bundled file of graph:map: what marks a stored map as the bundled
-    home (read once per process)."""
-    found = []
-    for item in bundled_files():
-        if item.graph is GraphName.MAP:
-            triples = list(ox.parse(path=str(item.path), format=ox.RdfFormat.TURTLE))
-            for head in {t.subject for t in triples if t.predicate == _TYPE and t.object == _ONTOLOGY}:
-                if isinstance(head, ox.NamedNode):
-                    versions = frozenset(
-                        str(t.object) for t in triples if t.subject == head and t.predicate == _VERSION_INFO
-                    )
-                    found.append((head, versions))
-    return tuple(found)
 
 
 class KnowledgeBase:
@@ -121,7 +101,10 @@ class KnowledgeBase:
         if check_timeout is not None and isinstance(store, EmbeddedStore) and check_timeout != store.guard.timeout:
             store.guard = QueryGuard(timeout=check_timeout)
         kb = cls(store)
-        if seed and not kb.store.is_seeded():
+        if not seed:
+            return kb
+        check = check_store(store, kb.queries)  # one request to a remote store: seeded, upgrade, entailed
+        if not check.seeded:
             kb._seed_kept(seed_cache or SeedCache.default())
             if not isinstance(store, EmbeddedStore):  # an empty server shows its default graph only now
                 try:
@@ -129,12 +112,8 @@ class KnowledgeBase:
                 except BaseException:
                     store.close()
                     raise
-        elif seed:
-            kb.upgrade()
-            if kb._map_outdated():
-                kb.add_semantic_map()
-            if next(kb.store.quads(graph=GraphName.ENTAILED.node), None) is None:
-                kb._entail()  # a store seeded before the alignments existed
+        elif not kb.upgrade(check).changed and GraphName.ENTAILED not in check.holding:
+            kb._entail()  # a store seeded before the alignments existed
         return kb
 
     def _check_map_load(
@@ -283,55 +262,17 @@ class KnowledgeBase:
             _log.warning("graph:entailed not brought up to date (it lags until the next write): %s", error)
             return None
 
-    def upgrade(self) -> UpgradeReport:
-        """Bring a store seeded by an older cbrs up to the bundled ontologies (:mod:`kb.upgrade`): its
-        conditions out of the reified form, the core vocabulary replaced, the other ontologies merged
-        (what the lab said of them stays), the headers replaced."""
-        report = upgrade_store(self.store, self.queries)
+    def upgrade(self, check: StoreCheck | None = None) -> UpgradeReport:
+        """Bring a store seeded by an older cbrs up to the bundled ontologies and map (:mod:`kb.upgrade`):
+        its conditions out of the reified form, the core vocabulary replaced, the other ontologies and the
+        map merged (what the lab said of them stays, what it deleted stays deleted), the headers replaced,
+        an emptied map given the bundled one. ``check``: what :func:`kb.upgrade.check_store` just found."""
+        report = upgrade_store(self.store, self.queries, check)
         if report.changed:
             self._reader.clear_cache()
+            self._map_read = None
             self._entail()
         return report
-
-    def _map_outdated(self) -> bool:
-        """Whether the store's semantic map is missing, or is the bundled one at an older version. A map
-        that does not name the bundled map's ontology is a lab's own home (``cbrs load --graph map
-        --replace``): it is left alone, where the bundled home's statements used to join it on the next
-        open (its kitchen table, cup and person beside the lab's own). Every open asks, so it reads the
-        bundled header's version statements, not the list of graphs (6.9 s of a 7.7 s open of the
-        OWLS-TC store on Virtuoso, docs/remote-store.md); an empty map is looked for by one quad."""
-        found = False
-        for head, bundled in _bundled_map_versions():
-            stored = {str(quad.object) for quad in self.store.quads(head, _VERSION_INFO, None, GraphName.MAP.node)}
-            if stored or next(iter(self.store.quads(head, _TYPE, _ONTOLOGY, GraphName.MAP.node)), None) is not None:
-                found = True
-                if not bundled <= stored:
-                    return True
-        return not found and next(iter(self.store.quads(graph=GraphName.MAP.node)), None) is None
-
-    def add_semantic_map(self) -> None:
-        """Bring a store seeded before the semantic map (or its current version) existed up to date.
-
-        The bundled ontology files are added again: their new terms join, nothing is removed, and a term the
-        store describes keeps its structures (:func:`kb.upgrade.new_terms`). Of the bundled map, what the
-        stored map does not say yet is added: a statement joins unless the stored map already gives its
-        subject a value for that property, so a thing a user moved stays moved.
-        """
-        files = bundled_files()
-        ontology = [parse_file(item.path, item.graph) for item in files if item.graph is GraphName.ONTOLOGY]
-        world = [parse_file(item.path, item.graph) for item in files if item.graph is GraphName.MAP]
-        known = {(quad.subject, quad.predicate) for quad in self.store.quads(graph=GraphName.MAP.node)}
-        # the ontology files at once: one scan of the stored graph for what it describes, not one per file
-        added = new_terms(self.store, [quad for item in ontology for quad in item.quads])
-        added += [  # (the map by the bundle's own graph name: a parsed file names its graph by IRI)
-            quad
-            for item in world
-            for quad in item.quads
-            if (quad.subject, quad.predicate) not in known or quad.predicate == _VERSION_INFO
-        ]
-        self.store.add(added)
-        self._reader.clear_cache()
-        self._entail()
 
     def seed(self) -> list[ParsedFile]:
         """Load the bundled ontologies, advertisements and requirements in one transaction."""

@@ -1,8 +1,9 @@
-"""A store seeded by an older cbrs, brought up to the bundled ontologies when it is opened.
+"""A store seeded by an older cbrs, brought up to the bundled ontologies and map when it is opened.
 
-:meth:`KnowledgeBase.open` calls :func:`upgrade_store` on every seeded store; it writes only when
-something is out of date, and then in one transaction. An ontology is out of date when the store holds
-it at another version (``owl:versionInfo``) than the bundled file, unless the store's is newer. The
+:meth:`KnowledgeBase.open` asks :func:`check_store` what it needs to know of the store (one request to a
+remote store) and calls :func:`upgrade_store` on every seeded store; it writes only when something is out
+of date, and then in one transaction. An ontology (or the semantic map) is out of date when the store
+holds it at another version (``owl:versionInfo``) than the bundled file, unless the store's is newer. The
 rules, each about what cbrs owns (docs/ontologies.md, "Upgrading a store"):
 
 - conditions: in every graph, a condition written in the reified form of core 0.1.0 (``rdf:subject``,
@@ -22,12 +23,15 @@ rules, each about what cbrs owns (docs/ontologies.md, "Upgrading a store"):
   by the bundled one, so that the next open finds nothing to do;
 - new ontologies: a bundled file of the ontology graph whose ontology the store does not name at all
   (the standard vocabularies and the alignments, for a store seeded before they were bundled) is
-  added whole, as a seed would have stored it.
+  added whole, as a seed would have stored it;
+- the semantic map (graph:map), when it names the bundled map's ontology at an older version: the same
+  three-way merge, except that a bundled value does not join where the lab gave the thing a value of
+  its own for that property (a thing a user moved stays where it was put, with one position). An empty
+  map is given the bundled one whole; a map that does not name the bundled map's ontology is a lab's
+  own home, and is left alone.
 
 Nothing else is touched: the advertisements and requirements a user registered, changed or
-deregistered stay as they are, and the semantic map keeps its own upgrade
-(:meth:`KnowledgeBase.add_semantic_map`). A condition on a blank node (which no cbrs write makes) is
-left alone.
+deregistered stay as they are. A condition on a blank node (which no cbrs write makes) is left alone.
 """
 
 from __future__ import annotations
@@ -49,11 +53,15 @@ from cbrs.kb.resources import bundled_files, ontology_dir
 from cbrs.kb.skolem import closure, is_skolem, quads_by_subject
 from cbrs.kb.store import EmbeddedStore, Store, Term
 
-__all__ = ["UpgradeReport", "new_terms", "statement_keys", "upgrade_store"]
+__all__ = ["StoreCheck", "UpgradeReport", "check_store", "statement_keys", "upgrade_store"]
 
 log = logging.getLogger(__name__)
 
-UPGRADED_GRAPHS = (GraphName.ONTOLOGY, GraphName.SERVICES, GraphName.REQUIREMENTS)
+UPGRADED_GRAPHS = (GraphName.ONTOLOGY, GraphName.SERVICES, GraphName.REQUIREMENTS, GraphName.MAP)
+MERGED_GRAPHS = (GraphName.ONTOLOGY, GraphName.MAP)  # the graphs whose bundled files are merged
+# the graphs every open asks whether they hold anything: seeded or not, a map to put back, graph:entailed
+# to work out (KnowledgeBase.open)
+HELD_GRAPHS = (GraphName.ONTOLOGY, GraphName.MAP, GraphName.ENTAILED)
 CORE_FILE = "core.ttl"
 HISTORY = "history.toml"
 _VERSION_INFO = OWL + "versionInfo"
@@ -86,24 +94,44 @@ class _Headers:
     versions: dict[_Asked, frozenset[str]]  # the versions their graph gives them (owl:versionInfo)
 
 
-def upgrade_store(store: Store, queries: QueryLibrary) -> UpgradeReport:
-    """Bring ``store`` up to the bundled ontologies (the rules above), in one transaction."""
-    legacy, headers = _check(store, queries)
-    remove, add, conditions = _condition_changes(legacy)
-    add += _missing_ontologies(headers)
-    outdated = _outdated(headers)
+@dataclass(frozen=True)
+class StoreCheck:
+    """What every open needs to know of a store, asked at once (:func:`check_store`)."""
+
+    holding: frozenset[GraphName]  # those of HELD_GRAPHS that hold a statement
+    legacy: tuple[dict[str, Term], ...]  # the conditions in the reified form (the named query legacy_conditions)
+    headers: _Headers
+
+    @property
+    def seeded(self) -> bool:
+        """Whether the ontology graph holds anything (as :meth:`Store.is_seeded` says)."""
+        return GraphName.ONTOLOGY in self.holding
+
+
+def upgrade_store(store: Store, queries: QueryLibrary, check: StoreCheck | None = None) -> UpgradeReport:
+    """Bring ``store`` up to the bundled ontologies and map (the rules above), in one transaction; ``check``
+    is what :func:`check_store` found, if it was just asked."""
+    if check is None:
+        check = check_store(store, queries)
+    remove, add, conditions = _condition_changes(check.legacy)
+    add += _missing_ontologies(check.headers)
+    if GraphName.MAP not in check.holding:
+        add += _bundled_map()
+    outdated = _outdated(check.headers)
     merged: list[str] = []
     if outdated:
-        if any(path.name == CORE_FILE for path, _ in _ontology_files(outdated)):
+        if any(path.name == CORE_FILE for path, _, _ in _merged_files(outdated)):
             core_remove, core_add = _core_changes(store)
             remove += core_remove
             add += core_add
-        files = [(path, stored) for path, stored in _ontology_files(outdated) if path.name != CORE_FILE]
-        if files:
-            merge_remove, merge_add = _merge_changes(store, files, remove, add)
-            remove += merge_remove
-            add += merge_add
-            merged = [path.name for path, _ in files]
+        for graph in MERGED_GRAPHS:
+            files = [(path, stored) for path, g, stored in _merged_files(outdated) if g is graph]
+            files = [(path, stored) for path, stored in files if path.name != CORE_FILE]
+            if files:
+                merge_remove, merge_add = _merge_changes(store, graph, files, remove, add)
+                remove += merge_remove
+                add += merge_add
+                merged += [path.name for path, _ in files]
         header_remove, header_add = _header_changes(store, outdated)
         remove += header_remove
         add += header_add
@@ -124,12 +152,16 @@ def upgrade_store(store: Store, queries: QueryLibrary) -> UpgradeReport:
     return UpgradeReport(conditions, len(removing), len(adding), tuple(merged))
 
 
-def _check(store: Store, queries: QueryLibrary) -> tuple[list[dict[str, Term]], _Headers]:
-    """What the rules need to know of a store on every open: the conditions in the reified form, and
-    the bundled ontologies' headers. A remote store is asked all at once, in one request (a lookup per
-    header cost every open 18); the embedded store looks each header up by pattern, in a tenth of what a
-    query of it takes."""
+def check_store(store: Store, queries: QueryLibrary) -> StoreCheck:
+    """What the rules and the open need to know of a store every time it is opened: which of
+    :data:`HELD_GRAPHS` hold anything, the conditions in the reified form, and the bundled ontologies'
+    headers. A remote store is asked all at once, in one request (a request each cost every open 4, and a
+    lookup per header 18 before that); the embedded store looks each up by pattern, in a tenth of what a
+    query of it takes, and asks an unseeded store nothing more."""
     if isinstance(store, EmbeddedStore):
+        holding = frozenset(g for g in HELD_GRAPHS if next(store.quads(graph=g.node), None) is not None)
+        if GraphName.ONTOLOGY not in holding:
+            return StoreCheck(holding, (), _Headers(frozenset(), {}))
         version, kind = ox.NamedNode(_VERSION_INFO), ox.NamedNode(RDF + "type")
         versions = {
             (head, graph): frozenset(_text(q.object) for q in store.quads(head, version, None, graph.node))
@@ -140,23 +172,32 @@ def _check(store: Store, queries: QueryLibrary) -> tuple[list[dict[str, Term]], 
             for _, graph, head in _bundled_ontology_files()
             if next(store.quads(head, kind, _ONTOLOGY, graph.node), None) is not None
         )
-        return queries.select(store, "legacy_conditions"), _Headers(declared, versions)
+        return StoreCheck(holding, tuple(queries.select(store, "legacy_conditions")), _Headers(declared, versions))
     asked = _asked()
     answers = queries.select_each(
         store,
         [
+            *(("graph_holds", {"graph": graph.node}) for graph in HELD_GRAPHS),
             ("legacy_conditions", {}),
             *(("ontology_header", {"ontology": head, "graph": graph.node}) for head, graph in asked),
         ],
     )
-    rows_of = dict(zip(asked, answers[1:], strict=True))
-    return answers[0], _Headers(
-        frozenset(pair for pair, rows in rows_of.items() if any("declared" in row for row in rows)),
-        {pair: frozenset(_text(row["version"]) for row in rows if "version" in row) for pair, rows in rows_of.items()},
+    held, (legacy, *headers) = answers[: len(HELD_GRAPHS)], answers[len(HELD_GRAPHS) :]
+    rows_of = dict(zip(asked, headers, strict=True))
+    return StoreCheck(
+        frozenset(graph for graph, rows in zip(HELD_GRAPHS, held, strict=True) if rows),
+        tuple(legacy),
+        _Headers(
+            frozenset(pair for pair, rows in rows_of.items() if any("declared" in row for row in rows)),
+            {
+                pair: frozenset(_text(row["version"]) for row in rows if "version" in row)
+                for pair, rows in rows_of.items()
+            },
+        ),
     )
 
 
-def _condition_changes(legacy: list[dict[str, Term]]) -> tuple[list[ox.Quad], list[ox.Quad], int]:
+def _condition_changes(legacy: Sequence[dict[str, Term]]) -> tuple[list[ox.Quad], list[ox.Quad], int]:
     remove: list[ox.Quad] = []
     add: list[ox.Quad] = []
     nodes = set()
@@ -174,7 +215,21 @@ def _condition_changes(legacy: list[dict[str, Term]]) -> tuple[list[ox.Quad], li
 @functools.cache
 def _bundled(path: Path, graph: GraphName) -> tuple[ox.Quad, ...]:
     """A bundled file's quads, skolemised as a fresh seed would store them (parsed once per process)."""
-    return tuple(parse_file(path, graph).quads)
+    return _as_stored(parse_file(path, graph).quads)
+
+
+def _as_stored(quads: Iterable[ox.Quad]) -> tuple[ox.Quad, ...]:
+    """``quads`` as Oxigraph keeps them (``"2.70"^^xsd:decimal`` as ``"2.7"``), so that the merge compares
+    a file's statements with a store's, whose literals are so kept, as equal when they are."""
+    scratch = ox.Store()
+    scratch.extend(quads)
+    return tuple(scratch)
+
+
+def _bundled_map() -> list[ox.Quad]:
+    """The quads of the bundled map, for a store whose graph:map is empty (as a seed stores them)."""
+    log.info("graph:map is empty: the bundled map is added")
+    return [q for item in bundled_files() if item.graph is GraphName.MAP for q in _bundled(item.path, item.graph)]
 
 
 @functools.cache
@@ -222,12 +277,17 @@ def _bundled_versions() -> tuple[tuple[ox.NamedNode, GraphName, frozenset[str]],
     return tuple(dict.fromkeys(found))
 
 
-@functools.cache
 def _bundled_ontology_files() -> tuple[tuple[Path, GraphName, ox.NamedNode], ...]:
-    """(file, graph, ontology IRI) of the bundled files of the ontology graph, each read up to its header."""
+    """(file, graph, ontology IRI) of the bundled files of the ontology graph."""
+    return tuple(entry for entry in _bundled_merged_files() if entry[1] is GraphName.ONTOLOGY)
+
+
+@functools.cache
+def _bundled_merged_files() -> tuple[tuple[Path, GraphName, ox.NamedNode], ...]:
+    """(file, graph, ontology IRI) of the bundled files of the merged graphs, each read up to its header."""
     found = []
     for item in bundled_files():
-        if item.graph is not GraphName.ONTOLOGY:
+        if item.graph not in MERGED_GRAPHS:
             continue
         for triple in ox.parse(path=str(item.path), format=ox.RdfFormat.TURTLE):
             if _is_header(triple):
@@ -294,9 +354,9 @@ def _outdated(headers: _Headers) -> dict[ox.NamedNode, frozenset[str]]:
     return found
 
 
-def _ontology_files(outdated: dict[ox.NamedNode, frozenset[str]]) -> list[tuple[Path, frozenset[str]]]:
-    """(file, stored versions) of the out-of-date ontologies of the ontology graph."""
-    return [(path, outdated[head]) for path, _, head in _bundled_ontology_files() if head in outdated]
+def _merged_files(outdated: dict[ox.NamedNode, frozenset[str]]) -> list[tuple[Path, GraphName, frozenset[str]]]:
+    """(file, graph, stored versions) of the out-of-date ontologies of the merged graphs."""
+    return [(path, graph, outdated[head]) for path, graph, head in _bundled_merged_files() if head in outdated]
 
 
 def _header_changes(store: Store, outdated: dict[ox.NamedNode, frozenset[str]]) -> tuple[list[ox.Quad], list[ox.Quad]]:
@@ -381,7 +441,7 @@ def _history() -> dict[tuple[str, str], tuple[Path, Path | None]]:
 @functools.cache
 def _said(path: Path) -> frozenset[Key]:
     """The statement keys of a history file (parsed once per process, as an upgrade reads it)."""
-    return frozenset(statement_keys(parse_file(path, GraphName.ONTOLOGY).quads))
+    return frozenset(statement_keys(_as_stored(parse_file(path, GraphName.ONTOLOGY).quads)))
 
 
 def _base(name: str, stored: frozenset[str]) -> tuple[frozenset[Key], frozenset[Key]]:
@@ -401,13 +461,18 @@ def _base(name: str, stored: frozenset[str]) -> tuple[frozenset[Key], frozenset[
 
 
 def _merge_changes(
-    store: Store, files: Sequence[tuple[Path, frozenset[str]]], removing: list[ox.Quad], adding: list[ox.Quad]
+    store: Store,
+    graph: GraphName,
+    files: Sequence[tuple[Path, frozenset[str]]],
+    removing: list[ox.Quad],
+    adding: list[ox.Quad],
 ) -> tuple[list[ox.Quad], list[ox.Quad]]:
-    """The three-way merge of the out-of-date ``files`` into the ontology graph as the other rules
-    (``removing``, ``adding``) leave it: add what a file says and its stored version did not, remove what
-    that version said and no bundled file says now. Headers are the header rule's."""
-    graph = GraphName.ONTOLOGY
-    heads = {head for _, _, head in _bundled_ontology_files()}
+    """The three-way merge of the out-of-date ``files`` into ``graph`` as the other rules (``removing``,
+    ``adding``) leave it: add what a file says and its stored version did not, remove what that version
+    said and no bundled file says now. Headers are the header rule's. In graph:map, a statement does not
+    join where the store gives its subject a value of the lab's own for its property (one neither that
+    version nor the bundle says): a thing has one position, one size, one colour, and the lab's stands."""
+    heads = {head for _, g, head in _bundled_merged_files() if g is graph}
     view = set(store.quads(graph=graph.node)) - {q for q in removing if q.graph_name == graph.node}
     view |= {q for q in adding if q.graph_name == graph.node}
     stored = statement_keys(view)
@@ -420,8 +485,9 @@ def _merge_changes(
     for path, versions in files:
         theirs = statement_keys(_bundled(path, graph))
         every, some = _base(path.name, versions)
+        own = _own_values(stored, some | current.keys()) if graph is GraphName.MAP else frozenset()
         for key, quads in theirs.items():
-            if key not in every and key not in stored and not _about(key, heads):
+            if key not in every and key not in stored and not _about(key, heads) and key[:2] not in own:
                 add += quads
         for key in some - current.keys():
             if key in stored and not _about(key, heads):
@@ -433,13 +499,7 @@ def _about(key: Key, heads: set[ox.NamedNode]) -> bool:
     return key[0] in heads
 
 
-def new_terms(store: Store, quads: Sequence[ox.Quad]) -> list[ox.Quad]:
-    """What of a bundled file's ``quads`` may join a store seeded from an older version of it: every
-    statement between IRIs, and the skolemised structures (restrictions, models) of the terms the store
-    does not describe yet. A term the store describes keeps its structures: taken again from a changed
-    file, they would come in a second time under other skolem IRIs (the file's digest names them)."""
-    described = {q.subject for q in store.quads(graph=quads[0].graph_name)} if quads else set()  # type: ignore[arg-type]
-    flat = [q for q in quads if not is_skolem(q.subject) and not is_skolem(q.object)]
-    roots = {q.subject for q in quads if isinstance(q.subject, ox.NamedNode) and not is_skolem(q.subject)} - described
-    hanging = closure(roots, quads_by_subject(quads))
-    return flat + [q for q in hanging if is_skolem(q.subject) or is_skolem(q.object)]
+def _own_values(stored: dict[Key, list[ox.Quad]], known: Iterable[Key]) -> frozenset[Key]:
+    """The (subject, property) pairs to which the store gives a value that none of ``known`` gives: the
+    lab's own (a thing it moved, a colour it changed)."""
+    return frozenset(key[:2] for key in stored.keys() - set(known) if len(key) == 3)
