@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import asyncio
 import functools
+from collections import Counter
 from collections.abc import Awaitable, Callable, Collection, Iterable
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
@@ -54,13 +55,15 @@ class SparqlFront:
         wsgi_threads: int = 24,
         inline_bytes: int = 256 * 1024,
         body_timeout: float = 30.0,
+        bodies_per_client: int = 16,
     ) -> None:
         self.sparql = sparql
         self.host_names = host_names  # the names Host may give, None for any (as cbrs.web._check_host)
         self.max_body = max_body
         self.inline_bytes = inline_bytes
         self.body_timeout = body_timeout
-        self.wsgi = _WsgiAdapter(wsgi_app, wsgi_threads, max_body, body_timeout)
+        self.bodies = BodyWaits(bodies_per_client)
+        self.wsgi = _WsgiAdapter(wsgi_app, wsgi_threads, max_body, body_timeout, self.bodies)
         self._names: Collection[str | None] | None = None
         self._hosts: dict[str, bool] = {}
         self._queries = ThreadPoolExecutor(threads, thread_name_prefix="cbrs-sparql")
@@ -80,18 +83,24 @@ class SparqlFront:
             await self.wsgi(scope, receive, send)
             return
         text, short, length = plain
+        client = scope.get("client")
         if length >= 0:  # a POST: the body is the query
+            sender = client and client[0]
+            if not self.bodies.admit(sender):
+                await _too_many_bodies(send, sender, self.bodies.per_client)
+                return
             try:
                 body = await asyncio.wait_for(_read_body(receive), self.body_timeout)
             except TimeoutError:
                 await _body_late(send, self.body_timeout)
                 return
+            finally:
+                self.bodies.done(sender)
             try:
                 text = body.decode("utf-8")
             except UnicodeDecodeError:  # Flask reads it again and names the error
                 await self.wsgi(scope, _replay(body, receive), send)
                 return
-        client = scope.get("client")
         status, media_type, content = await self._answer(text, headers.get(b"accept"), short, client and client[0])
         await _respond(send, scope["method"] == "HEAD", status, media_type, content)
 
@@ -144,6 +153,29 @@ class SparqlFront:
         return known
 
 
+class BodyWaits:
+    """The requests of each client (an IP address) whose body is still coming. Each holds a connection,
+    and Granian serves a fixed number of connections at once: a client sending bodies slowly (a byte a
+    second, each within ``body_timeout``) held all of them, and nobody else was answered. Past
+    ``per_client`` such requests, a client's next one is refused at once (503), which closes its
+    connection. All on the event loop's thread, so no lock."""
+
+    def __init__(self, per_client: int) -> None:
+        self.per_client = per_client
+        self.waiting: Counter[str | None] = Counter()
+
+    def admit(self, client: str | None) -> bool:
+        if self.waiting[client] >= self.per_client:
+            return False
+        self.waiting[client] += 1
+        return True
+
+    def done(self, client: str | None) -> None:
+        self.waiting[client] -= 1
+        if self.waiting[client] <= 0:
+            del self.waiting[client]
+
+
 class ClientDisconnectedError(OSError):
     """Raised in a WSGI thread writing to a client that has gone, so that the app's iterable is closed
     (a stream ends and gives its slot back) instead of writing on into nothing."""
@@ -154,17 +186,18 @@ class _WsgiAdapter(WSGIMiddleware):
     thread only once its body is in (at most ``max_body`` bytes of it, within ``body_timeout``), so a
     slow client holds no thread; and the app hears when its client has gone."""
 
-    def __init__(self, app: WSGIApp, workers: int, max_body: int, body_timeout: float) -> None:
+    def __init__(self, app: WSGIApp, workers: int, max_body: int, body_timeout: float, bodies: BodyWaits) -> None:
         super().__init__(app, workers=workers)  # type: ignore[arg-type]
         self.max_body = max_body
         self.body_timeout = body_timeout
+        self.bodies = bodies
 
     async def __call__(self, scope: Any, receive: Any, send: Any) -> None:
         if scope["type"] != "http":
             await super().__call__(scope, _coroutine(receive), send)  # type: ignore[arg-type]
             return
         responder = _Responder(self.app, self.executor, self.send_queue_size)
-        await responder.serve(scope, receive, send, self.max_body, self.body_timeout)
+        await responder.serve(scope, receive, send, self.max_body, self.body_timeout, self.bodies)
 
 
 class _Responder(WSGIResponder):
@@ -175,7 +208,15 @@ class _Responder(WSGIResponder):
 
     gone = False
 
-    async def serve(self, scope: Any, receive: Any, send: Any, max_body: int, body_timeout: float) -> None:
+    async def serve(
+        self, scope: Any, receive: Any, send: Any, max_body: int, body_timeout: float, bodies: BodyWaits
+    ) -> None:
+        client = scope.get("client")
+        sender = client and client[0]
+        waits = _has_body(scope)
+        if waits and not bodies.admit(sender):
+            await _too_many_bodies(send, sender, bodies.per_client)
+            return
         messages: asyncio.Queue[Message] = asyncio.Queue()
         body_in = asyncio.Event()
         size = 0
@@ -205,6 +246,10 @@ class _Responder(WSGIResponder):
             except TimeoutError:
                 await _body_late(send, body_timeout)
                 return
+            finally:
+                if waits:
+                    bodies.done(sender)
+                    waits = False
             if not self.gone:
                 await self(_with_length(scope, size), messages.get, send)  # type: ignore[arg-type]
         except ClientDisconnectedError:
@@ -216,6 +261,14 @@ class _Responder(WSGIResponder):
         if self.gone:
             raise ClientDisconnectedError("the client closed the connection")
         super().send(message)
+
+
+def _has_body(scope: Scope) -> bool:
+    """Whether the request announces a body: a Content-Length other than 0, or a transfer coding."""
+    for name, value in scope.get("headers", ()):
+        if name == b"transfer-encoding" or (name == b"content-length" and value.strip() not in (b"", b"0")):
+            return True
+    return False
 
 
 def _with_length(scope: Scope, size: int) -> Scope:
@@ -305,6 +358,14 @@ def _replay(body: bytes, receive: Receive) -> Receive:
 async def _body_late(send: Send, timeout: float) -> None:
     message = f"the request body did not arrive within {timeout:g} s"
     await _respond(send, False, 408, "application/json", json_body({"error": "timeout", "message": message}))
+
+
+async def _too_many_bodies(send: Send, client: str | None, limit: int) -> None:
+    message = (
+        f"{client} is already sending {limit} request bodies at once, the most one client may; "
+        "send the rest when those are in"
+    )
+    await _respond(send, False, 503, "application/json", json_body({"error": "busy", "message": message}))
 
 
 async def _respond(send: Send, head: bool, status: int, media_type: str, body: bytes) -> None:

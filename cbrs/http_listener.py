@@ -15,6 +15,7 @@ import asyncio
 import contextlib
 import logging
 import os
+import resource
 import socket
 import threading
 import time
@@ -51,7 +52,11 @@ class ListenerConfig:
     io_threads: int = 1  # Rust threads doing the HTTP work; Python runs on the one loop whatever this is
     header_timeout: float = 10.0  # seconds a client may take to send a request's headers
     max_header_bytes: int = 64 * 1024  # what one connection may buffer while its headers are read
-    backlog: int = 128  # connections waiting to be accepted; also the requests in Python at once
+    backlog: int = 1024  # connections the kernel holds before Granian accepts them
+    # Connections open at once, idle ones included: Granian holds a permit per connection from accept to
+    # close, and at 128 (its default) 128 idle sockets from one client kept every other client out
+    # until header_timeout closed them (docs/security.md, section 2)
+    max_connections: int = 4096
     loop: str = "auto"  # the asyncio loop the app runs on: "uvloop", "asyncio", or "auto" (uvloop when installed)
 
 
@@ -75,6 +80,30 @@ def _refuse_taken(host: str, port: int) -> None:
     with socket.socket(family, kind, proto) as probe:
         probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         probe.bind(address)
+
+
+# Descriptors kept for what is not a client's connection: the store's files, the query workers' pipes,
+# the bridge's listener and connections.
+_SPARE_DESCRIPTORS = 1024
+
+
+def _descriptors_for(connections: int) -> int:
+    """The connections the listener may hold, ``connections`` if the process may open that many files
+    beside its others: the soft limit on open files is raised toward the hard one if needed, and past
+    the hard one the count is cut (with a warning), so that a flood of connections meets Granian's
+    permit, not a failing ``accept`` or a store that cannot open a file."""
+    wanted = connections + _SPARE_DESCRIPTORS
+    soft, hard = resource.getrlimit(resource.RLIMIT_NOFILE)
+    if soft != resource.RLIM_INFINITY and soft < wanted:
+        raised = wanted if hard == resource.RLIM_INFINITY else min(wanted, hard)
+        with contextlib.suppress(ValueError, OSError):
+            resource.setrlimit(resource.RLIMIT_NOFILE, (raised, hard))
+            soft = raised
+    if soft != resource.RLIM_INFINITY and soft < wanted:
+        allowed = max(64, soft - _SPARE_DESCRIPTORS)
+        log.warning("the limit on open files (%d) allows %d HTTP connections, not %d", soft, allowed, connections)
+        return allowed
+    return connections
 
 
 class UnknownLoopError(ValueError):
@@ -117,6 +146,7 @@ class HttpListener:
             websockets=False,  # the rosbridge websocket has its own port and server
             runtime_threads=config.io_threads,
             backlog=config.backlog,
+            backpressure=_descriptors_for(config.max_connections),
             http1_settings=HTTP1Settings(
                 header_read_timeout=int(config.header_timeout * 1000), max_buffer_size=config.max_header_bytes
             ),

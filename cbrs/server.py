@@ -53,6 +53,8 @@ class ServeConfig:
     http_io_threads: int = 1  # Granian's Rust threads reading and writing HTTP, off the GIL
     header_timeout: float = 10.0  # seconds a client may take to send a request's headers, then it is dropped
     body_timeout: float = 30.0  # seconds it may take to send a body (held on the loop, not a thread); then 408
+    max_connections: int = 4096  # HTTP connections open at once, idle ones included (Granian's permits)
+    bodies_per_client: int = 16  # requests of one client whose body is still coming; one more: 503
     inline_bytes: int = 256 * 1024  # a single scan answered on the loop up to this result size, else on a thread
     http_loop: str = field(default_factory=lambda: setting("http_loop").resolve())  # auto, uvloop or asyncio
     stream_limit: int = field(default_factory=lambda: setting("stream_limit").resolve())
@@ -131,12 +133,14 @@ class Server:
             wsgi_threads=self.config.http_threads + self.config.stream_limit,
             inline_bytes=self.config.inline_bytes,
             body_timeout=self.config.body_timeout,
+            bodies_per_client=self.config.bodies_per_client,
         )
         listener = ListenerConfig(
             host=self.config.host,
             port=self.config.port,
             io_threads=self.config.http_io_threads,
             header_timeout=self.config.header_timeout,
+            max_connections=self.config.max_connections,
             loop=self.config.http_loop,
         )
         self._http = HttpListener(self._front, listener)
