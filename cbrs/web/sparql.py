@@ -153,6 +153,11 @@ def _operation() -> tuple[str | None, str | None]:
             raise BadProtocolRequest("an update must be sent with POST")
         query, update = _one("query", request.args), None
     else:
+        in_url = [name for name in ("query", "update") if name in request.args]
+        if in_url:  # which of the two texts was meant? The body's was run, the URL's ignored without a word
+            raise BadProtocolRequest(
+                f"a POST carries its {in_url[0]} in the body, but the URL has {in_url[0]}= too; send it once"
+            )
         media_type = request.mimetype
         if media_type == FORM_TYPE:
             query, update = _one("query", request.form), _one("update", request.form)
