@@ -9,6 +9,7 @@ a readable semantic map readable (as a load or an update into graph:map must), a
 from __future__ import annotations
 
 import logging
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import pyoxigraph as ox
@@ -78,22 +79,32 @@ class GraphStore:
     def __init__(self, sparql: SparqlService) -> None:
         self.sparql = sparql
 
-    def read(self, target: Target, accept: str | None) -> tuple[bytes, str]:
-        """The graph (or the dataset) serialised in the format ``accept`` names, with its media type."""
+    def read(self, target: Target, accept: str | None, client: str | None = None) -> tuple[bytes, str]:
+        """The graph (or the dataset) serialised in the format ``accept`` names, with its media type.
+
+        With the endpoint's limits (:meth:`SparqlService.bounded_read`): one of ``client``'s query
+        slots, ``max_result_bytes`` and ``query_timeout``. The quads are read twice, once for the
+        prefixes the text declares and once to write it, rather than held in memory."""
         store = self.sparql.kb.store
-        whole = target.node is None
-        fmt = _negotiate(accept, DATASET_FORMATS if whole else GRAPH_FORMATS)
-        if whole:
-            quads = list(store.quads())
-            data = ox.serialize(quads, format=fmt, prefixes=used_prefixes(quads))
-        else:
-            node = target.node
-            assert node is not None
-            if isinstance(node, ox.NamedNode) and node.value not in store.graphs():
-                raise UnknownGraphError(node.value)
-            triples = [ox.Triple(q.subject, q.predicate, q.object) for q in store.quads(graph=node)]
-            data = ox.serialize(triples, format=fmt, prefixes=used_prefixes(triples))
-        return data or b"", fmt.media_type
+        node = target.node
+        fmt = _negotiate(accept, DATASET_FORMATS if node is None else GRAPH_FORMATS)
+        if isinstance(node, ox.NamedNode) and node.value not in store.graphs():
+            raise UnknownGraphError(node.value)
+
+        def statements() -> Iterator[ox.Triple | ox.Quad]:
+            if node is None:
+                return store.quads()
+            return (ox.Triple(q.subject, q.predicate, q.object) for q in store.quads(graph=node))
+
+        with self.sparql.bounded_read(client) as budget:
+            try:
+                prefixes = used_prefixes(budget.watch(statements()))
+                return budget.serialize(statements(), fmt, prefixes), fmt.media_type
+            except KnowledgeBaseError as error:  # stopped at the limit or the deadline
+                # The traceback's frames hold Oxigraph's iterator, which must be dropped on this thread:
+                # the error goes on without them.
+                error.__context__ = None
+                raise error.with_traceback(None) from None
 
     def replace(self, target: Target, body: bytes, media_type: str, token: str | None) -> bool:
         """PUT: the graph becomes the body's triples; True when the graph did not exist before."""

@@ -23,13 +23,14 @@ Which graphs a query reads follows SPARQL 1.1 (Query §13.2, Protocol §2.1.4): 
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import hmac
 import io
 import threading
 import time
 from collections import Counter
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import Future
 from concurrent.futures import TimeoutError as FutureTimeout
 from dataclasses import dataclass, field
@@ -322,6 +323,35 @@ class _BudgetWriter(io.BytesIO):
         return written
 
 
+_T = TypeVar("_T")
+
+
+class ReadBudget:
+    """The limits of one read that is not a SPARQL query (the Graph Store protocol's ``GET /store``): its
+    result stops at ``max_result_bytes`` (422) and its reading and writing at the deadline (503)."""
+
+    def __init__(self, limit: int, timeout: float) -> None:
+        self.limit = limit
+        self.timeout = timeout
+        self.deadline = time.monotonic() + timeout
+
+    def watch(self, items: Iterable[_T], every: int = 4096) -> Iterator[_T]:
+        """``items``, checking the deadline every ``every`` of them."""
+        for count, item in enumerate(items):
+            if count % every == 0 and time.monotonic() > self.deadline:
+                raise QueryTimeoutError(self.timeout, stopped=True)
+            yield item
+
+    def serialize(self, statements: Iterable[Any], fmt: ox.RdfFormat, prefixes: dict[str, str]) -> bytes:
+        """``statements`` in ``fmt``, within the byte budget and the deadline."""
+        writer = _BudgetWriter(self.limit, self.deadline, self.timeout)
+        try:
+            ox.serialize(self.watch(statements), writer, format=fmt, prefixes=prefixes)
+        except _Stop as stop:
+            raise stop.error from None
+        return writer.getvalue()
+
+
 BOM = "\ufeff"
 _P = ParamSpec("_P")
 _R = TypeVar("_R")
@@ -470,6 +500,18 @@ class SparqlService:
             if limit < self.config.max_result_bytes:
                 return None  # not too large for the endpoint, only for this thread
             raise
+        finally:
+            release()
+
+    @contextlib.contextmanager
+    def bounded_read(self, client: str | None) -> Iterator[ReadBudget]:
+        """A read of the store that is not a query (``GET /store``), with a query's limits: it takes a
+        worker slot and counts against ``client``'s share (503 ``busy`` past either), and what it
+        writes stops at ``max_result_bytes`` and ``query_timeout`` (:class:`ReadBudget`). A whole
+        store's dump took a request thread, its quads and their text in memory, without any limit."""
+        release = self._admit(client)
+        try:
+            yield ReadBudget(self.config.max_result_bytes, self.config.timeout)
         finally:
             release()
 

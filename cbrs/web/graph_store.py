@@ -9,6 +9,7 @@ need ``Authorization: Bearer <token>``.
 
 from __future__ import annotations
 
+import pyoxigraph as ox
 from flask import Blueprint, Response, request
 from werkzeug.exceptions import BadRequest
 
@@ -33,6 +34,10 @@ def _target() -> Target:
         graph = graphs[0]
         if "://" not in graph and not graph.startswith("urn:"):
             raise BadRequest(f"graph must be an absolute IRI, not {graph!r}")
+        try:
+            ox.NamedNode(graph)
+        except ValueError as error:  # a space, a '<': was a 500 where Target made its node
+            raise BadRequest(f"graph={graph!r} is not an IRI: {error}") from None
         return Target(graph)
     return Target(None, default)
 
@@ -46,7 +51,7 @@ def read() -> Response:
     accept = request.headers.get("Accept")
     if request.accept_mimetypes.best == "text/html":  # a browser following a link: Turtle, not RDF/XML
         accept = "text/turtle"
-    data, media_type = _store().read(_target(), accept)
+    data, media_type = _store().read(_target(), accept, request.remote_addr)
     return Response(b"" if request.method == "HEAD" else data, content_type=media_type, headers={"Vary": "Accept"})
 
 
