@@ -19,7 +19,7 @@ from flask import Flask, Response, g, jsonify, make_response, render_template, r
 from werkzeug.exceptions import HTTPException, MisdirectedRequest
 
 from cbrs import __version__
-from cbrs.kb.errors import KnowledgeBaseError
+from cbrs.kb.errors import KnowledgeBaseError, without_password
 from cbrs.matchmakers import Matchmakers
 from cbrs.sparql_service import SparqlService
 from cbrs.tasks import TaskRunner
@@ -27,6 +27,7 @@ from cbrs.web import links, warmup
 from cbrs.web.context import EventLog, StreamSlots
 from cbrs.web.pages import http_error_message, keep_error_headers
 from cbrs.web.sparql_wsgi import SparqlHotPath
+from cbrs.web.strict_request import StrictRequest
 
 # The page blueprints, in navigation order: (module under cbrs.web, endpoint of its nav link, label).
 PAGES: tuple[tuple[str, str, str], ...] = (
@@ -49,6 +50,8 @@ CONTENT_SECURITY_POLICY = (
     "img-src 'self' data:; connect-src 'self'; object-src 'none'; base-uri 'none'; form-action 'self'; "
     "frame-ancestors 'none'"
 )
+# A picture opened on its own is a document too: no script, whatever its text came from.
+SVG_POLICY = "default-src 'none'; style-src 'unsafe-inline'; img-src data:; frame-ancestors 'self'"
 LOOPBACK_NAMES = frozenset({"127.0.0.1", "localhost", "::1"})
 # Paths only programs ask (the protocols, the components' registrations): errors there are always JSON.
 PROGRAM_PATHS = frozenset({"/sparql", "/update", "/store", "/components", "/healthz"})
@@ -73,7 +76,11 @@ def create_app(
     from cbrs.web.graph_store import blueprint as graph_store_blueprint
     from cbrs.web.sparql import blueprint
 
+    # A remote store's URL may carry HTTP basic credentials: every page's footer, /healthz and the
+    # overview showed them to anyone who could reach the port.
+    shown_location = without_password(sparql.kb.store.location)
     app = Flask(__name__)
+    app.request_class = StrictRequest  # a parameter that is not UTF-8 is a 400, not a changed text
     app.debug = False  # whatever FLASK_DEBUG says: the debugger runs code and tracebacks show internals
     app.config["MAX_CONTENT_LENGTH"] = 3 * sparql.config.max_query_bytes + 4096  # form encoding triples bytes
     app.json.sort_keys = False  # type: ignore[attr-defined]
@@ -124,7 +131,7 @@ def create_app(
             "endpoints": set(app.view_functions),
             "json_twin": twin,
             "version": __version__,
-            "store_location": sparql.kb.store.location,
+            "store_location": shown_location,
             "csp_nonce": _nonce(),
             "warming": warming.note() if (warming := warmup.current(app)) is not None else None,
         }
@@ -141,7 +148,7 @@ def create_app(
 
     @app.get("/healthz")
     def health() -> Response:
-        return jsonify(status="ok", version=__version__, store=sparql.kb.store.location, writable=sparql.writable)
+        return jsonify(status="ok", version=__version__, store=shown_location, writable=sparql.writable)
 
     @app.errorhandler(KnowledgeBaseError)
     def library_error(error: KnowledgeBaseError) -> tuple[Response | str, int]:
@@ -185,6 +192,8 @@ def create_app(
         if response.mimetype == "text/html":
             response.headers["Content-Security-Policy"] = CONTENT_SECURITY_POLICY.format(nonce=_nonce())
             response.headers["X-Frame-Options"] = "DENY"
+        elif response.mimetype == "image/svg+xml":
+            response.headers["Content-Security-Policy"] = SVG_POLICY
         origin = request.headers.get("Origin")
         if origin is not None and origin in allowed:
             response.headers["Access-Control-Allow-Origin"] = origin

@@ -7,6 +7,7 @@ from typing import Any
 from flask import Blueprint, url_for
 
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.errors import without_password
 from cbrs.kb.namespaces import GraphName
 from cbrs.web import context, services
 from cbrs.web.graphs import about as graph_note
@@ -24,7 +25,7 @@ def overview() -> Page:
         "overview.html",
         "Overview",
         {
-            "store": kb.store.location,
+            "store": without_password(kb.store.location),  # a remote store's URL may carry credentials
             "graphs": graphs,
             "counts": counts,
             "events": context.events().recent(),
