@@ -10,6 +10,13 @@ was, the server's own output went to the null device; a Ctrl-C then lost "stoppe
 thread being stopped before it could put the descriptors back. So the banner is kept off only while
 the calling thread is the process's only one (a CLI command); with other threads running it is let
 through: one line in a server's log is harmless, its own lines lost are not.
+
+With other threads running, C's own ``stdout`` and ``stderr`` streams are held instead: made fully
+buffered for the duration, so that what C code prints (the banner goes to ``stderr``, which C leaves
+unbuffered) waits in their buffers, and then those buffers are discarded (``__fpurge``) and the streams
+buffered as before. Python writes to the descriptors, not through C's streams, so the server's own
+lines are untouched; only C output of another thread during the import would be lost too. Where the C
+library lacks those names (not glibc or musl), the banner is let through.
 """
 
 from __future__ import annotations
@@ -29,7 +36,8 @@ def quiet_output() -> Iterator[None]:
     """Send what C code writes to file descriptors 1 and 2 to the null device for the duration, when
     no other thread runs (their output would go there too)."""
     if threading.active_count() > 1:
-        yield
+        with _held_c_streams():
+            yield
         return
     sys.stdout.flush()
     sys.stderr.flush()
@@ -50,6 +58,40 @@ def quiet_output() -> Iterator[None]:
         for fd, copy in zip((1, 2), saved, strict=True):
             os.dup2(copy, fd)
             os.close(copy)
+
+
+_IOFBF, _IOLBF, _IONBF = 0, 1, 2  # setvbuf's modes (glibc, musl)
+_HELD = threading.Lock()  # the C streams are the process's: one holder at a time
+# The buffers C's streams are given, kept for the life of the process: setvbuf with no buffer keeps
+# the one a stream has, and a buffer freed under it crashed the process when it exited.
+_BUFFERS = (ctypes.create_string_buffer(1 << 16), ctypes.create_string_buffer(1 << 16))
+
+
+@contextlib.contextmanager
+def _held_c_streams() -> Iterator[None]:
+    """What C code prints to ``stdout`` and ``stderr`` meanwhile is dropped, the descriptors untouched."""
+    try:
+        libc = ctypes.CDLL(None)
+        streams = [ctypes.c_void_p.in_dll(libc, name) for name in ("stdout", "stderr")]
+        purge = libc.__fpurge
+    except (AttributeError, ValueError, OSError):  # another C library: let it through
+        yield
+        return
+    # as C had them after: stdout by line on a terminal, else in blocks; stderr unbuffered
+    modes = [_IOLBF if os.isatty(1) else _IOFBF, _IONBF]
+    with _HELD:
+        for stream, buffer in zip(streams, _BUFFERS, strict=True):
+            libc.fflush(stream)
+            libc.setvbuf(stream, buffer, _IOFBF, len(buffer))
+        try:
+            yield
+        finally:
+            for stream, buffer, mode in zip(streams, _BUFFERS, modes, strict=True):
+                purge(stream)
+                if mode == _IONBF:
+                    libc.setvbuf(stream, None, mode, 0)
+                else:
+                    libc.setvbuf(stream, buffer, mode, len(buffer))
 
 
 with quiet_output():  # the banner is printed when pybullet is first imported, too
