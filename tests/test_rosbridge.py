@@ -334,7 +334,7 @@ BAD_FRAMES = [
         '{"op": "png", "data": "x"}', "png: PNG-compressed messages from a client are not supported", None, id="png"
     ),
     pytest.param(
-        '{"op": "publish", "topic": "/a", "id": "p"}', "publish: missing required field 'msg'", "p", id="missing"
+        '{"op": "advertise", "topic": "/a", "id": "p"}', "advertise: missing required field 'type'", "p", id="missing"
     ),
     pytest.param(
         '{"op": "subscribe", "topic": 5}',
@@ -396,7 +396,7 @@ BAD_FRAMES = [
         id="infinite-timeout",
     ),
     pytest.param("[" * 100_000 + "]" * 100_000, "nested too deeply", None, id="nested"),
-    pytest.param('{"op": "set_level", "level": "info"} {"op": "x"}', "not valid JSON: Extra data", None, id="two"),
+    pytest.param('{"op": "set_level", "level": "info"} and', "not valid JSON: Extra data", None, id="two"),
     pytest.param(  # white space around a message is JSON: it is read
         ' {"op": "publish", "topic": "/nobody", "msg": {}}\n', "'/nobody' is not advertised", None, id="spaced"
     ),

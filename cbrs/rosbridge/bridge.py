@@ -15,6 +15,7 @@ import itertools
 import logging
 import math
 from collections.abc import Awaitable, Callable, Mapping, Sequence
+from importlib.resources import files
 from typing import TYPE_CHECKING, Any
 
 from cbrs.rosbridge import protocol, rosapi, wire
@@ -34,6 +35,10 @@ if TYPE_CHECKING:
 log = logging.getLogger("cbrs.rosbridge")
 
 MIB = 1 << 20
+
+#: rosapi's own service types (ROS 1's), so a call may give its args as a list in field order and the
+#: details services describe them.
+ROSAPI_DEFINITIONS = files("cbrs.rosbridge") / "definitions" / "rosapi"
 
 #: The status a binary frame that holds no UTF-8 JSON gets.
 BINARY_REFUSED = (
@@ -97,6 +102,8 @@ class Bridge:
         connections_per_client: int = 64,
         action_workers: int = 4,
         non_finite: str = "null",
+        max_calls_per_client: int = 256,
+        max_names_per_client: int = 1000,
     ) -> None:
         for label, value in [
             ("max_message_bytes", max_message_bytes),
@@ -106,6 +113,8 @@ class Bridge:
             ("max_queue_bytes", max_queue_bytes),
             ("connections_per_client", connections_per_client),
             ("action_workers", action_workers),
+            ("max_calls_per_client", max_calls_per_client),
+            ("max_names_per_client", max_names_per_client),
         ]:
             if isinstance(value, bool) or not isinstance(value, int | float) or value <= 0:
                 raise ValueError(f"{label} must be a positive number, not {value!r}")
@@ -116,12 +125,15 @@ class Bridge:
         self.max_queue_bytes = int(max_queue_bytes)
         self.connections_per_client = int(connections_per_client)
         self.action_workers = int(action_workers)
+        self.max_calls_per_client = int(max_calls_per_client)
+        self.max_names_per_client = int(max_names_per_client)
         self.token = token
         self.non_finite = protocol.check_non_finite(non_finite)
         self.reserved = tuple(protocol.resolve(prefix) for prefix in reserved)
         self.params = ParamStore(params)
         self.interfaces = Interfaces()
         """The message and service types rosapi describes: add a package's with ``interfaces.load``."""
+        self.interfaces.load(ROSAPI_DEFINITIONS, "rosapi")
         self._graph = Graph()
         services = rosapi.services(self._graph, self.params, self.non_finite, self.interfaces)
         for name, (kind, handler) in services.items():
@@ -386,7 +398,15 @@ class Bridge:
         message_id = None
         message: Message | None = None
         try:
-            message = protocol.decode(frame, self.max_message_bytes)
+            try:
+                message = protocol.decode(frame, self.max_message_bytes)
+            except ProtocolError as error:
+                texts = protocol.several(frame) if "Extra data" in error.reason else None
+                if texts is None:
+                    raise
+                for text in texts:  # as rosbridge_suite reads a frame of several messages: one by one
+                    self._handle(session, text, whole)
+                return
             message_id = message.get("id")
             op = protocol.check(message)
             if whole and op == "fragment":
@@ -486,6 +506,18 @@ class Bridge:
 
     # -- ops ----------------------------------------------------------------------------------------
 
+    def _hold_name(self, session: Session, held: Mapping[str, Any], name: str) -> None:
+        """Refuse a new topic, service or action name to a client that holds ``max_names_per_client``
+        already: each costs the server memory, and every rosapi listing, for as long as it stays."""
+        if name in held:
+            return
+        count = len(session.queues) + len(session.advertised) + len(session.provided) + len(session.provided_actions)
+        if count >= self.max_names_per_client:
+            raise ProtocolError(
+                f"this client holds {count} topics, services and actions already (max_names_per_client):"
+                " unsubscribe or unadvertise some first"
+            )
+
     def _owned(self, name: str) -> bool:
         return bool(self.reserved) and name.startswith(self.reserved)
 
@@ -499,6 +531,7 @@ class Bridge:
         name, kind = protocol.resolve(message["topic"], "topic"), message["type"]
         if not kind:
             raise ProtocolError("field 'type' must name the message type, e.g. 'std_msgs/String'")
+        self._hold_name(session, session.advertised, name)
         with self._graph.lock:
             topic = self._graph.topics.get(name)
             self._refuse_owned_topic(name, topic)
@@ -533,13 +566,16 @@ class Bridge:
                 self._refuse_owned_topic(name, topic)
                 if topic is None:
                     raise ProtocolError(f"topic {name!r} is not advertised: send advertise (with its type) first")
+                self._hold_name(session, session.advertised, name)
                 topic.publishers.add(session)
                 session.advertised.setdefault(name, spelling)
             latch = topic.latch or message.get("latch")
             subscribers = list(topic.subscribers)
         if not (subscribers or latch):  # nobody to send it to, now or later: not even encoded
             return
-        values = message["msg"]
+        values = message.get("msg")
+        if values is None:  # rosbridge_suite publishes a message of defaults (std_msgs/Empty: nothing)
+            values = {}
         text, exact = protocol.encode_decoded(values, self.non_finite)
         if latch:  # the text if it holds every number (a late CBOR subscriber reads it back): a map costs more
             with self._graph.lock:
@@ -548,6 +584,7 @@ class Bridge:
 
     def _subscribe(self, session: Session, message: Message) -> None:
         name, kind, message_id = protocol.resolve(message["topic"], "topic"), message.get("type"), message.get("id")
+        self._hold_name(session, session.queues, name)
         throttle_rate, queue_length = message.get("throttle_rate", 0), message.get("queue_length", 0)
         if throttle_rate < 0 or queue_length < 0:
             raise ProtocolError("throttle_rate and queue_length must not be negative")
@@ -613,6 +650,15 @@ class Bridge:
             service = self._graph.services.get(name)
         if service is None:
             self._calls.finish(call, False, protocol.dumps(f"service {name!r} does not exist"))
+            return
+        if isinstance(args, list):
+            args = self._named_args(service, args)
+        if not service.inline and self._calls.in_flight(session) >= self.max_calls_per_client:
+            reason = (
+                f"this client has {self.max_calls_per_client} calls waiting for answers already"
+                " (max_calls_per_client): wait for their answers before sending more"
+            )
+            self._calls.finish(call, False, protocol.dumps(reason))
         elif service.provider is not None:
             provider = service.provider
             self._calls.to_provider(call, provider, provider.provided[name], args, timeout)
@@ -625,6 +671,21 @@ class Bridge:
         else:
             assert service.handler is not None
             self._calls.to_handler(call, service.handler, args, timeout)
+
+    def _named_args(self, service: Service, args: list[Any]) -> dict[str, Any] | list[Any]:
+        """``args`` given as a list, as rosbridge_suite takes them: the request's fields in the order its
+        definition lists them (the service's type must be one ``interfaces`` defines). A list for a
+        type not defined here goes as it is to a providing client, and is refused by a server handler."""
+        fields = self.interfaces.request_fields(service.type)
+        if fields is None:
+            return args
+        if len(args) > len(fields):
+            listed = ", ".join(fields) or "none"
+            raise ProtocolError(
+                f"service {service.name!r} ({service.type}) takes {len(fields)} request fields ({listed}),"
+                f" not the {len(args)} values of args"
+            )
+        return dict(zip(fields, args, strict=False))
 
     def _service_response(self, session: Session, message: Message) -> None:
         assert self._calls is not None
@@ -641,6 +702,7 @@ class Bridge:
 
     def _advertise_service(self, session: Session, message: Message) -> None:
         name, kind = protocol.resolve(message["service"], "service"), message["type"]
+        self._hold_name(session, session.provided, name)
         if self._owned(name):
             raise ProtocolError(f"service {name!r} is in a namespace of this server; clients cannot provide it")
         for holder in self._holders:
@@ -663,9 +725,8 @@ class Bridge:
     def _unadvertise_service(self, session: Session, message: Message) -> None:
         assert self._calls is not None
         name = protocol.resolve(message["service"], "service")
-        if session.provided.pop(name, None) is None:
-            session.report("warning", f"unadvertise_service: this client does not provide {name!r}", message.get("id"))
-            return
+        if session.provided.pop(name, None) is None:  # an error, as rosbridge_suite reports it
+            raise ProtocolError(f"this client does not provide service {name!r}")
         with self._graph.lock:
             del self._graph.services[name]
         self._calls.fail_provider(session, name, "service {service!r} was unadvertised by its provider")
@@ -673,6 +734,7 @@ class Bridge:
 
     def _advertise_action(self, session: Session, message: Message) -> None:
         name, kind = protocol.resolve(message["action"], "action"), message["type"]
+        self._hold_name(session, session.provided_actions, name)
         if self._owned(name):
             raise ProtocolError(f"action {name!r} is in a namespace of this server; clients cannot provide it")
         with self._graph.lock:
@@ -710,6 +772,9 @@ class Bridge:
             self._goals.fail(goal, f"a goal with id {goal.caller_id!r} is already running; give each goal its own id")
         elif action is None:
             self._goals.fail(goal, f"action {name!r} does not exist")
+        elif self._goals.in_flight(session) >= self.max_calls_per_client:
+            reason = f"this client has {self.max_calls_per_client} goals in progress already (max_calls_per_client)"
+            self._goals.fail(goal, f"{reason}: wait for their results before sending more")
         elif action.provider is not None:
             self._goals.to_provider(goal, action.provider, action.spelling, action.type, args)
         elif not isinstance(args, dict):

@@ -11,6 +11,7 @@ import asyncio
 import contextlib
 import itertools
 import logging
+from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -77,9 +78,14 @@ class Calls:
         self._non_finite = non_finite  # how values' NaNs are written (protocol.NON_FINITE)
         self._pending: dict[str, Call] = {}
         self._keys = itertools.count(1)
+        self._per_caller: Counter[Session] = Counter()
 
     def __len__(self) -> int:
         return len(self._pending)
+
+    def in_flight(self, caller: Session) -> int:
+        """How many of ``caller``'s calls wait for an answer (a handler's or a provider's)."""
+        return self._per_caller[caller]
 
     def to_handler(self, call: Call, handler: Handler, args: dict[str, Any], timeout: float) -> None:
         """Run ``handler`` on a worker thread; its answer (or the timeout) goes to the caller."""
@@ -171,7 +177,10 @@ class Calls:
         if call.done:
             return
         call.done = True
-        self._pending.pop(call.key, None)
+        if self._pending.pop(call.key, None) is not None:
+            self._per_caller[call.caller] -= 1
+            if self._per_caller[call.caller] <= 0:
+                del self._per_caller[call.caller]
         if call.timer is not None:
             call.timer.cancel()
         text = protocol.service_response(call.spelling, result, values_json, call.caller_id)
@@ -183,6 +192,7 @@ class Calls:
 
     def _start(self, call: Call, timeout: float) -> None:
         self._pending[call.key] = call
+        self._per_caller[call.caller] += 1
         message = protocol.dumps(f"service {call.service!r} did not answer within {timeout:g} s")
         call.timer = self._loop.call_later(timeout, self.finish, call, False, message)
 

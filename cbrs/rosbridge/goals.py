@@ -17,6 +17,7 @@ import itertools
 import json
 import logging
 import threading
+from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass
 from enum import IntEnum
@@ -167,9 +168,14 @@ class Goals:
         self._pending: dict[str, Goal] = {}
         self._by_caller: dict[tuple[Session, MessageId], Goal] = {}
         self._keys = itertools.count(1)
+        self._per_caller: Counter[Session] = Counter()
 
     def __len__(self) -> int:
         return len(self._pending)
+
+    def in_flight(self, caller: Session) -> int:
+        """How many of ``caller``'s goals have not ended."""
+        return self._per_caller[caller]
 
     def new(self, caller: Session, message: protocol.Message, action: str) -> Goal:
         """A goal for a ``send_action_goal`` message (not yet started)."""
@@ -255,7 +261,10 @@ class Goals:
         if goal.done:
             return
         goal.done = True
-        self._pending.pop(goal.key, None)
+        if self._pending.pop(goal.key, None) is not None:
+            self._per_caller[goal.caller] -= 1
+            if self._per_caller[goal.caller] <= 0:
+                del self._per_caller[goal.caller]
         if goal.caller_id is not None and self._by_caller.get((goal.caller, goal.caller_id)) is goal:
             del self._by_caller[(goal.caller, goal.caller_id)]
         if not result:  # rosbridge logs its failures: an error status besides the result
@@ -264,6 +273,7 @@ class Goals:
 
     def _start(self, goal: Goal) -> None:
         self._pending[goal.key] = goal
+        self._per_caller[goal.caller] += 1
         if goal.caller_id is not None:
             self._by_caller[(goal.caller, goal.caller_id)] = goal
 

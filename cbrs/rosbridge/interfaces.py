@@ -217,6 +217,12 @@ class Interfaces:
         pair = self.services.get(_short(kind, "srv"))
         return self._nested(pair[0], set()) if pair else []
 
+    def request_fields(self, kind: str) -> tuple[str, ...] | None:
+        """The names of a service request's fields in the order its definition lists them (what a call
+        whose args are a list fills, as rosbridge_suite fills them); None for a type not defined here."""
+        pair = self.services.get(_short(kind, "srv"))
+        return None if pair is None else tuple(field.name for field in pair[0].fields)
+
     def response(self, kind: str) -> list[dict[str, Any]]:
         """rosapi's ``service_response_details``; [] for a service type not defined here."""
         pair = self.services.get(_short(kind, "srv"))

@@ -16,6 +16,21 @@ from typing import Any
 
 _MISSING: Any = object()
 
+#: Characters of JSON the store holds at most (about: each value's text and its names): parameters are
+#: small settings, and any client may set them, so a flood of them must not take the server's memory.
+MAX_BYTES = 16 << 20
+
+
+class ParamLimitError(ValueError):
+    """A parameter that would take the store past its size; keeps the name and the sizes."""
+
+    def __init__(self, name: str, size: int, limit: int) -> None:
+        super().__init__(
+            f"parameter {name!r} would bring the parameters to {size} characters of JSON, past the limit of"
+            f" {limit}: delete some first"
+        )
+        self.name, self.size, self.limit = name, size, limit
+
 
 def _parts(name: str) -> list[str]:
     return [part for part in name.split("/") if part]
@@ -24,18 +39,30 @@ def _parts(name: str) -> list[str]:
 def _copy(value: Any) -> Any:
     """A deep copy through JSON, which also refuses values JSON cannot hold (but for NaN and infinities,
     which Python's json writes and reads back as the floats)."""
+    return _copy_sized(value)[0]
+
+
+def _copy_sized(value: Any) -> tuple[Any, int]:
+    """:func:`_copy`, and the length of the value's JSON text."""
     try:
-        return json.loads(json.dumps(value))
-    except (TypeError, ValueError) as error:
+        text = json.dumps(value)
+        return json.loads(text), len(text)
+    except (TypeError, ValueError, RecursionError) as error:
         raise ValueError(f"a parameter must be JSON (numbers, strings, booleans, lists, dicts): {error}") from None
+
+
+def _size(value: Any) -> int:
+    return len(json.dumps(value))
 
 
 class ParamStore:
     """Parameters by global name; every method may be called from any thread."""
 
-    def __init__(self, initial: Mapping[str, Any] | None = None) -> None:
+    def __init__(self, initial: Mapping[str, Any] | None = None, max_bytes: int = MAX_BYTES) -> None:
         self._tree: dict[str, Any] = {}
         self._lock = threading.Lock()
+        self.max_bytes = max_bytes
+        self._bytes = 2  # about len(json.dumps(tree)): kept up to date by set and delete
         for name, value in (initial or {}).items():
             self.set(name, value)
 
@@ -54,19 +81,34 @@ class ParamStore:
     def set(self, name: str, value: Any) -> None:
         """Set a value; a dict value replaces the whole namespace, intermediate namespaces are created."""
         parts = _parts(name)
-        value = _copy(value)
+        value, size = _copy_sized(value)
         if not parts and not isinstance(value, dict):
             raise ValueError("only a dict can be set at the root '/'")
         with self._lock:
             if not parts:
-                self._tree = value
+                if size > self.max_bytes:
+                    raise ParamLimitError(name, size, self.max_bytes)
+                self._tree, self._bytes = value, size
                 return
+            node: Any = self._tree
+            replaced = 0  # the text the new value takes the place of: a value, or a value in its way
+            for part in parts:
+                if not isinstance(node, dict) or part not in node:
+                    break
+                node = node[part]
+            else:
+                replaced = _size(node)
+            names = sum(len(part) + 4 for part in parts)  # a name's quotes, colon and comma: about
+            grown = self._bytes + size + names - replaced
+            if grown > self.max_bytes and size + names > replaced:
+                raise ParamLimitError("/" + "/".join(parts), grown, self.max_bytes)
             node = self._tree
             for part in parts[:-1]:
                 if not isinstance(node.get(part), dict):
                     node[part] = {}
                 node = node[part]
             node[parts[-1]] = value
+            self._bytes = grown
 
     def delete(self, name: str) -> bool:
         """Delete a value or namespace; False if it was not set."""
@@ -74,12 +116,12 @@ class ParamStore:
         with self._lock:
             if not parts:
                 had = bool(self._tree)
-                self._tree = {}
+                self._tree, self._bytes = {}, 2
                 return had
             node = self._find(parts[:-1])
             if not isinstance(node, dict) or parts[-1] not in node:
                 return False
-            del node[parts[-1]]
+            self._bytes = max(2, self._bytes - _size(node.pop(parts[-1])) - len(parts[-1]) - 4)
             return True
 
     def has(self, name: str) -> bool:

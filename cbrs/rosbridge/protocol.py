@@ -54,7 +54,7 @@ def _req(name: str, *kinds: type) -> Field:
 OPS: dict[str, tuple[Field, ...]] = {
     "advertise": (_req("topic", str), _req("type", str), _opt("latch", bool), _opt("queue_size", int)),
     "unadvertise": (_req("topic", str),),
-    "publish": (_req("topic", str), _req("msg", dict), _opt("latch", bool)),
+    "publish": (_req("topic", str), _opt("msg", dict), _opt("latch", bool)),
     "subscribe": (
         _req("topic", str),
         _opt("type", str),
@@ -191,6 +191,28 @@ def leading_fields(text: str) -> Message:
             break
         position = match.end()
     return fields
+
+
+def several(text: str, limit: int = 1000) -> list[str] | None:
+    """The texts of the JSON objects ``text`` holds one after the other (``{...} {...}``), as rosbridge_suite
+    reads a frame that carries several messages; None unless it holds two or more objects and nothing
+    else but white space (at most ``limit``: the frame is within ``max_message_bytes`` anyway)."""
+    found: list[str] = []
+    position, end = 0, len(text)
+    while position < end and len(found) < limit:
+        while position < end and text[position] in " \t\r\n":
+            position += 1
+        if position == end:
+            break
+        if text[position] != "{":
+            return None
+        try:
+            _, stop = _SCAN(text, position)
+        except (StopIteration, ValueError, RecursionError):
+            return None
+        found.append(text[position:stop])
+        position = stop
+    return found if len(found) > 1 and position >= end else None
 
 
 def _parse(text: str) -> Any:

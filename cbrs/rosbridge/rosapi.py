@@ -39,8 +39,11 @@ def _global(name: str) -> str:
 def _decoded(text: str, what: str) -> Any:
     try:
         return json.loads(text)
+    except RecursionError:
+        raise ServiceError(f"{what} is nested too deeply to parse ({len(text)} characters)") from None
     except ValueError:
-        raise ServiceError(f"{what} must be JSON-encoded (e.g. '3', '\"text\"', '[1, 2]'), not {text!r}") from None
+        shown = text if len(text) <= 200 else f"{text[:200]}... ({len(text)} characters)"
+        raise ServiceError(f"{what} must be JSON-encoded (e.g. '3', '\"text\"', '[1, 2]'), not {shown!r}") from None
 
 
 def services(
@@ -82,7 +85,7 @@ def services(
 
     def get_param(args: dict[str, Any]) -> dict[str, Any]:
         name = _global(_text(args, "name"))
-        default = _text(args, "default", "")
+        default = _text(args, "default", "") or _text(args, "default_value", "")  # ROS 1's name, ROS 2's
         if params.has(name):
             return {"value": encoded(params.get(name)), "successful": True, "reason": ""}
         if default:

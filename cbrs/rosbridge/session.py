@@ -87,6 +87,9 @@ class Session:
         self.provided_actions: dict[str, str] = {}
         self.spelling: dict[str, str] = {}
         self.queues: dict[str, TopicQueue] = {}
+        #: the queues that may hold a message: the writer looks only at these, so a client subscribed to
+        #: many quiet topics costs each message nothing more (a queue found empty leaves)
+        self._waiting: dict[str, TopicQueue] = {}
         #: how a subscribed topic's messages go out when a subscription asked (cbrs.rosbridge.wire): per
         #: subscribe request (compression, fragment_size), and merged per topic as rosbridge merges them
         #: (CBOR if any asks, else PNG if any asks; the smallest fragment size); topics sent as plain JSON
@@ -191,6 +194,7 @@ class Session:
         if queue.requests:
             return False
         del self.queues[topic]
+        self._waiting.pop(topic, None)
         del self.spelling[topic]
         self._wire_requests.pop(topic, None)
         return True
@@ -203,6 +207,7 @@ class Session:
         before = queue.dropped
         self._seq += 1
         queue.push(self._seq, text)
+        self._waiting[topic] = queue
         if queue.dropped != before and (queue.dropped & (queue.dropped - 1)) == 0:
             log.debug("%s: dropped %d messages of %s (queue of %d)", self.name, queue.dropped, topic, queue.capacity)
         self._wake()
@@ -221,6 +226,7 @@ class Session:
             self.reassembly.clear()
         for queue in self.queues.values():
             queue.clear()
+        self._waiting.clear()
 
     # -- the writer --------------------------------------------------------------------------------
 
@@ -270,14 +276,18 @@ class Session:
         best_topic = ""
         best_seq = self._replies[0][0] if self._replies else None
         wait: float | None = None
-        for topic, queue in self.queues.items():
+        empty: list[str] = []
+        for topic, queue in self._waiting.items():
             ready = queue.ready_at()
             if ready is None:
+                empty.append(topic)
                 continue
             if ready > now:
                 wait = ready - now if wait is None else min(wait, ready - now)
             elif best_seq is None or queue.head() < best_seq:
                 best, best_seq, best_topic = queue, queue.head(), topic
+        for topic in empty:
+            del self._waiting[topic]
         if best is not None:
             text = best.pop(now)
             return (self._encoded(best_topic, text) if self.wire else text), None
