@@ -249,3 +249,55 @@ def test_a_flood_of_bad_messages_at_level_none_costs_nothing_to_read(client: Cal
         me.ws.send(f'{{"op": "dance", "id": {n}}}' if n % 2 else "{not json")
     assert me.call("/echo", {"after": "flood"})["values"] == {"after": "flood"}
     me.nothing()
+
+
+def test_a_subscriber_that_never_reads_many_topics_is_disconnected_past_the_total_bound(
+    client: Callable[[], Client], running: RunningBridge, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(session, "QUEUED_BYTES", 4 << 20)  # each queue stays within its own 16 MiB
+    publisher, other = client(), client()
+    reader = Client(running.url, small_buffers=True)
+    try:
+        topics = [f"/wide/{n}" for n in range(8)]
+        for topic in topics:
+            reader.send(op="subscribe", topic=topic)
+            publisher.send(op="advertise", topic=topic, type="std_msgs/String")
+        reader.sync()
+        publisher.sync()
+        chunk = "x" * 200_000
+        for _ in range(8):  # 64 messages of 200 kB, 12.8 MB in all, 1.6 MB per queue
+            for topic in topics:
+                publisher.send(op="publish", topic=topic, msg={"data": chunk})
+        publisher.sync()
+        with pytest.raises(ConnectionClosed):
+            for _ in range(100):  # what left before the server gave up on it, then the end
+                reader.ws.recv(timeout=WAIT)
+        assert other.call("/echo", {"fine": True})["values"] == {"fine": True}
+    finally:
+        reader.close()
+
+
+def test_the_bytes_a_session_holds_are_its_queues_and_replies() -> None:
+    aborted: list[str] = []
+
+    async def send(frame: Any) -> None:
+        return None
+
+    me = session.Session("s", send, aborted.append, backlog=5)
+    me.subscribe("/a", "/a", None, 0, 0)
+    me.subscribe("/b", "/b", "q", 1000, 2)
+    for n in range(8):
+        me.offer("/a", "a" * (n + 1))
+        me.offer("/b", "b" * 10)
+    me.reply("r" * 7)
+
+    def held() -> int:
+        return sum(queue.size for queue in me.queues.values()) + 7
+
+    assert me.pending_bytes == held() == (4 + 5 + 6 + 7 + 8) + 2 * 10 + 7
+    me.subscribe("/a", "/a", "short", 0, 1)  # a second request with a shorter queue: the longest applies
+    me.unsubscribe("/a", None, every=False)
+    assert me.pending_bytes == held() == 8 + 2 * 10 + 7
+    me.unsubscribe("/b", None, every=True)
+    assert me.pending_bytes == held() == 8 + 7
+    assert not aborted

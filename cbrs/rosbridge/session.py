@@ -32,6 +32,9 @@ log = logging.getLogger("cbrs.rosbridge")
 REPLY_BACKLOG = 10_000
 #: Bytes of replies a client may leave unread before it is disconnected.
 REPLY_BYTES = 64 << 20
+#: Bytes of topic messages, all its queues together, a client may leave unsent before it is disconnected:
+#: each queue is bounded (``max_queue_bytes``), but a client may hold a thousand of them.
+QUEUED_BYTES = 256 << 20
 #: Messages the writer hands the transport at once when several are due (with ``send_many``), so the
 #: transport can write a burst together instead of message by message. Bounded, so a burst held outside
 #: the queues (where the queues' drop-oldest rule no longer reaches it) stays small.
@@ -108,6 +111,7 @@ class Session:
         self._clock = clock
         self._replies: deque[tuple[int, str]] = deque()
         self._reply_bytes = 0
+        self._topic_bytes = 0  # the sizes of every topic queue, together
         self._seq = 0
         self._waiter: asyncio.Future[None] | None = None  # the writer waiting for something to send
 
@@ -120,7 +124,7 @@ class Session:
     @property
     def pending_bytes(self) -> int:
         """Bytes of messages waiting to be sent to this client (replies and topic queues)."""
-        return self._reply_bytes + sum(queue.size for queue in self.queues.values())
+        return self._reply_bytes + self._topic_bytes
 
     # -- what the bridge calls -------------------------------------------------------------------
 
@@ -161,7 +165,9 @@ class Session:
         queue = self.queues.get(topic)
         if queue is None:
             queue = self.queues[topic] = TopicQueue(self._backlog, self._backlog_bytes)
-        queue.add(request, throttle_rate, queue_length)
+        before = queue.size
+        queue.add(request, throttle_rate, queue_length)  # a shorter queue may drop messages
+        self._topic_bytes += queue.size - before
         self.spelling[topic] = spelling
         self._wire_requests.setdefault(topic, {})[request] = (compression, fragment_size)
         self._merge_wire(topic)
@@ -184,15 +190,18 @@ class Session:
         """Drop one subscribe request (or ``every`` one); True if the client no longer subscribes."""
         queue = self.queues[topic]
         wire = self._wire_requests.get(topic, {})
+        before = queue.size
         if every:
             queue.requests.clear()
             wire.clear()
         else:
             queue.remove(request)
             wire.pop(request, None)
+        self._topic_bytes += queue.size - before
         self._merge_wire(topic)
         if queue.requests:
             return False
+        self._topic_bytes -= queue.size
         del self.queues[topic]
         self._waiting.pop(topic, None)
         del self.spelling[topic]
@@ -204,10 +213,16 @@ class Session:
         queue = self.queues.get(topic)
         if queue is None or self.closed:
             return
-        before = queue.dropped
+        before, size = queue.dropped, queue.size
         self._seq += 1
         queue.push(self._seq, text)
         self._waiting[topic] = queue
+        self._topic_bytes += queue.size - size
+        if self._topic_bytes > QUEUED_BYTES:
+            self.closed = True
+            self._abort(f"{self._topic_bytes} bytes of topic messages unsent in {len(self._waiting)} queues")
+            self.drop()
+            return
         if queue.dropped != before and (queue.dropped & (queue.dropped - 1)) == 0:
             log.debug("%s: dropped %d messages of %s (queue of %d)", self.name, queue.dropped, topic, queue.capacity)
         self._wake()
@@ -227,6 +242,7 @@ class Session:
         for queue in self.queues.values():
             queue.clear()
         self._waiting.clear()
+        self._topic_bytes = 0
 
     # -- the writer --------------------------------------------------------------------------------
 
@@ -290,6 +306,7 @@ class Session:
             del self._waiting[topic]
         if best is not None:
             text = best.pop(now)
+            self._topic_bytes -= len(text)
             return (self._encoded(best_topic, text) if self.wire else text), None
         if best_seq is not None:
             text = self._replies.popleft()[1]
