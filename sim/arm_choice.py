@@ -514,17 +514,25 @@ def _loading_by(
         else f"passing the {model.name} to the {loader.value} arm"
     )
 
+    near = ""  # why the first spot whose holds serve does not keep CARRY_CLEARANCE from the appliances
+
     def holds(spot: Region, given_by: ObjectModel, taken_by: ObjectModel) -> str:
         # Both holds' moves are dry-run before the first moves: the giver's from where the object is to the
         # spot, the loader's from the spot to the platform (from its posture now; a re-grasping arm will
         # have folded home, where it starts a task); and where either comes within CARRY_CLEARANCE of an
-        # appliance, which relay_spot passes the spot over for.
+        # appliance, which relay_spot passes the spot over for, taking the first such spot only when none
+        # keeps clear: after it, a giver's carry that comes near leaves the loader's moves unasked.
+        nonlocal near
         why, brushed = carry_check(ctx, giver, spot, (estimate, given_by))
         refuse_moves(why, given_by, giver, setting_down, spot)
+        if brushed and near:
+            return brushed
         there = resting_at(spot, model, estimate, world.time)
         why, loading_brushed = _keeping_clear(ctx, loader, lambda: _loads(ctx, there, base, loader, taken_by))
         refuse_moves(why, taken_by, loader, purpose, platform)
-        return brushed or (loading_brushed and f"the {loader.value} arm loading the {model.name}: {loading_brushed}")
+        here = brushed or (loading_brushed and f"the {loader.value} arm loading the {model.name}: {loading_brushed}")
+        near = near or here
+        return here
 
     try:
         spot, given_by, taken_by = relay_spot(ctx, estimate, giving, loading, giver, loader, holds)

@@ -41,7 +41,7 @@ RELAY_TRIES = 40
 milliseconds) before passing is given up."""
 
 
-CLEAR_TRIES = 6
+CLEAR_TRIES = 8
 """How many spots whose holds' moves serve but come within CARRY_CLEARANCE of an appliance (a tap's
 lever) a pass, or an arm's choice of where it takes an object, passes over for the next before it takes
 the first of them, as before the clearance was asked: each is a dry run of a take and a carry (50-100 ms)."""
