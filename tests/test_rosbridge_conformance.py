@@ -212,3 +212,41 @@ def test_status_levels_filter_as_rosbridge_does(client: Callable[[], Client]) ->
     me.send(op="publish", topic="/never", msg={}, id="quiet")  # an error, but the client wants none
     me.nothing()
     assert me.call("/rosapi/get_time")["result"] is True  # answers are not statuses: they still come
+
+
+#: The services rosbridge_suite's ROS 2 rosapi node offers (rosapi/scripts/rosapi_node, ros2 c1bfc2f).
+ROS2_ROSAPI = [
+    "topics",
+    "topics_for_type",
+    "topics_and_raw_types",
+    "services",
+    "services_for_type",
+    "nodes",
+    "node_details",
+    "action_servers",
+    "topic_type",
+    "service_type",
+    "publishers",
+    "subscribers",
+    "service_providers",
+    "service_node",
+    "message_details",
+    "service_request_details",
+    "service_response_details",
+    "set_param",
+    "get_param",
+    "has_param",
+    "delete_param",
+    "get_param_names",
+    "get_time",
+    "get_ros_version",
+]
+
+
+def test_every_service_of_ros_2s_rosapi_answers(client: Callable[[], Client]) -> None:
+    me = client()
+    listed = set(me.call("/rosapi/services")["values"]["services"])
+    assert {f"/rosapi/{name}" for name in ROS2_ROSAPI} <= listed
+    assert me.call("/rosapi/get_ros_version")["values"] == {"version": 2, "distro": ""}
+    described = me.call("/rosapi/service_response_details", {"type": "rosapi/GetROSVersion"})["values"]
+    assert described["typedefs"][0]["fieldnames"] == ["version", "distro"]

@@ -19,6 +19,9 @@ from cbrs.rosbridge.interfaces import Interfaces
 from cbrs.rosbridge.params import ParamStore
 from cbrs.rosbridge.protocol import finite, json_type
 
+#: What ``/rosapi/get_ros_version`` answers: the bridge speaks rosbridge_suite's ROS 2 protocol.
+ROS_VERSION = 2
+
 #: The node names rosapi reports: the bridge and rosapi itself.
 NODES = ["/cbrs_rosbridge", "/rosapi"]
 
@@ -119,6 +122,11 @@ def services(
         # ROS 1 clients (roslibpy) read secs/nsecs, ROS 2 ones sec/nanosec
         return {"time": {"secs": secs, "nsecs": nsecs, "sec": secs, "nanosec": nsecs}}
 
+    def get_ros_version(_: dict[str, Any]) -> dict[str, Any]:
+        # ROS 2's rosapi: the ops are rosbridge_suite's ros2 branch's (actions included); no ROS
+        # distribution is installed, so there is none to name
+        return {"version": ROS_VERSION, "distro": ""}
+
     # As in ROS, where rosbridge publishes and subscribes on its clients' behalf, the bridge is the node
     # at the end of every topic a client or the server uses: clients have no node names of their own.
     def published() -> list[str]:
@@ -195,4 +203,5 @@ def services(
         "/rosapi/get_param_names": ("rosapi/GetParamNames", get_param_names),
         "/rosapi/search_param": ("rosapi/SearchParam", search_param),
         "/rosapi/get_time": ("rosapi/GetTime", get_time),
+        "/rosapi/get_ros_version": ("rosapi/GetROSVersion", get_ros_version),
     }
