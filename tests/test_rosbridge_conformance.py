@@ -250,3 +250,17 @@ def test_every_service_of_ros_2s_rosapi_answers(client: Callable[[], Client]) ->
     assert me.call("/rosapi/get_ros_version")["values"] == {"version": 2, "distro": ""}
     described = me.call("/rosapi/service_response_details", {"type": "rosapi/GetROSVersion"})["values"]
     assert described["typedefs"][0]["fieldnames"] == ["version", "distro"]
+
+
+def test_ros_1_and_ros_2_spellings_of_a_type_are_the_same_type(client: Callable[[], Client]) -> None:
+    ros1, ros2 = client(), client()
+    ros2.send(op="subscribe", topic="/mixed", type="std_msgs/msg/String", id="s")
+    ros2.sync()
+    ros1.send(op="advertise", topic="/mixed", type="std_msgs/String", id="a")
+    ros1.send(op="publish", topic="/mixed", msg={"data": "both"})
+    assert ros2.expect("publish")["msg"] == {"data": "both"}
+    ros1.nothing()  # no type conflict
+    for spelling in ("std_msgs/String", "std_msgs/msg/String"):
+        assert "/mixed" in ros1.call("/rosapi/topics_for_type", {"type": spelling})["values"]["topics"]
+    ros1.send(op="subscribe", topic="/mixed", type="std_msgs/msg/Int32", id="other")
+    assert "has type 'std_msgs/" in ros1.expect("status")["msg"]

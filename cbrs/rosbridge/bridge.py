@@ -231,7 +231,7 @@ class Bridge:
             topic = self._graph.topics.get(name)
             if topic is None:
                 topic = self._graph.topics[name] = Topic(name, type)
-            elif topic.type and topic.type != type:
+            elif topic.type and not protocol.same_type(topic.type, type):
                 raise RosbridgeError(f"topic {name!r} already has type {topic.type!r}, not {type!r}")
             topic.type, topic.server, topic.latch = type, True, topic.latch or latch
 
@@ -537,7 +537,7 @@ class Bridge:
             self._refuse_owned_topic(name, topic)
             if topic is None:
                 topic = self._graph.topics[name] = Topic(name, kind)
-            elif topic.type and topic.type != kind:
+            elif topic.type and not protocol.same_type(topic.type, kind):
                 raise ProtocolError(f"topic {name!r} already has type {topic.type!r}, not {kind!r}")
             topic.type = kind
             topic.latch = topic.latch or bool(message.get("latch"))
@@ -609,7 +609,7 @@ class Bridge:
             topic = self._graph.topics.get(name)
             if topic is None:
                 topic = self._graph.topics[name] = Topic(name, kind or "")
-            elif kind and topic.type and topic.type != kind:
+            elif kind and topic.type and not protocol.same_type(topic.type, kind):
                 raise ProtocolError(f"topic {name!r} has type {topic.type!r}, not {kind!r}")
             topic.type = topic.type or kind or ""
             topic.subscribers.add(session)

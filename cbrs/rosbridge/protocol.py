@@ -268,6 +268,18 @@ def resolve(name: str, what: str = "name") -> str:
     return name if name.startswith("/") else "/" + name
 
 
+def same_type(one: str, other: str) -> bool:
+    """Whether two type names name the same type: ROS 2's ``std_msgs/msg/String`` is ROS 1's
+    ``std_msgs/String`` (and ``pkg/srv/Name``, ``pkg/action/Name`` likewise), as rosbridge_suite's ROS 2
+    loader reads either, so a roslibpy publisher and a ROS 2 roslibjs subscriber can share a topic."""
+    return one == other or _short_type(one) == _short_type(other)
+
+
+def _short_type(kind: str) -> str:
+    parts = kind.split("/")
+    return f"{parts[0]}/{parts[2]}" if len(parts) == 3 and parts[1] in ("msg", "srv", "action") else kind
+
+
 def loads(text: str) -> Any:
     """Values back from JSON text this server wrote (a message's ``msg``, to send it again as CBOR)."""
     return _parse(text)

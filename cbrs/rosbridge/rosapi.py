@@ -17,7 +17,7 @@ from cbrs.rosbridge.errors import ServiceError
 from cbrs.rosbridge.graph import Graph, Handler
 from cbrs.rosbridge.interfaces import Interfaces
 from cbrs.rosbridge.params import ParamStore
-from cbrs.rosbridge.protocol import finite, json_type
+from cbrs.rosbridge.protocol import finite, json_type, same_type
 
 #: What ``/rosapi/get_ros_version`` answers: the bridge speaks rosbridge_suite's ROS 2 protocol.
 ROS_VERSION = 2
@@ -66,7 +66,7 @@ def services(
 
     def topics_for_type(args: dict[str, Any]) -> dict[str, Any]:
         wanted = _text(args, "type")
-        return {"topics": [name for name, kind in graph.topic_list() if kind == wanted]}
+        return {"topics": [name for name, kind in graph.topic_list() if same_type(kind, wanted)]}
 
     def topic_type(args: dict[str, Any]) -> dict[str, Any]:
         name = _global(_text(args, "topic"))
@@ -81,7 +81,7 @@ def services(
 
     def services_for_type(args: dict[str, Any]) -> dict[str, Any]:
         wanted = _text(args, "type")
-        return {"services": [name for name, kind in graph.service_list() if kind == wanted]}
+        return {"services": [name for name, kind in graph.service_list() if same_type(kind, wanted)]}
 
     def nodes(_: dict[str, Any]) -> dict[str, Any]:
         return {"nodes": list(NODES)}
@@ -156,7 +156,7 @@ def services(
 
     def service_providers(args: dict[str, Any]) -> dict[str, Any]:
         wanted = _text(args, "service")
-        return {"providers": [NODES[0]] if any(kind == wanted for _, kind in graph.service_list()) else []}
+        return {"providers": [NODES[0]] if any(same_type(kind, wanted) for _, kind in graph.service_list()) else []}
 
     def topics_and_raw_types(_: dict[str, Any]) -> dict[str, Any]:
         listed = graph.topic_list()
