@@ -92,12 +92,17 @@ def location(store_location: str, old_store: Path, tmp_path: Path) -> str:
     return store_location
 
 
+@pytest.fixture(scope="module")
+def seeded(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    folder = tmp_path_factory.mktemp("seeded") / "store"
+    KnowledgeBase.open(str(folder)).close()
+    return folder
+
+
 @pytest.fixture
-def current(tmp_path: Path) -> str:
-    """A current embedded store, closed."""
-    location = str(tmp_path / "current")
-    KnowledgeBase.open(location).close()
-    return location
+def current(seeded: Path, tmp_path: Path) -> str:
+    """A current embedded store, closed (a copy of one seeded once)."""
+    return str(shutil.copytree(seeded, tmp_path / "current"))
 
 
 @pytest.mark.both_stores
