@@ -239,6 +239,8 @@ class BridgeClient:
         try:
             if handler is None:
                 raise LookupError(f"this client does not provide {service}")
+            if isinstance(args, list) and args:  # rosbridge's positional form: no field names to give them
+                raise TypeError(f"{service} takes its args as an object of named fields, not the list {args!r:.80}")
             values = _response(service, handler(args if isinstance(args, dict) else {}))
             reply |= {"result": True, "values": values}
         except Exception as error:  # the handler's failure is the call's answer, not this client's crash

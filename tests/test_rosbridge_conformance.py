@@ -14,6 +14,7 @@ from typing import Any
 
 import pytest
 
+from cbrs.bridge_client import BridgeClient
 from cbrs.rosbridge import Bridge, GoalHandle, RunningBridge
 from tests.test_rosbridge import WAIT, Client
 
@@ -264,3 +265,15 @@ def test_ros_1_and_ros_2_spellings_of_a_type_are_the_same_type(client: Callable[
         assert "/mixed" in ros1.call("/rosapi/topics_for_type", {"type": spelling})["values"]["topics"]
     ros1.send(op="subscribe", topic="/mixed", type="std_msgs/msg/Int32", id="other")
     assert "has type 'std_msgs/" in ros1.expect("status")["msg"]
+
+
+def test_the_python_client_answers_a_positional_call_with_the_reason(
+    running: RunningBridge, client: Callable[[], Client]
+) -> None:
+    with BridgeClient(running.url, timeout=WAIT) as provider:
+        provider.advertise("/py/echo", "py/Echo", lambda args: dict(args))
+        caller = client()
+        assert caller.call("/py/echo", {"a": 1})["values"] == {"a": 1}
+        answer = caller.call("/py/echo", [1, 2])
+        assert answer["result"] is False
+        assert "/py/echo takes its args as an object of named fields, not the list [1, 2]" in answer["values"]
