@@ -19,7 +19,10 @@
    step, or the plan is refused naming it (``ComposeConfig.protect``).
 
 When the requirement alone cannot be composed and its action class has KnowRob-style sub-actions,
-each sub-action is composed in their partial order and the plans are concatenated ("decomposed").
+each sub-action is composed in their partial order and the plans are concatenated ("decomposed"). A
+plan joined from parts (these, or a requirement's goals planned one by one) is checked by progression as
+it will run: a statement one part takes from the world that an earlier part deletes is achieved again
+by composing that part once more without it, or the plan is refused naming it.
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ import re
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from enum import Enum
+from functools import partial
 from typing import TYPE_CHECKING, Any
 
 import pyoxigraph as ox
@@ -35,6 +39,7 @@ import pyoxigraph as ox
 from cbrs.actions.areas import AreaRule, Leads, WorldPlaces
 from cbrs.actions.extraction import Extraction, Objective
 from cbrs.actions.graph import (
+    SRE,
     SRI,
     Matcher,
     ServicePool,
@@ -44,6 +49,7 @@ from cbrs.actions.graph import (
 )
 from cbrs.actions.model import ActionLibrary, Task, resolve_task
 from cbrs.actions.plan import Binding, Plan, PlanStep, Source
+from cbrs.actions.progression import Clobbered, progress_parts
 from cbrs.actions.search import SearchTrace, bidirectional_search
 from cbrs.actions.unmet import Unsatisfied
 from cbrs.kb import Advertisement, KnowledgeBase, Requirement, Statement
@@ -82,10 +88,11 @@ class ComposeConfig:
     # cbrs:areaRole marks (home.ttl marks home:InformationEntity, home:SpatialData, home:Feature); lists override
     area_informs: tuple[str, ...] | None = None
     area_leads: tuple[str, ...] | None = None
-    # check each extracted plan by progression over its add and delete effects: a statement a step needs
-    # (or a goal) that an earlier step deletes is achieved again after it, or the plan is refused naming it
+    # check each extracted plan, and each plan joined from parts, by progression over its add and delete
+    # effects: a statement a step needs (or a goal) that an earlier step deletes is achieved again after
+    # it, or the plan is refused naming it
     protect: bool = True
-    max_reachieved: int = 8  # statements achieved again per extraction before the plan is refused
+    max_reachieved: int = 8  # statements achieved again per extraction, and per joined plan, before refusing
 
 
 class PlanStatus(Enum):
@@ -139,6 +146,21 @@ class CompositionResult:
         return found
 
 
+Composed = tuple[Plan | None, tuple[Unsatisfied, ...], list[Attempt]]
+"""A part's plan (None: none), why not, and the attempts made for it."""
+
+
+@dataclass
+class _Part:
+    """One part of a joined plan: a sub-action or a goal, composed again without the statements an
+    earlier part undoes (``undone``: those facts of the world and of its requirement are left out)."""
+
+    label: str  # "sub-action act:X" or "goal 2 (...)", as reasons name it
+    compose: Callable[[frozenset[Statement]], Composed]
+    plan: Plan
+    undone: frozenset[Statement] = frozenset()
+
+
 class Composer:
     """Plans tasks over the advertisements in a knowledge base."""
 
@@ -184,9 +206,25 @@ class Composer:
     def task(self, name: str) -> Task:
         return resolve_task(self.kb, self.actions, name, self.requirements)
 
-    def graph(self, requirement: Requirement) -> ServiceResourceGraph:
-        holding = self.world_state() if self.config.world_state else ()
-        return ServiceResourceGraph(requirement, self.pool, holding)
+    def graph(self, requirement: Requirement, undone: frozenset[Statement] = frozenset()) -> ServiceResourceGraph:
+        """The SRG for ``requirement``, from what holds but for the facts that meet a statement of ``undone``
+        (an earlier part of the plan deleted them: see :meth:`_joined`)."""
+        holding = self._holding(undone) if self.config.world_state else []
+        return ServiceResourceGraph(self._without(requirement, undone), self.pool, holding)
+
+    def _holding(self, undone: frozenset[Statement] = frozenset()) -> list[Statement]:
+        """What holds (:meth:`world_state`), but for the facts that meet a statement of ``undone``."""
+        return [fact for fact in self.world_state() if not self._meets(fact, undone)]
+
+    def _without(self, requirement: Requirement, undone: frozenset[Statement]) -> Requirement:
+        """``requirement`` without the preconditions that meet a statement of ``undone``."""
+        if not undone:
+            return requirement
+        kept = tuple(p for p in requirement.preconditions if not self._meets(p, undone))
+        return requirement if kept == requirement.preconditions else replace(requirement, preconditions=kept)
+
+    def _meets(self, fact: Statement, undone: frozenset[Statement]) -> bool:
+        return any(self.matcher.statement(needed, fact) is not None for needed in undone)
 
     def world_state(self) -> list[Statement]:
         """What holds, as statements between classes: in the semantic map, and in the belief state when
@@ -381,8 +419,12 @@ class Composer:
         stated = {r.for_task for r in self.requirements()}
         return all(sub in stated for sub in task.action.sub_actions)
 
-    def attempt(self, requirement: Requirement, task: Task | None = None) -> Attempt:
-        graph = self.graph(requirement)
+    def attempt(
+        self, requirement: Requirement, task: Task | None = None, undone: frozenset[Statement] = frozenset()
+    ) -> Attempt:
+        """Compose ``requirement`` in one extraction; ``undone``: statements that do not hold when it starts,
+        although the world or the requirement says so (an earlier part of the plan deleted them)."""
+        graph = self.graph(requirement, undone)
         trace = bidirectional_search(graph)
         areas = self.area_rule(requirement)
         config = self.config
@@ -437,26 +479,23 @@ class Composer:
             return []
         return [(o.constraint, o.before, o.after) for o in self.actions.orderings_for(task.action.iri)]
 
-    def _decomposed(self, task: Task, direct: Attempt, depth: int = 0) -> CompositionResult:
-        """Compose each sub-action on its own, in order, and concatenate the plans. A sub-action that
-        is a task with sub-actions of its own is decomposed in turn (two-level tasks), at most
-        ``MAX_DEPTH`` levels down."""
+    def _decomposed(
+        self, task: Task, direct: Attempt, depth: int = 0, undone: frozenset[Statement] = frozenset()
+    ) -> CompositionResult:
+        """Compose each sub-action on its own, in order, and join the plans (:meth:`_joined`). A sub-action
+        that is a task with sub-actions of its own is decomposed in turn (two-level tasks), at most
+        ``MAX_DEPTH`` levels down; ``undone``: statements an earlier part of an enclosing plan deleted."""
         assert task.action is not None
         attempts = [direct]
-        plans: list[Plan] = []
-        holding = self.world_state() if self.config.world_state else []
+        parts: list[_Part] = []
+        holding = self._holding(undone) if self.config.world_state else []
         for sub in task.action.ordered_sub_actions():
             sub_task = resolve_task(self.kb, self.actions, sub, self.requirements)
             if self._achieved(sub_task.requirement, holding):
                 continue  # its effects hold already (a re-plan keeps what the last plan achieved)
-            attempt = self.attempt(sub_task.requirement, sub_task)
-            attempts.append(attempt)
-            plan = attempt.plan
-            unsatisfied = attempt.unsatisfied
-            if plan is None and depth < MAX_DEPTH and self._decomposable(sub_task):
-                nested = self._decomposed(sub_task, attempt, depth + 1)
-                attempts += nested.attempts[1:]
-                plan, unsatisfied = nested.plan, nested.unsatisfied or unsatisfied
+            compose = partial(self._sub_action, sub_task, depth)
+            plan, unsatisfied, tried = compose(undone)
+            attempts += tried
             if plan is None:
                 unsatisfied = direct.unsatisfied + tuple(
                     replace(
@@ -468,21 +507,32 @@ class Composer:
                     for u in unsatisfied
                 )
                 return self._result(task, None, unsatisfied, tuple(attempts))
-            plans.append(plan)
-        if not plans:  # every part is achieved: nothing to do but check
+            parts.append(_Part(f"sub-action {shorten(sub)}", compose, plan, undone))
+        if not parts:  # every part is achieved: nothing to do but check
             return self._result(task, _achieved_plan(task), (), tuple(attempts))
-        return self._result(task, _concatenate(task, plans), (), tuple(attempts))
+        return self._joined(task, parts, attempts, holding)
+
+    def _sub_action(self, sub_task: Task, depth: int, undone: frozenset[Statement]) -> Composed:
+        """One sub-action's plan: directly, else decomposed in turn."""
+        attempt = self.attempt(sub_task.requirement, sub_task, undone)
+        tried = [attempt]
+        plan, unsatisfied = attempt.plan, attempt.unsatisfied
+        if plan is None and depth < MAX_DEPTH and self._decomposable(sub_task):
+            nested = self._decomposed(sub_task, attempt, depth + 1, undone)
+            tried += nested.attempts[1:]
+            plan, unsatisfied = nested.plan, nested.unsatisfied or unsatisfied
+        return plan, unsatisfied, tried
 
     def _per_goal(self, task: Task, direct: Attempt) -> CompositionResult:
-        """Plan each goal on its own, in the requirement's order, and concatenate the plans: the direct
-        plan credited one step's effect with goals about different things (the cup on the tray and the
-        remote on its spot, both to one put-down), and one step moves one thing. Each goal's part takes
+        """Plan each goal on its own, in the requirement's order, and join the plans (:meth:`_joined`): the
+        direct plan credited one step's effect with goals about different things (the cup on the tray and
+        the remote on its spot, both to one put-down), and one step moves one thing. Each goal's part takes
         the inputs of its own things (a class at or below the goal's subject or object) and those of no
         goal's (the robot's), so the cup's part fetches the cup; a goal that holds already is skipped."""
         requirement = task.requirement
         goals = requirement.effects
         attempts = [direct]
-        plans: list[Plan] = []
+        parts: list[_Part] = []
         holding = self._state if self._state is not None else []
         for n, goal in enumerate(goals, start=1):
             others = [g for g in goals if g != goal]
@@ -494,19 +544,62 @@ class Composer:
             part = replace(requirement, inputs=inputs, outputs=(), effects=(goal,))
             if self._achieved(part, holding):
                 continue
-            sub_task = Task(f"{task.name}/goal{n}", part, None)
-            attempt = self.attempt(part, sub_task)
-            attempts.append(attempt)
-            if attempt.plan is None:
+            compose = partial(self._goal_part, Task(f"{task.name}/goal{n}", part, None))
+            plan, unsatisfied, tried = compose(frozenset())
+            attempts += tried
+            if plan is None:
                 unsatisfied = tuple(
                     replace(u, chain=(f"goal {n} {statement_text(goal)}", *u.chain[1:]), undeclared=(), near=())
-                    for u in attempt.unsatisfied
+                    for u in unsatisfied
                 )
                 return self._result(task, None, unsatisfied, tuple(attempts))
-            plans.append(attempt.plan)
-        if not plans:
+            parts.append(_Part(f"goal {n} {statement_text(goal)}", compose, plan))
+        if not parts:
             return self._result(task, _achieved_plan(task), (), tuple(attempts))
-        return self._result(task, _concatenate(task, plans), (), tuple(attempts))
+        return self._joined(task, parts, attempts, holding)
+
+    def _goal_part(self, sub_task: Task, undone: frozenset[Statement]) -> Composed:
+        attempt = self.attempt(sub_task.requirement, sub_task, undone)
+        return attempt.plan, attempt.unsatisfied, [attempt]
+
+    def _joined(
+        self, task: Task, parts: list[_Part], attempts: list[Attempt], holding: Sequence[Statement]
+    ) -> CompositionResult:
+        """The parts' plans concatenated, checked by progression as they will run, part after part from
+        ``holding`` and the task's preconditions (``ComposeConfig.protect``). Each part was checked on its
+        own, from what holds when the whole plan starts; a statement a later part took from the world (or
+        from its requirement) that an earlier part deletes is achieved again by composing that part once
+        more without it, so a step of its own provides it, at most ``max_reachieved`` times; else the plan
+        is refused naming the statement, the step that needs it and the step that deletes it."""
+        initial = [*task.requirement.preconditions, *holding]
+        achieved_again = 0
+        while True:
+            plan = _concatenate(task, [part.plan for part in parts])
+            undone = self._undone_between(parts, initial) if self.config.protect else None
+            if undone is None:
+                return self._result(task, plan, (), tuple(attempts))
+            part = parts[undone.part]
+            exhausted = achieved_again >= self.config.max_reachieved
+            again: Plan | None = None
+            if not exhausted:
+                again, _, tried = part.compose(part.undone | {undone.statement})
+                attempts += tried
+            if again is None or again == part.plan:
+                refusal = _deleted_between(plan, part, undone, exhausted)
+                return self._result(task, None, (refusal,), tuple(attempts))
+            part.plan, part.undone = again, part.undone | {undone.statement}
+            achieved_again += 1
+
+    def _undone_between(self, parts: Sequence[_Part], initial: Sequence[Statement]) -> Clobbered | None:
+        """The first statement a part needs that an earlier part deleted, in the joined plan's numbering.
+        A statement undone within one part is that part's extraction's to achieve again."""
+        ends: list[int] = []  # the joined plan's index of each part's last step
+        for part in parts:
+            ends.append((ends[-1] if ends else 0) + len(part.plan.steps))
+        for found in progress_parts([part.plan for part in parts], initial, self.matcher):
+            if found.deleter is not None and next(n for n, end in enumerate(ends) if found.deleter <= end) < found.part:
+                return found
+        return None
 
     def _about(self, concept: str | None, goal: Statement) -> bool:
         """Whether an input of class ``concept`` names a thing of ``goal``: at or below its subject or object."""
@@ -595,6 +688,19 @@ def _achieved_plan(task: Task) -> Plan:
         for n, effect in enumerate(requirement.effects, start=1)
     )
     return Plan(task.name, requirement.iri, "achieved", (), goals, 1.0, 0.0)
+
+
+def _deleted_between(plan: Plan, part: _Part, undone: Clobbered, exhausted: bool) -> Unsatisfied:
+    """The reason a joined ``plan`` is refused: ``undone``, a statement ``part`` needs, deleted by a step of
+    an earlier part, that composing the part again without it could not provide (``exhausted``: each
+    part composed again undid another statement, ``max_reachieved`` times)."""
+    assert undone.deleter is not None
+    need = f"precondition {statement_text(undone.statement)}"
+    if undone.consumer is None:  # a goal of the part, needed when the part ends
+        return Unsatisfied(need, SRE, (part.label,), exhausted, deleted_by=(plan.step(undone.deleter).component,))
+    consumer = plan.step(undone.consumer).component
+    chain = (part.label, shorten(consumer))
+    return Unsatisfied(need, consumer, chain, exhausted, deleted_by=(plan.step(undone.deleter).component,))
 
 
 def _concatenate(task: Task, plans: list[Plan]) -> Plan:

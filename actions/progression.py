@@ -9,7 +9,10 @@ as in STRIPS, so a step that deletes and adds the same statement leaves it true.
 
 Composition checks each plan it extracts this way (``actions.extraction``): a statement that held at the
 start, or that a step made, and that a later step deletes before it is needed, is achieved again or the
-plan is refused naming it (docs/composition.md, "A statement a later step undoes").
+plan is refused naming it (docs/composition.md, "A statement a later step undoes"). A plan joined from
+parts (a decomposed task's sub-actions, a requirement's goals one by one) is checked as it will run, part
+after part from the state the previous one left, each part's goals when that part ends
+(:func:`progress_parts`; ``actions.composer``).
 """
 
 from __future__ import annotations
@@ -31,6 +34,7 @@ class Clobbered:
     statement: Statement
     consumer: int | None
     deleter: int | None
+    part: int = 0  # the part of a joined plan that needs it, counted from 0 (progress_parts)
 
     def text(self, plan: Plan) -> str:
         need = f"goal {statement_text(self.statement)}"
@@ -58,21 +62,33 @@ def progress(plan: Plan, initial: Iterable[Statement], matcher: Matcher) -> list
     """Every precondition and goal of ``plan`` that does not hold when it is needed, in plan order, with
     the step that deleted it; ``initial``: what holds when the plan starts (the requirement's
     preconditions and the world state composition offered)."""
+    return progress_parts((plan,), initial, matcher)
+
+
+def progress_parts(parts: Sequence[Plan], initial: Iterable[Statement], matcher: Matcher) -> list[Clobbered]:
+    """:func:`progress` over the plans of ``parts`` run one after the other, as the plan joined from them
+    (``actions.composer``): steps numbered as in the joined plan, each part's goals needed when that part
+    ends (a sub-action's goal, such as being near the table, is for the sub-actions after it, not for the
+    end of the whole task), each found statement with the part that needs it."""
     state: list[Statement] = list(dict.fromkeys(initial))
     deleted_by: dict[Statement, int] = {}  # fact -> the step that deleted it last
     found: list[Clobbered] = []
-    for step in plan.steps:
-        for binding in step.preconditions:
-            if binding.statement is not None and not _holds(binding.statement, state, matcher):
-                found.append(_clobbered(binding.statement, step.index, deleted_by, matcher))
-        removed = [f for f in state if any(threatens(matcher.index, d, f) for d in step.deletes)]
-        for fact in removed:
-            deleted_by[fact] = step.index
-        state = [f for f in state if f not in removed]
-        state += [e for e in step.effects if e not in state]
-    for goal in plan.goals:
-        if goal.statement is not None and not _holds(goal.statement, state, matcher):
-            found.append(_clobbered(goal.statement, None, deleted_by, matcher))
+    offset = 0
+    for part, plan in enumerate(parts):
+        for step in plan.steps:
+            index = step.index + offset
+            for binding in step.preconditions:
+                if binding.statement is not None and not _holds(binding.statement, state, matcher):
+                    found.append(_clobbered(binding.statement, index, deleted_by, matcher, part))
+            removed = [f for f in state if any(threatens(matcher.index, d, f) for d in step.deletes)]
+            for fact in removed:
+                deleted_by[fact] = index
+            state = [f for f in state if f not in removed]
+            state += [e for e in step.effects if e not in state]
+        for goal in plan.goals:
+            if goal.statement is not None and not _holds(goal.statement, state, matcher):
+                found.append(_clobbered(goal.statement, None, deleted_by, matcher, part))
+        offset += len(plan.steps)
     return found
 
 
@@ -81,11 +97,11 @@ def _holds(needed: Statement, state: Sequence[Statement], matcher: Matcher) -> b
 
 
 def _clobbered(
-    needed: Statement, consumer: int | None, deleted_by: dict[Statement, int], matcher: Matcher
+    needed: Statement, consumer: int | None, deleted_by: dict[Statement, int], matcher: Matcher, part: int
 ) -> Clobbered:
     """The latest step that deleted a fact which would have met ``needed``."""
     deleters = [step for fact, step in deleted_by.items() if matcher.statement(needed, fact) is not None]
-    return Clobbered(needed, consumer, max(deleters) if deleters else None)
+    return Clobbered(needed, consumer, max(deleters) if deleters else None, part)
 
 
-__all__ = ["Clobbered", "progress", "threatens"]
+__all__ = ["Clobbered", "progress", "progress_parts", "threatens"]
