@@ -88,14 +88,14 @@ class Unsatisfied:
         if self.deleted_by and self.cycle:
             return (
                 "ask for the statements that undo each other in separate tasks, or allow more of them to be "
-                "achieved again (ComposeConfig.max_reachieved from Python)"
+                "achieved again (cbrs plan or cbrs run --max-reachieved N; ComposeConfig.max_reachieved from Python)"
             )
         if self.deleted_by:
             statement = self.need.split(" ", 1)[-1]
             return (
                 f"register a component whose effect is {statement} and that can run after "
                 f"{', '.join(shorten(c) for c in self.deleted_by)}, or compose without protecting what steps "
-                "need (ComposeConfig(protect=False) from Python)"
+                "need (cbrs plan or cbrs run --no-protect; ComposeConfig(protect=False) from Python)"
             )
         if self.out_of_area:
             return (

@@ -44,6 +44,33 @@ _IGNORE_AREAS = click.option(  # cbrs plan and cbrs run alike
         " task's things are (ComposeConfig.respect_area off)."
     ),
 )
+_PROTECT = click.option(  # cbrs plan and cbrs run alike
+    "--protect/--no-protect",
+    default=ComposeConfig().protect,
+    show_default=True,
+    help=(
+        "Check the plan by progression over its steps' add and delete effects, its parts as they will run one"
+        " after the other, and achieve again a statement a step needs that an earlier step deleted, or refuse"
+        " the plan naming it; --no-protect: the plan as extracted, left to the run's checks and re-plan"
+        " (ComposeConfig.protect)."
+    ),
+)
+_MAX_REACHIEVED = click.option(
+    "--max-reachieved",
+    type=click.IntRange(min=0),
+    default=ComposeConfig().max_reachieved,
+    show_default=True,
+    metavar="N",
+    help=(
+        "With --protect, how many statements may be achieved again, per extraction and per plan joined from"
+        " parts, before the plan is refused (ComposeConfig.max_reachieved)."
+    ),
+)
+
+
+def _compose_config(ignore_areas: bool, protect: bool, max_reachieved: int, **more: Any) -> ComposeConfig:
+    """What the composition options of ``cbrs plan`` and ``cbrs run`` ask for."""
+    return ComposeConfig(respect_area=not ignore_areas, protect=protect, max_reachieved=max_reachieved, **more)
 
 
 @click.command()
@@ -64,9 +91,19 @@ _IGNORE_AREAS = click.option(  # cbrs plan and cbrs run alike
 )
 @click.option("--no-store", is_flag=True, help="Do not record the plan in the plans graph.")
 @_IGNORE_AREAS
+@_PROTECT
+@_MAX_REACHIEVED
 @pass_app
 def plan(
-    app: App, task: str, as_json: bool, drawing: Path | None, objective: str, no_store: bool, ignore_areas: bool
+    app: App,
+    task: str,
+    as_json: bool,
+    drawing: Path | None,
+    objective: str,
+    no_store: bool,
+    ignore_areas: bool,
+    protect: bool,
+    max_reachieved: int,
 ) -> None:
     """Compose a plan for TASK: a requirement or action (req:FetchMyPen, act:RobotArmServeACup, or a bare name).
 
@@ -76,7 +113,7 @@ def plan(
         raise click.BadParameter(f"{drawing.name!r} must end in .svg or .png", param_hint="--draw")
     actions = ActionLibrary.from_kb(app.kb)  # read once: the task's name and the composer take it
     requested = task_iri(app.kb, task, actions)  # an unknown name is refused before the composer reads the store
-    config = ComposeConfig(objective=Objective(objective), respect_area=not ignore_areas)
+    config = _compose_config(ignore_areas, protect, max_reachieved, objective=Objective(objective))
     composer = Composer(app.kb, config, actions=actions)
     result = composer.compose(requested)
     if result.plan is not None and not no_store:
@@ -210,6 +247,8 @@ def _source(binding: Binding) -> str:
     ),
 )
 @_IGNORE_AREAS
+@_PROTECT
+@_MAX_REACHIEVED
 @pass_app
 def run(
     app: App,
@@ -224,6 +263,8 @@ def run(
     as_json: bool,
     record: Path | None,
     ignore_areas: bool,
+    protect: bool,
+    max_reachieved: int,
 ) -> None:
     """Plan TASK, then execute it in the simulated home, step by step, failing over where needed.
 
@@ -286,7 +327,7 @@ def run(
                 iri,
                 environment,
                 failing,
-                composer=Composer(app.kb, ComposeConfig(respect_area=not ignore_areas), actions=actions),
+                composer=Composer(app.kb, _compose_config(ignore_areas, protect, max_reachieved), actions=actions),
                 on_event=follow,
                 fault_policy=policy,
                 replan_policy=ReplanPolicy(max_repeats=repeat_failures),
