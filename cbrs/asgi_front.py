@@ -11,15 +11,19 @@ sends no ``Origin`` and names this server in ``Host``. A single scan whose resul
 ``inline_bytes`` is answered on the loop itself (:meth:`SparqlService.query_here`); any other query
 waits on one of ``threads`` threads, so the loop never waits for a query worker. Every other request,
 and any this front is unsure of, goes to the Flask app through a2wsgi's WSGI-to-ASGI adapter, whose
-threads run it as waitress's did.
+threads run it as waitress's did. Whichever answers, the answer goes to Granian paced
+(:class:`UnreadAnswers`), and a client holds at most a share of the connections' bodies still coming
+(:class:`BodyWaits`): docs/security.md, section 8.
 """
 
 from __future__ import annotations
 
 import asyncio
 import functools
+import logging
+import types
 from collections import Counter
-from collections.abc import Awaitable, Callable, Collection, Iterable
+from collections.abc import Awaitable, Callable, Collection, Generator, Iterable, Iterator
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any
 from urllib.parse import unquote_to_bytes
@@ -29,6 +33,8 @@ from a2wsgi.wsgi import WSGIResponder
 
 from cbrs.sparql_service import Answer, SparqlService
 from cbrs.web.sparql_wsgi import COMMON_HEADERS, error_answer, host_allowed, json_body, plain_get, plain_post_length
+
+log = logging.getLogger("cbrs.server")
 
 Scope = dict[str, Any]
 Message = dict[str, Any]
@@ -56,6 +62,8 @@ class SparqlFront:
         inline_bytes: int = 256 * 1024,
         body_timeout: float = 30.0,
         bodies_per_client: int = 16,
+        unread_per_client: int = 64 * 1024 * 1024,
+        send_timeout: float = 30.0,
     ) -> None:
         self.sparql = sparql
         self.host_names = host_names  # the names Host may give, None for any (as cbrs.web._check_host)
@@ -63,6 +71,7 @@ class SparqlFront:
         self.inline_bytes = inline_bytes
         self.body_timeout = body_timeout
         self.bodies = BodyWaits(bodies_per_client)
+        self.unread = UnreadAnswers(unread_per_client, send_timeout)
         self.wsgi = _WsgiAdapter(wsgi_app, wsgi_threads, max_body, body_timeout, self.bodies)
         self._names: Collection[str | None] | None = None
         self._hosts: dict[str, bool] = {}
@@ -77,6 +86,17 @@ class SparqlFront:
         if scope["type"] != "http":
             await self.wsgi(scope, receive, send)
             return
+        client = scope.get("client")
+        reader = client and client[0]
+        if self.unread.over(reader):
+            await _too_much_unread(send, reader, self.unread)
+            return
+        try:
+            await self._http(scope, receive, self.unread.paced(send, reader))
+        except SlowReaderError as error:  # the answer is dropped with its connection
+            log.info("%s", error)
+
+    async def _http(self, scope: Scope, receive: Receive, send: Send) -> None:
         headers = _headers(scope)
         plain = self._plain_query(scope, headers) if headers is not None else None
         if headers is None or plain is None:
@@ -153,6 +173,102 @@ class SparqlFront:
         return known
 
 
+class ClientDisconnectedError(OSError):
+    """Raised in a WSGI thread writing to a client that has gone, so that the app's iterable is closed
+    (a stream ends and gives its slot back) instead of writing on into nothing."""
+
+
+PIECE = 64 * 1024  # an answer goes to Granian in pieces of this size, each awaited: its send waits for the reader
+
+
+class SlowReaderError(ClientDisconnectedError):
+    """A client read nothing of its answer for ``send_timeout``: the answer is dropped."""
+
+    def __init__(self, client: str | None, timeout: float) -> None:
+        self.client = client
+        super().__init__(f"dropped an answer to {client}: it read nothing of it for {timeout:g} s")
+
+
+class UnreadAnswers:
+    """The bytes of answers each client (an IP address) has not read yet, and the pace they are sent at.
+
+    Granian takes a body given in one message whole, at once, whether the client reads it or not: 40
+    connections that sent a query for a 3 MB result and read nothing held 170 MB of the server's memory,
+    and up to ``max_result_bytes`` (64 MiB) each. So an answer is handed over in :data:`PIECE` pieces,
+    each awaited (Granian's send waits once the connection's buffers are full); a piece not taken within
+    ``timeout`` drops the answer and its connection; and a client with ``per_client`` bytes or more of
+    answers unread gets 503 at once for anything more. All on the event loop's thread, so no lock."""
+
+    def __init__(self, per_client: int, timeout: float) -> None:
+        self.per_client = per_client
+        self.timeout = timeout
+        self.held: Counter[str | None] = Counter()
+
+    def over(self, client: str | None) -> bool:
+        return self.held[client] >= self.per_client
+
+    def paced(self, send: Send, client: str | None) -> Send:
+        """``send`` with every body sent in pieces, counted against ``client`` until taken."""
+
+        async def paced_send(message: Message) -> None:
+            body = message.get("body", b"") if message["type"] == "http.response.body" else b""
+            if len(body) <= PIECE:  # as _within, without its frame: every answer's two messages pass here
+                waiting = send(message).__await__()
+                try:
+                    signal = next(waiting)
+                except StopIteration:
+                    return
+                await self._rest(waiting, signal, client)
+                return
+            more = message.get("more_body", False)
+            self.held[client] += len(body)
+            left = len(body)
+            try:
+                view = memoryview(body)
+                for start in range(0, len(body), PIECE):
+                    piece = bytes(view[start : start + PIECE])
+                    last = start + PIECE >= len(body)
+                    await self._within(send({**message, "body": piece, "more_body": more or not last}), client)
+                    self.held[client] -= len(piece)
+                    left -= len(piece)
+            finally:
+                self.held[client] -= left
+                if self.held[client] <= 0:
+                    del self.held[client]
+
+        return paced_send
+
+    async def _within(self, sending: Awaitable[None], client: str | None) -> None:
+        """Await ``sending`` for at most :attr:`timeout`. A send Granian takes at once (a lookup's
+        answer, a piece while the buffers have room) costs no timer: a timer per message cost a
+        lookup some 5-20 microseconds of the front's 20."""
+        waiting = sending.__await__()
+        try:
+            signal = next(waiting)
+        except StopIteration:
+            return
+        await self._rest(waiting, signal, client)
+
+    async def _rest(self, waiting: Iterator[Any], signal: Any, client: str | None) -> None:
+        """The rest of a send that has to wait (``signal``: for what), for at most :attr:`timeout`."""
+        try:
+            async with asyncio.timeout(self.timeout):
+                await _resumed(waiting, signal)
+        except TimeoutError:
+            raise SlowReaderError(client, self.timeout) from None
+
+
+@types.coroutine
+def _resumed(waiting: Iterator[Any], signal: Any) -> Generator[Any, None, None]:
+    """The rest of an awaitable whose first step, which gave ``signal`` (what it waits for), was taken."""
+    while True:
+        yield signal
+        try:
+            signal = next(waiting)
+        except StopIteration:
+            return
+
+
 class BodyWaits:
     """The requests of each client (an IP address) whose body is still coming. Each holds a connection,
     and Granian serves a fixed number of connections at once: a client sending bodies slowly (a byte a
@@ -174,11 +290,6 @@ class BodyWaits:
         self.waiting[client] -= 1
         if self.waiting[client] <= 0:
             del self.waiting[client]
-
-
-class ClientDisconnectedError(OSError):
-    """Raised in a WSGI thread writing to a client that has gone, so that the app's iterable is closed
-    (a stream ends and gives its slot back) instead of writing on into nothing."""
 
 
 class _WsgiAdapter(WSGIMiddleware):
@@ -261,6 +372,22 @@ class _Responder(WSGIResponder):
         if self.gone:
             raise ClientDisconnectedError("the client closed the connection")
         super().send(message)
+
+    async def sender(self, send: Any) -> None:
+        """a2wsgi's, except that a client that stops reading ends the answer: the app's next write
+        raises, and what it had queued is taken and dropped (a2wsgi's would stop taking, and leave the
+        app's thread waiting to queue for ever)."""
+        while True:
+            message = await self.send_queue.get()
+            if message is None:
+                break
+            if not self.gone:
+                try:
+                    await send(message)
+                except SlowReaderError as error:
+                    self.gone = True
+                    log.info("%s", error)
+            self.send_queue.task_done()
 
 
 def _has_body(scope: Scope) -> bool:
@@ -364,6 +491,14 @@ async def _too_many_bodies(send: Send, client: str | None, limit: int) -> None:
     message = (
         f"{client} is already sending {limit} request bodies at once, the most one client may; "
         "send the rest when those are in"
+    )
+    await _respond(send, False, 503, "application/json", json_body({"error": "busy", "message": message}))
+
+
+async def _too_much_unread(send: Send, client: str | None, unread: UnreadAnswers) -> None:
+    message = (
+        f"{client} has {unread.held[client]} bytes of answers it has not read yet, the most one client may "
+        f"have ({unread.per_client}); read them, or close their connections"
     )
     await _respond(send, False, 503, "application/json", json_body({"error": "busy", "message": message}))
 

@@ -55,6 +55,8 @@ class ServeConfig:
     body_timeout: float = 30.0  # seconds it may take to send a body (held on the loop, not a thread); then 408
     max_connections: int = 4096  # HTTP connections open at once, idle ones included (Granian's permits)
     bodies_per_client: int = 16  # requests of one client whose body is still coming; one more: 503
+    unread_per_client: int = 64 * 1024 * 1024  # bytes of answers one client has not read; past them: 503
+    send_timeout: float = 30.0  # seconds a client may read nothing of an answer; then it is dropped
     inline_bytes: int = 256 * 1024  # a single scan answered on the loop up to this result size, else on a thread
     http_loop: str = field(default_factory=lambda: setting("http_loop").resolve())  # auto, uvloop or asyncio
     stream_limit: int = field(default_factory=lambda: setting("stream_limit").resolve())
@@ -134,6 +136,8 @@ class Server:
             inline_bytes=self.config.inline_bytes,
             body_timeout=self.config.body_timeout,
             bodies_per_client=self.config.bodies_per_client,
+            unread_per_client=self.config.unread_per_client,
+            send_timeout=self.config.send_timeout,
         )
         listener = ListenerConfig(
             host=self.config.host,

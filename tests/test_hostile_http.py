@@ -17,12 +17,15 @@ import threading
 import time
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 from urllib.parse import quote
 
 import httpx
 import pytest
 
+from cbrs.asgi_front import SlowReaderError, UnreadAnswers
 from cbrs.graph_store import GraphStore, Target
+from cbrs.http_listener import HttpListener, ListenerConfig
 from cbrs.kb import KnowledgeBase
 from cbrs.server import ServeConfig, Server
 from cbrs.sparql_service import EndpointBusyError, EndpointConfig, SparqlService
@@ -129,6 +132,64 @@ def test_a_client_sending_bodies_slowly_holds_its_share_not_the_server(served: S
     finally:
         for socket_ in slow:
             socket_.close()
+
+
+async def _big_answer(scope: dict[str, Any], receive: Any, send: Any) -> None:
+    """20 MiB for every request, sent as the front sends answers (paced, counted for its client)."""
+    if scope["type"] != "http":
+        return
+    body = b"x" * (20 << 20)
+    paced = SLOW.paced(send, scope["client"][0])
+    try:
+        await paced({"type": "http.response.start", "status": 200, "headers": [(b"content-length", b"%d" % len(body))]})
+        await paced({"type": "http.response.body", "body": body})
+    except SlowReaderError:
+        DROPPED.append(scope["client"][0])
+
+
+SLOW = UnreadAnswers(per_client=8 << 20, timeout=0.5)
+DROPPED: list[str] = []
+
+
+def test_an_answer_its_client_does_not_read_is_dropped_and_its_memory_freed() -> None:
+    """Granian took a whole answer at once whether its client read it or not: 40 connections asking
+    for 3 MB and reading nothing held 170 MB of the server. Paced, an unread answer waits in the
+    server's memory, counted for its client, until send_timeout drops it with its connection."""
+    listener = HttpListener(_big_answer, ListenerConfig(port=0))
+    listener.start()
+    try:
+        reader = socket.socket()
+        reader.setsockopt(socket.SOL_SOCKET, socket.SO_RCVBUF, 4096)
+        reader.settimeout(WAIT)
+        reader.connect(("127.0.0.1", listener.port))
+        reader.sendall(b"GET / HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n")
+        deadline, counted = time.monotonic() + WAIT, 0
+        while not DROPPED and time.monotonic() < deadline:
+            counted = max(counted, SLOW.held.get("127.0.0.1", 0))
+            time.sleep(0.01)
+        assert counted > SLOW.per_client  # what the buffers did not take was counted for its client
+        assert DROPPED == ["127.0.0.1"] and SLOW.held == {}
+        received = 0
+        while chunk := reader.recv(1 << 20):  # what was in the buffers, then the end of the connection
+            received += len(chunk)
+        assert received < 20 << 20
+        reader.close()
+    finally:
+        listener.stop(WAIT)
+
+
+def test_a_client_with_answers_unread_gets_no_more(served: Server) -> None:
+    front = served._front
+    assert front is not None
+    front.unread.held["127.0.0.2"] = front.unread.per_client  # as if it had asked for that much and read none
+    try:
+        with client("127.0.0.2") as slow, client() as other:
+            refused = slow.get(url(served, "/sparql"), params={"query": "ASK { ?s ?p ?o }"})
+            assert refused.status_code == 503 and refused.json()["error"] == "busy"
+            assert refused.json()["message"].startswith("127.0.0.2 has 67108864 bytes of answers it has not read yet")
+            assert other.get(url(served, "/sparql"), params={"query": "ASK { ?s ?p ?o }"}).status_code == 200
+    finally:
+        del front.unread.held["127.0.0.2"]
 
 
 # -- parameters -----------------------------------------------------------------------------------------
