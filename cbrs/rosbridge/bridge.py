@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import functools
 import hmac
 import itertools
 import logging
@@ -45,6 +46,13 @@ BINARY_REFUSED = (
     "binary frames are not supported unless they hold UTF-8 JSON text (as rosbridge_suite reads them):"
     " CBOR or BSON from a client is not read; send the message as JSON"
 )
+
+
+@functools.cache
+def _rosapi_interfaces() -> Interfaces:
+    interfaces = Interfaces()
+    interfaces.load(ROSAPI_DEFINITIONS, "rosapi")
+    return interfaces
 
 
 def _json_in_binary(frame: bytes) -> str | None:
@@ -133,7 +141,9 @@ class Bridge:
         self.params = ParamStore(params)
         self.interfaces = Interfaces()
         """The message and service types rosapi describes: add a package's with ``interfaces.load``."""
-        self.interfaces.load(ROSAPI_DEFINITIONS, "rosapi")
+        rosapi_types = _rosapi_interfaces()  # read once per process: the definitions are immutable
+        self.interfaces.messages.update(rosapi_types.messages)
+        self.interfaces.services.update(rosapi_types.services)
         self._graph = Graph()
         services = rosapi.services(self._graph, self.params, self.non_finite, self.interfaces)
         for name, (kind, handler) in services.items():
