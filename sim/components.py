@@ -369,13 +369,18 @@ class SimEnvironment:
             self._computables = table
         return self._computables.get(predicate)
 
-    def _ground(self, concept: str, inputs: Mapping[str, Any]) -> Grounded | None:
+    def _ground(self, concept: str, inputs: Mapping[str, Any], besides: Grounded | None = None) -> Grounded | None:
         """The thing a class-level statement means at this step: a thing the step was given, else what
-        is at hand (the arm's object, its gripper, the base, the person, the target)."""
+        is at hand (the arm's object, its gripper, the base, the person, the target). ``besides`` is what
+        the statement's other side means, never taken for this side: a cupboard a carry is given as its
+        place is a physical object too, and without this it stood for both sides of "object above place",
+        so the belief held the cupboard above itself and a re-plan put down nothing."""
         people = self.world.map.people
         for value in inputs.values():
             if isinstance(value, dict) and "@id" in value:
                 iri = str(value["@id"])
+                if besides is not None and besides.role == "thing" and besides.name == iri:
+                    continue
                 types = (*self.world.map.types.get(iri, ()), str(value.get("@type", "")))
                 if any(self.is_a(t, concept) for t in types):
                     return Grounded("person", people[iri].name) if iri in people else Grounded("thing", iri)
@@ -478,10 +483,11 @@ class SimEnvironment:
         world graph, grounded in the things at hand. Its object may be a status or another quality
         (``home:Opened`` in (Door, hasStatus, Opened)): a class no thing of the world stands for, which is
         then the object itself, as ``home:Water`` is in (Cup, contains, Water)."""
-        sides = [self._ground(concept, self.context.inputs) for concept in (statement.subject, statement.object)]
-        subject = self._iri_of(sides[0]) if sides[0] is not None else None
-        if sides[1] is not None:
-            obj = self._iri_of(sides[1])
+        grounded = self._ground(statement.object, self.context.inputs)
+        side = self._ground(statement.subject, self.context.inputs, besides=grounded)
+        subject = self._iri_of(side) if side is not None else None
+        if grounded is not None:
+            obj = self._iri_of(grounded)
         else:
             obj = statement.object if self.is_a(statement.object, HOME + "Quality") else None
         if subject is None or obj is None:
@@ -534,8 +540,8 @@ class SimEnvironment:
             odometry = self.world.base_pose()  # the base's own estimate of where it is
             return math.hypot(estimate.x - odometry.x, estimate.y - odometry.y) <= LOCALISATION_TOLERANCE
         inputs = self.context.inputs
-        subject = self._ground(statement.subject, inputs)
         obj = self._ground(statement.object, inputs)
+        subject = self._ground(statement.subject, inputs, besides=obj)
         if subject is None or obj is None:
             return None
         if look and isinstance(judge, PerceivedWorld):

@@ -14,9 +14,10 @@ from typing import Any
 
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.semantic_map import Arm as ArmSpec
 from cbrs.kb.semantic_map import local_name
 from cbrs.sim import skills
-from cbrs.sim.arm_choice import free_arm, grasp_pose_for, holdable_spot, note_choice, who_loads, who_takes
+from cbrs.sim.arm_choice import carry_check, free_arm, grasp_pose_for, holdable_spot, note_choice, who_loads, who_takes
 from cbrs.sim.arms import ArmSide
 from cbrs.sim.context import SimContext, SkillFailed, Work, check_outcome, robot_camera
 from cbrs.sim.errors import SimulationError
@@ -140,8 +141,7 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
     others = other_objects(world, ctx.belief, carried)
 
     def spots(side: ArmSide) -> tuple[Region, list[tuple[float, float]]]:
-        spec = world.arm_specs[side]
-        return place_spots(ctx.map, place, size, [(spec.mount[0], spec.mount[1], spec.reach)], others)
+        return place_spots(ctx.map, place, size, [_reach_of(world.arm_specs[side])], others)
 
     surface, mine = spots(ctx.arm)
     spot = holdable_spot(ctx, ctx.arm, surface, mine)
@@ -155,6 +155,22 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
                 options.append((math.hypot(theirs[0][0] - cx, theirs[0][1] - cy), side, theirs[0]))
         if not options:
             spec = world.arm_specs[giver]
+            crowded = [  # arms that would have a spot but for the objects on the place
+                side
+                for side in sorted(world.arm_specs)
+                if place_spots(ctx.map, place, size, [_reach_of(world.arm_specs[side])], [])[1]
+            ]
+            if crowded:
+                names = [name for name in world.objects if name != carried]  # in the order of ``others``
+                on_it = [n for n, (x, y, _) in zip(names, others, strict=True) if surface.contains_xy(x, y)]
+                arms = " and ".join(side.value for side in crowded) + (
+                    " arms reach" if len(crowded) > 1 else " arm reaches"
+                )
+                blockers = " and ".join(f"the {name}" for name in on_it) if on_it else "the objects"
+                raise SkillFailed(
+                    f"no spot of {place.name} is clear for the {model.name} (around ({cx:.2f}, {cy:.2f})): the "
+                    f"{arms} it, but {blockers} on it {'leaves' if len(on_it) == 1 else 'leave'} no spot free"
+                )
             raise SkillFailed(
                 f"no arm reaches a spot of {place.name} to set the {model.name} down on (around ({cx:.2f}, "
                 f"{cy:.2f})): the {giver.value} arm holding it reaches {spec.reach:.2f} m from ({spec.mount[0]:.2f}, "
@@ -188,16 +204,16 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
         # a spot whose moves are refused is passed over for the next (relay_spot).
         passing = f"passing the {model.name} from the {giver.value} arm to the {taker.value} for {place.name}"
         before = "the pass moved anything"
-        holding = world.arm(giver).ee_pose().position
 
-        def holds(spot: Region, _: ObjectModel, taken_by: ObjectModel) -> None:
-            why = skills.can_carry_held(world, giver, spot, floor_to(ctx, model, giver, holding, spot))
+        def holds(spot: Region, _: ObjectModel, taken_by: ObjectModel) -> str:
+            # and where either carry comes within CARRY_CLEARANCE of an appliance (relay_spot passes it over)
+            why, near = carry_check(ctx, giver, spot)
             refuse_moves(why, model, giver, passing, spot, before)
             there = resting_at(spot, model, taken, world.time)
-            floor = floor_to(ctx, taken_by, taker, there.position, target)
             # the giver will have folded home by the time the taker moves
-            why = skills.can_carry(world, there, taker, taken_by, target, floor=floor, folded=(giver,))
+            why, onward = carry_check(ctx, taker, target, (there, taken_by), folded=(giver,))
             refuse_moves(why, taken_by, taker, passing, target, before)
+            return near or onward
 
         relay, _, taken_by = relay_spot(ctx, taken, Candidates([model]), placing, giver, taker, holds)
         found = set_down_for(ctx, device, model, giver, taker, relay, None)
@@ -228,6 +244,11 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
     floor = None if grasped is None else floor_to(ctx, grasped.model, ctx.arm, hand, target)
     check_outcome(skills.carry_object(world, ctx.arm, target, floor=floor))
     return {}
+
+
+def _reach_of(spec: ArmSpec) -> tuple[float, float, float]:
+    """An arm's reach as place_spots takes it: (mount x, mount y, reach)."""
+    return (spec.mount[0], spec.mount[1], spec.reach)
 
 
 def put_down(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
