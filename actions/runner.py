@@ -288,7 +288,7 @@ def run_task(
         while composition.plan is not None:
             plan = composition.plan
             try:
-                given = environment.given(plan, _supplying(kb, plan))
+                given = environment.given(plan, _supplying(kb, composition))
             except Exception:
                 if not replans:  # refused before anything moved: the store is left as it was
                     belief.restore(before)
@@ -542,17 +542,27 @@ def _check_goals(
     return tuple(checks)
 
 
-def _supplying(kb: KnowledgeBase, plan: Plan) -> dict[str, Requirement]:
-    """The requirements that supply the plan's inputs, each read alone: reading every requirement of
-    the store for the one or two a plan names took longer than a step (0.1 s a plan in the home)."""
+def _supplying(kb: KnowledgeBase, composition: CompositionResult) -> dict[str, Requirement]:
+    """The requirements that supply the plan's inputs: those the composition was made from (its attempts:
+    the task's, each sub-action's), which name the inputs as the plan's bindings do; one it did not attempt
+    is read alone. Reading them again sent one request each to a remote store (three for a task of three
+    sub-actions), and reading every requirement took longer than a step (0.1 s a plan in the home)."""
+    plan = composition.plan
+    assert plan is not None
     named = {
         binding.source.requirement
         for step in plan.steps
         for binding in step.bindings
         if binding.source.step is None and binding.source.requirement
     }
+    composed: dict[str, Requirement] = {}
+    for attempt in composition.attempts:  # the task's own first: a goal's part has only that goal's inputs
+        composed.setdefault(attempt.requirement.iri, attempt.requirement)
     found: dict[str, Requirement] = {}
     for iri in sorted(named):
+        if iri in composed:
+            found[iri] = composed[iri]
+            continue
         try:
             description = kb.description(iri)
         except NotFoundError:
