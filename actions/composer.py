@@ -146,7 +146,7 @@ class CompositionResult:
         return found
 
 
-Composed = tuple[Plan | None, tuple[Unsatisfied, ...], list[Attempt]]
+_Composed = tuple[Plan | None, tuple[Unsatisfied, ...], list[Attempt]]
 """A part's plan (None: none), why not, and the attempts made for it."""
 
 
@@ -156,7 +156,7 @@ class _Part:
     earlier part undoes (``undone``: those facts of the world and of its requirement are left out)."""
 
     label: str  # "sub-action act:X" or "goal 2 (...)", as reasons name it
-    compose: Callable[[frozenset[Statement]], Composed]
+    compose: Callable[[frozenset[Statement]], _Composed]
     plan: Plan
     undone: frozenset[Statement] = frozenset()
 
@@ -512,7 +512,7 @@ class Composer:
             return self._result(task, _achieved_plan(task), (), tuple(attempts))
         return self._joined(task, parts, attempts, holding)
 
-    def _sub_action(self, sub_task: Task, depth: int, undone: frozenset[Statement]) -> Composed:
+    def _sub_action(self, sub_task: Task, depth: int, undone: frozenset[Statement]) -> _Composed:
         """One sub-action's plan: directly, else decomposed in turn."""
         attempt = self.attempt(sub_task.requirement, sub_task, undone)
         tried = [attempt]
@@ -558,7 +558,7 @@ class Composer:
             return self._result(task, _achieved_plan(task), (), tuple(attempts))
         return self._joined(task, parts, attempts, holding)
 
-    def _goal_part(self, sub_task: Task, undone: frozenset[Statement]) -> Composed:
+    def _goal_part(self, sub_task: Task, undone: frozenset[Statement]) -> _Composed:
         attempt = self.attempt(sub_task.requirement, sub_task, undone)
         return attempt.plan, attempt.unsatisfied, [attempt]
 
