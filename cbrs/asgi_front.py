@@ -116,6 +116,9 @@ class SparqlFront:
                 return
             finally:
                 self.bodies.done(sender)
+            if body is None:
+                await _body_cut(send)
+                return
             try:
                 text = body.decode("utf-8")
             except UnicodeDecodeError:  # Flask reads it again and names the error
@@ -361,7 +364,9 @@ class _Responder(WSGIResponder):
                 if waits:
                     bodies.done(sender)
                     waits = False
-            if not self.gone:
+            if self.gone:  # Granian says so of a malformed body too: answered (a gone client hears nothing)
+                await _body_cut(send)
+            else:
                 await self(_with_length(scope, size), messages.get, send)  # type: ignore[arg-type]
         except ClientDisconnectedError:
             pass  # nobody to answer
@@ -446,17 +451,23 @@ def _headers(scope: Scope) -> dict[bytes, str] | None:
     return found
 
 
-async def _read_body(receive: Receive) -> bytes:
-    """The request body (the server holds it to its Content-Length, which the front has checked)."""
+async def _read_body(receive: Receive) -> bytes | None:
+    """The request body (the server holds it to its Content-Length, which the front has checked), or
+    None if the connection ended first (Granian says so of a malformed chunked body too)."""
     chunks: list[bytes] = []
     while True:
         message = await receive()
         if message["type"] != "http.request":
-            break
+            return None
         chunks.append(message.get("body", b""))
         if not message.get("more_body", False):
-            break
-    return b"".join(chunks)
+            return b"".join(chunks)
+
+
+async def _body_cut(send: Send) -> None:
+    """Granian answered 500 when the app sent nothing for a request whose body it could not read."""
+    message = "the request body ended before it was whole (a malformed chunked encoding, or a closed connection)"
+    await _respond(send, False, 400, "application/json", json_body({"error": "bad-request", "message": message}))
 
 
 def _coroutine(receive: Receive) -> Receive:

@@ -192,6 +192,29 @@ def test_a_client_with_answers_unread_gets_no_more(served: Server) -> None:
         del front.unread.held["127.0.0.2"]
 
 
+@pytest.mark.parametrize(
+    ("path", "media_type"),
+    [
+        pytest.param("/sparql", "application/sparql-query", id="front"),
+        pytest.param("/update", "application/sparql-update", id="flask"),
+    ],
+)
+def test_a_malformed_chunked_body_is_a_400(served: Server, path: str, media_type: str) -> None:
+    """Granian tells the app such a body as a disconnect; the app answered nothing, and Granian 500."""
+    head = (
+        f"POST {path} HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: {media_type}\r\nTransfer-Encoding: chunked\r\n\r\n"
+    )
+    held = connection(served, "127.0.0.1", head.encode("ascii") + b"zz\r\nASK {}\r\n0\r\n\r\n")
+    try:
+        answer = _answer(held)
+    finally:
+        held.close()
+    assert answer.startswith(b"HTTP/1.1 400")
+    assert json.loads(answer.partition(b"\r\n\r\n")[2])["message"].startswith(
+        "the request body ended before it was whole"
+    )
+
+
 # -- parameters -----------------------------------------------------------------------------------------
 
 # INSERT DATA { GRAPH <urn:cafe> { <urn:a> <urn:b> "café" } }, percent-encoded from Latin-1 (é is %E9)
