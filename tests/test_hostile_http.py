@@ -291,6 +291,15 @@ def test_a_post_with_its_text_in_the_url_too_is_a_400(served: Server, path: str,
     assert "but the URL has" in answer.json()["message"]
 
 
+def test_a_json_body_nested_past_the_parser_is_a_400(served: Server) -> None:
+    """POST /tasks read its JSON before the access check: 100,000 brackets were a RecursionError, 500."""
+    deep = "[" * 100_000 + "]" * 100_000
+    with client() as http:
+        answer = http.post(url(served, "/tasks.json"), content=deep, headers={"Content-Type": "application/json"})
+    assert answer.status_code == 400
+    assert answer.json()["message"].startswith("the JSON body nests deeper than this server reads")
+
+
 # -- the graph store ----------------------------------------------------------------------------------
 
 
