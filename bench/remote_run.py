@@ -108,7 +108,7 @@ def cbrs_serve(store: Path, env: dict[str, str]) -> Iterator[str]:
     """``cbrs serve`` over ``store`` on a free loopback port, its URL; stopped by its PID."""
     port = _free_port()
     argv = [sys.executable, "-m", "cbrs", "--store", str(store), "serve", "--port", str(port), "--bridge-port", "0"]
-    process = subprocess.Popen(argv, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    process = subprocess.Popen(argv, env=env, cwd=store.parent, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     url = f"http://127.0.0.1:{port}"
     try:
         import httpx
@@ -153,9 +153,12 @@ def measure(
     """Wall seconds of ``cbrs ARGV`` in a process of its own, the requests it sent by kind and the ms it
     waited for their answers, its exit status."""
     out = scratch / "counts.json"
-    command = [sys.executable, __file__, "--child", str(out), "--latency", str(latency), "--", *argv]
+    script = str(Path(__file__).resolve())
+    command = [sys.executable, script, "--child", str(out), "--latency", str(latency), "--", *argv]
     start = time.perf_counter()
-    subprocess.run(command, env=env, check=False, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    # run from the scratch folder: `-m cbrs` puts the working directory first on the path, so from inside a
+    # checkout every --source would run the checkout's code
+    subprocess.run(command, env=env, cwd=scratch, check=False, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     wall = time.perf_counter() - start
     found = json.loads(out.read_text())
     return wall, found["counts"], found["ms"], found["exit"]
@@ -193,6 +196,7 @@ def main() -> None:
             subprocess.run(
                 [sys.executable, "-m", "cbrs", "--store", str(seeded), "init"],
                 env=env,
+                cwd=scratch,  # not the checkout's code first on the path (see measure)
                 check=True,
                 stdout=subprocess.DEVNULL,
             )
