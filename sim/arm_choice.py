@@ -313,14 +313,18 @@ def carry_clear(
 
 
 def carry_check(
-    ctx: SimContext, side: ArmSide, spot: Region, taking: tuple[ObjectEstimate, ObjectModel] | None = None
+    ctx: SimContext,
+    side: ArmSide,
+    spot: Region,
+    taking: tuple[ObjectEstimate, ObjectModel] | None = None,
+    folded: Sequence[ArmSide] = (),
 ) -> tuple[str, str]:
     """Why the arm's planning would refuse the carry over ``spot`` and its way down, and where those moves
     would come within CARRY_CLEARANCE of an appliance (each empty when not): a dry run
     (:meth:`Arm.keeping_clear`) of the carry of what ``side`` holds, from its posture now
     (:func:`skills.can_carry_held`), or, given ``taking`` (an object where it lies, the approach), of its
-    take and carry from where it lies (:func:`skills.can_carry`); the floor as the carry's
-    (:func:`floor_to`). Told apart, so a choice can pass over the spot that does not keep clear and
+    take and carry from where it lies (:func:`skills.can_carry`, the arms of ``folded`` home); the floor as
+    the carry's (:func:`floor_to`). Told apart, so a choice can pass over the spot that does not keep clear and
     still take it, as before, when none does."""
     world = ctx.world
     if taking is None:
@@ -334,7 +338,7 @@ def carry_check(
         seen, held = taking
         floor = floor_to(ctx, held, side, seen.position, spot)
         refused, brushed = _keeping_clear(
-            ctx, side, lambda: skills.can_carry(world, seen, side, held, spot, floor=floor)
+            ctx, side, lambda: skills.can_carry(world, seen, side, held, spot, floor=floor, folded=folded)
         )
     cx, cy, _ = spot.center
     return refused, brushed and f"the {side.value} arm carrying the {held.name} to ({cx:.2f}, {cy:.2f}): {brushed}"
