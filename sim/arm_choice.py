@@ -359,24 +359,23 @@ def _clear_spot(
     others: Callable[[], Iterator[Region]],
     taking: tuple[ObjectEstimate, ObjectModel],
 ) -> Region | tuple[str, str]:
-    """Of ``first`` and then ``others`` (asked only when ``first``'s carry does not keep clear), the first
-    spot whose take and carry (:func:`carry_check`) the arm's planning would make keeping CARRY_CLEARANCE,
-    up to CLEAR_TRIES of them; else why the arm's planning would refuse the take and carry to ``first``
-    (empty: it would make them) and why no spot's keeps clear. Where the take itself comes that near (an
-    object below a tap's spout), no spot's can: the others are not asked."""
+    """Of ``first`` and then ``others`` (asked only when the planning would make the take and carry to
+    ``first`` but they come within CARRY_CLEARANCE of an appliance), the first spot whose take and carry
+    (:func:`carry_check`) the arm's planning would make keeping that clearance, up to CLEAR_TRIES of them;
+    else why the planning would refuse the take and carry to ``first`` (empty: it would make them, as the
+    approach choice asks, :func:`first_clear`) and why no spot's keeps clear. Where the take itself comes
+    that near (an object below a tap's spout), no spot's can: the others are not asked."""
     refused, brushed = carry_check(ctx, side, first, taking)
-    if not refused and not brushed:
-        return first
-    unclear = refused or brushed
-    if brushed:
-        seen, held = taking
-        at_take = _keeping_clear(ctx, side, lambda: skills.can_carry(ctx.world, seen, side, held))[1]
-        if at_take:
-            return refused, f"taking the {held.name}: {at_take}"
+    if refused or not brushed:
+        return (refused, refused) if refused else first
+    seen, held = taking
+    at_take = _keeping_clear(ctx, side, lambda: skills.can_carry(ctx.world, seen, side, held))[1]
+    if at_take:
+        return "", f"taking the {held.name}: {at_take}"
     for spot in itertools.islice(others(), CLEAR_TRIES - 1):
         if not carry_clear(ctx, side, spot, taking):
             return spot
-    return refused, unclear
+    return "", brushed
 
 
 def note_choice(ctx: SimContext, choice: GraspChoice) -> None:

@@ -5,9 +5,10 @@ _loading_by), as the spot a carry aims at does (tests/test_carry_clearance.py).
 The world: the bundled store with the tap's lever moved (a 2 cm square, 0.85-0.90 m up) to the front of
 the kitchen table, at (7.66-7.68, 3.10-3.12), past which the left arm carries the bundled cup, which only
 it reaches, to be passed to the right arm, which loads the platform. Before, the first relay spot whose
-holds' moves the planning would make was taken, (7.80, 3.06): the left arm's carry there comes within 1 cm
-of the lever, and in FetchMyCup (seed 0) it touched it at 17.2 s. Checked here on the kinematics copies
-only (no task runs)."""
+holds' moves the planning would make was taken, (7.80, 3.06) for the cup where the map puts it: the left
+arm's carry there comes within 1 cm of the lever; in FetchMyCup (seed 0, the spot (7.78, 3.06) from the
+Kinect's estimate) it touched the lever at 17.2 s, and now, set down at (7.78, 3.10), the arms keep 2 cm
+from it. Checked here on the kinematics copies only (no task runs)."""
 
 from __future__ import annotations
 
