@@ -2,12 +2,13 @@
 
 KnowRob style, a hand is a part of its arm in the store (``home:hasGripper``), and what the grasp planner
 needs of it is stated on it: how far its jaws open, how far its palm sits above the grasp point, how long
-its fingers are (its geometry, required of a gripper the map names), and how it is used (its policy: the
-side grasp's tilt and least hold, the pre-grasp distance; each a default here unless the store states
-one, and then the store's). A value is stated on the gripper, or once on a class of grippers (a model) it is
-an individual of: its own value wins, else the nearest class's (:func:`read_hands`). The named query
-``robot_hands`` reads them; an arm the map gives no gripper has :data:`PANDA_HAND`, the hand of the
-simulated arms (docs/simulation.md, "The hand").
+its fingers are (its geometry, required of a gripper the map names; how far the fingertips reach below
+the grasp point, which they imply unless stated), and how it is used (its policy: the side grasp's tilt
+and least hold, the pre-grasp distance, how far the fingertips stay above a surface and each jaw clear of
+the object; each a default here unless the store states one, and then the store's). A value is stated on
+the gripper, or once on a class of grippers (a model) it is an individual of: its own value wins, else the
+nearest class's (:func:`read_hands`). The named query ``robot_hands`` reads them; an arm the map gives no
+gripper has :data:`PANDA_HAND`, the hand of the simulated arms (docs/simulation.md, "The hand").
 """
 
 from __future__ import annotations
@@ -27,6 +28,8 @@ if TYPE_CHECKING:
     from cbrs.kb.knowledge_base import KnowledgeBase
 
 __all__ = [
+    "FINGERTIP_CLEARANCE",
+    "JAW_CLEARANCE",
     "PANDA_HAND",
     "PREGRASP_DISTANCE",
     "SIDE_HOLD",
@@ -54,6 +57,20 @@ PREGRASP_DISTANCE = 0.10
 fingers there touches nothing, near enough that the final approach is a short straight move. The default
 of ``home:pregraspDistance``."""
 
+FINGERTIP_CLEARANCE = 0.002
+"""How far above the surface an object rests on a top grasp keeps the fingertips (m): the grasp point is
+raised to at least the fingertips' depth and this above the object's bottom, so the hand does not come
+down on the surface and close over a thin object's top edge. 2 mm: the object's bottom is found from the
+depth camera's view of its top, a Kinect's depth error at a metre is of that order, and it leaves 3.8 mm of
+the Panda's fingers' flat inner faces on an 8 mm ruler (docs/simulation.md, "Thin objects"). The default
+of ``home:fingertipClearance``."""
+
+JAW_CLEARANCE = 0.0035
+"""How far each open jaw must clear an object as the hand moves in around it (m): an object wider than
+the opening less twice this is refused. The Kinect's estimate of an object's centre is off by up to 2.3 mm
+across the jaws (the cup, seeds 0-7), and the Panda's open fingers' inner faces sit 1.1 mm inside the
+stated opening on each side (docs/simulation.md, "The hand"). The default of ``home:jawClearance``."""
+
 
 @dataclass(frozen=True)
 class Hand:
@@ -73,6 +90,20 @@ class Hand:
     pregrasp_distance: float = PREGRASP_DISTANCE
     iri: str = ""
     """The gripper in the store; empty for a hand the store does not describe."""
+    fingertip_depth: float = math.nan
+    """How far the fingertips reach below the grasp point, the hand pointing down; unstated (NaN), what
+    the palm depth and finger length imply (``finger_length - palm_depth``), the most it can be."""
+    fingertip_clearance: float = FINGERTIP_CLEARANCE
+    jaw_clearance: float = JAW_CLEARANCE
+
+    def __post_init__(self) -> None:
+        if math.isnan(self.fingertip_depth):
+            object.__setattr__(self, "fingertip_depth", self.finger_length - self.palm_depth)
+
+    @property
+    def widest(self) -> float:
+        """The widest an object may be across the jaws: the opening less each jaw's clearance."""
+        return self.jaw_opening - 2.0 * self.jaw_clearance
 
     @property
     def side_span(self) -> float:
@@ -81,13 +112,23 @@ class Hand:
         return self.finger_length * math.cos(self.side_pitch)
 
 
-PANDA_HAND = Hand(jaw_opening=0.08, palm_depth=0.034, finger_length=0.046)
+PANDA_HAND = Hand(jaw_opening=0.08, palm_depth=0.034, finger_length=0.046, fingertip_depth=0.0082)
 """The Franka Panda's hand, the hand of every simulated arm (pybullet_data's ``franka_panda/panda.urdf``):
 the hand of an arm the store gives no ``home:hasGripper``. ``ontologies/world.ttl`` states the same values
-on the bundled robot's hands, with where each comes from; tests/test_grasp16_depth.py measures them again
-from the URDF."""
+on the bundled robot's hands, with where each comes from; tests/test_grasp16_depth.py and
+tests/test_grasp_thin.py measure them again from the URDF."""
 
-_PROPERTIES = ("jawOpening", "palmDepth", "fingerLength", "sideHoldFraction", "sideGraspPitch", "pregraspDistance")
+_PROPERTIES = (
+    "jawOpening",
+    "palmDepth",
+    "fingerLength",
+    "sideHoldFraction",
+    "sideGraspPitch",
+    "pregraspDistance",
+    "fingertipDepth",
+    "fingertipClearance",
+    "jawClearance",
+)
 """The store's properties (local names in the home namespace) of :class:`Hand`'s values, in its order."""
 _GEOMETRY = ("jawOpening", "palmDepth", "fingerLength")
 """What a gripper the map names must state: there is no other hand's geometry to assume for it."""
@@ -129,6 +170,8 @@ def _limits(name: str, number: float) -> str:
         return "" if 0.0 < number <= 1.0 else "a fraction of the object's depth, more than 0 and at most 1"
     if name == "sideGraspPitch":
         return "" if 0.0 <= number < math.pi / 2.0 else "radians down from level, at least 0 and below pi/2"
+    if name in ("fingertipClearance", "jawClearance"):
+        return "" if number >= 0.0 else "a length in metres, at least 0"
     return "" if number > 0.0 else "a length in metres, more than 0"
 
 
@@ -184,6 +227,25 @@ def _hand(hand: str, arm: str, robot: str, stated: dict[str, list[_Stated]]) -> 
             f"the grasp point is between the fingertips, so the palm is nearer to it than the fingers are long "
             f"(home:fingerLength {values['fingerLength']:g})",
         )
+    beyond = values["fingerLength"] - values["palmDepth"]  # how far the fingers reach past the grasp point
+    if values.get("fingertipDepth", 0.0) > beyond + 1e-9:
+        raise HandError(
+            hand,
+            arm,
+            robot,
+            "fingertipDepth",
+            f"{values['fingertipDepth']:g}",
+            f"the fingertips reach at most home:fingerLength less home:palmDepth below the grasp point ({beyond:g})",
+        )
+    if 2.0 * values.get("jawClearance", JAW_CLEARANCE) >= values["jawOpening"]:
+        raise HandError(
+            hand,
+            arm,
+            robot,
+            "jawClearance",
+            f"{values.get('jawClearance', JAW_CLEARANCE):g}",
+            f"each jaw's clearance, twice over, must leave room within home:jawOpening {values['jawOpening']:g}",
+        )
     return Hand(
         values["jawOpening"],
         values["palmDepth"],
@@ -192,6 +254,9 @@ def _hand(hand: str, arm: str, robot: str, stated: dict[str, list[_Stated]]) -> 
         values.get("sideGraspPitch", SIDE_PITCH),
         values.get("pregraspDistance", PREGRASP_DISTANCE),
         hand,
+        values.get("fingertipDepth", math.nan),
+        values.get("fingertipClearance", FINGERTIP_CLEARANCE),
+        values.get("jawClearance", JAW_CLEARANCE),
     )
 
 

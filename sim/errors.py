@@ -127,14 +127,39 @@ class GraspTooWideError(GraspMisfitError):
     it (a long box taken from the side across its length): the hand could not close on it so, wherever
     the arm reaches. ``width`` and ``opening`` are in metres."""
 
-    def __init__(self, name: str, approach: str, width: float, opening: float) -> None:
+    def __init__(self, name: str, approach: str, width: float, opening: float, clearance: float = 0.0) -> None:
         self.name = name
         self.approach = approach
         self.width = width
         self.opening = opening
+        self.clearance = clearance
+        """How far each jaw must clear the object (the hand's ``jaw_clearance``)."""
+        clear = (
+            f", less {clearance * 100:.2f} cm clear of each jaw: at most {(opening - 2 * clearance) * 100:.1f} cm"
+            if clearance > 0.0
+            else ""
+        )
         super().__init__(
             f"the {name} is {width * 100:.1f} cm wide across the jaws by its {approach} grasp, and the hand "
-            f"opens {opening * 100:.1f} cm"
+            f"opens {opening * 100:.1f} cm{clear}"
+        )
+
+
+class GraspTooThinError(GraspMisfitError):
+    """An object too thin for a top grasp to hold above the surface it rests on: with the fingertips kept
+    ``clearance`` above that surface, no part of its ``height`` would lie between them (the fingertips
+    reach ``fingertip_depth`` below the grasp point). Lengths in metres."""
+
+    def __init__(self, name: str, approach: str, height: float, fingertip_depth: float, clearance: float) -> None:
+        self.name = name
+        self.approach = approach
+        self.height = height
+        self.fingertip_depth = fingertip_depth
+        self.clearance = clearance
+        super().__init__(
+            f"the {name} is {height * 100:.2f} cm thick, and its {approach} grasp keeps the fingertips "
+            f"{clearance * 100:.2f} cm above the surface it rests on (they reach {fingertip_depth * 100:.2f} cm "
+            "below the grasp point): nothing of it would lie between them"
         )
 
 

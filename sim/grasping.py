@@ -16,7 +16,7 @@ import numpy as np
 
 from cbrs.kb.hands import PANDA_HAND, Hand
 from cbrs.kb.semantic_map import MapObject, NotGraspableError
-from cbrs.sim.errors import GraspTooDeepError, GraspTooWideError
+from cbrs.sim.errors import GraspTooDeepError, GraspTooThinError, GraspTooWideError
 from cbrs.sim.geometry import Quat, Vec3, quat_from_matrix
 
 __all__ = [
@@ -24,6 +24,7 @@ __all__ = [
     "GraspPose",
     "ObjectModel",
     "compute_grasp_pose",
+    "held_height",
     "side_held",
 ]
 
@@ -137,6 +138,21 @@ def _x_axis(footprint: tuple[float, float], axis: float) -> float:
     return axis if footprint[0] >= footprint[1] else axis - math.pi / 2.0
 
 
+def held_height(model: ObjectModel, hand: Hand) -> float:
+    """The grasp point's height above the object's bottom when ``hand`` holds it by ``model``'s approach:
+    its class's, raised for a top grasp until the fingertips, ``hand.fingertip_depth`` below the grasp
+    point, stay ``hand.fingertip_clearance`` above the surface it rests on (a ruler 8 mm thick at 0.5 put
+    them 4 mm into the table, and the fingers closed over its top edge). :class:`GraspTooThinError` for an
+    object no thicker than that clearance: nothing of it would lie between the fingertips."""
+    if model.grasp is not GraspKind.TOP:
+        return model.grasp_height
+    if model.height <= hand.fingertip_clearance:
+        raise GraspTooThinError(
+            model.name, model.grasp.value, model.height, hand.fingertip_depth, hand.fingertip_clearance
+        )
+    return max(model.grasp_height, hand.fingertip_depth + hand.fingertip_clearance)
+
+
 def side_held(depth: float, hand: Hand) -> float:
     """How much of an object ``depth`` deep along a side grasp's horizontal approach lies between
     ``hand``'s fingers: they come in tilted down by its side pitch, so they span its ``side_span`` of it
@@ -158,7 +174,8 @@ class GraspPose:
     approach: Vec3
     """Unit vector the gripper moves along to reach the grasp point."""
     bottom_offset: float
-    """Grasp point height above the object's bottom: how far the object hangs below the hand."""
+    """Grasp point height above the object's bottom: how far the object hangs below the hand (the
+    model's ``grasp_height``, which :func:`held_height` may have raised for the hand)."""
     width: float
     """How far apart the jaws are when the fingers touch the object, for this approach and turn of the
     hand (:meth:`ObjectModel.grip`): what the fingers close to."""
@@ -210,12 +227,18 @@ def compute_grasp_pose(
 
     A side grasp comes in from the robot's side of the table, tilted down by the hand's side pitch, its
     jaws closing across that direction; a top grasp closes them across the object's long axis.
-    GraspTooWideError when the object is wider across the jaws than the hand opens them,
-    GraspTooDeepError when a side grasp would hold less than the hand's side-hold fraction of its depth
-    along the approach (:func:`side_held`): the hand could not hold it so, whatever the arm can reach.
+    The grasp point is at :func:`held_height` above the object's bottom (the pose's model says so too).
+    GraspTooWideError when the object is wider across the jaws than the hand opens them less each jaw's
+    clearance (``hand.widest``), GraspTooDeepError when a side grasp would hold less than the hand's
+    side-hold fraction of its depth along the approach (:func:`side_held`), GraspTooThinError when a top
+    grasp would hold nothing of it above its surface: the hand could not hold it so, whatever the arm can
+    reach.
     """
     cx, cy, cz = centre
     bottom = cz - model.height / 2.0
+    raised = held_height(model, hand)
+    if raised != model.grasp_height:
+        model = replace(model, grasp_height=raised)
     grasp_z = bottom + model.grasp_height
     if model.grasp is GraspKind.SIDE:
         # Straight in from the robot's side of the table, whatever the object's position.
@@ -240,8 +263,8 @@ def compute_grasp_pose(
         orientation = top_orientation(finger)
         approach = (0.0, 0.0, -1.0)
     width = model.across(closing, yaw, seen)
-    if width > hand.jaw_opening + 1e-9:
-        raise GraspTooWideError(model.name, model.grasp.value, width, hand.jaw_opening)
+    if width > hand.widest + 1e-9:
+        raise GraspTooWideError(model.name, model.grasp.value, width, hand.jaw_opening, hand.jaw_clearance)
     if model.grasp is GraspKind.SIDE:
         depth = model.across(facing, yaw, seen)  # its extent along the approach, as across the jaws
         held = side_held(depth, hand)

@@ -108,10 +108,12 @@ def test_the_limit_is_where_the_centre_of_mass_reaches_the_fingertips() -> None:
 
 
 def test_depth_is_along_the_approach_and_a_top_grasp_is_not_limited_by_it() -> None:
-    """A 7.8 x 4 cm box: lying across the approach the jaws pass its 7.8 cm and the fingers hold all of its
-    4 cm depth; lying along it, the fingers would hold 3.8 of 7.8 cm; askew, its extent along the approach."""
+    """A 7.8 x 4 cm box: lying across the approach the jaws (with no clearance) pass its 7.8 cm and the fingers
+    hold all of its 4 cm depth; lying along it, the fingers would hold 3.8 of 7.8 cm; askew, its extent along
+    the approach."""
     box = deep_box(0.078)
-    across = compute_grasp_pose(box, BESIDE_THE_CUP, 0.0, LEFT, FACING)  # its long axis along x
+    snug = replace(HAND, jaw_clearance=0.0)  # 7.8 cm passes the 8 cm jaws only with no clearance to spare
+    across = compute_grasp_pose(box, BESIDE_THE_CUP, 0.0, LEFT, FACING, hand=snug)  # its long axis along x
     assert across.model.grasp is GraspKind.SIDE and across.width == pytest.approx(0.078)
     with pytest.raises(GraspTooDeepError) as along:
         compute_grasp_pose(box, BESIDE_THE_CUP, math.pi / 2.0, LEFT, FACING, hand=HAND)
