@@ -36,6 +36,7 @@ def _help(name: str) -> str:
 )
 @click.option("--read-only", is_flag=True, default=None, help=_help("read_only"))
 @click.option("--cors-origin", "cors_origins", multiple=True, metavar="ORIGIN", help=_help("cors_origins"))
+@click.option("--server-name", "server_names", multiple=True, metavar="NAME", help=_help("server_names"))
 @click.option(
     "--log-level", type=click.Choice(LOG_LEVELS, case_sensitive=False), help=_help("log_level") + " [default INFO]"
 )
@@ -55,6 +56,7 @@ def serve(
     update_token_file: Path | None,
     read_only: bool | None,
     cors_origins: tuple[str, ...],
+    server_names: tuple[str, ...],
     log_level: str | None,
     match_params: tuple[str, ...],
 ) -> None:
@@ -84,6 +86,7 @@ def serve(
             isolate_memory=True,  # a query past its deadline is stopped whatever the store
         ),
         cors_origins=setting("cors_origins").resolve(_option("cors_origins", cors_origins, "--cors-origin")),
+        server_names=setting("server_names").resolve(_option("server_names", server_names, "--server-name")),
         match_params=setting("match_params").resolve(_option("match_params", match_params, "--match-param")),
     )
     if config.match_params:  # a wrong name or value fails now, not at the first ranking
@@ -94,6 +97,13 @@ def serve(
     _check_free(config.host, config.bridge_port, "--bridge-port", "CBRS_BRIDGE_PORT")
     if not _is_loopback(config.host):  # after the checks: a host it cannot listen on is no warning but an error
         click.echo(f"warning: listening on {config.host}, reachable from other machines", err=True)
+        if not config.server_names:
+            click.echo(
+                "warning: any host name is answered: give --server-name (CBRS_SERVER_NAMES) with the names "
+                "clients use, so that a web page whose name resolves to this machine is refused (DNS rebinding) "
+                "and the browser's pages under those names may start tasks",
+                err=True,
+            )
     # One query before anything listens: a store that cannot answer as cbrs needs (a remote server whose
     # default graph is not the union of its graphs, found only once the seed is in) stops the command
     # with its reason, instead of a server that answers every request with that error.

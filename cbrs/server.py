@@ -49,6 +49,7 @@ class ServeConfig:
     bridge_port: int = 9090
     endpoint: EndpointConfig = field(default_factory=EndpointConfig)
     cors_origins: Sequence[str] = ()
+    server_names: Sequence[str] = ()  # the host names clients reach a routable bind by (the server_names setting)
     http_threads: int = 16  # threads answering requests; the streams have their own on top
     http_io_threads: int = 1  # Granian's Rust threads reading and writing HTTP, off the GIL
     header_timeout: float = 10.0  # seconds a client may take to send a request's headers, then it is dropped
@@ -106,7 +107,14 @@ class Server:
         self.sensors.offer(self.bridge)
         self.tasks.sensors = self.sensors
         self._transport: BridgeClient | None = None
-        self.app = create_app(self.sparql, self.config.cors_origins, self.tasks, self.matchmakers, self.own_origins)
+        self.app = create_app(
+            self.sparql,
+            self.config.cors_origins,
+            self.tasks,
+            self.matchmakers,
+            self.own_origins,
+            self.config.server_names,
+        )
         self.app.extensions["cbrs.live"] = self.live
         self.app.register_blueprint(components_blueprint)
         self.app.extensions["cbrs.streams"] = StreamSlots(self.config.stream_limit, self.config.streams_per_client)
@@ -180,13 +188,14 @@ class Server:
         return self._transport
 
     def own_origins(self) -> frozenset[str]:
-        """The origins this server's pages come from: the address it binds (and, for loopback, the
-        loopback names), on its HTTP port. Never taken from a request, so DNS rebinding cannot add one."""
+        """The origins this server's pages come from: the address it binds, the loopback names and the
+        configured server names, on its HTTP port. Never taken from a request, so DNS rebinding cannot
+        add one."""
         if self._http is None or not self._http.port:
             return frozenset()
         port = self.http_port
         host = f"[{self.config.host}]" if ":" in self.config.host else self.config.host
-        names = {host, "127.0.0.1", "localhost", "[::1]"}
+        names = {host, "127.0.0.1", "localhost", "[::1]", *self.config.server_names}
         return frozenset(f"http://{name}:{port}" for name in names)
 
     def bridge_origins(self) -> list[str | None]:
@@ -230,7 +239,7 @@ class Server:
         if self._names:
             return self._names[0]
         own = self.own_origins()
-        names = host_names(own, frozenset(self.config.cors_origins))
+        names = host_names(own, frozenset(self.config.cors_origins), frozenset(self.config.server_names))
         if own and self._http is not None and self._http.port:
             self._names.append(names)
         return names

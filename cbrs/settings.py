@@ -7,6 +7,7 @@ a value is taken from the command line, else the environment, else the default.
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -76,6 +77,18 @@ def _web_origins(text: str) -> tuple[str, ...]:
         if parts.scheme not in ("http", "https") or not parts.hostname or parts.path or parts.query:
             raise ValueError(f"{origin!r} is not a web origin: give scheme://host[:port], e.g. https://lab.example")
         found.append(origin)
+    return tuple(found)
+
+
+def _server_names(text: str) -> tuple[str, ...]:
+    """Host names as a client puts them in ``Host`` (``labhost``, ``cbrs.lab.example``), lower case, no
+    port: a URL or a name with a port would never match a request, and every page would be refused."""
+    found = []
+    for name in _origins(text):
+        label = r"[a-z0-9]([a-z0-9-]{0,61}[a-z0-9])?"
+        if not re.fullmatch(rf"{label}(\.{label})*\.?", name.lower()):
+            raise ValueError(f"{name!r} is not a host name: give a name such as labhost or cbrs.lab.example, no port")
+        found.append(name.lower().rstrip("."))
     return tuple(found)
 
 
@@ -397,6 +410,15 @@ SETTINGS: tuple[Setting, ...] = (
         "websocket, besides the server's own pages; none by default.",
         "CBRS_CORS_ORIGINS",
         _web_origins,
+    ),
+    Setting(
+        "server_names",
+        lambda: (),
+        "Comma-separated host names clients reach cbrs serve by when it listens on a routable address "
+        "(e.g. labhost,cbrs.lab.example): a request naming another host is refused (DNS rebinding), and "
+        "the browser's pages under these names may start tasks. None: any name is answered.",
+        "CBRS_SERVER_NAMES",
+        _server_names,
     ),
     Setting(
         "match_params",

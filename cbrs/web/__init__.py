@@ -64,6 +64,7 @@ def create_app(
     tasks: TaskRunner | None = None,
     matchmakers: Matchmakers | None = None,
     own_origins: Callable[[], Collection[str]] | None = None,
+    server_names: Sequence[str] = (),
 ) -> Flask:
     """The Flask app over ``sparql``'s knowledge base: the browser's pages, ``/sparql``, ``/update`` and
     ``/healthz``. Without ``tasks`` or ``matchmakers``, the app makes its own.
@@ -71,7 +72,8 @@ def create_app(
     ``own_origins`` gives the origins this server's pages are served from (``http://127.0.0.1:8080``...),
     from the address it was told to bind, never from a request's ``Host`` header (which DNS rebinding
     sets). ``cbrs serve`` passes them; then a request whose ``Host`` names none of them (when bound to
-    loopback) is refused, and a task may be started only from those pages or with the update token.
+    loopback, or not one of ``server_names`` when bound to a routable address) is refused, and a task
+    may be started only from those pages or with the update token.
     """
     from cbrs.web.graph_store import blueprint as graph_store_blueprint
     from cbrs.web.sparql import blueprint
@@ -106,6 +108,7 @@ def create_app(
         app.register_blueprint(importlib.import_module(f"cbrs.web.{module}").blueprint)
     page_blueprints = {module for module, _, _ in PAGES} | set(OTHER_PAGES)
     allowed = frozenset(cors_origins)
+    named = frozenset(server_names)
     links.install(app)
 
     known: list[frozenset[str | None] | None] = []
@@ -115,8 +118,8 @@ def create_app(
             return known[0]
         own = frozenset(own_origins()) if own_origins is not None else frozenset()
         if own:  # the server is listening: its address and port stay what they are
-            known.append(host_names(own, allowed))
-        return host_names(own, allowed)
+            known.append(host_names(own, allowed, named))
+        return host_names(own, allowed, named)
 
     # plain /sparql queries skip Flask's request machinery (cbrs.web.sparql_wsgi), with the same answers
     app.wsgi_app = SparqlHotPath(app.wsgi_app, sparql, names, app.config["MAX_CONTENT_LENGTH"])  # type: ignore[method-assign]
@@ -178,7 +181,7 @@ def create_app(
     @app.before_request
     def preflight() -> Response | None:
         if own_origins is not None:
-            _check_host(own_origins(), allowed)
+            _check_host(own_origins(), allowed, named)
         if request.method == "OPTIONS" and request.headers.get("Origin") in allowed:
             return Response(status=204)
         return None
@@ -216,14 +219,15 @@ def _nonce() -> str:
     return str(g.csp_nonce)
 
 
-def _check_host(own: Collection[str], cors_origins: Collection[str]) -> None:
-    """Refuse a request whose ``Host`` is not a name of this server, when it serves only loopback.
+def _check_host(own: Collection[str], cors_origins: Collection[str], server_names: frozenset[str]) -> None:
+    """Refuse a request whose ``Host`` is not a name of this server, when it serves only loopback or was
+    told its names (``server_names``).
 
     A page of another site whose name was made to resolve to 127.0.0.1 (DNS rebinding) reaches the
     server as same-origin to the browser, with its own name in ``Host``: that is what gives it away.
     """
     given = urlsplit("//" + request.host).hostname
-    names = host_names(frozenset(own), frozenset(cors_origins))
+    names = host_names(frozenset(own), frozenset(cors_origins), server_names)
     if names is not None and given not in names:
         raise MisdirectedRequest(
             f"this server answers to {', '.join(sorted(n for n in names if n))}, not to {given!r} "
@@ -232,10 +236,13 @@ def _check_host(own: Collection[str], cors_origins: Collection[str]) -> None:
 
 
 @functools.lru_cache(maxsize=16)
-def host_names(own: frozenset[str], cors_origins: frozenset[str]) -> frozenset[str | None] | None:
-    """The host names a request may give when the server binds only loopback; ``None``: any (bound to
-    a routable address, clients use names we cannot know)."""
+def host_names(
+    own: frozenset[str], cors_origins: frozenset[str], server_names: frozenset[str] = frozenset()
+) -> frozenset[str | None] | None:
+    """The host names a request may give: when the server binds only loopback, or was told the names
+    clients reach it by (``server_names``, the ``server_names`` setting); ``None``: any (bound to a
+    routable address with no names given, clients use names we cannot know)."""
     hosts = {urlsplit(origin).hostname for origin in own}
-    if not hosts or not hosts <= LOOPBACK_NAMES | {None}:
+    if not hosts or (not server_names and not hosts <= LOOPBACK_NAMES | {None}):
         return None
-    return frozenset(hosts | LOOPBACK_NAMES | {urlsplit(origin).hostname for origin in cors_origins})
+    return frozenset(hosts | LOOPBACK_NAMES | server_names | {urlsplit(origin).hostname for origin in cors_origins})
