@@ -67,6 +67,7 @@ class ServeConfig:
     )
     action_workers: int = field(default_factory=lambda: setting("action_workers").resolve())
     bridge_non_finite: str = field(default_factory=lambda: setting("bridge_non_finite").resolve())
+    bridge_max_message_bytes: int = field(default_factory=lambda: setting("bridge_max_message_bytes").resolve())
     component_lease: float = field(default_factory=lambda: setting("component_lease").resolve())
     match_params: tuple[str, ...] = field(default_factory=lambda: setting("match_params").resolve())
 
@@ -88,6 +89,7 @@ class Server:
             connections_per_client=self.config.bridge_connections_per_client,
             action_workers=self.config.action_workers,
             non_finite=self.config.bridge_non_finite,
+            max_message_bytes=self.config.bridge_max_message_bytes,
         )
         # one taxonomy index for the pages and the bridge
         self.matchmakers = Matchmakers(self.sparql, tuple(self.config.match_params))

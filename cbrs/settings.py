@@ -307,6 +307,15 @@ SETTINGS: tuple[Setting, ...] = (
         _non_finite,
     ),
     Setting(
+        "bridge_max_message_bytes",
+        lambda: 1024 * 1024,
+        "Largest message a rosbridge client may send, whole or in fragments; a larger one gets an error "
+        "status. rosbridge_suite allows 10 MB: raise it for raw images (a 640x480 RGB image is about "
+        "1.2 MB of base64).",
+        "CBRS_BRIDGE_MAX_MESSAGE_BYTES",
+        _positive(int),
+    ),
+    Setting(
         "component_lease",
         lambda: 3.0,
         "Seconds a component registered live over the bridge stays available without a heartbeat; when "
