@@ -13,6 +13,7 @@ import math
 from collections import defaultdict
 from contextvars import ContextVar
 from dataclasses import dataclass, field
+from enum import Enum
 from typing import TYPE_CHECKING
 
 from pyoxigraph import NamedNode
@@ -41,6 +42,7 @@ __all__ = [
     "NotGraspableError",
     "Person",
     "Pose",
+    "Reading",
     "SemanticMap",
     "UnresolvedDesignatorError",
     "designate",
@@ -91,20 +93,34 @@ class UnresolvedDesignatorError(KnowledgeBaseError):
 
 
 class AmbiguousDesignatorError(KnowledgeBaseError):
-    """Several things of the world are of the class a task's input names, and nothing tells them apart."""
+    """Several things of the world are of the class a task's input names, and nothing tells them apart.
+    ``stated``: each of ``candidates`` is stated to be of that very class (True), none is (False), not
+    asked (None: :attr:`Reading.ANY`)."""
 
     http_status = 422
 
-    def __init__(self, concept: str, candidates: list[str]) -> None:
+    def __init__(self, concept: str, candidates: list[str], stated: bool | None = None) -> None:
         self.concept = concept
         self.candidates = candidates
+        self.stated = stated
         names = ", ".join(local_name(c) for c in candidates)
         kind = local_name(concept)
         example = f"{shorten(candidates[0])} a lab:My{kind} . lab:My{kind} rdfs:subClassOf {shorten(concept)}"
-        super().__init__(
-            f"{kind} is ambiguous: {names} are all {kind}s; give the one the task means a class of its own in "
-            f"the map ({example}) and name that class in the task (its input's cbrs:parameterType and its goals)"
-        )
+        own = f"a class of its own in the map ({example})"
+        task = "the task (its input's cbrs:parameterType and its goals)"
+        if stated:
+            advice = (
+                f"are each stated to be a {kind}; give the one the task means {own} and name that class in {task}: "
+                f"a thing stated to be of a narrower class is named by that class, not by {shorten(concept)}"
+            )
+        elif stated is None:
+            advice = f"are all {kind}s; give the one the task means {own} and name that class in {task}"
+        else:
+            advice = (
+                f"are all {kind}s, none stated to be a {kind} and of no narrower class; name in {task} the "
+                f"narrower class of the one it means, or give the one the task means {own} and name that"
+            )
+        super().__init__(f"{kind} is ambiguous: {names} {advice} (docs/tasks.md, Write a task)")
 
 
 def local_name(iri: str) -> str:
@@ -771,23 +787,55 @@ def _dispenser(built: SemanticMap, iri: str, tap: str, facts: dict[str, dict[str
     return Dispenser(iri, built.things[iri], built.things[tap], built.things[spout], outlet)
 
 
-def designate(kb: KnowledgeBase, concept: str, prefer: str | None = None) -> str:
+class Reading(Enum):
+    """How :func:`designate` reads a class that several things of the world are of.
+
+    ``DIRECT_FIRST`` (the default): a class means, of those things, the ones *stated* to be of it and of
+    none of its narrower classes (its direct instances, as an OWL reasoner's ``direct`` instances); a
+    thing stated only of a narrower class (a lab's ``lab:GreenCup``) is named by that class. ``ANY``:
+    every thing of the class or below counts alike, and two are always ambiguous."""
+
+    DIRECT_FIRST = "direct-first"
+    ANY = "any"
+
+
+def designate(
+    kb: KnowledgeBase, concept: str, prefer: str | None = None, reading: Reading = Reading.DIRECT_FIRST
+) -> str:
     """The one thing of the world that is a ``concept`` (a task input's class), by the ``designate`` query.
 
     With several candidates, those that are parts of ``prefer`` (the requesting robot, through any
-    one or two links) win; still several is :class:`AmbiguousDesignatorError`, none is
+    one or two links) win; then, by ``reading``, the one stated to be a ``concept`` and of no narrower
+    class (docs/tasks.md, "Write a task"); still several is :class:`AmbiguousDesignatorError`, none is
     :class:`UnresolvedDesignatorError`.
     """
-    candidates = sorted({row["thing"].value for row in kb.select("designate", {"class": concept})})
+    types: dict[str, set[str]] = defaultdict(set)
+    for row in kb.select("designate", {"class": concept}):
+        types[row["thing"].value].add(row["type"].value)
+    candidates = sorted(types)
     if not candidates:
         raise UnresolvedDesignatorError(concept)
     if len(candidates) > 1 and prefer is not None:
         owned = [c for c in candidates if _linked(kb, prefer, c)]
         if len(owned) == 1:
             return owned[0]
+    if len(candidates) > 1 and reading is Reading.DIRECT_FIRST:
+        direct = _direct(kb, concept, types)
+        if len(direct) == 1:
+            return direct[0]
+        raise AmbiguousDesignatorError(concept, direct or candidates, stated=bool(direct))
     if len(candidates) > 1:
         raise AmbiguousDesignatorError(concept, candidates)
     return candidates[0]
+
+
+def _direct(kb: KnowledgeBase, concept: str, types: dict[str, set[str]]) -> list[str]:
+    """The things whose every stated class at or below ``concept`` (``types``, by thing) is ``concept``
+    or one the taxonomy makes the same (a subclass cycle): its direct instances among them."""
+    same = {concept}
+    if any(kinds - same for kinds in types.values()):
+        same |= {row["superclass"].value for row in kb.select("subclasses", {"class": concept})}
+    return sorted(thing for thing, kinds in types.items() if kinds <= same)
 
 
 def _linked(kb: KnowledgeBase, owner: str, thing: str) -> bool:

@@ -1,8 +1,9 @@
 """A second person loaded into the map (new-user trial: a task for a new receiving person). The map read,
 but the simulation built one person, so every later run was refused, also those that never look for a
 person ("the simulated home takes one mobile robot and one person"). The home now holds both; a task whose
-input is of class home:Person cannot tell which one it means and is refused by name before anything moves
-(tests/test_home_people.py runs a task for one of two people)."""
+input is of class home:Person cannot tell which one it means when both are stated to be a home:Person
+(one stated only of a narrower class, home:ElderlyPerson, is not what home:Person designates: docs/tasks.md)
+and is refused by name before anything moves (tests/test_home_people.py runs a task for one of two people)."""
 
 from __future__ import annotations
 
@@ -19,7 +20,7 @@ from cbrs.sim.world import open_world
 
 GRANDMA = """@prefix home: <https://w3id.org/cbrs/home#> . @prefix world: <https://w3id.org/cbrs/world#> .
 @prefix lab: <https://example.org/lab#> .
-lab:Grandma a home:ElderlyPerson ; home:colourName "red" ; home:rgba "0.85 0.1 0.1 1" ;
+lab:Grandma a home:Person ; home:colourName "red" ; home:rgba "0.85 0.1 0.1 1" ;
     home:isLocated world:Bedroom ; home:x 4.0 ; home:y 7.0 ; home:yaw 0.0 .
 """
 
