@@ -1,8 +1,9 @@
 """The checks before a run: a plan the home cannot carry out is refused before anything moves.
 
 By the map and where things are believed to be: a step that needs a person the home cannot tell, an
-arm step given a thing no arm reaches (or a place with no clear spot for the object), a camera that
-would not see what it looks for, an object no arm can load onto the platform. Otherwise the base drives
+arm step given a thing no arm reaches (an object's grasp point counted in three dimensions; a place with
+no clear spot for the object) or an object no hand can grip, a camera that would not see what it looks
+for, an object no arm can load onto the platform. Otherwise the base drives
 off and the step fails later. Each refusal is a typed error naming what was wrong.
 """
 
@@ -24,9 +25,9 @@ from cbrs.kb.semantic_map import MapObject, NotGraspableError, Person, Thing, lo
 from cbrs.sim import sight
 from cbrs.sim.arm_choice import who_loads
 from cbrs.sim.context import SimContext, SkillFailed
-from cbrs.sim.errors import MovesRefusedError
+from cbrs.sim.errors import GraspTooThinError, MovesRefusedError
 from cbrs.sim.geometry import Pose2D
-from cbrs.sim.grasping import ObjectModel
+from cbrs.sim.grasping import ObjectModel, held_height
 from cbrs.sim.grounding import docking_pose, people_given, task_inputs_of
 from cbrs.sim.perceived import PerceivedWorld
 from cbrs.sim.perception import ObjectEstimate
@@ -60,7 +61,9 @@ class CannotLoadError(KnowledgeBaseError):
 
 class OutOfReachError(KnowledgeBaseError):
     """A thing a task gives to a robot's arms is beyond the reach of every one of them, by the map: the
-    run is refused before anything moves. ``arms`` holds (arm IRI, mount x, y, reach, distance)."""
+    run is refused before anything moves. ``arms`` holds (arm IRI, mount x, y, reach, distance): for an
+    object the distance from the mount to its grasp point ``height`` m up (a sphere of the reach about
+    the mount), for a place on the floor plan (``height`` None)."""
 
     http_status = 422
 
@@ -71,6 +74,7 @@ class OutOfReachError(KnowledgeBaseError):
         where: tuple[float, float],
         arms: list[tuple[str, float, float, float, float]],
         why: str = "",
+        height: float | None = None,
     ) -> None:
         self.robot = robot
         self.thing = thing
@@ -78,14 +82,35 @@ class OutOfReachError(KnowledgeBaseError):
         self.arms = tuple(arms)
         self.why = why
         """For a place part of which is in reach: why none of it will do (empty otherwise)."""
+        self.height = height
         each = "; ".join(
             f"{local_name(arm)} reaches {reach:.2f} m from ({x:.2f}, {y:.2f}), {distance:.2f} m away"
             for arm, x, y, reach, distance in self.arms
         )
+        up = "" if height is None else f", its grasp point {height:.2f} m up"
+        lower = "" if height is None else ", or onto a lower surface"
         super().__init__(
-            f"no arm of {local_name(robot)} reaches the {local_name(thing)} at ({where[0]:.2f}, {where[1]:.2f}): "
-            f"{each}{f'; {why}' if why else ''}; move it within reach in the map (home:x, home:y) or give the "
-            "arms more home:reach"
+            f"no arm of {local_name(robot)} reaches the {local_name(thing)} at ({where[0]:.2f}, {where[1]:.2f}){up}: "
+            f"{each}{f'; {why}' if why else ''}; move it within reach in the map (home:x, home:y{lower}) or give "
+            "the arms more home:reach"
+        )
+
+
+class CannotGripError(KnowledgeBaseError):
+    """An object a task gives to a robot's arms is too thin for every hand of the robot by every approach
+    its class allows (:class:`GraspTooThinError`: a top grasp keeps the fingertips above the surface it
+    rests on): the run is refused before anything moves. ``refusals`` holds (arm IRI, approach, why)."""
+
+    http_status = 422
+
+    def __init__(self, robot: str, thing: str, refusals: list[tuple[str, str, str]]) -> None:
+        self.robot = robot
+        self.thing = thing
+        self.refusals = tuple(refusals)
+        each = "; ".join(f"{local_name(arm)} ({approach} grasp): {why}" for arm, approach, why in self.refusals)
+        super().__init__(
+            f"no hand of {local_name(robot)} can grip the {local_name(thing)}: {each}; a hand's "
+            "home:fingertipClearance says how far above the surface its fingertips stay"
         )
 
 
@@ -263,9 +288,11 @@ class PlanChecks:
 
     def _check_reach(self, plan: Plan, values: Mapping[str, Any]) -> None:
         """Refuse a plan whose arm steps work on a thing the task gives that no arm of their robot
-        reaches (by the map's mounts and reaches, and where the thing is believed to be), before any
-        step runs: otherwise the base drives off and the failure comes later, from a camera that
-        cannot see it or an arm that cannot reach it."""
+        reaches (by the map's mounts and reaches, and where the thing is believed to be: an object's grasp
+        point within the reach of a mount in three dimensions, a mug on a shelf 65 cm above the mounts
+        being out of reach though near on the floor plan), or an object no hand of theirs can grip
+        (:class:`CannotGripError`), before any step runs: otherwise the base drives off and the failure
+        comes later, from a camera that cannot see it or an arm that cannot reach it."""
         smap = self.world.map
         arms: dict[str, list[Any]] = {}
         for arm in smap.arms.values():
@@ -282,19 +309,67 @@ class PlanChecks:
             for iri in objects:  # an arm would take it: its class must say how (a decoration need not)
                 if not smap.objects[iri].grasp_approaches:
                     raise NotGraspableError(iri, smap.objects[iri].types)
+                self._check_grip(step.device or "", iri, robot_arms)
             if objects:
                 at_hand[step.device or ""] = objects
             for iri in iris:
                 box = self._reach_extent(iri)
                 if box is None:
                     continue
-                reaches = [(arm, distance_to_extent(box, arm.mount)) for arm in robot_arms]
+                height = self._grasp_height(iri)
+                reaches = [(arm, self._distance(box, height, arm.mount)) for arm in robot_arms]
                 report = [(arm.iri, arm.mount[0], arm.mount[1], arm.reach, d) for arm, d in reaches]
                 where = ((box[0] + box[1]) / 2, (box[2] + box[3]) / 2)
                 if not any(distance <= arm.reach for arm, distance in reaches):
-                    raise OutOfReachError(step.device or "", iri, where, report)
+                    raise OutOfReachError(step.device or "", iri, where, report, height=height)
                 if iri in smap.regions or iri in smap.furniture:
                     self._check_spot(step, iri, at_hand.get(step.device or "", []), report)
+
+    @staticmethod
+    def _distance(
+        box: tuple[float, float, float, float], height: float | None, mount: tuple[float, float, float]
+    ) -> float:
+        """How far from ``mount`` a hand must reach: to the extent ``box`` on the floor plan, and with a
+        ``height`` (an object's grasp point) up or down to it too (an arm reaches as far every way)."""
+        across = distance_to_extent(box, mount)
+        return across if height is None else math.hypot(across, height - mount[2])
+
+    def _grasp_height(self, iri: str) -> float | None:
+        """How high a hand takes an object of the map: its grasp point (its class's grasp height above its
+        bottom), where it is believed to be, else resting on its support; None for anything else (a
+        place keeps the floor plan: a hand reaches over part of it)."""
+        smap = self.world.map
+        obj = smap.objects.get(iri)
+        support = smap.things.get(obj.support or "") if obj is not None else None
+        if obj is None:
+            return None
+        believed = self.belief.position(obj.name)
+        if believed is not None:
+            bottom = believed[2] - obj.size[2] / 2
+        elif support is not None:
+            bottom = support.box.max_z
+        else:
+            return None
+        return bottom + obj.grasp_height
+
+    def _check_grip(self, robot: str, iri: str, arms: list[Any]) -> None:
+        """Refuse an object no hand of ``arms`` can grip by any approach its class allows, wherever it
+        is: too thin for a top grasp to hold above its surface (:func:`held_height`)."""
+        obj = self.world.map.objects[iri]
+        model = ObjectModel.of(obj)
+        refusals: list[tuple[str, str, str]] = []
+        for kind in model.preference:
+            for arm in arms:
+                hand = self.world.map.hands.get(arm.iri)
+                if hand is None:
+                    return  # a hand the map does not describe: the run's own to find
+                try:
+                    held_height(model.by(kind), hand)
+                except GraspTooThinError as thin:
+                    refusals.append((arm.iri, kind.value, str(thin)))
+                    continue
+                return
+        raise CannotGripError(robot, iri, refusals)
 
     def _check_spot(
         self, step: PlanStep, iri: str, carried: list[str], report: list[tuple[str, float, float, float, float]]

@@ -18,7 +18,7 @@ from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
 from cbrs.sim.components import SimEnvironment
-from cbrs.sim.sight import OutOfViewError
+from cbrs.sim.run_checks import OutOfReachError
 from cbrs.sim.world import open_world
 
 EXAMPLES = Path(__file__).parent.parent / "docs" / "examples"
@@ -101,18 +101,28 @@ def test_a_goal_that_holds_already_is_in_the_world_before_the_run() -> None:
 
 
 def test_a_mug_in_a_wall_cabinet_is_refused_before_anything_moves() -> None:
-    """The shelf is 65 cm above the arms' mounts, within their reach on the floor plan: refused by the
-    Kinect's view before anything moves (the reach check is on the floor plan only)."""
+    """The shelf is 65 cm above the arms' mounts, within their reach on the floor plan (0.65 m) but not
+    in three dimensions (its grasp point 0.97 m from the nearer mount): refused by the reach check before
+    anything moves, naming both arms and their distances, not by the Kinect's view (which would advise a
+    camera that could not help)."""
     kb = _store(["wall_cabinet.ttl"], ["mug_from_the_cabinet.ttl"])
     plan = Composer(kb).compose("MugFromTheCabinet").plan
     assert plan is not None
     requirements = {r.iri: r for r in kb.requirements()}
     with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
         environment = SimEnvironment(world, kb)
-        with pytest.raises(OutOfViewError) as refused:
+        with pytest.raises(OutOfReachError) as refused:
             environment.given(plan, requirements)
         assert not world.arm("left").held and not world.arm("right").held
-    assert "Mug1" in str(refused.value) and "Kinect01" in str(refused.value)
+    error = refused.value
+    assert error.thing == LAB + "Mug1" and error.height == pytest.approx(1.30 + 0.095 * 0.7)
+    distances = {arm: distance for arm, _, _, _, distance in error.arms}
+    assert distances == {
+        WORLD + "CytonDualArm01LeftArm": pytest.approx(0.97, abs=0.005),
+        WORLD + "CytonDualArm01RightArm": pytest.approx(1.14, abs=0.005),
+    }
+    assert all(reach == 0.85 for _, _, _, reach, _ in error.arms)
+    assert "1.37 m up" in str(error) and "onto a lower surface" in str(error)
 
 
 def test_the_pen_reaches_the_caregiver_in_the_bedroom_through_a_tracker_registered_in_turtle() -> None:
