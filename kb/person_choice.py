@@ -70,9 +70,9 @@ class AmbiguousPersonError(PersonError):
             step,
             people,
             f"is ambiguous for {local_name(step)}: the map has {len(people)} people ({names}) and the task "
-            "designates none of them; give the task an input of the class of the one it means (home:Person "
-            "designates a person only in a home of one; a class of their own, e.g. home:Caregiver or a lab's "
-            "subclass of home:Person, tells them apart)",
+            "designates none of them; give the task an input of the class of the one it means (a class "
+            "designates the one person stated to be of it and of no narrower class, so give each a class "
+            "of their own, e.g. home:Caregiver or a lab's subclass of home:Person)",
         )
 
 
