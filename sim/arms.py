@@ -643,13 +643,16 @@ class Arm:
         ok = motion.reached and error <= REACH_TOLERANCE
         return MotionResult(ok, error, "" if ok else f"stopped {error:.3f} m short")
 
-    def can_hold(self, position: Vec3, orientation: Quat, symmetric: bool = True) -> bool:
+    def can_hold(
+        self, position: Vec3, orientation: Quat, symmetric: bool = True, folded: Sequence[ArmSide] = ()
+    ) -> bool:
         """Whether the hand can be at this pose at all (inverse kinematics from any seed posture, or from
         the current one, in a posture that does not push into a fixed thing: :meth:`Kinematics.strikes`),
         without moving: a skill asks before it picks up what it could not set down. Before, a posture in
-        the dispenser's spout counted, and a cup taken from the top was carried into the spout."""
+        the dispenser's spout counted, and a cup taken from the top was carried into the spout. The arms
+        of ``folded`` are taken to be home, as in :meth:`dry_run`."""
         candidates = [orientation, flipped(orientation)] if symmetric else [orientation]
-        others = self._others()
+        others = self._others(folded)
         for candidate in candidates:
             if self._kinematics.wrist_strikes(self.side, position, candidate):
                 continue  # every solution would push into it: no need to solve
@@ -663,15 +666,20 @@ class Arm:
                     return True
         return False
 
-    def _others(self) -> dict[ArmSide, Sequence[float]]:
-        return {side: arm.joint_positions() for side, arm in self.peers.items() if side is not self.side}
+    def _others(self, folded: Sequence[ArmSide] = ()) -> dict[ArmSide, Sequence[float]]:
+        """The other arms' postures: where they are, or home for those of ``folded``."""
+        return {
+            side: HOME_CONFIGURATIONS[side] if side in folded else arm.joint_positions()
+            for side, arm in self.peers.items()
+            if side is not self.side
+        }
 
     def dry_run(self, folded: Sequence[ArmSide] = (), clear_by: float | None = None) -> PlannedArm:
         """A stand-in for this arm, from its posture now, whose moves are planned and not made; the other
         arms where they are, or those of ``folded`` in their home posture (where they will be by then: an
         arm that sets an object down for this one folds home after). With ``clear_by`` it notes where its
         moves first come within that distance of a fixture (:attr:`PlannedArm.brushed`)."""
-        others = {side: HOME_CONFIGURATIONS[side] if side in folded else q for side, q in self._others().items()}
+        others = self._others(folded)
         margin = self._clear_by if clear_by is None else clear_by
         planned = PlannedArm(self.side, self._kinematics, self.joint_positions(), others, margin)
         if self._keeping is not None:

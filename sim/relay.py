@@ -165,8 +165,12 @@ def relay_spot(
                 )
             except GraspMisfitError:
                 continue  # the hand cannot hold it so, wherever it is
-            if world.arm(side).can_hold(hand.position, hand.orientation) and world.arm(side).can_hold(
-                hand.pregrasp, hand.orientation
+            # the giver sets the object down and folds home before the taker's hand comes: asked with the
+            # giver where it is now, holding the object over the spot, no spot had room for the taker's hand
+            folded = (giver,) if side is taker and taker is not giver else ()
+            arm = world.arm(side)
+            if arm.can_hold(hand.position, hand.orientation, folded=folded) and arm.can_hold(
+                hand.pregrasp, hand.orientation, folded=folded
             ):
                 return held
         return None
