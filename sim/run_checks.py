@@ -25,7 +25,7 @@ from cbrs.kb.semantic_map import MapObject, NotGraspableError, Person, Thing, lo
 from cbrs.sim import sight
 from cbrs.sim.arm_choice import who_loads
 from cbrs.sim.context import SimContext, SkillFailed
-from cbrs.sim.errors import GraspTooThinError, MovesRefusedError
+from cbrs.sim.errors import GraspTooThinError, GraspTooWideError, MovesRefusedError
 from cbrs.sim.geometry import Pose2D
 from cbrs.sim.grasping import ObjectModel, held_height
 from cbrs.sim.grounding import docking_pose, people_given, task_inputs_of
@@ -97,9 +97,11 @@ class OutOfReachError(KnowledgeBaseError):
 
 
 class CannotGripError(KnowledgeBaseError):
-    """An object a task gives to a robot's arms is too thin for every hand of the robot by every approach
-    its class allows (:class:`GraspTooThinError`: a top grasp keeps the fingertips above the surface it
-    rests on): the run is refused before anything moves. ``refusals`` holds (arm IRI, approach, why)."""
+    """An object a task gives to a robot's arms fits no hand of the robot by any approach its class allows,
+    wherever it is and however it lies: too thin for a top grasp to hold above the surface it rests on
+    (:class:`GraspTooThinError`), or wider at its narrowest than the jaws open less their clearance
+    (:class:`GraspTooWideError`): the run is refused before anything moves. ``refusals`` holds (arm IRI,
+    approach, why)."""
 
     http_status = 422
 
@@ -107,10 +109,16 @@ class CannotGripError(KnowledgeBaseError):
         self.robot = robot
         self.thing = thing
         self.refusals = tuple(refusals)
-        each = "; ".join(f"{local_name(arm)} ({approach} grasp): {why}" for arm, approach, why in self.refusals)
+        said: dict[tuple[str, str], list[str]] = {}  # one reason once, with the arms it holds for
+        for arm, approach, why in self.refusals:
+            said.setdefault((approach, why), []).append(local_name(arm))
+        each = "; ".join(
+            f"by its {approach} grasp ({', '.join(arms)}): {why}" for (approach, why), arms in said.items()
+        )
         super().__init__(
             f"no hand of {local_name(robot)} can grip the {local_name(thing)}: {each}; a hand's "
-            "home:fingertipClearance says how far above the surface its fingertips stay"
+            "home:fingertipClearance and home:jawClearance say how far above the surface its fingertips stay "
+            "and how far each jaw must clear the object"
         )
 
 
@@ -309,7 +317,6 @@ class PlanChecks:
             for iri in objects:  # an arm would take it: its class must say how (a decoration need not)
                 if not smap.objects[iri].grasp_approaches:
                     raise NotGraspableError(iri, smap.objects[iri].types)
-                self._check_grip(step.device or "", iri, robot_arms)
             if objects:
                 at_hand[step.device or ""] = objects
             for iri in iris:
@@ -322,6 +329,8 @@ class PlanChecks:
                 where = ((box[0] + box[1]) / 2, (box[2] + box[3]) / 2)
                 if not any(distance <= arm.reach for arm, distance in reaches):
                     raise OutOfReachError(step.device or "", iri, where, report, height=height)
+                if iri in objects:  # in reach: a hand must fit it too
+                    self._check_grip(step.device or "", iri, robot_arms)
                 if iri in smap.regions or iri in smap.furniture:
                     self._check_spot(step, iri, at_hand.get(step.device or "", []), report)
 
@@ -354,7 +363,9 @@ class PlanChecks:
 
     def _check_grip(self, robot: str, iri: str, arms: list[Any]) -> None:
         """Refuse an object no hand of ``arms`` can grip by any approach its class allows, wherever it
-        is: too thin for a top grasp to hold above its surface (:func:`held_height`)."""
+        is and however it lies: too thin for a top grasp to hold above its surface (:func:`held_height`),
+        or wider at its narrowest (a cylinder's diameter, a box's narrower side: the least the jaws pass
+        whichever way they close) than the hand's widest."""
         obj = self.world.map.objects[iri]
         model = ObjectModel.of(obj)
         refusals: list[tuple[str, str, str]] = []
@@ -367,6 +378,10 @@ class PlanChecks:
                     held_height(model.by(kind), hand)
                 except GraspTooThinError as thin:
                     refusals.append((arm.iri, kind.value, str(thin)))
+                    continue
+                if model.width > hand.widest + 1e-9:
+                    wide = GraspTooWideError(model.name, kind.value, model.width, hand.jaw_opening, hand.jaw_clearance)
+                    refusals.append((arm.iri, kind.value, str(wide)))
                     continue
                 return
         raise CannotGripError(robot, iri, refusals)

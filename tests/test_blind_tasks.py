@@ -19,9 +19,10 @@ from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
 from cbrs.sim import skills
 from cbrs.sim.arms import ArmSide
-from cbrs.sim.components import CannotLoadError, SimEnvironment
+from cbrs.sim.components import SimEnvironment
 from cbrs.sim.grasping import ObjectModel, compute_grasp_pose
 from cbrs.sim.perception import recognise_object
+from cbrs.sim.run_checks import CannotGripError
 from cbrs.sim.world import open_world
 
 EXAMPLES = Path(__file__).parent.parent / "docs" / "examples"
@@ -88,7 +89,7 @@ def test_a_tin_wider_than_either_hand_opens_is_refused_before_anything_moves() -
     kb = _store("biscuit_tin.ttl", "fetch_my_biscuits.ttl")
     with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
         base = world.base_pose()
-        with pytest.raises(CannotLoadError) as refused:
+        with pytest.raises(CannotGripError) as refused:  # no hand fits it, before the loading check asks
             run_task(kb, "FetchMyBiscuits", SimEnvironment(world, kb), composer=Composer(kb))
         assert world.base_pose().distance_to(base.x, base.y) < 0.01
     message = str(refused.value)

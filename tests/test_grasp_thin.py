@@ -175,6 +175,27 @@ def test_an_object_wider_than_the_jaws_less_their_clearance_is_refused_naming_it
     assert compute_grasp_pose(replace(bottle, width=0.073), where, None, mount, facing, hand=HAND).width == 0.073
 
 
+def test_the_wine_bottle_is_refused_before_anything_moves() -> None:
+    """PutWineOnCupboard (docs/examples): the bottle's class allows only a side grasp, and no hand's jaws
+    pass its 7.5 cm with their clearance, whatever the seed; before, the hand moving in pushed it over."""
+    kb = KnowledgeBase.open(":memory:")
+    for name in ("wine_bottle.ttl", "low_cupboard.ttl"):
+        kb.load([EXAMPLES / name], graph="ontology")
+        kb.load([EXAMPLES / name], graph="map")
+    kb.load([EXAMPLES / "put_wine_on_cupboard.ttl"], graph="requirements")
+    plan = Composer(kb).compose("PutWineOnCupboard").plan
+    assert plan is not None
+    requirements = {r.iri: r for r in kb.requirements()}
+    with open_world(seed=1, semantic_map=SemanticMap.read(kb)) as world:
+        start = world.time
+        with pytest.raises(CannotGripError) as refused:
+            SimEnvironment(world, kb).given(plan, requirements)
+        assert world.time == start
+    assert refused.value.thing == LAB + "WineBottle1"
+    assert {approach for _, approach, _ in refused.value.refusals} == {"side"}
+    assert "at most 7.3 cm" in str(refused.value) and "home:jawClearance" in str(refused.value)
+
+
 def test_the_bundled_objects_fit_the_jaws_with_their_clearance() -> None:
     smap = bundled_map()
     for obj in smap.objects.values():
