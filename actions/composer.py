@@ -282,6 +282,10 @@ class Composer:
             return result
         if direct.plan is not None and not task.requirement.outputs and _shared_goals(direct.plan, self.index):
             return self._per_goal(task, direct)  # (outputs are no goal's: a task asking for one stays whole)
+        if direct.plan is None and not task.requirement.outputs and self._holds_some(task.requirement, holding):
+            # a goal that holds already wants no step: planned whole, it was asked of the components, and
+            # a goal nothing provides (a cup "on" a table) refused a task the world had half done
+            return self._per_goal(task, direct)
         if direct.plan is not None:
             return self._result(task, direct.plan, direct.unsatisfied, (direct,))
         if self.config.matched:
@@ -528,11 +532,14 @@ class Composer:
         direct plan credited one step's effect with goals about different things (the cup on the tray and
         the remote on its spot, both to one put-down), and one step moves one thing. Each goal's part takes
         the inputs of its own things (a class at or below the goal's subject or object) and those of no
-        goal's (the robot's), so the cup's part fetches the cup; a goal that holds already is skipped."""
+        goal's (the robot's), so the cup's part fetches the cup. A goal that holds already is a part of no
+        step, after the others: the world meets it, the runner checks it at the end, and a part before it
+        that undoes it has it achieved again or the plan refused (:meth:`_joined`)."""
         requirement = task.requirement
         goals = requirement.effects
         attempts = [direct]
         parts: list[_Part] = []
+        held: list[_Part] = []
         holding = self._state if self._state is not None else []
         for n, goal in enumerate(goals, start=1):
             others = [g for g in goals if g != goal]
@@ -542,9 +549,11 @@ class Composer:
                 if self._about(p.type, goal) or not any(self._about(p.type, other) for other in others)
             )
             part = replace(requirement, inputs=inputs, outputs=(), effects=(goal,))
+            sub_task = Task(f"{task.name}/goal{n}", part, None)
+            compose = partial(self._goal_part, sub_task)
             if self._achieved(part, holding):
+                held.append(_Part(f"goal {n} {statement_text(goal)}", compose, _achieved_plan(sub_task)))
                 continue
-            compose = partial(self._goal_part, Task(f"{task.name}/goal{n}", part, None))
             plan, unsatisfied, tried = compose(frozenset())
             attempts += tried
             if plan is None:
@@ -556,7 +565,7 @@ class Composer:
             parts.append(_Part(f"goal {n} {statement_text(goal)}", compose, plan))
         if not parts:
             return self._result(task, _achieved_plan(task), (), tuple(attempts))
-        return self._joined(task, parts, attempts, holding)
+        return self._joined(task, parts + held, attempts, holding)
 
     def _goal_part(self, sub_task: Task, undone: frozenset[Statement]) -> _Composed:
         attempt = self.attempt(sub_task.requirement, sub_task, undone)
@@ -615,6 +624,10 @@ class Composer:
         if requirement.outputs or not requirement.effects:
             return False
         return all(any(self._entails(h, e) for h in holding) for e in requirement.effects)
+
+    def _holds_some(self, requirement: Requirement, holding: Sequence[Statement]) -> bool:
+        """Whether some of the requirement's goals hold already (all of them: :meth:`_achieved`)."""
+        return any(any(self._entails(h, e) for h in holding) for e in requirement.effects)
 
     def _entails(self, fact: Statement, goal: Statement) -> bool:
         sides = ((goal.subject, fact.subject), (goal.predicate, fact.predicate), (goal.object, fact.object))
@@ -684,8 +697,10 @@ def _achieved_plan(task: Task) -> Plan:
     asked to stand on the table top was picked up and carried to the table's centre, out of reach."""
     requirement = task.requirement
     goals = tuple(
-        Binding("precondition", f"goal{n}", Source("world", None, requirement.iri), "Exact", 1.0, None, effect)
-        for n, effect in enumerate(requirement.effects, start=1)
+        Binding(
+            "precondition", statement_text(effect), Source("world", None, requirement.iri), "Exact", 1.0, None, effect
+        )
+        for effect in requirement.effects
     )
     return Plan(task.name, requirement.iri, "achieved", (), goals, 1.0, 0.0)
 

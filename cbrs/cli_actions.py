@@ -184,7 +184,10 @@ def _unused_note(result: CompositionResult) -> str:
 
 
 def _source(binding: Binding) -> str:
-    origin = "requirement" if binding.source.step is None else f"#{binding.source.step}"
+    if binding.source.step is None:  # a goal the world meets at the start (actions.composer) says so
+        origin = "world" if binding.source.name == "world" else "requirement"
+    else:
+        origin = f"#{binding.source.step}"
     if binding.role == "input":
         return f"{binding.name} <- {origin}.{binding.source.name}"
     return f"{binding.name} <- {origin}"
