@@ -7,6 +7,7 @@ simulation provides one (``sim.components``); tests provide stubs.
 
 from __future__ import annotations
 
+import collections.abc
 import json
 import time
 from collections.abc import Callable, Iterable, Mapping
@@ -379,11 +380,11 @@ def _runnable(
     if plan is None:
         return composition
     used = {c for step in plan.steps for c in step.candidates}
-    if all(step.component in registry and step.component not in passed for step in plan.steps):
+    if all(_can_run(step.component, registry, passed) for step in plan.steps):
         # Each step's first choice can run; an alternative that cannot would fail a failover for sure
         # (NoImplementationError after the others timed out), so the run keeps only those that can.
         steps = tuple(
-            replace(step, alternatives=tuple(c for c in step.alternatives if c in registry and c not in passed))
+            replace(step, alternatives=tuple(c for c in step.alternatives if _can_run(c, registry, passed)))
             for step in plan.steps
         )
         return composition if steps == plan.steps else replace(composition, plan=replace(plan, steps=steps))
@@ -393,13 +394,35 @@ def _runnable(
     if again.plan is not None:
         return again
     # Say which components the first plan wanted: "no component provides" alone hid a registered one.
-    wanted = {c for c in used if c not in registry or c in passed}
+    wanted = {c for c in used if not _can_run(c, registry, passed)}
     why = [
         (ad.iri, passed.get(ad.iri) or _cannot_run(ad))
         for ad in sorted(advertisements, key=lambda ad: ad.iri)
         if ad.iri in wanted
     ]
     return replace(again, unsatisfied=tuple(replace(u, unrunnable=tuple(why)) for u in again.unsatisfied))
+
+
+def unrunnable_steps(
+    kb: KnowledgeBase, plan: Plan, registry: collections.abc.Container[str], passed: Mapping[str, str] | None = None
+) -> tuple[tuple[PlanStep, str], ...]:
+    """The steps of ``plan`` whose component ``registry`` has no implementation of (or the environment
+    passes over), each with why: those :func:`run_task` composes the task without. ``cbrs plan`` says
+    so, where it composes over every advertisement."""
+    passed = passed or {}
+    if all(_can_run(step.component, registry, passed) for step in plan.steps):
+        return ()
+    ads = {ad.iri: ad for ad in kb.advertisements(include_unavailable=True)}
+    return tuple(
+        (step, passed.get(step.component) or _cannot_run(ads[step.component]))
+        for step in plan.steps
+        if not _can_run(step.component, registry, passed)
+    )
+
+
+def _can_run(component: str, registry: collections.abc.Container[str], passed: Mapping[str, str]) -> bool:
+    """Whether the environment implements ``component`` and does not pass it over now."""
+    return component in registry and component not in passed
 
 
 def _passed_over(environment: Environment, bus: EventBus, before: Mapping[str, str]) -> dict[str, str]:

@@ -10,6 +10,7 @@ import sys
 import time
 from collections import Counter
 from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -21,11 +22,11 @@ from cbrs.actions.events import Event
 from cbrs.actions.faults import RandomFaults, planned_faults
 from cbrs.actions.graph import statement_text
 from cbrs.actions.model import ActionLibrary
-from cbrs.actions.plan import Binding, Plan
+from cbrs.actions.plan import Binding, Plan, PlanStep
 from cbrs.actions.replanning import ReplanPolicy
-from cbrs.actions.runner import Replan, RunResult, run_task
+from cbrs.actions.runner import Replan, RunResult, run_task, unrunnable_steps
 from cbrs.app import App, parse_iri, pass_app
-from cbrs.extras import require
+from cbrs.extras import installed, require
 from cbrs.kb import KnowledgeBase, RemoteStoreError
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import shorten
@@ -131,11 +132,61 @@ def plan(
         from cbrs.actions.draw import draw  # matplotlib is slow to import; only when asked
 
         draw(result, drawing)
-    click.echo(json.dumps(result.to_dict(), indent=2) if as_json else plan_text(result))
+    here = _not_here(app.kb, result.plan) if result.plan is not None else None
+    if as_json:
+        found = result.to_dict()
+        if here is not None:
+            found.update(here.to_dict())
+        click.echo(json.dumps(found, indent=2))
+    else:
+        click.echo(plan_text(result) + (here.text() if here is not None else ""))
     if drawing is not None and not as_json:
         click.echo(f"drawing written to {drawing}")
     if result.status is not PlanStatus.PLANNED:
         raise SystemExit(1)
+
+
+@dataclass(frozen=True)
+class _NotHere:
+    """The plan's steps ``cbrs run`` cannot run in the simulated home now, with why, and those it reaches
+    only over a bridge (live components in other processes): ``cbrs plan`` composes over every
+    advertisement, the run over those it can run, so a plan alone would promise too much."""
+
+    unrunnable: tuple[tuple[PlanStep, str], ...]
+    bridged: tuple[PlanStep, ...]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "unrunnable": [{"step": s.index, "component": s.component, "why": why} for s, why in self.unrunnable],
+            "over_bridge": [{"step": s.index, "component": s.component} for s in self.bridged],
+        }
+
+    def text(self) -> str:
+        lines = [
+            f"\nnote: step {s.index} {shorten(s.component)} cannot run in the simulated home now: {why}; cbrs run"
+            " plans without it"
+            for s, why in self.unrunnable
+        ]
+        lines += [
+            f"\nnote: step {s.index} {shorten(s.component)} is a live component in another process: cbrs run"
+            " reaches it with --bridge ws://HOST:PORT of the server it registered with"
+            for s in self.bridged
+        ]
+        return "".join(lines)
+
+
+def _not_here(kb: KnowledgeBase, plan: Plan) -> _NotHere | None:
+    """What of ``plan`` the simulated home cannot run now (None without the [sim] part, which runs
+    nothing): the runner's own check, over the simulation's skills (no world is built) and the
+    components registered live."""
+    if not installed("sim"):
+        return None
+    from cbrs.sim.components import implementations
+
+    live = {iri for iri, state in kb.liveness.states().items() if state.live}
+    runnable = set(implementations(kb).names()) | live
+    bridged = tuple(step for step in plan.steps if step.component in live)
+    return _NotHere(unrunnable_steps(kb, plan, runnable), bridged)
 
 
 def plan_text(result: CompositionResult) -> str:
