@@ -135,9 +135,9 @@ def observations() -> Iterator[list[Observation]]:
     written: list[Observation] = []
     original = BeliefState.write
 
-    def keep(self: BeliefState, observation: Observation) -> None:
+    def keep(self: BeliefState, observation: Observation, whole: bool = False) -> None:
         written.append(observation)
-        original(self, observation)
+        original(self, observation, whole=whole)
 
     BeliefState.write = keep  # type: ignore[method-assign]
     try:
