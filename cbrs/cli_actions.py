@@ -76,7 +76,15 @@ def _compose_config(ignore_areas: bool, protect: bool, max_reachieved: int, **mo
 
 @click.command()
 @click.argument("task")
-@click.option("--json", "as_json", is_flag=True, help="Print the plan (or what is unsatisfied) as JSON.")
+@click.option(
+    "--json",
+    "as_json",
+    is_flag=True,
+    help=(
+        "Print the plan (or what is unsatisfied) as JSON; with a plan, its steps cbrs run cannot run in the"
+        " simulated home now (unrunnable) and those it reaches only with --bridge (over_bridge)."
+    ),
+)
 @click.option(
     "--draw",
     "drawing",
@@ -108,7 +116,10 @@ def plan(
 ) -> None:
     """Compose a plan for TASK: a requirement or action (req:FetchMyPen, act:RobotArmServeACup, or a bare name).
 
-    Exits with status 1 when no plan exists, after saying which need no component meets.
+    Exits with status 1 when no plan exists, after saying which need no component meets. The plan is
+    composed over every advertisement; a note follows it for each step cbrs run cannot run in the
+    simulated home now (no skill for its service, no live component to call), which the run plans
+    without.
     """
     if drawing is not None and drawing.suffix.lower() not in (".svg", ".png"):
         raise click.BadParameter(f"{drawing.name!r} must end in .svg or .png", param_hint="--draw")
