@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import click
+import pyoxigraph as ox
 
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import expand
@@ -63,6 +64,11 @@ def parse_iri(name: str, hint: str = "IRI", default_prefix: str | None = None) -
     if default_prefix is not None and ":" not in name:
         name = f"{default_prefix}:{name}"
     try:
-        return expand(name)
+        full = expand(name)
     except ValueError as error:
         raise click.BadParameter(str(error), param_hint=hint) from error
+    try:  # a space or a quote left in: said of the name as typed, not "Invalid IRI code point" alone
+        ox.NamedNode(full)
+    except ValueError as error:
+        raise click.BadParameter(f"{name!r} is not an IRI: {error}", param_hint=hint) from None
+    return full

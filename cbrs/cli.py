@@ -5,6 +5,7 @@ Library errors become one-line messages and a non-zero exit here, at the edge, a
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import json
 import os
@@ -13,6 +14,7 @@ import shlex
 import sys
 import traceback
 from collections import Counter
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -28,7 +30,7 @@ from cbrs.extras import require
 from cbrs.kb import Advertisement, KnowledgeBase, KnowledgeBaseError, Requirement, ServiceDescription
 from cbrs.kb.catalog import Catalogue, merge
 from cbrs.kb.derived_prefixes import StoreNames
-from cbrs.kb.errors import AlreadyRegisteredError, NotFoundError, QuerySyntaxError, without_password
+from cbrs.kb.errors import AlreadyRegisteredError, NotFoundError, QuerySyntaxError, RdfParseError, without_password
 from cbrs.kb.liveness import ComponentState
 from cbrs.kb.loader import LoadReport, ParsedFile
 from cbrs.kb.namespaces import CBRS, OWL, PREFIXES, RDF, GraphName, expand, near_prefixes, shorten, store_names
@@ -221,7 +223,8 @@ def load(app: App, files: tuple[Path, ...], graph: str | None, catalogs: tuple[P
             shown(stage, done, total)
 
         try:
-            report = app.kb.load(list(files), graph, catalogue, progress, replace=replace)
+            with _undeclared_prefixes():
+                report = app.kb.load(list(files), graph, catalogue, progress, replace=replace)
         finally:
             shown.clear()
     if interrupts.interrupted:
@@ -240,6 +243,36 @@ def load(app: App, files: tuple[Path, ...], graph: str | None, catalogs: tuple[P
     for graph, count in report.kept.items():
         robots = ", ".join(shorten(iri) for iri in report.kept_robots)
         click.echo(f"kept in {shorten(graph)}: the robots' own descriptions ({robots}; {_plural(count, 'triple')})")
+
+
+_UNDECLARED = re.compile(r"The prefix ([\w.-]*): has not been declared")
+"""Oxigraph's Turtle and TriG parsers' words for a prefix used and not declared."""
+
+
+@contextlib.contextmanager
+def _undeclared_prefixes() -> Iterator[None]:
+    """A file that did not parse for a prefix it uses and does not declare: said with the fix."""
+    try:
+        yield
+    except RdfParseError as error:
+        hint = _undeclared_hint(error.message)
+        if not hint:
+            raise
+        raise click.ClickException(with_notes(error) + hint) from error
+
+
+def _undeclared_hint(message: str) -> str:
+    """For a prefix a file uses without declaring it: its declaration when cbrs knows the prefix (the
+    file's own @prefix line is mistyped or missing), else the known prefixes nearest it (hme: for home:)."""
+    found = _UNDECLARED.search(message)
+    if found is None:
+        return ""
+    prefix = found.group(1)
+    if prefix in PREFIXES:
+        return f"; declare it: @prefix {prefix}: <{PREFIXES[prefix]}> ."
+    near = near_prefixes(prefix)
+    meant = f"did you mean {' or '.join(p + ':' for p in near)}? " if near else ""
+    return f"; {meant}(a file declares each prefix it uses: @prefix {prefix}: <IRI> .)"
 
 
 def _note_defaulted(report: LoadReport) -> None:
@@ -382,7 +415,7 @@ def _few(iris: list[str], limit: int = 3) -> str:
 @cli.command()
 @click.argument("text", required=False)
 @click.option("--file", "query_file", type=click.File("r", encoding="utf-8"), help="Read the query from a .rq file.")
-@click.option("--name", help="Run the named query queries/NAME.rq (see --list).")
+@click.option("--name", metavar="NAME", help="Run the named query queries/NAME.rq (see --list).")
 @click.option("--bind", "bindings", multiple=True, metavar="VAR=VALUE", help="Bind a named query's parameter.")
 @click.option(
     "--format",
@@ -413,6 +446,7 @@ def query(
         raise click.UsageError("give exactly one of TEXT, --file or --name")
     values = _bindings(bindings)
     if name:
+        _check_required(app.kb, name, values)
         # --bind takes the names the browser shows (books1:Novel), and its notes print them; the rows,
         # printed after, keep the declared prefixes, as the endpoint's do
         with store_names(StoreNames(lambda: app.kb)):
@@ -436,6 +470,18 @@ def query(
                 raise
             raise explained from error
     click.echo(render_result(result, fmt))
+
+
+def _check_required(kb: KnowledgeBase, name: str, values: dict[str, str]) -> None:
+    """Refuse a named query whose required parameter is not bound, saying the --bind that binds it (the
+    library's "binding description: ... needs this parameter" did not say how)."""
+    for parameter in kb.queries.get(name).parameters.values():
+        if parameter.required and parameter.name not in values:
+            what = f" ({parameter.description})" if parameter.description else ""
+            raise click.ClickException(
+                f"query {name!r} needs --bind {parameter.name}={parameter.kind.upper()}{what};"
+                " cbrs query --list shows each query's parameters"
+            )
 
 
 def _note_unknown_bindings(kb: KnowledgeBase, name: str, values: dict[str, str]) -> None:
@@ -476,7 +522,8 @@ def register(app: App, files: tuple[Path, ...], update: bool, as_json: bool) -> 
     transaction: a bad file registers none of them)."""
     inputs = [(file.read_bytes(), str(file)) for file in files]
     if update:
-        synced = app.kb.registry.synced_all(inputs)
+        with _undeclared_prefixes():
+            synced = app.kb.registry.synced_all(inputs)
         registered = [iri for done in synced for iri in done.registered]
         updated = [iri for done in synced for iri in done.updated]
         if as_json:
@@ -493,7 +540,8 @@ def register(app: App, files: tuple[Path, ...], update: bool, as_json: bool) -> 
                     click.echo(line)
         return
     try:
-        iris = app.kb.registry.register_all(inputs)
+        with _undeclared_prefixes():
+            iris = app.kb.registry.register_all(inputs)
     except AlreadyRegisteredError as error:  # some of the files' may be registered, some not: --update does both
         again = " ".join(shlex.quote(str(file)) for file in files)
         raise click.ClickException(f"{error}: cbrs register --update {again}") from error
@@ -510,7 +558,7 @@ def register(app: App, files: tuple[Path, ...], update: bool, as_json: bool) -> 
 @pass_app
 def deregister(app: App, iri: str, as_json: bool) -> None:
     """Remove a registered advertisement, or a requirement, and the nodes of its description (one transaction)."""
-    full = parse_iri(iri)
+    full = _resource_iri(app.kb, iri)
     name = shorten(full)  # as it was named: its prefix may be the store's own, gone with it
     try:
         removed = app.kb.registry.deregister(full)
@@ -591,7 +639,7 @@ def _live_state(state: ComponentState | None) -> str:
 @pass_app
 def show(app: App, iri: str, as_json: bool) -> None:
     """Show a service description's six-tuple, or any resource's triples (IRI or prefix:name)."""
-    full = parse_iri(iri)
+    full = _resource_iri(app.kb, iri)
     kb = app.kb
     if not kb.describes(full):
         raise click.ClickException(f"nothing in the store mentions <{full}>{not_found_hint(kb, full)}")
@@ -863,6 +911,29 @@ def _into(item: ParsedFile) -> str:
         return f"{item.triples} triples into {shorten(item.graph)}"
     parts = ", ".join(f"{n} into {shorten(graph)}" for graph, n in sorted(counts.items()))
     return f"{item.triples} triples: {parts}"
+
+
+def _resource_iri(kb: KnowledgeBase, text: str) -> str:
+    """:func:`parse_iri`, offering for a bare name (LocateMobileRobot_CeilingCamera01) the prefixed names
+    the store mentions."""
+    try:
+        return parse_iri(text)
+    except click.BadParameter:
+        if ":" in text:
+            raise
+        known = [f"{prefix}:{text}" for prefix, space in PREFIXES.items() if _mentions(kb, space + text)]
+        if not known:
+            raise
+        raise click.BadParameter(
+            f"{text!r} has no prefix; did you mean {' or '.join(known)}?", param_hint="IRI"
+        ) from None
+
+
+def _mentions(kb: KnowledgeBase, iri: str) -> bool:
+    try:
+        return kb.describes(iri)
+    except ValueError:  # not an IRI at all
+        return False
 
 
 def _prefix_hint(full: str) -> str:

@@ -40,6 +40,8 @@ def home(app: App, drawing: Path | None, width: int, browser: str | None, as_jso
     above as SVG. Exits with status 1 when the map cannot be read or the simulation would refuse it (the
     drawing is written all the same when the map can be read: it shows what is there).
     """
+    if drawing is not None and drawing.suffix.lower() != ".svg":  # SVG text in a .png: no viewer opens it
+        raise click.BadParameter(f"{drawing.name!r} must end in .svg (the drawing is SVG)", param_hint="--draw")
     found = survey(app.kb)
     root = (browser or f"http://127.0.0.1:{setting('port').resolve()}").rstrip("/")
     written = None

@@ -47,7 +47,7 @@ _PARAM = click.option(
     "params",
     multiple=True,
     metavar="NAME=VALUE",
-    help="Set a matchmaking parameter (repeatable; --params lists them), instead of the match_params "
+    help="Set a matchmaking parameter (repeatable; cbrs match --params lists them), instead of the match_params "
     f"setting [env {setting('match_params').env}].",
 )
 
