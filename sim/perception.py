@@ -125,27 +125,30 @@ def blobs(mask: NDArray[np.bool_]) -> list[tuple[NDArray[np.float64], NDArray[np
 def _connected(pixels: Sequence[tuple[int, int]], joined: Callable[[int, int], bool] | None = None) -> list[list[int]]:
     """The 8-connected groups of ``pixels`` (each (v, u)) as lists of their indices, each in the order a
     breadth-first walk meets them: two neighbouring pixels ``n`` and ``m`` are of one group when
-    ``joined(n, m)`` (always, when None). Masks hold a few hundred pixels, so the walk is cheap."""
-    index = {pixel: n for n, pixel in enumerate(pixels)}
+    ``joined(n, m)`` (always, when None). Masks hold a few hundred pixels, so the walk is cheap; a pixel
+    is keyed by one integer (rows ``stride`` apart, wide enough that no neighbour wraps to another row)."""
+    if not pixels:
+        return []
+    stride = max(u for _, u in pixels) + 3
+    keys = [v * stride + u for v, u in pixels]
+    find = {key: n for n, key in enumerate(keys)}.get
+    around = [dv * stride + du for dv in (-1, 0, 1) for du in (-1, 0, 1)]
     label = [-1] * len(pixels)
     groups: list[list[int]] = []
     for first in range(len(pixels)):
         if label[first] >= 0:
             continue
-        label[first] = len(groups)
+        group = len(groups)
+        label[first] = group
         members = [first]
-        at = 0
-        while at < len(members):
-            n = members[at]
-            at += 1
-            v, u = pixels[n]
-            for dv in (-1, 0, 1):
-                for du in (-1, 0, 1):
-                    m = index.get((v + dv, u + du))
-                    if m is None or label[m] >= 0 or (joined is not None and not joined(n, m)):
-                        continue
-                    label[m] = len(groups)
-                    members.append(m)
+        for n in members:  # a list walked while appended to: breadth-first
+            key = keys[n]
+            for step in around:
+                m = find(key + step)
+                if m is None or label[m] >= 0 or (joined is not None and not joined(n, m)):
+                    continue
+                label[m] = group
+                members.append(m)
         groups.append(members)
     return groups
 
