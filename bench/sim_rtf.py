@@ -25,7 +25,12 @@ moves less than the wall-clock one (pybullet's DIRECT client steps and renders o
 the most time of their own. ``--physics`` runs each task and seed once more, timing its own physics
 steps (``p.stepSimulation``) against the fresh world's steps alone: the ratio the run would reach if
 nothing but its physics cost anything (cProfile is not on then: it cools the caches between steps).
-``--json FILE`` writes the rows as a list of records.
+``--split`` runs each task once more (seed 0) and divides its CPU time by where it goes, each part
+less the parts it calls (no profiler, whose overhead on small calls distorts them): physics, the
+inverse-kinematics solver, rendering, the rest of the kinematics (collision checks, forward kinematics,
+lines), of perception, of stepping (the taps' check, the recorders), of driving the base, store
+queries, composing, and the rest (skills, executor, checks). ``--json FILE`` writes the rows as a list
+of records.
 
 Every run also gets a digest of what it did, so that a change made for speed can be shown to leave
 the runs as they were: SHA-256 over every observation written to the world graph (the belief after
@@ -65,7 +70,11 @@ from cbrs.actions.composer import Composer
 from cbrs.actions.runner import RunResult, run_task
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.semantic_map import SemanticMap
+from cbrs.kb.store import EmbeddedStore
+from cbrs.sim.arms import Kinematics
+from cbrs.sim.base import MobileBase
 from cbrs.sim.components import SimEnvironment
+from cbrs.sim.perceived import PerceivedWorld
 from cbrs.sim.world import TIME_STEP, HomeWorld
 
 TASKS = ("RobotArmServeACup", "FetchMyPen")
@@ -280,6 +289,61 @@ def physics_bound(
     return spent[0] / steps, alone / steps
 
 
+def _split_targets() -> list[tuple[Any, str, str]]:
+    """What :func:`split` times: (owner, attribute, part)."""
+    kinematics = ("solve", "collides", "strikes", "brushes", "wrist_strikes", "forward", "path_clear", "line")
+    return [
+        (p, "stepSimulation", "physics"),
+        (p, "calculateInverseKinematics", "inverse kinematics (pybullet)"),
+        (p, "getCameraImage", "rendering (pybullet)"),
+        *((Kinematics, name, "kinematics, the rest") for name in (*kinematics, "joint_path")),
+        (PerceivedWorld, "look", "perception, the rest"),
+        (PerceivedWorld, "feel", "perception, the rest"),
+        (HomeWorld, "step", "stepping, the rest"),
+        (MobileBase, "follow", "driving, the rest"),
+        (EmbeddedStore, "query", "store queries"),
+        (Composer, "compose", "composing"),
+    ]
+
+
+def split(kb: KnowledgeBase, smap: SemanticMap, composer: Composer, task: str, seed: int) -> dict[str, float]:
+    """CPU seconds of one run of ``task`` by part (:func:`_split_targets`), each less the parts it calls,
+    and the rest (``total`` is the run's)."""
+    spent: dict[str, float] = {}
+    stack: list[list[Any]] = []  # part, start, CPU of the parts called
+
+    def timed(part: str, original: Any) -> Any:
+        def call(*args: Any, **kwargs: Any) -> Any:
+            stack.append([part, time.thread_time(), 0.0])
+            try:
+                return original(*args, **kwargs)
+            finally:
+                _, start, inner = stack.pop()
+                took = time.thread_time() - start
+                spent[part] = spent.get(part, 0.0) + took - inner
+                if stack:
+                    stack[-1][2] += took
+
+        return call
+
+    originals = [(owner, name, getattr(owner, name)) for owner, name, _ in _split_targets()]
+    try:
+        for (owner, name, part), (_, _, original) in zip(_split_targets(), originals, strict=True):
+            setattr(owner, name, timed(part, original))
+        # built with the parts timed: the arms and the base keep the world's step as they find it
+        with HomeWorld.create(seed=seed, semantic_map=smap) as world:
+            spent.clear()
+            start = time.thread_time()
+            run_task(kb, task, SimEnvironment(world, kb), composer=composer)
+            total = time.thread_time() - start
+    finally:
+        for owner, name, original in originals:
+            setattr(owner, name, original)
+    spent["the rest"] = total - sum(spent.values())
+    spent["total"] = total
+    return spent
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--tasks", default=",".join(TASKS))
@@ -289,6 +353,7 @@ def main() -> None:
     parser.add_argument(
         "--physics", action="store_true", help="also time the tasks' own physics steps against stepping alone"
     )
+    parser.add_argument("--split", action="store_true", help="also divide a run's CPU time by where it goes")
     parser.add_argument("--json", type=Path, help="also write the rows to FILE as a list of records")
     parser.add_argument("--digests", type=Path, help="write each run's outcome digest to FILE (JSON)")
     parser.add_argument("--check", type=Path, help="compare the runs' digests with FILE; exit 1 if any differs")
@@ -346,6 +411,13 @@ def main() -> None:
                     f"{task:<18} {seed:>4}: {in_run * 1e6:.0f} us a step in the run, {alone * 1e6:.0f} alone: "
                     f"with nothing but its physics the run would reach {alone / in_run:.2f}x"
                 )
+    if args.split:
+        print("\nCPU seconds of one run (seed 0) by part, each less the parts it calls:")
+        for task in tasks:
+            parts = split(kb, smap, composer, task, 0)
+            total = parts.pop("total")
+            listed = ", ".join(f"{part} {cpu:.3f}" for part, cpu in sorted(parts.items(), key=lambda kv: -kv[1]))
+            print(f"{task}: {total:.3f} s: {listed}")
     if args.profile:
         listing = profile(kb, smap, composer, tasks, args.profile)
         print(f"\nprofile of one run of each task (seed 0), by own CPU time:\n{listing}")
