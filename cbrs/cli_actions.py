@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import contextlib
+import difflib
 import json
 import os
 import socket
@@ -357,6 +358,8 @@ def run(
     failing = [parse_iri(f, "--fail") for f in faults]
     actions = ActionLibrary.from_kb(app.kb)  # read once: the task's name and the composer take it
     iri = task_iri(app.kb, task, actions)  # an unknown task fails before the world is built
+    if failing:
+        _check_failing(app.kb, failing, bridged=bridge is not None)  # so does a mistyped --fail
 
     transport = _bridge(bridge) if bridge else None
     start = time.perf_counter()
@@ -445,6 +448,26 @@ def run(
                 err=True,
             )
         raise SystemExit(1)
+
+
+def _check_failing(kb: KnowledgeBase, failing: list[str], bridged: bool) -> None:
+    """Refuse a --fail that names no component the run could invoke, with the nearest names, before the
+    world is built (seconds): the simulation's components (cameras aside: the world's check after it is
+    built still applies), and with --bridge those in other processes."""
+    from cbrs.sim.components import implementations
+
+    known = set(implementations(kb).names())
+    if bridged:
+        known |= {ad.iri for ad in kb.advertisements() if ad.bridge_port is not None}
+    unknown = [f for f in failing if f not in known]
+    if not unknown:
+        return
+    names = sorted(shorten(k) for k in known)
+    said = []
+    for component in unknown:
+        near = difflib.get_close_matches(shorten(component), names, n=2)
+        said.append(shorten(component) + (f" (did you mean {' or '.join(near)}?)" if near else ""))
+    raise click.BadParameter(f"no simulated component {', '.join(said)}", param_hint="--fail")
 
 
 def _bridge(url: str) -> BridgeClient:

@@ -147,3 +147,21 @@ def test_a_home_drawing_is_refused_a_name_of_another_format(tmp_path: Path) -> N
     code, _, err = run("home", "--draw", str(tmp_path / "home.png"))
     assert code == 2 and "'home.png' must end in .svg" in error_line(err)
     assert not (tmp_path / "home.png").exists()
+
+
+def test_a_mistyped_fail_is_refused_with_its_near_names_before_the_world_is_built(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    pytest.importorskip("pybullet")
+    import cbrs.sim.world
+
+    def no_world(*args: object, **kwargs: object) -> None:
+        raise RuntimeError("the world was built for a run refused by its options")
+
+    monkeypatch.setattr(cbrs.sim.world, "open_world", no_world)
+    code, _, err = run("run", "FetchMyPen", "--fail", "svc:LocateMobileRobot_CeilingCamera1")
+    assert code == 2
+    assert error_line(err).endswith(
+        "no simulated component svc:LocateMobileRobot_CeilingCamera1 (did you mean"
+        " svc:LocateMobileRobot_CeilingCamera01 or svc:LocateMobileRobot_CeilingCamera02?)"
+    )
