@@ -22,7 +22,7 @@ from cbrs.kb.namespaces import BASE, RDF, RDFS, GraphName, shorten, written
 from cbrs.kb.owls import is_owls, is_owls_service
 from cbrs.kb.owls_source import GraphReads, owls_services, owls_source
 from cbrs.kb.results import releases_results
-from cbrs.kb.shapes import check_descriptions, line_of
+from cbrs.kb.shapes import check_descriptions, line_of, nearest_term
 from cbrs.kb.skolem import closure, is_skolem
 from cbrs.kb.standard_terms import StandardTerms
 from cbrs.kb.store import Store
@@ -509,7 +509,8 @@ def _problems(iri: str, by_subject: _Fields) -> list[str]:
         for parameter in model.get(prop, []):
             fields = by_subject.get(parameter, {}) if isinstance(parameter, ox.NamedNode) else {}
             if not fields.get(CBRS.parameterType):
-                problems.append(f"{_node(role, parameter, fields)} has no cbrs:parameterType")
+                hint = _slips(fields, [CBRS.parameterType])
+                problems.append(f"{_node(role, parameter, fields)} has no cbrs:parameterType{hint}")
     for prop, role in ((CBRS.hasPrecondition, "precondition"), (CBRS.hasEffect, "effect")):
         for condition in model.get(prop, []):
             fields = by_subject.get(condition, {}) if isinstance(condition, ox.NamedNode) else {}
@@ -521,8 +522,24 @@ def _problems(iri: str, by_subject: _Fields) -> list[str]:
                     "(outside OWL 2 DL): write cbrs:conditionSubject, cbrs:conditionPredicate and cbrs:conditionObject"
                 )
             elif missing:
-                problems.append(f"{_node(role, condition, fields)} lacks {', '.join(missing)}")
+                hint = _slips(fields, [p for p in CONDITION_PARTS if not fields.get(p)])
+                problems.append(f"{_node(role, condition, fields)} lacks {', '.join(missing)}{hint}")
     return problems
+
+
+_PARTS = frozenset((*CONDITION_PARTS, CBRS.parameterType, CBRS.parameterName, RDF + "type"))
+
+
+def _slips(fields: dict[str, list[ox.NamedNode | ox.BlankNode | ox.Literal]], absent: Sequence[str]) -> str:
+    """`` (it has cbrs:conditionPredicat: did you mean cbrs:conditionPredicate?)`` for a property of the node
+    that reads as a misspelling of a part it lacks; empty when none does. A misspelt required part was
+    reported as missing only, where a misspelt optional one got its did-you-mean from the shapes."""
+    hints = []
+    for prop in sorted(set(fields) - _PARTS):  # a part it has is no slip: conditionSubject is near conditionObject
+        near = nearest_term(prop, absent, cutoff=0.8)
+        if near is not None:
+            hints.append(f"it has {shorten(prop)}: did you mean {shorten(near)}?")
+    return f" ({'; '.join(hints)})" if hints else ""
 
 
 def _node(role: str, node: object, fields: dict[str, list[ox.NamedNode | ox.BlankNode | ox.Literal]]) -> str:
