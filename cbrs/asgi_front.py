@@ -147,11 +147,15 @@ class SparqlFront:
             return None
         if not self._host_ok(headers.get(b"host")):
             return None
+        method = scope.get("method")
         try:
-            parameters = _parameters(scope.get("query_string", b"").decode("ascii"))
+            query_string = scope.get("query_string", b"").decode("ascii")
+            lookup = _lone_query(query_string) if method == "GET" else None
+            if lookup is not None:
+                return lookup, None, -1
+            parameters = _parameters(query_string)
         except (UnicodeDecodeError, ValueError):
             return None
-        method = scope.get("method")
         if method in ("GET", "HEAD"):
             plain = plain_get(parameters)
             return None if plain is None else (*plain, -1)
@@ -208,7 +212,7 @@ class UnreadAnswers:
         self.held: Counter[str | None] = Counter()
 
     def over(self, client: str | None) -> bool:
-        return self.held[client] >= self.per_client
+        return self.held.get(client, 0) >= self.per_client  # without Counter's miss, in Python
 
     def paced(self, send: Send, client: str | None) -> Send:
         """``send`` with every body sent in pieces, counted against ``client`` until taken."""
@@ -422,6 +426,14 @@ def _parameters(query_string: str) -> list[tuple[str, str]]:
             name, _, value = field.partition("=")
             pairs.append((_unquote(name), _unquote(value)))
     return pairs
+
+
+def _lone_query(query_string: str) -> str | None:
+    """The query of an ASCII query string that is one ``query`` parameter, as ``plain_get(_parameters(...))``
+    reads it; ``None`` for any other (then those two read it). A robot's lookup sends just that."""
+    if "&" in query_string or not query_string.startswith("query="):
+        return None
+    return _unquote(query_string[6:])
 
 
 def _unquote(text: str) -> str:

@@ -29,7 +29,6 @@ import hmac
 import io
 import threading
 import time
-from collections import Counter
 from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import Future
 from concurrent.futures import TimeoutError as FutureTimeout
@@ -391,7 +390,7 @@ class SparqlService:
         self.config = config or EndpointConfig()
         self.lock = lock or threading.RLock()  # held by writers, so readers of cached descriptions see whole updates
         self._slots = threading.BoundedSemaphore(self.config.workers)
-        self._clients: Counter[str] = Counter()
+        self._clients: dict[str, int] = {}  # queries running per client
         self._clients_lock = threading.Lock()
         self._listeners: list[Callable[[], None]] = []
         self.generation = 0  # bumped by every update, so caches built from the store know they are stale
@@ -525,24 +524,29 @@ class SparqlService:
         slots (a single scan runs on the request's thread and takes none); the call returned gives
         them back (once)."""
         limit = min(self.config.workers_per_client, self.config.workers)
+        clients = self._clients  # a plain dict: every point lookup passes here, Counter's misses run Python
         with self._clients_lock:
-            if client is not None and self._clients[client] >= limit:
+            running = clients.get(client, 0) if client is not None else 0
+            if client is not None and running >= limit:
                 raise EndpointBusyError(self.config.workers, client, limit)
             if slot and not self._slots.acquire(blocking=False):
                 raise EndpointBusyError(self.config.workers)
             if client is not None:
-                self._clients[client] += 1
-        released = [False]
+                clients[client] = running + 1
+        released = False
 
         def release() -> None:
+            nonlocal released
             with self._clients_lock:
-                if released[0]:
+                if released:
                     return
-                released[0] = True
+                released = True
                 if client is not None:
-                    self._clients[client] -= 1
-                    if self._clients[client] <= 0:
-                        del self._clients[client]
+                    left = clients[client] - 1
+                    if left > 0:
+                        clients[client] = left
+                    else:
+                        del clients[client]
                 if slot:
                     self._slots.release()
 

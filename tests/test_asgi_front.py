@@ -21,11 +21,12 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from werkzeug.test import Client
 
-from cbrs.asgi_front import SparqlFront, _parameters
+from cbrs.asgi_front import SparqlFront, _lone_query, _parameters
 from cbrs.http_listener import HttpListener, ListenerConfig, UnknownLoopError, new_loop
 from cbrs.kb import KnowledgeBase
 from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.web import create_app
+from cbrs.web.sparql_wsgi import plain_get
 
 WAIT = 10.0
 OWN = "http://127.0.0.1:8080"
@@ -165,6 +166,18 @@ def test_any_ascii_query_string_is_read_as_parse_qsl_reads_it(query_string: str)
             _parameters(query_string)
         return
     assert _parameters(query_string) == expected
+    lone = _lone_query(query_string)  # the front's shortcut for a lookup's one parameter
+    if lone is not None:
+        assert plain_get(expected) == (lone, None)
+
+
+@pytest.mark.parametrize("query_string", ["query=a%20b", "query=", "query=%2B+", "query=a&format=json", "format=json"])
+def test_a_lone_query_parameter_is_read_as_plain_get_reads_it(query_string: str) -> None:
+    lone = _lone_query(query_string)
+    plain = plain_get(parse_qsl(query_string, keep_blank_values=True))
+    assert (lone is None) == ("&" in query_string or not query_string.startswith("query="))
+    if lone is not None:
+        assert plain == (lone, None)
 
 
 def test_a_query_string_that_is_not_utf8_goes_to_flask() -> None:
