@@ -1,7 +1,7 @@
 """Profile: where a point lookup's server CPU goes in cbrs serve, part by part, beside oxigraph serve.
 
 Run: python bench/endpoint_parts.py [--triples 200000] [--clients 4] [--seconds 2.5] [--rounds 5]
-[--memory] [--against DIR]
+[--memory] [--against DIR ...]
 
 Four servers (up to seven with the options) over the same generated data (10 triples per entity), each
 its own process, up at once and measured in turns (the order reversed every other round), with point
@@ -17,9 +17,9 @@ process, from /proc/PID/stat, around the turn, divided by the lookups answered i
 - ``oxigraph serve --union-default-graph``;
 - with ``--memory``, a cbrs server as ``cbrs serve`` makes it over an in-memory store holding the same
   data (a store ``cbrs serve --store :memory:`` cannot be loaded from outside before it serves);
-- with ``--against DIR``, each cbrs server also run from the cbrs package in DIR (another version,
-  such as ``git archive HEAD~1 | tar -x -C DIR``): a change measured beside what it changes, turn by
-  turn in one run.
+- with ``--against DIR`` (repeatable), each cbrs server also run from the cbrs package in DIR (another
+  version, such as ``git archive HEAD~1 | tar -x -C DIR``): a change measured beside what it changes,
+  turn by turn in one run.
 
 Each cbrs server has its own copy of the store (an on-disk store admits one process). The load
 generator runs on the same cores as the servers. Prints the machine (with its load average), the
@@ -29,6 +29,7 @@ inputs and one line per server.
 from __future__ import annotations
 
 import argparse
+import functools
 import os
 import platform
 import shutil
@@ -97,7 +98,8 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=5)
     parser.add_argument("--oxigraph", default=str(Path(PYTHON).parent / "oxigraph"))
     parser.add_argument("--memory", action="store_true", help="also serve the data from an in-memory store")
-    parser.add_argument("--against", type=Path, help="a cbrs version (a directory holding cbrs/) to serve beside")
+    parser.add_argument("--against", type=Path, action="append",
+                        help="a cbrs version (a directory holding cbrs/) to serve beside; may be repeated")  # fmt: skip
     args = parser.parse_args()
     print(f"machine: {platform.platform()}, {os.cpu_count()} cores, python {platform.python_version()}, "
           f"load average {os.getloadavg()[0]:.2f}")  # fmt: skip
@@ -124,11 +126,14 @@ def main() -> None:
         }
         if args.memory:
             starts["cbrs serve, in memory"] = lambda: _in_memory(data, None)
-        if args.against is not None:
-            against = args.against.resolve()
-            starts[f"cbrs serve, {against.name}"] = lambda: serve_cbrs(stores[3], against)
+        for index, other in enumerate(args.against or ()):
+            against = other.resolve()
+            copy = stores[3] if index == 0 else folder / f"cbrs-against{index}"
+            if index:
+                shutil.copytree(stores[0], copy)
+            starts[f"cbrs serve, {against.name}"] = functools.partial(serve_cbrs, copy, against)
             if args.memory:
-                starts[f"cbrs serve, in memory, {against.name}"] = lambda: _in_memory(data, against)
+                starts[f"cbrs serve, in memory, {against.name}"] = functools.partial(_in_memory, data, against)
         servers: dict[str, Served] = {}
         samples: dict[str, list[tuple[float, float]]] = {label: [] for label in starts}
         try:

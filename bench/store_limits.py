@@ -1,7 +1,8 @@
 """Benchmark: cbrs at the store's own limit, side by side with Oxigraph's own server and loader (issue 18).
 
 Run: python bench/store_limits.py [--quick] [--triples N] [--seconds S] [--clients 1,4,8] [--rounds 3]
-[--repeat 5] [--rows load,serve,memory] [--json FILE]
+[--repeat 5] [--rows load,serve,lookups,memory]
+[--cbrs-from DIR] [--json FILE]
 
 One run does every row against its anchor, on the same data and the same machine:
 
@@ -278,7 +279,16 @@ def main() -> None:
     parser.add_argument("--rounds", type=int, default=3, help="turns of each server per client count (median)")
     parser.add_argument("--quick", action="store_true", help="200,000 triples, 2 s turns, 3 repeats")
     parser.add_argument("--oxigraph", default=shutil.which("oxigraph") or str(Path(PYTHON).parent / "oxigraph"))
-    parser.add_argument("--rows", default="load,serve,memory", help="which rows to run, comma-separated")
+    parser.add_argument(
+        "--rows",
+        default="load,serve,memory",
+        help="which rows to run, comma-separated (lookups: the point lookups without the heavy queries)",
+    )
+    parser.add_argument(
+        "--cbrs-from",
+        type=Path,
+        help="serve cbrs from the cbrs package in this directory (another version) for the serving rows",
+    )
     parser.add_argument("--json", type=Path, help="write the rows to FILE as a JSON list of records")
     args = parser.parse_args()
     if args.quick:
@@ -288,7 +298,8 @@ def main() -> None:
     print(f"machine: {platform.platform()}, {os.cpu_count()} cores, python {platform.python_version()}, "
           f"load average {os.getloadavg()[0]:.2f}")  # fmt: skip
     print(f"anchor: {version} (serve --union-default-graph, load --graph)")
-    print(f"inputs: {args.triples} triples; point lookups {args.seconds:g} s per client count {clients}; "
+    print(f"inputs: {args.triples} triples; cbrs from {args.cbrs_from or 'this checkout'}; "
+          f"point lookups {args.seconds:g} s per client count {clients}; "
           f"heavy queries x{args.repeat}; rows {args.rows}")  # fmt: skip
     wanted = set(args.rows.split(","))
     rows = Rows()
@@ -297,11 +308,11 @@ def main() -> None:
         seed = folder / "seed.nq"
         _seed_dump(seed)
         print(f"\n  {'row':<46} {'cbrs':>12} {'anchor':>12} {'ratio':>7}  {'unit':<10} {'goal':<9}")
-        if wanted & {"load", "serve"}:
+        if wanted & {"load", "serve", "lookups"}:
             cbrs_store, ox_store, entities = _load_rows(rows, args, folder, "load" in wanted)
             _oxigraph_load(args.oxigraph, ox_store, seed)  # the bundled data too: both stores hold the same
-            if "serve" in wanted:
-                _serving_rows(rows, args, cbrs_store, ox_store, entities, clients)
+            if wanted & {"serve", "lookups"}:
+                _serving_rows(rows, args, cbrs_store, ox_store, entities, clients, heavy="serve" in wanted)
         if "memory" in wanted:
             _memory_rows(rows, args, folder, seed)
     if args.json is not None:
@@ -345,13 +356,16 @@ def _seed_dump(path: Path) -> None:
     kb.close()
 
 
-def _serving_rows(rows: Rows, args: Any, cbrs_store: Path, ox_store: Path, entities: int, clients: list[int]) -> None:
+def _serving_rows(
+    rows: Rows, args: Any, cbrs_store: Path, ox_store: Path, entities: int, clients: list[int], heavy: bool = True
+) -> None:
     """Both servers up at once, measured in turns (ABBA...) so that a change in the machine's other load
-    falls on both alike; each figure is the median of ``args.rounds`` turns."""
+    falls on both alike; each figure is the median of ``args.rounds`` turns. The heavy queries' row
+    too unless ``heavy`` is false (``--rows lookups``: the point lookups alone)."""
     rates: dict[tuple[str, int], float] = {}
     p99: dict[tuple[str, int], float] = {}
-    heavy: dict[str, dict[str, float]] = {"cbrs": {}, "oxigraph": {}}
-    servers = {"cbrs": serve_cbrs(cbrs_store)}
+    timings: dict[str, dict[str, float]] = {"cbrs": {}, "oxigraph": {}}
+    servers = {"cbrs": serve_cbrs(cbrs_store, args.cbrs_from)}
     try:
         servers["oxigraph"] = serve_oxigraph(args.oxigraph, ox_store)
         for count in clients:
@@ -362,9 +376,9 @@ def _serving_rows(rows: Rows, args: Any, cbrs_store: Path, ox_store: Path, entit
             for label, taken in samples.items():
                 rates[label, count] = statistics.median(rate for rate, _ in taken)
                 p99[label, count] = statistics.median(latency for _, latency in taken)
-        for name, query in HEAVY.items():
+        for name, query in HEAVY.items() if heavy else ():
             for label, served in servers.items():
-                heavy[label][name] = heavy_query(served, query, args.repeat)
+                timings[label][name] = heavy_query(served, query, args.repeat)
     finally:
         for served in servers.values():
             served.stop()
@@ -378,10 +392,12 @@ def _serving_rows(rows: Rows, args: Any, cbrs_store: Path, ox_store: Path, entit
         more = all(rates["cbrs", b] > rates["cbrs", a] for a, b in itertools.pairwise(clients))
         shown = {label: ", ".join(f"{rates[label, c]:.0f}" for c in clients) for label in ("cbrs", "oxigraph")}
         print(f"  more clients, more queries/s (cbrs): {more} ({shown['cbrs']}; oxigraph {shown['oxigraph']})")
+    if not heavy:
+        return
     for name in HEAVY:
-        ours, theirs = heavy["cbrs"][name] * 1000, heavy["oxigraph"][name] * 1000
+        ours, theirs = timings["cbrs"][name] * 1000, timings["oxigraph"][name] * 1000
         print(f"  heavy: {name:<28} cbrs {ours:8.1f} ms   oxigraph {theirs:8.1f} ms")
-    total_cbrs, total_ox = sum(heavy["cbrs"].values()), sum(heavy["oxigraph"].values())
+    total_cbrs, total_ox = sum(timings["cbrs"].values()), sum(timings["oxigraph"].values())
     rows.add("heavy queries (aggregates), queries/s", len(HEAVY) / total_cbrs, len(HEAVY) / total_ox, "queries/s",
              ">= 0.95x")  # fmt: skip
 
