@@ -22,6 +22,7 @@ while the transport lives (a server's own bridge connection outlives its runs).
 
 from __future__ import annotations
 
+import logging
 import threading
 import weakref
 from collections.abc import Mapping
@@ -31,6 +32,8 @@ from typing import Any, Protocol
 
 from cbrs.actions.errors import ActionsError
 from cbrs.kb.namespaces import shorten
+
+log = logging.getLogger("cbrs.actions.remote")
 
 __all__ = ["BreakerPolicy", "BreakerPolicyError", "ServiceCalls", "busy", "calls_of", "passed_over"]
 
@@ -119,6 +122,7 @@ class ServiceCalls:
             entry.timeout = timeout
             if pending is not None and not pending.done():
                 entry.given_up = (pending, sent, timeout)
+                _say_when_late(service, component, pending, timeout)
             if (
                 policy is not None
                 and policy.timeouts
@@ -150,6 +154,7 @@ class ServiceCalls:
         with self._lock:
             entry = self._services.setdefault(service, _Service(component))
             entry.given_up = (pending, sent, timeout)
+        _say_when_late(service, component, pending, timeout)
 
     def busy(self, service: str, now: float) -> str:
         with self._lock:
@@ -187,6 +192,30 @@ class ServiceCalls:
     def _forget_if_idle(self, service: str, entry: _Service) -> None:
         if entry.given_up is None or entry.given_up[0].done():
             del self._services[service]
+
+
+def _say_when_late(service: str, component: str, pending: Future[dict[str, Any]], timeout: float) -> None:
+    """Log an actuator's answer to a call given up, when it comes: the device may have acted (a door
+    motor opened the door 15 s after a 10 s timeout), and the run, which no longer waits, believes
+    nothing of it. The answer was dropped in silence, so nobody knew the belief had gone stale."""
+
+    def late(done: Future[dict[str, Any]]) -> None:
+        error = done.exception() if not done.cancelled() else None
+        if done.cancelled() or error is not None:
+            what = f"ended without an answer ({error or 'cancelled'})"
+        else:
+            what = "answered"
+        log.warning(
+            "%s (%s) %s after its call was given up (no answer within %g s): the run acted on none of it, "
+            "and what it believes of the device's effects may be stale; check the device "
+            "(docs/execution.md, 'An actuator is sent one command at a time')",
+            shorten(component),
+            service,
+            what,
+            timeout,
+        )
+
+    pending.add_done_callback(late)
 
 
 def _busy(service: str, entry: _Service, now: float) -> str:

@@ -120,6 +120,20 @@ def test_an_actuator_is_passed_over_while_it_executes_a_call_given_up_then_for_t
     assert len(transport.calls) == 1
 
 
+def test_an_actuators_answer_to_a_call_given_up_is_logged_when_it_comes(caplog: pytest.LogCaptureFixture) -> None:
+    """The door motor opened the door after the run gave its call up: the answer was dropped in silence, and
+    nobody knew that what the store believed of the door had gone stale."""
+    transport, clock = Silent(), Clock()
+    _time_out(_call(transport, clock, exclusive=True), clock)
+    assert not [r for r in caplog.records if "given up" in r.getMessage()]  # nothing yet: it may never answer
+    with caplog.at_level("WARNING", logger="cbrs.actions.remote"):
+        transport.calls[0][2].set_result({"doorStatus": {"@type": "home:Opened"}})
+    (record,) = [r for r in caplog.records if "given up" in r.getMessage()]
+    assert "svc:OpenDoor_DoorMotor05" in record.getMessage() and SERVICE in record.getMessage()
+    assert "answered after its call was given up (no answer within 10 s)" in record.getMessage()
+    assert "may be stale" in record.getMessage()
+
+
 def test_a_component_registered_again_by_a_restarted_program_starts_afresh() -> None:
     transport, clock = Silent(), Clock()
     _time_out(_call(transport, clock, session="cbrs session client 1"), clock)
