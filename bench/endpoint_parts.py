@@ -3,7 +3,7 @@
 Run: python bench/endpoint_parts.py [--triples 200000] [--clients 4] [--seconds 2.5] [--rounds 5]
 [--memory] [--against DIR ...]
 
-Four servers (up to seven with the options) over the same generated data (10 triples per entity), each
+Five servers (more with the options) over the same generated data (10 triples per entity), each
 its own process, up at once and measured in turns (the order reversed every other round), with point
 lookups from C client processes (``store_limits.run_clients``, no warm-up): for each, the median over the
 rounds of the queries per second and of the server's CPU per lookup (user + system of the whole
@@ -13,6 +13,8 @@ process, from /proc/PID/stat, around the turn, divided by the lookups answered i
 - the same process (Granian embedded, the store open, the bridge up) with the HTTP front replaced by
   a bare ASGI function that unquotes the query and has pyoxigraph evaluate it and write its JSON into
   bytes: Granian and pyoxigraph without cbrs's checks, accounting and budget writer;
+- the same written through the endpoint's budget writer (``_BudgetWriter``, which checks the byte
+  limit and the deadline as pyoxigraph writes), as ``cbrs serve`` writes a lookup's result;
 - the same answering a fixed body of a lookup's size: Granian alone, in the cbrs process;
 - ``oxigraph serve --union-default-graph``;
 - with ``--memory``, a cbrs server as ``cbrs serve`` makes it over an in-memory store holding the same
@@ -46,14 +48,14 @@ from store_limits import GRAPH, PYTHON, Served, _free_port, generate, run_client
 
 _PART = textwrap.dedent(
     """
-    import sys, threading
+    import sys, threading, time
     from urllib.parse import unquote_to_bytes
     import pyoxigraph as ox
     import cbrs.server as server_module
     from cbrs.http_listener import HttpListener
     from cbrs.kb import KnowledgeBase
     from cbrs.server import ServeConfig, Server
-    from cbrs.sparql_service import EndpointConfig
+    from cbrs.sparql_service import EndpointConfig, _BudgetWriter
     store, port, part = sys.argv[1], int(sys.argv[2]), sys.argv[3]
     kb = KnowledgeBase.open(store)
     backend = kb.store._backend
@@ -63,6 +65,11 @@ _PART = textwrap.dedent(
         if part == "pyoxigraph":
             text = unquote_to_bytes(scope["query_string"].partition(b"=")[2].replace(b"+", b" ")).decode()
             body = backend.query(text, use_default_graph_as_union=True).serialize(format=JSON)
+        elif part == "writer":  # the same, written through the endpoint's budget writer
+            text = unquote_to_bytes(scope["query_string"].partition(b"=")[2].replace(b"+", b" ")).decode()
+            writer = _BudgetWriter(1 << 26, time.monotonic() + 30, 30)
+            backend.query(text, use_default_graph_as_union=True).serialize(writer, JSON)
+            body = writer.getvalue()
         else:
             body = FIXED
         headers = [(b"content-type", b"application/sparql-results+json"), (b"content-length", str(len(body)).encode())]
@@ -109,7 +116,7 @@ def main() -> None:
         folder = Path(name)
         data = folder / "data.nt"
         entities = generate(data, args.triples)
-        stores = [folder / f"cbrs{i}" for i in range(4)]
+        stores = [folder / f"cbrs{i}" for i in range(5)]
         subprocess.run([PYTHON, "-m", "cbrs", "--store", str(stores[0]), "load", str(data), "--graph", GRAPH],
                        check=True, stdout=subprocess.DEVNULL)  # fmt: skip
         for copy in stores[1:]:
@@ -122,6 +129,7 @@ def main() -> None:
             "cbrs serve": lambda: serve_cbrs(stores[0]),
             "cbrs process, pyoxigraph only": lambda: _part(stores[1], "pyoxigraph", size),
             "cbrs process, fixed body": lambda: _part(stores[2], "fixed", size),
+            "cbrs process, pyoxigraph, budget writer": lambda: _part(stores[4], "writer", size),
             "oxigraph serve": lambda: serve_oxigraph(args.oxigraph, ox_store),
         }
         if args.memory:
