@@ -6,6 +6,7 @@ Library errors become one-line messages and a non-zero exit here, at the edge, a
 from __future__ import annotations
 
 import contextlib
+import difflib
 import importlib
 import json
 import os
@@ -234,6 +235,7 @@ def load(app: App, files: tuple[Path, ...], graph: str | None, catalogs: tuple[P
         click.echo(f"loaded {item.source}: {what}{_into(item)}{_mended(item)}")
     if graph is None:
         _note_defaulted(report)
+    _note_near_namespaces(report)
     for line in _load_summary(report, app.kb.store):
         click.echo(line)
     for line in _added_summary(report):
@@ -273,6 +275,34 @@ def _undeclared_hint(message: str) -> str:
     near = near_prefixes(prefix)
     meant = f"did you mean {' or '.join(p + ':' for p in near)}? " if near else ""
     return f"; {meant}(a file declares each prefix it uses: @prefix {prefix}: <IRI> .)"
+
+
+def _note_near_namespaces(report: LoadReport) -> None:
+    """Say on standard error which namespaces a file names things in that are one slip from one of
+    cbrs's (``https://w3id.org/cbrs/hom#``): the file parses and loads, and its things are of no class
+    the store knows, which nothing else said."""
+    known = list(PREFIXES.values())
+    for item in report.files:
+        spaces = {
+            _namespace(term.value)
+            for quad in item.quads
+            for term in (quad.subject, quad.predicate, quad.object)
+            if isinstance(term, ox.NamedNode)
+        }
+        for space in sorted(spaces - set(known)):
+            near = difflib.get_close_matches(space, known, n=1, cutoff=0.95)
+            if near:
+                prefix = next(p for p, namespace in PREFIXES.items() if namespace == near[0])
+                click.echo(
+                    f"note: {item.source} names things in <{space}>, which cbrs does not know: is it {prefix}:"
+                    f" <{near[0]}> mistyped?",
+                    err=True,
+                )
+
+
+def _namespace(iri: str) -> str:
+    cut = max(iri.rfind("#"), iri.rfind("/"))
+    return iri[: cut + 1] if cut > 0 else iri
 
 
 def _note_defaulted(report: LoadReport) -> None:

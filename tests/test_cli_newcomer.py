@@ -165,3 +165,14 @@ def test_a_mistyped_fail_is_refused_with_its_near_names_before_the_world_is_buil
         "no simulated component svc:LocateMobileRobot_CeilingCamera1 (did you mean"
         " svc:LocateMobileRobot_CeilingCamera01 or svc:LocateMobileRobot_CeilingCamera02?)"
     )
+
+
+def test_a_namespace_one_slip_from_cbrs_s_is_noted(tmp_path: Path) -> None:
+    text = PENCIL.read_text(encoding="utf-8")
+    typo = tmp_path / "pencil.ttl"
+    typo.write_text(text.replace("<https://w3id.org/cbrs/home#>", "<https://w3id.org/cbrs/hom#>", 1), encoding="utf-8")
+    code, out, err = run("load", "--graph", "map", str(typo))
+    assert code == 0 and "12 triples into graph:map" in out  # valid RDF: it loads
+    assert f"note: {typo} names things in <https://w3id.org/cbrs/hom#>, which cbrs does not know: is it home:" in err
+    code, _, err = run("load", "--graph", "map", str(PENCIL))
+    assert code == 0 and "note:" not in err
