@@ -23,8 +23,11 @@ from cbrs.kb.namespaces import PREFIXES, shorten
 from cbrs.kb.shapes import nearest_term
 
 if TYPE_CHECKING:
+    from collections.abc import Sequence
+
     from cbrs.kb.hands import Hand
     from cbrs.kb.knowledge_base import KnowledgeBase
+    from cbrs.kb.store import Term
 
 HOME = PREFIXES["home"]
 
@@ -46,6 +49,7 @@ __all__ = [
     "SemanticMap",
     "UnresolvedDesignatorError",
     "designate",
+    "designate_each",
     "local_name",
     "overlaps",
 ]
@@ -809,8 +813,24 @@ def designate(
     class (docs/tasks.md, "Write a task"); still several is :class:`AmbiguousDesignatorError`, none is
     :class:`UnresolvedDesignatorError`.
     """
+    return designate_each(kb, [(concept, prefer)], reading)[0]
+
+
+def designate_each(
+    kb: KnowledgeBase, wanted: Sequence[tuple[str, str | None]], reading: Reading = Reading.DIRECT_FIRST
+) -> list[str]:
+    """:func:`designate` of each (concept, prefer) of ``wanted``, their ``designate`` queries asked at
+    once: one request to a remote store instead of one per input of a task."""
+    asked = kb.queries.select_each(kb.store, [("designate", {"class": concept}) for concept, _ in wanted])
+    pairs = zip(wanted, asked, strict=True)
+    return [_designated(kb, concept, prefer, reading, rows) for (concept, prefer), rows in pairs]
+
+
+def _designated(
+    kb: KnowledgeBase, concept: str, prefer: str | None, reading: Reading, rows: list[dict[str, Term]]
+) -> str:
     types: dict[str, set[str]] = defaultdict(set)
-    for row in kb.select("designate", {"class": concept}):
+    for row in rows:
         types[row["thing"].value].add(row["type"].value)
     candidates = sorted(types)
     if not candidates:

@@ -39,7 +39,7 @@ from cbrs.kb import KnowledgeBase, Requirement, Statement
 from cbrs.kb.errors import NotFoundError
 from cbrs.kb.model import Advertisement
 from cbrs.kb.namespaces import PREFIXES
-from cbrs.kb.semantic_map import designate
+from cbrs.kb.semantic_map import designate_each
 from cbrs.kb.vocab import CBRS
 from cbrs.settings import setting
 from cbrs.sim import predicates as pred
@@ -326,19 +326,23 @@ class SimEnvironment:
 
     def given(self, plan: Plan, requirements: Mapping[str, Requirement]) -> dict[str, Any]:
         """The world's thing for each input a requirement gives: the one individual of the input's class."""
-        values: dict[str, Any] = {}
+        wanted: dict[str, tuple[str, str | None]] = {}  # input name -> (its class, the requesting robot)
         for step in plan.steps:
             for binding in step.inputs:
                 source = binding.source
-                if source.step is not None or source.name in values:
+                if source.step is not None or source.name in wanted:
                     continue
                 requirement = requirements.get(source.requirement or "")
                 if requirement is None:
                     continue
                 for parameter in requirement.inputs:
                     if parameter.name == source.name:
-                        iri = designate(self.kb, parameter.type, prefer=requirement.requested_by)
-                        values[source.name] = designator(iri, parameter.type)
+                        wanted[source.name] = (parameter.type, requirement.requested_by)
+        # every input's thing asked at once: one request to a remote store, not one per input
+        things = designate_each(self.kb, list(wanted.values())) if wanted else []
+        values: dict[str, Any] = {
+            name: designator(iri, concept) for (name, (concept, _)), iri in zip(wanted.items(), things, strict=True)
+        }
         self.context.designated = frozenset(str(value["@id"]) for value in values.values())
         self.context.plan, self.context.given = plan, values  # where a hold ends, for the approach
         self.context.step, self.context.known = None, {}

@@ -21,6 +21,7 @@ from cbrs.kb.errors import NotFoundError
 from cbrs.kb.queries import QueryLibrary
 from cbrs.kb.remote_store import RemoteStore, _order_keys, union_of_selects
 from cbrs.kb.resources import query_dir
+from cbrs.kb.semantic_map import designate, designate_each
 from cbrs.kb.store import EmbeddedStore
 from cbrs.kb.update_delta import DataUpdate, data_operations
 from cbrs.kb.vocab import CBRS
@@ -341,3 +342,13 @@ def test_a_belief_write_after_a_failed_one_replaces_the_graph(
     belief.write(Observation({pen: HOME + "Pen"}, time=3.0))
     held = {(q.subject.value, q.object.value) for q in kb.store.quads(graph=GraphName.WORLD.node)}
     assert held == {(pen, HOME + "Pen"), (STATE, "3")}  # the stray is gone (Oxigraph writes the double so)
+
+
+def test_a_runs_inputs_are_designated_with_one_request(remote: KnowledgeBase) -> None:
+    """The ``given`` step designates every input of a task at once (kb.semantic_map.designate_each): the
+    same things as one by one, in one request to a remote store instead of one per input."""
+    wanted = [(HOME + "Cup", None), (HOME + "Person", None), (HOME + "Table", None)]  # (a test above adds a pen)
+    one_by_one = [designate(remote, concept) for concept, _ in wanted]
+    requests = Requests(remote)
+    assert designate_each(remote, wanted) == one_by_one
+    assert requests.total == 1 and requests.kinds["designate"] == 0, requests.kinds
