@@ -12,7 +12,7 @@ import pytest
 
 from cbrs.rosbridge import Bridge, RunningBridge
 from tests.helpers_threads import assert_threads_end
-from tests.test_rosbridge import WAIT, Client
+from tests.test_rosbridge import WAIT, Client, client_maker
 
 LIMIT = 4096
 CALL_TIMEOUT = 120.0
@@ -23,15 +23,8 @@ CALL_TIMEOUT = 120.0
 def clients() -> Iterator[Callable[[], Client]]:
     threads = threading.active_count()
     running: RunningBridge = Bridge(call_timeout=CALL_TIMEOUT, max_message_bytes=LIMIT).start(port=0)
-    opened: list[Client] = []
-
-    def make() -> Client:
-        opened.append(Client(running.url))
-        return opened[-1]
-
-    yield make
-    for each in opened:
-        each.close()
+    with client_maker(running.url) as make:
+        yield make
     assert running.stop(timeout=5.0)
     assert_threads_end(threads, WAIT)
 

@@ -13,7 +13,7 @@ import socket
 import threading
 import time
 from collections.abc import Callable, Iterator
-from contextlib import ExitStack
+from contextlib import ExitStack, contextmanager
 from typing import Any
 
 import pytest
@@ -291,6 +291,22 @@ class Client:
         self._stack.close()
 
 
+@contextmanager
+def client_maker(url: str) -> Iterator[Callable[[], Client]]:
+    """Clients of the bridge at ``url``, made on demand and each closed at the end."""
+    opened: list[Client] = []
+
+    def make() -> Client:
+        opened.append(Client(url))
+        return opened[-1]
+
+    try:
+        yield make
+    finally:
+        for each in opened:
+            each.close()
+
+
 @pytest.fixture
 def bridge() -> Bridge:
     bridge = Bridge(call_timeout=WAIT, params={"/robot/speed": 0.5})
@@ -311,15 +327,8 @@ def server(bridge: Bridge) -> Iterator[RunningBridge]:
 @pytest.fixture
 def client(server: RunningBridge) -> Iterator[Callable[[], Client]]:
     """A factory of clients, all closed before the server stops."""
-    opened: list[Client] = []
-
-    def make() -> Client:
-        opened.append(Client(server.url))
-        return opened[-1]
-
-    yield make
-    for each in opened:
-        each.close()
+    with client_maker(server.url) as make:
+        yield make
 
 
 BAD_FRAMES = [

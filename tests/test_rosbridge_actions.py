@@ -14,7 +14,7 @@ import pytest
 
 from cbrs.rosbridge import Bridge, GoalHandle, GoalResult, GoalStatus, RunningBridge, ServiceError
 from tests.helpers_threads import assert_threads_end
-from tests.test_rosbridge import WAIT, Client
+from tests.test_rosbridge import WAIT, Client, client_maker
 
 TOKEN = "actions-test-token"
 
@@ -50,15 +50,8 @@ def server(bridge: Bridge) -> Iterator[RunningBridge]:
 
 @pytest.fixture
 def client(server: RunningBridge) -> Iterator[Callable[[], Client]]:
-    opened: list[Client] = []
-
-    def make() -> Client:
-        opened.append(Client(server.url))
-        return opened[-1]
-
-    yield make
-    for each in opened:
-        each.close()
+    with client_maker(server.url) as make:
+        yield make
 
 
 def goal(me: Client, action: str, args: Any, goal_id: str = "g1", feedback: bool = True) -> None:

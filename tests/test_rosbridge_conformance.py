@@ -16,7 +16,7 @@ import pytest
 
 from cbrs.bridge_client import BridgeClient
 from cbrs.rosbridge import Bridge, GoalHandle, RunningBridge
-from tests.test_rosbridge import WAIT, Client
+from tests.test_rosbridge import WAIT, Client, client_maker
 
 
 @pytest.fixture(scope="module")
@@ -40,15 +40,8 @@ def running(tmp_path_factory: pytest.TempPathFactory) -> Iterator[RunningBridge]
 
 @pytest.fixture
 def client(running: RunningBridge) -> Iterator[Callable[[], Client]]:
-    opened: list[Client] = []
-
-    def make() -> Client:
-        opened.append(Client(running.url))
-        return opened[-1]
-
-    yield make
-    for each in opened:
-        each.close()
+    with client_maker(running.url) as make:
+        yield make
 
 
 def test_publish_without_msg_sends_an_empty_message_as_rosbridge_does(client: Callable[[], Client]) -> None:

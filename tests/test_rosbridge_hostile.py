@@ -18,7 +18,7 @@ import pytest
 from websockets.exceptions import ConnectionClosed
 
 from cbrs.rosbridge import Bridge, GoalHandle, RunningBridge, server, session
-from tests.test_rosbridge import WAIT, Client
+from tests.test_rosbridge import WAIT, Client, client_maker
 
 NAMES, CALLS = 20, 4
 
@@ -54,15 +54,8 @@ def running(gate: threading.Event) -> Iterator[RunningBridge]:
 
 @pytest.fixture
 def client(running: RunningBridge) -> Iterator[Callable[[], Client]]:
-    opened: list[Client] = []
-
-    def make() -> Client:
-        opened.append(Client(running.url))
-        return opened[-1]
-
-    yield make
-    for each in opened:
-        each.close()
+    with client_maker(running.url) as make:
+        yield make
 
 
 def test_a_client_holding_too_many_names_is_refused_the_next_one(client: Callable[[], Client]) -> None:
