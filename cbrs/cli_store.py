@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import json
+import re
 import sys
 from pathlib import Path
 from typing import Any
@@ -14,9 +15,11 @@ import pyoxigraph as ox
 from cbrs import __version__
 from cbrs.app import App, pass_app
 from cbrs.cli_interrupts import HeldInterrupts
+from cbrs.kb import KnowledgeBase
 from cbrs.kb.backup import DEFAULT, Backup, NotAnExportError, export_format, read_backup
 from cbrs.kb.errors import QuerySyntaxError, StoreEvaluationError, without_password
-from cbrs.kb.namespaces import GraphName, shorten
+from cbrs.kb.namespaces import PREFIXES, GraphName, shorten
+from cbrs.kb.sparql_lexemes import HIDING
 from cbrs.kb.store import refuse_inserted_blank_nodes
 from cbrs.output import ProgressLine
 from cbrs.sparql_hints import explain_syntax_error, operation_kind
@@ -200,12 +203,38 @@ def update(app: App, text: str | None, update_file: Any, as_json: bool) -> None:
         return
     for line in report.lines():
         click.echo(line)
+    if not report.changed:
+        _note_unknown_names(app.kb, body)
     if report.changed and not app.kb.store.is_seeded():  # CLEAR ALL, DROP GRAPH graph:ontology
         click.echo(
             "note: graph:ontology is empty now: the next command that opens the store seeds it again with the "
             "bundled data (cbrs restore FILE puts a backup back)",
             err=True,
         )
+
+
+_PREFIXED = re.compile(r"(?<![\w?$:])([A-Za-z][\w-]*):([A-Za-z_][\w-]*(?:\.[\w-]+)*)")
+_DECLARED = re.compile(r"PREFIX\s+([\w-]*):", re.IGNORECASE)
+
+
+def _note_unknown_names(kb: KnowledgeBase, body: str) -> None:
+    """After an update that changed no graph's size: say which names it uses that the store mentions
+    nowhere (home:yw for home:yaw matched nothing, and "no graph changed" said no more), with the
+    nearest names. Only cbrs's own prefixes, as the update does not declare them itself."""
+    from cbrs.task_names import near_names  # the action model: only when an update changed nothing
+
+    text = re.sub(HIDING, " ", body)
+    declared = set(_DECLARED.findall(text))
+    seen = set(map(shorten, kb.store.graphs()))  # a graph's name is mentioned in no triple
+    for prefix, local in _PREFIXED.findall(text):
+        name = f"{prefix}:{local}"
+        if prefix not in PREFIXES or prefix in declared or name in seen:
+            continue
+        seen.add(name)
+        if not kb.describes(PREFIXES[prefix] + local):
+            near = near_names(kb, PREFIXES[prefix] + local)
+            meant = f"; did you mean {' or '.join(near)}?" if near else ""
+            click.echo(f"note: nothing in the store mentions {name}{meant}", err=True)
 
 
 def _stopped(location: str, writing: bool) -> str:

@@ -176,3 +176,11 @@ def test_a_namespace_one_slip_from_cbrs_s_is_noted(tmp_path: Path) -> None:
     assert f"note: {typo} names things in <https://w3id.org/cbrs/hom#>, which cbrs does not know: is it home:" in err
     code, _, err = run("load", "--graph", "map", str(PENCIL))
     assert code == 0 and "note:" not in err
+
+
+def test_an_update_that_changed_nothing_names_what_the_store_does_not_mention() -> None:
+    code, out, err = run("update", "DELETE WHERE { GRAPH graph:map { world:Pen home:yw ?yaw } }  # home:zz")
+    assert code == 0 and "no graph changed in size" in out
+    assert err.splitlines() == ["note: nothing in the store mentions home:yw; did you mean home:yaw?"]
+    code, out, err = run("update", "DELETE WHERE { GRAPH graph:map { world:Pen home:yaw ?yaw } }")
+    assert code == 0 and "graph:map: -1 triples" in out and err == ""
