@@ -53,22 +53,27 @@ def deep_box(depth: float, approaches: tuple[GraspKind, ...] = (GraspKind.SIDE, 
     return ObjectModel("Carton", "green", 0.08, 0.04, approaches[0], 0.06, approaches, (0.04, depth))
 
 
+def panda_pointing_down(client: int) -> tuple[int, tuple[float, float, float]]:
+    """The Panda loaded into ``client``, its hand pointing down and its fingers open: the body, and where
+    its grasp target (panda_grasptarget) is."""
+    p.setAdditionalSearchPath(PYBULLET_DATA, physicsClientId=client)
+    body = p.loadURDF(panda_urdf(), useFixedBase=True, physicsClientId=client)
+    down = p.getQuaternionFromEuler((math.pi, 0.0, 0.0))
+    q = p.calculateInverseKinematics(body, EE_LINK, (0.5, 0.0, 0.4), down, maxNumIterations=200, physicsClientId=client)
+    for joint, angle in enumerate(q[:7]):
+        p.resetJointState(body, joint, angle, physicsClientId=client)
+    for finger in (9, 10):
+        p.resetJointState(body, finger, 0.04, physicsClientId=client)
+    target = p.getLinkState(body, EE_LINK, computeForwardKinematics=True, physicsClientId=client)[4]
+    return body, target
+
+
 def test_the_finger_length_is_the_robots_hand_from_the_palm_to_the_fingertips() -> None:
     """Measured on the Panda's URDF (its collision meshes, the hand pointing down): the palm's lowest
     point to the fingertips. The shipped map describes the robot's hands; this keeps them the URDF's."""
     client = p.connect(p.DIRECT)
     try:
-        p.setAdditionalSearchPath(PYBULLET_DATA, physicsClientId=client)
-        body = p.loadURDF(panda_urdf(), useFixedBase=True, physicsClientId=client)
-        down = p.getQuaternionFromEuler((math.pi, 0.0, 0.0))
-        q = p.calculateInverseKinematics(
-            body, EE_LINK, (0.5, 0.0, 0.4), down, maxNumIterations=200, physicsClientId=client
-        )
-        for joint, angle in enumerate(q[:7]):
-            p.resetJointState(body, joint, angle, physicsClientId=client)
-        for finger in (9, 10):
-            p.resetJointState(body, finger, 0.04, physicsClientId=client)
-        target = p.getLinkState(body, EE_LINK, computeForwardKinematics=True, physicsClientId=client)[4]
+        body, target = panda_pointing_down(client)
         palm = p.getAABB(body, 8, physicsClientId=client)[0][2]  # panda_hand's lowest point
         tips = min(p.getAABB(body, finger, physicsClientId=client)[0][2] for finger in (9, 10))
     finally:

@@ -19,13 +19,13 @@ from cbrs.kb import KnowledgeBase
 from cbrs.kb.hands import FINGERTIP_CLEARANCE, JAW_CLEARANCE, HandError
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
-from cbrs.sim.arms import EE_LINK, PYBULLET_DATA, panda_urdf
 from cbrs.sim.components import SimEnvironment
 from cbrs.sim.errors import GraspMisfitError, GraspTooThinError, GraspTooWideError
 from cbrs.sim.grasping import GraspKind, ObjectModel, compute_grasp_pose, held_height
 from cbrs.sim.run_checks import CannotGripError
 from cbrs.sim.scene import bundled_map
 from cbrs.sim.world import open_world
+from tests.test_grasp16_depth import panda_pointing_down
 from tests.test_hand_reader import hands_of
 
 EXAMPLES = Path(__file__).parent.parent / "docs" / "examples"
@@ -51,17 +51,7 @@ def _measured() -> tuple[float, float]:
     distance from it, by the collision shapes' closest points (the hand pointing down, the fingers open)."""
     client = p.connect(p.DIRECT)
     try:
-        p.setAdditionalSearchPath(PYBULLET_DATA, physicsClientId=client)
-        body = p.loadURDF(panda_urdf(), useFixedBase=True, physicsClientId=client)
-        down = p.getQuaternionFromEuler((math.pi, 0.0, 0.0))
-        q = p.calculateInverseKinematics(
-            body, EE_LINK, (0.5, 0.0, 0.4), down, maxNumIterations=200, physicsClientId=client
-        )
-        for joint, angle in enumerate(q[:7]):
-            p.resetJointState(body, joint, angle, physicsClientId=client)
-        for finger in (9, 10):
-            p.resetJointState(body, finger, 0.04, physicsClientId=client)
-        target = p.getLinkState(body, EE_LINK, computeForwardKinematics=True, physicsClientId=client)[4]
+        body, target = panda_pointing_down(client)
         below = 0.05  # a plate's top this far below the grasp point
         plate = p.createCollisionShape(p.GEOM_BOX, halfExtents=(0.2, 0.2, 0.001), physicsClientId=client)
         plate_body = p.createMultiBody(
