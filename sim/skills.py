@@ -307,8 +307,76 @@ def _lower(arm: _Moving, grasp: GraspPose, region: Region) -> tuple[MotionResult
     return arm.move_to(place, ee.orientation, speed=PLACE_SPEED, symmetric=False), place
 
 
+BACK_OFF_STEP = 0.05
+"""The retreat's collision check plans each straight line in pieces of up to 5 cm (:func:`_clear_way`):
+each piece is a joint-space move checked for collisions every 0.05 rad, and asks the inverse kinematics
+from every seed posture (about 0.1-0.3 s a piece), so fewer pieces cost less."""
+BACK_OFF_TURN = 0.6
+"""The most (rad) a joint may turn over one piece of the retreat's collision-checked line: a piece that
+turns more has gone round to another posture, since the line's own was not clear (:func:`_clear_way`).
+Measured: a piece turned a joint at most 0.14 rad along the bundled retreats and 0.09 along a 30 cm
+bottle's; 1.3 rad where the line's own posture ran into the Kinect."""
+
+
+def _retreat(grasp: GraspPose, place: Vec3) -> list[Vec3]:
+    """Where the hand goes, in straight lines, after letting go of the object at ``place``: back along the
+    approach by the pre-grasp distance (:meth:`GraspPose.backed_off`); then, when the object's top stands
+    above the grasp point there (the hand is beside it), straight up to ABOVE_CLEARANCE over that top,
+    before the joint-space fold home. Folded home from beside a 30 cm bottle, the hand swung forward over
+    it below its top and knocked it over; the backed-off hand is above a cup's or a pen's top (by 2.8 cm
+    over the cup under the tap) and folds home from there as before."""
+    back = grasp.backed_off(place)
+    top = place[2] - grasp.bottom_offset + grasp.model.height
+    return [back] if back[2] >= top else [back, (back[0], back[1], top + ABOVE_CLEARANCE)]
+
+
+def _clear_way(arm: _Moving, legs: Sequence[Vec3], orientation: Quat) -> str:
+    """Why the hand, where it is, could not go along the straight ``legs`` in turn (empty if it can). A
+    straight line is planned on inverse kinematics alone, so each is planned again here in pieces of
+    BACK_OFF_STEP, each a joint-space move whose path keeps the arm clear of the fixed things and the
+    other arm (:meth:`Arm.reach`, on a dry run) and turns no joint more than BACK_OFF_TURN. The first piece
+    goes by its line and only its end is checked: the fingers start within the collision margin of the
+    surface they let go on (a pen's fingertips 2 mm over the table), which every path from there meets; an
+    arm that has run into something by then is caught there. Unchecked, the
+    right arm setting a 30 cm bottle down beside the torso drove its upper arm into the Kinect 3 cm into
+    the back-off, and the jammed wrist swung the open fingers into the bottle, which fell."""
+    planned = arm.dry_run()
+    lifting = True  # the fingers start on the surface, within the collision margin of it
+    for leg in legs:
+        start = np.asarray(planned.ee_pose().position)
+        way = np.asarray(leg) - start
+        pieces = max(1, math.ceil(float(np.linalg.norm(way)) / BACK_OFF_STEP))
+        for i in range(1, pieces + 1):
+            x, y, z = (float(v) for v in start + way * (i / pieces))
+            before = np.asarray(planned.joint_positions())
+            if lifting:  # so the first piece goes by its line, and the posture it ends in is checked
+                lifting = False
+                lifted = planned.move_to((x, y, z), orientation, symmetric=False)
+                if not lifted.reached:
+                    return lifted.reason
+            moved = planned.reach((x, y, z), orientation, symmetric=False)
+            if not moved.reached:
+                return moved.reason
+            if float(np.max(np.abs(np.asarray(planned.joint_positions()) - before))) > BACK_OFF_TURN:
+                return (
+                    f"the arm would run into a fixed thing or the other arm on the way to ({x:.2f}, {y:.2f}, {z:.2f})"
+                )
+    return ""
+
+
+def _set_down(arm: _Moving, grasp: GraspPose, region: Region) -> MotionResult:
+    """put_down_object's moves on a dry run: the way down (:func:`_lower`), then whether the hand can go
+    its way back from there once it lets go (:func:`_retreat`, :func:`_clear_way`; not moving the dry run)."""
+    lowered, place = _lower(arm, grasp, region)
+    if not lowered.reached:
+        return lowered
+    blocked = _clear_way(arm, _retreat(grasp, place), arm.ee_pose().orientation)
+    return MotionResult(False, math.inf, f"backing off once it is let go: {blocked}") if blocked else lowered
+
+
 def put_down_object(world: HomeWorld, side: ArmSide | str, region: Region) -> Outcome:
-    """PutDownObject: lower the held object onto the surface below, let go, back off, raise the arm home."""
+    """PutDownObject: lower the held object onto the surface below, let go, back off (and rise over a tall
+    object), raise the arm home. A way back that would run into something fails it before it lets go."""
     start = world.time
     arm = _arm(world, side)
     grasp = arm.held_grasp
@@ -319,14 +387,22 @@ def put_down_object(world: HomeWorld, side: ArmSide | str, region: Region) -> Ou
     result, place = _lower(arm, grasp, region)
     if not result.reached:
         return _done(world, "PutDownObject", start, False, result.reason)
+    back, *rise = _retreat(grasp, place)
+    blocked = _clear_way(arm, [back, *rise], ee.orientation)
+    if blocked:
+        return _done(
+            world, "PutDownObject", start, False, f"the hand could not back off from the {name} once let go: {blocked}"
+        )
     arm.detach()
     arm.open_gripper()
-    back = grasp.backed_off(place)
     retreat = arm.move_to(back, ee.orientation, speed=PLACE_SPEED, symmetric=False)
     if not retreat.reached:
-        # The straight line ran out of inverse kinematics (a worktop 5 cm lower than the bundled table,
-        # at every seed): back off through joint space, not fold home from beside the object.
+        # The straight line failed all the same (its inverse kinematics asked tighter than the check's, or
+        # the hand stopped short; a worktop 5 cm lower than the bundled table, at every seed, before the
+        # check): back off through joint space, not fold home from beside the object.
         retreat = arm.reach(back, ee.orientation, symmetric=False)
+    for leg in rise if retreat.reached else []:
+        retreat = arm.move_to(leg, ee.orientation, speed=PLACE_SPEED, symmetric=False)
     world.step(SETTLE_TIME)
     folded = arm.home()
     ok = pred.object_located_in(world, name, region)
@@ -507,7 +583,7 @@ def can_carry(
 ) -> str:
     """Why ``side``'s own motion planning would refuse to take the object where it is by ``model``'s
     approach and, given a ``region``, carry it over its middle (empty if it would not): the moves of
-    approach_object, pick_up_object and carry_object, and put_down_object's way down, planned one after
+    approach_object, pick_up_object and carry_object, and put_down_object's way down and back, planned one after
     the other on the kinematics copies from the arm's posture now, without moving (a dry run,
     :meth:`Arm.dry_run`). The inverse kinematics
     of the end poses alone (:func:`can_take`, :func:`can_set_down`) misses a joint-space move whose every
@@ -529,7 +605,7 @@ def can_carry(
         cx, cy, _ = region.center
         moves.append((f"carrying it to ({cx:.2f}, {cy:.2f})", lambda: _carry(hand, grasp, region, yaw, floor)))
         lowering = f"lowering it onto {region.name} at ({cx:.2f}, {cy:.2f})"
-        moves.append((lowering, lambda: _lower(hand, grasp, region)[0]))
+        moves.append((lowering, lambda: _set_down(hand, grasp, region)))
     return _first_refused(moves, arm, model)
 
 
@@ -560,7 +636,7 @@ def can_carry_held(
     model = grasp.model
     moves: list[tuple[str, Callable[[], MotionResult]]] = [
         (f"carrying it to ({cx:.2f}, {cy:.2f})", lambda: _carry(hand, grasp, region, None, floor)),
-        (f"lowering it onto {region.name} at ({cx:.2f}, {cy:.2f})", lambda: _lower(hand, grasp, region)[0]),
+        (f"lowering it onto {region.name} at ({cx:.2f}, {cy:.2f})", lambda: _set_down(hand, grasp, region)),
     ]
     refused = _first_refused(moves, ArmSide(side), model)
     if refused or not hand.brushed:
