@@ -518,9 +518,10 @@ def can_grip(model: ObjectModel, hand: Hand) -> str:
     """Why ``hand`` cannot close on the object by the approach ``model`` is held by, wherever it is
     (empty if it can): a top grasp whose grasp point is deeper below the object's top than the palm
     is above the fingers' grasp point would press the palm on it; an object whose narrowest width (a
-    cylinder's diameter, a box's narrower side) is wider than the jaws open fits no approach."""
-    if model.width > hand.jaw_opening:
-        return str(GraspTooWideError(model.name, model.grasp.value, model.width, hand.jaw_opening))
+    cylinder's diameter, a box's narrower side) is wider than the jaws open, less each jaw's clearance,
+    fits no approach."""
+    if model.width > hand.widest:  # the opening less each jaw's clearance, as compute_grasp_pose holds it
+        return str(GraspTooWideError(model.name, model.grasp.value, model.width, hand.jaw_opening, hand.jaw_clearance))
     if model.grasp is GraspKind.TOP and model.top_clearance(hand) < 0.0:
         depth = model.height - model.grasp_height
         least = math.ceil((1.0 - hand.palm_depth / model.height) * 100.0) / 100.0 if model.height > 0.0 else 1.0

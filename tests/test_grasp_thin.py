@@ -19,6 +19,7 @@ from cbrs.kb import KnowledgeBase
 from cbrs.kb.hands import FINGERTIP_CLEARANCE, JAW_CLEARANCE, HandError
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
+from cbrs.sim import skills
 from cbrs.sim.components import SimEnvironment
 from cbrs.sim.errors import GraspMisfitError, GraspTooThinError, GraspTooWideError
 from cbrs.sim.grasping import GraspKind, ObjectModel, compute_grasp_pose, held_height
@@ -163,6 +164,9 @@ def test_an_object_wider_than_the_jaws_less_their_clearance_is_refused_naming_it
     assert "opens 8.0 cm, less 0.35 cm clear of each jaw: at most 7.3 cm" in str(refused.value)
     assert HAND.widest == pytest.approx(0.073)
     assert compute_grasp_pose(replace(bottle, width=0.073), where, None, mount, facing, hand=HAND).width == 0.073
+    # the skills' own check, asked before a take wherever the object is, holds the jaws to the same width
+    assert "at most 7.3 cm" in skills.can_grip(bottle, HAND)
+    assert skills.can_grip(replace(bottle, width=0.073), HAND) == ""
 
 
 def test_the_wine_bottle_is_refused_before_anything_moves() -> None:

@@ -85,4 +85,4 @@ def test_the_simulated_arm_takes_its_hand_from_the_store() -> None:
         assert left.gripper_width() == pytest.approx(0.05, abs=0.002)
         seen = ObjectEstimate(*WHERE, None, (0.06, 0.06, 0.10), "red", "Kinect01", world.time, 0)
         refusal = skills.can_take(world, seen, ArmSide.LEFT, CUP)
-    assert refusal == str(GraspTooWideError("Cup", "side", 0.06, 0.05))
+    assert refusal == str(GraspTooWideError("Cup", "side", 0.06, 0.05, left.hand.jaw_clearance))
