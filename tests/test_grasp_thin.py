@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 from pathlib import Path
+from typing import TypeVar
 
 import pybullet as p
 import pytest
@@ -32,6 +33,7 @@ from tests.test_hand_reader import hands_of
 EXAMPLES = Path(__file__).parent.parent / "docs" / "examples"
 WORLD, LAB = PREFIXES["world"], "https://example.org/lab#"
 LEFT_ARM = WORLD + "CytonDualArm01LeftArm"
+Refusal = TypeVar("Refusal", bound=Exception)
 HAND = bundled_map().hands[LEFT_ARM]
 """The left arm's hand as the shipped map describes it (the Panda hand)."""
 GRIPPER = "home:jawOpening 0.08 ; home:palmDepth 0.034 ; home:fingerLength 0.046"
@@ -129,25 +131,34 @@ def test_an_object_too_thin_to_hold_above_its_surface_is_refused_naming_it_and_t
     assert held_height(card, replace(HAND, fingertip_clearance=0.001)) == pytest.approx(0.0092)
 
 
+def refused_before_moving(
+    things: list[Path], task_file: Path, task: str, error: type[Refusal], seed: int = 0
+) -> Refusal:
+    """The ``error`` the checks before a run raise for ``task`` (of ``task_file``), with ``things`` (Turtle
+    for the ontology and the map) added to the bundled store: asked before anything moves, and nothing
+    moved or held when it is raised."""
+    kb = KnowledgeBase.open(":memory:")
+    kb.load(things, graph="ontology")
+    kb.load(things, graph="map")
+    kb.load([task_file], graph="requirements")
+    plan = Composer(kb).compose(task).plan
+    assert plan is not None
+    requirements = {r.iri: r for r in kb.requirements()}
+    with open_world(seed=seed, semantic_map=SemanticMap.read(kb)) as world:
+        start = world.time
+        with pytest.raises(error) as refused:
+            SimEnvironment(world, kb).given(plan, requirements)
+        assert world.time == start and not world.arm("left").held and not world.arm("right").held
+    return refused.value
+
+
 def test_a_ruler_too_thin_for_every_hand_is_refused_before_anything_moves(tmp_path: Path) -> None:
     thin = tmp_path / "ruler.ttl"
     thin.write_text(
         (EXAMPLES / "ruler.ttl").read_text(encoding="utf-8").replace("home:sizeZ 0.008", "home:sizeZ 0.0015"),
         encoding="utf-8",
     )
-    kb = KnowledgeBase.open(":memory:")
-    kb.load([thin], graph="ontology")
-    kb.load([thin], graph="map")
-    kb.load([EXAMPLES / "fetch_my_ruler.ttl"], graph="requirements")
-    plan = Composer(kb).compose("FetchMyRuler").plan
-    assert plan is not None
-    requirements = {r.iri: r for r in kb.requirements()}
-    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
-        start = world.time
-        with pytest.raises(CannotGripError) as refused:
-            SimEnvironment(world, kb).given(plan, requirements)
-        assert world.time == start and not world.arm("left").held and not world.arm("right").held
-    error = refused.value
+    error = refused_before_moving([thin], EXAMPLES / "fetch_my_ruler.ttl", "FetchMyRuler", CannotGripError)
     assert error.thing == LAB + "Ruler1" and error.http_status == 422
     assert {arm for arm, _, _ in error.refusals} == {LEFT_ARM, WORLD + "CytonDualArm01RightArm"}
     assert "the Ruler1 is 0.15 cm thick" in str(error) and "home:fingertipClearance" in str(error)
@@ -172,22 +183,12 @@ def test_an_object_wider_than_the_jaws_less_their_clearance_is_refused_naming_it
 def test_the_wine_bottle_is_refused_before_anything_moves() -> None:
     """PutWineOnCupboard (docs/examples): the bottle's class allows only a side grasp, and no hand's jaws
     pass its 7.5 cm with their clearance, whatever the seed; before, the hand moving in pushed it over."""
-    kb = KnowledgeBase.open(":memory:")
-    for name in ("wine_bottle.ttl", "low_cupboard.ttl"):
-        kb.load([EXAMPLES / name], graph="ontology")
-        kb.load([EXAMPLES / name], graph="map")
-    kb.load([EXAMPLES / "put_wine_on_cupboard.ttl"], graph="requirements")
-    plan = Composer(kb).compose("PutWineOnCupboard").plan
-    assert plan is not None
-    requirements = {r.iri: r for r in kb.requirements()}
-    with open_world(seed=1, semantic_map=SemanticMap.read(kb)) as world:
-        start = world.time
-        with pytest.raises(CannotGripError) as refused:
-            SimEnvironment(world, kb).given(plan, requirements)
-        assert world.time == start
-    assert refused.value.thing == LAB + "WineBottle1"
-    assert {approach for _, approach, _ in refused.value.refusals} == {"side"}
-    assert "at most 7.3 cm" in str(refused.value) and "home:jawClearance" in str(refused.value)
+    places = [EXAMPLES / "wine_bottle.ttl", EXAMPLES / "low_cupboard.ttl"]
+    task = EXAMPLES / "put_wine_on_cupboard.ttl"
+    error = refused_before_moving(places, task, "PutWineOnCupboard", CannotGripError, seed=1)
+    assert error.thing == LAB + "WineBottle1"
+    assert {approach for _, approach, _ in error.refusals} == {"side"}
+    assert "at most 7.3 cm" in str(error) and "home:jawClearance" in str(error)
 
 
 def test_the_bundled_objects_fit_the_jaws_with_their_clearance() -> None:

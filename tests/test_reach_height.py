@@ -10,13 +10,9 @@ from pathlib import Path
 
 import pytest
 
-from cbrs.actions.composer import Composer
-from cbrs.kb import KnowledgeBase
-from cbrs.kb.semantic_map import SemanticMap
-from cbrs.sim.components import SimEnvironment
 from cbrs.sim.run_checks import PlanChecks
 from cbrs.sim.sight import OutOfViewError
-from cbrs.sim.world import open_world
+from tests.test_grasp_thin import refused_before_moving
 
 EXAMPLES = Path(__file__).parent.parent / "docs" / "examples"
 
@@ -41,14 +37,6 @@ def test_a_mug_on_a_lower_cabinet_passes_the_reach_check(tmp_path: Path) -> None
     text = text.replace("home:minZ 1.25 ; home:maxZ 1.30", "home:minZ 0.90 ; home:maxZ 0.95")
     text = text.replace("home:sizeX 0.08 ; home:sizeY 0.08", "home:sizeX 0.065 ; home:sizeY 0.065")  # fits the jaws
     lower.write_text(text, encoding="utf-8")
-    kb = KnowledgeBase.open(":memory:")
-    kb.load([lower], graph="ontology")
-    kb.load([lower], graph="map")
-    kb.load([EXAMPLES / "mug_from_the_cabinet.ttl"], graph="requirements")
-    plan = Composer(kb).compose("MugFromTheCabinet").plan
-    assert plan is not None
-    requirements = {r.iri: r for r in kb.requirements()}
     # refused by the check after the reach check's
-    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world, pytest.raises(OutOfViewError) as refused:
-        SimEnvironment(world, kb).given(plan, requirements)
-    assert "Mug1" in str(refused.value) and "Kinect01" in str(refused.value)
+    refused = refused_before_moving([lower], EXAMPLES / "mug_from_the_cabinet.ttl", "MugFromTheCabinet", OutOfViewError)
+    assert "Mug1" in str(refused) and "Kinect01" in str(refused)
