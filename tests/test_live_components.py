@@ -336,7 +336,7 @@ def test_a_flooding_component_harms_no_plan_and_no_store(server: Server) -> None
         beats = [flood.call("/cbrs/heartbeat", {}, 10.0) for _ in range(500)]  # as fast as it can send
         for beat in beats:  # each is answered (this session has no component of its own), or refused past
             # the bridge's max_calls_per_client (256 waiting); none harms
-            with pytest.raises(RemoteCallError, match="no live component|max_calls_per_client"):
+            with pytest.raises(RemoteCallError, match=r"no live component|max_calls_per_client"):
                 beat.result(timeout=20)
         huge = flood.call("/cbrs/register", {"description": "# " + "x" * (300 << 10)}, 10.0)
         with pytest.raises(RemoteCallError, match="larger than"):
