@@ -116,7 +116,8 @@ def test_sparql_editor_runs_a_query_into_a_table(page: Any, shots: Path) -> None
     assert page.locator("a[data-format=csv]").get_attribute("href").startswith("/sparql?")
     snap(page, shots, "sparql")
     page.locator("#query").fill("SELECT ?x WHERE {")
-    page.get_by_role("button", name="Run").click()
+    with page.expect_navigation(wait_until="load"):  # the form's GET: focus asked of a page still loading was lost
+        page.get_by_role("button", name="Run").click()
     assert page.locator("#query-error").is_visible()  # the parser's message beside the editor
     # Tab indents in the editor, so a keyboard user leaves it with Esc then Tab; the help (which describes
     # the editor to a screen reader) says so: a user tabbing forward was held in the editor, unaware.
