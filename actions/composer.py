@@ -623,11 +623,14 @@ class Composer:
         although the two would match as services do (a superclass is an accepted degree there)."""
         if requirement.outputs or not requirement.effects:
             return False
-        return all(any(self._entails(h, e) for h in holding) for e in requirement.effects)
+        return all(self._held(e, holding) for e in requirement.effects)
 
     def _holds_some(self, requirement: Requirement, holding: Sequence[Statement]) -> bool:
         """Whether some of the requirement's goals hold already (all of them: :meth:`_achieved`)."""
-        return any(any(self._entails(h, e) for h in holding) for e in requirement.effects)
+        return any(self._held(e, holding) for e in requirement.effects)
+
+    def _held(self, goal: Statement, holding: Sequence[Statement]) -> bool:
+        return any(self._entails(fact, goal) for fact in holding)
 
     def _entails(self, fact: Statement, goal: Statement) -> bool:
         sides = ((goal.subject, fact.subject), (goal.predicate, fact.predicate), (goal.object, fact.object))

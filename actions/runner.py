@@ -10,7 +10,7 @@ from __future__ import annotations
 import collections.abc
 import json
 import time
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import Any, Protocol
 
@@ -426,15 +426,21 @@ def _naming_the_unavailable(
 
 
 def unrunnable_steps(
-    kb: KnowledgeBase, plan: Plan, registry: collections.abc.Container[str], passed: Mapping[str, str] | None = None
+    kb: KnowledgeBase,
+    plan: Plan,
+    registry: collections.abc.Container[str],
+    passed: Mapping[str, str] | None = None,
+    advertisements: Sequence[Advertisement] | None = None,
 ) -> tuple[tuple[PlanStep, str], ...]:
     """The steps of ``plan`` whose component ``registry`` has no implementation of (or the environment
     passes over), each with why: those :func:`run_task` composes the task without. ``cbrs plan`` says
-    so, where it composes over every advertisement."""
+    so, where it composes over every advertisement. ``advertisements``: those the plan was composed
+    over, if the caller has them, instead of reading them again."""
     passed = passed or {}
     if all(_can_run(step.component, registry, passed) for step in plan.steps):
         return ()
-    ads = {ad.iri: ad for ad in kb.advertisements(include_unavailable=True)}
+    found = advertisements if advertisements is not None else kb.advertisements(include_unavailable=True)
+    ads = {ad.iri: ad for ad in found}
     return tuple(
         (step, passed.get(step.component) or _cannot_run(ads[step.component]))
         for step in plan.steps

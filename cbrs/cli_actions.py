@@ -10,7 +10,7 @@ import socket
 import sys
 import time
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -28,7 +28,7 @@ from cbrs.actions.replanning import ReplanPolicy
 from cbrs.actions.runner import Replan, RunResult, run_task, unrunnable_steps
 from cbrs.app import App, parse_iri, pass_app
 from cbrs.extras import installed, require
-from cbrs.kb import KnowledgeBase, RemoteStoreError
+from cbrs.kb import Advertisement, KnowledgeBase, RemoteStoreError
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import shorten
 from cbrs.output import table
@@ -144,7 +144,7 @@ def plan(
         from cbrs.actions.draw import draw  # matplotlib is slow to import; only when asked
 
         draw(result, drawing)
-    here = _not_here(app.kb, result.plan) if result.plan is not None else None
+    here = _not_here(app.kb, result.plan, composer.advertisements) if result.plan is not None else None
     if as_json:
         found = result.to_dict()
         if here is not None:
@@ -187,18 +187,18 @@ class _NotHere:
         return "".join(lines)
 
 
-def _not_here(kb: KnowledgeBase, plan: Plan) -> _NotHere | None:
+def _not_here(kb: KnowledgeBase, plan: Plan, advertisements: Sequence[Advertisement]) -> _NotHere | None:
     """What of ``plan`` the simulated home cannot run now (None without the [sim] part, which runs
     nothing): the runner's own check, over the simulation's skills (no world is built) and the
-    components registered live."""
+    components registered live; ``advertisements``, those the plan was composed over, read once."""
     if not installed("sim"):
         return None
     from cbrs.sim.components import implementations
 
     live = {iri for iri, state in kb.liveness.states().items() if state.live}
-    runnable = set(implementations(kb).names()) | live
+    runnable = set(implementations(kb, advertisements=advertisements).names()) | live
     bridged = tuple(step for step in plan.steps if step.component in live)
-    return _NotHere(unrunnable_steps(kb, plan, runnable), bridged)
+    return _NotHere(unrunnable_steps(kb, plan, runnable, advertisements=advertisements), bridged)
 
 
 def plan_text(result: CompositionResult) -> str:

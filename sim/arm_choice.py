@@ -27,7 +27,7 @@ from cbrs.sim.geometry import Pose2D, Region
 from cbrs.sim.grasping import GraspKind, GraspPose, ObjectModel, compute_grasp_pose
 from cbrs.sim.hold_choice import Candidates, GraspChoice, first_clear, refuse_moves, seen_extent
 from cbrs.sim.perception import ObjectEstimate
-from cbrs.sim.place_spots import other_objects, place_spots, spot_region
+from cbrs.sim.place_spots import other_objects, place_spots, reach_of, spot_region
 from cbrs.sim.relay import CLEAR_TRIES, RELAY_TRIES, relay_spot, resting_at
 from cbrs.sim.transit import floor_to
 
@@ -273,7 +273,7 @@ def hold_end(
         spec = ctx.world.arm_specs[side or ctx.arm]
         others = other_objects(ctx.world, ctx.belief, name)
         size = ctx.world.objects[name].size if name in ctx.world.objects else (0.0, 0.0, 0.0)
-        surface, spots = place_spots(smap, place, size, [(spec.mount[0], spec.mount[1], spec.reach)], others)
+        surface, spots = place_spots(smap, place, size, [reach_of(spec)], others)
         return place, surface, spots
     return None
 

@@ -25,7 +25,7 @@ from __future__ import annotations
 import logging
 import math
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -125,14 +125,16 @@ def implementations(
     world: HomeWorld | None = None,
     registry: Registry | None = None,
     transport: Transport | None = None,
+    advertisements: Sequence[Advertisement] | None = None,
 ) -> Registry:
     """An implementation for every advertisement the store says how to invoke, added to ``registry``
     if given (a refresh): a remote component for one whose service port names a bridge service and its
     type (when there is a ``transport`` to reach it), else a simulated one where the simulation can
-    perform its service on its device (cameras must exist in the world)."""
+    perform its service on its device (cameras must exist in the world). ``advertisements``: those a
+    caller has read already (a composer's), instead of reading them again."""
     registry = registry if registry is not None else Registry()
     calls = _RemoteCalls.read(kb) if transport is not None else None
-    for ad in kb.advertisements():
+    for ad in advertisements if advertisements is not None else kb.advertisements():
         remote = ad.bridge_port
         if remote is not None:
             if transport is not None and calls is not None and remote.topic is not None:

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from cbrs.kb.semantic_map import SemanticMap, Thing
+from cbrs.kb.semantic_map import Arm, SemanticMap, Thing
 from cbrs.sim import skills
 from cbrs.sim.geometry import Region
 from cbrs.sim.perceived import PerceivedWorld
@@ -32,6 +32,11 @@ RELAY_EDGE = 0.02
 
 RELAY_STEP = 0.02
 """The spots tried are a 2 cm grid over the surface."""
+
+
+def reach_of(arm: Arm) -> tuple[float, float, float]:
+    """An arm's reach as :func:`place_spots` takes it: (mount x, mount y, reach)."""
+    return (arm.mount[0], arm.mount[1], arm.reach)
 
 
 def distance_to_extent(box: tuple[float, float, float, float], point: tuple[float, ...]) -> float:

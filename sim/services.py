@@ -14,7 +14,6 @@ from typing import Any
 
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
-from cbrs.kb.semantic_map import Arm as ArmSpec
 from cbrs.kb.semantic_map import local_name
 from cbrs.sim import skills
 from cbrs.sim.arm_choice import carry_check, free_arm, grasp_pose_for, holdable_spot, note_choice, who_loads, who_takes
@@ -35,7 +34,7 @@ from cbrs.sim.perception import (
     recognise_object,
     track_person,
 )
-from cbrs.sim.place_spots import other_objects, place_spots, spot_region
+from cbrs.sim.place_spots import other_objects, place_spots, reach_of, spot_region
 from cbrs.sim.planning import PlannedPath, plan_path
 from cbrs.sim.relations import region_of
 from cbrs.sim.relay import check_passing, relay_object, relay_spot, resting_at, set_down_for
@@ -141,7 +140,7 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
     others = other_objects(world, ctx.belief, carried)
 
     def spots(side: ArmSide) -> tuple[Region, list[tuple[float, float]]]:
-        return place_spots(ctx.map, place, size, [_reach_of(world.arm_specs[side])], others)
+        return place_spots(ctx.map, place, size, [reach_of(world.arm_specs[side])], others)
 
     surface, mine = spots(ctx.arm)
     spot = holdable_spot(ctx, ctx.arm, surface, mine)
@@ -158,7 +157,7 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
             crowded = [  # arms that would have a spot but for the objects on the place
                 side
                 for side in sorted(world.arm_specs)
-                if place_spots(ctx.map, place, size, [_reach_of(world.arm_specs[side])], [])[1]
+                if place_spots(ctx.map, place, size, [reach_of(world.arm_specs[side])], [])[1]
             ]
             if crowded:
                 names = [name for name in world.objects if name != carried]  # in the order of ``others``
@@ -244,11 +243,6 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
     floor = None if grasped is None else floor_to(ctx, grasped.model, ctx.arm, hand, target)
     check_outcome(skills.carry_object(world, ctx.arm, target, floor=floor))
     return {}
-
-
-def _reach_of(spec: ArmSpec) -> tuple[float, float, float]:
-    """An arm's reach as place_spots takes it: (mount x, mount y, reach)."""
-    return (spec.mount[0], spec.mount[1], spec.reach)
 
 
 def put_down(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
