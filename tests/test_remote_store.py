@@ -10,6 +10,7 @@ import socket
 import threading
 from collections.abc import Callable, Iterator
 from pathlib import Path
+from urllib.parse import parse_qs
 
 import httpx
 import pyoxigraph as ox
@@ -124,6 +125,61 @@ def test_blank_nodes_and_bad_names_cannot_be_bound() -> None:
         inject_values("SELECT * { ?x ?p ?o }", {"x y": ox.Literal("1")})
     with pytest.raises(QuerySyntaxError, match="no SELECT"):
         inject_values("INSERT DATA { }", X)
+
+
+def _recording_server(server: str, sent: list[str]) -> httpx.MockTransport:
+    """An endpoint that answers every query with no rows, as ``server`` says it is, keeping each text."""
+
+    def answer(request: httpx.Request) -> httpx.Response:
+        sent.append(parse_qs(request.content.decode("utf-8"))["query"][0])
+        body = b'{"head": {"vars": []}, "results": {"bindings": []}}'
+        return httpx.Response(
+            200, headers={"Server": server, "Content-Type": "application/sparql-results+json"}, content=body
+        )
+
+    return httpx.MockTransport(answer)
+
+
+@pytest.mark.parametrize(
+    ("server", "query", "bindings", "in_order"),
+    [
+        pytest.param(
+            "Virtuoso/07.20.3229", "SELECT * { ?t rdfs:subClassOf* cbrs:Port . ?x a ?t }", X, True, id="fixed"
+        ),
+        pytest.param(
+            "Virtuoso/07.20.3229", "SELECT * { ?t rdfs:subClassOf* cbrs:Port . ?x a ?t }", {}, True, id="free"
+        ),
+        pytest.param("Virtuoso/07.20.3229", "SELECT * { ?t <urn:p>+ <urn:c> . ?x a ?t }", X, True, id="iri"),
+        pytest.param("Virtuoso/07.20.3229", "SELECT * { ?x rdfs:subClassOf* ?c }", X, False, id="variable-end"),
+        pytest.param(
+            "Virtuoso/07.20.3229",
+            'SELECT (GROUP_CONCAT(?t; separator=" ") AS ?ts) { ?t rdfs:subClassOf* cbrs:Port . ?x a ?t }',
+            X,
+            False,
+            id="values-bound",
+        ),
+        pytest.param("Virtuoso/07.20.3229", "SELECT (COUNT(*) AS ?n) { ?x a cbrs:Port }", X, False, id="no-path"),
+        pytest.param("Oxigraph/0.4.0", "SELECT * { ?t rdfs:subClassOf* cbrs:Port . ?x a ?t }", X, False, id="oxigraph"),
+    ],
+)
+def test_virtuoso_joins_a_query_with_a_path_to_a_fixed_class_as_written(
+    server: str, query: str, bindings: dict[str, ox.NamedNode], in_order: bool
+) -> None:
+    """On Virtuoso, its optimiser sometimes walked such a path from each row of an earlier pattern and
+    answered short (the description of a service, 0 rows of 1): the written order walks it first."""
+    sent: list[str] = []
+    store = RemoteStore(
+        "http://sparql.test/sparql", Endpoints("http://sparql.test/sparql", "http://sparql.test/sparql")
+    )
+    store._client = httpx.Client(transport=_recording_server(server, sent))
+    try:
+        store._query("ASK {}")  # the first answer tells the store what the server is
+        store._union_verified = True
+        store.query(query, bindings)
+    finally:
+        store.close()
+    assert sent[-1].startswith('DEFINE sql:select-option "order"') is in_order
+    assert all(str(value) in sent[-1] for value in bindings.values())
 
 
 def test_every_named_query_with_parameters_gives_the_embedded_answer(
