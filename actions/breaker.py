@@ -25,7 +25,7 @@ from __future__ import annotations
 import logging
 import threading
 import weakref
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from concurrent.futures import Future
 from dataclasses import dataclass
 from typing import Any, Protocol
@@ -35,7 +35,11 @@ from cbrs.kb.namespaces import shorten
 
 log = logging.getLogger("cbrs.actions.remote")
 
-__all__ = ["BreakerPolicy", "BreakerPolicyError", "ServiceCalls", "busy", "calls_of", "passed_over"]
+__all__ = ["BreakerPolicy", "BreakerPolicyError", "Late", "ServiceCalls", "busy", "calls_of", "passed_over"]
+
+
+Late = Callable[[Future[dict[str, Any]]], None]
+"""Called with an actuator's call given up once it ends (answered, failed or ended by the transport)."""
 
 
 class _Transport(Protocol):
@@ -111,9 +115,10 @@ class ServiceCalls:
         session: str | None,
         pending: Future[dict[str, Any]] | None = None,
         sent: float = 0.0,
+        late: Late | None = None,
     ) -> None:
         """A call to ``service`` got no answer within ``timeout``; ``pending``: an actuator's call, kept
-        until it answers."""
+        until it answers; ``late``: what to do with its answer if one comes (by default, log it)."""
         with self._lock:
             entry = self._current(service, component, session) or self._services.setdefault(
                 service, _Service(component, session)
@@ -122,7 +127,7 @@ class ServiceCalls:
             entry.timeout = timeout
             if pending is not None and not pending.done():
                 entry.given_up = (pending, sent, timeout)
-                _say_when_late(service, component, pending, timeout)
+                pending.add_done_callback(late or _say_when_late(service, component, timeout))
             if (
                 policy is not None
                 and policy.timeouts
@@ -148,13 +153,20 @@ class ServiceCalls:
                 entry.trial = None
 
     def given_up(
-        self, service: str, component: str, pending: Future[dict[str, Any]], sent: float, timeout: float
+        self,
+        service: str,
+        component: str,
+        pending: Future[dict[str, Any]],
+        sent: float,
+        timeout: float,
+        late: Late | None = None,
     ) -> None:
-        """An actuator's call that is still out was given up (its step was halted)."""
+        """An actuator's call that is still out was given up (its step was halted); ``late`` as for
+        :meth:`timed_out`."""
         with self._lock:
             entry = self._services.setdefault(service, _Service(component))
             entry.given_up = (pending, sent, timeout)
-        _say_when_late(service, component, pending, timeout)
+        pending.add_done_callback(late or _say_when_late(service, component, timeout))
 
     def busy(self, service: str, now: float) -> str:
         with self._lock:
@@ -194,10 +206,11 @@ class ServiceCalls:
             del self._services[service]
 
 
-def _say_when_late(service: str, component: str, pending: Future[dict[str, Any]], timeout: float) -> None:
-    """Log an actuator's answer to a call given up, when it comes: the device may have acted (a door
-    motor opened the door 15 s after a 10 s timeout), and the run, which no longer waits, believes
-    nothing of it. The answer was dropped in silence, so nobody knew the belief had gone stale."""
+def _say_when_late(service: str, component: str, timeout: float) -> Late:
+    """A callback that logs an actuator's answer to a call given up, when it comes: the device may have
+    acted (a door motor opened the door 15 s after a 10 s timeout). Used when nothing records the answer
+    in the belief (no store to write: :mod:`actions.late_answers` does it otherwise), so that a person
+    learns that what is believed of the device's effects may be stale."""
 
     def late(done: Future[dict[str, Any]]) -> None:
         error = done.exception() if not done.cancelled() else None
@@ -215,7 +228,7 @@ def _say_when_late(service: str, component: str, pending: Future[dict[str, Any]]
             timeout,
         )
 
-    pending.add_done_callback(late)
+    return late
 
 
 def _busy(service: str, entry: _Service, now: float) -> str:

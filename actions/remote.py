@@ -16,13 +16,24 @@ from concurrent.futures import Future
 from concurrent.futures import TimeoutError as FutureTimeout
 from typing import Any, Protocol
 
-from cbrs.actions.answers import Classes, ContradictedEffectError, read_answer
-from cbrs.actions.breaker import BreakerPolicy, busy, calls_of
+from cbrs.actions.answers import Classes, ContradictedEffectError, StoreClasses, read_answer
+from cbrs.actions.breaker import BreakerPolicy, Late, busy, calls_of
 from cbrs.actions.components import Component, Status
+from cbrs.actions.errors import ActionsError
+from cbrs.actions.late_answers import GivenUp, watch
 from cbrs.actions.remote_errors import RemoteCallError
-from cbrs.kb import Statement
+from cbrs.kb import KnowledgeBase, Statement
 
-__all__ = ["LATE_WINDOW", "MAX_POLLS", "POLL_SECONDS", "RemoteCallError", "RemoteComponent", "Transport", "given_up"]
+__all__ = [
+    "LATE_WINDOW",
+    "MAX_POLLS",
+    "POLL_SECONDS",
+    "AnswerRefusedError",
+    "RemoteCallError",
+    "RemoteComponent",
+    "Transport",
+    "given_up",
+]
 
 log = logging.getLogger("cbrs.actions.remote")
 
@@ -45,6 +56,15 @@ class Transport(Protocol):
         """Send the call; the future gets the answer's values, or raises RemoteCallError or another error."""
 
 
+class AnswerRefusedError(ActionsError):
+    """An answer the checks refuse: not an object of named outputs, an output missing or of the wrong
+    type. Keeps the service; the message is the step's reason."""
+
+    def __init__(self, service: str, reason: str) -> None:
+        super().__init__(reason)
+        self.service, self.reason = service, reason
+
+
 OutputCheck = Callable[[str, Any], Any]
 """(port type, value) -> the value to pass on; raises ValueError (or a subclass) for a wrong one."""
 
@@ -64,6 +84,10 @@ class RemoteComponent(Component):
     ``breaker``: after calls time out the service is passed over for a cool-down (:mod:`actions.breaker`);
     None, as before it, calls it whenever asked. ``session``: the registration the component is live
     under now, so that a restarted program is not held to its predecessor's timeouts.
+
+    ``kb``: the store whose belief an actuator's answer to a call given up corrects when it comes
+    (:mod:`actions.late_answers`); by default the one ``classes`` reads, if a :class:`StoreClasses`.
+    Without one the answer is only logged.
     """
 
     def __init__(
@@ -81,6 +105,7 @@ class RemoteComponent(Component):
         contradictions: str = "fail",
         breaker: BreakerPolicy | None = None,
         session: str | None = None,
+        kb: KnowledgeBase | None = None,
     ) -> None:
         super().__init__(iri)
         self.transport = transport
@@ -95,8 +120,10 @@ class RemoteComponent(Component):
         self.contradictions = contradictions
         self.breaker = breaker
         self.session = session
+        self.kb = kb if kb is not None else classes.kb if isinstance(classes, StoreClasses) else None
         self._calls = calls_of(transport)
         self._pending: Future[dict[str, Any]] | None = None
+        self._inputs: dict[str, Any] = {}
         self._sent = 0.0
         self._deadline = 0.0
 
@@ -106,6 +133,7 @@ class RemoteComponent(Component):
         self.outputs = {}
         self.reason = ""
         self._pending = None
+        self._inputs = dict(inputs)
         now = self._clock()
         why = self._calls.admit(self.service, self.iri, now, self.timeout * LATE_WINDOW, self.exclusive, self.session)
         if why:
@@ -144,14 +172,27 @@ class RemoteComponent(Component):
         return self._accept(values)
 
     def _accept(self, values: Any) -> Status:
-        if not isinstance(values, dict):
-            self.reason = f"{self.service} answered {type(values).__name__}, not an object of named outputs"
+        try:
+            self.outputs = self._read(values)
+        except AnswerRefusedError as refused:
+            self.reason = refused.reason
             return Status.FAILED
+        return Status.SUCCEEDED
+
+    def _read(self, values: Any) -> dict[str, Any]:
+        """The outputs of an answer, checked: every output there and of its type (:attr:`check`), none
+        contradicting the effects. :class:`AnswerRefusedError` or :class:`ContradictedEffectError` when
+        one is not; an answer that comes after its call was given up is read by this too."""
+        if not isinstance(values, dict):
+            raise AnswerRefusedError(
+                self.service, f"{self.service} answered {type(values).__name__}, not an object of named outputs"
+            )
         missing = [name for name in self.output_types if name not in values]
         if missing:
             given = ", ".join(sorted(values)) or "nothing"
-            self.reason = f"{self.service} answered without {', '.join(missing)} (it gave {given})"
-            return Status.FAILED
+            raise AnswerRefusedError(
+                self.service, f"{self.service} answered without {', '.join(missing)} (it gave {given})"
+            )
         outputs = {}
         for name, concept in self.output_types.items():
             value = values[name]
@@ -159,12 +200,12 @@ class RemoteComponent(Component):
                 try:
                     value = self.check(concept, value)
                 except ValueError as error:
-                    self.reason = f"{self.service} answered a wrong {name}: {error}"
-                    return Status.FAILED
+                    raise AnswerRefusedError(
+                        self.service, f"{self.service} answered a wrong {name}: {error}"
+                    ) from error
             outputs[name] = value
         self._against_effects(outputs)
-        self.outputs = outputs
-        return Status.SUCCEEDED
+        return outputs
 
     def _against_effects(self, outputs: Mapping[str, Any]) -> None:
         """Raise :class:`ContradictedEffectError` when an answered value contradicts the effects
@@ -196,10 +237,17 @@ class RemoteComponent(Component):
         kept until it answers, since the provider may still be executing it (a door motor cannot be told
         to stop by a dropped call)."""
         pending = self._pending if self.exclusive else None
+        late = self._late() if pending is not None else None
         self._calls.timed_out(
-            self.service, self.iri, self._clock(), self.timeout, self.breaker, self.session, pending, self._sent
+            self.service, self.iri, self._clock(), self.timeout, self.breaker, self.session, pending, self._sent, late
         )
         return self._fail()
+
+    def _late(self) -> Late | None:
+        """What the answer to the call given up now does to the belief if it comes (None: it is logged)."""
+        if self.kb is None or self.classes is None:
+            return None
+        return watch(self.kb, self.classes, GivenUp(self.iri, self.service, self.timeout, self._inputs), self._read)
 
     def halt(self) -> None:
         """The step was stopped while the call was out (a cancelled run, the executor's tick bound)."""
@@ -207,7 +255,7 @@ class RemoteComponent(Component):
         if pending is not None and not pending.done():
             self._calls.released(self.service)
             if self.exclusive:
-                self._calls.given_up(self.service, self.iri, pending, self._sent, self.timeout)
+                self._calls.given_up(self.service, self.iri, pending, self._sent, self.timeout, self._late())
         self._fail()
 
 

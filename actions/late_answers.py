@@ -1,0 +1,275 @@
+"""An actuator's answer that comes after its call was given up: what it does to the belief.
+
+A door motor that needs 15 s and is given 10 s opens the door after the run stopped waiting, and the
+belief (the world graph) still said closed, so the next run believed a closed door. When the answer
+comes, it is read as an in-time answer is (every output there and of its type, the designators of
+the map's things right, no effect contradicted: ``RemoteComponent._read``), and then:
+
+- **a success** believes the component's effects as an in-time success does (``SimEnvironment.succeeded``):
+  of the relations no test of the store decides, its delete effects stop being believed and its effects
+  are believed, each replacing the values it excludes (disjoint classes, a functional relation). A
+  relation a test decides is left to the next run's perception. If the world graph's belief of a
+  relation it sets has changed since the call was given up (a newer call, a run), which came last
+  cannot be told: that relation becomes unknown (no value believed), unless the answer agrees with
+  the newer belief.
+- **a failure** (``result: false``: the handler raised, or the bridge ended the call, at its deadline
+  or because the provider went) leaves the command's end in doubt after it ran past its timeout: it
+  may have done part of it (a door stopped half-way), so every relation the call would set or delete
+  becomes unknown. The protocol does not tell the handler's error from the bridge's, and neither
+  says what the device did.
+- **an answer the checks refuse** (malformed, a wrong thing, a contradicted effect) is no ground for any
+  belief, as in time: nothing is written. Nor is anything when this process stops hearing the call (its
+  own connection closed, the call was cancelled): that is no word of the device's, and it happens as
+  the process ends, when its store may be closing.
+
+Each case is one warning of ``cbrs.actions.remote`` naming the component. An effect is grounded in the
+step's inputs (the one designated thing of its class; a quality, ``home:Opened``, stands for itself) when
+the call is given up, and the belief of what it would change is read then, to tell later changes.
+The write is :func:`actions.belief.correct`: one transaction, and kept by a run still going
+(docs/reliability.md, "Late answers").
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+from collections.abc import Callable, Iterable, Mapping
+from concurrent.futures import Future
+from dataclasses import dataclass
+from typing import Any
+
+import pyoxigraph as ox
+
+from cbrs.actions.answers import Classes
+from cbrs.actions.belief import Fact, Pair, believed, correct
+from cbrs.actions.errors import ActionsError
+from cbrs.actions.remote_errors import RemoteCallError
+from cbrs.kb import KnowledgeBase, KnowledgeBaseError, Statement
+from cbrs.kb.namespaces import HOME, expand, shorten
+
+__all__ = ["GivenUp", "watch"]
+
+log = logging.getLogger("cbrs.actions.remote")
+
+Read = Callable[[Any], Mapping[str, Any]]
+"""An answer's values -> its checked outputs; raises an :class:`ActionsError` for one the checks refuse."""
+
+
+@dataclass(frozen=True)
+class GivenUp:
+    """A call given up: the component, its service, the timeout it missed and the step's inputs."""
+
+    component: str
+    service: str
+    timeout: float
+    inputs: Mapping[str, Any]
+
+    def said(self, what: str) -> str:
+        return (
+            f"{shorten(self.component)} ({self.service}) {what} after its call was given up "
+            f"(no answer within {self.timeout:g} s)"
+        )
+
+
+@dataclass(frozen=True)
+class _Expected:
+    """What a success would change, grounded when the call was given up, and what was believed of it then."""
+
+    deletes: tuple[Fact, ...]
+    adds: tuple[Fact, ...]
+    before: frozenset[Fact]
+    ungrounded: tuple[Statement, ...]
+    functional: frozenset[str]
+
+    @property
+    def pairs(self) -> frozenset[Pair]:
+        return frozenset((s, p) for s, p, _ in (*self.deletes, *self.adds))
+
+
+def watch(
+    kb: KnowledgeBase, classes: Classes, call: GivenUp, read: Read
+) -> Callable[[Future[dict[str, Any]]], None] | None:
+    """The callback that settles ``call``'s answer when it comes, in a thread of its own (the transport's
+    reader calls it, and must not wait for the store). None, after a warning, when what it would change
+    cannot be read now (the component was deregistered, the store is unreachable): it is then only logged."""
+    try:
+        expected = _expect(kb, classes, call)
+    except KnowledgeBaseError as error:
+        log.warning("%s; its answer, if it comes, changes no belief: %s", call.said("is out"), error)
+        return None
+
+    def ended(done: Future[dict[str, Any]]) -> None:
+        settle = threading.Thread(
+            target=_settle, args=(kb, classes, call, expected, read, done), name="cbrs-late-answer", daemon=True
+        )
+        settle.start()
+
+    return ended
+
+
+def _expect(kb: KnowledgeBase, classes: Classes, call: GivenUp) -> _Expected:
+    description = kb.description(call.component)
+    untested = [s for s in (*description.deletes, *description.effects) if not _tested(kb, s.predicate)]
+    grounded = {s: _grounded(kb, classes, s, call.inputs) for s in untested}
+    deletes = tuple(f for s in description.deletes if (f := grounded.get(s)) is not None)
+    adds = tuple(f for s in description.effects if (f := grounded.get(s)) is not None)
+    functional = frozenset(row["property"].value for row in kb.select("functional_properties"))
+    pairs = {(s, p) for s, p, _ in (*deletes, *adds)}
+    ungrounded = tuple(s for s, fact in grounded.items() if fact is None)
+    return _Expected(deletes, adds, believed(kb, pairs), ungrounded, functional)
+
+
+def _tested(kb: KnowledgeBase, predicate: str) -> bool:
+    """Whether a test of the store decides ``predicate`` (then perception believes it, not a step)."""
+    return bool(kb.select("computables", {"relation": ox.NamedNode(predicate)}))
+
+
+def _grounded(kb: KnowledgeBase, classes: Classes, statement: Statement, inputs: Mapping[str, Any]) -> Fact | None:
+    """``statement`` (between classes) about the step's things: each side the one thing the step was
+    given of its class; an object no given thing is and that is a quality (``home:Opened``) stands for
+    itself. None when a side means no given thing or several."""
+    obj = _thing(kb, classes, statement.object, inputs, None)
+    if obj is None and classes.is_a(statement.object, HOME + "Quality"):
+        obj = statement.object
+    subject = _thing(kb, classes, statement.subject, inputs, obj)
+    return (subject, statement.predicate, obj) if subject is not None and obj is not None else None
+
+
+def _thing(
+    kb: KnowledgeBase, classes: Classes, concept: str, inputs: Mapping[str, Any], besides: str | None
+) -> str | None:
+    found = set()
+    for value in inputs.values():
+        if not isinstance(value, dict) or not isinstance(value.get("@id"), str) or value["@id"] == besides:
+            continue
+        thing = value["@id"]
+        rows = kb.select("map_types", {"thing": ox.NamedNode(thing)})
+        kinds = {row["type"].value for row in rows} | set(_given_as(value))
+        if any(classes.is_a(kind, concept) for kind in kinds):
+            found.add(thing)
+    return found.pop() if len(found) == 1 else None
+
+
+def _given_as(value: Mapping[str, Any]) -> Iterable[str]:
+    written = value.get("@type")
+    if isinstance(written, str):
+        try:
+            yield expand(written)
+        except ValueError:
+            return
+
+
+def _settle(
+    kb: KnowledgeBase, classes: Classes, call: GivenUp, expected: _Expected, read: Read, done: Future[dict[str, Any]]
+) -> None:
+    """What ``done``'s ending does to the belief, logged as one warning."""
+    error = done.exception() if not done.cancelled() else None
+    if done.cancelled() or (error is not None and not isinstance(error, RemoteCallError)):
+        log.warning(
+            "%s: nothing is believed of it, and what the store believes of the device's effects may be stale; "
+            "check the device (docs/execution.md, 'An actuator is sent one command at a time')",
+            call.said(f"ended without an answer ({error or 'cancelled'})"),
+        )
+        return
+    if error is None:
+        try:
+            read(done.result())
+        except ActionsError as refused:
+            log.warning(
+                "%s, and the answer is refused as one in time would be: %s. The belief is left as it was, and "
+                "may be stale: check the device",
+                call.said("answered"),
+                refused,
+            )
+            return
+    try:
+        outcome = _believe(kb, classes, expected, failed=error is not None)
+    except KnowledgeBaseError as broken:
+        log.warning("%s, but the belief could not be written: %s", call.said("answered"), broken)
+        return
+    log.warning("%s", _told(call, expected, outcome, error))
+
+
+@dataclass(frozen=True)
+class _Outcome:
+    believed: frozenset[Fact]  # now held, by this answer
+    unknown: frozenset[Pair]  # no value believed any more
+    changed: frozenset[Pair]  # of those, the ones a newer belief had changed since the call was given up
+
+
+def _believe(kb: KnowledgeBase, classes: Classes, expected: _Expected, failed: bool) -> _Outcome:
+    unknown: set[Pair] = set()
+    changed: set[Pair] = set()
+    believed_now: set[Fact] = set()
+
+    def decide(now: frozenset[Fact]) -> frozenset[Fact]:
+        held: set[Fact] = set()
+        for pair in sorted(expected.pairs):
+            current = _of(now, pair)
+            wanted = _applied(classes, expected, pair, current)
+            if failed:
+                unknown.add(pair)
+            elif current == _of(expected.before, pair) or wanted == current:
+                held |= wanted
+                believed_now.update(f for f in wanted if f in expected.adds)
+            else:
+                unknown.add(pair)
+                changed.add(pair)
+        return frozenset(held)
+
+    if expected.pairs:
+        correct(kb, expected.pairs, decide)
+    return _Outcome(frozenset(believed_now), frozenset(unknown), frozenset(changed))
+
+
+def _of(facts: Iterable[Fact], pair: Pair) -> frozenset[Fact]:
+    return frozenset(f for f in facts if (f[0], f[1]) == pair)
+
+
+def _applied(classes: Classes, expected: _Expected, pair: Pair, current: frozenset[Fact]) -> frozenset[Fact]:
+    """``current`` (the facts of ``pair``) after the effects, as in STRIPS: the deletes go, then each
+    effect comes and takes the place of the values it excludes."""
+    facts = set(current) - set(expected.deletes)
+    for add in (f for f in expected.adds if (f[0], f[1]) == pair):
+        facts = {f for f in facts if not _excludes(classes, expected, f[1], f[2], add[2])}
+        facts.add(add)
+    return frozenset(facts)
+
+
+def _excludes(classes: Classes, expected: _Expected, predicate: str, old: str, new: str) -> bool:
+    """Whether a thing cannot have both values of ``predicate``: a functional relation, or two values the
+    store declares disjoint classes (a door Closed is not Opened)."""
+    return old != new and (predicate in expected.functional or classes.disjoint(old, new))
+
+
+def _told(call: GivenUp, expected: _Expected, outcome: _Outcome, error: BaseException | None) -> str:
+    parts = [call.said(f"failed ({error})" if error is not None else "answered")]
+    if outcome.believed:
+        parts.append(f"now believed, as its effects: {', '.join(_fact(f) for f in sorted(outcome.believed))}")
+    if outcome.changed:
+        pairs = ", ".join(_pair(p) for p in sorted(outcome.changed))
+        parts.append(
+            f"the belief of {pairs} changed after the call was given up, and which came last cannot be told: "
+            "no value of it is believed now"
+        )
+    if outcome.unknown - outcome.changed:
+        pairs = ", ".join(_pair(p) for p in sorted(outcome.unknown - outcome.changed))
+        parts.append(f"it may have acted in part, so no value of {pairs} is believed now")
+    if expected.ungrounded:
+        statements = ", ".join(_statement(s) for s in expected.ungrounded)
+        parts.append(f"not believed: {statements} (no one thing of the step's inputs is meant)")
+    if not expected.pairs and not expected.ungrounded:
+        parts.append("none of its effects is a belief that only a step sets: the next run perceives them")
+    return "; ".join(parts)
+
+
+def _fact(fact: Fact) -> str:
+    return "(" + ", ".join(shorten(term) for term in fact) + ")"
+
+
+def _pair(pair: Pair) -> str:
+    return f"{shorten(pair[0])} {shorten(pair[1])}"
+
+
+def _statement(statement: Statement) -> str:
+    return _fact((statement.subject, statement.predicate, statement.object))

@@ -1,0 +1,328 @@
+"""An actuator's answer that comes after its call was given up corrects the belief (actions.late_answers,
+docs/reliability.md "Late answers"): the bedroom door motor of docs/examples that opens the door after the
+run stopped waiting leaves the door believed open, not closed. The answer is read as an in-time one is:
+garbage, a wrong thing or a contradiction changes nothing; an error answer, or a belief changed since the
+call was given up, leaves the door's status unknown. Tick by tick with a silent transport and a clock of the
+test's, then a slow motor written with the SDK on a loopback server. Every wait is a bounded poll."""
+
+from __future__ import annotations
+
+import logging
+import threading
+from collections.abc import Callable, Iterator, Mapping
+from concurrent.futures import Future
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from cbrs.actions.answers import StoreClasses, check_designation
+from cbrs.actions.belief import BeliefState, Observation
+from cbrs.actions.breaker import passed_over
+from cbrs.actions.components import Registry, Status
+from cbrs.actions.composer import Composer
+from cbrs.actions.plan import Plan, PlanStep
+from cbrs.actions.remote import RemoteComponent
+from cbrs.actions.remote_errors import RemoteCallError
+from cbrs.actions.runner import RunResult, run_task
+from cbrs.bridge_client import BridgeClient
+from cbrs.component import Component
+from cbrs.kb import KnowledgeBase, Requirement, Statement
+from cbrs.kb.namespaces import PREFIXES, GraphName
+from cbrs.server import ServeConfig, Server
+from cbrs.sim.components import implementations
+from cbrs.sim.values import check
+from cbrs.sparql_service import EndpointConfig
+from tests.test_live_components import eventually
+from tests.test_remote_call_timeout import Clock, Silent
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "docs" / "examples"
+HOME = PREFIXES["home"]
+LAB = "https://example.org/lab#"
+OPEN = LAB + "OpenDoor_BedroomDoorMotor01"
+SERVICE = "/bedroom_door_motor_01/open"
+DOOR = {"@id": LAB + "BedroomDoor", "@type": HOME + "Door"}
+OPENED, CLOSED = (
+    (LAB + "BedroomDoor", HOME + "hasStatus", HOME + "Opened"),
+    (
+        LAB + "BedroomDoor",
+        HOME + "hasStatus",
+        HOME + "Closed",
+    ),
+)
+TOKEN = "late-answers-token"
+
+
+@pytest.fixture(scope="module")
+def kb() -> Iterator[KnowledgeBase]:
+    store = KnowledgeBase.open(":memory:")
+    store.load([EXAMPLES / "lab_bedroom_door.ttl"], graph="map")
+    store.registry.register((EXAMPLES / "lab_open_door.ttl").read_text(encoding="utf-8"))
+    yield store
+    store.close()
+
+
+def _believe(kb: KnowledgeBase, *facts: tuple[str, str, str]) -> None:
+    """The world graph as a run leaves it, believing ``facts`` (another run's, gone)."""
+    BeliefState(kb).write(Observation(facts=frozenset(facts)), whole=True)
+
+
+def _kept(kb: KnowledgeBase) -> list[str]:
+    """Every statement but the liveness graph's (a live component's lease is renewed as time goes)."""
+    return sorted(str(q) for q in kb.store.quads() if q.graph_name != GraphName.LIVENESS.node)
+
+
+def _door(kb: KnowledgeBase) -> list[str]:
+    return sorted(o for s, p, o in BeliefState(kb).facts(DOOR["@id"]) if p == HOME + "hasStatus")
+
+
+def _motor(kb: KnowledgeBase, transport: Silent, clock: Clock) -> RemoteComponent:
+    """The open service as a run makes it (sim.components._remote), with the test's clock."""
+    classes = StoreClasses(kb)
+
+    def checked(concept: str, value: Any) -> dict[str, Any]:
+        found = check(concept, value, classes.is_a)
+        check_designation(concept, found, classes)
+        return found
+
+    effects = kb.description(OPEN).effects
+    outputs = {"doorStatus": HOME + "DoorStatus"}
+    return RemoteComponent(OPEN, transport, SERVICE, outputs, checked, 10.0, clock, True, effects, classes)
+
+
+def _given_up(kb: KnowledgeBase) -> Future[dict[str, Any]]:
+    """A call to the motor, given up after its 10 s: the future the motor's answer ends."""
+    transport, clock = Silent(), Clock()
+    motor = _motor(kb, transport, clock)
+    motor.begin({"door": DOOR})
+    assert motor.update() is Status.RUNNING
+    clock.now += 10.5
+    assert motor.update() is Status.FAILED and motor.reason == f"{SERVICE} did not answer within 10 s"
+    return transport.calls[0][2]
+
+
+def _told(caplog: pytest.LogCaptureFixture) -> str:
+    """The warning the late answer was settled with (written after the belief): waited for, bounded."""
+    found = lambda: [r.getMessage() for r in caplog.records if "after its call was given up" in r.getMessage()]  # noqa: E731
+    assert eventually(lambda: bool(found()), 5.0), "the late answer was never settled"
+    (message,) = found()
+    assert "OpenDoor_BedroomDoorMotor01" in message and SERVICE in message
+    return message
+
+
+@pytest.fixture
+def warnings(caplog: pytest.LogCaptureFixture) -> Iterator[pytest.LogCaptureFixture]:
+    with caplog.at_level(logging.WARNING, logger="cbrs.actions.remote"):
+        yield caplog
+
+
+def test_a_late_success_is_believed_as_its_effects(kb: KnowledgeBase, warnings: pytest.LogCaptureFixture) -> None:
+    _believe(kb, CLOSED)
+    _given_up(kb).set_result({"doorStatus": {"@type": "home:Opened"}})
+    message = _told(warnings)
+    assert _door(kb) == [HOME + "Opened"]  # Closed went: disjoint with Opened
+    assert "now believed, as its effects: (" in message and "home:hasStatus, home:Opened)" in message
+
+
+def test_a_late_error_answer_leaves_what_the_call_would_change_unknown(
+    kb: KnowledgeBase, warnings: pytest.LogCaptureFixture
+) -> None:
+    _believe(kb, CLOSED)
+    _given_up(kb).set_exception(RemoteCallError("the door jammed half-way"))
+    message = _told(warnings)
+    assert _door(kb) == []
+    assert "failed (the door jammed half-way) after its call was given up" in message
+    assert "may have acted in part" in message
+
+
+@pytest.mark.parametrize(
+    ("newer", "left"),
+    [
+        pytest.param(CLOSED, [], id="a-newer-close-disagrees"),
+        pytest.param(OPENED, [HOME + "Opened"], id="a-newer-open-agrees"),
+    ],
+)
+def test_a_late_answer_after_a_newer_belief_of_the_same_fact_leaves_it_unknown_unless_they_agree(
+    kb: KnowledgeBase, warnings: pytest.LogCaptureFixture, newer: tuple[str, str, str], left: list[str]
+) -> None:
+    _believe(kb)  # nothing believed of the door when the call was given up
+    call = _given_up(kb)
+    _believe(kb, newer)  # another call, or a run, set it since
+    call.set_result({"doorStatus": {"@type": "home:Opened"}})
+    message = _told(warnings)
+    assert _door(kb) == left
+    assert ("which came last cannot be told" in message) == (not left)
+
+
+@pytest.mark.parametrize(
+    ("answer", "why"),
+    [
+        pytest.param({"doorStatus": "wide open"}, "answered a wrong doorStatus", id="garbage"),
+        pytest.param({"doorStatus": {"@type": "home:Closed"}}, "which contradicts its effect", id="contradicting"),
+        pytest.param({}, "answered without doorStatus", id="missing"),
+        pytest.param(
+            {"doorStatus": {"@id": LAB + "BedroomDoor", "@type": "home:Opened"}}, "designates", id="wrong-thing"
+        ),
+    ],
+)
+def test_a_late_answer_the_checks_refuse_changes_nothing(
+    kb: KnowledgeBase, warnings: pytest.LogCaptureFixture, answer: dict[str, Any], why: str
+) -> None:
+    _believe(kb, CLOSED)
+    before = _kept(kb)
+    _given_up(kb).set_result(answer)
+    message = _told(warnings)
+    assert _kept(kb) == before
+    assert "the answer is refused as one in time would be" in message and "may be stale" in message
+    assert why in message
+
+
+def test_a_call_the_transport_ends_unanswered_changes_nothing(
+    kb: KnowledgeBase, warnings: pytest.LogCaptureFixture
+) -> None:
+    _believe(kb, CLOSED)
+    before = _kept(kb)
+    _given_up(kb).set_exception(ConnectionError("the connection to the bridge closed"))
+    assert "ended without an answer (the connection to the bridge closed)" in _told(warnings)
+    assert _kept(kb) == before
+
+
+def test_a_run_still_going_keeps_the_late_answer_until_its_own_belief_of_the_door_changes(
+    kb: KnowledgeBase, warnings: pytest.LogCaptureFixture
+) -> None:
+    """The run's observation knows nothing of the answer (its environment believed the door closed): its
+    later writes, a whole one and a restore included, keep the door open; once the run itself believes
+    something else of the door (it read the answer back, then closed the door), its belief is the newer."""
+    running = BeliefState(kb)
+    running.write(Observation(facts=frozenset({CLOSED})), whole=True)
+    snapshot = running.snapshot()
+    _given_up(kb).set_result({"doorStatus": {"@type": "home:Opened"}})
+    _told(warnings)
+    running.write(Observation(facts=frozenset({CLOSED})), whole=True)
+    assert _door(kb) == [HOME + "Opened"]
+    running.restore(snapshot)
+    assert _door(kb) == [HOME + "Opened"]
+    running.write(Observation(facts=frozenset({OPENED})))
+    running.write(Observation(facts=frozenset({CLOSED})))  # a step of its own closed it
+    assert _door(kb) == [HOME + "Closed"]
+
+
+# -- over the bridge ---------------------------------------------------------------------------------
+
+
+class Motor:
+    """The open service's handler: it waits for the test to let it answer (at most 5 s)."""
+
+    def __init__(self) -> None:
+        self.answer: dict[str, Any] = {"doorStatus": {"@type": "home:Opened"}}
+        self.release = threading.Event()
+        self.calls = 0
+
+    def __call__(self, request: dict[str, Any]) -> dict[str, Any]:
+        self.calls += 1
+        self.release.wait(5.0)
+        return self.answer
+
+
+@pytest.fixture(scope="module")
+def lab() -> Iterator[tuple[Server, Motor]]:
+    """A loopback server whose store has the examples' door and tasks, and the slow motor registered."""
+    store = KnowledgeBase.open(":memory:")
+    store.load([EXAMPLES / "lab_bedroom_door.ttl"], graph="map")
+    store.load([EXAMPLES / "lab_bedroom_door_tasks.ttl"], graph="requirements")
+    running = Server(
+        store, ServeConfig(port=0, bridge_port=0, endpoint=EndpointConfig(update_token=TOKEN, isolate=False))
+    )
+    running.start()
+    motor = Motor()
+    description = (EXAMPLES / "lab_open_door.ttl").read_text(encoding="utf-8")
+    quick = description.replace("cbrs:responseTime 2.0", "cbrs:responseTime 0.05")  # 0.2 s to answer, not 6
+    assert quick != description
+    opener = Component(quick)
+    opener.handler(motor)
+    try:
+        with opener.connect(f"ws://127.0.0.1:{running.bridge_port}", token=TOKEN):
+            yield running, motor
+    finally:
+        motor.release.set()
+        running.stop()
+
+
+class Bedroom:
+    """A stub environment (no simulation): it gives the door, verifies nothing, and believes it closed."""
+
+    def __init__(self, kb: KnowledgeBase, transport: BridgeClient, motor: Motor) -> None:
+        self.kb, self.transport, self.motor = kb, transport, motor
+        self.facts = frozenset({CLOSED})
+        self.before_answer: list[str] = []
+        self.settled: Callable[[], bool] = lambda: True
+        self.registry: Registry = implementations(kb, transport=transport)
+        self.context = None
+
+    def passed_over(self) -> dict[str, str]:
+        """Asked before each composition: at the re-plan the call has been given up, and the motor is let
+        answer then, while the run is still going; the re-plan is composed once the answer is settled
+        (:attr:`settled`, waited for at most 5 s). What the store held before is kept."""
+        import time
+
+        if self.motor.calls and not self.motor.release.is_set():
+            self.before_answer = _kept(self.kb)
+            self.motor.release.set()
+            assert eventually(self.settled, 5.0), "the late answer was never settled"
+        return passed_over(self.transport, time.monotonic())
+
+    def given(self, plan: Plan, requirements: Mapping[str, Requirement]) -> dict[str, Any]:
+        return {"door": DOOR}
+
+    def verify(self, step: PlanStep | None, statement: Statement, outputs: Mapping[str, Any]) -> bool | None:
+        return None
+
+    def observe(self) -> Observation:
+        return Observation(facts=self.facts)
+
+    def clock(self) -> float:
+        return 0.0
+
+
+def _run(
+    server: Server, motor: Motor, answer: Any, settled: Callable[[], bool], monkeypatch: pytest.MonkeyPatch
+) -> tuple[RunResult, Bedroom]:
+    """OpenTheBedroomDoor with the door believed closed: its call to the motor is given up after 0.6 s, and
+    the motor answers ``answer`` as the run re-plans (the bridge would end the call at 1.2 s)."""
+    monkeypatch.setenv("CBRS_REMOTE_CALL_TIMEOUT", "0.6")
+    motor.answer, motor.release, motor.calls = answer, threading.Event(), 0
+    kb = server.kb
+    with BridgeClient(f"ws://127.0.0.1:{server.bridge_port}", TOKEN) as bridge:
+        bedroom = Bedroom(kb, bridge, motor)
+        bedroom.settled = settled
+        result = run_task(kb, LAB + "OpenTheBedroomDoor", bedroom, composer=Composer(kb), max_replans=1)
+    (replaced,) = result.replans
+    (attempt,) = replaced.to_dict()["execution"]["steps"][0]["attempts"]
+    assert attempt["reason"] == f"{SERVICE} did not answer within 0.6 s"
+    assert motor.calls == 1 and bedroom.before_answer
+    return result, bedroom
+
+
+def test_a_slow_motor_over_the_bridge_leaves_the_door_believed_open_once_it_answers(
+    lab: tuple[Server, Motor], warnings: pytest.LogCaptureFixture, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The answer comes as the run re-plans: the re-plan finds the door open (nothing to do), and the end of
+    the run, which writes the belief whole from an observation that believes the door closed, keeps it."""
+    server, motor = lab
+    opened = lambda: _door(server.kb) == [HOME + "Opened"]  # noqa: E731
+    result, _ = _run(server, motor, {"doorStatus": {"@type": "home:Opened"}}, opened, monkeypatch)
+    assert "now believed, as its effects" in _told(warnings)
+    assert result.succeeded and result.composition.plan is not None and not result.composition.plan.steps
+    assert _door(server.kb) == [HOME + "Opened"]
+
+
+def test_a_garbage_late_answer_over_the_bridge_changes_nothing(
+    lab: tuple[Server, Motor], warnings: pytest.LogCaptureFixture, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    server, motor = lab
+    refused = lambda: any("the answer is refused" in r.getMessage() for r in warnings.records)  # noqa: E731
+    result, bedroom = _run(server, motor, {"doorStatus": "wide open"}, refused, monkeypatch)
+    assert "the answer is refused as one in time would be" in _told(warnings)
+    assert not result.succeeded and result.composition.plan is None  # the motor passed over: no plan
+    assert _kept(server.kb) == bedroom.before_answer
+    assert _door(server.kb) == [HOME + "Closed"]
