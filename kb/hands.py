@@ -5,7 +5,9 @@ needs of it is stated on it: how far its jaws open, how far its palm sits above 
 its fingers are (its geometry, required of a gripper the map names; how far the fingertips reach below
 the grasp point, which they imply unless stated), and how it is used (its policy: the side grasp's tilt
 and least hold, the pre-grasp distance, how far the fingertips stay above a surface and each jaw clear of
-the object; each a default here unless the store states one, and then the store's). A value is stated on
+the object; each a default here unless the store states one, and then the store's), and what a carry must
+keep clear of it (the corridor either side of its way, and the arm behind a side grasp, :mod:`kb.arm_bands`;
+unstated, the Panda's, the arm and hand of every simulated robot). A value is stated on
 the gripper, or once on a class of grippers (a model) it is an individual of: its own value wins, else the
 nearest class's (:func:`read_hands`). The named query ``robot_hands`` reads them; an arm the map gives no
 gripper has :data:`PANDA_HAND`, the hand of the simulated arms (docs/simulation.md, "The hand").
@@ -20,6 +22,7 @@ from typing import TYPE_CHECKING
 
 from pyoxigraph import Literal
 
+from cbrs.kb.arm_bands import BAND_PROPERTIES, PANDA_SIDE_ARM, ArmBand, StatedBands, band_problem, stated_bands
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import MapError, local_name
 from cbrs.kb.shapes import nearest_term
@@ -28,6 +31,7 @@ if TYPE_CHECKING:
     from cbrs.kb.knowledge_base import KnowledgeBase
 
 __all__ = [
+    "CARRY_CORRIDOR",
     "FINGERTIP_CLEARANCE",
     "JAW_CLEARANCE",
     "PANDA_HAND",
@@ -71,6 +75,12 @@ the opening less twice this is refused. The Kinect's estimate of an object's cen
 across the jaws (the cup, seeds 0-7), and the Panda's open fingers' inner faces sit 1.1 mm inside the
 stated opening on each side (docs/simulation.md, "The hand"). The default of ``home:jawClearance``."""
 
+CARRY_CORRIDOR = 0.10
+"""How far to either side of what a hand carries (the object's footprint, or the open jaws' if wider) its
+palm passes over other things, footprint to footprint (m): a carry keeps the palm over the top of any
+thing standing within this of its way. The Panda hand's (its bounding box is 20.05 cm across along the
+fingers' axis), the hand of every simulated arm: the default of ``home:carryCorridor``."""
+
 
 @dataclass(frozen=True)
 class Hand:
@@ -95,6 +105,10 @@ class Hand:
     the palm depth and finger length imply (``finger_length - palm_depth``), the most it can be."""
     fingertip_clearance: float = FINGERTIP_CLEARANCE
     jaw_clearance: float = JAW_CLEARANCE
+    carry_corridor: float = CARRY_CORRIDOR
+    side_arm: tuple[ArmBand, ...] = PANDA_SIDE_ARM
+    """The arm behind a side grasp by this hand (``home:sideGraspBand``): a carry keeps each band's
+    underside over what stands under it (sim/transit.py)."""
 
     def __post_init__(self) -> None:
         if math.isnan(self.fingertip_depth):
@@ -128,6 +142,7 @@ _PROPERTIES = (
     "fingertipDepth",
     "fingertipClearance",
     "jawClearance",
+    "carryCorridor",
 )
 """The store's properties (local names in the home namespace) of :class:`Hand`'s values, in its order."""
 _GEOMETRY = ("jawOpening", "palmDepth", "fingerLength")
@@ -138,16 +153,25 @@ class HandError(MapError):
     """A gripper's description lacks or contradicts what the grasp planner needs: names the gripper, its
     arm and robot, the property and the value (None when missing), and the class it has the value from
     (``source``; empty for its own value, or for classes equally near that disagree, which ``problem``
-    names)."""
+    names), and the arm band of the gripper the property is of (``band``; empty for the gripper's own)."""
 
     def __init__(
-        self, hand: str, arm: str, robot: str, prop: str, value: str | None, problem: str, source: str = ""
+        self,
+        hand: str,
+        arm: str,
+        robot: str,
+        prop: str,
+        value: str | None,
+        problem: str,
+        source: str = "",
+        band: str = "",
     ) -> None:
         self.hand, self.arm, self.robot, self.property, self.value = hand, arm, robot, prop, value
-        self.source = source
+        self.source, self.band = source, band
         whose = "an arm" if hand == arm else f"the gripper of {local_name(arm)}"
         whose += f" of {local_name(robot)}" if robot else ""
         said = f"has no home:{prop}" if value is None else f"has home:{prop} {value!r}"
+        said += f" for its arm band {local_name(band)}" if band else ""
         said += f" from its class {local_name(source)}" if source else ""
         super().__init__(hand, f"({whose}) {said}: {problem}")
 
@@ -199,8 +223,9 @@ def _nearest(hand: str, arm: str, robot: str, name: str, stated: list[_Stated]) 
     return values[0], "" if near == 0 else nearest[0][1]
 
 
-def _hand(hand: str, arm: str, robot: str, stated: dict[str, list[_Stated]]) -> Hand:
-    """The :class:`Hand` of what the store states of ``hand`` and its classes (property IRI -> values)."""
+def _hand(hand: str, arm: str, robot: str, stated: dict[str, list[_Stated]], bands: list[StatedBands]) -> Hand:
+    """The :class:`Hand` of what the store states of ``hand`` and its classes (property IRI -> values,
+    and the bands of its arm it names)."""
     values: dict[str, float] = {}
     for name in _PROPERTIES:
         found = _nearest(hand, arm, robot, name, stated.get(HOME + name, []))
@@ -257,13 +282,61 @@ def _hand(hand: str, arm: str, robot: str, stated: dict[str, list[_Stated]]) -> 
         values.get("fingertipDepth", math.nan),
         values.get("fingertipClearance", FINGERTIP_CLEARANCE),
         values.get("jawClearance", JAW_CLEARANCE),
+        values.get("carryCorridor", CARRY_CORRIDOR),
+        _side_arm(hand, arm, robot, bands),
     )
+
+
+def _side_arm(hand: str, arm: str, robot: str, stated: list[StatedBands]) -> tuple[ArmBand, ...]:
+    """The bands of the arm behind ``hand``'s side grasp, back from the grasp point: those its nearest source
+    names (itself, else its nearest class), each checked; :data:`PANDA_SIDE_ARM` when it names none.
+    :class:`HandError` for equally near classes naming other bands, or a band no arm can have."""
+    if not stated:
+        return PANDA_SIDE_ARM
+    near = [each for each in stated if each.distance == stated[0].distance]
+    if any(each.bands != near[0].bands for each in near[1:]):
+        said = " and ".join(
+            f"{local_name(each.source)} ({', '.join(map(local_name, sorted(each.bands)))})" for each in near
+        )
+        raise HandError(
+            hand,
+            arm,
+            robot,
+            "sideGraspBand",
+            " and ".join(sorted({local_name(band) for each in near for band in each.bands})),
+            f"its classes {said}, equally near it, name other bands: name the bands on the gripper, or on a class "
+            "of it nearer than those",
+        )
+    source = near[0].source if near[0].distance else ""
+    bands = [_band(hand, arm, robot, band, values, source) for band, values in near[0].bands.items()]
+    return tuple(sorted(bands, key=lambda band: (band.near, band.far, band.half_width, band.underside)))
+
+
+def _band(hand: str, arm: str, robot: str, band: str, stated: dict[str, tuple[str, ...]], source: str) -> ArmBand:
+    """The :class:`ArmBand` of what the store states of ``band``, one of ``hand``'s arm's bands."""
+    numbers: dict[str, float] = {}
+    for name in BAND_PROPERTIES:
+        values = stated[name]
+        if len(values) != 1:
+            problem = (
+                "one value is needed" if values else f"a band states all of home:{', home:'.join(BAND_PROPERTIES)}"
+            )
+            raise HandError(hand, arm, robot, name, " and ".join(values) or None, problem, source, band)
+        try:
+            numbers[name] = float(values[0])
+        except ValueError:
+            raise HandError(hand, arm, robot, name, values[0], "not a number", source, band) from None
+    built = ArmBand(*numbers.values())
+    name, problem = band_problem(built)
+    if problem:
+        raise HandError(hand, arm, robot, name, stated[name][0], problem, source, band)
+    return built
 
 
 def _slip(name: str, stated: dict[str, list[_Stated]]) -> str:
     """A did-you-mean for a missing ``name``: the property of the gripper or its classes it may be a
     misspelling of (home:jawOpenning), which the load took silently, being declared nowhere."""
-    known = {HOME + other for other in _PROPERTIES}
+    known = {HOME + other for other in (*_PROPERTIES, "sideGraspBand")}
     slip = nearest_term(HOME + name, [prop for prop in stated if prop not in known])
     if not slip:
         return ""
@@ -274,14 +347,19 @@ def _slip(name: str, stated: dict[str, list[_Stated]]) -> str:
 
 def read_hands(kb: KnowledgeBase, robot: str | None = None) -> dict[str, Hand]:
     """Each arm's hand (by arm IRI) that the semantic map gives ``robot`` (every robot by default), by the
-    named query ``robot_hands``: an arm with no ``home:hasGripper`` has :data:`PANDA_HAND`. Each value is
+    named queries ``robot_hands`` and ``side_grasp_bands``: an arm with no ``home:hasGripper`` has
+    :data:`PANDA_HAND`. Each value (and the set of bands of the arm behind a side grasp) is
     the gripper's own, else the one of the nearest of its classes (``rdf:type``, then ``rdfs:subClassOf``)
     that states it, so a gripper model's geometry is stated once on its class.
     :class:`HandError` for a gripper missing its geometry, stating a value no hand can have, or having two
-    values of a property from equally near classes."""
+    values of a property from equally near classes (:func:`_side_arm` for the bands)."""
     arms: dict[str, tuple[str, set[str]]] = {}
     stated: dict[str, dict[str, list[_Stated]]] = defaultdict(lambda: defaultdict(list))
-    for row in kb.select("robot_hands", {"robot": robot} if robot is not None else None):
+    hand_rows, band_rows = kb.select_each(
+        ["robot_hands", "side_grasp_bands"], {"robot": robot} if robot is not None else None
+    )
+    bands = stated_bands(band_rows)
+    for row in hand_rows:
         arm = row["arm"].value
         owner, grippers = arms.setdefault(arm, (row["robot"].value, set()))
         if "hand" in row:
@@ -299,5 +377,5 @@ def read_hands(kb: KnowledgeBase, robot: str | None = None) -> dict[str, Hand]:
             hands[arm] = PANDA_HAND
             continue
         hand = grippers.pop()
-        hands[arm] = _hand(hand, arm, owner, stated.get(hand, {}))
+        hands[arm] = _hand(hand, arm, owner, stated.get(hand, {}), bands.get(hand, []))
     return hands

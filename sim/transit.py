@@ -3,52 +3,28 @@
 Without a floor for the object's bottom, a pill box passed between the arms was carried 4 cm above the
 table and the hand swept the cup beside its way off the table. Behind a side grasp the hand and the
 forearm reach 30 cm back towards the robot, the wrist below the grasp point: a cup carried by its side
-past a second cup 20 cm behind its way knocked that one off the table (:data:`SIDE_GRASP_ARM`).
+past a second cup 20 cm behind its way knocked that one off the table. How far the hand reaches either side
+of its way and where the arm is behind a side grasp are the carrying hand's, as the store describes it
+(:class:`kb.hands.Hand`'s ``carry_corridor`` and ``side_arm``: ``home:carryCorridor``, ``home:sideGraspBand``).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 
+from cbrs.kb.arm_bands import ArmBand
 from cbrs.sim.arms import ArmSide
 from cbrs.sim.context import SimContext
 from cbrs.sim.geometry import Region
 from cbrs.sim.grasping import GraspKind, ObjectModel
 
-TRANSIT_CORRIDOR = 0.10
-"""The hand's palm passes over another thing standing within 10 cm of the way, footprint to footprint (the
-Panda hand is about 20 cm across along its fingers' axis)..."""
-
-
 TRANSIT_CLEARANCE = 0.02
-"""... 2 cm above its top; so does the carried object's bottom over a thing standing within 2 cm of the
-fingers' or the object's footprint."""
-
-
-@dataclass(frozen=True)
-class ArmBand:
-    """Where the arm is behind a side grasp's grasp point: from ``near`` to ``far`` back along the approach
-    (m, level) and ``half_width`` either side of it, no part of the arm but the fingers is lower than
-    ``underside`` above the grasp point (below it when negative)."""
-
-    near: float
-    far: float
-    half_width: float
-    underside: float
-
-
-SIDE_GRASP_ARM = (ArmBand(0.0, 0.175, 0.10, 0.01), ArmBand(0.175, 0.325, 0.10, -0.03))
-"""The bundled arms (Franka Panda) behind a side grasp tilted down by the default 35 degrees: the hand,
-rising back from the grasp point, and the wrist and forearm, 17.5-32.5 cm back, as low as 3 cm below it.
-Measured on the arms' kinematics at 239 side grasps the two arms reach over the kitchen table (grasp points
-7.2-8.25 x 3.1-3.5, 0.78-0.95 m high), straight up from the table under each: the lowest point, 20-30 cm
-back, was 3.0 cm below the grasp point; 12.5 cm or more to either side, or 32.5 cm or more back, the arm
-was higher than the grasp point (tests/test_designate_subclass.py checks a sample). The carried object's
-floor keeps this underside TRANSIT_CLEARANCE over the top of any object whose footprint comes within
-TRANSIT_CLEARANCE of a band anywhere along the way, where the way ends too: there the arm comes down
-whatever the floor, and a thing under it is met either way (from the side, or from above when the carry
+"""How far above the top of a thing standing by the way a carry keeps what passes over it (m): the carried
+object's bottom over a thing within this of the fingers' or the object's footprint; the hand's palm over one
+within the hand's carry corridor; by a side grasp, each band of the arm behind it over one whose footprint
+comes within this of the band anywhere along the way, where the way ends too (there the arm comes down
+whatever the floor, and a thing under it is met either way: from the side, or from above when the carry
 was lifted over it)."""
 
 
@@ -60,9 +36,10 @@ def transit_floor(
     where each is believed to be (else where the map puts it): TRANSIT_CLEARANCE over the top of any whose
     footprint comes within that of the object's or the fingers' (the jaws' opening across), and the palm
     (the grasp height and the hand's palm depth above the object's bottom) as far over the top of any within
-    TRANSIT_CORRIDOR; by a side grasp, the arm behind it (:data:`SIDE_GRASP_ARM`) as far over the top of any
-    under it. None when no object stands by the way. Without it, a pill box passed between the arms was
-    carried 4 cm above the table, and the hand swept the cup beside its way off the table."""
+    the hand's ``carry_corridor``; by a side grasp, each band of the arm behind it (the hand's ``side_arm``)
+    as far over the top of any under it. None when no object stands by the way. Without it, a pill box passed
+    between the arms was carried 4 cm above the table, and the hand swept the cup beside its way off the
+    table."""
     world = ctx.world
     hand = world.arm(side).hand
     size = world.objects[held.name].size if held.name in world.objects else (held.width, held.width, held.height)
@@ -85,19 +62,25 @@ def transit_floor(
         needed: list[float] = []
         if apart < near + TRANSIT_CLEARANCE:
             needed.append(top)
-        elif apart < near + TRANSIT_CORRIDOR:
+        elif apart < near + hand.carry_corridor:
             needed.append(top - palm)
         if facing is not None:
-            needed += [top - band.underside - held.grasp_height for band in _under(start, end, facing, (x, y), radius)]
+            under = _under(hand.side_arm, start, end, facing, (x, y), radius)
+            needed += [top - band.underside - held.grasp_height for band in under]
         if needed:
             floor = max(needed) if floor is None else max(floor, *needed)
     return floor
 
 
 def _under(
-    start: tuple[float, float], end: tuple[float, float], facing: float, point: tuple[float, float], radius: float
+    bands: Sequence[ArmBand],
+    start: tuple[float, float],
+    end: tuple[float, float],
+    facing: float,
+    point: tuple[float, float],
+    radius: float,
 ) -> list[ArmBand]:
-    """The bands of :data:`SIDE_GRASP_ARM` that pass within TRANSIT_CLEARANCE of the footprint (``radius``
+    """The ``bands`` of an arm behind a side grasp that pass within TRANSIT_CLEARANCE of the footprint (``radius``
     round ``point``) of a thing standing by the way from ``start`` to ``end`` of a side grasp's grasp point,
     its approach level along ``facing``. In each band's frame (back along the approach, to the side) the
     grasp point's way is a segment and the band a rectangle."""
@@ -109,7 +92,7 @@ def _under(
 
     a, b = banded(start), banded(end)
     reach = radius + TRANSIT_CLEARANCE
-    return [band for band in SIDE_GRASP_ARM if _box_distance(a, b, band) < reach]
+    return [band for band in bands if _box_distance(a, b, band) < reach]
 
 
 def _box_distance(a: tuple[float, float], b: tuple[float, float], band: ArmBand) -> float:

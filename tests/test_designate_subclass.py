@@ -3,13 +3,14 @@ home:Cup) made every bundled task about "the cup" ambiguous; a class now means t
 it and of no narrower class first (kb.semantic_map.designate, Reading.DIRECT_FIRST; docs/tasks.md). With
 that, RobotArmServeACup carried the red cup past the green one, 20 cm behind its way, and the forearm behind
 the side grasp knocked the green cup off the table: the carry's floor now keeps the arm behind a side grasp
-over what stands under it (sim/transit.py, SIDE_GRASP_ARM; docs/simulation.md)."""
+over what stands under it (sim/transit.py; the bands of the arm are the hand's home:sideGraspBand in the store,
+kb/arm_bands.py; docs/simulation.md)."""
 
 from __future__ import annotations
 
 import math
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import pybullet as p
@@ -18,6 +19,7 @@ import pytest
 from cbrs.actions.composer import Composer
 from cbrs.actions.runner import run_task
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.arm_bands import PANDA_SIDE_ARM
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import AmbiguousDesignatorError, Reading, SemanticMap, designate
 from cbrs.sim import transit
@@ -111,7 +113,7 @@ class _Served:
 def served(kb: KnowledgeBase) -> Iterator[tuple[HomeWorld, _Served]]:
     """RobotArmServeACup at seed 0 with the green cup at (7.62, 3.12), 20 cm behind the red cup's way from
     (7.45, 3.32) to below the tap (7.75, 3.31); and the floor of that carry, with and without the arm behind
-    the side grasp (SIDE_GRASP_ARM empty: the floor as it was)."""
+    the side grasp (the left hand's bands, as the store states them, and none: the floor as it was)."""
     with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
         env = SimEnvironment(world, kb)
         red = ObjectModel.of(world.map.objects[WORLD + "Cup"]).by(GraspKind.SIDE)
@@ -119,11 +121,12 @@ def served(kb: KnowledgeBase) -> Iterator[tuple[HomeWorld, _Served]]:
         spot = Region("BelowOfTap", below.min_x, below.max_x, below.min_y, below.max_y, below.min_z, below.max_z)
         start = world.pose("Cup").position
         with_arm = transit.floor_to(env.context, red, ArmSide.LEFT, start, spot)
-        bands, transit.SIDE_GRASP_ARM = transit.SIDE_GRASP_ARM, ()
+        left = world.arm(ArmSide.LEFT)
+        stated, left.hand = left.hand, replace(left.hand, side_arm=())
         try:
             without_arm = transit.floor_to(env.context, red, ArmSide.LEFT, start, spot)
         finally:
-            transit.SIDE_GRASP_ARM = bands
+            left.hand = stated
         green_before = world.pose("Cup2").position
         result = run_task(kb, "RobotArmServeACup", env, composer=Composer(kb))
         yield (
@@ -151,21 +154,23 @@ def test_the_red_cup_is_served_and_the_green_cup_stays_where_it_was(served: tupl
 
 def test_the_floor_keeps_the_forearm_over_the_green_cup(kb: KnowledgeBase, served: tuple[HomeWorld, _Served]) -> None:
     """The green cup's top is 0.84 m: the forearm, up to 3 cm below the grasp point, passes 2 cm over it."""
-    _, run = served
+    world, run = served
     assert run.floor_with_arm is not None
     smap = SemanticMap.read(kb)
     green, table = smap.objects[LAB + "Cup2"], smap.things[WORLD + "KitchenTable"].box
     grasp_height = ObjectModel.of(smap.objects[WORLD + "Cup"]).grasp_height
-    wrist = min(band.underside for band in transit.SIDE_GRASP_ARM)
+    wrist = min(band.underside for band in world.arm(ArmSide.LEFT).hand.side_arm)
     top = table.max_z + green.size[2]
     assert run.floor_with_arm + grasp_height + wrist == pytest.approx(top + transit.TRANSIT_CLEARANCE)
     assert run.floor_without_arm is None or run.floor_without_arm < run.floor_with_arm - 0.02
 
 
-def test_the_arm_behind_a_side_grasp_is_where_side_grasp_arm_says(served: tuple[HomeWorld, _Served]) -> None:
-    """SIDE_GRASP_ARM against the arms themselves, at a few side grasps over the table: straight up from the
-    table under each band, the first link the ray meets (the fingers aside) is no lower than its underside."""
+def test_the_arm_behind_a_side_grasp_is_where_the_store_says(served: tuple[HomeWorld, _Served]) -> None:
+    """The bands the store states of the bundled hands (ontologies/world.ttl) against the arms themselves, at
+    a few side grasps over the table: straight up from the table under each band, the first link the ray
+    meets (the fingers aside) is no lower than its underside."""
     world, _ = served
+    assert all(world.arm(side).hand.side_arm == PANDA_SIDE_ARM for side in ArmSide)
     met = 0
     for side, grasp in (
         (ArmSide.LEFT, (7.45, 3.30, 0.86)),
@@ -179,7 +184,7 @@ def test_the_arm_behind_a_side_grasp_is_where_side_grasp_arm_says(served: tuple[
             p.resetJointState(arm.body, joint, angle, physicsClientId=world.client)
         tip = arm.ee_pose().position
         back, aside = (-math.cos(spec.yaw), -math.sin(spec.yaw)), (-math.sin(spec.yaw), math.cos(spec.yaw))
-        for band in transit.SIDE_GRASP_ARM:
+        for band in arm.hand.side_arm:
             samples = [
                 (tip[0] + b * back[0] + s * aside[0], tip[1] + b * back[1] + s * aside[1])
                 for b in (band.near + 0.01, (band.near + band.far) / 2, band.far)
