@@ -127,7 +127,8 @@ class BeliefState:
                 if isinstance(q.subject, ox.NamedNode) and isinstance(q.object, ox.NamedNode) and q.predicate != _TYPE
             }
             facts = self._corrected(frozenset(found))
-            kept = [q for q in quads if q not in found.values()]
+            replaced = set(found.values())
+            kept = [q for q in quads if q not in replaced]
             self.kb.store.replace_graph(graph, kept + _quads(facts))
 
     def facts(self, thing: str | None = None) -> set[tuple[str, str, str]]:
@@ -166,8 +167,9 @@ def correct(
         if stray:
             raise ValueError(f"a correction of {sorted(wanted)} may not set {stray}: nothing was written")
         correction = Correction(wanted, before, held)
-        if held != before:
-            kb.store.replace(_quads(before - held), _quads(held - before))
+        if held == before:
+            return correction
+        kb.store.replace(_quads(before - held), _quads(held - before))
         for state in list(_live):
             if state.kb.store is kb.store:
                 state._corrections.append(correction)

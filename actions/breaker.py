@@ -17,7 +17,9 @@ timeout before failing over. A breaker per service remembers the timeouts instea
 An actuator (``RemoteComponent(exclusive=True)``) keeps the rule it had before the breaker: while a call
 given up unanswered may still be executing, no new call goes to its service (:func:`given_up`), and
 composition passes it over with that reason. Both facts live in one table per transport, kept only
-while the transport lives (a server's own bridge connection outlives its runs).
+while the transport lives (a server's own bridge connection outlives its runs). The answer to a call
+given up, when it comes, corrects the belief (:mod:`actions.late_answers`, the ``late`` callback), or
+is logged when there is no store to write.
 """
 
 from __future__ import annotations

@@ -94,7 +94,7 @@ def watch(
     cannot be read now (the component was deregistered, the store is unreachable): it is then only logged."""
     try:
         expected = _expect(kb, classes, call)
-    except KnowledgeBaseError as error:
+    except (KnowledgeBaseError, ValueError) as error:
         log.warning("%s; its answer, if it comes, changes no belief: %s", call.said("is out"), error)
         return None
 
@@ -143,7 +143,11 @@ def _thing(
         if not isinstance(value, dict) or not isinstance(value.get("@id"), str) or value["@id"] == besides:
             continue
         thing = value["@id"]
-        rows = kb.select("map_types", {"thing": ox.NamedNode(thing)})
+        try:
+            node = ox.NamedNode(thing)
+        except ValueError:  # not an IRI: no thing of the map, nor of the world graph
+            continue
+        rows = kb.select("map_types", {"thing": node})
         kinds = {row["type"].value for row in rows} | set(_given_as(value))
         if any(classes.is_a(kind, concept) for kind in kinds):
             found.add(thing)
@@ -184,8 +188,8 @@ def _settle(
             return
     try:
         outcome = _believe(kb, classes, expected, failed=error is not None)
-    except KnowledgeBaseError as broken:
-        log.warning("%s, but the belief could not be written: %s", call.said("answered"), broken)
+    except Exception as broken:  # a thread of its own: say what broke, never end in silence
+        log.warning("%s, but the belief could not be corrected: %s", call.said("answered"), broken)
         return
     log.warning("%s", _told(call, expected, outcome, error))
 

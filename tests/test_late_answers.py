@@ -90,11 +90,11 @@ def _motor(kb: KnowledgeBase, transport: Silent, clock: Clock) -> RemoteComponen
     return RemoteComponent(OPEN, transport, SERVICE, outputs, checked, 10.0, clock, True, effects, classes)
 
 
-def _given_up(kb: KnowledgeBase) -> Future[dict[str, Any]]:
-    """A call to the motor, given up after its 10 s: the future the motor's answer ends."""
+def _given_up(kb: KnowledgeBase, door: Mapping[str, Any] = DOOR) -> Future[dict[str, Any]]:
+    """A call to the motor for ``door``, given up after its 10 s: the future the motor's answer ends."""
     transport, clock = Silent(), Clock()
     motor = _motor(kb, transport, clock)
-    motor.begin({"door": DOOR})
+    motor.begin({"door": door})
     assert motor.update() is Status.RUNNING
     clock.now += 10.5
     assert motor.update() is Status.FAILED and motor.reason == f"{SERVICE} did not answer within 10 s"
@@ -122,6 +122,18 @@ def test_a_late_success_is_believed_as_its_effects(kb: KnowledgeBase, warnings: 
     message = _told(warnings)
     assert _door(kb) == [HOME + "Opened"]  # Closed went: disjoint with Opened
     assert "now believed, as its effects: (" in message and "home:hasStatus, home:Opened)" in message
+
+
+@pytest.mark.parametrize(
+    "door", [pytest.param({"@id": "not an IRI"}, id="not-an-iri"), pytest.param({}, id="no-thing")]
+)
+def test_an_effect_no_thing_of_the_step_is_meant_by_is_named_not_guessed(
+    kb: KnowledgeBase, warnings: pytest.LogCaptureFixture, door: dict[str, Any]
+) -> None:
+    _believe(kb, CLOSED)
+    _given_up(kb, door).set_result({"doorStatus": {"@type": "home:Opened"}})
+    assert "not believed: (home:Door, home:hasStatus, home:Opened) (no one thing" in _told(warnings)
+    assert _door(kb) == [HOME + "Closed"]
 
 
 def test_a_late_error_answer_leaves_what_the_call_would_change_unknown(
