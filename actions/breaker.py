@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import logging
 import threading
+import time
 import weakref
 from collections.abc import Callable, Mapping
 from concurrent.futures import Future
@@ -37,11 +38,21 @@ from cbrs.kb.namespaces import shorten
 
 log = logging.getLogger("cbrs.actions.remote")
 
-__all__ = ["BreakerPolicy", "BreakerPolicyError", "Late", "ServiceCalls", "busy", "calls_of", "passed_over"]
+__all__ = [
+    "BreakerPolicy",
+    "BreakerPolicyError",
+    "Late",
+    "ServiceCalls",
+    "busy",
+    "calls_of",
+    "passed_over",
+    "settle_late_answers",
+]
 
 
 Late = Callable[[Future[dict[str, Any]]], None]
-"""Called with an actuator's call given up once it ends (answered, failed or ended by the transport)."""
+"""Called with an actuator's call given up once it ends (answered, failed or ended by the transport), in
+a thread of its own: the transport's reader ends the future, and must not wait for a store."""
 
 
 class _Transport(Protocol):
@@ -90,6 +101,7 @@ class ServiceCalls:
     def __init__(self) -> None:
         self._lock = threading.Lock()
         self._services: dict[str, _Service] = {}
+        self._settling: list[tuple[str, float, threading.Event]] = []  # calls given up: service, end, taken
 
     def admit(
         self, service: str, component: str, now: float, window: float, exclusive: bool, session: str | None
@@ -129,7 +141,12 @@ class ServiceCalls:
             entry.timeout = timeout
             if pending is not None and not pending.done():
                 entry.given_up = (pending, sent, timeout)
-                pending.add_done_callback(late or _say_when_late(service, component, timeout))
+                self._watch(
+                    service,
+                    pending,
+                    sent + timeout * _late_window(),
+                    late or _say_when_late(service, component, timeout),
+                )
             if (
                 policy is not None
                 and policy.timeouts
@@ -168,7 +185,43 @@ class ServiceCalls:
         with self._lock:
             entry = self._services.setdefault(service, _Service(component))
             entry.given_up = (pending, sent, timeout)
-        pending.add_done_callback(late or _say_when_late(service, component, timeout))
+            self._watch(
+                service, pending, sent + timeout * _late_window(), late or _say_when_late(service, component, timeout)
+            )
+
+    def _watch(self, service: str, pending: Future[dict[str, Any]], ends: float, late: Late) -> None:
+        """Have ``late`` take ``pending`` when it ends, in a thread of its own, and remember the call until
+        then (:meth:`settle`). ``ends``: when the transport ends it at the latest."""
+        settled = threading.Event()
+        self._settling = [entry for entry in self._settling if not entry[2].is_set()]
+        self._settling.append((service, ends, settled))
+
+        def take(done: Future[dict[str, Any]]) -> None:
+            try:
+                late(done)
+            finally:
+                settled.set()
+
+        pending.add_done_callback(
+            lambda done: threading.Thread(target=take, args=(done,), name="cbrs-late-answer", daemon=True).start()
+        )
+
+    def settle(
+        self, now: float, limit: float, grace: float = 5.0, clock: Callable[[], float] | None = None
+    ) -> list[str]:
+        """Wait until every actuator's call given up has ended and what it answered has been taken
+        (:mod:`actions.late_answers`): each at most until the transport ends it and ``grace`` seconds more,
+        and all at most ``limit`` seconds. ``now``: the time on the clock the calls were sent by; ``clock``
+        the one to wait by."""
+        clock = clock or time.monotonic
+        start = clock()
+        with self._lock:
+            waiting = list(self._settling)
+        for _service, ends, settled in waiting:
+            settled.wait(max(0.0, start + min(ends - now + grace, limit) - clock()))
+        with self._lock:
+            self._settling = [entry for entry in self._settling if not entry[2].is_set()]
+            return sorted({service for service, _, _ in self._settling})
 
     def busy(self, service: str, now: float) -> str:
         with self._lock:
@@ -231,6 +284,12 @@ def _say_when_late(service: str, component: str, timeout: float) -> Late:
         )
 
     return late
+
+
+def _late_window() -> float:
+    from cbrs.actions.remote import LATE_WINDOW
+
+    return LATE_WINDOW
 
 
 def _busy(service: str, entry: _Service, now: float) -> str:
@@ -298,6 +357,15 @@ def busy(transport: _Transport, service: str, now: float) -> str:
     """Why no new call may go to the actuator ``service`` over ``transport`` now (``remote.given_up``)."""
     table = _table(transport)
     return table.busy(service, now) if table is not None else ""
+
+
+def settle_late_answers(transport: _Transport, limit: float) -> list[str]:
+    """Wait, at most ``limit`` seconds, for the actuators' calls given up over ``transport`` to end and
+    their answers to be taken in the belief, before a program closes the transport (which would end
+    them unanswered): ``cbrs run`` gives up a door motor's call at 10 s and exits while the motor opens
+    the door. The services still out after it (empty: none)."""
+    table = _table(transport)
+    return table.settle(time.monotonic(), limit) if table is not None else []
 
 
 def _table(transport: _Transport) -> ServiceCalls | None:

@@ -32,7 +32,6 @@ The write is :func:`actions.belief.correct`: one transaction, and kept by a run 
 from __future__ import annotations
 
 import logging
-import threading
 from collections.abc import Callable, Iterable, Mapping
 from concurrent.futures import Future
 from dataclasses import dataclass
@@ -42,6 +41,7 @@ import pyoxigraph as ox
 
 from cbrs.actions.answers import Classes
 from cbrs.actions.belief import Fact, Pair, believed, correct
+from cbrs.actions.breaker import Late
 from cbrs.actions.errors import ActionsError
 from cbrs.actions.remote_errors import RemoteCallError
 from cbrs.kb import KnowledgeBase, KnowledgeBaseError, Statement
@@ -86,25 +86,16 @@ class _Expected:
         return frozenset((s, p) for s, p, _ in (*self.deletes, *self.adds))
 
 
-def watch(
-    kb: KnowledgeBase, classes: Classes, call: GivenUp, read: Read
-) -> Callable[[Future[dict[str, Any]]], None] | None:
-    """The callback that settles ``call``'s answer when it comes, in a thread of its own (the transport's
-    reader calls it, and must not wait for the store). None, after a warning, when what it would change
-    cannot be read now (the component was deregistered, the store is unreachable): it is then only logged."""
+def watch(kb: KnowledgeBase, classes: Classes, call: GivenUp, read: Read) -> Late | None:
+    """What settles ``call``'s answer once it comes (:data:`actions.breaker.Late`: called in a thread of
+    its own). None, after a warning, when what it would change cannot be read now (the component was
+    deregistered, the store is unreachable): the answer is then only logged."""
     try:
         expected = _expect(kb, classes, call)
     except (KnowledgeBaseError, ValueError) as error:
         log.warning("%s; its answer, if it comes, changes no belief: %s", call.said("is out"), error)
         return None
-
-    def ended(done: Future[dict[str, Any]]) -> None:
-        settle = threading.Thread(
-            target=_settle, args=(kb, classes, call, expected, read, done), name="cbrs-late-answer", daemon=True
-        )
-        settle.start()
-
-    return ended
+    return lambda done: _settle(kb, classes, call, expected, read, done)
 
 
 def _expect(kb: KnowledgeBase, classes: Classes, call: GivenUp) -> _Expected:

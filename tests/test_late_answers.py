@@ -18,7 +18,7 @@ import pytest
 
 from cbrs.actions.answers import StoreClasses, check_designation
 from cbrs.actions.belief import BeliefState, Observation
-from cbrs.actions.breaker import passed_over
+from cbrs.actions.breaker import calls_of, passed_over, settle_late_answers
 from cbrs.actions.components import Registry, Status
 from cbrs.actions.composer import Composer
 from cbrs.actions.plan import Plan, PlanStep
@@ -92,13 +92,18 @@ def _motor(kb: KnowledgeBase, transport: Silent, clock: Clock) -> RemoteComponen
 
 def _given_up(kb: KnowledgeBase, door: Mapping[str, Any] = DOOR) -> Future[dict[str, Any]]:
     """A call to the motor for ``door``, given up after its 10 s: the future the motor's answer ends."""
-    transport, clock = Silent(), Clock()
+    return _give_up(kb, Silent(), Clock(), door)
+
+
+def _give_up(
+    kb: KnowledgeBase, transport: Silent, clock: Clock, door: Mapping[str, Any] = DOOR
+) -> Future[dict[str, Any]]:
     motor = _motor(kb, transport, clock)
     motor.begin({"door": door})
     assert motor.update() is Status.RUNNING
     clock.now += 10.5
     assert motor.update() is Status.FAILED and motor.reason == f"{SERVICE} did not answer within 10 s"
-    return transport.calls[0][2]
+    return transport.calls[-1][2]
 
 
 def _told(caplog: pytest.LogCaptureFixture) -> str:
@@ -217,6 +222,25 @@ def test_a_run_still_going_keeps_the_late_answer_until_its_own_belief_of_the_doo
     running.write(Observation(facts=frozenset({OPENED})))
     running.write(Observation(facts=frozenset({CLOSED})))  # a step of its own closed it
     assert _door(kb) == [HOME + "Closed"]
+
+
+def test_a_program_that_is_ending_can_wait_for_the_late_answers_first(kb: KnowledgeBase) -> None:
+    """cbrs run gives up the motor's call and ends; closing its transport then would end the call unanswered
+    while the motor opens the door. settle_late_answers waits for the answer and its correction (bounded)."""
+    _believe(kb, CLOSED)
+    transport, clock = Silent(), Clock()
+    call = _give_up(kb, transport, clock)
+    answer = threading.Timer(0.1, call.set_result, args=({"doorStatus": {"@type": "home:Opened"}},))
+    answer.start()
+    assert calls_of(transport).settle(clock(), 5.0) == []  # the answer came and was taken
+    assert _door(kb) == [HOME + "Opened"]  # at once: nothing to poll for
+    silent, its_clock = Silent(), Clock()
+    unanswered = _give_up(kb, silent, its_clock)
+    assert calls_of(silent).settle(its_clock(), 0.05) == [SERVICE]  # at most 0.05 s: still out
+    assert settle_late_answers(Silent(), 0.05) == []  # a transport that gave up nothing
+    unanswered.set_exception(ConnectionError("the test ends it"))
+    assert calls_of(silent).settle(its_clock(), 5.0) == []
+    answer.join()
 
 
 # -- over the bridge ---------------------------------------------------------------------------------
