@@ -22,6 +22,7 @@ from cbrs.actions.events import Event, EventBus
 from cbrs.actions.executor import ExecutionReport, Executor, RunStatus
 from cbrs.actions.faults import Combined, FaultPolicy, FixedFaults
 from cbrs.actions.graph import parameter_names, statement_text
+from cbrs.actions.model import ActionLibrary
 from cbrs.actions.plan import Plan, PlanStep
 from cbrs.actions.replanning import Failure, FailureMemory, ReplanPolicy
 from cbrs.kb import Advertisement, KnowledgeBase, NotFoundError, Requirement, Statement
@@ -51,7 +52,9 @@ class Environment(Protocol):
     # the inputs of every step known by then, for an environment that looks ahead (where a hold ends);
     # ``succeeded(step, component)`` (``executor.StepDone``), called when a step succeeded, for an
     # environment that keeps beliefs no sense can check (a door a remote motor opened); ``passed_over()``,
-    # the components to compose without now, with why (remote ones whose calls timed out).
+    # the components to compose without now, with why (remote ones whose calls timed out);
+    # ``unimplemented(advertisements)``, why it has no implementation of some of them, where it knows
+    # better than "no skill for its service" (a camera the simulated home lacks).
 
 
 @dataclass(frozen=True)
@@ -262,7 +265,8 @@ def run_task(
     composition = composer.compose(task, belief=True)
     config = composer.config
     passed = _passed_over(environment, bus, {})
-    composition = _runnable(kb, config, task, composition, environment.registry, passed=passed)
+    why_not = _why_not(environment)
+    composition = _runnable(kb, config, task, composition, environment.registry, passed=passed, why_not=why_not)
     if composition.plan is None:
         belief.restore(before)  # nothing can be done and nothing was: the store is left as it was
         return RunResult(composition, None, passed_over=_pairs(passed))
@@ -279,7 +283,8 @@ def run_task(
         it passes over now."""
         nonlocal passed
         passed = _passed_over(environment, bus, passed)
-        return _runnable(kb, config, task, _compose(kb, config, task, avoid), environment.registry, avoid, passed)
+        again = _compose(kb, config, task, avoid)
+        return _runnable(kb, config, task, again, environment.registry, avoid, passed, why_not=why_not)
 
     stopped = ""
     composed_without = _pairs(passed)
@@ -342,6 +347,90 @@ def run_task(
     return RunResult(composition, report, tuple(replans), goals, stopped, composed_without)
 
 
+def refusal_before_world(
+    kb: KnowledgeBase,
+    task: str,
+    runnable: collections.abc.Container[str],
+    composer: Composer | None = None,
+    why_not: Callable[[Sequence[Advertisement]], Mapping[str, str]] | None = None,
+) -> RunResult | None:
+    """The no-plan answer :func:`run_task` gives ``task``, found before its environment is built and has
+    perceived the world (seconds, for the simulated home), when nothing perceived could change it; None
+    when something might, and the run goes on as before.
+
+    ``runnable``: the components the environment will implement, as far as is known before it is built
+    (a superset is what keeps this sound). The run composes from what it perceives, so the answer is
+    given early only when no plan composes even over the most the world could offer (:func:`_optimist`):
+    every precondition any component states held, every goal held that a perception could find, no area
+    refusing a component, no plan refused for a statement a step deletes. This takes an environment
+    that perceives afresh only the relations a test decides (``home:computedBy``) and keeps the world
+    graph's others, as the simulated home does. Only then is the task composed as the run composes it,
+    but from the map (the world is built from it) rather than a belief perceived, for the same account
+    of what no component provides and which components cannot run here (``why_not``, as the
+    environment's ``unimplemented`` would say); should that plan after all, None.
+    """
+    composer = composer or Composer(kb)
+    optimist = _optimist(kb, composer, runnable)
+    if optimist.compose(task, belief=True).plan is not None:
+        return None
+    first = composer.compose(task)
+    composition = _runnable(kb, composer.config, task, first, runnable, belief=False, why_not=why_not)
+    if composition.plan is not None:  # the map alone offers more than the optimist was told: go and look
+        return None
+    return RunResult(composition, None)
+
+
+class _Assuming(Composer):
+    """A composer to which ``assumed`` statements hold too, besides what the store says holds."""
+
+    def __init__(
+        self,
+        kb: KnowledgeBase,
+        config: ComposeConfig,
+        assumed: Iterable[Statement],
+        *,
+        index: TaxonomyIndex,
+        actions: ActionLibrary,
+        advertisements: Sequence[Advertisement],
+    ) -> None:
+        super().__init__(kb, config, index=index, actions=actions, advertisements=advertisements)
+        self.assumed = tuple(assumed)
+
+    def world_state(self) -> list[Statement]:
+        return list(dict.fromkeys([*super().world_state(), *self.assumed]))
+
+
+def _optimist(kb: KnowledgeBase, composer: Composer, runnable: collections.abc.Container[str]) -> Composer:
+    """A composer over the components in ``runnable`` as if the world offered all it could: every
+    precondition of theirs holding; every goal of a requirement holding that a perception could find
+    (:func:`_perceivable`); no area rule (where things are is perceived); and no check by progression
+    (``protect``: a statement the world offers may be deleted by a step, and the plan refused). A task it
+    cannot plan has no plan from any perception either: its search only gains by more that holds and by
+    fewer refusals."""
+    ads = [ad for ad in composer.advertisements if ad.iri in runnable]
+    assumed = [statement for ad in ads for statement in ad.preconditions]
+    decided = {row["relation"].value for row in kb.select("computables")}
+    found: dict[str, bool] = {}  # by class: whether the world has things of it
+    for requirement in composer.requirements():
+        assumed += [goal for goal in requirement.effects if _perceivable(kb, composer.index, goal, decided, found)]
+    config = replace(composer.config, respect_area=False, protect=False)
+    return _Assuming(kb, config, assumed, index=composer.index, actions=composer.actions, advertisements=ads)
+
+
+def _perceivable(
+    kb: KnowledgeBase, index: TaxonomyIndex, goal: Statement, decided: set[str], found: dict[str, bool]
+) -> bool:
+    """Whether a perception of the world might find ``goal`` holding (a goal that holds is planned for by
+    no step): its subject is of a class the world (map or belief) has things of, and a relation a test
+    decides (``home:computedBy``: the only relations an environment perceives afresh, the others being
+    kept from the world graph, which the optimist reads) is at or below its relation."""
+    if not any(index.is_a(relation, goal.predicate) for relation in decided):
+        return False
+    if goal.subject not in found:
+        found[goal.subject] = bool(kb.select("designate", {"class": goal.subject}))
+    return found[goal.subject]
+
+
 def _await_return(kb: KnowledgeBase, failures: Iterable[Failure], grace: float, bus: EventBus) -> None:
     """Wait up to ``grace`` seconds for the failed live components that are unavailable now (their
     program exited or hung) to register again, saying so on the progress topic. Components not
@@ -364,9 +453,11 @@ def _runnable(
     config: ComposeConfig,
     task: str,
     composition: CompositionResult,
-    registry: Registry,
+    registry: collections.abc.Container[str],
     avoid: frozenset[str] = frozenset(),
     passed: Mapping[str, str] | None = None,
+    belief: bool = True,
+    why_not: Callable[[Sequence[Advertisement]], Mapping[str, str]] | None = None,
 ) -> CompositionResult:
     """``composition`` without the alternatives the environment cannot run; or, when a step's component
     is one it does not implement (the store advertises services the simulation does not perform,
@@ -374,11 +465,13 @@ def _runnable(
     after the steps before it moved things (a goal-only task picked the cup up, then found no room
     locator, three times over). So too without the components the environment ``passed`` over
     (component -> why): a remote one whose calls timed out would make the run wait its timeout again
-    (``actions.breaker``)."""
+    (``actions.breaker``). ``belief``: compose again from the belief graph as well as the map (as
+    ``composition`` was), else from the map alone. ``why_not``: why the environment has no
+    implementation of some advertisements, where it knows (else :func:`_cannot_run` says)."""
     plan = composition.plan
     passed = passed or {}
     if plan is None:
-        return _naming_the_unavailable(kb, config, task, composition, avoid)
+        return _naming_the_unavailable(kb, config, task, composition, avoid, belief)
     used = {c for step in plan.steps for c in step.candidates}
     if all(_can_run(step.component, registry, passed) for step in plan.steps):
         # Each step's first choice can run; an alternative that cannot would fail a failover for sure
@@ -390,13 +483,14 @@ def _runnable(
         return composition if steps == plan.steps else replace(composition, plan=replace(plan, steps=steps))
     advertisements = kb.advertisements()
     missing = frozenset(ad.iri for ad in advertisements if ad.iri not in registry) | frozenset(passed)
-    again = _compose(kb, config, task, avoid | missing)
+    again = _compose(kb, config, task, avoid | missing, belief)
     if again.plan is not None:
         return again
     # Say which components the first plan wanted: "no component provides" alone hid a registered one.
     wanted = {c for c in used if not _can_run(c, registry, passed)}
+    known = why_not([ad for ad in advertisements if ad.iri in wanted]) if why_not is not None else {}
     why = [
-        (ad.iri, passed.get(ad.iri) or _cannot_run(ad))
+        (ad.iri, passed.get(ad.iri) or known.get(ad.iri) or _cannot_run(ad))
         for ad in sorted(advertisements, key=lambda ad: ad.iri)
         if ad.iri in wanted
     ]
@@ -404,7 +498,12 @@ def _runnable(
 
 
 def _naming_the_unavailable(
-    kb: KnowledgeBase, config: ComposeConfig, task: str, composition: CompositionResult, avoid: frozenset[str]
+    kb: KnowledgeBase,
+    config: ComposeConfig,
+    task: str,
+    composition: CompositionResult,
+    avoid: frozenset[str],
+    belief: bool = True,
 ) -> CompositionResult:
     """``composition``, which has no plan, with the live components it lacks named: those registered but
     unavailable now (a program stopped, its lease lapsed) that a plan would use, each with why. The store
@@ -415,7 +514,7 @@ def _naming_the_unavailable(
     if not gone:
         return composition
     everyone = [ad for ad in kb.advertisements(include_unavailable=True) if ad.iri not in avoid]
-    would = Composer(kb, config, advertisements=everyone).compose(task, belief=True).plan
+    would = Composer(kb, config, advertisements=everyone).compose(task, belief=belief).plan
     if would is None:
         return composition
     wanted = {c for step in would.steps for c in step.candidates if c in gone}
@@ -464,6 +563,13 @@ def _passed_over(environment: Environment, bus: EventBus, before: Mapping[str, s
     return passed
 
 
+def _why_not(environment: Environment) -> Callable[[Sequence[Advertisement]], Mapping[str, str]] | None:
+    """The environment's account of the advertisements it has no implementation of (the Environment
+    protocol's optional ``unimplemented``), if it gives one."""
+    found = getattr(environment, "unimplemented", None)
+    return found if callable(found) else None
+
+
 def _pairs(passed: Mapping[str, str]) -> tuple[tuple[str, str], ...]:
     return tuple(sorted(passed.items()))
 
@@ -484,12 +590,15 @@ def _cannot_run(ad: Advertisement) -> str:
     )
 
 
-def _compose(kb: KnowledgeBase, config: ComposeConfig, task: str, avoid: frozenset[str]) -> CompositionResult:
-    """Compose ``task`` afresh from the belief, over every advertisement but those in ``avoid``."""
+def _compose(
+    kb: KnowledgeBase, config: ComposeConfig, task: str, avoid: frozenset[str], belief: bool = True
+) -> CompositionResult:
+    """Compose ``task`` afresh from the belief (``belief``; else the map alone), over every advertisement
+    but those in ``avoid``."""
     if not avoid:
-        return Composer(kb, config).compose(task, belief=True)
+        return Composer(kb, config).compose(task, belief=belief)
     kept = [ad for ad in kb.advertisements() if ad.iri not in avoid]
-    return Composer(kb, config, advertisements=kept).compose(task, belief=True)
+    return Composer(kb, config, advertisements=kept).compose(task, belief=belief)
 
 
 _WHERE = {HOME + "x", HOME + "minX"}  # what places a thing in the map: a position or an extent
@@ -497,19 +606,37 @@ _WHERE = {HOME + "x", HOME + "minX"}  # what places a thing in the map: a positi
 
 def _check_grounded(kb: KnowledgeBase, index: TaxonomyIndex, plan: Plan) -> None:
     """Refuse, before anything moves, a task that names a class of thing the world should hold and
-    does not (:func:`_missing`). In a goal: a place the home lacks (a dish rack) named by the goal alone
-    was planned towards the object's own place, and the arm carried the cup there. In an input, whether
-    a step takes it or not (the environment designates only those the plan uses): a suction cup no
-    robot has was ignored, and the pen fetched by a gripper."""
+    does not (:func:`ungrounded`, the first it finds)."""
+    for refusal in ungrounded(kb, index, plan):
+        raise refusal
+
+
+def ungrounded(
+    kb: KnowledgeBase, index: TaxonomyIndex, plan: Plan
+) -> tuple[UnresolvedDesignatorError | UngroundedGoalError, ...]:
+    """Why :func:`run_task` refuses ``plan`` before anything moves for want of things in the world: each
+    class of thing the task names that the world should hold and does not (:func:`_missing`), by the
+    store alone (the map, and the belief). In a goal: a place the home lacks (a dish rack) named by the
+    goal alone was planned towards the object's own place, and the arm carried the cup there. In an
+    input, whether a step takes it or not (the environment designates only those the plan uses): a
+    suction cup no robot has was ignored, and the pen fetched by a gripper. ``cbrs plan`` notes them all."""
     try:
         requirement = kb.description(plan.requirement)
     except NotFoundError:
         requirement = None
     placed = {row["thing"].value for row in kb.select("map_facts") if row["property"].value in _WHERE}
+    known: dict[str, bool] = {}  # by class: whether it is missing (a goal names the classes inputs give)
+
+    def missing(concept: str) -> bool:
+        if concept not in known:
+            known[concept] = _missing(kb, index, placed, concept)
+        return known[concept]
+
+    found: list[UnresolvedDesignatorError | UngroundedGoalError] = []
     if isinstance(requirement, Requirement):
         for parameter in requirement.inputs:
-            if parameter.type and _missing(kb, index, placed, parameter.type):
-                raise UnresolvedDesignatorError(parameter.type)
+            if parameter.type and missing(parameter.type):
+                found.append(UnresolvedDesignatorError(parameter.type))
     produced = {kind for step in plan.steps for _, kind in step.outputs if kind}
     for goal in plan.goals:
         statement = goal.statement
@@ -518,10 +645,11 @@ def _check_grounded(kb: KnowledgeBase, index: TaxonomyIndex, plan: Plan) -> None
         for concept in (statement.subject, statement.object):
             if _produced(index, produced, concept):
                 continue  # a step of the plan answers one (a scale's weight): it is made, not found
-            if _missing(kb, index, placed, concept):
+            if missing(concept):
                 rows = kb.select("things_elsewhere", {"class": concept})
                 elsewhere = [(row["thing"].value, row["graph"].value) for row in rows]
-                raise UngroundedGoalError(statement_text(statement), concept, elsewhere)
+                found.append(UngroundedGoalError(statement_text(statement), concept, elsewhere))
+    return tuple(found)
 
 
 def _produced(index: TaxonomyIndex, produced: set[str], concept: str) -> bool:

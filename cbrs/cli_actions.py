@@ -13,24 +13,33 @@ from collections import Counter
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NoReturn
 
 import click
 
 from cbrs.actions.components import Registry
 from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, Objective, PlanStatus, store_plan
+from cbrs.actions.errors import UngroundedGoalError
 from cbrs.actions.events import Event
 from cbrs.actions.faults import RandomFaults, planned_faults
 from cbrs.actions.graph import statement_text
 from cbrs.actions.model import ActionLibrary
 from cbrs.actions.plan import Binding, Plan, PlanStep
 from cbrs.actions.replanning import ReplanPolicy
-from cbrs.actions.runner import Replan, RunResult, run_task, unrunnable_steps
+from cbrs.actions.runner import (
+    Replan,
+    RunResult,
+    refusal_before_world,
+    run_task,
+    ungrounded,
+    unrunnable_steps,
+)
 from cbrs.app import App, parse_iri, pass_app
 from cbrs.extras import installed, require
 from cbrs.kb import Advertisement, KnowledgeBase, RemoteStoreError
 from cbrs.kb.errors import KnowledgeBaseError
-from cbrs.kb.namespaces import shorten
+from cbrs.kb.namespaces import HOME, shorten
+from cbrs.kb.semantic_map import SemanticMap, UnresolvedDesignatorError, local_name
 from cbrs.output import table
 from cbrs.settings import setting
 from cbrs.task_names import task_iri
@@ -83,7 +92,9 @@ def _compose_config(ignore_areas: bool, protect: bool, max_reachieved: int, **mo
     is_flag=True,
     help=(
         "Print the plan (or what is unsatisfied) as JSON; with a plan, its steps cbrs run cannot run in the"
-        " simulated home now (unrunnable) and those it reaches only with --bridge (over_bridge)."
+        " simulated home now (unrunnable), those it reaches only with --bridge (over_bridge), and what it"
+        " would refuse or plan without for what the map lacks (unmapped: a camera it does not place, a thing"
+        " the task names that it does not hold)."
     ),
 )
 @click.option(
@@ -119,8 +130,9 @@ def plan(
 
     Exits with status 1 when no plan exists, after saying which need no component meets. The plan is
     composed over every advertisement; a note follows it for each step cbrs run cannot run in the
-    simulated home now (no skill for its service, no live component to call), which the run plans
-    without.
+    simulated home now (no skill for its service, no live component to call, a camera the map does not
+    place), which the run plans without, and for each thing the task names that the map does not hold,
+    for which the run refuses the task. These are read from the store: no world is built.
     """
     if drawing is not None and drawing.suffix.lower() not in (".svg", ".png"):
         raise click.BadParameter(f"{drawing.name!r} must end in .svg or .png", param_hint="--draw")
@@ -145,13 +157,17 @@ def plan(
 
         draw(result, drawing)
     here = _not_here(app.kb, result.plan, composer.advertisements) if result.plan is not None else None
+    unmapped = _unmapped(app.kb, composer, result.plan) if result.plan is not None else None
     if as_json:
         found = result.to_dict()
         if here is not None:
             found.update(here.to_dict())
+        if unmapped is not None:
+            found.update(unmapped.to_dict())
         click.echo(json.dumps(found, indent=2))
     else:
-        click.echo(plan_text(result) + (here.text() if here is not None else ""))
+        notes = (here.text() if here is not None else "") + (unmapped.text() if unmapped is not None else "")
+        click.echo(plan_text(result) + notes)
     if drawing is not None and not as_json:
         click.echo(f"drawing written to {drawing}")
     if result.status is not PlanStatus.PLANNED:
@@ -199,6 +215,64 @@ def _not_here(kb: KnowledgeBase, plan: Plan, advertisements: Sequence[Advertisem
     runnable = set(implementations(kb, advertisements=advertisements).names()) | live
     bridged = tuple(step for step in plan.steps if step.component in live)
     return _NotHere(unrunnable_steps(kb, plan, runnable, advertisements=advertisements), bridged)
+
+
+@dataclass(frozen=True)
+class _Unmapped:
+    """What ``cbrs run`` would plan without or refuse for what the semantic map lacks, read from the store
+    alone (the run's own checks, no world built): the plan's steps whose component looks with a camera
+    the map does not place (``sim.run_checks.unplaced_cameras``: the run plans without it, or a table-top
+    finder's step fails when it looks), and each class of thing the task names, in a goal or an input,
+    of which the map holds nothing (``actions.runner.ungrounded``: the run refuses the task). Before,
+    only the run found them, after building the world."""
+
+    cameras: tuple[tuple[PlanStep, str, str, bool], ...]  # step, camera, why, whether the run plans without it
+    things: tuple[UnresolvedDesignatorError | UngroundedGoalError, ...]
+
+    def to_dict(self) -> dict[str, Any]:
+        found: list[dict[str, Any]] = [
+            {
+                "kind": "camera",
+                "step": step.index,
+                "component": step.component,
+                "camera": camera,
+                "why": why,
+                "planned_without": without,
+            }
+            for step, camera, why, without in self.cameras
+        ]
+        for error in self.things:
+            if isinstance(error, UngroundedGoalError):
+                found.append({"kind": "goal", "goal": error.goal, "concept": error.concept, "why": str(error)})
+            else:
+                found.append({"kind": "input", "concept": error.concept, "why": str(error)})
+        return {"unmapped": found}
+
+    def text(self) -> str:
+        lines = [
+            f"\nnote: step {step.index} {shorten(step.component)} cannot run in the simulated home now: {why};"
+            + (" cbrs run plans without it" if without else " cbrs run plans it, and the step fails when it looks")
+            for step, _, why, without in self.cameras
+        ]
+        lines += [f"\nnote: cbrs run refuses the task: {error}" for error in self.things]
+        return "".join(lines)
+
+
+def _unmapped(kb: KnowledgeBase, composer: Composer, plan: Plan) -> _Unmapped:
+    """What of ``plan`` ``cbrs run`` would plan without or refuse for what the map lacks: the things from
+    the store alone; the cameras with the [sim] part only (its skills say which components look with a
+    camera). The world has a camera for each the map gives a field of view (``SemanticMap.cameras``)."""
+    things = ungrounded(kb, composer.index, plan)
+    cameras: list[tuple[PlanStep, str, str, bool]] = []
+    if installed("sim"):
+        from cbrs.sim.run_checks import unplaced_cameras
+
+        rows = kb.select("map_facts")
+        placed = {local_name(row["thing"].value) for row in rows if row["property"].value == HOME + "fieldOfView"}
+        used = {step.component for step in plan.steps}
+        unplaced = unplaced_cameras(kb, [ad for ad in composer.advertisements if ad.iri in used], placed)
+        cameras = [(step, *unplaced[step.component]) for step in plan.steps if step.component in unplaced]
+    return _Unmapped(tuple(cameras), things)
 
 
 def plan_text(result: CompositionResult) -> str:
@@ -338,9 +412,9 @@ def run(
     it could not meet and every component tried for it.
     """
     require("sim", "cbrs run")
-    from cbrs.kb.semantic_map import SemanticMap
-    from cbrs.sim.components import SimEnvironment  # pybullet loads only for this command
+    from cbrs.sim.components import SimEnvironment, implementations  # pybullet loads only for this command
     from cbrs.sim.recording import Recorder, RecordingError, check_target
+    from cbrs.sim.run_checks import without_camera
     from cbrs.sim.world import open_world
     from cbrs.sim_sensors import SensorsTakenError, provide_sensors
 
@@ -364,10 +438,26 @@ def run(
     transport = _bridge(bridge) if bridge else None
     start = time.perf_counter()
     recorder: Recorder | None = None
+    composer = Composer(app.kb, _compose_config(ignore_areas, protect, max_reachieved), actions=actions)
     with contextlib.ExitStack() as held:
         if transport is not None:
             held.callback(transport.close)
-        world = held.enter_context(open_world(seed=seed, gui=gui, semantic_map=SemanticMap.read(app.kb)))
+        # A task no plan could come of is refused before the world is built (a second or more of pybullet):
+        # the world will implement what the simulation has skills for, but for components whose own camera
+        # the map does not place (the world has a camera for each the map places, and no other).
+        semantic_map = SemanticMap.read(app.kb)
+        placed = {camera.name for camera in semantic_map.cameras.values()}
+        before = implementations(app.kb, transport=transport, advertisements=composer.advertisements)
+        runnable = set(before.names()) - set(without_camera(composer.advertisements, placed))
+
+        def why_not(advertisements: Sequence[Advertisement]) -> dict[str, str]:
+            return without_camera(advertisements, placed)
+
+        no_plan = refusal_before_world(app.kb, iri, runnable, composer, why_not)
+        if no_plan is not None:
+            wall = time.perf_counter() - start
+            _say_refused(app.kb, no_plan, before, seed, as_json, wall, bridged=transport is not None)
+        world = held.enter_context(open_world(seed=seed, gui=gui, semantic_map=semantic_map))
         if transport is not None:  # devices' programs read this world's sensors on the bridge until it ends
             try:
                 held.enter_context(provide_sensors(transport, world))
@@ -395,7 +485,7 @@ def run(
                 iri,
                 environment,
                 failing,
-                composer=Composer(app.kb, _compose_config(ignore_areas, protect, max_reachieved), actions=actions),
+                composer=composer,
                 on_event=follow,
                 fault_policy=policy,
                 replan_policy=ReplanPolicy(max_repeats=repeat_failures),
@@ -439,15 +529,35 @@ def run(
                 f" simulated); paths drawn to {recorded.path_map}"
             )
     if not result.succeeded:
-        unreached = [] if transport is not None else _live_unreached(app.kb, environment.registry)
-        if unreached:
-            kind = "is a component" if len(unreached) == 1 else "are components"
-            click.echo(
-                f"note: {', '.join(map(shorten, unreached))} {kind} in another process, which this run could not"
-                " call: pass --bridge ws://HOST:PORT of the cbrs server it is connected to",
-                err=True,
-            )
+        _note_unreached(app.kb, environment.registry, bridged=transport is not None)
         raise SystemExit(1)
+
+
+def _say_refused(
+    kb: KnowledgeBase, result: RunResult, registry: Registry, seed: int, as_json: bool, wall: float, bridged: bool
+) -> NoReturn:
+    """Say a run has no plan, as a run that built the world says it (nothing simulated), and exit 1."""
+    if as_json:
+        found = result.to_dict()
+        found["seed"] = seed
+        found["sim_seconds"] = 0.0
+        click.echo(json.dumps(found, indent=2))
+    else:
+        click.echo(run_text(result, 0.0, wall))
+    _note_unreached(kb, registry, bridged)
+    raise SystemExit(1)
+
+
+def _note_unreached(kb: KnowledgeBase, registry: Registry, bridged: bool) -> None:
+    """After a run that did not succeed: name the components in other processes it could not call."""
+    unreached = [] if bridged else _live_unreached(kb, registry)
+    if unreached:
+        kind = "is a component" if len(unreached) == 1 else "are components"
+        click.echo(
+            f"note: {', '.join(map(shorten, unreached))} {kind} in another process, which this run could not"
+            " call: pass --bridge ws://HOST:PORT of the cbrs server it is connected to",
+            err=True,
+        )
 
 
 def _check_failing(kb: KnowledgeBase, failing: list[str], bridged: bool) -> None:

@@ -52,8 +52,15 @@ from cbrs.sim.perceived import PerceivedWorld
 from cbrs.sim.perception import RobotPoseEstimate
 from cbrs.sim.referee import Referee
 from cbrs.sim.relations import Grounded, Judge
-from cbrs.sim.run_checks import CannotLoadError, OutOfReachError, PlaceCrowdedError, PlanChecks
-from cbrs.sim.services import SKILLS, locate, recognise_by_colour, track
+from cbrs.sim.run_checks import (
+    CannotLoadError,
+    OutOfReachError,
+    PlaceCrowdedError,
+    PlanChecks,
+    own_camera,
+    without_camera,
+)
+from cbrs.sim.services import SKILLS
 from cbrs.sim.values import GRASP_POSE, GraspPlan, MalformedValueError, check, decode, designator
 from cbrs.sim.world import HomeWorld
 
@@ -144,7 +151,8 @@ def implementations(
         device = ad.device_name or ""
         if work is None:
             continue
-        if world is not None and work in (locate, track, recognise_by_colour) and device not in world.cameras:
+        camera = own_camera(ad)  # a camera the world lacks: no implementation (sim.run_checks.unplaced_cameras)
+        if world is not None and camera is not None and camera not in world.cameras:
             continue
         names = tuple(p.name for p in ad.outputs if p.name)
         registry.add(ad.iri, _maker(work, device, names))
@@ -280,6 +288,11 @@ class SimEnvironment:
             return {}
         sessions = {iri: state.registered_by for iri, state in self.kb.liveness.states().items()}
         return passed_over(self.transport, time.monotonic(), sessions)
+
+    def unimplemented(self, advertisements: Sequence[Advertisement]) -> dict[str, str]:
+        """Why the simulation has no implementation of those of ``advertisements`` it lacks a camera for
+        (``sim.run_checks.without_camera``), for the run's account of what it cannot run."""
+        return without_camera(advertisements, self.world.cameras)
 
     def refresh(self) -> None:
         """Before a new plan: forget the measured map (the world may have changed) and add the

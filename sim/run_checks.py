@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Collection, Iterable, Mapping
 from dataclasses import replace
 from typing import Any
 
@@ -32,7 +32,15 @@ from cbrs.sim.grounding import docking_pose, people_given, task_inputs_of
 from cbrs.sim.perceived import PerceivedWorld
 from cbrs.sim.perception import ObjectEstimate
 from cbrs.sim.place_spots import RELAY_CLEARANCE, RELAY_MARGIN, distance_to_extent, other_objects, place_spots
-from cbrs.sim.services import MOVING, SKILLS, WITH_PERSON, find_object_on_table, recognise_by_colour, track
+from cbrs.sim.services import (
+    MOVING,
+    SKILLS,
+    WITH_PERSON,
+    find_object_on_table,
+    locate,
+    recognise_by_colour,
+    track,
+)
 from cbrs.sim.values import Manipulation
 from cbrs.sim.world import HomeWorld
 
@@ -286,13 +294,8 @@ class PlanChecks:
         work = SKILLS.get(ad.service_name or "") if ad is not None else None
         if ad is None or work not in (recognise_by_colour, find_object_on_table, track):
             return None
-        if ad.bridge_port is not None:
-            return ""
-        device = ad.device_name or ""
-        if work is find_object_on_table:
-            rows = self.kb.select("mounted_cameras", {"robot": PREFIXES["svc"] + device})
-            device = next((local_name(row["device"].value) for row in rows), "")
-        return device if device in self.world.cameras else ""
+        device = looked_with(self.kb, ad)
+        return device if device and device in self.world.cameras else ""
 
     def _check_reach(self, plan: Plan, values: Mapping[str, Any]) -> None:
         """Refuse a plan whose arm steps work on a thing the task gives that no arm of their robot
@@ -453,3 +456,74 @@ class PlanChecks:
             return None
         box = thing.box
         return (box.min_x, box.max_x, box.min_y, box.max_y)
+
+
+_LOOKING = (locate, track, recognise_by_colour)
+"""The skills that look with the component's own device."""
+
+
+def own_camera(ad: Advertisement) -> str | None:
+    """The camera a simulated component must find among the world's to be implemented at all: its device,
+    for a skill that looks with its own (locating, tracking, recognising by colour); None for any other
+    (a table-top finder looks with its robot's, a component in another process with its own). Without
+    it the simulation has no implementation of the component (``sim.components.implementations``), and
+    a run plans without it."""
+    if ad.bridge_port is not None or SKILLS.get(ad.service_name or "") not in _LOOKING:
+        return None
+    return ad.device_name or ""
+
+
+def looked_with(kb: KnowledgeBase, ad: Advertisement) -> str | None:
+    """The name of the camera a simulated component looks with: its own (:func:`own_camera`), or for a
+    table-top finder the first camera the store says is mounted on its robot ("" if none is); None for a
+    component that looks with no camera of the home (another skill, or a component in another process)."""
+    own = own_camera(ad)
+    if own is not None or ad.bridge_port is not None or SKILLS.get(ad.service_name or "") is not find_object_on_table:
+        return own
+    rows = kb.select("mounted_cameras", {"robot": PREFIXES["svc"] + (ad.device_name or "")})
+    return next((local_name(row["device"].value) for row in rows), "")
+
+
+def unplaced_cameras(
+    kb: KnowledgeBase, advertisements: Iterable[Advertisement], cameras: Collection[str]
+) -> dict[str, tuple[str, str, bool]]:
+    """The components of ``advertisements`` that look with a camera the world does not have (``cameras``:
+    the names of those it has; before it is built, those the map places, ``SemanticMap.cameras``, of
+    which it builds one each), by component: (the camera's name, why, whether a run plans without the
+    component: :func:`own_camera`). A table-top finder whose robot carries no camera of the world is
+    planned, and its step fails when it looks."""
+    found: dict[str, tuple[str, str, bool]] = {}
+    for ad in advertisements:
+        name = looked_with(kb, ad)
+        if name is None or name in cameras:
+            continue
+        if own_camera(ad) is not None:
+            found[ad.iri] = (name, _unplaced(name), True)
+        else:
+            robot = ad.device_name or ""
+            why = (
+                f"it looks with {name}, the camera mounted on {robot}, which the map does not place (a camera needs"
+                " home:x, home:y, home:z and home:fieldOfView in graph:map)"
+                if name
+                else f"it looks with the camera mounted on {robot}, and none is (home:mountedOn {robot})"
+            )
+            found[ad.iri] = (name, why, False)
+    return found
+
+
+def without_camera(advertisements: Iterable[Advertisement], cameras: Collection[str]) -> dict[str, str]:
+    """The components of ``advertisements`` a run plans without for want of their own camera among
+    ``cameras`` (:func:`own_camera`; those :func:`unplaced_cameras` marks so), each with why: the
+    simulation has no implementation of them."""
+    return {
+        ad.iri: _unplaced(camera)
+        for ad in advertisements
+        if (camera := own_camera(ad)) is not None and camera not in cameras
+    }
+
+
+def _unplaced(camera: str) -> str:
+    return (
+        f"it looks with {camera or 'no camera'}, which the map does not place (a camera needs home:x, home:y,"
+        " home:z and home:fieldOfView in graph:map)"
+    )
