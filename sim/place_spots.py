@@ -3,27 +3,19 @@
 A grid of spots over the surface, each far enough inside an arm's reach, from the edge, from the other
 objects (where they are believed to be) and from the fixtures standing on the surface: the carry aims
 at the first of them, the pass between arms looks among them, and the check before a run refuses a
-place that has none. Set down by a side grasp, the hand has the arm behind it, lower than the grasp point
-(the hand's bands, ``home:sideGraspBand``): a cup standing 20-26 cm straight behind a spot, clear of the
-object's footprint, was under the forearm as the hand came down; given the arm behind the grasp
-(:class:`ArmBehind`), a spot whose arm would come down on a thing standing there is passed over.
+place that has none.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
 
-from cbrs.kb.arm_bands import ArmBand
 from cbrs.kb.semantic_map import Arm, SemanticMap, Thing
 from cbrs.sim import skills
-from cbrs.sim.arms import ArmSide
 from cbrs.sim.geometry import Region
-from cbrs.sim.grasping import GraspKind, ObjectModel
 from cbrs.sim.perceived import PerceivedWorld
 from cbrs.sim.relations import region_of
-from cbrs.sim.transit import TRANSIT_CLEARANCE, bands_over
 from cbrs.sim.world import HomeWorld
 
 RELAY_MARGIN = 0.05
@@ -40,48 +32,6 @@ RELAY_EDGE = 0.02
 
 RELAY_STEP = 0.02
 """The spots tried are a 2 cm grid over the surface."""
-
-
-@dataclass(frozen=True)
-class ArmBehind:
-    """The arm behind a side grasp that sets an object down, for :func:`place_spots`: the approach's heading
-    (the arm's yaw), how high the grasp point is above the object's bottom, the arm's bands (the hand's
-    ``side_arm``), and the things standing by the place as (x, y, footprint radius, top height)."""
-
-    facing: float
-    grasp_height: float
-    bands: tuple[ArmBand, ...]
-    standing: tuple[tuple[float, float, float, float], ...]
-
-    def comes_down_on(self, spot: tuple[float, float], surface: float) -> bool:
-        """Whether, the object set down at ``spot`` on a surface ``surface`` high, a band of the arm comes
-        lower than TRANSIT_CLEARANCE over the top of a thing standing under it (within that of it)."""
-        grasp = surface + self.grasp_height
-        return any(
-            top + TRANSIT_CLEARANCE > grasp + band.underside
-            for x, y, radius, top in self.standing
-            for band in bands_over(self.bands, spot, self.facing, (x, y), radius)
-        )
-
-
-def arm_behind(world: HomeWorld, belief: PerceivedWorld | None, side: ArmSide, held: ObjectModel) -> ArmBehind | None:
-    """The arm behind ``side``'s hand setting ``held`` down by its approach: None for a top grasp (no arm
-    below the palm). The other objects stand where each is believed to be, else where the map puts them."""
-    if held.grasp is not GraspKind.SIDE:
-        return None
-    standing = []
-    for name, obj in world.objects.items():
-        if name == held.name or any(arm.held == world.body(name) for arm in world.arms.values()):
-            continue
-        believed = belief.position(name) if belief is not None else None
-        if believed is None:
-            support = world.map.things.get(obj.support or "")
-            rest = support.box.max_z if support is not None else 0.0
-            believed = (obj.start.x, obj.start.y, rest + obj.size[2] / 2.0)
-        radius = math.hypot(obj.size[0], obj.size[1]) / 2.0
-        standing.append((believed[0], believed[1], radius, believed[2] + obj.size[2] / 2.0))
-    hand = world.arm(side).hand
-    return ArmBehind(world.arm_specs[side].yaw, held.grasp_height, hand.side_arm, tuple(standing))
 
 
 def reach_of(arm: Arm) -> tuple[float, float, float]:
@@ -136,7 +86,6 @@ def place_spots(
     size: tuple[float, float, float],
     mounts: Sequence[tuple[float, float, float]],
     others: Sequence[tuple[float, float, float]],
-    behind: ArmBehind | None = None,
 ) -> tuple[Region, list[tuple[float, float]]]:
     """Where on a place an object of ``size`` can be set down by an arm mounted at one of ``mounts``
     (x, y, reach): the place's surface (a region's bottom, a piece of furniture's top), and the spots of
@@ -144,8 +93,7 @@ def place_spots(
     over the place and at least RELAY_MARGIN inside a mount's reach, its footprint on the surface it
     rests on (the furniture under a region) RELAY_EDGE inside the edge, RELAY_CLEARANCE clear of
     ``others`` (x, y, radius) and of the fixtures it would meet on the way down (a dispenser's body; not
-    the spout high above it), and, given the arm ``behind`` a side grasp, where none of its bands comes down
-    on a thing standing under it. The place's centre is the first spot where it is one: a place an arm only
+    the spout high above it). The place's centre is the first spot where it is one: a place an arm only
     partly reaches is worked at its reachable part, not at a centre no arm reaches."""
     furniture = place.iri in smap.furniture
     surface = region_of(place, furniture)
@@ -183,8 +131,6 @@ def place_spots(
             if any(math.hypot(x - ox_, y - oy) < radius + r + RELAY_CLEARANCE for ox_, oy, r in others):
                 continue
             if any(distance_to_extent(extent, (x, y)) < radius + RELAY_CLEARANCE for extent in fixtures):
-                continue
-            if behind is not None and behind.comes_down_on((x, y), z):
                 continue
             spots.append((math.hypot(x - cx, y - cy), x, y))
     return surface, [(x, y) for _, x, y in sorted(spots)]

@@ -95,15 +95,6 @@ def _under(
     return [band for band in bands if _box_distance(a, b, band) < reach]
 
 
-def bands_over(
-    bands: Sequence[ArmBand], grasp: tuple[float, float], facing: float, point: tuple[float, float], radius: float
-) -> list[ArmBand]:
-    """The ``bands`` of an arm behind a side grasp at ``grasp`` (x, y; its approach level along ``facing``)
-    that come within TRANSIT_CLEARANCE of the footprint (``radius`` round ``point``) of a thing standing
-    there: where the hand comes down to set an object down, the arm behind it comes down over these."""
-    return _under(bands, grasp, grasp, facing, point, radius)
-
-
 def _box_distance(a: tuple[float, float], b: tuple[float, float], band: ArmBand) -> float:
     """How far the segment from ``a`` to ``b`` is from the rectangle ``band`` spans (near..far along the
     first axis, within half_width of 0 along the second): 0 when it crosses it (Liang-Barsky clipping)."""
