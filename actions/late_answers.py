@@ -177,6 +177,13 @@ def _settle(
                 refused,
             )
             return
+        except Exception as broken:  # the checks themselves broke (the store went away): believe nothing
+            log.warning(
+                "%s, but the answer could not be checked (%s): the belief is left as it was",
+                call.said("answered"),
+                broken,
+            )
+            return
     try:
         outcome = _believe(kb, classes, expected, failed=error is not None)
     except Exception as broken:  # a thread of its own: say what broke, never end in silence
