@@ -32,7 +32,7 @@ __all__ = ["PLACEMENT", "ROBOT_PARTS", "KeptRobots", "kept_robots"]
 
 ROBOT_PARTS = frozenset(ox.NamedNode(HOME + name) for name in ("hasArm", "hasPlatform", "hasMarker"))
 """The properties that make a thing of the map a robot: a file stating one describes its own robots."""
-_PARTS_OF_PARTS = frozenset(ox.NamedNode(HOME + name) for name in ("hasGripper", "hasColour"))
+_PARTS_OF_PARTS = frozenset(ox.NamedNode(HOME + name) for name in ("hasGripper", "hasColour", "sideGraspBand"))
 _MOUNTED_ON = ox.NamedNode(HOME + "mountedOn")
 PLACEMENT = tuple(ox.NamedNode(HOME + name) for name in ("x", "y", "yaw", "minX", "maxX", "minY", "maxY"))
 """Where a thing stands on the floor and which way it faces: a kept thing's must come from the files."""
@@ -87,20 +87,23 @@ def kept_robots(stored: Iterable[ox.Quad], given: Sequence[ox.Quad]) -> KeptRobo
 def _parts(
     robots: list[ox.NamedNode | ox.BlankNode], about: dict[ox.NamedNode | ox.BlankNode, list[ox.Quad]]
 ) -> list[ox.NamedNode | ox.BlankNode]:
-    """The robots, their parts and their parts' parts (an arm's hand, a marker's colours), and the
-    devices mounted on them, each once, in that order."""
+    """The robots, their parts and their parts' parts, however deep (an arm's hand, the bands of the arm
+    behind the hand's side grasp, a marker's colours), and the devices mounted on them, each once, in
+    that order."""
     found = dict.fromkeys(robots)
     for robot in robots:
         for quad in about[robot]:
             if quad.predicate in ROBOT_PARTS and isinstance(quad.object, ox.NamedNode | ox.BlankNode):
                 found.setdefault(quad.object)
-                found.update(
-                    dict.fromkeys(
-                        q.object
-                        for q in about.get(quad.object, [])
-                        if q.predicate in _PARTS_OF_PARTS and isinstance(q.object, ox.NamedNode | ox.BlankNode)
-                    )
-                )
+                below = [quad.object]
+                while below:  # ends: each part is walked once
+                    part = below.pop(0)
+                    for q in about.get(part, []):
+                        inner = q.object
+                        is_part = q.predicate in _PARTS_OF_PARTS and isinstance(inner, ox.NamedNode | ox.BlankNode)
+                        if is_part and inner not in found:
+                            found[inner] = None
+                            below.append(inner)
     mounted = sorted(
         (s for s, quads in about.items() if any(q.predicate == _MOUNTED_ON and q.object in found for q in quads)),
         key=str,
