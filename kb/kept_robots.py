@@ -100,8 +100,9 @@ def _parts(
                     part = below.pop(0)
                     for q in about.get(part, []):
                         inner = q.object
-                        is_part = q.predicate in _PARTS_OF_PARTS and isinstance(inner, ox.NamedNode | ox.BlankNode)
-                        if is_part and inner not in found:
+                        if not isinstance(inner, ox.NamedNode | ox.BlankNode):
+                            continue
+                        if q.predicate in _PARTS_OF_PARTS and inner not in found:
                             found[inner] = None
                             below.append(inner)
     mounted = sorted(
