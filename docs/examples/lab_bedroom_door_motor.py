@@ -11,7 +11,9 @@ Component per service, each on a connection of its own) and answers /bedroom_doo
     contradict  answers home:Closed to "open": the step fails, ContradictedEffectError
     crash       exits mid-call (status 3): the step fails "the provider ... disconnected"
 
-In each case nothing of the answer is believed: the store stays as it was. With the server of the
+In the last three cases nothing of the answer is believed: the store stays as it was. The late answer,
+when it comes, is checked as an in-time one and then believed: the door open (docs/reliability.md,
+section 6). With the server of the
 steps (the map's door and the two tasks loaded, CBRS_UPDATE_TOKEN set as for cbrs serve):
 
     CBRS_UPDATE_TOKEN=secret python docs/examples/lab_bedroom_door_motor.py [--bridge ws://127.0.0.1:9090]
