@@ -381,7 +381,8 @@ def refusal_before_world(
 
 
 class _Assuming(Composer):
-    """A composer to which ``assumed`` statements hold too, besides what the store says holds."""
+    """A composer to which ``assumed`` statements hold too, besides what the store says holds, over the
+    ``requirements`` already read (the store's, read once for the assumptions and the composition)."""
 
     def __init__(
         self,
@@ -392,12 +393,17 @@ class _Assuming(Composer):
         index: TaxonomyIndex,
         actions: ActionLibrary,
         advertisements: Sequence[Advertisement],
+        requirements: Sequence[Requirement],
     ) -> None:
         super().__init__(kb, config, index=index, actions=actions, advertisements=advertisements)
         self.assumed = tuple(assumed)
+        self.known = list(requirements)
 
     def world_state(self) -> list[Statement]:
         return list(dict.fromkeys([*super().world_state(), *self.assumed]))
+
+    def requirements(self) -> list[Requirement]:
+        return self.known
 
 
 def _optimist(kb: KnowledgeBase, composer: Composer, runnable: collections.abc.Container[str]) -> Composer:
@@ -411,10 +417,19 @@ def _optimist(kb: KnowledgeBase, composer: Composer, runnable: collections.abc.C
     assumed = [statement for ad in ads for statement in ad.preconditions]
     decided = {row["relation"].value for row in kb.select("computables")}
     found: dict[str, bool] = {}  # by class: whether the world has things of it
-    for requirement in composer.requirements():
+    requirements = composer.requirements()
+    for requirement in requirements:
         assumed += [goal for goal in requirement.effects if _perceivable(kb, composer.index, goal, decided, found)]
     config = replace(composer.config, respect_area=False, protect=False)
-    return _Assuming(kb, config, assumed, index=composer.index, actions=composer.actions, advertisements=ads)
+    return _Assuming(
+        kb,
+        config,
+        assumed,
+        index=composer.index,
+        actions=composer.actions,
+        advertisements=ads,
+        requirements=requirements,
+    )
 
 
 def _perceivable(

@@ -38,8 +38,8 @@ from cbrs.app import App, parse_iri, pass_app
 from cbrs.extras import installed, require
 from cbrs.kb import Advertisement, KnowledgeBase, RemoteStoreError
 from cbrs.kb.errors import KnowledgeBaseError
-from cbrs.kb.namespaces import HOME, shorten
-from cbrs.kb.semantic_map import SemanticMap, UnresolvedDesignatorError, local_name
+from cbrs.kb.namespaces import shorten
+from cbrs.kb.semantic_map import SemanticMap, UnresolvedDesignatorError
 from cbrs.output import table
 from cbrs.settings import setting
 from cbrs.task_names import task_iri
@@ -261,14 +261,13 @@ class _Unmapped:
 def _unmapped(kb: KnowledgeBase, composer: Composer, plan: Plan) -> _Unmapped:
     """What of ``plan`` ``cbrs run`` would plan without or refuse for what the map lacks: the things from
     the store alone; the cameras with the [sim] part only (its skills say which components look with a
-    camera). The world has a camera for each the map gives a field of view (``SemanticMap.cameras``)."""
+    camera)."""
     things = ungrounded(kb, composer.index, plan)
     cameras: list[tuple[PlanStep, str, str, bool]] = []
     if installed("sim"):
-        from cbrs.sim.run_checks import unplaced_cameras
+        from cbrs.sim.run_checks import map_cameras, unplaced_cameras
 
-        rows = kb.select("map_facts")
-        placed = {local_name(row["thing"].value) for row in rows if row["property"].value == HOME + "fieldOfView"}
+        placed = map_cameras(kb)
         used = {step.component for step in plan.steps}
         unplaced = unplaced_cameras(kb, [ad for ad in composer.advertisements if ad.iri in used], placed)
         cameras = [(step, *unplaced[step.component]) for step in plan.steps if step.component in unplaced]
@@ -409,12 +408,14 @@ def run(
     """Plan TASK, then execute it in the simulated home, step by step, failing over where needed.
 
     Exits with status 1 when there is no plan or the run fails; a failed run names the requirement
-    it could not meet and every component tried for it.
+    it could not meet and every component tried for it. A task no plan can come of, whatever the robots
+    perceive, is refused before the simulated home is built (docs/execution.md); cbrs plan TASK notes
+    what the run will plan without or refuse.
     """
     require("sim", "cbrs run")
     from cbrs.sim.components import SimEnvironment, implementations  # pybullet loads only for this command
     from cbrs.sim.recording import Recorder, RecordingError, check_target
-    from cbrs.sim.run_checks import without_camera
+    from cbrs.sim.run_checks import map_cameras, without_camera
     from cbrs.sim.world import open_world
     from cbrs.sim_sensors import SensorsTakenError, provide_sensors
 
@@ -445,8 +446,7 @@ def run(
         # A task no plan could come of is refused before the world is built (a second or more of pybullet):
         # the world will implement what the simulation has skills for, but for components whose own camera
         # the map does not place (the world has a camera for each the map places, and no other).
-        semantic_map = SemanticMap.read(app.kb)
-        placed = {camera.name for camera in semantic_map.cameras.values()}
+        placed = map_cameras(app.kb)
         before = implementations(app.kb, transport=transport, advertisements=composer.advertisements)
         runnable = set(before.names()) - set(without_camera(composer.advertisements, placed))
 
@@ -457,7 +457,7 @@ def run(
         if no_plan is not None:
             wall = time.perf_counter() - start
             _say_refused(app.kb, no_plan, before, seed, as_json, wall, bridged=transport is not None)
-        world = held.enter_context(open_world(seed=seed, gui=gui, semantic_map=semantic_map))
+        world = held.enter_context(open_world(seed=seed, gui=gui, semantic_map=SemanticMap.read(app.kb)))
         if transport is not None:  # devices' programs read this world's sensors on the bridge until it ends
             try:
                 held.enter_context(provide_sensors(transport, world))

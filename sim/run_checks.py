@@ -473,6 +473,13 @@ def own_camera(ad: Advertisement) -> str | None:
     return ad.device_name or ""
 
 
+def map_cameras(kb: KnowledgeBase) -> set[str]:
+    """The names of the cameras the world will have, from the store alone: each thing the map gives a field
+    of view is a camera (``SemanticMap.cameras``), and the world builds one for each and no other."""
+    rows = kb.select("map_facts")
+    return {local_name(row["thing"].value) for row in rows if row["property"].value == HOME + "fieldOfView"}
+
+
 def looked_with(kb: KnowledgeBase, ad: Advertisement) -> str | None:
     """The name of the camera a simulated component looks with: its own (:func:`own_camera`), or for a
     table-top finder the first camera the store says is mounted on its robot ("" if none is); None for a

@@ -95,6 +95,9 @@ def test_run_composes_with_the_options_given(apps: dict[bool, App], monkeypatch:
     monkeypatch.setattr(cbrs.kb.semantic_map.SemanticMap, "read", staticmethod(lambda kb: None))
     monkeypatch.setattr(cbrs.sim.components, "SimEnvironment", lambda *_: type("Env", (), {"registry": {}})())
     monkeypatch.setattr(cbrs.cli_actions, "run_task", run_task)
+    # the lab's components have no simulated skill, so the check before the world is built would refuse
+    # the task: it composes with the run's composer, and goes on here
+    monkeypatch.setattr(cbrs.cli_actions, "refusal_before_world", lambda *_: None)
     for options, expected in (
         ([], (True, ComposeConfig().max_reachieved)),
         (["--no-protect", "--max-reachieved", "3"], (False, 3)),

@@ -15,7 +15,8 @@ from click.testing import CliRunner
 from cbrs.cli import cli
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
-from cbrs.sim.run_checks import unplaced_cameras, without_camera
+from cbrs.kb.semantic_map import SemanticMap
+from cbrs.sim.run_checks import map_cameras, unplaced_cameras, without_camera
 
 HOME, SVC = PREFIXES["home"], PREFIXES["svc"]
 DATA = Path(__file__).parent / "data" / "turtle_tasks_more"
@@ -103,3 +104,4 @@ def test_a_table_top_finder_without_a_placed_camera_on_its_robot_is_planned_and_
         iri: why for iri, (_, why, without) in found.items() if without
     }
     assert unplaced_cameras(kb, ads, {"CeilingCamera01", "CeilingCamera02", "Kinect01"}) == {}
+    assert map_cameras(kb) == {camera.name for camera in SemanticMap.read(kb).cameras.values()}

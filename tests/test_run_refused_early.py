@@ -21,7 +21,7 @@ from cbrs.kb import Advertisement, KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
 from cbrs.sim.components import SimEnvironment, implementations
-from cbrs.sim.run_checks import without_camera
+from cbrs.sim.run_checks import map_cameras, without_camera
 from cbrs.sim.world import open_world
 
 SVC, REQ = PREFIXES["svc"], PREFIXES["req"]
@@ -80,7 +80,7 @@ def blind_store(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
 
 def runnable(kb: KnowledgeBase) -> tuple[set[str], Callable[[Sequence[Advertisement]], Mapping[str, str]]]:
     """What the simulated home will implement, by the store (as ``cbrs run`` works it out before building it)."""
-    placed = {camera.name for camera in SemanticMap.read(kb).cameras.values()}
+    placed = map_cameras(kb)
     names = set(implementations(kb).names()) - set(without_camera(kb.advertisements(), placed))
     return names, lambda ads: without_camera(ads, placed)
 
