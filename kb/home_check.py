@@ -6,7 +6,10 @@ floor of, one mobile robot and a dual-arm robot with a left and a right arm, and
 (none: a home where the robots only move things; several: a resident and a caregiver); the base, each
 person and every docking pose start on the floor of a room, none inside a wall, a piece of furniture or
 a robot's body. A map that lacks one of them, or puts a start where nothing could stand, is refused
-with a :class:`HomeError` naming what it lacks and where, before anything is built or moves. Before, a
+with a :class:`HomeError` naming what it lacks and where, before anything is built or moves. A piece of
+furniture objects stand on with no docking pose is built, and reported (:func:`undocked_supports`): the
+arms of a robot beside it may reach it, but the mobile base has nowhere to park to fetch from it, so a
+task that would is refused (:class:`NoDockingPoseError`, :func:`docked_place`). Before, a
 map had to hold exactly one person: a home with nobody modelled, or two residents, stopped every task,
 also those that never look for a person. Which person a step means is asked per run
 (:mod:`kb.person_choice`); whether a camera sees the person or an object, before each run too, of the
@@ -15,11 +18,12 @@ camera the run's steps look with (``sim.sight``).
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
 
-from cbrs.kb.semantic_map import HOME, MapError, Pose, SemanticMap, local_name
+from cbrs.kb.semantic_map import HOME, MapError, Pose, SemanticMap, Thing, local_name
 
-__all__ = ["HomeError", "check_home"]
+__all__ = ["HomeError", "NoDockingPoseError", "Undocked", "check_home", "docked_place", "undocked_supports"]
 
 _ARM_SIDES = ("left", "right")
 
@@ -28,6 +32,66 @@ class HomeError(MapError, ValueError):
     """The semantic map lacks, or has too many of, what the simulated home is built from, or starts a
     robot or person where nothing can stand. ``thing`` is what is missing (a class) or misplaced.
     Also a ``ValueError``, which the simulation raised for some of these before."""
+
+
+class NoDockingPoseError(HomeError):
+    """The object a task fetches stands only on things with no docking pose (``home:dockingPose``): the
+    mobile base has nowhere to park to take it from there. ``thing`` is the object, ``supports`` what it
+    is on (by the world graph, else the map)."""
+
+    def __init__(self, thing: str, supports: tuple[str, ...]) -> None:
+        self.supports = supports
+        names = " and ".join(local_name(s) for s in supports)
+        which = "which has no" if len(supports) == 1 else "none of which has a"
+        super().__init__(
+            thing,
+            f"is on {names} (home:isLocatedOn), {which} home:dockingPose: the mobile base has nowhere to "
+            f"park to fetch it; give {names} a home:dockingPose (a home:Pose2D with home:x, home:y and "
+            "home:yaw, on a room's floor beside it, as lab4_trolley.ttl's Trolley1Dock in docs/examples)",
+        )
+
+
+@dataclass(frozen=True)
+class Undocked:
+    """A thing of the map that objects stand on and that has no docking pose, with those objects."""
+
+    support: str
+    objects: tuple[str, ...]
+
+    @property
+    def said(self) -> str:
+        """The warning, in words."""
+        held = ", ".join(local_name(o) for o in self.objects)
+        return (
+            f"{local_name(self.support)} holds {held} and has no home:dockingPose: a task that sends the "
+            "mobile base to fetch from it is refused (an arm beside it may still reach it)"
+        )
+
+
+def undocked_supports(semantic_map: SemanticMap) -> list[Undocked]:
+    """The things objects stand on (``home:isLocatedOn``) that have no docking pose, by IRI: no refusal
+    of the home (a spice rack on a table, a wall cabinet, a sofa's book are there to be reached by the
+    arms or not at all), but what ``cbrs home`` warns of."""
+    held: dict[str, list[str]] = {}
+    for obj in semantic_map.objects.values():
+        thing = semantic_map.things.get(obj.support or "")
+        if thing is not None and thing.dock is None:
+            held.setdefault(thing.iri, []).append(obj.iri)
+    return [Undocked(support, tuple(sorted(objects))) for support, objects in sorted(held.items())]
+
+
+def docked_place(semantic_map: SemanticMap, thing: str, supports: Iterable[str]) -> Thing | None:
+    """The first of ``supports`` (what ``thing`` is on, believed first, then by the map) that the mobile
+    base can park at: a thing of the map with a docking pose. :class:`NoDockingPoseError` when it is on
+    things of the map and none has one; None when it is on nothing the map gives an extent (rooms aside)."""
+    rooms = semantic_map.rooms  # a room it is believed in is no support to park at
+    known = [semantic_map.things[s] for s in dict.fromkeys(supports) if s in semantic_map.things and s not in rooms]
+    for place in known:
+        if place.dock is not None:
+            return place
+    if known:
+        raise NoDockingPoseError(thing, tuple(place.iri for place in known))
+    return None
 
 
 def check_home(semantic_map: SemanticMap) -> None:

@@ -42,6 +42,7 @@ __all__ = [
     "MapObject",
     "Marker",
     "MobileRobot",
+    "NoExtentError",
     "NotGraspableError",
     "Person",
     "Pose",
@@ -80,6 +81,25 @@ class NotGraspableError(MapError):
             thing,
             f"is a {kinds} and no class above it says how to grasp it: give one home:graspApproach and "
             "home:graspHeightRatio",
+        )
+
+
+class NoExtentError(MapError):
+    """A piece of furniture or a place objects are kept (``home:Furniture``, ``home:ObjectPlace`` by the
+    taxonomy) with no extent: the simulation builds such a thing as a box, stands things on its top and
+    finds spots on it, so without ``home:minX`` .. ``home:maxZ`` no task can use it. Refused when the map is
+    read (a load into graph:map, ``cbrs home``, a run), naming what it lacks (``missing``); before, it was
+    left out of the map's things but kept among its furniture, and a task about it failed mid-run."""
+
+    def __init__(self, thing: str, types: tuple[str, ...], missing: tuple[str, ...], hint: str = "") -> None:
+        self.missing = missing
+        kinds = ", ".join(local_name(t) for t in types)
+        super().__init__(
+            thing,
+            f"is a {kinds} with no extent ({', '.join(missing)} missing){hint}: the simulation builds furniture "
+            "and the places objects are kept as boxes and stands things on their top (home:maxZ), so it cannot "
+            "use this one; give it home:minX, home:maxX, home:minY, home:maxY and home:maxZ (home:minZ too for a "
+            "top that is a slab; the kitchen table's are in ontologies/world.ttl), or take it out of graph:map",
         )
 
 
@@ -411,6 +431,7 @@ class SemanticMap:
         for iri, values in facts.items():
             for tap in values.get(HOME + "hasTap", []):
                 built.dispensers[iri] = _dispenser(built, iri, tap, facts)
+        _check_extents(built, things_of("ObjectPlace"))
         _check_supports(built)
         _check_overlaps(built)
         _check_properties(declared, facts)
@@ -683,6 +704,30 @@ def _stated_twice(concept: str, name: str, stated: list[tuple[str, str, str]], i
         f"and {', '.join(local_name(cls) for cls in sorted(said)[1:])} are as near above {local_name(concept)} and "
         f"give home:{name} ({each}):{how}, on one class",
     )
+
+
+_EXTENT = ("minX", "maxX", "minY", "maxY", "maxZ")
+"""The properties of an extent a piece of furniture needs (``home:minZ`` defaults to its top)."""
+
+
+def _check_extents(built: SemanticMap, places: frozenset[str]) -> None:
+    """Every piece of furniture and object place the map describes is built: a box of its own (a
+    thing), or an object with a size. One with neither was read as nothing, yet listed as furniture, so
+    the home check passed it and a task putting something on it failed mid-run (the lab4 bench)."""
+    declared = _DECLARED.get()
+    for iri in sorted((built.furniture | places) & built.types.keys()):
+        if iri in built.things or iri in built.objects:
+            continue
+        values = built.facts.get(iri, {})
+        missing = tuple(f"home:{name}" for name in _EXTENT if HOME + name not in values)
+        wanted = [HOME + name.removeprefix("home:") for name in missing]
+        slips = [  # a misspelt property is declared nowhere: the load took it
+            f"home:{local_name(near)} for its home:{local_name(prop)}"
+            for prop in sorted(values)
+            if prop not in declared and (near := nearest_term(prop, wanted)) is not None
+        ]
+        hint = f" (did you mean {'; '.join(slips)}?)" if slips else ""
+        raise NoExtentError(iri, built.types[iri], missing, hint)
 
 
 def _check_supports(built: SemanticMap) -> None:

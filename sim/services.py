@@ -13,6 +13,7 @@ from dataclasses import replace
 from typing import Any
 
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.home_check import NoDockingPoseError, docked_place
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import local_name
 from cbrs.sim import skills
@@ -299,10 +300,15 @@ def infer_object_place(ctx: SimContext, inputs: Mapping[str, Any], device: str) 
     model = model_of(ctx, inputs["object"])
     believed = [o for _, p, o in _facts(ctx.kb, iri) if p in (HOME + "isLocatedOn", HOME + "isLocated")]
     known = ctx.map.facts.get(iri, {}).get(HOME + "isLocatedOn", [])
-    places = [o for o in [*believed, *known] if o in ctx.map.things and ctx.map.things[o].dock is not None]
-    if not places:
-        raise SkillFailed(f"the knowledge base does not say where the {model.name} is kept, or how to reach it")
-    place = ctx.map.things[places[0]]
+    try:
+        place = docked_place(ctx.map, iri, [*believed, *known])
+    except NoDockingPoseError as error:  # said by name: the support and the docking pose it lacks
+        raise SkillFailed(str(error)) from None
+    if place is None:
+        raise SkillFailed(
+            f"the knowledge base does not say where the {model.name} is kept: neither the world graph nor the "
+            "map puts it on (home:isLocatedOn) a thing of the map with an extent"
+        )
     dock = docking_pose(place)
     return {
         "objectPlace": designator(place.iri, HOME + "ObjectPlace"),
