@@ -25,7 +25,7 @@ from cbrs.sparql_service import SparqlService
 from cbrs.tasks import TaskRunner
 from cbrs.web import links, warmup
 from cbrs.web.context import EventLog, StreamSlots
-from cbrs.web.pages import http_error_message, keep_error_headers
+from cbrs.web.pages import http_error_message, keep_error_headers, wants_json
 from cbrs.web.sparql_wsgi import SparqlHotPath
 from cbrs.web.strict_request import StrictRequest
 
@@ -142,7 +142,7 @@ def create_app(
     def as_page() -> bool:
         if g.get("sparql_protocol"):  # a SPARQL client's request to a page's path (/query)
             return False
-        return request.blueprint in page_blueprints and not request.path.endswith(".json")
+        return request.blueprint in page_blueprints and not wants_json()  # a .json twin, or JSON negotiated
 
     @app.before_request
     def first_page() -> None:

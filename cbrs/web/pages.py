@@ -3,6 +3,10 @@
 A view returns a :class:`Page`; :func:`page` registers both routes and renders whichever was asked. A
 form whose input is wrong raises :class:`FormError`; the page is shown again with the message next to
 the field (status 400), and the twin answers ``{"error": "invalid-form", "fields": {...}}``.
+
+A page that programs act on (``page(..., negotiate=True)``: the tasks pages) also answers its twin at
+its own path when the request prefers JSON (:func:`prefers_json`), as HTTP APIs negotiate: a program
+that posts a run to ``/tasks`` with ``Accept: application/json`` got the HTML page.
 """
 
 from __future__ import annotations
@@ -13,7 +17,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from flask import Blueprint, Response, current_app, jsonify, render_template, request
+from flask import Blueprint, Response, current_app, jsonify, make_response, render_template, request
 from werkzeug.exceptions import HTTPException, MethodNotAllowed, NotFound
 
 from cbrs.kb.errors import KnowledgeBaseError
@@ -25,6 +29,7 @@ class Page:
     title: str
     data: dict[str, Any] = field(default_factory=dict)
     status: int = 200
+    headers: dict[str, str] = field(default_factory=dict)  # sent with either rendering (a 202's Location)
 
 
 class FormError(KnowledgeBaseError):
@@ -42,33 +47,61 @@ class FormError(KnowledgeBaseError):
 View = Callable[..., Page]
 
 
+_NEGOTIATED = "cbrs.negotiated_pages"  # app.extensions: the endpoints that answer JSON when it is preferred
+
+
 def wants_json() -> bool:
-    return request.path.endswith(".json")
+    """Whether this request gets a page's JSON twin: its ``.json`` path, or a negotiating page asked for JSON."""
+    if request.path.endswith(".json"):
+        return True
+    return request.endpoint in current_app.extensions.get(_NEGOTIATED, ()) and prefers_json()
 
 
-def page(blueprint: Blueprint, rule: str, **options: Any) -> Callable[[View], View]:
-    """Register ``view`` at ``rule`` (HTML) and ``rule + '.json'`` (its twin)."""
+def prefers_json() -> bool:
+    """``Accept`` ranks ``application/json`` above ``text/html``; or ranks them alike (``*/*``, or no
+    ``Accept``) and the body is JSON, which no browser form sends. A browser names ``text/html`` first."""
+    accept = request.accept_mimetypes
+    json, html = accept["application/json"], accept["text/html"]
+    return json > html or (json == html and request.is_json)
+
+
+def page(blueprint: Blueprint, rule: str, negotiate: bool = False, **options: Any) -> Callable[[View], View]:
+    """Register ``view`` at ``rule`` (HTML) and ``rule + '.json'`` (its twin); with ``negotiate``, ``rule``
+    answers the twin too when the request prefers JSON (:func:`prefers_json`)."""
 
     def register(view: View) -> View:
         @functools.wraps(view)
-        def respond(**kwargs: Any) -> Response | tuple[Response, int] | str | tuple[str, int]:
+        def respond(**kwargs: Any) -> Response:
             try:
                 shown = view(**kwargs)
             except FormError as error:
                 if wants_json():
-                    return jsonify(error="invalid-form", message=str(error), fields=error.fields), 400
+                    return _negotiated(jsonify(error="invalid-form", message=str(error), fields=error.fields), 400)
                 if error.page is None:
                     raise
                 shown = error.page
                 shown.status = 400
                 shown.data = {**shown.data, "errors": error.fields}
             if wants_json():
-                return jsonify(shown.data), shown.status
-            return render_template(shown.template, title=shown.title, **shown.data), shown.status
+                answer = jsonify(shown.data)
+            else:
+                answer = make_response(render_template(shown.template, title=shown.title, **shown.data))
+            answer.headers.update(shown.headers)
+            return _negotiated(answer, shown.status)
+
+        def _negotiated(answer: Response, status: int) -> Response:
+            answer.status_code = status
+            if negotiate and not request.path.endswith(".json"):
+                answer.vary.add("Accept")  # the same URL answers HTML or JSON: caches must key on Accept
+            return answer
 
         json_rule = "/index.json" if rule == "/" else rule + ".json"
         blueprint.add_url_rule(rule, view.__name__, respond, **options)
         blueprint.add_url_rule(json_rule, view.__name__ + "_json", respond, **options)
+        if negotiate:
+            blueprint.record_once(
+                lambda state: state.app.extensions.setdefault(_NEGOTIATED, set()).add(f"{state.name}.{view.__name__}")
+            )
         return view
 
     return register

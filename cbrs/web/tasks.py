@@ -52,11 +52,13 @@ def _defaults(state: BlueprintSetupState) -> None:
         state.app.config.setdefault(name, value)
 
 
-@page(blueprint, "/tasks", methods=["GET", "POST"])
+@page(blueprint, "/tasks", negotiate=True, methods=["GET", "POST"])
 def tasks() -> Page:
     """The tasks to start, the run going now (or the last one), the camera and the recent runs.
 
-    A POST starts a run (202); while one is going it is refused with 409 and says which.
+    A POST starts a run (202, its ``Location`` the run's page, or its JSON for a JSON answer); while one
+    is going it is refused with 409 and says which. A program gets JSON here as at ``/tasks.json`` when
+    it prefers it (:func:`cbrs.web.pages.prefers_json`).
     """
     form = _form()
     shown = Page("tasks.html", "Tasks", {"mode": "tasks", **_overview(form)})
@@ -75,12 +77,13 @@ def tasks() -> Page:
         shown.data.update(error="busy", message=str(error), running=error.running)
         return shown
     shown.status = 202
+    shown.headers["Location"] = url_for("tasks.run_json" if wants_json() else "tasks.run", run_id=started.id)
     shown.title = f"Tasks: {started.id} started"
     shown.data.update(_overview(form), started=_summary(started), message=f"{started.id} started: {started.task}")
     return shown
 
 
-@page(blueprint, "/tasks/<run_id>")
+@page(blueprint, "/tasks/<run_id>", negotiate=True)
 def run(run_id: str) -> Page:
     """One run: its steps, every event it published, and its result (the plan and execution report)."""
     found = context.tasks().get(run_id)  # an unknown run: 404
@@ -88,7 +91,7 @@ def run(run_id: str) -> Page:
     return _for_script(Page("tasks.html", f"Run {found.id}: {found.task}, {found.status}", data))
 
 
-@page(blueprint, "/tasks/<run_id>/cancel", methods=["POST"])
+@page(blueprint, "/tasks/<run_id>/cancel", negotiate=True, methods=["POST"])
 def cancel(run_id: str) -> Page:
     """Ask a run to stop after the step under way (202); the same people who may start a run may stop it.
 
