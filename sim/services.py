@@ -15,7 +15,7 @@ from typing import Any
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.home_check import NoDockingPoseError, docked_place
 from cbrs.kb.namespaces import PREFIXES
-from cbrs.kb.semantic_map import local_name
+from cbrs.kb.semantic_map import Thing, local_name
 from cbrs.sim import skills
 from cbrs.sim.arm_choice import carry_check, free_arm, grasp_pose_for, holdable_spot, note_choice, who_loads, who_takes
 from cbrs.sim.arms import ArmSide
@@ -298,10 +298,8 @@ def infer_object_place(ctx: SimContext, inputs: Mapping[str, Any], device: str) 
             "approachPosition": to_json(dock, APPROACH_POSITION),
         }
     model = model_of(ctx, inputs["object"])
-    believed = [o for _, p, o in _facts(ctx.kb, iri) if p in (HOME + "isLocatedOn", HOME + "isLocated")]
-    known = ctx.map.facts.get(iri, {}).get(HOME + "isLocatedOn", [])
     try:
-        place = docked_place(ctx.map, iri, [*believed, *known])
+        place = kept_place(ctx, iri)
     except NoDockingPoseError as error:  # said by name: the support and the docking pose it lacks
         raise SkillFailed(str(error)) from None
     if place is None:
@@ -316,6 +314,16 @@ def infer_object_place(ctx: SimContext, inputs: Mapping[str, Any], device: str) 
         "approachPosition": to_json(dock, APPROACH_POSITION),
         "objectFeature": to_json(ObjectFeature(model.colour)),
     }
+
+
+def kept_place(ctx: SimContext, iri: str) -> Thing | None:
+    """The thing the object ``iri`` is kept on that the mobile base can park at (a docking pose): where the
+    world graph believes it is, else where the map puts it. :class:`kb.home_check.NoDockingPoseError` when
+    it is on furniture and none has a docking pose; None when it is on nothing of the map. What
+    :func:`infer_object_place` answers with, and what a check before the run can ask."""
+    believed = [o for _, p, o in _facts(ctx.kb, iri) if p in (HOME + "isLocatedOn", HOME + "isLocated")]
+    known = ctx.map.facts.get(iri, {}).get(HOME + "isLocatedOn", [])
+    return docked_place(ctx.map, iri, [*believed, *known])
 
 
 def _facts(kb: KnowledgeBase, thing: str) -> list[tuple[str, str, str]]:

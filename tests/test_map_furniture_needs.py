@@ -26,7 +26,7 @@ from cbrs.kb.home_check import NoDockingPoseError, Undocked, check_home, docked_
 from cbrs.kb.namespaces import PREFIXES, GraphName
 from cbrs.kb.semantic_map import NoExtentError, SemanticMap
 from cbrs.sim.context import SimContext, SkillFailed
-from cbrs.sim.services import infer_object_place
+from cbrs.sim.services import infer_object_place, kept_place
 from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.web import create_app
 
@@ -165,6 +165,8 @@ def test_inferring_where_the_torch_is_kept_names_the_trolley_and_its_missing_doc
     """The home server's step, on the map alone (a stand-in world that only holds the map): it said "the
     knowledge base does not say where the Torch1 is kept, or how to reach it"."""
     ctx = SimContext(world=SimpleNamespace(map=SemanticMap.read(undocked)), kb=undocked)  # type: ignore[arg-type]
+    with pytest.raises(NoDockingPoseError):  # what a check before the run can ask
+        kept_place(ctx, LAB + "Torch1")
     with pytest.raises(SkillFailed) as failed:
         infer_object_place(ctx, {"object": {"@id": LAB + "Torch1"}}, "HomeServer01")
     assert "Torch1" in str(failed.value) and "Trolley1" in str(failed.value)
