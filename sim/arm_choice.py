@@ -320,12 +320,13 @@ def carry_check(
     folded: Sequence[ArmSide] = (),
 ) -> tuple[str, str]:
     """Why the arm's planning would refuse the carry over ``spot`` and its way down, and where those moves
-    would come within CARRY_CLEARANCE of an appliance (each empty when not): a dry run
-    (:meth:`Arm.keeping_clear`) of the carry of what ``side`` holds, from its posture now
-    (:func:`skills.can_carry_held`), or, given ``taking`` (an object where it lies, the approach), of its
-    take and carry from where it lies (:func:`skills.can_carry`, the arms of ``folded`` home); the floor as
-    the carry's (:func:`floor_to`). Told apart, so a choice can pass over the spot that does not keep clear and
-    still take it, as before, when none does."""
+    would come within CARRY_CLEARANCE of an appliance (each empty when not): a dry run with that clearance
+    of the carry of what ``side`` holds, from its posture now (:func:`skills.plan_carry_held`), or, given
+    ``taking`` (an object where it lies, the approach), of its take and carry from where it lies
+    (:func:`skills.plan_carry`, the arms of ``folded`` home); the floor as the carry's (:func:`floor_to`).
+    Told apart, so a choice can pass over the spot that does not keep clear and still take it, as before,
+    when none does; but a held carry that comes that near is given as refused too, saying where: a pass's
+    giver passes such a spot over (``services.carry``), and takes none of them when none keeps clear."""
     world = ctx.world
     if taking is None:
         grasp = world.arm(side).held_grasp
@@ -333,23 +334,19 @@ def carry_check(
             return f"the {side.value} gripper holds nothing", ""
         held, start = grasp.model, world.arm(side).ee_pose().position
         floor = floor_to(ctx, held, side, start, spot)
-        refused, brushed = _keeping_clear(ctx, side, lambda: skills.can_carry_held(world, side, spot, floor))
+        planned = skills.plan_carry_held(world, side, spot, floor, CARRY_CLEARANCE)
     else:
         seen, held = taking
         floor = floor_to(ctx, held, side, seen.position, spot)
-        refused, brushed = _keeping_clear(
-            ctx, side, lambda: skills.can_carry(world, seen, side, held, spot, floor=floor, folded=folded)
+        planned = skills.plan_carry(
+            world, seen, side, held, spot, floor=floor, folded=folded, clearance=CARRY_CLEARANCE
         )
     cx, cy, _ = spot.center
-    return refused, brushed and f"the {side.value} arm carrying the {held.name} to ({cx:.2f}, {cy:.2f}): {brushed}"
-
-
-def _keeping_clear(ctx: SimContext, side: ArmSide, dry_run: Callable[[], str]) -> tuple[str, str]:
-    """What ``dry_run`` says (why the arm's planning would refuse its moves) and where its moves first came
-    within CARRY_CLEARANCE of an appliance (:attr:`PlannedArm.brushed`; empty: they kept clear)."""
-    with ctx.world.arm(side).keeping_clear(CARRY_CLEARANCE) as planned:
-        refused = dry_run()
-    return refused, next((run.brushed for run in planned if run.brushed), "")
+    near = planned.brushed
+    brushed = near and f"the {side.value} arm carrying the {held.name} to ({cx:.2f}, {cy:.2f}): {near}"
+    if taking is None:  # a held carry that comes that near is refused too
+        return planned.refused or brushed, brushed
+    return planned.refused, brushed
 
 
 def _clear_spot(
@@ -369,7 +366,7 @@ def _clear_spot(
     if refused or not brushed:
         return (refused, refused) if refused else first
     seen, held = taking
-    at_take = _keeping_clear(ctx, side, lambda: skills.can_carry(ctx.world, seen, side, held))[1]
+    at_take = skills.plan_carry(ctx.world, seen, side, held, clearance=CARRY_CLEARANCE).brushed
     if at_take:
         return "", f"taking the {held.name}: {at_take}"
     for spot in itertools.islice(others(), CLEAR_TRIES - 1):
@@ -531,7 +528,8 @@ def _loading_by(
         if brushed and near:
             return brushed
         there = resting_at(spot, model, estimate, world.time)
-        why, loading_brushed = _keeping_clear(ctx, loader, lambda: _loads(ctx, there, base, loader, taken_by))
+        loads = skills.plan_hand_over(world, there, base, loader, taken_by, CARRY_CLEARANCE)
+        why, loading_brushed = loads.refused, loads.brushed
         refuse_moves(why, taken_by, loader, purpose, platform)
         here = brushed or (loading_brushed and f"the {loader.value} arm loading the {model.name}: {loading_brushed}")
         near = near or here

@@ -11,8 +11,7 @@ simulated time and reports whether it reached its target.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from enum import StrEnum
 from importlib.resources import files
@@ -529,8 +528,6 @@ class Arm:
         self._targets: tuple[float, ...] = HOME_CONFIGURATIONS[side]
         self._gripper_width = self.open_width
         self.peers: dict[ArmSide, Arm] = {}
-        self._keeping: list[PlannedArm] | None = None  # the dry runs made within keeping_clear
-        self._clear_by: float | None = None
         """Both arms of the robot (set by the world), for collision checks against the other arm."""
         for joint, q in zip(ARM_JOINTS, self._targets, strict=True):
             p.resetJointState(body, joint, q, physicsClientId=client)
@@ -678,25 +675,9 @@ class Arm:
         """A stand-in for this arm, from its posture now, whose moves are planned and not made; the other
         arms where they are, or those of ``folded`` in their home posture (where they will be by then: an
         arm that sets an object down for this one folds home after). With ``clear_by`` it notes where its
-        moves first come within that distance of a fixture (:attr:`PlannedArm.brushed`)."""
-        others = self._others(folded)
-        margin = self._clear_by if clear_by is None else clear_by
-        planned = PlannedArm(self.side, self._kinematics, self.joint_positions(), others, margin)
-        if self._keeping is not None:
-            self._keeping.append(planned)
-        return planned
-
-    @contextmanager
-    def keeping_clear(self, margin: float) -> Iterator[list[PlannedArm]]:
-        """Within it this arm's dry runs note where their moves first come within ``margin`` of a fixture,
-        as with ``clear_by``, and the list it gives holds them: a check that plans on a dry run of its own
-        (``skills.can_carry``, from where an object lies) is asked how near the fixtures its moves come."""
-        kept: list[PlannedArm] = []
-        self._keeping, self._clear_by = kept, margin
-        try:
-            yield kept
-        finally:
-            self._keeping, self._clear_by = None, None
+        moves first come within that distance of a fixture (:attr:`PlannedArm.brushed`): the clearance a
+        check asks of a carry (``skills.plan_carry``'s ``clearance``)."""
+        return PlannedArm(self.side, self._kinematics, self.joint_positions(), self._others(folded), clear_by)
 
     def _settle(self, goal: NDArray[np.float64]) -> float:
         waited = 0.0

@@ -40,6 +40,7 @@ __all__ = [
     "FILL_TIME_LIMIT",
     "LIFT_HEIGHT",
     "NAVIGATION_TOLERANCE",
+    "DryRun",
     "Outcome",
     "approach_object",
     "can_carry",
@@ -58,6 +59,9 @@ __all__ = [
     "navigate_to_person",
     "navigate_to_place",
     "pick_up_object",
+    "plan_carry",
+    "plan_carry_held",
+    "plan_hand_over",
     "platform_region",
     "put_down_object",
 ]
@@ -572,6 +576,17 @@ def can_set_down(world: HomeWorld, pen: ObjectEstimate, side: ArmSide | str, mod
     return ""
 
 
+@dataclass(frozen=True)
+class DryRun:
+    """What a hold's moves, planned and not made, came to (:func:`plan_carry`)."""
+
+    refused: str
+    """Why the arm's planning would refuse them; empty: it would make them."""
+    brushed: str = ""
+    """Where they first came within the clearance asked of the appliances (:attr:`PlannedArm.brushed`);
+    empty: they kept it, or none was asked."""
+
+
 def can_carry(
     world: HomeWorld,
     pen: ObjectEstimate,
@@ -583,19 +598,37 @@ def can_carry(
     folded: Sequence[ArmSide] = (),
 ) -> str:
     """Why ``side``'s own motion planning would refuse to take the object where it is by ``model``'s
-    approach and, given a ``region``, carry it over its middle (empty if it would not): the moves of
-    approach_object, pick_up_object and carry_object, and put_down_object's way down and back, planned one after
-    the other on the kinematics copies from the arm's posture now, without moving (a dry run,
-    :meth:`Arm.dry_run`). The inverse kinematics
+    approach and, given a ``region``, carry it over its middle (empty if it would not): :func:`plan_carry`'s
+    refusal."""
+    return plan_carry(world, pen, side, model, region, yaw, floor, folded).refused
+
+
+def plan_carry(
+    world: HomeWorld,
+    pen: ObjectEstimate,
+    side: ArmSide | str,
+    model: ObjectModel,
+    region: Region | None = None,
+    yaw: float | None = None,
+    floor: float | None = None,
+    folded: Sequence[ArmSide] = (),
+    clearance: float | None = None,
+) -> DryRun:
+    """The moves of ``side`` taking the object where it is by ``model``'s approach and, given a ``region``,
+    carrying it over its middle: approach_object, pick_up_object and carry_object, and put_down_object's
+    way down and back, planned one after the other on the kinematics copies from the arm's posture now,
+    without moving (a dry run, :meth:`Arm.dry_run`). The inverse kinematics
     of the end poses alone (:func:`can_take`, :func:`can_set_down`) misses a joint-space move whose every
     path collides or lets the held object dip, and a straight line that leaves the arm's reach. ``yaw``
     turns a top-grasped object on the way, and ``floor`` keeps its bottom up on the way, as
-    :func:`carry_object` does; the arms of ``folded`` are taken to be home (:meth:`Arm.dry_run`)."""
+    :func:`carry_object` does; the arms of ``folded`` are taken to be home (:meth:`Arm.dry_run`). With
+    ``clearance``, also where the moves first come within that distance of an appliance, a tap's lever
+    too (:attr:`DryRun.brushed`), which the planning does not refuse them for."""
     arm = ArmSide(side)
     grasp = _grasp(world, pen, arm, model)
     if isinstance(grasp, str):
-        return grasp
-    hand = world.arm(arm).dry_run(folded)
+        return DryRun(grasp)
+    hand = world.arm(arm).dry_run(folded, clear_by=clearance)
     x, y, z = grasp.position
     moves: list[tuple[str, Callable[[], MotionResult]]] = [
         ("reaching the pre-grasp pose", lambda: _approach(hand, grasp)),
@@ -607,42 +640,56 @@ def can_carry(
         moves.append((f"carrying it to ({cx:.2f}, {cy:.2f})", lambda: _carry(hand, grasp, region, yaw, floor)))
         lowering = f"lowering it onto {region.name} at ({cx:.2f}, {cy:.2f})"
         moves.append((lowering, lambda: _set_down(hand, grasp, region)))
-    return _first_refused(moves, arm, model)
+    return DryRun(_first_refused(moves, arm, model), hand.brushed)
 
 
 def can_hand_over(
     world: HomeWorld, pen: ObjectEstimate, base: Pose2D | RobotPoseEstimate, side: ArmSide | str, model: ObjectModel
 ) -> str:
     """Why ``side`` cannot load the object onto the platform of the base parked at ``base`` by
-    :func:`hand_over_onto_platform`'s moves (empty if it can): the end poses (:func:`can_load`), then a dry
-    run of the take and of the carry over the platform with the wrist turned as the hand-over turns it
-    (:func:`can_carry`)."""
+    :func:`hand_over_onto_platform`'s moves (empty if it can): :func:`plan_hand_over`'s refusal."""
+    return plan_hand_over(world, pen, base, side, model).refused
+
+
+def plan_hand_over(
+    world: HomeWorld,
+    pen: ObjectEstimate,
+    base: Pose2D | RobotPoseEstimate,
+    side: ArmSide | str,
+    model: ObjectModel,
+    clearance: float | None = None,
+) -> DryRun:
+    """:func:`hand_over_onto_platform`'s moves: the end poses (:func:`can_load`), then a dry run of the take
+    and of the carry over the platform with the wrist turned as the hand-over turns it (:func:`plan_carry`,
+    with ``clearance``)."""
     _, region, yaw, reason = _loading(world, pen, base, side, model)
-    return reason or can_carry(world, pen, side, model, region, yaw)
+    return DryRun(reason) if reason else plan_carry(world, pen, side, model, region, yaw, clearance=clearance)
 
 
-def can_carry_held(
-    world: HomeWorld, side: ArmSide | str, region: Region, floor: float | None = None, clear_by: float | None = None
-) -> str:
+def can_carry_held(world: HomeWorld, side: ArmSide | str, region: Region, floor: float | None = None) -> str:
     """Why ``side``'s planning would refuse to carry what it holds over the middle of ``region`` and lower
-    it there, as :func:`carry_object` and :func:`put_down_object` move it (empty if it would not): a dry
-    run from the arm's posture now; with ``clear_by``, also where those moves would bring the arm within
-    that distance of an appliance, a tap's lever too (:attr:`PlannedArm.brushed`)."""
+    it there (empty if it would not): :func:`plan_carry_held`'s refusal."""
+    return plan_carry_held(world, side, region, floor).refused
+
+
+def plan_carry_held(
+    world: HomeWorld, side: ArmSide | str, region: Region, floor: float | None = None, clearance: float | None = None
+) -> DryRun:
+    """The moves of ``side`` carrying what it holds over the middle of ``region`` and lowering it there, as
+    :func:`carry_object` and :func:`put_down_object` move it: a dry run from the arm's posture now; with
+    ``clearance``, also where they first come within that distance of an appliance, a tap's lever too
+    (:attr:`DryRun.brushed`)."""
     arm = _arm(world, side)
     grasp = arm.held_grasp
     if arm.held is None or grasp is None:
-        return f"the {arm.side} gripper holds nothing"
-    hand = arm.dry_run(clear_by=clear_by)
+        return DryRun(f"the {arm.side} gripper holds nothing")
+    hand = arm.dry_run(clear_by=clearance)
     cx, cy, _ = region.center
-    model = grasp.model
     moves: list[tuple[str, Callable[[], MotionResult]]] = [
         (f"carrying it to ({cx:.2f}, {cy:.2f})", lambda: _carry(hand, grasp, region, None, floor)),
         (f"lowering it onto {region.name} at ({cx:.2f}, {cy:.2f})", lambda: _set_down(hand, grasp, region)),
     ]
-    refused = _first_refused(moves, ArmSide(side), model)
-    if refused or not hand.brushed:
-        return refused
-    return f"the {arm.side} arm carrying the {model.name} to ({cx:.2f}, {cy:.2f}): {hand.brushed}"
+    return DryRun(_first_refused(moves, ArmSide(side), grasp.model), hand.brushed)
 
 
 def _first_refused(moves: list[tuple[str, Callable[[], MotionResult]]], arm: ArmSide, model: ObjectModel) -> str:

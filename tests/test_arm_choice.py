@@ -164,17 +164,19 @@ def test_a_pass_whose_holds_are_refused_at_one_relay_spot_tries_the_next(monkeyp
         first = arm_choice.who_loads(context, seen, cup, base)
         assert first.giver is not None and first.giver.arm is LEFT and first.spot is not None
         refused_at = first.spot.center
-        real = skills.can_carry
+        real = skills.plan_carry
 
-        def can_carry(world: HomeWorld, seen: ObjectEstimate, side: ArmSide | str, *rest: object, **kw: object) -> str:
+        def plan_carry(
+            world: HomeWorld, seen: ObjectEstimate, side: ArmSide | str, *rest: object, **kw: object
+        ) -> skills.DryRun:
             region = rest[1] if len(rest) > 1 else None
             if ArmSide(side) is LEFT and isinstance(region, Region) and region.center == refused_at:
-                return "the stand-in refuses this spot"
+                return skills.DryRun("the stand-in refuses this spot")
             return real(world, seen, side, *rest, **kw)  # type: ignore[arg-type]
 
-        monkeypatch.setattr(skills, "can_carry", can_carry)
+        monkeypatch.setattr(skills, "plan_carry", plan_carry)
         second = arm_choice.who_loads(context, seen, cup, base)
-        monkeypatch.setattr(skills, "can_carry", lambda *args, **kw: "the stand-in refuses every spot")
+        monkeypatch.setattr(skills, "plan_carry", lambda *args, **kw: skills.DryRun("the stand-in refuses every spot"))
         with pytest.raises(MovesRefusedError) as refused:
             arm_choice.who_loads(context, seen, cup, base)
     assert second.spot is not None and second.spot.center != refused_at

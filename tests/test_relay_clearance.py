@@ -16,6 +16,7 @@ import logging
 import math
 from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -32,7 +33,7 @@ from cbrs.sim.geometry import Pose2D
 from cbrs.sim.grasping import ObjectModel
 from cbrs.sim.perception import ObjectEstimate
 from cbrs.sim.values import designator
-from cbrs.sim.world import open_world
+from cbrs.sim.world import HomeWorld, open_world
 
 WORLD, HOME = PREFIXES["world"], PREFIXES["home"]
 TASKS = Path(__file__).parent / "data" / "tasks"
@@ -76,14 +77,18 @@ def scene() -> Iterator[Scene]:
         cup = ObjectModel.of(world.map.objects[WORLD + "Cup"])
         base = grounding.docking_pose(world.map.things[WORLD + "KitchenTable"])
         with pytest.MonkeyPatch.context() as before:  # the choice as before the clearance was asked
-            before.setattr(arm_choice, "_keeping_clear", _blind)
+            before.setattr(skills, "plan_carry", _blind(skills.plan_carry))
             old = arm_choice.who_loads(context, seen, cup, base)
         yield context, seen, cup, base, old
 
 
-def _blind(ctx: SimContext, side: ArmSide, dry_run: Callable[[], str]) -> tuple[str, str]:
+def _blind(real: Callable[..., skills.DryRun]) -> Callable[..., skills.DryRun]:
     """The dry runs as before the clearance was asked: what the planning refuses, nothing of how near."""
-    return dry_run(), ""
+
+    def plan_carry(*args: Any, **kwargs: Any) -> skills.DryRun:
+        return skills.DryRun(real(*args, **kwargs).refused)
+
+    return plan_carry
 
 
 def test_the_relay_spot_is_one_whose_holds_keep_clear_of_the_lever(scene: Scene) -> None:
@@ -132,20 +137,22 @@ def test_of_two_arms_that_can_take_it_there_the_one_whose_carry_keeps_clear_take
         "place": designator(WORLD + "TrayPlace", HOME + "ObjectPlace"),
     }
     there = ObjectEstimate(7.80, 3.05, seen.z, None, seen.size, "red", "Kinect01", seen.time, 500)
-    real = arm_choice._keeping_clear
+    real = skills.plan_carry
 
-    def near(*sides: ArmSide) -> Callable[[SimContext, ArmSide, Callable[[], str]], tuple[str, str]]:
-        def keeping_clear(ctx: SimContext, side: ArmSide, dry_run: Callable[[], str]) -> tuple[str, str]:
-            refused, brushed = real(ctx, side, dry_run)
-            return refused, brushed or ("the stand-in appliance is within 1 cm" if side in sides else "")
+    def near(*sides: ArmSide) -> Callable[..., skills.DryRun]:
+        def plan_carry(world: HomeWorld, seen: ObjectEstimate, side: ArmSide, *rest: Any, **kw: Any) -> skills.DryRun:
+            planned = real(world, seen, side, *rest, **kw)
+            asked = kw.get("clearance") is not None  # as the clearance is asked, of the arms of ``sides``
+            stand_in = "the stand-in appliance is within 1 cm" if asked and ArmSide(side) in sides else ""
+            return skills.DryRun(planned.refused, planned.brushed or stand_in)
 
-        return keeping_clear
+        return plan_carry
 
     assert arm_choice.reaching(ctx, there.x, there.y) == [RIGHT, LEFT]
     chosen = arm_choice.who_takes(ctx, there, cup)
-    monkeypatch.setattr(arm_choice, "_keeping_clear", near(RIGHT))
+    monkeypatch.setattr(skills, "plan_carry", near(RIGHT))
     other = arm_choice.who_takes(ctx, there, cup)
-    monkeypatch.setattr(arm_choice, "_keeping_clear", near(LEFT, RIGHT))
+    monkeypatch.setattr(skills, "plan_carry", near(LEFT, RIGHT))
     with caplog.at_level(logging.INFO, logger="cbrs.sim"):
         both = arm_choice.who_takes(ctx, there, cup)
     assert (chosen.arm, other.arm, both.arm) == (RIGHT, LEFT, RIGHT)
