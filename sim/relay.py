@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 
 from cbrs.sim import skills
 from cbrs.sim.arms import CARRY_CLEARANCE, ArmSide
@@ -33,7 +33,23 @@ from cbrs.sim.transit import floor_to
 
 RELAY_MOVES_TRIES = 3
 """How many spots whose end poses serve a pass or a re-grasp may have its holds' moves refused by the
-arms' planning (a dry run) before the pass is refused with the first refusal."""
+arms' planning (a dry run, 0.1-0.8 s a spot), nearest the mounts first, before the pass looks farther
+(RELAY_SPREAD)."""
+
+
+RELAY_SPREAD = 0.15
+"""Once RELAY_MOVES_TRIES spots are refused, the pass asks only spots at least this far from every spot
+refused (up to RELAY_SPREAD_TRIES more refusals), then is refused with the first refusal. The spots 2 cm
+apart nearest the mounts put the arms in nearly the same postures, refused for the same thing. Measured
+with the 7 cm wine bottle passed from the right arm to the left (PutWineOnCupboard, seed 0), along the
+table's front (y 3.07): the right arm's back-off runs into the Kinect's mast from x 7.73-7.79, its
+straight line leaves its reach from 7.65-7.71, its carry is refused from 7.81-7.95; west of 7.63 and
+east of 7.97 the spots serve. Nearest first, the first that serves was the 25th; after three refused
+beside the torso, spread 9-20 cm apart it is the 5th; 3-7 cm apart none is within three more."""
+
+
+RELAY_SPREAD_TRIES = 3
+"""How many spots spread RELAY_SPREAD apart may be refused after the first RELAY_MOVES_TRIES."""
 
 
 RELAY_TRIES = 40
@@ -117,7 +133,8 @@ def relay_spot(
     there (asked of the inverse kinematics: a side grasp close to the mount has none), and, given
     ``moves``, whose holds' moves the arms' planning would make (a dry run raising
     :class:`MovesRefusedError`): a spot so refused is passed over for the next, as a refused approach is
-    for the next approach, up to RELAY_MOVES_TRIES of them; then the first refusal. ``moves`` returns where
+    for the next approach, up to RELAY_MOVES_TRIES of them, and then up to RELAY_SPREAD_TRIES more, each
+    RELAY_SPREAD from every spot refused (:func:`_asked`); then the first refusal. ``moves`` returns where
     the holds' moves would come within CARRY_CLEARANCE of an appliance (``arm_choice.carry_check``; empty
     or None: they keep clear): such a spot is passed over for the next whose moves keep clear, up to
     CLEAR_TRIES of them; when none does, the first of them, as before, and the log says so."""
@@ -176,8 +193,9 @@ def relay_spot(
         return None
 
     refused: list[MovesRefusedError] = []
+    refused_at: list[tuple[float, float]] = []  # where the holds' moves were refused
     near: list[tuple[Region, ObjectModel, ObjectModel, str]] = []  # served, not keeping clear
-    for *_, cx, cy in sorted(spots)[:RELAY_TRIES]:
+    for cx, cy in _asked([(cx, cy) for *_, cx, cy in sorted(spots)], refused_at):
         centre = (cx, cy, surface + model.height / 2.0)
         given = held_by(giver, giving, centre)
         taken = held_by(taker, taking, centre) if given is not None else None
@@ -190,7 +208,10 @@ def relay_spot(
                 brushed = moves(region, given, taken) if moves is not None else None
             except MovesRefusedError as why:
                 refused.append(why)
-                if len(refused) >= RELAY_MOVES_TRIES:
+                refused_at.append((cx, cy))
+                if len(refused) >= RELAY_MOVES_TRIES + RELAY_SPREAD_TRIES or (
+                    len(refused) >= RELAY_MOVES_TRIES and near
+                ):
                     break
                 continue
             if not brushed:
@@ -226,6 +247,21 @@ def relay_spot(
         f"there is no spot on {supports[0].name} where both the {giver.value} and the {taker.value} arm can hold "
         f"the {model.name} by its {kinds} grasp, to pass it from one to the other"
     )
+
+
+def _asked(spots: list[tuple[float, float]], refused_at: list[tuple[float, float]]) -> Iterator[tuple[float, float]]:
+    """Of ``spots`` (nearest the mounts first), the ones a pass asks in turn: the first RELAY_TRIES, until
+    RELAY_MOVES_TRIES of them have been refused (``refused_at``, which grows as they are asked); from
+    then on, of the rest, those at least RELAY_SPREAD from every spot refused."""
+    for index, spot in enumerate(spots):
+        if len(refused_at) >= RELAY_MOVES_TRIES:
+            yield from (
+                other for other in spots[index:] if all(math.dist(other, at) >= RELAY_SPREAD for at in refused_at)
+            )
+            return
+        if index >= RELAY_TRIES:
+            return
+        yield spot
 
 
 def resting_at(spot: Region, model: ObjectModel, seen: ObjectEstimate, now: float) -> ObjectEstimate:

@@ -8,6 +8,7 @@ kinematics copies only: nothing is stepped."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -15,10 +16,13 @@ import pytest
 
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.semantic_map import SemanticMap
-from cbrs.sim import skills
+from cbrs.sim import relay, skills
 from cbrs.sim.arms import ArmSide
+from cbrs.sim.components import SimEnvironment
+from cbrs.sim.errors import MovesRefusedError
 from cbrs.sim.geometry import Region
 from cbrs.sim.grasping import GraspKind, ObjectModel, compute_grasp_pose
+from cbrs.sim.hold_choice import Candidates, refuse_moves
 from cbrs.sim.perception import ObjectEstimate
 from cbrs.sim.world import HomeWorld, open_world
 
@@ -28,9 +32,9 @@ TABLE_TOP = 0.75
 
 
 @pytest.fixture(scope="module")
-def world(tmp_path_factory: pytest.TempPathFactory) -> Iterator[HomeWorld]:
-    """The bundled home at seed 0 with the wine bottle narrowed to 7 cm (the 7.5 cm one is refused by the
-    jaws); the tests only plan on its kinematics copies."""
+def store(tmp_path_factory: pytest.TempPathFactory) -> KnowledgeBase:
+    """The bundled store with the wine bottle narrowed to 7 cm (the 7.5 cm one is refused by the jaws) and
+    the low cupboard."""
     text = (EXAMPLES / "wine_bottle.ttl").read_text(encoding="utf-8")
     narrowed = text.replace("home:sizeX 0.075 ; home:sizeY 0.075", "home:sizeX 0.07 ; home:sizeY 0.07")
     assert narrowed != text
@@ -39,7 +43,13 @@ def world(tmp_path_factory: pytest.TempPathFactory) -> Iterator[HomeWorld]:
     kb = KnowledgeBase.open(":memory:")
     for graph in ("ontology", "map"):
         kb.load([wine, EXAMPLES / "low_cupboard.ttl"], graph=graph)
-    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as home:
+    return kb
+
+
+@pytest.fixture(scope="module")
+def world(store: KnowledgeBase) -> Iterator[HomeWorld]:
+    """Its home at seed 0; the tests only plan on its kinematics copies."""
+    with open_world(seed=0, semantic_map=SemanticMap.read(store)) as home:
         yield home
 
 
@@ -72,3 +82,56 @@ def test_a_put_down_whose_way_back_runs_into_the_kinect_is_refused_by_the_dry_ru
     # where it stands, the same hold's way back is clear
     here = Region("TakenFrom", x - 0.02, x + 0.02, y - 0.02, y + 0.02, TABLE_TOP, TABLE_TOP + 0.3)
     assert skills.can_carry(world, seen, ArmSide.RIGHT, model, here) == ""
+
+
+def test_the_pass_looks_farther_after_three_spots_beside_the_torso_are_refused(
+    store: KnowledgeBase, world: HomeWorld, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The bottle passed from the right arm to the left (PutWineOnCupboard, for the cupboard west of the
+    robot): the three relay spots nearest both mounts, 2 cm apart beside the torso, are refused by the
+    right arm's back-off into the Kinect's mast; then spots RELAY_SPREAD from every refused one are asked,
+    and one west of them serves. Before, the pass was refused after the three (as it still is with no
+    spread tries). The holds' moves are the giver's, from where the bottle stands (its take included)."""
+    context = SimEnvironment(world, store).context
+    model = ObjectModel.of(world.map.objects[LAB + "WineBottle1"]).by(GraspKind.SIDE)
+    x, y, z = world.pose("WineBottle1").position
+    seen = ObjectEstimate(x, y, z, None, world.objects["WineBottle1"].size, "green", "Kinect01", 0.0, 100)
+    asked: list[tuple[tuple[float, float], str]] = []
+
+    def moves(spot: Region, given: ObjectModel, _: ObjectModel) -> str:
+        refused = skills.can_carry(world, seen, ArmSide.RIGHT, given, spot)
+        asked.append((spot.center[:2], refused))
+        refuse_moves(refused, given, ArmSide.RIGHT, "passing the WineBottle1", spot)
+        return ""
+
+    def pass_it() -> Region:
+        held = Candidates([model])
+        return relay.relay_spot(context, seen, held, held, ArmSide.RIGHT, ArmSide.LEFT, moves)[0]
+
+    spot = pass_it()
+    first = [at for at, _ in asked[: relay.RELAY_MOVES_TRIES]]
+    assert all("backing off once it is let go" in why for _, why in asked[: relay.RELAY_MOVES_TRIES])
+    assert max(math.dist(a, b) for a in first for b in first) < 0.05  # side by side
+    for n, (at, _) in enumerate(asked[relay.RELAY_MOVES_TRIES :], relay.RELAY_MOVES_TRIES):
+        assert all(math.dist(at, before) >= relay.RELAY_SPREAD for before, _ in asked[:n])
+    assert len(asked) <= relay.RELAY_MOVES_TRIES + relay.RELAY_SPREAD_TRIES
+    assert asked[-1] == (spot.center[:2], "")
+    assert spot.center[0] < min(at[0] for at in first) - relay.RELAY_SPREAD  # west of them, toward the left arm
+
+    asked.clear()
+    monkeypatch.setattr(relay, "RELAY_SPREAD_TRIES", 0)
+    with pytest.raises(MovesRefusedError, match="backing off once it is let go"):
+        pass_it()
+    assert [at for at, _ in asked] == first
+
+
+def test_spots_are_asked_nearest_first_then_spread_from_the_refused() -> None:
+    spots = [(7.75 + 0.02 * i, 3.07) for i in range(12)]  # 2 cm apart
+    refused: list[tuple[float, float]] = []
+    asked = []
+    for spot in relay._asked(spots, refused):
+        asked.append(spot)
+        refused.append(spot)  # every spot asked is refused
+    spread = math.ceil(relay.RELAY_SPREAD / 0.02 - 1e-9)  # in grid steps
+    tail = list(range(relay.RELAY_MOVES_TRIES - 1 + spread, len(spots), spread))
+    assert asked == [spots[i] for i in [*range(relay.RELAY_MOVES_TRIES), *tail]]
