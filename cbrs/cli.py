@@ -51,7 +51,7 @@ from cbrs.output import (
     term_text,
 )
 from cbrs.settings import SETTINGS, setting
-from cbrs.sparql_hints import explain_syntax_error
+from cbrs.sparql_hints import explain_syntax_error, one_line_up, prologue, store_prefixes_used
 
 # Commands whose modules import numpy, networkx, the composer or the web server (most of a second at
 # start-up): each is imported when it runs or shows its own help. ``cbrs --help`` lists them from the
@@ -87,9 +87,10 @@ _LAZY_COMMANDS: dict[str, tuple[str, str, str]] = {
 
 
 _DECLARED_NAMES_ONLY = frozenset({"serve", "query"})
-"""Commands that print and take names with the declared prefixes only: the server's threads name IRIs
-for their clients, and a query's text declares its own prefixes (the endpoint knows only cbrs's). A
-named query's --bind values are names typed like any command's, so they take the derived ones too."""
+"""Commands that print names with the declared prefixes only: the server's threads name IRIs for their
+clients, and a query's rows are printed as the endpoint gives them. A query's text may still use the
+store's derived prefixes (declared above it when it uses them), and a named query's --bind values are
+names typed like any command's, so they take the derived ones too."""
 
 _ARGS = "cbrs.subcommand_args"  # ctx.meta: the subcommand's arguments, as typed
 
@@ -492,10 +493,15 @@ def query(
                 f"this is a SPARQL update ({update.group(1).upper()}); cbrs query runs queries only: "
                 "run it with cbrs update (or send it to /update of cbrs serve, with its update token)"
             )
+        # the names cbrs prints for this store (lab4:Trolley1) may be written: their derived prefixes are
+        # declared above the text when it uses them and declares them not (from the store's IRIs only)
+        names = StoreNames(lambda: app.kb)
+        added = store_prefixes_used(body, lambda: names.prefixes)
         try:
-            result = app.kb.query(body)
+            result = app.kb.query(prologue(added) + body)
         except QuerySyntaxError as error:  # a prefix nobody declared: said plainly, as the endpoint does
-            explained = explain_syntax_error(error, body, "query")
+            counted = one_line_up(error, body) if added else error
+            explained = explain_syntax_error(counted, body, "query", names.prefixes)
             if explained is error:
                 raise
             raise explained from error

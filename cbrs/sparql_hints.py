@@ -6,6 +6,9 @@ have read ("expected one of Prefix not found, ['%'], ...") or, in a subject, "ex
 endpoint, the bridge's ``/cbrs/query`` and ``cbrs query`` put the reason in front: what the text is and
 where to send it, or which prefix is undeclared and the nearest cbrs declares. The text is only read
 here, never run: the parser still decides what is valid.
+
+``cbrs query`` and the browser's SPARQL editor also declare, above a query, the store's derived prefixes
+it uses (``lab4:``, which they print): :func:`store_prefixes_used`.
 """
 
 from __future__ import annotations
@@ -13,6 +16,7 @@ from __future__ import annotations
 import difflib
 import re
 from collections import Counter
+from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass
 from typing import Literal
 
@@ -20,7 +24,17 @@ from cbrs.kb.errors import QuerySyntaxError
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.sparql_lexemes import HIDING
 
-__all__ = ["FORMS", "TOKENS", "explain_syntax_error", "first_keyword", "operation_kind", "undeclared_prefix"]
+__all__ = [
+    "FORMS",
+    "TOKENS",
+    "explain_syntax_error",
+    "first_keyword",
+    "one_line_up",
+    "operation_kind",
+    "prologue",
+    "store_prefixes_used",
+    "undeclared_prefix",
+]
 
 TOKENS = re.compile(
     r'(?P<iri><[^<>"{}|^`\\\x00-\x20]*>)|'
@@ -36,6 +50,7 @@ FORMS = frozenset({"SELECT", "CONSTRUCT", "DESCRIBE", "ASK"})
 _UPDATE_WORDS = frozenset({"INSERT", "DELETE", "LOAD", "CLEAR", "CREATE", "DROP", "COPY", "MOVE", "ADD", "WITH"})
 _PROLOGUE_WORDS = frozenset({"PREFIX", "BASE", "VERSION"})
 _ERROR_AT = re.compile(r"error at (\d+:\d+)(?::\s*)?")
+_POSITION = re.compile(r"\berror at (\d+):(\d+)")
 
 
 def first_keyword(text: str) -> str | None:
@@ -56,9 +71,10 @@ def operation_kind(text: str) -> Literal["query", "update"] | None:
     return "update" if word in _UPDATE_WORDS else None
 
 
-def undeclared_prefix(text: str) -> str | None:
-    """The first prefix ``text`` uses that neither its own ``PREFIX`` lines nor cbrs's table declare."""
-    found = undeclared_prefixes(text)
+def undeclared_prefix(text: str, known: Collection[str] = ()) -> str | None:
+    """The first prefix ``text`` uses that neither its own ``PREFIX`` lines nor cbrs's table (nor ``known``)
+    declare."""
+    found = [prefix for prefix in undeclared_prefixes(text) if prefix not in known]
     return found[0] if found else None
 
 
@@ -82,10 +98,56 @@ def undeclared_prefixes(text: str) -> list[str]:
     return [prefix for prefix in used if prefix not in declared]
 
 
-def explain_syntax_error(error: QuerySyntaxError, text: str, expected: Literal["query", "update"]) -> QuerySyntaxError:
+def store_prefixes_used(text: str, table: Callable[[], Mapping[str, str]]) -> dict[str, str]:
+    """The prefixes of ``table`` (a store's derived prefixes, :mod:`cbrs.kb.derived_prefixes`) that ``text``
+    uses and does not declare itself, in the order it uses them: what to declare above it, so that the names
+    cbrs prints for the store (``lab4:Trolley1``) may be written in a query for it. ``table`` is read only
+    when ``text`` uses a prefix nobody declares. A namespace that is no plain IRI is left out: the prologue
+    is written from the store's IRIs, and nothing typed is put into it."""
+    wanted = undeclared_prefixes(text)
+    found = table() if wanted else {}
+    return {
+        prefix: found[prefix]
+        for prefix in wanted
+        if prefix in found and _PREFIX_NAME.fullmatch(prefix) and _PLAIN_IRI.fullmatch(found[prefix])
+    }
+
+
+def prologue(prefixes: Mapping[str, str]) -> str:
+    """``PREFIX`` declarations of ``prefixes`` on one line, for :func:`store_prefixes_used`'s prefixes: the
+    parser's line numbers are then off by one (:func:`one_line_up`); empty for none."""
+    if not prefixes:
+        return ""
+    return " ".join(f"PREFIX {prefix}: <{namespace}>" for prefix, namespace in prefixes.items()) + "\n"
+
+
+def one_line_up(error: QuerySyntaxError, text: str) -> QuerySyntaxError:
+    """``error`` of ``text`` run under a one-line :func:`prologue`, its ``error at LINE:COLUMN`` counted
+    in ``text`` as written."""
+    if type(error) is not QuerySyntaxError:
+        return error
+
+    def up(match: re.Match[str]) -> str:
+        return f"error at {max(int(match.group(1)) - 1, 1)}:{match.group(2)}"
+
+    return QuerySyntaxError(text, _POSITION.sub(up, error.message, count=1))
+
+
+_PREFIX_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_-]*")  # the derived prefixes' form (kb.derived_prefixes)
+_PLAIN_IRI = re.compile(r'[^<>"{}|^`\\\x00-\x20]+')  # SPARQL's IRIREF, without its brackets
+
+
+def explain_syntax_error(
+    error: QuerySyntaxError,
+    text: str,
+    expected: Literal["query", "update"],
+    known: Mapping[str, str] | None = None,
+) -> QuerySyntaxError:
     """``error`` with a plain reason in front where the parser's list of expected tokens hides it: an
     update sent as a query (or the other way round), a misspelt first keyword, a prefix nobody declared,
-    a bracket closed by the wrong kind, or a text that ends inside brackets."""
+    a bracket closed by the wrong kind, or a text that ends inside brackets. ``known`` are prefixes the
+    text was run with besides cbrs's (a store's derived prefixes): not undeclared, and offered for a
+    misspelt one with their namespace."""
     if type(error) is not QuerySyntaxError:  # QueryTooComplexError and the like say what they mean
         return error
     at = _ERROR_AT.search(error.message)
@@ -107,17 +169,20 @@ def explain_syntax_error(error: QuerySyntaxError, text: str, expected: Literal["
         return QuerySyntaxError(
             text, f"{where}{word!r} begins no SPARQL {expected}: did you mean {close[0]}? (the parser: {said})"
         )
-    prefix = undeclared_prefix(text)
+    derived = known or {}
+    prefix = undeclared_prefix(text, derived)
     if prefix is not None:
         # Oxigraph says "Prefix not found" among the tokens it expected, or (in a subject) nothing of it
-        close = difflib.get_close_matches(prefix, PREFIXES, n=1)
-        if close:
-            known = f"did you mean '{close[0]}:'?"
+        close = difflib.get_close_matches(prefix, [*PREFIXES, *derived], n=1)
+        if close and close[0] in derived:  # the store's: the declaration is known
+            hint = f"did you mean '{close[0]}:' (PREFIX {close[0]}: <{derived[close[0]]}>, derived for this store)?"
+        elif close:
+            hint = f"did you mean '{close[0]}:'?"
         elif "Prefix not found" in said:
-            known = "cbrs declares " + ", ".join(f"{p}:" for p in PREFIXES)
+            hint = "cbrs declares " + ", ".join(f"{p}:" for p in PREFIXES)
         else:
-            known = f"the parser: {said}"
-        reason = f"the prefix '{prefix}:' is not declared: add PREFIX {prefix}: <IRI>; {known}"
+            hint = f"the parser: {said}"
+        reason = f"the prefix '{prefix}:' is not declared: add PREFIX {prefix}: <IRI>; {hint}"
         return QuerySyntaxError(text, where + reason)
     nesting = _nesting(text)
     if nesting.wrong is not None and (at is None or _offset(text, at.group(1)) >= nesting.wrong.closed_at):
