@@ -374,7 +374,10 @@ def refusal_before_world(
     if optimist.compose(task, belief=True).plan is not None:
         return None
     first = composer.compose(task)
-    composition = _runnable(kb, composer.config, task, first, runnable, belief=False, why_not=why_not)
+    ads = composer.advertisements
+    composition = _runnable(
+        kb, composer.config, task, first, runnable, belief=False, why_not=why_not, advertisements=ads
+    )
     if composition.plan is not None:  # the map alone offers more than the optimist was told: go and look
         return None
     return RunResult(composition, None)
@@ -473,6 +476,7 @@ def _runnable(
     passed: Mapping[str, str] | None = None,
     belief: bool = True,
     why_not: Callable[[Sequence[Advertisement]], Mapping[str, str]] | None = None,
+    advertisements: Sequence[Advertisement] | None = None,
 ) -> CompositionResult:
     """``composition`` without the alternatives the environment cannot run; or, when a step's component
     is one it does not implement (the store advertises services the simulation does not perform,
@@ -482,7 +486,8 @@ def _runnable(
     (component -> why): a remote one whose calls timed out would make the run wait its timeout again
     (``actions.breaker``). ``belief``: compose again from the belief graph as well as the map (as
     ``composition`` was), else from the map alone. ``why_not``: why the environment has no
-    implementation of some advertisements, where it knows (else :func:`_cannot_run` says)."""
+    implementation of some advertisements, where it knows (else :func:`_cannot_run` says).
+    ``advertisements``: the store's, if the caller has just read them (else read here)."""
     plan = composition.plan
     passed = passed or {}
     if plan is None:
@@ -496,9 +501,9 @@ def _runnable(
             for step in plan.steps
         )
         return composition if steps == plan.steps else replace(composition, plan=replace(plan, steps=steps))
-    advertisements = kb.advertisements()
+    advertisements = kb.advertisements() if advertisements is None else advertisements
     missing = frozenset(ad.iri for ad in advertisements if ad.iri not in registry) | frozenset(passed)
-    again = _compose(kb, config, task, avoid | missing, belief)
+    again = _compose(kb, config, task, avoid | missing, belief, advertisements)
     if again.plan is not None:
         return again
     # Say which components the first plan wanted: "no component provides" alone hid a registered one.
@@ -606,13 +611,19 @@ def _cannot_run(ad: Advertisement) -> str:
 
 
 def _compose(
-    kb: KnowledgeBase, config: ComposeConfig, task: str, avoid: frozenset[str], belief: bool = True
+    kb: KnowledgeBase,
+    config: ComposeConfig,
+    task: str,
+    avoid: frozenset[str],
+    belief: bool = True,
+    advertisements: Sequence[Advertisement] | None = None,
 ) -> CompositionResult:
     """Compose ``task`` afresh from the belief (``belief``; else the map alone), over every advertisement
-    but those in ``avoid``."""
+    (``advertisements``, if just read) but those in ``avoid``."""
     if not avoid:
-        return Composer(kb, config).compose(task, belief=belief)
-    kept = [ad for ad in kb.advertisements() if ad.iri not in avoid]
+        return Composer(kb, config, advertisements=advertisements).compose(task, belief=belief)
+    found = kb.advertisements() if advertisements is None else advertisements
+    kept = [ad for ad in found if ad.iri not in avoid]
     return Composer(kb, config, advertisements=kept).compose(task, belief=belief)
 
 

@@ -456,7 +456,8 @@ def run(
         no_plan = refusal_before_world(app.kb, iri, runnable, composer, why_not)
         if no_plan is not None:
             wall = time.perf_counter() - start
-            _say_refused(app.kb, no_plan, before, seed, as_json, wall, bridged=transport is not None)
+            bridged = transport is not None
+            _say_refused(app.kb, no_plan, before, seed, as_json, wall, bridged, composer.advertisements)
         world = held.enter_context(open_world(seed=seed, gui=gui, semantic_map=SemanticMap.read(app.kb)))
         if transport is not None:  # devices' programs read this world's sensors on the bridge until it ends
             try:
@@ -534,7 +535,14 @@ def run(
 
 
 def _say_refused(
-    kb: KnowledgeBase, result: RunResult, registry: Registry, seed: int, as_json: bool, wall: float, bridged: bool
+    kb: KnowledgeBase,
+    result: RunResult,
+    registry: Registry,
+    seed: int,
+    as_json: bool,
+    wall: float,
+    bridged: bool,
+    advertisements: Sequence[Advertisement],
 ) -> NoReturn:
     """Say a run has no plan, as a run that built the world says it (nothing simulated), and exit 1."""
     if as_json:
@@ -544,13 +552,15 @@ def _say_refused(
         click.echo(json.dumps(found, indent=2))
     else:
         click.echo(run_text(result, 0.0, wall))
-    _note_unreached(kb, registry, bridged)
+    _note_unreached(kb, registry, bridged, advertisements)
     raise SystemExit(1)
 
 
-def _note_unreached(kb: KnowledgeBase, registry: Registry, bridged: bool) -> None:
+def _note_unreached(
+    kb: KnowledgeBase, registry: Registry, bridged: bool, advertisements: Sequence[Advertisement] | None = None
+) -> None:
     """After a run that did not succeed: name the components in other processes it could not call."""
-    unreached = [] if bridged else _live_unreached(kb, registry)
+    unreached = [] if bridged else _live_unreached(kb, registry, advertisements)
     if unreached:
         kind = "is a component" if len(unreached) == 1 else "are components"
         click.echo(
@@ -592,10 +602,14 @@ def _bridge(url: str) -> BridgeClient:
         raise click.BadParameter(str(error), param_hint="--bridge") from None
 
 
-def _live_unreached(kb: KnowledgeBase, registry: Registry) -> list[str]:
+def _live_unreached(
+    kb: KnowledgeBase, registry: Registry, advertisements: Sequence[Advertisement] | None = None
+) -> list[str]:
     """The advertisements invoked through a bridge service (components in other processes) that the run
-    had no implementation of: what ``--bridge`` would have let it call."""
-    return sorted(ad.iri for ad in kb.advertisements() if ad.iri not in registry and ad.bridge_port is not None)
+    had no implementation of: what ``--bridge`` would have let it call (``advertisements``: the store's,
+    if just read)."""
+    found = kb.advertisements() if advertisements is None else advertisements
+    return sorted(ad.iri for ad in found if ad.iri not in registry and ad.bridge_port is not None)
 
 
 def display_problem(environ: dict[str, str] | os._Environ[str]) -> str | None:
