@@ -51,6 +51,7 @@ from cbrs.actions.model import ActionLibrary, Task, resolve_task
 from cbrs.actions.plan import Binding, Plan, PlanStep, Source
 from cbrs.actions.progression import Clobbered, progress_parts
 from cbrs.actions.search import SearchTrace, bidirectional_search
+from cbrs.actions.undeclared_terms import described
 from cbrs.actions.unmet import Unsatisfied
 from cbrs.kb import Advertisement, KnowledgeBase, Requirement, Statement
 from cbrs.kb.namespaces import GraphName, shorten
@@ -663,7 +664,8 @@ class Composer:
         if not missing:
             return unsatisfied
         near = tuple((c, found) for c in missing if (found := nearest_term(c, self.index.nodes(), 0.6)) is not None)
-        return replace(unsatisfied, undeclared=missing, near=near)
+        reason = replace(unsatisfied, undeclared=missing, near=near)
+        return described(reason, requirement, self.index, self.kb, self.advertisements)  # a thing, or a new class
 
 
 def store_plan(kb: KnowledgeBase, plan: Plan) -> None:

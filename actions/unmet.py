@@ -32,6 +32,8 @@ class Unsatisfied:
     out_of_area: tuple[tuple[str, str], ...] = ()  # (component, why): provides it, but not where it is needed
     provided: tuple[tuple[str, str], ...] = ()  # (component, effect): what is provided about the need's subject
     deleted_by: tuple[str, ...] = ()  # components whose delete effect undoes it before it is needed
+    individuals: tuple[tuple[str, tuple[str, ...]], ...] = ()  # (undeclared term, its classes): a thing of the map
+    superclasses: tuple[tuple[str, str], ...] = ()  # (undeclared class, the class its use suggests declaring it under)
 
     def text(self) -> str:
         found = self._text()
@@ -72,17 +74,28 @@ class Unsatisfied:
         """What to register or state so that this need is met (first, a class to declare: no component
         can be matched against a class the ontology does not have)."""
         if self.undeclared:
-            names = ", ".join(shorten(c) for c in self.undeclared)
-            example = shorten(self.undeclared[0])
-            meant = "; ".join(f"{shorten(typed)}: did you mean {shorten(known)}?" for typed, known in self.near)
-            return (
-                f"{names} {'is no class' if len(self.undeclared) == 1 else 'are no classes'} of the ontology"
-                f"{f' ({meant})' if meant else ''}: "
-                f"declare {'it' if len(self.undeclared) == 1 else 'them'} under a class the components know "
-                f"(e.g. {example} rdfs:subClassOf home:PersonalItem, loaded into the ontology graph), "
-                f"or {self._remedy()}"
-            )
+            things = dict(self.individuals)
+            said = [_an_individual(term, things[term]) for term in self.undeclared if term in things]
+            classes = [term for term in self.undeclared if term not in things]
+            if classes:
+                said.append(self._no_classes(classes))
+            return f"{'; '.join(said)}; or {self._remedy()}"
         return self._remedy()
+
+    def _no_classes(self, classes: list[str]) -> str:
+        """Terms that are nothing of the ontology: declare them, under the class their use suggests."""
+        names = ", ".join(shorten(c) for c in classes)
+        meant = "; ".join(
+            f"{shorten(typed)}: did you mean {shorten(known)}?" for typed, known in self.near if typed in classes
+        )
+        example, above = shorten(classes[0]), dict(self.superclasses).get(classes[0])
+        under = f"rdfs:subClassOf {shorten(above)}" if above else "rdfs:subClassOf the class it is a kind of"
+        return (
+            f"{names} {'is no class' if len(classes) == 1 else 'are no classes'} of the ontology"
+            f"{f' ({meant})' if meant else ''}: "
+            f"declare {'it' if len(classes) == 1 else 'them'} under a class the components know "
+            f"(e.g. {example} {under}, loaded into the ontology graph)"
+        )
 
     def _remedy(self) -> str:
         if self.deleted_by and self.cycle:
@@ -134,6 +147,16 @@ class Unsatisfied:
             "provided": [{"component": component, "effect": effect} for component, effect in self.provided],
             "deleted_by": list(self.deleted_by),
         }
+
+
+def _an_individual(term: str, classes: tuple[str, ...]) -> str:
+    """A term that is a thing of the map, named where a class belongs: name its class."""
+    of = " or ".join(shorten(c) for c in classes)
+    return (
+        f"{shorten(term)} is a thing of the map (an individual of {of.replace(' or ', ' and ')}), not a class: "
+        f"a task's goals and inputs name classes, and a run finds the things of the map of those classes "
+        f"(did you mean {of}?)"
+    )
 
 
 __all__ = ["GOAL", "Unsatisfied"]
