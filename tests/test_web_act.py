@@ -347,8 +347,10 @@ def test_the_event_and_camera_streams_follow_one_run_and_end_by_themselves(live:
     camera.close()
     assert not runner._listeners[1:] and not runner._frame_listeners  # both unsubscribed (the event log stays)
     assert max(seen) > 2 and seen == sorted(seen)
-    still = client.get("/camera.jpg")
-    assert still.mimetype == "image/jpeg" and int(still.headers["X-Frame"]) == max(seen)
+    still, latest = client.get("/camera.jpg"), runner.frame()
+    assert latest is not None and still.mimetype == "image/jpeg"
+    # the latest frame; the stream may have ended idle before it came (frames > 3 s apart under load)
+    assert int(still.headers["X-Frame"]) == latest.number >= max(seen)
 
 
 def test_the_steps_of_a_new_plan_follow_the_old_plans_steps() -> None:
