@@ -52,8 +52,14 @@ def home(app: App, drawing: Path | None, width: int, browser: str | None, as_jso
         written = str(drawing)
         entries = [entry.to_dict() for entry in picture.entries]
     if as_json:
-        said = {"verdict": found.verdict, "counts": found.counts(), "rooms": _rooms(found), "drawing": written}
+        said: dict[str, object] = {
+            "verdict": found.verdict,
+            "counts": found.counts(),
+            "rooms": _rooms(found),
+            "drawing": written,
+        }
         said["people"] = found.people()
+        said["warnings"] = found.warnings()
         said["persons"] = (
             [c.to_dict() for c in people_check(found.semantic_map)] if found.semantic_map is not None else []
         )
@@ -102,6 +108,7 @@ def _text(found: HomeSurvey, written: str | None) -> str:
     if not rooms:
         lines.append(f"  {NO_ROOMS}")
     lines.append(f"people: {found.people()}")
+    lines += [f"warning: {warning}" for warning in found.warnings()]
     moved = [iri for iri in found.believed if iri in smap.objects or iri in smap.robots or iri in smap.people]
     if moved:
         lines.append(f"the world graph places {len(moved)} of its things after a run: a drawing shows those that moved")

@@ -49,7 +49,7 @@ from cbrs.home_canvas import (
 )
 from cbrs.kb.camera_view import floor_view
 from cbrs.kb.errors import KnowledgeBaseError
-from cbrs.kb.home_check import check_home
+from cbrs.kb.home_check import check_home, undocked_supports
 from cbrs.kb.knowledge_base import KnowledgeBase
 from cbrs.kb.namespaces import RDFS, shorten
 from cbrs.kb.person_choice import look_alikes, shirt_clashes
@@ -160,6 +160,13 @@ class HomeSurvey:
     def counted(self) -> list[str]:
         """:meth:`counts` in words: "3 rooms", "1 piece of furniture", "1 person"."""
         return [_counted(n, name) for name, n in self.counts().items()]
+
+    def warnings(self) -> list[str]:
+        """What the home check lets through but a task may trip on, in words: furniture that holds objects
+        and has no docking pose (kb.home_check.undocked_supports)."""
+        if self.semantic_map is None:
+            return []
+        return [undocked.said for undocked in undocked_supports(self.semantic_map)]
 
     def people(self) -> str | None:
         """Who lives in the home and what that allows, in words (None when the map cannot be read): a home

@@ -11,6 +11,7 @@ built: the reader and the checks work on the store."""
 
 from __future__ import annotations
 
+import json
 from collections.abc import Iterator
 from pathlib import Path
 from types import SimpleNamespace
@@ -19,7 +20,9 @@ import pyoxigraph as ox
 import pytest
 from click.testing import CliRunner
 
+from cbrs.app import App
 from cbrs.cli import cli
+from cbrs.cli_home import home
 from cbrs.home_plan import survey
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.home_check import NoDockingPoseError, Undocked, check_home, docked_place, undocked_supports
@@ -137,6 +140,21 @@ def test_a_trolley_holding_the_torch_without_a_docking_pose_is_built_and_warned_
     assert undocked_supports(smap) == [Undocked(LAB + "Trolley1", (LAB + "Torch1",))]
     said = undocked_supports(smap)[0].said
     assert said.startswith("Trolley1 holds Torch1 and has no home:dockingPose")
+
+
+def test_cbrs_home_and_the_home_page_warn_of_the_trolley_without_a_docking_pose(undocked: KnowledgeBase) -> None:
+    """A warning, not a refusal: the text, the JSON and /home.json say it; the page shows it."""
+    runner = CliRunner()
+    text = runner.invoke(home, [], obj=App(":memory:", undocked))
+    assert text.exit_code == 0, text.output
+    assert "warning: Trolley1 holds Torch1 and has no home:dockingPose" in text.output
+    said = json.loads(runner.invoke(home, ["--json"], obj=App(":memory:", undocked)).output)
+    assert said["verdict"] == "ok" and [w.split(":")[0] for w in said["warnings"]] == [
+        "Trolley1 holds Torch1 and has no home"
+    ]
+    client = create_app(SparqlService(undocked, EndpointConfig(update_token=TOKEN, isolate=False))).test_client()
+    assert client.get("/home.json").get_json()["warnings"] == said["warnings"]
+    assert "Trolley1 holds Torch1 and has no home:dockingPose" in client.get("/home").get_data(as_text=True)
 
 
 def test_the_bundled_home_holds_nothing_on_a_support_without_a_docking_pose() -> None:

@@ -34,6 +34,7 @@ def home() -> Page:
         "counts": found.counts(),
         "counted": found.counted(),
         "people": found.people(),
+        "warnings": found.warnings(),
         "persons": [],
         "things": [],
         "picture": None,
