@@ -28,6 +28,7 @@ from cbrs.actions.replanning import Failure, FailureMemory, ReplanPolicy
 from cbrs.kb import Advertisement, KnowledgeBase, NotFoundError, Requirement, Statement
 from cbrs.kb.namespaces import HOME, shorten
 from cbrs.kb.semantic_map import UnresolvedDesignatorError
+from cbrs.kb.store import Term
 from cbrs.reasoner.taxonomy import ROOT, TaxonomyIndex
 
 
@@ -638,19 +639,21 @@ def _check_grounded(kb: KnowledgeBase, index: TaxonomyIndex, plan: Plan) -> None
 
 
 def ungrounded(
-    kb: KnowledgeBase, index: TaxonomyIndex, plan: Plan
+    kb: KnowledgeBase, index: TaxonomyIndex, plan: Plan, facts: Sequence[Mapping[str, Term]] | None = None
 ) -> tuple[UnresolvedDesignatorError | UngroundedGoalError, ...]:
     """Why :func:`run_task` refuses ``plan`` before anything moves for want of things in the world: each
     class of thing the task names that the world should hold and does not (:func:`_missing`), by the
     store alone (the map, and the belief). In a goal: a place the home lacks (a dish rack) named by the
     goal alone was planned towards the object's own place, and the arm carried the cup there. In an
     input, whether a step takes it or not (the environment designates only those the plan uses): a
-    suction cup no robot has was ignored, and the pen fetched by a gripper. ``cbrs plan`` notes them all."""
+    suction cup no robot has was ignored, and the pen fetched by a gripper. ``cbrs plan`` notes them all.
+    ``facts``: the rows of ``map_facts`` when the caller has read them already."""
     try:
         requirement = kb.description(plan.requirement)
     except NotFoundError:
         requirement = None
-    placed = {row["thing"].value for row in kb.select("map_facts") if row["property"].value in _WHERE}
+    rows = kb.select("map_facts") if facts is None else facts
+    placed = {row["thing"].value for row in rows if row["property"].value in _WHERE}
     known: dict[str, bool] = {}  # by class: whether it is missing (a goal names the classes inputs give)
 
     def missing(concept: str) -> bool:

@@ -262,12 +262,13 @@ def _unmapped(kb: KnowledgeBase, composer: Composer, plan: Plan) -> _Unmapped:
     """What of ``plan`` ``cbrs run`` would plan without or refuse for what the map lacks: the things from
     the store alone; the cameras with the [sim] part only (its skills say which components look with a
     camera)."""
-    things = ungrounded(kb, composer.index, plan)
+    facts = kb.select("map_facts")  # read once for both
+    things = ungrounded(kb, composer.index, plan, facts)
     cameras: list[tuple[PlanStep, str, str, bool]] = []
     if installed("sim"):
         from cbrs.sim.run_checks import map_cameras, unplaced_cameras
 
-        placed = map_cameras(kb)
+        placed = map_cameras(kb, facts)
         used = {step.component for step in plan.steps}
         unplaced = unplaced_cameras(kb, [ad for ad in composer.advertisements if ad.iri in used], placed)
         cameras = [(step, *unplaced[step.component]) for step in plan.steps if step.component in unplaced]

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Callable, Collection, Iterable, Mapping
+from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
 from dataclasses import replace
 from typing import Any
 
@@ -22,6 +22,7 @@ from cbrs.kb.model import Advertisement
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.person_choice import person_for
 from cbrs.kb.semantic_map import MapObject, NotGraspableError, Person, Thing, local_name
+from cbrs.kb.store import Term
 from cbrs.sim import sight
 from cbrs.sim.arm_choice import who_loads
 from cbrs.sim.context import SimContext, SkillFailed
@@ -473,10 +474,11 @@ def own_camera(ad: Advertisement) -> str | None:
     return ad.device_name or ""
 
 
-def map_cameras(kb: KnowledgeBase) -> set[str]:
+def map_cameras(kb: KnowledgeBase, facts: Sequence[Mapping[str, Term]] | None = None) -> set[str]:
     """The names of the cameras the world will have, from the store alone: each thing the map gives a field
-    of view is a camera (``SemanticMap.cameras``), and the world builds one for each and no other."""
-    rows = kb.select("map_facts")
+    of view is a camera (``SemanticMap.cameras``), and the world builds one for each and no other.
+    ``facts``: the rows of ``map_facts`` when the caller has read them already."""
+    rows = kb.select("map_facts") if facts is None else facts
     return {local_name(row["thing"].value) for row in rows if row["property"].value == HOME + "fieldOfView"}
 
 
