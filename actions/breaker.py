@@ -45,6 +45,7 @@ __all__ = [
     "ServiceCalls",
     "busy",
     "calls_of",
+    "late_answers_awaited",
     "passed_over",
     "settle_late_answers",
 ]
@@ -223,6 +224,11 @@ class ServiceCalls:
             self._settling = [entry for entry in self._settling if not entry[2].is_set()]
             return sorted({service for service, _, _ in self._settling})
 
+    def awaited(self) -> list[str]:
+        """The services whose calls given up are still out, their answers awaited."""
+        with self._lock:
+            return sorted({service for service, _, settled in self._settling if not settled.is_set()})
+
     def busy(self, service: str, now: float) -> str:
         with self._lock:
             entry = self._services.get(service)
@@ -366,6 +372,13 @@ def settle_late_answers(transport: _Transport, limit: float) -> list[str]:
     the door. The services still out after it (empty: none)."""
     table = _table(transport)
     return table.settle(time.monotonic(), limit) if table is not None else []
+
+
+def late_answers_awaited(transport: _Transport) -> list[str]:
+    """The services whose calls over ``transport`` were given up and may still answer: what
+    :func:`settle_late_answers` would wait for (a program says so before it waits)."""
+    table = _table(transport)
+    return table.awaited() if table is not None else []
 
 
 def _table(transport: _Transport) -> ServiceCalls | None:

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any, NoReturn
 
 import click
 
+from cbrs.actions.breaker import late_answers_awaited, settle_late_answers
 from cbrs.actions.components import Registry
 from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, Objective, PlanStatus, store_plan
 from cbrs.actions.errors import UngroundedGoalError
@@ -444,6 +445,7 @@ def run(
     with contextlib.ExitStack() as held:
         if transport is not None:
             held.callback(transport.close)
+            held.callback(_settle_late_answers, transport)  # before the close (a stack unwinds last first)
         # A task no plan could come of is refused before the world is built (a second or more of pybullet):
         # the world will implement what the simulation has skills for, but for components whose own camera
         # the map does not place (the world has a camera for each the map places, and no other).
@@ -601,6 +603,20 @@ def _bridge(url: str) -> BridgeClient:
         return BridgeClient(url, setting("update_token").resolve())
     except BridgeClosedError as error:
         raise click.BadParameter(str(error), param_hint="--bridge") from None
+
+
+def _settle_late_answers(transport: BridgeClient) -> None:
+    """Wait (``late_answer_wait``) for the actuators whose calls the run gave up to answer, so that what
+    they did is believed, before the connection closes and ends their calls unanswered; said on stderr."""
+    awaited = late_answers_awaited(transport)
+    wait = float(setting("late_answer_wait").resolve())
+    if not awaited or wait <= 0:
+        return
+    names = ", ".join(shorten(service) for service in awaited)
+    click.echo(f"waiting up to {wait:g} s for the answer of {names}, whose call was given up", err=True)
+    left = settle_late_answers(transport, wait)
+    if left:
+        click.echo(f"no answer from {', '.join(map(shorten, left))}: what it did is not believed", err=True)
 
 
 def _live_unreached(

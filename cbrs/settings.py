@@ -51,6 +51,13 @@ def _non_negative(text: str) -> int:
     return value
 
 
+def _non_negative_seconds(text: str) -> float:
+    value = float(text)
+    if not value >= 0:  # NaN too
+        raise ValueError(f"{text} must be a number of seconds, 0 or more")
+    return value
+
+
 def _flag(text: str) -> bool:
     word = text.strip().lower()
     if word in ("1", "true", "yes", "on"):
@@ -314,6 +321,14 @@ SETTINGS: tuple[Setting, ...] = (
         "1.2 MB of base64).",
         "CBRS_BRIDGE_MAX_MESSAGE_BYTES",
         _positive(int),
+    ),
+    Setting(
+        "late_answer_wait",
+        lambda: 30.0,
+        "Seconds cbrs run --bridge waits, once the run is over, for the answers of actuators whose calls it "
+        "gave up, so that what they did is believed (docs/reliability.md); 0: it does not wait.",
+        "CBRS_LATE_ANSWER_WAIT",
+        _non_negative_seconds,
     ),
     Setting(
         "component_lease",

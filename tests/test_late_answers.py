@@ -15,7 +15,9 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from click.testing import CliRunner
 
+from cbrs import cli_actions
 from cbrs.actions.answers import StoreClasses, check_designation
 from cbrs.actions.belief import BeliefState, Observation
 from cbrs.actions.breaker import calls_of, passed_over, settle_late_answers
@@ -26,6 +28,7 @@ from cbrs.actions.remote import RemoteComponent
 from cbrs.actions.remote_errors import RemoteCallError
 from cbrs.actions.runner import RunResult, run_task
 from cbrs.bridge_client import BridgeClient
+from cbrs.cli import cli
 from cbrs.component import Component
 from cbrs.kb import KnowledgeBase, Requirement, Statement
 from cbrs.kb.namespaces import PREFIXES, GraphName
@@ -247,16 +250,17 @@ def test_a_program_that_is_ending_can_wait_for_the_late_answers_first(kb: Knowle
 
 
 class Motor:
-    """The open service's handler: it waits for the test to let it answer (at most 5 s)."""
+    """The open service's handler: it waits for the test to let it answer (at most ``patience`` s)."""
 
     def __init__(self) -> None:
         self.answer: dict[str, Any] = {"doorStatus": {"@type": "home:Opened"}}
         self.release = threading.Event()
         self.calls = 0
+        self.patience = 5.0
 
     def __call__(self, request: dict[str, Any]) -> dict[str, Any]:
         self.calls += 1
-        self.release.wait(5.0)
+        self.release.wait(self.patience)
         return self.answer
 
 
@@ -362,3 +366,37 @@ def test_a_garbage_late_answer_over_the_bridge_changes_nothing(
     assert not result.succeeded and result.composition.plan is None  # the motor passed over: no plan
     assert _kept(server.kb) == bedroom.before_answer
     assert _door(server.kb) == [HOME + "Closed"]
+
+
+def test_cbrs_run_with_a_bridge_waits_for_the_late_answer_before_it_closes(
+    lab: tuple[Server, Motor], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The motor answers only once the run is over and the command waits (late_answer_wait): the answer is
+    believed; closing at once would have ended the call unanswered, the door believed closed."""
+    server, motor = lab
+    _believe(server.kb, CLOSED)
+    monkeypatch.setenv("CBRS_REMOTE_CALL_TIMEOUT", "2.5")  # the bridge ends the call at 5 s: the run is over by then
+    monkeypatch.setenv("CBRS_UPDATE_TOKEN", TOKEN)
+    motor.answer, motor.release, motor.calls, motor.patience = (
+        {"doorStatus": {"@type": "home:Opened"}},
+        threading.Event(),
+        0,
+        60.0,
+    )
+    waited = cli_actions.settle_late_answers
+
+    def settling(transport: BridgeClient, limit: float) -> list[str]:
+        motor.release.set()  # the run is over: the motor answers now
+        return waited(transport, limit)
+
+    monkeypatch.setattr(cli_actions, "settle_late_answers", settling)
+    try:
+        bridge = f"ws://127.0.0.1:{server.bridge_port}"
+        store = f"http://127.0.0.1:{server.http_port}"
+        done = CliRunner().invoke(cli, ["--store", store, "run", "OpenTheBedroomDoor", "--bridge", bridge])
+    finally:
+        motor.release.set()
+    assert motor.calls == 1, done.output
+    assert "waiting up to 30 s for the answer of" in done.stderr, done.output
+    assert "no answer from" not in done.stderr
+    assert eventually(lambda: _door(server.kb) == [HOME + "Opened"], 5.0), _door(server.kb)
