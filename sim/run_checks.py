@@ -38,6 +38,8 @@ from cbrs.sim.services import (
     SKILLS,
     WITH_PERSON,
     find_object_on_table,
+    infer_object_place,
+    kept_place,
     locate,
     recognise_by_colour,
     track,
@@ -172,12 +174,14 @@ class PlanChecks:
     def check(self, plan: Plan, values: Mapping[str, Any]) -> None:
         """Refuse ``plan`` with the first check's typed error (:class:`kb.person_choice.PersonError`,
         :class:`OutOfReachError`, :class:`PlaceCrowdedError`, :class:`sight.OutOfViewError`,
-        :class:`CannotLoadError`); nothing when every check passes."""
+        :class:`CannotLoadError`, :class:`kb.home_check.NoDockingPoseError`); nothing when every check
+        passes."""
         ads = {ad.iri: ad for ad in self.kb.advertisements()}  # read once: 23-26 ms each on the bundled store
         meant = self._people_of(plan, values, ads)  # a step needing a person the home cannot give (nobody, who?)
         self._check_reach(plan, values)
         self._check_sight(plan, values, ads, meant)
         self._check_loading(plan, values)
+        self._check_docks(plan, values, ads)
 
     def _estimate(self, obj: MapObject, support: Thing) -> ObjectEstimate:
         """Where the plan's checks take an object to be: where it is believed to be, else where the map
@@ -208,6 +212,20 @@ class PlanChecks:
                 except (SkillFailed, MovesRefusedError) as refused:
                     if not self._loads_nearby(estimate, model, dock):
                         raise CannotLoadError(step.component, obj.iri, str(refused)) from None
+
+    def _check_docks(self, plan: Plan, values: Mapping[str, Any], ads: Mapping[str, Advertisement]) -> None:
+        """Refuse a plan that sends the base to fetch an object standing only on furniture with no docking
+        pose (:func:`services.kept_place`), before anything moves: the run went as far as the step that
+        asks where the object is kept, and failed there."""
+        steps = {step.index: step for step in plan.steps}
+        for step in plan.steps:
+            ad = ads.get(step.component)
+            if ad is None or SKILLS.get(ad.service_name or "") is not infer_object_place:
+                continue
+            for name in sorted(task_inputs_of(step, steps)):
+                value = values.get(name)
+                if isinstance(value, dict) and str(value.get("@id")) in self.world.map.objects:
+                    kept_place(self.context, str(value["@id"]))
 
     def _loads_nearby(self, estimate: ObjectEstimate, model: ObjectModel, dock: Pose2D) -> bool:
         """Whether some arm could load the object were it LOADING_SLACK away from where it is believed to be

@@ -189,3 +189,30 @@ def test_inferring_where_the_torch_is_kept_names_the_trolley_and_its_missing_doc
         infer_object_place(ctx, {"object": {"@id": LAB + "Torch1"}}, "HomeServer01")
     assert "Torch1" in str(failed.value) and "Trolley1" in str(failed.value)
     assert "home:dockingPose" in str(failed.value)
+
+
+def test_fetching_the_torch_from_the_trolley_without_a_docking_pose_is_refused_before_anything_moves(
+    tmp_path: Path,
+) -> None:
+    """The run's checks ask where the object is kept before the base drives: the refusal names the trolley
+    and the docking pose it lacks, with nothing moved (it failed at the step that infers where the torch is
+    kept, after a localisation and a re-plan)."""
+    trolley = tmp_path / "trolley.ttl"
+    text = (EXAMPLES / "lab4_trolley.ttl").read_text(encoding="utf-8")
+    trolley.write_text(text.replace(" ;\n    home:dockingPose lab:Trolley1Dock .", " ."), encoding="utf-8")
+    store, runner = str(tmp_path / "store"), CliRunner()
+    loads = [
+        ("ontology", trolley),
+        ("map", trolley),
+        ("map", EXAMPLES / "lab4_trolley_camera_map.ttl"),
+        ("services", EXAMPLES / "lab4_trolley_camera.ttl"),
+        ("requirements", EXAMPLES / "lab4_fetch_my_torch.ttl"),
+    ]
+    for graph, path in loads:
+        loaded = runner.invoke(cli, ["--store", store, "load", "--graph", graph, str(path)])
+        assert loaded.exit_code == 0, loaded.output
+    done = runner.invoke(cli, ["--store", store, "run", "FetchMyTorch", "--seed", "0", "--json"])
+    assert done.exit_code == 1, done.output
+    said = json.loads(done.stdout)  # the answer of a refusal before anything moved: no steps, no seconds
+    assert said["status"] == "error" and said["error"].startswith("NoDockingPoseError"), said
+    assert "Trolley1 (home:isLocatedOn), which has no home:dockingPose" in said["error"], said
