@@ -4,16 +4,13 @@ over every advertisement, the run over those it can run. No simulation is run.""
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
-from typing import Any
 
 import pytest
-from click.testing import CliRunner
 
-from cbrs.cli import cli
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
+from tests.helpers_plan_cli import plan, planned
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "docs" / "examples"
 LAB = "https://example.org/lab#"
@@ -39,18 +36,6 @@ def store(tmp_path_factory: pytest.TempPathFactory) -> str:
     finally:
         kb.close()
     return location
-
-
-def plan(store: str, task: str, *more: str) -> tuple[int, str]:
-    result = CliRunner().invoke(cli, ["--store", store, "plan", task, "--no-store", *more])
-    return result.exit_code, result.output
-
-
-def planned(store: str, task: str) -> dict[str, Any]:
-    code, out = plan(store, task, "--json")
-    assert code == 0, out
-    found: dict[str, Any] = json.loads(out)
-    return found
 
 
 def test_a_plan_names_the_steps_the_simulation_has_no_skill_for(store: str) -> None:

@@ -5,18 +5,15 @@ not place, a thing the task names that the map does not hold. The run's own chec
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
-from typing import Any
 
 import pytest
-from click.testing import CliRunner
 
-from cbrs.cli import cli
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
 from cbrs.sim.run_checks import map_cameras, unplaced_cameras, without_camera
+from tests.helpers_plan_cli import plan, planned
 
 HOME, SVC = PREFIXES["home"], PREFIXES["svc"]
 DATA = Path(__file__).parent / "data" / "turtle_tasks_more"
@@ -36,18 +33,6 @@ def store(tmp_path_factory: pytest.TempPathFactory) -> str:
     finally:
         kb.close()
     return location
-
-
-def plan(store: str, task: str, *more: str) -> tuple[int, str]:
-    result = CliRunner().invoke(cli, ["--store", store, "plan", task, "--no-store", *more])
-    return result.exit_code, result.output
-
-
-def planned(store: str, task: str) -> dict[str, Any]:
-    code, out = plan(store, task, "--json")
-    assert code == 0, out
-    found: dict[str, Any] = json.loads(out)
-    return found
 
 
 def test_a_step_looking_with_a_camera_the_map_does_not_place_is_noted(store: str) -> None:
