@@ -11,16 +11,15 @@ from pathlib import Path
 import pyoxigraph as ox
 import pytest
 
-from cbrs.kb import KnowledgeBase, Store
+from cbrs.kb import KnowledgeBase
 from cbrs.kb.arm_bands import PANDA_SIDE_ARM, ArmBand
-from cbrs.kb.hands import CARRY_CORRIDOR, Hand, HandError, read_hands
+from cbrs.kb.hands import CARRY_CORRIDOR, Hand, HandError
 from cbrs.kb.loader import parse_file
 from cbrs.kb.namespaces import PREFIXES, GraphName
 from cbrs.kb.resources import ontology_dir
+from tests.helpers_hands import LAB, read_lab_hands
 
 HOME, WORLD = PREFIXES["home"], PREFIXES["world"]
-LAB = "http://example.org/lab#"
-PREFIX = f"@prefix home: <{HOME}> .\n@prefix lab: <{LAB}> .\n@prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .\n"
 BAND, MAP = ox.NamedNode(HOME + "sideGraspBand"), ox.NamedNode(PREFIXES["graph"] + "map")
 GEOMETRY = "home:jawOpening 0.085 ; home:palmDepth 0.04 ; home:fingerLength 0.05"
 
@@ -44,12 +43,7 @@ lab:RightHand a lab:LongArmGripper ; home:sideGraspBand [ a home:ArmBand ;
 
 
 def read(tmp_path: Path, models: str, robot: str = ROBOT) -> dict[str, Hand]:
-    kb = KnowledgeBase(Store.open(":memory:"))
-    kb.load([ontology_dir() / "core.ttl", ontology_dir() / "home.ttl"], graph="ontology")
-    for name, text, graph in (("models", models, "ontology"), ("robot", robot, "map")):
-        (tmp_path / f"{name}.ttl").write_text(PREFIX + text, encoding="utf-8")
-        kb.load([tmp_path / f"{name}.ttl"], graph=graph)
-    return read_hands(kb)
+    return read_lab_hands(tmp_path, models, robot)
 
 
 def test_a_grippers_corridor_and_bands_are_its_own_else_its_classes(tmp_path: Path) -> None:

@@ -8,14 +8,11 @@ from pathlib import Path
 
 import pytest
 
-from cbrs.kb import KnowledgeBase, Store
-from cbrs.kb.hands import PREGRASP_DISTANCE, Hand, HandError, read_hands
+from cbrs.kb.hands import PREGRASP_DISTANCE, Hand, HandError
 from cbrs.kb.namespaces import PREFIXES
-from cbrs.kb.resources import ontology_dir
+from tests.helpers_hands import LAB, read_lab_hands
 
 HOME = PREFIXES["home"]
-LAB = "http://example.org/lab#"
-PREFIX = f"@prefix home: <{HOME}> .\n@prefix lab: <{LAB}> .\n@prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .\n"
 
 MODELS = """
 lab:ParallelGripper rdfs:subClassOf home:Gripper ; home:pregraspDistance 0.12 .
@@ -36,12 +33,7 @@ lab:RightHand a lab:Robotiq2F85 ; home:jawOpening 0.05 .
 
 
 def read(tmp_path: Path, models: str, robot: str = ROBOT) -> dict[str, Hand]:
-    kb = KnowledgeBase(Store.open(":memory:"))
-    kb.load([ontology_dir() / "core.ttl", ontology_dir() / "home.ttl"], graph="ontology")
-    for name, text, graph in (("models", models, "ontology"), ("robot", robot, "map")):
-        (tmp_path / f"{name}.ttl").write_text(PREFIX + text, encoding="utf-8")
-        kb.load([tmp_path / f"{name}.ttl"], graph=graph)
-    return read_hands(kb)
+    return read_lab_hands(tmp_path, models, robot)
 
 
 def test_each_gripper_of_a_model_has_the_models_values_and_its_own_win(tmp_path: Path) -> None:
