@@ -1,7 +1,8 @@
 """Tasks started by clients of ``cbrs serve``: one run at a time in the simulated home, followed by events.
 
 A run composes the task, executes it in a fresh headless world and records its events; listeners (the
-rosbridge topics, the browser) receive every event as it happens, from the run's thread.
+rosbridge topics, the browser) receive every event as it happens, from the run's thread. A task no plan
+can come of ends ``no-plan`` before the world is built (:func:`refusal_in_home`, as ``cbrs run`` refuses it).
 
 The runner also keeps the ceiling camera's latest view (a JPEG and a counter): taken when a run starts
 and after every step that ends, or of the idle home when nothing has run yet. Frame listeners
@@ -17,7 +18,7 @@ import logging
 import threading
 import time
 from collections import OrderedDict
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Sequence
 from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -28,9 +29,12 @@ from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import expand, shorten
 
 if TYPE_CHECKING:
+    from cbrs.actions.composer import Composer
     from cbrs.actions.events import Event
     from cbrs.actions.remote import Transport
     from cbrs.actions.runner import RunResult
+    from cbrs.kb import Advertisement
+    from cbrs.kb.semantic_map import SemanticMap
     from cbrs.sim_sensors import SimSensors
 
 log = logging.getLogger("cbrs.tasks")
@@ -318,19 +322,7 @@ class TaskRunner:
 
     def _run(self, run: TaskRun) -> None:
         from cbrs.actions.composer import Composer
-        from cbrs.actions.executor import RunStatus
-        from cbrs.actions.faults import RandomFaults
-        from cbrs.actions.replanning import ReplanPolicy
         from cbrs.kb.semantic_map import SemanticMap
-        from cbrs.sim.components import SimEnvironment  # pybullet loads only when a task runs
-        from cbrs.sim.world import open_world
-
-        def follow(event: Event) -> None:
-            message = dict(event.message, run=run.id)
-            run.events.append({"topic": event.topic, **message})
-            self._emit(event.topic, message)
-            if event.topic == "/cbrs/task_progress" and message.get("event") in ("step_succeeded", "step_failed"):
-                self._capture(world, run.id)
 
         try:
             # The lock covers reading the taxonomy, actions and components as one view (an update cannot
@@ -340,30 +332,14 @@ class TaskRunner:
                 composer = Composer(self.kb)
                 _ = composer.pool  # built now, under the lock
                 semantic_map = SemanticMap.read(self.kb)
-            with open_world(seed=run.seed, semantic_map=semantic_map) as world, self._sensing(world):
-                self._capture(world, run.id)
-                environment = SimEnvironment(world, self.kb, self.transport() if self.transport else None)
-                policy = RandomFaults(run.seed, run.fault_rate) if run.fault_rate > 0 else None
-                result = run_task(
-                    self.kb,
-                    run.iri,
-                    environment,
-                    run.faults,
-                    composer,
-                    follow,
-                    fault_policy=policy,
-                    cancelled=run.cancel_requested.is_set,
-                    replan_policy=ReplanPolicy(max_repeats=run.repeat_failures),
-                )
-                found = result.to_dict()
-                found["sim_seconds"] = round(world.time, 3)
-            run.result = found
-            if result.report is None:
-                run.status = "no-plan"
-            elif result.report.status is RunStatus.CANCELLED:
-                run.status = "cancelled"
+            transport = self.transport() if self.transport else None
+            result = refusal_in_home(self.kb, run.iri, composer, transport)
+            if result is not None:  # no plan can come of it: said without building the world (nothing simulated)
+                found = {**result.to_dict(), "sim_seconds": 0.0}
             else:
-                run.status = "succeeded" if result.succeeded else "failed"
+                result, found = self._simulate(run, composer, semantic_map, transport)
+            run.result = found
+            run.status = _status(result)
         except Exception as error:  # a run must end with a status, whatever broke
             if isinstance(error, KnowledgeBaseError):  # refused on purpose (out of reach, ambiguous): one line
                 log.warning("task run %s refused: %s", run.id, error)
@@ -374,6 +350,42 @@ class TaskRunner:
             run.finished = time.time()
             run.done.set()
             self._emit(RUN_TOPIC, {"event": "run_finished", "run": run.id, "task": run.task, "status": run.status})
+
+    def _simulate(
+        self, run: TaskRun, composer: Composer, semantic_map: SemanticMap, transport: Transport | None
+    ) -> tuple[RunResult, dict[str, Any]]:
+        """Run ``run`` in a fresh world built from ``semantic_map``: its result, and that as JSON with the
+        simulated seconds."""
+        from cbrs.actions.faults import RandomFaults
+        from cbrs.actions.replanning import ReplanPolicy
+        from cbrs.sim.components import SimEnvironment  # pybullet loads only when a task runs
+        from cbrs.sim.world import open_world
+
+        def follow(event: Event) -> None:
+            message = dict(event.message, run=run.id)
+            run.events.append({"topic": event.topic, **message})
+            self._emit(event.topic, message)
+            if event.topic == "/cbrs/task_progress" and message.get("event") in ("step_succeeded", "step_failed"):
+                self._capture(world, run.id)
+
+        with open_world(seed=run.seed, semantic_map=semantic_map) as world, self._sensing(world):
+            self._capture(world, run.id)
+            environment = SimEnvironment(world, self.kb, transport)
+            policy = RandomFaults(run.seed, run.fault_rate) if run.fault_rate > 0 else None
+            result = run_task(
+                self.kb,
+                run.iri,
+                environment,
+                run.faults,
+                composer,
+                follow,
+                fault_policy=policy,
+                cancelled=run.cancel_requested.is_set,
+                replan_policy=ReplanPolicy(max_repeats=run.repeat_failures),
+            )
+            found = result.to_dict()
+            found["sim_seconds"] = round(world.time, 3)
+        return result, found
 
     def _sensing(self, world: Any) -> AbstractContextManager[Any]:
         """The simulation's sensors answering from ``world`` for the run (none offered: nothing to do)."""
@@ -446,6 +458,47 @@ def run_task(*args: Any, **kwargs: Any) -> RunResult:
     from cbrs.actions.runner import run_task as run
 
     return run(*args, **kwargs)
+
+
+def refusal_in_home(
+    kb: KnowledgeBase, task: str, composer: Composer, transport: Transport | None = None
+) -> RunResult | None:
+    """The no-plan answer a run of ``task`` in the simulated home gives, found before the world is built
+    (``actions.runner.refusal_before_world``, as ``cbrs run`` finds it); None when the world is needed.
+
+    The world will implement what the simulation has skills for and what ``transport`` reaches, but for
+    components whose own camera the map does not place. While the transport passes components over
+    (their calls timed out, ``actions.breaker``), the run's answer names them: the world is built, as before.
+    """
+    from cbrs.actions.breaker import passed_over
+    from cbrs.actions.runner import refusal_before_world
+    from cbrs.sim.components import implementations
+    from cbrs.sim.run_checks import map_cameras, without_camera
+
+    if transport is not None:
+        sessions = {iri: state.registered_by for iri, state in kb.liveness.states().items()}
+        if passed_over(transport, time.monotonic(), sessions):
+            return None
+    placed = map_cameras(kb)
+    ads = composer.advertisements
+    runnable = set(implementations(kb, transport=transport, advertisements=ads).names())
+    runnable -= set(without_camera(ads, placed))
+
+    def why_not(advertisements: Sequence[Advertisement]) -> dict[str, str]:
+        return without_camera(advertisements, placed)
+
+    return refusal_before_world(kb, task, runnable, composer, why_not)
+
+
+def _status(result: RunResult) -> str:
+    """A finished run's status from its result: no-plan, cancelled, succeeded or failed."""
+    from cbrs.actions.executor import RunStatus
+
+    if result.report is None:
+        return "no-plan"
+    if result.report.status is RunStatus.CANCELLED:
+        return "cancelled"
+    return "succeeded" if result.succeeded else "failed"
 
 
 def _jpeg(rgb: Any) -> bytes:
