@@ -67,7 +67,8 @@ def test_a_program_gets_the_run_in_json_and_its_location(
     assert answer.status_code == 202 and answer.mimetype == "application/json", answer.text[:200]
     started = answer.get_json()["started"]
     assert started["task"] == "FetchMyPen" and started["seed"] == 1
-    assert answer.headers["Location"] == f"/tasks/{started['id']}.json"
+    assert answer.headers["Location"] == f"/tasks/{started['id']}.json" == started["url"]
+    assert started["page"] == f"/tasks/{started['id']}"  # for a person to open
     _ended(runner, started["id"])
     status = client.get(answer.headers["Location"])
     assert status.status_code == 200 and status.get_json()["run"]["id"] == started["id"]

@@ -79,7 +79,7 @@ def tasks() -> Page:
     shown.status = 202
     shown.headers["Location"] = url_for("tasks.run_json" if wants_json() else "tasks.run", run_id=started.id)
     shown.title = f"Tasks: {started.id} started"
-    shown.data.update(_overview(form), started=_summary(started), message=f"{started.id} started: {started.task}")
+    shown.data.update(_overview(form), started=_started(started), message=f"{started.id} started: {started.task}")
     return shown
 
 
@@ -314,6 +314,16 @@ def _summary(found: TaskRun) -> dict[str, Any]:
     data.pop("result", None)
     data["faults"] = [short(f) for f in found.faults]
     data["url"] = url_for("tasks.run", run_id=found.id)
+    return data
+
+
+def _started(found: TaskRun) -> dict[str, Any]:
+    """A run just started: its ``url`` where this answer's ``Location`` points (the status JSON for a JSON
+    answer, the page for the page), and its ``page`` for a person."""
+    data = _summary(found)
+    data["page"] = data["url"]
+    if wants_json():
+        data["url"] = url_for("tasks.run_json", run_id=found.id)
     return data
 
 
