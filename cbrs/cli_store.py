@@ -1,11 +1,13 @@
 """The ``cbrs`` commands that keep a store over months: ``export`` and ``restore`` (:mod:`kb.backup`), and
-``update``, a SPARQL update with what it changed said graph by graph (:mod:`kb.update_report`)."""
+``update``, a SPARQL update with what it changed said graph by graph (:mod:`kb.update_report`), which
+takes the store's derived prefixes as ``cbrs query`` does (:func:`cbrs.sparql_hints.store_prefixes_used`)."""
 
 from __future__ import annotations
 
 import json
 import re
 import sys
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -17,12 +19,13 @@ from cbrs.app import App, pass_app
 from cbrs.cli_interrupts import HeldInterrupts
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.backup import DEFAULT, Backup, NotAnExportError, export_format, read_backup
+from cbrs.kb.derived_prefixes import StoreNames
 from cbrs.kb.errors import QuerySyntaxError, StoreEvaluationError, without_password
 from cbrs.kb.namespaces import PREFIXES, GraphName, shorten
 from cbrs.kb.sparql_lexemes import HIDING
 from cbrs.kb.store import refuse_inserted_blank_nodes
 from cbrs.output import ProgressLine
-from cbrs.sparql_hints import explain_syntax_error, operation_kind
+from cbrs.sparql_hints import explain_syntax_error, one_line_up, operation_kind, prologue, store_prefixes_used
 
 _GRAPH_HELP = "A graph to take (repeatable): " + ", ".join(g.value for g in GraphName) + ", or a full IRI."
 _FORMAT_CHOICE = click.Choice(["nquads", "trig"])
@@ -181,12 +184,17 @@ def update(app: App, text: str | None, update_file: Any, as_json: bool) -> None:
     if operation_kind(body) == "query":
         raise click.ClickException("this is a SPARQL query, not an update: run it with cbrs query")
     refuse_inserted_blank_nodes(body)  # what cbrs stores it must be able to read back by name
+    # the names cbrs prints for this store (lab4:Trolley1) may be written, as cbrs query takes them: their
+    # derived prefixes are declared above the text when it uses them and declares them not
+    names = StoreNames(lambda: app.kb)
+    added = store_prefixes_used(body, lambda: names.prefixes)
     with HeldInterrupts() as interrupts:
         interrupts.hold("running the update")
         try:
-            report = app.kb.update_counted(body)
+            report = app.kb.update_counted(prologue(added) + body)
         except QuerySyntaxError as error:
-            explained = explain_syntax_error(error, body, "update")
+            counted = one_line_up(error, body) if added else error  # placed in the text as written
+            explained = explain_syntax_error(counted, body, "update", names.prefixes)
             explained.add_note("nothing was changed")
             if explained is error:
                 raise
@@ -204,7 +212,7 @@ def update(app: App, text: str | None, update_file: Any, as_json: bool) -> None:
     for line in report.lines():
         click.echo(line)
     if not report.changed:
-        _note_unknown_names(app.kb, body)
+        _note_unknown_names(app.kb, body, added)
     if report.changed and not app.kb.store.is_seeded():  # CLEAR ALL, DROP GRAPH graph:ontology
         click.echo(
             "note: graph:ontology is empty now: the next command that opens the store seeds it again with the "
@@ -217,22 +225,24 @@ _PREFIXED = re.compile(r"(?<![\w?$:])([A-Za-z][\w-]*):([A-Za-z_][\w-]*(?:\.[\w-]
 _DECLARED = re.compile(r"PREFIX\s+([\w-]*):", re.IGNORECASE)
 
 
-def _note_unknown_names(kb: KnowledgeBase, body: str) -> None:
+def _note_unknown_names(kb: KnowledgeBase, body: str, derived: Mapping[str, str]) -> None:
     """After an update that changed no graph's size: say which names it uses that the store mentions
     nowhere (home:yw for home:yaw matched nothing, and "no graph changed" said no more), with the
-    nearest names. Only cbrs's own prefixes, as the update does not declare them itself."""
+    nearest names. Only cbrs's own prefixes and the store's ``derived`` ones declared for it, as the
+    update does not declare them itself."""
     from cbrs.task_names import near_names  # the action model: only when an update changed nothing
 
     text = re.sub(HIDING, " ", body)
     declared = set(_DECLARED.findall(text))
+    known = {**PREFIXES, **derived}
     seen = set(map(shorten, kb.store.graphs()))  # a graph's name is mentioned in no triple
     for prefix, local in _PREFIXED.findall(text):
         name = f"{prefix}:{local}"
-        if prefix not in PREFIXES or prefix in declared or name in seen:
+        if prefix not in known or prefix in declared or name in seen:
             continue
         seen.add(name)
-        if not kb.describes(PREFIXES[prefix] + local):
-            near = near_names(kb, PREFIXES[prefix] + local)
+        if not kb.describes(known[prefix] + local):
+            near = near_names(kb, known[prefix] + local)
             meant = f"; did you mean {' or '.join(near)}?" if near else ""
             click.echo(f"note: nothing in the store mentions {name}{meant}", err=True)
 

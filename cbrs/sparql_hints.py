@@ -7,8 +7,8 @@ endpoint, the bridge's ``/cbrs/query`` and ``cbrs query`` put the reason in fron
 where to send it, or which prefix is undeclared and the nearest cbrs declares. The text is only read
 here, never run: the parser still decides what is valid.
 
-``cbrs query`` and the browser's SPARQL editor also declare, above a query, the store's derived prefixes
-it uses (``lab4:``, which they print): :func:`store_prefixes_used`.
+``cbrs query``, ``cbrs update`` and the browser's SPARQL editor also declare, above the text, the store's
+derived prefixes it uses (``lab4:``, which cbrs prints): :func:`store_prefixes_used`.
 """
 
 from __future__ import annotations
