@@ -10,17 +10,20 @@ import json
 import time
 import urllib.request
 from collections.abc import Iterator
-from typing import Any
+from typing import Any, cast
 
 import pytest
 from click.testing import CliRunner
 
+from cbrs.actions.composer import Composer
 from cbrs.bridge_client import BridgeClient
 from cbrs.cli import cli
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import PREFIXES
 from cbrs.rosbridge import GoalStatus
 from cbrs.server import ServeConfig, Server
 from cbrs.sparql_service import EndpointConfig
+from cbrs.tasks import refusal_in_home
 from tests.test_rosbridge import Client
 
 TOKEN = "refused-early-test-token"
@@ -130,3 +133,14 @@ def test_the_run_task_action_is_aborted_with_the_no_plan_answer_and_no_feedback(
     assert not [m for m in received if m["op"] == "action_feedback"]
     events = [m["msg"] for m in received if m["op"] == "publish" and m["msg"].get("run") == run["id"]]
     assert [e["event"] for e in events][:1] == ["run_started"]
+
+
+def test_while_the_bridge_passes_components_over_the_home_is_built_so_the_answer_names_them(
+    server: Server, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A run names the components it passes over (their calls timed out) in its answer, which the early
+    refusal does not know of: with any passed over, the run builds the home as before."""
+    monkeypatch.setattr("cbrs.actions.breaker.passed_over", lambda *_: {"urn:x:Thermometer": "timed out"})
+    composer = Composer(server.kb)
+    assert refusal_in_home(server.kb, PREFIXES["req"] + TASK, composer, transport=cast(Any, object())) is None
+    assert refusal_in_home(server.kb, PREFIXES["req"] + TASK, composer) is not None
