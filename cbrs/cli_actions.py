@@ -30,7 +30,6 @@ from cbrs.actions.replanning import ReplanPolicy
 from cbrs.actions.runner import (
     Replan,
     RunResult,
-    refusal_before_world,
     run_task,
     ungrounded,
     unrunnable_steps,
@@ -417,9 +416,9 @@ def run(
     require("sim", "cbrs run")
     from cbrs.sim.components import SimEnvironment, implementations  # pybullet loads only for this command
     from cbrs.sim.recording import Recorder, RecordingError, check_target
-    from cbrs.sim.run_checks import map_cameras, without_camera
     from cbrs.sim.world import open_world
     from cbrs.sim_sensors import SensorsTakenError, provide_sensors
+    from cbrs.tasks import refusal_in_home
 
     if gui:
         missing = display_problem(os.environ)
@@ -446,20 +445,13 @@ def run(
         if transport is not None:
             held.callback(transport.close)
             held.callback(_settle_late_answers, transport)  # before the close (a stack unwinds last first)
-        # A task no plan could come of is refused before the world is built (a second or more of pybullet):
-        # the world will implement what the simulation has skills for, but for components whose own camera
-        # the map does not place (the world has a camera for each the map places, and no other).
-        placed = map_cameras(app.kb)
-        before = implementations(app.kb, transport=transport, advertisements=composer.advertisements)
-        runnable = set(before.names()) - set(without_camera(composer.advertisements, placed))
-
-        def why_not(advertisements: Sequence[Advertisement]) -> dict[str, str]:
-            return without_camera(advertisements, placed)
-
-        no_plan = refusal_before_world(app.kb, iri, runnable, composer, why_not)
+        # A task no plan could come of is refused before the world is built (a second or more of pybullet),
+        # as a server's run refuses it
+        no_plan = refusal_in_home(app.kb, iri, composer, transport)
         if no_plan is not None:
             wall = time.perf_counter() - start
             bridged = transport is not None
+            before = implementations(app.kb, transport=transport, advertisements=composer.advertisements)
             _say_refused(app.kb, no_plan, before, seed, as_json, wall, bridged, composer.advertisements)
         world = held.enter_context(open_world(seed=seed, gui=gui, semantic_map=SemanticMap.read(app.kb)))
         if transport is not None:  # devices' programs read this world's sensors on the bridge until it ends

@@ -74,6 +74,7 @@ def test_run_composes_with_the_options_given(apps: dict[bool, App], monkeypatch:
     import cbrs.kb.semantic_map
     import cbrs.sim.components
     import cbrs.sim.world
+    import cbrs.tasks
 
     class Composed(Exception):
         pass
@@ -97,7 +98,7 @@ def test_run_composes_with_the_options_given(apps: dict[bool, App], monkeypatch:
     monkeypatch.setattr(cbrs.cli_actions, "run_task", run_task)
     # the lab's components have no simulated skill, so the check before the world is built would refuse
     # the task: it composes with the run's composer, and goes on here
-    monkeypatch.setattr(cbrs.cli_actions, "refusal_before_world", lambda *_: None)
+    monkeypatch.setattr(cbrs.tasks, "refusal_in_home", lambda *_: None)
     for options, expected in (
         ([], (True, ComposeConfig().max_reachieved)),
         (["--no-protect", "--max-reachieved", "3"], (False, 3)),
