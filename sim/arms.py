@@ -216,6 +216,7 @@ class Kinematics:
                 for side, (pos, orn) in mounts.items()
             }
             self._obstacles = [self._box(region) for region in obstacles]
+            self._names = {body: region.name for body, region in zip(self._obstacles, obstacles, strict=True)}
             self._fixtures = [(region.name, self._box(region)) for region in fixtures]
             self._at: dict[int, tuple[float, ...]] = {}  # where each copy's joints were last put
             self._solved: dict[tuple[object, ...], _Solution] = {}  # _refine's answers, by their inputs
@@ -271,12 +272,22 @@ class Kinematics:
     def collides(self, side: ArmSide, q: Sequence[float], others: dict[ArmSide, Sequence[float]]) -> bool:
         """Whether the arm at ``q`` comes within COLLISION_MARGIN of a fixed thing or of the other arm
         (set to ``others``). The base links standing on the torso do not count."""
+        return bool(self.hits(side, q, others))
+
+    def hits(self, side: ArmSide, q: Sequence[float], others: dict[ArmSide, Sequence[float]]) -> str:
+        """What the arm at ``q`` comes within COLLISION_MARGIN of first (:meth:`collides`): the fixed
+        thing's name, or the other arm ("the left arm"); empty when it keeps clear of them all."""
         body, targets = self._posed(side, q, others)
         for target in targets:
             for point in p.getClosestPoints(body, target, COLLISION_MARGIN, physicsClientId=self.client):
                 if point[3] > 0:
-                    return True
-        return False
+                    return self._name_of(target)
+        return ""
+
+    def _name_of(self, target: int) -> str:
+        """A fixed thing's name, or "the <side> arm" for an arm's copy."""
+        arm = next((side for side, body in self._bodies.items() if body == target), None)
+        return f"the {arm.value} arm" if arm is not None else f"the {self._names.get(target, 'fixed thing')}"
 
     def strikes(self, side: ArmSide, q: Sequence[float], others: dict[ArmSide, Sequence[float]]) -> bool:
         """Whether the arm at ``q``, its fingers aside, is more than STRIKE_DEPTH into a fixed thing or the
@@ -327,6 +338,56 @@ class Kinematics:
             if min_height is not None and self.forward(side, q).position[2] < min_height:
                 return False
         return True
+
+    def _path_blocked(
+        self,
+        side: ArmSide,
+        start: Sequence[float],
+        goal: Sequence[float],
+        others: dict[ArmSide, Sequence[float]],
+        min_height: float | None,
+    ) -> str:
+        """Why :meth:`path_clear` refuses the path: what its first posture that does would run into, or how
+        low it would take the hand; empty when it is clear."""
+        for q in _joint_samples(start, goal):
+            hit = self.hits(side, q, others)
+            at = self.forward(side, q).position
+            if hit:
+                return f"would come within {COLLISION_MARGIN * 100:.0f} cm of {hit} (the hand at {_fmt(at)})"
+            if min_height is not None and at[2] < min_height:
+                return f"would take the hand down to {at[2]:.3f} m (at {_fmt(at)})"
+        return ""
+
+    def line_blocked(
+        self,
+        side: ArmSide,
+        start: Sequence[float],
+        others: dict[ArmSide, Sequence[float]],
+        position: Vec3,
+        orientation: Quat,
+        loose: bool = False,
+    ) -> str:
+        """Why the straight line from the posture ``start`` to the pose (:meth:`line`) would not keep the arm
+        clear: no inverse kinematics part-way, or the first of its postures within COLLISION_MARGIN of a fixed
+        thing or the other arm, by what and how far into the line; empty when it would. What the arm at
+        ``start`` is within the margin of already (the surface the fingers let go on) does not count: the
+        line leaves it."""
+        begin = self.forward(side, start)
+        chain = self.line(side, start, position, orientation, begin, loose)
+        if isinstance(chain, str):
+            return chain
+        touching = self.hits(side, start, others)
+        length = math.dist(begin.position, position)
+        for q in chain:
+            hit = self.hits(side, q, others)
+            if hit and hit != touching:
+                at = self.forward(side, q).position
+                return (
+                    f"the arm would come within {COLLISION_MARGIN * 100:.0f} cm of {hit} with the hand at {_fmt(at)}, "
+                    f"{math.dist(begin.position, at) * 100:.1f} cm into the {length * 100:.1f} cm line to "
+                    f"{_fmt(position)}"
+                )
+        return ""
 
     def close(self) -> None:
         if not self._closed:
@@ -421,7 +482,12 @@ class Kinematics:
             target = (float(point[0]), float(point[1]), float(point[2]))
             solution = self.solve(side, target, _slerp(begin.orientation, orientation, t), [seed], loose)
             if solution.position_error > IK_TOLERANCE or solution.orientation_error > 0.02:
-                return f"no inverse kinematics at {i}/{pieces} of the line to {_fmt(position)}"
+                into = (
+                    f"{distance * t * 100:.1f} cm into the {distance * 100:.1f} cm line"
+                    if distance >= CARTESIAN_STEP / 10
+                    else f"{angle * t:.2f} rad into the hand's {angle:.2f} rad turn"
+                )
+                return f"no inverse kinematics at {_fmt(target)}, {into} to {_fmt(position)}"
             chain.append(solution.q)
             seed = solution.q
         return chain
@@ -464,6 +530,45 @@ class Kinematics:
             if best is not None and min_height is None:
                 break
         return best
+
+    def no_joint_path(
+        self,
+        side: ArmSide,
+        current: Sequence[float],
+        others: dict[ArmSide, Sequence[float]],
+        position: Vec3,
+        orientation: Quat,
+        symmetric: bool = True,
+        min_height: float | None = None,
+        loose: bool = False,
+        down_to: float | None = None,
+    ) -> str:
+        """Why :meth:`joint_path`, given the same, found no move: no inverse-kinematics solution at the pose
+        from any seed posture; or what the path to the nearest solution would run into (or how low it would
+        take the hand, or that the hand could not go straight down from it). Asked once a move is refused,
+        its answers looked up (:meth:`_refine`)."""
+        where = "" if min_height is None else f" above {min_height:.2f} m"
+        if down_to is not None:
+            where += f" from which the hand goes straight down to {down_to:.3f} m"
+        candidates = [orientation, flipped(orientation)] if symmetric else [orientation]
+        found = [
+            solution
+            for candidate in candidates
+            for seed in (*_SEEDS, current)
+            if (solution := self.solve(side, position, candidate, [seed], loose)).position_error <= IK_TOLERANCE
+            and solution.orientation_error <= 0.02
+        ]
+        if not found:
+            return (
+                f"no inverse kinematics at {_fmt(position)} from any seed posture: the arm cannot reach it, the hand "
+                "so turned"
+            )
+        nearest = min(found, key=lambda s: _joint_distance(current, s.q))
+        why = self._path_blocked(side, current, nearest.q, others, min_height)
+        if not why and down_to is not None and not self._goes_down(side, nearest.q, down_to, loose):
+            why = f"ends where the hand cannot go straight down to {down_to:.3f} m"
+        because = f": the path to the nearest posture there {why}" if why else ""
+        return f"no collision-free joint path to {_fmt(position)}{where}{because}"
 
     def _goes_down(self, side: ArmSide, q: Sequence[float], height: float, loose: bool) -> bool:
         """Whether the grasp point goes straight down from the posture ``q`` to ``height``, the hand kept
@@ -634,7 +739,10 @@ class Arm:
             self.side, current, self._others(), position, orientation, symmetric, min_height, down_to=down_to
         )
         if best is None:
-            return _no_joint_path(position, min_height, down_to)
+            why = self._kinematics.no_joint_path(
+                self.side, current, self._others(), position, orientation, symmetric, min_height, down_to=down_to
+            )
+            return MotionResult(False, math.inf, why)
         motion = self.move_joints(best.q)
         error = float(np.linalg.norm(np.asarray(self.ee_pose().position) - np.asarray(position)))
         ok = motion.reached and error <= REACH_TOLERANCE
@@ -842,6 +950,11 @@ class PlannedArm:
         self._q = chain[-1]
         return MotionResult(True, 0.0)
 
+    def blocked(self, position: Vec3, orientation: Quat) -> str:
+        """Why the straight line from here to the pose would not keep the arm clear of the fixed things and
+        the other arm (:meth:`Kinematics.line_blocked`); empty when it would. Planned, not made."""
+        return self._kinematics.line_blocked(self.side, self._q, self._others, position, orientation, loose=True)
+
     def reach(
         self,
         position: Vec3,
@@ -855,17 +968,13 @@ class PlannedArm:
             self.side, self._q, self._others, position, orientation, symmetric, min_height, True, down_to
         )
         if best is None:
-            return _no_joint_path(position, min_height, down_to)
+            why = self._kinematics.no_joint_path(
+                self.side, self._q, self._others, position, orientation, symmetric, min_height, True, down_to
+            )
+            return MotionResult(False, math.inf, why)
         self._note(_joint_samples(self._q, best.q), position)
         self._q = best.q
         return MotionResult(True, 0.0)
-
-
-def _no_joint_path(position: Vec3, min_height: float | None, down_to: float | None = None) -> MotionResult:
-    where = "" if min_height is None else f" above {min_height:.2f} m"
-    if down_to is not None:
-        where += f" from which the hand goes straight down to {down_to:.3f} m"
-    return MotionResult(False, math.inf, f"no collision-free joint path to {_fmt(position)}{where}")
 
 
 def _joint_samples(start: Sequence[float], goal: Sequence[float]) -> list[list[float]]:

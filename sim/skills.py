@@ -343,10 +343,12 @@ def _clear_way(arm: _Moving, legs: Sequence[Vec3], orientation: Quat) -> str:
     surface they let go on (a pen's fingertips 2 mm over the table), which every path from there meets; an
     arm that has run into something by then is caught there. Unchecked, the
     right arm setting a 30 cm bottle down beside the torso drove its upper arm into the Kinect 3 cm into
-    the back-off, and the jammed wrist swung the open fingers into the bottle, which fell."""
+    the back-off, and the jammed wrist swung the open fingers into the bottle, which fell. A piece that went
+    round is refused with why the leg's own straight line cannot be taken (:meth:`PlannedArm.blocked`)."""
     planned = arm.dry_run()
     lifting = True  # the fingers start on the surface, within the collision margin of it
     for leg in legs:
+        along = planned.dry_run()  # the leg's straight line, to say why a piece went round
         start = np.asarray(planned.ee_pose().position)
         way = np.asarray(leg) - start
         pieces = max(1, math.ceil(float(np.linalg.norm(way)) / BACK_OFF_STEP))
@@ -361,9 +363,11 @@ def _clear_way(arm: _Moving, legs: Sequence[Vec3], orientation: Quat) -> str:
             moved = planned.reach((x, y, z), orientation, symmetric=False)
             if not moved.reached:
                 return moved.reason
-            if float(np.max(np.abs(np.asarray(planned.joint_positions()) - before))) > BACK_OFF_TURN:
-                return (
-                    f"the arm would run into a fixed thing or the other arm on the way to ({x:.2f}, {y:.2f}, {z:.2f})"
+            turn = float(np.max(np.abs(np.asarray(planned.joint_positions()) - before)))
+            if turn > BACK_OFF_TURN:
+                return along.blocked((x, y, z), orientation) or (
+                    f"the arm would turn a joint {turn:.2f} rad (more than {BACK_OFF_TURN} rad) over the piece to "
+                    f"({x:.3f}, {y:.3f}, {z:.3f}), going round to another posture"
                 )
     return ""
 

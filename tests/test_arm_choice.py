@@ -228,4 +228,4 @@ def test_the_loading_check_does_not_refuse_an_object_loadable_a_centimetre_from_
         monkeypatch.setattr(run_checks, "LOADING_SLACK", 0.0)
         with pytest.raises(CannotLoadError) as refused:
             environment.given(plan, requirements)
-    assert "no collision-free joint path" in str(refused.value)
+    assert "no inverse kinematics at" in str(refused.value)

@@ -65,7 +65,8 @@ def test_on_the_larger_tray_the_cup_is_taken_from_the_top_and_put_there_without_
     assert [(c.arm, c.model.grasp) for c in choices] == [(ArmSide.LEFT, GraspKind.TOP)]
     assert str(choices[0]).startswith(
         "taking the Cup to TrayPlace: the left arm holds the Cup by its top grasp (not by its side grasp: the left "
-        "arm would not get the Cup by its side grasp past carrying it to (7.54, 3.10): no collision-free joint path"
+        "arm would not get the Cup by its side grasp past carrying it to (7.54, 3.10): no inverse kinematics at "
+        "(7.540, 3.100"
     )
 
 
@@ -81,8 +82,8 @@ def test_the_dry_run_refuses_what_the_end_poses_allow_and_moves_nothing(tmp_path
         assert skills.can_carry(world, seen, ArmSide.LEFT, top, SPOT) == ""
         assert skills.can_carry(world, seen, ArmSide.LEFT, side) == ""  # taking and lifting it: yes
         after, ended = {s: world.arm(s).joint_positions() for s in ArmSide}, world.time
-    assert "past carrying it to (7.54, 3.10): no collision-free joint path to (7.540, 3.100" in refused
-    assert refused.endswith("above 0.84 m")
+    assert "past carrying it to (7.54, 3.10): no inverse kinematics at (7.540, 3.100" in refused
+    assert refused.endswith("from any seed posture: the arm cannot reach it, the hand so turned")
     assert after == before and ended == started  # nothing moved, no physics step
 
 

@@ -79,6 +79,11 @@ def test_a_put_down_whose_way_back_runs_into_the_kinect_is_refused_by_the_dry_ru
     refused = skills.can_carry(world, seen, ArmSide.RIGHT, model, relay)
     assert "lowering it onto KitchenTableRelay" in refused
     assert "backing off once it is let go" in refused
+    assert "would come within 1 cm of the Kinect01Mast" in refused  # what it would hit, named
+    # 6 cm west, the straight back-off leaves the arm's reach instead: nothing is hit, and the refusal says so
+    west = Region("KitchenTableRelay", 7.65, 7.73, 3.03, 3.11, TABLE_TOP, TABLE_TOP + 0.3)
+    out = skills.can_carry(world, seen, ArmSide.RIGHT, model, west)
+    assert "backing off once it is let go: no inverse kinematics at (" in out and " cm into the " in out, out
     # where it stands, the same hold's way back is clear
     here = Region("TakenFrom", x - 0.02, x + 0.02, y - 0.02, y + 0.02, TABLE_TOP, TABLE_TOP + 0.3)
     assert skills.can_carry(world, seen, ArmSide.RIGHT, model, here) == ""
