@@ -8,13 +8,16 @@ and their positions. Queries ``world_facts`` and ``world_positions`` read it bac
 One other writer: an actuator's answer that came after its call was given up (:mod:`actions.late_answers`)
 sets what holds of some (thing, relation) pairs with :func:`correct`. A run still going then keeps that
 in its later writes, whose observation knows nothing of it, for as long as its own belief of those pairs
-stays what the world graph held before the correction (docs/reliability.md, "Late answers").
+stays what the world graph held before the correction, or until its observation says it has taken the
+correction into its own belief (``Observation.heard``, by :class:`Heard`; docs/reliability.md, "Late
+answers").
 """
 
 from __future__ import annotations
 
 import threading
 import weakref
+from collections import deque
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 
@@ -36,16 +39,6 @@ Pair = tuple[str, str]
 
 
 @dataclass(frozen=True)
-class Observation:
-    """Things with their classes, the relations that hold, positions, and when (simulated seconds)."""
-
-    types: Mapping[str, str] = field(default_factory=dict)
-    facts: frozenset[tuple[str, str, str]] = frozenset()
-    positions: Mapping[str, tuple[float, float, float]] = field(default_factory=dict)
-    time: float = 0.0
-
-
-@dataclass(frozen=True)
 class Correction:
     """What :func:`correct` set of ``pairs``: ``before``, the facts of them the world graph held; ``held``,
     those that hold now (none: unknown, neither believed nor denied)."""
@@ -62,11 +55,25 @@ class Correction:
         return (facts - self.of(facts)) | self.held
 
 
+@dataclass(frozen=True)
+class Observation:
+    """Things with their classes, the relations that hold, positions, and when (simulated seconds);
+    ``heard``, the corrections the observer has taken into its own belief (:class:`Heard`), which a belief
+    state then stops keeping for it."""
+
+    types: Mapping[str, str] = field(default_factory=dict)
+    facts: frozenset[tuple[str, str, str]] = frozenset()
+    positions: Mapping[str, tuple[float, float, float]] = field(default_factory=dict)
+    time: float = 0.0
+    heard: tuple[Correction, ...] = ()
+
+
 class BeliefState:
     def __init__(self, kb: KnowledgeBase) -> None:
         self.kb = kb
         self._written: frozenset[ox.Quad] | None = None  # what this object last wrote, while it may trust it
         self._corrections: list[Correction] = []  # made while this object lived, and still kept (:func:`correct`)
+        self._made: list[Correction] = []  # every correction made while this object lived, for :meth:`restore`
         with _guard:
             _live.add(self)
 
@@ -82,7 +89,7 @@ class BeliefState:
         A correction made while this object lived is kept (:meth:`_corrected`)."""
         graph = GraphName.WORLD.node
         with _guard:
-            facts = self._corrected(frozenset(observation.facts))
+            facts = self._corrected(frozenset(observation.facts), observation.heard)
             new = [
                 ox.Quad(ox.NamedNode(t), _TYPE, ox.NamedNode(c), graph) for t, c in sorted(observation.types.items())
             ]
@@ -98,14 +105,17 @@ class BeliefState:
                 self.kb.store.replace(sorted(written.difference(new), key=str), [q for q in new if q not in written])
             self._written = frozenset(new)
 
-    def _corrected(self, facts: frozenset[Fact]) -> frozenset[Fact]:
+    def _corrected(self, facts: frozenset[Fact], heard: Iterable[Correction] = ()) -> frozenset[Fact]:
         """``facts`` (an observation's) with the corrections this object keeps applied. One is kept while
         the observation holds of its pairs what the world graph held before it: the run has not changed
         them since, so the correction is the newer word. Once the observation differs there (a step of
-        the run set them, or the run read the correction back), the run's own belief is: it is dropped."""
+        the run set them, or the run read the correction back), the run's own belief is: it is dropped.
+        So is one the observer has ``heard``: its own belief took it in, and a step of the run that sets
+        the pairs back to what they were before it is then the newer word, not the correction."""
+        taken = set(heard)
         kept = []
         for correction in self._corrections:
-            if correction.of(facts) == correction.before:
+            if correction not in taken and correction.of(facts) == correction.before:
                 facts = correction.applied(facts)
                 kept.append(correction)
         self._corrections = kept
@@ -117,7 +127,8 @@ class BeliefState:
 
     def restore(self, quads: list[ox.Quad]) -> None:
         """Put the world graph back as a :meth:`snapshot` found it (a run refused before it acted), with
-        the corrections made since this object was made."""
+        the corrections made since this object was made (those a write since has dropped too: the snapshot
+        may be older than them)."""
         graph = GraphName.WORLD.node
         with _guard:
             self._written = None
@@ -126,7 +137,10 @@ class BeliefState:
                 for q in quads
                 if isinstance(q.subject, ox.NamedNode) and isinstance(q.object, ox.NamedNode) and q.predicate != _TYPE
             }
-            facts = self._corrected(frozenset(found))
+            facts = frozenset(found)
+            for correction in self._made:
+                if correction.of(facts) == correction.before:
+                    facts = correction.applied(facts)
             replaced = set(found.values())
             kept = [q for q in quads if q not in replaced]
             self.kb.store.replace_graph(graph, kept + _quads(facts))
@@ -138,6 +152,39 @@ class BeliefState:
     def positions(self) -> dict[str, tuple[float, float, float]]:
         rows = self.kb.select("world_positions")
         return {r["thing"].value: (float(r["x"].value), float(r["y"].value), float(r["z"].value)) for r in rows}
+
+
+class Heard:
+    """The corrections of a store's belief (:func:`correct`) made from now on, for an environment that keeps a
+    belief of its own (``sim.components.SimEnvironment.effects``, the relations only steps set) to take in,
+    in its own thread, before it next uses that belief (:meth:`take`). Without it a run's step that set a
+    corrected relation back to what it was before the correction looked like no change to the run's belief
+    state, and the correction stood. Heard for as long as the owner keeps it (held weakly here)."""
+
+    def __init__(self, kb: KnowledgeBase) -> None:
+        self._store = kb.store
+        self._pending: deque[Correction] = deque()  # appended by the correcting thread, taken by the owner's
+        self.taken: tuple[Correction, ...] = ()
+        """Every correction :meth:`take` has dealt with, for the owner's observations (``Observation.heard``)."""
+        with _guard:
+            _hearing.add(self)
+
+    def take(self, facts: set[Fact], about: Callable[[Pair], bool] = lambda pair: True) -> set[Fact]:
+        """``facts`` (the owner's belief) with the corrections heard since the last call applied, in order:
+        each whose pairs are all ``about`` the owner's belief and where ``facts`` hold of its pairs what the
+        world graph held before it (the owner has not changed them since, so the correction is the newer
+        word). Where they differ the owner's own act is the newer and the correction is passed over. Either
+        way it is taken, so a belief state stops keeping it once an observation says so. ``facts`` itself
+        when none was heard."""
+        if not self._pending:
+            return facts
+        held = frozenset(facts)
+        while self._pending:
+            correction = self._pending.popleft()
+            if all(about(pair) for pair in correction.pairs) and correction.of(held) == correction.before:
+                held = correction.applied(held)
+            self.taken += (correction,)
+        return set(held)
 
 
 def believed(kb: KnowledgeBase, pairs: Iterable[Pair]) -> frozenset[Fact]:
@@ -156,7 +203,8 @@ def correct(
     kb: KnowledgeBase, pairs: Iterable[Pair], decide: Callable[[frozenset[Fact]], frozenset[Fact]]
 ) -> Correction:
     """Make what the world graph holds of ``pairs`` ``decide(what it holds of them now)``, in one transaction,
-    and have every :class:`BeliefState` of the store living now keep it (:meth:`BeliefState._corrected`).
+    and have every :class:`BeliefState` of the store living now keep it (:meth:`BeliefState._corrected`) and
+    every :class:`Heard` of the store hear it.
     The reading, the decision and the write are one step for this process's belief writers. ``decide``
     may only return facts of ``pairs`` (``ValueError`` naming the others: nothing is written)."""
     wanted = frozenset(pairs)
@@ -173,6 +221,10 @@ def correct(
         for state in list(_live):
             if state.kb.store is kb.store:
                 state._corrections.append(correction)
+                state._made.append(correction)
+        for heard in list(_hearing):
+            if heard._store is kb.store:
+                heard._pending.append(correction)
     return correction
 
 
@@ -190,3 +242,5 @@ _guard = threading.RLock()
 are not interleaved with a run's write."""
 _live: weakref.WeakSet[BeliefState] = weakref.WeakSet()
 """The belief states of this process that may write again (a run's lives as long as the run)."""
+_hearing: weakref.WeakSet[Heard] = weakref.WeakSet()
+"""The environments' ears of this process (:class:`Heard`; a simulation environment's lives as long as it)."""

@@ -25,8 +25,8 @@ the map's things right, no effect contradicted: ``RemoteComponent._read``), and 
 Each case is one warning of ``cbrs.actions.remote`` naming the component. An effect is grounded in the
 step's inputs (the one designated thing of its class; a quality, ``home:Opened``, stands for itself) when
 the call is given up, and the belief of what it would change is read then, to tell later changes.
-The write is :func:`actions.belief.correct`: one transaction, and kept by a run still going
-(docs/reliability.md, "Late answers").
+The write is :func:`actions.belief.correct`: one transaction, kept by a run still going, and heard by a
+simulation environment running (:class:`actions.belief.Heard`; docs/reliability.md, "Late answers").
 """
 
 from __future__ import annotations

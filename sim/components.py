@@ -30,7 +30,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from cbrs.actions.answers import StoreClasses, check_designation
-from cbrs.actions.belief import Observation
+from cbrs.actions.belief import Heard, Observation
 from cbrs.actions.breaker import BreakerPolicy, passed_over
 from cbrs.actions.components import Component, Registry, Status
 from cbrs.actions.plan import Plan, PlanStep
@@ -276,6 +276,7 @@ class SimEnvironment:
         self._superclasses: dict[str, set[str]] | None = None
         self._computables: dict[str, str] | None = None
         self._exclusions: tuple[frozenset[str], tuple[tuple[str, str], ...]] | None = None
+        self._heard = Heard(kb)  # before the world graph is read: a correction made after the read is heard
         self.effects |= self._untestable_beliefs()
 
     def clock(self) -> float:
@@ -440,6 +441,7 @@ class SimEnvironment:
         be told. Without a step (a goal that held at the start) the things at hand are the task's."""
         if step is None:
             self.context.inputs = dict(self.context.given)
+        self._hear()
         found = self._judge(self.belief, statement, outputs, look=True)
         if found is not None:
             return found
@@ -460,6 +462,7 @@ class SimEnvironment:
         except NotFoundError:  # deregistered while it ran: what it did is no longer described
             log.warning("%s did a step but is no longer described: its effects are not believed", component)
             return
+        self._hear()  # what was corrected before the step, so that the step's own act is the newer
         for statement in description.deletes:
             fact = self._untestable(statement)
             if fact is not None:
@@ -468,6 +471,12 @@ class SimEnvironment:
             fact = self._untestable(statement)
             if fact is not None:
                 self._believe(fact)
+
+    def _hear(self) -> None:
+        """Take the corrections of the world graph made since (an actuator's late answer:
+        :class:`actions.belief.Heard`) into :attr:`effects`, those of relations no test decides: a later step
+        that sets one back then changes the belief, and the run's writes say so."""
+        self.effects = self._heard.take(self.effects, lambda pair: self.computable(pair[1]) is None)
 
     def _untestable(self, statement: Statement) -> tuple[str, str, str] | None:
         """The statement grounded in the things at hand, when the store maps its relation to no test."""
@@ -587,6 +596,7 @@ class SimEnvironment:
         believed to be: from the robots' perception and proprioception (no new images are taken)."""
         belief = self.belief
         belief.feel()
+        self._hear()
         world, smap = self.world, self.world.map
         arm = self.context.arm
         facts: set[tuple[str, str, str]] = set()
@@ -639,4 +649,4 @@ class SimEnvironment:
                         facts.add((iri, HOME + "isLocated", room.iri))
         facts |= self.effects
         types = {iri: kinds[0] for iri, kinds in smap.types.items() if kinds and not iri.endswith("/world")}
-        return Observation(types, frozenset(facts), positions, world.time)
+        return Observation(types, frozenset(facts), positions, world.time, heard=self._heard.taken)

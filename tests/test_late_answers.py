@@ -19,7 +19,7 @@ from click.testing import CliRunner
 
 from cbrs import cli_actions
 from cbrs.actions.answers import StoreClasses, check_designation
-from cbrs.actions.belief import BeliefState, Observation
+from cbrs.actions.belief import BeliefState, Heard, Observation, correct
 from cbrs.actions.breaker import calls_of, passed_over, settle_late_answers
 from cbrs.actions.components import Registry, Status
 from cbrs.actions.composer import Composer
@@ -225,6 +225,62 @@ def test_a_run_still_going_keeps_the_late_answer_until_its_own_belief_of_the_doo
     running.write(Observation(facts=frozenset({OPENED})))
     running.write(Observation(facts=frozenset({CLOSED})))  # a step of its own closed it
     assert _door(kb) == [HOME + "Closed"]
+
+
+@pytest.mark.parametrize("hears", [pytest.param(True, id="heard"), pytest.param(False, id="not-heard")])
+def test_a_run_whose_environment_hears_the_late_answer_can_set_the_door_back(
+    kb: KnowledgeBase, warnings: pytest.LogCaptureFixture, hears: bool
+) -> None:
+    """The run's environment believes the door closed (SimEnvironment.effects, from the world graph as the
+    run began). The late answer opens it; then a step of the run closes it: exactly what the world graph
+    held before the correction. An environment that hears the correction (actions.belief.Heard) took the
+    door open into its own belief, so the close is a change, and its observation says it heard: the door
+    is believed closed. One that does not hear it looks as if nothing changed, and the correction stands
+    (docs/reliability.md, "Not promised")."""
+    heard = Heard(kb) if hears else None
+    effects = {CLOSED}
+    running = BeliefState(kb)
+    running.write(Observation(facts=frozenset(effects)), whole=True)
+    _given_up(kb).set_result({"doorStatus": {"@type": "home:Opened"}})
+    _told(warnings)
+    taken: tuple[Any, ...] = ()
+    if heard is not None:
+        effects = heard.take(effects)
+        taken = heard.taken
+        assert effects == {OPENED} and len(taken) == 1  # the environment's own belief took the door open in
+        assert heard.take(effects) is effects  # nothing new heard: its belief as it was
+    running.write(Observation(facts=frozenset(effects), heard=taken))
+    assert _door(kb) == [HOME + "Opened"]
+    effects = {CLOSED}  # a step of the run closed the door (Closed believed in place of Opened)
+    running.write(Observation(facts=frozenset(effects), heard=taken), whole=True)
+    assert _door(kb) == [HOME + "Closed" if hears else HOME + "Opened"]
+
+
+def test_a_correction_the_environment_has_acted_on_since_is_passed_over_but_taken(
+    kb: KnowledgeBase, warnings: pytest.LogCaptureFixture
+) -> None:
+    """A step of the run opened the door after the call was given up, not written yet, when the motor's late
+    error answer makes the door's status unknown: the run's own act is the newer (Heard.take passes the
+    correction over), and its belief state, told it was heard, writes the door open."""
+    _believe(kb, CLOSED)
+    heard = Heard(kb)
+    running = BeliefState(kb)
+    call = _given_up(kb)
+    effects = {OPENED}
+    call.set_exception(RemoteCallError("the door jammed half-way"))
+    _told(warnings)
+    assert _door(kb) == []  # the world graph: unknown
+    assert heard.take(effects) == {OPENED} and len(heard.taken) == 1
+    running.write(Observation(facts=frozenset(effects), heard=heard.taken))
+    assert _door(kb) == [HOME + "Opened"]
+
+
+def test_an_environment_takes_in_only_the_relations_it_keeps(kb: KnowledgeBase) -> None:
+    _believe(kb, CLOSED)
+    heard = Heard(kb)
+    correct(kb, {(DOOR["@id"], HOME + "hasStatus")}, lambda now: frozenset({OPENED}))
+    assert heard.take({CLOSED}, about=lambda pair: False) == {CLOSED}  # a relation a test decides, say
+    assert len(heard.taken) == 1
 
 
 def test_a_program_that_is_ending_can_wait_for_the_late_answers_first(kb: KnowledgeBase) -> None:
