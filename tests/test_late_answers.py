@@ -275,6 +275,22 @@ def test_a_correction_the_environment_has_acted_on_since_is_passed_over_but_take
     assert _door(kb) == [HOME + "Opened"]
 
 
+def test_a_restore_puts_back_a_correction_the_environment_took_in(
+    kb: KnowledgeBase, warnings: pytest.LogCaptureFixture
+) -> None:
+    """A run refused before it acted puts the world graph back as its snapshot found it, with the corrections
+    made since: one its environment took in, which its belief state no longer keeps, too."""
+    running = BeliefState(kb)
+    running.write(Observation(facts=frozenset({CLOSED})), whole=True)
+    snapshot = running.snapshot()
+    heard = Heard(kb)
+    _given_up(kb).set_result({"doorStatus": {"@type": "home:Opened"}})
+    _told(warnings)
+    running.write(Observation(facts=frozenset(heard.take({CLOSED})), heard=heard.taken))
+    running.restore(snapshot)
+    assert _door(kb) == [HOME + "Opened"]
+
+
 def test_an_environment_takes_in_only_the_relations_it_keeps(kb: KnowledgeBase) -> None:
     _believe(kb, CLOSED)
     heard = Heard(kb)
