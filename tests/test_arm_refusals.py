@@ -101,22 +101,22 @@ def test_a_joint_path_refusal_tells_an_unreachable_pose_from_a_blocked_path(
     free: Kinematics, walled: Kinematics
 ) -> None:
     home = HOME_CONFIGURATIONS[LEFT]
-    beyond = PlannedArm(LEFT, free, home, OTHERS).reach((1.5, 0.2, 0.9), DOWN)
+    beyond = PlannedArm(LEFT, free, home, OTHERS).reach((1.5, 0.2, 0.9), DOWN, symmetric=False)
     assert not beyond.reached
     assert beyond.reason.startswith("no inverse kinematics at (1.500, 0.200, 0.900) from any seed posture")
-    blocked = PlannedArm(LEFT, walled, home, OTHERS).reach(TARGET, DOWN)
+    blocked = PlannedArm(LEFT, walled, home, OTHERS).reach(TARGET, DOWN, symmetric=False)
     assert not blocked.reached
     assert blocked.reason.startswith(
         "no collision-free joint path to (0.450, 0.250, 0.950): the path to the nearest posture there would come "
         f"{MARGIN} the Block (the hand at ("
     )
-    high = PlannedArm(LEFT, free, home, OTHERS).reach(TARGET, DOWN, min_height=1.5)
+    high = PlannedArm(LEFT, free, home, OTHERS).reach(TARGET, DOWN, symmetric=False, min_height=1.5)
     assert re.match(
         r"no collision-free joint path to \(0\.450, 0\.250, 0\.950\) above 1\.50 m: the path to the nearest posture "
         r"there would take the hand down to 1\.\d+ m",
         high.reason,
     ), high.reason
-    assert PlannedArm(LEFT, free, home, OTHERS).reach(TARGET, DOWN).reached  # with nothing in the way
+    assert PlannedArm(LEFT, free, home, OTHERS).reach(TARGET, DOWN, symmetric=False).reached  # with nothing in the way
 
 
 def test_a_back_off_says_what_it_would_hit(walled: Kinematics) -> None:

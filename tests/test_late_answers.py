@@ -30,11 +30,13 @@ from cbrs.actions.runner import RunResult, run_task
 from cbrs.bridge_client import BridgeClient
 from cbrs.cli import cli
 from cbrs.component import Component
-from cbrs.kb import KnowledgeBase, Requirement, Statement
+from cbrs.kb import KnowledgeBase, NotFoundError, Requirement, Statement
 from cbrs.kb.namespaces import PREFIXES, GraphName
+from cbrs.kb.semantic_map import SemanticMap
 from cbrs.server import ServeConfig, Server
-from cbrs.sim.components import implementations
+from cbrs.sim.components import SimEnvironment, implementations
 from cbrs.sim.values import check
+from cbrs.sim.world import open_world
 from cbrs.sparql_service import EndpointConfig
 from tests.test_live_components import eventually
 from tests.test_remote_call_timeout import Clock, Silent
@@ -43,6 +45,7 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "docs" / "examples"
 HOME = PREFIXES["home"]
 LAB = "https://example.org/lab#"
 OPEN = LAB + "OpenDoor_BedroomDoorMotor01"
+CLOSE = LAB + "CloseDoor_BedroomDoorMotor01"
 SERVICE = "/bedroom_door_motor_01/open"
 DOOR = {"@id": LAB + "BedroomDoor", "@type": HOME + "Door"}
 OPENED, CLOSED = (
@@ -297,6 +300,34 @@ def test_an_environment_takes_in_only_the_relations_it_keeps(kb: KnowledgeBase) 
     correct(kb, {(DOOR["@id"], HOME + "hasStatus")}, lambda now: frozenset({OPENED}))
     assert heard.take({CLOSED}, about=lambda pair: False) == {CLOSED}  # a relation a test decides, say
     assert len(heard.taken) == 1
+
+
+def test_the_simulation_environment_hears_the_late_answer_and_its_own_later_step_sets_the_door_back(
+    kb: KnowledgeBase, warnings: pytest.LogCaptureFixture
+) -> None:
+    """SimEnvironment hears the correction (its Heard, made with it): the door believed open at once, then
+    closed by a step of its run (the motor's close service told the environment it succeeded), and the
+    run's last write says closed. The world is built, not stepped."""
+    try:
+        kb.description(CLOSE)
+    except NotFoundError:
+        kb.registry.register((EXAMPLES / "lab_close_door.ttl").read_text(encoding="utf-8"))
+    _believe(kb, CLOSED)
+    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
+        environment = SimEnvironment(world, kb)
+        assert environment.effects == {CLOSED}
+        running = BeliefState(kb)
+        running.write(environment.observe(), whole=True)
+        _given_up(kb).set_result({"doorStatus": {"@type": "home:Opened"}})
+        _told(warnings)
+        seen = environment.observe()
+        assert OPENED in seen.facts and CLOSED not in seen.facts and len(seen.heard) == 1
+        running.write(seen)
+        environment.context.inputs = {"door": DOOR}
+        environment.succeeded(PlanStep(0, CLOSE, None, None, None, None, (), (), (), 0.0), CLOSE)
+        assert environment.effects == {CLOSED}
+        running.write(environment.observe(), whole=True)  # the run's last write
+    assert _door(kb) == [HOME + "Closed"]
 
 
 def test_a_program_that_is_ending_can_wait_for_the_late_answers_first(kb: KnowledgeBase) -> None:
