@@ -25,8 +25,17 @@ __all__ = [
     "ObjectModel",
     "compute_grasp_pose",
     "held_height",
+    "palm_stop",
     "side_held",
 ]
+
+PALM_LEAD = 0.0052
+"""How far ahead of its point on the hand's axis (``palm_depth`` back from the grasp point) a side grasp's
+palm reaches along the level approach (m): tilted down by the side pitch, the palm's face leans forward
+above the axis. The Panda hand's at the default 35 degrees, measured on its collision mesh: a tall object's
+near side touches it 2.27 cm behind the grasp point, where ``palm_depth * cos(pitch)`` puts the palm
+2.79 cm behind (tests/test_grasp_palm_stop.py measures it again). Like the hand's arm bands, it holds
+for that pitch only (docs/simulation.md, "How far in a side grasp goes")."""
 
 
 class GraspKind(StrEnum):
@@ -156,10 +165,20 @@ def held_height(model: ObjectModel, hand: Hand) -> float:
 def side_held(depth: float, hand: Hand) -> float:
     """How much of an object ``depth`` deep along a side grasp's horizontal approach lies between
     ``hand``'s fingers: they come in tilted down by its side pitch, so they span its ``side_span`` of it
-    (3.8 cm for the Panda's); a deeper object meets the palm and is pushed until its near face rests
-    against it, the rest of it beyond the fingertips (measured with the Panda: a 4 x 10 cm box taken so
-    ended with its centre 1.9 cm beyond the grasp point, 1 cm beyond the fingertips)."""
+    (3.8 cm for the Panda's) from its near face, which a deeper object has at the palm (the hand stops
+    there, :func:`palm_stop`), the rest of it beyond the fingertips."""
     return min(depth, hand.side_span)
+
+
+def palm_stop(depth: float, hand: Hand, lead: float = PALM_LEAD) -> float:
+    """How far short of an object's centre, along a side grasp's level approach, ``hand``'s grasp point
+    stops so that the palm stops at the object's near side instead of pushing it: the near side is half
+    its ``depth`` back from its centre, the palm ``palm_depth * cos(side_pitch)`` back from the grasp point
+    less its ``lead`` (:data:`PALM_LEAD`). 0 for an object the palm does not reach (the bundled cup, 6 cm
+    across, is reached: 0.7 cm). Before, the hand went on to the centre and the palm pushed a 7 cm bottle
+    2.3 cm and tipped it 8.5 degrees before the fingers closed, and it fell."""
+    palm = hand.palm_depth * math.cos(hand.side_pitch) - lead
+    return max(0.0, depth / 2.0 - palm)
 
 
 @dataclass(frozen=True)
@@ -232,7 +251,8 @@ def compute_grasp_pose(
     clearance (``hand.widest``), GraspTooDeepError when a side grasp would hold less than the hand's
     side-hold fraction of its depth along the approach (:func:`side_held`), GraspTooThinError when a top
     grasp would hold nothing of it above its surface: the hand could not hold it so, whatever the arm can
-    reach.
+    reach. A side grasp's grasp point stops :func:`palm_stop` short of the centre, so the palm does not
+    push the object before the fingers close.
     """
     cx, cy, cz = centre
     bottom = cz - model.height / 2.0
@@ -270,5 +290,7 @@ def compute_grasp_pose(
         held = side_held(depth, hand)
         if held < hand.side_hold * depth - 1e-9:
             raise GraspTooDeepError(model.name, model.grasp.value, depth, hand.finger_length, held, hand.side_hold)
+        short = palm_stop(depth, hand)
+        cx, cy = cx - math.cos(facing) * short, cy - math.sin(facing) * short
     grip = model.grip(closing, yaw)
     return GraspPose(model, (cx, cy, grasp_z), orientation, approach, model.grasp_height, grip, hand)
