@@ -51,7 +51,7 @@ from cbrs.output import (
     term_text,
 )
 from cbrs.settings import SETTINGS, setting
-from cbrs.sparql_hints import explain_syntax_error, one_line_up, prologue, store_prefixes_used
+from cbrs.sparql_hints import declared, explain_syntax_error, one_line_up, store_prefixes_used
 
 # Commands whose modules import numpy, networkx, the composer or the web server (most of a second at
 # start-up): each is imported when it runs or shows its own help. ``cbrs --help`` lists them from the
@@ -498,7 +498,7 @@ def query(
         names = StoreNames(lambda: app.kb)
         added = store_prefixes_used(body, lambda: names.prefixes)
         try:
-            result = app.kb.query(prologue(added) + body)
+            result = app.kb.query(declared(added, body))
         except QuerySyntaxError as error:  # a prefix nobody declared: said plainly, as the endpoint does
             counted = one_line_up(error, body) if added else error
             explained = explain_syntax_error(counted, body, "query", names.prefixes)

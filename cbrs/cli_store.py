@@ -25,7 +25,7 @@ from cbrs.kb.namespaces import PREFIXES, GraphName, shorten
 from cbrs.kb.sparql_lexemes import HIDING
 from cbrs.kb.store import refuse_inserted_blank_nodes
 from cbrs.output import ProgressLine
-from cbrs.sparql_hints import explain_syntax_error, one_line_up, operation_kind, prologue, store_prefixes_used
+from cbrs.sparql_hints import declared, explain_syntax_error, one_line_up, operation_kind, store_prefixes_used
 
 _GRAPH_HELP = "A graph to take (repeatable): " + ", ".join(g.value for g in GraphName) + ", or a full IRI."
 _FORMAT_CHOICE = click.Choice(["nquads", "trig"])
@@ -191,7 +191,7 @@ def update(app: App, text: str | None, update_file: Any, as_json: bool) -> None:
     with HeldInterrupts() as interrupts:
         interrupts.hold("running the update")
         try:
-            report = app.kb.update_counted(prologue(added) + body)
+            report = app.kb.update_counted(declared(added, body))
         except QuerySyntaxError as error:
             counted = one_line_up(error, body) if added else error  # placed in the text as written
             explained = explain_syntax_error(counted, body, "update", names.prefixes)

@@ -27,6 +27,7 @@ from cbrs.kb.sparql_lexemes import HIDING
 __all__ = [
     "FORMS",
     "TOKENS",
+    "declared",
     "explain_syntax_error",
     "first_keyword",
     "one_line_up",
@@ -119,6 +120,14 @@ def prologue(prefixes: Mapping[str, str]) -> str:
     if not prefixes:
         return ""
     return " ".join(f"PREFIX {prefix}: <{namespace}>" for prefix, namespace in prefixes.items()) + "\n"
+
+
+def declared(prefixes: Mapping[str, str], text: str) -> str:
+    """The user's own ``text`` under a :func:`prologue` of ``prefixes`` (the store's derived ones it uses and
+    does not declare, :func:`store_prefixes_used`: names and namespaces checked there, from the store's
+    IRIs only). Nothing typed goes into the prologue; the text itself is the user's query or update, run
+    as written."""
+    return prologue(prefixes) + text
 
 
 def one_line_up(error: QuerySyntaxError, text: str) -> QuerySyntaxError:
