@@ -22,6 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.person_choice import look_alikes
 from cbrs.sim import predicates as pred
 from cbrs.sim.arms import Arm, ArmSide
 from cbrs.sim.cameras import Camera, Frame, project
@@ -76,6 +77,11 @@ class PerceivedWorld(Judge):
         self.colour_owners: dict[str, frozenset[str]] = _colour_owners(world)
         """Who shows each colour, by the map (objects, markers' patches, shirts, water): an object is
         looked for anywhere only when nothing else is of its colour."""
+        self.look_alikes: frozenset[str] = frozenset(iri for _, iris in look_alikes(world.map) for iri in iris)
+        """The people who share their shirt colour with another (by IRI): the cameras, which find a person by
+        the largest patch of that colour, cannot say which of them a patch is, so none of them is believed
+        anywhere by sight (the map's place stands), and a task for one is refused by the plan's checks
+        (``kb.person_choice.LookAlikePeopleError``) whatever the seed put where."""
 
     # -- updating the belief ---------------------------------------------------------------------
 
@@ -117,7 +123,10 @@ class PerceivedWorld(Judge):
         An object's belief comes from the preferred camera that finds it: the cameras are asked in
         reverse name order (Kinect01, CeilingCamera02, CeilingCamera01 in the bundled home) and the
         first that finds the object decides; a camera is rendered only when it is asked. A person's
-        comes from the camera looking down that sees most of their shirt, so all those are rendered.
+        comes from the camera looking down that sees most of their shirt, so all those are rendered; a
+        person whose shirt colour another wears is not looked for (:attr:`look_alikes`): one patch would
+        place both, and at seeds where the other's patch was larger the resident was believed in the
+        kitchen at the visitor's place, and the run answered "no plan" instead of the look-alike refusal.
         """
         self.feel()
         names = sorted(self.world.objects) if objects is None else sorted(set(objects))
@@ -139,6 +148,8 @@ class PerceivedWorld(Judge):
             if frame is None:
                 continue
             for person in self.world.map.people.values():
+                if person.iri in self.look_alikes:
+                    continue
                 try:
                     estimate = track_person(frame, person.colour)
                 except SimulationError:

@@ -1,0 +1,54 @@
+"""What the fifth blind round (docs/tasks.md, "A fifth round") saw fail mid-run is refused before anything
+moves: two people in one shirt colour at every seed (the cameras place neither, so a seed that saw the
+other's patch larger no longer puts the resident at the visitor's place), a hand that grips but does not
+reach no longer lets the grip check pass for one that reaches but cannot grip, and fingers too short for a
+side grasp (and a palm too deep for a top one) are found before the run, in the step's own words. One
+world is built and not stepped (seed 1, where the look-alike refusal used to be "no plan")."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from cbrs.actions.composer import Composer
+from cbrs.actions.runner import run_task
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.person_choice import LookAlikePeopleError
+from cbrs.kb.semantic_map import SemanticMap
+from cbrs.sim.components import SimEnvironment
+from cbrs.sim.world import open_world
+
+EXAMPLES = Path(__file__).parent.parent / "docs" / "examples"
+WORLD, LAB5 = PREFIXES["world"], "https://example.org/lab5#"
+
+
+def _store(*, things: tuple[str, ...] = (), hands: str | None = None) -> KnowledgeBase:
+    """A bundled store with the round's ``things`` in the ontology and the map, and, when given, the lab's
+    ``hands`` in place of the Panda hands."""
+    kb = KnowledgeBase.open(":memory:")
+    for name in things:
+        kb.load([EXAMPLES / name], graph="ontology")
+        kb.load([EXAMPLES / name], graph="map")
+    if hands is not None:
+        kb.update((EXAMPLES / "lab5_unhand.ru").read_text())
+        kb.load([EXAMPLES / hands], graph="map")
+    return kb
+
+
+def test_two_people_in_one_colour_are_placed_by_no_camera_and_the_task_is_refused_at_seed_1() -> None:
+    """At seed 1 the visitor's yellow patch is the larger: both people were believed at the visitor's place,
+    the living room's tracker was passed over for the resident, and the run said "no plan". Neither is
+    believed anywhere by sight now, and FetchMyPen is refused for the look-alike before anything moves."""
+    kb = _store(things=("lab5_visitor_in_yellow.ttl",))
+    with open_world(seed=1, semantic_map=SemanticMap.read(kb)) as world:
+        environment = SimEnvironment(world, kb)
+        assert environment.belief.look_alikes == {WORLD + "Person", LAB5 + "Visitor1"}
+        environment.perceive()
+        assert environment.belief.people == {}
+        start = world.time
+        with pytest.raises(LookAlikePeopleError, match="as Visitor1 does") as refused:
+            run_task(kb, "FetchMyPen", environment, composer=Composer(kb))
+        assert refused.value.step.endswith("TrackPerson_CeilingCamera01")
+        assert world.time == start  # nothing moved
