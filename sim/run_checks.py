@@ -351,8 +351,8 @@ class PlanChecks:
                 where = ((box[0] + box[1]) / 2, (box[2] + box[3]) / 2)
                 if not any(distance <= arm.reach for arm, distance in reaches):
                     raise OutOfReachError(step.device or "", iri, where, report, height=height)
-                if iri in objects:  # in reach: a hand must fit it too
-                    self._check_grip(step.device or "", iri, robot_arms)
+                if iri in objects:  # in reach: a hand of an arm that reaches it must fit it too
+                    self._check_grip(step.device or "", iri, [arm for arm, d in reaches if d <= arm.reach])
                 if iri in smap.regions or iri in smap.furniture:
                     self._check_spot(step, iri, at_hand.get(step.device or "", []), report)
 
@@ -384,7 +384,9 @@ class PlanChecks:
         return bottom + obj.grasp_height
 
     def _check_grip(self, robot: str, iri: str, arms: list[Any]) -> None:
-        """Refuse an object no hand of ``arms`` can grip by any approach its class allows, wherever it
+        """Refuse an object no hand of ``arms`` (those that reach it: a hand that grips it out of reach
+        takes nothing, and the narrow left hand's cup passed here on the right arm's Panda hand, to be
+        refused by the approach after a re-plan) can grip by any approach its class allows, wherever it
         is and however it lies: too thin for a top grasp to hold above its surface (:func:`held_height`),
         or wider at its narrowest (a cylinder's diameter, a box's narrower side: the least the jaws pass
         whichever way they close) than the hand's widest."""

@@ -8,6 +8,8 @@ world is built and not stepped (seed 1, where the look-alike refusal used to be 
 from __future__ import annotations
 
 from pathlib import Path
+from types import SimpleNamespace
+from typing import Any, cast
 
 import pytest
 
@@ -16,12 +18,15 @@ from cbrs.actions.runner import run_task
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.person_choice import LookAlikePeopleError
-from cbrs.kb.semantic_map import SemanticMap
+from cbrs.kb.semantic_map import SemanticMap, designate_each
 from cbrs.sim.components import SimEnvironment
+from cbrs.sim.run_checks import CannotGripError, PlanChecks
+from cbrs.sim.values import designator
 from cbrs.sim.world import open_world
 
 EXAMPLES = Path(__file__).parent.parent / "docs" / "examples"
 WORLD, LAB5 = PREFIXES["world"], "https://example.org/lab5#"
+LEFT, RIGHT = WORLD + "CytonDualArm01LeftArm", WORLD + "CytonDualArm01RightArm"
 
 
 def _store(*, things: tuple[str, ...] = (), hands: str | None = None) -> KnowledgeBase:
@@ -52,3 +57,37 @@ def test_two_people_in_one_colour_are_placed_by_no_camera_and_the_task_is_refuse
             run_task(kb, "FetchMyPen", environment, composer=Composer(kb))
         assert refused.value.step.endswith("TrackPerson_CeilingCamera01")
         assert world.time == start  # nothing moved
+
+
+class _Unseen:
+    """A belief that has seen nothing yet: the checks take each object where the map puts it."""
+
+    def position(self, name: str) -> None:
+        return None
+
+
+def _grip_refusal(kb: KnowledgeBase, task: str) -> CannotGripError:
+    """The refusal the plan's reach and grip checks give ``task``, from the map alone (no world is built:
+    those checks read nothing else), its inputs valued as the simulation's ``given`` values them."""
+    plan = Composer(kb).compose(task).plan
+    assert plan is not None
+    requirement = next(r for r in kb.requirements() if r.service_name == task)
+    wanted = [(parameter.type, requirement.requested_by) for parameter in requirement.inputs]
+    things = designate_each(kb, wanted)
+    values = {
+        parameter.name: designator(iri, concept)
+        for parameter, iri, (concept, _) in zip(requirement.inputs, things, wanted, strict=True)
+    }
+    world = cast(Any, SimpleNamespace(map=SemanticMap.read(kb)))
+    checks = PlanChecks(world, kb, cast(Any, _Unseen()), cast(Any, None), lambda one, other: one == other)
+    with pytest.raises(CannotGripError) as refused:
+        checks._check_reach(plan, values)
+    return refused.value
+
+
+def test_a_hand_that_cannot_grip_is_not_let_off_by_a_hand_that_does_not_reach() -> None:
+    """The narrow hand on the left arm only: the right arm's Panda hand would grip the cup but does not reach
+    it, so the cup is refused for the left hand's jaws (it went on to ApproachToObject, and a re-plan)."""
+    error = _grip_refusal(_store(hands="lab5_narrow_left_hand.ttl"), "RobotArmServeACup")
+    assert {arm for arm, _, _ in error.refusals} == {LEFT}
+    assert "the hand opens 5.0 cm" in str(error)
