@@ -29,7 +29,7 @@ from cbrs.sim.hold_choice import Candidates, GraspChoice, first_clear, refuse_mo
 from cbrs.sim.perception import ObjectEstimate
 from cbrs.sim.place_spots import other_objects, place_spots, reach_of, spot_region
 from cbrs.sim.relay import CLEAR_TRIES, RELAY_TRIES, relay_spot, resting_at
-from cbrs.sim.transit import floor_to
+from cbrs.sim.transit import floor_cause, floor_to
 
 ACT = PREFIXES["act"]
 
@@ -333,20 +333,28 @@ def carry_check(
         if grasp is None:
             return f"the {side.value} gripper holds nothing", ""
         held, start = grasp.model, world.arm(side).ee_pose().position
+        bottom = start[2] - grasp.bottom_offset
         floor = floor_to(ctx, held, side, start, spot)
         planned = skills.plan_carry_held(world, side, spot, floor, CARRY_CLEARANCE)
     else:
         seen, held = taking
-        floor = floor_to(ctx, held, side, seen.position, spot)
+        start = seen.position
+        bottom = seen.position[2] - seen.size[2] / 2.0 + skills.LIFT_HEIGHT  # lifted, as the take's dry run
+        floor = floor_to(ctx, held, side, start, spot)
         planned = skills.plan_carry(
             world, seen, side, held, spot, floor=floor, folded=folded, clearance=CARRY_CLEARANCE
         )
     cx, cy, _ = spot.center
+    refused = planned.refused
+    if refused and floor is not None and floor >= max(bottom, spot.zmin + skills.ABOVE_CLEARANCE):
+        # the floor sets how high the carry goes: say what it keeps over, as the store states it
+        cause = floor_cause(ctx, held, side, (start[0], start[1]), (cx, cy))
+        refused += f"; the carry keeps the {held.name}'s bottom at {floor:.3f} m or higher: {cause}"
     near = planned.brushed
     brushed = near and f"the {side.value} arm carrying the {held.name} to ({cx:.2f}, {cy:.2f}): {near}"
     if taking is None:  # a held carry that comes that near is refused too
-        return planned.refused or brushed, brushed
-    return planned.refused, brushed
+        return refused or brushed, brushed
+    return refused, brushed
 
 
 def _clear_spot(

@@ -19,7 +19,7 @@ import pybullet as p
 
 from cbrs.kb.hands import Hand
 from cbrs.sim import predicates as pred
-from cbrs.sim.arms import Arm, ArmSide, MotionResult, PlannedArm
+from cbrs.sim.arms import COLLISION_MARGIN, Arm, ArmSide, MotionResult, PlannedArm
 from cbrs.sim.errors import GraspMisfitError, GraspTooWideError
 from cbrs.sim.geometry import Pose2D, Pose3D, Quat, Region, Vec3, wrap_angle
 from cbrs.sim.grasping import (
@@ -42,6 +42,7 @@ __all__ = [
     "NAVIGATION_TOLERANCE",
     "DryRun",
     "Outcome",
+    "appliances",
     "approach_object",
     "can_carry",
     "can_carry_held",
@@ -55,6 +56,7 @@ __all__ = [
     "deliver_object",
     "fill_cup_from_tap",
     "hand_over_onto_platform",
+    "held_meets",
     "navigate",
     "navigate_to_person",
     "navigate_to_place",
@@ -218,7 +220,7 @@ def carry_object(
     if arm.held is None or grasp is None:
         return _done(world, "CarryObject", start, False, f"the {arm.side} gripper holds nothing")
     name = world.name_of(arm.held) or "?"
-    result = _carry(arm, grasp, region, yaw, floor)
+    result = _carry(arm, grasp, region, yaw, floor, appliances(world))
     if not result.reached:
         return _done(world, "CarryObject", start, False, result.reason)
     ok = pred.object_above_region(world, name, region)
@@ -247,7 +249,12 @@ class _Moving(Protocol):
 
 
 def _carry(
-    arm: _Moving, grasp: GraspPose, region: Region, yaw: float | None, floor: float | None = None
+    arm: _Moving,
+    grasp: GraspPose,
+    region: Region,
+    yaw: float | None,
+    floor: float | None = None,
+    fixtures: Sequence[Region] = (),
 ) -> MotionResult:
     """carry_object's moves: up to the transit height (the object's bottom where it is, ABOVE_CLEARANCE
     over the region, or ``floor``, whichever is highest), across to over the region's centre, down to
@@ -256,7 +263,8 @@ def _carry(
     would leave the hand where put_down_object cannot lower the object (:func:`_down`). Through joint
     space the hand keeps its turn about its approach axis unless that axis is vertical (a top grasp): a
     half turn about a side grasp's axis turns the object over. Before, a 15 cm vase reached a sill
-    tilted 109 degrees and fell over as the hand opened."""
+    tilted 109 degrees and fell over as the hand opened. A way on which the held object would meet one of
+    ``fixtures`` (:func:`held_meets`) is refused before any move, real or planned."""
     ee = arm.ee_pose()
     orientation = ee.orientation
     if yaw is not None and grasp.model.grasp is GraspKind.TOP:
@@ -265,6 +273,9 @@ def _carry(
     above = region.zmin + ABOVE_CLEARANCE
     transit = max(bottom, above, bottom if floor is None else floor) + grasp.bottom_offset
     cx, cy, _ = region.center
+    met = held_meets(fixtures, grasp, ee.position, (cx, cy, above + grasp.bottom_offset), transit - grasp.bottom_offset)
+    if met:
+        return MotionResult(False, math.inf, met)
     turnable = grasp.model.grasp is GraspKind.TOP
     legs: list[Vec3] = [
         (ee.position[0], ee.position[1], transit),
@@ -283,6 +294,55 @@ def _carry(
         if not result.reached:
             return result
     return result
+
+
+HELD_STEP = 0.005
+"""How finely (m) :func:`held_meets` follows the held object along its way."""
+
+
+def appliances(world: HomeWorld) -> list[Region]:
+    """What a held object is carried clear of: each dispenser's body and spout, as the map places them, the
+    appliances the arms' planning keeps the arm clear of (a tap's lever, which a hand pushes, is not one;
+    the carry's clearance notes it, :data:`~cbrs.sim.arms.CARRY_CLEARANCE`). The planning knows nothing of
+    the held object."""
+    return [
+        Region(thing.name, b.min_x, b.max_x, b.min_y, b.max_y, b.min_z, b.max_z)
+        for dispenser in world.dispensers
+        for thing in (dispenser.body, dispenser.spout)
+        if (b := thing.box) is not None
+    ]
+
+
+def held_meets(fixtures: Sequence[Region], grasp: GraspPose, start: Vec3, end: Vec3, bottom: float) -> str:
+    """Why the object held by ``grasp`` cannot go carry_object's way (empty if it can): carried with its
+    bottom at ``bottom`` from over the grasp point at ``start`` to over ``end``, and lowered there until
+    the grasp point is at ``end``, it would come within COLLISION_MARGIN (what the arm's joint-space moves
+    keep from the fixed things) of one of ``fixtures``, its footprint a circle round the grasp point (the
+    object's width across, or its footprint's diagonal). The arms' planning sees the arm alone: with the
+    floor a side grasp keeps for a lab's forearm band 6 cm below the grasp point over a second cup, a cup
+    was carried with its top at 0.95 m, the height of the tap's lever and spout (0.94-0.98 m), towards the
+    spot below the spout, and the carry stopped 10 cm short against them after the dry run had passed it."""
+    model = grasp.model
+    radius = (math.hypot(*model.footprint) if model.footprint is not None else model.width) / 2.0
+    reach = radius + COLLISION_MARGIN
+    top = bottom + model.height
+    lowest = end[2] - grasp.bottom_offset
+    steps = max(1, math.ceil(math.dist(start[:2], end[:2]) / HELD_STEP))
+    for fixture in fixtures:
+        for i in range(steps + 1):
+            t = i / steps
+            x, y = start[0] + (end[0] - start[0]) * t, start[1] + (end[1] - start[1]) * t
+            low = lowest if i == steps else bottom  # lowered where the way ends
+            level = fixture.zmin < top + COLLISION_MARGIN and fixture.zmax > low - COLLISION_MARGIN
+            dx = max(fixture.xmin - x, 0.0, x - fixture.xmax)
+            dy = max(fixture.ymin - y, 0.0, y - fixture.ymax)
+            if level and math.hypot(dx, dy) < reach:
+                return (
+                    f"the {model.name}, carried with its bottom at {bottom:.3f} m (its top at {top:.3f} m), would "
+                    f"come within {COLLISION_MARGIN * 100:.0f} cm of the {fixture.name} ({fixture.zmin:.3f}-"
+                    f"{fixture.zmax:.3f} m high) at ({x:.3f}, {y:.3f}) on its way to ({end[0]:.3f}, {end[1]:.3f})"
+                )
+    return ""
 
 
 def _down(arm: _Moving, grasp: GraspPose, region: Region, leg: Vec3, orientation: Quat) -> MotionResult:
@@ -641,7 +701,8 @@ def plan_carry(
     ]
     if region is not None:
         cx, cy, _ = region.center
-        moves.append((f"carrying it to ({cx:.2f}, {cy:.2f})", lambda: _carry(hand, grasp, region, yaw, floor)))
+        carrying = f"carrying it to ({cx:.2f}, {cy:.2f})"
+        moves.append((carrying, lambda: _carry(hand, grasp, region, yaw, floor, appliances(world))))
         lowering = f"lowering it onto {region.name} at ({cx:.2f}, {cy:.2f})"
         moves.append((lowering, lambda: _set_down(hand, grasp, region)))
     return DryRun(_first_refused(moves, arm, model), hand.brushed)
@@ -690,7 +751,7 @@ def plan_carry_held(
     hand = arm.dry_run(clear_by=clearance)
     cx, cy, _ = region.center
     moves: list[tuple[str, Callable[[], MotionResult]]] = [
-        (f"carrying it to ({cx:.2f}, {cy:.2f})", lambda: _carry(hand, grasp, region, None, floor)),
+        (f"carrying it to ({cx:.2f}, {cy:.2f})", lambda: _carry(hand, grasp, region, None, floor, appliances(world))),
         (f"lowering it onto {region.name} at ({cx:.2f}, {cy:.2f})", lambda: _set_down(hand, grasp, region)),
     ]
     return DryRun(_first_refused(moves, ArmSide(side), grasp.model), hand.brushed)

@@ -40,13 +40,31 @@ def transit_floor(
     as far over the top of any under it. None when no object stands by the way. Without it, a pill box passed
     between the arms was carried 4 cm above the table, and the hand swept the cup beside its way off the
     table."""
+    needs = _needs(ctx, held, side, start, end)
+    return max(height for height, _ in needs) if needs else None
+
+
+def floor_cause(
+    ctx: SimContext, held: ObjectModel, side: ArmSide, start: tuple[float, float], end: tuple[float, float]
+) -> str:
+    """What sets :func:`transit_floor` of the same way: the thing standing by it, and what of the hand or the
+    arm keeps over it (a band of the arm behind a side grasp, as the store states it); empty when nothing
+    stands by the way. A carry that cannot be made at that floor is refused naming it."""
+    needs = _needs(ctx, held, side, start, end)
+    return max(needs)[1] if needs else ""
+
+
+def _needs(
+    ctx: SimContext, held: ObjectModel, side: ArmSide, start: tuple[float, float], end: tuple[float, float]
+) -> list[tuple[float, str]]:
+    """Each height :func:`transit_floor` asks of the held object's bottom, with what asks it."""
     world = ctx.world
     hand = world.arm(side).hand
     size = world.objects[held.name].size if held.name in world.objects else (held.width, held.width, held.height)
     near = max(math.hypot(size[0], size[1]) / 2.0, hand.jaw_opening / 2.0)
     palm = held.grasp_height + hand.palm_depth
     facing = world.arm_specs[side].yaw if held.grasp is GraspKind.SIDE else None
-    floor: float | None = None
+    needs: list[tuple[float, str]] = []
     for name, obj in world.objects.items():
         if name == held.name or any(arm.held == world.body(name) for arm in world.arms.values()):
             continue
@@ -59,17 +77,26 @@ def transit_floor(
         radius = math.hypot(obj.size[0], obj.size[1]) / 2.0
         apart = _segment_distance(start, end, (x, y)) - radius
         top = z + obj.size[2] / 2.0 + TRANSIT_CLEARANCE
-        needed: list[float] = []
+        over = f"the {name} (its top at {top - TRANSIT_CLEARANCE:.3f} m)"
         if apart < near + TRANSIT_CLEARANCE:
-            needed.append(top)
+            needs.append((top, f"the {held.name} itself kept {TRANSIT_CLEARANCE * 100:.0f} cm over {over}"))
         elif apart < near + hand.carry_corridor:
-            needed.append(top - palm)
+            corridor = f"{hand.carry_corridor * 100:.0f} cm carry corridor"
+            needs.append((top - palm, f"the hand's palm, over {over} within its {corridor}"))
         if facing is not None:
-            under = _under(hand.side_arm, start, end, facing, (x, y), radius)
-            needed += [top - band.underside - held.grasp_height for band in under]
-        if needed:
-            floor = max(needed) if floor is None else max(floor, *needed)
-    return floor
+            for band in _under(hand.side_arm, start, end, facing, (x, y), radius):
+                needs.append((top - band.underside - held.grasp_height, f"{_band(band)} over {over}"))
+    return needs
+
+
+def _band(band: ArmBand) -> str:
+    """A band of the arm behind a side grasp, as the store states it, for a message."""
+    level = "level with" if band.underside == 0.0 else f"{abs(band.underside) * 100:.1f} cm "
+    level += "" if band.underside == 0.0 else ("above" if band.underside > 0.0 else "below")
+    return (
+        f"the arm's band {band.near:.3f}-{band.far:.3f} m back from the grasp point ({band.half_width * 100:.0f} cm "
+        f"to either side, {level} the grasp point; home:sideGraspBand)"
+    )
 
 
 def _under(

@@ -55,13 +55,13 @@ def test_the_jar_is_set_down_where_its_carry_keeps_clear_of_the_tap() -> None:
         mounts = [(spec.mount[0], spec.mount[1], spec.reach)]
         surface, spots = place_spots(smap, smap.things[WORLD + "KitchenTableTop"], size, mounts, others)
         first = spot_region(surface, *spots[0])
-        unchecked = skills.can_carry_held(world, side, first)  # the arm's own planning makes that carry
+        unchecked = skills.can_carry_held(world, side, first)  # the arm's planning would; the jar meets the spout
         brushed = arm_choice.carry_clear(ctx, side, first)
         chosen = arm_choice.holdable_spot(ctx, side, surface, spots)
         assert chosen is not None
         clear = arm_choice.carry_clear(ctx, side, spot_region(surface, *chosen))
     assert spots[0] == (7.63, 3.33)  # beside the dispenser, nearest the table's centre
-    assert unchecked == ""
-    assert "would come within 1 cm of the Tap01" in brushed
+    assert "the SpiceJar1, carried with its bottom at" in unchecked and "of the Spout01" in unchecked  # held_meets
+    assert "would come within 1 cm of the Spout01" in brushed  # the jar it holds, as the dry run says
     assert chosen != spots[0] and clear == ""
     assert math.dist(chosen, spots[0]) <= 0.05  # the next spots clear of it, not the far side of the table
