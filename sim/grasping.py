@@ -23,6 +23,7 @@ __all__ = [
     "GraspKind",
     "GraspPose",
     "ObjectModel",
+    "check_side_depth",
     "compute_grasp_pose",
     "held_height",
     "palm_stop",
@@ -170,6 +171,15 @@ def side_held(depth: float, hand: Hand) -> float:
     return min(depth, hand.side_span)
 
 
+def check_side_depth(model: ObjectModel, depth: float, hand: Hand) -> None:
+    """:class:`GraspTooDeepError` when a side grasp by ``hand`` would hold less than its side-hold fraction
+    of an object ``depth`` deep along the approach (:func:`side_held`): the grasp's own decision, which the
+    checks before a run ask too (``sim.run_checks``), so that they refuse it in the same words."""
+    held = side_held(depth, hand)
+    if held < hand.side_hold * depth - 1e-9:
+        raise GraspTooDeepError(model.name, model.grasp.value, depth, hand.finger_length, held, hand.side_hold)
+
+
 def palm_stop(depth: float, hand: Hand, lead: float = PALM_LEAD) -> float:
     """How far short of an object's centre, along a side grasp's level approach, ``hand``'s grasp point
     stops so that the palm stops at the object's near side instead of pushing it: the near side is half
@@ -287,9 +297,7 @@ def compute_grasp_pose(
         raise GraspTooWideError(model.name, model.grasp.value, width, hand.jaw_opening, hand.jaw_clearance)
     if model.grasp is GraspKind.SIDE:
         depth = model.across(facing, yaw, seen)  # its extent along the approach, as across the jaws
-        held = side_held(depth, hand)
-        if held < hand.side_hold * depth - 1e-9:
-            raise GraspTooDeepError(model.name, model.grasp.value, depth, hand.finger_length, held, hand.side_hold)
+        check_side_depth(model, depth, hand)
         short = palm_stop(depth, hand)
         cx, cy = cx - math.cos(facing) * short, cy - math.sin(facing) * short
     grip = model.grip(closing, yaw)

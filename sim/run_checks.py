@@ -18,17 +18,18 @@ from typing import Any
 from cbrs.actions.plan import Plan, PlanStep
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import KnowledgeBaseError
+from cbrs.kb.hands import Hand
 from cbrs.kb.model import Advertisement
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.person_choice import person_for
 from cbrs.kb.semantic_map import MapObject, NotGraspableError, Person, Thing, local_name
 from cbrs.kb.store import Term
-from cbrs.sim import sight
+from cbrs.sim import sight, skills
 from cbrs.sim.arm_choice import who_loads
 from cbrs.sim.context import SimContext, SkillFailed
-from cbrs.sim.errors import GraspTooThinError, GraspTooWideError, MovesRefusedError
+from cbrs.sim.errors import GraspTooDeepError, GraspTooThinError, GraspTooWideError, MovesRefusedError
 from cbrs.sim.geometry import Pose2D
-from cbrs.sim.grasping import ObjectModel, held_height
+from cbrs.sim.grasping import GraspKind, ObjectModel, check_side_depth, held_height
 from cbrs.sim.grounding import docking_pose, people_given, task_inputs_of
 from cbrs.sim.perceived import PerceivedWorld
 from cbrs.sim.perception import ObjectEstimate
@@ -108,29 +109,98 @@ class OutOfReachError(KnowledgeBaseError):
 
 
 class CannotGripError(KnowledgeBaseError):
-    """An object a task gives to a robot's arms fits no hand of the robot by any approach its class allows,
-    wherever it is and however it lies: too thin for a top grasp to hold above the surface it rests on
-    (:class:`GraspTooThinError`), or wider at its narrowest than the jaws open less their clearance
-    (:class:`GraspTooWideError`): the run is refused before anything moves. ``refusals`` holds (arm IRI,
-    approach, why)."""
+    """An object a task gives to a robot's arms fits no hand of the robot that reaches it, by any approach its
+    class allows, wherever it is and however it lies (:func:`grip_refusal`): the run is refused before
+    anything moves. ``refusals`` holds (arm IRI, approach, why); ``limits`` which of a hand's values limit
+    each (the keys of :data:`GRIP_LIMITS`), for the advice."""
 
     http_status = 422
 
-    def __init__(self, robot: str, thing: str, refusals: list[tuple[str, str, str]]) -> None:
+    def __init__(
+        self, robot: str, thing: str, refusals: list[tuple[str, str, str]], limits: Sequence[str] = ()
+    ) -> None:
         self.robot = robot
         self.thing = thing
         self.refusals = tuple(refusals)
+        self.limits = tuple(dict.fromkeys(limits))
         said: dict[tuple[str, str], list[str]] = {}  # one reason once, with the arms it holds for
         for arm, approach, why in self.refusals:
             said.setdefault((approach, why), []).append(local_name(arm))
         each = "; ".join(
             f"by its {approach} grasp ({', '.join(arms)}): {why}" for (approach, why), arms in said.items()
         )
-        super().__init__(
-            f"no hand of {local_name(robot)} can grip the {local_name(thing)}: {each}; a hand's "
-            "home:fingertipClearance and home:jawClearance say how far above the surface its fingertips stay "
-            "and how far each jaw must clear the object"
-        )
+        advice = "; ".join(GRIP_LIMITS[limit] for limit in self.limits if limit in GRIP_LIMITS)
+        super().__init__(f"no hand of {local_name(robot)} can grip the {local_name(thing)}: {each}; a hand's {advice}")
+
+
+GRIP_LIMITS = {
+    "thin": (
+        "home:fingertipClearance and home:fingertipDepth say how far above the surface its fingertips stay "
+        "and how far below the grasp point they reach"
+    ),
+    "wide": "home:jawOpening says how far its jaws open, home:jawClearance how far each must clear the object",
+    "deep": (
+        "home:fingerLength says how long its fingers are (tilted down by home:sideGraspPitch in a side grasp), "
+        "home:sideHoldFraction how much of the object's depth they must hold"
+    ),
+    "palm": "home:palmDepth says how far its palm is above the fingers' grasp point",
+}
+"""The hand's values that limit a grip, by the kind of misfit, as :class:`CannotGripError` advises them:
+the value that refused it first (the jaws' opening for an object too wide), then the policy beside it."""
+
+
+def grip_refusal(model: ObjectModel, hand: Hand) -> tuple[str, str] | None:
+    """Why ``hand`` cannot hold the object by ``model``'s approach wherever it is and however it lies, and
+    the kind of misfit (a key of :data:`GRIP_LIMITS`); None when it can. The step's own decisions, in its
+    words: too thin for a top grasp to hold above its surface (:func:`held_height`); wider at its narrowest
+    (a cylinder's diameter, a box's narrower side: the least the jaws pass whichever way they close) than
+    the hand's widest, or a top grasp whose palm meets the object's top (:func:`skills.can_grip`); a side
+    grasp deeper than the fingers hold (:func:`check_side_depth`) however the object is turned to the jaws
+    that pass it (a box across either side). The short fingers' cup was refused so by ApproachToObject
+    after a re-plan, the check before the run knowing only the jaws and the thickness."""
+    try:
+        held_height(model, hand)
+    except GraspTooThinError as thin:
+        return str(thin), "thin"
+    if model.width > hand.widest + 1e-9:
+        wide = GraspTooWideError(model.name, model.grasp.value, model.width, hand.jaw_opening, hand.jaw_clearance)
+        return str(wide), "wide"
+    palm = skills.can_grip(model, hand)  # the jaws pass it: a top grasp's palm on its top is what is left
+    if palm:
+        return palm, "palm" if model.top_clearance(hand) < 0.0 else "wide"
+    if model.grasp is not GraspKind.SIDE:
+        return None
+    deep: GraspTooDeepError | None = None
+    for across, depth in _side_lies(model, hand):
+        if across > hand.widest + 1e-9:
+            continue
+        try:
+            check_side_depth(model, depth, hand)
+        except GraspTooDeepError as error:
+            deep = deep or error
+            continue
+        return None
+    return (str(deep), "deep") if deep is not None else None
+
+
+def _side_lies(model: ObjectModel, hand: Hand) -> list[tuple[float, float]]:
+    """(width across the jaws, depth along the approach) of the object turned to a side grasp each way that
+    may pass both (the step's ``ObjectModel.across`` each way): a box turned by t from lying with its
+    side ``a`` across the jaws is a cos t + b sin t across and a sin t + b cos t deep, so the turns at
+    which either meets its limit (the hand's widest; the deepest its fingers hold) bound the ranges of
+    turns that pass it, and a turn that passes both is among them or the square lies. Narrowest across
+    first. A cylinder is its diameter either way."""
+    if model.footprint is None:
+        return [(model.width, model.width)]
+    a, b = sorted(model.footprint)
+    radius = math.hypot(a, b)
+    held = hand.side_span / hand.side_hold if hand.side_hold > 0.0 else math.inf
+    turns = [0.0, math.pi / 2.0]
+    for limit, phase in ((hand.widest, math.atan2(b, a)), (held, math.atan2(a, b))):
+        if limit < radius:
+            spread = math.acos(limit / radius)
+            turns += [t for t in (phase - spread, phase + spread) if 0.0 < t < math.pi / 2.0]
+    return [(a * math.cos(t) + b * math.sin(t), a * math.sin(t) + b * math.cos(t)) for t in sorted(turns)]
 
 
 class PlaceCrowdedError(KnowledgeBaseError):
@@ -387,28 +457,22 @@ class PlanChecks:
         """Refuse an object no hand of ``arms`` (those that reach it: a hand that grips it out of reach
         takes nothing, and the narrow left hand's cup passed here on the right arm's Panda hand, to be
         refused by the approach after a re-plan) can grip by any approach its class allows, wherever it
-        is and however it lies: too thin for a top grasp to hold above its surface (:func:`held_height`),
-        or wider at its narrowest (a cylinder's diameter, a box's narrower side: the least the jaws pass
-        whichever way they close) than the hand's widest."""
+        is and however it lies (:func:`grip_refusal`)."""
         obj = self.world.map.objects[iri]
         model = ObjectModel.of(obj)
         refusals: list[tuple[str, str, str]] = []
+        limits: list[str] = []
         for kind in model.preference:
             for arm in arms:
                 hand = self.world.map.hands.get(arm.iri)
                 if hand is None:
                     return  # a hand the map does not describe: the run's own to find
-                try:
-                    held_height(model.by(kind), hand)
-                except GraspTooThinError as thin:
-                    refusals.append((arm.iri, kind.value, str(thin)))
-                    continue
-                if model.width > hand.widest + 1e-9:
-                    wide = GraspTooWideError(model.name, kind.value, model.width, hand.jaw_opening, hand.jaw_clearance)
-                    refusals.append((arm.iri, kind.value, str(wide)))
-                    continue
-                return
-        raise CannotGripError(robot, iri, refusals)
+                refused = grip_refusal(model.by(kind), hand)
+                if refused is None:
+                    return
+                refusals.append((arm.iri, kind.value, refused[0]))
+                limits.append(refused[1])
+        raise CannotGripError(robot, iri, refusals, limits)
 
     def _check_spot(
         self, step: PlanStep, iri: str, carried: list[str], report: list[tuple[str, float, float, float, float]]

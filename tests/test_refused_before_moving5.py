@@ -91,3 +91,19 @@ def test_a_hand_that_cannot_grip_is_not_let_off_by_a_hand_that_does_not_reach() 
     error = _grip_refusal(_store(hands="lab5_narrow_left_hand.ttl"), "RobotArmServeACup")
     assert {arm for arm, _, _ in error.refusals} == {LEFT}
     assert "the hand opens 5.0 cm" in str(error)
+    assert "home:jawOpening says how far its jaws open" in str(error)  # the value the lab stated limits it
+    assert "home:fingertipClearance" not in str(error)  # the cup is not too thin: that advice does not apply
+
+
+def test_fingers_too_short_for_a_side_grasp_are_refused_before_the_run_in_the_steps_words() -> None:
+    """3 cm fingers and a 2 cm palm: the cup too deep for the side grasp, its top too far above the grasp point
+    for the top grasp's palm. ApproachToObject refused both after a re-plan; the check before the run now
+    does, in the same words (``grasping.check_side_depth``, ``skills.can_grip``), naming the values that
+    limit it."""
+    error = _grip_refusal(_store(hands="lab5_short_fingers.ttl"), "RobotArmServeACup")
+    said = str(error)
+    assert {approach for _, approach, _ in error.refusals} == {"side", "top"}
+    assert "deep along the hand's approach by its side grasp, and the fingers are 3.0 cm long" in said
+    assert "the hand's palm is 2.0 cm above the fingers' grasp point" in said
+    assert error.limits == ("deep", "palm")
+    assert "home:fingerLength" in said and "home:palmDepth" in said and "home:jawOpening" not in said
