@@ -75,6 +75,11 @@ the opening less twice this is refused. The Kinect's estimate of an object's cen
 across the jaws (the cup, seeds 0-7), and the Panda's open fingers' inner faces sit 1.1 mm inside the
 stated opening on each side (docs/simulation.md, "The hand"). The default of ``home:jawClearance``."""
 
+SIDE_PALM_LEAD = 0.0052
+"""How far ahead of its point on the hand's axis a side grasp's palm reaches along the level approach (m):
+tilted down by the side pitch, the palm's face leans forward above the axis. The Panda hand's at 35
+degrees, measured on its collision mesh (ontologies/world.ttl): the default of ``home:sidePalmLead``."""
+
 CARRY_CORRIDOR = 0.10
 """How far to either side of what a hand carries (the object's footprint, or the open jaws' if wider) its
 palm passes over other things, footprint to footprint (m): a carry keeps the palm over the top of any
@@ -109,6 +114,9 @@ class Hand:
     side_arm: tuple[ArmBand, ...] = PANDA_SIDE_ARM
     """The arm behind a side grasp by this hand (``home:sideGraspBand``): a carry keeps each band's
     underside over what stands under it (sim/transit.py)."""
+    side_palm_lead: float = SIDE_PALM_LEAD
+    """How far ahead of its point on the axis the palm reaches by a side grasp (``home:sidePalmLead``):
+    the grasp point stops short so the palm meets a deep object's near side (sim/grasping.py)."""
 
     def __post_init__(self) -> None:
         if math.isnan(self.fingertip_depth):
@@ -143,6 +151,7 @@ _PROPERTIES = (
     "fingertipClearance",
     "jawClearance",
     "carryCorridor",
+    "sidePalmLead",
 )
 """The store's properties (local names in the home namespace) of :class:`Hand`'s values, in its order."""
 _GEOMETRY = ("jawOpening", "palmDepth", "fingerLength")
@@ -194,7 +203,7 @@ def _limits(name: str, number: float) -> str:
         return "" if 0.0 < number <= 1.0 else "a fraction of the object's depth, more than 0 and at most 1"
     if name == "sideGraspPitch":
         return "" if 0.0 <= number < math.pi / 2.0 else "radians down from level, at least 0 and below pi/2"
-    if name in ("fingertipClearance", "jawClearance"):
+    if name in ("fingertipClearance", "jawClearance", "sidePalmLead"):
         return "" if number >= 0.0 else "a length in metres, at least 0"
     return "" if number > 0.0 else "a length in metres, more than 0"
 
@@ -284,6 +293,7 @@ def _hand(hand: str, arm: str, robot: str, stated: dict[str, list[_Stated]], ban
         values.get("jawClearance", JAW_CLEARANCE),
         values.get("carryCorridor", CARRY_CORRIDOR),
         _side_arm(hand, arm, robot, bands),
+        values.get("sidePalmLead", SIDE_PALM_LEAD),
     )
 
 

@@ -30,14 +30,6 @@ __all__ = [
     "side_held",
 ]
 
-PALM_LEAD = 0.0052
-"""How far ahead of its point on the hand's axis (``palm_depth`` back from the grasp point) a side grasp's
-palm reaches along the level approach (m): tilted down by the side pitch, the palm's face leans forward
-above the axis. The Panda hand's at the default 35 degrees, measured on its collision mesh: a tall object's
-near side touches it 2.27 cm behind the grasp point, where ``palm_depth * cos(pitch)`` puts the palm
-2.79 cm behind (tests/test_grasp_palm_stop.py measures it again). Like the hand's arm bands, it holds
-for that pitch only (docs/simulation.md, "How far in a side grasp goes")."""
-
 
 class GraspKind(StrEnum):
     """TOP: the hand comes down vertically (flat things). SIDE: it comes in horizontally (upright cups)."""
@@ -180,14 +172,15 @@ def check_side_depth(model: ObjectModel, depth: float, hand: Hand) -> None:
         raise GraspTooDeepError(model.name, model.grasp.value, depth, hand.finger_length, held, hand.side_hold)
 
 
-def palm_stop(depth: float, hand: Hand, lead: float = PALM_LEAD) -> float:
+def palm_stop(depth: float, hand: Hand) -> float:
     """How far short of an object's centre, along a side grasp's level approach, ``hand``'s grasp point
     stops so that the palm stops at the object's near side instead of pushing it: the near side is half
     its ``depth`` back from its centre, the palm ``palm_depth * cos(side_pitch)`` back from the grasp point
-    less its ``lead`` (:data:`PALM_LEAD`). 0 for an object the palm does not reach (the bundled cup, 6 cm
-    across, is reached: 0.7 cm). Before, the hand went on to the centre and the palm pushed a 7 cm bottle
-    2.3 cm and tipped it 8.5 degrees before the fingers closed, and it fell."""
-    palm = hand.palm_depth * math.cos(hand.side_pitch) - lead
+    less how far its tilted face leads (``hand.side_palm_lead``, ``home:sidePalmLead``: the Panda's 5.2 mm,
+    measured on its collision mesh). 0 for an object the palm does not reach (the bundled cup, 6 cm across,
+    is reached: 0.7 cm). Before, the hand went on to the centre and the palm pushed a 7 cm bottle 2.3 cm
+    and tipped it 8.5 degrees before the fingers closed, and it fell."""
+    palm = hand.palm_depth * math.cos(hand.side_pitch) - hand.side_palm_lead
     return max(0.0, depth / 2.0 - palm)
 
 

@@ -15,12 +15,15 @@ import pybullet as p
 import pytest
 
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.hands import HandError
 from cbrs.kb.semantic_map import SemanticMap
 from cbrs.sim import skills
 from cbrs.sim.arms import EE_LINK, PYBULLET_DATA, ArmSide, panda_urdf
-from cbrs.sim.grasping import PALM_LEAD, GraspKind, ObjectModel, compute_grasp_pose, palm_stop, side_orientation
+from cbrs.sim.grasping import GraspKind, ObjectModel, compute_grasp_pose, palm_stop, side_orientation
 from cbrs.sim.scene import bundled_map
 from cbrs.sim.world import HomeWorld, open_world
+from tests.helpers_hands import LAB as HANDS_LAB
+from tests.helpers_hands import read_lab_hands
 from tests.home_layout import ARM_FACING, ARM_MOUNTS
 
 EXAMPLES = Path(__file__).parent.parent / "docs" / "examples"
@@ -29,7 +32,7 @@ HAND = bundled_map().hands[WORLD + "CytonDualArm01LeftArm"]
 """The bundled robot's hand as the shipped map describes it (the Panda hand)."""
 LEFT, FACING = ARM_MOUNTS["left"], ARM_FACING["left"]
 AT = (7.35, 3.30, 0.90)
-PALM = HAND.palm_depth * math.cos(HAND.side_pitch) - PALM_LEAD
+PALM = HAND.palm_depth * math.cos(HAND.side_pitch) - HAND.side_palm_lead
 """How far behind the grasp point, along the level approach, the tilted palm's face reaches."""
 
 
@@ -67,10 +70,27 @@ def test_an_object_the_palm_does_not_reach_and_a_top_grasp_are_held_at_the_centr
 
 
 def test_the_stop_follows_the_hand_and_the_lead() -> None:
-    """The palm's place is the store's (palm depth and side pitch); its lead a parameter."""
-    assert palm_stop(0.07, HAND, lead=0.0) == pytest.approx(0.035 - HAND.palm_depth * math.cos(HAND.side_pitch))
+    """The palm's place is the store's (palm depth and side pitch), and so is its lead."""
+    unled = replace(HAND, side_palm_lead=0.0)
+    assert palm_stop(0.07, unled) == pytest.approx(0.035 - HAND.palm_depth * math.cos(HAND.side_pitch))
     level = replace(HAND, side_pitch=0.0)
-    assert palm_stop(0.07, level) == pytest.approx(0.035 - HAND.palm_depth + PALM_LEAD)
+    assert palm_stop(0.07, level) == pytest.approx(0.035 - HAND.palm_depth + HAND.side_palm_lead)
+
+
+def test_a_grippers_lead_is_its_own_else_its_classes_else_the_pandas(tmp_path: Path) -> None:
+    models = "lab:LongPalm rdfs:subClassOf home:Gripper ; home:sidePalmLead 0.009 .\n"
+    geometry = "home:jawOpening 0.08 ; home:palmDepth 0.034 ; home:fingerLength 0.046"
+    robot = (
+        "lab:Robot home:hasArm lab:Left , lab:Right .\n"
+        'lab:Left home:armSide "left" ; home:hasGripper lab:LeftHand .\n'
+        'lab:Right home:armSide "right" ; home:hasGripper lab:RightHand .\n'
+        f"lab:LeftHand a lab:LongPalm ; {geometry} .\nlab:RightHand a home:Gripper ; {geometry} .\n"
+    )
+    hands = read_lab_hands(tmp_path, models, robot)
+    assert hands[HANDS_LAB + "Left"].side_palm_lead == 0.009  # its class's
+    assert hands[HANDS_LAB + "Right"].side_palm_lead == HAND.side_palm_lead  # unstated: the Panda's
+    with pytest.raises(HandError, match="sidePalmLead"):
+        read_lab_hands(tmp_path, models.replace("0.009", "-0.001"), robot)
 
 
 # -- on the Panda's collision meshes -------------------------------------------------------------------
