@@ -20,25 +20,11 @@ from cbrs.kb.person_choice import LookAlikePeopleError, person_for
 from cbrs.kb.semantic_map import MapError, SemanticMap, designate
 from cbrs.sim.components import SimEnvironment
 from cbrs.sim.world import open_world
+from tests.helpers_examples import lab5_store as _store
 
 EXAMPLES = Path(__file__).parent.parent / "docs" / "examples"
 HOME, WORLD, SVC, LAB5 = PREFIXES["home"], PREFIXES["world"], PREFIXES["svc"], "https://example.org/lab5#"
 LEFT, RIGHT = WORLD + "CytonDualArm01LeftArm", WORLD + "CytonDualArm01RightArm"
-
-
-def _store(*, updates: tuple[str, ...] = (), things: tuple[str, ...] = (), hands: str | None = None) -> KnowledgeBase:
-    """A bundled store with the round's updates applied, its things loaded into the ontology and the map,
-    and, when given, the lab's hands in place of the Panda hands."""
-    kb = KnowledgeBase.open(":memory:")
-    for name in updates:
-        kb.update((EXAMPLES / name).read_text())
-    for name in things:
-        kb.load([EXAMPLES / name], graph="ontology")
-        kb.load([EXAMPLES / name], graph="map")
-    if hands is not None:
-        kb.update((EXAMPLES / "lab5_unhand.ru").read_text())
-        kb.load([EXAMPLES / hands], graph="map")
-    return kb
 
 
 def _map_size(kb: KnowledgeBase) -> int:

@@ -14,7 +14,6 @@ from pathlib import Path
 import pybullet as p
 import pytest
 
-from cbrs.kb import KnowledgeBase
 from cbrs.kb.hands import HandError
 from cbrs.kb.semantic_map import SemanticMap
 from cbrs.sim import skills
@@ -22,11 +21,11 @@ from cbrs.sim.arms import EE_LINK, PYBULLET_DATA, ArmSide, panda_urdf
 from cbrs.sim.grasping import GraspKind, ObjectModel, compute_grasp_pose, palm_stop, side_orientation
 from cbrs.sim.scene import bundled_map
 from cbrs.sim.world import HomeWorld, open_world
+from tests.helpers_examples import wine7_store
 from tests.helpers_hands import LAB as HANDS_LAB
 from tests.helpers_hands import read_lab_hands
 from tests.home_layout import ARM_FACING, ARM_MOUNTS
 
-EXAMPLES = Path(__file__).parent.parent / "docs" / "examples"
 WORLD, LAB = "https://w3id.org/cbrs/world#", "https://example.org/lab#"
 HAND = bundled_map().hands[WORLD + "CytonDualArm01LeftArm"]
 """The bundled robot's hand as the shipped map describes it (the Panda hand)."""
@@ -155,14 +154,7 @@ def test_the_palm_stops_at_the_near_side_not_in_it(panda: tuple[int, int], kind:
 @pytest.fixture(scope="module")
 def home(tmp_path_factory: pytest.TempPathFactory) -> Iterator[HomeWorld]:
     """The bundled home with the wine bottle narrowed to 7 cm (docs/tasks.md, "the 7 cm variant"), seed 2."""
-    text = (EXAMPLES / "wine_bottle.ttl").read_text(encoding="utf-8")
-    narrowed = text.replace("home:sizeX 0.075 ; home:sizeY 0.075", "home:sizeX 0.07 ; home:sizeY 0.07")
-    assert narrowed != text
-    wine = tmp_path_factory.mktemp("wine") / "wine7.ttl"
-    wine.write_text(narrowed, encoding="utf-8")
-    kb = KnowledgeBase.open(":memory:")
-    for graph in ("ontology", "map"):
-        kb.load([wine, EXAMPLES / "low_cupboard.ttl"], graph=graph)
+    kb = wine7_store(tmp_path_factory.mktemp("wine"))
     with open_world(seed=2, semantic_map=SemanticMap.read(kb)) as world:
         yield world
 

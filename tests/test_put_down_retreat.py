@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator
-from pathlib import Path
 
 import pytest
 
@@ -25,8 +24,8 @@ from cbrs.sim.grasping import GraspKind, ObjectModel, compute_grasp_pose
 from cbrs.sim.hold_choice import Candidates, refuse_moves
 from cbrs.sim.perception import ObjectEstimate
 from cbrs.sim.world import HomeWorld, open_world
+from tests.helpers_examples import wine7_store
 
-EXAMPLES = Path(__file__).parent.parent / "docs" / "examples"
 WORLD, LAB = "https://w3id.org/cbrs/world#", "https://example.org/lab#"
 TABLE_TOP = 0.75
 
@@ -35,15 +34,7 @@ TABLE_TOP = 0.75
 def store(tmp_path_factory: pytest.TempPathFactory) -> KnowledgeBase:
     """The bundled store with the wine bottle narrowed to 7 cm (the 7.5 cm one is refused by the jaws) and
     the low cupboard."""
-    text = (EXAMPLES / "wine_bottle.ttl").read_text(encoding="utf-8")
-    narrowed = text.replace("home:sizeX 0.075 ; home:sizeY 0.075", "home:sizeX 0.07 ; home:sizeY 0.07")
-    assert narrowed != text
-    wine = tmp_path_factory.mktemp("wine") / "wine7.ttl"
-    wine.write_text(narrowed, encoding="utf-8")
-    kb = KnowledgeBase.open(":memory:")
-    for graph in ("ontology", "map"):
-        kb.load([wine, EXAMPLES / "low_cupboard.ttl"], graph=graph)
-    return kb
+    return wine7_store(tmp_path_factory.mktemp("wine"))
 
 
 @pytest.fixture(scope="module")

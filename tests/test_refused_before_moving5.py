@@ -7,7 +7,6 @@ world is built and not stepped (seed 1, where the look-alike refusal used to be 
 
 from __future__ import annotations
 
-from pathlib import Path
 from types import SimpleNamespace
 from typing import Any, cast
 
@@ -23,23 +22,10 @@ from cbrs.sim.components import SimEnvironment
 from cbrs.sim.run_checks import CannotGripError, PlanChecks
 from cbrs.sim.values import designator
 from cbrs.sim.world import open_world
+from tests.helpers_examples import lab5_store as _store
 
-EXAMPLES = Path(__file__).parent.parent / "docs" / "examples"
 WORLD, LAB5 = PREFIXES["world"], "https://example.org/lab5#"
 LEFT, RIGHT = WORLD + "CytonDualArm01LeftArm", WORLD + "CytonDualArm01RightArm"
-
-
-def _store(*, things: tuple[str, ...] = (), hands: str | None = None) -> KnowledgeBase:
-    """A bundled store with the round's ``things`` in the ontology and the map, and, when given, the lab's
-    ``hands`` in place of the Panda hands."""
-    kb = KnowledgeBase.open(":memory:")
-    for name in things:
-        kb.load([EXAMPLES / name], graph="ontology")
-        kb.load([EXAMPLES / name], graph="map")
-    if hands is not None:
-        kb.update((EXAMPLES / "lab5_unhand.ru").read_text())
-        kb.load([EXAMPLES / hands], graph="map")
-    return kb
 
 
 def test_two_people_in_one_colour_are_placed_by_no_camera_and_the_task_is_refused_at_seed_1() -> None:
