@@ -18,15 +18,13 @@ from click.testing import CliRunner
 from cbrs.actions.composer import Composer
 from cbrs.bridge_client import BridgeClient
 from cbrs.cli import cli
-from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.rosbridge import GoalStatus
-from cbrs.server import ServeConfig, Server
-from cbrs.sparql_service import EndpointConfig
+from cbrs.server import Server
 from cbrs.tasks import refusal_in_home
+from tests.test_live_components import TOKEN, live_server
 from tests.test_rosbridge import Client
 
-TOKEN = "refused-early-test-token"
 TASK, SEED = "RouteToGoal", 4  # no component of the bundled store offers a route
 WAIT = 20.0
 
@@ -47,13 +45,8 @@ def built() -> Iterator[list[str]]:
 
 @pytest.fixture(scope="module")
 def server(built: list[str]) -> Iterator[Server]:
-    endpoint = EndpointConfig(update_token=TOKEN, isolate=False)
-    running = Server(KnowledgeBase.open(":memory:"), ServeConfig(port=0, bridge_port=0, endpoint=endpoint))
-    running.start()
-    try:
+    with live_server() as running:
         yield running
-    finally:
-        running.stop()
 
 
 @pytest.fixture(scope="module")
