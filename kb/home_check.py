@@ -2,8 +2,9 @@
 
 A lab that replaces the bundled home with its own (``cbrs load --graph map --replace``, docs/tasks.md "A
 home of your own") writes every room, robot and person itself. The simulation takes rooms to make the
-floor of, one mobile robot and a dual-arm robot with a left and a right arm, and any number of people
-(none: a home where the robots only move things; several: a resident and a caregiver); the base, each
+floor of, one mobile robot, the arms on the torso (one or two, a "left" and a "right" one, each side once;
+none, a home where the robots only drive), and any number of people (none: a home where the robots only
+move things; several: a resident and a caregiver); the base, each
 person and every docking pose start on the floor of a room, none inside a wall, a piece of furniture or
 a robot's body. A map that lacks one of them, or puts a start where nothing could stand, is refused
 with a :class:`HomeError` naming what it lacks and where, before anything is built or moves. A piece of
@@ -98,16 +99,32 @@ def check_home(semantic_map: SemanticMap) -> None:
     """Refuse a map the simulated home cannot be built from (:class:`HomeError`), naming what is wrong."""
     semantic_map.extent()  # no rooms: a MapError of its own
     _check_counts(semantic_map)
-    arms = sorted(arm.side for arm in semantic_map.arms.values())
-    if arms != list(_ARM_SIDES):
-        raise HomeError(
-            HOME + "Arm",
-            f"is missing: the map's arms have the sides {', '.join(arms) or 'none'}, and the dual-arm robot needs one "
-            '"left" and one "right" arm (home:hasArm, each with home:armSide, home:x, home:y, home:z, '
-            "home:reach and home:hasGripper; the bundled ones are in ontologies/world.ttl)",
-        )
+    _check_arms(semantic_map)
     for iri, what, pose in _starts(semantic_map):
         _check_floor(semantic_map, iri, what, pose)
+
+
+def _check_arms(semantic_map: SemanticMap) -> None:
+    """Each arm has a side, "left" or "right", of its own: one arm or two, either side (none: the robots only
+    drive, and a task for an arm is refused before it runs)."""
+    sides: dict[str, list[str]] = {}
+    for iri in sorted(semantic_map.arms):
+        side = semantic_map.arms[iri].side
+        if side not in _ARM_SIDES:
+            raise HomeError(
+                iri,
+                f'has home:armSide {side!r}: an arm is on the "left" or the "right" of its robot (which way it folds '
+                "when idle, and the name its steps use); write one of them",
+            )
+        sides.setdefault(side, []).append(iri)
+    for side, iris in sides.items():
+        if len(iris) > 1:
+            other = "right" if side == "left" else "left"
+            raise HomeError(
+                iris[1],
+                f'has home:armSide "{side}", as {local_name(iris[0])} has: the simulated robot takes one arm a side; '
+                f'give one of them home:armSide "{other}", or take one out of graph:map',
+            )
 
 
 def _check_counts(semantic_map: SemanticMap) -> None:

@@ -171,7 +171,8 @@ def _variant(old: str, new: str) -> str:
         ),
         pytest.param(
             _variant("world:CytonDualArm01LeftArm home:x", 'world:CytonDualArm01LeftArm home:armSide "right" ; home:x'),
-            r"Arm .* the map's arms have the sides right, right, and the dual-arm robot needs one \"left\"",
+            r"CytonDualArm01RightArm .* has home:armSide \"right\", as CytonDualArm01LeftArm has: the simulated robot "
+            r"takes one arm a side",
             id="two-right-arms",
         ),
         pytest.param(
