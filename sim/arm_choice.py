@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 from cbrs.kb.namespaces import PREFIXES
-from cbrs.kb.semantic_map import Thing
+from cbrs.kb.semantic_map import Thing, local_name
 from cbrs.sim import skills
 from cbrs.sim.arms import CARRY_CLEARANCE, ArmSide
 from cbrs.sim.context import SimContext, SkillFailed
@@ -64,8 +64,29 @@ def free_arm(ctx: SimContext, x: float, y: float, what: str) -> ArmSide:
     """The free arm whose mount is nearest (x, y) and within its reach; on a tie, not the one that just acted."""
     arms = reaching(ctx, x, y)
     if not arms:
-        raise SkillFailed(f"no free arm reaches {what} at ({x:.2f}, {y:.2f})")
+        raise SkillFailed(f"no free arm reaches {what} at ({x:.2f}, {y:.2f}){why_none(ctx, x, y)}")
     return arms[0]
+
+
+def why_none(ctx: SimContext, x: float, y: float) -> str:
+    """Why no free arm reaches (x, y), to follow a refusal: each arm's reach from its mount and how far away
+    the point is, or what it holds; and, for a robot of one arm, that there is no other to pass a thing to
+    (docs/simulation.md, "A robot with one arm")."""
+    world = ctx.world
+    if not world.arm_specs:
+        return ": the robot has no arm (home:hasArm)"
+    said = []
+    for side, spec in world.arm_specs.items():
+        distance = math.hypot(x - spec.mount[0], y - spec.mount[1])
+        held = world.arm(side).held
+        what = (
+            f"holds the {world.name_of(held)}"
+            if held is not None and distance <= spec.reach
+            else f"reaches {spec.reach:.2f} m from ({spec.mount[0]:.2f}, {spec.mount[1]:.2f}), {distance:.2f} m away"
+        )
+        said.append(f"the {side.value} arm ({local_name(spec.iri)}) {what}")
+    alone = "; it is the robot's one arm, and there is no other to pass a thing to" if len(said) == 1 else ""
+    return f" ({', '.join(said)}{alone})"
 
 
 def grasp_pose_for(ctx: SimContext, estimate: ObjectEstimate, side: ArmSide, held: ObjectModel) -> GraspPose:
@@ -88,7 +109,7 @@ def who_takes(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel) -> 
     x, y, _ = estimate.position
     arms = reaching(ctx, x, y)
     if not arms:
-        raise SkillFailed(f"no free arm reaches the {model.name} at ({x:.2f}, {y:.2f})")
+        raise SkillFailed(f"no free arm reaches the {model.name} at ({x:.2f}, {y:.2f}){why_none(ctx, x, y)}")
     fits = _fitting(ctx, model, arms) if len(model.preference) > 1 else ""  # one approach: its typed misfit
     if fits:
         raise SkillFailed(fits)
@@ -418,11 +439,11 @@ def who_loads(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, bas
     takers = reaching(ctx, x, y)
     loaders = reaching(ctx, base.x, base.y)
     if not takers:
-        raise SkillFailed(f"no free arm reaches the {model.name} at ({x:.2f}, {y:.2f})")
+        raise SkillFailed(f"no free arm reaches the {model.name} at ({x:.2f}, {y:.2f}){why_none(ctx, x, y)}")
     if not loaders:
         raise SkillFailed(
             f"no free arm reaches the base's platform at ({base.x:.2f}, {base.y:.2f}): the docking pose is "
-            "beyond every arm's reach"
+            f"beyond every arm's reach{why_none(ctx, base.x, base.y)}"
         )
     fits = _fitting(ctx, model, takers)
     if fits:

@@ -51,6 +51,10 @@ class SimContext:
     step: PlanStep | None = None  # the plan's step being run, and every step's inputs known at its start
     known: Mapping[int, Mapping[str, Any]] = field(default_factory=dict)
 
+    def __post_init__(self) -> None:
+        if self.arm not in self.world.arm_specs and self.world.arm_specs:
+            self.arm = next(iter(self.world.arm_specs))  # a robot with one arm: the arm at work is that one
+
     @property
     def map(self) -> SemanticMap:
         return self.world.map

@@ -115,7 +115,7 @@ def _speed(world: HomeWorld, name: str) -> float:
 def is_grasped(world: HomeWorld, name: str, side: ArmSide | str | None = None) -> bool:
     """(object, isGraspedBy, gripper): an arm holds it and it is still where the fingers took it."""
     body = world.body(name)
-    sides = [ArmSide(side)] if side is not None else list(ArmSide)
+    sides = [ArmSide(side)] if side is not None else list(world.arms)  # the arms the robot has
     for s in sides:
         arm = world.arm(s)
         if arm.held == body:

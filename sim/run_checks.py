@@ -25,7 +25,7 @@ from cbrs.kb.person_choice import person_for
 from cbrs.kb.semantic_map import MapObject, NotGraspableError, Person, Thing, local_name
 from cbrs.kb.store import Term
 from cbrs.sim import sight, skills
-from cbrs.sim.arm_choice import who_loads
+from cbrs.sim.arm_choice import TAKING, who_loads
 from cbrs.sim.context import SimContext, SkillFailed
 from cbrs.sim.errors import GraspTooDeepError, GraspTooThinError, GraspTooWideError, MovesRefusedError
 from cbrs.sim.geometry import Pose2D
@@ -101,10 +101,10 @@ class OutOfReachError(KnowledgeBaseError):
         )
         up = "" if height is None else f", its grasp point {height:.2f} m up"
         lower = "" if height is None else ", or onto a lower surface"
+        said = "; ".join(part for part in (each, why) if part)
         super().__init__(
             f"no arm of {local_name(robot)} reaches the {local_name(thing)} at ({where[0]:.2f}, {where[1]:.2f}){up}: "
-            f"{each}{f'; {why}' if why else ''}; move it within reach in the map (home:x, home:y{lower}) or give "
-            "the arms more home:reach"
+            f"{said}; move it within reach in the map (home:x, home:y{lower}) or give the arms more home:reach"
         )
 
 
@@ -401,8 +401,11 @@ class PlanChecks:
         at_hand: dict[str, list[str]] = {}  # by robot: the objects its latest arm step given one works on
         for step in plan.steps:
             robot_arms = arms.get(step.device or "")
-            if not robot_arms:
+            # a robot of the map with no arm (its arms taken off) that a step would have take a thing in hand
+            armless = not robot_arms and step.action in TAKING and (step.device or "") in smap.bodies
+            if not robot_arms and not armless:
                 continue
+            robot_arms = robot_arms or []
             given = [values.get(name) for name in sorted(task_inputs_of(step, steps))]
             iris = [str(value["@id"]) for value in given if isinstance(value, dict) and "@id" in value]
             objects = [iri for iri in iris if iri in smap.objects]
@@ -420,7 +423,8 @@ class PlanChecks:
                 report = [(arm.iri, arm.mount[0], arm.mount[1], arm.reach, d) for arm, d in reaches]
                 where = ((box[0] + box[1]) / 2, (box[2] + box[3]) / 2)
                 if not any(distance <= arm.reach for arm, distance in reaches):
-                    raise OutOfReachError(step.device or "", iri, where, report, height=height)
+                    none = f"{local_name(step.device or '')} has no arm (home:hasArm)" if armless else ""
+                    raise OutOfReachError(step.device or "", iri, where, report, none, height=height)
                 if iri in objects:  # in reach: a hand of an arm that reaches it must fit it too
                     self._check_grip(step.device or "", iri, [arm for arm, d in reaches if d <= arm.reach])
                 if iri in smap.regions or iri in smap.furniture:

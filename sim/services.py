@@ -171,10 +171,11 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
                     f"no spot of {place.name} is clear for the {model.name} (around ({cx:.2f}, {cy:.2f})): the "
                     f"{arms} it, but {blockers} on it {'leaves' if len(on_it) == 1 else 'leave'} no spot free"
                 )
+            other = "no other free arm reaches one" if len(world.arm_specs) > 1 else "the robot has no other arm"
             raise SkillFailed(
                 f"no arm reaches a spot of {place.name} to set the {model.name} down on (around ({cx:.2f}, "
                 f"{cy:.2f})): the {giver.value} arm holding it reaches {spec.reach:.2f} m from ({spec.mount[0]:.2f}, "
-                f"{spec.mount[1]:.2f}), and no other free arm reaches one"
+                f"{spec.mount[1]:.2f}), and {other} to pass it to"
             )
         _, taker, (sx, sy) = min(options)
         target = spot_region(surface, sx, sy)

@@ -233,7 +233,7 @@ class HomeWorld:
         self.objects: dict[str, MapObject] = {obj.name: obj for obj in self.map.objects.values()}
         """The movable objects by body name (the local name of their IRI)."""
         self.containers = {name for name, obj in self.objects.items() if obj.iri in self.map.containers}
-        check_home(self.map)  # rooms, one base, two arms, starts on a room's floor (kb.home_check)
+        check_home(self.map)  # rooms, one base, an arm a side at most, starts on a room's floor (kb.home_check)
         self.robot = next(iter(self.map.robots.values()))
         self.base_name = self.robot.name
         self.people: dict[str, Person] = {person.name: person for _, person in sorted(self.map.people.items())}
@@ -428,7 +428,12 @@ class HomeWorld:
         return self.base.pose()
 
     def arm(self, side: ArmSide | str) -> Arm:
-        return self.arms[ArmSide(side)]
+        """The arm on that side; :class:`UnknownEntityError` when the robot has none there (a robot with one
+        arm, docs/simulation.md "A robot with one arm")."""
+        arm = self.arms.get(ArmSide(side))
+        if arm is None:
+            raise UnknownEntityError(f"{ArmSide(side).value} arm", [f"{s.value} arm" for s in self.arms])
+        return arm
 
     def camera(self, name: str) -> Camera:
         try:
@@ -824,10 +829,11 @@ class HomeWorld:
                 self._solid(body.name, body.box, _TORSO)
                 obstacles.append(_region(body.name, body.box))
         obstacles += self._build_camera_housings()
-        arms = {ArmSide(arm.side): arm for arm in self.map.arms.values()}
-        arms = {ArmSide(arm.side): arm for arm in self.map.arms.values()}
+        # the arms the map has, one a side (kb.home_check), built left first as they always were
+        by_side = {ArmSide(arm.side): arm for arm in self.map.arms.values()}
+        arms = {side: by_side[side] for side in ArmSide if side in by_side}
         self.arm_specs = arms
-        mounts = {side: (arms[side].mount, quat_from_yaw(arms[side].yaw)) for side in ArmSide}
+        mounts = {side: (spec.mount, quat_from_yaw(spec.yaw)) for side, spec in arms.items()}
         tops = [
             Region(thing.name, b.min_x, b.max_x, b.min_y, b.max_y, b.max_z - 0.04, b.max_z)
             for iri in sorted(self.map.furniture)
@@ -840,8 +846,7 @@ class HomeWorld:
         # to carry a thing into it (Arm.dry_run's clear_by)
         levers = [_region(d.lever.name, d.lever.box) for d in self.dispensers]
         self._kinematics = Kinematics(mounts, [*obstacles, *tops, *appliances], [*appliances, *levers])
-        for side in ArmSide:
-            mount, orientation = mounts[side]
+        for side, (mount, orientation) in mounts.items():
             body = p.loadURDF(
                 panda_urdf(self.arm_detail),
                 mount,
