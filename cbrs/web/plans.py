@@ -16,9 +16,9 @@ from markupsafe import Markup
 
 from cbrs.actions.shown_names import file_qualifier, shown_names, two_lines
 from cbrs.extras import installed, require
-from cbrs.kb.namespaces import shorten
+from cbrs.kb.namespaces import PREFIXES, shorten
 from cbrs.web import context, diagram
-from cbrs.web.links import display_text, short, tail_parts
+from cbrs.web.links import display_text, expand_name, short, tail_parts
 from cbrs.web.pages import FormError, Page, page, wants_json
 
 if TYPE_CHECKING:  # the planner (and networkx) load with the first plan asked for, not at start-up
@@ -108,13 +108,25 @@ def _composed(task: str, objective: str, shown: Page | None) -> _Composed:
     composer = context.composers().get(Objective(objective))
     kept: dict[tuple[str, str], _Composed] = context.per_generation("plans_composed", dict)
     try:
-        iri = task_iri(context.kb(), task)
+        iri = task_iri(context.kb(), _with_derived_prefix(task))
         found = kept.get((objective, iri))
         if found is None or found.composer is not composer:
             found = kept[(objective, iri)] = _Composed(composer, composer.compose(iri))
         return found
     except UnknownTaskError as error:  # says what was meant and how to type every known task
         raise FormError({"task": str(error)}, page=shown) from None
+
+
+def _with_derived_prefix(task: str) -> str:
+    """``task`` as the planner reads it: a name with a prefix the pages derived for a lab's namespace
+    (``lab5:FetchPenForVisitor``, as the list and every link show it) as its IRI; anything else as typed."""
+    prefix, sep, _ = task.partition(":")
+    if not sep or prefix in PREFIXES or task.startswith(prefix + "://"):
+        return task
+    try:
+        return expand_name(task)
+    except ValueError:
+        return task
 
 
 DRAWING_MODULE = "cbrs.actions.draw"
@@ -163,19 +175,30 @@ def _read_tasks() -> dict[str, list[dict[str, str | None]]]:
     with context.lock():
         requirements = kb.requirements()
         library = ActionLibrary.from_kb(kb)
-    # the names go back as ?task=, which the planner reads with the declared prefixes only
+    # the names go back as ?task=, which the planner reads with the declared prefixes only; ``shown`` is
+    # what the pages show (a lab's own namespace by its derived prefix: the list showed its full IRIs)
     return {
-        "requirements": [{"name": shorten(r.iri), "label": r.label} for r in sorted(requirements, key=lambda r: r.iri)],
+        "requirements": [
+            {"name": shorten(r.iri), "shown": short(r.iri), "label": r.label}
+            for r in sorted(requirements, key=lambda r: r.iri)
+        ],
         "actions": [
-            {"name": shorten(a.iri), "label": a.label} for a in sorted(library, key=lambda a: a.iri) if a.sub_actions
+            {"name": shorten(a.iri), "shown": short(a.iri), "label": a.label}
+            for a in sorted(library, key=lambda a: a.iri)
+            if a.sub_actions
         ],
     }
 
 
 def _selected(task: str, options: dict[str, list[dict[str, str | None]]]) -> str | None:
-    """The option a task name means: a bare name is a requirement first, as for ``resolve_task``."""
-    names = [str(t["name"]) for group in ("requirements", "actions") for t in options[group]]
-    return next((n for n in names if task in (n, n.partition(":")[2])), None)
+    """The option a task name means: a bare name is a requirement first, as for ``resolve_task``; a task
+    of a lab's own namespace by its bare name, its derived prefixed name or its IRI (the form showed
+    "(choose)" above such a task's plan)."""
+    for t in (t for group in ("requirements", "actions") for t in options[group]):
+        name, shown = str(t["name"]), str(t["shown"])
+        if task in (name, shown, shown.partition(":")[2], name.partition(":")[2] if "://" not in name else None):
+            return name
+    return None
 
 
 def _composition(result: CompositionResult) -> dict[str, Any]:
