@@ -331,7 +331,34 @@ def _detail(found: TaskRun) -> dict[str, Any]:
     data = found.to_dict()
     data["url"] = url_for("tasks.run", run_id=found.id)
     data["steps"] = steps(data["events"])
+    data["unmet"] = unmet(data.get("result"))
+    data["verdict"] = verdict(data)
     return data
+
+
+def unmet(result: dict[str, Any] | None) -> list[str]:
+    """What no component provides, each need with its remedy, when the run made no plan: the run page
+    said only "Plan: unsolvable", and the reasons were in its JSON alone."""
+    plan = (result or {}).get("plan") or {}
+    return [str(need.get("text") or need.get("need")) for need in plan.get("unsatisfied", [])]
+
+
+def verdict(run: dict[str, Any]) -> str | None:
+    """How the run ended, in a line: the execution's status and reason, why no plan came of it, or the
+    error; None while it runs."""
+    result = run.get("result") or {}
+    execution = result.get("execution")
+    if execution:
+        reason = f": {execution['reason']}" if execution.get("reason") else ""
+        return f"{execution['status']}{reason}; {result.get('sim_seconds', 0.0)} s simulated"
+    if run.get("error"):
+        return str(run["error"])
+    plan = result.get("plan")
+    if not plan or run.get("status") != "no-plan":
+        return None
+    needs = run.get("unmet") or []
+    why = f": {needs[0]}" + (f" (and {len(needs) - 1} more, below)" if len(needs) > 1 else "") if needs else ""
+    return f"no plan ({plan.get('status')}), nothing was simulated{why}"
 
 
 def steps(events: list[dict[str, Any]]) -> list[dict[str, Any]]:

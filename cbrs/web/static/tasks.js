@@ -138,18 +138,30 @@
     // Events sent before this page subscribed: rebuild the table and the list from the run's record.
     const response = await fetch(live.dataset.runs + "/" + encodeURIComponent(id) + ".json");
     if (!response.ok) return;
-    const run = await response.json();
+    const run = (await response.json()).run; // the run page's twin: {mode, run}
     if (current !== id) startRun(id, run.task);
     steps.replaceChildren();
     eventList.replaceChildren();
     run.events.forEach(handleRunEvent);
     setBadge(run.status);
+    if (run.verdict) verdict.textContent = run.verdict;
+  }
+
+  async function showVerdict(id) {
+    // A run that made no plan or broke publishes no /cbrs/task verdict: its record says why.
+    const response = await fetch(live.dataset.runs + "/" + encodeURIComponent(id) + ".json");
+    if (!response.ok) return;
+    const run = (await response.json()).run;
+    if (run && run.verdict && current === id) verdict.textContent = run.verdict;
   }
 
   function handleRunEvent(message) {
     if (message.topic === "/cbrs/task_progress") stepEvent(message);
     if (message.topic === "/cbrs/task") verdict.textContent = message.status + (message.reason ? ": " + message.reason : "");
-    if (message.event === "run_finished") setBadge(message.status);
+    if (message.event === "run_finished") {
+      setBadge(message.status);
+      if (!verdict.textContent) showVerdict(message.run);
+    }
     listEvent(message);
   }
 

@@ -1,0 +1,78 @@
+"""What a robotics student new to cbrs met walking through the browser, and what now answers them.
+
+Each test is one thing the walk-through found (docs/web.md, "A new user's walk-through"): a run that made
+no plan said only "Plan: unsolvable"; ...
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterator
+from html import unescape
+
+import pytest
+from flask.testing import FlaskClient
+
+from cbrs.kb import KnowledgeBase
+from cbrs.sparql_service import SparqlService
+from cbrs.tasks import TaskRunner
+from cbrs.web import create_app
+from tests.helpers_examples import EXAMPLES, lab5_store
+
+WAIT = 30.0
+UNPLANNABLE = "RouteToGoal"  # a bundled requirement no component chain provides: it ends no-plan, unsimulated
+
+
+@pytest.fixture(scope="module")
+def served(bundled_kb: KnowledgeBase) -> Iterator[tuple[FlaskClient, TaskRunner]]:
+    sparql = SparqlService(bundled_kb)
+    runner = TaskRunner(bundled_kb, sparql.lock, camera=None)
+    yield create_app(sparql, tasks=runner).test_client(), runner
+
+
+def _text(html: str) -> str:
+    return " ".join(unescape(re.sub(r"<[^>]+>", " ", html)).split())
+
+
+def test_a_run_that_made_no_plan_says_why_on_its_page_and_in_the_latest_run_panel(
+    served: tuple[FlaskClient, TaskRunner],
+) -> None:
+    client, runner = served
+    started = client.post("/tasks.json", json={"task": UNPLANNABLE}).get_json()["started"]
+    assert runner.get(started["id"]).done.wait(WAIT)
+    run = client.get(f"/tasks/{started['id']}.json").get_json()["run"]
+    assert run["status"] == "no-plan"
+    needs = [need["text"] for need in run["result"]["plan"]["unsatisfied"]]
+    assert needs and run["unmet"] == needs
+    assert run["verdict"].startswith("no plan (unsolvable), nothing was simulated: ") and needs[0] in run["verdict"]
+    page = _text(client.get(f"/tasks/{started['id']}").text)
+    assert "Why no plan came of it" in page and all(_text(need) in page for need in needs)
+    assert _text(run["verdict"]) in page  # the line under the steps, which said nothing
+    panel = _text(client.get("/tasks").text)  # the latest run, on the start page
+    assert _text(run["verdict"]) in panel
+
+
+@pytest.fixture(scope="module")
+def lab() -> FlaskClient:
+    """The bundled store with a lab's visitor in the kitchen and the task to bring them the pen, loaded as
+    the examples' headers say: names of the lab's own namespace, which no cbrs prefix declares."""
+    kb = lab5_store(things=("lab5_visitor_in_kitchen.ttl",))
+    kb.load([EXAMPLES / "lab5_fetch_pen_for_visitor.ttl"], graph="requirements")
+    return create_app(SparqlService(kb)).test_client()
+
+
+@pytest.mark.parametrize(
+    "asked", ["FetchPenForVisitor", "lab5:FetchPenForVisitor", "https://example.org/lab5#FetchPenForVisitor"]
+)
+def test_a_lab_s_own_task_is_listed_by_its_prefixed_name_and_chosen_above_its_plan(
+    lab: FlaskClient, asked: str
+) -> None:
+    body = lab.get("/plans.json", query_string={"task": asked}).get_json()
+    assert body["composition"]["requirement"] == "https://example.org/lab5#FetchPenForVisitor"
+    option = next(t for t in body["tasks"]["requirements"] if t["name"] == body["selected"])
+    assert option["shown"] == "lab5:FetchPenForVisitor"
+    page = unescape(lab.get("/plans", query_string={"task": asked}).text)
+    chosen = re.findall(r'<option value="([^"]*)" selected>([^<]*)</option>', page)
+    assert chosen[0] == (option["name"], "lab5:FetchPenForVisitor")  # the form said "(choose)"
+    listed = re.search(r'<select id="task".*?</select>', page, re.S)
+    assert listed is not None and "https://example.org/lab5#" not in re.sub(r'value="[^"]*"', "", listed.group(0))
