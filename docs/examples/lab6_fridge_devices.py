@@ -3,8 +3,10 @@ lab's own, written with roslibpy alone (no cbrs package needed on the device), a
 "Writing one (roslibpy)", shows: each component on a connection of its own, authenticated before it
 connects, registered first, then its service advertised, then three heartbeats a lease.
 
-    lab6_fridge_door_sensor.ttl  /lab6_fridge_door_sensor_01/check  {"fridge": ...} -> {"fridgeDoor": DoorStatus}
-    lab6_caregiver_phone.ttl     /lab6_resident_phone_01/alert      {"doorStatus": ..., "person": ...} -> {"alert": AlarmMessage}
+    lab6_fridge_door_sensor.ttl  /lab6_fridge_door_sensor_01/check
+        {"fridge": ...} -> {"fridgeDoor": a home:DoorStatus}
+    lab6_caregiver_phone.ttl     /lab6_resident_phone_01/alert
+        {"doorStatus": ..., "person": ...} -> {"alert": a home:AlarmMessage}
 
 With the server of docs/tasks.md, "A sixth round" (lab6_fridge.ttl in the ontology and the map,
 lab6_watch_the_fridge.ttl in the requirements, cbrs serve started with CBRS_UPDATE_TOKEN):
@@ -63,7 +65,7 @@ class Device:
         if self.lapsed.is_set():  # register again, here rather than on roslibpy's event loop
             try:
                 self.registered()
-            except Exception as error:  # noqa: BLE001 - any refusal ends the program
+            except Exception as error:  # any refusal ends the program
                 stop(f"{self.service}: it could not register again: {error}")
             self.lapsed.clear()
 
@@ -82,8 +84,12 @@ def main() -> int:
     parser.add_argument("--bridge", default="ws://127.0.0.1:9090", help="the bridge of cbrs serve")
     parser.add_argument("--door", choices=("open", "closed"), default="open", help="what the sensor reads")
     parser.add_argument("--misbehave", choices=("wrong-type", "silent"), help="the sensor's mistake")
-    parser.add_argument("--sensor", type=Path, default=HERE / "lab6_fridge_door_sensor.ttl",
-                        help="the sensor's description (lab6_mistake_sensor_output.ttl: an output nobody takes)")
+    parser.add_argument(
+        "--sensor",
+        type=Path,
+        default=HERE / "lab6_fridge_door_sensor.ttl",
+        help="the sensor's description (lab6_mistake_sensor_output.ttl: an output nobody takes)",
+    )
     args = parser.parse_args()
     token = os.environ.get("CBRS_UPDATE_TOKEN", "")
     ended = threading.Event()
@@ -109,16 +115,26 @@ def main() -> int:
         return True
 
     devices = [
-        (Device(args.bridge, token, args.sensor,
-                "/lab6_fridge_door_sensor_01/check", "lab6_msgs/CheckFridgeDoor"), check),
-        (Device(args.bridge, token, HERE / "lab6_caregiver_phone.ttl",
-                "/lab6_resident_phone_01/alert", "lab6_msgs/Alert"), alert),
+        (
+            Device(args.bridge, token, args.sensor, "/lab6_fridge_door_sensor_01/check", "lab6_msgs/CheckFridgeDoor"),
+            check,
+        ),
+        (
+            Device(
+                args.bridge,
+                token,
+                HERE / "lab6_caregiver_phone.ttl",
+                "/lab6_resident_phone_01/alert",
+                "lab6_msgs/Alert",
+            ),
+            alert,
+        ),
     ]
     names = []
     for device, handler in devices:
         try:
             names.append(device.registered())  # 1. register ...
-        except Exception as error:  # noqa: BLE001 - the server's reason, said and exited on
+        except Exception as error:  # the server's reason, said and exited on
             print(f"fridge devices: registration of {device.service} refused: {error}", file=sys.stderr, flush=True)
             return 1
         device.provide(handler)  # 2. ... then provide
