@@ -28,7 +28,7 @@ by composing that part once more without it, or the plan is refused naming it.
 from __future__ import annotations
 
 import re
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field, replace
 from enum import Enum
 from functools import partial
@@ -48,11 +48,12 @@ from cbrs.actions.graph import (
     statement_text,
 )
 from cbrs.actions.model import ActionLibrary, Task, resolve_task
+from cbrs.actions.near_misses import near_misses
 from cbrs.actions.plan import Binding, Plan, PlanStep, Source
 from cbrs.actions.progression import Clobbered, progress_parts
 from cbrs.actions.search import SearchTrace, bidirectional_search
 from cbrs.actions.undeclared_terms import described
-from cbrs.actions.unmet import Unsatisfied
+from cbrs.actions.unmet import GOAL, Unsatisfied
 from cbrs.kb import Advertisement, KnowledgeBase, Requirement, Statement
 from cbrs.kb.namespaces import GraphName, shorten
 from cbrs.kb.shapes import nearest_term
@@ -94,6 +95,9 @@ class ComposeConfig:
     # it, or the plan is refused naming it
     protect: bool = True
     max_reachieved: int = 8  # statements achieved again per extraction, and per joined plan, before refusing
+    # a "no plan" answer names, per unmet need, at most this many components that come close: their output or
+    # effect is a near concept of the need's (actions.near_misses; docs/composition.md); 0: none
+    near_misses: int = 3
 
 
 class PlanStatus(Enum):
@@ -642,7 +646,7 @@ class Composer:
     ) -> CompositionResult:
         status = PlanStatus.PLANNED if plan is not None else PlanStatus.UNSOLVABLE
         if plan is None:
-            unsatisfied = tuple(self._undeclared(task.requirement, u) for u in unsatisfied)
+            unsatisfied = tuple(self._near_missed(self._undeclared(task.requirement, u), attempts) for u in unsatisfied)
         return CompositionResult(task.name, task.requirement.iri, status, plan, unsatisfied, attempts)
 
     def _undeclared(self, requirement: Requirement, unsatisfied: Unsatisfied) -> Unsatisfied:
@@ -667,6 +671,26 @@ class Composer:
         reason = replace(unsatisfied, undeclared=missing, near=near)
         return described(reason, requirement, self.index, self.kb, self.advertisements)  # a thing, or a new class
 
+    def _near_missed(self, unsatisfied: Unsatisfied, attempts: Sequence[Attempt]) -> Unsatisfied:
+        """``unsatisfied`` with the components that come close to meeting it (:mod:`actions.near_misses`),
+        in the attempt that found it unmet: those that attempt's search enabled and its area rule admits."""
+        u = unsatisfied
+        if self.config.near_misses <= 0 or u.cycle or u.deleted_by or u.consumer in (SRI, GOAL):
+            return u
+        for attempt in attempts:
+            if all((u.need, u.consumer) != (found.need, found.consumer) for found in attempt.unsatisfied):
+                continue
+            need = next((n for n in attempt.graph.needs(u.consumer) if n.text() == u.need), None)
+            if need is None:
+                continue
+            named = [c for c, _ in (*u.out_of_area, *u.unrunnable, *u.provided)]
+            refused = partial(_refused, self.area_rule(attempt.requirement), attempt.graph)
+            found = near_misses(
+                attempt.graph, u.consumer, need, attempt.trace.enabled, refused, named, self.config.near_misses
+            )
+            return replace(u, near_misses=found) if found else u
+        return u
+
 
 def store_plan(kb: KnowledgeBase, plan: Plan) -> None:
     """Write ``plan`` to the plans graph, replacing an earlier plan for the same task, in one transaction."""
@@ -678,6 +702,11 @@ def store_plan(kb: KnowledgeBase, plan: Plan) -> None:
         and (q.subject.value == plan.iri or q.subject.value.startswith(plan.iri + "/"))
     ]
     kb.store.replace(old, plan.to_quads())
+
+
+def _refused(areas: AreaRule | None, graph: ServiceResourceGraph, component: str, things: Iterable[str]) -> bool:
+    """Whether ``areas`` refuses ``component`` for a step handling the requirement inputs ``things``."""
+    return areas is not None and areas.why_not(graph.vertices[component].advertisement, things) is not None
 
 
 def _shared_goals(plan: Plan, index: TaxonomyIndex) -> list[tuple[Binding, Binding]]:

@@ -3,7 +3,8 @@
 A need is met by the requirement (SRI), by a step's output or effect, or not at all; the report names
 the need, its consumer and the way down to it from the goal, and suggests the remedy a user can act on
 (declare a class, register a component, state a fact), the components that were passed over for their
-effective area and those planned for it that cannot run here.
+effective area, those planned for it that cannot run here, and those that come close: they give a near
+concept of the need's, and would have met it after a small change (:mod:`actions.near_misses`).
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from cbrs.actions.graph import SRE, SRI, SRO
+from cbrs.actions.near_misses import NearMiss
 from cbrs.kb.namespaces import shorten
 
 GOAL = "GOAL"  # the extraction's virtual consumer: SRO's and SRE's needs together
@@ -34,6 +36,7 @@ class Unsatisfied:
     deleted_by: tuple[str, ...] = ()  # components whose delete effect undoes it before it is needed
     individuals: tuple[tuple[str, tuple[str, ...]], ...] = ()  # (undeclared term, its classes): a thing of the map
     superclasses: tuple[tuple[str, str], ...] = ()  # (undeclared class, the class its use suggests declaring it under)
+    near_misses: tuple[NearMiss, ...] = ()  # components whose output or effect is near the need (actions.near_misses)
 
     def text(self) -> str:
         found = self._text()
@@ -44,7 +47,15 @@ class Unsatisfied:
         if self.provided:
             each = "; ".join(f"{effect} by {shorten(component)}" for component, effect in self.provided)
             found += f"; what components provide about it: {each}"
+        for miss in self.near_misses:
+            found += f"; {miss.text(self._taker(miss.statement))}"
         return found
+
+    def _taker(self, statement: bool) -> str:
+        """Who takes the need, as a near miss's text names it."""
+        if self.consumer in (SRO, SRE, GOAL):
+            return "the requirement wants" if statement else "the requirement asks for"
+        return f"{shorten(self.consumer)} {'needs' if statement else 'takes'}"
 
     def _text(self) -> str:
         consumer = "the requirement" if self.consumer in (SRO, SRE, GOAL) else shorten(self.consumer)
@@ -146,6 +157,7 @@ class Unsatisfied:
             "out_of_area": [{"component": component, "why": why} for component, why in self.out_of_area],
             "provided": [{"component": component, "effect": effect} for component, effect in self.provided],
             "deleted_by": list(self.deleted_by),
+            "near_misses": [miss.to_dict() for miss in self.near_misses],
         }
 
 

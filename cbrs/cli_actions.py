@@ -77,11 +77,31 @@ _MAX_REACHIEVED = click.option(
         " parts, before the plan is refused (ComposeConfig.max_reachieved)."
     ),
 )
+_NEAR_MISSES = click.option(
+    "--near-misses",
+    type=click.IntRange(min=0),
+    default=ComposeConfig().near_misses,
+    show_default=True,
+    metavar="N",
+    help=(
+        "With no plan, name for each unmet need at most N components that come close: their output or effect"
+        " is a near class of the need's (the same parts, or a sibling; docs/composition.md, Near misses);"
+        " 0: none (ComposeConfig.near_misses)."
+    ),
+)
 
 
-def _compose_config(ignore_areas: bool, protect: bool, max_reachieved: int, **more: Any) -> ComposeConfig:
+def _compose_config(
+    ignore_areas: bool, protect: bool, max_reachieved: int, near_misses: int, **more: Any
+) -> ComposeConfig:
     """What the composition options of ``cbrs plan`` and ``cbrs run`` ask for."""
-    return ComposeConfig(respect_area=not ignore_areas, protect=protect, max_reachieved=max_reachieved, **more)
+    return ComposeConfig(
+        respect_area=not ignore_areas,
+        protect=protect,
+        max_reachieved=max_reachieved,
+        near_misses=near_misses,
+        **more,
+    )
 
 
 @click.command()
@@ -114,6 +134,7 @@ def _compose_config(ignore_areas: bool, protect: bool, max_reachieved: int, **mo
 @_IGNORE_AREAS
 @_PROTECT
 @_MAX_REACHIEVED
+@_NEAR_MISSES
 @pass_app
 def plan(
     app: App,
@@ -125,6 +146,7 @@ def plan(
     ignore_areas: bool,
     protect: bool,
     max_reachieved: int,
+    near_misses: int,
 ) -> None:
     """Compose a plan for TASK: a requirement or action (req:FetchMyPen, act:RobotArmServeACup, or a bare name).
 
@@ -138,7 +160,7 @@ def plan(
         raise click.BadParameter(f"{drawing.name!r} must end in .svg or .png", param_hint="--draw")
     actions = ActionLibrary.from_kb(app.kb)  # read once: the task's name and the composer take it
     requested = task_iri(app.kb, task, actions)  # an unknown name is refused before the composer reads the store
-    config = _compose_config(ignore_areas, protect, max_reachieved, objective=Objective(objective))
+    config = _compose_config(ignore_areas, protect, max_reachieved, near_misses, objective=Objective(objective))
     composer = Composer(app.kb, config, actions=actions)
     result = composer.compose(requested)
     if result.plan is not None and not no_store:
@@ -389,6 +411,7 @@ def _source(binding: Binding) -> str:
 @_IGNORE_AREAS
 @_PROTECT
 @_MAX_REACHIEVED
+@_NEAR_MISSES
 @pass_app
 def run(
     app: App,
@@ -405,6 +428,7 @@ def run(
     ignore_areas: bool,
     protect: bool,
     max_reachieved: int,
+    near_misses: int,
 ) -> None:
     """Plan TASK, then execute it in the simulated home, step by step, failing over where needed.
 
@@ -440,7 +464,8 @@ def run(
     transport = _bridge(bridge) if bridge else None
     start = time.perf_counter()
     recorder: Recorder | None = None
-    composer = Composer(app.kb, _compose_config(ignore_areas, protect, max_reachieved), actions=actions)
+    config = _compose_config(ignore_areas, protect, max_reachieved, near_misses)
+    composer = Composer(app.kb, config, actions=actions)
     with contextlib.ExitStack() as held:
         if transport is not None:
             held.callback(transport.close)

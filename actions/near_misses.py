@@ -1,0 +1,214 @@
+"""Near misses: the components that would have met an unmet need after a small change.
+
+A need no component meets (an input of class C, a precondition statement) may be close to what some
+component gives: the kitchen's tracker gives a home:PersonLocation where the drive to a person takes a
+home:PersonPosition. A "no plan" answer names such components, what differs and the change that would do.
+
+A concept D is *near* a needed concept C (docs/composition.md, "Near misses") when neither is an is-a
+relative of the other (a relative is a provider already), they are not declared disjoint, Sem-Str's
+complementary words do not tell them apart (PersonLocation and PersonPosition are both about a person;
+RobotPosition is about another thing) and, by the store's taxonomy, they
+
+* have the same parts (the same non-empty set of hasPart classes, own or inherited) and a superclass in
+  common other than the root (the same idea under another name, in one branch: a home:Person and a
+  home:PersonProfile both have a given and a family name, but meet only at the root), or
+* are siblings (a direct superclass in common, not the root).
+
+An offered statement is near a needed one when each position is met (an is-a relative) or near, and at
+least one is near. A component comes close only if it would then have done: the forward search enabled
+it (all it needs is there) and the area rule does not refuse it for the task's things it is given.
+Near misses are ranked by Sem-Str similarity (the measure edges are ranked by), then by IRI, and capped
+(``ComposeConfig.near_misses``).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Iterator
+from dataclasses import dataclass
+from typing import Any
+
+from cbrs.actions.graph import SRI, Matcher, Need, ServiceResourceGraph, statement_text
+from cbrs.kb import Statement
+from cbrs.kb.namespaces import shorten
+from cbrs.reasoner.degrees import degree_of_match
+from cbrs.reasoner.statements import statement_similarity
+from cbrs.reasoner.taxonomy import ROOT
+
+SAME_PARTS = "the same parts"
+SIBLINGS = "siblings"
+_POSITIONS = ("subject", "predicate", "object")
+
+
+@dataclass(frozen=True)
+class Difference:
+    """One term in which a near miss differs from the need: the needed term, the offered one, and how near."""
+
+    wanted: str
+    offered: str
+    relation: str  # SAME_PARTS or SIBLINGS
+    position: str = ""  # for a statement: subject, predicate or object
+
+    def to_dict(self) -> dict[str, str]:
+        found = {"wanted": self.wanted, "offered": self.offered, "relation": self.relation}
+        if self.position:
+            found["position"] = self.position
+        return found
+
+
+@dataclass(frozen=True)
+class NearMiss:
+    """A component whose output (or effect) is near the needed concept (or statement)."""
+
+    component: str
+    offer: str  # the output's name, or the effect's text
+    gives: str  # the offered concept's IRI, or the offered statement's text
+    wanted: str  # the needed concept's IRI, or the needed statement's text
+    differs: tuple[Difference, ...]
+    similarity: float
+
+    @property
+    def statement(self) -> bool:
+        return bool(self.differs[0].position)
+
+    def text(self, taker: str) -> str:
+        """``taker``: who takes the need, as the answer names it ("svc:NavigateToPerson_P3DX01 takes")."""
+        component = shorten(self.component)
+        if self.statement:
+            how = "; ".join(
+                f"its {d.position} {shorten(d.offered)} for {shorten(d.wanted)} ({d.relation}, neither a kind of"
+                " the other)"
+                for d in self.differs
+            )
+            said = f"{component} comes close: its effect {self.gives} differs from the {self.wanted} {taker}: {how}"
+            fix = f"register a component like it whose effect is {self.wanted}"
+        else:
+            said = (
+                f"{component} comes close: it gives {shorten(self.gives)}, {taker} {shorten(self.wanted)}"
+                f" ({self.differs[0].relation}, neither a kind of the other)"
+            )
+            fix = f"register a component like it that gives {shorten(self.wanted)}"
+        kinds = [d for d in self.differs if d.relation == SAME_PARTS]
+        if kinds:  # the same idea under another name: the ontology may say the one is a kind of the other
+            every = " and ".join(f"every {shorten(d.offered)} is a {shorten(d.wanted)}" for d in kinds)
+            declared = ", ".join(f"{shorten(d.offered)} rdfs:subClassOf {shorten(d.wanted)}" for d in kinds)
+            fix += f", or, if {every} here, say so ({declared}, loaded into the ontology graph)"
+        return f"{said}: {fix}"
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "component": self.component,
+            "offer": self.offer,
+            "gives": self.gives,
+            "wanted": self.wanted,
+            "differs": [d.to_dict() for d in self.differs],
+            "similarity": round(self.similarity, 6),
+        }
+
+
+def near(matcher: Matcher, wanted: str, offered: str) -> str | None:
+    """How ``offered`` is near ``wanted`` (SAME_PARTS, SIBLINGS), or None: not near, or met already."""
+    index = matcher.index
+    if wanted not in index or offered not in index or degree_of_match(index, wanted, offered).accepted:
+        return None
+    first, second = index.canonical(wanted), index.canonical(offered)
+    if index.disjoint(first, second) or matcher.measure.qualifier_factor(first, second) < 1:
+        return None
+    parts = index.parts_of(first)
+    if parts and parts == index.parts_of(second) and index.common_ancestor(first, second)[0] != ROOT:
+        return SAME_PARTS
+    if _superclasses(matcher, first) & _superclasses(matcher, second):
+        return SIBLINGS
+    return None
+
+
+def _superclasses(matcher: Matcher, concept: str) -> set[str]:
+    return {p for p, kind in matcher.index.parents(concept).items() if kind == "is-a" and p != ROOT}
+
+
+def near_misses(
+    graph: ServiceResourceGraph,
+    consumer: str,
+    need: Need,
+    enabled: Callable[[str], bool],
+    refused: Callable[[str, Iterable[str]], bool],
+    named: Iterable[str] = (),
+    most: int = 3,
+) -> tuple[NearMiss, ...]:
+    """The components of ``graph`` whose output or effect is near ``need`` of ``consumer``, at most ``most``,
+    best first.
+
+    ``enabled``: whether the forward search enabled a component; ``refused``: whether the area rule refuses
+    a component handling the given requirement inputs; ``named``: components the answer names already
+    (passed over, planned but unrunnable) or that provide the need as it is."""
+    if most <= 0:
+        return ()
+    skip = set(named) | {e.source for e in graph.providers(consumer, need)}
+    found = [
+        miss
+        for miss in _candidates(graph, need)
+        if miss.component not in skip
+        and enabled(miss.component)
+        and not refused(miss.component, _given(graph, miss.component))
+    ]
+    found.sort(key=lambda m: (-m.similarity, m.component, m.offer))
+    best: dict[str, NearMiss] = {}
+    for miss in found:  # one near miss per component: its closest offer
+        best.setdefault(miss.component, miss)
+    return tuple(best.values())[:most]
+
+
+def _candidates(graph: ServiceResourceGraph, need: Need) -> Iterator[NearMiss]:
+    matcher = graph.matcher
+    for vertex in graph.pool.vertices.values():
+        for offer in vertex.offers:
+            if need.concept is not None and offer.concept is not None:
+                relation = near(matcher, need.concept, offer.concept)
+                if relation is not None:
+                    difference = Difference(need.concept, offer.concept, relation)
+                    similarity = matcher.measure(need.concept, offer.concept).value
+                    yield NearMiss(vertex.iri, offer.name, offer.concept, need.concept, (difference,), similarity)
+            elif need.statement is not None and offer.statement is not None:
+                differs = _statement_differs(matcher, need.statement, offer.statement)
+                if differs:
+                    value = statement_similarity(need.statement, offer.statement, matcher.measure, matcher.config)
+                    yield NearMiss(
+                        vertex.iri,
+                        offer.name,
+                        statement_text(offer.statement),
+                        statement_text(need.statement),
+                        differs,
+                        value.value,
+                    )
+
+
+def _statement_differs(matcher: Matcher, wanted: Statement, offered: Statement) -> tuple[Difference, ...]:
+    """The positions in which ``offered`` is near ``wanted``; empty when one is neither met nor near (or
+    every position is met: then it is no miss)."""
+    differs = []
+    pairs = zip(_POSITIONS, _terms(wanted), _terms(offered), strict=True)
+    for position, want, offer in pairs:
+        if degree_of_match(matcher.index, want, offer).accepted:
+            continue
+        relation = near(matcher, want, offer)
+        if relation is None:
+            return ()
+        differs.append(Difference(want, offer, relation, position))
+    return tuple(differs)
+
+
+def _terms(statement: Statement) -> tuple[str, str, str]:
+    return statement.subject, statement.predicate, statement.object
+
+
+def _given(graph: ServiceResourceGraph, component: str) -> list[str]:
+    """The requirement inputs a component would be given directly (the things it would handle)."""
+    return [
+        edge.offer.name
+        for need in graph.needs(component)
+        if need.role == "input"
+        for edge in graph.providers(component, need)
+        if edge.source == SRI
+    ]
+
+
+__all__ = ["SAME_PARTS", "SIBLINGS", "Difference", "NearMiss", "near", "near_misses"]
