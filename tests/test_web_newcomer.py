@@ -76,3 +76,24 @@ def test_a_lab_s_own_task_is_listed_by_its_prefixed_name_and_chosen_above_its_pl
     assert chosen[0] == (option["name"], "lab5:FetchPenForVisitor")  # the form said "(choose)"
     listed = re.search(r'<select id="task".*?</select>', page, re.S)
     assert listed is not None and "https://example.org/lab5#" not in re.sub(r'value="[^"]*"', "", listed.group(0))
+
+
+def test_a_task_the_url_misspells_is_a_field_error_with_what_was_meant(served: tuple[FlaskClient, TaskRunner]) -> None:
+    client, _ = served
+    refused = client.get("/tasks.json", query_string={"task": "FetchMyPn"})
+    assert refused.status_code == 400 and "FetchMyPen" in refused.get_json()["fields"]["task"]
+    page = client.get("/tasks", query_string={"task": "FetchMyPn"})
+    assert page.status_code == 400 and 'id="task-error"' in page.text and 'aria-invalid="true"' in page.text
+    assert "did you mean FetchMyPen" in unescape(page.text)
+
+
+def test_a_task_the_url_names_by_its_iri_is_chosen_as_the_list_spells_it(
+    served: tuple[FlaskClient, TaskRunner],
+) -> None:
+    client, _ = served
+    listed = client.get("/tasks.json").get_json()["tasks"]
+    for asked in ("req:FetchMyPen", "https://w3id.org/cbrs/requirement#FetchMyPen"):
+        body = client.get("/tasks.json", query_string={"task": asked}).get_json()
+        assert body["form"]["task"] == "FetchMyPen" and "FetchMyPen" in listed
+        page = client.get("/tasks", query_string={"task": asked}).text
+        assert re.findall(r'<option value="([^"]*)" selected>', page)[0] == "FetchMyPen"

@@ -64,6 +64,7 @@ def tasks() -> Page:
     shown = Page("tasks.html", "Tasks", {"mode": "tasks", **_overview(form)})
     _for_script(shown)
     if request.method != "POST":
+        _check_asked(form, shown)
         return shown
     _may_act()
     try:
@@ -118,6 +119,26 @@ def _for_script(shown: Page) -> Page:
         # steps live under them, and OWLS-TC's 1,144 derived prefixes made this page 145 KB bigger
         shown.data["prefixes"] = PREFIXES
     return shown
+
+
+def _check_asked(form: dict[str, Any], shown: Page) -> None:
+    """A task the URL names (``/tasks?task=``, a link or a bookmark) chosen as the list spells it
+    (``req:FetchMyPen`` chooses FetchMyPen); one the store has not, a field error with its did-you-mean
+    (400), as the plans page says it. It was added to the list as typed and refused only at Start."""
+    asked = form["task"] if "task" in request.args else ""
+    offered = choices()["tasks"]
+    if not asked or asked in offered:
+        return
+    from cbrs.task_names import task_iri
+
+    try:
+        with context.lock():
+            iri = task_iri(context.kb(), asked)
+    except UnknownTaskError as error:
+        raise FormError({"task": str(error)}, page=shown) from None
+    listed = _typed(iri, offered)
+    if listed is not None:
+        shown.data["form"] = {**shown.data["form"], "task": listed}
 
 
 RUN_FIELDS = ("task", "seed", "fail", "fault_rate", "repeat_failures")
