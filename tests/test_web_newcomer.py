@@ -97,3 +97,19 @@ def test_a_task_the_url_names_by_its_iri_is_chosen_as_the_list_spells_it(
         assert body["form"]["task"] == "FetchMyPen" and "FetchMyPen" in listed
         page = client.get("/tasks", query_string={"task": asked}).text
         assert re.findall(r'<option value="([^"]*)" selected>', page)[0] == "FetchMyPen"
+
+
+def test_the_overview_says_where_to_start_with_every_page_of_the_navigation(
+    served: tuple[FlaskClient, TaskRunner],
+) -> None:
+    client, _ = served
+    page = client.get("/").text
+    start = re.search(r'<section class="start-here">.*?</section>', page, re.S)
+    assert start is not None
+    linked = re.findall(r'<li><a href="([^"]+)">([^<]+)</a>: [^<]{20,}</li>', start.group(0))
+    navigation = re.findall(r'<a href="([^"]+)"[^>]*>([^<]+)</a>', re.search(r"<nav>.*?</nav>", page, re.S).group(0))
+    assert linked == [(href, label) for href, label in navigation if href != "/"]
+    # each count card reads as a number and a word, to a screen reader too ("53services" before)
+    counts = client.get("/index.json").get_json()["counts"]
+    cards = [_text(card) for card in re.findall(r'<div class="card">(.*?)</div>', page, re.S)]
+    assert cards == [f"{value} {name}" for name, value in counts.items()]
