@@ -120,7 +120,8 @@ def _arm(world: HomeWorld, side: ArmSide | str) -> Arm:
 
 
 def clear_view(world: HomeWorld) -> Outcome:
-    """Raise both arms to their home posture, out of the Kinect's view (the first step of FindCupOnTable)."""
+    """Raise the arms (one or two) to their home posture, out of the Kinect's view (the first step of
+    FindCupOnTable): 0.2 s of simulated time an arm at least."""
     start = world.time
     for arm in world.arms.values():
         result = arm.home()
