@@ -113,3 +113,20 @@ def test_the_overview_says_where_to_start_with_every_page_of_the_navigation(
     counts = client.get("/index.json").get_json()["counts"]
     cards = [_text(card) for card in re.findall(r'<div class="card">(.*?)</div>', page, re.S)]
     assert cards == [f"{value} {name}" for name, value in counts.items()]
+
+
+def test_the_search_finds_the_home_s_things_a_lab_added_by_name_and_label(lab: FlaskClient) -> None:
+    home = lab.get("/home.json").get_json()["things"]
+    for needle in ("visitor", "kitchen", "pen"):
+        found = lab.get("/search.json", query_string={"q": needle}).get_json()
+        things = found["things"]["matches"]
+        assert {t["iri"] for t in things} >= {t["iri"] for t in home if needle in t["name"].casefold()}
+        assert found["total"] == sum(
+            found[group]["count"] for group in ("terms", "advertisements", "requirements", "things")
+        )
+        for thing in things:
+            assert lab.get("/resource", query_string={"iri": thing["iri"]}).status_code == 200
+    visitor = lab.get("/search.json", query_string={"q": "the visitor in"}).get_json()["things"]["matches"]
+    assert [(t["name"], t["kind"], t["room"]) for t in visitor] == [("lab5:Visitor1", "person", "Kitchen")]
+    page = _text(lab.get("/search", query_string={"q": "visitor"}).text)
+    assert "Things in the home (1) lab5:Visitor1 the visitor in the kitchen person in Kitchen" in page

@@ -1,4 +1,5 @@
-"""One search over the store by name: classes and properties, advertisements and requirements.
+"""One search over the store by name: classes and properties, advertisements, requirements and the
+home's things.
 
 A lab user knows a name (``Price``, ``ceiling camera``, ``FetchMyPen``), not where it lives: before,
 each page had a filter of its own and none looked across them. The box in every page's header leads
@@ -13,6 +14,7 @@ from typing import Any
 import pyoxigraph as ox
 from flask import Blueprint, request
 
+from cbrs.kb.namespaces import RDFS
 from cbrs.web import context, services
 from cbrs.web.links import expand_name, short
 from cbrs.web.pages import FormError, Page, page
@@ -43,10 +45,14 @@ def search() -> Page:
     data["terms"] = _terms(needle)
     data["advertisements"] = _advertisements(needle, data["terms"]["all"])
     data["requirements"] = _requirements(needle)
-    data["total"] = sum(data[group]["count"] for group in ("terms", "advertisements", "requirements"))
-    for group in ("terms", "advertisements", "requirements"):
+    data["things"] = _things(needle)
+    data["total"] = sum(data[group]["count"] for group in GROUPS)
+    for group in GROUPS:
         del data[group]["all"]
     return shown
+
+
+GROUPS = ("terms", "advertisements", "requirements", "things")
 
 
 def _group(found: list[tuple[int, str, dict[str, Any]]]) -> dict[str, Any]:
@@ -101,3 +107,37 @@ def _requirements(needle: str) -> dict[str, Any]:
         if score is not None:
             rows.append((score, requirement["name"], requirement))
     return _group(rows)
+
+
+def _things(needle: str) -> dict[str, Any]:
+    """The home's things (rooms, furniture, objects, robots and arms, people, cameras, docking poses) by
+    name or label: a lab's visitor, bookcase or pen was found nowhere but on the home's picture."""
+    rows = []
+    for thing in context.per_generation("search_home_things", _home_things):
+        score = rank(needle, (thing["local"],), (thing["label"],))
+        if score is not None:
+            rows.append((score, thing["local"], thing))
+    return _group(rows)
+
+
+def _home_things() -> list[dict[str, Any]]:
+    """Each thing the home's page draws and lists (``cbrs.home_plan``), with its label; none when the map
+    cannot be read (the home's page says why)."""
+    from cbrs.home_plan import draw_home, survey
+
+    with context.lock():  # the map reader goes through the knowledge base's caches
+        found = survey(context.kb())
+    if found.semantic_map is None:
+        return []
+    facts = found.semantic_map.facts
+    return [
+        {
+            "iri": entry.iri,
+            "name": short(entry.iri),
+            "local": entry.name,
+            "label": next(iter(facts.get(entry.iri, {}).get(RDFS + "label", [])), None),
+            "kind": entry.kind,
+            "room": entry.room,
+        }
+        for entry in draw_home(found.semantic_map, found.believed).entries
+    ]
