@@ -43,6 +43,7 @@ from cbrs.output import (
     Cell,
     ProgressLine,
     fitted_table,
+    json_row,
     node_view,
     output_width,
     render_result,
@@ -632,7 +633,7 @@ def services(app: App, as_json: bool, full: bool, width: int | None) -> None:
     if as_json:
         found = []
         for row in rows:
-            item: dict[str, object] = {k: v.value for k, v in row.items()}
+            item = json_row(row, ("inputs", "outputs"))
             state = live.get(row["service"].value)
             if state is not None:
                 item["live"] = {"available": state.live, "reason": state.reason}

@@ -100,6 +100,18 @@ def sorted_lists(rows: Iterable[dict[str, Term]], columns: Iterable[str]) -> lis
     return found
 
 
+def json_row(row: dict[str, Term], lists: Iterable[str]) -> dict[str, Any]:
+    """A query row as JSON: each value as text, but each of ``lists`` (a ``GROUP_CONCAT`` of IRIs joined
+    by spaces) as a list in IRI order, empty when the row has none, as the browser's JSON twins give them
+    (``cbrs services --json`` gave one string, which every reader had to split)."""
+    names = tuple(lists)
+    found: dict[str, Any] = {k: v.value for k, v in row.items() if k not in names}
+    for name in names:
+        term = row.get(name)
+        found[name] = sorted(term.value.split()) if term is not None else []
+    return found
+
+
 def table(headers: list[str], rows: list[list[str]]) -> str:
     widths = [len(h) for h in headers]
     for row in rows:

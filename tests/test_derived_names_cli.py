@@ -109,7 +109,7 @@ def test_services_prints_names_that_paste_back_and_json_keeps_iris(store: Path, 
     code, out = run(store, "services", "--json")
     assert code == 0, out
     ours = next(item for item in json.loads(out) if item["deviceName"] == "novel_price_service")
-    assert ours["service"] == SERVICE + "NOVEL_PRICE" and ours["inputs"] == BOOKS + "Novel"
+    assert ours["service"] == SERVICE + "NOVEL_PRICE" and ours["inputs"] == [BOOKS + "Novel"]
 
 
 def test_match_and_plan_take_a_derived_name(store: Path, browser: dict[str, str]) -> None:

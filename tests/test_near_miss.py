@@ -49,7 +49,8 @@ lab:TrackPerson_Bedroom a cbrs:DynamicPerceptionComponent ;
     cbrs:deviceName "CeilingCamera03" ; cbrs:serviceName "TrackPerson" ;
     cbrs:hasOWLSModel [ a cbrs:OWLSModel ;
         cbrs:hasInput  [ a cbrs:Parameter ; cbrs:parameterName "person" ; cbrs:parameterType home:Person ] ;
-        cbrs:hasOutput [ a cbrs:Parameter ; cbrs:parameterName "personLocation" ; cbrs:parameterType home:PersonLocation ] ] ;
+        cbrs:hasOutput [ a cbrs:Parameter ; cbrs:parameterName "personLocation" ;
+            cbrs:parameterType home:PersonLocation ] ] ;
     cbrs:hasSEAModel [ a cbrs:SEAModel ; cbrs:effectiveArea home:Bedroom ] .
 """
 
@@ -111,7 +112,9 @@ def test_the_kitchen_tracker_is_named_with_what_differs_and_the_fix(visitor_kb: 
             "offer": "personLocation",
             "gives": HOME + "PersonLocation",
             "wanted": HOME + "PersonPosition",
-            "differs": [{"wanted": HOME + "PersonPosition", "offered": HOME + "PersonLocation", "relation": SAME_PARTS}],
+            "differs": [
+                {"wanted": HOME + "PersonPosition", "offered": HOME + "PersonLocation", "relation": SAME_PARTS}
+            ],
             "similarity": shown[0]["similarity"],
         }
     ]

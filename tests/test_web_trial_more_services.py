@@ -120,7 +120,7 @@ def test_output_width_cuts_only_a_terminal(monkeypatch: pytest.MonkeyPatch) -> N
 
 
 @pytest.fixture(scope="module")
-def advertisements() -> dict[str, dict[str, str]]:
+def advertisements() -> dict[str, dict[str, Any]]:
     listed = CliRunner().invoke(cli, ["--store", ":memory:", "services", "--json"])
     assert listed.exit_code == 0, listed.output
     return {shorten(row["service"]): row for row in json.loads(listed.output)}
@@ -132,9 +132,9 @@ def _services(*args: str) -> str:
     return result.output
 
 
-def _check_cell(cell: str, iris: str) -> int:
+def _check_cell(cell: str, iris: list[str]) -> int:
     """That a list as shown is the list's first names, whole, and the count of the others; 1 if cut."""
-    names = [shorten(i) for i in iris.split()]
+    names = [shorten(i) for i in iris]
     tokens = cell.split()
     if not names:
         assert tokens == ["-"]
@@ -149,7 +149,7 @@ def _check_cell(cell: str, iris: str) -> int:
     return 1
 
 
-def test_a_row_on_one_line_cuts_its_lists_and_counts_the_rest(advertisements: dict[str, dict[str, str]]) -> None:
+def test_a_row_on_one_line_cuts_its_lists_and_counts_the_rest(advertisements: dict[str, dict[str, Any]]) -> None:
     text = _services("--width", "160")
     lines = text.splitlines()
     assert max(len(line) for line in lines) <= 160
@@ -158,13 +158,13 @@ def test_a_row_on_one_line_cuts_its_lists_and_counts_the_rest(advertisements: di
     for line in lines[2:-1]:
         cells = [line[a:b].strip() for a, b in zip(starts, [*starts[1:], None], strict=True)]
         row = advertisements[cells[0]]
-        cut += _check_cell(cells[3], row.get("inputs", "")) + _check_cell(cells[4], row.get("outputs", ""))
+        cut += _check_cell(cells[3], row["inputs"]) + _check_cell(cells[4], row["outputs"])
     assert len(lines) - 3 == len(advertisements) and cut > 0
     note = f"({len(advertisements)} advertisements; {cut} lists cut to 160 columns: --full prints them whole)"
     assert lines[-1] == note
 
 
-def test_a_narrow_width_gives_each_row_two_lines(advertisements: dict[str, dict[str, str]]) -> None:
+def test_a_narrow_width_gives_each_row_two_lines(advertisements: dict[str, dict[str, Any]]) -> None:
     text = _services("--width", "80")
     lines = text.splitlines()
     assert lines[:2] == ["service", "    kind  device  inputs -> outputs"]
@@ -177,7 +177,7 @@ def test_a_narrow_width_gives_each_row_two_lines(advertisements: dict[str, dict[
         front = f"    {kind}  {row['deviceName']}  "
         assert line.startswith(front) and (len(line) <= 80 or len(front) + 2 * LEAST_CUT + 4 > 80), line
         inputs, outputs = line[len(front) :].split(" -> ")
-        cut += _check_cell(inputs, row.get("inputs", "")) + _check_cell(outputs, row.get("outputs", ""))
+        cut += _check_cell(inputs, row["inputs"]) + _check_cell(outputs, row["outputs"])
     assert cut > 0 and f"; {cut} lists cut to 80 columns" in lines[-1]
 
 
