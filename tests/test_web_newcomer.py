@@ -9,6 +9,7 @@ from __future__ import annotations
 import re
 from collections.abc import Iterator
 from html import unescape
+from urllib.parse import unquote
 
 import pytest
 from flask.testing import FlaskClient
@@ -130,3 +131,19 @@ def test_the_search_finds_the_home_s_things_a_lab_added_by_name_and_label(lab: F
     assert [(t["name"], t["kind"], t["room"]) for t in visitor] == [("lab5:Visitor1", "person", "Kitchen")]
     page = _text(lab.get("/search", query_string={"q": "visitor"}).text)
     assert "Things in the home (1) lab5:Visitor1 the visitor in the kitchen person in Kitchen" in page
+
+
+def test_a_triple_stated_in_two_graphs_is_one_row_naming_both(lab: FlaskClient) -> None:
+    """The visitor's file goes into graph:ontology and graph:map, as its header says."""
+    body = lab.get("/resource.json", query_string={"iri": "lab5:Visitor1"}).get_json()
+    stated: dict[tuple[str, str], list[str]] = {}
+    for group in body["outgoing"]:
+        for value in group["values"]:
+            stated.setdefault((group["name"], value["term"]["value"]), []).append(value["graph"])
+    assert any(len(graphs) == 2 for graphs in stated.values())  # the twin keeps one value per triple
+    page = lab.get("/resource", query_string={"iri": "lab5:Visitor1"}).text
+    out = re.search(r"<h2>Out:.*?</table>", page, re.S)
+    assert out is not None
+    rows = re.findall(r"<tr>\s*<td>(.*?)</td>\s*<td>(.*?)</td>\s*<td class=\"graph\">(.*?)</td>", out.group(0), re.S)
+    shown = [[unquote(g) for g in re.findall(r'href="/resource\?iri=([^"]+)"', graphs)] for _, _, graphs in rows]
+    assert sorted(shown) == sorted(stated.values())  # one row per value, with every graph that states it

@@ -136,7 +136,21 @@ def resource() -> Page:
             "query": _uses_query(iri) if uses else None,
         },
     }
+    if not wants_json():  # the page's rows; the twin keeps one value per triple
+        for group in (*outgoing, *incoming):
+            group["rows"] = _merged(group["values"])
     return Page("resource.html", display_text(iri), data)
+
+
+def _merged(values: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """One row per value with the graphs that state it, in the order the values come: a lab's file loaded
+    into graph:ontology and graph:map, as the examples say to, showed each of its triples twice."""
+    rows: dict[tuple[str, ...], dict[str, Any]] = {}
+    for value in values:
+        term = value["term"]
+        key = (term["type"], term["value"], term.get("datatype", ""), term.get("language", ""))
+        rows.setdefault(key, {"term": term, "graphs": []})["graphs"].append(value["graph"])
+    return list(rows.values())
 
 
 def has_page(iri: str) -> bool:
