@@ -147,3 +147,28 @@ def test_a_triple_stated_in_two_graphs_is_one_row_naming_both(lab: FlaskClient) 
     rows = re.findall(r"<tr>\s*<td>(.*?)</td>\s*<td>(.*?)</td>\s*<td class=\"graph\">(.*?)</td>", out.group(0), re.S)
     shown = [[unquote(g) for g in re.findall(r'href="/resource\?iri=([^"]+)"', graphs)] for _, _, graphs in rows]
     assert sorted(shown) == sorted(stated.values())  # one row per value, with every graph that states it
+
+
+@pytest.mark.parametrize(
+    ("path", "asked", "has_page"),
+    [
+        pytest.param("/taxonomy/class", "home:NoSuchThing", False, id="class-unknown"),
+        pytest.param("/taxonomy/class", "world:Kitchen", True, id="individual-as-class"),
+        pytest.param("/resource", "home:NoSuchThing", False, id="resource-unknown"),
+    ],
+)
+def test_an_iri_the_store_lacks_is_a_not_found_page_naming_it_as_the_pages_do(
+    served: tuple[FlaskClient, TaskRunner], path: str, asked: str, has_page: bool
+) -> None:
+    client, _ = served
+    twin = client.get(path + ".json", query_string={"iri": asked})
+    assert twin.status_code == 404 and "<https://w3id.org/cbrs/" in twin.get_json()["message"]  # as it was
+    answer = client.get(path, query_string={"iri": asked})
+    page = _text(answer.text)
+    assert answer.status_code == 404 and "<title>Not Found · cbrs</title>" in answer.text
+    assert f" {asked} in the store" in page and "<https://" not in page
+    assert f"IRI {twin.get_json()['message'].split('<')[1].split('>')[0]}" in page
+    assert ("what the store says of " + asked in page) == has_page
+    if has_page:
+        link = re.search(r'<a href="([^"]+)">what the store says of', answer.text)
+        assert link is not None and client.get(unescape(link.group(1))).status_code == 200

@@ -25,7 +25,7 @@ from cbrs.sparql_service import SparqlService
 from cbrs.tasks import TaskRunner
 from cbrs.web import links, warmup
 from cbrs.web.context import EventLog, StreamSlots
-from cbrs.web.pages import http_error_message, keep_error_headers, wants_json
+from cbrs.web.pages import error_page, http_error_message, keep_error_headers, wants_json
 from cbrs.web.sparql_wsgi import SparqlHotPath
 from cbrs.web.strict_request import StrictRequest
 
@@ -156,7 +156,7 @@ def create_app(
     @app.errorhandler(KnowledgeBaseError)
     def library_error(error: KnowledgeBaseError) -> tuple[Response | str, int]:
         if as_page():
-            return render_template("error.html", title="Error", message=str(error)), error.http_status
+            return error_page(error), error.http_status
         return _error(getattr(error, "kind", type(error).__name__), str(error)), error.http_status
 
     def for_programs() -> bool:

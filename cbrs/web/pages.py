@@ -19,8 +19,9 @@ from typing import Any
 
 from flask import Blueprint, Response, current_app, jsonify, make_response, render_template, request
 from werkzeug.exceptions import HTTPException, MethodNotAllowed, NotFound
+from werkzeug.http import HTTP_STATUS_CODES
 
-from cbrs.kb.errors import KnowledgeBaseError
+from cbrs.kb.errors import KnowledgeBaseError, NotFoundError
 
 
 @dataclass
@@ -105,6 +106,26 @@ def page(blueprint: Blueprint, rule: str, negotiate: bool = False, **options: An
         return view
 
     return register
+
+
+def error_page(error: KnowledgeBaseError) -> str:
+    """A library error as a page, titled by its status ("Not Found"; every such page said "Error"). An
+    IRI the store lacks (:class:`NotFoundError`) is named as the pages name it (``home:Pen``, not
+    ``<https://w3id.org/cbrs/home#Pen>``), with a link to its own page when the store has triples about
+    it under another role (an individual asked for as a class)."""
+    from cbrs.web.links import iri_url, short
+    from cbrs.web.resource import has_page
+
+    status = error.http_status
+    title = HTTP_STATUS_CODES.get(status, "Error")
+    if not isinstance(error, NotFoundError):
+        return render_template("error.html", title=title, message=str(error))
+    name = short(error.iri)
+    message = f"no {error.what} {name} in the store" if name != error.iri else str(error)
+    own = iri_url(error.iri) if request.endpoint != "resource.resource" and has_page(error.iri) else None
+    return render_template(
+        "error.html", title=title, message=message, missing={"iri": error.iri, "name": name, "page": own}
+    )
 
 
 def http_error_message(error: HTTPException) -> str:

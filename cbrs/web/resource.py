@@ -23,7 +23,7 @@ from cbrs.kb.namespaces import OWL, RDF, RDFS, XSD, GraphName
 from cbrs.web import context
 from cbrs.web.graphs import about as graph_note
 from cbrs.web.links import display_text, expand_name, iri_link, short
-from cbrs.web.pages import Page, http_error_message, keep_error_headers, page, wants_json
+from cbrs.web.pages import Page, error_page, http_error_message, keep_error_headers, page, wants_json
 
 blueprint = Blueprint("resource", __name__)
 
@@ -223,6 +223,8 @@ def _row_order(row: dict[str, Any]) -> tuple[bool, int, str]:
 
 @blueprint.errorhandler(KnowledgeBaseError)
 def _library_error(error: KnowledgeBaseError) -> tuple[Response | str, int]:
+    if not wants_json():
+        return error_page(error), error.http_status
     return _failure(error.http_status, getattr(error, "kind", type(error).__name__), "Not found", str(error))
 
 
