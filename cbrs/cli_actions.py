@@ -150,7 +150,8 @@ def plan(
 ) -> None:
     """Compose a plan for TASK: a requirement or action (req:FetchMyPen, act:RobotArmServeACup, or a bare name).
 
-    Exits with status 1 when no plan exists, after saying which need no component meets. The plan is
+    Exits with status 1 when no plan exists, after saying which need no component meets and which
+    components come close to it (--near-misses). The plan is
     composed over every advertisement; a note follows it for each step cbrs run cannot run in the
     simulated home now (no skill for its service, no live component to call, a camera the map does not
     place), which the run plans without, and for each thing the task names that the map does not hold,
