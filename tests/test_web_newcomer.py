@@ -172,3 +172,19 @@ def test_an_iri_the_store_lacks_is_a_not_found_page_naming_it_as_the_pages_do(
     if has_page:
         link = re.search(r'<a href="([^"]+)">what the store says of', answer.text)
         assert link is not None and client.get(unescape(link.group(1))).status_code == 200
+
+
+def test_every_matching_method_offered_says_what_it_is(served: tuple[FlaskClient, TaskRunner]) -> None:
+    client, _ = served
+    methods = client.get("/match.json").get_json()["methods"]
+    page = client.get("/match").text
+    help_box = re.search(r'<details class="small" id="methods-help">.*?</details>', page, re.S)
+    assert help_box is not None and 'aria-describedby="methods-help"' in page
+    notes = dict(re.findall(r"<dt><code>([^<]+)</code></dt><dd>([^<]*)</dd>", help_box.group(0)))
+    assert list(notes) == methods and all(len(note) > 20 for note in notes.values())
+    titles = dict(re.findall(r'<option value="([^"]+)"[^>]* title="([^"]+)">', page))
+    assert {m: unescape(titles[m]) for m in methods} == {m: unescape(notes[m]) for m in methods}
+    refused = client.get("/match", query_string={"requirement": "req:RobotSelfPosition", "methods": "nope"})
+    select = re.search(r'<select id="methods"[^>]*>', refused.text)
+    assert refused.status_code == 400 and select is not None
+    assert select.group(0).count("aria-describedby") == 1 and 'aria-describedby="methods-error"' in select.group(0)
