@@ -188,3 +188,17 @@ def test_every_matching_method_offered_says_what_it_is(served: tuple[FlaskClient
     select = re.search(r'<select id="methods"[^>]*>', refused.text)
     assert refused.status_code == 400 and select is not None
     assert select.group(0).count("aria-describedby") == 1 and 'aria-describedby="methods-error"' in select.group(0)
+
+
+@pytest.mark.parametrize("table", ["advertisements", "requirements"])
+def test_each_cell_of_the_services_tables_names_its_column_for_the_phone_layout(lab: FlaskClient, table: str) -> None:
+    page = lab.get("/services").text
+    found = re.search(rf'<table id="{table}">.*?</table>', page, re.S)
+    assert found is not None
+    headers = [_text(h) for h in re.findall(r'<th scope="col">(.*?)</th>', found.group(0))]
+    rows = re.findall(r"<tr>(.*?)</tr>", found.group(0).split("<tbody>")[1], re.S)
+    assert len(rows) > 1
+    for row in rows:
+        labels = re.findall(r'<td(?: class="[^"]*")?(?: data-label="([^"]*)")?>', row)
+        assert [unescape(label) for label in labels] == [h if h != "ranking" else "" for h in headers][: len(labels)]
+        assert len(labels) == len(headers)
