@@ -683,7 +683,7 @@ class Composer:
             need = next((n for n in attempt.graph.needs(u.consumer) if n.text() == u.need), None)
             if need is None:
                 continue
-            named = [c for c, _ in (*u.out_of_area, *u.unrunnable, *u.provided)]
+            named = [c for c, _ in (*u.out_of_area, *u.unrunnable)]  # (what they provide about it: said again)
             refused = partial(_refused, self.area_rule(attempt.requirement), attempt.graph)
             found = near_misses(
                 attempt.graph, u.consumer, need, attempt.trace.enabled, refused, named, self.config.near_misses

@@ -14,10 +14,11 @@ RobotPosition is about another thing) and, by the store's taxonomy, they
   home:PersonProfile both have a given and a family name, but meet only at the root), or
 * are siblings (a direct superclass in common, not the root).
 
-An offered statement is near a needed one when each position is met (an is-a relative) or near, and at
-least one is near. A component comes close only if it would then have done: the forward search enabled
-it (all it needs is there) and the area rule does not refuse it for the task's things it is given.
-Near misses are ranked by Sem-Str similarity (the measure edges are ranked by), then by IRI, and capped
+An offered statement is near a needed one when its predicate is met (an is-a relative: another relation
+is another action, not a small change), its subject and object are each met or near, and one is near.
+A component comes close only if it would then have done: the forward search enabled it (all it needs
+is there) and the area rule does not refuse it for the task's things it is given. Near misses are
+ranked by Sem-Str similarity (the measure edges are ranked by), then by IRI, and capped
 (``ComposeConfig.near_misses``).
 """
 
@@ -139,7 +140,7 @@ def near_misses(
 
     ``enabled``: whether the forward search enabled a component; ``refused``: whether the area rule refuses
     a component handling the given requirement inputs; ``named``: components the answer names already
-    (passed over, planned but unrunnable) or that provide the need as it is."""
+    (passed over, planned but unrunnable); those that provide the need as it is are left out too."""
     if most <= 0:
         return ()
     skip = set(named) | {e.source for e in graph.providers(consumer, need)}
@@ -168,7 +169,7 @@ def _candidates(graph: ServiceResourceGraph, need: Need) -> Iterator[NearMiss]:
                     similarity = matcher.measure(need.concept, offer.concept).value
                     yield NearMiss(vertex.iri, offer.name, offer.concept, need.concept, (difference,), similarity)
             elif need.statement is not None and offer.statement is not None:
-                differs = _statement_differs(matcher, need.statement, offer.statement)
+                differs = statement_differences(matcher, need.statement, offer.statement)
                 if differs:
                     value = statement_similarity(need.statement, offer.statement, matcher.measure, matcher.config)
                     yield NearMiss(
@@ -181,16 +182,16 @@ def _candidates(graph: ServiceResourceGraph, need: Need) -> Iterator[NearMiss]:
                     )
 
 
-def _statement_differs(matcher: Matcher, wanted: Statement, offered: Statement) -> tuple[Difference, ...]:
-    """The positions in which ``offered`` is near ``wanted``; empty when one is neither met nor near (or
-    every position is met: then it is no miss)."""
+def statement_differences(matcher: Matcher, wanted: Statement, offered: Statement) -> tuple[Difference, ...]:
+    """The positions in which ``offered`` is near ``wanted``; empty when one is neither met nor near, the
+    predicate is not met, or every position is met (then it is no miss)."""
     differs = []
     pairs = zip(_POSITIONS, _terms(wanted), _terms(offered), strict=True)
     for position, want, offer in pairs:
         if degree_of_match(matcher.index, want, offer).accepted:
             continue
-        relation = near(matcher, want, offer)
-        if relation is None:
+        relation = near(matcher, want, offer) if position != "predicate" else None
+        if relation is None:  # another relation is another action, not a small change
             return ()
         differs.append(Difference(want, offer, relation, position))
     return tuple(differs)
@@ -211,4 +212,4 @@ def _given(graph: ServiceResourceGraph, component: str) -> list[str]:
     ]
 
 
-__all__ = ["SAME_PARTS", "SIBLINGS", "Difference", "NearMiss", "near", "near_misses"]
+__all__ = ["SAME_PARTS", "SIBLINGS", "Difference", "NearMiss", "near", "near_misses", "statement_differences"]

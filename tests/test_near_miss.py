@@ -15,9 +15,9 @@ import pytest
 
 from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, PlanStatus
 from cbrs.actions.graph import Matcher
-from cbrs.actions.near_misses import SAME_PARTS, SIBLINGS, near
+from cbrs.actions.near_misses import SAME_PARTS, SIBLINGS, Difference, NearMiss, near, statement_differences
 from cbrs.actions.unmet import Unsatisfied
-from cbrs.kb import KnowledgeBase
+from cbrs.kb import KnowledgeBase, Statement
 from cbrs.kb.namespaces import PREFIXES
 from tests.helpers_examples import EXAMPLES, lab5_store
 
@@ -166,3 +166,25 @@ def test_the_fix_named_composes(tmp_path_factory: pytest.TempPathFactory) -> Non
 )
 def test_which_concepts_are_near(matcher: Matcher, wanted: str, offered: str, relation: str | None) -> None:
     assert near(matcher, HOME + wanted, HOME + offered) == relation
+
+
+def test_a_statement_is_near_by_its_subject_or_object_never_its_predicate(matcher: Matcher) -> None:
+    wanted = Statement(HOME + "Mug", HOME + "isLocated", HOME + "BelowOfTap")
+    cup = Statement(HOME + "Cup", HOME + "isLocated", HOME + "BelowOfTap")
+    assert statement_differences(matcher, wanted, cup) == (Difference(HOME + "Mug", HOME + "Cup", SIBLINGS, "subject"),)
+    assert statement_differences(matcher, wanted, Statement(HOME + "Cup", HOME + "isAbove", HOME + "BelowOfTap")) == ()
+    assert statement_differences(matcher, wanted, Statement(HOME + "Cup", HOME + "isLocated", HOME + "Kitchen")) == ()
+    miss = NearMiss(
+        SVC + "PutCup",
+        "effect",
+        "(home:Cup, home:isLocated, home:BelowOfTap)",
+        "(home:Mug, home:isLocated, home:BelowOfTap)",
+        statement_differences(matcher, wanted, cup),
+        0.9,
+    )
+    assert miss.text("svc:Fill needs") == (
+        "svc:PutCup comes close: its effect (home:Cup, home:isLocated, home:BelowOfTap) differs from the"
+        " (home:Mug, home:isLocated, home:BelowOfTap) svc:Fill needs: its subject home:Cup for home:Mug (siblings,"
+        " neither a kind of the other): register a component like it whose effect is (home:Mug, home:isLocated,"
+        " home:BelowOfTap)"
+    )
