@@ -202,3 +202,22 @@ def test_each_cell_of_the_services_tables_names_its_column_for_the_phone_layout(
         labels = re.findall(r'<td(?: class="[^"]*")?(?: data-label="([^"]*)")?>', row)
         assert [unescape(label) for label in labels] == [h if h != "ranking" else "" for h in headers][: len(labels)]
         assert len(labels) == len(headers)
+
+
+@pytest.mark.parametrize(
+    ("path", "query", "title"),
+    [
+        pytest.param("/plans", {"task": "FetchMyPn"}, "Plans", id="plans"),
+        pytest.param("/match", {"requirement": "req:RobotSelfPositon"}, "Matchmaking", id="match"),
+    ],
+)
+def test_a_refused_form_is_not_titled_as_if_it_had_an_answer(
+    served: tuple[FlaskClient, TaskRunner], path: str, query: dict[str, str], title: str
+) -> None:
+    client, _ = served
+    refused = client.get(path, query_string=query)
+    assert refused.status_code == 400 and f"<h1>{title}</h1>" in refused.text and "did you mean" in refused.text
+    name = "FetchMyPen" if path == "/plans" else "req:RobotSelfPosition"
+    shown = client.get(path, query_string={key: name for key in query})
+    assert shown.status_code == 200 and f"<h1>{title if path == '/match' else 'Plan'}" in shown.text
+    assert name in re.search(r"<h1>(.*?)</h1>", shown.text).group(1)

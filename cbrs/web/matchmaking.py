@@ -46,7 +46,6 @@ def matchmaking() -> Page:
         shown.data["concepts"] = concepts()  # for the inputs' completion; the twin need not carry them
     if not _asked(form):
         return shown
-    shown.title = "Matchmaking: " + (form["requirement"] or "a written requirement")
     errors = _check_options(form)
     if errors:
         raise FormError(errors, page=shown)
@@ -54,6 +53,8 @@ def matchmaking() -> Page:
         matchmakers = {method: matchmaker(method) for method in form["methods"]}
         requirement = _requirement(form, next(iter(matchmakers.values())), shown)
         results = [m.rank(requirement, explain=form["top"]) for m in matchmakers.values()]
+    # titled by the requirement once it is known: a refused one titled the error page as if ranked
+    shown.title = "Matchmaking: " + (form["requirement"] or "a written requirement")
     shown.data.update(
         requirement=_requirement_dict(requirement),
         rankings=[_ranking(result, form["top"], requirement) for result in results],

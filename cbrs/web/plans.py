@@ -51,9 +51,9 @@ def plans() -> Page:
         if not wants_json():
             _load_drawing_library()  # while the user chooses a task
         return shown
-    shown.title = f"Plan for {task}" if task else "Plans"
     with context.lock():  # a GET stays safe: the plan is shown, not recorded (cbrs plan and /cbrs/plan record)
         result = _compose(task, objective, shown)
+    shown.title = f"Plan for {task}"  # once there is one: "Plan for FetchMyPn" titled the error
     data["composition"] = _composition(result)
     if not wants_json():  # markup, so not in the twin, which has the same steps as lists
         data["flow"] = _flow(data["composition"])
