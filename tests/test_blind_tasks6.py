@@ -36,6 +36,7 @@ from tests.test_live_components import TOKEN, eventually, live_server
 HOME, WORLD, LAB6 = PREFIXES["home"], PREFIXES["world"], "https://example.org/lab6#"
 SENSOR, PHONE = LAB6 + "CheckFridgeDoor_FridgeDoorSensor01", LAB6 + "AlertByPhone_ResidentPhone01"
 CHECK = "/lab6_fridge_door_sensor_01/check"
+KETTLE = LAB6 + "SwitchOnKettle_KettleSwitch01"
 
 
 def _graph_sizes(kb: KnowledgeBase) -> dict[str, int]:
@@ -205,3 +206,35 @@ def test_the_pen_off_the_table_plans_its_effect_and_a_delete_effect_alone_is_ref
     alone = Composer(kb).compose("PenNotOnTheTable")
     assert alone.plan is None
     assert any("delete effects alone are no goal" in need.text() for need in alone.unsatisfied)
+
+
+def test_the_kettle_written_with_plain_websockets_registers_plans_and_answers(server: Server) -> None:
+    """The protocol followed word for word (auth, register, advertise, heartbeats): SwitchOnTheKettle is
+    planned onto it and its call answers the kettle switched on."""
+    kb = server.kb
+    for graph in ("ontology", "map"):
+        kb.load([EXAMPLES / "lab6_kettle.ttl"], graph=graph)
+    kb.load([EXAMPLES / "lab6_switch_on_the_kettle.ttl"], graph="requirements")
+    url = f"ws://127.0.0.1:{server.bridge_port}"
+    command = [sys.executable, str(EXAMPLES / "lab6_kettle.py"), "--bridge", url]
+    env = {**os.environ, "CBRS_UPDATE_TOKEN": TOKEN}
+    child = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    try:
+        states = kb.liveness.states
+        assert eventually(lambda: KETTLE in states() and states()[KETTLE].live, 20.0)
+        plan = Composer(kb).compose("SwitchOnTheKettle").plan
+        assert plan is not None and plan.components() == [KETTLE]
+        with BridgeClient(url, TOKEN) as bridge:
+            outputs = {"kettleStatus": HOME + "DeviceStatus"}
+            component = RemoteComponent(KETTLE, bridge, "/lab6_kettle_switch_01/switch_on", outputs, check, 5.0)
+            component.begin({"kettle": {"@id": LAB6 + "Kettle1", "@type": LAB6 + "Kettle"}})
+            status = Status.RUNNING
+            for _ in range(5000):  # ticks of at most a few milliseconds each
+                status = component.update()
+                if status is not Status.RUNNING:
+                    break
+        assert status is Status.SUCCEEDED, component.reason
+        assert component.outputs["kettleStatus"]["@type"] == HOME + "SwitchedOn"
+    finally:
+        out = _stop(child)
+    assert "kettle: switched on" in out
