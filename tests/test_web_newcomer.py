@@ -221,3 +221,18 @@ def test_a_refused_form_is_not_titled_as_if_it_had_an_answer(
     shown = client.get(path, query_string={key: name for key in query})
     assert shown.status_code == 200 and f"<h1>{title if path == '/match' else 'Plan'}" in shown.text
     assert name in re.search(r"<h1>(.*?)</h1>", shown.text).group(1)
+
+
+def test_the_tasks_list_gives_each_task_s_label_as_the_plans_page_does(served: tuple[FlaskClient, TaskRunner]) -> None:
+    client, _ = served
+    body = client.get("/tasks.json").get_json()
+    plans = client.get("/plans.json").get_json()["tasks"]
+    planned = {t["shown"]: t["label"] for group in ("requirements", "actions") for t in plans[group] if t["label"]}
+    assert body["labels"] and set(body["labels"]) <= set(body["tasks"])
+    for name, label in body["labels"].items():  # the list spells a requirement bare, the plans page prefixed
+        assert label in (planned.get(name), *(v for k, v in planned.items() if k.partition(":")[2] == name))
+    page = unescape(client.get("/tasks").text)
+    options = dict(re.findall(r'<option value="([^"]+)"(?: selected)?>([^<]+)</option>', page))
+    for name in body["tasks"]:
+        label = body["labels"].get(name)
+        assert options[name] == (f"{name} · {label}" if label else name)

@@ -272,6 +272,7 @@ def _overview(form: dict[str, Any]) -> dict[str, Any]:
     return {
         "form": form,
         "tasks": offered["tasks"],
+        "labels": offered["labels"],
         "components": offered["components"],
         "active": _detail(latest) if latest is not None else None,
         "runs": [_summary(r) for r in reversed(runs)],
@@ -290,11 +291,21 @@ def choices() -> dict[str, Any]:
         runner, kb = context.tasks(), context.kb()
         with context.lock():
             known = runner.tasks()
-            composite = {action.iri for action in ActionLibrary.from_kb(kb) if action.sub_actions}
+            actions = [action for action in ActionLibrary.from_kb(kb) if action.sub_actions]
             rows = kb.select("requirements")
+        composite = {action.iri for action in actions}
         stated = sorted({row["requirement"].value for row in rows if "task" in row and row["task"].value in composite})
         several = sorted(name for name in (_typed(iri, known) for iri in stated) if name is not None)
-        return {"tasks": known, "components": [short(c) for c in runner.components()], "several": several}
+        # each task's label beside its name, as the plans page shows them ("FetchMyPen · Fetch my pen")
+        labelled = [(row["requirement"].value, row["label"].value) for row in rows if "label" in row]
+        labelled += [(action.iri, action.label) for action in actions if action.label]
+        labels = {name: label for name, label in ((_typed(iri, known), label) for iri, label in labelled) if name}
+        return {
+            "tasks": known,
+            "labels": labels,
+            "components": [short(c) for c in runner.components()],
+            "several": several,
+        }
 
     return context.per_generation("task_choices", read)
 
