@@ -236,3 +236,24 @@ def test_the_tasks_list_gives_each_task_s_label_as_the_plans_page_does(served: t
     for name in body["tasks"]:
         label = body["labels"].get(name)
         assert options[name] == (f"{name} · {label}" if label else name)
+
+
+@pytest.mark.parametrize(
+    ("asked", "member"),
+    [
+        pytest.param("lab5:Visitor", "lab5:Visitor1", id="lab"),
+        pytest.param("home:Kitchen", "world:Kitchen", id="bundled"),
+    ],
+)
+def test_a_class_page_lists_the_individuals_stated_of_it(lab: FlaskClient, asked: str, member: str) -> None:
+    body = lab.get("/taxonomy/class.json", query_string={"iri": asked}).get_json()
+    members = body["members"]
+    assert member in [m["name"] for m in members["shown"]] and members["count"] == len(members["shown"])
+    typed = lab.get("/resource.json", query_string={"iri": asked}).get_json()["incoming"]
+    stated = {v["term"]["value"] for g in typed if g["name"] == "rdf:type" for v in g["values"]}
+    assert {m["iri"] for m in members["shown"]} == stated  # once each, though stated in two graphs
+    page = unescape(lab.get("/taxonomy/class", query_string={"iri": asked}).text)
+    assert re.search(r'<h2 id="members-heading">Individuals <span class="muted">\(\d+\)</span></h2>', page)
+    assert f">{member}</a>" in page
+    person = lab.get("/taxonomy/class.json", query_string={"iri": "home:Person"}).get_json()["members"]
+    assert "lab5:Visitor1" not in [m["name"] for m in person["shown"]]  # a subclass's individuals are on its page

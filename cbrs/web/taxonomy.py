@@ -36,6 +36,7 @@ MAX_PATHS = 12  # ancestor paths shown per search match
 MAX_TREE_NODES = 2000
 MAX_PICTURE_ROW = 10  # subclasses (and parts) drawn in a class's picture; the rest is one "N more" box
 MAX_MATCHES = 200  # search matches listed with their paths; the count says how many there are
+MAX_MEMBERS = 100  # individuals listed on a class's page; the count says how many there are
 # How a service description reaches a concept, walking incoming triples back to the description.
 _USE_LINKS = {
     CBRS.parameterType: "parameter",
@@ -297,6 +298,7 @@ def concept() -> Page:
         "restrictions": _restrictions(kb, triples) if kind == "class" else [],
         "named_in": _named_in(kb, triples),
         "usage": _usage(kb, iri, triples),
+        "members": _members(triples) if kind == "class" else {"count": 0, "shown": []},
     }
     if not wants_json():  # markup, so not in the twin, which has the same facts as lists
         data["picture"] = _picture(found, iri, data["parts"])
@@ -375,6 +377,7 @@ def _undeclared(kb: KnowledgeBase, found: Taxonomy, iri: str, triples: list[dict
         "named_in": empty,
         "similar": similar,
         "usage": usage,
+        "members": {"count": 0, "shown": empty},
     }
     title = f"{'Built-in term' if built_in else 'Undeclared concept'} {display_text(iri)}"
     return Page("class.html", title, data)
@@ -433,6 +436,20 @@ def _expression_row(relation: str, expression: Expression) -> dict[str, Any]:
         "text": manchester(expression),
         "expression": expression,
     }
+
+
+def _members(triples: list[dict[str, Any]]) -> dict[str, Any]:
+    """The named individuals stated of the class (``rdf:type`` it, not a subclass): the pen, the kitchen,
+    the lab's visitor were reached from their class only through its "all triples" page."""
+    found = sorted(
+        {r["other"].value for r in triples if _in(r, RDF + "type") and isinstance(r["other"], ox.NamedNode)},
+        key=lambda t: (short(t).casefold(), t),
+    )
+    return {"count": len(found), "shown": [{"iri": t, "name": short(t)} for t in found[:MAX_MEMBERS]]}
+
+
+def _in(row: dict[str, Any], predicate: str) -> bool:
+    return bool(row["direction"].value == "in" and row["predicate"].value == predicate)
 
 
 def _out(row: dict[str, Any], predicate: str) -> bool:
