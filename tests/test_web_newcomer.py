@@ -16,11 +16,13 @@ from flask.testing import FlaskClient
 
 from cbrs.kb import KnowledgeBase
 from cbrs.sparql_service import SparqlService
-from cbrs.tasks import TaskRunner
+from cbrs.tasks import TaskRun, TaskRunner
 from cbrs.web import create_app
+from cbrs.web.links import short_text
 from tests.helpers_examples import EXAMPLES, lab5_store
 
 WAIT = 30.0
+SVC = "https://w3id.org/cbrs/service#"
 UNPLANNABLE = "RouteToGoal"  # a bundled requirement no component chain provides: it ends no-plan, unsimulated
 
 
@@ -257,3 +259,34 @@ def test_a_class_page_lists_the_individuals_stated_of_it(lab: FlaskClient, asked
     assert f">{member}</a>" in page
     person = lab.get("/taxonomy/class.json", query_string={"iri": "home:Person"}).get_json()["members"]
     assert "lab5:Visitor1" not in [m["name"] for m in person["shown"]]  # a subclass's individuals are on its page
+
+
+class _FailsOver(TaskRunner):
+    """A runner whose runs publish one step that fails over, with the executor's words, and end at once:
+    no world, no plan."""
+
+    def _run(self, run: TaskRun) -> None:
+        first, second = (SVC + f"LocateMobileRobot_CeilingCamera0{n}" for n in (1, 2))
+        progress = [
+            {"event": "step_started", "step": 1, "component": first},
+            {"event": "step_failed", "step": 1, "component": first, "reason": f"injected failure of {first}"},
+            {"event": "step_started", "step": 1, "component": second},
+            {"event": "step_succeeded", "step": 1, "component": second},
+        ]
+        run.events.extend({"topic": "/cbrs/task_progress", "run": run.id, **event} for event in progress)
+        run.result = {"plan": {"status": "planned"}, "execution": {"status": "succeeded", "reason": None, "steps": []}}
+        run.status = "succeeded"
+        run.done.set()
+
+
+def test_the_executor_s_reasons_name_components_as_the_page_does(bundled_kb: KnowledgeBase) -> None:
+    sparql = SparqlService(bundled_kb)
+    runner = _FailsOver(bundled_kb, sparql.lock, camera=None)
+    client = create_app(sparql, tasks=runner).test_client()
+    started = client.post("/tasks.json", json={"task": "FetchMyPen"}).get_json()["started"]
+    assert runner.get(started["id"]).done.wait(WAIT)
+    page = _text(client.get(f"/tasks/{started['id']}").text)
+    said = "injected failure of svc:LocateMobileRobot_CeilingCamera01"
+    assert page.count(said) == 2  # beside the step, and in the events
+    assert "failure of https://" not in page
+    assert short_text(f"(of {SVC}X01, http://example.org/thing.)") == "(of svc:X01, http://example.org/thing.)"

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 from flask import Flask, url_for
 from markupsafe import Markup, escape
 
@@ -92,8 +94,21 @@ def iri_link(iri: str, label: str | None = None) -> Markup:
     return Markup(f'<a href="{escape(href)}" title="{escape(iri)}">{text}</a>')
 
 
+# An IRI inside a sentence: up to a space, a quote or an angle bracket, and not ending in the sentence's
+# punctuation (a reason that ends "... of <IRI>." or "(<IRI>)").
+_IRI_IN_TEXT = re.compile(r"""https?://[^\s<>"']*[^\s<>"'.,;:)\]]""")
+
+
+def short_text(text: str) -> str:
+    """``text`` with each IRI in it shortened as the pages show it (:func:`short`): the executor's reasons
+    ("injected failure of https://w3id.org/cbrs/service#LocateMobileRobot_CeilingCamera01") read better
+    as ``svc:LocateMobileRobot_CeilingCamera01``, as the step's component beside them is shown."""
+    return _IRI_IN_TEXT.sub(lambda found: short(found.group(0)), text)
+
+
 def install(app: Flask) -> None:
     app.add_template_global(iri_link, "iri_link")
     app.add_template_global(iri_url, "iri_url")
     app.add_template_global(display_name, "display_name")
     app.add_template_filter(short, "short")
+    app.add_template_filter(short_text, "short_text")

@@ -29,6 +29,9 @@
     return local && /^[\w.-]+$/.test(local) ? best + ":" + local : iri;
   }
 
+  // IRIs inside a reason read as the components beside them do (links.short_text on the server).
+  const shortenText = (text) => text.replace(/https?:\/\/[^\s<>"']*[^\s<>"'.,;:)\]]/g, shorten);
+
   function el(tag, attrs, ...children) {
     const node = document.createElement(tag);
     for (const [name, value] of Object.entries(attrs || {})) node.setAttribute(name, value);
@@ -76,7 +79,7 @@
     }
     const status = { step_started: "started", step_succeeded: "succeeded", step_failed: "failed" }[message.event];
     state.replaceChildren(el("span", { class: "badge status-" + status }, status));
-    if (message.reason) state.append(el("br"), el("span", { class: "small muted" }, message.reason));
+    if (message.reason) state.append(el("br"), el("span", { class: "small muted" }, shortenText(message.reason)));
     tr.className = "step-" + status + (tr.tried.length > 1 || message.failover ? " failover" : "");
   }
 
@@ -84,7 +87,7 @@
     const parts = [el("code", {}, message.topic || ""), " " + (message.event || message.state || message.status || "")];
     if (message.step) parts.push(" · step " + message.step);
     if (message.component) parts.push(" · " + shorten(message.component));
-    if (message.reason) parts.push(" · ", el("span", { class: "muted" }, message.reason));
+    if (message.reason) parts.push(" · ", el("span", { class: "muted" }, shortenText(message.reason)));
     if (message.failover) parts.push(" · failover to " + shorten(message.failover));
     eventList.prepend(el("li", {}, ...parts));
     while (eventList.children.length > MAX_EVENTS) eventList.lastChild.remove();
@@ -144,7 +147,7 @@
     eventList.replaceChildren();
     run.events.forEach(handleRunEvent);
     setBadge(run.status);
-    if (run.verdict) verdict.textContent = run.verdict;
+    if (run.verdict) verdict.textContent = shortenText(run.verdict);
   }
 
   async function showVerdict(id) {
@@ -152,12 +155,12 @@
     const response = await fetch(live.dataset.runs + "/" + encodeURIComponent(id) + ".json");
     if (!response.ok) return;
     const run = (await response.json()).run;
-    if (run && run.verdict && current === id) verdict.textContent = run.verdict;
+    if (run && run.verdict && current === id) verdict.textContent = shortenText(run.verdict);
   }
 
   function handleRunEvent(message) {
     if (message.topic === "/cbrs/task_progress") stepEvent(message);
-    if (message.topic === "/cbrs/task") verdict.textContent = message.status + (message.reason ? ": " + message.reason : "");
+    if (message.topic === "/cbrs/task") verdict.textContent = message.status + (message.reason ? ": " + shortenText(message.reason) : "");
     if (message.event === "run_finished") {
       setBadge(message.status);
       if (!verdict.textContent) showVerdict(message.run);
