@@ -189,7 +189,7 @@ class Executor:
         # requirement's effects, as they were requested (the advertised effect may be more general).
         self.needed: dict[int, list[Statement]] = {}
         for binding in [b for s in plan.steps for b in s.preconditions] + list(plan.goals):
-            if binding.statement is not None and binding.source.step is not None:
+            if binding.statement is not None and binding.source.step is not None and binding.role != "deletion":
                 wanted = self.needed.setdefault(binding.source.step, [])
                 if binding.statement not in wanted:
                     wanted.append(binding.statement)

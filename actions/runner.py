@@ -87,9 +87,14 @@ class GoalCheck:
     statement: Statement
     believed: bool | None
     holds: bool | None
+    deleted: bool = False  # a delete effect the task wants: the goal is that the statement no longer holds
+
+    def text(self) -> str:
+        return f"not {statement_text(self.statement)}" if self.deleted else statement_text(self.statement)
 
     def to_dict(self) -> dict[str, Any]:
-        return {"statement": statement_text(self.statement), "believed": self.believed, "holds": self.holds}
+        found = {"statement": self.text(), "believed": self.believed, "holds": self.holds}
+        return {**found, "deleted": True} if self.deleted else found
 
 
 @dataclass(frozen=True)
@@ -746,7 +751,10 @@ def _check_goals(
         made = outputs.get(step.index, {}) if step is not None else {}
         believed = environment.verify(step, goal.statement, made)
         holds = audit(goal.statement) if callable(audit) else None
-        checks.append(GoalCheck(goal.statement, believed, holds if holds is None else bool(holds)))
+        if goal.role == "deletion":  # the task wants it to stop being true
+            believed, holds = (None if v is None else not v for v in (believed, holds))
+        holds = holds if holds is None else bool(holds)
+        checks.append(GoalCheck(goal.statement, believed, holds, goal.role == "deletion"))
     return tuple(checks)
 
 
