@@ -384,6 +384,11 @@ class Composer:
             if bound is None:
                 return None
             goals.append(bound)
+        for gone in requirement.deletes:  # what is to stop being true: the component must delete it
+            bound = self._statement_binding(gone, ad.deletes, lambda stated: Source(stated, 1))
+            if bound is None:
+                return None
+            goals.append(replace(bound, role="deletion", name=f"not {bound.name}"))
         step = PlanStep(
             index=1,
             component=ad.iri,
@@ -553,7 +558,7 @@ class Composer:
                 for p in requirement.inputs
                 if self._about(p.type, goal) or not any(self._about(p.type, other) for other in others)
             )
-            part = replace(requirement, inputs=inputs, outputs=(), effects=(goal,))
+            part = replace(requirement, inputs=inputs, outputs=(), effects=(goal,), deletes=())
             sub_task = Task(f"{task.name}/goal{n}", part, None)
             compose = partial(self._goal_part, sub_task)
             if self._achieved(part, holding):
@@ -568,6 +573,22 @@ class Composer:
                 )
                 return self._result(task, None, unsatisfied, tuple(attempts))
             parts.append(_Part(f"goal {n} {statement_text(goal)}", compose, plan))
+        for n, deleted in enumerate(requirement.deletes, start=len(goals) + 1):  # after the goals' parts
+            part = replace(requirement, outputs=(), effects=(), deletes=(deleted,))
+            sub_task = Task(f"{task.name}/goal{n}", part, None)
+            compose = partial(self._goal_part, sub_task)
+            label = f"goal {n} not {statement_text(deleted)}"
+            if self._achieved(part, holding):
+                held.append(_Part(label, compose, _achieved_plan(sub_task)))
+                continue
+            plan, unsatisfied, tried = compose(frozenset())
+            attempts += tried
+            if plan is None:
+                unsatisfied = tuple(
+                    replace(u, chain=(label, *u.chain[1:]), undeclared=(), near=()) for u in unsatisfied
+                )
+                return self._result(task, None, unsatisfied, tuple(attempts))
+            parts.append(_Part(label, compose, plan))
         if not parts:
             return self._result(task, _achieved_plan(task), (), tuple(attempts))
         return self._joined(task, parts + held, attempts, holding)
@@ -626,13 +647,16 @@ class Composer:
         a goal when it is as specific on every side (the remote on a side table holds "on a table"), not
         when it is more general: a remote on the kitchen table, a home:Table, is not on a lab:SideTable,
         although the two would match as services do (a superclass is an accepted degree there)."""
-        if requirement.outputs or not requirement.effects:
+        if requirement.outputs or not (requirement.effects or requirement.deletes):
             return False
-        return all(self._held(e, holding) for e in requirement.effects)
+        gone = not any(self._held(d, holding) for d in requirement.deletes)  # what is to stop being true is not
+        return gone and all(self._held(e, holding) for e in requirement.effects)
 
     def _holds_some(self, requirement: Requirement, holding: Sequence[Statement]) -> bool:
         """Whether some of the requirement's goals hold already (all of them: :meth:`_achieved`)."""
-        return any(self._held(e, holding) for e in requirement.effects)
+        return any(self._held(e, holding) for e in requirement.effects) or any(
+            not self._held(d, holding) for d in requirement.deletes
+        )
 
     def _held(self, goal: Statement, holding: Sequence[Statement]) -> bool:
         return any(self._entails(fact, goal) for fact in holding)
@@ -653,7 +677,7 @@ class Composer:
         """``unsatisfied`` with the classes of the requirement it names that the ontology lacks (a task
         about a home:Frisbee nobody declared): the likeliest reason nothing provides it."""
         named = {p.type for p in (*requirement.inputs, *requirement.outputs)}
-        for statement in (*requirement.preconditions, *requirement.effects):
+        for statement in (*requirement.preconditions, *requirement.effects, *requirement.deletes):
             named |= {statement.subject, statement.object}
         given = {p.type for p in requirement.inputs}  # an input of no known class feeds no component at all
         missing = tuple(
@@ -735,6 +759,11 @@ def _achieved_plan(task: Task) -> Plan:
             "precondition", statement_text(effect), Source("world", None, requirement.iri), "Exact", 1.0, None, effect
         )
         for effect in requirement.effects
+    ) + tuple(
+        Binding(
+            "deletion", f"not {statement_text(gone)}", Source("world", None, requirement.iri), "Exact", 1.0, None, gone
+        )
+        for gone in requirement.deletes
     )
     return Plan(task.name, requirement.iri, "achieved", (), goals, 1.0, 0.0)
 

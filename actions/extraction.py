@@ -111,6 +111,7 @@ class Extraction:
                         self.unsatisfied.append(cause)
             return
         self._expand(deque([self._new(GOAL, None).id]))
+        self._bind_deletions()
         if self.areas is not None and not self.unsatisfied:
             self._check_areas()
 
@@ -187,17 +188,21 @@ class Extraction:
         def differs(wanted_term: str, offered_term: str) -> bool:
             return not degree_of_match(index, wanted_term, offered_term).accepted
 
+        offers = (
+            self.graph.pool.deletions
+            if need.role == "deletion"  # what components delete about it
+            else [(v.iri, offer) for v in self.graph.pool.vertices.values() for offer in v.offers]
+        )
         found = {
             (
                 differs(wanted.predicate, offer.statement.predicate),
                 differs(wanted.object, offer.statement.object),
-                vertex.iri,
+                iri,
                 statement_text(offer.statement),
             )
-            for vertex in self.graph.pool.vertices.values()
-            for offer in vertex.offers
+            for iri, offer in offers
             if offer.statement is not None
-            and offer.role == "effect"
+            and offer.role in ("effect", "delete")
             and offer.statement.subject in index
             and index.canonical(offer.statement.subject) in above
         }
@@ -223,11 +228,35 @@ class Extraction:
     def _expand(self, queue: deque[int]) -> None:
         while queue:
             step = self.steps[queue.popleft()]
-            needs = self._goal_needs if step.node == GOAL else [(step.node, n) for n in self.graph.needs(step.node)]
+            needs = (
+                [(node, n) for node, n in self._goal_needs if n.role != "deletion"]
+                if step.node == GOAL
+                else [(step.node, n) for n in self.graph.needs(step.node)]
+            )
             # pre-actions (P-E) first, then pre-services (I-O), as in the paper's backward search
             needs.sort(key=lambda item: item[1].role != "precondition")
             for node, need in needs:
                 self._bind(step, node, need, queue)
+
+    def _bind_deletions(self) -> None:
+        """Bind each delete effect the requirement wants, once the rest of the plan is extracted: to a step
+        already planned whose delete effect meets it (the pick-up that takes the pen off the table on the
+        way to the shelf), else to a new step of its best provider, extracted in turn."""
+        goal = self.steps[0]
+        for node, need in self._goal_needs:
+            if need.role != "deletion":
+                continue
+            options = [e for e in self._options(node, need, 10**9) if e.source != SRI]
+            planned = [
+                (self._key(e), step.id, e) for step in self.steps.values() for e in options if e.source == step.node
+            ]
+            if planned:
+                *_, step_id, edge = min(planned, key=lambda item: item[:2])
+                goal.bindings.append(_Bound(need, edge, step_id))
+                continue
+            queue: deque[int] = deque()
+            if self._bind(goal, node, need, queue):
+                self._expand(queue)
 
     def _bind(self, step: _Step, node: str, need: Need, queue: deque[int], again: bool = False) -> bool:
         """Bind ``need`` of ``step`` by the preferences above; ``again``: to a new step, never to what the
@@ -698,7 +727,7 @@ class Extraction:
         for consumer in sorted(self.steps.values(), key=lambda s: s.id):
             for bound in consumer.bindings:
                 needed = bound.need.statement
-                if needed is None:
+                if needed is None or bound.need.role == "deletion":  # a statement to stop being true
                     continue
                 for threat, deletes in sorted(deleting.items()):
                     if threat in (consumer.id, bound.source) or not any(

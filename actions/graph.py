@@ -6,6 +6,8 @@ from a producer to a consumer for every need of the consumer that an offer of th
 
 * I-O: an output of the producer for an input of the consumer;
 * P-E: an effect of the producer for a precondition of the consumer (an RDF statement);
+* D: a delete effect of the producer for a delete effect the requirement wants (SRE's "deletion" needs:
+  the statement must stop being true, docs/composition.md "Delete effects a task wants");
 
 when the degree of match is in the paper's threshold {Exact, SubClassOf, HasSubClass}. Each edge
 carries that degree and the Sem-Str similarity (equation 8 for statements).
@@ -47,7 +49,7 @@ def statement_text(statement: Statement) -> str:
 class Need:
     """An input or precondition a vertex must have supplied before it can run."""
 
-    role: Literal["input", "precondition"]
+    role: Literal["input", "precondition", "deletion"]  # deletion: SRE's, a statement to stop being true
     name: str
     concept: str | None = None
     statement: Statement | None = None
@@ -57,6 +59,8 @@ class Need:
         return f"{self.role}:{self.name}"
 
     def text(self) -> str:
+        if self.statement is not None and self.role == "deletion":
+            return f"delete effect {statement_text(self.statement)}"
         if self.statement is not None:
             return f"precondition {statement_text(self.statement)}"
         return f"input {self.name} ({shorten(self.concept or '')})"
@@ -66,7 +70,7 @@ class Need:
 class Offer:
     """An output or effect a vertex supplies once it has run."""
 
-    role: Literal["output", "effect"]
+    role: Literal["output", "effect", "delete"]
     name: str
     concept: str | None = None
     statement: Statement | None = None
@@ -170,6 +174,12 @@ class ServicePool:
         }
         self._by_concept: dict[str, list[tuple[str, Offer]]] = {}
         self._statements: list[tuple[str, Offer]] = []
+        self.deletions = [  # what each component deletes, for the delete effects a requirement wants
+            (v.iri, Offer("delete", statement_text(s), statement=s))
+            for v in self.vertices.values()
+            if v.advertisement is not None
+            for s in v.advertisement.deletes
+        ]
         self._below: dict[str, set[str]] = {}  # ancestor -> offered concepts at or below it
         for vertex in self.vertices.values():
             self.index_offers(vertex)
@@ -202,7 +212,12 @@ class ServicePool:
     def providers_of(self, consumer: str, need: Need) -> list[Edge]:
         """Edges from the pool's offers into ``consumer`` for ``need``, most similar first."""
         found: list[Edge] = []
-        if need.concept is not None:
+        if need.role == "deletion":
+            for src, offer in self.deletions:
+                result = self.matcher.match(need, offer)
+                if result is not None:
+                    found.append(Edge(src, consumer, need, offer, *result))
+        elif need.concept is not None:
             for concept in self.candidates(need.concept):
                 result = self.matcher.concept(need.concept, concept)
                 if result is not None:
@@ -239,7 +254,7 @@ class ServiceResourceGraph:
             SRI: Vertex(SRI, (), given + state, 0.0),
             **pool.vertices,
             SRO: Vertex(SRO, _needs(requirement.outputs, ()), (), 0.0),
-            SRE: Vertex(SRE, _needs((), requirement.effects), (), 0.0),
+            SRE: Vertex(SRE, _needs((), requirement.effects) + _deletions(requirement.deletes), (), 0.0),
         }
         self._into: dict[str, dict[str, list[Edge]]] = {}
         for goal in (SRO, SRE):
@@ -254,6 +269,8 @@ class ServiceResourceGraph:
         for vertex in self.vertices.values():
             to_goal = vertex.iri in (SRO, SRE)
             for need in vertex.needs:
+                if need.role == "deletion":  # a step must delete it: what the task gives deletes nothing
+                    continue
                 offered = kinds[to_goal, need.role]
                 given_edges = [
                     Edge(SRI, vertex.iri, need, o, *m) for o in offered if (m := self.matcher.match(need, o))
@@ -296,6 +313,11 @@ def _needs(inputs: Sequence[Parameter], preconditions: Sequence[Statement]) -> t
     needs = [Need("input", name, concept=p.type) for p, name in zip(inputs, _names(inputs), strict=True)]
     needs += [Need("precondition", statement_text(s), statement=s) for s in preconditions]
     return tuple(needs)
+
+
+def _deletions(deletes: Sequence[Statement]) -> tuple[Need, ...]:
+    """The delete effects a requirement wants, as SRE's needs: met by a component's delete effect."""
+    return tuple(Need("deletion", f"not {statement_text(s)}", statement=s) for s in deletes)
 
 
 def _offers(outputs: Sequence[Parameter], effects: Sequence[Statement]) -> list[Offer]:

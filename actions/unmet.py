@@ -46,7 +46,8 @@ class Unsatisfied:
             found += f"; {shorten(component)} was planned for it but cannot run here: {why}"
         if self.provided:
             each = "; ".join(f"{effect} by {shorten(component)}" for component, effect in self.provided)
-            found += f"; what components provide about it: {each}"
+            done = "delete" if self.need.startswith("delete effect ") else "provide"
+            found += f"; what components {done} about it: {each}"
         for miss in self.near_misses:
             found += f"; {miss.text(self._taker(miss.statement))}"
         return found
@@ -79,6 +80,9 @@ class Unsatisfied:
             return f"the requirement gives {need}; {self.remedy()}"
         if self.out_of_area:
             return f"no component effective where it is needed provides {need} of {consumer}{via}; {self.remedy()}"
+        if need.startswith("delete effect "):
+            gone = need.removeprefix("delete effect ")
+            return f"no component deletes {gone} (a delete effect of {consumer}{via}); {self.remedy()}"
         return f"no component provides {need} of {consumer}{via}; {self.remedy()}"
 
     def remedy(self) -> str:
@@ -131,8 +135,14 @@ class Unsatisfied:
             return "correct the input's cbrs:parameterType"
         if self.consumer == GOAL:  # the task states nothing to plan towards
             return (
-                "state what the task wants as an output (cbrs:hasOutput) or an effect (cbrs:hasEffect): "
-                "composition plans towards those; delete effects alone are no goal it plans for"
+                "state what the task wants as an output (cbrs:hasOutput), an effect (cbrs:hasEffect) or a "
+                "delete effect (cbrs:hasDeleteEffect): composition plans towards those"
+            )
+        if self.need.startswith("delete effect "):  # a statement the task wants to stop being true
+            statement = self.need.removeprefix("delete effect ")
+            return (
+                f"register a component whose delete effect (cbrs:hasDeleteEffect) meets {statement}: its "
+                "subject, relation and object each the same class as the task's, a subclass or a superclass"
             )
         if self.need.startswith("precondition "):
             statement = self.need.removeprefix("precondition ")

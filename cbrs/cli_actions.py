@@ -28,6 +28,7 @@ from cbrs.actions.model import ActionLibrary
 from cbrs.actions.plan import Binding, Plan, PlanStep
 from cbrs.actions.replanning import ReplanPolicy
 from cbrs.actions.runner import (
+    GoalCheck,
     Replan,
     RunResult,
     run_task,
@@ -730,7 +731,7 @@ def run_text(result: RunResult, sim_seconds: float, wall_seconds: float) -> str:
         verdict += f"; {result.stopped}"
     if result.executed and result.refuted:  # the robots believed it done; the world says otherwise
         verdict = f"{shorten(report.task)}: failed (the robots believed it done, but in the world "
-        verdict += "; ".join(f"{statement_text(goal.statement)} does not hold" for goal in result.refuted) + ")"
+        verdict += "; ".join(_refuted_text(goal) for goal in result.refuted) + ")"
     elif result.goals and all(goal.holds for goal in result.goals if goal.holds is not None):
         checked = sum(1 for goal in result.goals if goal.holds is not None)
         verdict += f"; {checked} goal(s) confirmed in the world" if checked else ""
@@ -744,6 +745,13 @@ def run_text(result: RunResult, sim_seconds: float, wall_seconds: float) -> str:
     return f"{header}{steps}\n{verdict}; {timing}{_answers_text(result)}{_unused_note(result.composition)}"
 
 
+def _refuted_text(goal: GoalCheck) -> str:
+    """A goal the world contradicts: an effect that does not hold, or a delete effect whose statement still does."""
+    if goal.deleted:
+        return f"{statement_text(goal.statement)} still holds"
+    return f"{statement_text(goal.statement)} does not hold"
+
+
 def _unchecked_text(result: RunResult) -> str:
     """The goals nothing could check, said as such: a goal about a relation the environment has no test
     for (a lab's ``isInformedOf``) read as plainly "succeeded" as one the world confirmed."""
@@ -751,7 +759,7 @@ def _unchecked_text(result: RunResult) -> str:
     if not unchecked:
         return ""
     said = "; ".join(
-        statement_text(goal.statement)
+        goal.text()
         + (": the robots believe it" if goal.believed else ": nothing checked it, its step's effect says it")
         for goal in unchecked
     )

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import tomllib
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -173,8 +174,9 @@ def test_a_bare_name_finds_a_task_of_any_namespace_and_says_when_it_is_ambiguous
 
 
 def test_a_task_with_nothing_to_plan_towards_says_what_to_state(bundled_kb: KnowledgeBase) -> None:
-    """A task that wants only something to stop being true has no goal composition plans for: the
-    reason says so and what to state instead, not to register a component for 'an output or effect'."""
+    """A task that wants nothing (no output, effect or delete effect) has no goal composition plans for:
+    the reason says what to state, not to register a component for 'an output or effect'. One that wants
+    only something to stop being true is planned for (tests/test_delete_goals.py)."""
     from cbrs.kb import Requirement, Statement
 
     home = "https://w3id.org/cbrs/home#"
@@ -183,11 +185,13 @@ def test_a_task_with_nothing_to_plan_towards_says_what_to_state(bundled_kb: Know
         types=(),
         deletes=(Statement(home + "Pen", home + "isLocated", home + "Place"),),
     )
-    result = Composer(bundled_kb).compose(only_deletes)
+    result = Composer(bundled_kb).compose(replace(only_deletes, deletes=()))
     assert result.status is PlanStatus.UNSOLVABLE
     (reason,) = [u.text() for u in result.unsatisfied]
-    assert "cbrs:hasEffect" in reason and "delete effects alone" in reason
+    assert "cbrs:hasEffect" in reason and "cbrs:hasDeleteEffect" in reason
     assert "register a component" not in reason
+    plan = Composer(bundled_kb).compose(only_deletes).plan
+    assert plan is not None and [g.role for g in plan.goals] == ["deletion"]
 
 
 def test_a_plan_names_the_inputs_the_task_gives_that_no_step_takes(bundled_kb: KnowledgeBase) -> None:
