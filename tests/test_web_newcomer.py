@@ -19,7 +19,7 @@ import pytest
 from flask.testing import FlaskClient
 
 from cbrs.kb import KnowledgeBase
-from cbrs.sparql_service import SparqlService
+from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.tasks import TaskRun, TaskRunner
 from cbrs.web import create_app
 from cbrs.web.links import short_text
@@ -310,3 +310,21 @@ def test_the_executor_s_reasons_name_components_as_the_page_does(served: tuple[F
     assert page.count("injected failure of svc:LocateMobileRobot_CeilingCamera01") == 2  # the step, the events
     assert "failure of https://" not in page
     assert short_text(f"(of {SVC}X01, http://example.org/thing.)") == "(of svc:X01, http://example.org/thing.)"
+
+
+def test_a_wrong_token_for_a_run_is_told_apart_from_none(bundled_kb: KnowledgeBase) -> None:
+    token = "right-token"
+    sparql = SparqlService(bundled_kb, EndpointConfig(update_token=token, isolate=False))
+    runner = _Scripted(bundled_kb, sparql.lock, camera=None)
+    client = create_app(sparql, tasks=runner, own_origins=lambda: ["http://127.0.0.1:8080"]).test_client()
+    asked = {"task": "FetchMyPen"}
+    said = {}
+    for name, header in (("none", None), ("wrong", "Bearer wrong-token"), ("basic", "Basic dXNlcjpwYXNz")):
+        refused = client.post("/tasks.json", json=asked, headers={"Authorization": header} if header else {})
+        assert refused.status_code == 403
+        said[name] = refused.get_json()["message"]
+    assert "not this server's update token" in said["wrong"] and "not this server's" not in said["none"]
+    assert "'Basic', not a bearer token" in said["basic"]
+    started = client.post("/tasks.json", json=asked, headers={"Authorization": f"Bearer {token}"})
+    assert started.status_code == 202
+    assert runner.get(started.get_json()["started"]["id"]).done.wait(WAIT)

@@ -247,6 +247,18 @@ def _may_act(verb: str = "started") -> None:
                 f"a task run moves the robot: this server has no update token, so a run may be {verb} only from "
                 "its own tasks page (or start cbrs serve with CBRS_UPDATE_TOKEN and send Authorization: Bearer <token>)"
             )
+        given = request.headers.get("Authorization", "").strip()
+        if given:  # a token that is not the server's read the same as none: a person looked for a missing header
+            scheme = given.partition(" ")[0]
+            what = (
+                "the bearer token sent is not this server's update token"
+                if scheme.lower() == "bearer"
+                else f"the Authorization header gives {scheme!r}, not a bearer token"
+            )
+            raise Forbidden(
+                f"a task run moves the robot: {what}; send Authorization: Bearer <token> with the token "
+                "cbrs serve was started with, or use this server's tasks page"
+            )
         raise Forbidden(
             f"a task run moves the robot: it may be {verb} from this server's tasks page, or with the update token "
             "(Authorization: Bearer <token>)"
