@@ -17,6 +17,8 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from typing import NamedTuple
 
+from cbrs.actions.plan import PlanStep
+from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import Thing, local_name
 from cbrs.sim import skills
@@ -29,7 +31,7 @@ from cbrs.sim.hold_choice import Candidates, GraspChoice, first_clear, refuse_mo
 from cbrs.sim.perception import ObjectEstimate
 from cbrs.sim.place_spots import other_objects, place_spots, reach_of, spot_region
 from cbrs.sim.relay import CLEAR_TRIES, RELAY_TRIES, relay_spot, resting_at
-from cbrs.sim.transit import floor_cause, floor_to
+from cbrs.sim.transit import band_advice, floor_cause, floor_needs, floor_to
 
 ACT = PREFIXES["act"]
 
@@ -142,6 +144,78 @@ def who_takes(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel) -> 
     raise SkillFailed(f"{first}; {others}")
 
 
+class CannotCarryError(KnowledgeBaseError):
+    """A step would take an object the task gives to carry it to a place, and the step's own choice of arm and
+    approach (:func:`who_takes`, asked before the run where the object is believed to be) refuses every way
+    because the object held would meet an appliance on it (:func:`check_take`): the run is refused before
+    anything moves, not after a re-plan. ``reason`` is the choice's refusal, its advice included."""
+
+    http_status = 422
+
+    def __init__(self, component: str, thing: str, reason: str) -> None:
+        self.component = component
+        self.thing = thing
+        self.reason = reason
+        super().__init__(f"{local_name(component)} cannot take the {local_name(thing)} where it goes: {reason}")
+
+
+def check_take(ctx: SimContext, step: PlanStep, thing: str, estimate: ObjectEstimate, model: ObjectModel) -> None:
+    """Refuse, before the run, ``step`` (an arm taking the object ``thing`` where ``estimate`` says it lies, by
+    ``model``'s approaches) when the way of its hold to the place a later carry of the plan is given
+    (:func:`hold_end`) would bring the object held within COLLISION_MARGIN of an appliance
+    (:func:`skills.held_meeting`) for some arm and approach, and the step's own choice then refuses it
+    (:func:`who_takes`: :class:`CannotCarryError` with its words). The first question is the map's alone
+    (the hands' bands, where things are, the appliances; no planning), so a plan whose carry meets no
+    appliance costs no dry run here; the second is the step's decision, dry runs of the arms' planning as the
+    step will make them, which tells an approach the hand cannot let go by over the place (inverse
+    kinematics) from one it can. Before, the refusal came at the step, after the steps before it had run, and
+    the run failed after one re-plan that could change nothing."""
+    saved = ctx.step, ctx.component, ctx.known
+    ctx.step, ctx.component, ctx.known = step, step.component, {}
+    try:
+        if not _meets_appliance(ctx, estimate, model):
+            return
+        try:
+            who_takes(ctx, estimate, model)
+        except (SkillFailed, MovesRefusedError) as refused:
+            raise CannotCarryError(step.component, thing, str(refused)) from None
+    finally:
+        ctx.step, ctx.component, ctx.known = saved
+
+
+def _meets_appliance(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel) -> bool:
+    """Whether, for some free arm that reaches the object, approach its hand can grip it by and spot of the
+    hold's end the arm reaches (the first RELAY_TRIES, as the approach choice asks them), the object held
+    would meet an appliance on the carry's way, at the floor the carry keeps (:func:`floor_to`), lifted as
+    the pick-up leaves it: the map's answer, without the arms' planning."""
+    x, y, _ = estimate.position
+    fixtures = skills.appliances(ctx.world)
+    if not fixtures:
+        return False
+    for side in reaching(ctx, x, y):
+        end = hold_end(ctx, model.name, side)
+        if end is None:
+            continue
+        _, surface, spots = end
+        for kind in model.preference:
+            held = model.by(kind)
+            try:
+                grasp = grasp_pose_for(ctx, estimate, side, held)
+            except SimulationError:
+                continue
+            gx, gy, gz = grasp.position
+            start = (gx, gy, gz + skills.LIFT_HEIGHT)
+            for at in spots[:RELAY_TRIES]:
+                spot = spot_region(surface, *at)
+                cx, cy, _ = spot.center
+                above = spot.zmin + skills.ABOVE_CLEARANCE
+                floor = floor_to(ctx, held, side, start, spot)
+                bottom = max(start[2] - grasp.bottom_offset, above, -math.inf if floor is None else floor)
+                if skills.held_meeting(fixtures, grasp, start, (cx, cy, above + grasp.bottom_offset), bottom):
+                    return True
+    return False
+
+
 def _fitting(ctx: SimContext, model: ObjectModel, sides: Sequence[ArmSide]) -> str:
     """Why the hand of none of ``sides`` can close on the object by any of its approaches, wherever it is
     (:func:`skills.can_grip`: wider than the jaws open, a top grasp deeper than the palm allows); empty
@@ -235,13 +309,16 @@ def _taking_to(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, si
             refused, unclear = found
             refusals[held.grasp] = refused
             passed.append((held.grasp, unclear))
-        served = first_clear(
-            both,
-            side,
-            purpose,
-            lambda held: refusals[held.grasp],
-            first,
-        )
+        try:
+            served = first_clear(both, side, purpose, lambda held: refusals[held.grasp], first)
+        except MovesRefusedError as moves:
+            advice = [floor_advice(ctx, side, first[held.grasp], estimate, held) for held in both.models]
+            if not all(advice):  # an approach refused for another reason: the advice that fits every one
+                raise
+            said = "; ".join(dict.fromkeys(advice))
+            raise MovesRefusedError(
+                moves.name, moves.arm, moves.purpose, moves.refused, moves.ruled_out, advice=said
+            ) from None
         unclear = "; ".join(why for _, why in passed[len(both.ruled_out) :])
         return _Taking(served, True, unclear)
     unplaced = "; ".join(why for _, why in both.ruled_out)
@@ -376,6 +453,56 @@ def carry_check(
     if taking is None:  # a held carry that comes that near is refused too
         return refused or brushed, brushed
     return refused, brushed
+
+
+def floor_advice(ctx: SimContext, side: ArmSide, spot: Region, seen: ObjectEstimate, held: ObjectModel) -> str:
+    """What would let ``side`` take the object where it lies (``seen``) by ``held``'s approach and carry it
+    over ``spot`` when the floor the carry keeps over the things by its way (:func:`floor_needs`) is what
+    holds it up into an appliance (:func:`skills.held_meeting`); empty otherwise. From the refusal's own
+    values: how low the object's bottom must stay to pass the appliance, what asks it higher (each thing by
+    the way, and the arm's band kept over it, as the store states it), what of the band would do
+    (:func:`band_advice`), the thing moved off the way, another approach. The generic "set it nearer the
+    arm" fitted none of that: a lab's forearm band 6 cm below the grasp point, over a second cup, held the
+    cup it carried up against the tap's spout."""
+    world = ctx.world
+    try:
+        grasp = grasp_pose_for(ctx, seen, side, held)
+    except SimulationError:
+        return ""
+    x, y, z = grasp.position
+    start = (x, y, z + skills.LIFT_HEIGHT)  # lifted, as pick_up_object leaves it
+    cx, cy, _ = spot.center
+    above = spot.zmin + skills.ABOVE_CLEARANCE
+    end = (cx, cy, above + grasp.bottom_offset)
+    unfloored = max(start[2] - grasp.bottom_offset, above)
+    needs = floor_needs(ctx, held, side, (x, y), (cx, cy))
+    floor = max((need.height for need in needs), default=-math.inf)
+    fixtures = skills.appliances(world)
+    met = skills.held_meeting(fixtures, grasp, start, end, floor)
+    if floor <= unfloored or met is None or skills.held_meeting(fixtures, grasp, start, end, unfloored) is not None:
+        return ""  # the floor does not hold it up, it meets nothing there, or it would meet one without the floor
+    low, high = unfloored, floor  # passes at ``low``, meets at ``high``: the highest bottom that passes, to 1 mm
+    while high - low > 0.001:
+        middle = (low + high) / 2.0
+        low, high = (low, middle) if skills.held_meeting(fixtures, grasp, start, end, middle) else (middle, high)
+    things: list[str] = []
+    said: list[str] = []
+    bands: list[str] = []
+    for need in sorted(needs, key=lambda need: -need.height):
+        if need.height <= low:
+            break
+        things.append(need.thing)
+        said.append(f"{need.why} holds it at {need.height:.3f} m")
+        band = band_advice(ctx, held, side, (x, y), (cx, cy), need, low)
+        if band:
+            bands.append(band)
+    banded = f"with {', and '.join(bands)}, " if bands else ""
+    moved = " and ".join(f"the {thing}" for thing in dict.fromkeys(things))
+    return (
+        f"to pass the {met[0].name} by its {held.grasp.value} grasp the {held.name}'s bottom must stay at {low:.3f} m"
+        f" or lower, and {'; '.join(said)}: it would pass {banded}with {moved} moved off its way (home:x, home:y),"
+        f" or by another approach (home:graspApproach)"
+    )
 
 
 def _clear_spot(

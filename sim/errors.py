@@ -198,18 +198,23 @@ class MovesRefusedError(SimulationError):
         refused: Sequence[tuple[str, tuple[float, float] | None, str]],
         ruled_out: Sequence[tuple[str, str]] = (),
         before: str = "anything moved",
+        advice: str = "",
     ) -> None:
         self.name = name
         self.arm = arm
         self.purpose = purpose
         self.refused = tuple(refused)
         self.ruled_out = tuple(ruled_out)
+        self.advice = advice or (
+            f"set the {name} or its place nearer the arm, or allow it another approach (home:graspApproach)"
+        )
+        """What would help: given by the refusal (a carry held up by an arm band: ``arm_choice.floor_advice``),
+        else to set the object nearer the arm or allow it another approach."""
         reasons = "; ".join(why for _, _, why in self.refused)
         others = "".join(f"; not by its {approach} grasp: {why}" for approach, why in self.ruled_out)
         super().__init__(
             f"{purpose}: refused before {before}, the {arm} arm's planning making the moves by no approach: "
-            f"{reasons}{others};"
-            f" set the {name} or its place nearer the arm, or allow it another approach (home:graspApproach)"
+            f"{reasons}{others}; {self.advice}"
         )
 
 

@@ -56,6 +56,7 @@ __all__ = [
     "deliver_object",
     "fill_cup_from_tap",
     "hand_over_onto_platform",
+    "held_meeting",
     "held_meets",
     "navigate",
     "navigate_to_person",
@@ -318,11 +319,29 @@ def held_meets(fixtures: Sequence[Region], grasp: GraspPose, start: Vec3, end: V
     """Why the object held by ``grasp`` cannot go carry_object's way (empty if it can): carried with its
     bottom at ``bottom`` from over the grasp point at ``start`` to over ``end``, and lowered there until
     the grasp point is at ``end``, it would come within COLLISION_MARGIN (what the arm's joint-space moves
-    keep from the fixed things) of one of ``fixtures``, its footprint a circle round the grasp point (the
-    object's width across, or its footprint's diagonal). The arms' planning sees the arm alone: with the
-    floor a side grasp keeps for a lab's forearm band 6 cm below the grasp point over a second cup, a cup
-    was carried with its top at 0.95 m, the height of the tap's lever and spout (0.94-0.98 m), towards the
-    spot below the spout, and the carry stopped 10 cm short against them after the dry run had passed it."""
+    keep from the fixed things) of one of ``fixtures`` (:func:`held_meeting`). The arms' planning sees the
+    arm alone: with the floor a side grasp keeps for a lab's forearm band 6 cm below the grasp point over a
+    second cup, a cup was carried with its top at 0.95 m, the height of the tap's lever and spout
+    (0.94-0.98 m), towards the spot below the spout, and the carry stopped 10 cm short against them after
+    the dry run had passed it."""
+    met = held_meeting(fixtures, grasp, start, end, bottom)
+    if met is None:
+        return ""
+    fixture, (x, y) = met
+    model, top = grasp.model, bottom + grasp.model.height
+    return (
+        f"the {model.name}, carried with its bottom at {bottom:.3f} m (its top at {top:.3f} m), would "
+        f"come within {COLLISION_MARGIN * 100:.0f} cm of the {fixture.name} ({fixture.zmin:.3f}-"
+        f"{fixture.zmax:.3f} m high) at ({x:.3f}, {y:.3f}) on its way to ({end[0]:.3f}, {end[1]:.3f})"
+    )
+
+
+def held_meeting(
+    fixtures: Sequence[Region], grasp: GraspPose, start: Vec3, end: Vec3, bottom: float
+) -> tuple[Region, tuple[float, float]] | None:
+    """The first of ``fixtures`` the held object would come within COLLISION_MARGIN of on :func:`held_meets`'s
+    way, and where (x, y); None when it would meet none. Its footprint is a circle round the grasp point
+    (the object's width across, or its footprint's diagonal), followed every HELD_STEP."""
     model = grasp.model
     radius = (math.hypot(*model.footprint) if model.footprint is not None else model.width) / 2.0
     reach = radius + COLLISION_MARGIN
@@ -338,12 +357,8 @@ def held_meets(fixtures: Sequence[Region], grasp: GraspPose, start: Vec3, end: V
             dx = max(fixture.xmin - x, 0.0, x - fixture.xmax)
             dy = max(fixture.ymin - y, 0.0, y - fixture.ymax)
             if level and math.hypot(dx, dy) < reach:
-                return (
-                    f"the {model.name}, carried with its bottom at {bottom:.3f} m (its top at {top:.3f} m), would "
-                    f"come within {COLLISION_MARGIN * 100:.0f} cm of the {fixture.name} ({fixture.zmin:.3f}-"
-                    f"{fixture.zmax:.3f} m high) at ({x:.3f}, {y:.3f}) on its way to ({end[0]:.3f}, {end[1]:.3f})"
-                )
-    return ""
+                return fixture, (x, y)
+    return None
 
 
 def _down(arm: _Moving, grasp: GraspPose, region: Region, leg: Vec3, orientation: Quat) -> MotionResult:

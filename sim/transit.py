@@ -12,8 +12,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import replace
+from typing import NamedTuple
 
 from cbrs.kb.arm_bands import ArmBand
+from cbrs.kb.semantic_map import local_name
 from cbrs.sim.arms import ArmSide
 from cbrs.sim.context import SimContext
 from cbrs.sim.geometry import Region
@@ -40,8 +43,8 @@ def transit_floor(
     as far over the top of any under it. None when no object stands by the way. Without it, a pill box passed
     between the arms was carried 4 cm above the table, and the hand swept the cup beside its way off the
     table."""
-    needs = _needs(ctx, held, side, start, end)
-    return max(height for height, _ in needs) if needs else None
+    needs = floor_needs(ctx, held, side, start, end)
+    return max(need.height for need in needs) if needs else None
 
 
 def floor_cause(
@@ -50,13 +53,25 @@ def floor_cause(
     """What sets :func:`transit_floor` of the same way: the thing standing by it, and what of the hand or the
     arm keeps over it (a band of the arm behind a side grasp, as the store states it); empty when nothing
     stands by the way. A carry that cannot be made at that floor is refused naming it."""
-    needs = _needs(ctx, held, side, start, end)
-    return max(needs)[1] if needs else ""
+    needs = floor_needs(ctx, held, side, start, end)
+    return max(needs, key=lambda need: (need.height, need.why)).why if needs else ""
 
 
-def _needs(
+class FloorNeed(NamedTuple):
+    """One height :func:`transit_floor` asks of the held object's bottom (m), and what asks it: ``why`` in
+    words, the ``thing`` (its name) standing by the way, its ``top`` (m), and the ``band`` of the arm behind a
+    side grasp kept over it (None: the object itself or the palm is)."""
+
+    height: float
+    why: str
+    thing: str
+    top: float
+    band: ArmBand | None = None
+
+
+def floor_needs(
     ctx: SimContext, held: ObjectModel, side: ArmSide, start: tuple[float, float], end: tuple[float, float]
-) -> list[tuple[float, str]]:
+) -> list[FloorNeed]:
     """Each height :func:`transit_floor` asks of the held object's bottom, with what asks it."""
     world = ctx.world
     hand = world.arm(side).hand
@@ -64,7 +79,7 @@ def _needs(
     near = max(math.hypot(size[0], size[1]) / 2.0, hand.jaw_opening / 2.0)
     palm = held.grasp_height + hand.palm_depth
     facing = world.arm_specs[side].yaw if held.grasp is GraspKind.SIDE else None
-    needs: list[tuple[float, str]] = []
+    needs: list[FloorNeed] = []
     for name, obj in world.objects.items():
         if name == held.name or any(arm.held == world.body(name) for arm in world.arms.values()):
             continue
@@ -78,15 +93,70 @@ def _needs(
         apart = _segment_distance(start, end, (x, y)) - radius
         top = z + obj.size[2] / 2.0 + TRANSIT_CLEARANCE
         over = f"the {name} (its top at {top - TRANSIT_CLEARANCE:.3f} m)"
+        bare = top - TRANSIT_CLEARANCE
         if apart < near + TRANSIT_CLEARANCE:
-            needs.append((top, f"the {held.name} itself kept {TRANSIT_CLEARANCE * 100:.0f} cm over {over}"))
+            itself = f"the {held.name} itself kept {TRANSIT_CLEARANCE * 100:.0f} cm over {over}"
+            needs.append(FloorNeed(top, itself, name, bare))
         elif apart < near + hand.carry_corridor:
             corridor = f"{hand.carry_corridor * 100:.0f} cm carry corridor"
-            needs.append((top - palm, f"the hand's palm, over {over} within its {corridor}"))
+            needs.append(FloorNeed(top - palm, f"the hand's palm, over {over} within its {corridor}", name, bare))
         if facing is not None:
             for band in _under(hand.side_arm, start, end, facing, (x, y), radius):
-                needs.append((top - band.underside - held.grasp_height, f"{_band(band)} over {over}"))
+                height = top - band.underside - held.grasp_height
+                needs.append(FloorNeed(height, f"{_band(band)} over {over}", name, bare, band))
     return needs
+
+
+def band_advice(
+    ctx: SimContext,
+    held: ObjectModel,
+    side: ArmSide,
+    start: tuple[float, float],
+    end: tuple[float, float],
+    need: FloorNeed,
+    below: float,
+) -> str:
+    """What of ``need``'s band (a band of the arm behind a side grasp, over a thing by the way) would let the
+    held object's bottom stay at ``below`` m: its underside no lower under the grasp point than that asks,
+    or, when the thing is not behind the way itself, the band no wider than would miss it; empty for a need
+    no band sets."""
+    band = need.band
+    if band is None:
+        return ""
+    world = ctx.world
+    underside = math.ceil((need.top + TRANSIT_CLEARANCE - held.grasp_height - below) * 1000.0) / 1000.0  # to 1 mm, up
+    hand = ctx.world.arm(side).hand
+    whose = f"the {local_name(hand.iri)}'s" if hand.iri else "the hand's"
+    said = (
+        f"{whose} band (home:sideGraspBand) no lower than {_level(underside)} the grasp point (it is"
+        f" {_level(band.underside)}"
+    )
+    obj = world.objects.get(need.thing)
+    believed = ctx.belief.position(need.thing) if ctx.belief is not None else None
+    if obj is not None:
+        point = (believed[0], believed[1]) if believed is not None else (obj.start.x, obj.start.y)
+        radius = math.hypot(obj.size[0], obj.size[1]) / 2.0
+        facing = world.arm_specs[side].yaw
+
+        def under(half_width: float) -> bool:
+            return bool(_under([replace(band, half_width=half_width)], start, end, facing, point, radius))
+
+        if under(0.0):
+            return f"{said}; no narrower band would do: the {need.thing} is behind the way itself)"
+        low, high = 0.0, band.half_width  # missed at ``low``, met at ``high``
+        while high - low > 0.001:
+            middle = (low + high) / 2.0
+            low, high = (low, middle) if under(middle) else (middle, high)
+        wide = f"{math.floor(low * 1000.0) / 10.0:.1f} cm to either side (it is {band.half_width * 100:.0f} cm)"
+        return f"{said}), or that band no wider than {wide}"
+    return f"{said})"
+
+
+def _level(underside: float) -> str:
+    """A band's underside against the grasp point, for a message."""
+    if abs(underside) < 0.0005:
+        return "level with"
+    return f"{abs(underside) * 100:.1f} cm {'above' if underside > 0.0 else 'below'}"
 
 
 def _band(band: ArmBand) -> str:
