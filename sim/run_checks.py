@@ -25,7 +25,7 @@ from cbrs.kb.person_choice import person_for
 from cbrs.kb.semantic_map import MapObject, NotGraspableError, Person, Thing, local_name
 from cbrs.kb.store import Term
 from cbrs.sim import sight, skills
-from cbrs.sim.arm_choice import TAKING, who_loads
+from cbrs.sim.arm_choice import TAKING, check_take, who_loads
 from cbrs.sim.context import SimContext, SkillFailed
 from cbrs.sim.errors import GraspTooDeepError, GraspTooThinError, GraspTooWideError, MovesRefusedError
 from cbrs.sim.geometry import Pose2D
@@ -243,12 +243,14 @@ class PlanChecks:
 
     def check(self, plan: Plan, values: Mapping[str, Any]) -> None:
         """Refuse ``plan`` with the first check's typed error (:class:`kb.person_choice.PersonError`,
-        :class:`OutOfReachError`, :class:`PlaceCrowdedError`, :class:`sight.OutOfViewError`,
+        :class:`OutOfReachError`, :class:`PlaceCrowdedError`, :class:`arm_choice.CannotCarryError`,
+        :class:`sight.OutOfViewError`,
         :class:`CannotLoadError`, :class:`kb.home_check.NoDockingPoseError`); nothing when every check
         passes."""
         ads = {ad.iri: ad for ad in self.kb.advertisements()}  # read once: 23-26 ms each on the bundled store
         meant = self._people_of(plan, values, ads)  # a step needing a person the home cannot give (nobody, who?)
         self._check_reach(plan, values)
+        self._check_carry(plan, values)
         self._check_sight(plan, values, ads, meant)
         self._check_loading(plan, values)
         self._check_docks(plan, values, ads)
@@ -282,6 +284,23 @@ class PlanChecks:
                 except (SkillFailed, MovesRefusedError) as refused:
                     if not self._loads_nearby(estimate, model, dock):
                         raise CannotLoadError(step.component, obj.iri, str(refused)) from None
+
+    def _check_carry(self, plan: Plan, values: Mapping[str, Any]) -> None:
+        """Refuse a plan whose arm would take an object the task gives to carry it where the object held
+        would meet an appliance on the way, by every arm and approach the step would choose from
+        (:func:`arm_choice.check_take`: :class:`arm_choice.CannotCarryError`), before anything moves."""
+        steps = {step.index: step for step in plan.steps}
+        smap = self.world.map
+        for step in plan.steps:
+            if step.action != PREFIXES["act"] + "ApproachToObject":
+                continue
+            for name in sorted(task_inputs_of(step, steps)):
+                value = values.get(name)
+                obj = smap.objects.get(str(value["@id"])) if isinstance(value, dict) and "@id" in value else None
+                support = smap.things.get(obj.support or "") if obj is not None else None
+                if obj is not None and support is not None:
+                    estimate = self._estimate(obj, support)
+                    check_take(self.context, step, obj.iri, estimate, Manipulation.of(obj).model)
 
     def _check_docks(self, plan: Plan, values: Mapping[str, Any], ads: Mapping[str, Advertisement]) -> None:
         """Refuse a plan that sends the base to fetch an object standing only on furniture with no docking
