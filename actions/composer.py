@@ -48,7 +48,7 @@ from cbrs.actions.graph import (
     statement_text,
 )
 from cbrs.actions.model import ActionLibrary, Task, resolve_task
-from cbrs.actions.near_misses import near_misses
+from cbrs.actions.near_misses import NearMiss, near_misses
 from cbrs.actions.plan import Binding, Plan, PlanStep, Source
 from cbrs.actions.progression import Clobbered, progress_parts
 from cbrs.actions.search import SearchTrace, bidirectional_search
@@ -98,6 +98,9 @@ class ComposeConfig:
     # a "no plan" answer names, per unmet need, at most this many components that come close: their output or
     # effect is a near concept of the need's (actions.near_misses; docs/composition.md); 0: none
     near_misses: int = 3
+    # ... looked for at the unmet need and at each need above it on the chain the answer follows down (the
+    # requirement's output a lab's sensor nearly gives), at most this many in all per unmet need
+    near_misses_total: int = 6
 
 
 class PlanStatus(Enum):
@@ -704,15 +707,24 @@ class Composer:
         for attempt in attempts:
             if all((u.need, u.consumer) != (found.need, found.consumer) for found in attempt.unsatisfied):
                 continue
-            need = next((n for n in attempt.graph.needs(u.consumer) if n.text() == u.need), None)
+            graph = attempt.graph
+            need = next((n for n in graph.needs(u.consumer) if n.text() == u.need), None)
             if need is None:
                 continue
-            named = [c for c, _ in (*u.out_of_area, *u.unrunnable)]  # (what they provide about it: said again)
-            refused = partial(_refused, self.area_rule(attempt.requirement), attempt.graph)
-            found = near_misses(
-                attempt.graph, u.consumer, need, attempt.trace.enabled, refused, named, self.config.near_misses
-            )
-            return replace(u, near_misses=found) if found else u
+            named = {c for c, _ in (*u.out_of_area, *u.unrunnable)}  # (what they provide about it: said again)
+            refused = partial(_refused, self.area_rule(attempt.requirement), graph)
+            found: list[NearMiss] = []
+            # the need reported, then each need above it, nearest first
+            for consumer, text in ((u.consumer, u.need), *reversed(u.along)):
+                wanted = need if consumer == u.consumer and text == u.need else None
+                wanted = wanted or next((n for n in graph.needs(consumer) if n.text() == text), None)
+                room = min(self.config.near_misses, self.config.near_misses_total - len(found))
+                if wanted is None or room <= 0:
+                    continue
+                skip = named | {m.component for m in found}
+                more = near_misses(graph, consumer, wanted, attempt.trace.enabled, refused, skip, room)
+                found += [m if consumer == u.consumer else replace(m, consumer=consumer) for m in more]
+            return replace(u, near_misses=tuple(found)) if found else u
         return u
 
 

@@ -139,18 +139,26 @@ class Extraction:
         Depth first, on a stack of its own: a chain of blocked providers can be thousands long."""
         causes: list[Unsatisfied] = []
         followed: list[str] = []  # the providers followed down to the need on top of the stack
+        along: list[tuple[str, str]] = []  # (consumer, need) that each of them was followed for
         on_path: set[str] = set()
         stack: list[tuple[str, Need] | None] = [(node, need)]  # None: back up from the last provider followed
         while stack:
             item = stack.pop()
             if item is None:
                 on_path.discard(followed.pop())
+                along.pop()
                 continue
             node, need = item
             providers = [e for e in self.graph.providers(node, need) if e.source != node]
             if not providers:
                 causes.append(
-                    Unsatisfied(need.text(), node, self._chain(chain, followed), provided=self._provided(need))
+                    Unsatisfied(
+                        need.text(),
+                        node,
+                        self._chain(chain, followed),
+                        provided=self._provided(need),
+                        along=tuple(along),
+                    )
                 )
                 continue
             best = providers[0]
@@ -166,9 +174,10 @@ class Extraction:
                 if not self._options(best.source, sub, self._level(best.source))
             ]
             if not blocked:
-                causes.append(Unsatisfied(need.text(), node, self._chain(chain, followed)))
+                causes.append(Unsatisfied(need.text(), node, self._chain(chain, followed), along=tuple(along)))
                 continue
             followed.append(best.source)
+            along.append((node, need.text()))
             on_path.add(best.source)
             stack.append(None)
             stack.extend((best.source, sub) for sub in reversed(blocked))
@@ -437,6 +446,7 @@ class Extraction:
         While every one fails only for want of a provider of its own, the best is followed down (as ``_why``
         does), so the report names the components whose areas do not cover the things."""
         chain = self._path(step, need)
+        along: list[tuple[str, str]] = []  # the needs above the one reported, each with its consumer
         while True:
             judged = {e.source: self._judge(e.source, about) for e in sorted(candidates, key=self._key)}
             best = next(iter(judged))
@@ -447,10 +457,11 @@ class Extraction:
             deeper = [e for e in self._options(best, lower, self._level(best)) if e.source != SRI]
             if not deeper:
                 break
+            along.append((node, need.text()))
             node, need, about, candidates = best, lower, (*served, *about), deeper
             chain = (*chain, shorten(node))
         passed = tuple(sorted((iri, j.why or "") for iri, j in judged.items()))
-        self.unsatisfied.append(Unsatisfied(need.text(), node, chain, out_of_area=passed))
+        self.unsatisfied.append(Unsatisfied(need.text(), node, chain, out_of_area=passed, along=tuple(along)))
 
     def _check_areas(self) -> None:
         """Refuse the plan if a step's component is not effective where the things it handles are: the

@@ -66,6 +66,7 @@ class NearMiss:
     wanted: str  # the needed concept's IRI, or the needed statement's text
     differs: tuple[Difference, ...]
     similarity: float
+    consumer: str = ""  # who takes the need it is near, when not the unmet need's own consumer (one above it)
 
     @property
     def statement(self) -> bool:
@@ -103,6 +104,7 @@ class NearMiss:
             "wanted": self.wanted,
             "differs": [d.to_dict() for d in self.differs],
             "similarity": round(self.similarity, 6),
+            **({"consumer": self.consumer} if self.consumer else {}),
         }
 
 

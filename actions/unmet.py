@@ -37,6 +37,8 @@ class Unsatisfied:
     individuals: tuple[tuple[str, tuple[str, ...]], ...] = ()  # (undeclared term, its classes): a thing of the map
     superclasses: tuple[tuple[str, str], ...] = ()  # (undeclared class, the class its use suggests declaring it under)
     near_misses: tuple[NearMiss, ...] = ()  # components whose output or effect is near the need (actions.near_misses)
+    # or near a need above it on the chain: ``along`` holds those needs, (consumer, need text), from the goal down
+    along: tuple[tuple[str, str], ...] = ()
 
     def text(self) -> str:
         found = self._text()
@@ -49,14 +51,8 @@ class Unsatisfied:
             done = "delete" if self.need.startswith("delete effect ") else "provide"
             found += f"; what components {done} about it: {each}"
         for miss in self.near_misses:
-            found += f"; {miss.text(self._taker(miss.statement))}"
+            found += f"; {miss.text(_taker(miss.consumer or self.consumer, miss.statement))}"
         return found
-
-    def _taker(self, statement: bool) -> str:
-        """Who takes the need, as a near miss's text names it."""
-        if self.consumer in (SRO, SRE, GOAL):
-            return "the requirement wants" if statement else "the requirement asks for"
-        return f"{shorten(self.consumer)} {'needs' if statement else 'takes'}"
 
     def _text(self) -> str:
         consumer = "the requirement" if self.consumer in (SRO, SRE, GOAL) else shorten(self.consumer)
@@ -169,6 +165,13 @@ class Unsatisfied:
             "deleted_by": list(self.deleted_by),
             "near_misses": [miss.to_dict() for miss in self.near_misses],
         }
+
+
+def _taker(consumer: str, statement: bool) -> str:
+    """Who takes a need, as a near miss's text names it."""
+    if consumer in (SRO, SRE, GOAL):
+        return "the requirement wants" if statement else "the requirement asks for"
+    return f"{shorten(consumer)} {'needs' if statement else 'takes'}"
 
 
 def _an_individual(term: str, classes: tuple[str, ...]) -> str:
