@@ -150,7 +150,7 @@ def test_matchmaking_ranks_the_ceiling_camera_first(page: Any, shots: Path) -> N
 def test_fetch_my_pen_started_from_the_page_succeeds_while_the_camera_updates(page: Any, shots: Path) -> None:
     page.goto("/tasks")
     frame_before = int(page.locator("#frame").inner_text())
-    page.locator("#task").select_option(label="FetchMyPen")
+    page.locator("#task").select_option("FetchMyPen")  # by value: the option reads "FetchMyPen · Fetch my pen"
     page.locator("#start-button").click()
     # expect() polls without evaluating text in the page, which its Content-Security-Policy forbids
     playwright_api.expect(page.locator("#run-status")).to_have_text(
