@@ -2,7 +2,8 @@
 
 A lab that replaces the bundled home with its own (``cbrs load --graph map --replace``, docs/tasks.md "A
 home of your own") writes every room, robot and person itself. The simulation takes rooms to make the
-floor of, one mobile robot, the arms on the torso (one or two, a "left" and a "right" one, each side once;
+floor of, a mobile robot (or none: a home where only the arms work, and a task for the base is refused
+before it runs), the arms on the torso (one or two, a "left" and a "right" one, each side once;
 none, a home where the robots only drive), and any number of people (none: a home where the robots only
 move things; several: a resident and a caregiver); the base, each
 person and every docking pose start on the floor of a room, none inside a wall, a piece of furniture or
@@ -24,15 +25,40 @@ from dataclasses import dataclass
 
 from cbrs.kb.semantic_map import HOME, MapError, Pose, SemanticMap, Thing, local_name
 
-__all__ = ["HomeError", "NoDockingPoseError", "Undocked", "check_home", "docked_place", "undocked_supports"]
+__all__ = [
+    "NEEDS_BASE",
+    "HomeError",
+    "NoDockingPoseError",
+    "NoMobileBaseError",
+    "Undocked",
+    "check_home",
+    "docked_place",
+    "undocked_supports",
+]
 
 _ARM_SIDES = ("left", "right")
+NEEDS_BASE = "a robot with home:hasPlatform, home:hasMarker, home:x, home:y, home:sizeX and home:sizeY"
+"""What graph:map says of a mobile base, for a message that asks for one."""
 
 
 class HomeError(MapError, ValueError):
     """The semantic map lacks, or has too many of, what the simulated home is built from, or starts a
     robot or person where nothing can stand. ``thing`` is what is missing (a class) or misplaced.
     Also a ``ValueError``, which the simulation raised for some of these before."""
+
+
+class NoMobileBaseError(HomeError):
+    """A home with no mobile base (no robot of graph:map with home:hasPlatform or home:hasMarker) asked for
+    what only a base has: its drive, its pose, its platform or its marker. ``needed_by`` says who asked.
+    A run is refused before this can happen, by the components it cannot run (``sim.run_checks.without_base``)."""
+
+    def __init__(self, needed_by: str) -> None:
+        self.needed_by = needed_by
+        super().__init__(
+            HOME + "MobileRobot",
+            f"has no individual in the map, and {needed_by} needs one: the home has no mobile base (add "
+            f"{NEEDS_BASE} to graph:map, as ontologies/world.ttl has the bundled one)",
+        )
 
 
 class NoDockingPoseError(HomeError):
@@ -129,14 +155,7 @@ def _check_arms(semantic_map: SemanticMap) -> None:
 
 def _check_counts(semantic_map: SemanticMap) -> None:
     robots = sorted(semantic_map.robots)
-    needs = "a robot with home:hasPlatform, home:hasMarker, home:x, home:y, home:sizeX and home:sizeY"
-    if not robots:
-        raise HomeError(
-            HOME + "MobileRobot",
-            f"has no individual in the map, and the simulated home takes one: add {needs} to graph:map "
-            "(the bundled home's are in ontologies/world.ttl)",
-        )
-    if len(robots) != 1:
+    if len(robots) > 1:
         # Every run builds the whole map, so this stops every task, not only one about the second robot.
         raise HomeError(
             HOME + "MobileRobot",

@@ -58,9 +58,10 @@ from cbrs.sim.run_checks import (
     PlaceCrowdedError,
     PlanChecks,
     own_camera,
+    without_base,
     without_camera,
 )
-from cbrs.sim.services import SKILLS
+from cbrs.sim.services import SKILLS, WITH_BASE
 from cbrs.sim.values import GRASP_POSE, GraspPlan, MalformedValueError, check, decode, designator
 from cbrs.sim.world import HomeWorld
 
@@ -153,6 +154,8 @@ def implementations(
             continue
         camera = own_camera(ad)  # a camera the world lacks: no implementation (sim.run_checks.unplaced_cameras)
         if world is not None and camera is not None and camera not in world.cameras:
+            continue
+        if world is not None and not world.base_names and work in WITH_BASE:  # no base to work: none either
             continue
         names = tuple(p.name for p in ad.outputs if p.name)
         registry.add(ad.iri, _maker(work, device, names))
@@ -292,8 +295,12 @@ class SimEnvironment:
 
     def unimplemented(self, advertisements: Sequence[Advertisement]) -> dict[str, str]:
         """Why the simulation has no implementation of those of ``advertisements`` it lacks a camera for
-        (``sim.run_checks.without_camera``), for the run's account of what it cannot run."""
-        return without_camera(advertisements, self.world.cameras)
+        (``sim.run_checks.without_camera``) or a mobile base for (``without_base``), for the run's account of
+        what it cannot run."""
+        return {
+            **without_camera(advertisements, self.world.cameras),
+            **without_base(advertisements, bool(self.world.base_names)),
+        }
 
     def refresh(self) -> None:
         """Before a new plan: forget the measured map (the world may have changed) and add the
@@ -407,10 +414,11 @@ class SimEnvironment:
         ctx = self.context
         if self.is_a(concept, HOME + "Gripper") or self.is_a(concept, HOME + "Arm"):
             return Grounded("gripper", ctx.arm.value)
+        base = self.world.mobile  # None in a home with no mobile base: nothing to ground the base's statements in
         if self.is_a(concept, HOME + "RobotPlatform"):
-            return Grounded("platform", self.world.base_name)
+            return Grounded("platform", base.name) if base is not None else None
         if self.is_a(concept, HOME + "MobileRobot"):
-            return Grounded("base", self.world.base_name)
+            return Grounded("base", base.name) if base is not None else None
         if self.is_a(concept, HOME + "Robot"):
             return Grounded("robot", "")
         if self.is_a(concept, HOME + "Person"):
@@ -602,7 +610,8 @@ class SimEnvironment:
         facts: set[tuple[str, str, str]] = set()
         supports = [smap.things[iri] for iri in sorted(smap.furniture) if iri in smap.things]
         regions = [smap.things[iri] for iri in sorted(smap.regions) if iri in smap.things]
-        base_iri = world.robot.iri
+        base = world.mobile  # None in a home with no mobile base: nothing is said of a base
+        base_iri = base.iri if base is not None else None
         people = world.people
         for obj in smap.objects.values():
             name = obj.name
@@ -615,24 +624,26 @@ class SimEnvironment:
                 top = Region(support.name, box.min_x, box.max_x, box.min_y, box.max_y, box.max_z, box.max_z)
                 if belief.located_in(name, top, upright=False):
                     facts.add((obj.iri, HOME + "isLocatedOn", support.iri))
-            if world.robot.platform is not None and belief.on_platform(name):
-                facts.add((obj.iri, HOME + "isLocatedOn", world.robot.platform))
+            if base is not None and base.platform is not None and belief.on_platform(name):
+                facts.add((obj.iri, HOME + "isLocatedOn", base.platform))
             for person in people.values():
                 if belief.with_person(name, person.name):
                     facts.add((obj.iri, HOME + "isWith", person.iri))
             if name in world.containers and belief.contains_water(name):
                 facts.add((obj.iri, HOME + "contains", HOME + "Water"))
-        for person in people.values():
-            if belief.base_near_person(person.name):
-                facts.add((base_iri, HOME + "isNear", person.iri))
-        odometry = world.base_pose()
-        for support in supports:
-            if (
-                support.dock is not None
-                and odometry.distance_to(support.dock.x, support.dock.y) <= pred.BASE_NEAR_DISTANCE
-            ):
-                facts.add((base_iri, HOME + "isNear", support.iri))
-        positions: dict[str, tuple[float, float, float]] = {base_iri: (odometry.x, odometry.y, 0.0)}
+        positions: dict[str, tuple[float, float, float]] = {}
+        if base_iri is not None:
+            for person in people.values():
+                if belief.base_near_person(person.name):
+                    facts.add((base_iri, HOME + "isNear", person.iri))
+            odometry = world.base_pose()
+            for support in supports:
+                if (
+                    support.dock is not None
+                    and odometry.distance_to(support.dock.x, support.dock.y) <= pred.BASE_NEAR_DISTANCE
+                ):
+                    facts.add((base_iri, HOME + "isNear", support.iri))
+            positions[base_iri] = (odometry.x, odometry.y, 0.0)
         for obj in smap.objects.values():
             where = belief.position(obj.name)
             if where is not None:

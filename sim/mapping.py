@@ -117,7 +117,7 @@ def build_occupancy_grid(
     ys = origin[1] + (ii.ravel() + 0.5) * resolution
     tops = np.full(xs.shape, RAY_TOP)
     heights = np.full(xs.shape, -1.0)
-    ignored = [world.body(name) for name in (ignore if ignore is not None else (world.base_name,))]
+    ignored = [world.body(name) for name in (ignore if ignore is not None else world.base_names)]
     ignored += [body for body in overhead(world) if body not in ignored]
     # A ray outside every other body's bounding box can only meet the floor: it is not cast.
     floor = world.bodies.get("Floor")
@@ -156,7 +156,8 @@ def overhead(world: HomeWorld) -> list[int]:
     In the bundled home the ceiling cameras hang 4.5 m up, above the rays' start, and have no housing; a
     lab's housing under a 2.7 m ceiling marked the floor below it occupied. What stands (furniture, walls)
     or moves (the arms, which may come down) stays an obstacle wherever it reaches."""
-    clearance = (world.robot.platform_height or 0.0) + max((o.size[2] for o in world.objects.values()), default=0.0)
+    platform = world.mobile.platform_height if world.mobile is not None else None  # no base: nothing drives under
+    clearance = (platform or 0.0) + max((o.size[2] for o in world.objects.values()), default=0.0)
     above = []
     for camera in world.map.cameras.values():
         body = world.bodies.get(camera.name)

@@ -33,7 +33,7 @@ from cbrs.sim.perception import recognise_object, track_person
 from cbrs.sim.relations import Judge
 from cbrs.sim.world import HomeWorld
 
-__all__ = ["PERCEIVED_RESTING", "SEARCH_RADIUS", "PerceivedWorld", "Sighting"]
+__all__ = ["PERCEIVED_RESTING", "SEARCH_RADIUS", "UNSEEN_AT_START", "PerceivedWorld", "Sighting"]
 
 PERCEIVED_RESTING = 0.03
 """An object is believed to rest on a surface when its estimated bottom is within 3 cm of it: the
@@ -104,6 +104,8 @@ class PerceivedWorld(Judge):
             if name is not None and centre is not None:
                 self.objects[name] = Sighting(centre, f"{arm.side.value} hand", time)
                 self.holders.pop(name, None)
+        if not self.world.base_names:
+            return  # a home with no mobile base: no platform, nothing loaded on it
         base = self.world.base_pose()
         loaded = set(pred.objects_on_platform(self.world))  # the platform's load sensor
         for name in loaded:
@@ -250,8 +252,8 @@ class PerceivedWorld(Judge):
 
     def base_near_person(self, person: str) -> bool | None:
         sighting = self.people.get(person)
-        if sighting is None:
-            return None  # no camera saw them: nothing to go by
+        if sighting is None or not self.world.base_names:
+            return None  # no camera saw them, or no base: nothing to go by
         x, y, _ = sighting.position
         return self.world.base_pose().distance_to(x, y) <= pred.NEAR_PERSON_DISTANCE
 
@@ -294,6 +296,12 @@ class PerceivedWorld(Judge):
         bottom = where[2] - self.world.objects[name].size[2] / 2
         return region.contains_xy(where[0], where[1]) and abs(bottom - region.zmin) <= PERCEIVED_RESTING
 
+
+UNSEEN_AT_START = ("with", "grasped-by")
+"""The tests (``home:computedBy``) that never find their relation holding in a world just built: a person
+holds only what the base handed them (:attr:`PerceivedWorld.holders`), a hand only what it took. A task
+whose goal they decide is planned for before the world is built as if it did not hold
+(``actions.runner.refusal_before_world``'s ``unseen``)."""
 
 _COLOUR_PROPERTIES = tuple(PREFIXES["home"] + name for name in ("colourName", "frontColourName", "rearColourName"))
 

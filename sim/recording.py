@@ -343,7 +343,7 @@ class Recorder:
         if self.recording:
             return
         world = self.world
-        self._base = world.name_of(world.base.body) or "base"
+        self._base = (world.name_of(world.base.body) or "base") if world.base_names else ""  # "": a home with no base
         self._people = list(world.people)  # none, one or several
         self._movable = [name for name in world.snapshot() if name not in self._people]
         robots = {arm.robot.rsplit("#", 1)[-1] for arm in world.arm_specs.values()}
@@ -441,19 +441,23 @@ class Recorder:
             if name in world.bodies:
                 low, high = p.getAABB(world.body(name), physicsClientId=world.client)
                 points += [(low[0], low[1]), (high[0], high[1])]
-        base = self._xy(self._base)
         for name in self._movable:
             here = self._xy(name)
             start = self._starts[name]
             if math.hypot(here[0] - start[0], here[1] - start[1]) > MOVED:
                 points += [start, here]
-        start = self._starts.get(self._base, base)
-        driven = math.hypot(base[0] - start[0], base[1] - start[1]) > MOVED
-        for person in (self._xy(name) for name in self._people):
-            if driven and math.hypot(person[0] - base[0], person[1] - base[1]) < PERSON_NEAR:
-                points.append(person)
-        if not points:
-            points = [base]
+        if self._base:  # in a home with no base, nobody is driven to
+            base = self._xy(self._base)
+            start = self._starts.get(self._base, base)
+            driven = math.hypot(base[0] - start[0], base[1] - start[1]) > MOVED
+            for person in (self._xy(name) for name in self._people):
+                if driven and math.hypot(person[0] - base[0], person[1] - base[1]) < PERSON_NEAR:
+                    points.append(person)
+            if not points:
+                points = [base]
+        if not points:  # no base, no robot and nothing moved: the middle of the home
+            home = world.extent
+            points = [((home.xmin + home.xmax) / 2, (home.ymin + home.ymax) / 2)]
         wanted = Box.around(points, PAD)
         self._box = wanted if self._box is None else self._box.union(wanted)
         return self._box

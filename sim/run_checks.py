@@ -37,6 +37,7 @@ from cbrs.sim.place_spots import RELAY_CLEARANCE, RELAY_MARGIN, distance_to_exte
 from cbrs.sim.services import (
     MOVING,
     SKILLS,
+    WITH_BASE,
     WITH_PERSON,
     find_object_on_table,
     infer_object_place,
@@ -636,6 +637,32 @@ def without_camera(advertisements: Iterable[Advertisement], cameras: Collection[
         for ad in advertisements
         if (camera := own_camera(ad)) is not None and camera not in cameras
     }
+
+
+def map_bases(kb: KnowledgeBase, facts: Sequence[Mapping[str, Term]] | None = None) -> set[str]:
+    """The IRIs of the mobile bases the world will build, from the store alone: each thing the map gives a
+    platform or a marker is one (``SemanticMap.robots``). ``facts``: the rows of ``map_facts`` when the caller
+    has read them already."""
+    rows = kb.select("map_facts") if facts is None else facts
+    marks = (HOME + "hasPlatform", HOME + "hasMarker")
+    return {row["thing"].value for row in rows if row["property"].value in marks}
+
+
+def without_base(advertisements: Iterable[Advertisement], base: bool) -> dict[str, str]:
+    """The simulated components of ``advertisements`` that work the mobile base (``services.WITH_BASE``: drive
+    it, load its platform, find its marker), each with why, when the home has no ``base``: the simulation has
+    no implementation of them, and a run plans without them (docs/simulation.md, "A home with no mobile
+    base"). None when it has one."""
+    if base:
+        return {}
+    return {
+        ad.iri: _NO_BASE
+        for ad in advertisements
+        if ad.bridge_port is None and SKILLS.get(ad.service_name or "") in WITH_BASE
+    }
+
+
+_NO_BASE = "it works the mobile base (drives it, loads its platform or finds its marker), and graph:map has none"
 
 
 def _unplaced(camera: str) -> str:

@@ -333,8 +333,9 @@ def _facts(kb: KnowledgeBase, thing: str) -> list[tuple[str, str, str]]:
 
 
 def provide_grid_map(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
-    if ctx.grid is None:
-        ctx.grid = build_occupancy_grid(ctx.world, ignore=(ctx.world.base_name,))
+    if ctx.grid is None:  # inflated by the base's footprint; in a home with no base, by nothing
+        inflation = None if ctx.world.mobile is not None else 0.0
+        ctx.grid = build_occupancy_grid(ctx.world, inflation_radius=inflation, ignore=ctx.world.base_names)
     return {"map": to_json(ctx.grid)}
 
 
@@ -424,6 +425,11 @@ SKILLS: dict[str, Work] = {
 
 WITH_PERSON = (track, navigate_to_person, deliver)
 """The skills that look for, go to or hand something to a person: the home must say which one."""
+
+
+WITH_BASE = (hand_over, locate, navigate_to_place, navigate_to_person, deliver)
+"""The skills that work the mobile base: drive it, load its platform, find its marker. A home with no base
+has no implementation of them (``sim.run_checks.without_base``)."""
 
 
 MOVING = (pick_up, carry, put_down, fill_from_tap, hand_over, deliver)

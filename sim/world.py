@@ -22,7 +22,7 @@ import pybullet as p
 
 from cbrs.kb.camera_view import default_image_size, image_up
 from cbrs.kb.hands import PANDA_HAND
-from cbrs.kb.home_check import check_home
+from cbrs.kb.home_check import NoMobileBaseError, check_home
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.person_choice import person_for
 from cbrs.kb.semantic_map import Arm as ArmSpec
@@ -233,9 +233,12 @@ class HomeWorld:
         self.objects: dict[str, MapObject] = {obj.name: obj for obj in self.map.objects.values()}
         """The movable objects by body name (the local name of their IRI)."""
         self.containers = {name for name, obj in self.objects.items() if obj.iri in self.map.containers}
-        check_home(self.map)  # rooms, one base, an arm a side at most, starts on a room's floor (kb.home_check)
-        self.robot = next(iter(self.map.robots.values()))
-        self.base_name = self.robot.name
+        check_home(self.map)  # rooms, a base at most, an arm a side at most, starts on a room's floor (kb.home_check)
+        self.mobile: MobileRobot | None = next(iter(self.map.robots.values()), None)
+        """The map's mobile robot; None in a home with no mobile base (docs/simulation.md, "A home with no
+        mobile base"), where :attr:`robot`, :attr:`base` and what they give are a :class:`NoMobileBaseError`."""
+        self.base_names: tuple[str, ...] = (self.mobile.name,) if self.mobile is not None else ()
+        """The body names of the mobile bases built: one, or none."""
         self.people: dict[str, Person] = {person.name: person for _, person in sorted(self.map.people.items())}
         """The map's people by body name (the local name of their IRI), in IRI order: none, one or several."""
         self.spread = spread
@@ -265,11 +268,13 @@ class HomeWorld:
         self._kinematics: Kinematics | None = None
         self._taps: list[tuple[Dispenser, int]] = []
         self._joints: list[tuple[int, list[int]]] = []
+        self._base: MobileBase | None = None
         try:
             self._build()
             self._taps = [(d, self._bodies[d.name]) for d in self.dispensers]
             self._joints = self._moving_joints()
-            self.base = MobileBase(client, self._bodies[self.base_name], self.step)
+            if self.mobile is not None:
+                self._base = MobileBase(client, self._bodies[self.mobile.name], self.step)
             for a, b, depth in overlaps(self.map):
                 log.warning(
                     "%s and %s overlap by %.1f cm where the semantic map puts them: settling pushes them apart",
@@ -424,6 +429,25 @@ class HomeWorld:
         pos, orn = p.getBasePositionAndOrientation(self.body(name), physicsClientId=self.client)
         return Pose3D((pos[0], pos[1], pos[2]), (orn[0], orn[1], orn[2], orn[3]))
 
+    @property
+    def robot(self) -> MobileRobot:
+        """The map's mobile robot (:class:`NoMobileBaseError` in a home with none: :attr:`mobile` is None)."""
+        if self.mobile is None:
+            raise NoMobileBaseError("the simulation's mobile robot")
+        return self.mobile
+
+    @property
+    def base(self) -> MobileBase:
+        """The mobile base's drive (:class:`NoMobileBaseError` in a home with none)."""
+        if self._base is None:
+            raise NoMobileBaseError("the mobile base's drive")
+        return self._base
+
+    @property
+    def base_name(self) -> str:
+        """The mobile base's body name (:class:`NoMobileBaseError` in a home with none)."""
+        return self.robot.name
+
     def base_pose(self) -> Pose2D:
         return self.base.pose()
 
@@ -473,7 +497,7 @@ class HomeWorld:
 
     def snapshot(self) -> dict[str, Pose3D]:
         """Poses of everything that can move (objects, base, people), for comparing runs."""
-        return {name: self.pose(name) for name in (*sorted(self.objects), self.base_name, *self.people)}
+        return {name: self.pose(name) for name in (*sorted(self.objects), *self.base_names, *self.people)}
 
     @property
     def person(self) -> Person:
@@ -667,7 +691,8 @@ class HomeWorld:
         self._build_rooms()
         self._build_kitchen()
         self._build_robot()
-        self._build_base()
+        if self.mobile is not None:  # a home with no mobile base builds none
+            self._build_base()
         for person in self.people.values():
             self._build_person(person)
         self._draw_floor_last()
