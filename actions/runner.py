@@ -10,7 +10,7 @@ from __future__ import annotations
 import collections.abc
 import json
 import time
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import Any, Protocol
 
@@ -359,6 +359,8 @@ def refusal_before_world(
     runnable: collections.abc.Container[str],
     composer: Composer | None = None,
     why_not: Callable[[Sequence[Advertisement]], Mapping[str, str]] | None = None,
+    lacking: Mapping[str, str] | None = None,
+    unseen: Collection[str] = (),
 ) -> RunResult | None:
     """The no-plan answer :func:`run_task` gives ``task``, found before its environment is built and has
     perceived the world (seconds, for the simulated home), when nothing perceived could change it; None
@@ -374,9 +376,18 @@ def refusal_before_world(
     but from the map (the world is built from it) rather than a belief perceived, for the same account
     of what no component provides and which components cannot run here (``why_not``, as the
     environment's ``unimplemented`` would say); should that plan after all, None.
+
+    ``lacking``: components the environment will not implement for want of something of the home that a
+    lab can add (a mobile base), each with why. A no-plan answer names those a plan would use were they
+    there (:func:`_naming_the_lacking`): a map without the base lacks what their preconditions ask of it,
+    and the answer named only another way that fails (a sonar no component gives).
+
+    ``unseen``: the tests (``home:computedBy``) that never find a relation holding before a run acts, in a
+    world the run builds afresh (the simulated home: nobody holds a thing the base has not handed over,
+    no hand one it has not taken); the optimist assumes no goal they decide (:func:`_perceivable`).
     """
     composer = composer or Composer(kb)
-    optimist = _optimist(kb, composer, runnable)
+    optimist = _optimist(kb, composer, runnable, unseen)
     if optimist.compose(task, belief=True).plan is not None:
         return None
     first = composer.compose(task)
@@ -386,7 +397,36 @@ def refusal_before_world(
     )
     if composition.plan is not None:  # the map alone offers more than the optimist was told: go and look
         return None
-    return RunResult(composition, None)
+    named = _naming_the_lacking(kb, composer, task, runnable, composition, lacking or {}, unseen)
+    return RunResult(named, None)
+
+
+def _naming_the_lacking(
+    kb: KnowledgeBase,
+    composer: Composer,
+    task: str,
+    runnable: collections.abc.Container[str],
+    composition: CompositionResult,
+    lacking: Mapping[str, str],
+    unseen: Collection[str] = (),
+) -> CompositionResult:
+    """``composition``, which has no plan, with the components of ``lacking`` (component -> why the
+    environment lacks them) that a plan would use were they there, each with why, besides those it names:
+    one more composition by the optimist, over ``runnable`` and ``lacking``, only on the way to a no-plan
+    answer and only when something is lacking."""
+    if not lacking:
+        return composition
+    named = {component for u in composition.unsatisfied for component, _ in u.unrunnable}
+    more = {ad.iri for ad in composer.advertisements if ad.iri in runnable or ad.iri in lacking}
+    would = _optimist(kb, composer, more, unseen).compose(task, belief=True).plan
+    if would is None:
+        return composition
+    wanted = sorted({c for step in would.steps for c in step.candidates if c in lacking and c not in named})
+    why = tuple((component, lacking[component]) for component in wanted)
+    if not why:
+        return composition
+    unsatisfied = tuple(replace(u, unrunnable=(*u.unrunnable, *why)) for u in composition.unsatisfied)
+    return replace(composition, unsatisfied=unsatisfied)
 
 
 class _Assuming(Composer):
@@ -415,16 +455,20 @@ class _Assuming(Composer):
         return self.known
 
 
-def _optimist(kb: KnowledgeBase, composer: Composer, runnable: collections.abc.Container[str]) -> Composer:
+def _optimist(
+    kb: KnowledgeBase, composer: Composer, runnable: collections.abc.Container[str], unseen: Collection[str] = ()
+) -> Composer:
     """A composer over the components in ``runnable`` as if the world offered all it could: every
     precondition of theirs holding; every goal of a requirement holding that a perception could find
     (:func:`_perceivable`); no area rule (where things are is perceived); and no check by progression
     (``protect``: a statement the world offers may be deleted by a step, and the plan refused). A task it
     cannot plan has no plan from any perception either: its search only gains by more that holds and by
-    fewer refusals."""
+    fewer refusals. ``unseen``: tests whose relations no perception finds holding before the run acts
+    (:func:`refusal_before_world`)."""
     ads = [ad for ad in composer.advertisements if ad.iri in runnable]
     assumed = [statement for ad in ads for statement in ad.preconditions]
-    decided = {row["relation"].value for row in kb.select("computables")}
+    rows = kb.select("computables")
+    decided = {row["relation"].value for row in rows if row["computable"].value not in unseen}
     found: dict[str, bool] = {}  # by class: whether the world has things of it
     requirements = composer.requirements()
     for requirement in requirements:

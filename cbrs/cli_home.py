@@ -59,6 +59,7 @@ def home(app: App, drawing: Path | None, width: int, browser: str | None, as_jso
             "drawing": written,
         }
         said["people"] = found.people()
+        said["mobile_robots"] = found.bases()
         said["warnings"] = found.warnings()
         said["persons"] = (
             [c.to_dict() for c in people_check(found.semantic_map)] if found.semantic_map is not None else []
@@ -108,6 +109,8 @@ def _text(found: HomeSurvey, written: str | None) -> str:
     if not rooms:
         lines.append(f"  {NO_ROOMS}")
     lines.append(f"people: {found.people()}")
+    if not smap.robots:  # a home with no mobile base: what it allows (one base goes without saying)
+        lines.append(f"mobile robots: {found.bases()}")
     lines += [f"warning: {warning}" for warning in found.warnings()]
     moved = [iri for iri in found.believed if iri in smap.objects or iri in smap.robots or iri in smap.people]
     if moved:

@@ -58,6 +58,7 @@ from cbrs.kb.semantic_map import HOME, Box, MapObject, SemanticMap, Thing, local
 __all__ = [
     "DEFAULT_WIDTH",
     "MOVED",
+    "NO_BASE",
     "NO_ROOMS",
     "Entry",
     "HomePicture",
@@ -189,6 +190,24 @@ class HomeSurvey:
             said += f"; {clash.said}"
         return said
 
+    def bases(self) -> str | None:
+        """The home's mobile bases and what that allows, in words (None when the map cannot be read): a home
+        with none runs the tasks of the arms, the cameras and the sensors, and refuses before the world is
+        built a task that drives the base, loads its platform or finds its marker (``sim.run_checks.without_base``,
+        docs/simulation.md "A home with no mobile base")."""
+        smap = self.semantic_map
+        if smap is None:
+            return None
+        if not smap.robots:
+            return NO_BASE
+        return ", ".join(local_name(iri) for iri in sorted(smap.robots))
+
+
+NO_BASE = (
+    "none: a task that drives the base, loads its platform or finds its marker is refused before the world is "
+    "built; the others run (the arms', the cameras', the sensors')"
+)
+"""What ``cbrs home`` says of a home with no mobile base."""
 
 _ONE = {"people": "person", "furniture": "piece of furniture"}
 _MANY = {"furniture": "pieces of furniture"}

@@ -473,21 +473,25 @@ def refusal_in_home(
     from cbrs.actions.breaker import passed_over
     from cbrs.actions.runner import refusal_before_world
     from cbrs.sim.components import implementations
-    from cbrs.sim.run_checks import map_cameras, without_camera
+    from cbrs.sim.perceived import UNSEEN_AT_START
+    from cbrs.sim.run_checks import map_bases, map_cameras, without_base, without_camera
 
     if transport is not None:
         sessions = {iri: state.registered_by for iri, state in kb.liveness.states().items()}
         if passed_over(transport, time.monotonic(), sessions):
             return None
-    placed = map_cameras(kb)
+    facts = kb.select("map_facts")  # read once for the cameras and the bases
+    placed = map_cameras(kb, facts)
+    base = bool(map_bases(kb, facts))
     ads = composer.advertisements
     runnable = set(implementations(kb, transport=transport, advertisements=ads).names())
-    runnable -= set(without_camera(ads, placed))
+    lacking = without_base(ads, base)  # no mobile base: its components cannot run, and the answer says so
+    runnable -= set(without_camera(ads, placed)) | set(lacking)
 
     def why_not(advertisements: Sequence[Advertisement]) -> dict[str, str]:
-        return without_camera(advertisements, placed)
+        return {**without_camera(advertisements, placed), **without_base(advertisements, base)}
 
-    return refusal_before_world(kb, task, runnable, composer, why_not)
+    return refusal_before_world(kb, task, runnable, composer, why_not, lacking, UNSEEN_AT_START)
 
 
 def _status(result: RunResult) -> str:
