@@ -31,6 +31,7 @@ from cbrs.sim.errors import GraspTooDeepError, GraspTooThinError, GraspTooWideEr
 from cbrs.sim.geometry import Pose2D
 from cbrs.sim.grasping import GraspKind, ObjectModel, check_side_depth, held_height
 from cbrs.sim.grounding import docking_pose, people_given, task_inputs_of
+from cbrs.sim.packing import check_room
 from cbrs.sim.perceived import PerceivedWorld
 from cbrs.sim.perception import ObjectEstimate
 from cbrs.sim.place_spots import RELAY_CLEARANCE, RELAY_MARGIN, distance_to_extent, other_objects, place_spots
@@ -251,6 +252,7 @@ class PlanChecks:
         ads = {ad.iri: ad for ad in self.kb.advertisements()}  # read once: 23-26 ms each on the bundled store
         meant = self._people_of(plan, values, ads)  # a step needing a person the home cannot give (nobody, who?)
         self._check_reach(plan, values)
+        check_room(self.world, self.belief, plan, values)  # several objects onto one place: room for all
         self._check_carry(plan, values)
         self._check_sight(plan, values, ads, meant)
         self._check_loading(plan, values)
