@@ -265,7 +265,7 @@ def _given_iris(step: PlanStep, values: Mapping[str, Any], known: Mapping[int, M
 def later_sizes(
     plan: Plan | None,
     step: PlanStep | None,
-    world: HomeWorld,
+    smap: SemanticMap,
     place: str,
     values: Mapping[str, Any],
     known: Mapping[int, Mapping[str, Any]] | None = None,
@@ -278,7 +278,6 @@ def later_sizes(
     if step.index not in order:
         return []
     after = set(order[order.index(step.index) + 1 :])
-    smap = world.map
     return [
         smap.objects[down.obj].size
         for down in puts_down(plan, smap, values, known)
