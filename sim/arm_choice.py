@@ -492,10 +492,14 @@ def floor_advice(ctx: SimContext, side: ArmSide, spot: Region, seen: ObjectEstim
         if need.height <= low:
             break
         things.append(need.thing)
-        said.append(f"{need.why} holds it at {need.height:.3f} m")
-        band = band_advice(ctx, held, side, (x, y), (cx, cy), need, low)
-        if band:
-            bands.append(band)
+        band, what = need.band, need.why
+        if band is not None:  # said in full in the refusal before
+            what = f"the arm's band {band.near:.3f}-{band.far:.3f} m back over the {need.thing}"
+            what += f" (its top at {need.top:.3f} m)"
+        said.append(f"{what} holds it at {need.height:.3f} m")
+        advised = band_advice(ctx, held, side, (x, y), (cx, cy), need, low)
+        if advised:
+            bands.append(advised)
     banded = f"with {', and '.join(bands)}, " if bands else ""
     moved = " and ".join(f"the {thing}" for thing in dict.fromkeys(things))
     return (
