@@ -206,7 +206,8 @@ class AreaRule:
         self.places = dict(places)
         self.task = task
         self.boxes = boxes
-        self._why: dict[tuple[str, frozenset[str]], str | None] = {}  # asked for every step's alternatives
+        # asked for every step's alternatives: by component, things, and (thing, input, class) leading to them
+        self._why: dict[tuple[str, frozenset[str], frozenset[tuple[str, str, str | None]]], str | None] = {}
 
     def relevant(self, advertisements: Iterable[Advertisement]) -> bool:
         """Whether the rule can refuse any of ``advertisements`` (if not, composition need not ask it)."""
@@ -217,22 +218,30 @@ class AreaRule:
         value is about are: it leads to them, rather than only informing of them (docs/composition.md)."""
         return self.leads(concept)
 
-    def why_not(self, ad: Advertisement | None, things: Iterable[str]) -> str | None:
-        """Why ``ad`` cannot serve a step handling ``things`` (requirement input names); None: it can."""
+    def why_not(
+        self, ad: Advertisement | None, things: Iterable[str], via: Mapping[str, tuple[str, str | None]] | None = None
+    ) -> str | None:
+        """Why ``ad`` cannot serve a step handling ``things`` (requirement input names); None: it can.
+        ``via``: for a thing the step is not given directly, the (name, class) of its input whose value leads
+        to it, which the reason names (the refusal said only which thing, not what tied the step to it)."""
         if ad is None or ad.area is None:
             return None
-        key = (ad.iri, frozenset(t for t in things if t in self.places))
+        handled = frozenset(t for t in things if t in self.places)
+        leads = frozenset((t, *via[t]) for t in handled if via and t in via)
+        key = (ad.iri, handled, leads)
         if key not in self._why:
-            self._why[key] = self._why_not(ad.area, key[1])
+            self._why[key] = self._why_not(ad.area, handled, {t: (name, concept) for t, name, concept in leads})
         return self._why[key]
 
-    def _why_not(self, area: EffectiveArea, things: frozenset[str]) -> str | None:
+    def _why_not(
+        self, area: EffectiveArea, things: frozenset[str], via: Mapping[str, tuple[str, str | None]]
+    ) -> str | None:
         if self.task is not None and not reaches(self.index, *self._compared(self.task, area)):
             return f"its effective area ({area_text(area)}) lies outside the task's ({area_text(self.task)})"
         for name in sorted(things):
             place = self.places[name]
             if not self._reaches(place, area):
-                return f"its effective area ({area_text(area)}) does not cover {place.text()}"
+                return f"its effective area ({area_text(area)}) does not cover {place.text()}{_led(via.get(name))}"
         return None
 
     def _reaches(self, place: Whereabouts, area: EffectiveArea) -> bool:
@@ -251,6 +260,22 @@ class AreaRule:
         if self.boxes or not (wanted.areas and offered.areas):
             return wanted, offered
         return EffectiveArea(wanted.areas), EffectiveArea(offered.areas)
+
+
+def _led(via: tuple[str, str | None] | None) -> str:
+    """What ties a step to a thing it is not given directly: its input whose value is about the thing and of a
+    class that leads to it (docs/composition.md, "Values that lead to a thing"), and the mark that unties it."""
+    if via is None:
+        return ""
+    name, concept = via
+    if not concept:
+        return f", which its input {name} (of no class, so taken to lead to its thing) is about"
+    kind = shorten(concept)
+    return (
+        f", which its input {name} ({kind}, a class that leads to its thing) is about; if a {kind} only informs"
+        f" a step of its thing, mark the class cbrs:InformsOfThing (e.g. {kind} cbrs:areaRole"
+        " cbrs:InformsOfThing, loaded into the ontology graph)"
+    )
 
 
 def area_text(area: EffectiveArea) -> str:

@@ -423,11 +423,14 @@ class Extraction:
         assert self.areas is not None
         things: set[str] = set()
         bound: set[str] = set()  # those of its things it must be where they are (see _handled)
+        via: dict[str, tuple[str, str | None]] = {}  # a thing not given directly: the input that leads to it
+        given_here: set[str] = set()
         for need, given, below, providers in self._ways(vertex, about):
             if given is not None:
                 if need.role == "input":
                     things.add(given.offer.name)
                     bound.add(given.offer.name)
+                    given_here.add(given.offer.name)
                 continue
             fit = [e for e in providers if self._judged[(e.source, below)].why is None]
             if not fit:
@@ -438,7 +441,10 @@ class Extraction:
                 things |= fed
                 if self.areas.passes_on(need.concept):
                     bound |= fed
-        why_not = self.areas.why_not(self.graph.vertices[vertex].advertisement, bound)
+                    for thing in fed:
+                        via.setdefault(thing, (need.name, need.concept))
+        led = {t: way for t, way in via.items() if t not in given_here}  # one it is given itself ties it anyway
+        why_not = self.areas.why_not(self.graph.vertices[vertex].advertisement, bound, led)
         return _Judged(frozenset(things), why_not)
 
     def _pass_over(self, step: _Step, node: str, need: Need, candidates: list[Edge], about: tuple[str, ...]) -> None:
@@ -470,7 +476,7 @@ class Extraction:
         for step in sorted(self.steps.values(), key=lambda s: s.id):
             if step.made_for is None:
                 continue
-            why = self.areas.why_not(self.graph.vertices[step.node].advertisement, self._handled(step.id))
+            why = self.areas.why_not(self.graph.vertices[step.node].advertisement, *self._handled_via(step.id))
             if why is None:
                 continue
             consumer = self.steps[step.made_for]
@@ -483,15 +489,19 @@ class Extraction:
         """The requirement inputs whose things ``step_id`` handles, so must be effective where they are:
         those it is given directly, and those its other inputs are about when the input's class leads to
         its thing (``AreaRule.passes_on``: a position, a feature; not a weight, which only informs)."""
+        return self._handled_via(step_id)[0]
+
+    def _handled_via(self, step_id: int) -> tuple[frozenset[str], dict[str, tuple[str, str | None]]]:
+        """:meth:`_handled`, with the (name, class) of the input that leads to each thing not given directly."""
         assert self.areas is not None
         inputs = [b for b in self.steps[step_id].bindings if b.need.role == "input"]
-        found: set[str] = set()
+        direct = {b.edge.offer.name for b in inputs if b.source is None}
+        via: dict[str, tuple[str, str | None]] = {}
         for b in inputs:
-            if b.source is None:
-                found.add(b.edge.offer.name)
-            elif self.areas.passes_on(b.need.concept):
-                found |= self._about(b.source)
-        return frozenset(found)
+            if b.source is not None and self.areas.passes_on(b.need.concept):
+                for thing in sorted(self._about(b.source) - direct):
+                    via.setdefault(thing, (b.need.name, b.need.concept))
+        return frozenset(direct | via.keys()), via
 
     def _about(self, step_id: int) -> frozenset[str]:
         """The requirement inputs whose things the values ``step_id`` puts out are about: those it is given,

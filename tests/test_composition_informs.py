@@ -171,6 +171,7 @@ def test_the_roles_are_the_stores_marks_and_the_nearer_mark_wins(kb: KnowledgeBa
         HOME + "InformationEntity": INFORMS,
         HOME + "SpatialData": LEADS,
         HOME + "Feature": LEADS,
+        HOME + "Status": INFORMS,  # a door's or a device's state: an observation's result, as a measurement is
     }
     marked = Leads(composer.index, {**composer.area_roles().roles, HOME + "ObjectPosition3D": INFORMS})
     assert not marked(HOME + "ObjectPosition3D") and marked(HOME + "GraspPose")  # a sibling keeps SpatialData's
