@@ -2,8 +2,9 @@
 
 A grid of spots over the surface, each far enough inside an arm's reach, from the edge, from the other
 objects (where they are believed to be) and from the fixtures standing on the surface: the carry aims
-at the first of them, the pass between arms looks among them, and the check before a run refuses a
-place that has none.
+at the first of them (or, when the plan puts more things there after it, at the spot nearest its own in
+a packing of them all: :mod:`sim.packing`), the pass between arms looks among them, and the check before
+a run refuses a place that has none.
 """
 
 from __future__ import annotations
