@@ -332,9 +332,19 @@ def plan_text(result: CompositionResult) -> str:
     return f"{head}\n{table(columns, rows)}\nGoals:\n{goals}{_unused_note(result)}"
 
 
-def _unused_note(result: CompositionResult) -> str:
-    """A note naming the task's inputs the plan leaves unused (docs/composition.md)."""
-    unused = result.unused_inputs
+def _unused_note(result: CompositionResult, earlier: Sequence[Plan] = ()) -> str:
+    """A note naming the task's inputs the plan leaves unused (docs/composition.md); ``earlier``: the plans of
+    the run it replaced, and an input one of them took is not named. A re-plan, composed from what held
+    (the eraser on the shelf), needs no more what an earlier plan did with it, and the note blamed the
+    component classes for it (docs/tasks.md, "A sixth round")."""
+    taken = {
+        binding.source.name
+        for plan in earlier
+        for step in plan.steps
+        for binding in step.bindings
+        if binding.source.step is None and binding.source.requirement == result.requirement
+    }
+    unused = [(name, type_) for name, type_ in result.unused_inputs if name not in taken]
     if not unused:
         return ""
     named = ", ".join(f"{name} ({shorten(type_)})" for name, type_ in unused)
@@ -742,7 +752,8 @@ def run_text(result: RunResult, sim_seconds: float, wall_seconds: float) -> str:
     steps = table(["#", "component", "sim s", "outcome", "effects checked"], rows)
     if not report.steps:  # every effect held already: no table of no steps
         steps = "nothing to do: every effect of the task holds already"
-    return f"{header}{steps}\n{verdict}; {timing}{_answers_text(result)}{_unused_note(result.composition)}"
+    note = _unused_note(result.composition, [replan.plan for replan in result.replans])
+    return f"{header}{steps}\n{verdict}; {timing}{_answers_text(result)}{note}"
 
 
 def _refuted_text(goal: GoalCheck) -> str:
