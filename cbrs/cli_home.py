@@ -109,7 +109,7 @@ def _text(found: HomeSurvey, written: str | None) -> str:
     if not rooms:
         lines.append(f"  {NO_ROOMS}")
     lines.append(f"people: {found.people()}")
-    if not smap.robots:  # a home with no mobile base: what it allows (one base goes without saying)
+    if len(smap.robots) != 1:  # a home with no mobile base, or several: what it allows (one goes without saying)
         lines.append(f"mobile robots: {found.bases()}")
     lines += [f"warning: {warning}" for warning in found.warnings()]
     moved = [iri for iri in found.believed if iri in smap.objects or iri in smap.robots or iri in smap.people]

@@ -60,6 +60,7 @@ __all__ = [
     "MOVED",
     "NO_BASE",
     "NO_ROOMS",
+    "SEVERAL_BASES",
     "Entry",
     "HomePicture",
     "HomeSurvey",
@@ -192,15 +193,18 @@ class HomeSurvey:
 
     def bases(self) -> str | None:
         """The home's mobile bases and what that allows, in words (None when the map cannot be read): a home
-        with none runs the tasks of the arms, the cameras and the sensors, and refuses before the world is
-        built a task that drives the base, loads its platform or finds its marker (``sim.run_checks.without_base``,
-        docs/simulation.md "A home with no mobile base")."""
+        with none, or several, runs the tasks of the arms, the cameras and the sensors, and refuses before the
+        world is built a task that drives a base, loads its platform or finds its marker
+        (``sim.run_checks.without_base``, docs/simulation.md "A home with no mobile base")."""
         smap = self.semantic_map
         if smap is None:
             return None
         if not smap.robots:
             return NO_BASE
-        return ", ".join(local_name(iri) for iri in sorted(smap.robots))
+        said = ", ".join(local_name(iri) for iri in sorted(smap.robots))
+        if len(smap.robots) > 1:
+            said += f"; {SEVERAL_BASES}"
+        return said
 
 
 NO_BASE = (
@@ -208,6 +212,11 @@ NO_BASE = (
     "built; the others run (the arms', the cameras', the sensors')"
 )
 """What ``cbrs home`` says of a home with no mobile base."""
+SEVERAL_BASES = (
+    "a task that drives a base, loads its platform or finds its marker is refused before the world is built (the "
+    "simulation drives a base only in a home of one); the others run"
+)
+"""What ``cbrs home`` says of a home with several mobile bases, after their names."""
 
 _ONE = {"people": "person", "furniture": "piece of furniture"}
 _MANY = {"furniture": "pieces of furniture"}

@@ -482,14 +482,14 @@ def refusal_in_home(
             return None
     facts = kb.select("map_facts")  # read once for the cameras and the bases
     placed = map_cameras(kb, facts)
-    base = bool(map_bases(kb, facts))
+    bases = map_bases(kb, facts)
     ads = composer.advertisements
     runnable = set(implementations(kb, transport=transport, advertisements=ads).names())
-    lacking = without_base(ads, base)  # no mobile base: its components cannot run, and the answer says so
+    lacking = without_base(ads, bases)  # no mobile base, or several: its components cannot run, and the answer says so
     runnable -= set(without_camera(ads, placed)) | set(lacking)
 
     def why_not(advertisements: Sequence[Advertisement]) -> dict[str, str]:
-        return {**without_camera(advertisements, placed), **without_base(advertisements, base)}
+        return {**without_camera(advertisements, placed), **without_base(advertisements, bases)}
 
     return refusal_before_world(kb, task, runnable, composer, why_not, lacking, UNSEEN_AT_START)
 

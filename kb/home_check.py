@@ -2,12 +2,12 @@
 
 A lab that replaces the bundled home with its own (``cbrs load --graph map --replace``, docs/tasks.md "A
 home of your own") writes every room, robot and person itself. The simulation takes rooms to make the
-floor of, a mobile robot (or none: a home where only the arms work, and a task for the base is refused
-before it runs), the arms on the torso (one or two, a "left" and a "right" one, each side once;
-none, a home where the robots only drive), and any number of people (none: a home where the robots only
-move things; several: a resident and a caregiver); the base, each
-person and every docking pose start on the floor of a room, none inside a wall, a piece of furniture or
-a robot's body. A map that lacks one of them, or puts a start where nothing could stand, is refused
+floor of, mobile robots (one; none, a home where only the arms work; several, each built: a task that
+works a base is refused before it runs unless the home has exactly one), the arms on the torso (one or
+two, a "left" and a "right" one, each side once; none, a home where the robots only drive), and any
+number of people (none: a home where the robots only move things; several: a resident and a caregiver);
+each base, each person and every docking pose start on the floor of a room, none inside a wall, a piece
+of furniture or a robot's body. A map that lacks one of them, or puts a start where nothing could stand, is refused
 with a :class:`HomeError` naming what it lacks and where, before anything is built or moves. A piece of
 furniture objects stand on with no docking pose is built, and reported (:func:`undocked_supports`): the
 arms of a robot beside it may reach it, but the mobile base has nowhere to park to fetch from it, so a
@@ -20,6 +20,7 @@ camera the run's steps look with (``sim.sight``).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 
@@ -48,17 +49,24 @@ class HomeError(MapError, ValueError):
 
 
 class NoMobileBaseError(HomeError):
-    """A home with no mobile base (no robot of graph:map with home:hasPlatform or home:hasMarker) asked for
-    what only a base has: its drive, its pose, its platform or its marker. ``needed_by`` says who asked.
-    A run is refused before this can happen, by the components it cannot run (``sim.run_checks.without_base``)."""
+    """A home with no mobile base (no robot of graph:map with home:hasPlatform or home:hasMarker), or with
+    several (``bases``, their IRIs), asked for what only the base the simulation drives has: its drive, its
+    pose, its platform or its marker. ``needed_by`` says who asked. A run is refused before this can happen,
+    by the components it cannot run (``sim.run_checks.without_base``)."""
 
-    def __init__(self, needed_by: str) -> None:
-        self.needed_by = needed_by
-        super().__init__(
-            HOME + "MobileRobot",
-            f"has no individual in the map, and {needed_by} needs one: the home has no mobile base (add "
-            f"{NEEDS_BASE} to graph:map, as ontologies/world.ttl has the bundled one)",
-        )
+    def __init__(self, needed_by: str, bases: tuple[str, ...] = ()) -> None:
+        self.needed_by, self.bases = needed_by, bases
+        if bases:
+            said = (
+                f"has {len(bases)} individuals in the map ({', '.join(local_name(b) for b in bases)}), and "
+                f"{needed_by} needs the one the simulation drives: it drives a base only in a home of one"
+            )
+        else:
+            said = (
+                f"has no individual in the map, and {needed_by} needs one: the home has no mobile base (add "
+                f"{NEEDS_BASE} to graph:map, as ontologies/world.ttl has the bundled one)"
+            )
+        super().__init__(HOME + "MobileRobot", said)
 
 
 class NoDockingPoseError(HomeError):
@@ -154,15 +162,20 @@ def _check_arms(semantic_map: SemanticMap) -> None:
 
 
 def _check_counts(semantic_map: SemanticMap) -> None:
-    robots = sorted(semantic_map.robots)
-    if len(robots) > 1:
-        # Every run builds the whole map, so this stops every task, not only one about the second robot.
-        raise HomeError(
-            HOME + "MobileRobot",
-            f"has {len(robots)} individuals in the map ({', '.join(robots)}): the simulated home takes one mobile "
-            "robot; take the extra ones out of graph:map (a SPARQL update, or the map's files loaded into a fresh "
-            "store), whatever task runs",
-        )
+    """Mobile bases are any number (none, one, several: each built); two whose footprints overlap where the
+    map starts them are refused, naming both."""
+    robots = [semantic_map.robots[iri] for iri in sorted(semantic_map.robots)]
+    for i, one in enumerate(robots):
+        for other in robots[i + 1 :]:
+            apart = math.hypot(one.start.x - other.start.x, one.start.y - other.start.y)
+            room = (math.hypot(*one.footprint) + math.hypot(*other.footprint)) / 2
+            if apart < room:
+                raise HomeError(
+                    other.iri,
+                    f"starts at ({other.start.x:.2f}, {other.start.y:.2f}), {apart:.2f} m from {local_name(one.iri)} "
+                    f"at ({one.start.x:.2f}, {one.start.y:.2f}): two mobile bases start at least {room:.2f} m apart "
+                    "(half of each footprint's diagonal); move one",
+                )
 
 
 def _starts(semantic_map: SemanticMap) -> Iterator[tuple[str, str, Pose]]:

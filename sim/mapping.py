@@ -156,8 +156,8 @@ def overhead(world: HomeWorld) -> list[int]:
     In the bundled home the ceiling cameras hang 4.5 m up, above the rays' start, and have no housing; a
     lab's housing under a 2.7 m ceiling marked the floor below it occupied. What stands (furniture, walls)
     or moves (the arms, which may come down) stays an obstacle wherever it reaches."""
-    platform = world.mobile.platform_height if world.mobile is not None else None  # no base: nothing drives under
-    clearance = (platform or 0.0) + max((o.size[2] for o in world.objects.values()), default=0.0)
+    platform = max((robot.platform_height or 0.0 for robot in world.mobiles.values()), default=0.0)  # no base: 0
+    clearance = platform + max((o.size[2] for o in world.objects.values()), default=0.0)
     above = []
     for camera in world.map.cameras.values():
         body = world.bodies.get(camera.name)

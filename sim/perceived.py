@@ -104,8 +104,8 @@ class PerceivedWorld(Judge):
             if name is not None and centre is not None:
                 self.objects[name] = Sighting(centre, f"{arm.side.value} hand", time)
                 self.holders.pop(name, None)
-        if not self.world.base_names:
-            return  # a home with no mobile base: no platform, nothing loaded on it
+        if self.world.mobile is None:
+            return  # a home with no mobile base (or several): no platform it drives, nothing loaded on it
         base = self.world.base_pose()
         loaded = set(pred.objects_on_platform(self.world))  # the platform's load sensor
         for name in loaded:
@@ -252,7 +252,7 @@ class PerceivedWorld(Judge):
 
     def base_near_person(self, person: str) -> bool | None:
         sighting = self.people.get(person)
-        if sighting is None or not self.world.base_names:
+        if sighting is None or self.world.mobile is None:
             return None  # no camera saw them, or no base: nothing to go by
         x, y, _ = sighting.position
         return self.world.base_pose().distance_to(x, y) <= pred.NEAR_PERSON_DISTANCE

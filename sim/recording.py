@@ -343,7 +343,7 @@ class Recorder:
         if self.recording:
             return
         world = self.world
-        self._base = (world.name_of(world.base.body) or "base") if world.base_names else ""  # "": a home with no base
+        self._base = (world.name_of(world.base.body) or "base") if world.mobile else ""  # "": no base it drives
         self._people = list(world.people)  # none, one or several
         self._movable = [name for name in world.snapshot() if name not in self._people]
         robots = {arm.robot.rsplit("#", 1)[-1] for arm in world.arm_specs.values()}

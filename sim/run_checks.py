@@ -650,15 +650,22 @@ def map_bases(kb: KnowledgeBase, facts: Sequence[Mapping[str, Term]] | None = No
     return {row["thing"].value for row in rows if row["property"].value in marks}
 
 
-def without_base(advertisements: Iterable[Advertisement], base: bool) -> dict[str, str]:
+def without_base(advertisements: Iterable[Advertisement], bases: Collection[str]) -> dict[str, str]:
     """The simulated components of ``advertisements`` that work the mobile base (``services.WITH_BASE``: drive
-    it, load its platform, find its marker), each with why, when the home has no ``base``: the simulation has
-    no implementation of them, and a run plans without them (docs/simulation.md, "A home with no mobile
-    base"). None when it has one."""
-    if base:
+    it, load its platform, find its marker), each with why, unless the home has exactly one base (``bases``,
+    their IRIs or names): with none, or several, the simulation has no implementation of them, and a run
+    plans without them (docs/simulation.md, "A home with no mobile base")."""
+    if len(bases) == 1:
         return {}
+    why = _NO_BASE
+    if bases:
+        names = ", ".join(sorted(local_name(base) for base in bases))
+        why = (
+            f"it works a mobile base (drives it, loads its platform or finds its marker), and graph:map has "
+            f"{len(bases)} ({names}): the simulation drives a base only in a home of one"
+        )
     return {
-        ad.iri: _NO_BASE
+        ad.iri: why
         for ad in advertisements
         if ad.bridge_port is None and SKILLS.get(ad.service_name or "") in WITH_BASE
     }

@@ -335,9 +335,10 @@ def _facts(kb: KnowledgeBase, thing: str) -> list[tuple[str, str, str]]:
 
 
 def provide_grid_map(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
-    if ctx.grid is None:  # inflated by the base's footprint; in a home with no base, by nothing
-        inflation = None if ctx.world.mobile is not None else 0.0
-        ctx.grid = build_occupancy_grid(ctx.world, inflation_radius=inflation, ignore=ctx.world.base_names)
+    if ctx.grid is None:  # seen through the base it is for; the other bases of a home of several stand in it
+        world = ctx.world
+        ignore = (world.mobile.name,) if world.mobile is not None else ()
+        ctx.grid = build_occupancy_grid(world, inflation_radius=world.grid_inflation, ignore=ignore)
     return {"map": to_json(ctx.grid)}
 
 

@@ -134,6 +134,9 @@ class Perturbation:
     person: tuple[float, float]
     base: tuple[float, float, float]
     people: Mapping[str, tuple[float, float]] = field(default_factory=dict)
+    bases: Mapping[str, tuple[float, float, float]] = field(default_factory=dict)
+    """Each mobile base's offsets by IRI: a map's only base takes the shared draw (``base``); with several,
+    each draws its own (:meth:`of_base`)."""
 
     @classmethod
     def from_seed(
@@ -142,6 +145,7 @@ class Perturbation:
         objects: Mapping[str, tuple[str, bool]] | None = None,
         spread: Spread = Spread(),
         people: Sequence[str] = (),
+        bases: Sequence[str] = (),
     ) -> Perturbation:
         """``objects`` maps each object's name to its IRI and whether it is round (no yaw offset);
         ``people`` are the map's people's IRIs. A map's only person takes the seed's shared draw, as before
@@ -154,7 +158,20 @@ class Perturbation:
         shared = (float(person[0]), float(person[1]))
         alone = len(people) == 1
         offsets = {iri: shared if alone else cls.of_person(seed, iri, spread) for iri in people}
-        return cls(moved, shared, (float(base[0]), float(base[1]), float(base[2])), offsets)
+        drawn = (float(base[0]), float(base[1]), float(base[2]))
+        one = len(bases) == 1
+        each = {iri: drawn if one else cls.of_base(seed, iri, spread) for iri in bases}
+        return cls(moved, shared, drawn, offsets, each)
+
+    @staticmethod
+    def of_base(seed: int, iri: str, spread: Spread = Spread()) -> tuple[float, float, float]:
+        """One base's offsets (dx, dy, dyaw) at ``seed`` in a home of several: drawn, as a person's are, from a
+        generator seeded by the seed and the SHA-256 of its IRI."""
+        words = np.frombuffer(hashlib.sha256(iri.encode("utf-8")).digest(), dtype="<u4")
+        rng = np.random.default_rng([seed, *(int(word) for word in words)])
+        limits = [spread.base, spread.base, spread.base_yaw]
+        dx, dy, dyaw = rng.uniform([-v for v in limits], limits)
+        return (float(dx), float(dy), float(dyaw))
 
     @staticmethod
     def of_person(seed: int, iri: str, spread: Spread = Spread()) -> tuple[float, float]:
@@ -234,11 +251,14 @@ class HomeWorld:
         """The movable objects by body name (the local name of their IRI)."""
         self.containers = {name for name, obj in self.objects.items() if obj.iri in self.map.containers}
         check_home(self.map)  # rooms, a base at most, an arm a side at most, starts on a room's floor (kb.home_check)
-        self.mobile: MobileRobot | None = next(iter(self.map.robots.values()), None)
-        """The map's mobile robot; None in a home with no mobile base (docs/simulation.md, "A home with no
-        mobile base"), where :attr:`robot`, :attr:`base` and what they give are a :class:`NoMobileBaseError`."""
-        self.base_names: tuple[str, ...] = (self.mobile.name,) if self.mobile is not None else ()
-        """The body names of the mobile bases built: one, or none."""
+        self.mobiles: dict[str, MobileRobot] = {robot.name: robot for _, robot in sorted(self.map.robots.items())}
+        """The map's mobile robots by body name, in IRI order: one, none or several, each built."""
+        self.mobile: MobileRobot | None = next(iter(self.mobiles.values())) if len(self.mobiles) == 1 else None
+        """The mobile robot the simulation drives: the map's only one; None in a home with none or several
+        (docs/simulation.md, "A home with no mobile base"), where :attr:`robot`, :attr:`base` and what they give
+        are a :class:`NoMobileBaseError`."""
+        self.base_names: tuple[str, ...] = tuple(self.mobiles)
+        """The body names of the mobile bases built."""
         self.people: dict[str, Person] = {person.name: person for _, person in sorted(self.map.people.items())}
         """The map's people by body name (the local name of their IRI), in IRI order: none, one or several."""
         self.spread = spread
@@ -249,6 +269,7 @@ class HomeWorld:
             {name: (obj.iri, obj.shape == "cylinder") for name, obj in self.objects.items()},
             spread,
             [person.iri for person in self.people.values()],
+            [robot.iri for robot in self.mobiles.values()],
         )
         self._steps = 0
         self._watchers: list[tuple[int, Callable[[], None]]] = []
@@ -433,15 +454,24 @@ class HomeWorld:
     def robot(self) -> MobileRobot:
         """The map's mobile robot (:class:`NoMobileBaseError` in a home with none: :attr:`mobile` is None)."""
         if self.mobile is None:
-            raise NoMobileBaseError("the simulation's mobile robot")
+            raise NoMobileBaseError("the simulation's mobile robot", self._several())
         return self.mobile
 
     @property
     def base(self) -> MobileBase:
         """The mobile base's drive (:class:`NoMobileBaseError` in a home with none)."""
         if self._base is None:
-            raise NoMobileBaseError("the mobile base's drive")
+            raise NoMobileBaseError("the mobile base's drive", self._several())
         return self._base
+
+    def _several(self) -> tuple[str, ...]:
+        return tuple(robot.iri for robot in self.mobiles.values()) if len(self.mobiles) > 1 else ()
+
+    @property
+    def grid_inflation(self) -> float:
+        """How far the map server's grid grows obstacles: by :attr:`base_radius`; in a home with several bases,
+        by the largest's (any of them might drive along it); with none, by nothing."""
+        return max((_radius(robot) for robot in self.mobiles.values()), default=0.0)
 
     @property
     def base_name(self) -> str:
@@ -691,8 +721,8 @@ class HomeWorld:
         self._build_rooms()
         self._build_kitchen()
         self._build_robot()
-        if self.mobile is not None:  # a home with no mobile base builds none
-            self._build_base()
+        for robot in self.mobiles.values():  # none, one, or each of several
+            self._build_base(robot)
         for person in self.people.values():
             self._build_person(person)
         self._draw_floor_last()
@@ -927,18 +957,20 @@ class HomeWorld:
     @property
     def base_radius(self) -> float:
         """The base's footprint's circumscribed radius, rounded up to 5 cm: the map's obstacle inflation."""
-        length, width = self.robot.footprint
-        return math.ceil(math.hypot(length / 2, width / 2) / 0.05 - 1e-9) * 0.05
+        return _radius(self.robot)
 
-    def _build_base(self) -> None:
-        bx, by, btheta = self.perturbation.base
-        start = self.robot.start
-        marker = self.marker_model
-        half_length, half_width = self.robot.footprint[0] / 2, self.robot.footprint[1] / 2
+    def _build_base(self, robot: MobileRobot) -> None:
+        bx, by, btheta = self.perturbation.bases[robot.iri]
+        start = robot.start
+        marker = marker_model(robot)
+        half_length, half_width = robot.footprint[0] / 2, robot.footprint[1] / 2
         bottom = 0.02
-        chassis_half = (half_length, half_width, (self.platform_height - 0.02 - bottom) / 2)
+        if robot.platform_height is None:  # marker_model said so already
+            raise ValueError(f"the semantic map gives {robot.name} no platform (home:hasPlatform with home:maxZ)")
+        height = robot.platform_height
+        chassis_half = (half_length, half_width, (height - 0.02 - bottom) / 2)
         chassis_centre_z = bottom + chassis_half[2]
-        platform_z = self.platform_height - 0.01 - chassis_centre_z
+        platform_z = height - 0.01 - chassis_centre_z
         marker_z = marker.height - 0.001 - chassis_centre_z
         wheel = (math.sqrt(0.5), 0.0, 0.0, math.sqrt(0.5))  # cylinder axis along y
         patch = (marker.patch[0] / 2, marker.patch[1] / 2, 0.001)
@@ -962,7 +994,7 @@ class HomeWorld:
             ),
         ]
         body = self._multibody(
-            self.base_name,
+            robot.name,
             parts,
             (start.x + bx, start.y + by, chassis_centre_z),
             quat_from_yaw(start.yaw + btheta),
@@ -1018,6 +1050,12 @@ def marker_model(robot: MobileRobot) -> MarkerModel:
             "home:frontColourName and home:rearColourName): the ceiling cameras could not find it"
         )
     return MarkerModel(marker.front, marker.rear, marker.patch, marker.separation, robot.platform_height + MARKER_LIFT)
+
+
+def _radius(robot: MobileRobot) -> float:
+    """A base's footprint's circumscribed radius, rounded up to 5 cm: the map's obstacle inflation."""
+    length, width = robot.footprint
+    return math.ceil(math.hypot(length / 2, width / 2) / 0.05 - 1e-9) * 0.05
 
 
 def _region(name: str, box: Box) -> Region:

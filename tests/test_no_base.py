@@ -1,7 +1,8 @@
 """A home with no mobile base (docs/simulation.md, "A home with no mobile base"): the home check takes it; the
 simulation builds no base, and the components that work one have no implementation; a task of the arms runs
 (one simulation run); a task for the base is refused before the world is built, naming the base's components
-and why; `cbrs home` says what such a home allows; two bases are refused as before."""
+and why; `cbrs home` says what such a home allows. A home of two bases is taken too, and a task for a base
+refused alike, naming both; two started on each other are refused."""
 
 from __future__ import annotations
 
@@ -15,7 +16,7 @@ from cbrs.actions.composer import Composer
 from cbrs.actions.runner import run_task
 from cbrs.app import App
 from cbrs.cli_home import home
-from cbrs.home_plan import NO_BASE, survey
+from cbrs.home_plan import NO_BASE, SEVERAL_BASES, survey
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.home_check import HomeError, NoMobileBaseError, check_home
 from cbrs.kb.namespaces import PREFIXES
@@ -30,7 +31,7 @@ from cbrs.tasks import refusal_in_home
 from tests.helpers_examples import EXAMPLES
 
 SVC = PREFIXES["svc"]
-NO_BASE_RU = "lab6_no_base.ru"
+NO_BASE_RU, TWO_BASES_RU = "lab6_no_base.ru", "lab6_two_bases.ru"
 BASE_WORDS = "it works the mobile base (drives it, loads its platform or finds its marker), and graph:map has none"
 
 
@@ -99,21 +100,40 @@ def test_a_task_of_the_arms_is_not_refused_before_the_world(no_base: KnowledgeBa
     assert refusal_in_home(no_base, "RobotArmServeACup", Composer(no_base)) is None
 
 
-def test_with_a_base_no_component_is_left_out_for_it(no_base: KnowledgeBase) -> None:
+def test_with_one_base_no_component_is_left_out_for_it(no_base: KnowledgeBase) -> None:
     ads = Composer(no_base).advertisements
-    assert without_base(ads, base=True) == {}
-    assert SVC + "NavigateToPlace_P3DX01" in without_base(ads, base=False)
-    assert SVC + "PickUpObject_CytonDualArm01" not in without_base(ads, base=False)
+    assert without_base(ads, {SVC + "P3DX01"}) == {}
+    assert without_base(ads, set())[SVC + "NavigateToPlace_P3DX01"] == BASE_WORDS
+    assert SVC + "PickUpObject_CytonDualArm01" not in without_base(ads, set())
 
 
-def test_two_bases_are_refused_naming_both() -> None:
-    kb = _store()
+def test_two_bases_are_taken_and_a_task_for_a_base_refused_naming_both() -> None:
+    """docs/examples/lab6_two_bases.ru: the home is taken, cbrs home says what it allows, a task for a base
+    is refused before the world is built naming the two, a task of the arms is not."""
+    kb = _store(TWO_BASES_RU)
+    smap = SemanticMap.read(kb)
+    check_home(smap)  # no HomeError
+    assert sorted(smap.robots) == [SVC + "P3DX01", SVC + "P3DX02"]
+    assert survey(kb).bases() == f"P3DX01, P3DX02; {SEVERAL_BASES}"
+    result = refusal_in_home(kb, "FetchMyPen", Composer(kb))
+    assert result is not None and result.report is None
+    unrunnable = dict(result.composition.unsatisfied[0].unrunnable)
+    assert unrunnable[SVC + "NavigateToPlace_P3DX01"].endswith(
+        "and graph:map has 2 (P3DX01, P3DX02): the simulation drives a base only in a home of one"
+    )
+    assert refusal_in_home(kb, "RobotArmServeACup", Composer(kb)) is None
+
+
+def test_two_bases_started_on_each_other_are_refused_naming_both() -> None:
+    kb = _store(TWO_BASES_RU)
     kb.update(
         "PREFIX home: <https://w3id.org/cbrs/home#> PREFIX svc: <https://w3id.org/cbrs/service#> "
-        "INSERT { GRAPH <https://w3id.org/cbrs/graph/map> { svc:P3DX02 ?p ?o } } "
-        "WHERE { GRAPH <https://w3id.org/cbrs/graph/map> { svc:P3DX01 ?p ?o } }"
+        "DELETE { GRAPH <https://w3id.org/cbrs/graph/map> { svc:P3DX02 home:x ?x ; home:y ?y } } "
+        "INSERT { GRAPH <https://w3id.org/cbrs/graph/map> { svc:P3DX02 home:x 3.3 ; home:y 1.5 } } "
+        "WHERE { GRAPH <https://w3id.org/cbrs/graph/map> { svc:P3DX02 home:x ?x ; home:y ?y } }"
     )
-    with pytest.raises(HomeError, match=r"has 2 individuals in the map \(.*P3DX01, .*P3DX02\)"):
+    refused = r"P3DX02 .* starts at \(3\.30, 1\.50\), 0\.30 m from P3DX01 at \(3\.00, 1\.50\)"
+    with pytest.raises(HomeError, match=refused):
         check_home(SemanticMap.read(kb))
 
 
