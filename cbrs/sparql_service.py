@@ -598,8 +598,10 @@ class SparqlService:
             raise UpdateForbiddenError("updates are disabled: this server was started read-only")
         if expected is None:
             raise UpdateForbiddenError("updates are disabled: this server is read-only (no update token set)")
-        if token is None or not hmac.compare_digest(token.encode("utf-8"), expected.encode("utf-8")):
+        if token is None:
             raise UpdateForbiddenError("updates need the server's token: Authorization: Bearer <token>")
+        if not hmac.compare_digest(token.encode("utf-8"), expected.encode("utf-8")):
+            raise UpdateForbiddenError("the bearer token sent is not this server's update token")
 
     @_sparql_text("update")
     def update(self, text: str, token: str | None) -> None:

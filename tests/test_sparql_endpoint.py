@@ -155,6 +155,9 @@ def test_update_without_the_token_is_403_and_changes_nothing(
     response = client.post("/update", data=INSERT.encode(), content_type="application/sparql-update", headers=headers)
     assert response.status_code == 403
     assert kb.store.dump() == before
+    sent_wrong = authorization == "Bearer wrong"
+    assert ("not this server's update token" in response.get_data(as_text=True)) is sent_wrong
+    assert ("Authorization: Bearer <token>" in response.get_data(as_text=True)) is not sent_wrong
 
 
 @pytest.mark.parametrize("how", ["form-sparql", "direct-sparql", "direct-update"])
