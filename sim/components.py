@@ -279,6 +279,7 @@ class SimEnvironment:
         self._superclasses: dict[str, set[str]] | None = None
         self._computables: dict[str, str] | None = None
         self._exclusions: tuple[frozenset[str], tuple[tuple[str, str], ...]] | None = None
+        self._qualities: frozenset[str] | None = None  # home:hasQualityPart and the relations below it
         self._heard = Heard(kb)  # before the world graph is read: a correction made after the read is heard
         self.effects |= self._untestable_beliefs()
 
@@ -525,10 +526,32 @@ class SimEnvironment:
         if grounded is not None:
             obj = self._iri_of(grounded)
         else:
-            obj = statement.object if self.is_a(statement.object, HOME + "Quality") else None
+            obj = statement.object if self._own_quality(statement.predicate, statement.object) else None
         if subject is None or obj is None:
             return None
         return (subject, statement.predicate, obj)
+
+    def _own_quality(self, predicate: str, value: str) -> bool:
+        """Whether ``value``, a class, is the value of a quality of the subject: a quality (home:Opened) by a
+        relation of home:hasQualityPart's family ((Door, hasStatus, Opened)). A relation to a quality class
+        by another relation ((Person, lab6:isAlertedOf, DoorStatus): an alert sent) is no lasting state of
+        the subject, and is not kept, as an inform is not (docs/components.md; docs/tasks.md, "A sixth
+        round": the next alert-only run had "nothing to do")."""
+        if not self.is_a(value, HOME + "Quality"):
+            return False
+        if self._qualities is None:
+            parents: dict[str, set[str]] = {}
+            for row in self.kb.select("taxonomy_links"):
+                if row["link"].value == "is-a":
+                    parents.setdefault(row["child"].value, set()).add(row["parent"].value)
+            found, frontier = {HOME + "hasQualityPart"}, [HOME + "hasQualityPart"]
+            while frontier:
+                above = frontier.pop()
+                below = [child for child, ups in parents.items() if above in ups and child not in found]
+                found.update(below)
+                frontier += below
+            self._qualities = frozenset(found)
+        return predicate in self._qualities
 
     def _untestable_beliefs(self) -> set[tuple[str, str, str]]:
         """The relations about things of this world that the world graph (an earlier run's belief) holds
@@ -538,6 +561,8 @@ class SimEnvironment:
         for row in self.kb.select("world_facts"):
             fact = (row["thing"].value, row["relation"].value, row["other"].value)
             if fact[0] in self.world.map.types and self.computable(fact[1]) is None:
+                if self.is_a(fact[2], HOME + "Quality") and not self._own_quality(fact[1], fact[2]):
+                    continue  # an alert an earlier run believed (see _own_quality)
                 kept.add(fact)
         return kept
 
