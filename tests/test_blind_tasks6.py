@@ -24,7 +24,7 @@ from cbrs.actions.runner import run_task
 from cbrs.bridge_client import BridgeClient
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import InvalidDescriptionError
-from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.namespaces import PREFIXES, GraphName
 from cbrs.kb.semantic_map import SemanticMap
 from cbrs.server import Server
 from cbrs.sim.components import SimEnvironment
@@ -107,7 +107,11 @@ def test_the_fridge_is_watched_by_the_labs_roslibpy_program(server: Server) -> N
         assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
         [answer] = result.answers
         assert answer.value["@type"] == HOME + "Opened"
-        assert [goal.believed for goal in result.goals] == [True]
+        # an alert is no lasting state of the person: not believed on the phone's word, nor kept (an alert-only
+        # task would have had "nothing to do" the next time), as the speaker's inform of components.md
+        assert [(goal.believed, goal.holds) for goal in result.goals] == [(None, None)]
+        alerted = f"ASK {{ GRAPH <{GraphName.WORLD.iri}> {{ ?person <{LAB6}isAlertedOf> ?what }} }}"
+        assert not bool(kb.query(alerted))
     finally:
         out = _stop(child)
     assert "phone: ALERT the fridge door is Opened" in out
