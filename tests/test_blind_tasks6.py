@@ -95,7 +95,8 @@ def server() -> Iterator[Server]:
 
 def test_the_fridge_is_watched_by_the_labs_roslibpy_program(server: Server) -> None:
     """The sensor and the phone register from a program with no cbrs in it; WatchTheFridge is planned onto
-    them, the sensor's answer is the run's answer, the phone sends the alert, the goal is believed."""
+    them, the sensor's answer is the run's answer, the phone sends the alert,
+    which is not kept in the belief (tests/test_alert_not_kept.py)."""
     child = _devices(server)
     try:
         kb = server.kb
