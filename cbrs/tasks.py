@@ -25,8 +25,9 @@ from typing import TYPE_CHECKING, Any
 
 from cbrs.extras import installed, require
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.derived_prefixes import StoreNames
 from cbrs.kb.errors import KnowledgeBaseError
-from cbrs.kb.namespaces import expand, shorten
+from cbrs.kb.namespaces import expand, shorten, store_names
 
 if TYPE_CHECKING:
     from cbrs.actions.composer import Composer
@@ -321,6 +322,12 @@ class TaskRunner:
             active[1].join(timeout)
 
     def _run(self, run: TaskRun) -> None:
+        # the run's texts (its answers, goals, reasons) name the store's own namespaces by the prefixes
+        # derived for them, as `cbrs run` prints them and the pages show them (docs/web.md)
+        with store_names(StoreNames(lambda: self.kb)):
+            self._run_named(run)
+
+    def _run_named(self, run: TaskRun) -> None:
         from cbrs.actions.composer import Composer
         from cbrs.kb.semantic_map import SemanticMap
 
