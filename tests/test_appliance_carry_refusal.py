@@ -9,14 +9,16 @@ from __future__ import annotations
 
 import dataclasses
 import re
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import NamedTuple
 
 import pytest
 
 from cbrs.actions.composer import Composer
+from cbrs.actions.plan import Plan
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.arm_bands import PANDA_SIDE_ARM, ArmBand
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
 from cbrs.sim import arm_choice, skills
@@ -39,15 +41,18 @@ def _trial() -> KnowledgeBase:
     return kb
 
 
-def _given(kb: KnowledgeBase, world: HomeWorld) -> None:
-    plan = Composer(kb).compose(TASK).plan
-    assert plan is not None
+def _given(kb: KnowledgeBase, world: HomeWorld, plan: Plan) -> None:
     SimEnvironment(world, kb).given(plan, {r.iri: r for r in kb.requirements()})
+
+
+def _unasked(*_: object) -> None:
+    raise AssertionError("the arm choice was asked before the run")
 
 
 class Refused(NamedTuple):
     kb: KnowledgeBase
     world: HomeWorld
+    plan: Plan
     error: CannotCarryError
     moved: bool
     limit: float
@@ -58,15 +63,17 @@ class Refused(NamedTuple):
 @pytest.fixture(scope="module")
 def refused() -> Iterator[Refused]:
     kb = _trial()
+    plan = Composer(kb).compose(TASK).plan
+    assert plan is not None
     with open_world(seed=1, semantic_map=SemanticMap.read(kb)) as world:
         joints = {side: world.arm(side).joint_positions() for side in ArmSide}
         when = world.time
         with pytest.raises(CannotCarryError) as caught:
-            _given(kb, world)
+            _given(kb, world, plan)
         moved = world.time != when or {side: world.arm(side).joint_positions() for side in ArmSide} != joints
         spout = next(fixture for fixture in skills.appliances(world) if fixture.name == "Spout01")
         cup = world.map.objects[WORLD + "Cup"]
-        yield Refused(kb, world, caught.value, moved, spout.zmin - COLLISION_MARGIN - cup.size[2])
+        yield Refused(kb, world, plan, caught.value, moved, spout.zmin - COLLISION_MARGIN - cup.size[2])
 
 
 def test_the_take_is_refused_before_the_run_naming_the_spout_and_the_band(refused: Refused) -> None:
@@ -93,31 +100,32 @@ def test_the_advice_is_the_bands_not_to_set_the_cup_nearer_the_arm(refused: Refu
     assert "with the Cup2 moved off its way (home:x, home:y), or by another approach (home:graspApproach)" in reason
 
 
+def _banded(refused: Refused, monkeypatch: pytest.MonkeyPatch, bands: Callable[[ArmBand], ArmBand]) -> None:
+    for side in ArmSide:
+        arm = refused.world.arm(side)
+        stated = tuple(bands(band) for band in arm.hand.side_arm)
+        monkeypatch.setattr(arm, "hand", dataclasses.replace(arm.hand, side_arm=stated))
+
+
 def test_the_band_the_advice_names_lets_the_take_pass(refused: Refused, monkeypatch: pytest.MonkeyPatch) -> None:
-    """The same hands with the forearm band as the advice says (its underside that high): the plan's checks
-    pass the take."""
+    """The same hands with the forearm band as the advice says (its underside that high): the map's question
+    passes the take, and the arm choice is not asked before the run."""
     found = re.search(r"no lower than ([\d.]+) cm below the grasp point", refused.error.reason)
     assert found is not None
     advised = -float(found.group(1)) / 100.0
-    for side in ArmSide:
-        arm = refused.world.arm(side)
-        bands = tuple(
-            dataclasses.replace(band, underside=advised) if band.underside < advised else band
-            for band in arm.hand.side_arm
-        )
-        assert bands != arm.hand.side_arm
-        monkeypatch.setattr(arm, "hand", dataclasses.replace(arm.hand, side_arm=bands))
-    _given(refused.kb, refused.world)
+    assert advised > -0.06
+    _banded(refused, monkeypatch, lambda band: dataclasses.replace(band, underside=max(band.underside, advised)))
+    monkeypatch.setattr(arm_choice, "who_takes", _unasked)
+    _given(refused.kb, refused.world, refused.plan)
 
 
 def test_a_carry_that_meets_no_appliance_costs_no_dry_run_before_the_run(
-    bundled_kb: KnowledgeBase, monkeypatch: pytest.MonkeyPatch
+    refused: Refused, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """The bundled cup's way below the tap meets nothing by the map: the arm choice is not asked before the run."""
-
-    def asked(*_: object) -> None:
-        raise AssertionError("the arm choice was asked before the run")
-
-    monkeypatch.setattr(arm_choice, "who_takes", asked)
-    with open_world(seed=0, semantic_map=SemanticMap.read(bundled_kb)) as world:
-        _given(bundled_kb, world)
+    """The same hands with the bundled Panda arm's bands: the cup's top passes under the spout by the map,
+    and the arm choice is not asked before the run."""
+    for side in ArmSide:
+        arm = refused.world.arm(side)
+        monkeypatch.setattr(arm, "hand", dataclasses.replace(arm.hand, side_arm=PANDA_SIDE_ARM))
+    monkeypatch.setattr(arm_choice, "who_takes", _unasked)
+    _given(refused.kb, refused.world, refused.plan)
