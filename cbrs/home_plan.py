@@ -193,9 +193,10 @@ class HomeSurvey:
 
     def bases(self) -> str | None:
         """The home's mobile bases and what that allows, in words (None when the map cannot be read): a home
-        with none, or several, runs the tasks of the arms, the cameras and the sensors, and refuses before the
-        world is built a task that drives a base, loads its platform or finds its marker
-        (``sim.run_checks.without_base``, docs/simulation.md "A home with no mobile base")."""
+        with none runs the tasks of the arms, the cameras and the sensors, and refuses before the world is
+        built a task that drives a base, loads its platform or finds its marker (``sim.run_checks.without_base``);
+        one of several drives the base its plan works (``sim.run_checks.base_for``; docs/simulation.md, "A home
+        with no mobile base")."""
         smap = self.semantic_map
         if smap is None:
             return None
@@ -213,8 +214,8 @@ NO_BASE = (
 )
 """What ``cbrs home`` says of a home with no mobile base."""
 SEVERAL_BASES = (
-    "a task that drives a base, loads its platform or finds its marker is refused before the world is built (the "
-    "simulation drives a base only in a home of one); the others run"
+    "a run drives the base its plan works (the device of its drive, the marker colours a locator is given); "
+    "a plan that works two, or names none, is refused before anything moves"
 )
 """What ``cbrs home`` says of a home with several mobile bases, after their names."""
 

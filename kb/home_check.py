@@ -2,8 +2,8 @@
 
 A lab that replaces the bundled home with its own (``cbrs load --graph map --replace``, docs/tasks.md "A
 home of your own") writes every room, robot and person itself. The simulation takes rooms to make the
-floor of, mobile robots (one; none, a home where only the arms work; several, each built: a task that
-works a base is refused before it runs unless the home has exactly one), the arms on the torso (one or
+floor of, mobile robots (one; none, a home where only the arms work, and a task for a base is refused
+before it runs; several, each built, a run driving the one its plan works), the arms on the torso (one or
 two, a "left" and a "right" one, each side once; none, a home where the robots only drive), and any
 number of people (none: a home where the robots only move things; several: a resident and a caregiver);
 each base, each person and every docking pose start on the floor of a room, none inside a wall, a piece
@@ -59,7 +59,8 @@ class NoMobileBaseError(HomeError):
         if bases:
             said = (
                 f"has {len(bases)} individuals in the map ({', '.join(local_name(b) for b in bases)}), and "
-                f"{needed_by} needs the one the simulation drives: it drives a base only in a home of one"
+                f"{needed_by} needs the one the simulation drives: a run drives the one its plan works, and none "
+                "is chosen"
             )
         else:
             said = (

@@ -155,7 +155,7 @@ def implementations(
         camera = own_camera(ad)  # a camera the world lacks: no implementation (sim.run_checks.unplaced_cameras)
         if world is not None and camera is not None and camera not in world.cameras:
             continue
-        if world is not None and world.mobile is None and work in WITH_BASE:  # no base (or which?): none either
+        if world is not None and not world.base_names and work in WITH_BASE:  # no base to work: none either
             continue
         names = tuple(p.name for p in ad.outputs if p.name)
         registry.add(ad.iri, _maker(work, device, names))

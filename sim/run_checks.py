@@ -247,9 +247,13 @@ class PlanChecks:
         """Refuse ``plan`` with the first check's typed error (:class:`kb.person_choice.PersonError`,
         :class:`OutOfReachError`, :class:`PlaceCrowdedError`, :class:`arm_choice.CannotCarryError`,
         :class:`sight.OutOfViewError`,
-        :class:`CannotLoadError`, :class:`kb.home_check.NoDockingPoseError`); nothing when every check
-        passes."""
+        :class:`CannotLoadError`, :class:`kb.home_check.NoDockingPoseError`, :class:`WhichBaseError`);
+        nothing when every check passes. In a home of several bases, the world drives the one the plan works
+        from here on (:func:`base_for`)."""
         ads = {ad.iri: ad for ad in self.kb.advertisements()}  # read once: 23-26 ms each on the bundled store
+        base = base_for(self.world, plan, ads, values)  # a home of several bases: the one the plan works
+        if base is not None:
+            self.world.drive(base)
         meant = self._people_of(plan, values, ads)  # a step needing a person the home cannot give (nobody, who?)
         self._check_reach(plan, values)
         check_room(self.world, self.belief, plan, values)  # several objects onto one place: room for all
@@ -652,26 +656,84 @@ def map_bases(kb: KnowledgeBase, facts: Sequence[Mapping[str, Term]] | None = No
 
 def without_base(advertisements: Iterable[Advertisement], bases: Collection[str]) -> dict[str, str]:
     """The simulated components of ``advertisements`` that work the mobile base (``services.WITH_BASE``: drive
-    it, load its platform, find its marker), each with why, unless the home has exactly one base (``bases``,
-    their IRIs or names): with none, or several, the simulation has no implementation of them, and a run
-    plans without them (docs/simulation.md, "A home with no mobile base")."""
-    if len(bases) == 1:
-        return {}
-    why = _NO_BASE
+    it, load its platform, find its marker), each with why, when the home has no base (``bases``, their IRIs
+    or names, is empty): the simulation has no implementation of them, and a run plans without them
+    (docs/simulation.md, "A home with no mobile base"). None when it has one or several (a run drives the one
+    its plan works: :func:`base_for`)."""
     if bases:
-        names = ", ".join(sorted(local_name(base) for base in bases))
-        why = (
-            f"it works a mobile base (drives it, loads its platform or finds its marker), and graph:map has "
-            f"{len(bases)} ({names}): the simulation drives a base only in a home of one"
-        )
+        return {}
     return {
-        ad.iri: why
+        ad.iri: _NO_BASE
         for ad in advertisements
         if ad.bridge_port is None and SKILLS.get(ad.service_name or "") in WITH_BASE
     }
 
 
 _NO_BASE = "it works the mobile base (drives it, loads its platform or finds its marker), and graph:map has none"
+
+
+class WhichBaseError(KnowledgeBaseError):
+    """In a home of several mobile bases, a plan's steps that work a base name two of them (``named``: base
+    IRI -> the components naming it), or none (``unnamed``: the components that name none): the simulation
+    drives one base a run, the one the plan works, and cannot tell which. Refused before anything moves."""
+
+    def __init__(self, bases: Sequence[str], named: Mapping[str, Sequence[str]], unnamed: Sequence[str]) -> None:
+        self.bases, self.named, self.unnamed = tuple(bases), dict(named), tuple(unnamed)
+        home = f"the home has {len(self.bases)} mobile bases ({', '.join(local_name(b) for b in self.bases)})"
+        if len(self.named) > 1:
+            each = "; ".join(
+                f"{', '.join(local_name(c) for c in components)} work {local_name(base)}"
+                for base, components in sorted(self.named.items())
+            )
+            said = f"the plan works two of them ({each}), and a run drives one: compose it with one base's components"
+        else:
+            said = (
+                f"the plan's {', '.join(local_name(c) for c in self.unnamed)} name none of them (a base's own "
+                "component, or the marker colours of a base as its input, would)"
+            )
+        super().__init__(f"{home}: {said}")
+
+
+def base_for(world: HomeWorld, plan: Plan, ads: Mapping[str, Advertisement], values: Mapping[str, Any]) -> str | None:
+    """The body name of the base ``plan`` works, in a home of several (None in a home of one or none, or for
+    a plan that works no base): the device of a step that drives one (NavigateToPlace_P3DX01's P3DX01), or the
+    base whose marker colours a locator's input names; a hand-over onto a platform names none and takes that
+    base. :class:`WhichBaseError` when the steps name two, or none (docs/simulation.md, "A home with no
+    mobile base")."""
+    if len(world.mobiles) < 2:
+        return None
+    by_iri = {robot.iri: name for name, robot in world.mobiles.items()}
+    steps = {step.index: step for step in plan.steps}
+    named: dict[str, list[str]] = {}
+    unnamed: list[str] = []
+    for step in plan.steps:
+        ad = ads.get(step.component)
+        if ad is None or ad.bridge_port is not None or SKILLS.get(ad.service_name or "") not in WITH_BASE:
+            continue
+        device = ad.device or PREFIXES["svc"] + (ad.device_name or "")  # cbrs:device, else by its name
+        bases = [device] if device in by_iri else _marked(world, step, steps, values)
+        if bases:
+            for base in bases:
+                named.setdefault(base, []).append(step.component)
+        else:
+            unnamed.append(step.component)
+    if len(named) == 1:
+        return by_iri[next(iter(named))]
+    if named or unnamed:
+        raise WhichBaseError(sorted(by_iri), named, unnamed)
+    return None
+
+
+def _marked(world: HomeWorld, step: PlanStep, steps: Mapping[int, PlanStep], values: Mapping[str, Any]) -> list[str]:
+    """The bases (IRIs) whose marker shows the colours a task's input to ``step`` names."""
+    found = []
+    for name in sorted(task_inputs_of(step, steps)):
+        value = values.get(name)
+        iri = str(value["@id"]) if isinstance(value, dict) and "@id" in value else ""
+        colours = world.map.marker_colours(iri) if iri else None
+        if colours is not None:
+            found += [robot.iri for robot in world.mobiles.values() if robot.marker_colours == colours]
+    return sorted(set(found))
 
 
 def _unplaced(camera: str) -> str:

@@ -254,9 +254,10 @@ class HomeWorld:
         self.mobiles: dict[str, MobileRobot] = {robot.name: robot for _, robot in sorted(self.map.robots.items())}
         """The map's mobile robots by body name, in IRI order: one, none or several, each built."""
         self.mobile: MobileRobot | None = next(iter(self.mobiles.values())) if len(self.mobiles) == 1 else None
-        """The mobile robot the simulation drives: the map's only one; None in a home with none or several
-        (docs/simulation.md, "A home with no mobile base"), where :attr:`robot`, :attr:`base` and what they give
-        are a :class:`NoMobileBaseError`."""
+        """The mobile robot the simulation drives: the map's only one; in a home of several, the one a run's
+        plan works (:meth:`drive`), None until then; None in a home with none (docs/simulation.md, "A home
+        with no mobile base"). While None, :attr:`robot`, :attr:`base` and what they give are a
+        :class:`NoMobileBaseError`."""
         self.base_names: tuple[str, ...] = tuple(self.mobiles)
         """The body names of the mobile bases built."""
         self.people: dict[str, Person] = {person.name: person for _, person in sorted(self.map.people.items())}
@@ -290,12 +291,14 @@ class HomeWorld:
         self._taps: list[tuple[Dispenser, int]] = []
         self._joints: list[tuple[int, list[int]]] = []
         self._base: MobileBase | None = None
+        self._bases: dict[str, MobileBase] = {}
         try:
             self._build()
             self._taps = [(d, self._bodies[d.name]) for d in self.dispensers]
             self._joints = self._moving_joints()
+            self._bases = {name: MobileBase(client, self._bodies[name], self.step) for name in self.mobiles}
             if self.mobile is not None:
-                self._base = MobileBase(client, self._bodies[self.mobile.name], self.step)
+                self._base = self._bases[self.mobile.name]
             for a, b, depth in overlaps(self.map):
                 log.warning(
                     "%s and %s overlap by %.1f cm where the semantic map puts them: settling pushes them apart",
@@ -463,6 +466,14 @@ class HomeWorld:
         if self._base is None:
             raise NoMobileBaseError("the mobile base's drive", self._several())
         return self._base
+
+    def drive(self, name: str) -> None:
+        """Make the base ``name`` (a body name) the one the simulation drives: :attr:`mobile`, :attr:`robot`,
+        :attr:`base` and what they give are its from now on. In a home of several bases, a run's plan names
+        it (``sim.run_checks.base_for``); the others stand where they are."""
+        if name not in self._bases:
+            raise UnknownEntityError(name, sorted(self._bases))
+        self.mobile, self._base = self.mobiles[name], self._bases[name]
 
     def _several(self) -> tuple[str, ...]:
         return tuple(robot.iri for robot in self.mobiles.values()) if len(self.mobiles) > 1 else ()

@@ -1,13 +1,16 @@
 """A home with no mobile base (docs/simulation.md, "A home with no mobile base"): the home check takes it; the
 simulation builds no base, and the components that work one have no implementation; a task of the arms runs
 (one simulation run); a task for the base is refused before the world is built, naming the base's components
-and why; `cbrs home` says what such a home allows. A home of two bases is taken too, and a task for a base
-refused alike, naming both; two started on each other are refused."""
+and why; `cbrs home` says what such a home allows. A home of two bases is taken too: a run drives the base its
+plan's steps name, and a plan naming two, or none, is refused; two started on each other are refused."""
 
 from __future__ import annotations
 
 import json
 from collections.abc import Iterator
+from dataclasses import replace
+from types import SimpleNamespace
+from typing import cast
 
 import pytest
 from click.testing import CliRunner
@@ -23,14 +26,14 @@ from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
 from cbrs.sim.components import SimEnvironment
 from cbrs.sim.mapping import OccupancyGrid
-from cbrs.sim.run_checks import map_bases, without_base
+from cbrs.sim.run_checks import WhichBaseError, base_for, map_bases, without_base
 from cbrs.sim.services import provide_grid_map
 from cbrs.sim.values import decode
 from cbrs.sim.world import HomeWorld, open_world
 from cbrs.tasks import refusal_in_home
 from tests.helpers_examples import EXAMPLES
 
-SVC = PREFIXES["svc"]
+SVC, WORLD = PREFIXES["svc"], PREFIXES["world"]
 NO_BASE_RU, TWO_BASES_RU = "lab6_no_base.ru", "lab6_two_bases.ru"
 BASE_WORDS = "it works the mobile base (drives it, loads its platform or finds its marker), and graph:map has none"
 
@@ -100,32 +103,60 @@ def test_a_task_of_the_arms_is_not_refused_before_the_world(no_base: KnowledgeBa
     assert refusal_in_home(no_base, "RobotArmServeACup", Composer(no_base)) is None
 
 
-def test_with_one_base_no_component_is_left_out_for_it(no_base: KnowledgeBase) -> None:
+def test_with_a_base_or_several_no_component_is_left_out_for_it(no_base: KnowledgeBase) -> None:
     ads = Composer(no_base).advertisements
-    assert without_base(ads, {SVC + "P3DX01"}) == {}
+    assert without_base(ads, {SVC + "P3DX01"}) == {} == without_base(ads, {SVC + "P3DX01", SVC + "P3DX02"})
     assert without_base(ads, set())[SVC + "NavigateToPlace_P3DX01"] == BASE_WORDS
     assert SVC + "PickUpObject_CytonDualArm01" not in without_base(ads, set())
 
 
-def test_two_bases_are_taken_and_a_task_for_a_base_refused_naming_both() -> None:
-    """docs/examples/lab6_two_bases.ru: the home is taken, cbrs home says what it allows, a task for a base
-    is refused before the world is built naming the two, a task of the arms is not."""
-    kb = _store(TWO_BASES_RU)
-    smap = SemanticMap.read(kb)
+@pytest.fixture(scope="module")
+def two_bases() -> KnowledgeBase:
+    return _store(TWO_BASES_RU)
+
+
+def test_two_bases_are_taken_and_said(two_bases: KnowledgeBase) -> None:
+    """docs/examples/lab6_two_bases.ru: the home is taken, cbrs home says what it allows, and a task for a
+    base goes on to the world (its plan says which base)."""
+    smap = SemanticMap.read(two_bases)
     check_home(smap)  # no HomeError
     assert sorted(smap.robots) == [SVC + "P3DX01", SVC + "P3DX02"]
-    assert survey(kb).bases() == f"P3DX01, P3DX02; {SEVERAL_BASES}"
-    result = refusal_in_home(kb, "FetchMyPen", Composer(kb))
-    assert result is not None and result.report is None
-    unrunnable = dict(result.composition.unsatisfied[0].unrunnable)
-    assert unrunnable[SVC + "NavigateToPlace_P3DX01"].endswith(
-        "and graph:map has 2 (P3DX01, P3DX02): the simulation drives a base only in a home of one"
+    assert survey(two_bases).bases() == f"P3DX01, P3DX02; {SEVERAL_BASES}"
+    assert refusal_in_home(two_bases, "FetchMyPen", Composer(two_bases)) is None
+
+
+def _home_of(smap: SemanticMap) -> HomeWorld:
+    """What :func:`base_for` asks of the world (its bases and map), without building one."""
+    return cast(HomeWorld, SimpleNamespace(mobiles={r.name: r for r in smap.robots.values()}, map=smap))
+
+
+def test_the_base_a_plan_works_is_the_one_its_steps_name(two_bases: KnowledgeBase) -> None:
+    composer = Composer(two_bases)
+    plan = composer.compose("FetchMyPen").plan
+    assert plan is not None
+    ads = {ad.iri: ad for ad in composer.advertisements}
+    world = _home_of(SemanticMap.read(two_bases))
+    assert base_for(world, plan, ads, {}) == "P3DX01"  # NavigateToPlace_P3DX01 and the others: the locator names none
+    # the locator alone, given P3DX02's marker colours: P3DX02
+    locate = next(step for step in plan.steps if "LocateMobileRobot" in step.component)
+    marker = {name: {"@id": WORLD + "P3DX02MarkerColours"} for name in {b.source.name for b in locate.inputs}}
+    alone = replace(plan, steps=(locate,))
+    assert base_for(world, alone, ads, marker) == "P3DX02"
+    with pytest.raises(WhichBaseError, match=r"the home has 2 mobile bases \(P3DX01, P3DX02\): the plan's "):
+        base_for(world, alone, ads, {})  # nothing names a base
+    # a drive by a second base's component besides the first's: two bases, refused naming both
+    drive = next(step for step in plan.steps if "NavigateToPlace" in step.component)
+    other = replace(
+        ads[drive.component], iri=SVC + "NavigateToPlace_P3DX02", device_name="P3DX02", device=SVC + "P3DX02"
     )
-    assert refusal_in_home(kb, "RobotArmServeACup", Composer(kb)) is None
+    both = replace(plan, steps=(*plan.steps, replace(drive, component=other.iri)))
+    with pytest.raises(WhichBaseError, match=r"the plan works two of them \(.*NavigateToPlace_P3DX02 work P3DX02"):
+        base_for(world, both, {**ads, other.iri: other}, {})
+    assert base_for(_home_of(SemanticMap.read(_store())), plan, ads, {}) is None  # a home of one: nothing to choose
 
 
 def test_two_bases_started_on_each_other_are_refused_naming_both() -> None:
-    kb = _store(TWO_BASES_RU)
+    kb = _store(TWO_BASES_RU)  # its own: the update moves the second base
     kb.update(
         "PREFIX home: <https://w3id.org/cbrs/home#> PREFIX svc: <https://w3id.org/cbrs/service#> "
         "DELETE { GRAPH <https://w3id.org/cbrs/graph/map> { svc:P3DX02 home:x ?x ; home:y ?y } } "

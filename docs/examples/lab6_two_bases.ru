@@ -1,13 +1,13 @@
 # A second mobile base in the home: a Pioneer like the bundled one, parked in the bedroom, with its own
-# platform and colour marker (blue ahead, red behind), in one update. The simulation builds both, and
-# every task that needs no base runs; it drives a base only in a home of one, so a task that drives a
-# base, loads its platform or finds its marker is refused before the world is built, naming the bases
-# (docs/simulation.md, "A home with no mobile base"). Its components are not advertised here: a lab's
-# would be (cbrs register), and would be refused alike.
+# platform and colour marker (blue ahead, red behind), in one update. The simulation builds both; a run
+# drives the base its plan works (the device of its drives, the marker colours its locator is given), and
+# a plan that works two, or names none, is refused before anything moves (docs/simulation.md, "A home
+# with no mobile base"). Its components are not advertised here: a lab's would be (cbrs register), and a
+# plan of FetchMyPen, say, that mixed both bases' components would be refused.
 #   cbrs update --file docs/examples/lab6_two_bases.ru
 #   cbrs home                                        (mobile robots: P3DX01, P3DX02; what that allows)
 #   cbrs run RobotArmServeACup --seed 0 --json       (the arms: it runs)
-#   cbrs run FetchMyPen                              (refused before the world is built: which base?)
+#   cbrs run FetchMyPen --seed 0 --json              (P3DX01's components and marker: it drives P3DX01)
 PREFIX home:  <https://w3id.org/cbrs/home#>
 PREFIX owl:   <http://www.w3.org/2002/07/owl#>
 PREFIX rdfs:  <http://www.w3.org/2000/01/rdf-schema#>
