@@ -228,15 +228,7 @@ def _may_act(verb: str = "started") -> None:
     pages (their ``Origin``), or with the update token. Behind ``cbrs serve`` the pages' origins are those of the
     address it binds, never read from the request; a request with no ``Origin`` (not a browser) needs
     the token."""
-    origin = request.headers.get("Origin")
-    own = current_app.extensions.get("cbrs.own_origins")
-    if own is None:  # an app not behind cbrs serve (a test client): the page's own host is all we know
-        if origin is not None and origin.rstrip("/") != request.host_url.rstrip("/"):
-            raise Forbidden(f"a task may be {verb} only from this server's own pages, not from {origin}")
-        return
-    if origin is not None:
-        if origin.rstrip("/") not in own():
-            raise Forbidden(f"a task may be {verb} only from this server's own pages, not from {origin}")
+    if from_own_page(verb):
         return
     if not _has_token():
         config = context.sparql().config
@@ -263,6 +255,24 @@ def _may_act(verb: str = "started") -> None:
             f"a task run moves the robot: it may be {verb} from this server's tasks page, or with the update token "
             "(Authorization: Bearer <token>)"
         )
+
+
+def from_own_page(verb: str) -> bool:
+    """Whether the request comes from one of this server's own pages (its ``Origin`` one of the origins
+    ``cbrs serve`` binds); Forbidden for another site's page, naming it; False for a request with no
+    ``Origin`` (a program, not a browser). An app not behind cbrs serve (a test client) knows only the
+    page's own host, and takes a request with no ``Origin`` for its own."""
+    origin = request.headers.get("Origin")
+    own = current_app.extensions.get("cbrs.own_origins")
+    if own is None:
+        if origin is not None and origin.rstrip("/") != request.host_url.rstrip("/"):
+            raise Forbidden(f"a task may be {verb} only from this server's own pages, not from {origin}")
+        return True
+    if origin is not None:
+        if origin.rstrip("/") not in own():
+            raise Forbidden(f"a task may be {verb} only from this server's own pages, not from {origin}")
+        return True
+    return False
 
 
 def _has_token() -> bool:

@@ -1,0 +1,263 @@
+"""A task written as Turtle text, checked and planned before it is stored, then saved all or nothing.
+
+What the browser's task editor (``/tasks/new``) stands on. A draft is read as ``cbrs load --graph
+requirements FILE`` reads a file: the same parser (:func:`kb.loader.parse_bytes`), its blank nodes named
+as a load names them, and the same check against the SHACL shapes and the declared terms
+(:func:`kb.shapes.check_descriptions`), against the store as it is, with nothing written. Its requirement
+is read from the text alone, each parameter given the part tree the store's ontology has for its class,
+so that it is composed (:meth:`Composer.compose` takes a requirement) as it would be once stored.
+
+Saving is one SPARQL update through the endpoint's own guard (:meth:`SparqlService.update`: the update
+token, read-only servers, the lock, graph:entailed): ``INSERT DATA`` of the draft's quads, after a
+``DELETE DATA`` of the stored task's own description when it replaces one. The update is checked again
+as every update of graph:requirements is, and undone whole if refused.
+
+The text needs no ``@prefix`` lines for the prefixes the store uses: those the text does not declare are
+declared on one line put before it, and the parser's line numbers are given back as the text's own.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, cast
+
+import pyoxigraph as ox
+
+from cbrs.kb.descriptions import DescriptionReader
+from cbrs.kb.errors import KnowledgeBaseError, RdfParseError
+from cbrs.kb.loader import parse_bytes
+from cbrs.kb.model import Requirement
+from cbrs.kb.namespaces import CBRS as CBRS_NS
+from cbrs.kb.namespaces import GENID, RDF, RDFS, REQ, GraphName, shorten
+from cbrs.kb.registry import ComponentRegistry
+from cbrs.kb.resources import ontology_dir
+from cbrs.kb.shapes import DescriptionShapeError, ShapeProblem, check_descriptions
+from cbrs.kb.store import EmbeddedStore, data_block
+from cbrs.kb.vocab import CBRS
+
+if TYPE_CHECKING:
+    from cbrs.actions.composer import Composer, CompositionResult
+    from cbrs.kb import KnowledgeBase
+    from cbrs.sparql_service import SparqlService
+
+__all__ = [
+    "DraftError",
+    "DraftShapeError",
+    "TaskDraft",
+    "TaskExistsError",
+    "example",
+    "line_of",
+    "plan",
+    "read",
+    "save",
+]
+
+SOURCE = "the task"
+"""How errors name the text (it has no file)."""
+BASE = REQ
+"""What a relative IRI of the text (``<#MyTask>``) is resolved against: the requirements' namespace."""
+EXAMPLES_FILE = "requirements.ttl"
+"""The bundled requirements, from which the editor's example is taken."""
+
+
+class DraftError(KnowledgeBaseError):
+    """The text is not one task the editor can check: not Turtle, no requirement, or several. ``line`` is
+    the text's own line when known."""
+
+    http_status = 400
+    kind = "invalid-task"
+
+    def __init__(self, message: str, line: int | None = None, column: int | None = None) -> None:
+        self.line = line
+        self.column = column
+        where = f"line {line}{f', column {column}' if column else ''}: " if line else ""
+        super().__init__(where + message)
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One shape or term problem of a draft: what is wrong, the term (or value) at fault, its line."""
+
+    message: str
+    term: str | None
+    line: int | None
+
+
+class DraftShapeError(DraftError):
+    """The task breaks a shape or names a misspelt term, as a load would refuse it (422: the text is
+    Turtle, its content is not a task the store takes); nothing was written."""
+
+    http_status = 422
+    kind = "invalid-description"
+
+    def __init__(self, error: DescriptionShapeError, problems: Sequence[Problem]) -> None:
+        self.problems = list(problems)
+        self.iri = error.iri
+        first = self.problems[0] if self.problems else None
+        super().__init__(str(error), first.line if first else None)
+
+
+class TaskExistsError(DraftError):
+    """A task of this name is stored already, and the save was not asked to replace it."""
+
+    http_status = 409
+    kind = "task-exists"
+
+    def __init__(self, iri: str) -> None:
+        self.iri = iri
+        super().__init__(
+            f"a task named {shorten(iri)} is stored already: ask to replace it, or give the task another name"
+        )
+
+
+@dataclass(frozen=True)
+class TaskDraft:
+    """A checked task: its text, its IRI, the quads a save writes and the requirement read from them."""
+
+    text: str
+    iri: str
+    quads: tuple[ox.Quad, ...]
+    requirement: Requirement
+    exists: bool  # a task of this name is stored already (saving it replaces that one)
+
+
+def read(kb: KnowledgeBase, text: str, prefixes: Mapping[str, str]) -> TaskDraft:
+    """``text`` parsed and checked as a load into graph:requirements checks a file, against ``kb`` as it
+    is, writing nothing; ``prefixes`` (name → namespace) are declared for it where it does not declare
+    them. :class:`DraftError` (400) for text that is no one task, :class:`DraftShapeError` (422)."""
+    if not text.strip():
+        raise DraftError("the text is empty: write a task (a cbrs:Requirement) in Turtle")
+    head = _declarations(text, prefixes)
+    try:
+        parsed = parse_bytes((head + text).encode("utf-8"), SOURCE, ox.RdfFormat.TURTLE, GraphName.REQUIREMENTS, BASE)
+    except RdfParseError as error:
+        line = error.line - 1 if error.line and head else error.line
+        raise DraftError(error.message, line, error.column) from None
+    iri = _the_requirement(parsed.quads)
+    try:
+        check_descriptions(kb.store, parsed.quads)
+    except DescriptionShapeError as error:
+        raise DraftShapeError(error, [_located(p, text) for p in error.shape_problems]) from None
+    requirement = _requirement(kb, parsed.quads, iri)
+    exists = any(kb.store.quads(ox.NamedNode(iri), ox.NamedNode(RDF + "type"), None, GraphName.REQUIREMENTS.node))
+    return TaskDraft(text, iri, tuple(parsed.quads), requirement, exists)
+
+
+def plan(composer: Composer, draft: TaskDraft) -> CompositionResult:
+    """The draft composed as ``cbrs plan`` composes a stored task (not recorded); call with the store's
+    lock held, as for any composition."""
+    return composer.compose(draft.requirement)
+
+
+def save(sparql: SparqlService, draft: TaskDraft, token: str | None, replace: bool = False) -> int:
+    """Write ``draft`` into graph:requirements in one update with the update ``token``; a stored task of
+    its name is replaced only with ``replace`` (else :class:`TaskExistsError`). Returns the number of
+    triples the stored task had (0 for a new one)."""
+    sparql.check_token(token)  # before anything is read: no answer about the store without the token
+    graph = GraphName.REQUIREMENTS.node
+    with sparql.lock:
+        stored = any(sparql.kb.store.quads(ox.NamedNode(draft.iri), ox.NamedNode(RDF + "type"), None, graph))
+        if stored and not replace:
+            raise TaskExistsError(draft.iri)
+        old = (
+            ComponentRegistry(sparql.kb.store, sparql.kb.standard_terms).owned_quads(draft.iri, graph) if stored else []
+        )
+        new = set(draft.quads)
+        parts = []
+        removing = data_block(q for q in old if q not in new)
+        adding = data_block(q for q in draft.quads if q not in set(old))
+        if removing:
+            parts.append("DELETE DATA {\n" + removing + "}")
+        if adding:
+            parts.append("INSERT DATA {\n" + adding + "}")
+        if parts:
+            sparql.update(" ;\n".join(parts), token)
+    return len(old)
+
+
+def example(name: str, as_name: str | None = None) -> str:
+    """The Turtle of the bundled requirement ``name`` (a local name under ``req:``) as the bundled file
+    writes it, without its ``@prefix`` lines (the editor declares the store's prefixes), named ``as_name``
+    when given (a new task to edit, not the stored one); the file's first requirement when it has none
+    of that name."""
+    text = (ontology_dir() / EXAMPLES_FILE).read_text(encoding="utf-8")
+    blocks = re.findall(r"^(req:(\w+) a cbrs:Requirement ;.*?\.)\s*$", text, re.MULTILINE | re.DOTALL)
+    if not blocks:
+        raise KnowledgeBaseError(f"{EXAMPLES_FILE} holds no requirement written as req:Name a cbrs:Requirement")
+    chosen = next((block for block, local in blocks if local == name), blocks[0][0])
+    if as_name is not None:
+        chosen = re.sub(r"^req:\w+", f"req:{as_name}", chosen)
+    return str(chosen) + "\n"
+
+
+# -- pieces ----------------------------------------------------------------------------------------
+
+_DECLARED = re.compile(r"(?:@prefix|PREFIX)\s+([\w.-]*):", re.IGNORECASE)
+
+
+def _declarations(text: str, prefixes: Mapping[str, str]) -> str:
+    """One line declaring each of ``prefixes`` the text does not declare itself (its own win)."""
+    own = set(_DECLARED.findall(text))
+    declared = [f"@prefix {p}: <{ns}> ." for p, ns in prefixes.items() if p not in own and re.fullmatch(r"[\w.-]*", p)]
+    return " ".join(declared) + "\n" if declared else ""
+
+
+def _the_requirement(quads: Sequence[ox.Quad]) -> str:
+    """The IRI of the one requirement the text describes; a page saves one task at a time."""
+    kinds = (ox.NamedNode(RDF + "type"), ox.NamedNode(CBRS.Requirement))
+    found = sorted(
+        {q.subject.value for q in quads if (q.predicate, q.object) == kinds and isinstance(q.subject, ox.NamedNode)}
+    )
+    named = [iri for iri in found if not iri.startswith(GENID)]
+    if not found:
+        raise DraftError(
+            "the text describes no task: a task is a cbrs:Requirement (req:MyTask a cbrs:Requirement ; ...)"
+        )
+    if len(named) != len(found):
+        raise DraftError("the task has no name: give the cbrs:Requirement an IRI (req:MyTask), not a blank node")
+    if len(found) > 1:
+        raise DraftError(
+            f"the text describes {len(found)} tasks ({', '.join(shorten(i) for i in found)}): save one at a time"
+        )
+    return found[0]
+
+
+def _requirement(kb: KnowledgeBase, quads: Sequence[ox.Quad], iri: str) -> Requirement:
+    """The requirement as the store would read it: from the draft's quads alone, each parameter with the
+    part tree of its class in ``kb``'s ontology."""
+    scratch = EmbeddedStore(ox.Store(), ":memory:")
+    # the reader's queries find descriptions by their class (rdfs:subClassOf* cbrs:ServiceDescription)
+    core = ox.NamedNode(RDFS + "subClassOf")
+    classes = [q for q in kb.store.quads(None, core, None) if str(q.subject).startswith(f"<{CBRS_NS}")]
+    scratch.add([*quads, *classes])
+    found = cast(Requirement, DescriptionReader(scratch, kb.queries).read(iri))
+    inputs = tuple(dataclasses.replace(p, tree=kb.part_tree(p.type)) for p in found.inputs)
+    outputs = tuple(dataclasses.replace(p, tree=kb.part_tree(p.type)) for p in found.outputs)
+    return dataclasses.replace(found, inputs=inputs, outputs=outputs)
+
+
+_NAMED = re.compile(r"(?<![\w<])([A-Za-z][\w.-]*:[\w.-]*\w)|<([^>\s]+)>")
+
+
+def _located(problem: ShapeProblem, text: str) -> Problem:
+    """``problem`` with the term it is about (its value, else the first name its message gives) and the
+    first line of ``text`` that writes that term; else the line that names the task."""
+    terms = [problem.value] if problem.value is not None else []
+    terms += [a or b for a, b in _NAMED.findall(problem.message)]
+    for term in terms:
+        line = line_of(text, term)
+        if line is not None:
+            return Problem(problem.text(), term, line)
+    return Problem(problem.text(), terms[0] if terms else None, line_of(text, shorten(problem.description)))
+
+
+def line_of(text: str, term: str) -> int | None:
+    """The first line of ``text`` that writes ``term`` (a prefixed name, ``<IRI>`` or a literal) as a whole."""
+    pattern = re.compile(rf"(?<![\w:-]){re.escape(term)}(?![\w-])")
+    for number, line in enumerate(text.splitlines(), start=1):
+        if pattern.search(line):
+            return number
+    return None
