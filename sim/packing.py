@@ -2,11 +2,12 @@
 refusal before the run of a place that cannot hold them all.
 
 A carry used to set its object down at the place's spot nearest the centre (:func:`place_spots`), so a
-small eraser put first in the middle of a 40 x 40 cm shelf left no spot for the 16 cm pen the plan put
+small eraser put first in the middle of a 40 x 40 cm shelf left no spot for the 14 cm pen the plan put
 there next, and the run failed after the first thing had moved (docs/tasks.md, "A sixth round"). The
-footprints (the circles :func:`place_spots` keeps apart) are packed on the place's spots before the
-first set-down, largest first, each at the spot its :class:`PackingRule` prefers; the carry then aims at
-its own object's spot in that packing, and the checks before the run refuse a place no rule packs.
+footprints (the circles :func:`place_spots` keeps apart) are packed on the place's spots by a small
+exact search (:func:`arrange`): a carry sets its object down at the spot nearest the centre, as for one
+thing alone, among those that leave room for the things the plan puts there after it, and the checks
+before the run refuse a place on which no arrangement holds them all.
 docs/simulation.md, "Several things onto one place", gives the reasoning.
 """
 
@@ -28,6 +29,7 @@ from cbrs.sim.grounding import task_inputs_of
 from cbrs.sim.perceived import PerceivedWorld
 from cbrs.sim.place_spots import RELAY_CLEARANCE, RELAY_EDGE, RELAY_MARGIN, RELAY_STEP, other_objects, place_spots
 from cbrs.sim.relations import region_of
+from cbrs.sim.relay import RELAY_TRIES
 from cbrs.sim.world import HomeWorld
 
 log = logging.getLogger("cbrs.sim")
@@ -199,6 +201,16 @@ def arrange(
     return [chosen[n] for n in range(len(sizes))] if place_from(0) else None
 
 
+SET_DOWN_SLACK = 0.02
+"""How far a thing may come to rest from the spot it is set down at while the later things still fit: a
+spot is taken as leaving room when they fit beside its footprint grown by this much (a set-down is
+accurate to a centimetre or so), else, when no spot does, beside the footprint itself."""
+
+SPOT_BUDGET = 20_000
+"""The comparisons :func:`arrange` may make for one spot asked whether it leaves room (PACK_BUDGET is
+for one whole place); a spot undecided within it is taken as leaving none."""
+
+
 def set_down_spots(
     smap: SemanticMap,
     place: Thing,
@@ -208,18 +220,30 @@ def set_down_spots(
     later: Sequence[Size] = (),
     rule: PackingRule = PackingRule(),
 ) -> tuple[Region, list[Spot]]:
-    """The surface and spots of :func:`place_spots` for an object set down on ``place`` when the plan puts the objects
-    of ``later`` (sizes) there after it: nearest first to its own spot in the first packing of them all
-    by ``rule`` (:func:`pack`), so that the rest still fit; as :func:`place_spots` orders them when nothing comes
-    after it or no rule packs them all (the run goes on, and the later carry says what is in its way)."""
+    """The surface and spots of :func:`place_spots` for an object set down on ``place``, when the plan puts
+    the objects of ``later`` (sizes) there after it: first those that leave room for them all (some
+    arrangement of theirs, :func:`arrange`, fits beside it, with SET_DOWN_SLACK), nearest the centre first
+    as for one thing alone, up to RELAY_TRIES of them (as many as the carry asks the arm about), then the
+    rest. As :func:`place_spots` orders them when nothing comes after it or no spot leaves room (the run
+    goes on, and the later carry says what is in its way)."""
     surface, spots = place_spots(smap, place, size, mounts, others)
     if not later or not spots:
         return surface, spots
-    packed = pack(smap, place, [size, *later], mounts, others, rule)
-    if packed is None:
-        return surface, spots
-    sx, sy = packed[0]
-    return surface, sorted(spots, key=lambda spot: math.hypot(spot[0] - sx, spot[1] - sy))
+    radius = radius_of(size)
+    for slack in (SET_DOWN_SLACK, 0.0):
+        keeping: list[Spot] = []
+        for x, y in spots:
+            try:
+                grown = [*others, (x, y, radius + slack)]
+                if arrange(smap, place, later, mounts, grown, rule, SPOT_BUDGET) is not None:
+                    keeping.append((x, y))
+            except Undecided:
+                continue
+            if len(keeping) == RELAY_TRIES:
+                break
+        if keeping:
+            return surface, [*keeping, *(spot for spot in spots if spot not in keeping)]
+    return surface, spots
 
 
 def puts_down(

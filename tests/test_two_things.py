@@ -19,6 +19,7 @@ from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap, Thing
 from cbrs.sim.components import SimEnvironment
 from cbrs.sim.packing import (
+    SET_DOWN_SLACK,
     PackingRule,
     PlaceOverfilledError,
     Undecided,
@@ -103,8 +104,11 @@ def test_the_eraser_at_the_centre_left_no_spot_for_the_pen_and_its_packed_spot_l
     assert pen_after_centre == []  # the trial's failure: nearest the centre first
     _, packed = set_down_spots(smap, shelf, eraser, mounts, [], [pen])
     assert sorted(packed) == sorted(alone)  # the same spots, another order
-    _, pen_after_packed = place_spots(smap, shelf, pen, mounts, [(*packed[0], radius_of(eraser))])
-    assert pen_after_packed
+    # the first spot, nearest the centre, where the pen still has one if the eraser comes to rest 2 cm off
+    grown = radius_of(eraser) + SET_DOWN_SLACK
+    assert place_spots(smap, shelf, pen, mounts, [(*packed[0], grown)])[1]
+    for x, y in alone[: alone.index(packed[0])]:
+        assert not place_spots(smap, shelf, pen, mounts, [(x, y, grown)])[1]
     # nothing after it: as one thing alone is set down
     assert set_down_spots(smap, shelf, pen, mounts, [], []) == place_spots(smap, shelf, pen, mounts, [])
 
