@@ -12,7 +12,6 @@ import importlib
 import secrets
 import threading
 from collections.abc import Callable, Collection, Sequence
-from contextlib import ExitStack
 from typing import Any
 from urllib.parse import urlsplit
 
@@ -20,13 +19,11 @@ from flask import Flask, Response, g, jsonify, make_response, render_template, r
 from werkzeug.exceptions import HTTPException, MisdirectedRequest
 
 from cbrs import __version__
-from cbrs.kb.derived_prefixes import StoreNames
 from cbrs.kb.errors import KnowledgeBaseError, without_password
-from cbrs.kb.namespaces import store_names
 from cbrs.matchmakers import Matchmakers
 from cbrs.sparql_service import SparqlService
 from cbrs.tasks import TaskRunner
-from cbrs.web import context, links, warmup
+from cbrs.web import links, warmup
 from cbrs.web.context import EventLog, StreamSlots
 from cbrs.web.pages import error_page, http_error_message, keep_error_headers, wants_json
 from cbrs.web.sparql_wsgi import SparqlHotPath
@@ -149,20 +146,6 @@ def create_app(
         return request.blueprint in page_blueprints and not wants_json()  # a .json twin, or JSON negotiated
 
     @app.before_request
-    def derived_names() -> None:
-        # the library's texts made for this request (a shapes error, a plan's reasons) name the store's own
-        # namespaces by their derived prefixes, as the pages and the CLI do (docs/web.md)
-        names = ExitStack()
-        names.enter_context(store_names(_ShortenOnly(context.kb)))
-        g.cbrs_store_names = names
-
-    @app.teardown_request
-    def derived_names_done(_: BaseException | None) -> None:
-        names = g.pop("cbrs_store_names", None)
-        if names is not None:
-            names.close()
-
-    @app.before_request
     def first_page() -> None:
         if as_page():  # a person is browsing: import what the next pages need (cbrs.web.warmup)
             warmup.preload_once(app)
@@ -224,18 +207,6 @@ def create_app(
         return response
 
     return app
-
-
-class _ShortenOnly(StoreNames):
-    """The store's derived prefixes for the library's texts alone: the pages read the names they are given
-    by their own table (cbrs.web.prefixes), as before."""
-
-    @property
-    def prefixes(self) -> dict[str, str]:
-        return {}
-
-    def namespace_of(self, prefix: str) -> str | None:
-        return None
 
 
 def _error(kind: str, message: str, **extra: Any) -> Response:
