@@ -31,7 +31,7 @@ from cbrs.kb.errors import KnowledgeBaseError, RdfParseError
 from cbrs.kb.loader import parse_bytes
 from cbrs.kb.model import Requirement
 from cbrs.kb.namespaces import CBRS as CBRS_NS
-from cbrs.kb.namespaces import GENID, RDF, RDFS, REQ, GraphName, shorten
+from cbrs.kb.namespaces import GENID, RDF, RDFS, REQ, GraphName, near_prefixes, shorten
 from cbrs.kb.registry import ComponentRegistry
 from cbrs.kb.resources import ontology_dir
 from cbrs.kb.shapes import DescriptionShapeError, ShapeProblem, check_descriptions
@@ -135,7 +135,7 @@ def read(kb: KnowledgeBase, text: str, prefixes: Mapping[str, str]) -> TaskDraft
         parsed = parse_bytes((head + text).encode("utf-8"), SOURCE, ox.RdfFormat.TURTLE, GraphName.REQUIREMENTS, BASE)
     except RdfParseError as error:
         line = error.line - 1 if error.line and head else error.line
-        raise DraftError(error.message, line, error.column) from None
+        raise DraftError(error.message + _prefix_hint(error.message), line, error.column) from None
     iri = _the_requirement(parsed.quads)
     try:
         check_descriptions(kb.store, parsed.quads)
@@ -203,6 +203,20 @@ def _declarations(text: str, prefixes: Mapping[str, str]) -> str:
     own = set(_DECLARED.findall(text))
     declared = [f"@prefix {p}: <{ns}> ." for p, ns in prefixes.items() if p not in own and re.fullmatch(r"[\w.-]*", p)]
     return " ".join(declared) + "\n" if declared else ""
+
+
+_UNDECLARED = re.compile(r"The prefix ([\w.-]*): has not been declared")
+"""Oxigraph's Turtle parser's words for a prefix used and not declared."""
+
+
+def _prefix_hint(message: str) -> str:
+    """For a prefix neither the text nor the store declares: the store's prefixes nearest it (hme: for home:)."""
+    found = _UNDECLARED.search(message)
+    if found is None:
+        return ""
+    near = near_prefixes(found.group(1))
+    meant = f"did you mean {' or '.join(p + ':' for p in near)}? " if near else ""
+    return f"; {meant}(declare a prefix of your own with @prefix {found.group(1)}: <IRI> .)"
 
 
 def _the_requirement(quads: Sequence[ox.Quad]) -> str:
