@@ -189,6 +189,42 @@ def test_plans_page_shows_the_plan_and_draws_the_graph(page: Any, shots: Path) -
     snap(page, shots, "plans")
 
 
+def test_a_task_written_on_the_editor_is_checked_and_planned_from_the_keyboard(
+    browser: Any, server: Server, shots: Path
+) -> None:
+    """The task editor (/tasks/new) at a phone's width: its bundled example checked with Ctrl+Enter from the
+    text area shows its plan, and nothing scrolls sideways at 390 px."""
+    for width, name in ((1280, "task_editor"), (390, "task_editor-narrow")):
+        context = browser.new_context(
+            base_url=f"http://127.0.0.1:{server.http_port}", viewport={"width": width, "height": 860}
+        )
+        context.set_default_timeout(WAIT_MS)
+        opened = context.new_page()
+        errors: list[str] = []
+        opened.on("pageerror", lambda error, errors=errors: errors.append(str(error)))
+        try:
+            opened.goto("/tasks")
+            opened.locator("#new-task").click()
+            opened.wait_for_url("**/tasks/new")
+            opened.get_by_label("Task in Turtle").focus()
+            opened.keyboard.press("Control+Enter")
+            opened.wait_for_url("**/tasks/new")
+            playwright_api.expect(opened.locator(".badge.good")).to_have_text("planned")
+            assert opened.locator("tr[id^=step-]").count() >= 1
+            assert opened.evaluate("document.documentElement.scrollWidth") <= width
+            drawing = opened.locator("img.drawing")
+            drawing.scroll_into_view_if_needed()
+            for _ in range(300):  # bounded: 30 s for the SVG to arrive and decode
+                if drawing.evaluate("image => image.complete"):
+                    break
+                opened.wait_for_timeout(100)
+            assert drawing.evaluate("image => image.naturalWidth") > 0  # the draft's drawing, kept for it
+            snap(opened, shots, name)
+        finally:
+            context.close()
+        assert errors == [], f"JavaScript errors on the page: {errors}"
+
+
 NARROW_PAGES = (
     "/",
     "/taxonomy",
