@@ -252,3 +252,36 @@ def test_the_json_twin_is_negotiated_and_refuses_an_unknown_field(served: tuple[
     assert unknown.status_code == 400 and "did you mean 'turtle'?" in unknown.get_json()["fields"]["turtel"]
     action = client.post("/tasks/new.json", json={"turtle": PENCIL, "action": "run"})
     assert action.status_code == 400 and "'run' is not check or save" in action.get_json()["fields"]["action"]
+
+
+REFERENCES = re.compile(r'(?:for|aria-describedby|aria-labelledby)="([^"]+)"')
+
+
+@pytest.mark.parametrize(
+    ("form", "status"),
+    [
+        pytest.param(None, 200, id="start"),
+        pytest.param({"turtle": PENCIL, "action": "check"}, 200, id="planned"),
+        pytest.param(
+            {"turtle": PENCIL.replace("home:Pencil ;", "home:Frisbee ;"), "action": "check"}, 200, id="no-plan"
+        ),
+        pytest.param({"turtle": PENCIL.replace("home:isWith", "home:isWit"), "action": "check"}, 422, id="shape"),
+        pytest.param({"turtle": PENCIL, "action": "save", "token": "not-it"}, 403, id="token"),
+    ],
+)
+def test_every_state_of_the_page_has_labelled_fields_and_references_that_resolve(
+    served: tuple[FlaskClient, KnowledgeBase], form: dict[str, str] | None, status: int
+) -> None:
+    client, _ = served
+    answer = client.get("/tasks/new") if form is None else client.post("/tasks/new", data=form)
+    assert answer.status_code == status
+    page = answer.get_data(as_text=True)
+    ids = re.findall(r'\sid="([^"]+)"', page)
+    assert len(ids) == len(set(ids))
+    assert [name for found in REFERENCES.findall(page) for name in found.split() if name not in ids] == []
+    assert [name for name in re.findall(r'href="#([^"]+)"', page) if name not in ids] == []
+    for field in re.findall(r"<(?:input|select|textarea)\b[^>]*>", page):
+        named = re.search(r'\sid="([^"]+)"', field)
+        assert named is not None and f'for="{named.group(1)}"' in page, field
+    assert '<script src="/static/task_editor.js" defer></script>' in page  # our own script, no CDN
+    assert client.get("/static/task_editor.js").status_code == 200
