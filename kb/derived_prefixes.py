@@ -44,7 +44,7 @@ if TYPE_CHECKING:
     from cbrs.kb import KnowledgeBase
     from cbrs.kb.store import Store
 
-__all__ = ["CACHE_FILE", "StoreNames", "derive", "for_store", "name_for", "namespace", "read"]
+__all__ = ["CACHE_FILE", "StoreNames", "derive", "for_store", "name_for", "namespace", "namespaces_in", "read"]
 
 # Every term the store holds, in any position (graph names are the cbrs graph: prefixes). The IRIs are
 # picked out here: with FILTER(isIRI(?t)) the query took 2.9 s on OWLS-TC, without it 1.2 s.
@@ -115,17 +115,22 @@ def derive(namespaces: Iterable[str], declared: Mapping[str, str] = PREFIXES) ->
 
 def read(kb: KnowledgeBase) -> dict[str, str]:
     """The derived prefixes of the namespaces of every IRI in ``kb``'s store, read now."""
+    return derive(namespaces_in(kb.store))
+
+
+def namespaces_in(store: Store) -> set[str]:
+    """The namespaces of every IRI ``store`` holds (each term read: :func:`for_store` keeps the table)."""
     found = set()
-    solutions = kb.query(_TERMS)
+    solutions = store.query(_TERMS)
     if not isinstance(solutions, ox.QuerySolutions):  # a SELECT's answer always is
-        return {}
+        return set()
     for row in solutions:
         term = row[0]
         if isinstance(term, ox.NamedNode):
             ns = namespace(term.value)
             if ns is not None:
                 found.add(ns)
-    return derive(found)
+    return found
 
 
 _kept: weakref.WeakKeyDictionary[Store, tuple[int, dict[str, str]]] = weakref.WeakKeyDictionary()

@@ -113,6 +113,11 @@ def store_names(names: StoreNames | None) -> Iterator[None]:
         _store_names.reset(token)
 
 
+def active_store_names() -> StoreNames | None:
+    """The names :func:`store_names` set for the current block (None: none set, the table's alone)."""
+    return _store_names.get()
+
+
 def expand(name: str) -> str:
     """Expand ``prefix:local`` with the prefix table (and the store's derived prefixes within
     :func:`store_names`); absolute IRIs pass through unchanged.
