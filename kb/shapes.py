@@ -25,7 +25,7 @@ import functools
 import logging
 import re
 from collections.abc import Iterable, Iterator, Sequence
-from contextlib import contextmanager
+from contextlib import AbstractContextManager, contextmanager, nullcontext
 from dataclasses import dataclass
 from decimal import Decimal
 from pathlib import Path
@@ -33,8 +33,9 @@ from typing import TYPE_CHECKING, Any
 
 import pyoxigraph as ox
 
+from cbrs.kb import derived_prefixes
 from cbrs.kb.errors import InvalidDescriptionError
-from cbrs.kb.namespaces import GENID, OWL, RDF, RDFS, XSD, GraphName, shorten
+from cbrs.kb.namespaces import GENID, OWL, RDF, RDFS, XSD, GraphName, active_store_names, shorten, store_names
 from cbrs.kb.queries import QueryLibrary
 from cbrs.kb.resources import ontology_dir, query_dir
 from cbrs.kb.skolem import closure, is_skolem, quads_by_subject
@@ -105,6 +106,46 @@ class DescriptionShapeError(InvalidDescriptionError):
 # -- the ways in -----------------------------------------------------------------------------------
 
 
+class _DerivedNames:
+    """The prefixes derived for the store's namespaces and the input's (:mod:`cbrs.kb.derived_prefixes`),
+    read when a message first names an IRI no declared prefix covers: a problem names ``lab6:TidyShelf``
+    as ``cbrs`` prints it and the pages show it, not the whole IRI, wherever the library is called from
+    (a Graph Store request, Python); a caller that set names of its own (the CLI) keeps them."""
+
+    def __init__(self, store: Store, quads: Iterable[ox.Quad]) -> None:
+        self._store = store
+        self._quads = quads
+        self._table: dict[str, str] | None = None
+
+    @property
+    def prefixes(self) -> dict[str, str]:
+        if self._table is None:
+            found = derived_prefixes.namespaces_in(self._store)
+            for quad in self._quads:
+                for term in (quad.subject, quad.predicate, quad.object):
+                    if isinstance(term, ox.NamedNode) and (ns := derived_prefixes.namespace(term.value)) is not None:
+                        found.add(ns)
+            self._table = derived_prefixes.derive(found)
+        return self._table
+
+    def shorten(self, iri: str) -> str | None:
+        ns = derived_prefixes.namespace(iri)
+        prefix = next((p for p, n in self.prefixes.items() if n == ns), None) if ns is not None else None
+        local = iri[len(ns) :] if ns is not None else ""
+        if prefix is None or not local or not all(ch.isalnum() or ch in "_-." for ch in local):
+            return None
+        return f"{prefix}:{local}"
+
+    def namespace_of(self, prefix: str) -> str | None:
+        return self.prefixes.get(prefix)
+
+
+def _names(store: Store, quads: Iterable[ox.Quad]) -> AbstractContextManager[None]:
+    """Within the block, problems name IRIs by the derived prefixes (:class:`_DerivedNames`), unless the
+    caller set names of its own."""
+    return nullcontext() if active_store_names() is not None else store_names(_DerivedNames(store, quads))
+
+
 def check_descriptions(store: Store, quads: Iterable[ox.Quad], terms: bool = True) -> None:
     """Raise :class:`DescriptionShapeError` when a description among ``quads`` breaks a shape or (with
     ``terms``) names a class or property declared neither in ``store`` nor in ``quads``."""
@@ -112,9 +153,10 @@ def check_descriptions(store: Store, quads: Iterable[ox.Quad], terms: bool = Tru
     closures = _closures(incoming)
     if not closures:
         return
-    problems = _shape_problems(closures)
-    if terms:
-        problems += _term_problems(store, closures, incoming)
+    with _names(store, incoming):
+        problems = _shape_problems(closures)
+        if terms:
+            problems += _term_problems(store, closures, incoming)
     if problems:
         raise DescriptionShapeError(problems)
 
@@ -227,7 +269,8 @@ def line_of(source: str, iri: str) -> int | None:
 
 def _check_with_context(store: Store, quads: list[ox.Quad], context: list[ox.Quad]) -> None:
     closures = _closures(quads)
-    problems = _shape_problems(closures) + _term_problems(store, closures, context)
+    with _names(store, context):
+        problems = _shape_problems(closures) + _term_problems(store, closures, context)
     if problems:
         raise DescriptionShapeError(problems)
 
@@ -256,7 +299,8 @@ def checked_update(store: Store, whole: bool = False) -> Iterator[None]:
     closures = _closures(after)
     changed = {q.subject for q in (*added, *removed)}
     touched = {root: quads for root, quads in closures.items() if changed & {q.subject for q in quads}}
-    problems = _shape_problems(touched) + _term_problems(store, touched, [])
+    with _names(store, added):
+        problems = _shape_problems(touched) + _term_problems(store, touched, [])
     if problems:
         if everything is not None:
             now = set(store.quads())
