@@ -209,7 +209,8 @@ def test_a_task_written_on_the_editor_is_checked_and_planned_from_the_keyboard(
             opened.get_by_label("Task in Turtle").focus()
             opened.keyboard.press("Control+Enter")
             opened.wait_for_url("**/tasks/new")
-            playwright_api.expect(opened.locator(".badge.good")).to_have_text("planned", timeout=30_000)  # composed cold
+            badge = opened.locator(".badge.good")
+            playwright_api.expect(badge).to_have_text("planned", timeout=30_000)  # composed cold, on a loaded machine
             assert opened.locator("tr[id^=step-]").count() >= 1
             assert opened.evaluate("document.documentElement.scrollWidth") <= width
             drawing = opened.locator("img.drawing")
