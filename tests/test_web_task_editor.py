@@ -285,3 +285,11 @@ def test_every_state_of_the_page_has_labelled_fields_and_references_that_resolve
         assert named is not None and f'for="{named.group(1)}"' in page, field
     assert '<script src="/static/task_editor.js" defer></script>' in page  # our own script, no CDN
     assert client.get("/static/task_editor.js").status_code == 200
+
+
+def test_the_page_leads_to_the_line_that_does_not_parse(served: tuple[FlaskClient, KnowledgeBase]) -> None:
+    client, _ = served
+    broken = PENCIL.replace('cbrs:deviceName "P3DX01" ;', 'cbrs:deviceName "P3DX01" ;;; ]')
+    page = client.post("/tasks/new", data={"turtle": broken, "action": "check"})
+    line = _line(broken, ";;; ]")
+    assert page.status_code == 400 and f'data-line="{line}">Go to line {line}</a>' in page.get_data(as_text=True)
