@@ -65,6 +65,7 @@ if TYPE_CHECKING:
 from cbrs.reasoner.taxonomy import TaxonomyIndex
 
 MAX_DEPTH = 4  # how many levels of sub-actions a task may be decomposed into
+NEAR_MISS_NEEDS = 8  # how many needs of an unmet need's chain a "no plan" answer looks for near misses at
 
 _AT_OR_BELOW = frozenset({Degree.EXACT, Degree.SUBCLASS_OF})
 """Degrees at which a fact is as specific as a goal, side by side (a subclass, a subproperty)."""
@@ -714,12 +715,16 @@ class Composer:
             named = {c for c, _ in (*u.out_of_area, *u.unrunnable)}  # (what they provide about it: said again)
             refused = partial(_refused, self.area_rule(attempt.requirement), graph)
             found: list[NearMiss] = []
-            # the need reported, then each need above it, nearest first
-            for consumer, text in ((u.consumer, u.need), *reversed(u.along)):
+            # the need reported, the requirement's own, then those between, nearest first: a chain can be
+            # thousands of needs long, so at most NEAR_MISS_NEEDS of them are asked
+            above = [*u.along[:1], *reversed(u.along[1:])]
+            for consumer, text in [(u.consumer, u.need), *above][:NEAR_MISS_NEEDS]:
                 wanted = need if consumer == u.consumer and text == u.need else None
                 wanted = wanted or next((n for n in graph.needs(consumer) if n.text() == text), None)
                 room = min(self.config.near_misses, self.config.near_misses_total - len(found))
-                if wanted is None or room <= 0:
+                if room <= 0:
+                    break
+                if wanted is None:
                     continue
                 skip = named | {m.component for m in found}
                 more = near_misses(graph, consumer, wanted, attempt.trace.enabled, refused, skip, room)
