@@ -21,7 +21,8 @@ from tests.helpers_examples import EXAMPLES
 
 HOME, SVC = PREFIXES["home"], PREFIXES["svc"]
 PICK_UP = SVC + "PickUpObject_CytonDualArm01"  # deletes (PhysicalObject, isLocated, Place)
-OFF_A_PLACE = Statement(HOME + "Pen", HOME + "isLocatedOn", HOME + "ObjectPlace")
+# the pen off the table's top (world:KitchenTableTop, a home:TableTop: a region, so a place the pick-up deletes)
+OFF_THE_TOP = Statement(HOME + "Pen", HOME + "isLocatedOn", HOME + "TableTop")
 
 
 @pytest.fixture(scope="module")
@@ -36,18 +37,18 @@ def composer() -> Composer:
 def test_a_delete_effect_beside_an_effect_is_met_by_the_pick_up_already_planned(composer: Composer) -> None:
     task = composer.task("ClearPenOffTheTable")
     alone = composer.compose(replace(task.requirement, deletes=())).plan
-    result = composer.compose(replace(task.requirement, deletes=(OFF_A_PLACE,)))
+    result = composer.compose(replace(task.requirement, deletes=(OFF_THE_TOP,)))
     both = result.plan
     assert alone is not None and both is not None
     assert both.components() == alone.components()  # no second pick-up: the carry's own deletes it
     deletion = [g for g in both.goals if g.role == "deletion"]
-    assert [(g.statement, both.step(g.source.step or 0).component) for g in deletion] == [(OFF_A_PLACE, PICK_UP)]
-    assert "not (home:Pen, home:isLocatedOn, home:ObjectPlace) <- #" in plan_text(result)
+    assert [(g.statement, both.step(g.source.step or 0).component) for g in deletion] == [(OFF_THE_TOP, PICK_UP)]
+    assert "not (home:Pen, home:isLocatedOn, home:TableTop) <- #6" in plan_text(result)
 
 
 def test_a_delete_effect_alone_is_planned_for(composer: Composer) -> None:
     task = composer.task("PenNotOnTheTable")
-    plan = composer.attempt(replace(task.requirement, deletes=(OFF_A_PLACE,)), task).plan
+    plan = composer.attempt(replace(task.requirement, deletes=(OFF_THE_TOP,)), task).plan
     assert plan is not None and plan.components()[-1] == PICK_UP
     assert [g.role for g in plan.goals] == ["deletion"]
 
@@ -79,11 +80,11 @@ class _World:
 
 def test_the_check_after_the_run_asks_that_a_deleted_statement_no_longer_holds(composer: Composer) -> None:
     task = composer.task("ClearPenOffTheTable")
-    plan = composer.compose(replace(task.requirement, deletes=(OFF_A_PLACE,))).plan
+    plan = composer.compose(replace(task.requirement, deletes=(OFF_THE_TOP,))).plan
     assert isinstance(plan, Plan)
     checks = {c.deleted: c for c in _check_goals(_World(True, True), plan, {})}  # type: ignore[arg-type]
     assert (checks[False].believed, checks[False].holds) == (True, True)
-    assert (checks[True].believed, checks[True].holds) == (False, False)  # the pen is still on an object place
-    assert checks[True].to_dict()["statement"] == "not (home:Pen, home:isLocatedOn, home:ObjectPlace)"
+    assert (checks[True].believed, checks[True].holds) == (False, False)  # the pen is still on a table top
+    assert checks[True].to_dict()["statement"] == "not (home:Pen, home:isLocatedOn, home:TableTop)"
     gone = {c.deleted: c for c in _check_goals(_World(False, None), plan, {})}  # type: ignore[arg-type]
     assert (gone[True].believed, gone[True].holds) == (True, None)
