@@ -203,17 +203,23 @@ def _meets_appliance(ctx: SimContext, estimate: ObjectEstimate, model: ObjectMod
                 grasp = grasp_pose_for(ctx, estimate, side, held)
             except SimulationError:
                 continue
-            gx, gy, gz = grasp.position
-            start = (gx, gy, gz + skills.LIFT_HEIGHT)
             for at in spots[:RELAY_TRIES]:
-                spot = spot_region(surface, *at)
-                cx, cy, _ = spot.center
-                above = spot.zmin + skills.ABOVE_CLEARANCE
-                floor = floor_to(ctx, held, side, start, spot)
-                bottom = max(start[2] - grasp.bottom_offset, above, -math.inf if floor is None else floor)
-                if skills.held_meeting(fixtures, grasp, start, (cx, cy, above + grasp.bottom_offset), bottom):
+                if _held_meets_at(ctx, side, grasp, spot_region(surface, *at), fixtures):
                     return True
     return False
+
+
+def _held_meets_at(ctx: SimContext, side: ArmSide, grasp: GraspPose, spot: Region, fixtures: Sequence[Region]) -> bool:
+    """Whether the object held by ``grasp``, lifted as the pick-up leaves it and carried over ``spot`` at the
+    floor the carry keeps (:func:`floor_to`), would meet one of ``fixtures`` (:func:`skills.held_meeting`):
+    the map's answer to what the carry's dry run refuses first (:func:`skills.plan_carry`), without it."""
+    gx, gy, gz = grasp.position
+    start = (gx, gy, gz + skills.LIFT_HEIGHT)
+    cx, cy, _ = spot.center
+    above = spot.zmin + skills.ABOVE_CLEARANCE
+    floor = floor_to(ctx, grasp.model, side, start, spot)
+    bottom = max(start[2] - grasp.bottom_offset, above, -math.inf if floor is None else floor)
+    return skills.held_meeting(fixtures, grasp, start, (cx, cy, above + grasp.bottom_offset), bottom) is not None
 
 
 def _fitting(ctx: SimContext, model: ObjectModel, sides: Sequence[ArmSide]) -> str:
@@ -297,18 +303,28 @@ def _taking_to(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, si
         for held in both.models:
 
             def others(since: int, held: ObjectModel = held) -> Iterator[Region]:  # the next it can let go over
+                # and carry to without the object held meeting an appliance, by the map (no dry run spent)
                 regions = (spot_region(surface, *at) for at in spots[since:RELAY_TRIES])
-                return (spot for spot in regions if not skills.can_set_down(world, estimate, side, held, spot))
+                fixtures = skills.appliances(world)
+                try:
+                    grasp = grasp_pose_for(ctx, estimate, side, held) if fixtures else None
+                except SimulationError:
+                    grasp = None
+                return (
+                    spot
+                    for spot in regions
+                    if not skills.can_set_down(world, estimate, side, held, spot)
+                    and (grasp is None or not _held_meets_at(ctx, side, grasp, spot, fixtures))
+                )
 
             found = _clear_spot(
                 ctx, side, first[held.grasp], functools.partial(others, after[held.grasp]), (estimate, held)
             )
-            if isinstance(found, Region):
-                first[held.grasp] = found
+            first[held.grasp] = found.spot
+            if not (found.refused or found.unclear):
                 return _Taking(Candidates([held], passed).choice(side, held, purpose), True)
-            refused, unclear = found
-            refusals[held.grasp] = refused
-            passed.append((held.grasp, unclear))
+            refusals[held.grasp] = found.refused
+            passed.append((held.grasp, found.unclear or found.refused))
         try:
             served = first_clear(both, side, purpose, lambda held: refusals[held.grasp], first)
         except MovesRefusedError as moves:
@@ -381,21 +397,29 @@ def holdable_spot(
 ) -> tuple[float, float] | None:
     """Of ``spots`` (the first RELAY_TRIES) where the arm's hand, as it holds the object now, can let it go
     on the surface (asked of the inverse kinematics), the first whose carry keeps clear of the appliances
-    (:func:`carry_clear`), else the first; the first spot if it holds nothing. Before, the first spot the
-    hand could hold was taken, and a jar carried at the height it was lifted off a rack to the table's
-    spot beside the dispenser met the tap's lever and the spout and stopped 1.5-2 cm short."""
+    (:func:`carry_clear`), else the first whose carry the arm's planning would make, though coming near
+    (a carry the held object's check refuses, :func:`skills.held_meets`, is not taken while another is
+    not), else the first; the first spot if it holds nothing. Before, the first spot the hand could hold
+    was taken, and a jar carried at the height it was lifted off a rack to the table's spot beside the
+    dispenser met the tap's lever and the spout and stopped 1.5-2 cm short."""
     arm = ctx.world.arm(side)
     grasp = arm.held_grasp
     if grasp is None:
         return spots[0] if spots else None
     orientation = arm.ee_pose().orientation
     first: tuple[float, float] | None = None
+    unrefused: tuple[float, float] | None = None  # the first whose carry the planning makes, though near
     for x, y in spots[:RELAY_TRIES]:
         if arm.can_hold((x, y, surface.zmin + skills.PLACE_CLEARANCE + grasp.bottom_offset), orientation):
-            if not carry_clear(ctx, side, spot_region(surface, x, y)):
+            why, brushed = carry_check(ctx, side, spot_region(surface, x, y))
+            if not why:
                 return (x, y)
+            if why == brushed:  # only near, not refused (a held carry's check gives near as refused too)
+                unrefused = unrefused or (x, y)
             first = first or (x, y)
-    return first  # no carry there keeps clear (a cup carried below the tap, which it aims at): as before
+    # no carry there keeps clear (a cup carried below the tap, which it aims at): the first the planning
+    # makes, else the first, as before
+    return unrefused or first
 
 
 def carry_clear(
@@ -509,30 +533,48 @@ def floor_advice(ctx: SimContext, side: ArmSide, spot: Region, seen: ObjectEstim
     )
 
 
+class _Found(NamedTuple):
+    """The spot a take's carry aims at (:func:`_clear_spot`), why the arm's planning would refuse the take
+    and carry there (empty: it would make them) and why they would not keep CARRY_CLEARANCE from the
+    appliances (empty: they would)."""
+
+    spot: Region
+    refused: str = ""
+    unclear: str = ""
+
+
 def _clear_spot(
     ctx: SimContext,
     side: ArmSide,
     first: Region,
     others: Callable[[], Iterator[Region]],
     taking: tuple[ObjectEstimate, ObjectModel],
-) -> Region | tuple[str, str]:
-    """Of ``first`` and then ``others`` (asked only when the planning would make the take and carry to
-    ``first`` but they come within CARRY_CLEARANCE of an appliance), the first spot whose take and carry
-    (:func:`carry_check`) the arm's planning would make keeping that clearance, up to CLEAR_TRIES of them;
-    else why the planning would refuse the take and carry to ``first`` (empty: it would make them, as the
-    approach choice asks, :func:`first_clear`) and why no spot's keeps clear. Where the take itself comes
-    that near (an object below a tap's spout), no spot's can: the others are not asked."""
+) -> _Found:
+    """Of ``first`` and then ``others`` (asked only when the take and carry to ``first`` come within
+    CARRY_CLEARANCE of an appliance, or the arm's planning would refuse them), the first spot whose take
+    and carry (:func:`carry_check`) the planning would make keeping that clearance, up to CLEAR_TRIES of
+    them; else ``first`` when the planning would make them there, though not keeping clear, as before;
+    else the first of the others where it would; else ``first`` with why the planning refuses them there.
+    Where the take itself comes that near (an object below a tap's spout), no spot's can keep clear: the
+    others are not asked. A refused ``first`` asks the others too: since the held object is checked
+    against the appliances (:func:`skills.held_meets`), a jar carried to the table's spot beside the
+    dispenser is refused there, not only noted, and the spots a little farther went unasked
+    (JarOntoTheTable at seed 1 was refused before the run)."""
     refused, brushed = carry_check(ctx, side, first, taking)
-    if refused or not brushed:
-        return (refused, refused) if refused else first
+    if not (refused or brushed):
+        return _Found(first)
     seen, held = taking
     at_take = skills.plan_carry(ctx.world, seen, side, held, clearance=CARRY_CLEARANCE).brushed
     if at_take:
-        return "", f"taking the {held.name}: {at_take}"
+        return _Found(first, refused, refused or f"taking the {held.name}: {at_take}")
+    unrefused: _Found | None = None if refused else _Found(first, "", brushed)
     for spot in itertools.islice(others(), CLEAR_TRIES - 1):
-        if not carry_clear(ctx, side, spot, taking):
-            return spot
-    return "", brushed
+        refused_there, brushed_there = carry_check(ctx, side, spot, taking)
+        if not (refused_there or brushed_there):
+            return _Found(spot)
+        if not refused_there and unrefused is None:
+            unrefused = _Found(spot, "", brushed_there)
+    return unrefused or _Found(first, refused, refused)
 
 
 def note_choice(ctx: SimContext, choice: GraspChoice) -> None:
