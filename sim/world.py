@@ -480,8 +480,10 @@ class HomeWorld:
 
     @property
     def grid_inflation(self) -> float:
-        """How far the map server's grid grows obstacles: by :attr:`base_radius`; in a home with several bases,
-        by the largest's (any of them might drive along it); with none, by nothing."""
+        """How far the map server's grid grows obstacles: by the driven base's :attr:`base_radius`; in a home of
+        several with none driven yet, by the largest's (any of them might drive along it); with none, by nothing."""
+        if self.mobile is not None:
+            return _radius(self.mobile)
         return max((_radius(robot) for robot in self.mobiles.values()), default=0.0)
 
     @property

@@ -35,6 +35,13 @@ FLAT_FILE = Path(__file__).resolve().parents[1] / "docs" / "examples" / "studio_
 FLAT = "https://example.org/studio-flat#"
 
 
+BASE_OUTSIDE = (
+    "PREFIX home: <https://w3id.org/cbrs/home#> PREFIX svc: <https://w3id.org/cbrs/service#> "
+    "DELETE { GRAPH graph:map { svc:P3DX01 home:x ?x } } INSERT { GRAPH graph:map { svc:P3DX01 home:x 30.0 } } "
+    "WHERE { GRAPH graph:map { svc:P3DX01 home:x ?x } }"
+)
+
+
 def links(svg: str) -> dict[str, list[ET.Element]]:
     """The picture's links by the IRI they open, each with its shapes; every link has a title."""
     found: dict[str, list[ET.Element]] = {}
@@ -172,14 +179,14 @@ def test_the_page_shows_the_picture_and_the_things(bundled_kb: KnowledgeBase) ->
 
 def test_the_page_says_why_the_simulation_would_refuse_the_home_and_what_cannot_be_read() -> None:
     kb = KnowledgeBase.open(":memory:")
-    kb.update(f"DELETE WHERE {{ GRAPH graph:map {{ <{SVC}P3DX01> ?p ?o }} }}", check_map=False)
+    kb.update(BASE_OUTSIDE, check_map=False)  # a home of no base is taken (tests/test_no_base.py); this is not
     client = create_app(SparqlService(kb)).test_client()
     body = client.get("/home.json").get_json()  # 200: the home's problem is what the page shows
     assert body["verdict"] == "refused" and body["problem"]["kind"] == "HomeError"
-    assert "add a robot with home:hasPlatform, home:hasMarker" in body["problem"]["message"]
+    assert "starts at (30.00, 1.50), in no room of the map" in body["problem"]["message"]
     assert body["picture"] is not None, "what the map holds is drawn all the same"
     page = client.get("/home")
-    assert page.status_code == 200 and "add a robot with home:hasPlatform" in page.get_data(as_text=True)
+    assert page.status_code == 200 and "in no room of the map" in page.get_data(as_text=True)
 
     kb.update(
         f'INSERT DATA {{ GRAPH graph:map {{ <{WORLD}Pen> <https://w3id.org/cbrs/home#yaw> "north" }} }}',
@@ -224,10 +231,10 @@ def test_the_studio_flat_replacing_the_home_draws_too() -> None:
 
 def test_cbrs_home_exits_1_with_the_check_s_message_and_draws_what_is_there(tmp_path: Path) -> None:
     kb = KnowledgeBase.open(":memory:")
-    kb.update(f"DELETE WHERE {{ GRAPH graph:map {{ <{SVC}P3DX01> ?p ?o }} }}", check_map=False)
+    kb.update(BASE_OUTSIDE, check_map=False)  # a home of no base is taken (tests/test_no_base.py); this is not
     drawing = tmp_path / "home.svg"
     done = CliRunner().invoke(home, ["--draw", str(drawing)], obj=App(":memory:", kb))  # this store, as opened
     assert done.exit_code == 1
-    assert "0 mobile robots" in done.output and "check: the simulation would refuse this home" in done.output
-    assert "add a robot with home:hasPlatform, home:hasMarker" in done.output
+    assert "1 mobile robot" in done.output and "check: the simulation would refuse this home" in done.output
+    assert "P3DX01 (https://w3id.org/cbrs/service#P3DX01) starts at (30.00, 1.50), in no room" in done.output
     assert WORLD + "Cup" in links(drawing.read_text(encoding="utf-8"))

@@ -177,15 +177,19 @@ def test_the_graph_store_takes_a_map_that_reads(kb: KnowledgeBase, client: Flask
 
 def test_a_put_of_the_map_is_checked_as_a_whole_home(kb: KnowledgeBase, client: FlaskClient) -> None:
     """A PUT replaces the home, as ``cbrs load --graph map --replace`` does, and is checked as one:
-    a map without the mobile robot (which reads, thing by thing) is refused, and nothing is written."""
+    a map whose mobile robot starts in no room (which reads, thing by thing) is refused, and nothing is
+    written. (A map without the mobile robot is taken: tests/test_no_base.py.)"""
     auth = {"Authorization": f"Bearer {TOKEN}"}
     stored = client.get(f"/store?graph={MAP}", headers={"Accept": "application/n-triples"}).data.decode()
-    base = f"<{PREFIXES['svc']}P3DX01>"
-    without_base = "\n".join(line for line in stored.splitlines() if not line.startswith(base))
-    assert len(without_base) < len(stored)
+    base_x = f"<{PREFIXES['svc']}P3DX01> <{PREFIXES['home']}x> "
+    outside = "\n".join(
+        f'{base_x}"30.0"^^<http://www.w3.org/2001/XMLSchema#decimal> .' if line.startswith(base_x) else line
+        for line in stored.splitlines()
+    )
+    assert outside != stored
     before = kb.store.dump()
-    response = client.put(f"/store?graph={MAP}", data=without_base, content_type="application/n-triples", headers=auth)
+    response = client.put(f"/store?graph={MAP}", data=outside, content_type="application/n-triples", headers=auth)
     assert response.status_code == 422
     message = response.get_json()["message"]
-    assert "MobileRobot" in message and "simulated home" in message
+    assert "P3DX01" in message and "in no room of the map" in message
     assert kb.store.dump() == before
