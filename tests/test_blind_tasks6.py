@@ -33,7 +33,7 @@ from cbrs.sim.world import open_world
 from tests.helpers_examples import EXAMPLES
 from tests.test_live_components import TOKEN, eventually, live_server
 
-HOME, WORLD, LAB6 = PREFIXES["home"], PREFIXES["world"], "https://example.org/lab6#"
+HOME, WORLD, SVC, LAB6 = PREFIXES["home"], PREFIXES["world"], PREFIXES["svc"], "https://example.org/lab6#"
 SENSOR, PHONE = LAB6 + "CheckFridgeDoor_FridgeDoorSensor01", LAB6 + "AlertByPhone_ResidentPhone01"
 CHECK = "/lab6_fridge_door_sensor_01/check"
 KETTLE = LAB6 + "SwitchOnKettle_KettleSwitch01"
@@ -202,16 +202,15 @@ def test_two_things_to_the_shelf_are_planned_as_two_takes_and_a_typo_in_the_shel
     assert _graph_sizes(kb) == before
 
 
-def test_the_pen_off_the_table_is_refused_naming_its_delete_effect() -> None:
-    """A delete effect is a goal (tests/test_delete_goals.py); no component's meets (Pen, isLocatedOn, Table),
-    beside an effect or alone, and the answer names it."""
+def test_the_pen_off_the_table_is_planned_the_pick_up_deleting_it() -> None:
+    """A delete effect is a goal (tests/test_delete_goals.py): (Pen, isLocatedOn, Table), beside an effect
+    or alone, is met by the pick-up, which deletes where the object stood (a place or a piece of furniture)."""
     kb = _tidy_store("lab6_pen_off_the_table.ttl", "lab6_mistake_delete_only.ttl")
     for task in ("ClearPenOffTheTable", "PenNotOnTheTable"):
-        result = Composer(kb).compose(task)
-        assert result.plan is None
-        assert any(
-            "no component deletes (home:Pen, home:isLocatedOn, home:Table)" in u.text() for u in result.unsatisfied
-        )
+        plan = Composer(kb).compose(task).plan
+        assert plan is not None, task
+        goals = {str(g.statement): plan.step(g.source.step or 0).component for g in plan.goals if g.role == "deletion"}
+        assert list(goals.values()) == [SVC + "PickUpObject_CytonDualArm01"], task
 
 
 def test_the_kettle_written_with_plain_websockets_registers_plans_and_answers(server: Server) -> None:
