@@ -182,7 +182,7 @@ def test_inferring_where_the_torch_is_kept_names_the_trolley_and_its_missing_doc
 ) -> None:
     """The home server's step, on the map alone (a stand-in world that only holds the map): it said "the
     knowledge base does not say where the Torch1 is kept, or how to reach it"."""
-    ctx = SimContext(world=SimpleNamespace(map=SemanticMap.read(undocked)), kb=undocked)  # type: ignore[arg-type]
+    ctx = SimContext(world=SimpleNamespace(map=SemanticMap.read(undocked), arm_specs={}), kb=undocked)  # type: ignore[arg-type]
     with pytest.raises(NoDockingPoseError):  # what a check before the run can ask
         kept_place(ctx, LAB + "Torch1")
     with pytest.raises(SkillFailed) as failed:
