@@ -152,7 +152,7 @@ class HomeSurvey:
             "furniture": len(smap.furniture & smap.things.keys()),
             "objects": len(smap.objects),
             "mobile robots": len(smap.robots),
-            "dual-arm robots": len(_bodies(smap)),
+            "stationary robots": len(_bodies(smap)),  # a torso on the floor, whatever its arms
             "arms": len(smap.arms),
             "people": len(smap.people),
             "cameras": len(smap.cameras),

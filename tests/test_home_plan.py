@@ -204,7 +204,7 @@ def test_cbrs_home_summarises_the_home_and_draws_it(tmp_path: Path) -> None:
     drawing = tmp_path / "home.svg"
     done = CliRunner().invoke(cli, ["--store", ":memory:", "home", "--draw", str(drawing)])
     assert done.exit_code == 0, done.output
-    assert "3 rooms, 10 walls, 1 piece of furniture, 2 objects, 1 mobile robot, 1 dual-arm robot" in done.output
+    assert "3 rooms, 10 walls, 1 piece of furniture, 2 objects, 1 mobile robot, 1 stationary robot" in done.output
     assert "1 person, 3 cameras, 1 docking pose" in done.output
     assert "check: the simulation can build this home" in done.output
     said = json.loads(CliRunner().invoke(cli, ["--store", ":memory:", "home", "--json"]).output)
