@@ -14,6 +14,7 @@ from typing import cast
 
 import pytest
 from click.testing import CliRunner
+from markupsafe import escape
 
 from cbrs.actions.composer import Composer
 from cbrs.actions.runner import run_task
@@ -194,3 +195,13 @@ def test_the_world_builds_no_base_and_the_arms_serve_a_cup(no_base: KnowledgeBas
     assert result.succeeded, result.report
     observed = environment.observe()
     assert not any("P3DX01" in iri for iri in observed.positions)
+
+
+def test_the_home_page_says_what_a_home_with_no_base_allows(no_base: KnowledgeBase) -> None:
+    from cbrs.sparql_service import SparqlService
+    from cbrs.web import create_app
+
+    client = create_app(SparqlService(no_base)).test_client()
+    assert client.get("/home.json").get_json()["mobile_robots"] == NO_BASE
+    page = client.get("/home").get_data(as_text=True)
+    assert "Mobile robots" in page and str(escape(NO_BASE)) in page

@@ -34,6 +34,7 @@ def home() -> Page:
         "counts": found.counts(),
         "counted": found.counted(),
         "people": found.people(),
+        "mobile_robots": found.bases(),
         "warnings": found.warnings(),
         "persons": [],
         "things": [],
