@@ -14,6 +14,7 @@ from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import Any, Protocol
 
+from cbrs.actions.base_choice import BaseChoice, choose_base
 from cbrs.actions.belief import BeliefState, Observation
 from cbrs.actions.components import Container, Registry
 from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, PlanStatus, store_plan
@@ -143,6 +144,7 @@ class RunResult:
     goals: tuple[GoalCheck, ...] = ()  # the task's effects at the end, believed and in the world
     stopped: str = ""  # why re-planning stopped before its budget: the next plan would repeat a failure
     passed_over: tuple[tuple[str, str], ...] = ()  # (component, why) the last composition was made without
+    base: BaseChoice | None = None  # in a home of several mobile bases, the one the plans work and why
 
     @property
     def succeeded(self) -> bool:
@@ -196,6 +198,8 @@ class RunResult:
             found["stopped"] = self.stopped
         found["goals"] = [goal.to_dict() for goal in self.goals]
         found["answers"] = [answer.to_dict() for answer in self.answers]
+        if self.base is not None:
+            found["base"] = self.base.to_dict()
         return found
 
 
@@ -270,12 +274,16 @@ def run_task(
     belief.write(environment.observe())  # plan from what holds now, not from a past run's belief
     composition = composer.compose(task, belief=True)
     config = composer.config
+    composition, chosen = _one_base(kb, config, task, composition, environment, bus, frozenset())
     passed = _passed_over(environment, bus, {})
     why_not = _why_not(environment)
-    composition = _runnable(kb, config, task, composition, environment.registry, passed=passed, why_not=why_not)
+    left_out = chosen.left_out if chosen is not None else frozenset()
+    composition = _runnable(
+        kb, config, task, composition, environment.registry, left_out, passed=passed, why_not=why_not
+    )
     if composition.plan is None:
         belief.restore(before)  # nothing can be done and nothing was: the store is left as it was
-        return RunResult(composition, None, passed_over=_pairs(passed))
+        return RunResult(composition, None, passed_over=_pairs(passed), base=chosen)
     try:
         _check_grounded(kb, composer.index, composition.plan)
     except (UngroundedGoalError, UnresolvedDesignatorError):
@@ -286,10 +294,15 @@ def run_task(
 
     def compose(avoid: frozenset[str]) -> CompositionResult:
         """A fresh composition from the belief, without ``avoid``, what the environment cannot run and what
-        it passes over now."""
-        nonlocal passed
+        it passes over now; with the base the first plan chose (``_kept_base``), else one base chosen now."""
+        nonlocal passed, chosen
         passed = _passed_over(environment, bus, passed)
-        again = _compose(kb, config, task, avoid)
+        if chosen is not None:
+            avoid = avoid | _kept_base(environment, chosen)
+            again = _compose(kb, config, task, avoid)
+        else:
+            again, chosen = _one_base(kb, config, task, _compose(kb, config, task, avoid), environment, bus, avoid)
+            avoid = avoid | (chosen.left_out if chosen is not None else frozenset())
         return _runnable(kb, config, task, again, environment.registry, avoid, passed, why_not=why_not)
 
     stopped = ""
@@ -350,7 +363,7 @@ def run_task(
         container.finalise_all()
     belief.write(environment.observe(), whole=True)  # what a run leaves is exactly its belief
     goals = _check_goals(environment, composition.plan, outputs) if report is not None else ()
-    return RunResult(composition, report, tuple(replans), goals, stopped, composed_without)
+    return RunResult(composition, report, tuple(replans), goals, stopped, composed_without, chosen)
 
 
 def refusal_before_world(
@@ -658,6 +671,44 @@ def _cannot_run(ad: Advertisement) -> str:
         f"the simulation has no skill for its service name {ad.service_name!r}, and it names no service port"
         " (cbrs:ServicePort with cbrs:topic and cbrs:messageType) to call it through (docs/components.md)"
     )
+
+
+def _base_components(environment: Environment) -> dict[str, frozenset[str]]:
+    """Each mobile base's own components, by the base's IRI (the Environment protocol's optional
+    ``base_components``): more than one only in a home of several bases."""
+    found = getattr(environment, "base_components", None)
+    return dict(found()) if callable(found) else {}
+
+
+def _one_base(
+    kb: KnowledgeBase,
+    config: ComposeConfig,
+    task: str,
+    composition: CompositionResult,
+    environment: Environment,
+    bus: EventBus,
+    avoid: frozenset[str],
+) -> tuple[CompositionResult, BaseChoice | None]:
+    """``composition``, or in a home of several bases the best composed with one base's components
+    (``actions.base_choice``), said on the progress topic."""
+    groups = _base_components(environment)
+    if len(groups) < 2:
+        return composition, None
+    found, chosen = choose_base(lambda without: _compose(kb, config, task, avoid | without), composition, groups)
+    if chosen is not None:
+        bus.publish("/cbrs/task_progress", {"event": "base_chosen", "base": chosen.base, "why": chosen.why})
+    return found, chosen
+
+
+def _kept_base(environment: Environment, chosen: BaseChoice) -> frozenset[str]:
+    """The other bases' components, read again (a lab may have registered some since the first plan): a
+    re-plan works the base the first plan chose. What the run achieved is that base's (where it stands,
+    what its platform carries), and the composer's statements are of classes (an object on a
+    RobotPlatform), so another base's delivery would be planned on a load it does not carry
+    (docs/simulation.md, "A home with no mobile base")."""
+    groups = _base_components(environment)
+    others = [components for base, components in groups.items() if base != chosen.base]
+    return chosen.left_out.union(*others)
 
 
 def _compose(

@@ -57,6 +57,7 @@ from cbrs.sim.run_checks import (
     OutOfReachError,
     PlaceCrowdedError,
     PlanChecks,
+    base_components,
     own_camera,
     without_base,
     without_camera,
@@ -302,6 +303,11 @@ class SimEnvironment:
             **without_camera(advertisements, self.world.cameras),
             **without_base(advertisements, self.world.base_names),
         }
+
+    def base_components(self) -> dict[str, frozenset[str]]:
+        """Each mobile base's own components, in a home of several (``sim.run_checks.base_components``): a
+        plan works one base (``actions.runner``)."""
+        return base_components(self.world, self.kb)
 
     def refresh(self) -> None:
         """Before a new plan: forget the measured map (the world may have changed) and add the

@@ -724,6 +724,22 @@ def base_for(world: HomeWorld, plan: Plan, ads: Mapping[str, Advertisement], val
     return None
 
 
+def base_components(world: HomeWorld, kb: KnowledgeBase) -> dict[str, frozenset[str]]:
+    """In a home of several mobile bases, each base's own components (base IRI -> the IRIs of the
+    advertisements whose device, ``cbrs:device`` or by its ``cbrs:deviceName``, is that base: its drive,
+    navigation, delivery, odometry, battery, simulated or remote): a run composes with one base's and
+    without the others' (``actions.runner``, docs/simulation.md, "A home with no mobile base"). Empty in a
+    home of one base or none, where nothing is left out (the store's advertisements are not read)."""
+    if len(world.mobiles) < 2:
+        return {}
+    found: dict[str, set[str]] = {robot.iri: set() for robot in world.mobiles.values()}
+    for ad in kb.advertisements():
+        device = ad.device or PREFIXES["svc"] + (ad.device_name or "")
+        if device in found:
+            found[device].add(ad.iri)
+    return {base: frozenset(components) for base, components in sorted(found.items())}
+
+
 def _marked(world: HomeWorld, step: PlanStep, steps: Mapping[int, PlanStep], values: Mapping[str, Any]) -> list[str]:
     """The bases (IRIs) whose marker shows the colours a task's input to ``step`` names."""
     found = []
