@@ -343,7 +343,7 @@ class Recorder:
         if self.recording:
             return
         world = self.world
-        self._base = (world.name_of(world.base.body) or "base") if world.mobile else ""  # "": no base it drives
+        self._base = self._driven() if world.mobile else ""  # "": no base it drives, or none chosen yet
         self._people = list(world.people)  # none, one or several
         self._movable = [name for name in world.snapshot() if name not in self._people]
         robots = {arm.robot.rsplit("#", 1)[-1] for arm in world.arm_specs.values()}
@@ -376,12 +376,18 @@ class Recorder:
     def __exit__(self, *exc: object) -> None:
         self.stop()
 
+    def _driven(self) -> str:
+        """The body name of the base the world drives (in a home of several, the one a run's plan works)."""
+        return self.world.name_of(self.world.base.body) or "base"
+
     def _xy(self, name: str) -> tuple[float, float]:
         x, y, _ = self.world.pose(name).position
         return float(x), float(y)
 
     def _sample(self) -> None:
         now = self.world.time
+        if not self._base and self.world.mobile is not None:
+            self._base = self._driven()  # a home of several bases: the one a plan chose since the start
         for name in (*self._movable, *self._people):
             x, y = self._xy(name)
             points = self.track.setdefault(name, [])
