@@ -28,7 +28,7 @@ from cbrs.actions.plan import Plan, PlanStep
 from cbrs.actions.replanning import Failure, FailureMemory, ReplanPolicy
 from cbrs.kb import Advertisement, KnowledgeBase, NotFoundError, Requirement, Statement
 from cbrs.kb.namespaces import HOME, shorten
-from cbrs.kb.semantic_map import UnresolvedDesignatorError
+from cbrs.kb.semantic_map import AmbiguousDesignatorError, UnresolvedDesignatorError, designate
 from cbrs.kb.store import Term
 from cbrs.reasoner.taxonomy import ROOT, TaxonomyIndex
 
@@ -694,10 +694,27 @@ def _one_base(
     groups = _base_components(environment)
     if len(groups) < 2:
         return composition, None
-    found, chosen = choose_base(lambda without: _compose(kb, config, task, avoid | without), composition, groups)
+    named = _named_base(kb, composition, groups)
+    found, chosen = choose_base(lambda without: _compose(kb, config, task, avoid | without), composition, groups, named)
     if chosen is not None:
         bus.publish("/cbrs/task_progress", {"event": "base_chosen", "base": chosen.base, "why": chosen.why})
     return found, chosen
+
+
+def _named_base(kb: KnowledgeBase, composition: CompositionResult, groups: Mapping[str, Any]) -> str | None:
+    """The base (one of ``groups``) an input of the task designates itself, if one does (a lab's class of
+    which P3DX02 is the one thing): the task names its base so."""
+    if not composition.attempts:
+        return None
+    requirement = composition.attempts[0].requirement
+    for parameter in requirement.inputs:
+        try:
+            thing = designate(kb, parameter.type, prefer=requirement.requested_by)
+        except (UnresolvedDesignatorError, AmbiguousDesignatorError):
+            continue
+        if thing in groups:
+            return thing
+    return None
 
 
 def _kept_base(environment: Environment, chosen: BaseChoice) -> frozenset[str]:

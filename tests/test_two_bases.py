@@ -14,7 +14,7 @@ import pytest
 
 from cbrs.actions.base_choice import BaseChoice, choose_base
 from cbrs.actions.composer import Composer, CompositionResult
-from cbrs.actions.runner import Environment, _kept_base
+from cbrs.actions.runner import Environment, _kept_base, _named_base
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
@@ -23,7 +23,7 @@ from cbrs.sim.run_checks import base_components
 from cbrs.sim.world import HomeWorld
 from tests.helpers_examples import EXAMPLES
 
-SVC, LAB6 = PREFIXES["svc"], "https://example.org/lab6#"
+SVC, HOME, LAB6 = PREFIXES["svc"], PREFIXES["home"], "https://example.org/lab6#"
 P1, P2 = SVC + "P3DX01", SVC + "P3DX02"
 COMPONENTS = "lab6_second_base_components.ttl"
 
@@ -41,6 +41,10 @@ lab6:FetchMyPenAnyBase a cbrs:Requirement ; cbrs:serviceName "FetchMyPenAnyBase"
       cbrs:conditionObject home:Person ] ] .
 """
 
+# a lab's class of which P3DX02 is the one thing: an input of that class names the base
+SECOND_PIONEER = """PREFIX lab6: <https://example.org/lab6#> PREFIX svc: <https://w3id.org/cbrs/service#>
+INSERT DATA { GRAPH <https://w3id.org/cbrs/graph/map> { svc:P3DX02 a lab6:SecondPioneer } }"""
+
 
 def _store(tmp: Path) -> KnowledgeBase:
     """Two bases with the lab's components and requirements, P3DX02's delivery advertised at 10 s instead
@@ -53,6 +57,7 @@ def _store(tmp: Path) -> KnowledgeBase:
     anyone = tmp / "anyone.ttl"
     anyone.write_text(ANYONES, encoding="utf-8")
     kb.load([EXAMPLES / "lab6_second_base_fetch.ttl", anyone], graph="requirements")
+    kb.update(SECOND_PIONEER)
     return kb
 
 
@@ -146,6 +151,22 @@ def test_a_plan_of_no_base_or_a_home_of_one_is_kept() -> None:
     assert choose_base(_by_base(arms, arms), arms, GROUPS) == (arms, None)
     mixed = _stub(80.0, 0.9, ("nav1", "deliver2"))
     assert choose_base(_by_base(arms, arms), mixed, {P1: GROUPS[P1]}) == (mixed, None)
+
+
+def test_an_input_designating_a_base_names_it(faster: KnowledgeBase) -> None:
+    groups = base_components(_world(faster), faster)
+
+    def asking(*types: str) -> CompositionResult:
+        inputs = tuple(SimpleNamespace(type=t) for t in types)
+        attempt = SimpleNamespace(requirement=SimpleNamespace(inputs=inputs, requested_by=None))
+        return cast(CompositionResult, SimpleNamespace(attempts=(attempt,)))
+
+    assert _named_base(faster, asking(HOME + "Pen", LAB6 + "SecondPioneer"), groups) == P2
+    assert _named_base(faster, asking(HOME + "Pen", HOME + "CarrierRobot"), groups) is None  # both: ambiguous
+    mixed = _stub(80.0, 0.9, ("nav1", "deliver2"))
+    one, two = _stub(80.0, 0.9, ("nav1", "deliver1")), _stub(86.0, 0.9, ("nav2", "deliver2"))
+    found, chosen = choose_base(_by_base(one, two), mixed, GROUPS, named=P2)
+    assert found is two and chosen is not None and chosen.why == "an input of the task designates P3DX02"
 
 
 def test_a_replan_keeps_the_base_with_components_registered_since(faster: KnowledgeBase) -> None:
