@@ -704,6 +704,8 @@ def _planned(policy: RandomFaults, result: RunResult) -> list[dict[str, Any]]:
 def _progress(message: dict[str, Any]) -> str:
     if message["event"] == "replanning":
         return f"  re-planning (plan {message['plan']}) from what holds now: {message.get('reason', '')}"
+    if message["event"] == "base_chosen":  # a home of several mobile bases (actions.base_choice)
+        return f"  the plans work {shorten(message['base'])}: {message['why']}"
     if message["event"] == "awaiting":
         gone = ", ".join(map(shorten, message["components"]))
         return f"  waiting up to {message['seconds']:g} s for {gone} to register again before re-planning"

@@ -15,6 +15,7 @@ import pytest
 from cbrs.actions.base_choice import BaseChoice, choose_base
 from cbrs.actions.composer import Composer, CompositionResult
 from cbrs.actions.runner import Environment, _kept_base, _named_base
+from cbrs.cli_actions import _progress
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import SemanticMap
@@ -191,3 +192,8 @@ def test_the_recorder_tracks_the_base_chosen_after_it_started() -> None:
     world.mobile = object()  # HomeWorld.drive
     recorder._sample()
     assert recorder._base == "P3DX02"
+
+
+def test_cbrs_run_says_the_base_chosen_among_its_progress_lines() -> None:
+    line = _progress({"event": "base_chosen", "base": P2, "why": "an input of the task designates P3DX02"})
+    assert line == "  the plans work svc:P3DX02: an input of the task designates P3DX02"
