@@ -168,6 +168,9 @@ def _reason(found: dict[str, Any]) -> str:
         return str(report["reason"])
     plan = found.get("plan")
     if isinstance(plan, dict):
+        unsatisfied = plan.get("unsatisfied")
+        if isinstance(unsatisfied, list) and unsatisfied and isinstance(unsatisfied[0], dict):
+            return "no component provides " + "; ".join(str(u.get("need", u)) for u in unsatisfied)
         for key in ("reason", "explanation"):
             if plan.get(key):
                 return str(plan[key])
