@@ -709,6 +709,10 @@ def _progress(message: dict[str, Any]) -> str:
     if message["event"] == "awaiting":
         gone = ", ".join(map(shorten, message["components"]))
         return f"  waiting up to {message['seconds']:g} s for {gone} to register again before re-planning"
+    if message["event"] == "passed_over":  # remote components whose calls timed out (actions.breaker)
+        return "\n".join(f"  passing over {shorten(c)}: {why}" for c, why in sorted(message["components"].items()))
+    if "step" not in message or "component" not in message:  # an event of a newer runner: said as it is
+        return f"  {message['event']}: " + ", ".join(f"{k} {v}" for k, v in message.items() if k != "event")
     kind, step, component = message["event"], message["step"], shorten(message["component"])
     if kind == "step_started":
         return f"  step {step:>2}  {component} ..."
