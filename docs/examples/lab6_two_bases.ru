@@ -2,8 +2,8 @@
 # platform and colour marker (blue ahead, red behind), in one update. The simulation builds both; a run
 # drives the base its plan works (the device of its drives, the marker colours its locator is given), and
 # a plan that works two, or names none, is refused before anything moves (docs/simulation.md, "A home
-# with no mobile base"). Its components are not advertised here: a lab's would be (cbrs register), and a
-# plan of FetchMyPen, say, that mixed both bases' components would be refused.
+# with no mobile base"). Its components are not advertised here: a lab registers them
+# (docs/examples/lab6_second_base_components.ttl), and a run then composes once per base and drives one.
 #   cbrs update --file docs/examples/lab6_two_bases.ru
 #   cbrs home                                        (mobile robots: P3DX01, P3DX02; what that allows)
 #   cbrs run RobotArmServeACup --seed 0 --json       (the arms: it runs)
