@@ -24,7 +24,11 @@ the map's things right, no effect contradicted: ``RemoteComponent._read``), and 
 
 Each case is one warning of ``cbrs.actions.remote`` naming the component. An effect is grounded in the
 step's inputs (the one designated thing of its class; a quality, ``home:Opened``, stands for itself) when
-the call is given up, and the belief of what it would change is read then, to tell later changes.
+the call is given up, and the belief of what it would change is read then, to tell later changes. A quality
+class stands for itself only as the subject's own quality, by a relation of ``home:hasQualityPart``'s family,
+the rule the simulated environment believes a step's effect by (:class:`actions.qualities.OwnQualities`): an
+alert about a status, (Person, lab6:isAlertedOf, DoorStatus), is no lasting state and is neither believed
+nor kept, late as in time (docs/components.md).
 The write is :func:`actions.belief.correct`: one transaction, kept by a run still going, and heard by a
 simulation environment running (:class:`actions.belief.Heard`; docs/reliability.md, "Late answers").
 """
@@ -43,9 +47,10 @@ from cbrs.actions.answers import Classes
 from cbrs.actions.belief import Fact, Pair, believed, correct
 from cbrs.actions.breaker import Late
 from cbrs.actions.errors import ActionsError
+from cbrs.actions.qualities import OwnQualities
 from cbrs.actions.remote_errors import RemoteCallError
 from cbrs.kb import KnowledgeBase, KnowledgeBaseError, Statement
-from cbrs.kb.namespaces import HOME, expand, shorten
+from cbrs.kb.namespaces import expand, shorten
 
 __all__ = ["GivenUp", "watch"]
 
@@ -80,6 +85,7 @@ class _Expected:
     before: frozenset[Fact]
     ungrounded: tuple[Statement, ...]
     functional: frozenset[str]
+    passing: tuple[Statement, ...] = ()  # relations to a quality class that is no quality of the subject
 
     @property
     def pairs(self) -> frozenset[Pair]:
@@ -101,13 +107,20 @@ def watch(kb: KnowledgeBase, classes: Classes, call: GivenUp, read: Read) -> Lat
 def _expect(kb: KnowledgeBase, classes: Classes, call: GivenUp) -> _Expected:
     description = kb.description(call.component)
     untested = [s for s in (*description.deletes, *description.effects) if not _tested(kb, s.predicate)]
-    grounded = {s: _grounded(kb, classes, s, call.inputs) for s in untested}
+    quality = OwnQualities(kb, classes.is_a)
+    grounded = {s: _grounded(kb, classes, quality, s, call.inputs) for s in untested}
     deletes = tuple(f for s in description.deletes if (f := grounded.get(s)) is not None)
     adds = tuple(f for s in description.effects if (f := grounded.get(s)) is not None)
     functional = frozenset(row["property"].value for row in kb.select("functional_properties"))
     pairs = {(s, p) for s, p, _ in (*deletes, *adds)}
-    ungrounded = tuple(s for s, fact in grounded.items() if fact is None)
-    return _Expected(deletes, adds, believed(kb, pairs), ungrounded, functional)
+    missed = [s for s, fact in grounded.items() if fact is None]
+    passing = tuple(
+        s
+        for s in missed
+        if quality.passing(s.predicate, s.object) and _thing(kb, classes, s.object, call.inputs, None) is None
+    )
+    ungrounded = tuple(s for s in missed if s not in passing)
+    return _Expected(deletes, adds, believed(kb, pairs), ungrounded, functional, passing)
 
 
 def _tested(kb: KnowledgeBase, predicate: str) -> bool:
@@ -115,12 +128,16 @@ def _tested(kb: KnowledgeBase, predicate: str) -> bool:
     return bool(kb.select("computables", {"relation": ox.NamedNode(predicate)}))
 
 
-def _grounded(kb: KnowledgeBase, classes: Classes, statement: Statement, inputs: Mapping[str, Any]) -> Fact | None:
+def _grounded(
+    kb: KnowledgeBase, classes: Classes, quality: OwnQualities, statement: Statement, inputs: Mapping[str, Any]
+) -> Fact | None:
     """``statement`` (between classes) about the step's things: each side the one thing the step was
-    given of its class; an object no given thing is and that is a quality (``home:Opened``) stands for
-    itself. None when a side means no given thing or several."""
+    given of its class; an object no given thing is and that is a quality (``home:Opened``) of the subject
+    (``quality``: by a relation of ``home:hasQualityPart``'s family) stands for itself. None when a side
+    means no given thing or several, or the object is a quality class the relation does not make the
+    subject's own (an alert about a status)."""
     obj = _thing(kb, classes, statement.object, inputs, None)
-    if obj is None and classes.is_a(statement.object, HOME + "Quality"):
+    if obj is None and quality(statement.predicate, statement.object):
         obj = statement.object
     subject = _thing(kb, classes, statement.subject, inputs, obj)
     return (subject, statement.predicate, obj) if subject is not None and obj is not None else None
@@ -260,7 +277,10 @@ def _told(call: GivenUp, expected: _Expected, outcome: _Outcome, error: BaseExce
     if expected.ungrounded:
         statements = ", ".join(_statement(s) for s in expected.ungrounded)
         parts.append(f"not believed: {statements} (no one thing of the step's inputs is meant)")
-    if not expected.pairs and not expected.ungrounded:
+    if expected.passing:
+        statements = ", ".join(_statement(s) for s in expected.passing)
+        parts.append(f"not believed: {statements} (a quality class no quality of its subject: no lasting state)")
+    if not expected.pairs and not expected.ungrounded and not expected.passing:
         parts.append("none of its effects is a belief that only a step sets: the next run perceives them")
     return "; ".join(parts)
 

@@ -34,6 +34,7 @@ from cbrs.actions.belief import Heard, Observation
 from cbrs.actions.breaker import BreakerPolicy, passed_over
 from cbrs.actions.components import Component, Registry, Status
 from cbrs.actions.plan import Plan, PlanStep
+from cbrs.actions.qualities import OwnQualities
 from cbrs.actions.remote import RemoteComponent, Transport
 from cbrs.kb import KnowledgeBase, Requirement, Statement
 from cbrs.kb.errors import NotFoundError
@@ -280,7 +281,7 @@ class SimEnvironment:
         self._superclasses: dict[str, set[str]] | None = None
         self._computables: dict[str, str] | None = None
         self._exclusions: tuple[frozenset[str], tuple[tuple[str, str], ...]] | None = None
-        self._qualities: frozenset[str] | None = None  # home:hasQualityPart and the relations below it
+        self._qualities: OwnQualities | None = None  # the rule, read from the store at its first question
         self._heard = Heard(kb)  # before the world graph is read: a correction made after the read is heard
         self.effects |= self._untestable_beliefs()
 
@@ -538,26 +539,14 @@ class SimEnvironment:
         return (subject, statement.predicate, obj)
 
     def _own_quality(self, predicate: str, value: str) -> bool:
-        """Whether ``value``, a class, is the value of a quality of the subject: a quality (home:Opened) by a
-        relation of home:hasQualityPart's family ((Door, hasStatus, Opened)). A relation to a quality class
-        by another relation ((Person, lab6:isAlertedOf, DoorStatus): an alert sent) is no lasting state of
-        the subject, and is not kept, as an inform is not (docs/components.md; docs/tasks.md, "A sixth
-        round": the next alert-only run had "nothing to do")."""
-        if not self.is_a(value, HOME + "Quality"):
-            return False
+        """Whether ``value``, a class, stands for itself as ``predicate``'s value: a quality of the subject
+        (:class:`actions.qualities.OwnQualities`, the rule late answers share; docs/components.md)."""
+        return self._quality_rule()(predicate, value)
+
+    def _quality_rule(self) -> OwnQualities:
         if self._qualities is None:
-            parents: dict[str, set[str]] = {}
-            for row in self.kb.select("taxonomy_links"):
-                if row["link"].value == "is-a":
-                    parents.setdefault(row["child"].value, set()).add(row["parent"].value)
-            found, frontier = {HOME + "hasQualityPart"}, [HOME + "hasQualityPart"]
-            while frontier:
-                above = frontier.pop()
-                below = [child for child, ups in parents.items() if above in ups and child not in found]
-                found.update(below)
-                frontier += below
-            self._qualities = frozenset(found)
-        return predicate in self._qualities
+            self._qualities = OwnQualities(self.kb, self.is_a)
+        return self._qualities
 
     def _untestable_beliefs(self) -> set[tuple[str, str, str]]:
         """The relations about things of this world that the world graph (an earlier run's belief) holds
@@ -567,7 +556,7 @@ class SimEnvironment:
         for row in self.kb.select("world_facts"):
             fact = (row["thing"].value, row["relation"].value, row["other"].value)
             if fact[0] in self.world.map.types and self.computable(fact[1]) is None:
-                if self.is_a(fact[2], HOME + "Quality") and not self._own_quality(fact[1], fact[2]):
+                if self._quality_rule().passing(fact[1], fact[2]):
                     continue  # an alert an earlier run believed (see _own_quality)
                 kept.add(fact)
         return kept
