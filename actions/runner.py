@@ -185,11 +185,28 @@ class RunResult:
             found.append(Answer(goal.name, goal.concept, value, step, component, goal.source.name))
         return tuple(found)
 
+    @property
+    def unused_inputs(self) -> tuple[tuple[str, str], ...]:
+        """The (name, class) of the task's inputs no plan of the run took (docs/composition.md). A re-plan,
+        composed from what held (the eraser on the shelf), needs no more what an earlier plan did with it;
+        the last composition's own list named it (docs/tasks.md, "A sixth round")."""
+        requirement = self.composition.requirement
+        taken = {
+            binding.source.name
+            for replan in self.replans
+            for step in replan.plan.steps
+            for binding in step.bindings
+            if binding.source.step is None and binding.source.requirement == requirement
+        }
+        return tuple((name, type_) for name, type_ in self.composition.unused_inputs if name not in taken)
+
     def to_dict(self) -> dict[str, Any]:
         status = self.report.status.value if self.report else PlanStatus.UNSOLVABLE.value
         if self.executed and self.refuted:
             status = RunStatus.FAILED.value
         plan = {**self.composition.to_dict(), "passed_over": _passed_dicts(self.passed_over)}
+        if "unused_inputs" in plan:  # those no plan of the run took, not the last plan's alone
+            plan["unused_inputs"] = [{"name": name, "type": type_} for name, type_ in self.unused_inputs]
         found: dict[str, Any] = {"task": self.composition.task, "status": status, "plan": plan}
         if self.report is not None:
             found["execution"] = self.report.to_dict()

@@ -329,27 +329,12 @@ def plan_text(result: CompositionResult) -> str:
         )
     goals = "\n".join(f"  {_source(g)}" for g in plan.goals)
     columns = ["#", "component", "action", "inputs and preconditions from", "alternatives"]
-    return f"{head}\n{table(columns, rows)}\nGoals:\n{goals}{_unused_note(result)}"
+    return f"{head}\n{table(columns, rows)}\nGoals:\n{goals}{_unused_note(result.unused_inputs)}"
 
 
-def _unused(result: CompositionResult, earlier: Sequence[Plan] = ()) -> list[tuple[str, str]]:
-    """The (name, class) of the task's inputs the plan leaves unused (docs/composition.md); ``earlier``: the
-    plans of the run it replaced, and an input one of them took is not among them. A re-plan, composed from
-    what held (the eraser on the shelf), needs no more what an earlier plan did with it, and the note blamed
-    the component classes for it (docs/tasks.md, "A sixth round")."""
-    taken = {
-        binding.source.name
-        for plan in earlier
-        for step in plan.steps
-        for binding in step.bindings
-        if binding.source.step is None and binding.source.requirement == result.requirement
-    }
-    return [(name, type_) for name, type_ in result.unused_inputs if name not in taken]
-
-
-def _unused_note(result: CompositionResult, earlier: Sequence[Plan] = ()) -> str:
-    """A note naming the inputs :func:`_unused` gives (none: no note)."""
-    unused = _unused(result, earlier)
+def _unused_note(unused: Sequence[tuple[str, str]]) -> str:
+    """A note naming the task's inputs no plan took (``CompositionResult.unused_inputs`` for a plan,
+    ``RunResult.unused_inputs`` for a run; docs/composition.md); none: no note."""
     if not unused:
         return ""
     named = ", ".join(f"{name} ({shorten(type_)})" for name, type_ in unused)
@@ -548,7 +533,7 @@ def run(
         except RecordingError as error:
             raise click.ClickException(str(error)) from None
     if as_json:
-        found = run_dict(result)
+        found = result.to_dict()
         found["seed"] = seed
         found["sim_seconds"] = round(sim_seconds, 3)
         if policy is not None:
@@ -763,22 +748,8 @@ def run_text(result: RunResult, sim_seconds: float, wall_seconds: float) -> str:
     steps = table(["#", "component", "sim s", "outcome", "effects checked"], rows)
     if not report.steps:  # every effect held already: no table of no steps
         steps = "nothing to do: every effect of the task holds already"
-    note = _unused_note(result.composition, _replaced(result))
+    note = _unused_note(result.unused_inputs)
     return f"{header}{steps}\n{verdict}; {timing}{_answers_text(result)}{note}"
-
-
-def _replaced(result: RunResult) -> list[Plan]:
-    return [replan.plan for replan in result.replans]
-
-
-def run_dict(result: RunResult) -> dict[str, Any]:
-    """``cbrs run --json``'s object: the run's, with the plan's ``unused_inputs`` those no plan of the run
-    took, as the text's note names them (:func:`_unused`; the composition's own are the last plan's)."""
-    found = result.to_dict()
-    if "unused_inputs" in found["plan"]:
-        unused = _unused(result.composition, _replaced(result))
-        found["plan"]["unused_inputs"] = [{"name": name, "type": type_} for name, type_ in unused]
-    return found
 
 
 def _refuted_text(goal: GoalCheck) -> str:

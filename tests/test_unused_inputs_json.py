@@ -1,7 +1,8 @@
-"""``cbrs run --json``'s ``unused_inputs`` names the inputs no plan of the run took, as the text's note does
-(cbrs.cli_actions: one function gives both; docs/composition.md): after a re-plan that no longer takes an
-input the plan it replaced took, neither names it. The composition's own ``to_dict`` stays the last plan's.
-No world is run: the results are built from a composed plan."""
+"""A run's ``unused_inputs`` (``RunResult.unused_inputs``: `cbrs run --json`, the server's task runs, and
+`cbrs run`'s note) names the inputs no plan of the run took (docs/composition.md): after a re-plan that no
+longer takes an input the plan it replaced took, none names it (docs/tasks.md, "A sixth round":
+TidyPenAndEraser's re-plan was said to do without the eraser). A composition's own stays its plan's. No
+world is run: the results are built from a composed plan."""
 
 from __future__ import annotations
 
@@ -12,7 +13,7 @@ import pytest
 from cbrs.actions.composer import Composer, CompositionResult
 from cbrs.actions.executor import ExecutionReport, RunStatus
 from cbrs.actions.runner import Replan, RunResult
-from cbrs.cli_actions import run_dict, run_text
+from cbrs.cli_actions import run_text
 from cbrs.kb import KnowledgeBase
 
 
@@ -39,8 +40,8 @@ def test_the_json_leaves_out_an_input_an_earlier_plan_took(
 ) -> None:
     first, last = replanned
     result = _run(last, first)
-    assert [u["name"] for u in result.to_dict()["plan"]["unused_inputs"]] == ["pen"]  # the last plan's
-    assert run_dict(result)["plan"]["unused_inputs"] == []
+    assert [u["name"] for u in last.to_dict()["unused_inputs"]] == ["pen"]  # the last plan's own
+    assert result.unused_inputs == () and result.to_dict()["plan"]["unused_inputs"] == []
     assert "no step takes" not in run_text(result, 0.0, 0.0)
 
 
@@ -49,6 +50,6 @@ def test_the_json_and_the_note_name_an_input_no_plan_took(
 ) -> None:
     _, last = replanned
     for result in (_run(last), _run(last, last)):
-        (unused,) = run_dict(result)["plan"]["unused_inputs"]
+        (unused,) = result.to_dict()["plan"]["unused_inputs"]
         assert unused["name"] == "pen" and unused["type"].endswith("#Pen")
         assert "no step takes the task's input pen (home:Pen)" in run_text(result, 0.0, 0.0)
