@@ -52,8 +52,9 @@ class SimContext:
     known: Mapping[int, Mapping[str, Any]] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        if self.arm not in self.world.arm_specs and self.world.arm_specs:
-            self.arm = next(iter(self.world.arm_specs))  # a robot with one arm: the arm at work is that one
+        specs = getattr(self.world, "arm_specs", None)  # None: a context for planning alone, with no world
+        if specs and self.arm not in specs:
+            self.arm = next(iter(specs))  # a robot with one arm: the arm at work is that one
 
     @property
     def map(self) -> SemanticMap:
