@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
+from collections.abc import Callable, Collection, Iterable, Iterator, Mapping, Sequence
 from dataclasses import replace
 from typing import Any
 
@@ -274,40 +274,39 @@ class PlanChecks:
         """Refuse a plan that hands an object the task gives over onto the base's platform when no arm
         can load it there (by the map: the object where it is believed to be, the base at the docking
         pose of what it stands on; the same decision the hand-over makes), before the base drives off."""
-        steps = {step.index: step for step in plan.steps}
-        smap = self.world.map
-        for step in plan.steps:
-            if step.action != PREFIXES["act"] + "HandingOverOntoPlatform":
+        for step, obj, support in self._given_objects(plan, values, "HandingOverOntoPlatform"):
+            if support.dock is None:
                 continue
-            for name in sorted(task_inputs_of(step, steps)):
-                value = values.get(name)
-                obj = smap.objects.get(str(value["@id"])) if isinstance(value, dict) and "@id" in value else None
-                support = smap.things.get(obj.support or "") if obj is not None else None
-                if obj is None or support is None or support.dock is None:
-                    continue
-                estimate, model, dock = self._estimate(obj, support), Manipulation.of(obj).model, docking_pose(support)
-                try:
-                    who_loads(self.context, estimate, model, dock)
-                except (SkillFailed, MovesRefusedError) as refused:
-                    if not self._loads_nearby(estimate, model, dock):
-                        raise CannotLoadError(step.component, obj.iri, str(refused)) from None
+            estimate, model, dock = self._estimate(obj, support), Manipulation.of(obj).model, docking_pose(support)
+            try:
+                who_loads(self.context, estimate, model, dock)
+            except (SkillFailed, MovesRefusedError) as refused:
+                if not self._loads_nearby(estimate, model, dock):
+                    raise CannotLoadError(step.component, obj.iri, str(refused)) from None
 
     def _check_carry(self, plan: Plan, values: Mapping[str, Any]) -> None:
         """Refuse a plan whose arm would take an object the task gives to carry it where the object held
         would meet an appliance on the way, by every arm and approach the step would choose from
         (:func:`arm_choice.check_take`: :class:`arm_choice.CannotCarryError`), before anything moves."""
+        for step, obj, support in self._given_objects(plan, values, "ApproachToObject"):
+            check_take(self.context, step, obj.iri, self._estimate(obj, support), Manipulation.of(obj).model)
+
+    def _given_objects(
+        self, plan: Plan, values: Mapping[str, Any], action: str
+    ) -> Iterator[tuple[PlanStep, MapObject, Thing]]:
+        """(step, object, what it stands on) for each object of the map the task gives a step of ``action``
+        (a local name of the act: namespace), directly or through the steps before it."""
         steps = {step.index: step for step in plan.steps}
         smap = self.world.map
         for step in plan.steps:
-            if step.action != PREFIXES["act"] + "ApproachToObject":
+            if step.action != PREFIXES["act"] + action:
                 continue
             for name in sorted(task_inputs_of(step, steps)):
                 value = values.get(name)
                 obj = smap.objects.get(str(value["@id"])) if isinstance(value, dict) and "@id" in value else None
                 support = smap.things.get(obj.support or "") if obj is not None else None
                 if obj is not None and support is not None:
-                    estimate = self._estimate(obj, support)
-                    check_take(self.context, step, obj.iri, estimate, Manipulation.of(obj).model)
+                    yield step, obj, support
 
     def _check_docks(self, plan: Plan, values: Mapping[str, Any], ads: Mapping[str, Advertisement]) -> None:
         """Refuse a plan that sends the base to fetch an object standing only on furniture with no docking

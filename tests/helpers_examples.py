@@ -9,6 +9,15 @@ from cbrs.kb import KnowledgeBase
 EXAMPLES = Path(__file__).resolve().parents[1] / "docs" / "examples"
 
 
+def updated_store(*updates: str) -> KnowledgeBase:
+    """The bundled store with docs/examples' updates (``.ru`` files) applied, as `cbrs update --file` applies
+    them."""
+    kb = KnowledgeBase.open(":memory:")
+    for name in updates:
+        kb.update((EXAMPLES / name).read_text(encoding="utf-8"))
+    return kb
+
+
 def wine7_store(directory: Path) -> KnowledgeBase:
     """The bundled store with the wine bottle narrowed to 7 cm (docs/tasks.md, "the 7 cm variant": the
     7.5 cm one is refused by the jaws) and the low cupboard; the narrowed file written in ``directory``."""

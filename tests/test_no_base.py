@@ -32,24 +32,16 @@ from cbrs.sim.services import provide_grid_map
 from cbrs.sim.values import decode
 from cbrs.sim.world import HomeWorld, open_world
 from cbrs.tasks import refusal_in_home
-from tests.helpers_examples import EXAMPLES
+from tests.helpers_examples import updated_store
 
 SVC, WORLD = PREFIXES["svc"], PREFIXES["world"]
 NO_BASE_RU, TWO_BASES_RU = "lab6_no_base.ru", "lab6_two_bases.ru"
 BASE_WORDS = "it works the mobile base (drives it, loads its platform or finds its marker), and graph:map has none"
 
 
-def _store(*updates: str) -> KnowledgeBase:
-    """The bundled store with docs/examples' updates applied, as `cbrs update --file` applies them."""
-    kb = KnowledgeBase.open(":memory:")
-    for name in updates:
-        kb.update((EXAMPLES / name).read_text(encoding="utf-8"))
-    return kb
-
-
 @pytest.fixture(scope="module")
 def no_base() -> KnowledgeBase:
-    return _store(NO_BASE_RU)
+    return updated_store(NO_BASE_RU)
 
 
 @pytest.fixture(scope="module")
@@ -62,7 +54,7 @@ def test_the_update_takes_the_base_and_all_said_of_it_out_of_the_map(no_base: Kn
     smap = SemanticMap.read(no_base)
     check_home(smap)  # no HomeError
     assert smap.robots == {} and map_bases(no_base) == set()
-    assert map_bases(_store()) == {SVC + "P3DX01"}
+    assert map_bases(updated_store()) == {SVC + "P3DX01"}
     rows = no_base.query(
         "SELECT ?s WHERE { GRAPH <https://w3id.org/cbrs/graph/map> { ?s ?p ?o FILTER(CONTAINS(STR(?s), 'P3DX01')) } }"
     )
@@ -70,7 +62,7 @@ def test_the_update_takes_the_base_and_all_said_of_it_out_of_the_map(no_base: Kn
 
 
 def test_cbrs_home_says_what_a_home_with_no_base_allows(no_base: KnowledgeBase) -> None:
-    assert survey(no_base).bases() == NO_BASE and survey(_store()).bases() == "P3DX01"
+    assert survey(no_base).bases() == NO_BASE and survey(updated_store()).bases() == "P3DX01"
     done = CliRunner().invoke(home, [], obj=App(":memory:", no_base))
     assert done.exit_code == 0, done.output
     assert "0 mobile robots" in done.output
@@ -113,7 +105,7 @@ def test_with_a_base_or_several_no_component_is_left_out_for_it(no_base: Knowled
 
 @pytest.fixture(scope="module")
 def two_bases() -> KnowledgeBase:
-    return _store(TWO_BASES_RU)
+    return updated_store(TWO_BASES_RU)
 
 
 def test_two_bases_are_taken_and_said(two_bases: KnowledgeBase) -> None:
@@ -153,11 +145,12 @@ def test_the_base_a_plan_works_is_the_one_its_steps_name(two_bases: KnowledgeBas
     both = replace(plan, steps=(*plan.steps, replace(drive, component=other.iri)))
     with pytest.raises(WhichBaseError, match=r"the plan works two of them \(.*NavigateToPlace_P3DX02 work P3DX02"):
         base_for(world, both, {**ads, other.iri: other}, {})
-    assert base_for(_home_of(SemanticMap.read(_store())), plan, ads, {}) is None  # a home of one: nothing to choose
+    one = SemanticMap.read(updated_store())
+    assert base_for(_home_of(one), plan, ads, {}) is None  # a home of one: nothing to choose
 
 
 def test_two_bases_started_on_each_other_are_refused_naming_both() -> None:
-    kb = _store(TWO_BASES_RU)  # its own: the update moves the second base
+    kb = updated_store(TWO_BASES_RU)  # its own: the update moves the second base
     kb.update(
         "PREFIX home: <https://w3id.org/cbrs/home#> PREFIX svc: <https://w3id.org/cbrs/service#> "
         "DELETE { GRAPH <https://w3id.org/cbrs/graph/map> { svc:P3DX02 home:x ?x ; home:y ?y } } "

@@ -20,7 +20,7 @@ from cbrs.sim.components import SimEnvironment
 from cbrs.sim.errors import UnknownEntityError
 from cbrs.sim.run_checks import CannotLoadError, OutOfReachError
 from cbrs.sim.world import HomeWorld, open_world
-from tests.helpers_examples import EXAMPLES
+from tests.helpers_examples import updated_store
 
 WORLD = PREFIXES["world"]
 TASKS = Path(__file__).parent / "data" / "tasks"
@@ -32,18 +32,10 @@ world:Pencil1 a home:Pencil ; home:shapeKind "box" ; home:sizeX 0.16 ; home:size
 """
 
 
-def _store(*updates: str) -> KnowledgeBase:
-    """The bundled store with docs/examples' updates applied, as `cbrs update --file` applies them."""
-    kb = KnowledgeBase.open(":memory:")
-    for name in updates:
-        kb.update((EXAMPLES / name).read_text(encoding="utf-8"))
-    return kb
-
-
 @pytest.fixture(scope="module")
 def left_only(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[KnowledgeBase, HomeWorld]]:
     """The left arm alone, a pencil on the table's west (which only the left arm reaches) and its task."""
-    kb = _store(LEFT_ONLY)
+    kb = updated_store(LEFT_ONLY)
     pencil = tmp_path_factory.mktemp("one_arm") / "pencil.ttl"
     pencil.write_text(PENCIL_ON_THE_LEFT, encoding="utf-8")
     kb.load([pencil], graph="map")
@@ -61,7 +53,7 @@ def left_only(tmp_path_factory: pytest.TempPathFactory) -> Iterator[tuple[Knowle
     ],
 )
 def test_the_home_check_takes_one_arm_or_none(updates: tuple[str, ...], sides: list[str]) -> None:
-    smap = SemanticMap.read(_store(*updates))
+    smap = SemanticMap.read(updated_store(*updates))
     check_home(smap)  # no HomeError
     assert sorted(arm.side for arm in smap.arms.values()) == sides
     assert not any(iri.endswith("Hand") for iri in smap.things)  # the taken arm's gripper went with it
@@ -80,7 +72,7 @@ def test_the_home_check_takes_one_arm_or_none(updates: tuple[str, ...], sides: l
     ],
 )
 def test_two_arms_of_one_side_or_a_side_of_neither_are_refused_by_name(side: str, expected: str) -> None:
-    kb = _store()
+    kb = updated_store()
     kb.update(
         "PREFIX home: <https://w3id.org/cbrs/home#> PREFIX world: <https://w3id.org/cbrs/world#> "
         "DELETE { GRAPH <https://w3id.org/cbrs/graph/map> { world:CytonDualArm01LeftArm home:armSide ?s } } "
@@ -127,7 +119,7 @@ def test_an_object_out_of_the_one_arms_reach_is_refused_before_anything_moves(
 
 
 def test_a_robot_with_no_arm_is_refused_an_arm_task_before_anything_moves() -> None:
-    kb = _store(RIGHT_ONLY, LEFT_ONLY)
+    kb = updated_store(RIGHT_ONLY, LEFT_ONLY)
     with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
         started = world.time
         with pytest.raises(OutOfReachError, match=r"the Cup .*: CytonDualArm01 has no arm \(home:hasArm\)"):
@@ -138,7 +130,7 @@ def test_a_robot_with_no_arm_is_refused_an_arm_task_before_anything_moves() -> N
 def test_the_left_arm_alone_serves_a_cup() -> None:
     """The one simulation run: the left arm takes the cup below the tap, sets it down, and, free again,
     pushes the lever itself (with two arms the other arm pushes it)."""
-    kb = _store(LEFT_ONLY)
+    kb = updated_store(LEFT_ONLY)
     with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
         result = run_task(kb, "RobotArmServeACup", SimEnvironment(world, kb), composer=Composer(kb))
         assert world.arm(ArmSide.LEFT).held is None
