@@ -18,6 +18,7 @@ from typing import Any
 
 from cbrs.actions.composer import CompositionResult
 from cbrs.actions.plan import Plan
+from cbrs.kb.semantic_map import local_name as _local
 
 __all__ = ["BaseChoice", "choose_base"]
 
@@ -96,7 +97,3 @@ def _why(best: str, ranked: list[str], planned: Mapping[str, Plan], bases: list[
             f"{_local(second)}'s {theirs.similarity:.3f}"
         )
     return f"its plan and {_local(second)}'s cost alike and match alike: the first base by IRI"
-
-
-def _local(iri: str) -> str:
-    return iri.rsplit("#", 1)[-1].rsplit("/", 1)[-1]
