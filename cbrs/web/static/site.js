@@ -11,6 +11,23 @@
     box.focus();
     box.select();
   });
+  // A phone's header: the pages' links behind the Menu button, so that the header keeps to one line at
+  // 375 px (they took four). Only with this script: without it the button stays hidden and the links show.
+  const header = document.querySelector("header.top");
+  const toggle = document.getElementById("menu-toggle");
+  if (header && toggle) {
+    const show = (open) => {
+      header.classList.toggle("open", open);
+      toggle.setAttribute("aria-expanded", String(open));
+    };
+    header.classList.add("menu");
+    toggle.addEventListener("click", () => show(!header.classList.contains("open")));
+    header.addEventListener("keydown", (event) => {
+      if (event.key !== "Escape" || !header.classList.contains("open")) return;
+      show(false);
+      toggle.focus();
+    });
+  }
   // A picture wider than the page opens on its middle, where the class or the plan's trunk is drawn,
   // not on its empty left edge.
   for (const scroller of document.querySelectorAll(".diagram-scroll")) {
