@@ -10,6 +10,7 @@ camera"). Skipped where Chromium or Playwright is missing, as ``tests/test_brows
 from __future__ import annotations
 
 import os
+import re
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -129,3 +130,19 @@ def test_the_header_keeps_to_one_line_on_a_phone_and_hides_no_page(phone: Any, s
     phone.keyboard.press("Escape")
     assert toggle.get_attribute("aria-expanded") == "false" and not links.first.is_visible()
     assert phone.evaluate("document.activeElement.id") == "menu-toggle"
+
+
+def test_the_live_steps_table_keeps_what_the_server_renders(phone: Any, server: Server, shots: Path) -> None:
+    playwright_api.expect(phone.locator("#stream-state")).to_have_text("· live")  # subscribed
+    run = server.tasks.start("FetchMyPen")
+    playwright_api.expect(phone.locator("#run-status")).to_have_text("succeeded")
+    live = phone.locator("#steps tr").evaluate_all(ROWS)
+    snap(phone, shots, "tasks-phone")
+    phone.goto(f"/tasks/{run.id}")
+    rendered = phone.locator("#steps tr").evaluate_all(ROWS)
+    assert live == rendered
+    first, second, replanned = rendered
+    assert first[2] == "step-succeeded failover" and first[4][1] == [FIRST, SECOND]
+    assert re.fullmatch(r"succeeded\s+injected failure of svc:LocateMobileRobot_CeilingCamera01", first[5][0])
+    assert second[:3] == ["1", "2", "step-failed"] and "svc:GraspObject_CytonDualArm01 dropped the pen" in second[5][0]
+    assert replanned[:4] == ["2", "1", "step-succeeded", ["2.1", ["plan 2, after a re-plan"]]]

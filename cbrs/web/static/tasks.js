@@ -55,21 +55,37 @@
     }
   }
 
+  // One row per plan step, as the server's steps() builds them (cbrs/web/tasks.py): the components tried
+  // in order, the outcome, and every failure's reason, kept after a failover succeeds; after a re-plan the
+  // new plan's steps follow the old one's. Rows the server rendered carry their plan and what they show.
+  let plan = Number((steps.lastElementChild || {}).dataset?.plan) || 1;
+  const STEP_STATUS = { step_started: "started", step_succeeded: "succeeded", step_failed: "failed" };
+
   function row(step) {
-    let tr = steps.querySelector('tr[data-step="' + step + '"]');
+    const key = 'tr[data-plan="' + plan + '"][data-step="' + step + '"]';
+    let tr = steps.querySelector(key);
     if (!tr) {
-      tr = el("tr", { "data-step": String(step) }, el("td", { class: "num" }, String(step)), el("td"), el("td"));
-      tr.tried = [];
+      const num = el("td", { class: "num" });
+      if (plan > 1) num.append(el("span", { class: "small muted", title: "plan " + plan + ", after a re-plan" }, plan + "."));
+      num.append(String(step));
+      tr = el("tr", { "data-plan": String(plan), "data-step": String(step) }, num, el("td"), el("td"));
       steps.append(tr);
     }
-    if (!tr.tried) tr.tried = Array.from(tr.querySelectorAll("td:nth-child(2) [title]"), (a) => a.title);
+    if (!tr.tried) {
+      tr.tried = Array.from(tr.querySelectorAll("td:nth-child(2) [title]"), (a) => a.title);
+      tr.reasons = Array.from(tr.querySelectorAll("td:nth-child(3) .small"), (s) => s.textContent);
+      tr.failover = tr.classList.contains("failover");
+    }
     return tr;
   }
 
   function stepEvent(message) {
+    if (message.event === "replanning") plan = Number(message.plan) || plan + 1;
+    const status = STEP_STATUS[message.event];
+    if (!status) return; // the progress events that are no step's: awaiting, passed_over, base_chosen
     const tr = row(message.step);
     const [, who, state] = tr.children;
-    if (message.event === "step_started" && !tr.tried.includes(message.component)) {
+    if (status === "started" && !tr.tried.includes(message.component)) {
       tr.tried.push(message.component);
       who.replaceChildren();
       tr.tried.forEach((iri, i) => {
@@ -77,10 +93,13 @@
         who.append(iriLink(iri));
       });
     }
-    const status = { step_started: "started", step_succeeded: "succeeded", step_failed: "failed" }[message.event];
+    if (status === "failed") {
+      tr.reasons.push(shortenText(message.reason || ""));
+      tr.failover = Boolean(message.failover);
+    }
     state.replaceChildren(el("span", { class: "badge status-" + status }, status));
-    if (message.reason) state.append(el("br"), el("span", { class: "small muted" }, shortenText(message.reason)));
-    tr.className = "step-" + status + (tr.tried.length > 1 || message.failover ? " failover" : "");
+    for (const reason of tr.reasons) if (reason) state.append(el("br"), el("span", { class: "small muted" }, reason));
+    tr.className = "step-" + status + (tr.tried.length > 1 || tr.failover ? " failover" : "");
   }
 
   function listEvent(message) {
@@ -95,6 +114,7 @@
 
   function startRun(id, task) {
     current = id;
+    plan = 1;
     steps.replaceChildren();
     eventList.replaceChildren();
     verdict.textContent = "";
@@ -143,6 +163,7 @@
     if (!response.ok) return;
     const run = (await response.json()).run; // the run page's twin: {mode, run}
     if (current !== id) startRun(id, run.task);
+    plan = 1;
     steps.replaceChildren();
     eventList.replaceChildren();
     run.events.forEach(handleRunEvent);
