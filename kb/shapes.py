@@ -686,6 +686,8 @@ def _term_problems(store: Store, closures: dict[str, list[ox.Quad]], context: Se
         if namespace not in candidates:
             candidates[namespace] = _candidates(store, namespace, declared_here)
         near = nearest_term(term.value, candidates[namespace])
+        if near is None or not _misspelt(term.value, near):
+            near = _slip_of(term.value, candidates[namespace]) or near
         if namespace not in closed_namespaces and (near is None or not _misspelt(term.value, near)):
             # A new concept, not a misspelt one: matchmaking compares undeclared concepts by name.
             continue
@@ -739,6 +741,17 @@ def _misspelt(iri: str, near: str) -> bool:
 
     a, b = _local(iri).lower(), _local(near).lower()
     return jellyfish.damerau_levenshtein_distance(a, b) <= min(2, max(1, len(b) // 4))
+
+
+def _slip_of(iri: str, candidates: Iterable[str]) -> str | None:
+    """The candidate ``iri`` is a slip of by :func:`_misspelt` (the fewest edits, then the first by name),
+    where :func:`nearest_term`'s ratio misses it: two letters swapped in a short name (``home:Pne`` for
+    ``home:Pen`` has a ratio of 0.67, below the cutoff, and an edit distance of 1)."""
+    import jellyfish
+
+    namespace, local = _namespace(iri), _local(iri).lower()
+    slips = [c for c in candidates if c.startswith(namespace) and c != iri and _misspelt(iri, c)]
+    return min(slips, key=lambda c: (jellyfish.damerau_levenshtein_distance(local, _local(c).lower()), c), default=None)
 
 
 def _local(iri: str) -> str:
