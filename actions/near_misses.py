@@ -5,9 +5,11 @@ component gives: the kitchen's tracker gives a home:PersonLocation where the dri
 home:PersonPosition. A "no plan" answer names such components, what differs and the change that would do.
 
 A concept D is *near* a needed concept C (docs/composition.md, "Near misses") when neither is an is-a
-relative of the other (a relative is a provider already), they are not declared disjoint, Sem-Str's
-complementary words do not tell them apart (PersonLocation and PersonPosition are both about a person;
-RobotPosition is about another thing) and, by the store's taxonomy, they
+relative of the other (a relative is a provider already), they are not declared disjoint, their
+complementary words do not say they are about different things (:func:`about_other_things`:
+PersonLocation and PersonPosition are both about a person; RobotPosition is about a robot, a sibling of
+the person; DeviceStatus and DoorStatus are about a device and a door, which no sibling or disjointness
+keeps apart) and, by the store's taxonomy, they
 
 * have the same parts (the same non-empty set of hasPart classes, own or inherited) and a superclass in
   common other than the root (the same idea under another name, in one branch: a home:Person and a
@@ -32,6 +34,7 @@ from cbrs.actions.graph import SRI, Matcher, Need, ServiceResourceGraph, stateme
 from cbrs.kb import Statement
 from cbrs.kb.namespaces import shorten
 from cbrs.reasoner.degrees import degree_of_match
+from cbrs.reasoner.names import core_split, local_name
 from cbrs.reasoner.statements import statement_similarity
 from cbrs.reasoner.taxonomy import ROOT
 
@@ -114,7 +117,7 @@ def near(matcher: Matcher, wanted: str, offered: str) -> str | None:
     if wanted not in index or offered not in index or degree_of_match(index, wanted, offered).accepted:
         return None
     first, second = index.canonical(wanted), index.canonical(offered)
-    if index.disjoint(first, second) or matcher.measure.qualifier_factor(first, second) < 1:
+    if index.disjoint(first, second) or about_other_things(matcher, first, second):
         return None
     parts = index.parts_of(first)
     if parts and parts == index.parts_of(second) and index.common_ancestor(first, second)[0] != ROOT:
@@ -122,6 +125,39 @@ def near(matcher: Matcher, wanted: str, offered: str) -> str | None:
     if _superclasses(matcher, first) & _superclasses(matcher, second):
         return SIBLINGS
     return None
+
+
+def about_other_things(matcher: Matcher, first: str, second: str) -> bool:
+    """Whether the complementary words of two concepts say they are about different things.
+
+    Differing words alone do not: home:DeviceStatus and home:DoorStatus differ in "device" and "door",
+    yet nothing says a door is no device (a motorised one is both). Where each concept's complementary
+    words name a class of its own vocabulary (home:RobotPosition's "Robot", home:Robot), those classes
+    decide: they set the concepts apart when declared disjoint or siblings (a direct superclass in
+    common, not the root: a home:Robot or a home:Person, both home:Agents), and never when one is a kind
+    of the other or they meet only further up (home:Device is an artifact, home:Door a building element).
+    Words that name no class are all there is to go by: differing, they set the concepts apart."""
+    if matcher.measure.qualifier_factor(first, second) >= 1:
+        return False  # the same complementary words, or a name without any
+    one, other = _named_thing(matcher, first), _named_thing(matcher, second)
+    if one is None or other is None:
+        return True
+    index = matcher.index
+    if index.is_a(one, other) or index.is_a(other, one):
+        return False
+    return index.disjoint(one, other) or bool(_superclasses(matcher, one) & _superclasses(matcher, other))
+
+
+def _named_thing(matcher: Matcher, concept: str) -> str | None:
+    """The class a concept's complementary words name in its own vocabulary (home:RobotPosition:
+    home:Robot), or None."""
+    local = local_name(concept)
+    core, rest = core_split(local)
+    if not rest or not local.lower().endswith(core):
+        return None
+    words = local[: len(local) - len(core)].strip("_- ")
+    named = concept[: len(concept) - len(local)] + words
+    return named if words and named in matcher.index else None
 
 
 def _superclasses(matcher: Matcher, concept: str) -> set[str]:
@@ -214,4 +250,13 @@ def _given(graph: ServiceResourceGraph, component: str) -> list[str]:
     ]
 
 
-__all__ = ["SAME_PARTS", "SIBLINGS", "Difference", "NearMiss", "near", "near_misses", "statement_differences"]
+__all__ = [
+    "SAME_PARTS",
+    "SIBLINGS",
+    "Difference",
+    "NearMiss",
+    "about_other_things",
+    "near",
+    "near_misses",
+    "statement_differences",
+]

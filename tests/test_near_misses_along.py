@@ -1,7 +1,9 @@
 """Near misses are looked for at every need along the chain a "no plan" answer follows down, not only at
 the deepest (docs/composition.md, "Near misses"; docs/tasks.md, "A sixth round": the lab's fridge sensor,
 whose output the requirement's own output nearly is, went unnamed because the answer followed the bundled
-sensor board down to its missing home:Door)."""
+sensor board down to its missing home:Door). The lab's sensor is registered as the lab wrote it, giving a
+home:DeviceStatus: its complementary word names home:Device, which is no sibling of home:Door, so it does
+not set the two statuses apart (actions.near_misses.about_other_things)."""
 
 from __future__ import annotations
 
@@ -15,24 +17,16 @@ from tests.helpers_examples import EXAMPLES
 
 LAB6 = "https://example.org/lab6#"
 SENSOR = LAB6 + "CheckFridgeDoor_FridgeDoorSensor01"
-# a class for the door's state under another name, a sibling of home:DoorStatus (one word: nothing in its
-# name says what it is about, so Sem-Str's complementary words cannot tell it apart)
-OPENNESS = """@prefix home: <https://w3id.org/cbrs/home#> . @prefix lab6: <https://example.org/lab6#> .
-@prefix owl: <http://www.w3.org/2002/07/owl#> . @prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .
-lab6:Openness a owl:Class ; rdfs:subClassOf home:Status ; rdfs:label "openness"@en ."""
 
 
 @pytest.fixture(scope="module")
-def kb(tmp_path_factory: pytest.TempPathFactory) -> KnowledgeBase:
+def kb() -> KnowledgeBase:
     kb = KnowledgeBase.open(":memory:")
     for graph in ("ontology", "map"):
         kb.load([EXAMPLES / "lab6_fridge.ttl"], graph=graph)
-    openness = tmp_path_factory.mktemp("near") / "openness.ttl"
-    openness.write_text(OPENNESS)
-    kb.load([EXAMPLES / "lab6_door_status_informs.ttl", openness], graph="ontology")
+    kb.load([EXAMPLES / "lab6_door_status_informs.ttl"], graph="ontology")
     kb.load([EXAMPLES / "lab6_watch_the_fridge.ttl"], graph="requirements")
-    sensor = (EXAMPLES / "lab6_mistake_sensor_output.ttl").read_text().replace("home:DeviceStatus", "lab6:Openness")
-    kb.registry.register(sensor)
+    kb.registry.register((EXAMPLES / "lab6_mistake_sensor_output.ttl").read_text())
     kb.registry.register((EXAMPLES / "lab6_caregiver_phone.ttl").read_text())
     return kb
 
@@ -45,7 +39,7 @@ def test_the_sensor_that_nearly_gives_the_requirement_its_output_is_named(kb: Kn
     assert [(m.component, m.consumer) for m in unmet.near_misses] == [(SENSOR, "SRO")]
     text = unmet.text()
     assert "CheckFridgeDoor_FridgeDoorSensor01 comes close: it gives " in text
-    assert "Openness, the requirement asks for home:DoorStatus (siblings, neither a kind of the other)" in text
+    assert "home:DeviceStatus, the requirement asks for home:DoorStatus (siblings, neither a kind of the other)" in text
     assert unmet.to_dict()["near_misses"][0]["consumer"] == "SRO"
 
 
