@@ -20,7 +20,7 @@ from typing import NamedTuple
 from cbrs.actions.plan import PlanStep
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import PREFIXES
-from cbrs.kb.semantic_map import Thing, local_name
+from cbrs.kb.semantic_map import MapObject, Thing, local_name
 from cbrs.sim import skills
 from cbrs.sim.arms import CARRY_CLEARANCE, ArmSide
 from cbrs.sim.context import SimContext, SkillFailed
@@ -28,10 +28,13 @@ from cbrs.sim.errors import GraspMisfitError, MovesRefusedError, SimulationError
 from cbrs.sim.geometry import Pose2D, Region
 from cbrs.sim.grasping import GraspKind, GraspPose, ObjectModel, compute_grasp_pose
 from cbrs.sim.hold_choice import Candidates, GraspChoice, first_clear, refuse_moves, seen_extent
+from cbrs.sim.perceived import PerceivedWorld
 from cbrs.sim.perception import ObjectEstimate
-from cbrs.sim.place_spots import other_objects, place_spots, reach_of, spot_region
+from cbrs.sim.place_spots import RELAY_MARGIN, spot_region
 from cbrs.sim.relay import CLEAR_TRIES, RELAY_TRIES, relay_spot, resting_at
 from cbrs.sim.transit import band_advice, floor_cause, floor_needs, floor_to
+from cbrs.sim.values import Manipulation
+from cbrs.sim.world import HomeWorld
 
 ACT = PREFIXES["act"]
 
@@ -352,8 +355,9 @@ def hold_end(
 ) -> tuple[Thing, Region, list[tuple[float, float]]] | None:
     """Where the hold the running component starts ends, when the plan says: the place the first carry
     after the running step is given, before any other step of its robot takes an object; and that
-    place's surface and spots (:func:`place_spots`) for the arm ``side`` (else ``ctx.arm``), as the carry
-    will aim.
+    place's surface and spots for the arm ``side`` (else ``ctx.arm``) in the order the carry will aim at
+    them (:func:`packing.carry_spots`: first those that leave room for what the plan puts there after it;
+    before, :func:`place_spots`' order, whose first spot the carry need not take).
     The running step is the one the executor said it starts (``SimEnvironment.starting``), else the
     plan's one step of this component; the carry's place is what the executor knows of its inputs then
     (the task's value, or an earlier step's output), else the task's value. None when it is not known
@@ -383,13 +387,45 @@ def hold_end(
         places = [iri for iri in iris if iri in smap.regions or iri in smap.furniture]
         if len(places) != 1:
             return None
+        from cbrs.sim.packing import carry_spots  # packing asks this module whether an arm holds a spot
+
         place = smap.things[places[0]]
-        spec = ctx.world.arm_specs[side or ctx.arm]
-        others = other_objects(ctx.world, ctx.belief, name)
-        size = ctx.world.objects[name].size if name in ctx.world.objects else (0.0, 0.0, 0.0)
-        surface, spots = place_spots(smap, place, size, [reach_of(spec)], others)
+        surface, spots = carry_spots(ctx, place, name, side or ctx.arm, step)
         return place, surface, spots
     return None
+
+
+def lying_estimate(world: HomeWorld, belief: PerceivedWorld | None, obj: MapObject) -> ObjectEstimate:
+    """Where the checks of a plan take an object to be: where it is believed to be, else where the map puts
+    it on its support, lying as the map says (as perception gives it: the yaw of its long axis)."""
+    believed = belief.position(obj.name) if belief is not None else None
+    support = world.map.things.get(obj.support or "")
+    top = support.box.max_z if support is not None else 0.0
+    centre = believed or (obj.start.x, obj.start.y, top + obj.size[2] / 2)
+    axis = obj.start.yaw + (math.pi / 2.0 if obj.size[1] > obj.size[0] else 0.0)
+    return ObjectEstimate(centre[0], centre[1], centre[2], axis, obj.size, obj.colour, "map", 0.0, 0)
+
+
+def cannot_set_down(ctx: SimContext, obj: MapObject, surface: Region, at: tuple[float, float]) -> str:
+    """Why no arm of the robot whose reach the spot ``at`` of ``surface`` is RELAY_MARGIN inside can hold
+    ``obj`` over it to set it down, by any approach its hand can grip it by (empty: one can): what a carry
+    asks of a spot before it aims there (:func:`skills.can_set_down`, its hand turned as it takes the object
+    where it lies, believed or as the map says; the pass's taker asks the same with :func:`skills.can_grip`).
+    Asked of each spot a packing would give a later thing (:func:`packing.carry_spots`)."""
+    world = ctx.world
+    estimate, model = lying_estimate(world, ctx.belief, obj), Manipulation.of(obj).model
+    spot = spot_region(surface, *at)
+    refused: list[str] = []
+    for side, spec in sorted(world.arm_specs.items()):
+        if math.hypot(at[0] - spec.mount[0], at[1] - spec.mount[1]) > spec.reach - RELAY_MARGIN:
+            continue
+        for kind in model.preference:
+            held = model.by(kind)
+            why = skills.can_grip(held, world.arm(side).hand) or skills.can_set_down(world, estimate, side, held, spot)
+            if not why:
+                return ""
+            refused.append(why)
+    return refused[0] if refused else f"no arm reaches ({at[0]:.2f}, {at[1]:.2f}) {RELAY_MARGIN:.2f} m inside its reach"
 
 
 def holdable_spot(

@@ -15,22 +15,33 @@ from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 from cbrs.actions.plan import Plan, PlanStep
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import PREFIXES
-from cbrs.kb.semantic_map import SemanticMap, Thing, local_name
-from cbrs.sim.arm_choice import TAKING
+from cbrs.kb.semantic_map import MapObject, SemanticMap, Thing, local_name
+from cbrs.sim import skills
+from cbrs.sim.arm_choice import TAKING, cannot_set_down
+from cbrs.sim.arms import ArmSide
+from cbrs.sim.context import SimContext
 from cbrs.sim.geometry import Region
 from cbrs.sim.grounding import task_inputs_of
-from cbrs.sim.perceived import PerceivedWorld
-from cbrs.sim.place_spots import RELAY_CLEARANCE, RELAY_EDGE, RELAY_MARGIN, RELAY_STEP, other_objects, place_spots
+from cbrs.sim.place_spots import (
+    RELAY_CLEARANCE,
+    RELAY_EDGE,
+    RELAY_MARGIN,
+    RELAY_STEP,
+    fixtures_on,
+    other_objects,
+    place_spots,
+    reach_of,
+    support_of,
+)
 from cbrs.sim.relations import region_of
 from cbrs.sim.relay import RELAY_TRIES
-from cbrs.sim.world import HomeWorld
 
 log = logging.getLogger("cbrs.sim")
 
@@ -51,6 +62,9 @@ class PackingRule:
 
     order: str = "largest"
     toward: str = "rim"
+    footprint: str = "box"
+    """``box``: each thing covers its box (:class:`Footprint`) turned as the set-down leaves it; ``circle``:
+    the circle about its diagonal, as :func:`place_spots` keeps one thing alone (the packing's first form)."""
 
     def __post_init__(self) -> None:
         if self.order not in ("largest", "plan") or self.toward not in ("rim", "centre"):
@@ -58,6 +72,141 @@ class PackingRule:
                 f"a packing rule orders 'largest' or 'plan' and goes toward 'rim' or 'centre', not {self.order!r}"
                 f" and {self.toward!r}"
             )
+        if self.footprint not in FOOTPRINTS:
+            raise ValueError(f"a packing rule's footprint is one of {', '.join(FOOTPRINTS)}, not {self.footprint!r}")
+
+
+FOOTPRINTS = ("box", "circle")
+"""The footprints a :class:`PackingRule` may pack (docs/simulation.md, "Footprints")."""
+
+
+@dataclass(frozen=True)
+class Footprint:
+    """What a thing covers of the surface it rests on: the map's box of it (home:sizeX by home:sizeY; a round
+    thing's box holds its disc), its long side along ``axis`` (radians). A carry keeps the turn the hand
+    took the thing by (``skills.carry_object`` is given no yaw), so a thing comes to rest turned as it lay
+    where it was taken: the map's home:yaw, give or take the world's spread (docs/simulation.md)."""
+
+    length: float
+    width: float
+    axis: float
+
+    @classmethod
+    def lying(cls, size: Size, yaw: float) -> Footprint:
+        """The footprint of a thing of ``size`` whose x side lies along ``yaw`` (as the map's home:yaw)."""
+        across = size[1] > size[0]
+        return cls(max(size[0], size[1]), min(size[0], size[1]), yaw + (math.pi / 2.0 if across else 0.0))
+
+    @property
+    def radius(self) -> float:
+        """The circle about it (its half diagonal): nothing of it is farther from its centre."""
+        return math.hypot(self.length, self.width) / 2.0
+
+    def grown(self, by: float) -> Footprint:
+        return Footprint(self.length + 2.0 * by, self.width + 2.0 * by, self.axis)
+
+    def half_extent(self) -> tuple[float, float]:
+        """How far it reaches from its centre along x and along y."""
+        c, s = abs(math.cos(self.axis)), abs(math.sin(self.axis))
+        return (c * self.length + s * self.width) / 2.0, (s * self.length + c * self.width) / 2.0
+
+    def corners(self, x: float, y: float) -> list[Spot]:
+        """Its corners, in turn, centred at (x, y)."""
+        c, s = math.cos(self.axis), math.sin(self.axis)
+        a, b = self.length / 2.0, self.width / 2.0
+        return [(x + c * u - s * v, y + s * u + c * v) for u, v in ((a, b), (-a, b), (-a, -b), (a, -b))]
+
+
+def footprint_of(obj: MapObject) -> Footprint:
+    """The footprint of an object of the map, turned as the map says it lies."""
+    return Footprint.lying(obj.size, obj.start.yaw)
+
+
+def gap(a: Sequence[Spot], b: Sequence[Spot]) -> float:
+    """The distance between two convex polygons (corners in turn; one corner: a point), 0 where they meet."""
+    if _overlap(a, b):
+        return 0.0
+    return min(min(_to_polygon(p, b) for p in a), min(_to_polygon(p, a) for p in b))
+
+
+def _overlap(a: Sequence[Spot], b: Sequence[Spot]) -> bool:
+    for poly in (a, b):  # separated along the normal of an edge of one of them, else they meet
+        for (x0, y0), (x1, y1) in zip(poly, [*poly[1:], poly[0]], strict=True):
+            nx, ny = y0 - y1, x1 - x0
+            on_a = [nx * x + ny * y for x, y in a]
+            on_b = [nx * x + ny * y for x, y in b]
+            if max(on_a) < min(on_b) or max(on_b) < min(on_a):
+                return False
+    return True
+
+
+def _to_polygon(p: Spot, poly: Sequence[Spot]) -> float:
+    best = math.inf
+    for (x0, y0), (x1, y1) in zip(poly, [*poly[1:], poly[0]], strict=True):
+        dx, dy = x1 - x0, y1 - y0
+        length = dx * dx + dy * dy
+        t = 0.0 if length == 0.0 else max(0.0, min(1.0, ((p[0] - x0) * dx + (p[1] - y0) * dy) / length))
+        best = min(best, math.hypot(p[0] - x0 - t * dx, p[1] - y0 - t * dy))
+    return best
+
+
+Lying = tuple[float, float, Footprint]
+"""A thing on a place as the box packing takes it: (x, y, its footprint)."""
+
+
+def clear_of(
+    foot: Footprint,
+    x: float,
+    y: float,
+    others: Sequence[tuple[float, float, float]],
+    lying: Sequence[Lying],
+    fixtures: Sequence[Sequence[Spot]] = (),
+) -> bool:
+    """Whether ``foot`` at (x, y) keeps RELAY_CLEARANCE from ``others`` (circles: x, y, radius), from the
+    footprints of ``lying`` and from ``fixtures`` (polygons)."""
+    radius = foot.radius
+    near = [(ox, oy, r) for ox, oy, r in others if math.hypot(x - ox, y - oy) < radius + r + RELAY_CLEARANCE]
+    close = [
+        (ox, oy, other)
+        for ox, oy, other in lying
+        if math.hypot(x - ox, y - oy) < radius + other.radius + RELAY_CLEARANCE
+    ]
+    if not (near or close or fixtures):
+        return True
+    corners = foot.corners(x, y)
+    if any(gap(corners, [(ox, oy)]) < r + RELAY_CLEARANCE for ox, oy, r in near):
+        return False
+    if any(gap(corners, other.corners(ox, oy)) < RELAY_CLEARANCE for ox, oy, other in close):
+        return False
+    return all(gap(corners, fixture) >= RELAY_CLEARANCE for fixture in fixtures)
+
+
+def box_spots(
+    smap: SemanticMap,
+    place: Thing,
+    foot: Footprint,
+    height: float,
+    mounts: Sequence[Mount],
+    others: Sequence[tuple[float, float, float]],
+    lying: Sequence[Lying] = (),
+) -> tuple[Region, list[Spot]]:
+    """:func:`place_spots` for a thing of footprint ``foot`` (``height`` tall): the same grid, reach and
+    order (a point's spots), and the footprint itself RELAY_EDGE inside the edge of what it rests on and
+    RELAY_CLEARANCE clear of the fixtures it would meet on the way down, of ``others`` (x, y, radius) and
+    of the footprints of ``lying``."""
+    surface, points = place_spots(smap, place, (0.0, 0.0, height), mounts, [])
+    _, support = support_of(smap, place)
+    box = support.box
+    hx, hy = foot.half_extent()
+    extents = fixtures_on(smap, support, surface.center[2], height + skills.ABOVE_CLEARANCE)
+    fixtures = [[(x0, y0), (x1, y0), (x1, y1), (x0, y1)] for x0, x1, y0, y1 in extents]
+    return surface, [
+        (x, y)
+        for x, y in points
+        if box.min_x + hx + RELAY_EDGE <= x <= box.max_x - hx - RELAY_EDGE
+        and box.min_y + hy + RELAY_EDGE <= y <= box.max_y - hy - RELAY_EDGE
+        and clear_of(foot, x, y, others, lying, fixtures)
+    ]
 
 
 @dataclass(frozen=True)
@@ -72,10 +221,12 @@ class PutDown:
 
 class PlaceOverfilledError(KnowledgeBaseError):
     """The plan puts more on a place than it holds: each object has a spot there alone, but no arrangement
-    of their footprints (with what is on it already, the set-down's clearance and edge) holds them all.
-    The run is refused before anything moves. ``objects``: (IRI, size) of those the plan puts there;
-    ``already``: (IRI, x, y, radius) of those on it now; ``top``: its width and depth; ``reached``: the
-    part of its top the arms reach, and ``free``: what the objects on it leave of that, in square metres."""
+    of their footprints (with what is on it already, the set-down's clearance and edge), each where an arm
+    can set it down, holds them all. The run is refused before anything moves. ``objects``: (IRI, size) of
+    those the plan puts there; ``already``: (IRI, x, y, radius) of those on it now; ``top``: its width and
+    depth; ``reached``: the part of its top the arms reach, and ``free``: what the objects on it leave of
+    that, in square metres; ``footprint``: the packing's (:data:`FOOTPRINTS`); ``unheld``: for each object
+    the arms were asked about, (IRI, spots refused, spots asked, the first refusal)."""
 
     http_status = 422
 
@@ -86,16 +237,21 @@ class PlaceOverfilledError(KnowledgeBaseError):
         already: Sequence[tuple[str, float, float, float]],
         top: tuple[float, float],
         reached: float,
+        footprint: str = "circle",
+        unheld: Sequence[tuple[str, int, int, str]] = (),
     ) -> None:
         self.place = place
         self.objects = tuple(objects)
         self.already = tuple(already)
         self.top = top
         self.reached = reached
+        self.footprint = footprint
+        self.unheld = tuple(unheld)
         self.free = max(reached - sum(math.pi * r * r for *_, r in self.already), 0.0)
+        boxed = footprint == "box"
         each = ", ".join(
-            f"the {local_name(iri)} ({100 * size[0]:.1f} x {100 * size[1]:.1f} cm, {200 * radius_of(size):.1f} cm"
-            " across)"
+            f"the {local_name(iri)} ({100 * size[0]:.1f} x {100 * size[1]:.1f} cm"
+            + (")" if boxed else f", {200 * radius_of(size):.1f} cm across)")
             for iri, size in self.objects
         )
         on_it = (
@@ -105,14 +261,24 @@ class PlaceOverfilledError(KnowledgeBaseError):
             if self.already
             else ", nothing on it now"
         )
-        need = sum(math.pi * (radius_of(s) + RELAY_CLEARANCE / 2) ** 2 for _, s in self.objects)
+        c = RELAY_CLEARANCE
+        if boxed:
+            need = sum((s[0] + c) * (s[1] + c) for _, s in self.objects)
+            shape = "their footprints (their boxes, turned as they lie)"
+        else:
+            need = sum(math.pi * (radius_of(s) + c / 2) ** 2 for _, s in self.objects)
+            shape = "their footprints (the circles about their diagonals)"
+        held = "".join(
+            f"; the arms cannot hold the {local_name(iri)} over {no} of the {asked} spots asked ({why})"
+            for iri, no, asked, why in self.unheld
+        )
         super().__init__(
             f"the plan puts {each} on the {local_name(place)}, which cannot hold them together: of its"
             f" {100 * top[0]:.0f} x {100 * top[1]:.0f} cm top ({top[0] * top[1]:.3f} m2) the arms reach"
-            f" {reached:.3f} m2{on_it}; their footprints, {100 * RELAY_CLEARANCE:.0f} cm apart and"
-            f" {100 * RELAY_EDGE:.0f} cm inside its edge, need about {need:.3f} m2, and no arrangement of them on"
-            f" its spots (a {100 * RELAY_STEP:.0f} cm grid) holds them all, though each alone has one; put fewer"
-            " things there, clear it first, or make it larger (home:minX, home:maxX, home:minY, home:maxY)"
+            f" {reached:.3f} m2{on_it}; {shape}, {100 * c:.0f} cm apart and {100 * RELAY_EDGE:.0f} cm inside its"
+            f" edge, need about {need:.3f} m2, and no arrangement of them on its spots (a {100 * RELAY_STEP:.0f} cm"
+            f" grid) holds them all, each where an arm can set it down, though each alone has a spot{held}; put"
+            " fewer things there, clear it first, or make it larger (home:minX, home:maxX, home:minY, home:maxY)"
         )
 
 
@@ -149,6 +315,10 @@ class Undecided(Exception):
     """A packing gave up after PACK_BUDGET comparisons: whether the footprints fit is not known."""
 
 
+Holds = Callable[[int, Spot], bool]
+"""Whether the thing of a packing (by its index) can be set down at a spot: an arm can hold it over it."""
+
+
 def arrange(
     smap: SemanticMap,
     place: Thing,
@@ -157,15 +327,44 @@ def arrange(
     others: Sequence[tuple[float, float, float]],
     rule: PackingRule = PackingRule(),
     budget: int = PACK_BUDGET,
+    feet: Sequence[Footprint] | None = None,
+    lying: Sequence[Lying] = (),
+    holds: Holds | None = None,
 ) -> list[Spot] | None:
     """As :func:`pack`, but None only when no arrangement of the spots holds them all; :class:`Undecided`
     when ``budget`` comparisons did not decide. A footprint's spots do not depend on the others' but for
-    their distance, so each list is asked of :func:`place_spots` once and the search compares centres."""
+    their distance, so each list is asked once (:func:`place_spots`, or :func:`box_spots` for the rule's
+    ``box`` footprints: ``feet``, else each box along x) and the search compares centres. ``lying``: the
+    footprints of things on the place kept clear of (circles about them, for ``circle``); ``holds``: asked
+    of each spot the search would take, which it passes over when refused."""
+    shapes = list(feet) if feet is not None else [Footprint.lying(size, 0.0) for size in sizes]
+    lists = _spot_lists(smap, place, sizes, mounts, others, rule, shapes, lying)
+    if not all(lists):
+        return None
+    return _search(lists, sizes, shapes, rule, budget, holds)
+
+
+def _spot_lists(
+    smap: SemanticMap,
+    place: Thing,
+    sizes: Sequence[Size],
+    mounts: Sequence[Mount],
+    others: Sequence[tuple[float, float, float]],
+    rule: PackingRule,
+    shapes: Sequence[Footprint],
+    lying: Sequence[Lying],
+) -> list[list[Spot]]:
+    """Each thing's spots alone, in the order the rule prefers them."""
     surface = region_of(place, place.iri in smap.furniture)
     cx, cy, _ = surface.center
+    boxed = rule.footprint == "box"
+    circles = list(others) if boxed else [*others, *((x, y, foot.radius) for x, y, foot in lying)]
     lists: list[list[Spot]] = []
-    for size in sizes:
-        _, spots = place_spots(smap, place, size, mounts, others)
+    for size, foot in zip(sizes, shapes, strict=True):
+        if boxed:
+            _, spots = box_spots(smap, place, foot, size[2], mounts, circles, lying)
+        else:
+            _, spots = place_spots(smap, place, size, mounts, circles)
         if rule.toward == "rim":  # farthest from the centre first; on a tie the nearer an arm
             near = [min((math.hypot(x - mx, y - my) for mx, my, _ in mounts), default=0.0) for x, y in spots]
             ranked = sorted(
@@ -173,26 +372,46 @@ def arrange(
                 key=lambda k: (-round(math.hypot(spots[k][0] - cx, spots[k][1] - cy), 6), round(near[k], 6), k),
             )
             spots = [spots[k] for k in ranked]
-        if not spots:
-            return None
         lists.append(spots)
-    radii = [radius_of(size) for size in sizes]
+    return lists
+
+
+def _search(
+    lists: Sequence[Sequence[Spot]],
+    sizes: Sequence[Size],
+    shapes: Sequence[Footprint],
+    rule: PackingRule,
+    budget: int,
+    holds: Holds | None,
+) -> list[Spot] | None:
+    """The first arrangement of the things on their ``lists`` of spots (:func:`arrange`)."""
+    boxed = rule.footprint == "box"
+    radii = [foot.radius if boxed else radius_of(size) for size, foot in zip(sizes, shapes, strict=True)]
     order = sorted(range(len(sizes)), key=lambda n: -radii[n]) if rule.order == "largest" else list(range(len(sizes)))
     chosen: dict[int, Spot] = {}
     left = [budget]
+    known: dict[tuple[int, int, int, int], bool] = {}  # box footprints apart, by the grid offset between them
+
+    def apart(n: int, at: Spot, m: int, other: Spot) -> bool:
+        if math.hypot(at[0] - other[0], at[1] - other[1]) >= radii[n] + radii[m] + RELAY_CLEARANCE:
+            return True
+        if not boxed:
+            return False
+        key = (n, m, round((at[0] - other[0]) / RELAY_STEP), round((at[1] - other[1]) / RELAY_STEP))
+        if key not in known:
+            known[key] = gap(shapes[n].corners(*at), shapes[m].corners(*other)) >= RELAY_CLEARANCE
+        return known[key]
 
     def place_from(depth: int) -> bool:
         if depth == len(order):
             return True
         n = order[depth]
-        for x, y in lists[n]:
+        for at in lists[n]:
             left[0] -= len(chosen)
             if left[0] < 0:
                 raise Undecided()
-            if all(
-                math.hypot(x - ox, y - oy) >= radii[n] + radii[m] + RELAY_CLEARANCE for m, (ox, oy) in chosen.items()
-            ):
-                chosen[n] = (x, y)
+            if all(apart(n, at, m, other) for m, other in chosen.items()) and (holds is None or holds(n, at)):
+                chosen[n] = at
                 if place_from(depth + 1):
                     return True
                 del chosen[n]
@@ -219,23 +438,59 @@ def set_down_spots(
     others: Sequence[tuple[float, float, float]],
     later: Sequence[Size] = (),
     rule: PackingRule = PackingRule(),
+    foot: Footprint | None = None,
+    later_feet: Sequence[Footprint] | None = None,
+    lying: Sequence[Lying] = (),
+    holds: Holds | None = None,
 ) -> tuple[Region, list[Spot]]:
-    """The surface and spots of :func:`place_spots` for an object set down on ``place``, when the plan puts
+    """The surface and spots of :func:`place_spots` (:func:`box_spots` for the rule's ``box`` footprints:
+    ``foot``, ``later_feet``, else boxes along x) for an object set down on ``place``, when the plan puts
     the objects of ``later`` (sizes) there after it: first those that leave room for them all (some
-    arrangement of theirs, :func:`arrange`, fits beside it, with SET_DOWN_SLACK), nearest the centre first
-    as for one thing alone, up to RELAY_TRIES of them (as many as the carry asks the arm about), then the
-    rest. As :func:`place_spots` orders them when nothing comes after it or no spot leaves room (the run
-    goes on, and the later carry says what is in its way)."""
-    surface, spots = place_spots(smap, place, size, mounts, others)
+    arrangement of theirs, :func:`arrange`, fits beside it, with SET_DOWN_SLACK, each where ``holds``
+    says an arm can set it down), nearest the centre first as for one thing alone, up to RELAY_TRIES of
+    them (as many as the carry asks the arm about), then the rest. As the spots are ordered when nothing
+    comes after it or no spot leaves room (the run goes on, and the later carry says what is in its way)."""
+    boxed = rule.footprint == "box"
+    mine = foot if foot is not None else Footprint.lying(size, 0.0)
+    if boxed:
+        surface, spots = box_spots(smap, place, mine, size[2], mounts, others, lying)
+    else:
+        circles = [*others, *((x, y, each.radius) for x, y, each in lying)]
+        surface, spots = place_spots(smap, place, size, mounts, circles)
     if not later or not spots:
         return surface, spots
-    radius = radius_of(size)
+    asked: dict[tuple[int, Spot], bool] = {}  # an arm's answer for a later thing at a spot, asked once
+
+    def held(n: int, at: Spot) -> bool:
+        if (n, at) not in asked:
+            asked[n, at] = holds is None or holds(n, at)
+        return asked[n, at]
+
+    shapes = list(later_feet) if later_feet is not None else [Footprint.lying(each, 0.0) for each in later]
+    alone = _spot_lists(smap, place, later, mounts, others, rule, shapes, lying)  # without this thing
+    clear: dict[tuple[int, int, int, float], bool] = {}  # a later thing clear of this one, by their grid offset
+
+    def beside(n: int, at: Spot, spot: Spot, slack: float) -> bool:
+        if math.hypot(at[0] - spot[0], at[1] - spot[1]) >= shapes[n].radius + mine.radius + slack + RELAY_CLEARANCE:
+            return True
+        key = (n, round((at[0] - spot[0]) / RELAY_STEP), round((at[1] - spot[1]) / RELAY_STEP), slack)
+        if key not in clear:
+            clear[key] = clear_of(shapes[n], *at, [], [(*spot, mine.grown(slack))])
+        return clear[key]
+
     for slack in (SET_DOWN_SLACK, 0.0):
         keeping: list[Spot] = []
         for x, y in spots:
+            if boxed:
+                lists = [[at for at in each if beside(n, at, (x, y), slack)] for n, each in enumerate(alone)]
+            else:
+                reach = radius_of(size) + slack + RELAY_CLEARANCE
+                lists = [
+                    [at for at in each if math.hypot(at[0] - x, at[1] - y) >= radius_of(s) + reach]
+                    for each, s in zip(alone, later, strict=True)
+                ]
             try:
-                grown = [*others, (x, y, radius + slack)]
-                if arrange(smap, place, later, mounts, grown, rule, SPOT_BUDGET) is not None:
+                if all(lists) and _search(lists, later, shapes, rule, SPOT_BUDGET, held) is not None:
                     keeping.append((x, y))
             except Undecided:
                 continue
@@ -286,6 +541,31 @@ def _given_iris(step: PlanStep, values: Mapping[str, Any], known: Mapping[int, M
     return [str(v["@id"]) for v in given if isinstance(v, dict) and "@id" in v]
 
 
+def packed_with(
+    plan: Plan | None,
+    step: PlanStep | None,
+    smap: SemanticMap,
+    place: str,
+    values: Mapping[str, Any],
+    known: Mapping[int, Mapping[str, Any]] | None = None,
+) -> tuple[list[str], list[str]]:
+    """The objects (IRIs) the plan's carries by the robot of ``step`` (a carry) set down on ``place`` before
+    it and after it, each in the plan's order; none when the plan or the step is not known."""
+    if plan is None or step is None:
+        return [], []
+    order = [each.index for each in plan.steps]
+    if step.index not in order:
+        return [], []
+    at = order.index(step.index)
+    before, after = set(order[:at]), set(order[at + 1 :])
+    mine = [
+        down
+        for down in puts_down(plan, smap, values, known)
+        if down.place == place and down.device == (step.device or "")
+    ]
+    return [down.obj for down in mine if down.step in before], [down.obj for down in mine if down.step in after]
+
+
 def later_sizes(
     plan: Plan | None,
     step: PlanStep | None,
@@ -296,65 +576,136 @@ def later_sizes(
 ) -> list[Size]:
     """The sizes of the objects the plan's carries after ``step`` (the running one) set down on ``place``
     by the same robot, in the plan's order; none when the plan or the step is not known."""
-    if plan is None or step is None:
-        return []
-    order = [each.index for each in plan.steps]
-    if step.index not in order:
-        return []
-    after = set(order[order.index(step.index) + 1 :])
-    return [
-        smap.objects[down.obj].size
-        for down in puts_down(plan, smap, values, known)
-        if down.step in after and down.place == place and down.device == (step.device or "")
-    ]
+    return [smap.objects[iri].size for iri in packed_with(plan, step, smap, place, values, known)[1]]
 
 
-def check_room(world: HomeWorld, belief: PerceivedWorld, plan: Plan, values: Mapping[str, Any]) -> None:
+def carry_spots(
+    ctx: SimContext, place: Thing, carried: str, side: ArmSide, step: PlanStep | None, rule: PackingRule = PackingRule()
+) -> tuple[Region, list[Spot]]:
+    """Where the carry of ``carried`` (a name) at ``step`` by the arm ``side`` aims on ``place``, best first:
+    for one thing alone :func:`place_spots`' order, as before; when the plan's carries by the same robot
+    put others there before or after it, :func:`set_down_spots` with the rule's footprints (the map's, the
+    things on the place where they are believed to be) and each later thing's spots asked whether an arm
+    can hold it there (:func:`arm_choice.cannot_set_down`). Asked by the carry (``services.carry``) and by
+    the choice of approach before it (:func:`arm_choice.hold_end`), so both aim at the same spot."""
+    world, smap = ctx.world, ctx.map
+    obj = world.objects.get(carried)
+    size = obj.size if obj is not None else (0.0, 0.0, 0.0)
+    mounts = [reach_of(world.arm_specs[side])]
+    others = other_objects(world, ctx.belief, carried)
+    earlier, later = packed_with(ctx.plan, step, smap, place.iri, ctx.given, ctx.known)
+    if obj is None or not (earlier or later):
+        return place_spots(smap, place, size, mounts, others)
+    coming = [smap.objects[iri] for iri in later]
+    surface, _ = support_of(smap, place)
+    holds = _HoldAsked(ctx, coming, surface)
+    sizes = [each.size for each in coming]
+    if rule.footprint == "circle":
+        return set_down_spots(smap, place, size, mounts, others, sizes, rule, holds=holds)
+    names = [name for name in world.objects if name != carried]  # in the order of ``others``
+    lying = [(x, y, footprint_of(world.objects[name])) for name, (x, y, _) in zip(names, others, strict=True)]
+    feet = [footprint_of(each) for each in coming]
+    try:
+        return set_down_spots(smap, place, size, mounts, [], sizes, rule, footprint_of(obj), feet, lying, holds)
+    except Undecided:  # more spots asked of the arms than HOLD_TRIES: as for one thing alone
+        return place_spots(smap, place, size, mounts, others)
+
+
+HOLD_TRIES = 400
+"""The most spots one packing asks the arms about (:func:`arm_choice.cannot_set_down`: inverse kinematics,
+a few milliseconds each) before it gives up undecided."""
+
+
+class _HoldAsked:
+    """Whether an arm can set each thing of a packing down at a spot of ``surface`` (:data:`Holds`), each
+    asked once, and why not; :class:`Undecided` past HOLD_TRIES questions."""
+
+    def __init__(self, ctx: SimContext, objects: Sequence[MapObject], surface: Region) -> None:
+        self.ctx, self.objects, self.surface = ctx, objects, surface
+        self.answers: dict[tuple[int, Spot], str] = {}
+
+    def __call__(self, n: int, at: Spot) -> bool:
+        if (n, at) not in self.answers:
+            if len(self.answers) >= HOLD_TRIES:
+                raise Undecided()
+            self.answers[n, at] = cannot_set_down(self.ctx, self.objects[n], self.surface, at)
+        return not self.answers[n, at]
+
+    def refused(self) -> list[tuple[str, int, int, str]]:
+        """For each thing asked about: its IRI, the spots refused, the spots asked, the first refusal."""
+        said = []
+        for n, obj in enumerate(self.objects):
+            mine = [why for (m, _), why in self.answers.items() if m == n]
+            no = [why for why in mine if why]
+            if no:
+                said.append((obj.iri, len(no), len(mine), no[0]))
+        return said
+
+
+def check_room(ctx: SimContext, plan: Plan, values: Mapping[str, Any], rule: PackingRule = PackingRule()) -> None:
     """Refuse (:class:`PlaceOverfilledError`, :func:`overfilled`) a plan that puts several objects on one
-    place no arrangement of their footprints holds, the other objects where they are believed to be."""
-    found = other_objects(world, belief)
+    place no arrangement of their footprints holds where an arm can set each down, the other objects where
+    they are believed to be."""
+    world = ctx.world
+    found = other_objects(world, ctx.belief)
     where = {obj.iri: spot for obj, spot in zip(world.objects.values(), found, strict=True)}
-    refused = overfilled(world.map, plan, values, where)
+    refused = overfilled(world.map, plan, values, where, rule, ctx)
     if refused is not None:
         raise refused
 
 
 def overfilled(
-    smap: SemanticMap, plan: Plan, values: Mapping[str, Any], where: Mapping[str, tuple[float, float, float]]
+    smap: SemanticMap,
+    plan: Plan,
+    values: Mapping[str, Any],
+    where: Mapping[str, tuple[float, float, float]],
+    rule: PackingRule = PackingRule(),
+    ctx: SimContext | None = None,
 ) -> PlaceOverfilledError | None:
-    """Why ``plan`` puts several objects on one place when no arrangement of their footprints on its spots
-    holds them all (:func:`arrange`), with the objects of ``where`` (IRI: x, y, footprint radius) that it
-    does not carry where they are, and by the arms of the robot that sets them down; None when each such
-    place holds them, or when the search is undecided. A place that has no spot for one of them alone is
-    left to the check of each step (``run_checks.PlanChecks._check_spot``), which says why."""
+    """Why ``plan`` puts several objects on one place when no arrangement of their footprints (the rule's:
+    the map's boxes, turned as it says they lie, or circles) on its spots holds them all (:func:`arrange`),
+    with the objects of ``where`` (IRI: x, y, footprint radius) that it does not carry where they are, and
+    by the arms of the robot that sets them down; given ``ctx``, each where an arm can hold it
+    (:func:`arm_choice.cannot_set_down`). None when each such place holds them, or when the search is
+    undecided. A place that has no spot for one of them alone is left to the check of each step
+    (``run_checks.PlanChecks._check_spot``), which says why."""
     by_place: dict[tuple[str, str], list[str]] = {}
     for down in puts_down(plan, smap, values):
         objects = by_place.setdefault((down.place, down.device), [])
         if down.obj not in objects:
             objects.append(down.obj)
+    boxed = rule.footprint == "box"
     for (iri, device), objects in by_place.items():
         if len(objects) < 2:
             continue
         mounts = [(arm.mount[0], arm.mount[1], arm.reach) for arm in smap.arms.values() if arm.robot == device]
         place = smap.things[iri]
         rest = [(other, spot) for other, spot in where.items() if other not in objects]
-        others = [spot for _, spot in rest]
         sizes = [smap.objects[obj].size for obj in objects]
-        if not all(place_spots(smap, place, size, mounts, others)[1] for size in sizes):
+        feet = [footprint_of(smap.objects[obj]) for obj in objects]
+        if boxed:  # the things on it by their boxes, those of the map turned as it says
+            others = [spot for other, spot in rest if other not in smap.objects]
+            lying = [(x, y, footprint_of(smap.objects[other])) for other, (x, y, _) in rest if other in smap.objects]
+        else:
+            others, lying = [spot for _, spot in rest], []
+        if not all(place_spots(smap, place, size, mounts, [spot for _, spot in rest])[1] for size in sizes):
             continue  # one alone has no spot: the step's own check says why
+        surface = region_of(place, iri in smap.furniture)
+        holds = _HoldAsked(ctx, [smap.objects[obj] for obj in objects], surface) if ctx is not None else None
         try:
-            if arrange(smap, place, sizes, mounts, others) is not None:
+            if arrange(smap, place, sizes, mounts, others, rule, PACK_BUDGET, feet, lying, holds) is not None:
                 continue
         except Undecided:
             log.info("room check: whether %s holds %s is undecided; the run goes on", iri, ", ".join(objects))
             continue
-        surface = region_of(place, iri in smap.furniture)
         return PlaceOverfilledError(
             iri,
             [(obj, size) for obj, size in zip(objects, sizes, strict=True)],
             [(other, x, y, r) for other, (x, y, r) in rest if surface.contains_xy(x, y)],
             (surface.xmax - surface.xmin, surface.ymax - surface.ymin),
             reached_area(surface, mounts),
+            rule.footprint,
+            holds.refused() if holds is not None else [],
         )
     return None
 

@@ -96,22 +96,8 @@ def place_spots(
     ``others`` (x, y, radius) and of the fixtures it would meet on the way down (a dispenser's body; not
     the spout high above it). The place's centre is the first spot where it is one: a place an arm only
     partly reaches is worked at its reachable part, not at a centre no arm reaches."""
-    furniture = place.iri in smap.furniture
-    surface = region_of(place, furniture)
+    surface, support = support_of(smap, place)
     cx, cy, z = surface.center
-    if furniture:
-        support = place
-    else:
-        support = next(
-            (
-                smap.things[iri]
-                for iri in sorted(smap.furniture)
-                if iri in smap.things
-                and smap.things[iri].box.contains_xy(cx, cy)
-                and abs(smap.things[iri].box.max_z - z) <= 0.03
-            ),
-            place,
-        )
     box = support.box
     radius = math.hypot(size[0], size[1]) / 2.0
     fixtures = fixtures_on(smap, support, z, size[2] + skills.ABOVE_CLEARANCE)
@@ -135,6 +121,27 @@ def place_spots(
                 continue
             spots.append((math.hypot(x - cx, y - cy), x, y))
     return surface, [(x, y) for _, x, y in sorted(spots)]
+
+
+def support_of(smap: SemanticMap, place: Thing) -> tuple[Region, Thing]:
+    """A place's surface (a region's bottom, a piece of furniture's top) and what an object set down there
+    rests on: the furniture itself, or the furniture under a region (else the region)."""
+    furniture = place.iri in smap.furniture
+    surface = region_of(place, furniture)
+    cx, cy, z = surface.center
+    if furniture:
+        return surface, place
+    support = next(
+        (
+            smap.things[iri]
+            for iri in sorted(smap.furniture)
+            if iri in smap.things
+            and smap.things[iri].box.contains_xy(cx, cy)
+            and abs(smap.things[iri].box.max_z - z) <= 0.03
+        ),
+        place,
+    )
+    return surface, support
 
 
 def spot_region(surface: Region, x: float, y: float) -> Region:

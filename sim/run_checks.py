@@ -256,7 +256,7 @@ class PlanChecks:
             self.world.drive(base)
         meant = self._people_of(plan, values, ads)  # a step needing a person the home cannot give (nobody, who?)
         self._check_reach(plan, values)
-        check_room(self.world, self.belief, plan, values)  # several objects onto one place: room for all
+        check_room(self.context, plan, values)  # several objects onto one place: room for all
         self._check_carry(plan, values)
         self._check_sight(plan, values, ads, meant)
         self._check_loading(plan, values)

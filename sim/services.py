@@ -26,7 +26,7 @@ from cbrs.sim.grasping import ObjectModel, compute_grasp_pose
 from cbrs.sim.grounding import docking_pose, manipulation_of, meant_person, model_of, place_of, thing_iri, thing_region
 from cbrs.sim.hold_choice import Candidates, refuse_moves, seen_extent
 from cbrs.sim.mapping import OccupancyGrid, build_occupancy_grid
-from cbrs.sim.packing import later_sizes, set_down_spots
+from cbrs.sim.packing import carry_spots
 from cbrs.sim.perceived import SEARCH_RADIUS
 from cbrs.sim.perception import (
     ObjectEstimate,
@@ -140,10 +140,9 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
     carried = (world.name_of(held) if held is not None else None) or ctx.object or ""
     size = world.objects[carried].size if carried in world.objects else (0.0, 0.0, 0.0)
     others = other_objects(world, ctx.belief, carried)
-    later = later_sizes(ctx.plan, ctx.step, ctx.map, place.iri, ctx.given, ctx.known)  # room kept for them
 
-    def spots(side: ArmSide) -> tuple[Region, list[tuple[float, float]]]:
-        return set_down_spots(ctx.map, place, size, [reach_of(world.arm_specs[side])], others, later)
+    def spots(side: ArmSide) -> tuple[Region, list[tuple[float, float]]]:  # room kept for what comes after
+        return carry_spots(ctx, place, carried, side, ctx.step)
 
     surface, mine = spots(ctx.arm)
     spot = holdable_spot(ctx, ctx.arm, surface, mine)

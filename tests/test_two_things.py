@@ -39,6 +39,8 @@ WORLD, LAB6 = PREFIXES["world"], "https://example.org/lab6#"
 SHELF, PEN, ERASER, CUP = LAB6 + "TidyShelf1", WORLD + "Pen", LAB6 + "Eraser1", WORLD + "Cup"
 VALUES: dict[str, Any] = {"pen": {"@id": PEN}, "eraser": {"@id": ERASER}, "shelf": {"@id": SHELF}, "cup": {"@id": CUP}}
 """The task's inputs as the run grounds them in the lab's map (the one pen, eraser, cup and tidy shelf)."""
+CIRCLE = PackingRule(footprint="circle")
+"""The packing's first footprints, the circles about the things' diagonals (the boxes: test_packing_footprints)."""
 
 
 def _three(directory: Path) -> Path:
@@ -102,7 +104,7 @@ def test_the_eraser_at_the_centre_left_no_spot_for_the_pen_and_its_packed_spot_l
     _, alone = place_spots(smap, shelf, eraser, mounts, [])
     _, pen_after_centre = place_spots(smap, shelf, pen, mounts, [(*alone[0], radius_of(eraser))])
     assert pen_after_centre == []  # the trial's failure: nearest the centre first
-    _, packed = set_down_spots(smap, shelf, eraser, mounts, [], [pen])
+    _, packed = set_down_spots(smap, shelf, eraser, mounts, [], [pen], CIRCLE)
     assert sorted(packed) == sorted(alone)  # the same spots, another order
     # the first spot, nearest the centre, where the pen still has one if the eraser comes to rest 2 cm off
     grown = radius_of(eraser) + SET_DOWN_SLACK
@@ -110,7 +112,7 @@ def test_the_eraser_at_the_centre_left_no_spot_for_the_pen_and_its_packed_spot_l
     for x, y in alone[: alone.index(packed[0])]:
         assert not place_spots(smap, shelf, pen, mounts, [(x, y, grown)])[1]
     # nothing after it: as one thing alone is set down
-    assert set_down_spots(smap, shelf, pen, mounts, [], []) == place_spots(smap, shelf, pen, mounts, [])
+    assert set_down_spots(smap, shelf, pen, mounts, [], [], CIRCLE) == place_spots(smap, shelf, pen, mounts, [])
 
 
 def test_the_search_goes_back_where_the_first_choice_leaves_no_room(
@@ -121,7 +123,7 @@ def test_the_search_goes_back_where_the_first_choice_leaves_no_room(
     _, smap, _, _ = tidy
     shelf, mounts = _shelf(smap), _mounts(smap)
     sizes = [smap.objects[PEN].size, smap.objects[CUP].size, smap.objects[ERASER].size]
-    for rule in (PackingRule(), PackingRule("plan", "centre")):
+    for rule in (CIRCLE, PackingRule("plan", "centre", "circle")):
         spots = arrange(smap, shelf, sizes, mounts, [], rule)
         assert spots is not None
         radii = [radius_of(size) for size in sizes]
@@ -132,7 +134,7 @@ def test_the_search_goes_back_where_the_first_choice_leaves_no_room(
         if rule.toward == "centre":
             assert spots[0] != place_spots(smap, shelf, sizes[0], mounts, [])[1][0]
     with pytest.raises(Undecided):  # the search bounded: undecided is no refusal
-        arrange(smap, shelf, sizes, mounts, [], budget=1)
+        arrange(smap, shelf, sizes, mounts, [], CIRCLE, budget=1)
     assert pack(smap, shelf, sizes, mounts, [], PackingRule()) is not None
     with pytest.raises(ValueError, match="'middle'"):
         PackingRule("largest", "middle")
@@ -147,9 +149,9 @@ def test_three_things_and_a_pill_box_on_the_small_shelf_are_refused_before_the_r
         for iri, obj in smap.objects.items()
         if iri not in (PEN, ERASER, CUP)
     }
-    assert overfilled(smap, plan, VALUES, where) is None  # the three fit on the shelf as it is
+    assert overfilled(smap, plan, VALUES, where, CIRCLE) is None  # the three fit on the shelf as it is
     box = LAB6 + "PillBox1"
-    refused = overfilled(smap, plan, VALUES, {**where, box: (8.63, 2.68, radius_of((0.04, 0.04, 0.04)))})
+    refused = overfilled(smap, plan, VALUES, {**where, box: (8.63, 2.68, radius_of((0.04, 0.04, 0.04)))}, CIRCLE)
     assert isinstance(refused, PlaceOverfilledError) and refused.http_status == 422
     assert refused.place == SHELF
     assert sorted(iri for iri, _ in refused.objects) == sorted([PEN, ERASER, CUP])
