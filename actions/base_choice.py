@@ -2,37 +2,104 @@
 
 The composer chooses each step's component by the matchmaker alone, so with two bases' components
 advertised a plan could navigate with one and deliver with the other, which no run can do (a run drives
-one base). The environment says which components are whose base (``Environment.base_components``); the
-task is then composed once per base, the other bases' components left out, and the best plan is taken:
-the least cost, then the greatest similarity, then the first base by IRI. A task whose requirement names
-one of the bases is composed for that base alone: requested by it (``cbrs:requestedBy``), else an input
-of the task designating it (the caller's ``named``). A home of one base
-or none composes as before (docs/simulation.md, "A home with no mobile base").
+one base). The map says which components are whose base (:func:`base_groups`: the advertisements whose
+device is the base); the task is then composed once per base, the other bases' components left out, and
+the best plan is taken: the least cost, then the greatest similarity, then (``BaseTies.NEAREST``) the base
+with the least to drive to where its plan first takes it (:class:`MapDrives`), then the first base by IRI.
+A task whose requirement names one of the bases is composed for that base alone: requested by it
+(``cbrs:requestedBy``), else an input of the task designating it (:func:`named_base`). A home of one base
+or none composes as before. ``cbrs run`` chooses so (``actions.runner``), and ``cbrs plan`` and the plans
+page by the store alone (:func:`choose_in_map`): docs/simulation.md, "A home with no mobile base".
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+import math
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import dataclass, replace
+from enum import Enum
 from typing import Any
 
-from cbrs.actions.composer import CompositionResult
-from cbrs.actions.plan import Plan
+from cbrs.actions.composer import Composer, CompositionResult
+from cbrs.actions.plan import Plan, PlanStep
+from cbrs.kb import Advertisement, KnowledgeBase, NotFoundError, Requirement
+from cbrs.kb.namespaces import HOME, PREFIXES
+from cbrs.kb.semantic_map import (
+    AmbiguousDesignatorError,
+    SemanticMap,
+    UnresolvedDesignatorError,
+    designate,
+)
 from cbrs.kb.semantic_map import local_name as _local
+from cbrs.kb.store import Term
 
-__all__ = ["BaseChoice", "choose_base"]
+__all__ = [
+    "BaseChoice",
+    "BaseTies",
+    "FirstDrive",
+    "MapDrives",
+    "base_groups",
+    "choose_base",
+    "choose_in_map",
+    "map_bases",
+    "named_base",
+    "on_behalf",
+]
+
+_NEAR = HOME + "isNear"  # a drive's effect: the robot comes near a place, an object or a person
+_BASE_MARKS = frozenset({HOME + "hasPlatform", HOME + "hasMarker"})  # what makes a thing of the map a mobile base
+_SAME = 1e-3  # metres: distances closer than this are alike
+
+
+class BaseTies(Enum):
+    """How plans of one cost and one similarity, for different bases, are told apart (``cbrs run`` and
+    ``cbrs plan --base-ties``)."""
+
+    NEAREST = "nearest"  # the base with the least to drive to where its plan first goes, then the first by IRI
+    IRI = "iri"  # the first base by IRI
+
+
+@dataclass(frozen=True)
+class FirstDrive:
+    """Where a base's plan first drives it, and how far that is: the straight line in the floor's plane
+    from the base's pose in the map to the things its first drive approaches (their mean position)."""
+
+    step: int
+    component: str
+    towards: tuple[str, ...]  # the things, by IRI
+    metres: float
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "step": self.step,
+            "component": self.component,
+            "towards": list(self.towards),
+            "metres": round(self.metres, 3),
+        }
 
 
 @dataclass(frozen=True)
 class BaseChoice:
-    """The base a run's plans work, why, and the other bases' components its compositions leave out."""
+    """The base a run's plans work, why, and the other bases' components its compositions leave out.
+    ``rule`` names what decided: requested, designated, only, cost, similarity, nearest, iri or none;
+    ``drives``, each tied base's first drive when the distances were compared."""
 
     base: str
     why: str
     left_out: frozenset[str] = frozenset()
+    rule: str = ""
+    drives: tuple[tuple[str, FirstDrive | None], ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
-        return {"base": self.base, "why": self.why, "left_out": sorted(self.left_out)}
+        found: dict[str, Any] = {"base": self.base, "why": self.why, "rule": self.rule}
+        found["left_out"] = sorted(self.left_out)
+        if self.drives:  # None: the base's plan drives to nothing the map places
+            found["drives"] = [{"base": base, "drive": None if d is None else d.to_dict()} for base, d in self.drives]
+        return found
+
+
+Drive = Callable[[str, CompositionResult], FirstDrive | None]
+"""A base's first drive in its own plan (``MapDrives``), None when it drives to nothing the map places."""
 
 
 def choose_base(
@@ -40,13 +107,16 @@ def choose_base(
     composition: CompositionResult,
     groups: Mapping[str, frozenset[str]],
     named: str | None = None,
+    drive: Drive | None = None,
+    ties: BaseTies = BaseTies.NEAREST,
 ) -> tuple[CompositionResult, BaseChoice | None]:
     """``composition`` (composed over every component) kept, or replaced by the best one-base composition.
 
     ``compose`` composes the task without the components it is given; ``groups`` maps each base's IRI to
-    its own components; ``named``: the base an input of the task designates, if one does. Nothing changes
-    (None) with fewer than two bases, for no plan (none over a part of the components either), and for a
-    plan that no base's component could run (the arms' alone)."""
+    its own components; ``named``: the base an input of the task designates, if one does; ``drive``
+    measures a base's first drive, asked only of plans that cost alike and match alike (with ``ties``
+    NEAREST). Nothing changes (None) with fewer than two bases, for no plan (none over a part of the
+    components either), and for a plan that no base's component could run (the arms' alone)."""
     plan = composition.plan
     if len(groups) < 2 or plan is None:
         return composition, None
@@ -56,10 +126,11 @@ def choose_base(
     requester = composition.attempts[0].requirement.requested_by if composition.attempts else None
     if requester is not None and requester in groups:
         bases, said = [requester], f"the task's requirement is requested by {_local(requester)} (cbrs:requestedBy)"
+        rule = "requested"
     elif named is not None and named in groups:
-        bases, said = [named], f"an input of the task designates {_local(named)}"
+        bases, said, rule = [named], f"an input of the task designates {_local(named)}", "designated"
     else:
-        bases, said = sorted(groups), ""
+        bases, said, rule = sorted(groups), "", ""
     tried = {base: compose(every - groups[base]) for base in bases}
     planned = {base: found.plan for base, found in tried.items() if found.plan is not None}
     if not planned:
@@ -69,31 +140,235 @@ def choose_base(
             if said
             else "no one base's components make a plan (the plan over every component mixed them: a run drives one)"
         )
-        return tried[first], BaseChoice(first, why, every - groups[first])
+        return tried[first], BaseChoice(first, why, every - groups[first], "none")
     ranked = sorted(planned, key=lambda base: _rank(planned[base], base))
-    best = ranked[0]
-    why = said or _why(best, ranked, planned, bases)
-    return tried[best], BaseChoice(best, why, every - groups[best])
+    if said:
+        return tried[ranked[0]], BaseChoice(ranked[0], said, every - groups[ranked[0]], rule)
+    best, why, rule, drives = _decide(ranked, planned, tried, bases, drive if ties is BaseTies.NEAREST else None)
+    return tried[best], BaseChoice(best, why, every - groups[best], rule, drives)
 
 
 def _rank(plan: Plan, base: str) -> tuple[float, float, str]:
     return (plan.cost, -plan.similarity, base)
 
 
-def _why(best: str, ranked: list[str], planned: Mapping[str, Plan], bases: list[str]) -> str:
+def _decide(
+    ranked: list[str],
+    planned: Mapping[str, Plan],
+    tried: Mapping[str, CompositionResult],
+    bases: list[str],
+    drive: Drive | None,
+) -> tuple[str, str, str, tuple[tuple[str, FirstDrive | None], ...]]:
+    """The base, why, the rule that decided, and the first drives compared (if they were)."""
+    best = ranked[0]
     if len(ranked) == 1:
         others = ", ".join(_local(base) for base in bases if base != best)
-        return f"only {_local(best)}'s components make a plan ({others}: none)"
+        return best, f"only {_local(best)}'s components make a plan ({others}: none)", "only", ()
     second = ranked[1]
     mine, theirs = planned[best], planned[second]
     if mine.cost != theirs.cost:
-        return (
+        why = (
             f"its plan costs the least: {mine.cost:.3g} s of advertised response time, "
             f"{_local(second)}'s {theirs.cost:.3g} s"
         )
+        return best, why, "cost", ()
     if mine.similarity != theirs.similarity:
-        return (
+        why = (
             f"the plans cost alike ({mine.cost:.3g} s); its similarity is the greater: {mine.similarity:.3f}, "
             f"{_local(second)}'s {theirs.similarity:.3f}"
         )
-    return f"its plan and {_local(second)}'s cost alike and match alike: the first base by IRI"
+        return best, why, "similarity", ()
+    alike = f"its plan and {_local(second)}'s cost alike ({mine.cost:g} s) and match alike ({mine.similarity:.3f})"
+    if drive is None:
+        return best, f"{alike}: the first base by IRI", "iri", ()
+    tied = [base for base in ranked if _rank(planned[base], "") == _rank(mine, "")]
+    drives = tuple((base, drive(base, tried[base])) for base in tied)
+    unknown = [base for base, found in drives if found is None]
+    if unknown:
+        named = ", ".join(_local(base) for base in unknown)
+        why = f"{alike}, and {named}'s plan drives to nothing the map places: the first base by IRI"
+        return best, why, "iri", drives
+    measured = sorted(((found.metres, base) for base, found in drives if found is not None))
+    (near, nearest), (next_near, runner_up) = measured[0], measured[1]
+    if next_near - near < _SAME:
+        why = f"{alike}, and they stand as far from where their first drives go ({near:.2f} m): the first base by IRI"
+        return best, why, "iri", drives
+    found = dict(drives)[nearest]
+    assert found is not None
+    towards = ", ".join(_local(thing) for thing in found.towards)
+    why = (
+        f"its plan and {_local(runner_up)}'s cost alike ({mine.cost:g} s) and match alike ({mine.similarity:.3f});"
+        f" it has the least to drive: {near:.2f} m from where it stands in the map to {towards}, where its first"
+        f" drive ({_local(found.component)}) goes, {_local(runner_up)}'s {next_near:.2f} m"
+    )
+    return nearest, why, "nearest", drives
+
+
+class MapDrives:
+    """A base's first drive in its plan, measured in the semantic map (read on first use unless given):
+    the first step of one of the base's own components whose effect brings a robot near something
+    (``home:isNear``: a navigation), the task's inputs that step works on (directly or through the steps
+    that compute its inputs: the pen whose place a locator infers), designated as a run designates them
+    (preferring the requester's, else this base's), and of those the things the map places (an object or
+    a person where it starts, a place at its docking pose, else its extent's centre). The straight line
+    from the base's pose in the map to their mean: the map, not the simulation (the seed moves the bases
+    a little), so that ``cbrs plan`` and ``cbrs run`` choose alike."""
+
+    def __init__(self, kb: KnowledgeBase, groups: Mapping[str, frozenset[str]], smap: SemanticMap | None = None):
+        self.kb, self.groups, self._map = kb, groups, smap
+
+    @property
+    def map(self) -> SemanticMap:
+        if self._map is None:
+            self._map = SemanticMap.read(self.kb)
+        return self._map
+
+    def __call__(self, base: str, found: CompositionResult) -> FirstDrive | None:
+        plan, robot = found.plan, self.map.robots.get(base)
+        if plan is None or robot is None:
+            return None
+        step = next((s for s in plan.steps if s.component in self.groups.get(base, ()) and _drives(s)), None)
+        if step is None:
+            return None
+        things = self._things(base, found, _task_inputs(step, plan))
+        points = {thing: point for thing in things if (point := self._where(thing)) is not None}
+        if not points:
+            return None
+        x = sum(p[0] for p in points.values()) / len(points)
+        y = sum(p[1] for p in points.values()) / len(points)
+        metres = math.hypot(x - robot.start.x, y - robot.start.y)
+        return FirstDrive(step.index, step.component, tuple(sorted(points)), metres)
+
+    def _things(self, base: str, found: CompositionResult, inputs: Iterable[tuple[str, str]]) -> set[str]:
+        """The things the task's ``inputs`` (requirement, name) designate, as a run of ``base`` would."""
+        requirements = {attempt.requirement.iri: attempt.requirement for attempt in found.attempts}
+        things = set()
+        for iri, name in sorted(inputs):
+            requirement = requirements.get(iri) or _requirement(self.kb, iri)
+            parameter = next((p for p in requirement.inputs if p.name == name), None) if requirement else None
+            if requirement is None or parameter is None:
+                continue
+            try:
+                things.add(designate(self.kb, parameter.type, prefer=requirement.requested_by or base))
+            except (UnresolvedDesignatorError, AmbiguousDesignatorError):
+                continue  # a run refuses it, naming it; here it places nothing
+        return things
+
+    def _where(self, thing: str) -> tuple[float, float] | None:
+        smap = self.map
+        if thing in smap.objects:
+            return (smap.objects[thing].start.x, smap.objects[thing].start.y)
+        if thing in smap.people:
+            return (smap.people[thing].start.x, smap.people[thing].start.y)
+        place = smap.things.get(thing)
+        if place is None:
+            return None
+        if place.dock is not None:
+            return (place.dock.x, place.dock.y)
+        return place.box.centre[:2]
+
+
+def _drives(step: PlanStep) -> bool:
+    """Whether ``step`` brings a robot near something (a navigation's effect)."""
+    return any(effect.predicate == _NEAR for effect in step.effects)
+
+
+def _task_inputs(step: PlanStep, plan: Plan) -> set[tuple[str, str]]:
+    """The task's inputs (requirement, name) ``step`` works on, directly or through earlier steps."""
+    steps = {each.index: each for each in plan.steps}
+    found: set[tuple[str, str]] = set()
+    todo, seen = [step], {step.index}
+    while todo:
+        for binding in todo.pop().inputs:
+            source = binding.source
+            if source.step is None:
+                found.add((source.requirement or plan.requirement, source.name))
+            elif source.step not in seen and source.step in steps:
+                seen.add(source.step)
+                todo.append(steps[source.step])
+    return found
+
+
+def _requirement(kb: KnowledgeBase, iri: str) -> Requirement | None:
+    try:
+        found = kb.description(iri)
+    except NotFoundError:
+        return None
+    return found if isinstance(found, Requirement) else None
+
+
+def named_base(kb: KnowledgeBase, composition: CompositionResult, groups: Mapping[str, Any]) -> str | None:
+    """The base (one of ``groups``) an input of the task designates itself, if one does (a lab's class of
+    which P3DX02 is the one thing): the task names its base so."""
+    if not composition.attempts:
+        return None
+    requirement = composition.attempts[0].requirement
+    for parameter in requirement.inputs:
+        try:
+            thing = designate(kb, parameter.type, prefer=requirement.requested_by)
+        except (UnresolvedDesignatorError, AmbiguousDesignatorError):
+            continue
+        if thing in groups:
+            return thing
+    return None
+
+
+def on_behalf(requirements: Mapping[str, Requirement], chosen: BaseChoice | None) -> dict[str, Requirement]:
+    """``requirements`` as their inputs are designated in a run that drives ``chosen``: one no robot
+    requests as if the chosen base did, so that a thing of which each base has one (the marker's colours
+    a locator is given) is the chosen base's, the one the plan drives (docs/simulation.md, "A home with no
+    mobile base")."""
+    if chosen is None:
+        return dict(requirements)
+    return {
+        iri: found if found.requested_by is not None else replace(found, requested_by=chosen.base)
+        for iri, found in requirements.items()
+    }
+
+
+def base_groups(
+    kb: KnowledgeBase, bases: Iterable[str], advertisements: Sequence[Advertisement] | None = None
+) -> dict[str, frozenset[str]]:
+    """Each base's own components: base IRI -> the IRIs of the advertisements whose device
+    (``cbrs:device``, else by its ``cbrs:deviceName``) is that base, simulated or remote; ``advertisements``
+    if read already, else the store's."""
+    found: dict[str, set[str]] = {base: set() for base in bases}
+    for ad in kb.advertisements() if advertisements is None else advertisements:
+        device = ad.device or PREFIXES["svc"] + (ad.device_name or "")
+        if device in found:
+            found[device].add(ad.iri)
+    return {base: frozenset(components) for base, components in sorted(found.items())}
+
+
+def map_bases(kb: KnowledgeBase, facts: Sequence[Mapping[str, Term]] | None = None) -> set[str]:
+    """The IRIs of the mobile bases the world will build, from the store alone: each thing the map gives a
+    platform or a marker is one (``SemanticMap.robots``). ``facts``: the rows of ``map_facts`` when the caller
+    has read them already."""
+    rows = kb.select("map_facts") if facts is None else facts
+    return {row["thing"].value for row in rows if row["property"].value in _BASE_MARKS}
+
+
+def choose_in_map(
+    composer: Composer,
+    task: str,
+    composition: CompositionResult,
+    ties: BaseTies = BaseTies.NEAREST,
+    facts: Sequence[Mapping[str, Term]] | None = None,
+) -> tuple[CompositionResult, BaseChoice | None]:
+    """:func:`choose_base` as a run chooses, by the store alone (no world): the bases from the semantic map
+    (:func:`map_bases`; ``facts``, its rows if read already), their components among the advertisements
+    ``composer`` composes over; each base's plan composed as ``composition`` was (from the map, not the
+    belief). ``cbrs plan`` and the plans page."""
+    kb = composer.kb
+    bases = map_bases(kb, facts) if composition.plan is not None else set()
+    if len(bases) < 2:
+        return composition, None
+    groups = base_groups(kb, bases, composer.advertisements)
+
+    def compose(without: frozenset[str]) -> CompositionResult:
+        kept = [ad for ad in composer.advertisements if ad.iri not in without]
+        one = Composer(kb, composer.config, index=composer.index, actions=composer.actions, advertisements=kept)
+        return one.compose(task)
+
+    named = named_base(kb, composition, groups)
+    return choose_base(compose, composition, groups, named, MapDrives(kb, groups), ties)

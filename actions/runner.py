@@ -14,7 +14,7 @@ from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import Any, Protocol
 
-from cbrs.actions.base_choice import BaseChoice, choose_base
+from cbrs.actions.base_choice import BaseChoice, BaseTies, MapDrives, choose_base, named_base, on_behalf
 from cbrs.actions.belief import BeliefState, Observation
 from cbrs.actions.components import Container, Registry
 from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, PlanStatus, store_plan
@@ -28,7 +28,7 @@ from cbrs.actions.plan import Plan, PlanStep
 from cbrs.actions.replanning import Failure, FailureMemory, ReplanPolicy
 from cbrs.kb import Advertisement, KnowledgeBase, NotFoundError, Requirement, Statement
 from cbrs.kb.namespaces import HOME, shorten
-from cbrs.kb.semantic_map import AmbiguousDesignatorError, UnresolvedDesignatorError, designate
+from cbrs.kb.semantic_map import UnresolvedDesignatorError
 from cbrs.kb.store import Term
 from cbrs.reasoner.taxonomy import ROOT, TaxonomyIndex
 
@@ -263,6 +263,7 @@ def run_task(
     max_replans: int = 2,
     cancelled: Callable[[], bool] | None = None,
     replan_policy: ReplanPolicy | None = None,
+    base_ties: BaseTies = BaseTies.NEAREST,
 ) -> RunResult:
     """Perceive, compose ``task`` from what holds now, run it in ``environment``, keep the world graph current.
 
@@ -276,7 +277,8 @@ def run_task(
     ``replan_policy`` says what a re-plan does about a failure nothing has changed since (the same
     component, inputs and kind of failure, with the things it depended on believed where they were):
     compose without its component first, and repeat it at most ``max_repeats`` times, else stop with
-    ``RunResult.stopped`` saying why (``actions.replanning``).
+    ``RunResult.stopped`` saying why (``actions.replanning``). ``base_ties``: in a home of several mobile
+    bases, how plans of one cost and similarity for different bases are told apart (``actions.base_choice``).
     """
     composer = composer or Composer(kb)
     bus = EventBus()
@@ -291,7 +293,7 @@ def run_task(
     belief.write(environment.observe())  # plan from what holds now, not from a past run's belief
     composition = composer.compose(task, belief=True)
     config = composer.config
-    composition, chosen = _one_base(kb, config, task, composition, environment, bus, frozenset())
+    composition, chosen = _one_base(kb, config, task, composition, environment, bus, frozenset(), base_ties)
     passed = _passed_over(environment, bus, {})
     why_not = _why_not(environment)
     left_out = chosen.left_out if chosen is not None else frozenset()
@@ -318,7 +320,9 @@ def run_task(
             avoid = avoid | _kept_base(environment, chosen)
             again = _compose(kb, config, task, avoid)
         else:
-            again, chosen = _one_base(kb, config, task, _compose(kb, config, task, avoid), environment, bus, avoid)
+            again, chosen = _one_base(
+                kb, config, task, _compose(kb, config, task, avoid), environment, bus, avoid, base_ties
+            )
             avoid = avoid | (chosen.left_out if chosen is not None else frozenset())
         return _runnable(kb, config, task, again, environment.registry, avoid, passed, why_not=why_not)
 
@@ -330,7 +334,7 @@ def run_task(
         while composition.plan is not None:
             plan = composition.plan
             try:
-                given = environment.given(plan, _supplying(kb, composition))
+                given = environment.given(plan, on_behalf(_supplying(kb, composition), chosen))
             except Exception:
                 if not replans:  # refused before anything moved: the store is left as it was
                     belief.restore(before)
@@ -705,33 +709,23 @@ def _one_base(
     environment: Environment,
     bus: EventBus,
     avoid: frozenset[str],
+    ties: BaseTies = BaseTies.NEAREST,
 ) -> tuple[CompositionResult, BaseChoice | None]:
     """``composition``, or in a home of several bases the best composed with one base's components
-    (``actions.base_choice``), said on the progress topic."""
+    (``actions.base_choice``; plans alike told apart by ``ties``, measured in the store's map), said on
+    the progress topic."""
     groups = _base_components(environment)
     if len(groups) < 2:
         return composition, None
-    named = _named_base(kb, composition, groups)
-    found, chosen = choose_base(lambda without: _compose(kb, config, task, avoid | without), composition, groups, named)
+    named = named_base(kb, composition, groups)
+    drives = MapDrives(kb, groups)  # the map is read only if two plans cost alike and match alike
+    found, chosen = choose_base(
+        lambda without: _compose(kb, config, task, avoid | without), composition, groups, named, drives, ties
+    )
     if chosen is not None:
-        bus.publish("/cbrs/task_progress", {"event": "base_chosen", "base": chosen.base, "why": chosen.why})
+        message = {"event": "base_chosen", "base": chosen.base, "why": chosen.why, "rule": chosen.rule}
+        bus.publish("/cbrs/task_progress", message)
     return found, chosen
-
-
-def _named_base(kb: KnowledgeBase, composition: CompositionResult, groups: Mapping[str, Any]) -> str | None:
-    """The base (one of ``groups``) an input of the task designates itself, if one does (a lab's class of
-    which P3DX02 is the one thing): the task names its base so."""
-    if not composition.attempts:
-        return None
-    requirement = composition.attempts[0].requirement
-    for parameter in requirement.inputs:
-        try:
-            thing = designate(kb, parameter.type, prefer=requirement.requested_by)
-        except (UnresolvedDesignatorError, AmbiguousDesignatorError):
-            continue
-        if thing in groups:
-            return thing
-    return None
 
 
 def _kept_base(environment: Environment, chosen: BaseChoice) -> frozenset[str]:

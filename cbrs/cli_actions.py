@@ -10,13 +10,14 @@ import socket
 import sys
 import time
 from collections import Counter
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, NoReturn
 
 import click
 
+from cbrs.actions.base_choice import BaseChoice, BaseTies, choose_in_map
 from cbrs.actions.breaker import late_answers_awaited, settle_late_answers
 from cbrs.actions.components import Registry
 from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, Objective, PlanStatus, store_plan
@@ -41,6 +42,7 @@ from cbrs.kb import Advertisement, KnowledgeBase, RemoteStoreError
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import shorten
 from cbrs.kb.semantic_map import SemanticMap, UnresolvedDesignatorError
+from cbrs.kb.store import Term
 from cbrs.output import table
 from cbrs.settings import setting
 from cbrs.task_names import task_iri
@@ -90,6 +92,17 @@ _NEAR_MISSES = click.option(
         " 0: none (ComposeConfig.near_misses)."
     ),
 )
+_BASE_TIES = click.option(
+    "--base-ties",
+    type=click.Choice([t.value for t in BaseTies]),
+    default=BaseTies.NEAREST.value,
+    show_default=True,
+    help=(
+        "In a home of several mobile bases, how plans of one cost and similarity for different bases are told"
+        " apart: nearest, the base nearest where its plan first drives it (in the map), then the first by IRI;"
+        " iri, the first by IRI (docs/simulation.md, A home with no mobile base)."
+    ),
+)
 
 
 def _compose_config(
@@ -136,6 +149,7 @@ def _compose_config(
 @_PROTECT
 @_MAX_REACHIEVED
 @_NEAR_MISSES
+@_BASE_TIES
 @pass_app
 def plan(
     app: App,
@@ -148,6 +162,7 @@ def plan(
     protect: bool,
     max_reachieved: int,
     near_misses: int,
+    base_ties: str,
 ) -> None:
     """Compose a plan for TASK: a requirement or action (req:FetchMyPen, act:RobotArmServeACup, or a bare name).
 
@@ -156,7 +171,8 @@ def plan(
     composed over every advertisement; a note follows it for each step cbrs run cannot run in the
     simulated home now (no skill for its service, no live component to call, a camera the map does not
     place), which the run plans without, and for each thing the task names that the map does not hold,
-    for which the run refuses the task. These are read from the store: no world is built.
+    for which the run refuses the task. In a home of several mobile bases the plan works one, chosen as
+    cbrs run chooses it, and says which and why. These are read from the store: no world is built.
     """
     if drawing is not None and drawing.suffix.lower() not in (".svg", ".png"):
         raise click.BadParameter(f"{drawing.name!r} must end in .svg or .png", param_hint="--draw")
@@ -164,7 +180,8 @@ def plan(
     requested = task_iri(app.kb, task, actions)  # an unknown name is refused before the composer reads the store
     config = _compose_config(ignore_areas, protect, max_reachieved, near_misses, objective=Objective(objective))
     composer = Composer(app.kb, config, actions=actions)
-    result = composer.compose(requested)
+    facts = app.kb.select("map_facts")  # read once: the bases, and what the map lacks
+    result, chosen = choose_in_map(composer, requested, composer.compose(requested), BaseTies(base_ties), facts)
     if result.plan is not None and not no_store:
         try:
             store_plan(app.kb, result.plan)
@@ -181,9 +198,11 @@ def plan(
 
         draw(result, drawing)
     here = _not_here(app.kb, result.plan, composer.advertisements) if result.plan is not None else None
-    unmapped = _unmapped(app.kb, composer, result.plan) if result.plan is not None else None
+    unmapped = _unmapped(app.kb, composer, result.plan, facts) if result.plan is not None else None
     if as_json:
         found = result.to_dict()
+        if chosen is not None:
+            found["base"] = chosen.to_dict()
         if here is not None:
             found.update(here.to_dict())
         if unmapped is not None:
@@ -191,7 +210,7 @@ def plan(
         click.echo(json.dumps(found, indent=2))
     else:
         notes = (here.text() if here is not None else "") + (unmapped.text() if unmapped is not None else "")
-        click.echo(plan_text(result) + notes)
+        click.echo(plan_text(result) + _base_note(chosen) + notes)
     if drawing is not None and not as_json:
         click.echo(f"drawing written to {drawing}")
     if result.status is not PlanStatus.PLANNED:
@@ -282,11 +301,17 @@ class _Unmapped:
         return "".join(lines)
 
 
-def _unmapped(kb: KnowledgeBase, composer: Composer, plan: Plan) -> _Unmapped:
+def _base_note(chosen: BaseChoice | None) -> str:
+    """In a home of several mobile bases, the one the plan works and why (``actions.base_choice``)."""
+    if chosen is None:
+        return ""
+    return f"\nnote: the plan works {shorten(chosen.base)}, as cbrs run would choose it: {chosen.why}"
+
+
+def _unmapped(kb: KnowledgeBase, composer: Composer, plan: Plan, facts: Sequence[Mapping[str, Term]]) -> _Unmapped:
     """What of ``plan`` ``cbrs run`` would plan without or refuse for what the map lacks: the things from
     the store alone; the cameras with the [sim] part only (its skills say which components look with a
-    camera)."""
-    facts = kb.select("map_facts")  # read once for both
+    camera). ``facts``: the rows of ``map_facts``."""
     things = ungrounded(kb, composer.index, plan, facts)
     cameras: list[tuple[PlanStep, str, str, bool]] = []
     if installed("sim"):
@@ -414,6 +439,7 @@ def _source(binding: Binding) -> str:
 @_PROTECT
 @_MAX_REACHIEVED
 @_NEAR_MISSES
+@_BASE_TIES
 @pass_app
 def run(
     app: App,
@@ -431,6 +457,7 @@ def run(
     protect: bool,
     max_reachieved: int,
     near_misses: int,
+    base_ties: str,
 ) -> None:
     """Plan TASK, then execute it in the simulated home, step by step, failing over where needed.
 
@@ -512,6 +539,7 @@ def run(
                 on_event=follow,
                 fault_policy=policy,
                 replan_policy=ReplanPolicy(max_repeats=repeat_failures),
+                base_ties=BaseTies(base_ties),
             )
         except KnowledgeBaseError as error:  # refused before anything moved (out of reach, ambiguous...)
             if not as_json:

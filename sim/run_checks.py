@@ -15,6 +15,8 @@ from collections.abc import Callable, Collection, Iterable, Iterator, Mapping, S
 from dataclasses import replace
 from typing import Any
 
+from cbrs.actions.base_choice import base_groups
+from cbrs.actions.base_choice import map_bases as map_bases  # the store's bases: cbrs.tasks and the tests read it here
 from cbrs.actions.plan import Plan, PlanStep
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import KnowledgeBaseError
@@ -644,15 +646,6 @@ def without_camera(advertisements: Iterable[Advertisement], cameras: Collection[
     }
 
 
-def map_bases(kb: KnowledgeBase, facts: Sequence[Mapping[str, Term]] | None = None) -> set[str]:
-    """The IRIs of the mobile bases the world will build, from the store alone: each thing the map gives a
-    platform or a marker is one (``SemanticMap.robots``). ``facts``: the rows of ``map_facts`` when the caller
-    has read them already."""
-    rows = kb.select("map_facts") if facts is None else facts
-    marks = (HOME + "hasPlatform", HOME + "hasMarker")
-    return {row["thing"].value for row in rows if row["property"].value in marks}
-
-
 def without_base(advertisements: Iterable[Advertisement], bases: Collection[str]) -> dict[str, str]:
     """The simulated components of ``advertisements`` that work the mobile base (``services.WITH_BASE``: drive
     it, load its platform, find its marker), each with why, when the home has no base (``bases``, their IRIs
@@ -724,19 +717,13 @@ def base_for(world: HomeWorld, plan: Plan, ads: Mapping[str, Advertisement], val
 
 
 def base_components(world: HomeWorld, kb: KnowledgeBase) -> dict[str, frozenset[str]]:
-    """In a home of several mobile bases, each base's own components (base IRI -> the IRIs of the
-    advertisements whose device, ``cbrs:device`` or by its ``cbrs:deviceName``, is that base: its drive,
-    navigation, delivery, odometry, battery, simulated or remote): a run composes with one base's and
+    """In a home of several mobile bases, each base's own components (``actions.base_choice.base_groups``:
+    the advertisements whose device is that base, simulated or remote): a run composes with one base's and
     without the others' (``actions.runner``, docs/simulation.md, "A home with no mobile base"). Empty in a
     home of one base or none, where nothing is left out (the store's advertisements are not read)."""
     if len(world.mobiles) < 2:
         return {}
-    found: dict[str, set[str]] = {robot.iri: set() for robot in world.mobiles.values()}
-    for ad in kb.advertisements():
-        device = ad.device or PREFIXES["svc"] + (ad.device_name or "")
-        if device in found:
-            found[device].add(ad.iri)
-    return {base: frozenset(components) for base, components in sorted(found.items())}
+    return base_groups(kb, [robot.iri for robot in world.mobiles.values()])
 
 
 def _marked(world: HomeWorld, step: PlanStep, steps: Mapping[int, PlanStep], values: Mapping[str, Any]) -> list[str]:

@@ -12,9 +12,9 @@ from typing import Any, cast
 
 import pytest
 
-from cbrs.actions.base_choice import BaseChoice, choose_base
+from cbrs.actions.base_choice import BaseChoice, choose_base, named_base
 from cbrs.actions.composer import Composer, CompositionResult
-from cbrs.actions.runner import Environment, _kept_base, _named_base
+from cbrs.actions.runner import Environment, _kept_base
 from cbrs.cli_actions import _progress
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
@@ -162,8 +162,8 @@ def test_an_input_designating_a_base_names_it(faster: KnowledgeBase) -> None:
         attempt = SimpleNamespace(requirement=SimpleNamespace(inputs=inputs, requested_by=None))
         return cast(CompositionResult, SimpleNamespace(attempts=(attempt,)))
 
-    assert _named_base(faster, asking(HOME + "Pen", LAB6 + "SecondPioneer"), groups) == P2
-    assert _named_base(faster, asking(HOME + "Pen", HOME + "CarrierRobot"), groups) is None  # both: ambiguous
+    assert named_base(faster, asking(HOME + "Pen", LAB6 + "SecondPioneer"), groups) == P2
+    assert named_base(faster, asking(HOME + "Pen", HOME + "CarrierRobot"), groups) is None  # both: ambiguous
     mixed = _stub(80.0, 0.9, ("nav1", "deliver2"))
     one, two = _stub(80.0, 0.9, ("nav1", "deliver1")), _stub(86.0, 0.9, ("nav2", "deliver2"))
     found, chosen = choose_base(_by_base(one, two), mixed, GROUPS, named=P2)

@@ -22,6 +22,7 @@ from cbrs.web.links import display_text, expand_name, short, tail_parts
 from cbrs.web.pages import FormError, Page, page, wants_json
 
 if TYPE_CHECKING:  # the planner (and networkx) load with the first plan asked for, not at start-up
+    from cbrs.actions.base_choice import BaseChoice
     from cbrs.actions.composer import Composer, CompositionResult
 
 blueprint = Blueprint("plans", __name__)
@@ -52,9 +53,11 @@ def plans() -> Page:
             _load_drawing_library()  # while the user chooses a task
         return shown
     with context.lock():  # a GET stays safe: the plan is shown, not recorded (cbrs plan and /cbrs/plan record)
-        result = _compose(task, objective, shown)
+        composed = _composed(task, objective, shown)
+    result = composed.result
     shown.title = f"Plan for {task}"  # once there is one: "Plan for FetchMyPn" titled the error
     data["composition"] = _composition(result)
+    data["base"] = composed.base.to_dict() if composed.base is not None else None  # several mobile bases
     if not wants_json():  # markup, so not in the twin, which has the same steps as lists
         data["flow"] = _flow(data["composition"])
         _load_drawing_library()  # the page asks for the drawing next
@@ -78,16 +81,14 @@ def graph() -> Response:
 
 @dataclass
 class _Composed:
-    """A task's composition by one composer, and its drawing once asked for."""
+    """A task's composition by one composer, and its drawing once asked for; in a home of several mobile
+    bases, the one-base composition a run would take and the base (``actions.base_choice``), so the page
+    never shows a plan that mixes two bases' components."""
 
     composer: Composer
     result: CompositionResult
+    base: BaseChoice | None = None
     svg: bytes | None = None
-
-
-def _compose(task: str, objective: str, shown: Page | None) -> CompositionResult:
-    """Call with ``context.lock()`` held."""
-    return _composed(task, objective, shown).result
 
 
 def _composed(task: str, objective: str, shown: Page | None) -> _Composed:
@@ -96,6 +97,7 @@ def _composed(task: str, objective: str, shown: Page | None) -> _Composed:
     composer is made again when a component's lease lapses (:class:`cbrs.bridge_services.Composers`),
     which no store write marks, so a kept composition counts only with the composer that made it.
     Call with ``context.lock()`` held, which guards the kept compositions too."""
+    from cbrs.actions.base_choice import choose_in_map
     from cbrs.actions.composer import Objective
     from cbrs.actions.errors import UnknownTaskError
     from cbrs.task_names import task_iri
@@ -111,7 +113,8 @@ def _composed(task: str, objective: str, shown: Page | None) -> _Composed:
         iri = task_iri(context.kb(), _with_derived_prefix(task))
         found = kept.get((objective, iri))
         if found is None or found.composer is not composer:
-            found = kept[(objective, iri)] = _Composed(composer, composer.compose(iri))
+            result, base = choose_in_map(composer, iri, composer.compose(iri))
+            found = kept[(objective, iri)] = _Composed(composer, result, base)
         return found
     except UnknownTaskError as error:  # says what was meant and how to type every known task
         raise FormError({"task": str(error)}, page=shown) from None

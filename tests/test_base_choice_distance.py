@@ -1,0 +1,191 @@
+"""Two bases whose plans cost alike and match alike (docs/simulation.md, "A home with no mobile base"): the
+base with the least to drive to where its plan first goes is taken, measured in the map, then the first by
+IRI; ``cbrs plan`` and the plans page choose as a run does, from the store alone; a task no robot requests
+designates the chosen base's marker colours. One simulation run: FetchMyPenAnyBase with P3DX02 by the door."""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Callable
+from dataclasses import replace
+from types import SimpleNamespace
+from typing import cast
+
+import pytest
+from click.testing import CliRunner
+
+from cbrs.actions.base_choice import (
+    BaseChoice,
+    BaseTies,
+    FirstDrive,
+    MapDrives,
+    base_groups,
+    choose_base,
+    choose_in_map,
+    map_bases,
+    on_behalf,
+)
+from cbrs.actions.composer import Composer, CompositionResult
+from cbrs.actions.runner import run_task
+from cbrs.app import App
+from cbrs.cli_actions import _base_note, plan
+from cbrs.kb import KnowledgeBase, Requirement
+from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.semantic_map import AmbiguousDesignatorError, Pose, SemanticMap, designate
+from cbrs.sparql_service import SparqlService
+from cbrs.web import create_app
+from tests.helpers_examples import EXAMPLES
+
+SVC, HOME, WORLD = PREFIXES["svc"], PREFIXES["home"], PREFIXES["world"]
+P1, P2 = SVC + "P3DX01", SVC + "P3DX02"
+TASK = "https://example.org/lab6#FetchMyPenAnyBase"
+
+
+def _home(*updates: str) -> KnowledgeBase:
+    """Two Pioneers with their own components (the same QoS) and FetchMyPenAnyBase, asked by no robot."""
+    kb = KnowledgeBase.open(":memory:")
+    for name in ("lab6_two_bases.ru", *updates):
+        kb.update((EXAMPLES / name).read_text(encoding="utf-8"))
+    kb.registry.register((EXAMPLES / "lab6_second_base_components.ttl").read_text(encoding="utf-8"))
+    kb.load([EXAMPLES / "lab6b_fetch_any_base.ttl"], graph="requirements")
+    return kb
+
+
+@pytest.fixture(scope="module")
+def by_the_door() -> KnowledgeBase:
+    """P3DX02 moved from the bedroom to the kitchen door: nearer the pen than P3DX01, and second by IRI."""
+    return _home("lab6_second_base_near_table.ru")
+
+
+@pytest.fixture(scope="module")
+def plans(by_the_door: KnowledgeBase) -> dict[str, CompositionResult]:
+    """The task composed over every component, and with each base's own alone."""
+    composer = Composer(by_the_door)
+    groups = base_groups(by_the_door, map_bases(by_the_door))
+    every = frozenset().union(*groups.values())
+    found = {"every": composer.compose(TASK)}
+    for base, own in groups.items():
+        kept = [ad for ad in composer.advertisements if ad.iri not in every - own]
+        found[base] = Composer(by_the_door, advertisements=kept).compose(TASK)
+    return found
+
+
+def _stub(components: tuple[str, ...]) -> CompositionResult:
+    steps = tuple(SimpleNamespace(candidates=(c,)) for c in components)
+    found = SimpleNamespace(plan=SimpleNamespace(steps=steps, cost=86.75, similarity=0.9), attempts=())
+    return cast(CompositionResult, found)
+
+
+GROUPS = {P1: frozenset({"nav1"}), P2: frozenset({"nav2"})}
+ONE, TWO = _stub(("nav1",)), _stub(("nav2",))
+
+
+def _compose(avoid: frozenset[str]) -> CompositionResult:
+    return ONE if "nav2" in avoid else TWO
+
+
+def _drives(metres: dict[str, float | None]) -> Callable[[str, CompositionResult], FirstDrive | None]:
+    def drive(base: str, found: CompositionResult) -> FirstDrive | None:
+        assert found is (ONE if base == P1 else TWO)  # each base's own plan is measured
+        away = metres[base]
+        return None if away is None else FirstDrive(5, f"nav{base[-1]}", (WORLD + "Pen",), away)
+
+    return drive
+
+
+def test_plans_alike_go_to_the_base_with_the_least_to_drive() -> None:
+    mixed = _stub(("nav1", "nav2"))
+    found, chosen = choose_base(_compose, mixed, GROUPS, drive=_drives({P1: 5.38, P2: 3.3}))
+    assert found is TWO and chosen is not None and (chosen.base, chosen.rule) == (P2, "nearest")
+    assert "the least to drive: 3.30 m" in chosen.why and "to Pen" in chosen.why and "P3DX01's 5.38 m" in chosen.why
+    assert [base for base, _ in chosen.drives] == [P1, P2] and chosen.to_dict()["drives"][1]["drive"]["metres"] == 3.3
+    # as far, or a plan that drives to nothing the map places: the first by IRI, said so
+    _, chosen = choose_base(_compose, mixed, GROUPS, drive=_drives({P1: 4.0, P2: 4.0}))
+    assert chosen is not None and (chosen.base, chosen.rule) == (P1, "iri") and "as far" in chosen.why
+    _, chosen = choose_base(_compose, mixed, GROUPS, drive=_drives({P1: 5.38, P2: None}))
+    assert chosen is not None and chosen.base == P1 and "P3DX02's plan drives to nothing the map places" in chosen.why
+    # --base-ties iri: the distance is not asked
+    _, chosen = choose_base(_compose, mixed, GROUPS, drive=_drives({}), ties=BaseTies.IRI)
+    assert chosen is not None and (chosen.base, chosen.rule) == (P1, "iri") and chosen.drives == ()
+
+
+def test_the_first_drive_is_measured_in_the_map(
+    by_the_door: KnowledgeBase, plans: dict[str, CompositionResult]
+) -> None:
+    groups = base_groups(by_the_door, map_bases(by_the_door))
+    drives = MapDrives(by_the_door, groups)
+    for base in (P1, P2):
+        drive = drives(base, plans[base])
+        assert drive is not None and drive.towards == (WORLD + "Pen",)
+        assert drive.component.endswith("NavigateToPlace_" + base[-6:])  # the base's own navigation
+        pen, robot = drives.map.objects[WORLD + "Pen"].start, drives.map.robots[base].start
+        assert drive.metres == pytest.approx(math.hypot(pen.x - robot.x, pen.y - robot.y))
+    assert plans[P1].plan is not None and plans[P2].plan is not None
+    assert (plans[P1].plan.cost, plans[P1].plan.similarity) == (plans[P2].plan.cost, plans[P2].plan.similarity)
+    found, chosen = choose_base(lambda avoid: plans[_kept(avoid)], plans["every"], groups, drive=drives)
+    assert chosen is not None and (chosen.base, chosen.rule) == (P2, "nearest") and found is plans[P2]
+    # where lab6_two_bases.ru parks it, in the bedroom, P3DX02 is the farther
+    moved = replace(drives.map.robots[P2], start=Pose(2.0, 7.0))
+    bedroom = MapDrives(by_the_door, groups, replace(drives.map, robots={**drives.map.robots, P2: moved}))
+    _, chosen = choose_base(lambda avoid: plans[_kept(avoid)], plans["every"], groups, drive=bedroom)
+    assert chosen is not None and (chosen.base, chosen.rule) == (P1, "nearest")
+
+
+def _kept(avoid: frozenset[str]) -> str:
+    """The base whose components a composition without ``avoid`` keeps."""
+    return P1 if SVC + "NavigateToPlace_P3DX02" in avoid else P2
+
+
+def test_cbrs_plan_says_the_base_and_why(by_the_door: KnowledgeBase) -> None:
+    said = CliRunner().invoke(plan, [TASK, "--no-store", "--json"], obj=App(":memory:", by_the_door))
+    assert said.exit_code == 0, said.output
+    found = json.loads(said.output)
+    assert (found["base"]["base"], found["base"]["rule"]) == (P2, "nearest")
+    components = [step["component"] for step in found["steps"]]
+    assert SVC + "NavigateToPlace_P3DX02" in components and not any(c.endswith("P3DX01") for c in components)
+    note = _base_note(BaseChoice(P2, found["base"]["why"]))  # the text's note
+    assert note == f"\nnote: the plan works svc:P3DX02, as cbrs run would choose it: {found['base']['why']}"
+
+
+def test_the_plans_page_shows_the_base_chosen(by_the_door: KnowledgeBase) -> None:
+    client = create_app(SparqlService(by_the_door)).test_client()
+    twin = client.get("/plans.json", query_string={"task": TASK}).get_json()
+    assert twin["base"]["base"] == P2 and twin["base"]["rule"] == "nearest"
+    assert not any(step["component"].endswith("P3DX01") for step in twin["composition"]["steps"])
+    page = client.get("/plans", query_string={"task": TASK}).get_data(as_text=True)
+    assert "as a run would choose it: its plan and P3DX01&#39;s cost alike" in page
+
+
+def test_a_home_of_one_base_plans_as_before() -> None:
+    kb = KnowledgeBase.open(":memory:")
+    composition = _stub(("nav1",))  # the store is asked for its bases only
+    assert map_bases(kb) == {P1} and choose_in_map(Composer(kb), "FetchMyPen", composition) == (composition, None)
+    assert _base_note(None) == ""
+
+
+def test_no_requester_designates_the_chosen_bases_marker_colours(by_the_door: KnowledgeBase) -> None:
+    colours = HOME + "ColourOfMarker"
+    with pytest.raises(AmbiguousDesignatorError):  # two markers, no requester: which?
+        designate(by_the_door, colours)
+    requirement = cast(Requirement, by_the_door.description(TASK))
+    assert requirement.requested_by is None
+    chosen = BaseChoice(P2, "why")
+    on = on_behalf({TASK: requirement}, chosen)[TASK]
+    assert on.requested_by == P2 and on_behalf({TASK: requirement}, None)[TASK] is requirement
+    assert designate(by_the_door, colours, prefer=on.requested_by) == WORLD + "P3DX02MarkerColours"
+
+
+def test_a_run_drives_the_nearer_base_with_its_own_marker(by_the_door: KnowledgeBase) -> None:
+    """The one simulation run: asked by no robot, with P3DX02 by the door, the run drives P3DX02 and
+    locates it by its own marker (the other's colours would have the plan work two bases: refused)."""
+    from cbrs.sim.components import SimEnvironment
+    from cbrs.sim.world import open_world
+
+    with open_world(seed=0, semantic_map=SemanticMap.read(by_the_door)) as world:
+        result = run_task(by_the_door, TASK, SimEnvironment(world, by_the_door), composer=Composer(by_the_door))
+    assert result.base is not None and (result.base.base, result.base.rule) == (P2, "nearest")
+    assert result.succeeded, result.to_dict()
+    assert result.report is not None
+    used = {attempt.component for step in result.report.steps for attempt in step.attempts}
+    assert SVC + "DeliverObject_P3DX02" in used and not any(c.endswith("P3DX01") for c in used)
