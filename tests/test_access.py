@@ -10,6 +10,7 @@ from __future__ import annotations
 import ast
 import json
 import os
+import re
 import socket
 import threading
 from collections.abc import Iterator
@@ -252,6 +253,9 @@ def test_hostile_values_in_bridge_service_arguments_change_nothing(server: Serve
     assert server.kb.store.dump() == before
 
 
+CALLED = re.compile(r"\b(query|update|select)\b")
+
+
 def test_no_library_code_builds_sparql_from_formatted_text() -> None:
     """Queries are named .rq files with bound values; the only text built in code is what pyoxigraph
     serialised (data blocks, VALUES for a remote store). An f-string, ``%`` or ``.format`` handed to
@@ -263,8 +267,10 @@ def test_no_library_code_builds_sparql_from_formatted_text() -> None:
             relative = path.relative_to(ROOT)
             if relative in allowed:
                 continue
-            tree = ast.parse(path.read_text(encoding="utf-8"))
-            for node in ast.walk(tree):
+            text = path.read_text(encoding="utf-8")
+            if not CALLED.search(text):  # a call of .query etc. has the name in its text: half the files parse
+                continue
+            for node in ast.walk(ast.parse(text)):
                 if not (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)):
                     continue
                 if node.func.attr not in ("query", "update", "select") or not node.args:
