@@ -267,10 +267,10 @@ def test_no_library_code_builds_sparql_from_formatted_text() -> None:
             relative = path.relative_to(ROOT)
             if relative in allowed:
                 continue
-            text = path.read_text(encoding="utf-8")
-            if not CALLED.search(text):  # a call of .query etc. has the name in its text: half the files parse
+            source = path.read_text(encoding="utf-8")
+            if not CALLED.search(source):  # a call of .query etc. has the name in its text: half the files parse
                 continue
-            for node in ast.walk(ast.parse(text)):
+            for node in ast.walk(ast.parse(source)):
                 if not (isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute)):
                     continue
                 if node.func.attr not in ("query", "update", "select") or not node.args:
