@@ -9,8 +9,16 @@ so that it is composed (:meth:`Composer.compose` takes a requirement) as it woul
 
 Saving is one SPARQL update through the endpoint's own guard (:meth:`SparqlService.update`: the update
 token, read-only servers, the lock, graph:entailed): ``INSERT DATA`` of the draft's quads, after a
-``DELETE DATA`` of the stored task's own description when it replaces one. The update is checked again
-as every update of graph:requirements is, and undone whole if refused.
+``DELETE DATA`` of what the stored task's previous text added when it replaces one. The update is
+checked again as every update of graph:requirements is, and undone whole if refused.
+
+What a saved text added is recorded by the same update in graph:task-drafts (:data:`RECORDS`), one node
+per task (:func:`record_iri`), as N-Triples literals: the text's triples (``stated``) and the triples the
+editor's saves of that task put into graph:requirements (``added``: absent before). A replace removes the
+task's own description and whatever else its previous text stated that an editor's save added, except
+what the new text or another saved task's text states; a triple a load put there is not the editor's to
+remove. The copies are literals, not triples, so that queries over the union of the graphs see each
+triple once.
 
 The text needs no ``@prefix`` lines for the prefixes the store uses: those the text does not declare are
 declared on one line put before it, and the parser's line numbers are given back as the text's own.
@@ -19,8 +27,9 @@ declared on one line put before it, and the parser's line numbers are given back
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, cast
 
@@ -30,12 +39,13 @@ from cbrs.kb.descriptions import DescriptionReader
 from cbrs.kb.errors import KnowledgeBaseError, RdfParseError
 from cbrs.kb.loader import parse_bytes
 from cbrs.kb.model import Requirement
+from cbrs.kb.namespaces import BASE as CBRS_BASE
 from cbrs.kb.namespaces import CBRS as CBRS_NS
-from cbrs.kb.namespaces import GENID, RDF, RDFS, REQ, GraphName, near_prefixes, shorten
+from cbrs.kb.namespaces import GENID, GRAPH, RDF, RDFS, REQ, GraphName, near_prefixes, shorten
 from cbrs.kb.registry import ComponentRegistry
 from cbrs.kb.resources import ontology_dir
 from cbrs.kb.shapes import DescriptionShapeError, ShapeProblem, check_descriptions
-from cbrs.kb.store import EmbeddedStore, data_block
+from cbrs.kb.store import EmbeddedStore, Store, data_block
 from cbrs.kb.vocab import CBRS
 
 if TYPE_CHECKING:
@@ -52,6 +62,7 @@ __all__ = [
     "line_of",
     "plan",
     "read",
+    "record_iri",
     "save",
 ]
 
@@ -61,6 +72,10 @@ BASE = REQ
 """What a relative IRI of the text (``<#MyTask>``) is resolved against: the requirements' namespace."""
 EXAMPLES_FILE = "requirements.ttl"
 """The bundled requirements, from which the editor's example is taken."""
+RECORDS = ox.NamedNode(GRAPH + "task-drafts")
+"""The graph of what each saved text added (one node per task, :func:`record_iri`)."""
+_DRAFT = CBRS_BASE + "task-draft#"
+_TASK, _STATED, _ADDED = (ox.NamedNode(_DRAFT + name) for name in ("task", "stated", "added"))
 
 
 class DraftError(KnowledgeBaseError):
@@ -154,28 +169,76 @@ def plan(composer: Composer, draft: TaskDraft) -> CompositionResult:
 
 def save(sparql: SparqlService, draft: TaskDraft, token: str | None, replace: bool = False) -> int:
     """Write ``draft`` into graph:requirements in one update with the update ``token``; a stored task of
-    its name is replaced only with ``replace`` (else :class:`TaskExistsError`). Returns the number of
-    triples the stored task had (0 for a new one)."""
+    its name is replaced only with ``replace`` (else :class:`TaskExistsError`), and with it what its
+    previously saved text added. Returns the number of triples the stored task had (0 for a new one)."""
     sparql.check_token(token)  # before anything is read: no answer about the store without the token
-    graph = GraphName.REQUIREMENTS.node
+    store, graph = sparql.kb.store, GraphName.REQUIREMENTS.node
     with sparql.lock:
-        stored = any(sparql.kb.store.quads(ox.NamedNode(draft.iri), ox.NamedNode(RDF + "type"), None, graph))
+        stored = any(store.quads(ox.NamedNode(draft.iri), ox.NamedNode(RDF + "type"), None, graph))
         if stored and not replace:
             raise TaskExistsError(draft.iri)
-        old = (
-            ComponentRegistry(sparql.kb.store, sparql.kb.standard_terms).owned_quads(draft.iri, graph) if stored else []
-        )
-        new = set(draft.quads)
-        parts = []
-        removing = data_block(q for q in old if q not in new)
-        adding = data_block(q for q in draft.quads if q not in set(old))
-        if removing:
-            parts.append("DELETE DATA {\n" + removing + "}")
-        if adding:
-            parts.append("INSERT DATA {\n" + adding + "}")
-        if parts:
-            sparql.update(" ;\n".join(parts), token)
-    return len(old)
+        record = ox.NamedNode(record_iri(draft.iri))
+        records = list(store.quads(None, None, None, RECORDS))
+        mine = [q for q in records if q.subject == record]  # the previous save's record
+        owned = set(ComponentRegistry(store, sparql.kb.standard_terms).owned_quads(draft.iri, graph) if stored else [])
+        previous = {q for q in owned | _recorded(mine, _STATED) if _present(store, q)} if stored else set()
+        text = _as_stored(draft.quads)
+        said = _recorded((q for q in records if q.subject != record), _STATED) | set(text)
+        by_editor = _recorded(records, _ADDED)  # a triple a load put there is not the editor's to remove
+        removing = [q for q in previous if q not in said and (q in owned or q in by_editor)]
+        inserting = [q for q in text if not _present(store, q)]
+        carried = [q for q in _recorded(mine, _ADDED) if q not in removing and _present(store, q)]
+        written = _record(record, draft.iri, text, [*inserting, *carried])
+        update = "INSERT DATA {\n" + data_block([*inserting, *written])
+        if removing or mine:
+            update = "DELETE DATA {\n" + data_block([*removing, *mine]) + "} ;\n" + update
+        sparql.update(update + "}", token)
+    return len(previous)
+
+
+def record_iri(task: str) -> str:
+    """The node of graph:task-drafts that records what the saved text of ``task`` added."""
+    return _DRAFT + hashlib.sha256(task.encode("utf-8")).hexdigest()[:32]
+
+
+def _as_stored(quads: Sequence[ox.Quad]) -> list[ox.Quad]:
+    """``quads`` as the store keeps them: Oxigraph writes each literal in its canonical form (a text's
+    ``10.0`` is stored as ``10``), and a record must name the triples it will find."""
+    scratch = ox.Store()
+    scratch.extend(quads)
+    return list(scratch)
+
+
+def _record(node: ox.NamedNode, task: str, text: Sequence[ox.Quad], added: Sequence[ox.Quad]) -> list[ox.Quad]:
+    """The record of a save: the task, the text's triples and those the editor added, as N-Triples."""
+
+    def literal(quads: Sequence[ox.Quad]) -> ox.Literal:
+        triples = sorted((q.triple for q in quads), key=str)
+        return ox.Literal((ox.serialize(triples, format=ox.RdfFormat.N_TRIPLES) or b"").decode("utf-8"))
+
+    return [
+        ox.Quad(node, _TASK, ox.NamedNode(task), RECORDS),
+        ox.Quad(node, _STATED, literal(text), RECORDS),
+        ox.Quad(node, _ADDED, literal(added), RECORDS),
+    ]
+
+
+def _present(store: Store, quad: ox.Quad) -> bool:
+    subject, graph = quad.subject, quad.graph_name
+    if not isinstance(subject, ox.NamedNode | ox.BlankNode) or not isinstance(graph, ox.NamedNode):
+        return False
+    return quad in set(store.quads(subject, quad.predicate, None, graph))
+
+
+def _recorded(quads: Iterable[ox.Quad], kind: ox.NamedNode) -> set[ox.Quad]:
+    """The graph:requirements quads the ``kind`` literals among ``quads`` record."""
+    graph = GraphName.REQUIREMENTS.node
+    found = set()
+    for quad in quads:
+        if quad.predicate == kind and isinstance(quad.object, ox.Literal):
+            for triple in ox.parse(quad.object.value.encode("utf-8"), format=ox.RdfFormat.N_TRIPLES):
+                found.add(ox.Quad(triple.subject, triple.predicate, triple.object, graph))
+    return found
 
 
 def example(name: str, as_name: str | None = None) -> str:
