@@ -4,11 +4,13 @@ refusal before the run of a place that cannot hold them all.
 A carry used to set its object down at the place's spot nearest the centre (:func:`place_spots`), so a
 small eraser put first in the middle of a 40 x 40 cm shelf left no spot for the 14 cm pen the plan put
 there next, and the run failed after the first thing had moved (docs/tasks.md, "A sixth round"). The
-footprints (the circles :func:`place_spots` keeps apart) are packed on the place's spots by a small
-exact search (:func:`arrange`): a carry sets its object down at the spot nearest the centre, as for one
-thing alone, among those that leave room for the things the plan puts there after it, and the checks
-before the run refuse a place on which no arrangement holds them all.
-docs/simulation.md, "Several things onto one place", gives the reasoning.
+footprints (the things' boxes turned as they lie, :class:`Footprint`; else the circles :func:`place_spots`
+keeps apart) are packed on the place's spots by a small exact search (:func:`arrange`), each later thing
+only where an arm can set it down (:func:`arm_choice.cannot_set_down`): a carry sets its object down at the
+spot nearest the centre, as for one thing alone, among those that leave room for the things the plan puts
+there after it, and the checks before the run refuse a place on which no arrangement holds them all.
+docs/simulation.md, "Several things onto one place" and "Footprints, and the arms' say over the spots",
+gives the reasoning.
 """
 
 from __future__ import annotations
