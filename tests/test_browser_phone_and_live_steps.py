@@ -124,6 +124,7 @@ def test_the_header_keeps_to_one_line_on_a_phone_and_hides_no_page(phone: Any, s
     assert links.count() == 9 and not links.first.is_visible()
     toggle.click()
     assert toggle.get_attribute("aria-expanded") == "true"
+    assert toggle.get_attribute("aria-controls") == header.locator("nav").get_attribute("id")
     boxes = links.evaluate_all("links => links.map(link => link.getBoundingClientRect())")
     assert all(box["width"] > 0 and box["left"] >= 0 and box["right"] <= 375 for box in boxes)  # every page
     snap(phone, shots, "header-phone-menu")

@@ -20,6 +20,11 @@
       header.classList.toggle("open", open);
       toggle.setAttribute("aria-expanded", String(open));
     };
+    const nav = header.querySelector("nav");
+    if (nav) {
+      nav.id = nav.id || "site-nav";
+      toggle.setAttribute("aria-controls", nav.id);
+    }
     header.classList.add("menu");
     toggle.addEventListener("click", () => show(!header.classList.contains("open")));
     header.addEventListener("keydown", (event) => {
