@@ -57,7 +57,8 @@ def plans() -> Page:
     result = composed.result
     shown.title = f"Plan for {task}"  # once there is one: "Plan for FetchMyPn" titled the error
     data["composition"] = _composition(result)
-    data["base"] = composed.base.to_dict() if composed.base is not None else None  # several mobile bases
+    if composed.base is not None:  # a home of several mobile bases: the one the plan works, and why
+        data["base"] = composed.base.to_dict()
     if not wants_json():  # markup, so not in the twin, which has the same steps as lists
         data["flow"] = _flow(data["composition"])
         _load_drawing_library()  # the page asks for the drawing next
