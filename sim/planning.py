@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 from heapq import heappop, heappush
 from typing import Literal
@@ -27,7 +28,7 @@ import numpy as np
 from cbrs.sim.errors import NoFreeCellError, NoPathError, UnknownAlgorithmError
 from cbrs.sim.mapping import OccupancyGrid
 
-__all__ = ["ALGORITHMS", "SNAP_RADIUS", "PlannedPath", "approach_point", "plan_path", "snap_to_free"]
+__all__ = ["ALGORITHMS", "SNAP_RADIUS", "PlannedPath", "approach_point", "first_obstacle", "plan_path", "snap_to_free"]
 
 Algorithm = Literal["astar", "dijkstra"]
 ALGORITHMS: tuple[str, ...] = ("astar", "dijkstra")
@@ -187,6 +188,26 @@ def _visible(grid: OccupancyGrid, a: tuple[float, float], b: tuple[float, float]
     cols = np.floor((xs - grid.origin[0]) / grid.resolution).astype(np.intp)
     rows = np.floor((ys - grid.origin[1]) / grid.resolution).astype(np.intp)
     return not bool(grid.inflated[rows, cols].any())
+
+
+def first_obstacle(grid: OccupancyGrid, waypoints: Sequence[tuple[float, float]]) -> tuple[float, float] | None:
+    """The first point of the legs between ``waypoints`` on an obstacle the grid measured (not inflated), or
+    off the grid; None when the base's centre can follow them. A path from a planner in another process is
+    checked so before the base drives it: one that ignores the map (a straight line through a wall or the
+    arms' torso) drove the base into the torso, where no ceiling camera could see its marker again."""
+    rows, cols = grid.shape
+    for a, b in itertools.pairwise(waypoints):
+        samples = max(2, math.ceil(math.dist(a, b) / (grid.resolution / 4.0)) + 1)
+        xs, ys = np.linspace(a[0], b[0], samples), np.linspace(a[1], b[1], samples)
+        cols_at = np.floor((xs - grid.origin[0]) / grid.resolution).astype(np.intp)
+        rows_at = np.floor((ys - grid.origin[1]) / grid.resolution).astype(np.intp)
+        inside = (rows_at >= 0) & (rows_at < rows) & (cols_at >= 0) & (cols_at < cols)
+        hit = ~inside
+        hit[inside] = grid.occupied[rows_at[inside], cols_at[inside]]
+        if hit.any():
+            first = int(np.argmax(hit))
+            return (float(xs[first]), float(ys[first]))
+    return None
 
 
 def _shortcut(grid: OccupancyGrid, points: list[tuple[float, float]]) -> list[tuple[float, float]]:

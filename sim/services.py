@@ -7,6 +7,7 @@ a component in another process could stand in for any of them.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Mapping
 from dataclasses import replace
@@ -37,7 +38,7 @@ from cbrs.sim.perception import (
     track_person,
 )
 from cbrs.sim.place_spots import other_objects, place_spots, reach_of, spot_region
-from cbrs.sim.planning import PlannedPath, plan_path
+from cbrs.sim.planning import PlannedPath, first_obstacle, plan_path
 from cbrs.sim.relations import region_of
 from cbrs.sim.relay import check_passing, relay_object, relay_spot, resting_at, set_down_for
 from cbrs.sim.transit import floor_to
@@ -333,12 +334,38 @@ def _facts(kb: KnowledgeBase, thing: str) -> list[tuple[str, str, str]]:
     return [(r["thing"].value, r["relation"].value, r["other"].value) for r in rows]
 
 
-def provide_grid_map(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
+def _grid(ctx: SimContext) -> OccupancyGrid:
+    """The run's occupancy grid, measured once."""
     if ctx.grid is None:  # seen through the base it is for; the other bases of a home of several stand in it
         world = ctx.world
         ignore = (world.mobile.name,) if world.mobile is not None else ()
         ctx.grid = build_occupancy_grid(world, inflation_radius=world.grid_inflation, ignore=ignore)
-    return {"map": to_json(ctx.grid)}
+    return ctx.grid
+
+
+def provide_grid_map(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
+    return {"map": to_json(_grid(ctx))}
+
+
+def _drivable(ctx: SimContext, waypoints: list[tuple[float, float]]) -> None:
+    """Refuse, before the base moves, a path whose legs cross an obstacle of the run's measured grid: the
+    path may come from a planner in another process that ignores the map (planning.first_obstacle)."""
+    hit = first_obstacle(_grid(ctx), waypoints)
+    if hit is not None:
+        raise SkillFailed(
+            f"the path crosses an obstacle of the home's occupancy grid at ({hit[0]:.2f}, {hit[1]:.2f}), "
+            f"between waypoints {_leg(waypoints, hit)}: not driven (its planner must keep to the grid's free cells)"
+        )
+
+
+def _leg(waypoints: list[tuple[float, float]], hit: tuple[float, float]) -> str:
+    """Which leg ``hit`` lies on, as 'i and i+1' (counted from 0)."""
+    for index, (a, b) in enumerate(itertools.pairwise(waypoints)):
+        cross = (b[0] - a[0]) * (hit[1] - a[1]) - (b[1] - a[1]) * (hit[0] - a[0])
+        inside = min(a[0], b[0]) - 1e-6 <= hit[0] <= max(a[0], b[0]) + 1e-6
+        if abs(cross) < 1e-6 * max(1.0, math.dist(a, b)) and inside:
+            return f"{index} and {index + 1}"
+    return "?"
 
 
 def locate(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
@@ -382,12 +409,15 @@ def planner(algorithm: str) -> Work:
 
 def navigate_to_place(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     place = place_of(ctx, inputs["objectPlace"], "the place")
-    check_outcome(skills.navigate_to_place(ctx.world, decode(inputs["path"], PlannedPath), docking_pose(place)))
+    path, dock = decode(inputs["path"], PlannedPath), docking_pose(place)
+    _drivable(ctx, [*path.waypoints[:-1], dock.xy])  # the skill drives to the dock, not the path's last cell
+    check_outcome(skills.navigate_to_place(ctx.world, path, dock))
     return {}
 
 
 def navigate_to_person(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, Any]:
     path = decode(inputs["path"], PlannedPath)
+    _drivable(ctx, list(path.waypoints))
     estimate = decode(inputs["personPosition"], PersonEstimate)
     check_outcome(skills.navigate_to_person(ctx.world, path, estimate, meant_person(ctx).name))
     return {}
