@@ -50,7 +50,7 @@ from cbrs.actions.graph import (
 from cbrs.actions.model import ActionLibrary, Task, resolve_task
 from cbrs.actions.near_misses import NearMiss, near_misses
 from cbrs.actions.plan import Binding, Plan, PlanStep, Source
-from cbrs.actions.progression import Clobbered, progress_parts
+from cbrs.actions.progression import Clobbered, consumed_goals, progress_parts
 from cbrs.actions.search import SearchTrace, bidirectional_search
 from cbrs.actions.undeclared_terms import described
 from cbrs.actions.unmet import GOAL, Unsatisfied
@@ -616,7 +616,9 @@ class Composer:
             plan = _concatenate(task, [part.plan for part in parts])
             undone = self._undone_between(parts, initial) if self.config.protect else None
             if undone is None:
-                return self._result(task, plan, (), tuple(attempts))
+                consumed = consumed_goals([part.plan for part in parts], initial, self.matcher)
+                goals = tuple(g for g, gone in zip(plan.goals, consumed, strict=True) if not gone)
+                return self._result(task, replace(plan, goals=goals), (), tuple(attempts))
             part = parts[undone.part]
             exhausted = achieved_again >= self.config.max_reachieved
             again: Plan | None = None

@@ -94,6 +94,24 @@ def progress_parts(parts: Sequence[Plan], initial: Iterable[Statement], matcher:
     return found
 
 
+def consumed_goals(parts: Sequence[Plan], initial: Iterable[Statement], matcher: Matcher) -> list[bool]:
+    """For each goal of ``parts`` in order, whether it is a goal of a part before the last that no longer
+    holds when the joined plan ends: a sub-action's goal that a later sub-action deletes (the pen on the
+    base's platform, delivered from it to the person) was a means to the sub-actions after it, checked
+    when its part ended (:func:`progress_parts`), not an end of the whole task for the run to check."""
+    state: list[Statement] = list(dict.fromkeys(initial))
+    for plan in parts:
+        for step in plan.steps:
+            state = [f for f in state if not any(threatens(matcher.index, d, f) for d in step.deletes)]
+            state += [e for e in step.effects if e not in state]
+    last = len(parts) - 1
+    return [
+        n < last and g.role != "deletion" and g.statement is not None and not _holds(g.statement, state, matcher)
+        for n, plan in enumerate(parts)
+        for g in plan.goals
+    ]
+
+
 def _holds(needed: Statement, state: Sequence[Statement], matcher: Matcher) -> bool:
     return any(matcher.statement(needed, fact) is not None for fact in state)
 
@@ -106,4 +124,4 @@ def _clobbered(
     return Clobbered(needed, consumer, max(deleters) if deleters else None, part)
 
 
-__all__ = ["Clobbered", "progress", "progress_parts", "threatens"]
+__all__ = ["Clobbered", "consumed_goals", "progress", "progress_parts", "threatens"]

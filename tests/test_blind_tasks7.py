@@ -20,6 +20,7 @@ import pytest
 
 from cbrs.actions.composer import Composer
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.model import Statement
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.shapes import DescriptionShapeError
 from cbrs.sim.context import SimContext, SkillFailed
@@ -162,3 +163,34 @@ def test_navigation_refuses_a_planner_path_through_an_obstacle_without_moving() 
     person = {"@type": HOME + "PersonPosition", "x": 3.8, "y": 2.5}
     with pytest.raises(SkillFailed, match=r"crosses an obstacle .* at \(2\.0\d, 2\.50\), between waypoints 0 and 1"):
         navigate_to_person(ctx, {"path": path, "personPosition": person}, "P3DX01")
+
+
+def _chain_store(*names: str) -> KnowledgeBase:
+    kb = KnowledgeBase.open(":memory:")
+    kb.load([EXAMPLES / name for name in ("load_pen_onto_base.ttl", *names)], graph="requirements")
+    return kb
+
+
+def test_a_sub_actions_goal_a_later_one_consumes_is_no_goal_of_the_run() -> None:
+    """LoadThenDeliver: the pen loaded onto the base, then delivered from it. The first part's goal (the
+    pen on the platform) was checked at the end of the run, where the delivery had taken it off, and the
+    run failed with the pen in the person's hand; it is a means, met when its part ended."""
+    kb = _chain_store("lab7_deliver_from_the_base.ttl", "lab7_load_then_deliver.ttl")
+    plan = Composer(kb).compose("LoadThenDeliver").plan
+    assert plan is not None and plan.method == "decomposed"
+    assert [g.statement for g in plan.goals] == [Statement(HOME + "Pen", HOME + "isWith", HOME + "Person")]
+    components = [step.component for step in plan.steps]
+    loads, delivers = SVC + "HandOverOntoPlatform_CytonDualArm01", SVC + "DeliverObject_P3DX01"
+    assert components.index(loads) < components.index(delivers)
+
+
+def test_a_chained_tasks_precondition_is_taken_as_given() -> None:
+    """DeliverFromTheBase alone: its precondition (the pen on the platform) is offered by the requirement
+    (docs/composition.md), so the plan drives to the person and delivers without loading; the run, whose
+    world starts from the map with the pen on the table, fails at the delivery (a known failure)."""
+    kb = _chain_store("lab7_deliver_from_the_base.ttl")
+    plan = Composer(kb).compose("DeliverFromTheBase").plan
+    assert plan is not None
+    components = [step.component for step in plan.steps]
+    assert SVC + "HandOverOntoPlatform_CytonDualArm01" not in components
+    assert components[-1] == SVC + "DeliverObject_P3DX01"
