@@ -4,15 +4,23 @@ Run: python bench/example_tasks.py [--data bench/data/example_tasks.toml] [--onl
                                    [--json FILE] [--keep DIR]
 
 Each trial of the data file (written from the examples' headers and docs/tasks.md's round tables) is run
-at each of its seeds in a store of its own, as a user would: ``cbrs --store DIR init``, the trial's loads
-in order (``cbrs load --graph``, ``cbrs update --file``, ``cbrs register``), then ``cbrs run TASK --seed N
---json``. The stores are made once a trial and copied for each seed, before anything runs in them. Runs go
+at each of its seeds in a store of its own, as a user would: ``cbrs --store DIR init``, the trial's setup
+steps in order (``cbrs load --graph``, ``cbrs update --file``, ``cbrs register``; a step may load a copy
+of its file with literal substitutions, as the docs' ``sed`` variants, or be expected refused: then its
+error class and phrase are checked and the store's graph sizes are compared before and after), then its
+runs in order in that store (``cbrs run TASK --seed N --json``; a trial of several runs is a sequence in
+one store). A trial whose components are served by a program of the example's own starts, for each seed,
+``cbrs serve`` on free loopback ports with an update token and the program against its bridge, then
+runs ``cbrs --store URL run TASK --bridge WS``, as the docs do; a trial run over HTTP posts the task to
+the server's ``/tasks.json`` and polls the run's JSON. Both processes are stopped by PID; every wait is
+bounded. The stores are made once a trial and copied for each seed, before anything runs in them. Runs go
 in parallel processes, up to ``--jobs`` (default: the cores). The outcome is read from the run's JSON:
 succeeded, refused (before anything moved: the run's error), no plan, or failed; a run whose JSON cannot
-be read is "broken". Prints the machine, the commit, one row a run (expected and found status and
-simulated seconds) and the deviations: a status other than the docs', or a successful run's simulated
-seconds off by more than the data's tolerance. Exits 1 when there is a deviation. ``--json FILE`` writes
-the same as a record.
+be read is "broken". Prints the machine, the commit, the load checks, one row a run (expected and found
+status and simulated seconds) and the deviations: a status other than the docs', a successful run's
+simulated seconds off by more than the data's tolerance, a refused step accepted or refused otherwise,
+or a store changed by a refusal. Exits 1 when there is a deviation. ``--json FILE`` writes the same as a
+record.
 """
 
 from __future__ import annotations
@@ -23,13 +31,21 @@ import importlib.metadata
 import json
 import os
 import platform
+import secrets
 import shutil
+import signal
+import socket
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 import tomllib
-from dataclasses import asdict, dataclass
+import urllib.error
+import urllib.request
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -37,22 +53,72 @@ ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "docs" / "examples"
 DATA = ROOT / "bench" / "data" / "example_tasks.toml"
 GRAPHS = ("ontology", "map", "requirements")
+VERBS = (*GRAPHS, "update", "register")
 STATUSES = ("succeeded", "refused", "no plan", "failed")
 RUN_STATUS = {"succeeded": "succeeded", "failed": "failed", "cancelled": "failed", "unsolvable": "no plan"}
+SERVER_STATUS = {"succeeded": "succeeded", "failed": "failed", "cancelled": "failed", "no-plan": "no plan"}
+VIAS = ("cli", "bridge", "http")
+GRAPH_SIZES = "SELECT ?g (COUNT(*) AS ?n) WHERE { GRAPH ?g { ?s ?p ?o } } GROUP BY ?g"
+STARTUP = 90.0
+"""Seconds a server or a component program may take to answer or register (bounded waits)."""
+RUN_TIMEOUT = 600.0
+"""Seconds one run may take, wall time, before it is stopped and counted broken."""
+
+
+@dataclass(frozen=True)
+class Step:
+    """One setup step: a file loaded by ``verb``, maybe a copy with literal substitutions (the docs' sed
+    variants), maybe expected to be refused (its error class and a phrase of the docs' refusal)."""
+
+    verb: str
+    file: str
+    sed: tuple[tuple[str, str], ...] = ()
+    refused: str = ""
+    says: str = ""
+    replace: bool = False
+
+    @property
+    def expect_refusal(self) -> bool:
+        return bool(self.refused or self.says)
+
+
+@dataclass(frozen=True)
+class Run:
+    """One run of a trial: its task, and the status and simulated seconds the docs give at each seed."""
+
+    task: str
+    status: list[str]
+    seconds: list[float]
+    before: tuple[Step, ...] = ()
+
+
+@dataclass(frozen=True)
+class Serve:
+    """The example's own program, served to the trial's runs: started against ``cbrs serve``'s bridge,
+    ready once ``ready`` has appeared ``count`` times in its output."""
+
+    program: str
+    args: tuple[str, ...] = ()
+    ready: str = "registered"
+    count: int = 1
 
 
 @dataclass(frozen=True)
 class Trial:
-    """One row of the data file: a task run in a store made by ``setup``, and what the docs say of it."""
+    """One entry of the data file: a store made by ``setup``, the runs made in it, what the docs say."""
 
     label: str
-    task: str
     source: str
-    setup: list[tuple[str, str]]
+    setup: list[Step]
     seeds: list[int]
-    status: list[str]
-    seconds: list[float]
+    runs: list[Run]
+    via: str = "cli"
+    serve: Serve | None = None
     known_failure: bool = False
+
+    @property
+    def task(self) -> str:
+        return " then ".join(r.task for r in self.runs) or "(loads only)"
 
 
 @dataclass
@@ -69,93 +135,390 @@ class Outcome:
     deviation: str = ""
 
 
-def read_trials(path: Path) -> tuple[float, list[Trial]]:
-    """The data file's tolerance and trials, checked: each seed has a status and seconds, each status and
-    load is one the bench knows, each file exists."""
-    data = tomllib.loads(path.read_text(encoding="utf-8"))
-    trials = []
-    for row in data["trial"]:
-        seeds = list(row.get("seeds", [0, 1, 2]))
-        trial = Trial(
-            label=row["label"],
-            task=row["task"],
-            source=row.get("source", ""),
-            setup=[(verb, name) for verb, name in row["setup"]],
-            seeds=seeds,
-            status=list(row["status"]),
-            seconds=[float(s) for s in row["seconds"]],
-            known_failure=bool(row.get("known_failure", False)),
+@dataclass
+class Made:
+    """A trial's store, and what its expected refusals did."""
+
+    checks: list[str] = field(default_factory=list)
+    deviations: list[str] = field(default_factory=list)
+
+
+def _step(label: str, raw: Any) -> Step:
+    if isinstance(raw, list):
+        verb, name = raw
+        return Step(verb, name)
+    sed = tuple((str(a), str(b)) for a, b in raw.get("sed", []))
+    refused, says = str(raw.get("refused", "")), str(raw.get("says", ""))
+    return Step(raw["load"], raw["file"], sed, refused, says, bool(raw.get("replace", False)))
+
+
+def _trial(path: Path, row: dict[str, Any]) -> Trial:
+    label = row["label"]
+    seeds = list(row.get("seeds", [0, 1, 2]))
+    raw_runs = list(row.get("runs", []))
+    if "task" in row:
+        raw_runs.insert(0, {"task": row["task"], "status": row["status"], "seconds": row["seconds"]})
+    runs = [
+        Run(
+            r["task"],
+            list(r["status"]),
+            [float(s) for s in r["seconds"]],
+            tuple(_step(label, b) for b in r.get("before", [])),
         )
-        if not len(trial.status) == len(trial.seconds) == len(seeds):
-            raise SystemExit(f"{path}: {trial.label}: one status and one seconds a seed ({seeds})")
-        if bad := [s for s in trial.status if s not in STATUSES]:
-            raise SystemExit(f"{path}: {trial.label}: unknown status {bad} (one of {', '.join(STATUSES)})")
-        for verb, name in trial.setup:
-            if verb not in (*GRAPHS, "update", "register"):
-                raise SystemExit(f"{path}: {trial.label}: unknown load {verb!r} of {name}")
-            if not (EXAMPLES / name).is_file():
-                raise SystemExit(f"{path}: {trial.label}: no file docs/examples/{name}")
-        trials.append(trial)
+        for r in raw_runs
+    ]
+    serve = None
+    if "serve" in row:
+        s = row["serve"]
+        serve = Serve(s["program"], tuple(s.get("args", [])), s.get("ready", "registered"), int(s.get("count", 1)))
+    via = row.get("via", "bridge" if serve else "cli")
+    trial = Trial(
+        label,
+        row.get("source", ""),
+        [_step(label, s) for s in row["setup"]],
+        seeds,
+        runs,
+        via,
+        serve,
+        bool(row.get("known_failure", False)),
+    )
+    _check(path, trial)
+    return trial
+
+
+def _check(path: Path, trial: Trial) -> None:
+    """SystemExit naming what of ``trial`` the bench cannot run as written."""
+    where = f"{path}: {trial.label}"
+    for run in trial.runs:
+        if not len(run.status) == len(run.seconds) == len(trial.seeds):
+            raise SystemExit(f"{where}: {run.task}: one status and one seconds a seed ({trial.seeds})")
+        if bad := [s for s in run.status if s not in STATUSES]:
+            raise SystemExit(f"{where}: unknown status {bad} (one of {', '.join(STATUSES)})")
+    if not trial.runs and not any(s.expect_refusal for s in trial.setup):
+        raise SystemExit(f"{where}: neither a run nor a refusal to check")
+    if trial.via not in VIAS:
+        raise SystemExit(f"{where}: unknown via {trial.via!r} (one of {', '.join(VIAS)})")
+    if trial.via != "cli" and any(r.before for r in trial.runs):
+        raise SystemExit(f"{where}: steps between runs are made on the command line only (via cli)")
+    if trial.via == "bridge" and trial.serve is None:
+        raise SystemExit(f"{where}: a run over the bridge needs the program that serves its components (serve)")
+    steps = [*trial.setup, *(b for r in trial.runs for b in r.before)]
+    names = [s.file for s in steps] + ([trial.serve.program] if trial.serve else [])
+    for step in steps:
+        if step.verb not in VERBS:
+            raise SystemExit(f"{where}: unknown load {step.verb!r} of {step.file}")
+    for name in names:
+        if not (EXAMPLES / name).is_file():
+            raise SystemExit(f"{where}: no file docs/examples/{name}")
+
+
+def read_trials(path: Path) -> tuple[float, list[Trial]]:
+    """The data file's tolerance and trials, checked: each run has a status and seconds a seed, each status,
+    load and way of running is one the bench knows, each file exists."""
+    data = tomllib.loads(path.read_text(encoding="utf-8"))
+    trials = [_trial(path, row) for row in data["trial"]]
     labels = [t.label for t in trials]
     if len(set(labels)) != len(labels):
         raise SystemExit(f"{path}: labels repeat: {sorted({x for x in labels if labels.count(x) > 1})}")
     return float(data.get("tolerance", 0.2)), trials
 
 
-def _cbrs(store: Path, *args: str) -> subprocess.CompletedProcess[str]:
+def _cbrs(
+    store: Path | str, *args: str, env: dict[str, str] | None = None, timeout: float | None = None
+) -> subprocess.CompletedProcess[str]:
     return subprocess.run(
         [sys.executable, "-m", "cbrs", "--store", str(store), *args],
         cwd=ROOT,
         capture_output=True,
         text=True,
         check=False,
+        env=env,
+        timeout=timeout,
     )
 
 
-def make_store(trial: Trial, store: Path) -> None:
-    """A fresh store with the trial's loads, in order; SystemExit naming the load that failed."""
-    steps: list[tuple[str, ...]] = [("init",)]
-    for verb, name in trial.setup:
-        path = str(EXAMPLES / name)
-        if verb in GRAPHS:
-            steps.append(("load", "--graph", verb, path))
-        elif verb == "update":
-            steps.append(("update", "--file", path))
-        else:
-            steps.append(("register", path))
-    for step in steps:
-        done = _cbrs(store, *step)
+def _edited(step: Step, where: Path) -> Path:
+    """The step's file, or a copy of it under ``where`` with its substitutions made (each must match)."""
+    source = EXAMPLES / step.file
+    if not step.sed:
+        return source
+    text = source.read_text(encoding="utf-8")
+    for old, new in step.sed:
+        if old not in text:
+            raise RuntimeError(f"{step.file}: the substitution's {old!r} is not in the file (the docs' sed is stale)")
+        text = text.replace(old, new)
+    copy = where / step.file
+    copy.parent.mkdir(parents=True, exist_ok=True)
+    copy.write_text(text, encoding="utf-8")
+    return copy
+
+
+def graph_sizes(store: Path) -> dict[str, int]:
+    """Each named graph's number of triples (what a refusal must leave as it was)."""
+    done = _cbrs(store, "query", GRAPH_SIZES, "--format", "json")
+    if done.returncode != 0:
+        raise RuntimeError(f"cbrs query of the graph sizes exited {done.returncode}: {done.stderr[-300:]}")
+    rows = json.loads(done.stdout)
+    rows = rows.get("results", {}).get("bindings", rows) if isinstance(rows, dict) else rows
+    return {str(_value(r["g"])): int(_value(r["n"])) for r in rows}
+
+
+def _value(cell: Any) -> Any:
+    return cell.get("value") if isinstance(cell, dict) else cell
+
+
+def make_store(trial: Trial, store: Path) -> Made:
+    """A fresh store with the trial's setup steps, in order; RuntimeError naming a step that failed
+    unexpectedly. An expected refusal is checked (exit, class, phrase, graph sizes) and a miss recorded."""
+    made = Made()
+    done = _cbrs(store, "init")
+    if done.returncode != 0:
+        raise RuntimeError(f"{trial.label}: cbrs init exited {done.returncode}: {done.stderr[-400:]}")
+    for step in trial.setup:
+        apply_step(trial.label, step, store, made)
+    return made
+
+
+def apply_step(label: str, step: Step, store: Path, made: Made) -> None:
+    """Load ``step`` into ``store``; RuntimeError when an expected load fails, an expected refusal's miss
+    recorded in ``made``."""
+    path = str(_edited(step, store.parent / f"{store.name}.edited"))
+    load = ("load", "--graph", step.verb, *(("--replace",) if step.replace else ()), path)
+    args = {"update": ("update", "--file", path), "register": ("register", path)}.get(step.verb, load)
+    before = graph_sizes(store) if step.expect_refusal else {}
+    done = _cbrs(store, *args)
+    said = f"cbrs {' '.join(args[:-1])} {step.file}"
+    if not step.expect_refusal:
         if done.returncode != 0:
-            raise RuntimeError(f"{trial.label}: cbrs {' '.join(step)} exited {done.returncode}: {done.stderr[-400:]}")
+            raise RuntimeError(f"{label}: {said} exited {done.returncode}: {done.stderr[-400:]}")
+        return
+    made.checks.append(f"{label}: {said}: exit {done.returncode}: {_last_line(done)}")
+    if miss := refusal_deviation(step, done, before, graph_sizes(store)):
+        made.deviations.append(f"{label}: {said}: {miss}")
 
 
-def run_one(trial: Trial, index: int, store: Path) -> Outcome:
-    """Run the trial's task at its ``index``-th seed in ``store`` and read the outcome from its JSON."""
-    seed = trial.seeds[index]
-    started = time.perf_counter()
-    done = _cbrs(store, "run", trial.task, "--seed", str(seed), "--json")
-    wall = time.perf_counter() - started
-    try:
-        found: dict[str, Any] = json.loads(done.stdout)
-    except json.JSONDecodeError:
-        found = {"status": "broken", "error": (done.stderr or done.stdout)[-300:]}
+def _last_line(done: subprocess.CompletedProcess[str]) -> str:
+    lines = [line for line in (done.stderr or done.stdout).splitlines() if line.strip()]
+    return lines[-1][:300] if lines else "(nothing said)"
+
+
+def refusal_deviation(
+    step: Step, done: subprocess.CompletedProcess[str], before: dict[str, int], after: dict[str, int]
+) -> str:
+    """Why an expected refusal is not as the docs say (empty when it is)."""
+    said = done.stderr + done.stdout
+    if done.returncode == 0:
+        return "accepted, the docs say refused"
+    misses = [f"without {word!r}" for word in (step.refused, step.says) if word and word not in said]
+    if before != after:
+        changed = sorted(g for g in set(before) | set(after) if before.get(g) != after.get(g))
+        misses.append(
+            f"the graphs' sizes changed: {', '.join(f'{g} {before.get(g, 0)} -> {after.get(g, 0)}' for g in changed)}"
+        )
+    return ("refused " + "; ".join(misses) + f": {_last_line(done)}") if misses else ""
+
+
+def _outcome(trial: Trial, k: int, index: int, seed: int, found: dict[str, Any], wall: float) -> Outcome:
+    run = trial.runs[k]
     raw = str(found.get("status", "broken"))
     if raw == "error":
         status, reason = "refused", str(found.get("error", ""))
     else:
-        status = RUN_STATUS.get(raw, "broken")
+        status = RUN_STATUS.get(raw, SERVER_STATUS.get(raw, "broken"))
         reason = _reason(found) if status != "succeeded" else ""
+    label = trial.label if len(trial.runs) == 1 else f"{trial.label} [{k + 1}: {run.task}]"
     return Outcome(
-        trial.label,
-        trial.task,
+        label,
+        run.task,
         seed,
-        trial.status[index],
-        trial.seconds[index],
+        run.status[index],
+        run.seconds[index],
         status,
         float(found.get("sim_seconds", 0.0)),
         wall,
         reason,
     )
+
+
+def _parsed(done: subprocess.CompletedProcess[str]) -> dict[str, Any]:
+    try:
+        found = json.loads(done.stdout)
+    except json.JSONDecodeError:
+        return {"status": "broken", "error": (done.stderr or done.stdout)[-300:]}
+    return found if isinstance(found, dict) else {"status": "broken", "error": done.stdout[-300:]}
+
+
+def run_one(trial: Trial, index: int, store: Path) -> list[Outcome]:
+    """Run the trial's runs in order at its ``index``-th seed in ``store``: on the command line, or
+    against a server of the store with the trial's program, and read each outcome from its JSON."""
+    seed = trial.seeds[index]
+    if trial.via == "cli":
+        outcomes = []
+        for k, run in enumerate(trial.runs):
+            started = time.perf_counter()
+            try:
+                for step in run.before:
+                    apply_step(trial.label, step, store, Made())
+                done = _cbrs(store, "run", run.task, "--seed", str(seed), "--json", timeout=RUN_TIMEOUT)
+                found = _parsed(done)
+            except subprocess.TimeoutExpired:
+                found = {"status": "broken", "error": f"no answer in {RUN_TIMEOUT:.0f} s"}
+            except RuntimeError as failed:
+                found = {"status": "broken", "error": str(failed)}
+            outcomes.append(_outcome(trial, k, index, seed, found, time.perf_counter() - started))
+        return outcomes
+    return _served_runs(trial, index, store)
+
+
+def _free_port() -> int:
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
+        probe.bind(("127.0.0.1", 0))
+        return int(probe.getsockname()[1])
+
+
+class _Child:
+    """A child process whose output is read by a thread of its own (so it never blocks on a full pipe)."""
+
+    def __init__(self, argv: list[str], env: dict[str, str], log: Path) -> None:
+        self.log = log
+        self.lines: list[str] = []
+        self.process = subprocess.Popen(
+            argv, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, start_new_session=True
+        )
+        self._reader = threading.Thread(target=self._read, daemon=True)
+        self._reader.start()
+
+    def _read(self) -> None:
+        assert self.process.stdout is not None
+        with self.log.open("w", encoding="utf-8") as out:
+            for line in self.process.stdout:
+                self.lines.append(line)
+                out.write(line)
+                out.flush()
+
+    def wait_for(self, phrase: str, count: int, timeout: float) -> bool:
+        """Whether ``phrase`` appeared ``count`` times in the output within ``timeout`` s (bounded)."""
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if sum(phrase in line for line in list(self.lines)) >= count:
+                return True
+            if self.process.poll() is not None:
+                return False
+            time.sleep(0.2)
+        return False
+
+    def stop(self) -> None:
+        """SIGTERM to this child by its PID, then SIGKILL after 15 s."""
+        if self.process.poll() is None:
+            os.kill(self.process.pid, signal.SIGTERM)
+            try:
+                self.process.wait(timeout=15)
+            except subprocess.TimeoutExpired:
+                os.kill(self.process.pid, signal.SIGKILL)
+                self.process.wait(timeout=15)
+        self._reader.join(timeout=5)
+
+
+@contextmanager
+def _server(trial: Trial, store: Path, env: dict[str, str]) -> Iterator[tuple[str, str]]:
+    """``cbrs serve`` of ``store`` on free loopback ports, and the trial's program against its bridge;
+    yields the HTTP and the bridge URLs; both stopped by PID at the end."""
+    http, bridge = _free_port(), _free_port()
+    url, ws = f"http://127.0.0.1:{http}", f"ws://127.0.0.1:{bridge}"
+    argv = [
+        sys.executable,
+        "-m",
+        "cbrs",
+        "--store",
+        str(store),
+        "serve",
+        "--host",
+        "127.0.0.1",
+        "--port",
+        str(http),
+        "--bridge-port",
+        str(bridge),
+    ]
+    children = [_Child(argv, env, store.parent / f"{store.name}.serve.log")]
+    try:
+        if not _answers(url + "/sparql?query=ASK%7B%7D", STARTUP):
+            raise RuntimeError(
+                f"cbrs serve did not answer at {url} within {STARTUP:.0f} s: {''.join(children[0].lines)[-300:]}"
+            )
+        if trial.serve is not None:
+            program = [sys.executable, str(EXAMPLES / trial.serve.program), "--bridge", ws, *trial.serve.args]
+            children.append(_Child(program, env, store.parent / f"{store.name}.program.log"))
+            if not children[1].wait_for(trial.serve.ready, trial.serve.count, STARTUP):
+                said = "".join(children[1].lines)[-300:]
+                raise RuntimeError(
+                    f"{trial.serve.program} did not say {trial.serve.ready!r} within {STARTUP:.0f} s: {said}"
+                )
+        yield url, ws
+    finally:
+        for child in reversed(children):
+            child.stop()
+
+
+def _answers(url: str, timeout: float) -> bool:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        try:
+            with urllib.request.urlopen(url, timeout=5):
+                return True
+        except (urllib.error.URLError, OSError):
+            time.sleep(0.5)
+    return False
+
+
+def _served_runs(trial: Trial, index: int, store: Path) -> list[Outcome]:
+    seed = trial.seeds[index]
+    env = {**os.environ, "CBRS_UPDATE_TOKEN": secrets.token_hex(16)}
+    outcomes = []
+    try:
+        with _server(trial, store, env) as (url, ws):
+            for k, run in enumerate(trial.runs):
+                started = time.perf_counter()
+                if trial.via == "http":
+                    found = _http_run(url, run.task, seed, env["CBRS_UPDATE_TOKEN"])
+                else:
+                    args = ("run", run.task, "--bridge", ws, "--seed", str(seed), "--json")
+                    try:
+                        found = _parsed(_cbrs(url, *args, env=env, timeout=RUN_TIMEOUT))
+                    except subprocess.TimeoutExpired:
+                        found = {"status": "broken", "error": f"no answer in {RUN_TIMEOUT:.0f} s"}
+                outcomes.append(_outcome(trial, k, index, seed, found, time.perf_counter() - started))
+    except RuntimeError as failed:
+        done = len(outcomes)
+        for k in range(done, len(trial.runs)):
+            outcomes.append(_outcome(trial, k, index, seed, {"status": "broken", "error": str(failed)}, 0.0))
+    return outcomes
+
+
+def _http_run(url: str, task: str, seed: int, token: str) -> dict[str, Any]:
+    """POST the task to ``/tasks.json``, poll the run's JSON until it ends (bounded): the run's result
+    with its status, as ``cbrs run --json`` gives them."""
+    body = json.dumps({"task": task, "seed": seed}).encode()
+    headers = {"Authorization": f"Bearer {token}", "Content-Type": "application/json", "Accept": "application/json"}
+    try:
+        with urllib.request.urlopen(
+            urllib.request.Request(url + "/tasks.json", body, headers, method="POST"), timeout=30
+        ) as answer:
+            location = answer.headers["Location"]
+    except urllib.error.HTTPError as error:
+        return {"status": "broken", "error": f"POST /tasks.json: {error.code} {error.read()[:300]!r}"}
+    deadline = time.monotonic() + RUN_TIMEOUT
+    while time.monotonic() < deadline:
+        with urllib.request.urlopen(urllib.request.Request(url + location, headers=headers), timeout=30) as answer:
+            page = json.loads(answer.read())
+        found = page.get("run", page)
+        if found.get("status") != "running":
+            result = dict(found.get("result") or {})
+            result["status"] = found["status"] if found["status"] != "error" else "error"
+            if found.get("error"):
+                result["error"] = found["error"]
+            return result
+        time.sleep(1.0)
+    return {"status": "broken", "error": f"{location} still running after {RUN_TIMEOUT:.0f} s"}
 
 
 def _reason(found: dict[str, Any]) -> str:
@@ -197,6 +560,36 @@ def commit() -> str:
     return head.stdout.strip() + (" (with uncommitted changes)" if dirty.stdout.strip() else "")
 
 
+def _run_all(trials: list[Trial], scratch: Path, jobs: int) -> tuple[list[Outcome], list[str], Made]:
+    """Every trial's store made, then its seeds run, up to ``jobs`` processes at once."""
+    outcomes: list[Outcome] = []
+    broken: list[str] = []
+    loads = Made()
+    total = sum(len(t.seeds) * len(t.runs) for t in trials)
+    with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
+        made = {pool.submit(make_store, t, scratch / f"t{i}" / "made"): (i, t) for i, t in enumerate(trials)}
+        runs: list[concurrent.futures.Future[list[Outcome]]] = []
+        for future in concurrent.futures.as_completed(made):
+            i, trial = made[future]
+            try:
+                found = future.result()
+            except RuntimeError as failed:
+                broken.append(str(failed))
+                continue
+            loads.checks += found.checks
+            loads.deviations += found.deviations
+            for k in range(len(trial.seeds) if trial.runs else 0):
+                store = scratch / f"t{i}" / f"seed{trial.seeds[k]}"
+                shutil.copytree(scratch / f"t{i}" / "made", store)
+                runs.append(pool.submit(run_one, trial, k, store))
+        for ran in concurrent.futures.as_completed(runs):
+            for got in ran.result():
+                outcomes.append(got)
+                said = f"{got.label}, seed {got.seed}: {got.status}, {got.seconds:.1f} s ({got.wall:.0f} s wall)"
+                print(f"[{len(outcomes)}/{total}] {said}", file=sys.stderr, flush=True)
+    return outcomes, broken, loads
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--data", type=Path, default=DATA, help="the expectations (TOML)")
@@ -207,7 +600,7 @@ def main() -> None:
     args = parser.parse_args()
     tolerance, trials = read_trials(args.data)
     if args.only:
-        trials = [t for t in trials if t.label in args.only or t.task in args.only]
+        trials = [t for t in trials if t.label in args.only or any(r.task in args.only for r in t.runs)]
         if not trials:
             raise SystemExit(f"no trial is labelled or runs {', '.join(args.only)}")
     load = os.getloadavg()[0]
@@ -217,56 +610,50 @@ def main() -> None:
         f"load average at start {load:.2f}"
     )
     print(f"commit: {commit()}")
-    runs_in_all = sum(len(t.seeds) for t in trials)
-    print(f"inputs: {len(trials)} trials, {runs_in_all} runs, {args.jobs} at once; tolerance {tolerance} s\n")
+    runs_in_all = sum(len(t.seeds) * len(t.runs) for t in trials)
+    refusals = sum(s.expect_refusal for t in trials for s in t.setup)
+    print(
+        f"inputs: {len(trials)} trials, {runs_in_all} runs, {refusals} refusals at the load; "
+        f"{args.jobs} at once; tolerance {tolerance} s\n"
+    )
     scratch = Path(tempfile.mkdtemp(prefix="example_tasks_")) if args.keep is None else args.keep
     scratch.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
-    outcomes: list[Outcome] = []
-    broken: list[str] = []
     try:
-        with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
-            made: dict[concurrent.futures.Future[None], tuple[int, Trial]]
-            made = {pool.submit(make_store, t, scratch / f"t{i}" / "made"): (i, t) for i, t in enumerate(trials)}
-            runs: list[concurrent.futures.Future[Outcome]] = []
-            for future in concurrent.futures.as_completed(made):
-                i, trial = made[future]
-                try:
-                    future.result()
-                except RuntimeError as failed:
-                    broken.append(str(failed))
-                    continue
-                for k in range(len(trial.seeds)):
-                    store = scratch / f"t{i}" / f"seed{trial.seeds[k]}"
-                    shutil.copytree(scratch / f"t{i}" / "made", store)
-                    runs.append(pool.submit(run_one, trial, k, store))
-            for ran in concurrent.futures.as_completed(runs):
-                got = ran.result()
-                outcomes.append(got)
-                said = f"{got.label}, seed {got.seed}: {got.status}, {got.seconds:.1f} s ({got.wall:.0f} s wall)"
-                print(f"[{len(outcomes)}/{len(runs)}] {said}", file=sys.stderr, flush=True)
+        outcomes, broken, loads = _run_all(trials, scratch, args.jobs)
     finally:
         if args.keep is None:
             shutil.rmtree(scratch, ignore_errors=True)
     order = {t.label: i for i, t in enumerate(trials)}
-    outcomes.sort(key=lambda o: (order[o.label], o.seed))
+    outcomes.sort(key=lambda o: (order.get(o.label.split(" [")[0], 0), o.seed, o.label))
     for outcome in outcomes:
         outcome.deviation = deviation(outcome, tolerance)
+    if loads.checks:
+        print("refusals at the load:")
+        for check in loads.checks:
+            print(f"  {check}")
+        print()
     width = max((len(o.label) for o in outcomes), default=10)
     head = f"{'trial':<{width}} {'seed':>4} {'expected':<10} {'found':<10} {'docs s':>6} {'sim s':>6} {'wall s':>6}"
     print(f"{head}  deviation")
     for o in outcomes:
-        mark = o.deviation or ""
         print(
             f"{o.label:<{width}} {o.seed:>4} {o.expected:<10} {o.status:<10} {o.expected_seconds:>6.1f} "
-            f"{o.seconds:>6.1f} {o.wall:>6.1f}  {mark}"
+            f"{o.seconds:>6.1f} {o.wall:>6.1f}  {o.deviation}"
         )
     deviations = [o for o in outcomes if o.deviation]
-    print(f"\n{len(outcomes)} runs in {time.perf_counter() - started:.0f} s; {len(deviations)} deviations")
+    count = len(deviations) + len(loads.deviations)
+    print(
+        f"\n{len(outcomes)} runs and {len(loads.checks)} refusals in {time.perf_counter() - started:.0f} s; "
+        f"{count} deviations"
+    )
+    known = {t.label for t in trials if t.known_failure}
     for o in deviations:
-        known = " (a known failure in the docs)" if next(t for t in trials if t.label == o.label).known_failure else ""
+        mark = " (a known failure in the docs)" if o.label.split(" [")[0] in known else ""
         reason = f": {o.reason[:300]}" if o.reason else ""
-        print(f"- {o.label}, seed {o.seed}: {o.deviation}{known}{reason}")
+        print(f"- {o.label}, seed {o.seed}: {o.deviation}{mark}{reason}")
+    for message in loads.deviations:
+        print(f"- {message}")
     for message in broken:
         print(f"- the store could not be made: {message}")
     if args.json:
@@ -277,10 +664,12 @@ def main() -> None:
             "commit": commit(),
             "tolerance": tolerance,
             "runs": [asdict(o) for o in outcomes],
+            "refusals": loads.checks,
+            "refusal_deviations": loads.deviations,
             "broken": broken,
         }
         args.json.write_text(json.dumps(record, indent=2), encoding="utf-8")
-    if deviations or broken:
+    if deviations or broken or loads.deviations:
         sys.exit(1)
 
 
