@@ -90,6 +90,7 @@ class Run:
     status: list[str]
     seconds: list[float]
     before: tuple[Step, ...] = ()
+    between: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -133,6 +134,7 @@ class Outcome:
     wall: float
     reason: str
     deviation: str = ""
+    expected_between: tuple[float, float] | None = None
 
 
 @dataclass
@@ -157,7 +159,8 @@ def _trial(path: Path, row: dict[str, Any]) -> Trial:
     seeds = list(row.get("seeds", [0, 1, 2]))
     raw_runs = list(row.get("runs", []))
     if "task" in row:
-        raw_runs.insert(0, {"task": row["task"], "status": row["status"], "seconds": row["seconds"]})
+        keys = ("task", "status", "seconds", "between")
+        raw_runs.insert(0, {key: row[key] for key in keys if key in row})
     runs = [
         Run(
             r["task"],
@@ -327,17 +330,9 @@ def _outcome(trial: Trial, k: int, index: int, seed: int, found: dict[str, Any],
         status = RUN_STATUS.get(raw, SERVER_STATUS.get(raw, "broken"))
         reason = _reason(found) if status != "succeeded" else ""
     label = trial.label if len(trial.runs) == 1 else f"{trial.label} [{k + 1}: {run.task}]"
-    return Outcome(
-        label,
-        run.task,
-        seed,
-        run.status[index],
-        run.seconds[index],
-        status,
-        float(found.get("sim_seconds", 0.0)),
-        wall,
-        reason,
-    )
+    seconds = float(found.get("sim_seconds", 0.0))
+    expected = run.status[index]
+    return Outcome(label, run.task, seed, expected, run.seconds[index], status, seconds, wall, reason, "", run.between)
 
 
 def _parsed(done: subprocess.CompletedProcess[str]) -> dict[str, Any]:
@@ -547,6 +542,10 @@ def deviation(outcome: Outcome, tolerance: float) -> str:
     off = abs(outcome.seconds - outcome.expected_seconds)
     if outcome.status == "succeeded" and outcome.expected_seconds and off > tolerance:
         return f"{outcome.seconds:.1f} s simulated, the docs say {outcome.expected_seconds:.1f} s"
+    if outcome.status == "succeeded" and outcome.expected_between:
+        low, high = outcome.expected_between
+        if not low - tolerance <= outcome.seconds <= high + tolerance:
+            return f"{outcome.seconds:.1f} s simulated, the docs say {low:.1f}-{high:.1f} s"
     return ""
 
 
