@@ -750,7 +750,8 @@ def _slip_of(iri: str, candidates: Iterable[str]) -> str | None:
     import jellyfish
 
     namespace, local = _namespace(iri), _local(iri).lower()
-    slips = [c for c in candidates if c.startswith(namespace) and c != iri and _misspelt(iri, c)]
+    near = (c for c in candidates if c.startswith(namespace) and c != iri and abs(len(_local(c)) - len(local)) <= 2)
+    slips = [c for c in near if _misspelt(iri, c)]  # a slip changes the length by two letters at most
     return min(slips, key=lambda c: (jellyfish.damerau_levenshtein_distance(local, _local(c).lower()), c), default=None)
 
 
