@@ -17,7 +17,7 @@ from typing import Any, Protocol
 from cbrs.actions.base_choice import BaseChoice, BaseTies, MapDrives, choose_base, named_base, on_behalf
 from cbrs.actions.belief import BeliefState, Observation
 from cbrs.actions.components import Container, Registry
-from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, PlanStatus, store_plan
+from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, Objective, PlanStatus, store_plan
 from cbrs.actions.errors import UngroundedGoalError
 from cbrs.actions.events import Event, EventBus
 from cbrs.actions.executor import ExecutionReport, Executor, RunStatus
@@ -264,6 +264,7 @@ def run_task(
     cancelled: Callable[[], bool] | None = None,
     replan_policy: ReplanPolicy | None = None,
     base_ties: BaseTies = BaseTies.NEAREST,
+    objective: Objective | None = None,
 ) -> RunResult:
     """Perceive, compose ``task`` from what holds now, run it in ``environment``, keep the world graph current.
 
@@ -279,8 +280,13 @@ def run_task(
     compose without its component first, and repeat it at most ``max_repeats`` times, else stop with
     ``RunResult.stopped`` saying why (``actions.replanning``). ``base_ties``: in a home of several mobile
     bases, how plans of one cost and similarity for different bases are told apart (``actions.base_choice``).
+    ``objective``: what ranks the components that could do a step (``ComposeConfig.objective``), for a
+    script that gives no ``composer``; a composer's own config says it, and a different one is refused.
     """
-    composer = composer or Composer(kb)
+    if composer is not None and objective is not None and objective is not composer.config.objective:
+        mine = composer.config.objective.value
+        raise ValueError(f"objective {objective.value!r}: the composer given ranks by {mine!r}; give one or the other")
+    composer = composer or Composer(kb, ComposeConfig(objective=objective or Objective.SIMILARITY))
     bus = EventBus()
     if on_event is not None:
         bus.subscribe("*", on_event)
