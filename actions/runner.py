@@ -26,6 +26,7 @@ from cbrs.actions.graph import parameter_names, statement_text
 from cbrs.actions.model import ActionLibrary
 from cbrs.actions.plan import Plan, PlanStep
 from cbrs.actions.replanning import Failure, FailureMemory, ReplanPolicy
+from cbrs.actions.task_preconditions import PreconditionCheck, check_preconditions
 from cbrs.kb import Advertisement, KnowledgeBase, NotFoundError, Requirement, Statement
 from cbrs.kb.namespaces import HOME, shorten
 from cbrs.kb.semantic_map import UnresolvedDesignatorError
@@ -56,7 +57,9 @@ class Environment(Protocol):
     # environment that keeps beliefs no sense can check (a door a remote motor opened); ``passed_over()``,
     # the components to compose without now, with why (remote ones whose calls timed out);
     # ``unimplemented(advertisements)``, why it has no implementation of some of them, where it knows
-    # better than "no skill for its service" (a camera the simulated home lacks).
+    # better than "no skill for its service" (a camera the simulated home lacks); ``holds(statement)``,
+    # whether a statement about the task's things holds now by its tests, believing nothing (None: no test
+    # decides it), asked of the task's own preconditions before the first step (actions.task_preconditions).
 
 
 @dataclass(frozen=True)
@@ -145,6 +148,7 @@ class RunResult:
     stopped: str = ""  # why re-planning stopped before its budget: the next plan would repeat a failure
     passed_over: tuple[tuple[str, str], ...] = ()  # (component, why) the last composition was made without
     base: BaseChoice | None = None  # in a home of several mobile bases, the one the plans work and why
+    preconditions: tuple[PreconditionCheck, ...] = ()  # the task's own, before its first step (None: unchecked)
 
     @property
     def succeeded(self) -> bool:
@@ -215,6 +219,7 @@ class RunResult:
             found["stopped"] = self.stopped
         found["goals"] = [goal.to_dict() for goal in self.goals]
         found["answers"] = [answer.to_dict() for answer in self.answers]
+        found["preconditions"] = [check.to_dict() for check in self.preconditions]
         if self.base is not None:
             found["base"] = self.base.to_dict()
         return found
@@ -296,7 +301,8 @@ def run_task(
     belief = BeliefState(kb)
     _perceive(environment)
     before = belief.snapshot()
-    belief.write(environment.observe())  # plan from what holds now, not from a past run's belief
+    seen = environment.observe()
+    belief.write(seen)  # plan from what holds now, not from a past run's belief
     composition = composer.compose(task, belief=True)
     config = composer.config
     composition, chosen = _one_base(kb, config, task, composition, environment, bus, frozenset(), base_ties)
@@ -336,11 +342,15 @@ def run_task(
     composed_without = _pairs(passed)
     report: ExecutionReport | None = None
     outputs: Mapping[int, Mapping[str, Any]] = {}
+    checked: tuple[PreconditionCheck, ...] = ()
     try:
         while composition.plan is not None:
             plan = composition.plan
             try:
                 given = environment.given(plan, on_behalf(_supplying(kb, composition), chosen))
+                if not replans and composition.attempts:  # the task's own guarantees (actions.task_preconditions)
+                    requirement = composition.attempts[0].requirement
+                    checked = check_preconditions(environment, requirement, seen, composer.index.is_a)
             except Exception:
                 if not replans:  # refused before anything moved: the store is left as it was
                     belief.restore(before)
@@ -390,7 +400,7 @@ def run_task(
         container.finalise_all()
     belief.write(environment.observe(), whole=True)  # what a run leaves is exactly its belief
     goals = _check_goals(environment, composition.plan, outputs) if report is not None else ()
-    return RunResult(composition, report, tuple(replans), goals, stopped, composed_without, chosen)
+    return RunResult(composition, report, tuple(replans), goals, stopped, composed_without, chosen, checked)
 
 
 def refusal_before_world(

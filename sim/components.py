@@ -468,6 +468,18 @@ class SimEnvironment:
             return None
         return True
 
+    def holds(self, statement: Statement) -> bool | None:
+        """Whether ``statement`` about the task's things holds by what the robots perceive now, decided by
+        :meth:`verify`'s tests without a step; None where no test decides it before a step (a relation
+        with no test, a perception's result, a localisation). A question only: nothing is looked at again
+        and nothing believed (a task's precondition, before the first step: ``actions.task_preconditions``)."""
+        kept = self.context.inputs
+        self.context.inputs = dict(self.context.given)
+        try:
+            return self._judge(self.belief, statement, {}, look=False)
+        finally:
+            self.context.inputs = kept
+
     def succeeded(self, step: PlanStep, component: str) -> None:
         """``component`` did ``step``: of the relations no test decides, what its description deletes stops
         being believed, then what it adds is believed (in that order, as in STRIPS, so a statement both
