@@ -189,10 +189,11 @@ def save(sparql: SparqlService, draft: TaskDraft, token: str | None, replace: bo
         inserting = [q for q in text if not _present(store, q)]
         carried = [q for q in _recorded(mine, _ADDED) if q not in removing and _present(store, q)]
         written = _record(record, draft.iri, text, [*inserting, *carried])
-        update = "INSERT DATA {\n" + data_block([*inserting, *written])
+        # Terms serialised by data_block (escaped N-Triples), never the text itself.
+        update = "INSERT DATA {\n" + data_block([*inserting, *written]) + "}"
         if removing or mine:
             update = "DELETE DATA {\n" + data_block([*removing, *mine]) + "} ;\n" + update
-        sparql.update(update + "}", token)
+        sparql.update(update, token)
     return len(previous)
 
 
