@@ -22,8 +22,10 @@ from cbrs.actions.errors import UngroundedGoalError
 from cbrs.actions.runner import _WHERE, RunResult, _missing, run_task
 from cbrs.cli_actions import run_text
 from cbrs.kb import KnowledgeBase
-from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.loader import parse_bytes
+from cbrs.kb.namespaces import PREFIXES, GraphName
 from cbrs.kb.semantic_map import SemanticMap, UnresolvedDesignatorError
+from cbrs.kb.shapes import DescriptionShapeError
 from cbrs.sim.components import SimEnvironment
 from cbrs.sim.world import HomeWorld, open_world
 
@@ -187,13 +189,26 @@ def test_a_robot_part_no_robot_has_is_refused_and_a_part_of_another_robot_is_use
     assert (WORLD + "Pen", HOME + "isLocatedOn", WORLD + "P3DX01Platform") in facts(kb)
 
 
-def test_a_mistyped_class_is_named_with_the_class_meant() -> None:
-    """home:Pne for home:Pen: the plan used to fetch the base's colour marker (a physical object) instead."""
-    kb = knowledge(("requirements", "fetch_my_pen_typo.ttl"))
+def test_a_mistyped_class_is_refused_at_the_load_with_the_class_meant() -> None:
+    """home:Pne for home:Pen: the plan used to fetch the base's colour marker (a physical object) instead;
+    since the shapes know two swapped letters (kb/shapes.py), the load refuses it and keeps nothing."""
+    kb = knowledge()
     before = set(kb.store.quads())
-    result = run(kb, "FetchMyPenTypo")
-    assert result.report is None and result.composition.status is PlanStatus.UNSOLVABLE
-    [why] = result.composition.unsatisfied
+    with pytest.raises(DescriptionShapeError) as refused:
+        kb.load([DATA / "fetch_my_pen_typo.ttl"], graph="requirements")
+    assert "home:Pne is declared nowhere" in str(refused.value) and "did you mean home:Pen?" in str(refused.value)
+    assert set(kb.store.quads()) == before
+
+
+def test_a_mistyped_class_written_past_the_checks_is_named_by_the_plan() -> None:
+    """A store written by another tool is not checked: the composer still names the class meant."""
+    kb = knowledge()
+    path = DATA / "fetch_my_pen_typo.ttl"  # parsed as cbrs load parses it, then written past the checks
+    kb.store.add(parse_bytes(path.read_bytes(), str(path), ox.RdfFormat.TURTLE, GraphName.REQUIREMENTS).quads)
+    before = set(kb.store.quads())
+    composition = Composer(kb).compose("FetchMyPenTypo")
+    assert composition.status is PlanStatus.UNSOLVABLE
+    [why] = composition.unsatisfied
     assert why.undeclared == (HOME + "Pne",) and why.near == ((HOME + "Pne", HOME + "Pen"),)
     assert why.text().startswith("the requirement gives input pen (home:Pne); home:Pne is no class of the ontology")
     assert "did you mean home:Pen?" in why.text()
