@@ -186,8 +186,9 @@ def test_a_sub_actions_goal_a_later_one_consumes_is_no_goal_of_the_run() -> None
 
 def test_a_chained_tasks_precondition_is_taken_as_given() -> None:
     """DeliverFromTheBase alone: its precondition (the pen on the platform) is offered by the requirement
-    (docs/composition.md), so the plan drives to the person and delivers without loading; the run, whose
-    world starts from the map with the pen on the table, fails at the delivery (a known failure)."""
+    (docs/composition.md), so the plan drives to the person and delivers without loading. The run, whose
+    world starts from the map with the pen on the table, failed at the delivery; since 04fd46b it is refused
+    before its first step (tests/test_task_preconditions.py)."""
     kb = _chain_store("lab7_deliver_from_the_base.ttl")
     plan = Composer(kb).compose("DeliverFromTheBase").plan
     assert plan is not None
