@@ -75,6 +75,9 @@ _AT_OR_BELOW = frozenset({Degree.EXACT, Degree.SUBCLASS_OF})
 class ComposeConfig:
     objective: Objective = Objective.SIMILARITY
     default_cost: float = 1.0  # seconds, for components that advertise no response time
+    # objective "cost" ranks by the stated cbrs:cost (no unit, not seconds): None compares by it only when every
+    # candidate states one, else by response time as before; a number is the cost of one that states none
+    unstated_cost: float | None = None
     decompose: bool = True  # plan a task whose sub-actions are each stated as a requirement part by part
     # A step is one invocation, made per use; past this many steps, uses share an existing invocation
     # of the same component, so deep pools cannot make the plan grow exponentially.
@@ -128,6 +131,7 @@ class CompositionResult:
     plan: Plan | None
     unsatisfied: tuple[Unsatisfied, ...]
     attempts: tuple[Attempt, ...]  # the direct attempt, then one per sub-action when decomposed
+    objective: Objective = Objective.SIMILARITY  # what ranked providers (each step's ranked_by says what decided)
 
     @property
     def unused_inputs(self) -> tuple[tuple[str, str], ...]:
@@ -148,6 +152,7 @@ class CompositionResult:
 
     def to_dict(self) -> dict[str, Any]:
         found: dict[str, Any] = {"task": self.task, "requirement": self.requirement, "status": self.status.value}
+        found["objective"] = self.objective.value
         if self.plan is not None:
             found.update(self.plan.to_dict())
             found["unused_inputs"] = [{"name": name, "type": type_} for name, type_ in self.unused_inputs]
@@ -209,7 +214,8 @@ class Composer:
         """The components and the edges among them, built on first use and kept (they do not depend
         on the requirement). Make a new Composer after registering or deregistering components."""
         if self._pool is None:
-            self._pool = ServicePool(self.advertisements, self.matcher, self.config.default_cost)
+            config = self.config
+            self._pool = ServicePool(self.advertisements, self.matcher, config.default_cost, config.unstated_cost)
         return self._pool
 
     def task(self, name: str) -> Task:
@@ -677,7 +683,9 @@ class Composer:
         status = PlanStatus.PLANNED if plan is not None else PlanStatus.UNSOLVABLE
         if plan is None:
             unsatisfied = tuple(self._near_missed(self._undeclared(task.requirement, u), attempts) for u in unsatisfied)
-        return CompositionResult(task.name, task.requirement.iri, status, plan, unsatisfied, attempts)
+        return CompositionResult(
+            task.name, task.requirement.iri, status, plan, unsatisfied, attempts, self.config.objective
+        )
 
     def _undeclared(self, requirement: Requirement, unsatisfied: Unsatisfied) -> Unsatisfied:
         """``unsatisfied`` with the classes of the requirement it names that the ontology lacks (a task
@@ -822,6 +830,7 @@ def _concatenate(task: Task, plans: list[Plan]) -> Plan:
                     part_of=step.part_of or plan.task,
                     alternatives=step.alternatives,
                     deletes=step.deletes,
+                    ranked_by=step.ranked_by,
                 )
             )
         goals += [_shift(g, offset) for g in plan.goals]

@@ -13,8 +13,10 @@ what it is run.
 from __future__ import annotations
 
 from collections import deque
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from enum import Enum
+from functools import partial
 from typing import Any
 
 import networkx as nx
@@ -32,8 +34,13 @@ from cbrs.reasoner.taxonomy import TaxonomyIndex
 
 
 class Objective(Enum):
-    SIMILARITY = "similarity"  # highest similarity first, cost breaks ties
-    COST = "cost"  # lowest cost first, similarity breaks ties
+    SIMILARITY = "similarity"  # highest similarity first, estimated response time breaks ties
+    # lowest stated cbrs:cost first when every candidate states one (then response time), else lowest
+    # estimated response time; similarity breaks ties (docs/composition.md, "Which cost")
+    COST = "cost"
+
+
+_Key = Callable[[Edge], tuple[Any, ...]]
 
 
 @dataclass
@@ -88,6 +95,7 @@ class Extraction:
         self._things: dict[int, frozenset[str]] = {}  # see _about
         self._explained: set[str] = set()  # vertices whose blocked needs _why has followed
         self._best: dict[tuple[str, str], dict[str, Edge]] = {}  # see _best_from
+        self._ranked: dict[int, str | None] = {}  # step id -> what decided its component (see _decided)
         self.steps: dict[int, _Step] = {}
         self._next_id = 0
         self.unsatisfied: list[Unsatisfied] = []
@@ -221,12 +229,37 @@ class Extraction:
     def _chain(start: tuple[str, ...], followed: list[str]) -> tuple[str, ...]:
         return (*start, *map(shorten, followed))
 
-    def _key(self, edge: Edge) -> tuple[Any, ...]:
-        cost = self.trace.costs[edge.source]
-        level = self.trace.levels[edge.source]
+    def _key(self, edge: Edge, stated: bool = False) -> tuple[Any, ...]:
+        """How good a provider ``edge`` is, lowest best; ``stated``: its ``cbrs:cost`` first (see :meth:`_ranker`)."""
+        cost = round(self.trace.costs[edge.source], 9)
+        tail = (self.trace.levels[edge.source], edge.source, edge.offer.name)
+        if self.objective is not Objective.COST:
+            return (-round(edge.similarity, 9), cost, *tail)
+        stated_cost = self.graph.stated_cost(edge.source)
+        head = (round(stated_cost, 9),) if stated and stated_cost is not None else ()
+        return (*head, cost, -round(edge.similarity, 9), *tail)
+
+    def _ranker(self, edges: Sequence[Edge]) -> _Key:
+        """The key ``edges`` are ranked by among themselves: with objective cost, their providers' stated
+        ``cbrs:cost`` first when every one states one; a figure without a unit is not compared with
+        seconds, so when any states none they are ranked by estimated response time, as before."""
+        return partial(self._key, stated=self._stated(edges))
+
+    def _stated(self, edges: Sequence[Edge]) -> bool:
+        return self.objective is Objective.COST and all(self.graph.stated_cost(e.source) is not None for e in edges)
+
+    def _decided(self, best: Edge, candidates: Sequence[Edge], rank: _Key) -> str | None:
+        """What told ``best`` from the best candidate of another component: the first part of the key
+        where they differ (None: no other component could)."""
+        others = [e for e in candidates if e.source != best.source]
+        if not others:
+            return None
+        mine, theirs = rank(best), rank(min(others, key=rank))
+        names: tuple[str, ...] = ("similarity", "responseTime", "level", "iri", "iri")
         if self.objective is Objective.COST:
-            return (round(cost, 9), -round(edge.similarity, 9), level, edge.source, edge.offer.name)
-        return (-round(edge.similarity, 9), round(cost, 9), level, edge.source, edge.offer.name)
+            names = ("responseTime", "similarity", "level", "iri", "iri")
+            names = ("cbrs:cost", *names) if self._stated(candidates) else names
+        return next((name for name, a, b in zip(names, mine, theirs, strict=True) if a != b), "iri")
 
     def _new(self, node: str, made_for: int | None) -> _Step:
         step = _Step(self._next_id, node, made_for)
@@ -256,9 +289,8 @@ class Extraction:
             if need.role != "deletion":
                 continue
             options = [e for e in self._options(node, need, 10**9) if e.source != SRI]
-            planned = [
-                (self._key(e), step.id, e) for step in self.steps.values() for e in options if e.source == step.node
-            ]
+            rank = self._ranker(options)
+            planned = [(rank(e), step.id, e) for step in self.steps.values() for e in options if e.source == step.node]
             if planned:
                 *_, step_id, edge = min(planned, key=lambda item: item[:2])
                 goal.bindings.append(_Bound(need, edge, step_id))
@@ -284,7 +316,8 @@ class Extraction:
                 return True
             mine = [(e, p) for p in step.producers for e in options if e.source == self.steps[p].node]
             if mine:  # a step already made for this consumer meets this need too
-                edge, producer_id = min(mine, key=lambda item: (self._key(item[0]), item[1]))
+                rank = self._ranker([e for e, _ in mine])
+                edge, producer_id = min(mine, key=lambda item: (rank(item[0]), item[1]))
                 step.bindings.append(_Bound(need, edge, producer_id))
                 return True
             sibling = self._sibling(step, node, need)
@@ -302,7 +335,8 @@ class Extraction:
                 self._pass_over(step, node, need, candidates, about)
                 return False
             candidates = fit
-        best = min(candidates, key=self._key)
+        rank = self._ranker(candidates)
+        best = min(candidates, key=rank)
         if len(self.steps) > self.max_steps and not again:
             existing = next((other for other in self.steps.values() if other.node == best.source), None)
             if existing is not None:
@@ -310,6 +344,7 @@ class Extraction:
                 return True
         producer = self._new(best.source, step.id)
         producer.about = about
+        self._ranked[producer.id] = self._decided(best, candidates, rank)
         step.producers.append(producer.id)
         step.bindings.append(_Bound(need, best, producer.id))
         queue.append(producer.id)
@@ -437,7 +472,7 @@ class Extraction:
                 why = f"no provider of its {need.text()} is effective where it is needed"
                 return _Judged(frozenset(things), why, need)
             if need.role == "input":
-                fed = self._judged[(min(fit, key=self._key).source, below)].things
+                fed = self._judged[(min(fit, key=self._ranker(fit)).source, below)].things
                 things |= fed
                 if self.areas.passes_on(need.concept):
                     bound |= fed
@@ -454,7 +489,7 @@ class Extraction:
         chain = self._path(step, need)
         along: list[tuple[str, str]] = []  # the needs above the one reported, each with its consumer
         while True:
-            judged = {e.source: self._judge(e.source, about) for e in sorted(candidates, key=self._key)}
+            judged = {e.source: self._judge(e.source, about) for e in sorted(candidates, key=self._ranker(candidates))}
             best = next(iter(judged))
             lower = judged[best].blocked
             if lower is None or any(j.blocked is None for j in judged.values()):
@@ -586,6 +621,7 @@ class Extraction:
                     cost=vertex.cost,
                     alternatives=tuple(self._alternatives(step)),
                     deletes=ad.deletes,
+                    ranked_by=self._ranked.get(step_id),
                 )
             )
         goals = tuple(self._binding(b, number, requirement.iri) for b in self.steps[0].bindings)

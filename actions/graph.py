@@ -95,8 +95,9 @@ class Vertex:
     iri: str
     needs: tuple[Need, ...]
     offers: tuple[Offer, ...]
-    cost: float
+    cost: float  # seconds: the advertised response time (composition's default measure of cost)
     advertisement: Advertisement | None = None
+    stated_cost: float | None = None  # the advertised cbrs:cost, a unitless figure; None: it states none
 
     @property
     def shareable(self) -> bool:
@@ -160,7 +161,15 @@ class ServicePool:
     offers whose degree can be accepted (its subclasses, itself, its superclasses), never with all.
     """
 
-    def __init__(self, advertisements: Iterable[Advertisement], matcher: Matcher, default_cost: float = 1.0) -> None:
+    def __init__(
+        self,
+        advertisements: Iterable[Advertisement],
+        matcher: Matcher,
+        default_cost: float = 1.0,
+        unstated_cost: float | None = None,
+    ) -> None:
+        """``default_cost``: the response time of a component that advertises none; ``unstated_cost``: the
+        ``cbrs:cost`` of one that states none (None: it has none, and is not compared by it)."""
         self.matcher = matcher
         self.vertices: dict[str, Vertex] = {
             ad.iri: Vertex(
@@ -169,6 +178,7 @@ class ServicePool:
                 tuple(_offers(ad.outputs, ad.effects)),
                 _cost(ad, default_cost),
                 ad,
+                _stated_cost(ad, unstated_cost),
             )
             for ad in advertisements
         }
@@ -304,6 +314,10 @@ class ServiceResourceGraph:
     def cost(self, iri: str) -> float:
         return self.vertices[iri].cost
 
+    def stated_cost(self, iri: str) -> float | None:
+        """The ``cbrs:cost`` ``iri`` states (None: none, or a virtual node)."""
+        return self.vertices[iri].stated_cost
+
 
 def _rank(edge: Edge) -> tuple[float, str, str]:
     return (-edge.similarity, edge.source, edge.offer.name)
@@ -347,5 +361,15 @@ def _cost(ad: Advertisement, default: float) -> float:
     """The advertised response time in seconds: the paper's 'minimum cost' uses it."""
     for q in ad.qos:
         if q.metric == CBRS.responseTime:
+            return q.value
+    return default
+
+
+def _stated_cost(ad: Advertisement, default: float | None) -> float | None:
+    """The advertised ``cbrs:cost`` (core.ttl: lower is better, no unit), which ``--objective cost`` ranks
+    by; ``default`` for a component that states none. Kept apart from the response time: a figure
+    without a unit cannot be added to seconds (docs/composition.md, "Which cost")."""
+    for q in ad.qos:
+        if q.metric == CBRS.cost:
             return q.value
     return default

@@ -74,6 +74,9 @@ class PlanStep:
     part_of: str | None = None  # the sub-action of a decomposed task this step belongs to
     alternatives: tuple[str, ...] = ()  # components that can replace this one with the same bindings
     deletes: tuple[Statement, ...] = ()  # what stops being true when it has run (cbrs:hasDeleteEffect)
+    # what decided the component over the others that could have done the step ("cbrs:cost", "similarity",
+    # "responseTime", "level", "iri"); None: no other could, or it was not chosen by rank
+    ranked_by: str | None = None
 
     @property
     def candidates(self) -> tuple[str, ...]:
@@ -103,6 +106,7 @@ class PlanStep:
             "effects": [_statement(s) for s in self.effects],
             "deletes": [_statement(s) for s in self.deletes],
             "cost": self.cost,
+            "ranked_by": self.ranked_by,
             "alternatives": list(self.alternatives),
         }
 

@@ -104,6 +104,18 @@ _BASE_TIES = click.option(
     ),
 )
 
+_OBJECTIVE = click.option(
+    "--objective",
+    type=click.Choice([o.value for o in Objective]),
+    default=Objective.SIMILARITY.value,
+    show_default=True,
+    help=(
+        "Choose the component for each step by highest similarity (estimated response time breaks ties), or by"
+        " lowest cost: the stated cbrs:cost where every candidate states one, else the estimated response time"
+        " (similarity breaks ties); the plan says what decided each step (docs/composition.md, Which cost)."
+    ),
+)
+
 
 def _compose_config(
     ignore_areas: bool, protect: bool, max_reachieved: int, near_misses: int, **more: Any
@@ -137,13 +149,7 @@ def _compose_config(
     type=click.Path(dir_okay=False, path_type=Path),
     help="Draw the service resource graph and the plan to FILE.svg or FILE.png.",
 )
-@click.option(
-    "--objective",
-    type=click.Choice([o.value for o in Objective]),
-    default=Objective.SIMILARITY.value,
-    show_default=True,
-    help="Choose providers by highest similarity (cost breaks ties) or by lowest cost.",
-)
+@_OBJECTIVE
 @click.option("--no-store", is_flag=True, help="Do not record the plan in the plans graph.")
 @_IGNORE_AREAS
 @_PROTECT
@@ -354,7 +360,33 @@ def plan_text(result: CompositionResult) -> str:
         )
     goals = "\n".join(f"  {_source(g)}" for g in plan.goals)
     columns = ["#", "component", "action", "inputs and preconditions from", "alternatives"]
-    return f"{head}\n{table(columns, rows)}\nGoals:\n{goals}{_unused_note(result.unused_inputs)}"
+    notes = _unused_note(result.unused_inputs) + _ranking_note(result)
+    return f"{head}\n{table(columns, rows)}\nGoals:\n{goals}{notes}"
+
+
+_RANKED_BY = {
+    "cbrs:cost": "the stated cbrs:cost",
+    "responseTime": "the estimated response time",
+    "similarity": "similarity",
+    "level": "the forward level",
+    "iri": "IRI",
+}
+
+
+def _ranking_note(result: CompositionResult) -> str:
+    """With ``--objective cost``, what chose each step's component (``PlanStep.ranked_by``): a lab that
+    states a ``cbrs:cost`` sees whether it was compared. The default objective adds nothing, so its
+    output stays as it was; the JSON says it for both."""
+    if result.objective is Objective.SIMILARITY or result.plan is None:
+        return ""
+    by: dict[str, list[str]] = {}
+    for step in result.plan.steps:
+        if step.ranked_by is not None:
+            by.setdefault(step.ranked_by, []).append(str(step.index))
+    if not by:
+        return f"\nnote: --objective {result.objective.value}: no step had more than one component to choose from"
+    said = "; ".join(f"{_RANKED_BY.get(metric, metric)} at step {', '.join(steps)}" for metric, steps in by.items())
+    return f"\nnote: --objective {result.objective.value}: the component was chosen by {said} (others: no choice)"
 
 
 def _unused_note(unused: Sequence[tuple[str, str]]) -> str:
@@ -440,6 +472,7 @@ def _source(binding: Binding) -> str:
 @_MAX_REACHIEVED
 @_NEAR_MISSES
 @_BASE_TIES
+@_OBJECTIVE
 @pass_app
 def run(
     app: App,
@@ -458,6 +491,7 @@ def run(
     max_reachieved: int,
     near_misses: int,
     base_ties: str,
+    objective: str,
 ) -> None:
     """Plan TASK, then execute it in the simulated home, step by step, failing over where needed.
 
@@ -493,7 +527,7 @@ def run(
     transport = _bridge(bridge) if bridge else None
     start = time.perf_counter()
     recorder: Recorder | None = None
-    config = _compose_config(ignore_areas, protect, max_reachieved, near_misses)
+    config = _compose_config(ignore_areas, protect, max_reachieved, near_misses, objective=Objective(objective))
     composer = Composer(app.kb, config, actions=actions)
     with contextlib.ExitStack() as held:
         if transport is not None:
@@ -776,7 +810,7 @@ def run_text(result: RunResult, sim_seconds: float, wall_seconds: float) -> str:
     steps = table(["#", "component", "sim s", "outcome", "effects checked"], rows)
     if not report.steps:  # every effect held already: no table of no steps
         steps = "nothing to do: every effect of the task holds already"
-    note = _unused_note(result.unused_inputs)
+    note = _unused_note(result.unused_inputs) + _ranking_note(result.composition)
     return f"{header}{steps}\n{verdict}; {timing}{_answers_text(result)}{note}"
 
 
