@@ -219,9 +219,10 @@ class RunResult:
             found["stopped"] = self.stopped
         found["goals"] = [goal.to_dict() for goal in self.goals]
         found["answers"] = [answer.to_dict() for answer in self.answers]
-        found["preconditions"] = [check.to_dict() for check in self.preconditions]
         if self.base is not None:
             found["base"] = self.base.to_dict()
+        if self.preconditions:  # the task's own, how each stood before the first step (believed None: unchecked)
+            found["preconditions"] = [check.to_dict() for check in self.preconditions]
         return found
 
 

@@ -275,16 +275,20 @@ def _check_with_context(store: Store, quads: list[ox.Quad], context: list[ox.Qua
         raise DescriptionShapeError(problems)
 
 
-CHECKED_GRAPHS = (GraphName.SERVICES.node, GraphName.REQUIREMENTS.node)
-"""The graphs :func:`checked_update` reads: an update that writes none of them needs no check."""
+_DESCRIBED = (GraphName.SERVICES.node, GraphName.REQUIREMENTS.node)
+CHECKED_GRAPHS: tuple[ox.NamedNode | ox.DefaultGraph, ...] = (*_DESCRIBED, ox.DefaultGraph())
+"""The graphs :func:`checked_update` reads: an update that writes none of them needs no check. The default
+graph too: an update that names no graph writes its descriptions there, and a task is found in any graph
+(a ``GRAPH`` block left out ran a requirement nothing had checked: docs/tasks.md, "A seventh round"). cbrs's
+own writes name their graphs (a load, the registry, the belief), so only an update puts anything there."""
 
 
 @contextmanager
 def checked_update(store: Store, whole: bool = False) -> Iterator[None]:
     """Run the enclosed update, then check the descriptions it changed in the services and requirements
-    graphs; when one is broken, undo the update's changes to those graphs and raise. With ``whole``, the
-    whole store is kept beforehand and a refused update is undone everywhere (the caller cannot know what
-    else it wrote: :func:`may_write_descriptions`)."""
+    graphs and the default graph; when one is broken, undo the update's changes to those graphs and raise.
+    With ``whole``, the whole store is kept beforehand and a refused update is undone everywhere (the caller
+    cannot know what else it wrote: :func:`may_write_descriptions`)."""
     graphs = CHECKED_GRAPHS
     everything = set(store.quads()) if whole else None
     if everything is not None:  # the two graphs are in it: no second read
@@ -310,18 +314,21 @@ def checked_update(store: Store, whole: bool = False) -> Iterator[None]:
 
 
 _MAY_REACH = re.compile(
-    "|".join(re.escape(graph.value.rsplit("/", 1)[-1]) for graph in CHECKED_GRAPHS)  # their names' last words
-    + r"|prefix|base|\\u|GRAPH(?:\s|#[^\n]*\n)*[?$]|\b(?:ALL|NAMED)\b",
+    "|".join(re.escape(graph.value.rsplit("/", 1)[-1]) for graph in _DESCRIBED)  # their names' last words
+    + r"|prefix|base|\\u|GRAPH(?:\s|#[^\n]*\n)*[?$]|\b(?:ALL|NAMED|DEFAULT)\b"
+    + r"|\bcbrs:|/cbrs/core#",  # a description's own terms, which it may write into the default graph
     re.IGNORECASE,
 )
 
 
 def may_write_descriptions(text: str) -> bool:
-    """Whether the SPARQL update ``text`` might write graph:services or graph:requirements: it names one of
-    them (or a word of theirs), declares a prefix or a base that could spell them, has an escape, a
-    variable graph or CLEAR/DROP ALL/NAMED. Deliberately loose: it decides whether :func:`checked_update`
-    keeps the whole store to undo a refused update everywhere, and whether an update that is not data is
-    checked at all (KnowledgeBase: an update it says cannot reach them, and no LOAD, is not)."""
+    """Whether the SPARQL update ``text`` might write graph:services, graph:requirements or a description
+    into the default graph: it names one of them (or a word of theirs), declares a prefix or a base that
+    could spell them, has an escape, a variable graph, CLEAR/DROP ALL/NAMED or DEFAULT, or a term of the
+    cbrs core (a description's, by the ``cbrs:`` prefix every update is given, or spelt out). Deliberately
+    loose: it decides whether :func:`checked_update` keeps the whole store to undo a refused update
+    everywhere, and whether an update that is not data is checked at all (KnowledgeBase: an update it says
+    cannot reach them, and no LOAD, is not)."""
     return _MAY_REACH.search(text) is not None
 
 

@@ -188,7 +188,7 @@ class DataUpdate:
         named = {quad for operation in operations for quad in operation.quads}
         return cls(text, operations, {quad: _holds(store, quad) for quad in named})
 
-    def names_graph(self, graphs: Iterable[ox.NamedNode]) -> bool:
+    def names_graph(self, graphs: Iterable[ox.NamedNode | ox.DefaultGraph]) -> bool:
         """Whether the text names a quad in one of ``graphs`` (if not, the update leaves them as they are)."""
         wanted = set(graphs)
         return any(quad.graph_name in wanted for quad in self._present)

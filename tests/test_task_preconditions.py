@@ -10,16 +10,20 @@ from collections import Counter
 from collections.abc import Mapping
 from typing import Any
 
+import pyoxigraph as ox
 import pytest
 
 from cbrs.actions.belief import Observation
 from cbrs.actions.components import Component, Registry, Status
+from cbrs.actions.composer import Composer
 from cbrs.actions.graph import statement_text
 from cbrs.actions.plan import Plan, PlanStep
 from cbrs.actions.runner import run_task
 from cbrs.actions.task_preconditions import TaskPreconditionError
 from cbrs.kb import KnowledgeBase, Requirement, Statement
 from cbrs.kb.resources import ontology_dir
+from cbrs.kb.shapes import DescriptionShapeError, may_write_descriptions
+from tests.helpers_examples import EXAMPLES
 
 EX = "http://example.org/given#"
 TASK = f"""@prefix cbrs: <https://w3id.org/cbrs/core#> . @prefix ex: <{EX}> .
@@ -39,6 +43,7 @@ ex:Direct a cbrs:MethodInvocationComponent ; cbrs:serviceName "Direct" ;
     cbrs:hasQoSModel [ a cbrs:QoSModel ; cbrs:responseTime 1.0 ] .
 """
 ON_TRAY = Statement(EX + "A", EX + "on", EX + "Tray")
+LAB7 = "https://example.org/lab7#"
 
 
 class Worker(Component):
@@ -131,3 +136,35 @@ def test_a_precondition_not_believed_false_runs_and_the_result_says_how_it_stood
     assert result.succeeded and home.calls[EX + "Direct"] == 1
     assert [(check.statement, check.believed) for check in result.preconditions] == [(ON_TRAY, believed)]
     assert result.to_dict()["preconditions"] == [{"statement": statement_text(ON_TRAY), "believed": believed}]
+
+
+# A requirement written by an update that names no graph lands in the default graph, where a task is found
+# as in any graph; the update's descriptions are checked there as in graph:requirements (kb/shapes.py,
+# CHECKED_GRAPHS; docs/tasks.md, "A seventh round": the GRAPH block left out).
+WHERE_IS = (EXAMPLES / "lab7_where_is_my_pen.ru").read_text(encoding="utf-8")
+UNGRAPHED = WHERE_IS.replace("INSERT DATA { GRAPH <https://w3id.org/cbrs/graph/requirements> {", "INSERT DATA {")
+UNGRAPHED = UNGRAPHED[: UNGRAPHED.rindex("}")]  # the GRAPH block's closing brace
+
+
+def test_a_description_an_update_writes_into_the_default_graph_is_checked(kb: KnowledgeBase) -> None:
+    assert UNGRAPHED != WHERE_IS and "GRAPH" not in UNGRAPHED.rsplit("INSERT DATA", 1)[1]
+    misspelt = UNGRAPHED.replace("home:Pen .", "home:Pne .")
+    with pytest.raises(DescriptionShapeError, match="did you mean home:Pen"):
+        kb.update(misspelt)
+    assert not any(True for _ in kb.store.quads(ox.NamedNode(LAB7 + "WhereIsMyPen")))  # nothing written
+    kb.update(UNGRAPHED)  # the same, spelt right: stored in the default graph and found as a task
+    assert any(True for _ in kb.store.quads(ox.NamedNode(LAB7 + "WhereIsMyPen"), None, None, ox.DefaultGraph()))
+    assert Composer(kb).task("WhereIsMyPen").requirement.iri == LAB7 + "WhereIsMyPen"
+
+
+@pytest.mark.parametrize(
+    ("text", "may"),
+    [
+        pytest.param("INSERT { <urn:a> cbrs:hasInput <urn:b> } WHERE {}", True, id="a-cbrs-term"),
+        pytest.param("INSERT { <urn:a> <https://w3id.org/cbrs/core#hasInput> <urn:b> } WHERE {}", True, id="spelt-out"),
+        pytest.param("COPY <urn:g> TO DEFAULT", True, id="into-the-default-graph"),
+        pytest.param("INSERT { <urn:a> <urn:b> 1 } WHERE {}", False, id="no-description-term"),
+    ],
+)
+def test_an_update_that_might_write_a_description_into_the_default_graph_is_recognised(text: str, may: bool) -> None:
+    assert may_write_descriptions(text) is may

@@ -12,7 +12,7 @@
 # Every node is named (lab7:WhereIsMyPenModel ...): /update refuses blank nodes ([ ... ], as the
 # Turtle of docs/tasks.md writes a task) with BlankNodeInsertError, so that what it stores can be read
 # and deleted by name. The requirement goes into the requirements graph; the same INSERT DATA without the GRAPH block
-# writes it into the default graph, where no task is looked for (a newcomer's mistake tried below).
+# writes it into the default graph (a newcomer's mistake), where it is checked as here and found as a task.
 PREFIX cbrs: <https://w3id.org/cbrs/core#>
 PREFIX home: <https://w3id.org/cbrs/home#>
 PREFIX svc:  <https://w3id.org/cbrs/service#>
