@@ -1,9 +1,11 @@
 """Composition and execution: the action model, the service resource graph, plans, the container.
 
 ``Composer(kb).compose("FetchMyPen")`` gives a ``CompositionResult`` with the plan or the needs no
-component meets; docs/composition.md explains the algorithm. The names below load their modules on
-first use (the composer brings networkx): a program that only needs, say, a remote component's
-error type does not pay for the planner.
+component meets; docs/composition.md explains the algorithm. ``run_task(kb, task, environment)`` runs a
+task, as ``cbrs run`` and the server's runs do (they are thin layers over it), and gives a ``RunResult``:
+its status, steps, goals and answers (docs/execution.md, "A task run from Python"). The names below load
+their modules on first use (the composer brings networkx): a program that only needs, say, a remote
+component's error type does not pay for the planner.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ if TYPE_CHECKING:
     from cbrs.actions.errors import ActionsError, OrderingConflictError, UnknownTaskError
     from cbrs.actions.model import ActionClass, ActionLibrary, Ordering, Task, resolve_task
     from cbrs.actions.plan import Binding, Plan, PlanStep, Source
+    from cbrs.actions.runner import RunResult, run_task
 
 _HOMES = {
     "cbrs.actions.composer": (
@@ -38,6 +41,7 @@ _HOMES = {
     "cbrs.actions.errors": ("ActionsError", "OrderingConflictError", "UnknownTaskError"),
     "cbrs.actions.model": ("ActionClass", "ActionLibrary", "Ordering", "Task", "resolve_task"),
     "cbrs.actions.plan": ("Binding", "Plan", "PlanStep", "Source"),
+    "cbrs.actions.runner": ("RunResult", "run_task"),
 }
 _WHERE = {name: module for module, names in _HOMES.items() for name in names}
 
@@ -55,11 +59,13 @@ __all__ = [
     "Plan",
     "PlanStatus",
     "PlanStep",
+    "RunResult",
     "Source",
     "Task",
     "UnknownTaskError",
     "Unsatisfied",
     "resolve_task",
+    "run_task",
     "store_plan",
 ]
 

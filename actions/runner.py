@@ -141,6 +141,9 @@ class Answer:
 
 @dataclass(frozen=True)
 class RunResult:
+    """How a run went, as plain data: what a script reads (``succeeded``, ``answers``, ``goals``) and what
+    ``cbrs run --json`` and the server's runs print (``to_dict``), so the three cannot disagree."""
+
     composition: CompositionResult  # the last composition: of the plan that ran last, or the one that failed
     report: ExecutionReport | None  # the last plan's execution; None when there was no plan to run
     replans: tuple[Replan, ...] = ()  # the plans replaced before it, in order
