@@ -350,7 +350,7 @@ def map_bases(kb: KnowledgeBase, facts: Sequence[Mapping[str, Term]] | None = No
 
 def choose_in_map(
     composer: Composer,
-    task: str,
+    task: str | Requirement,
     composition: CompositionResult,
     ties: BaseTies = BaseTies.NEAREST,
     facts: Sequence[Mapping[str, Term]] | None = None,
@@ -358,7 +358,8 @@ def choose_in_map(
     """:func:`choose_base` as a run chooses, by the store alone (no world): the bases from the semantic map
     (:func:`map_bases`; ``facts``, its rows if read already), their components among the advertisements
     ``composer`` composes over; each base's plan composed as ``composition`` was (from the map, not the
-    belief). ``cbrs plan`` and the plans page."""
+    belief). ``cbrs plan``, the plans page, the bridge's /cbrs/plan and the task editor (a draft's
+    ``Requirement``)."""
     kb = composer.kb
     bases = map_bases(kb, facts) if composition.plan is not None else set()
     if len(bases) < 2:

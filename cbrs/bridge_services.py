@@ -5,12 +5,13 @@ Services (request fields -> response values):
 - ``/cbrs/query`` ``{query}`` -> ``{media_type, result}``: SPARQL JSON results for SELECT/ASK, JSON-LD
   for CONSTRUCT/DESCRIBE; read-only, with the endpoint's timeout and size limit.
 - ``/cbrs/match`` ``{requirement, method="sem-str", top=10}`` -> the ranking with explanations.
-- ``/cbrs/plan`` ``{task, objective="similarity"}`` -> the plan (recorded in the plans graph when the
-  caller may write) or what is unsatisfied.
+- ``/cbrs/plan`` ``{task, objective="similarity", base_ties="nearest"}`` -> the plan (recorded in the plans
+  graph when the caller may write) or what is unsatisfied; in a home of several mobile bases the plan works
+  one, chosen as ``cbrs plan`` and a run choose it, and ``base`` says which and why (``BaseChoice.to_dict``).
 
 Each type is defined in ``cbrs/interfaces`` (``srv/Match.srv``, ``msg/Candidate.msg``...), which rosapi's
 details services describe. A ROS client fills every field of a request, an unset one with its type's
-zero value: an empty ``method`` or ``objective`` and a ``top`` of 0 mean the default.
+zero value: an empty ``method``, ``objective`` or ``base_ties`` and a ``top`` of 0 mean the default.
 - ``/cbrs/tasks`` ``{}`` -> ``{tasks}``: every task the store can express, as ``task`` takes it.
 - ``/cbrs/run_task`` ``{task, seed=0, fail=[], fault_rate=0, repeat_failures=1, wait=true}`` -> the run;
   with ``wait`` false it returns at once and the run is followed on the topics, or with
@@ -88,7 +89,7 @@ _RUN = ("task", "seed", "fail", "fault_rate", "repeat_failures")
 FIELDS: dict[str, tuple[str, ...]] = {
     "/cbrs/query": ("query",),
     "/cbrs/match": ("requirement", "method", "top"),
-    "/cbrs/plan": ("task", "objective"),
+    "/cbrs/plan": ("task", "objective", "base_ties"),
     "/cbrs/run_task": (*_RUN, "wait"),
     "/cbrs/tasks": (),
     "/cbrs/task_status": ("run",),
@@ -166,20 +167,30 @@ class KnowledgeServices:
         return result.to_dict(top)
 
     def plan(self, args: dict[str, Any]) -> dict[str, Any]:
-        from cbrs.actions.composer import Objective, store_plan  # the planner loads with the first plan
+        """The task composed as ``cbrs plan`` composes it: in a home of two or more mobile bases, the plan of
+        the base a run would choose (``actions.base_choice.choose_in_map``), and ``base`` says which and why."""
+        from cbrs.actions.base_choice import BaseTies, choose_in_map  # the planner loads with the first plan
+        from cbrs.actions.composer import Objective, store_plan
         from cbrs.task_names import task_iri
 
         task = _field(args, "task", str)
         objective = _field(args, "objective", str, "") or Objective.SIMILARITY.value
         if objective not in {o.value for o in Objective}:
             raise ServiceError(f"objective {objective!r} is not one of {', '.join(o.value for o in Objective)}")
+        ties = _field(args, "base_ties", str, "") or BaseTies.NEAREST.value
+        if ties not in {t.value for t in BaseTies}:
+            raise ServiceError(f"base_ties {ties!r} is not one of {', '.join(t.value for t in BaseTies)}")
         with self.sparql.lock:
             composer = self.composers.get(Objective(objective))
-            result = _call(lambda: composer.compose(task_iri(self.sparql.kb, task)))
+            iri = _call(lambda: task_iri(self.sparql.kb, task))
+            result, chosen = _call(lambda: choose_in_map(composer, iri, composer.compose(iri), BaseTies(ties)))
             recorded = result.plan is not None and not self.sparql.config.read_only and self.may_write()
             if result.plan is not None and recorded:
                 store_plan(self.sparql.kb, result.plan)
-        return {**result.to_dict(), "recorded": recorded}
+        found = {**result.to_dict(), "recorded": recorded}
+        if chosen is not None:  # a home of one mobile base, or none: the answer as before
+            found["base"] = chosen.to_dict()
+        return found
 
     def known_tasks(self, args: dict[str, Any]) -> dict[str, Any]:
         return {"tasks": _call(self.tasks.tasks)}

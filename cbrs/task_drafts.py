@@ -49,6 +49,7 @@ from cbrs.kb.store import EmbeddedStore, Store, data_block
 from cbrs.kb.vocab import CBRS
 
 if TYPE_CHECKING:
+    from cbrs.actions.base_choice import BaseChoice
     from cbrs.actions.composer import Composer, CompositionResult
     from cbrs.kb import KnowledgeBase
     from cbrs.sparql_service import SparqlService
@@ -161,10 +162,13 @@ def read(kb: KnowledgeBase, text: str, prefixes: Mapping[str, str]) -> TaskDraft
     return TaskDraft(text, iri, tuple(parsed.quads), requirement, exists)
 
 
-def plan(composer: Composer, draft: TaskDraft) -> CompositionResult:
-    """The draft composed as ``cbrs plan`` composes a stored task (not recorded); call with the store's
-    lock held, as for any composition."""
-    return composer.compose(draft.requirement)
+def plan(composer: Composer, draft: TaskDraft) -> tuple[CompositionResult, BaseChoice | None]:
+    """The draft composed as ``cbrs plan`` composes a stored task (not recorded): in a home of two or more
+    mobile bases, the plan of the base a run would choose, and that choice (None otherwise:
+    ``actions.base_choice.choose_in_map``). Call with the store's lock held, as for any composition."""
+    from cbrs.actions.base_choice import choose_in_map  # the planner loads with the first plan
+
+    return choose_in_map(composer, draft.requirement, composer.compose(draft.requirement))
 
 
 def save(sparql: SparqlService, draft: TaskDraft, token: str | None, replace: bool = False) -> int:

@@ -86,6 +86,17 @@ class UnknownComponentError(KnowledgeBaseError):
         super().__init__(f"no simulated component {', '.join(names)}")
 
 
+class RunOptionError(KnowledgeBaseError):
+    """A composition option of a run (``objective``, ``base_ties``, ``near_misses``) given a value the run does
+    not take: it names the field, the value and what is allowed, as ``cbrs run`` refuses its options."""
+
+    http_status = 400
+
+    def __init__(self, field: str, value: object, allowed: str) -> None:
+        self.field, self.value = field, value
+        super().__init__(f"{field} {value!r} is not {allowed}")
+
+
 class UnknownRunError(KnowledgeBaseError):
     http_status = 404
 
@@ -111,6 +122,10 @@ class TaskRun:
     error: str | None = None
     done: threading.Event = field(default_factory=threading.Event, repr=False)
     cancel_requested: threading.Event = field(default_factory=threading.Event, repr=False)
+    # the composition options cbrs run takes (--objective, --base-ties, --near-misses), with its defaults
+    objective: str = "similarity"  # actions.composer.Objective
+    base_ties: str = "nearest"  # actions.base_choice.BaseTies
+    near_misses: int = 3  # ComposeConfig.near_misses (TaskRunner.start fills in its default)
 
     def to_dict(self, with_events: bool = True) -> dict[str, Any]:
         found: dict[str, Any] = {
@@ -120,6 +135,9 @@ class TaskRun:
             "faults": list(self.faults),
             "fault_rate": self.fault_rate,
             "repeat_failures": self.repeat_failures,
+            "objective": self.objective,
+            "base_ties": self.base_ties,
+            "near_misses": self.near_misses,
             "iri": self.iri,
             "status": self.status,
             "started": self.started,
@@ -242,6 +260,9 @@ class TaskRunner:
         faults: Iterable[str] = (),
         fault_rate: float = 0.0,
         repeat_failures: int = 1,
+        objective: str = "similarity",
+        base_ties: str = "nearest",
+        near_misses: int | None = None,
     ) -> TaskRun:
         """Check ``task`` and ``faults``, then run the task in the background; returns at once.
 
@@ -249,7 +270,9 @@ class TaskRunner:
         name, a prefixed name or an IRI); an unknown one fails with a did-you-mean (``TaskNameError``).
         ``fault_rate`` breaks each component with that probability at a random moment, seeded by ``seed``.
         ``repeat_failures`` bounds how often a re-plan may meet the same failure with nothing changed
-        (``ReplanPolicy.max_repeats``).
+        (``ReplanPolicy.max_repeats``). ``objective``, ``base_ties`` and ``near_misses`` compose as ``cbrs run
+        --objective --base-ties --near-misses`` do (None: ``ComposeConfig.near_misses``); a value it does not
+        take fails with :class:`RunOptionError`.
         """
         if self.read_only:
             raise TasksDisabledError()
@@ -261,6 +284,7 @@ class TaskRunner:
 
         RandomFaults(seed, fault_rate)  # an impossible rate fails here (FaultSpecError), not in the thread
         ReplanPolicy(max_repeats=repeat_failures)  # so does a negative bound (ReplanPolicyError)
+        near_misses = _check_options(objective, base_ties, near_misses)
         failing = tuple(expand(f) for f in faults)
         _check_components(self.kb, failing)
         self._refuse_if_busy()  # a second run is refused before its task is checked
@@ -271,6 +295,7 @@ class TaskRunner:
         with self._guard:
             self._refuse_if_busy()
             run = TaskRun(f"run-{next(self._ids)}", task, seed, failing, fault_rate, repeat_failures, iri)
+            run.objective, run.base_ties, run.near_misses = objective, base_ties, near_misses
             thread = threading.Thread(target=self._run, args=(run,), name=f"cbrs-{run.id}", daemon=True)
             self._active = (run, thread)
             self._runs[run.id] = run
@@ -293,9 +318,11 @@ class TaskRunner:
         timeout: float = 300.0,
         fault_rate: float = 0.0,
         repeat_failures: int = 1,
+        **options: Any,
     ) -> TaskRun:
-        """Start ``task`` and wait (at most ``timeout`` seconds) until it ends."""
-        run = self.start(task, seed, faults, fault_rate, repeat_failures)
+        """Start ``task`` and wait (at most ``timeout`` seconds) until it ends; ``options``: the composition
+        options :meth:`start` takes."""
+        run = self.start(task, seed, faults, fault_rate, repeat_failures, **options)
         run.done.wait(timeout)
         return run
 
@@ -328,7 +355,7 @@ class TaskRunner:
             self._run_named(run)
 
     def _run_named(self, run: TaskRun) -> None:
-        from cbrs.actions.composer import Composer
+        from cbrs.actions.composer import ComposeConfig, Composer, Objective
         from cbrs.kb.semantic_map import SemanticMap
 
         try:
@@ -336,7 +363,8 @@ class TaskRunner:
             # land half-way); the run itself only writes its plan and the world graph, one transaction
             # each, so matchmaking, plans and queries go on while the robot moves.
             with self.lock:
-                composer = Composer(self.kb)
+                config = ComposeConfig(objective=Objective(run.objective), near_misses=run.near_misses)
+                composer = Composer(self.kb, config)
                 _ = composer.pool  # built now, under the lock
                 semantic_map = SemanticMap.read(self.kb)
             transport = self.transport() if self.transport else None
@@ -363,6 +391,7 @@ class TaskRunner:
     ) -> tuple[RunResult, dict[str, Any]]:
         """Run ``run`` in a fresh world built from ``semantic_map``: its result, and that as JSON with the
         simulated seconds."""
+        from cbrs.actions.base_choice import BaseTies
         from cbrs.actions.faults import RandomFaults
         from cbrs.actions.replanning import ReplanPolicy
         from cbrs.sim.components import SimEnvironment  # pybullet loads only when a task runs
@@ -389,6 +418,7 @@ class TaskRunner:
                 fault_policy=policy,
                 cancelled=run.cancel_requested.is_set,
                 replan_policy=ReplanPolicy(max_repeats=run.repeat_failures),
+                base_ties=BaseTies(run.base_ties),
             )
             found = result.to_dict()
             found["sim_seconds"] = round(world.time, 3)
@@ -518,6 +548,23 @@ def _jpeg(rgb: Any) -> bytes:
     buffer = io.BytesIO()
     Image.fromarray(rgb).save(buffer, "JPEG", quality=JPEG_QUALITY)
     return buffer.getvalue()
+
+
+def _check_options(objective: str, base_ties: str, near_misses: int | None) -> int:
+    """The composition options checked as ``cbrs run`` checks its own (:class:`RunOptionError` naming the
+    one at fault); returns ``near_misses``, ``ComposeConfig``'s default for None."""
+    from cbrs.actions.base_choice import BaseTies
+    from cbrs.actions.composer import ComposeConfig, Objective
+
+    for name, value, kind in (("objective", objective, Objective), ("base_ties", base_ties, BaseTies)):
+        allowed = [member.value for member in kind]
+        if value not in allowed:
+            raise RunOptionError(name, value, "one of " + ", ".join(allowed))
+    if near_misses is None:
+        return ComposeConfig().near_misses
+    if isinstance(near_misses, bool) or not isinstance(near_misses, int) or near_misses < 0:
+        raise RunOptionError("near_misses", near_misses, "a whole number, 0 or more")
+    return near_misses
 
 
 def _check_components(kb: KnowledgeBase, failing: tuple[str, ...]) -> None:

@@ -159,7 +159,7 @@ def _planned(shown: Page, draft: TaskDraft) -> None:
         from cbrs.actions.composer import Objective
 
         composer = context.composers().get(Objective(objective))
-        result = task_drafts.plan(composer, draft)
+        result, base = task_drafts.plan(composer, draft)  # several mobile bases: the one a run would choose
         kept: dict[str, CompositionResult] = context.per_generation("draft_compositions", dict)
     key = hashlib.sha256(draft.text.encode("utf-8")).hexdigest()[:16]
     kept.pop(key, None)
@@ -169,6 +169,7 @@ def _planned(shown: Page, draft: TaskDraft) -> None:
     composition = _composition(result)
     shown.title = f"New task: {short(draft.iri)}, {composition['status']}"
     shown.data["composition"] = composition
+    shown.data["base"] = base.to_dict() if base is not None else None  # as the plans page says it
     shown.data["undeclared"] = [
         {"term": shorten(term), "line": task_drafts.line_of(draft.text, shorten(term))}
         for u in result.unsatisfied

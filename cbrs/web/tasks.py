@@ -27,7 +27,14 @@ from werkzeug.exceptions import BadRequest, Forbidden, NotFound, ServiceUnavaila
 from cbrs.actions.errors import UnknownTaskError
 from cbrs.kb.namespaces import PREFIXES, written
 from cbrs.kb.owls import local_name
-from cbrs.tasks import CameraFrame, TaskBusyError, TaskRun, TasksDisabledError, UnknownComponentError
+from cbrs.tasks import (
+    CameraFrame,
+    RunOptionError,
+    TaskBusyError,
+    TaskRun,
+    TasksDisabledError,
+    UnknownComponentError,
+)
 from cbrs.web import context
 from cbrs.web.links import expand_name, short
 from cbrs.web.pages import FormError, Page, page, wants_json
@@ -73,6 +80,8 @@ def tasks() -> Page:
         raise FormError({"task": str(error)}, page=shown) from None
     except UnknownComponentError as error:
         raise FormError({"fail": str(error)}, page=shown) from None
+    except RunOptionError as error:
+        raise FormError({error.field: str(error)}, page=shown) from None
     except TaskBusyError as error:
         shown.status = 409
         shown.data.update(error="busy", message=str(error), running=error.running)
@@ -141,7 +150,8 @@ def _check_asked(form: dict[str, Any], shown: Page) -> None:
         shown.data["form"] = {**shown.data["form"], "task": listed}
 
 
-RUN_FIELDS = ("task", "seed", "fail", "fault_rate", "repeat_failures")
+#: With the composition options cbrs run takes (--objective, --base-ties, --near-misses; TaskRunner.start checks them)
+RUN_FIELDS = ("task", "seed", "fail", "fault_rate", "repeat_failures", "objective", "base_ties", "near_misses")
 
 
 def _form() -> dict[str, Any]:
@@ -154,6 +164,9 @@ def _form() -> dict[str, Any]:
             "fail": [str(f) for f in (fail if isinstance(fail, list) else [fail])],
             "fault_rate": str(body.get("fault_rate", 0)),
             "repeat_failures": str(body.get("repeat_failures", 1)),
+            "objective": str(body.get("objective", "similarity")),
+            "base_ties": str(body.get("base_ties", "nearest")),
+            "near_misses": "" if body.get("near_misses") is None else str(body["near_misses"]),
         }
     values = request.form if request.method == "POST" else request.args
     return {
@@ -162,6 +175,9 @@ def _form() -> dict[str, Any]:
         "fail": [f.strip() for f in values.getlist("fail") if f.strip()],
         "fault_rate": values.get("fault_rate", "0").strip(),
         "repeat_failures": values.get("repeat_failures", "1").strip(),
+        "objective": values.get("objective", "").strip() or "similarity",
+        "base_ties": values.get("base_ties", "").strip() or "nearest",
+        "near_misses": values.get("near_misses", "").strip(),
     }
 
 
@@ -212,6 +228,13 @@ def _checked(form: dict[str, Any], shown: Page) -> dict[str, Any]:
         errors["repeat_failures"] = f"{form['repeat_failures']!r} is not a whole number"
     if repeats < 0:
         errors["repeat_failures"] = f"{form['repeat_failures']!r} is negative: a number of repeats is 0 or more"
+    near_misses = None  # ComposeConfig's default; objective and base_ties are checked by TaskRunner.start
+    try:
+        near_misses = int(form["near_misses"]) if form["near_misses"] else None
+    except ValueError:
+        errors["near_misses"] = f"{form['near_misses']!r} is not a whole number"
+    if near_misses is not None and near_misses < 0:
+        errors["near_misses"] = f"{form['near_misses']!r} is negative: a number of near misses is 0 or more"
     if errors:
         raise FormError(errors, page=shown)
     return {
@@ -220,6 +243,9 @@ def _checked(form: dict[str, Any], shown: Page) -> dict[str, Any]:
         "faults": faults,
         "fault_rate": fault_rate,
         "repeat_failures": repeats,
+        "objective": form["objective"],
+        "base_ties": form["base_ties"],
+        "near_misses": near_misses,
     }
 
 
