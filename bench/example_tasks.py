@@ -167,6 +167,7 @@ def _trial(path: Path, row: dict[str, Any]) -> Trial:
             list(r["status"]),
             [float(s) for s in r["seconds"]],
             tuple(_step(label, b) for b in r.get("before", [])),
+            (float(r["between"][0]), float(r["between"][1])) if "between" in r else None,
         )
         for r in raw_runs
     ]

@@ -96,3 +96,14 @@ def test_a_stale_substitution_and_an_unknown_status_are_refused(bench: ModuleTyp
     step = bench.Step("map", "water_bottle.ttl", (("no such text in the file", "x"),))
     with pytest.raises(RuntimeError, match="not in the file"):
         bench._edited(step, tmp_path)
+
+
+def test_a_range_the_docs_give_is_read_and_compared(bench: ModuleType) -> None:
+    _, trials = bench.read_trials(DATA)
+    ranged = [run for trial in trials for run in trial.runs if run.between is not None]
+    assert ranged, "no trial of the data gives a range"
+    low, high = ranged[0].between
+    inside = bench.Outcome("x", "T", 0, "succeeded", 0.0, "succeeded", (low + high) / 2, 1.0, "", "", (low, high))
+    outside = bench.Outcome("x", "T", 0, "succeeded", 0.0, "succeeded", high + 1.0, 1.0, "", "", (low, high))
+    assert bench.deviation(inside, 0.2) == ""
+    assert "the docs say" in bench.deviation(outside, 0.2)
