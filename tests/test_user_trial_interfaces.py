@@ -343,7 +343,8 @@ def test_a_run_asked_for_in_json_refuses_a_body_it_cannot_read(client: FlaskClie
     misspelt = post(data=json.dumps({"task": "PersonWhereabouts", "sed": 3}))
     assert misspelt.status_code == 400
     assert misspelt.get_json()["fields"] == {
-        "sed": "no such field; did you mean 'seed'? a run takes task, seed, fail, fault_rate, repeat_failures"
+        "sed": "no such field; did you mean 'seed'? a run takes task, seed, fail, fault_rate, repeat_failures,"
+        " objective, base_ties, near_misses"
     }
     assert client.get("/tasks.json").get_json()["runs"] == []  # nothing started
 
