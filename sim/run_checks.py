@@ -27,7 +27,7 @@ from cbrs.kb.person_choice import person_for
 from cbrs.kb.semantic_map import MapObject, NotGraspableError, Person, Thing, local_name
 from cbrs.kb.store import Term
 from cbrs.sim import sight, skills
-from cbrs.sim.arm_choice import TAKING, check_take, who_loads
+from cbrs.sim.arm_choice import TAKING, check_take, lying_estimate, who_loads
 from cbrs.sim.context import SimContext, SkillFailed
 from cbrs.sim.errors import GraspTooDeepError, GraspTooThinError, GraspTooWideError, MovesRefusedError
 from cbrs.sim.geometry import Pose2D
@@ -264,14 +264,6 @@ class PlanChecks:
         self._check_loading(plan, values)
         self._check_docks(plan, values, ads)
 
-    def _estimate(self, obj: MapObject, support: Thing) -> ObjectEstimate:
-        """Where the plan's checks take an object to be: where it is believed to be, else where the map
-        puts it on its support, lying as the map says (as perception gives it: the yaw of its long axis)."""
-        believed = self.belief.position(obj.name)
-        centre = believed or (obj.start.x, obj.start.y, support.box.max_z + obj.size[2] / 2)
-        axis = obj.start.yaw + (math.pi / 2.0 if obj.size[1] > obj.size[0] else 0.0)
-        return ObjectEstimate(centre[0], centre[1], centre[2], axis, obj.size, obj.colour, "map", 0.0, 0)
-
     def _check_loading(self, plan: Plan, values: Mapping[str, Any]) -> None:
         """Refuse a plan that hands an object the task gives over onto the base's platform when no arm
         can load it there (by the map: the object where it is believed to be, the base at the docking
@@ -279,7 +271,11 @@ class PlanChecks:
         for step, obj, support in self._given_objects(plan, values, "HandingOverOntoPlatform"):
             if support.dock is None:
                 continue
-            estimate, model, dock = self._estimate(obj, support), Manipulation.of(obj).model, docking_pose(support)
+            estimate, model, dock = (
+                lying_estimate(self.world, self.belief, obj),
+                Manipulation.of(obj).model,
+                docking_pose(support),
+            )
             try:
                 who_loads(self.context, estimate, model, dock)
             except (SkillFailed, MovesRefusedError) as refused:
@@ -290,8 +286,10 @@ class PlanChecks:
         """Refuse a plan whose arm would take an object the task gives to carry it where the object held
         would meet an appliance on the way, by every arm and approach the step would choose from
         (:func:`arm_choice.check_take`: :class:`arm_choice.CannotCarryError`), before anything moves."""
-        for step, obj, support in self._given_objects(plan, values, "ApproachToObject"):
-            check_take(self.context, step, obj.iri, self._estimate(obj, support), Manipulation.of(obj).model)
+        for step, obj, _support in self._given_objects(plan, values, "ApproachToObject"):
+            check_take(
+                self.context, step, obj.iri, lying_estimate(self.world, self.belief, obj), Manipulation.of(obj).model
+            )
 
     def _given_objects(
         self, plan: Plan, values: Mapping[str, Any], action: str
