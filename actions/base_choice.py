@@ -6,6 +6,9 @@ one base). The map says which components are whose base (:func:`base_groups`: th
 device is the base); the task is then composed once per base, the other bases' components left out, and
 the best plan is taken: the least cost, then the greatest similarity, then (``BaseTies.NEAREST``) the base
 with the least to drive to where its plan first takes it (:class:`MapDrives`), then the first base by IRI.
+The cost is the advertised response time; under ``--objective cost``, when every step of every plan names
+a component that states a ``cbrs:cost``, the plans' summed stated cost comes first (:class:`StatedCosts`),
+as the composition ranked each step's candidates.
 A task whose requirement names one of the bases is composed for that base alone: requested by it
 (``cbrs:requestedBy``), else an input of the task designating it (:func:`named_base`). A home of one base
 or none composes as before. ``cbrs run`` chooses so (``actions.runner``), and ``cbrs plan`` and the plans
@@ -20,7 +23,8 @@ from dataclasses import dataclass, replace
 from enum import Enum
 from typing import Any
 
-from cbrs.actions.composer import Composer, CompositionResult
+from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, Objective
+from cbrs.actions.graph import _stated_cost as stated_cost  # one reading of cbrs:cost, the composer's
 from cbrs.actions.plan import Plan, PlanStep
 from cbrs.kb import Advertisement, KnowledgeBase, NotFoundError, Requirement
 from cbrs.kb.namespaces import HOME, PREFIXES
@@ -38,12 +42,14 @@ __all__ = [
     "BaseTies",
     "FirstDrive",
     "MapDrives",
+    "StatedCosts",
     "base_groups",
     "choose_base",
     "choose_in_map",
     "map_bases",
     "named_base",
     "on_behalf",
+    "stated_costs",
 ]
 
 _NEAR = HOME + "isNear"  # a drive's effect: the robot comes near a place, an object or a person
@@ -101,6 +107,24 @@ class BaseChoice:
 Drive = Callable[[str, CompositionResult], FirstDrive | None]
 """A base's first drive in its own plan (``MapDrives``), None when it drives to nothing the map places."""
 
+StatedCosts = Mapping[str, float | None]
+"""Each component's stated ``cbrs:cost`` (None: it states none), given to :func:`choose_base` under
+``--objective cost`` (:func:`stated_costs`); no mapping: the objective is similarity."""
+
+
+def stated_costs(config: ComposeConfig, advertisements: Iterable[Advertisement]) -> StatedCosts | None:
+    """The stated ``cbrs:cost`` of each of ``advertisements`` as ``config`` reads it (its
+    ``unstated_cost`` for one that states none), or None when ``config`` ranks by similarity."""
+    if config.objective is not Objective.COST:
+        return None
+    return {ad.iri: stated_cost(ad, config.unstated_cost) for ad in advertisements}
+
+
+def _summed(plan: Plan, stated: StatedCosts) -> float | None:
+    """``plan``'s stated cost: the sum over its steps, None when a step's component states none."""
+    costs = [stated.get(step.component) for step in plan.steps]
+    return None if any(cost is None for cost in costs) else round(sum(c for c in costs if c is not None), 9)
+
 
 def choose_base(
     compose: Callable[[frozenset[str]], CompositionResult],
@@ -109,14 +133,17 @@ def choose_base(
     named: str | None = None,
     drive: Drive | None = None,
     ties: BaseTies = BaseTies.NEAREST,
+    stated: StatedCosts | None = None,
 ) -> tuple[CompositionResult, BaseChoice | None]:
     """``composition`` (composed over every component) kept, or replaced by the best one-base composition.
 
     ``compose`` composes the task without the components it is given; ``groups`` maps each base's IRI to
     its own components; ``named``: the base an input of the task designates, if one does; ``drive``
     measures a base's first drive, asked only of plans that cost alike and match alike (with ``ties``
-    NEAREST). Nothing changes (None) with fewer than two bases, for no plan (none over a part of the
-    components either), and for a plan that no base's component could run (the arms' alone)."""
+    NEAREST); ``stated``: the components' stated costs under ``--objective cost`` (:func:`stated_costs`),
+    whose sum over a plan's steps ranks the plans first when every plan's every step states one. Nothing
+    changes (None) with fewer than two bases, for no plan (none over a part of the components either), and
+    for a plan that no base's component could run (the arms' alone)."""
     plan = composition.plan
     if len(groups) < 2 or plan is None:
         return composition, None
@@ -141,15 +168,39 @@ def choose_base(
             else "no one base's components make a plan (the plan over every component mixed them: a run drives one)"
         )
         return tried[first], BaseChoice(first, why, every - groups[first], "none")
-    ranked = sorted(planned, key=lambda base: _rank(planned[base], base))
+    sums = {base: _summed(plan, stated) for base, plan in planned.items()} if stated is not None else {}
+    summed = {base: s for base, s in sums.items() if s is not None} if len(sums) > 1 else {}
+    rank = _Rank(summed if len(summed) == len(sums) else {}, stated is not None)
+    ranked = sorted(planned, key=lambda base: rank(planned[base], base))
     if said:
         return tried[ranked[0]], BaseChoice(ranked[0], said, every - groups[ranked[0]], rule)
-    best, why, rule, drives = _decide(ranked, planned, tried, bases, drive if ties is BaseTies.NEAREST else None)
+    near = drive if ties is BaseTies.NEAREST else None
+    best, why, rule, drives = _decide(ranked, planned, tried, bases, near, rank)
+    why += rank.unstated() if rule != "only" else ""
     return tried[best], BaseChoice(best, why, every - groups[best], rule, drives)
 
 
-def _rank(plan: Plan, base: str) -> tuple[float, float, str]:
-    return (plan.cost, -plan.similarity, base)
+@dataclass(frozen=True)
+class _Rank:
+    """How the bases' plans are ranked, lowest first: by ``summed`` stated cost (each base's, when every
+    plan's every step states one: a unitless figure is compared only with its like), then advertised
+    response time, then similarity, then IRI. ``objective_cost``: ``--objective cost`` was asked for."""
+
+    summed: Mapping[str, float]
+    objective_cost: bool
+
+    def __call__(self, plan: Plan, base: str) -> tuple[Any, ...]:
+        head = (self.summed[base],) if self.summed else ()
+        return (*head, plan.cost, -plan.similarity, base)
+
+    def alike(self, plan: Plan, base: str, other: Plan, other_base: str) -> bool:
+        return self(plan, base)[:-1] == self(other, other_base)[:-1]
+
+    def unstated(self) -> str:
+        """Why the stated cost did not rank, said under ``--objective cost``."""
+        if not self.objective_cost or self.summed:
+            return ""
+        return " (objective cost: not every step of the plans states a cbrs:cost, so response time ranks)"
 
 
 def _decide(
@@ -158,6 +209,7 @@ def _decide(
     tried: Mapping[str, CompositionResult],
     bases: list[str],
     drive: Drive | None,
+    rank: _Rank,
 ) -> tuple[str, str, str, tuple[tuple[str, FirstDrive | None], ...]]:
     """The base, why, the rule that decided, and the first drives compared (if they were)."""
     best = ranked[0]
@@ -166,22 +218,32 @@ def _decide(
         return best, f"only {_local(best)}'s components make a plan ({others}: none)", "only", ()
     second = ranked[1]
     mine, theirs = planned[best], planned[second]
+    if rank.summed and rank.summed[best] != rank.summed[second]:
+        why = (
+            f"objective cost: its plan's stated cbrs:cost is the least: {rank.summed[best]:.3g} summed over its "
+            f"{len(mine.steps)} steps, {_local(second)}'s {rank.summed[second]:.3g}"
+        )
+        return best, why, "stated-cost", ()
+    alike_stated = f"the plans' stated cbrs:cost is alike ({rank.summed[best]:.3g}); " if rank.summed else ""
     if mine.cost != theirs.cost:
         why = (
-            f"its plan costs the least: {mine.cost:.3g} s of advertised response time, "
+            f"{alike_stated}its plan costs the least: {mine.cost:.3g} s of advertised response time, "
             f"{_local(second)}'s {theirs.cost:.3g} s"
         )
         return best, why, "cost", ()
     if mine.similarity != theirs.similarity:
         why = (
-            f"the plans cost alike ({mine.cost:.3g} s); its similarity is the greater: {mine.similarity:.3f}, "
-            f"{_local(second)}'s {theirs.similarity:.3f}"
+            f"{alike_stated}the plans cost alike ({mine.cost:.3g} s); its similarity is the greater: "
+            f"{mine.similarity:.3f}, {_local(second)}'s {theirs.similarity:.3f}"
         )
         return best, why, "similarity", ()
-    alike = f"its plan and {_local(second)}'s cost alike ({mine.cost:g} s) and match alike ({mine.similarity:.3f})"
+    alike = (
+        f"{alike_stated}its plan and {_local(second)}'s cost alike ({mine.cost:g} s) "
+        f"and match alike ({mine.similarity:.3f})"
+    )
     if drive is None:
         return best, f"{alike}: the first base by IRI", "iri", ()
-    tied = [base for base in ranked if _rank(planned[base], "") == _rank(mine, "")]
+    tied = [base for base in ranked if rank.alike(planned[base], base, mine, best)]
     drives = tuple((base, drive(base, tried[base])) for base in tied)
     unknown = [base for base, found in drives if found is None]
     if unknown:
@@ -197,7 +259,8 @@ def _decide(
     assert found is not None
     towards = ", ".join(_local(thing) for thing in found.towards)
     why = (
-        f"its plan and {_local(runner_up)}'s cost alike ({mine.cost:g} s) and match alike ({mine.similarity:.3f});"
+        f"{alike_stated}its plan and {_local(runner_up)}'s cost alike ({mine.cost:g} s) "
+        f"and match alike ({mine.similarity:.3f});"
         f" it has the least to drive: {near:.2f} m from where it stands in the map to {towards}, where its first"
         f" drive ({_local(found.component)}) goes, {_local(runner_up)}'s {next_near:.2f} m"
     )
@@ -372,4 +435,5 @@ def choose_in_map(
         return one.compose(task)
 
     named = named_base(kb, composition, groups)
-    return choose_base(compose, composition, groups, named, MapDrives(kb, groups), ties)
+    stated = stated_costs(composer.config, composer.advertisements)
+    return choose_base(compose, composition, groups, named, MapDrives(kb, groups), ties, stated)

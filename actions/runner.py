@@ -14,7 +14,15 @@ from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import Any, Protocol
 
-from cbrs.actions.base_choice import BaseChoice, BaseTies, MapDrives, choose_base, named_base, on_behalf
+from cbrs.actions.base_choice import (
+    BaseChoice,
+    BaseTies,
+    MapDrives,
+    choose_base,
+    named_base,
+    on_behalf,
+    stated_costs,
+)
 from cbrs.actions.belief import BeliefState, Observation
 from cbrs.actions.components import Container, Registry
 from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, Objective, PlanStatus, store_plan
@@ -739,8 +747,9 @@ def _one_base(
         return composition, None
     named = named_base(kb, composition, groups)
     drives = MapDrives(kb, groups)  # the map is read only if two plans cost alike and match alike
+    stated = stated_costs(config, kb.advertisements()) if config.objective is Objective.COST else None
     found, chosen = choose_base(
-        lambda without: _compose(kb, config, task, avoid | without), composition, groups, named, drives, ties
+        lambda without: _compose(kb, config, task, avoid | without), composition, groups, named, drives, ties, stated
     )
     if chosen is not None:
         message = {"event": "base_chosen", "base": chosen.base, "why": chosen.why, "rule": chosen.rule}
