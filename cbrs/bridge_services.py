@@ -13,18 +13,24 @@ Each type is defined in ``cbrs/interfaces`` (``srv/Match.srv``, ``msg/Candidate.
 details services describe. A ROS client fills every field of a request, an unset one with its type's
 zero value: an empty ``method``, ``objective`` or ``base_ties`` and a ``top`` of 0 mean the default.
 - ``/cbrs/tasks`` ``{}`` -> ``{tasks}``: every task the store can express, as ``task`` takes it.
-- ``/cbrs/run_task`` ``{task, seed=0, fail=[], fault_rate=0, repeat_failures=1, wait=true}`` -> the run;
+- ``/cbrs/run_task`` ``{task, seed=0, fail=[], fault_rate=0, repeat_failures=1, objective="similarity",
+  base_ties="nearest", near_misses=3, wait=true}`` -> the run;
   with ``wait`` false it returns at once and the run is followed on the topics, or with
   ``/cbrs/task_status`` ``{run}``; with ``wait`` it answers when the run ends or, at the latest, two
   seconds before the bridge's call timeout, with the run as it is then (``running``). ``task`` is any
   requirement or action of the store, named as ``cbrs run`` takes it; ``repeat_failures`` as
-  ``cbrs run --repeat-failures``. Its ``result`` holds ``answers``: the values of the outputs the task asks
-  for (a room's temperature), with the component that gave each (docs/execution.md, "Answers").
+  ``cbrs run --repeat-failures``; ``objective``, ``base_ties`` and ``near_misses`` as ``cbrs run
+  --objective --base-ties --near-misses``, checked by ``TaskRunner.start`` as ``POST /tasks`` checks them:
+  an empty ``objective`` or ``base_ties`` and a ``near_misses`` of -1 (what a ROS client sends for "not
+  given"; its zero, 0, asks for none) mean ``cbrs run``'s default. Its ``result`` holds ``answers``: the
+  values of the outputs the task asks for (a room's temperature), with the component that gave each
+  (docs/execution.md, "Answers").
 
 Action (rosbridge's ROS 2 action ops, ``send_action_goal`` and the rest):
 
 - ``/cbrs/run_task`` (type ``cbrs/action/RunTask``), goal ``{task, seed=0, fail=[], fault_rate=0,
-  repeat_failures=1}``:
+  repeat_failures=1, objective="similarity", base_ties="nearest", near_misses=3}`` (read as the service
+  reads them):
   one feedback ``{run, plan, step, action, component, status, reason, failover}`` per plan step that
   ends (``status`` succeeded or failed); the result is the run as the service returns it, with status
   SUCCEEDED, CANCELED (the client cancelled: the run stops after the step under way) or ABORTED (the
@@ -85,7 +91,11 @@ GOAL_STATUS = {"succeeded": GoalStatus.SUCCEEDED, "cancelled": GoalStatus.CANCEL
 
 #: The fields each service (and the run_task action's goal) reads. Another is refused, as rosbridge refuses
 #: a field its message type lacks: a misspelt optional one ("metod") was ignored and the default used.
-_RUN = ("task", "seed", "fail", "fault_rate", "repeat_failures")
+_RUN = ("task", "seed", "fail", "fault_rate", "repeat_failures", "objective", "base_ties", "near_misses")
+
+#: How a request says "not given" for a run's composition option (a ROS client fills every field): the
+#: option is left to ``TaskRunner.start``'s default, ``cbrs run``'s. 0 near misses is a value (none).
+_UNSET: dict[str, tuple[object, ...]] = {"objective": (None, ""), "base_ties": (None, ""), "near_misses": (None, -1)}
 FIELDS: dict[str, tuple[str, ...]] = {
     "/cbrs/query": ("query",),
     "/cbrs/match": ("requirement", "method", "top"),
@@ -229,8 +239,9 @@ class KnowledgeServices:
         return GoalResult(GOAL_STATUS.get(run.status, GoalStatus.ABORTED), run.to_dict(with_events=False))
 
     def _run_request(self, args: dict[str, Any]) -> dict[str, Any]:
-        """A run's task, seed, failing components, fault rate and repeat bound, checked, from a client
-        that may write: the keywords of ``TaskRunner.start``."""
+        """A run's task, seed, failing components, fault rate, repeat bound and composition options, checked,
+        from a client that may write: the keywords of ``TaskRunner.start``. The options go to it as given
+        (but those :data:`_UNSET`), so a bad one is refused with the words ``POST /tasks`` refuses it with."""
         task = _field(args, "task", str)
         seed = _field(args, "seed", int, 0)
         faults = _field(args, "fail", list, [])
@@ -245,7 +256,9 @@ class KnowledgeServices:
                 "a task run moves the robot and writes the store: send the update token first "
                 '({"op": "auth", "mac": "<token>"}), or start it from this server\'s tasks page'
             )
-        return {"task": task, "seed": seed, "faults": faults, "fault_rate": float(rate), "repeat_failures": repeats}
+        options = {name: args[name] for name, unset in _UNSET.items() if name in args and _given(args[name], unset)}
+        found = {"task": task, "seed": seed, "faults": faults, "fault_rate": float(rate), "repeat_failures": repeats}
+        return {**found, **options}
 
     def task_status(self, args: dict[str, Any]) -> dict[str, Any]:
         run_id = _field(args, "run", str)
@@ -380,6 +393,12 @@ def _field(args: dict[str, Any], name: str, kind: type, default: Any = ...) -> A
     if (kind is int and isinstance(value, bool)) or not isinstance(value, kind):
         raise ServiceError(f"field {name!r} must be {kind.__name__}, not {type(value).__name__}")
     return value
+
+
+def _given(value: object, unset: tuple[object, ...]) -> bool:
+    """Whether ``value`` is given, not one of the ``unset`` values (of the same type: -1.0 or True is given,
+    and refused as such)."""
+    return not any(value is u or (type(value) is type(u) and value == u) for u in unset)
 
 
 def _known_fields(service: str, fields: tuple[str, ...], handler: Handler) -> Handler:
