@@ -12,6 +12,7 @@ the camera stream when a run starts.
 from __future__ import annotations
 
 import difflib
+import functools
 import hmac
 import json
 import queue
@@ -319,12 +320,28 @@ def _overview(form: dict[str, Any]) -> dict[str, Any]:
         form = {**form, "task": _first_choice(offered, latest)}
     return {
         "form": form,
+        "options": run_options(),
         "tasks": offered["tasks"],
         "labels": offered["labels"],
         "components": offered["components"],
         "active": _detail(latest) if latest is not None else None,
         "runs": [_summary(r) for r in reversed(runs)],
         **_live(),
+    }
+
+
+@functools.cache
+def run_options() -> dict[str, Any]:
+    """What the start form offers for the composition options ``cbrs run`` takes: the objectives and the
+    base ties by name, the CLI's default first, and ``ComposeConfig``'s number of near misses."""
+    from cbrs.actions.base_choice import BaseTies  # the planner loads with the first use
+    from cbrs.actions.composer import ComposeConfig, Objective
+
+    defaults = ComposeConfig()
+    return {
+        "objectives": [defaults.objective.value, *(o.value for o in Objective if o is not defaults.objective)],
+        "base_ties": [BaseTies.NEAREST.value, *(t.value for t in BaseTies if t is not BaseTies.NEAREST)],
+        "near_misses": defaults.near_misses,
     }
 
 
