@@ -24,7 +24,7 @@ from enum import Enum
 from typing import Any
 
 from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, Objective
-from cbrs.actions.graph import _stated_cost as stated_cost  # one reading of cbrs:cost, the composer's
+from cbrs.actions.graph import stated_cost  # one reading of cbrs:cost, the composer's
 from cbrs.actions.plan import Plan, PlanStep
 from cbrs.kb import Advertisement, KnowledgeBase, NotFoundError, Requirement
 from cbrs.kb.namespaces import HOME, PREFIXES

@@ -178,7 +178,7 @@ class ServicePool:
                 tuple(_offers(ad.outputs, ad.effects)),
                 _cost(ad, default_cost),
                 ad,
-                _stated_cost(ad, unstated_cost),
+                stated_cost(ad, unstated_cost),
             )
             for ad in advertisements
         }
@@ -365,7 +365,7 @@ def _cost(ad: Advertisement, default: float) -> float:
     return default
 
 
-def _stated_cost(ad: Advertisement, default: float | None) -> float | None:
+def stated_cost(ad: Advertisement, default: float | None = None) -> float | None:
     """The advertised ``cbrs:cost`` (core.ttl: lower is better, no unit), which ``--objective cost`` ranks
     by; ``default`` for a component that states none. Kept apart from the response time: a figure
     without a unit cannot be added to seconds (docs/composition.md, "Which cost")."""
