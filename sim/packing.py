@@ -18,7 +18,7 @@ from __future__ import annotations
 import logging
 import math
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 from cbrs.actions.plan import Plan, PlanStep
@@ -64,9 +64,14 @@ class PackingRule:
 
     order: str = "largest"
     toward: str = "rim"
-    footprint: str = "box"
+    footprint: str = "auto"
     """``box``: each thing covers its box (:class:`Footprint`) turned as the set-down leaves it; ``circle``:
-    the circle about its diagonal, as :func:`place_spots` keeps one thing alone (the packing's first form)."""
+    the circle about its diagonal, as :func:`place_spots` keeps one thing alone (the packing's first form);
+    ``auto``: circles where circles hold them all, else boxes. Circles ask nothing of the turn a thing
+    comes to rest at, which a carry does not set (the hand keeps the turn it took the thing by, give or
+    take how it slipped), so they are the safer where they fit; boxes fit what circles refuse (two long
+    things side by side on a narrow shelf). Boxes everywhere moved the cup of PenThenCupAway so that
+    the pen's carry stopped 4 cm short of its spot (docs/simulation.md, "Footprints")."""
 
     def __post_init__(self) -> None:
         if self.order not in ("largest", "plan") or self.toward not in ("rim", "centre"):
@@ -78,7 +83,7 @@ class PackingRule:
             raise ValueError(f"a packing rule's footprint is one of {', '.join(FOOTPRINTS)}, not {self.footprint!r}")
 
 
-FOOTPRINTS = ("box", "circle")
+FOOTPRINTS = ("auto", "box", "circle")
 """The footprints a :class:`PackingRule` may pack (docs/simulation.md, "Footprints")."""
 
 
@@ -602,8 +607,12 @@ def carry_spots(
     surface, _ = support_of(smap, place)
     holds = _HoldAsked(ctx, coming, surface)
     sizes = [each.size for each in coming]
-    if rule.footprint == "circle":
-        return set_down_spots(smap, place, size, mounts, others, sizes, rule, holds=holds)
+    circles = replace(rule, footprint="circle")
+    if rule.footprint == "circle" or (
+        rule.footprint == "auto" and _circles_hold(smap, place, size, sizes, mounts, others)
+    ):
+        return set_down_spots(smap, place, size, mounts, others, sizes, circles, holds=holds)
+    rule = replace(rule, footprint="box")
     names = [name for name in world.objects if name != carried]  # in the order of ``others``
     lying = [(x, y, footprint_of(world.objects[name])) for name, (x, y, _) in zip(names, others, strict=True)]
     feet = [footprint_of(each) for each in coming]
@@ -611,6 +620,22 @@ def carry_spots(
         return set_down_spots(smap, place, size, mounts, [], sizes, rule, footprint_of(obj), feet, lying, holds)
     except Undecided:  # more spots asked of the arms than HOLD_TRIES: as for one thing alone
         return place_spots(smap, place, size, mounts, others)
+
+
+def _circles_hold(
+    smap: SemanticMap,
+    place: Thing,
+    size: Size,
+    later: Sequence[Size],
+    mounts: Sequence[Mount],
+    others: Sequence[tuple[float, float, float]],
+) -> bool:
+    """Whether circles hold the thing carried now and those the plan puts on ``place`` after it, beside
+    what is there (the ``auto`` rule's first question; undecided counts as holding, as circles did)."""
+    try:
+        return arrange(smap, place, [size, *later], mounts, others, PackingRule(footprint="circle")) is not None
+    except Undecided:
+        return True
 
 
 HOLD_TRIES = 400
@@ -670,7 +695,12 @@ def overfilled(
     by the arms of the robot that sets them down; given ``ctx``, each where an arm can hold it
     (:func:`arm_choice.cannot_set_down`). None when each such place holds them, or when the search is
     undecided. A place that has no spot for one of them alone is left to the check of each step
-    (``run_checks.PlanChecks._check_spot``), which says why."""
+    (``run_checks.PlanChecks._check_spot``), which says why. The ``auto`` rule refuses what neither
+    circles nor boxes hold (with the boxes' words)."""
+    if rule.footprint == "auto":
+        if overfilled(smap, plan, values, where, replace(rule, footprint="circle"), ctx) is None:
+            return None
+        return overfilled(smap, plan, values, where, replace(rule, footprint="box"), ctx)
     by_place: dict[tuple[str, str], list[str]] = {}
     for down in puts_down(plan, smap, values):
         objects = by_place.setdefault((down.place, down.device), [])

@@ -41,7 +41,7 @@ from tests.helpers_examples import EXAMPLES
 WORLD, LAB6P = PREFIXES["world"], "https://example.org/lab6p#"
 SHELF, PEN, PENCIL = LAB6P + "NarrowShelf1", WORLD + "Pen", LAB6P + "Pencil1"
 VALUES: dict[str, Any] = {"pen": {"@id": PEN}, "pencil": {"@id": PENCIL}, "shelf": {"@id": SHELF}}
-CIRCLE = PackingRule(footprint="circle")
+CIRCLE, BOX = PackingRule(footprint="circle"), PackingRule(footprint="box")
 
 
 @pytest.fixture(scope="module")
@@ -94,7 +94,7 @@ def test_the_narrow_shelf_holds_the_pen_and_the_pencil_by_their_boxes_not_their_
     assert overfilled(smap, plan, VALUES, _where(smap)) is None
     things = [smap.objects[PEN], smap.objects[PENCIL]]
     feet = [footprint_of(thing) for thing in things]
-    spots = arrange(smap, shelf, [t.size for t in things], mounts, [], PackingRule(), feet=feet)
+    spots = arrange(smap, shelf, [t.size for t in things], mounts, [], BOX, feet=feet)
     assert spots is not None
     for thing, foot, at in zip(things, feet, spots, strict=True):
         assert at in box_spots(smap, shelf, foot, thing.size[2], mounts, [])[1]
@@ -111,7 +111,7 @@ def test_a_spot_no_arm_can_hold_is_passed_over_and_a_place_with_none_is_refused_
     things = [smap.objects[PEN], smap.objects[PENCIL]]
     feet = [footprint_of(thing) for thing in things]
     sizes = [t.size for t in things]
-    free = arrange(smap, shelf, sizes, mounts, [], PackingRule(), feet=feet)
+    free = arrange(smap, shelf, sizes, mounts, [], BOX, feet=feet)
     assert free is not None
     asked: list[tuple[int, tuple[float, float]]] = []
 
@@ -119,7 +119,7 @@ def test_a_spot_no_arm_can_hold_is_passed_over_and_a_place_with_none_is_refused_
         asked.append((n, at))
         return not (n == 1 and at == free[1])
 
-    held = arrange(smap, shelf, sizes, mounts, [], PackingRule(), feet=feet, holds=not_there)
+    held = arrange(smap, shelf, sizes, mounts, [], BOX, feet=feet, holds=not_there)
     assert held is not None and held[1] != free[1] and (1, free[1]) in asked
     why = "the right arm cannot hold the Pencil1 by its top grasp over NarrowShelf1 at (8.55, 2.66)"
 
