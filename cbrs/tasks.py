@@ -383,8 +383,9 @@ class TaskRunner:
             run.status, run.error = "error", f"{type(error).__name__}: {error}"
         finally:
             run.finished = time.time()
-            run.done.set()
+            # Said before done is set: whoever waited for the end (the bridge's action, a test) has heard it.
             self._emit(RUN_TOPIC, {"event": "run_finished", "run": run.id, "task": run.task, "status": run.status})
+            run.done.set()
 
     def _simulate(
         self, run: TaskRun, composer: Composer, semantic_map: SemanticMap, transport: Transport | None
