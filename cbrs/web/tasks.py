@@ -229,13 +229,11 @@ def _checked(form: dict[str, Any], shown: Page) -> dict[str, Any]:
         errors["repeat_failures"] = f"{form['repeat_failures']!r} is not a whole number"
     if repeats < 0:
         errors["repeat_failures"] = f"{form['repeat_failures']!r} is negative: a number of repeats is 0 or more"
-    near_misses = None  # ComposeConfig's default; objective and base_ties are checked by TaskRunner.start
+    near_misses = None  # ComposeConfig's default; the options' values are checked by TaskRunner.start
     try:
         near_misses = int(form["near_misses"]) if form["near_misses"] else None
     except ValueError:
         errors["near_misses"] = f"{form['near_misses']!r} is not a whole number"
-    if near_misses is not None and near_misses < 0:
-        errors["near_misses"] = f"{form['near_misses']!r} is negative: a number of near misses is 0 or more"
     if errors:
         raise FormError(errors, page=shown)
     return {
