@@ -61,7 +61,7 @@ from cbrs.kb.store import is_remote
 from cbrs.matchmakers import Matchmakers
 from cbrs.rosbridge import Bridge, GoalHandle, GoalResult, GoalStatus, ServiceError, current_caller
 from cbrs.sparql_service import SparqlService
-from cbrs.tasks import RUN_TOPIC, TaskRunner
+from cbrs.tasks import RUN_TOPIC, TaskRunner, check_choice
 
 if TYPE_CHECKING:
     from cbrs.actions.composer import Composer, Objective
@@ -185,11 +185,8 @@ class KnowledgeServices:
 
         task = _field(args, "task", str)
         objective = _field(args, "objective", str, "") or Objective.SIMILARITY.value
-        if objective not in {o.value for o in Objective}:
-            raise ServiceError(f"objective {objective!r} is not one of {', '.join(o.value for o in Objective)}")
         ties = _field(args, "base_ties", str, "") or BaseTies.NEAREST.value
-        if ties not in {t.value for t in BaseTies}:
-            raise ServiceError(f"base_ties {ties!r} is not one of {', '.join(t.value for t in BaseTies)}")
+        _call(lambda: (check_choice("objective", objective, Objective), check_choice("base_ties", ties, BaseTies)))
         with self.sparql.lock:
             composer = self.composers.get(Objective(objective))
             iri = _call(lambda: task_iri(self.sparql.kb, task))

@@ -21,6 +21,7 @@ from collections import OrderedDict
 from collections.abc import Callable, Iterable, Sequence
 from contextlib import AbstractContextManager, nullcontext
 from dataclasses import dataclass, field
+from enum import Enum
 from typing import TYPE_CHECKING, Any
 
 from cbrs.extras import installed, require
@@ -551,16 +552,23 @@ def _jpeg(rgb: Any) -> bytes:
     return buffer.getvalue()
 
 
+def check_choice(field: str, value: str, kind: type[Enum]) -> str:
+    """``value`` when it names a member of ``kind`` (an option's choices), else :class:`RunOptionError`
+    naming ``field`` and the choices: one set of words for a run's and a plan's options, wherever asked."""
+    allowed = [member.value for member in kind]
+    if value not in allowed:
+        raise RunOptionError(field, value, "one of " + ", ".join(allowed))
+    return value
+
+
 def _check_options(objective: str, base_ties: str, near_misses: int | None) -> int:
     """The composition options checked as ``cbrs run`` checks its own (:class:`RunOptionError` naming the
     one at fault); returns ``near_misses``, ``ComposeConfig``'s default for None."""
     from cbrs.actions.base_choice import BaseTies
     from cbrs.actions.composer import ComposeConfig, Objective
 
-    for name, value, kind in (("objective", objective, Objective), ("base_ties", base_ties, BaseTies)):
-        allowed = [member.value for member in kind]
-        if value not in allowed:
-            raise RunOptionError(name, value, "one of " + ", ".join(allowed))
+    check_choice("objective", objective, Objective)
+    check_choice("base_ties", base_ties, BaseTies)
     if near_misses is None:
         return ComposeConfig().near_misses
     if isinstance(near_misses, bool) or not isinstance(near_misses, int) or near_misses < 0:
