@@ -36,6 +36,7 @@ from cbrs.actions.runner import (
     ungrounded,
     unrunnable_steps,
 )
+from cbrs.actions.task_preconditions import PreconditionCheck
 from cbrs.app import App, parse_iri, pass_app
 from cbrs.extras import installed, require
 from cbrs.kb import Advertisement, KnowledgeBase, RemoteStoreError
@@ -811,7 +812,8 @@ def run_text(result: RunResult, sim_seconds: float, wall_seconds: float) -> str:
     if not report.steps:  # every effect held already: no table of no steps
         steps = "nothing to do: every effect of the task holds already"
     note = _unused_note(result.unused_inputs) + _ranking_note(result.composition)
-    return f"{header}{steps}\n{verdict}; {timing}{_answers_text(result)}{note}"
+    given = _preconditions_text(result.preconditions)
+    return f"{header}{steps}\n{verdict}; {timing}{given}{_answers_text(result)}{note}"
 
 
 def _refuted_text(goal: GoalCheck) -> str:
@@ -833,6 +835,26 @@ def _unchecked_text(result: RunResult) -> str:
         for goal in unchecked
     )
     return f"; {len(unchecked)} goal(s) the world cannot check ({said})"
+
+
+PRECONDITIONS_NAMED = 3  # the most statements taken as given the text names; --json lists each
+
+
+def _preconditions_text(checks: Sequence[PreconditionCheck]) -> str:
+    """The task's own preconditions as the run found them before its first step, one line: how many were
+    perceived holding, and those no test decides (taken as given, as a fetch task's ``home:hasMarker``)
+    named, at most ``PRECONDITIONS_NAMED`` (docs/execution.md, "A task's preconditions"); none: no line."""
+    if not checks:
+        return ""
+    held = sum(1 for check in checks if check.believed)
+    given = [statement_text(check.statement) for check in checks if check.believed is None]
+    parts = [f"{held} perceived holding"] if held else []
+    if given:
+        named = "; ".join(given[:PRECONDITIONS_NAMED])
+        if len(given) > PRECONDITIONS_NAMED:
+            named += f"; and {len(given) - PRECONDITIONS_NAMED} more (--json lists each)"
+        parts.append(f"{len(given)} taken as given, no test decides {'it' if len(given) == 1 else 'them'}: {named}")
+    return "\npreconditions: " + "; ".join(parts)
 
 
 def _answers_text(result: RunResult) -> str:
