@@ -5,13 +5,16 @@ Services (request fields -> response values):
 - ``/cbrs/query`` ``{query}`` -> ``{media_type, result}``: SPARQL JSON results for SELECT/ASK, JSON-LD
   for CONSTRUCT/DESCRIBE; read-only, with the endpoint's timeout and size limit.
 - ``/cbrs/match`` ``{requirement, method="sem-str", top=10}`` -> the ranking with explanations.
-- ``/cbrs/plan`` ``{task, objective="similarity", base_ties="nearest"}`` -> the plan (recorded in the plans
-  graph when the caller may write) or what is unsatisfied; in a home of several mobile bases the plan works
-  one, chosen as ``cbrs plan`` and a run choose it, and ``base`` says which and why (``BaseChoice.to_dict``).
+- ``/cbrs/plan`` ``{task, objective="similarity", base_ties="nearest", near_misses=3}`` -> the plan (recorded
+  in the plans graph when the caller may write) or what is unsatisfied, with as many near misses named per
+  unmet need as ``near_misses`` asks (-1: the default, 0: none), as ``cbrs plan --near-misses``; in a home
+  of several mobile bases the plan works one, chosen as ``cbrs plan`` and a run choose it, and ``base`` says
+  which and why (``BaseChoice.to_dict``).
 
 Each type is defined in ``cbrs/interfaces`` (``srv/Match.srv``, ``msg/Candidate.msg``...), which rosapi's
 details services describe. A ROS client fills every field of a request, an unset one with its type's
-zero value: an empty ``method``, ``objective`` or ``base_ties`` and a ``top`` of 0 mean the default.
+zero value: an empty ``method``, ``objective`` or ``base_ties`` and a ``top`` of 0 mean the default; not so
+a ``near_misses`` of 0, which names none (-1 is its "not given").
 - ``/cbrs/tasks`` ``{}`` -> ``{tasks}``: every task the store can express, as ``task`` takes it.
 - ``/cbrs/run_task`` ``{task, seed=0, fail=[], fault_rate=0, repeat_failures=1, objective="similarity",
   base_ties="nearest", near_misses=3, wait=true}`` -> the run;
@@ -52,6 +55,7 @@ import difflib
 import json
 import threading
 from collections.abc import Callable, Collection
+from dataclasses import replace
 from importlib.resources import files
 from typing import TYPE_CHECKING, Any, TypeVar
 
@@ -61,7 +65,7 @@ from cbrs.kb.store import is_remote
 from cbrs.matchmakers import Matchmakers
 from cbrs.rosbridge import Bridge, GoalHandle, GoalResult, GoalStatus, ServiceError, current_caller
 from cbrs.sparql_service import SparqlService
-from cbrs.tasks import RUN_TOPIC, TaskRunner, check_choice
+from cbrs.tasks import RUN_TOPIC, TaskRunner, check_choice, check_near_misses
 
 if TYPE_CHECKING:
     from cbrs.actions.composer import Composer, Objective
@@ -99,7 +103,7 @@ _UNSET: dict[str, tuple[object, ...]] = {"objective": (None, ""), "base_ties": (
 FIELDS: dict[str, tuple[str, ...]] = {
     "/cbrs/query": ("query",),
     "/cbrs/match": ("requirement", "method", "top"),
-    "/cbrs/plan": ("task", "objective", "base_ties"),
+    "/cbrs/plan": ("task", "objective", "base_ties", "near_misses"),
     "/cbrs/run_task": (*_RUN, "wait"),
     "/cbrs/tasks": (),
     "/cbrs/task_status": ("run",),
@@ -178,7 +182,8 @@ class KnowledgeServices:
 
     def plan(self, args: dict[str, Any]) -> dict[str, Any]:
         """The task composed as ``cbrs plan`` composes it: in a home of two or more mobile bases, the plan of
-        the base a run would choose (``actions.base_choice.choose_in_map``), and ``base`` says which and why."""
+        the base a run would choose (``actions.base_choice.choose_in_map``), and ``base`` says which and why.
+        The options are checked as a run's are (``check_choice``, ``check_near_misses``: the same words)."""
         from cbrs.actions.base_choice import BaseTies, choose_in_map  # the planner loads with the first plan
         from cbrs.actions.composer import Objective, store_plan
         from cbrs.task_names import task_iri
@@ -186,9 +191,12 @@ class KnowledgeServices:
         task = _field(args, "task", str)
         objective = _field(args, "objective", str, "") or Objective.SIMILARITY.value
         ties = _field(args, "base_ties", str, "") or BaseTies.NEAREST.value
+        near = args.get("near_misses")
+        near = near if _given(near, _UNSET["near_misses"]) else None
         _call(lambda: (check_choice("objective", objective, Objective), check_choice("base_ties", ties, BaseTies)))
+        near_misses = _call(lambda: check_near_misses(near))
         with self.sparql.lock:
-            composer = self.composers.get(Objective(objective))
+            composer = self.composers.get(Objective(objective), near_misses)
             iri = _call(lambda: task_iri(self.sparql.kb, task))
             result, chosen = _call(lambda: choose_in_map(composer, iri, composer.compose(iri), BaseTies(ties)))
             recorded = result.plan is not None and not self.sparql.config.read_only and self.may_write()
@@ -314,9 +322,9 @@ class StepFeed:
 
 
 class Composers:
-    """Composers kept between /cbrs/plan calls, one per objective, sharing the taxonomy index (with the
-    matchmakers, when given them), the action library and the advertisements (building them is most of
-    a call's time).
+    """Composers kept between /cbrs/plan calls, one per objective and count of near misses, sharing the
+    taxonomy index (with the matchmakers, when given them), the action library and the advertisements
+    (building them is most of a call's time).
 
     They are made again when the store changes: an update through the endpoint or a component
     registered or leaving (``SparqlService.generation``), a component whose lease lapsed (the set of
@@ -329,9 +337,10 @@ class Composers:
         self.sparql = sparql
         self.matchmakers = matchmakers  # whose taxonomy index the composers take: one per store version
         self._version: object = None
-        self._built: dict[Objective, Composer] = {}
+        self._built: dict[tuple[Objective, int], Composer] = {}
 
-    def get(self, objective: Objective) -> Composer:
+    def get(self, objective: Objective, near_misses: int | None = None) -> Composer:
+        """The composer of ``objective`` naming ``near_misses`` per unmet need (None: ``ComposeConfig``'s)."""
         from cbrs.actions.composer import ComposeConfig, Composer
 
         kb = self.sparql.kb
@@ -340,19 +349,22 @@ class Composers:
             version += (kb.store.count(GraphName.ONTOLOGY), kb.store.count(GraphName.SERVICES))
         if version != self._version:
             self._version, self._built = version, {}
-        composer = self._built.get(objective)
+        config = ComposeConfig(objective=objective)
+        config = config if near_misses is None else replace(config, near_misses=near_misses)
+        key = (objective, config.near_misses)
+        composer = self._built.get(key)
         if composer is None:
             shared = next(iter(self._built.values()), None)
             matchmakers = self.matchmakers
             index = shared.index if shared is not None else matchmakers.index() if matchmakers is not None else None
             composer = Composer(
                 kb,
-                ComposeConfig(objective=objective),
+                config,
                 index=index,
                 actions=shared.actions if shared is not None else None,
                 advertisements=shared.advertisements if shared is not None else None,
             )
-            self._built[objective] = composer
+            self._built[key] = composer
         return composer
 
 

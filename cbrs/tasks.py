@@ -565,15 +565,24 @@ def _check_options(objective: str, base_ties: str, near_misses: int | None) -> i
     """The composition options checked as ``cbrs run`` checks its own (:class:`RunOptionError` naming the
     one at fault); returns ``near_misses``, ``ComposeConfig``'s default for None."""
     from cbrs.actions.base_choice import BaseTies
-    from cbrs.actions.composer import ComposeConfig, Objective
+    from cbrs.actions.composer import Objective
 
     check_choice("objective", objective, Objective)
     check_choice("base_ties", base_ties, BaseTies)
-    if near_misses is None:
+    return check_near_misses(near_misses)
+
+
+def check_near_misses(value: object) -> int:
+    """``value`` when a whole number, 0 or more (how many components that come close to an unmet need a
+    "no plan" answer names; 0: none), ``ComposeConfig``'s default for None, else :class:`RunOptionError`:
+    one check for a run's ``near_misses`` and a plan's, wherever asked."""
+    from cbrs.actions.composer import ComposeConfig
+
+    if value is None:
         return ComposeConfig().near_misses
-    if isinstance(near_misses, bool) or not isinstance(near_misses, int) or near_misses < 0:
-        raise RunOptionError("near_misses", near_misses, "a whole number, 0 or more")
-    return near_misses
+    if isinstance(value, bool) or not isinstance(value, int) or value < 0:
+        raise RunOptionError("near_misses", value, "a whole number, 0 or more")
+    return value
 
 
 def _check_components(kb: KnowledgeBase, failing: tuple[str, ...]) -> None:
