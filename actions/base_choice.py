@@ -5,7 +5,9 @@ advertised a plan could navigate with one and deliver with the other, which no r
 one base). The map says which components are whose base (:func:`base_groups`: the advertisements whose
 device is the base); the task is then composed once per base, the other bases' components left out, and
 the best plan is taken: the least cost, then the greatest similarity, then (``BaseTies.NEAREST``) the base
-with the least to drive to where its plan first takes it (:class:`MapDrives`), then the first base by IRI.
+with the least to drive to where its plan first takes it, round the walls and the furniture
+(:class:`MapDrives`, :mod:`kb.floor_routes`; a base that cannot get there is not taken), then the first
+base by IRI.
 The cost is the advertised response time; under ``--objective cost``, when every step of every plan names
 a component that states a ``cbrs:cost``, the plans' summed stated cost comes first (:class:`StatedCosts`),
 as the composition ranked each step's candidates.
@@ -17,7 +19,6 @@ page by the store alone (:func:`choose_in_map`): docs/simulation.md, "A home wit
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from enum import Enum
@@ -27,6 +28,8 @@ from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, Ob
 from cbrs.actions.graph import stated_cost  # one reading of cbrs:cost, the composer's
 from cbrs.actions.plan import Plan, PlanStep
 from cbrs.kb import Advertisement, KnowledgeBase, NotFoundError, Requirement
+from cbrs.kb.floor_routes import Routes, RouteSettings
+from cbrs.kb.home_check import NoDockingPoseError, docked_place
 from cbrs.kb.namespaces import HOME, PREFIXES
 from cbrs.kb.semantic_map import (
     AmbiguousDesignatorError,
@@ -67,21 +70,30 @@ class BaseTies(Enum):
 
 @dataclass(frozen=True)
 class FirstDrive:
-    """Where a base's plan first drives it, and how far that is: the straight line in the floor's plane
-    from the base's pose in the map to the things its first drive approaches (their mean position)."""
+    """Where a base's plan first drives it, and how far: ``metres`` along the way round what stands in the
+    map (:mod:`kb.floor_routes`), from the base's pose in the map to where its first drive goes (the things
+    it approaches, their mean); ``straight``, the straight line in the floor's plane. ``metres`` None: the
+    base cannot get there (``why``). ``measure`` "line": the map gives nothing to route on (``why``), and
+    ``metres`` is the straight line."""
 
     step: int
     component: str
     towards: tuple[str, ...]  # the things, by IRI
-    metres: float
+    metres: float | None
+    straight: float
+    measure: str = "route"  # "route" or "line"
+    why: str = ""
 
     def to_dict(self) -> dict[str, Any]:
-        return {
+        found = {
             "step": self.step,
             "component": self.component,
             "towards": list(self.towards),
-            "metres": round(self.metres, 3),
+            "metres": None if self.metres is None else round(self.metres, 3),
+            "straight": round(self.straight, 3),
+            "measure": self.measure,
         }
+        return {**found, "why": self.why} if self.why else found
 
 
 @dataclass(frozen=True)
@@ -250,21 +262,55 @@ def _decide(
         named = ", ".join(_local(base) for base in unknown)
         why = f"{alike}, and {named}'s plan drives to nothing the map places: the first base by IRI"
         return best, why, "iri", drives
-    measured = sorted(((found.metres, base) for base, found in drives if found is not None))
-    (near, nearest), (next_near, runner_up) = measured[0], measured[1]
-    if next_near - near < _SAME:
-        why = f"{alike}, and they stand as far from where their first drives go ({near:.2f} m): the first base by IRI"
-        return best, why, "iri", drives
-    found = dict(drives)[nearest]
-    assert found is not None
-    towards = ", ".join(_local(thing) for thing in found.towards)
-    why = (
-        f"{alike_stated}its plan and {_local(runner_up)}'s cost alike ({mine.cost:g} s) "
-        f"and match alike ({mine.similarity:.3f});"
-        f" it has the least to drive: {near:.2f} m from where it stands in the map to {towards}, where its first"
-        f" drive ({_local(found.component)}) goes, {_local(runner_up)}'s {next_near:.2f} m"
-    )
+    measured = {base: found for base, found in drives if found is not None}
+
+    def head(other: str) -> str:
+        return (
+            f"{alike_stated}its plan and {other}'s cost alike ({mine.cost:g} s) and match alike ({mine.similarity:.3f})"
+        )
+
+    nearest, why = _nearest(measured, head)
+    if nearest is None:
+        return best, f"{alike}, {why}: the first base by IRI", "iri", drives
     return nearest, why, "nearest", drives
+
+
+def _nearest(drives: Mapping[str, FirstDrive], alike: Callable[[str], str]) -> tuple[str | None, str]:
+    """The base with the least to drive and why (``alike``: the words before, given the runner-up), or None and why
+    not: none gets there, or the two nearest are as far. The routes, unless a base's could not be laid
+    (no grid: then every base's straight line, one measure for all)."""
+    by_line = any(found.measure == "line" for found in drives.values())
+    metres = {base: found.straight if by_line else found.metres for base, found in drives.items()}
+    cannot = sorted(base for base, away in metres.items() if away is None)
+    stuck = "; ".join(f"{_local(base)} cannot get there ({drives[base].why})" for base in cannot)
+    ranked = sorted((away, base) for base, away in metres.items() if away is not None)
+    if not ranked:
+        return None, f"and no base can get to where its first drive goes: {stuck}"
+    (near, nearest) = ranked[0]
+    found = drives[nearest]
+    towards = ", ".join(_local(thing) for thing in found.towards)
+    if by_line:
+        lacking = next(f.why for f in drives.values() if f.measure == "line")
+        how = f"in a straight line (the map gives no way round what stands: {lacking})"
+    else:
+        how = f"round what stands in the way ({found.straight:.2f} m in a straight line)"
+    if len(ranked) == 1:
+        others = ", ".join(_local(base) for base in cannot)
+        return nearest, (
+            f"{alike(others)}; it alone can get to {towards}, where its first drive "
+            f"({_local(found.component)}) goes: {near:.2f} m from where it stands in the map, {how}; {stuck}"
+        )
+    next_near, runner_up = ranked[1]
+    if next_near - near < _SAME:
+        return None, f"and they stand as far from where their first drives go ({near:.2f} m)"
+    theirs = drives[runner_up]
+    also = "" if by_line else f" ({theirs.straight:.2f} m)"
+    why = (
+        f"{alike(_local(runner_up))}; it has the least to drive: {near:.2f} m from where it stands"
+        f" in the map to {towards}, {how}, where its first drive ({_local(found.component)}) goes,"
+        f" {_local(runner_up)}'s {next_near:.2f} m{also}"
+    )
+    return nearest, why + (f"; {stuck}" if stuck else "")
 
 
 class MapDrives:
@@ -272,19 +318,34 @@ class MapDrives:
     the first step of one of the base's own components whose effect brings a robot near something
     (``home:isNear``: a navigation), the task's inputs that step works on (directly or through the steps
     that compute its inputs: the pen whose place a locator infers), designated as a run designates them
-    (preferring the requester's, else this base's), and of those the things the map places (an object or
-    a person where it starts, a place at its docking pose, else its extent's centre). The straight line
-    from the base's pose in the map to their mean: the map, not the simulation (the seed moves the bases
-    a little), so that ``cbrs plan`` and ``cbrs run`` choose alike."""
+    (preferring the requester's, else this base's), and of those the things the map places: a person
+    where they start, a place at its docking pose (else its extent's centre), an object at the docking
+    pose of what it stands on (where a drive to fetch it parks; else where it starts). The way from the
+    base's pose in the map to their mean, round the walls, the furniture and the other bases
+    (:class:`kb.floor_routes.Routes`, from the map alone: ``cbrs plan`` and ``cbrs run`` choose alike, and
+    the seed moves the bases a little), or, where the map gives nothing to route on, the straight line."""
 
-    def __init__(self, kb: KnowledgeBase, groups: Mapping[str, frozenset[str]], smap: SemanticMap | None = None):
-        self.kb, self.groups, self._map = kb, groups, smap
+    def __init__(
+        self,
+        kb: KnowledgeBase,
+        groups: Mapping[str, frozenset[str]],
+        smap: SemanticMap | None = None,
+        settings: RouteSettings | None = None,
+    ):
+        self.kb, self.groups, self._map, self.settings = kb, groups, smap, settings
+        self._routes: Routes | None = None
 
     @property
     def map(self) -> SemanticMap:
         if self._map is None:
             self._map = SemanticMap.read(self.kb)
         return self._map
+
+    @property
+    def routes(self) -> Routes:
+        if self._routes is None:
+            self._routes = Routes(self.map, self.settings)
+        return self._routes
 
     def __call__(self, base: str, found: CompositionResult) -> FirstDrive | None:
         plan, robot = found.plan, self.map.robots.get(base)
@@ -299,8 +360,11 @@ class MapDrives:
             return None
         x = sum(p[0] for p in points.values()) / len(points)
         y = sum(p[1] for p in points.values()) / len(points)
-        metres = math.hypot(x - robot.start.x, y - robot.start.y)
-        return FirstDrive(step.index, step.component, tuple(sorted(points)), metres)
+        route = self.routes.route(base, (x, y))
+        towards = tuple(sorted(points))
+        if not route.grid:  # nothing to route on: the straight line, said so
+            return FirstDrive(step.index, step.component, towards, route.straight, route.straight, "line", route.why)
+        return FirstDrive(step.index, step.component, towards, route.metres, route.straight, "route", route.why)
 
     def _things(self, base: str, found: CompositionResult, inputs: Iterable[tuple[str, str]]) -> set[str]:
         """The things the task's ``inputs`` (requirement, name) designate, as a run of ``base`` would."""
@@ -320,7 +384,13 @@ class MapDrives:
     def _where(self, thing: str) -> tuple[float, float] | None:
         smap = self.map
         if thing in smap.objects:
-            return (smap.objects[thing].start.x, smap.objects[thing].start.y)
+            start = smap.objects[thing].start
+            support = smap.objects[thing].support
+            try:
+                place = docked_place(smap, thing, [support] if support else [])
+            except NoDockingPoseError:
+                place = None  # on something with no docking pose: a run refuses it; here, where it lies
+            return (place.dock.x, place.dock.y) if place is not None and place.dock else (start.x, start.y)
         if thing in smap.people:
             return (smap.people[thing].start.x, smap.people[thing].start.y)
         place = smap.things.get(thing)

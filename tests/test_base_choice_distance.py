@@ -1,6 +1,7 @@
 """Two bases whose plans cost alike and match alike (docs/simulation.md, "A home with no mobile base"): the
-base with the least to drive to where its plan first goes is taken, measured in the map, then the first by
-IRI; ``cbrs plan`` and the plans page choose as a run does, from the store alone; a task no robot requests
+base with the least to drive to where its plan first goes is taken, measured in the map round what stands
+in the way (kb.floor_routes; tests/test_base_routes.py checks the routes against the simulation's), then the
+first by IRI; ``cbrs plan`` and the plans page choose as a run does, from the store alone; a task no robot requests
 designates the chosen base's marker colours. One simulation run: FetchMyPenAnyBase with P3DX02 by the door."""
 
 from __future__ import annotations
@@ -9,6 +10,7 @@ import json
 import math
 from collections.abc import Callable
 from dataclasses import replace
+from pathlib import Path
 from types import SimpleNamespace
 from typing import cast
 
@@ -31,6 +33,7 @@ from cbrs.actions.runner import run_task
 from cbrs.app import App
 from cbrs.cli_actions import _base_note, plan
 from cbrs.kb import KnowledgeBase, Requirement
+from cbrs.kb.floor_routes import Routes
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import AmbiguousDesignatorError, Pose, SemanticMap, designate
 from cbrs.sparql_service import SparqlService
@@ -40,9 +43,10 @@ from tests.helpers_examples import EXAMPLES
 SVC, HOME, WORLD = PREFIXES["svc"], PREFIXES["home"], PREFIXES["world"]
 P1, P2 = SVC + "P3DX01", SVC + "P3DX02"
 TASK = "https://example.org/lab6#FetchMyPenAnyBase"
+BEHIND_WALL = Path(__file__).parent / "data" / "base_behind_wall.ru"  # P3DX02 in the bedroom, by the wall
 
 
-def _home(*updates: str) -> KnowledgeBase:
+def _home(*updates: str | Path) -> KnowledgeBase:
     """Two Pioneers with their own components (the same QoS) and FetchMyPenAnyBase, asked by no robot."""
     kb = KnowledgeBase.open(":memory:")
     for name in ("lab6_two_bases.ru", *updates):
@@ -85,11 +89,20 @@ def _compose(avoid: frozenset[str]) -> CompositionResult:
     return ONE if "nav2" in avoid else TWO
 
 
-def _drives(metres: dict[str, float | None]) -> Callable[[str, CompositionResult], FirstDrive | None]:
+def _drives(
+    metres: dict[str, float | None], straight: dict[str, float] | None = None, measure: str = "route"
+) -> Callable[[str, CompositionResult], FirstDrive | None]:
+    """Each base's first drive: ``metres`` its route (None: no route; a base missing: nothing the map places),
+    ``straight`` its straight line (the route's, by default)."""
+
     def drive(base: str, found: CompositionResult) -> FirstDrive | None:
         assert found is (ONE if base == P1 else TWO)  # each base's own plan is measured
-        away = metres[base]
-        return None if away is None else FirstDrive(5, f"nav{base[-1]}", (WORLD + "Pen",), away)
+        if base not in metres:
+            return None
+        away, line = metres[base], (straight or {}).get(base, metres[base] or 1.0)
+        why = "" if away is not None else "nothing connects where it stands (5.40, 5.60) to (8.50, 2.20)"
+        why = "the map has no rooms to lay a grid over" if measure == "line" else why
+        return FirstDrive(5, f"nav{base[-1]}", (WORLD + "Pen",), away, line, measure, why)
 
     return drive
 
@@ -103,24 +116,56 @@ def test_plans_alike_go_to_the_base_with_the_least_to_drive() -> None:
     # as far, or a plan that drives to nothing the map places: the first by IRI, said so
     _, chosen = choose_base(_compose, mixed, GROUPS, drive=_drives({P1: 4.0, P2: 4.0}))
     assert chosen is not None and (chosen.base, chosen.rule) == (P1, "iri") and "as far" in chosen.why
-    _, chosen = choose_base(_compose, mixed, GROUPS, drive=_drives({P1: 5.38, P2: None}))
+    _, chosen = choose_base(_compose, mixed, GROUPS, drive=_drives({P1: 5.38}))
     assert chosen is not None and chosen.base == P1 and "P3DX02's plan drives to nothing the map places" in chosen.why
     # --base-ties iri: the distance is not asked
     _, chosen = choose_base(_compose, mixed, GROUPS, drive=_drives({}), ties=BaseTies.IRI)
     assert chosen is not None and (chosen.base, chosen.rule) == (P1, "iri") and chosen.drives == ()
 
 
+def test_the_route_decides_not_the_straight_line() -> None:
+    """Nearer in a straight line, farther round the walls: the route decides, and the why says both; a base
+    that cannot get there at all is not taken, and with none that can, the first by IRI, said why."""
+    mixed = _stub(("nav1", "nav2"))
+    drives = _drives({P1: 5.63, P2: 10.12}, straight={P1: 5.54, P2: 4.60})
+    found, chosen = choose_base(_compose, mixed, GROUPS, drive=drives)
+    assert found is ONE and chosen is not None and (chosen.base, chosen.rule) == (P1, "nearest")
+    assert (
+        "5.63 m from where it stands in the map to Pen, round what stands in the way (5.54 m in a straight line)"
+        in (chosen.why)
+    )
+    assert "P3DX02's 10.12 m (4.60 m)" in chosen.why
+    said = chosen.to_dict()["drives"][1]["drive"]
+    assert (said["metres"], said["straight"], said["measure"]) == (10.12, 4.6, "route") and "why" not in said
+    # P3DX02 cannot get there: P3DX01 alone can, however far
+    _, chosen = choose_base(_compose, mixed, GROUPS, drive=_drives({P1: 20.0, P2: None}, straight={P2: 1.0}))
+    assert chosen is not None and (chosen.base, chosen.rule) == (P1, "nearest")
+    assert "it alone can get to Pen" in chosen.why and "P3DX02 cannot get there (nothing connects" in chosen.why
+    assert chosen.to_dict()["drives"][1]["drive"]["metres"] is None
+    _, chosen = choose_base(_compose, mixed, GROUPS, drive=_drives({P1: None, P2: None}))
+    assert chosen is not None and (chosen.base, chosen.rule) == (P1, "iri") and "no base can get to" in chosen.why
+    # no grid to route on: the straight lines, said so
+    by_line = _drives({P1: 5.54, P2: 4.60}, measure="line")
+    _, chosen = choose_base(_compose, mixed, GROUPS, drive=by_line)
+    assert chosen is not None and (chosen.base, chosen.rule) == (P2, "nearest")
+    assert "4.60 m from where it stands in the map to Pen, in a straight line (the map gives no way" in chosen.why
+
+
 def test_the_first_drive_is_measured_in_the_map(
     by_the_door: KnowledgeBase, plans: dict[str, CompositionResult]
 ) -> None:
+    """Where FetchMyPen's navigation parks, the docking pose of the pen's table, by the route the map leaves."""
     groups = base_groups(by_the_door, map_bases(by_the_door))
     drives = MapDrives(by_the_door, groups)
+    dock = drives.map.things[WORLD + "KitchenTable"].dock
+    assert dock is not None
     for base in (P1, P2):
         drive = drives(base, plans[base])
-        assert drive is not None and drive.towards == (WORLD + "Pen",)
+        assert drive is not None and drive.towards == (WORLD + "Pen",) and drive.measure == "route"
         assert drive.component.endswith("NavigateToPlace_" + base[-6:])  # the base's own navigation
-        pen, robot = drives.map.objects[WORLD + "Pen"].start, drives.map.robots[base].start
-        assert drive.metres == pytest.approx(math.hypot(pen.x - robot.x, pen.y - robot.y))
+        robot = drives.map.robots[base].start
+        assert drive.straight == pytest.approx(math.hypot(dock.x - robot.x, dock.y - robot.y))
+        assert drive.metres == Routes(drives.map).route(base, (dock.x, dock.y)).metres
     assert plans[P1].plan is not None and plans[P2].plan is not None
     assert (plans[P1].plan.cost, plans[P1].plan.similarity) == (plans[P2].plan.cost, plans[P2].plan.similarity)
     found, chosen = choose_base(lambda avoid: plans[_kept(avoid)], plans["every"], groups, drive=drives)
@@ -130,6 +175,24 @@ def test_the_first_drive_is_measured_in_the_map(
     bedroom = MapDrives(by_the_door, groups, replace(drives.map, robots={**drives.map.robots, P2: moved}))
     _, chosen = choose_base(lambda avoid: plans[_kept(avoid)], plans["every"], groups, drive=bedroom)
     assert chosen is not None and (chosen.base, chosen.rule) == (P1, "nearest")
+
+
+def test_behind_the_wall_cbrs_plan_takes_the_base_with_the_shorter_route(by_the_door: KnowledgeBase) -> None:
+    """P3DX02 parked behind the kitchen's wall (tests/data/base_behind_wall.ru) is the nearer in a straight
+    line; ``cbrs plan``'s choice, from the store alone, is P3DX01, whose drive is the shorter round the walls
+    (as the simulation's planner finds: tests/test_base_routes.py)."""
+    kb = _home(BEHIND_WALL)
+    try:
+        composer = Composer(kb)
+        _, chosen = choose_in_map(composer, TASK, composer.compose(TASK))
+    finally:
+        kb.close()
+    assert chosen is not None and (chosen.base, chosen.rule) == (P1, "nearest")
+    drives = {base: drive for base, drive in chosen.drives}
+    mine, theirs = drives[P1], drives[P2]
+    assert mine is not None and theirs is not None and mine.metres is not None and theirs.metres is not None
+    assert theirs.straight < mine.straight and mine.metres < theirs.metres
+    assert "round what stands in the way" in chosen.why
 
 
 def _kept(avoid: frozenset[str]) -> str:
