@@ -22,7 +22,7 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, replace
 from enum import Enum
-from typing import Any
+from typing import Any, Literal
 
 from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, Objective
 from cbrs.actions.graph import stated_cost  # one reading of cbrs:cost, the composer's
@@ -81,7 +81,7 @@ class FirstDrive:
     towards: tuple[str, ...]  # the things, by IRI
     metres: float | None
     straight: float
-    measure: str = "route"  # "route" or "line"
+    measure: Literal["route", "line"] = "route"
     why: str = ""
 
     def to_dict(self) -> dict[str, Any]:
@@ -276,9 +276,9 @@ def _decide(
 
 
 def _nearest(drives: Mapping[str, FirstDrive], alike: Callable[[str], str]) -> tuple[str | None, str]:
-    """The base with the least to drive and why (``alike``: the words before, given the runner-up), or None and why
-    not: none gets there, or the two nearest are as far. The routes, unless a base's could not be laid
-    (no grid: then every base's straight line, one measure for all)."""
+    """The base with the least to drive and why (``alike``: the words before, given the runner-up), or None
+    and why not: none gets there, or the two nearest are as far. By the routes, unless one could not be laid
+    (no grid: then by every base's straight line, one measure for all)."""
     by_line = any(found.measure == "line" for found in drives.values())
     metres = {base: found.straight if by_line else found.metres for base, found in drives.items()}
     cannot = sorted(base for base, away in metres.items() if away is None)
