@@ -177,22 +177,21 @@ def test_the_first_drive_is_measured_in_the_map(
     assert chosen is not None and (chosen.base, chosen.rule) == (P1, "nearest")
 
 
-def test_behind_the_wall_cbrs_plan_takes_the_base_with_the_shorter_route(by_the_door: KnowledgeBase) -> None:
+def test_behind_the_wall_cbrs_plan_takes_the_base_with_the_shorter_route() -> None:
     """P3DX02 parked behind the kitchen's wall (tests/data/base_behind_wall.ru) is the nearer in a straight
-    line; ``cbrs plan``'s choice, from the store alone, is P3DX01, whose drive is the shorter round the walls
-    (as the simulation's planner finds: tests/test_base_routes.py)."""
+    line; ``cbrs plan`` takes P3DX01, from the store alone, whose drive is the shorter round the walls (as
+    the simulation's planner finds: tests/test_base_routes.py)."""
     kb = _home(BEHIND_WALL)
     try:
-        composer = Composer(kb)
-        _, chosen = choose_in_map(composer, TASK, composer.compose(TASK))
+        said = CliRunner().invoke(plan, [TASK, "--no-store", "--json"], obj=App(":memory:", kb))
     finally:
         kb.close()
-    assert chosen is not None and (chosen.base, chosen.rule) == (P1, "nearest")
-    drives = {base: drive for base, drive in chosen.drives}
-    mine, theirs = drives[P1], drives[P2]
-    assert mine is not None and theirs is not None and mine.metres is not None and theirs.metres is not None
-    assert theirs.straight < mine.straight and mine.metres < theirs.metres
-    assert "round what stands in the way" in chosen.why
+    assert said.exit_code == 0, said.output
+    chosen = json.loads(said.output)["base"]
+    assert (chosen["base"], chosen["rule"]) == (P1, "nearest") and "round what stands in the way" in chosen["why"]
+    drives = {each["base"]: each["drive"] for each in chosen["drives"]}
+    assert drives[P2]["straight"] < drives[P1]["straight"] and drives[P1]["metres"] < drives[P2]["metres"]
+    assert drives[P1]["measure"] == drives[P2]["measure"] == "route"
 
 
 def _kept(avoid: frozenset[str]) -> str:
