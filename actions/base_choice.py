@@ -64,7 +64,7 @@ class BaseTies(Enum):
     """How plans of one cost and one similarity, for different bases, are told apart (``cbrs run`` and
     ``cbrs plan --base-ties``)."""
 
-    NEAREST = "nearest"  # the base with the least to drive to where its plan first goes, then the first by IRI
+    NEAREST = "nearest"  # the least to drive, round walls and furniture, to where its plan first goes; then by IRI
     IRI = "iri"  # the first base by IRI
 
 
