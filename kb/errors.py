@@ -307,3 +307,28 @@ class PartCycleError(KnowledgeBaseError):
             f"{', '.join(self.sources)}: hasPart cycle {' -> '.join(self.cycle)}; "
             "a concept cannot be a part of itself, so nothing was loaded"
         )
+
+
+class UndeclaredSuperclassError(KnowledgeBaseError):
+    """A load declares a class under a term of cbrs's own vocabularies (home:, cbrs:, act:) that they do
+    not declare, nor the store, nor the load: ``lab8:Apple rdfs:subClassOf home:Fruit``. The class would
+    hang from nothing the components know, so no step would take a thing of it, and the task's refusal
+    could not say why; nothing was loaded. ``suggestion`` is a declared term of a near spelling, if any."""
+
+    http_status = 400
+
+    def __init__(self, source: str, subclass: str, superclass: str, suggestion: str | None) -> None:
+        self.source = source
+        self.subclass = subclass
+        self.superclass = superclass
+        self.suggestion = suggestion
+        from cbrs.kb.namespaces import shorten
+
+        near = f"did you mean {shorten(suggestion)}? " if suggestion else ""
+        super().__init__(
+            f"{source}: {shorten(subclass)} rdfs:subClassOf {shorten(superclass)}: {shorten(superclass)} is declared "
+            f"nowhere in the store or in this input, so {shorten(subclass)} would be below no class the components "
+            f"know and no step would take a thing of it; {near}name a class the vocabulary declares (cbrs query "
+            "'SELECT ?c WHERE { ?c rdfs:subClassOf+ home:PhysicalObject }' lists the things an arm can move), or a "
+            "class of your own namespace declared under one; nothing was loaded"
+        )

@@ -42,6 +42,7 @@ from cbrs.kb.namespaces import CBRS, DUL, GENID, OWL, RDF, RDFS, GraphName, shor
 from cbrs.kb.owls import Conversion, Role, Vocabulary, convert, is_owls, owls_key, referenced_ontologies
 from cbrs.kb.shapes import check_loaded
 from cbrs.kb.store import EmbeddedStore, Store
+from cbrs.kb.superclasses import check_superclasses
 from cbrs.kb.xml_limits import check_entities
 
 FORMATS_BY_EXTENSION: dict[str, ox.RdfFormat] = {
@@ -365,6 +366,7 @@ def _prepare(
             if parsed.owls is not None:
                 _check_not_merged(store, parsed, held)
     _check_part_cycles(store, [*raws, *imported])
+    check_superclasses(store, [(raw.source, raw.quads) for raw in (*raws, *imported)])
     check_loaded(store, report)  # descriptions against the SHACL shapes, and their terms (kb/shapes.py)
     return held
 

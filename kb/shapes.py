@@ -731,6 +731,16 @@ def _candidates(store: Store, namespace: str, declared_here: set[str]) -> list[s
     return sorted({row["term"].value for row in rows} | {t for t in declared_here if t.startswith(namespace)})
 
 
+def did_you_mean(store: Store, iri: str, declared_here: Iterable[str] = ()) -> str | None:
+    """The declared term of ``iri``'s namespace (in ``store`` or ``declared_here``) it reads as a slip of,
+    else the nearest by spelling, else None: the did-you-mean of the description checks, for other checks."""
+    candidates = _candidates(store, _namespace(iri), set(declared_here))
+    near = nearest_term(iri, candidates)
+    if near is None or not _misspelt(iri, near):
+        near = _slip_of(iri, candidates) or near
+    return near
+
+
 def nearest_term(iri: str, candidates: Iterable[str], cutoff: float = 0.75) -> str | None:
     """The candidate of ``iri``'s namespace whose local name is closest to ``iri``'s, if any is close
     (``difflib``'s ratio at least ``cutoff``, case aside): the did-you-mean of a misspelt term."""
