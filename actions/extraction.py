@@ -351,19 +351,22 @@ class Extraction:
         return True
 
     def _fit(self, step: _Step, edge: Edge) -> tuple[int, int]:
-        """The order of the values the task gives for a need of ``step``: the most about what it serves
-        first (:meth:`_aboutness`), then, of two as much about it, one whose class falls under a goal's
-        subject (0) before one that does not (1). A statement is about its subject: in (TeaTin, isLocated,
-        Counter) the tin is what is moved and the counter where to, and a counter that is furniture as
-        well as a place is as much a physical object as the tin, at the same depth. The tie used to go
-        to the input whose name sorts first."""
+        """The order of the values the task gives for a need of ``step``: one whose class falls under the
+        subject of a goal the step serves (0) before one that does not (1), then the most about what it
+        serves (:meth:`_aboutness`). A statement is about its subject: in (TeaTin, isLocated, Counter) the
+        tin is what is moved and the counter where to, though a counter that is furniture as well as a
+        place is as much a physical object as the tin. The subject comes first whatever the depths: in
+        (Apple, isLocatedOn, FruitBowl), a lab's apple straight under home:PhysicalObject and a bowl under
+        home:Bowl, home:Container and home:Artifact, the deeper bowl was the more about the arm's steps,
+        and the arm was sent to pick up the bowl (docs/tasks.md, "An eighth round"). Before that, the
+        tie of two as deep went to the input whose name sorts first."""
         about = self._aboutness(step, edge)
         concept = edge.offer.concept
         index = self.graph.pool.matcher.index
         if concept is None or concept not in index:
-            return (about, 1)
+            return (1, about)
         ancestors = index.is_a_ancestors(concept)
-        return (about, 0 if any(c in ancestors for c in self._goal_subjects.intersection(step.about)) else 1)
+        return (0 if any(c in ancestors for c in self._goal_subjects.intersection(step.about)) else 1, about)
 
     def _aboutness(self, step: _Step, edge: Edge) -> int:
         """How well a value the task gives fits what ``step`` is for: minus the depth of the most specific
