@@ -691,8 +691,10 @@ class Composer:
         """``unsatisfied`` with the classes of the requirement it names that the ontology lacks (a task
         about a home:Frisbee nobody declared): the likeliest reason nothing provides it."""
         named = {p.type for p in (*requirement.inputs, *requirement.outputs)}
+        predicates = set()
         for statement in (*requirement.preconditions, *requirement.effects, *requirement.deletes):
-            named |= {statement.subject, statement.object}
+            named |= {statement.subject, statement.object, statement.predicate}
+            predicates.add(statement.predicate)
         given = {p.type for p in requirement.inputs}  # an input of no known class feeds no component at all
         missing = tuple(
             sorted(
@@ -705,8 +707,13 @@ class Composer:
         )
         if not missing:
             return unsatisfied
-        near = tuple((c, found) for c in missing if (found := nearest_term(c, self.index.nodes(), 0.6)) is not None)
-        reason = replace(unsatisfied, undeclared=missing, near=near)
+        near = tuple(
+            (c, found)
+            for c in missing  # a property by the did-you-mean's spelling only: home:isOn is no slip of home:isNear
+            if (found := nearest_term(c, self.index.nodes(), 0.75 if c in predicates else 0.6)) is not None
+        )
+        properties = tuple(c for c in missing if c in predicates)
+        reason = replace(unsatisfied, undeclared=missing, near=near, properties=properties)
         return described(reason, requirement, self.index, self.kb, self.advertisements)  # a thing, or a new class
 
     def _near_missed(self, unsatisfied: Unsatisfied, attempts: Sequence[Attempt]) -> Unsatisfied:

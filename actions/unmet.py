@@ -28,7 +28,8 @@ class Unsatisfied:
     chain: tuple[str, ...] = ()  # from the requirement's goal down to this need
     cycle: bool = False  # providers exist, but each needs (through others) what this need blocks; with
     # deleted_by: each step achieving it again undid another need, up to ComposeConfig.max_reachieved times
-    undeclared: tuple[str, ...] = ()  # classes the need names that the ontology does not have
+    undeclared: tuple[str, ...] = ()  # classes (and properties) the need names that the ontology does not have
+    properties: tuple[str, ...] = ()  # those of ``undeclared`` the requirement uses as a condition's predicate
     near: tuple[tuple[str, str], ...] = ()  # (undeclared class, the declared class its name is closest to)
     unrunnable: tuple[tuple[str, str], ...] = ()  # (component, why): planned for it, but cannot run here
     out_of_area: tuple[tuple[str, str], ...] = ()  # (component, why): provides it, but not where it is needed
@@ -87,9 +88,11 @@ class Unsatisfied:
         if self.undeclared:
             things = dict(self.individuals)
             said = [_an_individual(term, things[term]) for term in self.undeclared if term in things]
-            classes = [term for term in self.undeclared if term not in things]
+            classes = [term for term in self.undeclared if term not in things and term not in self.properties]
             if classes:
                 said.append(self._no_classes(classes))
+            if self.properties:
+                said.append(self._no_properties(list(self.properties)))
             return f"{'; '.join(said)}; or {self._remedy()}"
         return self._remedy()
 
@@ -106,6 +109,21 @@ class Unsatisfied:
             f"{f' ({meant})' if meant else ''}: "
             f"declare {'it' if len(classes) == 1 else 'them'} under a class the components know "
             f"(e.g. {example} {under}, loaded into the ontology graph)"
+        )
+
+    def _no_properties(self, properties: list[str]) -> str:
+        """Predicates that are no property of the ontology (``home:isOn``): no component's condition can
+        match them, so name a property the components' conditions use, or declare one under it."""
+        names = ", ".join(shorten(p) for p in properties)
+        meant = "; ".join(
+            f"{shorten(typed)}: did you mean {shorten(known)}?" for typed, known in self.near if typed in properties
+        )
+        listed = " (what components provide about it, below)" if self.provided else ""
+        return (
+            f"{names} {'is no property' if len(properties) == 1 else 'are no properties'} of the ontology"
+            f"{f' ({meant})' if meant else ''}: use a property the components' conditions use{listed}, or declare "
+            f"{'it' if len(properties) == 1 else 'them'} under one (e.g. lab:isOn rdfs:subPropertyOf "
+            "home:isLocatedOn, loaded into the ontology graph)"
         )
 
     def _remedy(self) -> str:
