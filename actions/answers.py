@@ -31,6 +31,7 @@ first answer that needs them; a designated thing's by ``map_types``, once per th
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, Protocol
@@ -47,8 +48,10 @@ __all__ = [
     "ContradictedEffectError",
     "Reading",
     "StoreClasses",
+    "UnitInTextError",
     "WrongThingError",
     "check_designation",
+    "check_quantities",
     "read_answer",
 ]
 
@@ -112,6 +115,46 @@ def check_designation(concept: str, value: Any, classes: StoreClasses) -> None:
     if answered is None or not stated or any(classes.is_a(c, answered) for c in stated):
         return
     raise WrongThingError(concept, thing, answered, stated)
+
+
+MEASUREMENT = expand("home:Measurement")
+"""The class whose values carry quantities: a temperature, a humidity, a weight, a distance."""
+
+_NUMBER_WITH_UNIT = re.compile(
+    r"\s*(?P<number>[-+]?(?:\d+(?:[.,]\d*)?|[.,]\d+)(?:[eE][-+]?\d+)?)\s*(?P<unit>[%°µA-Za-z][^\d\s:-]*)?\s*"
+)
+"""A number as text, with a unit (letters, %, °) or none; a date or a time ("2026-11-28", "12:30") is not one."""
+
+
+class UnitInTextError(ActionsError, ValueError):
+    """A remote answer of a measurement gives a quantity as text, a number with its unit in it
+    (``"percent": "47.5 %"``): values carry numbers as JSON numbers, in the units docs/values.md fixes, so
+    the reading would be passed on as a text no consumer can compare. Keeps the class, the key and the
+    text; a ``ValueError``, so the answer check fails the step that produced it (``actions.remote``)."""
+
+    def __init__(self, concept: str, key: str, text: str, number: str, unit: str | None) -> None:
+        self.concept, self.key, self.text, self.unit = concept, key, text, unit
+        what = f"a number with its unit ({unit!r}) written as text" if unit else "a number written as text"
+        super().__init__(
+            f"malformed {shorten(concept)}: {key!r} is {text!r}, {what}: a value carries a quantity as a JSON "
+            "number, in the units the conventions fix (docs/values.md), the unit in the key's name if need be "
+            f'("{key}": {number.replace(",", ".")})'
+        )
+
+
+def check_quantities(concept: str, value: Any, classes: Classes) -> None:
+    """Refuse (:class:`UnitInTextError`) a value of a measurement class (``home:Measurement`` or below) one
+    of whose keys is a number written as text, with or without a unit: a lab's hygrometer answering
+    ``{"@type": "home:Humidity", "percent": "47.5 %"}`` was believed, and its reading passed on as the text
+    (docs/tasks.md, "An eighth round"). Classes with a JSON shape of their own are checked by their shape."""
+    if not isinstance(value, dict) or not classes.is_a(concept, MEASUREMENT):
+        return
+    for key, field_value in value.items():
+        if key.startswith("@") or not isinstance(field_value, str):
+            continue
+        found = _NUMBER_WITH_UNIT.fullmatch(field_value)
+        if found is not None:
+            raise UnitInTextError(concept, key, field_value, found.group("number"), found.group("unit"))
 
 
 def _text(statement: Statement) -> str:

@@ -16,7 +16,7 @@ from concurrent.futures import Future
 from concurrent.futures import TimeoutError as FutureTimeout
 from typing import Any, Protocol
 
-from cbrs.actions.answers import Classes, ContradictedEffectError, StoreClasses, read_answer
+from cbrs.actions.answers import Classes, ContradictedEffectError, StoreClasses, check_quantities, read_answer
 from cbrs.actions.breaker import BreakerPolicy, Late, busy, calls_of
 from cbrs.actions.components import Component, Status
 from cbrs.actions.errors import ActionsError
@@ -199,6 +199,8 @@ class RemoteComponent(Component):
             if self.check is not None:
                 try:
                     value = self.check(concept, value)
+                    if self.classes is not None:
+                        check_quantities(concept, value, self.classes)  # "47.5 %" for a humidity
                 except ValueError as error:
                     raise AnswerRefusedError(
                         self.service, f"{self.service} answered a wrong {name}: {error}"
