@@ -37,6 +37,7 @@ CONTROL_PERIOD = 1.0 / 240.0
 """The set-point moves every physics step: moved in coarser jumps, the constraint would jerk the body
 (and shake the pen off the platform)."""
 CONSTRAINT_FORCE = 3000.0
+_TAU = 2.0 * math.pi
 
 
 @dataclass(frozen=True)
@@ -110,7 +111,6 @@ class MobileBase:
         """
         start = self.pose()
         self._command(start)
-        pose = start
         length = 0.0
         previous = start.xy
         for point in waypoints:
@@ -127,17 +127,28 @@ class MobileBase:
             self._step(0.1)
             return DriveResult(False, reason, self.pose(), elapsed, driven)
 
+        # The control loop runs once per physics step: on plain floats, its pybullet calls bound once (the
+        # same calls with the same arguments as _command and _lagging make, and the same arithmetic).
+        x, y, theta = start.x, start.y, start.theta
+        body, client, constraint, height = self.body, self.client, self._constraint, self.height
+        change, base_pose, sin, cos, hypot = (
+            p.changeConstraint,
+            p.getBasePositionAndOrientation,
+            math.sin,
+            math.cos,
+            math.hypot,
+        )
         for index, (wx, wy) in enumerate(waypoints):
             last = index == len(waypoints) - 1
             tolerance = GOAL_TOLERANCE if last else WAYPOINT_TOLERANCE
             while True:
-                dx, dy = wx - pose.x, wy - pose.y
-                distance = math.hypot(dx, dy)
+                dx, dy = wx - x, wy - y
+                distance = hypot(dx, dy)
                 if distance <= tolerance:
                     break
                 if elapsed >= limit:
                     return fail(f"time limit {limit:.1f} s reached {distance:.2f} m from waypoint {index}")
-                error = wrap_angle(math.atan2(dy, dx) - pose.theta)
+                error = (math.atan2(dy, dx) - theta + math.pi) % _TAU - math.pi  # wrap_angle
                 if abs(error) > TURN_IN_PLACE:
                     speed = max(0.0, speed - MAX_ACCELERATION * dt)
                 else:
@@ -146,17 +157,26 @@ class MobileBase:
                     speed = min(wanted, speed + MAX_ACCELERATION * dt)
                 turn = max(-MAX_TURN_RATE, min(MAX_TURN_RATE, 3.0 * error))
                 step = min(speed * dt, distance)
-                pose = Pose2D(
-                    pose.x + step * math.cos(pose.theta),
-                    pose.y + step * math.sin(pose.theta),
-                    wrap_angle(pose.theta + turn * dt),
+                x, y, theta = (
+                    x + step * cos(theta),
+                    y + step * sin(theta),
+                    (theta + turn * dt + math.pi) % _TAU - math.pi,
                 )
                 driven += step
-                self._command(pose)
+                change(  # _command
+                    constraint,
+                    jointChildPivot=(x, y, height),
+                    jointChildFrameOrientation=(0.0, 0.0, sin(theta / 2.0), cos(theta / 2.0)),
+                    maxForce=CONSTRAINT_FORCE,
+                    physicsClientId=client,
+                )
                 self._step(dt)
                 elapsed += dt
-                if self._lagging():
-                    return fail(f"blocked near ({pose.x:.2f}, {pose.y:.2f})")
+                (bx, by, _), _ = base_pose(body, physicsClientId=client)  # _lagging
+                if hypot(bx - x, by - y) > BLOCKED_DISTANCE:
+                    return fail(f"blocked near ({x:.2f}, {y:.2f})")
+        self._setpoint = Pose2D(x, y, theta)
+        pose = self._setpoint
         speed = 0.0
         if final_heading is not None:
             while abs(wrap_angle(final_heading - pose.theta)) > HEADING_TOLERANCE / 2.0:
