@@ -41,6 +41,7 @@ from cbrs.actions.extraction import Extraction, Objective
 from cbrs.actions.graph import (
     SRE,
     SRI,
+    SRO,
     Matcher,
     ServicePool,
     ServiceResourceGraph,
@@ -55,7 +56,7 @@ from cbrs.actions.search import SearchTrace, bidirectional_search
 from cbrs.actions.undeclared_terms import described
 from cbrs.actions.unmet import GOAL, Unsatisfied
 from cbrs.kb import Advertisement, KnowledgeBase, Requirement, Statement
-from cbrs.kb.namespaces import GraphName, shorten
+from cbrs.kb.namespaces import PREFIXES, GraphName, shorten
 from cbrs.kb.shapes import nearest_term
 from cbrs.reasoner.config import MatchConfig
 from cbrs.reasoner.degrees import Degree, degree_of_match
@@ -682,10 +683,31 @@ class Composer:
     ) -> CompositionResult:
         status = PlanStatus.PLANNED if plan is not None else PlanStatus.UNSOLVABLE
         if plan is None:
-            unsatisfied = tuple(self._near_missed(self._undeclared(task.requirement, u), attempts) for u in unsatisfied)
+            unsatisfied = tuple(
+                self._near_missed(self._of_the_world(task.requirement, self._undeclared(task.requirement, u)), attempts)
+                for u in unsatisfied
+            )
         return CompositionResult(
             task.name, task.requirement.iri, status, plan, unsatisfied, attempts, self.config.objective
         )
+
+    def _of_the_world(self, requirement: Requirement, unsatisfied: Unsatisfied) -> Unsatisfied:
+        """``unsatisfied`` marked when it is an output the task asks for whose class is a kind of physical
+        thing (a cup): no component gives cups, but the store says which there are (eighth round, "which
+        cups are in the kitchen?" written as a task)."""
+        if unsatisfied.consumer != SRO:
+            return unsatisfied
+        physical = PREFIXES["home"] + "PhysicalObject"
+        for output in requirement.outputs:
+            concept = output.type
+            if (
+                concept
+                and concept in self.index
+                and physical in self.index.is_a_ancestors(concept)
+                and unsatisfied.need.endswith(f"({shorten(concept)})")
+            ):
+                return replace(unsatisfied, world_things=True)
+        return unsatisfied
 
     def _undeclared(self, requirement: Requirement, unsatisfied: Unsatisfied) -> Unsatisfied:
         """``unsatisfied`` with the classes of the requirement it names that the ontology lacks (a task

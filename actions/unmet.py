@@ -30,6 +30,7 @@ class Unsatisfied:
     # deleted_by: each step achieving it again undid another need, up to ComposeConfig.max_reachieved times
     undeclared: tuple[str, ...] = ()  # classes (and properties) the need names that the ontology does not have
     properties: tuple[str, ...] = ()  # those of ``undeclared`` the requirement uses as a condition's predicate
+    world_things: bool = False  # the need is an output the task asks for whose class is a kind of physical thing
     near: tuple[tuple[str, str], ...] = ()  # (undeclared class, the declared class its name is closest to)
     unrunnable: tuple[tuple[str, str], ...] = ()  # (component, why): planned for it, but cannot run here
     out_of_area: tuple[tuple[str, str], ...] = ()  # (component, why): provides it, but not where it is needed
@@ -165,6 +166,13 @@ class Unsatisfied:
                 "or a fact of the semantic map"
             )
         concept = self.need.rsplit("(", 1)[-1].rstrip(")") if "(" in self.need else self.need
+        if self.consumer == SRO and self.world_things:  # "which cups are there?": the store knows
+            return (
+                f"register a component whose output is a {concept}; or, to know which {concept} there are and "
+                "where, ask the store, whose map and belief hold the things of the world as facts, not a "
+                f"component's output (cbrs query --name things_in_room --bind class={concept} --bind room=ROOM; "
+                "--name world_positions)"
+            )
         if self.consumer == SRO:  # what the task asks for: giving it as an input would be no answer
             return f"register a component whose output is a {concept}"
         return f"register a component whose output is a {concept}, or give one as an input of the task"

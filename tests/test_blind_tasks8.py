@@ -207,3 +207,18 @@ def test_which_things_are_in_a_room_from_the_world_knowledge(lab_kb: KnowledgeBa
     assert things(HOME + "Cup", HOME + "Kitchen") == {WORLD + "Cup"}  # the room's class names it too
     assert things(HOME + "Cup", WORLD + "Bedroom") == set()
     assert {WORLD + "Cup", WORLD + "Pen", LAB8 + "Apple1"} <= things(HOME + "PhysicalObject", WORLD + "Kitchen")
+
+
+def test_a_question_about_the_world_written_as_a_task_is_sent_to_the_store() -> None:
+    """The cups as the output of a task: no plan, and the answer said only to register a component."""
+    kb = KnowledgeBase.open(":memory:")
+    kb.load([EXAMPLES / "lab8_mistake_which_cups.ttl"], graph="requirements")
+    result = Composer(kb).compose("WhichCupsInTheKitchen")
+    assert result.plan is None and len(result.unsatisfied) == 1
+    text = result.unsatisfied[0].text()
+    assert "no component provides output cups (home:Cup) of the requirement" in text
+    assert "cbrs query --name things_in_room --bind class=home:Cup" in text
+    kb.load([EXAMPLES / "lab8_bedroom_humidity.ttl"], graph="requirements")  # no hygrometer: no plan
+    humidity = Composer(kb).compose("BedroomHumidity")  # an output that is no thing: no word of the store
+    assert humidity.plan is None and humidity.unsatisfied
+    assert all("things_in_room" not in u.text() for u in humidity.unsatisfied)
