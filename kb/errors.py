@@ -317,7 +317,9 @@ class UndeclaredSuperclassError(KnowledgeBaseError):
 
     http_status = 400
 
-    def __init__(self, source: str, subclass: str, superclass: str, suggestion: str | None) -> None:
+    def __init__(
+        self, source: str, subclass: str, superclass: str, suggestion: str | None, undone: str = "nothing was loaded"
+    ) -> None:
         self.source = source
         self.subclass = subclass
         self.superclass = superclass
@@ -330,5 +332,5 @@ class UndeclaredSuperclassError(KnowledgeBaseError):
             f"nowhere in the store or in this input, so {shorten(subclass)} would be below no class the components "
             f"know and no step would take a thing of it; {near}name a class the vocabulary declares (cbrs query "
             "'SELECT ?c WHERE { ?c rdfs:subClassOf+ home:PhysicalObject }' lists the things an arm can move), or a "
-            "class of your own namespace declared under one; nothing was loaded"
+            f"class of your own namespace declared under one; {undone}"
         )

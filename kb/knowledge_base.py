@@ -37,6 +37,7 @@ from cbrs.kb.seed_cache import SeedCache, bundle_digest
 from cbrs.kb.shapes import CHECKED_GRAPHS, DescriptionShapeError, checked_update, may_write_descriptions
 from cbrs.kb.standard_terms import PendingUpdate, Refresh, StandardTerms
 from cbrs.kb.store import MEMORY, EmbeddedStore, QueryResult, Store, Term, is_remote
+from cbrs.kb.superclasses import check_superclasses
 from cbrs.kb.update_delta import DataUpdate
 from cbrs.kb.update_report import GraphChange, UpdateReport, exact_changes, graph_sizes, net_changes, refuse_split
 from cbrs.kb.upgrade import StoreCheck, UpgradeReport, check_store, upgrade_store
@@ -436,6 +437,9 @@ class KnowledgeBase:
         as the descriptions; returns what graph:entailed's refresh changed (None: it lags)."""
         from cbrs.kb.semantic_map import MapError  # it imports this module
 
+        if data is not None:  # a class put under a home: term nobody declares, as a load refuses it
+            inserted = [quad for operation in data.operations if operation.insert for quad in operation.quads]
+            check_superclasses(self.store, [("the update", inserted)], "nothing was written")
         pending = self.standard_terms.prepare(data)
         checking: AbstractContextManager[None] = nullcontext()
         before = self._map_before_update(text, data) if check_map else None

@@ -10,7 +10,7 @@ are, declares none of its terms). A lab's own namespace is left alone: its terms
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 
 import pyoxigraph as ox
 
@@ -26,9 +26,12 @@ namespace without the ``#``."""
 _SUBCLASS = RDFS + "subClassOf"
 
 
-def check_superclasses(store: Store, sources: Iterable[tuple[str, list[ox.Quad]]]) -> None:
+def check_superclasses(
+    store: Store, sources: Iterable[tuple[str, Sequence[ox.Quad]]], undone: str = "nothing was loaded"
+) -> None:
     """Raise :class:`UndeclaredSuperclassError` for the first ``rdfs:subClassOf`` of the load (``sources``:
-    each file's name and quads) whose superclass is of :data:`OWN_NAMESPACES` and declared nowhere."""
+    each file's name and quads; or an update's inserted quads, ``undone`` then saying what became of it)
+    whose superclass is of :data:`OWN_NAMESPACES` and declared nowhere."""
     files = list(sources)
     declared_here = {q.subject.value for _, quads in files for q in quads if isinstance(q.subject, ox.NamedNode)}
     for source, quads in files:
@@ -47,7 +50,7 @@ def check_superclasses(store: Store, sources: Iterable[tuple[str, list[ox.Quad]]
                 continue
             near = did_you_mean(store, superclass.value, declared_here)
             subclass = quad.subject.value if isinstance(quad.subject, ox.NamedNode) else str(quad.subject)
-            raise UndeclaredSuperclassError(source, subclass, superclass.value, near)
+            raise UndeclaredSuperclassError(source, subclass, superclass.value, near, undone)
 
 
 def _holds_vocabulary(store: Store, namespace: str) -> bool:

@@ -76,6 +76,19 @@ def test_a_superclass_the_home_ontology_lacks_is_refused_at_the_load(tmp_path: P
     assert _sizes(kb) == before
 
 
+def test_the_same_superclass_is_refused_in_a_sparql_update() -> None:
+    """/update and cbrs update run kb.update: the class the load refuses was written by an INSERT DATA."""
+    kb = KnowledgeBase.open(":memory:")
+    before = _sizes(kb)
+    graph = "INSERT DATA { GRAPH <https://w3id.org/cbrs/graph/ontology> { <https://example.org/lab8#Apple> "
+    fruit, physical = graph + "rdfs:subClassOf home:Fruit } }", graph + "rdfs:subClassOf home:PhysicalObject } }"
+    with pytest.raises(UndeclaredSuperclassError, match=r"^the update: .*home:Fruit is declared nowhere.*written$"):
+        kb.update(fruit)
+    assert _sizes(kb) == before
+    kb.update(physical)
+    assert _sizes(kb) != before
+
+
 def test_sizes_written_in_centimetres_are_refused_naming_the_metres(tmp_path: Path) -> None:
     """home:sizeX 7 for a 7 cm apple: refused before as the cup being inside it "by 307.8 cm"."""
     kb = KnowledgeBase.open(":memory:")
