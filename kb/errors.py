@@ -313,22 +313,31 @@ class UndeclaredSuperclassError(KnowledgeBaseError):
     """A load declares a class under a term of cbrs's own vocabularies (home:, cbrs:, act:) that they do
     not declare, nor the store, nor the load: ``lab8:Apple rdfs:subClassOf home:Fruit``. The class would
     hang from nothing the components know, so no step would take a thing of it, and the task's refusal
-    could not say why; nothing was loaded. ``suggestion`` is a declared term of a near spelling, if any."""
+    could not say why; nothing was loaded. ``suggestion`` is a declared term of a near spelling, if any;
+    ``line`` the line of ``source`` (a file) where the subclass is written, as other refused loads name it."""
 
     http_status = 400
 
     def __init__(
-        self, source: str, subclass: str, superclass: str, suggestion: str | None, undone: str = "nothing was loaded"
+        self,
+        source: str,
+        subclass: str,
+        superclass: str,
+        suggestion: str | None,
+        undone: str = "nothing was loaded",
+        line: int | None = None,
     ) -> None:
         self.source = source
         self.subclass = subclass
         self.superclass = superclass
         self.suggestion = suggestion
+        self.line = line
         from cbrs.kb.namespaces import shorten
 
         near = f"did you mean {shorten(suggestion)}? " if suggestion else ""
+        where = f"{source}:{line}" if line else source
         super().__init__(
-            f"{source}: {shorten(subclass)} rdfs:subClassOf {shorten(superclass)}: {shorten(superclass)} is declared "
+            f"{where}: {shorten(subclass)} rdfs:subClassOf {shorten(superclass)}: {shorten(superclass)} is declared "
             f"nowhere in the store or in this input, so {shorten(subclass)} would be below no class the components "
             f"know and no step would take a thing of it; {near}name a class the vocabulary declares (cbrs query "
             "'SELECT ?c WHERE { ?c rdfs:subClassOf+ home:PhysicalObject }' lists the things an arm can move), or a "

@@ -16,7 +16,7 @@ import pyoxigraph as ox
 
 from cbrs.kb.errors import UndeclaredSuperclassError
 from cbrs.kb.namespaces import OWL, PREFIXES, RDF, RDFS
-from cbrs.kb.shapes import did_you_mean
+from cbrs.kb.shapes import did_you_mean, line_of
 from cbrs.kb.store import Store
 
 OWN_NAMESPACES = tuple(PREFIXES[name] for name in ("home", "cbrs", "act"))
@@ -50,7 +50,7 @@ def check_superclasses(
                 continue
             near = did_you_mean(store, superclass.value, declared_here)
             subclass = quad.subject.value if isinstance(quad.subject, ox.NamedNode) else str(quad.subject)
-            raise UndeclaredSuperclassError(source, subclass, superclass.value, near, undone)
+            raise UndeclaredSuperclassError(source, subclass, superclass.value, near, undone, line_of(source, subclass))
 
 
 def _holds_vocabulary(store: Store, namespace: str) -> bool:
