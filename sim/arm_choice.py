@@ -97,7 +97,8 @@ def why_none(ctx: SimContext, x: float, y: float) -> str:
 def grasp_pose_for(ctx: SimContext, estimate: ObjectEstimate, side: ArmSide, held: ObjectModel) -> GraspPose:
     spec = ctx.world.arm_specs[side]
     hand = ctx.world.arm(side).hand
-    return compute_grasp_pose(held, estimate.position, estimate.yaw, spec.mount, spec.yaw, seen_extent(estimate), hand)
+    seen = seen_extent(estimate)
+    return compute_grasp_pose(held, estimate.position, estimate.yaw, spec.mount, spec.yaw, seen, hand, estimate.size[2])
 
 
 def who_takes(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel) -> GraspChoice:

@@ -38,6 +38,7 @@ from cbrs.sim.place_spots import (
     RELAY_STEP,
     fixtures_on,
     other_objects,
+    place_inset,
     place_spots,
     reach_of,
     support_of,
@@ -198,13 +199,16 @@ def box_spots(
     lying: Sequence[Lying] = (),
 ) -> tuple[Region, list[Spot]]:
     """:func:`place_spots` for a thing of footprint ``foot`` (``height`` tall): the same grid, reach and
-    order (a point's spots), and the footprint itself RELAY_EDGE inside the edge of what it rests on and
+    order (a point's spots), its centre :func:`place_inset` inside the place's edges by the footprint's
+    half extent, and the footprint itself RELAY_EDGE inside the edge of what it rests on and
     RELAY_CLEARANCE clear of the fixtures it would meet on the way down, of ``others`` (x, y, radius) and
     of the footprints of ``lying``."""
     surface, points = place_spots(smap, place, (0.0, 0.0, height), mounts, [])
     _, support = support_of(smap, place)
     box = support.box
     hx, hy = foot.half_extent()
+    in_x = place_inset(hx, surface.xmax - surface.xmin) - 1e-9
+    in_y = place_inset(hy, surface.ymax - surface.ymin) - 1e-9
     extents = fixtures_on(smap, support, surface.center[2], height + skills.ABOVE_CLEARANCE)
     fixtures = [[(x0, y0), (x1, y0), (x1, y1), (x0, y1)] for x0, x1, y0, y1 in extents]
     return surface, [
@@ -212,6 +216,8 @@ def box_spots(
         for x, y in points
         if box.min_x + hx + RELAY_EDGE <= x <= box.max_x - hx - RELAY_EDGE
         and box.min_y + hy + RELAY_EDGE <= y <= box.max_y - hy - RELAY_EDGE
+        and surface.xmin + in_x <= x <= surface.xmax - in_x
+        and surface.ymin + in_y <= y <= surface.ymax - in_y
         and clear_of(foot, x, y, others, lying, fixtures)
     ]
 

@@ -35,6 +35,24 @@ RELAY_STEP = 0.02
 """The spots tried are a 2 cm grid over the surface."""
 
 
+SPOT_INSET = 0.01
+"""The least a spot's centre keeps inside its place's edge (:func:`place_inset`), where the place is too
+small to hold the object's footprint: a set-down lands within about a centimetre of its spot."""
+
+
+def place_inset(half: float, width: float) -> float:
+    """How far inside the edges of a place ``width`` wide (along one axis) a spot's centre keeps for an
+    object whose footprint reaches ``half`` from its centre along it: ``half``, so that the whole footprint
+    is over the place, where the place is that wide; else SPOT_INSET, or the middle of a place narrower
+    than twice that. Whether a thing is on or in a place is asked of its centre as perception sees it
+    (``predicates``): a centre on the edge counts either way by a fraction of a millimetre. Before, a
+    spot's centre only had to be over the place, edge included, and a lab's apple carried to the one part
+    of a bowl the arm reached, its edge, was seen 0.3 mm outside it (docs/simulation.md)."""
+    if width >= 2.0 * half:
+        return half
+    return min(SPOT_INSET, width / 2.0)
+
+
 def reach_of(arm: Arm) -> tuple[float, float, float]:
     """An arm's reach as :func:`place_spots` takes it: (mount x, mount y, reach)."""
     return (arm.mount[0], arm.mount[1], arm.reach)
@@ -91,7 +109,8 @@ def place_spots(
     """Where on a place an object of ``size`` can be set down by an arm mounted at one of ``mounts``
     (x, y, reach): the place's surface (a region's bottom, a piece of furniture's top), and the spots of
     a grid over the place, from its centre out, nearest the centre first, where the object's centre is
-    over the place and at least RELAY_MARGIN inside a mount's reach, its footprint on the surface it
+    over the place, :func:`place_inset` inside its edges (its footprint's circle where the place holds
+    it), and at least RELAY_MARGIN inside a mount's reach, its footprint on the surface it
     rests on (the furniture under a region) RELAY_EDGE inside the edge, RELAY_CLEARANCE clear of
     ``others`` (x, y, radius) and of the fixtures it would meet on the way down (a dispenser's body; not
     the spout high above it). The place's centre is the first spot where it is one: a place an arm only
@@ -102,16 +121,18 @@ def place_spots(
     radius = math.hypot(size[0], size[1]) / 2.0
     fixtures = fixtures_on(smap, support, z, size[2] + skills.ABOVE_CLEARANCE)
     inset = radius + RELAY_EDGE
+    in_x = place_inset(radius, surface.xmax - surface.xmin) - 1e-9
+    in_y = place_inset(radius, surface.ymax - surface.ymin) - 1e-9
     spots: list[tuple[float, float, float]] = []
     nx = int((surface.xmax - surface.xmin) / 2.0 / RELAY_STEP) + 1
     ny = int((surface.ymax - surface.ymin) / 2.0 / RELAY_STEP) + 1
     for i in range(-nx, nx + 1):
         x = cx + i * RELAY_STEP
-        if not (surface.xmin - 1e-9 <= x <= surface.xmax + 1e-9 and box.min_x + inset <= x <= box.max_x - inset):
+        if not (surface.xmin + in_x <= x <= surface.xmax - in_x and box.min_x + inset <= x <= box.max_x - inset):
             continue
         for j in range(-ny, ny + 1):
             y = cy + j * RELAY_STEP
-            if not (surface.ymin - 1e-9 <= y <= surface.ymax + 1e-9 and box.min_y + inset <= y <= box.max_y - inset):
+            if not (surface.ymin + in_y <= y <= surface.ymax - in_y and box.min_y + inset <= y <= box.max_y - inset):
                 continue
             if not any(math.hypot(x - mx, y - my) <= reach - RELAY_MARGIN for mx, my, reach in mounts):
                 continue

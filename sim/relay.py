@@ -78,8 +78,9 @@ def relay_object(
     on the same surface, where both reach, and the object is found again there."""
     world = ctx.world
     spec, hand = world.arm_specs[giver], world.arm(giver).hand
+    seen = seen_extent(estimate)
     grasp = compute_grasp_pose(
-        model, estimate.position, estimate.yaw, spec.mount, spec.yaw, seen_extent(estimate), hand
+        model, estimate.position, estimate.yaw, spec.mount, spec.yaw, seen, hand, estimate.size[2]
     )
     ctx.last_arm = giver
     for move in (skills.approach_object, skills.pick_up_object):

@@ -233,6 +233,7 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
             taker_spec.yaw,
             seen_extent(found),
             world.arm(taker).hand,
+            found.size[2],
         )
         for move in (skills.approach_object, skills.pick_up_object):
             check_passing(move(world, taker, grasp), model, giver, taker)

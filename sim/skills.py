@@ -555,7 +555,8 @@ def _grasp(world: HomeWorld, pen: ObjectEstimate, side: ArmSide | str, model: Ob
     spec = world.arm_specs[ArmSide(side)]
     hand = world.arm(side).hand
     try:
-        return compute_grasp_pose(model, pen.position, pen.yaw, spec.mount, spec.yaw, (pen.size[0], pen.size[1]), hand)
+        seen = (pen.size[0], pen.size[1])
+        return compute_grasp_pose(model, pen.position, pen.yaw, spec.mount, spec.yaw, seen, hand, pen.size[2])
     except GraspMisfitError as misfit:
         return str(misfit)
 
