@@ -147,8 +147,11 @@ def bindings(body: bytes) -> tuple[Any, Counter[str]]:
     return answer["head"], Counter(json.dumps(row, sort_keys=True) for row in rows)
 
 
+# A real random.Random that Hypothesis seeds (use_true_random): its own Random made every one of the
+# some 400 calls per example a choice it records for shrinking, 8 of the test's 8.7 s; the same 100
+# stores and 800 lookups are compared, and a failure is replayed from its seed (it is not shrunk).
 @settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(st.randoms(use_true_random=False))
+@given(st.randoms(use_true_random=True))
 def test_a_direct_lookup_answers_the_bytes_oxigraph_writes(rng: random.Random) -> None:
     store = ox.Store()
     random_store(rng, store)
