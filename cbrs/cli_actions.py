@@ -837,24 +837,13 @@ def _unchecked_text(result: RunResult) -> str:
     return f"; {len(unchecked)} goal(s) the world cannot check ({said})"
 
 
-PRECONDITIONS_NAMED = 3  # the most statements taken as given the text names; --json lists each
-
-
 def _preconditions_text(checks: Sequence[PreconditionCheck]) -> str:
-    """The task's own preconditions as the run found them before its first step, one line: how many were
-    perceived holding, and those no test decides (taken as given, as a fetch task's ``home:hasMarker``)
-    named, at most ``PRECONDITIONS_NAMED`` (docs/execution.md, "A task's preconditions"); none: no line."""
-    if not checks:
-        return ""
-    held = sum(1 for check in checks if check.believed)
-    given = [statement_text(check.statement) for check in checks if check.believed is None]
-    parts = [f"{held} perceived holding"] if held else []
-    if given:
-        named = "; ".join(given[:PRECONDITIONS_NAMED])
-        if len(given) > PRECONDITIONS_NAMED:
-            named += f"; and {len(given) - PRECONDITIONS_NAMED} more (--json lists each)"
-        parts.append(f"{len(given)} taken as given, no test decides {'it' if len(given) == 1 else 'them'}: {named}")
-    return "\npreconditions: " + "; ".join(parts)
+    """The task's own preconditions as the run found them, a line under the verdict
+    (:func:`cbrs.tasks.preconditions_line`, the run page's words); none: no line."""
+    from cbrs.tasks import preconditions_line
+
+    line = preconditions_line(check.to_dict() for check in checks)
+    return "\n" + line if line else ""
 
 
 def _answers_text(result: RunResult) -> str:

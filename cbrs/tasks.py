@@ -552,6 +552,27 @@ def _jpeg(rgb: Any) -> bytes:
     return buffer.getvalue()
 
 
+PRECONDITIONS_NAMED = 3  # the most preconditions taken as given the line names; the run's JSON lists each
+
+
+def preconditions_line(checks: Iterable[dict[str, Any]], listed: str = "--json lists each") -> str:
+    """A run's ``preconditions`` (its JSON's ``{statement, believed}``: the task's own, as the run found
+    them before its first step) in one line for a person, as ``cbrs run`` and the run page say them: those
+    perceived holding counted, those no test decides (taken as given, as a fetch task's ``home:hasMarker``)
+    named, at most ``PRECONDITIONS_NAMED``, then where the rest are ``listed`` (docs/execution.md, "A task's
+    preconditions"); "" for none."""
+    found = list(checks)
+    held = sum(1 for check in found if check.get("believed"))
+    given = [str(check.get("statement")) for check in found if check.get("believed") is None]
+    parts = [f"{held} perceived holding"] if held else []
+    if given:
+        named = "; ".join(given[:PRECONDITIONS_NAMED])
+        if len(given) > PRECONDITIONS_NAMED:
+            named += f"; and {len(given) - PRECONDITIONS_NAMED} more ({listed})"
+        parts.append(f"{len(given)} taken as given, no test decides {'it' if len(given) == 1 else 'them'}: {named}")
+    return "preconditions: " + "; ".join(parts) if parts else ""
+
+
 def check_choice(field: str, value: str, kind: type[Enum]) -> str:
     """``value`` when it names a member of ``kind`` (an option's choices), else :class:`RunOptionError`
     naming ``field`` and the choices: one set of words for a run's and a plan's options, wherever asked."""

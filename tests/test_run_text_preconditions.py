@@ -13,9 +13,10 @@ import pytest
 from cbrs.actions.graph import statement_text
 from cbrs.actions.runner import RunResult, run_task
 from cbrs.actions.task_preconditions import PreconditionCheck
-from cbrs.cli_actions import PRECONDITIONS_NAMED, run_text
+from cbrs.cli_actions import run_text
 from cbrs.kb import KnowledgeBase, Statement
 from cbrs.kb.resources import ontology_dir
+from cbrs.tasks import PRECONDITIONS_NAMED
 from tests.test_task_preconditions import EX, ON_TRAY, TASK, Home
 
 

@@ -35,6 +35,7 @@ from cbrs.tasks import (
     TaskRun,
     TasksDisabledError,
     UnknownComponentError,
+    preconditions_line,
 )
 from cbrs.web import context
 from cbrs.web.links import expand_name, short
@@ -428,6 +429,9 @@ def _detail(found: TaskRun) -> dict[str, Any]:
     data["steps"] = steps(data["events"])
     data["unmet"] = unmet(data.get("result"))
     data["verdict"] = verdict(data)
+    found_before = (data.get("result") or {}).get("preconditions", [])  # the task's own, before the first step
+    line = preconditions_line(found_before, listed="the run's JSON lists each")
+    data["preconditions_line"] = line[:1].upper() + line[1:]  # a sentence of the page's
     return data
 
 
