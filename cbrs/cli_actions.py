@@ -100,7 +100,8 @@ _BASE_TIES = click.option(
     show_default=True,
     help=(
         "In a home of several mobile bases, how plans of one cost and similarity for different bases are told"
-        " apart: nearest, the base nearest where its plan first drives it (in the map), then the first by IRI;"
+        " apart: nearest, the base with the shortest route (round walls and furniture in the map) to where its"
+        " plan first drives it, then the first by IRI;"
         " iri, the first by IRI (docs/simulation.md, A home with no mobile base)."
     ),
 )
