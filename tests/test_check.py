@@ -13,6 +13,7 @@ from cbrs.check import JavaMissingError, check
 from cbrs.cli import cli
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import GraphName
+from tests.test_owl_api import JVM_FLAGS
 
 needs_java = pytest.mark.skipif(
     shutil.which(str(owlready2.JAVA_EXE)) is None, reason="no Java runtime (apt-get install default-jre-headless)"
@@ -22,6 +23,15 @@ HEAD = """@prefix ex: <http://example.org/check#> . @prefix owl: <http://www.w3.
 @prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> . @prefix xsd: <http://www.w3.org/2001/XMLSchema#> .
 ex:Cup a owl:Class . ex:Plate a owl:Class ; owl:disjointWith ex:Cup .
 """
+
+
+@pytest.fixture(autouse=True)
+def quick_jvm(monkeypatch: pytest.MonkeyPatch) -> None:
+    """HermiT's JVM with the client compiler only and the serial collector, as tests/test_owl_api.py
+    runs it (the java launcher reads JDK_JAVA_OPTIONS; owlready2 passes none): the file took 15 s
+    instead of 9 on a loaded 2-core machine, the fresh store's check 7 s of it. What HermiT answers
+    does not depend on them."""
+    monkeypatch.setenv("JDK_JAVA_OPTIONS", " ".join(JVM_FLAGS))
 
 
 def small_kb(tmp_path: Path, turtle: str) -> KnowledgeBase:
