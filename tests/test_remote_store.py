@@ -201,6 +201,7 @@ def test_every_named_query_with_parameters_gives_the_embedded_answer(
         "thing": ["world:Pen", "world:Person", "world:Cup"],
         "relation": ["home:isLocatedOn", "home:isNear"],
         "class": ["home:Cup", "home:Drinkware"],
+        "room": ["home:Kitchen", "world:Kitchen"],
         "robot": ["svc:CytonDualArm01"],
         "graph": ["graph:ontology", "graph:world", "graph:map"],
         "component": [LOCATE],
