@@ -22,6 +22,7 @@ from pathlib import Path
 import pyoxigraph as ox
 import pytest
 
+from cbrs.check import JVM_OPTIONS
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.conditions import CONDITION_PARTS
 from cbrs.kb.namespaces import OWL, RDF
@@ -54,8 +55,8 @@ DEPENDENCY_JARS = (
 INSTALL = "apt-get install libowlapi-java default-jdk-headless"
 JAVA_SECONDS = 300  # the whole bundle takes about 10 s on a shared 2-core machine
 # A short run: the client compiler alone and the serial collector start sooner and leave the other core to
-# the other tests (javac and the round trip took 12.5 s with the defaults, 8.4 s with these).
-JVM_FLAGS = ("-XX:TieredStopAtLevel=1", "-XX:+UseSerialGC")
+# the other tests (javac and the round trip took 12.5 s with the defaults, 8.4 s with these); cbrs check's.
+JVM_FLAGS = JVM_OPTIONS
 
 
 @dataclass(frozen=True)
