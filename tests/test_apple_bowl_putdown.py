@@ -83,8 +83,8 @@ def test_the_partly_seen_apple_is_grasped_at_its_middle_and_hangs_where_the_gras
 
 def test_a_place_narrower_than_the_thing_keeps_its_centre_a_margin_inside() -> None:
     assert place_inset(0.0495, 0.20) == 0.0495  # the apple's circle in the 20 cm bowl
-    assert place_inset(0.0495, 0.06) == SPOT_INSET  # a 6 cm coaster: the centre 1 cm inside
-    assert place_inset(0.0495, 0.015) == pytest.approx(0.0075)  # narrower still: its middle
+    assert place_inset(0.0495, 0.06) == SPOT_INSET  # a 6 cm coaster: the centre SPOT_INSET inside
+    assert place_inset(0.0495, SPOT_INSET) == pytest.approx(SPOT_INSET / 2.0)  # narrower still: its middle
 
 
 def test_the_bowl_at_the_west_is_aimed_at_inside_by_the_apples_footprint(west_map: SemanticMap) -> None:
