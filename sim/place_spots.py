@@ -45,14 +45,21 @@ the cup down at, 5 mm inside its edge; 1 cm took it off, and a pass to the other
 
 def place_inset(half: float, width: float) -> float:
     """How far inside the edges of a place ``width`` wide (along one axis) a spot's centre keeps for an
-    object whose footprint reaches ``half`` from its centre along it: ``half``, so that the whole footprint
-    is over the place, where the place is that wide; else SPOT_INSET, or the middle of a place narrower
-    than twice that. Whether a thing is on or in a place is asked of its centre as perception sees it
-    (``predicates``): a centre on the edge counts either way by a fraction of a millimetre. Before, a
-    spot's centre only had to be over the place, edge included, and a lab's apple carried to the one part
-    of a bowl the arm reached, its edge, was seen 0.3 mm outside it (docs/simulation.md)."""
+    object whose footprint reaches ``half`` from its centre along it, so that the whole footprint is over
+    the place: ``half`` where the place is that wide, else :func:`least_inset`. Such spots come first
+    (:func:`place_spots`); the others keep only :func:`least_inset`."""
     if width >= 2.0 * half:
         return half
+    return least_inset(width)
+
+
+def least_inset(width: float) -> float:
+    """The least a spot's centre keeps inside the edges of a place ``width`` wide: SPOT_INSET, or the middle
+    of a place narrower than twice that. Whether a thing is on or in a place is asked of its centre as
+    perception sees it (``predicates``): a centre on the edge counts either way by a fraction of a
+    millimetre. Before, a spot's centre only had to be over the place, edge included, and a lab's apple
+    carried to the one part of a bowl the arm reached, its edge, was seen 0.3 mm outside it
+    (docs/simulation.md)."""
     return min(SPOT_INSET, width / 2.0)
 
 
@@ -117,16 +124,28 @@ def place_spots(
     rests on (the furniture under a region) RELAY_EDGE inside the edge, RELAY_CLEARANCE clear of
     ``others`` (x, y, radius) and of the fixtures it would meet on the way down (a dispenser's body; not
     the spout high above it). The place's centre is the first spot where it is one: a place an arm only
-    partly reaches is worked at its reachable part, not at a centre no arm reaches."""
+    partly reaches is worked at its reachable part, not at a centre no arm reaches.
+
+    The spots are those with the whole footprint over the place where ``mounts`` have any; else none where
+    another arm of the map has one (it sets the thing down wholly inside: the west bowl's apple goes to the
+    arm that reaches its middle, not onto the edge the other reaches); else those whose centre is only
+    :func:`least_inset` inside the place, so that a place with room for the whole footprint only where no
+    arm can set it down (the pen's 20 x 15 cm spot beside the dispenser) is still used."""
     surface, support = support_of(smap, place)
     cx, cy, z = surface.center
     box = support.box
     radius = math.hypot(size[0], size[1]) / 2.0
     fixtures = fixtures_on(smap, support, z, size[2] + skills.ABOVE_CLEARANCE)
     inset = radius + RELAY_EDGE
-    in_x = place_inset(radius, surface.xmax - surface.xmin) - 1e-9
-    in_y = place_inset(radius, surface.ymax - surface.ymin) - 1e-9
-    spots: list[tuple[float, float, float]] = []
+    width, depth = surface.xmax - surface.xmin, surface.ymax - surface.ymin
+    whole_x, whole_y = place_inset(radius, width) - 1e-9, place_inset(radius, depth) - 1e-9
+    in_x, in_y = least_inset(width) - 1e-9, least_inset(depth) - 1e-9
+    everyone = [reach_of(arm) for arm in smap.arms.values()]
+
+    def reached(x: float, y: float, by: Sequence[tuple[float, float, float]]) -> bool:
+        return any(math.hypot(x - mx, y - my) <= reach - RELAY_MARGIN for mx, my, reach in by)
+
+    found: list[tuple[bool, bool, float, float, float]] = []  # (whole, mine, distance from the centre, x, y)
     nx = int((surface.xmax - surface.xmin) / 2.0 / RELAY_STEP) + 1
     ny = int((surface.ymax - surface.ymin) / 2.0 / RELAY_STEP) + 1
     for i in range(-nx, nx + 1):
@@ -137,14 +156,24 @@ def place_spots(
             y = cy + j * RELAY_STEP
             if not (surface.ymin + in_y <= y <= surface.ymax - in_y and box.min_y + inset <= y <= box.max_y - inset):
                 continue
-            if not any(math.hypot(x - mx, y - my) <= reach - RELAY_MARGIN for mx, my, reach in mounts):
+            mine = reached(x, y, mounts)
+            if not (mine or reached(x, y, everyone)):
                 continue
             if any(math.hypot(x - ox_, y - oy) < radius + r + RELAY_CLEARANCE for ox_, oy, r in others):
                 continue
             if any(distance_to_extent(extent, (x, y)) < radius + RELAY_CLEARANCE for extent in fixtures):
                 continue
-            spots.append((math.hypot(x - cx, y - cy), x, y))
-    return surface, [(x, y) for _, x, y in sorted(spots)]
+            whole = surface.xmin + whole_x <= x <= surface.xmax - whole_x and (
+                surface.ymin + whole_y <= y <= surface.ymax - whole_y
+            )
+            found.append((whole, mine, math.hypot(x - cx, y - cy), x, y))
+    if any(whole for whole, mine, *_ in found if mine):
+        chosen = [(d, x, y) for whole, mine, d, x, y in found if whole and mine]
+    elif any(whole for whole, *_ in found):
+        chosen = []
+    else:
+        chosen = [(d, x, y) for _, mine, d, x, y in found if mine]
+    return surface, [(x, y) for _, x, y in sorted(chosen)]
 
 
 def support_of(smap: SemanticMap, place: Thing) -> tuple[Region, Thing]:
