@@ -34,7 +34,7 @@ from numpy.typing import NDArray
 
 from cbrs.kb.semantic_map import MapError, MobileRobot, SemanticMap, local_name
 
-__all__ = ["FloorGrid", "Route", "RouteSettings", "Routes", "base_radius"]
+__all__ = ["FloorGrid", "Route", "RouteSettings", "Routes", "base_radius", "inflate"]
 
 Point = tuple[float, float]
 Cell = tuple[int, int]
@@ -221,12 +221,13 @@ def _grid(obstacles: tuple[_Footprint, ...], bounds: Bounds, radius: float, sett
         c, s = math.cos(o.yaw), math.sin(o.yaw)
         u, v = c * dx + s * dy, -s * dx + c * dy
         occupied |= (np.abs(u) <= o.half[0] + 1e-9) & (np.abs(v) <= o.half[1] + 1e-9)
-    inflated = _inflate(occupied, (radius + res / 2) / res)
+    inflated = inflate(occupied, (radius + res / 2) / res)
     return FloorGrid(res, (bounds[0], bounds[2]), occupied, inflated, radius)
 
 
-def _inflate(occupied: NDArray[np.bool_], radius_cells: float) -> NDArray[np.bool_]:
-    """Obstacles grown by a disc of ``radius_cells`` (the map server's dilation)."""
+def inflate(occupied: NDArray[np.bool_], radius_cells: float) -> NDArray[np.bool_]:
+    """Obstacles grown by a disc of ``radius_cells`` (a morphological dilation with shifted copies): the map
+    server's (``sim.mapping``) and the routes' grids alike."""
     rows, cols = occupied.shape
     out = occupied.copy()
     reach = math.ceil(radius_cells)

@@ -21,6 +21,7 @@ import numpy as np
 import pybullet as p
 from numpy.typing import NDArray
 
+from cbrs.kb.floor_routes import inflate  # the map server's dilation, here for its callers
 from cbrs.sim.errors import OutsideMapError
 from cbrs.sim.layout import MAP_RESOLUTION
 from cbrs.sim.world import HomeWorld
@@ -80,20 +81,6 @@ class OccupancyGrid:
         """Whether the measured (not inflated) grid has an obstacle at a world point."""
         row, col = self.world_to_cell(x, y)
         return bool(self.occupied[row, col])
-
-
-def inflate(occupied: NDArray[np.bool_], radius_cells: float) -> NDArray[np.bool_]:
-    """Grow obstacles by a disc of ``radius_cells`` (a morphological dilation with shifted copies)."""
-    rows, cols = occupied.shape
-    out = occupied.copy()
-    reach = math.ceil(radius_cells)
-    for di in range(-reach, reach + 1):
-        for dj in range(-reach, reach + 1):
-            if (di == 0 and dj == 0) or di * di + dj * dj > radius_cells * radius_cells + 1e-9:
-                continue
-            src = occupied[max(0, -di) : rows - max(0, di), max(0, -dj) : cols - max(0, dj)]
-            out[max(0, di) : rows - max(0, -di), max(0, dj) : cols - max(0, -dj)] |= src
-    return out
 
 
 def build_occupancy_grid(
