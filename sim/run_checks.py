@@ -36,7 +36,14 @@ from cbrs.sim.grounding import docking_pose, people_given, task_inputs_of
 from cbrs.sim.packing import check_room
 from cbrs.sim.perceived import PerceivedWorld
 from cbrs.sim.perception import ObjectEstimate
-from cbrs.sim.place_spots import RELAY_CLEARANCE, RELAY_MARGIN, distance_to_extent, other_objects, place_spots
+from cbrs.sim.place_spots import (
+    RELAY_CLEARANCE,
+    RELAY_MARGIN,
+    SPOT_INSET,
+    distance_to_extent,
+    other_objects,
+    place_spots,
+)
 from cbrs.sim.services import (
     MOVING,
     SKILLS,
@@ -528,8 +535,9 @@ class PlanChecks:
             if blockers:
                 raise PlaceCrowdedError(iri, what, blockers, RELAY_CLEARANCE)
             why = (
-                f"no spot of it is {RELAY_MARGIN:.2f} m inside an arm's reach with {what} clear of the edge of the "
-                "surface, the other objects and the fixtures on it"
+                f"no spot of it is {RELAY_MARGIN:.2f} m inside an arm's reach with {what}'s centre "
+                f"{SPOT_INSET * 1000:.0f} mm inside the place and clear of the edge of the surface, the other "
+                "objects and the fixtures on it"
             )
             where = ((box.min_x + box.max_x) / 2, (box.min_y + box.max_y) / 2)
             raise OutOfReachError(step.device or "", iri, where, report, why)

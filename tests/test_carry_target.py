@@ -143,5 +143,5 @@ def test_a_place_in_reach_only_within_the_margin_is_refused_before_anything_move
         assert world.base_pose().distance_to(start.x, start.y) < 0.01
     assert refused.value.thing == WORLD + "PenRestAtTheEdge"
     assert any(distance <= reach for *_, reach, distance in refused.value.arms)  # part of it is in reach
-    assert "no spot of it" in refused.value.why and "Pen" in refused.value.why
+    assert "no spot of it" in refused.value.why and "Pen's centre 5 mm inside the place" in refused.value.why
     assert set(kb.store.quads()) == before
