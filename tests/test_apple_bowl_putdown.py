@@ -6,7 +6,9 @@ inside its place (sim.place_spots.place_inset), so a thing set down there is in 
 
 from __future__ import annotations
 
+import colorsys
 import math
+import re
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -24,6 +26,7 @@ from cbrs.sim.world import open_world
 from tests.helpers_examples import EXAMPLES
 
 LAB8 = "https://example.org/lab8#"
+DOCS_TASKS = Path(__file__).resolve().parents[1] / "docs" / "tasks.md"
 DEVICE = "CytonDualArm01"
 BOWL_EAST = "home:minX 8.20 ; home:maxX 8.40 ; home:minY 3.05 ; home:maxY 3.25"
 BOWL_WEST = "home:minX 7.15 ; home:maxX 7.35 ; home:minY 3.08 ; home:maxY 3.28"  # as the lab first wrote it
@@ -104,3 +107,20 @@ def test_the_bowl_at_the_west_is_aimed_at_inside_by_the_apples_footprint(west_ma
             assert box.min_y + radius - 1e-6 <= y <= box.max_y - radius + 1e-6
     _, both = place_spots(west_map, bowl, apple.size, list(arms.values()), [])
     assert both[0] == pytest.approx(((box.min_x + box.max_x) / 2.0, (box.min_y + box.max_y) / 2.0))
+
+
+def test_the_hue_windows_docs_tasks_md_gives_a_lab_are_perceptions() -> None:
+    """docs/tasks.md tells a lab writing home:rgba the hue window of each home:colourName, so that it paints
+    a thing well inside it (the apple at the edge of green was seen in part): the windows must be the
+    segmenter's, and the apple's hue must be at the edge the docs warn of."""
+    from cbrs.sim.perception import COLOURS
+
+    row = next(line for line in DOCS_TASKS.read_text(encoding="utf-8").splitlines() if line.startswith("| `home:rgba`"))
+    said = {name: (int(low), int(high)) for name, low, high in re.findall(r"(\w+) (\d+)-(\d+)", row)}
+    assert set(said) == set(COLOURS)
+    for name, (low, high) in said.items():
+        window = COLOURS[name]
+        assert (low, high) == (round(window.hue - window.hue_tolerance) % 360, round(window.hue + window.hue_tolerance))
+        assert f"saturation {window.min_saturation}" in row
+    hue, _, _ = colorsys.rgb_to_hsv(0.40, 0.80, 0.20)
+    assert round(hue * 360) == said["green"][0]
