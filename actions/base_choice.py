@@ -249,10 +249,13 @@ def _decide(
             f"{mine.similarity:.3f}, {_local(second)}'s {theirs.similarity:.3f}"
         )
         return best, why, "similarity", ()
-    alike = (
-        f"{alike_stated}its plan and {_local(second)}'s cost alike ({mine.cost:g} s) "
-        f"and match alike ({mine.similarity:.3f})"
-    )
+
+    def head(other: str) -> str:
+        return (
+            f"{alike_stated}its plan and {other}'s cost alike ({mine.cost:g} s) and match alike ({mine.similarity:.3f})"
+        )
+
+    alike = head(_local(second))
     if drive is None:
         return best, f"{alike}: the first base by IRI", "iri", ()
     tied = [base for base in ranked if rank.alike(planned[base], base, mine, best)]
@@ -263,12 +266,6 @@ def _decide(
         why = f"{alike}, and {named}'s plan drives to nothing the map places: the first base by IRI"
         return best, why, "iri", drives
     measured = {base: found for base, found in drives if found is not None}
-
-    def head(other: str) -> str:
-        return (
-            f"{alike_stated}its plan and {other}'s cost alike ({mine.cost:g} s) and match alike ({mine.similarity:.3f})"
-        )
-
     nearest, why = _nearest(measured, head)
     if nearest is None:
         return best, f"{alike}, {why}: the first base by IRI", "iri", drives
@@ -361,10 +358,9 @@ class MapDrives:
         x = sum(p[0] for p in points.values()) / len(points)
         y = sum(p[1] for p in points.values()) / len(points)
         route = self.routes.route(base, (x, y))
-        towards = tuple(sorted(points))
-        if not route.grid:  # nothing to route on: the straight line, said so
-            return FirstDrive(step.index, step.component, towards, route.straight, route.straight, "line", route.why)
-        return FirstDrive(step.index, step.component, towards, route.metres, route.straight, "route", route.why)
+        measure: Literal["route", "line"] = "route" if route.grid else "line"  # line: nothing to route on, said why
+        metres = route.metres if route.grid else route.straight
+        return FirstDrive(step.index, step.component, tuple(sorted(points)), metres, route.straight, measure, route.why)
 
     def _things(self, base: str, found: CompositionResult, inputs: Iterable[tuple[str, str]]) -> set[str]:
         """The things the task's ``inputs`` (requirement, name) designate, as a run of ``base`` would."""

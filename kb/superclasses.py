@@ -33,24 +33,28 @@ def check_superclasses(
     each file's name and quads; or an update's inserted quads, ``undone`` then saying what became of it)
     whose superclass is of :data:`OWN_NAMESPACES` and declared nowhere."""
     files = list(sources)
+    candidates = [  # one pass, and nothing more for a load that puts no class under a term of ours
+        (source, quad)
+        for source, quads in files
+        for quad in quads
+        if quad.predicate.value == _SUBCLASS
+        and isinstance(quad.object, ox.NamedNode)
+        and quad.object.value.startswith(OWN_NAMESPACES)
+    ]
+    if not candidates:
+        return
     declared_here = {q.subject.value for _, quads in files for q in quads if isinstance(q.subject, ox.NamedNode)}
-    for source, quads in files:
-        for quad in quads:
-            superclass = quad.object
-            if (
-                quad.predicate.value != _SUBCLASS
-                or not isinstance(superclass, ox.NamedNode)
-                or not superclass.value.startswith(OWN_NAMESPACES)
-                or superclass.value in declared_here
-                or next(iter(store.quads(superclass)), None) is not None
-            ):
-                continue
-            namespace = next(ns for ns in OWN_NAMESPACES if superclass.value.startswith(ns))
-            if not _holds_vocabulary(store, namespace):
-                continue
-            near = did_you_mean(store, superclass.value, declared_here)
-            subclass = quad.subject.value if isinstance(quad.subject, ox.NamedNode) else str(quad.subject)
-            raise UndeclaredSuperclassError(source, subclass, superclass.value, near, undone, line_of(source, subclass))
+    for source, quad in candidates:
+        superclass = quad.object
+        assert isinstance(superclass, ox.NamedNode)
+        if superclass.value in declared_here or next(iter(store.quads(superclass)), None) is not None:
+            continue
+        namespace = next(ns for ns in OWN_NAMESPACES if superclass.value.startswith(ns))
+        if not _holds_vocabulary(store, namespace):
+            continue
+        near = did_you_mean(store, superclass.value, declared_here)
+        subclass = quad.subject.value if isinstance(quad.subject, ox.NamedNode) else str(quad.subject)
+        raise UndeclaredSuperclassError(source, subclass, superclass.value, near, undone, line_of(source, subclass))
 
 
 def _holds_vocabulary(store: Store, namespace: str) -> bool:
