@@ -738,6 +738,8 @@ def _check_supports(built: SemanticMap) -> None:
         if obj.support is None:
             continue
         support = built.things.get(obj.support)
+        if support is None and obj.support in built.objects:
+            raise MapError(iri, _on_an_object(obj.support, built.objects[obj.support], built))
         if support is None:
             known = obj.support in built.facts or obj.support in built.types
             what = "has no extent (home:minX .. home:maxZ) to stand on" if known else "is nothing in the map"
@@ -753,6 +755,23 @@ def _check_supports(built: SemanticMap) -> None:
                 f"(home:isLocatedOn; x {box.min_x:g} .. {box.max_x:g}, y {box.min_y:g} .. {box.max_y:g}): "
                 "move it onto the support or name the support it is on",
             )
+
+
+def _on_an_object(iri: str, below: MapObject, built: SemanticMap) -> str:
+    """Why a thing cannot stand on ``below``, an object of the map, and what to write instead. The map's
+    objects are what moves (a shape, a size, a pose the seed varies, a body the arms take); what things
+    stand on is a piece of furniture or place, built as a fixed box whose top is their height. Said as "no
+    extent", a lab that gave the object an extent as well was told the same again."""
+    under = built.things.get(below.support or "")
+    top = f"home:maxZ {under.box.max_z + below.size[2]:.3g}" if under is not None else "home:maxZ"
+    return (
+        f"has home:isLocatedOn {iri}, which is an object of the map (home:shapeKind {below.shape!r} and a size: a "
+        "thing that moves), and nothing stands on an object: a thing stands on a piece of furniture or a place, "
+        f"with an extent (home:minX .. home:maxZ) and no home:shapeKind. To stack it, describe {below.name} as "
+        f"furniture (its class under home:Furniture, its extent home:minX .. {top}, its top), as "
+        "docs/examples/spice_rack.ttl does for a rack on the table; or stand the thing on "
+        f"what {below.name} stands on"
+    )
 
 
 def _check_fits(obj: MapObject, support: Thing) -> None:

@@ -1,0 +1,83 @@
+"""The ninth round of tasks written from the docs alone (docs/examples/lab9_*, docs/tasks.md "A ninth
+round"): a notebook stacked on a storage box on the kitchen table, the kitchen table replaced by the lab's
+own through one SPARQL update, a run started and stopped from roslibjs, and the map checked through the
+SPARQL endpoint, each with a newcomer's mistakes. Nothing is simulated here: the tasks are composed, the
+mistakes refused at the load or the update with the store as it was (bench/example_tasks.py runs the
+trials, docs/tasks.md gives their simulated seconds)."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+
+import pyoxigraph as ox
+import pytest
+
+from cbrs.actions.composer import Composer
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.semantic_map import MapError, SemanticMap
+from tests.helpers_examples import EXAMPLES
+
+HOME, WORLD, LAB9 = PREFIXES["home"], PREFIXES["world"], "https://example.org/lab9#"
+
+
+def _sizes(kb: KnowledgeBase) -> dict[str, int]:
+    rows = kb.query("SELECT ?g (COUNT(*) AS ?n) WHERE { GRAPH ?g { ?s ?p ?o } } GROUP BY ?g")
+    assert isinstance(rows, ox.QuerySolutions)
+    return {str(row["g"].value): int(row["n"].value) for row in rows}
+
+
+@pytest.fixture(scope="module")
+def book_kb() -> Iterator[KnowledgeBase]:
+    """The notebook on the storage box, and both of its tasks."""
+    kb = KnowledgeBase.open(":memory:")
+    kb.load([EXAMPLES / "lab9_book_on_box.ttl"], graph="ontology")
+    kb.load([EXAMPLES / "lab9_book_on_box.ttl"], graph="map")
+    for name in ("lab9_book_onto_the_table.ttl", "lab9_fetch_my_book.ttl"):
+        kb.load([EXAMPLES / name], graph="requirements")
+    yield kb
+    kb.close()
+
+
+# -- a thing stacked on another thing --------------------------------------------------------------
+
+
+def test_a_thing_on_an_object_is_refused_naming_the_object_and_how_to_stack(tmp_path: Path) -> None:
+    """The box first written as an object (a shape and a size): the notebook's support was said to have
+    "no extent (home:minX .. home:maxZ) to stand on", and said so again once the lab gave the box an
+    extent as well, since it was still an object."""
+    kb = KnowledgeBase.open(":memory:")
+    kb.load([EXAMPLES / "lab9_mistake_book_on_box.ttl"], graph="ontology")
+    before = _sizes(kb)
+    text = (EXAMPLES / "lab9_mistake_book_on_box.ttl").read_text(encoding="utf-8")
+    with_extent = tmp_path / "box_with_extent.ttl"
+    with_extent.write_text(
+        text.replace(
+            "home:y 3.13 ; home:yaw 0.0 .\n\nlab9:Notebook1",
+            "home:y 3.13 ; home:yaw 0.0 ;\n    home:minX 7.87 ; home:maxX 8.03 ; home:minY 3.07 ; home:maxY 3.19 ; "
+            "home:minZ 0.75 ; home:maxZ 0.81 .\n\nlab9:Notebook1",
+        ),
+        encoding="utf-8",
+    )
+    assert with_extent.read_text(encoding="utf-8") != text
+    for written in (EXAMPLES / "lab9_mistake_book_on_box.ttl", with_extent):
+        with pytest.raises(MapError) as refused:
+            kb.load([written], graph="map")
+        said = str(refused.value)
+        assert refused.value.thing == LAB9 + "Notebook1"
+        assert f"has home:isLocatedOn {LAB9}Box1, which is an object of the map" in said
+        assert "nothing stands on an object" in said and "no extent" not in said
+        assert "its class under home:Furniture, its extent home:minX .. home:maxZ 0.81" in said
+        assert "spice_rack.ttl" in said
+        assert _sizes(kb) == before
+
+
+def test_the_box_as_furniture_takes_the_notebook_and_both_tasks_plan(book_kb: KnowledgeBase) -> None:
+    semantic_map = SemanticMap.read(book_kb)
+    box, notebook = semantic_map.things[LAB9 + "Box1"], semantic_map.objects[LAB9 + "Notebook1"]
+    assert notebook.support == LAB9 + "Box1" and box.box.max_z == pytest.approx(0.81)
+    assert box.dock is not None and (box.dock.x, box.dock.y) == (8.5, 2.2)  # the table's docking pose
+    for task in ("BookOntoTheTable", "FetchMyBook"):
+        result = Composer(book_kb).compose(task)
+        assert result.plan is not None and result.unused_inputs == (), task
