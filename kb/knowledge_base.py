@@ -510,6 +510,8 @@ class KnowledgeBase:
             return
         problem = self._map_error()
         if problem is not None:
+            if stranded := _stranded(old_map, now):
+                problem.add_note(stranded)
             raise problem
 
     def _map_error(self) -> Exception | None:
@@ -595,6 +597,28 @@ class _MapBefore:
 
     quads: set[ox.Quad]
     read: bool
+
+
+_LOCATED_ON = ox.NamedNode("https://w3id.org/cbrs/home#isLocatedOn")
+
+
+def _stranded(before: set[ox.Quad], after: set[ox.Quad]) -> str:
+    """What an update that deleted every statement of a thing the map's things stand on left standing on
+    it, said after the reader's error (which can only call the support nothing in the map, and guess a name
+    near it): a lab replacing a piece of furniture must re-point them in the same update."""
+    left = {quad.subject for quad in after}
+    gone = {quad.subject for quad in before} - left
+    on: dict[str, list[str]] = {}
+    for quad in after:
+        if quad.predicate == _LOCATED_ON and quad.object in gone and isinstance(quad.object, ox.NamedNode):
+            on.setdefault(quad.object.value, []).append(str(quad.subject.value).rsplit("#", 1)[-1])
+    return "; ".join(
+        f"the update deleted every statement of {support}, and {', '.join(sorted(things))} still stand on it "
+        "(home:isLocatedOn): in the same update, delete those and insert what replaces it (DELETE { ?thing "
+        "home:isLocatedOn OLD } INSERT { ?thing home:isLocatedOn NEW } WHERE { ?thing home:isLocatedOn OLD }, as "
+        "docs/examples/lab9_new_kitchen_table.ru does)"
+        for support, things in sorted(on.items())
+    )
 
 
 def _refused(map_error: bool, whole: bool) -> str:

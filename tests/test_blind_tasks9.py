@@ -81,3 +81,31 @@ def test_the_box_as_furniture_takes_the_notebook_and_both_tasks_plan(book_kb: Kn
     for task in ("BookOntoTheTable", "FetchMyBook"):
         result = Composer(book_kb).compose(task)
         assert result.plan is not None and result.unused_inputs == (), task
+
+
+# -- the kitchen table replaced by the lab's own ---------------------------------------------------
+
+
+def test_an_update_that_deletes_a_support_names_what_still_stands_on_it() -> None:
+    """The old table deleted and the new one inserted, the cup, the pen and the dispenser still on the old
+    one: the refusal called the old table nothing in the map and asked whether KitchenTableTop was meant."""
+    kb = KnowledgeBase.open(":memory:")
+    before = _sizes(kb)
+    with pytest.raises(MapError) as refused:
+        kb.update((EXAMPLES / "lab9_mistake_new_table.ru").read_text(encoding="utf-8"))
+    notes = " ".join(getattr(refused.value, "__notes__", []))
+    assert f"the update deleted every statement of {WORLD}KitchenTable, and Cup, Pen, WaterDispenser01 still" in notes
+    assert "in the same update, delete those and insert what replaces it" in notes
+    assert "nothing was changed" in notes
+    assert _sizes(kb) == before
+
+
+def test_the_new_table_carries_what_stood_on_the_old_one() -> None:
+    kb = KnowledgeBase.open(":memory:")
+    kb.update((EXAMPLES / "lab9_new_kitchen_table.ru").read_text(encoding="utf-8"))
+    semantic_map = SemanticMap.read(kb)
+    assert WORLD + "KitchenTable" not in semantic_map.things
+    table = semantic_map.things[LAB9 + "KitchenTable2"]
+    assert (table.box.max_x, table.box.max_z) == (8.8, 0.75)
+    assert {semantic_map.objects[WORLD + name].support for name in ("Cup", "Pen")} == {LAB9 + "KitchenTable2"}
+    assert Composer(kb).compose("FetchMyPen").plan is not None
