@@ -15,7 +15,7 @@ import pyoxigraph as ox
 from cbrs.kb.backup import Backup, ExportReport, RestoreReport, export_store, read_backup, restore_store
 from cbrs.kb.catalog import Catalogue
 from cbrs.kb.descriptions import DescriptionReader
-from cbrs.kb.errors import ReplaceError, StoreError
+from cbrs.kb.errors import ReplaceError, StoreError, UndeclaredSuperclassError
 from cbrs.kb.liveness import Liveness
 from cbrs.kb.loader import (
     LoadReport,
@@ -37,7 +37,7 @@ from cbrs.kb.seed_cache import SeedCache, bundle_digest
 from cbrs.kb.shapes import CHECKED_GRAPHS, DescriptionShapeError, checked_update, may_write_descriptions
 from cbrs.kb.standard_terms import PendingUpdate, Refresh, StandardTerms
 from cbrs.kb.store import MEMORY, EmbeddedStore, QueryResult, Store, Term, is_remote
-from cbrs.kb.superclasses import check_superclasses
+from cbrs.kb.superclasses import check_added_superclasses, check_superclasses, may_add_subclasses, subclass_axioms
 from cbrs.kb.update_delta import DataUpdate
 from cbrs.kb.update_report import GraphChange, UpdateReport, exact_changes, graph_sizes, net_changes, refuse_split
 from cbrs.kb.upgrade import StoreCheck, UpgradeReport, check_store, upgrade_store
@@ -445,11 +445,15 @@ class KnowledgeBase:
         before = self._map_before_update(text, data) if check_map else None
         old_map = before.quads if before is not None else None
         everything: set[ox.Quad] | None = None  # the store before, kept here to put back whatever it wrote
+        axioms: set[ox.Quad] | None = None  # its subclass axioms, when the update may add one (not read)
         keep = data is not None  # whether a refused update is undone whole (a data update undoes itself)
         if data is None:  # what else it writes is unknown: keep the whole store if it might be refused
             described = may_write_descriptions(text) or _LOADS.search(text) is not None
-            keep = isinstance(self.store, EmbeddedStore) and (old_map is not None or described)
-            if keep and old_map is not None:  # one copy for both checks
+            embedded = isinstance(self.store, EmbeddedStore)
+            if embedded and may_add_subclasses(text):  # checked once it ran: kb/superclasses.py
+                axioms = subclass_axioms(self.store)
+            keep = embedded and (old_map is not None or described or axioms is not None)
+            if keep and (old_map is not None or axioms is not None):  # one copy for every check
                 everything = set(self.store.quads())
             if described:  # else it cannot reach them: the check read both graphs twice for nothing
                 checking = checked_update(self.store, keep and everything is None)  # kb/shapes.py puts back
@@ -458,8 +462,13 @@ class KnowledgeBase:
         try:
             with checking:
                 self.store.update(text)
+            if axioms is not None:
+                check_added_superclasses(self.store, axioms)
             if old_map is not None:
                 self._check_updated_map(old_map)
+        except UndeclaredSuperclassError:
+            self._put_back(everything, None)  # all it wrote: its message says nothing was
+            raise
         except (DescriptionShapeError, MapError) as error:
             unasked = isinstance(error, MapError) and before is not None and not before.read
             after = set(self.store.quads()) if unasked and data is None else None  # to redo it, if it stands
