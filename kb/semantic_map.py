@@ -433,6 +433,7 @@ class SemanticMap:
                 built.dispensers[iri] = _dispenser(built, iri, tap, facts)
         _check_extents(built, things_of("ObjectPlace"))
         _check_supports(built)
+        _check_heights(built)
         _check_overlaps(built)
         _check_properties(declared, facts)
         return built
@@ -755,6 +756,30 @@ def _check_supports(built: SemanticMap) -> None:
                 f"(home:isLocatedOn; x {box.min_x:g} .. {box.max_x:g}, y {box.min_y:g} .. {box.max_y:g}): "
                 "move it onto the support or name the support it is on",
             )
+
+
+def _check_heights(built: SemanticMap) -> None:
+    """No piece of furniture, place or wall has its top above the ceiling, where the map's ceiling cameras
+    (those looking straight down) hang: it is most often a height written in centimetres (home:maxZ 75 for a
+    table 75 cm high), which the map read without a word and a run refused only as a thing "75 m up" out of
+    every arm's reach. A map without a ceiling camera says nothing of its ceiling, and is not checked."""
+    ceiling = max((camera for camera in built.cameras.values() if camera.looks_down), key=_height, default=None)
+    if ceiling is None:
+        return
+    for iri, thing in sorted(built.things.items()):
+        top = thing.box.max_z
+        if top <= _height(ceiling):
+            continue
+        metres = f": heights are in metres, {top:g} cm is {top / 100:g}" if top / 100 <= _height(ceiling) else ""
+        raise MapError(
+            iri,
+            f"has its top at {top:g} m (home:maxZ {top:g}), above the ceiling, where {ceiling.name} hangs at "
+            f"{_height(ceiling):g} m{metres}",
+        )
+
+
+def _height(camera: Camera) -> float:
+    return camera.position[2]
 
 
 def _on_an_object(iri: str, below: MapObject, built: SemanticMap) -> str:

@@ -109,3 +109,28 @@ def test_the_new_table_carries_what_stood_on_the_old_one() -> None:
     assert (table.box.max_x, table.box.max_z) == (8.8, 0.75)
     assert {semantic_map.objects[WORLD + name].support for name in ("Cup", "Pen")} == {LAB9 + "KitchenTable2"}
     assert Composer(kb).compose("FetchMyPen").plan is not None
+
+
+def test_a_table_height_in_centimetres_is_refused_above_the_ceiling(tmp_path: Path) -> None:
+    """home:maxZ 75 for the new table: the update was taken without a word, and every run then refused the
+    pen as "75.01 m up", out of reach, naming neither the table nor the units."""
+    kb = KnowledgeBase.open(":memory:")
+    before = _sizes(kb)
+    text = (EXAMPLES / "lab9_new_kitchen_table.ru").read_text(encoding="utf-8")
+    in_cm = text.replace("home:maxZ 0.75 ;", "home:maxZ 75 ;")
+    assert in_cm != text
+    with pytest.raises(MapError) as refused:
+        kb.update(in_cm)
+    assert refused.value.thing == LAB9 + "KitchenTable2"
+    said = str(refused.value)
+    assert "has its top at 75 m (home:maxZ 75), above the ceiling, where CeilingCamera01 hangs at 4.5 m" in said
+    assert "heights are in metres, 75 cm is 0.75" in said
+    assert _sizes(kb) == before
+    cabinet = tmp_path / "cabinet.ttl"  # as high as a ceiling camera hangs, and no higher: taken
+    cabinet.write_text(
+        "@prefix home: <https://w3id.org/cbrs/home#> . @prefix lab9: <https://example.org/lab9#> .\n"
+        "lab9:Cabinet1 a home:Shelf ; home:minX 9.0 ; home:maxX 9.5 ; home:minY 4.5 ; home:maxY 4.9 ; "
+        "home:minZ 1.2 ; home:maxZ 4.5 .\n",
+        encoding="utf-8",
+    )
+    kb.load([cabinet], graph="map")
