@@ -242,11 +242,22 @@ def load(app: App, files: tuple[Path, ...], graph: str | None, catalogs: tuple[P
         click.echo(line)
     for line in _added_summary(report):
         click.echo(line)
+    _warn_colours(app.kb, report)
     for graph, count in report.removed.items():
         click.echo(f"replaced {shorten(graph)}: took out {_plural(count, 'triple')} the files do not give")
     for graph, count in report.kept.items():
         robots = ", ".join(shorten(iri) for iri in report.kept_robots)
         click.echo(f"kept in {shorten(graph)}: the robots' own descriptions ({robots}; {_plural(count, 'triple')})")
+
+
+def _warn_colours(kb: Any, report: LoadReport) -> None:
+    """Say on standard error which things the load painted where the cameras may not tell their colour
+    (:mod:`kb.colour_risk`): at a window's edge, outside every window, too grey or dark. Loaded all the
+    same: it is not wrong, only risky (an apple at the edge of green was seen in part, and dropped)."""
+    from cbrs.kb.colour_risk import written_colour_risks
+
+    for risk in written_colour_risks(kb, (quad for item in report.files for quad in item.quads)):
+        click.echo(f"warning: {risk.text()}", err=True)
 
 
 _UNDECLARED = re.compile(r"The prefix ([\w.-]*): has not been declared")

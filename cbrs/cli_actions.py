@@ -40,6 +40,7 @@ from cbrs.actions.task_preconditions import PreconditionCheck
 from cbrs.app import App, parse_iri, pass_app
 from cbrs.extras import installed, require
 from cbrs.kb import Advertisement, KnowledgeBase, RemoteStoreError
+from cbrs.kb.colour_risk import involved_colour_risks
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import shorten
 from cbrs.kb.semantic_map import SemanticMap, UnresolvedDesignatorError
@@ -596,10 +597,12 @@ def run(
             recorded = recorder.save(record)
         except RecordingError as error:
             raise click.ClickException(str(error)) from None
+    warnings = involved_colour_risks(app.kb, json.dumps(result.to_dict()))  # painted where cameras may not tell
     if as_json:
         found = result.to_dict()
         found["seed"] = seed
         found["sim_seconds"] = round(sim_seconds, 3)
+        found["warnings"] = [risk.to_dict() for risk in warnings]
         if policy is not None:
             found["random_faults"] = {"seed": policy.seed, "rate": policy.rate, "planned": _planned(policy, result)}
         click.echo(json.dumps(found, indent=2))
@@ -610,6 +613,8 @@ def run(
             )
             click.echo(f"random faults (seed {policy.seed}, rate {policy.rate}): {planned or 'none'}")
         click.echo(run_text(result, sim_seconds, wall))
+        for risk in warnings:
+            click.echo(f"warning: {risk.text()}")
         if recorded is not None:
             click.echo(
                 f"recording written to {recorded.video} ({recorded.frames} frames over {recorded.seconds:.1f} s"

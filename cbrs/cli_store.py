@@ -19,6 +19,7 @@ from cbrs.app import App, pass_app
 from cbrs.cli_interrupts import HeldInterrupts
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.backup import DEFAULT, Backup, NotAnExportError, export_format, read_backup
+from cbrs.kb.colour_risk import ColourRisk, colour_risks
 from cbrs.kb.derived_prefixes import StoreNames
 from cbrs.kb.errors import QuerySyntaxError, StoreEvaluationError, without_password
 from cbrs.kb.namespaces import PREFIXES, GraphName, shorten
@@ -188,6 +189,7 @@ def update(app: App, text: str | None, update_file: Any, as_json: bool) -> None:
     # derived prefixes are declared above the text when it uses them and declares them not
     names = StoreNames(lambda: app.kb)
     added = store_prefixes_used(body, lambda: names.prefixes)
+    colours = _ColourRisks(app.kb, body)
     with HeldInterrupts() as interrupts:
         interrupts.hold("running the update")
         try:
@@ -202,15 +204,21 @@ def update(app: App, text: str | None, update_file: Any, as_json: bool) -> None:
         except StoreEvaluationError as error:  # the store refused the request whole (one transaction)
             error.add_note("nothing was changed")
             raise
+    risks = colours.new()  # (a DELETE/INSERT that repaints changes no size: looked at all the same)
     if as_json:
         changes = [
             {"graph": change.graph or None, "net": change.net, "added": change.added, "removed": change.removed}
             for change in report.changes
         ]
-        click.echo(json.dumps({"exact": report.exact, "counted": report.counted, "changes": changes}, indent=2))
+        found: dict[str, Any] = {"exact": report.exact, "counted": report.counted, "changes": changes}
+        if risks:
+            found["warnings"] = [risk.to_dict() for risk in risks]
+        click.echo(json.dumps(found, indent=2))
         return
     for line in report.lines():
         click.echo(line)
+    for risk in risks:
+        click.echo(f"warning: {risk.text()}", err=True)
     if not report.changed:
         _note_unknown_names(app.kb, body, added)
     if report.changed and not app.kb.store.is_seeded():  # CLEAR ALL, DROP GRAPH graph:ontology
@@ -219,6 +227,22 @@ def update(app: App, text: str | None, update_file: Any, as_json: bool) -> None:
             "bundled data (cbrs restore FILE puts a backup back)",
             err=True,
         )
+
+
+class _ColourRisks:
+    """The things an update leaves painted where the cameras may not tell their colour and were not before
+    (:mod:`kb.colour_risk`); looked at only for an update that names a colour or a window's property."""
+
+    _WORDS = re.compile(r"rgba|colourName|ColourWindow|hueCentre|hueTolerance|hueMargin|minSaturation|minBrightness")
+
+    def __init__(self, kb: KnowledgeBase, body: str) -> None:
+        self._kb = kb
+        self._before = {risk.text() for risk in colour_risks(kb)} if self._WORDS.search(body) else None
+
+    def new(self) -> list[ColourRisk]:
+        if self._before is None:
+            return []
+        return [risk for risk in colour_risks(self._kb) if risk.text() not in self._before]
 
 
 _PREFIXED = re.compile(r"(?<![\w?$:])([A-Za-z][\w-]*):([A-Za-z_][\w-]*(?:\.[\w-]+)*)")

@@ -10,6 +10,7 @@ in it. ``cbrs demo --external`` starts two of them and kills one mid-run.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import os
 import sys
 from typing import Any
@@ -73,9 +74,12 @@ def localiser(camera: str, capture: BridgeClient, smap: SemanticMap) -> Any:
     except ValueError as error:
         raise SystemExit(str(error)) from None
 
+    # the colours the camera tells apart are the store's, as the simulation's cameras have them
+    colours = {w.name: w for cam in smap.cameras.values() if cam.name == camera for w in cam.colours}
+
     def locate(request: dict[str, Any]) -> dict[str, Any]:
         frame = frame_from_json(capture.call_sync(CAPTURE_SERVICE, {"camera": camera}))
-        return {"robotLocation": to_json(locate_robot(frame, marker))}
+        return {"robotLocation": to_json(locate_robot(dataclasses.replace(frame, colours=colours), marker))}
 
     return locate
 

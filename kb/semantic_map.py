@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from collections import defaultdict
 from contextvars import ContextVar
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from enum import Enum
 from typing import TYPE_CHECKING
 
@@ -25,6 +25,7 @@ from cbrs.kb.shapes import nearest_term
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
+    from cbrs.kb.colour_windows import ColourWindow
     from cbrs.kb.hands import Hand
     from cbrs.kb.knowledge_base import KnowledgeBase
     from cbrs.kb.store import Term
@@ -261,6 +262,8 @@ class Camera:
     occlusion_tolerance: float = 0.0
     """The largest fraction of the sight lines to a thing's outline that the map's solid boxes may cut for
     the camera still to see it whole (``home:occlusionTolerance``; ``kb.camera_view.hidden``)."""
+    colours: tuple[ColourWindow, ...] = ()
+    """The colours it tells apart (``home:hasColourWindow``, :func:`kb.colour_windows.read_colour_windows`)."""
 
     @property
     def looks_down(self) -> bool:
@@ -428,6 +431,11 @@ class SemanticMap:
         )
         for iri, values in facts.items():
             _classify(built, iri, values, tuple(types.get(iri, ())), affordances, facts, iri in people)
+        from cbrs.kb.colour_windows import read_colour_windows  # it builds on this module's MapError
+
+        windows = read_colour_windows(kb) if built.cameras else {}
+        for iri, camera in built.cameras.items():
+            built.cameras[iri] = replace(camera, colours=windows.get(iri, ()))
         for iri, values in facts.items():
             for tap in values.get(HOME + "hasTap", []):
                 built.dispensers[iri] = _dispenser(built, iri, tap, facts)

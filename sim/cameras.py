@@ -8,7 +8,7 @@ from pybullet's non-linear depth buffer.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Hashable
+from collections.abc import Callable, Hashable, Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any, Protocol
 
@@ -17,6 +17,7 @@ import pybullet as p
 from numpy.typing import NDArray
 
 from cbrs.kb.camera_view import focal_length
+from cbrs.kb.colour_windows import ColourWindow
 from cbrs.sim.errors import CameraUnavailableError
 from cbrs.sim.layout import CameraSpec
 
@@ -87,6 +88,8 @@ class Frame:
     """H x W, metres along the optical axis."""
     intrinsics: Intrinsics
     camera_to_world: NDArray[np.float64] = field(repr=False)
+    colours: Mapping[str, ColourWindow] = field(default_factory=dict, repr=False)
+    """The colours its camera tells apart, by name (the store's, :mod:`kb.colour_windows`)."""
 
     @property
     def eye(self) -> NDArray[np.float64]:
@@ -153,9 +156,16 @@ class Camera:
     """
 
     def __init__(
-        self, client: int, spec: CameraSpec, clock: Clock, scene: Callable[[], Hashable] | None = None
+        self,
+        client: int,
+        spec: CameraSpec,
+        clock: Clock,
+        scene: Callable[[], Hashable] | None = None,
+        colours: Mapping[str, ColourWindow] | None = None,
     ) -> None:
         self.spec = spec
+        self.colours = dict(colours or {})
+        """The colours it tells apart, by name: its frames carry them (``Frame.colours``)."""
         self.name = spec.name
         self.failed = False
         """A failed camera raises ``CameraUnavailableError``: the fault the executor must recover from."""
@@ -185,7 +195,7 @@ class Camera:
         rgb = np.ascontiguousarray(np.reshape(np.asarray(rgba, dtype=np.uint8), (s.height, s.width, 4))[:, :, :3])
         z = np.reshape(np.asarray(zbuffer, dtype=np.float64), (s.height, s.width))
         depth = (s.far * s.near / (s.far - (s.far - s.near) * z)).astype(np.float32)
-        frame = Frame(s.name, self._clock.time, rgb, depth, self.intrinsics, self.camera_to_world.copy())
+        frame = Frame(s.name, self._clock.time, rgb, depth, self.intrinsics, self.camera_to_world.copy(), self.colours)
         if key is not None:
             self._last = (key, _copy(frame))
         return frame

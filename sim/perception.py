@@ -6,6 +6,11 @@
 * ``recognise_object``: an object of a given colour in the Kinect's RGB-D frame; its 3D points come
   from the depth image.
 
+Colours are hue windows with floors of saturation and brightness (hue survives the renderer's shading,
+which scales brightness; the saturation floor keeps out the greys, whites and the wooden table). What a
+camera tells apart is knowledge about it, in the store (:mod:`kb.colour_windows`): a frame carries its
+camera's windows (``Frame.colours``), and a colour is looked for by its name among them.
+
 None of these read the simulator's state: only ``Frame`` (pixels, depth, calibration) and the known
 heights of the marker and the shirt (calibration knowledge a real system would have too).
 """
@@ -13,19 +18,18 @@ heights of the marker and the shirt (calibration knowledge a real system would h
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
+from cbrs.kb.colour_windows import ColourWindow
 from cbrs.sim.cameras import Frame
 from cbrs.sim.errors import AmbiguousSightingError, CutByBorderError, NotVisibleError, UnknownColourError
 from cbrs.sim.layout import SHIRT_RADIUS, SHIRT_TOP
 
 __all__ = [
-    "COLOURS",
-    "ColourRange",
     "MarkerModel",
     "ObjectEstimate",
     "PersonEstimate",
@@ -38,29 +42,6 @@ __all__ = [
 ]
 
 
-@dataclass(frozen=True)
-class ColourRange:
-    """A colour feature as a hue window (degrees) with minimum saturation and brightness.
-
-    Hue survives the renderer's shading (which scales brightness); the saturation floor keeps out the
-    greys, whites and the wooden table.
-    """
-
-    hue: float
-    hue_tolerance: float
-    min_saturation: float = 0.55
-    min_value: float = 0.20
-
-
-COLOURS: dict[str, ColourRange] = {
-    "red": ColourRange(0.0, 15.0),
-    "yellow": ColourRange(54.0, 12.0),
-    "green": ColourRange(125.0, 25.0),
-    "cyan": ColourRange(180.0, 15.0),
-    "blue": ColourRange(230.0, 20.0),
-    "magenta": ColourRange(300.0, 20.0),
-}
-
 MIN_MARKER_PIXELS = 6
 """Fewest pixels per marker patch (each patch covers ~25 pixels at the start pose)."""
 MIN_PERSON_PIXELS = 20
@@ -72,22 +53,25 @@ MARKER_MERGED_FACTOR = 1.5
 something else of its colour (an object of the marker's colour touching it): its centre would be wrong."""
 
 
-def _colour(colour: str | ColourRange) -> ColourRange:
-    if isinstance(colour, ColourRange):
+def _colour(colour: str | ColourWindow, windows: Mapping[str, ColourWindow]) -> ColourWindow:
+    if isinstance(colour, ColourWindow):
         return colour
     try:
-        return COLOURS[colour]
+        return windows[colour]
     except KeyError:
-        raise UnknownColourError(colour, sorted(COLOURS)) from None
+        raise UnknownColourError(colour, sorted(windows)) from None
 
 
-def segment(rgb: NDArray[np.uint8], colour: str | ColourRange) -> NDArray[np.bool_]:
-    """Boolean mask (H x W) of the pixels of a colour.
+def segment(
+    rgb: NDArray[np.uint8], colour: str | ColourWindow, windows: Mapping[str, ColourWindow] | None = None
+) -> NDArray[np.bool_]:
+    """Boolean mask (H x W) of the pixels of a colour: a window, or the name of one of ``windows`` (a
+    frame's, ``Frame.colours``: what its camera tells apart).
 
     Hue is worked out only for the pixels saturated and bright enough to count (a few hundred of the
     image's 76,800: the rest is white, grey and wood), with the same arithmetic as for all of them.
     """
-    spec = _colour(colour)
+    spec = _colour(colour, windows or {})
     red, green, blue = rgb[..., 0], rgb[..., 1], rgb[..., 2]  # (a reduction over the last axis is slow)
     value = np.maximum(np.maximum(red, green), blue).astype(np.float32) / 255.0  # largest and smallest channel
     chroma = value - np.minimum(np.minimum(red, green), blue).astype(np.float32) / 255.0
@@ -199,7 +183,9 @@ def locate_robot(frame: Frame, marker: MarkerModel) -> RobotPoseEstimate:
     """
     candidates: list[list[tuple[NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]]] = []
     for colour, target in ((marker.front, "marker front"), (marker.rear, "marker rear")):
-        found = [(us, vs) for us, vs in blobs(segment(frame.rgb, colour)) if us.size >= MIN_MARKER_PIXELS]
+        found = [
+            (us, vs) for us, vs in blobs(segment(frame.rgb, colour, frame.colours)) if us.size >= MIN_MARKER_PIXELS
+        ]
         if not found:
             raise NotVisibleError(frame.camera, f"robot {target} ({colour})", 0, MIN_MARKER_PIXELS)
         candidates.append(
@@ -260,7 +246,7 @@ def track_person(frame: Frame, shirt: str = "yellow") -> PersonEstimate:
     Across the viewing direction the blob is symmetric. So: centre = far edge minus the shirt's
     radius along the viewing direction, and the middle of the blob across it.
     """
-    found = blobs(segment(frame.rgb, shirt))
+    found = blobs(segment(frame.rgb, shirt, frame.colours))
     if not found or found[0][0].size < MIN_PERSON_PIXELS:
         raise NotVisibleError(
             frame.camera, f"person ({shirt} shirt)", int(found[0][0].size) if found else 0, MIN_PERSON_PIXELS
@@ -398,7 +384,7 @@ def recognise_object(
     are an ``AmbiguousSightingError`` rather than one estimate between them.
     """
     target = f"{colour} object" if near is None else f"{colour} object near ({near[0]:.2f}, {near[1]:.2f})"
-    things = _things(frame, segment(frame.rgb, colour))
+    things = _things(frame, segment(frame.rgb, colour, frame.colours))
     if near is not None:
         # the thing nearest where the object is believed to be, if it is within the radius; another
         # thing of its colour nearby is not part of it

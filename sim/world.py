@@ -21,6 +21,7 @@ import numpy as np
 import pybullet as p
 
 from cbrs.kb.camera_view import default_image_size, image_up
+from cbrs.kb.colour_windows import ColourWindow
 from cbrs.kb.hands import PANDA_HAND
 from cbrs.kb.home_check import NoMobileBaseError, check_home
 from cbrs.kb.namespaces import PREFIXES
@@ -34,7 +35,7 @@ from cbrs.sim.cameras import Camera
 from cbrs.sim.errors import ImageSizeError, UnknownEntityError, WorldClosedError
 from cbrs.sim.geometry import Pose2D, Pose3D, Quat, Region, Vec3, quat_from_yaw
 from cbrs.sim.layout import CameraSpec
-from cbrs.sim.perception import COLOURS, MarkerModel
+from cbrs.sim.perception import MarkerModel
 from cbrs.sim.quiet import quiet_output
 from cbrs.sim.scene import bundled_map
 
@@ -84,22 +85,24 @@ _STATIC_GROUP, _NOT_STATIC = 2, -1 ^ 2
 """Bullet's collision filter group of static things, and a mask of every group but that one."""
 WATER_CYAN = (0.05, 0.80, 0.80, 1.0)
 HOME = PREFIXES["home"]
-_NAMED_COLOURS = {
-    "red": (0.85, 0.08, 0.08, 1.0),
-    "yellow": (0.95, 0.85, 0.10, 1.0),
-    "green": (0.10, 0.85, 0.15, 1.0),
-    "cyan": (0.05, 0.80, 0.80, 1.0),
-    "blue": (0.10, 0.20, 0.85, 1.0),
-    "magenta": (0.85, 0.10, 0.85, 1.0),
-}
-"""How each colour perception knows (sim.perception.COLOURS) is painted: saturated, well inside its hue window."""
 
 
-def _named(colour: str) -> tuple[float, float, float, float]:
-    try:
-        return _NAMED_COLOURS[colour]
-    except KeyError:
-        raise ValueError(f"no display colour for {colour!r}; known: {', '.join(_NAMED_COLOURS)}") from None
+def _colours(semantic_map: SemanticMap) -> dict[str, ColourWindow]:
+    """The colours some camera of the map tells apart, by name (the first camera's by IRI, where two name
+    one differently): what a thing may be looked for by, and how a marker's patch of it is painted."""
+    found: dict[str, ColourWindow] = {}
+    for iri in sorted(semantic_map.cameras, reverse=True):
+        found.update({window.name: window for window in semantic_map.cameras[iri].colours})
+    return found
+
+
+def _painted(colour: str, windows: dict[str, ColourWindow]) -> tuple[float, float, float, float]:
+    """How a marker patch of ``colour`` is painted: its window's home:rgba (well inside the window)."""
+    window = windows.get(colour)
+    if window is None or window.rgba is None:
+        known = ", ".join(name for name, w in windows.items() if w.rgba is not None)
+        raise ValueError(f"no display colour (home:rgba of a colour window) for {colour!r}; known: {known}")
+    return window.rgba
 
 
 _CHASSIS = (0.28, 0.28, 0.30, 1.0)
@@ -243,7 +246,9 @@ class HomeWorld:
         self.arm_detail = ArmDetail(arm_detail)
         """The arms' visual meshes, for every camera and recording of this world (``ArmDetail``)."""
         self.map = semantic_map if semantic_map is not None else bundled_map()
-        _check_colours(self.map)
+        self.colour_windows = _colours(self.map)
+        """The colours some camera tells apart, by name (each camera's own: ``Camera.colours``)."""
+        _check_colours(self.map, self.colour_windows)
         self.image_sizes = _image_sizes(self.map, image_sizes or {})
         """Each camera's image width and height in pixels (``kb.camera_view.DOWNWARD_IMAGE_SIZE`` and
         ``OTHER_IMAGE_SIZE`` unless ``image_sizes`` named the camera)."""
@@ -757,7 +762,8 @@ class HomeWorld:
                 far=cam.far,
                 max_hidden=cam.occlusion_tolerance,
             )
-            self.cameras[spec.name] = Camera(c, spec, self, self.scene_key)
+            colours = {window.name: window for window in cam.colours}
+            self.cameras[spec.name] = Camera(c, spec, self, self.scene_key, colours)
         if self.gui:
             p.configureDebugVisualizer(render, 1, physicsClientId=c)
 
@@ -992,8 +998,8 @@ class HomeWorld:
         parts = [
             _box(chassis_half, (0, 0, 0), _CHASSIS),
             _box((half_length, half_width, 0.01), (0, 0, platform_z), _PLATFORM),
-            _box(patch, (offset, 0, marker_z), _named(marker.front), collide=False),
-            _box(patch, (-offset, 0, marker_z), _named(marker.rear), collide=False),
+            _box(patch, (offset, 0, marker_z), _painted(marker.front, self.colour_windows), collide=False),
+            _box(patch, (-offset, 0, marker_z), _painted(marker.rear, self.colour_windows), collide=False),
             *(
                 _Part(
                     p.GEOM_CYLINDER,
@@ -1034,21 +1040,23 @@ class HomeWorld:
         )
 
 
-def _check_colours(semantic_map: SemanticMap) -> None:
-    """Every colour name of the map's objects, people, markers and water is one perception can find
-    (``perception.COLOURS``): one it cannot was found only as the task looked for the thing, after the
-    base had driven off. A ``MapError`` names the thing, the property and the value."""
+def _check_colours(semantic_map: SemanticMap, known: dict[str, ColourWindow]) -> None:
+    """Every colour name of the map's objects, people, markers and water is one some camera tells apart
+    (``known``, the cameras' colour windows): one none can was found only as the task looked for the
+    thing, after the base had driven off. A ``MapError`` names the thing, the property and the value."""
     named: list[tuple[str, str, str]] = [(obj.iri, "colourName", obj.colour) for obj in semantic_map.objects.values()]
     named += [(person.iri, "colourName", person.colour) for person in semantic_map.people.values()]
     for iri, values in semantic_map.facts.items():
         for name in ("colourName", "frontColourName", "rearColourName"):
             named += [(iri, name, colour) for colour in values.get(HOME + name, [])]
     for iri, name, colour in sorted(set(named)):
-        if colour and colour not in COLOURS:  # none at all: the thing is not looked for
-            near = difflib.get_close_matches(colour.lower(), list(COLOURS), n=1, cutoff=0.6)
+        if colour and colour not in known:  # none at all: the thing is not looked for
+            near = difflib.get_close_matches(colour.lower(), list(known), n=1, cutoff=0.6)
             hint = f" (did you mean {near[0]!r}?)" if near else ""
             raise MapError(
-                iri, f"has home:{name} {colour!r}, a colour perception cannot find{hint}; known: {', '.join(COLOURS)}"
+                iri,
+                f"has home:{name} {colour!r}, a colour perception cannot find{hint}; known: {', '.join(known)} "
+                "(the colour windows of the map's cameras, docs/simulation.md)",
             )
 
 

@@ -109,18 +109,25 @@ def test_the_bowl_at_the_west_is_aimed_at_inside_by_the_apples_footprint(west_ma
     assert both[0] == pytest.approx(((box.min_x + box.max_x) / 2.0, (box.min_y + box.max_y) / 2.0))
 
 
-def test_the_hue_windows_docs_tasks_md_gives_a_lab_are_perceptions() -> None:
+def test_the_hue_windows_docs_tasks_md_gives_a_lab_are_the_cameras() -> None:
     """docs/tasks.md tells a lab writing home:rgba the hue window of each home:colourName, so that it paints
-    a thing well inside it (the apple at the edge of green was seen in part): the windows must be the
-    segmenter's, and the apple's hue must be at the edge the docs warn of."""
-    from cbrs.sim.perception import COLOURS
+    a thing well inside it (the apple at the edge of green was seen in part): the windows must be the ones
+    the bundled home.ttl gives every camera (kb.colour_windows, the source of truth the row points to), and
+    the apple's hue must be at the edge the docs warn of, as a load warns."""
+    from cbrs.kb.colour_risk import Risk, colour_risk, known_windows
 
+    kb = KnowledgeBase.open(":memory:")
+    windows = {window.name: window for window in known_windows(kb)}
+    kb.close()
     row = next(line for line in DOCS_TASKS.read_text(encoding="utf-8").splitlines() if line.startswith("| `home:rgba`"))
+    assert "home:hasColourWindow" in row and "home:Camera" in row  # where the windows are, and how to give others
     said = {name: (int(low), int(high)) for name, low, high in re.findall(r"(\w+) (\d+)-(\d+)", row)}
-    assert set(said) == set(COLOURS)
+    assert set(said) == set(windows)
     for name, (low, high) in said.items():
-        window = COLOURS[name]
+        window = windows[name]
         assert (low, high) == (round(window.hue - window.hue_tolerance) % 360, round(window.hue + window.hue_tolerance))
         assert f"saturation {window.min_saturation}" in row
     hue, _, _ = colorsys.rgb_to_hsv(0.40, 0.80, 0.20)
     assert round(hue * 360) == said["green"][0]
+    risk = colour_risk("https://w3id.org/cbrs/world#Apple", "green", (0.40, 0.80, 0.20, 1.0), list(windows.values()))
+    assert risk is not None and risk.risk is Risk.EDGE

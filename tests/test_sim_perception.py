@@ -9,6 +9,7 @@ import numpy as np
 import pybullet as p
 import pytest
 
+from cbrs.kb.colour_windows import ColourWindow
 from cbrs.sim import (
     CameraUnavailableError,
     HomeWorld,
@@ -106,7 +107,7 @@ def test_person_tracking_by_shirt_colour(world: HomeWorld) -> None:
     # The plain centroid of the shirt's pixels (on the shoulders' plane) is pulled towards the
     # camera by the shirt's side, which is most of what the camera sees: the estimator must do better.
     frame = world.camera("CeilingCamera01").capture()
-    vs, us = np.nonzero(segment(frame.rgb, "yellow"))
+    vs, us = np.nonzero(segment(frame.rgb, "yellow", frame.colours))
     naive = frame.intersect_plane(us.astype(float), vs.astype(float), SHIRT_TOP)[:, :2].mean(axis=0)
     assert math.hypot(naive[0] - truth[0], naive[1] - truth[1]) > 2 * PERSON_ERROR
 
@@ -194,11 +195,8 @@ def test_a_camera_renders_again_only_when_the_scene_changed(monkeypatch: pytest.
         assert np.array_equal(fresh.capture().rgb, fresh.capture().rgb) and len(renders) == 6
 
 
-def _segment_everywhere(rgb: np.ndarray, colour: str) -> np.ndarray:  # type: ignore[type-arg]
+def _segment_everywhere(rgb: np.ndarray, spec: ColourWindow) -> np.ndarray:  # type: ignore[type-arg]
     """The segmentation as first written, hue worked out for every pixel: the reference."""
-    from cbrs.sim.perception import COLOURS
-
-    spec = COLOURS[colour]
     img = rgb.astype(np.float32) / 255.0
     r, g, b = img[..., 0], img[..., 1], img[..., 2]
     value = img.max(axis=-1)
@@ -219,15 +217,15 @@ def _segment_everywhere(rgb: np.ndarray, colour: str) -> np.ndarray:  # type: ig
 
 
 def test_segmentation_marks_the_pixels_the_per_pixel_hue_marks(world: HomeWorld) -> None:
-    from cbrs.sim.perception import COLOURS
-
+    windows = world.colour_windows  # the store's (kb.colour_windows): the six of home:Camera
+    assert sorted(windows) == ["blue", "cyan", "green", "magenta", "red", "yellow"]
     rng = np.random.default_rng(5)
     images = [world.camera(name).capture().rgb for name in sorted(world.cameras)]
     images += [rng.integers(0, 256, (60, 80, 3), dtype=np.uint8) for _ in range(4)]
     reds, greens = np.meshgrid(np.arange(256), np.arange(256), indexing="ij")  # every red and green, some blue
     images.append(np.stack([reds, greens, np.full((256, 256), 40)], -1).astype(np.uint8))
     for rgb in images:
-        for colour in COLOURS:
-            expected = _segment_everywhere(rgb, colour)
-            assert np.array_equal(segment(rgb, colour), expected), colour
-    assert any(segment(rgb, colour).any() for rgb in images[:3] for colour in COLOURS)
+        for colour, window in windows.items():
+            expected = _segment_everywhere(rgb, window)
+            assert np.array_equal(segment(rgb, colour, windows), expected), colour
+    assert any(segment(rgb, window).any() for rgb in images[:3] for window in windows.values())
