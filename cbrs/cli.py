@@ -53,6 +53,7 @@ from cbrs.output import (
 )
 from cbrs.settings import SETTINGS, setting
 from cbrs.sparql_hints import declared, explain_syntax_error, one_line_up, store_prefixes_used
+from cbrs.unmentioned_names import unmentioned_names
 
 # Commands whose modules import numpy, networkx, the composer or the web server (most of a second at
 # start-up): each is imported when it runs or shows its own help. ``cbrs --help`` lists them from the
@@ -517,6 +518,9 @@ def query(
             if explained is error:
                 raise
             raise explained from error
+        with store_names(names):  # a misspelt term matches nothing, and "(0 rows)" said no more
+            for note in unmentioned_names(app.kb, body, added):
+                click.echo(f"note: {note}", err=True)
     click.echo(render_result(result, fmt))
 
 

@@ -12,11 +12,15 @@ from pathlib import Path
 
 import pyoxigraph as ox
 import pytest
+from click.testing import CliRunner
 
 from cbrs.actions.composer import Composer
+from cbrs.cli import cli
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import MapError, SemanticMap
+from cbrs.sparql_service import SparqlService
+from cbrs.web import create_app
 from tests.helpers_examples import EXAMPLES
 
 HOME, WORLD, LAB9 = PREFIXES["home"], PREFIXES["world"], "https://example.org/lab9#"
@@ -134,3 +138,36 @@ def test_a_table_height_in_centimetres_is_refused_above_the_ceiling(tmp_path: Pa
         encoding="utf-8",
     )
     kb.load([cabinet], graph="map")
+
+
+# -- the lab's map checked by SPARQL ---------------------------------------------------------------
+
+LOOKUP = "PREFIX lab9: <https://example.org/lab9#> SELECT ?support WHERE { lab9:Notebok1 home:isLocatedOnn ?support }"
+
+
+def test_a_query_of_names_that_name_nothing_says_which_in_the_editor(book_kb: KnowledgeBase) -> None:
+    """The notebook and the property misspelt: "0 rows", and no word of why (the eighth round's
+    home:isLocatedIn, the same)."""
+    client = create_app(SparqlService(book_kb)).test_client()
+    empty = client.get("/query.json", query_string={"query": LOOKUP}).get_json()
+    assert empty["result"]["count"] == 0
+    assert empty["notes"] == [
+        "nothing in the store mentions lab9:Notebok1; did you mean lab9:Notebook1?",
+        "nothing in the store mentions home:isLocatedOnn; did you mean home:isLocatedOn?",
+    ]
+    page = client.get("/query", query_string={"query": LOOKUP}).get_data(as_text=True)
+    assert 'id="query-notes"' in page and "did you mean lab9:Notebook1?" in page
+    right = LOOKUP.replace("Notebok1", "Notebook1").replace("isLocatedOnn", "isLocatedOn")
+    found = client.get("/query.json", query_string={"query": right}).get_json()
+    assert found["result"]["count"] >= 1 and "notes" not in found
+    typed = 'SELECT ?z WHERE { ?s home:maxZ ?z FILTER(?z > "9"^^xsd:decimal && xsd:decimal(?z) > 9) }'
+    assert client.get("/query.json", query_string={"query": typed}).get_json()["notes"] == []  # datatypes
+
+
+def test_cbrs_query_notes_the_names_that_name_nothing() -> None:
+    text = "SELECT ?cup WHERE { ?cup a home:Cup ; home:isLocatedIn world:Kitchen }"
+    result = CliRunner().invoke(cli, ["--store", ":memory:", "query", text])
+    assert result.exit_code == 0, result.output
+    assert "(0 rows)" in result.stdout
+    assert "note: nothing in the store mentions home:isLocatedIn; did you mean" in result.stderr
+    assert "home:Cup" not in result.stderr and "world:Kitchen" not in result.stderr

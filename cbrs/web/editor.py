@@ -20,6 +20,7 @@ from cbrs.kb.errors import KnowledgeBaseError, QuerySyntaxError, UnknownQueryErr
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.sparql_hints import operation_kind, store_prefixes_used
 from cbrs.sparql_service import BOM, Answer
+from cbrs.unmentioned_names import unmentioned_names
 from cbrs.web import context
 from cbrs.web.pages import FormError, Page, page, wants_json
 from cbrs.web.prefixes import derived
@@ -96,12 +97,19 @@ def editor() -> Page:
         shown.status = error.http_status
         return shown
     data["elapsed_ms"] = round((time.perf_counter() - started) * 1000, 1)
+    if _empty(data["result"]):  # a misspelt term matches nothing: say which names name nothing
+        data["notes"] = unmentioned_names(kb, text.removeprefix(BOM), added)
     form = "graph" if data["result"]["kind"] == "graph" else "select"
     data["downloads"] = [
         {"label": label, "format": short, "href": url_for("sparql.sparql", query=run, format=short)}
         for label, short in DOWNLOADS[form]
     ]
     return shown
+
+
+def _empty(result: dict[str, Any]) -> bool:
+    """Whether the page's result (:func:`_result`) holds nothing: no row, no triple, or an ASK's false."""
+    return not result["boolean"] if result["kind"] == "ask" else result["count"] == 0
 
 
 def _update_refused() -> str:
