@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import io
 import itertools
+import json
 import logging
 import threading
 import time
@@ -26,6 +27,7 @@ from typing import TYPE_CHECKING, Any
 
 from cbrs.extras import installed, require
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.colour_risk import involved_colour_risks
 from cbrs.kb.derived_prefixes import StoreNames
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import expand, shorten, store_names
@@ -424,6 +426,8 @@ class TaskRunner:
             )
             found = result.to_dict()
             found["sim_seconds"] = round(world.time, 3)
+            # the things it involves painted where the cameras may not tell them (docs/simulation.md)
+            found["warnings"] = [risk.to_dict() for risk in involved_colour_risks(self.kb, json.dumps(found))]
         return result, found
 
     def _sensing(self, world: Any) -> AbstractContextManager[Any]:
