@@ -552,7 +552,7 @@ def _note_unknown_bindings(kb: KnowledgeBase, name: str, values: dict[str, str])
 # An update, after its prologue (PREFIX and BASE declarations, comments): the query parser's own
 # message for one ("expected CONSTRUCT") does not say what is wrong.
 _UPDATE_START = re.compile(
-    r"(?:\s|#[^\n]*|PREFIX\s*[\w.-]*:\s*<[^>]*>|BASE\s*<[^>]*>)*"
+    r"(?:\s|#[^\n]*(?=\n|\Z)|PREFIX\s*[\w.-]*:\s*<[^>]*>|BASE\s*<[^>]*>)*"
     r"(INSERT|DELETE|LOAD|CLEAR|DROP|CREATE|ADD|MOVE|COPY|WITH)\b",
     re.IGNORECASE,
 )

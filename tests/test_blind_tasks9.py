@@ -171,3 +171,18 @@ def test_cbrs_query_notes_the_names_that_name_nothing() -> None:
     assert "(0 rows)" in result.stdout
     assert "note: nothing in the store mentions home:isLocatedIn; did you mean" in result.stderr
     assert "home:Cup" not in result.stderr and "world:Kitchen" not in result.stderr
+
+
+def test_cbrs_query_reads_a_comment_with_an_update_word_as_a_comment() -> None:
+    """The lab's check of its map, a query file whose comment says "... on a store with ...": refused as "a
+    SPARQL update (WITH)", the prologue's comment read up to the word."""
+    checked = CliRunner().invoke(
+        cli, ["--store", ":memory:", "query", "--file", str(EXAMPLES / "lab9_check_my_map.rq")]
+    )
+    assert checked.exit_code == 0, checked.output
+    assert "SPARQL update" not in checked.output and "thing" in checked.stdout
+    update = (
+        "# put the pen back with one update, and add nothing\nDELETE DATA { GRAPH graph:map { world:Pen home:yaw 9 } }"
+    )
+    refused = CliRunner().invoke(cli, ["--store", ":memory:", "query", update])
+    assert refused.exit_code != 0 and "this is a SPARQL update (DELETE)" in refused.output
