@@ -11,10 +11,15 @@ error class and phrase are checked and the store's graph sizes are compared befo
 runs in order in that store (``cbrs run TASK --seed N --json``; a trial of several runs is a sequence in
 one store). A trial whose components are served by a program of the example's own starts, for each seed,
 ``cbrs serve`` on free loopback ports with an update token and the program against its bridge, then
-runs ``cbrs --store URL run TASK --bridge WS``, as the docs do; a trial run over HTTP posts the task to
-the server's ``/tasks.json`` and polls the run's JSON. Both processes are stopped by PID; every wait is
-bounded. The stores are made once a trial and copied for each seed, before anything runs in them. Runs go
-in parallel processes, up to ``--jobs`` (default: the cores). The outcome is read from the run's JSON:
+runs ``cbrs --store URL run TASK --bridge WS``, as the docs do (several programs at once: each started
+once the one before says it is ready); a trial run over HTTP posts the task to the server's
+``/tasks.json`` and polls the run's JSON; one run over the bridge calls its ``/cbrs/run_task`` service with
+the token and polls ``/cbrs/task_status``. A trial may send its files to the server (``POST /store``,
+``POST /update``) instead of loading them before it starts. A library program of the examples runs its
+task itself in the trial's store (``python PROGRAM --store DIR --seed N``) and prints the outcome as JSON.
+The processes are stopped by PID; every wait is bounded. The stores are made once a trial and copied for
+each seed, before anything runs in them. Runs go in parallel processes, up to ``--jobs`` (default: the
+cores). The outcome is read from the run's JSON:
 succeeded, refused (before anything moved: the run's error), no plan, or failed; a run whose JSON cannot
 be read is "broken". Prints the machine, the commit, the load checks, one row a run (expected and found
 status and simulated seconds) and the deviations: a status other than the docs', a successful run's
@@ -42,6 +47,7 @@ import threading
 import time
 import tomllib
 import urllib.error
+import urllib.parse
 import urllib.request
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -57,7 +63,7 @@ VERBS = (*GRAPHS, "update", "register")
 STATUSES = ("succeeded", "refused", "no plan", "failed")
 RUN_STATUS = {"succeeded": "succeeded", "failed": "failed", "cancelled": "failed", "unsolvable": "no plan"}
 SERVER_STATUS = {"succeeded": "succeeded", "failed": "failed", "cancelled": "failed", "no-plan": "no plan"}
-VIAS = ("cli", "bridge", "http")
+VIAS = ("cli", "bridge", "http", "run_task", "library")
 GRAPH_SIZES = "SELECT ?g (COUNT(*) AS ?n) WHERE { GRAPH ?g { ?s ?p ?o } } GROUP BY ?g"
 STARTUP = 90.0
 """Seconds a server or a component program may take to answer or register (bounded waits)."""
@@ -105,8 +111,18 @@ class Serve:
 
 
 @dataclass(frozen=True)
+class Library:
+    """An example's Python program that runs its task through the library in a store it opens: started as
+    ``python PROGRAM --store DIR --seed N [args]``, it prints the run as JSON (``succeeded``, ``sim_seconds``)."""
+
+    program: str
+    args: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
 class Trial:
-    """One entry of the data file: a store made by ``setup``, the runs made in it, what the docs say."""
+    """One entry of the data file: a store made by ``setup``, the runs made in it, what the docs say.
+    ``serve``: the programs served to its runs, started in order (none: cbrs serve alone)."""
 
     label: str
     source: str
@@ -114,8 +130,12 @@ class Trial:
     seeds: list[int]
     runs: list[Run]
     via: str = "cli"
-    serve: Serve | None = None
+    serve: tuple[Serve, ...] = ()
     known_failure: bool = False
+    library: Library | None = None
+    post: bool = False
+    """Whether the setup's files are sent to the server (``POST /store``, ``POST /update``) once it answers,
+    for each seed, instead of loaded on the command line before it starts."""
 
     @property
     def task(self) -> str:
@@ -171,11 +191,15 @@ def _trial(path: Path, row: dict[str, Any]) -> Trial:
         )
         for r in raw_runs
     ]
-    serve = None
-    if "serve" in row:
-        s = row["serve"]
-        serve = Serve(s["program"], tuple(s.get("args", [])), s.get("ready", "registered"), int(s.get("count", 1)))
-    via = row.get("via", "bridge" if serve else "cli")
+    served = row.get("serve", [])
+    serve = tuple(
+        Serve(s["program"], tuple(s.get("args", [])), s.get("ready", "registered"), int(s.get("count", 1)))
+        for s in (served if isinstance(served, list) else [served])  # one program, or several at once
+    )
+    library = None
+    if "library" in row:
+        library = Library(row["library"]["program"], tuple(row["library"].get("args", [])))
+    via = row.get("via", "library" if library else "bridge" if serve else "cli")
     trial = Trial(
         label,
         row.get("source", ""),
@@ -185,6 +209,8 @@ def _trial(path: Path, row: dict[str, Any]) -> Trial:
         via,
         serve,
         bool(row.get("known_failure", False)),
+        library,
+        bool(row.get("post", False)),
     )
     _check(path, trial)
     return trial
@@ -204,10 +230,21 @@ def _check(path: Path, trial: Trial) -> None:
         raise SystemExit(f"{where}: unknown via {trial.via!r} (one of {', '.join(VIAS)})")
     if trial.via != "cli" and any(r.before for r in trial.runs):
         raise SystemExit(f"{where}: steps between runs are made on the command line only (via cli)")
-    if trial.via == "bridge" and trial.serve is None:
+    if trial.via == "bridge" and not trial.serve:
         raise SystemExit(f"{where}: a run over the bridge needs the program that serves its components (serve)")
+    if (trial.via == "library") != (trial.library is not None) or (trial.library and trial.serve):
+        raise SystemExit(f"{where}: a library program (library) runs alone, and only it runs via library")
+    if trial.library is not None and len(trial.runs) != 1:
+        raise SystemExit(f"{where}: a library program runs its one task: one run")
+    if trial.post and (trial.via not in ("http", "bridge", "run_task") or not trial.runs):
+        raise SystemExit(f"{where}: files are posted to a server: its runs must go to one (via http, bridge, run_task)")
+    if trial.post and any(
+        s.expect_refusal or s.replace or s.verb not in (*GRAPHS, "register", "update") for s in trial.setup
+    ):
+        raise SystemExit(f"{where}: a posted setup is of files the server takes, added (no refusal, no replace)")
     steps = [*trial.setup, *(b for r in trial.runs for b in r.before)]
-    names = [s.file for s in steps] + ([trial.serve.program] if trial.serve else [])
+    names = [s.file for s in steps] + [s.program for s in trial.serve]
+    names += [trial.library.program] if trial.library else []
     for step in steps:
         if step.verb not in VERBS:
             raise SystemExit(f"{where}: unknown load {step.verb!r} of {step.file}")
@@ -278,7 +315,7 @@ def make_store(trial: Trial, store: Path) -> Made:
     done = _cbrs(store, "init")
     if done.returncode != 0:
         raise RuntimeError(f"{trial.label}: cbrs init exited {done.returncode}: {done.stderr[-400:]}")
-    for step in trial.setup:
+    for step in trial.setup if not trial.post else ():  # posted to the server once it runs: _post_step
         apply_step(trial.label, step, store, made)
     return made
 
@@ -363,7 +400,28 @@ def run_one(trial: Trial, index: int, store: Path) -> list[Outcome]:
                 found = {"status": "broken", "error": str(failed)}
             outcomes.append(_outcome(trial, k, index, seed, found, time.perf_counter() - started))
         return outcomes
+    if trial.via == "library":
+        return _library_runs(trial, index, store)
     return _served_runs(trial, index, store)
+
+
+def _library_runs(trial: Trial, index: int, store: Path) -> list[Outcome]:
+    """The trial's library program on ``store`` at its ``index``-th seed, its printed JSON the outcome:
+    ``succeeded`` true or false, ``sim_seconds``; a program that prints no JSON object is broken."""
+    assert trial.library is not None
+    seed = trial.seeds[index]
+    argv = [sys.executable, str(EXAMPLES / trial.library.program), "--store", str(store), "--seed", str(seed)]
+    started = time.perf_counter()
+    try:
+        done = subprocess.run(
+            [*argv, *trial.library.args], cwd=ROOT, capture_output=True, text=True, check=False, timeout=RUN_TIMEOUT
+        )
+        found = _parsed(done)
+        if "succeeded" in found and "status" not in found:
+            found["status"] = "succeeded" if found["succeeded"] is True else "failed"
+    except subprocess.TimeoutExpired:
+        found = {"status": "broken", "error": f"no answer in {RUN_TIMEOUT:.0f} s"}
+    return [_outcome(trial, 0, index, seed, found, time.perf_counter() - started)]
 
 
 def _free_port() -> int:
@@ -441,18 +499,47 @@ def _server(trial: Trial, store: Path, env: dict[str, str]) -> Iterator[tuple[st
             raise RuntimeError(
                 f"cbrs serve did not answer at {url} within {STARTUP:.0f} s: {''.join(children[0].lines)[-300:]}"
             )
-        if trial.serve is not None:
-            program = [sys.executable, str(EXAMPLES / trial.serve.program), "--bridge", ws, *trial.serve.args]
-            children.append(_Child(program, env, store.parent / f"{store.name}.program.log"))
-            if not children[1].wait_for(trial.serve.ready, trial.serve.count, STARTUP):
-                said = "".join(children[1].lines)[-300:]
-                raise RuntimeError(
-                    f"{trial.serve.program} did not say {trial.serve.ready!r} within {STARTUP:.0f} s: {said}"
-                )
+        for step in trial.setup if trial.post else ():  # before the programs, as the files come first
+            _post_step(url, step, env["CBRS_UPDATE_TOKEN"], store.parent / f"{store.name}.edited")
+        for n, serve in enumerate(trial.serve):  # each ready before the next starts
+            program = [sys.executable, str(EXAMPLES / serve.program), "--bridge", ws, *serve.args]
+            children.append(_Child(program, env, store.parent / f"{store.name}.program{n}.log"))
+            if not children[-1].wait_for(serve.ready, serve.count, STARTUP):
+                said = "".join(children[-1].lines)[-300:]
+                raise RuntimeError(f"{serve.program} did not say {serve.ready!r} within {STARTUP:.0f} s: {said}")
         yield url, ws
     finally:
         for child in reversed(children):
             child.stop()
+
+
+MEDIA = {
+    ".ttl": "text/turtle",
+    ".rdf": "application/rdf+xml",
+    ".owl": "application/rdf+xml",
+    ".nt": "application/n-triples",
+}
+MEDIA |= {".jsonld": "application/ld+json", ".trig": "application/trig", ".nq": "application/n-quads"}
+
+
+def _post_step(url: str, step: Step, token: str, where: Path) -> None:
+    """Send a setup step's file to the server as a client of its protocols would: a graph's file by the
+    Graph Store Protocol (``POST /store?graph=.../graph/NAME``; a component's description into
+    graph/services, as ``cbrs register`` puts it), an update to ``/update``; RuntimeError unless accepted."""
+    path = _edited(step, where)
+    if step.verb == "update":
+        target, media = "/update", "application/sparql-update"
+    else:
+        graph = "services" if step.verb == "register" else step.verb
+        target = "/store?" + urllib.parse.urlencode({"graph": f"https://w3id.org/cbrs/graph/{graph}"})
+        media = MEDIA.get(path.suffix, "text/turtle")
+    headers = {"Authorization": f"Bearer {token}", "Content-Type": media}
+    request = urllib.request.Request(url + target, path.read_bytes(), headers, method="POST")
+    try:
+        with urllib.request.urlopen(request, timeout=60):
+            return
+    except urllib.error.HTTPError as error:
+        raise RuntimeError(f"POST {target} {step.file}: {error.code} {error.read()[:300]!r}") from None
 
 
 def _answers(url: str, timeout: float) -> bool:
@@ -476,6 +563,8 @@ def _served_runs(trial: Trial, index: int, store: Path) -> list[Outcome]:
                 started = time.perf_counter()
                 if trial.via == "http":
                     found = _http_run(url, run.task, seed, env["CBRS_UPDATE_TOKEN"])
+                elif trial.via == "run_task":
+                    found = _bridge_run(ws, run.task, seed, env["CBRS_UPDATE_TOKEN"])
                 else:
                     args = ("run", run.task, "--bridge", ws, "--seed", str(seed), "--json")
                     try:
@@ -508,13 +597,39 @@ def _http_run(url: str, task: str, seed: int, token: str) -> dict[str, Any]:
             page = json.loads(answer.read())
         found = page.get("run", page)
         if found.get("status") != "running":
-            result = dict(found.get("result") or {})
-            result["status"] = found["status"] if found["status"] != "error" else "error"
-            if found.get("error"):
-                result["error"] = found["error"]
-            return result
+            return _ended(found)
         time.sleep(1.0)
     return {"status": "broken", "error": f"{location} still running after {RUN_TIMEOUT:.0f} s"}
+
+
+def _ended(run: dict[str, Any]) -> dict[str, Any]:
+    """A server's run that ended (its JSON, as /tasks/<id>.json and /cbrs/task_status give it): its result
+    with its status and error, as ``cbrs run --json`` gives them."""
+    result = dict(run.get("result") or {})
+    result["status"] = run["status"]
+    if run.get("error"):
+        result["error"] = run["error"]
+    return result
+
+
+def _bridge_run(ws: str, task: str, seed: int, token: str) -> dict[str, Any]:
+    """Call the bridge's ``/cbrs/run_task`` service (``wait``: it answers when the run ends or, for a long
+    run, with the run going), then ``/cbrs/task_status`` each second until it ends (bounded), as a
+    rosbridge client does after sending the update token (op ``auth``)."""
+    from cbrs.bridge_client import BridgeClient  # the bench's own process: the client a lab's program uses
+
+    deadline = time.monotonic() + RUN_TIMEOUT
+    try:
+        with BridgeClient(ws, token, timeout=60.0) as client:
+            run = client.call_sync("/cbrs/run_task", {"task": task, "seed": seed})
+            while run.get("status") == "running" and time.monotonic() < deadline:
+                time.sleep(1.0)
+                run = client.call_sync("/cbrs/task_status", {"run": run["id"]})
+    except Exception as error:  # refused, or the bridge gone: the run's JSON cannot be read
+        return {"status": "broken", "error": f"/cbrs/run_task: {type(error).__name__}: {error}"[:300]}
+    if run.get("status") == "running":
+        return {"status": "broken", "error": f"{run.get('id')} still running after {RUN_TIMEOUT:.0f} s"}
+    return _ended(run)
 
 
 def _reason(found: dict[str, Any]) -> str:

@@ -5,6 +5,7 @@ here rather than going unchecked (bench/example_tasks.py runs the trials; nothin
 from __future__ import annotations
 
 import importlib.util
+import re
 import sys
 import tomllib
 from pathlib import Path
@@ -36,14 +37,15 @@ def bench() -> ModuleType:
 
 @pytest.fixture(scope="module")
 def named(bench: ModuleType) -> set[str]:
-    """Every file a trial of the data names: its setup steps, the steps between its runs, its program."""
+    """Every file a trial of the data names: its setup steps, the steps between its runs, its programs."""
     _, trials = bench.read_trials(DATA)
     found: set[str] = set()
     for trial in trials:
         found.update(step.file for step in trial.setup)
         found.update(step.file for run in trial.runs for step in run.before)
-        if trial.serve is not None:
-            found.add(trial.serve.program)
+        found.update(serve.program for serve in trial.serve)
+        if trial.library is not None:
+            found.add(trial.library.program)
     return found
 
 
@@ -107,3 +109,65 @@ def test_a_range_the_docs_give_is_read_and_compared(bench: ModuleType) -> None:
     outside = bench.Outcome("x", "T", 0, "succeeded", 0.0, "succeeded", high + 1.0, 1.0, "", "", (low, high))
     assert bench.deviation(inside, 0.2) == ""
     assert "the docs say" in bench.deviation(outside, 0.2)
+
+
+def test_the_forms_beyond_the_command_line_each_have_a_trial(bench: ModuleType) -> None:
+    """A library program, several programs at once, runs over /cbrs/run_task (with programs and without)
+    and files posted to the server are each swept: the forms the data's header names are used."""
+    _, trials = bench.read_trials(DATA)
+    assert any(t.via == "library" and t.library is not None for t in trials)
+    assert any(t.via == "bridge" and len(t.serve) > 1 for t in trials)
+    assert any(t.via == "run_task" and t.serve for t in trials)
+    assert any(t.via == "run_task" and not t.serve for t in trials)
+    assert any(t.post and t.via == "http" for t in trials)
+
+
+@pytest.mark.parametrize(
+    ("row", "said"),
+    [
+        pytest.param('library = { program = "lab7_where_is_my_pen.py" }\nvia = "cli"', "runs via library", id="via"),
+        pytest.param(
+            'library = { program = "lab7_where_is_my_pen.py" }\nserve = { program = "lab6_kettle.py" }',
+            "runs alone",
+            id="served",
+        ),
+        pytest.param(
+            'library = { program = "no_such_program.py" }', "no file docs/examples/no_such_program.py", id="missing"
+        ),
+        pytest.param(
+            'serve = [{ program = "lab6_kettle.py" }, { program = "no_such_speaker.py" }]',
+            "no file docs/examples/no_such_speaker.py",
+            id="second-program",
+        ),
+        pytest.param('via = "run_tasks"', "unknown via 'run_tasks'", id="unknown-via"),
+        pytest.param('post = true\nvia = "cli"', "its runs must go to one", id="posted-to-no-server"),
+        pytest.param(
+            'post = true\nvia = "http"\nsetup = [{ load = "map", file = "lab8_mistake_apple.ttl", says = "x" }]',
+            "no refusal, no replace",
+            id="posted-refusal",
+        ),
+    ],
+)
+def test_a_form_the_bench_cannot_run_as_written_is_refused(
+    bench: ModuleType, tmp_path: Path, row: str, said: str
+) -> None:
+    data = tmp_path / "forms.toml"
+    setup = "" if "setup =" in row else "setup = []\n"
+    data.write_text(
+        '[[trial]]\nlabel = "x"\ntask = "WhereIsMyPen"\nseeds = [0]\nstatus = ["succeeded"]\n'
+        f"seconds = [0.7]\n{setup}{row}\n",
+        encoding="utf-8",
+    )
+    with pytest.raises(SystemExit, match=re.escape(said)):
+        bench.read_trials(data)
+
+
+def test_a_run_s_json_from_the_server_or_a_library_program_is_read_as_cbrs_run_s(bench: ModuleType) -> None:
+    """/tasks/<id>.json and /cbrs/task_status give the run with its result inside; the library program
+    prints its outcome: both are read into the statuses the data gives."""
+    trial = bench.Trial("x", "", [], [0], [bench.Run("T", ["refused"], [0.0])], via="run_task")
+    ended = bench._ended({"status": "error", "error": "a precondition does not hold", "result": None})
+    assert ended == {"status": "error", "error": "a precondition does not hold"}
+    assert bench._outcome(trial, 0, 0, 0, ended, 1.0).status == "refused"
+    served = bench._ended({"status": "no-plan", "result": {"sim_seconds": 0.0, "plan": {"reason": "none"}}})
+    assert bench._outcome(trial, 0, 0, 0, served, 1.0).status == "no plan"
