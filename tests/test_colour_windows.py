@@ -241,3 +241,24 @@ def test_a_store_seeded_with_home_0_4_0_gets_the_windows(tmp_path: Path) -> None
         "yellow",
     ]
     kb.close()
+
+
+def test_the_run_page_lists_the_runs_colour_warnings(lab_kb: KnowledgeBase, windows: list[ColourWindow]) -> None:
+    """A run's result carries its warnings (cbrs.tasks, as cbrs run --json does); its page lists them."""
+    from markupsafe import escape
+
+    from cbrs.sparql_service import SparqlService
+    from cbrs.tasks import TaskRun, TaskRunner
+    from cbrs.web import create_app
+
+    risk = colour_risk(APPLE, "green", (0.40, 0.80, 0.20, 1.0), windows)
+    assert risk is not None
+    sparql = SparqlService(lab_kb)
+    runner = TaskRunner(lab_kb, sparql.lock, camera=None)
+    done = TaskRun("run-1", "FetchMyApple", 0, (), iri=PREFIXES["req"] + "FetchMyApple", status="failed")
+    done.result = {"plan": {"status": "solved", "steps": []}, "sim_seconds": 0.0, "warnings": [risk.to_dict()]}
+    runner._runs[done.id] = done
+    client = create_app(sparql, tasks=runner).test_client()
+    page = client.get("/tasks/run-1").text
+    assert "Colours the cameras may not tell" in page and str(escape(risk.text())) in page
+    assert client.get("/tasks/run-1.json").get_json()["run"]["result"]["warnings"][0]["risk"] == "edge"
