@@ -227,6 +227,8 @@ def colour_risks(
             facts[thing][row["property"].value].append(row["value"].value)
     risks = []
     for thing, values in sorted(facts.items()):
+        if HOME + "hueCentre" in values:
+            continue  # a colour window of the map's: its rgba is how the colour is painted, not a thing
         for colour in sorted(set(values.get(HOME + "colourName", []))):
             found = colour_risk(thing, colour, _paint(values.get(HOME + "rgba", [])), windows, margin)
             if found is not None:

@@ -1047,6 +1047,8 @@ def _check_colours(semantic_map: SemanticMap, known: dict[str, ColourWindow]) ->
     named: list[tuple[str, str, str]] = [(obj.iri, "colourName", obj.colour) for obj in semantic_map.objects.values()]
     named += [(person.iri, "colourName", person.colour) for person in semantic_map.people.values()]
     for iri, values in semantic_map.facts.items():
+        if HOME + "hueCentre" in values:
+            continue  # a colour window of the map's, which no camera need have
         for name in ("colourName", "frontColourName", "rearColourName"):
             named += [(iri, name, colour) for colour in values.get(HOME + name, [])]
     for iri, name, colour in sorted(set(named)):
