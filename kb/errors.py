@@ -95,6 +95,26 @@ class RdfParseError(KnowledgeBaseError):
         super().__init__(f"{where}: {_one_line(message)}")  # parsers quote the offending text, newlines and all
 
 
+class DescribedElsewhereError(KnowledgeBaseError):
+    """A load would describe (``cbrs:hasOWLSModel``) a service or requirement that the store describes in
+    another graph: all graphs are read as one, and the two models would merge into one description with
+    each input, precondition and effect twice. Nothing was loaded."""
+
+    http_status = 409
+
+    def __init__(self, source: str, subject: str, graph: str, elsewhere: str, requirement: bool) -> None:
+        self.source = source
+        self.subject = subject
+        self.graph = graph
+        self.elsewhere = elsewhere
+        own = " (a task into graph:requirements, its classes in a file of their own)" if requirement else ""
+        super().__init__(
+            f"{source}: {written(subject)} is described in {written(elsewhere)} already: load the file into one "
+            f"graph{own}, or cbrs deregister it first; all graphs are read as one, and loaded into "
+            f"{written(graph)} too, its two descriptions would merge, each input, precondition and effect twice"
+        )
+
+
 class UnknownFormatError(KnowledgeBaseError):
     """The RDF serialisation of a file could not be told from its name or content."""
 

@@ -37,7 +37,13 @@ from typing import Any
 import pyoxigraph as ox
 
 from cbrs.kb.catalog import Catalogue, Unresolved, is_built_in, ontology_iri
-from cbrs.kb.errors import PartCycleError, RdfParseError, UnknownFormatError, UnknownGraphError
+from cbrs.kb.errors import (
+    DescribedElsewhereError,
+    PartCycleError,
+    RdfParseError,
+    UnknownFormatError,
+    UnknownGraphError,
+)
 from cbrs.kb.namespaces import CBRS, DUL, GENID, OWL, RDF, RDFS, GraphName, shorten
 from cbrs.kb.owls import Conversion, Role, Vocabulary, convert, is_owls, owls_key, referenced_ontologies
 from cbrs.kb.shapes import check_loaded
@@ -365,6 +371,8 @@ def _prepare(
         for parsed in report.files:
             if parsed.owls is not None:
                 _check_not_merged(store, parsed, held)
+            else:
+                _check_not_described_elsewhere(store, parsed)
     _check_part_cycles(store, [*raws, *imported])
     check_superclasses(store, [(raw.source, raw.quads) for raw in (*raws, *imported)])
     check_loaded(store, report)  # descriptions against the SHACL shapes, and their terms (kb/shapes.py)
@@ -540,6 +548,34 @@ def _check_not_merged(store: Store, parsed: ParsedFile, held: Held) -> None:
                     f"one: loading it into {shorten(parsed.graph)} too would merge the two descriptions; "
                     f"cbrs deregister IRI first, or give the new one another IRI",
                 )
+
+
+def _check_not_described_elsewhere(store: Store, parsed: ParsedFile) -> None:
+    """Refuse a file that describes (``cbrs:hasOWLSModel``) a service or requirement the store describes in
+    another graph: queries read all graphs as one, and a file's nodes are named from its content and its
+    graph, so the two models would merge into one description with each input, precondition and effect
+    twice. The ninth round loaded a file of a class and a task into graph:ontology, for the class, and
+    graph:requirements, for the task: the task had six inputs, two goals and four preconditions, and the plan
+    said it did without "book#2", as if no component took a book. The same file into the same graph again
+    adds nothing, and is not refused."""
+    model = ox.NamedNode(CBRS + "hasOWLSModel")
+    described = {quad.subject for quad in parsed.quads if quad.predicate == model}
+    for subject in sorted(described, key=str):
+        if not isinstance(subject, ox.NamedNode):
+            continue
+        elsewhere = sorted(
+            {quad.graph_name.value for quad in store.quads(subject, model) if isinstance(quad.graph_name, ox.NamedNode)}
+            - {parsed.graph}
+        )
+        if elsewhere:
+            raise DescribedElsewhereError(
+                parsed.source, subject.value, parsed.graph, elsewhere[0], _is_requirement(parsed, subject)
+            )
+
+
+def _is_requirement(parsed: ParsedFile, subject: ox.NamedNode) -> bool:
+    kind = ox.NamedNode(CBRS + "Requirement")
+    return any(quad.subject == subject and quad.object == kind for quad in parsed.quads)
 
 
 def _describes(kind: str) -> bool:

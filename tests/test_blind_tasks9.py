@@ -17,6 +17,7 @@ from click.testing import CliRunner
 from cbrs.actions.composer import Composer
 from cbrs.cli import cli
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.errors import DescribedElsewhereError
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import MapError, SemanticMap
 from cbrs.sparql_service import SparqlService
@@ -186,3 +187,42 @@ def test_cbrs_query_reads_a_comment_with_an_update_word_as_a_comment() -> None:
     )
     refused = CliRunner().invoke(cli, ["--store", ":memory:", "query", update])
     assert refused.exit_code != 0 and "this is a SPARQL update (DELETE)" in refused.output
+
+
+# -- a precondition on what a sensor reads ---------------------------------------------------------
+
+
+def test_a_task_loaded_into_a_second_graph_is_refused_not_merged() -> None:
+    """The class and the task in one file, loaded into graph:ontology and graph:requirements: the task was
+    read with six inputs, two goals and four preconditions, and its plan said it did without "book#2"."""
+    kb = KnowledgeBase.open(":memory:")
+    mistake = EXAMPLES / "lab9_mistake_class_and_task.ttl"
+    kb.load([mistake], graph="ontology")
+    before = _sizes(kb)
+    with pytest.raises(DescribedElsewhereError) as refused:
+        kb.load([mistake], graph="requirements")
+    assert refused.value.subject == LAB9 + "FetchMyBookIfDark"
+    assert (refused.value.graph, refused.value.elsewhere) == (
+        PREFIXES["graph"] + "requirements",
+        PREFIXES["graph"] + "ontology",
+    )
+    said = str(refused.value)
+    assert "FetchMyBookIfDark> is described in graph:ontology already: load the file into one graph" in said
+    assert "(a task into graph:requirements, its classes in a file of their own)" in said
+    assert "each input, precondition and effect twice" in said
+    assert _sizes(kb) == before
+    kb.load([mistake], graph="ontology")  # the same file into the same graph again: nothing added, no refusal
+    assert _sizes(kb) == before
+
+
+def test_a_precondition_no_test_decides_is_planned_as_given(book_kb: KnowledgeBase) -> None:
+    """ "Only once the living room is dark": the class and the task each in a file of its own. Nothing reads
+    the room's light; the run takes the precondition as given and names it (execution.md)."""
+    kb = KnowledgeBase.open(":memory:")
+    for graph in ("ontology", "map"):
+        kb.load([EXAMPLES / "lab9_book_on_box.ttl"], graph=graph)
+    kb.load([EXAMPLES / "lab9_dark.ttl"], graph="ontology")
+    kb.load([EXAMPLES / "lab9_fetch_my_book_if_dark.ttl"], graph="requirements")
+    result = Composer(kb).compose("FetchMyBookIfDark")
+    assert result.plan is not None and result.unused_inputs == ()
+    assert len(result.plan.goals) == 1
