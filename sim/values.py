@@ -106,7 +106,7 @@ class Designator:
 
 @dataclass(frozen=True)
 class ColourFeature:
-    """The colour a recogniser segments an object by (a name the segmenter knows: sim.perception.COLOURS)."""
+    """The colour a recogniser segments an object by (a name among the camera's colour windows, kb.colour_windows)."""
 
     colour: str
 
