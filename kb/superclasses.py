@@ -79,6 +79,7 @@ def _holds_vocabulary(store: Store, namespace: str) -> bool:
 _SPELLS = re.compile(r"subclassof|rdf-schema#s|\\[uU]", re.IGNORECASE)
 _TOKEN = re.compile(HIDING + r"|\s+|\^\^|[{}\[\]();,]|[^\s{}\[\]();,<>\"'#^]+|.", re.DOTALL)
 _COPIES = frozenset({"ADD", "COPY", "MOVE", "LOAD"})
+_ADDS = re.compile(r"\b(?:INSERT|ADD|COPY|MOVE|LOAD)\b", re.IGNORECASE)
 
 
 def may_add_subclasses(text: str) -> bool:
@@ -87,6 +88,8 @@ def may_add_subclasses(text: str) -> bool:
     anything it cannot read as an INSERT template with fixed predicates none of which is that one."""
     if _SPELLS.search(text):
         return True
+    if not _ADDS.search(text):  # only deletes, clears, drops: nothing to read further
+        return False
     tokens = _tokens(text)
     words = [token.upper() for token in tokens]
     if _COPIES.intersection(words) or any("\\" in token for token in tokens if not token.startswith(("'", '"'))):
