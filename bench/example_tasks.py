@@ -63,7 +63,7 @@ VERBS = (*GRAPHS, "update", "register")
 STATUSES = ("succeeded", "refused", "no plan", "failed")
 RUN_STATUS = {"succeeded": "succeeded", "failed": "failed", "cancelled": "failed", "unsolvable": "no plan"}
 SERVER_STATUS = {"succeeded": "succeeded", "failed": "failed", "cancelled": "failed", "no-plan": "no plan"}
-VIAS = ("cli", "bridge", "http", "run_task", "library")
+VIAS = ("cli", "bridge", "http", "run_task", "action", "library")
 GRAPH_SIZES = "SELECT ?g (COUNT(*) AS ?n) WHERE { GRAPH ?g { ?s ?p ?o } } GROUP BY ?g"
 STARTUP = 90.0
 """Seconds a server or a component program may take to answer or register (bounded waits)."""
@@ -236,8 +236,10 @@ def _check(path: Path, trial: Trial) -> None:
         raise SystemExit(f"{where}: a library program (library) runs alone, and only it runs via library")
     if trial.library is not None and len(trial.runs) != 1:
         raise SystemExit(f"{where}: a library program runs its one task: one run")
-    if trial.post and (trial.via not in ("http", "bridge", "run_task") or not trial.runs):
-        raise SystemExit(f"{where}: files are posted to a server: its runs must go to one (via http, bridge, run_task)")
+    if trial.post and (trial.via not in ("http", "bridge", "run_task", "action") or not trial.runs):
+        raise SystemExit(
+            f"{where}: files are posted to a server: its runs must go to one (via http, bridge, run_task, action)"
+        )
     if trial.post and any(
         s.expect_refusal or s.replace or s.verb not in (*GRAPHS, "register", "update") for s in trial.setup
     ):
@@ -565,6 +567,8 @@ def _served_runs(trial: Trial, index: int, store: Path) -> list[Outcome]:
                     found = _http_run(url, run.task, seed, env["CBRS_UPDATE_TOKEN"])
                 elif trial.via == "run_task":
                     found = _bridge_run(ws, run.task, seed, env["CBRS_UPDATE_TOKEN"])
+                elif trial.via == "action":
+                    found = _action_run(ws, run.task, seed, env["CBRS_UPDATE_TOKEN"])
                 else:
                     args = ("run", run.task, "--bridge", ws, "--seed", str(seed), "--json")
                     try:
@@ -630,6 +634,38 @@ def _bridge_run(ws: str, task: str, seed: int, token: str) -> dict[str, Any]:
     if run.get("status") == "running":
         return {"status": "broken", "error": f"{run.get('id')} still running after {RUN_TIMEOUT:.0f} s"}
     return _ended(run)
+
+
+def _action_run(ws: str, task: str, seed: int, token: str) -> dict[str, Any]:
+    """Send the bridge's ``/cbrs/run_task`` action a goal, as a ROS 2 client through rosbridge does (the op
+    ``auth`` with the token, then ``send_action_goal`` with feedback), and read messages until its result
+    (bounded): the run as the result's values give it, its feedback counted (one a plan step that ended)."""
+    from websockets.sync.client import connect
+
+    goal = {"op": "send_action_goal", "id": "sweep-goal", "action": "/cbrs/run_task"}
+    goal |= {"action_type": "cbrs/action/RunTask", "args": {"task": task, "seed": seed}, "feedback": True}
+    deadline = time.monotonic() + RUN_TIMEOUT
+    feedback = 0
+    try:
+        with connect(ws, open_timeout=30, max_size=None) as socket_:
+            socket_.send(json.dumps({"op": "auth", "mac": token}))
+            socket_.send(json.dumps(goal))
+            while time.monotonic() < deadline:
+                message = json.loads(socket_.recv(timeout=max(1.0, deadline - time.monotonic())))
+                if message.get("op") == "action_feedback" and message.get("id") == goal["id"]:
+                    feedback += 1
+                elif message.get("op") == "action_result" and message.get("id") == goal["id"]:
+                    break
+                elif message.get("op") == "status" and message.get("level") == "error":
+                    return {"status": "broken", "error": f"/cbrs/run_task action: {message.get('msg')}"[:300]}
+            else:
+                return {"status": "broken", "error": f"no action result in {RUN_TIMEOUT:.0f} s"}
+    except Exception as error:  # the bridge gone or the socket's wait over: the run cannot be read
+        return {"status": "broken", "error": f"/cbrs/run_task action: {type(error).__name__}: {error}"[:300]}
+    run = message.get("values")
+    if not message.get("result") or not isinstance(run, dict) or "status" not in run:
+        return {"status": "broken", "error": f"/cbrs/run_task action refused: {str(run)[:300]}"}
+    return {**_ended(run), "feedback": feedback}
 
 
 def _reason(found: dict[str, Any]) -> str:
