@@ -620,7 +620,8 @@ def _stranded(before: set[ox.Quad], after: set[ox.Quad]) -> str:
     on: dict[str, list[str]] = {}
     for quad in after:
         if quad.predicate == _LOCATED_ON and quad.object in gone and isinstance(quad.object, ox.NamedNode):
-            on.setdefault(quad.object.value, []).append(str(quad.subject.value).rsplit("#", 1)[-1])
+            subject = quad.subject.value if not isinstance(quad.subject, ox.Triple) else str(quad.subject)
+            on.setdefault(quad.object.value, []).append(subject.rsplit("#", 1)[-1])
     return "; ".join(
         f"the update deleted every statement of {support}, and {', '.join(sorted(things))} still stand on it "
         "(home:isLocatedOn): in the same update, delete those and insert what replaces it (DELETE { ?thing "
