@@ -58,6 +58,19 @@ def _non_negative_seconds(text: str) -> float:
     return value
 
 
+def _metres(most: float) -> Callable[[str], float]:
+    """A parser of a length in metres from 0 to ``most``: a larger one is most likely millimetres or
+    centimetres, and refused saying so rather than taken."""
+
+    def parse(text: str) -> float:
+        value = float(text)
+        if not 0.0 <= value <= most:  # NaN too
+            raise ValueError(f"{text} must be a length in metres from 0 to {most:g} (5 mm is 0.005)")
+        return value
+
+    return parse
+
+
 def _flag(text: str) -> bool:
     word = text.strip().lower()
     if word in ("1", "true", "yes", "on"):
@@ -451,6 +464,22 @@ SETTINGS: tuple[Setting, ...] = (
         "undone_state_factor=0) for cbrs match, cbrs eval and cbrs serve's rankings; none by default.",
         "CBRS_MATCH_PARAMS",
         _match_params,
+    ),
+    Setting(
+        "spot_inset",
+        lambda: 0.005,  # cbrs.sim.place_spots.SPOT_INSET, kept here so settings load no simulation
+        "Metres a set-down spot's centre keeps inside the edge of a place too small for the thing's whole "
+        "footprint (docs/simulation.md, a spot's centre inside its place); 0 to 0.05.",
+        "CBRS_SPOT_INSET",
+        _metres(0.05),
+    ),
+    Setting(
+        "seen_short",
+        lambda: 0.01,  # cbrs.sim.grasping.SEEN_SHORT, kept here so settings load no simulation
+        "Metres less of its height than a thing has that perception may see and the grasp still take the "
+        "middle of what was seen; seen shorter, it takes the seen top less half the height; 0 to 0.1.",
+        "CBRS_SEEN_SHORT",
+        _metres(0.1),
     ),
     Setting(
         "log_level",

@@ -16,6 +16,7 @@ import numpy as np
 
 from cbrs.kb.hands import PANDA_HAND, Hand
 from cbrs.kb.semantic_map import MapObject, NotGraspableError
+from cbrs.settings import setting
 from cbrs.sim.errors import GraspTooDeepError, GraspTooThinError, GraspTooWideError
 from cbrs.sim.geometry import Quat, Vec3, quat_from_matrix
 
@@ -237,21 +238,28 @@ def side_orientation(approach_yaw: float, pitch: float) -> Quat:
 
 SEEN_SHORT = 0.01
 """How much less of an object's height (m) perception may see than it has before the middle of what it
-saw is taken for a part of it (:func:`seen_centre_z`): a thing seen whole is seen within a few
-millimetres of its height (the bundled cup 9.9-10.2 cm of its 10 cm, on the table and below the tap; the
-pen 1.56 of its 1.6 cm), the lab's apple seen in part 2.8 cm short or more."""
+saw is taken for a part of it (:func:`seen_centre_z`), by default: the ``seen_short`` setting
+(``CBRS_SEEN_SHORT``) sets it (:func:`seen_short`). A thing seen whole is seen within a few millimetres of
+its height (the bundled cup 9.9-10.2 cm of its 10 cm, on the table and below the tap; the pen 1.56 of its
+1.6 cm), the lab's apple seen in part 2.8 cm short or more."""
+
+
+def seen_short() -> float:
+    """SEEN_SHORT, or the ``seen_short`` setting where it is given (metres, 0 to 10 cm): a camera that sees
+    whole things less exactly (fewer pixels on them) needs more before a short sighting counts as a part."""
+    return float(setting("seen_short").resolve())
 
 
 def seen_centre_z(centre_z: float, seen_height: float | None, height: float) -> float:
     """The height of the centre of an object ``height`` tall whose seen points span ``seen_height`` about
     ``centre_z`` (the middle of what perception saw): that middle, unless it saw less of the object's
-    height than it has by more than SEEN_SHORT. Then the top of what it saw, less half the height: a
+    height than it has by more than :func:`seen_short`. Then the top of what it saw, less half the height: a
     camera above sees an object's top first (:func:`cbrs.sim.perception.recognise_object`), and a part
     it did not see is a part of the side below (hidden, or rendered off its colour). The lab's apple,
     green at the edge of what the camera calls green, was seen 4.2 cm of its 7 cm, its lower side lost;
     grasped 1.5 cm above its centre, it hung 1.5 cm lower than the grasp said, and the put-down pressed
     it into the bowl's floor, 1.2-1.3 cm short of the hand's goal (docs/simulation.md)."""
-    if seen_height is None or seen_height >= height - SEEN_SHORT:
+    if seen_height is None or seen_height >= height - seen_short():
         return centre_z
     return centre_z + seen_height / 2.0 - height / 2.0
 

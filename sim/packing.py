@@ -36,6 +36,7 @@ from cbrs.sim.place_spots import (
     RELAY_EDGE,
     RELAY_MARGIN,
     RELAY_STEP,
+    able_mounts,
     fixtures_on,
     other_objects,
     place_inset,
@@ -607,8 +608,8 @@ def carry_spots(
     mounts = [reach_of(world.arm_specs[side])]
     others = other_objects(world, ctx.belief, carried)
     earlier, later = packed_with(ctx.plan, step, smap, place.iri, ctx.given, ctx.known)
-    if obj is None or not (earlier or later):
-        return place_spots(smap, place, size, mounts, others)
+    if obj is None or not (earlier or later):  # an arm holding something else leaves this one its spots
+        return place_spots(smap, place, size, mounts, others, able_mounts(world, carried))
     coming = [smap.objects[iri] for iri in later]
     surface, _ = support_of(smap, place)
     holds = _HoldAsked(ctx, coming, surface)
@@ -625,7 +626,7 @@ def carry_spots(
     try:
         return set_down_spots(smap, place, size, mounts, [], sizes, rule, footprint_of(obj), feet, lying, holds)
     except Undecided:  # more spots asked of the arms than HOLD_TRIES: as for one thing alone
-        return place_spots(smap, place, size, mounts, others)
+        return place_spots(smap, place, size, mounts, others, able_mounts(world, carried))
 
 
 def _circles_hold(

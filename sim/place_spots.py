@@ -13,6 +13,7 @@ import math
 from collections.abc import Sequence
 
 from cbrs.kb.semantic_map import Arm, SemanticMap, Thing
+from cbrs.settings import setting
 from cbrs.sim import skills
 from cbrs.sim.geometry import Region
 from cbrs.sim.perceived import PerceivedWorld
@@ -37,10 +38,17 @@ RELAY_STEP = 0.02
 
 SPOT_INSET = 0.005
 """The least a spot's centre keeps inside its place's edge (:func:`place_inset`), where the place is too
-small to hold the object's footprint: more than a set-down's centre was seen from its spot in the runs
-traced (0.3 mm, the apple set down on the west bowl's edge; 0.9-1.4 mm, the cup below the tap). Half a
-centimetre keeps the spot of the 5 cm place below the tap that the fifth round's robot 10 cm west sets
-the cup down at, 5 mm inside its edge; 1 cm took it off, and a pass to the other arm was added."""
+small to hold the object's footprint, by default: the ``spot_inset`` setting (``CBRS_SPOT_INSET``) sets it
+(:func:`spot_inset`). More than a set-down's centre was seen from its spot in the runs traced (0.3 mm, the
+apple set down on the west bowl's edge; 0.9-1.4 mm, the cup below the tap). Half a centimetre keeps the
+spot of the 5 cm place below the tap that the fifth round's robot 10 cm west sets the cup down at, 5 mm
+inside its edge; 1 cm took it off, and a pass to the other arm was added."""
+
+
+def spot_inset() -> float:
+    """SPOT_INSET, or the ``spot_inset`` setting where it is given (metres, 0 to 5 cm): a lab whose
+    perception sees set-downs farther from their spots keeps spots farther inside narrow places."""
+    return float(setting("spot_inset").resolve())
 
 
 def place_inset(half: float, width: float) -> float:
@@ -54,13 +62,13 @@ def place_inset(half: float, width: float) -> float:
 
 
 def least_inset(width: float) -> float:
-    """The least a spot's centre keeps inside the edges of a place ``width`` wide: SPOT_INSET, or the middle
+    """The least a spot's centre keeps inside the edges of a place ``width`` wide: :func:`spot_inset`, or the middle
     of a place narrower than twice that. Whether a thing is on or in a place is asked of its centre as
     perception sees it (``predicates``): a centre on the edge counts either way by a fraction of a
     millimetre. Before, a spot's centre only had to be over the place, edge included, and a lab's apple
     carried to the one part of a bowl the arm reached, its edge, was seen 0.3 mm outside it
     (docs/simulation.md)."""
-    return min(SPOT_INSET, width / 2.0)
+    return min(spot_inset(), width / 2.0)
 
 
 def reach_of(arm: Arm) -> tuple[float, float, float]:
@@ -73,6 +81,17 @@ def distance_to_extent(box: tuple[float, float, float, float], point: tuple[floa
     dx = max(box[0] - point[0], 0.0, point[0] - box[1])
     dy = max(box[2] - point[1], 0.0, point[1] - box[3])
     return math.hypot(dx, dy)
+
+
+def able_mounts(world: HomeWorld, carried: str) -> list[tuple[float, float, float]]:
+    """The reaches (:func:`reach_of`) of the world's arms that could set ``carried`` (a name) down: those
+    holding nothing or it. An arm holding something else cannot take the step, so its spots must not take
+    away another arm's (:func:`place_spots`' ``able``)."""
+    return [
+        (spec.mount[0], spec.mount[1], spec.reach)
+        for side, spec in sorted(world.arm_specs.items())
+        if (held := world.arm(side).held) is None or world.name_of(held) == carried
+    ]
 
 
 def other_objects(world: HomeWorld, belief: PerceivedWorld | None, *names: str) -> list[tuple[float, float, float]]:
@@ -115,6 +134,7 @@ def place_spots(
     size: tuple[float, float, float],
     mounts: Sequence[tuple[float, float, float]],
     others: Sequence[tuple[float, float, float]],
+    able: Sequence[tuple[float, float, float]] | None = None,
 ) -> tuple[Region, list[tuple[float, float]]]:
     """Where on a place an object of ``size`` can be set down by an arm mounted at one of ``mounts``
     (x, y, reach): the place's surface (a region's bottom, a piece of furniture's top), and the spots of
@@ -127,10 +147,13 @@ def place_spots(
     partly reaches is worked at its reachable part, not at a centre no arm reaches.
 
     The spots are those with the whole footprint over the place where ``mounts`` have any; else none where
-    another arm of the map has one (it sets the thing down wholly inside: the west bowl's apple goes to the
-    arm that reaches its middle, not onto the edge the other reaches); else those whose centre is only
-    :func:`least_inset` inside the place, so that a place with room for the whole footprint only where no
-    arm can set it down (the pen's 20 x 15 cm spot beside the dispenser) is still used."""
+    another arm that can take the step has one (it sets the thing down wholly inside: the west bowl's apple
+    goes to the arm that reaches its middle, not onto the edge the other reaches); else those whose centre
+    is only :func:`least_inset` inside the place, so that a place with room for the whole footprint only
+    where no arm can set it down (the pen's 20 x 15 cm spot beside the dispenser) is still used. The arms
+    that can take the step are ``able`` (reaches as ``mounts``; :func:`able_mounts`: not one holding
+    something else), else every arm of the map: an arm that is busy does not take the edge from one that
+    is free."""
     surface, support = support_of(smap, place)
     cx, cy, z = surface.center
     box = support.box
@@ -140,7 +163,7 @@ def place_spots(
     width, depth = surface.xmax - surface.xmin, surface.ymax - surface.ymin
     whole_x, whole_y = place_inset(radius, width) - 1e-9, place_inset(radius, depth) - 1e-9
     in_x, in_y = least_inset(width) - 1e-9, least_inset(depth) - 1e-9
-    everyone = [reach_of(arm) for arm in smap.arms.values()]
+    everyone = [*mounts, *(able if able is not None else (reach_of(arm) for arm in smap.arms.values()))]
 
     def reached(x: float, y: float, by: Sequence[tuple[float, float, float]]) -> bool:
         return any(math.hypot(x - mx, y - my) <= reach - RELAY_MARGIN for mx, my, reach in by)

@@ -141,6 +141,7 @@ def _context(smap: SemanticMap, plan: Plan, step_index: int) -> SimContext:
         map=smap,
         objects={obj.name: obj for obj in smap.objects.values()},
         arm_specs={ArmSide(arm.side): arm for arm in smap.arms.values()},
+        arm=lambda side: SimpleNamespace(held=None),  # both arms free (place_spots.able_mounts)
     )
     step = next(s for s in plan.steps if s.index == step_index)
     return SimContext(
