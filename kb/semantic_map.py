@@ -21,6 +21,7 @@ from pyoxigraph import NamedNode
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import PREFIXES, shorten
 from cbrs.kb.shapes import nearest_term
+from cbrs.kb.turned_fit import fits_at, fits_some_turn, fits_unturned, fitting_turns
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -808,26 +809,37 @@ def _on_an_object(iri: str, below: MapObject, built: SemanticMap) -> str:
 
 
 def _check_fits(obj: MapObject, support: Thing) -> None:
-    """An object's footprint is no wider than its support's top, either way round: one that is stands
-    on nothing, and it is most often a size written in centimetres (home:sizeX 7 for a 7 cm apple), which
-    the overlap check then reported as another object inside it, by hundreds of centimetres, never
-    naming the size (docs/tasks.md, "An eighth round")."""
+    """An object's footprint fits its support's top at some turn (:mod:`kb.turned_fit`): one that does not
+    stands on nothing, and it is most often a size written in centimetres (home:sizeX 7 for a 7 cm apple),
+    which the overlap check then reported as another object inside it, by hundreds of centimetres, never
+    naming the size (docs/tasks.md, "An eighth round"). One that fits either way round passes, as before;
+    one that fits only turned (a 40 cm ruler across a 35 x 30 cm stool) passes where its home:yaw is such
+    a turn, since the simulation stands it as home:yaw says and never turns it to fit; elsewhere it is
+    refused, naming the turns that fit."""
     box = support.box
-    top = sorted((box.max_x - box.min_x, box.max_y - box.min_y))
-    footprint = sorted(obj.size[:2])
-    if footprint[0] <= top[0] + 1e-9 and footprint[1] <= top[1] + 1e-9:
+    sides = (box.max_x - box.min_x, box.max_y - box.min_y)
+    length, width = obj.size[0], obj.size[1]
+    if fits_unturned(length, width, sides):
         return
     sizes = f"home:sizeX {obj.size[0]:g}, home:sizeY {obj.size[1]:g}, home:sizeZ {obj.size[2]:g}"
+    said = f"is {obj.size[0]:g} x {obj.size[1]:g} m ({sizes})"
+    where = f"its support {support.name} (home:isLocatedOn; {sides[0]:.2f} x {sides[1]:.2f} m)"
+    if fits_some_turn(length, width, sides):
+        if fits_at(length, width, obj.start.yaw, sides):
+            return
+        turns = " or ".join(f"{low:.2f} to {high:.2f}" for low, high in fitting_turns(length, width, sides))
+        raise MapError(
+            obj.iri,
+            f"{said}, longer than the top of {where} and fits it only turned, at home:yaw {turns} rad (or the "
+            f"negative, or a half turn from these); its home:yaw is {obj.start.yaw:g}, and the simulation "
+            "stands it as home:yaw says and does not turn it to fit: give a home:yaw that fits",
+        )
     metres = (
         f"; sizes are in metres: {obj.size[0]:g} cm is {obj.size[0] / 100:g}"
-        if max(obj.size) >= 1.0 and all(v / 100 <= t for v, t in zip(footprint, top, strict=True))
+        if max(obj.size) >= 1.0 and fits_some_turn(length / 100, width / 100, sides)
         else ""
     )
-    raise MapError(
-        obj.iri,
-        f"is {obj.size[0]:g} x {obj.size[1]:g} m ({sizes}), wider than the top of its support {support.name} "
-        f"(home:isLocatedOn; {top[0]:.2f} x {top[1]:.2f} m){metres}",
-    )
+    raise MapError(obj.iri, f"{said}, wider than the top of {where}{metres or ', however turned'}")
 
 
 def _footprint(obj: MapObject) -> list[tuple[float, float]]:

@@ -26,6 +26,7 @@ from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.person_choice import person_for
 from cbrs.kb.semantic_map import MapObject, NotGraspableError, Person, Thing, local_name
 from cbrs.kb.store import Term
+from cbrs.kb.turned_fit import fits_some_turn
 from cbrs.sim import sight, skills
 from cbrs.sim.arm_choice import TAKING, check_take, lying_estimate, who_loads
 from cbrs.sim.context import SimContext, SkillFailed
@@ -38,11 +39,13 @@ from cbrs.sim.perceived import PerceivedWorld
 from cbrs.sim.perception import ObjectEstimate
 from cbrs.sim.place_spots import (
     RELAY_CLEARANCE,
+    RELAY_EDGE,
     RELAY_MARGIN,
-    SPOT_INSET,
     distance_to_extent,
     other_objects,
     place_spots,
+    spot_inset,
+    support_of,
 )
 from cbrs.sim.services import (
     MOVING,
@@ -231,6 +234,35 @@ class PlaceCrowdedError(KnowledgeBaseError):
         )
 
 
+class PlaceTooSmallError(KnowledgeBaseError):
+    """A place an arm step is given stands on a top too small for the object at hand as the carry sets it
+    down: by the circle about its footprint (it comes to rest turned as it lay in the hand, which the
+    carry does not turn), RELAY_EDGE inside the top's edge. The run is refused before anything moves,
+    saying so, and whether the object would fit turned (:func:`kb.turned_fit.fits_some_turn`), which the
+    map's check accepts for where an object stands at the start but a set-down cannot do."""
+
+    http_status = 422
+
+    def __init__(
+        self, place: str, what: str, size: tuple[float, float, float], top: tuple[float, float], support: str
+    ) -> None:
+        self.place = place
+        self.size = size
+        self.top = top
+        across = math.hypot(size[0], size[1])
+        turned = (
+            "; it would fit turned, which the simulation does not do" if fits_some_turn(size[0], size[1], top) else ""
+        )
+        on = "" if support == place else f" (on the {local_name(support)})"
+        super().__init__(
+            f"the {local_name(place)}{on} is {top[0]:.2f} x {top[1]:.2f} m, too small to set {what} "
+            f"({size[0]:g} x {size[1]:g} m) down on: a carry sets a thing down turned as it lies in the hand, "
+            f"never turned to fit, so it keeps the circle about its footprint ({across:.2f} m across) "
+            f"{RELAY_EDGE:.2f} m inside the edge of the top, which needs {across + 2 * RELAY_EDGE:.2f} m each "
+            f"way{turned}; choose a larger place"
+        )
+
+
 class PlanChecks:
     """The checks :meth:`SimEnvironment.given` makes of a plan before anything moves, by the map and where
     things are believed to be: every person a step needs can be told, every thing an arm step is given is
@@ -254,7 +286,8 @@ class PlanChecks:
 
     def check(self, plan: Plan, values: Mapping[str, Any]) -> None:
         """Refuse ``plan`` with the first check's typed error (:class:`kb.person_choice.PersonError`,
-        :class:`OutOfReachError`, :class:`PlaceCrowdedError`, :class:`arm_choice.CannotCarryError`,
+        :class:`OutOfReachError`, :class:`PlaceCrowdedError`, :class:`PlaceTooSmallError`,
+        :class:`arm_choice.CannotCarryError`,
         :class:`sight.OutOfViewError`,
         :class:`CannotLoadError`, :class:`kb.home_check.NoDockingPoseError`, :class:`WhichBaseError`);
         nothing when every check passes. In a home of several bases, the world drives the one the plan works
@@ -517,7 +550,8 @@ class PlanChecks:
         will do (:func:`place_spots`, by the map) for the object at hand: the one the step is given,
         else the one the robot's latest arm step given one worked on (a carry's object comes from the
         approach and pick-up before it); the largest, if there are several. The carry would aim at a
-        spot it then lacks."""
+        spot it then lacks. A top too small for the object's circle and the edge is refused as such
+        (:class:`PlaceTooSmallError`: the set-down does not turn a thing to fit), not as out of reach."""
         smap = self.world.map
         objects = [smap.objects[other] for other in carried]
         size = max(
@@ -531,12 +565,16 @@ class PlanChecks:
         if not spots:
             box = smap.things[iri].box
             what = f"the {name}" if name else "an object"
+            _, support = support_of(smap, smap.things[iri])
+            top = (support.box.max_x - support.box.min_x, support.box.max_y - support.box.min_y)
+            if math.hypot(size[0], size[1]) + 2 * RELAY_EDGE > min(top) + 1e-9:
+                raise PlaceTooSmallError(iri, what, size, top, support.iri)
             blockers = self._blockers(iri, size, mounts, names, others)
             if blockers:
                 raise PlaceCrowdedError(iri, what, blockers, RELAY_CLEARANCE)
             why = (
                 f"no spot of it is {RELAY_MARGIN:.2f} m inside an arm's reach with {what}'s centre "
-                f"{SPOT_INSET * 1000:.0f} mm inside the place and clear of the edge of the surface, the other "
+                f"{spot_inset() * 1000:.0f} mm inside the place and clear of the edge of the surface, the other "
                 "objects and the fixtures on it"
             )
             where = ((box.min_x + box.max_x) / 2, (box.min_y + box.max_y) / 2)
