@@ -165,6 +165,7 @@ class Extraction:
                         node,
                         self._chain(chain, followed),
                         provided=self._provided(need),
+                        unlike=self._unlike(need),
                         along=tuple(along),
                     )
                 )
@@ -224,6 +225,31 @@ class Extraction:
             and index.canonical(offer.statement.subject) in above
         }
         return tuple((iri, text) for *_, iri, text in sorted(found)[:most])
+
+    def _unlike(self, need: Need) -> tuple[str, tuple[str, ...]] | None:
+        """For a statement no component provides: the objects of the effects components provide about its
+        subject's class by its predicate (or one above it) that its own object is not, when it is none of
+        them. The ninth round's goal (StorageBox, isLocatedOn, Book) listed what the put-down, the hand-over
+        and the delivery provide, but not that a book is no place, no platform and no person."""
+        wanted = need.statement
+        index = self.graph.matcher.index
+        if need.role == "deletion" or wanted is None or wanted.subject not in index or wanted.object not in index:
+            return None
+        above = {*index.is_a_ancestors(wanted.subject), index.canonical(wanted.subject)}
+        objects: dict[str, bool] = {}
+        for vertex in self.graph.pool.vertices.values():
+            for offer in vertex.offers:
+                said = offer.statement
+                if said is None or offer.role != "effect" or said.subject not in index:
+                    continue
+                if index.canonical(said.subject) not in above:
+                    continue
+                if not degree_of_match(index, wanted.predicate, said.predicate).accepted:
+                    continue
+                objects[said.object] = degree_of_match(index, wanted.object, said.object).accepted
+        if not objects or any(objects.values()):
+            return None
+        return wanted.object, tuple(sorted(objects))
 
     @staticmethod
     def _chain(start: tuple[str, ...], followed: list[str]) -> tuple[str, ...]:

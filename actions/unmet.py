@@ -35,6 +35,8 @@ class Unsatisfied:
     unrunnable: tuple[tuple[str, str], ...] = ()  # (component, why): planned for it, but cannot run here
     out_of_area: tuple[tuple[str, str], ...] = ()  # (component, why): provides it, but not where it is needed
     provided: tuple[tuple[str, str], ...] = ()  # (component, effect): what is provided about the need's subject
+    # (the need's object, the objects of those effects by its predicate): it is none of them
+    unlike: tuple[str, tuple[str, ...]] | None = None
     deleted_by: tuple[str, ...] = ()  # components whose delete effect undoes it before it is needed
     individuals: tuple[tuple[str, tuple[str, ...]], ...] = ()  # (undeclared term, its classes): a thing of the map
     superclasses: tuple[tuple[str, str], ...] = ()  # (undeclared class, the class its use suggests declaring it under)
@@ -52,6 +54,11 @@ class Unsatisfied:
             each = "; ".join(f"{effect} by {shorten(component)}" for component, effect in self.provided)
             done = "delete" if self.need.startswith("delete effect ") else "provide"
             found += f"; what components {done} about it: {each}"
+        if self.unlike is not None:
+            thing, others = self.unlike
+            nots = [shorten(term) for term in others]
+            listed = ", no ".join(nots[:-1]) + " and no " + nots[-1] if len(nots) > 1 else nots[0]
+            found += f"; {shorten(thing)} is no {listed}"
         for miss in self.near_misses:
             found += f"; {miss.text(_taker(miss.consumer or self.consumer, miss.statement))}"
         return found
@@ -188,6 +195,7 @@ class Unsatisfied:
             "unrunnable": [{"component": component, "why": why} for component, why in self.unrunnable],
             "out_of_area": [{"component": component, "why": why} for component, why in self.out_of_area],
             "provided": [{"component": component, "effect": effect} for component, effect in self.provided],
+            "unlike": None if self.unlike is None else {"object": self.unlike[0], "none_of": list(self.unlike[1])},
             "deleted_by": list(self.deleted_by),
             "near_misses": [miss.to_dict() for miss in self.near_misses],
         }

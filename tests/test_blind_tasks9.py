@@ -241,3 +241,19 @@ def test_the_labs_roslibjs_program_parses() -> None:
         ["node", "--check", str(EXAMPLES / "lab9_run_and_stop.mjs")], capture_output=True, text=True, timeout=60
     )
     assert checked.returncode == 0, checked.stderr
+
+
+# -- an impossible goal -----------------------------------------------------------------------------
+
+
+def test_an_impossible_destination_is_named_as_none_of_those_components_reach(book_kb: KnowledgeBase) -> None:
+    """The box onto the notebook lying on it: the answer listed what the put-down, the hand-over and the
+    delivery provide, but not that a book is none of their destinations."""
+    book_kb.load([EXAMPLES / "lab9_mistake_box_onto_the_book.ttl"], graph="requirements")
+    result = Composer(book_kb).compose("BoxOntoTheBook")
+    assert result.plan is None and len(result.unsatisfied) == 1
+    unmet = result.unsatisfied[0]
+    assert unmet.text().endswith("by svc:DeliverObject_P3DX01; home:Book is no home:Place and no home:RobotPlatform")
+    assert unmet.to_dict()["unlike"] == {"object": HOME + "Book", "none_of": [HOME + "Place", HOME + "RobotPlatform"]}
+    onto_table = Composer(book_kb).compose("BookOntoTheTable")  # a destination that is a place: no such words
+    assert onto_table.plan is not None and all(u.unlike is None for u in onto_table.unsatisfied)
