@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import dataclasses
+import functools
 import logging
 import re
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from contextlib import AbstractContextManager, nullcontext
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -432,15 +433,21 @@ class KnowledgeBase:
         store; None for any other update or store."""
         return DataUpdate.read(text, self.store) if isinstance(self.store, EmbeddedStore) else None
 
-    def _update(self, text: str, data: DataUpdate | None, check_map: bool) -> Refresh | None:
+    def _update(
+        self, text: str, data: DataUpdate | None, check_map: bool, run: Callable[[], None] | None = None
+    ) -> Refresh | None:
         """:meth:`update` of ``text``, read as ``data``, with the semantic map checked (``check_map``) as well
-        as the descriptions; returns what graph:entailed's refresh changed (None: it lags)."""
+        as the descriptions; returns what graph:entailed's refresh changed (None: it lags). ``run`` carries
+        it out instead of the store's own update, on a copy of a remote store that is checked and thrown
+        away (:mod:`kb.remote_updates`): graph:entailed is then left alone."""
         from cbrs.kb.semantic_map import MapError  # it imports this module
 
+        if not isinstance(self.store, EmbeddedStore):
+            return self._update_remote(text, check_map)
         if data is not None:  # a class put under a home: term nobody declares, as a load refuses it
             inserted = [quad for operation in data.operations if operation.insert for quad in operation.quads]
             check_superclasses(self.store, [("the update", inserted)], "nothing was written")
-        pending = self.standard_terms.prepare(data)
+        pending = self.standard_terms.prepare(data) if run is None else None
         checking: AbstractContextManager[None] = nullcontext()
         before = self._map_before_update(text, data) if check_map else None
         old_map = before.quads if before is not None else None
@@ -461,7 +468,7 @@ class KnowledgeBase:
             checking = checked_update(self.store)
         try:
             with checking:
-                self.store.update(text)
+                (run or functools.partial(self.store.update, text))()
             if axioms is not None:
                 check_added_superclasses(self.store, axioms)
             if old_map is not None:
@@ -477,12 +484,45 @@ class KnowledgeBase:
             else:
                 self._put_back(everything, old_map)
             if not unasked or self._stored_map_reads():
-                error.add_note(_refused(isinstance(error, MapError), keep))
+                error.add_note(_refused(isinstance(error, MapError)))
                 raise
             self._redo(text, data, everything, after)  # the map did not read before either: the update stands
         finally:
             self._reader.clear_cache()
-        return self._entail(pending)
+        return self._entail(pending) if run is None else None
+
+    def _update_remote(self, text: str, check_map: bool) -> Refresh | None:
+        """:meth:`_update` on a remote store: an update the embedded store would check is carried out first
+        on a copy of the store, through the same checks, and only the change it made there is sent; a
+        refused one sends nothing (:mod:`kb.remote_updates`). Any other is sent as it is."""
+        from cbrs.kb.remote_store import RemoteStore
+        from cbrs.kb.remote_updates import CheckedCopy
+
+        assert isinstance(self.store, RemoteStore)
+        data = DataUpdate.read(text, EmbeddedStore(ox.Store(), MEMORY))  # only read: which quads it names
+        if data is not None:
+            inserted = [quad for operation in data.operations if operation.insert for quad in operation.quads]
+            on_map = check_map and data.names_graph((GraphName.MAP.node,))
+            checked = on_map or data.names_graph(CHECKED_GRAPHS)
+            if not checked:  # no copy needed: the superclasses are read from the store itself
+                check_superclasses(self.store, [("the update", inserted)], "nothing was written")
+        else:
+            on_map = check_map and _MAY_WRITE_MAP.search(text) is not None
+            checked = on_map or may_write_descriptions(text) or _LOADS.search(text) is not None
+            checked = checked or may_add_subclasses(text)
+        try:
+            if not checked:
+                self.store.update(text)
+            else:
+                copy = CheckedCopy(self.store)
+                scratch = KnowledgeBase(copy.store, self.queries)
+                scratch._update(
+                    text, DataUpdate.read(text, copy.store), check_map, run=functools.partial(copy.run, text)
+                )
+                copy.send(self.store, text)
+        finally:
+            self._reader.clear_cache()
+        return self._entail(None)
 
     def _redo(
         self, text: str, data: DataUpdate | None, before: set[ox.Quad] | None, after: set[ox.Quad] | None
@@ -497,9 +537,9 @@ class KnowledgeBase:
     def _map_before_update(self, text: str, data: DataUpdate | None) -> _MapBefore | None:
         """graph:map before an update that may write it (an update is checked as a load into graph:map is:
         :meth:`_check_map_load`); None: nothing to check, the map being empty (being built) or known not to
-        read (left to the reader's error). Whether it reads is asked now on a remote store only; on an
-        embedded one, only if the update leaves it unreadable (the update undone first, and redone if the
-        map did not read before either), so an update that leaves it readable reads it once, not twice."""
+        read (left to the reader's error). Whether it reads is asked only if the update leaves it unreadable
+        (the update undone first, and redone if the map did not read before either), so an update that leaves
+        it readable reads it once, not twice."""
         may = data.names_graph((GraphName.MAP.node,)) if data is not None else bool(_MAY_WRITE_MAP.search(text))
         if not may:
             return None
@@ -507,8 +547,6 @@ class KnowledgeBase:
         if not quads:
             return None
         known = self._known_map_reads()
-        if known is None and not isinstance(self.store, EmbeddedStore):
-            known = self._stored_map_reads()
         return None if known is False else _MapBefore(quads, read=known is True)
 
     def _check_updated_map(self, old_map: set[ox.Quad]) -> None:
@@ -631,13 +669,6 @@ def _stranded(before: set[ox.Quad], after: set[ox.Quad]) -> str:
     )
 
 
-def _refused(map_error: bool, whole: bool) -> str:
-    """What a refused update left: nothing, or (a remote store, not copied beforehand) the checked graphs
-    put back and what it wrote elsewhere, if anything."""
-    if whole:
-        return "nothing was changed" + (" (an update of graph:map is checked as a task reads the map)" * map_error)
-    what = "graph:map was" if map_error else "graph:services and graph:requirements were"
-    return (
-        f"{what} put back as before (a remote store is not copied to undo an update: what it wrote to other "
-        "graphs, if anything, stands; send that change on its own)"
-    )
+def _refused(map_error: bool) -> str:
+    """What a refused update left: nothing (a remote store's is refused on a copy, before it is sent)."""
+    return "nothing was changed" + (" (an update of graph:map is checked as a task reads the map)" * map_error)

@@ -424,8 +424,15 @@ class RemoteStore(Store):
         as a data update (it follows it in graph:entailed statement by statement, :mod:`kb.update_delta`); on
         a server that does not keep a request of two operations whole (Virtuoso 7), one ``DELETE { } INSERT
         { } WHERE { }`` operation, which it does keep whole."""
-        removing = data_block(self._as_kept(remove))
-        adding = data_block(self._as_kept(add))
+        self._write_blocks(data_block(self._as_kept(remove)), data_block(self._as_kept(add)))
+
+    def write_change(self, remove: Iterable[ox.Quad], add: Iterable[ox.Quad]) -> None:
+        """:meth:`replace` of a change worked out on a copy of the store (:mod:`kb.remote_updates`), whose
+        added quads may hold blank nodes the store does not: fresh nodes there, as :meth:`add` makes."""
+        self._write_blocks(data_block(self._as_kept(remove)), data_block(self._as_kept(add), blank_nodes=True))
+
+    def _write_blocks(self, removing: str, adding: str) -> None:
+        """Remove the quads of one data block and add those of another, in one request."""
         if removing and adding and self.keeps_requests_whole:
             self._update(f"DELETE DATA {{\n{removing}}} ;\nINSERT DATA {{\n{adding}}}", original=None)
         elif removing and adding:

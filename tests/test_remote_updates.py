@@ -1,0 +1,198 @@
+"""An update of a remote store gets the embedded store's checks, before anything is sent (kb/remote_updates.py).
+
+Against the session's loopback ``oxigraph serve`` (tests/conftest.py), seeded by one request with what a
+seed writes; the embedded store given the same update is the reference for the error and its words.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+
+import httpx
+import pyoxigraph as ox
+import pytest
+
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.errors import UndeclaredSuperclassError
+from cbrs.kb.remote_store import RemoteStore
+from cbrs.kb.remote_updates import CheckedCopy, as_on_union, operations
+from cbrs.kb.semantic_map import MapError
+from cbrs.kb.shapes import DescriptionShapeError
+from tests.conftest import OxigraphServer
+from tests.helpers_seeded import put_quads, seeded_quads
+
+EXAMPLES = Path(__file__).parent.parent / "docs" / "examples"
+LAB = "PREFIX lab: <https://example.org/lab#>\n"
+ENTAILED = b"<https://w3id.org/cbrs/graph/entailed>"
+
+
+@pytest.fixture(scope="module")
+def seed() -> bytes:
+    return seeded_quads()
+
+
+@pytest.fixture
+def remote(
+    remote_location: str, oxigraph_server: OxigraphServer, seed: bytes
+) -> Iterator[tuple[KnowledgeBase, list[httpx.Request]]]:
+    """A seeded knowledge base on the server, and the requests it sends from now on."""
+    put_quads(oxigraph_server, seed)
+    kb = KnowledgeBase.open(remote_location)
+    assert isinstance(kb.store, RemoteStore)
+    seen: list[httpx.Request] = []
+    kb.store._http().event_hooks["request"].append(seen.append)
+    yield kb, seen
+    kb.close()
+
+
+def _writes(seen: list[httpx.Request]) -> list[str]:
+    return [request.content.decode() for request in seen if request.url.path == "/update"]
+
+
+def _refusal(kb: KnowledgeBase, text: str, error: type[Exception]) -> Exception:
+    with pytest.raises(error) as refused:
+        kb.update(text)
+    return refused.value
+
+
+REFUSED = [
+    pytest.param(
+        LAB + "INSERT DATA { GRAPH graph:ontology { lab:Apple rdfs:subClassOf home:Fruit } }",
+        UndeclaredSuperclassError,
+        id="insert-data-superclass",
+    ),
+    pytest.param(
+        "INSERT { GRAPH graph:ontology { ?c rdfs:subClassOf home:Fruit } }\n"
+        "WHERE { GRAPH graph:map { world:Pen a ?c } }",
+        UndeclaredSuperclassError,
+        id="insert-where-superclass",
+    ),
+    pytest.param(
+        LAB + "INSERT DATA { GRAPH graph:world { lab:note lab:says 'kept?' } } ;\n"
+        "DELETE WHERE { GRAPH graph:map { world:Pen home:sizeX ?x } }",
+        MapError,
+        id="two-operations-map",
+    ),
+    pytest.param(
+        (EXAMPLES / "lab9_mistake_new_table.ru").read_text(encoding="utf-8"), MapError, id="stranded-on-the-table"
+    ),
+    pytest.param(
+        (EXAMPLES / "lab7_mistake_where_is_my_pne.ru").read_text(encoding="utf-8"),
+        DescriptionShapeError,
+        id="description",
+    ),
+]
+
+
+@pytest.mark.parametrize(("text", "error"), REFUSED)
+def test_a_refused_update_sends_nothing_and_says_what_the_embedded_store_says(
+    remote: tuple[KnowledgeBase, list[httpx.Request]], text: str, error: type[Exception]
+) -> None:
+    kb, seen = remote
+    before = kb.store.dump()
+    on_server = _refusal(kb, text, error)
+    assert _writes(seen) == [] and kb.store.dump() == before  # the world graph's note too: all or nothing
+    embedded = KnowledgeBase.open(":memory:")
+    try:
+        reference = _refusal(embedded, text, error)
+    finally:
+        embedded.close()
+    assert str(on_server) == str(reference)
+    assert getattr(on_server, "__notes__", None) == getattr(reference, "__notes__", None)
+
+
+def test_a_where_without_graph_reads_the_union_as_the_server_does(
+    remote: tuple[KnowledgeBase, list[httpx.Request]],
+) -> None:
+    kb, seen = remote
+    before = kb.store.dump()
+    text = "DELETE { GRAPH graph:map { world:Pen home:sizeX ?x } } WHERE { world:Pen home:sizeX ?x }"
+    _refusal(kb, text, MapError)  # the server's default graph is the union: the pattern finds the pen's size
+    assert _writes(seen) == [] and kb.store.dump() == before
+
+
+def test_a_checked_update_writes_what_the_server_would_in_one_request(
+    remote: tuple[KnowledgeBase, list[httpx.Request]], oxigraph_server: OxigraphServer, seed: bytes
+) -> None:
+    kb, seen = remote
+    text = (  # no GRAPH in the WHERE: on the server it reads the union, so it finds the pen
+        "DELETE { GRAPH graph:map { world:Pen home:x ?x } } INSERT { GRAPH graph:map { world:Pen home:x ?moved } }\n"
+        "WHERE { world:Pen home:x ?x BIND (?x + 0.01 AS ?moved) }"
+    )
+    kb.update(text)
+    change, *entailed = _writes(seen)
+    assert "DELETE DATA" in change and "INSERT DATA" in change and "WHERE" not in change
+    assert all("graph/entailed" in write for write in entailed)
+    checked = kb.store.dump()
+    oxigraph_server.clear()
+    put_quads(oxigraph_server, seed)
+    kb.store.update(text)  # the text itself, carried out by the server
+    sent = kb.store.dump()
+    assert [line for line in checked.splitlines() if ENTAILED not in line] == [
+        line for line in sent.splitlines() if ENTAILED not in line
+    ]
+    assert checked != seed
+
+
+def test_an_update_nothing_checks_is_sent_as_it_is_without_a_copy(
+    remote: tuple[KnowledgeBase, list[httpx.Request]], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    kb, seen = remote
+
+    def no_copy(*_: object) -> None:
+        raise AssertionError("the store was copied")
+
+    monkeypatch.setattr(CheckedCopy, "__init__", no_copy)
+    data = "INSERT DATA { GRAPH graph:world { <https://example.org/lab#a> <https://example.org/lab#b> 1 } }"
+    clear = "DELETE WHERE { GRAPH graph:world { ?s <https://example.org/lab#b> ?o } }"
+    kb.update(data)
+    kb.update(clear)
+    written = [write for write in _writes(seen) if "graph/entailed" not in write]
+    assert len(written) == 2 and written[0].endswith(data) and written[1].endswith(clear)
+
+
+def test_an_update_of_a_blank_node_the_store_holds_is_sent_as_its_text_once_checked(
+    remote: tuple[KnowledgeBase, list[httpx.Request]],
+) -> None:
+    kb, seen = remote
+    graph = ox.NamedNode("https://example.org/lab#g")
+    kb.store.add([ox.Quad(ox.BlankNode(), ox.NamedNode("https://example.org/lab#p"), ox.Literal("x"), graph)])
+    seen.clear()
+    text = LAB + "DELETE { GRAPH lab:g { ?b lab:p ?o } } WHERE { GRAPH lab:g { ?b lab:p ?o } }"
+    kb.update(text)  # no data block can name the node: the server is sent the text
+    assert text in _writes(seen)[0] and next(iter(kb.store.quads(graph=graph)), None) is None
+
+
+def test_operations_are_split_outside_braces_strings_and_iris_with_the_prologue_carried() -> None:
+    text = (
+        "PREFIX a: <http://a/;x>\nINSERT DATA { a:s a:p 'a ; b' ; a:q 1 } ;\n# a comment ; here\n"
+        "BASE <http://b/> DELETE WHERE { ?s a:p ?o } ;"
+    )
+    assert operations(text) == [
+        ("PREFIX a: <http://a/;x>\n", "INSERT DATA { a:s a:p 'a ; b' ; a:q 1 }"),
+        ("PREFIX a: <http://a/;x>\nBASE <http://b/>\n", "DELETE WHERE { ?s a:p ?o }"),
+    ]
+
+
+@pytest.mark.parametrize(
+    ("operation", "expected"),
+    [
+        ("DELETE WHERE { ?s ?p ?o }", "DELETE { ?s ?p ?o }\nUSING <g>\nWHERE { ?s ?p ?o }"),
+        ("delete { ?s ?p ?o } insert { ?s ?p 1 } where { ?s ?p ?o }", None),
+        ("INSERT { ?s ?p 1 } WHERE { { ?s ?p ?o } UNION { GRAPH ?g { ?s ?p ?o } } }", None),
+        ("WITH <h> DELETE { ?s ?p ?o } WHERE { ?s ?p ?o }", "same"),
+        ("DELETE { ?s ?p ?o } USING <h> WHERE { ?s ?p ?o }", "same"),
+        ("INSERT DATA { <s> <p> 'WHERE' }", "same"),
+        ("CLEAR GRAPH <h>", "same"),
+    ],
+)
+def test_an_operation_reads_the_union_unless_it_names_its_dataset(operation: str, expected: str | None) -> None:
+    rewritten = as_on_union(operation, "USING <g>")
+    if expected == "same":
+        assert rewritten == operation
+    elif expected is None:  # USING goes just before the top-level WHERE
+        at = operation.upper().index("WHERE", operation.index("}"))
+        assert rewritten == operation[:at] + "USING <g>\n" + operation[at:]
+    else:
+        assert rewritten == expected
