@@ -515,11 +515,9 @@ class KnowledgeBase:
                 self.store.update(text)
             else:
                 copy = CheckedCopy(self.store)
-                scratch = KnowledgeBase(copy.store, self.queries)
-                scratch._update(
-                    text, DataUpdate.read(text, copy.store), check_map, run=functools.partial(copy.run, text)
-                )
-                copy.send(self.store, text)
+                scratch, read = KnowledgeBase(copy.store, self.queries), DataUpdate.read(text, copy.store)
+                scratch._update(text, read, check_map, run=functools.partial(copy.run, text))
+                copy.send(self.store, text, read)
         finally:
             self._reader.clear_cache()
         return self._entail(None)

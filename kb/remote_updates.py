@@ -35,6 +35,7 @@ import pyoxigraph as ox
 from cbrs.kb.remote_store import RemoteStore
 from cbrs.kb.sparql_lexemes import HIDING
 from cbrs.kb.store import MEMORY, EmbeddedStore, Store
+from cbrs.kb.update_delta import DataUpdate
 
 _LEXEME = re.compile(HIDING + r"|\s+|[{};]|[^\s{};<\"'#]+|.", re.DOTALL)
 _OUTSIDE = frozenset({"LOAD", "SERVICE"})
@@ -129,16 +130,21 @@ class CheckedCopy:
     def __init__(self, remote: Store) -> None:
         from cbrs.kb.backup import DEFAULT, store_graphs  # it imports the loader, which imports the store
 
+        self._backend = ox.Store()
         if getattr(remote, "server", "oxigraph") == "oxigraph":  # every quad in one request
             graphs = remote.graphs()  # the empty ones too: CREATE GRAPH of one is refused there
-            self.before = list(remote.quads())
+            whole = remote.dataset_nquads() if isinstance(remote, RemoteStore) else None
+            if whole is not None:
+                self._backend.load(whole, format=ox.RdfFormat.N_QUADS)
+            else:
+                self._backend.extend(remote.quads())
         else:  # graph by graph, leaving out the server's own (Virtuoso's hold blank nodes no parser takes)
             graphs = [graph for graph in store_graphs(remote) if graph != DEFAULT]
-            self.before = [quad for graph in graphs for quad in remote.quads(graph=ox.NamedNode(graph))]
-        self._backend = ox.Store()
-        self._backend.extend(self.before)
+            for graph in graphs:
+                self._backend.extend(remote.quads(graph=ox.NamedNode(graph)))
         for graph in graphs:
             self._backend.add_graph(ox.NamedNode(graph))
+        self.before = set(self._backend)
         self.store = EmbeddedStore(self._backend, MEMORY)
         self.store.remote_access = remote.remote_access
 
@@ -164,15 +170,21 @@ class CheckedCopy:
                 if self._backend.contains_named_graph(stand_in):
                     self._backend.remove_graph(stand_in)
 
-    def send(self, remote: RemoteStore, text: str) -> None:
+    def send(self, remote: RemoteStore, text: str, data: DataUpdate | None = None) -> None:
         """Write to ``remote`` what the update changed on the copy, in one request; when that names a blank
         node the store held (which no data block can name), the update's text instead, which the server
-        carries out on the same data."""
-        before = set(self.before)
-        after = set(self._backend)
-        removed, added = before - after, after - before
-        held = {term for quad in before for term in _blank_nodes(quad)}
-        if any(_blank_nodes(quad) for quad in removed) or any(held.intersection(_blank_nodes(q)) for q in added):
+        carries out on the same data. ``data``: the update read as data on the copy before it ran, which
+        says what it changed without comparing the copy whole."""
+        before = self.before
+        delta = data.delta(self.store) if data is not None else None
+        if delta is None:
+            after = set(self._backend)
+            delta = frozenset(after - before), frozenset(before - after)
+        added, removed = delta
+        new_nodes = {node for quad in added for node in _blank_nodes(quad)}
+        if any(_blank_nodes(quad) for quad in removed) or (
+            new_nodes and any(new_nodes.intersection(_blank_nodes(quad)) for quad in before)
+        ):
             remote.update(text)
             return
         remote.write_change(removed, added)
