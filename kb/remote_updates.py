@@ -11,10 +11,11 @@ what was checked is what is written. A refused update sends nothing.
 By SPARQL 1.1 Update an ``INSERT``/``DELETE ... WHERE`` is its templates instantiated over the
 solutions of its ``WHERE`` (the deletes before the inserts), and the operations of a request run in
 turn, each on what the previous left: carried out in turn on the copy, they give the quads the request
-adds and removes. One difference is made up for: the server's default graph is the union of its graphs
-(``--union-default-graph``) and an embedded store's is not, so each operation with a ``WHERE`` and no
-``WITH`` or ``USING`` of its own is run on the copy with ``USING`` every graph the copy holds then
-(``USING NAMED`` the named ones): its pattern sees what it sees on the server. A ``LOAD`` or a
+adds and removes. One difference is made up for: Oxigraph server's default graph is the union of its
+graphs (``--union-default-graph``; Virtuoso's too) and an embedded store's is not, so there each operation
+with a ``WHERE`` and no ``WITH`` or ``USING`` of its own is run on the copy with ``USING`` every graph the
+copy holds then (``USING NAMED`` the named ones): its pattern sees what it sees on the server. Another
+server (a ``cbrs serve``, which runs updates on its embedded store) is taken to read its default graph. A ``LOAD`` or a
 ``SERVICE`` is then carried out by cbrs, under the same ``remote_access`` rule, not by the server.
 
 What is guaranteed: the change written is exactly the one checked, worked out from the store as one
@@ -145,6 +146,9 @@ class CheckedCopy:
         for graph in graphs:
             self._backend.add_graph(ox.NamedNode(graph))
         self.before = set(self._backend)
+        self.union = getattr(remote, "server", "other") in ("oxigraph", "virtuoso")
+        """Whether an operation's ``WHERE`` reads the union (see the module): on the servers known to read
+        it so; another (a ``cbrs serve``, whose updates run on an embedded store) reads the default graph."""
         self.store = EmbeddedStore(self._backend, MEMORY)
         self.store.remote_access = remote.remote_access
 
@@ -161,7 +165,7 @@ class CheckedCopy:
                 [f"USING {graph}" for graph in (*graphs, *([stand_in] if default else []))]
                 + [f"USING NAMED {graph}" for graph in graphs]
             )
-            rewritten = as_on_union(operation, using) if graphs or default else operation
+            rewritten = as_on_union(operation, using) if self.union and (graphs or default) else operation
             if rewritten is not operation and default:
                 self._backend.extend(ox.Quad(q.subject, q.predicate, q.object, stand_in) for q in default)
             try:
