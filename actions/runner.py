@@ -33,6 +33,7 @@ from cbrs.actions.faults import Combined, FaultPolicy, FixedFaults
 from cbrs.actions.graph import parameter_names, statement_text
 from cbrs.actions.model import ActionLibrary
 from cbrs.actions.plan import Plan, PlanStep
+from cbrs.actions.precondition_sensing import PreconditionSensing, SensingConfig
 from cbrs.actions.replanning import Failure, FailureMemory, ReplanPolicy
 from cbrs.actions.task_preconditions import PreconditionCheck, check_preconditions
 from cbrs.kb import Advertisement, KnowledgeBase, NotFoundError, Requirement, Statement
@@ -282,6 +283,7 @@ def run_task(
     replan_policy: ReplanPolicy | None = None,
     base_ties: BaseTies = BaseTies.NEAREST,
     objective: Objective | None = None,
+    sensing: SensingConfig | None = None,
 ) -> RunResult:
     """Perceive, compose ``task`` from what holds now, run it in ``environment``, keep the world graph current.
 
@@ -299,6 +301,8 @@ def run_task(
     bases, how plans of one cost and similarity for different bases are told apart (``actions.base_choice``).
     ``objective``: what ranks the components that could do a step (``ComposeConfig.objective``), for a
     script that gives no ``composer``; a composer's own config says it, and a different one is refused.
+    ``sensing``: whether a precondition on a measured state is asked of a sensor before the first step, and
+    its timeout (``actions.precondition_sensing``); None: as the settings say.
     """
     if composer is not None and objective is not None and objective is not composer.config.objective:
         mine = composer.config.objective.value
@@ -362,7 +366,8 @@ def run_task(
                 given = environment.given(plan, on_behalf(_supplying(kb, composition), chosen))
                 if not replans and composition.attempts:  # the task's own guarantees (actions.task_preconditions)
                     requirement = composition.attempts[0].requirement
-                    checked = check_preconditions(environment, requirement, seen, composer.index.is_a)
+                    sense = _sensing(kb, container, environment, composer, sensing, passed)
+                    checked = check_preconditions(environment, requirement, seen, composer.index.is_a, sense)
             except Exception:
                 if not replans:  # refused before anything moved: the store is left as it was
                     belief.restore(before)
@@ -413,6 +418,21 @@ def run_task(
     belief.write(environment.observe(), whole=True)  # what a run leaves is exactly its belief
     goals = _check_goals(environment, composition.plan, outputs) if report is not None else ()
     return RunResult(composition, report, tuple(replans), goals, stopped, composed_without, chosen, checked)
+
+
+def _sensing(
+    kb: KnowledgeBase,
+    container: Container,
+    environment: Environment,
+    composer: Composer,
+    config: SensingConfig | None,
+    passed: Mapping[str, str],
+) -> PreconditionSensing | None:
+    """The question a run's preconditions on measured states are asked through, unless sensing is off."""
+    config = config or SensingConfig.from_settings()
+    if not config.enabled:
+        return None
+    return PreconditionSensing(kb, container, environment.registry, composer.index, config.timeout, passed)
 
 
 def refusal_before_world(

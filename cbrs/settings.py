@@ -410,6 +410,24 @@ SETTINGS: tuple[Setting, ...] = (
         _contradictions,
     ),
     Setting(
+        "precondition_sensing",
+        lambda: True,
+        "Whether a task run asks the store's sensors about a precondition on a status the store defines by a "
+        "measured quantity (a room dark below 50 lx), before its first step; off: such a precondition is taken "
+        "as given, as one no test decides (docs/execution.md).",
+        "CBRS_PRECONDITION_SENSING",
+        _flag,
+    ),
+    Setting(
+        "precondition_sensing_timeout",
+        lambda: 10.0,
+        "Seconds one sensor has to give a task run its reading of a precondition before the next is asked (the "
+        "precondition is taken as given, saying so, when none answers); a component in another process also has "
+        "its own call timeout (docs/execution.md).",
+        "CBRS_PRECONDITION_SENSING_TIMEOUT",
+        _positive(float),
+    ),
+    Setting(
         "remote_batch",
         lambda: "auto",
         "Most quads one write request to a remote store carries; a larger write (the seed, a load) is "
@@ -480,6 +498,14 @@ SETTINGS: tuple[Setting, ...] = (
         "middle of what was seen; seen shorter, it takes the seen top less half the height; 0 to 0.1.",
         "CBRS_SEEN_SHORT",
         _metres(0.1),
+    ),
+    Setting(
+        "clear_spread",
+        lambda: 0.15,  # cbrs.sim.relay.CLEAR_SPREAD, kept here so settings load no simulation
+        "Metres a spot asked next for a carry's clearance keeps from every spot whose dry run came within the "
+        "clearance of an appliance, before the spots nearer them are asked; 0 asks them in order; 0 to 0.5.",
+        "CBRS_CLEAR_SPREAD",
+        _metres(0.5),
     ),
     Setting(
         "log_level",

@@ -564,11 +564,19 @@ def preconditions_line(checks: Iterable[dict[str, Any]], listed: str = "--json l
     them before its first step) in one line for a person, as ``cbrs run`` and the run page say them: those
     perceived holding counted, those no test decides (taken as given, as a fetch task's ``home:hasMarker``)
     named, at most ``PRECONDITIONS_NAMED``, then where the rest are ``listed`` (docs/execution.md, "A task's
-    preconditions"); "" for none."""
+    preconditions"); those a sensor read holding counted with what it read, and a precondition taken as
+    given after a sensor was looked for with why none decided it; "" for none."""
     found = list(checks)
-    held = sum(1 for check in found if check.get("believed"))
-    given = [str(check.get("statement")) for check in found if check.get("believed") is None]
+    held = sum(1 for check in found if check.get("believed") and not check.get("sensed"))
+    sensed = [str(check["sensed"]) for check in found if check.get("believed") and check.get("sensed")]
+    given = [
+        str(check.get("statement")) + (f" ({check['why']})" if check.get("why") else "")
+        for check in found
+        if check.get("believed") is None
+    ]
     parts = [f"{held} perceived holding"] if held else []
+    if sensed:
+        parts.append(f"{len(sensed)} sensed holding ({'; '.join(sensed)})")
     if given:
         named = "; ".join(given[:PRECONDITIONS_NAMED])
         if len(given) > PRECONDITIONS_NAMED:

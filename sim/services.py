@@ -26,6 +26,7 @@ from cbrs.sim.geometry import Pose2D, Region
 from cbrs.sim.grasping import ObjectModel, compute_grasp_pose
 from cbrs.sim.grounding import docking_pose, manipulation_of, meant_person, model_of, place_of, thing_iri, thing_region
 from cbrs.sim.hold_choice import Candidates, refuse_moves, seen_extent
+from cbrs.sim.light import measure_illuminance
 from cbrs.sim.mapping import OccupancyGrid, build_occupancy_grid
 from cbrs.sim.packing import carry_spots
 from cbrs.sim.perceived import SEARCH_RADIUS
@@ -452,6 +453,7 @@ SKILLS: dict[str, Work] = {
     "NavigateToPlace": navigate_to_place,
     "NavigateToPerson": navigate_to_person,
     "DeliverObject": deliver,
+    "MeasureIlluminance": measure_illuminance,
 }
 """The simulated skill behind each service name; the device comes from the advertisement."""
 
