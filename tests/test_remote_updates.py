@@ -22,6 +22,8 @@ from cbrs.kb.remote_updates import CheckedCopy, as_on_union, operations
 from cbrs.kb.semantic_map import MapError
 from cbrs.kb.shapes import DescriptionShapeError
 from cbrs.kb.store import Store
+from cbrs.server import ServeConfig, Server
+from cbrs.sparql_service import EndpointConfig
 from tests.conftest import OxigraphServer, VirtuosoServer
 from tests.helpers_seeded import put_quads, seeded_quads
 
@@ -248,3 +250,27 @@ def test_the_copy_holds_what_the_server_holds(remote: tuple[KnowledgeBase, list[
 def _unlabelled(quads: Iterable[ox.Quad]) -> list[str]:
     """``quads`` as text, a blank node's label left out (the copy's labels are its own)."""
     return sorted(re.sub(r"_:\w+", "_:", str(quad)) for quad in quads)
+
+
+@pytest.fixture
+def served() -> Iterator[tuple[Server, KnowledgeBase]]:
+    """A ``cbrs serve`` (in this process, loopback) on an embedded store, and a knowledge base on it."""
+    server = Server(
+        KnowledgeBase.open(":memory:"), ServeConfig(port=0, bridge_port=0, endpoint=EndpointConfig(update_token="t"))
+    )
+    server.start()
+    client = KnowledgeBase(RemoteStore.open(f"http://127.0.0.1:{server.http_port}", token="t"))
+    yield server, client
+    client.close()
+    server.stop(timeout=10)
+
+
+def test_a_cbrs_serve_as_the_remote_store_is_checked_and_reads_its_default_graph(
+    served: tuple[Server, KnowledgeBase],
+) -> None:
+    server, client = served
+    held = server.kb.store.dump()
+    _refusal(client, "DELETE WHERE { GRAPH graph:map { world:Pen home:sizeX ?x } }", MapError)
+    # its updates run on an embedded store, whose WHERE reads the default graph alone: this finds nothing
+    client.update("DELETE { GRAPH graph:map { world:Pen home:sizeX ?x } } WHERE { world:Pen home:sizeX ?x }")
+    assert server.kb.store.dump() == held
