@@ -16,6 +16,7 @@ import pytest
 from cbrs.actions.belief import Observation
 from cbrs.actions.components import Component, Container, LifecycleState, Registry, Status
 from cbrs.actions.composer import Composer
+from cbrs.actions.faults import FixedFaults
 from cbrs.actions.precondition_sensing import PreconditionSensing, SensingConfig
 from cbrs.actions.task_preconditions import TaskPreconditionError, check_preconditions
 from cbrs.kb import KnowledgeBase, Requirement, Statement
@@ -69,11 +70,11 @@ def index(kb: KnowledgeBase) -> Any:
 
 
 def _sensing(
-    kb: KnowledgeBase, index: Any, sensor: Sensor, timeout: float = 5.0
+    kb: KnowledgeBase, index: Any, sensor: Sensor, timeout: float = 5.0, failing: tuple[str, ...] = ()
 ) -> tuple[PreconditionSensing, Container]:
     registry = Registry()
     registry.add(BOARD, lambda iri: sensor)
-    container = Container(registry)
+    container = Container(registry, faults=FixedFaults.of(failing))
     return PreconditionSensing(kb, container, registry, index, timeout), container
 
 
@@ -153,16 +154,25 @@ def test_no_sensor_covering_the_place_leaves_it_taken_as_given_saying_why(kb: Kn
 
 
 @pytest.mark.parametrize(
-    ("sensor", "timeout", "why"),
+    ("sensor", "timeout", "failing", "why"),
     [
-        pytest.param(Sensor(BOARD, reason="lamp sensor unplugged"), 5.0, "failed: lamp sensor unplugged", id="fails"),
-        pytest.param(Sensor(BOARD, hang=True), 0.05, "failed: no reading within 0.05 s", id="hangs"),
+        pytest.param(
+            Sensor(BOARD, reason="lamp sensor unplugged"), 5.0, (), "failed: lamp sensor unplugged", id="fails"
+        ),
+        pytest.param(Sensor(BOARD, hang=True), 0.05, (), "failed: no reading within 0.05 s", id="hangs"),
+        pytest.param(
+            Sensor(BOARD, _lux(12.0)),
+            5.0,
+            (BOARD,),
+            f"failed: InjectedFault: injected failure of {BOARD}",
+            id="injected-fault",
+        ),
     ],
 )
 def test_a_sensor_that_gives_no_reading_leaves_it_taken_as_given_saying_why(
-    kb: KnowledgeBase, index: Any, sensor: Sensor, timeout: float, why: str
+    kb: KnowledgeBase, index: Any, sensor: Sensor, timeout: float, failing: tuple[str, ...], why: str
 ) -> None:
-    sense, container = _sensing(kb, index, sensor, timeout)
+    sense, container = _sensing(kb, index, sensor, timeout, failing)
     requirement = Requirement(LAB9 + "FetchMyBookIfDark", (), preconditions=(DARK,))
     (check,) = check_preconditions(object(), requirement, Observation({}, frozenset(), {}), index.is_a, sense)
     assert check.believed is None and check.why == f"SensorBoard01 (svc:MeasureIlluminance_SensorBoard01) {why}"
