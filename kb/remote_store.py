@@ -441,10 +441,24 @@ class RemoteStore(Store):
         { } WHERE { }`` operation, which it does keep whole."""
         self._write_blocks(data_block(self._as_kept(remove)), data_block(self._as_kept(add)))
 
-    def write_change(self, remove: Iterable[ox.Quad], add: Iterable[ox.Quad]) -> None:
+    def write_change(
+        self,
+        remove: Iterable[ox.Quad],
+        add: Iterable[ox.Quad],
+        dropped: Sequence[ox.NamedNode] = (),
+        created: Sequence[ox.NamedNode] = (),
+    ) -> None:
         """:meth:`replace` of a change worked out on a copy of the store (:mod:`kb.remote_updates`), whose
-        added quads may hold blank nodes the store does not: fresh nodes there, as :meth:`add` makes."""
-        self._write_blocks(data_block(self._as_kept(remove)), data_block(self._as_kept(add), blank_nodes=True))
+        added quads may hold blank nodes the store does not: fresh nodes there, as :meth:`add` makes. The
+        graphs ``dropped`` are gone afterwards and those ``created`` there, if empty (Oxigraph keeps empty
+        graphs), in the same request; on a server that keeps no empty graph (Virtuoso 7) they are left out."""
+        removing, adding = data_block(self._as_kept(remove)), data_block(self._as_kept(add), blank_nodes=True)
+        graphs = [f"DROP SILENT GRAPH {g}" for g in dropped] + [f"CREATE SILENT GRAPH {g}" for g in created]
+        if not graphs or not self.keeps_requests_whole:
+            self._write_blocks(removing, adding)
+            return
+        data = [f"DELETE DATA {{\n{removing}}}"] * bool(removing) + [f"INSERT DATA {{\n{adding}}}"] * bool(adding)
+        self._update(" ;\n".join([*data, *graphs]), original=None)
 
     def _write_blocks(self, removing: str, adding: str) -> None:
         """Remove the quads of one data block and add those of another, in one request."""

@@ -27,15 +27,17 @@ one process, ``cbrs serve`` runs updates one at a time (its lock), as on the emb
 
 from __future__ import annotations
 
+import contextlib
 import re
 import uuid
 from dataclasses import dataclass
 
 import pyoxigraph as ox
 
+from cbrs.kb.errors import StoreError
 from cbrs.kb.remote_store import RemoteStore
 from cbrs.kb.sparql_lexemes import HIDING
-from cbrs.kb.store import MEMORY, EmbeddedStore, Store
+from cbrs.kb.store import EmbeddedStore, Store
 from cbrs.kb.update_delta import DataUpdate
 
 _LEXEME = re.compile(HIDING + r"|\s+|[{};]|[^\s{};<\"'#]+|.", re.DOTALL)
@@ -146,17 +148,19 @@ class CheckedCopy:
         for graph in graphs:
             self._backend.add_graph(ox.NamedNode(graph))
         self.before = set(self._backend)
+        self._graphs = {ox.NamedNode(graph) for graph in graphs}
         self.union = getattr(remote, "server", "other") in ("oxigraph", "virtuoso")
         """Whether an operation's ``WHERE`` reads the union (see the module): on the servers known to read
         it so; another (a ``cbrs serve``, whose updates run on an embedded store) reads the default graph."""
-        self.store = EmbeddedStore(self._backend, MEMORY)
+        self.store = EmbeddedStore(self._backend, remote.location)  # its errors name the store the user named
         self.store.remote_access = remote.remote_access
 
     def run(self, text: str) -> None:
         """Carry out the update ``text`` on the copy as the server would (see the module); read first on
         an empty store, whole, so a mistake in it is told in the words and lines the embedded store uses."""
         if not _OUTSIDE.intersection(lexeme.word for lexeme in _lexemes(text)):
-            EmbeddedStore(ox.Store(), MEMORY).update(text)
+            with contextlib.suppress(StoreError):  # what it does to an empty store (a DROP of a graph it lacks)
+                EmbeddedStore(ox.Store(), self.store.location).update(text)
         for prologue, operation in operations(text):
             stand_in = ox.NamedNode(f"urn:uuid:{uuid.uuid4()}")  # the default graph's triples, while it runs
             default = list(self._backend.quads_for_pattern(None, None, None, ox.DefaultGraph()))
@@ -185,13 +189,15 @@ class CheckedCopy:
             after = set(self._backend)
             delta = frozenset(after - before), frozenset(before - after)
         added, removed = delta
+        graphs = {graph for graph in self._backend.named_graphs() if isinstance(graph, ox.NamedNode)}
+        dropped, created = sorted(self._graphs - graphs, key=str), sorted(graphs - self._graphs, key=str)
         new_nodes = {node for quad in added for node in _blank_nodes(quad)}
         if any(_blank_nodes(quad) for quad in removed) or (
             new_nodes and any(new_nodes.intersection(_blank_nodes(quad)) for quad in before)
         ):
             remote.update(text)
             return
-        remote.write_change(removed, added)
+        remote.write_change(removed, added, dropped, created)
 
 
 def _blank_nodes(quad: ox.Quad | ox.Triple) -> set[ox.BlankNode]:

@@ -15,7 +15,7 @@ import pyoxigraph as ox
 import pytest
 
 from cbrs.kb import KnowledgeBase
-from cbrs.kb.errors import UndeclaredSuperclassError
+from cbrs.kb.errors import StoreEvaluationError, UndeclaredSuperclassError
 from cbrs.kb.namespaces import GraphName
 from cbrs.kb.remote_store import RemoteStore
 from cbrs.kb.remote_updates import CheckedCopy, as_on_union, operations
@@ -169,6 +169,18 @@ def test_an_update_of_a_blank_node_the_store_holds_is_sent_as_its_text_once_chec
     text = LAB + "DELETE { GRAPH lab:g { ?b lab:p ?o } } WHERE { GRAPH lab:g { ?b lab:p ?o } }"
     kb.update(text)  # no data block can name the node: the server is sent the text
     assert text in _writes(seen)[0] and next(iter(kb.store.quads(graph=graph)), None) is None
+
+
+def test_an_operation_that_fails_on_an_empty_store_runs_on_the_copy(
+    remote: tuple[KnowledgeBase, list[httpx.Request]],
+) -> None:
+    kb, _ = remote
+    graph = ox.NamedNode("https://example.org/lab#g")
+    kb.store.add([ox.Quad(graph, RDFS_LABEL, ox.Literal("a lab's graph"), graph)])
+    kb.update(LAB + "DROP GRAPH lab:g")  # read first on an empty store, where the graph is not
+    assert "https://example.org/lab#g" not in kb.store.graphs()
+    with pytest.raises(StoreEvaluationError, match=kb.store.location):  # the server's own words: it is not there
+        kb.update(LAB + "DROP GRAPH lab:g")
 
 
 def test_operations_are_split_outside_braces_strings_and_iris_with_the_prologue_carried() -> None:
