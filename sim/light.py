@@ -6,7 +6,8 @@ the map says its light level in lux (``home:lightLevel``, in graph:map: ``world:
 gives ``home:Room`` 300 lx, a room lit by day). A sensor reads the places of the map its effective area
 names (``cbrs:effectiveArea home:LivingRoom``: the living rooms), their mean where it names several; one
 whose area names no place has nowhere to read and fails, saying so. The reading is a ``home:Illuminance``
-in lux (docs/values.md): ``{"@type": ".../home#Illuminance", "lux": 300.0}``. docs/execution.md, "A sensed precondition in the simulated home".
+in lux (docs/values.md): ``{"@type": ".../home#Illuminance", "lux": 300.0}``. docs/execution.md, "A sensed
+precondition in the simulated home".
 """
 
 from __future__ import annotations
