@@ -26,7 +26,7 @@ from typing import Any
 
 from cbrs.actions.components import Container, LifecycleState, Status
 from cbrs.kb import Advertisement, KnowledgeBase, Statement
-from cbrs.kb.measured_states import MeasuredCondition, Units, read_conditions
+from cbrs.kb.measured_states import MeasuredCondition, MeasuredConditionError, Units, conditions_by_status
 from cbrs.kb.namespaces import PREFIXES, shorten
 from cbrs.reasoner.names import local_name
 from cbrs.reasoner.sea import Bounds, covers_concept, overlap
@@ -99,7 +99,7 @@ class PreconditionSensing:
         self.kb, self.container, self.runnable, self.index, self.timeout = kb, container, runnable, index, timeout
         self.passed = frozenset(passed)
         self._ads = advertisements
-        self._conditions: dict[str, MeasuredCondition] | None = None
+        self._conditions: dict[str, MeasuredCondition | MeasuredConditionError] | None = None
         self._units: Units | None = None
         self._rooms: tuple[tuple[str, Bounds], ...] | None = None
 
@@ -109,10 +109,12 @@ class PreconditionSensing:
         if statement.predicate != HAS_STATUS:
             return None
         if self._conditions is None:
-            self._conditions = read_conditions(self.kb)
+            self._conditions = conditions_by_status(self.kb)
         condition = self._conditions.get(statement.object)
         if condition is None:
             return None
+        if isinstance(condition, MeasuredConditionError):
+            raise condition  # the store says this status is measured, and not how: refused, naming it
         units = self.units()
         bound = condition.text(units)
         sensors = self.sensors(condition.quantity, statement.subject)

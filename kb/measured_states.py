@@ -27,7 +27,15 @@ from cbrs.kb.namespaces import shorten
 if TYPE_CHECKING:
     from cbrs.kb.knowledge_base import KnowledgeBase
 
-__all__ = ["MeasuredCondition", "MeasuredConditionError", "Reading", "UnitError", "Units", "read_conditions"]
+__all__ = [
+    "MeasuredCondition",
+    "MeasuredConditionError",
+    "Reading",
+    "UnitError",
+    "Units",
+    "conditions_by_status",
+    "read_conditions",
+]
 
 
 class MeasuredConditionError(KnowledgeBaseError):
@@ -177,40 +185,59 @@ class MeasuredCondition:
 
 def read_conditions(kb: KnowledgeBase) -> dict[str, MeasuredCondition]:
     """Each status class's measured condition (the named query ``measured_conditions``), checked:
-    :class:`MeasuredConditionError` for one no reading can decide."""
+    :class:`MeasuredConditionError` for the first no reading can decide."""
+    found: dict[str, MeasuredCondition] = {}
+    for status, condition in conditions_by_status(kb).items():
+        if isinstance(condition, MeasuredConditionError):
+            raise condition
+        found[status] = condition
+    return found
+
+
+def conditions_by_status(kb: KnowledgeBase) -> dict[str, MeasuredCondition | MeasuredConditionError]:
+    """Each status class's measured condition, or the error that says why no reading can decide it: a
+    run raises it only for a status it asks about, so that a lab's broken condition of one status does
+    not stop the tasks about another."""
     rows: dict[str, list[Mapping[str, Any]]] = {}
     for row in kb.select("measured_conditions"):
         rows.setdefault(row["status"].value, []).append(row)
-    found: dict[str, MeasuredCondition] = {}
+    found: dict[str, MeasuredCondition | MeasuredConditionError] = {}
     for status, its in rows.items():
-        conditions = {row["condition"].value for row in its}
-        if len(conditions) > 1:
-            raise MeasuredConditionError(status, f"is {len(conditions)} conditions, where one is meant")
-        values = {
-            name: {row[name].value for row in its if name in row} for name in ("quantity", "atLeast", "below", "unit")
-        }
-        for name, prop in (("quantity", "home:measuredQuantity"), ("unit", "qudt:hasUnit")):
-            if len(values[name]) != 1:
-                raise MeasuredConditionError(status, f"has {len(values[name]) or 'no'} {prop}, where one is meant")
-        bounds: list[float | None] = []
-        for name, prop in (("atLeast", "home:atLeast"), ("below", "home:below")):
-            if len(values[name]) > 1:
-                raise MeasuredConditionError(status, f"has {len(values[name])} {prop}, where one at most is meant")
-            try:
-                bound = float(next(iter(values[name]))) if values[name] else None
-            except ValueError:
-                raise MeasuredConditionError(status, f"has {prop} {next(iter(values[name]))!r}, not a number") from None
-            if bound is not None and not math.isfinite(bound):
-                raise MeasuredConditionError(status, f"has {prop} {bound}, not a finite number")
-            bounds.append(bound)
-        at_least, below = bounds
-        if at_least is None and below is None:
-            raise MeasuredConditionError(status, "has no bound (home:atLeast, home:below)")
-        if at_least is not None and below is not None and not at_least < below:
-            raise MeasuredConditionError(status, f"holds at least {at_least:g} and below {below:g}, which nothing is")
-        (quantity,), (unit,) = values["quantity"], values["unit"]
-        found[status] = MeasuredCondition(status, quantity, at_least, below, unit)
+        try:
+            found[status] = _condition(status, its)
+        except MeasuredConditionError as error:
+            found[status] = error
     return found
+
+
+def _condition(status: str, its: list[Mapping[str, Any]]) -> MeasuredCondition:
+    conditions = {row["condition"].value for row in its}
+    if len(conditions) > 1:
+        raise MeasuredConditionError(status, f"is {len(conditions)} conditions, where one is meant")
+    values = {
+        name: {row[name].value for row in its if name in row} for name in ("quantity", "atLeast", "below", "unit")
+    }
+    for name, prop in (("quantity", "home:measuredQuantity"), ("unit", "qudt:hasUnit")):
+        if len(values[name]) != 1:
+            raise MeasuredConditionError(status, f"has {len(values[name]) or 'no'} {prop}, where one is meant")
+    bounds: list[float | None] = []
+    for name, prop in (("atLeast", "home:atLeast"), ("below", "home:below")):
+        if len(values[name]) > 1:
+            raise MeasuredConditionError(status, f"has {len(values[name])} {prop}, where one at most is meant")
+        try:
+            bound = float(next(iter(values[name]))) if values[name] else None
+        except ValueError:
+            raise MeasuredConditionError(status, f"has {prop} {next(iter(values[name]))!r}, not a number") from None
+        if bound is not None and not math.isfinite(bound):
+            raise MeasuredConditionError(status, f"has {prop} {bound}, not a finite number")
+        bounds.append(bound)
+    at_least, below = bounds
+    if at_least is None and below is None:
+        raise MeasuredConditionError(status, "has no bound (home:atLeast, home:below)")
+    if at_least is not None and below is not None and not at_least < below:
+        raise MeasuredConditionError(status, f"holds at least {at_least:g} and below {below:g}, which nothing is")
+    (quantity,), (unit,) = values["quantity"], values["unit"]
+    return MeasuredCondition(status, quantity, at_least, below, unit)
 
 
 def _number(row: Mapping[str, Any], name: str) -> float | None:

@@ -17,7 +17,7 @@ from cbrs.actions.belief import Observation
 from cbrs.actions.components import Component, Container, LifecycleState, Registry, Status
 from cbrs.actions.composer import Composer
 from cbrs.actions.faults import FixedFaults
-from cbrs.actions.precondition_sensing import PreconditionSensing, SensingConfig
+from cbrs.actions.precondition_sensing import PreconditionSensing, Sensed, SensingConfig
 from cbrs.actions.task_preconditions import TaskPreconditionError, check_preconditions
 from cbrs.kb import KnowledgeBase, Requirement, Statement
 from cbrs.kb.measured_states import MeasuredConditionError, UnitError, Units, read_conditions
@@ -199,6 +199,12 @@ def test_the_store_states_conditions_and_units_and_refuses_one_no_reading_can_de
     with pytest.raises(MeasuredConditionError, match=r"ex:Bright|x#Bright") as refused:
         read_conditions(broken)
     assert "has no qudt:hasUnit" in str(refused.value)
+    broken.load([EXAMPLES / "lab9_dark.ttl"], graph="ontology")  # a broken condition stops only its own status
+    sense = PreconditionSensing(broken, Container(Registry()), Registry(), Composer(broken).index, 1.0)
+    bright = Statement(HOME + "LivingRoom", HOME + "hasStatus", "http://example.org/x#Bright")
+    with pytest.raises(MeasuredConditionError, match="has no qudt:hasUnit"):
+        sense(bright)
+    assert sense(DARK) == Sensed(None, "no sensor of home:Illuminance covers home:LivingRoom", "below 50 lx")
 
 
 def test_sensing_is_configured_by_its_settings(monkeypatch: pytest.MonkeyPatch) -> None:
