@@ -203,6 +203,7 @@ def test_every_named_query_with_parameters_gives_the_embedded_answer(
         "class": ["home:Cup", "home:Drinkware"],
         "room": ["home:Kitchen", "world:Kitchen"],
         "robot": ["svc:CytonDualArm01"],
+        "camera": ["svc:CeilingCamera01", "svc:Kinect01"],
         "graph": ["graph:ontology", "graph:world", "graph:map"],
         "component": [LOCATE],
         "namespace": ["https://w3id.org/cbrs/world#"],
