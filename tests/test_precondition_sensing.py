@@ -7,6 +7,7 @@ simulated board's reading from the store, and one run of FetchMyBookIfDark refus
 from __future__ import annotations
 
 from collections.abc import Mapping
+from concurrent.futures import Future
 from pathlib import Path
 from types import SimpleNamespace
 from typing import Any
@@ -248,3 +249,61 @@ def test_fetch_my_book_if_dark_in_a_lit_home_is_refused_before_anything_moves(tm
         assert world.time < 1.0  # nothing drove or reached: only the cameras' first look
     assert refused.value.sensed is not None and refused.value.sensed.sensor == BOARD
     assert sorted(str(row) for row in store.select("world_facts")) == before
+
+
+LAB_SENSOR = """@prefix cbrs: <https://w3id.org/cbrs/core#> . @prefix home: <https://w3id.org/cbrs/home#> .
+@prefix labl: <https://example.org/lablight#> . @prefix owl: <http://www.w3.org/2002/07/owl#> .
+labl:Light01 a owl:NamedIndividual , home:Device .
+labl:MeasureLight_Light01 a cbrs:DynamicPerceptionComponent ; cbrs:device labl:Light01 ;
+    cbrs:deviceName "Light01" ; cbrs:serviceName "MeasureLight" ; cbrs:serviceCategory "EnvironmentalSensing" ;
+    cbrs:hasOWLSModel [ a cbrs:OWLSModel ;
+        cbrs:hasOutput [ a cbrs:Parameter ; cbrs:parameterName "light" ; cbrs:parameterType home:Illuminance ] ] ;
+    cbrs:hasSEAModel [ a cbrs:SEAModel ; cbrs:effectiveArea home:Bedroom ] ;
+    cbrs:hasPort [ a cbrs:ServicePort ; cbrs:portName "read" ; cbrs:topic "/lab_light/read" ;
+        cbrs:messageType "lab_msgs/Light" ] .
+"""
+
+
+class Bridge:
+    """A stand-in transport: each call answered with ``answer``, or never."""
+
+    def __init__(self, answer: dict[str, Any] | None) -> None:
+        self.answer, self.calls = answer, []
+
+    def call(self, service: str, args: Mapping[str, Any], timeout: float) -> Future[dict[str, Any]]:
+        self.calls.append(service)
+        future: Future[dict[str, Any]] = Future()
+        if self.answer is not None:
+            future.set_result(self.answer)
+        return future
+
+
+@pytest.mark.parametrize(
+    ("answer", "believed", "said"),
+    [
+        pytest.param({"light": {"@type": "home:Illuminance", "lux": 8.0}}, True, "8 lx by Light01", id="answers"),
+        pytest.param(
+            None,
+            None,
+            "Light01 (MeasureLight_Light01) failed: /lab_light/read did not answer within 0.1 s",
+            id="silent",
+        ),
+    ],
+)
+def test_a_sensor_in_another_process_is_asked_over_the_bridge_with_its_own_timeout(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, answer: dict[str, Any] | None, believed: bool | None, said: str
+) -> None:
+    from cbrs.sim.components import implementations
+
+    monkeypatch.setenv("CBRS_REMOTE_CALL_TIMEOUT", "0.1")
+    store = KnowledgeBase.open(":memory:")
+    store.load([EXAMPLES / "lab9_dark.ttl"], graph="ontology")
+    (tmp_path / "light.ttl").write_text(LAB_SENSOR, encoding="utf-8")
+    store.load([tmp_path / "light.ttl"], graph="services")
+    bridge = Bridge(answer)
+    registry = implementations(store, transport=bridge)
+    sense = PreconditionSensing(store, Container(registry), registry, Composer(store).index, 5.0)
+    bedroom = Statement(HOME + "Bedroom", HOME + "hasStatus", LAB9 + "Dark")
+    found = sense(bedroom)
+    assert found is not None and bridge.calls == ["/lab_light/read"]
+    assert (found.holds, found.how.replace("https://example.org/lablight#", "")) == (believed, said)
