@@ -268,7 +268,8 @@ class Bridge:
     """A stand-in transport: each call answered with ``answer``, or never."""
 
     def __init__(self, answer: dict[str, Any] | None) -> None:
-        self.answer, self.calls = answer, []
+        self.answer = answer
+        self.calls: list[str] = []
 
     def call(self, service: str, args: Mapping[str, Any], timeout: float) -> Future[dict[str, Any]]:
         self.calls.append(service)
