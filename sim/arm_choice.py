@@ -31,7 +31,7 @@ from cbrs.sim.hold_choice import Candidates, GraspChoice, first_clear, refuse_mo
 from cbrs.sim.perceived import PerceivedWorld
 from cbrs.sim.perception import ObjectEstimate
 from cbrs.sim.place_spots import RELAY_MARGIN, spot_region
-from cbrs.sim.relay import CLEAR_TRIES, RELAY_TRIES, relay_spot, resting_at
+from cbrs.sim.relay import CLEAR_TRIES, RELAY_TRIES, clear_asked, relay_spot, resting_at
 from cbrs.sim.transit import band_advice, floor_cause, floor_needs, floor_to
 from cbrs.sim.values import Manipulation
 from cbrs.sim.world import HomeWorld
@@ -306,9 +306,11 @@ def _taking_to(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, si
         refusals: dict[GraspKind, str] = {}  # of the carry to the first spot, when its clearance was asked
         for held in both.models:
 
-            def others(since: int, held: ObjectModel = held) -> Iterator[Region]:  # the next it can let go over
-                # and carry to without the object held meeting an appliance, by the map (no dry run spent)
-                regions = (spot_region(surface, *at) for at in spots[since:RELAY_TRIES])
+            def others(
+                since: int, near: Sequence[tuple[float, float]], held: ObjectModel = held
+            ) -> Iterator[Region]:  # the next it can let go over and carry to without the object held meeting
+                # an appliance, by the map (no dry run spent); away from those whose dry run came near first
+                regions = (spot_region(surface, *at) for at in clear_asked(spots, near, lambda at: at, since))
                 fixtures = skills.appliances(world)
                 try:
                     grasp = grasp_pose_for(ctx, estimate, side, held) if fixtures else None
@@ -446,11 +448,14 @@ def holdable_spot(
     orientation = arm.ee_pose().orientation
     first: tuple[float, float] | None = None
     unrefused: tuple[float, float] | None = None  # the first whose carry the planning makes, though near
-    for x, y in spots[:RELAY_TRIES]:
+    near: list[tuple[float, float]] = []  # where the carry came near an appliance: asked away from them next
+    for x, y in clear_asked(spots, near, lambda at: at):
         if arm.can_hold((x, y, surface.zmin + skills.PLACE_CLEARANCE + grasp.bottom_offset), orientation):
             why, brushed = carry_check(ctx, side, spot_region(surface, x, y))
             if not why:
                 return (x, y)
+            if brushed:
+                near.append((x, y))
             if why == brushed:  # only near, not refused (a held carry's check gives near as refused too)
                 unrefused = unrefused or (x, y)
             first = first or (x, y)
@@ -584,7 +589,7 @@ def _clear_spot(
     ctx: SimContext,
     side: ArmSide,
     first: Region,
-    others: Callable[[], Iterator[Region]],
+    others: Callable[[Sequence[tuple[float, float]]], Iterator[Region]],
     taking: tuple[ObjectEstimate, ObjectModel],
 ) -> _Found:
     """Of ``first`` and then ``others`` (asked only when the take and carry to ``first`` come within
@@ -596,7 +601,9 @@ def _clear_spot(
     others are not asked. A refused ``first`` asks the others too: since the held object is checked
     against the appliances (:func:`skills.held_meets`), a jar carried to the table's spot beside the
     dispenser is refused there, not only noted, and the spots a little farther went unasked
-    (JarOntoTheTable at seed 1 was refused before the run)."""
+    (JarOntoTheTable at seed 1 was refused before the run). ``others`` is given where the dry runs came
+    near so far, and gives the spots away from them first (:func:`relay.clear_asked`): the neighbours of
+    a spot whose carry passes by a tap's lever pass by it too (BookOntoTheTable at seed 2)."""
     refused, brushed = carry_check(ctx, side, first, taking)
     if not (refused or brushed):
         return _Found(first)
@@ -605,10 +612,13 @@ def _clear_spot(
     if at_take:
         return _Found(first, refused, refused or f"taking the {held.name}: {at_take}")
     unrefused: _Found | None = None if refused else _Found(first, "", brushed)
-    for spot in itertools.islice(others(), CLEAR_TRIES - 1):
+    near = [first.center[:2]] if brushed else []  # where the dry runs came near an appliance
+    for spot in itertools.islice(others(near), CLEAR_TRIES - 1):
         refused_there, brushed_there = carry_check(ctx, side, spot, taking)
         if not (refused_there or brushed_there):
             return _Found(spot)
+        if brushed_there:
+            near.append(spot.center[:2])
         if not refused_there and unrefused is None:
             unrefused = _Found(spot, "", brushed_there)
     return unrefused or _Found(first, refused, refused)

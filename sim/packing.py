@@ -344,15 +344,17 @@ def arrange(
     feet: Sequence[Footprint] | None = None,
     lying: Sequence[Lying] = (),
     holds: Holds | None = None,
+    able: Sequence[Sequence[Mount] | None] | None = None,
 ) -> list[Spot] | None:
     """As :func:`pack`, but None only when no arrangement of the spots holds them all; :class:`Undecided`
     when ``budget`` comparisons did not decide. A footprint's spots do not depend on the others' but for
     their distance, so each list is asked once (:func:`place_spots`, or :func:`box_spots` for the rule's
     ``box`` footprints: ``feet``, else each box along x) and the search compares centres. ``lying``: the
     footprints of things on the place kept clear of (circles about them, for ``circle``); ``holds``: asked
-    of each spot the search would take, which it passes over when refused."""
+    of each spot the search would take, which it passes over when refused; ``able``: for each thing, the
+    arms that can set it down (:func:`place_spots`' ``able``; None: every arm of the map)."""
     shapes = list(feet) if feet is not None else [Footprint.lying(size, 0.0) for size in sizes]
-    lists = _spot_lists(smap, place, sizes, mounts, others, rule, shapes, lying)
+    lists = _spot_lists(smap, place, sizes, mounts, others, rule, shapes, lying, able)
     if not all(lists):
         return None
     return _search(lists, sizes, shapes, rule, budget, holds)
@@ -367,18 +369,23 @@ def _spot_lists(
     rule: PackingRule,
     shapes: Sequence[Footprint],
     lying: Sequence[Lying],
+    able: Sequence[Sequence[Mount] | None] | None = None,
 ) -> list[list[Spot]]:
-    """Each thing's spots alone, in the order the rule prefers them."""
+    """Each thing's spots alone, in the order the rule prefers them; by circles, each counting only the arms
+    of ``able`` that can set it down (its entry; None: every arm of the map), as one thing alone does
+    (:func:`place_spots`: an arm holding something else takes no spot away from another). A box's spots
+    (:func:`box_spots`) keep its whole footprint over the place, whichever arm has them."""
     surface = region_of(place, place.iri in smap.furniture)
     cx, cy, _ = surface.center
     boxed = rule.footprint == "box"
     circles = list(others) if boxed else [*others, *((x, y, foot.radius) for x, y, foot in lying)]
     lists: list[list[Spot]] = []
-    for size, foot in zip(sizes, shapes, strict=True):
+    ables = list(able) if able is not None else [None] * len(sizes)
+    for size, foot, arms in zip(sizes, shapes, ables, strict=True):
         if boxed:
             _, spots = box_spots(smap, place, foot, size[2], mounts, circles, lying)
         else:
-            _, spots = place_spots(smap, place, size, mounts, circles)
+            _, spots = place_spots(smap, place, size, mounts, circles, arms)
         if rule.toward == "rim":  # farthest from the centre first; on a tie the nearer an arm
             near = [min((math.hypot(x - mx, y - my) for mx, my, _ in mounts), default=0.0) for x, y in spots]
             ranked = sorted(
@@ -456,6 +463,8 @@ def set_down_spots(
     later_feet: Sequence[Footprint] | None = None,
     lying: Sequence[Lying] = (),
     holds: Holds | None = None,
+    able: Sequence[Mount] | None = None,
+    later_able: Sequence[Sequence[Mount] | None] | None = None,
 ) -> tuple[Region, list[Spot]]:
     """The surface and spots of :func:`place_spots` (:func:`box_spots` for the rule's ``box`` footprints:
     ``foot``, ``later_feet``, else boxes along x) for an object set down on ``place``, when the plan puts
@@ -463,14 +472,16 @@ def set_down_spots(
     arrangement of theirs, :func:`arrange`, fits beside it, with SET_DOWN_SLACK, each where ``holds``
     says an arm can set it down), nearest the centre first as for one thing alone, up to RELAY_TRIES of
     them (as many as the carry asks the arm about), then the rest. As the spots are ordered when nothing
-    comes after it or no spot leaves room (the run goes on, and the later carry says what is in its way)."""
+    comes after it or no spot leaves room (the run goes on, and the later carry says what is in its way).
+    ``able`` (this thing's) and ``later_able`` (each later thing's): the arms that can set it down
+    (:func:`place_spots`' ``able``, :func:`able_mounts`; None: every arm of the map)."""
     boxed = rule.footprint == "box"
     mine = foot if foot is not None else Footprint.lying(size, 0.0)
     if boxed:
         surface, spots = box_spots(smap, place, mine, size[2], mounts, others, lying)
     else:
         circles = [*others, *((x, y, each.radius) for x, y, each in lying)]
-        surface, spots = place_spots(smap, place, size, mounts, circles)
+        surface, spots = place_spots(smap, place, size, mounts, circles, able)
     if not later or not spots:
         return surface, spots
     asked: dict[tuple[int, Spot], bool] = {}  # an arm's answer for a later thing at a spot, asked once
@@ -481,7 +492,7 @@ def set_down_spots(
         return asked[n, at]
 
     shapes = list(later_feet) if later_feet is not None else [Footprint.lying(each, 0.0) for each in later]
-    alone = _spot_lists(smap, place, later, mounts, others, rule, shapes, lying)  # without this thing
+    alone = _spot_lists(smap, place, later, mounts, others, rule, shapes, lying, later_able)  # without this thing
     clear: dict[tuple[int, int, int, float], bool] = {}  # a later thing clear of this one, by their grid offset
 
     def beside(n: int, at: Spot, spot: Spot, slack: float) -> bool:
@@ -608,17 +619,22 @@ def carry_spots(
     mounts = [reach_of(world.arm_specs[side])]
     others = other_objects(world, ctx.belief, carried)
     earlier, later = packed_with(ctx.plan, step, smap, place.iri, ctx.given, ctx.known)
-    if obj is None or not (earlier or later):  # an arm holding something else leaves this one its spots
-        return place_spots(smap, place, size, mounts, others, able_mounts(world, carried))
+    able = able_mounts(world, carried)  # an arm holding something else leaves this one its spots
+    if obj is None or not (earlier or later):
+        return place_spots(smap, place, size, mounts, others, able)
     coming = [smap.objects[iri] for iri in later]
+    # a later thing's: the arms holding nothing, it, or what is carried now (set down before it)
+    later_able = [able_mounts(world, each.name, carried) for each in coming]
     surface, _ = support_of(smap, place)
     holds = _HoldAsked(ctx, coming, surface)
     sizes = [each.size for each in coming]
     circles = replace(rule, footprint="circle")
     if rule.footprint == "circle" or (
-        rule.footprint == "auto" and _circles_hold(smap, place, size, sizes, mounts, others)
+        rule.footprint == "auto" and _circles_hold(smap, place, size, sizes, mounts, others, [able, *later_able])
     ):
-        return set_down_spots(smap, place, size, mounts, others, sizes, circles, holds=holds)
+        return set_down_spots(
+            smap, place, size, mounts, others, sizes, circles, holds=holds, able=able, later_able=later_able
+        )
     rule = replace(rule, footprint="box")
     names = [name for name in world.objects if name != carried]  # in the order of ``others``
     lying = [(x, y, footprint_of(world.objects[name])) for name, (x, y, _) in zip(names, others, strict=True)]
@@ -626,7 +642,7 @@ def carry_spots(
     try:
         return set_down_spots(smap, place, size, mounts, [], sizes, rule, footprint_of(obj), feet, lying, holds)
     except Undecided:  # more spots asked of the arms than HOLD_TRIES: as for one thing alone
-        return place_spots(smap, place, size, mounts, others, able_mounts(world, carried))
+        return place_spots(smap, place, size, mounts, others, able)
 
 
 def _circles_hold(
@@ -636,11 +652,14 @@ def _circles_hold(
     later: Sequence[Size],
     mounts: Sequence[Mount],
     others: Sequence[tuple[float, float, float]],
+    able: Sequence[Sequence[Mount] | None] | None = None,
 ) -> bool:
     """Whether circles hold the thing carried now and those the plan puts on ``place`` after it, beside
-    what is there (the ``auto`` rule's first question; undecided counts as holding, as circles did)."""
+    what is there (the ``auto`` rule's first question; undecided counts as holding, as circles did);
+    ``able``: each one's arms that can set it down, as :func:`arrange`'s."""
     try:
-        return arrange(smap, place, [size, *later], mounts, others, PackingRule(footprint="circle")) is not None
+        circles = PackingRule(footprint="circle")
+        return arrange(smap, place, [size, *later], mounts, others, circles, able=able) is not None
     except Undecided:
         return True
 

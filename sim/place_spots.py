@@ -83,14 +83,16 @@ def distance_to_extent(box: tuple[float, float, float, float], point: tuple[floa
     return math.hypot(dx, dy)
 
 
-def able_mounts(world: HomeWorld, carried: str) -> list[tuple[float, float, float]]:
+def able_mounts(world: HomeWorld, carried: str, *also: str) -> list[tuple[float, float, float]]:
     """The reaches (:func:`reach_of`) of the world's arms that could set ``carried`` (a name) down: those
-    holding nothing or it. An arm holding something else cannot take the step, so its spots must not take
-    away another arm's (:func:`place_spots`' ``able``)."""
+    holding nothing, it, or one of ``also`` (a thing a packing's later carry follows: set down first). An arm
+    holding something else cannot take the step, so its spots must not take away another arm's
+    (:func:`place_spots`' ``able``)."""
+    names = {carried, *also}
     return [
         (spec.mount[0], spec.mount[1], spec.reach)
         for side, spec in sorted(world.arm_specs.items())
-        if (held := world.arm(side).held) is None or world.name_of(held) == carried
+        if (held := world.arm(side).held) is None or world.name_of(held) in names
     ]
 
 

@@ -38,7 +38,7 @@ from cbrs.sim.perception import (
     recognise_object,
     track_person,
 )
-from cbrs.sim.place_spots import other_objects, place_spots, reach_of, spot_region
+from cbrs.sim.place_spots import able_mounts, other_objects, place_spots, reach_of, spot_region
 from cbrs.sim.planning import PlannedPath, first_obstacle, plan_path
 from cbrs.sim.relations import region_of
 from cbrs.sim.relay import check_passing, relay_object, relay_spot, resting_at, set_down_for
@@ -134,7 +134,9 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
     """CarryObject to the target place by the arm holding the object, over the spot of the place nearest
     its centre that the arm reaches and can hold the object over (:func:`place_spots`): a table only
     part of which is in reach is worked at that part. When no spot is in that arm's reach and the other
-    arm reaches one, the object is first passed to the other arm."""
+    arm reaches one, the object is first passed to the other arm. When no free arm has one, the refusal
+    names the objects that crowd the spots of the arms that could take the step, and each arm that reaches
+    a spot but holds something else, and what (before, the objects were blamed for an arm that was busy)."""
     world = ctx.world
     place = place_of(ctx, inputs["targetPlace"], "the target place")
     ctx.region = region_of(place, place.iri in ctx.map.furniture)
@@ -158,21 +160,33 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
                 options.append((math.hypot(theirs[0][0] - cx, theirs[0][1] - cy), side, theirs[0]))
         if not options:
             spec = world.arm_specs[giver]
-            crowded = [  # arms that would have a spot but for the objects on the place
-                side
-                for side in sorted(world.arm_specs)
-                if place_spots(ctx.map, place, size, [reach_of(world.arm_specs[side])], [])[1]
-            ]
-            if crowded:
-                names = [name for name in world.objects if name != carried]  # in the order of ``others``
-                on_it = [n for n, (x, y, _) in zip(names, others, strict=True) if surface.contains_xy(x, y)]
-                arms = " and ".join(side.value for side in crowded) + (
-                    " arms reach" if len(crowded) > 1 else " arm reaches"
-                )
-                blockers = " and ".join(f"the {name}" for name in on_it) if on_it else "the objects"
+            able = able_mounts(world, carried)
+            busy: list[str] = []  # arms that would have a spot but hold something else
+            crowded: list[ArmSide] = []  # arms that can take the step and would have a spot but for the objects
+            for side in sorted(world.arm_specs):
+                reach = reach_of(world.arm_specs[side])
+                held_there = world.arm(side).held
+                holding = world.name_of(held_there) if held_there is not None else None
+                if holding is not None and holding != carried:
+                    if place_spots(ctx.map, place, size, [reach], [], [reach])[1]:
+                        busy.append(f"the {side.value} arm, which reaches it, holds the {holding}")
+                elif place_spots(ctx.map, place, size, [reach], [], able)[1]:
+                    crowded.append(side)
+            if crowded or busy:
+                said = []
+                if crowded:
+                    names = [name for name in world.objects if name != carried]  # in the order of ``others``
+                    on_it = [n for n, (x, y, _) in zip(names, others, strict=True) if surface.contains_xy(x, y)]
+                    arms = " and ".join(side.value for side in crowded) + (
+                        " arms reach" if len(crowded) > 1 else " arm reaches"
+                    )
+                    blockers = " and ".join(f"the {name}" for name in on_it) if on_it else "the objects"
+                    said.append(
+                        f"the {arms} it, but {blockers} on it {'leaves' if len(on_it) == 1 else 'leave'} no spot free"
+                    )
                 raise SkillFailed(
-                    f"no spot of {place.name} is clear for the {model.name} (around ({cx:.2f}, {cy:.2f})): the "
-                    f"{arms} it, but {blockers} on it {'leaves' if len(on_it) == 1 else 'leave'} no spot free"
+                    f"no spot of {place.name} is clear for the {model.name} (around ({cx:.2f}, {cy:.2f})): "
+                    + "; ".join([*said, *busy])
                 )
             other = "no other free arm reaches one" if len(world.arm_specs) > 1 else "the robot has no other arm"
             raise SkillFailed(
