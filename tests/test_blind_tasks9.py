@@ -217,9 +217,10 @@ def test_a_task_loaded_into_a_second_graph_is_refused_not_merged() -> None:
     assert _sizes(kb) == before
 
 
-def test_a_precondition_no_test_decides_is_planned_as_given(book_kb: KnowledgeBase) -> None:
-    """ "Only once the living room is dark": the class and the task each in a file of its own. Nothing reads
-    the room's light; the run takes the precondition as given and names it (execution.md)."""
+def test_a_precondition_on_the_rooms_light_is_not_planned_for(book_kb: KnowledgeBase) -> None:
+    """ "Only once the living room is dark": the class and the task each in a file of its own compose to one
+    plan for the goal alone; the precondition is the requester's, which the run decides before its first
+    step by the living room's light sensor (tests/test_precondition_sensing.py, execution.md)."""
     kb = KnowledgeBase.open(":memory:")
     for graph in ("ontology", "map"):
         kb.load([EXAMPLES / "lab9_book_on_box.ttl"], graph=graph)
