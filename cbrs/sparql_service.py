@@ -38,12 +38,13 @@ from typing import Any, Concatenate, Literal, ParamSpec, TypeVar
 import pyoxigraph as ox
 from werkzeug.datastructures import MIMEAccept
 
-from cbrs import pattern_lookup
+from cbrs import __version__, pattern_lookup
 from cbrs._query_worker import dataset_options
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import KnowledgeBaseError, QuerySyntaxError, QueryTooComplexError, StoreEvaluationError
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.query_guard import start_evaluation_thread
+from cbrs.kb.served_updates import HEADER, header_value
 from cbrs.kb.store import EmbeddedStore, QueryResult, is_remote, refuse_inserted_blank_nodes
 from cbrs.query_workers import QueryProcesses, QueryStopped, Request
 from cbrs.scan_queries import is_single_scan, single_scan, uses_prefixes
@@ -96,6 +97,21 @@ SHORT_NAMES: dict[str, tuple[str, str]] = {
     "trig": ("application/sparql-results+json", "application/trig"),
     "n3": ("application/sparql-results+json", "text/n3"),
 }
+
+
+UPDATES_CHECKED = True
+"""Whether :meth:`SparqlService.update` runs every update through :meth:`KnowledgeBase.update`'s checks (the
+semantic map, descriptions, superclasses), all or nothing, and brings graph:entailed up to date: always, no
+setting turns them off. A remote store client on this server trusts the word in :func:`identity_header`
+to send a checked update as it is, unchecked by itself (:mod:`kb.served_updates`): a setting that
+skipped a check must make this False for that server."""
+
+
+def identity_header() -> tuple[str, str]:
+    """The header every answer of the SPARQL endpoints carries: ``Cbrs-Server: cbrs/VERSION checked-updates``
+    (docs/serving.md), from which a remote store client learns, on its first request, that this server
+    checks its updates itself."""
+    return HEADER, header_value(__version__, UPDATES_CHECKED)
 
 
 class EndpointError(KnowledgeBaseError):
@@ -613,7 +629,7 @@ class SparqlService:
             try:
                 # refused, nothing changed: StoreEvaluationError (400), a description the shapes refuse (400),
                 # a semantic map it would leave unreadable (MapError, 422: KnowledgeBase.update checks it)
-                self.kb.update(text)
+                self.kb.update(text, check_map=UPDATES_CHECKED)
             finally:
                 self.generation += 1
         for listener in list(self._listeners):

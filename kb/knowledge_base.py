@@ -494,11 +494,20 @@ class KnowledgeBase:
     def _update_remote(self, text: str, check_map: bool) -> Refresh | None:
         """:meth:`_update` on a remote store: an update the embedded store would check is carried out first
         on a copy of the store, through the same checks, and only the change it made there is sent; a
-        refused one sends nothing (:mod:`kb.remote_updates`). Any other is sent as it is."""
+        refused one sends nothing (:mod:`kb.remote_updates`). Any other is sent as it is, and so is every
+        update to a ``cbrs serve`` that says it checks them (:attr:`RemoteStore.checks_updates`): it runs the
+        same checks on its own store, all or nothing, refuses in the same words (:mod:`kb.served_updates`)
+        and brings graph:entailed up to date itself, so a copy of the store would be read for nothing."""
         from cbrs.kb.remote_store import RemoteStore
         from cbrs.kb.remote_updates import CheckedCopy
 
         assert isinstance(self.store, RemoteStore)
+        if self.store.checks_updates:
+            try:
+                self.store.update(text)
+            finally:
+                self._reader.clear_cache()
+            return None
         data = DataUpdate.read(text, EmbeddedStore(ox.Store(), MEMORY))  # only read: which quads it names
         if data is not None:
             inserted = [quad for operation in data.operations if operation.insert for quad in operation.quads]

@@ -40,6 +40,8 @@ from cbrs.kb.errors import BindingError, QuerySyntaxError, RemoteStoreError, Sto
 from cbrs.kb.namespaces import PREFIXES, GraphName
 from cbrs.kb.remote_access import refuse_remote_access
 from cbrs.kb.results import releases_results
+from cbrs.kb.served_updates import HEADER as CBRS_HEADER
+from cbrs.kb.served_updates import claims_checked, refusal
 from cbrs.kb.staged_writes import write_staged
 from cbrs.kb.store import QueryResult, Store, Term, data_block, refuse_deep_nesting
 
@@ -169,6 +171,8 @@ class RemoteStore(Store):
         # whether bound values go in as BIND clauses (Virtuoso, see _binds)
         self._oxigraph = False
         self._virtuoso = False
+        self._cbrs = False  # a cbrs serve (its Cbrs-Server header), and whether it says its updates are checked
+        self._checks_updates = False
 
     @classmethod
     def open(
@@ -406,6 +410,14 @@ class RemoteStore(Store):
         return "oxigraph" if self._oxigraph else "virtuoso" if self._virtuoso else "other"
 
     @property
+    def checks_updates(self) -> bool:
+        """Whether the server is a ``cbrs serve`` that runs every update through the embedded store's checks,
+        all or nothing, and brings graph:entailed up to date, as its ``Cbrs-Server`` header says
+        (:mod:`kb.served_updates`), known from the open's first answer on: a checked update is then sent as
+        it is rather than carried out first on a copy of the store (:mod:`kb.remote_updates`)."""
+        return self._checks_updates
+
+    @property
     def keeps_requests_whole(self) -> bool:
         """Whether the server runs an update request of several operations as one transaction: not Virtuoso
         7, which keeps what the first wrote when a later one fails (:mod:`kb.update_report` refuses such a
@@ -637,8 +649,14 @@ class RemoteStore(Store):
         server = response.headers.get("server", "").lower()
         self._oxigraph = server.startswith("oxigraph/")
         self._virtuoso = server.startswith("virtuoso/")
+        cbrs = response.headers.get(CBRS_HEADER)
+        self._cbrs, self._checks_updates = cbrs is not None, claims_checked(cbrs)
         if response.is_success:
             return response
+        if self._cbrs and original is not None and 400 <= response.status_code < 500:
+            refused = refusal(self.location, url, response.status_code, response.content, original)
+            if refused is not None:  # a check's refusal, in the embedded store's words (kb/served_updates.py)
+                raise refused
         message = _POSITION.sub(_one_line_up, response.text.strip())
         status = response.status_code
         too_large = status == 413 or "limited to" in message

@@ -15,11 +15,12 @@ import pyoxigraph as ox
 import pytest
 
 from cbrs.kb import KnowledgeBase
-from cbrs.kb.errors import StoreEvaluationError, UndeclaredSuperclassError
+from cbrs.kb.errors import BlankNodeInsertError, QuerySyntaxError, StoreEvaluationError, UndeclaredSuperclassError
 from cbrs.kb.namespaces import GraphName
 from cbrs.kb.remote_store import RemoteStore
 from cbrs.kb.remote_updates import CheckedCopy, as_on_union, operations
 from cbrs.kb.semantic_map import MapError
+from cbrs.kb.served_updates import HEADER, claims_checked
 from cbrs.kb.shapes import DescriptionShapeError
 from cbrs.kb.store import Store
 from cbrs.server import ServeConfig, Server
@@ -32,6 +33,7 @@ LAB = "PREFIX lab: <https://example.org/lab#>\n"
 ENTAILED = b"<https://w3id.org/cbrs/graph/entailed>"
 RDFS_LABEL = ox.NamedNode("http://www.w3.org/2000/01/rdf-schema#label")
 MAP = GraphName.MAP.node
+UPDATE_TYPE = "application/sparql-update"
 
 
 @pytest.fixture(scope="module")
@@ -264,25 +266,128 @@ def _unlabelled(quads: Iterable[ox.Quad]) -> list[str]:
     return sorted(re.sub(r"_:\w+", "_:", str(quad)) for quad in quads)
 
 
-@pytest.fixture
-def served() -> Iterator[tuple[Server, KnowledgeBase]]:
-    """A ``cbrs serve`` (in this process, loopback) on an embedded store, and a knowledge base on it."""
+@pytest.fixture(scope="module")
+def served() -> Iterator[tuple[Server, KnowledgeBase, list[httpx.Request]]]:
+    """A ``cbrs serve`` (in this process, loopback) on an embedded store, a knowledge base on it, and the
+    requests it sends (cleared by each test that reads them). Shared: a test that writes puts it back."""
     server = Server(
         KnowledgeBase.open(":memory:"), ServeConfig(port=0, bridge_port=0, endpoint=EndpointConfig(update_token="t"))
     )
     server.start()
-    client = KnowledgeBase(RemoteStore.open(f"http://127.0.0.1:{server.http_port}", token="t"))
-    yield server, client
+    try:
+        client = KnowledgeBase(RemoteStore.open(f"http://127.0.0.1:{server.http_port}", token="t"))
+    except BaseException:
+        server.stop(timeout=10)
+        raise
+    assert isinstance(client.store, RemoteStore)
+    seen: list[httpx.Request] = []
+    client.store._http().event_hooks["request"].append(seen.append)
+    yield server, client, seen
     client.close()
     server.stop(timeout=10)
 
 
 def test_a_cbrs_serve_as_the_remote_store_is_checked_and_reads_its_default_graph(
-    served: tuple[Server, KnowledgeBase],
+    served: tuple[Server, KnowledgeBase, list[httpx.Request]],
 ) -> None:
-    server, client = served
+    server, client, _ = served
     held = server.kb.store.dump()
     _refusal(client, "DELETE WHERE { GRAPH graph:map { world:Pen home:sizeX ?x } }", MapError)
     # its updates run on an embedded store, whose WHERE reads the default graph alone: this finds nothing
     client.update("DELETE { GRAPH graph:map { world:Pen home:sizeX ?x } } WHERE { world:Pen home:sizeX ?x }")
     assert server.kb.store.dump() == held
+
+
+@pytest.mark.parametrize(("text", "error"), REFUSED)
+def test_a_cbrs_serve_is_sent_a_checked_update_as_it_is_and_its_refusal_is_the_embedded_stores(
+    served: tuple[Server, KnowledgeBase, list[httpx.Request]],
+    monkeypatch: pytest.MonkeyPatch,
+    text: str,
+    error: type[Exception],
+) -> None:
+    server, client, seen = served
+    assert isinstance(client.store, RemoteStore) and client.store.checks_updates  # from the open's first answer
+
+    def no_copy(*_: object) -> None:
+        raise AssertionError("the store was copied: the server checks the update itself")
+
+    monkeypatch.setattr(CheckedCopy, "__init__", no_copy)
+    held = server.kb.store.dump()
+    seen.clear()
+    on_server = _refusal(client, text, error)
+    assert [request.url.path for request in seen] == ["/update"] and seen[0].content.decode().endswith(text)
+    assert server.kb.store.dump() == held
+    embedded = KnowledgeBase.open(":memory:")
+    try:
+        reference = _refusal(embedded, text, error)
+    finally:
+        embedded.close()
+    assert type(on_server) is type(reference)
+    assert str(on_server) == str(reference)
+    assert getattr(on_server, "__notes__", None) == getattr(reference, "__notes__", None)
+
+
+def test_a_cbrs_serve_carries_out_an_update_that_passes_and_keeps_graph_entailed_itself(
+    served: tuple[Server, KnowledgeBase, list[httpx.Request]],
+) -> None:
+    server, client, seen = served
+    held = server.kb.store.dump()
+    added = "INSERT DATA { GRAPH graph:services { <https://example.org/lab#Cam9> a cbrs:DynamicPerceptionComponent } }"
+    reference = KnowledgeBase.open(":memory:")
+    try:
+        reference.update(added)
+        entailed = set(reference.store.quads(graph=GraphName.ENTAILED.node))
+    finally:
+        reference.close()
+    assert entailed != set(server.kb.store.quads(graph=GraphName.ENTAILED.node))  # the update entails something
+    seen.clear()
+    try:
+        client.update(added)
+        assert [request.url.path for request in seen] == ["/update"]  # no copy read, no refresh from here
+        assert set(client.store.quads(graph=GraphName.ENTAILED.node)) == entailed  # the server's refresh
+    finally:
+        client.update(added.replace("INSERT", "DELETE"))
+    assert server.kb.store.dump() == held
+
+
+@pytest.mark.parametrize(
+    ("text", "error", "words"),
+    [
+        pytest.param("INSERT DATA { <urn:a> <urn:b> ", QuerySyntaxError, "SPARQL syntax error: error at", id="syntax"),
+        pytest.param("DROP GRAPH <urn:x:absent>", StoreEvaluationError, "update failed: ", id="evaluation"),
+        pytest.param(
+            "INSERT DATA { GRAPH graph:world { <urn:a> <urn:b> _:x } }",
+            BlankNodeInsertError,
+            "inserts a blank node",
+            id="blank",
+        ),
+    ],
+)
+def test_a_cbrs_serve_refusing_the_text_itself_is_told_as_the_embedded_store_tells_it(
+    served: tuple[Server, KnowledgeBase, list[httpx.Request]], text: str, error: type[Exception], words: str
+) -> None:
+    _, client, _ = served
+    refused = _refusal(client, text, error)
+    assert type(refused) is error and words in str(refused)
+    assert '"error"' not in str(refused)  # the server's message, not its JSON
+    if isinstance(refused, StoreEvaluationError):
+        assert str(refused).startswith(f"store {client.store.location}: update failed: ")  # the store as named
+
+
+def test_only_a_cbrs_server_saying_so_is_taken_to_check_its_updates(
+    served: tuple[Server, KnowledgeBase, list[httpx.Request]], remote_location: str
+) -> None:
+    server, _, _ = served
+    base = f"http://127.0.0.1:{server.http_port}"
+    for answer in (
+        httpx.post(base + "/sparql", data={"query": "ASK {}"}),  # the hot path
+        httpx.get(base + "/sparql", headers={"Accept": "text/turtle"}),  # the service description, from Flask
+        httpx.post(base + "/update", content=b"CLEAR GRAPH <urn:x>", headers={"Content-Type": UPDATE_TYPE}),
+    ):
+        assert claims_checked(answer.headers.get(HEADER)), answer.request.url
+    assert not claims_checked("cbrs/0.1.0") and not claims_checked("oxigraph/0.4 checked-updates")
+    other = RemoteStore.open(remote_location)  # Oxigraph: the copy's path
+    try:
+        assert not other.checks_updates
+    finally:
+        other.close()

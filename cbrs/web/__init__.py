@@ -158,7 +158,8 @@ def create_app(
     def library_error(error: KnowledgeBaseError) -> tuple[Response | str, int]:
         if as_page():
             return error_page(error), error.http_status
-        return _error(getattr(error, "kind", type(error).__name__), str(error)), error.http_status
+        notes = {"notes": error.__notes__} if getattr(error, "__notes__", None) else {}  # "nothing was changed"
+        return _error(getattr(error, "kind", type(error).__name__), str(error), **notes), error.http_status
 
     def for_programs() -> bool:
         """A path only programs use (the protocol endpoints, a ``.json`` twin): its errors are JSON even

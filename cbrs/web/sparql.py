@@ -15,7 +15,15 @@ import pyoxigraph as ox
 from flask import Blueprint, Response, g, request, url_for
 from werkzeug.datastructures import MIMEAccept, MultiDict
 
-from cbrs.sparql_service import GRAPH_TYPES, RESULT_TYPES, Dataset, EndpointError, accept_ranges, negotiate
+from cbrs.sparql_service import (
+    GRAPH_TYPES,
+    RESULT_TYPES,
+    Dataset,
+    EndpointError,
+    accept_ranges,
+    identity_header,
+    negotiate,
+)
 from cbrs.web import context
 
 blueprint = Blueprint("sparql", __name__)
@@ -73,6 +81,7 @@ def sparql() -> Response:
 def _vary(response: Response) -> Response:
     # The answer depends on the Accept header, and its CORS headers on the Origin: caches must key on both.
     response.vary.update(("Accept", "Origin"))
+    response.headers.setdefault(*identity_header())  # a remote store client learns the server checks updates
     return response
 
 
@@ -132,6 +141,7 @@ def protocol_answer() -> Response:
     g.sparql_protocol = True
     response = sparql()
     response.vary.update(("Accept", "Origin"))
+    response.headers.setdefault(*identity_header())
     return response
 
 

@@ -24,7 +24,7 @@ from werkzeug.exceptions import InternalServerError
 from werkzeug.http import HTTP_STATUS_CODES
 
 from cbrs.kb.errors import KnowledgeBaseError
-from cbrs.sparql_service import SparqlService
+from cbrs.sparql_service import SparqlService, identity_header
 
 log = logging.getLogger("cbrs.web")
 
@@ -32,7 +32,12 @@ WSGIApp = Callable[[dict[str, Any], Callable[..., Any]], Iterable[bytes]]
 _SHORT_FORMAT = ("format", "output")
 _QUERY_TYPE = "application/sparql-query"
 # What every answer of /sparql carries (the blueprint's Vary, the app's other after_request headers).
-COMMON_HEADERS = (("Vary", "Accept, Origin"), ("X-Content-Type-Options", "nosniff"), ("Referrer-Policy", "same-origin"))
+COMMON_HEADERS = (
+    ("Vary", "Accept, Origin"),
+    ("X-Content-Type-Options", "nosniff"),
+    ("Referrer-Policy", "same-origin"),
+    identity_header(),
+)
 
 
 class SparqlHotPath:
