@@ -500,14 +500,6 @@ SETTINGS: tuple[Setting, ...] = (
         _metres(0.1),
     ),
     Setting(
-        "clear_spread",
-        lambda: 0.15,  # cbrs.sim.relay.CLEAR_SPREAD, kept here so settings load no simulation
-        "Metres a spot asked next for a carry's clearance keeps from every spot whose dry run came within the "
-        "clearance of an appliance, before the spots nearer them are asked; 0 asks them in order; 0 to 0.5.",
-        "CBRS_CLEAR_SPREAD",
-        _metres(0.5),
-    ),
-    Setting(
         "log_level",
         lambda: "INFO",
         "Lowest level of the log lines cbrs serve writes to standard error: " + ", ".join(LOG_LEVELS) + ".",

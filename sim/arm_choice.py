@@ -31,7 +31,7 @@ from cbrs.sim.hold_choice import Candidates, GraspChoice, first_clear, refuse_mo
 from cbrs.sim.perceived import PerceivedWorld
 from cbrs.sim.perception import ObjectEstimate
 from cbrs.sim.place_spots import RELAY_MARGIN, spot_region
-from cbrs.sim.relay import CLEAR_TRIES, RELAY_TRIES, clear_asked, relay_spot, resting_at
+from cbrs.sim.relay import CLEAR_TRIES, RELAY_TRIES, appliance_distance, clear_asked, relay_spot, resting_at
 from cbrs.sim.transit import band_advice, floor_cause, floor_needs, floor_to
 from cbrs.sim.values import Manipulation
 from cbrs.sim.world import HomeWorld
@@ -309,8 +309,9 @@ def _taking_to(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, si
             def others(
                 since: int, near: Sequence[tuple[float, float]], held: ObjectModel = held
             ) -> Iterator[Region]:  # the next it can let go over and carry to without the object held meeting
-                # an appliance, by the map (no dry run spent); away from those whose dry run came near first
-                regions = (spot_region(surface, *at) for at in clear_asked(spots, near, lambda at: at, since))
+                # an appliance, by the map (no dry run spent); farther from the appliances than any that came near first
+                away = appliance_distance(world)
+                regions = (spot_region(surface, *at) for at in clear_asked(spots, near, lambda at: at, away, since))
                 fixtures = skills.appliances(world)
                 try:
                     grasp = grasp_pose_for(ctx, estimate, side, held) if fixtures else None
@@ -448,8 +449,8 @@ def holdable_spot(
     orientation = arm.ee_pose().orientation
     first: tuple[float, float] | None = None
     unrefused: tuple[float, float] | None = None  # the first whose carry the planning makes, though near
-    near: list[tuple[float, float]] = []  # where the carry came near an appliance: asked away from them next
-    for x, y in clear_asked(spots, near, lambda at: at):
+    near: list[tuple[float, float]] = []  # where the carry came near an appliance: farther spots asked next
+    for x, y in clear_asked(spots, near, lambda at: at, appliance_distance(ctx.world)):
         if arm.can_hold((x, y, surface.zmin + skills.PLACE_CLEARANCE + grasp.bottom_offset), orientation):
             why, brushed = carry_check(ctx, side, spot_region(surface, x, y))
             if not why:
@@ -602,8 +603,8 @@ def _clear_spot(
     against the appliances (:func:`skills.held_meets`), a jar carried to the table's spot beside the
     dispenser is refused there, not only noted, and the spots a little farther went unasked
     (JarOntoTheTable at seed 1 was refused before the run). ``others`` is given where the dry runs came
-    near so far, and gives the spots away from them first (:func:`relay.clear_asked`): the neighbours of
-    a spot whose carry passes by a tap's lever pass by it too (BookOntoTheTable at seed 2)."""
+    near so far, and gives the spots farther from the appliances than those first (:func:`relay.clear_asked`):
+    the neighbours of a spot whose carry passes by a tap's lever pass by it too (BookOntoTheTable at seed 2)."""
     refused, brushed = carry_check(ctx, side, first, taking)
     if not (refused or brushed):
         return _Found(first)

@@ -13,7 +13,6 @@ import math
 from collections.abc import Callable, Iterator, Sequence
 from typing import TypeVar
 
-from cbrs.settings import setting
 from cbrs.sim import skills
 from cbrs.sim.arms import CARRY_CLEARANCE, ArmSide
 from cbrs.sim.context import SimContext, SkillFailed, check_outcome, robot_camera
@@ -32,6 +31,7 @@ from cbrs.sim.place_spots import (
     other_objects,
 )
 from cbrs.sim.transit import floor_to
+from cbrs.sim.world import HomeWorld
 
 RELAY_MOVES_TRIES = 3
 """How many spots whose end poses serve a pass or a re-grasp may have its holds' moves refused by the
@@ -65,51 +65,46 @@ lever) a pass, or an arm's choice of where it takes an object, passes over for t
 the first of them, as before the clearance was asked: each is a dry run of a take and a carry (50-100 ms)."""
 
 
-CLEAR_SPREAD = 0.15
-"""Once a spot's dry run comes within CARRY_CLEARANCE of an appliance, the spots asked next for a carry's
-clearance (:func:`clear_asked`: an arm's choice of where it takes an object, the carry's own) are first
-those at least this far from every spot whose dry run came that near, by default: the ``clear_spread``
-setting (``CBRS_CLEAR_SPREAD``) sets it (:func:`clear_spread`). The spots are ordered nearest the place's
-centre, 2 cm apart, and a carry to one spot passes the appliance as the carries to its neighbours do: on
-the ninth round's table the first 8 spots of both arms lay within 12 cm of each other in front of the
-dispenser, every one's carry came within 1 cm of the tap's lever, and the carry to the first stopped 17 cm
-short at seed 2 (BookOntoTheTable). 15 cm, as RELAY_SPREAD for the pass's spots: farther than the 8
-neighbours' spread, within the arms' reach along a table's front."""
-
 S = TypeVar("S")
 
 log = logging.getLogger("cbrs.sim")
 
 
-def clear_spread() -> float:
-    """CLEAR_SPREAD, or the ``clear_spread`` setting where it is given (metres, 0 to 0.5; 0: the spots in
-    their order, as before)."""
-    return float(setting("clear_spread").resolve())
+def appliance_distance(world: HomeWorld) -> Callable[[tuple[float, float]], float]:
+    """How far a point of the floor plan is from the nearest appliance a carry keeps CARRY_CLEARANCE from
+    (each dispenser's body, tap's lever and spout, their extents as the map gives them); inf with none."""
+    boxes = [
+        (part.box.min_x, part.box.max_x, part.box.min_y, part.box.max_y)
+        for dispenser in world.dispensers
+        for part in (dispenser.body, dispenser.lever, dispenser.spout)
+    ]
+    return lambda point: min((distance_to_extent(box, point) for box in boxes), default=math.inf)
 
 
 def clear_asked(
-    spots: Sequence[S], near: Sequence[tuple[float, float]], at: Callable[[S], tuple[float, float]], since: int = 0
+    spots: Sequence[S],
+    near: Sequence[tuple[float, float]],
+    at: Callable[[S], tuple[float, float]],
+    away: Callable[[tuple[float, float]], float],
+    since: int = 0,
 ) -> Iterator[S]:
     """Of ``spots`` (in the order a carry prefers them), the order they are asked in for a carry's clearance:
-    the first RELAY_TRIES, as before, until a spot's dry run comes near an appliance (``near``: where, which
-    grows as they are asked); from then on first each spot, of all of them, at least :func:`clear_spread`
-    from every spot in ``near`` (the first of them in ``spots``' order), and when none is left, the rest of
-    the first RELAY_TRIES in their order. A place whose spots all lie within that of one another (the 5 cm
-    place below the tap) is asked in its order, as before. ``at``: a spot's (x, y); ``since``: the index of
-    the first spot to ask (those before it were asked already)."""
-    spread = clear_spread()
+    the first RELAY_TRIES, as before, until a spot's dry run comes within CARRY_CLEARANCE of an appliance
+    (``near``: where, which grows as they are asked); from then on first each spot, of all of them, farther
+    from the appliances (``away``, :func:`appliance_distance`) than every spot in ``near`` (the first such
+    in ``spots``' order), and when none is left, the rest of the first RELAY_TRIES in their order. The spots
+    are ordered nearest the place's centre, 2 cm apart, and the carries to the neighbours of one that passes
+    by an appliance pass by it too: the ninth round's table top, whose centre is behind the dispenser, had
+    its first 40 spots in the arms' reach in front of it, each carry within 1 cm of the tap's lever, and
+    BookOntoTheTable's carry to the first of them met the lever at seed 2. A spot nearer the appliance than
+    one whose carry came near is the least likely to keep clear, and is asked last. ``at``: a spot's
+    (x, y); ``since``: the index of the first spot to ask (those before it were asked already)."""
     asked = [index < since for index in range(len(spots))]
     while True:
         pick = None
-        if near and spread > 0.0:
-            pick = next(
-                (
-                    index
-                    for index, spot in enumerate(spots)
-                    if not asked[index] and all(math.dist(at(spot), where) >= spread for where in near)
-                ),
-                None,
-            )
+        if near:
+            bar = max(away(where) for where in near)
+            pick = next((index for index, spot in enumerate(spots) if not asked[index] and away(at(spot)) > bar), None)
         if pick is None:
             pick = next((index for index in range(min(len(spots), RELAY_TRIES)) if not asked[index]), None)
         if pick is None:

@@ -1,12 +1,12 @@
-"""Spots asked away from a carry that came near an appliance (sim/relay.py: clear_asked, CLEAR_SPREAD and the
-``clear_spread`` setting; sim/arm_choice.py: holdable_spot, _clear_spot).
+"""Spots asked farther from the appliances once a carry came near one (sim/relay.py: clear_asked,
+appliance_distance; sim/arm_choice.py: holdable_spot, _clear_spot).
 
 The ninth round's notebook, lying on a storage box on the kitchen table, set down on the table's top
 (docs/examples/lab9_book_on_box.ttl, BookOntoTheTable): the top's spots in the arms' reach are ordered
 nearest its centre, which is behind the dispenser, so the first ones lie together in front of it, and the
 carry to each of the first 40 came within 1 cm of the tap's lever. The carry took the first of them "as
 before", and at seed 2 it met the lever, stopped 17 cm short and was re-planned (18.1 s). Now, once a spot's
-carry comes near, the spots asked next are those 15 cm from every such spot first."""
+carry comes near, the spots asked next are those farther from the appliances than every such spot first."""
 
 from __future__ import annotations
 
@@ -16,7 +16,6 @@ import pytest
 
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.semantic_map import SemanticMap
-from cbrs.settings import setting
 from cbrs.sim import relay
 from cbrs.sim.arm_choice import carry_check, holdable_spot, lying_estimate
 from cbrs.sim.arms import ArmSide
@@ -60,26 +59,21 @@ def test_the_notebook_is_carried_to_a_spot_away_from_the_tap_s_lever(holding: Si
     spot = holdable_spot(context, ArmSide.RIGHT, surface, spots)
     assert spot is not None and spots.index(spot) >= relay.RELAY_TRIES  # before, only the first 40 were asked
     assert carry_check(context, ArmSide.RIGHT, spot_region(surface, *spot)) == ("", "")
+    away = relay.appliance_distance(context.world)
+    assert away(spot) > max(away(at) for at in spots[: relay.RELAY_TRIES])
 
 
 def test_the_spots_asked_after_one_that_came_near() -> None:
-    spots = [(0.02 * i, 0.0) for i in range(12)]  # 2 cm apart along a line
+    spots = [(0.02 * i, 0.0) for i in range(8)]  # 2 cm apart along a line, an appliance at x 0.07
+
+    def away(at: tuple[float, float]) -> float:
+        return abs(at[0] - 0.07)
+
     near: list[tuple[float, float]] = []
-    asked = relay.clear_asked(spots, near, lambda at: at)
+    asked = relay.clear_asked(spots, near, lambda at: at, away)
     assert [next(asked), next(asked)] == spots[:2]  # in order until one comes near
-    near.append(spots[1])
-    assert next(asked) == spots[9]  # the first 15 cm from it (0.16 m)
-    near.append(spots[9])
-    assert list(asked) == spots[2:9] + spots[10:]  # none 15 cm from both: the rest in order
-    together = [(0.02 * i, 0.0) for i in range(5)]  # a small place: all within 15 cm, in order as before
-    assert list(relay.clear_asked(together, [together[0]], lambda at: at)) == together
-    assert list(relay.clear_asked(spots, [], lambda at: at, since=10)) == spots[10:]
-
-
-def test_clear_spread_is_a_setting(monkeypatch: pytest.MonkeyPatch) -> None:
-    assert setting("clear_spread").default() == relay.CLEAR_SPREAD == relay.clear_spread()
-    monkeypatch.setenv("CBRS_CLEAR_SPREAD", "0.3")
-    assert relay.clear_spread() == 0.3
-    monkeypatch.setenv("CBRS_CLEAR_SPREAD", "15")  # centimetres meant
-    with pytest.raises(ValueError, match=r"CBRS_CLEAR_SPREAD='15': 15 must be a length in metres from 0 to 0.5"):
-        relay.clear_spread()
+    near.append(spots[1])  # 5 cm from the appliance
+    assert next(asked) == spots[7]  # the first farther (7 cm), across it
+    near.append(spots[7])
+    assert list(asked) == spots[2:7]  # none farther than 7 cm: the rest in order
+    assert list(relay.clear_asked(spots, [], lambda at: at, away, since=5)) == spots[5:]
