@@ -654,7 +654,8 @@ class RemoteStore(Store):
         if response.is_success:
             return response
         if self._cbrs and original is not None and 400 <= response.status_code < 500:
-            refused = refusal(self.location, url, response.status_code, response.content, original)
+            fixed = functools.partial(_POSITION.sub, _one_line_up)
+            refused = refusal(self.location, url, response.status_code, response.content, original, fixed)
             if refused is not None:  # a check's refusal, in the embedded store's words (kb/served_updates.py)
                 raise refused
         message = _POSITION.sub(_one_line_up, response.text.strip())

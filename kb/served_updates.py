@@ -17,6 +17,7 @@ update's checks raise. Its structured fields (a shape error's problems, a map er
 from __future__ import annotations
 
 import json
+from collections.abc import Callable
 
 from cbrs.kb.errors import (
     BlankNodeInsertError,
@@ -66,12 +67,20 @@ def _refusal_classes() -> dict[str, type[KnowledgeBaseError]]:
     return found
 
 
-def refusal(location: str, endpoint: str, status: int, body: bytes, request: str) -> KnowledgeBaseError | None:
+def refusal(
+    location: str,
+    endpoint: str,
+    status: int,
+    body: bytes,
+    request: str,
+    positions: Callable[[str], str] = str,
+) -> KnowledgeBaseError | None:
     """The error a cbrs server's refusal (``body``, its JSON) of the caller's update or query ``request``
     stands for, as the embedded store raises it: a check's error of the same class, words and notes, a
     syntax error as :class:`QuerySyntaxError` of the text as given, an evaluation error as
     :class:`StoreEvaluationError` naming ``location`` (the store the caller named, not the server's own).
-    None for any other answer (left to the caller's handling of the status)."""
+    ``positions`` corrects a syntax error's line for the prologue sent before the text. None for any other
+    answer (left to the caller's handling of the status)."""
     try:
         said = json.loads(body)
     except ValueError:
@@ -82,7 +91,7 @@ def refusal(location: str, endpoint: str, status: int, body: bytes, request: str
     notes = [note for note in said.get("notes") or () if isinstance(note, str)]
     error: KnowledgeBaseError
     if kind == "QuerySyntaxError":
-        error = QuerySyntaxError(request, message.removeprefix("SPARQL syntax error: "))
+        error = QuerySyntaxError(request, positions(message.removeprefix("SPARQL syntax error: ")))
     elif kind == "StoreEvaluationError":
         operation, _, reason = message.partition(" failed: ")
         error = StoreEvaluationError(location, operation.rsplit(" ", 1)[-1] or "update", reason or message)

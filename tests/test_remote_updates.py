@@ -353,7 +353,9 @@ def test_a_cbrs_serve_carries_out_an_update_that_passes_and_keeps_graph_entailed
 @pytest.mark.parametrize(
     ("text", "error", "words"),
     [
-        pytest.param("INSERT DATA { <urn:a> <urn:b> ", QuerySyntaxError, "SPARQL syntax error: error at", id="syntax"),
+        pytest.param(
+            "INSERT DATA { <urn:a> <urn:b> ", QuerySyntaxError, "SPARQL syntax error: error at 1:", id="syntax"
+        ),
         pytest.param("DROP GRAPH <urn:x:absent>", StoreEvaluationError, "update failed: ", id="evaluation"),
         pytest.param(
             "INSERT DATA { GRAPH graph:world { <urn:a> <urn:b> _:x } }",
