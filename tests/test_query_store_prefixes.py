@@ -59,7 +59,8 @@ def test_a_query_that_declares_the_prefix_itself_keeps_its_own(store: str, print
     own = f"PREFIX {printed}: <https://example.org/elsewhere#> SELECT * WHERE {{ {printed}:Trolley1 ?p ?o }}"
     answer = _cbrs(store, "query", own, "--format", "json")
     assert answer.exit_code == 0, answer.output
-    assert json.loads(answer.output)["results"]["bindings"] == []  # elsewhere#Trolley1 is nothing of the store
+    assert json.loads(answer.stdout)["results"]["bindings"] == []  # elsewhere#Trolley1 is nothing of the store
+    assert f"nothing in the store mentions {printed}:Trolley1" in answer.stderr  # and standard error says so
 
 
 def test_a_misspelt_prefix_is_offered_the_stores_with_its_namespace(store: str, printed: str) -> None:
