@@ -120,10 +120,14 @@ class ColourRisk:
                 f"{said}, in the window {self.inside.span()}, not {window.span()}: the cameras would take it "
                 f"for {self.inside.name}"
             )
-        nearest = f" (the nearest: {near.span()})" if near is not None else ""
+        if near is None or near.name == window.name:  # beside its own window: say how far and which way
+            return (
+                f"{said}, outside {window.span()} and every other window the cameras know: they would not find "
+                f"it as {self.colour}; paint it nearer {window.hue:g}°"
+            )
         return (
-            f"{said}, outside every window the cameras know{nearest}, not in {window.span()}: the cameras would "
-            f"not find it as {self.colour}"
+            f"{said}, outside every window the cameras know (the nearest: {near.span()}), not in "
+            f"{window.span()}: the cameras would not find it as {self.colour}"
         )
 
     def to_dict(self) -> dict[str, Any]:

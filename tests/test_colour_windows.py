@@ -130,6 +130,9 @@ def test_hsv_is_the_segmentations_arithmetic() -> None:
         pytest.param((0.40, 0.80, 0.20, 1.0), Risk.EDGE, "hue 100°, within 3° of the edge", id="at-the-edge"),
         pytest.param((0.43, 0.80, 0.20, 1.0), Risk.EDGE, "hue 97°, within 3° of the edge", id="just-outside"),
         pytest.param((0.55, 0.85, 0.00, 1.0), Risk.OUTSIDE, "outside every window the cameras know", id="outside"),
+        pytest.param(
+            (0.50, 1.00, 0.00, 1.0), Risk.OUTSIDE, "outside green (100-150°) and every other", id="beside-its-own"
+        ),
         pytest.param((0.90, 0.80, 0.10, 1.0), Risk.OUTSIDE, "in the window yellow (42-66°)", id="in-another"),
         pytest.param((0.50, 0.55, 0.50, 1.0), Risk.GREY, "saturation 0.09, below green's floor", id="grey"),
         pytest.param((0.02, 0.15, 0.03, 1.0), Risk.DARK, "brightness 0.15, below green's floor", id="dark"),
