@@ -14,6 +14,7 @@ a thing painted where its camera may not tell its colour.
 
 from __future__ import annotations
 
+import colorsys
 import math
 from collections import defaultdict
 from dataclasses import dataclass
@@ -88,21 +89,10 @@ class ColourWindow:
 
 
 def hsv(rgba: tuple[float, ...]) -> tuple[float, float, float]:
-    """Hue (degrees), saturation and value of a colour in 0..1, by the arithmetic the segmentation uses on
-    a pixel (hue 0 for a grey, which has none)."""
-    r, g, b = rgba[0], rgba[1], rgba[2]
-    value = max(r, g, b)
-    chroma = value - min(r, g, b)
-    saturation = chroma / value if value > 0 else 0.0
-    if chroma <= 1e-6:
-        return 0.0, saturation, value
-    if value == r:
-        hue = ((g - b) / chroma) % 6.0
-    elif value == g:
-        hue = (b - r) / chroma + 2.0
-    else:
-        hue = (r - g) / chroma + 4.0
-    return hue * 60.0, saturation, value
+    """Hue (degrees), saturation and value of a colour in 0..1, the segmentation's HSV (hue 0 for a grey,
+    which has none)."""
+    hue, saturation, value = colorsys.rgb_to_hsv(rgba[0], rgba[1], rgba[2])
+    return hue * 360.0, saturation, value
 
 
 def read_colour_windows(kb: KnowledgeBase, camera: str | None = None) -> dict[str, tuple[ColourWindow, ...]]:

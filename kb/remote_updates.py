@@ -36,7 +36,7 @@ import pyoxigraph as ox
 
 from cbrs.kb.errors import StoreError
 from cbrs.kb.remote_store import RemoteStore
-from cbrs.kb.sparql_lexemes import HIDING
+from cbrs.kb.sparql_lexemes import HIDING, closing_brace
 from cbrs.kb.store import EmbeddedStore, Store
 from cbrs.kb.update_delta import DataUpdate
 
@@ -102,7 +102,7 @@ def as_on_union(operation: str, using: str) -> str:
     if len(words) < 3 or words[0] not in ("DELETE", "INSERT") or words[1] == "DATA":
         return operation
     if words[:3] == ["DELETE", "WHERE", "{"]:
-        end = _closing(words, 2)
+        end = closing_brace(words, 2)
         if end is None:
             return operation
         pattern = operation[lexemes[2].end : lexemes[end].start]
@@ -115,15 +115,6 @@ def as_on_union(operation: str, using: str) -> str:
             return operation[: lexeme.start] + using + "\n" + operation[lexeme.start :]
         depth += (lexeme.text == "{") - (lexeme.text == "}")
     return operation
-
-
-def _closing(words: list[str], opening: int) -> int | None:
-    depth = 0
-    for index in range(opening, len(words)):
-        depth += (words[index] == "{") - (words[index] == "}")
-        if depth == 0:
-            return index
-    return None
 
 
 class CheckedCopy:

@@ -18,7 +18,7 @@ import pyoxigraph as ox
 from cbrs.kb.errors import UndeclaredSuperclassError
 from cbrs.kb.namespaces import OWL, PREFIXES, RDF, RDFS
 from cbrs.kb.shapes import did_you_mean, line_of
-from cbrs.kb.sparql_lexemes import HIDING
+from cbrs.kb.sparql_lexemes import HIDING, closing_brace
 from cbrs.kb.store import Store
 
 OWN_NAMESPACES = tuple(PREFIXES[name] for name in ("home", "cbrs", "act"))
@@ -96,7 +96,7 @@ def may_add_subclasses(text: str) -> bool:
         return True  # a graph copied or a file loaded; an escape in a name, which hides what follows it
     for position, word in enumerate(words):
         if word == "INSERT" and words[position + 1 : position + 2] == ["{"]:
-            end = _closing(tokens, position + 1)
+            end = closing_brace(tokens, position + 1)
             if end is None or _variable_predicate(tokens[position + 2 : end]):
                 return True
     return False
@@ -130,16 +130,6 @@ def _tokens(text: str) -> list[str]:
         if len(word) < len(token):
             found.append(".")
     return found
-
-
-def _closing(tokens: Sequence[str], opening: int) -> int | None:
-    """The index of the brace that closes the one at ``opening``."""
-    depth = 0
-    for index in range(opening, len(tokens)):
-        depth += (tokens[index] == "{") - (tokens[index] == "}")
-        if depth == 0:
-            return index
-    return None
 
 
 def _variable_predicate(template: Sequence[str]) -> bool:

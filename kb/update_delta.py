@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import pyoxigraph as ox
 
 from cbrs.kb.namespaces import PREFIXES
-from cbrs.kb.sparql_lexemes import HIDING
+from cbrs.kb.sparql_lexemes import HIDING, closing_brace
 from cbrs.kb.store import Store
 
 # Strings, IRIs and comments first (nothing inside them counts), then blanks, the brackets and separators
@@ -85,7 +85,7 @@ def data_operations(text: str) -> tuple[DataOperation, ...] | None:
             and separated
             and words[position + 1 : position + 3] == ["DATA", "{"]
         ):
-            end = _closing(words, position + 2)
+            end = closing_brace(words, position + 2)
             if end is None:
                 return None
             quads = _block_quads(text, tokens[position + 3 : end], words[position + 3 : end], "".join(declared))
@@ -109,19 +109,6 @@ def _plain(token: str) -> bool:
     return not any(sign in token for sign in "\\[]()") and not token.startswith(("_:", "?", "$"))
 
 
-def _closing(words: list[str], opening: int) -> int | None:
-    """The index of the brace that closes the one at ``opening``."""
-    depth = 0
-    for index in range(opening, len(words)):
-        if words[index] == "{":
-            depth += 1
-        elif words[index] == "}":
-            depth -= 1
-            if depth == 0:
-                return index
-    return None
-
-
 def _block_quads(text: str, tokens: list[_Token], words: list[str], declared: str) -> tuple[ox.Quad, ...] | None:
     """The quads of one data block's tokens, read as TriG from the text itself: each run of default-graph
     triples wrapped in braces (TriG's default graph block, where the last '.' may be left out as in
@@ -136,7 +123,7 @@ def _block_quads(text: str, tokens: list[_Token], words: list[str], declared: st
                 return None
             if words[position + 2 : position + 3] != ["{"]:
                 return None
-            end = _closing(words, position + 2)
+            end = closing_brace(words, position + 2)
             if end is None or "{" in words[position + 3 : end] or "}" in words[position + 3 : end]:
                 return None
             pieces.append(_wrapped(text, run))
