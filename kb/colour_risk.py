@@ -27,6 +27,7 @@ from pyoxigraph import Triple
 
 from cbrs.kb.colour_windows import ColourWindow, hsv, read_colour_windows
 from cbrs.kb.namespaces import PREFIXES, shorten
+from cbrs.kb.semantic_map import UNPAINTED
 
 if TYPE_CHECKING:
     from collections.abc import Collection, Iterable, Sequence
@@ -47,8 +48,6 @@ __all__ = [
 ]
 
 HOME = PREFIXES["home"]
-UNPAINTED = (0.5, 0.5, 0.5, 1.0)
-"""How the simulation paints a thing the map gives no home:rgba (kb.semantic_map)."""
 
 
 class Risk(Enum):

@@ -522,8 +522,14 @@ def _two_values(iri: str, name: str, raw: list[str]) -> MapError:
     )
 
 
+UNPAINTED = (0.5, 0.5, 0.5, 1.0)
+"""How a thing the map gives no home:rgba is painted: a mid grey, no colour a camera tells."""
+
+
 def _rgba(iri: str, values: dict[str, list[str]]) -> tuple[float, float, float, float]:
-    text = _text(values, "rgba", iri) or "0.5 0.5 0.5 1"
+    text = _text(values, "rgba", iri)
+    if not text:
+        return UNPAINTED
     try:
         parts = [float(part) for part in text.split()]
     except ValueError:
