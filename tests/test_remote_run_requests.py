@@ -151,7 +151,8 @@ def _rows(rows: list[dict[str, Any]]) -> list[str]:
         pytest.param("ASK { ?s ?p ?o }", id="ask"),
         pytest.param("PREFIX x: <http://example.org/> SELECT ?s WHERE { ?s ?p x:o }", id="own-prefix"),
         pytest.param("SELECT ?s WHERE { ?s ?p ?o } ORDER BY DESC(STR(?s))", id="order-by-expression"),
-        pytest.param("SELECT ?s WHERE { ?s ?p ?o } ORDER BY ?o", id="order-by-unprojected"),
+        # ?o over IRIs only: Oxigraph's server once panicked sorting the whole store's mixed literals
+        pytest.param("SELECT ?s WHERE { ?s a ?o } ORDER BY ?o", id="order-by-unprojected"),
         pytest.param("SELECT ?cbrs__x WHERE { ?cbrs__x ?p ?o }", id="own-variable"),
     ],
 )
