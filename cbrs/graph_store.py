@@ -3,7 +3,9 @@
 One named graph (``graph=IRI``), the store's own default graph (``default``), or, for reading and for
 adding quads, the whole dataset. Writes take the update token, parse the body whole before anything
 is written (a broken body changes nothing), pass the description shapes like every other way in, leave
-a readable semantic map readable (as a load or an update into graph:map must), and are one transaction each.
+a readable semantic map readable (as a load or an update into graph:map must), leave no class under a term
+of cbrs's own vocabularies that nothing declares (as an ``INSERT DATA`` or ``DELETE DATA`` of the same
+statements must: :func:`kb.superclasses.check_change`), and are one transaction each.
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.loader import parse_bytes
 from cbrs.kb.namespaces import GraphName
 from cbrs.kb.shapes import check_descriptions
+from cbrs.kb.superclasses import check_change, says_used_terms
 from cbrs.output import used_prefixes
 from cbrs.sparql_service import NotAcceptableError, SparqlService, negotiate
 
@@ -115,7 +118,9 @@ class GraphStore:
             self.sparql.kb.check_map_write(new, replaces_map=node == GraphName.MAP.node)
             store = self.sparql.kb.store
             created = isinstance(node, ox.NamedNode) and node.value not in store.graphs()
-            store.replace(list(store.quads(graph=node)), new)
+            old = list(store.quads(graph=node))
+            check_change(store, old, new, _request("PUT", node))
+            store.replace(old, new)
             self._written()
         return created
 
@@ -126,6 +131,7 @@ class GraphStore:
         new = self._parse(body, media_type, node)
         with self.sparql.lock:
             self.sparql.kb.check_map_write(new)
+            check_change(self.sparql.kb.store, (), new, _request("POST", node))
             self.sparql.kb.store.add(new)
             self._written()
 
@@ -135,12 +141,16 @@ class GraphStore:
         node = self._graph_node(target, "DELETE")
         with self.sparql.lock:
             store = self.sparql.kb.store
+            if isinstance(node, ox.NamedNode) and node.value not in store.graphs():
+                raise UnknownGraphError(node.value)
             if isinstance(node, ox.NamedNode):
-                if node.value not in store.graphs():
-                    raise UnknownGraphError(node.value)
+                if says_used_terms(store, node):  # else it cannot remove a declaration: not read
+                    check_change(store, list(store.quads(graph=node)), [], _request("DELETE", node))
                 store.clear_graph(node)
             else:
-                store.replace(list(store.quads(graph=node)), [])
+                old = list(store.quads(graph=node))
+                check_change(store, old, [], _request("DELETE", node))
+                store.replace(old, [])
             self._written()
 
     def _written(self) -> None:
@@ -173,6 +183,15 @@ class GraphStore:
             quads = [ox.Quad(q.subject, q.predicate, q.object, ox.DefaultGraph()) for q in quads]
         check_descriptions(self.sparql.kb.store, quads)  # a description written so passes the shapes too
         return quads
+
+
+def _request(method: str, node: ox.NamedNode | ox.DefaultGraph | None) -> str:
+    """How a refusal names the request: ``the PUT of graph <IRI>``, ``the POST to the store``."""
+    if node is None:
+        what = "the store"
+    else:
+        what = "the default graph" if isinstance(node, ox.DefaultGraph) else f"graph {node}"
+    return f"the {method} {'to' if method == 'POST' else 'of'} {what}"
 
 
 def _negotiate(accept: str | None, offered: tuple[ox.RdfFormat, ...]) -> ox.RdfFormat:

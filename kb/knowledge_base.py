@@ -38,7 +38,14 @@ from cbrs.kb.seed_cache import SeedCache, bundle_digest
 from cbrs.kb.shapes import CHECKED_GRAPHS, DescriptionShapeError, checked_update, may_write_descriptions
 from cbrs.kb.standard_terms import PendingUpdate, Refresh, StandardTerms
 from cbrs.kb.store import MEMORY, EmbeddedStore, QueryResult, Store, Term, is_remote
-from cbrs.kb.superclasses import check_added_superclasses, check_superclasses, may_add_subclasses, subclass_axioms
+from cbrs.kb.superclasses import (
+    Watch,
+    check_data_update,
+    check_watched,
+    may_add_subclasses,
+    may_remove_declarations,
+    watch_update,
+)
 from cbrs.kb.update_delta import DataUpdate
 from cbrs.kb.update_report import GraphChange, UpdateReport, exact_changes, graph_sizes, net_changes, refuse_split
 from cbrs.kb.upgrade import StoreCheck, UpgradeReport, check_store, upgrade_store
@@ -444,23 +451,22 @@ class KnowledgeBase:
 
         if not isinstance(self.store, EmbeddedStore):
             return self._update_remote(text, check_map)
-        if data is not None:  # a class put under a home: term nobody declares, as a load refuses it
-            inserted = [quad for operation in data.operations if operation.insert for quad in operation.quads]
-            check_superclasses(self.store, [("the update", inserted)], "nothing was written")
+        if data is not None:  # a class put under a home: term nobody declares (or left so), as a load refuses it
+            check_data_update(self.store, data.operations)
         pending = self.standard_terms.prepare(data) if run is None else None
         checking: AbstractContextManager[None] = nullcontext()
         before = self._map_before_update(text, data) if check_map else None
         old_map = before.quads if before is not None else None
         everything: set[ox.Quad] | None = None  # the store before, kept here to put back whatever it wrote
-        axioms: set[ox.Quad] | None = None  # its subclass axioms, when the update may add one (not read)
+        watch: Watch | None = None  # its superclasses, when the update may change them (kb/superclasses.py)
         keep = data is not None  # whether a refused update is undone whole (a data update undoes itself)
         if data is None:  # what else it writes is unknown: keep the whole store if it might be refused
             described = may_write_descriptions(text) or _LOADS.search(text) is not None
             embedded = isinstance(self.store, EmbeddedStore)
-            if embedded and may_add_subclasses(text):  # checked once it ran: kb/superclasses.py
-                axioms = subclass_axioms(self.store)
-            keep = embedded and (old_map is not None or described or axioms is not None)
-            if keep and (old_map is not None or axioms is not None):  # one copy for every check
+            if embedded:  # checked once it ran: kb/superclasses.py
+                watch = watch_update(self.store, text)
+            keep = embedded and (old_map is not None or described or watch is not None)
+            if keep and (old_map is not None or watch is not None):  # one copy for every check
                 everything = set(self.store.quads())
             if described:  # else it cannot reach them: the check read both graphs twice for nothing
                 checking = checked_update(self.store, keep and everything is None)  # kb/shapes.py puts back
@@ -469,8 +475,8 @@ class KnowledgeBase:
         try:
             with checking:
                 (run or functools.partial(self.store.update, text))()
-            if axioms is not None:
-                check_added_superclasses(self.store, axioms)
+            if watch is not None:
+                check_watched(self.store, watch)
             if old_map is not None:
                 self._check_updated_map(old_map)
         except UndeclaredSuperclassError:
@@ -510,15 +516,14 @@ class KnowledgeBase:
             return None
         data = DataUpdate.read(text, EmbeddedStore(ox.Store(), MEMORY))  # only read: which quads it names
         if data is not None:
-            inserted = [quad for operation in data.operations if operation.insert for quad in operation.quads]
             on_map = check_map and data.names_graph((GraphName.MAP.node,))
             checked = on_map or data.names_graph(CHECKED_GRAPHS)
             if not checked:  # no copy needed: the superclasses are read from the store itself
-                check_superclasses(self.store, [("the update", inserted)], "nothing was written")
+                check_data_update(self.store, data.operations)
         else:
             on_map = check_map and _MAY_WRITE_MAP.search(text) is not None
             checked = on_map or may_write_descriptions(text) or _LOADS.search(text) is not None
-            checked = checked or may_add_subclasses(text)
+            checked = checked or may_add_subclasses(text) or may_remove_declarations(self.store, text)
         try:
             if not checked:
                 self.store.update(text)

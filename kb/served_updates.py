@@ -50,6 +50,7 @@ def _refusal_classes() -> dict[str, type[KnowledgeBaseError]]:
     """The errors an update's checks raise, and every subclass, by the name the server sends as the kind."""
     from cbrs.kb.semantic_map import MapError  # it imports the knowledge base, which imports the store
     from cbrs.kb.shapes import DescriptionShapeError
+    from cbrs.kb.superclasses import RemovedDeclarationError  # a subclass of one below, defined with its check
 
     found: dict[str, type[KnowledgeBaseError]] = {}
     waiting: list[type[KnowledgeBaseError]] = [
@@ -57,6 +58,7 @@ def _refusal_classes() -> dict[str, type[KnowledgeBaseError]]:
         InvalidDescriptionError,
         DescriptionShapeError,
         UndeclaredSuperclassError,
+        RemovedDeclarationError,
         BlankNodeInsertError,
         RemoteAccessError,
     ]
