@@ -32,10 +32,14 @@ from __future__ import annotations
 
 import argparse
 import concurrent.futures
+import hashlib
+import html
+import html.parser
 import importlib.metadata
 import json
 import os
 import platform
+import re
 import secrets
 import shutil
 import signal
@@ -49,7 +53,7 @@ import tomllib
 import urllib.error
 import urllib.parse
 import urllib.request
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -63,7 +67,11 @@ VERBS = (*GRAPHS, "update", "register")
 STATUSES = ("succeeded", "refused", "no plan", "failed")
 RUN_STATUS = {"succeeded": "succeeded", "failed": "failed", "cancelled": "failed", "unsolvable": "no plan"}
 SERVER_STATUS = {"succeeded": "succeeded", "failed": "failed", "cancelled": "failed", "no-plan": "no plan"}
-VIAS = ("cli", "bridge", "http", "run_task", "action", "library")
+VIAS = ("cli", "bridge", "http", "run_task", "action", "library", "page")
+SERVED = ("http", "bridge", "run_task", "action", "page")
+"""The ways of running that go to a server of the trial's store (``cbrs serve``)."""
+STARTS = ("http", "page")
+"""The ways of running whose starts the server may answer 409 while a run goes (two runs at once)."""
 GRAPH_SIZES = "SELECT ?g (COUNT(*) AS ?n) WHERE { GRAPH ?g { ?s ?p ?o } } GROUP BY ?g"
 STARTUP = 90.0
 """Seconds a server or a component program may take to answer or register (bounded waits)."""
@@ -135,7 +143,11 @@ class Trial:
     library: Library | None = None
     post: bool = False
     """Whether the setup's files are sent to the server (``POST /store``, ``POST /update``) once it answers,
-    for each seed, instead of loaded on the command line before it starts."""
+    for each seed, instead of loaded on the command line before it starts (via page: a requirement's file
+    written on the New task page); an expected refusal is checked there (status, words, the store as it was)."""
+    busy: str = ""
+    """Two runs at once: while each run but the last goes, the next run's start is sent and must be refused
+    (409) saying this phrase and naming the run going; the next is started once the run has ended."""
 
     @property
     def task(self) -> str:
@@ -211,6 +223,7 @@ def _trial(path: Path, row: dict[str, Any]) -> Trial:
         bool(row.get("known_failure", False)),
         library,
         bool(row.get("post", False)),
+        str(row.get("busy", "")),
     )
     _check(path, trial)
     return trial
@@ -236,14 +249,15 @@ def _check(path: Path, trial: Trial) -> None:
         raise SystemExit(f"{where}: a library program (library) runs alone, and only it runs via library")
     if trial.library is not None and len(trial.runs) != 1:
         raise SystemExit(f"{where}: a library program runs its one task: one run")
-    if trial.post and (trial.via not in ("http", "bridge", "run_task", "action") or not trial.runs):
+    if trial.post and trial.via not in SERVED:
+        raise SystemExit(f"{where}: files are posted to a server: its runs must go to one (via {', '.join(SERVED)})")
+    if trial.post and any(s.replace for s in trial.setup):
+        raise SystemExit(f"{where}: a posted setup's files are added (POST), none replaces its graph (no replace)")
+    if trial.busy and (trial.via not in STARTS or len(trial.runs) < 2):
         raise SystemExit(
-            f"{where}: files are posted to a server: its runs must go to one (via http, bridge, run_task, action)"
+            f"{where}: two runs at once (busy) start the next run while one goes: two runs or more, "
+            f"via {' or '.join(STARTS)}"
         )
-    if trial.post and any(
-        s.expect_refusal or s.replace or s.verb not in (*GRAPHS, "register", "update") for s in trial.setup
-    ):
-        raise SystemExit(f"{where}: a posted setup is of files the server takes, added (no refusal, no replace)")
     steps = [*trial.setup, *(b for r in trial.runs for b in r.before)]
     names = [s.file for s in steps] + [s.program for s in trial.serve]
     names += [trial.library.program] if trial.library else []
@@ -383,9 +397,10 @@ def _parsed(done: subprocess.CompletedProcess[str]) -> dict[str, Any]:
     return found if isinstance(found, dict) else {"status": "broken", "error": done.stdout[-300:]}
 
 
-def run_one(trial: Trial, index: int, store: Path) -> list[Outcome]:
+def run_one(trial: Trial, index: int, store: Path, made: Made | None = None) -> list[Outcome]:
     """Run the trial's runs in order at its ``index``-th seed in ``store``: on the command line, or
-    against a server of the store with the trial's program, and read each outcome from its JSON."""
+    against a server of the store with the trial's program, and read each outcome from its JSON (or the
+    run's page); what the server refused on the way (posted files, a second start) checked in ``made``."""
     seed = trial.seeds[index]
     if trial.via == "cli":
         outcomes = []
@@ -404,7 +419,7 @@ def run_one(trial: Trial, index: int, store: Path) -> list[Outcome]:
         return outcomes
     if trial.via == "library":
         return _library_runs(trial, index, store)
-    return _served_runs(trial, index, store)
+    return _served_runs(trial, index, store, made if made is not None else Made())
 
 
 def _library_runs(trial: Trial, index: int, store: Path) -> list[Outcome]:
@@ -476,9 +491,12 @@ class _Child:
 
 
 @contextmanager
-def _server(trial: Trial, store: Path, env: dict[str, str]) -> Iterator[tuple[str, str]]:
-    """``cbrs serve`` of ``store`` on free loopback ports, and the trial's program against its bridge;
-    yields the HTTP and the bridge URLs; both stopped by PID at the end."""
+def _server(
+    trial: Trial, store: Path, env: dict[str, str], prepare: Callable[[str], None] | None = None
+) -> Iterator[tuple[str, str]]:
+    """``cbrs serve`` of ``store`` on free loopback ports, ``prepare(url)`` once it answers (the files
+    posted), and the trial's programs against its bridge; yields the HTTP and the bridge URLs; every
+    process stopped by PID at the end."""
     http, bridge = _free_port(), _free_port()
     url, ws = f"http://127.0.0.1:{http}", f"ws://127.0.0.1:{bridge}"
     argv = [
@@ -501,8 +519,8 @@ def _server(trial: Trial, store: Path, env: dict[str, str]) -> Iterator[tuple[st
             raise RuntimeError(
                 f"cbrs serve did not answer at {url} within {STARTUP:.0f} s: {''.join(children[0].lines)[-300:]}"
             )
-        for step in trial.setup if trial.post else ():  # before the programs, as the files come first
-            _post_step(url, step, env["CBRS_UPDATE_TOKEN"], store.parent / f"{store.name}.edited")
+        if prepare is not None:  # before the programs, as the files come first
+            prepare(url)
         for n, serve in enumerate(trial.serve):  # each ready before the next starts
             program = [sys.executable, str(EXAMPLES / serve.program), "--bridge", ws, *serve.args]
             children.append(_Child(program, env, store.parent / f"{store.name}.program{n}.log"))
@@ -524,10 +542,10 @@ MEDIA = {
 MEDIA |= {".jsonld": "application/ld+json", ".trig": "application/trig", ".nq": "application/n-quads"}
 
 
-def _post_step(url: str, step: Step, token: str, where: Path) -> None:
-    """Send a setup step's file to the server as a client of its protocols would: a graph's file by the
-    Graph Store Protocol (``POST /store?graph=.../graph/NAME``; a component's description into
-    graph/services, as ``cbrs register`` puts it), an update to ``/update``; RuntimeError unless accepted."""
+def _post_request(url: str, step: Step, token: str, where: Path) -> tuple[str, urllib.request.Request]:
+    """A setup step's file as a client of the server's protocols sends it: a graph's file by the Graph
+    Store Protocol (``POST /store?graph=.../graph/NAME``; a component's description into graph/services,
+    as ``cbrs register`` puts it), an update to ``/update``; with what it is sent to."""
     path = _edited(step, where)
     if step.verb == "update":
         target, media = "/update", "application/sparql-update"
@@ -536,12 +554,93 @@ def _post_step(url: str, step: Step, token: str, where: Path) -> None:
         target = "/store?" + urllib.parse.urlencode({"graph": f"https://w3id.org/cbrs/graph/{graph}"})
         media = MEDIA.get(path.suffix, "text/turtle")
     headers = {"Authorization": f"Bearer {token}", "Content-Type": media}
-    request = urllib.request.Request(url + target, path.read_bytes(), headers, method="POST")
+    return f"POST {target.split('?')[0]} {step.file}", urllib.request.Request(
+        url + target, path.read_bytes(), headers, method="POST"
+    )
+
+
+def _post_step(url: str, step: Step, token: str, where: Path) -> None:
+    """Send a setup step's file to the server (:func:`_post_request`); RuntimeError unless accepted."""
+    said, request = _post_request(url, step, token, where)
     try:
         with urllib.request.urlopen(request, timeout=60):
             return
     except urllib.error.HTTPError as error:
-        raise RuntimeError(f"POST {target} {step.file}: {error.code} {error.read()[:300]!r}") from None
+        raise RuntimeError(f"{said}: {error.code} {error.read()[:300]!r}") from None
+
+
+def _post_setup(trial: Trial, url: str, token: str, where: Path, made: Made) -> None:
+    """The trial's setup sent to the server in order: each file posted (an expected refusal checked, its
+    miss recorded in ``made``); via page, a requirement's file written on the New task page instead."""
+    browser = _Browser(url)
+    for step in trial.setup:
+        if step.expect_refusal:
+            said, miss = post_refusal(url, step, token, where)
+            made.checks.append(f"{trial.label}: {said}")
+            if miss:
+                made.deviations.append(f"{trial.label}: {miss}")
+        elif trial.via == "page" and step.verb == "requirements":
+            made.checks.append(f"{trial.label}: {_editor_save(browser, step, token, where)}")
+        else:
+            _post_step(url, step, token, where)
+
+
+def dataset(url: str) -> tuple[str, dict[str, int]]:
+    """The server's whole store (``GET /store`` as N-Quads): a digest of its sorted quads, and each
+    graph's number of quads (what a refused file must leave as it was)."""
+    import pyoxigraph as ox  # the bench's own process: the library cbrs reads its files with
+
+    request = urllib.request.Request(url + "/store", headers={"Accept": "application/n-quads"})
+    with urllib.request.urlopen(request, timeout=60) as answer:
+        data = answer.read()
+    lines = sorted(line for line in data.decode("utf-8").splitlines() if line.strip())
+    sizes: dict[str, int] = {}
+    for quad in ox.parse(data, ox.RdfFormat.N_QUADS):
+        graph = quad.graph_name.value if isinstance(quad.graph_name, ox.NamedNode) else "(default)"
+        sizes[graph] = sizes.get(graph, 0) + 1
+    return hashlib.sha256("\n".join(lines).encode("utf-8")).hexdigest(), sizes
+
+
+def post_refusal(url: str, step: Step, token: str, where: Path) -> tuple[str, str]:
+    """Post a file the server must refuse: what it answered, and why that is not as the docs say (empty
+    when it is): a 4xx (a 5xx is the server's fault, not the file's) whose message (with its notes) says
+    the step's phrase and error class, and the store's digest the same before and after."""
+    before = dataset(url)
+    said, request = _post_request(url, step, token, where)
+    try:
+        with urllib.request.urlopen(request, timeout=60) as answer:
+            status, body = answer.status, answer.read()
+    except urllib.error.HTTPError as error:
+        status, body = error.code, error.read()
+    after = dataset(url)
+    try:
+        answered = json.loads(body)
+    except json.JSONDecodeError:
+        answered = {"message": body.decode("utf-8", "replace")}
+    answered = answered if isinstance(answered, dict) else {"message": str(answered)}
+    words = " ".join([str(answered.get("error", "")), str(answered.get("message", "")), *answered.get("notes", [])])
+    line = f"{said}: {status}: {words.strip()[:300] or '(nothing said)'}"
+    return line, refused_post_deviation(step, status, words, before, after, said)
+
+
+def refused_post_deviation(
+    step: Step,
+    status: int,
+    words: str,
+    before: tuple[str, dict[str, int]],
+    after: tuple[str, dict[str, int]],
+    said: str = "",
+) -> str:
+    """Why a posted file's refusal is not as the docs say (empty when it is)."""
+    if status < 400:
+        return f"{said}: accepted ({status}), the docs say refused"
+    misses = [f"answered {status}, a server error"] if status >= 500 else []
+    misses += [f"without {word!r}" for word in (step.refused, step.says) if word and word not in words]
+    if before[0] != after[0]:
+        changed = sorted(g for g in set(before[1]) | set(after[1]) if before[1].get(g) != after[1].get(g))
+        sizes = ", ".join(f"{g} {before[1].get(g, 0)} -> {after[1].get(g, 0)}" for g in changed)
+        misses.append(f"the store changed: {sizes or 'the same sizes, other quads'}")
+    return f"{said}: refused " + "; ".join(misses) + f": {words.strip()[:300]}" if misses else ""
 
 
 def _answers(url: str, timeout: float) -> bool:
@@ -555,20 +654,27 @@ def _answers(url: str, timeout: float) -> bool:
     return False
 
 
-def _served_runs(trial: Trial, index: int, store: Path) -> list[Outcome]:
+def _served_runs(trial: Trial, index: int, store: Path, made: Made) -> list[Outcome]:
     seed = trial.seeds[index]
-    env = {**os.environ, "CBRS_UPDATE_TOKEN": secrets.token_hex(16)}
+    token = secrets.token_hex(16)
+    env = {**os.environ, "CBRS_UPDATE_TOKEN": token}
+    where = store.parent / f"{store.name}.edited"
     outcomes = []
+
+    def prepare(url: str) -> None:
+        if trial.post:
+            _post_setup(trial, url, token, where, made)
+
     try:
-        with _server(trial, store, env) as (url, ws):
+        with _server(trial, store, env, prepare) as (url, ws):
             for k, run in enumerate(trial.runs):
                 started = time.perf_counter()
-                if trial.via == "http":
-                    found = _http_run(url, run.task, seed, env["CBRS_UPDATE_TOKEN"])
+                if trial.via in STARTS:
+                    found = _started_run(trial, k, seed, url, token, made)
                 elif trial.via == "run_task":
-                    found = _bridge_run(ws, run.task, seed, env["CBRS_UPDATE_TOKEN"])
+                    found = _bridge_run(ws, run.task, seed, token)
                 elif trial.via == "action":
-                    found = _action_run(ws, run.task, seed, env["CBRS_UPDATE_TOKEN"])
+                    found = _action_run(ws, run.task, seed, token)
                 else:
                     args = ("run", run.task, "--bridge", ws, "--seed", str(seed), "--json")
                     try:
@@ -576,34 +682,372 @@ def _served_runs(trial: Trial, index: int, store: Path) -> list[Outcome]:
                     except subprocess.TimeoutExpired:
                         found = {"status": "broken", "error": f"no answer in {RUN_TIMEOUT:.0f} s"}
                 outcomes.append(_outcome(trial, k, index, seed, found, time.perf_counter() - started))
-    except RuntimeError as failed:
+    except (RuntimeError, OSError) as failed:
         done = len(outcomes)
         for k in range(done, len(trial.runs)):
             outcomes.append(_outcome(trial, k, index, seed, {"status": "broken", "error": str(failed)}, 0.0))
+        if not trial.runs:
+            made.deviations.append(f"{trial.label}: broken: {failed}")
     return outcomes
 
 
-def _http_run(url: str, task: str, seed: int, token: str) -> dict[str, Any]:
-    """POST the task to ``/tasks.json``, poll the run's JSON until it ends (bounded): the run's result
-    with its status, as ``cbrs run --json`` gives them."""
-    body = json.dumps({"task": task, "seed": seed}).encode()
-    headers = {"Authorization": f"Bearer {token}", "Content-Type": "application/json", "Accept": "application/json"}
+@dataclass(frozen=True)
+class Started:
+    """A run the server took: its id, where it is followed (its JSON, or its page), and the page the
+    start answered (the tasks page again, with its form, for the form's runs)."""
+
+    run: str
+    where: str
+    page: str = ""
+
+
+def _started_run(trial: Trial, k: int, seed: int, url: str, token: str, made: Made) -> dict[str, Any]:
+    """Start the trial's ``k``-th run (POST /tasks.json, or the tasks page's form), then, for two runs at
+    once, the next run while it goes (checked in ``made``: refused, 409, saying the trial's phrase and
+    naming the run going); follow the run until it ends (bounded): its result as ``cbrs run --json``."""
+    task, browser = trial.runs[k].task, _Browser(url)
     try:
-        with urllib.request.urlopen(
-            urllib.request.Request(url + "/tasks.json", body, headers, method="POST"), timeout=30
-        ) as answer:
+        begun = _page_start(browser, task, seed) if trial.via == "page" else _http_start(url, task, seed, token)
+    except _NotStarted as refused:
+        return {"status": "broken", "error": str(refused)[:300]}
+    if trial.busy and k + 1 < len(trial.runs):
+        said, miss = busy_check(trial, begun, trial.runs[k + 1].task, seed, browser, token)
+        made.checks.append(f"{trial.label}, seed {seed}: {said}")
+        if miss:
+            made.deviations.append(f"{trial.label}, seed {seed}: {miss}")
+    if trial.via == "page":
+        return _page_follow(browser, begun)
+    return _http_follow(url, begun, token)
+
+
+class _NotStarted(RuntimeError):
+    """The server did not take a start (its status and words)."""
+
+    def __init__(self, said: str, status: int, words: str) -> None:
+        self.status, self.words = status, words
+        super().__init__(f"{said}: {status} {words[:300]}")
+
+
+def _json_headers(token: str) -> dict[str, str]:
+    return {"Authorization": f"Bearer {token}", "Content-Type": "application/json", "Accept": "application/json"}
+
+
+def _http_start(url: str, task: str, seed: int, token: str) -> Started:
+    """POST the task to ``/tasks.json`` as a program does (JSON, the update token): the run it started;
+    :class:`_NotStarted` with the answer's status and words otherwise."""
+    body = json.dumps({"task": task, "seed": seed}).encode()
+    request = urllib.request.Request(url + "/tasks.json", body, _json_headers(token), method="POST")
+    try:
+        with urllib.request.urlopen(request, timeout=30) as answer:
             location = answer.headers["Location"]
     except urllib.error.HTTPError as error:
-        return {"status": "broken", "error": f"POST /tasks.json: {error.code} {error.read()[:300]!r}"}
+        raise _NotStarted(f"POST /tasks.json {task}", error.code, _words(error.read())) from None
+    return Started(location.rsplit("/", 1)[-1].removesuffix(".json"), location)
+
+
+def _http_follow(url: str, begun: Started, token: str) -> dict[str, Any]:
+    """Poll the run's JSON until it ends (bounded): the run's result with its status."""
     deadline = time.monotonic() + RUN_TIMEOUT
     while time.monotonic() < deadline:
-        with urllib.request.urlopen(urllib.request.Request(url + location, headers=headers), timeout=30) as answer:
+        request = urllib.request.Request(url + begun.where, headers=_json_headers(token))
+        with urllib.request.urlopen(request, timeout=30) as answer:
             page = json.loads(answer.read())
         found = page.get("run", page)
         if found.get("status") != "running":
             return _ended(found)
         time.sleep(1.0)
-    return {"status": "broken", "error": f"{location} still running after {RUN_TIMEOUT:.0f} s"}
+    return {"status": "broken", "error": f"{begun.where} still running after {RUN_TIMEOUT:.0f} s"}
+
+
+def _http_run(url: str, task: str, seed: int, token: str) -> dict[str, Any]:
+    """POST the task to ``/tasks.json``, poll the run's JSON until it ends (bounded): the run's result
+    with its status, as ``cbrs run --json`` gives them."""
+    try:
+        return _http_follow(url, _http_start(url, task, seed, token), token)
+    except _NotStarted as refused:
+        return {"status": "broken", "error": str(refused)[:300]}
+
+
+def busy_check(trial: Trial, begun: Started, task: str, seed: int, browser: _Browser, token: str) -> tuple[str, str]:
+    """Start ``task`` while the run ``begun`` goes, as the trial's runs are started: what the server
+    answered, and why that is not as the docs say (empty when it is): refused with 409, saying the trial's
+    phrase and the run going. A start taken after the run had ended is said so (the race was lost: the
+    first run was too short to start another beside it)."""
+    sent = time.time()
+    if trial.via == "page":
+        said = f"the tasks page's Start with {task} while {begun.run} goes"
+        try:
+            taken = _page_start(browser, task, seed, begun.page)
+            status, words = 202, f"started {taken.run}"
+        except _NotStarted as refused:
+            status, words = refused.status, refused.words
+    else:
+        said = f"POST /tasks.json {task} while {begun.run} goes"
+        try:
+            taken = _http_start(browser.url, task, seed, token)
+            status, words = 202, f"started {taken.run}"
+        except _NotStarted as refused:
+            status, words = refused.status, refused.words
+    line = f"{said}: {status}: {words[:300] or '(nothing said)'}"
+    ended = _run_json(browser.url, begun.run, token).get("finished") if status != 409 else None
+    return line, busy_deviation(said, status, words, trial.busy, begun.run, bool(ended and ended < sent))
+
+
+def busy_deviation(said: str, status: int, words: str, phrase: str, running: str, ended_before: bool) -> str:
+    """Why the answer to a start sent while ``running`` goes is not as the docs say (empty when it is):
+    409, saying ``phrase`` and naming the run going. ``ended_before``: that run had ended before the start
+    was sent (the race lost: the bench's first run too short, no two at once)."""
+    if status != 409:
+        race = " (the first run had ended before it: no two at once)" if ended_before else ""
+        return f"{said}: {status}, the docs say 409{race}: {words[:300]}"
+    misses = [f"without {word!r}" for word in (phrase, running) if word not in words]
+    return (f"{said}: 409 " + "; ".join(misses) + f": {words[:300]}") if misses else ""
+
+
+def _run_json(url: str, run: str, token: str) -> dict[str, Any]:
+    request = urllib.request.Request(f"{url}/tasks/{run}.json", headers=_json_headers(token))
+    with urllib.request.urlopen(request, timeout=30) as answer:
+        page = json.loads(answer.read())
+    return dict(page.get("run", page))
+
+
+def _words(body: bytes) -> str:
+    """What an answer says: a JSON error's message (and notes), else its text."""
+    try:
+        answered = json.loads(body)
+    except json.JSONDecodeError:
+        return body.decode("utf-8", "replace")
+    if not isinstance(answered, dict):
+        return str(answered)
+    notes = [str(n) for n in answered.get("notes", [])]
+    return " ".join([str(answered.get("error", "")), str(answered.get("message", "")), *notes]).strip()
+
+
+@dataclass
+class Form:
+    """A page's form as a browser submits it: its named fields in order (a text input's value, a checked
+    box, a select's chosen options or else its first, a textarea's text), each select's options, and its
+    submit buttons (name and value)."""
+
+    id: str
+    method: str
+    action: str
+    fields: list[list[str]] = field(default_factory=list)
+    options: dict[str, list[str]] = field(default_factory=dict)
+    buttons: list[tuple[str, str]] = field(default_factory=list)
+    page: str = ""
+
+    def set(self, name: str, value: str) -> None:
+        """Type ``value`` into the field ``name``; RuntimeError when the form has no such field."""
+        for pair in self.fields:
+            if pair[0] == name:
+                pair[1] = value
+                return
+        raise RuntimeError(f"the form {self.id!r} of {self.page} has no field {name!r}")
+
+    def choose(self, name: str, value: str) -> None:
+        """Choose ``value`` in the select ``name``, as a person can: only an option the page offers."""
+        offered = self.options.get(name)
+        if offered is None:
+            raise RuntimeError(f"the form {self.id!r} of {self.page} has no list {name!r}")
+        if value not in offered:
+            raise _NotStarted(f"the form {self.id!r} of {self.page}", 200, f"offers no {value!r} in {name!r}")
+        self.fields = [pair for pair in self.fields if pair[0] != name] + [[name, value]]
+
+    def chosen(self, name: str) -> list[str]:
+        return [value for key, value in self.fields if key == name]
+
+
+class _FormReader(html.parser.HTMLParser):
+    """The forms of a page, read as a browser reads them to submit one (no script)."""
+
+    def __init__(self, page: str) -> None:
+        super().__init__(convert_charrefs=True)
+        self.page = page
+        self.forms: dict[str, Form] = {}
+        self._form: Form | None = None
+        self._select: tuple[str, bool, list[str], list[str]] | None = None
+        self._textarea: list[str] | None = None
+
+    def handle_starttag(self, tag: str, attrs: list[tuple[str, str | None]]) -> None:
+        a = {key: value or "" for key, value in attrs}
+        if tag == "form":
+            self._form = Form(a.get("id", ""), a.get("method", "get").lower(), a.get("action", ""), page=self.page)
+            self.forms[self._form.id] = self._form
+            return
+        if self._form is None or "disabled" in a:
+            return
+        name, kind = a.get("name", ""), a.get("type", "text" if tag == "input" else "submit").lower()
+        if tag in ("input", "button") and kind == "submit":
+            if name:
+                self._form.buttons.append((name, a.get("value", "")))
+        elif tag == "input" and name and kind not in ("button", "reset", "image", "file"):
+            if kind not in ("checkbox", "radio") or "checked" in a:
+                self._form.fields.append([name, a.get("value", "on" if kind in ("checkbox", "radio") else "")])
+        elif tag == "select" and name:
+            self._select = (name, "multiple" in a, [], [])
+        elif tag == "option" and self._select is not None:
+            self._select[2].append(a.get("value", ""))
+            if "selected" in a:
+                self._select[3].append(a.get("value", ""))
+        elif tag == "textarea" and name:
+            self._textarea = [name, ""]
+
+    def handle_data(self, data: str) -> None:
+        if self._textarea is not None:
+            self._textarea[1] += data
+
+    def handle_endtag(self, tag: str) -> None:
+        if tag == "textarea" and self._textarea is not None and self._form is not None:
+            name, text = self._textarea
+            self._form.fields.append([name, text.removeprefix("\n")])  # HTML drops the newline after the tag
+            self._textarea = None
+        elif tag == "select" and self._select is not None and self._form is not None:
+            name, multiple, options, chosen = self._select
+            chosen = chosen if multiple else (chosen[-1:] or options[:1])
+            self._form.fields += [[name, value] for value in chosen]
+            self._form.options[name] = options
+            self._select = None
+        elif tag == "form":
+            self._form = None
+
+
+def read_form(page: str, form_id: str, where: str = "the page") -> Form:
+    """The form ``form_id`` of the HTML ``page``; RuntimeError when the page has none."""
+    reader = _FormReader(where)
+    reader.feed(page)
+    if form_id not in reader.forms:
+        raise RuntimeError(f"{where} has no form {form_id!r} (it has {sorted(reader.forms)})")
+    return reader.forms[form_id]
+
+
+def _element_text(page: str, element_id: str) -> str:
+    """The text of the element ``element_id`` of ``page`` (tags dropped), empty when there is none."""
+    found = re.search(rf'<(\w+)[^>]*\bid="{re.escape(element_id)}"[^>]*>(.*?)</\1>', page, re.S)
+    return " ".join(html.unescape(re.sub(r"<[^>]+>", "", found.group(2))).split()) if found else ""
+
+
+@dataclass
+class Answer:
+    status: int
+    url: str
+    body: str
+
+
+class _Browser:
+    """What the bench does of a browser on the server's pages: GET a page, submit a form form-encoded with
+    the page's ``Origin`` and ``Referer`` (as a browser sends a form's POST: the pages' guard against
+    another site's forms; they use no CSRF token), following redirects; no script runs."""
+
+    def __init__(self, url: str) -> None:
+        self.url = url
+
+    def get(self, path: str) -> Answer:
+        return self._open(urllib.request.Request(urllib.parse.urljoin(self.url, path), headers={"Accept": "text/html"}))
+
+    def submit(self, form: Form, button: tuple[str, str] | None = None) -> Answer:
+        if button is not None and button not in form.buttons:
+            raise RuntimeError(f"the form {form.id!r} of {form.page} has no button {button!r}")
+        fields = [(name, value) for name, value in form.fields] + ([button] if button else [])
+        target = urllib.parse.urljoin(form.page, form.action or form.page)
+        body = urllib.parse.urlencode(fields)
+        if form.method != "post":
+            return self._open(urllib.request.Request(f"{target}?{body}", headers={"Accept": "text/html"}))
+        headers = {"Content-Type": "application/x-www-form-urlencoded", "Accept": "text/html"}
+        headers |= {"Origin": self.url, "Referer": form.page}
+        return self._open(urllib.request.Request(target, body.encode("ascii"), headers, method="POST"))
+
+    def form(self, path: str, form_id: str) -> tuple[Answer, Form]:
+        """GET the page ``path`` and read its form ``form_id``."""
+        page = self.get(path)
+        if page.status != 200:
+            raise RuntimeError(f"GET {path}: {page.status}: {_element_text(page.body, 'content')[:300]}")
+        return page, read_form(page.body, form_id, page.url)
+
+    @staticmethod
+    def _open(request: urllib.request.Request) -> Answer:
+        try:
+            with urllib.request.urlopen(request, timeout=60) as answer:
+                return Answer(answer.status, answer.url, answer.read().decode("utf-8", "replace"))
+        except urllib.error.HTTPError as error:
+            return Answer(error.code, error.url or request.full_url, error.read().decode("utf-8", "replace"))
+
+
+PAGE_STATUS = re.compile(r'id="run-status" class="badge status-([\w-]+)"')
+PAGE_SECONDS = re.compile(r"; ([0-9.]+) s simulated")
+
+
+def _page_start(browser: _Browser, task: str, seed: int, page: str = "") -> Started:
+    """Start ``task`` from the tasks page's Start form (``page``: the one the browser shows, else GET
+    /tasks): the task chosen from the list, the seed typed; the run the answer's message links to, or
+    :class:`_NotStarted` with its status and the page's message."""
+    form = read_form(page, "start", browser.url + "/tasks") if page else browser.form("/tasks", "start")[1]
+    form.choose("task", task)
+    form.set("seed", str(seed))
+    answer = browser.submit(form)
+    said = f"the tasks page's Start with {task}"
+    if answer.status != 202:
+        words = _element_text(answer.body, "busy") or _form_errors(answer.body)
+        raise _NotStarted(said, answer.status, words)
+    link = re.search(r'started: .*?<a href="([^"]+)">its own page</a>', answer.body, re.S)
+    if link is None:
+        raise _NotStarted(said, answer.status, "no link to the run on the page")
+    where = html.unescape(link.group(1))
+    return Started(where.rsplit("/", 1)[-1], where, answer.body)
+
+
+def _form_errors(page: str) -> str:
+    """A page's messages: its alert boxes and the errors beside its fields."""
+    found = re.findall(
+        r'<(?:p|span)[^>]*class="[^"]*(?:error-box|field-error)[^"]*"[^>]*>(.*?)</(?:p|span)>', page, re.S
+    )
+    return " ".join(" ".join(html.unescape(re.sub(r"<[^>]+>", "", f)).split()) for f in found)
+
+
+def _page_follow(browser: _Browser, begun: Started) -> dict[str, Any]:
+    """Read the run's page each second until its status badge leaves running (bounded): the status and
+    the simulated seconds as the page shows them (its verdict line), and the verdict as the reason."""
+    deadline = time.monotonic() + RUN_TIMEOUT
+    while time.monotonic() < deadline:
+        page = browser.get(begun.where)
+        badge = PAGE_STATUS.search(page.body)
+        if page.status != 200 or badge is None:
+            return {"status": "broken", "error": f"GET {begun.where}: {page.status}, no status badge"}
+        if badge.group(1) != "running":
+            verdict = _element_text(page.body, "verdict")
+            seconds = PAGE_SECONDS.search(verdict)
+            found: dict[str, Any] = {"status": badge.group(1), "reason": verdict, "error": verdict}
+            return found | ({"sim_seconds": float(seconds.group(1))} if seconds else {})
+        time.sleep(1.0)
+    return {"status": "broken", "error": f"{begun.where} still running after {RUN_TIMEOUT:.0f} s"}
+
+
+def _editor_save(browser: _Browser, step: Step, token: str, where: Path) -> str:
+    """Write a requirement's file on the New task page as a person does: its text into the form, Check and
+    plan (the page must show the task checked), then Save as task with the update token typed in its
+    field (201, the page saying it saved), and the saved page's link to the tasks page followed (the task
+    chosen in its Start form). What the pages said; RuntimeError when one is not as it should be."""
+    text = _edited(step, where).read_text(encoding="utf-8")
+    form = browser.form("/tasks/new", "task-form")[1]
+    form.set("turtle", text)
+    checked = browser.submit(form, ("action", "check"))
+    said = f"New task page, {step.file}"
+    if checked.status != 200 or 'id="task-name"' not in checked.body:
+        raise RuntimeError(f"{said}: Check and plan: {checked.status}: {_form_errors(checked.body)[:300]}")
+    form = read_form(checked.body, "task-form", checked.url)
+    if form.chosen("turtle") != [text]:
+        raise RuntimeError(f"{said}: the checked page's editor does not hold the text sent")
+    form.set("token", token)
+    saved = browser.submit(form, ("action", "save"))
+    link = re.search(r'<a id="run-link" href="([^"]+)"', saved.body)
+    if saved.status != 201 or link is None:
+        raise RuntimeError(f"{said}: Save as task: {saved.status}: {_form_errors(saved.body)[:300]}")
+    name = re.search(r"(?:Saved|Replaced) <code>([^<]+)</code>", saved.body)
+    chosen = browser.form(html.unescape(link.group(1)), "start")[1].chosen("task")
+    saved_name = html.unescape(name.group(1)) if name else "?"
+    if not chosen or not (saved_name.endswith(chosen[0].rpartition(":")[2]) or chosen[0] == saved_name):
+        raise RuntimeError(f"{said}: the saved page's link chose {chosen} in the Start form, not {saved_name}")
+    return f"{said}: checked, saved as {saved_name} (201), chosen on the tasks page"
 
 
 def _ended(run: dict[str, Any]) -> dict[str, Any]:
@@ -719,7 +1163,7 @@ def _run_all(trials: list[Trial], scratch: Path, jobs: int) -> tuple[list[Outcom
     total = sum(len(t.seeds) * len(t.runs) for t in trials)
     with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
         made = {pool.submit(make_store, t, scratch / f"t{i}" / "made"): (i, t) for i, t in enumerate(trials)}
-        runs: list[concurrent.futures.Future[list[Outcome]]] = []
+        runs: dict[concurrent.futures.Future[list[Outcome]], Made] = {}
         for future in concurrent.futures.as_completed(made):
             i, trial = made[future]
             try:
@@ -729,11 +1173,15 @@ def _run_all(trials: list[Trial], scratch: Path, jobs: int) -> tuple[list[Outcom
                 continue
             loads.checks += found.checks
             loads.deviations += found.deviations
-            for k in range(len(trial.seeds) if trial.runs else 0):
+            # a posted refusal alone is checked at the server once, at the first seed
+            for k in range(len(trial.seeds) if trial.runs else int(trial.post)):
                 store = scratch / f"t{i}" / f"seed{trial.seeds[k]}"
                 shutil.copytree(scratch / f"t{i}" / "made", store)
-                runs.append(pool.submit(run_one, trial, k, store))
+                served = Made()
+                runs[pool.submit(run_one, trial, k, store, served)] = served
         for ran in concurrent.futures.as_completed(runs):
+            loads.checks += runs[ran].checks
+            loads.deviations += runs[ran].deviations
             for got in ran.result():
                 outcomes.append(got)
                 said = f"{got.label}, seed {got.seed}: {got.status}, {got.seconds:.1f} s ({got.wall:.0f} s wall)"

@@ -143,9 +143,16 @@ def test_the_forms_beyond_the_command_line_each_have_a_trial(bench: ModuleType) 
         pytest.param('via = "run_tasks"', "unknown via 'run_tasks'", id="unknown-via"),
         pytest.param('post = true\nvia = "cli"', "its runs must go to one", id="posted-to-no-server"),
         pytest.param(
-            'post = true\nvia = "http"\nsetup = [{ load = "map", file = "lab8_mistake_apple.ttl", says = "x" }]',
-            "no refusal, no replace",
-            id="posted-refusal",
+            'post = true\nvia = "http"\nsetup = [{ load = "map", file = "lab8_mistake_apple.ttl", replace = true }]',
+            "(no replace)",
+            id="posted-replace",
+        ),
+        pytest.param('busy = "one task runs at a time"\nvia = "http"', "two runs or more", id="busy-one-run"),
+        pytest.param(
+            'busy = "one task runs at a time"\nvia = "run_task"\nruns = [{ task = "A", status = ["succeeded"], '
+            'seconds = [0] }, { task = "B", status = ["succeeded"], seconds = [0] }]',
+            "via http or page",
+            id="busy-over-the-bridge",
         ),
     ],
 )
