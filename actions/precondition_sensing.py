@@ -7,7 +7,8 @@ home:holdsWhen`` a condition on a quantity, :mod:`kb.measured_states`: ``lab9:Da
 components that can take one (an output of the quantity's class or one below it, no inputs, an effective
 area that covers the place: its area concepts by composition's rule, ``reasoner.sea.covers_concept``,
 else its box overlapping the place's extent in the map, as ``actions.areas`` compares them; one that
-states no area says nothing of where it measures, and is not asked), invokes the first through the run's
+states no area measures where its device is, :mod:`actions.sensor_places`, and covers the place when the
+room of the map its device is in is that place or of its class by the same rule), invokes the first through the run's
 container as the executor invokes a step's component (a simulated one or one in another process over the
 bridge, with its own call timeout and the run's faults), and compares the reading with the bound in the
 condition's unit, converted where the store says how (:class:`kb.measured_states.Units`). A sensor that
@@ -25,6 +26,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from cbrs.actions.components import Container, LifecycleState, Status
+from cbrs.actions.sensor_places import MapPlaces
 from cbrs.kb import Advertisement, KnowledgeBase, Statement
 from cbrs.kb.measured_states import MeasuredCondition, MeasuredConditionError, Units, conditions_by_status
 from cbrs.kb.namespaces import PREFIXES, shorten
@@ -102,6 +104,7 @@ class PreconditionSensing:
         self._conditions: dict[str, MeasuredCondition | MeasuredConditionError] | None = None
         self._units: Units | None = None
         self._rooms: tuple[tuple[str, Bounds], ...] | None = None
+        self._map: MapPlaces | None = None
 
     def __call__(self, statement: Statement) -> Sensed | None:
         """What a reading says of ``statement``; None where the store gives its status no measured
@@ -166,16 +169,28 @@ class PreconditionSensing:
 
     def _covers(self, ad: Advertisement, place: str) -> bool:
         """Whether ``ad``'s effective area covers ``place`` (a class of places, or a place of the map):
-        by its area concepts when it names some, else by its box against the place's extent."""
+        by its area concepts when it names some, else by its box against the place's extent, else (it
+        states none) by the rooms of the map its device is in: the place itself, or a room of a class that
+        covers the place's."""
         area = ad.area
-        if area is None:
-            return False
         places = self._places(place)
-        if area.areas:
+        if area is not None and area.areas:
             return any(covers_concept(self.index, offered, concept) for offered in area.areas for concept in places)
-        if area.bounds is not None:
+        if area is not None and area.bounds is not None:
             return any(overlap(extent, area.bounds) for concept, extent in self._room_extents() if concept in places)
-        return False
+        if not ad.device:
+            return False
+        where = self._map_places()
+        rooms = where.rooms_of(ad.device)
+        if place not in self.index:
+            return place in rooms
+        offered = {concept for room in rooms for concept in where.types.get(room, ())}
+        return any(covers_concept(self.index, concept, place) for concept in offered)
+
+    def _map_places(self) -> MapPlaces:
+        if self._map is None:
+            self._map = MapPlaces.read(self.kb)
+        return self._map
 
     def _places(self, place: str) -> tuple[str, ...]:
         """The place's classes: itself when it is one, else those the map gives it."""

@@ -26,7 +26,6 @@ from cbrs.sim.geometry import Pose2D, Region
 from cbrs.sim.grasping import ObjectModel, compute_grasp_pose
 from cbrs.sim.grounding import docking_pose, manipulation_of, meant_person, model_of, place_of, thing_iri, thing_region
 from cbrs.sim.hold_choice import Candidates, refuse_moves, seen_extent
-from cbrs.sim.light import measure_illuminance
 from cbrs.sim.mapping import OccupancyGrid, build_occupancy_grid
 from cbrs.sim.packing import carry_spots
 from cbrs.sim.perceived import SEARCH_RADIUS
@@ -42,6 +41,7 @@ from cbrs.sim.place_spots import able_mounts, other_objects, place_spots, reach_
 from cbrs.sim.planning import PlannedPath, first_obstacle, plan_path
 from cbrs.sim.relations import region_of
 from cbrs.sim.relay import check_passing, relay_object, relay_spot, resting_at, set_down_for
+from cbrs.sim.room_quantities import measure
 from cbrs.sim.transit import floor_to
 from cbrs.sim.values import (
     APPROACH_POSITION,
@@ -467,7 +467,9 @@ SKILLS: dict[str, Work] = {
     "NavigateToPlace": navigate_to_place,
     "NavigateToPerson": navigate_to_person,
     "DeliverObject": deliver,
-    "MeasureIlluminance": measure_illuminance,
+    "MeasureIlluminance": measure,
+    "MeasureTemperature": measure,
+    "MeasureHumidity": measure,
 }
 """The simulated skill behind each service name; the device comes from the advertisement."""
 

@@ -23,7 +23,7 @@ from cbrs.actions.task_preconditions import TaskPreconditionError, check_precond
 from cbrs.kb import KnowledgeBase, Requirement, Statement
 from cbrs.kb.measured_states import MeasuredConditionError, UnitError, Units, read_conditions
 from cbrs.kb.namespaces import PREFIXES, shorten
-from cbrs.sim.light import measure_illuminance
+from cbrs.sim.room_quantities import measure
 from cbrs.tasks import preconditions_line
 from tests.helpers_examples import EXAMPLES
 
@@ -219,10 +219,10 @@ def test_sensing_is_configured_by_its_settings(monkeypatch: pytest.MonkeyPatch) 
 
 def test_the_simulated_board_reads_the_light_level_the_map_states(kb: KnowledgeBase) -> None:
     context: Any = SimpleNamespace(kb=kb, component=BOARD)
-    assert measure_illuminance(context, {}, "SensorBoard01") == {"illuminance": _lux(300.0)}  # home:Room's, by day
+    assert measure(context, {}, "SensorBoard01") == {"illuminance": _lux(300.0)}  # home:Room's, by day
     kb.update(LIGHT_UPDATE.format(lux="12.0"))
     try:
-        assert measure_illuminance(context, {}, "SensorBoard01") == {"illuminance": _lux(12.0)}
+        assert measure(context, {}, "SensorBoard01") == {"illuminance": _lux(12.0)}
     finally:
         kb.update(
             "PREFIX home: <https://w3id.org/cbrs/home#> PREFIX world: <https://w3id.org/cbrs/world#>"
