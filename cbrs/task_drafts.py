@@ -337,9 +337,51 @@ def _located(problem: ShapeProblem, text: str) -> Problem:
 
 
 def line_of(text: str, term: str) -> int | None:
-    """The first line of ``text`` that writes ``term`` (a prefixed name, ``<IRI>`` or a literal) as a whole."""
+    """The first line of ``text`` that writes ``term`` (a prefixed name, ``<IRI>`` or a literal) as a whole,
+    outside comments: a file's header often names the very term at fault ("home:Refridgerator for
+    home:Refrigerator"), and the page pointed at it."""
     pattern = re.compile(rf"(?<![\w:-]){re.escape(term)}(?![\w-])")
-    for number, line in enumerate(text.splitlines(), start=1):
+    for number, line in enumerate(_uncommented(text), start=1):
         if pattern.search(line):
             return number
     return None
+
+
+def _uncommented(text: str) -> list[str]:
+    """``text``'s lines with each Turtle comment cut off: a ``#`` outside an ``<IRI>`` and a string (short
+    or long, which may span lines) begins one, to the line's end."""
+    lines: list[str] = []
+    quote = ""  # the string we are in: '"', "'", '"""' or "'''"
+    for line in text.splitlines():
+        kept, i = [], 0
+        while i < len(line):
+            char = line[i]
+            if quote:
+                if char == "\\":
+                    kept.append(line[i : i + 2])
+                    i += 2
+                    continue
+                if line.startswith(quote, i):
+                    kept.append(quote)
+                    i += len(quote)
+                    quote = ""
+                    continue
+            elif char in "\"'":
+                quote = char * 3 if line.startswith(char * 3, i) else char
+                kept.append(quote)
+                i += len(quote)
+                continue
+            elif char == "<":
+                end = line.find(">", i)
+                if end > i and not any(c.isspace() for c in line[i:end]):
+                    kept.append(line[i : end + 1])
+                    i = end + 1
+                    continue
+            elif char == "#":
+                break
+            kept.append(char)
+            i += 1
+        if len(quote) == 1:  # a short string ends with its line (broken Turtle: the parser says so)
+            quote = ""
+        lines.append("".join(kept))
+    return lines
