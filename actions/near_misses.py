@@ -14,12 +14,19 @@ keeps apart) and, by the store's taxonomy, they
 * have the same parts (the same non-empty set of hasPart classes, own or inherited) and a superclass in
   common other than the root (the same idea under another name, in one branch: a home:Person and a
   home:PersonProfile both have a given and a family name, but meet only at the root), or
-* are siblings (a direct superclass in common, not the root).
+* are siblings (a direct superclass in common, not the root), or
+* in a statement whose predicate is met, one is a kind of the other's sibling (a direct superclass of one
+  is a sibling of the other): a lab's own lab10:TravelMug, a home:Mug, beside the home:Cup a fill at the
+  tap gives (docs/tasks.md, "A tenth round"), a lab's classes being refinements one level below where
+  the bundled siblings meet. Only in a statement, where the relation and the other side are the need's
+  already: an input's class alone, so widened, would bring a home:Path near a home:PersonPosition.
 
 An offered statement is near a needed one when its predicate is met (an is-a relative: another relation
 is another action, not a small change), its subject and object are each met or near, and one is near.
 A component comes close only if it would then have done: the forward search enabled it (all it needs
-is there) and the area rule does not refuse it for the task's things it is given. Near misses are
+is there), or would have with each offered term it is near read as the needed one (the fill of a cup
+needs the cup it fills, an input and a precondition of class home:Cup, and the task gives the mug), and
+the area rule does not refuse it for the task's things it is given. Near misses are
 ranked by Sem-Str similarity (the measure edges are ranked by), then by IRI, and capped
 (``ComposeConfig.near_misses``).
 """
@@ -27,7 +34,7 @@ ranked by Sem-Str similarity (the measure edges are ranked by), then by IRI, and
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 from cbrs.actions.graph import SRI, Matcher, Need, ServiceResourceGraph, statement_text
@@ -40,6 +47,7 @@ from cbrs.reasoner.taxonomy import ROOT
 
 SAME_PARTS = "the same parts"
 SIBLINGS = "siblings"
+SIBLINGS_KIND = "a kind of a sibling"
 _POSITIONS = ("subject", "predicate", "object")
 
 
@@ -49,14 +57,26 @@ class Difference:
 
     wanted: str
     offered: str
-    relation: str  # SAME_PARTS or SIBLINGS
+    relation: str  # SAME_PARTS, SIBLINGS or SIBLINGS_KIND
     position: str = ""  # for a statement: subject, predicate or object
+    via: str = ""  # for SIBLINGS_KIND: the direct superclass of one that is the other's sibling
+    kind: str = ""  # for SIBLINGS_KIND: which is the kind of that sibling, "wanted" or "offered"
 
     def to_dict(self) -> dict[str, str]:
         found = {"wanted": self.wanted, "offered": self.offered, "relation": self.relation}
         if self.position:
             found["position"] = self.position
+        if self.via:
+            found["via"] = self.via
+            found["kind"] = self.kind
         return found
+
+    def how(self) -> str:
+        """How the two are near, for the answer's text."""
+        if not self.via:
+            return f"{self.relation}, neither a kind of the other"
+        kind, sibling = (self.wanted, self.offered) if self.kind == "wanted" else (self.offered, self.wanted)
+        return f"{shorten(kind)} is a {shorten(self.via)}, a sibling of {shorten(sibling)}; neither a kind of the other"
 
 
 @dataclass(frozen=True)
@@ -80,22 +100,24 @@ class NearMiss:
         component = shorten(self.component)
         if self.statement:
             how = "; ".join(
-                f"its {d.position} {shorten(d.offered)} for {shorten(d.wanted)} ({d.relation}, neither a kind of"
-                " the other)"
-                for d in self.differs
+                f"its {d.position} {shorten(d.offered)} for {shorten(d.wanted)} ({d.how()})" for d in self.differs
             )
             said = f"{component} comes close: its effect {self.gives} differs from the {self.wanted} {taker}: {how}"
             fix = f"register a component like it whose effect is {self.wanted}"
         else:
             said = (
                 f"{component} comes close: it gives {shorten(self.gives)}, {taker} {shorten(self.wanted)}"
-                f" ({self.differs[0].relation}, neither a kind of the other)"
+                f" ({self.differs[0].how()})"
             )
             fix = f"register a component like it that gives {shorten(self.wanted)}"
-        kinds = [d for d in self.differs if d.relation == SAME_PARTS]
-        if kinds:  # the same idea under another name: the ontology may say the one is a kind of the other
-            every = " and ".join(f"every {shorten(d.offered)} is a {shorten(d.wanted)}" for d in kinds)
-            declared = ", ".join(f"{shorten(d.offered)} rdfs:subClassOf {shorten(d.wanted)}" for d in kinds)
+        # the same idea under another name, or a class below a sibling of what a component handles (a lab's
+        # own travel mug, a home:Mug, by a fill of a home:Cup): the ontology may say the one is a kind of the other
+        claims = [(d.offered, d.wanted) for d in self.differs if d.relation == SAME_PARTS] + [
+            (d.wanted, d.offered) for d in self.differs if d.relation == SIBLINGS_KIND and d.kind == "wanted"
+        ]
+        if claims:
+            every = " and ".join(f"every {shorten(kind)} is a {shorten(of)}" for kind, of in claims)
+            declared = ", ".join(f"{shorten(kind)} rdfs:subClassOf {shorten(of)}" for kind, of in claims)
             fix += f", or, if {every} here, say so ({declared}, loaded into the ontology graph)"
         return f"{said}: {fix}"
 
@@ -111,8 +133,16 @@ class NearMiss:
         }
 
 
-def near(matcher: Matcher, wanted: str, offered: str) -> str | None:
-    """How ``offered`` is near ``wanted`` (SAME_PARTS, SIBLINGS), or None: not near, or met already."""
+def near(matcher: Matcher, wanted: str, offered: str, in_statement: bool = False) -> str | None:
+    """How ``offered`` is near ``wanted`` (SAME_PARTS, SIBLINGS; SIBLINGS_KIND ``in_statement``), or None:
+    not near, or met already."""
+    found = nearness(matcher, wanted, offered, in_statement)
+    return None if found is None else found.relation
+
+
+def nearness(matcher: Matcher, wanted: str, offered: str, in_statement: bool = False) -> Difference | None:
+    """How ``offered`` is near ``wanted`` (a Difference without its position), or None; a kind of a
+    sibling only ``in_statement``, at a subject or object."""
     index = matcher.index
     if wanted not in index or offered not in index or degree_of_match(index, wanted, offered).accepted:
         return None
@@ -121,9 +151,15 @@ def near(matcher: Matcher, wanted: str, offered: str) -> str | None:
         return None
     parts = index.parts_of(first)
     if parts and parts == index.parts_of(second) and index.common_ancestor(first, second)[0] != ROOT:
-        return SAME_PARTS
+        return Difference(wanted, offered, SAME_PARTS)
     if _superclasses(matcher, first) & _superclasses(matcher, second):
-        return SIBLINGS
+        return Difference(wanted, offered, SIBLINGS)
+    if not in_statement:
+        return None
+    for one, other, kind in ((first, second, "wanted"), (second, first, "offered")):  # a kind of a sibling
+        for parent in sorted(_superclasses(matcher, one)):
+            if _superclasses(matcher, parent) & _superclasses(matcher, other):
+                return Difference(wanted, offered, SIBLINGS_KIND, via=parent, kind=kind)
     return None
 
 
@@ -186,7 +222,7 @@ def near_misses(
         miss
         for miss in _candidates(graph, need)
         if miss.component not in skip
-        and enabled(miss.component)
+        and (enabled(miss.component) or _enabled_after(graph, enabled, miss))
         and not refused(miss.component, _given(graph, miss.component))
     ]
     found.sort(key=lambda m: (-m.similarity, m.component, m.offer))
@@ -201,9 +237,8 @@ def _candidates(graph: ServiceResourceGraph, need: Need) -> Iterator[NearMiss]:
     for vertex in graph.pool.vertices.values():
         for offer in vertex.offers:
             if need.concept is not None and offer.concept is not None:
-                relation = near(matcher, need.concept, offer.concept)
-                if relation is not None:
-                    difference = Difference(need.concept, offer.concept, relation)
+                difference = nearness(matcher, need.concept, offer.concept)
+                if difference is not None:
                     similarity = matcher.measure(need.concept, offer.concept).value
                     yield NearMiss(vertex.iri, offer.name, offer.concept, need.concept, (difference,), similarity)
             elif need.statement is not None and offer.statement is not None:
@@ -220,6 +255,34 @@ def _candidates(graph: ServiceResourceGraph, need: Need) -> Iterator[NearMiss]:
                     )
 
 
+def _enabled_after(graph: ServiceResourceGraph, enabled: Callable[[str], bool], miss: NearMiss) -> bool:
+    """Whether the forward search would have enabled ``miss``'s component with each offered term it is near
+    read as the needed one: every need of it no enabled vertex meets is met so read (the fill of a home:Cup
+    needs a home:Cup given and below the tap; read as the task's mug, the task gives it and the carry puts
+    it there)."""
+    swap = {d.offered: d.wanted for d in miss.differs}
+    ready = [v for v in graph.vertices.values() if v.iri != miss.component and enabled(v.iri)]
+    for need in graph.needs(miss.component):
+        if any(enabled(edge.source) for edge in graph.providers(miss.component, need)):
+            continue
+        read = _read_as(need, swap)
+        if read == need or not any(graph.matcher.match(read, offer) for v in ready for offer in v.offers):
+            return False
+    return True
+
+
+def _read_as(need: Need, swap: dict[str, str]) -> Need:
+    """``need`` with each term ``swap`` names replaced."""
+    if need.concept is not None:
+        return replace(need, concept=swap.get(need.concept, need.concept))
+    if need.statement is not None:
+        s = need.statement
+        return replace(
+            need, statement=Statement(swap.get(s.subject, s.subject), s.predicate, swap.get(s.object, s.object))
+        )
+    return need
+
+
 def statement_differences(matcher: Matcher, wanted: Statement, offered: Statement) -> tuple[Difference, ...]:
     """The positions in which ``offered`` is near ``wanted``; empty when one is neither met nor near, the
     predicate is not met, or every position is met (then it is no miss)."""
@@ -228,10 +291,10 @@ def statement_differences(matcher: Matcher, wanted: Statement, offered: Statemen
     for position, want, offer in pairs:
         if degree_of_match(matcher.index, want, offer).accepted:
             continue
-        relation = near(matcher, want, offer) if position != "predicate" else None
-        if relation is None:  # another relation is another action, not a small change
+        found = nearness(matcher, want, offer, in_statement=True) if position != "predicate" else None
+        if found is None:  # another relation is another action, not a small change
             return ()
-        differs.append(Difference(want, offer, relation, position))
+        differs.append(replace(found, position=position))
     return tuple(differs)
 
 
@@ -253,10 +316,12 @@ def _given(graph: ServiceResourceGraph, component: str) -> list[str]:
 __all__ = [
     "SAME_PARTS",
     "SIBLINGS",
+    "SIBLINGS_KIND",
     "Difference",
     "NearMiss",
     "about_other_things",
     "near",
     "near_misses",
+    "nearness",
     "statement_differences",
 ]
