@@ -5,10 +5,14 @@ from __future__ import annotations
 import pyoxigraph as ox
 import pytest
 from flask.testing import FlaskClient
+from werkzeug.test import TestResponse
 
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.store import Store
 from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.web import create_app
+from tests.conftest import OxigraphServer
+from tests.helpers_seeded import put_quads, seeded_quads
 
 TOKEN = "graph-store-token"
 GRAPH = "urn:test:notes"
@@ -107,3 +111,71 @@ def test_a_write_through_the_graph_store_reaches_the_standard_terms(client: Flas
     assert "urn:test:camera9" in found()
     assert client.delete(f"/store?graph={GRAPH}", headers=AUTH).status_code == 204
     assert "urn:test:camera9" not in found()
+
+
+# A lab declares home:Fruit (in its graph, as a lab adds a term to home:); another's banana is under it.
+FRUIT_PREFIXES = (
+    "@prefix home: <https://w3id.org/cbrs/home#> . @prefix lab: <https://example.org/lab#> .\n"
+    "@prefix owl: <http://www.w3.org/2002/07/owl#> . @prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .\n"
+)
+FRUIT = FRUIT_PREFIXES + "home:Fruit a owl:Class ; rdfs:subClassOf home:PhysicalObject .\n"
+BANANA = FRUIT_PREFIXES + "lab:Banana rdfs:subClassOf home:Fruit .\n"
+EIGHT, NINE = "https://example.org/lab/eight", "https://example.org/lab/nine"
+
+
+def _refused(answer: TestResponse, kind: str, *words: str) -> None:
+    assert answer.status_code == 400, answer.data
+    body = answer.get_json()
+    assert body["error"] == kind and all(word in body["message"] for word in words), body
+    assert body["message"].endswith("nothing was written")
+
+
+def _superclasses_are_checked(client: FlaskClient, store: Store) -> None:
+    """What the Graph Store Protocol's writes refuse, as INSERT DATA and DELETE DATA of the same statements
+    are refused, on ``store``: a class under an undeclared term, and the last declaration of a term a class
+    stays under; each leaves ``store`` as it was."""
+    before = store.dump()
+    banana = client.post(f"/store?graph={NINE}", data=BANANA, content_type=TURTLE, headers=AUTH)
+    _refused(banana, "UndeclaredSuperclassError", f"the POST to graph <{NINE}>: ", "Banana")
+    assert store.dump() == before
+    assert client.put(f"/store?graph={EIGHT}", data=FRUIT, content_type=TURTLE, headers=AUTH).status_code == 201
+    assert client.post(f"/store?graph={NINE}", data=BANANA, content_type=TURTLE, headers=AUTH).status_code == 204
+    held = store.dump()
+    renamed = FRUIT.replace("home:Fruit", "home:Fruits")  # the graph replaced by one without home:Fruit
+    put = client.put(f"/store?graph={EIGHT}", data=renamed, content_type=TURTLE, headers=AUTH)
+    _refused(
+        put, "RemovedDeclarationError", "the PUT of graph <https://example.org/lab/eight>: ", "home:Fruit", "Banana"
+    )
+    dropped = client.delete(f"/store?graph={EIGHT}", headers=AUTH)
+    _refused(dropped, "RemovedDeclarationError", f"the DELETE of graph <{EIGHT}>: ", "Banana")
+    assert store.dump() == held
+    # the way there in steps, each leaving every class under a declared term: the new term, the classes
+    # re-pointed, the old term gone
+    both = FRUIT + renamed.removeprefix(FRUIT_PREFIXES)
+    assert client.put(f"/store?graph={EIGHT}", data=both, content_type=TURTLE, headers=AUTH).status_code == 204
+    moved = BANANA.replace("home:Fruit", "home:Fruits")
+    assert client.put(f"/store?graph={NINE}", data=moved, content_type=TURTLE, headers=AUTH).status_code == 204
+    assert client.put(f"/store?graph={EIGHT}", data=renamed, content_type=TURTLE, headers=AUTH).status_code == 204
+    assert client.delete(f"/store?graph={NINE}", headers=AUTH).status_code == 204
+    assert client.delete(f"/store?graph={EIGHT}", headers=AUTH).status_code == 204
+
+
+def test_a_write_leaving_a_class_under_an_undeclared_term_is_refused_as_an_update_is() -> None:
+    kb = KnowledgeBase.open(":memory:")
+    try:
+        app = create_app(SparqlService(kb, EndpointConfig(update_token=TOKEN, isolate=False)))
+        _superclasses_are_checked(app.test_client(), kb.store)
+    finally:
+        kb.close()
+
+
+def test_a_remote_store_behind_the_graph_store_is_checked_as_well(
+    remote_location: str, oxigraph_server: OxigraphServer
+) -> None:
+    put_quads(oxigraph_server, seeded_quads())
+    kb = KnowledgeBase.open(remote_location)
+    try:
+        app = create_app(SparqlService(kb, EndpointConfig(update_token=TOKEN, isolate=False)))
+        _superclasses_are_checked(app.test_client(), kb.store)
+    finally:
+        kb.close()

@@ -16,13 +16,14 @@ import pytest
 
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import BlankNodeInsertError, QuerySyntaxError, StoreEvaluationError, UndeclaredSuperclassError
-from cbrs.kb.namespaces import GraphName
+from cbrs.kb.namespaces import OWL, RDF, RDFS, GraphName
 from cbrs.kb.remote_store import RemoteStore
 from cbrs.kb.remote_updates import CheckedCopy, as_on_union, operations
 from cbrs.kb.semantic_map import MapError
 from cbrs.kb.served_updates import HEADER, claims_checked
 from cbrs.kb.shapes import DescriptionShapeError
-from cbrs.kb.store import Store
+from cbrs.kb.store import Store, data_block
+from cbrs.kb.superclasses import RemovedDeclarationError
 from cbrs.server import ServeConfig, Server
 from cbrs.sparql_service import EndpointConfig
 from tests.conftest import OxigraphServer, VirtuosoServer
@@ -33,6 +34,8 @@ LAB = "PREFIX lab: <https://example.org/lab#>\n"
 ENTAILED = b"<https://w3id.org/cbrs/graph/entailed>"
 RDFS_LABEL = ox.NamedNode("http://www.w3.org/2000/01/rdf-schema#label")
 MAP = GraphName.MAP.node
+LAB_GRAPH = ox.NamedNode("https://example.org/lab#g")
+SUBCLASS = ox.NamedNode(RDFS + "subClassOf")
 UPDATE_TYPE = "application/sparql-update"
 
 
@@ -90,6 +93,11 @@ REFUSED = [
         (EXAMPLES / "lab7_mistake_where_is_my_pne.ru").read_text(encoding="utf-8"),
         DescriptionShapeError,
         id="description",
+    ),
+    pytest.param(  # home:Server stays under it
+        "DELETE WHERE { GRAPH graph:ontology { home:ComputingDevice ?p ?o } }",
+        RemovedDeclarationError,
+        id="removed-declaration",
     ),
 ]
 
@@ -393,3 +401,45 @@ def test_only_a_cbrs_server_saying_so_is_taken_to_check_its_updates(
         assert not other.checks_updates
     finally:
         other.close()
+
+
+def test_a_delete_data_of_a_used_terms_last_statements_is_refused_against_the_store_itself(
+    remote: tuple[KnowledgeBase, list[httpx.Request]], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A data update that needs no other check is checked with a few lookups on the server, no copy."""
+    kb, seen = remote
+    term = ox.NamedNode("https://w3id.org/cbrs/home#ComputingDevice")
+    text = "DELETE DATA {\n" + data_block(kb.store.quads(term)) + "}"
+
+    def no_copy(*_: object) -> None:
+        raise AssertionError("the store was copied")
+
+    monkeypatch.setattr(CheckedCopy, "__init__", no_copy)
+    before = kb.store.dump()
+    on_server = _refusal(kb, text, RemovedDeclarationError)
+    assert _writes(seen) == [] and kb.store.dump() == before
+    embedded = KnowledgeBase.open(":memory:")
+    try:
+        reference = _refusal(embedded, text, RemovedDeclarationError)
+    finally:
+        embedded.close()
+    assert str(on_server) == str(reference) and "home:Server rdfs:subClassOf home:ComputingDevice stays" in str(
+        reference
+    )
+
+
+def test_removing_a_used_terms_last_statement_leaves_both_servers_as_they_were(unseeded: KnowledgeBase) -> None:
+    """On Oxigraph and Virtuoso, the check on the copy: a DELETE WHERE and a DROP of the graph declaring
+    home:Fruit (a lab's, with the home vocabulary's header) are refused while a banana is under it."""
+    home = "https://w3id.org/cbrs/home"
+    unseeded.store.add(
+        [
+            ox.Quad(ox.NamedNode(home), ox.NamedNode(RDF + "type"), ox.NamedNode(OWL + "Ontology"), MAP),
+            ox.Quad(ox.NamedNode(home + "#Fruit"), ox.NamedNode(RDF + "type"), ox.NamedNode(OWL + "Class"), LAB_GRAPH),
+            ox.Quad(ox.NamedNode("https://example.org/lab#Banana"), SUBCLASS, ox.NamedNode(home + "#Fruit"), MAP),
+        ]
+    )
+    before = _ours(unseeded.store)
+    for text in (LAB + "DELETE WHERE { GRAPH lab:g { home:Fruit ?p ?o } }", LAB + "DROP GRAPH lab:g"):
+        refused = _refusal(unseeded, text, RemovedDeclarationError)
+        assert "Banana rdfs:subClassOf home:Fruit stays" in str(refused) and _ours(unseeded.store) == before

@@ -194,3 +194,17 @@ def test_the_update_endpoint_refuses_it_with_a_400_and_keeps_the_store(kb: Knowl
     body = response.get_json()
     assert body["error"] == "RemovedDeclarationError" and "Banana rdfs:subClassOf home:Fruit stays" in body["message"]
     assert _everything(kb) == before
+
+
+def test_an_insert_data_whose_declaration_the_same_update_deletes_is_refused(kb: KnowledgeBase) -> None:
+    """Each quad is checked as the last operation naming it leaves it: before, the declaration inserted
+    counted though a later DELETE DATA of the same update took it away again."""
+    before = _everything(kb)
+    with pytest.raises(
+        UndeclaredSuperclassError, match=r"Pear rdfs:subClassOf home:Pome: home:Pome is declared nowhere"
+    ):
+        kb.update(
+            LAB + "INSERT DATA { GRAPH lab:eight { home:Pome a owl:Class . lab:Pear rdfs:subClassOf home:Pome } } ;\n"
+            "DELETE DATA { GRAPH lab:eight { home:Pome a owl:Class } }"
+        )
+    assert _everything(kb) == before
