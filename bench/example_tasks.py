@@ -72,6 +72,8 @@ SERVED = ("http", "bridge", "run_task", "action", "page")
 """The ways of running that go to a server of the trial's store (``cbrs serve``)."""
 STARTS = ("http", "page")
 """The ways of running whose starts the server may answer 409 while a run goes (two runs at once)."""
+REQUIREMENTS_GRAPH = "https://w3id.org/cbrs/graph/requirements"
+REQUIREMENT = "https://w3id.org/cbrs/core#Requirement"
 GRAPH_SIZES = "SELECT ?g (COUNT(*) AS ?n) WHERE { GRAPH ?g { ?s ?p ?o } } GROUP BY ?g"
 STARTUP = 90.0
 """Seconds a server or a component program may take to answer or register (bounded waits)."""
@@ -574,7 +576,12 @@ def _post_setup(trial: Trial, url: str, token: str, where: Path, made: Made) -> 
     miss recorded in ``made``); via page, a requirement's file written on the New task page instead."""
     browser = _Browser(url)
     for step in trial.setup:
-        if step.expect_refusal:
+        if step.expect_refusal and trial.via == "page" and step.verb == "requirements":
+            said, miss = editor_refusal(browser, step, token, where)
+            made.checks.append(f"{trial.label}: {said}")
+            if miss:
+                made.deviations.append(f"{trial.label}: {miss}")
+        elif step.expect_refusal:
             said, miss = post_refusal(url, step, token, where)
             made.checks.append(f"{trial.label}: {said}")
             if miss:
@@ -1047,7 +1054,65 @@ def _editor_save(browser: _Browser, step: Step, token: str, where: Path) -> str:
     saved_name = html.unescape(name.group(1)) if name else "?"
     if not chosen or not (saved_name.endswith(chosen[0].rpartition(":")[2]) or chosen[0] == saved_name):
         raise RuntimeError(f"{said}: the saved page's link chose {chosen} in the Start form, not {saved_name}")
-    return f"{said}: checked, saved as {saved_name} (201), chosen on the tasks page"
+    asked = _editor_asks(browser, saved_name)
+    return f"{said}: checked, saved as {saved_name} (201), chosen on the tasks page; the SPARQL page: {asked}"
+
+
+def _editor_asks(browser: _Browser, task: str) -> str:
+    """Ask the SPARQL page's form (a GET form, read-only) whether graph:requirements now holds ``task``, as
+    a person checks a save: the answer the page shows; RuntimeError unless it shows true."""
+    if not re.fullmatch(r"[^\s<>\"{}|^`\\]+", task):
+        raise RuntimeError(f"the saved task {task!r} is no IRI to ask about")
+    form = browser.form("/query", "sparql-form")[1]
+    form.set("query", f"ASK {{ GRAPH <{REQUIREMENTS_GRAPH}> {{ <{task}> a <{REQUIREMENT}> }} }}")
+    answer = browser.submit(form)
+    shown = re.search(r'<p class="answer"><span class="badge \w+">(\w+)</span>', answer.body)
+    if answer.status != 200 or shown is None or shown.group(1) != "true":
+        raise RuntimeError(f"the SPARQL page asked for the saved {task}: {answer.status}, {shown and shown.group(1)}")
+    return "ASK shows true"
+
+
+def editor_refusal(browser: _Browser, step: Step, token: str, where: Path) -> tuple[str, str]:
+    """Write a requirement's file the docs say is refused on the New task page: Check and plan, then Save
+    as task with the token. What the pages said, and why that is not as the docs say (empty when it is):
+    each a 4xx page whose messages beside the text say the step's phrase, the store's digest the same."""
+    text = _edited(step, where).read_text(encoding="utf-8")
+    before = dataset(browser.url)
+    form = browser.form("/tasks/new", "task-form")[1]
+    form.set("turtle", text)
+    checked = browser.submit(form, ("action", "check"))
+    form = read_form(checked.body, "task-form", checked.url)
+    form.set("token", token)
+    saved = browser.submit(form, ("action", "save"))
+    after = dataset(browser.url)
+    said = f"New task page, {step.file}"
+    check_words, save_words = _form_errors(checked.body), _form_errors(saved.body)
+    line = f"{said}: Check {checked.status}, Save {saved.status}: {save_words[:300] or '(nothing said)'}"
+    misses = [
+        miss
+        for name, answer, words in (("Check", checked, check_words), ("Save", saved, save_words))
+        if (miss := refused_post_deviation(step, answer.status, words, before, after, f"{said}, {name}"))
+    ]
+    misses += [f"{said}, Check: {miss}" for miss in misplaced_lines(checked.body, text)]
+    return line, "; ".join(misses)
+
+
+PROBLEM_LINE = re.compile(r'data-line="(\d+)">line \d+</a>: (?:<code>([^<]+)</code>)?')
+
+
+def misplaced_lines(page: str, text: str) -> list[str]:
+    """The editor's problems whose "line N" link does not point at a line of ``text`` that writes the term
+    they name (outside a comment): where the page sends a person to mend it."""
+    lines = text.splitlines()
+    misses = []
+    for number, term in PROBLEM_LINE.findall(page):
+        term = html.unescape(term)
+        line = lines[int(number) - 1] if 0 < int(number) <= len(lines) else ""
+        code = "" if line.lstrip().startswith("#") else line.split(" #")[0]  # an IRI's # has no space before it
+        if not term or term in code:
+            continue
+        misses.append(f"line {number} is not where {term} is written: {line.strip()[:120]!r}")
+    return misses
 
 
 def _ended(run: dict[str, Any]) -> dict[str, Any]:
