@@ -19,6 +19,7 @@ import click
 
 from cbrs.actions.base_choice import BaseChoice, BaseTies, choose_in_map
 from cbrs.actions.breaker import late_answers_awaited, settle_late_answers
+from cbrs.actions.colour_warnings import run_colour_risks
 from cbrs.actions.components import Registry
 from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, Objective, PlanStatus, store_plan
 from cbrs.actions.errors import UngroundedGoalError
@@ -40,7 +41,6 @@ from cbrs.actions.task_preconditions import PreconditionCheck
 from cbrs.app import App, parse_iri, pass_app
 from cbrs.extras import installed, require
 from cbrs.kb import Advertisement, KnowledgeBase, RemoteStoreError
-from cbrs.kb.colour_risk import involved_colour_risks
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import shorten
 from cbrs.kb.semantic_map import SemanticMap, UnresolvedDesignatorError
@@ -597,7 +597,7 @@ def run(
             recorded = recorder.save(record)
         except RecordingError as error:
             raise click.ClickException(str(error)) from None
-    warnings = involved_colour_risks(app.kb, json.dumps(result.to_dict()))  # painted where cameras may not tell
+    warnings = run_colour_risks(app.kb, result, environment.looked_for())  # what it looked for, at risk by colour
     if as_json:
         found = result.to_dict()
         found["seed"] = seed

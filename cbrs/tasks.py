@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import io
 import itertools
-import json
 import logging
 import threading
 import time
@@ -27,7 +26,6 @@ from typing import TYPE_CHECKING, Any
 
 from cbrs.extras import installed, require
 from cbrs.kb import KnowledgeBase
-from cbrs.kb.colour_risk import involved_colour_risks
 from cbrs.kb.derived_prefixes import StoreNames
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import expand, shorten, store_names
@@ -396,6 +394,7 @@ class TaskRunner:
         """Run ``run`` in a fresh world built from ``semantic_map``: its result, and that as JSON with the
         simulated seconds."""
         from cbrs.actions.base_choice import BaseTies
+        from cbrs.actions.colour_warnings import run_colour_risks
         from cbrs.actions.faults import RandomFaults
         from cbrs.actions.replanning import ReplanPolicy
         from cbrs.sim.components import SimEnvironment  # pybullet loads only when a task runs
@@ -426,8 +425,9 @@ class TaskRunner:
             )
             found = result.to_dict()
             found["sim_seconds"] = round(world.time, 3)
-            # the things it involves painted where the cameras may not tell them (docs/simulation.md)
-            found["warnings"] = [risk.to_dict() for risk in involved_colour_risks(self.kb, json.dumps(found))]
+            # what it perceived and looked for, painted where the cameras may not tell it (docs/simulation.md)
+            warnings = run_colour_risks(self.kb, result, environment.looked_for())
+            found["warnings"] = [risk.to_dict() for risk in warnings]
         return result, found
 
     def _sensing(self, world: Any) -> AbstractContextManager[Any]:

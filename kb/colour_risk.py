@@ -5,7 +5,7 @@ Not wrong, so nothing is refused: risky. A map whose apple was painted at hue 10
 of green's 100-150, loaded without a word, and in the run the camera saw only part of its pixels and the
 grasp went wrong; a colour outside every window was found only when the task looked for the thing. So a
 load or an update that paints a thing says so (``cbrs load``, ``cbrs update``), and so does the report
-of a run that involves it (docs/simulation.md, "Colour windows").
+of a run that perceives it (:mod:`actions.colour_warnings`; docs/simulation.md, "Colour windows").
 
 A thing is checked when the map gives it a ``home:colourName`` (what perception looks for it by) and
 ``home:rgba`` (how the simulation paints it; one with a colour name and no rgba is painted grey). Its
@@ -17,7 +17,6 @@ the hue lies in none, the nearest of all. The margin at a window's edge is the w
 
 from __future__ import annotations
 
-import re
 from collections import defaultdict
 from dataclasses import dataclass
 from enum import Enum
@@ -25,7 +24,7 @@ from typing import TYPE_CHECKING, Any
 
 from pyoxigraph import Triple
 
-from cbrs.kb.colour_windows import ColourWindow, hsv, read_colour_windows
+from cbrs.kb.colour_windows import SIMULATED_LIGHTING, ColourWindow, Lighting, hsv, read_colour_windows
 from cbrs.kb.namespaces import PREFIXES, shorten
 from cbrs.kb.semantic_map import UNPAINTED
 
@@ -42,7 +41,6 @@ __all__ = [
     "Risk",
     "colour_risk",
     "colour_risks",
-    "involved_colour_risks",
     "known_windows",
     "written_colour_risks",
 ]
@@ -60,7 +58,11 @@ class Risk(Enum):
     GREY = "grey"
     """It is less saturated than the window's floor: its pixels are no colour at all."""
     DARK = "dark"
-    """It is darker than the window's floor."""
+    """Even its lit top is seen darker than the window's floor: its paint's brightness times the light's
+    shading (:class:`kb.colour_windows.Lighting`)."""
+    SHADED = "shaded"
+    """Its faces turned from the light are seen darker than the window's floor: a camera sees only its lit
+    faces (part of it)."""
     UNKNOWN = "unknown"
     """No camera of the map has a window of its colour name."""
 
@@ -86,6 +88,10 @@ class ColourRisk:
     """The window whose edge is nearest its hue, of every colour (for one whose hue is in none)."""
     painted: bool = True
     """False: the map gives it no home:rgba, and it is painted grey."""
+    seen: float | None = None
+    """For a dark or shaded one: the brightness the cameras see of its lit top, or of a face in shadow."""
+    needed: float | None = None
+    """For a shaded one: the least paint brightness whose faces in shadow the cameras see."""
 
     def text(self) -> str:
         """One line naming the thing, its hue and the window: what ``cbrs load`` prints after ``warning:``."""
@@ -106,8 +112,15 @@ class ColourRisk:
             )
         if self.risk is Risk.DARK:
             return (
-                f"{said} but brightness {self.value:.2f}, below {window.name}'s floor of {window.min_value:g}: "
-                f"too dark for the cameras to tell its hue (window {window.span()})"
+                f"{said} but brightness {self.value:.2f}, seen at {self.seen or 0.0:.2f} on its lit top, below "
+                f"{window.name}'s floor of {window.min_value:g}: too dark for the cameras to tell its hue (window "
+                f"{window.span()})"
+            )
+        if self.risk is Risk.SHADED:
+            return (
+                f"{said} and brightness {self.value:.2f}, seen at {self.seen or 0.0:.2f} on a face turned from the "
+                f"light, below {window.name}'s floor of {window.min_value:g} (window {window.span()}): a camera may "
+                f"see only its lit faces; paint it at least {self.needed or 1.0:.2f} bright"
             )
         if self.risk is Risk.EDGE:
             return (
@@ -137,6 +150,7 @@ class ColourRisk:
             "hue": round(self.hue, 1),
             "saturation": round(self.saturation, 3),
             "value": round(self.value, 3),
+            "seen": None if self.seen is None else round(self.seen, 3),
             "risk": self.risk.value,
             "window": None if self.window is None else self.window.span(),
             "nearest": None if self.nearest is None else self.nearest.span(),
@@ -151,9 +165,11 @@ def colour_risk(
     rgba: tuple[float, float, float, float] | None,
     windows: Sequence[ColourWindow],
     margin: float | None = None,
+    lighting: Lighting = SIMULATED_LIGHTING,
 ) -> ColourRisk | None:
     """Why the cameras whose windows are ``windows`` may not tell ``thing``'s colour (None: they will).
-    ``rgba`` None is the grey a thing the map gives no rgba is painted."""
+    ``rgba`` None is the grey a thing the map gives no rgba is painted; its brightness is held to a
+    window's floor as ``lighting`` shades it."""
     paint = rgba if rgba is not None else UNPAINTED
     hue, saturation, value = hsv(paint)
 
@@ -161,14 +177,21 @@ def colour_risk(
         edge = margin if margin is not None else (window.hue_margin if window is not None else 0.0)
         nearest = _nearest(hue, windows)
         painted = rgba is not None
-        return ColourRisk(thing, colour, paint, hue, saturation, value, kind, window, edge, inside, nearest, painted)
+        seen = needed = None
+        if window is not None and kind is Risk.DARK:
+            seen = lighting.seen(value, lighting.lit)
+        if window is not None and kind is Risk.SHADED:
+            seen, needed = lighting.seen(value, lighting.shaded), lighting.least(window.min_value, lighting.shaded)
+        return ColourRisk(
+            thing, colour, paint, hue, saturation, value, kind, window, edge, inside, nearest, painted, seen, needed
+        )
 
     own = [window for window in windows if window.name == colour]
     if not own:
         return risk(Risk.UNKNOWN, None)
     found: list[tuple[Risk, ColourWindow]] = []
     for window in own:
-        kind = _held(hue, saturation, value, window, margin)
+        kind = _held(hue, saturation, value, window, margin, lighting)
         if kind is None:
             return None  # some camera tells it (where cameras differ, one that can is the one to use)
         found.append((kind, window))
@@ -179,23 +202,28 @@ def colour_risk(
     return risk(kind, window, inside)
 
 
-_ORDER = (Risk.EDGE, Risk.DARK, Risk.GREY, Risk.OUTSIDE)
+_ORDER = (Risk.SHADED, Risk.EDGE, Risk.DARK, Risk.GREY, Risk.OUTSIDE)
 """Which of a thing's risks to say where several cameras' windows of its colour give different ones: the
 mildest (the camera that comes nearest to telling it)."""
 
 
-def _held(hue: float, saturation: float, value: float, window: ColourWindow, margin: float | None) -> Risk | None:
-    """How a paint of ``hue``, ``saturation`` and ``value`` fares in ``window`` (None: well inside it)."""
+def _held(
+    hue: float, saturation: float, value: float, window: ColourWindow, margin: float | None, lighting: Lighting
+) -> Risk | None:
+    """How a paint of ``hue``, ``saturation`` and ``value`` fares in ``window`` under ``lighting`` (None:
+    well inside it). Brightness is held to the floor as the cameras see it, shaded (docs/simulation.md)."""
     edge = window.hue_margin if margin is None else margin
     if saturation < window.min_saturation:
         return Risk.GREY
-    if value < window.min_value:
+    if lighting.seen(value, lighting.lit) < window.min_value:
         return Risk.DARK
     distance = window.distance(hue)
     if distance > window.hue_tolerance + edge:
         return Risk.OUTSIDE
     if distance >= window.hue_tolerance - edge:
         return Risk.EDGE
+    if lighting.seen(value, lighting.shaded) < window.min_value:
+        return Risk.SHADED
     return None
 
 
@@ -269,21 +297,3 @@ def written_colour_risks(kb: KnowledgeBase, quads: Iterable[Quad]) -> list[Colou
         if quad.predicate.value in _PAINT and not isinstance(quad.subject, Triple):
             things.add(quad.subject.value)
     return colour_risks(kb, things) if things else []
-
-
-def involved_colour_risks(kb: KnowledgeBase, report: str) -> list[ColourRisk]:
-    """The risks of the things a run's ``report`` (its JSON) names, by IRI or by a class they are asserted
-    to be of (a task that fetches a home:Pen involves the map's pen), written whole or shortened."""
-    risks = colour_risks(kb)
-    if not risks:
-        return []
-    types: dict[str, set[str]] = defaultdict(set)
-    for row in kb.select("map_types"):
-        types[row["thing"].value].add(row["type"].value)
-
-    def named(iri: str) -> bool:
-        return re.search(rf"{re.escape(iri)}(?![\w-])", report) is not None or (
-            re.search(rf"(?<![\w:-]){re.escape(shorten(iri))}(?![\w-])", report) is not None
-        )
-
-    return [risk for risk in risks if named(risk.thing) or any(named(t) for t in types.get(risk.thing, ()))]

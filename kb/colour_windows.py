@@ -34,8 +34,10 @@ __all__ = [
     "DEFAULT_HUE_MARGIN",
     "DEFAULT_MIN_SATURATION",
     "DEFAULT_MIN_VALUE",
+    "SIMULATED_LIGHTING",
     "ColourWindow",
     "ColourWindowError",
+    "Lighting",
     "hsv",
     "read_colour_windows",
 ]
@@ -86,6 +88,50 @@ class ColourWindow:
         """The window as its readers write it: ``green (100-150°)``."""
         low, high = (self.hue - self.hue_tolerance) % 360.0, (self.hue + self.hue_tolerance) % 360.0
         return f"{self.name} ({low:g}-{high:g}°)"
+
+
+@dataclass(frozen=True)
+class Lighting:
+    """How the simulated cameras' renderer lights a face: a face of paint brightness V is seen at V times
+    ``ambient + diffuse * max(0, n . l)``, n its normal and l the unit direction towards the light (the
+    renderer's Lambert shading; no specular part, no cast shadows), which scales the channels and so keeps
+    hue and saturation. The paint's channel is made a byte and the shaded one too, each cut down, not
+    rounded (measured: docs/simulation.md, "Colour windows")."""
+
+    direction: tuple[float, float, float] = (0.3, 0.2, 1.0)
+    """Towards the light, not normalised (as ``pybullet.getCameraImage`` takes it): above, a little to +x and +y."""
+    ambient: float = 0.6
+    diffuse: float = 0.4
+
+    def factor(self, normal: tuple[float, float, float]) -> float:
+        """What a face of unit ``normal`` scales its paint's brightness by."""
+        length = math.sqrt(sum(part * part for part in self.direction))
+        facing = sum(n * d for n, d in zip(normal, self.direction, strict=True)) / length
+        return self.ambient + self.diffuse * max(0.0, facing)
+
+    @property
+    def lit(self) -> float:
+        """The factor of a thing's top, the face every camera looking down on it sees, and its best lit
+        (the light is mostly above): 0.976 for the simulated light."""
+        return self.factor((0.0, 0.0, 1.0))
+
+    @property
+    def shaded(self) -> float:
+        """The factor of a face turned from the light: the ambient part alone."""
+        return self.ambient
+
+    def seen(self, value: float, factor: float) -> float:
+        """The brightness a camera sees of a face of paint brightness ``value`` lit by ``factor``."""
+        return math.floor(math.floor(value * 255.0 + 1e-9) * factor + 1e-9) / 255.0
+
+    def least(self, floor: float, factor: float) -> float:
+        """The least paint brightness whose face lit by ``factor`` is seen at ``floor`` or brighter (1.0
+        when none is)."""
+        return next((level / 255.0 for level in range(256) if self.seen(level / 255.0, factor) >= floor), 1.0)
+
+
+SIMULATED_LIGHTING = Lighting()
+"""The light the simulated cameras render by (``sim.cameras.render``), the same for every camera."""
 
 
 def hsv(rgba: tuple[float, ...]) -> tuple[float, float, float]:

@@ -17,7 +17,7 @@ import pybullet as p
 from numpy.typing import NDArray
 
 from cbrs.kb.camera_view import focal_length
-from cbrs.kb.colour_windows import ColourWindow
+from cbrs.kb.colour_windows import SIMULATED_LIGHTING, ColourWindow
 from cbrs.sim.errors import CameraUnavailableError
 from cbrs.sim.layout import CameraSpec
 
@@ -129,16 +129,17 @@ class Clock(Protocol):
 
 def render(client: int, width: int, height: int, view: Any, projection: Any) -> tuple[Any, Any]:
     """One frame (RGBA and depth buffer) by pybullet's software renderer, lit the same for every
-    camera: the perception thresholds and the recordings see the same colours."""
+    camera: the perception thresholds and the recordings see the same colours. The light is
+    ``kb.colour_windows.SIMULATED_LIGHTING``, which the colour warnings shade a paint by."""
     _, _, rgba, zbuffer, _ = p.getCameraImage(
         width,
         height,
         view,
         projection,
         shadow=0,
-        lightDirection=(0.3, 0.2, 1.0),
-        lightAmbientCoeff=0.6,
-        lightDiffuseCoeff=0.4,
+        lightDirection=SIMULATED_LIGHTING.direction,
+        lightAmbientCoeff=SIMULATED_LIGHTING.ambient,
+        lightDiffuseCoeff=SIMULATED_LIGHTING.diffuse,
         lightSpecularCoeff=0.0,
         renderer=p.ER_TINY_RENDERER,
         flags=p.ER_NO_SEGMENTATION_MASK,

@@ -305,6 +305,12 @@ class SimEnvironment:
             **without_base(advertisements, self.world.base_names),
         }
 
+    def looked_for(self) -> frozenset[str]:
+        """The things (IRIs) a camera looked for by colour for the run's steps and to verify their effects,
+        so far: not the look at everything before a plan. What a run's colour warnings are of, besides the
+        things its plans perceive (``actions.colour_warnings``)."""
+        return frozenset(self.context.looked_for)
+
     def base_components(self) -> dict[str, frozenset[str]]:
         """Each mobile base's own components, in a home of several (``sim.run_checks.base_components``): a
         plan works one base (``actions.runner``)."""
@@ -620,12 +626,19 @@ class SimEnvironment:
         """Perceive what a test is about: the object in a region or a container's water by the cameras,
         the person the base should be near by the ceiling cameras; the rest the robots feel."""
         thing = belief.object_name(subject)
+        smap, looked = self.world.map, self.context.looked_for
         if test in ("inside", "on", "contains") and thing is not None and obj.role != "platform":
             belief.look([thing], people=False)
+            looked.add(self.world.objects[thing].iri)
+            if thing in self.world.containers and belief.water_colour is not None:  # its water, by its colour
+                looked.update(smap.of_type(HOME + "Water"))
         elif test == "near" and obj.role == "person":
             belief.look([], people=True)
+            looked.update(person.iri for person in smap.people.values() if person.name == obj.name)
         elif test == "near" and subject.role == "gripper" and belief.object_name(obj) is not None:
-            belief.look([name for name in [belief.object_name(obj)] if name is not None], people=False)
+            names = [name for name in [belief.object_name(obj)] if name is not None]
+            belief.look(names, people=False)
+            looked.update(self.world.objects[name].iri for name in names)
         else:
             belief.feel()
 

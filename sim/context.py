@@ -50,6 +50,9 @@ class SimContext:
     component: str | None = None  # the IRI of the running component
     step: PlanStep | None = None  # the plan's step being run, and every step's inputs known at its start
     known: Mapping[int, Mapping[str, Any]] = field(default_factory=dict)
+    looked_for: set[str] = field(default_factory=set)
+    """The things (IRIs) a camera looked for by colour for the run's steps and their effects: a run's colour
+    warnings are of these and what its plans perceive (``actions.colour_warnings``)."""
 
     def __post_init__(self) -> None:
         specs = getattr(self.world, "arm_specs", None)  # None: a context for planning alone, with no world

@@ -79,6 +79,7 @@ def _recognise(ctx: SimContext, camera: str, colour: str) -> ObjectEstimate:
     frame = ctx.world.camera(camera).capture()
     alike = sorted(name for name, obj in ctx.world.objects.items() if obj.colour == colour)
     meant = [name for name in alike if ctx.world.objects[name].iri in ctx.designated] if len(alike) > 1 else alike
+    ctx.looked_for.update(ctx.world.objects[name].iri for name in (meant if len(meant) == 1 else alike))
     if len(meant) != 1:
         return recognise_object(frame, colour)  # one thing of its colour in view, else ambiguous
     name = meant[0]
@@ -404,6 +405,7 @@ def track(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
     if person is None or not person.colour:
         raise SkillFailed("the semantic map gives no colour to find the person by (home:colourName)")
     shirt = person.colour
+    ctx.looked_for.add(person.iri)
     return {"personPosition": to_json(track_person(ctx.world.camera(device).capture(), shirt))}
 
 

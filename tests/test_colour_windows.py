@@ -1,11 +1,13 @@
 """The cameras' colour windows as knowledge (kb/colour_windows.py) and the warning for a thing painted where
 they may not tell its colour (kb/colour_risk.py): read from the store by camera, its own or its class's or
 home:Camera's; a bad window refused at the load; a paint inside, at an edge, outside, grey or dark said so by
-cbrs load, cbrs update and a run's report, with no simulation run."""
+cbrs load, cbrs update and a run's report, with no simulation run (the light's shading as the renderer
+draws it: tests/test_run_colour_warnings.py)."""
 
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -19,14 +21,21 @@ from cbrs.kb.colour_risk import (
     Risk,
     colour_risk,
     colour_risks,
-    involved_colour_risks,
     known_windows,
     written_colour_risks,
 )
-from cbrs.kb.colour_windows import DEFAULT_HUE_MARGIN, ColourWindow, ColourWindowError, hsv, read_colour_windows
+from cbrs.kb.colour_windows import (
+    DEFAULT_HUE_MARGIN,
+    SIMULATED_LIGHTING,
+    ColourWindow,
+    ColourWindowError,
+    Lighting,
+    hsv,
+    read_colour_windows,
+)
 from cbrs.kb.loader import parse_file
 from cbrs.kb.namespaces import PREFIXES, GraphName
-from cbrs.kb.upgrade import ontology_dir
+from cbrs.kb.resources import ontology_dir
 
 HOME, SVC, WORLD = PREFIXES["home"], PREFIXES["svc"], PREFIXES["world"]
 APPLE = WORLD + "Apple"
@@ -135,7 +144,13 @@ def test_hsv_is_the_segmentations_arithmetic() -> None:
         ),
         pytest.param((0.90, 0.80, 0.10, 1.0), Risk.OUTSIDE, "in the window yellow (42-66°)", id="in-another"),
         pytest.param((0.50, 0.55, 0.50, 1.0), Risk.GREY, "saturation 0.09, below green's floor", id="grey"),
-        pytest.param((0.02, 0.15, 0.03, 1.0), Risk.DARK, "brightness 0.15, below green's floor", id="dark"),
+        pytest.param((0.02, 0.15, 0.03, 1.0), Risk.DARK, "brightness 0.15, seen at 0.15 on its lit top", id="dark"),
+        # the floor is held to what the cameras see: the paint shaded by the simulated light, in bytes
+        pytest.param((0.03, 0.203, 0.05, 1.0), Risk.DARK, "0.20, seen at 0.19 on its lit top, below", id="dark-lit"),
+        pytest.param(
+            (0.05, 0.30, 0.08, 1.0), Risk.SHADED, "0.30, seen at 0.18 on a face turned from the light", id="shaded"
+        ),
+        pytest.param((0.05, 0.35, 0.08, 1.0), None, "", id="bright-enough-in-shadow"),
     ],
 )
 def test_a_paint_is_held_to_its_colours_window(
@@ -149,6 +164,19 @@ def test_a_paint_is_held_to_its_colours_window(
     assert found.text().startswith("world:Apple (green, home:rgba ") and said in found.text()
     assert "green (100-150°)" in found.text()  # the window it is held to
     assert found.to_dict()["risk"] == risk.value
+
+
+def test_a_paint_is_seen_as_the_simulated_light_shades_it(windows: list[ColourWindow]) -> None:
+    light = SIMULATED_LIGHTING
+    assert light.lit == pytest.approx(0.6 + 0.4 / math.sqrt(1.13)) and light.shaded == 0.6
+    assert light.factor((-1.0, 0.0, 0.0)) == 0.6  # a face turned from the light: the ambient part alone
+    assert [round(light.seen(0.25, f) * 255) for f in (light.lit, light.shaded)] == [61, 37]  # measured bytes
+    assert light.least(0.20, light.shaded) == pytest.approx(85 / 255)  # 85 * 0.6 = 51 = 0.20 of 255
+    shaded = colour_risk(APPLE, "green", (0.05, 0.30, 0.08, 1.0), windows)
+    assert shaded is not None and shaded.needed == pytest.approx(85 / 255) and "at least 0.33 bright" in shaded.text()
+    assert shaded.to_dict()["seen"] == round(light.seen(0.30, 0.6), 3)
+    brighter = Lighting(ambient=0.8, diffuse=0.2)  # another light: what the cameras see of the same paint
+    assert colour_risk(APPLE, "green", (0.05, 0.30, 0.08, 1.0), windows, lighting=brighter) is None
 
 
 def test_the_margin_is_the_windows_unless_given(windows: list[ColourWindow]) -> None:
@@ -186,10 +214,7 @@ def test_a_write_is_checked_for_the_things_it_painted(windows: list[ColourWindow
     assert [risk.thing for risk in written_colour_risks(kb, quads)] == [APPLE]
     cup = [ox.Quad(ox.NamedNode(WORLD + "Cup"), ox.NamedNode(HOME + "rgba"), ox.Literal("x"), GraphName.MAP.node)]
     assert written_colour_risks(kb, cup) == []  # the cup is painted well inside red
-    # a run's report names the apple, or its class
-    assert [r.thing for r in involved_colour_risks(kb, json.dumps({"inputs": {"object": "world:Apple"}}))] == [APPLE]
-    assert [r.thing for r in involved_colour_risks(kb, json.dumps({"concept": HOME + "Apple"}))] == [APPLE]
-    assert involved_colour_risks(kb, json.dumps({"concept": HOME + "AppleJuice", "thing": "world:Apples"})) == []
+    assert [r.thing for r in colour_risks(kb, {APPLE, WORLD + "Cup"})] == [APPLE]  # of those asked about
     kb.close()
 
 

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import pytest
 
+from cbrs.actions.colour_warnings import perceived_things
 from cbrs.actions.composer import Composer
 from cbrs.actions.runner import run_task
 from cbrs.kb import KnowledgeBase
@@ -83,13 +84,18 @@ def test_a_task_runs_beside_an_object_of_a_shared_colour(colour: str, task: str)
     is still localised and the pen fetched."""
     kb = remote_of(colour, task=True)
     with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
-        result = run_task(kb, task, SimEnvironment(world, kb), composer=Composer(kb))
+        environment = SimEnvironment(world, kb)
+        result = run_task(kb, task, environment, composer=Composer(kb))
     assert result.succeeded, result.report.reason if result.report else result.composition.unsatisfied
     assert not result.replans
     facts = {(r["thing"].value, r["relation"].value, r["other"].value) for r in kb.select("world_facts")}
     fetched, stayed = ("Remote1", "Pen") if task == "FetchMyRemote" else ("Pen", "Remote1")
     assert (WORLD + fetched, HOME + "isWith", WORLD + "Person") in facts
     assert (WORLD + stayed, HOME + "isLocatedOn", WORLD + "KitchenTable") in facts
+    # what its colour warnings would be of: what it perceived, not the other thing of the fetched one's colour
+    looked = environment.looked_for()
+    assert {WORLD + fetched, WORLD + "Person"} <= looked and WORLD + stayed not in looked
+    assert perceived_things(kb, result) == {WORLD + fetched, WORLD + "Person", WORLD + "P3DX01MarkerColours"}
 
 
 def test_an_object_at_the_edge_of_the_kinects_view_is_said_to_be_cut_by_it() -> None:
