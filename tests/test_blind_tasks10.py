@@ -7,6 +7,7 @@ newcomer's mistakes. Nothing is simulated here: the tasks are composed and the m
 from __future__ import annotations
 
 from collections.abc import Iterator
+from pathlib import Path
 
 import pytest
 
@@ -14,6 +15,7 @@ from cbrs.actions.composer import Composer
 from cbrs.actions.near_misses import SIBLINGS_KIND, near
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.semantic_map import MapError
 from tests.helpers_examples import EXAMPLES
 
 HOME, SVC, LAB10 = PREFIXES["home"], PREFIXES["svc"], "https://example.org/lab10#"
@@ -70,4 +72,21 @@ def test_the_fix_the_answer_names_plans_the_fill() -> None:
     result = Composer(kb).compose("FillMyTravelMug")
     assert result.plan is not None, [u.text() for u in result.unsatisfied]
     assert result.plan.steps[-1].component == SVC + "FillCupFromTap_CytonDualArm01"
+    kb.close()
+
+
+def test_a_mass_in_grams_is_refused_at_the_load_naming_the_unit(tmp_path: Path) -> None:
+    """The travel mug as first written, 300 g as home:massKg 300: loaded without a word, and the run failed
+    after two re-plans, 32.5 s simulated, "PickUpObject: lifting: stopped 0.039 m short"."""
+    kb = KnowledgeBase.open(":memory:")
+    kb.load([EXAMPLES / "lab10_travel_mug.ttl"], graph="ontology")
+    before = kb.statistics()
+    grams = tmp_path / "mug_in_grams.ttl"
+    grams.write_text((EXAMPLES / "lab10_travel_mug.ttl").read_text("utf-8").replace("massKg 0.30", "massKg 300"))
+    with pytest.raises(MapError) as refused:
+        kb.load([grams], graph="map")
+    said = str(refused.value)
+    assert "Mug1" in said and "weighs 300 kg (home:massKg 300) in a cylinder of 431 cm³" in said
+    assert "denser than any solid" in said and "masses are in kilograms, 300 g is 0.3" in said
+    assert kb.statistics() == before
     kb.close()
