@@ -17,6 +17,12 @@ once the one before says it is ready); a trial run over HTTP posts the task to t
 the token and polls ``/cbrs/task_status``. A trial may send its files to the server (``POST /store``,
 ``POST /update``) instead of loading them before it starts. A library program of the examples runs its
 task itself in the trial's store (``python PROGRAM --store DIR --seed N``) and prints the outcome as JSON.
+A posted file the docs say is refused must be answered 4xx saying their phrase, the store's digest
+(``GET /store`` as N-Quads) the same before and after. A trial run from the pages (``page``) uses the
+knowledge browser's forms as a browser submits them (form-encoded, with the page's ``Origin``; no
+script): the tasks page's Start form, the run read from its page; a requirement's file written on the New
+task page (checked, saved with the token, or refused there). Two runs at once (``busy``): while a run
+goes, the next one's start must be refused with 409 saying so, and taken once the run has ended.
 The processes are stopped by PID; every wait is bounded. The stores are made once a trial and copied for
 each seed, before anything runs in them. Runs go in parallel processes, up to ``--jobs`` (default: the
 cores). The outcome is read from the run's JSON:
@@ -24,8 +30,8 @@ succeeded, refused (before anything moved: the run's error), no plan, or failed;
 be read is "broken". Prints the machine, the commit, the load checks, one row a run (expected and found
 status and simulated seconds) and the deviations: a status other than the docs', a successful run's
 simulated seconds off by more than the data's tolerance, a refused step accepted or refused otherwise,
-or a store changed by a refusal. Exits 1 when there is a deviation. ``--json FILE`` writes the same as a
-record.
+a store changed by a refusal, a second start taken or refused otherwise, a page not as it should be.
+Exits 1 when there is a deviation. ``--json FILE`` writes the same as a record.
 """
 
 from __future__ import annotations
@@ -1276,9 +1282,11 @@ def main() -> None:
     print(f"commit: {commit()}")
     runs_in_all = sum(len(t.seeds) * len(t.runs) for t in trials)
     refusals = sum(s.expect_refusal for t in trials for s in t.setup)
+    posted = sum(s.expect_refusal for t in trials if t.post for s in t.setup)
+    busy = sum(len(t.seeds) * (len(t.runs) - 1) for t in trials if t.busy)
     print(
-        f"inputs: {len(trials)} trials, {runs_in_all} runs, {refusals} refusals at the load; "
-        f"{args.jobs} at once; tolerance {tolerance} s\n"
+        f"inputs: {len(trials)} trials, {runs_in_all} runs, {refusals} refusals at the load ({posted} sent to a "
+        f"server), {busy} second starts while a run goes; {args.jobs} at once; tolerance {tolerance} s\n"
     )
     scratch = Path(tempfile.mkdtemp(prefix="example_tasks_")) if args.keep is None else args.keep
     scratch.mkdir(parents=True, exist_ok=True)
@@ -1293,7 +1301,7 @@ def main() -> None:
     for outcome in outcomes:
         outcome.deviation = deviation(outcome, tolerance)
     if loads.checks:
-        print("refusals at the load:")
+        print("checks (refusals at the load and by the server, second starts, the New task page's saves):")
         for check in loads.checks:
             print(f"  {check}")
         print()
@@ -1308,7 +1316,7 @@ def main() -> None:
     deviations = [o for o in outcomes if o.deviation]
     count = len(deviations) + len(loads.deviations)
     print(
-        f"\n{len(outcomes)} runs and {len(loads.checks)} refusals in {time.perf_counter() - started:.0f} s; "
+        f"\n{len(outcomes)} runs and {len(loads.checks)} checks in {time.perf_counter() - started:.0f} s; "
         f"{count} deviations"
     )
     known = {t.label for t in trials if t.known_failure}
