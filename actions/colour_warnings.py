@@ -39,7 +39,8 @@ __all__ = ["looking_devices", "perceived_things", "run_colour_risks"]
 def run_colour_risks(kb: KnowledgeBase, result: RunResult, looked_for: Iterable[str] = ()) -> list[ColourRisk]:
     """The colour risks of the things ``result``'s plans perceive or grasp, and of ``looked_for`` (the
     things its environment says a camera looked for): what ``cbrs run`` and a server's run report."""
-    return colour_risks(kb, perceived_things(kb, result) | set(looked_for))
+    things = perceived_things(kb, result) | set(looked_for)
+    return colour_risks(kb, things) if things else []  # no plan, nothing looked at: nothing to read
 
 
 def perceived_things(kb: KnowledgeBase, result: RunResult) -> set[str]:

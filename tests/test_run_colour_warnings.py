@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Iterator
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -80,8 +81,9 @@ def test_the_warnings_are_of_what_the_plan_perceives_not_what_its_report_names(k
     assert HOME + "Cup" in report and HOME + "Pen" not in report and WORLD + "Pen" not in report
     assert perceived_things(kb, result) == {WORLD + "Pen", WORLD + "Person", WORLD + "P3DX01MarkerColours"}
     assert [risk.thing for risk in run_colour_risks(kb, result)] == [WORLD + "Pen"]
-    # what the run looked for counts too, whatever the plan
+    # what the run looked for counts too, whatever the plan; with no plan and nothing looked for, nothing
     assert [risk.thing for risk in run_colour_risks(kb, result, [WORLD + "Cup"])] == [WORLD + "Cup", WORLD + "Pen"]
+    assert run_colour_risks(kb, RunResult(replace(composition, plan=None), None)) == []
 
 
 def test_the_looking_devices_are_the_cameras_and_the_robot_a_camera_is_on(kb: KnowledgeBase) -> None:
