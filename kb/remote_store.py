@@ -687,9 +687,12 @@ class RemoteStore(Store):
                 "or a bearer token in CBRS_UPDATE_TOKEN"
             )
         elif self._token_sent:
-            hint = "the server refused the token in CBRS_UPDATE_TOKEN"
-        else:
-            hint = "the server refused the request: set CBRS_UPDATE_TOKEN to its update token (a cbrs serve's)"
+            hint = "the server refused the token sent (the cbrs command's CBRS_UPDATE_TOKEN, a program's remote_token)"
+        else:  # a notebook with CBRS_UPDATE_TOKEN set was told to set it: only the cbrs command reads it
+            hint = (
+                "sent without a token: set CBRS_UPDATE_TOKEN (the cbrs command's), or a program passes "
+                "KnowledgeBase.open(URL, remote_token=TOKEN)"
+            )
         return f"{hint}; it said: {said}" if said else hint
 
 

@@ -6,6 +6,8 @@ newcomer's mistakes. Nothing is simulated here: the tasks are composed and the m
 
 from __future__ import annotations
 
+import http.server
+import threading
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -14,6 +16,7 @@ import pytest
 from cbrs.actions.composer import Composer
 from cbrs.actions.near_misses import SIBLINGS_KIND, near
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.errors import RemoteStoreError
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import MapError
 from tests.helpers_examples import EXAMPLES
@@ -90,3 +93,40 @@ def test_a_mass_in_grams_is_refused_at_the_load_naming_the_unit(tmp_path: Path) 
     assert "denser than any solid" in said and "masses are in kilograms, 300 g is 0.3" in said
     assert kb.statistics() == before
     kb.close()
+
+
+class _Forbidding(http.server.BaseHTTPRequestHandler):
+    """A cbrs serve's answer to a write without its token, to every request."""
+
+    def do_POST(self) -> None:
+        self.rfile.read(int(self.headers.get("Content-Length") or 0))
+        body = b'{"error":"forbidden","message":"updates need the server\'s token: Authorization: Bearer <token>"}'
+        self.send_response(403)
+        self.send_header("Content-Type", "application/json")
+        self.send_header("Content-Length", str(len(body)))
+        self.end_headers()
+        self.wfile.write(body)
+
+    do_GET = do_POST
+
+    def log_message(self, *args: object) -> None:
+        pass
+
+
+def test_a_program_without_the_token_is_told_to_pass_it(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The notebook's run on the server by its URL, CBRS_UPDATE_TOKEN set as for the cbrs command: its first
+    write was refused, "set CBRS_UPDATE_TOKEN to its update token", which was set: the library reads none."""
+    monkeypatch.setenv("CBRS_UPDATE_TOKEN", "secret")
+    server = http.server.HTTPServer(("127.0.0.1", 0), _Forbidding)
+    thread = threading.Thread(target=server.serve_forever, args=(0.05,), daemon=True)
+    thread.start()
+    try:
+        with pytest.raises(RemoteStoreError) as refused:
+            KnowledgeBase.open(f"http://127.0.0.1:{server.server_port}")
+    finally:
+        server.shutdown()
+        server.server_close()
+        thread.join(timeout=5)
+    said = str(refused.value)
+    assert "sent without a token: set CBRS_UPDATE_TOKEN (the cbrs command's), or a program passes" in said
+    assert "KnowledgeBase.open(URL, remote_token=TOKEN); it said: " in said and "updates need the server" in said
