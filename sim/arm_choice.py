@@ -13,7 +13,7 @@ import functools
 import itertools
 import logging
 import math
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Collection, Iterator, Sequence
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -410,17 +410,26 @@ def lying_estimate(world: HomeWorld, belief: PerceivedWorld | None, obj: MapObje
     return ObjectEstimate(centre[0], centre[1], centre[2], axis, obj.size, obj.colour, "map", 0.0, 0)
 
 
-def cannot_set_down(ctx: SimContext, obj: MapObject, surface: Region, at: tuple[float, float]) -> str:
-    """Why no arm of the robot whose reach the spot ``at`` of ``surface`` is RELAY_MARGIN inside can hold
-    ``obj`` over it to set it down, by any approach its hand can grip it by (empty: one can): what a carry
-    asks of a spot before it aims there (:func:`skills.can_set_down`, its hand turned as it takes the object
-    where it lies, believed or as the map says; the pass's taker asks the same with :func:`skills.can_grip`).
-    Asked of each spot a packing would give a later thing (:func:`packing.carry_spots`)."""
+def cannot_set_down(
+    ctx: SimContext,
+    obj: MapObject,
+    surface: Region,
+    at: tuple[float, float],
+    sides: Collection[ArmSide] | None = None,
+) -> str:
+    """Why no arm of the robot (of ``sides``: those free when it is set down) whose reach the spot ``at`` of
+    ``surface`` is RELAY_MARGIN inside can hold ``obj`` over it to set it down, by any approach its hand can
+    grip it by (empty: one can): what a carry asks of a spot before it aims there (:func:`skills.can_set_down`,
+    its hand turned as it takes the object where it lies, believed or as the map says; the pass's taker asks
+    the same with :func:`skills.can_grip`). Asked of each spot a packing would give a later thing
+    (:func:`packing.carry_spots`)."""
     world = ctx.world
     estimate, model = lying_estimate(world, ctx.belief, obj), Manipulation.of(obj).model
     spot = spot_region(surface, *at)
     refused: list[str] = []
     for side, spec in sorted(world.arm_specs.items()):
+        if sides is not None and side not in sides:
+            continue
         if math.hypot(at[0] - spec.mount[0], at[1] - spec.mount[1]) > spec.reach - RELAY_MARGIN:
             continue
         for kind in model.preference:
@@ -429,7 +438,10 @@ def cannot_set_down(ctx: SimContext, obj: MapObject, surface: Region, at: tuple[
             if not why:
                 return ""
             refused.append(why)
-    return refused[0] if refused else f"no arm reaches ({at[0]:.2f}, {at[1]:.2f}) {RELAY_MARGIN:.2f} m inside its reach"
+    if refused:
+        return refused[0]
+    free = "free " if sides is not None and len(sides) < len(world.arm_specs) else ""  # the others hold something
+    return f"no {free}arm reaches ({at[0]:.2f}, {at[1]:.2f}) {RELAY_MARGIN:.2f} m inside its reach"
 
 
 def holdable_spot(

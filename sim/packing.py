@@ -15,18 +15,19 @@ gives the reasoning.
 
 from __future__ import annotations
 
+import itertools
 import logging
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import Any
 
 from cbrs.actions.plan import Plan, PlanStep
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import PREFIXES
-from cbrs.kb.semantic_map import MapObject, SemanticMap, Thing, local_name
+from cbrs.kb.semantic_map import Arm, MapObject, SemanticMap, Thing, local_name
 from cbrs.sim import skills
-from cbrs.sim.arm_choice import TAKING, cannot_set_down
+from cbrs.sim.arm_choice import ARM_TIE, TAKING, cannot_set_down
 from cbrs.sim.arms import ArmSide
 from cbrs.sim.context import SimContext
 from cbrs.sim.geometry import Region
@@ -38,6 +39,7 @@ from cbrs.sim.place_spots import (
     RELAY_STEP,
     able_mounts,
     fixtures_on,
+    held_now,
     other_objects,
     place_inset,
     place_spots,
@@ -345,6 +347,7 @@ def arrange(
     lying: Sequence[Lying] = (),
     holds: Holds | None = None,
     able: Sequence[Sequence[Mount] | None] | None = None,
+    by: Sequence[Sequence[Mount]] | None = None,
 ) -> list[Spot] | None:
     """As :func:`pack`, but None only when no arrangement of the spots holds them all; :class:`Undecided`
     when ``budget`` comparisons did not decide. A footprint's spots do not depend on the others' but for
@@ -352,9 +355,10 @@ def arrange(
     ``box`` footprints: ``feet``, else each box along x) and the search compares centres. ``lying``: the
     footprints of things on the place kept clear of (circles about them, for ``circle``); ``holds``: asked
     of each spot the search would take, which it passes over when refused; ``able``: for each thing, the
-    arms that can set it down (:func:`place_spots`' ``able``; None: every arm of the map)."""
+    arms that can set it down (:func:`place_spots`' ``able``; None: every arm of the map); ``by``: for each
+    thing, the arms whose reach its spots are in (else ``mounts``)."""
     shapes = list(feet) if feet is not None else [Footprint.lying(size, 0.0) for size in sizes]
-    lists = _spot_lists(smap, place, sizes, mounts, others, rule, shapes, lying, able)
+    lists = _spot_lists(smap, place, sizes, mounts, others, rule, shapes, lying, able, by)
     if not all(lists):
         return None
     return _search(lists, sizes, shapes, rule, budget, holds)
@@ -370,24 +374,27 @@ def _spot_lists(
     shapes: Sequence[Footprint],
     lying: Sequence[Lying],
     able: Sequence[Sequence[Mount] | None] | None = None,
+    by: Sequence[Sequence[Mount]] | None = None,
 ) -> list[list[Spot]]:
-    """Each thing's spots alone, in the order the rule prefers them; by circles, each counting only the arms
-    of ``able`` that can set it down (its entry; None: every arm of the map), as one thing alone does
-    (:func:`place_spots`: an arm holding something else takes no spot away from another). A box's spots
-    (:func:`box_spots`) keep its whole footprint over the place, whichever arm has them."""
+    """Each thing's spots alone, in the order the rule prefers them, in the reach of its entry of ``by``
+    (else ``mounts``); by circles, each counting only the arms of ``able`` that can set it down (its entry;
+    None: every arm of the map), as one thing alone does (:func:`place_spots`: an arm holding something
+    else takes no spot away from another). A box's spots (:func:`box_spots`) keep its whole footprint over
+    the place, whichever arm has them."""
     surface = region_of(place, place.iri in smap.furniture)
     cx, cy, _ = surface.center
     boxed = rule.footprint == "box"
     circles = list(others) if boxed else [*others, *((x, y, foot.radius) for x, y, foot in lying)]
     lists: list[list[Spot]] = []
     ables = list(able) if able is not None else [None] * len(sizes)
-    for size, foot, arms in zip(sizes, shapes, ables, strict=True):
+    reaches = list(by) if by is not None else [mounts] * len(sizes)
+    for size, foot, arms, reach in zip(sizes, shapes, ables, reaches, strict=True):
         if boxed:
-            _, spots = box_spots(smap, place, foot, size[2], mounts, circles, lying)
+            _, spots = box_spots(smap, place, foot, size[2], reach, circles, lying)
         else:
-            _, spots = place_spots(smap, place, size, mounts, circles, arms)
+            _, spots = place_spots(smap, place, size, reach, circles, arms)
         if rule.toward == "rim":  # farthest from the centre first; on a tie the nearer an arm
-            near = [min((math.hypot(x - mx, y - my) for mx, my, _ in mounts), default=0.0) for x, y in spots]
+            near = [min((math.hypot(x - mx, y - my) for mx, my, _ in reach), default=0.0) for x, y in spots]
             ranked = sorted(
                 range(len(spots)),
                 key=lambda k: (-round(math.hypot(spots[k][0] - cx, spots[k][1] - cy), 6), round(near[k], 6), k),
@@ -465,6 +472,8 @@ def set_down_spots(
     holds: Holds | None = None,
     able: Sequence[Mount] | None = None,
     later_able: Sequence[Sequence[Mount] | None] | None = None,
+    later_by: Sequence[Sequence[Mount]] | None = None,
+    wider_by: Sequence[Sequence[Mount]] | None = None,
 ) -> tuple[Region, list[Spot]]:
     """The surface and spots of :func:`place_spots` (:func:`box_spots` for the rule's ``box`` footprints:
     ``foot``, ``later_feet``, else boxes along x) for an object set down on ``place``, when the plan puts
@@ -474,7 +483,9 @@ def set_down_spots(
     them (as many as the carry asks the arm about), then the rest. As the spots are ordered when nothing
     comes after it or no spot leaves room (the run goes on, and the later carry says what is in its way).
     ``able`` (this thing's) and ``later_able`` (each later thing's): the arms that can set it down
-    (:func:`place_spots`' ``able``, :func:`able_mounts`; None: every arm of the map)."""
+    (:func:`place_spots`' ``able``, :func:`able_mounts`; None: every arm of the map); ``later_by``: each
+    later thing's arms whose reach its spots are in (else ``mounts``), and ``wider_by`` those asked when no
+    spot leaves room within them (the arms free at its carry: it may go to another arm)."""
     boxed = rule.footprint == "box"
     mine = foot if foot is not None else Footprint.lying(size, 0.0)
     if boxed:
@@ -492,7 +503,6 @@ def set_down_spots(
         return asked[n, at]
 
     shapes = list(later_feet) if later_feet is not None else [Footprint.lying(each, 0.0) for each in later]
-    alone = _spot_lists(smap, place, later, mounts, others, rule, shapes, lying, later_able)  # without this thing
     clear: dict[tuple[int, int, int, float], bool] = {}  # a later thing clear of this one, by their grid offset
 
     def beside(n: int, at: Spot, spot: Spot, slack: float) -> bool:
@@ -503,7 +513,9 @@ def set_down_spots(
             clear[key] = clear_of(shapes[n], *at, [], [(*spot, mine.grown(slack))])
         return clear[key]
 
-    for slack in (SET_DOWN_SLACK, 0.0):
+    tiers = [later_by, *([wider_by] if wider_by is not None and wider_by != later_by else [])]
+    for by, slack in itertools.product(tiers, (SET_DOWN_SLACK, 0.0)):
+        alone = _spot_lists(smap, place, later, mounts, others, rule, shapes, lying, later_able, by)  # without it
         keeping: list[Spot] = []
         for x, y in spots:
             if boxed:
@@ -543,10 +555,9 @@ def puts_down(
     for step in plan.steps:
         device = step.device or ""
         if step.action in TAKING:
-            given = [values.get(name) for name in sorted(task_inputs_of(step, steps))]
-            iris = [str(v["@id"]) for v in given if isinstance(v, dict) and str(v.get("@id")) in smap.objects]
-            if len(iris) == 1:
-                holding[device] = iris[0]
+            taken = _taken(step, steps, smap, values)
+            if taken is not None:
+                holding[device] = taken
             else:
                 holding.pop(device, None)
             continue
@@ -556,6 +567,99 @@ def puts_down(
         if len(places) == 1:
             found.append(PutDown(step.index, device, places[0], holding.pop(device)))
     return found
+
+
+def _taken(step: PlanStep, steps: Mapping[int, PlanStep], smap: SemanticMap, values: Mapping[str, Any]) -> str | None:
+    """The one object of the map a taking step works on (the task's values, through the steps that compute
+    them), else None."""
+    given = [values.get(name) for name in sorted(task_inputs_of(step, steps))]
+    iris = [str(v["@id"]) for v in given if isinstance(v, dict) and str(v.get("@id")) in smap.objects]
+    return iris[0] if len(iris) == 1 else None
+
+
+APPROACHING = PREFIXES["act"] + "ApproachToObject"
+"""The taking step whose hold lasts until a carry sets the thing down (loading the platform ends its own)."""
+
+
+def arms_free(
+    plan: Plan,
+    smap: SemanticMap,
+    values: Mapping[str, Any],
+    where: Mapping[str, tuple[float, float, float]] | None = None,
+    held: Mapping[str, str] | None = None,
+    after: int | None = None,
+    known: Mapping[int, Mapping[str, Any]] | None = None,
+) -> dict[int, list[Arm]]:
+    """For each carry of ``plan`` that sets an object down on a place (:func:`puts_down`; by its step's
+    index), the arms of its robot that can set it down then: those that hold nothing else at that point of
+    the plan. An arm holds what it holds now (``held``: arm IRI to object IRI) until the robot's next carry
+    with no hold of the plan open sets it down, and what the plan's ApproachToObject takes until the carry
+    after it; another take before that carry leaves the first thing in its hand (the cup a task takes and
+    keeps while it puts the pen away). Which arm takes a thing is the run's choice (``who_takes``); here
+    the one it asks first (``arm_choice.reaching``): of the robot's free arms whose mount is within their
+    reach of the thing (where ``where`` puts it: x, y, radius; else the map), the nearest, on a tie (ARM_TIE)
+    the first by side, as the run cannot know which arm acted last. A take no arm is foreseen
+    for holds no arm. ``after``: the running step's index, whose own steps and those before are not walked
+    (``held`` is the world as it is then)."""
+    downs = {down.step: down for down in puts_down(plan, smap, values, known)}
+    steps = {step.index: step for step in plan.steps}
+    holding = dict(held or {})  # arm IRI: the object it holds
+    latest: dict[str, str] = {}  # by robot: the arm of its latest take that no carry has followed yet
+    found: dict[int, list[Arm]] = {}
+    walked = [step.index for step in plan.steps]
+    if after is not None and after in walked:
+        walked = walked[walked.index(after) + 1 :]
+    for index in walked:
+        step = steps[index]
+        device = step.device or ""
+        arms = sorted((arm for arm in smap.arms.values() if arm.robot == device), key=lambda arm: arm.side)
+        if step.action == APPROACHING:
+            taken = _taken(step, steps, smap, values)
+            arm = _taker(arms, holding, _at(taken, where, smap)) if taken is not None else None
+            if arm is not None and taken is not None:
+                holding[arm.iri] = taken
+                latest[device] = arm.iri
+            else:
+                latest.pop(device, None)
+            continue
+        if step.action != CARRYING:
+            continue
+        carrying = latest.pop(device, None)
+        if carrying is None:  # no take before it: it carries what the robot's one busy arm holds
+            busy = [arm.iri for arm in arms if arm.iri in holding]
+            carrying = busy[0] if len(busy) == 1 else None
+        if index in downs:
+            thing = downs[index].obj
+            found[index] = [arm for arm in arms if holding.get(arm.iri, thing) == thing]
+        if carrying is not None:
+            holding.pop(carrying, None)  # set down there
+    return found
+
+
+def _at(
+    iri: str | None, where: Mapping[str, tuple[float, float, float]] | None, smap: SemanticMap
+) -> tuple[float, float] | None:
+    if iri is None:
+        return None
+    if where is not None and iri in where:
+        return where[iri][0], where[iri][1]
+    obj = smap.objects.get(iri)
+    return (obj.start.x, obj.start.y) if obj is not None else None
+
+
+def _taker(arms: Sequence[Arm], holding: Mapping[str, str], at: tuple[float, float] | None) -> Arm | None:
+    """The arm the run asks first to take a thing at ``at``: the free one nearest it within its reach."""
+    if at is None:
+        return None
+    options = [
+        (distance, arm)
+        for arm in arms
+        if arm.iri not in holding and (distance := math.hypot(at[0] - arm.mount[0], at[1] - arm.mount[1])) <= arm.reach
+    ]
+    if not options:
+        return None
+    best = min(distance for distance, _ in options)
+    return min((arm for distance, arm in options if distance - best <= ARM_TIE), key=lambda arm: arm.side)
 
 
 def _given_iris(step: PlanStep, values: Mapping[str, Any], known: Mapping[int, Mapping[str, Any]] | None) -> list[str]:
@@ -576,6 +680,19 @@ def packed_with(
 ) -> tuple[list[str], list[str]]:
     """The objects (IRIs) the plan's carries by the robot of ``step`` (a carry) set down on ``place`` before
     it and after it, each in the plan's order; none when the plan or the step is not known."""
+    earlier, later = _packed(plan, step, smap, place, values, known)
+    return [down.obj for down in earlier], [down.obj for down in later]
+
+
+def _packed(
+    plan: Plan | None,
+    step: PlanStep | None,
+    smap: SemanticMap,
+    place: str,
+    values: Mapping[str, Any],
+    known: Mapping[int, Mapping[str, Any]] | None = None,
+) -> tuple[list[PutDown], list[PutDown]]:
+    """:func:`packed_with`'s put-downs themselves."""
     if plan is None or step is None:
         return [], []
     order = [each.index for each in plan.steps]
@@ -588,7 +705,7 @@ def packed_with(
         for down in puts_down(plan, smap, values, known)
         if down.place == place and down.device == (step.device or "")
     ]
-    return [down.obj for down in mine if down.step in before], [down.obj for down in mine if down.step in after]
+    return [down for down in mine if down.step in before], [down for down in mine if down.step in after]
 
 
 def later_sizes(
@@ -618,29 +735,65 @@ def carry_spots(
     size = obj.size if obj is not None else (0.0, 0.0, 0.0)
     mounts = [reach_of(world.arm_specs[side])]
     others = other_objects(world, ctx.belief, carried)
-    earlier, later = packed_with(ctx.plan, step, smap, place.iri, ctx.given, ctx.known)
+    earlier, downs = _packed(ctx.plan, step, smap, place.iri, ctx.given, ctx.known)
     able = able_mounts(world, carried)  # an arm holding something else leaves this one its spots
-    if obj is None or not (earlier or later):
+    if obj is None or step is None or ctx.plan is None or not (earlier or downs):
         return place_spots(smap, place, size, mounts, others, able)
-    coming = [smap.objects[iri] for iri in later]
-    # a later thing's: the arms holding nothing, it, or what is carried now (set down before it)
-    later_able = [able_mounts(world, each.name, carried) for each in coming]
+    coming = [smap.objects[down.obj] for down in downs]
+    # a later thing's arms: those free at its carry, what the plan takes and keeps until then counted
+    # (arms_free; the world's arms as they are now, what is carried now set down before it)
+    found = other_objects(world, ctx.belief)
+    where = {each.iri: spot for each, spot in zip(world.objects.values(), found, strict=True)}
+    free = arms_free(ctx.plan, smap, ctx.given, where, held_now(world, carried), step.index, ctx.known)
+    later_arms = [free.get(down.step, []) for down in downs]
+    later_able = [[reach_of(arm) for arm in arms] for arms in later_arms]
+    # within the reach of the arm that sets this one down where it is free then, as before; else of those that are
+    later_by = [
+        mounts if any(arm.side == side.value for arm in arms) else list(reach)
+        for arms, reach in zip(later_arms, later_able, strict=True)
+    ]
     surface, _ = support_of(smap, place)
-    holds = _HoldAsked(ctx, coming, surface)
+    holds = _HoldAsked(ctx, coming, surface, [{ArmSide(arm.side) for arm in arms} for arms in later_arms])
     sizes = [each.size for each in coming]
     circles = replace(rule, footprint="circle")
     if rule.footprint == "circle" or (
-        rule.footprint == "auto" and _circles_hold(smap, place, size, sizes, mounts, others, [able, *later_able])
+        rule.footprint == "auto"
+        and _circles_hold(smap, place, size, sizes, mounts, others, [able, *later_able], [mounts, *later_by])
     ):
         return set_down_spots(
-            smap, place, size, mounts, others, sizes, circles, holds=holds, able=able, later_able=later_able
+            smap,
+            place,
+            size,
+            mounts,
+            others,
+            sizes,
+            circles,
+            holds=holds,
+            able=able,
+            later_able=later_able,
+            later_by=later_by,
+            wider_by=later_able,
         )
     rule = replace(rule, footprint="box")
     names = [name for name in world.objects if name != carried]  # in the order of ``others``
     lying = [(x, y, footprint_of(world.objects[name])) for name, (x, y, _) in zip(names, others, strict=True)]
     feet = [footprint_of(each) for each in coming]
     try:
-        return set_down_spots(smap, place, size, mounts, [], sizes, rule, footprint_of(obj), feet, lying, holds)
+        return set_down_spots(
+            smap,
+            place,
+            size,
+            mounts,
+            [],
+            sizes,
+            rule,
+            footprint_of(obj),
+            feet,
+            lying,
+            holds,
+            later_by=later_by,
+            wider_by=later_able,
+        )
     except Undecided:  # more spots asked of the arms than HOLD_TRIES: as for one thing alone
         return place_spots(smap, place, size, mounts, others, able)
 
@@ -653,13 +806,15 @@ def _circles_hold(
     mounts: Sequence[Mount],
     others: Sequence[tuple[float, float, float]],
     able: Sequence[Sequence[Mount] | None] | None = None,
+    by: Sequence[Sequence[Mount]] | None = None,
 ) -> bool:
     """Whether circles hold the thing carried now and those the plan puts on ``place`` after it, beside
     what is there (the ``auto`` rule's first question; undecided counts as holding, as circles did);
-    ``able``: each one's arms that can set it down, as :func:`arrange`'s."""
+    ``able`` and ``by``: each one's arms that can set it down, and whose reach its spots are in, as
+    :func:`arrange`'s."""
     try:
         circles = PackingRule(footprint="circle")
-        return arrange(smap, place, [size, *later], mounts, others, circles, able=able) is not None
+        return arrange(smap, place, [size, *later], mounts, others, circles, able=able, by=by) is not None
     except Undecided:
         return True
 
@@ -673,15 +828,23 @@ class _HoldAsked:
     """Whether an arm can set each thing of a packing down at a spot of ``surface`` (:data:`Holds`), each
     asked once, and why not; :class:`Undecided` past HOLD_TRIES questions."""
 
-    def __init__(self, ctx: SimContext, objects: Sequence[MapObject], surface: Region) -> None:
+    def __init__(
+        self,
+        ctx: SimContext,
+        objects: Sequence[MapObject],
+        surface: Region,
+        sides: Sequence[Collection[ArmSide]] | None = None,
+    ) -> None:
         self.ctx, self.objects, self.surface = ctx, objects, surface
+        self.sides = sides  # each thing's arms that can set it down then (None: every arm of the robot)
         self.answers: dict[tuple[int, Spot], str] = {}
 
     def __call__(self, n: int, at: Spot) -> bool:
         if (n, at) not in self.answers:
             if len(self.answers) >= HOLD_TRIES:
                 raise Undecided()
-            self.answers[n, at] = cannot_set_down(self.ctx, self.objects[n], self.surface, at)
+            sides = self.sides[n] if self.sides is not None else None
+            self.answers[n, at] = cannot_set_down(self.ctx, self.objects[n], self.surface, at, sides)
         return not self.answers[n, at]
 
     def refused(self) -> list[tuple[str, int, int, str]]:
@@ -702,7 +865,7 @@ def check_room(ctx: SimContext, plan: Plan, values: Mapping[str, Any], rule: Pac
     world = ctx.world
     found = other_objects(world, ctx.belief)
     where = {obj.iri: spot for obj, spot in zip(world.objects.values(), found, strict=True)}
-    refused = overfilled(world.map, plan, values, where, rule, ctx)
+    refused = overfilled(world.map, plan, values, where, rule, ctx, held_now(world))
     if refused is not None:
         raise refused
 
@@ -714,29 +877,33 @@ def overfilled(
     where: Mapping[str, tuple[float, float, float]],
     rule: PackingRule = PackingRule(),
     ctx: SimContext | None = None,
+    held: Mapping[str, str] | None = None,
 ) -> PlaceOverfilledError | None:
     """Why ``plan`` puts several objects on one place when no arrangement of their footprints (the rule's:
     the map's boxes, turned as it says they lie, or circles) on its spots holds them all (:func:`arrange`),
-    with the objects of ``where`` (IRI: x, y, footprint radius) that it does not carry where they are, and
-    by the arms of the robot that sets them down; given ``ctx``, each where an arm can hold it
-    (:func:`arm_choice.cannot_set_down`). None when each such place holds them, or when the search is
-    undecided. A place that has no spot for one of them alone is left to the check of each step
-    (``run_checks.PlanChecks._check_spot``), which says why. The ``auto`` rule refuses what neither
-    circles nor boxes hold (with the boxes' words)."""
+    with the objects of ``where`` (IRI: x, y, footprint radius) that it does not carry where they are, each
+    by the arms of the robot that sets them down that are free at its carry (:func:`arms_free`: not holding,
+    then, what they hold now, ``held``: arm IRI to object IRI, or what the plan took and keeps); given
+    ``ctx``, each where one of those arms can hold it (:func:`arm_choice.cannot_set_down`). None when each
+    such place holds them, or when the search is undecided. A place that has no spot for one of them alone
+    is left to the check of each step (``run_checks.PlanChecks._check_spot``), which says why. The ``auto``
+    rule refuses what neither circles nor boxes hold (with the boxes' words)."""
     if rule.footprint == "auto":
-        if overfilled(smap, plan, values, where, replace(rule, footprint="circle"), ctx) is None:
+        if overfilled(smap, plan, values, where, replace(rule, footprint="circle"), ctx, held) is None:
             return None
-        return overfilled(smap, plan, values, where, replace(rule, footprint="box"), ctx)
-    by_place: dict[tuple[str, str], list[str]] = {}
+        return overfilled(smap, plan, values, where, replace(rule, footprint="box"), ctx, held)
+    free = arms_free(plan, smap, values, where, held)
+    by_place: dict[tuple[str, str], dict[str, list[Arm]]] = {}
     for down in puts_down(plan, smap, values):
-        objects = by_place.setdefault((down.place, down.device), [])
-        if down.obj not in objects:
-            objects.append(down.obj)
+        arms_of = by_place.setdefault((down.place, down.device), {})
+        arms_of.setdefault(down.obj, free.get(down.step, []))  # at its first carry there
     boxed = rule.footprint == "box"
-    for (iri, device), objects in by_place.items():
-        if len(objects) < 2:
+    for (iri, _), carried in by_place.items():
+        if len(carried) < 2:
             continue
-        mounts = [(arm.mount[0], arm.mount[1], arm.reach) for arm in smap.arms.values() if arm.robot == device]
+        objects = list(carried)
+        by = [[reach_of(arm) for arm in arms] for arms in carried.values()]
+        mounts = list(dict.fromkeys(reach for reach in itertools.chain(*by)))
         place = smap.things[iri]
         rest = [(other, spot) for other, spot in where.items() if other not in objects]
         sizes = [smap.objects[obj].size for obj in objects]
@@ -746,12 +913,14 @@ def overfilled(
             lying = [(x, y, footprint_of(smap.objects[other])) for other, (x, y, _) in rest if other in smap.objects]
         else:
             others, lying = [spot for _, spot in rest], []
-        if not all(place_spots(smap, place, size, mounts, [spot for _, spot in rest])[1] for size in sizes):
+        around = [spot for _, spot in rest]
+        if not all(place_spots(smap, place, size, arms, around, arms)[1] for size, arms in zip(sizes, by, strict=True)):
             continue  # one alone has no spot: the step's own check says why
         surface = region_of(place, iri in smap.furniture)
-        holds = _HoldAsked(ctx, [smap.objects[obj] for obj in objects], surface) if ctx is not None else None
+        sides = [{ArmSide(arm.side) for arm in arms} for arms in carried.values()]
+        holds = _HoldAsked(ctx, [smap.objects[obj] for obj in objects], surface, sides) if ctx is not None else None
         try:
-            if arrange(smap, place, sizes, mounts, others, rule, PACK_BUDGET, feet, lying, holds) is not None:
+            if arrange(smap, place, sizes, mounts, others, rule, PACK_BUDGET, feet, lying, holds, by, by) is not None:
                 continue
         except Undecided:
             log.info("room check: whether %s holds %s is undecided; the run goes on", iri, ", ".join(objects))

@@ -96,6 +96,18 @@ def able_mounts(world: HomeWorld, carried: str, *also: str) -> list[tuple[float,
     ]
 
 
+def held_now(world: HomeWorld, *leaving: str) -> dict[str, str]:
+    """What the world's arms hold now: object IRI by arm IRI, but the things of ``leaving`` (names: set down
+    before what is asked about)."""
+    found = {}
+    for side, spec in sorted(world.arm_specs.items()):
+        body = world.arm(side).held
+        name = world.name_of(body) if body is not None else None
+        if name is not None and name in world.objects and name not in leaving:
+            found[spec.iri] = world.objects[name].iri
+    return found
+
+
 def other_objects(world: HomeWorld, belief: PerceivedWorld | None, *names: str) -> list[tuple[float, float, float]]:
     """The objects other than ``names`` as (x, y, footprint radius): where each is believed to be, else
     where the map puts it."""

@@ -123,7 +123,7 @@ def test_a_spot_no_arm_can_hold_is_passed_over_and_a_place_with_none_is_refused_
     assert held is not None and held[1] != free[1] and (1, free[1]) in asked
     why = "the right arm cannot hold the Pencil1 by its top grasp over NarrowShelf1 at (8.55, 2.66)"
 
-    def refusing(ctx: Any, obj: MapObject, surface: Region, at: tuple[float, float]) -> str:
+    def refusing(ctx: Any, obj: MapObject, surface: Region, at: tuple[float, float], sides: Any = None) -> str:
         return why if obj.iri == PENCIL else ""
 
     monkeypatch.setattr(packing, "cannot_set_down", refusing)

@@ -1,0 +1,282 @@
+"""Room on a place judged by the arms that will be free to set each thing down (sim/packing.py: arms_free,
+carry_spots, overfilled; docs/execution.md, "Room on a top: which arms count"). A task takes the cup and keeps
+it while it puts the eraser and the pen on a mat at the table's front, which the left arm reaches whole and
+the right arm only along its east part: the left arm, the only one that reaches the cup, is busy from the
+cup's take on. Before, the check before the run counted every arm of the robot, and the eraser's spot was
+chosen leaving the pen room by arms free at the eraser's carry, the left among them. Asked of the map and
+the plan alone: no world is built (a stand-in gives the map's arms and objects, both arms empty before the
+run), and every spot in reach counts as one an arm can hold the thing over."""
+
+from __future__ import annotations
+
+import itertools
+import math
+from types import SimpleNamespace
+from typing import Any, cast
+
+import pytest
+
+from cbrs.actions.composer import Composer
+from cbrs.actions.plan import Plan
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.semantic_map import SemanticMap
+from cbrs.sim import packing
+from cbrs.sim.arms import ArmSide
+from cbrs.sim.context import SimContext
+from cbrs.sim.packing import (
+    SET_DOWN_SLACK,
+    PackingRule,
+    PlaceOverfilledError,
+    arms_free,
+    carry_spots,
+    overfilled,
+    puts_down,
+    radius_of,
+)
+from cbrs.sim.place_spots import RELAY_CLEARANCE, place_spots, reach_of
+from tests.helpers_examples import EXAMPLES
+
+WORLD, LAB6 = PREFIXES["world"], "https://example.org/lab6#"
+MAT, PEN, ERASER, CUP = LAB6 + "Mat1", WORLD + "Pen", LAB6 + "Eraser1", WORLD + "Cup"
+LEFT, RIGHT = WORLD + "CytonDualArm01LeftArm", WORLD + "CytonDualArm01RightArm"
+VALUES: dict[str, Any] = {"pen": {"@id": PEN}, "eraser": {"@id": ERASER}, "cup": {"@id": CUP}, "mat": {"@id": MAT}}
+CIRCLE = PackingRule(footprint="circle")
+Mats = tuple[SemanticMap, SemanticMap, Plan, Plan, Plan]
+
+# A mat at the front of the kitchen table, 40 x 23 cm: the left arm reaches it whole, the right arm its east
+# part, which has spots for the eraser's whole footprint and for the pen's centre only. The cup moved from
+# (7.45, 3.32), on the mat, to the table's west, where only the left arm reaches it.
+MAT_MAP = """
+@prefix home: <https://w3id.org/cbrs/home#> .
+@prefix world: <https://w3id.org/cbrs/world#> .
+@prefix lab6: <https://example.org/lab6#> .
+@prefix owl: <http://www.w3.org/2002/07/owl#> .
+@prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .
+lab6:Mat a owl:Class ; rdfs:subClassOf home:ObjectPlace ; rdfs:label "mat"@en .
+lab6:Mat1 a lab6:Mat ; home:isLocated world:Kitchen ;
+    home:minX 7.35 ; home:maxX 7.75 ; home:minY 3.22 ; home:maxY 3.45 ; home:minZ 0.75 ; home:maxZ 0.78 .
+"""
+CUP_WEST = """
+PREFIX home: <https://w3id.org/cbrs/home#>
+PREFIX world: <https://w3id.org/cbrs/world#>
+DELETE { GRAPH <https://w3id.org/cbrs/graph/map> { world:Cup home:x ?x ; home:y ?y } }
+INSERT { GRAPH <https://w3id.org/cbrs/graph/map> { world:Cup home:x 7.10 ; home:y 3.20 } }
+WHERE { GRAPH <https://w3id.org/cbrs/graph/map> { world:Cup home:x ?x ; home:y ?y } }
+"""
+# The mat 30 x 20 cm, 5 cm farther west (x 7.30-7.60, y 3.20-3.40): the right arm's part of it holds the
+# eraser or the pen, not both, by circles or by boxes; the left arm's part holds both.
+MAT_WEST = """
+PREFIX home: <https://w3id.org/cbrs/home#>
+PREFIX lab6: <https://example.org/lab6#>
+DELETE { GRAPH <https://w3id.org/cbrs/graph/map> {
+    lab6:Mat1 home:minX ?a ; home:maxX ?b ; home:minY ?c ; home:maxY ?d } }
+INSERT { GRAPH <https://w3id.org/cbrs/graph/map> {
+    lab6:Mat1 home:minX 7.30 ; home:maxX 7.60 ; home:minY 3.20 ; home:maxY 3.40 } }
+WHERE { GRAPH <https://w3id.org/cbrs/graph/map> {
+    lab6:Mat1 home:minX ?a ; home:maxX ?b ; home:minY ?c ; home:maxY ?d } }
+"""
+
+
+def _task(name: str, *parts: str) -> str:
+    """A task of parts in order (docs/tasks.md, "Several things in one task"): each part one thing, the
+    cup's part a take whose goal is the cup in a gripper (no carry ends that hold)."""
+    some = " ,\n        ".join(
+        f"[ a owl:Restriction ; owl:onProperty act:subAction ; owl:someValuesFrom lab6:{part} ]" for part in parts
+    )
+    orders = " , ".join(f"lab6:{name}_{n}" for n in range(1, len(parts)))
+    each = "".join(
+        f"lab6:{name}_{n} a owl:NamedIndividual , act:PartialOrderingStrict ;\n"
+        f"    act:occursBefore lab6:{before} ; act:occursAfter lab6:{after} .\n"
+        for n, (before, after) in enumerate(itertools.pairwise(parts), start=1)
+    )
+    cup = (
+        '        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "cup" ; cbrs:parameterType home:Cup ] ;\n'
+        if "KeepCup" in parts
+        else ""
+    )
+    return f"""
+lab6:{name} a owl:Class ; rdfs:subClassOf act:PhysicalAction ;
+    rdfs:subClassOf {some} ;
+    act:orderingConstraint {orders} .
+{each}lab6:{name}Task a cbrs:Requirement ;
+    cbrs:requestedBy svc:CytonDualArm01 ; cbrs:deviceName "CytonDualArm01" ; cbrs:serviceName "{name}" ;
+    cbrs:forTask lab6:{name} ;
+    cbrs:hasOWLSModel [ a cbrs:OWLSModel ;
+        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "pen" ; cbrs:parameterType home:Pen ] ;
+        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "eraser" ; cbrs:parameterType lab6:Eraser ] ;
+{cup}        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "mat" ; cbrs:parameterType lab6:Mat ] ;
+        cbrs:hasEffect [ a cbrs:Effect ; cbrs:conditionSubject home:Pen ; cbrs:conditionPredicate home:isLocated ;
+            cbrs:conditionObject lab6:Mat ] ;
+        cbrs:hasEffect [ a cbrs:Effect ; cbrs:conditionSubject lab6:Eraser ; cbrs:conditionPredicate home:isLocated ;
+            cbrs:conditionObject lab6:Mat ] ] .
+"""
+
+
+def _part(name: str, thing: str, kind: str, goal: str) -> str:
+    return f"""
+lab6:{name} a owl:Class ; rdfs:subClassOf act:PhysicalAction .
+lab6:{name}Task a cbrs:Requirement ;
+    cbrs:requestedBy svc:CytonDualArm01 ; cbrs:deviceName "CytonDualArm01" ; cbrs:serviceName "{name}" ;
+    cbrs:forTask lab6:{name} ;
+    cbrs:hasOWLSModel [ a cbrs:OWLSModel ;
+        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "{thing}" ; cbrs:parameterType {kind} ] ;
+        {goal} ] .
+"""
+
+
+def _onto_mat(kind: str) -> str:
+    return (
+        f'cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "mat" ; cbrs:parameterType lab6:Mat ] ;\n'
+        f"        cbrs:hasEffect [ a cbrs:Effect ; cbrs:conditionSubject {kind} ;"
+        " cbrs:conditionPredicate home:isLocated ; cbrs:conditionObject lab6:Mat ]"
+    )
+
+
+TASKS = (
+    "@prefix cbrs: <https://w3id.org/cbrs/core#> .\n@prefix home: <https://w3id.org/cbrs/home#> .\n"
+    "@prefix act: <https://w3id.org/cbrs/action#> .\n@prefix svc: <https://w3id.org/cbrs/service#> .\n"
+    "@prefix lab6: <https://example.org/lab6#> .\n@prefix owl: <http://www.w3.org/2002/07/owl#> .\n"
+    "@prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .\n"
+    + _part("EraserOntoMat", "eraser", "lab6:Eraser", _onto_mat("lab6:Eraser"))
+    + _part("PenOntoMat", "pen", "home:Pen", _onto_mat("home:Pen"))
+    + _part(
+        "KeepCup",
+        "cup",
+        "home:Cup",
+        "cbrs:hasEffect [ a cbrs:Effect ; cbrs:conditionSubject home:Cup ; cbrs:conditionPredicate home:isGraspedBy ;"
+        " cbrs:conditionObject home:Gripper ]",
+    )
+    + _task("EraserCupPen", "EraserOntoMat", "KeepCup", "PenOntoMat")
+    + _task("CupEraserPen", "KeepCup", "EraserOntoMat", "PenOntoMat")
+    + _task("EraserThenPen", "EraserOntoMat", "PenOntoMat")
+)
+
+
+@pytest.fixture(scope="module")
+def mat(tmp_path_factory: pytest.TempPathFactory) -> Mats:
+    """The map with the mat at the table's front, the map with it 5 cm farther west, and the plans of
+    EraserCupPen (the cup taken between the eraser's carry and the pen's), CupEraserPen (first) and
+    EraserThenPen (no cup)."""
+    directory = tmp_path_factory.mktemp("mat")
+    (directory / "mat.ttl").write_text(MAT_MAP, encoding="utf-8")
+    (directory / "tasks.ttl").write_text(TASKS, encoding="utf-8")
+    kb = KnowledgeBase.open(":memory:")
+    for graph in ("ontology", "map"):
+        kb.load([EXAMPLES / "lab6_tidy_shelf.ttl", directory / "mat.ttl"], graph=graph)
+    kb.load([directory / "tasks.ttl"], graph="requirements")
+    kb.update(CUP_WEST)
+    composer = Composer(kb)
+    between, first = composer.compose("EraserCupPen").plan, composer.compose("CupEraserPen").plan
+    plain = composer.compose("EraserThenPen").plan
+    assert between is not None and first is not None and plain is not None
+    front = SemanticMap.read(kb)
+    kb.update(MAT_WEST)
+    return front, SemanticMap.read(kb), between, first, plain
+
+
+def _where(smap: SemanticMap) -> dict[str, tuple[float, float, float]]:
+    return {iri: (o.start.x, o.start.y, radius_of(o.size)) for iri, o in smap.objects.items()}
+
+
+def test_the_plan_keeps_the_cup_in_the_left_hand_through_the_pens_carry(
+    mat: Mats,
+) -> None:
+    smap, _, between, first, _ = mat
+    downs = puts_down(between, smap, VALUES)
+    assert [(down.place, down.obj) for down in downs] == [(MAT, ERASER), (MAT, PEN)]
+    free = arms_free(between, smap, VALUES, _where(smap))
+    assert [[arm.iri for arm in free[down.step]] for down in downs] == [[LEFT, RIGHT], [RIGHT]]
+    free = arms_free(first, smap, VALUES, _where(smap))  # the cup taken first: busy at both carries
+    assert [[arm.iri for arm in arms] for arms in free.values()] == [[RIGHT], [RIGHT]]
+    # what an arm holds before the run and the plan never sets down keeps it busy too
+    held = arms_free(between, smap, VALUES, _where(smap), {LEFT: LAB6 + "Keys"})
+    assert [[arm.iri for arm in held[down.step]] for down in downs] == [[RIGHT], [RIGHT]]
+
+
+def test_the_check_before_the_run_counts_only_the_arms_free_at_each_carry(
+    mat: Mats,
+) -> None:
+    """On the mat 30 x 20 cm 5 cm farther west the right arm's part holds the eraser or the pen, not both. With the
+    cup kept from the start, the left arm is busy at both carries: refused (before, every arm of the robot
+    counted, and the left arm's part held both). With the cup taken between the carries, the eraser goes
+    where the left arm reaches, and the pen fits the right arm's part beside it: not refused."""
+    _, west, between, first, _ = mat
+    where = _where(west)
+    refused = overfilled(west, first, VALUES, where, CIRCLE)
+    assert isinstance(refused, PlaceOverfilledError) and refused.place == MAT
+    assert sorted(iri for iri, _ in refused.objects) == sorted([ERASER, PEN])
+    assert overfilled(west, first, VALUES, where) is not None  # nor by boxes
+    assert overfilled(west, between, VALUES, where, CIRCLE) is None
+
+
+def _context(smap: SemanticMap, plan: Plan, step_index: int) -> SimContext:
+    """A context over a stand-in world of the map's arms and objects, both arms empty, running the step."""
+    world = SimpleNamespace(
+        map=smap,
+        objects={obj.name: obj for obj in smap.objects.values()},
+        arm_specs={ArmSide(arm.side): arm for arm in smap.arms.values()},
+        arm=lambda side: SimpleNamespace(held=None),
+    )
+    step = next(s for s in plan.steps if s.index == step_index)
+    return SimContext(
+        cast(Any, world), cast(Any, None), plan=plan, given=VALUES, component=step.candidates[0], step=step
+    )
+
+
+def test_the_erasers_spot_leaves_the_pen_room_where_the_arm_free_at_its_carry_reaches(
+    mat: Mats, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The eraser, carried by the right arm (the only one that reaches it), first: the left arm is free
+    then, and it reaches the whole pen over the mat, so by circles the right arm's spots for the pen were
+    none where the left arm has one (place_spots), no eraser spot was found leaving room, and the eraser
+    went to the first, nearest the centre, where the pen has no spot left by the right arm, the one free at
+    its carry. Now the pen's room is judged by the right arm alone. By the default rule the carry went to
+    boxes, circles not seeming to hold the two; now circles hold them and are packed by, the safer
+    (docs/simulation.md, "Circles first")."""
+    smap, _, between, _, _ = mat
+    monkeypatch.setattr(packing, "cannot_set_down", lambda *_: "")  # every arm holds every spot
+    eraser_carry = puts_down(between, smap, VALUES)[0].step
+    step = next(s for s in between.steps if s.index == eraser_carry)
+    ctx = _context(smap, between, eraser_carry)
+    place = smap.things[MAT]
+    _, spots = carry_spots(ctx, place, "Eraser1", ArmSide.RIGHT, step, CIRCLE)
+    assert carry_spots(ctx, place, "Eraser1", ArmSide.RIGHT, step)[1] == spots
+    right = reach_of(smap.arms[RIGHT])
+    eraser, pen = smap.objects[ERASER].size, smap.objects[PEN].size
+    around = [(o.start.x, o.start.y, radius_of(o.size)) for iri, o in smap.objects.items() if iri not in (ERASER, PEN)]
+    lying = (*spots[0], radius_of(eraser) + SET_DOWN_SLACK)
+    assert place_spots(smap, place, pen, [right], [*around, lying], [right])[1]
+    centre_first = place_spots(smap, place, eraser, [right], around, [right])[1][0]
+    assert spots[0] != centre_first
+    gone = (*centre_first, radius_of(eraser))
+    assert place_spots(smap, place, pen, [right], [*around, gone], [right])[1] == []  # where it went before
+
+
+def test_where_the_carrying_arm_leaves_no_room_the_arms_free_then_are_asked(
+    mat: Mats, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """EraserThenPen on the west mat, nothing kept: the right arm's part holds the eraser or the pen, not
+    both, so no spot of the eraser's leaves the pen room within the right arm's reach, and the eraser went to
+    its spot nearest the centre as for one thing alone, though the check before the run, counting both
+    arms, let the task run. The pen may go to the left arm, free at its carry: the eraser's first spot now
+    leaves the pen a spot the left arm reaches, which the spot nearest the centre does not."""
+    _, west, _, _, plain = mat
+    monkeypatch.setattr(packing, "cannot_set_down", lambda *_: "")
+    eraser_carry = puts_down(plain, west, VALUES)[0].step
+    step = next(s for s in plain.steps if s.index == eraser_carry)
+    ctx = _context(west, plain, eraser_carry)
+    place = west.things[MAT]
+    both = [reach_of(arm) for arm in west.arms.values()]
+    right = reach_of(west.arms[RIGHT])
+    eraser, pen = west.objects[ERASER].size, west.objects[PEN].size
+    around = [(o.start.x, o.start.y, radius_of(o.size)) for iri, o in west.objects.items() if iri not in (ERASER, PEN)]
+    assert overfilled(west, plain, VALUES, _where(west)) is None
+    _, spots = carry_spots(ctx, place, "Eraser1", ArmSide.RIGHT, step, CIRCLE)
+    alone = place_spots(west, place, eraser, [right], around, both)[1]
+    assert sorted(spots) == sorted(alone) and spots[0] != alone[0]
+    apart = radius_of(pen) + radius_of(eraser) + RELAY_CLEARANCE  # no spot leaves room 2 cm off
+    for at, room in ((spots[0], True), (alone[0], False)):
+        for arms, left in ((both, room), ([right], False)):  # the pen's own spots, clear of the eraser
+            pens = place_spots(west, place, pen, arms, around, arms)[1]
+            assert any(math.dist(at, spot) >= apart for spot in pens) is left
