@@ -267,11 +267,11 @@ _ESCAPE = re.compile(r"\\[uU]")
 
 @dataclass(frozen=True)
 class Reach:
-    """What statements an update's text may remove: any (``anything``), else those of these predicates
-    (about any subject) and those in these graphs."""
+    """What statements an update's text may remove: any (``anything``), else those of these patterns
+    (subject, predicate, graph; a subject or graph None: any), and every statement of these graphs."""
 
     anything: bool = False
-    predicates: frozenset[ox.NamedNode] = frozenset()
+    statements: frozenset[tuple[ox.NamedNode | None, ox.NamedNode, ox.NamedNode | None]] = frozenset()
     graphs: frozenset[ox.NamedNode] = frozenset()
 
 
@@ -291,7 +291,7 @@ def removal_reach(text: str) -> Reach | None:
         return _ANYTHING
     words = [token.upper() for token in tokens]
     names = _Names(tokens, words)
-    predicates: set[ox.NamedNode] = set()
+    statements: set[tuple[ox.NamedNode | None, ox.NamedNode, ox.NamedNode | None]] = set()
     graphs: set[ox.NamedNode] = set()
     for position, word in enumerate(words):
         if word == "DELETE":
@@ -300,20 +300,22 @@ def removal_reach(text: str) -> Reach | None:
             triples = _triples(tokens[opening + 1 : end]) if end is not None else None
             if triples is None:
                 return _ANYTHING
-            for subject, predicate in triples:
+            within = tokens[position - 1] if words[position - 2 : position - 1] == ["WITH"] else None
+            for subject, predicate, graph in triples:
                 if names.may_be_ours(subject):
                     node = names.node(predicate)
                     if node is None:
                         return _ANYTHING
-                    predicates.add(node)
+                    named = graph or within  # a GRAPH block's, else WITH's; else any (the default graph)
+                    statements.add((names.node(subject), node, names.node(named) if named is not None else None))
         elif word in ("CLEAR", "DROP", "MOVE", "COPY"):
             emptied = _emptied(tokens[position:], words[position:], names)
             if emptied is None:
                 return _ANYTHING
             graphs |= emptied
-    if not predicates and not graphs:
+    if not statements and not graphs:
         return None
-    return Reach(False, frozenset(predicates), frozenset(graphs))
+    return Reach(False, frozenset(statements), frozenset(graphs))
 
 
 class _Names:
@@ -353,29 +355,34 @@ class _Names:
         return iri is None or iri.startswith(OWN_NAMESPACES)
 
 
-def _triples(template: Sequence[str]) -> list[tuple[str, str]] | None:
-    """The (subject, predicate) of each triple of a template's tokens (inside its braces), read as Turtle
-    is, with ``GRAPH`` blocks; None for what it does not read (brackets, quoted triples, a stray token).
-    States: S a subject, P a predicate, O an object, A after an object."""
-    found: list[tuple[str, str]] = []
+def _triples(template: Sequence[str]) -> list[tuple[str, str, str | None]] | None:
+    """The (subject, predicate, the ``GRAPH`` block's name or None) of each triple of a template's tokens
+    (inside its braces), read as Turtle is; None for what it does not read (brackets, quoted triples, a
+    stray token). States: S a subject, P a predicate, O an object, A after an object."""
+    found: list[tuple[str, str, str | None]] = []
     state, subject = "S", ""
+    graph: str | None = None
     tokens = iter(template)
     for token in tokens:
-        if token in ("[", "(", "<<") or token.startswith("<<"):
+        if token in ("[", "(", "<") or token.startswith("<<"):  # a blank node, a collection, a quoted triple
             return None
-        if token == "^^" or token.upper() == "GRAPH":
-            next(tokens, None)  # the datatype, or the graph's name (its '{' follows)
+        if token.upper() == "GRAPH":
+            graph = next(tokens, None)  # its '{' follows
+        elif token == "^^":
+            next(tokens, None)  # the datatype
         elif token.startswith("@") or (token == "." and state == "S"):
             continue  # a language tag; an empty statement
         elif token in ("{", "}"):
             state = "S"
+            if token == "}":
+                graph = None
         elif state == "S":
             subject, state = token, "P"
         elif state == "P":
             if token in (".", ";"):
                 state = "S" if token == "." else "P"
                 continue
-            found.append((subject, token))
+            found.append((subject, token, graph))
             state = "O"
         elif state == "O":
             state = "A"
@@ -412,6 +419,11 @@ _SAID_WITH = (
     "WHERE { ?x <http://www.w3.org/2000/01/rdf-schema#subClassOf> ?c . ?c ?p ?o .\n"
     "  FILTER (STRSTARTS(STR(?c), ?ns0) || STRSTARTS(STR(?c), ?ns1) || STRSTARTS(STR(?c), ?ns2)) } LIMIT 1"
 )
+_SAID_WITH_IN = (
+    "SELECT ?c ?p ?g ?ns0 ?ns1 ?ns2\n"
+    "WHERE { ?x <http://www.w3.org/2000/01/rdf-schema#subClassOf> ?c . GRAPH ?g { ?c ?p ?o }\n"
+    "  FILTER (STRSTARTS(STR(?c), ?ns0) || STRSTARTS(STR(?c), ?ns1) || STRSTARTS(STR(?c), ?ns2)) } LIMIT 1"
+)
 _SAID_IN = (
     "SELECT ?c ?g ?ns0 ?ns1 ?ns2\n"
     "WHERE { ?x <http://www.w3.org/2000/01/rdf-schema#subClassOf> ?c . GRAPH ?g { ?c ?p ?o }\n"
@@ -429,9 +441,10 @@ def may_remove_declarations(store: Store, text: str) -> bool:
     if reach.anything:
         return True
     spaces = _spaces()
-    asked: list[tuple[str, Mapping[str, Term]]] = [
-        (_SAID_WITH, {"p": p, **spaces}) for p in sorted(reach.predicates, key=str)
-    ]
+    asked: list[tuple[str, Mapping[str, Term]]] = []
+    for subject, predicate, graph in sorted(reach.statements, key=str):
+        about: dict[str, Term] = {"p": predicate, **spaces} | ({"c": subject} if subject is not None else {})
+        asked.append((_SAID_WITH, about) if graph is None else (_SAID_WITH_IN, {"g": graph, **about}))
     asked += [(_SAID_IN, {"g": g, **spaces}) for g in sorted(reach.graphs, key=str)]
     return any(store.select_each(asked))
 

@@ -13,7 +13,7 @@ import pytest
 
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import UndeclaredSuperclassError
-from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.namespaces import PREFIXES, RDF, RDFS
 from cbrs.kb.superclasses import Reach, RemovedDeclarationError, removal_reach, watch_update
 from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.web import create_app
@@ -21,6 +21,7 @@ from cbrs.web import create_app
 TOKEN = "removed-declarations-token"
 LAB = "PREFIX lab: <https://example.org/lab#>\n"
 HOME = PREFIXES["home"]
+CUP = ox.NamedNode(HOME + "Cup")
 # A lab declares home:Fruit (as a lab adds a term to home:, by declaring it) and an apple under it; another
 # lab's banana is under it too.
 FRUIT = (
@@ -131,15 +132,31 @@ def test_an_update_that_leaves_the_store_without_the_vocabulary_is_not_refused()
         pytest.param("DELETE WHERE { GRAPH graph:map { world:Cup home:yaw ?y } }", None, id="subject-not-ours"),
         pytest.param(
             "DELETE { ?s home:yaw ?y } INSERT { ?s home:yaw 1.5 } WHERE { ?s home:yaw ?y }",
-            Reach(predicates=frozenset({ox.NamedNode(HOME + "yaw")})),
+            Reach(statements=frozenset({(None, ox.NamedNode(HOME + "yaw"), None)})),
             id="fixed-predicate",
         ),
         pytest.param(
             "PREFIX h: <https://w3id.org/cbrs/home#> DELETE DATA { h:Cup rdfs:label 'x' ; a owl:Class }",
             Reach(
-                predicates=frozenset({ox.NamedNode(PREFIXES["rdfs"] + "label"), ox.NamedNode(PREFIXES["rdf"] + "type")})
+                statements=frozenset(
+                    {(CUP, ox.NamedNode(RDFS + "label"), None), (CUP, ox.NamedNode(RDF + "type"), None)}
+                )
             ),
             id="prefix-of-ours",
+        ),
+        pytest.param(
+            "WITH <urn:g> DELETE { ?s rdfs:label ?l } WHERE { ?s rdfs:label ?l } ;\n"
+            "DELETE WHERE { GRAPH <urn:h> { ?s rdfs:label ?l } GRAPH ?g { ?s a ?c } }",
+            Reach(
+                statements=frozenset(
+                    {
+                        (None, ox.NamedNode(RDFS + "label"), ox.NamedNode("urn:g")),
+                        (None, ox.NamedNode(RDFS + "label"), ox.NamedNode("urn:h")),
+                        (None, ox.NamedNode(RDF + "type"), None),
+                    }
+                )
+            ),
+            id="graphs-of-statements",
         ),
         pytest.param("DELETE WHERE { home:Cup ?p ?o }", Reach(anything=True), id="variable-predicate"),
         pytest.param("DELETE WHERE { [] home:p ?o }", Reach(anything=True), id="blank-node"),
@@ -166,6 +183,22 @@ def test_the_text_says_what_an_update_may_remove(text: str, reach: Reach | None)
     [
         pytest.param("DELETE { ?s home:yaw ?y } WHERE { ?s home:yaw ?y }", False, id="a-predicate-no-class-has"),
         pytest.param("DELETE WHERE { ?s rdfs:label ?l }", True, id="a-predicate-classes-have"),
+        pytest.param(
+            "DELETE WHERE { GRAPH <https://example.org/lab#nine> { ?s rdfs:label ?l } }",
+            False,
+            id="a-predicate-classes-have-in-a-graph-saying-nothing-of-them",
+        ),
+        pytest.param(
+            "DELETE WHERE { GRAPH graph:ontology { ?s rdfs:label ?l } }", True, id="a-predicate-classes-have-there"
+        ),
+        pytest.param(
+            "DELETE WHERE { GRAPH graph:ontology { home:Bowl rdfs:comment ?c } }", False, id="a-term-no-class-is-under"
+        ),
+        pytest.param(
+            "DELETE WHERE { GRAPH graph:ontology { home:Container rdfs:comment ?c } }",
+            True,
+            id="a-term-classes-are-under",
+        ),
         pytest.param("DROP GRAPH graph:map", False, id="a-graph-saying-nothing-of-them"),
         pytest.param("DROP GRAPH graph:ontology", True, id="the-ontology"),
         pytest.param("DELETE WHERE { GRAPH graph:map { world:Cup ?p ?o } }", False, id="not-ours"),
