@@ -20,7 +20,7 @@ import logging
 import math
 from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import Any, NamedTuple
 
 from cbrs.actions.plan import Plan, PlanStep
 from cbrs.kb.errors import KnowledgeBaseError
@@ -242,7 +242,8 @@ class PlaceOverfilledError(KnowledgeBaseError):
     those the plan puts there; ``already``: (IRI, x, y, radius) of those on it now; ``top``: its width and
     depth; ``reached``: the part of its top the arms reach, and ``free``: what the objects on it leave of
     that, in square metres; ``footprint``: the packing's (:data:`FOOTPRINTS`); ``unheld``: for each object
-    the arms were asked about, (IRI, spots refused, spots asked, the first refusal)."""
+    the arms were asked about, (IRI, spots refused, spots asked, the first refusal); ``busy``: (side, IRI)
+    of each arm of the robot not counted at a carry of them, holding that object then (:func:`arms_free`)."""
 
     http_status = 422
 
@@ -255,6 +256,7 @@ class PlaceOverfilledError(KnowledgeBaseError):
         reached: float,
         footprint: str = "circle",
         unheld: Sequence[tuple[str, int, int, str]] = (),
+        busy: Sequence[tuple[str, str]] = (),
     ) -> None:
         self.place = place
         self.objects = tuple(objects)
@@ -263,6 +265,7 @@ class PlaceOverfilledError(KnowledgeBaseError):
         self.reached = reached
         self.footprint = footprint
         self.unheld = tuple(unheld)
+        self.busy = tuple(busy)
         self.free = max(reached - sum(math.pi * r * r for *_, r in self.already), 0.0)
         boxed = footprint == "box"
         each = ", ".join(
@@ -288,9 +291,11 @@ class PlaceOverfilledError(KnowledgeBaseError):
             f"; the arms cannot hold the {local_name(iri)} over {no} of the {asked} spots asked ({why})"
             for iri, no, asked, why in self.unheld
         )
+        holding = " and ".join(f"the {side} arm holds the {local_name(iri)}" for side, iri in self.busy)
+        arms = f"the arms free to set them down reach (when {holding})" if self.busy else "the arms reach"
         super().__init__(
             f"the plan puts {each} on the {local_name(place)}, which cannot hold them together: of its"
-            f" {100 * top[0]:.0f} x {100 * top[1]:.0f} cm top ({top[0] * top[1]:.3f} m2) the arms reach"
+            f" {100 * top[0]:.0f} x {100 * top[1]:.0f} cm top ({top[0] * top[1]:.3f} m2) {arms}"
             f" {reached:.3f} m2{on_it}; {shape}, {100 * c:.0f} cm apart and {100 * RELAY_EDGE:.0f} cm inside its"
             f" edge, need about {need:.3f} m2, and no arrangement of them on its spots (a {100 * RELAY_STEP:.0f} cm"
             f" grid) holds them all, each where an arm can set it down, though each alone has a spot{held}; put"
@@ -577,6 +582,14 @@ def _taken(step: PlanStep, steps: Mapping[int, PlanStep], smap: SemanticMap, val
     return iris[0] if len(iris) == 1 else None
 
 
+class AtCarry(NamedTuple):
+    """A robot's arms at one of its carries (:func:`arms_free`): ``free``, those that can set the thing
+    down, and ``busy``, what each other one holds then (arm IRI: object IRI)."""
+
+    free: list[Arm]
+    busy: dict[str, str]
+
+
 APPROACHING = PREFIXES["act"] + "ApproachToObject"
 """The taking step whose hold lasts until a carry sets the thing down (loading the platform ends its own)."""
 
@@ -589,23 +602,24 @@ def arms_free(
     held: Mapping[str, str] | None = None,
     after: int | None = None,
     known: Mapping[int, Mapping[str, Any]] | None = None,
-) -> dict[int, list[Arm]]:
+) -> dict[int, AtCarry]:
     """For each carry of ``plan`` that sets an object down on a place (:func:`puts_down`; by its step's
-    index), the arms of its robot that can set it down then: those that hold nothing else at that point of
-    the plan. An arm holds what it holds now (``held``: arm IRI to object IRI) until the robot's next carry
-    with no hold of the plan open sets it down, and what the plan's ApproachToObject takes until the carry
-    after it; another take before that carry leaves the first thing in its hand (the cup a task takes and
-    keeps while it puts the pen away). Which arm takes a thing is the run's choice (``who_takes``); here
-    the one it asks first (``arm_choice.reaching``): of the robot's free arms whose mount is within their
-    reach of the thing (where ``where`` puts it: x, y, radius; else the map), the nearest, on a tie (ARM_TIE)
-    the first by side, as the run cannot know which arm acted last. A take no arm is foreseen
-    for holds no arm. ``after``: the running step's index, whose own steps and those before are not walked
-    (``held`` is the world as it is then)."""
+    index), the arms of its robot that can set it down then (:class:`AtCarry`): those that hold nothing
+    else at that point of the plan. A carry sets down what the robot's latest ApproachToObject took (as
+    :func:`puts_down` has it), else, with no take since its last carry, what its one busy arm holds; until
+    then that arm holds it. So a thing an arm holds now (``held``: arm IRI to object IRI) and the plan does
+    not carry keeps that arm busy throughout, and a thing the plan takes and carries nowhere (the cup a task
+    takes and keeps while it puts the pen away) from its take on. Which arm takes a thing is the run's
+    choice (``who_takes``); here the one it asks first (``arm_choice.reaching``): of the robot's free arms
+    whose mount is within their reach of the thing (where ``where`` puts it: x, y, radius; else the map),
+    the nearest, on a tie (ARM_TIE) the first by side, as which arm acted last is not known here. A take
+    no free arm reaches is foreseen by no arm. ``after``: the running step's index; the steps up to it are
+    not walked (``held`` is the world as it is then)."""
     downs = {down.step: down for down in puts_down(plan, smap, values, known)}
     steps = {step.index: step for step in plan.steps}
     holding = dict(held or {})  # arm IRI: the object it holds
     latest: dict[str, str] = {}  # by robot: the arm of its latest take that no carry has followed yet
-    found: dict[int, list[Arm]] = {}
+    found: dict[int, AtCarry] = {}
     walked = [step.index for step in plan.steps]
     if after is not None and after in walked:
         walked = walked[walked.index(after) + 1 :]
@@ -630,7 +644,8 @@ def arms_free(
             carrying = busy[0] if len(busy) == 1 else None
         if index in downs:
             thing = downs[index].obj
-            found[index] = [arm for arm in arms if holding.get(arm.iri, thing) == thing]
+            free = [arm for arm in arms if holding.get(arm.iri, thing) == thing]
+            found[index] = AtCarry(free, {arm.iri: holding[arm.iri] for arm in arms if arm not in free})
         if carrying is not None:
             holding.pop(carrying, None)  # set down there
     return found
@@ -745,7 +760,7 @@ def carry_spots(
     found = other_objects(world, ctx.belief)
     where = {each.iri: spot for each, spot in zip(world.objects.values(), found, strict=True)}
     free = arms_free(ctx.plan, smap, ctx.given, where, held_now(world, carried), step.index, ctx.known)
-    later_arms = [free.get(down.step, []) for down in downs]
+    later_arms = [free[down.step].free if down.step in free else [] for down in downs]
     later_able = [[reach_of(arm) for arm in arms] for arms in later_arms]
     # within the reach of the arm that sets this one down where it is free then, as before; else of those that are
     later_by = [
@@ -893,16 +908,16 @@ def overfilled(
             return None
         return overfilled(smap, plan, values, where, replace(rule, footprint="box"), ctx, held)
     free = arms_free(plan, smap, values, where, held)
-    by_place: dict[tuple[str, str], dict[str, list[Arm]]] = {}
+    by_place: dict[tuple[str, str], dict[str, AtCarry]] = {}
     for down in puts_down(plan, smap, values):
         arms_of = by_place.setdefault((down.place, down.device), {})
-        arms_of.setdefault(down.obj, free.get(down.step, []))  # at its first carry there
+        arms_of.setdefault(down.obj, free.get(down.step, AtCarry([], {})))  # at its first carry there
     boxed = rule.footprint == "box"
     for (iri, _), carried in by_place.items():
         if len(carried) < 2:
             continue
         objects = list(carried)
-        by = [[reach_of(arm) for arm in arms] for arms in carried.values()]
+        by = [[reach_of(arm) for arm in at.free] for at in carried.values()]
         mounts = list(dict.fromkeys(reach for reach in itertools.chain(*by)))
         place = smap.things[iri]
         rest = [(other, spot) for other, spot in where.items() if other not in objects]
@@ -917,7 +932,7 @@ def overfilled(
         if not all(place_spots(smap, place, size, arms, around, arms)[1] for size, arms in zip(sizes, by, strict=True)):
             continue  # one alone has no spot: the step's own check says why
         surface = region_of(place, iri in smap.furniture)
-        sides = [{ArmSide(arm.side) for arm in arms} for arms in carried.values()]
+        sides = [{ArmSide(arm.side) for arm in at.free} for at in carried.values()]
         holds = _HoldAsked(ctx, [smap.objects[obj] for obj in objects], surface, sides) if ctx is not None else None
         try:
             if arrange(smap, place, sizes, mounts, others, rule, PACK_BUDGET, feet, lying, holds, by, by) is not None:
@@ -933,6 +948,7 @@ def overfilled(
             reached_area(surface, mounts),
             rule.footprint,
             holds.refused() if holds is not None else [],
+            list(dict.fromkeys((smap.arms[arm].side, obj) for at in carried.values() for arm, obj in at.busy.items())),
         )
     return None
 

@@ -186,12 +186,14 @@ def test_the_plan_keeps_the_cup_in_the_left_hand_through_the_pens_carry(
     downs = puts_down(between, smap, VALUES)
     assert [(down.place, down.obj) for down in downs] == [(MAT, ERASER), (MAT, PEN)]
     free = arms_free(between, smap, VALUES, _where(smap))
-    assert [[arm.iri for arm in free[down.step]] for down in downs] == [[LEFT, RIGHT], [RIGHT]]
+    assert [[arm.iri for arm in free[down.step].free] for down in downs] == [[LEFT, RIGHT], [RIGHT]]
+    assert [free[down.step].busy for down in downs] == [{}, {LEFT: CUP}]
     free = arms_free(first, smap, VALUES, _where(smap))  # the cup taken first: busy at both carries
-    assert [[arm.iri for arm in arms] for arms in free.values()] == [[RIGHT], [RIGHT]]
+    assert [[arm.iri for arm in at.free] for at in free.values()] == [[RIGHT], [RIGHT]]
     # what an arm holds before the run and the plan never sets down keeps it busy too
     held = arms_free(between, smap, VALUES, _where(smap), {LEFT: LAB6 + "Keys"})
-    assert [[arm.iri for arm in held[down.step]] for down in downs] == [[RIGHT], [RIGHT]]
+    assert [[arm.iri for arm in held[down.step].free] for down in downs] == [[RIGHT], [RIGHT]]
+    assert held[downs[1].step].busy == {LEFT: LAB6 + "Keys"}  # the cup not foreseen: no free arm reaches it
 
 
 def test_the_check_before_the_run_counts_only_the_arms_free_at_each_carry(
@@ -206,6 +208,11 @@ def test_the_check_before_the_run_counts_only_the_arms_free_at_each_carry(
     refused = overfilled(west, first, VALUES, where, CIRCLE)
     assert isinstance(refused, PlaceOverfilledError) and refused.place == MAT
     assert sorted(iri for iri, _ in refused.objects) == sorted([ERASER, PEN])
+    assert refused.busy == (("left", CUP),)
+    assert (
+        "of its 30 x 20 cm top (0.060 m2) the arms free to set them down reach (when the left arm holds the Cup)"
+        in str(refused)
+    )
     assert overfilled(west, first, VALUES, where) is not None  # nor by boxes
     assert overfilled(west, between, VALUES, where, CIRCLE) is None
 
