@@ -1067,10 +1067,14 @@ def _editor_save(browser: _Browser, step: Step, token: str, where: Path) -> str:
 def _editor_asks(browser: _Browser, task: str) -> str:
     """Ask the SPARQL page's form (a GET form, read-only) whether graph:requirements now holds ``task``, as
     a person checks a save: the answer the page shows; RuntimeError unless it shows true."""
-    if not re.fullmatch(r"[^\s<>\"{}|^`\\]+", task):
-        raise RuntimeError(f"the saved task {task!r} is no IRI to ask about")
+    if re.fullmatch(r"[A-Za-z][\w.-]*:[\w.-]+", task) and "://" not in task:
+        term = task  # a prefixed name of cbrs's own, which the SPARQL page declares (req:FetchMyKeys)
+    elif re.fullmatch(r"[^\s<>\"{}|^`\\]+", task):
+        term = f"<{task}>"
+    else:
+        raise RuntimeError(f"the saved task {task!r} is neither an IRI nor a prefixed name to ask about")
     form = browser.form("/query", "sparql-form")[1]
-    form.set("query", f"ASK {{ GRAPH <{REQUIREMENTS_GRAPH}> {{ <{task}> a <{REQUIREMENT}> }} }}")
+    form.set("query", f"ASK {{ GRAPH <{REQUIREMENTS_GRAPH}> {{ {term} a <{REQUIREMENT}> }} }}")
     answer = browser.submit(form)
     shown = re.search(r'<p class="answer"><span class="badge \w+">(\w+)</span>', answer.body)
     if answer.status != 200 or shown is None or shown.group(1) != "true":

@@ -108,7 +108,9 @@ def test_a_task_written_on_the_new_task_page_is_saved_and_a_misspelt_one_refused
 ) -> None:
     browser = bench._Browser(served)
     said = bench._editor_save(browser, bench.Step("requirements", "load_pen_onto_base.ttl"), TOKEN, tmp_path)
-    assert "saved as" in said and "ASK shows true" in said
+    assert "saved as https://example.org/lab#LoadPenOntoBase" in said and "ASK shows true" in said
+    said = bench._editor_save(browser, bench.Step("requirements", "fetch_my_keys.ttl"), TOKEN, tmp_path)
+    assert "saved as req:FetchMyKeys" in said and "ASK shows true" in said  # a name in cbrs's own namespace
     misspelt = (("cbrs:parameterType home:Pen ]", "cbrs:parameterType home:Pne ]"),)
     step = bench.Step("requirements", "load_pen_onto_base.ttl", misspelt, says="did you mean home:Pen?")
     said, miss = bench.editor_refusal(browser, step, TOKEN, tmp_path)
