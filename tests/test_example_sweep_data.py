@@ -113,7 +113,9 @@ def test_a_range_the_docs_give_is_read_and_compared(bench: ModuleType) -> None:
 
 def test_the_forms_beyond_the_command_line_each_have_a_trial(bench: ModuleType) -> None:
     """A library program, several programs at once, runs over /cbrs/run_task (the service with programs
-    and without, the action) and files posted to the server are each swept: the header's forms are used."""
+    and without, the action), files posted to the server (taken and refused), two runs at once and the
+    browser's forms (the Start form, the New task page saving and refusing) are each swept: the header's
+    forms are used."""
     _, trials = bench.read_trials(DATA)
     assert any(t.via == "library" and t.library is not None for t in trials)
     assert any(t.via == "bridge" and len(t.serve) > 1 for t in trials)
@@ -121,6 +123,10 @@ def test_the_forms_beyond_the_command_line_each_have_a_trial(bench: ModuleType) 
     assert any(t.via == "run_task" and not t.serve for t in trials)
     assert any(t.post and t.via == "http" for t in trials)
     assert any(t.via == "action" for t in trials)
+    assert any(t.busy and t.via == "http" for t in trials) and any(t.busy and t.via == "page" for t in trials)
+    assert any(t.post and any(s.expect_refusal for s in t.setup) for t in trials if t.via == "http")
+    assert any(t.via == "page" and t.post and any(s.verb == "requirements" for s in t.setup) for t in trials)
+    assert any(t.via == "page" and any(s.expect_refusal and s.verb == "requirements" for s in t.setup) for t in trials)
 
 
 @pytest.mark.parametrize(
