@@ -707,7 +707,55 @@ def _term_problems(store: Store, closures: dict[str, list[ox.Quad]], context: Se
                 suggestion=shorten(near) if near else None,
             )
         )
+    problems += _individuals(store, closures, context)
     return sorted(set(problems), key=lambda p: (p.description, p.message))
+
+
+_CLASS_POSITIONS = frozenset({CBRS.parameterType, CBRS.conditionSubject, CBRS.conditionObject})
+_CLASS_MARKS = frozenset({OWL + "Class", RDFS + "Class"})
+_NO_CLASS = frozenset({OWL + "NamedIndividual", OWL + "Thing"})
+
+
+def _individuals(store: Store, closures: dict[str, list[ox.Quad]], context: Sequence[ox.Quad]) -> list[ShapeProblem]:
+    """A component's input, output or condition that names a thing of the map where a class belongs (an
+    effect (lab10:ReadingLamp1, home:hasStatus, home:SwitchedOn) for the lamp's class): registered, the
+    component met no task's goal about the class and no answer named it (docs/tasks.md, "A tenth round").
+    A task's are named when it is planned (actions.unmet), as the fourth round's goal naming the trolley."""
+    problems = []
+    for root, quads in closures.items():
+        if any(q.predicate.value == RDF + "type" and q.object.value == CBRS.Requirement for q in quads):
+            continue
+        for quad in quads:
+            if quad.predicate.value not in _CLASS_POSITIONS or not isinstance(quad.object, ox.NamedNode):
+                continue
+            classes = _individual_of(store, context, quad.object)
+            if not classes:
+                continue
+            problems.append(
+                ShapeProblem(
+                    description=root,
+                    message=f"{shorten(quad.object.value)} is a thing of the map (an individual of "
+                    f"{' and '.join(map(shorten, classes))}), not a class: a component's inputs, outputs, "
+                    "preconditions and effects name classes, and a run finds the things of those classes",
+                    path=quad.predicate.value,
+                    suggestion=shorten(classes[0]) if len(classes) == 1 else None,
+                )
+            )
+    return problems
+
+
+def _individual_of(store: Store, context: Sequence[ox.Quad], term: ox.NamedNode) -> list[str]:
+    """The classes ``term`` is stated an individual of, in the store or ``context``; none for a class."""
+    here = [q for q in context if q.subject == term]
+    stated = [
+        *here,
+        *store.quads(term, ox.NamedNode(RDF + "type")),
+        *store.quads(term, ox.NamedNode(RDFS + "subClassOf")),
+    ]
+    types = {q.object.value for q in stated if q.predicate.value == RDF + "type" and isinstance(q.object, ox.NamedNode)}
+    if types & _CLASS_MARKS or any(q.predicate.value == RDFS + "subClassOf" for q in stated):
+        return []
+    return sorted(types - _NO_CLASS)
 
 
 def _namespace(iri: str) -> str:

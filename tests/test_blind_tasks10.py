@@ -19,6 +19,7 @@ from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import RemoteStoreError
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import MapError
+from cbrs.kb.shapes import DescriptionShapeError
 from tests.helpers_examples import EXAMPLES
 
 HOME, SVC, LAB10 = PREFIXES["home"], PREFIXES["svc"], "https://example.org/lab10#"
@@ -130,3 +131,23 @@ def test_a_program_without_the_token_is_told_to_pass_it(monkeypatch: pytest.Monk
     said = str(refused.value)
     assert "sent without a token: set CBRS_UPDATE_TOKEN (the cbrs command's), or a program passes" in said
     assert "KnowledgeBase.open(URL, remote_token=TOKEN); it said: " in said and "updates need the server" in said
+
+
+def test_a_component_naming_the_lamp_itself_is_refused_at_its_registration() -> None:
+    """The plug's switch-on effect written about the lamp of the map, lab10:ReadingLamp1, not its class: it
+    registered without a word, and SwitchOnTheReadingLamp had no plan naming only the switch-off component
+    ("home:SwitchedOn is no home:SwitchedOff"), the lab's switch-on nowhere."""
+    kb = KnowledgeBase.open(":memory:")
+    for graph in ("ontology", "map"):
+        kb.load([EXAMPLES / "lab10_reading_lamp.ttl"], graph=graph)
+    before = kb.statistics()
+    text = (EXAMPLES / "lab10_lamp_switch.ttl").read_text("utf-8")
+    itself = text.replace("cbrs:conditionSubject lab10:ReadingLamp ;", "cbrs:conditionSubject lab10:ReadingLamp1 ;", 1)
+    with pytest.raises(DescriptionShapeError) as refused:
+        kb.registry.register(itself)
+    said = str(refused.value)
+    assert "lab10:ReadingLamp1 is a thing of the map (an individual of lab10:ReadingLamp), not a class" in said
+    assert "did you mean lab10:ReadingLamp?" in said and "SwitchOnReadingLamp_LampPlug01" in said
+    assert kb.statistics() == before
+    kb.registry.register(text)  # as the example writes it
+    kb.close()
