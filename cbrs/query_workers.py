@@ -41,7 +41,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from cbrs.kb.errors import KnowledgeBaseError, QuerySyntaxError, QueryTooComplexError, StoreEvaluationError
+from cbrs.kb.engine_faults import ErrorLog
+from cbrs.kb.errors import (
+    EngineFaultError,
+    KnowledgeBaseError,
+    QuerySyntaxError,
+    QueryTooComplexError,
+    StoreEvaluationError,
+)
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.query_guard import EVALUATION_STACK
 from cbrs.kb.store import EmbeddedStore
@@ -88,8 +95,9 @@ class _Process:
 
     def __init__(self, stack: int, memory: int) -> None:
         command = [sys.executable, str(_SCRIPT), json.dumps(PREFIXES), str(stack), str(memory)]
+        self.errors = ErrorLog()  # what it says as it dies tells a panic from an allocation past the cap
         self.popen = subprocess.Popen(
-            command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, start_new_session=True
+            command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self.errors.file, start_new_session=True
         )
         self.ready = False
         self.snapshot: _Snapshot | None = None
@@ -109,6 +117,7 @@ class _Process:
     def kill(self) -> None:
         _stop(self.popen)
         _started.discard(self.popen)
+        self.errors.close()
 
 
 class QueryProcesses:
@@ -334,9 +343,12 @@ class QueryProcesses:
             code = worker.popen.wait(timeout=5)
         except subprocess.TimeoutExpired:
             code = None
+        death = worker.errors.death()
         self._discard(worker)
         self._spare()
         how = f"signal {signal.Signals(-code).name}" if code is not None and code < 0 else f"exit status {code}"
+        if death.panic is not None and not starting:  # the engine named its own fault: not the memory cap
+            return EngineFaultError("", death.explain())  # the endpoint knows the text
         if code == -signal.SIGABRT and self.memory > 0:  # an allocation past the address-space cap aborts
             return QueryStopped("memory")
         if starting:

@@ -41,7 +41,13 @@ from werkzeug.datastructures import MIMEAccept
 from cbrs import __version__, pattern_lookup
 from cbrs._query_worker import dataset_options
 from cbrs.kb import KnowledgeBase
-from cbrs.kb.errors import KnowledgeBaseError, QuerySyntaxError, QueryTooComplexError, StoreEvaluationError
+from cbrs.kb.errors import (
+    EngineFaultError,
+    KnowledgeBaseError,
+    QuerySyntaxError,
+    QueryTooComplexError,
+    StoreEvaluationError,
+)
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.query_guard import start_evaluation_thread
 from cbrs.kb.served_updates import HEADER, header_value
@@ -596,6 +602,8 @@ class SparqlService:
             raise self._stopped(stopped, refusals) from None
         except QueryTooComplexError as error:
             raise QueryTooComplexError(text, error.message) from None
+        except EngineFaultError as error:
+            raise EngineFaultError(text, error.reason) from None
         return Answer(body, media_type)
 
     def _stopped(self, stopped: QueryStopped, refusals: dict[bool, NotAcceptableError]) -> EndpointError:

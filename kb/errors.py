@@ -194,6 +194,21 @@ class QueryTooComplexError(QuerySyntaxError):
         return str(self.args[0])
 
 
+class EngineFaultError(KnowledgeBaseError):
+    """The store's SPARQL engine crashed on ``query`` in a process of its own (a checker or a query
+    worker), which died instead of the server; ``reason`` is what the engine said as it died
+    (:mod:`kb.engine_faults`). A fault of the engine, not of the text's syntax: HTTP 500."""
+
+    http_status = 500
+
+    def __init__(self, query: str, reason: str) -> None:
+        self.query = query
+        self.reason = reason
+        super().__init__(
+            f"the query crashed the store's SPARQL engine in an isolated process: {reason}; the server goes on"
+        )
+
+
 class NotFoundError(KnowledgeBaseError):
     """No resource with this IRI is described in the store."""
 

@@ -38,7 +38,8 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import IO, Literal
 
-from cbrs.kb.errors import QuerySyntaxError, QueryTooComplexError, StoreError
+from cbrs.kb.engine_faults import ErrorLog
+from cbrs.kb.errors import EngineFaultError, QuerySyntaxError, QueryTooComplexError, StoreError
 from cbrs.kb.recent_keys import RecentKeys
 
 Kind = Literal["query", "update"]
@@ -142,8 +143,9 @@ class _Checker:
         package_root = str(Path(__file__).resolve().parents[1])
         env = dict(os.environ, PYTHONPATH=os.pathsep.join([package_root, os.environ.get("PYTHONPATH", "")]))
         command = [sys.executable, "-c", f"import {__name__} as guard; guard.serve_checks({stack})"]
+        self.errors = ErrorLog()  # what it says as it dies tells a panic from a stack overflow
         self.process = subprocess.Popen(
-            command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=env
+            command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=self.errors.file, env=env
         )
         _started.add(self.process)
 
@@ -153,6 +155,7 @@ class _Checker:
     def stop(self) -> None:
         _stop(self.process)
         _started.discard(self.process)
+        self.errors.close()
 
     def check(self, kind: Kind, text: str, timeout: float) -> _Verdict:
         deadline = time.monotonic() + timeout
@@ -187,9 +190,12 @@ class _Checker:
             code = self.process.wait(timeout=5)
         except subprocess.TimeoutExpired:
             code = None
+        death = self.errors.death()
         self.stop()
+        if death.panic is not None:  # the engine's own fault, which it named: not a text too deep
+            return _Verdict(EngineFaultError(text, death.explain()), crashed=True)
         how = f"signal {signal.Signals(-code).name}" if code is not None and code < 0 else f"exit status {code}"
-        stage = "evaluating" if parsed else "parsing"
+        stage = "evaluating" if parsed else "parsing or planning"
         what = "query" if kind == "query" else "update"
         return _Verdict(
             QueryTooComplexError(
