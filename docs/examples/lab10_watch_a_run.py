@@ -10,8 +10,9 @@ lab10_fill_my_travel_mug.ttl in the requirements:
 A store by its URL (a cbrs serve's) is written with the server's update token, which the program passes
 itself (``remote_token``): the library reads no CBRS_UPDATE_TOKEN, the cbrs command does.
 
-It prints one line per event as it comes (the topic, then the message's fields), then one line of JSON:
-the task, succeeded, sim_seconds, the number of events by topic and the steps in the order they ended.
+It prints one line per event as it comes (the topic, then the message's fields) on standard error, where a
+notebook shows it as well, and then one line of JSON on standard output: the task, succeeded, sim_seconds,
+the number of events by topic and the steps in the order they ended.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import sys
 from collections import Counter
 
 from cbrs.actions import run_task
@@ -42,7 +44,7 @@ def watch(event: Event) -> None:
     """What a notebook cell would show as the run goes."""
     topics[event.topic] += 1
     message = event.message
-    print(event.topic, {k: v for k, v in message.items() if v not in (None, "", [], {})}, flush=True)
+    print(event.topic, {k: v for k, v in message.items() if v not in (None, "", [], {})}, file=sys.stderr, flush=True)
     if message.get("event") in ("step_succeeded", "step_failed"):  # docs/serving.md, the bridge's topics
         ended.append(f"{message['step']} {str(message['component']).rsplit('#', 1)[-1]} {message['event'][5:]}")
 
