@@ -1047,6 +1047,7 @@ def _editor_save(browser: _Browser, step: Step, token: str, where: Path) -> str:
     said = f"New task page, {step.file}"
     if checked.status != 200 or 'id="task-name"' not in checked.body:
         raise RuntimeError(f"{said}: Check and plan: {checked.status}: {_form_errors(checked.body)[:300]}")
+    planned = re.search(r"<title>New task: .*, ([\w -]+) · [^<]*</title>", checked.body)
     form = read_form(checked.body, "task-form", checked.url)
     if form.chosen("turtle") != [text]:
         raise RuntimeError(f"{said}: the checked page's editor does not hold the text sent")
@@ -1061,7 +1062,8 @@ def _editor_save(browser: _Browser, step: Step, token: str, where: Path) -> str:
     if not chosen or not (saved_name.endswith(chosen[0].rpartition(":")[2]) or chosen[0] == saved_name):
         raise RuntimeError(f"{said}: the saved page's link chose {chosen} in the Start form, not {saved_name}")
     asked = _editor_asks(browser, saved_name)
-    return f"{said}: checked, saved as {saved_name} (201), chosen on the tasks page; the SPARQL page: {asked}"
+    plan = html.unescape(planned.group(1)) if planned else "no plan status shown"
+    return f"{said}: checked ({plan}), saved as {saved_name} (201), chosen on the tasks page; the SPARQL page: {asked}"
 
 
 def _editor_asks(browser: _Browser, task: str) -> str:

@@ -109,6 +109,7 @@ def test_a_task_written_on_the_new_task_page_is_saved_and_a_misspelt_one_refused
     browser = bench._Browser(served)
     said = bench._editor_save(browser, bench.Step("requirements", "load_pen_onto_base.ttl"), TOKEN, tmp_path)
     assert "saved as https://example.org/lab#LoadPenOntoBase" in said and "ASK shows true" in said
+    assert "checked (planned)" in said
     said = bench._editor_save(browser, bench.Step("requirements", "fetch_my_keys.ttl"), TOKEN, tmp_path)
     assert "saved as req:FetchMyKeys" in said and "ASK shows true" in said  # a name in cbrs's own namespace
     misspelt = (("cbrs:parameterType home:Pen ]", "cbrs:parameterType home:Pne ]"),)
