@@ -723,7 +723,7 @@ def _individuals(store: Store, closures: dict[str, list[ox.Quad]], context: Sequ
     A task's are named when it is planned (actions.unmet), as the fourth round's goal naming the trolley."""
     problems = []
     for root, quads in closures.items():
-        if any(q.predicate.value == RDF + "type" and q.object.value == CBRS.Requirement for q in quads):
+        if any(q.predicate.value == RDF + "type" and q.object == ox.NamedNode(CBRS.Requirement) for q in quads):
             continue
         for quad in quads:
             if quad.predicate.value not in _CLASS_POSITIONS or not isinstance(quad.object, ox.NamedNode):
