@@ -4,7 +4,8 @@
 asks (Turtle by default, and for a browser, whose Accept prefers HTML and then XML); ``GET /store``
 answers the whole dataset (TriG or N-Quads). ``PUT`` replaces a graph with the body, ``POST`` adds the
 body to it (or, with no graph, adds a TriG or N-Quads body to the store), ``DELETE`` drops it. Writes
-need ``Authorization: Bearer <token>``.
+need ``Authorization: Bearer <token>``, and pass the checks of :mod:`cbrs.graph_store` (the shapes, the
+map, superclasses) before anything is written; a refusal is the error's JSON with its HTTP status.
 """
 
 from __future__ import annotations
