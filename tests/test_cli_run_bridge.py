@@ -17,6 +17,7 @@ from cbrs.bridge_client import BridgeClient
 from cbrs.cli import cli
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.server import Server
+from cbrs.sim.services import SKILLS
 from tests.test_live_components import READING, THERMOMETER, TOKEN, eventually, sdk_thermometer, server, url
 
 __all__ = ["server"]  # the fixture, used by name
@@ -29,7 +30,12 @@ def run(server: Server, *options: str) -> Any:
     return CliRunner().invoke(cli, arguments, env={"CBRS_UPDATE_TOKEN": TOKEN})
 
 
-def test_a_run_calls_a_live_component_through_the_bridge_it_is_given(server: Server) -> None:
+def test_a_run_calls_a_live_component_through_the_bridge_it_is_given(
+    server: Server, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # a home whose only room thermometer is the lab's: the bundled sensor board's simulated temperature
+    # (sim.room_quantities) would answer the run without a bridge
+    monkeypatch.delitem(SKILLS, "MeasureTemperature")
     calls: list[dict[str, Any]] = []
     tables: list[dict[str, Any]] = []  # what a device's program read from the run's load cell meanwhile
     device = BridgeClient(url(server), TOKEN)

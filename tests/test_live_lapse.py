@@ -11,6 +11,7 @@ import pytest
 from cbrs.actions.remote import RemoteCallError
 from cbrs.bridge_client import BridgeClient
 from cbrs.server import Server
+from cbrs.sim.services import SKILLS
 from tests.test_live_components import READING, THERMOMETER, TOKEN, server, thermometer, url
 
 __all__ = ["server"]  # the fixture, used by name
@@ -37,9 +38,13 @@ def test_a_call_in_flight_fails_when_its_components_lease_lapses(server: Server)
             release.set()
 
 
-def test_a_run_waits_for_a_component_whose_program_restarts_and_uses_it_again(server: Server) -> None:
+def test_a_run_waits_for_a_component_whose_program_restarts_and_uses_it_again(
+    server: Server, monkeypatch: pytest.MonkeyPatch
+) -> None:
     """The thermometer's program dies in the middle of its call and its supervisor starts it again a
-    moment later: the re-plan waits for it (ReplanPolicy.reconnect_grace) instead of finding no plan."""
+    moment later: the re-plan waits for it (ReplanPolicy.reconnect_grace) instead of finding no plan. In a
+    home where it is the only room thermometer: the bundled sensor board's simulated temperature
+    (sim.room_quantities) would take the step over."""
     from cbrs.actions.composer import Composer
     from cbrs.actions.events import Event
     from cbrs.actions.runner import run_task
@@ -49,6 +54,7 @@ def test_a_run_waits_for_a_component_whose_program_restarts_and_uses_it_again(se
     from cbrs.sim.world import open_world
     from tests.test_live_components import sdk_thermometer
 
+    monkeypatch.delitem(SKILLS, "MeasureTemperature")
     kb, restarted = server.kb, threading.Event()
     first = BridgeClient(url(server), TOKEN)
 

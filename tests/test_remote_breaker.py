@@ -183,13 +183,15 @@ class Lab:
 
 
 class Room:
-    """A stub environment over a transport: no simulation, nothing to verify, passing over as a
-    simulated home does (``SimEnvironment.passed_over``)."""
+    """A stub environment over a transport: no simulation (only the components in another process are
+    implemented: not the bundled sensor board's simulated temperature), nothing to verify, passing over
+    as a simulated home does (``SimEnvironment.passed_over``)."""
 
     def __init__(self, kb: KnowledgeBase, transport: Any) -> None:
         self.kb = kb
         self.transport = transport
-        self.registry: Registry = implementations(kb, transport=transport)
+        remote = [ad for ad in kb.advertisements() if ad.bridge_port is not None]
+        self.registry: Registry = implementations(kb, transport=transport, advertisements=remote)
         self.context = None
 
     def passed_over(self) -> dict[str, str]:
@@ -252,8 +254,9 @@ def test_a_later_run_is_planned_without_the_hanging_component_and_says_why(lab_k
 
 
 def test_a_failover_goes_only_to_alternatives_the_run_can_call(lab_kb: KnowledgeBase, quick: None) -> None:
-    """The bundled sensor board also gives a room temperature, but nothing here implements it: after both
-    thermometers timed out, the run failed over to it and failed again with NoImplementationError."""
+    """The bundled sensor board also gives a room temperature, but nothing here implements it (the stub
+    simulates nothing): after both thermometers timed out, the run failed over to it and failed again with
+    NoImplementationError."""
     lab = Lab("/thermometer31/read")
     lab.answers = False  # both hang
     result = _run(lab_kb, Room(lab_kb, lab), max_replans=0)
