@@ -140,7 +140,7 @@ def test_the_run_composes_with_them_as_cbrs_run_does(
     monkeypatch.setattr(tasks_module, "refusal_in_home", lambda *a, **kw: None)
     monkeypatch.setattr(tasks_module, "run_task", stand_in)
     monkeypatch.setattr("cbrs.sim.world.open_world", no_world)
-    monkeypatch.setattr("cbrs.sim.components.SimEnvironment", lambda *a: None)
+    monkeypatch.setattr("cbrs.sim.components.SimEnvironment", lambda *a: SimpleNamespace(looked_for=lambda: ()))
     runner = TaskRunner(bundled_kb, threading.RLock(), camera=None)
     run = runner.run("FetchMyPen", objective="cost", base_ties="iri", near_misses=1, timeout=WAIT)
     assert run.status == "no-plan", run.error
