@@ -135,7 +135,8 @@ def test_the_run_composes_with_them_as_cbrs_run_does(
 
     def stand_in(kb: KnowledgeBase, task: str, env: Any, faults: Any, composer: Composer, *a: Any, **kw: Any) -> Any:
         seen.update(config=composer.config, base_ties=kw["base_ties"])
-        return SimpleNamespace(report=None, to_dict=dict)
+        no_plan = SimpleNamespace(plan=None, attempts=())
+        return SimpleNamespace(report=None, to_dict=dict, replans=(), composition=no_plan, base=None)
 
     monkeypatch.setattr(tasks_module, "refusal_in_home", lambda *a, **kw: None)
     monkeypatch.setattr(tasks_module, "run_task", stand_in)
