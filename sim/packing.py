@@ -548,17 +548,14 @@ def puts_down(
     smap: SemanticMap,
     values: Mapping[str, Any],
     known: Mapping[int, Mapping[str, Any]] | None = None,
-    in_hand: Mapping[str, str] | None = None,
 ) -> list[PutDown]:
     """The steps of ``plan`` that set an object down on a place of the map, in the plan's order: a carry
     (:data:`CARRYING`) given one place, of the object the robot's latest taking step before it works on
-    (the task's ``values``, through the steps that compute them), else, with no take before it, of what
-    ``in_hand`` says the robot holds as the plan starts (by robot: a re-plan's plan starts with a carry of
-    the thing still held). The place is what ``known`` (the executor's inputs of a step, by index) says,
-    else the task's value; a carry whose place or object is not known before the run (a later step's
-    output) is left out."""
+    (the task's ``values``, through the steps that compute them). The place is what ``known`` (the
+    executor's inputs of a step, by index) says, else the task's value; a carry whose place or object is
+    not known before the run (a later step's output) is left out."""
     steps = {step.index: step for step in plan.steps}
-    holding = dict(in_hand or {})  # by robot: the object its latest taking step works on
+    holding: dict[str, str] = {}  # by robot: the object its latest taking step works on
     found: list[PutDown] = []
     for step in plan.steps:
         device = step.device or ""
@@ -575,16 +572,6 @@ def puts_down(
         if len(places) == 1:
             found.append(PutDown(step.index, device, places[0], holding.pop(device)))
     return found
-
-
-def in_hand_of(smap: SemanticMap, held: Mapping[str, str]) -> dict[str, str]:
-    """By robot, the one object its arms hold (``held``: arm IRI to object IRI): :func:`puts_down`'s
-    ``in_hand``. A robot holding two things is left out: which one its carry sets down the plan says."""
-    things: dict[str, list[str]] = {}
-    for arm, obj in held.items():
-        if arm in smap.arms:
-            things.setdefault(smap.arms[arm].robot, []).append(obj)
-    return {robot: objects[0] for robot, objects in things.items() if len(objects) == 1}
 
 
 def _taken(step: PlanStep, steps: Mapping[int, PlanStep], smap: SemanticMap, values: Mapping[str, Any]) -> str | None:
@@ -615,7 +602,6 @@ def arms_free(
     held: Mapping[str, str] | None = None,
     after: int | None = None,
     known: Mapping[int, Mapping[str, Any]] | None = None,
-    in_hand: Mapping[str, str] | None = None,
 ) -> dict[int, AtCarry]:
     """For each carry of ``plan`` that sets an object down on a place (:func:`puts_down`; by its step's
     index), the arms of its robot that can set it down then (:class:`AtCarry`): those that hold nothing
@@ -628,8 +614,8 @@ def arms_free(
     whose mount is within their reach of the thing (where ``where`` puts it: x, y, radius; else the map),
     the nearest, on a tie (ARM_TIE) the first by side, as which arm acted last is not known here. A take
     no free arm reaches is foreseen by no arm. ``after``: the running step's index; the steps up to it are
-    not walked (``held`` is the world as it is then); ``in_hand``: as :func:`puts_down`'s."""
-    downs = {down.step: down for down in puts_down(plan, smap, values, known, in_hand)}
+    not walked (``held`` is the world as it is then)."""
+    downs = {down.step: down for down in puts_down(plan, smap, values, known)}
     steps = {step.index: step for step in plan.steps}
     holding = dict(held or {})  # arm IRI: the object it holds
     latest: dict[str, str] = {}  # by robot: the arm of its latest take that no carry has followed yet
@@ -706,12 +692,10 @@ def packed_with(
     place: str,
     values: Mapping[str, Any],
     known: Mapping[int, Mapping[str, Any]] | None = None,
-    in_hand: Mapping[str, str] | None = None,
 ) -> tuple[list[str], list[str]]:
     """The objects (IRIs) the plan's carries by the robot of ``step`` (a carry) set down on ``place`` before
-    it and after it, each in the plan's order (``in_hand`` as :func:`puts_down`'s); none when the plan or the
-    step is not known."""
-    earlier, later = _packed(plan, step, smap, place, values, known, in_hand)
+    it and after it, each in the plan's order; none when the plan or the step is not known."""
+    earlier, later = _packed(plan, step, smap, place, values, known)
     return [down.obj for down in earlier], [down.obj for down in later]
 
 
@@ -722,7 +706,6 @@ def _packed(
     place: str,
     values: Mapping[str, Any],
     known: Mapping[int, Mapping[str, Any]] | None = None,
-    in_hand: Mapping[str, str] | None = None,
 ) -> tuple[list[PutDown], list[PutDown]]:
     """:func:`packed_with`'s put-downs themselves."""
     if plan is None or step is None:
@@ -734,7 +717,7 @@ def _packed(
     before, after = set(order[:at]), set(order[at + 1 :])
     mine = [
         down
-        for down in puts_down(plan, smap, values, known, in_hand)
+        for down in puts_down(plan, smap, values, known)
         if down.place == place and down.device == (step.device or "")
     ]
     return [down for down in mine if down.step in before], [down for down in mine if down.step in after]
@@ -767,11 +750,7 @@ def carry_spots(
     size = obj.size if obj is not None else (0.0, 0.0, 0.0)
     mounts = [reach_of(world.arm_specs[side])]
     others = other_objects(world, ctx.belief, carried)
-    # a plan with no take before this carry (a re-plan's, the thing still held) started with it in hand
-    in_hand = (
-        {step.device or "": obj.iri} if obj is not None and step is not None and _first_hold(ctx.plan, step) else {}
-    )
-    earlier, downs = _packed(ctx.plan, step, smap, place.iri, ctx.given, ctx.known, in_hand)
+    earlier, downs = _packed(ctx.plan, step, smap, place.iri, ctx.given, ctx.known)
     able = able_mounts(world, carried)  # an arm holding something else leaves this one its spots
     if obj is None or step is None or ctx.plan is None or not (earlier or downs):
         return place_spots(smap, place, size, mounts, others, able)
@@ -780,7 +759,7 @@ def carry_spots(
     # (arms_free; the world's arms as they are now, what is carried now set down before it)
     found = other_objects(world, ctx.belief)
     where = {each.iri: spot for each, spot in zip(world.objects.values(), found, strict=True)}
-    free = arms_free(ctx.plan, smap, ctx.given, where, held_now(world, carried), step.index, ctx.known, in_hand)
+    free = arms_free(ctx.plan, smap, ctx.given, where, held_now(world, carried), step.index, ctx.known)
     later_arms = [free[down.step].free if down.step in free else [] for down in downs]
     later_able = [[reach_of(arm) for arm in arms] for arms in later_arms]
     # within the reach of the arm that sets this one down where it is free then, as before; else of those that are
@@ -832,18 +811,6 @@ def carry_spots(
         )
     except Undecided:  # more spots asked of the arms than HOLD_TRIES: as for one thing alone
         return place_spots(smap, place, size, mounts, others, able)
-
-
-def _first_hold(plan: Plan | None, step: PlanStep) -> bool:
-    """Whether no step of ``step``'s robot before it in ``plan`` takes a thing."""
-    if plan is None:
-        return False
-    for each in plan.steps:
-        if each.index == step.index:
-            return True
-        if each.device == step.device and each.action in TAKING:
-            return False
-    return False
 
 
 def _circles_hold(
@@ -931,8 +898,7 @@ def overfilled(
     the map's boxes, turned as it says they lie, or circles) on its spots holds them all (:func:`arrange`),
     with the objects of ``where`` (IRI: x, y, footprint radius) that it does not carry where they are, each
     by the arms of the robot that sets them down that are free at its carry (:func:`arms_free`: not holding,
-    then, what they hold now, ``held``: arm IRI to object IRI, or what the plan took and keeps; the one thing
-    a robot holds is what its first carry with no take before it sets down, :func:`in_hand_of`); given
+    then, what they hold now, ``held``: arm IRI to object IRI, or what the plan took and keeps); given
     ``ctx``, each where one of those arms can hold it (:func:`arm_choice.cannot_set_down`). None when each
     such place holds them, or when the search is undecided. A place that has no spot for one of them alone
     is left to the check of each step (``run_checks.PlanChecks._check_spot``), which says why. The ``auto``
@@ -941,10 +907,9 @@ def overfilled(
         if overfilled(smap, plan, values, where, replace(rule, footprint="circle"), ctx, held) is None:
             return None
         return overfilled(smap, plan, values, where, replace(rule, footprint="box"), ctx, held)
-    in_hand = in_hand_of(smap, held or {})
-    free = arms_free(plan, smap, values, where, held, in_hand=in_hand)
+    free = arms_free(plan, smap, values, where, held)
     by_place: dict[tuple[str, str], dict[str, AtCarry]] = {}
-    for down in puts_down(plan, smap, values, in_hand=in_hand):
+    for down in puts_down(plan, smap, values):
         arms_of = by_place.setdefault((down.place, down.device), {})
         arms_of.setdefault(down.obj, free.get(down.step, AtCarry([], {})))  # at its first carry there
     boxed = rule.footprint == "box"

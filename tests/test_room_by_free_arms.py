@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import replace
 from types import SimpleNamespace
 from typing import Any, cast
 
@@ -219,15 +218,13 @@ def test_the_check_before_the_run_counts_only_the_arms_free_at_each_carry(
     assert overfilled(west, between, VALUES, where, CIRCLE) is None
 
 
-def _context(smap: SemanticMap, plan: Plan, step_index: int, holding: str | None = None) -> SimContext:
-    """A context over a stand-in world of the map's arms and objects, running the step: both arms empty,
-    or the right arm holding the thing named ``holding``."""
+def _context(smap: SemanticMap, plan: Plan, step_index: int) -> SimContext:
+    """A context over a stand-in world of the map's arms and objects, both arms empty, running the step."""
     world = SimpleNamespace(
         map=smap,
         objects={obj.name: obj for obj in smap.objects.values()},
         arm_specs={ArmSide(arm.side): arm for arm in smap.arms.values()},
-        arm=lambda side: SimpleNamespace(held=1 if holding is not None and side == ArmSide.RIGHT else None),
-        name_of=lambda body: holding,
+        arm=lambda side: SimpleNamespace(held=None),
     )
     step = next(s for s in plan.steps if s.index == step_index)
     return SimContext(
@@ -291,33 +288,3 @@ def test_where_the_carrying_arm_leaves_no_room_the_arms_free_then_are_asked(
         for arms, left in ((both, room), ([right], False)):  # the pen's own spots, clear of the eraser
             pens = place_spots(west, place, pen, arms, around, arms)[1]
             assert any(math.dist(at, spot) >= apart for spot in pens) is left
-
-
-def test_a_replans_carry_of_the_thing_still_held_leaves_room_for_what_comes_after(
-    mat: Mats, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """A re-plan after a carry stopped short starts with the carry of the thing still in hand, no take before
-    it, and that carry was no put-down of the plan's (puts_down took a carry's thing from the take before it):
-    the eraser went where it would alone, and the pen found no room (EraserCupPen in the simulation, seed 0).
-    The thing in hand when the plan starts is what such a carry sets down, at the carry and in the check."""
-    _, west, _, _, plain = mat
-    monkeypatch.setattr(packing, "cannot_set_down", lambda *_: "")
-    downs = puts_down(plain, west, VALUES)
-    eraser_carry = downs[0].step
-    step = next(s for s in plain.steps if s.index == eraser_carry)
-    taking = [s.index for s in plain.steps if s.index < eraser_carry]  # the eraser's take, done before
-    replan = replace(plain, steps=tuple(s for s in plain.steps if s.index not in taking))
-    device = step.device or ""
-    assert [down.obj for down in puts_down(replan, west, VALUES)] == [PEN]
-    assert [down.obj for down in puts_down(replan, west, VALUES, in_hand={device: ERASER})] == [ERASER, PEN]
-    first = _context(west, plain, eraser_carry)
-    _, planned = carry_spots(first, west.things[MAT], "Eraser1", ArmSide.RIGHT, step, CIRCLE)
-    again = _context(west, replan, eraser_carry, holding="Eraser1")
-    _, spots = carry_spots(again, west.things[MAT], "Eraser1", ArmSide.RIGHT, step, CIRCLE)
-    assert spots == planned
-    # the check before the re-plan's run counts the eraser: with only the right arm's part of the mat (the
-    # left arm's reach 30 cm shorter) there is no room for both
-    assert overfilled(west, replan, VALUES, _where(west), held={RIGHT: ERASER}) is None
-    short = replace(west, arms={**west.arms, LEFT: replace(west.arms[LEFT], reach=0.55)})
-    assert overfilled(short, replan, VALUES, _where(west), held={RIGHT: ERASER}) is not None
-    assert overfilled(short, replan, VALUES, _where(west)) is None  # the eraser's carry not known as a put-down
