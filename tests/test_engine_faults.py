@@ -1,9 +1,10 @@
 """A query that crashes Oxigraph itself (a Rust panic, which aborts the process) is told as the engine's fault.
 
-The query guard's checker and the endpoint's query workers run such a text in processes of their own; when
-one dies, what it wrote to its standard error says why (``kb.engine_faults``). The real crash used here is
-``tests/data/engine_faults/ordering_panic.rq``: ``ORDER BY`` over dateTimes some with a time zone and some
-without, which pyoxigraph 0.5.13 cannot sort. Where a later pyoxigraph sorts them, those tests skip saying so.
+The query guard's checker, the endpoint's query workers and ``cbrs query`` (for a text that sorts) run such
+a text in processes of their own; when one dies, what it wrote to its standard error says why
+(``kb.engine_faults``). The real crashes used here are ``ORDER BY`` over dateTimes some with a time zone and
+some without, which pyoxigraph 0.5.13 cannot sort: in a text (``tests/data/engine_faults/ordering_panic.rq``)
+and in a store's data (``mixed_times.ttl``). Where a later pyoxigraph sorts them, those tests skip saying so.
 """
 
 from __future__ import annotations
@@ -13,15 +14,24 @@ import sys
 from collections.abc import Iterator
 from pathlib import Path
 
+import pyoxigraph as ox
 import pytest
+from click.testing import CliRunner
 
+from cbrs.cli import cli
+from cbrs.isolated_queries import IsolatedQueries, sorts
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.engine_faults import read_death
 from cbrs.kb.errors import EngineFaultError
 from cbrs.kb.store import EmbeddedStore
+from cbrs.output import render_result
 from cbrs.sparql_service import EndpointConfig, SparqlService
 
-ORDERING_PANIC = (Path(__file__).parent / "data" / "engine_faults" / "ordering_panic.rq").read_text(encoding="utf-8")
+FAULTS = Path(__file__).parent / "data" / "engine_faults"
+ORDERING_PANIC = (FAULTS / "ordering_panic.rq").read_text(encoding="utf-8")
+MIXED_TIMES = FAULTS / "mixed_times.ttl"
+READINGS = "http://example.org/lab#readings"
+SORTED_READINGS = "SELECT ?s ?t WHERE { ?s <http://example.org/lab#seenAt> ?t } ORDER BY ?t"
 JSON = "application/sparql-results+json"
 PANIC_OUTPUT = (
     "\nthread '<unnamed>' (4806) panicked at /rustc/58cf8f9c/library/core/src/slice/sort/shared/smallsort.rs:854:5:\n"
@@ -89,3 +99,84 @@ def test_a_worker_the_engine_aborts_in_is_its_fault_not_the_memory_cap(
         assert answer is not None and b'"boolean":true' in answer.body
     finally:
         service.close()
+
+
+def test_a_text_that_may_sort_is_told_by_its_order_by_wherever_it_stands() -> None:
+    assert sorts(SORTED_READINGS) and sorts("select * { { select ?t { ?s ?p ?t } order\n  by ?t limit 1 } }")
+    assert sorts("SELECT ?t { ?s ?p ?t } ORDER # by time\nBY ?t")
+    assert not sorts("SELECT ?t { ?s ?p ?t } GROUP BY ?t") and not sorts("SELECT (MIN(?t) AS ?m) { ?s ?p ?t }")
+    assert sorts('ASK { ?s ?p "ORDER BY" }')  # a string's words cost a worker, never a missed sort
+
+
+@pytest.fixture(scope="module")
+def lab_store(tmp_path_factory: pytest.TempPathFactory) -> str:
+    """A seeded on-disk store that also holds a lab's readings: dateTimes with and without a time zone."""
+    location = str(tmp_path_factory.mktemp("engine-faults-lab") / "store")
+    kb = KnowledgeBase.open(location)
+    triples = ox.parse(MIXED_TIMES.read_bytes(), format=ox.RdfFormat.TURTLE)
+    kb.store.add([ox.Quad(t.subject, t.predicate, t.object, ox.NamedNode(READINGS)) for t in triples])
+    kb.close()
+    return location
+
+
+def test_cbrs_query_on_data_the_engine_cannot_sort_says_so_in_one_line(lab_store: str) -> None:
+    """Before, the command died with Rust's panic line and "Aborted" (exit 134). Run as a child process, so
+    that a regression aborts it, not pytest."""
+    code = (
+        "import pyoxigraph as ox, sys; store = ox.Store(); store.load(path=sys.argv[1], format=ox.RdfFormat.TURTLE);"
+        " list(store.query(sys.argv[2]))"
+    )
+    probe = subprocess.run([sys.executable, "-c", code, str(MIXED_TIMES), SORTED_READINGS], capture_output=True)
+    if probe.returncode == 0:
+        pytest.skip("this pyoxigraph sorts the readings' dateTimes with and without a time zone without panicking")
+    done = subprocess.run(
+        [sys.executable, "-m", "cbrs", "--store", lab_store, "query", SORTED_READINGS],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert done.returncode == 1 and done.stdout == ""
+    lines = done.stderr.splitlines()
+    assert len(lines) == 1, done.stderr
+    assert lines[0].startswith("Error: the query crashed the store's SPARQL engine in an isolated process")
+    assert "total order" in lines[0] and "give every one a time zone" in lines[0]
+    ordered = SORTED_READINGS.replace("ORDER BY ?t", "ORDER BY STR(?t)")  # what the message says to do
+    result = CliRunner().invoke(cli, ["--store", lab_store, "query", ordered, "--format", "csv"])
+    assert result.exit_code == 0 and len(result.stdout.split()) == 1 + 24
+
+
+SORTING_QUERIES = [  # each kind of result in the formats whose printing differs
+    ("SELECT ?c ?label WHERE { ?c a owl:Class ; rdfs:label ?label } ORDER BY DESC(?label) ?c LIMIT 12", "table"),
+    ("SELECT ?r ?p WHERE { ?r owl:onProperty ?p } ORDER BY ?p ?r LIMIT 6", "csv"),
+    ("ASK { { SELECT ?c WHERE { ?c a owl:Class } ORDER BY ?c LIMIT 1 } }", "table"),
+    ("CONSTRUCT { ?c rdfs:label ?l } WHERE { ?c a owl:Class ; rdfs:label ?l } ORDER BY ?l LIMIT 5", "table"),
+    ("DESCRIBE ?c WHERE { ?c a owl:Class } ORDER BY ?c LIMIT 1", "json"),
+]
+
+
+def test_a_query_that_sorts_prints_from_its_worker_what_it_printed_in_process(
+    lab_store: str, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    isolated: list[str] = []
+    query = IsolatedQueries.query
+
+    def counted(self: IsolatedQueries, text: str) -> object:
+        isolated.append(text)
+        return query(self, text)
+
+    monkeypatch.setattr(IsolatedQueries, "query", counted)
+    printed: dict[tuple[str, str], bytes] = {}
+    for text, fmt in SORTING_QUERIES:
+        result = CliRunner().invoke(cli, ["--store", lab_store, "query", text, "--format", fmt])
+        assert result.exit_code == 0, result.output
+        printed[text, fmt] = result.stdout_bytes
+    assert len(isolated) == len(printed)
+    unsorted = "SELECT ?c WHERE { ?c a owl:Class } LIMIT 1"
+    assert CliRunner().invoke(cli, ["--store", lab_store, "query", unsorted]).exit_code == 0
+    assert len(isolated) == len(printed)  # a text that does not sort runs in this process, as before
+    kb = KnowledgeBase.open(lab_store)
+    try:
+        for (text, fmt), output in printed.items():
+            assert output == (render_result(kb.query(text), fmt) + "\n").encode(), (text, fmt)
+    finally:
+        kb.close()
