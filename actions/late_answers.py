@@ -31,6 +31,13 @@ alert about a status, (Person, lab6:isAlertedOf, DoorStatus), is no lasting stat
 nor kept, late as in time (docs/components.md).
 The write is :func:`actions.belief.correct`: one transaction, kept by a run still going, and heard by a
 simulation environment running (:class:`actions.belief.Heard`; docs/reliability.md, "Late answers").
+
+An answer in time that fails its step is the same case as a late failure (:func:`unsettle`): the call was
+sent, so the device may have acted, in full or in part, and the answer does not say how far. Every relation
+the call would set or delete about the things it was given becomes unknown, by the same grounding, so the
+next plan senses or acts instead of trusting the belief from before the call. A call refused before it was
+sent (its breaker open, an actuator still busy) did nothing, and the belief stays (docs/execution.md,
+"The belief after a failed step").
 """
 
 from __future__ import annotations
@@ -52,7 +59,7 @@ from cbrs.actions.remote_errors import RemoteCallError
 from cbrs.kb import KnowledgeBase, KnowledgeBaseError, Statement
 from cbrs.kb.namespaces import expand, shorten
 
-__all__ = ["GivenUp", "watch"]
+__all__ = ["GivenUp", "SentAndFailed", "unsettle", "watch"]
 
 log = logging.getLogger("cbrs.actions.remote")
 
@@ -92,6 +99,47 @@ class _Expected:
         return frozenset((s, p) for s, p, _ in (*self.deletes, *self.adds))
 
 
+@dataclass(frozen=True)
+class SentAndFailed:
+    """A call that was sent and whose step failed without a checked success, for a reason other than a
+    timeout whose answer is still awaited: the component, its service, why and the step's inputs."""
+
+    component: str
+    service: str
+    reason: str
+    inputs: Mapping[str, Any]
+
+    def said(self, what: str) -> str:
+        return f"{shorten(self.component)} ({self.service}) {what}"
+
+
+def unsettle(kb: KnowledgeBase, classes: Classes, call: SentAndFailed) -> None:
+    """Make every relation ``call`` would set or delete about the things it was given unknown (no value
+    believed), as a late failure does (:func:`_believe`), with one warning naming the component, the reason
+    and the relations. A relation a test of the store decides is left to perception. Never raises: a store
+    that cannot be read or written now is only named in the warning (the step has failed either way)."""
+    try:
+        expected = _expect(kb, classes, call)
+        outcome = _believe(kb, classes, expected, failed=True)
+    except Exception as broken:  # the step's own failure is what the run reports: say this, do not hide it
+        log.warning(
+            "%s; what it may have done could not be marked unknown (%s): the belief may be stale, check the device",
+            call.said(f"failed after its call was sent ({call.reason})"),
+            broken,
+        )
+        return
+    if not outcome.unknown and not expected.ungrounded:
+        return  # it sets nothing only a step sets: perception decides the rest
+    parts = [call.said(f"failed after its call was sent ({call.reason})")]
+    if outcome.unknown:
+        pairs = ", ".join(_pair(p) for p in sorted(outcome.unknown))
+        parts.append(f"it may have acted, in full or in part, so no value of {pairs} is believed now")
+    if expected.ungrounded:
+        statements = ", ".join(_statement(s) for s in expected.ungrounded)
+        parts.append(f"not changed: {statements} (no one thing of the step's inputs is meant)")
+    log.warning("%s", "; ".join(parts))
+
+
 def watch(kb: KnowledgeBase, classes: Classes, call: GivenUp, read: Read) -> Late | None:
     """What settles ``call``'s answer once it comes (:data:`actions.breaker.Late`: called in a thread of
     its own). None, after a warning, when what it would change cannot be read now (the component was
@@ -104,7 +152,7 @@ def watch(kb: KnowledgeBase, classes: Classes, call: GivenUp, read: Read) -> Lat
     return lambda done: _settle(kb, classes, call, expected, read, done)
 
 
-def _expect(kb: KnowledgeBase, classes: Classes, call: GivenUp) -> _Expected:
+def _expect(kb: KnowledgeBase, classes: Classes, call: GivenUp | SentAndFailed) -> _Expected:
     description = kb.description(call.component)
     untested = [s for s in (*description.deletes, *description.effects) if not _tested(kb, s.predicate)]
     quality = OwnQualities(kb, classes.is_a)
