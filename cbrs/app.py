@@ -8,7 +8,9 @@ import click
 import pyoxigraph as ox
 
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.errors import StoreError
 from cbrs.kb.namespaces import expand
+from cbrs.kb.store import StoreInUseError
 from cbrs.settings import setting
 
 
@@ -27,15 +29,24 @@ class App:
         """The knowledge base, opened on first use; ``seed=False`` for a command that replaces the store's
         contents whole (``cbrs restore``): a new store is not seeded, an old one not upgraded, first."""
         if self._kb is None:
-            self._kb = KnowledgeBase.open(
-                self.store_location,
-                seed=seed,
-                remote_timeout=setting("remote_timeout").resolve(),
-                check_timeout=setting("query_check_timeout").resolve(),
-                remote_access=setting("federation_allow").resolve(),
-                remote_token=setting("update_token").resolve(),
-                remote_batch=_batch(setting("remote_batch").resolve()),
-            )
+            try:
+                self._kb = KnowledgeBase.open(
+                    self.store_location,
+                    seed=seed,
+                    remote_timeout=setting("remote_timeout").resolve(),
+                    check_timeout=setting("query_check_timeout").resolve(),
+                    remote_access=setting("federation_allow").resolve(),
+                    remote_token=setting("update_token").resolve(),
+                    remote_batch=_batch(setting("remote_batch").resolve()),
+                )
+            except StoreInUseError as error:  # the library advises a program; a person at the CLI, this
+                hint = (
+                    f"a cbrs server serves it: use --store {error.served} (the token from CBRS_UPDATE_TOKEN)"
+                    if error.served
+                    else "stop it or pick another store with --store"
+                )
+                reason = f"is in use by another process (RocksDB lock held); {hint} ({error.cause})"
+                raise StoreError(error.location, reason) from error
         return self._kb
 
     @property

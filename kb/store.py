@@ -309,6 +309,24 @@ def _refuse_url_like(text: str, path: Path) -> None:
         )
 
 
+class StoreInUseError(StoreError):
+    """Another process holds an on-disk store's lock (RocksDB's: one process at a time). ``served``: the URL
+    a cbrs server serving the directory wrote into it (None: no server's), which a caller opens instead;
+    ``cause``: the lock's own message. Advice for a program, in its terms; the CLI words its own
+    (``cbrs.app``)."""
+
+    def __init__(self, location: str, served: str | None, cause: str) -> None:
+        self.served = served
+        self.cause = cause
+        hint = (
+            f"a cbrs server serves it: open it by the server's URL, KnowledgeBase.open({served!r}, "
+            "remote_token=...) with the server's update token for writes"
+            if served
+            else "stop that process, or open another store"
+        )
+        super().__init__(location, f"is in use by another process (RocksDB lock held); {hint} ({cause})")
+
+
 class EmbeddedStore(Store):
     """An Oxigraph store in this process, on disk or in memory.
 
@@ -357,13 +375,7 @@ class EmbeddedStore(Store):
             return store
         except OSError as error:
             if "lock" in str(error).lower():
-                served = _served_at(path)
-                hint = (
-                    f"a cbrs server serves it: use --store {served} (the token from CBRS_UPDATE_TOKEN)"
-                    if served
-                    else "stop it or pick another store with --store"
-                )
-                raise StoreError(text, f"is in use by another process (RocksDB lock held); {hint} ({error})") from error
+                raise StoreInUseError(text, _served_at(path), str(error)) from error
             raise StoreError(text, str(error)) from error
 
     @property
