@@ -553,7 +553,8 @@ def run(
         environment = SimEnvironment(world, app.kb, transport)
         unknown = [f for f in failing if f not in environment.registry]
         if unknown:
-            raise click.BadParameter(f"no simulated component {', '.join(map(shorten, unknown))}", param_hint="--fail")
+            kind = "component" if transport is not None else "simulated component"  # what this run can invoke
+            raise click.BadParameter(f"no {kind} {', '.join(map(shorten, unknown))}", param_hint="--fail")
         if record is not None:
             recorder = Recorder(world, title=task)
 
@@ -678,7 +679,8 @@ def _check_failing(kb: KnowledgeBase, failing: list[str], bridged: bool) -> None
     for component in unknown:
         near = difflib.get_close_matches(shorten(component), names, n=2)
         said.append(shorten(component) + (f" (did you mean {' or '.join(near)}?)" if near else ""))
-    raise click.BadParameter(f"no simulated component {', '.join(said)}", param_hint="--fail")
+    kind = "component" if bridged else "simulated component"  # without --bridge it can invoke no other
+    raise click.BadParameter(f"no {kind} {', '.join(said)}", param_hint="--fail")
 
 
 def _bridge(url: str) -> BridgeClient:

@@ -12,6 +12,7 @@ until one comes, for the browser's MJPEG stream.
 
 from __future__ import annotations
 
+import difflib
 import io
 import itertools
 import logging
@@ -82,9 +83,13 @@ class TasksDisabledError(KnowledgeBaseError):
 class UnknownComponentError(KnowledgeBaseError):
     http_status = 400
 
-    def __init__(self, names: list[str]) -> None:
+    def __init__(self, names: list[str], near: dict[str, list[str]] | None = None) -> None:
+        """``names``: those given that no component is (simulated or over the bridge: a server's run reaches
+        both); ``near``: for some of them, the nearest names of components that are, as ``cbrs run`` says."""
         self.names = names
-        super().__init__(f"no simulated component {', '.join(names)}")
+        self.near = dict(near or {})
+        said = [n + (f" (did you mean {' or '.join(self.near[n])}?)" if self.near.get(n) else "") for n in names]
+        super().__init__(f"no component {', '.join(said)}")
 
 
 class RunOptionError(KnowledgeBaseError):
@@ -286,8 +291,9 @@ class TaskRunner:
         RandomFaults(seed, fault_rate)  # an impossible rate fails here (FaultSpecError), not in the thread
         ReplanPolicy(max_repeats=repeat_failures)  # so does a negative bound (ReplanPolicyError)
         near_misses = _check_options(objective, base_ties, near_misses)
-        failing = tuple(expand(f) for f in faults)
-        _check_components(self.kb, failing)
+        with store_names(StoreNames(lambda: self.kb)):  # the names a run's texts and cbrs run --fail take
+            failing = tuple(expand(f) for f in faults)
+            _check_components(self.kb, failing)
         self._refuse_if_busy()  # a second run is refused before its task is checked
         with self.lock:
             library = ActionLibrary.from_kb(self.kb)
@@ -627,4 +633,5 @@ def _check_components(kb: KnowledgeBase, failing: tuple[str, ...]) -> None:
     known |= {ad.iri for ad in kb.advertisements(include_unavailable=True) if ad.bridge_port is not None}
     unknown = [shorten(f) for f in failing if f not in known]
     if unknown:
-        raise UnknownComponentError(unknown)
+        names = sorted(shorten(k) for k in known)
+        raise UnknownComponentError(unknown, {u: difflib.get_close_matches(u, names, n=2) for u in unknown})
