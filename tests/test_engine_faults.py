@@ -29,6 +29,7 @@ from cbrs.sparql_service import EndpointConfig, SparqlService
 
 FAULTS = Path(__file__).parent / "data" / "engine_faults"
 ORDERING_PANIC = (FAULTS / "ordering_panic.rq").read_text(encoding="utf-8")
+SHORT_PANIC = (FAULTS / "short_ordering_panic.rq").read_text(encoding="utf-8")
 MIXED_TIMES = FAULTS / "mixed_times.ttl"
 READINGS = "http://example.org/lab#readings"
 SORTED_READINGS = "SELECT ?s ?t WHERE { ?s <http://example.org/lab#seenAt> ?t } ORDER BY ?t"
@@ -99,6 +100,19 @@ def test_a_worker_the_engine_aborts_in_is_its_fault_not_the_memory_cap(
         assert answer is not None and b'"boolean":true' in answer.body
     finally:
         service.close()
+
+
+def test_a_short_text_that_panics_the_engine_costs_a_library_user_a_worker_only(
+    engine_panics: None, disk_kb: KnowledgeBase
+) -> None:
+    """The guard runs a text this short in the caller's process; IsolatedQueries runs it in a worker."""
+    assert len(SHORT_PANIC) <= EmbeddedStore.guard.direct_chars and sorts(SHORT_PANIC)
+    assert isinstance(disk_kb.store, EmbeddedStore)
+    with IsolatedQueries(disk_kb.store, keep=1) as isolated:
+        with pytest.raises(EngineFaultError, match="total order") as failed:
+            isolated.query(SHORT_PANIC)
+        assert failed.value.query == SHORT_PANIC
+        assert isolated.query("ASK { ?s ?p ?o }")  # a new worker, this process untouched
 
 
 def test_a_text_that_may_sort_is_told_by_its_order_by_wherever_it_stands() -> None:
