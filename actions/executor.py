@@ -14,9 +14,9 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from enum import Enum
-from typing import Any, Protocol
+from typing import Any, Protocol, runtime_checkable
 
-from cbrs.actions.components import Container, LifecycleState, Status
+from cbrs.actions.components import Component, Container, LifecycleState, Status
 from cbrs.actions.events import Priority
 from cbrs.actions.graph import statement_text
 from cbrs.actions.plan import Plan, PlanStep
@@ -47,6 +47,16 @@ class StepDone(Protocol):
         """``component`` did ``step`` and its effects were checked: what an environment that keeps beliefs
         no sense can check (a door a remote motor opened) updates them from (the component's effects
         added, its delete effects removed)."""
+
+
+@runtime_checkable
+class Uncounted(Protocol):
+    """A component that wants to know when the executor did not count an invocation it ended as succeeded
+    (an effect not reached, the environment's bookkeeping failed): a remote actuator then treats what it
+    may have done as unknown (``sim.components._Acting``; docs/execution.md, "The belief after a failed
+    step")."""
+
+    def uncounted(self, reason: str) -> None: ...
 
 
 @dataclass
@@ -300,13 +310,13 @@ class Executor:
         missed = [statement_text(effect) for effect, ok in checks if ok is False]
         if missed:
             self.reports[self._position].effects = checks
-            self._violation(step, iri, "effect not reached: " + ", ".join(missed))
+            self._uncounted(component, step, iri, "effect not reached: " + ", ".join(missed))
             return
         if self.on_done is not None:
             try:
                 self.on_done(step, iri)
             except Exception as error:  # the environment's bookkeeping failed: the step did not count
-                self._violation(step, iri, f"{type(error).__name__}: {error}")
+                self._uncounted(component, step, iri, f"{type(error).__name__}: {error}")
                 return
         report = self.reports[self._position]
         report.attempts.append(self._attempt(iri, "succeeded"))
@@ -352,6 +362,15 @@ class Executor:
             return None
         found = self.verifier(step, statement, outputs)
         return None if found is None else bool(found)
+
+    def _uncounted(self, component: Component, step: PlanStep, iri: str, reason: str) -> None:
+        """A violation after ``component`` ended as succeeded: it is told first, if it asks to be."""
+        if isinstance(component, Uncounted):
+            try:
+                component.uncounted(reason)
+            except Exception as error:  # its bookkeeping must not hide the step's own failure
+                reason = f"{reason} ({type(error).__name__} telling it: {error})"
+        self._violation(step, iri, reason)
 
     def _violation(self, step: PlanStep, iri: str, reason: str) -> None:
         """Record the failed attempt; the next tick starts the next alternative (or fails the run)."""

@@ -231,15 +231,17 @@ def _remote(transport: Transport, service: str, ad: Advertisement, calls: _Remot
 class _Acting(RemoteComponent):
     """A remote component with effects: when a call it sent ends its step without a checked success (an
     error answer, a malformed or contradicting one, the connection lost, a timeout whose answer nobody
-    awaits, the step halted while the call was out), the device may have acted, so what its effects would
-    set about the things it was given becomes unknown (:func:`actions.late_answers.unsettle`). A call
+    awaits, the step halted while the call was out, an answer taken but the step then failed by the
+    executor: :meth:`uncounted`), the device may have acted, so what its effects would set about the things
+    it was given becomes unknown (:func:`actions.late_answers.unsettle`). A call
     refused before it was sent changes no belief, nor does an actuator's call given up, whose late answer
     settles it (:func:`actions.late_answers.watch`). docs/execution.md, "The belief after a failed step"."""
 
     _sent_call = False  # a call of this invocation went out and has not been accounted for
+    _answered = False  # its answer was taken: the step may still not count (actions.executor.Uncounted)
 
     def begin(self, inputs: Mapping[str, Any]) -> None:
-        self._sent_call = False
+        self._sent_call = self._answered = False
         super().begin(inputs)
         self._sent_call = self._pending is not None
 
@@ -252,8 +254,15 @@ class _Acting(RemoteComponent):
         if status is Status.FAILED:
             self._unsettle(self.reason)
         elif status is Status.SUCCEEDED:
-            self._sent_call = False
+            self._sent_call, self._answered = False, True
         return status
+
+    def uncounted(self, reason: str) -> None:
+        """The executor did not count the step this answered as succeeded (an effect not reached): the
+        device may have done part of it, so what its effects set is unknown, as for a failed answer."""
+        if self._answered:
+            self._answered, self._sent_call = False, True
+            self._unsettle(f"its answer was taken, but the step failed: {reason}")
 
     def _timed_out(self) -> Status:
         if self.exclusive and self.kb is not None:

@@ -149,8 +149,9 @@ class LivingRoom:
     """A stub environment: it gives the lamp, verifies nothing, keeps the world graph's belief it started
     with and believes a succeeded step's effect, as the simulated home does for a relation no test decides."""
 
-    def __init__(self, kb: KnowledgeBase, transport: Answering) -> None:
+    def __init__(self, kb: KnowledgeBase, transport: Answering, refuting: bool = False) -> None:
         self.kb = kb
+        self.refuting = refuting  # verify finds a step's effect not reached (as a test of the store would)
         self.registry: Registry = implementations(kb, transport=transport)
         self.context = None
         self.facts = frozenset(BeliefState(kb).facts())
@@ -162,7 +163,7 @@ class LivingRoom:
         return {"lamp": LAMP}
 
     def verify(self, step: PlanStep | None, statement: Statement, outputs: Mapping[str, Any]) -> bool | None:
-        return None
+        return False if self.refuting and step is not None else None
 
     def succeeded(self, step: PlanStep, component: str) -> None:
         status = IS_ON if component == ON else IS_OFF
@@ -175,9 +176,9 @@ class LivingRoom:
         return 0.0
 
 
-def _run(kb: KnowledgeBase, task: str, answer: Any) -> tuple[RunResult, Answering]:
+def _run(kb: KnowledgeBase, task: str, answer: Any, refuting: bool = False) -> tuple[RunResult, Answering]:
     transport = Answering(answer)
-    return run_task(kb, LAB10 + task, LivingRoom(kb, transport), max_replans=0), transport
+    return run_task(kb, LAB10 + task, LivingRoom(kb, transport, refuting), max_replans=0), transport
 
 
 def test_after_a_malformed_switch_off_the_next_switch_on_acts(kb: KnowledgeBase) -> None:
@@ -192,3 +193,13 @@ def test_after_a_malformed_switch_off_the_next_switch_on_acts(kb: KnowledgeBase)
     assert third.succeeded and third.composition.plan is not None
     assert [s.component for s in third.composition.plan.steps] == [ON]
     assert plug.calls == ["/lab10_lamp_plug_01/switch_on"] and _status(kb) == [IS_ON[2]]
+
+
+def test_an_answer_taken_whose_effect_is_then_not_reached_leaves_the_lamp_unknown(kb: KnowledgeBase) -> None:
+    """The plug answered "off", well formed, and the verifier found the lamp not off: the step failed after
+    its answer was taken (actions.executor.Uncounted), and the "on" from before is not kept."""
+    _believe(kb, IS_ON)
+    result, plug = _run(kb, "SwitchOffTheReadingLamp", ANSWERED_OFF, refuting=True)
+    assert not result.succeeded and plug.calls == ["/lab10_lamp_plug_01/switch_off"]
+    assert result.report is not None and "effect not reached" in result.report.reason
+    assert _status(kb) == []
