@@ -1,7 +1,8 @@
 """Why a process running the store's SPARQL engine died: a Rust panic, an allocation that failed, or neither.
 
 cbrs runs texts it cannot vouch for in processes of their own (:mod:`kb.query_guard`'s checkers, the
-endpoint's query workers), so a crash of the engine costs that process only. A dead process's exit
+endpoint's query workers, and ``cbrs query``'s for a text that sorts, :mod:`cbrs.isolated_queries`), so a
+crash of the engine costs that process only. A dead process's exit
 signal alone does not say why: Oxigraph is built to abort on a panic, and an allocation past the worker's
 address-space cap aborts too, both with SIGABRT. What the process wrote to its standard error as it died
 does say: a panic prints ``thread '...' panicked at FILE:LINE:COL:`` and then its message; a failed
@@ -12,7 +13,10 @@ the parent reads once the process is gone.
 One panic is known to be reachable from a query (pyoxigraph 0.5.13): ``ORDER BY`` over values the engine
 cannot order against each other, dateTimes some with a time zone and some without, can make Rust's sort
 find that the comparison is no total order, and panic. Twenty-one values in a ``VALUES`` block suffice: the
-text alone crashes the engine, on any store (docs/security.md, "When the engine itself crashes").
+text alone crashes the engine, on any store, and a text short enough to skip the guard's checker can make
+them (278 characters); so can a store's own data, readings written with and without a time zone. An update
+whose ``WHERE`` sorts them aborts the process that holds the store (docs/security.md, "When the engine
+itself crashes").
 """
 
 from __future__ import annotations
