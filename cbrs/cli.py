@@ -28,10 +28,11 @@ from cbrs.cli_interrupts import HeldInterrupts
 from cbrs.cli_notes import no_store_at, note_new_store, wants_json, with_notes
 from cbrs.cli_store import export, restore, update
 from cbrs.extras import require
-from cbrs.isolated_queries import IsolatedQueries, IsolatedResult, sorts
+from cbrs.isolated_queries import IsolatedQueries, IsolatedResult
 from cbrs.kb import Advertisement, KnowledgeBase, KnowledgeBaseError, Requirement, ServiceDescription
 from cbrs.kb.catalog import Catalogue, merge
 from cbrs.kb.derived_prefixes import StoreNames
+from cbrs.kb.engine_faults import sorts
 from cbrs.kb.errors import AlreadyRegisteredError, NotFoundError, QuerySyntaxError, RdfParseError, without_password
 from cbrs.kb.liveness import ComponentState
 from cbrs.kb.loader import LoadReport, ParsedFile

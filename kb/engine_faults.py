@@ -25,12 +25,23 @@ import re
 import tempfile
 from dataclasses import dataclass
 
-__all__ = ["Death", "ErrorLog", "read_death"]
+__all__ = ["Death", "ErrorLog", "read_death", "sorts"]
 
 _TAIL = 8192  # bytes of a dead process's standard error read: the panic's message is at its end
 _PANIC = re.compile(r"panicked at [^\n]*:\d+:\d+:\n(?P<message>[^\n]+)")
 _ALLOCATION = re.compile(r"memory allocation of \d+ bytes failed")
 _TOTAL_ORDER = "total order"
+_SORTS = re.compile(r"ORDER(?:\s|#[^\n]*)+BY", re.IGNORECASE)
+"""``ORDER BY`` with anything between its two words that may stand there (white space and comments). Read
+on the raw text, strings, IRIs and comments included: a word there costs a worker needlessly, while a lexer
+that took an operator ``<`` for an IRI's start could hide a real ``ORDER BY`` and let the engine abort."""
+
+
+def sorts(text: str) -> bool:
+    """Whether the query or update ``text`` may sort solutions (``ORDER BY`` in it or in a subquery of it): the
+    one way known to reach the panic above (no ``MIN``, ``MAX``, ``GROUP BY``, ``DISTINCT`` or comparison did,
+    ``bench/isolated_queries.py``), so what a caller evaluates where an abort costs a child process only."""
+    return _SORTS.search(text) is not None
 
 
 @dataclass(frozen=True)

@@ -19,9 +19,9 @@ import pytest
 from click.testing import CliRunner
 
 from cbrs.cli import cli
-from cbrs.isolated_queries import IsolatedQueries, sorts
+from cbrs.isolated_queries import IsolatedQueries
 from cbrs.kb import KnowledgeBase
-from cbrs.kb.engine_faults import read_death
+from cbrs.kb.engine_faults import read_death, sorts
 from cbrs.kb.errors import EngineFaultError
 from cbrs.kb.store import EmbeddedStore
 from cbrs.output import render_result
