@@ -13,9 +13,11 @@ from typing import TYPE_CHECKING
 
 import pyoxigraph as ox
 
+from cbrs.kb import sorting_updates
 from cbrs.kb.backup import Backup, ExportReport, RestoreReport, export_store, read_backup, restore_store
 from cbrs.kb.catalog import Catalogue
 from cbrs.kb.descriptions import DescriptionReader
+from cbrs.kb.engine_faults import sorts
 from cbrs.kb.errors import ReplaceError, StoreError, UndeclaredSuperclassError
 from cbrs.kb.liveness import Liveness
 from cbrs.kb.loader import (
@@ -474,7 +476,7 @@ class KnowledgeBase:
             checking = checked_update(self.store)
         try:
             with checking:
-                (run or functools.partial(self.store.update, text))()
+                (run or self._runner(text, data))()
             if watch is not None:
                 check_watched(self.store, watch)
             if old_map is not None:
@@ -496,6 +498,15 @@ class KnowledgeBase:
         finally:
             self._reader.clear_cache()
         return self._entail(pending) if run is None else None
+
+    def _runner(self, text: str, data: DataUpdate | None) -> Callable[[], None]:
+        """What runs ``text`` on the embedded store: its own update, or, for a text that may sort, a child
+        process on a copy of it whose effect is written here as data (:mod:`kb.sorting_updates`), since the
+        engine aborts the process on some sorts. A data update has no ``WHERE`` to sort in."""
+        assert isinstance(self.store, EmbeddedStore)
+        if data is None and sorts(text):
+            return functools.partial(sorting_updates.update, self.store, text)
+        return functools.partial(self.store.update, text)
 
     def _update_remote(self, text: str, check_map: bool) -> Refresh | None:
         """:meth:`_update` on a remote store: an update the embedded store would check is carried out first

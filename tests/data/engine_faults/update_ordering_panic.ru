@@ -1,0 +1,2 @@
+# sorts short_ordering_panic.rq's dateTimes in a subquery: it aborts pyoxigraph 0.5.13
+PREFIX xsd: <http://www.w3.org/2001/XMLSchema#> INSERT { GRAPH <http://e/g> { <http://e/first> <http://e/at> ?t } } WHERE { { SELECT ?t { VALUES ?v { "04" "08" "15-14:00" "15-14:00" "06" "15" "12-14:00" "19" "22-14:00" "08Z" "18" "10" "00" "20" "12Z" "13" "16Z" "14-14:00" "17Z" "11Z" "21Z" } BIND(STRDT(CONCAT("2020-01-01T", SUBSTR(?v, 1, 2), ":00:00", SUBSTR(?v, 3)), xsd:dateTime) AS ?t) } ORDER BY ?t LIMIT 1 } }
