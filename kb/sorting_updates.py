@@ -127,7 +127,7 @@ def _quads(data: bytes) -> list[ox.Quad]:
 def _apply(store: EmbeddedStore, removed: Sequence[ox.Quad], added: Sequence[ox.Quad]) -> None:
     """Remove ``removed`` and add ``added`` in one transaction, blank nodes as they are."""
     operations = []
-    functions: dict[ox.NamedNode, Callable[[ox.Literal, ox.Literal], object]] = {}
+    functions: dict[ox.NamedNode, Callable[[ox.Literal, ox.Literal], _Term | None]] = {}
     for operation, quads, name in (("DELETE", removed, _REMOVED), ("INSERT", added, _ADDED)):
         if quads:
             rows = " ".join(str(n) for n in range(len(quads)))
@@ -142,11 +142,20 @@ def _apply(store: EmbeddedStore, removed: Sequence[ox.Quad], added: Sequence[ox.
         store.generation += 1
 
 
-def _terms(quads: Sequence[ox.Quad]) -> Callable[[ox.Literal, ox.Literal], object]:
-    def term(row: ox.Literal, position: ox.Literal) -> object:
+_Term = ox.NamedNode | ox.BlankNode | ox.Literal | ox.Triple
+
+
+def _terms(quads: Sequence[ox.Quad]) -> Callable[[ox.Literal, ox.Literal], _Term | None]:
+    """The custom function of :data:`_APPLY` for ``quads``: term ``position`` of quad ``row``, or None (unbound)."""
+
+    def term(row: ox.Literal, position: ox.Literal) -> _Term | None:
         quad, at = quads[int(row.value)], int(position.value)
-        if (at >= 4) != (quad.graph_name == ox.DefaultGraph()):
-            return None  # unbound: this template triple is not this quad's
-        return (quad.subject, quad.predicate, quad.object, quad.graph_name)[at % 4]
+        graph = quad.graph_name
+        if isinstance(graph, ox.DefaultGraph) != (at >= 4):
+            return None  # this template triple is not this quad's
+        if at % 4 == 3:
+            assert not isinstance(graph, ox.DefaultGraph)
+            return graph
+        return (quad.subject, quad.predicate, quad.object)[at % 4]
 
     return term
