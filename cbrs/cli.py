@@ -41,7 +41,6 @@ from cbrs.kb.skolem import is_skolem
 from cbrs.kb.staged_writes import STAGING
 from cbrs.kb.store import EmbeddedStore, QueryResult, Term
 from cbrs.output import (
-    _GRAPH_FORMATS,
     RESULT_FORMATS,
     Cell,
     ProgressLine,
@@ -53,7 +52,6 @@ from cbrs.output import (
     sorted_lists,
     table,
     term_text,
-    used_prefixes,
 )
 from cbrs.settings import SETTINGS, setting
 from cbrs.sparql_hints import declared, explain_syntax_error, one_line_up, store_prefixes_used
@@ -526,11 +524,7 @@ def query(
         with store_names(names):  # a misspelt term matches nothing, and "(0 rows)" said no more
             for note in unmentioned_names(app.kb, body, added):
                 click.echo(f"note: {note}", err=True)
-    if isinstance(result, list):  # a graph a query worker answered (_evaluate): printed as render_result does
-        data = ox.serialize(result, format=_GRAPH_FORMATS[fmt], prefixes=used_prefixes(result))
-        click.echo(data.decode("utf-8") if data else "")
-        return
-    click.echo(render_result(result, fmt))
+    click.echo(render_result(result, fmt))  # a list: a graph a query worker answered (_evaluate)
 
 
 def _evaluate(kb: KnowledgeBase, text: str) -> QueryResult | IsolatedResult:

@@ -56,9 +56,10 @@ def used_prefixes(statements: Iterable[ox.Triple | ox.Quad]) -> dict[str, str]:
     return dict(sorted(used.items()))
 
 
-def render_result(result: QueryResult, fmt: str) -> str:
-    """The text for a query result in one of ``RESULT_FORMATS``."""
-    if isinstance(result, ox.QueryTriples):
+def render_result(result: QueryResult | list[ox.Triple], fmt: str) -> str:
+    """The text for a query result in one of ``RESULT_FORMATS``; a list is a graph's triples (as a query
+    worker answers a CONSTRUCT or DESCRIBE, cbrs.isolated_queries)."""
+    if isinstance(result, ox.QueryTriples | list):
         triples = list(result)
         data = ox.serialize(triples, format=_GRAPH_FORMATS[fmt], prefixes=used_prefixes(triples))
         return data.decode("utf-8") if data else ""

@@ -204,9 +204,7 @@ class EngineFaultError(KnowledgeBaseError):
     def __init__(self, query: str, reason: str) -> None:
         self.query = query
         self.reason = reason
-        super().__init__(
-            f"the query crashed the store's SPARQL engine in an isolated process: {reason}; the server goes on"
-        )
+        super().__init__(f"the query crashed the store's SPARQL engine in an isolated process: {reason}")
 
 
 class NotFoundError(KnowledgeBaseError):

@@ -952,23 +952,32 @@ def union_of_selects(texts: Sequence[str]) -> str | None:
     its ``ORDER BY`` variables to keys of its own, and the whole is ordered by the number, then by every
     branch's keys (those of the other branches are unbound in a row, so equal): each query's rows come in
     its own order. None when a text cannot be a sub-SELECT as it is: not a SELECT, a ``PREFIX`` or
-    ``BASE`` of its own, a ``cbrs__`` variable, or an ``ORDER BY`` of other than variables (with
-    ``ASC`` or ``DESC``)."""
+    ``BASE`` of its own, a ``cbrs__`` variable, or an ``ORDER BY`` of other than variables or ``STR`` of
+    one (with ``ASC`` or ``DESC``)."""
     branches, keys = [], []
     for number, text in enumerate(texts):
         order = _order_keys(text)
         if order is None:
             return None
         names = [f"?cbrs__key{number}_{index}" for index in range(len(order))]
-        copies = "".join(f" BIND ({variable} AS {name})" for (_, variable), name in zip(order, names, strict=True))
+        copies = "".join(f" BIND ({key.expression} AS {name})" for key, name in zip(order, names, strict=True))
         branches.append(f"{{ {{ {text}\n}} BIND ({number} AS ?{_PART}){copies} }}")
-        keys += [f"{direction}({name})" for (direction, _), name in zip(order, names, strict=True)]
+        keys += [f"{key.direction}({name})" for key, name in zip(order, names, strict=True)]
     return "SELECT * WHERE {\n" + "\nUNION\n".join(branches) + f"\n}} ORDER BY ?{_PART} " + " ".join(keys)
 
 
-def _order_keys(text: str) -> list[tuple[str, str]] | None:
-    """The ``(ASC|DESC, ?variable)`` pairs of a SELECT query's top-level ``ORDER BY`` ([] without one),
-    None when the text is no plain SELECT (see :func:`union_of_selects`)."""
+class OrderKey(NamedTuple):
+    """One key of an ``ORDER BY``: ``ASC`` or ``DESC``, its variable, and the expression sorted
+    (the variable, or ``STR(variable)``: what cbrs's named queries sort literals by, docs/security.md)."""
+
+    direction: str
+    variable: str
+    expression: str
+
+
+def _order_keys(text: str) -> list[OrderKey] | None:
+    """The keys of a SELECT query's top-level ``ORDER BY`` ([] without one), None when the text is no
+    plain SELECT (see :func:`union_of_selects`)."""
     tokens = _tokens(text)
     names = [token.text.upper() for token in tokens if token.kind == "name"]
     if (
@@ -986,23 +995,28 @@ def _order_keys(text: str) -> list[tuple[str, str]] | None:
     if start is None:
         return []
     projected = _projected(tokens)
-    keys: list[tuple[str, str]] = []
+    keys: list[OrderKey] = []
     rest = tokens[start:]
     while rest and not (rest[0].kind == "name" and rest[0].text.upper() in ("LIMIT", "OFFSET", "VALUES")):
-        if rest[0].kind == "variable":
-            keys.append(("ASC", rest[0].text))
-            rest = rest[1:]
-        elif (
-            len(rest) >= 4
-            and rest[0].text.upper() in ("ASC", "DESC")
-            and rest[2].kind == "variable"
-            and rest[3].text == ")"
-        ):
-            keys.append((rest[0].text.upper(), rest[2].text))
-            rest = rest[4:]
+        direction = "ASC"
+        if rest[0].text.upper() in ("ASC", "DESC") and len(rest) >= 2 and rest[1].text == "(":
+            direction, rest, closing = rest[0].text.upper(), rest[2:], 1
+        else:
+            closing = 0
+        if rest and rest[0].kind == "variable":
+            key, rest = OrderKey(direction, rest[0].text, rest[0].text), rest[1:]
+        elif len(rest) >= 4 and rest[0].text.upper() == "STR" and rest[1].text == "(" and rest[2].kind == "variable":
+            if rest[3].text != ")":
+                return None
+            key, rest = OrderKey(direction, rest[2].text, f"STR({rest[2].text})"), rest[4:]
         else:
             return None
-    if projected is not None and any(variable not in projected for _, variable in keys):
+        if closing:
+            if not rest or rest[0].text != ")":
+                return None
+            rest = rest[1:]
+        keys.append(key)
+    if projected is not None and any(key.variable not in projected for key in keys):
         return None  # a key the sub-SELECT does not project cannot order the rows outside it
     return keys
 

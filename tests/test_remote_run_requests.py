@@ -134,7 +134,7 @@ def test_queries_asked_together_give_the_rows_and_order_each_gives_alone(remote:
     assert sent.kinds == {"combined": 1}
     for name, rows, expected in zip(free, together, alone, strict=True):
         assert _rows(rows) == _rows(expected), name
-        keys = [variable.lstrip("?") for _, variable in _order_keys(remote.queries.get(name).text) or []]
+        keys = [key.variable.lstrip("?") for key in _order_keys(remote.queries.get(name).text) or []]
         assert [[row.get(key) for key in keys] for row in rows] == [[row.get(key) for key in keys] for row in expected]
     bound = {"description": LOCATE}
     assert remote.select_each(PER_DESCRIPTION, bound) == [remote.select(name, bound) for name in PER_DESCRIPTION]
@@ -150,7 +150,7 @@ def _rows(rows: list[dict[str, Any]]) -> list[str]:
     [
         pytest.param("ASK { ?s ?p ?o }", id="ask"),
         pytest.param("PREFIX x: <http://example.org/> SELECT ?s WHERE { ?s ?p x:o }", id="own-prefix"),
-        pytest.param("SELECT ?s WHERE { ?s ?p ?o } ORDER BY DESC(STR(?s))", id="order-by-expression"),
+        pytest.param("SELECT ?s WHERE { ?s ?p ?o } ORDER BY DESC(UCASE(STR(?s)))", id="order-by-expression"),
         # ?o over IRIs only: Oxigraph's server once panicked sorting the whole store's mixed literals
         pytest.param("SELECT ?s WHERE { ?s a ?o } ORDER BY ?o", id="order-by-unprojected"),
         pytest.param("SELECT ?cbrs__x WHERE { ?cbrs__x ?p ?o }", id="own-variable"),
@@ -162,6 +162,18 @@ def test_a_query_that_cannot_be_a_branch_is_asked_alone(remote: KnowledgeBase, t
         sent = Requests(remote)
         both = remote.store.select_each([("SELECT ?s WHERE { ?s a owl:Ontology } ORDER BY ?s", {}), (text, {})])
         assert sent.kinds == {"other": 2} and both[0]
+
+
+def test_keys_of_a_variable_or_its_string_are_read_and_other_expressions_are_not() -> None:
+    text = "SELECT ?a ?b ?c WHERE { ?a ?b ?c } ORDER BY ?a DESC(?b) STR(?c) DESC(STR(?a)) LIMIT 3"
+    assert [tuple(key) for key in _order_keys(text) or []] == [
+        ("ASC", "?a", "?a"),
+        ("DESC", "?b", "?b"),
+        ("ASC", "?c", "STR(?c)"),
+        ("DESC", "?a", "STR(?a)"),
+    ]
+    for other in ("LCASE(?c)", "STR(?c, ?a)", "DESC(STR(?c) ?a", "STR(?c"):
+        assert _order_keys("SELECT ?a ?c WHERE { ?a ?b ?c } ORDER BY " + other) is None, other
 
 
 def test_order_by_descending_keys_is_kept(remote: KnowledgeBase) -> None:
