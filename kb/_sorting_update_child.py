@@ -2,10 +2,11 @@
 what it changed.
 
 Run by path (``python .../_sorting_update_child.py COPY PREFIXES``, the update on stdin), so it imports
-nothing but the standard library and pyoxigraph. It answers on stdout with one status byte: ``K`` then the
-quads removed and the quads added as N-Quads lines, the first part's length before it (8 bytes); or ``S``, ``E``,
-``O`` (a syntax, evaluation or input/output error) then the engine's message. A panic of the engine aborts
-it before it answers: the parent reads why from its standard error.
+nothing but the standard library and pyoxigraph. ``COPY`` is an on-disk store, or an N-Quads file (ending
+``.nq``: an in-memory store's dump, loaded into memory here). It answers on stdout with one status byte:
+``K`` then the quads removed and the quads added as N-Quads lines, the first part's length before it (8
+bytes); or ``S``, ``E``, ``O`` (a syntax, evaluation or input/output error) then the engine's message. A
+panic of the engine aborts it before it answers: the parent reads why from its standard error.
 """
 
 from __future__ import annotations
@@ -30,7 +31,11 @@ def lines(store: ox.Store) -> set[bytes]:
 def main() -> None:
     copy, prefixes = sys.argv[1], json.loads(sys.argv[2])
     text = sys.stdin.buffer.read().decode("utf-8", "surrogatepass")
-    store = ox.Store(copy)
+    if copy.endswith(".nq"):
+        store = ox.Store()
+        store.load(path=copy, format=ox.RdfFormat.N_QUADS)
+    else:
+        store = ox.Store(copy)
     before = lines(store)
     try:
         store.update(text, prefixes=prefixes)

@@ -9,9 +9,10 @@ user's program. So :meth:`kb.knowledge_base.KnowledgeBase.update` hands an updat
 (:func:`kb.engine_faults.sorts`) to :func:`update` instead of the store's own update:
 
 1. the same checks first (nesting, remote access, the query guard's checker for a long text);
-2. a copy of the store: a RocksDB checkpoint beside it (hard links to its immutable files, which Oxigraph
-   documents as a database that "operates independently from the original"; the child writes to its own
-   new files) or, in memory, its quads copied into an on-disk store (:meth:`EmbeddedStore.snapshot`);
+2. a copy of the store: a RocksDB checkpoint beside it (:meth:`EmbeddedStore.snapshot`: hard links to its
+   immutable files, which Oxigraph documents as a database that "operates independently from the
+   original"; the child writes to its own new files) or, in memory, its N-Quads dump, which the child
+   loads into memory (blank nodes keep their labels);
 3. a child process (``_sorting_update_child.py``) runs the update on the copy and prints what it removed
    and added, as N-Quads lines (blank nodes keep their labels);
 4. here, in one transaction, those quads are removed and added: one update whose ``VALUES`` rows a custom
@@ -75,8 +76,11 @@ def _evaluate(store: EmbeddedStore, text: str) -> tuple[list[ox.Quad], list[ox.Q
     root = _scratch(store)
     errors = ErrorLog()
     try:
-        copy = root / "copy"
-        store.snapshot(copy)
+        copy = root / ("copy.nq" if store.in_memory else "copy")
+        if store.in_memory:  # its dump, which the child loads into memory: faster than an on-disk copy
+            store._backend.dump(str(copy), format=ox.RdfFormat.N_QUADS)  # blank nodes' labels kept
+        else:
+            store.snapshot(copy)
         command = [sys.executable, str(_CHILD), str(copy), json.dumps(PREFIXES)]
         done = subprocess.run(
             command,

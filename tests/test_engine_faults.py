@@ -281,8 +281,9 @@ def test_cbrs_update_of_data_the_engine_cannot_sort_says_so_and_changes_nothing(
 def test_a_sorting_update_leaves_the_store_as_it_did_in_process_and_others_run_in_process(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    """The same updates on two stores seeded alike: in this process as before this change (``sorts`` said no to
-    all), and through a child process on an on-disk store's checkpoint; every quad the same, blank nodes too."""
+    """The same updates on three stores seeded alike: in this process as before this change (``sorts`` said no
+    to all), and through a child process on an on-disk store's checkpoint and on an in-memory store's dump;
+    every quad the same, blank nodes too."""
     import cbrs.kb.knowledge_base as knowledge_base
     from cbrs.kb import sorting_updates
 
@@ -295,24 +296,28 @@ def test_a_sorting_update_leaves_the_store_as_it_did_in_process_and_others_run_i
 
     monkeypatch.setattr(sorting_updates, "update", counted)
     old = KnowledgeBase.open(":memory:")
-    new = KnowledgeBase.open(tmp_path / "store")
+    disk = KnowledgeBase.open(tmp_path / "store")
+    memory = KnowledgeBase.open(":memory:")
+    unsorted = "DELETE WHERE { GRAPH ?g { ?c a owl:Class ; rdfs:comment ?comment } }"
     try:
-        assert set(old.store.quads()) == set(new.store.quads())
-        unsorted = "DELETE WHERE { GRAPH ?g { ?c a owl:Class ; rdfs:comment ?comment } }"
+        assert set(old.store.quads()) == set(disk.store.quads()) == set(memory.store.quads())
         with monkeypatch.context() as patched:
             patched.setattr(knowledge_base, "sorts", lambda text: False)
             old.update(SORTING_UPDATE)
             old.update(unsorted)
-        new.update(SORTING_UPDATE)
-        assert isolated == [SORTING_UPDATE]
-        new.update(unsorted)
-        assert isolated == [SORTING_UPDATE]  # a text that does not sort runs in this process, as before
-        assert set(new.store.quads()) == set(old.store.quads())
-        assert next(iter(new.store.quads(subject=ox.NamedNode("http://example.org/first"))), None) is not None
+        expected = set(old.store.quads())
+        assert next(iter(old.store.quads(subject=ox.NamedNode("http://example.org/first"))), None) is not None
+        for kb in (disk, memory):
+            kb.update(SORTING_UPDATE)
+            assert isolated == [SORTING_UPDATE]
+            kb.update(unsorted)
+            assert isolated == [SORTING_UPDATE]  # a text that does not sort runs in this process, as before
+            assert set(kb.store.quads()) == expected
+            isolated.clear()
         with pytest.raises(QuerySyntaxError):
-            new.update("INSERT { ?s ?p ?o } WHERE { { SELECT * { ?s ?p ?o } ORDER BY ?s LIMIT 1 } ")
-        assert set(new.store.quads()) == set(old.store.quads())
+            disk.update("INSERT { ?s ?p ?o } WHERE { { SELECT * { ?s ?p ?o } ORDER BY ?s LIMIT 1 } ")
+        assert set(disk.store.quads()) == expected
     finally:
-        old.close()
-        new.close()
+        for kb in (old, disk, memory):
+            kb.close()
     assert not list(tmp_path.glob(".cbrs-update-copy-*"))  # the copies are gone
