@@ -444,6 +444,28 @@ def cannot_set_down(
     return f"no {free}arm reaches ({at[0]:.2f}, {at[1]:.2f}) {RELAY_MARGIN:.2f} m inside its reach"
 
 
+def let_go_held(
+    ctx: SimContext, side: ArmSide, name: str, surface: Region, at: tuple[float, float], planned: bool = True
+) -> bool | None:
+    """Whether the arm ``side``, holding the object ``name`` now, can set it down at the spot ``at`` of
+    ``surface``: its hand there turned as now (what :func:`holdable_spot` asks), and, with ``planned``, the
+    carry there one the arm's planning would make, though it may come near an appliance (what
+    :func:`holdable_spot` takes when no carry keeps clear). None when the arm does not hold it (then
+    :func:`cannot_set_down` asks as it would take it where it lies). Asked of the spots a carry's packing
+    takes as leaving room for what comes after (:func:`packing.carry_spots`)."""
+    arm = ctx.world.arm(side)
+    if arm.held is None or arm.held_grasp is None or ctx.world.name_of(arm.held) != name:
+        return None
+    grasp = arm.held_grasp
+    at_z = surface.zmin + skills.PLACE_CLEARANCE + grasp.bottom_offset
+    if not arm.can_hold((at[0], at[1], at_z), arm.ee_pose().orientation):
+        return False
+    if not planned:
+        return True
+    why, brushed = carry_check(ctx, side, spot_region(surface, *at))
+    return why == brushed  # refused only for coming near, or not at all
+
+
 def holdable_spot(
     ctx: SimContext, side: ArmSide, surface: Region, spots: Sequence[tuple[float, float]]
 ) -> tuple[float, float] | None:

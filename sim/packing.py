@@ -27,7 +27,7 @@ from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import Arm, MapObject, SemanticMap, Thing, local_name
 from cbrs.sim import skills
-from cbrs.sim.arm_choice import ARM_TIE, TAKING, cannot_set_down
+from cbrs.sim.arm_choice import ARM_TIE, TAKING, cannot_set_down, let_go_held
 from cbrs.sim.arms import ArmSide
 from cbrs.sim.context import SimContext
 from cbrs.sim.geometry import Region
@@ -479,6 +479,7 @@ def set_down_spots(
     later_able: Sequence[Sequence[Mount] | None] | None = None,
     later_by: Sequence[Sequence[Mount]] | None = None,
     wider_by: Sequence[Sequence[Mount]] | None = None,
+    own: Callable[[Spot], bool] | None = None,
 ) -> tuple[Region, list[Spot]]:
     """The surface and spots of :func:`place_spots` (:func:`box_spots` for the rule's ``box`` footprints:
     ``foot``, ``later_feet``, else boxes along x) for an object set down on ``place``, when the plan puts
@@ -490,7 +491,50 @@ def set_down_spots(
     ``able`` (this thing's) and ``later_able`` (each later thing's): the arms that can set it down
     (:func:`place_spots`' ``able``, :func:`able_mounts`; None: every arm of the map); ``later_by``: each
     later thing's arms whose reach its spots are in (else ``mounts``), and ``wider_by`` those asked when no
-    spot leaves room within them (the arms free at its carry: it may go to another arm)."""
+    spot leaves room within them (the arms free at its carry: it may go to another arm); ``own``: whether
+    the arm that sets this one down can let it go over a spot (None: any it reaches), asked of each spot
+    found leaving room: one it cannot is not taken as leaving room (the carry would pass it over and set the
+    thing down at the first it can, as for one thing alone)."""
+    surface, spots, _ = _set_down_spots(
+        smap,
+        place,
+        size,
+        mounts,
+        others,
+        later,
+        rule,
+        foot,
+        later_feet,
+        lying,
+        holds,
+        able,
+        later_able,
+        later_by,
+        wider_by,
+        own,
+    )
+    return surface, spots
+
+
+def _set_down_spots(
+    smap: SemanticMap,
+    place: Thing,
+    size: Size,
+    mounts: Sequence[Mount],
+    others: Sequence[tuple[float, float, float]],
+    later: Sequence[Size] = (),
+    rule: PackingRule = PackingRule(),
+    foot: Footprint | None = None,
+    later_feet: Sequence[Footprint] | None = None,
+    lying: Sequence[Lying] = (),
+    holds: Holds | None = None,
+    able: Sequence[Mount] | None = None,
+    later_able: Sequence[Sequence[Mount] | None] | None = None,
+    later_by: Sequence[Sequence[Mount]] | None = None,
+    wider_by: Sequence[Sequence[Mount]] | None = None,
+    own: Callable[[Spot], bool] | None = None,
+) -> tuple[Region, list[Spot], int]:
+    """:func:`set_down_spots`, and how many of its first spots leave room (0 when none does)."""
     boxed = rule.footprint == "box"
     mine = foot if foot is not None else Footprint.lying(size, 0.0)
     if boxed:
@@ -499,7 +543,14 @@ def set_down_spots(
         circles = [*others, *((x, y, each.radius) for x, y, each in lying)]
         surface, spots = place_spots(smap, place, size, mounts, circles, able)
     if not later or not spots:
-        return surface, spots
+        return surface, spots, 0
+    mine_asked: dict[Spot, bool] = {}  # the carrying arm's answer at a spot, asked once
+
+    def letting_go(at: Spot) -> bool:
+        if at not in mine_asked:
+            mine_asked[at] = own is None or own(at)
+        return mine_asked[at]
+
     asked: dict[tuple[int, Spot], bool] = {}  # an arm's answer for a later thing at a spot, asked once
 
     def held(n: int, at: Spot) -> bool:
@@ -532,15 +583,19 @@ def set_down_spots(
                     for each, s in zip(alone, later, strict=True)
                 ]
             try:
-                if all(lists) and _search(lists, later, shapes, rule, SPOT_BUDGET, held) is not None:
+                if (
+                    all(lists)
+                    and _search(lists, later, shapes, rule, SPOT_BUDGET, held) is not None
+                    and letting_go((x, y))
+                ):
                     keeping.append((x, y))
             except Undecided:
                 continue
             if len(keeping) == RELAY_TRIES:
                 break
         if keeping:
-            return surface, [*keeping, *(spot for spot in spots if spot not in keeping)]
-    return surface, spots
+            return surface, [*keeping, *(spot for spot in spots if spot not in keeping)], len(keeping)
+    return surface, spots, 0
 
 
 def puts_down(
@@ -744,7 +799,38 @@ def carry_spots(
     put others there before or after it, :func:`set_down_spots` with the rule's footprints (the map's, the
     things on the place where they are believed to be) and each later thing's spots asked whether an arm
     can hold it there (:func:`arm_choice.cannot_set_down`). Asked by the carry (``services.carry``) and by
-    the choice of approach before it (:func:`arm_choice.hold_end`), so both aim at the same spot."""
+    the choice of approach before it (:func:`arm_choice.hold_end`), so both aim at the same spot.
+
+    A spot leaves room only where this arm can let the thing go over it (:func:`arm_choice.let_go_held`,
+    else :func:`arm_choice.cannot_set_down`).
+    Where it has no such spot and another arm, free now, has one, none are given for this arm: the carry
+    passes the thing to that arm (``services.carry``), as where this arm reaches no spot at all. Before, the
+    spots that left room came first whether or not this arm could set the thing down there, and the carry
+    took the first it could, which left none (docs/execution.md, "Room on a top: which arms count")."""
+    surface, spots, kept = _carry_spots(ctx, place, carried, side, step, rule)
+    if kept or not spots:
+        return surface, spots
+    world = ctx.world
+    for other in sorted(world.arm_specs):
+        if other is side or world.arm(other).held is not None:
+            continue
+        if _carry_spots(ctx, place, carried, other, step, rule)[2]:
+            log.info(
+                "the %s arm has no spot of %s leaving room; the %s has: %s is passed",
+                side.value,
+                place.iri,
+                other.value,
+                carried,
+            )
+            return surface, []
+    return surface, spots
+
+
+def _carry_spots(
+    ctx: SimContext, place: Thing, carried: str, side: ArmSide, step: PlanStep | None, rule: PackingRule
+) -> tuple[Region, list[Spot], int]:
+    """:func:`carry_spots` for the arm ``side`` alone, and how many of its first spots leave room for what
+    the plan puts there after it (0 when none does or nothing comes after)."""
     world, smap = ctx.world, ctx.map
     obj = world.objects.get(carried)
     size = obj.size if obj is not None else (0.0, 0.0, 0.0)
@@ -753,7 +839,7 @@ def carry_spots(
     earlier, downs = _packed(ctx.plan, step, smap, place.iri, ctx.given, ctx.known)
     able = able_mounts(world, carried)  # an arm holding something else leaves this one its spots
     if obj is None or step is None or ctx.plan is None or not (earlier or downs):
-        return place_spots(smap, place, size, mounts, others, able)
+        return (*place_spots(smap, place, size, mounts, others, able), 0)
     coming = [smap.objects[down.obj] for down in downs]
     # a later thing's arms: those free at its carry, what the plan takes and keeps until then counted
     # (arms_free; the world's arms as they are now, what is carried now set down before it)
@@ -768,6 +854,16 @@ def carry_spots(
         for arms, reach in zip(later_arms, later_able, strict=True)
     ]
     surface, _ = support_of(smap, place)
+
+    made: list[Spot] = []  # a spot whose carry the arm's planning would make: the later ones are asked less
+
+    def own(at: Spot) -> bool:  # whether this arm can let it go over the spot (and carry it there)
+        held = let_go_held(ctx, side, carried, surface, at, planned=not made)
+        if not (not cannot_set_down(ctx, obj, surface, at, {side}) if held is None else held):
+            return False
+        made.append(at)
+        return True
+
     holds = _HoldAsked(ctx, coming, surface, [{ArmSide(arm.side) for arm in arms} for arms in later_arms])
     sizes = [each.size for each in coming]
     circles = replace(rule, footprint="circle")
@@ -775,7 +871,7 @@ def carry_spots(
         rule.footprint == "auto"
         and _circles_hold(smap, place, size, sizes, mounts, others, [able, *later_able], [mounts, *later_by])
     ):
-        return set_down_spots(
+        return _set_down_spots(
             smap,
             place,
             size,
@@ -788,13 +884,14 @@ def carry_spots(
             later_able=later_able,
             later_by=later_by,
             wider_by=later_able,
+            own=own,
         )
     rule = replace(rule, footprint="box")
     names = [name for name in world.objects if name != carried]  # in the order of ``others``
     lying = [(x, y, footprint_of(world.objects[name])) for name, (x, y, _) in zip(names, others, strict=True)]
     feet = [footprint_of(each) for each in coming]
     try:
-        return set_down_spots(
+        return _set_down_spots(
             smap,
             place,
             size,
@@ -808,9 +905,10 @@ def carry_spots(
             holds,
             later_by=later_by,
             wider_by=later_able,
+            own=own,
         )
     except Undecided:  # more spots asked of the arms than HOLD_TRIES: as for one thing alone
-        return place_spots(smap, place, size, mounts, others, able)
+        return (*place_spots(smap, place, size, mounts, others, able), 0)
 
 
 def _circles_hold(

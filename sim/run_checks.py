@@ -34,7 +34,7 @@ from cbrs.sim.errors import GraspTooDeepError, GraspTooThinError, GraspTooWideEr
 from cbrs.sim.geometry import Pose2D
 from cbrs.sim.grasping import GraspKind, ObjectModel, check_side_depth, held_height
 from cbrs.sim.grounding import docking_pose, people_given, task_inputs_of
-from cbrs.sim.packing import check_room
+from cbrs.sim.packing import AtCarry, arms_free, check_room
 from cbrs.sim.perceived import PerceivedWorld
 from cbrs.sim.perception import ObjectEstimate
 from cbrs.sim.place_spots import (
@@ -42,6 +42,7 @@ from cbrs.sim.place_spots import (
     RELAY_EDGE,
     RELAY_MARGIN,
     distance_to_extent,
+    held_now,
     other_objects,
     place_spots,
     spot_inset,
@@ -464,6 +465,9 @@ class PlanChecks:
             arms.setdefault(arm.robot, []).append(arm)
         steps = {step.index: step for step in plan.steps}
         at_hand: dict[str, list[str]] = {}  # by robot: the objects its latest arm step given one works on
+        found = other_objects(self.world, self.belief)
+        where = {obj.iri: spot for obj, spot in zip(self.world.objects.values(), found, strict=True)}
+        free = arms_free(plan, smap, values, where, held_now(self.world))  # at each carry onto a place
         for step in plan.steps:
             robot_arms = arms.get(step.device or "")
             # a robot of the map with no arm (its arms taken off) that a step would have take a thing in hand
@@ -493,7 +497,7 @@ class PlanChecks:
                 if iri in objects:  # in reach: a hand of an arm that reaches it must fit it too
                     self._check_grip(step.device or "", iri, [arm for arm, d in reaches if d <= arm.reach])
                 if iri in smap.regions or iri in smap.furniture:
-                    self._check_spot(step, iri, at_hand.get(step.device or "", []), report)
+                    self._check_spot(step, iri, at_hand.get(step.device or "", []), report, free.get(step.index))
 
     @staticmethod
     def _distance(
@@ -544,14 +548,23 @@ class PlanChecks:
         raise CannotGripError(robot, iri, refusals, limits)
 
     def _check_spot(
-        self, step: PlanStep, iri: str, carried: list[str], report: list[tuple[str, float, float, float, float]]
+        self,
+        step: PlanStep,
+        iri: str,
+        carried: list[str],
+        report: list[tuple[str, float, float, float, float]],
+        at_carry: AtCarry | None = None,
     ) -> None:
         """Refuse a place an arm step is given, part of which the robot's arms reach, when no spot of it
         will do (:func:`place_spots`, by the map) for the object at hand: the one the step is given,
         else the one the robot's latest arm step given one worked on (a carry's object comes from the
         approach and pick-up before it); the largest, if there are several. The carry would aim at a
         spot it then lacks. A top too small for the object's circle and the edge is refused as such
-        (:class:`PlaceTooSmallError`: the set-down does not turn a thing to fit), not as out of reach."""
+        (:class:`PlaceTooSmallError`: the set-down does not turn a thing to fit), not as out of reach. At a
+        carry that sets a thing down there (``at_carry``, :func:`packing.arms_free`) only the arms free then
+        count, as the check of the room on a place counts them (docs/execution.md, "Room on a top: which
+        arms count"): a spot only an arm holding something else reaches will not do. Before, every arm of
+        the robot counted."""
         smap = self.world.map
         objects = [smap.objects[other] for other in carried]
         size = max(
@@ -561,7 +574,24 @@ class PlanChecks:
         name = names[0] if len(names) == 1 else ""
         mounts = [(x, y, reach) for _, x, y, reach, _ in report]
         others = other_objects(self.world, self.belief, *names)
-        _, spots = place_spots(smap, smap.things[iri], size, mounts, others)
+        able = None  # every arm of the robot, but at a carry those free then
+        if at_carry is not None and at_carry.busy:
+            free = {arm.iri for arm in at_carry.free}
+            able = [(x, y, reach) for arm, x, y, reach, _ in report if arm in free]
+            if (
+                not place_spots(smap, smap.things[iri], size, able, others, able)[1]
+                and (place_spots(smap, smap.things[iri], size, mounts, others)[1])
+            ):
+                box = smap.things[iri].box
+                holding = " and ".join(
+                    f"the {smap.arms[arm].side} arm holds the {local_name(obj)}" for arm, obj in at_carry.busy.items()
+                )
+                thing = f"the {name}" if name else "an object"
+                why = f"the arms that reach a spot of it for {thing} hold other things then ({holding})"
+                where = ((box.min_x + box.max_x) / 2, (box.min_y + box.max_y) / 2)
+                raise OutOfReachError(step.device or "", iri, where, report, why)
+            mounts = able
+        _, spots = place_spots(smap, smap.things[iri], size, mounts, others, able)
         if not spots:
             box = smap.things[iri].box
             what = f"the {name}" if name else "an object"

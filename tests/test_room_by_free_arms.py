@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from dataclasses import replace
 from types import SimpleNamespace
 from typing import Any, cast
 
@@ -34,7 +35,8 @@ from cbrs.sim.packing import (
     puts_down,
     radius_of,
 )
-from cbrs.sim.place_spots import RELAY_CLEARANCE, place_spots, reach_of
+from cbrs.sim.place_spots import RELAY_CLEARANCE, distance_to_extent, place_spots, reach_of
+from cbrs.sim.run_checks import OutOfReachError, PlanChecks
 from tests.helpers_examples import EXAMPLES
 
 WORLD, LAB6 = PREFIXES["world"], "https://example.org/lab6#"
@@ -288,3 +290,75 @@ def test_where_the_carrying_arm_leaves_no_room_the_arms_free_then_are_asked(
         for arms, left in ((both, room), ([right], False)):  # the pen's own spots, clear of the eraser
             pens = place_spots(west, place, pen, arms, around, arms)[1]
             assert any(math.dist(at, spot) >= apart for spot in pens) is left
+
+
+def test_the_check_of_a_carrys_place_counts_only_the_arms_free_then(mat: Mats) -> None:
+    """The check of each step (``run_checks.PlanChecks._check_spot``) counts the arms free at a carry too: the
+    mat moved 30 cm west, which the left arm reaches and the right does not, has a spot for the pen, but
+    not at CupEraserPen's carry of it, the left arm holding the cup then (before, every arm of the robot
+    counted and the run went on to a carry the right arm cannot make). The mat where it is passes: the
+    right arm reaches its east part."""
+    smap, _, _, first, _ = mat
+    mat_there = smap.things[MAT]
+    box = replace(mat_there.box, min_x=mat_there.box.min_x - 0.30, max_x=mat_there.box.max_x - 0.30)
+    west = replace(smap, things={**smap.things, MAT: replace(mat_there, box=box)})
+    world = SimpleNamespace(map=west, objects={obj.name: obj for obj in west.objects.values()})
+    belief = SimpleNamespace(position=lambda name: None)  # where the map puts each thing
+    free = arms_free(first, west, VALUES, _where(west))
+    pen_carry = puts_down(first, west, VALUES)[1].step
+    step = next(s for s in first.steps if s.index == pen_carry)
+    assert [arm.iri for arm in free[pen_carry].free] == [RIGHT]
+    for place_map, refused in ((west, True), (smap, False)):
+        world.map = place_map
+        checks = PlanChecks(cast(Any, world), cast(Any, None), cast(Any, belief), cast(Any, None), lambda a, b: a == b)
+        thing = place_map.things[MAT]
+        report = [
+            (
+                arm.iri,
+                arm.mount[0],
+                arm.mount[1],
+                arm.reach,
+                distance_to_extent((thing.box.min_x, thing.box.max_x, thing.box.min_y, thing.box.max_y), arm.mount),
+            )
+            for arm in place_map.arms.values()
+        ]
+        checks._check_spot(step, MAT, [PEN], report)  # every arm counted: a spot
+        if not refused:
+            checks._check_spot(step, MAT, [PEN], report, free[pen_carry])
+            continue
+        with pytest.raises(OutOfReachError) as caught:
+            checks._check_spot(step, MAT, [PEN], report, free[pen_carry])
+        assert (
+            "the arms that reach a spot of it for the Pen hold other things then (the left arm holds the Cup)"
+            in str(caught.value)
+        )
+
+
+def test_the_carrying_arm_sets_down_only_where_it_can_and_else_passes_to_a_free_arm_that_can(
+    mat: Mats, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """EraserCupPen on the front mat: the eraser's spots that leave the pen room in the right arm's part lie at
+    the edge of its reach, where in the simulation it could not hold the eraser over them, and the carry took
+    the first spot it could, which left the pen none (the run failed at the pen's carry). A spot is taken as
+    leaving room only where the carrying arm can let the thing go over it; the right arm has none here, the
+    left is free, and its spots leave the pen room: the right arm is given no spot, so the carry passes the
+    eraser to the left. The arms here can hold every spot but the right arm the eraser's east of x 7.68."""
+    smap, _, between, _, _ = mat
+
+    def refusing(ctx: Any, obj: Any, surface: Any, at: tuple[float, float], sides: Any = None) -> str:
+        return "too far" if obj.iri == ERASER and sides == {ArmSide.RIGHT} and at[0] > 7.68 else ""
+
+    monkeypatch.setattr(packing, "cannot_set_down", refusing)
+    eraser_carry = puts_down(between, smap, VALUES)[0].step
+    step = next(s for s in between.steps if s.index == eraser_carry)
+    ctx = _context(smap, between, eraser_carry)
+    place = smap.things[MAT]
+    assert carry_spots(ctx, place, "Eraser1", ArmSide.RIGHT, step, CIRCLE)[1] == []
+    _, lefts = carry_spots(ctx, place, "Eraser1", ArmSide.LEFT, step, CIRCLE)
+    right = reach_of(smap.arms[RIGHT])
+    pen, eraser = smap.objects[PEN].size, smap.objects[ERASER].size
+    around = [(o.start.x, o.start.y, radius_of(o.size)) for iri, o in smap.objects.items() if iri not in (ERASER, PEN)]
+    lying = (*lefts[0], radius_of(eraser) + SET_DOWN_SLACK)
+    assert place_spots(smap, place, pen, [right], [*around, lying], [right])[1]  # the pen fits the right arm's part
+    monkeypatch.setattr(packing, "cannot_set_down", lambda *_: "")  # the right arm holds them all: its own spots
+    assert carry_spots(ctx, place, "Eraser1", ArmSide.RIGHT, step, CIRCLE)[1][0][0] > 7.68
