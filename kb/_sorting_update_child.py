@@ -2,8 +2,8 @@
 what it changed.
 
 Run by path (``python .../_sorting_update_child.py COPY PREFIXES``, the update on stdin), so it imports
-nothing but the standard library and pyoxigraph. ``COPY`` is an on-disk store, or an N-Quads file (ending
-``.nq``: an in-memory store's dump, loaded into memory here). It answers on stdout with one status byte:
+nothing but the standard library and pyoxigraph. ``COPY`` is the store's N-Quads dump, loaded into memory
+here. It answers on stdout with one status byte:
 ``K`` then the quads removed and the quads added as N-Quads lines, the first part's length before it (8
 bytes); or ``S``, ``E``, ``O`` (a syntax, evaluation or input/output error) then the engine's message. A
 panic of the engine aborts it before it answers: the parent reads why from its standard error.
@@ -31,11 +31,8 @@ def lines(store: ox.Store) -> set[bytes]:
 def main() -> None:
     copy, prefixes = sys.argv[1], json.loads(sys.argv[2])
     text = sys.stdin.buffer.read().decode("utf-8", "surrogatepass")
-    if copy.endswith(".nq"):
-        store = ox.Store()
-        store.load(path=copy, format=ox.RdfFormat.N_QUADS)
-    else:
-        store = ox.Store(copy)
+    store = ox.Store()
+    store.load(path=copy, format=ox.RdfFormat.N_QUADS)
     before = lines(store)
     try:
         store.update(text, prefixes=prefixes)

@@ -9,10 +9,11 @@ user's program. So :meth:`kb.knowledge_base.KnowledgeBase.update` hands an updat
 (:func:`kb.engine_faults.sorts`) to :func:`update` instead of the store's own update:
 
 1. the same checks first (nesting, remote access, the query guard's checker for a long text);
-2. a copy of the store: a RocksDB checkpoint beside it (:meth:`EmbeddedStore.snapshot`: hard links to its
-   immutable files, which Oxigraph documents as a database that "operates independently from the
-   original"; the child writes to its own new files) or, in memory, its N-Quads dump, which the child
-   loads into memory (blank nodes keep their labels);
+2. a copy of the store: its N-Quads dump (Oxigraph's serialiser, blank nodes' labels kept), which the
+   child loads into memory. A RocksDB checkpoint of an on-disk store, which the child may open and write
+   (Oxigraph documents it as a database that "operates independently from the original", and so it
+   proved), took longer on the bundled store (docs/security.md), since the child then read its quads
+   twice from disk;
 3. a child process (``_sorting_update_child.py``) runs the update on the copy and prints what it removed
    and added, as N-Quads lines (blank nodes keep their labels);
 4. here, in one transaction, those quads are removed and added: one update whose ``VALUES`` rows a custom
@@ -22,7 +23,8 @@ user's program. So :meth:`kb.knowledge_base.KnowledgeBase.update` hands an updat
 A child that dies wrote nothing here: a panic is an :class:`~kb.errors.EngineFaultError` naming it. The
 caller holds the writer's lock, as for any update, so nothing is written between the copy and the delta.
 An update that does not sort runs as before. The cost (docs/security.md, "When the engine itself crashes")
-is the copy, a Python process start and two dumps of the copy.
+is a dump of the store, a Python process start, loading the dump there and dumping it twice; it grows
+with the store.
 """
 
 from __future__ import annotations
@@ -73,14 +75,14 @@ def update(store: EmbeddedStore, text: str) -> None:
 
 def _evaluate(store: EmbeddedStore, text: str) -> tuple[list[ox.Quad], list[ox.Quad]]:
     """The quads ``text`` removes from and adds to ``store``, found on a copy of it in a child process."""
-    root = _scratch(store)
+    root = Path(tempfile.mkdtemp(prefix="cbrs-update-copy-"))
     errors = ErrorLog()
     try:
-        copy = root / ("copy.nq" if store.in_memory else "copy")
-        if store.in_memory:  # its dump, which the child loads into memory: faster than an on-disk copy
-            store._backend.dump(str(copy), format=ox.RdfFormat.N_QUADS)  # blank nodes' labels kept
-        else:
-            store.snapshot(copy)
+        copy = root / "store.nq"
+        try:
+            store._backend.dump(str(copy), format=ox.RdfFormat.N_QUADS)  # its own read, here
+        except OSError as error:
+            raise StoreError(store.location, f"a copy for the update failed: {error}") from error
         command = [sys.executable, str(_CHILD), str(copy), json.dumps(PREFIXES)]
         done = subprocess.run(
             command,
@@ -112,16 +114,6 @@ def _evaluate(store: EmbeddedStore, text: str) -> tuple[list[ox.Quad], list[ox.Q
     (length,) = _LENGTH.unpack(body[: _LENGTH.size])
     first = _LENGTH.size + length
     return _quads(body[_LENGTH.size : first]), _quads(body[first:])
-
-
-def _scratch(store: EmbeddedStore) -> Path:
-    """A new folder for the copy: beside an on-disk store, so the checkpoint hard-links its files."""
-    if not store.in_memory:
-        try:
-            return Path(tempfile.mkdtemp(prefix=".cbrs-update-copy-", dir=Path(store.location).resolve().parent))
-        except OSError:
-            pass
-    return Path(tempfile.mkdtemp(prefix="cbrs-update-copy-"))
 
 
 def _quads(data: bytes) -> list[ox.Quad]:

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import subprocess
 import sys
+import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -295,6 +296,7 @@ def test_a_sorting_update_leaves_the_store_as_it_did_in_process_and_others_run_i
         run(store, text)
 
     monkeypatch.setattr(sorting_updates, "update", counted)
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))  # where the copies go
     old = KnowledgeBase.open(":memory:")
     disk = KnowledgeBase.open(tmp_path / "store")
     memory = KnowledgeBase.open(":memory:")
@@ -320,4 +322,4 @@ def test_a_sorting_update_leaves_the_store_as_it_did_in_process_and_others_run_i
     finally:
         for kb in (old, disk, memory):
             kb.close()
-    assert not list(tmp_path.glob(".cbrs-update-copy-*"))  # the copies are gone
+    assert not list(tmp_path.glob("cbrs-update-copy-*"))  # the copies are gone
