@@ -15,8 +15,8 @@ cannot order against each other, dateTimes some with a time zone and some withou
 find that the comparison is no total order, and panic. Twenty-one values in a ``VALUES`` block suffice: the
 text alone crashes the engine, on any store, and a text short enough to skip the guard's checker can make
 them (278 characters); so can a store's own data, readings written with and without a time zone. An update
-whose ``WHERE`` sorts them aborts the process that holds the store (docs/security.md, "When the engine
-itself crashes").
+whose ``WHERE`` sorts is therefore evaluated on a copy of the store in a child process too, its effect then
+written as data (:mod:`kb.sorting_updates`; docs/security.md, "When the engine itself crashes").
 """
 
 from __future__ import annotations

@@ -228,8 +228,8 @@ def update_panics() -> None:
 
 
 def test_an_update_that_panics_the_engine_costs_a_child_process_and_writes_nothing(update_panics: None) -> None:
-    """Before, the process running KnowledgeBase.update died (exit 134). Run in a child process all the same, so
-    that a regression aborts it, not pytest."""
+    """Before, the process running KnowledgeBase.update died (exit 134), and so did a server sent it on /update
+    by a token holder. Run in a child process all the same, so that a regression aborts it, not pytest."""
     assert len(UPDATE_PANIC) <= EmbeddedStore.guard.direct_chars  # the guard's checker never sees it
     code = """if True:
         import sys
@@ -237,17 +237,26 @@ def test_an_update_that_panics_the_engine_costs_a_child_process_and_writes_nothi
         from cbrs.kb.errors import EngineFaultError
         kb = KnowledgeBase.open(":memory:")
         before = set(kb.store.quads())
+        text = sys.stdin.read()
         try:
-            kb.update(sys.stdin.read())
+            kb.update(text)
         except EngineFaultError as error:
             print("refused", "total order" in error.reason, "time zone" in str(error))
         print("unchanged", set(kb.store.quads()) == before)
         kb.update("INSERT DATA { <http://example.org/a> <http://example.org/b> 1 }")
         print("writable", len(set(kb.store.quads()) - before))
+        from cbrs.sparql_service import EndpointConfig, SparqlService
+        service = SparqlService(kb, EndpointConfig(workers=1, update_token="t"))
+        try:
+            service.update(text, "t")
+        except EngineFaultError as error:
+            print("endpoint refused", error.http_status)
+        finally:
+            service.close()
     """
     done = subprocess.run([sys.executable, "-c", code], input=UPDATE_PANIC, text=True, capture_output=True, timeout=120)
     assert done.returncode == 0, done.stderr
-    assert done.stdout.split("\n") == ["refused True True", "unchanged True", "writable 1", ""]
+    assert done.stdout.split("\n") == ["refused True True", "unchanged True", "writable 1", "endpoint refused 500", ""]
 
 
 def test_cbrs_update_of_data_the_engine_cannot_sort_says_so_and_changes_nothing(
