@@ -465,9 +465,7 @@ class PlanChecks:
             arms.setdefault(arm.robot, []).append(arm)
         steps = {step.index: step for step in plan.steps}
         at_hand: dict[str, list[str]] = {}  # by robot: the objects its latest arm step given one works on
-        found = other_objects(self.world, self.belief)
-        where = {obj.iri: spot for obj, spot in zip(self.world.objects.values(), found, strict=True)}
-        free = arms_free(plan, smap, values, where, held_now(self.world))  # at each carry onto a place
+        free: dict[int, AtCarry] | None = None  # the arms free at each carry onto a place, asked once when needed
         for step in plan.steps:
             robot_arms = arms.get(step.device or "")
             # a robot of the map with no arm (its arms taken off) that a step would have take a thing in hand
@@ -497,6 +495,10 @@ class PlanChecks:
                 if iri in objects:  # in reach: a hand of an arm that reaches it must fit it too
                     self._check_grip(step.device or "", iri, [arm for arm, d in reaches if d <= arm.reach])
                 if iri in smap.regions or iri in smap.furniture:
+                    if free is None:
+                        found = other_objects(self.world, self.belief)
+                        lying = {obj.iri: at for obj, at in zip(self.world.objects.values(), found, strict=True)}
+                        free = arms_free(plan, smap, values, lying, held_now(self.world))
                     self._check_spot(step, iri, at_hand.get(step.device or "", []), report, free.get(step.index))
 
     @staticmethod
