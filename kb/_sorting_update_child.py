@@ -32,7 +32,7 @@ def main() -> None:
     copy, prefixes = sys.argv[1], json.loads(sys.argv[2])
     text = sys.stdin.buffer.read().decode("utf-8", "surrogatepass")
     store = ox.Store()
-    store.load(path=copy, format=ox.RdfFormat.N_QUADS)
+    store.extend(ox.parse(path=copy, format=ox.RdfFormat.N_QUADS))  # Store.load would rename the blank nodes
     before = lines(store)
     try:
         store.update(text, prefixes=prefixes)
