@@ -10,10 +10,10 @@ user's program. So :meth:`kb.knowledge_base.KnowledgeBase.update` hands an updat
 
 1. the same checks first (nesting, remote access, the query guard's checker for a long text);
 2. a copy of the store: its N-Quads dump (Oxigraph's serialiser, blank nodes' labels kept), which the
-   child loads into memory. A RocksDB checkpoint of an on-disk store, which the child may open and write
-   (Oxigraph documents it as a database that "operates independently from the original", and so it
-   proved), took longer on the bundled store (docs/security.md), since the child then read its quads
-   twice from disk;
+   child parses into an in-memory store (``Store.load`` would give every blank node a new label). A
+   RocksDB checkpoint of an on-disk store, which the child may open and write (Oxigraph documents it as
+   a database that "operates independently from the original", and so it proved), took longer on the
+   bundled store (docs/security.md), since the child then read its quads twice from disk;
 3. a child process (``_sorting_update_child.py``) runs the update on the copy and prints what it removed
    and added, as N-Quads lines (blank nodes keep their labels);
 4. here, in one transaction, those quads are removed and added: one update whose ``VALUES`` rows a custom
