@@ -533,8 +533,9 @@ def _set_down_spots(
     later_by: Sequence[Sequence[Mount]] | None = None,
     wider_by: Sequence[Sequence[Mount]] | None = None,
     own: Callable[[Spot], bool] | None = None,
-) -> tuple[Region, list[Spot], int]:
-    """:func:`set_down_spots`, and how many of its first spots leave room (0 when none does)."""
+) -> tuple[Region, list[Spot], int | None]:
+    """:func:`set_down_spots`, and how many of its first spots leave room (0 when none does; None when
+    nothing comes after it or it has no spot)."""
     boxed = rule.footprint == "box"
     mine = foot if foot is not None else Footprint.lying(size, 0.0)
     if boxed:
@@ -543,7 +544,7 @@ def _set_down_spots(
         circles = [*others, *((x, y, each.radius) for x, y, each in lying)]
         surface, spots = place_spots(smap, place, size, mounts, circles, able)
     if not later or not spots:
-        return surface, spots, 0
+        return surface, spots, None
     mine_asked: dict[Spot, bool] = {}  # the carrying arm's answer at a spot, asked once
 
     def letting_go(at: Spot) -> bool:
@@ -808,7 +809,7 @@ def carry_spots(
     spots that left room came first whether or not this arm could set the thing down there, and the carry
     took the first it could, which left none (docs/execution.md, "Room on a top: which arms count")."""
     surface, spots, kept = _carry_spots(ctx, place, carried, side, step, rule)
-    if kept or not spots:
+    if kept is None or kept or not spots:
         return surface, spots
     world = ctx.world
     for other in sorted(world.arm_specs):
@@ -828,9 +829,10 @@ def carry_spots(
 
 def _carry_spots(
     ctx: SimContext, place: Thing, carried: str, side: ArmSide, step: PlanStep | None, rule: PackingRule
-) -> tuple[Region, list[Spot], int]:
+) -> tuple[Region, list[Spot], int | None]:
     """:func:`carry_spots` for the arm ``side`` alone, and how many of its first spots leave room for what
-    the plan puts there after it (0 when none does or nothing comes after)."""
+    the plan puts there after it (0 when none does; None when nothing comes after it or the packing is
+    undecided)."""
     world, smap = ctx.world, ctx.map
     obj = world.objects.get(carried)
     size = obj.size if obj is not None else (0.0, 0.0, 0.0)
@@ -839,7 +841,7 @@ def _carry_spots(
     earlier, downs = _packed(ctx.plan, step, smap, place.iri, ctx.given, ctx.known)
     able = able_mounts(world, carried)  # an arm holding something else leaves this one its spots
     if obj is None or step is None or ctx.plan is None or not (earlier or downs):
-        return (*place_spots(smap, place, size, mounts, others, able), 0)
+        return (*place_spots(smap, place, size, mounts, others, able), None)
     coming = [smap.objects[down.obj] for down in downs]
     # a later thing's arms: those free at its carry, what the plan takes and keeps until then counted
     # (arms_free; the world's arms as they are now, what is carried now set down before it)
@@ -908,7 +910,7 @@ def _carry_spots(
             own=own,
         )
     except Undecided:  # more spots asked of the arms than HOLD_TRIES: as for one thing alone
-        return (*place_spots(smap, place, size, mounts, others, able), 0)
+        return (*place_spots(smap, place, size, mounts, others, able), None)
 
 
 def _circles_hold(
