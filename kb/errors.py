@@ -195,16 +195,18 @@ class QueryTooComplexError(QuerySyntaxError):
 
 
 class EngineFaultError(KnowledgeBaseError):
-    """The store's SPARQL engine crashed on ``query`` in a process of its own (a checker or a query
-    worker), which died instead of the server; ``reason`` is what the engine said as it died
-    (:mod:`kb.engine_faults`). A fault of the engine, not of the text's syntax: HTTP 500."""
+    """The store's SPARQL engine crashed on ``query`` (a query's or an update's text, as ``kind`` says) in
+    a process of its own (a checker, a query worker, an update's child), which died instead of this one;
+    ``reason`` is what the engine said as it died (:mod:`kb.engine_faults`). A fault of the engine, not of
+    the text's syntax: HTTP 500."""
 
     http_status = 500
 
-    def __init__(self, query: str, reason: str) -> None:
+    def __init__(self, query: str, reason: str, kind: str = "query") -> None:
         self.query = query
         self.reason = reason
-        super().__init__(f"the query crashed the store's SPARQL engine in an isolated process: {reason}")
+        self.kind = kind
+        super().__init__(f"the {kind} crashed the store's SPARQL engine in an isolated process: {reason}")
 
 
 class NotFoundError(KnowledgeBaseError):

@@ -193,7 +193,7 @@ class _Checker:
         death = self.errors.death()
         self.stop()
         if death.panic is not None:  # the engine's own fault, which it named: not a text too deep
-            return _Verdict(EngineFaultError(text, death.explain()), crashed=True)
+            return _Verdict(EngineFaultError(text, death.explain(), kind), crashed=True)
         how = f"signal {signal.Signals(-code).name}" if code is not None and code < 0 else f"exit status {code}"
         stage = "evaluating" if parsed else "parsing or planning"
         what = "query" if kind == "query" else "update"

@@ -94,7 +94,7 @@ def _evaluate(store: EmbeddedStore, text: str) -> tuple[list[ox.Quad], list[ox.Q
         if done.returncode != 0 or not done.stdout:
             death = errors.death()
             if death.panic is not None:
-                raise EngineFaultError(text, death.explain())
+                raise EngineFaultError(text, death.explain(), "update")
             code = done.returncode
             how = f"signal {signal.Signals(-code).name}" if code < 0 else f"exit status {code}"
             raise StoreEvaluationError(store.location, "update", f"the process evaluating it died ({how})")
