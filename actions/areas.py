@@ -72,7 +72,7 @@ class WorldPlaces:
         types: dict[str, list[str]] = {}
         for row in type_rows:
             types.setdefault(row["thing"].value, []).append(row["type"].value)
-        bounds = {thing: found for thing, values in facts.items() if (found := _bounds(values)) is not None}
+        bounds = {thing: found for thing, values in facts.items() if (found := map_bounds(values)) is not None}
         if belief:
             for row in positions[0]:
                 thing, x, y = row["thing"].value, float(row["x"].value), float(row["y"].value)
@@ -120,8 +120,9 @@ class WorldPlaces:
         return tuple(dict.fromkeys(c for c, extent in self.rooms if (within if point else overlap)(bounds, extent)))
 
 
-def _bounds(values: Mapping[str, str]) -> Bounds | None:
-    """A thing's map position (a point) or else its extent; None when the map places it nowhere."""
+def map_bounds(values: Mapping[str, str]) -> Bounds | None:
+    """A thing's map position (a point) or else its extent, from its map facts (property IRI: lexical
+    value); None when the map places it nowhere."""
     try:
         if _HOME + "x" in values and _HOME + "y" in values:
             x, y = float(values[_HOME + "x"]), float(values[_HOME + "y"])
@@ -286,4 +287,14 @@ def area_text(area: EffectiveArea) -> str:
     return "; ".join(parts) or "unstated"
 
 
-__all__ = ["INFORMS", "LEADS", "AreaRule", "Leads", "UnknownAreaClassError", "Whereabouts", "WorldPlaces", "area_text"]
+__all__ = [
+    "INFORMS",
+    "LEADS",
+    "AreaRule",
+    "Leads",
+    "UnknownAreaClassError",
+    "Whereabouts",
+    "WorldPlaces",
+    "area_text",
+    "map_bounds",
+]

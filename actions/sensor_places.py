@@ -14,6 +14,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
+from cbrs.actions.areas import map_bounds
 from cbrs.kb import EffectiveArea, KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.reasoner.sea import Bounds, overlap, within
@@ -47,7 +48,7 @@ class MapPlaces:
         up: dict[str, set[str]] = {}
         for row in up_rows:
             up.setdefault(row["class"].value, {row["class"].value}).add(row["superclass"].value)
-        bounds = {thing: found for thing, values in facts.items() if (found := _bounds(values)) is not None}
+        bounds = {thing: found for thing, values in facts.items() if (found := map_bounds(values)) is not None}
         located = {thing: values[LOCATED] for thing, values in facts.items() if LOCATED in values}
         return cls(
             {thing: frozenset(classes) for thing, classes in types.items()},
@@ -101,19 +102,3 @@ class MapPlaces:
 def stated(area: EffectiveArea | None) -> bool:
     """Whether an effective area says where its component is effective: area concepts or a box."""
     return area is not None and (bool(area.areas) or area.bounds is not None)
-
-
-def _bounds(values: Mapping[str, str]) -> Bounds | None:
-    """A thing's map position (a point), else its extent; None when the map places it nowhere (or in
-    words no number reads: the map checks say so when a run reads the map)."""
-    try:
-        if _HOME + "x" in values and _HOME + "y" in values:
-            x, y = float(values[_HOME + "x"]), float(values[_HOME + "y"])
-            return (x, x, y, y)
-        corners = [values.get(_HOME + axis) for axis in ("minX", "maxX", "minY", "maxY")]
-        if all(corner is not None for corner in corners):
-            x0, x1, y0, y1 = (float(c) for c in corners if c is not None)
-            return (x0, x1, y0, y1)
-    except ValueError:
-        return None
-    return None
