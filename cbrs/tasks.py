@@ -240,9 +240,12 @@ class TaskRunner:
         return frame if frame is not None and frame.number > after else None
 
     def active(self) -> TaskRun | None:
-        """The run going now, if any."""
+        """The run going now, if any: one whose thread lives and whose result is not final yet (a run that
+        ended, and said so on the run topic, frees the runner although its thread has a moment still to go:
+        a listener starting the next run as it hears the end is not refused)."""
         active = self._active
-        return active[0] if active is not None and active[1].is_alive() else None
+        going = active is not None and active[0].finished is None and active[1].is_alive()
+        return active[0] if active is not None and going else None
 
     def components(self) -> list[str]:
         """The IRIs of the simulated components, which a run may be told to fail (none without [sim])."""
@@ -313,9 +316,9 @@ class TaskRunner:
         return run
 
     def _refuse_if_busy(self) -> None:
-        active = self._active
-        if active is not None and active[1].is_alive():
-            raise TaskBusyError(active[0].id)
+        going = self.active()
+        if going is not None:
+            raise TaskBusyError(going.id)
 
     def run(
         self,
