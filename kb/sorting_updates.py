@@ -16,9 +16,9 @@ user's program. So :meth:`kb.knowledge_base.KnowledgeBase.update` hands an updat
    bundled store (docs/security.md), since the child then read its quads twice from disk;
 3. a child process (``_sorting_update_child.py``) runs the update on the copy and prints what it removed
    and added, as N-Quads lines (blank nodes keep their labels);
-4. here, in one transaction, those quads are removed and added: one update whose ``VALUES`` rows a custom
-   function turns into the quads' terms, since a ``DATA`` block cannot name a blank node; nothing in it
-   sorts.
+4. here, in one transaction, those quads are removed and added (:meth:`EmbeddedStore.exchange`: one
+   update whose ``VALUES`` rows a custom function turns into the quads' terms, since a ``DATA`` block
+   cannot name a blank node; nothing in it sorts).
 
 A child that dies wrote nothing here: a panic is an :class:`~kb.errors.EngineFaultError` naming it. The
 caller holds the writer's lock, as for any update, so nothing is written between the copy and the delta.
@@ -36,7 +36,6 @@ import struct
 import subprocess
 import sys
 import tempfile
-from collections.abc import Callable, Sequence
 from pathlib import Path
 
 import pyoxigraph as ox
@@ -51,16 +50,6 @@ __all__ = ["update"]
 
 _CHILD = Path(__file__).with_name("_sorting_update_child.py")
 _LENGTH = struct.Struct(">Q")
-_REMOVED = ox.NamedNode("urn:cbrs:sorting-update:removed")
-_ADDED = ox.NamedNode("urn:cbrs:sorting-update:added")
-_APPLY = """{operation} {{ GRAPH ?g {{ ?s ?p ?o }} ?ds ?dp ?do }} WHERE {{
-  VALUES ?row {{ {rows} }}
-  BIND (<{f}>(?row, 0) AS ?s) BIND (<{f}>(?row, 1) AS ?p) BIND (<{f}>(?row, 2) AS ?o) BIND (<{f}>(?row, 3) AS ?g)
-  BIND (<{f}>(?row, 4) AS ?ds) BIND (<{f}>(?row, 5) AS ?dp) BIND (<{f}>(?row, 6) AS ?do)
-}}"""
-"""One operation writing the quads of a list: row ``?row`` is the list's quad, terms 0 to 3 bound for a quad
-of a named graph, 4 to 6 for one of the default graph (a template triple with an unbound variable is left
-out). Only row numbers are written into the text; the terms come from the custom function ``f``."""
 
 
 def update(store: EmbeddedStore, text: str) -> None:
@@ -70,7 +59,7 @@ def update(store: EmbeddedStore, text: str) -> None:
     store.guard.admit("update", text)
     removed, added = _evaluate(store, text)
     if removed or added:
-        _apply(store, removed, added)
+        store.exchange(removed, added)
 
 
 def _evaluate(store: EmbeddedStore, text: str) -> tuple[list[ox.Quad], list[ox.Quad]]:
@@ -79,10 +68,7 @@ def _evaluate(store: EmbeddedStore, text: str) -> tuple[list[ox.Quad], list[ox.Q
     errors = ErrorLog()
     try:
         copy = root / "store.nq"
-        try:
-            store._backend.dump(str(copy), format=ox.RdfFormat.N_QUADS)  # its own read, here
-        except OSError as error:
-            raise StoreError(store.location, f"a copy for the update failed: {error}") from error
+        store.dump_to(copy)  # its own read, here
         command = [sys.executable, str(_CHILD), str(copy), json.dumps(PREFIXES)]
         done = subprocess.run(
             command,
@@ -118,40 +104,3 @@ def _evaluate(store: EmbeddedStore, text: str) -> tuple[list[ox.Quad], list[ox.Q
 
 def _quads(data: bytes) -> list[ox.Quad]:
     return list(ox.parse(data, format=ox.RdfFormat.N_QUADS)) if data else []
-
-
-def _apply(store: EmbeddedStore, removed: Sequence[ox.Quad], added: Sequence[ox.Quad]) -> None:
-    """Remove ``removed`` and add ``added`` in one transaction, blank nodes as they are."""
-    operations = []
-    functions: dict[ox.NamedNode, Callable[[ox.Literal, ox.Literal], _Term | None]] = {}
-    for operation, quads, name in (("DELETE", removed, _REMOVED), ("INSERT", added, _ADDED)):
-        if quads:
-            rows = " ".join(str(n) for n in range(len(quads)))
-            operations.append(_APPLY.format(operation=operation, rows=rows, f=name.value))
-            functions[name] = _terms(quads)
-    store.generation += 1  # before as well as after: a snapshot taken meanwhile is never current
-    try:
-        store._backend.update(" ;\n".join(operations), custom_functions=functions)
-    except OSError as error:
-        raise StoreError(store.location, f"update failed: {error}") from error
-    finally:
-        store.generation += 1
-
-
-_Term = ox.NamedNode | ox.BlankNode | ox.Literal | ox.Triple
-
-
-def _terms(quads: Sequence[ox.Quad]) -> Callable[[ox.Literal, ox.Literal], _Term | None]:
-    """The custom function of :data:`_APPLY` for ``quads``: term ``position`` of quad ``row``, or None (unbound)."""
-
-    def term(row: ox.Literal, position: ox.Literal) -> _Term | None:
-        quad, at = quads[int(row.value)], int(position.value)
-        graph = quad.graph_name
-        if isinstance(graph, ox.DefaultGraph) != (at >= 4):
-            return None  # this template triple is not this quad's
-        if at % 4 == 3:
-            assert not isinstance(graph, ox.DefaultGraph)
-            return graph
-        return (quad.subject, quad.predicate, quad.object)[at % 4]
-
-    return term

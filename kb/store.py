@@ -14,7 +14,7 @@ import hashlib
 import re
 from abc import ABC, abstractmethod
 from collections import defaultdict
-from collections.abc import Iterable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from pathlib import Path
 
 import pyoxigraph as ox
@@ -58,6 +58,20 @@ QueryResult = ox.QuerySolutions | ox.QueryBoolean | ox.QueryTriples
 
 _GRAPH = ox.Variable("g")
 _GRAPH_SIZE = "SELECT ?g (COUNT(*) AS ?n) WHERE { GRAPH ?g { ?s ?p ?o } } GROUP BY ?g"
+
+_REMOVED = ox.NamedNode("urn:cbrs:exchange:removed")
+_ADDED = ox.NamedNode("urn:cbrs:exchange:added")
+_APPLY = """{operation} {{ GRAPH ?g {{ ?s ?p ?o }} ?ds ?dp ?do }} WHERE {{
+  VALUES ?row {{ {rows} }}
+  BIND (<{f}>(?row, 0) AS ?s) BIND (<{f}>(?row, 1) AS ?p) BIND (<{f}>(?row, 2) AS ?o) BIND (<{f}>(?row, 3) AS ?g)
+  BIND (<{f}>(?row, 4) AS ?ds) BIND (<{f}>(?row, 5) AS ?dp) BIND (<{f}>(?row, 6) AS ?do)
+}}"""
+"""One operation writing the quads of a list: row ``?row`` is the list's quad, terms 0 to 3 bound for a quad
+of a named graph, 4 to 6 for one of the default graph (a template triple with an unbound variable is left
+out). Only row numbers are written into the text; the terms come from the custom function ``f``."""
+_Term = ox.NamedNode | ox.BlankNode | ox.Literal | ox.Triple
+_TermOfRow = Callable[[ox.Literal, ox.Literal], _Term | None]
+"""A custom function of :data:`_APPLY`: term ``position`` of the quad of row ``row`` (None: unbound)."""
 
 
 class Store(ABC):
@@ -541,10 +555,36 @@ class EmbeddedStore(Store):
                 raise
             raise StoreEvaluationError(self.location, "update", f"LOAD failed: {error.__cause__}") from error
 
-    def _apply_own_update(self, text: str) -> None:
+    def dump_to(self, path: Path) -> None:
+        """Write the whole dataset to ``path`` as N-Quads, streamed by Oxigraph (blank nodes' labels kept,
+        in no order: :meth:`dump` sorts, for comparing, at a cost this copy need not pay)."""
+        try:
+            self._backend.dump(str(path), format=ox.RdfFormat.N_QUADS)
+        except OSError as error:
+            raise StoreError(self.location, f"a copy to {path} failed: {error}") from error
+
+    def exchange(self, removed: Sequence[ox.Quad], added: Sequence[ox.Quad]) -> None:
+        """Remove ``removed`` and add ``added`` in one transaction, blank nodes as they are (which
+        :meth:`replace`'s data blocks cannot name): one update of :data:`_APPLY` operations whose terms a
+        custom function gives; nothing in it sorts (:mod:`kb.sorting_updates` writes a child's delta so)."""
+        operations = []
+        functions: dict[ox.NamedNode, _TermOfRow] = {}
+        for operation, quads, name in (("DELETE", removed, _REMOVED), ("INSERT", added, _ADDED)):
+            if quads:
+                rows = " ".join(str(n) for n in range(len(quads)))
+                operations.append(_APPLY.format(operation=operation, rows=rows, f=name.value))
+                functions[name] = _terms(quads)
+        if operations:
+            self._apply_own_update(" ;\n".join(operations), functions)
+
+    def _apply_own_update(
+        self,
+        text: str,
+        functions: Mapping[ox.NamedNode, _TermOfRow] | None = None,
+    ) -> None:
         self.generation += 1  # before as well as after: a snapshot taken meanwhile is never current
         try:
-            self._backend.update(text, prefixes=PREFIXES)
+            self._backend.update(text, prefixes=PREFIXES, custom_functions=dict(functions or {}))
         except SyntaxError as error:
             raise QuerySyntaxError(text, str(error)) from error
         except OSError as error:
@@ -603,3 +643,19 @@ def _served_at(path: Path) -> str | None:
         return (path / SERVED_AT).read_text(encoding="utf-8").strip() or None
     except OSError:
         return None
+
+
+def _terms(quads: Sequence[ox.Quad]) -> _TermOfRow:
+    """The custom function of :data:`_APPLY` for ``quads``: term ``position`` of quad ``row``, or None (unbound)."""
+
+    def term(row: ox.Literal, position: ox.Literal) -> _Term | None:
+        quad, at = quads[int(row.value)], int(position.value)
+        graph = quad.graph_name
+        if isinstance(graph, ox.DefaultGraph) != (at >= 4):
+            return None  # this template triple is not this quad's
+        if at % 4 == 3:
+            assert not isinstance(graph, ox.DefaultGraph)
+            return graph
+        return (quad.subject, quad.predicate, quad.object)[at % 4]
+
+    return term
