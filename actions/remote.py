@@ -5,6 +5,10 @@ the request's fields, ``update`` polls for the answer (waiting a few millisecond
 tick is bounded in time), and the answer's fields become the outputs. Whatever the remote side does
 (answers with an error, with the wrong fields or types, never, or goes away) ends the invocation
 with a reason; nothing it sends can reach the plan unchecked.
+
+A component that acts (an advertisement with effects or delete effects) whose call was sent and whose step
+then ends without a checked success leaves what its effects would set unknown (:func:`actions.late_answers.unsettle`;
+docs/execution.md, "The belief after a failed step"): the device may have acted, whoever runs it.
 """
 
 from __future__ import annotations
@@ -20,7 +24,7 @@ from cbrs.actions.answers import Classes, ContradictedEffectError, StoreClasses,
 from cbrs.actions.breaker import BreakerPolicy, Late, busy, calls_of
 from cbrs.actions.components import Component, Status
 from cbrs.actions.errors import ActionsError
-from cbrs.actions.late_answers import GivenUp, watch
+from cbrs.actions.late_answers import GivenUp, SentAndFailed, unsettle, watch
 from cbrs.actions.remote_errors import RemoteCallError
 from cbrs.kb import KnowledgeBase, Statement
 
@@ -88,6 +92,14 @@ class RemoteComponent(Component):
     ``kb``: the store whose belief an actuator's answer to a call given up corrects when it comes
     (:mod:`actions.late_answers`); by default the one ``classes`` reads, if a :class:`StoreClasses`.
     Without one the answer is only logged.
+
+    The failed-step rule: with ``effects`` or ``deletes`` (the advertisement's delete effects) and a
+    store, a call that was sent and whose step ends without a checked success (an error answer, a
+    malformed or contradicting one, the connection lost, a timeout whose answer nobody awaits, the step
+    halted while the call was out, or an answer taken but the step then failed by the executor:
+    :meth:`uncounted`) leaves the relations its effects set or delete about the step's things unknown
+    (:func:`actions.late_answers.unsettle`). A call refused before it was sent changes no belief, nor does
+    an actuator's call given up, whose late answer settles it (:func:`actions.late_answers.watch`).
     """
 
     def __init__(
@@ -106,6 +118,7 @@ class RemoteComponent(Component):
         breaker: BreakerPolicy | None = None,
         session: str | None = None,
         kb: KnowledgeBase | None = None,
+        deletes: Iterable[Statement] = (),
     ) -> None:
         super().__init__(iri)
         self.transport = transport
@@ -116,6 +129,7 @@ class RemoteComponent(Component):
         self._clock = clock
         self.exclusive = exclusive
         self.effects = tuple(effects)
+        self.deletes = tuple(deletes)
         self.classes = classes
         self.contradictions = contradictions
         self.breaker = breaker
@@ -126,6 +140,8 @@ class RemoteComponent(Component):
         self._inputs: dict[str, Any] = {}
         self._sent = 0.0
         self._deadline = 0.0
+        self._sent_call = False  # a call of this invocation went out and has not been accounted for
+        self._answered = False  # its answer was taken: the step may still not count (actions.executor.Uncounted)
 
     def begin(self, inputs: Mapping[str, Any]) -> None:
         """Send the call, unless the service is passed over now (its breaker is open, or an actuator's call
@@ -133,6 +149,7 @@ class RemoteComponent(Component):
         self.outputs = {}
         self.reason = ""
         self._pending = None
+        self._sent_call = self._answered = False
         self._inputs = dict(inputs)
         now = self._clock()
         why = self._calls.admit(self.service, self.iri, now, self.timeout * LATE_WINDOW, self.exclusive, self.session)
@@ -146,8 +163,28 @@ class RemoteComponent(Component):
         except BaseException:
             self._calls.released(self.service)
             raise
+        self._sent_call = True
 
     def update(self) -> Status:
+        try:
+            status = self._poll()
+        except Exception as error:  # a contradicting answer: refused after it came
+            self._unsettle(f"{type(error).__name__}: {error}")
+            raise
+        if status is Status.FAILED:
+            self._unsettle(self.reason)
+        elif status is Status.SUCCEEDED:
+            self._sent_call, self._answered = False, True
+        return status
+
+    def uncounted(self, reason: str) -> None:
+        """The executor did not count the step this answered as succeeded (an effect not reached): the
+        device may have done part of it, so what its effects set is unknown, as for a failed answer."""
+        if self._answered:
+            self._answered, self._sent_call = False, True
+            self._unsettle(f"its answer was taken, but the step failed: {reason}")
+
+    def _poll(self) -> Status:
         pending = self._pending
         if pending is None:
             self.reason = self.reason or "not started"
@@ -239,6 +276,8 @@ class RemoteComponent(Component):
         kept until it answers, since the provider may still be executing it (a door motor cannot be told
         to stop by a dropped call)."""
         pending = self._pending if self.exclusive else None
+        if pending is not None and self.kb is not None:
+            self._sent_call = False  # given up: its answer, when it comes, settles the belief
         late = self._late() if pending is not None else None
         self._calls.timed_out(
             self.service, self.iri, self._clock(), self.timeout, self.breaker, self.session, pending, self._sent, late
@@ -254,11 +293,23 @@ class RemoteComponent(Component):
     def halt(self) -> None:
         """The step was stopped while the call was out (a cancelled run, the executor's tick bound)."""
         pending = self._pending
+        if pending is not None and self.exclusive and not pending.done() and self.kb is not None:
+            self._sent_call = False  # given up: its late answer settles the belief
+        if pending is not None:
+            self._unsettle(f"halted while its call was out ({self.reason or 'the step was stopped'})")
         if pending is not None and not pending.done():
             self._calls.released(self.service)
             if self.exclusive:
                 self._calls.given_up(self.service, self.iri, pending, self._sent, self.timeout, self._late())
         self._fail()
+
+    def _unsettle(self, reason: str) -> None:
+        """The failed-step rule, once per call sent: nothing for a component without effects."""
+        if not self._sent_call:
+            return
+        self._sent_call = False
+        if self.kb is not None and self.classes is not None and (self.effects or self.deletes):
+            unsettle(self.kb, self.classes, SentAndFailed(self.iri, self.service, reason, self._inputs))
 
 
 def given_up(transport: Transport, service: str, clock: Callable[[], float] = time.monotonic) -> str:

@@ -33,7 +33,6 @@ from cbrs.actions.answers import StoreClasses, check_designation
 from cbrs.actions.belief import Heard, Observation
 from cbrs.actions.breaker import BreakerPolicy, passed_over
 from cbrs.actions.components import Component, Registry, Status
-from cbrs.actions.late_answers import SentAndFailed, unsettle
 from cbrs.actions.plan import Plan, PlanStep
 from cbrs.actions.qualities import OwnQualities
 from cbrs.actions.remote import RemoteComponent, Transport
@@ -211,8 +210,7 @@ def _remote(transport: Transport, service: str, ad: Advertisement, calls: _Remot
         check_designation(concept, found, calls.classes)  # the pen answered as a weight
         return found
 
-    made = _Acting if ad.effects or ad.deletes else RemoteComponent
-    return lambda iri: made(
+    return lambda iri: RemoteComponent(
         iri,
         transport,
         service,
@@ -221,68 +219,12 @@ def _remote(transport: Transport, service: str, ad: Advertisement, calls: _Remot
         timeout,
         exclusive=exclusive,
         effects=ad.effects,
+        deletes=ad.deletes,
         classes=calls.classes,
         contradictions=calls.contradictions,
         breaker=calls.breaker,
         session=calls.sessions.get(ad.iri),
     )
-
-
-class _Acting(RemoteComponent):
-    """A remote component with effects: when a call it sent ends its step without a checked success (an
-    error answer, a malformed or contradicting one, the connection lost, a timeout whose answer nobody
-    awaits, the step halted while the call was out, an answer taken but the step then failed by the
-    executor: :meth:`uncounted`), the device may have acted, so what its effects would set about the things
-    it was given becomes unknown (:func:`actions.late_answers.unsettle`). A call
-    refused before it was sent changes no belief, nor does an actuator's call given up, whose late answer
-    settles it (:func:`actions.late_answers.watch`). docs/execution.md, "The belief after a failed step"."""
-
-    _sent_call = False  # a call of this invocation went out and has not been accounted for
-    _answered = False  # its answer was taken: the step may still not count (actions.executor.Uncounted)
-
-    def begin(self, inputs: Mapping[str, Any]) -> None:
-        self._sent_call = self._answered = False
-        super().begin(inputs)
-        self._sent_call = self._pending is not None
-
-    def update(self) -> Status:
-        try:
-            status = super().update()
-        except Exception as error:  # a contradicting answer: refused after it came
-            self._unsettle(f"{type(error).__name__}: {error}")
-            raise
-        if status is Status.FAILED:
-            self._unsettle(self.reason)
-        elif status is Status.SUCCEEDED:
-            self._sent_call, self._answered = False, True
-        return status
-
-    def uncounted(self, reason: str) -> None:
-        """The executor did not count the step this answered as succeeded (an effect not reached): the
-        device may have done part of it, so what its effects set is unknown, as for a failed answer."""
-        if self._answered:
-            self._answered, self._sent_call = False, True
-            self._unsettle(f"its answer was taken, but the step failed: {reason}")
-
-    def _timed_out(self) -> Status:
-        if self.exclusive and self.kb is not None:
-            self._sent_call = False  # given up: its answer, when it comes, settles the belief
-        return super()._timed_out()
-
-    def halt(self) -> None:
-        pending = self._pending
-        if pending is not None and self.exclusive and not pending.done():
-            self._sent_call = False  # given up by halt(): its late answer settles the belief
-        if pending is not None:
-            self._unsettle(f"halted while its call was out ({self.reason or 'the step was stopped'})")
-        super().halt()
-
-    def _unsettle(self, reason: str) -> None:
-        if not self._sent_call:
-            return
-        self._sent_call = False
-        if self.kb is not None and self.classes is not None:
-            unsettle(self.kb, self.classes, SentAndFailed(self.iri, self.service, reason, self._inputs))
 
 
 def _maker(work: Work, device: str, outputs: tuple[str, ...]) -> Callable[[str], Component]:

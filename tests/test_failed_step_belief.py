@@ -16,15 +16,18 @@ from typing import Any
 
 import pytest
 
-from cbrs.actions.answers import ContradictedEffectError
+from cbrs.actions.answers import ContradictedEffectError, StoreClasses
 from cbrs.actions.belief import BeliefState, Observation
 from cbrs.actions.components import Component, Registry, Status
+from cbrs.actions.executor import Uncounted
 from cbrs.actions.plan import Plan, PlanStep
+from cbrs.actions.remote import RemoteComponent
 from cbrs.actions.remote_errors import RemoteCallError
 from cbrs.actions.runner import RunResult, run_task
 from cbrs.kb import KnowledgeBase, Requirement, Statement
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.sim.components import implementations
+from cbrs.sim.values import check
 from tests.test_remote_call_timeout import Silent
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "docs" / "examples"
@@ -202,4 +205,43 @@ def test_an_answer_taken_whose_effect_is_then_not_reached_leaves_the_lamp_unknow
     result, plug = _run(kb, "SwitchOffTheReadingLamp", ANSWERED_OFF, refuting=True)
     assert not result.succeeded and plug.calls == ["/lab10_lamp_plug_01/switch_off"]
     assert result.report is not None and "effect not reached" in result.report.reason
+    assert _status(kb) == []
+
+
+def test_the_rule_holds_for_a_remote_component_built_outside_the_simulation(
+    kb: KnowledgeBase, warnings: pytest.LogCaptureFixture
+) -> None:
+    """An executor against real devices builds RemoteComponent itself, with the advertisement's effects and
+    delete effects and the store's classes: a malformed answer leaves the lamp unknown, as in a run (before,
+    only sim.components' own subclass applied the rule, and this kept "on"). A call answered and then not
+    counted by the executor (RemoteComponent.uncounted) does the same; one without effects changes nothing."""
+    (ad,) = [ad for ad in kb.advertisements() if ad.iri == OFF]
+    assert ad.effects and ad.bridge_port is not None and ad.bridge_port.topic is not None
+    service = ad.bridge_port.topic
+    classes = StoreClasses(kb)
+    outputs = {p.name: p.type for p in ad.outputs if p.name}
+
+    def checked(concept: str, value: Any) -> Any:
+        return check(concept, value, classes.is_a)
+
+    def plug(answer: Any, acting: bool = True) -> RemoteComponent:
+        effects, deletes = (ad.effects, ad.deletes) if acting else ((), ())
+        return RemoteComponent(
+            OFF, Answering(answer), service, outputs, checked, 1.0,
+            effects=effects, deletes=deletes, classes=classes,
+        )  # fmt: skip
+
+    _believe(kb, IS_ON)
+    without = plug({"lampStatus": "off"}, acting=False)
+    assert _invoke(without) is Status.FAILED and _status(kb) == [IS_ON[2]]
+    malformed = plug({"lampStatus": "off"})
+    assert _invoke(malformed) is Status.FAILED and "answered a wrong lampStatus" in malformed.reason
+    assert _status(kb) == []
+    assert any("failed after its call was sent" in r.getMessage() for r in warnings.records)
+
+    _believe(kb, IS_ON)
+    answered = plug(ANSWERED_OFF)
+    assert _invoke(answered) is Status.SUCCEEDED and _status(kb) == [IS_ON[2]]
+    assert isinstance(answered, Uncounted)
+    answered.uncounted("effect not reached: (ReadingLamp1, hasStatus, SwitchedOff)")
     assert _status(kb) == []
