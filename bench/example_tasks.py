@@ -42,6 +42,7 @@ import hashlib
 import html
 import html.parser
 import importlib.metadata
+import itertools
 import json
 import os
 import platform
@@ -70,9 +71,11 @@ EXAMPLES = ROOT / "docs" / "examples"
 DATA = ROOT / "bench" / "data" / "example_tasks.toml"
 GRAPHS = ("ontology", "map", "requirements")
 VERBS = (*GRAPHS, "update", "register")
-STATUSES = ("succeeded", "refused", "no plan", "failed")
-RUN_STATUS = {"succeeded": "succeeded", "failed": "failed", "cancelled": "failed", "unsolvable": "no plan"}
-SERVER_STATUS = {"succeeded": "succeeded", "failed": "failed", "cancelled": "failed", "no-plan": "no plan"}
+STATUSES = ("succeeded", "refused", "no plan", "failed", "cancelled")
+RUN_STATUS = {"succeeded": "succeeded", "failed": "failed", "cancelled": "cancelled", "unsolvable": "no plan"}
+SERVER_STATUS = {"succeeded": "succeeded", "failed": "failed", "cancelled": "cancelled", "no-plan": "no plan"}
+SKIPPED = "skipped"
+"""A run the machine cannot make (a program's interpreter or its modules missing): said why, no deviation."""
 VIAS = ("cli", "bridge", "http", "run_task", "action", "library", "page")
 SERVED = ("http", "bridge", "run_task", "action", "page")
 """The ways of running that go to a server of the trial's store (``cbrs serve``)."""
@@ -85,6 +88,14 @@ STARTUP = 90.0
 """Seconds a server or a component program may take to answer or register (bounded waits)."""
 RUN_TIMEOUT = 600.0
 """Seconds one run may take, wall time, before it is stopped and counted broken."""
+NODE_MODULES = ROOT / "tests" / "js" / "node_modules"
+"""Where a Node program's modules are (``npm ci --prefix tests/js``: roslib); ``--node-modules`` sets another.
+Node resolves an ES module's imports beside the program, not by NODE_PATH: the program runs from a copy
+in the trial's directory with this linked beside it, as its header says (roslib beside it)."""
+INTERPRETERS = {".py": "python", ".mjs": "node", ".js": "node"}
+"""How a served program is started, by its suffix."""
+BRIDGE = "{bridge}"
+"""In a served program's args, where its bridge's URL goes (else ``--bridge URL`` first, as the Python ones take it)."""
 
 
 @dataclass(frozen=True)
@@ -106,13 +117,17 @@ class Step:
 
 @dataclass(frozen=True)
 class Run:
-    """One run of a trial: its task, and the status and simulated seconds the docs give at each seed."""
+    """One run of a trial: its task, and the status and simulated seconds the docs give at each seed;
+    where the docs say more, a phrase of the run's words (``says``: its JSON, or its page's verdict) and
+    the number of steps it took at each seed (``steps``)."""
 
     task: str
     status: list[str]
     seconds: list[float]
     before: tuple[Step, ...] = ()
     between: tuple[float, float] | None = None
+    says: str = ""
+    steps: list[int] | None = None
 
 
 @dataclass(frozen=True)
@@ -124,6 +139,48 @@ class Serve:
     args: tuple[str, ...] = ()
     ready: str = "registered"
     count: int = 1
+
+    def argv(self, ws: str, where: Path, node_modules: Path) -> list[str]:
+        """The command that serves this program against the bridge ``ws``: Python's, or Node's on a copy of
+        the program in ``where`` beside the other example files (linked) and ``node_modules``;
+        :class:`Skip` when Node or the modules are missing."""
+        args = [a.replace(BRIDGE, ws) for a in self.args]
+        args = args if any(BRIDGE in a for a in self.args) else ["--bridge", ws, *args]
+        if INTERPRETERS.get(Path(self.program).suffix) != "node":
+            return [sys.executable, str(EXAMPLES / self.program), *args]
+        node = node_command(node_modules)
+        where.mkdir(parents=True, exist_ok=True)
+        for path in EXAMPLES.iterdir():  # the files it reads beside itself (its description), linked
+            if path.is_file() and path.name != self.program and not (where / path.name).exists():
+                (where / path.name).symlink_to(path)
+        if not (where / "node_modules").exists():
+            (where / "node_modules").symlink_to(node_modules.resolve())
+        shutil.copy(EXAMPLES / self.program, where / self.program)
+        return [node, str(where / self.program), *args]
+
+
+class Skip(Exception):
+    """A trial this machine cannot run (a program's interpreter or modules missing): why."""
+
+
+def node_command(node_modules: Path) -> str:
+    """Node's path; :class:`Skip` saying what is missing: node itself, or roslib in ``node_modules``."""
+    node = shutil.which("node")
+    if node is None:
+        raise Skip("node is not installed (the program runs on node >= 20 with roslib)")
+    if not (node_modules / "roslib").is_dir():
+        raise Skip(f"roslib is not in {node_modules} (npm ci --prefix tests/js, or --node-modules DIR)")
+    return node
+
+
+def skip_reason(trial: Trial, node_modules: Path) -> str:
+    """Why this machine cannot run ``trial`` (empty when it can): a Node program, node or its modules missing."""
+    if any(INTERPRETERS.get(Path(s.program).suffix) == "node" for s in trial.serve):
+        try:
+            node_command(node_modules)
+        except Skip as missing:
+            return str(missing)
+    return ""
 
 
 @dataclass(frozen=True)
@@ -156,10 +213,42 @@ class Trial:
     busy: str = ""
     """Two runs at once: while each run but the last goes, the next run's start is sent and must be refused
     (409) saying this phrase and naming the run going; the next is started once the run has ended."""
+    stop: StopAt | None = None
+    """The tasks page's Stop button pressed on each run's page (via page)."""
+    forms: tuple[PageForm, ...] = ()
+    """The pages' GET forms (via page), submitted in order once the server answers (at the first seed)."""
 
     @property
     def task(self) -> str:
         return " then ".join(r.task for r in self.runs) or "(loads only)"
+
+
+@dataclass(frozen=True)
+class StopAt:
+    """The tasks page's Stop this run, pressed on the run's page once it shows ``after`` steps ended: the
+    stop must be taken (202, the page saying ``says``), the run end cancelled with the steps not taken
+    pending in its result, and the same button pressed again refused (409, saying ``again``), the run
+    left as it was."""
+
+    after: int
+    says: str
+    again: str
+
+
+@dataclass(frozen=True)
+class PageForm:
+    """A GET form of the pages, submitted as a browser does: on ``page`` (else on the page the form before
+    answered), the form whose id is ``form`` or that holds the element of that id, with its fields typed
+    (``fill``) and its lists' options chosen (``choose``); the answer must have ``status``, and its text
+    (tags dropped) must say each of ``says`` and none of ``lacks`` (what a filter leaves out)."""
+
+    form: str
+    page: str = ""
+    fill: tuple[tuple[str, str], ...] = ()
+    choose: tuple[tuple[str, str], ...] = ()
+    status: int = 200
+    says: tuple[str, ...] = ()
+    lacks: tuple[str, ...] = ()
 
 
 @dataclass
@@ -175,6 +264,10 @@ class Outcome:
     reason: str
     deviation: str = ""
     expected_between: tuple[float, float] | None = None
+    expected_says: str = ""
+    said: bool = True
+    expected_steps: int | None = None
+    steps: int | None = None
 
 
 @dataclass
@@ -199,7 +292,7 @@ def _trial(path: Path, row: dict[str, Any]) -> Trial:
     seeds = list(row.get("seeds", [0, 1, 2]))
     raw_runs = list(row.get("runs", []))
     if "task" in row:
-        keys = ("task", "status", "seconds", "between")
+        keys = ("task", "status", "seconds", "between", "says", "steps")
         raw_runs.insert(0, {key: row[key] for key in keys if key in row})
     runs = [
         Run(
@@ -208,9 +301,23 @@ def _trial(path: Path, row: dict[str, Any]) -> Trial:
             [float(s) for s in r["seconds"]],
             tuple(_step(label, b) for b in r.get("before", [])),
             (float(r["between"][0]), float(r["between"][1])) if "between" in r else None,
+            str(r.get("says", "")),
+            [int(n) for n in r["steps"]] if "steps" in r else None,
         )
         for r in raw_runs
     ]
+    forms = tuple(
+        PageForm(
+            str(f["form"]),
+            str(f.get("page", "")),
+            tuple((str(k), str(v)) for k, v in f.get("fill", {}).items()),
+            tuple((str(k), str(v)) for k, v in f.get("choose", {}).items()),
+            int(f.get("status", 200)),
+            tuple(str(w) for w in f.get("says", [])),
+            tuple(str(w) for w in f.get("lacks", [])),
+        )
+        for f in row.get("forms", [])
+    )
     served = row.get("serve", [])
     serve = tuple(
         Serve(s["program"], tuple(s.get("args", [])), s.get("ready", "registered"), int(s.get("count", 1)))
@@ -232,6 +339,10 @@ def _trial(path: Path, row: dict[str, Any]) -> Trial:
         library,
         bool(row.get("post", False)),
         str(row.get("busy", "")),
+        StopAt(int(row["stop"]["after"]), str(row["stop"]["says"]), str(row["stop"]["again"]))
+        if "stop" in row
+        else None,
+        forms,
     )
     _check(path, trial)
     return trial
@@ -245,8 +356,16 @@ def _check(path: Path, trial: Trial) -> None:
             raise SystemExit(f"{where}: {run.task}: one status and one seconds a seed ({trial.seeds})")
         if bad := [s for s in run.status if s not in STATUSES]:
             raise SystemExit(f"{where}: unknown status {bad} (one of {', '.join(STATUSES)})")
-    if not trial.runs and not any(s.expect_refusal for s in trial.setup):
-        raise SystemExit(f"{where}: neither a run nor a refusal to check")
+        if run.steps is not None and len(run.steps) != len(trial.seeds):
+            raise SystemExit(f"{where}: {run.task}: steps, one number a seed ({trial.seeds})")
+    if not trial.runs and not trial.forms and not any(s.expect_refusal for s in trial.setup):
+        raise SystemExit(f"{where}: neither a run, a form nor a refusal to check")
+    if (trial.stop or trial.forms) and trial.via != "page":
+        raise SystemExit(f"{where}: the Stop button (stop) and the pages' forms (forms) are the pages' (via page)")
+    if trial.stop and (trial.busy or any(s != "cancelled" for r in trial.runs for s in r.status)):
+        raise SystemExit(f"{where}: a run stopped (stop) ends cancelled at each seed, one run at a time")
+    if any(not f.page for f in trial.forms[:1]):
+        raise SystemExit(f"{where}: the first form's page (page) is where the browser starts")
     if trial.via not in VIAS:
         raise SystemExit(f"{where}: unknown via {trial.via!r} (one of {', '.join(VIAS)})")
     if trial.via != "cli" and any(r.before for r in trial.runs):
@@ -394,7 +513,17 @@ def _outcome(trial: Trial, k: int, index: int, seed: int, found: dict[str, Any],
     label = trial.label if len(trial.runs) == 1 else f"{trial.label} [{k + 1}: {run.task}]"
     seconds = float(found.get("sim_seconds", 0.0))
     expected = run.status[index]
-    return Outcome(label, run.task, seed, expected, run.seconds[index], status, seconds, wall, reason, "", run.between)
+    outcome = Outcome(
+        label, run.task, seed, expected, run.seconds[index], status, seconds, wall, reason, "", run.between
+    )
+    outcome.expected_says, outcome.said = run.says, run.says in json.dumps(found, ensure_ascii=False)
+    outcome.expected_steps = run.steps[index] if run.steps is not None else None
+    execution = found.get("execution")
+    if isinstance(execution, dict) and isinstance(execution.get("steps"), list):
+        outcome.steps = len(execution["steps"])
+    elif isinstance(found.get("steps"), int):  # a run's page: its steps table's rows
+        outcome.steps = int(found["steps"])
+    return outcome
 
 
 def _parsed(done: subprocess.CompletedProcess[str]) -> dict[str, Any]:
@@ -405,7 +534,9 @@ def _parsed(done: subprocess.CompletedProcess[str]) -> dict[str, Any]:
     return found if isinstance(found, dict) else {"status": "broken", "error": done.stdout[-300:]}
 
 
-def run_one(trial: Trial, index: int, store: Path, made: Made | None = None) -> list[Outcome]:
+def run_one(
+    trial: Trial, index: int, store: Path, made: Made | None = None, node_modules: Path = NODE_MODULES
+) -> list[Outcome]:
     """Run the trial's runs in order at its ``index``-th seed in ``store``: on the command line, or
     against a server of the store with the trial's program, and read each outcome from its JSON (or the
     run's page); what the server refused on the way (posted files, a second start) checked in ``made``."""
@@ -427,7 +558,7 @@ def run_one(trial: Trial, index: int, store: Path, made: Made | None = None) -> 
         return outcomes
     if trial.via == "library":
         return _library_runs(trial, index, store)
-    return _served_runs(trial, index, store, made if made is not None else Made())
+    return _served_runs(trial, index, store, made if made is not None else Made(), node_modules)
 
 
 def _library_runs(trial: Trial, index: int, store: Path) -> list[Outcome]:
@@ -500,11 +631,15 @@ class _Child:
 
 @contextmanager
 def _server(
-    trial: Trial, store: Path, env: dict[str, str], prepare: Callable[[str], None] | None = None
+    trial: Trial,
+    store: Path,
+    env: dict[str, str],
+    prepare: Callable[[str], None] | None = None,
+    node_modules: Path = NODE_MODULES,
 ) -> Iterator[tuple[str, str]]:
     """``cbrs serve`` of ``store`` on free loopback ports, ``prepare(url)`` once it answers (the files
-    posted), and the trial's programs against its bridge; yields the HTTP and the bridge URLs; every
-    process stopped by PID at the end."""
+    posted), and the trial's programs against its bridge (Python's or Node's: :meth:`Serve.argv`); yields
+    the HTTP and the bridge URLs; every process stopped by PID at the end."""
     http, bridge = _free_port(), _free_port()
     url, ws = f"http://127.0.0.1:{http}", f"ws://127.0.0.1:{bridge}"
     argv = [
@@ -530,7 +665,7 @@ def _server(
         if prepare is not None:  # before the programs, as the files come first
             prepare(url)
         for n, serve in enumerate(trial.serve):  # each ready before the next starts
-            program = [sys.executable, str(EXAMPLES / serve.program), "--bridge", ws, *serve.args]
+            program = serve.argv(ws, store.parent / f"{store.name}.programs", node_modules)
             children.append(_Child(program, env, store.parent / f"{store.name}.program{n}.log"))
             if not children[-1].wait_for(serve.ready, serve.count, STARTUP):
                 said = "".join(children[-1].lines)[-300:]
@@ -667,7 +802,7 @@ def _answers(url: str, timeout: float) -> bool:
     return False
 
 
-def _served_runs(trial: Trial, index: int, store: Path, made: Made) -> list[Outcome]:
+def _served_runs(trial: Trial, index: int, store: Path, made: Made, node_modules: Path = NODE_MODULES) -> list[Outcome]:
     seed = trial.seeds[index]
     token = secrets.token_hex(16)
     env = {**os.environ, "CBRS_UPDATE_TOKEN": token}
@@ -679,7 +814,12 @@ def _served_runs(trial: Trial, index: int, store: Path, made: Made) -> list[Outc
             _post_setup(trial, url, token, where, made)
 
     try:
-        with _server(trial, store, env, prepare) as (url, ws):
+        with _server(trial, store, env, prepare, node_modules) as (url, ws):
+            if trial.forms and index == 0:  # the pages' GET forms read the store: once, at the first seed
+                for said, miss in form_checks(_Browser(url), trial.forms):
+                    made.checks.append(f"{trial.label}: {said}")
+                    if miss:
+                        made.deviations.append(f"{trial.label}: {miss}")
             for k, run in enumerate(trial.runs):
                 started = time.perf_counter()
                 if trial.via in STARTS:
@@ -695,12 +835,23 @@ def _served_runs(trial: Trial, index: int, store: Path, made: Made) -> list[Outc
                     except subprocess.TimeoutExpired:
                         found = {"status": "broken", "error": f"no answer in {RUN_TIMEOUT:.0f} s"}
                 outcomes.append(_outcome(trial, k, index, seed, found, time.perf_counter() - started))
+    except Skip as missing:  # a program this machine cannot start: no run made, none a deviation
+        return skipped(trial, index, str(missing))
     except (RuntimeError, OSError) as failed:
         done = len(outcomes)
         for k in range(done, len(trial.runs)):
             outcomes.append(_outcome(trial, k, index, seed, {"status": "broken", "error": str(failed)}, 0.0))
         if not trial.runs:
             made.deviations.append(f"{trial.label}: broken: {failed}")
+    return outcomes
+
+
+def skipped(trial: Trial, index: int, why: str) -> list[Outcome]:
+    """The trial's runs at its ``index``-th seed, skipped saying ``why``."""
+    found = {"status": SKIPPED, "reason": why}
+    outcomes = [_outcome(trial, k, index, trial.seeds[index], found, 0.0) for k in range(len(trial.runs))]
+    for outcome in outcomes:
+        outcome.status, outcome.reason = SKIPPED, why
     return outcomes
 
 
@@ -728,9 +879,111 @@ def _started_run(trial: Trial, k: int, seed: int, url: str, token: str, made: Ma
         made.checks.append(f"{trial.label}, seed {seed}: {said}")
         if miss:
             made.deviations.append(f"{trial.label}, seed {seed}: {miss}")
+    if trial.via == "page" and trial.stop is not None:
+        said, miss, found = stop_run(browser, begun, trial.stop, token)
+        made.checks.append(f"{trial.label}, seed {seed}: {said}")
+        if miss:
+            made.deviations.append(f"{trial.label}, seed {seed}: {miss}")
+        return found
     if trial.via == "page":
         return _page_follow(browser, begun)
     return _http_follow(url, begun, token)
+
+
+STEP_ROW = re.compile(r'<tr data-plan="\d+" data-step="\d+" class="step-(\w+)')
+
+
+def stop_run(browser: _Browser, begun: Started, stop: StopAt, token: str) -> tuple[str, str, dict[str, Any]]:
+    """Press the run's page's Stop this run once the page shows ``stop.after`` steps ended, follow the run
+    to its end, then press the same button again: what the pages said, why that is not as the docs say
+    (empty when it is: the button shown while the run goes, 202 saying ``stop.says``, the run's result
+    its steps taken then the rest pending, 409 saying ``stop.again`` and the run as it was), and the run
+    as its page shows it."""
+    deadline = time.monotonic() + RUN_TIMEOUT
+    while True:
+        page = browser.get(begun.where)
+        badge = PAGE_STATUS.search(page.body)
+        ended = sum(row in ("succeeded", "failed") for row in STEP_ROW.findall(page.body))
+        if badge is None or badge.group(1) != "running" or ended >= stop.after or time.monotonic() > deadline:
+            break
+        time.sleep(0.25)
+    said = f"Stop this run on {begun.where} after {ended} steps ended"
+    if badge is None or badge.group(1) != "running":
+        status = badge.group(1) if badge else "no status"
+        return said, f"{said}: the run was {status} before {stop.after} steps ended", _page_follow(browser, begun)
+    form = read_form(page.body, "cancel", page.url)
+    misses = ["the Stop button is hidden while the run goes"] if form.hidden else []
+    stopped = browser.submit(form)
+    words = _element_text(stopped.body, "content")
+    if stopped.status != 202 or stop.says not in words:
+        misses.append(
+            f"Stop answered {stopped.status}, the docs say 202 saying {stop.says!r}: {_form_messages(stopped.body)}"
+        )
+    found = _page_follow(browser, begun)
+    steps = _run_json(browser.url, begun.run, token).get("result", {}) or {}
+    outcomes = [str(step.get("outcome")) for step in (steps.get("execution") or {}).get("steps", [])]
+    taken = len(list(itertools.takewhile(lambda outcome: outcome != "pending", outcomes)))
+    if found.get("status") == "cancelled" and (taken == len(outcomes) or set(outcomes[taken:]) != {"pending"}):
+        misses.append(f"the cancelled run's steps are {outcomes}: the docs say the steps not taken are left pending")
+    found["steps"] = taken
+    again = browser.submit(form)
+    after = PAGE_STATUS.search(browser.get(begun.where).body)
+    if again.status != 409 or stop.again not in _element_text(again.body, "content"):
+        misses.append(
+            f"Stop again answered {again.status}, the docs say 409 saying {stop.again!r}: {_form_messages(again.body)}"
+        )
+    if after is None or after.group(1) != found.get("status"):
+        misses.append(
+            f"Stop again changed the run: {found.get('status')} -> {after.group(1) if after else 'no status'}"
+        )
+    line = f"{said}: {stopped.status}, {found.get('status')} after {taken} of {len(outcomes)} steps; "
+    line += f"again {again.status}: {_form_messages(again.body)[:200]}"
+    return line, f"{said}: " + "; ".join(misses) if misses else "", found
+
+
+def _form_messages(page: str) -> str:
+    """A page's message boxes (what a start, a stop or a save answered)."""
+    found = re.findall(r'<p class="[^"]*(?:error-box|ok-box)[^"]*"[^>]*>(.*?)</p>', page, re.S)
+    return " ".join(" ".join(html.unescape(re.sub(r"<[^>]+>", "", f)).split()) for f in found) or "(nothing said)"
+
+
+def form_checks(browser: _Browser, forms: tuple[PageForm, ...]) -> list[tuple[str, str]]:
+    """Submit the pages' GET forms in order as a browser does, each on its page (else on the page the one
+    before answered): for each, what the page answered and why that is not as the docs say (empty when
+    it is: its status, each phrase in its text and none it lacks)."""
+    checks: list[tuple[str, str]] = []
+    answer = Answer(0, browser.url, "")
+    for check in forms:
+        if check.page:
+            answer = browser.get(check.page)
+        where = urllib.parse.urlsplit(answer.url)
+        said = f"{where.path}{'?' + where.query if where.query else ''}: the form {check.form!r}"
+        try:
+            form = find_form(answer.body, check.form, answer.url)
+            for name, value in check.fill:
+                form.set(name, value)
+            for name, value in check.choose:
+                form.choose(name, value)
+        except (RuntimeError, _NotStarted) as failed:
+            checks.append((f"{said}: {failed}", f"{said}: {failed}"))
+            continue
+        if form.method != "get":
+            checks.append(
+                (f"{said}: a {form.method.upper()} form", f"{said}: a {form.method.upper()} form, not a GET form")
+            )
+            continue
+        answer = browser.submit(form)
+        text = page_text(answer.body)
+        title = re.search(r"<title>([^<]*)</title>", answer.body)
+        sent = ", ".join(
+            f"{name}={value[:60]}{'...' if len(value) > 60 else ''}" for name, value in form.fields if value
+        )
+        line = f"{said} ({sent}): {answer.status}, {html.unescape(title.group(1)) if title else 'no title'}"
+        misses = [f"answered {answer.status}, the docs say {check.status}"] if answer.status != check.status else []
+        misses += [f"without {phrase!r}" for phrase in check.says if phrase not in text]
+        misses += [f"with {phrase!r}" for phrase in check.lacks if phrase in text]
+        checks.append((line, f"{line}: " + "; ".join(misses) if misses else ""))
+    return checks
 
 
 class _NotStarted(RuntimeError):
@@ -840,7 +1093,7 @@ def _words(body: bytes) -> str:
 class Form:
     """A page's form as a browser submits it: its named fields in order (a text input's value, a checked
     box, a select's chosen options or else its first, a textarea's text), each select's options, and its
-    submit buttons (name and value)."""
+    submit buttons (name and value); the ids of the elements inside it, and whether the page hides it."""
 
     id: str
     method: str
@@ -849,6 +1102,8 @@ class Form:
     options: dict[str, list[str]] = field(default_factory=dict)
     buttons: list[tuple[str, str]] = field(default_factory=list)
     page: str = ""
+    ids: set[str] = field(default_factory=set)
+    hidden: bool = False
 
     def set(self, name: str, value: str) -> None:
         """Type ``value`` into the field ``name``; RuntimeError when the form has no such field."""
@@ -878,6 +1133,7 @@ class _FormReader(html.parser.HTMLParser):
         super().__init__(convert_charrefs=True)
         self.page = page
         self.forms: dict[str, Form] = {}
+        self.all: list[Form] = []
         self._form: Form | None = None
         self._select: tuple[str, bool, list[str], list[str]] | None = None
         self._textarea: list[str] | None = None
@@ -886,8 +1142,12 @@ class _FormReader(html.parser.HTMLParser):
         a = {key: value or "" for key, value in attrs}
         if tag == "form":
             self._form = Form(a.get("id", ""), a.get("method", "get").lower(), a.get("action", ""), page=self.page)
-            self.forms[self._form.id] = self._form
+            self._form.hidden = "hidden" in a
+            self.forms.setdefault(self._form.id, self._form)  # the first of a page's forms without an id
+            self.all.append(self._form)
             return
+        if self._form is not None and a.get("id"):
+            self._form.ids.add(a["id"])
         if self._form is None or "disabled" in a:
             return
         name, kind = a.get("name", ""), a.get("type", "text" if tag == "input" else "submit").lower()
@@ -932,6 +1192,28 @@ def read_form(page: str, form_id: str, where: str = "the page") -> Form:
     if form_id not in reader.forms:
         raise RuntimeError(f"{where} has no form {form_id!r} (it has {sorted(reader.forms)})")
     return reader.forms[form_id]
+
+
+def find_form(page: str, key: str, where: str = "the page") -> Form:
+    """The form of the HTML ``page`` whose id is ``key``, else the one holding the element of id ``key`` (a
+    form without an id of its own is found by its field, as a person finds it by its label); RuntimeError
+    when the page has neither."""
+    reader = _FormReader(where)
+    reader.feed(page)
+    if key in reader.forms:
+        return reader.forms[key]
+    for form in reader.all:
+        if key in form.ids:
+            return form
+    held = sorted(i for form in reader.all for i in form.ids | {form.id} if i)
+    raise RuntimeError(f"{where} has no form {key!r} nor one holding an element {key!r} (it has {held})")
+
+
+def page_text(page: str) -> str:
+    """What a person reads of a page's content (its main part, tags dropped, spaces collapsed)."""
+    main = re.search(r'<main[^>]*id="content"[^>]*>(.*)</main>', page, re.S)
+    text = re.sub(r"<(script|style)[^>]*>.*?</\1>", " ", main.group(1) if main else page, flags=re.S)
+    return " ".join(html.unescape(re.sub(r"<[^>]+>", " ", text)).split())
 
 
 def _element_text(page: str, element_id: str) -> str:
@@ -1209,9 +1491,15 @@ def _reason(found: dict[str, Any]) -> str:
 
 
 def deviation(outcome: Outcome, tolerance: float) -> str:
-    """Why the outcome is not what the docs say (empty when it is)."""
+    """Why the outcome is not what the docs say (empty when it is); a skipped run is none."""
+    if outcome.status == SKIPPED:
+        return ""
     if outcome.status != outcome.expected:
         return f"{outcome.status}, the docs say {outcome.expected}"
+    if not outcome.said:
+        return f"{outcome.status} without {outcome.expected_says!r}, which the docs say"
+    if outcome.expected_steps is not None and outcome.steps != outcome.expected_steps:
+        return f"{outcome.steps} steps, the docs say {outcome.expected_steps}"
     off = abs(outcome.seconds - outcome.expected_seconds)
     if outcome.status == "succeeded" and outcome.expected_seconds and off > tolerance:
         return f"{outcome.seconds:.1f} s simulated, the docs say {outcome.expected_seconds:.1f} s"
@@ -1232,12 +1520,20 @@ def commit() -> str:
     return head.stdout.strip() + (" (with uncommitted changes)" if dirty.stdout.strip() else "")
 
 
-def _run_all(trials: list[Trial], scratch: Path, jobs: int) -> tuple[list[Outcome], list[str], Made]:
-    """Every trial's store made, then its seeds run, up to ``jobs`` processes at once."""
+def _run_all(
+    trials: list[Trial], scratch: Path, jobs: int, node_modules: Path = NODE_MODULES
+) -> tuple[list[Outcome], list[str], Made]:
+    """Every trial's store made, then its seeds run, up to ``jobs`` processes at once; a trial this
+    machine cannot run (:func:`skip_reason`) skipped, saying why."""
     outcomes: list[Outcome] = []
     broken: list[str] = []
     loads = Made()
     total = sum(len(t.seeds) * len(t.runs) for t in trials)
+    for trial in trials:
+        if why := skip_reason(trial, node_modules):
+            outcomes += [o for k in range(len(trial.seeds)) for o in skipped(trial, k, why)]
+            print(f"[{len(outcomes)}/{total}] {trial.label}: skipped: {why}", file=sys.stderr, flush=True)
+    trials = [t for t in trials if not skip_reason(t, node_modules)]
     with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, jobs)) as pool:
         made = {pool.submit(make_store, t, scratch / f"t{i}" / "made"): (i, t) for i, t in enumerate(trials)}
         runs: dict[concurrent.futures.Future[list[Outcome]], Made] = {}
@@ -1250,12 +1546,12 @@ def _run_all(trials: list[Trial], scratch: Path, jobs: int) -> tuple[list[Outcom
                 continue
             loads.checks += found.checks
             loads.deviations += found.deviations
-            # a posted refusal alone is checked at the server once, at the first seed
-            for k in range(len(trial.seeds) if trial.runs else int(trial.post)):
+            # a posted refusal or the pages' forms alone are checked at the server once, at the first seed
+            for k in range(len(trial.seeds) if trial.runs else int(trial.post or bool(trial.forms))):
                 store = scratch / f"t{i}" / f"seed{trial.seeds[k]}"
                 shutil.copytree(scratch / f"t{i}" / "made", store)
                 served = Made()
-                runs[pool.submit(run_one, trial, k, store, served)] = served
+                runs[pool.submit(run_one, trial, k, store, served, node_modules)] = served
         for ran in concurrent.futures.as_completed(runs):
             loads.checks += runs[ran].checks
             loads.deviations += runs[ran].deviations
@@ -1273,6 +1569,12 @@ def main() -> None:
     parser.add_argument("--jobs", type=int, default=os.cpu_count() or 1, help="runs at once (default: the cores)")
     parser.add_argument("--json", type=Path, help="write the record here")
     parser.add_argument("--keep", type=Path, help="make the stores under DIR and keep them (default: a temporary one)")
+    parser.add_argument(
+        "--node-modules",
+        type=Path,
+        default=NODE_MODULES,
+        help="the modules a Node program imports, roslib among them (default: tests/js/node_modules)",
+    )
     args = parser.parse_args()
     tolerance, trials = read_trials(args.data)
     if args.only:
@@ -1298,7 +1600,7 @@ def main() -> None:
     scratch.mkdir(parents=True, exist_ok=True)
     started = time.perf_counter()
     try:
-        outcomes, broken, loads = _run_all(trials, scratch, args.jobs)
+        outcomes, broken, loads = _run_all(trials, scratch, args.jobs, args.node_modules)
     finally:
         if args.keep is None:
             shutil.rmtree(scratch, ignore_errors=True)
@@ -1321,9 +1623,10 @@ def main() -> None:
         )
     deviations = [o for o in outcomes if o.deviation]
     count = len(deviations) + len(loads.deviations)
+    skips = sum(o.status == SKIPPED for o in outcomes)
     print(
-        f"\n{len(outcomes)} runs and {len(loads.checks)} checks in {time.perf_counter() - started:.0f} s; "
-        f"{count} deviations"
+        f"\n{len(outcomes) - skips} runs and {len(loads.checks)} checks in {time.perf_counter() - started:.0f} s"
+        f"{f' ({skips} runs skipped)' if skips else ''}; {count} deviations"
     )
     known = {t.label for t in trials if t.known_failure}
     for o in deviations:
@@ -1332,6 +1635,8 @@ def main() -> None:
         print(f"- {o.label}, seed {o.seed}: {o.deviation}{mark}{reason}")
     for message in loads.deviations:
         print(f"- {message}")
+    for skip in sorted({f"{o.label.split(' [')[0]}: {o.reason}" for o in outcomes if o.status == SKIPPED}):
+        print(f"- skipped, not a deviation: {skip}")
     for message in broken:
         print(f"- the store could not be made: {message}")
     if args.json:
