@@ -27,6 +27,7 @@ from typing import Any, Literal
 from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, Objective
 from cbrs.actions.graph import stated_cost  # one reading of cbrs:cost, the composer's
 from cbrs.actions.plan import Plan, PlanStep
+from cbrs.actions.unavailable import name_unavailable
 from cbrs.kb import Advertisement, KnowledgeBase, NotFoundError, Requirement
 from cbrs.kb.floor_routes import Routes, RouteSettings
 from cbrs.kb.home_check import NoDockingPoseError, docked_place
@@ -488,9 +489,12 @@ def choose_in_map(
     (:func:`map_bases`; ``facts``, its rows if read already), their components among the advertisements
     ``composer`` composes over; each base's plan composed as ``composition`` was (from the map, not the
     belief). ``cbrs plan``, the plans page, the bridge's /cbrs/plan and the task editor (a draft's
-    ``Requirement``)."""
+    ``Requirement``). Without a plan, the live components a plan would use that are unavailable now are
+    named with why, as a run names them (:func:`actions.unavailable.name_unavailable`)."""
     kb = composer.kb
-    bases = map_bases(kb, facts) if composition.plan is not None else set()
+    if composition.plan is None:
+        return name_unavailable(kb, composer.config, task, composition), None
+    bases = map_bases(kb, facts)
     if len(bases) < 2:
         return composition, None
     groups = base_groups(kb, bases, composer.advertisements)

@@ -36,6 +36,7 @@ from cbrs.actions.plan import Plan, PlanStep
 from cbrs.actions.precondition_sensing import PreconditionSensing, SensingConfig
 from cbrs.actions.replanning import Failure, FailureMemory, ReplanPolicy
 from cbrs.actions.task_preconditions import PreconditionCheck, check_preconditions
+from cbrs.actions.unavailable import name_unavailable
 from cbrs.kb import Advertisement, KnowledgeBase, NotFoundError, Requirement, Statement
 from cbrs.kb.namespaces import HOME, shorten
 from cbrs.kb.semantic_map import UnresolvedDesignatorError
@@ -623,7 +624,7 @@ def _runnable(
     plan = composition.plan
     passed = passed or {}
     if plan is None:
-        return _naming_the_unavailable(kb, config, task, composition, avoid, belief)
+        return name_unavailable(kb, config, task, composition, avoid, belief)
     used = {c for step in plan.steps for c in step.candidates}
     if all(_can_run(step.component, registry, passed) for step in plan.steps):
         # Each step's first choice can run; an alternative that cannot would fail a failover for sure
@@ -647,33 +648,6 @@ def _runnable(
         if ad.iri in wanted
     ]
     return replace(again, unsatisfied=tuple(replace(u, unrunnable=tuple(why)) for u in again.unsatisfied))
-
-
-def _naming_the_unavailable(
-    kb: KnowledgeBase,
-    config: ComposeConfig,
-    task: str,
-    composition: CompositionResult,
-    avoid: frozenset[str],
-    belief: bool = True,
-) -> CompositionResult:
-    """``composition``, which has no plan, with the live components it lacks named: those registered but
-    unavailable now (a program stopped, its lease lapsed) that a plan would use, each with why. The store
-    leaves them out of composition, so the answer was "no component provides ...; register a component
-    whose effect is ...", to a user who had registered one. One more composition, only on the way to a
-    no-plan answer, and only when a live component is unavailable."""
-    gone = {iri: state for iri, state in kb.liveness.states().items() if not state.live and iri not in avoid}
-    if not gone:
-        return composition
-    everyone = [ad for ad in kb.advertisements(include_unavailable=True) if ad.iri not in avoid]
-    would = Composer(kb, config, advertisements=everyone).compose(task, belief=belief).plan
-    if would is None:
-        return composition
-    wanted = {c for step in would.steps for c in step.candidates if c in gone}
-    why = tuple((iri, f"unavailable: {gone[iri].reason or 'not live'}") for iri in sorted(wanted))
-    if not why:
-        return composition
-    return replace(composition, unsatisfied=tuple(replace(u, unrunnable=why) for u in composition.unsatisfied))
 
 
 def unrunnable_steps(

@@ -1,5 +1,5 @@
 """A task with no plan because the one component that provides its goal is a live component unavailable
-now (its program stopped, its lease lapsed) names that component and why (actions/runner.py): the store
+now (its program stopped, its lease lapsed) names that component and why (actions/unavailable.py): the store
 leaves it out of composition, so the answer was "no component provides ...; register a component whose
 effect is ...", to a user who had registered one."""
 
@@ -8,7 +8,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from cbrs.actions.composer import ComposeConfig, Composer
-from cbrs.actions.runner import _naming_the_unavailable
+from cbrs.actions.unavailable import name_unavailable
 from tests.test_composition import EX
 from tests.test_progression_joined import PREFIXES, _component, _condition, _parameter, _requirement, _store
 
@@ -26,7 +26,7 @@ def test_a_lapsed_live_component_a_plan_would_use_is_named_with_why(tmp_path: Pa
     kb.liveness.expire(EX + "PutAway", "its lease lapsed")
     composition = Composer(kb).compose(EX + "Req", belief=True)
     assert composition.plan is None and composition.unsatisfied
-    named = _naming_the_unavailable(kb, ComposeConfig(), EX + "Req", composition, frozenset())
+    named = name_unavailable(kb, ComposeConfig(), EX + "Req", composition, frozenset(), belief=True)
     assert named.plan is None
     for unmet in named.unsatisfied:
         assert unmet.unrunnable == ((EX + "PutAway", "unavailable: its lease lapsed"),)
@@ -38,5 +38,5 @@ def test_a_component_the_run_avoids_is_not_named_as_unavailable(tmp_path: Path) 
     kb.liveness.renew(EX + "PutAway", 600.0)
     kb.liveness.expire(EX + "PutAway", "its lease lapsed")
     composition = Composer(kb).compose(EX + "Req", belief=True)
-    avoided = _naming_the_unavailable(kb, ComposeConfig(), EX + "Req", composition, frozenset({EX + "PutAway"}))
+    avoided = name_unavailable(kb, ComposeConfig(), EX + "Req", composition, frozenset({EX + "PutAway"}), belief=True)
     assert avoided is composition  # a component the run chose to avoid is its own reason, said elsewhere
