@@ -28,6 +28,7 @@ from cbrs.actions.plan import Binding, Plan, PlanStep, Source
 from cbrs.actions.progression import Clobbered, progress, threatens
 from cbrs.actions.search import SearchTrace
 from cbrs.actions.unmet import GOAL, Unsatisfied
+from cbrs.kb import Statement
 from cbrs.kb.namespaces import shorten
 from cbrs.reasoner.degrees import degree_of_match
 from cbrs.reasoner.taxonomy import TaxonomyIndex
@@ -617,10 +618,15 @@ class Extraction:
                 return plan
             # only what a step deletes is this rule's: the extraction binds every need to what meets it
             undone = [u for u in progress(plan, initial, self.graph.matcher) if u.deleter is not None]
-            if not undone:
-                return plan
             exhausted = achieved_again >= self.max_reachieved
-            if exhausted or not self._achieve_again(undone[0]):
+            if not undone:
+                restated = _restated(plan, index)
+                if restated is None:
+                    return plan
+                if exhausted or not self._delete_again(*restated):
+                    self.unsatisfied.insert(0, self._restated_need(plan, *restated, exhausted))
+                    return None
+            elif exhausted or not self._achieve_again(undone[0]):
                 self.unsatisfied.insert(0, self._undone(plan, undone[0], exhausted))
                 return None
             achieved_again += 1
@@ -665,8 +671,34 @@ class Extraction:
         assert undone.deleter is not None
         by_index = {n: step_id for step_id, n in self._number.items()}
         consumer = self.steps[0 if undone.consumer is None else by_index[undone.consumer]]
-        deleter = by_index[undone.deleter]
-        position, bound = next((n, b) for n, b in enumerate(consumer.bindings) if b.need.statement == undone.statement)
+        position = next(n for n, b in enumerate(consumer.bindings) if b.need.statement == undone.statement)
+        return self._bind_after(consumer, position, by_index[undone.deleter])
+
+    def _delete_again(self, statement: Statement, adder: int) -> bool:
+        """Bind the delete effect the requirement wants of ``statement``, which step ``adder`` (its number in
+        the draft) makes true again after the step it was bound to, to a new step of its best provider
+        ordered after ``adder``: the base driven to the table before it drove to the person no longer
+        leaves the person at the end. False when no provider can."""
+        by_index = {n: step_id for step_id, n in self._number.items()}
+        goal = self.steps[0]
+        position = next(
+            n for n, b in enumerate(goal.bindings) if b.need.role == "deletion" and b.need.statement == statement
+        )
+        return self._bind_after(goal, position, by_index[adder])
+
+    def _restated_need(self, plan: Plan, statement: Statement, adder: int, exhausted: bool) -> Unsatisfied:
+        """The delete effect wanted of ``statement`` as an unmet need: step ``adder`` makes it true again
+        after the step that deleted it, and no new step can delete it after that one."""
+        goal = self.steps[0]
+        need = next(b.need for b in goal.bindings if b.need.role == "deletion" and b.need.statement == statement)
+        why = f"step {adder} ({shorten(plan.step(adder).component)}) makes it true again and no step deletes it after"
+        return Unsatisfied(need.text(), SRE, (*self._path(goal, need), why), cycle=exhausted)
+
+    def _bind_after(self, consumer: _Step, position: int, before: int) -> bool:
+        """Bind ``consumer``'s binding at ``position`` anew, to a new step of its best provider ordered after
+        step ``before`` with the new steps that feed it (:meth:`_achieve_again`, :meth:`_delete_again`)."""
+        deleter = before
+        bound = consumer.bindings[position]
         node = self._goal_node(bound.need) if consumer.id == 0 else consumer.node
         unmet, first_new = len(self.unsatisfied), self._next_id
         del consumer.bindings[position]
@@ -892,6 +924,35 @@ class Extraction:
 
     def _goal_node(self, need: Need) -> str:
         return SRO if need.role == "input" else SRE
+
+
+def _restated(plan: Plan, index: TaxonomyIndex) -> tuple[Statement, int] | None:
+    """The first delete effect the requirement wants that a step after the one it is bound to (or, held
+    by the world, any step) makes true again, with that step's number: an effect of the same relation or
+    one below it, between things as specific as the deleted statement's or more (the base driven to the
+    person, for the base no longer by the person). A more general effect does not say it (the put-down's
+    (PhysicalObject, isLocated, Place) does not put the pen back on the table the pick-up took it off), as a
+    fact holds a goal only when it is at least as specific (docs/composition.md, "A goal that holds already")."""
+    for goal in plan.goals:
+        wanted = goal.statement
+        if goal.role != "deletion" or wanted is None:
+            continue
+        after = goal.source.step or 0
+        for step in plan.steps:
+            if step.index > after and any(_restates(index, effect, wanted) for effect in step.effects):
+                return wanted, step.index
+    return None
+
+
+def _restates(index: TaxonomyIndex, effect: Statement, deleted: Statement) -> bool:
+    return all(
+        index.is_a(mine, theirs)
+        for mine, theirs in (
+            (effect.subject, deleted.subject),
+            (effect.predicate, deleted.predicate),
+            (effect.object, deleted.object),
+        )
+    )
 
 
 def _goal_text(need: Need) -> str:

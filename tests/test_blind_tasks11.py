@@ -1,0 +1,40 @@
+"""The eleventh round of tasks written from the docs alone (docs/examples/lab11_*, docs/tasks.md "An eleventh
+round"): the pen brought and the base sent away from the person in one task (a delete effect a later step
+would undo), and a newcomer's Turtle mistakes in the map. Nothing is simulated here: the tasks are composed
+and the mistakes refused (bench/example_tasks.py runs the trials, docs/tasks.md gives their simulated
+seconds)."""
+
+from __future__ import annotations
+
+import pytest
+
+from cbrs.actions.composer import Composer
+from cbrs.kb import KnowledgeBase, Statement
+from cbrs.kb.namespaces import PREFIXES
+from tests.helpers_examples import EXAMPLES
+
+HOME, SVC = PREFIXES["home"], PREFIXES["svc"]
+AWAY = Statement(HOME + "MobileRobot", HOME + "isNear", HOME + "Person")
+
+
+@pytest.fixture(scope="module")
+def kb() -> KnowledgeBase:
+    kb = KnowledgeBase.open(":memory:")
+    kb.load([EXAMPLES / "lab11_pen_then_leave_me.ttl"], graph="requirements")
+    return kb
+
+
+def test_the_base_leaves_the_person_after_it_delivered(kb: KnowledgeBase) -> None:
+    """The delete effect was credited to the drive to the table that loads the pen, before the drive to the
+    person undid it: the run delivered and ended by the person ("... still holds"). Now a delete effect a
+    later step makes true again is bound to a new step after that one: a drive back to the table."""
+    plan = Composer(kb).compose("PenThenLeaveMe").plan
+    assert plan is not None
+    (goal,) = [g for g in plan.goals if g.role == "deletion"]
+    assert goal.statement == AWAY and goal.source.step is not None
+    leaving = plan.step(goal.source.step)
+    assert leaving.component == SVC + "NavigateToPlace_P3DX01"
+    to_person = [s.index for s in plan.steps if s.component == SVC + "NavigateToPerson_P3DX01"]
+    delivery = [s.index for s in plan.steps if s.component == SVC + "DeliverObject_P3DX01"]
+    assert to_person and delivery and leaving.index > max(to_person + delivery)
+
