@@ -16,7 +16,7 @@ from dataclasses import dataclass, field, replace
 from enum import Enum
 from typing import TYPE_CHECKING
 
-from pyoxigraph import NamedNode
+from pyoxigraph import Literal, NamedNode
 
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import PREFIXES, shorten
@@ -396,8 +396,11 @@ class SemanticMap:
     @classmethod
     def _read(cls, kb: KnowledgeBase, declared: frozenset[str]) -> SemanticMap:
         facts: dict[str, dict[str, list[str]]] = defaultdict(lambda: defaultdict(list))
+        quoted: set[tuple[str, str]] = set()  # (thing, property) given a literal: text where a thing may belong
         for row in kb.select("map_facts"):
             facts[row["thing"].value][row["property"].value].append(row["value"].value)
+            if isinstance(row["value"], Literal):
+                quoted.add((row["thing"].value, row["property"].value))
         types: dict[str, list[str]] = defaultdict(list)
         for row in kb.select("map_types"):
             types[row["thing"].value].append(row["type"].value)
@@ -441,7 +444,7 @@ class SemanticMap:
             for tap in values.get(HOME + "hasTap", []):
                 built.dispensers[iri] = _dispenser(built, iri, tap, facts)
         _check_extents(built, things_of("ObjectPlace"))
-        _check_supports(built)
+        _check_supports(built, quoted)
         _check_heights(built)
         _check_masses(built)
         _check_overlaps(built)
@@ -747,16 +750,27 @@ def _check_extents(built: SemanticMap, places: frozenset[str]) -> None:
         raise NoExtentError(iri, built.types[iri], missing, hint)
 
 
-def _check_supports(built: SemanticMap) -> None:
+def _check_supports(built: SemanticMap, quoted: set[tuple[str, str]] = set()) -> None:  # noqa: B006 (read only)
     """Each object's support (home:isLocatedOn) is a thing of the map with an extent, and the object's
     centre is over it: the simulation stands the object on the support's top, and an unknown support
-    (a misspelt IRI) stood it on the floor, an object beyond its support's edge was moved onto it."""
+    (a misspelt IRI) stood it on the floor, an object beyond its support's edge was moved onto it.
+    ``quoted``: the (thing, property) pairs the map gives a literal, said as such (``home:isLocatedOn
+    "KitchenTable"`` was called a support that is nothing in the map, as a misspelt IRI is)."""
     for iri, obj in sorted(built.objects.items()):
         if obj.support is None:
             continue
         support = built.things.get(obj.support)
         if support is None and obj.support in built.objects:
             raise MapError(iri, _on_an_object(obj.support, built.objects[obj.support], built))
+        if support is None and (iri, HOME + "isLocatedOn") in quoted:
+            named = sorted(t for t in built.things if local_name(t) == obj.support)
+            near = named[0] if named else nearest_term(obj.support, built.things)
+            meant = f" (did you mean {shorten(near)}, {near}?)" if near else ""
+            raise MapError(
+                iri,
+                f'has home:isLocatedOn "{obj.support}", a literal (text in quotes), where the thing it stands on '
+                f"belongs: name that thing by its IRI, without quotes{meant}",
+            )
         if support is None:
             known = obj.support in built.facts or obj.support in built.types
             what = "has no extent (home:minX .. home:maxZ) to stand on" if known else "is nothing in the map"

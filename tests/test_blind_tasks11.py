@@ -6,11 +6,14 @@ seconds)."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import pytest
 
 from cbrs.actions.composer import Composer
 from cbrs.kb import KnowledgeBase, Statement
 from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.semantic_map import MapError
 from tests.helpers_examples import EXAMPLES
 
 HOME, SVC = PREFIXES["home"], PREFIXES["svc"]
@@ -38,3 +41,22 @@ def test_the_base_leaves_the_person_after_it_delivered(kb: KnowledgeBase) -> Non
     delivery = [s.index for s in plan.steps if s.component == SVC + "DeliverObject_P3DX01"]
     assert to_person and delivery and leaving.index > max(to_person + delivery)
 
+
+def test_a_literal_where_the_support_belongs_is_named_a_literal(tmp_path: Path) -> None:
+    """``home:isLocatedOn "KitchenTable"`` was refused as a support "which is nothing in the map", as a
+    misspelt IRI is; it now says a literal was given, and names the thing of that name; nothing loaded."""
+    text = (EXAMPLES / "lab11_two_flasks.ttl").read_text(encoding="utf-8")
+    quoted = text.replace(
+        "home:isLocatedOn world:KitchenTable ; home:x 7.90", 'home:isLocatedOn "KitchenTable" ; home:x 7.90'
+    )
+    assert quoted != text
+    path = tmp_path / "flasks.ttl"
+    path.write_text(quoted, encoding="utf-8")
+    kb = KnowledgeBase.open(":memory:")
+    before = kb.store.count()
+    with pytest.raises(MapError) as refused:
+        kb.load([path], graph="map")
+    said = str(refused.value)
+    assert 'has home:isLocatedOn "KitchenTable", a literal (text in quotes)' in said
+    assert "did you mean world:KitchenTable" in said
+    assert kb.store.count() == before
