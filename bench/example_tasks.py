@@ -12,7 +12,8 @@ runs in order in that store (``cbrs run TASK --seed N --json``; a trial of sever
 one store). A trial whose components are served by a program of the example's own starts, for each seed,
 ``cbrs serve`` on free loopback ports with an update token and the program against its bridge, then
 runs ``cbrs --store URL run TASK --bridge WS``, as the docs do (several programs at once: each started
-once the one before says it is ready); a trial run over HTTP posts the task to the server's
+once the one before says it is ready; a Node program by node from a copy with the modules beside it,
+skipped, saying why, where node or roslib is missing); a trial run over HTTP posts the task to the server's
 ``/tasks.json`` and polls the run's JSON; one run over the bridge calls its ``/cbrs/run_task`` service with
 the token and polls ``/cbrs/task_status``. A trial may send its files to the server (``POST /store``,
 ``POST /update``) instead of loading them before it starts. A library program of the examples runs its
@@ -22,7 +23,10 @@ A posted file the docs say is refused must be answered 4xx saying their phrase, 
 knowledge browser's forms as a browser submits them (form-encoded, with the page's ``Origin``; no
 script): the tasks page's Start form, the run read from its page; a requirement's file written on the New
 task page (checked, saved with the token, or refused there). Two runs at once (``busy``): while a run
-goes, the next one's start must be refused with 409 saying so, and taken once the run has ended.
+goes, the next one's start must be refused with 409 saying so, and taken once the run has ended. The
+Stop button (``stop``): pressed on the run's page after some steps, taken (202), the run cancelled with
+the steps not taken pending, pressed again refused (409). The pages' GET forms (``forms``: search,
+taxonomy, services, plans, matchmaking, the SPARQL page's), each answer's status and words checked.
 The processes are stopped by PID; every wait is bounded. The stores are made once a trial and copied for
 each seed, before anything runs in them. Runs go in parallel processes, up to ``--jobs`` (default: the
 cores). The outcome is read from the run's JSON:
@@ -30,7 +34,8 @@ succeeded, refused (before anything moved: the run's error), no plan, or failed;
 be read is "broken". Prints the machine, the commit, the load checks, one row a run (expected and found
 status and simulated seconds) and the deviations: a status other than the docs', a successful run's
 simulated seconds off by more than the data's tolerance, a refused step accepted or refused otherwise,
-a store changed by a refusal, a second start taken or refused otherwise, a page not as it should be.
+a store changed by a refusal, a second start taken or refused otherwise, a page not as it should be,
+a run without the docs' phrase or steps.
 Exits 1 when there is a deviation. ``--json FILE`` writes the same as a record.
 """
 
