@@ -39,7 +39,7 @@ from cbrs.actions.task_preconditions import PreconditionCheck, check_preconditio
 from cbrs.actions.unavailable import name_unavailable
 from cbrs.kb import Advertisement, KnowledgeBase, NotFoundError, Requirement, Statement
 from cbrs.kb.namespaces import HOME, shorten
-from cbrs.kb.semantic_map import UnresolvedDesignatorError
+from cbrs.kb.semantic_map import AmbiguousDesignatorError, UnresolvedDesignatorError
 from cbrs.kb.store import Term
 from cbrs.reasoner.taxonomy import ROOT, TaxonomyIndex
 
@@ -369,9 +369,11 @@ def run_task(
                     requirement = composition.attempts[0].requirement
                     sense = _sensing(kb, container, environment, composer, sensing, passed)
                     checked = check_preconditions(environment, requirement, seen, composer.index.is_a, sense)
-            except Exception:
+            except Exception as error:
                 if not replans:  # refused before anything moved: the store is left as it was
                     belief.restore(before)
+                if isinstance(error, AmbiguousDesignatorError) and composition.attempts:
+                    raise _undecided(error, composition.attempts[0].requirement, composer.index) from error
                 raise
             store_plan(kb, plan)
             starting = getattr(environment, "starting", None)  # optional: a look-ahead at the plan's values
@@ -780,6 +782,27 @@ def _compose(
 
 
 _WHERE = {HOME + "x", HOME + "minX"}  # what places a thing in the map: a position or an extent
+
+
+def _undecided(
+    error: AmbiguousDesignatorError, requirement: Requirement, index: TaxonomyIndex
+) -> AmbiguousDesignatorError:
+    """``error`` saying which of ``requirement``'s preconditions are about the ambiguous class: a lab wrote
+    one to choose among the things (the full flask of two, by its weight), and a precondition chooses
+    nothing: it is what the requester guarantees of the thing the task names, asked once that thing is found
+    (docs/execution.md, "A task's preconditions"). ``error`` itself where none is."""
+    about = [
+        statement_text(p)
+        for p in requirement.preconditions
+        if p.subject == error.concept or (p.subject in index and index.is_a(error.concept, p.subject))
+    ]
+    if not about:
+        return error
+    which = "; ".join(about)
+    return error.noting(
+        f"the task's precondition {which} does not tell them apart: a precondition is what the requester "
+        "guarantees of the thing the task names, asked once that thing is found, not a choice among things"
+    )
 
 
 def _check_grounded(kb: KnowledgeBase, index: TaxonomyIndex, plan: Plan) -> None:

@@ -125,10 +125,11 @@ class AmbiguousDesignatorError(KnowledgeBaseError):
 
     http_status = 422
 
-    def __init__(self, concept: str, candidates: list[str], stated: bool | None = None) -> None:
+    def __init__(self, concept: str, candidates: list[str], stated: bool | None = None, note: str = "") -> None:
         self.concept = concept
         self.candidates = candidates
         self.stated = stated
+        self.note = note
         names = ", ".join(local_name(c) for c in candidates)
         kind = local_name(concept)
         example = f"{shorten(candidates[0])} a lab:My{kind} . lab:My{kind} rdfs:subClassOf {shorten(concept)}"
@@ -146,7 +147,12 @@ class AmbiguousDesignatorError(KnowledgeBaseError):
                 f"are all {kind}s, none stated to be a {kind} and of no narrower class; name in {task} the "
                 f"narrower class of the one it means, or give the one the task means {own} and name that"
             )
-        super().__init__(f"{kind} is ambiguous: {names} {advice} (docs/tasks.md, Write a task)")
+        said = f"; {note}" if note else ""
+        super().__init__(f"{kind} is ambiguous: {names} {advice}{said} (docs/tasks.md, Write a task)")
+
+    def noting(self, note: str) -> AmbiguousDesignatorError:
+        """The same refusal saying ``note`` too (what the task says of the class that does not tell them apart)."""
+        return AmbiguousDesignatorError(self.concept, self.candidates, self.stated, note)
 
 
 def local_name(iri: str) -> str:

@@ -11,12 +11,13 @@ from pathlib import Path
 import pytest
 
 from cbrs.actions.composer import Composer
+from cbrs.actions.runner import _undecided
 from cbrs.kb import KnowledgeBase, Statement
 from cbrs.kb.namespaces import PREFIXES
-from cbrs.kb.semantic_map import MapError
+from cbrs.kb.semantic_map import AmbiguousDesignatorError, MapError, designate
 from tests.helpers_examples import EXAMPLES
 
-HOME, SVC = PREFIXES["home"], PREFIXES["svc"]
+HOME, SVC, LAB11 = PREFIXES["home"], PREFIXES["svc"], "https://example.org/lab11#"
 AWAY = Statement(HOME + "MobileRobot", HOME + "isNear", HOME + "Person")
 
 
@@ -60,3 +61,30 @@ def test_a_literal_where_the_support_belongs_is_named_a_literal(tmp_path: Path) 
     assert 'has home:isLocatedOn "KitchenTable", a literal (text in quotes)' in said
     assert "did you mean world:KitchenTable" in said
     assert kb.store.count() == before
+
+
+@pytest.fixture(scope="module")
+def flasks() -> KnowledgeBase:
+    """Two flasks of one class, the full one meant by the task's precondition on its weight."""
+    kb = KnowledgeBase.open(":memory:")
+    for graph in ("ontology", "map"):
+        kb.load([EXAMPLES / "lab11_two_flasks.ttl"], graph=graph)
+    kb.load([EXAMPLES / "lab11_fetch_the_full_flask.ttl"], graph="requirements")
+    return kb
+
+
+def test_a_precondition_meant_to_choose_between_two_things_is_said_to_choose_nothing(flasks: KnowledgeBase) -> None:
+    """FetchTheFullFlask was refused as ambiguous, naming both flasks and saying nothing of the precondition
+    the lab wrote to tell them apart (lab11:Full, 0.4 kg and more); the refusal now says a precondition
+    chooses nothing, and a precondition about another class is not named."""
+    composer = Composer(flasks)
+    requirement = composer.task("FetchTheFullFlask").requirement
+    with pytest.raises(AmbiguousDesignatorError) as ambiguous:
+        designate(flasks, LAB11 + "Flask", prefer=requirement.requested_by)
+    said = str(_undecided(ambiguous.value, requirement, composer.index))
+    assert said.startswith("Flask is ambiguous: Flask1, Flask2 are each stated to be a Flask")
+    assert (
+        "the task's precondition (lab11:Flask, home:hasStatus, lab11:Full) does not tell them apart: a precondition"
+        " is what the requester guarantees of the thing the task names" in said.replace(LAB11, "lab11:")
+    )
+    assert "hasMarker" not in said
