@@ -17,8 +17,9 @@ import pyoxigraph as ox
 from cbrs import __version__
 from cbrs.app import App, pass_app
 from cbrs.cli_interrupts import HeldInterrupts
+from cbrs.cli_notes import no_store_at
 from cbrs.kb import KnowledgeBase
-from cbrs.kb.backup import DEFAULT, Backup, NotAnExportError, export_format, read_backup
+from cbrs.kb.backup import DEFAULT, Backup, NotAnExportError, check_declarations, export_format, read_backup
 from cbrs.kb.colour_risk import ColourRisk, colour_risks
 from cbrs.kb.derived_prefixes import StoreNames
 from cbrs.kb.errors import QuerySyntaxError, StoreEvaluationError, without_password
@@ -82,7 +83,7 @@ def export(app: App, file: str, graphs: tuple[str, ...], fmt: str | None, as_jso
     "--force",
     is_flag=True,
     help="Restore a file that is not a whole cbrs export (no manifest, counts that differ, cbrs's own "
-    "graphs missing) as it is.",
+    "graphs missing), or one that holds a class under a home:/cbrs:/act: term it does not declare, as it is.",
 )
 @click.option("--json", "as_json", is_flag=True, help="Print what was restored as JSON.")
 @pass_app
@@ -101,6 +102,8 @@ def restore(
     problems = backup.problems(list(graphs) or None)
     if problems and not force:  # before the store is opened: a new one is not created for nothing
         raise NotAnExportError(backup.source, problems)
+    if not force and not graphs and no_store_at(app.store_location):
+        check_declarations(None, backup)  # before a new store is made there for nothing
     # a whole restore replaces everything: a new store is not seeded first, an old one not upgraded first
     kb = app.open_kb(seed=bool(graphs))
     if problems:

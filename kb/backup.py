@@ -40,6 +40,7 @@ from cbrs.kb.namespaces import BASE, GRAPH, PREFIXES, GraphName, shorten
 from cbrs.kb.resources import ontology_dir
 from cbrs.kb.staged_writes import STAGING, write_staged
 from cbrs.kb.store import BULK_LOADING, EmbeddedStore, Store, data_block
+from cbrs.kb.superclasses import check_change, check_whole
 
 Progress = Callable[[str, int, int], None]
 """Told how an export or restore goes: the stage, items done, of how many (0: not counted; the stage's
@@ -441,6 +442,9 @@ def restore_store(
             f"{backup.source}: the file has triples in the default graph, and a remote store is restored into "
             "named graphs only (restore the named graphs with --graph NAME); nothing was restored"
         )
+    if not force:
+        tell("checking the classes under cbrs's terms", 0, 0)
+        check_declarations(store, backup, graphs)
     tell("counting what the store holds", 0, 0)
     present = wanted if graphs else store_graphs(store)
     # a remote store's own default-graph triples cannot be told apart in an update on a union server: left
@@ -454,6 +458,28 @@ def restore_store(
     restored = {graph: len(backup.quads.get(graph, ())) for graph in wanted}
     skipped = {graph: len(q) for graph, q in backup.quads.items() if graph not in wanted}
     return RestoreReport(backup.source, before, restored, skipped=skipped)
+
+
+def check_declarations(store: Store | None, backup: Backup, graphs: Sequence[str] | None = None) -> None:
+    """Refuse a restore of ``backup`` (only ``graphs``, when given) into ``store`` (None: there is none
+    yet) that would leave a class under a term of cbrs's own vocabularies declared nowhere
+    (:mod:`kb.superclasses`), as a load or an update that left the same store would be refused. A whole
+    restore puts the file in place of the store: the file is checked by itself, since nothing of the store
+    stays. One of some ``graphs`` replaces those alone: it is checked as the change it makes to the store,
+    as a Graph Store ``PUT`` of each is (:func:`kb.superclasses.check_change`). :func:`restore_store` calls
+    it unless forced; a caller may call it first, before it makes a store to restore into."""
+    undone = "nothing was restored (cbrs restore --force takes the file as it is)"
+    said = f"the restore of {backup.source}"
+    if not graphs:
+        check_whole(store, (quad for quads in backup.quads.values() for quad in quads), said, undone)
+        return
+    if store is None:
+        return  # some graphs go into a store seeded first: checked against it, by restore_store
+    wanted = [_iri(graph) for graph in graphs]
+    quads = [quad for graph in wanted for quad in backup.quads.get(graph, ())]
+    given = set(quads)
+    replaced = [quad for graph in wanted for quad in store.quads(graph=_node(graph)) if quad not in given]
+    check_change(store, replaced, quads, said, undone)
 
 
 def _size(store: Store, graph: str) -> int:

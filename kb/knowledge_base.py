@@ -317,7 +317,8 @@ class KnowledgeBase:
         """Load RDF and OWL-S files (or every RDF file of a directory) all-or-nothing; ``progress`` is told
         each stage as it goes (:data:`kb.loader.Progress`). With ``replace`` (graph:map only) the files
         become the semantic map, a lab's own home in place of the bundled one (:meth:`_check_new_home`),
-        with the stored map's robots when the files describe none (:mod:`kb.kept_robots`).
+        with the stored map's robots when the files describe none (:mod:`kb.kept_robots`); it may not take
+        out the last statement about a term of cbrs's own a class stays under (``RemovedDeclarationError``).
 
         OWL-S files are converted into cbrs advertisements, or requirements when ``graph`` is
         ``requirements`` (see :mod:`kb.owls`). With a ``catalogue`` (a :class:`Catalogue`, a folder or
@@ -374,7 +375,9 @@ class KnowledgeBase:
         progress: Progress | None = None,
     ) -> RestoreReport:
         """Replace the store's contents (or only ``graphs``) with an export's, all or nothing
-        (:mod:`kb.backup`); a file that is not a whole cbrs export is refused unless ``force``.
+        (:mod:`kb.backup`); a file that is not a whole cbrs export, or that would leave a class under a term
+        of cbrs's own vocabularies declared nowhere (:func:`kb.backup.check_declarations`), is refused unless
+        ``force``.
         graph:entailed comes from the file, or is worked out afresh when the file does not give all of it."""
         if not isinstance(backup, Backup):
             backup = read_backup(backup, progress=progress)

@@ -48,7 +48,7 @@ from cbrs.kb.namespaces import CBRS, DUL, GENID, OWL, RDF, RDFS, GraphName, shor
 from cbrs.kb.owls import Conversion, Role, Vocabulary, convert, is_owls, owls_key, referenced_ontologies
 from cbrs.kb.shapes import check_loaded
 from cbrs.kb.store import EmbeddedStore, Store
-from cbrs.kb.superclasses import check_superclasses
+from cbrs.kb.superclasses import check_change, check_superclasses
 from cbrs.kb.xml_limits import check_entities
 
 FORMATS_BY_EXTENSION: dict[str, ox.RdfFormat] = {
@@ -292,6 +292,7 @@ def load_files(
         given.extend(quad for item in (*report.files, *report.imports) for quad in item.quads)
         given.extend(ox.Quad(q.subject, q.predicate, q.object, replacing.node) for q in kept)
         old = [quad for quad in store.quads(graph=replacing.node) if quad not in given]
+        _check_replaced_declarations(store, old, new, [item.source for item in report.files], replacing)
         report.removed[replacing.iri] = len(old)
         if kept:
             report.kept[replacing.iri] = len(kept)
@@ -303,6 +304,19 @@ def load_files(
         tell(f"writing {len(new)} triples", 0, 0)
         store.add(new)
     return report
+
+
+def _check_replaced_declarations(
+    store: Store, old: Sequence[ox.Quad], new: Sequence[ox.Quad], sources: Sequence[str], replaced: GraphName
+) -> None:
+    """Refuse a replacing load that leaves a class under a term of cbrs's own vocabularies declared nowhere
+    (:func:`kb.superclasses.check_change`, as a Graph Store ``PUT`` of the graph is checked): a statement
+    about the term held only in the graph it replaces goes (``RemovedDeclarationError``), or the files put
+    a class under a term only that graph declared (``UndeclaredSuperclassError``). The check of each file's
+    classes before (:func:`_prepare`) reads the store as it is, with the old graph in it."""
+    files = ", ".join(sources) or "the files"
+    undone = f"nothing was loaded and graph:{replaced.value} is as it was"
+    check_change(store, old, new, f"the load of {files} replacing graph:{replaced.value}", undone)
 
 
 def prepare_owls(store: Store, raw: bytes, source: str, rdf_format: ox.RdfFormat, base_iri: str) -> LoadReport:

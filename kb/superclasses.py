@@ -18,7 +18,7 @@ import pyoxigraph as ox
 
 from cbrs.kb.errors import KnowledgeBaseError, UndeclaredSuperclassError
 from cbrs.kb.namespaces import OWL, PREFIXES, RDF, RDFS, GraphName
-from cbrs.kb.shapes import did_you_mean, line_of
+from cbrs.kb.shapes import did_you_mean, line_of, nearest_term
 from cbrs.kb.sparql_lexemes import HIDING, closing_brace
 from cbrs.kb.store import Store, Term
 from cbrs.kb.update_delta import DataOperation
@@ -165,6 +165,37 @@ def check_data_update(store: Store, operations: Iterable[DataOperation], undone:
             last[quad] = operation.insert
     removed = {quad for quad, inserted in last.items() if not inserted}
     check_change(store, removed, [quad for quad, inserted in last.items() if inserted], "the update", undone)
+
+
+def check_whole(
+    store: Store | None, quads: Iterable[ox.Quad], source: str, undone: str = "nothing was written"
+) -> None:
+    """Refuse ``quads`` as the whole of ``store`` (a restore that replaces everything) when they hold a
+    class under a term of ours that none of them declares, while they hold the term's vocabulary: read
+    from ``quads`` alone, since none of the store stays. Declared means the subject of a statement in any
+    graph, graph:entailed too, as for an insert: an export of a store these checks kept passes. The store is
+    asked only about a term found so: if it declares it now, the restore removes its last statement
+    (:class:`RemovedDeclarationError`); else (or with no store yet, None) the quads put their class under a
+    term declared nowhere (:class:`UndeclaredSuperclassError`). One pass over ``quads``."""
+    subclass, kind, ontology = ox.NamedNode(_SUBCLASS), ox.NamedNode(RDF + "type"), ox.NamedNode(OWL + "Ontology")
+    declared: set[ox.NamedNode | ox.BlankNode | ox.Triple] = set()
+    headers: set[str] = set()
+    users: dict[ox.NamedNode, str] = {}
+    for quad in quads:
+        declared.add(quad.subject)
+        if quad.predicate == subclass and _ours(quad.object):
+            assert isinstance(quad.object, ox.NamedNode)
+            name = _name(quad.subject)
+            users[quad.object] = min(users.get(quad.object, name), name)  # the same class whatever the order
+        elif quad.predicate == kind and quad.object == ontology and isinstance(quad.subject, ox.NamedNode):
+            headers.add(quad.subject.value)
+    for term in sorted(users, key=str):
+        if term in declared or _namespace(term).rstrip("#") not in headers:
+            continue
+        if store is not None and _declarations(store, term):
+            raise RemovedDeclarationError(source, users[term], term.value, undone)
+        near = nearest_term(term.value, [t.value for t in declared if isinstance(t, ox.NamedNode)])
+        raise UndeclaredSuperclassError(source, users[term], term.value, near, undone)
 
 
 def _declarations(store: Store, term: ox.NamedNode) -> list[ox.Quad]:
