@@ -230,6 +230,7 @@ SETTINGS: tuple[Setting, ...] = (
         lambda: None,
         "Bearer token that SPARQL updates must carry; without one the endpoint is read-only.",
         "CBRS_UPDATE_TOKEN",
+        str.strip,  # $(cat token) keeps a CRLF file's CR, which --update-token-file drops
         secret=True,
     ),
     Setting(

@@ -158,6 +158,7 @@ class RemoteStore(Store):
         if batch is not None:
             self.batch = batch
         headers = {"User-Agent": "cbrs-kb"}
+        token = token.strip() if token else token  # a file read whole keeps its line end, which no header may carry
         if token:  # a cbrs server takes updates with its bearer token; Oxigraph's server ignores it
             headers["Authorization"] = f"Bearer {token}"
         self._token_sent = bool(token)

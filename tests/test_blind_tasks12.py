@@ -7,17 +7,25 @@ the fan's steps call the program over the bridge, and the plans are composed wit
 from __future__ import annotations
 
 import json
+import os
+import subprocess
+import sys
 from collections.abc import Iterator
 
 import pytest
+from websockets.sync.client import connect
 
 from cbrs.actions.base_choice import choose_in_map
 from cbrs.actions.composer import Composer
 from cbrs.kb import KnowledgeBase
+from cbrs.server import ServeConfig, Server
+from cbrs.settings import setting
+from cbrs.sparql_service import EndpointConfig
 from tests.helpers_examples import EXAMPLES
 
 LAB12 = "https://example.org/lab12#"
 SWITCH_ON, SWITCH_OFF = LAB12 + "SwitchOnDeskFan_FanPlug01", LAB12 + "SwitchOffDeskFan_FanPlug01"
+TOKEN = "lab12-test-token"
 
 
 @pytest.fixture(scope="module")
@@ -55,3 +63,76 @@ def test_a_plan_names_the_labs_component_whose_program_is_down(fan_kb: Knowledge
         unmet.text()
     )
     assert json.dumps(gone.to_dict()).count("its lease lapsed") >= 1
+
+
+@pytest.fixture(scope="module")
+def served() -> Iterator[Server]:
+    """A cbrs serve of the desk fan's store (ontology, map, the two tasks), with an update token."""
+    kb = KnowledgeBase.open(":memory:")
+    for graph in ("ontology", "map"):
+        kb.load([EXAMPLES / "lab12_desk_fan.ttl"], graph=graph)
+    for task in ("lab12_switch_on_the_fan.ttl", "lab12_switch_off_the_fan.ttl"):
+        kb.load([EXAMPLES / task], graph="requirements")
+    server = Server(kb, ServeConfig(port=0, bridge_port=0, endpoint=EndpointConfig(update_token=TOKEN, isolate=False)))
+    server.start()
+    yield server
+    server.stop()
+    kb.close()
+
+
+def test_the_websockets_plug_is_called_by_the_servers_run_which_the_run_log_follows(served: Server) -> None:
+    """lab12_fan_switch.py (the protocol by hand) registered and answered the server's own run, which
+    lab12_follow_runs.py started over the bridge and followed on the topics; its publish on /cbrs/task was
+    refused, as the server's topics are; a second copy of the plug was refused, "is its program running
+    twice?"."""
+    bridge = f"ws://127.0.0.1:{served.bridge_port}"
+    env = {**os.environ, "CBRS_UPDATE_TOKEN": TOKEN}
+    plug = [sys.executable, str(EXAMPLES / "lab12_fan_switch.py"), "--bridge", bridge]
+    child = subprocess.Popen(plug, stderr=subprocess.PIPE, text=True, env=env)
+    try:
+        assert child.stderr is not None
+        assert "registered" in child.stderr.readline()
+        twice = subprocess.run(plug, capture_output=True, text=True, env=env, timeout=60)
+        assert twice.returncode == 2 and "is its program running twice?" in twice.stderr
+        follow = [sys.executable, str(EXAMPLES / "lab12_follow_runs.py"), "--bridge", bridge]
+        log = subprocess.run(
+            [*follow, "--start", "SwitchOnTheDeskFan", "--spoof", "--seconds", "120"],
+            capture_output=True,
+            text=True,
+            env=env,
+            timeout=180,
+        )
+    finally:
+        child.kill()  # stopped by its PID
+        child.wait(timeout=10)
+    assert log.returncode == 0, log.stdout + log.stderr
+    assert "topic '/cbrs/task' belongs to this server" in log.stdout
+    assert f"step_succeeded 1 {SWITCH_ON}" in log.stdout
+    assert f"{LAB12}SwitchOnTheDeskFan succeeded" in log.stdout
+
+
+def test_a_token_with_a_line_end_or_a_space_at_its_end_is_the_token() -> None:
+    """The token file written on Windows (CRLF) and handed on as CBRS_UPDATE_TOKEN=$(cat token): the
+    server reads the file's first line without its CR, but the variable kept it, and every request of
+    `cbrs --store URL`, queries too, failed "Illegal header value b'Bearer secret\\r'", printing the token;
+    `cbrs serve` given the variable so took the CR into its token, which no client could then send."""
+    for raw in ("secret\r", "secret\r\n", " secret ", "secret\n"):
+        assert setting("update_token").resolve(environ={"CBRS_UPDATE_TOKEN": raw}) == "secret"
+
+
+def test_a_program_reading_the_token_file_whole_is_served(served: Server) -> None:
+    """KnowledgeBase.open(URL, remote_token=Path(file).read_text()) keeps the file's line end: every request
+    failed "Illegal header value", the token printed in the error; and the bridge's auth op refused the
+    same text as "not this server's update token"."""
+    url = f"http://127.0.0.1:{served.http_port}"
+    kb = KnowledgeBase.open(url, remote_token=TOKEN + "\r\n")
+    try:
+        kb.update("INSERT DATA { GRAPH <https://example.org/lab12/notes> { <urn:lab12:n> <urn:lab12:says> 1 } }")
+        assert kb.query("ASK { GRAPH <https://example.org/lab12/notes> { <urn:lab12:n> ?p ?o } }")
+    finally:
+        kb.close()
+    with connect(f"ws://127.0.0.1:{served.bridge_port}") as ws:
+        ws.send(json.dumps({"op": "set_level", "level": "info"}))
+        ws.send(json.dumps({"op": "auth", "mac": TOKEN + "\n"}))
+        said = json.loads(ws.recv(timeout=10))
+    assert said["level"] == "info" and "authorised" in said["msg"], said

@@ -830,6 +830,7 @@ class Bridge:
 
     def _auth(self, session: Session, message: Message) -> None:
         given = message.get("mac") or message.get("token")
+        given = given.strip() if isinstance(given, str) else given  # a token file read whole keeps its line end
         if self.token is None:
             raise ProtocolError("this server takes no token: it is read-only for every client", "auth")
         if not given or not hmac.compare_digest(str(given).encode("utf-8"), self.token.encode("utf-8")):
