@@ -186,7 +186,9 @@ def _read_token(path: Path | None) -> str | None:
         raise click.BadParameter(f"cannot read {path}: {error}", param_hint="--update-token-file") from None
     token = lines[0].strip() if lines else ""
     if not token:
-        raise click.BadParameter(f"{path} is empty: its first line must be the token", param_hint="--update-token-file")
+        later = next((n for n, line in enumerate(lines[1:], start=2) if line.strip()), None)
+        said = f"{path}: its first line is blank, and line {later} is not" if later else f"{path} is empty"
+        raise click.BadParameter(f"{said}: the token must be on the first line", param_hint="--update-token-file")
     return token
 
 

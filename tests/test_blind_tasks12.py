@@ -11,12 +11,15 @@ import os
 import subprocess
 import sys
 from collections.abc import Iterator
+from pathlib import Path
 
 import pytest
+from click.testing import CliRunner
 from websockets.sync.client import connect
 
 from cbrs.actions.base_choice import choose_in_map
 from cbrs.actions.composer import Composer
+from cbrs.cli import cli
 from cbrs.kb import KnowledgeBase
 from cbrs.server import ServeConfig, Server
 from cbrs.settings import setting
@@ -136,3 +139,14 @@ def test_a_program_reading_the_token_file_whole_is_served(served: Server) -> Non
         ws.send(json.dumps({"op": "auth", "mac": TOKEN + "\n"}))
         said = json.loads(ws.recv(timeout=10))
     assert said["level"] == "info" and "authorised" in said["msg"], said
+
+
+def test_a_token_file_whose_first_line_is_blank_is_said_so(tmp_path: Path) -> None:
+    """The administrator's token file began with a blank line, the token on the second: `cbrs serve
+    --update-token-file` said the file "is empty"."""
+    token = tmp_path / "token"
+    token.write_text("\nsecret\n", encoding="utf-8")
+    refused = CliRunner().invoke(cli, ["--store", ":memory:", "serve", "--update-token-file", str(token)])
+    assert refused.exit_code == 2
+    assert "is empty" not in refused.output
+    assert "its first line is blank, and line 2 is not: the token must be on the first line" in refused.output
