@@ -122,9 +122,7 @@ class PreconditionSensing:
         bound = condition.text(units)
         sensors = self.sensors(condition.quantity, statement.subject)
         if not sensors:
-            return Sensed(
-                None, f"no sensor of {shorten(condition.quantity)} covers {shorten(statement.subject)}", bound
-            )
+            return Sensed(None, self._none_covers(condition.quantity, statement.subject), bound)
         failures = []
         for ad, output in sensors:
             device = ad.device_name or local_name(ad.iri)
@@ -140,6 +138,19 @@ class PreconditionSensing:
                 said += f" ({converted:g} {units.symbol(condition.unit)})"
             return Sensed(condition.holds(converted), f"{said} by {device}", bound, ad.iri, said, device)
         return Sensed(None, "; ".join(failures), bound)
+
+    def _none_covers(self, quantity: str, subject: str) -> str:
+        """Why no sensor reads ``quantity`` for a precondition about ``subject``: none covers it, or it is no
+        place (a flask's weight: a sensor's effective area covers places, and one that reads a thing, as a
+        scale does, takes it as an input, which sensing gives none)."""
+        said = f"no sensor of {shorten(quantity)} covers {shorten(subject)}"
+        place = PREFIXES["home"] + "Place"
+        if any(self._is_a(concept, place) for concept in self._places(subject)):
+            return said
+        return (
+            f"{said}: {shorten(subject)} is no place, and a sensor reads a measured state of the place its "
+            "effective area covers, not of a thing"
+        )
 
     def units(self) -> Units:
         if self._units is None:

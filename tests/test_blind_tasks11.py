@@ -7,10 +7,13 @@ seconds)."""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import cast
 
 import pytest
 
+from cbrs.actions.components import Container
 from cbrs.actions.composer import Composer
+from cbrs.actions.precondition_sensing import PreconditionSensing
 from cbrs.actions.runner import _undecided
 from cbrs.kb import KnowledgeBase, Statement
 from cbrs.kb.namespaces import PREFIXES
@@ -88,3 +91,19 @@ def test_a_precondition_meant_to_choose_between_two_things_is_said_to_choose_not
         " is what the requester guarantees of the thing the task names" in said.replace(LAB11, "lab11:")
     )
     assert "hasMarker" not in said
+
+
+def test_a_measured_state_of_a_thing_is_said_to_be_read_of_places_only(flasks: KnowledgeBase) -> None:
+    """lab11:Full holds of an object weight of 0.4 kg and more; a precondition that a flask is full was taken
+    as given "(no sensor of home:ObjectWeight covers lab11:Flask)", as if one might: a sensor's effective
+    area covers places, and the flask is none. A room's is said as before."""
+    composer = Composer(flasks)
+    sensing = PreconditionSensing(flasks, cast(Container, None), (), composer.index, 1.0, advertisements=())
+    full = sensing(Statement(LAB11 + "Flask", HOME + "hasStatus", LAB11 + "Full"))
+    assert full is not None and full.holds is None
+    assert full.how.replace(LAB11, "lab11:") == (
+        "no sensor of home:ObjectWeight covers lab11:Flask: lab11:Flask is no place, and a sensor reads a measured"
+        " state of the place its effective area covers, not of a thing"
+    )
+    room = sensing(Statement(HOME + "Kitchen", HOME + "hasStatus", LAB11 + "Full"))
+    assert room is not None and room.how == "no sensor of home:ObjectWeight covers home:Kitchen"
