@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import importlib.util
 import re
+import shutil
 import sys
 import tomllib
 from pathlib import Path
@@ -62,12 +63,12 @@ def _with_a_task() -> set[str]:
     return found
 
 
-def test_the_data_parses_into_trials_with_runs_or_refusals(bench: ModuleType) -> None:
+def test_the_data_parses_into_trials_with_runs_forms_or_refusals(bench: ModuleType) -> None:
     tolerance, trials = bench.read_trials(DATA)
     assert tolerance > 0
     assert trials
     for trial in trials:
-        assert trial.runs or any(step.expect_refusal for step in trial.setup), trial.label
+        assert trial.runs or trial.forms or any(step.expect_refusal for step in trial.setup), trial.label
 
 
 def test_every_file_named_exists_under_docs_examples(named: set[str]) -> None:
@@ -127,6 +128,9 @@ def test_the_forms_beyond_the_command_line_each_have_a_trial(bench: ModuleType) 
     assert any(t.post and any(s.expect_refusal for s in t.setup) for t in trials if t.via == "http")
     assert any(t.via == "page" and t.post and any(s.verb == "requirements" for s in t.setup) for t in trials)
     assert any(t.via == "page" and any(s.expect_refusal and s.verb == "requirements" for s in t.setup) for t in trials)
+    assert any(serve.program.endswith(".mjs") for t in trials for serve in t.serve)  # a Node program
+    assert any(t.stop is not None for t in trials) and any(t.forms for t in trials)
+    assert any(run.says for t in trials for run in t.runs) and any(run.steps for t in trials for run in t.runs)
 
 
 @pytest.mark.parametrize(
@@ -154,6 +158,12 @@ def test_the_forms_beyond_the_command_line_each_have_a_trial(bench: ModuleType) 
             id="posted-replace",
         ),
         pytest.param('busy = "one task runs at a time"\nvia = "http"', "two runs or more", id="busy-one-run"),
+        pytest.param('stop = { after = 1, says = "a", again = "b" }\nvia = "http"', "(via page)", id="stop-by-http"),
+        pytest.param(
+            'stop = { after = 1, says = "a", again = "b" }\nvia = "page"', "ends cancelled", id="stop-succeeded"
+        ),
+        pytest.param('via = "page"\nforms = [{ form = "q" }]', "the first form's page", id="form-without-page"),
+        pytest.param("steps = [1, 2]", "steps, one number a seed", id="steps-per-seed"),
         pytest.param(
             'busy = "one task runs at a time"\nvia = "run_task"\nruns = [{ task = "A", status = ["succeeded"], '
             'seconds = [0] }, { task = "B", status = ["succeeded"], seconds = [0] }]',
@@ -185,3 +195,47 @@ def test_a_run_s_json_from_the_server_or_a_library_program_is_read_as_cbrs_run_s
     assert bench._outcome(trial, 0, 0, 0, ended, 1.0).status == "refused"
     served = bench._ended({"status": "no-plan", "result": {"sim_seconds": 0.0, "plan": {"reason": "none"}}})
     assert bench._outcome(trial, 0, 0, 0, served, 1.0).status == "no plan"
+
+
+def test_a_node_program_runs_from_a_copy_beside_its_modules(bench: ModuleType, tmp_path: Path) -> None:
+    """A Node program is started by node from a copy with node_modules and the example files beside it
+    (an ES module finds its imports there, not by NODE_PATH), its bridge's URL where its args say; a
+    Python program takes --bridge first. Without roslib the trial is skipped, saying where it looked."""
+    modules = tmp_path / "modules"
+    (modules / "roslib").mkdir(parents=True)
+    node = bench.Serve("lab10_lamp_switch.mjs", ("{bridge}", "--answer", "text"))
+    if shutil.which("node") is None:
+        with pytest.raises(bench.Skip, match="node is not installed"):
+            node.argv("ws://127.0.0.1:9", tmp_path / "copy", modules)
+    else:
+        argv = node.argv("ws://127.0.0.1:9", tmp_path / "copy", modules)
+        assert argv[1:] == [str(tmp_path / "copy" / "lab10_lamp_switch.mjs"), "ws://127.0.0.1:9", "--answer", "text"]
+        assert (tmp_path / "copy" / "node_modules").resolve() == modules.resolve()
+        assert (tmp_path / "copy" / "lab10_lamp_switch.ttl").resolve() == EXAMPLES / "lab10_lamp_switch.ttl"
+        assert not (tmp_path / "copy" / "lab10_lamp_switch.mjs").is_symlink()  # a copy: its imports resolve here
+    python = bench.Serve("lab6_kettle.py", ("--seconds", "5")).argv("ws://127.0.0.1:9", tmp_path / "py", modules)
+    assert python[1:] == [str(EXAMPLES / "lab6_kettle.py"), "--bridge", "ws://127.0.0.1:9", "--seconds", "5"]
+    run = bench.Run("SwitchOnTheReadingLamp", ["succeeded"], [0.3])
+    trial = bench.Trial("lamp", "", [], [0], [run], via="bridge", serve=(node,))
+    why = bench.skip_reason(trial, tmp_path / "nowhere")
+    assert ("roslib is not in" in why and "nowhere" in why) or "node is not installed" in why
+    assert bench.skip_reason(trial, modules) in (
+        "",
+        "node is not installed (the program runs on node >= 20 with roslib)",
+    )
+    (skipped,) = bench.skipped(trial, 0, why)
+    assert skipped.status == bench.SKIPPED and skipped.reason == why and bench.deviation(skipped, 0.2) == ""
+
+
+def test_a_runs_phrase_and_steps_are_read_from_its_json_and_compared(bench: ModuleType) -> None:
+    """A run the docs quote must say their phrase, and take the steps they count, else a deviation."""
+    run = bench.Run("T", ["failed", "failed"], [0.0, 0.0], says="did not answer within 10 s", steps=[1, 2])
+    trial = bench.Trial("x", "", [], [0, 1], [run], via="bridge")
+    steps = [{"outcome": "failed", "reason": "/plug did not answer within 10 s"}]
+    found = {"status": "failed", "execution": {"steps": steps}, "reason": "step 1 failed"}
+    first = bench._outcome(trial, 0, 0, 0, found, 1.0)
+    assert (first.said, first.steps, first.expected_steps) == (True, 1, 1) and bench.deviation(first, 0.2) == ""
+    second = bench._outcome(trial, 0, 1, 1, found, 1.0)
+    assert bench.deviation(second, 0.2) == "1 steps, the docs say 2"
+    quiet = bench._outcome(trial, 0, 0, 0, {"status": "failed", "execution": {"steps": []}}, 1.0)
+    assert bench.deviation(quiet, 0.2) == "failed without 'did not answer within 10 s', which the docs say"

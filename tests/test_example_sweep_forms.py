@@ -7,6 +7,7 @@ whatever the server said would fail here."""
 from __future__ import annotations
 
 import threading
+import time
 from collections.abc import Iterator
 from pathlib import Path
 from types import ModuleType
@@ -27,15 +28,28 @@ BUSY = "one task runs at a time"
 
 
 class _Held(TaskRunner):
-    """A runner whose runs go until ``release`` is set (bounded), then succeed in 12.5 simulated seconds."""
+    """A runner whose runs go until ``release`` is set (bounded), then succeed in 12.5 simulated seconds;
+    one asked to stop first ends cancelled after its first of three steps, the others pending."""
 
     release = threading.Event()
 
     def _run(self, run: TaskRun) -> None:
-        self.release.wait(30)
-        run.result = {"plan": {"status": "planned"}, "execution": {"status": "succeeded", "steps": []}}
-        run.result["sim_seconds"] = 12.5
-        run.status = "succeeded"
+        deadline = time.monotonic() + 30
+        while not (self.release.is_set() or run.cancel_requested.is_set()) and time.monotonic() < deadline:
+            self.release.wait(0.05)
+        if run.cancel_requested.is_set():
+            steps = [
+                {"index": n, "attempts": [], "seconds": 0.0, "effects": [], "outcome": outcome}
+                for n, outcome in enumerate(("succeeded", "pending", "pending"), 1)
+            ]
+            execution = {"status": "cancelled", "reason": "cancelled on request after 1 of 3 steps", "steps": steps}
+            run.result = {"plan": {"status": "planned"}, "execution": execution, "sim_seconds": 4.0}
+            run.status = "cancelled"
+        else:
+            run.result = {"plan": {"status": "planned"}, "execution": {"status": "succeeded", "steps": []}}
+            run.result["sim_seconds"] = 12.5
+            run.status = "succeeded"
+        run.finished = time.time()
         run.done.set()
 
 
@@ -161,3 +175,53 @@ def test_a_form_is_read_as_a_browser_submits_it(bench: ModuleType) -> None:
     assert form.chosen("s") == ["a"]
     with pytest.raises(bench._NotStarted, match="offers no 'z'"):
         form.choose("s", "z")
+
+
+def test_the_stop_button_stops_a_run_and_is_refused_once_it_has_ended(bench: ModuleType, served: str) -> None:
+    """The run's page shows Stop this run while the run goes; pressed, 202, the run cancelled with the steps
+    not taken pending; pressed again, 409 and the run as it was. A phrase the pages do not say is a miss."""
+    browser = bench._Browser(served)
+    _Held.release.clear()
+    stop = bench.StopAt(0, "asked to stop after the step under way", "has already ended: cancelled")
+    said, miss, found = bench.stop_run(browser, bench._page_start(browser, "FetchMyPen", 3), stop, TOKEN)
+    assert miss == "" and ": 202, cancelled after 1 of 3 steps; again 409" in said
+    assert found["status"] == "cancelled" and found["steps"] == 1 and "cancelled on request" in found["reason"]
+    wrong = bench.StopAt(0, "stopped at once", "has already ended: cancelled")
+    _, miss, _ = bench.stop_run(browser, bench._page_start(browser, "FetchMyPen", 3), wrong, TOKEN)
+    assert "the docs say 202 saying 'stopped at once'" in miss
+    _Held.release.set()
+    begun = bench._page_start(browser, "FetchMyPen", 3)
+    bench._page_follow(browser, begun)
+    _, miss, found = bench.stop_run(browser, begun, stop, TOKEN)  # ended before the button could be pressed
+    assert found["status"] == "succeeded" and "the run was succeeded before 0 steps ended" in miss
+
+
+def test_the_pages_get_forms_are_submitted_and_their_answers_read(bench: ModuleType, served: str) -> None:
+    """A form found by its id or its field's, typed into or chosen from, sent as a GET; the answer's status
+    and words compared, each miss said; the next form on the page the one before answered."""
+    forms = (
+        bench.PageForm("site-search", "/", (("q", "FetchMyPen"),), says=("req:FetchMyPen",)),
+        bench.PageForm("q", fill=(("q", "x" * 201),), status=400, says=("at most 200 characters",)),
+        bench.PageForm("task", "/plans", choose=(("task", "req:FetchMyPen"),), says=("no such words",)),
+        bench.PageForm("kind", "/services", lacks=("req:FetchMyPen",)),
+        bench.PageForm("no-such-form", "/"),
+        bench.PageForm("task", "/plans", choose=(("task", "req:FetchMyPne"),)),
+    )
+    (search, long, plans, services, missing, unoffered) = bench.form_checks(bench._Browser(served), forms)
+    assert search[1] == "" and search[0].startswith("/: the form 'site-search' (q=FetchMyPen): 200")
+    assert long[1] == "" and long[0].startswith("/search?q=FetchMyPen: the form 'q'") and "xxx...): 400" in long[0]
+    assert plans[1].endswith(": without 'no such words'")
+    assert "with 'req:FetchMyPen'" in services[1]  # the services page lists the requirements too
+    assert "has no form 'no-such-form'" in missing[1] and "offers no 'req:FetchMyPne'" in unoffered[1]
+
+
+def test_a_form_is_found_by_the_id_of_a_field_in_it_and_a_hidden_one_is_known(bench: ModuleType) -> None:
+    page = (
+        '<form method="get" action="/a"><input id="first" name="q"></form>'
+        '<form method="get" action="/b"><select id="second" name="k"><option value="1">1</option></select></form>'
+        '<form id="cancel" method="post" action="/c" hidden><button type="submit">Stop</button></form>'
+    )
+    assert bench.find_form(page, "second").action == "/b" and bench.find_form(page, "first").fields == [["q", ""]]
+    assert bench.find_form(page, "cancel").hidden and not bench.find_form(page, "first").hidden
+    with pytest.raises(RuntimeError, match="it has \\['cancel', 'first', 'second'\\]"):
+        bench.find_form(page, "third")
