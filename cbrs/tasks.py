@@ -353,10 +353,25 @@ class TaskRunner:
             return list(self._runs.values())
 
     def close(self, timeout: float = 30.0) -> None:
-        """Wait (bounded) for a run still going; it cannot be interrupted mid-step."""
+        """Wait (bounded) for a run still going; it cannot be interrupted mid-step. The log says which run
+        was waited for and how it ended, or that it did not, for the administrator who stopped the server:
+        the bridge and HTTP listeners are closed by then, so no client hears the run's verdict."""
         active = self._active
-        if active is not None:
-            active[1].join(timeout)
+        if active is None or not active[1].is_alive():
+            return
+        run, thread = active
+        log.warning("task run %s (%s) is still going: waiting up to %g s for it to end", run.id, run.task, timeout)
+        thread.join(timeout)
+        if thread.is_alive():
+            log.warning(
+                "task run %s (%s) did not end within %g s: it stops with the server, mid-step; the plan and the "
+                "world graph hold what it wrote before (each write one transaction)",
+                run.id,
+                run.task,
+                timeout,
+            )
+        else:
+            log.warning("task run %s (%s) ended: %s", run.id, run.task, run.status)
 
     def _run(self, run: TaskRun) -> None:
         # the run's texts (its answers, goals, reasons) name the store's own namespaces by the prefixes

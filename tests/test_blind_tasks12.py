@@ -7,9 +7,11 @@ the fan's steps call the program over the bridge, and the plans are composed wit
 from __future__ import annotations
 
 import json
+import logging
 import os
 import subprocess
 import sys
+import threading
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -24,6 +26,7 @@ from cbrs.kb import KnowledgeBase
 from cbrs.server import ServeConfig, Server
 from cbrs.settings import setting
 from cbrs.sparql_service import EndpointConfig
+from cbrs.tasks import TaskRun, TaskRunner
 from tests.helpers_examples import EXAMPLES
 
 LAB12 = "https://example.org/lab12#"
@@ -150,3 +153,30 @@ def test_a_token_file_whose_first_line_is_blank_is_said_so(tmp_path: Path) -> No
     assert refused.exit_code == 2
     assert "is empty" not in refused.output
     assert "its first line is blank, and line 2 is not: the token must be on the first line" in refused.output
+
+
+def test_a_server_stopped_during_a_run_says_how_the_run_ended(caplog: pytest.LogCaptureFixture) -> None:
+    """`cbrs serve` stopped with SIGTERM while FetchMyPen ran (step 5 of 16) printed "stopped" and exited 0
+    after 5 s: the run had ended meanwhile (its world graph written), but neither the log nor any client
+    said so, since the listeners close first; a run that outlives the wait stopped mid-step unsaid."""
+    kb = KnowledgeBase.open(":memory:")
+    runner = TaskRunner(kb, threading.RLock(), camera=None)
+    for seconds, said in ((0.2, "task run run-7 (FetchMyPen) ended: succeeded"), (5.0, "did not end within 0.5 s")):
+        run = TaskRun("run-7", "FetchMyPen", 0, ())
+        done = threading.Event()
+
+        def work(run: TaskRun = run, seconds: float = seconds, done: threading.Event = done) -> None:
+            if not done.wait(seconds):
+                run.status = "succeeded"
+
+        thread = threading.Thread(target=work, daemon=True)
+        thread.start()
+        runner._active = (run, thread)
+        caplog.clear()
+        with caplog.at_level(logging.INFO, logger="cbrs.tasks"):
+            runner.close(timeout=0.5)
+        done.set()
+        thread.join(timeout=5)
+        assert "task run run-7 (FetchMyPen) is still going: waiting up to 0.5 s for it to end" in caplog.text
+        assert said in caplog.text
+    kb.close()
