@@ -321,7 +321,27 @@ class PlanChecks:
                 who_loads(self.context, estimate, model, dock)
             except (SkillFailed, MovesRefusedError) as refused:
                 if not self._loads_nearby(estimate, model, dock):
-                    raise CannotLoadError(step.component, obj.iri, str(refused)) from None
+                    advice = self._other_approach(estimate, model, dock)
+                    raise CannotLoadError(step.component, obj.iri, str(refused) + advice) from None
+
+    def _other_approach(self, estimate: ObjectEstimate, model: ObjectModel, dock: Pose2D) -> str:
+        """What would load an object no arm loads by the approaches its class allows: an approach it does
+        not allow by which one would (the eleventh round's coaster, "side" alone, loaded from the top), said
+        as the class's home:graspApproach that adds it; empty when none would."""
+        allowed = model.preference
+        for kind in GraspKind:
+            if kind in allowed:
+                continue
+            try:
+                who_loads(self.context, estimate, replace(model, grasp=kind, approaches=()), dock)
+            except (SkillFailed, MovesRefusedError):
+                continue
+            approaches = " ".join(k.value for k in (*allowed, kind))
+            return (
+                f"; allowed its {kind.value} grasp too, an arm would load it: give its class home:graspApproach "
+                f'"{approaches}" (the approaches it may be taken by, best first)'
+            )
+        return ""
 
     def _check_carry(self, plan: Plan, values: Mapping[str, Any]) -> None:
         """Refuse a plan whose arm would take an object the task gives to carry it where the object held

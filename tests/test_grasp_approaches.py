@@ -127,7 +127,11 @@ def test_a_cup_allowed_only_its_side_grasp_is_still_refused_before_anything_move
     assert refused.value.thing == WORLD + "Cup"
     assert "only the left arm reaches the Cup and only the right arm the platform" in str(refused.value)
     assert "cannot hold the Cup by its side grasp over the platform" in str(refused.value)
-    assert "top" not in str(refused.value)
+    assert "by its top grasp" not in str(refused.value)  # no arm asked to take it so
+    assert str(refused.value).endswith(  # the approach that would serve, as advice (the eleventh round's coaster)
+        'allowed its top grasp too, an arm would load it: give its class home:graspApproach "side top" (the '
+        "approaches it may be taken by, best first)"
+    )
     assert set(kb.store.quads()) == before
 
 
