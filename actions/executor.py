@@ -53,7 +53,7 @@ class StepDone(Protocol):
 class Uncounted(Protocol):
     """A component that wants to know when the executor did not count an invocation it ended as succeeded
     (an effect not reached, the environment's bookkeeping failed): a remote actuator then treats what it
-    may have done as unknown (``sim.components._Acting``; docs/execution.md, "The belief after a failed
+    may have done as unknown (``actions.remote.RemoteComponent``; docs/execution.md, "The belief after a failed
     step")."""
 
     def uncounted(self, reason: str) -> None: ...
