@@ -1450,7 +1450,7 @@ def _action_run(ws: str, task: str, seed: int, token: str) -> dict[str, Any]:
     (bounded): the run as the result's values give it, its feedback counted (one a plan step that ended)."""
     from websockets.sync.client import connect
 
-    goal = {"op": "send_action_goal", "id": "sweep-goal", "action": "/cbrs/run_task"}
+    goal: dict[str, Any] = {"op": "send_action_goal", "id": "sweep-goal", "action": "/cbrs/run_task"}
     goal |= {"action_type": "cbrs/action/RunTask", "args": {"task": task, "seed": seed}, "feedback": True}
     deadline = time.monotonic() + RUN_TIMEOUT
     feedback = 0
