@@ -160,8 +160,11 @@ class Serve:
                 (where / path.name).symlink_to(path)
         if not (where / "node_modules").exists():
             (where / "node_modules").symlink_to(node_modules.resolve())
-        shutil.copy(EXAMPLES / self.program, where / self.program)
-        return [node, str(where / self.program), *args]
+        copy = where / self.program
+        if copy.is_symlink():  # linked for a Node program before it in the same trial
+            copy.unlink()
+        shutil.copy(EXAMPLES / self.program, copy)
+        return [node, str(copy), *args]
 
 
 class Skip(Exception):

@@ -213,6 +213,11 @@ def test_a_node_program_runs_from_a_copy_beside_its_modules(bench: ModuleType, t
         assert (tmp_path / "copy" / "node_modules").resolve() == modules.resolve()
         assert (tmp_path / "copy" / "lab10_lamp_switch.ttl").resolve() == EXAMPLES / "lab10_lamp_switch.ttl"
         assert not (tmp_path / "copy" / "lab10_lamp_switch.mjs").is_symlink()  # a copy: its imports resolve here
+        other = bench.Serve("lab10_lamp_switch.mjs").argv("ws://127.0.0.1:9", tmp_path / "two", modules)
+        (tmp_path / "two" / "lab10_lamp_switch.mjs").unlink()
+        (tmp_path / "two" / "lab10_lamp_switch.mjs").symlink_to(EXAMPLES / "lab10_lamp_switch.mjs")
+        assert bench.Serve("lab10_lamp_switch.mjs").argv("ws://127.0.0.1:9", tmp_path / "two", modules) == other
+        assert not (tmp_path / "two" / "lab10_lamp_switch.mjs").is_symlink()  # a second program's link replaced
     python = bench.Serve("lab6_kettle.py", ("--seconds", "5")).argv("ws://127.0.0.1:9", tmp_path / "py", modules)
     assert python[1:] == [str(EXAMPLES / "lab6_kettle.py"), "--bridge", "ws://127.0.0.1:9", "--seconds", "5"]
     run = bench.Run("SwitchOnTheReadingLamp", ["succeeded"], [0.3])
