@@ -246,6 +246,7 @@ def load(app: App, files: tuple[Path, ...], graph: str | None, catalogs: tuple[P
     for line in _added_summary(report):
         click.echo(line)
     _warn_colours(app.kb, report)
+    _warn_undeclared_classes(app.kb, report)
     for graph, count in report.removed.items():
         click.echo(f"replaced {shorten(graph)}: took out {_plural(count, 'triple')} the files do not give")
     for graph, count in report.kept.items():
@@ -261,6 +262,46 @@ def _warn_colours(kb: Any, report: LoadReport) -> None:
 
     for risk in written_colour_risks(kb, (quad for item in report.files for quad in item.quads)):
         click.echo(f"warning: {risk.text()}", err=True)
+
+
+_BUILT_IN = tuple(PREFIXES[name] for name in ("owl", "rdf", "rdfs", "xsd"))
+"""The vocabularies whose classes a file may state things to be of without declaring them."""
+
+
+def _warn_undeclared_classes(kb: Any, report: LoadReport) -> None:
+    """Say on standard error which things a load into the map states to be of a class that nothing in the
+    store declares (the subject of no statement in any graph), with the declared class of its namespace it
+    reads as a slip of: ``lab11:Flask2 a lab11:Flsk`` loaded without a word, and a task naming lab11:Flask
+    found the other flask, or none. Loaded all the same: a lab's class may come in a later file. Other graphs
+    are left alone (an OWL-S collection's services are of classes of ontologies it does not load)."""
+    from cbrs.kb.shapes import did_you_mean
+
+    said: set[str] = set()
+    for item in report.files:
+        if item.graph != GraphName.MAP.iri:
+            continue
+        for quad in item.quads:
+            concept = quad.object
+            if quad.predicate.value != RDF + "type" or not isinstance(concept, ox.NamedNode):
+                continue
+            if concept.value in said or concept.value.startswith(_BUILT_IN):
+                continue
+            said.add(concept.value)
+            if next(iter(kb.store.quads(concept, None, None, None)), None) is not None:
+                continue
+            near = did_you_mean(kb.store, concept.value)
+            meant = f" (did you mean {_local(near)}, {near}?)" if near else ""
+            thing = quad.subject.value
+            click.echo(
+                f"warning: {_local(thing)} ({thing}) is stated a {_local(concept.value)} ({concept.value}), a class "
+                f"nothing in the store declares{meant}: a task finds a thing by a class it is stated to be of, or "
+                "one below it; declare the class (in the ontology graph) or correct its name",
+                err=True,
+            )
+
+
+def _local(iri: str) -> str:
+    return iri.rsplit("#", 1)[-1].rsplit("/", 1)[-1]
 
 
 _UNDECLARED = re.compile(r"The prefix ([\w.-]*): has not been declared")

@@ -10,11 +10,13 @@ from pathlib import Path
 from typing import cast
 
 import pytest
+from click.testing import CliRunner
 
 from cbrs.actions.components import Container
 from cbrs.actions.composer import Composer
 from cbrs.actions.precondition_sensing import PreconditionSensing
 from cbrs.actions.runner import _undecided
+from cbrs.cli import cli
 from cbrs.kb import KnowledgeBase, Statement
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import AmbiguousDesignatorError, MapError, designate
@@ -107,3 +109,22 @@ def test_a_measured_state_of_a_thing_is_said_to_be_read_of_places_only(flasks: K
     )
     room = sensing(Statement(HOME + "Kitchen", HOME + "hasStatus", LAB11 + "Full"))
     assert room is not None and room.how == "no sensor of home:ObjectWeight covers home:Kitchen"
+
+
+def test_a_thing_of_a_misspelt_class_is_warned_of_at_the_load(tmp_path: Path) -> None:
+    """``lab11:Flask2 a lab11:Flsk`` loaded into the map without a word, and FetchTheFullFlask then meant the
+    other flask alone; the load now warns, naming the class and the declared one it reads as a slip of. A
+    thing of a declared class, or of a built-in one (owl:NamedIndividual), is not named."""
+    text = (EXAMPLES / "lab11_two_flasks.ttl").read_text(encoding="utf-8")
+    misspelt = text.replace("lab11:Flask2 a lab11:Flask ,", "lab11:Flask2 a lab11:Flsk ,")
+    assert misspelt != text
+    path = tmp_path / "flasks.ttl"
+    path.write_text(misspelt, encoding="utf-8")
+    result = CliRunner().invoke(cli, ["--store", ":memory:", "load", "--graph", "map", str(path)])
+    assert result.exit_code == 0, result.output
+    warnings = [line for line in result.stderr.splitlines() if line.startswith("warning: ")]
+    assert warnings == [
+        f"warning: Flask2 ({LAB11}Flask2) is stated a Flsk ({LAB11}Flsk), a class nothing in the store declares"
+        f" (did you mean Flask, {LAB11}Flask?): a task finds a thing by a class it is stated to be of, or one"
+        " below it; declare the class (in the ontology graph) or correct its name"
+    ]
