@@ -49,6 +49,7 @@ from cbrs.actions.graph import (
     statement_text,
 )
 from cbrs.actions.model import ActionLibrary, Task, resolve_task
+from cbrs.actions.named_things import Designations, NamedThings, WorldFact
 from cbrs.actions.near_misses import NearMiss, near_misses
 from cbrs.actions.plan import Binding, Plan, PlanStep, Source
 from cbrs.actions.progression import Clobbered, consumed_goals, progress_parts
@@ -197,6 +198,10 @@ class Composer:
         self._pool: ServicePool | None = None
         self._belief = False
         self._state: list[Statement] | None = None  # what holds, read once per compose
+        self._facts: list[tuple[WorldFact, str]] | None = None  # ... between which things, in which graph
+        self._lifted: dict[Statement, list[WorldFact]] = {}  # each statement held: the facts lifted to it
+        self._designations: Designations | None = None  # the things inputs name, read once per compose (if needed)
+        self._named: dict[tuple[tuple[str, ...], str | None], NamedThings] = {}  # by input classes and requester
         self._places: WorldPlaces | None = None  # where things are, read once per compose (if needed)
         self._places_at: tuple[tuple[object, bool], WorldPlaces] | None = None  # and kept while the store is unchanged
         self._matchmaker: Matchmaker | None = None  # for _matched, made on first use
@@ -226,7 +231,8 @@ class Composer:
         """The SRG for ``requirement``, from what holds but for the facts that meet a statement of ``undone``
         (an earlier part of the plan deleted them: see :meth:`_joined`)."""
         holding = self._holding(undone) if self.config.world_state else []
-        return ServiceResourceGraph(self._without(requirement, undone), self.pool, holding)
+        admits = partial(self._admits, requirement)
+        return ServiceResourceGraph(self._without(requirement, undone), self.pool, holding, admits)
 
     def _holding(self, undone: frozenset[Statement] = frozenset()) -> list[Statement]:
         """What holds (:meth:`world_state`), but for the facts that meet a statement of ``undone``."""
@@ -248,23 +254,60 @@ class Composer:
         an earlier run is not the state of the next one."""
         if self._state is not None:  # composing: read once for all its attempts
             return self._state
+        by_graph: dict[str, dict[Statement, None]] = {}
+        for fact, graph in self._facts if self._facts is not None else self._world_facts():
+            by_graph.setdefault(graph, {})[fact.statement] = None
+        return [statement for held in by_graph.values() for statement in held]
+
+    def world_facts(self) -> list[WorldFact]:
+        """What holds between which things (:meth:`world_state` lifts each to their classes)."""
+        return [fact for fact, _ in (self._facts if self._facts is not None else self._world_facts())]
+
+    def _world_facts(self) -> list[tuple[WorldFact, str]]:
         graphs = [GraphName.MAP, GraphName.WORLD] if self._belief else [GraphName.MAP]
         return [
-            Statement(row["subjectType"].value, row["relation"].value, row["objectType"].value)
+            (
+                WorldFact(
+                    Statement(row["subjectType"].value, row["relation"].value, row["objectType"].value),
+                    row["subject"].value,
+                    row["object"].value,
+                ),
+                graph.iri,
+            )
             for graph in graphs
             for row in self.kb.select("world_state", {"graph": graph.iri})
         ]
+
+    def named(self, requirement: Requirement) -> NamedThings:
+        """The things ``requirement``'s inputs designate (``actions.named_things``), read once per composition."""
+        key = (tuple(p.type or "" for p in requirement.inputs), requirement.requested_by)
+        if key not in self._named:
+            if self._designations is None:
+                self._designations = Designations(self.kb, self.index)
+            self._named[key] = self._designations.named(requirement)
+        return self._named[key]
+
+    def _admits(self, requirement: Requirement, wanted: Statement, held: Statement) -> bool:
+        """Whether ``held``, a statement the world offers that meets ``wanted`` by its classes, is about the
+        thing ``wanted`` concerns in ``requirement`` (:class:`NamedThings`); one no fact of the world is
+        behind (a subclass's assumption) meets it as its classes do."""
+        facts = self._lifted.get(held)
+        return not facts or self.named(requirement).admits(wanted, facts)
 
     def compose(self, task: str | Task | Requirement, belief: bool = False) -> CompositionResult:
         """Plan ``task``; with ``belief``, from what the belief graph says holds now as well."""
         self._belief, self._state, self._places = belief, None, None
         self._composing, self._requirements = True, None
         try:
+            self._facts = self._world_facts() if self.config.world_state else []
+            for fact, _ in self._facts:
+                self._lifted.setdefault(fact.statement, []).append(fact)
             self._state = self.world_state() if self.config.world_state else []
             return self._compose(task)
         finally:
             self._belief, self._state, self._places = False, None, None
             self._composing, self._requirements = False, None
+            self._facts, self._lifted, self._designations, self._named = None, {}, None, {}
 
     def requirements(self) -> list[Requirement]:
         """Every requirement: read once per composition, for the task, its sub-actions and every attempt
@@ -368,8 +411,10 @@ class Composer:
                 )
             )
         holding = [*requirement.preconditions, *(self.world_state() if self.config.world_state else [])]
+        guaranteed = set(requirement.preconditions)
         for wanted in ad.preconditions:
-            bound = self._statement_binding(wanted, holding, lambda met: Source(met, None, requirement.iri))
+            admitted = partial(self._given_or_admitted, requirement, guaranteed, wanted)
+            bound = self._statement_binding(wanted, holding, lambda met: Source(met, None, requirement.iri), admitted)
             if bound is None:
                 return None
             bindings.append(bound)
@@ -415,13 +460,24 @@ class Composer:
         )
         return Plan(task.name, requirement.iri, "matched", (step,), tuple(goals), score, step.cost)
 
+    def _given_or_admitted(
+        self, requirement: Requirement, given: set[Statement], wanted: Statement, held: Statement
+    ) -> bool:
+        """Whether ``held`` may meet ``wanted``: a precondition of ``requirement`` (``given``), or what holds in
+        the world about the thing ``wanted`` concerns (:meth:`_admits`)."""
+        return held in given or self._admits(requirement, wanted, held)
+
     def _statement_binding(
-        self, wanted: Statement, offered: Sequence[Statement], source: Callable[[str], Source]
+        self,
+        wanted: Statement,
+        offered: Sequence[Statement],
+        source: Callable[[str], Source],
+        admitted: Callable[[Statement], bool] | None = None,
     ) -> Binding | None:
-        """A binding of ``wanted`` to the first of ``offered`` that meets it, or None."""
+        """A binding of ``wanted`` to the first of ``offered`` that meets it (and that ``admitted`` lets), or None."""
         for candidate in offered:
             match = self.matcher.statement(wanted, candidate)
-            if match is not None:
+            if match is not None and (admitted is None or admitted(candidate)):
                 degree, similarity = match
                 return Binding(
                     "precondition",
@@ -662,17 +718,19 @@ class Composer:
         although the two would match as services do (a superclass is an accepted degree there)."""
         if requirement.outputs or not (requirement.effects or requirement.deletes):
             return False
-        gone = not any(self._held(d, holding) for d in requirement.deletes)  # what is to stop being true is not
-        return gone and all(self._held(e, holding) for e in requirement.effects)
+        held = partial(self._held, requirement, holding=holding)
+        gone = not any(held(d) for d in requirement.deletes)  # what is to stop being true is not
+        return gone and all(held(e) for e in requirement.effects)
 
     def _holds_some(self, requirement: Requirement, holding: Sequence[Statement]) -> bool:
         """Whether some of the requirement's goals hold already (all of them: :meth:`_achieved`)."""
-        return any(self._held(e, holding) for e in requirement.effects) or any(
-            not self._held(d, holding) for d in requirement.deletes
-        )
+        held = partial(self._held, requirement, holding=holding)
+        return any(held(e) for e in requirement.effects) or any(not held(d) for d in requirement.deletes)
 
-    def _held(self, goal: Statement, holding: Sequence[Statement]) -> bool:
-        return any(self._entails(fact, goal) for fact in holding)
+    def _held(self, requirement: Requirement, goal: Statement, holding: Sequence[Statement]) -> bool:
+        """Whether a fact of ``holding`` holds ``goal`` of ``requirement``: as specific on every side, and about
+        the things the requirement names where the goal concerns them (:meth:`_admits`)."""
+        return any(self._entails(fact, goal) and self._admits(requirement, goal, fact) for fact in holding)
 
     def _entails(self, fact: Statement, goal: Statement) -> bool:
         sides = ((goal.subject, fact.subject), (goal.predicate, fact.predicate), (goal.object, fact.object))

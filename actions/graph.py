@@ -15,7 +15,7 @@ carries that degree and the Sem-Str similarity (equation 8 for statements).
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Literal
@@ -245,10 +245,18 @@ class ServicePool:
 class ServiceResourceGraph:
     """The SRG for one requirement: the pool's vertices and edges plus SRI, SRO and SRE."""
 
-    def __init__(self, requirement: Requirement, pool: ServicePool, holding: Sequence[Statement] = ()) -> None:
+    def __init__(
+        self,
+        requirement: Requirement,
+        pool: ServicePool,
+        holding: Sequence[Statement] = (),
+        admits: Callable[[Statement, Statement], bool] | None = None,
+    ) -> None:
         """``holding``: statements that hold in the world now (the belief state, lifted to classes);
         SRI offers them to the components' preconditions, never to the goals, so what is already
-        achieved is kept and a goal is still planned for."""
+        achieved is kept and a goal is still planned for. ``admits(precondition, held)``: whether a
+        statement held may meet a precondition that its classes meet, for this requirement (it is about
+        the thing the precondition concerns: ``actions.named_things``); None: every one may."""
         self.requirement = requirement
         self.pool = pool
         self.matcher = pool.matcher
@@ -271,6 +279,7 @@ class ServiceResourceGraph:
             self._into[goal] = {n.key: pool.providers_of(goal, n) for n in self.vertices[goal].needs}
         # SRI's edges into every vertex that needs what the requirement gives; an input is met by
         # outputs only and a precondition by statements only, so each is compared with its kind alone
+        held = set(state) if admits is not None else set()  # what the world offers, as ``admits`` says
         kinds = {
             (to_goal, role): tuple(o for o in offers if (o.concept is not None) == (role == "input"))
             for to_goal, offers in ((True, given), (False, given + state))
@@ -283,7 +292,9 @@ class ServiceResourceGraph:
                     continue
                 offered = kinds[to_goal, need.role]
                 given_edges = [
-                    Edge(SRI, vertex.iri, need, o, *m) for o in offered if (m := self.matcher.match(need, o))
+                    Edge(SRI, vertex.iri, need, o, *m)
+                    for o in offered
+                    if (m := self.matcher.match(need, o)) and (o not in held or _admitted(admits, need, o))
                 ]
                 if given_edges:
                     base = self._into.get(vertex.iri, {}).get(need.key, pool.into.get(vertex.iri, {}).get(need.key, []))
@@ -317,6 +328,13 @@ class ServiceResourceGraph:
     def stated_cost(self, iri: str) -> float | None:
         """The ``cbrs:cost`` ``iri`` states (None: none, or a virtual node)."""
         return self.vertices[iri].stated_cost
+
+
+def _admitted(admits: Callable[[Statement, Statement], bool] | None, need: Need, offer: Offer) -> bool:
+    """Whether the world's ``offer`` may meet ``need``, as ``admits`` says."""
+    if admits is None or need.statement is None or offer.statement is None:
+        return True
+    return admits(need.statement, offer.statement)
 
 
 def _rank(edge: Edge) -> tuple[float, str, str]:
