@@ -646,9 +646,10 @@ class SimEnvironment:
     # -- the belief state ----------------------------------------------------------------------
 
     def observe(self) -> Observation:
-        """Types, the relations believed to hold now among the world's things, and where they are
-        believed to be: from the robots' perception and proprioception (no new images are taken), and the
-        relations only steps set, with the store's corrections heard since taken in (a failed step's)."""
+        """Types, the relations believed to hold now among the world's things (what each hand holds among
+        them: its gripper as the store names it), and where they are believed to be: from the robots'
+        perception and proprioception (no new images are taken), and the relations only steps set, with the
+        store's corrections heard since taken in (a failed step's)."""
         self._hear()
         belief = self.belief
         belief.feel()
@@ -679,6 +680,9 @@ class SimEnvironment:
                     facts.add((obj.iri, HOME + "isWith", person.iri))
             if name in world.containers and belief.contains_water(name):
                 facts.add((obj.iri, HOME + "contains", HOME + "Water"))
+            for side, holder in world.arms.items():  # what a hand holds, as it feels it (a re-plan keeps it)
+                if holder.hand.iri and belief.grasped(name, side):
+                    facts.add((obj.iri, HOME + "isGraspedBy", holder.hand.iri))
         positions: dict[str, tuple[float, float, float]] = {}
         if base_iri is not None:
             for person in people.values():

@@ -23,6 +23,9 @@ from cbrs.actions.named_things import NamedThings, WorldFact
 from cbrs.actions.plan import Plan
 from cbrs.kb import KnowledgeBase, Statement
 from cbrs.kb.namespaces import PREFIXES
+from cbrs.sim.arms import ArmSide
+from cbrs.sim.components import SimEnvironment
+from cbrs.sim.world import open_world
 from tests.helpers_examples import EXAMPLES
 from tests.test_room_by_free_arms import CUP, CUP_WEST, ERASER, LAB6, MAT, MAT_MAP, PEN, TASKS, WORLD
 
@@ -167,3 +170,20 @@ def test_a_goal_planned_on_its_own_given_the_cup_does_not_carry_the_pen_by_the_c
     result = Composer(kb, advertisements=without).compose("EraserCupPen", belief=True)
     assert result.plan is None
     assert any("PickUpObject" in u.text() for u in result.unsatisfied)
+
+
+def test_the_belief_says_what_each_hand_holds() -> None:
+    """``SimEnvironment.observe`` reports (thing, isGraspedBy, gripper) for what an arm holds, as the arm feels it:
+    the gripper the store names for that arm, none for the other (before, no grasp was ever reported)."""
+    kb = KnowledgeBase.open(":memory:")
+    with open_world(seed=0) as world:
+        environment = SimEnvironment(world, kb)
+        cup = world.map.objects[WORLD + "Cup"]
+        assert not [f for f in environment.observe().facts if f[1] == HOME + "isGraspedBy"]
+        left = world.arm(ArmSide.LEFT)
+        left.attach(world.body(cup.name))
+        grasps = [f for f in environment.observe().facts if f[1] == HOME + "isGraspedBy"]
+        assert grasps == [(cup.iri, HOME + "isGraspedBy", left.hand.iri)]
+        assert left.hand.iri == WORLD + "CytonDualArm01LeftHand"
+        left.detach()
+        assert not [f for f in environment.observe().facts if f[1] == HOME + "isGraspedBy"]
