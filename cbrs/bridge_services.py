@@ -64,6 +64,7 @@ from cbrs.kb.namespaces import GraphName, expand
 from cbrs.kb.store import is_remote
 from cbrs.matchmakers import Matchmakers
 from cbrs.rosbridge import Bridge, GoalHandle, GoalResult, GoalStatus, ServiceError, current_caller
+from cbrs.rosbridge.session import TOKEN_REFUSED
 from cbrs.sparql_service import SparqlService
 from cbrs.tasks import RUN_TOPIC, TaskRunner, check_choice, check_near_misses
 
@@ -257,6 +258,9 @@ class KnowledgeServices:
         if isinstance(rate, bool) or not isinstance(rate, (int, float)):
             raise ServiceError(f"field 'fault_rate' must be a number in [0, 1], not {type(rate).__name__}")
         if not self.may_write() and not self.sparql.config.read_only:  # a read-only server says so itself
+            caller = current_caller()
+            if caller is not None and caller.token_refused:
+                raise ServiceError(f"a task run moves the robot and writes the store: {TOKEN_REFUSED}")
             raise ServiceError(
                 "a task run moves the robot and writes the store: send the update token first "
                 '({"op": "auth", "mac": "<token>"}), or start it from this server\'s tasks page'

@@ -48,6 +48,7 @@ from cbrs.kb.store import EmbeddedStore
 from cbrs.kb.vocab import CBRS
 from cbrs.rosbridge import ServiceError, current_caller
 from cbrs.rosbridge.protocol import json_type
+from cbrs.rosbridge.session import TOKEN_REFUSED
 from cbrs.sparql_service import SparqlService
 
 __all__ = [
@@ -191,6 +192,8 @@ class LiveComponents:
             config = self.sparql.config
             if config.read_only or config.update_token is None:  # no token would help: say what would
                 raise ServiceError(READ_ONLY)
+            if caller.token_refused:
+                raise ServiceError(f"registering a component needs the update token: {TOKEN_REFUSED}")
             raise ServiceError(
                 "registering a component needs the update token: send it first with the auth op "
                 '({"op": "auth", "mac": TOKEN}; roslibpy sends Ros.authenticate() only as it connects, so call '

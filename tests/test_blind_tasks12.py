@@ -180,3 +180,25 @@ def test_a_server_stopped_during_a_run_says_how_the_run_ended(caplog: pytest.Log
         assert "task run run-7 (FetchMyPen) is still going: waiting up to 0.5 s for it to end" in caplog.text
         assert said in caplog.text
     kb.close()
+
+
+def test_a_registration_after_a_refused_token_says_the_token_was_refused(served: Server) -> None:
+    """The plug started with another server's token: the auth op's error status said so, but the
+    registration that followed was refused "send it first with the auth op", which the program had done
+    (the SDK reads the status back; a program of the protocol by hand, as components.md writes it, does
+    not); /cbrs/run_task likewise said "send the update token first"."""
+    with connect(f"ws://127.0.0.1:{served.bridge_port}") as ws:
+        ws.send(json.dumps({"op": "auth", "mac": "another-servers-token"}))
+        description = (EXAMPLES / "lab12_fan_switch.ttl").read_text("utf-8")
+        calls = {"/cbrs/register": {"description": description}, "/cbrs/run_task": {"task": "SwitchOnTheDeskFan"}}
+        for service, args in calls.items():
+            ws.send(json.dumps({"op": "call_service", "service": service, "args": args, "id": service}))
+        answers = {}
+        while len(answers) < len(calls):
+            frame = json.loads(ws.recv(timeout=30))
+            if frame.get("op") == "service_response":
+                answers[frame["id"]] = frame
+    for service, answer in answers.items():
+        assert answer["result"] is False, service
+        assert "the token this connection sent with the auth op is not this server's update token" in answer["values"]
+        assert "send it first" not in answer["values"] and "send the update token first" not in answer["values"]

@@ -834,9 +834,9 @@ class Bridge:
         if self.token is None:
             raise ProtocolError("this server takes no token: it is read-only for every client", "auth")
         if not given or not hmac.compare_digest(str(given).encode("utf-8"), self.token.encode("utf-8")):
-            session.authorised = False
+            session.authorised, session.token_refused = False, True
             raise ProtocolError("the token is not this server's update token", "auth")
-        session.authorised = True
+        session.authorised, session.token_refused = True, False
         session.report("info", "authorised: this client may write", message.get("id"))
 
     def _fragment_size(self, session: Session, message: Message) -> int | None:

@@ -51,9 +51,17 @@ class Caller:
     origin: str | None  # the Origin header of its websocket handshake: a web page's, or None for a program
     authorised: bool  # it sent the server's token with the auth op
     session: str = ""  # the connection's name, unique in the server (what outlives a call: a registration)
+    token_refused: bool = False  # its last auth op sent a token that is not the server's
 
 
 _CALLER: ContextVar[Caller | None] = ContextVar("cbrs_rosbridge_caller", default=None)
+
+
+#: what a write refused to a session whose token was refused says, rather than "send the token first"
+TOKEN_REFUSED = (
+    "the token this connection sent with the auth op is not this server's update token (its error status said"
+    " so): send the token cbrs serve was started with (CBRS_UPDATE_TOKEN or its --update-token-file)"
+)
 
 
 def current_caller() -> Caller | None:
@@ -81,6 +89,7 @@ class Session:
         self.peer = peer
         self.origin = origin
         self.authorised = False
+        self.token_refused = False  # its last auth op's token was not the server's: a refusal says so
         self.level = "error"
         self.closed = False
         #: topics this client advertised (global name -> the name as the client wrote it), likewise
@@ -119,7 +128,7 @@ class Session:
         return f"<Session {self.name}>"
 
     def identity(self) -> Caller:
-        return Caller(self.peer, self.origin, self.authorised, self.name)
+        return Caller(self.peer, self.origin, self.authorised, self.name, self.token_refused)
 
     @property
     def pending_bytes(self) -> int:
