@@ -13,6 +13,7 @@ import subprocess
 import sys
 import threading
 from collections.abc import Iterator
+from typing import Any
 from pathlib import Path
 
 import pytest
@@ -193,7 +194,7 @@ def test_a_registration_after_a_refused_token_says_the_token_was_refused(served:
         calls = {"/cbrs/register": {"description": description}, "/cbrs/run_task": {"task": "SwitchOnTheDeskFan"}}
         for service, args in calls.items():
             ws.send(json.dumps({"op": "call_service", "service": service, "args": args, "id": service}))
-        answers = {}
+        answers: dict[str, dict[str, Any]] = {}
         while len(answers) < len(calls):
             frame = json.loads(ws.recv(timeout=30))
             if frame.get("op") == "service_response":
