@@ -55,30 +55,67 @@ class Judgements:
     offers: list[str]
 
 
+#: The values each relevance set allows: binary relevance, and OWLS-TC's 4-graded scale.
+_SCALES = {"relevant": (0, 1), "grade/value": (0, 3)}
+_SET_NAMES = {"relevant": "binary relevance set", "grade/value": "graded relevance (relevancegrades)"}
+
+
 def read_relevance(path: Path) -> Judgements:
-    """Read an SME2 relevance file."""
+    """Read an SME2 relevance file. A value that is not a whole number of its scale (binary 0 or 1, grades
+    0 to 3), a request or offer without its URI, and a request judged in one set and not the other are
+    refused, each named: read as it was, a grade of 5 raised NDCG, 'yes' stopped the run with Python's
+    int() message, and a request left out of the graded set scored NDCG 0 without a word."""
     try:
         root = ET.parse(path).getroot()
     except (OSError, ET.ParseError) as error:
         raise CollectionError(path.parent, f"cannot read {path.name}: {error}") from error
+    wrong: list[str] = []
 
     def ratings(section: ET.Element | None, value_path: str) -> dict[str, dict[str, int]]:
         found: dict[str, dict[str, int]] = {}
-        for request in section.iter("request") if section is not None else ():
+        low, high = _SCALES[value_path]
+        for number, request in enumerate(section.iter("request") if section is not None else (), 1):
             uri = (request.findtext("uri") or "").strip()
+            if not uri:
+                wrong.append(f"request {number} of the {_SET_NAMES[value_path]} has no <uri>")
+                continue
             rated = found.setdefault(uri, {})
             for offer in request.iter("offer"):
                 value = offer.findtext(value_path)
-                if value is not None:
-                    rated[(offer.findtext("uri") or "").strip()] = int(value.strip())
+                if value is None:
+                    continue
+                offer_uri = (offer.findtext("uri") or "").strip()
+                if not offer_uri:
+                    wrong.append(f"request {uri} rates an offer without its <uri>")
+                    continue
+                text = value.strip()
+                if not text.lstrip("-").isdigit() or not low <= int(text) <= high:
+                    expected = f"{low} or {high}" if high == low + 1 else f"a whole number from {low} to {high}"
+                    wrong.append(
+                        f"request {uri} rates {offer_uri} {text!r} in the {_SET_NAMES[value_path]}: expected {expected}"
+                    )
+                    continue
+                rated[offer_uri] = int(text)
         return found
 
     offers = [(o.findtext("uri") or "").strip() for o in root.iterfind("offers/offer")]
     binary = ratings(root.find(".//binaryrelevanceset"), "relevant")
     graded = ratings(root.find(".//relevancegrades"), "grade/value")
-    if not binary:
+    if not binary and not wrong:
         raise CollectionError(path.parent, f"{path.name} has no binary relevance set")
+    for uri in sorted(binary.keys() - graded.keys()):
+        wrong.append(f"request {uri} is in the binary relevance set and not in the graded one (NDCG reads grades)")
+    for uri in sorted(graded.keys() - binary.keys()):
+        wrong.append(f"request {uri} is in the graded relevance and not in the binary set (MAP reads it)")
+    if wrong:
+        raise CollectionError(path.parent, f"{path.name}: " + _listed(wrong))
     return Judgements(binary, graded, offers)
+
+
+def _listed(problems: Sequence[str], shown: int = 5) -> str:
+    """The first ``shown`` problems, and how many more."""
+    more = f"; and {len(problems) - shown} more" if len(problems) > shown else ""
+    return "; ".join(problems[:shown]) + more
 
 
 def _file_key(uri: str) -> str:

@@ -1,0 +1,78 @@
+"""A round by a researcher in service matchmaking, from the docs alone (docs/examples/lab13_*,
+docs/matchmaking.md "Tried by a researcher"): their own OWL-S 1.1 collection of public transport
+services with graded relevance, evaluated by ``cbrs eval owls-tc``, ranked and composed, with a
+newcomer's mistakes in it. Each mistake is made on a copy of the collection in a temporary folder."""
+
+from __future__ import annotations
+
+import shutil
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from cbrs.cli import cli
+from cbrs.reasoner.owlstc import CollectionError, read_relevance
+from tests.helpers_examples import EXAMPLES
+
+COLLECTION = EXAMPLES / "lab13_collection"
+
+
+def _copy(tmp_path: Path) -> Path:
+    """The collection copied, to be spoilt."""
+    return Path(shutil.copytree(COLLECTION, tmp_path / "collection"))
+
+
+def _replace(path: Path, old: str, new: str, count: int = 1) -> None:
+    text = path.read_text(encoding="utf-8")
+    assert old in text
+    path.write_text(text.replace(old, new, count), encoding="utf-8")
+
+
+def test_the_collection_as_written_is_read_whole() -> None:
+    judged = read_relevance(COLLECTION / "relevance.xml")
+    assert len(judged.binary) == len(judged.graded) == 3
+    assert judged.graded["http://127.0.0.1/queries/lab13/train_fare.owls"] == {
+        "http://127.0.0.1/services/lab13/train_fare_lookup.owls": 3,
+        "http://127.0.0.1/services/lab13/buy_train_ticket.owls": 1,
+        "http://127.0.0.1/services/lab13/train_journey_planner.owls": 0,
+    }
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "said"),
+    [
+        # a grade out of OWLS-TC's scale: taken, it raised NDCG
+        (
+            "<grade><value>3</value></grade>",
+            "<grade><value>5</value></grade>",
+            "rates http://127.0.0.1/services/lab13/door_to_door_route_planner.owls '5' in the graded relevance "
+            "(relevancegrades): expected a whole number from 0 to 3",
+        ),
+        # a word for a binary judgement: Python's "invalid literal for int() with base 10: 'yes'"
+        (
+            "<relevant>1</relevant>",
+            "<relevant>yes</relevant>",
+            "request http://127.0.0.1/queries/lab13/trip_between_addresses.owls rates "
+            "http://127.0.0.1/services/lab13/door_to_door_route_planner.owls 'yes' in the binary relevance set: "
+            "expected 0 or 1",
+        ),
+        # the graded set left out: NDCG 0.0000 without a word
+        (
+            "<relevancegrades>",
+            "<unread>",
+            "request http://127.0.0.1/queries/lab13/get_me_a_train_ticket.owls is in the binary relevance set "
+            "and not in the graded one",
+        ),
+    ],
+)
+def test_a_relevance_value_out_of_its_scale_is_refused_naming_it(tmp_path: Path, old: str, new: str, said: str) -> None:
+    root = _copy(tmp_path)
+    if old == "<relevancegrades>":
+        _replace(root / "relevance.xml", "</relevancegrades>", "</unread>")
+    _replace(root / "relevance.xml", old, new)
+    with pytest.raises(CollectionError) as refused:
+        read_relevance(root / "relevance.xml")
+    assert str(refused.value).startswith(f"{root}: relevance.xml: ") and said in str(refused.value)
+    result = CliRunner().invoke(cli, ["--store", ":memory:", "eval", "owls-tc", str(root), "--json"])
+    assert result.exit_code == 1 and said in result.output and "Traceback" not in result.output
