@@ -9,6 +9,7 @@ method ranks the whole service pool for every request; the figures are the means
 
 from __future__ import annotations
 
+import difflib
 import statistics
 import time
 import xml.etree.ElementTree as ET
@@ -142,6 +143,36 @@ def check_layout(root: Path) -> None:
             )
 
 
+def _check_files(root: Path, judgements: Judgements, loaded: LoadedCollection) -> None:
+    """Raise CollectionError naming each request and judged offer of relevance.xml that no file of
+    ``queries/`` or ``services/`` describes (a misspelt name, a file left out): the evaluation dropped
+    such a request and counted such an offer as not there, and its figures were of another collection."""
+    missing: list[str] = []
+    for kind, folder, table, uris in (
+        ("request", "queries", loaded.requirements, sorted(judgements.binary.keys() | judgements.graded.keys())),
+        (
+            "judged offer",
+            "services",
+            loaded.advertisements,
+            sorted({o for sets in (judgements.binary, judgements.graded) for rated in sets.values() for o in rated}),
+        ),
+    ):
+        for uri in uris:
+            name = _file_key(uri)
+            if table.get(name):
+                continue
+            held = (
+                f"{folder}/ holds no {name}"
+                if not (root / folder / name).exists()
+                else f"{folder}/{name} describes no OWL-S service"
+            )
+            close = difflib.get_close_matches(name, sorted(table), n=2)
+            hint = f" (did you mean {' or '.join(close)}?)" if close else ""
+            missing.append(f"{kind} {uri}: {held}{hint}")
+    if missing:
+        raise CollectionError(root, "relevance.xml names what the collection does not hold: " + _listed(missing))
+
+
 Progress = Callable[[str, int, int], None]
 """Told how an evaluation goes (stage, items done, of how many; 0 when not counted): for a person waiting."""
 
@@ -242,21 +273,14 @@ def evaluate_collection(
     def to_iris(uri: str, table: dict[str, list[str]]) -> list[str]:
         return table.get(_file_key(uri), [])
 
+    _check_files(root, judgements, loaded)
     requests: dict[str, tuple[dict[str, int], dict[str, int]]] = {}
-    unmatched_requests: list[str] = []
-    unmatched_offers: set[str] = set()
     for uri, rated in judgements.binary.items():
         iris = to_iris(uri, loaded.requirements)
-        if not iris:
-            unmatched_requests.append(uri)
-            continue
         binary: dict[str, int] = {}
         grades: dict[str, int] = {}
         for offer, value in rated.items():
-            targets = to_iris(offer, loaded.advertisements)
-            if not targets:
-                unmatched_offers.add(offer)
-            binary.update(dict.fromkeys(targets, value))
+            binary.update(dict.fromkeys(to_iris(offer, loaded.advertisements), value))
         for offer, value in judgements.graded.get(uri, {}).items():
             grades.update(dict.fromkeys(to_iris(offer, loaded.advertisements), value))
         requests[iris[0]] = (binary, grades)
@@ -299,8 +323,6 @@ def evaluate_collection(
         queries=len(requests),
         services=len(first.advertisements) if first is not None else 0,
         curves=curves,
-        unmatched_requests=unmatched_requests,
-        unmatched_offers=len(unmatched_offers),
         unresolved_concepts=loaded.unresolved_concepts,
         unresolved_imports=loaded.unresolved_imports,
         load_seconds=loaded.seconds,

@@ -12,7 +12,7 @@ import pytest
 from click.testing import CliRunner
 
 from cbrs.cli import cli
-from cbrs.reasoner.owlstc import CollectionError, read_relevance
+from cbrs.reasoner.owlstc import CollectionError, evaluate_collection, read_relevance
 from tests.helpers_examples import EXAMPLES
 
 COLLECTION = EXAMPLES / "lab13_collection"
@@ -76,3 +76,31 @@ def test_a_relevance_value_out_of_its_scale_is_refused_naming_it(tmp_path: Path,
     assert str(refused.value).startswith(f"{root}: relevance.xml: ") and said in str(refused.value)
     result = CliRunner().invoke(cli, ["--store", ":memory:", "eval", "owls-tc", str(root), "--json"])
     assert result.exit_code == 1 and said in result.output and "Traceback" not in result.output
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "said"),
+    [
+        # a query misspelt: the request was dropped, 2 queries evaluated, "1 requests not found" unnamed
+        (
+            "queries/lab13/train_fare.owls",
+            "queries/lab13/train_fares.owls",
+            "request http://127.0.0.1/queries/lab13/train_fares.owls: queries/ holds no train_fares.owls "
+            "(did you mean train_fare.owls",
+        ),
+        # a judged service misspelt: counted as not there, the figures of another collection
+        (
+            "services/lab13/train_fare_lookup.owls",
+            "services/lab13/train_fare_look_up.owls",
+            "judged offer http://127.0.0.1/services/lab13/train_fare_look_up.owls: services/ holds no "
+            "train_fare_look_up.owls (did you mean train_fare_lookup.owls?)",
+        ),
+    ],
+)
+def test_relevance_naming_a_file_the_collection_lacks_is_refused(tmp_path: Path, old: str, new: str, said: str) -> None:
+    root = _copy(tmp_path)
+    _replace(root / "relevance.xml", old, new, count=-1)
+    with pytest.raises(CollectionError) as refused:
+        evaluate_collection(root, ["sem-str"])
+    assert "relevance.xml names what the collection does not hold: " in str(refused.value)
+    assert said in str(refused.value)
