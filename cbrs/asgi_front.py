@@ -31,8 +31,16 @@ from urllib.parse import unquote_to_bytes
 from a2wsgi import WSGIMiddleware
 from a2wsgi.wsgi import WSGIResponder
 
-from cbrs.sparql_service import Answer, SparqlService
-from cbrs.web.sparql_wsgi import COMMON_HEADERS, error_answer, host_allowed, json_body, plain_get, plain_post_length
+from cbrs.sparql_service import BUSY_RETRY_AFTER, Answer, SparqlService
+from cbrs.web.sparql_wsgi import (
+    COMMON_HEADERS,
+    error_answer,
+    error_headers,
+    host_allowed,
+    json_body,
+    plain_get,
+    plain_post_length,
+)
 
 log = logging.getLogger("cbrs.server")
 
@@ -44,6 +52,7 @@ WSGIApp = Callable[[dict[str, Any], Callable[..., Any]], Iterable[bytes]]
 
 # What every answer of /sparql carries, as the Flask view sends it.
 _COMMON = [(name.lower().encode("latin-1"), value.encode("latin-1")) for name, value in COMMON_HEADERS]
+_RETRY = (("Retry-After", str(BUSY_RETRY_AFTER)),)  # a busy answer's, as the endpoint's
 # The request headers the front reads; a request repeating one of them goes to Flask, which joins them.
 _READ = frozenset({b"host", b"accept", b"origin", b"content-type", b"content-length"})
 
@@ -124,12 +133,13 @@ class SparqlFront:
             except UnicodeDecodeError:  # Flask reads it again and names the error
                 await self.wsgi(scope, _replay(body, receive), send)
                 return
-        status, media_type, content = await self._answer(text, headers.get(b"accept"), short, client and client[0])
-        await _respond(send, scope["method"] == "HEAD", status, media_type, content)
+        answered = await self._answer(text, headers.get(b"accept"), short, client and client[0])
+        status, media_type, content, extra = answered
+        await _respond(send, scope["method"] == "HEAD", status, media_type, content, extra)
 
     async def _answer(
         self, text: str, accept: str | None, short: str | None, client: str | None
-    ) -> tuple[int, str, bytes]:
+    ) -> tuple[int, str, bytes, tuple[tuple[str, str], ...]]:
         try:
             answer: Answer | None = self.sparql.query_here(text, accept, short, client, self.inline_bytes)
             if answer is None:
@@ -137,8 +147,8 @@ class SparqlFront:
                 answer = await asyncio.get_running_loop().run_in_executor(self._queries, run)
         except Exception as error:
             status, body = error_answer(error)
-            return status, "application/json", body
-        return 200, answer.media_type + "; charset=utf-8", answer.body
+            return status, "application/json", body, error_headers(error)
+        return 200, answer.media_type + "; charset=utf-8", answer.body, ()
 
     def _plain_query(self, scope: Scope, headers: dict[bytes, str]) -> tuple[str, str | None, int] | None:
         """(query, short format, -1) of a GET or HEAD this front answers, ("", None, body length) of such
@@ -515,7 +525,7 @@ async def _too_many_bodies(send: Send, client: str | None, limit: int) -> None:
         f"{client} is already sending {limit} request bodies at once, the most one client may; "
         "send the rest when those are in"
     )
-    await _respond(send, False, 503, "application/json", json_body({"error": "busy", "message": message}))
+    await _respond(send, False, 503, "application/json", json_body({"error": "busy", "message": message}), _RETRY)
 
 
 async def _too_much_unread(send: Send, client: str | None, unread: UnreadAnswers) -> None:
@@ -523,10 +533,13 @@ async def _too_much_unread(send: Send, client: str | None, unread: UnreadAnswers
         f"{client} has {unread.held[client]} bytes of answers it has not read yet, the most one client may "
         f"have ({unread.per_client}); read them, or close their connections"
     )
-    await _respond(send, False, 503, "application/json", json_body({"error": "busy", "message": message}))
+    await _respond(send, False, 503, "application/json", json_body({"error": "busy", "message": message}), _RETRY)
 
 
-async def _respond(send: Send, head: bool, status: int, media_type: str, body: bytes) -> None:
+async def _respond(
+    send: Send, head: bool, status: int, media_type: str, body: bytes, extra: tuple[tuple[str, str], ...] = ()
+) -> None:
     headers = [(b"content-type", media_type.encode("latin-1")), (b"content-length", str(len(body)).encode()), *_COMMON]
+    headers.extend((name.lower().encode("latin-1"), value.encode("latin-1")) for name, value in extra)
     await send({"type": "http.response.start", "status": status, "headers": headers})
     await send({"type": "http.response.body", "body": b"" if head else body})

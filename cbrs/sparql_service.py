@@ -176,9 +176,15 @@ class QueryMemoryError(EndpointError):
         )
 
 
+#: seconds a busy answer (503) asks its client to wait before trying again, in its Retry-After header: a
+#: worker or a client's share is free again as soon as a query ends, which a lookup does in milliseconds
+BUSY_RETRY_AFTER = 1
+
+
 class EndpointBusyError(EndpointError):
     http_status = 503
     kind = "busy"
+    retry_after = BUSY_RETRY_AFTER
 
     def __init__(self, workers: int, client: str | None = None, per_client: int | None = None) -> None:
         self.client = client

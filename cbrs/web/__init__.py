@@ -26,7 +26,7 @@ from cbrs.tasks import TaskRunner
 from cbrs.web import links, warmup
 from cbrs.web.context import EventLog, StreamSlots
 from cbrs.web.pages import error_page, http_error_message, keep_error_headers, wants_json
-from cbrs.web.sparql_wsgi import SparqlHotPath
+from cbrs.web.sparql_wsgi import SparqlHotPath, error_headers
 from cbrs.web.strict_request import StrictRequest
 
 # The page blueprints, in navigation order: (module under cbrs.web, endpoint of its nav link, label).
@@ -159,7 +159,9 @@ def create_app(
         if as_page():
             return error_page(error), error.http_status
         notes = {"notes": error.__notes__} if getattr(error, "__notes__", None) else {}  # "nothing was changed"
-        return _error(getattr(error, "kind", type(error).__name__), str(error), **notes), error.http_status
+        answer = _error(getattr(error, "kind", type(error).__name__), str(error), **notes)
+        answer.headers.extend(error_headers(error))  # a busy server's Retry-After
+        return answer, error.http_status
 
     def for_programs() -> bool:
         """A path only programs use (the protocol endpoints, a ``.json`` twin): its errors are JSON even

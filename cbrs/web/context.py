@@ -12,7 +12,7 @@ from flask import current_app
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.matchmakers import Matchmakers
-from cbrs.sparql_service import SparqlService
+from cbrs.sparql_service import BUSY_RETRY_AFTER, SparqlService
 from cbrs.tasks import TaskRunner
 
 if TYPE_CHECKING:
@@ -79,6 +79,7 @@ class TooManyStreamsError(KnowledgeBaseError):
 
     http_status = 503
     kind = "busy"
+    retry_after = BUSY_RETRY_AFTER
 
 
 class StreamSlots:

@@ -65,7 +65,7 @@ class SparqlHotPath:
             )
         except Exception as error:
             status, body = error_answer(error)
-            return _answer(start_response, environ, status, "application/json", body)
+            return _answer(start_response, environ, status, "application/json", body, error_headers(error))
         return _answer(start_response, environ, 200, answer.media_type + "; charset=utf-8", answer.body)
 
     def _plain_query(self, environ: dict[str, Any]) -> tuple[str | None, str | None]:
@@ -149,6 +149,13 @@ def error_answer(error: Exception) -> tuple[int, bytes]:
     return 500, json_body({"error": "internal-server-error", "message": InternalServerError.description})
 
 
+def error_headers(error: Exception) -> tuple[tuple[str, str], ...]:
+    """The headers an answer to ``error`` adds: ``Retry-After`` for one that says when to try again (a
+    busy server's, ``retry_after`` seconds), as cbrs.web's error handler adds them."""
+    seconds = getattr(error, "retry_after", None)
+    return (("Retry-After", str(seconds)),) if seconds else ()
+
+
 class _Replay:
     """A request body already read, for Flask to read again."""
 
@@ -164,8 +171,13 @@ class _Replay:
 
 
 def _answer(
-    start_response: Callable[..., Any], environ: dict[str, Any], status: int, media_type: str, body: bytes
+    start_response: Callable[..., Any],
+    environ: dict[str, Any],
+    status: int,
+    media_type: str,
+    body: bytes,
+    extra: tuple[tuple[str, str], ...] = (),
 ) -> list[bytes]:
-    headers = [("Content-Type", media_type), ("Content-Length", str(len(body))), *COMMON_HEADERS]
+    headers = [("Content-Type", media_type), ("Content-Length", str(len(body))), *COMMON_HEADERS, *extra]
     start_response(f"{status} {HTTP_STATUS_CODES.get(status, 'unknown').upper()}", headers)
     return [] if environ.get("REQUEST_METHOD") == "HEAD" else [body]
