@@ -9,7 +9,7 @@ from pathlib import Path
 import click
 
 from cbrs.app import App, pass_app
-from cbrs.home_plan import DEFAULT_WIDTH, NO_ROOMS, HomeSurvey, draw_home, resource_link, survey
+from cbrs.home_plan import DEFAULT_WIDTH, NO_ROOMS, HomeSurvey, resource_link, survey
 from cbrs.kb.namespaces import shorten
 from cbrs.kb.person_choice import people_check
 from cbrs.kb.semantic_map import local_name
@@ -47,7 +47,7 @@ def home(app: App, drawing: Path | None, width: int, browser: str | None, as_jso
     written = None
     entries = []
     if drawing is not None and found.semantic_map is not None:
-        picture = draw_home(found.semantic_map, found.believed, width, link=lambda iri: root + resource_link(iri))
+        picture = found.picture(width, link=lambda iri: root + resource_link(iri))
         drawing.write_text(picture.svg, encoding="utf-8")
         written = str(drawing)
         entries = [entry.to_dict() for entry in picture.entries]

@@ -19,6 +19,8 @@ ROOM_FILLS = ("#eaf2fb", "#f1edf9", "#eaf6ee", "#fbf3e6", "#f8ebf0", "#e8f5f5")
 CAMERA_INKS = ("#c2410c", "#7c3aed", "#0e7490", "#be185d", "#4d7c0f")
 FURNITURE = ("#ead8b9", "#8a5a2b")
 APPLIANCE = ("#d5dde8", "#4b5563")
+THING = ("#f3e8c8", "#7a5c12")
+"""A physical thing of the map outside the reader's groups (a lab's lamp, a tap lever): fill and ink."""
 ROBOT = ("#b9cbe4", "#2f4f7a")
 BASE = ("#5b6b82", "#1d2330")
 DOCK = "#1a7f37"
@@ -183,6 +185,7 @@ _LEGEND = (
     ("wall", "wall"),
     ("furniture", "furniture (top height)"),
     ("appliance", "appliance"),
+    ("thing", "other thing, its kind"),
     ("object", "object (its colour)"),
     ("robot", "dual-arm robot, arm reach"),
     ("base", "mobile base, heading"),
@@ -193,17 +196,19 @@ _LEGEND = (
 )
 
 
-def legend(canvas: Canvas, top: float, width: int) -> tuple[list[str], float]:
-    """The legend's swatches in rows below the plan, and its height."""
+def legend(canvas: Canvas, top: float, width: int, things: bool = False) -> tuple[list[str], float]:
+    """The legend's swatches in rows below the plan, and its height; the other things' swatch only
+    where ``things`` are drawn."""
     column = 176
     per_row = max(1, int((width - 2 * MARGIN) // column))
     parts: list[str] = []
-    for index, (kind, text) in enumerate(_LEGEND):
+    shown = [(kind, text) for kind, text in _LEGEND if things or kind != "thing"]
+    for index, (kind, text) in enumerate(shown):
         x = canvas.left + (index % per_row) * column
         y = top + (index // per_row) * _LEGEND_ROW
         parts.append(_swatch(kind, x, y))
         parts.append(canvas.text(x + 26, y + 4, text, 11))
-    rows = -(-len(_LEGEND) // per_row)
+    rows = -(-len(shown) // per_row)
     return parts, rows * _LEGEND_ROW
 
 
@@ -214,6 +219,8 @@ def _swatch(kind: str, x: float, y: float) -> str:
         "wall": f'<rect x="{x:.1f}" y="{y - 3:.1f}" width="20" height="6" fill="#4b5563"/>',
         "furniture": f'<rect {box} fill="{FURNITURE[0]}" stroke="{FURNITURE[1]}"/>',
         "appliance": f'<rect {box} fill="{APPLIANCE[0]}" stroke="{APPLIANCE[1]}"/>',
+        "thing": f'<rect x="{x + 3:.1f}" y="{y - 6:.1f}" width="14" height="12" fill="{THING[0]}" '
+        f'stroke="{THING[1]}"/>',
         "object": f'<circle cx="{x + 6:.1f}" cy="{y:.1f}" r="5" fill="#d91414" stroke="{INK}" stroke-width="0.8"/>'
         f'<rect x="{x + 12:.1f}" y="{y - 1.5:.1f}" width="9" height="3" fill="#1a33d9"/>',
         "robot": f'<circle cx="{x + 10:.1f}" cy="{y:.1f}" r="9" fill="{ROBOT[1]}" fill-opacity="0.05" '

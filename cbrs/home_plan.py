@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import math
 import textwrap
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from html import escape
 from urllib.parse import quote
@@ -37,6 +37,7 @@ from cbrs.home_canvas import (
     PERSON_PX,
     ROBOT,
     ROOM_FILLS,
+    THING,
     Canvas,
     arrow,
     circle,
@@ -47,6 +48,7 @@ from cbrs.home_canvas import (
     scale_bar,
     svg_attributes,
 )
+from cbrs.home_things import Kind, others, position, read_kinds
 from cbrs.kb.camera_view import floor_view
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.home_check import check_home, undocked_supports
@@ -65,6 +67,7 @@ __all__ = [
     "HomePicture",
     "HomeSurvey",
     "draw_home",
+    "kind_of",
     "resource_link",
     "survey",
 ]
@@ -135,6 +138,15 @@ class HomeSurvey:
     semantic_map: SemanticMap | None
     problem: KnowledgeBaseError | None
     believed: dict[str, tuple[float, float]] = field(default_factory=dict)
+    kinds: dict[str, Kind] = field(default_factory=dict)
+    """What each physical thing of the map outside the reader's groups is, and each water dispenser's kind
+    (:func:`cbrs.home_things.read_kinds`): the things the picture draws as they are, grouped by kind."""
+
+    def picture(self, width: int = DEFAULT_WIDTH, link: Callable[[str], str] | None = None) -> HomePicture:
+        """:func:`draw_home` of this survey's map, with where things are believed to be and their kinds."""
+        if self.semantic_map is None:
+            raise ValueError("the map could not be read: there is nothing to draw")
+        return draw_home(self.semantic_map, self.believed, width, link or resource_link, kinds=self.kinds)
 
     @property
     def verdict(self) -> str:
@@ -157,11 +169,20 @@ class HomeSurvey:
             "people": len(smap.people),
             "cameras": len(smap.cameras),
             "docking poses": sum(1 for thing in smap.things.values() if thing.dock is not None),
-        }
+        } | {plural: len(iris) for plural, (_, iris) in self._kind_groups().items()}
+
+    def _kind_groups(self) -> dict[str, tuple[str, list[str]]]:
+        """The things of :attr:`kinds` by kind, as (singular, things) by plural, sorted by name."""
+        groups: dict[str, tuple[str, list[str]]] = {}
+        for iri in sorted(self.kinds):
+            kind = self.kinds[iri]
+            groups.setdefault(kind.plural, (kind.name, []))[1].append(iri)
+        return dict(sorted(groups.items(), key=lambda item: item[1][0]))
 
     def counted(self) -> list[str]:
         """:meth:`counts` in words: "3 rooms", "1 piece of furniture", "1 person"."""
-        return [_counted(n, name) for name, n in self.counts().items()]
+        singular = {plural: name for plural, (name, _) in self._kind_groups().items()}
+        return [_counted(n, name, singular.get(name)) for name, n in self.counts().items()]
 
     def warnings(self) -> list[str]:
         """What the home check lets through but a task may trip on, in words: furniture that holds objects
@@ -223,9 +244,9 @@ _ONE = {"people": "person", "furniture": "piece of furniture"}
 _MANY = {"furniture": "pieces of furniture"}
 
 
-def _counted(count: int, name: str) -> str:
+def _counted(count: int, name: str, one: str | None = None) -> str:
     if count == 1:
-        return f"1 {_ONE.get(name, name.removesuffix('s'))}"
+        return f"1 {one or _ONE.get(name, name.removesuffix('s'))}"
     return f"{count} {_MANY.get(name, name)}"
 
 
@@ -239,11 +260,18 @@ def survey(kb: KnowledgeBase) -> HomeSurvey:
     believed = {
         row["thing"].value: (float(row["x"].value), float(row["y"].value)) for row in kb.select("world_positions")
     }
+    kinds = read_kinds(kb, smap, [*others(smap), *smap.dispensers])
     try:
         check_home(smap)
     except KnowledgeBaseError as error:
-        return HomeSurvey(smap, error, believed)
-    return HomeSurvey(smap, None, believed)
+        return HomeSurvey(smap, error, believed, kinds)
+    return HomeSurvey(smap, None, believed, kinds)
+
+
+def kind_of(kinds: Mapping[str, Kind], iri: str, default: str) -> str:
+    """The name of ``iri``'s kind, ``default`` when the store gives none."""
+    kind = kinds.get(iri)
+    return kind.name if kind is not None else default
 
 
 # -- the drawing ------------------------------------------------------------------------------------
@@ -264,12 +292,16 @@ def draw_home(
     width: int = DEFAULT_WIDTH,
     link: Callable[[str], str] = resource_link,
     moved: float = MOVED,
+    kinds: Mapping[str, Kind] | None = None,
 ) -> HomePicture:
     """The home from above as SVG text, ``width`` pixels across, and the things drawn; ``believed``
     gives where the world graph believes things are (x, y by IRI), drawn where they are ``moved`` or
-    more from their start; ``link`` gives each thing's address."""
-    smap, believed = semantic_map, believed or {}
-    extent = _extent(smap, believed)
+    more from their start; ``link`` gives each thing's address; ``kinds`` what the physical things outside
+    the reader's groups are (:attr:`HomeSurvey.kinds`), each drawn by its extent or at its position. The
+    entries come grouped by kind, in the order each kind is first drawn."""
+    smap, believed, kinds = semantic_map, believed or {}, kinds or {}
+    placed = {iri: position(smap, iri) for iri in kinds if iri not in smap.things and iri not in smap.dispensers}
+    extent = _extent(smap, believed, [(p[0], p[1]) for p in placed.values() if p is not None])
     notice = None if smap.rooms & smap.things.keys() else NO_ROOMS
     if extent is None:  # nothing placed at all: the notice alone, not an empty grid
         return _notice_only(notice or NO_ROOMS, width)
@@ -279,6 +311,7 @@ def draw_home(
     plan_height = (extent.max_y - extent.min_y) * scale
     entries: list[Entry] = []
     solid = smap.furniture | {d.iri for d in smap.dispensers.values()} | {t.iri for t in _bodies(smap)}
+    solid |= {iri for iri in kinds if iri in smap.things}
     for iri in sorted(solid & smap.things.keys()):  # labels keep off them, the rooms' too
         canvas.block_box(smap.things[iri].box)
     layers: list[Iterator[str]] = [
@@ -286,7 +319,8 @@ def draw_home(
         _rooms(canvas, smap, link, entries),
         _walls(canvas, smap, link, entries),
         _cameras_views(canvas, smap, link),
-        _furniture(canvas, smap, link, entries),
+        _furniture(canvas, smap, link, entries, kinds),
+        _other_things(canvas, smap, link, entries, kinds, placed),
         _robot_bodies(canvas, smap, link, entries),
         _docks(canvas, smap, link, entries),
         _objects(canvas, smap, link, entries, believed, moved),
@@ -296,7 +330,7 @@ def draw_home(
     ]
     body = [part for layer in layers for part in layer]
     legend_top = canvas.top + plan_height + 84
-    key, legend_height = legend(canvas, legend_top, width)
+    key, legend_height = legend(canvas, legend_top, width, things=any(e.iri in kinds for e in entries))
     height = int(legend_top + legend_height + 8)
     rooms = ", ".join(_name(smap, iri) for iri in sorted(smap.rooms) if iri in smap.things)
     svg = "".join(
@@ -314,7 +348,16 @@ def draw_home(
             "</svg>",
         ]
     )
-    return HomePicture(svg, width, height, tuple(entries), notice)
+    return HomePicture(svg, width, height, _grouped(entries), notice)
+
+
+def _grouped(entries: list[Entry]) -> tuple[Entry, ...]:
+    """``entries`` by kind, each kind where it is first drawn, in drawing order within it: a lab's lamp
+    beside the water dispenser, both appliances."""
+    order: dict[str, int] = {}
+    for entry in entries:
+        order.setdefault(entry.kind, len(order))
+    return tuple(sorted(entries, key=lambda entry: order[entry.kind]))
 
 
 def _wrapped(notice: str | None, width: int) -> list[str]:
@@ -368,9 +411,12 @@ def _defs(canvas: Canvas) -> str:
     )
 
 
-def _extent(smap: SemanticMap, believed: dict[str, tuple[float, float]]) -> Box | None:
+def _extent(
+    smap: SemanticMap, believed: dict[str, tuple[float, float]], placed: list[tuple[float, float]]
+) -> Box | None:
     """The box around every thing drawn (not around the cameras' views), with some floor around it, and
-    at least :data:`_MIN_SPAN` across and up; None when the map places nothing."""
+    at least :data:`_MIN_SPAN` across and up; None when the map places nothing. ``placed``: the positions
+    of the things drawn by their position alone (:func:`_other_things`)."""
     xs: list[float] = []
     ys: list[float] = []
     for thing in smap.things.values():
@@ -382,6 +428,7 @@ def _extent(smap: SemanticMap, believed: dict[str, tuple[float, float]]) -> Box 
     points += [(c.position[0], c.position[1]) for c in smap.cameras.values()]
     points += [(a.mount[0], a.mount[1]) for a in smap.arms.values()]
     points += [(t.dock.x, t.dock.y) for t in smap.things.values() if t.dock is not None]
+    points += placed
     points += [where for iri, where in believed.items() if _drawn_at(smap, iri) is not None]
     xs += [x for x, _ in points]
     ys += [y for _, y in points]
@@ -475,7 +522,9 @@ def _walls(canvas: Canvas, smap: SemanticMap, link: Callable[[str], str], entrie
         entries.append(Entry(iri, local_name(iri), "wall", _classes(smap, iri), where))
 
 
-def _furniture(canvas: Canvas, smap: SemanticMap, link: Callable[[str], str], entries: list[Entry]) -> Iterator[str]:
+def _furniture(
+    canvas: Canvas, smap: SemanticMap, link: Callable[[str], str], entries: list[Entry], kinds: Mapping[str, Kind]
+) -> Iterator[str]:
     appliances = {d.iri for d in smap.dispensers.values()}
     drawn = sorted(
         (smap.furniture | appliances) & smap.things.keys(), key=lambda iri: (smap.things[iri].box.max_z, iri)
@@ -496,13 +545,75 @@ def _furniture(canvas: Canvas, smap: SemanticMap, link: Callable[[str], str], en
             top = canvas.y(box.max_y)
             body.append(canvas.text(cx, top + 14, local_name(iri), 11, text_anchor="middle", font_weight="bold"))
             body.append(canvas.text(cx, top + 27, f"top {box.max_z:g} m", 10, fill=MUTED, text_anchor="middle"))
-        kind = "appliance" if appliance else "furniture"
+        style = "appliance" if appliance else "furniture"
+        kind = kind_of(kinds, iri, style) if appliance else style
         support = smap.facts.get(iri, {}).get(HOME + "isLocatedOn", [])
         if support:
             where += f", on {local_name(support[0])}"
-        yield _linked(link(iri), f"{_label(smap, iri)}: {kind}, {where}", body, kind)
+        yield _linked(link(iri), f"{_label(smap, iri)}: {kind}, {where}", body, style)
         centre = box.centre
         entries.append(Entry(iri, local_name(iri), kind, _classes(smap, iri), where, _room_of(smap, *centre[:2])))
+
+
+def _other_things(
+    canvas: Canvas,
+    smap: SemanticMap,
+    link: Callable[[str], str],
+    entries: list[Entry],
+    kinds: Mapping[str, Kind],
+    placed: Mapping[str, tuple[float, float, float | None] | None],
+) -> Iterator[str]:
+    """The physical things of the map outside the reader's groups (:mod:`cbrs.home_things`): a box by its
+    extent, lowest first, else a diamond at its position, each named with its kind; a part of a water
+    dispenser (its lever, its spout) unnamed, its tooltip saying whose part it is. A thing with neither a
+    box nor a single number for x and y is listed, not drawn."""
+    parts = {part: d.iri for d in smap.dispensers.values() for part in (d.lever.iri, d.spout.iri)}
+    boxed = sorted(
+        (iri for iri in kinds if iri in smap.things and iri not in smap.dispensers),
+        key=lambda iri: (smap.things[iri].box.max_z, iri),
+    )
+    for iri in boxed:
+        box = smap.things[iri].box
+        kind = kinds[iri].name
+        where = f"{_span(box)}, top at {box.max_z:g} m"
+        least = 3.0 / canvas.scale  # a tap lever 2 cm across stays visible
+        shown = Box(box.min_x, max(box.max_x, box.min_x + least), box.min_y, max(box.max_y, box.min_y + least))
+        whole = parts.get(iri)
+        fill = "none" if whole is not None else THING[0]  # a spout's outline, the outlet's dot seen through it
+        body = [canvas.rect(shown, fill=fill, stroke=THING[1], stroke_width=1)]
+        if whole is not None:
+            where += f", part of {local_name(whole)}"
+        else:
+            cx, cy = canvas.x(box.centre[0]), canvas.y(box.centre[1])
+            half = (box.max_y - box.min_y) / 2 * canvas.scale
+            body.append(canvas.label(cx, cy, half + 1, local_name(iri), 10, font_weight="bold", fill=THING[1]))
+        yield _linked(link(iri), f"{_label(smap, iri)}: {kind}, {where}", body, "thing")
+        entries.append(Entry(iri, local_name(iri), kind, _classes(smap, iri), where, _room_of(smap, *box.centre[:2])))
+    for iri in sorted(placed):
+        kind, at = kinds[iri].name, placed[iri]
+        if at is None:
+            entries.append(Entry(iri, local_name(iri), kind, _classes(smap, iri), "no single home:x and home:y"))
+            continue
+        x, y, z = at
+        px, py = canvas.x(x), canvas.y(y)
+        where = f"at ({x:g}, {y:g}" + (f", {z:g})" if z is not None else ")")
+        body = [
+            canvas.polygon(
+                [
+                    (x + 6 / canvas.scale, y),
+                    (x, y + 6 / canvas.scale),
+                    (x - 6 / canvas.scale, y),
+                    (x, y - 6 / canvas.scale),
+                ],
+                fill=THING[0],
+                stroke=THING[1],
+                stroke_width=1.5,
+            ),
+            canvas.label(px, py, 7, local_name(iri), 10, font_weight="bold", fill=THING[1]),
+        ]
+        canvas.block(px - 6, py - 6, px + 6, py + 6)
+        yield _linked(link(iri), f"{_label(smap, iri)}: {kind}, {where}", body, "thing")
+        entries.append(Entry(iri, local_name(iri), kind, _classes(smap, iri), where, _room_of(smap, x, y)))
 
 
 def _robot_bodies(canvas: Canvas, smap: SemanticMap, link: Callable[[str], str], entries: list[Entry]) -> Iterator[str]:

@@ -9,7 +9,7 @@ from typing import Any
 from flask import Blueprint, Response
 from markupsafe import Markup
 
-from cbrs.home_plan import MOVED, HomeSurvey, draw_home, survey
+from cbrs.home_plan import MOVED, HomeSurvey, survey
 from cbrs.kb.person_choice import people_check
 from cbrs.kb.semantic_map import local_name
 from cbrs.web import context
@@ -43,7 +43,7 @@ def home() -> Page:
     }
     if found.semantic_map is not None:
         data["persons"] = [checked.to_dict() for checked in people_check(found.semantic_map)]
-        picture = draw_home(found.semantic_map, found.believed, link=iri_url)
+        picture = found.picture(link=iri_url)
         data["things"] = [entry.to_dict() | {"shown": short(entry.iri)} for entry in picture.entries]
         data["picture"] = {"svg": "/home.svg", "width": picture.width, "height": picture.height}
         if not wants_json():
@@ -57,7 +57,7 @@ def home_svg() -> Response:
     found = _survey()
     if found.semantic_map is None:
         return Response(str(found.problem), status=404, mimetype="text/plain")
-    svg = draw_home(found.semantic_map, found.believed, link=iri_url).svg
+    svg = found.picture(link=iri_url).svg
     return Response(svg, mimetype="image/svg+xml", headers={"Cache-Control": "no-cache"})
 
 

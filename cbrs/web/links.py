@@ -72,6 +72,13 @@ def display_text(iri: str) -> str:
     return "".join(name_parts(iri))
 
 
+def shown_term(name: str) -> str:
+    """A term a page's heading or title names as the pages show it (:func:`display_text`) when it is an
+    IRI, else as written: "Plan for https://example.org/lab5#FetchPenForVisitor" headed the plan of a lab's
+    task that the list beside it names ``lab5:FetchPenForVisitor``."""
+    return display_text(name) if "://" in name else name
+
+
 def display_name(iri: str, label: str | None = None) -> Markup:
     """How a link shows ``iri``: ``label`` if given, else :func:`name_parts` with the file part muted
     and the whole IRI left to the link's title. A label equal to the IRI counts as none (pages pass
@@ -112,3 +119,4 @@ def install(app: Flask) -> None:
     app.add_template_global(display_name, "display_name")
     app.add_template_filter(short, "short")
     app.add_template_filter(short_text, "short_text")
+    app.add_template_filter(shown_term, "shown_term")

@@ -18,7 +18,7 @@ from cbrs.actions.shown_names import file_qualifier, shown_names, two_lines
 from cbrs.extras import installed, require
 from cbrs.kb.namespaces import PREFIXES, shorten
 from cbrs.web import context, diagram
-from cbrs.web.links import display_text, expand_name, short, tail_parts
+from cbrs.web.links import display_text, expand_name, short, short_text, shown_term, tail_parts
 from cbrs.web.pages import FormError, Page, page, wants_json
 
 if TYPE_CHECKING:  # the planner (and networkx) load with the first plan asked for, not at start-up
@@ -55,7 +55,7 @@ def plans() -> Page:
     with context.lock():  # a GET stays safe: the plan is shown, not recorded (cbrs plan and /cbrs/plan record)
         composed = _composed(task, objective, shown)
     result = composed.result
-    shown.title = f"Plan for {task}"  # once there is one: "Plan for FetchMyPn" titled the error
+    shown.title = f"Plan for {_shown_task(task, options, data['selected'])}"  # not "Plan for FetchMyPn" over the error
     data["composition"] = _composition(result)
     if composed.base is not None:  # a home of several mobile bases: the one the plan works, and why
         data["base"] = composed.base.to_dict()
@@ -194,6 +194,14 @@ def _read_tasks() -> dict[str, list[dict[str, str | None]]]:
     }
 
 
+def _shown_task(task: str, options: dict[str, list[dict[str, str | None]]], selected: str | None) -> str:
+    """The task as the list names it (a lab's by its derived prefix), else as :func:`shown_term` shows it."""
+    for t in (t for group in ("requirements", "actions") for t in options[group]):
+        if selected is not None and t["name"] == selected:
+            return str(t["shown"])
+    return shown_term(task)
+
+
 def _selected(task: str, options: dict[str, list[dict[str, str | None]]]) -> str | None:
     """The option a task name means: a bare name is a requirement first, as for ``resolve_task``; a task
     of a lab's own namespace by its bare name, its derived prefixed name or its IRI (the form showed
@@ -252,7 +260,8 @@ def _flow(composition: dict[str, Any]) -> Markup | None:
     for goal in composition.get("goals") or []:
         source = goal["from"].get("step")
         key = f"step-{source}" if source is not None else "requirement"
-        edges.append(diagram.Edge(key, "goals", dashed=True, note=f"{goal['name']} ← {goal['source']}"))
+        note = short_text(f"{goal['name']} ← {goal['source']}")  # a lab's class by its prefix, as home:'s
+        edges.append(diagram.Edge(key, "goals", dashed=True, note=note))
     task = display_text(composition["task"])
     rows: list[list[diagram.Box]] = [
         [diagram.Box("requirement", task, f"the requirement {composition['task']}", None, "end")]

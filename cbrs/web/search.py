@@ -110,8 +110,9 @@ def _requirements(needle: str) -> dict[str, Any]:
 
 
 def _things(needle: str) -> dict[str, Any]:
-    """The home's things (rooms, furniture, objects, robots and arms, people, cameras, docking poses) by
-    name or label: a lab's visitor, bookcase or pen was found nowhere but on the home's picture."""
+    """The home's things (rooms, furniture, objects, robots and arms, people, cameras, docking poses, and
+    every other physical thing of the map with an extent or a position) by name or label: a lab's visitor,
+    bookcase or pen was found nowhere but on the home's picture, and its reading lamp nowhere at all."""
     rows = []
     for thing in context.per_generation("search_home_things", _home_things):
         score = rank(needle, (thing["local"],), (thing["label"],))
@@ -123,7 +124,7 @@ def _things(needle: str) -> dict[str, Any]:
 def _home_things() -> list[dict[str, Any]]:
     """Each thing the home's page draws and lists (``cbrs.home_plan``), with its label; none when the map
     cannot be read (the home's page says why)."""
-    from cbrs.home_plan import draw_home, survey
+    from cbrs.home_plan import survey
 
     with context.lock():  # the map reader goes through the knowledge base's caches
         found = survey(context.kb())
@@ -139,5 +140,5 @@ def _home_things() -> list[dict[str, Any]]:
             "kind": entry.kind,
             "room": entry.room,
         }
-        for entry in draw_home(found.semantic_map, found.believed).entries
+        for entry in found.picture().entries
     ]

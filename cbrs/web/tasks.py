@@ -38,7 +38,7 @@ from cbrs.tasks import (
     preconditions_line,
 )
 from cbrs.web import context
-from cbrs.web.links import expand_name, short
+from cbrs.web.links import expand_name, short, shown_term
 from cbrs.web.pages import FormError, Page, page, wants_json
 
 blueprint = Blueprint("tasks", __name__)
@@ -100,7 +100,7 @@ def run(run_id: str) -> Page:
     """One run: its steps, every event it published, and its result (the plan and execution report)."""
     found = context.tasks().get(run_id)  # an unknown run: 404
     data = {"mode": "run", "run": _detail(found), **_live()}
-    return _for_script(Page("tasks.html", f"Run {found.id}: {found.task}, {found.status}", data))
+    return _for_script(Page("tasks.html", f"Run {found.id}: {shown_term(found.task)}, {found.status}", data))
 
 
 @page(blueprint, "/tasks/<run_id>/cancel", negotiate=True, methods=["POST"])
@@ -114,12 +114,12 @@ def cancel(run_id: str) -> Page:
     data = {"mode": "run", **_live()}
     if found.done.is_set():
         data.update(run=_detail(found), error="ended", message=f"{found.id} has already ended: {found.status}")
-        shown = Page("tasks.html", f"Run {found.id}: {found.task}, {found.status}", data)
+        shown = Page("tasks.html", f"Run {found.id}: {shown_term(found.task)}, {found.status}", data)
         shown.status = 409
         return _for_script(shown)
     context.tasks().cancel(run_id)
     data.update(run=_detail(found), message=f"{found.id}: asked to stop after the step under way")
-    shown = Page("tasks.html", f"Run {found.id}: {found.task}, stopping", data)
+    shown = Page("tasks.html", f"Run {found.id}: {shown_term(found.task)}, stopping", data)
     shown.status = 202
     return _for_script(shown)
 

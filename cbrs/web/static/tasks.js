@@ -118,7 +118,7 @@
     steps.replaceChildren();
     eventList.replaceChildren();
     verdict.textContent = "";
-    runName.replaceChildren(el("a", { href: live.dataset.runs + "/" + id }, id), " · " + task);
+    runName.replaceChildren(el("a", { href: live.dataset.runs + "/" + id }, id), " · " + shorten(task));
     setBadge("running");
     restartCamera();
   }
