@@ -45,7 +45,16 @@ from cbrs.kb.errors import (
     UnknownGraphError,
 )
 from cbrs.kb.namespaces import CBRS, DUL, GENID, OWL, RDF, RDFS, GraphName, shorten
-from cbrs.kb.owls import Conversion, Role, Vocabulary, convert, is_owls, owls_key, referenced_ontologies
+from cbrs.kb.owls import (
+    Conversion,
+    Role,
+    Vocabulary,
+    convert,
+    is_owls,
+    is_owls_ontology,
+    owls_key,
+    referenced_ontologies,
+)
 from cbrs.kb.shapes import check_loaded
 from cbrs.kb.store import EmbeddedStore, Store
 from cbrs.kb.superclasses import check_change, check_superclasses
@@ -849,7 +858,8 @@ def _resolve_imports(
 ) -> list[_Raw]:
     """Parse, once each, the ontologies the files import (and, for OWL-S files, those their concepts'
     namespaces name), transitively, from local files only; what the catalogue cannot resolve is
-    reported, not fatal."""
+    reported, not fatal, except an OWL-S upper ontology (a researcher's own collection without copies of
+    them was told its every file had 3 unresolved imports)."""
     pending: deque[tuple[str, str, str]] = deque()
     for raw in raws:
         if raw.is_owls:
@@ -868,7 +878,8 @@ def _resolve_imports(
         seen.add(document)
         path = catalogue.resolve(document)
         if path is None:
-            report.unresolved_imports.append(Unresolved(document, needed_by, reason))
+            if not is_owls_ontology(document):  # read by the OWL-S reader itself: nothing is missing
+                report.unresolved_imports.append(Unresolved(document, needed_by, reason))
             continue
         if path.resolve() in loaded:
             continue

@@ -82,6 +82,12 @@ _KINDS = {
 }
 
 
+def is_owls_ontology(iri: str) -> bool:
+    """Whether ``iri`` is one of the OWL-S upper ontologies (``.../owl-s/1.1/Process.owl``...): the reader
+    turns their terms into cbrs's model itself, so a file importing them needs no copy of them."""
+    return _OWLS_TERM.match(iri.split("#", 1)[0] + "#x") is not None
+
+
 def owls_key(iri: str) -> str | None:
     """``Process:hasInput`` for any OWL-S version's ``.../Process.owl#hasInput``; None for other IRIs."""
     match = _OWLS_TERM.match(iri)
