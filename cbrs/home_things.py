@@ -110,12 +110,16 @@ def read_kinds(
 def _superclasses(kb: KnowledgeBase, classes: set[str]) -> dict[str, set[str]]:
     """Each class's superclasses, itself included (none for a class the store does not declare)."""
     asked = sorted(classes)
+    if not asked:  # no request at all to a remote store
+        return {}
     answers = kb.queries.select_each(kb.store, [("subclasses", {"class": c}) for c in asked])
     return {c: {c} | {row["superclass"].value for row in rows} for c, rows in zip(asked, answers, strict=True)}
 
 
 def _labels(kb: KnowledgeBase, classes: list[str]) -> dict[str, str]:
     """Each class's English (else untagged, else any) label, else its local name in words."""
+    if not classes:
+        return {}
     answers = kb.queries.select_each(kb.store, [("resource_triples", {"resource": c}) for c in classes])
     names = {}
     for concept, rows in zip(classes, answers, strict=True):

@@ -153,7 +153,7 @@ def test_a_thing_of_the_labs_own_class_under_physical_object_is_its_own_kind(
 ) -> None:
     gizmo = _thing(home_json, LAB + "Gizmo1")
     assert gizmo["kind"] == "floor gizmo"  # the class has no label: its local name in words
-    assert gizmo["room"] == "Bedroom" and gizmo["classes"] == [LAB + "FloorGizmo"]
+    assert gizmo["room"] == "Bedroom" and gizmo["classes"] == ["lab-every:FloorGizmo"]  # as the pages name it
     assert (_link(svg, LAB + "Gizmo1").findtext(SVG + "title") or "").startswith(
         "Gizmo1 (the lab's gizmo): floor gizmo"
     )

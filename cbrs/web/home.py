@@ -44,7 +44,10 @@ def home() -> Page:
     if found.semantic_map is not None:
         data["persons"] = [checked.to_dict() for checked in people_check(found.semantic_map)]
         picture = found.picture(link=iri_url)
-        data["things"] = [entry.to_dict() | {"shown": short(entry.iri)} for entry in picture.entries]
+        data["things"] = [
+            entry.to_dict() | {"shown": short(entry.iri), "classes": [_shown(c) for c in entry.classes]}
+            for entry in picture.entries
+        ]
         data["picture"] = {"svg": "/home.svg", "width": picture.width, "height": picture.height}
         if not wants_json():
             data["svg"] = Markup(picture.svg)  # built from escaped text only (cbrs.home_plan)
@@ -71,3 +74,9 @@ def _problem(found: HomeSurvey) -> dict[str, str | None] | None:
         "thing": thing,
         "name": local_name(thing) if thing else None,
     }
+
+
+def _shown(concept: str) -> str:
+    """A thing's class as the pages show it: a lab's by its derived prefix (``lab10:ReadingLamp``), not its
+    IRI; the declared prefixes' as the map reader wrote them."""
+    return short(concept) if "://" in concept else concept
