@@ -132,6 +132,8 @@ class LoadedCollection:
     unresolved_concepts: int
     unresolved_imports: int
     seconds: float
+    #: What is unresolved, one line each, named: the counts alone said neither which nor where from.
+    unresolved: tuple[str, ...] = ()
 
 
 def check_layout(root: Path) -> None:
@@ -203,7 +205,32 @@ def load_collection(root: Path, progress: Progress | None = None) -> LoadedColle
         unresolved_concepts=len({c.iri for c in (*services.unresolved_concepts, *queries.unresolved_concepts)}),
         unresolved_imports=len(services.unresolved_imports) + len(queries.unresolved_imports),
         seconds=time.perf_counter() - start,
+        unresolved=_unresolved(root, (services, queries)),
     )
+
+
+def _unresolved(root: Path, reports: Sequence[Any]) -> tuple[str, ...]:
+    """A line for each unresolved import (the file that needs it, and the ontology/ files of a near name)
+    and each concept no loaded ontology declares (what uses it): a misnamed import of the collection's own
+    ontology left its services' concepts hanging from the root, and the figures said nothing of it."""
+    held = sorted(path.name for path in (root / "ontology").iterdir()) if (root / "ontology").is_dir() else []
+    lines: list[str] = []
+    for report in reports:
+        for missing in report.unresolved_imports:
+            wanted = missing.iri.rstrip("/").rsplit("/", 1)[-1]
+            close = difflib.get_close_matches(wanted, held, n=2)
+            hint = f" (it holds {' and '.join(close)})" if close else ""
+            needed_by = Path(missing.needed_by)
+            lines.append(
+                f"unresolved import {missing.iri}, {missing.reason} of {needed_by.parent.name}/{needed_by.name}: "
+                f"ontology/ has no {wanted}{hint}"
+            )
+        for concept in report.unresolved_concepts:
+            lines.append(
+                f"unresolved concept {concept.iri}, {concept.used_as} of {concept.used_by}: "
+                "no loaded ontology declares it"
+            )
+    return tuple(dict.fromkeys(lines))
 
 
 @dataclass
@@ -217,6 +244,7 @@ class CollectionReport:
     unresolved_concepts: int = 0
     unresolved_imports: int = 0
     load_seconds: float = 0.0
+    unresolved: tuple[str, ...] = ()
 
     def to_json(self) -> dict[str, Any]:
         return {
@@ -225,6 +253,7 @@ class CollectionReport:
             },
             "queries": self.queries,
             "services": self.services,
+            "unresolved": list(self.unresolved),
         }
 
     def text(self) -> str:
@@ -240,6 +269,7 @@ class CollectionReport:
             f"{self.unresolved_concepts} concepts and {self.unresolved_imports} imports unresolved; "
             f"{self.unmatched_offers} judged offers and {len(self.unmatched_requests)} requests not found in the "
             "loaded files",
+            *self.unresolved,
             "",
             *rows,
         ]
@@ -326,6 +356,7 @@ def evaluate_collection(
         unresolved_concepts=loaded.unresolved_concepts,
         unresolved_imports=loaded.unresolved_imports,
         load_seconds=loaded.seconds,
+        unresolved=loaded.unresolved,
     )
 
 
