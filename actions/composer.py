@@ -201,7 +201,7 @@ class Composer:
         self._facts: list[tuple[WorldFact, str]] | None = None  # ... between which things, in which graph
         self._lifted: dict[Statement, list[WorldFact]] = {}  # each statement held: the facts lifted to it
         self._designations: Designations | None = None  # the things inputs name, read once per compose (if needed)
-        self._named: dict[tuple[tuple[str, ...], str | None], NamedThings] = {}  # by input classes and requester
+        self._named: dict[tuple[object, ...], NamedThings] = {}  # by input classes, requester and goals
         self._places: WorldPlaces | None = None  # where things are, read once per compose (if needed)
         self._places_at: tuple[tuple[object, bool], WorldPlaces] | None = None  # and kept while the store is unchanged
         self._matchmaker: Matchmaker | None = None  # for _matched, made on first use
@@ -280,7 +280,8 @@ class Composer:
 
     def named(self, requirement: Requirement) -> NamedThings:
         """The things ``requirement``'s inputs designate (``actions.named_things``), read once per composition."""
-        key = (tuple(p.type or "" for p in requirement.inputs), requirement.requested_by)
+        inputs = tuple(p.type or "" for p in requirement.inputs)
+        key = (inputs, requirement.requested_by, requirement.effects, requirement.deletes)
         if key not in self._named:
             if self._designations is None:
                 self._designations = Designations(self.kb, self.index)

@@ -155,6 +155,11 @@ def test_a_fact_meets_a_statement_only_on_the_sides_bound_to_the_things_named(
     assert not task.meets(carry, WorldFact(lifted, CUP, HAND))
     keep = composer.named(composer.task("KeepCup").requirement)
     assert keep.meets(carry, WorldFact(lifted, CUP, HAND))
+    # the same inputs, another goal: the cup's goal binds the carry to the cup
+    whole = composer.task("EraserCupPen").requirement
+    cup_goal = replace(whole, effects=(Statement(HOME + "Cup", HOME + "isGraspedBy", HOME + "Gripper"),))
+    assert composer.named(cup_goal).aims == {CUP}
+    assert composer.named(cup_goal).meets(carry, WorldFact(lifted, CUP, HAND))
 
 
 def test_a_goal_planned_on_its_own_given_the_cup_does_not_carry_the_pen_by_the_cups_grasp(
