@@ -10,6 +10,7 @@ method ranks the whole service pool for every request; the figures are the means
 from __future__ import annotations
 
 import difflib
+import math
 import statistics
 import time
 import xml.etree.ElementTree as ET
@@ -65,7 +66,8 @@ def read_relevance(path: Path) -> Judgements:
     """Read an SME2 relevance file. A value that is not a whole number of its scale (binary 0 or 1, grades
     0 to 3), a request or offer without its URI, and a request judged in one set and not the other are
     refused, each named: read as it was, a grade of 5 raised NDCG, 'yes' stopped the run with Python's
-    int() message, and a request left out of the graded set scored NDCG 0 without a word."""
+    int() message, and a request left out of the graded set scored NDCG 0 without a word. A file that
+    grades nothing is read (binary relevance alone): its NDCG is not computed."""
     try:
         root = ET.parse(path).getroot()
     except (OSError, ET.ParseError) as error:
@@ -104,7 +106,7 @@ def read_relevance(path: Path) -> Judgements:
     graded = ratings(root.find(".//relevancegrades"), "grade/value")
     if not binary and not wrong:
         raise CollectionError(path.parent, f"{path.name} has no binary relevance set")
-    for uri in sorted(binary.keys() - graded.keys()):
+    for uri in sorted(binary.keys() - graded.keys() if graded else ()):  # none graded: NDCG is not computed
         wrong.append(f"request {uri} is in the binary relevance set and not in the graded one (NDCG reads grades)")
     for uri in sorted(graded.keys() - binary.keys()):
         wrong.append(f"request {uri} is in the graded relevance and not in the binary set (MAP reads it)")
@@ -249,7 +251,8 @@ class CollectionReport:
     def to_json(self) -> dict[str, Any]:
         return {
             "methods": {
-                name: {metric: round(values[metric], 4) for metric in METRICS} for name, values in self.methods.items()
+                name: {metric: None if math.isnan(values[metric]) else round(values[metric], 4) for metric in METRICS}
+                for name, values in self.methods.items()
             },
             "queries": self.queries,
             "services": self.services,
@@ -261,7 +264,7 @@ class CollectionReport:
         rows = [header, "|---|---:|---:|---:|---:|---:|---:|"]
         for name, v in self.methods.items():
             rows.append(
-                f"| {name} | {v['map']:.4f} | {v['ndcg']:.4f} | {v['p_at_1']:.4f} | {v['p_at_10']:.4f} "
+                f"| {name} | {v['map']:.4f} | {_figure(v['ndcg'])} | {v['p_at_1']:.4f} | {v['p_at_10']:.4f} "
                 f"| {v['r_precision']:.4f} | {v['query_ms']:.2f} |"
             )
         lines = [
@@ -270,10 +273,20 @@ class CollectionReport:
             f"{self.unmatched_offers} judged offers and {len(self.unmatched_requests)} requests not found in the "
             "loaded files",
             *self.unresolved,
+            *(
+                ["relevance.xml grades nothing (no relevancegrades): NDCG is not computed"]
+                if any(math.isnan(v["ndcg"]) for v in self.methods.values())
+                else []
+            ),
             "",
             *rows,
         ]
         return "\n".join(lines)
+
+
+def _figure(value: float) -> str:
+    """A figure to four decimals; "-" for one not computed (NDCG of a collection that grades nothing)."""
+    return "-" if math.isnan(value) else f"{value:.4f}"
 
 
 def _stage(progress: Progress | None, prefix: str) -> Progress | None:
@@ -340,13 +353,16 @@ def evaluate_collection(
             ranking = [c.advertisement for c in result.candidates]
             relevant = {iri for iri, flag in binary.items() if flag}
             values["map"].append(average_precision(ranking, relevant))
-            values["ndcg"].append(ndcg(ranking, grades))
+            if judgements.graded:
+                values["ndcg"].append(ndcg(ranking, grades))
             values["p_at_1"].append(precision_at_k(ranking, relevant, 1))
             values["p_at_10"].append(precision_at_k(ranking, relevant, 10))
             values["r_precision"].append(r_precision(ranking, relevant))
             for i, p in enumerate(interpolated_precision(ranking, relevant)):
                 curve[i] += p / len(requests)
         figures[method] = {metric: statistics.fmean(v) if v else 0.0 for metric, v in values.items()}
+        if not judgements.graded:
+            figures[method]["ndcg"] = math.nan  # nothing graded: shown as not computed, not as 0
         curves[method] = curve
     return CollectionReport(
         methods=figures,

@@ -6,6 +6,7 @@ newcomer's mistakes in it. Each mistake is made on a copy of the collection in a
 from __future__ import annotations
 
 import json
+import re
 import shutil
 from pathlib import Path
 
@@ -70,6 +71,48 @@ def test_a_relevance_value_out_of_its_scale_is_refused_naming_it(tmp_path: Path,
     assert str(refused.value).startswith(f"{root}: relevance.xml: ") and said in str(refused.value)
     result = CliRunner().invoke(cli, ["--store", ":memory:", "eval", "owls-tc", str(root), "--json"])
     assert result.exit_code == 1 and said in result.output and "Traceback" not in result.output
+
+
+def _without_grades(root: Path, request: str | None) -> None:
+    """relevance.xml without the graded set's entry of ``request`` (None: without the graded set)."""
+    text = (root / "relevance.xml").read_text(encoding="utf-8")
+    graded = text.index("<relevancegrades>")
+    if request is None:
+        cut = re.sub(r"<relevancegrades>.*</relevancegrades>", "", text[graded:], flags=re.S)
+    else:
+        cut = re.sub(
+            rf"<request id=\"\d+\">\s*<name>{request}</name>.*?</request>", "", text[graded:], count=1, flags=re.S
+        )
+    (root / "relevance.xml").write_text(text[:graded] + cut, encoding="utf-8")
+
+
+def test_a_request_the_graded_set_leaves_out_is_refused(tmp_path: Path) -> None:
+    """Its NDCG was 0 without a word."""
+    root = _copy(tmp_path)
+    _without_grades(root, "train_fare")
+    with pytest.raises(
+        CollectionError,
+        match=re.escape(
+            "request http://127.0.0.1/queries/lab13/train_fare.owls is in the binary relevance set "
+            "and not in the graded one"
+        ),
+    ):
+        read_relevance(root / "relevance.xml")
+
+
+def test_a_collection_that_grades_nothing_has_no_ndcg(tmp_path: Path) -> None:
+    """Binary relevance alone is read; NDCG was 0.0000, as if every ranking were the worst."""
+    root = _copy(tmp_path)
+    _without_grades(root, None)
+    result = CliRunner().invoke(cli, ["--store", ":memory:", "eval", "owls-tc", str(root), "--method", "logic"])
+    assert result.exit_code == 0, result.output
+    assert "relevance.xml grades nothing (no relevancegrades): NDCG is not computed" in result.stdout
+    assert re.search(r"\| logic \| 0\.\d{4} \| - \|", result.stdout)
+    as_json = CliRunner().invoke(
+        cli, ["--store", ":memory:", "eval", "owls-tc", str(root), "--method", "logic", "--json"]
+    )
+    figures = json.loads(as_json.stdout)["methods"]["logic"]
+    assert figures["ndcg"] is None and figures["map"] > 0
 
 
 @pytest.mark.parametrize(
