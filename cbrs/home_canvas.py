@@ -185,7 +185,7 @@ _LEGEND = (
     ("wall", "wall"),
     ("furniture", "furniture (top height)"),
     ("appliance", "appliance"),
-    ("thing", "other thing, its kind"),
+    ("thing", "other physical thing"),
     ("object", "object (its colour)"),
     ("robot", "dual-arm robot, arm reach"),
     ("base", "mobile base, heading"),

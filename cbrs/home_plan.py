@@ -564,9 +564,9 @@ def _other_things(
     placed: Mapping[str, tuple[float, float, float | None] | None],
 ) -> Iterator[str]:
     """The physical things of the map outside the reader's groups (:mod:`cbrs.home_things`): a box by its
-    extent, lowest first, else a diamond at its position, each named with its kind; a part of a water
-    dispenser (its lever, its spout) unnamed, its tooltip saying whose part it is. A thing with neither a
-    box nor a single number for x and y is listed, not drawn."""
+    extent, lowest first, else a diamond at its position, each with its name (its kind in its tooltip); a
+    part of a water dispenser (its lever, its spout) unnamed, its tooltip saying whose part it is. A thing
+    with neither a box nor a single number for x and y is listed, not drawn."""
     parts = {part: d.iri for d in smap.dispensers.values() for part in (d.lever.iri, d.spout.iri)}
     boxed = sorted(
         (iri for iri in kinds if iri in smap.things and iri not in smap.dispensers),
