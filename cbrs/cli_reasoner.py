@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 
 import click
@@ -192,6 +193,24 @@ _TEXT_WEIGHT = click.option(
 )
 
 
+def _text_weight_first(params: tuple[str, ...], text_weight: float) -> MatchConfig:
+    """The matchmaking parameters with ``--text-weight``: given on the command line, it is used whatever
+    the match_params setting says (the setting's text_weight replaced it without a word), and given with
+    a ``--param text_weight`` of another value, the two are refused."""
+    config = match_config(params, MatchConfig(text_weight=text_weight))
+    source = click.get_current_context().get_parameter_source("text_weight")
+    if source is not click.core.ParameterSource.COMMANDLINE or config.text_weight == text_weight:
+        return config
+    if params:  # --param replaces the setting: the other value is the command line's own
+        raise click.UsageError(
+            f"--text-weight {text_weight:g} and --param text_weight={config.text_weight:g} set the same "
+            "parameter to two values: give one"
+        )
+    env = setting("match_params").env
+    click.echo(f"--text-weight {text_weight:g} is used, not the text_weight={config.text_weight:g} of {env}", err=True)
+    return replace(config, text_weight=text_weight)
+
+
 @eval_group.command("owls-tc")
 @click.argument("folder", type=click.Path(exists=True, file_okay=False, path_type=Path))
 @click.option("--method", "methods", multiple=True, type=click.Choice(METHODS), help="Only these methods (repeatable).")
@@ -210,7 +229,7 @@ def eval_owls_tc(
     """An OWL-S test collection in the OWLS-TC layout: services/, ontology/, queries/, relevance.xml."""
     from cbrs.reasoner.owlstc import evaluate_collection, plot_curves
 
-    config = match_config(params, MatchConfig(text_weight=text_weight))
+    config = _text_weight_first(params, text_weight)
     if not as_json:
         click.echo(f"loading {folder} and ranking every service for every query ...", err=True)
     shown = ProgressLine()  # on a terminal only: the --json output is as it was

@@ -9,6 +9,7 @@ import json
 import re
 import shutil
 from pathlib import Path
+from typing import Any
 
 import pytest
 from click.testing import CliRunner
@@ -16,6 +17,8 @@ from click.testing import CliRunner
 from cbrs.cli import cli
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.catalog import Catalogue
+from cbrs.reasoner import owlstc
+from cbrs.reasoner.config import MatchConfig
 from cbrs.reasoner.owlstc import CollectionError, evaluate_collection, read_relevance
 from tests.helpers_examples import EXAMPLES
 
@@ -180,3 +183,25 @@ def test_the_evaluation_names_what_is_unresolved(tmp_path: Path) -> None:
     assert len(unresolved) == 3 and unresolved[0].startswith(
         "unresolved import http://127.0.0.1/ontology/lab13_transport"
     )
+
+
+def test_an_explicit_text_weight_is_used_or_refused_beside_another(monkeypatch: pytest.MonkeyPatch) -> None:
+    """CBRS_MATCH_PARAMS=text_weight=0.5 replaced --text-weight 0.1 without a word (the figures were
+    0.5's), and --param text_weight=0.5 did too."""
+    used: list[float] = []
+
+    def evaluate(root: Path, methods: Any, config: MatchConfig, *rest: Any) -> Any:
+        used.append(config.text_weight)
+        raise CollectionError(root, "stopped here")
+
+    monkeypatch.setattr(owlstc, "evaluate_collection", evaluate)
+    monkeypatch.setenv("CBRS_MATCH_PARAMS", "text_weight=0.5")
+    command = ["eval", "owls-tc", str(COLLECTION), "--method", "sem-str-text", "--text-weight", "0.1"]
+    result = CliRunner().invoke(cli, command)
+    assert used == [0.1] and "--text-weight 0.1 is used, not the text_weight=0.5 of CBRS_MATCH_PARAMS" in result.output
+    refused = CliRunner().invoke(cli, [*command, "--param", "text_weight=0.5"])
+    assert refused.exit_code == 2 and used == [0.1]
+    assert "--text-weight 0.1 and --param text_weight=0.5 set the same parameter to two values" in refused.output
+    monkeypatch.delenv("CBRS_MATCH_PARAMS")
+    CliRunner().invoke(cli, command[:-2])  # the default, and the setting absent
+    assert used == [0.1, MatchConfig().text_weight]
