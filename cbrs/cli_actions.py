@@ -25,7 +25,7 @@ from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, Ob
 from cbrs.actions.errors import UngroundedGoalError
 from cbrs.actions.events import Event
 from cbrs.actions.faults import RandomFaults, planned_faults
-from cbrs.actions.graph import statement_text
+from cbrs.actions.graph import parameter_names, statement_text
 from cbrs.actions.model import ActionLibrary
 from cbrs.actions.plan import Binding, Plan, PlanStep
 from cbrs.actions.replanning import ReplanPolicy
@@ -363,7 +363,7 @@ def plan_text(result: CompositionResult) -> str:
         )
     goals = "\n".join(f"  {_source(g)}" for g in plan.goals)
     columns = ["#", "component", "action", "inputs and preconditions from", "alternatives"]
-    notes = _unused_note(result.unused_inputs) + _ranking_note(result)
+    notes = _unused_note(result.unused_inputs, result) + _ranking_note(result)
     return f"{head}\n{table(columns, rows)}\nGoals:\n{goals}{notes}"
 
 
@@ -392,16 +392,46 @@ def _ranking_note(result: CompositionResult) -> str:
     return f"\nnote: --objective {result.objective.value}: the component was chosen by {said} (others: no choice)"
 
 
-def _unused_note(unused: Sequence[tuple[str, str]]) -> str:
+def _unused_note(unused: Sequence[tuple[str, str]], composition: CompositionResult | None = None) -> str:
     """A note naming the task's inputs no plan took (``CompositionResult.unused_inputs`` for a plan,
-    ``RunResult.unused_inputs`` for a run; docs/composition.md); none: no note."""
+    ``RunResult.unused_inputs`` for a run; docs/composition.md); none: no note. An input whose class
+    another input of the task has, which the plan did take, is said to be passed over for that one: the
+    note said "no component takes a thing of that class" of a researcher's second station, where the
+    fare lookup took the first station for both of its own."""
     if not unused:
         return ""
-    named = ", ".join(f"{name} ({shorten(type_)})" for name, type_ in unused)
-    return (
-        f"\nnote: no step takes the task's input {named}: no component takes a thing of that class (a"
-        " destination must be a home:Place, say), so the plan does without it"
-    )
+    twins = _taken_twins(composition)
+    alike = [(name, type_) for name, type_ in unused if twins.get(type_)]
+    other = [(name, type_) for name, type_ in unused if not twins.get(type_)]
+    notes = ""
+    if other:
+        named = ", ".join(f"{name} ({shorten(type_)})" for name, type_ in other)
+        notes += (
+            f"\nnote: no step takes the task's input {named}: no component takes a thing of that class (a"
+            " destination must be a home:Place, say), so the plan does without it"
+        )
+    for name, type_ in alike:
+        taken = ", ".join(twins[type_])
+        notes += (
+            f"\nnote: no step takes the task's input {name} ({shorten(type_)}): each step's need of that class"
+            f" was given {taken}, the task's other input of the class (docs/composition.md, 'Extracting the"
+            " plan'), so the plan does without it"
+        )
+    return notes
+
+
+def _taken_twins(composition: CompositionResult | None) -> dict[str, list[str]]:
+    """The names of the task's inputs that a step of the plan takes, by their class."""
+    if composition is None or composition.plan is None or not composition.attempts:
+        return {}
+    plan = composition.plan
+    inputs = composition.attempts[0].requirement.inputs
+    classes = dict(zip(parameter_names(inputs), (parameter.type for parameter in inputs), strict=True))
+    taken = {b.source.name for step in plan.steps for b in step.bindings if b.source.step is None}
+    found: dict[str, list[str]] = {}
+    for name in sorted(taken & classes.keys()):
+        found.setdefault(classes[name], []).append(name)
+    return found
 
 
 def _source(binding: Binding) -> str:
@@ -819,7 +849,7 @@ def run_text(result: RunResult, sim_seconds: float, wall_seconds: float) -> str:
     steps = table(["#", "component", "sim s", "outcome", "effects checked"], rows)
     if not report.steps:  # every effect held already: no table of no steps
         steps = "nothing to do: every effect of the task holds already"
-    note = _unused_note(result.unused_inputs) + _ranking_note(result.composition)
+    note = _unused_note(result.unused_inputs, result.composition) + _ranking_note(result.composition)
     given = _preconditions_text(result.preconditions)
     return f"{header}{steps}\n{verdict}; {timing}{given}{_answers_text(result)}{note}"
 

@@ -14,7 +14,9 @@ from typing import Any
 import pytest
 from click.testing import CliRunner
 
+from cbrs.actions.composer import Composer
 from cbrs.cli import cli
+from cbrs.cli_actions import plan_text
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.catalog import Catalogue
 from cbrs.reasoner import owlstc
@@ -23,6 +25,7 @@ from cbrs.reasoner.owlstc import CollectionError, evaluate_collection, read_rele
 from tests.helpers_examples import EXAMPLES
 
 COLLECTION = EXAMPLES / "lab13_collection"
+FARE = "http://127.0.0.1/queries/lab13/train_fare.owls#TrainFareService-request"
 
 
 def _copy(tmp_path: Path) -> Path:
@@ -205,3 +208,28 @@ def test_an_explicit_text_weight_is_used_or_refused_beside_another(monkeypatch: 
     monkeypatch.delenv("CBRS_MATCH_PARAMS")
     CliRunner().invoke(cli, command[:-2])  # the default, and the setting absent
     assert used == [0.1, MatchConfig().text_weight]
+
+
+@pytest.fixture(scope="module")
+def transit_kb() -> KnowledgeBase:
+    """The bundled store with the researcher's services and queries loaded, as docs/owls.md loads them."""
+    kb = KnowledgeBase.open(":memory:")
+    ontology = Catalogue.open(COLLECTION / "ontology")
+    kb.load([COLLECTION / "services"], catalogue=ontology)
+    kb.load([COLLECTION / "queries"], graph="requirements", catalogue=ontology)
+    return kb
+
+
+def test_an_input_passed_over_for_its_twin_is_not_said_to_fit_no_component(transit_kb: KnowledgeBase) -> None:
+    """The fare between two stations: the lookup takes two stations and was given the first for both,
+    and the note said 'no component takes a thing of that class (a destination must be a home:Place,
+    say)' of the second, which the lookup does take."""
+    result = Composer(transit_kb).compose(FARE)
+    assert result.unused_inputs == (("_TrainStation1", "http://127.0.0.1/ontology/lab13_transit.owl#TrainStation"),)
+    text = plan_text(result)
+    assert re.search(
+        r"note: no step takes the task's input _TrainStation1 \(\S+TrainStation\): each step's need of that class "
+        r"was given _TrainStation0, the task's other input of the class",
+        text,
+    )
+    assert "no component takes a thing of that class" not in text
