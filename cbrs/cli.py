@@ -291,7 +291,7 @@ def _warn_undeclared_classes(kb: Any, report: LoadReport) -> None:
                 continue
             near = did_you_mean(kb.store, concept.value)
             meant = f" (did you mean {_local(near)}, {near}?)" if near else ""
-            thing = quad.subject.value
+            thing = quad.subject.value if isinstance(quad.subject, ox.NamedNode | ox.BlankNode) else str(quad.subject)
             click.echo(
                 f"warning: {_local(thing)} ({thing}) is stated a {_local(concept.value)} ({concept.value}), a class "
                 f"nothing in the store declares{meant}: a task finds a thing by a class it is stated to be of, or "
