@@ -525,7 +525,10 @@ class Matchmaker:
             best, output, term = max(found, key=lambda item: item[0].value)
             text = f"({_short(effect.subject)}, {_short(effect.predicate)}, {_short(effect.object)})"
             how = f"no effect; output {_short(output)} reports {_short(term)} ({best.value:.2f}) x {weight:g}"
-            pairs.append(EntityPair("effect", text, output, weight * best.value, how, Degree.FAIL.value, "reports"))
+            rule = "reports"
+            if best is _UNRELATED:  # no output reports a term of it: said "reports", shown as the rule's degree
+                how, rule = f"no effect; no output reports it ({_short(output)}: {best.situation})", ""
+            pairs.append(EntityPair("effect", text, output, weight * best.value, how, Degree.FAIL.value, rule))
             values.append(weight * best.value)
         return sum(values) / len(values)
 

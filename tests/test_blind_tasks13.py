@@ -21,11 +21,13 @@ from cbrs.kb import KnowledgeBase
 from cbrs.kb.catalog import Catalogue
 from cbrs.reasoner import owlstc
 from cbrs.reasoner.config import MatchConfig
+from cbrs.reasoner.matchmaker import Matchmaker
 from cbrs.reasoner.owlstc import CollectionError, evaluate_collection, read_relevance
 from tests.helpers_examples import EXAMPLES
 
 COLLECTION = EXAMPLES / "lab13_collection"
 FARE = "http://127.0.0.1/queries/lab13/train_fare.owls#TrainFareService-request"
+TICKET = "http://127.0.0.1/queries/lab13/get_me_a_train_ticket.owls#GetMeATrainTicketService-request"
 
 
 def _copy(tmp_path: Path) -> Path:
@@ -233,3 +235,18 @@ def test_an_input_passed_over_for_its_twin_is_not_said_to_fit_no_component(trans
         text,
     )
     assert "no component takes a thing of that class" not in text
+
+
+def test_an_output_that_reports_nothing_asked_is_not_said_to_report(transit_kb: KnowledgeBase) -> None:
+    """The ticket query's second candidate, the bundled fall detector, outputs a FallDownEvent, no kind
+    of anything the ticket's effect is about: its explanation said 'output FallDownEvent reports
+    Passenger (0.00)' with the degree 'Reports'. Its score (the inputs part alone) is as it was."""
+    result = Matchmaker(transit_kb).rank(TICKET, explain=3)
+    fall = next(c for c in result.candidates[:3] if c.advertisement.endswith("DetectFallDown_CeilingCamera01"))
+    (pair,) = [p for p in fall.pairs if p.role == "effect"]
+    assert pair.shown_degree() == "Fail" and "reports Passenger" not in pair.how
+    assert pair.how.startswith("no effect; no output reports it (") and pair.similarity == 0.0
+    assert fall.score == pytest.approx(0.2) and fall.parts == {"inputs": 0.5, "effects": 0.0}
+    assert [c.advertisement for c in result.candidates[:1]] == [
+        "http://127.0.0.1/services/lab13/buy_train_ticket.owls#BuyTrainTicketService"
+    ]
