@@ -43,6 +43,19 @@ def expand_name(name: str) -> str:
     return expand(name)
 
 
+def task_name(task: str) -> str:
+    """``task`` as the planner reads it (:func:`cbrs.task_names.task_iri`): a name with a prefix the pages
+    derived for a lab's namespace (``lab5:FetchPenForVisitor``, as the lists and links show it) as its IRI;
+    anything else as typed. The planner knows the declared prefixes alone."""
+    prefix, sep, _ = task.partition(":")
+    if not sep or prefix in PREFIXES or task.startswith(prefix + "://"):
+        return task
+    try:
+        return expand_name(task)
+    except ValueError:
+        return task
+
+
 def name_parts(iri: str) -> tuple[str, str]:
     """``iri`` as it is shown: ``("", prefixed name)`` with a declared or derived prefix
     (:func:`short`); for an IRI that neither shortens, its tail (:func:`tail_parts`)."""

@@ -18,7 +18,7 @@ from cbrs.actions.shown_names import file_qualifier, shown_names, two_lines
 from cbrs.extras import installed, require
 from cbrs.kb.namespaces import PREFIXES, shorten
 from cbrs.web import context, diagram
-from cbrs.web.links import display_text, expand_name, short, short_text, shown_term, tail_parts
+from cbrs.web.links import display_text, short, short_text, shown_term, tail_parts, task_name
 from cbrs.web.pages import FormError, Page, page, wants_json
 
 if TYPE_CHECKING:  # the planner (and networkx) load with the first plan asked for, not at start-up
@@ -111,7 +111,7 @@ def _composed(task: str, objective: str, shown: Page | None) -> _Composed:
     composer = context.composers().get(Objective(objective))
     kept: dict[tuple[str, str], _Composed] = context.per_generation("plans_composed", dict)
     try:
-        iri = task_iri(context.kb(), _with_derived_prefix(task))
+        iri = task_iri(context.kb(), task_name(task))
         found = kept.get((objective, iri))
         if found is None or found.composer is not composer:
             result, base = choose_in_map(composer, iri, composer.compose(iri))
@@ -119,18 +119,6 @@ def _composed(task: str, objective: str, shown: Page | None) -> _Composed:
         return found
     except UnknownTaskError as error:  # says what was meant and how to type every known task
         raise FormError({"task": str(error)}, page=shown) from None
-
-
-def _with_derived_prefix(task: str) -> str:
-    """``task`` as the planner reads it: a name with a prefix the pages derived for a lab's namespace
-    (``lab5:FetchPenForVisitor``, as the list and every link show it) as its IRI; anything else as typed."""
-    prefix, sep, _ = task.partition(":")
-    if not sep or prefix in PREFIXES or task.startswith(prefix + "://"):
-        return task
-    try:
-        return expand_name(task)
-    except ValueError:
-        return task
 
 
 DRAWING_MODULE = "cbrs.actions.draw"

@@ -38,7 +38,7 @@ from cbrs.tasks import (
     preconditions_line,
 )
 from cbrs.web import context
-from cbrs.web.links import expand_name, short, shown_term
+from cbrs.web.links import expand_name, short, shown_term, task_name
 from cbrs.web.pages import FormError, Page, page, wants_json
 
 blueprint = Blueprint("tasks", __name__)
@@ -144,7 +144,7 @@ def _check_asked(form: dict[str, Any], shown: Page) -> None:
 
     try:
         with context.lock():
-            iri = task_iri(context.kb(), asked)
+            iri = task_iri(context.kb(), task_name(asked))
     except UnknownTaskError as error:
         raise FormError({"task": str(error)}, page=shown) from None
     listed = _typed(iri, offered)
@@ -199,6 +199,13 @@ def _json_body() -> dict[str, Any]:
     return body
 
 
+def _as_listed(task: str) -> str:
+    """A task named with a prefix the pages derived (``lab10:SwitchOnTheReadingLamp``, as the New task page's
+    link names it) as the list spells it, which the runner takes; any other name as typed."""
+    iri = task_name(task)
+    return task if iri == task else (_typed(iri, choices()["tasks"]) or iri)
+
+
 def _checked(form: dict[str, Any], shown: Page) -> dict[str, Any]:
     """The form's fields as ``TaskRunner.start`` takes them; a FormError naming each bad one. The task
     name itself is checked by the runner, against the store (with a did-you-mean)."""
@@ -238,7 +245,7 @@ def _checked(form: dict[str, Any], shown: Page) -> dict[str, Any]:
     if errors:
         raise FormError(errors, page=shown)
     return {
-        "task": form["task"],
+        "task": _as_listed(form["task"]),
         "seed": seed,
         "faults": faults,
         "fault_rate": fault_rate,

@@ -1,0 +1,81 @@
+"""A fourteenth blind round: a lab member who uses only the browser (docs/web.md, "Tried from the browser alone").
+
+A care worker given the URL of a running ``cbrs serve`` and its update token drove the pages as a browser
+does: forms submitted as their HTML writes them (method, action, field names, the token field, the
+``Origin`` a browser sends), links followed. The store holds the tenth round's reading lamp, loaded into
+the ontology and the map as its header says. Each test here failed before its fix. One app per module,
+runs that end at once (no planner run, no simulation).
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Iterator
+from html import unescape
+from typing import Any
+
+import pytest
+from flask.testing import FlaskClient
+
+from cbrs.kb import KnowledgeBase
+from cbrs.sparql_service import EndpointConfig, SparqlService
+from cbrs.tasks import TaskRun, TaskRunner
+from cbrs.web import create_app
+from tests.helpers_examples import EXAMPLES
+
+TOKEN = "lab14-token"
+OWN = "http://127.0.0.1:8080"
+BROWSER = {"Origin": OWN, "Accept": "text/html,application/xhtml+xml,*/*;q=0.8"}
+LAMP_TASK = (EXAMPLES / "lab10_switch_on_the_lamp.ttl").read_text(encoding="utf-8")
+LAB10 = "https://example.org/lab10#"
+
+
+class _Ended(TaskRunner):
+    """A runner whose runs succeed at once: no planner, no world."""
+
+    def _run(self, run: TaskRun) -> None:
+        run.result = {"plan": {"status": "planned"}, "execution": {"status": "succeeded", "steps": []}}
+        run.status = "succeeded"
+        run.done.set()
+
+
+@pytest.fixture(scope="module")
+def client() -> Iterator[FlaskClient]:
+    kb = KnowledgeBase.open(":memory:")
+    for graph in ("ontology", "map"):  # as lab10_reading_lamp.ttl's header says
+        kb.load([EXAMPLES / "lab10_reading_lamp.ttl"], graph=graph)
+    sparql = SparqlService(kb, EndpointConfig(update_token=TOKEN))
+    app = create_app(sparql, tasks=_Ended(kb, sparql.lock, camera=None), own_origins=lambda: [OWN])
+    yield app.test_client()
+    kb.close()
+
+
+def _text(html: str) -> str:
+    html = re.sub(r"(?s)<(script|style)[^>]*>.*?</\1>", " ", html)
+    return " ".join(unescape(re.sub(r"<[^>]+>", " ", html)).split())
+
+
+def _errors(html: str) -> list[str]:
+    """What the page says is wrong: each field's message and each error box, in words."""
+    found = re.findall(r'(?s)class="[^"]*(?:field-error|error-box)[^"]*"[^>]*>(.*?)</(?:p|span|div)>', html)
+    return [_text(part) for part in found]
+
+
+def _post_form(client: FlaskClient, path: str, **fields: Any) -> Any:
+    return client.post(path, data=fields, headers=BROWSER)
+
+
+def test_a_lab_task_saved_on_the_new_task_page_opens_chosen_on_the_tasks_page(client: FlaskClient) -> None:
+    """"Run it on the tasks page" after saving lab10:SwitchOnTheReadingLamp led to a 400: the tasks page
+    did not take the derived prefix its own link used ("no requirement or action named
+    'lab10:SwitchOnTheReadingLamp'; did you mean SwitchOnTheReadingLamp?"), and Start refused it too."""
+    saved = _post_form(client, "/tasks/new", turtle=LAMP_TASK, action="save", token=TOKEN)
+    assert saved.status_code == 201, _errors(saved.text)
+    link = unescape(re.search(r'id="run-link" href="([^"]+)"', saved.text).group(1))
+    page = client.get(link, headers=BROWSER)
+    assert page.status_code == 200, _errors(page.text)
+    chosen = re.search(r'<option value="([^"]+)" selected>', page.text)
+    assert chosen is not None and chosen.group(1) == "SwitchOnTheReadingLamp"
+    started = _post_form(client, "/tasks", task="lab10:SwitchOnTheReadingLamp", seed="0")
+    assert started.status_code == 202, _errors(started.text)
+    assert "started: SwitchOnTheReadingLamp" in _text(started.text)
