@@ -66,7 +66,7 @@ def _post_form(client: FlaskClient, path: str, **fields: Any) -> Any:
 
 
 def test_a_lab_task_saved_on_the_new_task_page_opens_chosen_on_the_tasks_page(client: FlaskClient) -> None:
-    """"Run it on the tasks page" after saving lab10:SwitchOnTheReadingLamp led to a 400: the tasks page
+    """ "Run it on the tasks page" after saving lab10:SwitchOnTheReadingLamp led to a 400: the tasks page
     did not take the derived prefix its own link used ("no requirement or action named
     'lab10:SwitchOnTheReadingLamp'; did you mean SwitchOnTheReadingLamp?"), and Start refused it too."""
     saved = _post_form(client, "/tasks/new", turtle=LAMP_TASK, action="save", token=TOKEN)

@@ -16,7 +16,7 @@ from markupsafe import Markup
 
 from cbrs.actions.shown_names import file_qualifier, shown_names, two_lines
 from cbrs.extras import installed, require
-from cbrs.kb.namespaces import PREFIXES, shorten
+from cbrs.kb.namespaces import shorten
 from cbrs.web import context, diagram
 from cbrs.web.links import display_text, short, short_text, shown_term, tail_parts, task_name
 from cbrs.web.pages import FormError, Page, page, wants_json
