@@ -11,18 +11,25 @@ statements must: :func:`kb.superclasses.check_change`), and are one transaction 
 from __future__ import annotations
 
 import logging
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 
 import pyoxigraph as ox
 
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.loader import parse_bytes
-from cbrs.kb.namespaces import GraphName
-from cbrs.kb.shapes import check_descriptions
+from cbrs.kb.namespaces import GRAPH, PREFIXES, GraphName
+from cbrs.kb.shapes import DescriptionShapeError, check_descriptions
 from cbrs.kb.superclasses import check_change, says_used_terms
 from cbrs.output import used_prefixes
-from cbrs.sparql_service import NotAcceptableError, SparqlService, negotiate
+from cbrs.sparql_service import (
+    BadDatasetError,
+    BadRequestError,
+    NotAcceptableError,
+    SparqlService,
+    UnsupportedMediaTypeError,
+    negotiate,
+)
 
 __all__ = ["GraphStore", "GraphStoreError", "Target", "UnknownGraphError"]
 
@@ -39,27 +46,19 @@ DATASET_FORMATS = (ox.RdfFormat.TRIG, ox.RdfFormat.N_QUADS)
 log = logging.getLogger(__name__)
 
 
-class GraphStoreError(KnowledgeBaseError):
-    """A Graph Store request that cannot be answered as asked; names what was wrong."""
-
-    http_status = 400
+class GraphStoreError(BadRequestError):
+    """A Graph Store request that cannot be answered as asked; names what was wrong. Its errors are the
+    SPARQL endpoint's for the same mistake (400 ``bad-request``, 403 ``forbidden``, 406 ``not-acceptable``,
+    415 ``unsupported-media-type``), so a client reads one set of names (docs/serving.md)."""
 
 
 class UnknownGraphError(GraphStoreError):
     http_status = 404
+    kind = "not-found"  # as the server's other 404s are named
 
     def __init__(self, graph: str) -> None:
         self.graph = graph
         super().__init__(f"the store has no graph <{graph}>")
-
-
-class NotAcceptableFormatError(GraphStoreError):
-    http_status = 406
-
-    def __init__(self, asked: str, offered: tuple[ox.RdfFormat, ...]) -> None:
-        self.asked = asked
-        names = ", ".join(f.media_type for f in offered)
-        super().__init__(f"cannot answer in {asked!r}; ask for one of {names}")
 
 
 @dataclass(frozen=True)
@@ -68,6 +67,28 @@ class Target:
 
     graph: str | None
     default: bool = False
+
+    @classmethod
+    def from_parameters(cls, graphs: Sequence[str], default: bool) -> Target:
+        """The target a request's ``graph`` values and ``default`` flag name. A ``graph`` that is not an
+        absolute IRI is refused as the endpoint refuses a ``default-graph-uri`` that is not one (400
+        ``bad-dataset``), and so is a name written with one of cbrs's prefixes: ``graph:map`` parses as an IRI
+        of the scheme ``graph``, and would name a graph nobody has (cbrs's are ``https://w3id.org/cbrs/graph/NAME``)."""
+        if len(graphs) > 1 or (graphs and default):
+            raise GraphStoreError("name one graph: ?graph=IRI or ?default, once")
+        if not graphs:
+            return cls(None, default)
+        graph = graphs[0]
+        try:
+            ox.NamedNode(graph)
+        except ValueError as error:  # a space, a '<'
+            raise BadDatasetError("graph", graph, str(error)) from None
+        scheme, _, rest = graph.partition(":")
+        if scheme in PREFIXES and not rest.startswith("//"):
+            raise BadDatasetError(
+                "graph", graph, f"{scheme}: is a prefix of cbrs's, not a scheme; its graphs are {GRAPH}NAME"
+            )
+        return cls(graph)
 
     @property
     def node(self) -> ox.NamedNode | ox.DefaultGraph | None:
@@ -111,9 +132,10 @@ class GraphStore:
 
     def replace(self, target: Target, body: bytes, media_type: str, token: str | None) -> bool:
         """PUT: the graph becomes the body's triples; True when the graph did not exist before."""
-        self.sparql.check_token(token)
         node = self._graph_node(target, "PUT")
-        new = self._parse(body, media_type, node)
+        fmt = _body_format(media_type, node, "PUT")  # as the endpoint: 415 before 403, 403 before the body is read
+        self.sparql.check_token(token)
+        new = self._parse(body, fmt, node)
         with self.sparql.lock:
             self.sparql.kb.check_map_write(new, replaces_map=node == GraphName.MAP.node)
             store = self.sparql.kb.store
@@ -126,9 +148,10 @@ class GraphStore:
 
     def add(self, target: Target, body: bytes, media_type: str, token: str | None) -> None:
         """POST: the body's triples join the graph (or, for the dataset, its quads join the store)."""
-        self.sparql.check_token(token)
         node = target.node
-        new = self._parse(body, media_type, node)
+        fmt = _body_format(media_type, node, "POST")
+        self.sparql.check_token(token)
+        new = self._parse(body, fmt, node)
         with self.sparql.lock:
             self.sparql.kb.check_map_write(new)
             check_change(self.sparql.kb.store, (), new, _request("POST", node))
@@ -169,29 +192,29 @@ class GraphStore:
             raise GraphStoreError(f"{method} needs ?graph=IRI or ?default: it acts on one graph, not the whole store")
         return node
 
-    def _parse(self, body: bytes, media_type: str, node: ox.NamedNode | ox.DefaultGraph | None) -> list[ox.Quad]:
-        offered = DATASET_FORMATS if node is None else GRAPH_FORMATS
-        fmt = ox.RdfFormat.from_media_type(media_type) if media_type else None
-        if fmt not in offered:
-            names = ", ".join(f.media_type for f in offered)
-            raise GraphStoreError(f"a body of {media_type or '(no type)'} cannot be stored here; send one of {names}")
-        assert fmt is not None
+    def _parse(self, body: bytes, fmt: ox.RdfFormat, node: ox.NamedNode | ox.DefaultGraph | None) -> list[ox.Quad]:
         graph = node.value if isinstance(node, ox.NamedNode) else None
         parsed = parse_bytes(body, "<request body>", fmt, graph=graph, base_iri=graph)  # whole, or an error
         quads = parsed.quads
         if isinstance(node, ox.DefaultGraph):
             quads = [ox.Quad(q.subject, q.predicate, q.object, ox.DefaultGraph()) for q in quads]
-        check_descriptions(self.sparql.kb.store, quads)  # a description written so passes the shapes too
+        try:
+            check_descriptions(self.sparql.kb.store, quads)  # a description written so passes the shapes too
+        except DescriptionShapeError as error:
+            error.add_note("nothing was written")  # as /update's refusal of the same description says
+            raise
         return quads
 
 
 def _request(method: str, node: ox.NamedNode | ox.DefaultGraph | None) -> str:
     """How a refusal names the request: ``the PUT of graph <IRI>``, ``the POST to the store``."""
+    return f"the {method} {'to' if method == 'POST' else 'of'} {_named(node)}"
+
+
+def _named(node: ox.NamedNode | ox.DefaultGraph | None) -> str:
     if node is None:
-        what = "the store"
-    else:
-        what = "the default graph" if isinstance(node, ox.DefaultGraph) else f"graph {node}"
-    return f"the {method} {'to' if method == 'POST' else 'of'} {what}"
+        return "the store"
+    return "the default graph" if isinstance(node, ox.DefaultGraph) else f"graph {node}"
 
 
 def _negotiate(accept: str | None, offered: tuple[ox.RdfFormat, ...]) -> ox.RdfFormat:
@@ -200,5 +223,25 @@ def _negotiate(accept: str | None, offered: tuple[ox.RdfFormat, ...]) -> ox.RdfF
     by_type = {fmt.media_type: fmt for fmt in offered}
     try:
         return by_type[negotiate(True, accept, None, tuple(by_type))]
-    except NotAcceptableError as error:
-        raise NotAcceptableFormatError(accept or "", offered) from error
+    except NotAcceptableError:  # the endpoint's refusal, naming every type offered (it names four of its many)
+        raise NotAcceptableError(accept or "", tuple(by_type)) from None
+
+
+_FORM_TYPE = "application/x-www-form-urlencoded"
+
+
+def _body_format(media_type: str, node: ox.NamedNode | ox.DefaultGraph | None, method: str) -> ox.RdfFormat:
+    """The RDF format of a write's body by its ``Content-Type``; 415 naming the types taken, as the SPARQL
+    endpoint refuses a body it cannot read, for one of another type or of none. curl's ``--data-binary``
+    sends a form's type unless told another: the refusal says so."""
+    offered = DATASET_FORMATS if node is None else GRAPH_FORMATS
+    fmt = ox.RdfFormat.from_media_type(media_type) if media_type else None
+    if fmt is not None and fmt in offered:
+        return fmt
+    hint = ""
+    if media_type == _FORM_TYPE:
+        hint = f" (curl --data-binary sends {_FORM_TYPE} unless told: -H 'Content-Type: {offered[0].media_type}')"
+    elif node is None and fmt in GRAPH_FORMATS:
+        hint = " (a body of triples goes into one graph: ?graph=IRI or ?default)"
+    where = f"the body of a {method} to {_named(node)}"
+    raise UnsupportedMediaTypeError(media_type, where, [f.media_type for f in offered], hint)

@@ -203,6 +203,28 @@ class UpdateForbiddenError(EndpointError):
     kind = "forbidden"
 
 
+class BadRequestError(EndpointError):
+    """A request the protocol cannot read as asked (a parameter missing, doubled or misspelt); the
+    message names what was wrong."""
+
+    http_status = 400
+    kind = "bad-request"
+
+
+class UnsupportedMediaTypeError(EndpointError):
+    """A body of a media type the path does not take, or of none: ``where`` names the request, ``accepted``
+    the types it takes, ``hint`` (optional) how the mistake is usually made."""
+
+    http_status = 415
+    kind = "unsupported-media-type"
+
+    def __init__(self, media_type: str, where: str, accepted: Sequence[str], hint: str = "") -> None:
+        self.media_type = media_type
+        self.accepted = tuple(accepted)
+        types = ", ".join(self.accepted[:-1]) + f" or {self.accepted[-1]}" if len(self.accepted) > 1 else accepted[0]
+        super().__init__(f"{where} must be {types}, not {media_type or '(none)'!r}{hint}")
+
+
 class BadDatasetError(EndpointError):
     http_status = 400
     kind = "bad-dataset"

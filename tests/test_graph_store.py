@@ -77,7 +77,7 @@ def test_writes_need_the_token_and_bad_requests_change_nothing(client: FlaskClie
     whole = client.put("/store", data="<urn:a> <urn:p> 1 .", content_type=TURTLE, headers=AUTH)
     assert whole.status_code == 400 and "?graph=IRI or ?default" in whole.get_json()["message"]
     wrong_type = client.put(f"/store?graph={GRAPH}", data="x", content_type="image/png", headers=AUTH)
-    assert wrong_type.status_code == 400 and "text/turtle" in wrong_type.get_json()["message"]
+    assert wrong_type.status_code == 415 and "text/turtle" in wrong_type.get_json()["message"]  # as /update's
     assert client.get("/store?graph=notes").status_code == 400  # not an absolute IRI
     assert client.get(f"/store?graph={GRAPH}&default").status_code == 400
     refused = client.get("/store?graph=https://w3id.org/cbrs/graph/services", headers={"Accept": "image/png"})
