@@ -167,9 +167,10 @@ def test_a_goal_planned_on_its_own_given_the_cup_does_not_carry_the_pen_by_the_c
 ) -> None:
     """The re-plan in the simulation, the pen's approach refused and its component left out (the re-planning
     memory's first try): no part takes the pen, so the task is planned goal by goal, and the pen's goal is
-    given the inputs no goal is about, the cup among them. Before, the cup held met that part's carry, and the
-    plan carried the cup towards the pen's place (the carry failed: no inverse kinematics 1.5 m up). Now the
-    pen's goal has no plan without a take."""
+    given the inputs no goal is about, the cup among them. Before, the cup held met that part's carry: the plan
+    was the carry and the put-down (in the simulation, with the grasp reported and every named thing alike,
+    the carry took the cup towards the mat and failed, no inverse kinematics 1.5 m up). Now the pen's goal
+    has no plan without a take."""
     kb, _ = held
     without = [ad for ad in Composer(kb).advertisements if "ApproachToObject" not in ad.iri]
     result = Composer(kb, advertisements=without).compose("EraserCupPen", belief=True)
