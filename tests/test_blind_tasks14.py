@@ -79,3 +79,16 @@ def test_a_lab_task_saved_on_the_new_task_page_opens_chosen_on_the_tasks_page(cl
     started = _post_form(client, "/tasks", task="lab10:SwitchOnTheReadingLamp", seed="0")
     assert started.status_code == 202, _errors(started.text)
     assert "started: SwitchOnTheReadingLamp" in _text(started.text)
+
+
+def test_no_plan_names_a_lab_class_by_its_prefix_on_the_plans_and_new_task_pages(client: FlaskClient) -> None:
+    """The plans page and New task's check said "no component provides effect
+    (https://example.org/lab10#ReadingLamp, home:hasStatus, home:SwitchedOn)" where the run's page,
+    the class page and the home name it lab10:ReadingLamp."""
+    checked = _post_form(client, "/tasks/new", turtle=LAMP_TASK, action="check")
+    planned = client.get("/plans?task=lab10:SwitchOnTheReadingLamp", headers=BROWSER)
+    for page in (checked, planned):
+        assert page.status_code == 200, _errors(page.text)
+        said = _text(page.text.split("No plan.", 1)[1])
+        assert "(lab10:ReadingLamp, home:hasStatus, home:SwitchedOn)" in said
+        assert LAB10 not in said
