@@ -8,6 +8,8 @@ from __future__ import annotations
 import json
 import re
 import shutil
+import subprocess
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -219,6 +221,7 @@ def transit_kb() -> KnowledgeBase:
     ontology = Catalogue.open(COLLECTION / "ontology")
     kb.load([COLLECTION / "services"], catalogue=ontology)
     kb.load([COLLECTION / "queries"], graph="requirements", catalogue=ontology)
+    kb.load([EXAMPLES / "lab13_bus_ticket.ttl"], graph="requirements")
     return kb
 
 
@@ -250,3 +253,27 @@ def test_an_output_that_reports_nothing_asked_is_not_said_to_report(transit_kb: 
     assert [c.advertisement for c in result.candidates[:1]] == [
         "http://127.0.0.1/services/lab13/buy_train_ticket.owls#BuyTrainTicketService"
     ]
+
+
+def test_the_bus_ticket_in_turtle_has_no_chain_and_says_why(transit_kb: KnowledgeBase) -> None:
+    """No service issues a bus ticket: no plan, and the unmet need is the requirement's effect."""
+    result = Composer(transit_kb).compose("BuyMeABusTicket")
+    assert result.plan is None and result.status.value != "planned"
+    (unmet,) = result.unsatisfied
+    transit = "http://127.0.0.1/ontology/lab13_transit.owl#"
+    assert unmet.text().startswith(
+        f"no component provides effect ({transit}BusTicket, {transit}isIssuedTo, {transit}Passenger) of the requirement"
+    )
+
+
+def test_the_python_example_ranks_and_evaluates_the_collection() -> None:
+    """docs/examples/lab13_rank_from_python.py, as matchmaking.md's "From Python" shows the library."""
+    done = subprocess.run(
+        [sys.executable, str(EXAMPLES / "lab13_rank_from_python.py")], capture_output=True, text=True, timeout=120
+    )
+    assert done.returncode == 0, done.stderr
+    assert (
+        "train_fare.owls by sem-str: matched\n  0.987 train_fare_lookup (acceptable): output SubClassOf 0.98"
+        in done.stdout
+    )
+    assert re.search(r"\| sem-str \| 0\.7310 \| 0\.8892 \|", done.stdout)
