@@ -92,3 +92,18 @@ def test_no_plan_names_a_lab_class_by_its_prefix_on_the_plans_and_new_task_pages
         said = _text(page.text.split("No plan.", 1)[1])
         assert "(lab10:ReadingLamp, home:hasStatus, home:SwitchedOn)" in said
         assert LAB10 not in said
+
+
+def test_a_save_from_the_page_without_its_token_says_to_type_it_in_the_field(client: FlaskClient) -> None:
+    """Save as task with the Update token field left empty said "updates need the server's token:
+    Authorization: Bearer <token>", a header a person in a browser cannot send; a mistyped token "the bearer
+    token sent is not this server's update token". Both now speak of the page's field."""
+    text = LAMP_TASK.replace("SwitchOnTheReadingLamp", "SwitchOnMyLamp")
+    empty = _post_form(client, "/tasks/new", turtle=text, action="save", token="")
+    wrong = _post_form(client, "/tasks/new", turtle=text, action="save", token="lab14-tokn")
+    for page, said in ((empty, "type it in the Update token field"), (wrong, "is not this server's update token")):
+        assert page.status_code == 403
+        (message,) = _errors(page.text)
+        assert said in message and "Authorization" not in message and "Bearer" not in message
+    program = client.post("/tasks/new.json", json={"turtle": text, "action": "save"})
+    assert program.status_code == 403 and "Authorization: Bearer" in program.get_json()["message"]
