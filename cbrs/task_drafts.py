@@ -27,6 +27,7 @@ declared on one line put before it, and the parser's line numbers are given back
 from __future__ import annotations
 
 import dataclasses
+import difflib
 import hashlib
 import re
 from collections.abc import Iterable, Mapping, Sequence
@@ -152,7 +153,7 @@ def read(kb: KnowledgeBase, text: str, prefixes: Mapping[str, str]) -> TaskDraft
     except RdfParseError as error:
         line = error.line - 1 if error.line and head else error.line
         raise DraftError(error.message + _prefix_hint(error.message), line, error.column) from None
-    iri = _the_requirement(parsed.quads)
+    iri = _the_requirement(parsed.quads, text)
     try:
         check_descriptions(kb.store, parsed.quads)
     except DescriptionShapeError as error:
@@ -287,7 +288,7 @@ def _prefix_hint(message: str) -> str:
     return f"; {meant}(declare a prefix of your own with @prefix {found.group(1)}: <IRI> .)"
 
 
-def _the_requirement(quads: Sequence[ox.Quad]) -> str:
+def _the_requirement(quads: Sequence[ox.Quad], text: str) -> str:
     """The IRI of the one requirement the text describes; a page saves one task at a time."""
     kinds = (ox.NamedNode(RDF + "type"), ox.NamedNode(CBRS.Requirement))
     found = sorted(
@@ -295,9 +296,7 @@ def _the_requirement(quads: Sequence[ox.Quad]) -> str:
     )
     named = [iri for iri in found if not iri.startswith(GENID)]
     if not found:
-        raise DraftError(
-            "the text describes no task: a task is a cbrs:Requirement (req:MyTask a cbrs:Requirement ; ...)"
-        )
+        raise _no_requirement(quads, text)
     if len(named) != len(found):
         raise DraftError("the task has no name: give the cbrs:Requirement an IRI (req:MyTask), not a blank node")
     if len(found) > 1:
@@ -305,6 +304,29 @@ def _the_requirement(quads: Sequence[ox.Quad]) -> str:
             f"the text describes {len(found)} tasks ({', '.join(shorten(i) for i in found)}): save one at a time"
         )
     return found[0]
+
+
+def _no_requirement(quads: Sequence[ox.Quad], text: str) -> DraftError:
+    """The text names no cbrs:Requirement: when it types a thing with a class spelt like it
+    (``cbrs:Requirment``, ``req:Requirement``), that class, its line and the class meant."""
+    usage = "a task is a cbrs:Requirement (req:MyTask a cbrs:Requirement ; ...)"
+    kinds = {
+        q.object.value
+        for q in quads
+        if q.predicate.value == RDF + "type"
+        and isinstance(q.subject, ox.NamedNode)
+        and isinstance(q.object, ox.NamedNode)
+    }
+    for kind in sorted(kinds):
+        local = re.split(r"[#/:]", kind)[-1].casefold()
+        if difflib.SequenceMatcher(None, local, "requirement").ratio() >= 0.75:
+            shown = shorten(kind)
+            return DraftError(
+                f"the text describes no task: its {shown} is no class of cbrs; did you mean cbrs:Requirement? "
+                f"({usage})",
+                line_of(text, shown if shown != kind else f"<{kind}>"),
+            )
+    return DraftError(f"the text describes no task: {usage}")
 
 
 def _requirement(kb: KnowledgeBase, quads: Sequence[ox.Quad], iri: str) -> Requirement:

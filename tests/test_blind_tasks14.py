@@ -107,3 +107,15 @@ def test_a_save_from_the_page_without_its_token_says_to_type_it_in_the_field(cli
         assert said in message and "Authorization" not in message and "Bearer" not in message
     program = client.post("/tasks/new.json", json={"turtle": text, "action": "save"})
     assert program.status_code == 403 and "Authorization: Bearer" in program.get_json()["message"]
+
+
+def test_a_task_whose_class_is_misspelt_is_told_the_class_meant_and_where(client: FlaskClient) -> None:
+    """``lab10:SwitchOnTheReadingLamp a cbrs:Requirment`` was "the text describes no task: a task is a
+    cbrs:Requirement", with no word of the misspelt class the text does name, nor of its line."""
+    text = LAMP_TASK.replace("a cbrs:Requirement", "a cbrs:Requirment")
+    page = _post_form(client, "/tasks/new", turtle=text, action="check")
+    assert page.status_code == 400
+    (message,) = _errors(page.text)
+    line = next(n for n, row in enumerate(text.splitlines(), start=1) if "cbrs:Requirment" in row)
+    assert message.startswith(f"line {line}:") and "cbrs:Requirment" in message
+    assert "did you mean cbrs:Requirement?" in message
