@@ -119,3 +119,16 @@ def test_a_task_whose_class_is_misspelt_is_told_the_class_meant_and_where(client
     line = next(n for n, row in enumerate(text.splitlines(), start=1) if "cbrs:Requirment" in row)
     assert message.startswith(f"line {line}:") and "cbrs:Requirment" in message
     assert "did you mean cbrs:Requirement?" in message
+
+
+def test_a_concept_written_without_its_prefix_on_the_match_page_is_told_the_one_meant(client: FlaskClient) -> None:
+    """Matchmaking with the inputs "MarkerColour" (the name a class page shows after its prefix) said
+    "MarkerColour: MarkerColour: is not a known prefix; use one of cbrs, home, act, ..." (25 prefixes); a
+    lab's ReadingLamp and a slipped prefix (hom:Cup) were refused so too."""
+    page = client.get("/match?inputs=MarkerColour&outputs=ReadingLamp&effects=hom:Cup+home:isWith+home:Person")
+    assert page.status_code == 400
+    said = " | ".join(_errors(page.text))
+    assert "did you mean home:MarkerColour?" in said
+    assert "did you mean lab10:ReadingLamp?" in said
+    assert "did you mean home:Cup?" in said
+    assert "MarkerColour: MarkerColour:" not in said

@@ -180,14 +180,32 @@ def _concept(term: str, index: TaxonomyIndex) -> str:
         return _by_tail(term, index)
     prefix = term.partition(":")[0]
     known = prefix in PREFIXES or prefix in derived()  # the prefixes the pages show, the store's own included
+    if ":" not in term:  # a class page's name after its prefix: MarkerColour for home:MarkerColour
+        near = _by_local_name(term, index)
+        hint = f"did you mean {' or '.join(near)}?" if near else "concepts are prefixed names, e.g. home:Cup"
+        raise ValueError(f"{term} has no prefix; {hint}")
     if not term.startswith("<") and not known and prefix not in ("http", "https", "urn"):
-        raise ValueError(f"{term}: {prefix}: is not a known prefix; use one of {', '.join(PREFIXES)}")
+        near = _by_local_name(term.partition(":")[2], index)
+        hint = f"did you mean {' or '.join(near)}?" if near else f"use one of {', '.join(PREFIXES)}"
+        raise ValueError(f"{term}: {prefix}: is not a known prefix; {hint}")
     iri = expand_name(term)
     if iri not in index:
         near = difflib.get_close_matches(term, [display_text(n) for n in index.nodes()], n=3, cutoff=0.75)
         hint = f"; did you mean {' or '.join(near)}?" if near else "; concepts are prefixed names, e.g. home:Cup"
         raise ValueError(f"{term} is not a concept or property of the ontology{hint}")
     return iri
+
+
+def _by_local_name(local: str, index: TaxonomyIndex) -> list[str]:
+    """The concepts (as the pages name them) whose local name is ``local`` with case aside, else the
+    closest few: a name typed without its prefix, or with a slipped one, names its class still."""
+    names: dict[str, list[str]] = {}
+    for node in index.nodes():
+        shown = display_text(node)
+        names.setdefault(re.split(r"[:#/]", shown)[-1].casefold(), []).append(shown)
+    key = local.casefold()
+    close = [key] if key in names else difflib.get_close_matches(key, list(names), n=3, cutoff=0.75)
+    return sorted({shown for name in close for shown in names[name]})[:3]
 
 
 def _by_tail(term: str, index: TaxonomyIndex) -> str:
