@@ -277,3 +277,17 @@ def test_the_python_example_ranks_and_evaluates_the_collection() -> None:
         in done.stdout
     )
     assert re.search(r"\| sem-str \| 0\.7310 \| 0\.8892 \|", done.stdout)
+
+
+def test_matchmaking_md_from_python_runs_as_written() -> None:
+    """The researcher found the library API by reading the source: matchmaking.md now shows it."""
+    page = (EXAMPLES.parents[1] / "docs" / "matchmaking.md").read_text(encoding="utf-8")
+    section = page.split("### From Python\n", 1)[1].split("\n#", 1)[0]
+    found = re.search(r"^```python\n(.*?)^```", section, re.MULTILINE | re.DOTALL)
+    assert found is not None
+    done = subprocess.run(
+        [sys.executable, "-c", found.group(1)], cwd=EXAMPLES.parents[1], capture_output=True, text=True, timeout=120
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.startswith("0.987 train_fare_lookup True {'outputs': 0.98, 'inputs': 1.0}\n")
+    assert "| logic | 0.7448 | 0.9422 |" in done.stdout
