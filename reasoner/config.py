@@ -185,6 +185,7 @@ class MatchConfig:
         that does not exist, whose value is not of its type or lies outside its range."""
         types = {f.name: f.type for f in fields(self)}
         values: dict[str, Any] = {}
+        written: dict[str, str] = {}  # each value as given, for the refusal: '2', not the '2.0' it was read as
         for item in params:
             name, equals, text = item.partition("=")
             name, text = name.strip(), text.strip()
@@ -195,11 +196,12 @@ class MatchConfig:
                 hint = f"; did you mean {' or '.join(close)}?" if close else "; cbrs match --params lists them"
                 raise MatchParameterError(name, text, "no such parameter" + hint)
             values[name] = _parsed(name, text, str(types[name]))
+            written[name] = text
         try:
             return replace(self, **values)
         except ValueError as error:  # __post_init__'s range checks name the field
             name = next((n for n in values if n in str(error)), next(iter(values)))
-            raise MatchParameterError(name, str(values[name]), str(error)) from error
+            raise MatchParameterError(name, written[name], str(error)) from error
 
     @property
     def part_weights(self) -> dict[str, float]:

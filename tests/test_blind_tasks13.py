@@ -22,7 +22,7 @@ from cbrs.cli_actions import plan_text
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.catalog import Catalogue
 from cbrs.reasoner import owlstc
-from cbrs.reasoner.config import MatchConfig
+from cbrs.reasoner.config import MatchConfig, MatchParameterError
 from cbrs.reasoner.matchmaker import Matchmaker
 from cbrs.reasoner.owlstc import CollectionError, evaluate_collection, read_relevance
 from tests.helpers_examples import EXAMPLES
@@ -291,3 +291,11 @@ def test_matchmaking_md_from_python_runs_as_written() -> None:
     assert done.returncode == 0, done.stderr
     assert done.stdout.startswith("0.987 train_fare_lookup True {'outputs': 0.98, 'inputs': 1.0}\n")
     assert "| logic | 0.7448 | 0.9422 |" in done.stdout
+
+
+def test_a_parameter_out_of_range_is_quoted_as_written() -> None:
+    """CBRS_MATCH_PARAMS=text_weight=2 was refused as "text_weight='2.0'", a value the researcher never wrote."""
+    with pytest.raises(MatchParameterError) as refused:
+        MatchConfig().with_params(["accept_score=0.6", "text_weight=2"])
+    assert str(refused.value) == "matchmaking parameter text_weight='2': text_weight must lie in [0, 1], got 2.0"
+    assert refused.value.value == "2"
