@@ -13,6 +13,10 @@ operation that also empties the graphs it replaces (:mod:`kb.staged_writes`), th
 keeps whole. The export names every node as the store does (cbrs skolemises blank nodes on load), so a
 restore gives back the same quads; a blank node the store held comes back as a new one, linked the same way.
 
+graph:liveness is the servers' present state, which no file holds: a restore that replaces it keeps the facts
+of the components live when it begins (their session, their lease) and writes none of the file's leases as
+live (:meth:`kb.liveness.Liveness.restored`).
+
 A remote store's export leaves out the graphs its server keeps for itself (``ontologies/server_graphs.toml``:
 Virtuoso's system graphs), and its restore leaves them alone. See docs/backup.md.
 """
@@ -35,6 +39,7 @@ import pyoxigraph as ox
 
 from cbrs import __version__
 from cbrs.kb.errors import KnowledgeBaseError, RdfParseError, without_password
+from cbrs.kb.liveness import Liveness, Restored
 from cbrs.kb.loader import resolve_graph
 from cbrs.kb.namespaces import BASE, GRAPH, PREFIXES, GraphName, shorten
 from cbrs.kb.resources import ontology_dir
@@ -66,6 +71,7 @@ map back). graph:entailed is derived: a restore of a file without it works it ou
 _GZIP_MAGIC = b"\x1f\x8b"
 _RDF_TYPE = ox.NamedNode("http://www.w3.org/1999/02/22-rdf-syntax-ns#type")
 _PROGRESS_EVERY = 10_000  # quads between progress reports
+LIVENESS = GraphName.LIVENESS
 
 
 class BackupError(KnowledgeBaseError):
@@ -232,6 +238,10 @@ class RestoreReport:
     entailed_refreshed: bool = False
     skipped: dict[str, int] = field(default_factory=dict)
     """Graphs of the file left out (``graphs`` chosen), by triple count."""
+    live_kept: tuple[str, ...] = ()
+    """Components live when the restore began, whose liveness (session, lease) it kept, not the file's."""
+    live_ended: tuple[str, ...] = ()
+    """Components the file held as available that no session holds now: written unavailable."""
 
 
 # -- choosing graphs and formats ------------------------------------------------------------------
@@ -450,6 +460,10 @@ def restore_store(
     # a remote store's own default-graph triples cannot be told apart in an update on a union server: left
     before = {graph: _size(store, graph) for graph in present if embedded or graph != DEFAULT}
     replacing = wanted if graphs else list(before)
+    liveness = None
+    if LIVENESS.iri in wanted or LIVENESS.iri in replacing:
+        liveness = _liveness(store, backup, graphs)
+        quads = [quad for quad in quads if quad.graph_name != LIVENESS.node] + liveness.quads
     tell(f"writing {len(quads)} triples", 0, 0)
     if isinstance(store, EmbeddedStore):  # (embedded, for the type checker)
         _replace_embedded(store, replacing, quads, whole=not graphs)
@@ -457,7 +471,32 @@ def restore_store(
         _replace_remote(store, replacing, quads, tell)
     restored = {graph: len(backup.quads.get(graph, ())) for graph in wanted}
     skipped = {graph: len(q) for graph, q in backup.quads.items() if graph not in wanted}
-    return RestoreReport(backup.source, before, restored, skipped=skipped)
+    if liveness is None:
+        return RestoreReport(backup.source, before, restored, skipped=skipped)
+    if liveness.quads or LIVENESS.iri in wanted:
+        restored[LIVENESS.iri] = len(liveness.quads)
+    return RestoreReport(
+        backup.source, before, restored, skipped=skipped, live_kept=liveness.kept, live_ended=liveness.ended
+    )
+
+
+def _liveness(store: Store, backup: Backup, graphs: Sequence[str] | None) -> Restored:
+    """graph:liveness as the restore of ``backup`` writes it: the components live now keep their present
+    facts, the file's leases are not taken for live ones (:meth:`kb.liveness.Liveness.restored`). A live
+    component keeps them if the store describes it after the restore: in the file's graph:services when the
+    restore replaces that graph, else in the store's."""
+    services = GraphName.SERVICES
+    if not graphs or services.iri in {_iri(graph) for graph in graphs}:
+        held = {
+            quad.subject.value for quad in backup.quads.get(services.iri, ()) if isinstance(quad.subject, ox.NamedNode)
+        }
+        described: Callable[[str], bool] = held.__contains__
+    else:
+
+        def described(iri: str) -> bool:
+            return next(store.quads(ox.NamedNode(iri), graph=services.node), None) is not None
+
+    return Liveness(store).restored(backup.quads.get(LIVENESS.iri, ()), described)
 
 
 def check_declarations(store: Store | None, backup: Backup, graphs: Sequence[str] | None = None) -> None:
