@@ -249,23 +249,25 @@ class _ColourRisks:
 
 
 _PREFIXED = re.compile(r"(?<![\w?$:])([A-Za-z][\w-]*):([A-Za-z_][\w-]*(?:\.[\w-]+)*)")
-_DECLARED = re.compile(r"PREFIX\s+([\w-]*):", re.IGNORECASE)
+_DECLARED = re.compile(rf"\bPREFIX\s+([\w-]*):\s*<([^<>\"{{}}|^`\\\x00-\x20]*)>|{HIDING}", re.IGNORECASE)
+"""A PREFIX declaration (its prefix and namespace), or a string, IRI or comment that hides one."""
 
 
 def _note_unknown_names(kb: KnowledgeBase, body: str, derived: Mapping[str, str]) -> None:
     """After an update that changed no graph's size: say which names it uses that the store mentions
     nowhere (home:yw for home:yaw matched nothing, and "no graph changed" said no more), with the
-    nearest names. Only cbrs's own prefixes and the store's ``derived`` ones declared for it, as the
-    update does not declare them itself."""
+    nearest names. A prefix is the update's own declaration (``PREFIX lab11: <...>``: a misspelt thing of
+    the lab's, lab11:Flsk1, matched nothing too), else cbrs's or one of the store's ``derived`` ones
+    declared for it."""
     from cbrs.task_names import near_names  # the action model: only when an update changed nothing
 
-    text = re.sub(HIDING, " ", body)
-    declared = set(_DECLARED.findall(text))
-    known = {**PREFIXES, **derived}
+    own = {m.group(1): m.group(2) for m in _DECLARED.finditer(body) if m.group(2) is not None}
+    text = re.sub(_DECLARED, " ", body)  # the declarations, strings, IRIs and comments: no names in them
+    known = {**PREFIXES, **derived, **own}
     seen = set(map(shorten, kb.store.graphs()))  # a graph's name is mentioned in no triple
     for prefix, local in _PREFIXED.findall(text):
         name = f"{prefix}:{local}"
-        if prefix not in known or prefix in declared or name in seen:
+        if prefix not in known or name in seen:
             continue
         seen.add(name)
         if not kb.describes(known[prefix] + local):
