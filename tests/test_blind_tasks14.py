@@ -9,9 +9,11 @@ runs that end at once (no planner run, no simulation).
 
 from __future__ import annotations
 
+import io
 import re
 from collections.abc import Iterator
 from html import unescape
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -28,6 +30,7 @@ OWN = "http://127.0.0.1:8080"
 BROWSER = {"Origin": OWN, "Accept": "text/html,application/xhtml+xml,*/*;q=0.8"}
 LAMP_TASK = (EXAMPLES / "lab10_switch_on_the_lamp.ttl").read_text(encoding="utf-8")
 LAB10 = "https://example.org/lab10#"
+REPO = Path(__file__).parent.parent
 
 
 class _Ended(TaskRunner):
@@ -132,3 +135,32 @@ def test_a_concept_written_without_its_prefix_on_the_match_page_is_told_the_one_
     assert "did you mean lab10:ReadingLamp?" in said
     assert "did you mean home:Cup?" in said
     assert "MarkerColour: MarkerColour:" not in said
+
+
+def _load_form(client: FlaskClient, path: Path, graph: str, token: str, name: str | None = None) -> Any:
+    """The Load a file page's form as a browser sends it: multipart, the file under its own name."""
+    data = {"graph": graph, "token": token, "file": (io.BytesIO(path.read_bytes()), name or path.name)}
+    return client.post("/load", data=data, headers=BROWSER, content_type="multipart/form-data")
+
+
+def test_a_lab_file_is_loaded_from_the_browser_into_the_graphs_its_header_names(client: FlaskClient) -> None:
+    """A lab member with the URL and the token had no page to put their own things into the store: the
+    SPARQL editor refuses updates (pointing at /update and a header), New task writes requirements only.
+    docs/examples/lab11_coaster.ttl says to load it into the ontology and the map; from /load it is."""
+    form = client.get("/load", headers=BROWSER)
+    assert form.status_code == 200
+    assert 'enctype="multipart/form-data"' in form.text and 'name="file"' in form.text and 'name="token"' in form.text
+    coaster = EXAMPLES / "lab11_coaster.ttl"
+    before = client.get("/search.json?q=Coaster1").get_json()["things"]["count"]
+    refused = _load_form(client, coaster, "map", "")
+    assert refused.status_code == 403 and "type it in the Update token field" in " ".join(_errors(refused.text))
+    assert client.get("/search.json?q=Coaster1").get_json()["things"]["count"] == before == 0
+    for graph in ("ontology", "map"):
+        loaded = _load_form(client, coaster, graph, TOKEN)
+        assert loaded.status_code == 201, _errors(loaded.text)
+        assert f"lab11_coaster.ttl into graph:{graph}" in _text(loaded.text)
+    assert client.get("/search.json?q=Coaster1").get_json()["things"]["count"] == 1
+    broken = _load_form(client, REPO / "tests" / "data" / "bad" / "broken.ttl", "map", TOKEN, name="my_lamp.ttl")
+    assert broken.status_code == 400
+    (message,) = _errors(broken.text)
+    assert message.startswith("my_lamp.ttl:4:") and "<request body>" not in message

@@ -42,7 +42,7 @@ PAGES: tuple[tuple[str, str, str], ...] = (
     ("task_editor", "task_editor.task_editor", "New task"),
 )
 # Page blueprints reached from every page's header or from links, not from the navigation.
-OTHER_PAGES: tuple[str, ...] = ("search",)
+OTHER_PAGES: tuple[str, ...] = ("search", "load")
 
 
 # Where the pages may load from and be shown: this server only, never in another site's frame.

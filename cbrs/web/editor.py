@@ -117,7 +117,10 @@ def _update_refused() -> str:
     update token", which a new user read as a fault of the text, and on a read-only server there is no token."""
     said = "This is a SPARQL update; the editor runs queries and changes nothing."
     if context.sparql().writable:
-        return f"{said} POST the update to /update (form field update=) with the update token (docs/serving.md)."
+        return (
+            f"{said} To add a file's triples from the browser, use the Load a file page (/load); a program "
+            "can POST the update to /update (form field update=) with the update token (docs/serving.md)."
+        )
     return f"{said} This server takes no updates: it was started read-only (no update token set)."
 
 

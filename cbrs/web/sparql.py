@@ -20,6 +20,7 @@ from cbrs.sparql_service import (
     RESULT_TYPES,
     Dataset,
     EndpointError,
+    UpdateForbiddenError,
     accept_ranges,
     identity_header,
     negotiate,
@@ -230,6 +231,21 @@ def bearer_token() -> str | None:
     header = request.headers.get("Authorization", "")
     scheme, _, token = header.partition(" ")
     return token.strip() if scheme.lower() == "bearer" and token.strip() else None
+
+
+def typed_token_refusal(error: UpdateForbiddenError, typed: str) -> str:
+    """A refused write said in a page's words when its token came from the page's field: a person in a
+    browser cannot send the ``Authorization: Bearer`` header the endpoint's message names. A server that
+    takes no token (none set, or read-only), a header's token or a program's JSON keep the message."""
+    config = context.sparql().config
+    if request.is_json or bearer_token() or config.read_only or config.update_token is None:
+        return str(error)
+    if not typed:
+        return (
+            "writing into the store needs the server's update token: type it in the Update token field "
+            "(whoever started cbrs serve has it)"
+        )
+    return "the token typed is not this server's update token: check it with whoever started cbrs serve"
 
 
 def _short_format() -> str | None:

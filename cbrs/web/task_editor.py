@@ -26,7 +26,7 @@ from cbrs.web.links import short
 from cbrs.web.pages import FormError, Page, page, wants_json
 from cbrs.web.plans import _composition, _flow, _svg, default_objective
 from cbrs.web.prefixes import derived
-from cbrs.web.sparql import bearer_token
+from cbrs.web.sparql import bearer_token, typed_token_refusal
 from cbrs.web.tasks import from_own_page
 
 if TYPE_CHECKING:
@@ -79,7 +79,7 @@ def task_editor() -> Page:
             if saving:
                 replaced = task_drafts.save(context.sparql(), draft, token, form["replace"])
     except UpdateForbiddenError as error:
-        return _refused(shown, error.http_status, "forbidden", _in_page_words(error, form), field="token")
+        return _refused(shown, error.http_status, "forbidden", typed_token_refusal(error, form["token"]), field="token")
     except DraftShapeError as error:
         problems = [{"message": p.message, "term": p.term, "line": p.line} for p in error.problems]
         return _refused(shown, error.http_status, error.kind, str(error), line=error.line, problems=problems)
@@ -188,21 +188,6 @@ def _saved(shown: Page, draft: TaskDraft, replaced: int) -> Page:
     shown.title = f"New task: {short(draft.iri)} saved"
     shown.data["saved"] = {"iri": draft.iri, "name": name, "replaced": bool(replaced), "run": run}
     return shown
-
-
-def _in_page_words(error: UpdateForbiddenError, form: dict[str, Any]) -> str:
-    """A refused save said in the page's words when the token came from its field: a person in a browser
-    cannot send the ``Authorization: Bearer`` header the endpoint's message names. A server that takes no
-    token (none set, or read-only) keeps its message: no field would help."""
-    config = context.sparql().config
-    if request.is_json or bearer_token() or config.read_only or config.update_token is None:
-        return str(error)
-    if not form["token"]:
-        return (
-            "saving writes into the store and needs the server's update token: type it in the Update token "
-            "field (whoever started cbrs serve has it); Check and plan needs none"
-        )
-    return "the token typed is not this server's update token: check it with whoever started cbrs serve"
 
 
 def _refused(shown: Page, status: int, kind: str, message: str, field: str = "turtle", **extra: Any) -> Page:
