@@ -247,6 +247,7 @@ class CollectionReport:
     unresolved_imports: int = 0
     load_seconds: float = 0.0
     unresolved: tuple[str, ...] = ()
+    unjudged: tuple[str, ...] = ()  # query files relevance.xml judges nothing for: not evaluated
 
     def to_json(self) -> dict[str, Any]:
         return {
@@ -257,6 +258,7 @@ class CollectionReport:
             "queries": self.queries,
             "services": self.services,
             "unresolved": list(self.unresolved),
+            "unjudged": list(self.unjudged),
         }
 
     def text(self) -> str:
@@ -273,6 +275,11 @@ class CollectionReport:
             f"{self.unmatched_offers} judged offers and {len(self.unmatched_requests)} requests not found in the "
             "loaded files",
             *self.unresolved,
+            *(
+                [f"not evaluated, judged by no request of relevance.xml: {', '.join(self.unjudged)}"]
+                if self.unjudged
+                else []
+            ),
             *(
                 ["relevance.xml grades nothing (no relevancegrades): NDCG is not computed"]
                 if any(math.isnan(v["ndcg"]) for v in self.methods.values())
@@ -373,6 +380,10 @@ def evaluate_collection(
         unresolved_imports=loaded.unresolved_imports,
         load_seconds=loaded.seconds,
         unresolved=loaded.unresolved,
+        unjudged=tuple(
+            f"queries/{name}"
+            for name in sorted(set(loaded.requirements) - {_file_key(uri) for uri in judgements.binary})
+        ),
     )
 
 

@@ -299,3 +299,14 @@ def test_a_parameter_out_of_range_is_quoted_as_written() -> None:
         MatchConfig().with_params(["accept_score=0.6", "text_weight=2"])
     assert str(refused.value) == "matchmaking parameter text_weight='2': text_weight must lie in [0, 1], got 2.0"
     assert refused.value.value == "2"
+
+
+def test_a_query_relevance_xml_does_not_judge_is_named_as_not_evaluated(tmp_path: Path) -> None:
+    """A fourth query written and never graded: '3 queries against 9 services', and nothing else."""
+    root = _copy(tmp_path)
+    text = (root / "queries" / "train_fare.owls").read_text(encoding="utf-8")
+    (root / "queries" / "train_fare_return.owls").write_text(text.replace("train_fare", "train_fare_return"), "utf-8")
+    result = CliRunner().invoke(cli, ["--store", ":memory:", "eval", "owls-tc", str(root), "--method", "logic"])
+    assert result.exit_code == 0, result.output
+    assert result.stdout.startswith("3 queries against 9 services")
+    assert "not evaluated, judged by no request of relevance.xml: queries/train_fare_return.owls" in result.stdout
