@@ -164,3 +164,16 @@ def test_a_lab_file_is_loaded_from_the_browser_into_the_graphs_its_header_names(
     assert broken.status_code == 400
     (message,) = _errors(broken.text)
     assert message.startswith("my_lamp.ttl:4:") and "<request body>" not in message
+
+
+def test_a_file_too_big_to_load_is_told_the_limit_in_words(client: FlaskClient) -> None:
+    """A file over the server's request limit got Werkzeug's "The data value transmitted exceeds the
+    capacity limit.", naming neither the limit nor what to do."""
+    limit = client.application.config["MAX_CONTENT_LENGTH"]
+    big = b"# padding\n" * (limit // 10 + 1)
+    data = {"graph": "map", "token": TOKEN, "file": (io.BytesIO(big), "big.ttl")}
+    page = client.post("/load", data=data, headers=BROWSER, content_type="multipart/form-data")
+    assert page.status_code == 413
+    said = _text(page.text)
+    assert "capacity limit" not in said
+    assert f"{limit:,} bytes" in said and "cbrs load" in said

@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from flask import Blueprint, Response, current_app, jsonify, make_response, render_template, request
-from werkzeug.exceptions import HTTPException, MethodNotAllowed, NotFound
+from werkzeug.exceptions import HTTPException, MethodNotAllowed, NotFound, RequestEntityTooLarge
 from werkzeug.http import HTTP_STATUS_CODES
 
 from cbrs.kb.errors import KnowledgeBaseError, NotFoundError
@@ -140,6 +140,13 @@ def http_error_message(error: HTTPException) -> str:
         near = difflib.get_close_matches(request.path, sorted(paths - {"/static"}), n=3, cutoff=0.7)
         meant = f"; did you mean {' or '.join(near)}?" if near else ""
         return f"nothing is served at {request.path}{meant} (the pages start at /, the SPARQL endpoint is /sparql)"
+    if isinstance(error, RequestEntityTooLarge):  # Werkzeug: "The data value transmitted exceeds the capacity limit."
+        limit = current_app.config.get("MAX_CONTENT_LENGTH")
+        most = f" of {limit:,} bytes" if limit else ""
+        return (
+            f"the request is larger than this server's limit{most} (from the setting max_query_bytes): split the "
+            "file, or ask whoever started cbrs serve to load it with cbrs load"
+        )
     return error.description or error.name
 
 
