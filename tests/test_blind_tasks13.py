@@ -25,6 +25,8 @@ from cbrs.reasoner import owlstc
 from cbrs.reasoner.config import MatchConfig, MatchParameterError
 from cbrs.reasoner.matchmaker import Matchmaker
 from cbrs.reasoner.owlstc import CollectionError, evaluate_collection, read_relevance
+from cbrs.sparql_service import SparqlService
+from cbrs.web import create_app
 from tests.helpers_examples import EXAMPLES
 
 COLLECTION = EXAMPLES / "lab13_collection"
@@ -310,3 +312,13 @@ def test_a_query_relevance_xml_does_not_judge_is_named_as_not_evaluated(tmp_path
     assert result.exit_code == 0, result.output
     assert result.stdout.startswith("3 queries against 9 services")
     assert "not evaluated, judged by no request of relevance.xml: queries/train_fare_return.owls" in result.stdout
+
+
+def test_the_plans_page_names_an_input_no_step_takes(transit_kb: KnowledgeBase) -> None:
+    """The browser's plan of the fare showed both stations of the lookup '<- requirement._TrainStation0'
+    and nothing of the second station the task gives; /plans.json had it as unused_inputs."""
+    client = create_app(SparqlService(transit_kb)).test_client()
+    page = client.get("/plans", query_string={"task": FARE})
+    assert page.status_code == 200
+    text = re.sub(r"\s+", " ", re.sub(r"<[^>]+>", " ", page.get_data(as_text=True)))
+    assert re.search(r"Taken by no step: _TrainStation1 \S*TrainStation \. The plan does without it", text)
