@@ -155,3 +155,17 @@ def test_the_graph_stores_own_refusals_are_named_as_the_servers_others(client: F
     for answer in (client.get("/store?graph=urn:test:none"), client.delete("/store?graph=urn:test:none", headers=AUTH)):
         assert _said(answer) == (404, "not-found", "the store has no graph <urn:test:none>")
     assert _said(client.get("/no-such-path"))[:2] == (404, "not-found")
+
+
+@pytest.mark.parametrize("graph", ["http://a b", "notes", "graph:map"])
+def test_a_graph_parameter_that_is_no_iri_is_a_bad_dataset_on_store_as_on_the_endpoint(
+    client: FlaskClient, graph: str
+) -> None:
+    endpoint = _said(client.get("/sparql", query_string={"query": "ASK {}", "default-graph-uri": "http://a b"}))
+    for answer in (
+        client.get("/store", query_string={"graph": graph}),
+        client.put("/store", query_string={"graph": graph}, data=TRIPLE, content_type="text/turtle", headers=AUTH),
+    ):
+        status, kind, message = _said(answer)
+        assert (status, kind) == endpoint[:2] == (400, "bad-dataset")
+        assert message.startswith(f"graph={graph!r} is not an absolute IRI (") and "give a graph's full IRI" in message

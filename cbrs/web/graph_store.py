@@ -10,11 +10,9 @@ map, superclasses) before anything is written; a refusal is the error's JSON wit
 
 from __future__ import annotations
 
-import pyoxigraph as ox
 from flask import Blueprint, Response, request
-from werkzeug.exceptions import BadRequest
 
-from cbrs.graph_store import GraphStore, Target
+from cbrs.graph_store import GraphStore, GraphStoreError, Target
 from cbrs.web import context
 from cbrs.web.sparql import bearer_token, misspelt_parameter
 
@@ -26,21 +24,8 @@ blueprint = Blueprint("graph_store", __name__)
 def _target() -> Target:
     misspelt = misspelt_parameter(request.args, ("graph", "default"))
     if misspelt:  # "?grpah=" named the whole store: a GET read it all, a POST wrote where cbrs load would
-        raise BadRequest(f"/store has no parameter {misspelt}")
-    graphs = request.args.getlist("graph")
-    default = "default" in request.args
-    if len(graphs) > 1 or (graphs and default):
-        raise BadRequest("name one graph: ?graph=IRI or ?default, once")
-    if graphs:
-        graph = graphs[0]
-        if "://" not in graph and not graph.startswith("urn:"):
-            raise BadRequest(f"graph must be an absolute IRI, not {graph!r}")
-        try:
-            ox.NamedNode(graph)
-        except ValueError as error:  # a space, a '<': was a 500 where Target made its node
-            raise BadRequest(f"graph={graph!r} is not an IRI: {error}") from None
-        return Target(graph)
-    return Target(None, default)
+        raise GraphStoreError(f"/store has no parameter {misspelt}")
+    return Target.from_parameters(request.args.getlist("graph"), "default" in request.args)
 
 
 def _store() -> GraphStore:
