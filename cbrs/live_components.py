@@ -307,7 +307,7 @@ class LiveComponents:
                 iris = kb.registry.register(turtle, "<registration>")
             now = self._now()
             for iri in iris:
-                kb.liveness.renew(iri, ttl, registered_by=f"{self.name} session {session}")
+                kb.liveness.renew(iri, ttl, registered_by=self._registered_by(session))
                 with self._guard:
                     self._leases[iri] = _Lease(session, services[iri], over_bridge, now + ttl, ttl, now + ttl)
                     self._ended.get(session, {}).pop(iri, None)
@@ -386,8 +386,8 @@ class LiveComponents:
             with self.sparql.lock:
                 kb = self.sparql.kb
                 for iri, ttl in stale:
-                    if kb.registry.is_registered(iri):
-                        kb.liveness.renew(iri, ttl)
+                    if kb.registry.is_registered(iri):  # the session too: a restore or an update may have
+                        kb.liveness.renew(iri, ttl, registered_by=self._registered_by(session))  # changed it
                     else:
                         kb.liveness.forget(iri)
                         gone.append(iri)
@@ -401,6 +401,10 @@ class LiveComponents:
                 log.info("%s deregistered: its lease ended", ", ".join(gone))
                 renewed = [iri for iri in renewed if iri not in gone]
         return sorted(renewed)
+
+    def _registered_by(self, session: str) -> str:
+        """What the store says registered a component of ``session`` (``cbrs:registeredBy``)."""
+        return f"{self.name} session {session}"
 
     def ended(self, session: str) -> dict[str, str]:
         """The components of ``session`` whose lease ended while it stayed open, with why."""

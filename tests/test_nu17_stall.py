@@ -62,3 +62,16 @@ def test_time_the_server_runs_is_charged_as_before(live: tuple[LiveComponents, C
     clock.run(3.5, components)  # no beat for longer than the lease, the server running
     assert components.renew("session 1") == []
     assert components.sparql.kb.liveness.states()[THERMOMETER].reason == "its lease lapsed"
+
+
+def test_a_renewal_writes_the_session_again_where_the_store_says_another(live: tuple[LiveComponents, Clock]) -> None:
+    """A restore or an update to graph:liveness may name a session that is gone (docs/backup.md, "Live
+    components"): the next renewal written to the store names the live one again."""
+    components, clock = live
+    kb = components.sparql.kb
+    live_session = kb.liveness.states()[THERMOMETER].registered_by
+    assert live_session is not None and live_session.endswith("session 1")
+    kb.liveness.renew(THERMOMETER, 3.0, registered_by="cbrs session of a backup")
+    clock.run(2.0, components)  # past half a lease: the next beat writes the lease
+    assert components.renew("session 1") == [THERMOMETER]
+    assert kb.liveness.states()[THERMOMETER].registered_by == live_session
