@@ -306,6 +306,15 @@ def _the_requirement(quads: Sequence[ox.Quad], text: str) -> str:
     return found[0]
 
 
+_DECLARED = re.compile(r"^\s*(?:@prefix\s+|PREFIX\s+)([A-Za-z][\w.-]*)?:\s*<([^>\s]*)>", re.IGNORECASE | re.MULTILINE)
+
+
+def declared_prefixes(text: str) -> dict[str, str]:
+    """The prefixes ``text`` declares itself (``@prefix lab14: <...#> .``, name → namespace): how its writer
+    names its own terms, which the pages may not know yet."""
+    return {name: ns for name, ns in _DECLARED.findall(text) if name}
+
+
 def _no_requirement(quads: Sequence[ox.Quad], text: str) -> DraftError:
     """The text names no cbrs:Requirement: when it types a thing with a class spelt like it
     (``cbrs:Requirment``, ``req:Requirement``), that class, its line and the class meant."""

@@ -177,3 +177,23 @@ def test_a_file_too_big_to_load_is_told_the_limit_in_words(client: FlaskClient) 
     said = _text(page.text)
     assert "capacity limit" not in said
     assert f"{limit:,} bytes" in said and "cbrs load" in said
+
+
+def test_a_new_task_in_a_namespace_the_store_lacks_is_named_by_the_text_s_own_prefix(client: FlaskClient) -> None:
+    """A lab's first task, checked before anything of its namespace is stored, was titled "New task:
+    https://example.org/lab14#FetchMyMug, unsolvable", its undeclared class named by its IRI, although
+    the text declares @prefix lab14: and the user wrote lab14:FetchMyMug."""
+    text = (
+        "@prefix lab14: <https://example.org/lab14#> .\n"
+        'lab14:FetchMyMug a cbrs:Requirement ; rdfs:label "Fetch my mug"@en ;\n'
+        "    cbrs:hasOWLSModel [ a cbrs:OWLSModel ;\n"
+        '        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "mug" ; cbrs:parameterType lab14:Mug ] ;\n'
+        "        cbrs:hasEffect [ a cbrs:Effect ; cbrs:conditionSubject lab14:Mug ; "
+        "cbrs:conditionPredicate home:isWith ; cbrs:conditionObject home:Person ] ] .\n"
+    )
+    page = _post_form(client, "/tasks/new", turtle=text, action="check")
+    assert page.status_code == 200, _errors(page.text)
+    title = re.search(r"<title>(.*?)</title>", page.text).group(1)
+    assert title.startswith("New task: lab14:FetchMyMug")
+    assert "https://example.org/lab14#" not in _text(page.text.split("</textarea>", 1)[1])
+    assert "https://example.org/lab14#" not in client.get("/").text  # the next page knows no lab14:

@@ -3,14 +3,16 @@
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping
 
-from flask import Flask, url_for
+from flask import Flask, g, has_app_context, url_for
 from markupsafe import Markup, escape
 
 from cbrs.kb.namespaces import PREFIXES, expand, shorten
 from cbrs.web.prefixes import by_namespace, derived, namespace
 
 RESOURCE_ENDPOINT = "resource.resource"
+TEXT_PREFIXES = "cbrs_text_prefixes"  # flask.g: namespace -> prefix a text of this request declares
 
 
 def iri_url(iri: str) -> str:
@@ -27,9 +29,20 @@ def short(iri: str) -> str:
     ns = namespace(iri)
     prefix = by_namespace().get(ns) if ns is not None else None
     local = iri[len(ns) :] if ns is not None else ""
+    if prefix is None and ns is not None and has_app_context():
+        prefix = g.get(TEXT_PREFIXES, {}).get(ns)
     if prefix is not None and local and all(ch.isalnum() or ch in "_-." for ch in local):
         return f"{prefix}:{local}"
     return iri
+
+
+def use_text_prefixes(prefixes: Mapping[str, str]) -> None:
+    """For the rest of this request, :func:`short` also names an IRI with ``prefixes`` (name → namespace, a
+    text's own ``@prefix`` lines) where no declared or derived prefix covers it: New task's draft of a lab's
+    first task (lab14:FetchMyMug), whose namespace the store has nothing of yet. A name the pages give
+    another namespace is not taken."""
+    taken = {*PREFIXES, *derived()}
+    g.setdefault(TEXT_PREFIXES, {}).update({ns: name for name, ns in prefixes.items() if name and name not in taken})
 
 
 def expand_name(name: str) -> str:

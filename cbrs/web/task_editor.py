@@ -22,7 +22,7 @@ from cbrs.kb.namespaces import PREFIXES, shorten
 from cbrs.sparql_service import UpdateForbiddenError
 from cbrs.task_drafts import DraftError, DraftShapeError, TaskDraft
 from cbrs.web import context
-from cbrs.web.links import short
+from cbrs.web.links import short, use_text_prefixes
 from cbrs.web.pages import FormError, Page, page, wants_json
 from cbrs.web.plans import _composition, _flow, _svg, default_objective
 from cbrs.web.prefixes import derived
@@ -69,6 +69,7 @@ def task_editor() -> Page:
     if not form["turtle"].strip():
         raise FormError({"turtle": "write a task (a cbrs:Requirement) in Turtle"}, page=shown)
     saving = form["action"] == "save"
+    use_text_prefixes(task_drafts.declared_prefixes(form["turtle"]))  # a lab's first task: lab14:FetchMyMug
     try:
         if saving:
             from_own_page("saved")
@@ -171,7 +172,7 @@ def _planned(shown: Page, draft: TaskDraft) -> None:
     shown.data["composition"] = composition
     shown.data["base"] = base.to_dict() if base is not None else None  # as the plans page says it
     shown.data["undeclared"] = [
-        {"term": shorten(term), "line": task_drafts.line_of(draft.text, shorten(term))}
+        {"term": short(term), "line": task_drafts.line_of(draft.text, short(term))}
         for u in result.unsatisfied
         for term in u.undeclared
     ]
