@@ -307,6 +307,8 @@ class Matchmaker:
             needed = self._parameters(ad.inputs, requirement.inputs, "input", pairs, lacks)
         if requirement.inputs:
             used = self._parameters(requirement.inputs, ad.inputs, "provided input", [], lacks) if ad.inputs else 0.0
+            if not ad.inputs:  # the inputs part's half it loses, said (the part alone showed it)
+                lacks.extend(f"provided input {_short(p.type)}: it takes no input" for p in requirement.inputs)
             u = cfg.input_use_weight
             if needed is None and not cfg.no_input_invocable:
                 parts["inputs"] = used

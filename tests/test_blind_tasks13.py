@@ -252,6 +252,12 @@ def test_an_output_that_reports_nothing_asked_is_not_said_to_report(transit_kb: 
     assert pair.shown_degree() == "Fail" and "reports Passenger" not in pair.how
     assert pair.how.startswith("no effect; no output reports it (") and pair.similarity == 0.0
     assert fall.score == pytest.approx(0.2) and fall.parts == {"inputs": 0.5, "effects": 0.0}
+    # the inputs part's lost half said: it showed 'inp=0.50' and no line about inputs
+    assert [lack for lack in fall.lacks if lack.startswith("provided input")] == [
+        "provided input Passenger: it takes no input",
+        "provided input PaymentCard: it takes no input",
+        "provided input TrainItinerary: it takes no input",
+    ]
     assert [c.advertisement for c in result.candidates[:1]] == [
         "http://127.0.0.1/services/lab13/buy_train_ticket.owls#BuyTrainTicketService"
     ]
