@@ -197,3 +197,21 @@ def test_a_new_task_in_a_namespace_the_store_lacks_is_named_by_the_text_s_own_pr
     assert title.startswith("New task: lab14:FetchMyMug")
     assert "https://example.org/lab14#" not in _text(page.text.split("</textarea>", 1)[1])
     assert "https://example.org/lab14#" not in client.get("/").text  # the next page knows no lab14:
+
+
+def test_a_misspelt_search_offers_the_names_meant(client: FlaskClient) -> None:
+    """The search is how a person who types finds things, and "reading lamb", "kitchen tabel" and "celing
+    camera" each found nothing in four groups and said no more; each now offers the names meant, each a
+    link to its search, in the page and the twin (``meant``)."""
+    for typed, meant in (
+        ("reading lamb", "reading lamp"),
+        ("kitchen tabel", "kitchen table"),
+        ("celing camera", "ceiling camera"),
+    ):
+        page = client.get("/search", query_string={"q": typed})
+        assert page.status_code == 200
+        assert f'href="/search?q={meant.replace(" ", "+")}"' in page.text, typed
+        twin = client.get("/search.json", query_string={"q": typed}).get_json()
+        assert twin["total"] == 0 and meant in [m["text"] for m in twin["meant"]]
+    found = client.get("/search.json", query_string={"q": "reading lamp"}).get_json()
+    assert found["total"] > 0 and found["meant"] == []

@@ -9,10 +9,11 @@ a service whose inputs or outputs are of a matching concept comes last, saying w
 
 from __future__ import annotations
 
+import difflib
 from typing import Any
 
 import pyoxigraph as ox
-from flask import Blueprint, request
+from flask import Blueprint, request, url_for
 
 from cbrs.kb.namespaces import RDFS
 from cbrs.web import context, services
@@ -47,6 +48,7 @@ def search() -> Page:
     data["requirements"] = _requirements(needle)
     data["things"] = _things(needle)
     data["total"] = sum(data[group]["count"] for group in GROUPS)
+    data["meant"] = _meant(needle) if not data["total"] else []
     for group in GROUPS:
         del data[group]["all"]
     return shown
@@ -119,6 +121,33 @@ def _things(needle: str) -> dict[str, Any]:
         if score is not None:
             rows.append((score, thing["local"], thing))
     return _group(rows)
+
+
+def _meant(needle: str) -> list[dict[str, str]]:
+    """For a text that found nothing (a slip: "reading lamb", "celing camera"), the names and labels the
+    search looks in that are closest to it, each with its search: a person who types is not left with four
+    empty groups. difflib's ratio at least 0.8, the best three."""
+    names: dict[str, str] = {}
+    found = current_taxonomy()
+    for term in found.kinds:
+        names.setdefault(local_name(term).casefold(), local_name(term))
+        label = found.labels.get(term)
+        if label:
+            names.setdefault(label.casefold(), label)
+    for ad in services.advertisement_rows(context.kb()):
+        for name in (ad["service_name"], ad["device_name"], ad["label"]):
+            if name:
+                names.setdefault(name.casefold(), name)
+    for requirement in services.requirement_rows(context.kb()):
+        for name in (local_name(requirement["requirement"]), requirement["label"]):
+            if name:
+                names.setdefault(name.casefold(), name)
+    for thing in context.per_generation("search_home_things", _home_things):
+        for name in (thing["local"], thing["label"]):
+            if name:
+                names.setdefault(name.casefold(), name)
+    close = difflib.get_close_matches(needle, list(names), n=3, cutoff=0.8)
+    return [{"text": names[key], "url": url_for("search.search", q=names[key])} for key in close]
 
 
 def _home_things() -> list[dict[str, Any]]:
