@@ -10,7 +10,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from cbrs.reasoner import Matchmaker, MatchConfig
+from cbrs.reasoner import MatchConfig, Matchmaker
 from cbrs.reasoner.owlstc import evaluate_collection, load_collection
 
 folder = Path(sys.argv[1]) if len(sys.argv) > 1 else Path(__file__).parent / "lab13_collection"
