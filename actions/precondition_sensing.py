@@ -30,6 +30,8 @@ from cbrs.actions.sensor_places import MapPlaces
 from cbrs.kb import Advertisement, KnowledgeBase, Statement
 from cbrs.kb.measured_states import MeasuredCondition, MeasuredConditionError, Units, conditions_by_status
 from cbrs.kb.namespaces import PREFIXES, shorten
+from cbrs.kb.semantic_map import AmbiguousDesignatorError, UnresolvedDesignatorError, designate
+from cbrs.kb.stated_quantities import StatedQuantities
 from cbrs.reasoner.names import local_name
 from cbrs.reasoner.sea import Bounds, covers_concept, overlap
 from cbrs.reasoner.taxonomy import TaxonomyIndex
@@ -105,6 +107,7 @@ class PreconditionSensing:
         self._units: Units | None = None
         self._rooms: tuple[tuple[str, Bounds], ...] | None = None
         self._map: MapPlaces | None = None
+        self._stated_quantities: StatedQuantities | None = None
 
     def __call__(self, statement: Statement) -> Sensed | None:
         """What a reading says of ``statement``; None where the store gives its status no measured
@@ -121,8 +124,6 @@ class PreconditionSensing:
         units = self.units()
         bound = condition.text(units)
         sensors = self.sensors(condition.quantity, statement.subject)
-        if not sensors:
-            return Sensed(None, self._none_covers(condition.quantity, statement.subject), bound)
         failures = []
         for ad, output in sensors:
             device = ad.device_name or local_name(ad.iri)
@@ -137,7 +138,31 @@ class PreconditionSensing:
             if reading.unit != condition.unit:
                 said += f" ({converted:g} {units.symbol(condition.unit)})"
             return Sensed(condition.holds(converted), f"{said} by {device}", bound, ad.iri, said, device)
+        stated = self._stated(statement)  # no sensor read it: what the map states of the thing decides
+        if stated is not None:
+            return stated
+        if not sensors:
+            return Sensed(None, self._none_covers(condition.quantity, statement.subject), bound)
         return Sensed(None, "; ".join(failures), bound)
+
+    def _stated(self, statement: Statement) -> Sensed | None:
+        """``statement`` decided by the level of its status's quantity that the thing it is about states in
+        the map (:mod:`kb.stated_quantities`); None where it states none. The thing: the subject itself when
+        it is a thing of the map, else the one thing of the subject's class, designated as the run designates
+        a task's input (the precondition's status its guarantee); none or several: None."""
+        if self._stated_quantities is None:
+            self._stated_quantities = StatedQuantities.read(self.kb)
+        subject = statement.subject
+        try:
+            thing = designate(self.kb, subject, guarantees=(statement.object,)) if subject in self.index else subject
+        except (UnresolvedDesignatorError, AmbiguousDesignatorError):
+            return None
+        found = self._stated_quantities.decide(thing, statement.object)
+        if found is None:
+            return None
+        of = f"{found.reading} of {shorten(thing)}"
+        how = f"{found.reading}, the map's {shorten(found.level.prop)} of {shorten(thing)}"
+        return Sensed(found.holds, how, found.bound, found.level.prop, of, "the map")
 
     def _none_covers(self, quantity: str, subject: str) -> str:
         """Why no sensor reads ``quantity`` for a precondition about ``subject``: none covers it, or it is no
@@ -149,7 +174,8 @@ class PreconditionSensing:
             return said
         return (
             f"{said}: {shorten(subject)} is no place, and a sensor reads a measured state of the place its "
-            "effective area covers, not of a thing"
+            f"effective area covers, not of a thing; nor does the map state a level of {shorten(quantity)} of"
+            " it (a property with home:levelOf and home:levelUnit, as home:massKg is of home:ObjectWeight)"
         )
 
     def units(self) -> Units:

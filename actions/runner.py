@@ -787,21 +787,25 @@ _WHERE = {HOME + "x", HOME + "minX"}  # what places a thing in the map: a positi
 def _undecided(
     error: AmbiguousDesignatorError, requirement: Requirement, index: TaxonomyIndex
 ) -> AmbiguousDesignatorError:
-    """``error`` saying which of ``requirement``'s preconditions are about the ambiguous class: a lab wrote
-    one to choose among the things (the full flask of two, by its weight), and a precondition chooses
-    nothing: it is what the requester guarantees of the thing the task names, asked once that thing is found
-    (docs/execution.md, "A task's preconditions"). ``error`` itself where none is."""
+    """``error`` saying which of ``requirement``'s preconditions are about the ambiguous class and did not
+    tell the things apart: a lab wrote one to choose among them (the full flask of two, by its weight), and a
+    precondition leaves out only the things the map's stated quantities decide it false of (docs/execution.md,
+    "A thing's quantities stated in the map"); its example class in the task's own namespace. ``error``
+    itself, but for that namespace, where none is about it."""
     about = [
         statement_text(p)
         for p in requirement.preconditions
         if p.subject == error.concept or (p.subject in index and index.is_a(error.concept, p.subject))
     ]
     if not about:
-        return error
+        return error.noting(error.note, requirement.iri)
     which = "; ".join(about)
     return error.noting(
         f"the task's precondition {which} does not tell them apart: a precondition is what the requester "
-        "guarantees of the thing the task names, asked once that thing is found, not a choice among things"
+        "guarantees of the thing the task names, and of several things of its class it leaves out only those "
+        "whose quantity stated in the map decides it false (a status defined by a measured quantity, of which "
+        "each states a level: home:massKg for a home:ObjectWeight); here none or each is left",
+        requirement.iri,
     )
 
 

@@ -21,10 +21,11 @@ from pyoxigraph import Literal, NamedNode
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import PREFIXES, shorten
 from cbrs.kb.shapes import nearest_term
+from cbrs.kb.stated_quantities import StatedQuantities
 from cbrs.kb.turned_fit import fits_at, fits_some_turn, fits_unturned, fitting_turns
 
 if TYPE_CHECKING:
-    from collections.abc import Sequence
+    from collections.abc import Callable, Collection, Sequence
 
     from cbrs.kb.colour_windows import ColourWindow
     from cbrs.kb.hands import Hand
@@ -125,14 +126,20 @@ class AmbiguousDesignatorError(KnowledgeBaseError):
 
     http_status = 422
 
-    def __init__(self, concept: str, candidates: list[str], stated: bool | None = None, note: str = "") -> None:
+    def __init__(
+        self, concept: str, candidates: list[str], stated: bool | None = None, note: str = "", task: str = ""
+    ) -> None:
         self.concept = concept
         self.candidates = candidates
         self.stated = stated
         self.note = note
+        self.task = task
         names = ", ".join(local_name(c) for c in candidates)
         kind = local_name(concept)
-        example = f"{shorten(candidates[0])} a lab:My{kind} . lab:My{kind} rdfs:subClassOf {shorten(concept)}"
+        own_class = _own_namespace(task, concept, candidates[0]) + f"My{kind}"
+        example = (
+            f"{_turtle(candidates[0])} a {_turtle(own_class)} . {_turtle(own_class)} rdfs:subClassOf {_turtle(concept)}"
+        )
         own = f"a class of its own in the map ({example})"
         task = "the task (its input's cbrs:parameterType and its goals)"
         if stated:
@@ -150,9 +157,36 @@ class AmbiguousDesignatorError(KnowledgeBaseError):
         said = f"; {note}" if note else ""
         super().__init__(f"{kind} is ambiguous: {names} {advice}{said} (docs/tasks.md, Write a task)")
 
-    def noting(self, note: str) -> AmbiguousDesignatorError:
-        """The same refusal saying ``note`` too (what the task says of the class that does not tell them apart)."""
-        return AmbiguousDesignatorError(self.concept, self.candidates, self.stated, note)
+    def noting(self, note: str, task: str = "") -> AmbiguousDesignatorError:
+        """The same refusal saying ``note`` too (what the task says of the class that does not tell them
+        apart), its example class in the namespace of ``task`` (the requirement's IRI) where that is a lab's."""
+        return AmbiguousDesignatorError(self.concept, self.candidates, self.stated, note, task or self.task)
+
+
+def _namespace(iri: str) -> str:
+    cut = max(iri.rfind("#"), iri.rfind("/"))
+    return iri[: cut + 1]
+
+
+def _own_namespace(task: str, concept: str, candidate: str) -> str:
+    """Where the example class of :class:`AmbiguousDesignatorError` is named: the first of the task's, the
+    class's and the thing's namespaces that is a lab's own (no bundled prefix's), else the thing's."""
+    bundled = set(PREFIXES.values())
+    for iri in (task, concept, candidate):
+        if iri and _namespace(iri) and _namespace(iri) not in bundled:
+            return _namespace(iri)
+    return _namespace(candidate)
+
+
+def _turtle(iri: str) -> str:
+    """``iri`` as any Turtle file may write it: by a bundled prefix, which the lab's files declare as the
+    docs do (home:Cup, world:Cup1), else whole (``<https://example.org/lab11#MyFlask>``): a store's derived
+    prefix (lab11:) is not one the lab's file is known to declare, and pasted undeclared fails to parse."""
+    for prefix, namespace in sorted(PREFIXES.items(), key=lambda item: -len(item[1])):
+        local = iri[len(namespace) :]
+        if iri.startswith(namespace) and local and all(ch.isalnum() or ch in "_-" for ch in local):
+            return f"{prefix}:{local}"
+    return f"<{iri}>"
 
 
 def local_name(iri: str) -> str:
@@ -990,30 +1024,54 @@ class Reading(Enum):
 
 
 def designate(
-    kb: KnowledgeBase, concept: str, prefer: str | None = None, reading: Reading = Reading.DIRECT_FIRST
+    kb: KnowledgeBase,
+    concept: str,
+    prefer: str | None = None,
+    reading: Reading = Reading.DIRECT_FIRST,
+    guarantees: Collection[str] = (),
 ) -> str:
     """The one thing of the world that is a ``concept`` (a task input's class), by the ``designate`` query.
 
-    With several candidates, those that are parts of ``prefer`` (the requesting robot, through any
-    one or two links) win; then, by ``reading``, the one stated to be a ``concept`` and of no narrower
-    class (docs/tasks.md, "Write a task"); still several is :class:`AmbiguousDesignatorError`, none is
-    :class:`UnresolvedDesignatorError`.
+    With several candidates, those of which the map's stated quantities decide a status of ``guarantees``
+    false are left out (what the task's preconditions guarantee of the thing it means: the full flask of
+    two, by the weight each states; :mod:`kb.stated_quantities`), unless that leaves none; then those that
+    are parts of ``prefer`` (the requesting robot, through any one or two links) win; then, by ``reading``,
+    the one stated to be a ``concept`` and of no narrower class (docs/tasks.md, "Write a task"); still
+    several is :class:`AmbiguousDesignatorError`, none is :class:`UnresolvedDesignatorError`.
     """
-    return designate_each(kb, [(concept, prefer)], reading)[0]
+    return designate_each(kb, [(concept, prefer)], reading, [guarantees])[0]
 
 
 def designate_each(
-    kb: KnowledgeBase, wanted: Sequence[tuple[str, str | None]], reading: Reading = Reading.DIRECT_FIRST
+    kb: KnowledgeBase,
+    wanted: Sequence[tuple[str, str | None]],
+    reading: Reading = Reading.DIRECT_FIRST,
+    guarantees: Sequence[Collection[str]] | None = None,
 ) -> list[str]:
-    """:func:`designate` of each (concept, prefer) of ``wanted``, their ``designate`` queries asked at
-    once: one request to a remote store instead of one per input of a task."""
+    """:func:`designate` of each (concept, prefer) of ``wanted``, with the statuses ``guarantees`` gives
+    for it (in the same order; None: none), their ``designate`` queries asked at once: one request to a
+    remote store instead of one per input of a task."""
     asked = kb.queries.select_each(kb.store, [("designate", {"class": concept}) for concept, _ in wanted])
-    pairs = zip(wanted, asked, strict=True)
-    return [_designated(kb, concept, prefer, reading, rows) for (concept, prefer), rows in pairs]
+    statuses = list(guarantees) if guarantees is not None else [() for _ in wanted]
+    pairs = zip(wanted, asked, statuses, strict=True)
+    stated: list[StatedQuantities] = []  # read once, and only where several things are candidates
+
+    def quantities() -> StatedQuantities:
+        if not stated:
+            stated.append(StatedQuantities.read(kb))
+        return stated[0]
+
+    return [_designated(kb, concept, prefer, reading, rows, its, quantities) for (concept, prefer), rows, its in pairs]
 
 
 def _designated(
-    kb: KnowledgeBase, concept: str, prefer: str | None, reading: Reading, rows: list[dict[str, Term]]
+    kb: KnowledgeBase,
+    concept: str,
+    prefer: str | None,
+    reading: Reading,
+    rows: list[dict[str, Term]],
+    guarantees: Collection[str] = (),
+    quantities: Callable[[], StatedQuantities] | None = None,
 ) -> str:
     types: dict[str, set[str]] = defaultdict(set)
     for row in rows:
@@ -1021,6 +1079,11 @@ def _designated(
     candidates = sorted(types)
     if not candidates:
         raise UnresolvedDesignatorError(concept)
+    if len(candidates) > 1 and guarantees and quantities is not None:
+        meant = quantities().meeting(candidates, guarantees)
+        if meant and len(meant) < len(candidates):  # none left: the run's check of its preconditions refuses
+            types = {thing: kinds for thing, kinds in types.items() if thing in meant}
+            candidates = meant
     if len(candidates) > 1 and prefer is not None:
         owned = [c for c in candidates if _linked(kb, prefer, c)]
         if len(owned) == 1:
