@@ -215,3 +215,17 @@ def test_a_misspelt_search_offers_the_names_meant(client: FlaskClient) -> None:
         assert twin["total"] == 0 and meant in [m["text"] for m in twin["meant"]]
     found = client.get("/search.json", query_string={"q": "reading lamp"}).get_json()
     assert found["total"] > 0 and found["meant"] == []
+
+
+def test_a_task_file_chosen_for_the_map_is_told_where_tasks_go(client: FlaskClient) -> None:
+    """lab10_switch_on_the_lamp.ttl (a task, "for the requirements graph") chosen for the map was loaded
+    there without a word, as cbrs load --graph map does; the page now says where a task goes and writes
+    nothing, and so for a component's advertisement chosen for the ontology."""
+    before = client.get("/index.json").get_json()
+    refused = _load_form(client, EXAMPLES / "lab10_switch_on_the_lamp.ttl", "map", TOKEN, name="switch_on.ttl")
+    assert refused.status_code == 400
+    (message,) = _errors(refused.text)
+    assert "lab10:SwitchOnTheReadingLamp" in message and "the requirements graph" in message
+    plug = _load_form(client, EXAMPLES / "lab10_lamp_switch.ttl", "ontology", TOKEN)
+    assert plug.status_code == 400 and "the services graph" in " ".join(_errors(plug.text))
+    assert client.get("/index.json").get_json()["graphs"] == before["graphs"]

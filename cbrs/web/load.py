@@ -15,13 +15,17 @@ from __future__ import annotations
 from pathlib import PurePath
 from typing import Any
 
+import pyoxigraph as ox
 from flask import Blueprint, request, url_for
 
 from cbrs.graph_store import GraphStore, Target
 from cbrs.kb.errors import KnowledgeBaseError
-from cbrs.kb.namespaces import GraphName
+from cbrs.kb.loader import parse_bytes
+from cbrs.kb.namespaces import RDF, RDFS, GraphName
+from cbrs.kb.vocab import CBRS
 from cbrs.sparql_service import UpdateForbiddenError
 from cbrs.web import context
+from cbrs.web.links import short
 from cbrs.web.pages import FormError, Page, page
 from cbrs.web.sparql import bearer_token, typed_token_refusal
 from cbrs.web.tasks import from_own_page
@@ -75,8 +79,12 @@ def load() -> Page:
         token = bearer_token() or typed or None
         context.sparql().check_token(token)  # first: a page without the token learns nothing of the store
         assert upload is not None and media_type is not None  # checked above
+        body = upload.read()
+        misplaced = _misplaced(body, media_type, chosen)
+        if misplaced:
+            return _refused(shown, 400, "graph", f"{name} {misplaced}; nothing was loaded")
         before = _size(node)
-        GraphStore(context.sparql()).add(Target(node.value), upload.read(), media_type, token)
+        GraphStore(context.sparql()).add(Target(node.value), body, media_type, token)
     except UpdateForbiddenError as error:
         return _refused(shown, error.http_status, "token", typed_token_refusal(error, typed))
     except KnowledgeBaseError as error:  # not RDF, a shape or a map check refused it: nothing was written
@@ -91,6 +99,35 @@ def load() -> Page:
         "next": {"home": url_for("home.home"), "search": url_for("search.search"), "tasks": url_for("tasks.tasks")},
     }
     return shown
+
+
+def _misplaced(body: bytes, media_type: str, chosen: str) -> str | None:
+    """What is wrong with putting the file's descriptions into the graph ``chosen``: a task belongs in
+    graph:requirements and a component's advertisement in graph:services, which a file's header says and a
+    person choosing from a list may miss. None when it describes neither, or does not parse (the load then
+    says why, with the file's line)."""
+    try:
+        parsed = parse_bytes(body, BODY_NAME, ox.RdfFormat.from_media_type(media_type) or ox.RdfFormat.TURTLE)
+    except KnowledgeBaseError:
+        return None
+    kb = context.kb()
+    with context.lock():
+        advertised = {CBRS.Advertisement} | {
+            q.subject.value
+            for q in kb.store.quads(None, ox.NamedNode(RDFS + "subClassOf"), ox.NamedNode(CBRS.Advertisement))
+        }
+    for quad in parsed.quads:
+        if quad.predicate.value != RDF + "type" or not isinstance(quad.subject, ox.NamedNode):
+            continue
+        if quad.object.value == CBRS.Requirement and chosen != "requirements":
+            task = short(quad.subject.value)
+            return f"describes a task ({task}, a cbrs:Requirement): tasks go into the requirements graph"
+        if quad.object.value in advertised and chosen != "services":
+            return (
+                f"describes a component's advertisement ({short(quad.subject.value)}, a {short(quad.object.value)}): "
+                "advertisements go into the services graph"
+            )
+    return None
 
 
 def _refused(shown: Page, status: int, field: str, message: str) -> Page:
