@@ -112,19 +112,23 @@ def _misplaced(body: bytes, media_type: str, chosen: str) -> str | None:
         return None
     kb = context.kb()
     with context.lock():
+        subclasses = kb.store.quads(None, ox.NamedNode(RDFS + "subClassOf"), ox.NamedNode(CBRS.Advertisement))
         advertised = {CBRS.Advertisement} | {
-            q.subject.value
-            for q in kb.store.quads(None, ox.NamedNode(RDFS + "subClassOf"), ox.NamedNode(CBRS.Advertisement))
+            str(q.subject.value) for q in subclasses if isinstance(q.subject, ox.NamedNode)
         }
     for quad in parsed.quads:
-        if quad.predicate.value != RDF + "type" or not isinstance(quad.subject, ox.NamedNode):
+        subject, kind = quad.subject, quad.object
+        if quad.predicate.value != RDF + "type" or not isinstance(subject, ox.NamedNode):
             continue
-        if quad.object.value == CBRS.Requirement and chosen != "requirements":
-            task = short(quad.subject.value)
-            return f"describes a task ({task}, a cbrs:Requirement): tasks go into the requirements graph"
-        if quad.object.value in advertised and chosen != "services":
+        if not isinstance(kind, ox.NamedNode):
+            continue
+        if kind.value == CBRS.Requirement and chosen != "requirements":
             return (
-                f"describes a component's advertisement ({short(quad.subject.value)}, a {short(quad.object.value)}): "
+                f"describes a task ({short(subject.value)}, a cbrs:Requirement): tasks go into the requirements graph"
+            )
+        if kind.value in advertised and chosen != "services":
+            return (
+                f"describes a component's advertisement ({short(subject.value)}, a {short(kind.value)}): "
                 "advertisements go into the services graph"
             )
     return None
