@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import collections.abc
 import time
-from collections.abc import Collection, Sequence
+from collections.abc import Collection, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -99,9 +99,15 @@ class PreconditionSensing:
         timeout: float,
         passed: Collection[str] = (),
         advertisements: Sequence[Advertisement] | None = None,
+        given: Mapping[str, Any] | None = None,
     ) -> None:
         self.kb, self.container, self.runnable, self.index, self.timeout = kb, container, runnable, index, timeout
         self.passed = frozenset(passed)
+        self.designated = {  # the things the run's inputs name, with the class each was asked as
+            str(value["@id"]): str(value["@type"])
+            for value in (given or {}).values()
+            if isinstance(value, Mapping) and "@id" in value and "@type" in value
+        }
         self._ads = advertisements
         self._conditions: dict[str, MeasuredCondition | MeasuredConditionError] | None = None
         self._units: Units | None = None
@@ -148,13 +154,20 @@ class PreconditionSensing:
     def _stated(self, statement: Statement) -> Sensed | None:
         """``statement`` decided by the level of its status's quantity that the thing it is about states in
         the map (:mod:`kb.stated_quantities`); None where it states none. The thing: the subject itself when
-        it is a thing of the map, else the one thing of the subject's class, designated as the run designates
-        a task's input (the precondition's status its guarantee); none or several: None."""
+        it is a thing of the map; else the one thing the run's inputs name of the subject's class or one below
+        it (``given``); else the one thing of the subject's class, designated as the run designates a task's
+        input (the precondition's status its guarantee); none or several: None."""
         if self._stated_quantities is None:
             self._stated_quantities = StatedQuantities.read(self.kb)
         subject = statement.subject
+        meant = sorted(iri for iri, concept in self.designated.items() if self._is_a(concept, subject))
         try:
-            thing = designate(self.kb, subject, guarantees=(statement.object,)) if subject in self.index else subject
+            if subject not in self.index:
+                thing = subject
+            elif len(meant) == 1:
+                thing = meant[0]
+            else:
+                thing = designate(self.kb, subject, guarantees=(statement.object,))
         except (UnresolvedDesignatorError, AmbiguousDesignatorError):
             return None
         found = self._stated_quantities.decide(thing, statement.object)

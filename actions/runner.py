@@ -367,7 +367,7 @@ def run_task(
                 given = environment.given(plan, on_behalf(_supplying(kb, composition), chosen))
                 if not replans and composition.attempts:  # the task's own guarantees (actions.task_preconditions)
                     requirement = composition.attempts[0].requirement
-                    sense = _sensing(kb, container, environment, composer, sensing, passed)
+                    sense = _sensing(kb, container, environment, composer, sensing, passed, given)
                     checked = check_preconditions(environment, requirement, seen, composer.index.is_a, sense)
             except Exception as error:
                 if not replans:  # refused before anything moved: the store is left as it was
@@ -430,12 +430,15 @@ def _sensing(
     composer: Composer,
     config: SensingConfig | None,
     passed: Mapping[str, str],
+    given: Mapping[str, Any] | None = None,
 ) -> PreconditionSensing | None:
-    """The question a run's preconditions on measured states are asked through, unless sensing is off."""
+    """The question a run's preconditions on measured states are asked through, unless sensing is off;
+    ``given``: the values of the plan's inputs, whose things a precondition on a thing's stated quantity is
+    asked of (the flask the run designated, not another of its class)."""
     config = config or SensingConfig.from_settings()
     if not config.enabled:
         return None
-    return PreconditionSensing(kb, container, environment.registry, composer.index, config.timeout, passed)
+    return PreconditionSensing(kb, container, environment.registry, composer.index, config.timeout, passed, given=given)
 
 
 def refusal_before_world(

@@ -124,6 +124,16 @@ def test_a_precondition_on_a_thing_is_decided_by_the_weight_the_map_states(kb: K
     assert "holds at least 0.4 kg (its home:holdsWhen)" in said
 
 
+def test_the_thing_the_run_designated_is_the_one_asked_about(kb: KnowledgeBase, index: Any) -> None:
+    """Where the run's input names the yellow flask (as a run that designated it gives it), the precondition is
+    decided of that flask, not of the one the precondition alone would tell apart."""
+    given = {"flask": {"@id": LAB11 + "Flask2", "@type": FLASK}, "person": {"@id": "x", "@type": HOME + "Person"}}
+    sensing = PreconditionSensing(kb, cast(Container, None), (), index, 1.0, advertisements=(), given=given)
+    with pytest.raises(TaskPreconditionError) as refused:
+        _check(kb, index, Statement(FLASK, HOME + "hasStatus", FULL), sensing=sensing)
+    assert "reads 0.15 kg of " in str(refused.value)
+
+
 def test_a_lab_s_own_quantity_in_another_unit_is_converted(kb: KnowledgeBase, index: Any) -> None:
     quantities = StatedQuantities.read(kb)
     level = quantities.level(LAB11 + "Flask1", LAB + "LiquidVolume")
