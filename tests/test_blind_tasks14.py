@@ -20,6 +20,7 @@ import pytest
 from flask.testing import FlaskClient
 
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import CBRS, HOME, RDFS
 from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.tasks import TaskRun, TaskRunner
 from cbrs.web import create_app
@@ -31,6 +32,14 @@ BROWSER = {"Origin": OWN, "Accept": "text/html,application/xhtml+xml,*/*;q=0.8"}
 LAMP_TASK = (EXAMPLES / "lab10_switch_on_the_lamp.ttl").read_text(encoding="utf-8")
 LAB10 = "https://example.org/lab10#"
 REPO = Path(__file__).parent.parent
+MUG_TASK = (
+    "@prefix lab14: <https://example.org/lab14#> .\n"
+    'lab14:FetchMyMug a cbrs:Requirement ; rdfs:label "Fetch my mug"@en ;\n'
+    "    cbrs:hasOWLSModel [ a cbrs:OWLSModel ;\n"
+    '        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "mug" ; cbrs:parameterType lab14:Mug ] ;\n'
+    "        cbrs:hasEffect [ a cbrs:Effect ; cbrs:conditionSubject lab14:Mug ; "
+    "cbrs:conditionPredicate home:isWith ; cbrs:conditionObject home:Person ] ] .\n"
+)
 
 
 class _Ended(TaskRunner):
@@ -183,14 +192,7 @@ def test_a_new_task_in_a_namespace_the_store_lacks_is_named_by_the_text_s_own_pr
     """A lab's first task, checked before anything of its namespace is stored, was titled "New task:
     https://example.org/lab14#FetchMyMug, unsolvable", its undeclared class named by its IRI, although
     the text declares @prefix lab14: and the user wrote lab14:FetchMyMug."""
-    text = (
-        "@prefix lab14: <https://example.org/lab14#> .\n"
-        'lab14:FetchMyMug a cbrs:Requirement ; rdfs:label "Fetch my mug"@en ;\n'
-        "    cbrs:hasOWLSModel [ a cbrs:OWLSModel ;\n"
-        '        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "mug" ; cbrs:parameterType lab14:Mug ] ;\n'
-        "        cbrs:hasEffect [ a cbrs:Effect ; cbrs:conditionSubject lab14:Mug ; "
-        "cbrs:conditionPredicate home:isWith ; cbrs:conditionObject home:Person ] ] .\n"
-    )
+    text = MUG_TASK
     page = _post_form(client, "/tasks/new", turtle=text, action="check")
     assert page.status_code == 200, _errors(page.text)
     title = re.search(r"<title>(.*?)</title>", page.text).group(1)
@@ -229,3 +231,15 @@ def test_a_task_file_chosen_for_the_map_is_told_where_tasks_go(client: FlaskClie
     plug = _load_form(client, EXAMPLES / "lab10_lamp_switch.ttl", "ontology", TOKEN)
     assert plug.status_code == 400 and "the services graph" in " ".join(_errors(plug.text))
     assert client.get("/index.json").get_json()["graphs"] == before["graphs"]
+
+
+def test_a_misplaced_task_of_a_new_namespace_is_named_by_the_file_s_prefix(client: FlaskClient) -> None:
+    """The refusal of a task file chosen for the map named a task of a namespace the store lacks by its
+    whole IRI (https://example.org/lab14#FetchMyMug), where the file writes lab14:FetchMyMug."""
+    declared = "".join(f"@prefix {p}: <{ns}> .\n" for p, ns in (("cbrs", CBRS), ("home", HOME), ("rdfs", RDFS)))
+    body = (declared + MUG_TASK).encode()
+    data = {"graph": "map", "token": TOKEN, "file": (io.BytesIO(body), "fetch_my_mug.ttl")}
+    page = client.post("/load", data=data, headers=BROWSER, content_type="multipart/form-data")
+    assert page.status_code == 400
+    (message,) = _errors(page.text)
+    assert "a task (lab14:FetchMyMug, a cbrs:Requirement)" in message

@@ -24,8 +24,9 @@ from cbrs.kb.loader import parse_bytes
 from cbrs.kb.namespaces import RDF, RDFS, GraphName
 from cbrs.kb.vocab import CBRS
 from cbrs.sparql_service import UpdateForbiddenError
+from cbrs.task_drafts import declared_prefixes
 from cbrs.web import context
-from cbrs.web.links import short
+from cbrs.web.links import short, use_text_prefixes
 from cbrs.web.pages import FormError, Page, page
 from cbrs.web.sparql import bearer_token, typed_token_refusal
 from cbrs.web.tasks import from_own_page
@@ -110,6 +111,7 @@ def _misplaced(body: bytes, media_type: str, chosen: str) -> str | None:
         parsed = parse_bytes(body, BODY_NAME, ox.RdfFormat.from_media_type(media_type) or ox.RdfFormat.TURTLE)
     except KnowledgeBaseError:
         return None
+    use_text_prefixes(declared_prefixes(body.decode("utf-8", "replace")))  # lab14:FetchMyMug, as the file writes it
     kb = context.kb()
     with context.lock():
         subclasses = kb.store.quads(None, ox.NamedNode(RDFS + "subClassOf"), ox.NamedNode(CBRS.Advertisement))
