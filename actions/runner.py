@@ -40,6 +40,7 @@ from cbrs.actions.unavailable import name_unavailable
 from cbrs.kb import Advertisement, KnowledgeBase, NotFoundError, Requirement, Statement
 from cbrs.kb.namespaces import HOME, shorten
 from cbrs.kb.semantic_map import AmbiguousDesignatorError, UnresolvedDesignatorError
+from cbrs.kb.stated_quantities import StatedQuantities, guaranteed_statuses
 from cbrs.kb.store import Term
 from cbrs.reasoner.taxonomy import ROOT, TaxonomyIndex
 
@@ -373,7 +374,7 @@ def run_task(
                 if not replans:  # refused before anything moved: the store is left as it was
                     belief.restore(before)
                 if isinstance(error, AmbiguousDesignatorError) and composition.attempts:
-                    raise _undecided(error, composition.attempts[0].requirement, composer.index) from error
+                    raise _undecided(error, composition.attempts[0].requirement, composer.index, kb) from error
                 raise
             store_plan(kb, plan)
             starting = getattr(environment, "starting", None)  # optional: a look-ahead at the plan's values
@@ -788,21 +789,32 @@ _WHERE = {HOME + "x", HOME + "minX"}  # what places a thing in the map: a positi
 
 
 def _undecided(
-    error: AmbiguousDesignatorError, requirement: Requirement, index: TaxonomyIndex
+    error: AmbiguousDesignatorError, requirement: Requirement, index: TaxonomyIndex, kb: KnowledgeBase | None = None
 ) -> AmbiguousDesignatorError:
     """``error`` saying which of ``requirement``'s preconditions are about the ambiguous class and did not
     tell the things apart: a lab wrote one to choose among them (the full flask of two, by its weight), and a
     precondition leaves out only the things the map's stated quantities decide it false of (docs/execution.md,
-    "A thing's quantities stated in the map"); its example class in the task's own namespace. ``error``
-    itself, but for that namespace, where none is about it."""
-    about = [
-        statement_text(p)
+    "A thing's quantities stated in the map"); where they would have (``kb``'s stated quantities), that the
+    environment designated the task's inputs without the task's guarantees. Its example class in the task's
+    own namespace. ``error`` itself, but for that namespace, where no precondition is about the class."""
+    preconditions = [
+        p
         for p in requirement.preconditions
         if p.subject == error.concept or (p.subject in index and index.is_a(error.concept, p.subject))
     ]
-    if not about:
+    if not preconditions:
         return error.noting(error.note, requirement.iri)
-    which = "; ".join(about)
+    which = "; ".join(statement_text(p) for p in preconditions)
+    statuses = guaranteed_statuses(requirement, error.concept, lambda c, a: a in index and index.is_a(c, a))
+    meant = StatedQuantities.read(kb).meeting(error.candidates, statuses) if kb is not None and statuses else []
+    if len(meant) == 1:
+        return error.noting(
+            f"the task's precondition {which} tells them apart by the quantity each states in the map (only "
+            f"{shorten(meant[0])} meets it), but the environment designated the task's inputs without the statuses "
+            "its preconditions guarantee (kb.semantic_map.designate_each's guarantees, "
+            "kb.stated_quantities.guaranteed_statuses)",
+            requirement.iri,
+        )
     return error.noting(
         f"the task's precondition {which} does not tell them apart: a precondition is what the requester "
         "guarantees of the thing the task names, and of several things of its class it leaves out only those "

@@ -11,7 +11,9 @@ device is in), their mean where it measures several, and gives each of its outpu
 or one below it, as a reading of its output's class under the key of the level's unit (docs/values.md):
 ``{"@type": ".../home#Temperature", "celsius": 21.0}``. A sensor that measures no place of the map, or
 places no level is stated of, fails, saying so. docs/execution.md, "A sensed precondition in the
-simulated home".
+simulated home". Things state levels the same way (``home:massKg``, a ``home:ObjectWeight`` in
+kilograms); a sensor here reads places only, and a thing's own level decides a precondition on it where no
+sensor reads it (:mod:`kb.stated_quantities`).
 """
 
 from __future__ import annotations

@@ -194,3 +194,16 @@ def test_a_sensor_s_reading_comes_before_the_level_a_place_states(kb: KnowledgeB
     bedroom = Statement(HOME + "Bedroom", HOME + "hasStatus", "https://example.org/lab9#Dark")
     (check,) = _check(kb, index, bedroom)
     assert check.believed is None and check.why == "no sensor of home:Illuminance covers home:Bedroom"
+
+
+def test_an_environment_that_designates_without_the_guarantees_is_told_so(kb: KnowledgeBase, index: Any) -> None:
+    """A lab's own environment that designates the task's inputs without the statuses the task guarantees (an
+    older one) meets the two flasks as ambiguous; the refusal says the stated weights tell them apart."""
+    from cbrs.actions.runner import _undecided
+
+    requirement = Composer(kb).task("FetchTheFullFlask").requirement
+    with pytest.raises(AmbiguousDesignatorError) as ambiguous:
+        designate_each(kb, [(FLASK, requirement.requested_by)])
+    said = str(_undecided(ambiguous.value, requirement, index, kb)).replace(LAB11, "lab11:")
+    assert "(lab11:Flask, home:hasStatus, lab11:Full) tells them apart by the quantity each states" in said
+    assert "(only lab11:Flask1 meets it), but the environment designated the task's inputs without" in said
