@@ -243,3 +243,16 @@ def test_a_misplaced_task_of_a_new_namespace_is_named_by_the_file_s_prefix(clien
     assert page.status_code == 400
     (message,) = _errors(page.text)
     assert "a task (lab14:FetchMyMug, a cbrs:Requirement)" in message
+
+
+def test_a_planned_goal_names_a_lab_class_by_its_prefix(client: FlaskClient) -> None:
+    """With the plug's components loaded (from the page, into services), the lamp's task plans, and the
+    plans page's Goals said "(https://example.org/lab10#ReadingLamp, home:hasStatus, home:SwitchedOn)".
+    Last in the module: the plug makes the lamp's task plannable for the tests after it."""
+    saved = _post_form(client, "/tasks/new", turtle=LAMP_TASK, action="save", token=TOKEN, replace="1")
+    loaded = _load_form(client, EXAMPLES / "lab10_lamp_switch.ttl", "services", TOKEN)
+    assert saved.status_code == 201 and loaded.status_code == 201, _errors(saved.text + loaded.text)
+    page = client.get("/plans?task=lab10:SwitchOnTheReadingLamp", headers=BROWSER)
+    assert page.status_code == 200 and "No plan." not in page.text
+    goals = _text(page.text.split(">Goals<", 1)[1].split("</ul>", 1)[0])
+    assert "(lab10:ReadingLamp, home:hasStatus, home:SwitchedOn)" in goals and LAB10 not in goals
