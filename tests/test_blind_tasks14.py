@@ -10,6 +10,7 @@ runs that end at once (no planner run, no simulation).
 from __future__ import annotations
 
 import io
+import json
 import re
 from collections.abc import Iterator
 from html import unescape
@@ -256,3 +257,14 @@ def test_a_planned_goal_names_a_lab_class_by_its_prefix(client: FlaskClient) -> 
     assert page.status_code == 200 and "No plan." not in page.text
     goals = _text(page.text.split(">Goals<", 1)[1].split("</ul>", 1)[0])
     assert "(lab10:ReadingLamp, home:hasStatus, home:SwitchedOn)" in goals and LAB10 not in goals
+
+
+def test_the_live_tasks_page_is_given_the_prefix_of_a_lab_s_components(client: FlaskClient) -> None:
+    """The tasks page's script names the IRIs of live events (steps, components, reasons) with the
+    prefixes the page gives it (``data-prefixes``): cbrs's own only, so a lab's plug (a component over the
+    bridge, in no "Make fail" list) read
+    https://example.org/lab10#SwitchOnReadingLamp_LampPlug01 live, and lab10:... once the page was
+    reloaded. Runs after the plug's components are loaded (the test above)."""
+    page = client.get("/tasks", headers=BROWSER)
+    given = json.loads(unescape(re.search(r'data-prefixes="([^"]*)"', page.text).group(1)))
+    assert given.get("lab10") == LAB10 and given["svc"] == "https://w3id.org/cbrs/service#"

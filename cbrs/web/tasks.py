@@ -37,9 +37,10 @@ from cbrs.tasks import (
     UnknownComponentError,
     preconditions_line,
 )
-from cbrs.web import context
+from cbrs.web import context, services
 from cbrs.web.links import expand_name, short, shown_term, task_name
 from cbrs.web.pages import FormError, Page, page, wants_json
+from cbrs.web.prefixes import derived, namespace
 
 blueprint = Blueprint("tasks", __name__)
 
@@ -48,6 +49,7 @@ DEFAULTS = {
     "CBRS_STREAM_IDLE_SECONDS": 120.0,  # a stream with no event (no new frame) this long ends
     "CBRS_HEARTBEAT_SECONDS": 5.0,  # an SSE comment this often, so a gone client is noticed
     "CBRS_CAMERA_REPEAT_SECONDS": 2.0,  # the last frame again this often, so the browser keeps showing it
+    "CBRS_LIVE_PREFIXES": 50,  # at most this many derived prefixes go to tasks.js (the components' namespaces)
 }
 SLICE = 0.5  # seconds a stream waits at most before it looks whether the server is closing
 QUEUE_SIZE = 1000  # events a slow client may fall behind by before its stream ends (a run sends ~150)
@@ -126,10 +128,25 @@ def cancel(run_id: str) -> Page:
 
 def _for_script(shown: Page) -> Page:
     if not wants_json():
-        # tasks.js shortens the IRIs of live events with cbrs's own prefixes: the runs' components and
-        # steps live under them, and OWLS-TC's 1,144 derived prefixes made this page 145 KB bigger
-        shown.data["prefixes"] = PREFIXES
+        shown.data["prefixes"] = {**_component_prefixes(), **PREFIXES}
     return shown
+
+
+def _component_prefixes() -> dict[str, str]:
+    """The prefixes derived for the namespaces of the advertisements (a lab's plug: ``lab10:``), for tasks.js
+    to name live events' IRIs as the page names them; none when they are more than
+    ``CBRS_LIVE_PREFIXES``: OWLS-TC's 1,144 made the page 145 KB bigger, and its services run no task."""
+    by_prefix = derived()
+    if not by_prefix:
+        return {}
+    by_ns = {ns: prefix for prefix, ns in by_prefix.items()}
+    rows = services.advertisement_rows(context.kb())
+    used = {by_ns[ns] for ns in (namespace(row["service"]) for row in rows) if ns in by_ns}
+    return (
+        {prefix: by_prefix[prefix] for prefix in sorted(used)}
+        if len(used) <= current_app.config["CBRS_LIVE_PREFIXES"]
+        else {}
+    )
 
 
 def _check_asked(form: dict[str, Any], shown: Page) -> None:
