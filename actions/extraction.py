@@ -338,16 +338,20 @@ class Extraction:
                 # another goal's thing (the tray the cup goes to) is no value for the steps of this
                 # one (where the base parks to load the pen), which have a provider of their own
                 given = [e for e in given if not self._foreign(step, e)]
+            taken = self._taken(step, need)
             if given:
-                step.bindings.append(_Bound(need, min(given, key=lambda e: (*self._fit(step, e), *self._key(e))), None))
+                chosen = min(given, key=partial(self._given_key, step, taken))
+                step.bindings.append(_Bound(need, chosen, None))
                 return True
             mine = [(e, p) for p in step.producers for e in options if e.source == self.steps[p].node]
             if mine:  # a step already made for this consumer meets this need too
                 rank = self._ranker([e for e, _ in mine])
-                edge, producer_id = min(mine, key=lambda item: (rank(item[0]), item[1]))
+                edge, producer_id = min(
+                    mine, key=lambda item: ((item[1], item[0].offer.name) in taken, rank(item[0]), item[1])
+                )
                 step.bindings.append(_Bound(need, edge, producer_id))
                 return True
-            sibling = self._sibling(step, node, need)
+            sibling = self._sibling(step, node, need, taken)
             if sibling is not None:
                 step.bindings.append(sibling)
                 return True
@@ -376,6 +380,13 @@ class Extraction:
         step.bindings.append(_Bound(need, best, producer.id))
         queue.append(producer.id)
         return True
+
+    def _given_key(self, step: _Step, taken: set[tuple[int | None, str]], edge: Edge) -> tuple[Any, ...]:
+        """The order of the values the task gives for a need of ``step``, best first: one not ``taken`` by
+        another input of the step of the same class (:meth:`_taken`), then :meth:`_fit`, then :meth:`_key`,
+        whose last part is the value's name: twin inputs, in the order the component declares them, take
+        the task's things of their class in the order of their names (``_TrainStation0`` the first)."""
+        return ((None, edge.offer.name) in taken, *self._fit(step, edge), *self._key(edge))
 
     def _fit(self, step: _Step, edge: Edge) -> tuple[int, int]:
         """The order of the values the task gives for a need of ``step``: one whose class falls under the
@@ -425,8 +436,25 @@ class Extraction:
         others = [index.depth(c) for c in self._goal_concepts - set(step.about) if c in ancestors and c in index]
         return bool(others) and max(others) > -self._aboutness(step, edge)
 
-    def _sibling(self, step: _Step, node: str, need: Need) -> _Bound | None:
-        """An output of a step made for the same consumer, if one meets this input."""
+    def _twins(self, need: Need, other: Need) -> bool:
+        """Whether ``other`` is another input of the same class as input ``need`` (see :meth:`_taken`)."""
+        mine, theirs = need.concept, other.concept
+        if need.role != "input" or other.role != "input" or other == need or mine is None or theirs is None:
+            return False
+        index = self.graph.pool.matcher.index
+        if mine in index and theirs in index:
+            return index.canonical(mine) == index.canonical(theirs)
+        return mine == theirs
+
+    def _taken(self, step: _Step, need: Need) -> set[tuple[int | None, str]]:
+        """The values (producing step, or None for the task; and the name) already bound to ``step``'s other
+        inputs of ``need``'s class. A component that takes two things of one class (a fare's two stations)
+        means two things: each is given one not taken yet where there is one, and shares only when what
+        the task and the steps give is fewer (docs/composition.md, "Extracting the plan")."""
+        return {(b.source, b.edge.offer.name) for b in step.bindings if self._twins(need, b.need)}
+
+    def _sibling(self, step: _Step, node: str, need: Need, taken: set[tuple[int | None, str]]) -> _Bound | None:
+        """An output of a step made for the same consumer, if one meets this input (one not ``taken`` first)."""
         if need.role != "input" or step.made_for is None:
             return None
         level = self.trace.levels[step.node]
@@ -437,7 +465,8 @@ class Extraction:
                 continue
             for edge in self.graph.providers(node, need):
                 if edge.source == other.node and edge.offer.role == "output":
-                    found.append(((-edge.similarity, other.id, edge.offer.name), _Bound(need, edge, other.id)))
+                    rank = ((other.id, edge.offer.name) in taken, -edge.similarity, other.id, edge.offer.name)
+                    found.append((rank, _Bound(need, edge, other.id)))
         return min(found, key=lambda item: item[0])[1] if found else None
 
     # -- service effective areas (actions.areas) --------------------------------------------------
@@ -478,7 +507,11 @@ class Extraction:
             given = [e for e in options if e.source == SRI]
             if given and len(given) < len(options):
                 given = [e for e in given if not self._foreign(probe, e)]
-            chosen = min(given, key=lambda e: (*self._fit(probe, e), *self._key(e))) if given else None
+            taken = self._taken(probe, need)
+            key = partial(self._given_key, probe, taken)
+            chosen = min(given, key=key) if given else None
+            if chosen is not None:
+                probe.bindings.append(_Bound(need, chosen, None))
             served = (need.statement.subject, need.statement.object) if need.statement is not None else ()
             ways.append((need, chosen, (*served, *about), [e for e in options if e.source != SRI]))
         return ways
