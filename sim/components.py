@@ -41,6 +41,7 @@ from cbrs.kb.errors import NotFoundError
 from cbrs.kb.model import Advertisement
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import designate_each
+from cbrs.kb.stated_quantities import guaranteed_statuses
 from cbrs.kb.vocab import CBRS
 from cbrs.settings import setting
 from cbrs.sim import predicates as pred
@@ -365,6 +366,7 @@ class SimEnvironment:
     def given(self, plan: Plan, requirements: Mapping[str, Requirement]) -> dict[str, Any]:
         """The world's thing for each input a requirement gives: the one individual of the input's class."""
         wanted: dict[str, tuple[str, str | None]] = {}  # input name -> (its class, the requesting robot)
+        guaranteed: dict[str, tuple[str, ...]] = {}  # input name -> the statuses the task guarantees of its thing
         for step in plan.steps:
             for binding in step.inputs:
                 source = binding.source
@@ -376,8 +378,9 @@ class SimEnvironment:
                 for parameter in requirement.inputs:
                     if parameter.name == source.name:
                         wanted[source.name] = (parameter.type, requirement.requested_by)
+                        guaranteed[source.name] = guaranteed_statuses(requirement, parameter.type, self.is_a)
         # every input's thing asked at once: one request to a remote store, not one per input
-        things = designate_each(self.kb, list(wanted.values())) if wanted else []
+        things = designate_each(self.kb, list(wanted.values()), guarantees=list(guaranteed.values())) if wanted else []
         values: dict[str, Any] = {
             name: designator(iri, concept) for (name, (concept, _)), iri in zip(wanted.items(), things, strict=True)
         }
