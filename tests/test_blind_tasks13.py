@@ -227,19 +227,18 @@ def transit_kb() -> KnowledgeBase:
     return kb
 
 
-def test_an_input_passed_over_for_its_twin_is_not_said_to_fit_no_component(transit_kb: KnowledgeBase) -> None:
-    """The fare between two stations: the lookup takes two stations and was given the first for both,
-    and the note said 'no component takes a thing of that class (a destination must be a home:Place,
-    say)' of the second, which the lookup does take."""
+def test_the_fare_lookup_takes_both_stations(transit_kb: KnowledgeBase) -> None:
+    """The fare between two stations: the lookup takes two stations and was given the first for both
+    (the tie-break by name), and the note said of the second 'no component takes a thing of that class'
+    (ffc72ff made it 'was given _TrainStation0'); now each input takes one (tests/test_distinct_bindings.py)."""
     result = Composer(transit_kb).compose(FARE)
-    assert result.unused_inputs == (("_TrainStation1", "http://127.0.0.1/ontology/lab13_transit.owl#TrainStation"),)
-    text = plan_text(result)
-    assert re.search(
-        r"note: no step takes the task's input _TrainStation1 \(\S+TrainStation\): each step's need of that class "
-        r"was given _TrainStation0, the task's other input of the class",
-        text,
-    )
-    assert "no component takes a thing of that class" not in text
+    assert result.plan is not None and result.unused_inputs == ()
+    (step,) = result.plan.steps
+    assert [(b.name, b.source.name) for b in step.bindings] == [
+        ("_TrainStation0", "_TrainStation0"),
+        ("_TrainStation1", "_TrainStation1"),
+    ]
+    assert "no step takes" not in plan_text(result)
 
 
 def test_an_output_that_reports_nothing_asked_is_not_said_to_report(transit_kb: KnowledgeBase) -> None:
@@ -320,11 +319,12 @@ def test_a_query_relevance_xml_does_not_judge_is_named_as_not_evaluated(tmp_path
     assert "not evaluated, judged by no request of relevance.xml: queries/train_fare_return.owls" in result.stdout
 
 
-def test_the_plans_page_names_an_input_no_step_takes(transit_kb: KnowledgeBase) -> None:
+def test_the_plans_page_shows_each_station_given(transit_kb: KnowledgeBase) -> None:
     """The browser's plan of the fare showed both stations of the lookup '<- requirement._TrainStation0'
-    and nothing of the second station the task gives; /plans.json had it as unused_inputs."""
+    and nothing of the second station the task gives (e970ae5 added 'Taken by no step'); now each is taken."""
     client = create_app(SparqlService(transit_kb)).test_client()
     page = client.get("/plans", query_string={"task": FARE})
     assert page.status_code == 200
     text = re.sub(r"\s+", " ", re.sub(r"<[^>]+>", " ", page.get_data(as_text=True)))
-    assert re.search(r"Taken by no step: _TrainStation1 \S*TrainStation \. The plan does without it", text)
+    assert "Taken by no step" not in text
+    assert "_TrainStation1 ← requirement ._TrainStation1" in text
