@@ -412,10 +412,11 @@ def _unused_note(unused: Sequence[tuple[str, str]], composition: CompositionResu
         )
     for name, type_ in alike:
         taken = ", ".join(twins[type_])
+        others = "the task's other input" if len(twins[type_]) == 1 else "the task's other inputs"
         notes += (
             f"\nnote: no step takes the task's input {name} ({shorten(type_)}): each step's need of that class"
-            f" was given {taken}, the task's other input of the class (docs/composition.md, 'Extracting the"
-            " plan'), so the plan does without it"
+            f" was given {taken}, {others} of the class (docs/composition.md, 'Extracting the plan'), so the"
+            " plan does without it"
         )
     return notes
 

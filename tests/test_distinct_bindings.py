@@ -12,6 +12,7 @@ import pytest
 
 from cbrs.actions.composer import Composer
 from cbrs.actions.plan import Plan
+from cbrs.cli_actions import _unused_note
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.catalog import Catalogue
 from tests.helpers_examples import EXAMPLES
@@ -31,6 +32,14 @@ t:FareFromOneStation a cbrs:Requirement ;
     cbrs:serviceName "FareFromOneStation" ;
     cbrs:hasOWLSModel [ a cbrs:OWLSModel ;
         cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "station" ; cbrs:parameterType transit:TrainStation ] ;
+        cbrs:hasOutput [ a cbrs:Parameter ; cbrs:parameterName "fare" ; cbrs:parameterType transit:Fare ] ] .
+
+t:FareViaThreeStations a cbrs:Requirement ;
+    cbrs:serviceName "FareViaThreeStations" ;
+    cbrs:hasOWLSModel [ a cbrs:OWLSModel ;
+        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "a" ; cbrs:parameterType transit:TrainStation ] ;
+        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "b" ; cbrs:parameterType transit:TrainStation ] ;
+        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "c" ; cbrs:parameterType transit:TrainStation ] ;
         cbrs:hasOutput [ a cbrs:Parameter ; cbrs:parameterName "fare" ; cbrs:parameterType transit:Fare ] ] .
 
 t:FareOfMyJourney a cbrs:Requirement ;
@@ -97,3 +106,13 @@ def test_two_stations_a_step_gives_go_one_to_each_input(kb: KnowledgeBase) -> No
     assert result.plan is not None
     ends = next(s.index for s in result.plan.steps if s.component.endswith("JourneyEnds_Booking01"))
     assert _lookup_inputs(result.plan) == {"_TrainStation0": (ends, "station0"), "_TrainStation1": (ends, "station1")}
+
+
+def test_a_third_station_left_aside_is_said_to_be_passed_over_for_the_other_two(kb: KnowledgeBase) -> None:
+    """Three stations, a lookup of two: the first two are taken, one each, and the note names both."""
+    result = Composer(kb).compose("https://example.org/distinct#FareViaThreeStations")
+    assert _lookup_inputs(result.plan) == {"_TrainStation0": (None, "a"), "_TrainStation1": (None, "b")}
+    assert [name for name, _ in result.unused_inputs] == ["c"]
+    note = _unused_note(result.unused_inputs, result)
+    assert "no step takes the task's input c (" in note
+    assert "was given a, b, the task's other inputs of the class" in note
