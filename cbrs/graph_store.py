@@ -5,7 +5,9 @@ adding quads, the whole dataset. Writes take the update token, parse the body wh
 is written (a broken body changes nothing), pass the description shapes like every other way in, leave
 a readable semantic map readable (as a load or an update into graph:map must), leave no class under a term
 of cbrs's own vocabularies that nothing declares (as an ``INSERT DATA`` or ``DELETE DATA`` of the same
-statements must: :func:`kb.superclasses.check_change`), and are one transaction each.
+statements must: :func:`kb.superclasses.check_change`), put a task nowhere but graph:requirements and an
+advertisement nowhere but graph:services (:func:`kb.loader.check_placement`, as ``cbrs load --graph``), and are
+one transaction each.
 """
 
 from __future__ import annotations
@@ -17,7 +19,7 @@ from dataclasses import dataclass
 import pyoxigraph as ox
 
 from cbrs.kb.errors import KnowledgeBaseError
-from cbrs.kb.loader import parse_bytes
+from cbrs.kb.loader import check_placement, parse_bytes
 from cbrs.kb.namespaces import GRAPH, PREFIXES, GraphName
 from cbrs.kb.shapes import DescriptionShapeError, check_descriptions
 from cbrs.kb.superclasses import check_change, says_used_terms
@@ -198,6 +200,7 @@ class GraphStore:
         quads = parsed.quads
         if isinstance(node, ox.DefaultGraph):
             quads = [ox.Quad(q.subject, q.predicate, q.object, ox.DefaultGraph()) for q in quads]
+        check_placement(self.sparql.kb.store, quads, "<request body>")  # a task into graph:map: 400, as cbrs load
         try:
             check_descriptions(self.sparql.kb.store, quads)  # a description written so passes the shapes too
         except DescriptionShapeError as error:

@@ -15,14 +15,12 @@ from __future__ import annotations
 from pathlib import PurePath
 from typing import Any
 
-import pyoxigraph as ox
 from flask import Blueprint, request, url_for
 
 from cbrs.graph_store import GraphStore, Target
 from cbrs.kb.errors import KnowledgeBaseError
-from cbrs.kb.loader import parse_bytes
-from cbrs.kb.namespaces import RDF, RDFS, GraphName
-from cbrs.kb.vocab import CBRS
+from cbrs.kb.loader import MisplacedDescriptionError
+from cbrs.kb.namespaces import GraphName
 from cbrs.sparql_service import UpdateForbiddenError
 from cbrs.task_drafts import declared_prefixes
 from cbrs.web import context
@@ -81,13 +79,12 @@ def load() -> Page:
         context.sparql().check_token(token)  # first: a page without the token learns nothing of the store
         assert upload is not None and media_type is not None  # checked above
         body = upload.read()
-        misplaced = _misplaced(body, media_type, chosen)
-        if misplaced:
-            return _refused(shown, 400, "graph", f"{name} {misplaced}; nothing was loaded")
         before = _size(node)
         GraphStore(context.sparql()).add(Target(node.value), body, media_type, token)
     except UpdateForbiddenError as error:
         return _refused(shown, error.http_status, "token", typed_token_refusal(error, typed))
+    except MisplacedDescriptionError as error:  # the graph chosen is the fault, not the file
+        return _refused(shown, error.http_status, "graph", _misplaced(error, body, name))
     except KnowledgeBaseError as error:  # not RDF, a shape or a map check refused it: nothing was written
         return _refused(shown, error.http_status, "file", str(error).replace(BODY_NAME, name))
     added = _size(node) - before
@@ -102,38 +99,14 @@ def load() -> Page:
     return shown
 
 
-def _misplaced(body: bytes, media_type: str, chosen: str) -> str | None:
-    """What is wrong with putting the file's descriptions into the graph ``chosen``: a task belongs in
-    graph:requirements and a component's advertisement in graph:services, which a file's header says and a
-    person choosing from a list may miss. None when it describes neither, or does not parse (the load then
-    says why, with the file's line)."""
-    try:
-        parsed = parse_bytes(body, BODY_NAME, ox.RdfFormat.from_media_type(media_type) or ox.RdfFormat.TURTLE)
-    except KnowledgeBaseError:
-        return None
-    use_text_prefixes(declared_prefixes(body.decode("utf-8", "replace")))  # lab14:FetchMyMug, as the file writes it
-    kb = context.kb()
-    with context.lock():
-        subclasses = kb.store.quads(None, ox.NamedNode(RDFS + "subClassOf"), ox.NamedNode(CBRS.Advertisement))
-        advertised = {CBRS.Advertisement} | {
-            str(q.subject.value) for q in subclasses if isinstance(q.subject, ox.NamedNode)
-        }
-    for quad in parsed.quads:
-        subject, kind = quad.subject, quad.object
-        if quad.predicate.value != RDF + "type" or not isinstance(subject, ox.NamedNode):
-            continue
-        if not isinstance(kind, ox.NamedNode):
-            continue
-        if kind.value == CBRS.Requirement and chosen != "requirements":
-            return (
-                f"describes a task ({short(subject.value)}, a cbrs:Requirement): tasks go into the requirements graph"
-            )
-        if kind.value in advertised and chosen != "services":
-            return (
-                f"describes a component's advertisement ({short(subject.value)}, a {short(kind.value)}): "
-                "advertisements go into the services graph"
-            )
-    return None
+def _misplaced(error: MisplacedDescriptionError, body: bytes, name: str) -> str:
+    """The library's refusal of a task or advertisement in the wrong graph (:func:`cbrs.kb.loader.check_placement`,
+    which ``cbrs load --graph`` and the Graph Store meet too) in the page's words: the description named as the
+    pages name it, by the prefix its file declares when the store has nothing of its namespace (lab14:FetchMyMug)."""
+    use_text_prefixes(declared_prefixes(body.decode("utf-8", "replace")))
+    rule = error.rule.replace(f"graph:{error.belongs.value}", f"the {error.belongs.value} graph")
+    named = f"{short(error.subject)}, a {short(error.described_as)}"
+    return f"{name} describes {error.what} ({named}): {rule}; nothing was loaded"
 
 
 def _refused(shown: Page, status: int, field: str, message: str) -> Page:
