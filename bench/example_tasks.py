@@ -1287,8 +1287,11 @@ def _page_start(browser: _Browser, task: str, seed: int, page: str = "") -> Star
     form = read_form(page, "start", browser.url + "/tasks") if page else browser.form("/tasks", "start")[1]
     form.choose("task", task)
     form.set("seed", str(seed))
-    answer = browser.submit(form)
+    answer = browser.submit(form)  # followed, as a browser follows it, to the run's page (303 since 2026-11-28)
     said = f"the tasks page's Start with {task}"
+    sent_on = re.fullmatch(r"/tasks/(run-\d+)", urllib.parse.urlparse(answer.url).path)
+    if answer.status == 200 and sent_on is not None:  # the start form is the tasks page's: the page to start again
+        return Started(sent_on.group(1), sent_on.group(0), browser.get("/tasks").body)
     if answer.status != 202:
         words = _element_text(answer.body, "busy") or _form_errors(answer.body)
         raise _NotStarted(said, answer.status, words)

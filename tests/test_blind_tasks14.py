@@ -90,7 +90,7 @@ def test_a_lab_task_saved_on_the_new_task_page_opens_chosen_on_the_tasks_page(cl
     chosen = re.search(r'<option value="([^"]+)" selected>', page.text)
     assert chosen is not None and chosen.group(1) == "SwitchOnTheReadingLamp"
     started = _post_form(client, "/tasks", task="lab10:SwitchOnTheReadingLamp", seed="0")
-    assert started.status_code == 202, _errors(started.text)
+    assert started.status_code == 303, _errors(started.text)  # on to the run's page (Post/Redirect/Get)
     assert "started: SwitchOnTheReadingLamp" in _text(started.text)
 
 

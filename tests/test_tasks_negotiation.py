@@ -76,9 +76,10 @@ def test_a_program_gets_the_run_in_json_and_its_location(
 
 
 def test_a_browser_form_gets_the_page_and_the_run_page_as_its_location(served: tuple[FlaskClient, _Held]) -> None:
+    """A browser is sent on to the run's page (303, Post/Redirect/Get), the page in the body all the same."""
     client, runner = served
     answer = client.post("/tasks", data={"task": "FetchMyPen"}, headers={"Accept": BROWSER})
-    assert answer.status_code == 202 and answer.mimetype == "text/html"
+    assert answer.status_code == 303 and answer.mimetype == "text/html"
     run_id = answer.headers["Location"].removeprefix("/tasks/")
     assert run_id.startswith("run-") and f"{run_id} started" in answer.text
     assert "Accept" in answer.headers.get("Vary", "")  # one URL, two answers: caches key on Accept

@@ -6,6 +6,8 @@ A task file chosen for another graph than requirements was refused by the Load a
 
 from __future__ import annotations
 
+import re
+from collections.abc import Iterator
 from pathlib import Path
 
 import pyoxigraph as ox
@@ -18,12 +20,16 @@ from cbrs.kb import KnowledgeBase
 from cbrs.kb.loader import MisplacedDescriptionError
 from cbrs.kb.namespaces import GraphName
 from cbrs.sparql_service import EndpointConfig, SparqlService
+from cbrs.tasks import TaskRun, TaskRunner
 from cbrs.web import create_app
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "docs" / "examples"
 LAMP_TASK = EXAMPLES / "lab10_switch_on_the_lamp.ttl"
 LAMP_PLUG = EXAMPLES / "lab10_lamp_switch.ttl"
+LAMP = EXAMPLES / "lab10_reading_lamp.ttl"
 TOKEN = "followups-token"
+BROWSER = {"Accept": "text/html,application/xhtml+xml,application/xml;q=0.9,*/*;q=0.8"}
+WAIT = 10.0
 AUTH = {"Authorization": f"Bearer {TOKEN}"}
 
 
@@ -99,3 +105,51 @@ def test_a_task_into_requirements_and_a_plug_into_services_still_load(kb: Knowle
     kb.load([LAMP_TASK], "requirements")
     kb.load([LAMP_PLUG], "services")
     assert _sizes(kb)["requirements"] > 0
+
+
+class _Ended(TaskRunner):
+    """A runner whose runs end at once, without the world: these tests are about the pages, not the runs."""
+
+    def _run(self, run: TaskRun) -> None:
+        run.status = "succeeded"
+        run.done.set()
+
+
+@pytest.fixture(scope="module")
+def served() -> Iterator[tuple[FlaskClient, _Ended]]:
+    """The lamp in the ontology and the map, its task in requirements; runs that end at once."""
+    kb = KnowledgeBase.open(":memory:")
+    for graph in ("ontology", "map"):
+        kb.load([LAMP], graph)
+    kb.load([LAMP_TASK], "requirements")
+    sparql = SparqlService(kb)
+    runner = _Ended(kb, sparql.lock, camera=None)
+    yield create_app(sparql, tasks=runner).test_client(), runner
+
+
+def _started(runner: _Ended, location: str) -> TaskRun:
+    run = runner.get(location.removesuffix(".json").rsplit("/", 1)[1])
+    assert run.done.wait(WAIT)
+    return run
+
+
+def test_a_browser_s_start_is_sent_on_to_the_run_s_page(served: tuple[FlaskClient, _Ended]) -> None:
+    """After Start the browser stayed at /tasks, so a reload asked to send the form again, and while the run
+    went that gave a 409. A browser's form is sent on to the run's page (303); the JSON API answers as it did."""
+    client, runner = served
+    answer = client.post("/tasks", data={"task": "FetchMyPen", "seed": "0"}, headers=BROWSER)
+    assert answer.status_code == 303
+    location = answer.headers["Location"]
+    assert re.fullmatch(r"/tasks/run-\d+", location), location
+    run = _started(runner, location)
+    page = client.get(location, headers=BROWSER)
+    assert page.status_code == 200 and f"Run {run.id}: FetchMyPen" in page.text
+    twin = client.post("/tasks.json", data={"task": "FetchMyPen"})  # what tasks.js sends
+    assert twin.status_code == 202 and twin.get_json()["started"]["task"] == "FetchMyPen"
+    _started(runner, twin.headers["Location"])
+    program = client.post("/tasks", json={"task": "FetchMyPen"}, headers={"Accept": "application/json"})
+    assert program.status_code == 202 and program.headers["Location"].endswith(".json")
+    _started(runner, program.headers["Location"])
+    curl = client.post("/tasks", data={"task": "FetchMyPen"}, headers={"Accept": "*/*"})
+    assert curl.status_code == 202 and "started: FetchMyPen" in curl.text  # a program's form keeps the page
+    _started(runner, curl.headers["Location"])

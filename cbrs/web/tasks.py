@@ -67,7 +67,8 @@ def _defaults(state: BlueprintSetupState) -> None:
 def tasks() -> Page:
     """The tasks to start, the run going now (or the last one), the camera and the recent runs.
 
-    A POST starts a run (202, its ``Location`` the run's page, or its JSON for a JSON answer); while one
+    A POST starts a run (202, its ``Location`` the run's page, or its JSON for a JSON answer; a browser's form
+    is sent on to the run's page, 303: :func:`_from_a_browser`); while one
     is going it is refused with 409 and says which. A program gets JSON here as at ``/tasks.json`` when
     it prefers it (:func:`cbrs.web.pages.prefers_json`).
     """
@@ -90,7 +91,7 @@ def tasks() -> Page:
         shown.status = 409
         shown.data.update(error="busy", message=str(error), running=error.running)
         return shown
-    shown.status = 202
+    shown.status = 303 if _from_a_browser() else 202  # Post/Redirect/Get: a reload re-sent the form, a 409 mid-run
     shown.headers["Location"] = url_for("tasks.run_json" if wants_json() else "tasks.run", run_id=started.id)
     shown.title = f"Tasks: {started.id} started"
     shown.data.update(_overview(form), started=_started(started), message=f"{started.id} started: {started.task}")
@@ -124,6 +125,13 @@ def cancel(run_id: str) -> Page:
     shown = Page("tasks.html", f"Run {found.id}: {shown_term(found.task)}, stopping", data)
     shown.status = 202
     return _for_script(shown)
+
+
+def _from_a_browser() -> bool:
+    """Whether a page's answer goes to a browser's form, which names ``text/html`` in its ``Accept``: it is
+    sent on to the run's page (303), so that a reload or Back does not send the form again (a second Start,
+    refused with 409 while the run goes). A program's form post (curl's ``*/*``) keeps the 202 and the page."""
+    return not wants_json() and any(value == "text/html" for value, _ in request.accept_mimetypes)
 
 
 def _for_script(shown: Page) -> Page:
