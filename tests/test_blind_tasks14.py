@@ -91,7 +91,7 @@ def test_a_lab_task_saved_on_the_new_task_page_opens_chosen_on_the_tasks_page(cl
     assert chosen is not None and chosen.group(1) == "SwitchOnTheReadingLamp"
     started = _post_form(client, "/tasks", task="lab10:SwitchOnTheReadingLamp", seed="0")
     assert started.status_code == 303, _errors(started.text)  # on to the run's page (Post/Redirect/Get)
-    assert "started: SwitchOnTheReadingLamp" in _text(started.text)
+    assert "started: lab10:SwitchOnTheReadingLamp" in _text(started.text)  # as the plans page names it
 
 
 def test_no_plan_names_a_lab_class_by_its_prefix_on_the_plans_and_new_task_pages(client: FlaskClient) -> None:

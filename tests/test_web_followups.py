@@ -153,3 +153,25 @@ def test_a_browser_s_start_is_sent_on_to_the_run_s_page(served: tuple[FlaskClien
     curl = client.post("/tasks", data={"task": "FetchMyPen"}, headers={"Accept": "*/*"})
     assert curl.status_code == 202 and "started: FetchMyPen" in curl.text  # a program's form keeps the page
     _started(runner, curl.headers["Location"])
+
+
+def test_the_tasks_page_names_a_lab_s_task_by_its_prefix(served: tuple[FlaskClient, _Ended]) -> None:
+    """The tasks page and a run's title said SwitchOnTheReadingLamp where the plans page says
+    lab10:SwitchOnTheReadingLamp; the list's value stays the name cbrs run takes."""
+    client, runner = served
+    page = client.get("/tasks", query_string={"task": "SwitchOnTheReadingLamp"}, headers=BROWSER)
+    option = re.search(r'<option value="SwitchOnTheReadingLamp" selected>([^<]*)</option>', page.text)
+    assert option is not None and option.group(1).startswith("lab10:SwitchOnTheReadingLamp · "), page.text[:300]
+    assert '<option value="FetchMyPen"' in page.text and ">FetchMyPen · " in page.text  # cbrs's own as listed
+    plans = client.get("/plans", headers=BROWSER).text
+    assert ">lab10:SwitchOnTheReadingLamp · " in plans  # the name the plans page gives it
+    curl = client.post("/tasks", data={"task": "SwitchOnTheReadingLamp"}, headers={"Accept": "*/*"})
+    assert curl.status_code == 202 and "started: lab10:SwitchOnTheReadingLamp" in curl.text
+    run = _started(runner, curl.headers["Location"])
+    shown = client.get(f"/tasks/{run.id}", headers=BROWSER).text
+    assert f"<title>Run {run.id}: lab10:SwitchOnTheReadingLamp, succeeded" in shown
+    assert f"{run.id}</a> · lab10:SwitchOnTheReadingLamp" in shown
+    listed = client.get("/tasks", headers=BROWSER).text
+    assert "<td>lab10:SwitchOnTheReadingLamp</td>" in listed  # the recent runs
+    twin = client.get("/tasks.json").get_json()
+    assert twin["runs"][0]["shown"] == "lab10:SwitchOnTheReadingLamp" and twin["runs"][0]["task"] == run.task

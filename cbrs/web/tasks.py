@@ -26,7 +26,7 @@ from flask.sansio.blueprints import BlueprintSetupState
 from werkzeug.exceptions import BadRequest, Forbidden, NotFound, ServiceUnavailable
 
 from cbrs.actions.errors import UnknownTaskError
-from cbrs.kb.namespaces import PREFIXES, written
+from cbrs.kb.namespaces import PREFIXES, shorten, written
 from cbrs.kb.owls import local_name
 from cbrs.tasks import (
     CameraFrame,
@@ -94,7 +94,8 @@ def tasks() -> Page:
     shown.status = 303 if _from_a_browser() else 202  # Post/Redirect/Get: a reload re-sent the form, a 409 mid-run
     shown.headers["Location"] = url_for("tasks.run_json" if wants_json() else "tasks.run", run_id=started.id)
     shown.title = f"Tasks: {started.id} started"
-    shown.data.update(_overview(form), started=_started(started), message=f"{started.id} started: {started.task}")
+    said = f"{started.id} started: {shown_task(started.task, started.iri)}"
+    shown.data.update(_overview(form), started=_started(started), message=said)
     return shown
 
 
@@ -103,7 +104,7 @@ def run(run_id: str) -> Page:
     """One run: its steps, every event it published, and its result (the plan and execution report)."""
     found = context.tasks().get(run_id)  # an unknown run: 404
     data = {"mode": "run", "run": _detail(found), **_live()}
-    return _for_script(Page("tasks.html", f"Run {found.id}: {shown_term(found.task)}, {found.status}", data))
+    return _for_script(Page("tasks.html", f"Run {found.id}: {data['run']['shown']}, {found.status}", data))
 
 
 @page(blueprint, "/tasks/<run_id>/cancel", negotiate=True, methods=["POST"])
@@ -117,12 +118,12 @@ def cancel(run_id: str) -> Page:
     data = {"mode": "run", **_live()}
     if found.done.is_set():
         data.update(run=_detail(found), error="ended", message=f"{found.id} has already ended: {found.status}")
-        shown = Page("tasks.html", f"Run {found.id}: {shown_term(found.task)}, {found.status}", data)
+        shown = Page("tasks.html", f"Run {found.id}: {shown_task(found.task, found.iri)}, {found.status}", data)
         shown.status = 409
         return _for_script(shown)
     context.tasks().cancel(run_id)
     data.update(run=_detail(found), message=f"{found.id}: asked to stop after the step under way")
-    shown = Page("tasks.html", f"Run {found.id}: {shown_term(found.task)}, stopping", data)
+    shown = Page("tasks.html", f"Run {found.id}: {shown_task(found.task, found.iri)}, stopping", data)
     shown.status = 202
     return _for_script(shown)
 
@@ -354,6 +355,7 @@ def _overview(form: dict[str, Any]) -> dict[str, Any]:
         "options": run_options(),
         "tasks": offered["tasks"],
         "labels": offered["labels"],
+        "shown_names": offered["shown"],
         "components": offered["components"],
         "active": _detail(latest) if latest is not None else None,
         "runs": [_summary(r) for r in reversed(runs)],
@@ -396,14 +398,29 @@ def choices() -> dict[str, Any]:
         labelled = [(row["requirement"].value, row["label"].value) for row in rows if "label" in row]
         labelled += [(action.iri, action.label) for action in actions if action.label]
         labels = {name: label for name, label in ((_typed(iri, known), label) for iri, label in labelled) if name}
+        listed = ((_typed(iri, known), iri) for iri in {row["requirement"].value for row in rows} | composite)
+        shown = {name: shown_task(name, iri) for name, iri in listed if name is not None}
         return {
             "tasks": known,
             "labels": labels,
+            "shown": {name: text for name, text in shown.items() if text != name},
             "components": [short(c) for c in runner.components()],
             "several": several,
         }
 
     return context.per_generation("task_choices", read)
+
+
+def shown_task(listed: str, iri: str | None) -> str:
+    """A task as the pages show it: a lab's own by the prefix derived for its namespace
+    (lab10:SwitchOnTheReadingLamp, as the plans page names it: :func:`cbrs.web.links.short`), since its bare
+    name in the list (what ``cbrs run`` takes) says not whose it is; a task of cbrs's own namespaces as the
+    list names it (FetchMyPen, act:FetchMyPen), else as :func:`shown_term` shows a name."""
+    if iri and ":" not in listed and shorten(iri) == iri:  # bare, and no prefix of cbrs's covers it
+        derived_name = short(iri)
+        if derived_name != iri:
+            return derived_name
+    return shown_term(listed)
 
 
 def _typed(iri: str, known: list[str]) -> str | None:
@@ -442,6 +459,7 @@ def _summary(found: TaskRun) -> dict[str, Any]:
     data.pop("result", None)
     data["faults"] = [short(f) for f in found.faults]
     data["url"] = url_for("tasks.run", run_id=found.id)
+    data["shown"] = shown_task(found.task, found.iri)
     return data
 
 
@@ -458,6 +476,7 @@ def _started(found: TaskRun) -> dict[str, Any]:
 def _detail(found: TaskRun) -> dict[str, Any]:
     data = found.to_dict()
     data["url"] = url_for("tasks.run", run_id=found.id)
+    data["shown"] = shown_task(found.task, found.iri)
     data["steps"] = steps(data["events"])
     data["unmet"] = unmet(data.get("result"))
     data["verdict"] = verdict(data)

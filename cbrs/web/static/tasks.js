@@ -147,7 +147,7 @@
           "tr",
           {},
           el("td", {}, el("a", { href: r.url }, r.id)),
-          el("td", {}, r.task),
+          el("td", {}, r.shown || r.task),
           el("td", { class: "num" }, String(r.seed)),
           el("td", {}, r.faults.join(", ") || "–"),
           el("td", {}, el("span", { class: "badge status-" + r.status }, r.status)),
@@ -157,12 +157,19 @@
     );
   }
 
+  async function showName(id) {
+    const response = await fetch(live.dataset.runs + "/" + encodeURIComponent(id) + ".json");
+    if (!response.ok) return;
+    const run = (await response.json()).run;
+    if (current === id && run.shown) runName.lastChild.textContent = " · " + run.shown;
+  }
+
   async function catchUp(id) {
     // Events sent before this page subscribed: rebuild the table and the list from the run's record.
     const response = await fetch(live.dataset.runs + "/" + encodeURIComponent(id) + ".json");
     if (!response.ok) return;
     const run = (await response.json()).run; // the run page's twin: {mode, run}
-    if (current !== id) startRun(id, run.task);
+    if (current !== id) startRun(id, run.shown || run.task);
     plan = 1;
     steps.replaceChildren();
     eventList.replaceChildren();
@@ -199,7 +206,10 @@
     }
     if (message.event === "frame") return showFrame(message.frame);
     if (message.event === "store_updated") return;
-    if (message.event === "run_started" && follow === "latest") startRun(message.run, message.task);
+    if (message.event === "run_started" && follow === "latest") {
+      startRun(message.run, message.task);
+      showName(message.run); // the event has the list's name; the record the pages' (lab10:SwitchOnTheReadingLamp)
+    }
     if (message.run !== current) return;
     handleRunEvent(message);
     if (message.event === "run_finished") refreshRuns();
@@ -246,7 +256,7 @@
         const data = await response.json();
         let note;
         if (response.status === 202) {
-          startRun(data.started.id, data.started.task);
+          startRun(data.started.id, data.started.shown || data.started.task);
           note = el("p", { class: "ok-box form-message", role: "status" }, data.message);
         } else if (data.fields) {
           for (const [name, text] of Object.entries(data.fields)) {
