@@ -175,3 +175,20 @@ def test_the_tasks_page_names_a_lab_s_task_by_its_prefix(served: tuple[FlaskClie
     assert "<td>lab10:SwitchOnTheReadingLamp</td>" in listed  # the recent runs
     twin = client.get("/tasks.json").get_json()
     assert twin["runs"][0]["shown"] == "lab10:SwitchOnTheReadingLamp" and twin["runs"][0]["task"] == run.task
+
+
+def test_a_cross_site_load_is_refused_in_the_load_page_s_words(client: FlaskClient, kb: KnowledgeBase) -> None:
+    """Another site's page posting to /load was told "a task may be loaded only from this server's own pages":
+    the page loads files, of any kind."""
+    before = _sizes(kb)
+    data = {"graph": "map", "token": TOKEN, "file": (LAMP.open("rb"), LAMP.name)}
+    headers = {**BROWSER, "Origin": "https://elsewhere.example"}
+    answer = client.post("/load", data=data, headers=headers, content_type="multipart/form-data")
+    assert answer.status_code == 403
+    said = answer.text.replace("&#39;", "'")
+    assert (
+        "a file may be loaded into the store only from this server's own pages, not from https://elsewhere.example"
+        in said
+    )
+    assert "a task may" not in said
+    assert _sizes(kb) == before

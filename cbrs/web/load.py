@@ -74,7 +74,7 @@ def load() -> Page:
     typed = request.form.get("token", "").strip()
     node = GraphName[chosen.upper()].node
     try:
-        from_own_page("loaded")
+        from_own_page("loaded into the store", "a file")  # "a task may be loaded": the page loads files
         token = bearer_token() or typed or None
         context.sparql().check_token(token)  # first: a page without the token learns nothing of the store
         assert upload is not None and media_type is not None  # checked above

@@ -316,20 +316,22 @@ def _may_act(verb: str = "started") -> None:
         )
 
 
-def from_own_page(verb: str) -> bool:
+def from_own_page(verb: str, what: str = "a task") -> bool:
     """Whether the request comes from one of this server's own pages (its ``Origin`` one of the origins
-    ``cbrs serve`` binds); Forbidden for another site's page, naming it; False for a request with no
-    ``Origin`` (a program, not a browser). An app not behind cbrs serve (a test client) knows only the
-    page's own host, and takes a request with no ``Origin`` for its own."""
+    ``cbrs serve`` binds); Forbidden for another site's page, naming it and ``what`` is ``verb`` (a file
+    loaded, not a task); False for a request with no ``Origin`` (a program, not a browser). An app not
+    behind cbrs serve (a test client) knows only the page's own host, and takes a request with no
+    ``Origin`` for its own."""
     origin = request.headers.get("Origin")
     own = current_app.extensions.get("cbrs.own_origins")
+    foreign = f"{what} may be {verb} only from this server's own pages, not from {origin}"
     if own is None:
         if origin is not None and origin.rstrip("/") != request.host_url.rstrip("/"):
-            raise Forbidden(f"a task may be {verb} only from this server's own pages, not from {origin}")
+            raise Forbidden(foreign)
         return True
     if origin is not None:
         if origin.rstrip("/") not in own():
-            raise Forbidden(f"a task may be {verb} only from this server's own pages, not from {origin}")
+            raise Forbidden(foreign)
         return True
     return False
 
