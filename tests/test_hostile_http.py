@@ -307,7 +307,7 @@ def test_a_graph_name_that_is_no_iri_is_a_400_not_a_500(served: Server) -> None:
     with client() as http:
         answer = http.get(url(served, "/store"), params={"graph": "http://a b"})
     assert answer.status_code == 400
-    assert answer.json()["message"].startswith("graph='http://a b' is not an IRI")
+    assert answer.json()["message"].startswith("graph='http://a b' is not an absolute IRI")
 
 
 def test_reading_the_store_keeps_the_endpoints_result_limit(served: Server) -> None:
