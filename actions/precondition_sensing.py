@@ -54,6 +54,7 @@ class Sensed:
     sensor: str = ""
     reading: str = ""
     device: str = ""
+    stated: bool = False  # decided by what the map states (``sensor`` the property), no sensor's reading
 
 
 @dataclass(frozen=True)
@@ -175,7 +176,7 @@ class PreconditionSensing:
             return None
         of = f"{found.reading} of {shorten(thing)}"
         how = f"{found.reading}, the map's {shorten(found.level.prop)} of {shorten(thing)}"
-        return Sensed(found.holds, how, found.bound, found.level.prop, of, "the map")
+        return Sensed(found.holds, how, found.bound, found.level.prop, of, "the map", stated=True)
 
     def _none_covers(self, quantity: str, subject: str) -> str:
         """Why no sensor reads ``quantity`` for a precondition about ``subject``: none covers it, or it is no

@@ -51,6 +51,15 @@ class TaskPreconditionError(ActionsError):
         self.statement = statement
         self.instead = tuple(instead)
         self.sensed = sensed
+        if sensed is not None and sensed.stated:
+            super().__init__(
+                f"the task's precondition {statement_text(statement)} of {shorten(requirement)} does not hold:"
+                f" the map states {sensed.reading} ({shorten(sensed.sensor)}), and {shorten(statement.object)}"
+                f" holds {sensed.bound} (its home:holdsWhen). A task takes its preconditions as given and plans"
+                " nothing to make them hold: where the thing has changed, correct the map (cbrs update), or"
+                " leave the precondition out of the requirement"
+            )
+            return
         if sensed is not None:
             super().__init__(
                 f"the task's precondition {statement_text(statement)} of {shorten(requirement)} does not hold:"
@@ -79,18 +88,21 @@ class TaskPreconditionError(ActionsError):
 class PreconditionCheck:
     """One precondition of the task's requirement as the run found it before its first step: ``believed``
     True where the robots perceive it holding or a sensor read it so (``sensed``: ``12 lx by
-    SensorBoard01``), None where nothing could check it (taken as given; ``why``, where sensing was tried:
-    why no sensor decided it)."""
+    SensorBoard01``; ``stated``: the map's statement decided it), None where nothing could check it (taken
+    as given; ``why``, where sensing was tried: why no sensor decided it)."""
 
     statement: Statement
     believed: bool | None
     sensed: str = ""
     why: str = ""
+    stated: bool = False  # ``sensed`` is what the map states, not a reading
 
     def to_dict(self) -> dict[str, Any]:
         found: dict[str, Any] = {"statement": statement_text(self.statement), "believed": self.believed}
         if self.sensed:
             found["sensed"] = self.sensed
+        if self.stated:
+            found["stated"] = True
         if self.why:
             found["why"] = self.why
         return found
@@ -116,7 +128,7 @@ def check_preconditions(
         elif sensed.holds is None:
             checks.append(PreconditionCheck(statement, None, why=sensed.how))
         elif sensed.holds:
-            checks.append(PreconditionCheck(statement, True, sensed=sensed.how))
+            checks.append(PreconditionCheck(statement, True, sensed=sensed.how, stated=sensed.stated))
         else:
             raise TaskPreconditionError(requirement.iri, statement, (), sensed)
     return tuple(checks)

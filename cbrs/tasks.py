@@ -589,10 +589,13 @@ def preconditions_line(checks: Iterable[dict[str, Any]], listed: str = "--json l
     perceived holding counted, those no test decides (taken as given, as a fetch task's ``home:hasMarker``)
     named, at most ``PRECONDITIONS_NAMED``, then where the rest are ``listed`` (docs/execution.md, "A task's
     preconditions"); those a sensor read holding counted with what it read, and a precondition taken as
-    given after a sensor was looked for with why none decided it; "" for none."""
+    given after a sensor was looked for with why none decided it, those the map's statements decided
+    counted apart with what the map states; "" for none."""
     found = list(checks)
     held = sum(1 for check in found if check.get("believed") and not check.get("sensed"))
-    sensed = [str(check["sensed"]) for check in found if check.get("believed") and check.get("sensed")]
+    read = [check for check in found if check.get("believed") and check.get("sensed")]
+    sensed = [str(check["sensed"]) for check in read if not check.get("stated")]
+    stated = [str(check["sensed"]) for check in read if check.get("stated")]
     given = [
         str(check.get("statement")) + (f" ({check['why']})" if check.get("why") else "")
         for check in found
@@ -601,6 +604,8 @@ def preconditions_line(checks: Iterable[dict[str, Any]], listed: str = "--json l
     parts = [f"{held} perceived holding"] if held else []
     if sensed:
         parts.append(f"{len(sensed)} sensed holding ({'; '.join(sensed)})")
+    if stated:
+        parts.append(f"{len(stated)} holding by the map ({'; '.join(stated)})")
     if given:
         named = "; ".join(given[:PRECONDITIONS_NAMED])
         if len(given) > PRECONDITIONS_NAMED:

@@ -23,6 +23,7 @@ from cbrs.kb import KnowledgeBase, Requirement, Statement
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import AmbiguousDesignatorError, designate, designate_each
 from cbrs.kb.stated_quantities import StatedQuantities, guaranteed_statuses
+from cbrs.tasks import preconditions_line
 from tests.helpers_examples import EXAMPLES
 
 HOME, SVC = PREFIXES["home"], PREFIXES["svc"]
@@ -120,8 +121,14 @@ def test_a_precondition_on_a_thing_is_decided_by_the_weight_the_map_states(kb: K
     with pytest.raises(TaskPreconditionError) as refused, _yellow(kb):
         _check(kb, index, yellow)
     said = str(refused.value).replace(LAB11, "lab11:")
-    assert "does not hold: the map (home:massKg) reads 0.15 kg of lab11:Flask2" in said
+    assert "does not hold: the map states 0.15 kg of lab11:Flask2 (home:massKg)" in said
     assert "holds at least 0.4 kg (its home:holdsWhen)" in said
+    assert "correct the map (cbrs update)" in said and "once the reading says" not in said
+    assert check.stated and check.to_dict()["stated"] is True
+    line = preconditions_line([check.to_dict()])
+    assert line.replace(LAB11, "lab11:") == (
+        "preconditions: 1 holding by the map (0.55 kg, the map's home:massKg of lab11:Flask1)"
+    )
 
 
 def test_the_thing_the_run_designated_is_the_one_asked_about(kb: KnowledgeBase, index: Any) -> None:
@@ -131,7 +138,7 @@ def test_the_thing_the_run_designated_is_the_one_asked_about(kb: KnowledgeBase, 
     sensing = PreconditionSensing(kb, cast(Container, None), (), index, 1.0, advertisements=(), given=given)
     with pytest.raises(TaskPreconditionError) as refused:
         _check(kb, index, Statement(FLASK, HOME + "hasStatus", FULL), sensing=sensing)
-    assert "reads 0.15 kg of " in str(refused.value)
+    assert "the map states 0.15 kg of " in str(refused.value)
 
 
 def test_a_lab_s_own_quantity_in_another_unit_is_converted(kb: KnowledgeBase, index: Any) -> None:
@@ -145,7 +152,7 @@ def test_a_lab_s_own_quantity_in_another_unit_is_converted(kb: KnowledgeBase, in
     )
     with pytest.raises(TaskPreconditionError) as refused, _yellow(kb):
         _check(kb, index, Statement(LAB + "YellowFlask", HOME + "hasStatus", LAB + "Brimming"))
-    assert "reads 0.05 L (50 mL) of" in str(refused.value)
+    assert "the map states 0.05 L (50 mL) of" in str(refused.value)
 
 
 def test_a_thing_that_states_no_level_of_the_quantity_is_taken_as_given(kb: KnowledgeBase, index: Any) -> None:
