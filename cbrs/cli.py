@@ -264,44 +264,16 @@ def _warn_colours(kb: Any, report: LoadReport) -> None:
         click.echo(f"warning: {risk.text()}", err=True)
 
 
-_BUILT_IN = tuple(PREFIXES[name] for name in ("owl", "rdf", "rdfs", "xsd"))
-"""The vocabularies whose classes a file may state things to be of without declaring them."""
-
-
 def _warn_undeclared_classes(kb: Any, report: LoadReport) -> None:
     """Say on standard error which things a load into the map states to be of a class that nothing in the
-    store declares (the subject of no statement in any graph), with the declared class of its namespace it
-    reads as a slip of: ``lab11:Flask2 a lab11:Flsk`` loaded without a word, and a task naming lab11:Flask
-    found the other flask, or none. Loaded all the same: a lab's class may come in a later file. Other graphs
-    are left alone (an OWL-S collection's services are of classes of ontologies it does not load)."""
-    from cbrs.kb.shapes import did_you_mean
+    store declares (:mod:`kb.undeclared_classes`). Loaded all the same: a lab's class may come in a later
+    file. Other graphs are left alone (an OWL-S collection's services are of classes of ontologies it does
+    not load)."""
+    from cbrs.kb.undeclared_classes import written_undeclared_classes
 
-    said: set[str] = set()
-    for item in report.files:
-        if item.graph != GraphName.MAP.iri:
-            continue
-        for quad in item.quads:
-            concept = quad.object
-            if quad.predicate.value != RDF + "type" or not isinstance(concept, ox.NamedNode):
-                continue
-            if concept.value in said or concept.value.startswith(_BUILT_IN):
-                continue
-            said.add(concept.value)
-            if next(iter(kb.store.quads(concept, None, None, None)), None) is not None:
-                continue
-            near = did_you_mean(kb.store, concept.value)
-            meant = f" (did you mean {_local(near)}, {near}?)" if near else ""
-            thing = quad.subject.value if isinstance(quad.subject, ox.NamedNode | ox.BlankNode) else str(quad.subject)
-            click.echo(
-                f"warning: {_local(thing)} ({thing}) is stated a {_local(concept.value)} ({concept.value}), a class "
-                f"nothing in the store declares{meant}: a task finds a thing by a class it is stated to be of, or "
-                "one below it; declare the class (in the ontology graph) or correct its name",
-                err=True,
-            )
-
-
-def _local(iri: str) -> str:
-    return iri.rsplit("#", 1)[-1].rsplit("/", 1)[-1]
+    quads = (quad for item in report.files if item.graph == GraphName.MAP.iri for quad in item.quads)
+    for found in written_undeclared_classes(kb.store, quads):
+        click.echo(f"warning: {found.text()}", err=True)
 
 
 _UNDECLARED = re.compile(r"The prefix ([\w.-]*): has not been declared")

@@ -125,7 +125,7 @@ def test_a_thing_of_a_misspelt_class_is_warned_of_at_the_load(tmp_path: Path) ->
     assert result.exit_code == 0, result.output
     warnings = [line for line in result.stderr.splitlines() if line.startswith("warning: ")]
     assert warnings == [
-        f"warning: Flask2 ({LAB11}Flask2) is stated a Flsk ({LAB11}Flsk), a class nothing in the store declares"
-        f" (did you mean Flask, {LAB11}Flask?): a task finds a thing by a class it is stated to be of, or one"
-        " below it; declare the class (in the ontology graph) or correct its name"
+        f"warning: Flask2 ({LAB11}Flask2) is stated to be of class Flsk ({LAB11}Flsk), which nothing in the store"
+        f" declares (did you mean Flask, {LAB11}Flask?): a task finds a thing by a class it is stated to be of,"
+        " or one below it; declare the class (in the ontology graph) or correct its name"
     ]
