@@ -26,6 +26,8 @@ from cbrs.kb.errors import QuerySyntaxError, StoreEvaluationError, without_passw
 from cbrs.kb.namespaces import PREFIXES, GraphName, shorten
 from cbrs.kb.sparql_lexemes import HIDING
 from cbrs.kb.store import refuse_inserted_blank_nodes
+from cbrs.kb.undeclared_classes import written_undeclared_classes
+from cbrs.kb.update_delta import data_operations
 from cbrs.output import ProgressLine
 from cbrs.sparql_hints import declared, explain_syntax_error, one_line_up, operation_kind, store_prefixes_used
 
@@ -222,6 +224,8 @@ def update(app: App, text: str | None, update_file: Any, as_json: bool) -> None:
         click.echo(line)
     for risk in risks:
         click.echo(f"warning: {risk.text()}", err=True)
+    for undeclared in written_undeclared_classes(app.kb.store, _inserted_into_map(declared(added, body))):
+        click.echo(f"warning: {undeclared.text()}", err=True)
     if not report.changed:
         _note_unknown_names(app.kb, body, added)
     if report.changed and not app.kb.store.is_seeded():  # CLEAR ALL, DROP GRAPH graph:ontology
@@ -251,6 +255,14 @@ class _ColourRisks:
 _PREFIXED = re.compile(r"(?<![\w?$:])([A-Za-z][\w-]*):([A-Za-z_][\w-]*(?:\.[\w-]+)*)")
 _DECLARED = re.compile(rf"\bPREFIX\s+([\w-]*):\s*<([^<>\"{{}}|^`\\\x00-\x20]*)>|{HIDING}", re.IGNORECASE)
 """A PREFIX declaration (its prefix and namespace), or a string, IRI or comment that hides one."""
+
+
+def _inserted_into_map(body: str) -> list[ox.Quad]:
+    """The quads an update of ground data (``INSERT DATA``) put into graph:map, read as :mod:`kb.update_delta`
+    reads them; none for any other update (its quads are not known for certain), as ``cbrs load --graph map``
+    warns of the classes nothing declares (:mod:`kb.undeclared_classes`)."""
+    operations = data_operations(body) or ()
+    return [quad for op in operations if op.insert for quad in op.quads if quad.graph_name == GraphName.MAP.node]
 
 
 def _note_unknown_names(kb: KnowledgeBase, body: str, derived: Mapping[str, str]) -> None:

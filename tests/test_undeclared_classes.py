@@ -4,7 +4,9 @@ class it reads as a slip of (kb/undeclared_classes.py; docs/tasks.md, "Add an ob
 from __future__ import annotations
 
 import pyoxigraph as ox
+from click.testing import CliRunner
 
+from cbrs.cli import cli
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES, GraphName
 from cbrs.kb.undeclared_classes import written_undeclared_classes
@@ -39,3 +41,19 @@ def test_a_class_the_store_declares_in_any_graph_is_not_named() -> None:
     kb.update("INSERT DATA { GRAPH graph:ontology { home:Trolley a owl:Class } }")
     assert written_undeclared_classes(kb.store, [_typed("Trolley1", HOME + "Trolley")]) == []
     kb.close()
+
+
+def test_cbrs_update_warns_of_a_thing_inserted_into_the_map_as_cbrs_load_does() -> None:
+    """INSERT DATA into graph:map is read quad by quad, so its classes are checked as a load's are; into another
+    graph, or by a pattern (whose quads are not known for certain), nothing is said."""
+
+    def run(update: str) -> list[str]:
+        result = CliRunner().invoke(cli, ["--store", ":memory:", "update", update])
+        assert result.exit_code == 0, result.output
+        return [line for line in result.stderr.splitlines() if line.startswith("warning:")]
+
+    (line,) = run("INSERT DATA { GRAPH graph:map { world:Mug8 a home:Cpu } }")
+    assert line.startswith(f"warning: Mug8 ({WORLD}Mug8) is stated to be of class Cpu ({HOME}Cpu)")
+    assert "(did you mean Cup," in line
+    assert run("INSERT DATA { GRAPH graph:requirements { world:Mug8 a home:Cpu } }") == []
+    assert run("INSERT { GRAPH graph:map { world:Mug8 a home:Cpu } } WHERE {}") == []
