@@ -3,9 +3,9 @@
 A task finds a thing by a class it is stated to be of, or one below it, so a thing of a misspelt class is
 found by no task: ``lab11:Flask2 a lab11:Flsk`` loaded without a word, and a task naming ``lab11:Flask``
 found the other flask, or none. Not refused: a lab's class may come in a later file. So a load into the map
-says so (``cbrs load``, and ``cbrs update`` of an ``INSERT DATA``), with the declared class of the same namespace it reads as a slip of
-(:func:`kb.shapes.did_you_mean`). A class is declared when it is the subject of a statement in any graph;
-the classes of OWL, RDF, RDFS and XSD need none. docs/tasks.md, "Add an object".
+says so (``cbrs load``, and ``cbrs update`` of an ``INSERT DATA``), with the declared class of the same
+namespace it reads as a slip of (:func:`kb.shapes.did_you_mean`). A class is declared when it is the subject
+of a statement in any graph; the classes of OWL, RDF, RDFS and XSD need none. docs/tasks.md, "Add an object".
 """
 
 from __future__ import annotations
