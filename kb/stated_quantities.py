@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Collection, Iterable, Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from cbrs.kb.measured_states import MeasuredCondition, MeasuredConditionError, UnitError, Units, conditions_by_status
 from cbrs.kb.namespaces import PREFIXES
@@ -26,7 +26,7 @@ if TYPE_CHECKING:
     from cbrs.kb.knowledge_base import KnowledgeBase
     from cbrs.kb.model import Requirement
 
-__all__ = ["HAS_STATUS", "Stated", "StatedLevel", "StatedQuantities", "guaranteed_statuses"]
+__all__ = ["HAS_STATUS", "Stated", "StatedLevel", "StatedQuantities", "guaranteed_statuses", "stated_levels"]
 
 HAS_STATUS = PREFIXES["home"] + "hasStatus"
 IsA = Callable[[str, str], bool]
@@ -69,18 +69,8 @@ class StatedQuantities:
     def read(cls, kb: KnowledgeBase) -> StatedQuantities:
         level_rows, up_rows = kb.select_each(("place_levels", "subclasses"))
         found: dict[str, list[StatedLevel]] = {}
-        for row in level_rows:
-            if "unit" not in row:
-                continue  # a number in no stated unit could be in any: not read
-            try:
-                value = float(row["value"].value)
-            except ValueError:
-                continue
-            if not math.isfinite(value):
-                continue
-            thing = row["subject"].value
-            level = StatedLevel(thing, row["property"].value, value, row["quantity"].value, row["unit"].value)
-            found.setdefault(thing, []).append(level)
+        for level in stated_levels(level_rows):
+            found.setdefault(level.thing, []).append(level)
         up: dict[str, set[str]] = {}
         for row in up_rows:
             up.setdefault(row["class"].value, {row["class"].value}).add(row["superclass"].value)
@@ -139,6 +129,23 @@ class StatedQuantities:
             if all(found is None or found.holds for found in decided):
                 kept.append(thing)
         return kept
+
+
+def stated_levels(rows: Iterable[Mapping[str, Any]]) -> list[StatedLevel]:
+    """The levels of the ``place_levels`` query's ``rows`` (of a place, a class of places or a thing) that are
+    finite numbers in a stated unit: a number in no stated unit could be in any, and is not read."""
+    found = []
+    for row in rows:
+        if "unit" not in row:
+            continue
+        try:
+            value = float(row["value"].value)
+        except ValueError:
+            continue
+        if math.isfinite(value):
+            prop, quantity = row["property"].value, row["quantity"].value
+            found.append(StatedLevel(row["subject"].value, prop, value, quantity, row["unit"].value))
+    return found
 
 
 def guaranteed_statuses(requirement: Requirement, concept: str, is_a: IsA | None = None) -> tuple[str, ...]:

@@ -18,7 +18,6 @@ sensor reads it (:mod:`kb.stated_quantities`).
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -28,6 +27,7 @@ from cbrs.kb import Advertisement, KnowledgeBase
 from cbrs.kb.errors import NotFoundError
 from cbrs.kb.measured_states import UnitError, Units
 from cbrs.kb.namespaces import shorten
+from cbrs.kb.stated_quantities import stated_levels
 from cbrs.sim.context import SimContext, SkillFailed
 
 __all__ = ["Level", "levels", "measure"]
@@ -42,15 +42,6 @@ class Level:
     prop: str
 
 
-@dataclass(frozen=True)
-class _Stated:
-    subject: str
-    prop: str
-    value: float
-    quantity: str
-    unit: str | None
-
-
 def levels(kb: KnowledgeBase, quantity: str, places: tuple[str, ...], where: MapPlaces) -> dict[str, Level]:
     """The level of ``quantity`` (a class of reading) of each of ``places`` (things of the map): its own,
     else its nearest class's (the one with the most superclasses among those that state one), stated with
@@ -58,11 +49,11 @@ def levels(kb: KnowledgeBase, quantity: str, places: tuple[str, ...], where: Map
     neither is left out. A property with no unit (``home:levelUnit``) is not read: its numbers could be in
     any unit."""
     kinds = where.superclasses.get(quantity, frozenset({quantity}))
-    found = [s for s in _statements(kb) if s.quantity in kinds and s.unit is not None]
+    found = [s for s in stated_levels(kb.select("place_levels")) if s.quantity in kinds]
     found.sort(key=lambda s: (-len(where.superclasses.get(s.quantity, ())), s.prop))
     by_subject: dict[str, Level] = {}
     for s in found:
-        by_subject.setdefault(s.subject, Level(s.value, s.unit or "", s.prop))
+        by_subject.setdefault(s.thing, Level(s.value, s.unit, s.prop))
     result: dict[str, Level] = {}
     for place in places:
         if place in by_subject:
@@ -114,17 +105,3 @@ def measure(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str
             raise SkillFailed(f"{device}: the store gives {shorten(unit)} no reading key (home:readingKey)")
         outputs[parameter.name] = {"@type": parameter.type, key: round(sum(values) / len(values), 3)}
     return outputs
-
-
-def _statements(kb: KnowledgeBase) -> list[_Stated]:
-    found = []
-    for row in kb.select("place_levels"):
-        try:
-            value = float(row["value"].value)
-        except ValueError:
-            continue
-        if not math.isfinite(value):
-            continue
-        unit = row["unit"].value if "unit" in row else None
-        found.append(_Stated(row["subject"].value, row["property"].value, value, row["quantity"].value, unit))
-    return found
