@@ -207,8 +207,10 @@ def test_a_task_written_on_the_editor_is_checked_and_planned_from_the_keyboard(
             opened.locator("#new-task").click()
             opened.wait_for_url("**/tasks/new")
             opened.get_by_label("Task in Turtle").focus()
-            opened.keyboard.press("Control+Enter")
-            opened.wait_for_url("**/tasks/new")
+            # the checked page has this page's URL, so wait for its load (its stylesheet: laid out without
+            # it, the plan's table was 801 px wide at 390 on a loaded machine), not for the URL
+            with opened.expect_navigation(wait_until="load"):
+                opened.keyboard.press("Control+Enter")
             badge = opened.locator(".badge.good")
             playwright_api.expect(badge).to_have_text("planned", timeout=30_000)  # composed cold, on a loaded machine
             assert opened.locator("tr[id^=step-]").count() >= 1
