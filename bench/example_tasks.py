@@ -24,8 +24,8 @@ knowledge browser's forms as a browser submits them (form-encoded, with the page
 script): the tasks page's Start form, the run read from its page; a requirement's file written on the New
 task page (checked, saved with the token, or refused there). Two runs at once (``busy``): while a run
 goes, the next one's start must be refused with 409 saying so, and taken once the run has ended. The
-Stop button (``stop``): pressed on the run's page after some steps, taken (202), the run cancelled with
-the steps not taken pending, pressed again refused (409). The pages' GET forms (``forms``: search,
+Stop button (``stop``): pressed on the run's page after some steps, taken (303 to the run's page), the
+run cancelled with the steps not taken pending, pressed again refused (409). The pages' GET forms (``forms``: search,
 taxonomy, services, plans, matchmaking, the SPARQL page's), each answer's status and words checked.
 The processes are stopped by PID; every wait is bounded. The stores are made once a trial and copied for
 each seed, before anything runs in them. Runs go in parallel processes, up to ``--jobs`` (default: the
@@ -234,7 +234,7 @@ class Trial:
 @dataclass(frozen=True)
 class StopAt:
     """The tasks page's Stop this run, pressed on the run's page once it shows ``after`` steps ended: the
-    stop must be taken (202, the page saying ``says``), the run end cancelled with the steps not taken
+    stop must be taken (303 to the run's page, saying ``says``), the run end cancelled with the steps not taken
     pending in its result, and the same button pressed again refused (409, saying ``again``), the run
     left as it was."""
 
@@ -904,7 +904,7 @@ STEP_ROW = re.compile(r'<tr data-plan="\d+" data-step="\d+" class="step-(\w+)')
 def stop_run(browser: _Browser, begun: Started, stop: StopAt, token: str) -> tuple[str, str, dict[str, Any]]:
     """Press the run's page's Stop this run once the page shows ``stop.after`` steps ended, follow the run
     to its end, then press the same button again: what the pages said, why that is not as the docs say
-    (empty when it is: the button shown while the run goes, 202 saying ``stop.says``, the run's result
+    (empty when it is: the button shown while the run goes, 303 to the run's page saying ``stop.says``, the run's result
     its steps taken then the rest pending, 409 saying ``stop.again`` and the run as it was), and the run
     as its page shows it."""
     deadline = time.monotonic() + RUN_TIMEOUT
@@ -921,11 +921,13 @@ def stop_run(browser: _Browser, begun: Started, stop: StopAt, token: str) -> tup
         return said, f"{said}: the run was {status} before {stop.after} steps ended", _page_follow(browser, begun)
     form = read_form(page.body, "cancel", page.url)
     misses = ["the Stop button is hidden while the run goes"] if form.hidden else []
-    stopped = browser.submit(form)
+    stopped = browser.submit(form)  # followed, as a browser follows it, to the run's page (303 since 2026-11-28)
     words = _element_text(stopped.body, "content")
-    if stopped.status != 202 or stop.says not in words:
+    sent_on = stopped.status == 200 and urllib.parse.urlparse(stopped.url).path == begun.where
+    if not (stopped.status == 202 or sent_on) or stop.says not in words:
         misses.append(
-            f"Stop answered {stopped.status}, the docs say 202 saying {stop.says!r}: {_form_messages(stopped.body)}"
+            f"Stop answered {stopped.status}, the docs say 303 to the run's page saying {stop.says!r}: "
+            + _form_messages(stopped.body)
         )
     found = _page_follow(browser, begun)
     steps = _run_json(browser.url, begun.run, token).get("result", {}) or {}
@@ -944,7 +946,9 @@ def stop_run(browser: _Browser, begun: Started, stop: StopAt, token: str) -> tup
         misses.append(
             f"Stop again changed the run: {found.get('status')} -> {after.group(1) if after else 'no status'}"
         )
-    line = f"{said}: {stopped.status}, {found.get('status')} after {taken} of {len(outcomes)} steps; "
+    line = (
+        f"{said}: {303 if sent_on else stopped.status}, {found.get('status')} after {taken} of {len(outcomes)} steps; "
+    )
     line += f"again {again.status}: {_form_messages(again.body)[:200]}"
     return line, f"{said}: " + "; ".join(misses) if misses else "", found
 

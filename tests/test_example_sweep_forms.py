@@ -178,17 +178,17 @@ def test_a_form_is_read_as_a_browser_submits_it(bench: ModuleType) -> None:
 
 
 def test_the_stop_button_stops_a_run_and_is_refused_once_it_has_ended(bench: ModuleType, served: str) -> None:
-    """The run's page shows Stop this run while the run goes; pressed, 202, the run cancelled with the steps
+    """The run's page shows Stop this run while the run goes; pressed, 303 to its page, the run cancelled with the steps
     not taken pending; pressed again, 409 and the run as it was. A phrase the pages do not say is a miss."""
     browser = bench._Browser(served)
     _Held.release.clear()
     stop = bench.StopAt(0, "asked to stop after the step under way", "has already ended: cancelled")
     said, miss, found = bench.stop_run(browser, bench._page_start(browser, "FetchMyPen", 3), stop, TOKEN)
-    assert miss == "" and ": 202, cancelled after 1 of 3 steps; again 409" in said
+    assert miss == "" and ": 303, cancelled after 1 of 3 steps; again 409" in said
     assert found["status"] == "cancelled" and found["steps"] == 1 and "cancelled on request" in found["reason"]
     wrong = bench.StopAt(0, "stopped at once", "has already ended: cancelled")
     _, miss, _ = bench.stop_run(browser, bench._page_start(browser, "FetchMyPen", 3), wrong, TOKEN)
-    assert "the docs say 202 saying 'stopped at once'" in miss
+    assert "the docs say 303 to the run's page saying 'stopped at once'" in miss
     _Held.release.set()
     begun = bench._page_start(browser, "FetchMyPen", 3)
     bench._page_follow(browser, begun)

@@ -149,3 +149,28 @@ def test_a_second_start_is_refused_in_json_naming_the_run_going(served: tuple[Fl
     finally:
         runner.release.set()
     _ended(runner, first.get_json()["started"]["id"])
+
+
+def test_a_browsers_stop_is_sent_on_to_the_runs_page_and_a_programs_gets_202(
+    served: tuple[FlaskClient, _Held],
+) -> None:
+    """Stop's plain form POST (no script) is answered as Start's is: 303 to the run's page, which says the stop
+    was asked for, so a reload reads the page and does not send the Stop again (a 409 once the run ended)."""
+    client, runner = served
+    runner.release.clear()
+    try:
+        run_id = client.post("/tasks", json={"task": "FetchMyPen"}, headers=JSON).get_json()["started"]["id"]
+        stop = client.post(f"/tasks/{run_id}/cancel", headers={"Accept": BROWSER})
+        assert stop.status_code == 303 and stop.headers["Location"] == f"/tasks/{run_id}"
+        assert runner.get(run_id).cancel_requested.is_set()
+        page = client.get(stop.headers["Location"], headers={"Accept": BROWSER})
+        assert page.status_code == 200 and f"{run_id}: asked to stop after the step under way" in page.text
+        for path, headers in ((f"/tasks/{run_id}/cancel.json", {}), (f"/tasks/{run_id}/cancel", {"Accept": "*/*"})):
+            again = client.post(path, headers=headers)  # the script's fetch, and curl's form post
+            assert again.status_code == 202 and "Location" not in again.headers, path
+        assert "asked to stop" in client.post(f"/tasks/{run_id}/cancel.json").get_json()["message"]
+    finally:
+        runner.release.set()
+    _ended(runner, run_id)
+    ended = client.post(f"/tasks/{run_id}/cancel", headers={"Accept": BROWSER})
+    assert ended.status_code == 409 and "has already ended" in ended.text  # said on the page, not sent on

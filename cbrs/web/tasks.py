@@ -104,6 +104,8 @@ def run(run_id: str) -> Page:
     """One run: its steps, every event it published, and its result (the plan and execution report)."""
     found = context.tasks().get(run_id)  # an unknown run: 404
     data = {"mode": "run", "run": _detail(found), **_live()}
+    if found.cancel_requested.is_set():  # what Stop's 303 led here to say (the run may have ended meanwhile)
+        data["message"] = _stopping(found) + (f"; it ended {found.status}" if found.done.is_set() else "")
     return _for_script(Page("tasks.html", f"Run {found.id}: {data['run']['shown']}, {found.status}", data))
 
 
@@ -111,7 +113,9 @@ def run(run_id: str) -> Page:
 def cancel(run_id: str) -> Page:
     """Ask a run to stop after the step under way (202); the same people who may start a run may stop it.
 
-    A run that has already ended is left as it is and said so (409), as the bridge's cancel does.
+    A browser's form is sent on to the run's page (303, as Start's is: :func:`_from_a_browser`): it stayed at
+    ``/cancel``, and a reload sent the Stop again and got the 409 below. A run that has already ended is left
+    as it is and said so (409), as the bridge's cancel does.
     """
     _may_act("stopped")
     found = context.tasks().get(run_id)  # an unknown run: 404
@@ -122,10 +126,17 @@ def cancel(run_id: str) -> Page:
         shown.status = 409
         return _for_script(shown)
     context.tasks().cancel(run_id)
-    data.update(run=_detail(found), message=f"{found.id}: asked to stop after the step under way")
+    data.update(run=_detail(found), message=_stopping(found))
     shown = Page("tasks.html", f"Run {found.id}: {shown_task(found.task, found.iri)}, stopping", data)
     shown.status = 202
+    if _from_a_browser():  # Post/Redirect/Get
+        shown.status = 303
+        shown.headers["Location"] = url_for("tasks.run", run_id=found.id)
     return _for_script(shown)
+
+
+def _stopping(found: TaskRun) -> str:
+    return f"{found.id}: asked to stop after the step under way"
 
 
 def _from_a_browser() -> bool:
