@@ -30,6 +30,7 @@ __all__ = [
     "CARRY_CLEARANCE",
     "EE_LINK",
     "HOME_CONFIGURATIONS",
+    "MEET_MARGIN",
     "REACH_TOLERANCE",
     "Arm",
     "ArmDetail",
@@ -139,6 +140,13 @@ CARRY_CLEARANCE = 0.01
 keep the arm, fingers included, this far from the appliances standing on the furniture (a dispenser's
 body and spout, and its tap's lever, which the arms' planning does not avoid since a hand pushes it):
 the margin the joint-space moves keep from the fixed things (COLLISION_MARGIN)."""
+MEET_MARGIN = 0.0
+"""A take's moves to the pre-grasp and grasp poses, planned to choose the arm and approach
+(:meth:`Arm.dry_run`'s ``meet_by``, ``skills.plan_carry``), are refused where the arm, fingers included,
+would touch a fixture (what a carry keeps clear of: a tap's lever, which the arms' planning does not
+avoid since a hand pushes it). A right hand reaching for a flask beside the lever met it with a finger
+and stopped 4.2 cm short of the pre-grasp pose. Touching, not a margin: a take below a tap's spout comes
+within CARRY_CLEARANCE of it and is made (a cup filled there is taken from there)."""
 
 
 @dataclass(frozen=True)
@@ -357,8 +365,9 @@ class Kinematics:
         ``margin`` of; empty when it keeps clear of them all."""
         body = self._bodies[side]
         self._set(body, q)
+        near = self._near(body, [target for _, target in self._fixtures], margin)
         for name, target in self._fixtures:
-            if p.getClosestPoints(body, target, margin, physicsClientId=self.client):
+            if target in near and p.getClosestPoints(body, target, margin, physicsClientId=self.client):
                 return name
         return ""
 
@@ -819,13 +828,16 @@ class Arm:
             if side is not self.side
         }
 
-    def dry_run(self, folded: Sequence[ArmSide] = (), clear_by: float | None = None) -> PlannedArm:
+    def dry_run(
+        self, folded: Sequence[ArmSide] = (), clear_by: float | None = None, meet_by: float | None = None
+    ) -> PlannedArm:
         """A stand-in for this arm, from its posture now, whose moves are planned and not made; the other
         arms where they are, or those of ``folded`` in their home posture (where they will be by then: an
         arm that sets an object down for this one folds home after). With ``clear_by`` it notes where its
         moves first come within that distance of a fixture (:attr:`PlannedArm.brushed`): the clearance a
-        check asks of a carry (``skills.plan_carry``'s ``clearance``)."""
-        return PlannedArm(self.side, self._kinematics, self.joint_positions(), self._others(folded), clear_by)
+        check asks of a carry (``skills.plan_carry``'s ``clearance``); with ``meet_by`` the same, apart, while
+        it is not set to None (:attr:`PlannedArm.met`): what a take's approach must not touch."""
+        return PlannedArm(self.side, self._kinematics, self.joint_positions(), self._others(folded), clear_by, meet_by)
 
     def _settle(self, goal: NDArray[np.float64]) -> float:
         waited = 0.0
@@ -935,6 +947,7 @@ class PlannedArm:
         q: Sequence[float],
         others: dict[ArmSide, Sequence[float]],
         clear_by: float | None = None,
+        meet_by: float | None = None,
     ) -> None:
         self.side = side
         self._kinematics = kinematics
@@ -945,6 +958,12 @@ class PlannedArm:
         """Where the moves planned on it first came within ``clear_by`` of a fixture
         (:meth:`Kinematics.brushes`), which they are not refused for, as the arm's own planning does not
         refuse them; empty when they kept clear or no clearance is asked."""
+        self.meet_by = meet_by
+        """The distance from a fixture at which :attr:`met` notes a move; None: moves from now on are not
+        asked (a take's dry run asks its approach, not its carry)."""
+        self.met = ""
+        """Where the moves planned on it while ``meet_by`` was set first came within it of a fixture; empty
+        when none did."""
 
     def joint_positions(self) -> tuple[float, ...]:
         return self._q
@@ -955,18 +974,34 @@ class PlannedArm:
         return PlannedArm(self.side, self._kinematics, self._q, self._others)
 
     def _note(self, postures: Sequence[Sequence[float]], target: Vec3) -> None:
-        """Note the first of ``postures`` (a move to ``target``) within ``clear_by`` of a fixture."""
-        if self._clear_by is None or self.brushed:
-            return
-        for q in postures:
-            name = self._kinematics.brushes(self.side, q, self._clear_by)
-            if name:
-                at = self._kinematics.forward(self.side, q).position
+        """Note the first of ``postures`` (a move to ``target``) within ``clear_by`` of a fixture, and the
+        first within ``meet_by``."""
+        if self._clear_by is not None and not self.brushed:
+            found = self._within(postures, self._clear_by)
+            if found:
+                name, at = found
                 self.brushed = (
                     f"on the way to {_fmt(target)} the arm would come within {self._clear_by * 100:.0f} cm of "
                     f"the {name} (the hand at {_fmt(at)})"
                 )
-                return
+        if self.meet_by is not None and not self.met:
+            found = self._within(postures, self.meet_by)
+            if found:
+                name, at = found
+                near = "touch" if self.meet_by <= 0.0 else f"come within {self.meet_by * 100:.0f} cm of"
+                self.met = (
+                    f"on the way to {_fmt(target)} the arm, fingers included, would {near} the {name}, a fixture "
+                    f"its planning does not keep clear of (the hand at {_fmt(at)})"
+                )
+
+    def _within(self, postures: Sequence[Sequence[float]], margin: float) -> tuple[str, Vec3] | None:
+        """The first fixture the first of ``postures`` within ``margin`` of one comes that near, and where the
+        hand is then; None when every posture keeps farther."""
+        for q in postures:
+            name = self._kinematics.brushes(self.side, q, margin)
+            if name:
+                return name, self._kinematics.forward(self.side, q).position
+        return None
 
     def ee_pose(self) -> Pose3D:
         return self._kinematics.forward(self.side, self._q)

@@ -19,7 +19,7 @@ import pybullet as p
 
 from cbrs.kb.hands import Hand
 from cbrs.sim import predicates as pred
-from cbrs.sim.arms import COLLISION_MARGIN, Arm, ArmSide, MotionResult, PlannedArm
+from cbrs.sim.arms import COLLISION_MARGIN, MEET_MARGIN, Arm, ArmSide, MotionResult, PlannedArm
 from cbrs.sim.errors import GraspMisfitError, GraspTooWideError
 from cbrs.sim.geometry import Pose2D, Pose3D, Quat, Region, Vec3, wrap_angle
 from cbrs.sim.grasping import (
@@ -709,11 +709,11 @@ def plan_carry(
     grasp = _grasp(world, pen, arm, model)
     if isinstance(grasp, str):
         return DryRun(grasp)
-    hand = world.arm(arm).dry_run(folded, clear_by=clearance)
+    hand = world.arm(arm).dry_run(folded, clear_by=clearance, meet_by=MEET_MARGIN)
     x, y, z = grasp.position
     moves: list[tuple[str, Callable[[], MotionResult]]] = [
-        ("reaching the pre-grasp pose", lambda: _approach(hand, grasp)),
-        ("moving in to grasp it", lambda: hand.move_to(grasp.position, grasp.orientation)),
+        ("reaching the pre-grasp pose", lambda: _unmet(hand, _approach(hand, grasp))),
+        ("moving in to grasp it", lambda: _unmet(hand, hand.move_to(grasp.position, grasp.orientation), last=True)),
         ("lifting it", lambda: hand.move_to((x, y, z + LIFT_HEIGHT), hand.ee_pose().orientation, symmetric=False)),
     ]
     if region is not None:
@@ -723,6 +723,18 @@ def plan_carry(
         lowering = f"lowering it onto {region.name} at ({cx:.2f}, {cy:.2f})"
         moves.append((lowering, lambda: _set_down(hand, grasp, region)))
     return DryRun(_first_refused(moves, arm, model), hand.brushed)
+
+
+def _unmet(hand: PlannedArm, result: MotionResult, last: bool = False) -> MotionResult:
+    """A take's planned move (``result``) refused where it touched a fixture (:attr:`PlannedArm.met`, asked
+    with MEET_MARGIN): the arm's planning does not avoid a tap's lever, and the hand that meets it on its way
+    to the object stops there. After the ``last`` of the take's moves, the others are not asked (a carry
+    keeps CARRY_CLEARANCE, asked apart)."""
+    if result.reached and hand.met:
+        return MotionResult(False, math.inf, hand.met)
+    if last:
+        hand.meet_by = None
+    return result
 
 
 def can_hand_over(
