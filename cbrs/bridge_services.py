@@ -46,7 +46,8 @@ caller that sent the update token (op ``auth``) or a page of this server's own (
 
 Topics: ``/cbrs/task_progress`` (steps started, succeeded, failed, with failovers), ``/cbrs/lifecycle``
 (component states), ``/cbrs/task`` (a run's verdict) and ``/cbrs/events`` (runs starting and ending,
-store updates).
+store updates). A run's messages and the answers about a run all carry its task's ``iri`` and ``shown`` (as
+the pages name it), beside a ``task`` whose meaning each kept (docs/rosbridge.md, "How a run names its task").
 """
 
 from __future__ import annotations

@@ -46,6 +46,9 @@ Listener = Callable[[str, dict[str, Any]], None]
 
 # Topic on which the runner announces runs starting and ending (the executor's own topics carry the steps).
 RUN_TOPIC = "/cbrs/events"
+#: The executor's topics whose messages name the run's task (``task``: the plan's task, an IRI); the runner
+#: adds the run's ``iri`` and ``shown`` to them, as to its own (docs/rosbridge.md, "How a run names its task").
+TASK_TOPICS = ("/cbrs/task", "/cbrs/task_progress")
 
 
 CAMERA = "CeilingCamera01"  # the view the browser shows (in the bundled home it covers both scenarios' rooms; _view)
@@ -132,6 +135,7 @@ class TaskRun:
     objective: str = "similarity"  # actions.composer.Objective
     base_ties: str = "nearest"  # actions.base_choice.BaseTies
     near_misses: int = 3  # ComposeConfig.near_misses (TaskRunner.start fills in its default)
+    shown: str = ""  # the task as the pages name it (:func:`shown_name`; TaskRunner.start fills it in)
 
     def to_dict(self, with_events: bool = True) -> dict[str, Any]:
         found: dict[str, Any] = {
@@ -145,6 +149,7 @@ class TaskRun:
             "base_ties": self.base_ties,
             "near_misses": self.near_misses,
             "iri": self.iri,
+            "shown": self.shown or self.task,
             "status": self.status,
             "started": self.started,
             "finished": self.finished,
@@ -156,6 +161,29 @@ class TaskRun:
         if self.result is not None:
             found["result"] = self.result
         return found
+
+
+def shown_name(listed: str, iri: str) -> str:
+    """A task as the pages, a run's events and its record name it: one asked for by its bare name (what
+    ``cbrs run`` takes) or its IRI, of a namespace no prefix of cbrs's covers, by the prefix derived for its
+    namespace (``lab10:SwitchOnTheReadingLamp``), since the bare name says not whose it is; else as it was
+    asked for (``FetchMyPen``, ``act:FetchMyPen``). Within :func:`store_names`, which gives the derived
+    prefixes (the same table the pages use)."""
+    typed = listed[1:-1] if listed.startswith("<") and listed.endswith(">") else listed
+    if not iri or (":" in typed and typed != iri):  # a prefixed name: as written
+        return listed
+    with store_names(None):
+        declared = shorten(iri)
+    if declared != iri:  # cbrs's own namespaces: as the list names it
+        return listed if ":" not in typed else declared
+    derived = shorten(iri)  # the store's derived prefixes, within store_names
+    return derived if derived != iri else listed
+
+
+def _naming(run: TaskRun) -> dict[str, str]:
+    """How every message of a run names it and its task: ``task`` as asked for (kept as it was), ``iri``
+    and ``shown`` as the run's record has them."""
+    return {"run": run.id, "task": run.task, "iri": run.iri, "shown": run.shown or run.task}
 
 
 def _view(world: Any, wanted: str) -> str:
@@ -302,16 +330,18 @@ class TaskRunner:
             library = ActionLibrary.from_kb(self.kb)
             iri = task_iri(self.kb, task, library)  # an unknown task fails here, not in the thread
             resolve_task(self.kb, library, iri)
+            with store_names(StoreNames(lambda: self.kb)):
+                shown = shown_name(task, iri)
         with self._guard:
             self._refuse_if_busy()
             run = TaskRun(f"run-{next(self._ids)}", task, seed, failing, fault_rate, repeat_failures, iri)
-            run.objective, run.base_ties, run.near_misses = objective, base_ties, near_misses
+            run.objective, run.base_ties, run.near_misses, run.shown = objective, base_ties, near_misses, shown
             thread = threading.Thread(target=self._run, args=(run,), name=f"cbrs-{run.id}", daemon=True)
             self._active = (run, thread)
             self._runs[run.id] = run
             while len(self._runs) > self.keep:
                 self._runs.popitem(last=False)
-        self._emit(RUN_TOPIC, {"event": "run_started", "run": run.id, "task": task})
+        self._emit(RUN_TOPIC, {"event": "run_started", **_naming(run)})
         thread.start()
         return run
 
@@ -409,7 +439,7 @@ class TaskRunner:
         finally:
             run.finished = time.time()
             # Said before done is set: whoever waited for the end (the bridge's action, a test) has heard it.
-            self._emit(RUN_TOPIC, {"event": "run_finished", "run": run.id, "task": run.task, "status": run.status})
+            self._emit(RUN_TOPIC, {"event": "run_finished", **_naming(run), "status": run.status})
             run.done.set()
 
     def _simulate(
@@ -426,6 +456,8 @@ class TaskRunner:
 
         def follow(event: Event) -> None:
             message = dict(event.message, run=run.id)
+            if event.topic in TASK_TOPICS:
+                message.update(iri=run.iri, shown=run.shown or run.task)
             run.events.append({"topic": event.topic, **message})
             self._emit(event.topic, message)
             if event.topic == "/cbrs/task_progress" and message.get("event") in ("step_succeeded", "step_failed"):

@@ -163,8 +163,12 @@ def test_run_task_streams_progress_and_ends_succeeded(server: Server) -> None:
     assert sum(1 for p in progress if p["event"] == "step_succeeded") == len(run["result"]["plan"]["steps"])
     assert any(m["topic"] == "/cbrs/lifecycle" for m in heard)
     finished = [m["msg"] for m in heard if m["topic"] == "/cbrs/events"]
-    ending = {"event": "run_finished", "run": run["id"], "task": "RobotArmServeACup", "status": run["status"]}
-    assert finished[-1] == ending
+    naming = {"run": run["id"], "task": "RobotArmServeACup", "iri": run["iri"], "shown": "RobotArmServeACup"}
+    assert finished[-1] == {"event": "run_finished", **naming, "status": run["status"]}
+    assert (run["shown"], finished[0]) == ("RobotArmServeACup", {"event": "run_started", **naming})
+    named = [m["msg"] for m in heard if m["topic"] in ("/cbrs/task_progress", "/cbrs/task")]
+    assert named and {(m["iri"], m["shown"]) for m in named} == {(run["iri"], run["shown"])}  # one name throughout
+    assert {m["task"] for m in named if "task" in m} == {run["iri"]}  # the plan's task, as before
     types = cbrs_types()  # every message and the reply are what rosapi's typedefs say
     assert mismatches(types.response("cbrs/RunTask"), run) == []
     assert {"/cbrs/task_progress", "/cbrs/lifecycle", "/cbrs/events"} <= {m["topic"] for m in heard} <= set(TOPICS)

@@ -9,18 +9,21 @@ from __future__ import annotations
 import re
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import pyoxigraph as ox
 import pytest
 from click.testing import CliRunner
 from flask.testing import FlaskClient
 
+from cbrs.bridge_services import KnowledgeServices
 from cbrs.cli import cli
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.derived_prefixes import StoreNames
 from cbrs.kb.loader import MisplacedDescriptionError
-from cbrs.kb.namespaces import GraphName
+from cbrs.kb.namespaces import PREFIXES, GraphName, store_names
 from cbrs.sparql_service import EndpointConfig, SparqlService
-from cbrs.tasks import TaskRun, TaskRunner
+from cbrs.tasks import TaskRun, TaskRunner, shown_name
 from cbrs.web import create_app
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "docs" / "examples"
@@ -192,3 +195,35 @@ def test_a_cross_site_load_is_refused_in_the_load_page_s_words(client: FlaskClie
     )
     assert "a task may" not in said
     assert _sizes(kb) == before
+
+
+def test_a_run_s_events_and_answers_name_its_task_alike(served: tuple[FlaskClient, _Ended]) -> None:
+    """/cbrs/events named a lab's task as the list does (SwitchOnTheReadingLamp) and /cbrs/task by its IRI, and
+    the tasks page fetched the run to learn the name it shows. Every message of a run and the services' answers
+    carry the IRI and the shown name alike, ``task`` as before. The real runner: the lamp's task has no plug
+    here, so it ends no-plan before any world is built."""
+    client, ended = served
+    runner = TaskRunner(ended.kb, ended.lock, camera=None)
+    heard: list[tuple[str, dict[str, Any]]] = []
+    runner.subscribe(lambda topic, message: heard.append((topic, message)))
+    run = runner.run("SwitchOnTheReadingLamp", timeout=60.0)
+    assert run.done.is_set() and run.status == "no-plan", run.error
+    iri, shown = "https://example.org/lab10#SwitchOnTheReadingLamp", "lab10:SwitchOnTheReadingLamp"
+    naming = {"run": run.id, "task": "SwitchOnTheReadingLamp", "iri": iri, "shown": shown}
+    assert heard == [
+        ("/cbrs/events", {"event": "run_started", **naming}),
+        ("/cbrs/events", {"event": "run_finished", **naming, "status": "no-plan"}),
+    ]
+    services = KnowledgeServices(SparqlService(ended.kb), runner)
+    answer = services.task_status({"run": run.id})
+    assert (answer["task"], answer["iri"], answer["shown"]) == ("SwitchOnTheReadingLamp", iri, shown)
+    page = client.get("/tasks", query_string={"task": "SwitchOnTheReadingLamp"}, headers=BROWSER)
+    assert f'<option value="SwitchOnTheReadingLamp" selected>{shown} · ' in page.text  # the pages' name, the same
+    with store_names(StoreNames(lambda: ended.kb)):  # cbrs's own tasks keep the name they were asked for
+        own = PREFIXES["req"] + "FetchMyPen"
+        assert [shown_name(name, own) for name in ("FetchMyPen", "req:FetchMyPen", own)] == [
+            "FetchMyPen",
+            "req:FetchMyPen",
+            "req:FetchMyPen",
+        ]
+        assert [shown_name(name, iri) for name in ("SwitchOnTheReadingLamp", f"<{iri}>", shown)] == [shown] * 3

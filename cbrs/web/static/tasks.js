@@ -157,13 +157,6 @@
     );
   }
 
-  async function showName(id) {
-    const response = await fetch(live.dataset.runs + "/" + encodeURIComponent(id) + ".json");
-    if (!response.ok) return;
-    const run = (await response.json()).run;
-    if (current === id && run.shown) runName.lastChild.textContent = " · " + run.shown;
-  }
-
   async function catchUp(id) {
     // Events sent before this page subscribed: rebuild the table and the list from the run's record.
     const response = await fetch(live.dataset.runs + "/" + encodeURIComponent(id) + ".json");
@@ -207,8 +200,7 @@
     if (message.event === "frame") return showFrame(message.frame);
     if (message.event === "store_updated") return;
     if (message.event === "run_started" && follow === "latest") {
-      startRun(message.run, message.task);
-      showName(message.run); // the event has the list's name; the record the pages' (lab10:SwitchOnTheReadingLamp)
+      startRun(message.run, message.shown || message.task); // the pages' name (lab10:SwitchOnTheReadingLamp)
     }
     if (message.run !== current) return;
     handleRunEvent(message);
