@@ -7,7 +7,7 @@ from __future__ import annotations
 import json
 import re
 import sys
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -26,8 +26,8 @@ from cbrs.kb.errors import QuerySyntaxError, StoreEvaluationError, without_passw
 from cbrs.kb.namespaces import PREFIXES, GraphName, shorten
 from cbrs.kb.sparql_lexemes import HIDING
 from cbrs.kb.store import refuse_inserted_blank_nodes
-from cbrs.kb.undeclared_classes import written_undeclared_classes
-from cbrs.kb.update_delta import data_operations
+from cbrs.kb.undeclared_classes import MapTypes, UndeclaredClass, written_undeclared_classes
+from cbrs.kb.update_delta import DataOperation, data_operations
 from cbrs.output import ProgressLine
 from cbrs.sparql_hints import declared, explain_syntax_error, one_line_up, operation_kind, store_prefixes_used
 
@@ -195,6 +195,8 @@ def update(app: App, text: str | None, update_file: Any, as_json: bool) -> None:
     names = StoreNames(lambda: app.kb)
     added = store_prefixes_used(body, lambda: names.prefixes)
     colours = _ColourRisks(app.kb, body)
+    operations = data_operations(declared(added, body))  # None: an update by a pattern
+    typed = MapTypes(app.kb.store, body) if operations is None else None  # its quads known once it has run
     with HeldInterrupts() as interrupts:
         interrupts.hold("running the update")
         try:
@@ -224,7 +226,8 @@ def update(app: App, text: str | None, update_file: Any, as_json: bool) -> None:
         click.echo(line)
     for risk in risks:
         click.echo(f"warning: {risk.text()}", err=True)
-    for undeclared in written_undeclared_classes(app.kb.store, _inserted_into_map(declared(added, body))):
+    written = typed.undeclared() if typed is not None else _undeclared_in_map(app.kb, operations or ())
+    for undeclared in written:
         click.echo(f"warning: {undeclared.text()}", err=True)
     if not report.changed:
         _note_unknown_names(app.kb, body, added)
@@ -257,12 +260,12 @@ _DECLARED = re.compile(rf"\bPREFIX\s+([\w-]*):\s*<([^<>\"{{}}|^`\\\x00-\x20]*)>|
 """A PREFIX declaration (its prefix and namespace), or a string, IRI or comment that hides one."""
 
 
-def _inserted_into_map(body: str) -> list[ox.Quad]:
-    """The quads an update of ground data (``INSERT DATA``) put into graph:map, read as :mod:`kb.update_delta`
-    reads them; none for any other update (its quads are not known for certain), as ``cbrs load --graph map``
-    warns of the classes nothing declares (:mod:`kb.undeclared_classes`)."""
-    operations = data_operations(body) or ()
-    return [quad for op in operations if op.insert for quad in op.quads if quad.graph_name == GraphName.MAP.node]
+def _undeclared_in_map(kb: KnowledgeBase, operations: Iterable[DataOperation]) -> list[UndeclaredClass]:
+    """The classes nothing declares of the quads an update of ground data (``INSERT DATA``) put into graph:map,
+    read as :mod:`kb.update_delta` reads them, as ``cbrs load --graph map`` warns of them
+    (:mod:`kb.undeclared_classes`); an update by a pattern is read by what it added (``MapTypes``)."""
+    inserted = [quad for op in operations if op.insert for quad in op.quads if quad.graph_name == GraphName.MAP.node]
+    return written_undeclared_classes(kb.store, inserted)
 
 
 def _note_unknown_names(kb: KnowledgeBase, body: str, derived: Mapping[str, str]) -> None:
