@@ -9,6 +9,7 @@ from an arm that reaches the object to one that reaches the platform. Each is as
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import itertools
 import logging
@@ -99,6 +100,42 @@ def grasp_pose_for(ctx: SimContext, estimate: ObjectEstimate, side: ArmSide, hel
     hand = ctx.world.arm(side).hand
     seen = seen_extent(estimate)
     return compute_grasp_pose(held, estimate.position, estimate.yaw, spec.mount, spec.yaw, seen, hand, estimate.size[2])
+
+
+TURN = math.pi / 2.0
+"""How far a top grasp of a round object turns the fingers' closing when the usual way would touch a fixture
+(:func:`turned`): along the way they closed, not across it, the other way the hand can close on it."""
+
+
+def turned(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, side: ArmSide) -> ObjectModel:
+    """``model``, or, for a round object (no footprint: as wide whichever way) that ``side`` may take by a top
+    grasp, the same turned TURN round (:attr:`ObjectModel.turn`) when the take's moves by that grasp as
+    :func:`compute_grasp_pose` turns the hand would touch a fixture the arms' planning does not avoid (a tap's
+    lever: :attr:`skills.DryRun.met`) and the turned take's the planning would make touching none. The flask
+    2 cm south of the lever, taken with the fingers closing north-south, touched it with one; closing
+    east-west, they pass it. The take's dry runs are asked only where the hand, its grasp point between
+    the pre-grasp and the grasp pose, could come near a fixture by the map (:meth:`Arm.fixture_near`): a
+    take meeting none is chosen as before, at no cost. The choice carries the turn to the moves."""
+    if model.footprint is not None or model.turn or GraspKind.TOP not in model.preference:
+        return model
+    top = model.by(GraspKind.TOP)
+    try:
+        grasp = grasp_pose_for(ctx, estimate, side, top)
+    except SimulationError:
+        return model
+    world = ctx.world
+    if not world.arm(side).fixture_near(grasp.pregrasp, grasp.position):
+        return model
+    plain = skills.plan_carry(world, estimate, side, top)
+    if not plain.met:
+        return model
+    other = dataclasses.replace(top, turn=TURN)
+    again = skills.plan_carry(world, estimate, side, other)
+    if again.refused:
+        log.info("the %s, %s: turned, %s", model.name, plain.met, again.refused)
+        return model
+    log.info("the %s taken by its top grasp turned a quarter round: %s", model.name, plain.refused)
+    return dataclasses.replace(model, turn=TURN)
 
 
 def who_takes(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel) -> GraspChoice:
@@ -273,6 +310,7 @@ def taking_to(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, sid
 
 def _taking_to(ctx: SimContext, estimate: ObjectEstimate, model: ObjectModel, side: ArmSide) -> _Taking:
     world, name = ctx.world, model.name
+    model = turned(ctx, estimate, model, side)
 
     def take(held: ObjectModel) -> str:
         return skills.can_take(world, estimate, side, held)
@@ -747,7 +785,8 @@ def _loading_by(
     refused: MovesRefusedError | None = None
     if both:  # one hold, from where it is to the platform
         whole = Candidates.of(
-            model, *([lambda held: skills.can_take(world, estimate, loader, held), *checks] if choosing else checks)
+            turned(ctx, estimate, model, loader),
+            *([lambda held: skills.can_take(world, estimate, loader, held), *checks] if choosing else checks),
         )
         unserved = whole.refusal()
         if whole.models:  # the first whose moves the loader's planning would make, one alone too (first_clear)
@@ -774,7 +813,10 @@ def _loading_by(
     # down and takes it anew by an approach that loads (the re-grasp).
     gripping = [lambda held: skills.can_grip(held, world.arm(loader).hand)]
     loading = Candidates.of(model, *([*gripping, *checks] if choosing else checks))
-    giving = Candidates.of(model, lambda held: skills.can_take(world, estimate, giver, held)) if choosing else None
+    given_model = turned(ctx, estimate, model, giver)  # the giver takes it where it lies; the loader from the spot
+    giving = (
+        Candidates.of(given_model, lambda held: skills.can_take(world, estimate, giver, held)) if choosing else None
+    )
     if whole is not None and not (loading.models and giving is not None and giving.models):
         if refused is not None:
             raise refused
@@ -790,7 +832,7 @@ def _loading_by(
         if only:
             raise SkillFailed(f"only the {giver.value} arm reaches the {model.name}, and {giving.refusal()}")
         raise SkillFailed(f"the {giver.value} arm would pass the {model.name}, but {giving.refusal()}")
-    giving = giving or Candidates([model])
+    giving = giving or Candidates([given_model])
     setting_down = (
         f"setting the {model.name} down to take it anew, no one approach serving from where it is to the "
         f"platform ({unserved})"

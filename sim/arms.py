@@ -230,6 +230,7 @@ class Kinematics:
             self._obstacles = [self._box(region) for region in obstacles]
             self._names = {body: region.name for body, region in zip(self._obstacles, obstacles, strict=True)}
             self._fixtures = [(region.name, self._box(region)) for region in fixtures]
+            self._fixture_regions = list(fixtures)
             self._at: dict[int, tuple[float, ...]] = {}  # where each copy's joints were last put
             # each body's bounding box (the union of its links'), and for a copy the posture it was taken at
             self._bounds: dict[int, tuple[tuple[float, ...] | None, tuple[Vec3, Vec3]]] = {
@@ -238,6 +239,9 @@ class Kinematics:
             self._links: dict[int, int] = {}  # each copy's number of links, the base aside
             self._solved: dict[tuple[object, ...], _Solution] = {}  # _refine's answers, by their inputs
             self._wrist, self._wrist_at, self._wrist_reach = self._wrist_probe()
+            self.hand_reach = self._hand_reach()
+            """How far from the grasp point a point of the hand (the links past the arm's last: flange, hand,
+            fingers) may be, by their bounding boxes: an upper bound, the same for each arm (one URDF)."""
         except BaseException:
             p.disconnect(physicsClientId=self.client)
             raise
@@ -263,6 +267,40 @@ class Kinematics:
             corners = [(x, y, z) for x in (low[0], high[0]) for y in (low[1], high[1]) for z in (low[2], high[2])]
             reach = max(reach, *(math.dist(corner, (0.0, 0.0, 0.0)) for corner in corners))
         return probe, offsets, reach
+
+    def _hand_reach(self) -> float:
+        """:attr:`hand_reach`: the farthest corner of the hand links' bounding boxes from the grasp point, the
+        arm at its zero posture and its fingers open as wide as their joints let them."""
+        body = next(iter(self._bodies.values()))
+        self._set(body, [0.0] * len(ARM_JOINTS))
+        for joint in FINGER_JOINTS:
+            p.resetJointState(
+                body, joint, p.getJointInfo(body, joint, physicsClientId=self.client)[9], physicsClientId=self.client
+            )
+        ee = p.getLinkState(body, EE_LINK, computeForwardKinematics=True, physicsClientId=self.client)[4]
+        reach = 0.0
+        for link in range(_WRIST_LINK + 1, EE_LINK):
+            low, high = _aabb(self.client, body, link)
+            corners = [(x, y, z) for x in (low[0], high[0]) for y in (low[1], high[1]) for z in (low[2], high[2])]
+            reach = max(reach, *(math.dist(corner, ee) for corner in corners))
+        for joint in FINGER_JOINTS:
+            p.resetJointState(body, joint, 0.0, physicsClientId=self.client)
+        return reach
+
+    def fixture_near(self, start: Vec3, end: Vec3, reach: float) -> str:
+        """The name of the first fixture (``fixtures``) whose box comes within ``reach`` of the straight line
+        from ``start`` to ``end`` (followed every centimetre); empty when none does. The map's answer, no
+        contact query: whether a hand on that line could touch one at all."""
+        steps = max(1, math.ceil(math.dist(start, end) / 0.01))
+        points = [tuple(a + (b - a) * i / steps for a, b in zip(start, end, strict=True)) for i in range(steps + 1)]
+        for region in self._fixture_regions:
+            for x, y, z in points:
+                dx = max(region.xmin - x, 0.0, x - region.xmax)
+                dy = max(region.ymin - y, 0.0, y - region.ymax)
+                dz = max(region.zmin - z, 0.0, z - region.zmax)
+                if math.sqrt(dx * dx + dy * dy + dz * dz) <= reach:
+                    return region.name
+        return ""
 
     def wrist_strikes(self, side: ArmSide, position: Vec3, orientation: Quat) -> bool:
         """Whether every posture that holds the hand at this pose as closely as a solution must (within
@@ -827,6 +865,12 @@ class Arm:
             for side, arm in self.peers.items()
             if side is not self.side
         }
+
+    def fixture_near(self, start: Vec3, end: Vec3) -> str:
+        """The first fixture the hand, its grasp point on the line from ``start`` to ``end``, could come
+        within MEET_MARGIN of by the map (:meth:`Kinematics.fixture_near` with the hand's reach); empty when
+        none: a take there cannot touch one with its hand."""
+        return self._kinematics.fixture_near(start, end, self._kinematics.hand_reach + MEET_MARGIN)
 
     def dry_run(
         self, folded: Sequence[ArmSide] = (), clear_by: float | None = None, meet_by: float | None = None

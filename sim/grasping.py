@@ -62,6 +62,11 @@ class ObjectModel:
     """A box's size along its own x and y axes (m), from the map: its width across the jaws depends on
     the approach and on how it lies (:meth:`across`). None for a cylinder (its diameter whichever way)
     and for a model a value gave with its width alone (that width is used whichever way)."""
+    turn: float = 0.0
+    """How far (rad) a top grasp turns the closing of the fingers about the vertical from the way
+    :func:`compute_grasp_pose` closes them across the object. 0 but for a round object (no ``footprint``),
+    which a top grasp holds the same whichever way: a quarter turn where the fingers the usual way would
+    touch a fixture the arms' planning does not avoid (``arm_choice.turned``: the flask beside a tap's lever)."""
 
     @property
     def preference(self) -> tuple[GraspKind, ...]:
@@ -311,7 +316,7 @@ def compute_grasp_pose(
         # Of the two finger directions across the axis, pick the one nearer the arm's natural wrist
         # yaw (fingers across the arm's reach), so the wrist does not run into its joint limit.
         reach_yaw = math.atan2(cy - arm_mount[1], cx - arm_mount[0])
-        finger = axis + math.pi / 2.0
+        finger = axis + math.pi / 2.0 + model.turn
         if math.cos(finger - (reach_yaw + math.pi / 2.0)) < 0.0:
             finger += math.pi
         closing = finger

@@ -666,6 +666,9 @@ class DryRun:
     brushed: str = ""
     """Where they first came within the clearance asked of the appliances (:attr:`PlannedArm.brushed`);
     empty: they kept it, or none was asked."""
+    met: str = ""
+    """Where the take's moves to the pre-grasp and grasp poses touched a fixture (:attr:`PlannedArm.met`),
+    what ``refused`` says unless the planning refused them for its own reason; empty: they touched none."""
 
 
 def can_carry(
@@ -722,7 +725,7 @@ def plan_carry(
         moves.append((carrying, lambda: _carry(hand, grasp, region, yaw, floor, appliances(world))))
         lowering = f"lowering it onto {region.name} at ({cx:.2f}, {cy:.2f})"
         moves.append((lowering, lambda: _set_down(hand, grasp, region)))
-    return DryRun(_first_refused(moves, arm, model), hand.brushed)
+    return DryRun(_first_refused(moves, arm, model), hand.brushed, hand.met)
 
 
 def _unmet(hand: PlannedArm, result: MotionResult, last: bool = False) -> MotionResult:
