@@ -227,10 +227,17 @@ class Composer:
     def task(self, name: str) -> Task:
         return resolve_task(self.kb, self.actions, name, self.requirements)
 
-    def graph(self, requirement: Requirement, undone: frozenset[Statement] = frozenset()) -> ServiceResourceGraph:
+    def graph(
+        self,
+        requirement: Requirement,
+        undone: frozenset[Statement] = frozenset(),
+        before: tuple[Statement, ...] = (),
+    ) -> ServiceResourceGraph:
         """The SRG for ``requirement``, from what holds but for the facts that meet a statement of ``undone``
-        (an earlier part of the plan deleted them: see :meth:`_joined`)."""
+        (an earlier part of the plan deleted them: see :meth:`_joined`), and with ``before``, the goals an
+        earlier part of the plan achieves (the sub-actions before it: :meth:`_decomposed`)."""
         holding = self._holding(undone) if self.config.world_state else []
+        holding += [s for s in before if s not in holding and not self._meets(s, undone)]
         admits = partial(self._admits, requirement)
         return ServiceResourceGraph(self._without(requirement, undone), self.pool, holding, admits)
 
@@ -502,11 +509,16 @@ class Composer:
         return all(sub in stated for sub in task.action.sub_actions)
 
     def attempt(
-        self, requirement: Requirement, task: Task | None = None, undone: frozenset[Statement] = frozenset()
+        self,
+        requirement: Requirement,
+        task: Task | None = None,
+        undone: frozenset[Statement] = frozenset(),
+        before: tuple[Statement, ...] = (),
     ) -> Attempt:
         """Compose ``requirement`` in one extraction; ``undone``: statements that do not hold when it starts,
-        although the world or the requirement says so (an earlier part of the plan deleted them)."""
-        graph = self.graph(requirement, undone)
+        although the world or the requirement says so (an earlier part of the plan deleted them); ``before``:
+        statements that hold when it starts, although the world does not say so (an earlier part achieves them)."""
+        graph = self.graph(requirement, undone, before)
         trace = bidirectional_search(graph)
         areas = self.area_rule(requirement)
         config = self.config
@@ -562,20 +574,29 @@ class Composer:
         return [(o.constraint, o.before, o.after) for o in self.actions.orderings_for(task.action.iri)]
 
     def _decomposed(
-        self, task: Task, direct: Attempt, depth: int = 0, undone: frozenset[Statement] = frozenset()
+        self,
+        task: Task,
+        direct: Attempt,
+        depth: int = 0,
+        undone: frozenset[Statement] = frozenset(),
+        before: tuple[Statement, ...] = (),
     ) -> CompositionResult:
-        """Compose each sub-action on its own, in order, and join the plans (:meth:`_joined`). A sub-action
-        that is a task with sub-actions of its own is decomposed in turn (two-level tasks), at most
-        ``MAX_DEPTH`` levels down; ``undone``: statements an earlier part of an enclosing plan deleted."""
+        """Compose each sub-action on its own, in order, and join the plans (:meth:`_joined`), each from what
+        holds with the goals of the sub-actions before it. A sub-action that is a task with sub-actions of its
+        own is decomposed in turn (two-level tasks), at most ``MAX_DEPTH`` levels down; ``undone``: statements
+        an earlier part of an enclosing plan deleted; ``before``: the goals of the enclosing plan's parts before it."""
         assert task.action is not None
         attempts = [direct]
         parts: list[_Part] = []
         holding = self._holding(undone) if self.config.world_state else []
+        achieved: tuple[Statement, ...] = before  # the goals of the sub-actions before this one
         for sub in task.action.ordered_sub_actions():
             sub_task = resolve_task(self.kb, self.actions, sub, self.requirements)
             if self._achieved(sub_task.requirement, holding):
                 continue  # its effects hold already (a re-plan keeps what the last plan achieved)
-            compose = partial(self._sub_action, sub_task, depth)
+            # it starts where the sub-actions before it leave the world: their goals hold (the table set, the
+            # dinner bell's precondition); composed from the world as the task starts, it planned them again
+            compose = partial(self._sub_action, sub_task, depth, before=achieved)
             plan, unsatisfied, tried = compose(undone)
             attempts += tried
             if plan is None:
@@ -590,19 +611,26 @@ class Composer:
                 )
                 return self._result(task, None, unsatisfied, tuple(attempts))
             parts.append(_Part(f"sub-action {shorten(sub)}", compose, plan, undone))
+            achieved += tuple(g for g in sub_task.requirement.effects if g not in achieved)
         if not parts:  # every part is achieved: nothing to do but check
             return self._result(task, _achieved_plan(task), (), tuple(attempts))
         return self._joined(task, parts, attempts, holding)
 
-    def _sub_action(self, sub_task: Task, depth: int, undone: frozenset[Statement]) -> _Composed:
-        """One sub-action's plan: directly, else decomposed in turn."""
-        attempt = self.attempt(sub_task.requirement, sub_task, undone)
+    def _sub_action(
+        self, sub_task: Task, depth: int, undone: frozenset[Statement], before: tuple[Statement, ...] = ()
+    ) -> _Composed:
+        """One sub-action's plan, from what holds with ``before`` (the goals of the parts before it): part by
+        part when it is split into sub-actions each stated as a requirement, as a task is (:meth:`_compose`: a
+        direct plan may not follow its author's parts, and credited the saucer's and the cup's goals to one
+        put-down), else directly."""
+        attempt = self.attempt(sub_task.requirement, sub_task, undone, before)
         tried = [attempt]
         plan, unsatisfied = attempt.plan, attempt.unsatisfied
-        if plan is None and depth < MAX_DEPTH and self._decomposable(sub_task):
-            nested = self._decomposed(sub_task, attempt, depth + 1, undone)
+        if depth < MAX_DEPTH and self._decomposable(sub_task):
+            nested = self._decomposed(sub_task, attempt, depth + 1, undone, before)
             tried += nested.attempts[1:]
-            plan, unsatisfied = nested.plan, nested.unsatisfied or unsatisfied
+            if nested.plan is not None or plan is None:
+                plan, unsatisfied = nested.plan, nested.unsatisfied or unsatisfied
         return plan, unsatisfied, tried
 
     def _per_goal(self, task: Task, direct: Attempt) -> CompositionResult:
@@ -902,7 +930,15 @@ def _concatenate(task: Task, plans: list[Plan]) -> Plan:
     goals: list[Binding] = []
     for plan in plans:
         offset = len(steps)
+        # a precondition a part took as holding because a part before it achieves it: from that part's step
+        achieved = {f"holds {g.name}": g.source for g in goals if g.source.step is not None}
         for step in plan.steps:
+            bindings = tuple(
+                replace(b, source=achieved[b.source.name])
+                if b.source.step is None and b.role == "precondition" and b.source.name in achieved
+                else _shift(b, offset)
+                for b in step.bindings
+            )
             steps.append(
                 PlanStep(
                     index=step.index + offset,
@@ -911,7 +947,7 @@ def _concatenate(task: Task, plans: list[Plan]) -> Plan:
                     kind=step.kind,
                     device=step.device,
                     action=step.action,
-                    bindings=tuple(_shift(b, offset) for b in step.bindings),
+                    bindings=bindings,
                     outputs=step.outputs,
                     effects=step.effects,
                     cost=step.cost,
