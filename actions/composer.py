@@ -37,6 +37,7 @@ from typing import TYPE_CHECKING, Any
 import pyoxigraph as ox
 
 from cbrs.actions.areas import AreaRule, Leads, WorldPlaces
+from cbrs.actions.decomposition_notes import decomposition_notes
 from cbrs.actions.extraction import Extraction, Objective
 from cbrs.actions.graph import (
     SRE,
@@ -134,6 +135,8 @@ class CompositionResult:
     unsatisfied: tuple[Unsatisfied, ...]
     attempts: tuple[Attempt, ...]  # the direct attempt, then one per sub-action when decomposed
     objective: Objective = Objective.SIMILARITY  # what ranked providers (each step's ranked_by says what decided)
+    # what of the task's written decomposition composition does not follow, and why (actions.decomposition_notes)
+    notes: tuple[str, ...] = ()
 
     @property
     def unused_inputs(self) -> tuple[tuple[str, str], ...]:
@@ -159,6 +162,7 @@ class CompositionResult:
             found.update(self.plan.to_dict())
             found["unused_inputs"] = [{"name": name, "type": type_} for name, type_ in self.unused_inputs]
         found["unsatisfied"] = [u.to_dict() for u in self.unsatisfied]
+        found["notes"] = list(self.notes)
         return found
 
 
@@ -774,8 +778,10 @@ class Composer:
                 self._near_missed(self._of_the_world(task.requirement, self._undeclared(task.requirement, u)), attempts)
                 for u in unsatisfied
             )
+        stated = (r.for_task for r in self.requirements() if r.for_task)
+        notes = decomposition_notes(task.action, self.actions, stated) if self.config.decompose else ()
         return CompositionResult(
-            task.name, task.requirement.iri, status, plan, unsatisfied, attempts, self.config.objective
+            task.name, task.requirement.iri, status, plan, unsatisfied, attempts, self.config.objective, notes
         )
 
     def _of_the_world(self, requirement: Requirement, unsatisfied: Unsatisfied) -> Unsatisfied:

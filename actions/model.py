@@ -36,6 +36,7 @@ class ActionClass:
     parents: tuple[str, ...] = ()
     sub_actions: tuple[str, ...] = ()
     orderings: tuple[Ordering, ...] = ()
+    dangling: tuple[str, ...] = ()  # ordering constraints that name no act:occursBefore and act:occursAfter
 
     def ordered_sub_actions(self) -> list[str]:
         """The sub-actions in an order that respects every ordering constraint (IRI order breaks ties);
@@ -64,7 +65,11 @@ class ActionLibrary:
             if "subActions" in row and row["subActions"].value:
                 subs[iri] = sorted(set(row["subActions"].value.split()))
         orderings: dict[str, list[Ordering]] = {}
+        dangling: dict[str, list[str]] = {}
         for row in ordering_rows:
+            if "before" not in row or "after" not in row:  # a misspelt constraint: said, not followed
+                dangling.setdefault(row["action"].value, []).append(row["constraint"].value)
+                continue
             orderings.setdefault(row["action"].value, []).append(
                 Ordering(row["constraint"].value, row["before"].value, row["after"].value)
             )
@@ -72,7 +77,8 @@ class ActionLibrary:
         for iri in parents:
             ordering = tuple(orderings.get(iri, ()))
             declared = _ordered(subs.get(iri, []), ordering)
-            library.actions[iri] = ActionClass(iri, labels[iri], tuple(sorted(parents[iri])), declared, ordering)
+            loose = tuple(sorted(set(dangling.get(iri, ()))))
+            library.actions[iri] = ActionClass(iri, labels[iri], tuple(sorted(parents[iri])), declared, ordering, loose)
         return library
 
     def __contains__(self, iri: object) -> bool:

@@ -339,6 +339,7 @@ def plan_text(result: CompositionResult) -> str:
     if result.plan is None:
         lines = [f"{name}: no plan. What no component provides:"]
         lines += [f"  - {u.text()}" for u in result.unsatisfied]
+        lines += [f"note: {n}" for n in result.notes]  # the task's decomposition not followed
         return "\n".join(lines)
     plan: Plan = result.plan
     how = {
@@ -364,6 +365,7 @@ def plan_text(result: CompositionResult) -> str:
     goals = "\n".join(f"  {_source(g)}" for g in plan.goals)
     columns = ["#", "component", "action", "inputs and preconditions from", "alternatives"]
     notes = _unused_note(result.unused_inputs, result) + _ranking_note(result)
+    notes += "".join(f"\nnote: {n}" for n in result.notes)  # the task's decomposition not followed
     return f"{head}\n{table(columns, rows)}\nGoals:\n{goals}{notes}"
 
 
@@ -851,6 +853,7 @@ def run_text(result: RunResult, sim_seconds: float, wall_seconds: float) -> str:
     if not report.steps:  # every effect held already: no table of no steps
         steps = "nothing to do: every effect of the task holds already"
     note = _unused_note(result.unused_inputs, result.composition) + _ranking_note(result.composition)
+    note += "".join(f"\nnote: {n}" for n in result.composition.notes)  # the decomposition not followed
     given = _preconditions_text(result.preconditions)
     return f"{header}{steps}\n{verdict}; {timing}{given}{_answers_text(result)}{note}"
 
