@@ -21,6 +21,7 @@ import pyoxigraph as ox
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.loader import check_placement, parse_bytes
 from cbrs.kb.namespaces import GRAPH, PREFIXES, GraphName
+from cbrs.kb.owl_syntaxes import MEDIA_TYPES as OWL_MEDIA_TYPES
 from cbrs.kb.shapes import DescriptionShapeError, check_descriptions
 from cbrs.kb.superclasses import check_change, says_used_terms
 from cbrs.output import used_prefixes
@@ -246,5 +247,10 @@ def _body_format(media_type: str, node: ox.NamedNode | ox.DefaultGraph | None, m
         hint = f" (curl --data-binary sends {_FORM_TYPE} unless told: -H 'Content-Type: {offered[0].media_type}')"
     elif node is None and fmt in GRAPH_FORMATS:
         hint = " (a body of triples goes into one graph: ?graph=IRI or ?default)"
+    elif media_type in OWL_MEDIA_TYPES:
+        hint = (
+            f" ({OWL_MEDIA_TYPES[media_type]} is no RDF syntax: save the ontology from Protégé as RDF/XML or Turtle "
+            "and send it as application/rdf+xml or text/turtle)"
+        )
     where = f"the body of a {method} to {_named(node)}"
     raise UnsupportedMediaTypeError(media_type, where, [f.media_type for f in offered], hint)

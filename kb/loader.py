@@ -46,6 +46,7 @@ from cbrs.kb.errors import (
     UnknownGraphError,
 )
 from cbrs.kb.namespaces import CBRS, DUL, GENID, OWL, RDF, RDFS, GraphName, shorten, written
+from cbrs.kb.owl_syntaxes import check_rdf
 from cbrs.kb.owls import (
     Conversion,
     Role,
@@ -222,6 +223,7 @@ def parse_bytes(
 ) -> ParsedFile:
     """Parse serialised RDF from memory; ``source`` names it in errors."""
     data = _as_utf8(raw, source)
+    check_rdf(data, source)
     parsed, _, repairs = _parse_quads(data, source, rdf_format, _base_for(source, base_iri))
     target = resolve_graph(graph) if graph is not None else _graph_for(parsed)
     return ParsedFile(source, target.value, skolemise(_into(parsed, target), source), repairs=repairs)
@@ -869,6 +871,7 @@ def _read(path: Path, graph: str | GraphName | None, base_iri: str | None = None
     source = str(path)
     if not raw.strip():
         raise RdfParseError(source, "the file is empty" if not raw else "the file holds only white space")
+    check_rdf(_as_utf8(raw[:65536], source, strict=False), source)  # Protégé's OWL/XML, saved as .owl too
     rdf_format = _format_for(path, raw)
     data = _as_utf8(raw, source)
     quads, prefixes, repairs = _parse_quads(data, source, rdf_format, _base_for(source, base_iri))
