@@ -35,8 +35,8 @@ from cbrs.kb.derived_prefixes import StoreNames
 from cbrs.kb.engine_faults import sorts
 from cbrs.kb.errors import AlreadyRegisteredError, NotFoundError, QuerySyntaxError, RdfParseError, without_password
 from cbrs.kb.liveness import ComponentState
-from cbrs.kb.loader import LoadReport, ParsedFile
-from cbrs.kb.namespaces import CBRS, OWL, PREFIXES, RDF, GraphName, expand, near_prefixes, shorten, store_names
+from cbrs.kb.loader import LoadReport, ParsedFile, holds_ontology
+from cbrs.kb.namespaces import CBRS, OWL, PREFIXES, GraphName, expand, near_prefixes, shorten, store_names
 from cbrs.kb.skolem import is_skolem
 from cbrs.kb.staged_writes import STAGING
 from cbrs.kb.store import EmbeddedStore, QueryResult, Term
@@ -419,21 +419,21 @@ def _load_summary(report: LoadReport, store: Any = None) -> list[str]:
                 lines.append(f"  {item.source}{_mended(item)}{unchanged}")
         unresolved = sorted({u.iri for u in report.unresolved_imports})
         lines.append(f"unresolved imports: {len(unresolved)}{_few(unresolved)}")
-    elif owls:
+    else:  # an ontology's imports as an OWL-S file's: a Protégé file importing its neighbour was loaded silently
         imports = sorted(
             {
                 q.object.value
-                for item in owls
+                for item in report.files
                 for q in item.quads
                 if q.predicate.value == OWL_IMPORTS and isinstance(q.object, ox.NamedNode)
             }
         )
         if imports:
             lines.append(f"imports not followed (no --catalog): {len(imports)}{_few(imports)}")
-            held = [iri for iri in imports if store is not None and _holds_ontology(store, iri)]
+            held = [iri for iri in imports if store is not None and holds_ontology(store, iri)]
             if held:  # "not followed" alone reads as missing after a reload
                 lines.append(f"  of which already in the store: {len(held)}{_few(held)}")
-    if owls or report.catalogue is not None:
+    if owls:  # only an OWL-S file's concepts are looked up
         for used_as in ("parameter type", "statement term"):
             concepts = sorted({u.iri for u in report.unresolved_concepts if u.used_as == used_as})
             lines.append(f"unresolved {used_as}s (declared by no loaded ontology): {len(concepts)}{_few(concepts)}")
@@ -453,12 +453,6 @@ def _load_summary(report: LoadReport, store: Any = None) -> list[str]:
 
 
 OWL_IMPORTS = OWL + "imports"
-
-
-def _holds_ontology(store: Any, iri: str) -> bool:
-    """Whether the store declares ``iri`` an owl:Ontology (a load of it, with a catalogue, says so)."""
-    found = store.quads(ox.NamedNode(iri), ox.NamedNode(RDF + "type"), ox.NamedNode(OWL + "Ontology"))
-    return next(iter(found), None) is not None
 
 
 def _few(iris: list[str], limit: int = 3) -> str:

@@ -28,6 +28,9 @@ from cbrs.kb.namespaces import OWL, RDF, RDFS, XSD
 OWLS_TC_PREFIX = "http://127.0.0.1/ontology/"
 OASIS_NS = "urn:oasis:names:tc:entity:xmlns:xml:catalog"
 
+PROTEGE_CATALOGUE = "catalog-v001.xml"
+"""The catalogue Protégé reads from, and writes into, the folder of an ontology it opens."""
+
 # Vocabularies every RDF tool knows: importing them needs no file, so they are never "unresolved".
 BUILT_IN = tuple(ns.rstrip("#") for ns in (RDF, RDFS, OWL, XSD))
 
@@ -73,11 +76,20 @@ class Catalogue:
 
     @classmethod
     def from_directory(cls, folder: str | Path, prefixes: Iterable[str] = (OWLS_TC_PREFIX,)) -> Catalogue:
-        """Every file in ``folder`` answers for IRIs ending in its name, and for ``prefixes`` + its path."""
+        """Every file in ``folder`` answers for IRIs ending in its name, and for ``prefixes`` + its path;
+        first, the ``catalog-v001.xml`` Protégé keeps in the folder of an ontology, if there is one (its
+        entries were passed over: an import of ``http://lab/glassware`` mapped there to ``glassware.ttl``
+        was unresolved, the folder having no file named ``glassware``)."""
         path = Path(folder)
         if not path.is_dir():
             raise CatalogueError(str(path), "is not a directory")
-        return cls(prefixes=[(prefix, path) for prefix in prefixes], folders=[path], source=str(path))
+        catalogue = cls(prefixes=[(prefix, path) for prefix in prefixes], folders=[path], source=str(path))
+        protege = path / PROTEGE_CATALOGUE
+        if protege.is_file():
+            kept = cls.from_file(protege)
+            catalogue.entries.update(kept.entries)
+            catalogue.prefixes[:0] = kept.prefixes
+        return catalogue
 
     @classmethod
     def from_file(cls, path: str | Path) -> Catalogue:

@@ -156,6 +156,7 @@ class LoadReport:
     files: list[ParsedFile] = field(default_factory=list)
     imports: list[ParsedFile] = field(default_factory=list)
     already_loaded: list[str] = field(default_factory=list)
+    """The ontologies imports named that no catalogue entry maps but the store declares already (a bundled one)."""
     unresolved_imports: list[Unresolved] = field(default_factory=list)
     unresolved_concepts: list[UnresolvedConcept] = field(default_factory=list)
     catalogue: Catalogue | None = None
@@ -989,7 +990,7 @@ def _resolve_imports(
         else:
             references = [(iri, "owl:imports") for iri in _imports(raw.quads)]
         pending.extend((iri, raw.source, reason) for iri, reason in references)
-    seen: set[str] = set()
+    seen = {ontology for raw in raws for ontology in _ontologies(raw.quads)}  # given in this load
     loaded = {Path(raw.source).resolve() for raw in raws}
     imported: list[_Raw] = []
     while pending:
@@ -1000,7 +1001,9 @@ def _resolve_imports(
         seen.add(document)
         path = catalogue.resolve(document)
         if path is None:
-            if not is_owls_ontology(document):  # read by the OWL-S reader itself: nothing is missing
+            if holds_ontology(store, document):  # a bundled ontology (home), or one an earlier load brought
+                report.already_loaded.append(document)
+            elif not is_owls_ontology(document):  # read by the OWL-S reader itself: nothing is missing
                 report.unresolved_imports.append(Unresolved(document, needed_by, reason))
             continue
         if path.resolve() in loaded:
@@ -1113,6 +1116,22 @@ def _part_path(edges: dict[str, set[str]], start: str, goal: str) -> list[str] |
                 previous[nxt] = node
                 queue.append(nxt)
     return None
+
+
+def holds_ontology(store: Store, iri: str) -> bool:
+    """Whether ``store`` declares ``iri`` an ``owl:Ontology``, in any graph: an import of it needs no file."""
+    declared = store.quads(ox.NamedNode(iri), ox.NamedNode(RDF + "type"), ox.NamedNode(OWL + "Ontology"))
+    return next(iter(declared), None) is not None
+
+
+def _ontologies(quads: Iterable[ox.Quad]) -> set[str]:
+    """The IRIs ``quads`` declare ``owl:Ontology``s."""
+    rdf_type, ontology = RDF + "type", OWL + "Ontology"
+    return {
+        q.subject.value
+        for q in quads
+        if q.predicate.value == rdf_type and isinstance(q.object, ox.NamedNode) and q.object.value == ontology
+    }
 
 
 def _imports(quads: Iterable[ox.Quad]) -> list[str]:
