@@ -49,12 +49,21 @@ __all__ = ["CACHE_FILE", "StoreNames", "derive", "for_store", "name_for", "names
 # Every term the store holds, in any position (graph names are the cbrs graph: prefixes). The IRIs are
 # picked out here: with FILTER(isIRI(?t)) the query took 2.9 s on OWLS-TC, without it 1.2 s.
 _TERMS = "SELECT DISTINCT ?t WHERE { { ?t ?p ?o } UNION { ?s ?t ?o } UNION { ?s ?p ?t } }"
+# IRIs that name documents, not terms: an ontology (and a module it imports), its version IRI and those of
+# its other versions. Protégé gives an ontology <http://lab/kit> the version IRI <http://lab/kit/1.0>, whose
+# namespace http://lab/kit/ derives "kit" as the terms' http://lab/kit# does: neither got it, and the lab's
+# terms were shown as kit1:MeasuringBeaker. A namespace that terms use is still read from the terms.
+_DOCUMENTS = """PREFIX owl: <http://www.w3.org/2002/07/owl#>
+SELECT DISTINCT ?d WHERE {
+  { ?d a owl:Ontology } UNION { ?o owl:versionIRI|owl:imports|owl:priorVersion ?d }
+  UNION { ?o owl:backwardCompatibleWith|owl:incompatibleWith ?d }
+}"""
 _EXTENSION = re.compile(r"\.[A-Za-z][A-Za-z0-9]*$")
 _NOT_IN_PREFIX = re.compile(r"[^A-Za-z0-9_-]")
 
 CACHE_FILE = "cbrs-derived-prefixes.json"
 """The table of an on-disk store, kept in its folder with the key of the data files it was read from."""
-_RULE = "1"  # bumped when the rule changes, so that a kept table of the old rule is not taken
+_RULE = "2"  # bumped when the rule changes, so that a kept table of the old rule is not taken
 
 
 def namespace(iri: str) -> str | None:
@@ -119,18 +128,28 @@ def read(kb: KnowledgeBase) -> dict[str, str]:
 
 
 def namespaces_in(store: Store) -> set[str]:
-    """The namespaces of every IRI ``store`` holds (each term read: :func:`for_store` keeps the table)."""
+    """The namespaces of every IRI ``store`` holds (each term read: :func:`for_store` keeps the table), but
+    for the IRIs that only name ontologies (:data:`_DOCUMENTS`)."""
     found = set()
     solutions = store.query(_TERMS)
     if not isinstance(solutions, ox.QuerySolutions):  # a SELECT's answer always is
         return set()
+    documents = _documents(store)
     for row in solutions:
         term = row[0]
-        if isinstance(term, ox.NamedNode):
+        if isinstance(term, ox.NamedNode) and term.value not in documents:
             ns = namespace(term.value)
             if ns is not None:
                 found.add(ns)
     return found
+
+
+def _documents(store: Store) -> set[str]:
+    """The IRIs of the store that name ontologies, their versions and what they import, and nothing else."""
+    solutions = store.query(_DOCUMENTS)
+    if not isinstance(solutions, ox.QuerySolutions):
+        return set()
+    return {row[0].value for row in solutions if isinstance(row[0], ox.NamedNode)}
 
 
 _kept: weakref.WeakKeyDictionary[Store, tuple[int, dict[str, str]]] = weakref.WeakKeyDictionary()
