@@ -13,6 +13,7 @@ from __future__ import annotations
 from flask import Blueprint, Response, request
 
 from cbrs.graph_store import GraphStore, GraphStoreError, Target
+from cbrs.sparql_service import identity_header
 from cbrs.web import context
 from cbrs.web.sparql import bearer_token, misspelt_parameter
 
@@ -38,7 +39,19 @@ def read() -> Response:
     if request.accept_mimetypes.best == "text/html":  # a browser following a link: Turtle, not RDF/XML
         accept = "text/turtle"
     data, media_type = _store().read(_target(), accept, request.remote_addr)
-    return Response(b"" if request.method == "HEAD" else data, content_type=media_type, headers={"Vary": "Accept"})
+    # the body whole for HEAD too: the answer then drops it and keeps its Content-Length (RFC 9110, 9.3.2),
+    # where an empty body said Content-Length: 0, a graph of no triples
+    return Response(data, content_type=media_type)
+
+
+@blueprint.after_request
+def _headers(response: Response) -> Response:
+    """The headers every answer of ``/sparql`` carries, on every answer of ``/store``, its errors too: the
+    answer depends on Accept (and its CORS headers on Origin), and the ``Cbrs-Server`` header says what
+    server answers (the errors had neither, a 200 ``Vary: Accept`` alone)."""
+    response.vary.update(("Accept", "Origin"))
+    response.headers.setdefault(*identity_header())
+    return response
 
 
 @blueprint.put("/store")
