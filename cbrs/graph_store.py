@@ -6,7 +6,7 @@ is written (a broken body changes nothing), pass the description shapes like eve
 a readable semantic map readable (as a load or an update into graph:map must), leave no class under a term
 of cbrs's own vocabularies that nothing declares (as an ``INSERT DATA`` or ``DELETE DATA`` of the same
 statements must: :func:`kb.superclasses.check_change`), put a task nowhere but graph:requirements and an
-advertisement nowhere but graph:services (:func:`kb.loader.check_placement`, as ``cbrs load --graph``), and are
+advertisement nowhere but graph:services (:func:`kb.placement.check_placement`, as ``cbrs load --graph``), and are
 one transaction each.
 """
 
@@ -19,9 +19,10 @@ from dataclasses import dataclass
 import pyoxigraph as ox
 
 from cbrs.kb.errors import KnowledgeBaseError
-from cbrs.kb.loader import check_placement, parse_bytes
+from cbrs.kb.loader import parse_bytes
 from cbrs.kb.namespaces import GRAPH, PREFIXES, GraphName
 from cbrs.kb.owl_syntaxes import MEDIA_TYPES as OWL_MEDIA_TYPES
+from cbrs.kb.placement import check_placement
 from cbrs.kb.shapes import DescriptionShapeError, check_descriptions
 from cbrs.kb.superclasses import check_change, says_used_terms
 from cbrs.output import used_prefixes

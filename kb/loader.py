@@ -29,7 +29,7 @@ import subprocess
 import sys
 import xml.parsers.expat
 from collections import defaultdict, deque
-from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -39,13 +39,12 @@ import pyoxigraph as ox
 from cbrs.kb.catalog import Catalogue, Unresolved, is_built_in, ontology_iri
 from cbrs.kb.errors import (
     DescribedElsewhereError,
-    KnowledgeBaseError,
     PartCycleError,
     RdfParseError,
     UnknownFormatError,
     UnknownGraphError,
 )
-from cbrs.kb.namespaces import CBRS, DUL, GENID, OWL, RDF, RDFS, GraphName, shorten, written
+from cbrs.kb.namespaces import CBRS, DUL, GENID, OWL, RDF, RDFS, GraphName, shorten
 from cbrs.kb.owl_syntaxes import check_rdf
 from cbrs.kb.owls import (
     Conversion,
@@ -57,6 +56,8 @@ from cbrs.kb.owls import (
     owls_key,
     referenced_ontologies,
 )
+from cbrs.kb.placement import DECLARATION_TYPES, check_placement
+from cbrs.kb.placement import MisplacedDescriptionError as MisplacedDescriptionError  # where it lived: re-exported
 from cbrs.kb.shapes import check_loaded
 from cbrs.kb.store import EmbeddedStore, Store
 from cbrs.kb.superclasses import check_change, check_superclasses
@@ -77,7 +78,6 @@ FORMATS_BY_EXTENSION: dict[str, ox.RdfFormat] = {
     ".owls": ox.RdfFormat.RDF_XML,
 }
 
-_DECLARATION_TYPES = {OWL + "Class", RDFS + "Class", OWL + "ObjectProperty", OWL + "DatatypeProperty"}
 _XML_ENCODING = re.compile(rb"""^(<\?xml[^>]*?encoding\s*=\s*["'])([A-Za-z0-9._-]+)(["'])""")
 _XMLNS = re.compile(r"""xmlns:([A-Za-z_][\w.-]*)\s*=\s*(["'])(.*?)\2""")
 _ENTITY = re.compile(r"""<!ENTITY\s+([\w.-]+)\s+(["'])(.*?)\2\s*>""", re.S)
@@ -407,121 +407,6 @@ def _prepare(
     check_superclasses(store, [(raw.source, raw.quads) for raw in (*raws, *imported)])
     check_loaded(store, report)  # descriptions against the SHACL shapes, and their terms (kb/shapes.py)
     return held
-
-
-class MisplacedDescriptionError(KnowledgeBaseError):
-    """A task (a ``cbrs:Requirement``) written into another of the graphs a lab loads into than
-    graph:requirements, or a component's advertisement (a ``cbrs:Advertisement`` or a kind of it) into another
-    than graph:services. A lab's file says in its header where it goes, and ``--graph map`` or a list on a page
-    is easy to pick wrong; loaded, the task sat in the map without a word. Nothing was written."""
-
-    http_status = 400
-    kind = "bad-request"  # the JSON error's name, as the Graph Store's other 400s
-
-    def __init__(
-        self, source: str, subject: str, kind: str, graph: str, belongs: GraphName, prefixes: Mapping[str, str]
-    ) -> None:
-        self.source = source
-        self.subject = subject
-        self.described_as = kind
-        self.graph = graph
-        self.belongs = belongs
-        named = f"{_written(subject, prefixes)}, a {_written(kind, prefixes)}"
-        super().__init__(
-            f"{source} describes {self.what} ({named}): {self.rule}, not {written(graph)}; nothing was loaded"
-        )
-
-    @property
-    def what(self) -> str:
-        return "a task" if self.belongs is GraphName.REQUIREMENTS else "a component's advertisement"
-
-    @property
-    def rule(self) -> str:
-        """Where such a description goes: ``tasks go into graph:requirements``."""
-        plural = "tasks" if self.belongs is GraphName.REQUIREMENTS else "advertisements"
-        return f"{plural} go into graph:{self.belongs.value}"
-
-
-_PLACED = (GraphName.ONTOLOGY, GraphName.MAP, GraphName.SERVICES, GraphName.REQUIREMENTS)
-"""The graphs a lab loads its files into, of which a task and an advertisement each belong in one; a graph of
-another name (a lab's own, the default graph) is not judged."""
-
-
-def check_placement(store: Store, quads: Sequence[ox.Quad], source: str, prefixes: Mapping[str, str] = {}) -> None:
-    """Refuse ``quads`` that put a task anywhere among :data:`_PLACED` but graph:requirements, or an
-    advertisement anywhere among them but graph:services (:class:`MisplacedDescriptionError`, naming the
-    first). Every way in passes here: ``cbrs load --graph`` (:func:`load_files`), the Graph Store's ``POST``
-    and ``PUT`` (:mod:`cbrs.graph_store`) and so the Load a file page. A node typed both is judged an
-    advertisement, as :func:`_graph_for_types` places it. graph:ontology takes either when the same quads declare
-    a class or property there (a two-level task's action classes with their requirements, evening_routine.ttl):
-    such a file goes into one graph, and ``cbrs load`` without ``--graph`` puts it into the ontology. The refusal
-    names the description by the ``prefixes`` its text declares when cbrs's table has none for it
-    (lab10:SwitchOnTheReadingLamp)."""
-    judged = {g.node: g for g in _PLACED}
-    rdf_type = RDF + "type"
-    typed: dict[tuple[str, ox.NamedNode], list[str]] = defaultdict(list)
-    declaring = {
-        q.graph_name
-        for q in quads
-        if q.predicate.value == rdf_type and isinstance(q.object, ox.NamedNode) and q.object.value in _DECLARATION_TYPES
-    }
-    for quad in quads:
-        if quad.predicate.value != rdf_type or quad.graph_name not in judged:
-            continue
-        if isinstance(quad.subject, ox.NamedNode) and isinstance(quad.object, ox.NamedNode):
-            assert isinstance(quad.graph_name, ox.NamedNode)
-            typed[(quad.subject.value, quad.graph_name)].append(quad.object.value)
-    if not typed:
-        return
-    advertised = _advertisement_kinds(store, quads)
-    for (subject, node), kinds in typed.items():
-        graph = judged[node]
-        if graph is GraphName.ONTOLOGY and node in declaring:
-            continue
-        kind = next((k for k in kinds if k in advertised), None)
-        if kind is not None:
-            if graph is not GraphName.SERVICES:
-                raise MisplacedDescriptionError(source, subject, kind, node.value, GraphName.SERVICES, prefixes)
-        elif CBRS + "Requirement" in kinds and graph is not GraphName.REQUIREMENTS:
-            requirement = CBRS + "Requirement"
-            raise MisplacedDescriptionError(source, subject, requirement, node.value, GraphName.REQUIREMENTS, prefixes)
-
-
-def _written(iri: str, prefixes: Mapping[str, str]) -> str:
-    """``iri`` as cbrs writes it, or by a prefix of ``prefixes`` when cbrs has none for its namespace."""
-    shown = written(iri)
-    if shown.startswith("<"):
-        for name, namespace in prefixes.items():
-            local = iri[len(namespace) :]
-            if name and iri.startswith(namespace) and _NCNAME.match(local):
-                return f"{name}:{local}"
-    return shown
-
-
-def _advertisement_kinds(store: Store, quads: Sequence[ox.Quad]) -> set[str]:
-    """``cbrs:Advertisement`` and every class under it, in the store or in ``quads`` (a lab's own kind)."""
-    sub_class = ox.NamedNode(RDFS + "subClassOf")
-    given: defaultdict[str, set[str]] = defaultdict(set)
-    for quad in quads:
-        if (
-            quad.predicate == sub_class
-            and isinstance(quad.subject, ox.NamedNode)
-            and isinstance(quad.object, ox.NamedNode)
-        ):
-            given[quad.object.value].add(quad.subject.value)
-    kinds = {CBRS + "Advertisement"}
-    frontier = list(kinds)
-    while frontier:
-        kind = frontier.pop()
-        stored = {
-            q.subject.value
-            for q in store.quads(None, sub_class, ox.NamedNode(kind))
-            if isinstance(q.subject, ox.NamedNode)
-        }
-        for found in (stored | given[kind]) - kinds:
-            kinds.add(found)
-            frontier.append(found)
-    return kinds
 
 
 Held = Callable[[ox.Quad], bool]
@@ -1299,7 +1184,7 @@ _DEFAULT_TARGETS = (GraphName.ONTOLOGY, GraphName.REQUIREMENTS, GraphName.SERVIC
 
 
 def _graph_for_types(types: set[str]) -> ox.NamedNode:
-    if types & _DECLARATION_TYPES:
+    if types & DECLARATION_TYPES:
         return GraphName.ONTOLOGY.node
     if CBRS + "Requirement" in types and CBRS + "Advertisement" not in types:
         return GraphName.REQUIREMENTS.node

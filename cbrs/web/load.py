@@ -19,8 +19,8 @@ from flask import Blueprint, request, url_for
 
 from cbrs.graph_store import GraphStore, Target
 from cbrs.kb.errors import KnowledgeBaseError
-from cbrs.kb.loader import MisplacedDescriptionError
 from cbrs.kb.namespaces import GraphName
+from cbrs.kb.placement import MisplacedDescriptionError
 from cbrs.sparql_service import UpdateForbiddenError
 from cbrs.task_drafts import declared_prefixes
 from cbrs.web import context
@@ -100,7 +100,7 @@ def load() -> Page:
 
 
 def _misplaced(error: MisplacedDescriptionError, body: bytes, name: str) -> str:
-    """The library's refusal of a task or advertisement in the wrong graph (:func:`cbrs.kb.loader.check_placement`,
+    """The library's refusal of a task or advertisement in the wrong graph (:func:`cbrs.kb.placement.check_placement`,
     which ``cbrs load --graph`` and the Graph Store meet too) in the page's words: the description named as the
     pages name it, by the prefix its file declares when the store has nothing of its namespace (lab14:FetchMyMug)."""
     use_text_prefixes(declared_prefixes(body.decode("utf-8", "replace")))
