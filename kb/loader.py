@@ -1015,7 +1015,10 @@ def _ontologies(quads: Iterable[ox.Quad]) -> set[str]:
     return {
         q.subject.value
         for q in quads
-        if q.predicate.value == rdf_type and isinstance(q.object, ox.NamedNode) and q.object.value == ontology
+        if q.predicate.value == rdf_type
+        and isinstance(q.subject, ox.NamedNode)
+        and isinstance(q.object, ox.NamedNode)
+        and q.object.value == ontology
     }
 
 
