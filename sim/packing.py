@@ -15,12 +15,13 @@ gives the reasoning.
 
 from __future__ import annotations
 
+import functools
 import itertools
 import logging
 import math
 from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass, replace
-from typing import Any, NamedTuple
+from typing import Any, NamedTuple, ParamSpec
 
 from cbrs.actions.plan import Plan, PlanStep
 from cbrs.kb.errors import KnowledgeBaseError
@@ -50,6 +51,7 @@ from cbrs.sim.relations import region_of
 from cbrs.sim.relay import RELAY_TRIES
 
 log = logging.getLogger("cbrs.sim")
+_P = ParamSpec("_P")
 
 CARRYING = PREFIXES["act"] + "CarryingWhileLocomoting"
 """The action of the steps that set an object down on the place they are given."""
@@ -463,59 +465,6 @@ SPOT_BUDGET = 20_000
 for one whole place); a spot undecided within it is taken as leaving none."""
 
 
-def set_down_spots(
-    smap: SemanticMap,
-    place: Thing,
-    size: Size,
-    mounts: Sequence[Mount],
-    others: Sequence[tuple[float, float, float]],
-    later: Sequence[Size] = (),
-    rule: PackingRule = PackingRule(),
-    foot: Footprint | None = None,
-    later_feet: Sequence[Footprint] | None = None,
-    lying: Sequence[Lying] = (),
-    holds: Holds | None = None,
-    able: Sequence[Mount] | None = None,
-    later_able: Sequence[Sequence[Mount] | None] | None = None,
-    later_by: Sequence[Sequence[Mount]] | None = None,
-    wider_by: Sequence[Sequence[Mount]] | None = None,
-    own: Callable[[Spot], bool] | None = None,
-) -> tuple[Region, list[Spot]]:
-    """The surface and spots of :func:`place_spots` (:func:`box_spots` for the rule's ``box`` footprints:
-    ``foot``, ``later_feet``, else boxes along x) for an object set down on ``place``, when the plan puts
-    the objects of ``later`` (sizes) there after it: first those that leave room for them all (some
-    arrangement of theirs, :func:`arrange`, fits beside it, with SET_DOWN_SLACK, each where ``holds``
-    says an arm can set it down), nearest the centre first as for one thing alone, up to RELAY_TRIES of
-    them (as many as the carry asks the arm about), then the rest. As the spots are ordered when nothing
-    comes after it or no spot leaves room (the run goes on, and the later carry says what is in its way).
-    ``able`` (this thing's) and ``later_able`` (each later thing's): the arms that can set it down
-    (:func:`place_spots`' ``able``, :func:`able_mounts`; None: every arm of the map); ``later_by``: each
-    later thing's arms whose reach its spots are in (else ``mounts``), and ``wider_by`` those asked when no
-    spot leaves room within them (the arms free at its carry: it may go to another arm); ``own``: whether
-    the arm that sets this one down can let it go over a spot (None: any it reaches), asked of each spot
-    found leaving room: one it cannot is not taken as leaving room (the carry would pass it over and set the
-    thing down at the first it can, as for one thing alone)."""
-    surface, spots, _ = _set_down_spots(
-        smap,
-        place,
-        size,
-        mounts,
-        others,
-        later,
-        rule,
-        foot,
-        later_feet,
-        lying,
-        holds,
-        able,
-        later_able,
-        later_by,
-        wider_by,
-        own,
-    )
-    return surface, spots
-
-
 def _set_down_spots(
     smap: SemanticMap,
     place: Thing,
@@ -534,8 +483,22 @@ def _set_down_spots(
     wider_by: Sequence[Sequence[Mount]] | None = None,
     own: Callable[[Spot], bool] | None = None,
 ) -> tuple[Region, list[Spot], int | None]:
-    """:func:`set_down_spots`, and how many of its first spots leave room (0 when none does; None when
-    nothing comes after it or it has no spot)."""
+    """The surface and spots of :func:`place_spots` (:func:`box_spots` for the rule's ``box`` footprints:
+    ``foot``, ``later_feet``, else boxes along x) for an object set down on ``place``, when the plan puts
+    the objects of ``later`` (sizes) there after it: first those that leave room for them all (some
+    arrangement of theirs, :func:`arrange`, fits beside it, with SET_DOWN_SLACK, each where ``holds``
+    says an arm can set it down), nearest the centre first as for one thing alone, up to RELAY_TRIES of
+    them (as many as the carry asks the arm about), then the rest. As the spots are ordered when nothing
+    comes after it or no spot leaves room (the run goes on, and the later carry says what is in its way).
+    ``able`` (this thing's) and ``later_able`` (each later thing's): the arms that can set it down
+    (:func:`place_spots`' ``able``, :func:`able_mounts`; None: every arm of the map); ``later_by``: each
+    later thing's arms whose reach its spots are in (else ``mounts``), and ``wider_by`` those asked when no
+    spot leaves room within them (the arms free at its carry: it may go to another arm); ``own``: whether
+    the arm that sets this one down can let it go over a spot (None: any it reaches), asked of each spot
+    found leaving room: one it cannot is not taken as leaving room (the carry would pass it over and set the
+    thing down at the first it can, as for one thing alone).
+    With them, how many of its first spots leave room (0 when none does; None when nothing comes after it
+    or it has no spot), which :func:`carry_spots` reads; :func:`set_down_spots` gives the first two."""
     boxed = rule.footprint == "box"
     mine = foot if foot is not None else Footprint.lying(size, 0.0)
     if boxed:
@@ -597,6 +560,24 @@ def _set_down_spots(
         if keeping:
             return surface, [*keeping, *(spot for spot in spots if spot not in keeping)], len(keeping)
     return surface, spots, 0
+
+
+def _surface_and_spots(
+    found: Callable[_P, tuple[Region, list[Spot], int | None]],
+) -> Callable[_P, tuple[Region, list[Spot]]]:
+    """``found`` (:func:`_set_down_spots`) giving the surface and spots alone, its parameters its own: the
+    public form, which says nothing of how many spots leave room, without a copy of its sixteen parameters."""
+
+    @functools.wraps(found)
+    def spots(*args: _P.args, **kwargs: _P.kwargs) -> tuple[Region, list[Spot]]:
+        surface, each, _ = found(*args, **kwargs)
+        return surface, each
+
+    spots.__name__ = spots.__qualname__ = "set_down_spots"
+    return spots
+
+
+set_down_spots = _surface_and_spots(_set_down_spots)
 
 
 def puts_down(
