@@ -346,7 +346,7 @@ def plan_text(result: CompositionResult) -> str:
         "direct": "composed directly",
         "matched": "matched to one component by the matchmaker",
         "achieved": "nothing to do: every effect holds already",
-    }.get(plan.method, "decomposed into " + ", ".join(map(shorten, plan.sub_actions)))
+    }.get(plan.method, "decomposed into " + ", ".join(map(_part_name, plan.sub_actions)))
     steps = f"{len(plan.steps)} step{'' if len(plan.steps) == 1 else 's'}"
     head = f"{name}: planned ({how}), {steps}, mean similarity {plan.similarity:.3f}, cost {plan.cost:g} s"
     rows = []
@@ -367,6 +367,17 @@ def plan_text(result: CompositionResult) -> str:
     notes = _unused_note(result.unused_inputs, result) + _ranking_note(result)
     notes += "".join(f"\nnote: {n}" for n in result.notes)  # the task's decomposition not followed
     return f"{head}\n{table(columns, rows)}\nGoals:\n{goals}{notes}"
+
+
+def _part_name(part: str) -> str:
+    """A part of a decomposed plan as the output names things: a sub-action shortened, and a goal's part (the
+    task's IRI and ``/goal1``, as the composer names it) by the task's shortened name and its goal, which
+    :func:`shorten` left whole (``https://example.org/lab15#SetTheTableForOne/goal1``: no prefixed name has
+    a slash)."""
+    task, slash, goal = part.rpartition("/")
+    if slash and goal.startswith("goal") and goal.removeprefix("goal").isdigit():
+        return f"{shorten(task)}/{goal}"
+    return shorten(part)
 
 
 _RANKED_BY = {
