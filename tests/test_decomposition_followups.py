@@ -4,6 +4,8 @@ an ordering constraint the plan cannot follow is a reason of no plan, not an err
 
 from __future__ import annotations
 
+import re
+from html import unescape
 from pathlib import Path
 
 import pytest
@@ -13,6 +15,8 @@ from cbrs.cli_actions import plan_text
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.derived_prefixes import StoreNames
 from cbrs.kb.namespaces import store_names
+from cbrs.sparql_service import EndpointConfig, SparqlService
+from cbrs.web import create_app
 from tests.helpers_examples import EXAMPLES
 
 LAB15 = "https://example.org/lab15#"
@@ -52,3 +56,28 @@ def test_goal_parts_are_named_shortened(misspelt: KnowledgeBase) -> None:
     head = text.splitlines()[0]
     assert "decomposed into lab15:SetTheTableForOne/goal1, lab15:SetTheTableForOne/goal2" in head, head
     assert LAB15 not in head
+
+
+def _page_text(html: str) -> str:
+    html = re.sub(r"(?s)<(script|style)[^>]*>.*?</\1>", " ", html)
+    return " ".join(unescape(re.sub(r"<[^>]+>", " ", html)).split())
+
+
+def test_the_plans_page_shows_the_notes_by_the_names_the_pages_show(misspelt: KnowledgeBase) -> None:
+    """``/plans.json`` had the notes (``composition.notes``), the page none: a lab member in the browser saw
+    the table set goal by goal and not why. The page now says them where it says what the plan does without,
+    with the lab's terms by their prefix, as the rest of the page names them."""
+    app = create_app(SparqlService(misspelt, EndpointConfig(update_token="t")), tasks=None)
+    client = app.test_client()
+    notes = client.get("/plans.json?task=lab15:SetTheTableForOne").get_json()["composition"]["notes"]
+    assert any(f"{LAB15}PutCupOnMatt" in note for note in notes), notes
+    page = client.get("/plans?task=lab15:SetTheTableForOne", headers={"Accept": "text/html"})
+    assert page.status_code == 200
+    said = _page_text(page.text)
+    assert (
+        "lab15:SetTheTableForOne is not planned by its sub-actions, nor in their order: its sub-action"
+        " lab15:PutCupOnMatt (no action class the store declares; did you mean lab15:PutCupOnMat?)" in said
+    ), said
+    assert "orders lab15:PutCupOnMat, no sub-action of it" in said
+    assert LAB15 not in said.split("Data flow", 1)[0], said  # the parts too: lab15:SetTheTableForOne/goal1
+    assert "decomposed into lab15:SetTheTableForOne/goal1 , lab15:SetTheTableForOne/goal2" in said

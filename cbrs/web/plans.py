@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import functools
 import importlib
+import re
 import tempfile
 import threading
 from dataclasses import dataclass
@@ -119,6 +120,27 @@ def _composed(task: str, objective: str, shown: Page | None) -> _Composed:
         return found
     except UnknownTaskError as error:  # says what was meant and how to type every known task
         raise FormError({"task": str(error)}, page=shown) from None
+
+
+_IRI_BEFORE_QUESTION = re.compile(r"""(https?://[^\s<>"'?]+)\?""")
+
+
+@blueprint.app_template_filter("note_text")
+def note_text(text: str) -> str:
+    """A composition's note (``CompositionResult.notes``) with its IRIs as the pages name them: as
+    :func:`short_text` does, and an IRI a question mark ends ("did you mean ...#PutCupOnMat?"), which
+    :func:`short_text` takes as part of it and leaves whole."""
+    return short_text(_IRI_BEFORE_QUESTION.sub(lambda found: f"{short(found.group(1))}?", text))
+
+
+@blueprint.app_template_filter("plan_part")
+def plan_part(part: str) -> str:
+    """A part of a decomposed plan as the pages name it: a sub-action by :func:`short`, a goal's part (the
+    task's IRI and ``/goal1``) by the task's short name and its goal, which :func:`short` leaves whole."""
+    task, slash, goal = part.rpartition("/")
+    if slash and goal.startswith("goal") and goal.removeprefix("goal").isdigit():
+        return f"{short(task)}/{goal}"
+    return short(part)
 
 
 DRAWING_MODULE = "cbrs.actions.draw"
