@@ -13,10 +13,10 @@ from typing import Any
 import pytest
 from flask.testing import FlaskClient
 
-from cbrs.kb import KnowledgeBase
+from cbrs.kb import KnowledgeBase, derived_prefixes
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.sparql_service import EndpointConfig, SparqlService
-from cbrs.web import create_app, prefixes
+from cbrs.web import create_app
 from cbrs.web.prefixes import derive, name_for, namespace
 
 BOOKS = "http://127.0.0.1/ontology/books.owl#"
@@ -128,15 +128,15 @@ def client(kb: KnowledgeBase) -> FlaskClient:
 
 @pytest.fixture
 def reads(monkeypatch: pytest.MonkeyPatch) -> list[int]:
-    """One entry per read of the store's namespaces."""
+    """One entry per read of the store's namespaces (by the table kept per store, which the pages take)."""
     counted: list[int] = []
-    original = prefixes.read
+    original = derived_prefixes.read
 
     def counting(kb: KnowledgeBase) -> dict[str, str]:
         counted.append(1)
         return original(kb)
 
-    monkeypatch.setattr(prefixes, "read", counting)
+    monkeypatch.setattr(derived_prefixes, "read", counting)
     return counted
 
 
