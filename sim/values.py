@@ -636,8 +636,12 @@ def check(concept: str, data: object, is_a: IsA | None = None) -> dict[str, Any]
     - A port of any other class (a thing, a status, a thermometer's reading) takes any JSON object of
       its class or a subclass (``home:Opened`` for ``home:DoorStatus``), a designator of one included.
 
+    ``concept`` may be a prefixed name (``home:ObjectPosition3D``), as ``@type`` may: given so, it was no
+    class with a shape, and a good value was refused as of another class.
+
     Returns the value with its ``@type`` written in full; ``MalformedValueError`` (a ``ValueError``)
     names the port's class, what was given and what was expected."""
+    concept = expand(concept)
     named = local_name(concept)
     if not isinstance(data, dict):
         raise MalformedValueError(concept, WHOLE, data, f"a JSON object with '@type' {named}")

@@ -106,6 +106,16 @@ def test_a_value_of_another_class_or_a_designator_for_a_shaped_port_is_refused_n
     assert port.split("#")[1] in message.split("expected", 1)[1]
 
 
+def test_a_port_type_given_as_a_prefixed_name_is_the_class_it_names() -> None:
+    """docs/values.md's own example, ``check("home:ObjectPosition3D", ...)``: a good value was refused as of
+    another class, the port's prefixed name being no class with a shape."""
+    value = {"@type": OBJECT_POSITION, "x": 1.0, "y": 2.0, "z": 0.8}
+    assert check("home:ObjectPosition3D", value) == check(OBJECT_POSITION, value)
+    with pytest.raises(MalformedValueError) as refused:
+        check("home:ObjectPosition3D", {"@id": "urn:x", "@type": "home:Cup"})
+    assert refused.value.concept == OBJECT_POSITION
+
+
 def test_a_designator_of_the_port_class_or_a_subclass_is_a_thing_of_that_class() -> None:
     door = {"@id": "https://w3id.org/cbrs/world#KitchenDoor", "@type": "home:Door"}
     assert check(HOME + "BuildingElement", door)["@id"] == door["@id"]
