@@ -69,7 +69,9 @@ LAST_HOLD = 2.0
 """The last frame, with the verdict, stays up this long (s)."""
 VIDEO_FPS = 8
 FORMATS = (".gif", ".mp4", ".webm")
-VIDEO_INSTALL = "pip install 'cbrs[video]' (imageio-ffmpeg, which ships an ffmpeg binary) or put ffmpeg on PATH"
+VIDEO_INSTALL = (
+    "pip install '.[video]' in the cbrs checkout (imageio-ffmpeg, which ships an ffmpeg binary) or put ffmpeg on PATH"
+)
 PATH_MAP_SIZE = (800, 720)
 """Pixels of the path map (width, height)."""
 

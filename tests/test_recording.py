@@ -183,7 +183,7 @@ def test_unknown_suffix_and_missing_video_writer_are_usage_errors(
     for suffix in (".mp4", ".webm"):
         bad = runner.invoke(cli, ["--store", ":memory:", "run", SERVE, "--record", str(tmp_path / f"run{suffix}")])
         assert bad.exit_code == 2, bad.output
-        assert f"writing {suffix} needs ffmpeg" in bad.output and "pip install 'cbrs[video]'" in bad.output
+        assert f"writing {suffix} needs ffmpeg" in bad.output and "pip install '.[video]'" in bad.output
     assert not list(tmp_path.iterdir())  # refused before anything ran or was written
     with pytest.raises(RecordingError, match="must end in"):
         check_target(Path("x.png"))
@@ -201,7 +201,7 @@ def demo() -> Recorder:
     return recorder
 
 
-@pytest.mark.skipif(find_ffmpeg() is None, reason="no ffmpeg: pip install 'cbrs[video]' to test video recordings")
+@pytest.mark.skipif(find_ffmpeg() is None, reason="no ffmpeg: pip install '.[video]' to test video recordings")
 @pytest.mark.parametrize("suffix", [".mp4", ".webm"])
 def test_videos_are_written_with_ffmpeg(demo: Recorder, tmp_path: Path, suffix: str) -> None:
     target = tmp_path / f"demo{suffix}"
