@@ -206,7 +206,8 @@ def _left_behind(graph: str) -> str:
     metavar="DIR|FILE",
     type=click.Path(exists=True, path_type=Path),
     help="Resolve owl:imports (and the ontologies of OWL-S parameter types) to local files: a folder of "
-    "ontologies, an OASIS catalog-v001.xml or a two-column TSV. Nothing is fetched from the network.",
+    "ontologies (with the catalog-v001.xml Protégé keeps in it, if any), an OASIS catalog-v001.xml or a two-column "
+    "TSV. Nothing is fetched from the network.",
 )
 @click.option(
     "--replace",
