@@ -37,7 +37,8 @@ from typing import TYPE_CHECKING, Any
 import pyoxigraph as ox
 
 from cbrs.actions.areas import AreaRule, Leads, WorldPlaces
-from cbrs.actions.decomposition_notes import decomposition_notes
+from cbrs.actions.decomposition_notes import UnfollowedOrdering, decomposition_notes, unfollowed_ordering
+from cbrs.actions.errors import OrderingConflictError
 from cbrs.actions.extraction import Extraction, Objective
 from cbrs.actions.graph import (
     SRE,
@@ -351,6 +352,18 @@ class Composer:
         result = self._decomposed(task, direct) if self._decomposable(task) else None
         if result is not None and result.plan is not None:
             return result
+        found = self._undecomposed(task, direct, holding)
+        if result is None:
+            return found
+        if found.plan is None:
+            return result
+        # planned otherwise than by its parts: say why, as for a decomposition written so it cannot be followed
+        why = "; ".join(u.text() for u in result.unsatisfied) or "no plan"
+        note = f"{shorten(task.name)} is not planned by its sub-actions, nor in their order: {why}"
+        return replace(found, notes=(*found.notes, note))
+
+    def _undecomposed(self, task: Task, direct: Attempt, holding: Sequence[Statement]) -> CompositionResult:
+        """``task`` planned otherwise than by its sub-actions: whole, goal by goal, or matched to one component."""
         if direct.plan is not None and not task.requirement.outputs and _shared_goals(direct.plan, self.index):
             return self._per_goal(task, direct)  # (outputs are no goal's: a task asking for one stays whole)
         if direct.plan is None and not task.requirement.outputs and self._holds_some(task.requirement, holding):
@@ -363,7 +376,7 @@ class Composer:
             plan = self._matched(task)
             if plan is not None:
                 return self._result(task, plan, (), (direct,))
-        return result or self._result(task, None, direct.unsatisfied, (direct,))
+        return self._result(task, None, direct.unsatisfied, (direct,))
 
     def _matched(self, task: Task) -> Plan | None:
         """The paper's own answer when no plan composes: one advertisement the matchmaker accepts for
@@ -532,7 +545,12 @@ class Composer:
         if not extraction.solved:
             return Attempt(requirement, graph, trace, None, tuple(extraction.unsatisfied))
         orderings = self._orderings(task)
-        plan = extraction.plan(task.name if task else requirement.iri, self.index, orderings)
+        try:
+            plan = extraction.plan(task.name if task else requirement.iri, self.index, orderings)
+        except OrderingConflictError as error:  # no plan, and why: as every other task that cannot be planned
+            assert task is not None and task.action is not None  # only a task's action class has orderings
+            ordering = unfollowed_ordering(error, task.action.iri, self.actions.orderings_for(task.action.iri))
+            return Attempt(requirement, graph, trace, None, (ordering,))
         return Attempt(requirement, graph, trace, plan, tuple(extraction.unsatisfied) if plan is None else ())
 
     def area_rule(self, requirement: Requirement) -> AreaRule | None:
@@ -836,6 +854,8 @@ class Composer:
         in the attempt that found it unmet: those that attempt's search enabled and its area rule admits."""
         u = unsatisfied
         if self.config.near_misses <= 0 or u.cycle or u.deleted_by or u.consumer in (SRI, GOAL):
+            return u
+        if isinstance(u, UnfollowedOrdering):  # every need was met: the order is what cannot be
             return u
         for attempt in attempts:
             if all((u.need, u.consumer) != (found.need, found.consumer) for found in attempt.unsatisfied):

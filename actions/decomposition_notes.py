@@ -12,10 +12,14 @@ round's cup before its saucer), and nothing said why. These notes say it, as ``c
 from __future__ import annotations
 
 from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import Any
 
 import networkx as nx
 
-from cbrs.actions.model import ActionClass, ActionLibrary
+from cbrs.actions.errors import OrderingConflictError
+from cbrs.actions.model import ActionClass, ActionLibrary, Ordering
+from cbrs.actions.unmet import Unsatisfied
 from cbrs.kb.namespaces import shorten
 from cbrs.kb.shapes import nearest_term
 
@@ -88,4 +92,53 @@ def _orderings(action: ActionClass) -> list[str]:
     return notes
 
 
-__all__ = ["decomposition_notes"]
+@dataclass(frozen=True)
+class UnfollowedOrdering(Unsatisfied):
+    """An ordering constraint no plan can follow, as a reason of no plan: the data flow needs ``after``'s
+    component before ``before``'s (a put-down ordered before the approach that finds what it puts down).
+    It ended ``cbrs plan`` with an error and status 1 (``OrderingConflictError``), where every other task
+    that cannot be planned is answered "no plan" with its reasons, in the text, the JSON and the plans page.
+    ``need``: the constraint; ``consumer``: the action class whose constraints the task follows;
+    ``before``, ``after``: the components the constraint orders, as the error named them; ``ordered``:
+    the action classes it orders, as its act:occursBefore and act:occursAfter say (none: not found)."""
+
+    before: str = ""
+    after: str = ""
+    ordered: tuple[str, str] | None = None
+
+    def _text(self) -> str:
+        classes = ""
+        if self.ordered is not None:
+            first, then = map(shorten, self.ordered)
+            classes = f" (act:occursBefore {first}, act:occursAfter {then})"
+        return (
+            f"the ordering constraint {shorten(self.need)} of {shorten(self.consumer)}{classes} puts"
+            f" {self.before} before {self.after}, but the plan needs the opposite order; {self.remedy()}"
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        found = super().to_dict()
+        ordered = None if self.ordered is None else {"before": self.ordered[0], "after": self.ordered[1]}
+        found["ordering"] = {"before": self.before, "after": self.after, "classes": ordered}
+        return found
+
+    def remedy(self) -> str:
+        return (
+            "correct the constraint (which sub-action comes first is its act:occursBefore), or remove it"
+            " (docs/composition.md, 'Decomposition')"
+        )
+
+
+def unfollowed_ordering(error: OrderingConflictError, action: str, orderings: Iterable[Ordering]) -> UnfollowedOrdering:
+    """``error`` as a reason of no plan for a task of ``action``, whose constraints (and its ancestors') are
+    ``orderings``; the error names the constraint shortened, so it is found again by that name."""
+    ordered = next(
+        ((o.before, o.after) for o in orderings if error.constraint in (o.constraint, shorten(o.constraint))), None
+    )
+    found = next(
+        (o.constraint for o in orderings if error.constraint in (o.constraint, shorten(o.constraint))), error.constraint
+    )
+    return UnfollowedOrdering(found, action, before=error.before, after=error.after, ordered=ordered)
+
+
+__all__ = ["UnfollowedOrdering", "decomposition_notes", "unfollowed_ordering"]

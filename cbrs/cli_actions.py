@@ -22,6 +22,7 @@ from cbrs.actions.breaker import late_answers_awaited, settle_late_answers
 from cbrs.actions.colour_warnings import run_colour_risks
 from cbrs.actions.components import Registry
 from cbrs.actions.composer import ComposeConfig, Composer, CompositionResult, Objective, PlanStatus, store_plan
+from cbrs.actions.decomposition_notes import UnfollowedOrdering
 from cbrs.actions.errors import UngroundedGoalError
 from cbrs.actions.events import Event
 from cbrs.actions.faults import RandomFaults, planned_faults
@@ -337,7 +338,8 @@ def plan_text(result: CompositionResult) -> str:
     """The plan as a table of steps with their sources, or the unsatisfied needs."""
     name = shorten(result.task)
     if result.plan is None:
-        lines = [f"{name}: no plan. What no component provides:"]
+        orders = all(isinstance(u, UnfollowedOrdering) for u in result.unsatisfied)  # a need is met, not the order
+        lines = [f"{name}: no plan. {'Why' if orders and result.unsatisfied else 'What no component provides'}:"]
         lines += [f"  - {u.text()}" for u in result.unsatisfied]
         lines += [f"note: {n}" for n in result.notes]  # the task's decomposition not followed
         return "\n".join(lines)
