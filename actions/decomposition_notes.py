@@ -6,7 +6,8 @@ of its ordering constraints, only when every sub-action is stated as a requireme
 sub-action naming no declared action class (a misspelt ``owl:someValuesFrom``), an ordering constraint that
 says nothing of what comes before what, or orders a class that is no sub-action of its own, or orders them in
 a cycle, were each passed over without a word: the plan came out in another order than written (the fifteenth
-round's cup before its saucer), and nothing said why. These notes say it, as ``cbrs plan`` prints them.
+round's cup before its saucer), and nothing said why. These notes say it, as ``cbrs plan`` prints them. An
+ordering constraint no plan can follow is a reason of no plan (:class:`UnfollowedOrdering`), not a note.
 """
 
 from __future__ import annotations
