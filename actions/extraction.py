@@ -340,7 +340,7 @@ class Extraction:
                 given = [e for e in given if not self._foreign(step, e)]
             taken = self._taken(step, need)
             if given:
-                chosen = min(given, key=partial(self._given_key, step, taken))
+                chosen = min(given, key=partial(self._given_key, step, need, taken))
                 step.bindings.append(_Bound(need, chosen, None))
                 return True
             mine = [(e, p) for p in step.producers for e in options if e.source == self.steps[p].node]
@@ -381,12 +381,32 @@ class Extraction:
         queue.append(producer.id)
         return True
 
-    def _given_key(self, step: _Step, taken: set[tuple[int | None, str]], edge: Edge) -> tuple[Any, ...]:
-        """The order of the values the task gives for a need of ``step``, best first: one not ``taken`` by
-        another input of the step of the same class (:meth:`_taken`), then :meth:`_fit`, then :meth:`_key`,
-        whose last part is the value's name: twin inputs, in the order the component declares them, take
-        the task's things of their class in the order of their names (``_TrainStation0`` the first)."""
-        return ((None, edge.offer.name) in taken, *self._fit(step, edge), *self._key(edge))
+    def _given_key(self, step: _Step, need: Need, taken: set[tuple[int | None, str]], edge: Edge) -> tuple[Any, ...]:
+        """The order of the values the task gives for ``need`` of ``step``, best first: one not ``taken`` by
+        another input of the step of the same class (:meth:`_taken`), then :meth:`_fit`, then one named as
+        the input (:meth:`_named`), then :meth:`_key`, whose last part is the value's name: twin inputs, in
+        the order the component declares them, take the task's things of their class in the order of their
+        names (``_TrainStation0`` the first)."""
+        return (
+            (None, edge.offer.name) in taken,
+            *self._fit(step, edge),
+            self._named(step, need, edge),
+            *self._key(edge),
+        )
+
+    def _named(self, step: _Step, need: Need, edge: Edge) -> int:
+        """For an input with twins (other inputs of the step of its class, :meth:`_twins`), how the name of a
+        value the task gives tells them apart: named as this input (0), as none of them (1), as another of
+        them (2), the case aside. A component's ``departure`` takes the task's ``departure``, and its
+        ``arrival`` the task's other station, where the order of the names gave ``arrival`` the departure.
+        Other inputs read no names (0): their class tells their values apart (docs/composition.md)."""
+        if need.role != "input" or step.node == GOAL:
+            return 0
+        twins = [other.name.casefold() for other in self.graph.needs(step.node) if self._twins(need, other)]
+        if not twins:
+            return 0
+        name = edge.offer.name.casefold()
+        return 0 if name == need.name.casefold() else 2 if name in twins else 1
 
     def _fit(self, step: _Step, edge: Edge) -> tuple[int, int]:
         """The order of the values the task gives for a need of ``step``: one whose class falls under the
@@ -508,7 +528,7 @@ class Extraction:
             if given and len(given) < len(options):
                 given = [e for e in given if not self._foreign(probe, e)]
             taken = self._taken(probe, need)
-            key = partial(self._given_key, probe, taken)
+            key = partial(self._given_key, probe, need, taken)
             chosen = min(given, key=key) if given else None
             if chosen is not None:
                 probe.bindings.append(_Bound(need, chosen, None))

@@ -42,6 +42,13 @@ t:FareViaThreeStations a cbrs:Requirement ;
         cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "c" ; cbrs:parameterType transit:TrainStation ] ;
         cbrs:hasOutput [ a cbrs:Parameter ; cbrs:parameterName "fare" ; cbrs:parameterType transit:Fare ] ] .
 
+t:TicketToTheCoast a cbrs:Requirement ;
+    cbrs:serviceName "TicketToTheCoast" ;
+    cbrs:hasOWLSModel [ a cbrs:OWLSModel ;
+        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "Departure" ; cbrs:parameterType transit:TrainStation ] ;
+        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "coast" ; cbrs:parameterType transit:TrainStation ] ;
+        cbrs:hasOutput [ a cbrs:Parameter ; cbrs:parameterName "ticket" ; cbrs:parameterType t:Ticket ] ] .
+
 t:FareOfMyJourney a cbrs:Requirement ;
     cbrs:serviceName "FareOfMyJourney" ;
     cbrs:hasOWLSModel [ a cbrs:OWLSModel ;
@@ -51,8 +58,19 @@ t:FareOfMyJourney a cbrs:Requirement ;
 
 ENDS = """
 @prefix cbrs: <https://w3id.org/cbrs/core#> .
+@prefix owl: <http://www.w3.org/2002/07/owl#> .
 @prefix transit: <http://127.0.0.1/ontology/lab13_transit.owl#> .
 @prefix t: <https://example.org/distinct#> .
+
+t:Ticket a owl:Class .
+
+t:Tickets_Booking01 a cbrs:MethodInvocationComponent ;
+    cbrs:deviceName "Booking01" ;
+    cbrs:serviceName "Tickets" ;
+    cbrs:hasOWLSModel [ a cbrs:OWLSModel ;
+        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "arrival" ; cbrs:parameterType transit:TrainStation ] ;
+        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "departure" ; cbrs:parameterType transit:TrainStation ] ;
+        cbrs:hasOutput [ a cbrs:Parameter ; cbrs:parameterName "ticket" ; cbrs:parameterType t:Ticket ] ] .
 
 t:JourneyEnds_Booking01 a cbrs:MethodInvocationComponent ;
     cbrs:deviceName "Booking01" ;
@@ -116,3 +134,14 @@ def test_a_third_station_left_aside_is_said_to_be_passed_over_for_the_other_two(
     note = _unused_note(result.unused_inputs, result)
     assert "no step takes the task's input c (" in note
     assert "was given a, b, the task's other inputs of the class" in note
+
+
+def test_twin_inputs_take_the_values_named_as_they_are(kb: KnowledgeBase) -> None:
+    """A component's twin inputs ``arrival`` and ``departure`` and a task's ``Departure`` and ``coast``: in the
+    order of the names, ``arrival`` took the departure and ``departure`` the coast. The value named as an input
+    (the case aside) goes to it, and the one named as neither to the other."""
+    result = Composer(kb).compose("https://example.org/distinct#TicketToTheCoast")
+    assert result.plan is not None
+    (step,) = [s for s in result.plan.steps if s.component.endswith("Tickets_Booking01")]
+    found = {b.name: (b.source.step, b.source.name) for b in step.bindings if b.role == "input"}
+    assert found == {"departure": (None, "Departure"), "arrival": (None, "coast")}
