@@ -28,7 +28,7 @@ by composing that part once more without it, or the plan is refused naming it.
 from __future__ import annotations
 
 import re
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from enum import Enum
 from functools import partial
@@ -51,7 +51,7 @@ from cbrs.actions.graph import (
     statement_text,
 )
 from cbrs.actions.model import ActionLibrary, Task, resolve_task
-from cbrs.actions.named_things import Designations, NamedThings, WorldFact
+from cbrs.actions.named_things import AchievedGoal, Designations, NamedThings, WorldFact
 from cbrs.actions.near_misses import NearMiss, near_misses
 from cbrs.actions.plan import Binding, Plan, PlanStep, Source
 from cbrs.actions.progression import Clobbered, consumed_goals, progress_parts
@@ -236,14 +236,18 @@ class Composer:
         self,
         requirement: Requirement,
         undone: frozenset[Statement] = frozenset(),
-        before: tuple[Statement, ...] = (),
+        before: tuple[AchievedGoal, ...] = (),
     ) -> ServiceResourceGraph:
         """The SRG for ``requirement``, from what holds but for the facts that meet a statement of ``undone``
         (an earlier part of the plan deleted them: see :meth:`_joined`), and with ``before``, the goals an
-        earlier part of the plan achieves (the sub-actions before it: :meth:`_decomposed`)."""
+        earlier part of the plan achieves (the sub-actions before it: :meth:`_decomposed`), each offered to
+        the statements about the things it is about, as a world fact is."""
         holding = self._holding(undone) if self.config.world_state else []
-        holding += [s for s in before if s not in holding and not self._meets(s, undone)]
-        admits = partial(self._admits, requirement)
+        achieved: dict[Statement, list[AchievedGoal]] = {}
+        for goal in before:
+            achieved.setdefault(goal.statement, []).append(goal)
+        holding += [s for s in achieved if s not in holding and not self._meets(s, undone)]
+        admits = partial(self._admits, requirement, achieved=achieved)
         return ServiceResourceGraph(self._without(requirement, undone), self.pool, holding, admits)
 
     def _holding(self, undone: frozenset[Statement] = frozenset()) -> list[Statement]:
@@ -300,12 +304,24 @@ class Composer:
             self._named[key] = self._designations.named(requirement)
         return self._named[key]
 
-    def _admits(self, requirement: Requirement, wanted: Statement, held: Statement) -> bool:
-        """Whether ``held``, a statement the world offers that meets ``wanted`` by its classes, is about the
-        thing ``wanted`` concerns in ``requirement`` (:class:`NamedThings`); one no fact of the world is
-        behind (a subclass's assumption) meets it as its classes do."""
-        facts = self._lifted.get(held)
-        return not facts or self.named(requirement).admits(wanted, facts)
+    def _admits(
+        self,
+        requirement: Requirement,
+        wanted: Statement,
+        held: Statement,
+        achieved: Mapping[Statement, list[AchievedGoal]] | None = None,
+    ) -> bool:
+        """Whether ``held``, a statement the world offers or an earlier part achieves (``achieved``) that meets
+        ``wanted`` by its classes, is about the thing ``wanted`` concerns in ``requirement``
+        (:class:`NamedThings`); one neither a fact of the world nor a part is behind (a subclass's
+        assumption) meets it as its classes do."""
+        facts, goals = self._lifted.get(held), (achieved or {}).get(held)
+        if not facts and not goals:
+            return True
+        named = self.named(requirement)
+        if facts and named.admits(wanted, facts):
+            return True
+        return any(named.meets_achieved(wanted, goal) for goal in goals or ())
 
     def compose(self, task: str | Task | Requirement, belief: bool = False) -> CompositionResult:
         """Plan ``task``; with ``belief``, from what the belief graph says holds now as well."""
@@ -530,7 +546,7 @@ class Composer:
         requirement: Requirement,
         task: Task | None = None,
         undone: frozenset[Statement] = frozenset(),
-        before: tuple[Statement, ...] = (),
+        before: tuple[AchievedGoal, ...] = (),
     ) -> Attempt:
         """Compose ``requirement`` in one extraction; ``undone``: statements that do not hold when it starts,
         although the world or the requirement says so (an earlier part of the plan deleted them); ``before``:
@@ -601,7 +617,7 @@ class Composer:
         direct: Attempt,
         depth: int = 0,
         undone: frozenset[Statement] = frozenset(),
-        before: tuple[Statement, ...] = (),
+        before: tuple[AchievedGoal, ...] = (),
     ) -> CompositionResult:
         """Compose each sub-action on its own, in order, and join the plans (:meth:`_joined`), each from what
         holds with the goals of the sub-actions before it. A sub-action that is a task with sub-actions of its
@@ -611,7 +627,7 @@ class Composer:
         attempts = [direct]
         parts: list[_Part] = []
         holding = self._holding(undone) if self.config.world_state else []
-        achieved: tuple[Statement, ...] = before  # the goals of the sub-actions before this one
+        achieved: tuple[AchievedGoal, ...] = before  # the goals of the sub-actions before this one
         for sub in task.action.ordered_sub_actions():
             sub_task = resolve_task(self.kb, self.actions, sub, self.requirements)
             if self._achieved(sub_task.requirement, holding):
@@ -633,13 +649,19 @@ class Composer:
                 )
                 return self._result(task, None, unsatisfied, tuple(attempts))
             parts.append(_Part(f"sub-action {shorten(sub)}", compose, plan, undone))
-            achieved += tuple(g for g in sub_task.requirement.effects if g not in achieved)
+            # each about the things the part names: the cup it keeps in a hand is not the pen a later part sets
+            # down (a goal about no thing met every statement of its classes: the pen's put-down took the cup)
+            named = self.named(sub_task.requirement)
+            goals = (
+                AchievedGoal(g, named.bound(g.subject), named.bound(g.object)) for g in sub_task.requirement.effects
+            )
+            achieved += tuple(goal for goal in goals if goal not in achieved)
         if not parts:  # every part is achieved: nothing to do but check
             return self._result(task, _achieved_plan(task), (), tuple(attempts))
         return self._joined(task, parts, attempts, holding)
 
     def _sub_action(
-        self, sub_task: Task, depth: int, undone: frozenset[Statement], before: tuple[Statement, ...] = ()
+        self, sub_task: Task, depth: int, undone: frozenset[Statement], before: tuple[AchievedGoal, ...] = ()
     ) -> _Composed:
         """One sub-action's plan, from what holds with ``before`` (the goals of the parts before it): part by
         part when it is split into sub-actions each stated as a requirement, as a task is (:meth:`_compose`: a

@@ -34,7 +34,7 @@ from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.semantic_map import designate
 from cbrs.reasoner.taxonomy import TaxonomyIndex
 
-__all__ = ["Designations", "NamedThings", "WorldFact"]
+__all__ = ["AchievedGoal", "Designations", "NamedThings", "WorldFact"]
 
 
 @dataclass(frozen=True)
@@ -45,6 +45,16 @@ class WorldFact:
     statement: Statement
     subject: str
     object: str
+
+
+@dataclass(frozen=True)
+class AchievedGoal:
+    """A goal an earlier part of the plan achieves (a sub-action before), about the things that part's
+    requirement names on each side of it (:meth:`NamedThings.bound`; none: a side about no named thing)."""
+
+    statement: Statement
+    subjects: frozenset[str]
+    objects: frozenset[str]
 
 
 @dataclass
@@ -73,6 +83,15 @@ class NamedThings:
         return all(
             not (bound := self.bound(side)) or thing in bound
             for thing, side in ((fact.subject, wanted.subject), (fact.object, wanted.object))
+        )
+
+    def meets_achieved(self, wanted: Statement, goal: AchievedGoal) -> bool:
+        """Whether ``goal``, achieved by an earlier part, is about the things ``wanted`` concerns here: on each
+        side where both name things, they share one (the cup the part before keeps in a hand is not the pen
+        this part sets down)."""
+        return all(
+            not (bound := self.bound(side)) or not things or bool(bound & things)
+            for things, side in ((goal.subjects, wanted.subject), (goal.objects, wanted.object))
         )
 
     def admits(self, wanted: Statement, facts: Iterable[WorldFact]) -> bool:
