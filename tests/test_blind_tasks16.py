@@ -5,7 +5,10 @@ by a semantic-web engineer"). Each test failed before its fix."""
 
 from __future__ import annotations
 
+import os
 import shutil
+import subprocess
+import sys
 from collections.abc import Iterator
 from pathlib import Path
 
@@ -20,6 +23,7 @@ from cbrs.kb.catalog import Catalogue
 from cbrs.kb.derived_prefixes import derive, namespaces_in
 from cbrs.kb.errors import RdfParseError
 from cbrs.kb.owl_syntaxes import NotRdfSyntaxError, owl_syntax
+from cbrs.server import ServeConfig, Server
 from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.web import create_app
 
@@ -175,3 +179,36 @@ def test_every_graph_store_answer_carries_the_endpoints_headers(client: FlaskCli
     for answer in answers:
         assert answer.headers["Cbrs-Server"] == endpoint.headers["Cbrs-Server"]
         assert set(answer.headers["Vary"].replace(" ", "").split(",")) == {"Accept", "Origin"}
+
+
+# -- the round's program, as docs/examples/lab16_endpoint.py's docstring runs it -----------------------------
+
+
+def test_the_rounds_rdflib_and_protocol_program_runs_against_a_served_store() -> None:
+    """The program the round's write-up quotes, run against ``cbrs serve`` on loopback (the kit loaded into a
+    store of its own: the program writes): every trial answers as written there, and the program ends well."""
+    program = LAB.parent / "lab16_endpoint.py"
+    kb = KnowledgeBase.open(":memory:")
+    kb.load([LAB / "kit.ttl"], catalogue=Catalogue.open(LAB))
+    server = Server(kb, ServeConfig(port=0, bridge_port=0, endpoint=EndpointConfig(update_token=TOKEN, isolate=False)))
+    server.start()
+    try:
+        ran = subprocess.run(
+            [sys.executable, str(program), f"http://127.0.0.1:{server.http_port}"],
+            env={**os.environ, "CBRS_UPDATE_TOKEN": TOKEN},
+            capture_output=True,
+            text=True,
+            timeout=120,
+            check=False,
+        )
+    finally:
+        server.stop(timeout=10)
+        kb.close()
+    assert ran.returncode == 0, ran.stderr
+    lines = ran.stdout.splitlines()
+    assert any(line.startswith("SPARQLUpdateStore set: ") and "'300'" in line for line in lines), ran.stdout
+    for expected in ("PUT 201", "POST 204", "DELETE 204"):
+        assert expected in lines, ran.stdout
+    assert any(line.startswith("PUT OWL/XML 415 ") for line in lines), ran.stdout
+    again = next(line for line in lines if line.startswith("DELETE again "))
+    assert again.startswith("DELETE again 404 True Accept, Origin "), again
