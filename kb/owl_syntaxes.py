@@ -24,12 +24,11 @@ MEDIA_TYPES = {
 }
 """The media types OWL 2 registers for its syntaxes that are not RDF (OWL 2 Overview, section 2.1)."""
 
-# The first element of an OWL/XML document: <Ontology xmlns="...owl#"> or <owl:Ontology ...> as the root.
-_OWL_XML_ROOT = re.compile(
-    rb"^(?:\s|<\?[^>]*\?>|<!--.*?-->|<!DOCTYPE[^\[>]*(?:\[.*?\])?\s*>)*<(?:[\w.-]+:)?Ontology\b[^>]*"
-    rb"xmlns(?::[\w.-]+)?\s*=\s*[\"']http://www\.w3\.org/2002/07/owl#[\"']",
-    re.DOTALL,
-)
+# An OWL/XML document's root element: <Ontology xmlns="...owl#"> (or a prefixed Ontology declaring the OWL
+# namespace). Asked of the root's start tag alone (:func:`_root_tag`): one expression over the prolog too, its
+# comments and DOCTYPE each optional inside a repetition, backtracked for minutes on an OWL-S file's entities.
+_ONTOLOGY_TAG = re.compile(rb"<(?:[\w.-]+:)?Ontology[\s/>]")
+_OWL_NAMESPACE = re.compile(rb"xmlns(?::[\w.-]+)?\s*=\s*[\"']http://www\.w3\.org/2002/07/owl#[\"']")
 # Functional syntax opens with Prefix(...) or Ontology(, Manchester syntax with "Prefix: p: <IRI>" or
 # "Ontology:", after comments and blank lines. Turtle's "Prefix : <IRI>" (SPARQL style, the empty prefix) has
 # a space before its colon and no second one, so it is neither.
@@ -59,13 +58,42 @@ def owl_syntax(data: bytes) -> str | None:
     extension, or ``None`` for anything else (RDF, or text no syntax claims: the RDF parsers then say what is
     wrong with it)."""
     head = data[:65536]
-    if _OWL_XML_ROOT.match(head):
+    root = _root_tag(head)
+    if root is not None and _ONTOLOGY_TAG.match(root) and _OWL_NAMESPACE.search(root):
         return "OWL/XML"
     if _FUNCTIONAL.match(head):
         return "OWL functional syntax"
     if _MANCHESTER.match(head):
         return "Manchester syntax"
     return None
+
+
+def _root_tag(head: bytes) -> bytes | None:
+    """The start tag of the XML root element in ``head``, past the prolog (a byte order mark, white space,
+    processing instructions, comments, a DOCTYPE with its internal subset), in one pass; ``None`` when
+    ``head`` does not open as XML does, or ends first."""
+    at = 3 if head.startswith(b"\xef\xbb\xbf") else 0
+    while True:
+        while at < len(head) and head[at] in b" \t\r\n":
+            at += 1
+        if head.startswith(b"<?", at):
+            end = head.find(b"?>", at + 2)
+            at = -1 if end < 0 else end + 2
+        elif head.startswith(b"<!--", at):
+            end = head.find(b"-->", at + 4)
+            at = -1 if end < 0 else end + 3
+        elif head.startswith(b"<!DOCTYPE", at):
+            close, subset = head.find(b">", at), head.find(b"[", at)
+            if 0 <= subset < close:  # the internal subset's declarations hold '>' of their own
+                close = head.find(b">", max(head.find(b"]", subset), subset))
+            at = -1 if close < 0 else close + 1
+        elif head.startswith(b"<", at):
+            end = head.find(b">", at)
+            return head[at : end + 1] if end >= 0 else None
+        else:
+            return None
+        if at < 0:
+            return None
 
 
 def check_rdf(data: bytes, source: str) -> None:

@@ -81,6 +81,34 @@ def test_the_syntaxes_are_told_by_content_and_turtle_is_none_of_them() -> None:
     assert owl_syntax(b'<?xml version="1.0"?>\n<Ontology xmlns="urn:other#"/>') is None
 
 
+OWLS_PROLOG = b"""<?xml version='1.0' encoding='ISO-8859-1'?>
+<!DOCTYPE uridef [
+  <!ENTITY rdf "http://www.w3.org/1999/02/22-rdf-syntax-ns">
+  <!ENTITY owl "http://www.w3.org/2002/07/owl">
+]>
+<!-- entity types as a shorthand for URIs -->
+<!-- a second comment -->
+"""
+
+
+@pytest.mark.parametrize(
+    ("root", "syntax"),
+    [
+        (b'<rdf:RDF xmlns:rdf="&rdf;#" xmlns:owl="http://www.w3.org/2002/07/owl#">', None),
+        (b'<Ontology xmlns="http://www.w3.org/2002/07/owl#" ontologyIRI="http://x/">', "OWL/XML"),
+        (b"<owl:Ontology xmlns:owl='http://www.w3.org/2002/07/owl#'>", "OWL/XML"),
+        (b'<Ontology xmlns="urn:other#">', None),
+        (b'<rdf:RDF xmlns:rdf="&rdf;#"><owl:Ontology xmlns:owl="http://www.w3.org/2002/07/owl#"/>', None),
+    ],
+)
+def test_the_root_element_is_read_past_an_owl_s_prolog(root: bytes, syntax: str | None) -> None:
+    """An OWL-S file's prolog (a DOCTYPE of entities, comments) before its root: the root alone decides.
+    The first reader, one regular expression over prolog and root, backtracked for minutes on each of
+    OWLS-TC's files whose root was not an Ontology, and CI's load of OWLS-TC with it did not end."""
+    assert owl_syntax(b"\xef\xbb\xbf" + OWLS_PROLOG + root + b"\n</x>") == syntax
+    assert owl_syntax(OWLS_PROLOG + b"<!-- unclosed comment") is None
+
+
 def test_the_cli_refuses_owl_xml_in_one_line() -> None:
     result = CliRunner().invoke(cli, ["--store", ":memory:", "load", str(LAB / "kit.owx")])
     assert result.exit_code == 1
