@@ -270,8 +270,11 @@ class Kinematics:
 
     def _hand_reach(self) -> float:
         """:attr:`hand_reach`: the farthest corner of the hand links' bounding boxes from the grasp point, the
-        arm at its zero posture and its fingers open as wide as their joints let them."""
-        body = next(iter(self._bodies.values()))
+        arm at its zero posture and its fingers open as wide as their joints let them; 0 for a robot with no
+        arm (its copies have no body to ask, and no hand comes near a fixture)."""
+        body = next(iter(self._bodies.values()), None)
+        if body is None:
+            return 0.0
         self._set(body, [0.0] * len(ARM_JOINTS))
         for joint in FINGER_JOINTS:
             p.resetJointState(
