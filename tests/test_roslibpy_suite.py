@@ -141,9 +141,13 @@ def test_roslibpys_own_integration_tests_pass_against_cbrs(server: Server) -> No
     tests = [*sorted(folder.glob("ros1/test_*.py")), *sorted(folder.glob("ros2/test_*.py")), *folder.glob("test_*.py")]
     files = [str(path) for path in tests if path.name not in LEFT_OUT]
     deselect = " and ".join(f"not {name}" for name in LEFT_OUT if not name.endswith(".py"))
-    command = [sys.executable, "-m", "pytest", "-q", "-rA", "-p", "no:cacheprovider", "-k", deselect, *files]
+    command = [sys.executable, "-m", "pytest", "-v", "-rA", "-p", "no:cacheprovider", "-k", deselect, *files]
     environment = {**os.environ, "ROSLIBPY_TRANSPORT": "twisted"}
-    child = subprocess.run(command, cwd=folder.parent, capture_output=True, text=True, timeout=300, env=environment)
+    try:
+        child = subprocess.run(command, cwd=folder.parent, capture_output=True, text=True, timeout=300, env=environment)
+    except subprocess.TimeoutExpired as late:  # say which of roslibpy's tests it was in (22 s when all is well)
+        shown = late.stdout.decode(errors="replace") if isinstance(late.stdout, bytes) else late.stdout or ""
+        pytest.fail(f"roslibpy's tests did not end within 300 s; the last they printed: {shown[-3000:]}")
     summary = child.stdout.strip().splitlines()[-1] if child.stdout.strip() else child.stderr
     assert child.returncode == 0, child.stdout[-3000:] + child.stderr[-2000:]
     passed = re.search(r"(\d+) passed", summary)
