@@ -4,10 +4,13 @@ A run composes the task, executes it in a fresh headless world and records its e
 rosbridge topics, the browser) receive every event as it happens, from the run's thread. A task no plan
 can come of ends ``no-plan`` before the world is built (:func:`refusal_in_home`, as ``cbrs run`` refuses it).
 
-The runner also keeps the ceiling camera's latest view (a JPEG and a counter): taken when a run starts
-and after every step that ends, or of the idle home when nothing has run yet. Frame listeners
-(:meth:`TaskRunner.on_frame`) hear of each new frame; :meth:`TaskRunner.wait_frame` blocks (bounded)
-until one comes, for the browser's MJPEG stream.
+The runner also keeps the ceiling camera's latest view (a JPEG and a counter). A run renders it only
+while someone watches (:meth:`TaskRunner.watch`: the browser's MJPEG stream, a still asked for): when the
+run starts, after every step that ends, and within ``FRAME_CHECK_STEPS`` physics steps of a watcher
+joining mid-run; and once as the run leaves the home, for whoever looks later. A headless served run
+renders nothing else for the picture. Before any run the idle home is rendered once, when first asked.
+Frame listeners (:meth:`TaskRunner.on_frame`) hear of each new frame; :meth:`TaskRunner.wait_frame`
+blocks (bounded) until one comes.
 """
 
 from __future__ import annotations
@@ -53,6 +56,8 @@ TASK_TOPICS = ("/cbrs/task", "/cbrs/task_progress")
 
 CAMERA = "CeilingCamera01"  # the view the browser shows (in the bundled home it covers both scenarios' rooms; _view)
 JPEG_QUALITY = 80
+#: How often (in physics steps, 1/240 s each) a run looks whether a watcher who joined wants a frame now.
+FRAME_CHECK_STEPS = 12
 
 
 @dataclass(frozen=True)
@@ -216,6 +221,8 @@ class TaskRunner:
         self._frame_ready = threading.Condition()
         self._frame_listeners: list[Callable[[CameraFrame], None]] = []
         self._idle_render = threading.Lock()
+        self._watchers = 0  # open camera streams and stills being taken (watch)
+        self._frame_wanted = threading.Event()  # a watcher joined mid-run: the run renders at its next check
         self._runs: OrderedDict[str, TaskRun] = OrderedDict()
         self._listeners: list[Listener] = []
         self._guard = threading.Lock()
@@ -244,6 +251,41 @@ class TaskRunner:
                     self._frame_listeners.remove(listener)
 
         return unsubscribe
+
+    def watch(self) -> Callable[[], None]:
+        """Count a watcher of the camera until the returned call (idempotent): a run renders frames only
+        while one watches. One joining mid-run asks the run for a frame now, which it renders within
+        ``FRAME_CHECK_STEPS`` physics steps (:meth:`wait_frame` hears of it)."""
+        with self._guard:
+            self._watchers += 1
+        if self.active() is not None:
+            self._frame_wanted.set()
+        released = threading.Event()
+
+        def release() -> None:
+            if not released.is_set():
+                released.set()
+                with self._guard:
+                    self._watchers -= 1
+
+        return release
+
+    @property
+    def watched(self) -> bool:
+        """Whether someone watches the camera now (:meth:`watch`)."""
+        return self._watchers > 0
+
+    def current_frame(self, timeout: float) -> CameraFrame | None:
+        """The camera's view now: while a run goes, a frame it renders for this call (waiting at most
+        ``timeout`` seconds, else the latest); otherwise the latest frame, as :meth:`frame`."""
+        release = self.watch()
+        try:
+            latest = self.frame()
+            if self.active() is None:
+                return latest
+            return self.wait_frame(latest.number if latest is not None else 0, timeout) or self._frame
+        finally:
+            release()
 
     def frame(self) -> CameraFrame | None:
         """The latest camera frame; before any run, the idle home is rendered once (about half a second).
@@ -461,10 +503,16 @@ class TaskRunner:
             run.events.append({"topic": event.topic, **message})
             self._emit(event.topic, message)
             if event.topic == "/cbrs/task_progress" and message.get("event") in ("step_succeeded", "step_failed"):
-                self._capture(world, run.id)
+                self._capture_watched(world, run.id)
 
+        def wanted() -> None:  # a watcher joined mid-run: a frame now, not after the step under way
+            if self._frame_wanted.is_set():
+                self._capture_watched(world, run.id)
+
+        self._frame_wanted.clear()
         with open_world(seed=run.seed, semantic_map=semantic_map) as world, self._sensing(world):
-            self._capture(world, run.id)
+            self._capture_watched(world, run.id)
+            stop_checking = world.on_steps(FRAME_CHECK_STEPS, wanted) if self.camera is not None else None
             environment = SimEnvironment(world, self.kb, transport)
             policy = RandomFaults(run.seed, run.fault_rate) if run.fault_rate > 0 else None
             result = run_task(
@@ -479,6 +527,9 @@ class TaskRunner:
                 replan_policy=ReplanPolicy(max_repeats=run.repeat_failures),
                 base_ties=BaseTies(run.base_ties),
             )
+            if stop_checking is not None:
+                stop_checking()
+            self._capture(world, run.id)  # the home as the run leaves it, for whoever looks later
             found = result.to_dict()
             found["sim_seconds"] = round(world.time, 3)
             # what it perceived and looked for, painted where the cameras may not tell it (docs/simulation.md)
@@ -489,6 +540,12 @@ class TaskRunner:
     def _sensing(self, world: Any) -> AbstractContextManager[Any]:
         """The simulation's sensors answering from ``world`` for the run (none offered: nothing to do)."""
         return self.sensors.watching(world) if self.sensors is not None else nullcontext()
+
+    def _capture_watched(self, world: Any, run_id: str) -> None:
+        """:meth:`_capture` while someone watches (a headless run renders nothing for the picture)."""
+        self._frame_wanted.clear()
+        if self.watched:
+            self._capture(world, run_id)
 
     def _capture(self, world: Any, run_id: str | None) -> None:
         """Take the camera's view of ``world`` as the latest frame (a camera failure only costs the frame)."""

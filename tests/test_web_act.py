@@ -180,6 +180,15 @@ def test_a_started_run_succeeds_and_a_second_is_refused_while_it_goes(live: tupl
     assert busy.status_code == 409 and busy.get_json()["running"] == run_id
     assert "one task runs at a time" in busy.get_json()["message"]
     assert "one task runs at a time" in client.post("/tasks", data={"task": "FetchMyPen"}).text
+    # nobody watches the camera: the run renders no frame until a still is asked for, which it renders at once
+    deadline = time.monotonic() + RUN_WAIT
+    while not any(e.get("event") == "step_started" for e in runner.get(run_id).events) and time.monotonic() < deadline:
+        time.sleep(0.05)
+    assert runner.frame_number == frames_before
+    still = client.get("/camera.jpg")
+    assert runner.get(run_id).finished is None  # it came mid-run, not with the run's last frame
+    assert still.status_code == 200 and int(still.headers["X-Frame"]) == frames_before + 1
+    assert runner.frame() is not None and runner.frame().run == run_id and not runner.watched
     wait_done(runner, run_id)
     run = client.get(f"/tasks/{run_id}.json").get_json()["run"]
     assert run["status"] == "succeeded" and run["faults"] == [expand(CAMERA)]
@@ -198,7 +207,7 @@ def test_a_started_run_succeeds_and_a_second_is_refused_while_it_goes(live: tupl
     assert len(run["steps"]) == len(run["result"]["plan"]["steps"])
     listing = client.get("/tasks.json").get_json()
     assert listing["runs"][0]["id"] == run_id and listing["runs"][0]["url"] == f"/tasks/{run_id}"
-    assert listing["camera"]["frame"] > frames_before + len(run["steps"]) // 2
+    assert listing["camera"]["frame"] == frames_before + 2  # the still and the home as the run left it
     page = client.get(f"/tasks/{run_id}").text
     assert "failover" in page and "status-succeeded" in page
 
@@ -346,6 +355,7 @@ def test_the_event_and_camera_streams_follow_one_run_and_end_by_themselves(live:
     assert not reader.is_alive(), "the camera stream did not end by itself"
     camera.close()
     assert not runner._listeners[1:] and not runner._frame_listeners  # both unsubscribed (the event log stays)
+    assert not runner.watched  # the camera stream's watch ended with it
     assert max(seen) > 2 and seen == sorted(seen)
     still, latest = client.get("/camera.jpg"), runner.frame()
     assert latest is not None and still.mimetype == "image/jpeg"

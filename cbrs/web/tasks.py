@@ -33,6 +33,7 @@ from cbrs.tasks import (
     RunOptionError,
     TaskBusyError,
     TaskRun,
+    TaskRunner,
     TasksDisabledError,
     UnknownComponentError,
     preconditions_line,
@@ -49,6 +50,7 @@ DEFAULTS = {
     "CBRS_STREAM_IDLE_SECONDS": 120.0,  # a stream with no event (no new frame) this long ends
     "CBRS_HEARTBEAT_SECONDS": 5.0,  # an SSE comment this often, so a gone client is noticed
     "CBRS_CAMERA_REPEAT_SECONDS": 2.0,  # the last frame again this often, so the browser keeps showing it
+    "CBRS_FIRST_FRAME_SECONDS": 3.0,  # the longest a camera watcher joining mid-run waits for the run's frame
     "CBRS_LIVE_PREFIXES": 50,  # at most this many derived prefixes go to tasks.js (the components' namespaces)
 }
 SLICE = 0.5  # seconds a stream waits at most before it looks whether the server is closing
@@ -563,12 +565,12 @@ T = TypeVar("T")
 
 
 class _Held(Generic[T]):
-    """A response body that gives its stream slot back when the server closes it, started or not
-    (a generator closed before it starts runs no ``finally``)."""
+    """A response body that gives its stream slot back (and whatever else it holds: a camera watcher) when
+    the server closes it, started or not (a generator closed before it starts runs no ``finally``)."""
 
-    def __init__(self, body: Iterator[T], release: Callable[[], None]) -> None:
+    def __init__(self, body: Iterator[T], *releases: Callable[[], None]) -> None:
         self._body = body
-        self._release = release
+        self._releases = releases
 
     def __iter__(self) -> Iterator[T]:
         return self._body
@@ -579,11 +581,13 @@ class _Held(Generic[T]):
             if close is not None:
                 close()
         finally:
-            self._release()
+            for release in self._releases:
+                release()
 
 
-def _held(body: Iterator[T]) -> Iterable[T]:
-    return _Held(body, context.streams().take(request.remote_addr or "unknown"))
+def _held(body: Iterator[T], *also: Callable[[], None]) -> Iterable[T]:
+    """``body`` holding a stream slot of the client's, and ``also`` released with it."""
+    return _Held(body, context.streams().take(request.remote_addr or "unknown"), *also)
 
 
 @blueprint.get("/tasks/events")
@@ -649,13 +653,13 @@ def events() -> Response:
 
 @blueprint.get("/camera.mjpg")
 def camera() -> Response:
-    """The ceiling camera as ``multipart/x-mixed-replace``: the frame now, each new one, the last again every ~2 s."""
+    """The ceiling camera as ``multipart/x-mixed-replace``: the frame now, each new one, the last again every ~2 s.
+
+    The stream is a watcher of the camera (``TaskRunner.watch``): a run renders frames only while one is open,
+    and one opened mid-run starts with a frame the run renders for it."""
     runner = context.tasks()
     life, idle, closing = _stream_bounds()
     repeat = float(current_app.config["CBRS_CAMERA_REPEAT_SECONDS"])
-    first = runner.frame()
-    if first is None:
-        raise ServiceUnavailable("this server takes no camera frames")
 
     def stream(frame: CameraFrame) -> Iterator[bytes]:
         started = last = sent = time.monotonic()
@@ -675,19 +679,40 @@ def camera() -> Response:
             sent = time.monotonic()
             yield _part(frame)
 
+    release = runner.watch()
+    try:
+        first = _current_frame(runner)
+        if first is None:
+            raise ServiceUnavailable(_NO_FRAME)
+        body = _held(stream(first), release)
+    except BaseException:
+        release()
+        raise
     mimetype = f"multipart/x-mixed-replace; boundary={BOUNDARY}"
-    return Response(_held(stream(first)), headers={**_no_buffering(), "Content-Type": mimetype})
+    return Response(body, headers={**_no_buffering(), "Content-Type": mimetype})
 
 
 @blueprint.get("/camera.jpg")
 def snapshot() -> Response:
-    """The ceiling camera's latest frame, once (its number in ``X-Frame``)."""
-    frame = context.tasks().frame()
+    """The ceiling camera's view now, once (its number in ``X-Frame``): mid-run, one the run renders for it."""
+    frame = _current_frame(context.tasks())
     if frame is None:
-        raise NotFound("this server takes no camera frames")
+        raise NotFound(_NO_FRAME)
     return Response(
         frame.jpeg, mimetype="image/jpeg", headers={"Cache-Control": "no-store", "X-Frame": str(frame.number)}
     )
+
+
+_NO_FRAME = "this server takes no camera frames"
+
+
+def _current_frame(runner: TaskRunner) -> CameraFrame | None:
+    """The frame a watcher starts with (``TaskRunner.current_frame``, waiting ``CBRS_FIRST_FRAME_SECONDS`` at
+    most for a run to render it); None when there is none (no camera, no simulation, a run that rendered none
+    in time)."""
+    if runner.camera is None:
+        return None
+    return runner.current_frame(float(current_app.config["CBRS_FIRST_FRAME_SECONDS"]))
 
 
 def _stream_bounds() -> tuple[float, float, threading.Event]:
