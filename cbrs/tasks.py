@@ -29,6 +29,7 @@ from enum import Enum
 from typing import TYPE_CHECKING, Any
 
 from cbrs.extras import installed, require
+from cbrs.iri_tail import tail
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.derived_prefixes import StoreNames
 from cbrs.kb.errors import KnowledgeBaseError
@@ -168,12 +169,17 @@ class TaskRun:
         return found
 
 
-def shown_name(listed: str, iri: str) -> str:
-    """A task as the pages, a run's events and its record name it: one asked for by its bare name (what
-    ``cbrs run`` takes) or its IRI, of a namespace no prefix of cbrs's covers, by the prefix derived for its
-    namespace (``lab10:SwitchOnTheReadingLamp``), since the bare name says not whose it is; else as it was
-    asked for (``FetchMyPen``, ``act:FetchMyPen``). Within :func:`store_names`, which gives the derived
-    prefixes (the same table the pages use)."""
+def shown_name(listed: str, iri: str, shortened: Callable[[str], str] | None = None) -> str:
+    """A task as the pages, a run's events and its record name it (the one rule all of them use): one asked
+    for by a prefixed name as written (``act:FetchMyPen``, ``lab10:SwitchOnTheReadingLamp``); one of cbrs's
+    own namespaces by its bare name as written (``FetchMyPen``, what ``cbrs run`` takes), by its IRI with its
+    prefix (``req:FetchMyPen``); a lab's, asked for by its bare name or its IRI, by the prefix derived for
+    its namespace (``lab10:SwitchOnTheReadingLamp``), since the bare name says not whose it is; and by an IRI
+    that no prefix covers, its tail (``lab.ttl#Fetch(Pen)``, :func:`cbrs.iri_tail.tail`), as every page shows
+    such an IRI: the whole IRI is the run's ``iri``, for programs.
+
+    ``shortened``: how the caller shortens an IRI with cbrs's prefixes and the store's derived ones (the pages
+    pass their own, ``cbrs.web.links.short``); by default :func:`shorten`, within :func:`store_names`."""
     typed = listed[1:-1] if listed.startswith("<") and listed.endswith(">") else listed
     if not iri or (":" in typed and typed != iri):  # a prefixed name: as written
         return listed
@@ -181,8 +187,10 @@ def shown_name(listed: str, iri: str) -> str:
         declared = shorten(iri)
     if declared != iri:  # cbrs's own namespaces: as the list names it
         return listed if ":" not in typed else declared
-    derived = shorten(iri)  # the store's derived prefixes, within store_names
-    return derived if derived != iri else listed
+    derived = (shortened or shorten)(iri)
+    if derived != iri:
+        return derived
+    return listed if ":" not in typed else tail(iri)
 
 
 def _naming(run: TaskRun) -> dict[str, str]:

@@ -8,6 +8,7 @@ from collections.abc import Mapping
 from flask import Flask, g, has_app_context, url_for
 from markupsafe import Markup, escape
 
+from cbrs.iri_tail import tail_parts
 from cbrs.kb.namespaces import PREFIXES, expand, shorten
 from cbrs.web.prefixes import by_namespace, derived, namespace
 
@@ -78,21 +79,6 @@ def name_parts(iri: str) -> tuple[str, str]:
     return tail_parts(iri)
 
 
-def tail_parts(iri: str) -> tuple[str, str]:
-    """The part of ``iri`` after its last ``/`` split at ``#``: ``("my_ontology.owl#", "Car")`` rather
-    than ``http://127.0.0.1/ontology/my_ontology.owl#Car``, which filled table columns and hid the
-    local name at the end (the pages showed OWLS-TC's IRIs so before they had derived prefixes, and the
-    match form still takes a concept so named). An IRI without such a tail is ``("", iri)``."""
-    _, scheme, rest = iri.partition("://")
-    _host, slash, path = rest.partition("/")
-    if not scheme or not slash or not path or iri.endswith("/"):  # no path to take a tail of
-        return "", iri
-    namespace, hash_, local = path.rsplit("/", 1)[-1].rpartition("#")
-    if not hash_ or not local:
-        return "", path.rsplit("/", 1)[-1]
-    return namespace + "#", local
-
-
 def display_text(iri: str) -> str:
     """:func:`name_parts` as plain text (a picture's box, a tooltip)."""
     return "".join(name_parts(iri))
@@ -103,6 +89,15 @@ def shown_term(name: str) -> str:
     IRI, else as written: "Plan for https://example.org/lab5#FetchPenForVisitor" headed the plan of a lab's
     task that the list beside it names ``lab5:FetchPenForVisitor``."""
     return display_text(name) if "://" in name else name
+
+
+def shown_task(listed: str, iri: str | None) -> str:
+    """A task as the pages name it, ``listed`` as the list (or the user) spells it: by the rule a run's events
+    and record use (:func:`cbrs.tasks.shown_name`), with the pages' own prefixes (:func:`short`); a name
+    that means no task (``iri`` None) as :func:`shown_term` shows it."""
+    from cbrs.tasks import shown_name
+
+    return shown_name(listed, iri, short) if iri else shown_term(listed)
 
 
 def display_name(iri: str, label: str | None = None) -> Markup:

@@ -9,6 +9,7 @@ from typing import Any, Literal
 
 from flask import Blueprint, request
 
+from cbrs.iri_tail import tail_parts
 from cbrs.kb import NotFoundError, Parameter, Requirement, Statement
 from cbrs.kb.namespaces import PREFIXES, shorten
 from cbrs.kb.vocab import CBRS
@@ -17,7 +18,7 @@ from cbrs.reasoner.matchmaker import Candidate, Matchmaker, MatchResult
 from cbrs.reasoner.methods import METHODS
 from cbrs.reasoner.taxonomy import TaxonomyIndex
 from cbrs.web import context
-from cbrs.web.links import display_text, expand_name, short, tail_parts
+from cbrs.web.links import display_text, expand_name, short
 from cbrs.web.pages import FormError, Page, page, wants_json
 from cbrs.web.prefixes import derived
 

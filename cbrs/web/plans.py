@@ -17,9 +17,10 @@ from markupsafe import Markup
 
 from cbrs.actions.shown_names import file_qualifier, shown_names, two_lines
 from cbrs.extras import installed, require
-from cbrs.kb.namespaces import shorten
+from cbrs.iri_tail import tail_parts
+from cbrs.kb.namespaces import expand, shorten
 from cbrs.web import context, diagram
-from cbrs.web.links import display_text, short, short_text, shown_term, tail_parts, task_name
+from cbrs.web.links import display_text, short, short_text, shown_task, task_name
 from cbrs.web.pages import FormError, Page, page, wants_json
 
 if TYPE_CHECKING:  # the planner (and networkx) load with the first plan asked for, not at start-up
@@ -56,7 +57,7 @@ def plans() -> Page:
     with context.lock():  # a GET stays safe: the plan is shown, not recorded (cbrs plan and /cbrs/plan record)
         composed = _composed(task, objective, shown)
     result = composed.result
-    shown.title = f"Plan for {_shown_task(task, options, data['selected'])}"  # not "Plan for FetchMyPn" over the error
+    shown.title = f"Plan for {_shown_task(task, data['selected'])}"  # not "Plan for FetchMyPn" over the error
     data["composition"] = _composition(result)
     if composed.base is not None:  # a home of several mobile bases: the one the plan works, and why
         data["base"] = composed.base.to_dict()
@@ -204,12 +205,9 @@ def _read_tasks() -> dict[str, list[dict[str, str | None]]]:
     }
 
 
-def _shown_task(task: str, options: dict[str, list[dict[str, str | None]]], selected: str | None) -> str:
-    """The task as the list names it (a lab's by its derived prefix), else as :func:`shown_term` shows it."""
-    for t in (t for group in ("requirements", "actions") for t in options[group]):
-        if selected is not None and t["name"] == selected:
-            return str(t["shown"])
-    return shown_term(task)
+def _shown_task(task: str, selected: str | None) -> str:
+    """The task as every page and a run name it (:func:`shown_task`), ``selected`` the option it means."""
+    return shown_task(task, expand(selected) if selected is not None else None)
 
 
 def _selected(task: str, options: dict[str, list[dict[str, str | None]]]) -> str | None:

@@ -26,7 +26,7 @@ from flask.sansio.blueprints import BlueprintSetupState
 from werkzeug.exceptions import BadRequest, Forbidden, NotFound, ServiceUnavailable
 
 from cbrs.actions.errors import UnknownTaskError
-from cbrs.kb.namespaces import PREFIXES, shorten, written
+from cbrs.kb.namespaces import PREFIXES, written
 from cbrs.kb.owls import local_name
 from cbrs.tasks import (
     CameraFrame,
@@ -39,7 +39,7 @@ from cbrs.tasks import (
     preconditions_line,
 )
 from cbrs.web import context, services
-from cbrs.web.links import expand_name, short, shown_term, task_name
+from cbrs.web.links import expand_name, short, shown_task, task_name
 from cbrs.web.pages import FormError, Page, page, wants_json
 from cbrs.web.prefixes import derived, namespace
 
@@ -424,18 +424,6 @@ def choices() -> dict[str, Any]:
         }
 
     return context.per_generation("task_choices", read)
-
-
-def shown_task(listed: str, iri: str | None) -> str:
-    """A task as the pages show it: a lab's own by the prefix derived for its namespace
-    (lab10:SwitchOnTheReadingLamp, as the plans page names it: :func:`cbrs.web.links.short`), since its bare
-    name in the list (what ``cbrs run`` takes) says not whose it is; a task of cbrs's own namespaces as the
-    list names it (FetchMyPen, act:FetchMyPen), else as :func:`shown_term` shows a name."""
-    if iri and ":" not in listed and shorten(iri) == iri:  # bare, and no prefix of cbrs's covers it
-        derived_name = short(iri)
-        if derived_name != iri:
-            return derived_name
-    return shown_term(listed)
 
 
 def _typed(iri: str, known: list[str]) -> str | None:
