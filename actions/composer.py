@@ -39,7 +39,7 @@ import pyoxigraph as ox
 from cbrs.actions.areas import AreaRule, Leads, WorldPlaces
 from cbrs.actions.decomposition_notes import UnfollowedOrdering, decomposition_notes, unfollowed_ordering
 from cbrs.actions.errors import OrderingConflictError
-from cbrs.actions.extraction import Extraction, Objective
+from cbrs.actions.extraction import THING, Extraction, Objective
 from cbrs.actions.graph import (
     SRE,
     SRI,
@@ -109,6 +109,10 @@ class ComposeConfig:
     # ... looked for at the unmet need and at each need above it on the chain the answer follows down (the
     # requirement's output a lab's sensor nearly gives), at most this many in all per unmet need
     near_misses_total: int = 6
+    # an input of this class or below designates a thing: it takes only a value of the class the statements its
+    # step is planned for name for it (the bell's home:Cup), or below (Extraction._things_wanted); None: any
+    # value of the input's class (docs/composition.md, "The thing an input is for")
+    thing_class: str | None = THING
 
 
 class PlanStatus(Enum):
@@ -356,7 +360,9 @@ class Composer:
             task = Task(task.iri, task, self.actions.actions.get(task.for_task or ""))
         direct = self.attempt(task.requirement, task)
         unknown = [p for p in task.requirement.inputs if p.type and p.type not in self.index]
-        if unknown and direct.plan is not None:  # planned without the thing given: it fetches some other (a marker)
+        # planned without the thing given, it would fetch some other (a marker); unplanned for want of the thing
+        # the goal is about (Extraction._things_wanted), the input of no known class is why
+        if unknown and (direct.plan is not None or any(u.things for u in direct.unsatisfied)):
             needs = tuple(Unsatisfied(f"input {p.name} ({shorten(p.type)})", SRI) for p in unknown)
             return self._result(task, None, needs, (replace(direct, plan=None, unsatisfied=needs),))
         holding = self._state if self._state is not None else []
@@ -556,7 +562,14 @@ class Composer:
         areas = self.area_rule(requirement)
         config = self.config
         extraction = Extraction(
-            graph, trace, config.objective, config.max_steps, areas, config.protect, config.max_reachieved
+            graph,
+            trace,
+            config.objective,
+            config.max_steps,
+            areas,
+            config.protect,
+            config.max_reachieved,
+            config.thing_class,
         )
         if not extraction.solved:
             return Attempt(requirement, graph, trace, None, tuple(extraction.unsatisfied))

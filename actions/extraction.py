@@ -29,7 +29,7 @@ from cbrs.actions.progression import Clobbered, progress, threatens
 from cbrs.actions.search import SearchTrace
 from cbrs.actions.unmet import GOAL, Unsatisfied
 from cbrs.kb import Statement
-from cbrs.kb.namespaces import shorten
+from cbrs.kb.namespaces import PREFIXES, shorten
 from cbrs.reasoner.degrees import degree_of_match
 from cbrs.reasoner.taxonomy import TaxonomyIndex
 
@@ -42,6 +42,9 @@ class Objective(Enum):
 
 
 _Key = Callable[[Edge], tuple[Any, ...]]
+
+THING = PREFIXES["home"] + "PhysicalObject"
+"""An input of this class or below designates a thing of the world (see :meth:`Extraction._things_wanted`)."""
 
 
 @dataclass
@@ -59,6 +62,9 @@ class _Step:
     bindings: list[_Bound] = field(default_factory=list)
     producers: list[int] = field(default_factory=list)
     about: tuple[str, ...] = ()  # the classes of the statements this step serves, down from the goal
+    # what a class of its component's statements stands for here: the more specific class of the statement it
+    # serves, side by side (the put-down's PhysicalObject is the bell's Cup); an input's producer, its consumer's
+    refines: dict[str, str] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -82,8 +88,10 @@ class Extraction:
         areas: AreaRule | None = None,
         protect: bool = True,
         max_reachieved: int = 8,
+        thing_class: str | None = THING,
     ) -> None:
         self.graph = graph
+        self.thing_class = thing_class  # None: an input that designates a thing takes any value of its class
         self.protect = protect  # check the plan by progression and achieve again what a step undoes
         self.max_reachieved = max_reachieved
         self._after: list[tuple[int, int]] = []  # (deleter, step achieving again what it deleted, or a feeder)
@@ -332,6 +340,13 @@ class Extraction:
         False when no provider can serve (the reason is in ``unsatisfied``, unless ``again``)."""
         below = 10**9 if step.node == GOAL else self.trace.levels[step.node]
         options = self._options(node, need, below)
+        wanted = self._things_wanted(step, need)
+        if wanted:
+            fitting = [e for e in options if self._is_wanted(e, wanted)]
+            if not fitting:
+                self._no_thing(step, node, need, wanted, options)
+                return False
+            options = fitting
         if not again:
             given = [e for e in options if e.source == SRI]
             if given and len(given) < len(options):
@@ -351,7 +366,7 @@ class Extraction:
                 )
                 step.bindings.append(_Bound(need, edge, producer_id))
                 return True
-            sibling = self._sibling(step, node, need, taken)
+            sibling = self._sibling(step, node, need, taken, wanted)
             if sibling is not None:
                 step.bindings.append(sibling)
                 return True
@@ -375,6 +390,7 @@ class Extraction:
                 return True
         producer = self._new(best.source, step.id)
         producer.about = about
+        producer.refines = self._refined(step, need, best)
         self._ranked[producer.id] = self._decided(best, candidates, rank)
         step.producers.append(producer.id)
         step.bindings.append(_Bound(need, best, producer.id))
@@ -444,6 +460,98 @@ class Extraction:
         depths = [index.depth(c) for c in step.about if c in ancestors and c in index]
         return -max(depths) if depths else 0
 
+    def _things_wanted(self, step: _Step, need: Need, loose: bool = False) -> tuple[str, ...]:
+        """For an input of ``step`` that designates a thing (its class at or below ``thing_class``): the most
+        specific classes its class stands for in the statements the step is planned for (``refines``). The
+        value must be of one of them: the pick-up's chain for the bell's (Cup, isLocated, PlaceMat) wants a
+        home:Cup, where its input's home:PhysicalObject took the base's colour marker a ceiling camera finds.
+        ``loose``: any class, at or below the input's, of the statements it serves (``about``), for judging
+        a component before it is chosen (:meth:`_ways`). Empty: any value of the input's class will do
+        (docs/composition.md, "The thing an input is for")."""
+        concept, thing = need.concept, self.thing_class
+        if thing is None or need.role != "input" or step.node == GOAL or concept is None:
+            return ()
+        index = self.graph.matcher.index
+        if concept not in index or not index.is_a(concept, thing):
+            return ()
+        if loose:
+            return tuple(sorted({index.canonical(c) for c in step.about if c in index and index.is_a(c, concept)}))
+        under = {
+            index.canonical(specific)
+            for general, specific in step.refines.items()
+            if index.is_a(specific, concept) and (index.is_a(general, concept) or index.is_a(concept, general))
+        }
+        return tuple(sorted(c for c in under if not any(o != c and index.is_a(o, c) for o in under)))
+
+    def _refined(self, consumer: _Step, need: Need, edge: Edge) -> dict[str, str]:
+        """What the classes of ``edge``'s provider stand for, made a step for ``need`` of ``consumer``: for an
+        input, what the consumer's do (it prepares data about the consumer's things); for a precondition, the
+        need's class on each side where it is below the offer's, the need read as the consumer's classes
+        stand for (the carry's (PhysicalObject, isGraspedBy, Gripper), for the bell's cup, makes the
+        pick-up's PhysicalObject a Cup)."""
+        wanted, offered = need.statement, edge.offer.statement
+        if wanted is None or offered is None:
+            return dict(consumer.refines)
+        index = self.graph.matcher.index
+        found: dict[str, str] = {}
+        for mine, theirs in ((wanted.subject, offered.subject), (wanted.object, offered.object)):
+            if mine not in index or theirs not in index:
+                continue
+            mine = consumer.refines.get(index.canonical(mine), mine)
+            if index.canonical(mine) != index.canonical(theirs) and index.is_a(mine, theirs):
+                found[index.canonical(theirs)] = mine
+        return found
+
+    def _is_wanted(self, edge: Edge, wanted: tuple[str, ...]) -> bool:
+        """Whether the value ``edge`` offers is of a class of ``wanted`` or below (none wanted: any is)."""
+        if not wanted:
+            return True
+        concept = edge.offer.concept
+        index = self.graph.matcher.index
+        return concept is not None and any(index.is_a(concept, c) for c in wanted)
+
+    def _no_thing(self, step: _Step, node: str, need: Need, wanted: tuple[str, ...], options: list[Edge]) -> None:
+        """``need``, an input for a thing of a class of ``wanted``, as unmet: the task gives none and no step
+        gives one; the values of its class passed over (what the task gives, what providers output), by class."""
+        passed = tuple(
+            sorted(
+                {
+                    ("the task" if e.source == SRI else e.source, f"{e.offer.name} ({shorten(e.offer.concept or '')})")
+                    for e in options
+                }
+            )
+        )
+        served = next(
+            (s for s in self._served(step) if any(self._canonical(side) in wanted for side in (s.subject, s.object))),
+            None,
+        )
+        self.unsatisfied.append(
+            Unsatisfied(
+                need.text(),
+                node,
+                self._path(step, need),
+                things=wanted,
+                things_for=statement_text(served) if served is not None else "",
+                passed_over=passed,
+            )
+        )
+
+    def _canonical(self, concept: str) -> str:
+        index = self.graph.matcher.index
+        return index.canonical(concept) if concept in index else concept
+
+    def _served(self, step: _Step) -> list[Statement]:
+        """The statements ``step`` is planned for, nearest first: the need it was made for, up to the goal."""
+        found: list[Statement] = []
+        current = step
+        while current.made_for is not None:
+            parent = self.steps[current.made_for]
+            bound = next((b for b in parent.bindings if b.source == current.id), None)
+            if bound is not None and bound.need.statement is not None:
+                found.append(bound.need.statement)
+            current = parent
+        return found
+
     def _foreign(self, step: _Step, edge: Edge) -> bool:
         """Whether a value the task gives belongs to another goal than the ones ``step`` serves: its class
         falls under a class another goal names more specifically than under any class of the statements
@@ -473,8 +581,11 @@ class Extraction:
         the task and the steps give is fewer (docs/composition.md, "Extracting the plan")."""
         return {(b.source, b.edge.offer.name) for b in step.bindings if self._twins(need, b.need)}
 
-    def _sibling(self, step: _Step, node: str, need: Need, taken: set[tuple[int | None, str]]) -> _Bound | None:
-        """An output of a step made for the same consumer, if one meets this input (one not ``taken`` first)."""
+    def _sibling(
+        self, step: _Step, node: str, need: Need, taken: set[tuple[int | None, str]], wanted: tuple[str, ...] = ()
+    ) -> _Bound | None:
+        """An output of a step made for the same consumer, if one meets this input (one not ``taken`` first;
+        of a class of ``wanted``, when it names any: :meth:`_things_wanted`)."""
         if need.role != "input" or step.made_for is None:
             return None
         level = self.trace.levels[step.node]
@@ -484,7 +595,7 @@ class Extraction:
             if other.id == step.id or self.trace.levels[other.node] >= level:
                 continue
             for edge in self.graph.providers(node, need):
-                if edge.source == other.node and edge.offer.role == "output":
+                if edge.source == other.node and edge.offer.role == "output" and self._is_wanted(edge, wanted):
                     rank = ((other.id, edge.offer.name) in taken, -edge.similarity, other.id, edge.offer.name)
                     found.append((rank, _Bound(need, edge, other.id)))
         return min(found, key=lambda item: item[0])[1] if found else None
@@ -524,6 +635,8 @@ class Extraction:
         ways: list[tuple[Need, Edge | None, tuple[str, ...], list[Edge]]] = []
         for need in self.graph.needs(vertex):
             options = self._options(vertex, need, self._level(vertex))
+            wanted = self._things_wanted(probe, need, loose=True)
+            options = [e for e in options if self._is_wanted(e, wanted)]
             given = [e for e in options if e.source == SRI]
             if given and len(given) < len(options):
                 given = [e for e in given if not self._foreign(probe, e)]
@@ -549,6 +662,8 @@ class Extraction:
                     things.add(given.offer.name)
                     bound.add(given.offer.name)
                     given_here.add(given.offer.name)
+                continue
+            if not providers:  # no value of the thing it is for (_things_wanted): _bind says so, not the area
                 continue
             fit = [e for e in providers if self._judged[(e.source, below)].why is None]
             if not fit:

@@ -43,6 +43,12 @@ class Unsatisfied:
     near_misses: tuple[NearMiss, ...] = ()  # components whose output or effect is near the need (actions.near_misses)
     # or near a need above it on the chain: ``along`` holds those needs, (consumer, need text), from the goal down
     along: tuple[tuple[str, str], ...] = ()
+    # an input that designates a thing: the classes the statements its step serves name for it (one of which
+    # its value must be), the first such statement, and the values of the input's class passed over, each
+    # as (who gives it: "the task" or a component, "name (class)")
+    things: tuple[str, ...] = ()
+    things_for: str = ""
+    passed_over: tuple[tuple[str, str], ...] = ()
 
     def text(self) -> str:
         found = self._text()
@@ -85,10 +91,22 @@ class Unsatisfied:
             return f"the requirement gives {need}; {self.remedy()}"
         if self.out_of_area:
             return f"no component effective where it is needed provides {need} of {consumer}{via}; {self.remedy()}"
+        if self.things:
+            return f"{self._no_thing(need, consumer, via)}; {self.remedy()}"
         if need.startswith("delete effect "):
             gone = need.removeprefix("delete effect ")
             return f"no component deletes {gone} (a delete effect of {consumer}{via}); {self.remedy()}"
         return f"no component provides {need} of {consumer}{via}; {self.remedy()}"
+
+    def _no_thing(self, need: str, consumer: str, via: str) -> str:
+        """An input for a thing of a class of ``things``, of which the task gives none and no step gives one."""
+        wanted = " or ".join(shorten(c) for c in self.things)
+        about = f" the {wanted} of {self.things_for}" if self.things_for else f" a {wanted}"
+        found = f"the task gives no {wanted} and no step gives one for {need} of {consumer}{via}, which is for{about}"
+        if self.passed_over:
+            each = ", ".join(f"{by if by == 'the task' else shorten(by)}'s {value}" for by, value in self.passed_over)
+            found += f"; passed over, being no {wanted}: {each}"
+        return found
 
     def remedy(self) -> str:
         """What to register or state so that this need is met (first, a class to declare: no component
@@ -155,6 +173,13 @@ class Unsatisfied:
             )
         if self.consumer == SRI:
             return "correct the input's cbrs:parameterType"
+        if self.things:
+            wanted = " or ".join(shorten(c) for c in self.things)
+            held = f", or plan the task where {self.things_for} holds already (after a task that achieves it)"
+            return (
+                f"give a {wanted} as an input of the task (cbrs:hasInput with cbrs:parameterType "
+                f"{shorten(self.things[0])}){held if self.things_for else ''}"
+            )
         if self.consumer == GOAL:  # the task states nothing to plan towards
             return (
                 "state what the task wants as an output (cbrs:hasOutput), an effect (cbrs:hasEffect) or a "
@@ -198,6 +223,9 @@ class Unsatisfied:
             "unlike": None if self.unlike is None else {"object": self.unlike[0], "none_of": list(self.unlike[1])},
             "deleted_by": list(self.deleted_by),
             "near_misses": [miss.to_dict() for miss in self.near_misses],
+            "things": list(self.things),
+            "things_for": self.things_for,
+            "passed_over": [{"by": by, "value": value} for by, value in self.passed_over],
         }
 
 
