@@ -32,6 +32,7 @@ from cbrs.isolated_queries import IsolatedQueries, IsolatedResult
 from cbrs.kb import Advertisement, KnowledgeBase, KnowledgeBaseError, Requirement, ServiceDescription
 from cbrs.kb.catalog import Catalogue, merge
 from cbrs.kb.derived_prefixes import StoreNames
+from cbrs.kb.described import about_in, complete
 from cbrs.kb.engine_faults import sorts
 from cbrs.kb.errors import AlreadyRegisteredError, NotFoundError, QuerySyntaxError, RdfParseError, without_password
 from cbrs.kb.liveness import ComponentState
@@ -54,7 +55,7 @@ from cbrs.output import (
     term_text,
 )
 from cbrs.settings import SETTINGS, setting
-from cbrs.sparql_hints import declared, explain_syntax_error, one_line_up, store_prefixes_used
+from cbrs.sparql_hints import declared, explain_syntax_error, first_keyword, one_line_up, store_prefixes_used
 from cbrs.unmentioned_names import unmentioned_names
 
 # Commands whose modules import numpy, networkx, the composer or the web server (most of a second at
@@ -539,10 +540,15 @@ def _evaluate(kb: KnowledgeBase, text: str) -> QueryResult | IsolatedResult:
     """A user's query text evaluated where a crash of the SPARQL engine costs a child process only when it
     sorts (cbrs.isolated_queries: ORDER BY over dateTimes with and without a time zone aborts Oxigraph);
     in this process otherwise, and always on a remote store, which evaluates on its own server."""
+    result: QueryResult | IsolatedResult
     if not isinstance(kb.store, EmbeddedStore) or not sorts(text):
-        return kb.query(text)
-    with IsolatedQueries(kb.store) as isolated:
-        return isolated.query(text)
+        result = kb.query(text)
+    else:
+        with IsolatedQueries(kb.store) as isolated:
+            result = isolated.query(text)
+    if (first_keyword(text) or "").upper() == "DESCRIBE" and isinstance(result, ox.QueryTriples | list):
+        return complete(result, about_in(kb.store))  # through skolemised blank nodes, as the endpoint's
+    return result
 
 
 def _check_required(kb: KnowledgeBase, name: str, values: dict[str, str]) -> None:

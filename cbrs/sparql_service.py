@@ -41,6 +41,7 @@ from werkzeug.datastructures import MIMEAccept
 from cbrs import __version__, pattern_lookup
 from cbrs._query_worker import dataset_options
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.described import about_in, complete
 from cbrs.kb.errors import (
     EngineFaultError,
     KnowledgeBaseError,
@@ -55,7 +56,7 @@ from cbrs.kb.store import EmbeddedStore, QueryResult, is_remote, refuse_inserted
 from cbrs.query_workers import QueryProcesses, QueryStopped, Request
 from cbrs.scan_queries import is_single_scan, single_scan, uses_prefixes
 from cbrs.settings import setting
-from cbrs.sparql_hints import FORMS, TOKENS, explain_syntax_error
+from cbrs.sparql_hints import FORMS, TOKENS, explain_syntax_error, first_keyword
 
 # Media types offered for SELECT and ASK results, the first being the default.
 RESULT_TYPES: dict[str, ox.QueryResultsFormat] = {
@@ -485,7 +486,7 @@ class SparqlService:
                 release()
         if self.processes is not None:
             try:
-                return self._in_process(text, accept, short_format, graphs)
+                return self._described(text, self._in_process(text, accept, short_format, graphs), graphs)
             finally:
                 release()
         deadline = time.monotonic() + self.config.timeout
@@ -507,9 +508,31 @@ class SparqlService:
             release()
             raise
         try:
-            return future.result(timeout=self.config.timeout)
+            answer = future.result(timeout=self.config.timeout)
         except FutureTimeout:
             raise QueryTimeoutError(self.config.timeout) from None
+        return self._described(text, answer, graphs)
+
+    def _described(self, text: str, answer: Answer, graphs: dict[str, Any]) -> Answer:
+        """A DESCRIBE's ``answer`` completed through the skolemised blank nodes it reaches (a class's OWL
+        restrictions: :func:`cbrs.kb.described.complete`), within the query's dataset, serialised again in
+        its media type under the endpoint's size limit; any other answer as it is."""
+        if (first_keyword(text) or "").upper() != "DESCRIBE" or answer.media_type not in GRAPH_TYPES:
+            return answer
+        form = GRAPH_TYPES[answer.media_type]
+        triples = [quad.triple for quad in ox.parse(answer.body, format=form)]
+        default = graphs.get("default")
+        about = about_in(self.kb.store, None if graphs.get("union") or default is None else map(ox.NamedNode, default))
+        completed = complete(triples, about)
+        if len(completed) == len(triples):
+            return answer
+        timeout = self.config.timeout
+        writer = _BudgetWriter(self.config.max_result_bytes, time.monotonic() + timeout, timeout)
+        try:
+            ox.serialize(completed, writer, form)
+        except _Stop as stop:
+            raise stop.error from None
+        return Answer(writer.getvalue(), answer.media_type)
 
     @_sparql_text("query")
     def query_here(
