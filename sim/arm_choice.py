@@ -33,7 +33,7 @@ from cbrs.sim.perceived import PerceivedWorld
 from cbrs.sim.perception import ObjectEstimate
 from cbrs.sim.place_spots import RELAY_MARGIN, spot_region
 from cbrs.sim.relay import CLEAR_TRIES, RELAY_TRIES, appliance_distance, clear_asked, relay_spot, resting_at
-from cbrs.sim.transit import band_advice, floor_cause, floor_needs, floor_to
+from cbrs.sim.transit import band_advice, floor_cause, floor_needs, floor_to, transit_floor
 from cbrs.sim.values import Manipulation
 from cbrs.sim.world import HomeWorld
 
@@ -459,7 +459,10 @@ def cannot_set_down(
     ``surface`` is RELAY_MARGIN inside can hold ``obj`` over it to set it down, by any approach its hand can
     grip it by (empty: one can): what a carry asks of a spot before it aims there (:func:`skills.can_set_down`,
     its hand turned as it takes the object where it lies, believed or as the map says; the pass's taker asks
-    the same with :func:`skills.can_grip`). Asked of each spot a packing would give a later thing
+    the same with :func:`skills.can_grip`), and, where the hand there could come near a fixture by the map,
+    whether some posture holds it there and backed off from there CARRY_CLEARANCE from the fixtures
+    (:func:`skills.set_down_meets`): under a tap's spout the end poses' inverse kinematics let through spots
+    the arm's planning has no way to. Asked of each spot a packing would give a later thing
     (:func:`packing.carry_spots`)."""
     world = ctx.world
     estimate, model = lying_estimate(world, ctx.belief, obj), Manipulation.of(obj).model
@@ -472,7 +475,11 @@ def cannot_set_down(
             continue
         for kind in model.preference:
             held = model.by(kind)
-            why = skills.can_grip(held, world.arm(side).hand) or skills.can_set_down(world, estimate, side, held, spot)
+            why = (
+                skills.can_grip(held, world.arm(side).hand)
+                or skills.can_set_down(world, estimate, side, held, spot)
+                or skills.set_down_meets(world, estimate, side, held, spot)
+            )
             if not why:
                 return ""
             refused.append(why)
@@ -520,7 +527,7 @@ def holdable_spot(
         return spots[0] if spots else None
     orientation = arm.ee_pose().orientation
     first: tuple[float, float] | None = None
-    unrefused: tuple[float, float] | None = None  # the first whose carry the planning makes, though near
+    unrefused: list[tuple[float, float]] = []  # those whose carry the planning makes, though near
     near: list[tuple[float, float]] = []  # where the carry came near an appliance: farther spots asked next
     for x, y in clear_asked(spots, near, lambda at: at, appliance_distance(ctx.world)):
         if arm.can_hold((x, y, surface.zmin + skills.PLACE_CLEARANCE + grasp.bottom_offset), orientation):
@@ -530,11 +537,16 @@ def holdable_spot(
             if brushed:
                 near.append((x, y))
             if why == brushed:  # only near, not refused (a held carry's check gives near as refused too)
-                unrefused = unrefused or (x, y)
+                unrefused.append((x, y))
             first = first or (x, y)
-    # no carry there keeps clear (a cup carried below the tap, which it aims at): the first the planning
-    # makes, else the first, as before
-    return unrefused or first
+    # no straight carry keeps clear: the first whose carry keeps clear going round the fixture it came near
+    # (skills.carry_object's ``around``, as the run's carry goes), up to CLEAR_TRIES of them
+    for x, y in unrefused[:CLEAR_TRIES]:
+        if not carry_check(ctx, side, spot_region(surface, x, y), around=True)[0]:
+            return (x, y)
+    # none does (a cup carried below the tap, which it aims at): the first the planning makes, else the
+    # first, as before
+    return unrefused[0] if unrefused else first
 
 
 def carry_clear(
@@ -555,6 +567,7 @@ def carry_check(
     spot: Region,
     taking: tuple[ObjectEstimate, ObjectModel] | None = None,
     folded: Sequence[ArmSide] = (),
+    around: bool = False,
 ) -> tuple[str, str]:
     """Why the arm's planning would refuse the carry over ``spot`` and its way down, and where those moves
     would come within CARRY_CLEARANCE of an appliance (each empty when not): a dry run with that clearance
@@ -563,7 +576,9 @@ def carry_check(
     (:func:`skills.plan_carry`, the arms of ``folded`` home); the floor as the carry's (:func:`floor_to`).
     Told apart, so a choice can pass over the spot that does not keep clear and still take it, as before,
     when none does; but a held carry that comes that near is given as refused too, saying where: a pass's
-    giver passes such a spot over (``services.carry``), and takes none of them when none keeps clear."""
+    giver passes such a spot over (``services.carry``), and takes none of them when none keeps clear. With
+    ``around``, the carry goes round a fixture its straight way comes near, where a way round keeps clear
+    (:func:`way_round`), as the run's carry does."""
     world = ctx.world
     if taking is None:
         grasp = world.arm(side).held_grasp
@@ -572,14 +587,23 @@ def carry_check(
         held, start = grasp.model, world.arm(side).ee_pose().position
         bottom = start[2] - grasp.bottom_offset
         floor = floor_to(ctx, held, side, start, spot)
-        planned = skills.plan_carry_held(world, side, spot, floor, CARRY_CLEARANCE)
+        rounding = way_round(ctx, side, held) if around else None
+        planned = skills.plan_carry_held(world, side, spot, floor, CARRY_CLEARANCE, rounding)
     else:
         seen, held = taking
         start = seen.position
         bottom = seen.position[2] - seen.size[2] / 2.0 + skills.LIFT_HEIGHT  # lifted, as the take's dry run
         floor = floor_to(ctx, held, side, start, spot)
         planned = skills.plan_carry(
-            world, seen, side, held, spot, floor=floor, folded=folded, clearance=CARRY_CLEARANCE
+            world,
+            seen,
+            side,
+            held,
+            spot,
+            floor=floor,
+            folded=folded,
+            clearance=CARRY_CLEARANCE,
+            around=way_round(ctx, side, held) if around else None,
         )
     cx, cy, _ = spot.center
     refused = planned.refused
@@ -592,6 +616,13 @@ def carry_check(
     if taking is None:  # a held carry that comes that near is refused too
         return refused or brushed, brushed
     return refused, brushed
+
+
+def way_round(ctx: SimContext, side: ArmSide, held: ObjectModel) -> skills.Round:
+    """What ``side``'s carry of ``held`` needs to go round a fixture (:class:`skills.Round`): the arm's mount,
+    and the floor over the things standing by a way (:func:`transit_floor`, where each is believed to be)."""
+    mount = ctx.world.arm_specs[side].mount
+    return skills.Round((mount[0], mount[1]), lambda a, b: transit_floor(ctx, held, side, a, b))
 
 
 def floor_advice(ctx: SimContext, side: ArmSide, spot: Region, seen: ObjectEstimate, held: ObjectModel) -> str:

@@ -861,6 +861,30 @@ class Arm:
                     return True
         return False
 
+    def hold_meets(self, position: Vec3, orientation: Quat, margin: float, symmetric: bool = True) -> str:
+        """The fixture (``Kinematics``'s ``fixtures``: the appliances, a tap's lever too) that every posture
+        holding the hand at this pose (those :meth:`can_hold` takes) brings the arm, fingers included,
+        within ``margin`` of, the first such posture's; empty when one keeps farther from them all, or none
+        holds the pose (:meth:`can_hold` says that)."""
+        candidates = [orientation, flipped(orientation)] if symmetric else [orientation]
+        others = self._others()
+        met = ""
+        for candidate in candidates:
+            if self._kinematics.wrist_strikes(self.side, position, candidate):
+                continue
+            for seed in (*_SEEDS, self.joint_positions()):
+                solution = self._kinematics.solve(self.side, position, candidate, [seed], loose=True)
+                if (
+                    solution.position_error <= IK_TOLERANCE
+                    and solution.orientation_error <= 0.02
+                    and not self._kinematics.strikes(self.side, solution.q, others)
+                ):
+                    name = self._kinematics.brushes(self.side, solution.q, margin)
+                    if not name:
+                        return ""
+                    met = met or name
+        return met
+
     def _others(self, folded: Sequence[ArmSide] = ()) -> dict[ArmSide, Sequence[float]]:
         """The other arms' postures: where they are, or home for those of ``folded``."""
         return {
@@ -869,11 +893,11 @@ class Arm:
             if side is not self.side
         }
 
-    def fixture_near(self, start: Vec3, end: Vec3) -> str:
+    def fixture_near(self, start: Vec3, end: Vec3, margin: float = MEET_MARGIN) -> str:
         """The first fixture the hand, its grasp point on the line from ``start`` to ``end``, could come
-        within MEET_MARGIN of by the map (:meth:`Kinematics.fixture_near` with the hand's reach); empty when
-        none: a take there cannot touch one with its hand."""
-        return self._kinematics.fixture_near(start, end, self._kinematics.hand_reach + MEET_MARGIN)
+        within ``margin`` of by the map (:meth:`Kinematics.fixture_near` with the hand's reach); empty when
+        none: the hand there cannot come that near one."""
+        return self._kinematics.fixture_near(start, end, self._kinematics.hand_reach + margin)
 
     def dry_run(
         self, folded: Sequence[ArmSide] = (), clear_by: float | None = None, meet_by: float | None = None
@@ -1015,10 +1039,10 @@ class PlannedArm:
     def joint_positions(self) -> tuple[float, ...]:
         return self._q
 
-    def dry_run(self) -> PlannedArm:
-        """A copy from the posture planned so far, to plan moves on without changing this one (and
-        without noting what they brush: a probe)."""
-        return PlannedArm(self.side, self._kinematics, self._q, self._others)
+    def dry_run(self, *, clear_by: float | None = None) -> PlannedArm:
+        """A copy from the posture planned so far, to plan moves on without changing this one (a probe);
+        with ``clear_by``, noting where they first come that near a fixture, as :meth:`Arm.dry_run`."""
+        return PlannedArm(self.side, self._kinematics, self._q, self._others, clear_by)
 
     def _note(self, postures: Sequence[Sequence[float]], target: Vec3) -> None:
         """Note the first of ``postures`` (a move to ``target``) within ``clear_by`` of a fixture, and the

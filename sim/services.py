@@ -18,7 +18,16 @@ from cbrs.kb.home_check import NoDockingPoseError, docked_place
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import Thing, local_name
 from cbrs.sim import skills
-from cbrs.sim.arm_choice import carry_check, free_arm, grasp_pose_for, holdable_spot, note_choice, who_loads, who_takes
+from cbrs.sim.arm_choice import (
+    carry_check,
+    free_arm,
+    grasp_pose_for,
+    holdable_spot,
+    note_choice,
+    way_round,
+    who_loads,
+    who_takes,
+)
 from cbrs.sim.arms import ArmSide
 from cbrs.sim.context import SimContext, SkillFailed, Work, check_outcome, robot_camera
 from cbrs.sim.errors import SimulationError
@@ -262,7 +271,8 @@ def carry(ctx: SimContext, inputs: Mapping[str, Any], device: str) -> dict[str, 
     grasped = world.arm(ctx.arm).held_grasp
     hand = world.arm(ctx.arm).ee_pose().position
     floor = None if grasped is None else floor_to(ctx, grasped.model, ctx.arm, hand, target)
-    check_outcome(skills.carry_object(world, ctx.arm, target, floor=floor))
+    around = None if grasped is None else way_round(ctx, ctx.arm, grasped.model)
+    check_outcome(skills.carry_object(world, ctx.arm, target, floor=floor, around=around))
     return {}
 
 

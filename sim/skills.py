@@ -9,6 +9,7 @@ simulated time: a skill never runs forever.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -19,7 +20,7 @@ import pybullet as p
 
 from cbrs.kb.hands import Hand
 from cbrs.sim import predicates as pred
-from cbrs.sim.arms import COLLISION_MARGIN, MEET_MARGIN, Arm, ArmSide, MotionResult, PlannedArm
+from cbrs.sim.arms import CARRY_CLEARANCE, COLLISION_MARGIN, MEET_MARGIN, Arm, ArmSide, MotionResult, PlannedArm
 from cbrs.sim.errors import GraspMisfitError, GraspTooWideError
 from cbrs.sim.geometry import Pose2D, Pose3D, Quat, Region, Vec3, wrap_angle
 from cbrs.sim.grasping import (
@@ -40,8 +41,10 @@ __all__ = [
     "FILL_TIME_LIMIT",
     "LIFT_HEIGHT",
     "NAVIGATION_TOLERANCE",
+    "ROUND_PULLS",
     "DryRun",
     "Outcome",
+    "Round",
     "appliances",
     "approach_object",
     "can_carry",
@@ -67,6 +70,7 @@ __all__ = [
     "plan_hand_over",
     "platform_region",
     "put_down_object",
+    "set_down_meets",
 ]
 
 LIFT_HEIGHT = 0.04
@@ -94,6 +98,23 @@ NAVIGATION_TOLERANCE = 0.05
 """The base has arrived when it is within 5 cm of the last waypoint."""
 PLATFORM_TARGET = 0.05
 """Half-size of the put-down window on the platform around its localised centre."""
+ROUND_PULLS = (0.05, 0.10, 0.15, 0.20, 0.25)
+"""How far (m) a carry whose straight way across comes within CARRY_CLEARANCE of a fixture pulls its way
+in towards the arm's mount, each tried in turn until one keeps clear (:func:`_way_round`). Measured on
+EraserCupPen's pen, carried west from (8.07, 3.30) under the tap's lever by the right arm: pulled in 10 cm
+the forearm still comes within 1 cm of the lever, 15 cm and more it keeps clear."""
+
+
+@dataclass(frozen=True)
+class Round:
+    """What a carry needs to go round a fixture its straight way would come near (:func:`carry_object`'s
+    ``around``): where the arm is mounted (x, y; the way is pulled in towards it), and how high the held
+    object's bottom must stay over the things standing by a way from one (x, y) to another
+    (``transit.transit_floor``; None: nothing stands by it). A way round is taken only where nothing by it
+    asks the object higher than the straight way's floor."""
+
+    mount: tuple[float, float]
+    floor: Callable[[tuple[float, float], tuple[float, float]], float | None]
 
 
 @dataclass(frozen=True)
@@ -211,18 +232,25 @@ def pick_up_object(world: HomeWorld, side: ArmSide | str, grasp: GraspPose) -> O
 
 
 def carry_object(
-    world: HomeWorld, side: ArmSide | str, region: Region, yaw: float | None = None, floor: float | None = None
+    world: HomeWorld,
+    side: ArmSide | str,
+    region: Region,
+    yaw: float | None = None,
+    floor: float | None = None,
+    around: Round | None = None,
 ) -> Outcome:
     """CarryObject: take the held object over ``region`` (its centre over the region's centre, its
     bottom ABOVE_CLEARANCE over the surface), turning a top-grasped object's axis to ``yaw``; on the way
-    its bottom stays at or above ``floor`` (over the other things standing by the way)."""
+    its bottom stays at or above ``floor`` (over the other things standing by the way). With ``around``,
+    a straight way across that would come within CARRY_CLEARANCE of a fixture is left for one pulled in
+    towards the arm that keeps clear (:func:`_way_round`), where there is one."""
     start = world.time
     arm = _arm(world, side)
     grasp = arm.held_grasp
     if arm.held is None or grasp is None:
         return _done(world, "CarryObject", start, False, f"the {arm.side} gripper holds nothing")
     name = world.name_of(arm.held) or "?"
-    result = _carry(arm, grasp, region, yaw, floor, appliances(world))
+    result = _carry(arm, grasp, region, yaw, floor, appliances(world), around)
     if not result.reached:
         return _done(world, "CarryObject", start, False, result.reason)
     ok = pred.object_above_region(world, name, region)
@@ -247,7 +275,7 @@ class _Moving(Protocol):
         down_to: float | None = ...,
     ) -> MotionResult: ...
 
-    def dry_run(self) -> PlannedArm: ...
+    def dry_run(self, *, clear_by: float | None = ...) -> PlannedArm: ...
 
 
 def _carry(
@@ -257,6 +285,7 @@ def _carry(
     yaw: float | None,
     floor: float | None = None,
     fixtures: Sequence[Region] = (),
+    around: Round | None = None,
 ) -> MotionResult:
     """carry_object's moves: up to the transit height (the object's bottom where it is, ABOVE_CLEARANCE
     over the region, or ``floor``, whichever is highest), across to over the region's centre, down to
@@ -266,7 +295,8 @@ def _carry(
     space the hand keeps its turn about its approach axis unless that axis is vertical (a top grasp): a
     half turn about a side grasp's axis turns the object over. Before, a 15 cm vase reached a sill
     tilted 109 degrees and fell over as the hand opened. A way on which the held object would meet one of
-    ``fixtures`` (:func:`held_meets`) is refused before any move, real or planned."""
+    ``fixtures`` (:func:`held_meets`) is refused before any move, real or planned. With ``around``, the way
+    across may go round a fixture the straight one comes near (:func:`_way_round`)."""
     ee = arm.ee_pose()
     orientation = ee.orientation
     if yaw is not None and grasp.model.grasp is GraspKind.TOP:
@@ -284,18 +314,77 @@ def _carry(
         (cx, cy, transit),
         (cx, cy, above + grasp.bottom_offset),
     ]
+    if around is not None:
+        legs = _way_round(arm, grasp, legs, orientation, floor, fixtures, around)
     result = MotionResult(True, 0.0)
     for index, leg in enumerate(legs):
         if math.dist(leg, arm.ee_pose().position) < 1e-3:
             continue
-        result = _down(arm, grasp, region, leg, orientation) if index == 2 else arm.move_to(leg, orientation)
-        if not result.reached and index == 1 and math.isinf(result.error):
+        last = index == len(legs) - 1
+        result = _down(arm, grasp, region, leg, orientation) if last else arm.move_to(leg, orientation)
+        if not result.reached and index == 1 and len(legs) == 3 and math.isinf(result.error):
             # The straight line leaves the arm's reach (it would have to change posture on the
             # way): go through joint space instead, keeping the object at the transit height.
             result = arm.reach(leg, orientation, symmetric=turnable, min_height=transit - TRANSIT_SAG)
         if not result.reached:
             return result
     return result
+
+
+def _way_round(
+    arm: _Moving,
+    grasp: GraspPose,
+    legs: list[Vec3],
+    orientation: Quat,
+    floor: float | None,
+    fixtures: Sequence[Region],
+    around: Round,
+) -> list[Vec3]:
+    """The legs a carry goes by (:func:`_carry`'s up, across and down, planned as straight lines): those
+    given, unless, planned on a dry run, they would come within CARRY_CLEARANCE of a fixture (the arm,
+    fingers included: :attr:`PlannedArm.brushed`) and a way pulled in towards the arm's mount by one of
+    ROUND_PULLS keeps clear; then the first such: up, in, across at the same height, out, down. The arms'
+    joint-space planning keeps 1 cm from the dispenser, not from its tap's lever, which a hand pushes to fill
+    a cup; a straight carry under the lever brings the forearm into it (EraserCupPen's pen, carried west
+    from east of the dispenser, stopped 0.16 m short). A way round is not taken where its lines are refused,
+    the held object would meet an appliance on it (:func:`held_meets`), or a thing standing by it asks the
+    object higher than ``floor`` (``around.floor``): it passes ground the straight way does not. Given legs
+    refused on the dry run are kept (the carry's own fallbacks and refusals, as before)."""
+    straight = arm.dry_run(clear_by=CARRY_CLEARANCE)
+    if not _plans(straight, legs, orientation) or not straight.brushed:
+        return legs
+    up, across, down = legs
+    transit = up[2]
+    bottom = transit - grasp.bottom_offset
+    highest = -math.inf if floor is None else floor
+    for pull in ROUND_PULLS:
+        way = [up, _pulled(up, around.mount, pull), _pulled(across, around.mount, pull), across]
+        pairs = list(itertools.pairwise(way))
+        floors = (around.floor((a[0], a[1]), (b[0], b[1])) for a, b in pairs)
+        if any(height is not None and height > highest for height in floors):
+            continue
+        if any(held_meets(fixtures, grasp, a, b, bottom) for a, b in pairs):
+            continue
+        planned = arm.dry_run(clear_by=CARRY_CLEARANCE)
+        if _plans(planned, [*way, down], orientation) and not planned.brushed:
+            return [*way, down]
+    return legs
+
+
+def _pulled(point: Vec3, mount: tuple[float, float], by: float) -> Vec3:
+    """``point`` moved ``by`` (m) towards ``mount`` (x, y) in the horizontal, at most onto it."""
+    dx, dy = mount[0] - point[0], mount[1] - point[1]
+    length = math.hypot(dx, dy)
+    t = 1.0 if length <= by else by / length
+    return (point[0] + dx * t, point[1] + dy * t, point[2])
+
+
+def _plans(planned: PlannedArm, legs: Sequence[Vec3], orientation: Quat) -> bool:
+    """Whether each of ``legs`` in turn is a straight line the planning makes (on the dry run ``planned``)."""
+    for leg in legs:
+        if math.dist(leg, planned.ee_pose().position) >= 1e-3 and not planned.move_to(leg, orientation).reached:
+            return False
+    return True
 
 
 HELD_STEP = 0.005
@@ -657,6 +746,38 @@ def can_set_down(world: HomeWorld, pen: ObjectEstimate, side: ArmSide | str, mod
     return ""
 
 
+def set_down_meets(
+    world: HomeWorld, pen: ObjectEstimate, side: ArmSide | str, model: ObjectModel, region: Region
+) -> str:
+    """Why ``side``, taking the object where it is by ``model``'s approach, would let it go over the middle of
+    ``region`` only with the arm, fingers included, within CARRY_CLEARANCE of a fixture (an appliance, or a
+    tap's lever), in every posture that holds the hand there or backed off from there (:func:`_retreat`'s
+    first pose): empty when some posture keeps clear at each, or the hand there could come near none by the
+    map (:meth:`Arm.fixture_near`; then nothing is solved). The arms' joint-space moves keep that margin
+    from the appliances, so a pose no posture holds clear has no way to it; and a carry keeps it from a
+    lever (``arm_choice.carry_clear``). Asked with :func:`can_set_down` of a later thing's spots, which the
+    end poses' inverse kinematics alone let through under a tap's spout (EraserCupPen's pen)."""
+    arm = ArmSide(side)
+    grasp = _grasp(world, pen, arm, model)
+    if isinstance(grasp, str):
+        return grasp
+    cx, cy, _ = region.center
+    letting_go = (cx, cy, region.zmin + PLACE_CLEARANCE + grasp.bottom_offset)
+    back = grasp.backed_off(letting_go)
+    hand = world.arm(arm)
+    if not hand.fixture_near(back, letting_go, CARRY_CLEARANCE):
+        return ""
+    for what, pose in (("letting it go", letting_go), ("backing off once it is let go", back)):
+        name = hand.hold_meets(pose, grasp.orientation, CARRY_CLEARANCE)
+        if name:
+            return (
+                f"the {arm.value} arm holding the {model.name} by its {model.grasp.value} grasp over {region.name} at "
+                f"({cx:.2f}, {cy:.2f}), {what}, would come within {CARRY_CLEARANCE * 100:.0f} cm of the {name} in "
+                f"every posture that holds the hand there"
+            )
+    return ""
+
+
 @dataclass(frozen=True)
 class DryRun:
     """What a hold's moves, planned and not made, came to (:func:`plan_carry`)."""
@@ -697,6 +818,7 @@ def plan_carry(
     floor: float | None = None,
     folded: Sequence[ArmSide] = (),
     clearance: float | None = None,
+    around: Round | None = None,
 ) -> DryRun:
     """The moves of ``side`` taking the object where it is by ``model``'s approach and, given a ``region``,
     carrying it over its middle: approach_object, pick_up_object and carry_object, and put_down_object's
@@ -707,7 +829,8 @@ def plan_carry(
     turns a top-grasped object on the way, and ``floor`` keeps its bottom up on the way, as
     :func:`carry_object` does; the arms of ``folded`` are taken to be home (:meth:`Arm.dry_run`). With
     ``clearance``, also where the moves first come within that distance of an appliance, a tap's lever
-    too (:attr:`DryRun.brushed`), which the planning does not refuse them for."""
+    too (:attr:`DryRun.brushed`), which the planning does not refuse them for; with ``around``, the carry
+    going round a fixture as :func:`carry_object` does given it."""
     arm = ArmSide(side)
     grasp = _grasp(world, pen, arm, model)
     if isinstance(grasp, str):
@@ -722,7 +845,7 @@ def plan_carry(
     if region is not None:
         cx, cy, _ = region.center
         carrying = f"carrying it to ({cx:.2f}, {cy:.2f})"
-        moves.append((carrying, lambda: _carry(hand, grasp, region, yaw, floor, appliances(world))))
+        moves.append((carrying, lambda: _carry(hand, grasp, region, yaw, floor, appliances(world), around)))
         lowering = f"lowering it onto {region.name} at ({cx:.2f}, {cy:.2f})"
         moves.append((lowering, lambda: _set_down(hand, grasp, region)))
     return DryRun(_first_refused(moves, arm, model), hand.brushed, hand.met)
@@ -770,12 +893,17 @@ def can_carry_held(world: HomeWorld, side: ArmSide | str, region: Region, floor:
 
 
 def plan_carry_held(
-    world: HomeWorld, side: ArmSide | str, region: Region, floor: float | None = None, clearance: float | None = None
+    world: HomeWorld,
+    side: ArmSide | str,
+    region: Region,
+    floor: float | None = None,
+    clearance: float | None = None,
+    around: Round | None = None,
 ) -> DryRun:
     """The moves of ``side`` carrying what it holds over the middle of ``region`` and lowering it there, as
-    :func:`carry_object` and :func:`put_down_object` move it: a dry run from the arm's posture now; with
-    ``clearance``, also where they first come within that distance of an appliance, a tap's lever too
-    (:attr:`DryRun.brushed`)."""
+    :func:`carry_object` (given ``around``) and :func:`put_down_object` move it: a dry run from the arm's
+    posture now; with ``clearance``, also where they first come within that distance of an appliance, a
+    tap's lever too (:attr:`DryRun.brushed`)."""
     arm = _arm(world, side)
     grasp = arm.held_grasp
     if arm.held is None or grasp is None:
@@ -783,7 +911,10 @@ def plan_carry_held(
     hand = arm.dry_run(clear_by=clearance)
     cx, cy, _ = region.center
     moves: list[tuple[str, Callable[[], MotionResult]]] = [
-        (f"carrying it to ({cx:.2f}, {cy:.2f})", lambda: _carry(hand, grasp, region, None, floor, appliances(world))),
+        (
+            f"carrying it to ({cx:.2f}, {cy:.2f})",
+            lambda: _carry(hand, grasp, region, None, floor, appliances(world), around),
+        ),
         (f"lowering it onto {region.name} at ({cx:.2f}, {cy:.2f})", lambda: _set_down(hand, grasp, region)),
     ]
     return DryRun(_first_refused(moves, ArmSide(side), grasp.model), hand.brushed)
