@@ -7,6 +7,11 @@ unsatisfiable, and, since the reasoner gives no reason for an inconsistency, the
 is not the range their property declares (``4.5`` is an ``xsd:decimal``, not an ``xsd:double``): places
 to look first.
 
+The graphs are cbrs's own by name (``ontology``) or any named graph by its IRI, a lab's own that ``cbrs load
+--graph IRI`` wrote included: checked with cbrs's ontologies when given with ``ontology`` too, alone otherwise
+(its classes then mean what the graph alone says of them). An IRI the store holds no graph of is refused
+(:class:`NoSuchGraphError`), naming the store's other graphs, rather than checked as empty and "consistent".
+
 HermiT runs once and briefly, so its JVM gets the client compiler only and the serial collector
 (:data:`JVM_OPTIONS`, passed in ``JDK_JAVA_OPTIONS``, which owlready2's launch leaves to the environment):
 a fresh store's check took about 7 s with the JVM's defaults and 3.5 s so, with the same answer. A user's
@@ -28,6 +33,7 @@ from typing import Any
 import pyoxigraph as ox
 
 from cbrs.kb import KnowledgeBase, KnowledgeBaseError
+from cbrs.kb.loader import resolve_graph
 from cbrs.kb.namespaces import OWL, GraphName, shorten
 
 DEFAULT_GRAPHS = (GraphName.ONTOLOGY, GraphName.SERVICES, GraphName.REQUIREMENTS)
@@ -46,6 +52,22 @@ class JavaMissingError(KnowledgeBaseError):
         self.java = java
         super().__init__(
             f"cbrs check runs the HermiT reasoner, which needs Java, but {java!r} was not found: {JAVA_HINT}"
+        )
+
+
+class NoSuchGraphError(KnowledgeBaseError):
+    """A graph to check given by an IRI the store holds no graph of (a misspelt one would check as empty)."""
+
+    http_status = 404
+
+    def __init__(self, graph: str, others: Sequence[str]) -> None:
+        self.graph = graph
+        self.others = list(others)
+        held = f"its graphs other than cbrs's own: {', '.join(self.others)}" if self.others else "it has none"
+        super().__init__(
+            f"the store holds no graph {graph}; check a graph of cbrs's by its name ("
+            + ", ".join(g.value for g in GraphName)
+            + f") or one of the store's own by its IRI ({held})"
         )
 
 
@@ -100,21 +122,23 @@ class CheckResult:
         }
 
 
-def check(kb: KnowledgeBase, graphs: Sequence[GraphName] = DEFAULT_GRAPHS) -> CheckResult:
-    """Classify ``graphs`` of the store with HermiT; :class:`JavaMissingError` without Java."""
+def check(kb: KnowledgeBase, graphs: Sequence[GraphName | str] = DEFAULT_GRAPHS) -> CheckResult:
+    """Classify ``graphs`` of the store with HermiT: cbrs's graphs by name, any other named graph by its IRI
+    (:class:`NoSuchGraphError` for one the store does not hold); :class:`JavaMissingError` without Java."""
     import owlready2
 
+    nodes = checked_graphs(kb, graphs)
     java = str(owlready2.JAVA_EXE)
     if shutil.which(java) is None:
         raise JavaMissingError(java)
     start = time.perf_counter()
     triples = [
         ox.Triple(q.subject, q.predicate, q.object)
-        for graph in graphs
-        for q in kb.store.quads(graph=graph.node)
+        for graph in nodes
+        for q in kb.store.quads(graph=graph)
         if q.predicate.value != OWL + "imports"
     ]
-    names = tuple(graph.iri for graph in graphs)
+    names = tuple(graph.value for graph in nodes)
     with tempfile.TemporaryDirectory(prefix="cbrs-check-") as folder:
         path = Path(folder) / "graphs.nt"
         path.write_bytes(ox.serialize(triples, format=ox.RdfFormat.N_TRIPLES) or b"")
@@ -124,16 +148,14 @@ def check(kb: KnowledgeBase, graphs: Sequence[GraphName] = DEFAULT_GRAPHS) -> Ch
             with ontology, _java_options(JVM_OPTIONS):
                 owlready2.sync_reasoner_hermit(world, infer_property_values=False, debug=0)
         except owlready2.OwlReadyInconsistentOntologyError:
-            return CheckResult(names, len(triples), False, [], _range_clashes(kb, graphs), time.perf_counter() - start)
+            return CheckResult(names, len(triples), False, [], _range_clashes(kb, names), time.perf_counter() - start)
         except (owlready2.OwlReadyError, OSError) as error:
             raise ReasonerError(str(error)) from error
         unsatisfiable = sorted(
             c.iri for c in world.inconsistent_classes() if getattr(c, "iri", OWL + "Nothing") != OWL + "Nothing"
         )
         world.close()
-    return CheckResult(
-        names, len(triples), True, unsatisfiable, _range_clashes(kb, graphs), time.perf_counter() - start
-    )
+    return CheckResult(names, len(triples), True, unsatisfiable, _range_clashes(kb, names), time.perf_counter() - start)
 
 
 @contextmanager
@@ -150,9 +172,22 @@ def _java_options(options: Sequence[str]) -> Iterator[None]:
             os.environ["JDK_JAVA_OPTIONS"] = own
 
 
-def _range_clashes(kb: KnowledgeBase, graphs: Sequence[GraphName]) -> list[RangeClash]:
+def checked_graphs(kb: KnowledgeBase, graphs: Sequence[GraphName | str]) -> list[ox.NamedNode]:
+    """The graphs to check, each once, in order: a name of cbrs's (``ontology``: its graph, even while it is
+    empty) or a graph IRI the store holds; ``UnknownGraphError`` for a word that is neither a name nor an
+    IRI, :class:`NoSuchGraphError` for an IRI of no graph of the store."""
+    nodes = list(dict.fromkeys(resolve_graph(graph) for graph in graphs))
+    own = {graph.iri for graph in GraphName}
+    held = kb.store.graphs()
+    for node in nodes:
+        if node.value not in own and node.value not in held:
+            raise NoSuchGraphError(node.value, [graph for graph in held if graph not in own])
+    return nodes
+
+
+def _range_clashes(kb: KnowledgeBase, graphs: Sequence[str]) -> list[RangeClash]:
     """Literals typed with another XSD datatype than the one their property's rdfs:range names."""
-    rows = [row for graph in graphs for row in kb.select("range_clashes", {"graph": graph.iri})]
+    rows = [row for graph in graphs for row in kb.select("range_clashes", {"graph": graph})]
     clashes = []
     for row in rows:
         literal = row["o"]

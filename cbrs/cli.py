@@ -808,8 +808,10 @@ class _NodeNames:
     "--graph",
     "graphs",
     multiple=True,
-    type=click.Choice([g.value for g in GraphName]),
-    help="A graph to reason over (repeatable). Default: ontology, services and requirements.",
+    metavar="NAME|IRI",
+    help="A graph to reason over (repeatable): " + ", ".join(g.value for g in GraphName) + ", or the IRI of "
+    "a graph of your own (cbrs load --graph IRI; add --graph ontology to check it with cbrs's ontologies). "
+    "Default: ontology, services and requirements.",
 )
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
 @pass_app
@@ -820,7 +822,7 @@ def check_command(app: App, graphs: tuple[str, ...], as_json: bool) -> None:
     """
     from cbrs.check import DEFAULT_GRAPHS, check  # owlready2 loads only for this command
 
-    result = check(app.kb, tuple(GraphName(g) for g in graphs) or DEFAULT_GRAPHS)
+    result = check(app.kb, graphs or DEFAULT_GRAPHS)
     if as_json:
         click.echo(json.dumps(result.to_dict(), indent=2))
     else:
