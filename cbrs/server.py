@@ -19,7 +19,7 @@ from cbrs.asgi_front import SparqlFront
 from cbrs.bridge_services import KnowledgeServices, attach
 from cbrs.http_listener import HttpListener, ListenerConfig
 from cbrs.kb import KnowledgeBase
-from cbrs.kb.store import EmbeddedStore, mark_served
+from cbrs.kb.store import EmbeddedStore, StoreDiskError, mark_served
 from cbrs.live_components import LiveComponents
 from cbrs.matchmakers import Matchmakers
 from cbrs.rosbridge import Bridge
@@ -173,6 +173,7 @@ class Server:
         if isinstance(self.kb.store, EmbeddedStore) and not self.kb.store.in_memory:
             host = "127.0.0.1" if self.config.host in ("0.0.0.0", "::") else self.config.host
             mark_served(self.kb.store.location, f"http://{host}:{self.http_port}")
+            self.kb.store.on_failure = _log_store_failure
         for name in LOGGERS:
             logging.getLogger(name).addHandler(self._rosout)
         warm_up(self.app)  # a big store's first pages: read in the background now (cbrs.web.warmup)
@@ -254,3 +255,9 @@ class Server:
         if self._front is not None:
             self._front.close()
             self._front = None
+
+
+def _log_store_failure(error: StoreDiskError) -> None:
+    """The first of a run of disk errors (a full disk): the client whose write failed is told, the log
+    is the administrator's (docs/serving.md, "Logs")."""
+    log.error("%s", error)

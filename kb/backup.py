@@ -467,6 +467,7 @@ def restore_store(
     tell(f"writing {len(quads)} triples", 0, 0)
     if isinstance(store, EmbeddedStore):  # (embedded, for the type checker)
         _replace_embedded(store, replacing, quads, whole=not graphs)
+        store.flush()  # on disk before it is reported: a full disk failed the flush after "restored ..." was said
     else:
         _replace_remote(store, replacing, quads, tell)
     restored = {graph: len(backup.quads.get(graph, ())) for graph in wanted}

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import logging
 import re
 from abc import ABC, abstractmethod
 from collections import defaultdict
@@ -26,6 +27,8 @@ from cbrs.kb.recent_keys import RecentKeys
 from cbrs.kb.remote_access import loads, refuse_remote_access
 from cbrs.kb.results import releases_results
 from cbrs.kb.sparql_lexemes import HIDING
+
+log = logging.getLogger(__name__)
 
 MEMORY = ":memory:"
 REMOTE_SCHEMES = ("http://", "https://")
@@ -84,6 +87,10 @@ class Store(ABC):
     location: str
     remote_access: tuple[str, ...] = ()
     """IRI prefixes a SERVICE or LOAD may reach (:mod:`kb.remote_access`); none by default."""
+    failure: StoreError | None = None
+    """The disk error the last write (or snapshot) of this store met, until one succeeds again: what a
+    health check reports, since a full disk fails every write and every heavy query of a server that
+    otherwise answers (:class:`StoreDiskError`)."""
 
     @classmethod
     def open(cls, location: str | Path) -> Store:
@@ -341,6 +348,58 @@ class StoreInUseError(StoreError):
         super().__init__(location, f"is in use by another process (RocksDB lock held); {hint} ({cause})")
 
 
+# What the engine's IO errors say when the store's disk, not the request, is at fault, and what to do.
+_DISK_CAUSES = (
+    ("No space left on device", "its disk is full: free space on it"),
+    ("Disk quota exceeded", "the disk quota is used up: free space or raise the quota"),
+    (
+        "Read-only file system",
+        "its file system is read-only: cbrs opens a store for writing even to read it (RocksDB writes its "
+        "LOG and LOCK files), so copy the directory somewhere writable (cp -a) and open the copy",
+    ),
+)
+# Only when opening: a write's "Permission denied" may be an allowed LOAD's file, the request's fault.
+_OPEN_CAUSES = (
+    ("Permission denied", "permission denied: the directory and its files must be writable by the user cbrs runs as"),
+)
+
+
+class StoreDiskError(StoreError):
+    """The store's disk refused a write: full, read-only or not ours. ``cause`` is the engine's message,
+    ``advice`` what to do about it. HTTP 507 Insufficient Storage: the request was fine, the server could
+    not keep it."""
+
+    http_status = 507
+
+    def __init__(self, location: str, doing: str, advice: str, cause: str, after: str) -> None:
+        self.doing = doing
+        self.advice = advice
+        self.cause = cause
+        super().__init__(location, f"{doing} failed: {advice}{after} ({cause})")
+
+
+def disk_error(
+    location: str, doing: str, error: OSError, after: str = "", causes: tuple[tuple[str, str], ...] = _DISK_CAUSES
+) -> StoreDiskError | None:
+    """``error`` as a :class:`StoreDiskError` when the disk is at fault (the engine's message names one of
+    ``causes``), else None; ``after`` is what the caller adds to the advice (what was kept, what to do)."""
+    text = str(error)
+    for said, advice in causes:
+        if said in text:
+            return StoreDiskError(location, doing, advice, text, after)
+    return None
+
+
+_WRITE_FAILED = (
+    "; nothing of this write was kept, what was committed before is; RocksDB takes no further writes "
+    "in this process after a failed one, so once the disk is fixed restart the process that holds the store "
+    "(cbrs serve)"
+)
+"""What a write that met a disk error adds: seen on a full disk, every later write and snapshot failed
+until the store was opened again, space freed or not (docs/serving.md, "Tried by a lab's system
+administrator")."""
+
+
 class EmbeddedStore(Store):
     """An Oxigraph store in this process, on disk or in memory.
 
@@ -356,6 +415,9 @@ class EmbeddedStore(Store):
         self.location = location
         self.generation = 0
         """Counts the writes made through this object, so a snapshot knows whether it is current."""
+        self.on_failure: Callable[[StoreDiskError], None] | None = None
+        """Told of the first disk error after a success: ``cbrs serve`` logs it, since the client whose
+        request failed is told and nobody else is (a command raises it to its user instead)."""
         self._checked = RecentKeys()
 
     @property
@@ -365,10 +427,18 @@ class EmbeddedStore(Store):
         return self._open
 
     def close(self) -> None:
-        """Flush and release the store (and its on-disk lock) even if this object lives on."""
+        """Flush and release the store (and its on-disk lock) even if this object lives on. A flush the disk
+        refuses is logged, not raised: what was committed is in the write-ahead log, and the next open
+        replays it (a full disk made every command that had written end in "internal error" before)."""
         if self._open is not None:
-            self.flush()
-            self._open = None
+            told = self.failure is not None  # a write that failed so raised to its caller already
+            try:
+                self.flush()
+            except StoreDiskError as error:  # the write-ahead log keeps every committed write
+                if not told and self.on_failure is None:
+                    log.error("%s", error)  # nobody heard of it: a command would end without a word
+            finally:
+                self._open = None  # the lock goes with the engine, flushed or not
 
     @classmethod
     def open(cls, location: str | Path) -> EmbeddedStore:
@@ -390,7 +460,8 @@ class EmbeddedStore(Store):
         except OSError as error:
             if "lock" in str(error).lower():
                 raise StoreInUseError(text, _served_at(path), str(error)) from error
-            raise StoreError(text, str(error)) from error
+            causes = _DISK_CAUSES + _OPEN_CAUSES
+            raise disk_error(text, "opening it", error, causes=causes) or StoreError(text, str(error)) from error
 
     @property
     def in_memory(self) -> bool:
@@ -446,7 +517,11 @@ class EmbeddedStore(Store):
                 return
             self._backend.backup(str(target))
         except OSError as error:
-            raise StoreError(self.location, f"snapshot into {target} failed: {error}") from error
+            doing = f"a snapshot into {target}"
+            raise self._failed(disk_error(self.location, doing, error, _WRITE_FAILED)) or StoreError(
+                self.location, f"snapshot into {target} failed: {error}"
+            ) from error
+        self.failure = None
 
     def quads(
         self,
@@ -492,7 +567,11 @@ class EmbeddedStore(Store):
         try:
             self._backend.extend(quads)
         except OSError as error:
-            raise StoreError(self.location, f"write failed: {error}") from error
+            raise self._failed(disk_error(self.location, "the write", error, _WRITE_FAILED)) or StoreError(
+                self.location, f"write failed: {error}"
+            ) from error
+        else:
+            self.failure = None
         finally:
             self.generation += 1
 
@@ -502,7 +581,11 @@ class EmbeddedStore(Store):
         try:
             self._backend.load(data, ox.RdfFormat.N_QUADS)
         except OSError as error:
-            raise StoreError(self.location, f"write failed: {error}") from error
+            raise self._failed(disk_error(self.location, "the write", error, _WRITE_FAILED)) or StoreError(
+                self.location, f"write failed: {error}"
+            ) from error
+        else:
+            self.failure = None
         finally:
             self.generation += 1
 
@@ -588,15 +671,41 @@ class EmbeddedStore(Store):
         except SyntaxError as error:
             raise QuerySyntaxError(text, str(error)) from error
         except OSError as error:
-            raise StoreError(self.location, f"update failed: {error}") from error
+            raise self._failed(disk_error(self.location, "the update", error, _WRITE_FAILED)) or StoreError(
+                self.location, f"update failed: {error}"
+            ) from error
         except RuntimeError as error:  # e.g. CREATE GRAPH of a graph that exists
             raise StoreEvaluationError(self.location, "update", str(error)) from error
+        else:
+            self.failure = None
         finally:
             self.generation += 1
 
     def flush(self) -> None:
-        if not self.in_memory:
+        """Write the engine's memory tables to disk. Every write was committed to the write-ahead log
+        before; a flush that fails (a full disk) loses none of it: the next open replays the log."""
+        if self.in_memory:
+            return
+        try:
             self._backend.flush()
+        except OSError as error:
+            after = (
+                "; every write that was committed is in its write-ahead log and is kept: "
+                "the next open finishes the flush, once the disk is fixed"
+            )
+            raise self._failed(disk_error(self.location, "flushing it to disk", error, after)) or StoreError(
+                self.location, f"flushing it to disk failed: {error}"
+            ) from error
+        self.failure = None
+
+    def _failed(self, error: StoreDiskError | None) -> StoreDiskError | None:
+        """Remember a disk error, and hand the first since a write last succeeded to :attr:`on_failure`;
+        ``error`` unchanged."""
+        if error is not None:
+            if self.failure is None and self.on_failure is not None:
+                self.on_failure(error)
+            self.failure = error
+        return error
 
 
 def data_block(quads: Iterable[ox.Quad], blank_nodes: bool = False) -> str:

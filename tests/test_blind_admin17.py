@@ -1,0 +1,132 @@
+"""The seventeenth blind round: a lab's system administrator ran ``cbrs serve`` for months from README and
+docs/ alone (docs/serving.md, "Tried by a lab's system administrator"). Each test is a fault found then.
+
+A full disk is a real engine's error text handed back by a stand-in for the store's Oxigraph backend (the
+round filled a small tmpfs; a test cannot mount one), so the store's handling of it is what is tested.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pyoxigraph as ox
+import pytest
+
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.store import EmbeddedStore, StoreDiskError
+
+TOKEN = "admin17-token-0123456789abcdef"
+FULL = "IO error: No space left on device: While appending to file: {}/000024.log: No space left on device"
+
+
+def _insert(n: int) -> str:
+    """A one-triple update of a lab's own graph, the ``n``-th."""
+    return f'INSERT DATA {{ GRAPH <urn:lab:admin> {{ <urn:lab:a> <urn:lab:b> "{n}" }} }}'
+
+
+class _Disk:
+    """The store's backend with a switch: while ``full``, writes and flushes fail as on a full disk (only
+    the flush, when ``flushes_only``: the write went into the log before the disk filled)."""
+
+    def __init__(self, backend: ox.Store, location: str) -> None:
+        self.backend = backend
+        self.location = location
+        self.full = False
+        self.flushes_only = False
+
+    def _refuse(self, flush: bool) -> None:
+        if self.full and (flush or not self.flushes_only):
+            raise OSError(FULL.format(self.location))
+
+    def update(self, *args: Any, **kwargs: Any) -> None:
+        self._refuse(flush=False)
+        self.backend.update(*args, **kwargs)
+
+    def flush(self) -> None:
+        self._refuse(flush=True)
+        self.backend.flush()
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self.backend, name)
+
+
+def _fill(store: EmbeddedStore) -> _Disk:
+    disk = _Disk(store._backend, store.location)
+    store._open = disk  # type: ignore[assignment]
+    return disk
+
+
+@pytest.fixture
+def kb(tmp_path: Path) -> Iterator[KnowledgeBase]:
+    opened = KnowledgeBase.open(tmp_path / "store")
+    yield opened
+    opened.close()
+
+
+def test_a_flush_on_a_full_disk_says_what_is_kept_and_the_store_still_closes(kb: KnowledgeBase) -> None:
+    # The round: every command that had written ended "internal error: OSError: IO error: No space left
+    # on device" at its close (cbrs restore after "restored 8105 triples", cbrs serve after "stopped").
+    store = kb.store
+    assert isinstance(store, EmbeddedStore)
+    kb.update(_insert(1))
+    disk = _fill(store)
+    disk.full = True
+    with pytest.raises(StoreDiskError) as raised:
+        store.flush()
+    assert "disk is full" in str(raised.value) and "write-ahead log and is kept" in str(raised.value)
+    assert raised.value.http_status == 507
+    store.close()  # no error: what was committed is in the log, and the engine (and its lock) let go
+    assert store._open is None
+
+
+def test_a_write_on_a_full_disk_is_507_says_to_restart_and_is_reported_once(kb: KnowledgeBase) -> None:
+    store = kb.store
+    assert isinstance(store, EmbeddedStore)
+    told: list[StoreDiskError] = []
+    store.on_failure = told.append
+    disk = _fill(store)
+    disk.full = True
+    for n in range(2):
+        with pytest.raises(StoreDiskError) as raised:
+            store.update(_insert(n))
+        assert raised.value.http_status == 507
+        assert "nothing of this write was kept" in str(raised.value) and "restart" in str(raised.value)
+    assert len(told) == 1 and store.failure is not None  # the first of a run, for the log
+    disk.full = False
+    store.update(_insert(3))
+    assert store.failure is None
+    disk.full = True
+    with pytest.raises(StoreDiskError):
+        store.update(_insert(4))
+    assert len(told) == 2
+
+
+def test_a_store_on_a_read_only_file_system_says_how_to_read_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # The round mounted the store read-only: cbrs query and cbrs export said only the engine's "IO error:
+    # While open a file for appending: .../LOG: Read-only file system", though neither writes.
+    location = tmp_path / "store"
+    location.mkdir()
+
+    def read_only(path: str) -> ox.Store:
+        raise OSError(f"IO error: While open a file for appending: {path}/LOG: Read-only file system")
+
+    monkeypatch.setattr(ox, "Store", read_only)
+    with pytest.raises(StoreDiskError) as raised:
+        EmbeddedStore.open(location)
+    assert "read-only" in str(raised.value) and "cp -a" in str(raised.value)
+
+
+def test_a_restore_onto_a_full_disk_fails_before_it_says_restored(kb: KnowledgeBase, tmp_path: Path) -> None:
+    backup = tmp_path / "lab.nq"
+    kb.update(_insert(7))
+    kb.export(backup)
+    store = kb.store
+    assert isinstance(store, EmbeddedStore)
+    disk = _fill(store)
+    disk.full = disk.flushes_only = True
+    with pytest.raises(StoreDiskError, match="flushing it to disk failed"):
+        kb.restore(backup)
