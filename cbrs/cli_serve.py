@@ -89,6 +89,8 @@ def serve(
         server_names=setting("server_names").resolve(_option("server_names", server_names, "--server-name")),
         match_params=setting("match_params").resolve(_option("match_params", match_params, "--match-param")),
     )
+    if config.endpoint.update_token:
+        _redact_in_log(config.endpoint.update_token)
     if config.match_params:  # a wrong name or value fails now, not at the first ranking
         from cbrs.reasoner.config import MatchConfig
 
@@ -135,6 +137,27 @@ def serve(
             f"{error.strerror or error}"
         ) from None
     click.echo("stopped")
+
+
+class _Redacted(logging.Filter):
+    """Writes ``***`` for the update token wherever a log line would carry it: at DEBUG the websockets
+    library logs every frame it reads, the bridge's ``auth`` op (``"mac": "<token>"``) among them."""
+
+    def __init__(self, secret: str) -> None:
+        super().__init__()
+        self.secret = secret
+
+    def filter(self, record: logging.LogRecord) -> bool:
+        message = record.getMessage()
+        if self.secret in message:
+            record.msg, record.args = message.replace(self.secret, "***"), None
+        return True
+
+
+def _redact_in_log(token: str) -> None:
+    """Keep ``token`` out of every line the root logger's handlers write (cbrs serve's standard error)."""
+    for handler in logging.getLogger().handlers:
+        handler.addFilter(_Redacted(token))
 
 
 def _websockets_level(level: str) -> int:

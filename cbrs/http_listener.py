@@ -34,6 +34,7 @@ log = logging.getLogger("cbrs.server")
 
 # Granian's own log records go to the root logger (cbrs serve's format), errors only: its
 # default configuration prints every start and stop on stdout, where cbrs serve says it is ready.
+# Its access log, one line a request, goes there too, at INFO.
 _LOGGING: dict[str, Any] = {
     "version": 1,
     "disable_existing_loggers": False,
@@ -41,6 +42,12 @@ _LOGGING: dict[str, Any] = {
     "handlers": {},
     "loggers": {"_granian": {"propagate": True}, "granian.access": {"propagate": True}},
 }
+
+ACCESS_LOGGER = "granian.access"
+ACCESS_FORMAT = '%(addr)s "%(method)s %(path)s" %(status)d %(dt_ms).1f ms'
+"""One line a request: the client's address, the method and path, the status and the time taken. No query
+string (a query's text, up to 1 MiB) and no header: the update token travels in ``Authorization`` and is
+never written (docs/serving.md, "Logs")."""
 
 
 @dataclass(frozen=True)
@@ -58,6 +65,7 @@ class ListenerConfig:
     # until header_timeout closed them (docs/security.md, section 2)
     max_connections: int = 4096
     loop: str = "auto"  # the asyncio loop the app runs on: "uvloop", "asyncio", or "auto" (uvloop when installed)
+    access_log: bool = True  # a line a request at INFO (ACCESS_FORMAT), unless the log level leaves INFO out
 
 
 class _Server(_Embedded):
@@ -152,6 +160,9 @@ class HttpListener:
             ),
             log_level=LogLevels.error,  # its warning that embedding is "experimental" would greet every start
             log_dictconfig=_LOGGING,
+            # decided once: a level that leaves INFO out (--log-level warning) costs the requests nothing
+            log_access=config.access_log and logging.getLogger(ACCESS_LOGGER).isEnabledFor(logging.INFO),
+            log_access_format=ACCESS_FORMAT,
         )
         self._loop: asyncio.AbstractEventLoop | None = None
         self._thread: threading.Thread | None = None

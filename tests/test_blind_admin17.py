@@ -7,6 +7,13 @@ round filled a small tmpfs; a test cannot mount one), so the store's handling of
 
 from __future__ import annotations
 
+import io
+import json
+import logging
+import threading
+import urllib.error
+import urllib.parse
+import urllib.request
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -14,8 +21,12 @@ from typing import Any
 import pyoxigraph as ox
 import pytest
 
+from cbrs.cli_serve import _redact_in_log
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.store import EmbeddedStore, StoreDiskError
+from cbrs.server import ServeConfig, Server
+from cbrs.sparql_service import EndpointConfig
+from tests.helpers_threads import assert_threads_end
 
 TOKEN = "admin17-token-0123456789abcdef"
 FULL = "IO error: No space left on device: While appending to file: {}/000024.log: No space left on device"
@@ -130,3 +141,75 @@ def test_a_restore_onto_a_full_disk_fails_before_it_says_restored(kb: KnowledgeB
     disk.full = disk.flushes_only = True
     with pytest.raises(StoreDiskError, match="flushing it to disk failed"):
         kb.restore(backup)
+
+
+@pytest.fixture
+def served(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> Iterator[Server]:
+    caplog.set_level(logging.INFO)  # before the listener is made: it logs requests when INFO is on
+    threads = threading.active_count()
+    opened = KnowledgeBase.open(tmp_path / "served")
+    running = Server(opened, ServeConfig(port=0, bridge_port=0, endpoint=EndpointConfig(update_token=TOKEN)))
+    running.start()
+    yield running
+    running.stop(timeout=10)
+    opened.close()
+    assert_threads_end(threads, 10)
+
+
+def _post_update(server: Server, text: str, token: str) -> tuple[int, bytes]:
+    request = urllib.request.Request(
+        f"http://127.0.0.1:{server.http_port}/update",
+        data=urllib.parse.urlencode({"update": text}).encode(),
+        headers={"Authorization": f"Bearer {token}"},
+    )
+    try:
+        with urllib.request.urlopen(request, timeout=10) as answer:
+            return answer.status, answer.read()
+    except urllib.error.HTTPError as error:
+        return error.code, error.read()
+
+
+def _access_lines(caplog: pytest.LogCaptureFixture) -> list[str]:
+    return [record.getMessage() for record in caplog.records if record.name == "granian.access"]
+
+
+def test_every_request_is_logged_without_the_token_and_a_full_disk_once(
+    served: Server, caplog: pytest.LogCaptureFixture
+) -> None:
+    # The round: the log held "rosbridge serving on ..." and nothing of the requests, not the writes nor
+    # the refused ones (settings.md's log_level says "requests refused" are logged); then a full disk
+    # failed every update with 500 and wrote nothing in the log.
+    assert _post_update(served, _insert(1), TOKEN)[0] == 204
+    assert _post_update(served, _insert(2), "a-wrong-token")[0] == 403
+    store = served.kb.store
+    assert isinstance(store, EmbeddedStore)
+    _fill(store).full = True
+    for n in (3, 4):
+        status, body = _post_update(served, _insert(n), TOKEN)
+        assert status == 507 and b"disk is full" in body
+    lines = _access_lines(caplog)
+    for wanted in ('"POST /update" 204', '"POST /update" 403', '"POST /update" 507'):
+        assert any(wanted in line for line in lines), (wanted, lines)
+    assert all(line.startswith("127.0.0.1 ") and line.endswith(" ms") for line in lines), lines
+    assert TOKEN not in caplog.text
+    full = [r for r in caplog.records if r.levelno >= logging.ERROR and "disk is full" in r.getMessage()]
+    assert len(full) == 1, [r.getMessage() for r in full]  # the first of the run, not one per request
+
+
+def test_the_token_is_kept_out_of_the_log_at_debug() -> None:
+    # The round at --log-level debug: the websockets library logged the bridge's auth frame, the token in it.
+    root = logging.getLogger()
+    written = io.StringIO()
+    handler = logging.StreamHandler(written)
+    root.addHandler(handler)
+    frames = logging.getLogger("websockets.server")
+    level = frames.level
+    frames.setLevel(logging.DEBUG)
+    try:
+        _redact_in_log(TOKEN)
+        frame = json.dumps({"op": "auth", "mac": TOKEN})
+        frames.debug("< TEXT %r [%d bytes]", frame, len(frame))
+    finally:
+        root.removeHandler(handler)
+        frames.setLevel(level)
+    assert TOKEN not in written.getvalue() and '"mac": "***"' in written.getvalue()
