@@ -522,7 +522,9 @@ class SparqlService:
         form = GRAPH_TYPES[answer.media_type]
         triples = [quad.triple for quad in ox.parse(answer.body, format=form)]
         default = graphs.get("default")
-        about = about_in(self.kb.store, None if graphs.get("union") or default is None else map(ox.NamedNode, default))
+        about = about_in(
+            self.kb.store, None if graphs.get("union") or default is None else [ox.NamedNode(g) for g in default]
+        )
         completed = complete(triples, about)
         if len(completed) == len(triples):
             return answer
