@@ -80,6 +80,9 @@ class UpgradeReport:
     removed: int = 0  # quads removed, all rules together
     added: int = 0
     merged: tuple[str, ...] = ()  # the bundled files merged into the store (their names)
+    versions: tuple[
+        str, ...
+    ] = ()  # each out-of-date file's versions in the store and bundled, "home.ttl 0.4.0 -> 0.5.0"
 
     @property
     def changed(self) -> bool:
@@ -142,14 +145,27 @@ def upgrade_store(store: Store, queries: QueryLibrary, check: StoreCheck | None 
     if not removing and not adding:
         return UpgradeReport()
     store.replace(sorted(removing, key=str), sorted(adding, key=str))
+    versions = _version_changes(outdated)
     log.info(
-        "upgraded the store: %d conditions rewritten, %s merged, %d quads out, %d in",
+        "upgraded the store%s: %d conditions rewritten, %s merged, %d quads out, %d in",
+        f" ({', '.join(versions)})" if versions else "",
         conditions,
         ", ".join(merged) or "no ontology",
         len(removing),
         len(adding),
     )
-    return UpgradeReport(conditions, len(removing), len(adding), tuple(merged))
+    return UpgradeReport(conditions, len(removing), len(adding), tuple(merged), versions)
+
+
+def _version_changes(outdated: dict[ox.NamedNode, frozenset[str]]) -> tuple[str, ...]:
+    """ "home.ttl 0.4.0 -> 0.5.0" for each out-of-date bundled file: what an administrator who upgraded cbrs
+    looks for in the log (the line named the files merged, not from which version to which)."""
+    bundled = {head: versions for head, _, versions in _bundled_versions()}
+    return tuple(
+        f"{path.name} {'/'.join(sorted(outdated[head]))} -> {'/'.join(sorted(bundled.get(head, ())))}"
+        for path, _, head in _bundled_merged_files()
+        if head in outdated
+    )
 
 
 def check_store(store: Store, queries: QueryLibrary) -> StoreCheck:

@@ -23,6 +23,7 @@ import pytest
 
 from cbrs.cli_serve import _redact_in_log
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import GraphName
 from cbrs.kb.store import EmbeddedStore, StoreDiskError
 from cbrs.server import ServeConfig, Server
 from cbrs.sparql_service import EndpointConfig
@@ -213,3 +214,22 @@ def test_the_token_is_kept_out_of_the_log_at_debug() -> None:
         root.removeHandler(handler)
         frames.setLevel(level)
     assert TOKEN not in written.getvalue() and '"mac": "***"' in written.getvalue()
+
+
+def test_an_upgrade_names_the_versions_it_went_from_and_to(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    # The round upgraded a store seeded by cbrs at 56ca954~1: the log said "home.ttl, qudt.ttl merged",
+    # not from which version to which.
+    location = tmp_path / "old"
+    home = ox.NamedNode("https://w3id.org/cbrs/home")
+    version = ox.NamedNode("http://www.w3.org/2002/07/owl#versionInfo")
+    kb = KnowledgeBase.open(location)
+    [bundled] = [q.object for q in kb.store.quads(home, version, None, GraphName.ONTOLOGY.node)]
+    assert isinstance(bundled, ox.Literal) and bundled.value != "0.4.0"
+    kb.store.replace(
+        [ox.Quad(home, version, bundled, GraphName.ONTOLOGY.node)],
+        [ox.Quad(home, version, ox.Literal("0.4.0"), GraphName.ONTOLOGY.node)],
+    )
+    kb.close()
+    caplog.set_level(logging.INFO, logger="cbrs.kb.upgrade")
+    KnowledgeBase.open(location).close()
+    assert f"home.ttl 0.4.0 -> {bundled.value}" in caplog.text
