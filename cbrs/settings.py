@@ -27,8 +27,18 @@ def _default_seed_cache() -> str:
     return user_cache_dir("cbrs", appauthor=False)
 
 
+def _number(kind: Callable[[str], Any], text: str) -> Any:
+    """``kind(text)`` (int or float), refused in words: Python's own "invalid literal for int() with base
+    10: 'abc'" was what CBRS_PORT=abc said."""
+    try:
+        return kind(text)
+    except ValueError:
+        what = "a whole number" if kind is int else "a number"
+        raise ValueError(f"{text!r} is not {what}") from None
+
+
 def _port(text: str) -> int:
-    port = int(text)
+    port: int = _number(int, text)
     if not 0 <= port <= 65535:
         raise ValueError(f"{port} is not a TCP port (0-65535)")
     return port
@@ -36,7 +46,7 @@ def _port(text: str) -> int:
 
 def _positive(kind: Callable[[str], float]) -> Callable[[str], Any]:
     def parse(text: str) -> Any:
-        value = kind(text)
+        value = _number(kind, text)
         if value <= 0:
             raise ValueError(f"{text} must be positive")
         return value
@@ -45,14 +55,14 @@ def _positive(kind: Callable[[str], float]) -> Callable[[str], Any]:
 
 
 def _non_negative(text: str) -> int:
-    value = int(text)
+    value: int = _number(int, text)
     if value < 0:
         raise ValueError(f"{text} must not be negative")
     return value
 
 
 def _non_negative_seconds(text: str) -> float:
-    value = float(text)
+    value: float = _number(float, text)
     if not value >= 0:  # NaN too
         raise ValueError(f"{text} must be a number of seconds, 0 or more")
     return value
@@ -63,7 +73,7 @@ def _metres(most: float) -> Callable[[str], float]:
     centimetres, and refused saying so rather than taken."""
 
     def parse(text: str) -> float:
-        value = float(text)
+        value: float = _number(float, text)
         if not 0.0 <= value <= most:  # NaN too
             raise ValueError(f"{text} must be a length in metres from 0 to {most:g} (5 mm is 0.005)")
         return value

@@ -26,6 +26,7 @@ from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import GraphName
 from cbrs.kb.store import EmbeddedStore, StoreDiskError
 from cbrs.server import ServeConfig, Server
+from cbrs.settings import setting
 from cbrs.sparql_service import EndpointConfig
 from tests.helpers_threads import assert_threads_end
 
@@ -233,3 +234,14 @@ def test_an_upgrade_names_the_versions_it_went_from_and_to(tmp_path: Path, caplo
     caplog.set_level(logging.INFO, logger="cbrs.kb.upgrade")
     KnowledgeBase.open(location).close()
     assert f"home.ttl 0.4.0 -> {bundled.value}" in caplog.text
+
+
+@pytest.mark.parametrize(
+    ("name", "raw", "said"), [("port", "abc", "a whole number"), ("query_timeout", "5s", "a number")]
+)
+def test_a_setting_that_is_no_number_is_refused_in_words(name: str, raw: str, said: str) -> None:
+    # The round's service file had CBRS_PORT=abc: "invalid literal for int() with base 10: 'abc'".
+    item = setting(name)
+    with pytest.raises(ValueError) as raised:
+        item.resolve(environ={item.env: raw})
+    assert str(raised.value) == f"environment variable {item.env}={raw!r}: {raw!r} is not {said}"
