@@ -513,7 +513,8 @@ SETTINGS: tuple[Setting, ...] = (
     Setting(
         "log_level",
         lambda: "INFO",
-        "Lowest level of the log lines cbrs serve writes to standard error: " + ", ".join(LOG_LEVELS) + ".",
+        "Lowest level of the log lines cbrs serve writes to standard error (INFO and below: a line per HTTP "
+        "request too; WARNING leaves those out): " + ", ".join(LOG_LEVELS) + ".",
         "CBRS_LOG_LEVEL",
         _log_level,
     ),

@@ -245,3 +245,27 @@ def test_a_setting_that_is_no_number_is_refused_in_words(name: str, raw: str, sa
     with pytest.raises(ValueError) as raised:
         item.resolve(environ={item.env: raw})
     assert str(raised.value) == f"environment variable {item.env}={raw!r}: {raw!r} is not {said}"
+
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "docs" / "examples"
+
+
+def test_the_service_files_name_only_options_and_settings_cbrs_serve_has() -> None:
+    # docs/examples/lab17_cbrs.service and lab17_cbrs.env, the round's unit for a lab's server
+    from cbrs.cli_serve import serve
+    from cbrs.settings import SETTINGS
+
+    unit = (EXAMPLES / "lab17_cbrs.service").read_text("utf-8")
+    [start] = [line.split("=", 1)[1].split() for line in unit.splitlines() if line.startswith("ExecStart=")]
+    assert start[1:2] == ["serve"], start
+    options = {name for param in serve.params for name in param.opts}
+    assert [word for word in start if word.startswith("--") and word not in options] == []
+    environment = {}
+    for line in (EXAMPLES / "lab17_cbrs.env").read_text("utf-8").splitlines():
+        if line.strip() and not line.startswith("#"):
+            name, _, value = line.partition("=")
+            environment[name] = value
+    by_variable = {item.env: item for item in SETTINGS}
+    assert sorted(set(environment) - set(by_variable)) == []
+    for name in environment:
+        by_variable[name].resolve(environ=environment)  # each value is one the setting takes
