@@ -30,6 +30,7 @@ from cbrs.kb import KnowledgeBase, Statement
 
 __all__ = [
     "LATE_WINDOW",
+    "MAX_CALL_SECONDS",
     "MAX_POLLS",
     "POLL_SECONDS",
     "AnswerRefusedError",
@@ -51,6 +52,11 @@ LATE_WINDOW = 2.0
 """The transport is given this many times the component's timeout: a call the component has given up
 stays open at the bridge for as long again, so that the provider's late answer is still heard and,
 until it is, no new call is sent to a service that may still be executing the last one (an actuator)."""
+MAX_CALL_SECONDS = 86400.0
+"""The longest one call is waited for: a day. A description may state any ``cbrs:responseTime``, and three
+times a mistyped one (``1e308`` for ``1e3``) is no time a clock or a lock can wait (infinity, or past the
+platform's ``time_t``): its call failed with an ``OverflowError`` before it could be answered, said to have
+been sent. Such a component is waited for a day, with a warning naming it and the time it states."""
 
 
 class Transport(Protocol):
@@ -125,6 +131,16 @@ class RemoteComponent(Component):
         self.service = service
         self.output_types = dict(outputs)
         self.check = check
+        if not timeout <= MAX_CALL_SECONDS:  # NaN too
+            log.warning(
+                "%s (%s) would be waited for %g s a call, more than a day: waiting %g s (its description's"
+                " cbrs:responseTime is three times less than the wait; is it mistyped?)",
+                iri,
+                service,
+                timeout,
+                MAX_CALL_SECONDS,
+            )
+            timeout = MAX_CALL_SECONDS
         self.timeout = timeout
         self._clock = clock
         self.exclusive = exclusive
