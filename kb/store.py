@@ -390,14 +390,15 @@ def disk_error(
     return None
 
 
-_WRITE_FAILED = (
-    "; nothing of this write was kept, what was committed before is; RocksDB takes no further writes "
-    "in this process after a failed one, so once the disk is fixed restart the process that holds the store "
-    "(cbrs serve)"
+_RESTART = (
+    "; RocksDB takes no further writes in this process after a failed one, so once the disk is fixed "
+    "restart the process that holds the store (cbrs serve)"
 )
-"""What a write that met a disk error adds: seen on a full disk, every later write and snapshot failed
-until the store was opened again, space freed or not (docs/serving.md, "Tried by a lab's system
-administrator")."""
+_WRITE_FAILED = "; nothing of this write was kept, what was committed before is" + _RESTART
+_SNAPSHOT_FAILED = "; the query was not run, and the store is as it was" + _RESTART
+"""What a write (or a query's snapshot) that met a disk error adds: seen on a full disk, every later
+write and snapshot failed until the store was opened again, space freed or not (docs/serving.md, "Tried
+by a lab's system administrator")."""
 
 
 class EmbeddedStore(Store):
@@ -518,7 +519,7 @@ class EmbeddedStore(Store):
             self._backend.backup(str(target))
         except OSError as error:
             doing = f"a snapshot into {target}"
-            raise self._failed(disk_error(self.location, doing, error, _WRITE_FAILED)) or StoreError(
+            raise self._failed(disk_error(self.location, doing, error, _SNAPSHOT_FAILED)) or StoreError(
                 self.location, f"snapshot into {target} failed: {error}"
             ) from error
         self.failure = None
