@@ -34,8 +34,9 @@ Action (rosbridge's ROS 2 action ops, ``send_action_goal`` and the rest):
 - ``/cbrs/run_task`` (type ``cbrs/action/RunTask``), goal ``{task, seed=0, fail=[], fault_rate=0,
   repeat_failures=1, objective="similarity", base_ties="nearest", near_misses=3}`` (read as the service
   reads them):
-  one feedback ``{run, plan, step, action, component, status, reason, failover}`` per plan step that
-  ends (``status`` succeeded or failed); the result is the run as the service returns it, with status
+  one feedback ``{run, iri, shown, plan, step, action, component, status, reason, failover}`` per plan
+  step that ends (``status`` succeeded or failed; ``iri`` and ``shown`` name the run's task as its result
+  does); the result is the run as the service returns it, with status
   SUCCEEDED, CANCELED (the client cancelled: the run stops after the step under way) or ABORTED (the
   run failed, found no plan or broke). A refused goal (no token, unknown task, a run going) fails as
   rosbridge fails a goal: ``result: false``, status UNKNOWN, the reason as ``values``.
@@ -67,7 +68,7 @@ from cbrs.matchmakers import Matchmakers
 from cbrs.rosbridge import Bridge, GoalHandle, GoalResult, GoalStatus, ServiceError, current_caller
 from cbrs.rosbridge.session import TOKEN_REFUSED
 from cbrs.sparql_service import SparqlService
-from cbrs.tasks import RUN_TOPIC, TaskRunner, check_choice, check_near_misses
+from cbrs.tasks import RUN_TOPIC, TaskRun, TaskRunner, check_choice, check_near_misses
 
 if TYPE_CHECKING:
     from cbrs.actions.composer import Composer, Objective
@@ -234,7 +235,7 @@ class KnowledgeServices:
         unsubscribe = self.tasks.subscribe(feed)
         try:
             run = _call(lambda: self.tasks.start(**request))
-            feed.follow(run.id)
+            feed.follow(run)
 
             def cancel() -> None:
                 self.tasks.cancel(run.id)  # the run stops after the step under way
@@ -277,13 +278,16 @@ class KnowledgeServices:
 
 class StepFeed:
     """A task listener that turns one run's step events into its goal's feedback: one message per step
-    that ends. Events that come before the run's id is known are held, then relayed in order."""
+    that ends, naming the run and its task (``iri``, ``shown``) as the run's result names them, so a
+    client that follows several runs need not keep its goals' names. Events that come before the run is
+    known are held, then relayed in order."""
 
     def __init__(self, goal: GoalHandle, realises: dict[str, str | None]) -> None:
         self.goal = goal
         self.realises = realises  # component IRI -> the action class it realises
         self._lock = threading.Lock()
         self._run: str | None = None
+        self._names: dict[str, str] = {}  # the run's iri and shown, as its record (TaskRun.to_dict) has them
         self._early: list[dict[str, Any]] = []
         self._plan = 1
 
@@ -296,10 +300,11 @@ class StepFeed:
             else:
                 self._relay(message)
 
-    def follow(self, run_id: str) -> None:
+    def follow(self, run: TaskRun) -> None:
         """The run is known: relay what came before and follow it from now on."""
         with self._lock:
-            self._run = run_id
+            self._run = run.id
+            self._names = {"iri": run.iri, "shown": run.shown or run.task}
             early, self._early = self._early, []
             for message in early:
                 self._relay(message)
@@ -315,6 +320,7 @@ class StepFeed:
             self.goal.publish_feedback(
                 {
                     "run": self._run,
+                    **self._names,
                     "plan": self._plan,
                     "step": message.get("step"),
                     "action": self.realises.get(component) if isinstance(component, str) else None,

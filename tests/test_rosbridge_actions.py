@@ -6,14 +6,18 @@ of ``cbrs serve`` running a task in the simulated home. Every receive is bounded
 
 from __future__ import annotations
 
+import json
 import threading
 from collections.abc import Callable, Iterator
 from typing import Any
 
 import pytest
 
-from cbrs.rosbridge import Bridge, GoalHandle, GoalResult, GoalStatus, RunningBridge, ServiceError
+from cbrs.bridge_services import StepFeed
+from cbrs.rosbridge import Bridge, Caller, GoalHandle, GoalResult, GoalStatus, RunningBridge, ServiceError
+from cbrs.tasks import TaskRun
 from tests.helpers_threads import assert_threads_end
+from tests.test_rosapi_typedefs import cbrs_types, mismatches
 from tests.test_rosbridge import WAIT, Client, client_maker
 
 TOKEN = "actions-test-token"
@@ -329,6 +333,33 @@ def test_clients_cannot_provide_the_servers_actions(client: Callable[[], Client]
 # -- /cbrs/run_task in cbrs serve --------------------------------------------------------------------
 
 
+def test_run_task_feedback_names_the_run_and_its_task_as_the_result_does() -> None:
+    """Each feedback carries the run's ``iri`` and ``shown`` (it named no task, so a client following
+    several runs had to keep its goals' names), those of steps that ended before the run was known too,
+    and only the fields ``cbrs/RunTaskFeedback`` defines; another run's steps are not relayed."""
+    sent: list[dict[str, Any]] = []
+    goal = GoalHandle("/cbrs/run_task", {}, Caller("127.0.0.1", None, True), lambda text: sent.append(json.loads(text)))
+    iri = "http://lab10.example/tasks#SwitchOnTheReadingLamp"
+    run = TaskRun("run-7", "SwitchOnTheReadingLamp", 0, (), iri=iri)
+    run.shown = "lab10:SwitchOnTheReadingLamp"
+    lamp = "http://lab10.example/svc#Lamp"
+    feed = StepFeed(goal, {lamp: "http://lab10.example/act#SwitchOn"})
+    step = {"run": "run-7", "task": iri, "iri": iri, "shown": run.shown, "step": 1, "component": lamp}
+    feed("/cbrs/task_progress", {**step, "event": "step_failed", "reason": "stuck", "failover": None})
+    feed.follow(run)
+    feed("/cbrs/task_progress", {**step, "run": "run-6", "event": "step_succeeded"})
+    feed("/cbrs/task_progress", {**step, "event": "replanning", "plan": 2})
+    feed("/cbrs/task_progress", {**step, "event": "step_succeeded"})
+    named = {key: run.to_dict()[key] for key in ("iri", "shown")}
+    assert named == {"iri": iri, "shown": "lab10:SwitchOnTheReadingLamp"}
+    assert [(f["run"], f["iri"], f["shown"], f["plan"], f["status"]) for f in sent] == [
+        ("run-7", iri, "lab10:SwitchOnTheReadingLamp", 1, "failed"),
+        ("run-7", iri, "lab10:SwitchOnTheReadingLamp", 2, "succeeded"),
+    ]
+    described = cbrs_types().message("cbrs/RunTaskFeedback")
+    assert all(set(f) == set(described[0]["fieldnames"]) and mismatches(described, f) == [] for f in sent), sent
+
+
 @pytest.fixture
 def served(fresh_bundled_kb: Any) -> Iterator[tuple[str, Any]]:
     pytest.importorskip("pybullet", reason="a task run needs the [sim] extra")
@@ -379,6 +410,10 @@ def test_run_task_action_needs_the_token_then_reports_each_step_and_the_verdict(
             (s["index"], s["component"], s["action"], "succeeded") for s in steps
         ]
         assert {f["run"] for f in feedback} == {run["id"]} and {f["plan"] for f in feedback} == {1}
+        assert {(f["iri"], f["shown"]) for f in feedback} == {(run["iri"], "RobotArmServeACup")}
+        assert run["iri"].endswith("#RobotArmServeACup")
+        described = cbrs_types().message("cbrs/RunTaskFeedback")
+        assert [mismatches(described, f) for f in feedback] == [[] for _ in feedback]
         assert run["result"]["goals"] and all(g["holds"] is not False for g in run["result"]["goals"])
     finally:
         me.close()
