@@ -1064,9 +1064,14 @@ cli.add_command(update)
 
 def main() -> None:
     """Entry point. click reports usage and library errors in one line; anything else is a bug,
-    reported in one line too unless CBRS_DEBUG asks for the traceback."""
+    reported in one line too unless CBRS_DEBUG asks for the traceback. A library error raised after the
+    command, as its store closes (``ctx.call_on_close``, outside :meth:`_Group.invoke`), is said as the
+    others are: ``Error: ...`` and status 1, on standard error only (the command's output is out already)."""
     try:
         cli.main(prog_name="cbrs")
+    except KnowledgeBaseError as error:
+        click.echo(f"Error: {with_notes(error)}", err=True)
+        sys.exit(1)
     except Exception as error:
         if os.environ.get("CBRS_DEBUG"):
             traceback.print_exc()
