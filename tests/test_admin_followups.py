@@ -4,12 +4,16 @@ what it left in files its helper did not own, each a test that failed before its
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 import pytest
 
 from cbrs.app import App
 from cbrs.cli import main
 from cbrs.kb.errors import StoreError
+from cbrs.settings import setting
+
+DOCS = Path(__file__).resolve().parents[1] / "docs"
 
 
 def test_a_library_error_as_the_store_closes_is_an_error_not_an_internal_one(
@@ -27,3 +31,14 @@ def test_a_library_error_as_the_store_closes_is_an_error_not_an_internal_one(
     assert caught.value.code == 1
     err = capsys.readouterr().err
     assert err == "Error: store /lab/store: flushing it to disk failed: its disk is full\n"
+
+
+def test_settings_md_says_what_the_log_level_help_says_of_requests() -> None:
+    # The help of cbrs serve --log-level said INFO logs a line per request (b49616a); settings.md did not.
+    [row] = [
+        line for line in (DOCS / "settings.md").read_text("utf-8").splitlines() if line.startswith("| `log_level`")
+    ]
+    help_text = setting("log_level").help
+    assert "a line per HTTP request" in help_text and "WARNING leaves those out" in help_text
+    assert "At `INFO` and below the log also has one line per HTTP request" in row
+    assert "`WARNING` leaves those out" in row
