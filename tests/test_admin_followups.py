@@ -10,8 +10,13 @@ import pytest
 
 from cbrs.app import App
 from cbrs.cli import main
+from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import StoreError
+from cbrs.kb.store import EmbeddedStore
 from cbrs.settings import setting
+from cbrs.sparql_service import EndpointConfig, SparqlService
+from cbrs.web import create_app
+from tests.test_blind_admin17 import _fill, _insert
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"
 
@@ -42,3 +47,31 @@ def test_settings_md_says_what_the_log_level_help_says_of_requests() -> None:
     assert "a line per HTTP request" in help_text and "WARNING leaves those out" in help_text
     assert "At `INFO` and below the log also has one line per HTTP request" in row
     assert "`WARNING` leaves those out" in row
+
+
+def test_healthz_is_503_while_the_stores_disk_refuses_writes_and_reads_no_store() -> None:
+    # The round: on a full disk every update failed 507 while /healthz said "ok", "writable": true.
+    kb = KnowledgeBase.open(":memory:")
+    store = kb.store
+    assert isinstance(store, EmbeddedStore)
+    token = "followups-token"
+    http = create_app(SparqlService(kb, EndpointConfig(update_token=token, isolate=False))).test_client()
+    auth = {"Authorization": f"Bearer {token}"}
+    ok = http.get("/healthz")
+    assert ok.status_code == 200 and ok.get_json()["status"] == "ok"
+    disk = _fill(store)
+    disk.full = True
+    assert http.post("/update", data={"update": _insert(1)}, headers=auth).status_code == 507
+    backend, store._open = store._open, None  # any read of the store now raises "is closed"
+    failing = http.get("/healthz")
+    store._open = backend
+    assert failing.status_code == 503
+    body = failing.get_json()
+    assert body["status"] == "failing" and "disk is full" in body["error"] and "restart" in body["error"]
+    assert {key: body[key] for key in ("version", "store", "writable")} == {
+        key: ok.get_json()[key] for key in ("version", "store", "writable")
+    }
+    disk.full = False  # a write that succeeds again clears the failure (a store opened anew has none)
+    assert http.post("/update", data={"update": _insert(2)}, headers=auth).status_code == 204
+    assert http.get("/healthz").get_json()["status"] == "ok"
+    kb.close()

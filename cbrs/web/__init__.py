@@ -151,8 +151,15 @@ def create_app(
             warmup.preload_once(app)
 
     @app.get("/healthz")
-    def health() -> Response:
-        return jsonify(status="ok", version=__version__, store=shown_location, writable=sparql.writable)
+    def health() -> Response | tuple[Response, int]:
+        """200 while the process serves; 503 once the store's disk refused a write (or a query's snapshot),
+        which the store remembers (``Store.failure``) until a write succeeds: a monitor of this path saw
+        "ok" while every write failed on a full disk. No store read: this stays as cheap as the process."""
+        failure = sparql.kb.store.failure
+        fields = {"version": __version__, "store": shown_location, "writable": sparql.writable}
+        if failure is not None:
+            return jsonify(status="failing", error=str(failure), **fields), 503
+        return jsonify(status="ok", **fields)
 
     @app.errorhandler(KnowledgeBaseError)
     def library_error(error: KnowledgeBaseError) -> tuple[Response | str, int]:
