@@ -7,11 +7,27 @@ from dataclasses import dataclass, field
 import click
 import pyoxigraph as ox
 
+from cbrs.cli_notes import note_upgraded_store
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import StoreError
 from cbrs.kb.namespaces import expand
 from cbrs.kb.store import StoreInUseError
+from cbrs.kb.upgrade import StoreCheck, UpgradeReport
 from cbrs.settings import setting
+
+
+class _NotedKnowledgeBase(KnowledgeBase):
+    """A knowledge base that keeps what the upgrade of its open did (``KnowledgeBase.open`` logs it and
+    returns the knowledge base alone), for the command to say: a command that upgraded an old store said
+    nothing of it."""
+
+    upgraded: UpgradeReport | None = None
+
+    def upgrade(self, check: StoreCheck | None = None) -> UpgradeReport:
+        report = super().upgrade(check)
+        if report.changed:
+            self.upgraded = report
+        return report
 
 
 @dataclass
@@ -30,7 +46,7 @@ class App:
         contents whole (``cbrs restore``): a new store is not seeded, an old one not upgraded, first."""
         if self._kb is None:
             try:
-                self._kb = KnowledgeBase.open(
+                opened = _NotedKnowledgeBase.open(
                     self.store_location,
                     seed=seed,
                     remote_timeout=setting("remote_timeout").resolve(),
@@ -47,6 +63,9 @@ class App:
                 )
                 reason = f"is in use by another process (RocksDB lock held); {hint} ({error.cause})"
                 raise StoreError(error.location, reason) from error
+            self._kb = opened
+            if isinstance(opened, _NotedKnowledgeBase) and opened.upgraded is not None:
+                note_upgraded_store(opened.store.location, opened.upgraded)
         return self._kb
 
     @property

@@ -1,14 +1,19 @@
 """What the ``cbrs`` command says at its edges besides its output: errors as JSON for a command asked for
-JSON, the notes an error gathered on its way up, and a store the command made where none was."""
+JSON, the notes an error gathered on its way up, a store the command made where none was, and one it
+upgraded."""
 
 from __future__ import annotations
 
+import logging
 import sys
 from pathlib import Path
 
 import click
 
+from cbrs.kb.errors import without_password
 from cbrs.kb.store import MEMORY, is_remote
+from cbrs.kb.upgrade import UpgradeReport
+from cbrs.kb.upgrade import log as upgrade_log
 from cbrs.settings import setting
 
 
@@ -54,3 +59,18 @@ def note_new_store(location: str) -> None:
             "(is the path right? cbrs init makes one on purpose)",
             err=True,
         )
+
+
+def note_upgraded_store(location: str, report: UpgradeReport) -> None:
+    """Say that opening the store brought it up to the bundled ontologies, and from which versions to which:
+    it changed the user's store, once, and a command said nothing of it. Said whether or not a person is at
+    a terminal (a cron job's mail or a unit's journal should carry it too), unless the log already says it
+    (``cbrs serve`` logs the upgrade at INFO)."""
+    if upgrade_log.isEnabledFor(logging.INFO) and upgrade_log.hasHandlers():
+        return
+    # no version changed: conditions rewritten, or an emptied map given the bundled one
+    what = ", ".join(report.versions) or f"{report.removed} quads out, {report.added} in"
+    click.echo(
+        f"note: upgraded the store at {without_password(location)} to this cbrs's bundled ontologies: {what}",
+        err=True,
+    )

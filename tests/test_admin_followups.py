@@ -3,15 +3,19 @@ what it left in files its helper did not own, each a test that failed before its
 
 from __future__ import annotations
 
+import logging
 import sys
 from pathlib import Path
 
+import pyoxigraph as ox
 import pytest
+from click.testing import CliRunner
 
 from cbrs.app import App
-from cbrs.cli import main
+from cbrs.cli import cli, main
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import StoreError
+from cbrs.kb.namespaces import GraphName
 from cbrs.kb.store import EmbeddedStore
 from cbrs.settings import setting
 from cbrs.sparql_service import EndpointConfig, SparqlService
@@ -75,3 +79,42 @@ def test_healthz_is_503_while_the_stores_disk_refuses_writes_and_reads_no_store(
     assert http.post("/update", data={"update": _insert(2)}, headers=auth).status_code == 204
     assert http.get("/healthz").get_json()["status"] == "ok"
     kb.close()
+
+
+def _old_store(location: Path) -> str:
+    """A store whose home.ttl says 0.4.0 (as one seeded at 56ca954~1 does); the bundled version."""
+    home = ox.NamedNode("https://w3id.org/cbrs/home")
+    version = ox.NamedNode("http://www.w3.org/2002/07/owl#versionInfo")
+    kb = KnowledgeBase.open(location)
+    [bundled] = [q.object for q in kb.store.quads(home, version, None, GraphName.ONTOLOGY.node)]
+    assert isinstance(bundled, ox.Literal) and bundled.value != "0.4.0"
+    kb.store.replace(
+        [ox.Quad(home, version, bundled, GraphName.ONTOLOGY.node)],
+        [ox.Quad(home, version, ox.Literal("0.4.0"), GraphName.ONTOLOGY.node)],
+    )
+    kb.close()
+    return bundled.value
+
+
+def test_a_command_that_upgrades_the_store_says_so(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    # The round: cbrs query on an old store upgraded it (home.ttl 0.4.0 -> 0.5.0) without a word.
+    location = tmp_path / "old"
+    bundled = _old_store(location)
+    caplog.set_level(logging.WARNING, logger="cbrs.kb.upgrade")  # a command's log: nothing at INFO
+    upgraded = CliRunner().invoke(cli, ["--store", str(location), "services"])
+    assert upgraded.exit_code == 0, upgraded.output
+    assert upgraded.stderr == (
+        f"note: upgraded the store at {location} to this cbrs's bundled ontologies: home.ttl 0.4.0 -> {bundled}\n"
+    )
+    again = CliRunner().invoke(cli, ["--store", str(location), "services"])
+    assert again.exit_code == 0 and again.stderr == ""
+
+
+def test_an_upgrade_the_log_says_is_not_said_twice(tmp_path: Path, caplog: pytest.LogCaptureFixture) -> None:
+    # cbrs serve logs the upgrade at INFO (its log is its standard error): no note besides.
+    location = tmp_path / "old"
+    bundled = _old_store(location)
+    caplog.set_level(logging.INFO, logger="cbrs.kb.upgrade")
+    upgraded = CliRunner().invoke(cli, ["--store", str(location), "services"])
+    assert upgraded.exit_code == 0 and upgraded.stderr == ""
+    assert f"home.ttl 0.4.0 -> {bundled}" in caplog.text
