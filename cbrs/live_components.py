@@ -166,9 +166,10 @@ class LiveComponents:
         self.provided = provided
         """Whether a bridge client provides a service (the server's bridge); None: not checked."""
         self.on_lapse: Callable[[str, str], None] | None = None
-        """Called with the bridge service and the reason when a component's lease lapses: the server fails
-        the calls waiting on it (``Bridge.fail_calls``), since its late answer would act on a plan that
-        has moved on, and a lapse is the server giving up on it as a disconnect is."""
+        """Called with the bridge service and the reason when a component's lease lapses or it is found
+        deregistered: the server fails the calls waiting on it (``Bridge.fail_calls``), since its late
+        answer would act on a plan that has moved on (or on a component nobody describes any more), and
+        each is the server giving up on it as a disconnect is."""
         self._leases: dict[str, _Lease] = {}
         self._ended: OrderedDict[str, dict[str, str]] = OrderedDict()  # session -> {component: why it ended}
         self._guard = threading.Lock()
@@ -395,10 +396,12 @@ class LiveComponents:
                     self.sparql.changed()
             if gone:
                 with self._guard:
-                    for iri in gone:
-                        self._leases.pop(iri, None)
+                    services = {iri: lease.service for iri in gone if (lease := self._leases.pop(iri, None))}
                 self._remember_ended(session, gone, "it was deregistered")
                 log.info("%s deregistered: its lease ended", ", ".join(gone))
+                for iri, service in services.items():  # removed on purpose: its answer would act for nobody
+                    if self.on_lapse is not None and service:
+                        self.on_lapse(service, f"<{iri}> was deregistered while {{service!r}} was executing the call")
                 renewed = [iri for iri in renewed if iri not in gone]
         return sorted(renewed)
 

@@ -7,19 +7,29 @@ from __future__ import annotations
 
 import math
 import threading
+import time
 from collections.abc import Iterator
+from typing import Any
 
 import pytest
 
 from cbrs.actions.components import Status
-from cbrs.actions.remote import MAX_CALL_SECONDS, RemoteComponent
+from cbrs.actions.remote import MAX_CALL_SECONDS, RemoteCallError, RemoteComponent
 from cbrs.bridge_client import BridgeClient
 from cbrs.rosbridge import Bridge, RunningBridge
+from cbrs.server import Server
 from tests.helpers_threads import assert_threads_end
+from tests.test_live_components import READING, THERMOMETER, TOKEN, live_server, thermometer, url
 from tests.test_rosbridge import WAIT
 
 BLIND = "https://example.org/lab18#LowerBlind_BlindMotor01"
 LOWER = "/lab18_blind_motor_01/lower"
+
+
+@pytest.fixture
+def live() -> Iterator[Server]:
+    with live_server() as running:
+        yield running
 
 
 @pytest.fixture
@@ -60,3 +70,33 @@ def test_a_mistyped_response_time_is_waited_a_day_and_its_call_is_answered(
         assert component.outputs["blindStatus"] == {"@type": "https://example.org/lab18#Lowered"}
     assert component.timeout == MAX_CALL_SECONDS
     assert f"{BLIND} ({LOWER}) would be waited for" in caplog.text and "more than a day" in caplog.text
+
+
+def test_a_call_in_flight_fails_when_its_component_is_deregistered(live: Server) -> None:
+    """`cbrs deregister` of the blind's raise while the motor ran: the call went on, the motor's answer
+    was taken and the run succeeded with the blind believed raised, though the run's own log said "did a
+    step but is no longer described: its effects are not believed". Someone removed it on purpose, as a
+    lease that lapses is the server giving up on it: the calls waiting on it fail at once, saying so."""
+    release = threading.Event()
+
+    def stuck(request: dict[str, Any]) -> dict[str, Any]:
+        release.wait(10.0)  # the motor still running
+        return READING
+
+    with BridgeClient(url(live), TOKEN) as component, BridgeClient(url(live), TOKEN) as caller:
+        component.provide("/thermometer07/read", "cbrs_msgs/RoomTemperature", stuck)
+        registered = component.call_sync("/cbrs/register", {"description": thermometer(), "ttl": 1.0})
+        assert registered["components"] == [THERMOMETER]
+        call = caller.call("/thermometer07/read", {}, timeout=20.0)
+        try:
+            with live.sparql.lock:
+                live.kb.registry.deregister(THERMOMETER)
+            for _ in range(40):  # beats, until one past half the lease writes the store and finds it gone
+                if call.done():
+                    break
+                component.call("/cbrs/heartbeat", {}, timeout=5.0)
+                time.sleep(0.1)
+            with pytest.raises(RemoteCallError, match="was deregistered while '/thermometer07/read' was executing"):
+                call.result(timeout=2.0)  # well before the call's own 20 s
+        finally:
+            release.set()
