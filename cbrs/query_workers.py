@@ -27,6 +27,8 @@ import contextlib
 import json
 import logging
 import os
+import re
+import secrets
 import select
 import shutil
 import signal
@@ -140,14 +142,13 @@ class QueryProcesses:
         self._closed = False
         self._reaper: threading.Thread | None = None
         self._wake = threading.Event()
+        owner = _owner(store)
         try:  # beside the store, so the checkpoint hard-links its files instead of copying them
             if store.in_memory:
                 raise OSError("an in-memory store's snapshots are copies: the temporary folder will do")
-            parent = Path(store.location).resolve().parent
-            self._root = Path(tempfile.mkdtemp(prefix=".cbrs-query-snapshots-", dir=parent))
+            self._root = _snapshot_root(Path(store.location).resolve().parent, "." + SNAPSHOTS, owner)
         except OSError:
-            self._root = Path(tempfile.mkdtemp(prefix="cbrs-query-snapshots-"))
-        _roots.add(self._root)
+            self._root = _snapshot_root(Path(tempfile.gettempdir()), SNAPSHOTS, owner)
 
     def run(self, request: Request) -> tuple[bytes, str]:
         """Evaluate ``request`` in a worker; (body, media type), or an error the endpoint reports."""
@@ -377,6 +378,70 @@ class QueryProcesses:
 
 _started: set[subprocess.Popen[bytes]] = set()
 _roots: set[Path] = set()
+_roots_lock = threading.Lock()  # a root is made and counted as this process's in one step
+
+SNAPSHOTS = "cbrs-query-snapshots-"
+"""How a folder of query snapshots is named: ``.cbrs-query-snapshots-STORE-PID-XXXXXXXX`` beside the store
+directory STORE (``cbrs-query-snapshots-...`` in the temporary folder for an in-memory store, ``memory``,
+or when the store's folder takes none), PID the process that made it. A process killed with SIGKILL
+leaves it behind, holding hard links to store files the store has since compacted away; the next process
+to snapshot the same store removes every such folder whose process has ended (:func:`_remove_left`)."""
+_OWNER_LENGTH = 100  # of a store's name in the folder's: a folder name is at most 255 bytes
+
+
+def _owner(store: EmbeddedStore) -> str:
+    """The store's name as its snapshots' folder carries it: its directory's, or ``memory``."""
+    return "memory" if store.in_memory else Path(store.location).name[:_OWNER_LENGTH] or "store"
+
+
+def _snapshot_root(parent: Path, prefix: str, owner: str) -> Path:
+    """A new folder for this process's snapshots of ``owner`` in ``parent``, after removing those a process
+    that ended left there."""
+    with _roots_lock:
+        _remove_left(parent, prefix + owner)
+        while True:
+            root = parent / f"{prefix}{owner}-{os.getpid()}-{secrets.token_hex(4)}"
+            try:
+                root.mkdir(mode=0o700)
+            except FileExistsError:
+                continue
+            _roots.add(root)
+            return root
+
+
+def _remove_left(parent: Path, stem: str) -> None:
+    """Remove the folders ``stem-PID-XXXXXXXX`` in ``parent`` whose process PID has ended (or is this one,
+    which made it before: a service restarted in a container often gets its old PID, and this process's
+    own live folders are in ``_roots``). A live process's folder is never touched: a PID taken since by
+    another process keeps its folder until that one ends too."""
+    pattern = re.compile(re.escape(stem) + r"-(\d+)-[0-9a-f]{8}")
+    try:
+        names = [entry.name for entry in os.scandir(parent) if entry.is_dir(follow_symlinks=False)]
+    except OSError:
+        return
+    for name in names:
+        matched = pattern.fullmatch(name)
+        if matched is None:
+            continue
+        path = parent / name
+        pid = int(matched.group(1))
+        if path in _roots or (pid != os.getpid() and _alive(pid)):
+            continue
+        log.info("removing %s, query snapshots left by process %d, which has ended", path, pid)
+        shutil.rmtree(path, ignore_errors=True)
+
+
+def _alive(pid: int) -> bool:
+    """Whether process ``pid`` exists (another user's too: signal 0 is refused to it, not unknown)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    except (OSError, OverflowError):  # a PID past the system's range: no process has it
+        return False
+    return True
 
 
 def _stop(process: subprocess.Popen[bytes]) -> None:

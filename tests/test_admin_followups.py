@@ -4,6 +4,8 @@ what it left in files its helper did not own, each a test that failed before its
 from __future__ import annotations
 
 import logging
+import os
+import subprocess
 import sys
 from pathlib import Path
 
@@ -17,6 +19,7 @@ from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import StoreError
 from cbrs.kb.namespaces import GraphName
 from cbrs.kb.store import EmbeddedStore
+from cbrs.query_workers import QueryProcesses
 from cbrs.settings import setting
 from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.web import create_app
@@ -118,3 +121,44 @@ def test_an_upgrade_the_log_says_is_not_said_twice(tmp_path: Path, caplog: pytes
     upgraded = CliRunner().invoke(cli, ["--store", str(location), "services"])
     assert upgraded.exit_code == 0 and upgraded.stderr == ""
     assert f"home.ttl 0.4.0 -> {bundled}" in caplog.text
+
+
+def _ended_pid() -> int:
+    """The PID of a process that has ended (and been waited for)."""
+    child = subprocess.Popen([sys.executable, "-c", "pass"])
+    child.wait(timeout=30)
+    return child.pid
+
+
+def test_query_snapshots_name_their_store_and_process_and_a_dead_ones_are_removed(tmp_path: Path) -> None:
+    # The round: a SIGKILLed server left .cbrs-query-snapshots-XXXXXXXX beside the store, hard links to old
+    # store files holding disk space, named so that nobody could tell whose it was.
+    store = EmbeddedStore.open(tmp_path / "labstore")
+    live = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    try:
+        left = tmp_path / f".cbrs-query-snapshots-labstore-{_ended_pid()}-0a1b2c3d"
+        mine_before = tmp_path / f".cbrs-query-snapshots-labstore-{os.getpid()}-0a1b2c3e"  # a restart, same PID
+        kept = [
+            tmp_path / f".cbrs-query-snapshots-labstore-{live.pid}-0a1b2c3f",  # a live server's
+            tmp_path / f".cbrs-query-snapshots-labstore-2-{_ended_pid()}-0a1b2c40",  # store labstore-2's
+            tmp_path / ".cbrs-query-snapshots-0a1b2c41",  # an older cbrs's: whose, it does not say
+        ]
+        for folder in (left, mine_before, *kept):
+            (folder / "snapshot-1").mkdir(parents=True)
+        processes = QueryProcesses(store, size=1, memory=0)
+        try:
+            root = processes._root
+            assert root.parent == tmp_path
+            assert root.name.startswith(f".cbrs-query-snapshots-labstore-{os.getpid()}-")
+            assert not left.exists() and not mine_before.exists()
+            assert all(folder.exists() for folder in kept)
+            again = QueryProcesses(store, size=1, memory=0)  # a second in this process leaves the first's
+            assert root.exists() and again._root != root
+            again.close()
+        finally:
+            processes.close()
+        assert not root.exists()
+    finally:
+        live.kill()
+        live.wait(timeout=10)
+        store.close()
