@@ -57,6 +57,7 @@ from cbrs.actions.errors import ActionsError
 from cbrs.actions.qualities import OwnQualities
 from cbrs.actions.remote_errors import RemoteCallError
 from cbrs.kb import KnowledgeBase, KnowledgeBaseError, Statement
+from cbrs.kb.errors import NotFoundError
 from cbrs.kb.namespaces import expand, shorten
 
 __all__ = ["GivenUp", "SentAndFailed", "unsettle", "watch"]
@@ -75,6 +76,8 @@ class GivenUp:
     service: str
     timeout: float
     inputs: Mapping[str, Any]
+    effects: tuple[Statement, ...] = ()  # the advertisement's the call was made from: what it would set,
+    deletes: tuple[Statement, ...] = ()  # should the store no longer describe the component (deregistered)
 
     def said(self, what: str) -> str:
         return (
@@ -108,6 +111,8 @@ class SentAndFailed:
     service: str
     reason: str
     inputs: Mapping[str, Any]
+    effects: tuple[Statement, ...] = ()  # as GivenUp's
+    deletes: tuple[Statement, ...] = ()
 
     def said(self, what: str) -> str:
         return f"{shorten(self.component)} ({self.service}) {what}"
@@ -153,12 +158,18 @@ def watch(kb: KnowledgeBase, classes: Classes, call: GivenUp, read: Read) -> Lat
 
 
 def _expect(kb: KnowledgeBase, classes: Classes, call: GivenUp | SentAndFailed) -> _Expected:
-    description = kb.description(call.component)
-    untested = [s for s in (*description.deletes, *description.effects) if not _tested(kb, s.predicate)]
+    try:
+        description = kb.description(call.component)
+        said_deletes, said_effects = description.deletes, description.effects
+    except NotFoundError:  # deregistered while the call was out: the device may have acted all the same
+        if not (call.effects or call.deletes):
+            raise
+        said_deletes, said_effects = call.deletes, call.effects
+    untested = [s for s in (*said_deletes, *said_effects) if not _tested(kb, s.predicate)]
     quality = OwnQualities(kb, classes.is_a)
     grounded = {s: _grounded(kb, classes, quality, s, call.inputs) for s in untested}
-    deletes = tuple(f for s in description.deletes if (f := grounded.get(s)) is not None)
-    adds = tuple(f for s in description.effects if (f := grounded.get(s)) is not None)
+    deletes = tuple(f for s in said_deletes if (f := grounded.get(s)) is not None)
+    adds = tuple(f for s in said_effects if (f := grounded.get(s)) is not None)
     functional = frozenset(row["property"].value for row in kb.select("functional_properties"))
     pairs = {(s, p) for s, p, _ in (*deletes, *adds)}
     missed = [s for s, fact in grounded.items() if fact is None]

@@ -304,7 +304,12 @@ class RemoteComponent(Component):
         """What the answer to the call given up now does to the belief if it comes (None: it is logged)."""
         if self.kb is None or self.classes is None:
             return None
-        return watch(self.kb, self.classes, GivenUp(self.iri, self.service, self.timeout, self._inputs), self._read)
+        return watch(
+            self.kb,
+            self.classes,
+            GivenUp(self.iri, self.service, self.timeout, self._inputs, self.effects, self.deletes),
+            self._read,
+        )
 
     def halt(self) -> None:
         """The step was stopped while the call was out (a cancelled run, the executor's tick bound)."""
@@ -325,7 +330,11 @@ class RemoteComponent(Component):
             return
         self._sent_call = False
         if self.kb is not None and self.classes is not None and (self.effects or self.deletes):
-            unsettle(self.kb, self.classes, SentAndFailed(self.iri, self.service, reason, self._inputs))
+            unsettle(
+                self.kb,
+                self.classes,
+                SentAndFailed(self.iri, self.service, reason, self._inputs, self.effects, self.deletes),
+            )
 
 
 def given_up(transport: Transport, service: str, clock: Callable[[], float] = time.monotonic) -> str:

@@ -9,21 +9,31 @@ import math
 import threading
 import time
 from collections.abc import Iterator
+from pathlib import Path
 from typing import Any
 
 import pytest
 
+from cbrs.actions.answers import StoreClasses
+from cbrs.actions.belief import BeliefState, Observation
 from cbrs.actions.components import Status
 from cbrs.actions.remote import MAX_CALL_SECONDS, RemoteCallError, RemoteComponent
 from cbrs.bridge_client import BridgeClient
+from cbrs.kb import KnowledgeBase
+from cbrs.kb.namespaces import PREFIXES
 from cbrs.rosbridge import Bridge, RunningBridge
 from cbrs.server import Server
 from tests.helpers_threads import assert_threads_end
+from tests.test_failed_step_belief import Answering
 from tests.test_live_components import READING, THERMOMETER, TOKEN, live_server, thermometer, url
 from tests.test_rosbridge import WAIT
 
 BLIND = "https://example.org/lab18#LowerBlind_BlindMotor01"
 LOWER = "/lab18_blind_motor_01/lower"
+LAB18, HOME = "https://example.org/lab18#", PREFIXES["home"]
+RAISE = LAB18 + "RaiseBlind_BlindMotor01"
+BLIND_THING = {"@id": LAB18 + "SouthWindowBlind", "@type": LAB18 + "WindowBlind"}
+EXAMPLES = Path(__file__).resolve().parents[1] / "docs" / "examples"
 
 
 @pytest.fixture
@@ -100,3 +110,39 @@ def test_a_call_in_flight_fails_when_its_component_is_deregistered(live: Server)
                 call.result(timeout=2.0)  # well before the call's own 20 s
         finally:
             release.set()
+
+
+def test_a_failed_call_of_a_component_deregistered_meanwhile_still_unsettles_its_effects() -> None:
+    """The blind's raise deregistered mid-motion: its call failed (the test above), and the belief was to
+    become unknown, since the motor may have moved, but the store no longer described the component: "what
+    it may have done could not be marked unknown (no service description ...): the belief may be stale".
+    The call knows what it would set (the advertisement it was made from), and that is what is unsettled."""
+
+    kb = KnowledgeBase.open(":memory:")
+    try:
+        for graph in ("ontology", "map"):
+            kb.load([EXAMPLES / "lab18_window_blind.ttl"], graph=graph)
+        kb.registry.register((EXAMPLES / "lab18_blind_motor.ttl").read_text(encoding="utf-8"))
+        effects = kb.description(RAISE).effects
+        kb.registry.deregister(RAISE)  # by `cbrs deregister`, while the motor ran
+        BeliefState(kb).write(
+            Observation(facts=frozenset({(BLIND_THING["@id"], HOME + "hasStatus", LAB18 + "Lowered")})), whole=True
+        )
+        classes = StoreClasses(kb)
+        transport = Answering(
+            RemoteCallError("<…> was deregistered while '/lab18_blind_motor_01/raise' was executing the call")
+        )
+        component = RemoteComponent(
+            RAISE,
+            transport,
+            "/lab18_blind_motor_01/raise",
+            {"blindStatus": HOME + "DeviceStatus"},
+            effects=effects,
+            classes=classes,
+        )
+        component.begin({"blind": BLIND_THING})
+        assert component.update() is Status.FAILED
+        status = [o for s, p, o in BeliefState(kb).facts(BLIND_THING["@id"]) if p == HOME + "hasStatus"]
+        assert status == []  # it may have moved: unknown, not still lowered
+    finally:
+        kb.close()
