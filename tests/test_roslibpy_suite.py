@@ -48,8 +48,8 @@ LEFT_OUT = {
     # not wake the server's event loop: the set is seen only if the client's closing handshake reaches the
     # loop after it. When the main thread comes a few milliseconds late (a loaded machine), the loop already
     # sleeps with nothing to wait for, the test fails ("Server did not stop as expected") and its non-daemon
-    # server thread keeps the process from ever exiting: the suite's one run past 300 s. A 50 ms sleep
-    # before the set reproduces it; with port 9000 taken by another program it fails outright.
+    # server thread keeps the process from ever exiting: the suite's one run past 300 s. A sleep before the
+    # set reproduces it (2-3 s: 3 runs of 3; 10-50 ms: 2 of 3); with port 9000 taken it fails outright.
     "test_ws_headers.py": "stops its own port-9000 server with an asyncio.Event set from another thread: "
     "a race that hangs the process at exit on a loaded machine",
 }
