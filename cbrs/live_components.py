@@ -300,9 +300,10 @@ class LiveComponents:
                 if iri not in states:
                     raise StoredComponentError(iri)  # a component of the store, not a live one
                 returning.append(iri)
-            if returning and len(returning) != len(named):
-                raise ValueError("register the components coming back apart from the new ones")
-            if returning:
+            if returning and len(returning) != len(named):  # one of a program's components was deregistered
+                registered, updated = kb.registry.sync(turtle, "<registration>")  # both back, in one transaction
+                iris = [iri for iri in sorted(named) if iri in {*registered, *updated}]
+            elif returning:
                 iris = kb.registry.update(turtle, "<registration>")
             else:
                 iris = kb.registry.register(turtle, "<registration>")
@@ -396,7 +397,7 @@ class LiveComponents:
                     self.sparql.changed()
             if gone:
                 with self._guard:
-                    services = {iri: lease.service for iri in gone if (lease := self._leases.pop(iri, None))}
+                    services = {iri: self._leases.pop(iri).service for iri in gone if iri in self._leases}
                 self._remember_ended(session, gone, "it was deregistered")
                 log.info("%s deregistered: its lease ended", ", ".join(gone))
                 for iri, service in services.items():  # removed on purpose: its answer would act for nobody

@@ -146,3 +146,21 @@ def test_a_failed_call_of_a_component_deregistered_meanwhile_still_unsettles_its
         assert status == []  # it may have moved: unknown, not still lowered
     finally:
         kb.close()
+
+
+def test_a_program_whose_one_component_was_deregistered_registers_both_again(live: Server) -> None:
+    """The blind motor's program registers its two components in one call. After `cbrs deregister` of the
+    raise, the program restarted was refused for good, "register the components coming back apart from the
+    new ones": the lower was coming back, the raise new. Both are registered again, in one transaction."""
+    motor = (EXAMPLES / "lab18_blind_motor.ttl").read_text(encoding="utf-8")
+    with BridgeClient(url(live), TOKEN) as first:
+        assert first.call_sync("/cbrs/register", {"description": motor, "ttl": 1.0})["components"] == [BLIND, RAISE]
+    with live.sparql.lock:
+        live.kb.registry.deregister(RAISE)
+    with BridgeClient(url(live), TOKEN) as again:
+        assert sorted(again.call_sync("/cbrs/register", {"description": motor, "ttl": 1.0})["components"]) == [
+            BLIND,
+            RAISE,
+        ]
+        states = live.kb.liveness.states()
+        assert states[BLIND].live and states[RAISE].live
