@@ -503,7 +503,9 @@ class Bridge:
         """A provider's ``result: false`` fails the call of a service ``predicate(service)`` is true for,
         even with an object of values, which rosbridge_suite takes as the answer (below): roslibpy
         answers ``{}`` with a handler's ``False``, and a live component that cannot act must not be
-        taken for one that acted. Asked on the bridge's loop: keep it short."""
+        taken for one that acted. Such a service's answer holding a NaN or an infinity (roslibpy sends the
+        tokens) fails too, naming the field: JSON callers would get ``null``, a broken reading taken for a
+        missing one. Asked on the bridge's loop: keep it short."""
         self._verdicts.append(predicate)
 
     def _strict(self, service: str) -> bool:

@@ -115,12 +115,16 @@ class Calls:
         call = self._pending.get(str(key))
         if call is None or call.provider is not provider:
             return False
-        if isinstance(values, dict) and not result and self._strict(call.service):
+        strict = isinstance(values, dict) and self._strict(call.service)
+        if strict and not result:
             given = protocol.dumps(values, self._non_finite)
             result, values = (
                 False,
                 f"service {call.service!r} answered result: false" + (f" (values {given[:200]})" if values else ""),
             )
+        elif strict and (where := protocol.non_finite_field(values)) is not None:
+            # Its JSON callers would read null: a broken reading taken for a missing one.
+            result, values = False, f"service {call.service!r} answered values that are not JSON: {where}"
         elif isinstance(values, dict):
             result = True  # rosbridge_suite's rule: an object of values is the response, whatever `result` says
         elif values is None:

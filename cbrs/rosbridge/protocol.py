@@ -375,6 +375,31 @@ def _decoded_tokens(value: Any) -> str:
     return "".join(_TOKENS_C(value, 0))
 
 
+def non_finite_field(value: Any) -> str | None:
+    """Where the first NaN or infinity in a decoded ``value`` is, as a field path (``percent``,
+    ``pose.x``, ``ranges[2]``) and the token roslibpy sends for it: ``"field 'percent' is NaN"``. None if
+    it holds none, found at the C encoder's speed; the walk runs only when there is one."""
+    try:
+        _STRICT_C(value, 0)
+        return None
+    except ValueError:
+        pass
+    found = _non_finite_in(value, "")
+    return None if found is None else f"field {found[0]!r} is {found[1]}"
+
+
+def _non_finite_in(value: Any, path: str) -> tuple[str, str] | None:
+    if isinstance(value, float) and value - value != 0.0:  # NaN, or an infinity (inf - inf is NaN)
+        token = "NaN" if value != value else ("Infinity" if value > 0 else "-Infinity")
+        return path or "(the values)", token
+    items: Any = value.items() if isinstance(value, dict) else enumerate(value) if isinstance(value, list) else ()
+    for key, item in items:
+        found = _non_finite_in(item, f"{path}[{key}]" if isinstance(key, int) else f"{path}.{key}" if path else key)
+        if found is not None:
+            return found
+    return None
+
+
 def encode_decoded(value: Any, non_finite: str = "null") -> tuple[str, bool]:
     """:func:`encode` of a value that came out of :func:`decode` (what a client sent), faster: every
     message a publisher sends passes here (bench/rosbridge_relay.py)."""

@@ -1,0 +1,90 @@
+"""What the eighteenth round (a lab's developer writing components without the SDK, docs/components.md's
+"Tried by a component developer") left, fixed: a live component's answer over the bridge, and a Stop
+during a call to a slow one. One server for the module, on loopback ports; raw programs write the frames
+roslibpy and buggy clients send."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+
+from cbrs.actions.remote import RemoteCallError
+from cbrs.bridge_client import BridgeClient
+from cbrs.rosbridge import Bridge
+from cbrs.server import Server
+from tests.test_live_components import TOKEN, live_server, thermometer, url
+from tests.test_remote_trial_bridge import WAIT, Raw
+
+
+@pytest.fixture(scope="module")
+def server() -> Iterator[Server]:
+    with live_server() as running:
+        yield running
+
+
+def registered(server: Server, service: str, device: str) -> Raw:
+    """A raw program that registered a thermometer named ``device`` and advertised ``service``."""
+    description = thermometer(service).replace("Thermometer07", device)
+    program = Raw(url(server))
+    program.send({"op": "auth", "mac": TOKEN})
+    program.send({"op": "call_service", "service": "/cbrs/register", "id": "r", "args": {"description": description}})
+    assert program.expect("service_response", id="r")["result"] is True
+    program.send({"op": "advertise_service", "service": service, "type": "cbrs_msgs/RoomTemperature"})
+    synced(program)
+    return program
+
+
+def synced(program: Raw) -> None:
+    """Wait until the bridge has read what ``program`` sent before (a call of its own answered)."""
+    program.send({"op": "call_service", "service": "/rosapi/get_time", "id": "sync"})
+    program.expect("service_response", id="sync")
+
+
+def answer_text(call: dict[str, Any], values: Any, service: str | None = None) -> str:
+    """A service_response as roslibpy writes it: Python's json.dumps, NaN and infinities as tokens."""
+    message = {"op": "service_response", "service": service or call["service"], "id": call["id"]}
+    return json.dumps({**message, "result": True, "values": values})
+
+
+@pytest.mark.parametrize(
+    ("values", "where"),
+    [
+        pytest.param({"percent": float("nan")}, "field 'percent' is NaN", id="nan"),
+        pytest.param({"r": {"ranges": [1.0, float("-inf")]}}, "field 'r.ranges[1]' is -Infinity", id="nested"),
+    ],
+)
+def test_a_live_components_non_finite_answer_fails_the_call_naming_the_field(
+    server: Server, values: dict[str, Any], where: str
+) -> None:
+    """roslibpy sends a NaN as the token; the bridge writes it to JSON callers as null, so a broken
+    reading was taken for a missing one and the run succeeded with {"percent": null}."""
+    program = registered(server, "/followup01/read", "Thermometer81")
+    try:
+        with BridgeClient(url(server), TOKEN) as caller:
+            answer = caller.call("/followup01/read", {}, timeout=10)
+            program.send(answer_text(program.expect("call_service"), values))
+            with pytest.raises(RemoteCallError, match="answered values that are not JSON") as failed:
+                answer.result(timeout=WAIT)
+            assert where in str(failed.value) and "'/followup01/read'" in str(failed.value)
+    finally:
+        program.close()
+
+
+def test_another_services_non_finite_answer_still_reaches_its_caller_as_null() -> None:
+    """Only a live component's service is held to finite numbers: a ROS client's scan keeps its
+    rosbridge_suite meaning (null for a float JSON cannot hold)."""
+    with Bridge().start(port=0) as bridge:
+        provider, caller = Raw(bridge.url), Raw(bridge.url)
+        try:
+            provider.send({"op": "advertise_service", "service": "/scan/read", "type": "x/Y"})
+            synced(provider)
+            caller.send({"op": "call_service", "service": "/scan/read", "id": "c"})
+            provider.send(answer_text(provider.expect("call_service"), {"range": float("inf")}))
+            answer = caller.expect("service_response", id="c")
+            assert answer["result"] is True and answer["values"] == {"range": None}
+        finally:
+            provider.close()
+            caller.close()
