@@ -13,7 +13,7 @@ import pytest
 
 from cbrs.actions.remote import RemoteCallError
 from cbrs.bridge_client import BridgeClient
-from cbrs.rosbridge import Bridge
+from cbrs.rosbridge import Bridge, RunningBridge
 from cbrs.server import Server
 from tests.test_live_components import TOKEN, live_server, thermometer, url
 from tests.test_remote_trial_bridge import WAIT, Raw
@@ -73,18 +73,51 @@ def test_a_live_components_non_finite_answer_fails_the_call_naming_the_field(
         program.close()
 
 
-def test_another_services_non_finite_answer_still_reaches_its_caller_as_null() -> None:
+@pytest.fixture(scope="module")
+def bridge() -> Iterator[RunningBridge]:
+    with Bridge().start(port=0) as running:
+        yield running
+
+
+def test_another_services_non_finite_answer_still_reaches_its_caller_as_null(bridge: RunningBridge) -> None:
     """Only a live component's service is held to finite numbers: a ROS client's scan keeps its
     rosbridge_suite meaning (null for a float JSON cannot hold)."""
-    with Bridge().start(port=0) as bridge:
-        provider, caller = Raw(bridge.url), Raw(bridge.url)
-        try:
-            provider.send({"op": "advertise_service", "service": "/scan/read", "type": "x/Y"})
-            synced(provider)
-            caller.send({"op": "call_service", "service": "/scan/read", "id": "c"})
-            provider.send(answer_text(provider.expect("call_service"), {"range": float("inf")}))
-            answer = caller.expect("service_response", id="c")
-            assert answer["result"] is True and answer["values"] == {"range": None}
-        finally:
-            provider.close()
-            caller.close()
+    provider, caller = Raw(bridge.url), Raw(bridge.url)
+    try:
+        provider.send({"op": "advertise_service", "service": "/scan/read", "type": "x/Y"})
+        synced(provider)
+        caller.send({"op": "call_service", "service": "/scan/read", "id": "c"})
+        provider.send(answer_text(provider.expect("call_service"), {"range": float("inf")}))
+        answer = caller.expect("service_response", id="c")
+        assert answer["result"] is True and answer["values"] == {"range": None}
+    finally:
+        provider.close()
+        caller.close()
+
+
+def test_an_answer_naming_another_service_is_dropped_and_the_call_waits_for_its_own(
+    bridge: RunningBridge, caplog: pytest.LogCaptureFixture
+) -> None:
+    """A motor providing lower and raise answered a lower call with raise's name: it was taken as the
+    lower's answer; rosbridge_suite looks the id up under the service named and drops it."""
+    provider, caller = Raw(bridge.url), Raw(bridge.url)
+    try:
+        for service in ("/motor/lower", "/motor/raise"):
+            provider.send({"op": "advertise_service", "service": service, "type": "x/Y"})
+        synced(provider)
+        caller.send({"op": "call_service", "service": "/motor/lower", "id": "c"})
+        call = provider.expect("call_service")
+        with caplog.at_level("WARNING", logger="cbrs.rosbridge"):
+            provider.send(answer_text(call, {"by": "raise"}, service="/motor/raise"))
+            refused = provider.expect("status", level="error")
+        assert "names '/motor/raise', but its id" in refused["msg"] and "'/motor/lower'" in refused["msg"]
+        assert any("/motor/lower" in r.getMessage() and "/motor/raise" in r.getMessage() for r in caplog.records)
+        unread = {"op": "service_response", "service": "/motor/raise", "id": call["id"], "result": "yes"}
+        provider.send(unread)  # nor does one that cannot be read fail the call it does not answer
+        assert "'result' must be a boolean" in provider.expect("status", level="error")["msg"]
+        provider.send(answer_text(call, {"by": "lower"}, service="motor/lower"))  # a relative name is the same
+        answer = caller.expect("service_response", id="c")
+        assert answer["result"] is True and answer["values"] == {"by": "lower"}, answer
+    finally:
+        provider.close()
+        caller.close()

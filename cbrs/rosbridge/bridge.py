@@ -431,7 +431,8 @@ class Bridge:
             text = f"{op}: {error.reason}" if op else error.reason
             log.info("%s: %s", session.name, text)
             session.report("error", text, error.message_id if error.message_id is not None else message_id)
-            self._refuse_answer(session, frame, op, message_id, error.reason, read=message is not None)
+            named = request.get("service")
+            self._refuse_answer(session, frame, op, message_id, error.reason, message is not None, named)
             if op == "call_service" and message_id is not None:  # its caller waits for an answer: this is it
                 self._refuse_call(session, request, message_id, text)
             if op == "send_action_goal" and (message is not None or message_id is not None):  # its callbacks too
@@ -441,15 +442,23 @@ class Bridge:
             session.report("error", f"{op or 'message'}: internal error: {type(error).__name__}: {error}", message_id)
 
     def _refuse_answer(
-        self, session: Session, frame: str, op: str | None, message_id: MessageId | None, reason: str, read: bool
+        self,
+        session: Session,
+        frame: str,
+        op: str | None,
+        message_id: MessageId | None,
+        reason: str,
+        read: bool,
+        named: Any = None,
     ) -> None:
         """A provider's answer the bridge refused (a field of the wrong type, too large to read) fails the
         call it answers at once, with the reason the provider is told: the caller would otherwise wait
-        for the call's timeout with the reason known here."""
+        for the call's timeout with the reason known here. Not when it ``named`` another service than
+        that call's: it is not that call's answer."""
         if self._calls is None or not session.provided:
             return
         if op == "service_response" and message_id is not None:
-            self._calls.refuse(session, message_id, reason)
+            self._calls.refuse(session, message_id, reason, named)
         elif op in (None, "service_response") and message_id is None and not read:  # its id comes late, if at all
             self._calls.refuse_unread(session, frame, reason)
 
@@ -709,7 +718,8 @@ class Bridge:
                 "missing field 'id': a service_response carries the id of the call_service it answers"
                 + (f" (the one call of {name} waiting on this client failed)" if failed else "")
             )
-        if not self._calls.answer(session, message_id, message["result"], message.get("values")):
+        name = protocol.resolve(message["service"], "service")
+        if not self._calls.answer(session, message_id, message["result"], message.get("values"), name):
             raise ProtocolError(f"no call with id {message_id!r} is waiting for this client's answer")
 
     def _advertise_service(self, session: Session, message: Message) -> None:

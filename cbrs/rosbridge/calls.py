@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from cbrs.rosbridge import protocol
-from cbrs.rosbridge.errors import ServiceError
+from cbrs.rosbridge.errors import ProtocolError, ServiceError
 from cbrs.rosbridge.graph import Handler
 from cbrs.rosbridge.protocol import MessageId
 from cbrs.rosbridge.session import _CALLER, Caller, Session
@@ -110,11 +110,21 @@ class Calls:
         self._start(call, timeout)
         provider.reply(protocol.call_service(spelling, args, call.key, self._non_finite))
 
-    def answer(self, provider: Session, key: MessageId | None, result: bool, values: Any) -> bool:
-        """A provider's ``service_response``; False if ``provider`` has no call with that id."""
+    def answer(self, provider: Session, key: MessageId | None, result: bool, values: Any, service: str) -> bool:
+        """A provider's ``service_response`` for ``service`` (its global name); False if ``provider`` has no
+        call with that id. One that names another service than its call's is dropped (ProtocolError), as
+        rosbridge_suite, which looks the id up under the service named, drops it: the call waits on."""
         call = self._pending.get(str(key))
         if call is None or call.provider is not provider:
             return False
+        if service != call.service:
+            log.warning(
+                "%s answered call %s of %s as %s: dropped, the call waits", provider.name, key, call.service, service
+            )
+            raise ProtocolError(
+                f"service_response names {service!r}, but its id {key!r} is a call of {call.service!r}:"
+                " dropped, that call still waits for its answer"
+            )
         strict = isinstance(values, dict) and self._strict(call.service)
         if strict and not result:
             given = protocol.dumps(values, self._non_finite)
@@ -134,12 +144,15 @@ class Calls:
         self.finish(call, result, protocol.dumps(values, self._non_finite))
         return True
 
-    def refuse(self, provider: Session, key: MessageId | None, reason: str) -> bool:
+    def refuse(self, provider: Session, key: MessageId | None, reason: str, named: Any = None) -> bool:
         """A provider's ``service_response`` that could not be read (``"result": "yes"``, ``"values": 42``):
         the call it answers, when ``provider`` has one with that id, fails at once with ``reason``, as the
-        caller would otherwise wait for its timeout. False if there is no such call."""
+        caller would otherwise wait for its timeout. False if there is no such call, or the response
+        ``named`` another service than the call's (it answers none: see :meth:`answer`)."""
         call = self._pending.get(str(key)) if key is not None else None
         if call is None or call.provider is not provider:
+            return False
+        if isinstance(named, str) and named.strip() and protocol.resolve(named) != call.service:
             return False
         self.finish(call, False, protocol.dumps(_malformed(call, reason)))
         return True
