@@ -174,6 +174,8 @@ class LiveComponents:
         self._ended: OrderedDict[str, dict[str, str]] = OrderedDict()  # session -> {component: why it ended}
         self._guard = threading.Lock()
         self._stop = threading.Event()
+        self._written = threading.Event()  # the store was written: the watchdog looks for deregistrations
+        self._unwatch: Callable[[], None] | None = None
         self._watchdog: threading.Thread | None = None
         self._period = min(0.25, ttl / 4)  # the watchdog's
         self._seen = clock()  # when this server last kept time (the watchdog, a registration, a heartbeat)
@@ -396,15 +398,39 @@ class LiveComponents:
                 if gone:
                     self.sparql.changed()
             if gone:
-                with self._guard:
-                    services = {iri: self._leases.pop(iri).service for iri in gone if iri in self._leases}
-                self._remember_ended(session, gone, "it was deregistered")
-                log.info("%s deregistered: its lease ended", ", ".join(gone))
-                for iri, service in services.items():  # removed on purpose: its answer would act for nobody
-                    if self.on_lapse is not None and service:
-                        self.on_lapse(service, f"<{iri}> was deregistered while {{service!r}} was executing the call")
+                self._deregistered(dict.fromkeys(gone, session))
                 renewed = [iri for iri in renewed if iri not in gone]
         return sorted(renewed)
+
+    def forget_deregistered(self) -> list[str]:
+        """End the leases of live components the store no longer registers (``cbrs deregister`` through
+        the SPARQL endpoint, any update that removed their description), as :meth:`renew` does at a
+        lease's store write: the watchdog asks at once after each store write, so a call's answer that
+        comes meanwhile is not taken. Returns the components whose lease ended."""
+        with self.sparql.lock:
+            with self._guard:
+                sessions = {iri: lease.session for iri, lease in self._leases.items()}
+            kb = self.sparql.kb
+            gone = {iri: session for iri, session in sessions.items() if not kb.registry.is_registered(iri)}
+            for iri in gone:
+                kb.liveness.forget(iri)
+            if gone:
+                self.sparql.changed()
+        self._deregistered(gone)
+        return sorted(gone)
+
+    def _deregistered(self, gone: dict[str, str]) -> None:
+        """Components (with their sessions) found deregistered: their leases end and their calls fail."""
+        if not gone:
+            return
+        with self._guard:
+            services = {iri: self._leases.pop(iri).service for iri in gone if iri in self._leases}
+        for iri, session in gone.items():
+            self._remember_ended(session, [iri], "it was deregistered")
+        log.info("%s deregistered: its lease ended", ", ".join(sorted(gone)))
+        for iri, service in services.items():  # removed on purpose: its answer would act for nobody
+            if self.on_lapse is not None and service:
+                self.on_lapse(service, f"<{iri}> was deregistered while {{service!r}} was executing the call")
 
     def _registered_by(self, session: str) -> str:
         """What the store says registered a component of ``session`` (``cbrs:registeredBy``)."""
@@ -487,21 +513,33 @@ class LiveComponents:
         if self._watchdog is None:
             self._stop.clear()
             self._now()  # time kept from here
+            # a store write only wakes the watchdog: the listener is called with the store's lock held
+            self._unwatch = self.sparql.on_update(self._written.set)
             self._watchdog = threading.Thread(target=self._watch, name="cbrs-leases", daemon=True)
             self._watchdog.start()
 
     def stop(self) -> None:
         self._stop.set()
+        self._written.set()
+        if self._unwatch is not None:
+            self._unwatch()
+            self._unwatch = None
         if self._watchdog is not None:
             self._watchdog.join(timeout=5.0)
             self._watchdog = None
 
     def _watch(self) -> None:
-        while not self._stop.wait(self._period):
+        while not self._stop.is_set():
+            written = self._written.wait(self._period)
+            if self._stop.is_set():
+                return
+            self._written.clear()  # before the store is read: a write after it wakes the next round
             try:
                 self.expire_lapsed()
+                if written:
+                    self.forget_deregistered()
             except Exception:  # the watchdog must outlive a failed write
-                log.exception("ending lapsed leases failed")
+                log.exception("ending lapsed or deregistered leases failed")
 
 
 REGISTER_FIELDS = ("description", "format", "ttl")

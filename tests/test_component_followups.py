@@ -13,9 +13,10 @@ import pytest
 
 from cbrs.actions.remote import RemoteCallError
 from cbrs.bridge_client import BridgeClient
+from cbrs.kb import KnowledgeBase
 from cbrs.rosbridge import Bridge, RunningBridge
 from cbrs.server import Server
-from tests.test_live_components import TOKEN, live_server, thermometer, url
+from tests.test_live_components import READING, THERMOMETER, TOKEN, live_server, thermometer, url
 from tests.test_remote_trial_bridge import WAIT, Raw
 
 
@@ -121,3 +122,32 @@ def test_an_answer_naming_another_service_is_dropped_and_the_call_waits_for_its_
     finally:
         provider.close()
         caller.close()
+
+
+def test_a_call_fails_at_once_when_its_component_is_deregistered_through_the_endpoint(server: Server) -> None:
+    """`cbrs deregister` (a SPARQL update through the server) was noticed only at the lease's next store
+    write, half a lease and a beat later (6.7 s for the lab's motor), and an answer that came first was
+    taken. The server's watchdog now looks at each store write: the call fails long before that write."""
+    description = thermometer("/followup02/read").replace("Thermometer07", "Thermometer82")
+    iri = THERMOMETER.replace("Thermometer07", "Thermometer82")
+    program = Raw(url(server))
+    store = KnowledgeBase.open(f"http://127.0.0.1:{server.http_port}", remote_token=TOKEN)
+    try:
+        program.send({"op": "auth", "mac": TOKEN})
+        args = {"description": description, "ttl": 600.0}  # no store write of its lease within the test
+        program.send({"op": "call_service", "service": "/cbrs/register", "id": "r", "args": args})
+        assert program.expect("service_response", id="r")["result"] is True
+        program.send({"op": "advertise_service", "service": "/followup02/read", "type": "cbrs_msgs/RoomTemperature"})
+        synced(program)
+        with BridgeClient(url(server), TOKEN) as caller:
+            answer = caller.call("/followup02/read", {}, timeout=60)
+            call = program.expect("call_service")
+            assert store.registry.deregister(iri) > 0  # as `cbrs deregister --store URL` does
+            with pytest.raises(RemoteCallError, match="was deregistered while '/followup02/read' was executing"):
+                answer.result(timeout=WAIT)  # no heartbeat meanwhile: the watchdog noticed the update
+            program.send(answer_text(call, READING))  # the motor's answer, after: it acts for nobody
+            assert "no call with id" in program.expect("status", level="error")["msg"]
+        assert iri not in server.live.live()
+    finally:
+        store.close()
+        program.close()
