@@ -9,7 +9,6 @@ run), and every spot in reach counts as one an arm can hold the thing over."""
 
 from __future__ import annotations
 
-import itertools
 import math
 from dataclasses import replace
 from types import SimpleNamespace
@@ -46,27 +45,10 @@ VALUES: dict[str, Any] = {"pen": {"@id": PEN}, "eraser": {"@id": ERASER}, "cup":
 CIRCLE = PackingRule(footprint="circle")
 Mats = tuple[SemanticMap, SemanticMap, Plan, Plan, Plan]
 
-# A mat at the front of the kitchen table, 40 x 23 cm: the left arm reaches it whole, the right arm its east
-# part, which has spots for the eraser's whole footprint and for the pen's centre only. The cup moved from
-# (7.45, 3.32), on the mat, to the table's front edge, 0.51 m from the left arm's mount and 0.69 m from the
-# right's, where the Kinect sees it (the same task runs in the simulation: docs/execution.md).
-MAT_MAP = """
-@prefix home: <https://w3id.org/cbrs/home#> .
-@prefix world: <https://w3id.org/cbrs/world#> .
-@prefix lab6: <https://example.org/lab6#> .
-@prefix owl: <http://www.w3.org/2002/07/owl#> .
-@prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .
-lab6:Mat a owl:Class ; rdfs:subClassOf home:ObjectPlace ; rdfs:label "mat"@en .
-lab6:Mat1 a lab6:Mat ; home:isLocated world:Kitchen ;
-    home:minX 7.35 ; home:maxX 7.75 ; home:minY 3.22 ; home:maxY 3.45 ; home:minZ 0.75 ; home:maxZ 0.78 .
-"""
-CUP_WEST = """
-PREFIX home: <https://w3id.org/cbrs/home#>
-PREFIX world: <https://w3id.org/cbrs/world#>
-DELETE { GRAPH <https://w3id.org/cbrs/graph/map> { world:Cup home:x ?x ; home:y ?y } }
-INSERT { GRAPH <https://w3id.org/cbrs/graph/map> { world:Cup home:x 7.45 ; home:y 3.05 } }
-WHERE { GRAPH <https://w3id.org/cbrs/graph/map> { world:Cup home:x ?x ; home:y ?y } }
-"""
+# A mat at the front of the kitchen table, 40 x 23 cm, and the cup moved to the table's front edge, where the
+# Kinect sees it (the same task runs in the simulation and in the example sweep: docs/execution.md).
+MAT_MAP = (EXAMPLES / "lab6_front_mat.ttl").read_text(encoding="utf-8")
+CUP_WEST = (EXAMPLES / "lab6_cup_to_the_front.ru").read_text(encoding="utf-8")
 # The mat 30 x 20 cm, 5 cm farther west (x 7.30-7.60, y 3.20-3.40): the right arm's part of it holds the
 # eraser or the pen, not both, by circles or by boxes; the left arm's part holds both.
 MAT_WEST = """
@@ -81,79 +63,9 @@ WHERE { GRAPH <https://w3id.org/cbrs/graph/map> {
 """
 
 
-def _task(name: str, *parts: str) -> str:
-    """A task of parts in order (docs/tasks.md, "Several things in one task"): each part one thing, the
-    cup's part a take whose goal is the cup in a gripper (no carry ends that hold)."""
-    some = " ,\n        ".join(
-        f"[ a owl:Restriction ; owl:onProperty act:subAction ; owl:someValuesFrom lab6:{part} ]" for part in parts
-    )
-    orders = " , ".join(f"lab6:{name}_{n}" for n in range(1, len(parts)))
-    each = "".join(
-        f"lab6:{name}_{n} a owl:NamedIndividual , act:PartialOrderingStrict ;\n"
-        f"    act:occursBefore lab6:{before} ; act:occursAfter lab6:{after} .\n"
-        for n, (before, after) in enumerate(itertools.pairwise(parts), start=1)
-    )
-    cup = (
-        '        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "cup" ; cbrs:parameterType home:Cup ] ;\n'
-        if "KeepCup" in parts
-        else ""
-    )
-    return f"""
-lab6:{name} a owl:Class ; rdfs:subClassOf act:PhysicalAction ;
-    rdfs:subClassOf {some} ;
-    act:orderingConstraint {orders} .
-{each}lab6:{name}Task a cbrs:Requirement ;
-    cbrs:requestedBy svc:CytonDualArm01 ; cbrs:deviceName "CytonDualArm01" ; cbrs:serviceName "{name}" ;
-    cbrs:forTask lab6:{name} ;
-    cbrs:hasOWLSModel [ a cbrs:OWLSModel ;
-        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "pen" ; cbrs:parameterType home:Pen ] ;
-        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "eraser" ; cbrs:parameterType lab6:Eraser ] ;
-{cup}        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "mat" ; cbrs:parameterType lab6:Mat ] ;
-        cbrs:hasEffect [ a cbrs:Effect ; cbrs:conditionSubject home:Pen ; cbrs:conditionPredicate home:isLocated ;
-            cbrs:conditionObject lab6:Mat ] ;
-        cbrs:hasEffect [ a cbrs:Effect ; cbrs:conditionSubject lab6:Eraser ; cbrs:conditionPredicate home:isLocated ;
-            cbrs:conditionObject lab6:Mat ] ] .
-"""
-
-
-def _part(name: str, thing: str, kind: str, goal: str) -> str:
-    return f"""
-lab6:{name} a owl:Class ; rdfs:subClassOf act:PhysicalAction .
-lab6:{name}Task a cbrs:Requirement ;
-    cbrs:requestedBy svc:CytonDualArm01 ; cbrs:deviceName "CytonDualArm01" ; cbrs:serviceName "{name}" ;
-    cbrs:forTask lab6:{name} ;
-    cbrs:hasOWLSModel [ a cbrs:OWLSModel ;
-        cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "{thing}" ; cbrs:parameterType {kind} ] ;
-        {goal} ] .
-"""
-
-
-def _onto_mat(kind: str) -> str:
-    return (
-        f'cbrs:hasInput [ a cbrs:Parameter ; cbrs:parameterName "mat" ; cbrs:parameterType lab6:Mat ] ;\n'
-        f"        cbrs:hasEffect [ a cbrs:Effect ; cbrs:conditionSubject {kind} ;"
-        " cbrs:conditionPredicate home:isLocated ; cbrs:conditionObject lab6:Mat ]"
-    )
-
-
-TASKS = (
-    "@prefix cbrs: <https://w3id.org/cbrs/core#> .\n@prefix home: <https://w3id.org/cbrs/home#> .\n"
-    "@prefix act: <https://w3id.org/cbrs/action#> .\n@prefix svc: <https://w3id.org/cbrs/service#> .\n"
-    "@prefix lab6: <https://example.org/lab6#> .\n@prefix owl: <http://www.w3.org/2002/07/owl#> .\n"
-    "@prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> .\n"
-    + _part("EraserOntoMat", "eraser", "lab6:Eraser", _onto_mat("lab6:Eraser"))
-    + _part("PenOntoMat", "pen", "home:Pen", _onto_mat("home:Pen"))
-    + _part(
-        "KeepCup",
-        "cup",
-        "home:Cup",
-        "cbrs:hasEffect [ a cbrs:Effect ; cbrs:conditionSubject home:Cup ; cbrs:conditionPredicate home:isGraspedBy ;"
-        " cbrs:conditionObject home:Gripper ]",
-    )
-    + _task("EraserCupPen", "EraserOntoMat", "KeepCup", "PenOntoMat")
-    + _task("CupEraserPen", "KeepCup", "EraserOntoMat", "PenOntoMat")
-    + _task("EraserThenPen", "EraserOntoMat", "PenOntoMat")
-)
+# EraserCupPen (the cup taken between the eraser's carry and the pen's), CupEraserPen (the cup first) and
+# EraserThenPen (no cup): parts in order, each one thing (docs/tasks.md, "Several things in one task").
+TASKS = (EXAMPLES / "lab6_eraser_cup_pen.ttl").read_text(encoding="utf-8")
 
 
 @pytest.fixture(scope="module")
