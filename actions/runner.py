@@ -294,8 +294,9 @@ def run_task(
     registered since: what is achieved is kept, since the belief offers it to the new plan's
     preconditions. At most ``max_replans`` times; each replaced plan is kept in the result with its
     reason. ``faults`` fail whenever invoked; ``fault_policy`` (e.g. ``RandomFaults``) may break others.
-    ``cancelled`` is asked before the first step and after each step: once it says True the run stops
-    there (status cancelled), without replanning; a step under way is never cut short.
+    ``cancelled`` is asked before the first step and whenever a step's attempt ends, succeeded or failed:
+    once it says True the run stops there (status cancelled), with no alternative tried and no re-plan; a
+    step under way is never cut short.
     ``replan_policy`` says what a re-plan does about a failure nothing has changed since (the same
     component, inputs and kind of failure, with the things it depended on believed where they were):
     compose without its component first, and repeat it at most ``max_repeats`` times, else stop with
@@ -383,12 +384,15 @@ def run_task(
                 plan, container, given, environment.verify, environment.clock, on_start=starting, on_done=keeping
             )
             done = 0
+            ended = 0
             _stop_if_cancelled(executor, cancelled, done)
             while executor.status is RunStatus.RUNNING and executor.ticks < max_ticks:
                 executor.tick()
                 if len(executor.results) != done:  # a step finished: the world changed
                     done = len(executor.results)
                     belief.write(environment.observe())
+                if _attempts(executor) != ended:  # a step's attempt ended, however: a Stop takes effect now
+                    ended = _attempts(executor)
                     _stop_if_cancelled(executor, cancelled, done)
             report = executor.run(max_ticks)  # ends a run that hit max_ticks; otherwise just the report
             outputs = executor.results
@@ -902,9 +906,16 @@ def _missing(kb: KnowledgeBase, index: TaxonomyIndex, placed: set[str], concept:
 
 
 def _stop_if_cancelled(executor: Executor, cancelled: Callable[[], bool] | None, done: int) -> None:
-    """Between steps: stop the run if asked to (a plan whose steps are all done just finishes)."""
+    """Before the first step and whenever a step's attempt ends, succeeded or failed: stop the run if asked
+    to (a plan whose steps are all done just finishes). Asked only after successes, a Stop during a step
+    that failed let the executor start the step's next alternative, or the run re-plan, as if unasked."""
     if cancelled is not None and done < len(executor.plan.steps) and cancelled():
         executor.cancel(f"cancelled on request after {done} of {len(executor.plan.steps)} steps")
+
+
+def _attempts(executor: Executor) -> int:
+    """How many attempts of the plan's steps have ended (each success and each failure is one)."""
+    return sum(len(report.attempts) for report in executor.reports)
 
 
 def _settle(environment: Environment) -> None:
