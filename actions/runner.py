@@ -36,7 +36,7 @@ from cbrs.actions.plan import Plan, PlanStep
 from cbrs.actions.precondition_sensing import PreconditionSensing, SensingConfig
 from cbrs.actions.replanning import Failure, FailureMemory, ReplanPolicy
 from cbrs.actions.task_preconditions import PreconditionCheck, check_preconditions
-from cbrs.actions.unavailable import name_unavailable
+from cbrs.actions.unavailable import name_unavailable, would_serve
 from cbrs.kb import Advertisement, KnowledgeBase, NotFoundError, Requirement, Statement
 from cbrs.kb.namespaces import HOME, shorten
 from cbrs.kb.semantic_map import AmbiguousDesignatorError, UnresolvedDesignatorError
@@ -652,12 +652,15 @@ def _runnable(
     # Say which components the first plan wanted: "no component provides" alone hid a registered one.
     wanted = {c for c in used if not _can_run(c, registry, passed)}
     known = why_not([ad for ad in advertisements if ad.iri in wanted]) if why_not is not None else {}
-    why = [
+    why = tuple(
         (ad.iri, passed.get(ad.iri) or known.get(ad.iri) or _cannot_run(ad))
         for ad in sorted(advertisements, key=lambda ad: ad.iri)
         if ad.iri in wanted
-    ]
-    return replace(again, unsatisfied=tuple(replace(u, unrunnable=tuple(why)) for u in again.unsatisfied))
+    )
+    named = replace(again, unsatisfied=tuple(replace(u, unrunnable=why) for u in again.unsatisfied))
+    # And the unavailable live components a plan without those would use: named alone, the bundled
+    # component the simulation cannot run hid the lab's one that is merely stopped.
+    return name_unavailable(kb, config, task, named, avoid | missing, belief)
 
 
 def unrunnable_steps(
@@ -666,18 +669,25 @@ def unrunnable_steps(
     registry: collections.abc.Container[str],
     passed: Mapping[str, str] | None = None,
     advertisements: Sequence[Advertisement] | None = None,
+    config: ComposeConfig | None = None,
 ) -> tuple[tuple[PlanStep, str], ...]:
     """The steps of ``plan`` whose component ``registry`` has no implementation of (or the environment
     passes over), each with why: those :func:`run_task` composes the task without. ``cbrs plan`` says
     so, where it composes over every advertisement. ``advertisements``: those the plan was composed
-    over, if the caller has them, instead of reading them again."""
+    over, if the caller has them, instead of reading them again. The why also names the unavailable live
+    components a plan without them would use (``config``: how ``plan`` was composed), as a run's no-plan
+    answer does: named alone, a bundled component the simulation cannot run hid a lab's stopped one."""
     passed = passed or {}
     if all(_can_run(step.component, registry, passed) for step in plan.steps):
         return ()
     found = advertisements if advertisements is not None else kb.advertisements(include_unavailable=True)
     ads = {ad.iri: ad for ad in found}
+    live = set(kb.liveness.states())  # the unavailable live components are left to name, not avoided
+    avoid = frozenset(iri for iri in ads if iri not in live and not _can_run(iri, registry, passed))
+    serving = would_serve(kb, config or ComposeConfig(), plan.task, avoid)
+    instead = "; a plan without it would use " + ", ".join(f"{shorten(c)}, {why}" for c, why in serving)
     return tuple(
-        (step, passed.get(step.component) or _cannot_run(ads[step.component]))
+        (step, (passed.get(step.component) or _cannot_run(ads[step.component])) + (instead if serving else ""))
         for step in plan.steps
         if not _can_run(step.component, registry, passed)
     )

@@ -6,8 +6,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from cbrs.actions.components import Registry
+from cbrs.actions.composer import Composer
 from cbrs.actions.executor import RunStatus
-from cbrs.actions.runner import run_task
+from cbrs.actions.runner import run_task, unrunnable_steps
+from cbrs.kb import KnowledgeBase
 from tests.test_replanning_memory import AROUND, DIRECT, EX, Home, Worker, component, kb_with
 
 SPARE = component("Spare", "A", "D", 2.0)  # the step's alternative to Direct: same inputs and outputs
@@ -39,3 +42,43 @@ def test_a_stop_asked_while_the_last_alternative_fails_does_not_re_plan(tmp_path
     result = run_task(kb, EX + "Req", home, cancelled=lambda: home.calls[EX + "Direct"] > 0)
     assert result.report is not None and result.report.status is RunStatus.CANCELLED
     assert not result.replans and dict(home.calls) == {EX + "Direct": 1}
+
+
+LIVE = component("Gauge", "A", "D", 1.0)  # the lab's live component: could do the task, its program stopped
+
+
+def _stopped_gauge(tmp_path: Path) -> KnowledgeBase:
+    kb = kb_with(DIRECT + LIVE, tmp_path)
+    kb.liveness.renew(EX + "Gauge", 600.0)
+    kb.liveness.expire(EX + "Gauge", "its session closed")
+    return kb
+
+
+def test_no_plan_names_the_unavailable_live_component_beside_the_one_that_cannot_run_here(tmp_path: Path) -> None:
+    """As TellMeTheBatteryLevel with the lab's gauge stopped: the bundled MonitorBattery the simulation has
+    no skill for was named, and not the gauge (docs/components.md, "Tried by a component developer")."""
+    kb = _stopped_gauge(tmp_path)
+    home = _home({})
+    home.registry = Registry()  # Direct has no implementation here, as a bundled service with no skill
+    result = run_task(kb, EX + "Req", home)
+    assert result.composition.plan is None and result.report is None and not home.calls
+    (unmet,) = result.composition.unsatisfied
+    assert [component for component, _ in unmet.unrunnable] == [EX + "Direct", EX + "Gauge"]
+    assert dict(unmet.unrunnable)[EX + "Gauge"] == "unavailable: its session closed"
+    assert "Gauge was planned for it but cannot run here: unavailable: its session closed" in unmet.text()
+    assert "Direct was planned for it but cannot run here" in unmet.text()
+
+
+def test_a_plan_whose_step_cannot_run_here_says_which_unavailable_component_would_do_it(tmp_path: Path) -> None:
+    """What ``cbrs plan`` notes of a step the simulated home cannot run."""
+    kb = _stopped_gauge(tmp_path)
+    plan = Composer(kb).compose(EX + "Req").plan
+    assert plan is not None and [step.component for step in plan.steps] == [EX + "Direct"]
+    ((step, why),) = unrunnable_steps(kb, plan, Registry())
+    assert step.component == EX + "Direct"
+    assert why.endswith(f"; a plan without it would use {EX}Gauge, unavailable: its session closed")
+    kb.liveness.renew(EX + "Gauge", 600.0)  # its program back: nothing unavailable to name
+    plan = Composer(kb).compose(EX + "Req").plan
+    assert plan is not None
+    ((_, why),) = unrunnable_steps(kb, plan, Registry())
+    assert "would use" not in why
