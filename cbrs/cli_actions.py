@@ -207,7 +207,7 @@ def plan(
         from cbrs.actions.draw import draw  # matplotlib is slow to import; only when asked
 
         draw(result, drawing)
-    here = _not_here(app.kb, result.plan, composer.advertisements) if result.plan is not None else None
+    here = _not_here(app.kb, result.plan, composer.advertisements, composer.config) if result.plan is not None else None
     unmapped = _unmapped(app.kb, composer, result.plan, facts) if result.plan is not None else None
     if as_json:
         found = result.to_dict()
@@ -256,10 +256,13 @@ class _NotHere:
         return "".join(lines)
 
 
-def _not_here(kb: KnowledgeBase, plan: Plan, advertisements: Sequence[Advertisement]) -> _NotHere | None:
+def _not_here(
+    kb: KnowledgeBase, plan: Plan, advertisements: Sequence[Advertisement], config: ComposeConfig
+) -> _NotHere | None:
     """What of ``plan`` the simulated home cannot run now (None without the [sim] part, which runs
     nothing): the runner's own check, over the simulation's skills (no world is built) and the
-    components registered live; ``advertisements``, those the plan was composed over, read once."""
+    components registered live; ``advertisements``, those the plan was composed over, read once, and
+    ``config`` how (the unavailable live components a plan without the steps would use are found so)."""
     if not installed("sim"):
         return None
     from cbrs.sim.components import implementations
@@ -267,7 +270,7 @@ def _not_here(kb: KnowledgeBase, plan: Plan, advertisements: Sequence[Advertisem
     live = {iri for iri, state in kb.liveness.states().items() if state.live}
     runnable = set(implementations(kb, advertisements=advertisements).names()) | live
     bridged = tuple(step for step in plan.steps if step.component in live)
-    return _NotHere(unrunnable_steps(kb, plan, runnable, advertisements=advertisements), bridged)
+    return _NotHere(unrunnable_steps(kb, plan, runnable, advertisements=advertisements, config=config), bridged)
 
 
 @dataclass(frozen=True)
