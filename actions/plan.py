@@ -13,7 +13,7 @@ from typing import Any
 import pyoxigraph as ox
 
 from cbrs.kb import Statement
-from cbrs.kb.namespaces import BASE, PREFIXES, GraphName
+from cbrs.kb.namespaces import BASE, PREFIXES, GraphName, shorten
 from cbrs.kb.vocab import CBRS
 
 RDF_TYPE = ox.NamedNode(PREFIXES["rdf"] + "type")
@@ -58,6 +58,18 @@ class Binding:
         found["similarity"] = round(self.similarity, 4)
         return found
 
+    def __repr__(self) -> str:
+        """One line, where the value comes from and how well it fits: the fields in full (the concept's
+        and the statement's IRIs, the source's requirement) made a plan's repr thousands of characters
+        long in a notebook; :meth:`to_dict` keeps them all."""
+        origin = f"step {self.source.step}" if self.source.step is not None else "the requirement"
+        taken = (
+            f"{self.name} <- {origin}"
+            if self.source.name == self.name
+            else f"{self.name} <- {self.source.name} of {origin}"
+        )
+        return f"<Binding {self.role} {taken}, {self.degree} {self.similarity:.2f}>"
+
 
 @dataclass(frozen=True)
 class PlanStep:
@@ -90,6 +102,13 @@ class PlanStep:
     @property
     def preconditions(self) -> tuple[Binding, ...]:
         return tuple(b for b in self.bindings if b.role == "precondition")
+
+    def __repr__(self) -> str:
+        """One line: the step's component and where its inputs and preconditions come from (see
+        :meth:`Binding.__repr__`), and how many components could stand in for it."""
+        taken = "; ".join(_taken(b) for b in self.bindings) or "nothing taken"
+        others = f", {len(self.alternatives)} alternative(s)" if self.alternatives else ""
+        return f"<PlanStep {self.index} {shorten(self.component)}: {taken}{others}>"
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -132,6 +151,18 @@ class Plan:
 
     def step(self, index: int) -> PlanStep:
         return self.steps[index - 1]
+
+    def __repr__(self) -> str:
+        """One line: the task, how it was planned and its steps' components in order; each step's own repr
+        says where its inputs come from, :meth:`to_dict` says everything (a plan's dataclass repr ran to
+        8,000 characters for eight steps, and a composition's, holding it, to 47,000)."""
+        components = ", ".join(f"{step.index} {shorten(step.component)}" for step in self.steps)
+        steps = f"{len(self.steps)} step{'' if len(self.steps) == 1 else 's'}"
+        goals = f"{len(self.goals)} goal{'' if len(self.goals) == 1 else 's'}"
+        return (
+            f"<Plan {shorten(self.task)} ({self.method}): {steps} [{components}], {goals},"
+            f" similarity {self.similarity:.3f}, cost {self.cost:g}>"
+        )
 
     def components(self) -> list[str]:
         return [s.component for s in self.steps]
@@ -207,6 +238,12 @@ class Plan:
 _DOUBLE = ox.NamedNode(PREFIXES["xsd"] + "double")
 _INTEGER = ox.NamedNode(PREFIXES["xsd"] + "integer")
 _BOOLEAN = ox.NamedNode(PREFIXES["xsd"] + "boolean")
+
+
+def _taken(binding: Binding) -> str:
+    """A binding as a step's repr lists it: its name and the step it comes from (``req`` for the task)."""
+    origin = f"#{binding.source.step}" if binding.source.step is not None else "req"
+    return f"{binding.name} <- {origin}"
 
 
 def _statement(statement: Statement) -> dict[str, str]:
