@@ -78,6 +78,20 @@ class KnowledgeBase:
         self._reader = DescriptionReader(store, self.queries)
         self._map_read: tuple[int, bool] | None = None  # (store generation, whether the map read then)
 
+    def __repr__(self) -> str:
+        """Where the store is and which kind it is: a notebook showing ``kb`` said only its address in
+        memory, and two stores open side by side (in memory, on disk) could not be told apart."""
+        return f"<KnowledgeBase {self.store.location!r} ({type(self.store).__name__})>"
+
+    def __enter__(self) -> KnowledgeBase:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        """:meth:`close` when the block ends, failed or not: an on-disk store's lock is held until then, so
+        a notebook cell that raised between open and close left the directory locked, and opening it again
+        was refused (``StoreInUseError``) until the kernel restarted."""
+        self.close()
+
     @classmethod
     def open(
         cls,
@@ -323,7 +337,13 @@ class KnowledgeBase:
         OWL-S files are converted into cbrs advertisements, or requirements when ``graph`` is
         ``requirements`` (see :mod:`kb.owls`). With a ``catalogue`` (a :class:`Catalogue`, a folder or
         a catalogue file) the ontologies the files import are loaded too, from local files only.
+
+        ``paths`` is a list even for one file: a lone path is refused with a ``TypeError`` naming it (a
+        string is a sequence too, so ``kb.load("lab.ttl")`` was read character by character and refused
+        for its first one, ``"/": a directory with no RDF file in it``, a ``Path`` as not iterable).
         """
+        if isinstance(paths, str | Path):
+            raise TypeError(f"load takes a list of paths, not one {type(paths).__name__}: kb.load([{str(paths)!r}])")
         if catalogue is not None and not isinstance(catalogue, Catalogue):
             catalogue = Catalogue.open(catalogue)
         read = None
@@ -398,6 +418,11 @@ class KnowledgeBase:
         return report
 
     def query(self, text: str, bindings: Mapping[str, Term] | None = None) -> QueryResult:
+        """Run a SPARQL query over the union of the graphs, the table prefixes declared (``home:``,
+        ``svc:``..., :data:`PREFIXES`), so a query need not know which graph holds a fact. ``bindings``
+        are values for its variables, bound by the store rather than pasted into the text (nothing a user
+        typed is parsed as SPARQL). Gives pyoxigraph's solutions (read them once), a boolean or triples;
+        a bad text is a :class:`QuerySyntaxError` keeping the text."""
         return self.store.query(text, bindings)
 
     def update(self, text: str, check_map: bool = True) -> None:
@@ -614,6 +639,10 @@ class KnowledgeBase:
         return self.queries.run(self.store, name, values)
 
     def select(self, name: str, values: Mapping[str, Term | str | int | float] | None = None) -> list[dict[str, Term]]:
+        """:meth:`run`'s solutions as a list of dicts, variable name to term: read as often as needed,
+        unlike the store's solutions. ``values`` are checked against the query's declared parameters (an
+        unknown name or a value of the wrong kind is a :class:`BindingError`, an unknown query an
+        :class:`UnknownQueryError` listing the known ones); ``kb.queries.names()`` lists them."""
         return self.queries.select(self.store, name, values)
 
     def select_each(
@@ -624,6 +653,9 @@ class KnowledgeBase:
         return self.queries.select_each(self.store, [(name, values or {}) for name in names])
 
     def description(self, iri: str) -> ServiceDescription:
+        """The six-tuple of the advertisement or requirement ``iri`` (a full IRI) as typed values, read
+        through the named queries and cached until the store changes; a :class:`NotFoundError` when the
+        store describes no such service."""
         return self._reader.read(iri)
 
     def advertisements(self, include_unavailable: bool = False) -> list[Advertisement]:
@@ -641,6 +673,7 @@ class KnowledgeBase:
         return Liveness(self.store)
 
     def requirements(self) -> list[Requirement]:
+        """Every requirement (a robot's request or a task) the store describes, as typed values."""
         return self._reader.requirements()
 
     def action_requirement(self, action: str, label: str | None = None) -> Requirement:
@@ -661,6 +694,9 @@ class KnowledgeBase:
         return any(True for _ in self.store.quads(node)) or any(True for _ in self.store.quads(None, None, node))
 
     def close(self) -> None:
+        """Release the store: an on-disk one is flushed and its lock freed, so that another process (or a
+        later :meth:`open` here) can open it; using this object afterwards raises :class:`StoreError`.
+        Closing twice does nothing. ``with KnowledgeBase.open(...) as kb:`` closes it when the block ends."""
         self.store.close()
 
 

@@ -7,10 +7,48 @@ base raises importable from ``cbrs.kb``, and a docstring on every public method 
 
 from __future__ import annotations
 
+from pathlib import Path
+
+import pytest
+
 from cbrs.actions import Binding, Plan, PlanStep, Source
+from cbrs.kb import KnowledgeBase
 
 SVC = "https://w3id.org/cbrs/service#"
 LAB19 = "https://example.org/lab19#"
+
+
+@pytest.fixture(scope="module")
+def memory() -> KnowledgeBase:
+    return KnowledgeBase.open(":memory:")
+
+
+def test_a_knowledge_base_shows_where_its_store_is(memory: KnowledgeBase) -> None:
+    """It showed ``<cbrs.kb.knowledge_base.KnowledgeBase object at 0x...>``."""
+    assert repr(memory) == "<KnowledgeBase ':memory:' (EmbeddedStore)>"
+
+
+def test_a_with_block_frees_the_store_when_the_cell_fails(tmp_path: Path) -> None:
+    """A cell that raised between open and close left the directory locked: opening it again was refused
+    until the kernel restarted. KnowledgeBase had no ``__enter__``."""
+    folder = tmp_path / "lab"
+    with pytest.raises(RuntimeError, match="the cell failed"), KnowledgeBase.open(folder, seed=False) as kb:
+        assert repr(kb) == f"<KnowledgeBase {str(folder)!r} (EmbeddedStore)>"
+        raise RuntimeError("the cell failed")
+    with KnowledgeBase.open(folder, seed=False) as again:
+        assert again.statistics() == {}
+
+
+@pytest.mark.parametrize(
+    "lone", ["docs/examples/lab19_vial_and_rack.ttl", Path("docs/examples/lab19_vial_and_rack.ttl")]
+)
+def test_a_lone_path_is_refused_naming_it(memory: KnowledgeBase, lone: str | Path) -> None:
+    """``kb.load("lab.ttl")`` was read character by character: '/: a directory with no RDF file in it' for an
+    absolute path; a Path was "'PosixPath' object is not iterable"."""
+    before = memory.statistics()
+    with pytest.raises(TypeError, match=r"not one \w+: kb\.load\(\['docs/examples/lab19_vial_and_rack\.ttl'\]\)"):
+        memory.load(lone, graph="map")  # type: ignore[arg-type]
+    assert memory.statistics() == before
 
 
 def _step(index: int, name: str, bindings: tuple[Binding, ...]) -> PlanStep:
@@ -31,3 +69,11 @@ def test_a_plan_step_and_binding_show_in_one_short_line() -> None:
     assert repr(steps[0]) == "<PlanStep 1 svc:Step1_Device01: objectType <- req; graspPose <- #2, 1 alternative(s)>"
     assert repr(vial) == "<Binding input objectType <- vial of the requirement, SubClassOf 0.40>"
     assert repr(pose) == "<Binding input graspPose <- step 2, Exact 1.00>"
+
+
+def test_every_public_method_of_a_knowledge_base_says_what_it_is_for() -> None:
+    """``help(kb.query)``, ``select``, ``description``, ``requirements`` and ``close`` said nothing."""
+    undocumented = sorted(
+        name for name in dir(KnowledgeBase) if not name.startswith("_") and not getattr(KnowledgeBase, name).__doc__
+    )
+    assert undocumented == []
