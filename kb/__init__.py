@@ -44,7 +44,9 @@ if TYPE_CHECKING:
         Statement,
     )
     from cbrs.kb.namespaces import PREFIXES, GraphName
-    from cbrs.kb.store import EmbeddedStore, Store
+    from cbrs.kb.semantic_map import MapError
+    from cbrs.kb.shapes import DescriptionShapeError
+    from cbrs.kb.store import EmbeddedStore, Store, StoreInUseError
 
 _HOMES = {
     "cbrs.kb.catalog": ("Catalogue",),
@@ -79,7 +81,11 @@ _HOMES = {
         "Statement",
     ),
     "cbrs.kb.namespaces": ("PREFIXES", "GraphName"),
-    "cbrs.kb.store": ("EmbeddedStore", "Store"),
+    # raised by KnowledgeBase's own methods (a load or update the map or the shapes refuse, an on-disk store
+    # open elsewhere): a caller catches them by these names without knowing the module that raises them
+    "cbrs.kb.semantic_map": ("MapError",),
+    "cbrs.kb.shapes": ("DescriptionShapeError",),
+    "cbrs.kb.store": ("EmbeddedStore", "Store", "StoreInUseError"),
 }
 _WHERE = {name: module for module, names in _HOMES.items() for name in names}
 
@@ -90,6 +96,7 @@ __all__ = [
     "BindingError",
     "Catalogue",
     "CatalogueError",
+    "DescriptionShapeError",
     "EffectiveArea",
     "EmbeddedStore",
     "GraphName",
@@ -97,6 +104,7 @@ __all__ = [
     "KnowledgeBase",
     "KnowledgeBaseError",
     "LoadReport",
+    "MapError",
     "NotFoundError",
     "Parameter",
     "PartNode",
@@ -112,6 +120,7 @@ __all__ = [
     "Store",
     "StoreError",
     "StoreEvaluationError",
+    "StoreInUseError",
     "UnknownFormatError",
     "UnknownGraphError",
     "UnknownQueryError",

@@ -71,6 +71,20 @@ def test_a_plan_step_and_binding_show_in_one_short_line() -> None:
     assert repr(pose) == "<Binding input graspPose <- step 2, Exact 1.00>"
 
 
+def test_the_errors_a_knowledge_base_raises_come_from_cbrs_kb() -> None:
+    """A failed update's MapError, a refused description's DescriptionShapeError and a locked store's
+    StoreInUseError had to be imported from the modules that raise them."""
+    import cbrs.kb
+    from cbrs.kb.semantic_map import MapError
+    from cbrs.kb.shapes import DescriptionShapeError
+    from cbrs.kb.store import StoreInUseError
+
+    assert cbrs.kb.MapError is MapError
+    assert cbrs.kb.DescriptionShapeError is DescriptionShapeError
+    assert cbrs.kb.StoreInUseError is StoreInUseError
+    assert {"MapError", "DescriptionShapeError", "StoreInUseError"} <= set(cbrs.kb.__all__)
+
+
 def test_every_public_method_of_a_knowledge_base_says_what_it_is_for() -> None:
     """``help(kb.query)``, ``select``, ``description``, ``requirements`` and ``close`` said nothing."""
     undocumented = sorted(
