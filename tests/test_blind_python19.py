@@ -7,6 +7,8 @@ base raises importable from ``cbrs.kb``, and a docstring on every public method 
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -14,6 +16,8 @@ import pytest
 from cbrs.actions import Binding, Plan, PlanStep, Source
 from cbrs.kb import KnowledgeBase
 
+ROOT = Path(__file__).resolve().parents[1]
+NOTEBOOK = ROOT / "docs" / "examples" / "lab19_notebook.py"
 SVC = "https://w3id.org/cbrs/service#"
 LAB19 = "https://example.org/lab19#"
 
@@ -21,6 +25,36 @@ LAB19 = "https://example.org/lab19#"
 @pytest.fixture(scope="module")
 def memory() -> KnowledgeBase:
     return KnowledgeBase.open(":memory:")
+
+
+def test_the_notebook_runs_as_the_page_says() -> None:
+    done = subprocess.run([sys.executable, str(NOTEBOOK)], cwd=ROOT, capture_output=True, text=True, timeout=240)
+    assert done.returncode == 0, done.stderr[-3000:]
+    lines = done.stdout.splitlines()
+    said = "\n".join(lines)
+    assert lines[0] == "<KnowledgeBase ':memory:' (EmbeddedStore)>"
+    assert "in the kitchen: https://example.org/lab19#Vial1 at (7.90, 3.16)" in lines
+    assert "LocateMyVial by sem-str: matched" in lines and "LocateMyVial by string: matched" in lines
+    plan = next(line for line in lines if line.startswith("<Plan "))
+    assert plan.startswith("<Plan https://example.org/lab19#PutVialInRack (direct): 8 steps [1 svc:")
+    assert "8 svc:PutDownObject_CytonDualArm01" in plan and len(plan) < 600
+    carry = "svc:CarryObject_CytonDualArm01: (home:PhysicalObject, home:isGraspedBy, home:Gripper) <- #6"
+    assert f"  <PlanStep 7 {carry}; targetPlace <- req>" in lines
+    assert "ShakeMyVial: unsolvable" in lines
+    assert "no component provides effect (https://example.org/lab19#SampleVial, home:isGraspedBy, home:Person)" in said
+    slip = "lab19:SampleViall is declared nowhere in the store or in this input (as cbrs:parameterType)"
+    assert f"{slip}; did you mean lab19:SampleVial?" in said
+    assert "bad query: error at 1:59:" in said and "missing file: lab19_no_such_file.ttl cannot read" in said
+    assert (
+        "failed update: Vial1 (https://example.org/lab19#Vial1) has home:x 9, home:y 3.16, not over its support" in said
+    )
+    assert "unknown task: PutVialInRak - PutVialInRack known: True" in lines
+    assert "store as it was: True" in lines
+    assert "two threads: 6 containers, planned" in lines
+    ran = [line for line in lines if line.startswith("run: succeeded in ")]
+    assert len(ran) == 1 and ran[0].endswith("simulated s; steps done: 1, 2, 3, 4, 5, 6, 7, 8")
+    assert "  goal isLocated: believed True, holds True" in lines
+    assert "opened twice: True" in lines and lines[-1] == "reopened: True planned"
 
 
 def test_a_knowledge_base_shows_where_its_store_is(memory: KnowledgeBase) -> None:
