@@ -1,19 +1,23 @@
 """``cbrs check``: the store's ontologies and descriptions through an OWL 2 DL reasoner (HermiT, from owlready2).
 
 HermiT runs on Java. The graphs are written to a temporary N-Triples file without their ``owl:imports``
-(the imported ontologies are in the store already, and nothing may be fetched), loaded into a fresh
-owlready2 world and classified. The report says whether the graphs are consistent, which classes are
-unsatisfiable, and, since the reasoner gives no reason for an inconsistency, the literals whose datatype
-is not the range their property declares (``4.5`` is an ``xsd:decimal``, not an ``xsd:double``): places
-to look first.
+(the imported ontologies are in the store already, and nothing may be fetched), which HermiT classifies.
+The report says whether the graphs are consistent, which classes are unsatisfiable, and, since the reasoner
+gives no reason for an inconsistency, the literals whose datatype is not the range their property declares
+(``4.5`` is an ``xsd:decimal``, not an ``xsd:double``): places to look first.
 
 The graphs are cbrs's own by name (``ontology``) or any named graph by its IRI, a lab's own that ``cbrs load
 --graph IRI`` wrote included: checked with cbrs's ontologies when given with ``ontology`` too, alone otherwise
 (its classes then mean what the graph alone says of them). An IRI the store holds no graph of is refused
 (:class:`NoSuchGraphError`), naming the store's other graphs, rather than checked as empty and "consistent".
 
+With :func:`write_inferred` (``cbrs check --write-inferred``) what HermiT concluded and the store does not
+already say (inferred subclasses and equivalences of named classes and properties, types of named
+individuals) is written to graph:inferred (:mod:`kb.inferred`), replacing what it held; over
+inconsistent graphs, or with an unsatisfiable class, nothing is (:class:`WriteRefusedError`).
+
 HermiT runs once and briefly, so its JVM gets the client compiler only and the serial collector
-(:data:`JVM_OPTIONS`, passed in ``JDK_JAVA_OPTIONS``, which owlready2's launch leaves to the environment):
+(:data:`JVM_OPTIONS`, passed in the child's ``JDK_JAVA_OPTIONS``; HermiT's jar is owlready2's):
 a fresh store's check took about 7 s with the JVM's defaults and 3.5 s so, with the same answer. A user's
 own ``JDK_JAVA_OPTIONS`` comes after them, so it wins where they disagree.
 """
@@ -21,11 +25,12 @@ own ``JDK_JAVA_OPTIONS`` comes after them, so it wins where they disagree.
 from __future__ import annotations
 
 import os
+import re
 import shutil
+import subprocess
 import tempfile
 import time
-from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -33,8 +38,9 @@ from typing import Any
 import pyoxigraph as ox
 
 from cbrs.kb import KnowledgeBase, KnowledgeBaseError
+from cbrs.kb.inferred import INFERRED, InferredGraph, replace_inferred
 from cbrs.kb.loader import resolve_graph
-from cbrs.kb.namespaces import OWL, GraphName, shorten
+from cbrs.kb.namespaces import GENID, OWL, RDF, RDFS, GraphName, shorten
 
 DEFAULT_GRAPHS = (GraphName.ONTOLOGY, GraphName.SERVICES, GraphName.REQUIREMENTS)
 JVM_OPTIONS = ("-XX:TieredStopAtLevel=1", "-XX:+UseSerialGC")
@@ -79,6 +85,27 @@ class ReasonerError(KnowledgeBaseError):
         super().__init__(f"HermiT failed: {' '.join(message.split())[:400]}")
 
 
+class WriteRefusedError(KnowledgeBaseError):
+    """HermiT's conclusions not written back: over inconsistent graphs every statement follows, and an
+    unsatisfiable class is below every class, so what it concluded would say nothing true."""
+
+    http_status = 409
+
+    def __init__(self, result: CheckResult) -> None:
+        self.result = result
+        if not result.consistent:
+            why = "they are inconsistent"
+        else:
+            count = len(result.unsatisfiable)
+            named = ", ".join(shorten(iri) for iri in result.unsatisfiable[:5]) + (", ..." if count > 5 else "")
+            why = f"{count} class{'es are' if count > 1 else ' is'} unsatisfiable ({named})"
+        graphs = ", ".join(shorten(graph) for graph in result.graphs)
+        super().__init__(
+            f"HermiT's conclusions over {graphs} were not written to {shorten(INFERRED.value)}: {why}; "
+            "nothing was written (cbrs check without --write-inferred says more)"
+        )
+
+
 @dataclass(frozen=True)
 class RangeClash:
     subject: str
@@ -105,6 +132,8 @@ class CheckResult:
     range_clashes: list[RangeClash] = field(default_factory=list)
     seconds: float = 0.0
     reasoner: str = "HermiT (owlready2)"
+    conclusions: list[ox.Triple] = field(default_factory=list)
+    """HermiT's direct subclasses, subproperties, equivalences and types (:func:`_conclusions`), stated or not."""
 
     @property
     def ok(self) -> bool:
@@ -142,34 +171,91 @@ def check(kb: KnowledgeBase, graphs: Sequence[GraphName | str] = DEFAULT_GRAPHS)
     with tempfile.TemporaryDirectory(prefix="cbrs-check-") as folder:
         path = Path(folder) / "graphs.nt"
         path.write_bytes(ox.serialize(triples, format=ox.RdfFormat.N_TRIPLES) or b"")
-        world = owlready2.World()
-        try:
-            ontology = world.get_ontology(path.as_uri()).load(format="ntriples")
-            with ontology, _java_options(JVM_OPTIONS):
-                owlready2.sync_reasoner_hermit(world, infer_property_values=False, debug=0)
-        except owlready2.OwlReadyInconsistentOntologyError:
-            return CheckResult(names, len(triples), False, [], _range_clashes(kb, names), time.perf_counter() - start)
-        except (owlready2.OwlReadyError, OSError) as error:
-            raise ReasonerError(str(error)) from error
-        unsatisfiable = sorted(
-            c.iri for c in world.inconsistent_classes() if getattr(c, "iri", OWL + "Nothing") != OWL + "Nothing"
-        )
-        world.close()
-    return CheckResult(names, len(triples), True, unsatisfiable, _range_clashes(kb, names), time.perf_counter() - start)
+        output = _hermit(java, path)
+    clashes = _range_clashes(kb, names)
+    if output is None:
+        return CheckResult(names, len(triples), False, [], clashes, time.perf_counter() - start)
+    conclusions, unsatisfiable = _conclusions(output)
+    seconds = time.perf_counter() - start
+    return CheckResult(names, len(triples), True, unsatisfiable, clashes, seconds, conclusions=conclusions)
 
 
-@contextmanager
-def _java_options(options: Sequence[str]) -> Iterator[None]:
-    """``JDK_JAVA_OPTIONS`` set to ``options`` then the user's own, for the java launched inside; as it was after."""
+def write_inferred(
+    kb: KnowledgeBase, graphs: Sequence[GraphName | str] = DEFAULT_GRAPHS
+) -> tuple[CheckResult, InferredGraph]:
+    """Check ``graphs`` (:func:`check`), then make graph:inferred hold HermiT's conclusions that the store
+    does not already say (:func:`kb.inferred.replace_inferred`): all or nothing, replacing what an earlier
+    write-back put there. :class:`WriteRefusedError`, nothing written, when the graphs are inconsistent or
+    have an unsatisfiable class."""
+    result = check(kb, graphs)
+    if not result.ok:
+        raise WriteRefusedError(result)
+    return result, replace_inferred(kb, result.conclusions)
+
+
+def _hermit(java: str, path: Path) -> str | None:
+    """HermiT's classification of the ontology at ``path`` (its command line, as owlready2 runs it: classes,
+    object and data properties, individuals), or None when it finds the ontology inconsistent.
+
+    HermiT is run here rather than through ``owlready2.sync_reasoner_hermit``, whose results keep one kind
+    per entity: a class also used as an individual (OWL 2 punning, as home:Cup is) had its inferred
+    superclasses taken for its types. The JVM options go in the child's environment only."""
+    import owlready2.reasoning
+
+    classpath = str(owlready2.reasoning._HERMIT_CLASSPATH)  # the jar owlready2 ships, on its own classpath
+    memory = getattr(owlready2.reasoning, "JAVA_MEMORY", 2000)
+    command = [java, f"-Xmx{memory}M", "-cp", classpath, "org.semanticweb.HermiT.cli.CommandLine"]
+    command += ["-c", "-O", "-D", "-I", path.as_uri()]
     own = os.environ.get("JDK_JAVA_OPTIONS")
-    os.environ["JDK_JAVA_OPTIONS"] = " ".join([*options, *([own] if own else [])])
+    environment = {**os.environ, "JDK_JAVA_OPTIONS": " ".join([*JVM_OPTIONS, *([own] if own else [])])}
     try:
-        yield
-    finally:
-        if own is None:
-            del os.environ["JDK_JAVA_OPTIONS"]
-        else:
-            os.environ["JDK_JAVA_OPTIONS"] = own
+        done = subprocess.run(command, capture_output=True, env=environment, check=False)
+    except OSError as error:
+        raise ReasonerError(str(error)) from error
+    output = done.stdout.decode("utf-8", "replace")
+    errors = done.stderr.decode("utf-8", "replace")
+    if done.returncode == 1 and "Inconsistent ontology" in output + errors:
+        return None
+    if done.returncode != 0:
+        raise ReasonerError(errors or output)
+    return output
+
+
+_RELATION = re.compile(r"^([A-Za-z]+)\( ((?:<[^>]+>\s*)+)\)$", re.MULTILINE)
+_PREDICATES = {
+    "SubClassOf": RDFS + "subClassOf",
+    "SubObjectPropertyOf": RDFS + "subPropertyOf",
+    "SubDataPropertyOf": RDFS + "subPropertyOf",
+    "Type": RDF + "type",
+    "EquivalentClasses": OWL + "equivalentClass",
+    "EquivalentObjectProperties": OWL + "equivalentProperty",
+    "EquivalentDataProperties": OWL + "equivalentProperty",
+}
+
+
+def _conclusions(output: str) -> tuple[list[ox.Triple], list[str]]:
+    """HermiT's conclusions as triples, and the unsatisfiable classes (those equivalent to owl:Nothing).
+
+    HermiT prints the direct relations of its taxonomy: each class's direct superclasses, each
+    individual's direct types, each set of equivalent classes or properties. Left out: those naming an
+    OWL built-in (owl:Thing above every class, owl:Nothing below) or a node the loader made from a blank
+    node (a class expression, no named class)."""
+    conclusions: list[ox.Triple] = []
+    unsatisfiable: set[str] = set()
+    for relation, listed in _RELATION.findall(output):
+        terms = listed.strip()[1:-1].split("> <")
+        predicate = _PREDICATES.get(relation)
+        if predicate is None:
+            continue
+        if relation == "EquivalentClasses" and OWL + "Nothing" in terms:
+            unsatisfiable.update(term for term in terms if not term.startswith(OWL))
+            continue
+        if any(term.startswith((OWL, GENID)) for term in terms):
+            continue
+        pairs = [(a, b) for a in terms for b in terms if a < b] if relation.startswith("Equivalent") else [terms]
+        node = ox.NamedNode(predicate)
+        conclusions += [ox.Triple(ox.NamedNode(a), node, ox.NamedNode(b)) for a, b in pairs]
+    return conclusions, sorted(unsatisfiable)
 
 
 def checked_graphs(kb: KnowledgeBase, graphs: Sequence[GraphName | str]) -> list[ox.NamedNode]:

@@ -813,22 +813,46 @@ class _NodeNames:
     "a graph of your own (cbrs load --graph IRI; add --graph ontology to check it with cbrs's ontologies). "
     "Default: ontology, services and requirements.",
 )
+@click.option(
+    "--write-inferred",
+    is_flag=True,
+    help="Also write what HermiT concludes and the store does not already say (inferred subclasses, "
+    "equivalences, types of individuals) to graph:inferred, replacing what it held; refused, nothing "
+    "written, when the graphs are inconsistent or have an unsatisfiable class (docs/ontologies.md).",
+)
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
 @pass_app
-def check_command(app: App, graphs: tuple[str, ...], as_json: bool) -> None:
+def check_command(app: App, graphs: tuple[str, ...], write_inferred: bool, as_json: bool) -> None:
     """Run the HermiT OWL reasoner (owlready2; needs Java) over the ontologies and registered descriptions.
 
     Reports whether they are consistent and which classes are unsatisfiable; exits with status 1 if either.
     """
-    from cbrs.check import DEFAULT_GRAPHS, check  # owlready2 loads only for this command
+    from cbrs import check as checking  # owlready2 loads only for this command
 
-    result = check(app.kb, graphs or DEFAULT_GRAPHS)
+    chosen = graphs or checking.DEFAULT_GRAPHS
+    if write_inferred:
+        result, inferred = checking.write_inferred(app.kb, chosen)
+    else:
+        result, inferred = checking.check(app.kb, chosen), None
     if as_json:
-        click.echo(json.dumps(result.to_dict(), indent=2))
+        answer = result.to_dict()
+        if inferred is not None:
+            answer["inferred"] = inferred.to_dict()
+        click.echo(json.dumps(answer, indent=2))
     else:
         click.echo(_check_text(result))
+        if inferred is not None:
+            click.echo(_inferred_text(inferred))
     if not result.ok:
         raise SystemExit(1)
+
+
+def _inferred_text(inferred: Any) -> str:
+    change = f"{inferred.added} added, {inferred.removed} removed" if inferred.changed else "unchanged"
+    return (
+        f"{shorten(inferred.graph)}: {inferred.holds} conclusions ({change}; "
+        f"{inferred.already_said} already stated or entailed, left out)"
+    )
 
 
 def _check_text(result: Any) -> str:
