@@ -200,3 +200,12 @@ def test_what_graph_entailed_holds_is_not_written_again(tmp_path: Path) -> None:
     assert (report.holds, report.added, report.already_said) == (1, 1, 1)
     with pytest.raises(ValueError, match="types, subclasses, subproperties and equivalences only"):
         replace_inferred(kb, [ox.Triple(box1.subject, ox.NamedNode(EX + "hasLid"), box1.object)])
+
+
+def test_an_equivalence_only_hermit_finds_is_written_once(tmp_path: Path) -> None:
+    """Two classes defined by the same restriction: HermiT names them equivalent, both ways round."""
+    same = "[ a owl:Restriction ; owl:onProperty ex:hasLid ; owl:someValuesFrom ex:Lid ]"
+    kb = small_kb(tmp_path, f"ex:Closed owl:equivalentClass {same} .\nex:WithLid owl:equivalentClass {same} .\n")
+    write_inferred(kb)
+    equivalences = {t for t in inferred(kb) if t[1] == OWL + "equivalentClass"}
+    assert equivalences == {triple("Closed", OWL + "equivalentClass", "WithLid")}
