@@ -826,6 +826,7 @@ def check_command(app: App, graphs: tuple[str, ...], write_inferred: bool, as_js
     """Run the HermiT OWL reasoner (owlready2; needs Java) over the ontologies and registered descriptions.
 
     Reports whether they are consistent and which classes are unsatisfiable; exits with status 1 if either.
+    With --write-inferred, HermiT's new conclusions go into graph:inferred, where SPARQL sees them.
     """
     from cbrs import check as checking  # owlready2 loads only for this command
 
