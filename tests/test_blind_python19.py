@@ -125,3 +125,13 @@ def test_every_public_method_of_a_knowledge_base_says_what_it_is_for() -> None:
         name for name in dir(KnowledgeBase) if not name.startswith("_") and not getattr(KnowledgeBase, name).__doc__
     )
     assert undocumented == []
+
+
+def test_the_package_says_where_its_library_is() -> None:
+    """``help(cbrs)`` said one sentence about the service: nothing of the four packages a program imports."""
+    import cbrs
+
+    assert cbrs.__doc__ is not None
+    for name in ("cbrs.kb", "KnowledgeBase.open", "cbrs.reasoner", "Matchmaker", "cbrs.actions", "Composer"):
+        assert name in cbrs.__doc__
+    assert "run_task" in cbrs.__doc__ and "cbrs.sim" in cbrs.__doc__
