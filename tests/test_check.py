@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 import shutil
 from pathlib import Path
 
@@ -10,7 +9,7 @@ import owlready2
 import pytest
 from click.testing import CliRunner
 
-from cbrs.check import JVM_OPTIONS, JavaMissingError, check
+from cbrs.check import JavaMissingError, check
 from cbrs.cli import cli
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import GraphName
@@ -23,30 +22,6 @@ HEAD = """@prefix ex: <http://example.org/check#> . @prefix owl: <http://www.w3.
 @prefix rdfs: <http://www.w3.org/2000/01/rdf-schema#> . @prefix xsd: <http://www.w3.org/2001/XMLSchema#> .
 ex:Cup a owl:Class . ex:Plate a owl:Class ; owl:disjointWith ex:Cup .
 """
-
-
-@needs_java
-@pytest.mark.parametrize("own", [None, "-Xss2m"])
-def test_hermit_runs_on_the_quick_jvm_options_then_the_users_own(
-    monkeypatch: pytest.MonkeyPatch, tmp_path: Path, own: str | None
-) -> None:
-    """The client compiler and the serial collector halve a short check (7 s to 3.5 s on a fresh store);
-    a user's own JDK_JAVA_OPTIONS follows them, so it wins, and is as it was afterwards."""
-    if own is None:
-        monkeypatch.delenv("JDK_JAVA_OPTIONS", raising=False)
-    else:
-        monkeypatch.setenv("JDK_JAVA_OPTIONS", own)
-    seen: list[str | None] = []
-    reason = owlready2.sync_reasoner_hermit
-
-    def recorded(*args: object, **kwargs: object) -> object:
-        seen.append(os.environ.get("JDK_JAVA_OPTIONS"))
-        return reason(*args, **kwargs)
-
-    monkeypatch.setattr(owlready2, "sync_reasoner_hermit", recorded)
-    assert check(small_kb(tmp_path, "ex:Mug rdfs:subClassOf ex:Cup .")).consistent
-    assert seen == [" ".join([*JVM_OPTIONS, *([own] if own else [])])]
-    assert os.environ.get("JDK_JAVA_OPTIONS") == own
 
 
 def small_kb(tmp_path: Path, turtle: str) -> KnowledgeBase:
