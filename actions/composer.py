@@ -138,7 +138,9 @@ class CompositionResult:
     status: PlanStatus
     plan: Plan | None
     unsatisfied: tuple[Unsatisfied, ...]
-    attempts: tuple[Attempt, ...]  # the direct attempt, then one per sub-action when decomposed
+    # the direct attempt, then one per sub-action when decomposed; left out of the repr (each holds its graph
+    # and search trace: 31,000 characters for an eight-step plan in a notebook cell)
+    attempts: tuple[Attempt, ...] = field(repr=False)
     objective: Objective = Objective.SIMILARITY  # what ranked providers (each step's ranked_by says what decided)
     # what of the task's written decomposition composition does not follow, and why (actions.decomposition_notes)
     notes: tuple[str, ...] = ()

@@ -117,7 +117,7 @@ class ParsedFile:
 
     source: str
     graph: str
-    quads: list[ox.Quad]
+    quads: list[ox.Quad] = field(repr=False)  # every quad: a notebook showing a report printed each one
     owls: Conversion | None = None
     ontology: str | None = None
     repairs: tuple[str, ...] = ()

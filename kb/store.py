@@ -345,7 +345,10 @@ class StoreInUseError(StoreError):
             if served
             else "stop that process, or open another store"
         )
-        super().__init__(location, f"is in use by another process (RocksDB lock held); {hint} ({cause})")
+        holder = "another process"
+        if "current process" in cause:  # RocksDB's words for a lock this process holds: a KnowledgeBase open here
+            holder, hint = "this process", "close the KnowledgeBase that has it open (kb.close(), or a with block)"
+        super().__init__(location, f"is in use by {holder} (RocksDB lock held); {hint} ({cause})")
 
 
 # What the engine's IO errors say when the store's disk, not the request, is at fault, and what to do.

@@ -707,6 +707,11 @@ class _Ranking(Sequence[Candidate]):
     def __len__(self) -> int:
         return len(self._head) + self._remaining
 
+    def __repr__(self) -> str:
+        """The count and the first three, by label and score: a notebook showing a result saw an address."""
+        first = ", ".join(f"{c.label or c.advertisement} {c.score:.3f}" for c in self[:3])
+        return f"<{len(self)} candidates: {first}{', ...' if len(self) > 3 else ''}>"
+
     def first_acceptable(self) -> bool:
         """Is the best candidate acceptable? Read from the batch scores, without explaining it (tests check
         that the batch and the explanation agree on acceptability)."""

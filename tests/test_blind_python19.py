@@ -13,8 +13,9 @@ from pathlib import Path
 
 import pytest
 
-from cbrs.actions import Binding, Plan, PlanStep, Source
-from cbrs.kb import KnowledgeBase
+from cbrs.actions import Binding, Composer, Plan, PlanStep, Source
+from cbrs.kb import KnowledgeBase, StoreInUseError
+from cbrs.reasoner import MatchConfig, Matchmaker
 
 ROOT = Path(__file__).resolve().parents[1]
 NOTEBOOK = ROOT / "docs" / "examples" / "lab19_notebook.py"
@@ -135,3 +136,26 @@ def test_the_package_says_where_its_library_is() -> None:
     for name in ("cbrs.kb", "KnowledgeBase.open", "cbrs.reasoner", "Matchmaker", "cbrs.actions", "Composer"):
         assert name in cbrs.__doc__
     assert "run_task" in cbrs.__doc__ and "cbrs.sim" in cbrs.__doc__
+
+
+def test_a_store_open_twice_in_one_kernel_says_to_close_the_other(tmp_path: Path) -> None:
+    """A second open in the same kernel said "in use by another process ... stop that process": there was
+    none, only the notebook's own KnowledgeBase from an earlier cell."""
+    folder = tmp_path / "lab"
+    with KnowledgeBase.open(folder, seed=False), pytest.raises(StoreInUseError, match="by this process") as refused:
+        KnowledgeBase.open(folder, seed=False)
+    assert "close the KnowledgeBase" in str(refused.value)
+
+
+def test_a_load_report_a_composition_and_a_ranking_show_in_a_few_lines() -> None:
+    """A load's report printed every quad it loaded, a composition its search's graphs and traces (31,383
+    characters for an eight-step plan), a ranking ``<_Ranking object at 0x...>``."""
+    with KnowledgeBase.open(":memory:") as kb:
+        report = kb.load([ROOT / "docs" / "examples" / "lab19_vial_and_rack.ttl"], graph="ontology")
+        assert "Quad(" not in repr(report) and len(repr(report)) < 2_000
+        composition = Composer(kb).compose("FetchMyPen")
+        assert composition.plan is not None and len(repr(composition)) < 5_000
+        assert "attempts=" not in repr(composition)
+        ranking = Matchmaker(kb, "sem-str", MatchConfig()).rank(kb.requirements()[0], explain=3)
+        shown = repr(ranking.candidates)
+        assert shown.startswith(f"<{len(ranking.candidates)} candidates: ") and "object at" not in shown
