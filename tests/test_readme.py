@@ -37,7 +37,7 @@ SKIPPED_BLOCKS = {
 # Commands left out (by their first words): long, and each covered by its own tests.
 SKIPPED_COMMANDS = {
     "cbrs eval paper": "every method over the 20 x 100 testbed; tests/test_eval_cli.py runs it",
-    "cbrs check": "starts Java's HermiT (seconds); tests/test_check.py runs it on a fresh store",
+    "cbrs check": "starts Java's HermiT (seconds); tests/test_check.py and tests/test_check_write_back.py run it",
     "cbrs --store :memory: demo": "plans and runs three simulated scenarios; tests/test_cli.py runs the demo",
     "cbrs demo --external": "starts camera programs and kills one mid-run; tests/test_external_demo.py runs it",
 }
