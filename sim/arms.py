@@ -11,7 +11,7 @@ simulated time and reports whether it reached its target.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 from enum import StrEnum
 from importlib.resources import files
@@ -846,6 +846,27 @@ class Arm:
         without moving: a skill asks before it picks up what it could not set down. Before, a posture in
         the dispenser's spout counted, and a cup taken from the top was carried into the spout. The arms
         of ``folded`` are taken to be home, as in :meth:`dry_run`."""
+        return next(self._holding(position, orientation, symmetric, folded), None) is not None
+
+    def hold_meets(self, position: Vec3, orientation: Quat, margin: float, symmetric: bool = True) -> str:
+        """The fixture (``Kinematics``'s ``fixtures``: the appliances, a tap's lever too) that every posture
+        holding the hand at this pose (those :meth:`can_hold` takes) brings the arm, fingers included,
+        within ``margin`` of, the first such posture's; empty when one keeps farther from them all, or none
+        holds the pose (:meth:`can_hold` says that)."""
+        met = ""
+        for posture in self._holding(position, orientation, symmetric):
+            name = self._kinematics.brushes(self.side, posture, margin)
+            if not name:
+                return ""
+            met = met or name
+        return met
+
+    def _holding(
+        self, position: Vec3, orientation: Quat, symmetric: bool, folded: Sequence[ArmSide] = ()
+    ) -> Iterator[tuple[float, ...]]:
+        """The postures (joint positions) that hold the hand at this pose, the half-turned hand too when
+        ``symmetric``, solved from each seed posture and the current one in turn, lazily: those within the
+        tolerances that push into no fixed thing (:meth:`Kinematics.strikes`)."""
         candidates = [orientation, flipped(orientation)] if symmetric else [orientation]
         others = self._others(folded)
         for candidate in candidates:
@@ -858,32 +879,7 @@ class Arm:
                     and solution.orientation_error <= 0.02
                     and not self._kinematics.strikes(self.side, solution.q, others)
                 ):
-                    return True
-        return False
-
-    def hold_meets(self, position: Vec3, orientation: Quat, margin: float, symmetric: bool = True) -> str:
-        """The fixture (``Kinematics``'s ``fixtures``: the appliances, a tap's lever too) that every posture
-        holding the hand at this pose (those :meth:`can_hold` takes) brings the arm, fingers included,
-        within ``margin`` of, the first such posture's; empty when one keeps farther from them all, or none
-        holds the pose (:meth:`can_hold` says that)."""
-        candidates = [orientation, flipped(orientation)] if symmetric else [orientation]
-        others = self._others()
-        met = ""
-        for candidate in candidates:
-            if self._kinematics.wrist_strikes(self.side, position, candidate):
-                continue
-            for seed in (*_SEEDS, self.joint_positions()):
-                solution = self._kinematics.solve(self.side, position, candidate, [seed], loose=True)
-                if (
-                    solution.position_error <= IK_TOLERANCE
-                    and solution.orientation_error <= 0.02
-                    and not self._kinematics.strikes(self.side, solution.q, others)
-                ):
-                    name = self._kinematics.brushes(self.side, solution.q, margin)
-                    if not name:
-                        return ""
-                    met = met or name
-        return met
+                    yield solution.q
 
     def _others(self, folded: Sequence[ArmSide] = ()) -> dict[ArmSide, Sequence[float]]:
         """The other arms' postures: where they are, or home for those of ``folded``."""
