@@ -347,7 +347,9 @@ class StoreInUseError(StoreError):
         )
         holder = "another process"
         if "current process" in cause:  # RocksDB's words for a lock this process holds: a KnowledgeBase open here
-            holder, hint = "this process", "close the KnowledgeBase that has it open (kb.close(), or a with block)"
+            holder = "this process"  # a server in this process (a test's, a notebook's) keeps its URL's advice
+            if not served:
+                hint = "close the KnowledgeBase that has it open (kb.close(), or a with block)"
         super().__init__(location, f"is in use by {holder} (RocksDB lock held); {hint} ({cause})")
 
 
