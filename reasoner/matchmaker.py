@@ -38,6 +38,7 @@ from cbrs.kb import (
     Requirement,
     Statement,
 )
+from cbrs.kb.namespaces import expand
 from cbrs.reasoner.config import MatchConfig
 from cbrs.reasoner.degrees import Degree, degree_of_match
 from cbrs.reasoner.methods import REFINED, Method, make_method
@@ -189,7 +190,8 @@ class Matchmaker:
         return self._advertisements
 
     def rank(self, requirement: Requirement | str, explain: int | None = None) -> MatchResult:
-        """Score every advertisement against ``requirement`` (an IRI or a Requirement), best first.
+        """Score every advertisement against ``requirement`` (a Requirement, its IRI, ``prefix:local``, or a
+        bare name taken in ``req:``, as ``cbrs match`` takes it), best first.
 
         The whole pool is scored at once (reasoner/batch.py); the first ``explain`` candidates (all
         when None) also carry their explanation (entity pairs and what they lack), worked out when a
@@ -197,7 +199,7 @@ class Matchmaker:
         """
         with self._lock:
             if isinstance(requirement, str):
-                requirement = self._requirement(requirement)
+                requirement = self._requirement(expand(requirement if ":" in requirement else "req:" + requirement))
             ads = self.advertisements
             gone = self.kb.liveness.unavailable()  # read at every ranking: a component may leave at any time
             candidates = self._rank_batch(requirement, ads, len(ads) if explain is None else explain, gone)

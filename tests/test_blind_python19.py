@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 
 from cbrs.actions import Binding, Composer, Plan, PlanStep, Source
-from cbrs.kb import KnowledgeBase, StoreInUseError
+from cbrs.kb import KnowledgeBase, NotFoundError, StoreInUseError
 from cbrs.reasoner import MatchConfig, Matchmaker
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -159,3 +159,16 @@ def test_a_load_report_a_composition_and_a_ranking_show_in_a_few_lines() -> None
         ranking = Matchmaker(kb, "sem-str", MatchConfig()).rank(kb.requirements()[0], explain=3)
         shown = repr(ranking.candidates)
         assert shown.startswith(f"<{len(ranking.candidates)} candidates: ") and "object at" not in shown
+
+
+def test_a_requirement_is_ranked_by_its_short_name_as_cbrs_match_takes_it(memory: KnowledgeBase) -> None:
+    """``Matchmaker.rank("RobotSelfPosition")`` failed with a BindingError about an internal parameter, where
+    ``cbrs match RobotSelfPosition`` and ``Composer.compose`` take the short name."""
+    matchmaker = Matchmaker(memory, "sem-str", MatchConfig())
+    full = matchmaker.rank("https://w3id.org/cbrs/requirement#RobotSelfPosition", explain=1)
+    for name in ("RobotSelfPosition", "req:RobotSelfPosition"):
+        ranked = matchmaker.rank(name, explain=1)
+        assert ranked.requirement == full.requirement
+        assert ranked.candidates[0].advertisement == full.candidates[0].advertisement
+    with pytest.raises(NotFoundError, match="reqq:RobotSelfPosition"):
+        matchmaker.rank("reqq:RobotSelfPosition")
