@@ -12,22 +12,7 @@ from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import StoreError
 from cbrs.kb.namespaces import expand
 from cbrs.kb.store import StoreInUseError
-from cbrs.kb.upgrade import StoreCheck, UpgradeReport
 from cbrs.settings import setting
-
-
-class _NotedKnowledgeBase(KnowledgeBase):
-    """A knowledge base that keeps what the upgrade of its open did (``KnowledgeBase.open`` logs it and
-    returns the knowledge base alone), for the command to say: a command that upgraded an old store said
-    nothing of it."""
-
-    upgraded: UpgradeReport | None = None
-
-    def upgrade(self, check: StoreCheck | None = None) -> UpgradeReport:
-        report = super().upgrade(check)
-        if report.changed:
-            self.upgraded = report
-        return report
 
 
 @dataclass
@@ -46,7 +31,7 @@ class App:
         contents whole (``cbrs restore``): a new store is not seeded, an old one not upgraded, first."""
         if self._kb is None:
             try:
-                opened = _NotedKnowledgeBase.open(
+                opened = KnowledgeBase.open(
                     self.store_location,
                     seed=seed,
                     remote_timeout=setting("remote_timeout").resolve(),
@@ -64,7 +49,7 @@ class App:
                 reason = f"is in use by another process (RocksDB lock held); {hint} ({error.cause})"
                 raise StoreError(error.location, reason) from error
             self._kb = opened
-            if isinstance(opened, _NotedKnowledgeBase) and opened.upgraded is not None:
+            if opened.upgraded is not None:
                 note_upgraded_store(opened.store.location, opened.upgraded)
         return self._kb
 

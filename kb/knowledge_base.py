@@ -77,6 +77,9 @@ class KnowledgeBase:
         self.registry = ComponentRegistry(store, self.standard_terms)
         self._reader = DescriptionReader(store, self.queries)
         self._map_read: tuple[int, bool] | None = None  # (store generation, whether the map read then)
+        self.upgraded: UpgradeReport | None = None
+        """What the last :meth:`upgrade` that changed the store did (:meth:`open` upgrades an old store and
+        returns the knowledge base alone; a command says what it did)."""
 
     def __repr__(self) -> str:
         """Where the store is and which kind it is: a notebook showing ``kb`` said only its address in
@@ -294,6 +297,7 @@ class KnowledgeBase:
         an emptied map given the bundled one. ``check``: what :func:`kb.upgrade.check_store` just found."""
         report = upgrade_store(self.store, self.queries, check)
         if report.changed:
+            self.upgraded = report
             self._reader.clear_cache()
             self._map_read = None
             self._entail()
