@@ -11,7 +11,7 @@ through skolemised nodes only (a named resource it reaches stays a bare IRI, as 
 
 Bounded, as a concise bounded description must be on a store of any shape: at most ``depth`` links from
 the answer's own triples (:data:`DEPTH`; an OWL list of n members is n links deep) and ``most`` triples
-added (:data:`MOST`); a node past either bound is left as it was, a bare IRI. docs/sparql.md.
+added (:data:`MOST`); a node past either bound is left as it was, a bare IRI (docs/serving.md, "DESCRIBE").
 """
 
 from __future__ import annotations

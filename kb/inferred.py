@@ -16,13 +16,11 @@ default graph, so every SPARQL query sees them (docs/ontologies.md, "HermiT's co
 
 from __future__ import annotations
 
-import logging
 from collections.abc import Iterable
 from dataclasses import dataclass
 
 import pyoxigraph as ox
 
-from cbrs.kb.errors import StoreError
 from cbrs.kb.knowledge_base import KnowledgeBase
 from cbrs.kb.namespaces import GRAPH, OWL, RDF, RDFS
 
@@ -44,8 +42,6 @@ PREDICATES = tuple(
 )
 """The predicates of the conclusions graph:inferred holds."""
 _SYMMETRIC = frozenset(PREDICATES[3:])
-
-_log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -76,9 +72,9 @@ class InferredGraph:
 
 def replace_inferred(kb: KnowledgeBase, conclusions: Iterable[ox.Triple]) -> InferredGraph:
     """Make graph:inferred hold those of ``conclusions`` (triples with one of :data:`PREDICATES`) that no
-    other graph holds, in one update; no write when it holds them already. graph:entailed is brought up to
-    date after a change (the alignments read the inferred types too); if that fails the write stands and
-    graph:entailed lags until the next write, as after any write."""
+    other graph holds, in one update; no write when it holds them already. After a change the knowledge
+    base brings what it derives up to date (:meth:`KnowledgeBase.replace_graph`: graph:entailed, whose
+    alignments read the inferred types too, and the descriptions it has read)."""
     conclusions = list(dict.fromkeys(conclusions))
     if any(triple.predicate not in PREDICATES for triple in conclusions):
         raise ValueError("replace_inferred takes types, subclasses, subproperties and equivalences only")
@@ -92,11 +88,7 @@ def replace_inferred(kb: KnowledgeBase, conclusions: Iterable[ox.Triple]) -> Inf
         INFERRED.value, len(wanted), len(wanted - held), len(held - wanted), len(conclusions) - len(unsaid)
     )
     if report.changed:
-        kb.store.replace_graph(INFERRED, quads)
-        try:
-            kb.refresh_standard_terms()
-        except StoreError as error:
-            _log.warning("graph:entailed not brought up to date (it lags until the next write): %s", error)
+        kb.replace_graph(INFERRED, quads)
     return report
 
 

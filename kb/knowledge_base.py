@@ -279,6 +279,15 @@ class KnowledgeBase:
         Every write method here calls it; call it after writing to the store by other means."""
         return self.standard_terms.refresh()
 
+    def replace_graph(self, graph: ox.NamedNode, quads: Sequence[ox.Quad]) -> None:
+        """Make ``graph`` hold exactly ``quads``, in one transaction, then bring what is derived from the
+        store up to date as every write here does (descriptions read again, graph:entailed): for a graph
+        whose contents a caller works out itself (:mod:`kb.inferred`'s HermiT conclusions)."""
+        self.store.replace_graph(graph, quads)
+        self._reader.clear_cache()
+        self._map_read = None
+        self._entail()
+
     def _entail(self, update: PendingUpdate | None = None) -> Refresh | None:
         """After a write that stands: bring graph:entailed up to date, or say why it lags (None). After an
         update :meth:`StandardTerms.prepare` read, from the nodes it changed; otherwise from the whole store."""
