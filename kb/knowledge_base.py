@@ -322,8 +322,11 @@ class KnowledgeBase:
 
     def _seed_kept(self, cache: SeedCache) -> None:
         """Seed from ``cache``'s copy of this bundle's seed, else in full and keep the result. A remote
-        store is always seeded in full: its server works graph:entailed out for itself."""
-        if not isinstance(self.store, EmbeddedStore):
+        store is always seeded in full: its server works graph:entailed out for itself; so is a store that
+        holds something already (a lab's graph loaded unseeded): its graph:entailed is worked out over what
+        it holds, and what it holds is not the bundle's seed to keep (kept, it went into every later
+        ``:memory:`` store of the process)."""
+        if not isinstance(self.store, EmbeddedStore) or next(self.store.quads(), None) is not None:
             self.seed()
             return
         digest = bundle_digest()

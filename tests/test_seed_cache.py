@@ -101,3 +101,22 @@ def test_the_digest_follows_the_bundled_files(monkeypatch: pytest.MonkeyPatch, t
 
     monkeypatch.setattr(seed_cache, "bundled_files", files)
     assert bundle_digest() != before
+
+
+def test_a_store_seeded_over_a_labs_graph_keeps_no_copy_of_it(tmp_path: Path) -> None:
+    """A lab's graph loaded into an unseeded store, then the store seeded (opened again as usual): its whole
+    contents were kept as the bundle's seed, so every later ``:memory:`` store of the process held the lab's
+    graph too (the final suite's test_backup and test_remote_store met test_check_write_back's)."""
+    lab = tmp_path / "lab.ttl"
+    lab.write_text("<urn:lab:a> <urn:lab:b> <urn:lab:c> .\n", encoding="utf-8")
+    cache = SeedCache(tmp_path / "cache")
+    unseeded = KnowledgeBase.open(tmp_path / "store", seed=False)
+    unseeded.load([lab], graph="https://example.org/lab/graph")
+    unseeded.close()
+    seeded = KnowledgeBase.open(tmp_path / "store", seed_cache=cache)
+    try:
+        assert "https://example.org/lab/graph" in seeded.store.graphs()
+    finally:
+        seeded.close()
+    later = KnowledgeBase.open(":memory:", seed_cache=cache)
+    assert later.store.dump() == _full_seed().store.dump()
