@@ -101,13 +101,27 @@ class ServiceDescription:
     area: EffectiveArea | None = None
     qos: tuple[QoSValue, ...] = ()
 
+    def __repr__(self) -> str:
+        """The IRI, label and how much the description holds: the generated repr printed every part tree
+        in full, 1-4 KB for one bundled component, so a notebook listing a few was unreadable.
+        :meth:`to_dict` gives everything."""
+        counts = [
+            (len(self.inputs), "input"),
+            (len(self.outputs), "output"),
+            (len(self.preconditions), "precondition"),
+            (len(self.effects), "effect"),
+        ]
+        held = ", ".join(f"{n} {word}{'' if n == 1 else 's'}" for n, word in counts if n)
+        label = f" {self.label!r}" if self.label else ""
+        return f"<{type(self).__name__} {self.iri!r}{label}: {held or 'no inputs, outputs or statements'}>"
+
     def to_dict(self) -> dict[str, Any]:
         data = asdict(self)
         data["class"] = type(self).__name__
         return data
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Advertisement(ServiceDescription):
     """A component's advertised service; ``kind`` is one of the four component kinds."""
 
@@ -123,7 +137,7 @@ class Advertisement(ServiceDescription):
         return next((p for p in self.ports if p.kind == "service" and p.topic and p.message_type), None)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, repr=False)
 class Requirement(ServiceDescription):
     """What a requester needs; ``for_task`` names the action class of a task requirement."""
 

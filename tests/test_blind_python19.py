@@ -172,3 +172,18 @@ def test_a_requirement_is_ranked_by_its_short_name_as_cbrs_match_takes_it(memory
         assert ranked.candidates[0].advertisement == full.candidates[0].advertisement
     with pytest.raises(NotFoundError, match="reqq:RobotSelfPosition"):
         matchmaker.rank("reqq:RobotSelfPosition")
+
+
+def test_an_advertisement_and_a_requirement_show_in_one_short_line(memory: KnowledgeBase) -> None:
+    """The generated repr of one bundled advertisement spelt its part trees in full, 1-4 KB each, so a
+    notebook listing ``kb.advertisements()[:3]`` filled the screen; ``to_dict`` still gives every field."""
+    advertisements, requirements = memory.advertisements(), memory.requirements()
+    for description in [*advertisements, *requirements]:
+        shown = repr(description)
+        assert shown.startswith(f"<{type(description).__name__} {description.iri!r}")
+        assert len(shown) < 300 and "PartNode" not in shown
+    carry = next(a for a in advertisements if a.iri == SVC + "CarryObject_CytonDualArm01")
+    assert repr(carry) == (
+        f"<Advertisement {carry.iri!r} 'Carry object (Cyton dual arm 1)': 1 input, 1 precondition, 1 effect>"
+    )
+    assert carry.to_dict()["inputs"][0]["tree"] is not None

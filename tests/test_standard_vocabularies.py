@@ -191,8 +191,8 @@ def _answers(kb: KnowledgeBase) -> tuple[object, ...]:
         kb.select("world_state"),
         kb.select("map_types"),
         robots,
-        [repr(ad) for ad in kb.advertisements()],
-        [repr(requirement) for requirement in kb.requirements()],
+        [ad.to_dict() for ad in kb.advertisements()],
+        [requirement.to_dict() for requirement in kb.requirements()],
     )
 
 
