@@ -682,8 +682,16 @@ def camera() -> Response:
 
 @blueprint.get("/camera.jpg")
 def snapshot() -> Response:
-    """The ceiling camera's view now, once (its number in ``X-Frame``): mid-run, one the run renders for it."""
-    frame = _current_frame(context.tasks())
+    """The ceiling camera's view now, once (its number in ``X-Frame``): mid-run, one the run renders for it.
+
+    ``?frame=N``: the latest frame, at once, when it is numbered N or more (the tasks page asks so for a
+    frame the events or its checks announced, when the server had no stream slot left for its camera:
+    twenty such pages asking the run for a frame each would hold twenty request threads and renders)."""
+    runner = context.tasks()
+    wanted = request.args.get("frame", type=int)
+    latest = runner.frame() if wanted is not None and runner.camera is not None else None
+    frame = latest if latest is not None and wanted is not None and latest.number >= wanted else None
+    frame = frame or _current_frame(runner)
     if frame is None:
         raise NotFound(_NO_FRAME)
     return Response(

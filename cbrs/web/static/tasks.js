@@ -123,8 +123,19 @@
     restartCamera();
   }
 
+  // The camera is a stream (MJPEG) while the server has a stream slot for it; refused (all slots taken: a
+  // class of twenty pages open at once), it is the still of the latest frame, asked for when the events or
+  // the page's checks say a newer one exists (camera.jpg?frame=N answers at once, asking the run for none).
+  let stills = false;
+  camera.addEventListener("error", () => {
+    if (stills) return;
+    stills = true;
+    camera.src = live.dataset.still + "?frame=" + Number(frameCount.dataset.frame || 0) + "&t=" + Date.now();
+  });
+
   function restartCamera() {
-    // The stream ends by itself when idle; a new run deserves a fresh one.
+    // The stream ends by itself when idle; a new run deserves a fresh one (and a slot may be free again).
+    stills = false;
     camera.src = live.dataset.stream + "?t=" + Date.now();
   }
 
@@ -132,6 +143,7 @@
     if (number > Number(frameCount.dataset.frame || 0)) {
       frameCount.dataset.frame = String(number);
       frameCount.textContent = String(number);
+      if (stills) camera.src = live.dataset.still + "?frame=" + number;
     }
   }
 
@@ -207,11 +219,81 @@
     if (message.event === "run_finished") refreshRuns();
   }
 
-  const source = new EventSource(live.dataset.events);
-  source.onopen = () => (streamState.textContent = "· live");
-  source.onerror = () => (streamState.textContent = "· reconnecting…");
-  source.onmessage = (event) => handle(JSON.parse(event.data));
-  source.addEventListener("end", () => (streamState.textContent = "· paused, reconnecting…"));
+  // Without a stream (the server refused it: every stream slot taken, 503), the page asks for the run's JSON
+  // every POLL_MS and redraws what changed, and tries the stream again every RETRY_MS: an EventSource that
+  // is refused does not reconnect by itself, and the page sat at "running" with an empty steps table.
+  const POLL_MS = 2000;
+  const RETRY_MS = 20000;
+  let polling = null;
+  let seen = -1; // events of the current run already drawn by a check
+
+  function applyRun(run) {
+    if (run.id !== current) {
+      startRun(run.id, run.shown || run.task);
+      seen = -1;
+    }
+    if (run.events.length !== seen || live.dataset.status !== run.status) {
+      seen = run.events.length;
+      plan = 1;
+      steps.replaceChildren();
+      eventList.replaceChildren();
+      verdict.textContent = "";
+      run.events.forEach((message) => {
+        if (message.topic === "/cbrs/task_progress") stepEvent(message);
+        listEvent(message);
+      });
+      const ended = live.dataset.status === "running" && run.status !== "running";
+      setBadge(run.status);
+      if (run.verdict) verdict.textContent = shortenText(run.verdict);
+      if (ended) refreshRuns();
+    }
+  }
+
+  async function check() {
+    const url = follow === "latest" ? live.dataset.runs + ".json" : live.dataset.runs + "/" + encodeURIComponent(follow) + ".json";
+    try {
+      const response = await fetch(url, { headers: { Accept: "application/json" } });
+      if (!response.ok) return;
+      const data = await response.json();
+      const run = follow === "latest" ? data.active : data.run;
+      if (run) applyRun(run);
+      if (data.camera) showFrame(data.camera.frame);
+    } catch (error) {
+      streamState.textContent = "· the server does not answer; checking again";
+    }
+  }
+
+  function startPolling() {
+    if (polling) return;
+    streamState.textContent = "· the server's live streams are all in use (many pages follow runs): this page checks every " + POLL_MS / 1000 + " s instead";
+    seen = -1;
+    check();
+    polling = setInterval(check, POLL_MS);
+    setTimeout(connect, RETRY_MS);
+  }
+
+  function stopPolling() {
+    if (!polling) return;
+    clearInterval(polling);
+    polling = null;
+  }
+
+  function connect() {
+    const source = new EventSource(live.dataset.events);
+    source.onopen = () => {
+      stopPolling();
+      streamState.textContent = "· live";
+    };
+    source.onerror = () => {
+      if (source.readyState === EventSource.CLOSED) {
+        if (polling) setTimeout(connect, RETRY_MS);
+        else startPolling();
+      } else streamState.textContent = "· reconnecting…";
+    };
+    source.onmessage = (event) => handle(JSON.parse(event.data));
+    source.addEventListener("end", () => (streamState.textContent = "· paused, reconnecting…"));
+  }
+  connect();
 
   // Stop the run shown without leaving the page; the form still works without this script.
   const stopForm = byId("cancel");

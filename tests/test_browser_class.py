@@ -1,0 +1,62 @@
+"""A class on one server (docs/web.md, "Tried by a teacher with a class"): the tasks page when every stream
+slot is taken follows the run all the same, by asking for its JSON, and says why it is not live.
+
+One page session against ``cbrs serve`` whose task runner plays a scripted run (no planner, no
+simulation) and whose stream slots are all taken, as twenty open tasks pages take them. Skipped where
+Chromium or Playwright is missing, as ``tests/test_browser.py`` is.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from typing import Any
+
+import pytest
+
+import cbrs.server
+from cbrs.kb import KnowledgeBase
+from cbrs.server import ServeConfig, Server
+from cbrs.web.context import StreamSlots
+from tests.test_browser import CHROMIUM, FLAGS, WAIT_MS, pytestmark  # noqa: F401  (the same skip)
+from tests.test_browser_phone_and_live_steps import _Scripted
+
+playwright_api = pytest.importorskip("playwright.sync_api", reason="Playwright is not installed (pip install .[test])")
+
+
+@pytest.fixture(scope="module")
+def server() -> Iterator[Server]:
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(cbrs.server, "TaskRunner", _Scripted)
+        running = Server(KnowledgeBase.open(":memory:"), ServeConfig(port=0, bridge_port=0))
+    running.app.extensions["cbrs.streams"] = StreamSlots(limit=0)  # the class holds every slot
+    running.start()
+    yield running
+    running.stop(timeout=10)
+
+
+@pytest.fixture(scope="module")
+def page(server: Server) -> Iterator[Any]:
+    with playwright_api.sync_playwright() as playwright:
+        browser = playwright.chromium.launch(executable_path=CHROMIUM, headless=True, args=FLAGS)
+        context = browser.new_context(base_url=f"http://127.0.0.1:{server.http_port}")
+        context.set_default_timeout(WAIT_MS)
+        opened = context.new_page()
+        errors: list[str] = []
+        opened.on("pageerror", lambda error: errors.append(str(error)))
+        opened.goto("/tasks")
+        yield opened
+        context.close()
+        browser.close()
+    assert errors == [], f"JavaScript errors on the page: {errors}"
+
+
+def test_a_run_is_followed_without_a_stream_slot(page: Any) -> None:
+    state = page.locator("#stream-state")
+    playwright_api.expect(state).to_contain_text("live streams are all in use")
+    page.locator("#start-button").click()
+    # the scripted run ends at once; only the page's checks can tell it (before: "running" for good)
+    playwright_api.expect(page.locator("#run-status")).to_have_text("succeeded")
+    rows = page.locator("#steps tr")
+    playwright_api.expect(rows).to_have_count(3)  # plan 1's steps 1 and 2, plan 2's step 1
+    playwright_api.expect(rows.nth(0)).to_contain_text("→")
+    playwright_api.expect(page.locator("#runs tr").first).to_contain_text("succeeded")

@@ -1,0 +1,83 @@
+"""A class on one server (docs/web.md, "Tried by a teacher with a class"): what the SPARQL editor says when
+others' queries hold every worker or a query runs out of time, and the camera's still asked for by number."""
+
+from __future__ import annotations
+
+import threading
+from typing import Any
+
+import pytest
+from flask.testing import FlaskClient
+
+from cbrs.kb import KnowledgeBase
+from cbrs.sparql_service import EndpointBusyError, EndpointConfig, QueryTimeoutError, SparqlService
+from cbrs.tasks import CameraFrame, TaskRunner
+from cbrs.web import create_app
+
+CROSS = "SELECT (COUNT(*) AS ?n) WHERE { ?a ?b ?c . ?d ?e ?f . ?g ?h ?i }"
+
+
+@pytest.fixture(scope="module")
+def service(bundled_kb: KnowledgeBase) -> SparqlService:
+    return SparqlService(bundled_kb, EndpointConfig(workers=4, timeout=30.0))
+
+
+@pytest.fixture(scope="module")
+def client(service: SparqlService) -> FlaskClient:
+    return create_app(service).test_client()
+
+
+def test_every_worker_taken_says_the_query_is_fine_and_to_run_it_again(
+    client: FlaskClient, service: SparqlService
+) -> None:
+    held = [service._admit(f"10.0.0.{n}") for n in range(4)]  # four other students' long queries
+    try:
+        page = client.get("/query", query_string={"query": CROSS})
+    finally:
+        for release in held:
+            release()
+    text = page.get_data(as_text=True)
+    assert page.status_code == 503
+    assert "all 4 query workers are busy" in text  # the endpoint's words, kept
+    assert "Nothing is wrong with this query" in text and "run it again in a few seconds" in text
+    assert 'id="query-advice"' in text and "Run it again</a>" in text
+
+
+def test_a_query_out_of_time_says_how_to_narrow_it(client: FlaskClient, monkeypatch: pytest.MonkeyPatch) -> None:
+    def stopped(*args: Any, **kwargs: Any) -> Any:
+        raise QueryTimeoutError(30.0, stopped=True)
+
+    monkeypatch.setattr(SparqlService, "query", stopped)
+    text = client.get("/query", query_string={"query": CROSS}).get_data(as_text=True)
+    assert "did not finish within 30 s" in text
+    assert "share no variable multiply" in text and "LIMIT 100" in text
+
+
+def test_a_busy_answer_of_one_client_says_it_is_theirs(client: FlaskClient, monkeypatch: pytest.MonkeyPatch) -> None:
+    def busy(*args: Any, **kwargs: Any) -> Any:
+        raise EndpointBusyError(4, "127.0.0.1", 2)
+
+    monkeypatch.setattr(SparqlService, "query", busy)
+    text = client.get("/query", query_string={"query": CROSS}).get_data(as_text=True)
+    assert "Your computer already runs 2 queries" in text
+
+
+def test_a_still_asked_for_by_number_asks_the_run_for_none(bundled_kb: KnowledgeBase) -> None:
+    runner = TaskRunner(bundled_kb, threading.RLock(), camera=object())  # type: ignore[arg-type]
+    runner._frame = CameraFrame(7, b"\xff\xd8seven\xff\xd9", "run-1")
+
+    asked: list[float] = []
+
+    def current_frame(timeout: float) -> CameraFrame | None:
+        asked.append(timeout)
+        return runner._frame
+
+    runner.current_frame = current_frame  # type: ignore[method-assign]
+    client = create_app(SparqlService(bundled_kb), tasks=runner).test_client()
+    still = client.get("/camera.jpg?frame=7")
+    assert still.status_code == 200 and still.headers["X-Frame"] == "7" and still.data.endswith(b"seven\xff\xd9")
+    assert client.get("/camera.jpg?frame=6").headers["X-Frame"] == "7"
+    assert asked == []  # a frame the page knows of is answered at once
+    client.get("/camera.jpg?frame=8")  # newer than any: the run is asked, as for a plain still
+    client.get("/camera.jpg")
+    assert len(asked) == 2
