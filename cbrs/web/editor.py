@@ -19,7 +19,7 @@ from flask import Blueprint, Response, current_app, request, url_for
 from cbrs.kb.errors import KnowledgeBaseError, QuerySyntaxError, UnknownQueryError
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.sparql_hints import operation_kind, store_prefixes_used
-from cbrs.sparql_service import BOM, Answer
+from cbrs.sparql_service import BOM, Answer, EndpointBusyError, QueryTimeoutError
 from cbrs.unmentioned_names import unmentioned_names
 from cbrs.web import context
 from cbrs.web.pages import FormError, Page, page, wants_json
@@ -94,6 +94,7 @@ def editor() -> Page:
         if wants_json():
             raise
         data["failure"] = str(error)
+        data["advice"] = _advice(error)
         shown.status = error.http_status
         return shown
     data["elapsed_ms"] = round((time.perf_counter() - started) * 1000, 1)
@@ -110,6 +111,32 @@ def editor() -> Page:
 def _empty(result: dict[str, Any]) -> bool:
     """Whether the page's result (:func:`_result`) holds nothing: no row, no triple, or an ASK's false."""
     return not result["boolean"] if result["kind"] == "ask" else result["count"] == 0
+
+
+def _advice(error: KnowledgeBaseError) -> str | None:
+    """What a person does next about a refused or stopped query, in the words of a class on one server: the
+    endpoint's "all 4 query workers are busy; retry shortly (setting query_workers)" named an
+    administrator's setting and not that the text is fine and others' queries hold the server."""
+    config = context.sparql().config
+    if isinstance(error, EndpointBusyError):
+        if error.client is not None:
+            most = min(config.workers_per_client, config.workers)
+            return (
+                f"Your computer already runs {most} queries, the most one may run at once; "
+                f"each may take up to {config.timeout:g} s. Run this one again when one of them has ended."
+            )
+        return (
+            f"The server runs at most {config.workers} queries at once, and that many are running now (other "
+            f"people's, or yours: each may take up to {config.timeout:g} s). Nothing is wrong with this query "
+            "as far as the server has read it: run it again in a few seconds."
+        )
+    if isinstance(error, QueryTimeoutError):
+        return (
+            f"A query is stopped after {config.timeout:g} s. Patterns that share no variable multiply each "
+            "other's rows (every ?a ?b ?c beside every ?d ?e ?f); give them a variable in common, name a class "
+            "or a property instead of a variable, or add LIMIT 100 at the end."
+        )
+    return None
 
 
 def _update_refused() -> str:
