@@ -80,6 +80,12 @@ SIDE_PALM_LEAD = 0.0052
 tilted down by the side pitch, the palm's face leans forward above the axis. The Panda hand's at 35
 degrees, measured on its collision mesh (ontologies/world.ttl): the default of ``home:sidePalmLead``."""
 
+PAYLOAD = 3.0
+"""The most a hand lifts (kg): the Franka Panda's rated payload (Franka Emika's datasheet gives 3 kg), the
+arm of every simulated hand. The simulation's grasp is a constraint that would hold far more (a 4.5 kg hand
+weight was fetched, the twentieth round), so the check before a run refuses what is heavier. The default of
+``home:payloadKg``, on the gripper or a class of grippers."""
+
 CARRY_CORRIDOR = 0.10
 """How far to either side of what a hand carries (the object's footprint, or the open jaws' if wider) its
 palm passes over other things, footprint to footprint (m): a carry keeps the palm over the top of any
@@ -117,6 +123,8 @@ class Hand:
     side_palm_lead: float = SIDE_PALM_LEAD
     """How far ahead of its point on the axis the palm reaches by a side grasp (``home:sidePalmLead``):
     the grasp point stops short so the palm meets a deep object's near side (sim/grasping.py)."""
+    payload: float = PAYLOAD
+    """The most it lifts, in kilograms (``home:payloadKg``): a heavier object is refused before the run."""
 
     def __post_init__(self) -> None:
         if math.isnan(self.fingertip_depth):
@@ -152,6 +160,7 @@ _PROPERTIES = (
     "jawClearance",
     "carryCorridor",
     "sidePalmLead",
+    "payloadKg",
 )
 """The store's properties (local names in the home namespace) of :class:`Hand`'s values, in its order."""
 _GEOMETRY = ("jawOpening", "palmDepth", "fingerLength")
@@ -205,6 +214,8 @@ def _limits(name: str, number: float) -> str:
         return "" if 0.0 <= number < math.pi / 2.0 else "radians down from level, at least 0 and below pi/2"
     if name in ("fingertipClearance", "jawClearance", "sidePalmLead"):
         return "" if number >= 0.0 else "a length in metres, at least 0"
+    if name == "payloadKg":
+        return "" if number > 0.0 else "a mass in kilograms, more than 0"
     return "" if number > 0.0 else "a length in metres, more than 0"
 
 
@@ -294,6 +305,7 @@ def _hand(hand: str, arm: str, robot: str, stated: dict[str, list[_Stated]], ban
         values.get("carryCorridor", CARRY_CORRIDOR),
         _side_arm(hand, arm, robot, bands),
         values.get("sidePalmLead", SIDE_PALM_LEAD),
+        values.get("payloadKg", PAYLOAD),
     )
 
 

@@ -57,6 +57,8 @@ from cbrs.sim.services import (
     infer_object_place,
     kept_place,
     locate,
+    navigate_to_person,
+    navigate_to_place,
     recognise_by_colour,
     track,
 )
@@ -145,7 +147,10 @@ class CannotGripError(KnowledgeBaseError):
             f"by its {approach} grasp ({', '.join(arms)}): {why}" for (approach, why), arms in said.items()
         )
         advice = "; ".join(GRIP_LIMITS[limit] for limit in self.limits if limit in GRIP_LIMITS)
-        super().__init__(f"no hand of {local_name(robot)} can grip the {local_name(thing)}: {each}; a hand's {advice}")
+        verb = "lift" if self.limits == ("heavy",) else "grip"
+        super().__init__(
+            f"no hand of {local_name(robot)} can {verb} the {local_name(thing)}: {each}; a hand's {advice}"
+        )
 
 
 GRIP_LIMITS = {
@@ -159,6 +164,10 @@ GRIP_LIMITS = {
         "home:sideHoldFraction how much of the object's depth they must hold"
     ),
     "palm": "home:palmDepth says how far its palm is above the fingers' grasp point",
+    "heavy": (
+        "home:payloadKg says how much it lifts (3 kg, the Panda's, where none is stated); the object's "
+        "home:massKg is in kilograms"
+    ),
 }
 """The hand's values that limit a grip, by the kind of misfit, as :class:`CannotGripError` advises them:
 the value that refused it first (the jaws' opening for an object too wide), then the policy beside it."""
@@ -294,7 +303,8 @@ class PlanChecks:
         :class:`OutOfReachError`, :class:`PlaceCrowdedError`, :class:`PlaceTooSmallError`,
         :class:`arm_choice.CannotCarryError`,
         :class:`sight.OutOfViewError`,
-        :class:`CannotLoadError`, :class:`kb.home_check.NoDockingPoseError`, :class:`WhichBaseError`);
+        :class:`CannotLoadError`, :class:`kb.home_check.NoDockingPoseError`, :class:`sight.BaseOutOfViewError`,
+        :class:`WhichBaseError`);
         nothing when every check passes. In a home of several bases, the world drives the one the plan works
         from here on (:func:`base_for`)."""
         ads = self.advertisements  # the environment's read: 20-30 ms each on the bundled store
@@ -310,6 +320,7 @@ class PlanChecks:
         self._check_sight(plan, values, ads, meant)
         self._check_loading(plan, values)
         self._check_docks(plan, values, ads)
+        self._check_localising(plan, values, ads)
 
     def _check_loading(self, plan: Plan, values: Mapping[str, Any]) -> None:
         """Refuse a plan that hands an object the task gives over onto the base's platform when no arm
@@ -388,6 +399,61 @@ class PlanChecks:
                 value = values.get(name)
                 if isinstance(value, dict) and str(value.get("@id")) in self.world.map.objects:
                     kept_place(self.context, str(value["@id"]))
+
+    def _check_localising(self, plan: Plan, values: Mapping[str, Any], ads: Mapping[str, Advertisement]) -> None:
+        """Refuse a plan that parks the base at a place (NavigateToPlace, at its docking pose) and then locates
+        it by its marker, and the camera of no locator of the home sees the marker there
+        (``sight.marker_centres``): the base drove off, was lost at the place and the next drive failed with
+        "marker not visible" (the twentieth round's desk in the bedroom, which no bundled camera sees). Every
+        locator counts, not only the step's candidates: the plan picks them by where the base is now (their
+        effective areas), and the run fails over or re-plans to one that covers the place once the base is
+        there. A drive to a person, or a locator of unknown camera (in another process), leaves where the
+        base is to the run."""
+        steps = {step.index: step for step in plan.steps}
+        blockers = sight.occluders(self.world.map)
+        locators = [ad for ad in ads.values() if SKILLS.get(ad.service_name or "") is locate]
+        parked: tuple[Thing, Pose2D] | None = None
+        for step in plan.steps:
+            ad = ads.get(step.component)
+            work = SKILLS.get(ad.service_name or "") if ad is not None else None
+            if work is navigate_to_place:
+                parked = self._parked_at(step, steps, values)
+            elif work is navigate_to_person or (ad is not None and ad.bridge_port is not None):
+                parked = None
+            elif work is locate and parked is not None:
+                cameras = [self._camera_of(each, (locate,)) for each in locators]
+                if not all(cameras):
+                    parked = None  # a camera the simulation does not have may see it
+                    continue
+                place, pose = parked
+                centres = sight.marker_centres(self.world.marker_model, pose)
+                why = [
+                    (name, sight.unseen(self.world.cameras[name], centres, blockers))
+                    for name in dict.fromkeys(cameras)
+                    if name
+                ]
+                if all(reason for _, reason in why):
+                    raise sight.BaseOutOfViewError(step.component, place.iri, pose, why)
+
+    def _parked_at(
+        self, step: PlanStep, steps: Mapping[int, PlanStep], values: Mapping[str, Any]
+    ) -> tuple[Thing, Pose2D] | None:
+        """The place a NavigateToPlace step parks the base at, and its docking pose: the place the task gives
+        the step, or the one an object the task gives is kept on (``services.kept_place``, what
+        InferObjectPlace answers); None when the map does not say."""
+        smap = self.world.map
+        for name in sorted(task_inputs_of(step, steps)):
+            value = values.get(name)
+            iri = str(value["@id"]) if isinstance(value, dict) and "@id" in value else ""
+            thing = smap.things.get(iri)
+            if thing is None and iri in smap.objects:
+                try:
+                    thing = kept_place(self.context, iri)
+                except KnowledgeBaseError:
+                    thing = None
+            if thing is not None and thing.dock is not None:
+                return thing, docking_pose(thing)
+        return None
 
     def _loads_nearby(self, estimate: ObjectEstimate, model: ObjectModel, dock: Pose2D) -> bool:
         """Whether some arm could load the object were it LOADING_SLACK away from where it is believed to be
@@ -469,11 +535,14 @@ class PlanChecks:
                 if all(reason for _, reason in why):
                     raise sight.OutOfViewError(step.component, iri, centre, why)
 
-    def _camera_of(self, ad: Advertisement | None) -> str | None:
-        """The camera of the world a recognition component looks with; None for a component that is none,
-        "" for one whose camera the simulation does not have (a component in another process)."""
+    def _camera_of(
+        self, ad: Advertisement | None, looking: tuple[Any, ...] = (recognise_by_colour, find_object_on_table, track)
+    ) -> str | None:
+        """The camera of the world a component of one of the ``looking`` skills (by default, the recognisers
+        and the tracker) looks with; None for a component that is none, "" for one whose camera the
+        simulation does not have (a component in another process)."""
         work = SKILLS.get(ad.service_name or "") if ad is not None else None
-        if ad is None or work not in (recognise_by_colour, find_object_on_table, track):
+        if ad is None or work not in looking:
             return None
         device = looked_with(self.kb, ad)
         return device if device and device in self.world.cameras else ""
@@ -563,6 +632,14 @@ class PlanChecks:
         model = ObjectModel.of(obj)
         refusals: list[tuple[str, str, str]] = []
         limits: list[str] = []
+        hands = [self.world.map.hands.get(arm.iri) for arm in arms]
+        if hands and all(hand is not None and obj.mass > hand.payload + 1e-9 for hand in hands):
+            for arm, hand in zip(arms, hands, strict=True):
+                assert hand is not None
+                for kind in model.preference:
+                    heavy = f"it weighs {obj.mass:g} kg (home:massKg), and the hand lifts {hand.payload:g} kg"
+                    refusals.append((arm.iri, kind.value, heavy))
+            raise CannotGripError(robot, iri, refusals, ["heavy"])
         for kind in model.preference:
             for arm in arms:
                 hand = self.world.map.hands.get(arm.iri)

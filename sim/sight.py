@@ -19,10 +19,20 @@ from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.semantic_map import MapObject, Person, local_name
 from cbrs.sim import layout as L
 from cbrs.sim.cameras import Camera, project
-from cbrs.sim.geometry import Vec3
+from cbrs.sim.geometry import Pose2D, Vec3
+from cbrs.sim.perception import MarkerModel
 from cbrs.sim.world import Spread
 
-__all__ = ["OutOfViewError", "object_outline", "occluders", "person_centre", "person_outline", "unseen"]
+__all__ = [
+    "BaseOutOfViewError",
+    "OutOfViewError",
+    "marker_centres",
+    "object_outline",
+    "occluders",
+    "person_centre",
+    "person_outline",
+    "unseen",
+]
 
 RIM_POINTS = 24
 """Points taken round each rim of a cylinder: its silhouette is then under 1% of its radius larger
@@ -41,6 +51,16 @@ def object_outline(obj: MapObject, centre: Vec3) -> NDArray[np.float64]:
         corners = np.array([[x, y] for x in (-sx / 2, sx / 2) for y in (-sy / 2, sy / 2)])
         flat = corners @ np.array([[c, s], [-s, c]])
     rows = [[centre[0] + dx, centre[1] + dy, centre[2] + dz] for dz in (-sz / 2, sz / 2) for dx, dy in flat]
+    return np.array(rows, dtype=np.float64)
+
+
+def marker_centres(marker: MarkerModel, pose: Pose2D) -> NDArray[np.float64]:
+    """The centres of the base's two marker patches (2 x 3), the base parked at ``pose``: where a locator
+    must see each colour. Centres, not outlines: a patch seen in part is still found (perception needs a
+    few of its pixels, ``MIN_MARKER_PIXELS``), and the base stops a few centimetres from a docking pose."""
+    half = marker.separation / 2.0
+    c, s = math.cos(pose.theta), math.sin(pose.theta)
+    rows = [[pose.x + sign * half * c, pose.y + sign * half * s, marker.height] for sign in (1.0, -1.0)]
     return np.array(rows, dtype=np.float64)
 
 
@@ -119,6 +139,31 @@ class OutOfViewError(KnowledgeBaseError):
             f"{where[2]:.2f}) with {names}, which cannot see it whole ({each}); move it in the map (home:x, home:y) "
             f"to where {names} sees it{_or_what_hides(self.cameras)}, or hang a camera over it and register a "
             "component that looks with that camera (docs/tasks.md, 'Which arm')"
+        )
+
+
+class BaseOutOfViewError(KnowledgeBaseError):
+    """A step would locate the mobile base by its marker where an earlier step of the plan parks it (a
+    place's docking pose), and no camera of the locators that may do the step sees the marker there: the
+    base would drive off and be lost at the place, the next drive failing with "marker not visible". The
+    run is refused before anything moves. ``cameras`` holds (camera name, why it does not see it)."""
+
+    http_status = 422
+
+    def __init__(self, component: str, place: str, pose: Pose2D, cameras: list[tuple[str, str]]) -> None:
+        self.component = component
+        self.place = place
+        self.pose = pose
+        self.cameras = tuple(cameras)
+        each = "; ".join(f"{camera}: {why}" for camera, why in self.cameras)
+        names = " or ".join(camera for camera, _ in self.cameras)
+        super().__init__(
+            f"{local_name(component)} would locate the mobile base by its marker at {local_name(place)}'s docking "
+            f"pose ({pose.x:.2f}, {pose.y:.2f}), where an earlier step parks it, with {names}, which cannot see "
+            f"the marker there ({each}); the base would be lost there and could not drive on. Hang a camera "
+            "over the place and register a locator (LocateMobileRobot) that looks with it "
+            "(docs/examples/camera3.ttl and bedroom_camera.ttl do so for the bedroom), or move the place's "
+            "home:dockingPose to where a camera sees the base"
         )
 
 
