@@ -28,13 +28,14 @@ from granian.http import HTTP1Settings
 from granian.log import LogLevels
 from granian.server.embed import Server as _Embedded
 
+from cbrs.access_log import ACCESS_LOGGER, AccessLog
 from cbrs.settings import EVENT_LOOPS
 
 log = logging.getLogger("cbrs.server")
 
 # Granian's own log records go to the root logger (cbrs serve's format), errors only: its
 # default configuration prints every start and stop on stdout, where cbrs serve says it is ready.
-# Its access log, one line a request, goes there too, at INFO.
+# The access log, one line a request at INFO, is cbrs's (cbrs.access_log), on Granian's logger name.
 _LOGGING: dict[str, Any] = {
     "version": 1,
     "disable_existing_loggers": False,
@@ -42,12 +43,6 @@ _LOGGING: dict[str, Any] = {
     "handlers": {},
     "loggers": {"_granian": {"propagate": True}, "granian.access": {"propagate": True}},
 }
-
-ACCESS_LOGGER = "granian.access"
-ACCESS_FORMAT = '%(addr)s "%(method)s %(path)s" %(status)d %(dt_ms).1f ms'
-"""One line a request: the client's address, the method and path, the status and the time taken. No query
-string (a query's text, up to 1 MiB) and no header: the update token travels in ``Authorization`` and is
-never written (docs/serving.md, "Logs")."""
 
 
 @dataclass(frozen=True)
@@ -65,7 +60,7 @@ class ListenerConfig:
     # until header_timeout closed them (docs/security.md, section 2)
     max_connections: int = 4096
     loop: str = "auto"  # the asyncio loop the app runs on: "uvloop", "asyncio", or "auto" (uvloop when installed)
-    access_log: bool = True  # a line a request at INFO (ACCESS_FORMAT), unless the log level leaves INFO out
+    access_log: bool = True  # a line a request at INFO (cbrs.access_log), unless the log level leaves INFO out
 
 
 class _Server(_Embedded):
@@ -145,8 +140,11 @@ class HttpListener:
 
     def __init__(self, app: Any, config: ListenerConfig) -> None:
         self.config = config
+        # decided once: a level that leaves INFO out (--log-level warning) costs the requests nothing
+        logged = config.access_log and logging.getLogger(ACCESS_LOGGER).isEnabledFor(logging.INFO)
+        self.access = AccessLog() if logged else None
         self._server = _Server(
-            app,
+            app if self.access is None else self.access.wrap(app),
             address=config.host,
             port=config.port,
             interface=Interfaces.ASGINL,
@@ -160,9 +158,7 @@ class HttpListener:
             ),
             log_level=LogLevels.error,  # its warning that embedding is "experimental" would greet every start
             log_dictconfig=_LOGGING,
-            # decided once: a level that leaves INFO out (--log-level warning) costs the requests nothing
-            log_access=config.access_log and logging.getLogger(ACCESS_LOGGER).isEnabledFor(logging.INFO),
-            log_access_format=ACCESS_FORMAT,
+            log_access=False,  # cbrs's own (self.access): Granian's wrote each line on the event loop
         )
         self._loop: asyncio.AbstractEventLoop | None = None
         self._thread: threading.Thread | None = None
@@ -172,6 +168,8 @@ class HttpListener:
 
     def start(self, timeout: float = 10.0) -> None:
         """Listen and serve on a thread; returns once the socket is open, raising OSError if it cannot be."""
+        if self.access is not None:
+            self.access.start()
         self._thread = threading.Thread(target=self._run, name="cbrs-http", daemon=True)
         self._thread.start()
         if not self._listening.wait(timeout) and self._failed is None:
@@ -205,6 +203,8 @@ class HttpListener:
             if thread.is_alive():
                 log.warning("the HTTP listener did not stop within %g s", timeout)
         self._thread = None
+        if self.access is not None:
+            self.access.close()
 
     def _run(self) -> None:
         loop = new_loop(self.config.loop)
