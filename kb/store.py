@@ -12,6 +12,7 @@ from __future__ import annotations
 import functools
 import hashlib
 import logging
+import os
 import re
 from abc import ABC, abstractmethod
 from collections import defaultdict
@@ -95,7 +96,7 @@ class Store(ABC):
     @classmethod
     def open(cls, location: str | Path) -> Store:
         """Open the store at ``location``: a SPARQL endpoint URL, a directory (created if needed), or ``:memory:``."""
-        text = str(location)
+        text = _location_text(location)
         if is_remote(text):
             from cbrs.kb.remote_store import RemoteStore  # only a remote store needs the HTTP client
 
@@ -313,6 +314,19 @@ _OTHER_SCHEME = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]*://")
 _HOST_PORT = re.compile(r"^(?:\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9._-]+):\d{1,5}(?:/\S*)?$")
 
 
+def _location_text(location: object) -> str:
+    """``location`` as text, refusing what names no store: ``KnowledgeBase.open(None)`` made and seeded a
+    store in a directory called ``None``, and ``""`` opened one in the working directory."""
+    if not isinstance(location, str | os.PathLike):
+        raise TypeError(
+            f"a store's location is a directory, ':memory:' or an endpoint URL (str or Path), not {location!r}"
+        )
+    text = os.fspath(location)
+    if not isinstance(text, str) or not text.strip():
+        raise StoreError(repr(text), "names no store: give a directory, ':memory:' or an endpoint URL")
+    return text
+
+
 def _refuse_url_like(text: str, path: Path) -> None:
     """A location that reads as a server but is no directory yet is refused, not created: with
     ``--store localhost:7878`` (``http://`` left out) a new store was made and seeded in the working
@@ -449,7 +463,7 @@ class EmbeddedStore(Store):
     @classmethod
     def open(cls, location: str | Path) -> EmbeddedStore:
         """Open (creating if needed) the store at ``location``: a directory, or ``:memory:``."""
-        text = str(location)
+        text = _location_text(location)
         if text == MEMORY:
             return cls(ox.Store(), MEMORY)
         if is_remote(text):

@@ -19,6 +19,8 @@ from cbrs.kb.store import EmbeddedStore
         pytest.param("127.0.0.1:7878", "http://127.0.0.1:7878", id="address-port"),
         pytest.param("[::1]:7878/query", "http://[::1]:7878/query", id="ipv6-path"),
         pytest.param("ftp://127.0.0.1:7878", "http:// or https://", id="other-scheme"),
+        pytest.param("", "names no store", id="empty"),
+        pytest.param("   ", "names no store", id="blank"),
     ],
 )
 def test_url_like_location_is_refused_and_nothing_is_made(
@@ -39,3 +41,16 @@ def test_existing_directory_of_such_a_name_still_opens(tmp_path: Path, monkeypat
     assert (tmp_path / "new:7878").is_dir()
     with pytest.raises(StoreError, match=r"\./other:1"):
         EmbeddedStore.open("other:1")
+
+
+@pytest.mark.parametrize("location", [None, 7878, b"store"])
+def test_a_location_of_another_type_is_refused_naming_it(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, location: object
+) -> None:
+    """``KnowledgeBase.open(None)`` made and seeded a store in a directory called ``None``."""
+    from cbrs.kb import KnowledgeBase
+
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(TypeError, match=repr(location)):
+        KnowledgeBase.open(location)  # type: ignore[arg-type]
+    assert list(tmp_path.iterdir()) == []
