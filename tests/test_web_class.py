@@ -3,16 +3,19 @@ others' queries hold every worker or a query runs out of time, and the camera's 
 
 from __future__ import annotations
 
+import re
 import threading
+from pathlib import Path
 from typing import Any
 
 import pytest
 from flask.testing import FlaskClient
 
+import cbrs.web
 from cbrs.kb import KnowledgeBase
 from cbrs.sparql_service import EndpointBusyError, EndpointConfig, QueryTimeoutError, SparqlService
 from cbrs.tasks import CameraFrame, TaskRunner
-from cbrs.web import create_app
+from cbrs.web import create_app, diagram
 
 CROSS = "SELECT (COUNT(*) AS ?n) WHERE { ?a ?b ?c . ?d ?e ?f . ?g ?h ?i }"
 
@@ -81,3 +84,30 @@ def test_a_still_asked_for_by_number_asks_the_run_for_none(bundled_kb: Knowledge
     client.get("/camera.jpg?frame=8")  # newer than any: the run is asked, as for a plain still
     client.get("/camera.jpg")
     assert len(asked) == 2
+
+
+def _luminance(colour: str) -> float:
+    channels = [int(colour[i : i + 2], 16) / 255 for i in (1, 3, 5)]
+    r, g, b = (c / 12.92 if c <= 0.03928 else ((c + 0.055) / 1.055) ** 2.4 for c in channels)
+    return 0.2126 * r + 0.7152 * g + 0.0722 * b
+
+
+def _contrast(one: str, other: str) -> float:
+    light, dark = sorted((_luminance(one), _luminance(other)), reverse=True)
+    return (light + 0.05) / (dark + 0.05)
+
+
+def test_the_pages_colours_read_on_a_projector() -> None:
+    """Text and its background at 7:1 at least (WCAG's AAA), as a projector in a lit room washes contrast out:
+    the links (4.6:1), the muted notes (5.3:1 on the page's wash) and the status badges (4.6:1) were at AA."""
+    css = (Path(cbrs.web.__file__).parent / "static" / "cbrs.css").read_text(encoding="utf-8")
+    root = dict(re.findall(r"--(\w+):\s*(#[0-9a-fA-F]{6});", css.split("}", 1)[0]))
+    pairs = [(root[text], root[ground]) for text in ("ink", "muted", "accent") for ground in ("paper", "wash")]
+    for rule, text in ((".badge.good", "good"), (".badge.bad", "bad"), (".badge.warn", "warn"), (".error-box", "bad")):
+        ground = re.search(re.escape(rule) + r"[^{]*\{[^}]*background: (#[0-9a-fA-F]{6})", css)
+        assert ground is not None, rule
+        pairs.append((root[text], ground.group(1)))
+    pairs.append(("#ffffff", root["accent"]))  # a button's label
+    pairs += [(ink, fill) for fill, _, ink in diagram.COLOURS.values()]  # the pictures' boxes
+    weak = [(text, ground, round(_contrast(text, ground), 2)) for text, ground in pairs if _contrast(text, ground) < 7]
+    assert weak == []

@@ -30,10 +30,10 @@ MARGIN = 12
 
 # fill, stroke, text colour per kind of box
 COLOURS = {
-    "focus": ("#1f6feb", "#1f6feb", "#ffffff"),
+    "focus": ("#0a4aad", "#0a4aad", "#ffffff"),
     "node": ("#ffffff", "#8c96a8", "#1d2330"),
     "part": ("#f1f8f1", "#1a7f37", "#1d2330"),
-    "more": ("#f4f6f9", "#c3cad6", "#5d6778"),
+    "more": ("#f4f6f9", "#c3cad6", "#474f5e"),
     "end": ("#fff8e1", "#9a6700", "#1d2330"),
 }
 
@@ -265,7 +265,7 @@ def _edge(points: list[tuple[float, float]], edge: Edge, arrow: str, place: tupl
         return line
     x, y = place
     return line + (
-        f'<text x="{x:.1f}" y="{y:.1f}" text-anchor="middle" font-size="10" fill="#5d6778" '
+        f'<text x="{x:.1f}" y="{y:.1f}" text-anchor="middle" font-size="10" fill="#474f5e" '
         f'stroke="#ffffff" stroke-width="3" paint-order="stroke">{escape(_shown(edge.label))}</text>'
     )
 
