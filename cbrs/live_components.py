@@ -14,11 +14,18 @@ A registration holds the bridge service it is grounded on: a second registration
 live component of another session holds is refused (:class:`ServiceHeldError`), so a program started
 twice, or a copy-pasted description, cannot take another device's calls; a service of the server's own
 namespaces (``/cbrs/``, ``/rosapi/``) is refused as a grounding. A component deregistered while live
-loses its lease at its next store write, and its heartbeat says so (:data:`DEREGISTERED`).
+loses its lease within a watchdog period of the write that removed it, and its heartbeat says so
+(:data:`DEREGISTERED`).
+
+The leases a server holds are its present state; the liveness graph only publishes them. A write by
+anyone else (a restore, whose copy of the liveness it read before its long write; an update of the
+liveness graph) that leaves the store saying otherwise of a lease this server holds is corrected before
+that write is answered (:meth:`LiveComponents.restate`).
 """
 
 from __future__ import annotations
 
+import datetime as dt
 import difflib
 import logging
 import math
@@ -144,6 +151,7 @@ class _Lease:
     deadline: float  # monotonic seconds
     ttl: float
     written_until: float  # the monotonic time the stored leaseUntil corresponds to
+    stored: dt.datetime | None = None  # the leaseUntil this server last wrote (restate compares the store's)
 
 
 class LiveComponents:
@@ -175,6 +183,7 @@ class LiveComponents:
         self._guard = threading.Lock()
         self._stop = threading.Event()
         self._written = threading.Event()  # the store was written: the watchdog looks for deregistrations
+        self._own = threading.local()  # .writing: this thread is telling the listeners of a write of ours
         self._unwatch: Callable[[], None] | None = None
         self._watchdog: threading.Thread | None = None
         self._period = min(0.25, ttl / 4)  # the watchdog's
@@ -311,11 +320,11 @@ class LiveComponents:
                 iris = kb.registry.register(turtle, "<registration>")
             now = self._now()
             for iri in iris:
-                kb.liveness.renew(iri, ttl, registered_by=self._registered_by(session))
+                until = kb.liveness.renew(iri, ttl, registered_by=self._registered_by(session))
                 with self._guard:
-                    self._leases[iri] = _Lease(session, services[iri], over_bridge, now + ttl, ttl, now + ttl)
+                    self._leases[iri] = _Lease(session, services[iri], over_bridge, now + ttl, ttl, now + ttl, until)
                     self._ended.get(session, {}).pop(iri, None)
-            self.sparql.changed()
+            self._changed()
         log.info("%s registered %s (lease %g s)", session, ", ".join(iris), ttl)
         return iris
 
@@ -372,7 +381,7 @@ class LiveComponents:
                     renewed.append(iri)
                     if lease.written_until - now < lease.ttl / 2:
                         lease.written_until = lease.deadline
-                        stale.append((iri, lease.ttl))
+                        stale.append((iri, lease))
                         if self.provided is not None and not self.provided(lease.service):
                             unprovided.append((iri, lease))
         for iri, lease in unprovided:  # nobody would answer its calls: plans must not count on it
@@ -383,20 +392,20 @@ class LiveComponents:
                 self._end([iri], "no bridge client provides its service")
         if unprovided:
             dropped = {iri for iri, _ in unprovided}
-            stale = [(iri, ttl) for iri, ttl in stale if iri not in dropped]
+            stale = [(iri, lease) for iri, lease in stale if iri not in dropped]
             renewed = [iri for iri in renewed if iri not in dropped]
         if stale:
             gone = []
             with self.sparql.lock:
                 kb = self.sparql.kb
-                for iri, ttl in stale:
+                for iri, lease in stale:
                     if kb.registry.is_registered(iri):  # the session too: a restore or an update may have
-                        kb.liveness.renew(iri, ttl, registered_by=self._registered_by(session))  # changed it
+                        lease.stored = kb.liveness.renew(iri, lease.ttl, registered_by=self._registered_by(session))
                     else:
                         kb.liveness.forget(iri)
                         gone.append(iri)
                 if gone:
-                    self.sparql.changed()
+                    self._changed()
             if gone:
                 self._deregistered(dict.fromkeys(gone, session))
                 renewed = [iri for iri in renewed if iri not in gone]
@@ -415,9 +424,60 @@ class LiveComponents:
             for iri in gone:
                 kb.liveness.forget(iri)
             if gone:
-                self.sparql.changed()
+                self._changed()
         self._deregistered(gone)
         return sorted(gone)
+
+    def restate(self) -> list[str]:
+        """Write again the liveness of the components this server holds a lease of where the store says
+        otherwise: not available, another lease's end or another session. Another's write did that: a
+        restore by URL keeps the liveness it read before its write, which takes seconds, so the lease it
+        puts back may have ended meanwhile (or be of a session that has since gone); an update of the
+        liveness graph. The store is written with the lease's remaining time; a component the store no
+        longer registers is left to :meth:`forget_deregistered`. Returns the components written again."""
+        written = []
+        with self.sparql.lock:
+            kb = self.sparql.kb
+            states = kb.liveness.states()
+            now = self._now()
+            with self._guard:
+                due = [
+                    (iri, lease)
+                    for iri, lease in self._leases.items()
+                    if lease.deadline > now and _misstated(states.get(iri), lease, self._registered_by(lease.session))
+                ]
+            for iri, lease in due:
+                if not kb.registry.is_registered(iri):
+                    continue
+                left = lease.deadline - now
+                lease.stored = kb.liveness.renew(iri, left, registered_by=self._registered_by(lease.session))
+                lease.written_until = lease.deadline
+                written.append(iri)
+            if written:
+                self._changed()
+        if written:
+            log.info("%s: the store said otherwise of its lease; written again", ", ".join(written))
+        return written
+
+    def _changed(self) -> None:
+        """Tell the store's listeners of a write of ours (with the store's lock held): our own listener
+        does not check it, since a lease write or end changes nothing it looks for."""
+        self._own.writing = True
+        try:
+            self.sparql.changed()
+        finally:
+            self._own.writing = False
+
+    def _store_written(self) -> None:
+        """The store's update listener: after another's write, the leases are stated again at once (before
+        that write is answered) and the watchdog looks for deregistrations."""
+        if getattr(self._own, "writing", False):
+            return
+        try:
+            self.restate()
+        except Exception:  # a listener must not fail the write it hears of
+            log.exception("writing the leases again after a store write failed")
+        self._written.set()
 
     def _deregistered(self, gone: dict[str, str]) -> None:
         """Components (with their sessions) found deregistered: their leases end and their calls fail."""
@@ -504,7 +564,7 @@ class LiveComponents:
         with self.sparql.lock:
             for iri in components:
                 self.sparql.kb.liveness.expire(iri, reason)
-            self.sparql.changed()
+            self._changed()
         log.info("%s unavailable: %s", ", ".join(components), reason)
 
     # -- the watchdog --------------------------------------------------------------------------
@@ -513,8 +573,7 @@ class LiveComponents:
         if self._watchdog is None:
             self._stop.clear()
             self._now()  # time kept from here
-            # a store write only wakes the watchdog: the listener is called with the store's lock held
-            self._unwatch = self.sparql.on_update(self._written.set)
+            self._unwatch = self.sparql.on_update(self._store_written)
             self._watchdog = threading.Thread(target=self._watch, name="cbrs-leases", daemon=True)
             self._watchdog.start()
 
@@ -540,6 +599,13 @@ class LiveComponents:
                     self.forget_deregistered()
             except Exception:  # the watchdog must outlive a failed write
                 log.exception("ending lapsed or deregistered leases failed")
+
+
+def _misstated(state: ComponentState | None, lease: _Lease, registered_by: str) -> bool:
+    """Whether the store's ``state`` of a component says other than the ``lease`` this server holds."""
+    if state is None or not state.live or state.registered_by != registered_by:
+        return True
+    return lease.stored is not None and state.lease_until != lease.stored
 
 
 REGISTER_FIELDS = ("description", "format", "ttl")

@@ -16,6 +16,7 @@ import pyoxigraph as ox
 import pytest
 from click.testing import CliRunner
 
+import cbrs.kb.backup
 from cbrs.cli import cli
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.liveness import RESTORED_REASON
@@ -23,7 +24,7 @@ from cbrs.kb.namespaces import PREFIXES, GraphName
 from cbrs.kb.vocab import CBRS
 from cbrs.server import ServeConfig, Server
 from cbrs.sparql_service import EndpointConfig
-from tests.test_live_components import TOKEN, eventually, sdk_thermometer, thermometer, url
+from tests.test_live_components import TOKEN, eventually, live_server, sdk_thermometer, thermometer, url
 
 THERMOMETER = PREFIXES["svc"] + "ReadRoomTemperature_Thermometer07"
 
@@ -59,6 +60,69 @@ def test_a_restore_by_url_keeps_the_session_that_holds_a_live_component(
             (shown,) = httpx.get(f"{location}/components", timeout=10).json()
             assert shown["component"] == THERMOMETER and shown["available"] is True
             assert shown["registeredBy"] == now.registered_by  # the live session, not the backup's
+    finally:
+        server.stop()
+
+
+LAPSED = """
+DELETE { GRAPH graph:liveness { ?c cbrs:leaseUntil ?until } }
+INSERT { GRAPH graph:liveness { ?c cbrs:leaseUntil "2001-01-01T00:00:00+00:00"^^xsd:dateTime } }
+WHERE { GRAPH graph:liveness { ?c cbrs:leaseUntil ?until } }
+"""
+"""An update that says every lease ended long ago: what a restore's old copy of the liveness writes."""
+
+
+def test_a_write_that_says_a_held_lease_ended_is_corrected_before_it_is_answered() -> None:
+    """The flake of the restore by URL above: the restore read the liveness, took seconds to write the
+    store (a loaded machine), and put back a lease that had ended meanwhile, though the server had renewed
+    it; the server wrote it again only at its next renewal's store write. Now the server states the leases
+    it holds again as soon as another's write says otherwise. A long lease: its own renewal writes the
+    store only after 30 s, so nothing else would correct it here."""
+    with live_server() as server, sdk_thermometer().connect(url(server), TOKEN, heartbeat=1.0, ttl=60.0):
+        held = server.kb.liveness.states()[THERMOMETER]
+        server.sparql.update(LAPSED, TOKEN)  # as over HTTP: the listeners are told before it is answered
+        now = server.kb.liveness.states()[THERMOMETER]
+        assert now.live and now.registered_by == held.registered_by
+        assert now.lease_until is not None and now.lease_until > dt.datetime.now(dt.UTC) + dt.timedelta(seconds=30)
+
+
+def test_a_restore_by_url_written_after_the_program_came_back_keeps_its_new_session(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """The component's program reconnects while a restore by URL is being written: the restore's copy of
+    the liveness, read before, names the session that has gone; the store ends up naming the live one."""
+    endpoint = EndpointConfig(update_token=TOKEN, isolate=False)
+    server = Server(KnowledgeBase.open(":memory:"), ServeConfig(port=0, bridge_port=0, endpoint=endpoint))
+    server.start()
+    try:
+        location = f"http://127.0.0.1:{server.http_port}"
+        monkeypatch.setenv("CBRS_UPDATE_TOKEN", TOKEN)
+        backup, runner = tmp_path / "liveness.nq", CliRunner()
+        first = sdk_thermometer().connect(url(server), TOKEN, ttl=60.0)
+        before = server.kb.liveness.states()[THERMOMETER].registered_by
+        exported = runner.invoke(cli, ["--store", location, "export", "--graph", "liveness", str(backup)])
+        assert exported.exit_code == 0, exported.output
+        came_back = []
+        write = cbrs.kb.backup._replace_remote
+
+        def reconnected_meanwhile(*args: object, **kwargs: object) -> None:
+            first.stop()  # the liveness to write was read: the program goes and comes back
+            assert eventually(lambda: not server.kb.liveness.states()[THERMOMETER].live)
+            came_back.append(sdk_thermometer().connect(url(server), TOKEN, ttl=60.0))
+            write(*args, **kwargs)  # type: ignore[arg-type]
+
+        monkeypatch.setattr(cbrs.kb.backup, "_replace_remote", reconnected_meanwhile)
+        try:
+            restored = runner.invoke(cli, ["--store", location, "restore", str(backup), "--graph", "liveness", "--yes"])
+            assert restored.exit_code == 0, restored.output
+            assert len(came_back) == 1
+            (shown,) = httpx.get(f"{location}/components", timeout=10).json()
+            now = server.kb.liveness.states()[THERMOMETER]
+            assert shown["available"] is True and shown["registeredBy"] == now.registered_by
+            assert now.live and now.registered_by not in (None, before)
+        finally:
+            for connected in came_back:
+                connected.stop()
     finally:
         server.stop()
 
