@@ -17,6 +17,7 @@ from cbrs.sparql_service import EndpointBusyError, EndpointConfig, QueryTimeoutE
 from cbrs.tasks import CameraFrame, TaskRunner
 from cbrs.web import create_app, diagram
 
+EXAMPLES = Path(__file__).resolve().parents[1] / "docs" / "examples"
 CROSS = "SELECT (COUNT(*) AS ?n) WHERE { ?a ?b ?c . ?d ?e ?f . ?g ?h ?i }"
 
 
@@ -111,3 +112,33 @@ def test_the_pages_colours_read_on_a_projector() -> None:
     pairs += [(ink, fill) for fill, _, ink in diagram.COLOURS.values()]  # the pictures' boxes
     weak = [(text, ground, round(_contrast(text, ground), 2)) for text, ground in pairs if _contrast(text, ground) < 7]
     assert weak == []
+
+
+def test_an_actions_sub_actions_are_drawn_level_by_level_in_their_order() -> None:
+    """The lab's two-level action (docs/tasks.md, fifteenth round): its sub-actions, and the first one's own,
+    each numbered where it comes, a box and an arrow each; FetchMyPen's four on one level; a class that is no
+    action with sub-actions has no such picture."""
+    kb = KnowledgeBase.open(":memory:")
+    kb.load([EXAMPLES / "lab15_place_setting.ttl"], graph="ontology")
+    for name in ("lab15_set_the_table.ttl", "lab15_set_the_table_and_call_me.ttl"):
+        kb.load([EXAMPLES / name], graph="requirements")
+    client = create_app(SparqlService(kb)).test_client()
+    twin = client.get("/taxonomy/class.json", query_string={"iri": "lab15:SetTheTableAndCallMe"}).get_json()
+    tree = [(n["name"], n["order"], [(m["name"], m["order"]) for m in n["sub_actions"]]) for n in twin["sub_actions"]]
+    assert tree == [
+        ("lab15:SetTheTableForOne", 1, [("lab15:PutSaucerOnMat", 1), ("lab15:PutCupOnMat", 2)]),
+        ("lab15:CallToTheTable", 2, []),
+    ]
+    page = client.get("/taxonomy/class", query_string={"iri": "lab15:SetTheTableAndCallMe"}).get_data(as_text=True)
+    picture = page[page.index('id="hierarchy-heading"') :].split("</svg>")[0]
+    boxes = re.findall(r'<tspan x="[\d.]+" y="[\d.]+">([^<]+)</tspan>', picture)
+    assert boxes[0] == "lab15:SetTheTableAndCallMe"
+    assert sorted(boxes[1:]) == sorted(
+        ["1. lab15:SetTheTableForOne", "2. lab15:CallToTheTable", "1.1. lab15:PutSaucerOnMat", "1.2. lab15:PutCupOnMat"]
+    )
+    assert "4 sub-actions on 2 levels" in picture and picture.count("<polyline") >= 4
+    fetch = client.get("/taxonomy/class", query_string={"iri": "act:FetchMyPen"}).get_data(as_text=True)
+    assert "4. act:Delivering" in fetch and "4 sub-actions on 1 level," in fetch
+    cup = client.get("/taxonomy/class.json", query_string={"iri": "home:Cup"}).get_json()
+    assert "sub_actions" not in cup
+    assert 'id="hierarchy-heading"' not in client.get("/taxonomy/class?iri=home:Cup").get_data(as_text=True)

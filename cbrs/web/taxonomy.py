@@ -35,6 +35,7 @@ MAX_PATHS = 12  # ancestor paths shown per search match
 # class tree has 18,687 nodes, a page of 9 MB that took 2.5 s to serve and longer to lay out.
 MAX_TREE_NODES = 2000
 MAX_PICTURE_ROW = 10  # subclasses (and parts) drawn in a class's picture; the rest is one "N more" box
+MAX_HIERARCHY_DEPTH = 4  # levels of sub-actions drawn below an action, as many as the composer decomposes
 MAX_MATCHES = 200  # search matches listed with their paths; the count says how many there are
 MAX_MEMBERS = 100  # individuals listed on a class's page; the count says how many there are
 # How a service description reaches a concept, walking incoming triples back to the description.
@@ -300,8 +301,13 @@ def concept() -> Page:
         "usage": _usage(kb, iri, triples),
         "members": _members(triples) if kind == "class" else {"count": 0, "shown": []},
     }
+    hierarchy = _sub_actions(iri) if kind == "class" else None
+    if hierarchy is not None:
+        data["sub_actions"] = hierarchy
     if not wants_json():  # markup, so not in the twin, which has the same facts as lists
         data["picture"] = _picture(found, iri, data["parts"])
+        if hierarchy is not None:
+            data["hierarchy"] = _hierarchy_picture(iri, hierarchy)
     noun = "Class" if kind == "class" else "Property"
     return Page("class.html", f"{noun} {display_text(iri)}", data)
 
@@ -345,6 +351,65 @@ def _picture(found: Taxonomy, iri: str, parts: list[dict[str, Any]]) -> Markup:
     nouns = "subclasses" if found.kinds.get(iri) == "class" else "subproperties"
     what = f"{len(distance)} ancestors, {len(below)} direct {nouns}"
     return diagram.layered(rows, edges, f"{display_text(iri)} in the taxonomy", f"{what} and {len(parts)} parts")
+
+
+def _sub_actions(iri: str) -> list[dict[str, Any]] | None:
+    """An action class's sub-actions as the composer decomposes it (each its own, in their order, down to
+    ``MAX_HIERARCHY_DEPTH`` levels): ``[{iri, name, order, sub_actions}]``; None for a class that is no action
+    with sub-actions. A robotics class looked at FetchMyPen's four sub-actions as four lines of Manchester
+    syntax among its restrictions: no picture drew the hierarchy a task is planned by."""
+    from cbrs.actions.model import ActionLibrary  # the planner's model; networkx loads with it
+
+    library = context.per_generation("action_library", lambda: ActionLibrary.from_kb(context.kb()))
+    if iri not in library or not library.get(iri).sub_actions:
+        return None
+
+    def below(action: str, depth: int, seen: tuple[str, ...]) -> list[dict[str, Any]]:
+        if depth >= MAX_HIERARCHY_DEPTH or action not in library:
+            return []
+        return [
+            {
+                "iri": sub,
+                "name": short(sub),
+                "order": n,
+                "sub_actions": [] if sub in seen else below(sub, depth + 1, (*seen, sub)),
+            }
+            for n, sub in enumerate(library.get(action).ordered_sub_actions(), start=1)
+        ]
+
+    return below(iri, 0, (iri,))
+
+
+def _hierarchy_picture(iri: str, tree: list[dict[str, Any]]) -> Markup:
+    """The action on top, each level of sub-actions a row below, an arrow from an action to each of its
+    sub-actions named by its place in the order; a sub-action under two actions is drawn once, on the
+    lower row."""
+    depth: dict[str, int] = {iri: 0}
+    order: dict[str, tuple[int, ...]] = {iri: ()}  # where a sub-action first comes: (1, 2) is 1's second
+    edges: list[diagram.Edge] = []
+
+    def walk(parent: str, nodes: list[dict[str, Any]], level: int) -> None:
+        for node in nodes:
+            depth[node["iri"]] = max(depth.get(node["iri"], 0), level)
+            order.setdefault(node["iri"], (*order[parent], node["order"]))
+            edges.append(diagram.Edge(parent, node["iri"], note=f"sub-action {node['order']}"))
+            walk(node["iri"], node["sub_actions"], level + 1)
+
+    walk(iri, tree, 1)
+    edges = [e for e in dict.fromkeys(edges) if depth[e.target] > depth[e.source]]  # no arrow back up a cycle
+
+    def box(term: str) -> diagram.Box:
+        number = ".".join(map(str, order[term]))
+        text = f"{number}. {display_text(term)}" if number else display_text(term)
+        return diagram.Box(term, text, term, concept_url(term), "focus" if term == iri else "node")
+
+    rows = [
+        [box(term) for term in sorted((t for t, d in depth.items() if d == level), key=lambda t: order[t])]
+        for level in range(max(depth.values()) + 1)
+    ]
+    levels = len(rows) - 1
+    said = f"{len(depth) - 1} sub-actions on {levels} level{'' if levels == 1 else 's'}, numbered in their order"
+    return diagram.layered(rows, edges, f"{display_text(iri)} and its sub-actions", said, ident="hierarchy")
 
 
 def _undeclared(kb: KnowledgeBase, found: Taxonomy, iri: str, triples: list[dict[str, Any]]) -> Page:
