@@ -37,7 +37,17 @@ from cbrs.kb.engine_faults import sorts
 from cbrs.kb.errors import AlreadyRegisteredError, NotFoundError, QuerySyntaxError, RdfParseError, without_password
 from cbrs.kb.liveness import ComponentState
 from cbrs.kb.loader import LoadReport, ParsedFile, holds_ontology
-from cbrs.kb.namespaces import CBRS, OWL, PREFIXES, GraphName, expand, near_prefixes, shorten, store_names
+from cbrs.kb.namespaces import (
+    CBRS,
+    OWL,
+    PREFIXES,
+    GraphName,
+    expand,
+    is_absolute_iri,
+    near_prefixes,
+    shorten,
+    store_names,
+)
 from cbrs.kb.skolem import is_skolem
 from cbrs.kb.staged_writes import STAGING
 from cbrs.kb.store import EmbeddedStore, QueryResult, Term
@@ -1046,7 +1056,7 @@ def _prefix_hint(full: str) -> str:
     """A hint when ``full`` looks like prefix:name with a prefix nobody declared (lab:Cam for a lab's own);
     the closest prefixes first, the store's derived ones among them (docs/web.md)."""
     scheme, _, local = full.partition(":")
-    if "://" in full or scheme in ("urn", "tag", "mailto", "file"):
+    if is_absolute_iri(full):  # a scheme cbrs reads bare, or one with an authority
         return ""
     near = near_prefixes(scheme)
     meant = f"; did you mean {' or '.join(f'{p}:{local}' for p in near)}?" if near else ""

@@ -63,6 +63,14 @@ PREFIXES: dict[str, str] = {
 
 
 _SCHEME = re.compile(r"[A-Za-z][A-Za-z0-9+.-]*")
+_PREFIX_LIKE = re.compile(r"[A-Za-z][A-Za-z0-9_+.-]*")
+"""What a person typing a prefix (or a scheme) types before the colon: ``lab_4``, ``hom``."""
+
+BARE_SCHEMES = frozenset({"http", "https", "urn", "tag", "mailto", "file", "data", "did", "geo", "tel", "info"})
+"""The IRI schemes a name is read as an absolute IRI of without ``//`` after the colon (``urn:uuid:...``,
+``tag:lab.example,2026:cup``, ``mailto:``): those RDF data writes so. Any other ``x:local`` whose ``x`` is
+no declared prefix is a mistyped prefix (``hom:Cup``), refused, not an IRI of scheme ``x`` that names
+nothing; an IRI of another scheme is written in ``<>`` or with its authority (``ftp://...``)."""
 
 
 class GraphName(StrEnum):
@@ -120,9 +128,12 @@ def active_store_names() -> StoreNames | None:
 
 def expand(name: str) -> str:
     """Expand ``prefix:local`` with the prefix table (and the store's derived prefixes within
-    :func:`store_names`); absolute IRIs pass through unchanged.
+    :func:`store_names`); an IRI in ``<>``, one with an authority (``scheme://``) or one of
+    :data:`BARE_SCHEMES` passes through unchanged.
 
-    Raises ``ValueError`` for a name that is neither.
+    Raises :class:`~cbrs.kb.name_errors.UnknownPrefixError` (a ``ValueError``) for ``x:local`` with an
+    ``x`` that is neither a prefix nor such a scheme, naming the prefixes nearest ``x``; a plain
+    ``ValueError`` for a name with no colon.
     """
     if name.startswith("<") and name.endswith(">"):
         return name[1:-1]
@@ -134,14 +145,27 @@ def expand(name: str) -> str:
         found = names.namespace_of(prefix)
         if found is not None:
             return found + local
-    if sep and _SCHEME.fullmatch(prefix):
+    if sep and is_absolute_iri(name):
         return name
     known = ", ".join(PREFIXES)
     if names is not None and names.prefixes:
         known += f", or one of the store's {len(names.prefixes)} derived prefixes"
+    if sep and (not prefix or _PREFIX_LIKE.fullmatch(prefix) is not None):
+        from cbrs.kb.name_errors import UnknownPrefixError  # kb.errors writes IRIs with this module
+
+        raise UnknownPrefixError(name, prefix, near_prefixes(prefix) if prefix else [], known)
     near = near_prefixes(prefix) if sep else []
     hint = f"; did you mean {' or '.join(f'{p}:{local}' for p in near)}?" if near else ""
     raise ValueError(f"{name!r} is neither an absolute IRI nor a prefixed name with a known prefix ({known}){hint}")
+
+
+def is_absolute_iri(name: str) -> bool:
+    """Whether ``name``, written bare, is read as an absolute IRI rather than a prefixed name: its scheme
+    is followed by an authority (``//``) or is one of :data:`BARE_SCHEMES` (any case, as schemes are)."""
+    scheme, sep, rest = name.partition(":")
+    if not sep or _SCHEME.fullmatch(scheme) is None:
+        return False
+    return rest.startswith("//") or scheme.lower() in BARE_SCHEMES
 
 
 def near_prefixes(prefix: str) -> list[str]:

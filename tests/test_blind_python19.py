@@ -14,7 +14,8 @@ from pathlib import Path
 import pytest
 
 from cbrs.actions import Binding, Composer, Plan, PlanStep, Source
-from cbrs.kb import KnowledgeBase, NotFoundError, StoreInUseError
+from cbrs.kb import KnowledgeBase, StoreInUseError
+from cbrs.kb.name_errors import UnknownPrefixError
 from cbrs.reasoner import MatchConfig, Matchmaker
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -170,8 +171,8 @@ def test_a_requirement_is_ranked_by_its_short_name_as_cbrs_match_takes_it(memory
         ranked = matchmaker.rank(name, explain=1)
         assert ranked.requirement == full.requirement
         assert ranked.candidates[0].advertisement == full.candidates[0].advertisement
-    with pytest.raises(NotFoundError, match="reqq:RobotSelfPosition"):
-        matchmaker.rank("reqq:RobotSelfPosition")
+    with pytest.raises(UnknownPrefixError, match=r"reqq:RobotSelfPosition.*did you mean req:RobotSelfPosition"):
+        matchmaker.rank("reqq:RobotSelfPosition")  # a misspelt prefix, not an IRI of scheme reqq that names nothing
 
 
 def test_an_advertisement_and_a_requirement_show_in_one_short_line(memory: KnowledgeBase) -> None:

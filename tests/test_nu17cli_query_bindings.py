@@ -28,10 +28,14 @@ def test_a_misspelt_class_is_named() -> None:
     )
 
 
-def test_an_unknown_prefix_is_hinted_and_json_stays_json() -> None:
-    out, err = _query("kind=lab:Camera", fmt="json")
-    assert json.loads(out)["results"]["bindings"] == []
-    assert "<lab:Camera> (bound to kind) (is 'lab' a mistyped prefix?" in err
+def test_an_unknown_prefix_is_refused_and_json_stays_json() -> None:
+    """``lab:Camera`` with no prefix lab: declared is refused (tests/test_unknown_prefix.py); it was bound
+    as an IRI of scheme ``lab`` and gave "(0 rows)" with a note."""
+    args = ["query", "--name", "advertisements", "--format", "json", "--bind", "kind=lab:Camera"]
+    result = CliRunner().invoke(cli, ["--store", ":memory:", *args])
+    assert result.exit_code == 1
+    answer = json.loads(result.stdout)
+    assert "binding kind='lab:Camera'" in answer["error"] and "lab: is declared nowhere" in answer["error"]
 
 
 def test_a_known_class_says_nothing_more() -> None:
