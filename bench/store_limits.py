@@ -14,7 +14,9 @@ One run does every row against its anchor, on the same data and the same machine
   graph and cbrs's bundled data), then point lookups (``SELECT ?p ?o WHERE { <entity> ?p ?o }`` for a
   seeded random entity, JSON results) from 1, 4 and 8 client processes with one kept-alive HTTP
   connection each (from a loopback address of its own), S seconds a turn, the servers in turns, the
-  median of ``--rounds`` turns: queries per second and the 99th percentile of the latency;
+  median of ``--rounds`` turns: queries per second and the 99th percentile of the latency; the turns
+  start once both servers are idle (``Served.settle``: ``cbrs serve`` reads what its pages need in the
+  background for its first seconds on a big store), so the rows are the steady rate;
 - heavy queries (aggregates over the whole store), one at a time: the median time of each;
 - the memory of an idle ``cbrs serve`` over the bundled data after it answered a point lookup and a
   heavy query: resident and proportional set size of its whole process tree (query workers included),
@@ -124,6 +126,25 @@ class Served:
                 if self.process.poll() is not None or time.monotonic() > deadline:
                     raise RuntimeError(f"{label} did not start ({argv})") from None
                 time.sleep(0.05)
+
+    def settle(self, idle: float = 0.05, most: float = 120.0) -> float:
+        """Wait until the server's process used less than ``idle`` of a core over a second (at most
+        ``most`` seconds); returns the seconds waited. ``cbrs serve`` over a big store reads what its
+        first pages need in a background thread once it answers (``cbrs.web.warmup``: 17-23 s of a core
+        on 1M triples), and lookups measured meanwhile are the first seconds', not the steady rate."""
+        start = time.monotonic()
+        clock = os.sysconf("SC_CLK_TCK")
+
+        def used() -> float:
+            fields = Path(f"/proc/{self.process.pid}/stat").read_text().rsplit(")", 1)[1].split()
+            return (int(fields[11]) + int(fields[12])) / clock
+
+        while time.monotonic() - start < most:
+            before = used()
+            time.sleep(1.0)
+            if used() - before < idle:
+                break
+        return time.monotonic() - start
 
     def stop(self) -> None:
         self.process.terminate()
@@ -368,6 +389,9 @@ def _serving_rows(
     servers = {"cbrs": serve_cbrs(cbrs_store, args.cbrs_from)}
     try:
         servers["oxigraph"] = serve_oxigraph(args.oxigraph, ox_store)
+        settled = {label: served.settle() for label, served in servers.items()}
+        print(f"  servers idle after start: cbrs {settled['cbrs']:.1f} s, oxigraph {settled['oxigraph']:.1f} s "
+              "(the steady rate is measured from then)")  # fmt: skip
         for count in clients:
             samples: dict[str, list[tuple[float, float]]] = {"cbrs": [], "oxigraph": []}
             for turn in range(args.rounds):
