@@ -91,12 +91,23 @@ class NoExtentError(MapError):
     """A piece of furniture or a place objects are kept (``home:Furniture``, ``home:ObjectPlace`` by the
     taxonomy) with no extent: the simulation builds such a thing as a box, stands things on its top and
     finds spots on it, so without ``home:minX`` .. ``home:maxZ`` no task can use it. Refused when the map is
-    read (a load into graph:map, ``cbrs home``, a run), naming what it lacks (``missing``); before, it was
-    left out of the map's things but kept among its furniture, and a task about it failed mid-run."""
+    read (a load into graph:map, an update of it, ``cbrs home``, a run), naming what it lacks (``missing``);
+    before, it was left out of the map's things but kept among its furniture, and a task about it failed
+    mid-run. A region or a wall with none is refused alike, and so is a thing whose extent lacks a height the
+    simulation reads (``why``): a table whose ``home:maxZ`` an update deleted stood its top at 0 m."""
 
-    def __init__(self, thing: str, types: tuple[str, ...], missing: tuple[str, ...], hint: str = "") -> None:
+    def __init__(
+        self, thing: str, types: tuple[str, ...], missing: tuple[str, ...], hint: str = "", why: str = ""
+    ) -> None:
         self.missing = missing
-        kinds = ", ".join(local_name(t) for t in types)
+        kinds = ", ".join(local_name(t) for t in types) or "thing of no class"
+        if why:
+            super().__init__(
+                thing,
+                f"is a {kinds} whose extent lacks {', '.join(missing)}{hint}: {why}; give it "
+                f"{', '.join(missing)} (the kitchen table's are in ontologies/world.ttl), or take it out of graph:map",
+            )
+            return
         super().__init__(
             thing,
             f"is a {kinds} with no extent ({', '.join(missing)} missing){hint}: the simulation builds furniture "
@@ -694,7 +705,7 @@ def _classify(
             geometry,
         )
         return
-    if HOME + "minX" in values:
+    if HOME + "minX" in values:  # the floor's 0 m and a top's own height only where _check_heights_given allows
         top = _number(values, "maxZ", iri, 0.0)
         box = Box(
             _number(values, "minX", iri),
@@ -771,23 +782,75 @@ _EXTENT = ("minX", "maxX", "minY", "maxY", "maxZ")
 
 
 def _check_extents(built: SemanticMap, places: frozenset[str]) -> None:
-    """Every piece of furniture and object place the map describes is built: a box of its own (a
-    thing), or an object with a size. One with neither was read as nothing, yet listed as furniture, so
-    the home check passed it and a task putting something on it failed mid-run (the lab4 bench)."""
-    declared = _DECLARED.get()
-    for iri in sorted((built.furniture | places) & built.types.keys()):
+    """Every piece of furniture, object place, region and wall the map describes is built: a box of its
+    own (a thing), or an object with a size. One with neither was read as nothing, yet listed as furniture,
+    so the home check passed it and a task putting something on it failed mid-run (the lab4 bench); a wall
+    or a region was left out of the home without a word. Then :func:`_check_heights_given`."""
+    for iri in sorted((built.furniture | places | built.regions | built.walls) & built.types.keys()):
         if iri in built.things or iri in built.objects:
             continue
         values = built.facts.get(iri, {})
         missing = tuple(f"home:{name}" for name in _EXTENT if HOME + name not in values)
-        wanted = [HOME + name.removeprefix("home:") for name in missing]
-        slips = [  # a misspelt property is declared nowhere: the load took it
-            f"home:{local_name(near)} for its home:{local_name(prop)}"
-            for prop in sorted(values)
-            if prop not in declared and (near := nearest_term(prop, wanted)) is not None
-        ]
-        hint = f" (did you mean {'; '.join(slips)}?)" if slips else ""
-        raise NoExtentError(iri, built.types[iri], missing, hint)
+        raise NoExtentError(iri, built.types[iri], missing, _slip(values, missing))
+    for iri, values in sorted(built.facts.items()):  # a room or a device whose home:minX an update deleted
+        given = [name for name in ("maxX", "minY", "maxY") if HOME + name in values]
+        if given and iri not in built.things and HOME + "minX" not in values:
+            why = (
+                f"it gives home:{', home:'.join(given)} of an extent, and a thing without home:minX is read as one "
+                "with no extent at all (left out of the home: a room's floor, what rooms a device is in)"
+            )
+            missing = ("home:minX",)
+            raise NoExtentError(iri, built.types.get(iri, ()), missing, _slip(values, missing), why)
+    _check_heights_given(built, places)
+
+
+def _check_heights_given(built: SemanticMap, places: frozenset[str]) -> None:
+    """Every thing built as a box has the heights the simulation reads of it; none stands in as 0 m.
+
+    A room is a floor area (``home:minX`` .. ``home:maxY``; its height is the floor's, 0 m), and so is any
+    other thing with a footprint alone (a device the map places by its area, which only says what rooms it
+    is in). A piece of furniture needs its top (``home:maxZ``, where things stand; it is built as a top on
+    legs, and its ``home:minZ`` is its top unless given). Everything else the simulation builds or rests
+    things in (a region, an object place, a wall, an appliance and its tap and spout, a robot's body), or
+    any thing that gives one of its heights, needs both ``home:minZ`` and ``home:maxZ``: deleting the
+    kitchen table's ``home:maxZ`` by an update left its top at 0 m, and a region's missing ``home:minZ`` read
+    as its top."""
+    parts = {
+        part.iri
+        for dispenser in built.dispensers.values()
+        for part in (dispenser.body, dispenser.lever, dispenser.spout)
+    }
+    solid = built.furniture | places | built.regions | built.walls | built.bodies | parts
+    for iri in sorted(built.things):
+        if iri in built.rooms:
+            continue
+        values = built.facts.get(iri, {})
+        if iri not in solid and HOME + "minZ" not in values and HOME + "maxZ" not in values:
+            continue
+        table = iri in built.furniture and iri not in built.regions and iri not in places
+        wanted = ("maxZ",) if table else ("minZ", "maxZ")
+        missing = tuple(f"home:{name}" for name in wanted if HOME + name not in values)
+        if not missing:
+            continue
+        why = (
+            "things stand on its top (home:maxZ), which no default may stand in for (it read as 0 m, the floor)"
+            if table
+            else "the simulation builds it, or rests things in it, from home:minZ up to home:maxZ, and no default "
+            "may stand in for either (a missing home:maxZ read as 0 m, a missing home:minZ as its top)"
+        )
+        raise NoExtentError(iri, built.types.get(iri, ()), missing, _slip(values, missing), why)
+
+
+def _slip(values: dict[str, list[str]], missing: tuple[str, ...]) -> str:
+    """A hint at a property of the thing's own that may be a slip of a missing one (home:maxz for home:maxZ)."""
+    declared = _DECLARED.get()
+    wanted = [HOME + name.removeprefix("home:") for name in missing]
+    slips = [  # a misspelt property is declared nowhere: the load took it
+        f"home:{local_name(near)} for its home:{local_name(prop)}"
+        for prop in sorted(values)
+        if prop not in declared and (near := nearest_term(prop, wanted)) is not None
+    ]
+    return f" (did you mean {'; '.join(slips)}?)" if slips else ""
 
 
 def _check_supports(built: SemanticMap, quoted: set[tuple[str, str]] = set()) -> None:  # noqa: B006 (read only)
