@@ -151,12 +151,16 @@ def explain_syntax_error(
     text: str,
     expected: Literal["query", "update"],
     known: Mapping[str, str] | None = None,
+    offered: Callable[[], Mapping[str, str]] | None = None,
 ) -> QuerySyntaxError:
     """``error`` with a plain reason in front where the parser's list of expected tokens hides it: an
     update sent as a query (or the other way round), a misspelt first keyword, a prefix nobody declared,
     a bracket closed by the wrong kind, or a text that ends inside brackets. ``known`` are prefixes the
     text was run with besides cbrs's (a store's derived prefixes): not undeclared, and offered for a
-    misspelt one with their namespace."""
+    misspelt one with their namespace. ``offered`` gives the store's derived prefixes where the text was
+    run without them (the endpoint), read only for a prefix nobody declared: such a prefix is given its
+    declaration, a misspelt one the nearest with its own, so that ``cbrs query``, the endpoint and the
+    browser's SPARQL editor say the same."""
     if type(error) is not QuerySyntaxError:  # QueryTooComplexError and the like say what they mean
         return error
     at = _ERROR_AT.search(error.message)
@@ -178,21 +182,11 @@ def explain_syntax_error(
         return QuerySyntaxError(
             text, f"{where}{word!r} begins no SPARQL {expected}: did you mean {close[0]}? (the parser: {said})"
         )
-    derived = known or {}
-    prefix = undeclared_prefix(text, derived)
+    prefix = undeclared_prefix(text, known or {})
     if prefix is not None:
-        # Oxigraph says "Prefix not found" among the tokens it expected, or (in a subject) nothing of it
-        close = difflib.get_close_matches(prefix, [*PREFIXES, *derived], n=1)
-        if close and close[0] in derived:  # the store's: the declaration is known
-            hint = f"did you mean '{close[0]}:' (PREFIX {close[0]}: <{derived[close[0]]}>, derived for this store)?"
-        elif close:
-            hint = f"did you mean '{close[0]}:'?"
-        elif "Prefix not found" in said:
-            hint = "cbrs declares " + ", ".join(f"{p}:" for p in PREFIXES)
-        else:
-            hint = f"the parser: {said}"
-        reason = f"the prefix '{prefix}:' is not declared: add PREFIX {prefix}: <IRI>; {hint}"
-        return QuerySyntaxError(text, where + reason)
+        return QuerySyntaxError(
+            text, where + _undeclared_reason(prefix, said, {**(offered() if offered else {}), **(known or {})})
+        )
     nesting = _nesting(text)
     if nesting.wrong is not None and (at is None or _offset(text, at.group(1)) >= nesting.wrong.closed_at):
         wrong = nesting.wrong  # the parser's list would name what may follow, not which bracket is wrong
@@ -205,6 +199,27 @@ def explain_syntax_error(
     if nesting.wrong is None and nesting.open:  # the parser lists every token that could have come next
         return QuerySyntaxError(text, f"{where or 'at the end: '}the text ends with {_still_open(nesting.open)}")
     return error
+
+
+def _undeclared_reason(prefix: str, said: str, derived: Mapping[str, str]) -> str:
+    """Why the text did not parse, for ``prefix`` that nothing declares: its declaration when it is one of
+    the store's ``derived`` prefixes, else the nearest prefix (a derived one with its declaration)."""
+    if prefix in derived:  # the store's, used where no one declares it for the text (the endpoint)
+        return (
+            f"the prefix '{prefix}:' is not declared: add PREFIX {prefix}: <{derived[prefix]}> (derived for this "
+            "store; the endpoint declares cbrs's own prefixes only)"
+        )
+    # Oxigraph says "Prefix not found" among the tokens it expected, or (in a subject) nothing of it
+    close = difflib.get_close_matches(prefix, [*PREFIXES, *derived], n=1)
+    if close and close[0] in derived:  # the store's: the declaration is known
+        hint = f"did you mean '{close[0]}:' (PREFIX {close[0]}: <{derived[close[0]]}>, derived for this store)?"
+    elif close:
+        hint = f"did you mean '{close[0]}:'?"
+    elif "Prefix not found" in said:
+        hint = "cbrs declares " + ", ".join(f"{p}:" for p in PREFIXES)
+    else:
+        hint = f"the parser: {said}"
+    return f"the prefix '{prefix}:' is not declared: add PREFIX {prefix}: <IRI>; {hint}"
 
 
 _CLOSERS = {"{": "}", "(": ")", "[": "]"}

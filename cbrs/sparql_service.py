@@ -41,6 +41,7 @@ from werkzeug.datastructures import MIMEAccept
 from cbrs import __version__, pattern_lookup
 from cbrs._query_worker import dataset_options
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.derived_prefixes import for_store as derived_prefixes
 from cbrs.kb.described import about_in, complete
 from cbrs.kb.errors import (
     EngineFaultError,
@@ -412,7 +413,7 @@ def _sparql_text(
 ) -> Callable[[Callable[Concatenate[SparqlService, str, _P], _R]], Callable[Concatenate[SparqlService, str, _P], _R]]:
     """Run a method taking the SPARQL text first: without a leading byte order mark (a file saved by a
     Windows editor and posted as it is; the parser refuses it as a character it did not expect), and
-    with its syntax errors explained (:func:`explain_syntax_error`)."""
+    with its syntax errors explained (:func:`explain_syntax_error`, with the store's derived prefixes offered)."""
 
     def wrap(
         method: Callable[Concatenate[SparqlService, str, _P], _R],
@@ -423,7 +424,8 @@ def _sparql_text(
             try:
                 return method(self, text, *args, **kwargs)
             except QuerySyntaxError as error:
-                explained = explain_syntax_error(error, text, expected)
+                # a prefix nobody declared is offered the store's derived one, as cbrs query offers it
+                explained = explain_syntax_error(error, text, expected, offered=lambda: derived_prefixes(self.kb))
                 if explained is error:
                     raise
                 raise explained from error
