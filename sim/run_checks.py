@@ -244,6 +244,28 @@ class PlaceCrowdedError(KnowledgeBaseError):
         )
 
 
+class PlaceMovesError(KnowledgeBaseError):
+    """A step would set a thing down onto a place the task gives that is a movable object of the map (a
+    shape, a size and a pose: a tray), not furniture or a region with an extent: the simulated home builds
+    each thing of the map as one or the other, a carry aims at a place's extent, and the check took the
+    place for an object to grip ("no hand ... can grip the Tray1", the twentieth round). The run is refused
+    before anything moves, saying what a place things are put onto must be."""
+
+    http_status = 422
+
+    def __init__(self, component: str, place: str, given_as: str) -> None:
+        self.component = component
+        self.place = place
+        super().__init__(
+            f"{local_name(component)} would set a thing down onto the {local_name(place)} (the task's "
+            f"{given_as}), which the map describes as a movable object (home:shapeKind, home:sizeX .. home:sizeZ, "
+            "home:x, home:y): nothing is put onto a thing that moves, a place things are put onto is furniture "
+            "or a region with an extent (home:minX .. home:maxZ; docs/tasks.md, 'Put something onto furniture'); "
+            "to have things put onto it, describe it so instead (its class under home:Furniture and "
+            "home:ObjectPlace, its extent where it stands), as the ninth round's storage box"
+        )
+
+
 class PlaceTooSmallError(KnowledgeBaseError):
     """A place an arm step is given stands on a top too small for the object at hand as the carry sets it
     down: by the circle about its footprint (it comes to rest turned as it lay in the hand, which the
@@ -300,7 +322,7 @@ class PlanChecks:
 
     def check(self, plan: Plan, values: Mapping[str, Any]) -> None:
         """Refuse ``plan`` with the first check's typed error (:class:`kb.person_choice.PersonError`,
-        :class:`OutOfReachError`, :class:`PlaceCrowdedError`, :class:`PlaceTooSmallError`,
+        :class:`PlaceMovesError`, :class:`OutOfReachError`, :class:`PlaceCrowdedError`, :class:`PlaceTooSmallError`,
         :class:`arm_choice.CannotCarryError`,
         :class:`sight.OutOfViewError`,
         :class:`CannotLoadError`, :class:`kb.home_check.NoDockingPoseError`, :class:`sight.BaseOutOfViewError`,
@@ -568,6 +590,7 @@ class PlanChecks:
             if not robot_arms and not armless:
                 continue
             robot_arms = robot_arms or []
+            self._check_place_stands(step, values)
             given = [values.get(name) for name in sorted(task_inputs_of(step, steps))]
             iris = [str(value["@id"]) for value in given if isinstance(value, dict) and "@id" in value]
             objects = [iri for iri in iris if iri in smap.objects]
@@ -595,6 +618,17 @@ class PlanChecks:
                         lying = {obj.iri: at for obj, at in zip(self.world.objects.values(), found, strict=True)}
                         free = arms_free(plan, smap, values, lying, held_now(self.world))
                     self._check_spot(step, iri, at_hand.get(step.device or "", []), report, free.get(step.index))
+
+    def _check_place_stands(self, step: PlanStep, values: Mapping[str, Any]) -> None:
+        """Refuse a step given, as a place (an input of a class at or below ``home:Place``: a carry's
+        target), a movable object of the map (:class:`PlaceMovesError`)."""
+        for binding in step.inputs:
+            if binding.source.step is not None or not binding.concept or not self.is_a(binding.concept, HOME + "Place"):
+                continue
+            value = values.get(binding.source.name)
+            iri = str(value["@id"]) if isinstance(value, dict) and "@id" in value else ""
+            if iri in self.world.map.objects:
+                raise PlaceMovesError(step.component, iri, binding.source.name)
 
     @staticmethod
     def _distance(

@@ -162,7 +162,7 @@ class BaseOutOfViewError(KnowledgeBaseError):
             f"pose ({pose.x:.2f}, {pose.y:.2f}), where an earlier step parks it, with {names}, which cannot see "
             f"the marker there ({each}); the base would be lost there and could not drive on. Hang a camera "
             "over the place and register a locator (LocateMobileRobot) that looks with it "
-            "(docs/examples/camera3.ttl and bedroom_camera.ttl do so for the bedroom), or move the place's "
+            "(docs/examples/lab20_bedroom_locator.ttl does so for the bedroom), or move the place's "
             "home:dockingPose to where a camera sees the base"
         )
 

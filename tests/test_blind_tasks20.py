@@ -14,7 +14,7 @@ from cbrs.kb.semantic_map import SemanticMap
 from cbrs.sim import sight
 from cbrs.sim.components import SimEnvironment
 from cbrs.sim.geometry import Pose2D
-from cbrs.sim.run_checks import CannotGripError
+from cbrs.sim.run_checks import CannotGripError, PlaceMovesError
 from cbrs.sim.world import open_world
 
 EXAMPLES = Path(__file__).parent.parent / "docs" / "examples"
@@ -28,7 +28,7 @@ def _desk_store(camera: bool) -> KnowledgeBase:
     kb.load([EXAMPLES / "lab20_desk_then_me.ttl"], graph="ontology")
     if camera:
         kb.load([EXAMPLES / "lab20_bedroom_camera_map.ttl"], graph="map")
-        kb.registry.register((EXAMPLES / "camera3.ttl").read_text())
+        kb.registry.register((EXAMPLES / "lab20_bedroom_locator.ttl").read_text())
     return kb
 
 
@@ -76,3 +76,23 @@ def test_a_thing_heavier_than_the_hand_lifts_is_refused_before_anything_moves() 
     assert error.thing == LAB20 + "HandWeight1" and error.limits == ("heavy",)
     assert "can lift the HandWeight1" in str(error) and "it weighs 4.5 kg (home:massKg)" in str(error)
     assert "the hand lifts 3 kg" in str(error) and "home:payloadKg" in str(error)
+
+
+def test_a_place_that_is_a_movable_object_is_refused_as_such() -> None:
+    """PenOntoTheTray: the tray a thing (a shape, a size, a pose) and a home:ObjectPlace. The check took the
+    place the carry is given for an object to take ("no hand of CytonDualArm01 can grip the Tray1"); it
+    now says that nothing is put onto a thing that moves, and how to describe the tray instead."""
+    kb = KnowledgeBase.open(":memory:")
+    for graph in ("ontology", "map"):
+        kb.load([EXAMPLES / "lab20_serving_tray.ttl"], graph=graph)
+    kb.load([EXAMPLES / "lab20_pen_onto_the_tray.ttl"], graph="requirements")
+    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
+        started = world.time
+        with pytest.raises(PlaceMovesError) as refused:
+            run_task(kb, "PenOntoTheTray", SimEnvironment(world, kb), composer=Composer(kb))
+        assert world.time == started
+    error = refused.value
+    assert error.place == LAB20 + "Tray1" and error.component.endswith("CarryObject_CytonDualArm01")
+    assert "onto the Tray1 (the task's tray)" in str(error) and "under home:Furniture and home:ObjectPlace" in str(
+        error
+    )
