@@ -3,8 +3,11 @@
 HermiT runs on Java. The graphs are written to a temporary N-Triples file without their ``owl:imports``
 (the imported ontologies are in the store already, and nothing may be fetched), which HermiT classifies.
 The report says whether the graphs are consistent, which classes are unsatisfiable, and, since the reasoner
-gives no reason for an inconsistency, the literals whose datatype is not the range their property declares
-(``4.5`` is an ``xsd:decimal``, not an ``xsd:double``): places to look first.
+gives no reason for an inconsistency, the literals whose datatype is not one their property's range admits
+(``"seven"`` on ``home:x``, whose range is ``xsd:decimal or xsd:double or xsd:float``): places to look first.
+
+HermiT runs as a child process with a time limit (``timeout``, else the ``check_timeout`` setting): past it
+the child is killed and :class:`ReasonerTimeoutError` says so (docs/ontologies.md, "How long HermiT may take").
 
 The graphs are cbrs's own by name (``ontology``) or any named graph by its IRI, a lab's own that ``cbrs load
 --graph IRI`` wrote included: checked with cbrs's ontologies when given with ``ontology`` too, alone otherwise
@@ -41,12 +44,16 @@ from cbrs.kb import KnowledgeBase, KnowledgeBaseError
 from cbrs.kb.inferred import INFERRED, InferredGraph, replace_inferred
 from cbrs.kb.loader import resolve_graph
 from cbrs.kb.namespaces import GENID, OWL, RDF, RDFS, GraphName, shorten
+from cbrs.kb.skolem import is_skolem
+from cbrs.settings import setting
 
 DEFAULT_GRAPHS = (GraphName.ONTOLOGY, GraphName.SERVICES, GraphName.REQUIREMENTS)
 JVM_OPTIONS = ("-XX:TieredStopAtLevel=1", "-XX:+UseSerialGC")
 """The JVM options HermiT runs with: a short run is dominated by compiling and collecting, not by the
 reasoning these options would slow down."""
 JAVA_HINT = "install a Java runtime (Debian/Ubuntu: apt-get install default-jre-headless) or put java on PATH"
+SETTING = "check_timeout"
+"""The setting that bounds a HermiT run, in seconds."""
 
 
 class JavaMissingError(KnowledgeBaseError):
@@ -85,6 +92,38 @@ class ReasonerError(KnowledgeBaseError):
         super().__init__(f"HermiT failed: {' '.join(message.split())[:400]}")
 
 
+class ReasonerTimeoutError(ReasonerError):
+    """HermiT did not finish within its time limit; its process was killed, and nothing was concluded."""
+
+    http_status = 504
+
+    def __init__(self, seconds: float, graphs: Sequence[str], triples: int) -> None:
+        self.seconds = seconds
+        self.graphs = tuple(graphs)
+        self.triples = triples
+        self.message = f"no answer within {seconds:g} s"
+        names = ", ".join(shorten(graph) for graph in self.graphs)
+        KnowledgeBaseError.__init__(
+            self,
+            f"HermiT did not finish over {names} ({triples} triples) within {seconds:g} s, and was stopped: give it "
+            f"longer with the {SETTING} setting ({setting(SETTING).env}=SECONDS), or check fewer graphs (--graph)",
+        )
+
+
+class HermitMissingError(ReasonerError):
+    """owlready2 no longer ships HermiT where cbrs looks for it (:func:`hermit_classpath`)."""
+
+    http_status = 503
+
+    def __init__(self, version: str, why: str) -> None:
+        self.version = version
+        KnowledgeBaseError.__init__(
+            self,
+            f"cbrs check found no HermiT in owlready2 {version}: {why}; install the owlready2 version "
+            "pyproject.toml names (owlready2>=0.47,<1), with which cbrs was tested",
+        )
+
+
 class WriteRefusedError(KnowledgeBaseError):
     """HermiT's conclusions not written back: over inconsistent graphs every statement follows, and an
     unsatisfiable class is below every class, so what it concluded would say nothing true."""
@@ -113,11 +152,14 @@ class RangeClash:
     value: str
     datatype: str
     range: str
+    admitted: tuple[str, ...] = ()
+    """The datatypes a union range names (``range`` is then its node); empty for a named datatype."""
 
     def text(self) -> str:
+        named = " or ".join(shorten(member) for member in self.admitted) if self.admitted else shorten(self.range)
         return (
             f"{shorten(self.subject)} {shorten(self.property)} {self.value} is an {shorten(self.datatype)}, "
-            f"but {shorten(self.property)} has range {shorten(self.range)}"
+            f"but {shorten(self.property)} has range {named}"
         )
 
 
@@ -151,11 +193,15 @@ class CheckResult:
         }
 
 
-def check(kb: KnowledgeBase, graphs: Sequence[GraphName | str] = DEFAULT_GRAPHS) -> CheckResult:
+def check(
+    kb: KnowledgeBase, graphs: Sequence[GraphName | str] = DEFAULT_GRAPHS, timeout: float | None = None
+) -> CheckResult:
     """Classify ``graphs`` of the store with HermiT: cbrs's graphs by name, any other named graph by its IRI
-    (:class:`NoSuchGraphError` for one the store does not hold); :class:`JavaMissingError` without Java."""
+    (:class:`NoSuchGraphError` for one the store does not hold); :class:`JavaMissingError` without Java.
+    HermiT has ``timeout`` seconds (default: the ``check_timeout`` setting), else :class:`ReasonerTimeoutError`."""
     import owlready2
 
+    limit = setting(SETTING).resolve() if timeout is None else timeout
     nodes = checked_graphs(kb, graphs)
     java = str(owlready2.JAVA_EXE)
     if shutil.which(java) is None:
@@ -171,8 +217,11 @@ def check(kb: KnowledgeBase, graphs: Sequence[GraphName | str] = DEFAULT_GRAPHS)
     with tempfile.TemporaryDirectory(prefix="cbrs-check-") as folder:
         path = Path(folder) / "graphs.nt"
         path.write_bytes(ox.serialize(triples, format=ox.RdfFormat.N_TRIPLES) or b"")
-        output = _hermit(java, path)
-    clashes = _range_clashes(kb, names)
+        try:
+            output = _hermit(java, path, limit)
+        except _TimedOut:
+            raise ReasonerTimeoutError(limit, [graph.value for graph in nodes], len(triples)) from None
+    clashes = range_clashes(kb, names)
     if output is None:
         return CheckResult(names, len(triples), False, [], clashes, time.perf_counter() - start)
     conclusions, unsatisfiable = _conclusions(output)
@@ -181,42 +230,78 @@ def check(kb: KnowledgeBase, graphs: Sequence[GraphName | str] = DEFAULT_GRAPHS)
 
 
 def write_inferred(
-    kb: KnowledgeBase, graphs: Sequence[GraphName | str] = DEFAULT_GRAPHS
+    kb: KnowledgeBase, graphs: Sequence[GraphName | str] = DEFAULT_GRAPHS, timeout: float | None = None
 ) -> tuple[CheckResult, InferredGraph]:
     """Check ``graphs`` (:func:`check`), then make graph:inferred hold HermiT's conclusions that the store
     does not already say (:func:`kb.inferred.replace_inferred`): all or nothing, replacing what an earlier
     write-back put there. :class:`WriteRefusedError`, nothing written, when the graphs are inconsistent or
-    have an unsatisfiable class."""
-    result = check(kb, graphs)
+    have an unsatisfiable class; :class:`ReasonerTimeoutError`, nothing written, when HermiT ran out of time."""
+    result = check(kb, graphs, timeout)
     if not result.ok:
         raise WriteRefusedError(result)
     return result, replace_inferred(kb, result.conclusions)
 
 
-def _hermit(java: str, path: Path) -> str | None:
+class _TimedOut(Exception):
+    """HermiT's process outlived its time limit and was killed."""
+
+
+def hermit_classpath() -> str:
+    """The Java classpath of the HermiT that owlready2 ships: its patched classes, then its jar.
+
+    owlready2 has no public name for it: this reads its private ``owlready2.reasoning._HERMIT_CLASSPATH``,
+    the classpath its own ``sync_reasoner_hermit`` runs, here alone. Should a release rename it or move
+    the jar, :class:`HermitMissingError` says so (tests/test_owl_numbers.py fails first)."""
+    import owlready2
+    import owlready2.reasoning
+
+    version = str(getattr(owlready2, "VERSION", "?"))
+    classpath = getattr(owlready2.reasoning, "_HERMIT_CLASSPATH", None)
+    if not isinstance(classpath, str):
+        raise HermitMissingError(version, "owlready2.reasoning has no _HERMIT_CLASSPATH")
+    jars = [entry for entry in classpath.split(os.pathsep) if entry.endswith(".jar")]
+    if not jars or not all(Path(jar).is_file() for jar in jars):
+        raise HermitMissingError(version, f"its HermiT classpath names no jar that exists ({classpath})")
+    return classpath
+
+
+def _hermit(java: str, path: Path, timeout: float) -> str | None:
     """HermiT's classification of the ontology at ``path`` (its command line, as owlready2 runs it: classes,
-    object and data properties, individuals), or None when it finds the ontology inconsistent.
+    object and data properties, individuals), or None when it finds the ontology inconsistent; :class:`_TimedOut`
+    when it has not finished within ``timeout`` seconds, its process then killed by its PID and reaped.
 
     HermiT is run here rather than through ``owlready2.sync_reasoner_hermit``, whose results keep one kind
     per entity: a class also used as an individual (OWL 2 punning, as home:Cup is) had its inferred
-    superclasses taken for its types. The JVM options go in the child's environment only."""
+    superclasses taken for its types; and which has no time limit. The JVM options go in the child's
+    environment only."""
     import owlready2.reasoning
 
-    classpath = str(owlready2.reasoning._HERMIT_CLASSPATH)  # the jar owlready2 ships, on its own classpath
     memory = getattr(owlready2.reasoning, "JAVA_MEMORY", 2000)
-    command = [java, f"-Xmx{memory}M", "-cp", classpath, "org.semanticweb.HermiT.cli.CommandLine"]
+    command = [java, f"-Xmx{memory}M", "-cp", hermit_classpath(), "org.semanticweb.HermiT.cli.CommandLine"]
     command += ["-c", "-O", "-D", "-I", path.as_uri()]
     own = os.environ.get("JDK_JAVA_OPTIONS")
     environment = {**os.environ, "JDK_JAVA_OPTIONS": " ".join([*JVM_OPTIONS, *([own] if own else [])])}
     try:
-        done = subprocess.run(command, capture_output=True, env=environment, check=False)
+        process = subprocess.Popen(
+            command, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.PIPE, env=environment
+        )
     except OSError as error:
         raise ReasonerError(str(error)) from error
-    output = done.stdout.decode("utf-8", "replace")
-    errors = done.stderr.decode("utf-8", "replace")
-    if done.returncode == 1 and "Inconsistent ontology" in output + errors:
+    try:
+        out, err = process.communicate(timeout=timeout)
+    except subprocess.TimeoutExpired:
+        process.kill()  # this child, by its PID: the JVM starts no process of its own
+        process.communicate()
+        raise _TimedOut from None
+    except BaseException:  # an interrupt while waiting: the JVM goes with it
+        process.kill()
+        process.communicate()
+        raise
+    output = out.decode("utf-8", "replace")
+    errors = err.decode("utf-8", "replace")
+    if process.returncode == 1 and "Inconsistent ontology" in output + errors:
         return None
-    if done.returncode != 0:
+    if process.returncode != 0:
         raise ReasonerError(errors or output)
     return output
 
@@ -271,14 +356,40 @@ def checked_graphs(kb: KnowledgeBase, graphs: Sequence[GraphName | str]) -> list
     return nodes
 
 
-def _range_clashes(kb: KnowledgeBase, graphs: Sequence[str]) -> list[RangeClash]:
-    """Literals typed with another XSD datatype than the one their property's rdfs:range names."""
+def range_clashes(kb: KnowledgeBase, graphs: Sequence[str]) -> list[RangeClash]:
+    """Literals whose datatype is not one their property's rdfs:range admits (the named query
+    ``range_clashes``: an XSD datatype, or a union of them, and the XSD types derived from those)."""
     rows = [row for graph in graphs for row in kb.select("range_clashes", {"graph": graph})]
     clashes = []
+    members: dict[str, tuple[str, ...]] = {}
     for row in rows:
-        literal = row["o"]
-        assert isinstance(literal, ox.Literal)
+        literal, range_ = row["o"], row["range"]
+        assert isinstance(literal, ox.Literal) and isinstance(range_, ox.NamedNode)
+        if is_skolem(range_) and range_.value not in members:
+            members[range_.value] = _union_members(kb, range_)
         clashes.append(
-            RangeClash(row["s"].value, row["p"].value, literal.value, literal.datatype.value, row["range"].value)
+            RangeClash(
+                row["s"].value,
+                row["p"].value,
+                literal.value,
+                literal.datatype.value,
+                range_.value,
+                members.get(range_.value, ()),
+            )
         )
     return clashes
+
+
+def _union_members(kb: KnowledgeBase, node: ox.NamedNode) -> tuple[str, ...]:
+    """The datatypes of the union ``node`` is (its owl:unionOf list), in order; empty if it is none."""
+    found: list[str] = []
+    union = next(iter(kb.store.quads(node, ox.NamedNode(OWL + "unionOf"), None)), None)
+    cell = union.object if union is not None else None
+    while isinstance(cell, ox.NamedNode) and cell.value != RDF + "nil" and len(found) < 100:
+        first = next(iter(kb.store.quads(cell, ox.NamedNode(RDF + "first"), None)), None)
+        rest = next(iter(kb.store.quads(cell, ox.NamedNode(RDF + "rest"), None)), None)
+        if first is None or rest is None or not isinstance(first.object, ox.NamedNode):
+            break
+        found.append(first.object.value)
+        cell = rest.object
+    return tuple(found)

@@ -371,6 +371,15 @@ SETTINGS: tuple[Setting, ...] = (
         _positive(float),
     ),
     Setting(
+        "check_timeout",
+        lambda: 300.0,
+        "Seconds cbrs check gives the HermiT reasoner (a Java process) before it is stopped and the check fails "
+        "saying so; the bundled ontologies take a few seconds, a large lab ontology may need more "
+        "(docs/ontologies.md).",
+        "CBRS_CHECK_TIMEOUT",
+        _positive(float),
+    ),
+    Setting(
         "federation_allow",
         lambda: (),
         "Comma-separated IRI prefixes that SPARQL SERVICE (federated queries) and LOAD may reach; none by "

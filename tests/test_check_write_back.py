@@ -178,13 +178,13 @@ def test_hermit_runs_on_the_quick_jvm_options_then_the_users_own(
     else:
         monkeypatch.setenv("JDK_JAVA_OPTIONS", own)
     seen: list[str | None] = []
-    run = subprocess.run
+    popen = subprocess.Popen
 
     def recorded(*args: Any, **kwargs: Any) -> Any:
         seen.append(kwargs["env"].get("JDK_JAVA_OPTIONS"))
-        return run(*args, **kwargs)
+        return popen(*args, **kwargs)
 
-    monkeypatch.setattr(subprocess, "run", recorded)
+    monkeypatch.setattr(subprocess, "Popen", recorded)
     assert check(small_kb(tmp_path)).consistent
     assert seen == [" ".join([*JVM_OPTIONS, *([own] if own else [])])]
     assert os.environ.get("JDK_JAVA_OPTIONS") == own
