@@ -16,6 +16,7 @@ from cbrs.kb import KnowledgeBase
 from cbrs.sparql_service import EndpointBusyError, EndpointConfig, QueryTimeoutError, SparqlService
 from cbrs.tasks import CameraFrame, TaskRunner
 from cbrs.web import create_app, diagram
+from tests.test_tasks_negotiation import _Held
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "docs" / "examples"
 CROSS = "SELECT (COUNT(*) AS ?n) WHERE { ?a ?b ?c . ?d ?e ?f . ?g ?h ?i }"
@@ -142,3 +143,37 @@ def test_an_actions_sub_actions_are_drawn_level_by_level_in_their_order() -> Non
     cup = client.get("/taxonomy/class.json", query_string={"iri": "home:Cup"}).get_json()
     assert "sub_actions" not in cup
     assert 'id="hierarchy-heading"' not in client.get("/taxonomy/class?iri=home:Cup").get_data(as_text=True)
+
+
+def test_a_page_stops_only_the_runs_its_own_computer_started(bundled_kb: KnowledgeBase) -> None:
+    """Every tasks page shows Stop for the run going: a student's click stopped the teacher's run. Another
+    computer's page is refused, saying why and how; the token typed beside Stop, or the starter, stops it."""
+    service = SparqlService(bundled_kb, EndpointConfig(update_token="teacher"))
+    runner = _Held(bundled_kb, service.lock)
+    runner.release.clear()  # the run goes until released
+    client = create_app(service, tasks=runner).test_client()
+    teacher, student = {"REMOTE_ADDR": "10.0.0.1"}, {"REMOTE_ADDR": "10.0.0.2"}
+    try:
+        started = client.post("/tasks.json", data={"task": "FetchMyPen"}, environ_base=teacher)
+        assert started.status_code == 202
+        run_id = started.get_json()["started"]["id"]
+        refused = client.post(f"/tasks/{run_id}/cancel.json", environ_base=student)
+        assert refused.status_code == 403
+        assert "started from another computer" in refused.get_json()["message"]
+        assert "update token typed beside Stop this run" in refused.get_json()["message"]
+        assert not runner.get(run_id).cancel_requested.is_set()
+        wrong = client.post(f"/tasks/{run_id}/cancel.json", data={"token": "guess"}, environ_base=student)
+        assert wrong.status_code == 403 and not runner.get(run_id).cancel_requested.is_set()
+        page = client.get(f"/tasks/{run_id}", environ_base=student).get_data(as_text=True)
+        assert 'id="stop-token"' in page and 'name="token"' in page
+        typed = client.post(f"/tasks/{run_id}/cancel.json", data={"token": "teacher"}, environ_base=student)
+        assert typed.status_code == 202 and runner.get(run_id).cancel_requested.is_set()
+    finally:
+        runner.release.set()
+    assert runner.get(run_id).done.wait(10)
+    runner.release.clear()
+    try:
+        own = client.post("/tasks.json", data={"task": "FetchMyPen"}, environ_base=student).get_json()["started"]["id"]
+        assert client.post(f"/tasks/{own}/cancel.json", environ_base=student).status_code == 202
+    finally:
+        runner.release.set()

@@ -57,6 +57,7 @@ SLICE = 0.5  # seconds a stream waits at most before it looks whether the server
 QUEUE_SIZE = 1000  # events a slow client may fall behind by before its stream ends (a run sends ~150)
 BOUNDARY = "frame"
 STEP_EVENTS = ("step_started", "step_succeeded", "step_failed")
+MAX_STARTERS = 256  # runs whose starting address is kept, for who may stop them (the runner keeps fewer runs)
 
 
 @blueprint.record_once
@@ -93,6 +94,7 @@ def tasks() -> Page:
         shown.status = 409
         shown.data.update(error="busy", message=str(error), running=error.running)
         return shown
+    _starters(started.id)
     shown.status = 303 if _from_a_browser() else 202  # Post/Redirect/Get: a reload re-sent the form, a 409 mid-run
     shown.headers["Location"] = url_for("tasks.run_json" if wants_json() else "tasks.run", run_id=started.id)
     shown.title = f"Tasks: {started.id} started"
@@ -121,6 +123,7 @@ def cancel(run_id: str) -> Page:
     """
     _may_act("stopped")
     found = context.tasks().get(run_id)  # an unknown run: 404
+    _may_stop(found)
     data = {"mode": "run", **_live()}
     if found.done.is_set():
         data.update(run=_detail(found), error="ended", message=f"{found.id} has already ended: {found.status}")
@@ -135,6 +138,38 @@ def cancel(run_id: str) -> Page:
         shown.status = 303
         shown.headers["Location"] = url_for("tasks.run", run_id=found.id)
     return _for_script(shown)
+
+
+def _starters(started: str | None = None) -> dict[str, str | None]:
+    """Which address started each run from a page (``POST /tasks``), the last ``MAX_STARTERS``; with
+    ``started``, this request's address is recorded for that run."""
+    found: dict[str, str | None] = current_app.extensions.setdefault("cbrs.run_starters", {})
+    if started is not None:
+        found[started] = request.remote_addr
+        while len(found) > MAX_STARTERS:
+            del found[next(iter(found))]
+    return found
+
+
+def _may_stop(found: TaskRun) -> None:
+    """A page stops only a run its own computer started (its address); another run needs the update token
+    (``Authorization: Bearer``, or the Stop form's token field). In a class on one server every tasks page
+    showed Stop for the run going, and any student's click stopped the teacher's run, or another's."""
+    starter = _starters().get(found.id)
+    if (starter is not None and starter == request.remote_addr) or _has_token() or _token_typed():
+        return
+    where = "another computer" if starter is not None else "a program (over the bridge or with the token)"
+    raise Forbidden(
+        f"{found.id} was started from {where}: a page stops only the runs its own computer started; whoever "
+        "started cbrs serve may stop it, with the update token typed beside Stop this run"
+    )
+
+
+def _token_typed() -> bool:
+    """Whether the form's ``token`` field holds the server's update token (a page's Stop form)."""
+    expected = context.sparql().config.update_token
+    typed = request.form.get("token", "").strip() if request.method == "POST" else ""
+    return bool(expected and typed) and hmac.compare_digest(typed.encode("utf-8"), str(expected).encode("utf-8"))
 
 
 def _stopping(found: TaskRun) -> str:

@@ -303,7 +303,10 @@
       const button = byId("cancel-button");
       button.disabled = true;
       try {
-        const response = await fetch(stopForm.action + ".json", { method: "POST" });
+        const response = await fetch(stopForm.action + ".json", {
+          method: "POST",
+          body: new URLSearchParams(new FormData(stopForm)), // the token typed, for a run another computer started
+        });
         const data = await response.json();
         stopForm.parentElement.querySelectorAll(".form-message").forEach((node) => node.remove());
         const box = response.status === 202 ? "ok-box" : "error-box";
