@@ -619,7 +619,7 @@ def _classify(
             near=_number(values, "minRange", iri, 0.2),
             far=_number(values, "maxRange", iri, 8.0),
             size=size,
-            mount=values.get(HOME + "mountedOn", [None])[0],
+            mount=_named(facts, iri, "mountedOn", values.get(HOME + "mountedOn", [None])[0]),
             occlusion_tolerance=_number(values, "occlusionTolerance", iri, Camera.occlusion_tolerance),
         )
         if not 0.0 < camera.near < camera.far:
@@ -676,16 +676,16 @@ def _classify(
         )
         return
     if HOME + "hasPlatform" in values or HOME + "hasMarker" in values:
-        platform = values.get(HOME + "hasPlatform", [None])[0]
+        platform = _named(facts, iri, "hasPlatform", values.get(HOME + "hasPlatform", [None])[0])
         height = None
         if platform is not None:
             height = _number(facts.get(platform, {}), "maxZ", platform)
-        marker = values.get(HOME + "hasMarker", [None])[0]
+        marker = _named(facts, iri, "hasMarker", values.get(HOME + "hasMarker", [None])[0])
         colours = None
         geometry = None
         if marker is not None:
             marker_values = facts.get(marker, {})
-            colour_node = marker_values.get(HOME + "hasColour", [marker])[0]
+            colour_node = _named(facts, marker, "hasColour", marker_values.get(HOME + "hasColour", [marker])[0])
             node = facts.get(colour_node, {})
             front, rear = _text(node, "frontColourName", colour_node), _text(node, "rearColourName", colour_node)
             colours = (front, rear) if front and rear else None
@@ -715,12 +715,24 @@ def _classify(
             _number(values, "minZ", iri, top),
             top,
         )
-        dock_iri = values.get(HOME + "dockingPose", [None])[0]
+        dock_iri = _named(facts, iri, "dockingPose", values.get(HOME + "dockingPose", [None])[0])
         dock = None
         if dock_iri is not None:
             node = facts.get(dock_iri, {})
             dock = Pose(_number(node, "x", dock_iri), _number(node, "y", dock_iri), _number(node, "yaw", dock_iri, 0.0))
         built.things[iri] = Thing(iri, types, box, dock)
+
+
+def _named(facts: dict[str, dict[str, list[str]]], iri: str, prop: str, target: str | None) -> str | None:
+    """``target``, what ``iri``'s ``home:{prop}`` names, when graph:map says something of it (None: it names
+    nothing). One the map says nothing of is refused, with the thing it may mean: a misspelt platform was
+    said to have no home:maxZ, a misspelt marker left the robot without colours, and a camera mounted on a
+    misspelt thing was taken as mounted, its mast never built, without a word."""
+    if target is None or target in facts:
+        return target
+    near = nearest_term(target, facts)
+    hint = f" (did you mean {local_name(near)}?)" if near else ""
+    raise MapError(iri, f"has home:{prop} {local_name(target)} ({target}), of which graph:map says nothing{hint}")
 
 
 GRASP_APPROACHES = ("top", "side")
