@@ -14,7 +14,7 @@ from collections import defaultdict
 from contextvars import ContextVar
 from dataclasses import dataclass, field, replace
 from enum import Enum
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, overload
 
 from pyoxigraph import Literal, NamedNode
 
@@ -723,6 +723,10 @@ def _classify(
         built.things[iri] = Thing(iri, types, box, dock)
 
 
+@overload
+def _named(facts: dict[str, dict[str, list[str]]], iri: str, prop: str, target: str) -> str: ...
+@overload
+def _named(facts: dict[str, dict[str, list[str]]], iri: str, prop: str, target: str | None) -> str | None: ...
 def _named(facts: dict[str, dict[str, list[str]]], iri: str, prop: str, target: str | None) -> str | None:
     """``target``, what ``iri``'s ``home:{prop}`` names, when graph:map says something of it (None: it names
     nothing). One the map says nothing of is refused, with the thing it may mean: a misspelt platform was
