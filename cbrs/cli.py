@@ -66,7 +66,7 @@ from cbrs.output import (
 )
 from cbrs.settings import SETTINGS, setting
 from cbrs.sparql_hints import declared, explain_syntax_error, first_keyword, one_line_up, store_prefixes_used
-from cbrs.unmentioned_names import unmentioned_names
+from cbrs.unmentioned_names import unmentioned_bindings, unmentioned_names
 
 # Commands whose modules import numpy, networkx, the composer or the web server (most of a second at
 # start-up): each is imported when it runs or shows its own help. ``cbrs --help`` lists them from the
@@ -575,15 +575,10 @@ def _check_required(kb: KnowledgeBase, name: str, values: dict[str, str]) -> Non
 
 def _note_unknown_bindings(kb: KnowledgeBase, name: str, values: dict[str, str]) -> None:
     """Say on standard error which bound IRIs the store mentions nowhere: a misspelt class or prefix
-    (``kind=cbrs:DynamicPerceptonComponent``) gave "(0 rows)" and no word of why."""
-    parameters = kb.queries.get(name).parameters
-    for parameter, value in values.items():
-        if parameters[parameter].kind != "iri":
-            continue
-        full = expand(value.strip())
-        if not kb.describes(full):
-            hint = not_found_hint(kb, full)
-            click.echo(f"note: nothing in the store mentions <{full}> (bound to {parameter}){hint}", err=True)
+    (``kind=cbrs:DynamicPerceptonComponent``) gave "(0 rows)" and no word of why
+    (:func:`cbrs.unmentioned_names.unmentioned_bindings`, which a program calls too)."""
+    for note in unmentioned_bindings(kb, name, values):
+        click.echo(f"note: {note}", err=True)
 
 
 # An update, after its prologue (PREFIX and BASE declarations, comments): the query parser's own

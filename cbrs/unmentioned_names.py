@@ -24,7 +24,7 @@ from cbrs.sparql_hints import TOKENS
 if TYPE_CHECKING:
     from cbrs.kb import KnowledgeBase
 
-__all__ = ["unmentioned_names"]
+__all__ = ["unmentioned_bindings", "unmentioned_names"]
 
 
 def unmentioned_names(kb: KnowledgeBase, text: str, prefixes: Mapping[str, str] = {}) -> list[str]:
@@ -58,6 +58,27 @@ def unmentioned_names(kb: KnowledgeBase, text: str, prefixes: Mapping[str, str] 
                 f"; did you mean {' or '.join(near)}?" if near else ""
             )
     return list(notes.values())
+
+
+def unmentioned_bindings(kb: KnowledgeBase, name: str, values: Mapping[str, object]) -> list[str]:
+    """A note for each IRI bound to a parameter of the named query ``name`` that the store mentions nowhere,
+    in the order of ``values``: "nothing in the store mentions <...#DynamicPerceptonComponent> (bound to
+    kind); did you mean cbrs:DynamicPerceptionComponent?". A misspelt class bound so gave "(0 rows)" and
+    no word of why; ``cbrs query --name`` prints these, and a program calls this as it does. The values are
+    read as the query reads them (a bad one is the query's ``BindingError``)."""
+    from cbrs.task_names import near_names  # the action model: only for a name that names nothing
+
+    query = kb.queries.get(name)
+    notes = []
+    for parameter, term in query.bind(values).items():
+        if query.parameters[parameter].kind != "iri" or not isinstance(term, ox.NamedNode):
+            continue
+        if _mentions(kb, term.value):
+            continue
+        near = near_names(kb, term.value) if "://" in term.value else []
+        hint = f"; did you mean {' or '.join(near)}?" if near else ""
+        notes.append(f"nothing in the store mentions <{term.value}> (bound to {parameter}){hint}")
+    return notes
 
 
 def _name(token: object, table: Mapping[str, str]) -> tuple[str, str | None]:

@@ -104,3 +104,21 @@ def test_the_hint_is_read_from_the_store_only_for_a_prefix_nobody_declared(tmp_p
     error = QuerySyntaxError("SELECT * WHERE { ?s ?p ?o", "error at 1:26: expected '}'")
     explained = explain_syntax_error(error, "SELECT * WHERE { ?s ?p ?o", "query", offered=offered)
     assert "1 '{' not closed" in str(explained)
+
+
+def test_a_named_querys_binding_that_names_nothing_gets_the_clis_note_from_the_library() -> None:
+    """``cbrs query --name ... --bind`` said which bound IRI names nothing; the note was the CLI's own."""
+    from cbrs.unmentioned_names import unmentioned_bindings
+
+    values = {"class": "home:Cup", "room": "world:Kitchn"}
+    bound = ["--bind", "class=home:Cup", "--bind", "room=world:Kitchn"]
+    result = CliRunner().invoke(cli, ["--store", ":memory:", "query", "--name", "things_in_room", *bound])
+    kitchn = "https://w3id.org/cbrs/world#Kitchn"
+    note = f"nothing in the store mentions <{kitchn}> (bound to room); did you mean world:Kitchen?"
+    assert result.stderr.splitlines() == [f"note: {note}"]
+    kb = KnowledgeBase.open(":memory:")
+    try:
+        assert unmentioned_bindings(kb, "things_in_room", values) == [note]
+        assert unmentioned_bindings(kb, "things_in_room", {**values, "room": "world:Kitchen"}) == []
+    finally:
+        kb.close()
