@@ -180,22 +180,31 @@ class ServiceCalls:
         sent: float,
         timeout: float,
         late: Late | None = None,
+        awaited: bool = True,
     ) -> None:
         """An actuator's call that is still out was given up (its step was halted); ``late`` as for
-        :meth:`timed_out`."""
+        :meth:`timed_out`. Not ``awaited``: its answer is dropped (a Stop abandoned the call), so
+        :meth:`settle` does not wait for it; the service stays busy until it ends all the same."""
         with self._lock:
             entry = self._services.setdefault(service, _Service(component))
             entry.given_up = (pending, sent, timeout)
             self._watch(
-                service, pending, sent + timeout * _late_window(), late or _say_when_late(service, component, timeout)
+                service,
+                pending,
+                sent + timeout * _late_window(),
+                late or _say_when_late(service, component, timeout),
+                awaited,
             )
 
-    def _watch(self, service: str, pending: Future[dict[str, Any]], ends: float, late: Late) -> None:
+    def _watch(
+        self, service: str, pending: Future[dict[str, Any]], ends: float, late: Late, awaited: bool = True
+    ) -> None:
         """Have ``late`` take ``pending`` when it ends, in a thread of its own, and remember the call until
-        then (:meth:`settle`). ``ends``: when the transport ends it at the latest."""
+        then (:meth:`settle`, if ``awaited``). ``ends``: when the transport ends it at the latest."""
         settled = threading.Event()
         self._settling = [entry for entry in self._settling if not entry[2].is_set()]
-        self._settling.append((service, ends, settled))
+        if awaited:
+            self._settling.append((service, ends, settled))
 
         def take(done: Future[dict[str, Any]]) -> None:
             try:

@@ -72,6 +72,10 @@ class NoImplementationError(ActionsError):
         super().__init__(f"no implementation for component {component}")
 
 
+def _not_asked() -> bool:
+    return False
+
+
 class InjectedFault(RuntimeError):
     """Raised inside a component whose failure was injected (``--fail``)."""
 
@@ -83,6 +87,10 @@ class Component(ABC):
         self.iri = iri
         self.outputs: dict[str, Any] = {}
         self.reason = ""  # why the last invocation failed
+        self.stop_asked: Callable[[], bool] = _not_asked
+        """Whether the run was asked to stop (set by the container that starts an invocation): a component
+        whose tick waits long on another process looks between short waits, so a Stop need not wait out the
+        tick, and :meth:`halt` knows the run was stopped rather than timed out."""
 
     def initialise(self, context: Any) -> None:
         """Take the resources the component needs (a simulated world, a knowledge base)."""
@@ -99,6 +107,12 @@ class Component(ABC):
     def halt(self) -> None:
         """Stop an invocation that is still running (on timeout or failover)."""
         return None
+
+    def waiting(self) -> bool:
+        """Whether the invocation under way only waits on another process now (its call is out, unanswered):
+        a Stop then ends it at once (:meth:`halt`) instead of letting it end, since nothing in this process
+        is half done (docs/execution.md, "Stop"). A simulated motion is let end."""
+        return False
 
     def finalise(self) -> None:
         """Release what ``initialise`` took."""
@@ -123,9 +137,11 @@ class Container:
         context: Any = None,
         bus: EventBus | None = None,
         faults: FaultPolicy | None = None,
+        stopping: Callable[[], bool] | None = None,
     ) -> None:
         self._factory = factory
         self._context = context
+        self._stopping = stopping  # whether the run was asked to stop: each invocation started is told
         self.bus = bus or EventBus()
         self._managed: dict[str, Managed] = {}
         self._policy = faults
@@ -174,6 +190,8 @@ class Container:
         self._move(iri, LifecycleState.RUNNING)
         component.outputs = {}
         component.reason = ""
+        if self._stopping is not None:
+            component.stop_asked = self._stopping
         self._check_fault(self._managed[iri])
         component.begin(inputs)
 

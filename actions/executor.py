@@ -28,7 +28,7 @@ class RunStatus(Enum):
     RUNNING = "running"
     SUCCEEDED = "succeeded"
     FAILED = "failed"
-    CANCELLED = "cancelled"  # stopped on request between steps (run_task's ``cancelled``)
+    CANCELLED = "cancelled"  # stopped on request between steps, or during a remote call (run_task's ``cancelled``)
 
 
 class Verifier(Protocol):
@@ -62,7 +62,7 @@ class Uncounted(Protocol):
 @dataclass
 class Attempt:
     component: str
-    outcome: str  # "succeeded" or "failed"
+    outcome: str  # "succeeded", "failed", or "cancelled" (a remote call a Stop abandoned)
     reason: str = ""
     ticks: int = 0
     seconds: float = 0.0  # on the executor's clock (simulated seconds in the simulation)
@@ -240,13 +240,23 @@ class Executor:
         return self.status
 
     def cancel(self, reason: str) -> None:
-        """Stop the run on request: the step under way is aborted and nothing more starts."""
+        """Stop the run on request: the step under way is aborted (its attempt recorded as cancelled) and
+        nothing more starts."""
         if self.status is not RunStatus.RUNNING:
             return
         if self._active is not None:
-            self.container.abort(self._active, reason)
+            iri = self._active
+            self.container.abort(iri, reason)
+            report = self.reports[self._position]
+            report.attempts.append(self._attempt(iri, "cancelled", self.container.reason(iri)))
+            report.outcome = "cancelled"
             self._active = None
         self._finish(RunStatus.CANCELLED, reason)
+
+    def waiting(self) -> bool:
+        """Whether the step under way only waits on another process's answer (``Component.waiting``): a
+        Stop may end it now."""
+        return self._active is not None and self.container.component(self._active).waiting()
 
     def report(self) -> ExecutionReport:
         return ExecutionReport(

@@ -9,6 +9,11 @@ with a reason; nothing it sends can reach the plan unchecked.
 A component that acts (an advertisement with effects or delete effects) whose call was sent and whose step
 then ends without a checked success leaves what its effects would set unknown (:func:`actions.late_answers.unsettle`;
 docs/execution.md, "The belief after a failed step"): the device may have acted, whoever runs it.
+
+A Stop of the run while the call is out ends the wait within :data:`STOP_POLL` seconds, however long the
+tick's wait: the call is abandoned, what it would set made unknown, and its answer dropped when it comes
+(:meth:`RemoteComponent.halt`). The provider is not told: a component's call is a rosbridge service call,
+and the protocol has no cancel for one (only an action's goal has, ``cancel_action_goal``).
 """
 
 from __future__ import annotations
@@ -33,6 +38,7 @@ __all__ = [
     "MAX_CALL_SECONDS",
     "MAX_POLLS",
     "POLL_SECONDS",
+    "STOP_POLL",
     "AnswerRefusedError",
     "RemoteCallError",
     "RemoteComponent",
@@ -48,6 +54,9 @@ MAX_POLLS = 1000
 """A call's timeout is spread over at most this many ticks (a tick waits ``timeout / MAX_POLLS`` when
 that is longer than POLL_SECONDS), so that the executor's bound on a step's ticks (10,000) never cuts
 a call short before its own timeout, however long the timeout."""
+STOP_POLL = 0.1
+"""A tick that waits longer than this (a call's timeout over MAX_POLLS: 0.1 s from a 100 s timeout, 86 s for
+a day's) waits in parts this long, between which it asks whether the run was asked to stop."""
 LATE_WINDOW = 2.0
 """The transport is given this many times the component's timeout: a call the component has given up
 stays open at the bridge for as long again, so that the provider's late answer is still heard and,
@@ -206,7 +215,7 @@ class RemoteComponent(Component):
             self.reason = self.reason or "not started"
             return Status.FAILED
         try:
-            values = pending.result(timeout=max(POLL_SECONDS, self.timeout / MAX_POLLS))
+            values = self._result(pending, max(POLL_SECONDS, self.timeout / MAX_POLLS))
         except FutureTimeout:
             if self._clock() < self._deadline:
                 return Status.RUNNING
@@ -223,6 +232,22 @@ class RemoteComponent(Component):
         self._pending = None
         self._calls.answered(self.service)
         return self._accept(values)
+
+    def _result(self, pending: Future[dict[str, Any]], wait: float) -> dict[str, Any]:
+        """``pending``'s answer, waited for ``wait`` seconds at most, in parts of :data:`STOP_POLL`: a Stop of
+        the run asked meanwhile ends the wait (``FutureTimeout``), so the run need not wait out the tick."""
+        end = time.monotonic() + wait
+        while True:
+            left = end - time.monotonic()
+            try:
+                return pending.result(timeout=max(0.0, min(left, STOP_POLL)))
+            except FutureTimeout:
+                if left <= STOP_POLL or self.stop_asked():
+                    raise
+
+    def waiting(self) -> bool:
+        pending = self._pending
+        return pending is not None and not pending.done()
 
     def _accept(self, values: Any) -> Status:
         try:
@@ -312,8 +337,13 @@ class RemoteComponent(Component):
         )
 
     def halt(self) -> None:
-        """The step was stopped while the call was out (a cancelled run, the executor's tick bound)."""
+        """The step was stopped while the call was out: by the executor's tick bound or the run's end (what
+        the call would set is unknown; an actuator's late answer settles it), or by a Stop of the run
+        (:meth:`_abandon`)."""
         pending = self._pending
+        if pending is not None and not pending.done() and self.stop_asked():
+            self._abandon(pending)
+            return
         if pending is not None and self.exclusive and not pending.done() and self.kb is not None:
             self._sent_call = False  # given up: its late answer settles the belief
         if pending is not None:
@@ -322,6 +352,22 @@ class RemoteComponent(Component):
             self._calls.released(self.service)
             if self.exclusive:
                 self._calls.given_up(self.service, self.iri, pending, self._sent, self.timeout, self._late())
+        self._fail()
+
+    def _abandon(self, pending: Future[dict[str, Any]]) -> None:
+        """A Stop of the run while the call was out: the call is abandoned. What it would set becomes unknown,
+        as for a call of a component deregistered meanwhile: the provider may act on it, in full or in part,
+        and nothing will say how far, since its answer is dropped when it comes (the run that asked for it
+        has ended: rosbridge_suite drops an answer no call awaits too), and a service call cannot be cancelled
+        over the rosbridge protocol. An actuator's service still takes no new call from this process until
+        that answer comes or the bridge ends the call (:func:`given_up`), since the device may be executing it."""
+        self._unsettle("the run was stopped while its call was out (the call was abandoned)")
+        self._calls.released(self.service)
+        dropped = _dropped(self.iri, self.service)
+        if self.exclusive:
+            self._calls.given_up(self.service, self.iri, pending, self._sent, self.timeout, dropped, awaited=False)
+        else:
+            pending.add_done_callback(dropped)
         self._fail()
 
     def _unsettle(self, reason: str) -> None:
@@ -335,6 +381,22 @@ class RemoteComponent(Component):
                 self.classes,
                 SentAndFailed(self.iri, self.service, reason, self._inputs, self.effects, self.deletes),
             )
+
+
+def _dropped(component: str, service: str) -> Callable[[Future[dict[str, Any]]], None]:
+    """What becomes of the answer to a call a Stop abandoned: it is logged, and nothing else."""
+
+    def dropped(done: Future[dict[str, Any]]) -> None:
+        error = None if done.cancelled() else done.exception()
+        what = "answered" if not done.cancelled() and error is None else f"ended ({error or 'cancelled'})"
+        log.info(
+            "%s (%s) %s after the run that called it was stopped: dropped; what it would set stays unknown",
+            component,
+            service,
+            what,
+        )
+
+    return dropped
 
 
 def given_up(transport: Transport, service: str, clock: Callable[[], float] = time.monotonic) -> str:

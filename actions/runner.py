@@ -295,8 +295,10 @@ def run_task(
     preconditions. At most ``max_replans`` times; each replaced plan is kept in the result with its
     reason. ``faults`` fail whenever invoked; ``fault_policy`` (e.g. ``RandomFaults``) may break others.
     ``cancelled`` is asked before the first step and whenever a step's attempt ends, succeeded or failed:
-    once it says True the run stops there (status cancelled), with no alternative tried and no re-plan; a
-    step under way is never cut short.
+    once it says True the run stops there (status cancelled), with no alternative tried and no re-plan. A
+    step under way is not cut short, but for a remote call out: that is asked every tick (and between a
+    tick's short waits), and abandoned at once, what it would set made unknown and its answer dropped
+    (``RemoteComponent.halt``).
     ``replan_policy`` says what a re-plan does about a failure nothing has changed since (the same
     component, inputs and kind of failure, with the things it depended on believed where they were):
     compose without its component first, and repeat it at most ``max_repeats`` times, else stop with
@@ -316,7 +318,7 @@ def run_task(
         bus.subscribe("*", on_event)
     failing = FixedFaults.of(faults)
     policy = failing if fault_policy is None else Combined((failing, fault_policy))
-    container = Container(environment.registry, environment.context, bus, policy)
+    container = Container(environment.registry, environment.context, bus, policy, stopping=cancelled)
     belief = BeliefState(kb)
     _perceive(environment)
     before = belief.snapshot()
@@ -394,6 +396,8 @@ def run_task(
                 if _attempts(executor) != ended:  # a step's attempt ended, however: a Stop takes effect now
                     ended = _attempts(executor)
                     _stop_if_cancelled(executor, cancelled, done)
+                elif executor.waiting():  # a remote call out: a Stop ends the wait now
+                    _stop_if_cancelled(executor, cancelled, done, "; the remote call under way was abandoned")
             report = executor.run(max_ticks)  # ends a run that hit max_ticks; otherwise just the report
             outputs = executor.results
             if report.status is not RunStatus.FAILED or len(replans) >= max_replans:
@@ -915,12 +919,13 @@ def _missing(kb: KnowledgeBase, index: TaxonomyIndex, placed: set[str], concept:
     return any(row["thing"].value in placed for top in tops for row in kb.select("designate", {"class": top}))
 
 
-def _stop_if_cancelled(executor: Executor, cancelled: Callable[[], bool] | None, done: int) -> None:
-    """Before the first step and whenever a step's attempt ends, succeeded or failed: stop the run if asked
-    to (a plan whose steps are all done just finishes). Asked only after successes, a Stop during a step
-    that failed let the executor start the step's next alternative, or the run re-plan, as if unasked."""
+def _stop_if_cancelled(executor: Executor, cancelled: Callable[[], bool] | None, done: int, during: str = "") -> None:
+    """Before the first step, whenever a step's attempt ends, succeeded or failed, and every tick while a
+    remote call is out (``during`` says so): stop the run if asked to (a plan whose steps are all done just
+    finishes). Asked only after successes, a Stop during a step that failed let the executor start the
+    step's next alternative, or the run re-plan, as if unasked."""
     if cancelled is not None and done < len(executor.plan.steps) and cancelled():
-        executor.cancel(f"cancelled on request after {done} of {len(executor.plan.steps)} steps")
+        executor.cancel(f"cancelled on request after {done} of {len(executor.plan.steps)} steps{during}")
 
 
 def _attempts(executor: Executor) -> int:

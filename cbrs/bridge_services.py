@@ -37,7 +37,8 @@ Action (rosbridge's ROS 2 action ops, ``send_action_goal`` and the rest):
   one feedback ``{run, iri, shown, plan, step, action, component, status, reason, failover}`` per plan
   step that ends (``status`` succeeded or failed; ``iri`` and ``shown`` name the run's task as its result
   does); the result is the run as the service returns it, with status
-  SUCCEEDED, CANCELED (the client cancelled: the run stops after the step under way) or ABORTED (the
+  SUCCEEDED, CANCELED (the client cancelled: the run stops after the step under way, or at once during a
+  remote call, which it abandons: docs/execution.md) or ABORTED (the
   run failed, found no plan or broke). A refused goal (no token, unknown task, a run going) fails as
   rosbridge fails a goal: ``result: false``, status UNKNOWN, the reason as ``values``.
 
@@ -224,7 +225,8 @@ class KnowledgeServices:
     def run_task_goal(self, goal: GoalHandle) -> GoalResult:
         """The /cbrs/run_task action: start the run, relay its steps as feedback, wait for its end.
 
-        A cancel asks the run to stop after the step under way. The wait has no deadline of its own:
+        A cancel asks the run to stop after the step under way (at once during a remote call, abandoned:
+        docs/execution.md, "A Stop during a remote call"). The wait has no deadline of its own:
         a run always ends (the executor's tick bound), and a server stopping cancels the goal.
         """
         _check_fields("/cbrs/run_task", _RUN, goal.args)
@@ -238,7 +240,7 @@ class KnowledgeServices:
             feed.follow(run)
 
             def cancel() -> None:
-                self.tasks.cancel(run.id)  # the run stops after the step under way
+                self.tasks.cancel(run.id)  # the run stops after the step under way, or abandons its remote call
 
             goal.on_cancel(cancel)
             run.done.wait()
