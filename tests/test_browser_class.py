@@ -60,3 +60,14 @@ def test_a_run_is_followed_without_a_stream_slot(page: Any) -> None:
     playwright_api.expect(rows).to_have_count(3)  # plan 1's steps 1 and 2, plan 2's step 1
     playwright_api.expect(rows.nth(0)).to_contain_text("→")
     playwright_api.expect(page.locator("#runs tr").first).to_contain_text("succeeded")
+
+
+def test_the_run_and_the_camera_show_on_a_projectors_first_screen(page: Any) -> None:
+    """At 1280 x 720 the start form's eight fields, stacked, filled the screen; the run panel and the camera
+    began below it (at about 1,100 px). The options a class rarely changes are folded under More options."""
+    page.goto("/tasks")
+    top = page.locator("#live").evaluate("node => node.getBoundingClientRect().top")
+    assert top < page.viewport_size["height"]
+    assert not page.locator("#fault_rate").is_visible()
+    page.locator("#more-options summary").click()
+    assert page.locator("#fault_rate").is_visible()

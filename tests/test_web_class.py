@@ -177,3 +177,14 @@ def test_a_page_stops_only_the_runs_its_own_computer_started(bundled_kb: Knowled
         assert client.post(f"/tasks/{own}/cancel.json", environ_base=student).status_code == 202
     finally:
         runner.release.set()
+
+
+def test_more_options_open_when_one_of_them_is_wrong_or_set(bundled_kb: KnowledgeBase) -> None:
+    service = SparqlService(bundled_kb)
+    client = create_app(service, tasks=_Held(bundled_kb, service.lock)).test_client()
+    folded = client.get("/tasks").get_data(as_text=True)
+    assert '<details class="more-options" id="more-options">' in folded
+    wrong = client.post("/tasks", data={"task": "FetchMyPen", "fault_rate": "2"}, headers={"Accept": "text/html"})
+    assert wrong.status_code == 400
+    assert '<details class="more-options" id="more-options" open>' in wrong.get_data(as_text=True)
+    assert 'id="more-options" open>' in client.get("/tasks?objective=cost").get_data(as_text=True)
