@@ -155,7 +155,8 @@ def test_resource_html_links_every_iri(client: FlaskClient) -> None:
     [
         pytest.param({"iri": "svc:NoSuchService"}, 404, "NotFoundError", id="unknown"),
         pytest.param({}, 400, "bad-request", id="missing"),
-        pytest.param({"iri": "nope:X"}, 404, "NotFoundError", id="unknown-scheme"),  # an absolute IRI
+        pytest.param({"iri": "nope:X"}, 400, "bad-request", id="unknown-prefix"),  # no IRI of scheme nope
+        pytest.param({"iri": "urn:example:x"}, 404, "NotFoundError", id="unknown-urn"),  # an absolute IRI
         pytest.param({"iri": "  "}, 400, "bad-request", id="blank"),
         pytest.param({"iri": "http://example.org/a b"}, 400, "bad-request", id="malformed"),
     ],
