@@ -12,9 +12,11 @@ A parameter's value is substituted for the variable of the same name by Oxigraph
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
+from decimal import Decimal
 from pathlib import Path
 from typing import Any
 
@@ -64,19 +66,44 @@ class NamedQuery:
 
 
 def to_term(parameter: Parameter, value: Term | str | int | float) -> Term:
-    """The RDF term for ``value`` as the parameter's kind reads it (``svc:X`` or a full IRI for iri)."""
+    """The RDF term for ``value`` as the parameter's kind reads it (``svc:X`` or a full IRI for iri). A term
+    given is taken when it is of the parameter's kind: a literal bound to an IRI parameter (``"home:Cup"``
+    as ``ox.Literal``) matched nothing, and a number bound to an integer one lost its fraction, without a
+    word; each is a :class:`BindingError` naming the parameter and the value."""
     if isinstance(value, ox.NamedNode | ox.BlankNode | ox.Literal):
+        if (parameter.kind == "iri") != (not isinstance(value, ox.Literal)):
+            given, wanted = ("a literal", "IRI") if isinstance(value, ox.Literal) else ("an IRI", parameter.kind)
+            raise BindingError(parameter.name, value, f"{given}, where the query takes {_article(wanted)}")
         return value
     try:
         if parameter.kind == "iri":  # white space around an IRI is a paste's, never the IRI's (IRIs have none)
             return ox.NamedNode(expand(str(value).strip()))
         if parameter.kind == "integer":
-            return ox.Literal(str(int(value)), datatype=ox.NamedNode(XSD + "integer"))
+            return ox.Literal(str(_whole(value)), datatype=ox.NamedNode(XSD + "integer"))
         if parameter.kind == "decimal":
-            return ox.Literal(str(float(value)), datatype=ox.NamedNode(XSD + "decimal"))
+            number = float(value)
+            if not math.isfinite(number) or isinstance(value, bool):
+                raise ValueError(f"{value!r} is no finite number")
+            # xsd:decimal has no exponent: 1e-05 is written 0.00001
+            return ox.Literal(format(Decimal(repr(number)), "f"), datatype=ox.NamedNode(XSD + "decimal"))
         return ox.Literal(str(value))
     except ValueError as error:
         raise BindingError(parameter.name, value, f"not a valid {parameter.kind}: {error}") from error
+
+
+def _article(kind: str) -> str:
+    return f"an {kind}" if kind[0] in "aeiouAEIOU" else f"a {kind}"
+
+
+def _whole(value: str | int | float) -> int:
+    """``value`` as a whole number: ``3``, ``"3"`` and ``3.0`` are, ``3.7`` is refused (``int`` cut it to 3)."""
+    if isinstance(value, bool):
+        raise ValueError(f"{value!r} is a truth value")
+    if isinstance(value, float):
+        if not value.is_integer():
+            raise ValueError(f"{value!r} is not a whole number")
+        return int(value)
+    return int(value)
 
 
 class QueryLibrary:
