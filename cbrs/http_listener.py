@@ -177,6 +177,8 @@ class HttpListener:
             raise OSError(f"the HTTP listener did not start within {timeout:g} s")
         if self._failed is not None:
             self._thread.join(timeout)
+            if self.access is not None:
+                self.access.close()  # its thread too: a listener that never started is not stopped
             raise self._failed
         self._await_listen(timeout)
 
