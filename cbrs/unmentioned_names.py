@@ -23,6 +23,7 @@ from cbrs.sparql_hints import TOKENS
 
 if TYPE_CHECKING:
     from cbrs.kb import KnowledgeBase
+    from cbrs.kb.store import Term
 
 __all__ = ["unmentioned_bindings", "unmentioned_names"]
 
@@ -60,7 +61,7 @@ def unmentioned_names(kb: KnowledgeBase, text: str, prefixes: Mapping[str, str] 
     return list(notes.values())
 
 
-def unmentioned_bindings(kb: KnowledgeBase, name: str, values: Mapping[str, object]) -> list[str]:
+def unmentioned_bindings(kb: KnowledgeBase, name: str, values: Mapping[str, Term | str | int | float]) -> list[str]:
     """A note for each IRI bound to a parameter of the named query ``name`` that the store mentions nowhere,
     in the order of ``values``: "nothing in the store mentions <...#DynamicPerceptonComponent> (bound to
     kind); did you mean cbrs:DynamicPerceptionComponent?". A misspelt class bound so gave "(0 rows)" and
