@@ -96,3 +96,16 @@ def test_a_place_that_is_a_movable_object_is_refused_as_such() -> None:
     assert "onto the Tray1 (the task's tray)" in str(error) and "under home:Furniture and home:ObjectPlace" in str(
         error
     )
+
+
+def test_a_hands_own_payload_is_read_where_the_property_is_declared() -> None:
+    """``home:payloadKg`` on a gripper is read as its other values are; a hand that states none lifts the
+    Panda's 3 kg. The property is declared here, as ontologies/home.ttl is to declare it."""
+    kb = KnowledgeBase.open(":memory:")
+    kb.update("INSERT DATA { GRAPH graph:ontology { home:payloadKg a owl:DatatypeProperty ; rdfs:range xsd:double } }")
+    kb.update("INSERT DATA { GRAPH graph:map { world:CytonDualArm01RightHand home:payloadKg 5.0 } }")
+    hands = SemanticMap.read(kb).hands
+    assert {iri.rsplit("#", 1)[1]: hand.payload for iri, hand in hands.items()} == {
+        "CytonDualArm01LeftArm": 3.0,
+        "CytonDualArm01RightArm": 5.0,
+    }
