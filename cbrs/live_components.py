@@ -82,6 +82,12 @@ SERVER_NAMESPACES = ("/cbrs/", "/rosapi/")
 STALL_PERIODS = 4
 """A gap of more than this many watchdog periods (1 s at the default lease) between two moments this
 server kept time means it stood still (stopped, suspended, starved): no lease is charged for it."""
+SHARED_LOOK = 1.0
+"""Seconds between a server's looks at the liveness graph of a store other servers write too (a remote
+store), whose writes no listener of this one hears: a lease another server's restore put back stale is
+stated again, and a component deregistered through another server ends, within this and a watchdog
+period, rather than at the lease's next store write (half a lease and a beat). One look is one read of
+the liveness graph, and none while this server holds no lease."""
 ENDED_SESSIONS = 1024
 """Sessions whose ended components a heartbeat can still name (an HTTP lease never disconnects)."""
 
@@ -164,9 +170,12 @@ class LiveComponents:
         name: str = "cbrs",
         clock: Callable[[], float] = time.monotonic,
         provided: Callable[[str], bool] | None = None,
+        shared_look: float = SHARED_LOOK,
     ) -> None:
         if ttl <= 0:
             raise ValueError(f"a lease must last a positive time, not {ttl!r} s")
+        if not shared_look > 0:
+            raise ValueError(f"a shared store's liveness must be looked at every positive time, not {shared_look!r} s")
         self.sparql = sparql
         self.ttl = ttl
         self.name = name
@@ -187,6 +196,7 @@ class LiveComponents:
         self._unwatch: Callable[[], None] | None = None
         self._watchdog: threading.Thread | None = None
         self._period = min(0.25, ttl / 4)  # the watchdog's
+        self.shared_look = shared_look
         self._seen = clock()  # when this server last kept time (the watchdog, a registration, a heartbeat)
         self._stood_still = 0.0  # seconds this server did not run, which no lease is charged
 
@@ -435,7 +445,28 @@ class LiveComponents:
         puts back may have ended meanwhile (or be of a session that has since gone); an update of the
         liveness graph. The store is written with the lease's remaining time; a component the store no
         longer registers is left to :meth:`forget_deregistered`. Returns the components written again."""
-        written = []
+        return self._restate()[0]
+
+    def look(self) -> list[str]:
+        """What :meth:`restate` does, and end the leases of the components whose liveness facts and
+        description are both gone (``cbrs deregister`` removes both): the watchdog's look at a store other
+        servers write too, every :data:`SHARED_LOOK` seconds. Returns the components whose lease ended."""
+        _, unregistered = self._restate()
+        if not unregistered:
+            return []
+        with self._guard:
+            sessions = {iri: self._leases[iri].session for iri in unregistered if iri in self._leases}
+        self._deregistered(sessions)
+        return sorted(sessions)
+
+    def _restate(self) -> tuple[list[str], list[str]]:
+        """:meth:`restate`'s writes, and the leased components whose liveness facts are gone and which the
+        store no longer registers."""
+        written: list[str] = []
+        unregistered: list[str] = []
+        with self._guard:
+            if not self._leases:
+                return written, unregistered
         with self.sparql.lock:
             kb = self.sparql.kb
             states = kb.liveness.states()
@@ -448,6 +479,8 @@ class LiveComponents:
                 ]
             for iri, lease in due:
                 if not kb.registry.is_registered(iri):
+                    if iri not in states:
+                        unregistered.append(iri)
                     continue
                 left = lease.deadline - now
                 lease.stored = kb.liveness.renew(iri, left, registered_by=self._registered_by(lease.session))
@@ -457,7 +490,7 @@ class LiveComponents:
                 self._changed()
         if written:
             log.info("%s: the store said otherwise of its lease; written again", ", ".join(written))
-        return written
+        return written, unregistered
 
     def _changed(self) -> None:
         """Tell the store's listeners of a write of ours (with the store's lock held): our own listener
@@ -588,6 +621,8 @@ class LiveComponents:
             self._watchdog = None
 
     def _watch(self) -> None:
+        shared = not isinstance(self.sparql.kb.store, EmbeddedStore)  # other servers write it unheard
+        looked = time.monotonic()
         while not self._stop.is_set():
             written = self._written.wait(self._period)
             if self._stop.is_set():
@@ -597,6 +632,9 @@ class LiveComponents:
                 self.expire_lapsed()
                 if written:
                     self.forget_deregistered()
+                if shared and time.monotonic() - looked >= self.shared_look:
+                    looked = time.monotonic()
+                    self.look()
             except Exception:  # the watchdog must outlive a failed write
                 log.exception("ending lapsed or deregistered leases failed")
 
