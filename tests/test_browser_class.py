@@ -8,6 +8,7 @@ Chromium or Playwright is missing, as ``tests/test_browser.py`` is.
 
 from __future__ import annotations
 
+import threading
 from collections.abc import Iterator
 from typing import Any
 
@@ -16,6 +17,7 @@ import pytest
 import cbrs.server
 from cbrs.kb import KnowledgeBase
 from cbrs.server import ServeConfig, Server
+from cbrs.tasks import TaskRun
 from cbrs.web.context import StreamSlots
 from tests.test_browser import CHROMIUM, FLAGS, WAIT_MS, pytestmark  # noqa: F401  (the same skip)
 from tests.test_browser_phone_and_live_steps import _Scripted
@@ -23,10 +25,23 @@ from tests.test_browser_phone_and_live_steps import _Scripted
 playwright_api = pytest.importorskip("playwright.sync_api", reason="Playwright is not installed (pip install .[test])")
 
 
+class _Holding(_Scripted):
+    """The scripted run, held before it starts while ``hold`` is clear (a run going, for a second Start)."""
+
+    hold = threading.Event()
+
+    def _run(self, run: TaskRun) -> None:
+        _Holding.hold.wait(WAIT_MS / 1000)
+        super()._run(run)
+
+
+_Holding.hold.set()
+
+
 @pytest.fixture(scope="module")
 def server() -> Iterator[Server]:
     with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(cbrs.server, "TaskRunner", _Scripted)
+        patch.setattr(cbrs.server, "TaskRunner", _Holding)
         running = Server(KnowledgeBase.open(":memory:"), ServeConfig(port=0, bridge_port=0))
     running.app.extensions["cbrs.streams"] = StreamSlots(limit=0)  # the class holds every slot
     running.start()
@@ -71,3 +86,21 @@ def test_the_run_and_the_camera_show_on_a_projectors_first_screen(page: Any) -> 
     assert not page.locator("#fault_rate").is_visible()
     page.locator("#more-options summary").click()
     assert page.locator("#fault_rate").is_visible()
+
+
+def test_a_second_start_says_which_run_goes_and_what_to_do(page: Any) -> None:
+    """The script wrote "task run run-2 is still going; one task runs at a time run-2", the link run on after
+    the sentence; the page's own refusal says to follow that run, then start again."""
+    page.goto("/tasks")
+    _Holding.hold.clear()
+    try:
+        page.locator("#start-button").click()
+        playwright_api.expect(page.locator("#run-status")).to_have_text("running")
+        page.locator("#start-button").click()
+        refused = page.locator("p.error-box.form-message")
+        playwright_api.expect(refused).to_contain_text("one task runs at a time: follow run-")
+        playwright_api.expect(refused).to_contain_text(", then start again.")
+        assert refused.locator("a").get_attribute("href").startswith("/tasks/run-")
+    finally:
+        _Holding.hold.set()
+    playwright_api.expect(page.locator("#run-status")).to_have_text("succeeded")

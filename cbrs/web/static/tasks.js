@@ -341,8 +341,11 @@
             if (field) field.after(el("span", { class: "field-error", id: name + "-error", role: "alert" }, text));
           }
         } else {
-          const link = data.running ? el("a", { href: live.dataset.runs + "/" + data.running }, data.running) : "";
-          note = el("p", { class: "error-box form-message", role: "alert" }, data.message + " ", link);
+          // as the page words a refused Start (tasks.html): the run going, and what to do
+          const said = data.running
+            ? [data.message + ": follow ", el("a", { href: live.dataset.runs + "/" + data.running }, data.running), ", then start again."]
+            : [data.message];
+          note = el("p", { class: "error-box form-message", role: "alert" }, ...said);
         }
         if (note) form.before(note);
       } finally {
