@@ -40,6 +40,7 @@ from pyoxigraph import NamedNode
 
 from cbrs.actions.errors import ActionsError
 from cbrs.kb import KnowledgeBase, Statement
+from cbrs.kb.name_errors import UnknownPrefixError
 from cbrs.kb.namespaces import expand, shorten
 
 __all__ = [
@@ -49,9 +50,11 @@ __all__ = [
     "Reading",
     "StoreClasses",
     "UnitInTextError",
+    "UnknownTypeError",
     "WrongThingError",
     "check_designation",
     "check_quantities",
+    "class_named",
     "read_answer",
 ]
 
@@ -87,6 +90,28 @@ class ContradictedEffectError(ActionsError):
             f" {shorten(effect.object)}; nothing of the answer is believed (a handler that could not act should"
             " raise instead; docs/execution.md)"
         )
+
+
+class UnknownTypeError(ActionsError, ValueError):
+    """A value's ``@type`` that names no class: a prefix nobody declared (``hom:Cup``, with the prefixes
+    nearest it) or none at all. Taken as typed, it was of no class the store knows, and the value matched
+    nothing without a word. Keeps the ``@type`` as ``written``; a ``ValueError``, as every name that does
+    not read is."""
+
+    def __init__(self, written: str, reason: str) -> None:
+        self.written = written
+        super().__init__(f"the '@type' {written!r} names no class: {reason}")
+
+
+def class_named(written: str) -> str:
+    """The class ``written`` (a value's ``@type``: an IRI or a prefixed name) names, in full;
+    :class:`UnknownTypeError` when it names none."""
+    try:
+        return expand(written)
+    except UnknownPrefixError as error:
+        raise UnknownTypeError(written, error.reason) from error
+    except ValueError as error:
+        raise UnknownTypeError(written, "no IRI and no prefixed name") from error
 
 
 class WrongThingError(ActionsError, ValueError):
@@ -192,14 +217,12 @@ def read_answer(
 
 
 def _class_of(value: Any) -> str | None:
-    """The class a value names by its ``@type`` (expanded), if it names one."""
+    """The class a value names by its ``@type`` (expanded), None for a value with none;
+    :class:`UnknownTypeError` for an ``@type`` that names no class."""
     written = value.get("@type") if isinstance(value, dict) else None
     if not isinstance(written, str) or not written:
         return None
-    try:
-        return expand(written)
-    except ValueError:
-        return written
+    return class_named(written)
 
 
 @dataclass

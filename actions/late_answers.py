@@ -50,7 +50,7 @@ from typing import Any
 
 import pyoxigraph as ox
 
-from cbrs.actions.answers import Classes
+from cbrs.actions.answers import Classes, class_named
 from cbrs.actions.belief import Fact, Pair, believed, correct
 from cbrs.actions.breaker import Late
 from cbrs.actions.errors import ActionsError
@@ -58,7 +58,7 @@ from cbrs.actions.qualities import OwnQualities
 from cbrs.actions.remote_errors import RemoteCallError
 from cbrs.kb import KnowledgeBase, KnowledgeBaseError, Statement
 from cbrs.kb.errors import NotFoundError
-from cbrs.kb.namespaces import expand, shorten
+from cbrs.kb.namespaces import shorten
 
 __all__ = ["GivenUp", "SentAndFailed", "unsettle", "watch"]
 
@@ -222,12 +222,12 @@ def _thing(
 
 
 def _given_as(value: Mapping[str, Any]) -> Iterable[str]:
+    """The class an input names by its ``@type``; :class:`~actions.answers.UnknownTypeError` for one that
+    names none (it was dropped, and the input grounded no effect without a word: :func:`watch` and
+    :func:`unsettle` now say which type)."""
     written = value.get("@type")
     if isinstance(written, str):
-        try:
-            yield expand(written)
-        except ValueError:
-            return
+        yield class_named(written)
 
 
 def _settle(

@@ -43,13 +43,12 @@ from cbrs.app import App, parse_iri, pass_app
 from cbrs.extras import installed, require
 from cbrs.kb import Advertisement, KnowledgeBase, RemoteStoreError
 from cbrs.kb.errors import KnowledgeBaseError
-from cbrs.kb.name_errors import UnknownPrefixError
-from cbrs.kb.namespaces import expand, shorten
+from cbrs.kb.namespaces import shorten
 from cbrs.kb.semantic_map import SemanticMap, UnresolvedDesignatorError
 from cbrs.kb.store import Term
 from cbrs.output import table
 from cbrs.settings import setting
-from cbrs.task_names import TaskNameError, task_iri
+from cbrs.task_names import task_iri
 
 if TYPE_CHECKING:
     from cbrs.bridge_client import BridgeClient
@@ -122,22 +121,6 @@ _OBJECTIVE = click.option(
 )
 
 
-def _task_iri(kb: KnowledgeBase, task: str, actions: ActionLibrary) -> str:
-    """The task ``task`` names (:func:`cbrs.task_names.task_iri`); one typed with a prefix nobody declared
-    (``rq:FetchMyPen``) is refused saying so too, with the prefixes nearest it, as every other command's
-    name is: the did-you-mean of local names alone did not say what was wrong with it."""
-    try:
-        return task_iri(kb, task, actions)
-    except TaskNameError as error:
-        try:
-            expand(task.strip())
-        except UnknownPrefixError as unknown:
-            error.add_note(unknown.reason)
-        except ValueError:
-            pass
-        raise
-
-
 def _compose_config(
     ignore_areas: bool, protect: bool, max_reachieved: int, near_misses: int, **more: Any
 ) -> ComposeConfig:
@@ -204,7 +187,7 @@ def plan(
     if drawing is not None and drawing.suffix.lower() not in (".svg", ".png"):
         raise click.BadParameter(f"{drawing.name!r} must end in .svg or .png", param_hint="--draw")
     actions = ActionLibrary.from_kb(app.kb)  # read once: the task's name and the composer take it
-    requested = _task_iri(app.kb, task, actions)  # an unknown name is refused before the composer reads the store
+    requested = task_iri(app.kb, task, actions)  # an unknown name is refused before the composer reads the store
     config = _compose_config(ignore_areas, protect, max_reachieved, near_misses, objective=Objective(objective))
     composer = Composer(app.kb, config, actions=actions)
     facts = app.kb.select("map_facts")  # read once: the bases, and what the map lacks
@@ -589,7 +572,7 @@ def run(
             raise click.BadParameter(str(error), param_hint="--record") from None
     failing = [parse_iri(f, "--fail") for f in faults]
     actions = ActionLibrary.from_kb(app.kb)  # read once: the task's name and the composer take it
-    iri = _task_iri(app.kb, task, actions)  # an unknown task fails before the world is built
+    iri = task_iri(app.kb, task, actions)  # an unknown task fails before the world is built
     if failing:
         _check_failing(app.kb, failing, bridged=bridge is not None)  # so does a mistyped --fail
 

@@ -19,22 +19,35 @@ from cbrs.actions.errors import UnknownTaskError
 from cbrs.actions.model import ActionLibrary
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.derived_prefixes import namespace
+from cbrs.kb.name_errors import UnknownPrefixError
 from cbrs.kb.namespaces import expand, written
 from cbrs.kb.owls import local_name
 
 
 class TaskNameError(UnknownTaskError):
-    """No task (or more than one) answers to ``name``; ``suggestions`` are the likeliest meant."""
+    """No task (or more than one) answers to ``name``; ``suggestions`` are the likeliest meant.
+    ``prefix_reason`` is what is wrong with the prefix ``name`` was typed with, when nobody declared it
+    (:attr:`~cbrs.kb.name_errors.UnknownPrefixError.reason`, with the prefixes nearest it): part of the
+    message, not a note, since the pages show a message alone."""
 
-    def __init__(self, name: str, known: Sequence[str], suggestions: Sequence[str], ambiguous: bool = False) -> None:
+    def __init__(
+        self,
+        name: str,
+        known: Sequence[str],
+        suggestions: Sequence[str],
+        ambiguous: bool = False,
+        prefix_reason: str | None = None,
+    ) -> None:
         super().__init__(name, known)
         self.suggestions = tuple(suggestions)
         self.ambiguous = ambiguous
+        self.prefix_reason = prefix_reason
         if ambiguous:
             text = f"{name!r} names {len(suggestions)} tasks; type one of {', '.join(suggestions)}"
         else:
+            why = f" ({prefix_reason})" if prefix_reason else ""
             hint = f"; did you mean {' or '.join(suggestions)}?" if suggestions else "."
-            text = f"no requirement or action named {name!r}{hint} Known tasks: {', '.join(known)}"
+            text = f"no requirement or action named {name!r}{why}{hint} Known tasks: {', '.join(known)}"
         self.args = (text,)
 
     def __str__(self) -> str:
@@ -48,12 +61,16 @@ class _Task:
 
 
 def task_iri(kb: KnowledgeBase, name: str, library: ActionLibrary | None = None) -> str:
-    """The IRI of the requirement or action ``name`` means; :class:`TaskNameError` when there is none."""
+    """The IRI of the requirement or action ``name`` means; :class:`TaskNameError` when there is none (a
+    prefix nobody declared, ``rq:FetchMyPen``, named in it with the prefixes nearest it)."""
     tasks = _tasks(kb, library or ActionLibrary.from_kb(kb))
     typed = name.strip()
+    prefix_reason = None  # rq:FetchMyPen: the local names' did-you-mean alone did not say the prefix is wrong
     if ":" in typed:
         try:
             iri = expand(typed)
+        except UnknownPrefixError as unknown:
+            iri, prefix_reason = "", unknown.reason
         except ValueError:
             iri = ""
         if any(task.iri == iri for task in tasks):
@@ -65,7 +82,7 @@ def task_iri(kb: KnowledgeBase, name: str, library: ActionLibrary | None = None)
         named = sorted(task.iri for task in tasks if local_name(task.iri) == typed)
         if named:
             raise TaskNameError(name, _known(tasks), [_typed(iri, tasks) for iri in named], ambiguous=True)
-    raise TaskNameError(name, _known(tasks), _suggestions(typed, tasks))
+    raise TaskNameError(name, _known(tasks), _suggestions(typed, tasks), prefix_reason=prefix_reason)
 
 
 def known_tasks(kb: KnowledgeBase, library: ActionLibrary | None = None) -> list[str]:

@@ -13,11 +13,11 @@ from flask import Blueprint, current_app, request, url_for
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import NotFoundError
 from cbrs.kb.model import Advertisement, Requirement
-from cbrs.kb.namespaces import RDF, RDFS, expand
+from cbrs.kb.namespaces import RDF, RDFS
 from cbrs.kb.store import Term
 from cbrs.kb.vocab import CBRS
 from cbrs.web import context, resource
-from cbrs.web.links import RESOURCE_ENDPOINT, display_text, short
+from cbrs.web.links import RESOURCE_ENDPOINT, display_text, expand_name, short
 from cbrs.web.meets import INLINE_ADVERTISEMENTS, requirements_met, shown_inline
 from cbrs.web.pages import FormError, Page, page
 
@@ -49,10 +49,16 @@ def services() -> Page:
     shown = Page("services.html", "Services", data)
     given = (request.args.get("kind") or "").strip()
     if given:
-        kind = _kind(given)
+        try:
+            kind = _kind(given)
+        except ValueError as error:  # hom:Camera: the prefix is what is wrong, and its did-you-mean says so
+            data["kind"] = given
+            raise FormError({"kind": str(error)}, page=shown) from None
         if kind not in kinds:
-            known = ", ".join(short(k) for k in sorted(kinds))
-            message = f"no advertisement is of kind {given!r}; the kinds are {known}"
+            names = {short(k): k for k in kinds}
+            near = difflib.get_close_matches(short(kind), list(names), n=1)
+            meant = f"; did you mean {near[0]}? The kinds are" if near else "; the kinds are"
+            message = f"no advertisement is of kind {given!r}{meant} {', '.join(sorted(names))}"
             data["kind"] = given
             raise FormError({"kind": message}, page=shown)
         data["kind"] = kind
@@ -77,11 +83,10 @@ def _paged(data: dict[str, Any], rows: list[dict[str, Any]], shown: Page) -> Non
 
 
 def _kind(given: str) -> str:
-    """A kind as typed: a prefixed name, an IRI, or a bare name in the core namespace."""
-    try:
-        return expand(given if ":" in given else "cbrs:" + given)
-    except ValueError:
-        return given
+    """A kind as typed: a prefixed name (a derived prefix too), an IRI, or a bare name in the core namespace;
+    ``ValueError`` (:class:`~cbrs.kb.name_errors.UnknownPrefixError` for ``hom:Camera``) for a name that is
+    none: it was taken as typed, and the list said only that no advertisement was of that kind."""
+    return expand_name(given if ":" in given else "cbrs:" + given)
 
 
 @page(blueprint, "/service")
