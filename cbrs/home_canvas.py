@@ -14,7 +14,7 @@ from cbrs.kb.semantic_map import Box
 MARGIN = 44  # px around the plan: the metre ticks on the left and below
 _LEGEND_ROW = 26
 FONT = "DejaVu Sans, Helvetica, Arial, sans-serif"
-INK, MUTED = "#1d2330", "#5d6778"
+INK, MUTED = "#1d2330", "#474f5e"  # MUTED: the pages' --muted, 7:1 on every room fill (a projector)
 ROOM_FILLS = ("#eaf2fb", "#f1edf9", "#eaf6ee", "#fbf3e6", "#f8ebf0", "#e8f5f5")
 CAMERA_INKS = ("#c2410c", "#7c3aed", "#0e7490", "#be185d", "#4d7c0f")
 FURNITURE = ("#ead8b9", "#8a5a2b")

@@ -12,6 +12,7 @@ import pytest
 from flask.testing import FlaskClient
 
 import cbrs.web
+from cbrs import home_canvas
 from cbrs.kb import KnowledgeBase
 from cbrs.sparql_service import EndpointBusyError, EndpointConfig, QueryTimeoutError, SparqlService
 from cbrs.tasks import CameraFrame, TaskRunner
@@ -111,6 +112,7 @@ def test_the_pages_colours_read_on_a_projector() -> None:
         pairs.append((root[text], ground.group(1)))
     pairs.append(("#ffffff", root["accent"]))  # a button's label
     pairs += [(ink, fill) for fill, _, ink in diagram.COLOURS.values()]  # the pictures' boxes
+    pairs += [(home_canvas.MUTED, fill) for fill in ("#ffffff", *home_canvas.ROOM_FILLS)]  # the home map's labels
     weak = [(text, ground, round(_contrast(text, ground), 2)) for text, ground in pairs if _contrast(text, ground) < 7]
     assert weak == []
 
