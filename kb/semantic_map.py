@@ -879,6 +879,9 @@ def _check_supports(built: SemanticMap, quoted: set[tuple[str, str]] = set()) ->
         if obj.support is None:
             continue
         support = built.things.get(obj.support)
+        base = next((robot for robot in built.robots.values() if robot.platform == obj.support), None)
+        if base is not None:  # said so with an extent or without: "add an extent" led to a plan that cannot reach it
+            raise MapError(iri, _on_a_platform(obj.support, base))
         if support is None and obj.support in built.objects:
             raise MapError(iri, _on_an_object(obj.support, built.objects[obj.support], built))
         if support is None and (iri, HOME + "isLocatedOn") in quoted:
@@ -955,6 +958,18 @@ def _check_masses(built: SemanticMap) -> None:
             f"weighs {obj.mass:g} kg (home:massKg {obj.mass:g}) in a {obj.shape} of {volume * 1e6:.3g} cm³: "
             f"{obj.mass / volume / 1000:.3g} t/m³, denser than any solid (osmium, {DENSEST / 1000:.3g} t/m³){grams}",
         )
+
+
+def _on_a_platform(platform: str, base: MobileRobot) -> str:
+    """Why a thing cannot start on ``platform``, ``base``'s (home:hasPlatform), and how it gets there. Said as
+    "no extent", a lab gave the platform one: the map loaded, the parcel stood where the base starts, and
+    no plan could reach it (the twentieth round)."""
+    return (
+        f"has home:isLocatedOn {platform}, which is the platform of a mobile base ({base.name}, home:hasPlatform), "
+        "which moves: a thing starts on furniture or a region with an extent; a thing is put on the platform by "
+        "HandOverOntoPlatform (the arms' component whose effect is (home:PhysicalObject, home:isLocatedOn, "
+        "home:RobotPlatform)): start it on furniture, and a task with that effect has it loaded"
+    )
 
 
 def _on_an_object(iri: str, below: MapObject, built: SemanticMap) -> str:

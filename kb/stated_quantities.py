@@ -9,18 +9,20 @@ the thing by it where no sensor reads it: :class:`StatedQuantities`. Only the th
 a class's level (``home:Room`` 300 lx) is the simulated home's stand-in for what its sensors read, not
 knowledge of one thing. Used by a run's preconditions (:mod:`actions.precondition_sensing`) and, where a
 task's class names several things, to tell them apart by what the task guarantees of the one it means
-(:func:`kb.semantic_map.designate`). docs/execution.md, "A thing's quantities stated in the map".
+(:func:`kb.semantic_map.designate`), with the colour each states (:mod:`kb.stated_colours`). docs/execution.md,
+"A thing's quantities stated in the map".
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable, Collection, Iterable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from cbrs.kb.measured_states import MeasuredCondition, MeasuredConditionError, UnitError, Units, conditions_by_status
 from cbrs.kb.namespaces import PREFIXES
+from cbrs.kb.stated_colours import COLOUR, HAS_COLOUR, StatedColours
 
 if TYPE_CHECKING:
     from cbrs.kb.knowledge_base import KnowledgeBase
@@ -57,17 +59,19 @@ class Stated:
 
 @dataclass(frozen=True)
 class StatedQuantities:
-    """The levels the things of the store state, by thing, and the taxonomy's superclasses (each class
-    with itself), read once: the named queries ``place_levels`` and ``subclasses`` asked at once."""
+    """The levels the things of the store state, by thing, the taxonomy's superclasses (each class with
+    itself) and the colour classes of the things (:class:`kb.stated_colours.StatedColours`), read once: the
+    named queries ``place_levels``, ``subclasses`` and ``thing_colours`` asked at once."""
 
     levels: Mapping[str, tuple[StatedLevel, ...]]
     superclasses: Mapping[str, frozenset[str]]
     units: Units
     conditions: Mapping[str, MeasuredCondition | MeasuredConditionError]
+    colours: StatedColours = field(default_factory=lambda: StatedColours({}))
 
     @classmethod
     def read(cls, kb: KnowledgeBase) -> StatedQuantities:
-        level_rows, up_rows = kb.select_each(("place_levels", "subclasses"))
+        level_rows, up_rows, colour_rows = kb.select_each(("place_levels", "subclasses", "thing_colours"))
         found: dict[str, list[StatedLevel]] = {}
         for level in stated_levels(level_rows):
             found.setdefault(level.thing, []).append(level)
@@ -79,6 +83,7 @@ class StatedQuantities:
             {concept: frozenset(above) for concept, above in up.items()},
             Units.read(kb),
             conditions_by_status(kb),
+            StatedColours.of_rows(colour_rows),
         )
 
     def is_a(self, concept: str, ancestor: str) -> bool:
@@ -119,14 +124,16 @@ class StatedQuantities:
     def meeting(self, things: Iterable[str], statuses: Collection[str]) -> list[str]:
         """Those of ``things`` of which no status of ``statuses`` is decided false by what they state (each
         is kept where its levels decide nothing): the things a requester who guarantees ``statuses`` of the
-        one it means can mean."""
+        one it means can mean. A colour among ``statuses`` (a class at or below ``home:Colour``) is decided
+        by the thing's colour name (:meth:`kb.stated_colours.StatedColours.decide`)."""
         kept = []
         for thing in things:
+            colours = [self.colours.decide(thing, s, self.is_a) for s in statuses if self.is_a(s, COLOUR)]
             try:
-                decided = [self.decide(thing, status) for status in statuses]
+                decided = [self.decide(thing, status) for status in statuses if not self.is_a(status, COLOUR)]
             except (UnitError, MeasuredConditionError):
                 decided = []  # nothing decidable: the run's own check names the error
-            if all(found is None or found.holds for found in decided):
+            if all(found is None or found.holds for found in decided) and False not in colours:
                 kept.append(thing)
         return kept
 
@@ -149,15 +156,15 @@ def stated_levels(rows: Iterable[Mapping[str, Any]]) -> list[StatedLevel]:
 
 
 def guaranteed_statuses(requirement: Requirement, concept: str, is_a: IsA | None = None) -> tuple[str, ...]:
-    """The statuses ``requirement``'s preconditions guarantee of the thing its input of class ``concept``
-    names: ``(C, home:hasStatus, S)`` with ``C`` that class or one above it (``is_a``; without it, that class
-    alone)."""
+    """The statuses and colours ``requirement``'s preconditions guarantee of the thing its input of class
+    ``concept`` names: ``(C, home:hasStatus, S)`` and ``(C, home:hasColour, K)`` with ``C`` that class or one
+    above it (``is_a``; without it, that class alone)."""
     return tuple(
         sorted(
             {
                 p.object
                 for p in requirement.preconditions
-                if p.predicate == HAS_STATUS
+                if p.predicate in (HAS_STATUS, HAS_COLOUR)
                 and (p.subject == concept or (is_a is not None and _safe(is_a, concept, p.subject)))
             }
         )
