@@ -417,7 +417,8 @@ class TaskRunner:
         return run
 
     def cancel(self, run_id: str) -> TaskRun:
-        """Ask a run to stop after the step under way (a run that has ended is left as it is)."""
+        """Ask a run to stop after the step under way, or at once while it waits on a remote component's call,
+        which it abandons (docs/execution.md; a run that has ended is left as it is)."""
         run = self.get(run_id)
         run.cancel_requested.set()
         return run

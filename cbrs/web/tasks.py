@@ -115,7 +115,8 @@ def run(run_id: str) -> Page:
 
 @page(blueprint, "/tasks/<run_id>/cancel", negotiate=True, methods=["POST"])
 def cancel(run_id: str) -> Page:
-    """Ask a run to stop after the step under way (202); the same people who may start a run may stop it.
+    """Ask a run to stop after the step under way, or at once while it waits on a remote component's call, which
+    it abandons (202); the same people who may start a run may stop it.
 
     A browser's form is sent on to the run's page (303, as Start's is: :func:`_from_a_browser`): it stayed at
     ``/cancel``, and a reload sent the Stop again and got the 409 below. A run that has already ended is left
@@ -173,7 +174,8 @@ def _token_typed() -> bool:
 
 
 def _stopping(found: TaskRun) -> str:
-    return f"{found.id}: asked to stop after the step under way"
+    at_once = "a remote component's call under way is abandoned at once"
+    return f"{found.id}: asked to stop after the step under way ({at_once})"
 
 
 def _from_a_browser() -> bool:
