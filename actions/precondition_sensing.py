@@ -13,8 +13,9 @@ container as the executor invokes a step's component (a simulated one or one in 
 bridge, with its own call timeout and the run's faults), and compares the reading with the bound in the
 condition's unit, converted where the store says how (:class:`kb.measured_states.Units`). A sensor that
 fails, or gives no reading within the sensing timeout, passes the question to the next; when none can
-answer, the precondition stays taken as given and the run says why. docs/execution.md, "A task's
-preconditions".
+answer, the precondition stays taken as given and the run says why. A precondition ``(thing, home:hasColour,
+K)`` is decided by the colour the map states of the thing (:mod:`kb.stated_colours`), no sensor asked.
+docs/execution.md, "A task's preconditions".
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ from cbrs.kb import Advertisement, KnowledgeBase, Statement
 from cbrs.kb.measured_states import MeasuredCondition, MeasuredConditionError, Units, conditions_by_status
 from cbrs.kb.namespaces import PREFIXES, shorten
 from cbrs.kb.semantic_map import AmbiguousDesignatorError, UnresolvedDesignatorError, designate
+from cbrs.kb.stated_colours import HAS_COLOUR
 from cbrs.kb.stated_quantities import StatedQuantities
 from cbrs.reasoner.names import local_name
 from cbrs.reasoner.sea import Bounds, covers_concept, overlap
@@ -55,6 +57,8 @@ class Sensed:
     reading: str = ""
     device: str = ""
     stated: bool = False  # decided by what the map states (``sensor`` the property), no sensor's reading
+    rule: str = "its home:holdsWhen"
+    """Where ``bound`` comes from, as a refusal names it."""
 
 
 @dataclass(frozen=True)
@@ -119,6 +123,8 @@ class PreconditionSensing:
     def __call__(self, statement: Statement) -> Sensed | None:
         """What a reading says of ``statement``; None where the store gives its status no measured
         condition (it is not this module's to decide)."""
+        if statement.predicate == HAS_COLOUR:
+            return self._stated_colour(statement)
         if statement.predicate != HAS_STATUS:
             return None
         if self._conditions is None:
@@ -152,26 +158,57 @@ class PreconditionSensing:
             return Sensed(None, self._none_covers(condition.quantity, statement.subject), bound)
         return Sensed(None, "; ".join(failures), bound)
 
+    def _stated_colour(self, statement: Statement) -> Sensed | None:
+        """``statement`` (a colour of a thing) decided by the colour name the map states of the thing
+        (:class:`kb.stated_colours.StatedColours`); None where it decides nothing (no name, a name no
+        window tied to a class has, no one thing). The thing as :meth:`_stated` finds it."""
+        thing = self._thing(statement)
+        if thing is None:
+            return None
+        quantities = self.stated_quantities()
+        holds = quantities.colours.decide(thing, statement.object, quantities.is_a)
+        if holds is None:
+            return None
+        name = quantities.colours.names.get(thing, "")
+        classes = ", ".join(shorten(each) for each in sorted(quantities.colours.classes.get(thing, ())))
+        of = f'"{name}" of {shorten(thing)}'
+        how = f"\"{name}\", the map's home:colourName of {shorten(thing)}, a colour window's of {classes}"
+        bound = "of a thing whose colour name is a colour window's tied to it or to a class below it"
+        return Sensed(
+            holds, how, bound, PREFIXES["home"] + "colourName", of, "the map", stated=True, rule="home:windowColour"
+        )
+
+    def stated_quantities(self) -> StatedQuantities:
+        if self._stated_quantities is None:
+            self._stated_quantities = StatedQuantities.read(self.kb)
+        return self._stated_quantities
+
+    def _thing(self, statement: Statement) -> str | None:
+        """The thing ``statement`` is about: the subject itself when it is a thing of the map; else the one
+        thing the run's inputs name of the subject's class or one below it (``given``); else the one thing of
+        the subject's class, designated as the run designates a task's input (the statement's object its
+        guarantee); none or several: None."""
+        subject = statement.subject
+        meant = sorted(iri for iri, concept in self.designated.items() if self._is_a(concept, subject))
+        try:
+            if subject not in self.index:
+                return subject
+            if len(meant) == 1:
+                return meant[0]
+            return designate(self.kb, subject, guarantees=(statement.object,))
+        except (UnresolvedDesignatorError, AmbiguousDesignatorError):
+            return None
+
     def _stated(self, statement: Statement) -> Sensed | None:
         """``statement`` decided by the level of its status's quantity that the thing it is about states in
         the map (:mod:`kb.stated_quantities`); None where it states none. The thing: the subject itself when
         it is a thing of the map; else the one thing the run's inputs name of the subject's class or one below
         it (``given``); else the one thing of the subject's class, designated as the run designates a task's
         input (the precondition's status its guarantee); none or several: None."""
-        if self._stated_quantities is None:
-            self._stated_quantities = StatedQuantities.read(self.kb)
-        subject = statement.subject
-        meant = sorted(iri for iri, concept in self.designated.items() if self._is_a(concept, subject))
-        try:
-            if subject not in self.index:
-                thing = subject
-            elif len(meant) == 1:
-                thing = meant[0]
-            else:
-                thing = designate(self.kb, subject, guarantees=(statement.object,))
-        except (UnresolvedDesignatorError, AmbiguousDesignatorError):
+        thing = self._thing(statement)
+        if thing is None:
             return None
-        found = self._stated_quantities.decide(thing, statement.object)
+        found = self.stated_quantities().decide(thing, statement.object)
         if found is None:
             return None
         of = f"{found.reading} of {shorten(thing)}"

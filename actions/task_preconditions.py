@@ -55,7 +55,7 @@ class TaskPreconditionError(ActionsError):
             super().__init__(
                 f"the task's precondition {statement_text(statement)} of {shorten(requirement)} does not hold:"
                 f" the map states {sensed.reading} ({shorten(sensed.sensor)}), and {shorten(statement.object)}"
-                f" holds {sensed.bound} (its home:holdsWhen). A task takes its preconditions as given and plans"
+                f" holds {sensed.bound} ({sensed.rule}). A task takes its preconditions as given and plans"
                 " nothing to make them hold: where the thing has changed, correct the map (cbrs update), or"
                 " leave the precondition out of the requirement"
             )

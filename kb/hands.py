@@ -83,8 +83,9 @@ degrees, measured on its collision mesh (ontologies/world.ttl): the default of `
 PAYLOAD = 3.0
 """The most a hand lifts (kg): the Franka Panda's rated payload (Franka Emika's datasheet gives 3 kg), the
 arm of every simulated hand. The simulation's grasp is a constraint that would hold far more (a 4.5 kg hand
-weight was fetched, the twentieth round), so the check before a run refuses what is heavier. The default of
-``home:payloadKg``, on the gripper or a class of grippers."""
+weight was fetched, the twentieth round), so the check before a run refuses what is heavier. The store states
+it (``home:payloadKg``, on the gripper or a class of grippers; world.ttl on the bundled hands): this is only the
+fallback for a hand that states none, as the Panda's geometry is the other hands' defaults."""
 
 CARRY_CORRIDOR = 0.10
 """How far to either side of what a hand carries (the object's footprint, or the open jaws' if wider) its

@@ -16,7 +16,7 @@ docs/execution.md, "A thing's colour stated in the map".
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 from cbrs.kb.namespaces import PREFIXES
@@ -29,16 +29,20 @@ COLOUR = PREFIXES["home"] + "Colour"
 
 @dataclass(frozen=True)
 class StatedColours:
-    """The colour classes each thing of the map is of by its colour name (named query ``thing_colours``)."""
+    """The colour classes each thing of the map is of by its colour name (named query ``thing_colours``), and
+    that name, by thing."""
 
     classes: Mapping[str, frozenset[str]]
+    names: Mapping[str, str] = field(default_factory=dict)
 
     @classmethod
     def of_rows(cls, rows: Iterable[Mapping[str, Any]]) -> StatedColours:
         found: dict[str, set[str]] = {}
+        names: dict[str, str] = {}
         for row in rows:
             found.setdefault(row["thing"].value, set()).add(row["colour"].value)
-        return cls({thing: frozenset(classes) for thing, classes in found.items()})
+            names[row["thing"].value] = row["name"].value
+        return cls({thing: frozenset(classes) for thing, classes in found.items()}, names)
 
     def decide(self, thing: str, colour: str, is_a: Callable[[str, str], bool]) -> bool | None:
         """Whether ``thing`` has ``colour`` (a class at or below ``home:Colour``) by its colour name: one of its

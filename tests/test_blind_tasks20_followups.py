@@ -8,7 +8,11 @@ from pathlib import Path
 
 import pytest
 
+from cbrs.actions.components import Container
 from cbrs.actions.composer import Composer
+from cbrs.actions.precondition_sensing import PreconditionSensing
+from cbrs.actions.runner import run_task
+from cbrs.actions.task_preconditions import TaskPreconditionError
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.semantic_map import AmbiguousDesignatorError, MapError, SemanticMap, designate_each
@@ -131,7 +135,7 @@ def test_a_thing_has_a_colour_at_or_above_its_windows_class(
     """A thing has a colour when its window's class is that colour or below it: home:Colour holds of both
     mugs and chooses neither; home:Orange, which neither mug's window is tied to, is false of both, and
     designation keeps both (a guarantee nothing meets leaves the run's own check to refuse it)."""
-    requirement = two_mugs.description(LAB20 + "FetchTheGreenMug")
+    (requirement,) = [each for each in two_mugs.requirements() if each.iri == LAB20 + "FetchTheGreenMug"]
     statuses = guaranteed_statuses(requirement, HOME + "Mug")
     assert statuses == (HOME + "Green",)
     asked = [(HOME + "Mug", None)]
@@ -140,3 +144,37 @@ def test_a_thing_has_a_colour_at_or_above_its_windows_class(
             designate_each(two_mugs, asked, guarantees=[(HOME + colour,)])
     else:
         assert designate_each(two_mugs, asked, guarantees=[(HOME + colour,)]) == [LAB20 + meant]
+
+
+def test_the_colour_precondition_holds_by_the_map_of_the_mug_designated(two_mugs: KnowledgeBase) -> None:
+    """Asked of the mug the run designated, the precondition is decided by the map (it was taken as given):
+    holding of the green mug, false of the red one. A colour needs no sensor: none is made."""
+    composer = Composer(two_mugs)
+    (requirement,) = [each for each in two_mugs.requirements() if each.iri == LAB20 + "FetchTheGreenMug"]
+    (colour,) = [p for p in requirement.preconditions if p.predicate == HOME + "hasColour"]
+    for mug, holds in (("GreenMug1", True), ("RedMug1", False)):
+        given = {"mug": {"@id": LAB20 + mug, "@type": HOME + "Mug"}}
+        unmade = Container(lambda iri: pytest.fail(f"a sensor was made: {iri}"))
+        sense = PreconditionSensing(two_mugs, unmade, (), composer.index, 1.0, given=given)
+        sensed = sense(colour)
+        assert sensed is not None and sensed.holds is holds and sensed.stated
+        name = "green" if holds else "red"
+        assert sensed.how.startswith(f"\"{name}\", the map's home:colourName of {LAB20}{mug}, a colour window's of")
+
+
+def test_a_colour_precondition_no_thing_meets_is_refused_before_anything_moves(tmp_path: Path) -> None:
+    """The green mug's task where the map has only the red mug: refused before anything moves, by the
+    colour the map states of it (it ran, the precondition taken as given, and brought the red mug)."""
+    red = tmp_path / "red_mug.ttl"
+    red.write_text(TWO_MUGS.split("lab:GreenMug1")[0])
+    kb = KnowledgeBase.open(":memory:")
+    kb.load([red], graph="map")
+    kb.load([EXAMPLES / "lab20_fetch_the_green_mug.ttl"], graph="requirements")
+    with open_world(seed=0, semantic_map=SemanticMap.read(kb)) as world:
+        started, base = world.time, world.base_pose()
+        with pytest.raises(TaskPreconditionError) as refused:
+            run_task(kb, "FetchTheGreenMug", SimEnvironment(world, kb), composer=Composer(kb))
+        assert world.time == started and world.base_pose() == base
+    said = str(refused.value)
+    assert f'the map states "red" of {LAB20}RedMug1 (home:colourName), and home:Green holds of a thing' in said
+    assert "(home:windowColour)" in said and "correct the map" in said
