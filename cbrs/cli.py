@@ -49,6 +49,14 @@ from cbrs.kb.namespaces import (
     store_names,
 )
 from cbrs.kb.skolem import is_skolem
+from cbrs.kb.sparql_hints import (
+    declared,
+    explain_syntax_error,
+    first_keyword,
+    one_line_up,
+    store_prefixes_used,
+    unexplained,
+)
 from cbrs.kb.staged_writes import STAGING
 from cbrs.kb.store import EmbeddedStore, QueryResult, Term
 from cbrs.output import (
@@ -65,7 +73,6 @@ from cbrs.output import (
     term_text,
 )
 from cbrs.settings import SETTINGS, setting
-from cbrs.sparql_hints import declared, explain_syntax_error, first_keyword, one_line_up, store_prefixes_used
 from cbrs.unmentioned_names import unmentioned_bindings, unmentioned_names
 
 # Commands whose modules import numpy, networkx, the composer or the web server (most of a second at
@@ -535,7 +542,8 @@ def query(
         try:
             result = _evaluate(app.kb, declared(added, body))
         except QuerySyntaxError as error:  # a prefix nobody declared: said plainly, as the endpoint does
-            counted = one_line_up(error, body) if added else error
+            parsed = unexplained(error)  # the store explained the text run, prologue and all: explained anew
+            counted = one_line_up(parsed, body) if added else parsed
             explained = explain_syntax_error(counted, body, "query", names.prefixes)
             if explained is error:
                 raise

@@ -1,6 +1,6 @@
 """The ``cbrs`` commands that keep a store over months: ``export`` and ``restore`` (:mod:`kb.backup`), and
 ``update``, a SPARQL update with what it changed said graph by graph (:mod:`kb.update_report`), which
-takes the store's derived prefixes as ``cbrs query`` does (:func:`cbrs.sparql_hints.store_prefixes_used`)."""
+takes the store's derived prefixes as ``cbrs query`` does (:func:`cbrs.kb.sparql_hints.store_prefixes_used`)."""
 
 from __future__ import annotations
 
@@ -24,12 +24,19 @@ from cbrs.kb.colour_risk import ColourRisk, colour_risks
 from cbrs.kb.derived_prefixes import StoreNames
 from cbrs.kb.errors import QuerySyntaxError, StoreEvaluationError, without_password
 from cbrs.kb.namespaces import PREFIXES, GraphName, shorten
+from cbrs.kb.sparql_hints import (
+    declared,
+    explain_syntax_error,
+    one_line_up,
+    operation_kind,
+    store_prefixes_used,
+    unexplained,
+)
 from cbrs.kb.sparql_lexemes import HIDING
 from cbrs.kb.store import refuse_inserted_blank_nodes
 from cbrs.kb.undeclared_classes import MapTypes, UndeclaredClass, written_undeclared_classes
 from cbrs.kb.update_delta import DataOperation, data_operations
 from cbrs.output import ProgressLine
-from cbrs.sparql_hints import declared, explain_syntax_error, one_line_up, operation_kind, store_prefixes_used
 
 _GRAPH_HELP = "A graph to take (repeatable): " + ", ".join(g.value for g in GraphName) + ", or a full IRI."
 _FORMAT_CHOICE = click.Choice(["nquads", "trig"])
@@ -202,7 +209,8 @@ def update(app: App, text: str | None, update_file: Any, as_json: bool) -> None:
         try:
             report = app.kb.update_counted(declared(added, body))
         except QuerySyntaxError as error:
-            counted = one_line_up(error, body) if added else error  # placed in the text as written
+            parsed = unexplained(error)  # the store explained the text run, prologue and all: explained anew
+            counted = one_line_up(parsed, body) if added else parsed  # placed in the text as written
             explained = explain_syntax_error(counted, body, "update", names.prefixes)
             explained.add_note("nothing was changed")
             if explained is error:

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 import pyoxigraph as ox
 
 from cbrs.kb.namespaces import PREFIXES
-from cbrs.sparql_hints import TOKENS
+from cbrs.kb.sparql_hints import TOKENS
 
 if TYPE_CHECKING:
     from cbrs.kb import KnowledgeBase

@@ -171,11 +171,16 @@ class BindingError(KnowledgeBaseError):
 
 
 class QuerySyntaxError(KnowledgeBaseError):
+    """``query`` does not parse; ``message`` says why. ``parsed`` is the parser's own words when ``message``
+    is a plain reason put in their place (:func:`cbrs.kb.sparql_hints.explain_syntax_error`), None when
+    ``message`` is the parser's: an explained error is not explained again."""
+
     http_status = 400
 
-    def __init__(self, query: str, message: str) -> None:
+    def __init__(self, query: str, message: str, parsed: str | None = None) -> None:
         self.query = query
         self.message = message
+        self.parsed = parsed
         one_line = " ".join(message.split())
         if len(one_line) > 240:
             one_line = one_line[:240] + " ..."

@@ -6,19 +6,19 @@ import dataclasses
 import functools
 import logging
 import re
-from collections.abc import Callable, Mapping, Sequence
-from contextlib import AbstractContextManager, nullcontext
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import AbstractContextManager, contextmanager, nullcontext
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Literal
 
 import pyoxigraph as ox
 
-from cbrs.kb import sorting_updates
+from cbrs.kb import derived_prefixes, sorting_updates
 from cbrs.kb.backup import Backup, ExportReport, RestoreReport, export_store, read_backup, restore_store
 from cbrs.kb.catalog import Catalogue
 from cbrs.kb.descriptions import DescriptionReader
 from cbrs.kb.engine_faults import sorts
-from cbrs.kb.errors import ReplaceError, StoreError, UndeclaredSuperclassError
+from cbrs.kb.errors import QuerySyntaxError, ReplaceError, StoreError, UndeclaredSuperclassError
 from cbrs.kb.liveness import Liveness
 from cbrs.kb.loader import (
     LoadReport,
@@ -38,6 +38,7 @@ from cbrs.kb.registry import ComponentRegistry
 from cbrs.kb.resources import bundled_files, query_dir
 from cbrs.kb.seed_cache import SeedCache, bundle_digest
 from cbrs.kb.shapes import CHECKED_GRAPHS, DescriptionShapeError, checked_update, may_write_descriptions
+from cbrs.kb.sparql_hints import explain_syntax_error
 from cbrs.kb.standard_terms import PendingUpdate, Refresh, StandardTerms
 from cbrs.kb.store import MEMORY, EmbeddedStore, QueryResult, Store, Term, is_remote
 from cbrs.kb.superclasses import (
@@ -438,8 +439,11 @@ class KnowledgeBase:
         ``svc:``..., :data:`PREFIXES`), so a query need not know which graph holds a fact. ``bindings``
         are values for its variables, bound by the store rather than pasted into the text (nothing a user
         typed is parsed as SPARQL). Gives pyoxigraph's solutions (read them once), a boolean or triples;
-        a bad text is a :class:`QuerySyntaxError` keeping the text."""
-        return self.store.query(text, bindings)
+        a bad text is a :class:`QuerySyntaxError` keeping the text, explained as ``cbrs query`` and the
+        endpoint explain it (:func:`~cbrs.kb.sparql_hints.explain_syntax_error`: an undeclared prefix and the
+        nearest, a query sent as an update...)."""
+        with self._explained(text, "query"):
+            return self.store.query(text, bindings)
 
     def update(self, text: str, check_map: bool = True) -> None:
         """Run a SPARQL update in one transaction; the cached descriptions are read afresh afterwards, and
@@ -450,8 +454,10 @@ class KnowledgeBase:
         and every task fails on it. Only an update that may write graph:map is checked; the rest pay
         nothing for it.
         ``check_map=False`` skips the check, for a caller that builds or breaks a map on purpose (a test
-        of the map reader's errors): the map's reader then says what is wrong when a task reads it."""
-        self._update(text, self._data_update(text), check_map)
+        of the map reader's errors): the map's reader then says what is wrong when a task reads it.
+        A bad text is a :class:`QuerySyntaxError` explained as :meth:`query`'s."""
+        with self._explained(text, "update"):
+            self._update(text, self._data_update(text), check_map)
 
     def update_counted(self, text: str) -> UpdateReport:
         """:meth:`update`, saying what it changed graph by graph (:mod:`kb.update_report`): quad by quad for
@@ -459,9 +465,10 @@ class KnowledgeBase:
         update of several operations is refused on a store that does not run a request whole (Virtuoso), and
         one that leaves the semantic map unreadable is put back and refused, as :meth:`update` does."""
         refuse_split(self.store, text)
-        data = self._data_update(text)
-        before = graph_sizes(self.store) if data is None else None
-        entailed = self._update(text, data, check_map=True)
+        with self._explained(text, "update"):
+            data = self._data_update(text)
+            before = graph_sizes(self.store) if data is None else None
+            entailed = self._update(text, data, check_map=True)
         iri = GraphName.ENTAILED.iri
         refreshed = (
             GraphChange(iri, entailed.added - entailed.removed, entailed.added, entailed.removed)
@@ -480,6 +487,22 @@ class KnowledgeBase:
         if refreshed.net or refreshed.added or refreshed.removed:
             changes.append(refreshed)
         return UpdateReport(tuple(changes), exact, counted=before is not None or exact)
+
+    @contextmanager
+    def _explained(self, text: str, expected: Literal["query", "update"]) -> Iterator[None]:
+        """A syntax error of ``text`` (a library caller's) explained as the endpoint explains it, the store's
+        derived prefixes offered for an undeclared one (read only then). Only an embedded store's: its
+        parser's words are Oxigraph's, which the explanations read; a remote store's are its server's (a
+        cbrs serve's explained already)."""
+        try:
+            yield
+        except QuerySyntaxError as error:
+            if not isinstance(self.store, EmbeddedStore):
+                raise
+            explained = explain_syntax_error(error, text, expected, offered=lambda: derived_prefixes.for_store(self))
+            if explained is error:
+                raise
+            raise explained from error
 
     def _data_update(self, text: str) -> DataUpdate | None:
         """``text`` read as an update of ground data about to run (:mod:`kb.update_delta`), on an embedded

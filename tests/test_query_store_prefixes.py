@@ -15,7 +15,7 @@ from click.testing import CliRunner, Result
 
 from cbrs.cli import cli
 from cbrs.kb.errors import QuerySyntaxError
-from cbrs.sparql_hints import explain_syntax_error, one_line_up, prologue, store_prefixes_used
+from cbrs.kb.sparql_hints import explain_syntax_error, one_line_up, prologue, store_prefixes_used
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "docs" / "examples"
 LAB = "https://example.org/lab4#"

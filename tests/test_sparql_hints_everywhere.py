@@ -1,6 +1,6 @@
 """``cbrs query``, the SPARQL endpoint (JSON and the HTML a browser gets) and the browser's SPARQL editor
 give one hint for a query that does not parse for a prefix nobody declared, from one library function
-(:func:`cbrs.sparql_hints.explain_syntax_error`), and one note for a query whose names name nothing
+(:func:`cbrs.kb.sparql_hints.explain_syntax_error`), and one note for a query whose names name nothing
 (:func:`cbrs.unmentioned_names.unmentioned_names`; the endpoint answers those as the protocol says).
 
 The endpoint and the editor offered cbrs's own prefixes alone: ``lab:Trolley1`` in a store that derives
@@ -96,7 +96,7 @@ def test_the_hint_is_read_from_the_store_only_for_a_prefix_nobody_declared(tmp_p
     """``offered`` is called only when the text uses an undeclared prefix: a bracket left open costs no
     read of the store's terms."""
     from cbrs.kb.errors import QuerySyntaxError
-    from cbrs.sparql_hints import explain_syntax_error
+    from cbrs.kb.sparql_hints import explain_syntax_error
 
     def offered() -> dict[str, str]:
         raise AssertionError("read")

@@ -18,7 +18,7 @@ from flask import Blueprint, Response, current_app, request, url_for
 
 from cbrs.kb.errors import KnowledgeBaseError, QuerySyntaxError, UnknownQueryError
 from cbrs.kb.namespaces import PREFIXES
-from cbrs.sparql_hints import operation_kind, store_prefixes_used
+from cbrs.kb.sparql_hints import operation_kind, store_prefixes_used
 from cbrs.sparql_service import BOM, Answer, EndpointBusyError, QueryTimeoutError
 from cbrs.unmentioned_names import unmentioned_names
 from cbrs.web import context
@@ -155,7 +155,7 @@ def with_store_prefixes(text: str) -> tuple[str, dict[str, str]]:
     """``text`` with a ``PREFIX`` line put above it for each prefix derived for the store
     (:mod:`cbrs.web.prefixes`) that it uses and does not declare, and those prefixes: the results show
     ``books:Novel``, and a query may name it so, although the endpoint knows only cbrs's own prefixes.
-    The rule is ``cbrs query``'s (:func:`cbrs.sparql_hints.store_prefixes_used`)."""
+    The rule is ``cbrs query``'s (:func:`cbrs.kb.sparql_hints.store_prefixes_used`)."""
     text = text.removeprefix(BOM)
     added = store_prefixes_used(text, derived)  # the table is read only for a query that may use one
     lines = "".join(f"PREFIX {prefix}: <{namespace}>\n" for prefix, namespace in added.items())

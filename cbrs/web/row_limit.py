@@ -7,7 +7,7 @@ lazily), and the extra row tells the page the result was cut. The query still go
 endpoint's service, with its deadline, byte budget and worker slots.
 
 The text is read with the lexemes that can hide a brace or a keyword (strings, IRIs, comments, prefixed
-names: :data:`cbrs.sparql_hints.TOKENS`), never parsed here: only a ``LIMIT`` clause is added or
+names: :data:`cbrs.kb.sparql_hints.TOKENS`), never parsed here: only a ``LIMIT`` clause is added or
 lowered, and the parser still decides what the text means. A text this reading does not understand is
 left as it is (:func:`bounded` answers ``None``), and the caller runs it whole.
 
@@ -20,7 +20,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from cbrs.sparql_hints import TOKENS
+from cbrs.kb.sparql_hints import TOKENS
 
 # The tokens of TOKENS, and the brackets and integers between them that the bound depends on.
 _LEXEMES = re.compile(
