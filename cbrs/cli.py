@@ -15,7 +15,7 @@ import shlex
 import sys
 import traceback
 from collections import Counter
-from collections.abc import Iterator
+from collections.abc import Collection, Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -28,13 +28,21 @@ from cbrs.cli_interrupts import HeldInterrupts
 from cbrs.cli_notes import no_store_at, note_new_store, wants_json, with_notes
 from cbrs.cli_store import export, restore, update
 from cbrs.extras import require
+from cbrs.graph_names import graph_hint
 from cbrs.isolated_queries import IsolatedQueries, IsolatedResult
 from cbrs.kb import Advertisement, KnowledgeBase, KnowledgeBaseError, Requirement, ServiceDescription
 from cbrs.kb.catalog import Catalogue, merge
 from cbrs.kb.derived_prefixes import StoreNames
 from cbrs.kb.described import about_in, complete
 from cbrs.kb.engine_faults import sorts
-from cbrs.kb.errors import AlreadyRegisteredError, NotFoundError, QuerySyntaxError, RdfParseError, without_password
+from cbrs.kb.errors import (
+    AlreadyRegisteredError,
+    NotFoundError,
+    QuerySyntaxError,
+    RdfParseError,
+    UnknownGraphError,
+    without_password,
+)
 from cbrs.kb.liveness import ComponentState
 from cbrs.kb.loader import LoadReport, ParsedFile, holds_ontology
 from cbrs.kb.namespaces import (
@@ -250,6 +258,9 @@ def load(app: App, files: tuple[Path, ...], graph: str | None, catalogs: tuple[P
         try:
             with _undeclared_prefixes():
                 report = app.kb.load(list(files), graph, catalogue, progress, replace=replace)
+        except UnknownGraphError as error:  # --graph mapp: which graph it may mean
+            _note_near_graphs(error, [graph or ""], app.kb.store.graphs(), own_count=True)
+            raise
         finally:
             shown.clear()
     if interrupts.interrupted:
@@ -833,21 +844,39 @@ class _NodeNames:
     "equivalences, types of individuals) to graph:inferred, replacing what it held; refused, nothing "
     "written, when the graphs are inconsistent or have an unsatisfiable class (docs/ontologies.md).",
 )
+@click.option(
+    "--timeout",
+    type=click.FloatRange(min=0, min_open=True),
+    metavar="SECONDS",
+    help="Seconds HermiT may take before its process is stopped and the check fails saying so. Default: the "
+    f"check_timeout setting ({setting('check_timeout').env}, {setting('check_timeout').default():g} s; "
+    "docs/ontologies.md, 'How long HermiT may take').",
+)
 @click.option("--json", "as_json", is_flag=True, help="Print the result as JSON.")
 @pass_app
-def check_command(app: App, graphs: tuple[str, ...], write_inferred: bool, as_json: bool) -> None:
+def check_command(
+    app: App, graphs: tuple[str, ...], write_inferred: bool, timeout: float | None, as_json: bool
+) -> None:
     """Run the HermiT OWL reasoner (owlready2; needs Java) over the ontologies and registered descriptions.
 
     Reports whether they are consistent and which classes are unsatisfiable; exits with status 1 if either.
     With --write-inferred, HermiT's new conclusions go into graph:inferred, where SPARQL sees them.
+    HermiT has --timeout seconds (or the check_timeout setting's) before it is stopped.
     """
     from cbrs import check as checking  # owlready2 loads only for this command
 
     chosen = graphs or checking.DEFAULT_GRAPHS
-    if write_inferred:
-        result, inferred = checking.write_inferred(app.kb, chosen)
-    else:
-        result, inferred = checking.check(app.kb, chosen), None
+    try:
+        if write_inferred:
+            result, inferred = checking.write_inferred(app.kb, chosen, timeout)
+        else:
+            result, inferred = checking.check(app.kb, chosen, timeout), None
+    except checking.ReasonerTimeoutError as error:  # its words name the setting; this run may take --timeout
+        error.add_note("or give this check longer: cbrs check --timeout SECONDS")
+        raise
+    except (UnknownGraphError, checking.NoSuchGraphError) as error:  # --graph graph:mapp: which it may mean
+        _note_near_graphs(error, graphs, app.kb.store.graphs(), own_count=True)
+        raise
     if as_json:
         answer = result.to_dict()
         if inferred is not None:
@@ -859,6 +888,13 @@ def check_command(app: App, graphs: tuple[str, ...], write_inferred: bool, as_js
             click.echo(_inferred_text(inferred))
     if not result.ok:
         raise SystemExit(1)
+
+
+def _note_near_graphs(error: Exception, given: Iterable[str], held: Collection[str], own_count: bool = False) -> None:
+    """Add to ``error`` (a --graph that names no graph) the graphs it may mean (:func:`cbrs.graph_names.graph_hint`)."""
+    hint = graph_hint(given, held, own_count, prefixed=False)  # check and load read no graph:NAME
+    if hint is not None:
+        error.add_note(hint)
 
 
 def _inferred_text(inferred: Any) -> str:

@@ -18,11 +18,20 @@ from cbrs import __version__
 from cbrs.app import App, pass_app
 from cbrs.cli_interrupts import HeldInterrupts
 from cbrs.cli_notes import no_store_at
+from cbrs.graph_names import graph_hint
 from cbrs.kb import KnowledgeBase
-from cbrs.kb.backup import DEFAULT, Backup, NotAnExportError, check_declarations, export_format, read_backup
+from cbrs.kb.backup import (
+    DEFAULT,
+    Backup,
+    BackupError,
+    NotAnExportError,
+    check_declarations,
+    export_format,
+    read_backup,
+)
 from cbrs.kb.colour_risk import ColourRisk, colour_risks
 from cbrs.kb.derived_prefixes import StoreNames
-from cbrs.kb.errors import QuerySyntaxError, StoreEvaluationError, without_password
+from cbrs.kb.errors import QuerySyntaxError, StoreEvaluationError, UnknownGraphError, without_password
 from cbrs.kb.namespaces import PREFIXES, GraphName, shorten
 from cbrs.kb.sparql_hints import (
     declared,
@@ -60,6 +69,11 @@ def export(app: App, file: str, graphs: tuple[str, ...], fmt: str | None, as_jso
     shown = ProgressLine()
     try:
         report = app.kb.export(file, rdf_format, list(graphs) or None, shown)
+    except (UnknownGraphError, BackupError) as error:  # --graph graph:mapp: "no graph" said no more
+        hint = graph_hint(graphs, app.kb.store.graphs()) if graphs else None
+        if hint is not None:
+            error.add_note(hint)
+        raise
     finally:
         shown.clear()
     if as_json:
@@ -108,9 +122,15 @@ def restore(
         raise click.ClickException(f"{file}: Ctrl-C while reading it; nothing was restored") from None
     finally:
         shown.clear()
-    problems = backup.problems(list(graphs) or None)
-    if problems and not force:  # before the store is opened: a new one is not created for nothing
-        raise NotAnExportError(backup.source, problems)
+    try:
+        problems = backup.problems(list(graphs) or None)
+        if problems and not force:  # before the store is opened: a new one is not created for nothing
+            raise NotAnExportError(backup.source, problems)
+    except (UnknownGraphError, NotAnExportError) as error:  # --graph graph:mapp: which of the file's it may mean
+        hint = graph_hint(graphs, [graph for graph in backup.quads if graph != DEFAULT]) if graphs else None
+        if hint is not None:
+            error.add_note(hint)
+        raise
     if not force and not graphs and no_store_at(app.store_location):
         check_declarations(None, backup)  # before a new store is made there for nothing
     # a whole restore replaces everything: a new store is not seeded first, an old one not upgraded first

@@ -64,5 +64,5 @@ def test_an_iri_of_no_graph_is_refused_naming_the_stores_graphs(lab_store: Path,
     assert result.output == (
         f"Error: the store holds no graph {LAB}s; check a graph of cbrs's by its name (ontology, services, "
         "requirements, map, world, plans, liveness, entailed) or one of the store's own by its IRI (its graphs "
-        f"other than cbrs's own: {LAB})\n"
+        f"other than cbrs's own: {LAB}); '{LAB}s': did you mean {LAB}?\n"  # cbrs.graph_names' hint
     )
