@@ -126,3 +126,24 @@ def test_a_task_with_a_misspelt_prefix_says_what_is_wrong_with_the_prefix() -> N
         assert code == 1, err
         assert "no requirement or action named 'rq:FetchMyPen'" in err
         assert "rq: is declared nowhere and is no IRI scheme cbrs reads bare; did you mean req:FetchMyPen?" in err
+
+
+def test_a_page_links_a_stored_iri_of_any_scheme_and_still_refuses_a_slip() -> None:
+    """The pages link an IRI they show by its text: the link to a stored ``isbn:0451450523`` answered 400
+    once a name of an undeclared prefix was refused; what the store holds is read as itself, a slip that
+    names nothing is still refused."""
+    from cbrs.sparql_service import SparqlService
+    from cbrs.web import create_app
+
+    kb = KnowledgeBase.open(":memory:")
+    kb.update(
+        "PREFIX rdfs: <http://www.w3.org/2000/01/rdf-schema#> "
+        'INSERT DATA { GRAPH <urn:books> { <isbn:0451450523> rdfs:label "The Last Unicorn" } }'
+    )
+    http = create_app(SparqlService(kb)).test_client()
+    found = http.get("/search", query_string={"q": "isbn:0451450523"}, headers={"Accept": "text/html"})
+    assert found.status_code in (200, 302, 303)
+    page = http.get("/resource", query_string={"iri": "isbn:0451450523"}, headers={"Accept": "text/html"})
+    assert page.status_code == 200 and "The Last Unicorn" in page.text
+    slip = http.get("/resource", query_string={"iri": "isbm:0451450523"}, headers={"Accept": "text/html"})
+    assert slip.status_code == 400 and "isbm: is declared nowhere" in slip.text

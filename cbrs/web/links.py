@@ -5,11 +5,14 @@ from __future__ import annotations
 import re
 from collections.abc import Mapping
 
+import pyoxigraph as ox
 from flask import Flask, g, has_app_context, url_for
 from markupsafe import Markup, escape
 
 from cbrs.iri_tail import tail_parts
+from cbrs.kb.name_errors import UnknownPrefixError
 from cbrs.kb.namespaces import PREFIXES, expand, shorten
+from cbrs.web import context
 from cbrs.web.prefixes import by_namespace, derived, namespace
 
 RESOURCE_ENDPOINT = "resource.resource"
@@ -48,13 +51,35 @@ def use_text_prefixes(prefixes: Mapping[str, str]) -> None:
 
 def expand_name(name: str) -> str:
     """A prefixed name the pages show (declared or derived prefix) or an IRI, as an IRI; ``ValueError``
-    for a name that is neither (as :func:`cbrs.kb.namespaces.expand`)."""
+    for a name that is neither (as :func:`cbrs.kb.namespaces.expand`).
+
+    An IRI the store holds is read as itself whatever its scheme: the pages link every IRI they show by
+    its text, and since a name of an undeclared prefix is refused (``hom:Cup``), the link to a stored
+    ``javascript:alert(1)//x`` or ``isbn:0451450523`` answered 400. A slip names nothing stored."""
     prefix, sep, local = name.partition(":")
     if sep and prefix not in PREFIXES:
         ns = derived().get(prefix)
         if ns is not None:
             return ns + local
-    return expand(name)
+    try:
+        return expand(name)
+    except UnknownPrefixError:
+        if _stored(name):
+            return name
+        raise
+
+
+def _stored(iri: str) -> bool:
+    """Whether the app's store has a triple with ``iri`` as its subject, predicate or object."""
+    if not has_app_context():
+        return False
+    try:
+        node = ox.NamedNode(iri)
+    except ValueError:
+        return False
+    store = context.kb().store
+    patterns: tuple[dict[str, ox.NamedNode], ...] = ({"subject": node}, {"object": node}, {"predicate": node})
+    return any(next(iter(store.quads(**pattern)), None) is not None for pattern in patterns)
 
 
 def task_name(task: str) -> str:

@@ -98,9 +98,9 @@ def attach(state: BlueprintSetupState) -> None:
 def resource() -> Page:
     iri = iri_parameter()
     kb = context.kb()
-    rows = kb.select("resource_triples", {"resource": iri})
+    rows = kb.select("resource_triples", {"resource": ox.NamedNode(iri)})
     graph = _named_graph(iri)
-    uses = kb.select("predicate_uses", {"predicate": iri})  # the query reads MAX_VALUES + 1
+    uses = kb.select("predicate_uses", {"predicate": ox.NamedNode(iri)})  # the query reads MAX_VALUES + 1
     if not rows and graph is None and not uses:
         raise NotFoundError(iri)
     outgoing = _grouped(row for row in rows if row["direction"].value == "out")
@@ -110,7 +110,7 @@ def resource() -> Page:
     pages = []
     if types & TERM_TYPES:
         pages.append({"text": "In the taxonomy", "href": url_for("taxonomy.concept", iri=iri)})
-    if rows and kb.select("description", {"description": iri}):
+    if rows and kb.select("description", {"description": ox.NamedNode(iri)}):
         pages.append({"text": "Service description (six-tuple)", "href": url_for("services.service", iri=iri)})
     if graph is not None and graph["triples"]:
         pages.append({"text": "The graph's triples (Turtle)", "href": url_for("graph_store.read", graph=iri)})
@@ -158,7 +158,8 @@ def has_page(iri: str) -> bool:
     object, it names a graph, or triples use it as their predicate (the page's own three reads, cheapest
     first). Other pages use it to link an IRI they cannot show themselves (the service page of a class)."""
     kb = context.kb()
-    return _named_graph(iri) is not None or kb.describes(iri) or bool(kb.select("predicate_uses", {"predicate": iri}))
+    used = lambda: bool(kb.select("predicate_uses", {"predicate": ox.NamedNode(iri)}))  # noqa: E731
+    return _named_graph(iri) is not None or kb.describes(iri) or used()
 
 
 def _uses_query(iri: str) -> str:

@@ -71,7 +71,7 @@ def _resource(text: str) -> dict[str, str] | None:
         ox.NamedNode(iri)
     except ValueError:
         return None
-    if not context.kb().select("resource_triples", {"resource": iri}):
+    if not context.kb().select("resource_triples", {"resource": ox.NamedNode(iri)}):
         return None
     return {"iri": iri, "name": short(iri)}
 

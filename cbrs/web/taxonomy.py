@@ -280,7 +280,7 @@ def concept() -> Page:
     iri = resource.iri_parameter()
     kb = context.kb()
     found = current_taxonomy()
-    triples = kb.select("resource_triples", {"resource": iri})
+    triples = kb.select("resource_triples", {"resource": ox.NamedNode(iri)})
     if iri not in found:
         return _undeclared(kb, found, iri, triples)
     g.taxonomy_terms = found.kinds  # what expression_html links to a taxonomy page
@@ -524,7 +524,7 @@ def _out(row: dict[str, Any], predicate: str) -> bool:
 def _parts(kb: KnowledgeBase, iri: str) -> list[dict[str, Any]]:
     """The concept's hasPart children, own and inherited (own first when a part is both)."""
     parts: dict[tuple[str, str], dict[str, Any]] = {}
-    for row in kb.select("concept_parts", {"concept": iri}):
+    for row in kb.select("concept_parts", {"concept": ox.NamedNode(iri)}):
         key = (row["property"].value, row["part"].value)
         owner = row["owner"].value
         if key in parts and parts[key]["inherited_from"] is None:
