@@ -158,8 +158,9 @@ def has_page(iri: str) -> bool:
     object, it names a graph, or triples use it as their predicate (the page's own three reads, cheapest
     first). Other pages use it to link an IRI they cannot show themselves (the service page of a class)."""
     kb = context.kb()
-    used = lambda: bool(kb.select("predicate_uses", {"predicate": ox.NamedNode(iri)}))  # noqa: E731
-    return _named_graph(iri) is not None or kb.describes(iri) or used()
+    if _named_graph(iri) is not None or kb.describes(iri):
+        return True
+    return bool(kb.select("predicate_uses", {"predicate": ox.NamedNode(iri)}))
 
 
 def _uses_query(iri: str) -> str:
