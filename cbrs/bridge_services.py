@@ -20,7 +20,8 @@ a ``near_misses`` of 0, which names none (-1 is its "not given").
   base_ties="nearest", near_misses=3, wait=true}`` -> the run;
   with ``wait`` false it returns at once and the run is followed on the topics, or with
   ``/cbrs/task_status`` ``{run}``; with ``wait`` it answers when the run ends or, at the latest, two
-  seconds before the bridge's call timeout, with the run as it is then (``running``). ``task`` is any
+  seconds before the bridge's call timeout, with the run as it is then (``running``, or ``queued`` with its
+  ``position`` while it waits for the run going: the ``run_queue`` setting). ``task`` is any
   requirement or action of the store, named as ``cbrs run`` takes it; ``repeat_failures`` as
   ``cbrs run --repeat-failures``; ``objective``, ``base_ties`` and ``near_misses`` as ``cbrs run
   --objective --base-ties --near-misses``, checked by ``TaskRunner.start`` as ``POST /tasks`` checks them:
@@ -39,8 +40,12 @@ Action (rosbridge's ROS 2 action ops, ``send_action_goal`` and the rest):
   does); the result is the run as the service returns it, with status
   SUCCEEDED, CANCELED (the client cancelled: the run stops after the step under way, or at once during a
   remote call, which it abandons: docs/execution.md) or ABORTED (the
-  run failed, found no plan or broke). A refused goal (no token, unknown task, a run going) fails as
-  rosbridge fails a goal: ``result: false``, status UNKNOWN, the reason as ``values``.
+  run failed, found no plan or broke). A goal sent while a run goes waits in the runner's queue when it has
+  room (``run_queue``): its first feedback has ``status`` ``queued`` (``reason`` says its place in line), one
+  with ``status`` ``running`` follows when it starts, and a cancel meanwhile takes it out of the queue
+  (CANCELED, the run ``cancelled`` with its ``reason``). A refused goal (no token, unknown task, a run going
+  and no room to wait) fails as rosbridge fails a goal: ``result: false``, status UNKNOWN, the reason as
+  ``values``.
 
 Anonymous clients only read: recording a plan and running a task write the store, so they need a
 caller that sent the update token (op ``auth``) or a page of this server's own (its handshake's
@@ -69,7 +74,7 @@ from cbrs.matchmakers import Matchmakers
 from cbrs.rosbridge import Bridge, GoalHandle, GoalResult, GoalStatus, ServiceError, current_caller
 from cbrs.rosbridge.session import TOKEN_REFUSED
 from cbrs.sparql_service import SparqlService
-from cbrs.tasks import RUN_TOPIC, TaskRun, TaskRunner, check_choice, check_near_misses
+from cbrs.tasks import RUN_TOPIC, TaskRun, TaskRunner, check_choice, check_near_misses, in_line
 
 if TYPE_CHECKING:
     from cbrs.actions.composer import Composer, Objective
@@ -226,8 +231,9 @@ class KnowledgeServices:
         """The /cbrs/run_task action: start the run, relay its steps as feedback, wait for its end.
 
         A cancel asks the run to stop after the step under way (at once during a remote call, abandoned:
-        docs/execution.md, "A Stop during a remote call"). The wait has no deadline of its own:
-        a run always ends (the executor's tick bound), and a server stopping cancels the goal.
+        docs/execution.md, "A Stop during a remote call"); a queued run it takes out of the queue. The wait has
+        no deadline of its own: a run always ends (the executor's tick bound), a queued one ends when the server
+        stops (``TaskRunner.close``), and a server stopping cancels the goal.
         """
         _check_fields("/cbrs/run_task", _RUN, goal.args)
         request = self._run_request(goal.args)
@@ -292,9 +298,10 @@ class StepFeed:
         self._names: dict[str, str] = {}  # the run's iri and shown, as its record (TaskRun.to_dict) has them
         self._early: list[dict[str, Any]] = []
         self._plan = 1
+        self._queued = False
 
     def __call__(self, topic: str, message: dict[str, Any]) -> None:
-        if topic != "/cbrs/task_progress":
+        if topic != "/cbrs/task_progress" and not (topic == RUN_TOPIC and message.get("event") == "run_started"):
             return
         with self._lock:  # held while relaying, so the held events go first
             if self._run is None:
@@ -303,10 +310,23 @@ class StepFeed:
                 self._relay(message)
 
     def follow(self, run: TaskRun) -> None:
-        """The run is known: relay what came before and follow it from now on."""
+        """The run is known: relay what came before and follow it from now on. A queued run is said so
+        first (``status`` queued, its place in line as ``reason``); its start is said when it comes."""
         with self._lock:
             self._run = run.id
             self._names = {"iri": run.iri, "shown": run.shown or run.task}
+            self._queued = run.queued is not None
+            position = run.position
+            if self._queued:
+                place = in_line(position) if position is not None else "its turn has come"
+                self.goal.publish_feedback(
+                    {
+                        "run": run.id,
+                        **self._names,
+                        "status": "queued",
+                        "reason": f"queued behind the run going: {place}",
+                    }
+                )
             early, self._early = self._early, []
             for message in early:
                 self._relay(message)
@@ -315,7 +335,10 @@ class StepFeed:
         if message.get("run") != self._run:
             return
         event = message.get("event")
-        if event == "replanning":
+        if event == "run_started":
+            if self._queued:  # a queued run's turn came: said once, before its steps
+                self.goal.publish_feedback({"run": self._run, **self._names, "status": "running", "reason": ""})
+        elif event == "replanning":
             self._plan = int(message.get("plan", self._plan + 1))
         elif event in ("step_succeeded", "step_failed"):
             component = message.get("component")

@@ -329,6 +329,16 @@ SETTINGS: tuple[Setting, ...] = (
         _positive(int),
     ),
     Setting(
+        "run_queue",
+        lambda: 0,
+        "Task runs that may wait while one goes (a Start on the tasks page, a /cbrs/run_task call or goal): "
+        "each starts, planned on the world as the run before left it, when that run ends; one more is refused "
+        "saying the queue is full. 0: none wait, a run started while one goes is refused, as before "
+        "(docs/web.md).",
+        "CBRS_RUN_QUEUE",
+        _non_negative,
+    ),
+    Setting(
         "bridge_non_finite",
         lambda: "null",
         "How the bridge's JSON text frames write a NaN or an infinity, which JSON has no number for: null "

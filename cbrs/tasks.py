@@ -4,6 +4,12 @@ A run composes the task, executes it in a fresh headless world and records its e
 rosbridge topics, the browser) receive every event as it happens, from the run's thread. A task no plan
 can come of ends ``no-plan`` before the world is built (:func:`refusal_in_home`, as ``cbrs run`` refuses it).
 
+While a run goes, a run started waits in the runner's queue when it has room (``run_queue``, the
+``CBRS_RUN_QUEUE`` setting; 0 by default: refused, :class:`TaskBusyError`, as before the queue): it is
+``queued`` with its ``position`` (1: next), starts when the run before it ends, and is planned then, on the
+world as that run left it. A cancel takes it out of the queue; a server stopping ends those waiting
+``cancelled``, each with its ``reason``.
+
 The runner also keeps the ceiling camera's latest view (a JPEG and a counter). A run renders it only
 while someone watches (:meth:`TaskRunner.watch`: the browser's MJPEG stream, a still asked for): when the
 run starts, after every step that ends, and within ``FRAME_CHECK_STEPS`` physics steps of a watcher
@@ -34,6 +40,7 @@ from cbrs.kb import KnowledgeBase
 from cbrs.kb.derived_prefixes import StoreNames
 from cbrs.kb.errors import KnowledgeBaseError
 from cbrs.kb.namespaces import expand, shorten, store_names
+from cbrs.settings import setting
 
 if TYPE_CHECKING:
     from cbrs.actions.composer import Composer
@@ -72,11 +79,26 @@ class CameraFrame:
 
 
 class TaskBusyError(KnowledgeBaseError):
+    """A run started while another goes, with no queue to wait in (``run_queue`` 0)."""
+
     http_status = 409
 
-    def __init__(self, running: str) -> None:
+    def __init__(self, running: str, message: str | None = None) -> None:
         self.running = running
-        super().__init__(f"task run {running} is still going; one task runs at a time")
+        super().__init__(message or f"task run {running} is still going; one task runs at a time")
+
+
+class RunQueueFullError(TaskBusyError):
+    """A run started while another goes and ``limit`` runs already wait: the queue is full."""
+
+    def __init__(self, running: str, waiting: int, limit: int) -> None:
+        self.waiting, self.limit = waiting, limit
+        runs = "run waits" if waiting == 1 else "runs wait"
+        super().__init__(
+            running,
+            f"task run {running} is still going and the run queue is full: {waiting} {runs}, as many as it "
+            f"holds (run_queue {limit}); start again when one has ended",
+        )
 
 
 class TasksDisabledError(KnowledgeBaseError):
@@ -129,7 +151,7 @@ class TaskRun:
     fault_rate: float = 0.0  # random faults, seeded with ``seed`` (actions.faults.RandomFaults)
     repeat_failures: int = 1  # actions.replanning.ReplanPolicy.max_repeats
     iri: str = ""  # the requirement or action ``task`` names
-    status: str = "running"  # then succeeded, failed, cancelled, no-plan or error
+    status: str = "running"  # or queued before it; then succeeded, failed, cancelled, no-plan or error
     started: float = field(default_factory=time.time)
     finished: float | None = None
     events: list[dict[str, Any]] = field(default_factory=list)
@@ -142,6 +164,9 @@ class TaskRun:
     base_ties: str = "nearest"  # actions.base_choice.BaseTies
     near_misses: int = 3  # ComposeConfig.near_misses (TaskRunner.start fills in its default)
     shown: str = ""  # the task as the pages name it (:func:`shown_name`; TaskRunner.start fills it in)
+    position: int | None = None  # while queued: its place in the queue, 1 the next to start
+    queued: float | None = None  # when it was queued (None: it started at once)
+    reason: str | None = None  # why it ended without starting (taken out of the queue)
 
     def to_dict(self, with_events: bool = True) -> dict[str, Any]:
         found: dict[str, Any] = {
@@ -162,6 +187,10 @@ class TaskRun:
         }
         if self.error:
             found["error"] = self.error
+        if self.status == "queued" and self.position is not None:
+            found["position"] = self.position
+        if self.reason:
+            found["reason"] = self.reason
         if with_events:
             found["events"] = list(self.events)
         if self.result is not None:
@@ -193,6 +222,14 @@ def shown_name(listed: str, iri: str, shortened: Callable[[str], str] | None = N
     return listed if ":" not in typed else tail(iri)
 
 
+def in_line(position: int) -> str:
+    """Where a queued run stands, as the pages and the bridge say it: "next in line", "3rd in line"."""
+    if position == 1:
+        return "next in line"
+    suffix = "th" if 10 <= position % 100 <= 20 else {1: "st", 2: "nd", 3: "rd"}.get(position % 10, "th")
+    return f"{position}{suffix} in line"
+
+
 def _naming(run: TaskRun) -> dict[str, str]:
     """How every message of a run names it and its task: ``task`` as asked for (kept as it was), ``iri``
     and ``shown`` as the run's record has them."""
@@ -210,7 +247,8 @@ def _view(world: Any, wanted: str) -> str:
 
 
 class TaskRunner:
-    """Starts task runs in the simulated home, one at a time, and keeps the last ``keep`` of them."""
+    """Starts task runs in the simulated home, one at a time, queues up to ``queue`` more while one goes
+    (None: the ``run_queue`` setting), and keeps the last ``keep`` runs that ended, beside those to come."""
 
     def __init__(
         self,
@@ -219,7 +257,15 @@ class TaskRunner:
         keep: int = 20,
         camera: str | None = CAMERA,
         read_only: bool = False,
+        queue: int | None = None,
     ) -> None:
+        size = int(setting("run_queue").resolve()) if queue is None else queue
+        if isinstance(size, bool) or size < 0:
+            raise ValueError(f"a run queue holds 0 runs or more, not {queue!r}")
+        self.queue_size = size
+        """How many runs may wait while one goes (0: a run started then is refused)."""
+        self._waiting: list[TaskRun] = []
+        self._closed = False
         self.kb = kb
         self.lock = lock
         self.read_only = read_only
@@ -375,7 +421,7 @@ class TaskRunner:
         with store_names(StoreNames(lambda: self.kb)):  # the names a run's texts and cbrs run --fail take
             failing = tuple(expand(f) for f in faults)
             _check_components(self.kb, failing)
-        self._refuse_if_busy()  # a second run is refused before its task is checked
+        self._refuse_if_full()  # a run with no room to wait is refused before its task is checked
         with self.lock:
             library = ActionLibrary.from_kb(self.kb)
             iri = task_iri(self.kb, task, library)  # an unknown task fails here, not in the thread
@@ -383,22 +429,91 @@ class TaskRunner:
             with store_names(StoreNames(lambda: self.kb)):
                 shown = shown_name(task, iri)
         with self._guard:
-            self._refuse_if_busy()
+            ahead = self._refuse_if_full()
             run = TaskRun(f"run-{next(self._ids)}", task, seed, failing, fault_rate, repeat_failures, iri)
             run.objective, run.base_ties, run.near_misses, run.shown = objective, base_ties, near_misses, shown
-            thread = threading.Thread(target=self._run, args=(run,), name=f"cbrs-{run.id}", daemon=True)
-            self._active = (run, thread)
             self._runs[run.id] = run
-            while len(self._runs) > self.keep:
-                self._runs.popitem(last=False)
+            self._forget_old()
+            if ahead is not None:  # room in the queue: it starts when the runs before it have ended
+                run.status, run.queued = "queued", run.started
+                self._waiting.append(run)
+                run.position = len(self._waiting)
+            else:
+                thread = threading.Thread(target=self._run, args=(run,), name=f"cbrs-{run.id}", daemon=True)
+                self._active = (run, thread)
+        if ahead is not None:
+            log.info("task run %s (%s) queued, %s in line behind %s", run.id, run.task, run.position, ahead.id)
+            self._emit(RUN_TOPIC, {"event": "run_queued", **_naming(run), "status": "queued"})
+            return run
         self._emit(RUN_TOPIC, {"event": "run_started", **_naming(run)})
         thread.start()
         return run
 
-    def _refuse_if_busy(self) -> None:
+    def _refuse_if_full(self) -> TaskRun | None:
+        """The run a run started now would wait behind (the last queued, else the one going); None when
+        none goes; :class:`TaskBusyError` (:class:`RunQueueFullError`) when the queue has no room."""
         going = self.active()
-        if going is not None:
-            raise TaskBusyError(going.id)
+        waiting = list(self._waiting)
+        if going is None and not waiting:
+            return None
+        running = going.id if going is not None else waiting[0].id
+        if self.queue_size == 0:
+            raise TaskBusyError(running)
+        if len(waiting) >= self.queue_size:
+            raise RunQueueFullError(running, len(waiting), self.queue_size)
+        return waiting[-1] if waiting else going
+
+    def waiting(self) -> list[TaskRun]:
+        """The runs queued, the next to start first."""
+        with self._guard:
+            return list(self._waiting)
+
+    def _forget_old(self) -> None:
+        """Keep ``keep`` runs at most, forgetting the oldest that have ended (never one going or queued)."""
+        while len(self._runs) > self.keep:
+            ended = next((key for key, old in self._runs.items() if old.finished is not None), None)
+            if ended is None:
+                return
+            del self._runs[ended]
+
+    def _renumber(self) -> None:
+        for place, queued in enumerate(self._waiting, 1):
+            queued.position = place
+
+    def _promote(self, before: TaskRun) -> None:
+        """The next queued run made the one going, its thread started: it begins once ``before`` has
+        said its end (:meth:`_run_queued`). Called by the run ending, before it says so."""
+        with self._guard:
+            if self._closed or not self._waiting:
+                return
+            run = self._waiting.pop(0)
+            run.position = None
+            self._renumber()
+            thread = threading.Thread(target=self._run_queued, args=(run, before), name=f"cbrs-{run.id}", daemon=True)
+            self._active = (run, thread)
+            thread.start()
+
+    def _run_queued(self, run: TaskRun, before: TaskRun) -> None:
+        """A queued run's thread: wait until the run before it has ended (its ``run_finished`` said), then
+        run it, planned now on the world as that run left it; stopped or shut down meanwhile, it ends
+        ``cancelled`` without starting."""
+        before.done.wait()
+        if run.cancel_requested.is_set() or self._closed:
+            why = "the server stopped" if self._closed else "it was stopped"
+            self._end_unstarted(run, f"{why} before it started (it was queued)", promote=not self._closed)
+            return
+        run.status, run.started = "running", time.time()
+        self._emit(RUN_TOPIC, {"event": "run_started", **_naming(run)})
+        self._run(run)
+
+    def _end_unstarted(self, run: TaskRun, reason: str, promote: bool) -> None:
+        """End a queued run that never started: ``cancelled``, with ``reason``; said on the run topic."""
+        run.status, run.reason, run.position, run.finished = "cancelled", reason, None, time.time()
+        log.info("task run %s (%s) ended without starting: %s", run.id, run.task, reason)
+        if promote:
+            self._promote(run)
+        self._emit(RUN_TOPIC, {"event": "run_finished", **_naming(run), "status": run.status})
+        run.done.set()
 
     def run(
         self,
@@ -418,9 +533,17 @@ class TaskRunner:
 
     def cancel(self, run_id: str) -> TaskRun:
         """Ask a run to stop after the step under way, or at once while it waits on a remote component's call,
-        which it abandons (docs/execution.md; a run that has ended is left as it is)."""
+        which it abandons (docs/execution.md; a run that has ended is left as it is). A queued run is taken
+        out of the queue at once and ends ``cancelled`` without starting; those behind it move up."""
         run = self.get(run_id)
         run.cancel_requested.set()
+        with self._guard:
+            queued = run in self._waiting
+            if queued:
+                self._waiting.remove(run)
+                self._renumber()
+        if queued:
+            self._end_unstarted(run, "taken out of the queue before it started (stopped)", promote=False)
         return run
 
     def get(self, run_id: str) -> TaskRun:
@@ -434,9 +557,20 @@ class TaskRunner:
             return list(self._runs.values())
 
     def close(self, timeout: float = 30.0) -> None:
-        """Wait (bounded) for a run still going; it cannot be interrupted mid-step. The log says which run
-        was waited for and how it ended, or that it did not, for the administrator who stopped the server:
-        the bridge and HTTP listeners are closed by then, so no client hears the run's verdict."""
+        """End the queued runs (``cancelled``, the server stopping before they started), then wait (bounded)
+        for a run still going; it cannot be interrupted mid-step. The log says which run was waited for and
+        how it ended, or that it did not, for the administrator who stopped the server: the bridge and HTTP
+        listeners are closed by then, so no client hears the run's verdict."""
+        with self._guard:
+            self._closed = True
+            waiting, self._waiting = self._waiting, []
+        for run in waiting:
+            run.cancel_requested.set()
+            self._end_unstarted(run, "the server stopped before it started (it was queued)", promote=False)
+        if waiting:
+            log.warning(
+                "%d queued task run(s) ended without starting: %s", len(waiting), ", ".join(r.id for r in waiting)
+            )
         active = self._active
         if active is None or not active[1].is_alive():
             return
@@ -489,6 +623,7 @@ class TaskRunner:
             run.status, run.error = "error", f"{type(error).__name__}: {error}"
         finally:
             run.finished = time.time()
+            self._promote(run)  # the next queued run goes now; it begins once this one's end is said
             # Said before done is set: whoever waited for the end (the bridge's action, a test) has heard it.
             self._emit(RUN_TOPIC, {"event": "run_finished", **_naming(run), "status": run.status})
             run.done.set()

@@ -36,6 +36,7 @@ from cbrs.tasks import (
     TaskRunner,
     TasksDisabledError,
     UnknownComponentError,
+    in_line,
     preconditions_line,
 )
 from cbrs.web import context, services
@@ -71,8 +72,9 @@ def tasks() -> Page:
     """The tasks to start, the run going now (or the last one), the camera and the recent runs.
 
     A POST starts a run (202, its ``Location`` the run's page, or its JSON for a JSON answer; a browser's form
-    is sent on to the run's page, 303: :func:`_from_a_browser`); while one
-    is going it is refused with 409 and says which. A program gets JSON here as at ``/tasks.json`` when
+    is sent on to the run's page, 303: :func:`_from_a_browser`); while one is going it waits in the runner's
+    queue when there is room (202 too, ``queued`` with its ``position``), else it is refused with 409 and says
+    which run goes (and that the queue is full, with a queue). A program gets JSON here as at ``/tasks.json`` when
     it prefers it (:func:`cbrs.web.pages.prefers_json`).
     """
     form = _form()
@@ -97,8 +99,11 @@ def tasks() -> Page:
     _starters(started.id)
     shown.status = 303 if _from_a_browser() else 202  # Post/Redirect/Get: a reload re-sent the form, a 409 mid-run
     shown.headers["Location"] = url_for("tasks.run_json" if wants_json() else "tasks.run", run_id=started.id)
-    shown.title = f"Tasks: {started.id} started"
-    said = f"{started.id} started: {shown_task(started.task, started.iri)}"
+    queued = started.status == "queued"
+    shown.title = f"Tasks: {started.id} {'queued' if queued else 'started'}"
+    said = f"{started.id} {'queued' if queued else 'started'}: {shown_task(started.task, started.iri)}"
+    if queued:
+        said += f", {_in_line(started)}; it starts when the runs before it have ended"
     shown.data.update(_overview(form), started=_started(started), message=said)
     return shown
 
@@ -108,7 +113,9 @@ def run(run_id: str) -> Page:
     """One run: its steps, every event it published, and its result (the plan and execution report)."""
     found = context.tasks().get(run_id)  # an unknown run: 404
     data = {"mode": "run", "run": _detail(found), **_live()}
-    if found.cancel_requested.is_set():  # what Stop's 303 led here to say (the run may have ended meanwhile)
+    if found.reason:  # taken out of the queue (Stop, the server stopping): said in place of the stop under way
+        data["message"] = f"{found.id} ended {found.status} without starting: {found.reason}"
+    elif found.cancel_requested.is_set():  # what Stop's 303 led here to say (the run may have ended meanwhile)
         data["message"] = _stopping(found) + (f"; it ended {found.status}" if found.done.is_set() else "")
     return _for_script(Page("tasks.html", f"Run {found.id}: {data['run']['shown']}, {found.status}", data))
 
@@ -120,7 +127,8 @@ def cancel(run_id: str) -> Page:
 
     A browser's form is sent on to the run's page (303, as Start's is: :func:`_from_a_browser`): it stayed at
     ``/cancel``, and a reload sent the Stop again and got the 409 below. A run that has already ended is left
-    as it is and said so (409), as the bridge's cancel does.
+    as it is and said so (409), as the bridge's cancel does. A queued run is taken out of the queue (202; it
+    ends ``cancelled`` without starting), by the same people.
     """
     _may_act("stopped")
     found = context.tasks().get(run_id)  # an unknown run: 404
@@ -131,14 +139,21 @@ def cancel(run_id: str) -> Page:
         shown = Page("tasks.html", f"Run {found.id}: {shown_task(found.task, found.iri)}, {found.status}", data)
         shown.status = 409
         return _for_script(shown)
+    was_queued = found.status == "queued"
     context.tasks().cancel(run_id)
-    data.update(run=_detail(found), message=_stopping(found))
-    shown = Page("tasks.html", f"Run {found.id}: {shown_task(found.task, found.iri)}, stopping", data)
+    said = _stopping(found) if not found.reason else f"{found.id} {found.reason}; it ends {found.status}"
+    data.update(run=_detail(found), message=said)
+    state = "taken out of the queue" if was_queued and found.reason else "stopping"
+    shown = Page("tasks.html", f"Run {found.id}: {shown_task(found.task, found.iri)}, {state}", data)
     shown.status = 202
     if _from_a_browser():  # Post/Redirect/Get
         shown.status = 303
         shown.headers["Location"] = url_for("tasks.run", run_id=found.id)
     return _for_script(shown)
+
+
+def _in_line(found: TaskRun) -> str:
+    return in_line(found.position or 1)
 
 
 def _starters(started: str | None = None) -> dict[str, str | None]:
@@ -411,6 +426,8 @@ def _overview(form: dict[str, Any]) -> dict[str, Any]:
         "components": offered["components"],
         "active": _detail(latest) if latest is not None else None,
         "runs": [_summary(r) for r in reversed(runs)],
+        "run_queue": runner.queue_size,
+        "waiting": len(runner.waiting()),
         **_live(),
     }
 
@@ -500,6 +517,8 @@ def _summary(found: TaskRun) -> dict[str, Any]:
     data["faults"] = [short(f) for f in found.faults]
     data["url"] = url_for("tasks.run", run_id=found.id)
     data["shown"] = shown_task(found.task, found.iri)
+    if found.status == "queued":
+        data["in_line"] = _in_line(found)
     return data
 
 
@@ -517,6 +536,8 @@ def _detail(found: TaskRun) -> dict[str, Any]:
     data = found.to_dict()
     data["url"] = url_for("tasks.run", run_id=found.id)
     data["shown"] = shown_task(found.task, found.iri)
+    if found.status == "queued":
+        data["in_line"] = _in_line(found)
     data["steps"] = steps(data["events"])
     data["unmet"] = unmet(data.get("result"))
     data["verdict"] = verdict(data)
@@ -543,6 +564,8 @@ def verdict(run: dict[str, Any]) -> str | None:
         return f"{execution['status']}{reason}; {result.get('sim_seconds', 0.0)} s simulated"
     if run.get("error"):
         return str(run["error"])
+    if run.get("reason"):  # it never started: taken out of the queue
+        return f"{run.get('status')} without starting: {run['reason']}"
     plan = result.get("plan")
     if not plan or run.get("status") != "no-plan":
         return None

@@ -1,5 +1,6 @@
 // The tasks page, live: follows /tasks/events (server-sent events) and keeps the step table, the event
-// list, the status badge, the camera's frame counter and the recent runs current. No dependencies.
+// list, the status badge, the camera's frame counter and the recent runs current; a run's page follows a
+// queued run (its place in line) until it starts, then the run. No dependencies.
 (function () {
   "use strict";
   const live = document.getElementById("live");
@@ -44,13 +45,18 @@
     return el("a", { href: resource + "?iri=" + encodeURIComponent(iri), title: iri }, shorten(iri));
   }
 
-  function setBadge(status) {
+  function setBadge(status, inLine) {
     badge.textContent = status;
     badge.className = "badge status-" + status;
     live.dataset.status = status;
+    const place = byId("in-line");
+    if (place) {
+      place.textContent = status === "queued" ? inLine || "" : "";
+      place.hidden = status !== "queued";
+    }
     const stop = byId("cancel");
     if (stop) {
-      stop.hidden = status !== "running";
+      stop.hidden = status !== "running" && status !== "queued";
       if (current) stop.action = live.dataset.runs + "/" + encodeURIComponent(current) + "/cancel";
     }
   }
@@ -162,7 +168,7 @@
           el("td", {}, r.shown || r.task),
           el("td", { class: "num" }, String(r.seed)),
           el("td", {}, r.faults.join(", ") || "–"),
-          el("td", {}, el("span", { class: "badge status-" + r.status }, r.status)),
+          el("td", {}, el("span", { class: "badge status-" + r.status }, r.status), r.in_line ? el("span", { class: "muted small" }, " " + r.in_line) : ""),
           el("td", { class: "num" }, r.finished ? (r.finished - r.started).toFixed(1) : "…"),
         ),
       ),
@@ -179,8 +185,16 @@
     steps.replaceChildren();
     eventList.replaceChildren();
     run.events.forEach(handleRunEvent);
-    setBadge(run.status);
+    setBadge(run.status, run.in_line);
     if (run.verdict) verdict.textContent = shortenText(run.verdict);
+  }
+
+  async function followQueued() {
+    // A queued run's page: the runs before it started or ended, so its place in line changed (or it left).
+    const response = await fetch(live.dataset.runs + "/" + encodeURIComponent(current) + ".json");
+    if (!response.ok) return;
+    const run = (await response.json()).run;
+    if (run && run.id === current && run.status === "queued") setBadge(run.status, run.in_line);
   }
 
   async function showVerdict(id) {
@@ -206,15 +220,19 @@
       showFrame(message.frame);
       const mine = follow === "latest" || follow === message.active;
       if (message.active && mine) catchUp(message.active);
-      else if (live.dataset.status === "running" && current) catchUp(current); // it ended while we were away
+      else if ((live.dataset.status === "running" || live.dataset.status === "queued") && current) catchUp(current); // it started or ended while we were away
       return;
     }
     if (message.event === "frame") return showFrame(message.frame);
     if (message.event === "store_updated") return;
-    if (message.event === "run_started" && follow === "latest") {
+    if (message.event === "run_started" && (follow === "latest" || follow === message.run)) {
       startRun(message.run, message.shown || message.task); // the pages' name (lab10:SwitchOnTheReadingLamp)
     }
-    if (message.run !== current) return;
+    if (message.run !== current) {
+      if (message.event === "run_queued" || message.event === "run_finished") refreshRuns(); // the queue changed
+      if (live.dataset.status === "queued" && /^run_/.test(message.event || "")) followQueued();
+      return;
+    }
     handleRunEvent(message);
     if (message.event === "run_finished") refreshRuns();
   }
@@ -242,8 +260,9 @@
         if (message.topic === "/cbrs/task_progress") stepEvent(message);
         listEvent(message);
       });
-      const ended = live.dataset.status === "running" && run.status !== "running";
-      setBadge(run.status);
+      const was = live.dataset.status;
+      const ended = (was === "running" || was === "queued") && run.status !== "running" && run.status !== "queued";
+      setBadge(run.status, run.in_line);
       if (run.verdict) verdict.textContent = shortenText(run.verdict);
       if (ended) refreshRuns();
     }
@@ -332,7 +351,11 @@
         });
         const data = await response.json();
         let note;
-        if (response.status === 202) {
+        if (response.status === 202 && data.started.status === "queued") {
+          // it waits its turn: the page goes on following the run going, and its own page follows it
+          note = el("p", { class: "ok-box form-message", role: "status" }, data.message + "; ", el("a", { href: data.started.page }, "its own page"), ".");
+          refreshRuns();
+        } else if (response.status === 202) {
           startRun(data.started.id, data.started.shown || data.started.task);
           note = el("p", { class: "ok-box form-message", role: "status" }, data.message);
         } else if (data.fields) {
