@@ -53,11 +53,11 @@ from cbrs.kb.errors import (
 from cbrs.kb.namespaces import PREFIXES
 from cbrs.kb.query_guard import start_evaluation_thread
 from cbrs.kb.served_updates import HEADER, header_value
+from cbrs.kb.sparql_hints import FORMS, TOKENS, explain_syntax_error, first_keyword
 from cbrs.kb.store import EmbeddedStore, QueryResult, is_remote, refuse_inserted_blank_nodes
 from cbrs.query_workers import QueryProcesses, QueryStopped, Request
 from cbrs.scan_queries import is_single_scan, single_scan, uses_prefixes
 from cbrs.settings import setting
-from cbrs.sparql_hints import FORMS, TOKENS, explain_syntax_error, first_keyword
 
 # Media types offered for SELECT and ASK results, the first being the default.
 RESULT_TYPES: dict[str, ox.QueryResultsFormat] = {
