@@ -479,7 +479,11 @@ class SparqlService:
         self._check_size(text)
         graphs = dataset_for(text, dataset)
         scan = isinstance(self.kb.store, EmbeddedStore) and is_single_scan(text)
-        release = self._admit(client, slot=not scan)
+        try:
+            release = self._admit(client, slot=not scan)
+        except EndpointBusyError:
+            self._refuse_malformed(text)
+            raise
         if scan:  # one index scan: stopped by the writer's deadline, so it needs no worker (cbrs.scan_queries)
             try:
                 deadline = time.monotonic() + self.config.timeout
@@ -595,6 +599,22 @@ class SparqlService:
         """Stop the query worker processes and delete their snapshots."""
         if self.processes is not None:
             self.processes.close()
+
+    def _refuse_malformed(self, text: str) -> None:
+        """Raise ``text``'s syntax error if it has one. A busy endpoint answered a text that does not parse
+        "busy", so a class whose other students held every worker was told to retry a typo; parsing
+        (never evaluating: the solutions are lazy) on an empty store costs only the refused request, and a
+        long text is parsed by the query guard's checker process, as any long text is."""
+        store = self.kb.store
+        if not isinstance(store, EmbeddedStore):
+            return  # a remote store parses and answers its own errors
+        store.guard.admit("query", text)
+        if len(text) > store.guard.direct_chars:
+            return
+        try:
+            ox.Store().query(text, prefixes=PREFIXES, use_default_graph_as_union=True)
+        except SyntaxError as error:
+            raise QuerySyntaxError(text, str(error)) from error
 
     def _admit(self, client: str | None, slot: bool = True) -> Callable[[], None]:
         """Count a query of ``client`` against its share and, with ``slot``, take one of the ``workers``

@@ -14,6 +14,7 @@ from flask.testing import FlaskClient
 import cbrs.web
 from cbrs import home_canvas
 from cbrs.kb import KnowledgeBase
+from cbrs.kb.errors import QuerySyntaxError
 from cbrs.sparql_service import EndpointBusyError, EndpointConfig, QueryTimeoutError, SparqlService
 from cbrs.tasks import CameraFrame, TaskRunner
 from cbrs.web import create_app, diagram
@@ -47,6 +48,27 @@ def test_every_worker_taken_says_the_query_is_fine_and_to_run_it_again(
     assert "all 4 query workers are busy" in text  # the endpoint's words, kept
     assert "Nothing is wrong with this query" in text and "run it again in a few seconds" in text
     assert 'id="query-advice"' in text and "Run it again</a>" in text
+
+
+def test_a_typo_sent_while_every_worker_is_taken_gets_its_syntax_error(
+    client: FlaskClient, service: SparqlService
+) -> None:
+    """A text that does not parse was answered "busy" while others' queries held the workers (11 of the
+    class's typos and cross products were), so the page said nothing was wrong with it; a long one is
+    parsed by the query guard's checker, as any long text is."""
+    long_typo = "SELEKT * WHERE { ?s ?p ?o " + "FILTER(?o != 1) " * 40 + "}"
+    held = [service._admit(f"10.0.0.{n}") for n in range(4)]
+    try:
+        for typo in ("SELEKT * WHERE { ?s ?p ?o }", long_typo):
+            with pytest.raises(QuerySyntaxError, match="SELEKT"):
+                service.query(typo, client="10.0.1.1")
+        with pytest.raises(EndpointBusyError):
+            service.query(CROSS, client="10.0.1.1")
+        page = client.get("/query", query_string={"query": "SELECT * WHERE { ?s ?p ?o"})
+    finally:
+        for release in held:
+            release()
+    assert page.status_code == 400 and "busy" not in page.get_data(as_text=True)
 
 
 def test_a_query_out_of_time_says_how_to_narrow_it(client: FlaskClient, monkeypatch: pytest.MonkeyPatch) -> None:
