@@ -164,7 +164,7 @@ def test_the_colour_precondition_holds_by_the_map_of_the_mug_designated(two_mugs
 
 def test_a_colour_precondition_no_thing_meets_is_refused_before_anything_moves(tmp_path: Path) -> None:
     """The green mug's task where the map has only the red mug: refused before anything moves, by the
-    colour the map states of it (it ran, the precondition taken as given, and brought the red mug)."""
+    colour the map states of it (the precondition was taken as given)."""
     red = tmp_path / "red_mug.ttl"
     red.write_text(TWO_MUGS.split("lab:GreenMug1")[0])
     kb = KnowledgeBase.open(":memory:")
