@@ -26,6 +26,7 @@ from typing import Any, NoReturn, TypeAlias, TypeVar
 import numpy as np
 from numpy.typing import NDArray
 
+from cbrs.kb.name_errors import UnknownPrefixError
 from cbrs.kb.namespaces import HOME, expand
 from cbrs.kb.semantic_map import MapObject, local_name
 from cbrs.sim.errors import SimulationError
@@ -650,6 +651,8 @@ def check(concept: str, data: object, is_a: IsA | None = None) -> dict[str, Any]
         raise MalformedValueError(concept, "@type", written, f"the class of the value ({named})")
     try:
         full = expand(written)
+    except UnknownPrefixError as error:  # its did-you-mean: hom:Door for home:Door
+        raise MalformedValueError(concept, "@type", written, f"an IRI or a prefixed name ({error.reason})") from None
     except ValueError:
         raise MalformedValueError(concept, "@type", written, "an IRI or a prefixed name") from None
     is_a = is_a if is_a is not None else bundled_taxonomy()

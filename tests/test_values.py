@@ -47,6 +47,7 @@ from cbrs.sim.values import (
     MalformedValueError,
     Manipulation,
     ObjectFeature,
+    check,
     concepts_of,
     decode,
     from_json,
@@ -356,3 +357,10 @@ def test_every_type_with_a_shape_is_documented() -> None:
     for kind in kinds:
         for concept in concepts_of(kind):
             assert f"`home:{concept.rsplit('#')[-1]}`" in text, concept
+
+
+def test_a_type_of_a_misspelt_prefix_is_refused_with_the_name_meant() -> None:
+    """A component's ``"@type": "hom:Opened"`` was refused as "expected an IRI or a prefixed name", leaving
+    its author to find the slip; the refusal now says which prefix is unknown and the name it may mean."""
+    with pytest.raises(MalformedValueError, match=r"hom: is declared nowhere .*did you mean home:Opened\?"):
+        check(HOME + "DoorStatus", {"@type": "hom:Opened"})
