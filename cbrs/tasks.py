@@ -442,7 +442,7 @@ class TaskRunner:
                 thread = threading.Thread(target=self._run, args=(run,), name=f"cbrs-{run.id}", daemon=True)
                 self._active = (run, thread)
         if ahead is not None:
-            log.info("task run %s (%s) queued, %s in line behind %s", run.id, run.task, run.position, ahead.id)
+            log.info("task run %s (%s) queued, %s behind %s", run.id, run.task, in_line(run.position or 1), ahead.id)
             self._emit(RUN_TOPIC, {"event": "run_queued", **_naming(run), "status": "queued"})
             return run
         self._emit(RUN_TOPIC, {"event": "run_started", **_naming(run)})
