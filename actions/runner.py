@@ -836,8 +836,9 @@ def _undecided(
     return error.noting(
         f"the task's precondition {which} does not tell them apart: a precondition is what the requester "
         "guarantees of the thing the task names, and of several things of its class it leaves out only those "
-        "whose quantity stated in the map decides it false (a status defined by a measured quantity, of which "
-        "each states a level: home:massKg for a home:ObjectWeight); here none or each is left",
+        "whose quantity or colour stated in the map decides it false (a status defined by a measured quantity, "
+        "of which each states a level: home:massKg for a home:ObjectWeight; or a colour, by the window of its "
+        "home:colourName: home:windowColour); here none or each is left",
         requirement.iri,
     )
 
