@@ -439,7 +439,7 @@ class TaskRunner:
                 self._waiting.append(run)
                 run.position = len(self._waiting)
             else:
-                thread = threading.Thread(target=self._run, args=(run,), name=f"cbrs-{run.id}", daemon=True)
+                thread = threading.Thread(target=self._go, args=(run,), name=f"cbrs-{run.id}", daemon=True)
                 self._active = (run, thread)
         if ahead is not None:
             log.info("task run %s (%s) queued, %s behind %s", run.id, run.task, in_line(run.position or 1), ahead.id)
@@ -480,9 +480,16 @@ class TaskRunner:
         for place, queued in enumerate(self._waiting, 1):
             queued.position = place
 
+    def _go(self, run: TaskRun) -> None:
+        """A run's thread: the run, then the next queued run's turn (whatever ``_run`` is: a test's script)."""
+        try:
+            self._run(run)
+        finally:
+            self._promote(run)
+
     def _promote(self, before: TaskRun) -> None:
         """The next queued run made the one going, its thread started: it begins once ``before`` has
-        said its end (:meth:`_run_queued`). Called by the run ending, before it says so."""
+        said its end (:meth:`_run_queued`). A run started meanwhile (one that heard the end) queues behind it."""
         with self._guard:
             if self._closed or not self._waiting:
                 return
@@ -504,7 +511,7 @@ class TaskRunner:
             return
         run.status, run.started = "running", time.time()
         self._emit(RUN_TOPIC, {"event": "run_started", **_naming(run)})
-        self._run(run)
+        self._go(run)
 
     def _end_unstarted(self, run: TaskRun, reason: str, promote: bool) -> None:
         """End a queued run that never started: ``cancelled``, with ``reason``; said on the run topic."""
@@ -623,7 +630,6 @@ class TaskRunner:
             run.status, run.error = "error", f"{type(error).__name__}: {error}"
         finally:
             run.finished = time.time()
-            self._promote(run)  # the next queued run goes now; it begins once this one's end is said
             # Said before done is set: whoever waited for the end (the bridge's action, a test) has heard it.
             self._emit(RUN_TOPIC, {"event": "run_finished", **_naming(run), "status": run.status})
             run.done.set()
