@@ -308,3 +308,63 @@ def test_the_bridge_queues_a_goal_says_so_and_its_cancel_takes_it_out(
     finally:
         gates.open_all()
         worker.join(WAIT)
+
+
+def test_over_the_bridge_a_goal_waits_in_the_queue_and_its_cancel_takes_it_out(
+    fresh_bundled_kb: KnowledgeBase, gates: Gates, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``/cbrs/run_task`` over a real websocket of ``cbrs serve`` (``CBRS_RUN_QUEUE=1``): a goal while a run
+    goes is said queued, a third is refused naming the full queue, a cancel ends the queued one CANCELED."""
+    from cbrs.rosbridge import GoalStatus
+    from cbrs.server import ServeConfig, Server
+    from tests.test_rosbridge import Client
+
+    monkeypatch.setenv("CBRS_RUN_QUEUE", "1")
+    server = Server(fresh_bundled_kb, ServeConfig(port=0, bridge_port=0, endpoint=EndpointConfig(update_token="t")))
+    server.start()
+    me = Client(f"ws://127.0.0.1:{server.bridge_port}")
+
+    def goal(goal_id: str) -> None:
+        args = {"task": "FetchMyPen"}
+        me.send(
+            op="send_action_goal",
+            id=goal_id,
+            action="/cbrs/run_task",
+            action_type="cbrs/action/RunTask",
+            args=args,
+            feedback=True,
+        )
+
+    def until(op: str, goal_id: str) -> dict[str, Any]:
+        for _ in range(20):  # bounded: status messages and other goals' feedback come between
+            message = me.recv(WAIT)
+            if message["op"] == op and message.get("id") == goal_id:
+                return message
+        raise AssertionError(f"no {op} for {goal_id}")
+
+    try:
+        me.send(op="auth", mac="t")
+        goal("first")
+        deadline = time.monotonic() + WAIT
+        while server.tasks.active() is None:
+            assert time.monotonic() < deadline
+            time.sleep(0.01)
+        goal("second")
+        queued = until("action_feedback", "second")["values"]
+        assert queued["status"] == "queued" and queued["reason"] == "queued behind the run going: next in line"
+        status = me.call("/cbrs/task_status", {"run": queued["run"]})["values"]
+        assert status["status"] == "queued" and status["position"] == 1
+        goal("third")
+        full = until("action_result", "third")
+        assert full["result"] is False and "queue is full" in str(full["values"])
+        me.send(op="cancel_action_goal", id="second", action="/cbrs/run_task")
+        ended = until("action_result", "second")
+        assert ended["status"] == GoalStatus.CANCELED
+        assert ended["values"]["status"] == "cancelled" and "queue" in ended["values"]["reason"]
+        gates.open_all()
+        first = until("action_result", "first")
+        assert first["values"]["status"] == "no-plan"
+    finally:
+        gates.open_all()
+        me.close()
+        server.stop(timeout=WAIT)
