@@ -40,6 +40,7 @@ def _help(name: str) -> str:
 @click.option(
     "--log-level", type=click.Choice(LOG_LEVELS, case_sensitive=False), help=_help("log_level") + " [default INFO]"
 )
+@click.option("--run-queue", type=click.IntRange(0), metavar="N", help=_help("run_queue") + " [default 0]")
 @click.option(
     "--match-param",
     "match_params",
@@ -59,6 +60,7 @@ def serve(
     server_names: tuple[str, ...],
     log_level: str | None,
     match_params: tuple[str, ...],
+    run_queue: int | None,
 ) -> None:
     """Serve the knowledge base: SPARQL 1.1 at /sparql on the HTTP port, rosbridge v2 on the bridge port.
 
@@ -88,6 +90,7 @@ def serve(
         cors_origins=setting("cors_origins").resolve(_option("cors_origins", cors_origins, "--cors-origin")),
         server_names=setting("server_names").resolve(_option("server_names", server_names, "--server-name")),
         match_params=setting("match_params").resolve(_option("match_params", match_params, "--match-param")),
+        run_queue=setting("run_queue").resolve(run_queue),
     )
     if config.endpoint.update_token:
         _redact_in_log(config.endpoint.update_token)

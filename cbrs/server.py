@@ -66,6 +66,7 @@ class ServeConfig:
         default_factory=lambda: setting("bridge_connections_per_client").resolve()
     )
     action_workers: int = field(default_factory=lambda: setting("action_workers").resolve())
+    run_queue: int = field(default_factory=lambda: setting("run_queue").resolve())  # runs that may wait their turn
     bridge_non_finite: str = field(default_factory=lambda: setting("bridge_non_finite").resolve())
     bridge_max_message_bytes: int = field(default_factory=lambda: setting("bridge_max_message_bytes").resolve())
     component_lease: float = field(default_factory=lambda: setting("component_lease").resolve())
@@ -80,7 +81,7 @@ class Server:
         self.config = config or ServeConfig()
         self.lock = threading.RLock()
         self.sparql = SparqlService(kb, self.config.endpoint, self.lock)
-        self.tasks = TaskRunner(kb, self.lock, read_only=self.config.endpoint.read_only)
+        self.tasks = TaskRunner(kb, self.lock, read_only=self.config.endpoint.read_only, queue=self.config.run_queue)
         endpoint = self.config.endpoint
         token = None if endpoint.read_only else endpoint.update_token
         self.bridge = Bridge(

@@ -25,6 +25,7 @@ from cbrs.settings import setting
 from cbrs.sparql_service import EndpointConfig, SparqlService
 from cbrs.tasks import RunQueueFullError, TaskBusyError, TaskRunner
 from cbrs.web import create_app
+from tests.test_rosapi_typedefs import cbrs_types, mismatches
 
 WAIT = 10.0
 
@@ -145,6 +146,14 @@ def test_a_queued_run_stopped_leaves_the_queue_and_those_behind_move_up(
         assert second.reason is not None and "queue" in second.reason and second.finished is not None
         assert second.to_dict()["reason"] == second.reason and "position" not in second.to_dict()
         assert third.position == 1 and [r.id for r in runner.waiting()] == [third.id]
+        # the bridge's types describe a queued run and a stopped one (cbrs/interfaces): a client that
+        # checks an answer against them took position and reason for unknown fields
+        types = cbrs_types()
+        for run in (second, third):
+            assert mismatches(types.response("cbrs/TaskStatus"), run.to_dict()) == []
+            assert mismatches(types.response("cbrs/RunTask"), run.to_dict(with_events=False)) == []
+        feedback = {"run": third.id, "iri": third.iri, "status": "queued", "reason": "queued behind the run going"}
+        assert mismatches(types.message("cbrs/RunTaskFeedback"), feedback) == []
         assert first.status == "running" and not first.cancel_requested.is_set()
         gates.open_all()
         assert _ended(runner, first.id) and _ended(runner, third.id)
@@ -368,3 +377,38 @@ def test_over_the_bridge_a_goal_waits_in_the_queue_and_its_cancel_takes_it_out(
         gates.open_all()
         me.close()
         server.stop(timeout=WAIT)
+
+
+def test_cbrs_serve_takes_the_queue_as_an_option_and_its_runner_holds_it(monkeypatch: pytest.MonkeyPatch) -> None:
+    """``cbrs serve --run-queue N`` (the environment variable was the only way), and the server's runner
+    queues as many as its configuration says; a negative count is a usage error."""
+    from click.testing import CliRunner
+
+    import cbrs.server
+    from cbrs.cli import cli
+
+    seen: list[int] = []
+
+    class Stopped(Exception):
+        pass
+
+    def built(kb: KnowledgeBase, config: Any) -> Any:
+        seen.append(config.run_queue)
+        raise Stopped
+
+    monkeypatch.setattr(cbrs.server, "Server", built)
+    monkeypatch.delenv("CBRS_RUN_QUEUE", raising=False)
+    serve = ["--store", ":memory:", "serve", "--port", "0", "--bridge-port", "0"]
+    for options, expected in (([], 0), (["--run-queue", "12"], 12)):
+        result = CliRunner().invoke(cli, [*serve, *options])
+        assert isinstance(result.exception, Stopped), result.output
+        assert seen[-1] == expected
+    refused = CliRunner().invoke(cli, [*serve, "--run-queue", "-1"])
+    assert refused.exit_code == 2 and "--run-queue" in refused.output
+    monkeypatch.undo()
+    config = cbrs.server.ServeConfig(port=0, bridge_port=0, run_queue=5)
+    server = cbrs.server.Server(KnowledgeBase.open(":memory:"), config)
+    try:
+        assert server.tasks.queue_size == 5
+    finally:
+        server.stop(WAIT)
