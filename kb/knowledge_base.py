@@ -19,6 +19,7 @@ from cbrs.kb.catalog import Catalogue
 from cbrs.kb.descriptions import DescriptionReader
 from cbrs.kb.engine_faults import sorts
 from cbrs.kb.errors import QuerySyntaxError, ReplaceError, StoreError, UndeclaredSuperclassError
+from cbrs.kb.graph_slips import refuse_slips
 from cbrs.kb.liveness import Liveness
 from cbrs.kb.loader import (
     LoadReport,
@@ -521,6 +522,7 @@ class KnowledgeBase:
         if not isinstance(self.store, EmbeddedStore):
             return self._update_remote(text, check_map)
         if data is not None:  # a class put under a home: term nobody declares (or left so), as a load refuses it
+            refuse_slips(quad.graph_name for quad in data.named)  # graph#map for graph/map: kb/graph_slips.py
             check_data_update(self.store, data.operations)
         pending = self.standard_terms.prepare(data) if run is None else None
         checking: AbstractContextManager[None] = nullcontext()

@@ -234,6 +234,27 @@ def support_of(smap: SemanticMap, place: Thing) -> tuple[Region, Thing]:
     return surface, support
 
 
+def resting_surface(smap: SemanticMap, place: Thing) -> tuple[Thing | None, float]:
+    """What a thing set down in a region comes to rest on, and at what height: the highest top of the map's
+    furniture under the region's centre that is not above the region's top (a carry lowers a thing from
+    above until it rests), else the floor (None, 0 m). A region's ``home:minZ`` is where things in it rest
+    (:func:`relations.region_of`), so it must be that height: nothing of a region is built to rest on."""
+    box = place.box
+    cx, cy = (box.min_x + box.max_x) / 2, (box.min_y + box.max_y) / 2
+    under = [
+        smap.things[iri]
+        for iri in sorted(smap.furniture)
+        if iri in smap.things
+        and iri != place.iri
+        and smap.things[iri].box.contains_xy(cx, cy)
+        and smap.things[iri].box.max_z <= box.max_z + 1e-9
+    ]
+    if not under:
+        return None, 0.0
+    top = max(under, key=lambda thing: thing.box.max_z)
+    return top, top.box.max_z
+
+
 def spot_region(surface: Region, x: float, y: float) -> Region:
     """Where around a spot of a place's surface an object is carried to and set down (its centre over
     the spot, give or take a relay spot's tolerance): the place itself decides the step's effects."""

@@ -12,7 +12,7 @@ from __future__ import annotations
 import logging
 import math
 from collections.abc import Callable, Collection, Iterable, Iterator, Mapping, Sequence
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from typing import Any
 
 from cbrs.actions.base_choice import base_groups
@@ -27,6 +27,7 @@ from cbrs.kb.person_choice import person_for
 from cbrs.kb.semantic_map import MapObject, NotGraspableError, Person, Thing, local_name
 from cbrs.kb.store import Term
 from cbrs.kb.turned_fit import fits_some_turn
+from cbrs.sim import predicates as pred
 from cbrs.sim import sight, skills
 from cbrs.sim.arm_choice import TAKING, check_take, lying_estimate, who_loads
 from cbrs.sim.context import SimContext, SkillFailed
@@ -45,6 +46,7 @@ from cbrs.sim.place_spots import (
     held_now,
     other_objects,
     place_spots,
+    resting_surface,
     spot_inset,
     support_of,
 )
@@ -233,15 +235,71 @@ class PlaceCrowdedError(KnowledgeBaseError):
 
     http_status = 422
 
-    def __init__(self, place: str, what: str, blockers: list[tuple[str, float, float]], clearance: float) -> None:
+    def __init__(
+        self,
+        place: str,
+        what: str,
+        blockers: list[tuple[str, float, float]],
+        clearance: float,
+        later: Collection[str] = (),
+    ) -> None:
         self.place = place
         self.blockers = tuple(blockers)
         each = ", ".join(f"the {local_name(iri)} at ({x:.2f}, {y:.2f})" for iri, x, y in self.blockers)
-        super().__init__(
+        text = (
             f"no spot of the {local_name(place)} holds {what} {clearance:.2f} m clear of the other objects, though"
             f" its arms reach it: {each} {'leaves' if len(self.blockers) == 1 else 'leave'} no room; move"
             f" {'it' if len(self.blockers) == 1 else 'them'} in the map (home:x, home:y) or make the place larger"
         )
+        moving = [local_name(iri) for iri, _, _ in self.blockers if iri in later]
+        if moving:
+            text += (
+                f"; the task moves the {' and the '.join(moving)} too, but only after: where two things are to "
+                "take each other's places, one must first go to a third place (a task of its own, or a sub-action "
+                "ordered before, act:PartialOrderingStrict)"
+            )
+        super().__init__(text)
+
+
+FLOOR_MISMATCH = pred.RESTING_TOLERANCE / 2
+"""How far a region's bottom may be from what a thing set down in it rests on (m): half the tolerance the
+put-down's own test allows a thing's bottom (``predicates.RESTING_TOLERANCE``), the other half left to the
+physics (a thing settles a few millimetres into a top, or a hair above it). A drawer's floor 1 cm above the
+table (the twenty-second round) was at the tolerance's edge and failed after the put-down."""
+
+
+class PlaceFloatsError(KnowledgeBaseError):
+    """A region an arm step is given to set a thing down in has its bottom (``home:minZ``, where things in
+    it rest) above or below what a thing set down there comes to rest on (:func:`place_spots.resting_surface`:
+    a piece of furniture's top, or the floor): the thing would rest where the region is not, and the run
+    would fail after the put-down ("did not come to rest in"). Refused before anything moves."""
+
+    http_status = 422
+
+    def __init__(self, place: str, bottom: float, support: str | None, top: float, tolerance: float) -> None:
+        self.place = place
+        self.bottom = bottom
+        self.support = support
+        self.top = top
+        on = f"the top of the {local_name(support)}" if support else "the floor"
+        gap = (bottom - top) * 100
+        super().__init__(
+            f"the {local_name(place)}'s bottom (home:minZ {bottom:g} m), where a thing set down in it must rest, is "
+            f"{abs(gap):.1f} cm {'above' if gap > 0 else 'below'} {on} ({top:g} m), which is what a thing set "
+            f"down there rests on: nothing of a region is built (a box's or a drawer's floor is not), and a "
+            f"region's bottom must be within {tolerance * 100:g} cm of it; give the region home:minZ "
+            f"{top:g}, or describe the box as furniture with its own extent (its home:maxZ the height things "
+            f"rest at)"
+        )
+
+
+@dataclass(frozen=True)
+class Moved:
+    """The objects (IRIs) a plan's steps take in hand before (``before``) and after (``after``) the step
+    whose place is checked (:meth:`PlanChecks._check_spot`)."""
+
+    before: tuple[str, ...]
+    after: tuple[str, ...]
 
 
 class PlaceMovesError(KnowledgeBaseError):
@@ -583,6 +641,7 @@ class PlanChecks:
         steps = {step.index: step for step in plan.steps}
         at_hand: dict[str, list[str]] = {}  # by robot: the objects its latest arm step given one works on
         free: dict[int, AtCarry] | None = None  # the arms free at each carry onto a place, asked once when needed
+        taken = self._taken(plan, values, steps)
         for step in plan.steps:
             robot_arms = arms.get(step.device or "")
             # a robot of the map with no arm (its arms taken off) that a step would have take a thing in hand
@@ -617,7 +676,25 @@ class PlanChecks:
                         found = other_objects(self.world, self.belief)
                         lying = {obj.iri: at for obj, at in zip(self.world.objects.values(), found, strict=True)}
                         free = arms_free(plan, smap, values, lying, held_now(self.world))
-                    self._check_spot(step, iri, at_hand.get(step.device or "", []), report, free.get(step.index))
+                    moved = Moved(
+                        tuple(obj for index, obj in taken if index < step.index),
+                        tuple(obj for index, obj in taken if index > step.index),
+                    )
+                    carried = at_hand.get(step.device or "", [])
+                    self._check_spot(step, iri, carried, report, free.get(step.index), moved)
+
+    def _taken(self, plan: Plan, values: Mapping[str, Any], steps: Mapping[int, PlanStep]) -> list[tuple[int, str]]:
+        """The objects of the map the plan's steps take in hand (an approach to an object, a hand-over onto
+        the platform), as (step index, object IRI): a thing an earlier step takes no longer stands where it
+        stood when a later step sets another down (:class:`Moved`)."""
+        found = []
+        for step in plan.steps:
+            if step.action not in TAKING:
+                continue
+            given = [values.get(name) for name in sorted(task_inputs_of(step, steps))]
+            iris = [str(value["@id"]) for value in given if isinstance(value, dict) and "@id" in value]
+            found += [(step.index, iri) for iri in iris if iri in self.world.map.objects]
+        return found
 
     def _check_place_stands(self, step: PlanStep, values: Mapping[str, Any]) -> None:
         """Refuse a step given, as a place (an input of a class at or below ``home:Place``: a carry's
@@ -693,6 +770,7 @@ class PlanChecks:
         carried: list[str],
         report: list[tuple[str, float, float, float, float]],
         at_carry: AtCarry | None = None,
+        moved: Moved | None = None,
     ) -> None:
         """Refuse a place an arm step is given, part of which the robot's arms reach, when no spot of it
         will do (:func:`place_spots`, by the map) for the object at hand: the one the step is given,
@@ -703,8 +781,16 @@ class PlanChecks:
         carry that sets a thing down there (``at_carry``, :func:`packing.arms_free`) only the arms free then
         count, as the check of the room on a place counts them (docs/execution.md, "Room on a top: which
         arms count"): a spot only an arm holding something else reaches will not do. Before, every arm of
-        the robot counted."""
+        the robot counted. A thing an earlier step of the plan takes (``moved.before``) is not counted where
+        it stood (the cup a task moves out of the way before the pen goes where it was); where it will be
+        set down is the carry's choice at the run, by what it sees then."""
         smap = self.world.map
+        if iri in smap.regions and iri not in smap.furniture:
+            under, level = resting_surface(smap, smap.things[iri])
+            bottom = smap.things[iri].box.min_z
+            if abs(bottom - level) > FLOOR_MISMATCH:
+                raise PlaceFloatsError(iri, bottom, under.iri if under else None, level, FLOOR_MISMATCH)
+        moved = moved or Moved((), ())
         objects = [smap.objects[other] for other in carried]
         size = max(
             (obj.size for obj in objects), key=lambda size: math.hypot(size[0], size[1]), default=(0.0, 0.0, 0.0)
@@ -712,7 +798,8 @@ class PlanChecks:
         names = [obj.name for obj in objects]
         name = names[0] if len(names) == 1 else ""
         mounts = [(x, y, reach) for _, x, y, reach, _ in report]
-        others = other_objects(self.world, self.belief, *names)
+        gone = [smap.objects[iri].name for iri in moved.before if iri not in carried]
+        others = other_objects(self.world, self.belief, *names, *gone)
         able = None  # every arm of the robot, but at a carry those free then
         if at_carry is not None and at_carry.busy:
             free = {arm.iri for arm in at_carry.free}
@@ -738,9 +825,9 @@ class PlanChecks:
             top = (support.box.max_x - support.box.min_x, support.box.max_y - support.box.min_y)
             if math.hypot(size[0], size[1]) + 2 * RELAY_EDGE > min(top) + 1e-9:
                 raise PlaceTooSmallError(iri, what, size, top, support.iri)
-            blockers = self._blockers(iri, size, mounts, names, others)
+            blockers = self._blockers(iri, size, mounts, [*names, *gone], others)
             if blockers:
-                raise PlaceCrowdedError(iri, what, blockers, RELAY_CLEARANCE)
+                raise PlaceCrowdedError(iri, what, blockers, RELAY_CLEARANCE, moved.after)
             why = (
                 f"no spot of it is {RELAY_MARGIN:.2f} m inside an arm's reach with {what}'s centre "
                 f"{spot_inset() * 1000:.0f} mm inside the place and clear of the edge of the surface, the other "

@@ -51,7 +51,7 @@ def test_pages_share_one_read_until_the_store_is_written(kb: KnowledgeBase, read
 
     kb.update(
         f"PREFIX owl: <http://www.w3.org/2002/07/owl#> PREFIX rdfs: <http://www.w3.org/2000/01/rdf-schema#>\n"
-        f"INSERT DATA {{ GRAPH <https://w3id.org/cbrs/graph#ontology> {{\n"
+        f"INSERT DATA {{ GRAPH <https://w3id.org/cbrs/graph/ontology> {{\n"
         f"  <{LAB}Gadget> a owl:Class ; rdfs:subClassOf <https://w3id.org/cbrs/home#Device> }} }}"
     )
     found = client.get("/taxonomy.json", query_string={"q": "gadget"}).get_json()
