@@ -128,7 +128,13 @@ def test_the_pages_colours_read_on_a_projector() -> None:
     css = (Path(cbrs.web.__file__).parent / "static" / "cbrs.css").read_text(encoding="utf-8")
     root = dict(re.findall(r"--(\w+):\s*(#[0-9a-fA-F]{6});", css.split("}", 1)[0]))
     pairs = [(root[text], root[ground]) for text in ("ink", "muted", "accent") for ground in ("paper", "wash")]
-    for rule, text in ((".badge.good", "good"), (".badge.bad", "bad"), (".badge.warn", "warn"), (".error-box", "bad"), (".status-queued", "accent")):
+    for rule, text in (
+        (".badge.good", "good"),
+        (".badge.bad", "bad"),
+        (".badge.warn", "warn"),
+        (".error-box", "bad"),
+        (".status-queued", "accent"),
+    ):
         ground = re.search(re.escape(rule) + r"[^{]*\{[^}]*background: (#[0-9a-fA-F]{6})", css)
         assert ground is not None, rule
         pairs.append((root[text], ground.group(1)))
