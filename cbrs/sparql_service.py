@@ -602,13 +602,15 @@ class SparqlService:
 
     def _refuse_malformed(self, text: str) -> None:
         """Raise ``text``'s syntax error if it has one. A busy endpoint answered a text that does not parse
-        "busy", so a class whose other students held every worker was told to retry a typo; parsing
-        (never evaluating: the solutions are lazy) on an empty store costs only the refused request, and a
-        long text is parsed by the query guard's checker process, as any long text is."""
+        "busy", so a class whose other students held every worker was told to retry a typo; parsing on an
+        empty store costs only the refused request, and a long text is parsed by the query guard's checker
+        process, as any long text is. The store's checks come first (:meth:`EmbeddedStore.check_query`): the
+        parser's own store evaluates a ``SERVICE`` as it parses (Oxigraph sends the remote query at once, even
+        for a SELECT), and a busy endpoint must not reach out where an idle one refuses to."""
         store = self.kb.store
         if not isinstance(store, EmbeddedStore):
             return  # a remote store parses and answers its own errors
-        store.guard.admit("query", text)
+        store.check_query(text)  # deep nesting, SERVICE outside federation_allow, the guard's checker
         if len(text) > store.guard.direct_chars:
             return
         try:

@@ -3,7 +3,9 @@ others' queries hold every worker or a query runs out of time, and the camera's 
 
 from __future__ import annotations
 
+import contextlib
 import re
+import socket
 import threading
 from pathlib import Path
 from typing import Any
@@ -15,6 +17,7 @@ import cbrs.web
 from cbrs import home_canvas
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import QuerySyntaxError
+from cbrs.kb.remote_access import RemoteAccessError
 from cbrs.sparql_service import EndpointBusyError, EndpointConfig, QueryTimeoutError, SparqlService
 from cbrs.tasks import CameraFrame, TaskRunner
 from cbrs.web import create_app, diagram
@@ -69,6 +72,40 @@ def test_a_typo_sent_while_every_worker_is_taken_gets_its_syntax_error(
         for release in held:
             release()
     assert page.status_code == 400 and "busy" not in page.get_data(as_text=True)
+
+
+def test_a_service_sent_while_every_worker_is_taken_reaches_nothing(service: SparqlService) -> None:
+    """The busy path parses a text on an empty store of its own to find a typo, and Oxigraph sends a
+    ``SERVICE``'s query as it parses (a SELECT's too): that path reached a loopback port the endpoint refuses
+    to reach when idle (federation_allow is empty). It is refused as an idle endpoint refuses it."""
+    listener = socket.socket()
+    listener.bind(("127.0.0.1", 0))
+    listener.listen(4)
+    listener.settimeout(0.05)
+    reached: list[bytes] = []
+    stop = threading.Event()
+
+    def accept() -> None:  # a connection is noted and closed at once: the query never waits on it
+        while not stop.is_set():
+            with contextlib.suppress(TimeoutError):
+                connection, _ = listener.accept()
+                with connection:
+                    reached.append(connection.recv(64))
+
+    thread = threading.Thread(target=accept, daemon=True)
+    thread.start()
+    port = listener.getsockname()[1]
+    held = [service._admit(f"10.0.0.{n}") for n in range(4)]
+    try:
+        with pytest.raises(RemoteAccessError):
+            service.query(f"SELECT * WHERE {{ SERVICE <http://127.0.0.1:{port}/sparql> {{ ?s ?p ?o }} }}")
+    finally:
+        for release in held:
+            release()
+        stop.set()
+        thread.join(5)
+        listener.close()
+    assert reached == []
 
 
 def test_a_query_out_of_time_says_how_to_narrow_it(client: FlaskClient, monkeypatch: pytest.MonkeyPatch) -> None:
