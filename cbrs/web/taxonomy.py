@@ -35,7 +35,6 @@ MAX_PATHS = 12  # ancestor paths shown per search match
 # class tree has 18,687 nodes, a page of 9 MB that took 2.5 s to serve and longer to lay out.
 MAX_TREE_NODES = 2000
 MAX_PICTURE_ROW = 10  # subclasses (and parts) drawn in a class's picture; the rest is one "N more" box
-MAX_HIERARCHY_DEPTH = 4  # levels of sub-actions drawn below an action, as many as the composer decomposes
 MAX_MATCHES = 200  # search matches listed with their paths; the count says how many there are
 MAX_MEMBERS = 100  # individuals listed on a class's page; the count says how many there are
 # How a service description reaches a concept, walking incoming triples back to the description.
@@ -355,9 +354,11 @@ def _picture(found: Taxonomy, iri: str, parts: list[dict[str, Any]]) -> Markup:
 
 def _sub_actions(iri: str) -> list[dict[str, Any]] | None:
     """An action class's sub-actions as the composer decomposes it (each its own, in their order, down to
-    ``MAX_HIERARCHY_DEPTH`` levels): ``[{iri, name, order, sub_actions}]``; None for a class that is no action
-    with sub-actions. A robotics class looked at FetchMyPen's four sub-actions as four lines of Manchester
-    syntax among its restrictions: no picture drew the hierarchy a task is planned by."""
+    the composer's ``MAX_DEPTH`` levels, as deep as it decomposes a task): ``[{iri, name, order,
+    sub_actions}]``; None for a class that is no action with sub-actions. A robotics class looked at
+    FetchMyPen's four sub-actions as four lines of Manchester syntax among its restrictions: no picture drew
+    the hierarchy a task is planned by."""
+    from cbrs.actions.composer import MAX_DEPTH
     from cbrs.actions.model import ActionLibrary  # the planner's model; networkx loads with it
 
     library = context.per_generation("action_library", lambda: ActionLibrary.from_kb(context.kb()))
@@ -365,7 +366,7 @@ def _sub_actions(iri: str) -> list[dict[str, Any]] | None:
         return None
 
     def below(action: str, depth: int, seen: tuple[str, ...]) -> list[dict[str, Any]]:
-        if depth >= MAX_HIERARCHY_DEPTH or action not in library:
+        if depth >= MAX_DEPTH or action not in library:
             return []
         return [
             {
