@@ -165,7 +165,7 @@ class PreconditionSensing:
         thing = self._thing(statement)
         if thing is None:
             return None
-        quantities = self.stated_quantities()
+        quantities = self._quantities()
         holds = quantities.colours.decide(thing, statement.object, quantities.is_a)
         if holds is None:
             return None
@@ -178,7 +178,9 @@ class PreconditionSensing:
             holds, how, bound, PREFIXES["home"] + "colourName", of, "the map", stated=True, rule="home:windowColour"
         )
 
-    def stated_quantities(self) -> StatedQuantities:
+    def _quantities(self) -> StatedQuantities:
+        """What the store states of its things (levels and colour names), read once, when a precondition
+        first needs it: most runs have none that the map decides."""
         if self._stated_quantities is None:
             self._stated_quantities = StatedQuantities.read(self.kb)
         return self._stated_quantities
@@ -208,7 +210,7 @@ class PreconditionSensing:
         thing = self._thing(statement)
         if thing is None:
             return None
-        found = self.stated_quantities().decide(thing, statement.object)
+        found = self._quantities().decide(thing, statement.object)
         if found is None:
             return None
         of = f"{found.reading} of {shorten(thing)}"
