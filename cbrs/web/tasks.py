@@ -59,6 +59,7 @@ QUEUE_SIZE = 1000  # events a slow client may fall behind by before its stream e
 BOUNDARY = "frame"
 STEP_EVENTS = ("step_started", "step_succeeded", "step_failed")
 MAX_STARTERS = 256  # runs whose starting address is kept, for who may stop them (the runner keeps fewer runs)
+_STARTERS_LOCK = threading.Lock()  # held while the table of who started which run is written
 
 
 @blueprint.record_once
@@ -161,9 +162,13 @@ def _starters(started: str | None = None) -> dict[str, str | None]:
     ``started``, this request's address is recorded for that run."""
     found: dict[str, str | None] = current_app.extensions.setdefault("cbrs.run_starters", {})
     if started is not None:
-        found[started] = request.remote_addr
-        while len(found) > MAX_STARTERS:
-            del found[next(iter(found))]
+        # two Starts at once, the table full: unlocked, one trimming the oldest while the other added could
+        # fail (the dict changed size during iteration) or both delete the same key (KeyError), a 500 for a
+        # run that had started
+        with _STARTERS_LOCK:
+            found[started] = request.remote_addr
+            while len(found) > MAX_STARTERS:
+                del found[next(iter(found))]
     return found
 
 
