@@ -6,16 +6,15 @@ graph:mapp", ``cbrs check``, ``cbrs load`` and ``cbrs restore`` listed every nam
 from __future__ import annotations
 
 import os
-import stat
 from pathlib import Path
 
-import owlready2
 import pytest
 from click.testing import CliRunner
 
 from cbrs.cli import cli
 from cbrs.graph_names import graph_hint
 from cbrs.kb.namespaces import GraphName
+from tests.test_owl_numbers import _gone, stalling_java  # noqa: F401  (a fixture: pytest finds it by its name)
 
 OWN = [graph.iri for graph in GraphName]
 LAB = "https://example.org/lab/graphs/kitchen"
@@ -75,27 +74,7 @@ def test_restore_offers_the_files_graphs(tmp_path: Path) -> None:
     assert not (tmp_path / "new").exists()  # refused before a store was made
 
 
-@pytest.fixture
-def stalling_java(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
-    """A "java" that writes its PID and then sleeps, as a HermiT that never finishes would."""
-    script = tmp_path / "java"
-    script.write_text('#!/bin/sh\necho $$ > "$(dirname "$0")/pid"\nexec sleep 60\n', encoding="utf-8")
-    script.chmod(script.stat().st_mode | stat.S_IXUSR)
-    monkeypatch.setattr(owlready2, "JAVA_EXE", str(script))
-    return tmp_path / "pid"
-
-
-def _gone(pid_file: Path) -> bool:
-    if not pid_file.exists():  # killed before it wrote its PID
-        return True
-    try:
-        os.kill(int(pid_file.read_text()), 0)
-    except ProcessLookupError:
-        return True
-    return False
-
-
-def test_check_takes_its_time_limit_from_timeout_over_the_setting(stalling_java: Path) -> None:
+def test_check_takes_its_time_limit_from_timeout_over_the_setting(stalling_java: Path) -> None:  # noqa: F811
     code, err = _cli("check", "--graph", "ontology", "--timeout", "0.5", env={"CBRS_CHECK_TIMEOUT": "300"})
     assert code == 1, err
     assert "HermiT did not finish over graph:ontology" in err and "within 0.5 s, and was stopped" in err
