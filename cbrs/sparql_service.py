@@ -51,7 +51,7 @@ from cbrs.kb.errors import (
     StoreEvaluationError,
 )
 from cbrs.kb.namespaces import PREFIXES
-from cbrs.kb.query_guard import start_evaluation_thread
+from cbrs.kb.query_guard import GuardBusyError, start_evaluation_thread
 from cbrs.kb.served_updates import HEADER, header_value
 from cbrs.kb.sparql_hints import FORMS, TOKENS, explain_syntax_error, first_keyword
 from cbrs.kb.store import EmbeddedStore, QueryResult, is_remote, refuse_inserted_blank_nodes
@@ -602,21 +602,22 @@ class SparqlService:
 
     def _refuse_malformed(self, text: str) -> None:
         """Raise ``text``'s syntax error if it has one. A busy endpoint answered a text that does not parse
-        "busy", so a class whose other students held every worker was told to retry a typo; parsing on an
-        empty store costs only the refused request, and a long text is parsed by the query guard's checker
-        process, as any long text is. The store's checks come first (:meth:`EmbeddedStore.check_query`): the
-        parser's own store evaluates a ``SERVICE`` as it parses (Oxigraph sends the remote query at once, even
-        for a SELECT), and a busy endpoint must not reach out where an idle one refuses to."""
+        "busy", so a class whose other students held every worker was told to retry a typo. The store's
+        checks come first (:meth:`EmbeddedStore.check_query`: nesting, a ``SERVICE`` outside
+        ``federation_allow``), then the text is parsed in the query guard's checker process, never here:
+        Oxigraph evaluates an ASK, an aggregate or a ``SERVICE`` as it parses, so a parse on an empty store
+        of the request's own reached out and ran a cross product of ``VALUES`` with no worker and no
+        deadline. No checker free at once, or none done in its time: answered busy, as before."""
         store = self.kb.store
         if not isinstance(store, EmbeddedStore):
             return  # a remote store parses and answers its own errors
-        store.check_query(text)  # deep nesting, SERVICE outside federation_allow, the guard's checker
+        store.check_query(text)  # a long text is parsed by the checker here already
         if len(text) > store.guard.direct_chars:
             return
         try:
-            ox.Store().query(text, prefixes=PREFIXES, use_default_graph_as_union=True)
-        except SyntaxError as error:
-            raise QuerySyntaxError(text, str(error)) from error
+            store.guard.check("query", text, wait=0.0)
+        except (GuardBusyError, QueryTooComplexError):
+            return
 
     def _admit(self, client: str | None, slot: bool = True) -> Callable[[], None]:
         """Count a query of ``client`` against its share and, with ``slot``, take one of the ``workers``

@@ -100,6 +100,14 @@ class QueryGuard:
         self._check(kind, text)
         self._admitted.add(key, self.remember)
 
+    def check(self, kind: Kind, text: str, wait: float | None = None) -> None:
+        """Parse ``text`` (and evaluate it on an empty store) in a checker process whatever its length, for a
+        caller that must not evaluate it in this process: Oxigraph evaluates an ASK, an aggregate or a
+        ``SERVICE`` as it parses, and an empty store of the caller's own gave no deadline (the endpoint's
+        busy path). ``wait``: seconds to wait for a free checker (default: the check's timeout), else
+        :class:`GuardBusyError`; otherwise as :meth:`admit` refuses."""
+        self._check(kind, text, wait)
+
     def close(self) -> None:
         """Stop the idle checker processes (busy ones stop when their check ends)."""
         with self._lock:
@@ -107,9 +115,10 @@ class QueryGuard:
         for checker in idle:
             checker.stop()
 
-    def _check(self, kind: Kind, text: str) -> None:
-        if not self._slots.acquire(timeout=self.timeout):
-            raise GuardBusyError(self.checkers, self.timeout)
+    def _check(self, kind: Kind, text: str, wait: float | None = None) -> None:
+        waited = self.timeout if wait is None else wait
+        if not self._slots.acquire(timeout=waited):
+            raise GuardBusyError(self.checkers, waited)
         checker: _Checker | None = None
         try:
             with self._lock:

@@ -17,6 +17,7 @@ import cbrs.web
 from cbrs import home_canvas
 from cbrs.kb import KnowledgeBase
 from cbrs.kb.errors import QuerySyntaxError
+from cbrs.kb.query_guard import QueryGuard
 from cbrs.kb.remote_access import RemoteAccessError
 from cbrs.sparql_service import EndpointBusyError, EndpointConfig, QueryTimeoutError, SparqlService
 from cbrs.tasks import CameraFrame, TaskRunner
@@ -106,6 +107,40 @@ def test_a_service_sent_while_every_worker_is_taken_reaches_nothing(service: Spa
         thread.join(5)
         listener.close()
     assert reached == []
+
+
+def test_a_cross_product_sent_while_every_worker_is_taken_runs_in_no_request(
+    service: SparqlService, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Oxigraph evaluates an ASK as it parses it: the busy path's parse on an empty store of its own ran this
+    cross product of ``VALUES`` (20^6 rows, minutes) on the request's thread, with no worker and no deadline,
+    for any anonymous client. The text is parsed in the query guard's checker process, stopped at its time
+    limit, and the query is answered busy."""
+    guard = QueryGuard(timeout=1.0)
+    monkeypatch.setattr(service.kb.store, "guard", guard)
+    values = " ".join(str(n) for n in range(20))
+    clauses = " ".join(f"VALUES ?v{k} {{ {values} }}" for k in range(6))
+    ask = f"ASK {{ {clauses} FILTER(?v0 + ?v1 + ?v2 + ?v3 + ?v4 + ?v5 < 0) }}"
+    assert len(ask) <= guard.direct_chars  # a short text: parsed in the request's own process before
+    answered: list[BaseException] = []
+
+    def send() -> None:
+        try:
+            service.query(ask, client="10.0.1.2")
+        except BaseException as error:  # what the client is told
+            answered.append(error)
+
+    held = [service._admit(f"10.0.0.{n}") for n in range(4)]
+    sending = threading.Thread(target=send, daemon=True)
+    try:
+        sending.start()
+        sending.join(60)  # a bound for a test that fails, not a timing: the checker stops it after 1 s
+    finally:
+        for release in held:
+            release()
+        guard.close()
+    assert not sending.is_alive(), "the cross product runs in the server's own process"
+    assert len(answered) == 1 and isinstance(answered[0], EndpointBusyError), answered
 
 
 def test_a_query_out_of_time_says_how_to_narrow_it(client: FlaskClient, monkeypatch: pytest.MonkeyPatch) -> None:
