@@ -47,7 +47,7 @@ def _port(text: str) -> int:
 def _positive(kind: Callable[[str], float]) -> Callable[[str], Any]:
     def parse(text: str) -> Any:
         value = _number(kind, text)
-        if value <= 0:
+        if not value > 0:  # NaN too: float("nan") compares false, and a deadline of NaN never comes
             raise ValueError(f"{text} must be positive")
         return value
 

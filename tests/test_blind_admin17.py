@@ -247,6 +247,14 @@ def test_a_setting_that_is_no_number_is_refused_in_words(name: str, raw: str, sa
     assert str(raised.value) == f"environment variable {item.env}={raw!r}: {raw!r} is not {said}"
 
 
+@pytest.mark.parametrize("name", ["query_timeout", "check_timeout", "component_lease"])
+def test_a_positive_setting_refuses_not_a_number(name: str) -> None:
+    # CBRS_CHECK_TIMEOUT=nan was taken: "nan" parses as a float, and NaN <= 0 is false
+    item = setting(name)
+    with pytest.raises(ValueError, match="nan must be positive"):
+        item.resolve(environ={item.env: "nan"})
+
+
 EXAMPLES = Path(__file__).resolve().parents[1] / "docs" / "examples"
 
 
