@@ -27,6 +27,7 @@ own ``JDK_JAVA_OPTIONS`` comes after them, so it wins where they disagree.
 
 from __future__ import annotations
 
+import math
 import os
 import re
 import shutil
@@ -202,6 +203,8 @@ def check(
     import owlready2
 
     limit = setting(SETTING).resolve() if timeout is None else timeout
+    if not limit > 0:  # NaN too, which cbrs check --timeout nan passed on
+        raise ValueError(f"HermiT's time limit is a positive number of seconds (inf: none), not {limit!r}")
     nodes = checked_graphs(kb, graphs)
     java = str(owlready2.JAVA_EXE)
     if shutil.which(java) is None:
@@ -288,7 +291,8 @@ def _hermit(java: str, path: Path, timeout: float) -> str | None:
     except OSError as error:
         raise ReasonerError(str(error)) from error
     try:
-        out, err = process.communicate(timeout=timeout)
+        # inf (--timeout inf): no limit; the subprocess module cannot wait an infinite time
+        out, err = process.communicate(timeout=timeout if math.isfinite(timeout) else None)
     except subprocess.TimeoutExpired:
         process.kill()  # this child, by its PID: the JVM starts no process of its own
         process.communicate()

@@ -10,6 +10,7 @@ Java (.ci/run installs it) and are skipped without it; the others run anywhere.
 
 from __future__ import annotations
 
+import math
 import os
 import shutil
 import stat
@@ -174,6 +175,22 @@ def test_a_reasoner_past_its_time_limit_is_killed_and_named(stalling_java: Path)
         "fewer graphs (--graph)"
     )
     assert _gone(stalling_java)
+
+
+def test_a_time_limit_of_inf_waits_without_one_and_nan_is_refused(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``cbrs check --timeout inf`` (click's FloatRange takes it) failed with "cannot convert float infinity
+    to integer" from the subprocess module, and nan likewise: inf is no limit, nan is refused naming it."""
+    script = tmp_path / "java"
+    script.write_text("#!/bin/sh\nexit 0\n", encoding="utf-8")  # a HermiT that finds nothing, at once
+    script.chmod(script.stat().st_mode | stat.S_IXUSR)
+    monkeypatch.setattr(owlready2, "JAVA_EXE", str(script))
+    kb = KnowledgeBase.open(":memory:", seed=False)
+    assert check(kb, timeout=math.inf).consistent
+    with pytest.raises(ValueError, match=r"a positive number of seconds .*, not nan"):
+        check(kb, timeout=math.nan)
+    kb.close()
 
 
 def test_cbrs_check_takes_its_time_limit_from_the_setting(stalling_java: Path) -> None:
