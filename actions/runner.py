@@ -8,9 +8,10 @@ simulation provides one (``sim.components``); tests provide stubs.
 from __future__ import annotations
 
 import collections.abc
+import contextlib
 import json
 import time
-from collections.abc import Callable, Collection, Iterable, Mapping, Sequence
+from collections.abc import Callable, Collection, Iterable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, replace
 from typing import Any, Protocol
 
@@ -958,7 +959,14 @@ def _check_goals(
     if plan is None:
         return ()
     audit = getattr(environment, "audit", None)
-    checks = []
+    at_the_end = getattr(environment, "at_the_end", None)  # optional: how the environment reads "a gripper" now
+    with at_the_end() if callable(at_the_end) else contextlib.nullcontext():
+        return tuple(_checked(environment, plan, outputs, audit))
+
+
+def _checked(
+    environment: Environment, plan: Plan, outputs: Mapping[int, Mapping[str, Any]], audit: Any
+) -> Iterator[GoalCheck]:
     for goal in plan.goals:
         if goal.statement is None:
             continue
@@ -969,8 +977,7 @@ def _check_goals(
         if goal.role == "deletion":  # the task wants it to stop being true
             believed, holds = (None if v is None else not v for v in (believed, holds))
         holds = holds if holds is None else bool(holds)
-        checks.append(GoalCheck(goal.statement, believed, holds, goal.role == "deletion"))
-    return tuple(checks)
+        yield GoalCheck(goal.statement, believed, holds, goal.role == "deletion")
 
 
 def _supplying(kb: KnowledgeBase, composition: CompositionResult) -> dict[str, Requirement]:

@@ -22,10 +22,11 @@ inputs first and encodes its outputs last.
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -292,9 +293,23 @@ class SimEnvironment:
         self._qualities: OwnQualities | None = None  # the rule, read from the store at its first question
         self._heard = Heard(kb)  # before the world graph is read: a correction made after the read is heard
         self.effects |= self._untestable_beliefs()
+        self._at_the_end = False  # the task's goals are being checked: "a gripper" is any arm (:meth:`at_the_end`)
 
     def clock(self) -> float:
         return self.world.time
+
+    @contextlib.contextmanager
+    def at_the_end(self) -> Iterator[None]:
+        """Within the block the task's goals are checked, after its last step: a statement about "a
+        gripper" (the class) holds of any arm. A step's own effect is decided for the arm at work (a
+        hand-over's take is the taking arm's), but at the end the arm at work is the last step's, so
+        EraserCupPen's cup, kept in the left hand while the right set the pen down, was judged not grasped
+        and the run failed (since 78b8ac1 checks that goal)."""
+        self._at_the_end = True
+        try:
+            yield
+        finally:
+            self._at_the_end = False
 
     def passed_over(self) -> dict[str, str]:
         """The remote components a plan leaves out now, with why (``actions.breaker``): their calls timed
@@ -636,7 +651,8 @@ class SimEnvironment:
             return None
         if look and isinstance(judge, PerceivedWorld):
             self._look_for(judge, test, subject, obj)
-        return judge.decide(test, subject, obj, self.context.arm, self.context.region)
+        arm = None if self._at_the_end else self.context.arm
+        return judge.decide(test, subject, obj, arm, self.context.region)
 
     def _look_for(self, belief: PerceivedWorld, test: str, subject: Grounded, obj: Grounded) -> None:
         """Perceive what a test is about: the object in a region or a container's water by the cameras,

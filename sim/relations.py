@@ -48,10 +48,11 @@ class Judge(ABC):
         self.world = world
 
     def decide(
-        self, test: str, subject: Grounded, obj: Grounded, arm: ArmSide, region: Region | None = None
+        self, test: str, subject: Grounded, obj: Grounded, arm: ArmSide | None, region: Region | None = None
     ) -> bool | None:
-        """``arm`` is the arm at work (for a statement about "the gripper"), ``region`` where the
-        carried object goes (for a statement about "the place")."""
+        """``arm`` is the arm at work (for a statement about "the gripper"; None: any arm, as the task's
+        goals are checked after the last step), ``region`` where the carried object goes (for a statement
+        about "the place")."""
         thing = self.object_name(subject)
         if test == "near":
             if subject.role == "gripper":
