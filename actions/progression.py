@@ -17,9 +17,8 @@ after part from the state the previous one left, each part's goals when that par
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from typing import Any
 
 from cbrs.actions.graph import Matcher, statement_text
 from cbrs.actions.plan import Plan
@@ -102,46 +101,15 @@ def consumed_goals(parts: Sequence[Plan], initial: Iterable[Statement], matcher:
     when its part ended (:func:`progress_parts`), not an end of the whole task for the run to check."""
     state: list[Statement] = list(dict.fromkeys(initial))
     for plan in parts:
-        narrow = _narrowing(plan, matcher)
         for step in plan.steps:
-            deletes = [narrow(step.index, d, False) for d in step.deletes]
-            state = [f for f in state if not any(threatens(matcher.index, d, f) for d in deletes)]
-            for effect in step.effects:
-                state += [e for e in narrow(step.index, effect, True) if e not in state]
+            state = [f for f in state if not any(threatens(matcher.index, d, f) for d in step.deletes)]
+            state += [e for e in step.effects if e not in state]
     last = len(parts) - 1
     return [
         n < last and g.role != "deletion" and g.statement is not None and not _holds(g.statement, state, matcher)
         for n, plan in enumerate(parts)
         for g in plan.goals
     ]
-
-
-def _narrowing(plan: Plan, matcher: Matcher) -> Callable[..., Any]:
-    """How :func:`consumed_goals` reads a part's statements about its thing: the components state them of
-    classes (the put-down's (PhysicalObject, isLocated, Place)), which met every goal of the kind, so a
-    sub-action's goal a later part undid (the cup on the free spot, then carried on to the pen's spot) was
-    met again by the later put-down and checked at the end, where it no longer held (the twenty-second round's
-    SwapByAThirdPlace). A part whose goals are about one subject (each input class designates one thing)
-    acts on it: a statement of a class above it is read of it, and an effect the part's goal is credited to
-    (the goal's step) as that goal. A part about several subjects, or none, is read as stated."""
-    subjects = {g.statement.subject for g in plan.goals if g.statement is not None and g.role != "deletion"}
-    subject = next(iter(subjects)) if len(subjects) == 1 else None
-    provided: dict[int, list[Statement]] = {}
-    for goal in plan.goals:
-        if goal.statement is not None and goal.source.step is not None and goal.role != "deletion":
-            provided.setdefault(goal.source.step, []).append(goal.statement)
-
-    def narrow(step: int, statement: Statement, effect: bool) -> Any:
-        if effect:
-            met = [g for g in provided.get(step, []) if matcher.statement(g, statement) is not None]
-            if met:
-                return met
-        about = statement
-        if subject is not None and subject != statement.subject and matcher.index.is_a(subject, statement.subject):
-            about = Statement(subject, statement.predicate, statement.object)
-        return [about] if effect else about
-
-    return narrow
 
 
 def _holds(needed: Statement, state: Sequence[Statement], matcher: Matcher) -> bool:
