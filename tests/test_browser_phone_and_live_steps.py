@@ -56,8 +56,8 @@ SCRIPT: list[dict[str, Any]] = [
 class _Scripted(TaskRunner):
     """A runner whose every run publishes SCRIPT, as a run's events are published, and succeeds; no camera."""
 
-    def __init__(self, kb: KnowledgeBase, lock: Any, read_only: bool = False) -> None:
-        super().__init__(kb, lock, camera=None, read_only=read_only)
+    def __init__(self, kb: KnowledgeBase, lock: Any, read_only: bool = False, queue: int | None = None) -> None:
+        super().__init__(kb, lock, camera=None, read_only=read_only, queue=queue)
 
     def _run(self, run: TaskRun) -> None:
         for event in SCRIPT:
